@@ -1,0 +1,42 @@
+"""The data each template receives: a plain, sorted dict per language, decided here so
+that templates only lay text out."""
+
+from .functions import Function, Generator
+from .printers import PythonPrinter
+from .robot import Robot
+
+
+def _common(robot: Robot) -> dict:
+    return {
+        "name": robot.name,
+        "description": robot.description,
+        "dof": robot.dof,
+        "task": list(robot.task),
+        "length_unit": robot.length_unit,
+        "joints": [{"name": j.name, "kind": j.kind} for j in robot.joints],
+        "parameters": [{"name": p.name, "value": repr(p.value)} for p in robot.symbolic_parameters],
+    }
+
+
+def _python_function(function: Function, printer: PythonPrinter) -> dict:
+    body = function.body
+    return {
+        "name": function.name,
+        "summary": function.summary,
+        "output": function.output,
+        "rows": function.rows,
+        "cols": function.cols,
+        "operations": body.operation_count,
+        "inputs": [(f"q{i + 1}", f"q[..., {i}]") for i in body.joints_used],
+        "definitions": [(str(symbol), printer.doprint(e)) for symbol, e in body.definitions],
+        "outputs": [(index // function.cols, index % function.cols, printer.doprint(e))
+                    for index, e in enumerate(body.outputs)],
+    }
+
+
+def template_context(robot: Robot, generator: Generator, language: str, real: str) -> dict:
+    context = _common(robot)
+    if language == "python":
+        printer = PythonPrinter()
+        context["functions"] = [_python_function(f, printer) for f in generator.functions()]
+    return dict(sorted(context.items()))

@@ -1,0 +1,196 @@
+"""Symbolic kinematics (SPEC §2): the DH chain, fk, geometric and task Jacobians.
+
+The chain is built once over *trig atoms*: for the readable matrices the atoms are
+`cos(q_i + offset_i)` and `sin(...)`; for code generation they are plain symbols `c_i`,
+`s_i`, so the emitted code computes each sine and cosine once and common-subexpression
+elimination keeps the link-to-link structure (cost linear in the number of joints).
+"""
+
+from dataclasses import dataclass
+from functools import cached_property
+from typing import Callable
+
+import sympy
+from sympy.simplify.fu import TR10i
+
+from .robot import TASK_COMPONENTS, Pose, Robot
+
+Matrix = sympy.Matrix
+CosSin = Callable[[int], tuple[sympy.Expr, sympy.Expr]]
+
+
+def joint_symbols(robot: Robot) -> tuple[sympy.Symbol, ...]:
+    return sympy.symbols(f"q1:{robot.dof + 1}", real=True)
+
+
+def rot_x(c, s) -> Matrix:
+    return Matrix([[1, 0, 0, 0], [0, c, -s, 0], [0, s, c, 0], [0, 0, 0, 1]])
+
+
+def rot_z(c, s) -> Matrix:
+    return Matrix([[c, -s, 0, 0], [s, c, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]])
+
+
+def translation(x, y, z) -> Matrix:
+    return Matrix([[1, 0, 0, x], [0, 1, 0, y], [0, 0, 1, z], [0, 0, 0, 1]])
+
+
+def _trig(angle) -> tuple[sympy.Expr, sympy.Expr]:
+    return sympy.cos(angle), sympy.sin(angle)
+
+
+def pose_transform(pose: Pose) -> Matrix:
+    """Exact transform of a base/tool pose: translation, then Rz(yaw) Ry(pitch) Rx(roll)."""
+    roll, pitch, yaw = (v.exact for v in pose.rpy)
+    cp, sp = _trig(pitch)
+    rot_y = Matrix([[cp, 0, sp, 0], [0, 1, 0, 0], [-sp, 0, cp, 0], [0, 0, 0, 1]])
+    return translation(*(v.exact for v in pose.xyz)) * rot_z(*_trig(yaw)) * rot_y * rot_x(*_trig(roll))
+
+
+def link_transforms(robot: Robot, cos_sin: CosSin, q) -> list[tuple[Matrix, Matrix]]:
+    """Per joint, (before, after): the link transform split at the joint's axis frame.
+
+    Standard DH `Rz(theta) Tz(d) Tx(a) Rx(alpha)` moves about the axis at its start;
+    modified DH `Rx(alpha) Tx(a) Rz(theta) Tz(d)` about the axis after `Rx Tx`.
+    """
+    links = []
+    for i, joint in enumerate(robot.joints):
+        c, s = cos_sin(i) if joint.revolute else _trig(joint.theta.exact)
+        d = joint.d.exact if joint.revolute else q[i] + joint.offset.exact
+        twist = rot_x(*_trig(joint.alpha.exact)) * translation(joint.a.exact, 0, 0)
+        if robot.convention == "standard":
+            links.append((sympy.eye(4), rot_z(c, s) * translation(0, 0, d) * twist))
+        else:
+            links.append((twist, rot_z(c, s) * translation(0, 0, d)))
+    return links
+
+
+@dataclass(frozen=True)
+class Chain:
+    """World poses of each joint's axis frame (z = joint axis) and of the tool."""
+
+    axes: tuple[Matrix, ...]
+    tool: Matrix
+
+
+def build_chain(robot: Robot, cos_sin: CosSin, q, simplify=lambda e: e) -> Chain:
+    current = pose_transform(robot.base)
+    axes = []
+    for before, after in link_transforms(robot, cos_sin, q):
+        axis = (current * before).applyfunc(simplify)
+        axes.append(axis)
+        current = (axis * after).applyfunc(simplify)
+    return Chain(tuple(axes), (current * pose_transform(robot.tool)).applyfunc(simplify))
+
+
+def column_jacobian(robot: Robot, chain: Chain) -> Matrix:
+    """Geometric Jacobian in the world frame by the column formula of SPEC §2."""
+    p = chain.tool[:3, 3]
+    columns = []
+    for joint, axis in zip(robot.joints, chain.axes):
+        z, o = axis[:3, 2], axis[:3, 3]
+        columns.append(Matrix.vstack(z.cross(p - o), z) if joint.revolute else Matrix.vstack(z, sympy.zeros(3, 1)))
+    return Matrix.hstack(*columns)
+
+
+def tool_frame(jacobian: Matrix, pose: Matrix) -> Matrix:
+    """The same twist expressed in the frame whose world pose is `pose`."""
+    rotation_t = pose[:3, :3].T
+    return Matrix.vstack(rotation_t * jacobian[:3, :], rotation_t * jacobian[3:, :])
+
+
+def propagated_jacobian_tool(robot: Robot, cos_sin: CosSin, q) -> Matrix:
+    """Tool-frame geometric Jacobian by link-to-link velocity propagation (Craig 5.7).
+
+    Independent of the column formula: angular and linear velocity are carried from
+    frame to frame in local coordinates, w' = R^T (w + qd z), v' = R^T (v + w x p) (+ dd z),
+    and the Jacobian read off as the coefficients of the joint rates.
+    """
+    rates = sympy.symbols(f"qd1:{robot.dof + 1}", real=True)
+    z = Matrix([0, 0, 1])
+    omega, velocity = sympy.zeros(3, 1), sympy.zeros(3, 1)  # of the base, in base coordinates
+
+    def carry(transform: Matrix):
+        rotation_t, offset = transform[:3, :3].T, transform[:3, 3]
+        return rotation_t * omega, rotation_t * (velocity + omega.cross(offset))
+
+    for joint, rate, (before, after) in zip(robot.joints, rates, link_transforms(robot, cos_sin, q)):
+        omega, velocity = carry(before)
+        if joint.revolute:
+            omega = omega + rate * z
+        else:
+            velocity = velocity + rate * z
+        omega, velocity = carry(after)
+    omega, velocity = carry(pose_transform(robot.tool))
+    return Matrix.vstack(velocity, omega).jacobian(rates)
+
+
+def rpy_rates(rotation: Matrix, angular: Matrix) -> Matrix:
+    """Rows d(roll, pitch, yaw)/dq from the angular-velocity rows, for R = Rz Ry Rx.
+
+    omega = E(rpy) rpy_dot inverted with cos(pitch)^2 = R00^2 + R10^2; singular where
+    cos(pitch) = 0 (the Euler-angle representation singularity).
+    """
+    r00, r10, r20 = rotation[0, 0], rotation[1, 0], rotation[2, 0]
+    cos_pitch_sq = r00**2 + r10**2
+    wx, wy, wz = angular[0, :], angular[1, :], angular[2, :]
+    heading = (r00 * wx + r10 * wy) / cos_pitch_sq
+    return Matrix.vstack(heading, (r00 * wy - r10 * wx) / sympy.sqrt(cos_pitch_sq), wz - r20 * heading)
+
+
+def task_vector(robot: Robot, pose: Matrix) -> Matrix:
+    """mu: the declared components of (x, y, z, roll, pitch, yaw) of the pose."""
+    rotation = pose[:3, :3]
+    full = list(pose[:3, 3]) + [
+        sympy.atan2(rotation[2, 1], rotation[2, 2]),
+        sympy.atan2(-rotation[2, 0], sympy.sqrt(rotation[0, 0] ** 2 + rotation[1, 0] ** 2)),
+        sympy.atan2(rotation[1, 0], rotation[0, 0]),
+    ]
+    return Matrix([full[TASK_COMPONENTS.index(name)] for name in robot.task])
+
+
+def task_jacobian(robot: Robot, pose: Matrix, jacobian: Matrix) -> Matrix:
+    """d mu / d q: position rows of the geometric Jacobian, Euler-angle rates for the rest."""
+    rates = rpy_rates(pose[:3, :3], jacobian[3:, :])
+    rows = {name: jacobian[i, :] for i, name in enumerate(("x", "y", "z"))}
+    rows.update({name: rates[i, :] for i, name in enumerate(("roll", "pitch", "yaw"))})
+    return Matrix.vstack(*(rows[name] for name in robot.task))
+
+
+def simplify_trig(expression: sympy.Expr) -> sympy.Expr:
+    """Expand, then collapse sin/cos products of joint sums (c1 c2 - s1 s2 -> cos(q1 + q2))."""
+    return TR10i(sympy.expand(expression))
+
+
+class Kinematics:
+    """The readable symbolic matrices of a robot, in the joint variables q1..qn."""
+
+    def __init__(self, robot: Robot):
+        self.robot = robot
+        self.q = joint_symbols(robot)
+        offsets = [joint.offset.exact for joint in robot.joints]
+        self.cos_sin = lambda i: _trig(self.q[i] + offsets[i])
+
+    @cached_property
+    def chain(self) -> Chain:
+        return build_chain(self.robot, self.cos_sin, self.q, simplify_trig)
+
+    @cached_property
+    def fk(self) -> Matrix:
+        return self.chain.tool
+
+    @cached_property
+    def jacobian(self) -> Matrix:
+        return column_jacobian(self.robot, self.chain).applyfunc(simplify_trig)
+
+    @cached_property
+    def jacobian_tool(self) -> Matrix:
+        return propagated_jacobian_tool(self.robot, self.cos_sin, self.q).applyfunc(simplify_trig)
+
+    @cached_property
+    def task(self) -> Matrix:
+        return task_vector(self.robot, self.fk)
+
+    @cached_property
+    def task_jacobian(self) -> Matrix:
+        return task_jacobian(self.robot, self.fk, self.jacobian)

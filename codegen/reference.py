@@ -1,0 +1,115 @@
+"""Independent numeric reference (SPEC §5): numpy only, sharing no code with the symbolic path.
+
+The DH chain is multiplied out with floats, the geometric Jacobian is built column by
+column from the frame origins and axes, and the task Jacobian by central differences.
+It reads only the float side (`approx`) of the robot's values, at the nominal values of
+symbolic parameters.
+"""
+
+import numpy as np
+
+TASK_COMPONENTS = ("x", "y", "z", "roll", "pitch", "yaw")
+
+
+def _rot_x(angle):
+    c, s = np.cos(angle), np.sin(angle)
+    return np.array([[1, 0, 0, 0], [0, c, -s, 0], [0, s, c, 0], [0, 0, 0, 1.0]])
+
+
+def _rot_z(angle):
+    c, s = np.cos(angle), np.sin(angle)
+    return np.array([[c, -s, 0, 0], [s, c, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1.0]])
+
+
+def _translation(x, y, z):
+    transform = np.eye(4)
+    transform[:3, 3] = (x, y, z)
+    return transform
+
+
+def _pose(pose):
+    """world<-frame transform of a base/tool Pose: Rz(yaw) Ry(pitch) Rx(roll) after xyz."""
+    roll, pitch, yaw = (v.approx for v in pose.rpy)
+    cp, sp = np.cos(pitch), np.sin(pitch)
+    rot_y = np.array([[cp, 0, sp, 0], [0, 1, 0, 0], [-sp, 0, cp, 0], [0, 0, 0, 1.0]])
+    return _translation(*(v.approx for v in pose.xyz)) @ _rot_z(yaw) @ rot_y @ _rot_x(roll)
+
+
+def _link(robot, joint, qi):
+    theta = (qi + joint.offset.approx) if joint.revolute else joint.theta.approx
+    d = joint.d.approx if joint.revolute else (qi + joint.offset.approx)
+    a, alpha = joint.a.approx, joint.alpha.approx
+    if robot.convention == "standard":
+        return _rot_z(theta) @ _translation(0, 0, d) @ _translation(a, 0, 0) @ _rot_x(alpha)
+    return _rot_x(alpha) @ _translation(a, 0, 0) @ _rot_z(theta) @ _translation(0, 0, d)
+
+
+def frames(robot, q):
+    """World poses of the joint frames whose z axes are the joint axes, and of the tool.
+
+    Standard DH: joint i moves about z_{i-1}, so the axes are frames 0..n-1.
+    Modified DH: joint i moves about z_i, the frame after the row's Rx Tx.
+    """
+    q = np.asarray(q, dtype=float)
+    current = _pose(robot.base)
+    axes = []
+    for joint, qi in zip(robot.joints, q):
+        link = _link(robot, joint, qi)
+        if robot.convention == "standard":
+            axes.append(current)
+            current = current @ link
+        else:
+            axes.append(current @ _rot_x(joint.alpha.approx) @ _translation(joint.a.approx, 0, 0))
+            current = current @ link
+    return axes, current @ _pose(robot.tool)
+
+
+def fk(robot, q):
+    """4x4 pose of the tool in the world frame."""
+    return frames(robot, q)[1]
+
+
+def jacobian(robot, q):
+    """Geometric Jacobian in the world frame, rows vx vy vz wx wy wz (column formula)."""
+    axes, tool = frames(robot, q)
+    p = tool[:3, 3]
+    columns = []
+    for joint, axis_frame in zip(robot.joints, axes):
+        z, o = axis_frame[:3, 2], axis_frame[:3, 3]
+        columns.append(np.concatenate([np.cross(z, p - o), z]) if joint.revolute else np.concatenate([z, np.zeros(3)]))
+    return np.array(columns).T
+
+
+def jacobian_tool(robot, q):
+    """The same twist expressed in the tool frame."""
+    rotation = fk(robot, q)[:3, :3]
+    J = jacobian(robot, q)
+    return np.vstack([rotation.T @ J[:3], rotation.T @ J[3:]])
+
+
+def rpy(rotation):
+    """roll, pitch, yaw with R = Rz(yaw) Ry(pitch) Rx(roll)."""
+    pitch = np.arctan2(-rotation[2, 0], np.hypot(rotation[0, 0], rotation[1, 0]))
+    return np.array([np.arctan2(rotation[2, 1], rotation[2, 2]), pitch, np.arctan2(rotation[1, 0], rotation[0, 0])])
+
+
+def task(robot, q):
+    """The task vector mu(q): declared components of (x, y, z, roll, pitch, yaw)."""
+    pose = fk(robot, q)
+    full = np.concatenate([pose[:3, 3], rpy(pose[:3, :3])])
+    return np.array([full[TASK_COMPONENTS.index(name)] for name in robot.task])
+
+
+def task_jacobian(robot, q, step=1e-4):
+    """d mu / d q by fourth-order central differences (angles unwrapped across the ±pi seam)."""
+    q = np.asarray(q, dtype=float)
+    angular = [k for k, name in enumerate(robot.task) if name in ("roll", "pitch", "yaw")]
+    centre = task(robot, q)
+
+    def offset(i, h):
+        difference = task(robot, q + h * np.eye(len(q))[i]) - centre
+        difference[angular] = (difference[angular] + np.pi) % (2 * np.pi) - np.pi
+        return difference
+
+    return np.array([(8 * (offset(i, step) - offset(i, -step)) - (offset(i, 2 * step) - offset(i, -2 * step)))
+                     / (12 * step) for i in range(len(q))]).T
