@@ -18,8 +18,18 @@ def _common(robot: Robot) -> dict:
     }
 
 
+def _shape(function: Function) -> tuple[int, ...]:
+    """Array shape of a result: matrices (rows, cols), column vectors (rows,), scalars ()."""
+    if function.scalar:
+        return ()
+    return (function.rows,) if function.cols == 1 else (function.rows, function.cols)
+
+
 def _python_function(function: Function, printer: PythonPrinter) -> dict:
     body = function.body
+    shape = _shape(function)
+    indices = [", ".join(["..."] + [str(i) for i in divmod(k, function.cols)[: len(shape)]])
+               for k in range(len(body.outputs))]
     return {
         "name": function.name,
         "summary": function.summary,
@@ -29,8 +39,8 @@ def _python_function(function: Function, printer: PythonPrinter) -> dict:
         "operations": body.operation_count,
         "inputs": [(f"q{i + 1}", f"q[..., {i}]") for i in body.joints_used],
         "definitions": [(str(symbol), printer.doprint(e)) for symbol, e in body.definitions],
-        "outputs": [(index // function.cols, index % function.cols, printer.doprint(e))
-                    for index, e in enumerate(body.outputs)],
+        "shape": repr(shape),
+        "outputs": [(index, printer.doprint(e)) for index, e in zip(indices, body.outputs)],
     }
 
 
