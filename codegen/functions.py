@@ -48,10 +48,25 @@ class Generator:
     def __init__(self, robot: Robot):
         self.robot = robot
         self.q = kinematics.joint_symbols(robot)
-        n = robot.dof
-        self.cos = sympy.symbols(f"c1:{n + 1}", real=True)
-        self.sin = sympy.symbols(f"s1:{n + 1}", real=True)
-        self.chain = kinematics.build_chain(robot, lambda i: (self.cos[i], self.sin[i]), self.q)
+        self.trig_definitions: list[tuple[sympy.Symbol, sympy.Expr]] = []
+        self._trig: dict[tuple[int, ...], tuple[sympy.Symbol, sympy.Symbol]] = {}
+        self.chain = kinematics.build_chain(robot, lambda i: self.cos_sin((i,)), self.q, angle_sum=self.cos_sin)
+
+    def cos_sin(self, joints: tuple[int, ...]) -> tuple[sympy.Symbol, sympy.Symbol]:
+        """Symbols for the cos and sin of a sum of joint angles, defined on first use:
+        `c2 = cos(q2)` for one joint, `c23 = c2*c3 - s2*s3` for a run of parallel joints."""
+        if joints not in self._trig:
+            separator = "_" if any(i >= 9 for i in joints) else ""
+            label = separator.join(str(i + 1) for i in joints)
+            cos, sin = sympy.symbols(f"c{label} s{label}", real=True)
+            if len(joints) == 1:
+                angle = self.q[joints[0]] + self.robot.joints[joints[0]].offset.exact
+                value = (sympy.cos(angle), sympy.sin(angle))
+            else:
+                value = kinematics.angle_sum_products(self.cos_sin(joints[:-1]), self.cos_sin(joints[-1:]))
+            self.trig_definitions += [(cos, value[0]), (sin, value[1])]
+            self._trig[joints] = (cos, sin)
+        return self._trig[joints]
 
     @cached_property
     def jacobian(self) -> sympy.Matrix:
@@ -62,14 +77,12 @@ class Generator:
         expressions = list(outputs)
         temporaries = sympy.numbered_symbols("t", real=True)
         replacements, reduced = sympy.cse(expressions, symbols=temporaries, order="canonical")
-        used = set().union(*(e.free_symbols for e in reduced), *(e.free_symbols for _, e in replacements))
+        needed = set().union(*(e.free_symbols for e in reduced), *(e.free_symbols for _, e in replacements))
         trig = []
-        for i, joint in enumerate(self.robot.joints):
-            angle = self.q[i] + joint.offset.exact
-            if self.cos[i] in used:
-                trig.append((self.cos[i], sympy.cos(angle)))
-            if self.sin[i] in used:
-                trig.append((self.sin[i], sympy.sin(angle)))
+        for symbol, value in reversed(self.trig_definitions):  # sums need their terms' symbols
+            if symbol in needed:
+                trig.insert(0, (symbol, value))
+                needed |= value.free_symbols
         definitions = tuple((symbol, fold_constants(e)) for symbol, e in trig + replacements)
         reduced = tuple(fold_constants(e) for e in reduced)
         read = set().union(*(e.free_symbols for _, e in definitions), *(e.free_symbols for e in reduced))

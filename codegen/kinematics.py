@@ -73,14 +73,64 @@ class Chain:
     tool: Matrix
 
 
-def build_chain(robot: Robot, cos_sin: CosSin, q, simplify=lambda e: e) -> Chain:
-    current = pose_transform(robot.base)
+def angle_sum_products(a, b):
+    """cos and sin of an angle sum from those of its two terms."""
+    return a[0] * b[0] - a[1] * b[1], a[1] * b[0] + a[0] * b[1]
+
+
+def build_chain(robot: Robot, cos_sin: CosSin, q, simplify=lambda e: e, angle_sum=None) -> Chain:
+    """Multiply out the DH chain, one rotation per run of parallel joint axes.
+
+    A rotation about z is kept pending while the next axes stay parallel to it
+    (alpha = 0), since Rz(a) Tz(d) Tx(b) Rz(c) = Tz(d) T(b cos a, b sin a, 0) Rz(a + c):
+    the chain then multiplies one rotation for the run, with the cos and sin of the
+    summed angle from `angle_sum(joints)` (default: the product formulas inline).
+    """
+    frame = pose_transform(robot.base)  # the running frame, before the pending rotation
+    run: tuple[int, ...] = ()
+    pending = (sympy.Integer(1), sympy.Integer(0))  # cos, sin of the pending rotation about z
+
+    def flushed() -> Matrix:
+        return (frame * rot_z(*pending)).applyfunc(simplify)
+
+    def turn(i: int):
+        nonlocal run, pending
+        run += (i,)
+        if len(run) == 1:
+            pending = cos_sin(i)
+        else:
+            pending = angle_sum(run) if angle_sum else angle_sum_products(pending, cos_sin(i))
+
+    def fixed_turn(angle):
+        nonlocal frame, run, pending
+        if angle != 0:
+            frame, run, pending = flushed() * rot_z(*_trig(angle)), (), (sympy.Integer(1), sympy.Integer(0))
+
+    def shift(a, d):  # frame Rz(pending) Tz(d) Tx(a), keeping the rotation pending
+        nonlocal frame
+        frame = (frame * translation(a * pending[0], a * pending[1], d)).applyfunc(simplify)
+
+    def twist(alpha):
+        nonlocal frame, run, pending
+        if alpha != 0:
+            frame, run, pending = flushed() * rot_x(*_trig(alpha)), (), (sympy.Integer(1), sympy.Integer(0))
+
     axes = []
-    for before, after in link_transforms(robot, cos_sin, q):
-        axis = (current * before).applyfunc(simplify)
-        axes.append(axis)
-        current = (axis * after).applyfunc(simplify)
-    return Chain(tuple(axes), (current * pose_transform(robot.tool)).applyfunc(simplify))
+    for i, joint in enumerate(robot.joints):
+        d = joint.d.exact if joint.revolute else q[i] + joint.offset.exact
+        if robot.convention == "modified":
+            twist(joint.alpha.exact)
+            shift(joint.a.exact, 0)
+        axes.append(flushed())
+        if joint.revolute:
+            turn(i)
+        else:
+            fixed_turn(joint.theta.exact)
+        shift(0, d)
+        if robot.convention == "standard":
+            shift(joint.a.exact, 0)
+            twist(joint.alpha.exact)
+    return Chain(tuple(axes), (flushed() * pose_transform(robot.tool)).applyfunc(simplify))
 
 
 def column_jacobian(robot: Robot, chain: Chain) -> Matrix:
@@ -173,7 +223,9 @@ class Kinematics:
 
     @cached_property
     def chain(self) -> Chain:
-        return build_chain(self.robot, self.cos_sin, self.q, simplify_trig)
+        angles = [self.q[i] + joint.offset.exact for i, joint in enumerate(self.robot.joints)]
+        return build_chain(self.robot, self.cos_sin, self.q, simplify_trig,
+                           angle_sum=lambda joints: _trig(sum(angles[i] for i in joints)))
 
     @cached_property
     def fk(self) -> Matrix:

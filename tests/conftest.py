@@ -1,0 +1,42 @@
+"""Shared fixtures: the shipped robots and the generated modules under test."""
+
+import importlib.util
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from codegen import load_robot
+
+ROOT = Path(__file__).resolve().parent.parent
+ROBOT_FILES = sorted((ROOT / "robots").glob("*.yaml"))
+ROBOT_NAMES = [path.stem for path in ROBOT_FILES]
+GENERATED = ROOT / "generated"
+
+
+def robot(name: str):
+    return load_robot(ROOT / "robots" / f"{name}.yaml")
+
+
+def import_file(path: Path, module_name: str | None = None):
+    """Import a generated Python file by path (generated modules are not a package)."""
+    spec = importlib.util.spec_from_file_location(module_name or path.stem, path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def generated_module(name: str, suffix: str = ""):
+    return import_file(GENERATED / name / f"{name}{suffix}.py", f"generated_{name}{suffix}")
+
+
+def random_configurations(robot, count: int, seed: int = 0) -> np.ndarray:
+    """Uniform samples inside the joint limits ([-pi, pi] for a joint without limits)."""
+    rng = np.random.default_rng(seed)
+    bounds = np.array([joint.limits or (-np.pi, np.pi) for joint in robot.joints])
+    return rng.uniform(bounds[:, 0], bounds[:, 1], size=(count, robot.dof))
+
+
+@pytest.fixture(params=ROBOT_NAMES)
+def robot_name(request) -> str:
+    return request.param
