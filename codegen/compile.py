@@ -1,0 +1,96 @@
+"""Generated C as a shared library called from Python: for `jacgen verify` and the tests.
+
+The C is compiled with the warning flags SPEC §3 promises (any warning is an error) and
+loaded with ctypes; `CLibrary.evaluate` runs one generated function on a batch of joint
+vectors, one native call per configuration.
+"""
+
+import ctypes
+import os
+import shutil
+import subprocess
+from pathlib import Path
+
+import numpy as np
+
+from .errors import JacgenError
+from .functions import Function
+from .robot import Robot
+
+# SPEC §3: the generated C compiles without a warning under these flags.
+WARNING_FLAGS = ("-std=c99", "-Wall", "-Wextra", "-Wpedantic", "-Wconversion", "-Wshadow",
+                 "-Wdouble-promotion", "-Werror")
+C_TYPES = {"double": ctypes.c_double, "float": ctypes.c_float}
+NUMPY_TYPES = {"double": np.float64, "float": np.float32}
+
+
+class CompileError(JacgenError):
+    """No C compiler, or the generated C did not compile cleanly."""
+
+
+def c_compiler() -> str:
+    """The compiler to use: $CC, else gcc; an error when it is not installed."""
+    name = os.environ.get("CC", "gcc")
+    if shutil.which(name) is None:
+        raise CompileError(f"C compiler {name!r} not found (install gcc or set CC)")
+    return name
+
+
+def compile_shared(sources: list[Path], output: Path, flags: tuple[str, ...] = ("-O2",)) -> Path:
+    """Compile `sources` into the shared library `output`; CompileError with gcc's first error."""
+    compiler = c_compiler()
+    command = [compiler, *WARNING_FLAGS, *flags, "-shared", "-fPIC", "-o", str(output),
+               *(str(source) for source in sources), "-lm"]
+    result = subprocess.run(command, capture_output=True, text=True)
+    if result.returncode != 0:
+        lines = result.stderr.splitlines()
+        first = next((line for line in lines if " error: " in line), lines[0] if lines else "no output")
+        names = ", ".join(Path(source).name for source in sources)
+        raise CompileError(f"{compiler} failed on {names}: {first.strip()}")
+    return output
+
+
+class CLibrary:
+    """One robot's compiled functions (`NAME_fk`, ...), called on numpy arrays."""
+
+    def __init__(self, path: Path, robot: Robot, functions: list[Function], real: str):
+        self.robot, self.real = robot, real
+        self.dtype = NUMPY_TYPES[real]
+        scalar = C_TYPES[real]
+        self._library = ctypes.CDLL(str(path))
+        self._functions = {f.name: f for f in functions}
+        self._parameters = None  # the ctypes struct NAME_params
+        pointer = ctypes.POINTER(scalar)
+        extra = []
+        if robot.symbolic_parameters:
+            fields = [(p.name, scalar) for p in robot.symbolic_parameters]
+            self._parameters = type(f"{robot.name}_params", (ctypes.Structure,), {"_fields_": fields})
+            extra = [ctypes.POINTER(self._parameters)]
+        for function in functions:
+            symbol = getattr(self._library, f"{robot.name}_{function.name}")
+            symbol.argtypes = [pointer] + ([] if function.scalar else [pointer] * len(function.outputs)) + extra
+            symbol.restype = scalar if function.scalar else None
+
+    def evaluate(self, name: str, q: np.ndarray, parameters: dict[str, float] | None = None) -> np.ndarray:
+        """Function `name` at each row of q (k, dof): results (k, size), each output row-major
+        and the outputs of a fused function side by side.
+
+        Symbolic parameters take their nominal values unless given in `parameters`.
+        """
+        function = self._functions[name]
+        symbol = getattr(self._library, f"{self.robot.name}_{name}")
+        extra = []
+        if self._parameters is not None:
+            values = {p.name: p.value for p in self.robot.symbolic_parameters} | (parameters or {})
+            extra = [ctypes.byref(self._parameters(*(values[p.name] for p in self.robot.symbolic_parameters)))]
+        joints = np.ascontiguousarray(q, dtype=self.dtype)
+        starts = np.cumsum([0] + [output.size for output in function.outputs])
+        results = np.empty((len(joints), starts[-1]), dtype=self.dtype)
+        pointer = ctypes.POINTER(C_TYPES[self.real])
+        for row, out in zip(joints, results):
+            if function.scalar:
+                out[0] = symbol(row.ctypes.data_as(pointer), *extra)
+            else:
+                symbol(row.ctypes.data_as(pointer), *(out[start:].ctypes.data_as(pointer) for start in starts[:-1]),
+                       *extra)
+        return results.astype(np.float64)

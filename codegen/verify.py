@@ -1,0 +1,304 @@
+"""`jacgen verify` (SPEC §4): every function of every backend against the numpy reference.
+
+For each robot the code is generated into a temporary folder, the C is compiled twice
+(double and float) into shared libraries called through ctypes, and the Python and
+CasADi modules are imported. Every generated function is evaluated at random
+configurations inside the joint limits plus configurations near singularities, and
+compared with the function of the same name in `codegen.reference` (functions the
+reference does not have are listed as not compared).
+
+The joint vectors are rounded to float32 first, so that the float build, which can
+only read float32 joint angles, is compared at exactly the configuration the reference
+sees, and its error is the error of its arithmetic alone.
+"""
+
+import importlib.util
+import itertools
+import math
+import tempfile
+from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Callable
+
+import numpy as np
+
+from . import analysis, reference
+from .compile import CLibrary, c_compiler, compile_shared
+from .functions import Function, Generator
+from .render import render_robot, write_files
+from .robot import Robot
+
+BACKENDS = ("python", "casadi", "c double", "c float")
+DOUBLE_TOLERANCE = 1e-9
+# float32 keeps 24 bits (relative rounding 6e-8). An output is a sum of products along a
+# chain of at most 32 links, so its rounding error is a few tens of roundings of values no
+# larger than the reach (positions, Jacobian entries) or 1 (rotations): ~1e-6 * (1 + reach)
+# for the shipped arms. 1e-4 * (1 + reach) leaves a margin of ~100 for long chains and
+# cancellation, and is still far below any modelling error (a wrong term is >= 1e-3).
+FLOAT_TOLERANCE = 1e-4
+# Where cos(pitch) < this, roll and yaw and the Euler-angle rates are ill-conditioned (they
+# are undefined at pitch = +-90 deg): the angle rows of `task` and `task_jacobian` are not
+# compared there (and may be NaN). Beyond 0.05 (|pitch| < 87 deg) rounding is amplified at
+# most 1/0.05^2 = 400-fold and the reference's central differences (step 1e-4) agree with
+# the exact rates to 3e-11; at 0.01 they were measured 4e-9 off (stanford).
+EULER_MARGIN = 0.05
+ANGLES = ("roll", "pitch", "yaw")
+EULER_FUNCTIONS = ("task", "task_jacobian")
+# Functions of Js: undefined where cos(pitch) = 0 when Js is the task Jacobian.
+JS_FUNCTIONS = ("manipulability", "jacobian_det")
+# Smallest / largest singular value of Js below which factors must vanish, and above which
+# velocity_ik is checked (there |q_dot| <~ 1e3 |mu_dot|, so the reference's finite-difference
+# error of 1e-11 in task_jacobian stays below the tolerance in the residual).
+SINGULAR_RANK, REGULAR_RANK = 1e-9, 1e-3
+
+
+@dataclass(frozen=True)
+class Result:
+    """The largest error of one function of one robot, per backend (None: not compared)."""
+
+    robot: str
+    function: str
+    errors: dict[str, float | None]
+    tolerances: dict[str, float]
+    note: str = ""
+
+    @property
+    def failed(self) -> bool:
+        return any(error is not None and not error <= self.tolerances[backend]
+                   for backend, error in self.errors.items())
+
+
+def reach(robot: Robot) -> float:
+    """An upper bound of the distance of any frame origin from the world origin."""
+    total = sum(abs(v.approx) for pose in (robot.base, robot.tool) for v in pose.xyz)
+    for joint in robot.joints:
+        total += abs(joint.a.approx)
+        if joint.revolute:
+            total += abs(joint.d.approx)
+        else:
+            lo, hi = joint.limits or (-math.pi, math.pi)
+            total += max(abs(lo), abs(hi)) + abs(joint.offset.approx)
+    return total
+
+
+def bounds(robot: Robot) -> np.ndarray:
+    """(dof, 2) joint ranges: the limits, or [-pi, pi] for a joint without limits."""
+    return np.array([joint.limits or (-math.pi, math.pi) for joint in robot.joints])
+
+
+def random_configurations(robot: Robot, count: int, rng: np.random.Generator) -> np.ndarray:
+    ranges = bounds(robot)
+    return rng.uniform(ranges[:, 0], ranges[:, 1], size=(count, robot.dof))
+
+
+def singular_configurations(robot: Robot) -> np.ndarray:
+    """Configurations at or near singularities, (k, dof), verified besides the random ones.
+
+    This is the hook for configurations known from the robot's singularity analysis. For now
+    they are generic: revolute joints at 0 and +-pi/2 (all zero is the stretched-arm
+    singularity of most arms), prismatic joints mid-travel, clipped into the limits; every
+    combination for up to 4 revolute joints, otherwise all zero, one joint at +-pi/2 at a
+    time, and pairs of joints at +-pi/2.
+    """
+    ranges = bounds(robot)
+    revolute = [i for i, joint in enumerate(robot.joints) if joint.revolute]
+    values = (0.0, math.pi / 2, -math.pi / 2)
+    if len(revolute) <= 4:
+        settings = list(itertools.product(values, repeat=len(revolute)))
+    else:
+        settings = [(0.0,) * len(revolute)]
+        for count in (1, 2):
+            for chosen in itertools.combinations(range(len(revolute)), count):
+                for signs in itertools.product(values[1:], repeat=count):
+                    setting = [0.0] * len(revolute)
+                    for index, value in zip(chosen, signs):
+                        setting[index] = value
+                    settings.append(tuple(setting))
+    configurations = np.tile(ranges.mean(axis=1), (len(settings), 1))
+    configurations[:, revolute] = settings
+    found = analysis.singular_configurations(robot, analysis.analyse(robot))  # on each factor's zero set
+    return np.vstack([np.clip(configurations, ranges[:, 0], ranges[:, 1]), found])
+
+
+def _import(path: Path, module_name: str):
+    spec = importlib.util.spec_from_file_location(module_name, path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+class _Backends:
+    """The generated code of one robot, each backend evaluating a function on a batch of q."""
+
+    def __init__(self, robot: Robot, functions: list[Function], folder: Path, libraries: dict[str, Path]):
+        self.robot = robot
+        self.functions = {f.name: f for f in functions}
+        self.python = _import(folder / "double" / robot.name / f"{robot.name}.py", f"_jacgen_verify_{robot.name}")
+        self.casadi = _import(folder / "double" / robot.name / f"{robot.name}_casadi.py",
+                              f"_jacgen_verify_{robot.name}_casadi")
+        self.c = {real: CLibrary(path, robot, functions, real) for real, path in libraries.items()}
+
+    def evaluate(self, backend: str, name: str, q: np.ndarray) -> np.ndarray:
+        """(k, size) results, each output row-major, several outputs side by side, at the
+        nominal parameter values."""
+        nominal = {p.name: p.value for p in self.robot.symbolic_parameters}
+        if backend == "python":
+            with np.errstate(divide="ignore", invalid="ignore"):  # NaN at Euler singularities
+                return _side_by_side(getattr(self.python, name)(q, **nominal), len(q))
+        if backend == "casadi":
+            function = getattr(self.casadi, name)
+            extra = [list(self.casadi.PARAMETERS.values())] if nominal else []
+            return np.vstack([_side_by_side(function(row, *extra), 1) for row in q])
+        return self.c[backend.split()[1]].evaluate(name, q)
+
+
+def _side_by_side(results, count: int) -> np.ndarray:
+    """One result array, or a tuple of them (a fused function), as (count, size)."""
+    parts = results if isinstance(results, tuple) else (results,)
+    return np.hstack([np.reshape(np.asarray(part), (count, -1)) for part in parts])
+
+
+def _reference(robot: Robot, function: Function, q: np.ndarray) -> np.ndarray | None:
+    """The reference's values of each output side by side, None where it has no counterpart."""
+    evaluators = [getattr(reference, output.equals or function.name, None) for output in function.outputs]
+    if not all(callable(evaluate) for evaluate in evaluators):
+        return None
+    return np.array([np.concatenate([np.reshape(evaluate(robot, row), -1) for evaluate in evaluators]) for row in q])
+
+
+def compare(robot: Robot, function: Function, value: np.ndarray, expected: np.ndarray,
+            q: np.ndarray) -> tuple[float, int]:
+    """Largest error of results (k, rows * cols) against the reference at q (k, dof), and the
+    number of samples whose Euler-angle rows were not compared.
+
+    Angles of the task vector are compared modulo 2 pi; a NaN or infinity that is compared
+    is an infinite error.
+    """
+    elements = np.zeros(value.shape[1], dtype=bool)  # the entries undefined where cos(pitch) = 0
+    if function.name in EULER_FUNCTIONS:
+        elements = np.repeat([name in ANGLES for name in robot.task], function.outputs[0].cols)
+    elif function.name in JS_FUNCTIONS and analysis.singularity_rows(robot) is None:
+        elements[:] = True
+    compared = np.ones(value.shape, dtype=bool)
+    if elements.any():
+        rotations = np.array([reference.fk(robot, row)[:3, :3] for row in q])
+        euler_singular = np.hypot(rotations[:, 0, 0], rotations[:, 1, 0]) < EULER_MARGIN
+        compared[np.ix_(euler_singular, elements)] = False
+    difference = value - expected
+    if function.name == "task":
+        difference[:, elements] = (difference[:, elements] + math.pi) % (2 * math.pi) - math.pi
+    skipped = int((~compared.all(axis=1)).sum())
+    if not np.isfinite(value[compared]).all():
+        return math.inf, skipped
+    return float(np.max(np.abs(difference[compared]), initial=0.0)), skipped
+
+
+def verify_robot(robot: Robot, backends: _Backends, functions: list[Function], q: np.ndarray) -> list[Result]:
+    tolerances = {backend: DOUBLE_TOLERANCE for backend in BACKENDS}
+    tolerances["c float"] = FLOAT_TOLERANCE * (1 + reach(robot))
+    results = []
+    ranks = _rank_ratios(robot, q)
+    for function in functions:
+        if function.name == "singularity_factors":
+            errors = {backend: _vanishing_error(backends.evaluate(backend, function.name, q), ranks)
+                      for backend in BACKENDS}
+            results.append(Result(robot.name, function.name, errors, tolerances,
+                                  f"min |factor| at the {int((ranks < SINGULAR_RANK).sum())} samples where Js is singular"))
+            continue
+        expected = _reference(robot, function, q)
+        if expected is None or expected.shape[1] != sum(output.size for output in function.outputs):
+            note = "not compared: " + ("no reference" if expected is None else "reference has another shape")
+            results.append(Result(robot.name, function.name, dict.fromkeys(BACKENDS), tolerances, note))
+            continue
+        errors = {}
+        for backend in BACKENDS:
+            errors[backend], skipped = compare(robot, function, backends.evaluate(backend, function.name, q),
+                                               expected, q)
+        note = (f"angle rows not compared at {skipped} of {len(q)} samples (cos(pitch) < {EULER_MARGIN})"
+                if skipped else "")
+        results.append(Result(robot.name, function.name, errors, tolerances, note))
+    regular = ranks > REGULAR_RANK
+    residual = _velocity_ik_residual(robot, backends.python, q[regular])
+    results.append(Result(robot.name, "velocity_ik", {"python": residual} | dict.fromkeys(BACKENDS[1:]), tolerances,
+                          f"|Js q_dot - mu_dot| / (|Js| |q_dot| + |mu_dot|) at the {int(regular.sum())} samples where Js is regular"))
+    return results
+
+
+def _rank_ratios(robot: Robot, q: np.ndarray) -> np.ndarray:
+    """Smallest over largest singular value of the reference Js at each sample (NaN where
+    Js is undefined: Euler-angle rows at cos(pitch) < EULER_MARGIN)."""
+    ratios = np.full(len(q), np.nan)
+    for k, row in enumerate(q):
+        rotation = reference.fk(robot, row)[:3, :3]
+        if analysis.singularity_rows(robot) is None and np.hypot(rotation[0, 0], rotation[1, 0]) < EULER_MARGIN:
+            continue
+        values = np.linalg.svd(reference.singularity_jacobian(robot, row), compute_uv=False)
+        ratios[k] = values[-1] / values[0]
+    return ratios
+
+
+def _vanishing_error(factors: np.ndarray, ranks: np.ndarray) -> float:
+    """The largest, over samples where Js is singular, of the smallest |factor| (0 if none)."""
+    singular = ranks < SINGULAR_RANK
+    return float(np.max(np.min(np.abs(factors[singular]), axis=1), initial=0.0))
+
+
+def _velocity_ik_residual(robot: Robot, module, q: np.ndarray) -> float:
+    """Largest backward error |Js q_dot - mu_dot| / (|Js| |q_dot| + |mu_dot|) of the generated
+    Python velocity_ik, mu_dot random: the residual scaled by what rounding alone leaves, so
+    the bound does not depend on how well conditioned Js is."""
+    mu_dot = np.random.default_rng(0).normal(size=(len(q), len(robot.task)))
+    nominal = {p.name: p.value for p in robot.symbolic_parameters}
+    q_dot, ok = module.velocity_ik(q, mu_dot, **nominal)
+    if not ok.all():
+        return math.inf
+    js = np.array([reference.singularity_jacobian(robot, row) for row in q])
+    residual = np.linalg.norm(np.einsum("kij,kj->ki", js, q_dot) - mu_dot, axis=1)
+    scale = np.linalg.norm(js, ord=2, axis=(1, 2)) * np.linalg.norm(q_dot, axis=1) + np.linalg.norm(mu_dot, axis=1)
+    return float(np.max(residual / scale, initial=0.0))
+
+
+def verify(robots: list[Robot], samples: int, seed: int,
+           progress: Callable[[str], None] = lambda message: None) -> list[Result]:
+    """Generate, build and compare every robot; compiles run in the background meanwhile."""
+    c_compiler()  # fail before generating anything when there is none
+    results = []
+    with tempfile.TemporaryDirectory(prefix="jacgen-verify-") as temporary, ThreadPoolExecutor(2) as pool:
+        folder = Path(temporary)
+        jobs = []
+        for robot in robots:
+            progress(f"generating {robot.name}")
+            work, generator = folder / robot.name, Generator(robot)
+            write_files(render_robot(robot, ("c", "python", "casadi"), "double", generator), work / "double")
+            write_files(render_robot(robot, ("c",), "float", generator), work / "float")
+            builds = {real: pool.submit(compile_shared, [work / real / robot.name / f"{robot.name}.c"],
+                                        work / f"{robot.name}_{real}.so") for real in ("double", "float")}
+            jobs.append((robot, generator.functions(), work, builds))
+        for robot, functions, work, builds in jobs:
+            progress(f"verifying {robot.name}")
+            rng = np.random.default_rng(seed)
+            q = np.vstack([random_configurations(robot, samples, rng), singular_configurations(robot)])
+            q = q.astype(np.float32).astype(np.float64)
+            libraries = {real: build.result() for real, build in builds.items()}
+            results += verify_robot(robot, _Backends(robot, functions, work, libraries), functions, q)
+    return results
+
+
+def format_table(results: list[Result]) -> str:
+    """One row per robot and function, one column per backend: the largest error."""
+    header = ["robot", "function", *BACKENDS, "float tol", "note"]
+    rows = [header]
+    for result in results:
+        cells = [result.robot, result.function]
+        for backend in BACKENDS:
+            error = result.errors[backend]
+            mark = "" if error is None or error <= result.tolerances[backend] else " FAIL"
+            cells.append("-" if error is None else f"{error:.1e}{mark}")
+        cells += [f"{result.tolerances['c float']:.1e}", result.note]
+        rows.append(cells)
+    widths = [max(len(row[c]) for row in rows) for c in range(len(header))]
+    lines = ["  ".join(cell.ljust(width) for cell, width in zip(row, widths)).rstrip() for row in rows]
+    failed = sum(result.failed for result in results)
+    lines.append(f"double tolerance {DOUBLE_TOLERANCE:.0e}; {failed} of {len(results)} functions above tolerance")
+    return "\n".join(lines)

@@ -1,0 +1,232 @@
+"""The C99 backend: clean compiles (host and Cortex-M4F), libm only, SPEC §3 signatures.
+
+Numbers: the C of every shipped robot is compared with the reference by `jacgen verify`
+(tests/test_verify.py); here the C of test robots with runtime parameters, a function
+that reads no joint, a scalar result and a function SPEC does not name is checked
+against codegen.reference.
+"""
+
+import os
+import re
+import shutil
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+import sympy
+from numpy.testing import assert_allclose
+
+from codegen import reference
+from codegen.compile import WARNING_FLAGS, CLibrary, compile_shared
+from codegen.functions import Generator
+from codegen.printers import CPrinter
+from codegen.render import render_robot, write_files
+from codegen.robot import load_robot
+
+from conftest import ROBOT_FILES, ROOT, random_configurations
+
+ARM_FLAGS = ("-mcpu=cortex-m4", "-mthumb", "-mfloat-abi=hard", "-mfpu=fpv4-sp-d16", "-Os")
+LIBM = {name + suffix for name in "sin cos sincos tan asin acos atan atan2 sqrt fabs hypot".split()
+        for suffix in ("", "f")}
+# GCC may emit calls to these for array copies even in freestanding code, which must provide
+# them ("Standards", GCC manual); the sources call none of them.
+COMPILER_RUNTIME = {"memcpy", "memmove", "memset", "memcmp"}
+# Bytes per function. Straight-line functions keep only scalars (a few hundred bytes); ik
+# keeps its candidate solutions. A change that puts big arrays on the stack fails here.
+STACK_LIMIT = 4096
+
+# A robot with runtime parameters in the base translation only: fk and task read `p`, the
+# Jacobians do not (they must still take it, and compile without an unused-parameter warning).
+PARAMETRIC = """
+name: lifted
+convention: standard
+angle_unit: deg
+parameters:
+  height: {value: 0.25, symbolic: true}
+  shift: {value: -0.1, symbolic: true}
+  a1: 0.4
+joints:
+  - {type: revolute, a: a1, alpha: 90, d: 0.1, offset: 30, limits: [-170, 170]}
+  - {type: revolute, a: 0.3, alpha: 0, d: 0, offset: 0}
+  - {type: prismatic, a: 0, alpha: 0, theta: 90, offset: 0.05, limits: [0, 0.2]}
+base: {xyz: [shift, 0, height], rpy: [0, 0, 0]}
+task: [x, y, z]
+"""
+# Cartesian gantry: its Jacobians read no joint (q must be marked unused).
+GANTRY = """
+name: gantry
+convention: standard
+angle_unit: deg
+joints:
+  - {type: prismatic, a: 0, alpha: -90, theta: 0, offset: 0, limits: [0, 1]}
+  - {type: prismatic, a: 0, alpha: 0, theta: -90, offset: 0, limits: [0, 1]}
+task: [x, y, z]
+"""
+
+
+def _write_robot(folder, text, **replace):
+    name = re.search(r"name: (\w+)", text).group(1)
+    for old, new in replace.items():
+        text = text.replace(old, new)
+    path = folder / f"{name}{len(replace)}.yaml"
+    path.write_text(text)
+    return load_robot(path)
+
+
+def _run(command, cwd=None):
+    result = subprocess.run([str(part) for part in command], capture_output=True, text=True, cwd=cwd)
+    assert result.returncode == 0 and not result.stderr, result.stderr
+    return result.stdout
+
+
+@pytest.fixture(scope="module")
+def generators():
+    """One Generator per shipped robot, shared by both precisions."""
+    return [Generator(load_robot(path)) for path in ROBOT_FILES]
+
+
+@pytest.fixture(scope="module", params=["double", "float"])
+def shipped_c(request, generators, tmp_path_factory):
+    """The C of every shipped robot in one precision: (real, [.c files])."""
+    folder = tmp_path_factory.mktemp(f"c_{request.param}")
+    for generator in generators:
+        write_files(render_robot(generator.robot, ("c",), request.param, generator), folder)
+    return request.param, sorted(folder.glob("*/*.c"))
+
+
+def _check_objects(folder, nm, real, runtime=()):
+    """Only libm symbols (and the compiler's `runtime` helpers) are undefined, only the f
+    functions in float builds; every function's stack use is static and small."""
+    for obj in sorted(folder.glob("*.o")):
+        undefined = set(_run([nm, "-u", obj]).split()) - {"U"} - COMPILER_RUNTIME
+        undefined = {name for name in undefined if not name.startswith(runtime)} if runtime else undefined
+        assert undefined <= LIBM, (obj.name, undefined - LIBM)
+        if real == "float":
+            assert all(name.endswith("f") for name in undefined), (obj.name, undefined)
+    usage = []
+    for line in "".join(path.read_text() for path in folder.glob("*.su")).splitlines():
+        where, size, kind = line.rsplit("\t", 2)
+        usage.append((int(size), where.rsplit(":", 1)[-1], kind))
+    worst = max(usage)
+    print(f"worst stack usage ({real}): {worst[0]} bytes in {worst[1]} ({worst[2]})")
+    assert worst[0] <= STACK_LIMIT and all(kind == "static" for _, _, kind in usage)
+
+
+def test_host_compile_is_warning_free_and_needs_only_libm(shipped_c, tmp_path):
+    real, sources = shipped_c
+    _run(["gcc", *WARNING_FLAGS, "-O2", "-fstack-usage", "-c", *sources], cwd=tmp_path)
+    _check_objects(tmp_path, "nm", real)
+
+
+@pytest.mark.skipif(shutil.which("arm-none-eabi-gcc") is None, reason="arm-none-eabi-gcc not installed")
+def test_cortex_m4_compile_is_warning_free_and_needs_only_libm(shipped_c, tmp_path):
+    real, sources = shipped_c
+    _run(["arm-none-eabi-gcc", *ARM_FLAGS, *WARNING_FLAGS, "-fstack-usage", "-c", *sources], cwd=tmp_path)
+    # The FPU is single precision: double builds call libgcc's software double arithmetic
+    # and conversions (__aeabi_dmul, __aeabi_i2d...); float builds need no helper.
+    _check_objects(tmp_path, "arm-none-eabi-nm", real, runtime=("__aeabi_",) if real == "double" else ())
+
+
+def test_prototypes_are_those_of_spec():
+    header = render_robot(load_robot(ROOT / "robots" / "puma560.yaml"), ("c",))["puma560/puma560.h"]
+    spec = """
+        void      NAME_fk(const NAME_real q[NAME_DOF], NAME_real T[16]);
+        void      NAME_jacobian(const NAME_real q[NAME_DOF], NAME_real J[6 * NAME_DOF]);
+        void      NAME_jacobian_tool(const NAME_real q[NAME_DOF], NAME_real J[6 * NAME_DOF]);
+        void      NAME_task(const NAME_real q[NAME_DOF], NAME_real mu[NAME_TASK_DIM]);
+        void      NAME_task_jacobian(const NAME_real q[NAME_DOF], NAME_real J[NAME_TASK_DIM * NAME_DOF]);
+    """
+    for line in spec.strip().splitlines():
+        prototype = re.sub(r"\s+", " ", line.strip()).replace("NAME_real", "puma560_real").replace("NAME", "PUMA560")
+        prototype = prototype.replace("PUMA560_", "puma560_", 1)
+        assert prototype in header
+    for line in ("typedef double puma560_real;", "#define PUMA560_DOF 6", "#define PUMA560_TASK_DIM 6",
+                 "#ifndef PUMA560_H", 'extern "C" {'):
+        assert line in header
+
+
+@pytest.mark.skipif(shutil.which("g++") is None, reason="g++ not installed")
+def test_header_is_usable_from_cpp(tmp_path):
+    write_files(render_robot(load_robot(ROOT / "robots" / "ur5.yaml"), ("c",)), tmp_path)
+    source = tmp_path / "use.cpp"
+    source.write_text('#include "ur5.h"\nvoid use(const ur5_real *q, ur5_real *T) { ur5_fk(q, T); }\n')
+    _run(["g++", "-std=c++11", "-Wall", "-Wextra", "-Werror", "-fsyntax-only", f"-I{tmp_path / 'ur5'}", source])
+
+
+@pytest.mark.parametrize("real", ["double", "float"])
+def test_runtime_parameters(tmp_path, real):
+    robot = _write_robot(tmp_path, PARAMETRIC)
+    files = render_robot(robot, ("c",), real)
+    header = files["lifted/lifted.h"]
+    assert "typedef struct {\n    lifted_real height; /* nominal 0.25 */\n    lifted_real shift; /* nominal -0.1 */\n} lifted_params;" in header
+    functions = Generator(robot).functions()
+    for function in functions:
+        prototype = re.search(rf"^(?:void|lifted_real) lifted_{function.name}\(.*\);$", header, flags=re.MULTILINE)
+        assert prototype.group().endswith(", const lifted_params *p);")
+    write_files(files, tmp_path)
+    library = CLibrary(compile_shared([tmp_path / "lifted" / "lifted.c"], tmp_path / "lifted.so"), robot,
+                       functions, real)
+    moved = _write_robot(tmp_path, PARAMETRIC, **{"height: {value: 0.25, symbolic: true}": "height: 0.75",
+                                                  "shift: {value: -0.1, symbolic: true}": "shift: 0.5"})
+    q = random_configurations(robot, 20, seed=3)
+    tolerance = 1e-12 if real == "double" else 1e-5
+    for name in ("fk", "jacobian", "task"):
+        expected = np.array([getattr(reference, name)(robot, row).ravel() for row in q])
+        assert_allclose(library.evaluate(name, q), expected, atol=tolerance)
+        expected = np.array([getattr(reference, name)(moved, row).ravel() for row in q])
+        assert_allclose(library.evaluate(name, q, {"height": 0.75, "shift": 0.5}), expected, atol=tolerance)
+
+
+def test_functions_beyond_spec_render_generically(tmp_path, monkeypatch):
+    """A scalar function returns NAME_real; an output SPEC does not name gets its literal size."""
+    def functions(self):
+        pose = self.chain.tool
+        position = pose[:3, 3]
+        return original(self) + [
+            self.function("reach_squared", "squared distance of the tool from the origin",
+                          ("r", sympy.Matrix([position.dot(position)])), scalar=True),
+            self.function("tool_position", "tool origin", ("v", position)),
+        ]
+
+    original = Generator.functions
+    monkeypatch.setattr(Generator, "functions", functions)
+    robot = _write_robot(tmp_path, GANTRY)
+    files = render_robot(robot, ("c",))
+    header = files["gantry/gantry.h"]
+    assert "gantry_real gantry_reach_squared(const gantry_real q[GANTRY_DOF]);" in header
+    assert "void gantry_tool_position(const gantry_real q[GANTRY_DOF], gantry_real v[3]);" in header
+    assert "(void)q;" in files["gantry/gantry.c"]
+    write_files(files, tmp_path)
+    library = CLibrary(compile_shared([tmp_path / "gantry" / "gantry.c"], tmp_path / "gantry.so"), robot,
+                       Generator(robot).functions(), "double")
+    q = random_configurations(robot, 10, seed=4)
+    positions = np.array([reference.fk(robot, row)[:3, 3] for row in q])
+    assert_allclose(library.evaluate("tool_position", q), positions, atol=1e-12)
+    assert_allclose(library.evaluate("reach_squared", q)[:, 0], (positions**2).sum(axis=1), atol=1e-12)
+    assert_allclose(library.evaluate("jacobian", q), [reference.jacobian(robot, row).ravel() for row in q],
+                    atol=1e-12)
+
+
+def test_printer():
+    x, y = sympy.symbols("x y", real=True)
+    double, single = CPrinter("double"), CPrinter("float")
+    assert double.doprint(x**2 + y / x**3) == "y/(x*x*x) + (x*x)"
+    assert double.doprint(0.4318 * sympy.cos(x) / sympy.sqrt(y)) == "0.4318*cos(x)/sqrt(y)"
+    assert double.doprint(1 / sympy.sqrt(x + y)) == "1.0/sqrt(x + y)"
+    assert single.doprint(0.4318 * sympy.atan2(x, sympy.sqrt(y)) + 1 / x) == "0.4318F*atan2f(x, sqrtf(y)) + 1.0F/x"
+    with pytest.raises(Exception, match="[Uu]nsupported|not supported"):
+        double.doprint(sympy.Function("mystery")(x))
+    with pytest.raises(ValueError):
+        CPrinter("long double")
+
+
+def test_output_is_independent_of_hash_seed(tmp_path):
+    outputs = []
+    for seed in ("0", "1"):
+        folder = tmp_path / seed
+        subprocess.run([sys.executable, "-m", "codegen", "generate", "robots/ur5.yaml", "-o", str(folder),
+                        "--lang", "c,casadi", "--real", "float"], cwd=ROOT, check=True, capture_output=True,
+                       env={**os.environ, "PYTHONHASHSEED": seed, "PYTHONPATH": str(ROOT)})
+        outputs.append({path.name: path.read_bytes() for path in sorted(folder.glob("*/*"))})
+    assert outputs[0] == outputs[1] and len(outputs[0]) == 3

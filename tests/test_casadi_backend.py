@@ -1,0 +1,109 @@
+"""The CasADi backend: casadi.Function objects that match codegen.reference, and whose
+symbolic derivatives agree with the generated Jacobians."""
+
+import functools
+
+import casadi
+import numpy as np
+import pytest
+import sympy
+from numpy.testing import assert_allclose
+
+from codegen import reference
+from codegen.functions import Generator
+from codegen.printers import CasadiPrinter
+from codegen.render import render_robot, write_files
+from codegen.robot import load_robot
+from codegen.verify import compare
+
+from conftest import ROBOT_NAMES, import_file, random_configurations, robot as shipped_robot
+from test_c_backend import PARAMETRIC
+
+SAMPLES = 25
+
+
+def _module(robot, folder):
+    write_files(render_robot(robot, ("casadi",)), folder)
+    return import_file(folder / robot.name / f"{robot.name}_casadi.py", f"test_{robot.name}_casadi")
+
+
+@pytest.fixture(scope="module")
+def generated(tmp_path_factory):
+    """name -> (robot, functions, CasADi module, numpy module), each robot generated once."""
+    folder = tmp_path_factory.mktemp("casadi")
+
+    @functools.cache
+    def load(name):
+        robot = shipped_robot(name)
+        generator = Generator(robot)
+        write_files(render_robot(robot, ("casadi", "python"), "double", generator), folder)
+        return (robot, generator.functions(), import_file(folder / name / f"{name}_casadi.py", f"test_{name}_casadi"),
+                import_file(folder / name / f"{name}.py", f"test_{name}_numpy"))
+
+    return load
+
+
+def _as_list(result):
+    """A casadi.Function returns one DM, or a tuple of them for several outputs."""
+    return result if isinstance(result, tuple) else (result,)
+
+
+@pytest.mark.parametrize("name", ROBOT_NAMES)
+def test_functions_match_reference(name, generated):
+    """Every function against codegen.reference; one the reference lacks (manipulability...)
+    against the generated numpy module, which prints the same expressions another way."""
+    robot, functions, module, numpy_module = generated(name)
+    assert list(module.functions()) == [f.name for f in functions]
+    q = random_configurations(robot, SAMPLES, seed=5)
+    for function in functions:
+        generated_function = module.functions()[function.name]
+        assert isinstance(generated_function, casadi.Function) and generated_function.name() == function.name
+        assert generated_function.name_in() == ["q"] and generated_function.size_in(0) == (robot.dof, 1)
+        assert [generated_function.size_out(k) for k in range(len(function.outputs))] == [
+            (output.rows, output.cols) for output in function.outputs]
+        value = np.array([np.concatenate([np.asarray(result).ravel() for result in _as_list(generated_function(row))])
+                          for row in q])
+        if all(hasattr(reference, output.equals or function.name) for output in function.outputs):
+            expected = np.array([np.concatenate([np.ravel(getattr(reference, output.equals or function.name)(robot, row))
+                                                 for output in function.outputs]) for row in q])
+        else:
+            expected = np.reshape(getattr(numpy_module, function.name)(q), value.shape)
+        error, _ = compare(robot, function, value, expected, q)
+        assert error <= 1e-9, (function.name, error)
+
+
+@pytest.mark.parametrize("name", ["puma560", "stanford", "panda", "scara"])
+def test_derivative_of_fk_position_is_the_linear_jacobian(name, generated):
+    robot, _, module, _ = generated(name)
+    q = casadi.SX.sym("q", robot.dof)
+    derivative = casadi.Function("d", [q], [casadi.jacobian(module.fk(q)[0:3, 3], q)])
+    for row in random_configurations(robot, 10, seed=6):
+        linear = np.asarray(module.jacobian(row))[:3]
+        assert_allclose(np.asarray(derivative(row)), linear, atol=1e-12)
+        assert_allclose(linear, reference.jacobian(robot, row)[:3], atol=1e-12)
+
+
+def test_runtime_parameters_are_input_p(tmp_path):
+    path = tmp_path / "lifted.yaml"
+    path.write_text(PARAMETRIC)
+    robot = load_robot(path)
+    module = _module(robot, tmp_path)
+    assert module.PARAMETERS == {"height": 0.25, "shift": -0.1}
+    moved_path = tmp_path / "moved.yaml"
+    moved_path.write_text(PARAMETRIC.replace("height: {value: 0.25, symbolic: true}", "height: 0.75"))
+    moved = load_robot(moved_path)
+    for row in random_configurations(robot, 10, seed=7):
+        assert module.fk.name_in() == ["q", "p"]
+        assert_allclose(np.asarray(module.fk(row, [0.25, -0.1])), reference.fk(robot, row), atol=1e-12)
+        assert_allclose(np.asarray(module.fk(row, [0.75, -0.1])), reference.fk(moved, row), atol=1e-12)
+        assert_allclose(np.asarray(module.jacobian(row, [0.75, -0.1])), reference.jacobian(moved, row), atol=1e-12)
+
+
+def test_printer():
+    x, y = sympy.symbols("x y", real=True)
+    printer = CasadiPrinter()
+    assert printer.doprint(sympy.atan2(x, sympy.sqrt(y)) + 0.4318 / x**2) == \
+        "casadi.atan2(x, casadi.sqrt(y)) + 0.4318/x**2"
+    for unsupported in (sympy.Piecewise((x, x > 0), (y, True)), sympy.Max(x, y), sympy.gamma(x)):
+        with pytest.raises(Exception, match="[Uu]nsupported|not supported"):
+            printer.doprint(unsupported)

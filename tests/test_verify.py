@@ -1,0 +1,114 @@
+"""`jacgen verify`: exit codes, the table, and that it notices a wrong result."""
+
+import math
+
+import numpy as np
+import pytest
+import sympy
+from click.testing import CliRunner
+
+from codegen import reference, verify
+from codegen.cli import main
+from codegen.compile import CompileError, compile_shared
+from codegen.functions import Generator
+
+from conftest import robot as shipped_robot
+
+FUNCTIONS = ("fk", "jacobian", "jacobian_tool", "task", "task_jacobian")
+
+
+def _verify(*arguments, **environment):
+    return CliRunner().invoke(main, ["verify", *arguments], env=environment)
+
+
+def _rows(output: str) -> dict[tuple[str, str], list[str]]:
+    return {tuple(line.split()[:2]): line.split()[2:] for line in output.splitlines()[1:-1]}
+
+
+def test_every_function_of_every_backend_is_within_tolerance():
+    result = _verify("robots/puma560.yaml", "robots/stanford.yaml", "--samples", "40")
+    assert result.exit_code == 0, result.output
+    assert result.output.splitlines()[0].split()[:6] == ["robot", "function", "python", "casadi", "c", "double"]
+    rows = _rows(result.output)
+    assert set(rows) >= {(robot, function) for robot in ("puma560", "stanford") for function in FUNCTIONS}
+    for (robot, function), cells in rows.items():
+        if cells[:4] == ["-"] * 4:  # a function the reference does not have
+            assert function not in FUNCTIONS and " ".join(cells[5:]) == "not compared: no reference"
+            continue
+        errors = [0.0 if cell == "-" else float(cell) for cell in cells[:4]]  # velocity_ik: Python only
+        assert max(errors[:3]) <= 1e-9 and errors[3] <= float(cells[4])
+    assert f"0 of {len(rows)} functions above tolerance" in result.output
+    assert result.stderr == ""  # no progress when stderr is not a terminal
+
+
+def test_a_wrong_result_fails(monkeypatch):
+    correct = reference.jacobian_tool
+    monkeypatch.setattr(reference, "jacobian_tool", lambda robot, q: correct(robot, q) + 1e-3)
+    result = _verify("robots/planar_2r.yaml", "--samples", "5")
+    assert result.exit_code == 1
+    rows = _rows(result.output)
+    assert rows[("planar_2r", "jacobian_tool")][:8] == ["1.0e-03", "FAIL"] * 4
+    assert result.output.splitlines()[-1].endswith(f"; 1 of {len(rows)} functions above tolerance")
+
+
+def test_functions_without_reference_are_listed_not_compared(monkeypatch):
+    original = Generator.functions
+
+    def functions(self):
+        return original(self) + [self.function("tool_height", "z of the tool",
+                                               ("h", sympy.Matrix([self.chain.tool[2, 3]])), scalar=True)]
+
+    monkeypatch.setattr(Generator, "functions", functions)
+    result = _verify("robots/scara.yaml", "--samples", "5")
+    assert result.exit_code == 0, result.output
+    cells = _rows(result.output)[("scara", "tool_height")]
+    assert cells[:4] == ["-"] * 4 and " ".join(cells[5:]) == "not compared: no reference"
+
+
+def test_missing_compiler_and_compile_errors_exit_2():
+    for compiler in ("no-such-cc", "false"):
+        result = _verify("robots/planar_2r.yaml", "--samples", "2", CC=compiler)
+        assert result.exit_code == 2
+        assert len(result.stderr.splitlines()) == 1 and result.stderr.startswith("jacgen: error: ")
+        assert "Traceback" not in result.output
+
+
+def test_bad_input_exits_2(tmp_path):
+    assert _verify("robots/does_not_exist.yaml").exit_code == 2
+    assert _verify("robots/planar_2r.yaml", "--samples", "0").exit_code == 2
+
+
+def test_singular_configurations_are_inside_the_limits():
+    for name in ("puma560", "stanford", "planar_3r"):
+        robot = shipped_robot(name)
+        q = verify.singular_configurations(robot)
+        bounds = verify.bounds(robot)
+        assert ((q >= bounds[:, 0]) & (q <= bounds[:, 1])).all()
+        revolute = [joint.revolute for joint in robot.joints]
+        zero = np.clip(np.where(revolute, 0.0, bounds.mean(axis=1)), bounds[:, 0], bounds[:, 1])
+        assert (q == zero).all(axis=1).any()  # the stretched arm (all revolute joints at 0)
+    assert len(verify.singular_configurations(shipped_robot("planar_3r"))) == 27 + 3  # 3^3 grid, 3 on sin(q2) = 0
+
+
+def test_task_angles_compare_modulo_two_pi():
+    robot = shipped_robot("puma560")
+    function = next(f for f in Generator(robot).functions() if f.name == "task")
+    q = np.array([[0.1, 0.2, -0.3, 0.4, 0.5, 0.6]])
+    expected = reference.task(robot, q[0])[None]
+    shifted = expected + np.array([0, 0, 0, 2 * math.pi, 0, -2 * math.pi])
+    assert verify.compare(robot, function, shifted, expected, q) == (0.0, 0)
+    broken = expected.copy()
+    broken[0, 0] = math.nan
+    assert verify.compare(robot, function, broken, expected, q)[0] == math.inf
+
+
+@pytest.mark.parametrize("name, expected", [("planar_2r", 2.0), ("stanford", 0.412 + 0.154 + 0.0203 + 50 * 0.0254)])
+def test_reach(name, expected):
+    assert verify.reach(shipped_robot(name)) == pytest.approx(expected)
+
+
+def test_compile_error_is_one_line(tmp_path):
+    source = tmp_path / "bad.c"
+    source.write_text("int narrow(double x) { return x; }\n")
+    with pytest.raises(CompileError, match=r"^gcc failed on bad\.c: .*bad\.c:1:\d+: error: conversion"):
+        compile_shared([source], tmp_path / "bad.so")
