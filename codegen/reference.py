@@ -113,3 +113,23 @@ def task_jacobian(robot, q, step=1e-4):
 
     return np.array([(8 * (offset(i, step) - offset(i, -step)) - (offset(i, 2 * step) - offset(i, -2 * step)))
                      / (12 * step) for i in range(len(q))]).T
+
+
+def singularity_jacobian(robot, q):
+    """Js (SPEC §2): the geometric rows of the task when it holds all or none of roll, pitch,
+    yaw (angular velocity for the angles), else the task Jacobian."""
+    angles = sum(name in ("roll", "pitch", "yaw") for name in robot.task)
+    if angles in (0, 3):
+        return jacobian(robot, q)[[TASK_COMPONENTS.index(name) for name in robot.task]]
+    return task_jacobian(robot, q)
+
+
+def manipulability(robot, q):
+    """sqrt(det(Js Js^T)) (sqrt(det(Js^T Js)) when Js is tall): the product of the singular
+    values of Js, which stays accurate near 0 where the square root of a rounded det does not."""
+    return np.prod(np.linalg.svd(singularity_jacobian(robot, q), compute_uv=False))
+
+
+def jacobian_det(robot, q):
+    """det(Js) of a square Js."""
+    return np.linalg.det(singularity_jacobian(robot, q))

@@ -1,8 +1,16 @@
-"""Words a person reads: the DH table and task of a robot (`jacgen show`, the report)."""
+"""Words a person reads: DH table, task, singularities and IK of a robot (`jacgen show`,
+the generated NAME.md report), and the workspace plot of a planar arm (`show --plot`)."""
 
+import numpy as np
 import sympy
 
-from .robot import Robot
+from . import reference
+from .analysis import READABLE_TERMS, Factor, Singularities, analyse, singularity_rows
+from .errors import JacgenError
+from .robot import TASK_COMPONENTS, Robot
+from .structure import SOLVERS, classify
+
+DH_HEADER = ["#", "name", "type", "a", "alpha", "d", "theta", "offset", "limits"]
 
 
 def _angle(value) -> str:
@@ -29,10 +37,109 @@ def dh_table(robot: Robot) -> list[list[str]]:
     return rows
 
 
+def readable(expr: sympy.Expr) -> str:
+    """An expression with its non-integer numbers to 6 significant digits."""
+    numbers = {a: sympy.Float(a, 6) for a in expr.atoms(sympy.Rational) if not a.is_Integer}
+    return str(expr.xreplace(numbers))
+
+
+def _root(value: sympy.Expr, revolute: bool) -> str:
+    if not revolute:
+        return f"{float(value):.6g}"
+    turns = sympy.nsimplify(value / sympy.pi, rational=False)
+    if turns.is_Rational and turns.q <= 12:
+        return str(turns * sympy.pi)
+    return f"{float(value):.6g} ({np.degrees(float(value)):.4g} deg)"
+
+
+def condition_text(robot: Robot, factor: Factor) -> str:
+    """`sin(q3) = 0  ->  q3 in {0, pi}: elbow: arm fully stretched or folded`."""
+    terms = len(sympy.Add.make_args(factor.polynomial))
+    if terms > READABLE_TERMS:
+        joints = ", ".join(f"q{i + 1}" for i in factor.joints)
+        text = f"a polynomial of {terms} terms in the sines and cosines of {joints} = 0"
+    else:
+        text = f"{readable(factor.condition)} = 0"
+    if factor.roots:
+        joint = factor.joints[0]
+        values = ", ".join(_root(r, robot.joints[joint].revolute) for r in factor.roots)
+        text += f"  ->  q{joint + 1} in {{{values}}}"
+    if factor.multiplicity > 1:
+        text += f"  (multiplicity {factor.multiplicity})"
+    return text + (f": {factor.meaning}" if factor.meaning else "")
+
+
+def singularity_lines(robot: Robot, singular: Singularities) -> list[str]:
+    """The singularity conditions, one per line, then notes."""
+    lines = [condition_text(robot, factor) for factor in singular.factors] or ["none: Js has full rank everywhere"]
+    if singular.note:
+        lines.append(f"note: {singular.note}")
+    if robot.symbolic_parameters and any(f.roots for f in singular.factors):
+        lines.append("note: roots at the nominal values of the runtime parameters")
+    return lines
+
+
+def euler_lines(robot: Robot, singular: Singularities) -> list[str]:
+    """Where the roll-pitch-yaw representation itself is singular (cos(pitch) = 0)."""
+    if not any(component in ("roll", "pitch", "yaw") for component in robot.task):
+        return []
+    if singularity_rows(robot) is not None:
+        return ["cos(pitch) = 0 (pitch = ±90 deg): task_jacobian (roll, pitch, yaw rates) is undefined there; "
+                "Js uses the angular velocity, so it is no kinematic singularity"]
+    if not singular.euler:
+        return ["cos(pitch) = 0 never happens: the tool's pitch is 0 in every configuration"]
+    return ["cos(pitch) = 0 (pitch = ±90 deg), task_jacobian and Js undefined, where:"] + [
+        f"  {condition_text(robot, factor)}" for factor in singular.euler]
+
+
+def _planar(robot: Robot) -> bool:
+    """Every joint axis parallel to the world z axis (checked at a generic configuration)."""
+    frames, _ = reference.frames(robot, np.linspace(0.3, 0.9, robot.dof))
+    return all(np.linalg.norm(np.cross(frame[:3, 2], [0.0, 0.0, 1.0])) < 1e-9 for frame in frames)
+
+
+def isotropy_lines(robot: Robot) -> list[str]:
+    """Planar 2R (task x, y): the best-conditioned elbow angle, isotropic when l1 = sqrt(2) l2.
+
+    With link lengths l1, l2 and elbow angle phi, cond(J)^2 + 1/cond(J)^2 + 2 =
+    (l1^2 + 2 l2^2 + 2 l1 l2 cos(phi))^2 / (l1 l2 sin(phi))^2, least at
+    cos(phi) = -2 l1 l2 / (l1^2 + 2 l2^2), where cond(J) = 1 exactly when l1 = sqrt(2) l2.
+    """
+    if not (robot.dof == 2 and all(j.revolute for j in robot.joints) and robot.task == ("x", "y")
+            and _planar(robot)):
+        return []
+    frames, tool = reference.frames(robot, np.zeros(2))
+    l1 = float(np.linalg.norm((frames[1][:3, 3] - frames[0][:3, 3])[:2]))
+    l2 = float(np.linalg.norm((tool[:3, 3] - frames[1][:3, 3])[:2]))
+    if l1 == 0 or l2 == 0:
+        return []
+    link1 = (frames[1][:3, 3] - frames[0][:3, 3])[:2]
+    link2 = (tool[:3, 3] - frames[1][:3, 3])[:2]
+    phi0 = np.arctan2(link1[0] * link2[1] - link1[1] * link2[0], np.dot(link1, link2))  # elbow angle at q2 = 0
+    phi = np.arccos(-2 * l1 * l2 / (l1**2 + 2 * l2**2))
+    angles = sorted(float((s * phi - phi0 + np.pi) % (2 * np.pi) - np.pi) for s in (1, -1))
+    condition = np.linalg.cond(reference.jacobian(robot, np.array([0.0, angles[0]]))[:2])
+    where = f"q2 in {{{', '.join(f'{np.degrees(a):.4g} deg' for a in angles)}}}"
+    if abs(condition - 1) < 1e-9:
+        return [f"isotropic (condition number 1) at {where}: l1 = sqrt(2) l2"]
+    return [f"no isotropic configuration (that needs l1 = sqrt(2) l2; here l1 = {l1:.6g}, l2 = {l2:.6g}); "
+            f"best conditioned at {where}, condition number {condition:.6g}"]
+
+
+def ik_lines(robot: Robot) -> list[str]:
+    structure = classify(robot)
+    if structure.solver is None:
+        return [f"no closed form ({structure.reason}); ik_numeric only"]
+    info = SOLVERS[structure.solver]
+    return [f"{info.title} ({structure.reason}), at most {info.max_solutions} solutions, branches "
+            f"(outermost first): {'; '.join(info.branches)}"]
+
+
 def describe(robot: Robot) -> str:
-    header = ["#", "name", "type", "a", "alpha", "d", "theta", "offset", "limits"]
-    rows = [header] + dh_table(robot)
-    widths = [max(len(row[c]) for row in rows) for c in range(len(header))]
+    """`jacgen show`: everything above as plain text."""
+    singular = analyse(robot)
+    rows = [DH_HEADER] + dh_table(robot)
+    widths = [max(len(row[c]) for row in rows) for c in range(len(DH_HEADER))]
     lines = [f"{robot.name}: {robot.description}".rstrip(": "),
              f"{robot.dof} joints, {robot.convention} DH, lengths in {robot.length_unit}", ""]
     lines += ["  ".join(cell.ljust(width) for cell, width in zip(row, widths)).rstrip() for row in rows]
@@ -40,4 +147,63 @@ def describe(robot: Robot) -> str:
     symbolic = robot.symbolic_parameters
     if symbolic:
         lines.append("runtime parameters: " + ", ".join(f"{p.name} (nominal {p.value:g})" for p in symbolic))
+    lines += ["", f"singularities ({singular.kind} = 0, Js = {js_text(robot)}):"]
+    lines += [f"  {line}" for line in singularity_lines(robot, singular) + euler_lines(robot, singular)]
+    isotropy = isotropy_lines(robot)
+    if isotropy:
+        lines += ["", "isotropy:"] + [f"  {line}" for line in isotropy]
+    lines += ["", "inverse kinematics:"] + [f"  {line}" for line in ik_lines(robot)]
     return "\n".join(lines)
+
+
+def js_text(robot: Robot) -> str:
+    rows = singularity_rows(robot)
+    if rows is None:
+        return "task_jacobian"
+    names = ("vx", "vy", "vz", "wx", "wy", "wz")
+    return "jacobian rows (" + ", ".join(names[r] for r in rows) + ")"
+
+
+def plot_workspace(robot: Robot, path: str, samples: int = 4000, ellipses: int = 6) -> None:
+    """PNG of a planar arm: tool positions coloured by manipulability, and at a few
+    configurations the arm and its velocity ellipse (J_xy J_xy^T, x and y rows)."""
+    if not _planar(robot):
+        raise JacgenError(f"{robot.source}: --plot needs a planar arm (every joint axis parallel to world z)")
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from matplotlib.patches import Ellipse
+
+    rows = [TASK_COMPONENTS.index(c) for c in robot.task]  # planar: yaw rate = wz, roll = pitch = 0
+    rng = np.random.default_rng(0)
+    bounds = np.array([joint.limits or (-np.pi, np.pi) for joint in robot.joints])
+    configurations = rng.uniform(bounds[:, 0], bounds[:, 1], size=(samples, robot.dof))
+    points, measure = [], []
+    for q in configurations:
+        js = reference.jacobian(robot, q)[rows]
+        gram = js @ js.T if js.shape[0] <= js.shape[1] else js.T @ js
+        points.append(reference.fk(robot, q)[:2, 3])
+        measure.append(np.sqrt(max(np.linalg.det(gram), 0.0)))
+    points = np.array(points)
+    figure, axes = plt.subplots(figsize=(7, 6), dpi=100)
+    cloud = axes.scatter(points[:, 0], points[:, 1], c=measure, s=4, cmap="viridis")
+    figure.colorbar(cloud, ax=axes, label="manipulability sqrt(det(Js Js^T))")
+    reach = float(np.max(np.linalg.norm(points, axis=1))) or 1.0
+    shown = configurations[:ellipses]
+    jacobians = [reference.jacobian(robot, q)[:2] for q in shown]
+    largest = max(np.linalg.svd(j, compute_uv=False)[0] for j in jacobians) or 1.0
+    for q, j in zip(shown, jacobians):
+        frames, tool = reference.frames(robot, q)
+        chain = np.array([f[:2, 3] for f in frames] + [tool[:2, 3]])
+        axes.plot(chain[:, 0], chain[:, 1], "-o", color="0.3", lw=1, ms=2)
+        u, s, _ = np.linalg.svd(j)
+        scale = 0.25 * reach / largest
+        axes.add_patch(Ellipse(tool[:2, 3], 2 * scale * s[0], 2 * scale * (s[1] if len(s) > 1 else 0),
+                               angle=np.degrees(np.arctan2(u[1, 0], u[0, 0])), fill=False, color="tab:red"))
+    axes.set_aspect("equal")
+    axes.set_xlabel(f"x ({robot.length_unit})")
+    axes.set_ylabel(f"y ({robot.length_unit})")
+    axes.set_title(f"{robot.name}: manipulability over the workspace\nand velocity ellipses (red)", fontsize=10)
+    figure.savefig(path)
+    plt.close(figure)

@@ -1,0 +1,546 @@
+"""Singularity analysis (SPEC §2): the singularity Jacobian Js, its polynomial and factors.
+
+Js is the task Jacobian, except that a task holding all of roll, pitch and yaw uses the
+geometric angular-velocity rows instead (so the Euler-angle singularity at pitch = ±90°
+is not mistaken for a kinematic one; it is reported separately). The robot is singular
+where det(Js) (m = n), det(Js Js^T) (m < n) or det(Js^T Js) (m > n) vanishes.
+
+The polynomial is computed exactly in a polynomial ring over the joint atoms c_i, s_i
+(cos and sin of q_i + offset_i), the variables of prismatic joints and the symbolic
+parameters, where products and determinants are cheap. Where Js is the whole geometric
+Jacobian, its determinant and its maximal minors do not change when the twist is
+expressed in another frame or about another reference point (a rotation and a shift,
+both of determinant 1), so they are computed in whichever joint frame and about whichever
+joint origin make the matrix smallest: about a spherical wrist's centre the matrix is
+block triangular and det = det(arm 3x3) * det(wrist 3x3).
+
+Factoring happens in the free ring first (the product structure survives there), then
+each factor is reduced with s_i^2 + c_i^2 = 1 towards cosines and towards sines and
+factored again, keeping whichever splits it further. Trig polynomials do not factor
+uniquely (sin^2 = (1 - cos)(1 + cos)), so "irreducible" means no further split is found
+this way; every factor is exact, and constant * product of factors equals the polynomial
+wherever c_i^2 + s_i^2 = 1.
+"""
+
+import itertools
+import time
+from dataclasses import dataclass
+from functools import lru_cache
+
+import numpy as np
+import sympy
+from sympy.polys.orderings import lex
+from sympy.polys.rings import PolyElement, PolyRing
+
+from . import kinematics, reference
+from .robot import TASK_COMPONENTS, Robot
+
+EULER = ("roll", "pitch", "yaw")
+# Gram cofactors (redundant arms) above this many terms are not factored: sympy needs
+# minutes for the 10^4-term cofactors of 7-axis arms, a few seconds at most below this.
+FACTOR_TERM_LIMIT = 2000
+READABLE_TERMS = 64  # factors up to this many terms are written with angle sums collapsed
+ROOT_TOLERANCE = 1e-9  # |factor| at a numerically found root
+PARALLEL_TOLERANCE = 1e-9  # |z_a x z_b| for parallel unit axes
+
+
+def singularity_rows(robot: Robot) -> tuple[int, ...] | None:
+    """Rows of the geometric Jacobian (vx vy vz wx wy wz) forming Js, in task order;
+    None when Js is the task Jacobian itself (a task with some but not all Euler angles)."""
+    if sum(component in EULER for component in robot.task) in (0, 3):
+        return tuple(TASK_COMPONENTS.index(component) for component in robot.task)
+    return None
+
+
+def singularity_jacobian(robot: Robot, jacobian: sympy.Matrix, task_jacobian: sympy.Matrix) -> sympy.Matrix:
+    """Js from the geometric and the task Jacobian of one chain."""
+    rows = singularity_rows(robot)
+    return task_jacobian if rows is None else jacobian.extract(list(rows), list(range(robot.dof)))
+
+
+def joint_atoms(robot: Robot) -> tuple[tuple[sympy.Symbol, ...], ...]:
+    """Per joint, the symbols analysis polynomials are written in: (c_i, s_i), the cos and
+    sin of q_i + offset_i, for a revolute joint; (q_i,) for a prismatic one."""
+    q = kinematics.joint_symbols(robot)
+    return tuple(sympy.symbols(f"c{i + 1} s{i + 1}", real=True) if joint.revolute else (q[i],)
+                 for i, joint in enumerate(robot.joints))
+
+
+def maximal_minors(matrix, zero=0, one=1) -> list:
+    """Every largest square minor of a matrix (list of rows), by Laplace expansion.
+
+    The minors of the lower rows are shared (memoised), so a 6 x 7 matrix costs about 450
+    products, and the result is division-free: exact in a ring, and straight-line code
+    that stays finite at singular configurations. Wide matrices give one minor per column
+    subset, tall ones per row subset, subsets in lexicographic order.
+    """
+    if len(matrix) > len(matrix[0]):
+        matrix = [list(column) for column in zip(*matrix)]
+    rows, cols = len(matrix), len(matrix[0])
+
+    @lru_cache(maxsize=None)
+    def minor(row: int, columns: tuple[int, ...]):
+        if row == rows:
+            return one
+        total = zero
+        for k, c in enumerate(columns):
+            if matrix[row][c] != 0:
+                term = matrix[row][c] * minor(row + 1, columns[:k] + columns[k + 1:])
+                total = total - term if k % 2 else total + term
+        return total
+
+    return [minor(0, subset) for subset in itertools.combinations(range(cols), rows)]
+
+
+# ---------------------------------------------------------------------------------------
+# The polynomial ring of a robot
+
+
+class JointRing:
+    """Exact polynomials in the joint atoms (c_i, s_i of revolute joints, q_i of prismatic
+    ones) and the symbolic parameters; other irrational constants become opaque generators
+    so that every product stays in a ring over the rationals."""
+
+    def __init__(self, robot: Robot):
+        self.robot = robot
+        self.q = kinematics.joint_symbols(robot)
+        self.atoms = joint_atoms(robot)
+        self.opaque: dict[sympy.Expr, sympy.Symbol] = {}
+        links = kinematics.link_transforms(robot, lambda i: self.atoms[i], self.q)
+        transforms = [m for pair in links for m in pair]
+        transforms += [kinematics.pose_transform(robot.base), kinematics.pose_transform(robot.tool)]
+        transforms = [m.applyfunc(self._hide_constants) for m in transforms]
+        symbols = [a for atoms in self.atoms for a in atoms] + [p.symbol for p in robot.symbolic_parameters]
+        symbols += list(self.opaque.values())
+        self.ring = PolyRing(symbols, sympy.QQ, lex)  # c_i before s_i: reduces c_i^2
+        swapped = [a for atoms in self.atoms for a in reversed(atoms)] + symbols[len(symbols) - len(self.opaque)
+                                                                                - len(robot.symbolic_parameters):]
+        self.sin_ring = PolyRing(swapped, sympy.QQ, lex)  # s_i before c_i: reduces s_i^2
+        matrices = [self.matrix(m) for m in transforms]
+        self.links = [(matrices[2 * i], matrices[2 * i + 1]) for i in range(robot.dof)]
+        self.base, self.tool = matrices[-2], matrices[-1]
+        self.trig_gens = [i for i, atoms in enumerate(self.atoms) if len(atoms) == 2]
+        self.circles = {toward_cos: [ring(self.atoms[i][0] ** 2 + self.atoms[i][1] ** 2 - 1) for i in self.trig_gens]
+                        for toward_cos, ring in ((True, self.sin_ring), (False, self.ring))}
+
+    def _hide_constants(self, expr: sympy.Expr) -> sympy.Expr:
+        """Replace each irrational constant (sqrt(2)/2, cos(22*pi/225)) by a generator."""
+        if expr.is_Rational or expr.is_Symbol:
+            return expr
+        if expr.is_number or not (expr.is_Add or expr.is_Mul or (expr.is_Pow and expr.exp.is_Integer
+                                                                    and expr.exp >= 0)):
+            if expr not in self.opaque:
+                self.opaque[expr] = sympy.Symbol(f"_k{len(self.opaque)}", real=True)
+            return self.opaque[expr]
+        return expr.func(*(self._hide_constants(arg) for arg in expr.args))
+
+    def matrix(self, m: sympy.Matrix) -> list[list[PolyElement]]:
+        return [[self.ring.from_expr(m[r, c]) for c in range(m.cols)] for r in range(m.rows)]
+
+    def expr(self, p: PolyElement) -> sympy.Expr:
+        """Back to sympy, over the atoms c_i, s_i, q_i and parameters (constants restored)."""
+        values = {symbol: value for value, symbol in self.opaque.items()}
+        return p.as_expr().xreplace(values)
+
+    def trig_expr(self, p: PolyElement) -> sympy.Expr:
+        """Readable: cos(q_i + offset) for c_i, sums of angles collapsed (in polynomials of
+        up to READABLE_TERMS terms: beyond, collapsing costs minutes and reads no better)."""
+        values = {}
+        for i, atoms in enumerate(self.atoms):
+            if len(atoms) == 2:
+                angle = self.q[i] + self.robot.joints[i].offset.exact
+                values.update({atoms[0]: sympy.cos(angle), atoms[1]: sympy.sin(angle)})
+        condition = self.expr(p).xreplace(values)
+        return kinematics.simplify_trig(condition) if len(p) <= READABLE_TERMS else condition
+
+    def reduce(self, p: PolyElement, toward_cos: bool) -> PolyElement:
+        """Normal form modulo s_i^2 + c_i^2 - 1: no s_i^2 (toward cos) or no c_i^2."""
+        ring = self.sin_ring if toward_cos else self.ring
+        circles = self.circles[toward_cos]
+        return p.set_ring(ring).rem(circles).set_ring(self.ring) if circles else p
+
+    def joints_of(self, p: PolyElement) -> tuple[int, ...]:
+        degrees = p.degrees()
+        used, g = [], 0
+        for i, atoms in enumerate(self.atoms):
+            if any(degrees[g + k] > 0 for k in range(len(atoms))):
+                used.append(i)
+            g += len(atoms)
+        return tuple(used)
+
+
+def _mul(a, b):
+    return [[sum((a[r][k] * b[k][c] for k in range(len(b))), a[r][0].ring.zero) for c in range(len(b[0]))]
+            for r in range(len(a))]
+
+
+def _inverse(t):
+    """Inverse of a rigid transform (exact wherever c_i^2 + s_i^2 = 1)."""
+    rotation = [[t[c][r] for c in range(3)] for r in range(3)]
+    shift = [-sum((rotation[r][k] * t[k][3] for k in range(3)), t[0][0].ring.zero) for r in range(3)]
+    zero, one = t[0][0].ring.zero, t[0][0].ring.one
+    return [rotation[r] + [shift[r]] for r in range(3)] + [[zero, zero, zero, one]]
+
+
+def _frames_about(ring: JointRing, k: int) -> list:
+    """Poses of every joint-axis frame and of the tool relative to the axis frame of joint k."""
+    n = ring.robot.dof
+    step = [_mul(ring.links[j][1], ring.links[j + 1][0]) for j in range(n - 1)]  # axis j -> axis j+1
+    identity = [[ring.ring.one if r == c else ring.ring.zero for c in range(4)] for r in range(4)]
+    frames = [None] * n
+    frames[k] = identity
+    for i in range(k + 1, n):
+        frames[i] = _mul(frames[i - 1], step[i - 1])
+    back = identity
+    for i in range(k - 1, -1, -1):
+        back = _mul(step[i], back)
+        frames[i] = _inverse(back)
+    tool = _mul(_mul(frames[n - 1], ring.links[n - 1][1]), ring.tool)
+    return frames + [tool]
+
+
+def _geometric_columns(ring: JointRing, frames: list, point) -> list[list[PolyElement]]:
+    """Geometric Jacobian (6 x n rows) in the frames' coordinates about `point`, reduced."""
+    rows = [[None] * ring.robot.dof for _ in range(6)]
+    for i, joint in enumerate(ring.robot.joints):
+        z = [frames[i][r][2] for r in range(3)]
+        if joint.revolute:
+            arm = [point[r] - frames[i][r][3] for r in range(3)]
+            linear = [z[1] * arm[2] - z[2] * arm[1], z[2] * arm[0] - z[0] * arm[2], z[0] * arm[1] - z[1] * arm[0]]
+            column = linear + z
+        else:
+            column = z + [ring.ring.zero] * 3
+        for r in range(6):
+            rows[r][i] = ring.reduce(column[r], toward_cos=True)
+    return rows
+
+
+def _size(matrix) -> int:
+    return sum(len(entry) for row in matrix for entry in row)
+
+
+# ---------------------------------------------------------------------------------------
+# Factoring
+
+
+def _factor(ring: JointRing, p: PolyElement) -> tuple[PolyElement, list[tuple[PolyElement, int]]]:
+    """constant, [(factor, multiplicity)]: p = constant * prod(factor^multiplicity) on the torus.
+
+    Factors free of joint variables (parameters, opaque constants) go into the constant.
+    """
+    constant, factors = ring.ring.one, {}
+    coefficient, free = p.factor_list()
+    constant *= coefficient
+    for f, k in free:
+        candidates = [g.factor_list() for g in (ring.reduce(f, True), ring.reduce(f, False))]
+        best = max(candidates, key=lambda c: (sum(bool(ring.joints_of(g)) for g, _ in c[1]),
+                                              -sum(len(g) for g, _ in c[1])))
+        constant *= best[0] ** k
+        for g, j in best[1]:
+            if ring.joints_of(g):
+                factors[g] = factors.get(g, 0) + j * k
+            else:
+                constant *= g ** (j * k)
+    for i in ring.trig_gens:  # (c_i - 1)^a (c_i + 1)^a = (-1)^a s_i^(2a)
+        c, s = (ring.ring(atom) for atom in ring.atoms[i])
+        a = min(factors.get(c - 1, 0), factors.get(c + 1, 0))
+        if a:
+            for g in (c - 1, c + 1):
+                factors[g] -= a
+                if not factors[g]:
+                    del factors[g]
+            factors[s] = factors.get(s, 0) + 2 * a
+            constant *= (-1) ** a
+    normalised = []  # largest coefficient 1, so that factor values are of the order of 1
+    for f, k in factors.items():
+        scale = f.max_norm()
+        normalised.append((f.quo_ground(scale), k))
+        constant *= scale**k
+    normalised.sort(key=lambda item: (len(ring.joints_of(item[0])), ring.joints_of(item[0]),
+                                      len(item[0]), str(item[0])))
+    return constant, normalised
+
+
+# ---------------------------------------------------------------------------------------
+# The matrix analysed
+
+
+def _permutation_sign(order) -> int:
+    order, sign = list(order), 1
+    for i in range(len(order)):
+        while order[i] != i:
+            j = order[i]
+            order[i], order[j] = order[j], order[i]
+            sign = -sign
+    return sign
+
+
+def _analysed_matrix(ring: JointRing):
+    """(rows, sign, cos(pitch)^2 or None): a matrix with the singularity polynomial of Js.
+
+    The whole geometric Jacobian: in the smallest joint frame and about the smallest
+    reference point (always the tool point when tall, where only rotations keep
+    det(Js^T Js)); its determinant is sign * det(Js). Otherwise Js in the world frame,
+    Euler-angle rows multiplied by their denominators, which are returned as cos(pitch)^2.
+    """
+    robot = ring.robot
+    n, rows = robot.dof, singularity_rows(robot)
+    if rows is not None and len(rows) == 6:
+        best = None
+        for k in range(n):
+            frames = _frames_about(ring, k)
+            points = [frames[-1]] if n < 6 else frames
+            for frame in points:
+                matrix = _geometric_columns(ring, frames, [frame[r][3] for r in range(3)])
+                if best is None or _size(matrix) < _size(best):
+                    best = matrix
+        return best, _permutation_sign(rows), None
+    base_axis = _mul(ring.base, ring.links[0][0])
+    frames = [_mul(base_axis, frame) for frame in _frames_about(ring, 0)]
+    tool = frames[-1]
+    geometric = _geometric_columns(ring, frames, [tool[r][3] for r in range(3)])
+    if rows is not None:
+        return [geometric[r] for r in rows], 1, None
+    euler, cos_pitch_sq = _euler_rows(ring, [row[:3] for row in tool[:3]], geometric[3:])
+    chosen = [geometric[TASK_COMPONENTS.index(c)] if c in "xyz" else euler[c] for c in robot.task]
+    return [[ring.reduce(e, True) for e in row] for row in chosen], 1, cos_pitch_sq
+
+
+def _euler_rows(ring: JointRing, rotation, angular) -> tuple[dict, PolyElement]:
+    """Roll, pitch and yaw rate rows times their denominators (cos(pitch)^2, cos(pitch),
+    cos(pitch)^2: see kinematics.rpy_rates), and cos(pitch)^2 = r00^2 + r10^2 unreduced
+    (its product structure shows which joints make pitch reach ±90°)."""
+    r00, r10, r20 = rotation[0][0], rotation[1][0], rotation[2][0]
+    wx, wy, wz = angular
+    cos_pitch_sq = r00**2 + r10**2
+    reduced = ring.reduce(cos_pitch_sq, True)
+    roll = [r00 * wx[j] + r10 * wy[j] for j in range(ring.robot.dof)]
+    return {"roll": roll,
+            "pitch": [r00 * wy[j] - r10 * wx[j] for j in range(ring.robot.dof)],
+            "yaw": [reduced * wz[j] - r20 * roll[j] for j in range(ring.robot.dof)]}, cos_pitch_sq
+
+
+# ---------------------------------------------------------------------------------------
+# The analysis
+
+
+@dataclass(frozen=True)
+class Factor:
+    """One singularity condition `polynomial = 0`."""
+
+    polynomial: sympy.Expr  # over c_i, s_i, q_i (prismatic joints) and parameters: for code
+    condition: sympy.Expr  # the same in q (sin(q2 + q3)): for people
+    multiplicity: int
+    joints: tuple[int, ...]  # 0-based indices of the joints it depends on
+    roots: tuple[sympy.Expr, ...] | None  # one joint: its values in (-pi, pi] (prismatic: all)
+    meaning: str  # a name for the configuration, or ""
+
+
+@dataclass(frozen=True)
+class Singularities:
+    """The singularity polynomial of a robot, factored as far as the budget allows.
+
+    For square Js: det(Js) = constant * prod(p^k for p, k in determinant) / cos(pitch)^euler_power,
+    where cos(pitch) = sqrt(r00^2 + r10^2) of the tool rotation (euler_power > 0 only when
+    Js holds Euler-angle rate rows).
+    """
+
+    kind: str  # "det(Js)", "det(Js Js^T)" or "det(Js^T Js)"
+    factors: tuple[Factor, ...]  # the kinematic singularity conditions
+    complete: bool  # False: only the factors common to all maximal minors of Js are known
+    constant: sympy.Expr
+    determinant: tuple[tuple[sympy.Expr, int], ...]  # every factor of the polynomial, Euler ones too
+    euler_power: int
+    euler: tuple[Factor, ...]  # joint conditions for cos(pitch) = 0, when Js holds Euler rows
+    note: str
+    seconds: float
+
+
+def analyse(robot: Robot) -> Singularities:
+    """Factor the singularity polynomial of `robot` (see the module docstring)."""
+    start = time.perf_counter()
+    ring = JointRing(robot)
+    n, m = robot.dof, len(robot.task)
+    kind = "det(Js)" if m == n else ("det(Js Js^T)" if m < n else "det(Js^T Js)")
+    matrix, sign, cos_pitch_sq = _analysed_matrix(ring)
+    minors = maximal_minors(matrix, ring.ring.zero, ring.ring.one)
+    note, complete = "", True
+    if m == n:
+        constant, factors = _factor(ring, minors[0])
+        constant *= sign
+    else:
+        common = minors[0]
+        for minor in minors[1:]:
+            common = common.gcd(minor)
+        constant, factors = _factor(ring, common)
+        constant, factors = constant**2, [(f, 2 * k) for f, k in factors]
+        cofactor = ring.reduce(sum((minor.exquo(common) ** 2 for minor in minors), ring.ring.zero), True)
+        if len(cofactor) <= FACTOR_TERM_LIMIT:
+            extra_constant, extra = _factor(ring, cofactor)
+            constant *= extra_constant
+            merged = dict(factors)
+            for f, k in extra:
+                merged[f] = merged.get(f, 0) + k
+            factors = sorted(merged.items(), key=lambda item: [f for f, _ in factors + extra].index(item[0]))
+        else:
+            complete = False
+            note = (f"{kind} has {len(cofactor)} terms once the factors common to all {len(minors)} "
+                    f"maximal minors of Js are taken out: too many to factor, so the singularity "
+                    f"factors end with the Gram determinant itself (zero wherever the manipulability is)")
+    euler_power, euler = 0, []
+    if cos_pitch_sq is not None:
+        euler_power = sum({"roll": 2, "pitch": 1, "yaw": 2}.get(c, 0) for c in robot.task)
+        euler = [(f, k) for f, k in _factor(ring, cos_pitch_sq)[1]]
+    scale = dict(euler)
+    kinematic = [(f, k - euler_power * scale.get(f, 0) // 2) for f, k in factors]
+    context = _Numeric(robot, ring)
+    return Singularities(
+        kind=kind,
+        factors=tuple(context.describe(f, k) for f, k in kinematic if k > 0),
+        complete=complete,
+        constant=ring.expr(constant),
+        determinant=tuple((ring.expr(f), k) for f, k in factors),
+        euler_power=euler_power,
+        euler=tuple(context.describe(f, k // 2 or 1) for f, k in euler),
+        note=note,
+        seconds=time.perf_counter() - start,
+    )
+
+
+# ---------------------------------------------------------------------------------------
+# Roots and names
+
+
+class _Numeric:
+    """Numbers about the factors: roots, zero sets, and the axes there (from the numeric
+    reference chain) to name the configuration."""
+
+    def __init__(self, robot: Robot, ring: JointRing):
+        self.robot, self.ring = robot, ring
+        self.nominal = {p.symbol: sympy.Float(p.value, 30) for p in robot.symbolic_parameters}
+        self.rng = np.random.default_rng(20240601)
+
+    def describe(self, f: PolyElement, multiplicity: int) -> Factor:
+        joints = self.ring.joints_of(f)
+        condition = self.ring.trig_expr(f)
+        roots = self._roots(condition, joints[0]) if len(joints) == 1 else None
+        factor = Factor(self.ring.expr(f), condition, multiplicity, joints, roots, "")
+        return Factor(**{**factor.__dict__, "meaning": self._meaning(factor)})
+
+    def _roots(self, condition: sympy.Expr, joint: int) -> tuple[sympy.Expr, ...]:
+        q = self.ring.q[joint]
+        domain = (sympy.Interval(-sympy.pi, sympy.pi, left_open=True) if self.robot.joints[joint].revolute
+                  else sympy.S.Reals)
+        roots = sympy.solveset(condition.xreplace(self.nominal), q, domain)
+        if not isinstance(roots, sympy.FiniteSet):
+            return ()
+        return tuple(sorted(roots, key=lambda r: float(r)))
+
+    def _function(self, condition: sympy.Expr):
+        return sympy.lambdify([self.ring.q], condition.xreplace(self.nominal), "numpy")
+
+    def _configuration(self) -> np.ndarray:
+        bounds = [joint.limits or (-np.pi, np.pi) for joint in self.robot.joints]
+        return np.array([self.rng.uniform(lo, hi) for lo, hi in bounds])
+
+    def zero_set_points(self, factor: Factor, count: int = 3) -> list[np.ndarray]:
+        """Configurations where the factor vanishes: random ones with one joint solved for."""
+        value = self._function(factor.condition)
+        points = []
+        for _ in range(8 * count):
+            q = self._configuration()
+            for joint in factor.joints:
+                root = _solve_along(value, q, joint, self.robot.joints[joint])
+                if root is not None:
+                    points.append(root)
+                    break
+            if len(points) == count:
+                break
+        return points
+
+    def _meaning(self, factor: Factor) -> str:
+        robot = self.robot
+        n = robot.dof
+        if len(factor.joints) == 1:
+            k = factor.joints[0]
+            joint = robot.joints[k]
+            if not joint.revolute:
+                return f"prismatic joint {k + 1} at zero extension"
+            if 0 < k < n - 1 and factor.roots:
+                generic = _axes(robot, self._configuration())
+                if not _parallel(generic[k - 1][1], generic[k + 1][1]):
+                    aligned = []
+                    for root in factor.roots:
+                        q = self._configuration()
+                        q[k] = float(root)
+                        aligned.append(_axes(robot, q))
+                    if all(_parallel(a[k - 1][1], a[k + 1][1]) for a in aligned):
+                        word = "aligned" if all(_collinear(a[k - 1], a[k + 1]) for a in aligned) else "parallel"
+                        prefix = "wrist singularity: " if k == n - 2 else ""
+                        return f"{prefix}axes of joints {k} and {k + 2} {word}"
+            if k > 0 and robot.joints[k - 1].revolute:
+                generic = _axes(robot, self._configuration())
+                if _parallel(generic[k - 1][1], generic[k][1]):
+                    return "elbow: arm fully stretched or folded"
+            return ""
+        points = self.zero_set_points(factor) if len(sympy.Add.make_args(factor.polynomial)) <= READABLE_TERMS else []
+        for name, point in (("wrist point", lambda q: _axes(robot, q)[-1][0]),
+                            ("tool point", lambda q: reference.fk(robot, q)[:3, 3])):
+            if n >= 3 and points and all(_over_first_axis(robot, q, point(q)) for q in points):
+                return f"shoulder: {name} in the plane of the axes of joints 1 and 2 (over the axis of joint 1)"
+        return ""
+
+
+def _solve_along(value, q: np.ndarray, joint: int, spec) -> np.ndarray | None:
+    """q with joint `joint` moved to a root of `value` (a sign change on a grid, bisected)."""
+    lo, hi = spec.limits or ((-np.pi, np.pi) if spec.revolute else (-2.0, 2.0))
+    grid = np.linspace(lo, hi, 721)
+    trial = np.repeat(q[None, :], len(grid), axis=0)
+    trial[:, joint] = grid
+    values = np.broadcast_to(value(trial.T), grid.shape)
+    changes = np.nonzero(np.sign(values[:-1]) * np.sign(values[1:]) <= 0)[0]
+    if not len(changes):
+        return None
+    a, b = grid[changes[0]], grid[changes[0] + 1]
+    point = q.copy()
+    for _ in range(80):
+        point[joint] = 0.5 * (a + b)
+        if np.sign(value(point)) == np.sign(value(np.where(np.arange(len(q)) == joint, a, point))):
+            a = point[joint]
+        else:
+            b = point[joint]
+    return point if abs(value(point)) < ROOT_TOLERANCE else None
+
+
+def _axes(robot: Robot, q: np.ndarray) -> list[tuple[np.ndarray, np.ndarray]]:
+    """(point, unit direction) of every joint axis, from the numeric reference chain."""
+    frames, _ = reference.frames(robot, q)
+    return [(frame[:3, 3], frame[:3, 2]) for frame in frames]
+
+
+def _parallel(a: np.ndarray, b: np.ndarray) -> bool:
+    return np.linalg.norm(np.cross(a, b)) < PARALLEL_TOLERANCE
+
+
+def _collinear(a, b) -> bool:
+    return _parallel(a[1], b[1]) and _parallel(a[1], b[0] - a[0])
+
+
+def _over_first_axis(robot: Robot, q: np.ndarray, point: np.ndarray) -> bool:
+    """`point` lies in the plane through the axis of joint 1 spanned by the directions of
+    axes 1 and 2 (on the axis of joint 1 itself when the arm has no shoulder offset)."""
+    axes = _axes(robot, q)
+    (origin, first), (_, second) = axes[0], axes[1]
+    normal = np.cross(first, second)
+    if np.linalg.norm(normal) < PARALLEL_TOLERANCE:
+        return False
+    reach = max(1.0, float(np.linalg.norm(point - origin)))
+    return abs(np.dot(point - origin, normal / np.linalg.norm(normal))) < 1e-7 * reach
+
+
+def singular_configurations(robot: Robot, singular: Singularities, per_factor: int = 3) -> np.ndarray:
+    """Configurations on the zero set of each factor that changes sign, found numerically
+    (random configurations with one joint moved to a root), (k, dof)."""
+    numeric = _Numeric(robot, JointRing(robot))
+    points = [q for factor in singular.factors for q in numeric.zero_set_points(factor, per_factor)]
+    return np.array(points).reshape(-1, robot.dof)

@@ -1,0 +1,266 @@
+"""Singularity analysis against conditions derived independently of it.
+
+Every expected condition comes from the textbooks' geometry (sin of a joint angle, a
+prismatic joint at zero extension, the wrist point coplanar with two parallel axes or with
+the first two axes), and each is first confirmed by the rank of the numpy reference Js at
+configurations that satisfy it. The factors must vanish exactly there, nowhere else, and
+multiply back to det(Js) (or the Gram determinant) at random configurations.
+"""
+
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+import sympy
+from click.testing import CliRunner
+from scipy.optimize import brentq, minimize, minimize_scalar
+
+from codegen import kinematics, load_robot, reference
+from codegen.analysis import analyse
+from codegen.cli import main
+from codegen.render import render_robot, write_files
+
+from conftest import ROOT, ROBOT_NAMES, import_file, random_configurations, robot
+
+EULER = ("roll", "pitch", "yaw")
+RANK_TOLERANCE = 1e-9  # smallest / largest singular value of Js at a singular configuration
+
+
+def reference_js(arm, q):
+    """Js from codegen.reference alone: geometric rows, or the ZYX Euler-angle rates
+    omega = E(roll, pitch, yaw) rpy_dot solved for rpy_dot when the task has some angles."""
+    J = reference.jacobian(arm, q)
+    angles = [c for c in arm.task if c in EULER]
+    if len(angles) in (0, 3):
+        return J[[("x", "y", "z", "roll", "pitch", "yaw").index(c) for c in arm.task]]
+    _, pitch, yaw = reference.rpy(reference.fk(arm, q)[:3, :3])
+    E = np.array([[np.cos(yaw) * np.cos(pitch), -np.sin(yaw), 0],
+                  [np.sin(yaw) * np.cos(pitch), np.cos(yaw), 0],
+                  [-np.sin(pitch), 0, 1]])
+    rates = np.linalg.solve(E, J[3:])
+    rows = {"x": J[0], "y": J[1], "z": J[2], "roll": rates[0], "pitch": rates[1], "yaw": rates[2]}
+    return np.array([rows[c] for c in arm.task])
+
+
+def rank_ratio(arm, q) -> float:
+    s = np.linalg.svd(reference_js(arm, q), compute_uv=False)
+    return s[-1] / s[0]
+
+
+# --- independent conditions: f(arm, q) whose zero set is a singular set ----------------------
+
+def sine(k):
+    return lambda arm, q: np.sin(q[k])
+
+
+def extension(k):
+    return lambda arm, q: q[k] + arm.joints[k].offset.approx
+
+
+def _axes(arm, q):
+    frames, tool = reference.frames(arm, q)
+    return [(f[:3, 3], f[:3, 2]) for f in frames], tool[:3, 3]
+
+
+def elbow(j, k):
+    """Wrist point (origin of the last axis frame) in the plane of parallel axes j and k."""
+    def condition(arm, q):
+        axes, _ = _axes(arm, q)
+        (oj, n), (ok, _), (w, _) = axes[j], axes[k], axes[-1]
+        return np.dot(np.cross(ok - oj, w - oj), n)
+    return condition
+
+
+def shoulder(point="wrist"):
+    """The point in the plane through axis 1 spanned by axes 1 and 2 (Spong: the wrist
+    centre on the axis of joint 1, shifted by the shoulder offset)."""
+    def condition(arm, q):
+        axes, tool = _axes(arm, q)
+        p = axes[-1][0] if point == "wrist" else tool
+        normal = np.cross(axes[0][1], axes[1][1])
+        return np.dot(p - axes[0][0], normal / np.linalg.norm(normal))
+    return condition
+
+
+# robot -> [(condition, joint to solve it along)], one per expected factor
+CONDITIONS = {
+    "planar_2r": [(sine(1), 1)],
+    "planar_3r": [(sine(1), 1)],
+    "scara": [(sine(1), 1)],
+    "rexarm": [(sine(2), 2), (shoulder("tool"), 1)],
+    "puma560": [(elbow(1, 2), 2), (sine(4), 4), (shoulder(), 1)],
+    "kr5": [(elbow(1, 2), 2), (sine(4), 4), (shoulder(), 1)],
+    "ur5": [(sine(2), 2), (sine(4), 4), (shoulder(), 1)],
+    "stanford": [(sine(1), 1), (extension(2), 2), (sine(4), 4)],
+    "iiwa": [(sine(3), 3), (None, None)],  # the Gram cofactor: no closed condition in the books
+    "panda": [(None, None)],
+}
+
+
+def solve_along(arm, condition, q, joint):
+    """q with `joint` moved to a root of condition (a sign change on a grid, then brentq)."""
+    lo, hi = (-np.pi, np.pi) if arm.joints[joint].revolute else (-2.0, 2.0)
+    grid = np.linspace(lo - 0.01 * (hi - lo), hi, 400)
+
+    def value(x):
+        trial = q.copy()
+        trial[joint] = x
+        return condition(arm, trial)
+
+    values = np.array([value(x) for x in grid])
+    change = np.nonzero(np.sign(values[:-1]) != np.sign(values[1:]))[0]
+    assert len(change), "no root on this line"
+    root = q.copy()
+    root[joint] = brentq(value, grid[change[0]], grid[change[0] + 1], xtol=1e-15, rtol=1e-15)
+    return root
+
+
+@pytest.fixture(scope="module")
+def analyses():
+    return {}
+
+
+def analysed(cache, name):
+    if name not in cache:
+        arm = robot(name)
+        result = analyse(arm)
+        q = kinematics.joint_symbols(arm)
+        functions = [sympy.lambdify([q], f.condition, "numpy") for f in result.factors]
+        cache[name] = (arm, result, lambda x: np.array([f(x) for f in functions], dtype=float))
+    return cache[name]
+
+
+@pytest.mark.parametrize("name", ROBOT_NAMES)
+def test_factors_are_the_independent_conditions(name, analyses):
+    arm, result, factors = analysed(analyses, name)
+    expected = CONDITIONS[name]
+    assert len(result.factors) == len(expected)
+    rng = np.random.default_rng(7)
+    for q in random_configurations(arm, 20, seed=11):  # regular: no factor vanishes
+        assert np.abs(factors(q)).min() > 1e-6 and rank_ratio(arm, q) > 1e-6
+    matched = set()
+    for condition, joint in expected:
+        if condition is None:
+            continue
+        for q in random_configurations(arm, 3, seed=int(rng.integers(1000))):
+            singular = solve_along(arm, condition, q, joint)
+            assert rank_ratio(arm, singular) < RANK_TOLERANCE  # the condition is a singularity
+            values = np.abs(factors(singular))
+            assert (values < 1e-8).sum() == 1, values  # exactly one factor vanishes there
+            matched.add(int(np.argmin(values)))
+    assert len(matched) == sum(condition is not None for condition, _ in expected)
+
+
+@pytest.mark.parametrize("name", ["iiwa", "panda", "rexarm", "puma560"])
+def test_every_factor_vanishes_only_where_js_is_singular(name, analyses):
+    """Minimising factor^2 from random starts reaches its zero set, where the reference Js
+    loses rank (a Gram cofactor touches 0 without changing sign, so no root bracketing;
+    there the smallest singular value goes as sqrt(|factor|), hence the looser bound)."""
+    arm, result, factors = analysed(analyses, name)
+    for index, factor in enumerate(result.factors):
+        reached = []
+        for start in random_configurations(arm, 4, seed=5 + index):
+            found = minimize(lambda x: factors(x)[index] ** 2, start, method="BFGS", options={"gtol": 1e-14})
+            if abs(factors(found.x)[index]) < 1e-8:
+                reached.append(found.x)
+        assert reached
+        assert all(rank_ratio(arm, q) < 1e-4 for q in reached)
+
+
+def test_named_conditions():
+    expected = {
+        "planar_2r": ["sin(q2)"], "scara": ["sin(q2)"], "ur5": ["sin(q3)", "sin(q5)", None],
+        "stanford": ["sin(q2)", "q3", "sin(q5)"], "puma560": [None, "sin(q5)", None],
+    }
+    for name, conditions in expected.items():
+        result = analyse(robot(name))
+        for factor, condition in zip(result.factors, conditions):
+            if condition is not None:
+                assert str(factor.condition) == condition
+    puma = analyse(robot("puma560"))
+    assert [f.roots for f in puma.factors][1] == (0, sympy.pi)
+    assert puma.factors[1].meaning.startswith("wrist singularity")
+    assert puma.factors[0].meaning.startswith("elbow")
+    assert puma.factors[2].meaning.startswith("shoulder")
+
+
+@pytest.fixture(scope="module")
+def python_modules(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("python")
+    cache = {}
+
+    def module(name):
+        if name not in cache:
+            write_files(render_robot(robot(name), ("python",)), folder)
+            cache[name] = import_file(folder / name / f"{name}.py", f"analysis_{name}")
+        return cache[name]
+    return module
+
+
+@pytest.mark.parametrize("name", ROBOT_NAMES)
+def test_generated_determinant_and_manipulability(name, python_modules):
+    """constant * prod(factors) is det(Js) (or det(Js Js^T)) exactly, not just its zero set."""
+    arm, module = robot(name), python_modules(name)
+    q = random_configurations(arm, 25, seed=2)
+    js = [reference_js(arm, x) for x in q]
+    m, n = js[0].shape
+    gram = np.array([np.linalg.det(j @ j.T if m <= n else j.T @ j) for j in js])
+    np.testing.assert_allclose(module.manipulability(q), np.sqrt(gram), rtol=1e-8)
+    if m == n:
+        np.testing.assert_allclose(module.jacobian_det(q), [np.linalg.det(j) for j in js], rtol=1e-8)
+    assert module.singularity_factors(q).shape == (25, len(analyse(arm).factors))
+
+
+def test_euler_singularity_of_a_pitch_task():
+    """rexarm's Js divides by cos(pitch): its zero set is reported apart, at pitch = ±90°."""
+    arm = robot("rexarm")
+    result = analyse(arm)
+    (factor,) = result.euler
+    value = sympy.lambdify([kinematics.joint_symbols(arm)], factor.condition, "numpy")
+    q = solve_along(arm, lambda a, x: value(x), random_configurations(arm, 1, seed=4)[0], 3)
+    assert abs(abs(reference.rpy(reference.fk(arm, q)[:3, :3])[1]) - np.pi / 2) < 1e-6
+
+
+def _planar_2r(tmp_path, a1, a2):
+    path = tmp_path / "two.yaml"
+    path.write_text(f"name: two\nconvention: standard\njoints:\n"
+                    f"  - {{type: revolute, a: {a1}, alpha: 0, d: 0}}\n"
+                    f"  - {{type: revolute, a: {a2}, alpha: 0, d: 0}}\ntask: [x, y]\n")
+    return path
+
+
+@pytest.mark.parametrize("a1, a2", [(1.0, 1.0), ("sqrt(2)", 1.0), (0.5, 0.8)])
+def test_isotropy_of_planar_2r(tmp_path, a1, a2):
+    """The reported best elbow angle is where the reference J is best conditioned."""
+    arm = load_robot(_planar_2r(tmp_path, a1, a2))
+    def condition(x):
+        return np.linalg.cond(reference.jacobian(arm, np.array([0.3, x]))[:2])
+
+    grid = np.linspace(0.01, np.pi - 0.01, 721)
+    start = grid[int(np.argmin([condition(x) for x in grid]))]
+    best = minimize_scalar(condition, bounds=(start - 0.01, start + 0.01), method="bounded",
+                           options={"xatol": 1e-10}).x
+    result = CliRunner().invoke(main, ["show", str(tmp_path / "two.yaml")])
+    assert result.exit_code == 0
+    line = next(line for line in result.output.splitlines() if "best conditioned" in line or "isotropic (" in line)
+    assert f"{np.degrees(best):.4g} deg" in line
+    assert ("isotropic (condition number 1)" in line) == (a1 == "sqrt(2)")
+
+
+def test_show_plot_writes_a_png(tmp_path):
+    target = tmp_path / "workspace.png"
+    result = CliRunner().invoke(main, ["show", str(ROOT / "robots" / "planar_2r.yaml"), "--plot", str(target)])
+    assert result.exit_code == 0, result.output
+    assert target.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    refused = CliRunner().invoke(main, ["show", str(ROOT / "robots" / "puma560.yaml"), "--plot", str(target)])
+    assert refused.exit_code == 2 and "planar" in refused.output
+
+
+def test_report_is_independent_of_hashing():
+    script = ("from codegen import load_robot, render_robot; import sys; "
+              "sys.stdout.write(render_robot(load_robot('robots/rexarm.yaml'), ('report',))['rexarm/rexarm.md'])")
+    outputs = {subprocess.run([sys.executable, "-c", script], cwd=ROOT, capture_output=True, text=True, check=True,
+                              env={"PYTHONHASHSEED": seed, "PYTHONPATH": str(ROOT)}).stdout for seed in ("0", "4242")}
+    assert len(outputs) == 1
+    assert "sin(q3) = 0  ->  q3 in {0, pi}: elbow" in outputs.pop()
