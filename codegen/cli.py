@@ -5,10 +5,10 @@ from pathlib import Path
 
 import click
 
-from . import __version__
+from . import __version__, budget
 from .errors import JacgenError
 from .render import DEFAULT_LANGUAGES, LANGUAGES, render_robot, stale_files, write_files
-from .report import describe
+from .report import describe, plot_workspace
 from .robot import load_robot
 
 robot_files = click.argument("robot_files", nargs=-1, required=True, type=click.Path(dir_okay=False))
@@ -18,18 +18,38 @@ def _languages(ctx, param, value: str) -> tuple[str, ...]:
     names = tuple(dict.fromkeys(part.strip() for part in value.split(",") if part.strip()))
     unknown = [name for name in names if name not in LANGUAGES]
     if unknown or not names:
-        raise click.BadParameter(f"expected a comma-separated list of {', '.join(LANGUAGES)}")
+        what = f"unknown language {unknown[0]!r}; " if unknown else ""
+        raise click.BadParameter(f"{what}expected a comma-separated list of {', '.join(LANGUAGES)}")
     return names
 
 
 class JacgenGroup(click.Group):
-    """Turns every JacgenError into one line on stderr and exit code 2."""
+    """Turns every JacgenError, a file that cannot be written and a usage mistake into one
+    line on stderr and exit code 2."""
+
+    def main(self, *args, **kwargs):
+        """click's main, except that a usage mistake is one line (click adds usage and a hint)."""
+        try:
+            code = super().main(*args, standalone_mode=False, **kwargs)
+        except click.exceptions.NoArgsIsHelpError as error:
+            error.show()
+            code = error.exit_code
+        except click.ClickException as error:
+            click.echo(f"jacgen: error: {error.format_message()}", err=True)
+            code = error.exit_code
+        except click.Abort:
+            click.echo("jacgen: aborted", err=True)
+            code = 1
+        sys.exit(code if isinstance(code, int) else 0)
 
     def invoke(self, ctx):
         try:
             return super().invoke(ctx)
         except JacgenError as error:
             click.echo(f"jacgen: error: {error}", err=True)
+            ctx.exit(2)
+        except OSError as error:
+            click.echo(f"jacgen: error: {error.filename or ''}: {error.strerror or error}", err=True)
             ctx.exit(2)
 
 
@@ -48,9 +68,15 @@ def main():
 @click.option("--real", type=click.Choice(["double", "float"]), default="double", show_default=True,
               help="Floating-point type of the generated C.")
 @click.option("--check", is_flag=True, help="Write nothing; exit 1 with a diff if a file would change.")
-def generate(robot_files, output, languages, real, check):
+@click.option("--budget", "budget_seconds", default=budget.DEFAULT_SECONDS, show_default=True,
+              type=click.FloatRange(min=0), metavar="SECONDS",
+              help="Time limit of each symbolic simplification step, past which a cheaper exact "
+                   "form is used with a warning (0: no limit).")
+def generate(robot_files, output, languages, real, check, budget_seconds):
     """Generate code for each ROBOT_FILE."""
-    robots = [load_robot(path) for path in robot_files]  # validate every file before writing any
+    budget.set_seconds(budget_seconds)
+    robots = [load_robot(path) for path in dict.fromkeys(robot_files)]  # validate all before writing any
+    _check_unique_names(robots)
     files = {}
     for robot in robots:
         _progress(f"generating {robot.name}")
@@ -80,9 +106,42 @@ def validate(robot_files):
 
 @main.command()
 @click.argument("robot_file", type=click.Path(dir_okay=False))
-def show(robot_file):
-    """Describe a robot in words: DH table and task."""
-    click.echo(describe(load_robot(robot_file)))
+@click.option("--plot", "plot_file", type=click.Path(dir_okay=False), default=None, metavar="FILE.png",
+              help="Also write a PNG of the manipulability over the workspace (planar arms).")
+def show(robot_file, plot_file):
+    """Describe a robot in words: DH table, task, singularities, inverse kinematics."""
+    robot = load_robot(robot_file)
+    click.echo(describe(robot))
+    if plot_file:
+        plot_workspace(robot, plot_file)
+        click.echo(f"jacgen: wrote {plot_file}", err=True)
+
+
+@main.command()
+@robot_files
+@click.option("--samples", default=200, show_default=True, type=click.IntRange(min=1),
+              help="Random configurations per robot, besides those near singularities.")
+@click.option("--seed", default=0, show_default=True, type=int, help="Seed of the random configurations.")
+def verify(robot_files, samples, seed):
+    """Compare every generated function of every backend with the numpy reference."""
+    from .verify import format_table, verify as verify_robots  # numpy/ctypes only when verifying
+
+    robots = [load_robot(path) for path in dict.fromkeys(robot_files)]
+    _check_unique_names(robots)
+    results = verify_robots(robots, samples, seed, _progress)
+    click.echo(format_table(results))
+    if any(result.failed for result in results):
+        sys.exit(1)
+
+
+def _check_unique_names(robots) -> None:
+    """Each robot writes NAME/: two files naming the same robot would overwrite each other."""
+    first = {}
+    for robot in robots:
+        other = first.setdefault(robot.name, robot)
+        if other is not robot:
+            raise JacgenError(f"{robot.source}: name: robot name {robot.name!r} is already used by "
+                              f"{other.source} (each robot is written to its own folder NAME/)")
 
 
 def _progress(message: str) -> None:

@@ -12,6 +12,7 @@ reference never depends on the symbolic path.
 
 import math
 import re
+import sys
 from typing import Callable, NamedTuple
 
 import sympy
@@ -70,8 +71,11 @@ def number(text: str) -> Value:
 
 
 def _checked(exact: sympy.Expr, approx: float) -> Value:
+    """The value, unless its float is out of range or has underflowed away from the exact one."""
     if not math.isfinite(approx) or abs(approx) > MAX_MAGNITUDE:
         raise ExpressionError(f"value {approx:g} is out of range (|value| <= {MAX_MAGNITUDE:g})")
+    if abs(approx) < sys.float_info.min and exact.is_zero is False:
+        raise ExpressionError(f"value {sympy.N(exact, 3)} is too small for a double (underflows)")
     return Value(exact, approx)
 
 

@@ -15,14 +15,18 @@ import yaml
 
 from .errors import RobotFileError
 from .expr import ExpressionError, Value, parse
+from .names import PARAMETER_NAME_RULE, ROBOT_NAME_RULE, parameter_name_problem, robot_name_problem
 
 TASK_COMPONENTS = ("x", "y", "z", "roll", "pitch", "yaw")
 MAX_JOINTS = 32
 MAX_FILE_BYTES = 1 << 20
+MAX_NESTING = 16  # a robot file needs 4 levels: file, joints, a joint, its limits
 NAME_PATTERN = re.compile(r"^[a-z][a-z0-9_]{0,47}$")
 IDENTIFIER_PATTERN = re.compile(r"^[A-Za-z_][A-Za-z0-9_]{0,47}$")
-# Names a parameter may not take: the grammar's own words and the generated code's arguments.
-RESERVED_PARAMETER_NAMES = {"pi", "sqrt", "q", "p", "T", "J", "mu", "f", "damping", "target"}
+# Free text (description, length_unit) is copied into generated comments, docstrings and
+# strings: one printable line without what could end or escape them there.
+MAX_TEXT_LENGTH = 200
+FORBIDDEN_IN_TEXT = ('\\', '"""', "/*", "*/", "??")
 # Within this many radians of a multiple of pi/2, an angle becomes that multiple exactly.
 ANGLE_SNAP_TOLERANCE = 1e-9
 ZERO = Value(sympy.Integer(0), 0.0)
@@ -113,26 +117,55 @@ def parse_robot(data: bytes, path: str = "<robot>") -> Robot:
         text = data.decode("utf-8")
     except UnicodeDecodeError as error:
         line = data[: error.start].count(b"\n") + 1
-        raise RobotFileError(path, line, 1, "", "file is not valid UTF-8") from None
+        column = error.start - data.rfind(b"\n", 0, error.start)  # in bytes
+        raise RobotFileError(path, line, column, "", "file is not valid UTF-8") from None
     try:
-        root = yaml.compose(text, Loader=yaml.SafeLoader)
+        root = yaml.compose(text, Loader=_Composer)
+    except _Refused as error:
+        mark = error.problem_mark
+        raise RobotFileError(path, mark.line + 1, mark.column + 1, "", error.problem) from None
     except yaml.MarkedYAMLError as error:
         mark = error.problem_mark or error.context_mark
         line, column = (mark.line + 1, mark.column + 1) if mark else (1, 1)
         raise RobotFileError(path, line, column, "", f"invalid YAML: {error.problem or error.context}") from None
-    except yaml.YAMLError as error:
-        raise RobotFileError(path, 1, 1, "", f"invalid YAML: {error}") from None
-    except RecursionError:
-        raise RobotFileError(path, 1, 1, "", "invalid YAML: nested too deeply") from None
+    except yaml.reader.ReaderError as error:  # a character YAML does not allow, e.g. a control character
+        line = text.count("\n", 0, error.position) + 1
+        column = error.position - text.rfind("\n", 0, error.position)
+        raise RobotFileError(path, line, column, "", f"invalid YAML: character U+{error.character:04X} "
+                             "is not allowed") from None
     if root is None:
         raise RobotFileError(path, 1, 1, "", "file is empty")
     return _RobotReader(path, data).read(root)
 
 
+class _Refused(yaml.MarkedYAMLError):
+    """Valid YAML that robot files do not allow."""
+
+
+class _Composer(yaml.SafeLoader):
+    """PyYAML's safe parser and composer, refusing aliases (a value must be written where it
+    is used, so every error has one position) and nesting deeper than any robot file needs
+    (so that hostile input cannot exhaust the recursive composer)."""
+
+    depth = 0
+
+    def compose_node(self, parent, index):
+        event = self.peek_event()
+        if isinstance(event, yaml.AliasEvent):
+            raise _Refused(problem="YAML aliases (*name) are not supported; write the value out",
+                           problem_mark=event.start_mark)
+        if self.depth >= MAX_NESTING:
+            raise _Refused(problem=f"nested deeper than {MAX_NESTING} levels", problem_mark=event.start_mark)
+        self.depth += 1
+        try:
+            return super().compose_node(parent, index)
+        finally:
+            self.depth -= 1
+
+
 class _RobotReader:
     def __init__(self, path: str, data: bytes):
         self.path, self.data = path, data
-        self.seen_nodes: set[int] = set()
         self.values: dict[str, Value] = {}
         self.angle_scale = Value(sympy.Integer(1), 1.0)
 
@@ -141,21 +174,14 @@ class _RobotReader:
         mark = node.start_mark
         return RobotFileError(self.path, mark.line + 1, mark.column + 1, key, message)
 
-    def visit(self, node, key: str):
-        if id(node) in self.seen_nodes:
-            raise self.error(node, key, "YAML aliases are not supported; write the value out")
-        self.seen_nodes.add(id(node))
-        return node
-
     def mapping(self, node, key: str, allowed: tuple[str, ...], required: tuple[str, ...] = ()):
         """The entries of a mapping node as {key: value node}, checked against the schema."""
-        self.visit(node, key)
         if not isinstance(node, yaml.MappingNode):
             raise self.error(node, key or "file", f"expected a mapping, got {_describe(node)}")
         entries: dict[str, object] = {}
         for key_node, value_node in node.value:
-            name = key_node.value if isinstance(key_node, yaml.ScalarNode) else None
-            where = f"{key}.{name}" if key else str(name)
+            name = self.key(key_node, key)
+            where = _key_path(key, name)
             if name not in allowed:
                 hint = f"; expected one of: {', '.join(allowed)}"
                 raise self.error(key_node, where, f"unknown key{hint}")
@@ -167,8 +193,13 @@ class _RobotReader:
                 raise self.error(node, f"{key}.{name}" if key else name, "missing required key")
         return entries
 
+    def key(self, node, parent: str) -> str:
+        """The text of a mapping key, which must be a plain scalar."""
+        if not isinstance(node, yaml.ScalarNode):
+            raise self.error(node, parent or "file", f"expected a name as key, got {_describe(node)}")
+        return node.value
+
     def sequence(self, node, key: str, length: int | None = None):
-        self.visit(node, key)
         if not isinstance(node, yaml.SequenceNode):
             raise self.error(node, key, f"expected a list, got {_describe(node)}")
         if length is not None and len(node.value) != length:
@@ -176,18 +207,29 @@ class _RobotReader:
         return node.value
 
     def string(self, node, key: str, choices: tuple[str, ...] | None = None, pattern=None) -> str:
-        self.visit(node, key)
         if not isinstance(node, yaml.ScalarNode) or node.tag != "tag:yaml.org,2002:str":
             raise self.error(node, key, f"expected a string, got {_describe(node)}")
         if choices is not None and node.value not in choices:
-            raise self.error(node, key, f"expected one of {', '.join(choices)}, got {node.value!r}")
+            raise self.error(node, key, f"expected one of {', '.join(choices)}, got {_shown(node.value)}")
         if pattern is not None and not pattern.match(node.value):
-            raise self.error(node, key, f"invalid name {node.value!r} (expected {pattern.pattern})")
+            raise self.error(node, key, f"invalid name {_shown(node.value)} (expected {pattern.pattern})")
         return node.value
+
+    def text(self, node, key: str) -> str:
+        """Free text that is copied into generated files: one line, nothing that escapes."""
+        text = self.string(node, key)
+        if len(text) > MAX_TEXT_LENGTH:
+            raise self.error(node, key, f"longer than {MAX_TEXT_LENGTH} characters")
+        if not text.isprintable():
+            raise self.error(node, key, "must be one line of printable characters")
+        bad = [part for part in FORBIDDEN_IN_TEXT if part in text]
+        if bad:
+            raise self.error(node, key, f"may not contain {bad[0]!r} (it is copied into generated "
+                             f"comments and strings; not allowed: {' '.join(FORBIDDEN_IN_TEXT)})")
+        return text
 
     def value(self, node, key: str, angle: bool = False) -> Value:
         """A number, parameter name or expression; angles converted to radians and snapped."""
-        self.visit(node, key)
         numeric_tags = ("tag:yaml.org,2002:int", "tag:yaml.org,2002:float", "tag:yaml.org,2002:str")
         if not isinstance(node, yaml.ScalarNode) or node.tag not in numeric_tags:
             raise self.error(node, key, f"expected a number or expression, got {_describe(node)}")
@@ -199,7 +241,7 @@ class _RobotReader:
         try:
             value = parse(text, self.resolve)
         except ExpressionError as error:
-            raise self.error(node, key, f"{error} in {node.value!r}") from None
+            raise self.error(node, key, f"{error} in {_shown(node.value)}") from None
         return _snap_angle(_scaled(value, self.angle_scale)) if angle else value
 
     def resolve(self, name: str) -> Value:
@@ -216,12 +258,15 @@ class _RobotReader:
             ("name", "convention", "joints"),
         )
         name = self.string(top["name"], "name", pattern=NAME_PATTERN)
-        description = self.string(top["description"], "description") if "description" in top else ""
+        problem = robot_name_problem(name)
+        if problem:
+            raise self.error(top["name"], "name", f"{name!r} {problem}: {ROBOT_NAME_RULE}")
+        description = self.text(top["description"], "description") if "description" in top else ""
         convention = self.string(top["convention"], "convention", ("standard", "modified"))
         if "angle_unit" in top and self.string(top["angle_unit"], "angle_unit", ("deg", "rad")) == "deg":
             self.angle_scale = Value(sympy.pi / 180, math.pi / 180)
-        length_unit = self.string(top["length_unit"], "length_unit") if "length_unit" in top else "m"
-        parameters = self.parameters(top["parameters"]) if "parameters" in top else ()
+        length_unit = self.text(top["length_unit"], "length_unit") if "length_unit" in top else "m"
+        parameters = self.parameters(top["parameters"], name) if "parameters" in top else ()
         joints = self.joints(top["joints"])
         base = self.pose(top["base"], "base") if "base" in top else IDENTITY_POSE
         tool = self.pose(top["tool"], "tool") if "tool" in top else IDENTITY_POSE
@@ -229,16 +274,19 @@ class _RobotReader:
         return Robot(name, description, convention, length_unit, parameters, joints, base, tool,
                      task, self.path, hashlib.sha256(self.data).hexdigest()[:16])
 
-    def parameters(self, node) -> tuple[Parameter, ...]:
-        self.visit(node, "parameters")
+    def parameters(self, node, robot_name: str) -> tuple[Parameter, ...]:
         if not isinstance(node, yaml.MappingNode):
             raise self.error(node, "parameters", f"expected a mapping, got {_describe(node)}")
         result = []
         for key_node, value_node in node.value:
-            name = key_node.value if isinstance(key_node, yaml.ScalarNode) else ""
-            key = f"parameters.{name}"
-            if not IDENTIFIER_PATTERN.match(name) or name in RESERVED_PARAMETER_NAMES or re.match(r"^q\d+$", name):
-                raise self.error(key_node, key, f"invalid parameter name {name!r}")
+            name = self.key(key_node, "parameters")
+            key = _key_path("parameters", name)
+            if not IDENTIFIER_PATTERN.match(name):
+                raise self.error(key_node, key, f"invalid parameter name {_shown(name)} "
+                                 f"(expected {IDENTIFIER_PATTERN.pattern})")
+            problem = parameter_name_problem(name, robot_name)
+            if problem:
+                raise self.error(key_node, key, f"parameter name {name!r} {problem}: {PARAMETER_NAME_RULE}")
             if name in self.values:
                 raise self.error(key_node, key, "duplicate parameter")
             symbolic = False
@@ -246,7 +294,6 @@ class _RobotReader:
                 entries = self.mapping(value_node, key, ("value", "symbolic"), ("value",))
                 if "symbolic" in entries:
                     flag = entries["symbolic"]
-                    self.visit(flag, f"{key}.symbolic")
                     if not (isinstance(flag, yaml.ScalarNode) and flag.tag == "tag:yaml.org,2002:bool"):
                         raise self.error(flag, f"{key}.symbolic", f"expected true or false, got {_describe(flag)}")
                     symbolic = flag.value.lower() in ("true", "yes", "on")
@@ -295,10 +342,10 @@ class _RobotReader:
         return tuple(joints)
 
     def limits(self, node, key: str, angle: bool) -> tuple[float, float]:
-        lower, upper = (self.value(item, f"{key}[{i}]", angle) for i, item in
-                        enumerate(self.sequence(node, key, 2)))
+        items = self.sequence(node, key, 2)
+        lower, upper = (self.value(item, f"{key}[{i}]", angle) for i, item in enumerate(items))
         if lower.approx > upper.approx:
-            raise self.error(node, key, f"lower limit {lower.approx:g} is above upper limit {upper.approx:g}")
+            raise self.error(node, key, f"lower limit {items[0].value} is above upper limit {items[1].value}")
         return (lower.approx, upper.approx)
 
     def pose(self, node, key: str) -> Pose:
@@ -347,4 +394,15 @@ def _describe(node) -> str:
         return "a list"
     kinds = {"bool": "a boolean", "null": "nothing", "int": "a number", "float": "a number", "str": "a string"}
     kind = kinds.get(node.tag.rsplit(":", 1)[-1], "a value")
-    return f"{kind} ({node.value!r})" if node.value != "" else kind
+    return f"{kind} ({_shown(node.value)})" if node.value != "" else kind
+
+
+def _shown(text: str, limit: int = 60) -> str:
+    """User text quoted for a one-line message: escaped, and cut when long."""
+    return repr(text) if len(text) <= limit else repr(text[:limit]) + "..."
+
+
+def _key_path(parent: str, name: str) -> str:
+    """`parent.name`, with a name that is not a plain word quoted."""
+    shown = name if re.fullmatch(r"[\w<>-]{1,48}", name, re.ASCII) else _shown(name)
+    return f"{parent}.{shown}" if parent else shown

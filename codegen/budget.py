@@ -1,0 +1,127 @@
+"""A time budget for symbolic steps that can blow up (simplification, factoring).
+
+    from codegen import budget
+    factors = budget.within_budget(lambda: sympy.factor_list(p), lambda: (1, [(p, 1)]),
+                                   what="factoring the singularity polynomial")
+
+runs the work for at most `budget.seconds()` (set by `jacgen generate --budget`); when time
+runs out it prints one warning on stderr and returns the cheaper exact fallback instead.
+
+How: a real-time interval timer (`signal.setitimer`) whose SIGALRM handler raises
+`BudgetExceeded` inside the work. sympy is pure Python, so the exception lands between two
+bytecodes within milliseconds (a single long call into C, e.g. one huge integer product,
+delays it until that call returns). Threads cannot be interrupted and a process would have
+to pickle every expression back, so this is the cheapest sound choice. `BudgetExceeded`
+derives from BaseException so that sympy's own `except Exception` blocks do not swallow
+it, and the timer keeps firing every few milliseconds until the work has unwound (never
+raising inside this module's own frames, so the step that catches it cannot be hit again).
+Budgets nest: an inner step gets at most what its outer step has left. Signals only reach
+the main thread, so elsewhere (or without `setitimer`) the work runs unbounded.
+
+A fallback makes the output depend on the machine's speed: the warning says so, since
+generated files are otherwise byte-identical everywhere.
+"""
+
+import signal
+import sys
+import threading
+import time
+from typing import Callable, TypeVar
+
+T = TypeVar("T")
+
+DEFAULT_SECONDS = 60.0
+_REFIRE_SECONDS = 0.005  # after the deadline, until the work has unwound
+
+_seconds: float | None = DEFAULT_SECONDS
+_active: list["_Step"] = []  # the running steps, outermost first
+
+
+class BudgetExceeded(BaseException):
+    """Raised inside the work of the step whose time ran out; caught by that step."""
+
+    def __init__(self, step: "_Step"):
+        super().__init__(step.what)
+        self.step = step
+
+
+class _Step:
+    def __init__(self, what: str, deadline: float):
+        self.what, self.deadline, self.running = what, deadline, True
+
+
+def set_seconds(seconds: float | None) -> None:
+    """Set the budget of each step from now on; None or 0 means no limit."""
+    global _seconds
+    _seconds = seconds or None
+
+
+def seconds() -> float | None:
+    """The budget of each step in seconds (None: no limit)."""
+    return _seconds
+
+
+def within_budget(work: Callable[[], T], fallback: Callable[[], T], what: str,
+                  seconds: float | None = None) -> T:
+    """`work()` if it finishes within the budget, else `fallback()` and a warning on stderr.
+
+    `seconds` overrides the module-wide budget for this call. `what` names the step in the
+    warning ("factoring the singularity polynomial"). Exceptions of `work` propagate.
+    """
+    limit = _seconds if seconds is None else seconds
+    if not limit or not hasattr(signal, "setitimer") or threading.current_thread() is not threading.main_thread():
+        return work()
+    now = time.monotonic()
+    deadline = now + limit
+    if _active:
+        deadline = min(deadline, _active[-1].deadline)
+    step = _Step(what, deadline)
+    outermost = not _active
+    previous_handler = signal.signal(signal.SIGALRM, _on_alarm) if outermost else None
+    _active.append(step)
+    try:
+        _arm(now)
+        return work()
+    except BudgetExceeded as error:
+        if error.step is not step:
+            raise
+        step.running = False
+        _arm(time.monotonic())
+        print(f"jacgen: warning: {what} took longer than {limit:g} s (--budget); using a cheaper exact "
+              f"form, so this output depends on the machine's speed", file=sys.stderr)
+        return fallback()
+    finally:
+        step.running = False
+        _active.remove(step)
+        if outermost:
+            signal.setitimer(signal.ITIMER_REAL, 0)
+            signal.signal(signal.SIGALRM, previous_handler)
+        else:
+            _arm(time.monotonic())
+
+
+def _arm(now: float) -> None:
+    """Set the timer for the earliest deadline of the running steps (off when none)."""
+    running = [step.deadline for step in _active if step.running]
+    if not running:
+        signal.setitimer(signal.ITIMER_REAL, 0)
+        return
+    delay = max(min(running) - now, _REFIRE_SECONDS)
+    signal.setitimer(signal.ITIMER_REAL, delay, _REFIRE_SECONDS)
+
+
+def _on_alarm(signum, frame) -> None:
+    """Interrupt the outermost running step whose deadline has passed.
+
+    Never inside this module's own bookkeeping (the frame that caught an interruption and is
+    about to disarm the timer): there the next tick, inside the work, will do.
+    """
+    if frame is not None and frame.f_code in _BOOKKEEPING:
+        return
+    now = time.monotonic()
+    for step in _active:
+        if step.running and step.deadline <= now:
+            raise BudgetExceeded(step)
+
+
+_BOOKKEEPING = (within_budget.__code__, _arm.__code__)

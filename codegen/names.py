@@ -1,0 +1,112 @@
+"""Which names a robot file may give its robot and its parameters.
+
+A robot's name becomes file and module names (`NAME/NAME.h`, `NAME.py`, `NAME_casadi.py`)
+and the prefix of every C symbol; a symbolic parameter becomes a C struct field and local
+variable and a Python keyword argument. So a name is refused when the generated code could
+not compile or import with it, or would silently mean something else:
+
+- robot names: C and Python keywords (`for.py` cannot be imported), C standard headers
+  (`math/math.h` would hide `<math.h>`), Python standard modules and the modules the
+  generated code imports (`numpy/numpy.py` would import itself);
+- parameter names: C, C++ (the header may be included from C++) and Python keywords,
+  Python builtins, `<math.h>` functions and macros, the generated code's own words
+  (arguments, function names, temporaries `t0`, trig terms `c1`/`s23`/`c10_11`, joints `q1`,
+  locals), names starting with `_` and names starting with the robot's prefix (`NAME_...`).
+
+Python's keywords, builtins and standard modules are those of the interpreter running jacgen.
+
+Joint names appear only in comments and documentation; the identifier pattern they must
+match keeps them from ending a comment or a string.
+"""
+
+import builtins
+import keyword
+import re
+import sys
+
+C_KEYWORDS = frozenset("""
+    auto break case char const continue default do double else enum extern float for goto if
+    inline int long register restrict return short signed sizeof static struct switch typedef
+    union unsigned void volatile while
+""".split())
+CPP_KEYWORDS = frozenset("""
+    alignas alignof and and_eq asm bitand bitor bool catch char16_t char32_t char8_t class
+    compl concept consteval constexpr constinit const_cast co_await co_return co_yield decltype
+    delete dynamic_cast explicit export false friend mutable namespace new noexcept not not_eq
+    nullptr operator or or_eq private protected public reinterpret_cast requires static_assert
+    static_cast template this thread_local throw true try typeid typename using virtual wchar_t
+    xor xor_eq
+""".split())
+C_STANDARD_HEADERS = frozenset("""
+    assert complex ctype errno fenv float inttypes iso646 limits locale math setjmp signal
+    stdalign stdarg stdatomic stdbool stddef stdint stdio stdlib stdnoreturn string tgmath
+    threads time uchar wchar wctype
+""".split())
+_C_MATH_FUNCTIONS = """
+    acos asin atan atan2 cos sin tan acosh asinh atanh cosh sinh tanh exp exp2 expm1 frexp
+    ilogb ldexp log log10 log1p log2 logb modf scalbn scalbln cbrt fabs hypot pow sqrt erf erfc
+    lgamma tgamma ceil floor nearbyint rint lrint llrint round lround llround trunc fmod
+    remainder remquo copysign nan nextafter nexttoward fdim fmax fmin fma
+""".split()
+C_MATH_NAMES = frozenset(
+    [name + suffix for name in _C_MATH_FUNCTIONS for suffix in ("", "f", "l")]
+    + """
+    fpclassify isfinite isinf isnan isnormal signbit isgreater isgreaterequal isless
+    islessequal islessgreater isunordered float_t double_t math_errhandling HUGE_VAL HUGE_VALF
+    HUGE_VALL INFINITY NAN MATH_ERRNO MATH_ERREXCEPT NULL errno EDOM ERANGE EILSEQ
+    j0 j1 jn y0 y1 yn
+    """.split()
+)
+PYTHON_KEYWORDS = frozenset(keyword.kwlist)
+PYTHON_BUILTINS = frozenset(name for name in dir(builtins) if not name.startswith("_"))
+# Modules the generated Python imports.
+GENERATED_IMPORTS = frozenset({"numpy", "casadi", "math"})
+# Words of the value grammar and of the generated code (SPEC §2, §3): arguments, functions
+# and module constants, and the locals of generated functions that also take the parameters
+# (tests/test_adversarial.py finds any the templates add; new locals had better start with
+# '_', which no parameter name can).
+GENERATED_NAMES = frozenset("""
+    pi sqrt q p T J mu f damping target q0 max_iter tol q_dot mu_dot
+    fk jacobian jacobian_tool task task_jacobian singularity_factors manipulability ik
+    jacobian_det velocity_ik ik_numeric fk_jacobian functions DOF TASK PARAMETERS MAX_IK_SOLUTIONS
+    IK_NUMERIC_CONVERGED IK_NUMERIC_ITERATION_LIMIT IK_NUMERIC_STALLED VELOCITY_IK_RCOND
+    A Jt b d w x angles batch cost error identity least most ok revolute singular_values solutions step
+    trial trial_J trial_cost trial_error
+    centre count g h k reach shoulder tool_point tool_position tool_rotation tool_x v wrist yaw0
+""".split())
+# Temporaries t0.., trig terms c1.. s1.., joint variables q1.., the closed-form IK's axes h1..,
+# points p1.., unit vectors k1.. v6 and signs; names starting with '_'; <math.h>'s M_PI, FP_NAN...
+_GENERATED_PATTERN = re.compile(r"^(?:[tcsqhkpv]\d+(?:_\d+)*|sign\w*|_.*|M_\w+|FP_\w+)$")
+
+ROBOT_NAME_RULE = ("a robot name may not be a C or Python keyword, a C standard header or a "
+                   "Python module name, since it names the generated files and modules")
+PARAMETER_NAME_RULE = ("parameter names may not be C, C++ or Python keywords, Python builtins, "
+                       "<math.h> names, names the generated code uses (q, p, fk, t0, c1, s1, q1, "
+                       "h1, k1, p1, v1, see codegen/names.py), start with '_' or with the robot's "
+                       "name and '_'")
+
+
+def robot_name_problem(name: str) -> str | None:
+    """Why `name` cannot name a robot (None when it can)."""
+    if name in C_KEYWORDS or name in PYTHON_KEYWORDS:
+        return "is a keyword"
+    if name in C_STANDARD_HEADERS:
+        return f"would hide the C header <{name}.h>"
+    if name in GENERATED_IMPORTS or name in sys.stdlib_module_names:
+        return f"would hide the Python module {name!r}"
+    return None
+
+
+def parameter_name_problem(name: str, robot_name: str) -> str | None:
+    """Why `name` cannot name a parameter of robot `robot_name` (None when it can)."""
+    if name in C_KEYWORDS or name in CPP_KEYWORDS or name in PYTHON_KEYWORDS:
+        return "is a keyword"
+    if name in PYTHON_BUILTINS:
+        return "is a Python builtin"
+    if name in C_MATH_NAMES:
+        return "is a <math.h> name"
+    if name in GENERATED_NAMES or name in GENERATED_IMPORTS or _GENERATED_PATTERN.match(name):
+        return "is used by the generated code"
+    if name.lower().startswith(robot_name + "_"):
+        return f"starts with the robot's prefix {robot_name + '_'!r}"
+    return None
