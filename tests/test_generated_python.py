@@ -24,6 +24,10 @@ def test_every_function_matches_the_reference(robot_name):
         want = np.array([getattr(reference, name)(arm, sample) for sample in q])
         np.testing.assert_allclose(getattr(module, name)(q), want, atol=1e-9, rtol=0, err_msg=name)
 
+    pose, jacobian = module.fk_jacobian(q)
+    np.testing.assert_allclose(pose, module.fk(q), atol=1e-15, rtol=0)
+    np.testing.assert_allclose(jacobian, module.jacobian(q), atol=1e-15, rtol=0)
+
     mu, mu_want = module.task(q), np.array([reference.task(arm, sample) for sample in q])
     angular = [i for i, component in enumerate(arm.task) if component in ("roll", "pitch", "yaw")]
     linear = [i for i, component in enumerate(arm.task) if component in ("x", "y", "z")]
