@@ -201,7 +201,8 @@ def _ik_context(robot: Robot, printer, language: str, real: str) -> dict | None:
         "solver": form.solver,
         "max_solutions": form.info.max_solutions,
         "doc": ik.documentation(robot, form, "MAX_IK_SOLUTIONS" if is_python else f"{prefix}_MAX_IK_SOLUTIONS"),
-        "helpers": list(ik.HELPERS[form.solver]),
+        "helpers": list(form.helpers),
+        "flip": form.flip,
         "constants": [(name, literal(value)) for name, value in form.constants],
         "fields": [(name, len(value)) for name, value in form.constants],
         "parameters": ", ".join(name for name, _ in form.constants),
@@ -209,6 +210,7 @@ def _ik_context(robot: Robot, printer, language: str, real: str) -> dict | None:
         "parameters_unused": bool(robot.symbolic_parameters) and not read_names,
         "indices": dict(form.indices),
         "revolute": [i for i, joint in enumerate(robot.joints) if joint.revolute],
+        "pose": pose,
         "target_shape": "(4, 4)" if pose else f"({len(robot.task)},)",
         "target_name": "T" if pose else "mu",
         "target_size": 12 if pose else f"{prefix}_TASK_DIM",  # the entries read (not T's last row)

@@ -72,7 +72,7 @@ GENERATED_NAMES = frozenset("""
     IK_NUMERIC_CONVERGED IK_NUMERIC_ITERATION_LIMIT IK_NUMERIC_STALLED VELOCITY_IK_RCOND
     A Jt b d w x angles batch cost error identity least most ok revolute singular_values solutions step
     trial trial_J trial_cost trial_error
-    centre count g h k reach shoulder tool_point tool_position tool_rotation tool_x v wrist yaw0
+    centre count g h k reach shoulder tool_point tool_position tool_rotation tool_x v wrist yaw0 wrist_flip
 """.split())
 # Temporaries t0.., trig terms c1.. s1.., joint variables q1.., the closed-form IK's axes h1..,
 # points p1.., unit vectors k1.. v6 and signs; names starting with '_'; <math.h>'s M_PI, FP_NAN...

@@ -1,0 +1,170 @@
+"""Benchmark: jacgen's closed-form C ik (every branch) beside EAIK and ik-geo.
+
+    PYTHONPATH=. python bench/bench_ik.py [--targets 2000] [--rounds 7]
+
+For the UR5 and the Puma 560, the same random reachable poses (fk of random joint vectors
+inside the limits) are solved by:
+
+- "C native": the generated `NAME_ik` (double) called in a native loop by a C harness
+  compiled with -O2 (the generated file in its own translation unit);
+- "C via ctypes": the same shared library called from Python, one call per pose;
+- "EAIK": `eaik.IK_DH.DhRobot(...).IK(T)` from Python (its C++ solver through pybind11);
+- "ik-geo": `ik_geo.Robot.three_parallel_two_intersecting` / `spherical_two_parallel`
+  `.get_ik(R, t)` from Python (its Rust solver through PyO3).
+
+Every solver returns all branches; the table gives microseconds per pose (median over
+rounds), the real solutions found (EAIK and ik-geo also return least-squares candidates,
+not counted) and each time over the C-via-ctypes one. The derivation time of every shipped
+robot's closed form (structure detection and exact constants, `codegen.ik.closed_form`) is
+printed first.
+"""
+
+import argparse
+import ctypes
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+from eaik.IK_DH import DhRobot
+from ik_geo import Robot as IkGeoRobot
+
+ROOT = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT))
+sys.path.insert(0, str(ROOT / "tests"))
+
+from codegen import reference  # noqa: E402
+from codegen.compile import WARNING_FLAGS, compile_shared  # noqa: E402
+from codegen.ik import closed_form  # noqa: E402
+from codegen.render import render_robot, write_files  # noqa: E402
+from codegen.robot import load_robot  # noqa: E402
+from test_ik import kinematic_chain  # noqa: E402
+
+ROBOTS = {"ur5": IkGeoRobot.three_parallel_two_intersecting, "puma560": IkGeoRobot.spherical_two_parallel}
+
+HARNESS = r"""
+#define _POSIX_C_SOURCE 199309L
+#include <stdio.h>
+#include <stdlib.h>
+#include <time.h>
+#include "NAME.h"
+
+static double now(void) { struct timespec t; clock_gettime(CLOCK_MONOTONIC, &t); return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec; }
+
+int main(int argc, char **argv)
+{
+    const long count = atol(argv[2]);
+    const int rounds = atoi(argv[3]);
+    double *targets = malloc(sizeof(double) * 16 * (size_t)count);
+    double q[NAME_UPPER_MAX_IK_SOLUTIONS * NAME_UPPER_DOF];
+    FILE *file = fopen(argv[1], "rb");
+    long solutions = 0;
+    if (argc != 4 || !targets || !file || fread(targets, sizeof(double) * 16, (size_t)count, file) != (size_t)count) {
+        return 2;
+    }
+    fclose(file);
+    for (int round = 0; round < rounds; ++round) {
+        const double t0 = now();
+        solutions = 0;
+        for (long i = 0; i < count; ++i) solutions += NAME_ik(targets + 16 * i, q);
+        printf("%.4f %ld\n", (now() - t0) * 1e6 / (double)count, solutions);
+    }
+    free(targets);
+    return 0;
+}
+"""
+
+
+def native(robot, source: Path, targets: np.ndarray, rounds: int, folder: Path) -> tuple[float, int]:
+    """Median microseconds per pose of NAME_ik in a native loop, and the solutions found."""
+    harness = folder / f"harness_{robot.name}.c"
+    harness.write_text(HARNESS.replace("NAME_UPPER", robot.name.upper()).replace("NAME", robot.name))
+    binary, data = folder / f"harness_{robot.name}", folder / f"targets_{robot.name}.bin"
+    targets.astype(np.float64).tofile(data)
+    subprocess.run(["gcc", *WARNING_FLAGS, "-O2", "-I", source.parent, "-o", binary, harness, source, "-lm"],
+                   check=True)
+    output = subprocess.run([binary, data, str(len(targets)), str(rounds)], check=True, capture_output=True,
+                            text=True).stdout.split("\n")
+    rows = [line.split() for line in output if line]
+    return statistics.median(float(row[0]) for row in rows), int(rows[-1][1])
+
+
+def timed(solve, targets, rounds: int) -> tuple[float, int]:
+    """Median microseconds per pose of `solve(T) -> count` called from Python, and the count."""
+    times, found = [], 0
+    for _ in range(rounds):
+        start = time.perf_counter()
+        found = sum(solve(T) for T in targets)
+        times.append((time.perf_counter() - start) * 1e6 / len(targets))
+    return statistics.median(times), found
+
+
+def solvers(robot, library, ik_geo_factory):
+    """Functions pose -> number of real solutions, for each solver called from Python."""
+    function = library[f"{robot.name}_ik"]
+    function.argtypes, function.restype = [ctypes.c_void_p, ctypes.c_void_p], ctypes.c_int
+    out = np.zeros(8 * robot.dof)
+    address = out.ctypes.data
+
+    def ours(T):  # T: a C-contiguous float64 4x4 array, passed by address
+        return function(T.ctypes.data, address)
+
+    alpha, a, d = (np.array([getattr(joint, key).approx for joint in robot.joints]) for key in ("alpha", "a", "d"))
+    eaik = DhRobot(alpha, a, d)
+
+    def theirs_eaik(T):
+        return int(np.count_nonzero(~np.asarray(eaik.IK(T).is_LS, dtype=bool)))
+
+    H, P, tool_rotation = kinematic_chain(robot)
+    geo = ik_geo_factory(H, P)
+
+    def theirs_ik_geo(T):  # ik-geo takes R as a list of columns, and the tool rotation as identity
+        return sum(not least_squares for _, least_squares in geo.get_ik((T[:3, :3] @ tool_rotation.T).T, T[:3, 3]))
+
+    return {"C via ctypes": ours, "EAIK": theirs_eaik, "ik-geo": theirs_ik_geo}
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--targets", type=int, default=2000)
+    parser.add_argument("--rounds", type=int, default=7)
+    arguments = parser.parse_args()
+
+    print("derivation of the closed form (structure detection + exact constants):")
+    for path in sorted((ROOT / "robots").glob("*.yaml")):
+        robot = load_robot(path)
+        start = time.perf_counter()
+        form = closed_form(robot)
+        print(f"  {robot.name:10s} {1e3 * (time.perf_counter() - start):7.1f} ms  {form.solver if form else '-'}")
+
+    rows = []
+    with tempfile.TemporaryDirectory() as temporary:
+        folder = Path(temporary)
+        for name, ik_geo_factory in ROBOTS.items():
+            robot = load_robot(ROOT / "robots" / f"{name}.yaml")
+            write_files(render_robot(robot, ("c",)), folder)
+            source = folder / name / f"{name}.c"
+            library = ctypes.CDLL(str(compile_shared([source], folder / f"lib{name}.so")))
+            rng = np.random.default_rng(1)
+            limits = np.array([joint.limits for joint in robot.joints])
+            q = rng.uniform(limits[:, 0], limits[:, 1], (arguments.targets, robot.dof))
+            targets = np.array([reference.fk(robot, row) for row in q])
+            results = {"C native": native(robot, source, targets, arguments.rounds, folder)}
+            for label, solve in solvers(robot, library, ik_geo_factory).items():
+                results[label] = timed(solve, targets, arguments.rounds)
+            rows.append((name, results))
+
+    print(f"\nus per pose (all branches), median of {arguments.rounds} rounds over {arguments.targets} poses;"
+          " ratio = time / C via ctypes")
+    print(f"{'robot':8s} {'solver':13s} {'us/pose':>9s} {'solutions':>10s} {'ratio':>7s}")
+    for name, results in rows:
+        base = results["C via ctypes"][0]
+        for label, (micros, found) in results.items():
+            print(f"{name:8s} {label:13s} {micros:9.3f} {found:10d} {micros / base:7.2f}")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,328 @@
+"""Kinematic structure of an arm, decided exactly from its geometry at q = 0.
+
+At q = 0 every joint is a line in the world frame: the unit direction h_i of its axis and a
+point p_i on it (the origin of the joint's axis frame), computed with sympy from the DH table
+by `kinematics.build_chain` (base, joint offsets and tool included). This is the
+product-of-exponentials description T(q) = exp(xi_1 q_1) ... exp(xi_n q_n) T(0) that the
+closed-form solvers of `ik.py` work on. Relations between axes (parallel, intersecting,
+meeting in one point) are decided exactly, so a structure is recognised only when it holds
+for the robot's dimensions (with symbolic parameters: for every value of them).
+"""
+
+from dataclasses import dataclass, replace
+
+import sympy
+
+from . import kinematics
+from .expr import Value
+from .robot import TASK_COMPONENTS, Pose, Robot
+
+Matrix = sympy.Matrix
+E_Z = Matrix([0, 0, 1])
+PRECISION = 60  # digits of the irrational numbers of the geometry; zero means below 1e-40
+
+
+@dataclass(frozen=True)
+class SolverInfo:
+    """What a closed-form solver does, for the report and the generated documentation."""
+
+    title: str
+    max_solutions: int
+    branches: tuple[str, ...]  # the branch loops, outermost first; solutions come in this order
+
+
+SOLVERS = {
+    "planar": SolverInfo(
+        "planar arm: revolute axes (and any prismatic axis) parallel to world z; the last "
+        "revolute joint sets the yaw, the first two place the wrist point (SP3, SP1)",
+        2, ("elbow: the second revolute joint, '+' then '-' (elbow on either side of the line "
+            "from the first axis to the wrist point)",)),
+    "yaw_pitch": SolverInfo(
+        "base yaw + three parallel pitch axes: the pitch fixes the sum of the pitch angles "
+        "(SP4), the base yaw puts the arm's plane through the target (SP4), the law of "
+        "cosines gives the elbow (SP3)",
+        8, ("base: the two yaw angles that put the target in the arm's plane, '+' then '-' "
+            "(facing the target, then reaching over the top)",
+            "approach: the two sums of the pitch angles with the target pitch, '+' then '-'",
+            "elbow: q3, '+' then '-' (elbow up and down)")),
+    "spherical_wrist_parallel": SolverInfo(
+        "6R with a spherical wrist and axes 2, 3 parallel (Pieper): wrist centre, base "
+        "angle (SP4), elbow (SP3), shoulder (SP1), then the wrist orientation (SP2, SP1)",
+        8, ("shoulder: q1, '+' then '-' (the arm left and right of the base axis, rtb's l/r)",
+            "elbow: q3, '+' then '-' (elbow up and down, rtb's u/d)",
+            "wrist: (q4, q5), '+' then '-' (wrist flipped or not, rtb's f/n)")),
+    "spherical_wrist_intersecting": SolverInfo(
+        "6R with a spherical wrist and axes 1, 2 intersecting (Pieper): wrist centre, elbow "
+        "(SP3), base and shoulder together (SP2), then the wrist orientation (SP2, SP1)",
+        8, ("elbow: q3, '+' then '-' (elbow up and down)",
+            "shoulder: (q1, q2), '+' then '-' (the arm on either side of the base axis)",
+            "wrist: (q4, q5), '+' then '-' (wrist flipped or not)")),
+    "spherical_wrist_prismatic": SolverInfo(
+        "RRP + spherical wrist (Stanford arm): wrist centre, the prismatic joint 3 from the "
+        "distance to the shoulder point (quadratic), base and shoulder (SP2), then the wrist "
+        "orientation (SP2, SP1)",
+        8, ("reach: q3, larger root then smaller (the smaller is usually negative: check limits)",
+            "shoulder: (q1, q2), '+' then '-' (the arm on either side of the base axis)",
+            "wrist: (q4, q5), '+' then '-' (wrist flipped or not)")),
+    "three_parallel": SolverInfo(
+        "6R with axes 2, 3, 4 parallel and axes 5, 6 intersecting (Universal Robots): base "
+        "angle (SP4), wrist 2 (SP4), wrist 3 (SP1), the sum q2 + q3 + q4 (SP1), elbow (SP3), "
+        "shoulder (SP1)",
+        8, ("shoulder: q1, '+' then '-' (the arm left and right of the base axis)",
+            "wrist: q5, '+' then '-' (the two wrist-2 angles, wrist up and down)",
+            "elbow: q3, '+' then '-' (elbow up and down)")),
+}
+
+
+@dataclass(frozen=True)
+class Structure:
+    """The class of a robot: its closed-form solver (None when none applies) and why."""
+
+    solver: str | None
+    features: tuple[str, ...]  # what was found, in words
+    reason: str  # why the solver applies, or why no solver does
+
+
+def is_zero(expr) -> bool:
+    """Zero: simplified when symbolic, else evaluated (exact or 60-digit inputs) below 1e-40."""
+    expr = sympy.sympify(expr)
+    if expr.free_symbols:
+        return sympy.simplify(expr) == 0
+    return abs(complex(sympy.N(expr, PRECISION))) < 1e-40
+
+
+def tidy(expr: sympy.Expr) -> sympy.Expr:
+    """Simplified when symbolic (for readable reports); numbers stay as they are, since
+    simplifying exact trigonometric numbers is slow and their value is all that is used."""
+    return sympy.simplify(expr) if expr.free_symbols else expr
+
+
+def _precise(value: Value) -> Value:
+    """A value whose cosine and sine stay exact and small: rationals (lengths), multiples of
+    pi/2 and symbolic expressions as they are, other numbers as 60-digit floats. The exact
+    cosine of an angle such as 73.1234 deg does not simplify, and products of such terms
+    grow without bound while only their value matters."""
+    e = value.exact
+    if e.free_symbols or e.is_Rational or (2 * e / sympy.pi).is_Integer:
+        return value
+    return Value(sympy.Float(sympy.N(e, PRECISION), PRECISION), value.approx)
+
+
+def _precise_robot(robot: Robot) -> Robot:
+    """The robot with every value made `_precise`."""
+    def pose(p: Pose) -> Pose:
+        return Pose(tuple(map(_precise, p.xyz)), tuple(map(_precise, p.rpy)))
+
+    joints = tuple(replace(j, a=_precise(j.a), alpha=_precise(j.alpha), offset=_precise(j.offset),
+                           d=None if j.d is None else _precise(j.d),
+                           theta=None if j.theta is None else _precise(j.theta))
+                   for j in robot.joints)
+    return replace(robot, joints=joints, base=pose(robot.base), tool=pose(robot.tool))
+
+
+def squared_norm(v: Matrix) -> sympy.Expr:
+    return v.dot(v)
+
+
+class Geometry:
+    """Joint axes (unit directions, a point on each) and tool pose at q = 0, in the world frame,
+    exact (irrational numbers to 60 digits), and the relations between the axes."""
+
+    def __init__(self, robot: Robot):
+        self.robot = robot
+        n = robot.dof
+        precise = _precise_robot(robot)
+        cos_sin = [(sympy.cos(j.offset.exact), sympy.sin(j.offset.exact)) if j.revolute else None
+                   for j in precise.joints]
+        chain = kinematics.build_chain(precise, lambda i: cos_sin[i], [sympy.Integer(0)] * n)
+        self.revolute = tuple(j.revolute for j in robot.joints)
+        self.nominal = {p.symbol: p.value for p in robot.symbolic_parameters}
+        self.axes = tuple(frame[:3, 2] for frame in chain.axes)
+        self.points = tuple(frame[:3, 3] for frame in chain.axes)
+        self.tool = chain.tool
+        self.tool_point = chain.tool[:3, 3]
+
+    def parallel(self, i: int, j: int) -> bool:
+        return is_zero(squared_norm(self.axes[i].cross(self.axes[j])))
+
+    def on_axis(self, point: Matrix, i: int) -> bool:
+        return is_zero(squared_norm((point - self.points[i]).cross(self.axes[i])))
+
+    def same_line(self, i: int, j: int) -> bool:
+        return self.parallel(i, j) and self.on_axis(self.points[j], i)
+
+    def intersection(self, i: int, j: int) -> Matrix | None:
+        """The point where axes i and j cross, None when they are parallel or skew."""
+        normal = self.axes[i].cross(self.axes[j])
+        if is_zero(squared_norm(normal)):
+            return None
+        offset = self.points[j] - self.points[i]
+        if not is_zero(offset.dot(normal)):
+            return None
+        along = offset.cross(self.axes[j]).dot(normal) / squared_norm(normal)
+        return (self.points[i] + along * self.axes[i]).applyfunc(tidy)
+
+    def wrist_centre(self, i: int) -> Matrix | None:
+        """The point where revolute axes i, i+1, i+2 meet (consecutive ones not parallel), else None."""
+        if not all(self.revolute[i:i + 3]):
+            return None
+        point = self.intersection(i, i + 1)
+        if point is None or self.parallel(i + 1, i + 2) or not self.on_axis(point, i + 2):
+            return None
+        return point
+
+
+def point_text(point: Matrix) -> str:
+    if any(e.free_symbols for e in point):
+        return "(" + ", ".join(str(tidy(e)) for e in point) + ")"
+    return "(" + ", ".join(f"{float(e):.6g}" for e in point) + ")"
+
+
+def _features(g: Geometry) -> list[str]:
+    """Relations of consecutive axes, spherical wrists, runs of parallel axes, prismatic joints."""
+    n, lines = len(g.axes), []
+    pairs = []
+    for i in range(n - 1):
+        if g.same_line(i, i + 1):
+            pairs.append(f"{i + 1}-{i + 2} coincide")
+        elif g.parallel(i, i + 1):
+            pairs.append(f"{i + 1}-{i + 2} parallel")
+        elif (point := g.intersection(i, i + 1)) is not None:
+            pairs.append(f"{i + 1}-{i + 2} intersect at {point_text(point)}")
+        else:
+            pairs.append(f"{i + 1}-{i + 2} skew")
+    if pairs:
+        lines.append("consecutive axes: " + "; ".join(pairs))
+    for i in range(n - 2):
+        if g.parallel(i, i + 1) and g.parallel(i + 1, i + 2):
+            lines.append(f"axes {i + 1}, {i + 2}, {i + 3} parallel")
+        elif (centre := g.wrist_centre(i)) is not None:
+            lines.append(f"axes {i + 1}, {i + 2}, {i + 3} meet at {point_text(centre)} (spherical joint)")
+    prismatic = [str(i + 1) for i, revolute in enumerate(g.revolute) if not revolute]
+    if prismatic:
+        lines.append("prismatic joint" + ("s " if len(prismatic) > 1 else " ") + ", ".join(prismatic))
+    if all(is_zero(squared_norm(h.cross(E_Z))) for h in g.axes):
+        lines.append("planar: every axis parallel to world z")
+    return lines
+
+
+def _spherical_wrist(g: Geometry) -> tuple[str | None, str]:
+    """Solver and reason for a six-joint arm whose axes 4, 5, 6 might meet in one point."""
+    centre = g.wrist_centre(3)
+    if centre is None:
+        return None, "no spherical wrist (axes 4, 5, 6 do not meet in one point)"
+    wrist = f"spherical wrist: axes 4, 5, 6 meet at {point_text(centre)}"
+    rev = g.revolute
+    if all(rev[:3]) and g.parallel(1, 2) and not g.parallel(0, 1):
+        if g.same_line(1, 2) or g.on_axis(centre, 2):
+            return None, f"{wrist}, but axes 2 and 3 coincide or the wrist centre lies on axis 3"
+        return "spherical_wrist_parallel", f"{wrist}; axes 2 and 3 parallel"
+    x12 = g.intersection(0, 1) if rev[0] and rev[1] else None
+    if x12 is None:
+        return None, f"{wrist}, but neither axes 2, 3 parallel nor axes 1, 2 intersecting"
+    shoulder = f"axes 1 and 2 intersect at {point_text(x12)}"
+    if not rev[2]:
+        return "spherical_wrist_prismatic", f"{wrist}; {shoulder}; joint 3 prismatic"
+    if g.on_axis(x12, 2) or g.on_axis(centre, 2):
+        return None, f"{wrist}; {shoulder}, but axis 3 passes through that point or the wrist centre"
+    return "spherical_wrist_intersecting", f"{wrist}; {shoulder}"
+
+
+def _three_parallel(g: Geometry) -> tuple[str | None, str]:
+    """Solver and reason for a six-joint arm whose axes 2, 3, 4 might be parallel."""
+    if not (all(g.revolute) and g.parallel(1, 2) and g.parallel(2, 3)):
+        return None, "no three parallel revolute axes 2, 3, 4"
+    point = g.intersection(4, 5)
+    if point is None:
+        return None, "axes 2, 3, 4 parallel, but axes 5 and 6 do not intersect"
+    if g.parallel(0, 1) or g.parallel(4, 1):
+        return None, "axes 2, 3, 4 parallel, but axis 1 or axis 5 is parallel to them too"
+    if g.same_line(1, 2) or g.same_line(2, 3):
+        return None, "axes 2, 3, 4 parallel, but two of them coincide"
+    return "three_parallel", f"axes 2, 3, 4 parallel; axes 5 and 6 intersect at {point_text(point)}"
+
+
+def _six_dof(g: Geometry) -> tuple[str | None, str]:
+    """Solver and reason for a six-joint arm with a full-pose task: the first class that applies."""
+    reasons = []
+    for candidate in (_spherical_wrist, _three_parallel):
+        solver, reason = candidate(g)
+        if solver is not None:
+            return solver, reason
+        reasons.append(reason)
+    return None, "; ".join(reasons)
+
+
+def _planar(g: Geometry, task: tuple[str, ...]) -> tuple[str | None, str] | None:
+    """Solver and reason for an arm whose axes are all parallel to world z (None: not such an arm)."""
+    if not all(is_zero(squared_norm(h.cross(E_Z))) for h in g.axes):
+        return None
+    revolute = [i for i, r in enumerate(g.revolute) if r]
+    prismatic = [i for i, r in enumerate(g.revolute) if not r]
+    expected = ("x", "y") + (("z",) if prismatic else ()) + (("yaw",) if len(revolute) == 3 else ())
+    if len(revolute) not in (2, 3) or len(prismatic) > 1 or task != expected:
+        return None, (f"axes parallel to world z, but {len(revolute)} revolute and {len(prismatic)} "
+                      f"prismatic joints with task ({', '.join(task)}): the planar solver needs 2 or 3 "
+                      f"revolute joints, at most one prismatic, and the task (x, y[, z][, yaw])")
+    first, second = revolute[:2]
+    point = g.points[revolute[2]] if len(revolute) == 3 else g.tool_point
+    if g.same_line(first, second):
+        return None, f"axes {first + 1} and {second + 1} coincide"
+    if g.on_axis(point, second):
+        what = f"axis {revolute[2] + 1}" if len(revolute) == 3 else "the tool point"
+        return None, f"{what} lies on axis {second + 1}: the arm cannot reach around"
+    if "yaw" in task and is_zero(g.tool[0, 0] ** 2 + g.tool[1, 0] ** 2):
+        return None, "the tool's x axis is vertical at q = 0: yaw is undefined"
+    kinds = {2: "2R", 3: "3R"}[len(revolute)] + (" + prismatic z" if prismatic else "")
+    return "planar", f"planar {kinds}: every axis parallel to world z"
+
+
+def _yaw_pitch(g: Geometry, task: tuple[str, ...]) -> tuple[str | None, str] | None:
+    """Solver and reason for a base-yaw + three-pitch arm (None: not such an arm)."""
+    if len(g.axes) != 4 or not all(g.revolute) or task != ("x", "y", "z", "pitch"):
+        return None
+    if not is_zero(squared_norm(g.axes[0].cross(E_Z))):
+        return None, "task (x, y, z, pitch) but axis 1 is not vertical"
+    if not (g.parallel(1, 2) and g.parallel(2, 3)) or g.parallel(0, 1):
+        return None, "task (x, y, z, pitch) but axes 2, 3, 4 are not parallel pitch axes"
+    if g.same_line(1, 2) or g.same_line(2, 3):
+        return None, "axes 2, 3, 4 parallel, but two of them coincide"
+    if is_zero(squared_norm(g.tool[:3, 0].cross(g.axes[1]))):
+        return None, "the tool's x axis is parallel to the pitch axes: the pitch does not change"
+    return "yaw_pitch", "axis 1 vertical (yaw); axes 2, 3, 4 parallel (pitch)"
+
+
+def classify(robot: Robot, geometry: Geometry | None = None) -> Structure:
+    """The structure of `robot` and the closed-form solver that applies to it, if any."""
+    g = geometry or Geometry(robot)
+    n, task = robot.dof, robot.task
+    features = tuple(_features(g))
+    if task == TASK_COMPONENTS:
+        if n == 6:
+            solver, reason = _six_dof(g)
+        elif n > 6:
+            solver, reason = None, f"{n} joints for a 6-component task: redundant, infinitely many solutions"
+        else:
+            solver, reason = None, f"{n} joints cannot reach every pose of a 6-component task"
+        return Structure(solver, features, reason)
+    for candidate in (_planar, _yaw_pitch):
+        found = candidate(g, task)
+        if found is not None:
+            return Structure(found[0], features, found[1])
+    return Structure(None, features, (
+        f"{n} joints with task ({', '.join(task)}): closed forms exist for planar arms (axes parallel "
+        f"to world z, task x, y[, z][, yaw]) and base yaw + three parallel pitch axes (task x, y, z, pitch)"))
+
+
+def describe_structure(robot: Robot) -> list[str]:
+    """Lines for the report and `jacgen show`: the structure found and which ik solver applies."""
+    structure = classify(robot)
+    lines = [f"structure: {feature}" for feature in structure.features]
+    if structure.solver is None:
+        lines.append(f"closed-form ik: none ({structure.reason}); ik_numeric is generated")
+        return lines
+    info = SOLVERS[structure.solver]
+    lines.append(f"closed-form ik: {structure.reason}")
+    lines.append(f"solver: {info.title}; up to {info.max_solutions} solutions, in the order:")
+    lines += [f"  {branch}" for branch in info.branches]
+    return lines

@@ -1,0 +1,494 @@
+"""Closed-form ik and ik_numeric of the generated Python and C.
+
+Round trips on random configurations (every solution reproduces fk(q), the original q is
+among them), solution counts against EAIK and ik-geo on the arms they solve, random robots
+of every class, unreachable and singular targets, and the C (double and float) against the
+Python. Forward kinematics is the generated fk, itself checked against codegen.reference
+elsewhere; the random robots are checked against codegen.reference.fk directly.
+"""
+
+import ctypes
+import itertools
+
+import numpy as np
+import pytest
+from eaik.IK_HP import HPRobot
+from ik_geo import Robot as IkGeoRobot
+
+from codegen import reference
+from codegen.compile import compile_shared
+from codegen.context import _ik_context, _ik_math
+from codegen.printers import CPrinter, PythonPrinter
+from codegen.render import _environment, render_robot
+from codegen.robot import parse_robot
+
+from conftest import import_file, random_configurations, robot
+
+WITH_IK = ["planar_2r", "planar_3r", "scara", "rexarm", "puma560", "kr5", "stanford", "ur5"]
+WITHOUT_IK = ["iiwa", "panda"]
+SAMPLES = 1000  # random configurations per shipped robot (Python); the C takes 4 times as many
+TOLERANCE = 1e-9
+
+
+def _generate(arm, folder, languages=("python",), real="double"):
+    """Render `arm` into `folder`; the Python module (imported) or the C source path."""
+    files = render_robot(arm, languages, real)
+    for relative, text in files.items():
+        path = folder / relative
+        path.parent.mkdir(parents=True, exist_ok=True)
+        path.write_text(text)
+    if languages == ("python",):
+        return import_file(folder / arm.name / f"{arm.name}.py", f"ik_test_{arm.name}_{folder.name}")
+    return folder / arm.name / f"{arm.name}.c"
+
+
+@pytest.fixture(scope="module")
+def modules(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("python")
+    return {name: _generate(robot(name), folder) for name in WITH_IK + WITHOUT_IK}
+
+
+def _pose_task(arm) -> bool:
+    return len(arm.task) == 6
+
+
+def _targets(module, arm, q):
+    return module.fk(q) if _pose_task(arm) else module.task(q)
+
+
+def _target_error(arm, reached, target):
+    """Largest difference; angles of a task vector compared modulo 2 pi."""
+    difference = np.abs(reached - target)
+    if not _pose_task(arm):
+        angles = [i for i, name in enumerate(arm.task) if name in ("roll", "pitch", "yaw")]
+        difference[..., angles] = np.abs((difference[..., angles] + np.pi) % (2 * np.pi) - np.pi)
+    return difference.reshape(len(difference), -1).max(axis=1) if difference.size else np.zeros(0)
+
+
+def _joint_distance(arm, a, b):
+    """Largest joint difference, revolute joints modulo 2 pi."""
+    difference = np.abs(a - b)
+    revolute = [joint.revolute for joint in arm.joints]
+    difference[..., revolute] = np.abs((difference[..., revolute] + np.pi) % (2 * np.pi) - np.pi)
+    return difference.max(axis=-1)
+
+
+def _check_round_trip(arm, ik, targets_of, q, regular):
+    """ik(targets_of(q)): every solution reproduces its target, the original q is among them
+    where `regular`, revolute angles in (-pi, pi], no NaN. Returns the solution counts."""
+    targets = targets_of(q)
+    solutions = [ik(target) for target in targets]
+    owner = np.concatenate([np.full(len(s), i) for i, s in enumerate(solutions)]).astype(int)
+    stacked = np.concatenate(solutions)
+    assert np.all(np.isfinite(stacked))
+    errors = _target_error(arm, targets_of(stacked), targets[owner])
+    assert errors.max() < TOLERANCE, (arm.name, errors.max())
+    revolute = stacked[:, [joint.revolute for joint in arm.joints]]
+    assert np.all((revolute > -np.pi) & (revolute <= np.pi))
+    for row, found in enumerate(solutions):
+        if regular[row]:
+            assert len(found) and _joint_distance(arm, found, q[row]).min() < 1e-7, (arm.name, q[row])
+    return np.array([len(s) for s in solutions])
+
+
+@pytest.mark.parametrize("name", WITH_IK)
+def test_round_trip_of_random_configurations(modules, name):
+    arm, module = robot(name), modules[name]
+    q = random_configurations(arm, SAMPLES, seed=11)
+    counts = _check_round_trip(arm, module.ik, lambda q: _targets(module, arm, q), q, module.manipulability(q) > 1e-3)
+    expected = {"planar_2r": {2}, "planar_3r": {2}, "scara": {2}, "puma560": {8}, "stanford": {8},
+                "rexarm": {4, 8}, "kr5": {4, 8}, "ur5": {2, 4, 6, 8}}[name]
+    assert set(counts) <= expected and max(counts) == max(expected)
+    assert module.MAX_IK_SOLUTIONS == max(expected)
+
+
+def kinematic_chain(arm):
+    """The arm as EAIK and ik-geo take it, from codegen.reference at q = 0: axes H, offsets P
+    between points on consecutive axes, and the tool rotation (theirs is the identity at q = 0).
+    When axes 4, 5, 6 meet, their points are moved to the common point (ik-geo needs that)."""
+    frames, tool = reference.frames(arm, np.zeros(arm.dof))
+    points = [frame[:3, 3] for frame in frames]
+    H = np.array([frame[:3, 2] for frame in frames])
+    projections = [np.eye(3) - np.outer(h, h) for h in H[3:]]
+    centre = np.linalg.lstsq(np.vstack(projections), np.concatenate(
+        [m @ p for m, p in zip(projections, points[3:])]), rcond=None)[0]
+    if all(np.linalg.norm(m @ (centre - p)) < 1e-12 for m, p in zip(projections, points[3:])):
+        points[3:] = [centre] * 3
+    P = np.array([points[0]] + [b - a for a, b in zip(points, points[1:])] + [tool[:3, 3] - points[-1]])
+    return H, P, tool[:3, :3]
+
+
+def _real_solutions(solutions):
+    return np.array([q for q, least_squares in solutions if not least_squares]).reshape(-1, 6)
+
+
+def _assert_same_sets(arm, ours, theirs, context):
+    assert len(ours) == len(theirs), (context, ours, theirs)
+    if len(ours):
+        distance = _joint_distance(arm, ours[:, None, :], theirs[None, :, :])
+        assert distance.min(axis=1).max() < 1e-6 and distance.min(axis=0).max() < 1e-6, context
+
+
+def _compare_with_eaik(module, arm, q, fk, ik_geo_factory=None):
+    """Same real solution sets as EAIK (and ik-geo when given its factory) at the poses fk(q)."""
+    H, P, tool_rotation = kinematic_chain(arm)
+    eaik = HPRobot(H, P)
+    other = ik_geo_factory(H, P) if ik_geo_factory else None
+    counts = []
+    for row, T in zip(q, fk(q)):
+        ours = module.ik(T)
+        shifted = T.copy()
+        shifted[:3, :3] = T[:3, :3] @ tool_rotation.T
+        result = eaik.IK(shifted)
+        theirs = np.array(result.Q)[~np.array(result.is_LS, dtype=bool)].reshape(-1, 6)
+        _assert_same_sets(arm, ours, theirs, ("eaik", arm.name, row))
+        if other is not None:
+            # ik-geo's rotations are lists of columns (its forward_kinematics returns R^T)
+            found = _real_solutions(other.get_ik(shifted[:3, :3].T, shifted[:3, 3]))
+            _assert_same_sets(arm, ours, found, ("ik_geo", arm.name, row))
+        counts.append(len(ours))
+    return counts
+
+
+def test_ur5_matches_eaik_and_ik_geo(modules):
+    """Poses anywhere in the workspace (q in [-pi, pi]^6): 2, 4, 6 or 8 real solutions."""
+    arm = robot("ur5")
+    q = np.random.default_rng(12).uniform(-np.pi, np.pi, (300, 6))
+    counts = _compare_with_eaik(modules["ur5"], arm, q, modules["ur5"].fk, IkGeoRobot.three_parallel_two_intersecting)
+    assert set(counts) == {2, 4, 6, 8}
+
+
+@pytest.mark.parametrize("name", ["puma560", "kr5"])
+def test_spherical_wrist_arms_match_eaik_and_ik_geo(modules, name):
+    arm = robot(name)
+    counts = _compare_with_eaik(modules[name], arm, random_configurations(arm, 200, seed=13), modules[name].fk,
+                                IkGeoRobot.spherical_two_parallel)
+    assert max(counts) == 8
+
+
+# -- random robots of every class ---------------------------------------------------------------
+
+
+def _uniform(rng, low, high):
+    return float(np.round(rng.uniform(low, high), 4))
+
+
+def _pose(rng, planar=False):
+    xyz = [_uniform(rng, -0.3, 0.3) for _ in range(3)]
+    rpy = [0, 0, _uniform(rng, -180, 180)] if planar else [_uniform(rng, -180, 180) for _ in range(3)]
+    return f"{{xyz: {xyz}, rpy: {rpy}}}"
+
+
+def _revolute(a, alpha, d, offset):
+    return f"  - {{type: revolute, a: {a}, alpha: {alpha}, d: {d}, offset: {offset}}}\n"
+
+
+def _random_robot(kind: str, seed: int):
+    """A robot of the given class with random dimensions, offsets and base/tool poses."""
+    rng = np.random.default_rng(seed)
+    u = lambda low=0.1, high=0.6: _uniform(rng, low, high)  # noqa: E731
+    angle = lambda: _uniform(rng, -180, 180)  # noqa: E731
+    flip = lambda: int(rng.choice([0, 180]))  # noqa: E731 (axis direction reversed or not)
+    planar = kind in ("planar_2r", "planar_3r", "scara", "yaw_pitch")  # base turns about z only
+    rows, task = "", None
+    if kind == "planar_2r":
+        rows = _revolute(u(), flip(), u(-0.1, 0.1), angle()) + _revolute(u(), flip(), 0, angle())
+        task = "[x, y]"
+    elif kind == "planar_3r":
+        rows = "".join(_revolute(u(), flip(), u(-0.1, 0.1), angle()) for _ in range(3))
+        task = "[x, y, yaw]"
+    elif kind == "scara":
+        rows = (_revolute(u(), flip(), u(), angle()) + _revolute(u(), flip(), 0, angle())
+                + f"  - {{type: prismatic, a: {u(0, 0.05)}, alpha: {flip()}, theta: {angle()}, offset: {u()}}}\n"
+                + _revolute(0, 0, u(0, 0.1), angle()))
+        task = "[x, y, z, yaw]"
+    elif kind == "yaw_pitch":
+        rows = (_revolute(u(0, 0.05), 90, u(), 0) + _revolute(u(), 0, u(-0.05, 0.05), angle())
+                + _revolute(u(), 0, 0, angle()) + _revolute(u(), 0, 0, angle()))
+        task = "[x, y, z, pitch]"
+    elif kind == "spherical_wrist_parallel":  # Puma / KR5 / industrial arms
+        rows = (_revolute(u(0, 0.2), 90, u(), angle()) + _revolute(u(), 0, u(-0.2, 0.2), angle())
+                + _revolute(u(0, 0.1), -90, u(-0.2, 0.2), angle()) + _revolute(0, 90, u(), angle())
+                + _revolute(0, -90, 0, angle()) + _revolute(0, 0, u(), angle()))
+    elif kind == "spherical_wrist_intersecting":  # and a wrist whose axes are not perpendicular
+        rows = (_revolute(0, 90, u(), angle()) + _revolute(u(), _uniform(rng, 20, 70), u(-0.2, 0.2), angle())
+                + _revolute(u(0, 0.1), -90, u(-0.2, 0.2), angle()) + _revolute(0, _uniform(rng, 30, 80), u(), angle())
+                + _revolute(0, _uniform(rng, -80, -30), 0, angle()) + _revolute(0, 0, u(), angle()))
+    elif kind == "spherical_wrist_prismatic":  # Stanford arm
+        rows = (_revolute(0, -90, u(), angle()) + _revolute(0, 90, u(), angle())
+                + f"  - {{type: prismatic, a: {u(0, 0.05)}, alpha: 0, theta: {angle()}, offset: {u()}}}\n"
+                + _revolute(0, -90, 0, angle()) + _revolute(0, 90, 0, angle()) + _revolute(0, 0, u(), angle()))
+    elif kind == "three_parallel":  # Universal Robots; odd seeds with axis 5 not perpendicular to h
+        twist = 90 if seed % 2 == 0 else _uniform(rng, 30, 80)
+        rows = (_revolute(0, 90, u(), angle()) + _revolute(-u(), 0, 0, angle()) + _revolute(-u(), 0, 0, angle())
+                + _revolute(0, twist, u(), angle()) + _revolute(0, -90, u(), angle()) + _revolute(0, 0, u(), angle()))
+    text = (f"name: random_{kind}_{seed}\nconvention: standard\nangle_unit: deg\njoints:\n{rows}"
+            f"base: {_pose(rng, planar)}\ntool: {_pose(rng, planar)}\n" + (f"task: {task}\n" if task else ""))
+    return parse_robot(text.encode())
+
+
+EAIK_CLASSES = {"spherical_wrist_parallel", "spherical_wrist_intersecting", "three_parallel"}
+RANDOM_CLASSES = ["planar_2r", "planar_3r", "scara", "yaw_pitch", "spherical_wrist_parallel",
+                  "spherical_wrist_intersecting", "spherical_wrist_prismatic", "three_parallel"]
+
+
+def _ik_only(arm, folder):
+    """A module holding only the closed-form ik of `arm`: the full generated module runs a
+    singularity analysis that takes minutes for random dimensions, and is not needed here."""
+    context = {"ik": _ik_context(arm, PythonPrinter(), "python", "double"), "ik_math": _ik_math(arm, "double"),
+               "parameters": []}
+    text = "import math\n\nimport numpy\n\nDOF = %d\n" % arm.dof + _environment().get_template(
+        "python/ik.py.jinja").render(context)
+    path = folder / f"{arm.name}.py"
+    path.write_text(text)
+    return import_file(path, f"ik_only_{arm.name}")
+
+
+C_PREAMBLE = """#include <math.h>
+typedef {real} {name}_real;
+#define {prefix}_DOF {dof}
+#define {prefix}_TASK_DIM {task_dim}
+#define {prefix}_MAX_IK_SOLUTIONS {max_solutions}
+int {name}_ik({signature});
+"""
+
+
+def _c_ik_only(arm, folder, real):
+    """The closed-form ik of `arm` alone as a C shared library (compiled with SPEC's warning
+    flags), and a function target -> solutions (k, n) calling it."""
+    ik = _ik_context(arm, CPrinter(real), "c", real)
+    context = {"ik": ik, "ik_math": _ik_math(arm, real), "parameters": [], "name": arm.name,
+               "prefix": arm.name.upper()}
+    source = folder / f"{arm.name}_{real}.c"
+    source.write_text(C_PREAMBLE.format(real=real, name=arm.name, prefix=arm.name.upper(), dof=arm.dof,
+                                        task_dim=len(arm.task), max_solutions=ik["max_solutions"],
+                                        signature=ik["signature"])
+                      + _environment().get_template("c/ik.c.jinja").render(context))
+    library = ctypes.CDLL(str(compile_shared([source], folder / f"lib{arm.name}_{real}.so")))
+    function = library[f"{arm.name}_ik"]
+    function.argtypes, function.restype = [ctypes.c_void_p, ctypes.c_void_p], ctypes.c_int
+    dtype = np.float64 if real == "double" else np.float32
+    out = np.zeros(8 * arm.dof, dtype)
+
+    def solve(target):
+        count = function(np.ascontiguousarray(target, dtype).ctypes.data, out.ctypes.data)
+        return out[:count * arm.dof].reshape(count, arm.dof).astype(float)
+
+    return solve
+
+
+def _reference_targets(arm):
+    """Batched fk (pose tasks) or task vector of codegen.reference."""
+    single = reference.fk if _pose_task(arm) else reference.task
+    return lambda q: np.array([single(arm, row) for row in q])
+
+
+def _regular(arm, q):
+    """Smallest singular value of the reference (geometric or task) Jacobian above 1e-3."""
+    jacobian = reference.jacobian if _pose_task(arm) else reference.task_jacobian
+    return np.array([np.linalg.svd(jacobian(arm, row), compute_uv=False).min() > 1e-3 for row in q])
+
+
+@pytest.mark.parametrize("kind", RANDOM_CLASSES)
+def test_random_robots_of_each_class(kind, tmp_path):
+    """Random dimensions, offsets, axis directions, base and tool: round trips through
+    codegen.reference, the revolute 6R classes also against EAIK."""
+    for seed in range(3):
+        arm = _random_robot(kind, seed)
+        module = _ik_only(arm, tmp_path)
+        q = np.random.default_rng(seed).uniform(-np.pi, np.pi, (100, arm.dof))
+        q[:, [not joint.revolute for joint in arm.joints]] *= 0.1
+        counts = _check_round_trip(arm, module.ik, _reference_targets(arm), q, _regular(arm, q))
+        assert counts.max() == module.MAX_IK_SOLUTIONS
+        if seed < 2:  # the C: the Python's solutions in the Python's order; float compiles cleanly
+            solve = _c_ik_only(arm, tmp_path, "double")
+            for target in _reference_targets(arm)(q[:50]):
+                ours, python = solve(target), module.ik(target)
+                assert len(ours) == len(python) and (not len(ours) or _joint_distance(arm, ours, python).max() < 1e-6)
+            _c_ik_only(arm, tmp_path, "float")
+        if kind in EAIK_CLASSES:
+            _compare_with_eaik(module, arm, q[:50], _reference_targets(arm))
+
+
+# -- edges: out of reach, not finite, singular ---------------------------------------------------
+
+
+def test_unreachable_targets_give_no_solution(modules):
+    for name in WITH_IK:
+        module, arm = modules[name], robot(name)
+        target = _targets(module, arm, random_configurations(arm, 1, seed=14)[0])
+        if name == "stanford":  # the prismatic joint has no limit here: reach is unbounded
+            continue
+        far = target.copy()
+        if _pose_task(arm):
+            far[:3, 3] += 10.0
+        else:
+            far[:2] += 10.0
+        assert module.ik(far).shape == (0, arm.dof), name
+        nan = target.copy()
+        nan.flat[0] = np.nan
+        assert module.ik(nan).shape == (0, arm.dof), name
+    assert modules["rexarm"].ik([0.2, 0.0, 0.1, 2.0]).shape == (0, 4)  # pitch beyond 90 deg
+    # the Stanford arm's wrist centre (its tool point) cannot come within d2 of the shoulder point
+    shoulder = np.eye(4)
+    shoulder[2, 3] = 0.412
+    assert modules["stanford"].ik(shoulder).shape == (0, 6)
+
+
+def _assert_distinct_and_exact(module, arm, q):
+    target = _targets(module, arm, q)
+    found = module.ik(target)
+    assert len(found) and np.all(np.isfinite(found))
+    reached = _targets(module, arm, found)
+    assert _target_error(arm, reached, np.broadcast_to(target, reached.shape)).max() < TOLERANCE
+    for a, b in itertools.combinations(found, 2):
+        assert _joint_distance(arm, a, b) > 1e-6, (arm.name, found)
+    return found
+
+
+def test_singular_targets_give_finite_distinct_solutions(modules):
+    """A double root is returned once and a free angle is set to 0. Stretched planar arms: 1
+    solution. Puma with q5 = 0: that branch's wrist is singular (1 solution, q4 = 0), the three
+    other arm branches are not (2 each): 7. Puma with the elbow stretched: both shoulders have a
+    double elbow root: 2 x 1 x 2 = 4. UR5 with q5 = 0: 2 + 4 = 6 (the other shoulder branch is
+    regular)."""
+    assert len(_assert_distinct_and_exact(modules["planar_2r"], robot("planar_2r"), np.array([0.3, 0.0]))) == 1
+    assert len(_assert_distinct_and_exact(modules["planar_3r"], robot("planar_3r"), np.array([0.3, 0.0, 1.0]))) == 1
+    puma, module = robot("puma560"), modules["puma560"]
+    found = _assert_distinct_and_exact(module, puma, np.array([0.3, 0.5, -0.4, 0.6, 0.0, -0.2]))
+    assert len(found) == 7 and [0.3, 0.5, -0.4, 0.0, 0.0, 0.4] in np.round(found, 12).tolist()
+    stretched = np.arctan2(0.0203, 0.4318) - np.pi / 2  # forearm (a3, d4) in line with the upper arm
+    assert len(_assert_distinct_and_exact(module, puma, np.array([0.3, 0.5, stretched, 0.6, 0.4, -0.2]))) == 4
+    ur5 = np.array([0.3, -1.0, 1.2, 0.4, 0.0, 0.7])
+    assert len(_assert_distinct_and_exact(modules["ur5"], robot("ur5"), ur5)) == 6
+
+
+# -- the C, double and float ------------------------------------------------------------------------
+
+
+@pytest.fixture(scope="module", params=["double", "float"])
+def c_solvers(request, tmp_path_factory):
+    """Per robot: a function target -> solutions (k, n) calling NAME_ik, and NAME_ik_numeric."""
+    real = request.param
+    folder = tmp_path_factory.mktemp(f"c_{real}")
+    scalar, dtype = (ctypes.c_double, np.float64) if real == "double" else (ctypes.c_float, np.float32)
+    pointer = ctypes.POINTER(scalar)
+    solvers = {}
+    for name in WITH_IK + WITHOUT_IK:
+        arm = robot(name)
+        source = _generate(arm, folder, ("c",), real)
+        library = ctypes.CDLL(str(compile_shared([source], folder / f"lib{name}.so")))
+        numeric = library[f"{name}_ik_numeric"]
+        numeric.argtypes = [pointer, pointer, ctypes.c_int, scalar, pointer]
+
+        def solve_numeric(target, q0, max_iter=100, tol=1e-10, function=numeric, n=arm.dof):
+            q = np.zeros(n, dtype)
+            t, start = np.ascontiguousarray(target, dtype).ravel(), np.ascontiguousarray(q0, dtype)
+            status = function(t.ctypes.data_as(pointer), start.ctypes.data_as(pointer), max_iter, tol,
+                              q.ctypes.data_as(pointer))
+            return q.astype(float), status
+
+        closed = None
+        if name in WITH_IK:
+            function = library[f"{name}_ik"]
+            function.argtypes, function.restype = [pointer, pointer], ctypes.c_int
+            out = np.zeros(8 * arm.dof, dtype)
+
+            def closed(target, function=function, out=out, n=arm.dof):
+                t = np.ascontiguousarray(target, dtype).ravel()
+                count = function(t.ctypes.data_as(pointer), out.ctypes.data_as(pointer))
+                return out[:count * n].reshape(count, n).astype(float)
+
+        solvers[name] = (closed, solve_numeric)
+    return real, solvers
+
+
+@pytest.mark.parametrize("name", WITH_IK)
+def test_c_ik_agrees_with_python(modules, c_solvers, name):
+    """4000 random configurations: the double C reaches the targets to 1e-9 with the Python's
+    solutions in the Python's order; the float C has the same counts except within float
+    precision of a branch boundary (0.5 % allowed) and reaches the targets to 1e-2."""
+    real, solvers = c_solvers
+    arm, module, solve = robot(name), modules[name], solvers[name][0]
+    q = random_configurations(arm, 4 * SAMPLES, seed=15)
+    targets = _targets(module, arm, q)
+    different, worst = 0, 0.0
+    for target in targets:
+        ours, python = solve(target), module.ik(target)
+        assert np.all(np.isfinite(ours))
+        if len(ours) != len(python):
+            different += 1
+            continue
+        if len(ours) == 0:
+            continue
+        reached = _targets(module, arm, ours)
+        worst = max(worst, _target_error(arm, reached, np.broadcast_to(target, reached.shape)).max())
+        if real == "double":  # the same branches in the same order (angles near a singularity
+            assert _joint_distance(arm, ours, python).max() < 1e-6  # are ill-conditioned)
+    assert different == 0 if real == "double" else different <= len(q) // 200
+    assert worst < (TOLERANCE if real == "double" else 1e-2)
+    assert len(solve(np.full(targets.shape[1:], np.nan))) == 0
+
+
+# -- ik_numeric -----------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("name", WITH_IK + WITHOUT_IK)
+def test_ik_numeric_converges_from_nearby(modules, c_solvers, name):
+    real, solvers = c_solvers
+    arm, module, numeric = robot(name), modules[name], solvers[name][1]
+    rng = np.random.default_rng(16)
+    tolerance = 1e-10 if real == "double" else 1e-4
+    for q in random_configurations(arm, 10, seed=17):
+        target = _targets(module, arm, q)
+        start = q + rng.normal(0.0, 0.05, arm.dof)
+        for solve in (module.ik_numeric, numeric):
+            found, status = solve(target, start, 100, tolerance)
+            assert status == 0, (name, solve, status)
+            assert _target_error(arm, _targets(module, arm, found)[None], target[None])[0] < 10 * tolerance
+
+
+def test_ik_numeric_statuses_and_limits(modules, c_solvers):
+    _, solvers = c_solvers
+    arm, module, numeric = robot("puma560"), modules["puma560"], solvers["puma560"][1]
+    lower, upper = np.array([joint.limits for joint in arm.joints]).T
+    target = module.fk(np.zeros(6))
+    target[:3, 3] += 5.0  # out of reach
+    for solve in (module.ik_numeric, numeric):
+        found, status = solve(target, np.zeros(6), 200, 1e-10)
+        assert status in (1, 2)
+        assert np.all(found >= lower - 1e-6) and np.all(found <= upper + 1e-6)
+        found, status = solve(module.fk(np.zeros(6)), np.full(6, 10.0), 200, 1e-10)  # q0 beyond the limits
+        assert np.all(found >= lower - 1e-6) and np.all(found <= upper + 1e-6)
+    assert numeric(np.full(16, np.nan), np.zeros(6))[1] == 3
+    assert numeric(module.fk(np.zeros(6)), np.zeros(6), -1)[1] == 3
+    assert module.ik_numeric(module.fk(np.zeros(6)), np.zeros(6), 0)[1] == 0
+
+
+def test_robots_without_closed_form_have_no_ik(modules):
+    for name in WITHOUT_IK:
+        assert not hasattr(modules[name], "ik") and hasattr(modules[name], "ik_numeric")
+
+
+def test_runtime_parameters(tmp_path):
+    """A symbolic d3 on the Puma: the constants become expressions in it, in Python (keyword)
+    and C (the params struct)."""
+    text = open(robot("puma560").source).read().replace("name: puma560", "name: puma_runtime")
+    text = text.replace("  d3: 0.15005 ", "  d3: {value: 0.15005, symbolic: true} ")
+    arm = parse_robot(text.encode())
+    module = _generate(arm, tmp_path)
+    source = _generate(arm, tmp_path, ("c",))
+    library = ctypes.CDLL(str(compile_shared([source], tmp_path / "libpuma_runtime.so")))
+    parameters = type("params", (ctypes.Structure,), {"_fields_": [("d3", ctypes.c_double)]})
+    solve = library["puma_runtime_ik"]
+    solve.argtypes = [ctypes.c_void_p, ctypes.c_void_p, ctypes.POINTER(parameters)]
+    solve.restype = ctypes.c_int
+    q = random_configurations(robot("puma560"), 20, seed=18)
+    for d3 in (0.15005, 0.3):
+        for row in q:
+            T = module.fk(row, d3=d3)
+            found = module.ik(T, d3=d3)
+            assert len(found) == 8 and _joint_distance(arm, found, row).min() < 1e-7
+            out = np.zeros(48)
+            count = solve(np.ascontiguousarray(T).ctypes.data, out.ctypes.data, ctypes.byref(parameters(d3)))
+            assert count == 8 and np.abs(out.reshape(8, 6) - found).max() < 1e-9
