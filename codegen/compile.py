@@ -79,10 +79,7 @@ class CLibrary:
         """
         function = self._functions[name]
         symbol = getattr(self._library, f"{self.robot.name}_{name}")
-        extra = []
-        if self._parameters is not None:
-            values = {p.name: p.value for p in self.robot.symbolic_parameters} | (parameters or {})
-            extra = [ctypes.byref(self._parameters(*(values[p.name] for p in self.robot.symbolic_parameters)))]
+        extra = self._extra(parameters)
         joints = np.ascontiguousarray(q, dtype=self.dtype)
         starts = np.cumsum([0] + [output.size for output in function.outputs])
         results = np.empty((len(joints), starts[-1]), dtype=self.dtype)
@@ -94,3 +91,32 @@ class CLibrary:
                 symbol(row.ctypes.data_as(pointer), *(out[start:].ctypes.data_as(pointer) for start in starts[:-1]),
                        *extra)
         return results.astype(np.float64)
+
+    def _extra(self, parameters: dict[str, float] | None = None) -> list:
+        """The trailing `const NAME_params *p` argument, if the robot has runtime parameters."""
+        if self._parameters is None:
+            return []
+        values = {p.name: p.value for p in self.robot.symbolic_parameters} | (parameters or {})
+        return [ctypes.byref(self._parameters(*(values[p.name] for p in self.robot.symbolic_parameters)))]
+
+    def ik(self, target: np.ndarray, max_solutions: int) -> np.ndarray:
+        """`NAME_ik` for one target (4x4 pose or task vector): the solutions, (k, dof)."""
+        pointer = ctypes.POINTER(C_TYPES[self.real])
+        target = np.ascontiguousarray(np.ravel(target), dtype=self.dtype)
+        solutions = np.zeros(max_solutions * self.robot.dof, dtype=self.dtype)
+        count = getattr(self._library, f"{self.robot.name}_ik")(target.ctypes.data_as(pointer),
+                                                                 solutions.ctypes.data_as(pointer), *self._extra())
+        return solutions[: count * self.robot.dof].reshape(count, self.robot.dof).astype(np.float64)
+
+    def ik_numeric(self, target: np.ndarray, q0: np.ndarray, max_iter: int, tol: float) -> tuple[np.ndarray, int]:
+        """`NAME_ik_numeric` from q0: (q, status)."""
+        pointer = ctypes.POINTER(C_TYPES[self.real])
+        target = np.ascontiguousarray(np.ravel(target), dtype=self.dtype)
+        start = np.ascontiguousarray(q0, dtype=self.dtype)
+        q = np.zeros(self.robot.dof, dtype=self.dtype)
+        function = getattr(self._library, f"{self.robot.name}_ik_numeric")
+        function.argtypes = [pointer, pointer, ctypes.c_int, C_TYPES[self.real], pointer]
+        status = function(target.ctypes.data_as(pointer), start.ctypes.data_as(pointer), max_iter, tol,
+                          q.ctypes.data_as(pointer), *self._extra())
+        return q.astype(np.float64), status
+
