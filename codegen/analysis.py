@@ -32,7 +32,7 @@ import sympy
 from sympy.polys.orderings import lex
 from sympy.polys.rings import PolyElement, PolyRing
 
-from . import kinematics, reference
+from . import budget, kinematics, reference
 from .robot import TASK_COMPONENTS, Robot
 
 EULER = ("roll", "pitch", "yaw")
@@ -365,8 +365,10 @@ def analyse(robot: Robot) -> Singularities:
     matrix, sign, cos_pitch_sq = _analysed_matrix(ring)
     minors = maximal_minors(matrix, ring.ring.zero, ring.ring.one)
     note, complete = "", True
-    if m == n:
-        constant, factors = _factor(ring, minors[0])
+    what = f"factoring {kind} of {robot.name}"
+    if m == n:  # out of budget: the determinant itself is the one condition
+        constant, factors = budget.within_budget(lambda: _factor(ring, minors[0]),
+                                                 lambda: (ring.ring.one, [(minors[0], 1)]), what)
         constant *= sign
     else:
         common = minors[0]
@@ -375,8 +377,10 @@ def analyse(robot: Robot) -> Singularities:
         constant, factors = _factor(ring, common)
         constant, factors = constant**2, [(f, 2 * k) for f, k in factors]
         cofactor = ring.reduce(sum((minor.exquo(common) ** 2 for minor in minors), ring.ring.zero), True)
-        if len(cofactor) <= FACTOR_TERM_LIMIT:
-            extra_constant, extra = _factor(ring, cofactor)
+        factored = (budget.within_budget(lambda: _factor(ring, cofactor), lambda: None, what)
+                     if len(cofactor) <= FACTOR_TERM_LIMIT else None)
+        if factored is not None:
+            extra_constant, extra = factored
             constant *= extra_constant
             merged = dict(factors)
             for f, k in extra:
@@ -385,7 +389,7 @@ def analyse(robot: Robot) -> Singularities:
         else:
             complete = False
             note = (f"{kind} has {len(cofactor)} terms once the factors common to all {len(minors)} "
-                    f"maximal minors of Js are taken out: too many to factor, so the singularity "
+                    f"maximal minors of Js are taken out: too many to factor within the budget, so the singularity "
                     f"factors end with the Gram determinant itself (zero wherever the manipulability is)")
     euler_power, euler = 0, []
     if cos_pitch_sq is not None:

@@ -123,3 +123,14 @@ def test_generate_sets_the_budget(tmp_path):
                                        "--budget", "7.5"])
     assert result.exit_code == 0, result.output
     assert budget.seconds() == 7.5
+
+
+def test_singularity_factoring_falls_back_to_the_gram_determinant(capsys):
+    """Out of budget, the 7-axis analysis keeps the unfactored Gram determinant as its condition."""
+    from codegen import analysis
+    from conftest import robot
+
+    budget.set_seconds(0.01)
+    singular = analysis.analyse(robot("panda"))
+    assert not singular.complete and "within the budget" in singular.note
+    assert "factoring det(Js Js^T) of panda took longer than 0.01 s" in capsys.readouterr().err
