@@ -169,7 +169,10 @@ def plot_workspace(robot: Robot, path: str, samples: int = 4000, ellipses: int =
     configurations the arm and its velocity ellipse (J_xy J_xy^T, x and y rows)."""
     if not _planar(robot):
         raise JacgenError(f"{robot.source}: --plot needs a planar arm (every joint axis parallel to world z)")
-    import matplotlib
+    try:
+        import matplotlib
+    except ImportError:
+        raise JacgenError("--plot needs matplotlib: pip install 'jacgen[plot]'") from None
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
