@@ -193,49 +193,57 @@ def floor_source(robot) -> str:
         robot.name, "\n".join(lines))
 
 
+def casadi_variants(robot) -> dict[str, casadi.Function]:
+    """CasADi's fk+jacobian as built, and after `casadi.cse`, named as the harness expects."""
+    plain = casadi_fk_jacobian(robot)
+    cse = casadi.Function(f"casadi_cse_{robot.name}", plain.sx_in(), casadi.cse(plain.call(plain.sx_in())))
+    return {"casadi": plain, "casadi_cse": cse}
+
+
+def native_times(robots, folder: Path, calls: int, rounds: int) -> dict[tuple[str, str], float]:
+    """Build the harness with every variant in `folder`, run it: {(robot, variant): median ns}."""
+    sources, functions = [folder / "harness.c"], {}
+    for robot in robots:
+        write_files(render_robot(robot, ("c",), "double"), folder)
+        functions[robot.name] = casadi_variants(robot)
+        for function in functions[robot.name].values():
+            code = casadi.CodeGenerator(f"{function.name()}.c", {"casadi_real": "double",
+                                                                "casadi_int": "long long int"})
+            code.add(function)
+            code.generate(str(folder) + "/")
+            sources.append(folder / f"{function.name()}.c")
+        (folder / f"floor_{robot.name}.c").write_text(floor_source(robot))
+        sources += [folder / robot.name / f"{robot.name}.c", folder / f"floor_{robot.name}.c"]
+    (folder / "harness.c").write_text(harness(robots, functions))
+    includes = [f"-I{folder / robot.name}" for robot in robots]
+    subprocess.run(["gcc", "-std=c99", "-O2", *includes, "-o", str(folder / "bench"), *map(str, sources), "-lm"],
+                   check=True)
+    output = subprocess.run([str(folder / "bench"), str(calls), str(rounds)],
+                            check=True, capture_output=True, text=True).stdout
+    times: dict[tuple[str, str], list[float]] = {}
+    for line in output.splitlines():
+        name, variant, _, nanoseconds = line.split()
+        times.setdefault((name, variant), []).append(float(nanoseconds))
+    return {key: statistics.median(values) for key, values in times.items()}
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--calls", type=int, default=1_000_000)
     parser.add_argument("--rounds", type=int, default=7)
     arguments = parser.parse_args()
     robots = [load_robot(ROOT / "robots" / f"{name}.yaml") for name in ROBOTS]
-    operations, functions = {}, {}
+    operations = {}
+    for robot in robots:
+        variants = casadi_variants(robot)
+        q = np.random.default_rng(0).uniform(-1, 1, robot.dof)
+        T, J = (np.asarray(value) for value in variants["casadi"](q))
+        assert np.allclose(T, reference.fk(robot, q), atol=1e-12) and np.allclose(J, reference.jacobian(robot, q), atol=1e-12)
+        ours = {f.name: f.body.operation_count for f in Generator(robot).functions()}
+        operations[robot.name] = (ours["fk_jacobian"], ours["fk"], ours["jacobian"],
+                                  casadi_operations(variants["casadi"]), casadi_operations(variants["casadi_cse"]))
     with tempfile.TemporaryDirectory(prefix="jacgen-bench-") as temporary:
-        folder = Path(temporary)
-        sources = [folder / "harness.c"]
-        for robot in robots:
-            generator = Generator(robot)
-            write_files(render_robot(robot, ("c",), "double", generator=generator), folder)
-            sources.append(folder / robot.name / f"{robot.name}.c")
-            plain = casadi_fk_jacobian(robot)
-            q = np.random.default_rng(0).uniform(-1, 1, robot.dof)
-            T, J = (np.asarray(value) for value in plain(q))
-            assert np.allclose(T, reference.fk(robot, q), atol=1e-12) and np.allclose(J, reference.jacobian(robot, q), atol=1e-12)
-            outputs = casadi.cse(plain.call(plain.sx_in()))
-            cse = casadi.Function(f"casadi_cse_{robot.name}", plain.sx_in(), outputs)
-            functions[robot.name] = {"casadi": plain, "casadi_cse": cse}
-            for function in (plain, cse):
-                code = casadi.CodeGenerator(f"{function.name()}.c", {"casadi_real": "double",
-                                                                    "casadi_int": "long long int"})
-                code.add(function)
-                code.generate(str(folder) + "/")
-                sources.append(folder / f"{function.name()}.c")
-            (folder / f"floor_{robot.name}.c").write_text(floor_source(robot))
-            sources.append(folder / f"floor_{robot.name}.c")
-            ours = {f.name: f.body.operation_count for f in generator.functions()}
-            operations[robot.name] = (ours["fk_jacobian"], ours["fk"], ours["jacobian"], casadi_operations(plain),
-                                      casadi_operations(cse))
-        (folder / "harness.c").write_text(harness(robots, functions))
-        includes = [f"-I{folder / robot.name}" for robot in robots]
-        subprocess.run(["gcc", "-std=c99", "-O2", *includes, "-o", str(folder / "bench"), *map(str, sources), "-lm"],
-                       check=True)
-        output = subprocess.run([str(folder / "bench"), str(arguments.calls), str(arguments.rounds)],
-                                check=True, capture_output=True, text=True).stdout
-    times: dict[tuple[str, str], list[float]] = {}
-    for line in output.splitlines():
-        name, variant, _, nanoseconds = line.split()
-        times.setdefault((name, variant), []).append(float(nanoseconds))
-    median = {key: statistics.median(values) for key, values in times.items()}
+        median = native_times(robots, Path(temporary), arguments.calls, arguments.rounds)
     header = ["robot", "ours ns", "fk ns", "jac ns", "separate ns", "casadi ns", "cse ns", "floor ns", "ours/casadi",
               "ours/floor", "separate/casadi", "ours ops", "separate ops (fk+jac)", "casadi ops", "cse ops"]
     rows = [header]

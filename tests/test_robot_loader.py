@@ -65,7 +65,7 @@ def position(text: str, token: str, occurrence: int = 1) -> tuple[int, int]:
 
 
 def rows(count: int) -> str:
-    return "".join(f"  - {{type: revolute, a: 0.1, alpha: 0, d: 0}}\n" for _ in range(count))
+    return "  - {type: revolute, a: 0.1, alpha: 0, d: 0}\n" * count
 
 
 # (id, file text, token where the mistake is (None: 1:1), key path, message)
