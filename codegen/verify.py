@@ -7,9 +7,10 @@ configurations inside the joint limits plus configurations near singularities, a
 compared with the function of the same name in `codegen.reference` (functions the
 reference does not have are listed as not compared).
 
-The joint vectors are rounded to float32 first, so that the float build, which can
+The random joint vectors are rounded to float32 first, so that the float build, which can
 only read float32 joint angles, is compared at exactly the configuration the reference
-sees, and its error is the error of its arithmetic alone.
+sees, and its error is the error of its arithmetic alone. `ik` and `ik_numeric` are
+checked by round trip, `velocity_ik` by its backward error.
 """
 
 import functools
@@ -96,14 +97,14 @@ def random_configurations(robot: Robot, count: int, rng: np.random.Generator) ->
     return rng.uniform(ranges[:, 0], ranges[:, 1], size=(count, robot.dof))
 
 
-def singular_configurations(robot: Robot) -> np.ndarray:
+def singular_configurations(robot: Robot, singular: analysis.Singularities | None = None) -> np.ndarray:
     """Configurations at or near singularities, (k, dof), verified besides the random ones.
 
-    This is the hook for configurations known from the robot's singularity analysis. For now
-    they are generic: revolute joints at 0 and +-pi/2 (all zero is the stretched-arm
-    singularity of most arms), prismatic joints mid-travel, clipped into the limits; every
-    combination for up to 4 revolute joints, otherwise all zero, one joint at +-pi/2 at a
-    time, and pairs of joints at +-pi/2.
+    Points on the zero set of each singularity factor (from `singular`, the robot's
+    analysis, computed when not given), and a generic grid: revolute joints at 0 and
+    +-pi/2 (all zero is the stretched-arm singularity of most arms), prismatic joints
+    mid-travel, clipped into the limits; every combination for up to 4 revolute joints,
+    otherwise all zero, one joint at +-pi/2 at a time, and pairs of joints at +-pi/2.
     """
     ranges = bounds(robot)
     revolute = [i for i, joint in enumerate(robot.joints) if joint.revolute]
@@ -121,7 +122,7 @@ def singular_configurations(robot: Robot) -> np.ndarray:
                     settings.append(tuple(setting))
     configurations = np.tile(ranges.mean(axis=1), (len(settings), 1))
     configurations[:, revolute] = settings
-    found = analysis.singular_configurations(robot, analysis.analyse(robot))  # on each factor's zero set
+    found = analysis.singular_configurations(robot, singular or analysis.analyse(robot))
     return np.vstack([np.clip(configurations, ranges[:, 0], ranges[:, 1]), found])
 
 
@@ -348,14 +349,15 @@ def verify(robots: list[Robot], samples: int, seed: int,
             write_files(render_robot(robot, ("c",), "float", generator), work / "float")
             builds = {real: pool.submit(compile_shared, [work / real / robot.name / f"{robot.name}.c"],
                                         work / f"{robot.name}_{real}.so") for real in ("double", "float")}
-            jobs.append((robot, generator.functions(), work, builds))
-        for robot, functions, work, builds in jobs:
+            jobs.append((robot, generator, work, builds))
+        for robot, generator, work, builds in jobs:
+            functions = generator.functions()
             progress(f"verifying {robot.name}")
             rng = np.random.default_rng(seed)
             # Random samples are rounded to float32 so the float build sees exactly the reference's
             # input; singular ones are not, since rounding would move them off the singular set.
             random = random_configurations(robot, samples, rng).astype(np.float32).astype(np.float64)
-            q = np.vstack([random, singular_configurations(robot)])
+            q = np.vstack([random, singular_configurations(robot, generator.singularities)])
             libraries = {real: build.result() for real, build in builds.items()}
             results += verify_robot(robot, _Backends(robot, functions, work, libraries), functions, q, len(random))
     return results
