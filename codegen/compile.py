@@ -99,17 +99,19 @@ class CLibrary:
         values = {p.name: p.value for p in self.robot.symbolic_parameters} | (parameters or {})
         return [ctypes.byref(self._parameters(*(values[p.name] for p in self.robot.symbolic_parameters)))]
 
-    def ik(self, target: np.ndarray, max_solutions: int) -> np.ndarray:
+    def ik(self, target: np.ndarray, max_solutions: int, parameters: dict[str, float] | None = None) -> np.ndarray:
         """`NAME_ik` for one target (4x4 pose or task vector): the solutions, (k, dof)."""
         pointer = ctypes.POINTER(C_TYPES[self.real])
         target = np.ascontiguousarray(np.ravel(target), dtype=self.dtype)
         solutions = np.zeros(max_solutions * self.robot.dof, dtype=self.dtype)
         count = getattr(self._library, f"{self.robot.name}_ik")(target.ctypes.data_as(pointer),
-                                                                 solutions.ctypes.data_as(pointer), *self._extra())
+                                                                 solutions.ctypes.data_as(pointer),
+                                                                 *self._extra(parameters))
         return solutions[: count * self.robot.dof].reshape(count, self.robot.dof).astype(np.float64)
 
-    def ik_numeric(self, target: np.ndarray, q0: np.ndarray, max_iter: int, tol: float) -> tuple[np.ndarray, int]:
-        """`NAME_ik_numeric` from q0: (q, status)."""
+    def ik_numeric(self, target: np.ndarray, q0: np.ndarray, max_iter: int = 100,
+                   tol: float = 1e-10) -> tuple[np.ndarray, int]:
+        """`NAME_ik_numeric` from q0: (q, status); the defaults are the generated Python's."""
         pointer = ctypes.POINTER(C_TYPES[self.real])
         target = np.ascontiguousarray(np.ravel(target), dtype=self.dtype)
         start = np.ascontiguousarray(q0, dtype=self.dtype)

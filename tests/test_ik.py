@@ -7,7 +7,7 @@ Python. Forward kinematics is the generated fk, itself checked against codegen.r
 elsewhere; the random robots are checked against codegen.reference.fk directly.
 """
 
-import ctypes
+import functools
 import itertools
 
 import numpy as np
@@ -16,7 +16,7 @@ from eaik.IK_HP import HPRobot
 from ik_geo import Robot as IkGeoRobot
 
 from codegen import reference
-from codegen.compile import compile_shared
+from codegen.compile import CLibrary, compile_shared
 from codegen.context import _ik_context, _ik_math
 from codegen.printers import CPrinter, PythonPrinter
 from codegen.render import _environment, render_robot
@@ -264,17 +264,8 @@ def _c_ik_only(arm, folder, real):
                                         task_dim=len(arm.task), max_solutions=ik["max_solutions"],
                                         signature=ik["signature"])
                       + _environment().get_template("c/ik.c.jinja").render(context))
-    library = ctypes.CDLL(str(compile_shared([source], folder / f"lib{arm.name}_{real}.so")))
-    function = library[f"{arm.name}_ik"]
-    function.argtypes, function.restype = [ctypes.c_void_p, ctypes.c_void_p], ctypes.c_int
-    dtype = np.float64 if real == "double" else np.float32
-    out = np.zeros(8 * arm.dof, dtype)
-
-    def solve(target):
-        count = function(np.ascontiguousarray(target, dtype).ctypes.data, out.ctypes.data)
-        return out[:count * arm.dof].reshape(count, arm.dof).astype(float)
-
-    return solve
+    library = CLibrary(compile_shared([source], folder / f"lib{arm.name}_{real}.so"), arm, [], real)
+    return functools.partial(library.ik, max_solutions=8)
 
 
 def _reference_targets(arm):
@@ -371,35 +362,12 @@ def c_solvers(request, tmp_path_factory):
     """Per robot: a function target -> solutions (k, n) calling NAME_ik, and NAME_ik_numeric."""
     real = request.param
     folder = tmp_path_factory.mktemp(f"c_{real}")
-    scalar, dtype = (ctypes.c_double, np.float64) if real == "double" else (ctypes.c_float, np.float32)
-    pointer = ctypes.POINTER(scalar)
     solvers = {}
     for name in WITH_IK + WITHOUT_IK:
         arm = robot(name)
-        source = _generate(arm, folder, ("c",), real)
-        library = ctypes.CDLL(str(compile_shared([source], folder / f"lib{name}.so")))
-        numeric = library[f"{name}_ik_numeric"]
-        numeric.argtypes = [pointer, pointer, ctypes.c_int, scalar, pointer]
-
-        def solve_numeric(target, q0, max_iter=100, tol=1e-10, function=numeric, n=arm.dof):
-            q = np.zeros(n, dtype)
-            t, start = np.ascontiguousarray(target, dtype).ravel(), np.ascontiguousarray(q0, dtype)
-            status = function(t.ctypes.data_as(pointer), start.ctypes.data_as(pointer), max_iter, tol,
-                              q.ctypes.data_as(pointer))
-            return q.astype(float), status
-
-        closed = None
-        if name in WITH_IK:
-            function = library[f"{name}_ik"]
-            function.argtypes, function.restype = [pointer, pointer], ctypes.c_int
-            out = np.zeros(8 * arm.dof, dtype)
-
-            def closed(target, function=function, out=out, n=arm.dof):
-                t = np.ascontiguousarray(target, dtype).ravel()
-                count = function(t.ctypes.data_as(pointer), out.ctypes.data_as(pointer))
-                return out[:count * n].reshape(count, n).astype(float)
-
-        solvers[name] = (closed, solve_numeric)
+        library = CLibrary(compile_shared([_generate(arm, folder, ("c",), real)], folder / f"lib{name}.so"), arm, [], real)
+        closed = functools.partial(library.ik, max_solutions=8) if name in WITH_IK else None
+        solvers[name] = (closed, library.ik_numeric)
     return real, solvers
 
 
@@ -478,17 +446,12 @@ def test_runtime_parameters(tmp_path):
     arm = parse_robot(text.encode())
     module = _generate(arm, tmp_path)
     source = _generate(arm, tmp_path, ("c",))
-    library = ctypes.CDLL(str(compile_shared([source], tmp_path / "libpuma_runtime.so")))
-    parameters = type("params", (ctypes.Structure,), {"_fields_": [("d3", ctypes.c_double)]})
-    solve = library["puma_runtime_ik"]
-    solve.argtypes = [ctypes.c_void_p, ctypes.c_void_p, ctypes.POINTER(parameters)]
-    solve.restype = ctypes.c_int
+    library = CLibrary(compile_shared([source], tmp_path / "libpuma_runtime.so"), arm, [], "double")
     q = random_configurations(robot("puma560"), 20, seed=18)
     for d3 in (0.15005, 0.3):
         for row in q:
             T = module.fk(row, d3=d3)
             found = module.ik(T, d3=d3)
             assert len(found) == 8 and _joint_distance(arm, found, row).min() < 1e-7
-            out = np.zeros(48)
-            count = solve(np.ascontiguousarray(T).ctypes.data, out.ctypes.data, ctypes.byref(parameters(d3)))
-            assert count == 8 and np.abs(out.reshape(8, 6) - found).max() < 1e-9
+            in_c = library.ik(T, 8, {"d3": d3})
+            assert len(in_c) == 8 and np.abs(in_c - found).max() < 1e-9
