@@ -66,12 +66,11 @@ class Function:
         """Returns its one result by value."""
         return self.outputs[0].scalar
 
-    def parts(self, values):
-        """`values` (the body's outputs, or the last axis of an array) split per output."""
+    def parts(self, values: tuple[sympy.Expr, ...]):
+        """The body's outputs split per output: (Output, its values row-major)."""
         start = 0
         for output in self.outputs:
-            yield output, values[..., start:start + output.size] if hasattr(values, "ndim") else values[
-                start:start + output.size]
+            yield output, values[start:start + output.size]
             start += output.size
 
 
