@@ -23,7 +23,7 @@ wherever c_i^2 + s_i^2 = 1.
 """
 
 import itertools
-import time
+import math
 from dataclasses import dataclass
 from functools import lru_cache
 
@@ -32,13 +32,20 @@ import sympy
 from sympy.polys.orderings import lex
 from sympy.polys.rings import PolyElement, PolyRing
 
-from . import budget, kinematics, reference
+from . import kinematics, reference
 from .robot import TASK_COMPONENTS, Robot
 
 EULER = ("roll", "pitch", "yaw")
-# Gram cofactors (redundant arms) above this many terms are not factored: sympy needs
-# minutes for the 10^4-term cofactors of 7-axis arms, a few seconds at most below this.
-FACTOR_TERM_LIMIT = 2000
+# The exact analysis is bounded by counts, never by a clock, so its outcome is the same on
+# every machine. WORK_LIMIT bounds the monomial products of all polynomial multiplications
+# of one robot (about 10 s of sympy's sparse arithmetic at the most); MINOR_LIMIT the
+# maximal minors whose common factors are sought (C(n, m) of them); FACTOR_TERM_LIMIT the
+# size of a polynomial handed to sympy's factoring. Past any of them the exact factors
+# found so far stay, and the generated code computes the rest of the rank condition
+# numerically (det(Js), or det(Js Js^T) / det(Js^T Js)).
+WORK_LIMIT = 250_000
+MINOR_LIMIT = 64
+FACTOR_TERM_LIMIT = 400
 READABLE_TERMS = 64  # factors up to this many terms are written with angle sums collapsed
 ROOT_TOLERANCE = 1e-9  # |factor| at a numerically found root
 PARALLEL_TOLERANCE = 1e-9  # |z_a x z_b| for parallel unit axes
@@ -66,7 +73,7 @@ def joint_atoms(robot: Robot) -> tuple[tuple[sympy.Symbol, ...], ...]:
                  for i, joint in enumerate(robot.joints))
 
 
-def maximal_minors(matrix, zero=0, one=1) -> list:
+def maximal_minors(matrix, zero=0, one=1, times=lambda a, b: a * b) -> list:
     """Every largest square minor of a matrix (list of rows), by Laplace expansion.
 
     The minors of the lower rows are shared (memoised), so a 6 x 7 matrix costs about 450
@@ -85,7 +92,7 @@ def maximal_minors(matrix, zero=0, one=1) -> list:
         total = zero
         for k, c in enumerate(columns):
             if matrix[row][c] != 0:
-                term = matrix[row][c] * minor(row + 1, columns[:k] + columns[k + 1:])
+                term = times(matrix[row][c], minor(row + 1, columns[:k] + columns[k + 1:]))
                 total = total - term if k % 2 else total + term
         return total
 
@@ -106,6 +113,7 @@ class JointRing:
         self.q = kinematics.joint_symbols(robot)
         self.atoms = joint_atoms(robot)
         self.opaque: dict[sympy.Expr, sympy.Symbol] = {}
+        self.work = 0
         links = kinematics.link_transforms(robot, lambda i: self.atoms[i], self.q)
         transforms = [m for pair in links for m in pair]
         transforms += [kinematics.pose_transform(robot.base), kinematics.pose_transform(robot.tool)]
@@ -113,15 +121,12 @@ class JointRing:
         symbols = [a for atoms in self.atoms for a in atoms] + [p.symbol for p in robot.symbolic_parameters]
         symbols += list(self.opaque.values())
         self.ring = PolyRing(symbols, sympy.QQ, lex)  # c_i before s_i: reduces c_i^2
-        swapped = [a for atoms in self.atoms for a in reversed(atoms)] + symbols[len(symbols) - len(self.opaque)
-                                                                                - len(robot.symbolic_parameters):]
-        self.sin_ring = PolyRing(swapped, sympy.QQ, lex)  # s_i before c_i: reduces s_i^2
         matrices = [self.matrix(m) for m in transforms]
         self.links = [(matrices[2 * i], matrices[2 * i + 1]) for i in range(robot.dof)]
         self.base, self.tool = matrices[-2], matrices[-1]
         self.trig_gens = [i for i, atoms in enumerate(self.atoms) if len(atoms) == 2]
-        self.circles = {toward_cos: [ring(self.atoms[i][0] ** 2 + self.atoms[i][1] ** 2 - 1) for i in self.trig_gens]
-                        for toward_cos, ring in ((True, self.sin_ring), (False, self.ring))}
+        position = {symbol: k for k, symbol in enumerate(symbols)}
+        self.circle_gens = [(position[self.atoms[i][0]], position[self.atoms[i][1]]) for i in self.trig_gens]
 
     def _hide_constants(self, expr: sympy.Expr) -> sympy.Expr:
         """Replace each irrational constant (sqrt(2)/2, cos(22*pi/225)) by a generator."""
@@ -133,6 +138,17 @@ class JointRing:
                 self.opaque[expr] = sympy.Symbol(f"_k{len(self.opaque)}", real=True)
             return self.opaque[expr]
         return expr.func(*(self._hide_constants(arg) for arg in expr.args))
+
+    def charge(self, work: int) -> None:
+        """Count `work` monomial operations against WORK_LIMIT."""
+        self.work += work
+        if self.work > WORK_LIMIT:
+            raise TooLarge(f"more than {WORK_LIMIT:,} monomial operations")
+
+    def times(self, a: PolyElement, b: PolyElement) -> PolyElement:
+        """a * b, charged as len(a) * len(b) monomial products."""
+        self.charge(len(a) * len(b))
+        return a * b
 
     def matrix(self, m: sympy.Matrix) -> list[list[PolyElement]]:
         return [[self.ring.from_expr(m[r, c]) for c in range(m.cols)] for r in range(m.rows)]
@@ -154,10 +170,25 @@ class JointRing:
         return kinematics.simplify_trig(condition) if len(p) <= READABLE_TERMS else condition
 
     def reduce(self, p: PolyElement, toward_cos: bool) -> PolyElement:
-        """Normal form modulo s_i^2 + c_i^2 - 1: no s_i^2 (toward cos) or no c_i^2."""
-        ring = self.sin_ring if toward_cos else self.ring
-        circles = self.circles[toward_cos]
-        return p.set_ring(ring).rem(circles).set_ring(self.ring) if circles else p
+        """Normal form modulo s_i^2 + c_i^2 - 1: no s_i^2 (toward cos) or no c_i^2.
+
+        One pass per joint, s^(2k + r) -> s^r (1 - c^2)^k by the binomial theorem (or the
+        same with c and s swapped): linear in the size of the result, which is charged."""
+        terms = dict(p)
+        for cos, sin in self.circle_gens:
+            power, other = (sin, cos) if toward_cos else (cos, sin)
+            reduced: dict = {}
+            for monomial, coefficient in terms.items():
+                half = monomial[power] // 2
+                for j in range(half + 1):
+                    exponents = list(monomial)
+                    exponents[power] -= 2 * half
+                    exponents[other] += 2 * j
+                    key = tuple(exponents)
+                    reduced[key] = reduced.get(key, 0) + coefficient * math.comb(half, j) * (-1) ** j
+            terms = {m: c for m, c in reduced.items() if c}
+            self.charge(len(terms))
+        return self.ring.from_dict(terms) if terms else self.ring.zero
 
     def joints_of(self, p: PolyElement) -> tuple[int, ...]:
         degrees = p.degrees()
@@ -169,15 +200,19 @@ class JointRing:
         return tuple(used)
 
 
-def _mul(a, b):
-    return [[sum((a[r][k] * b[k][c] for k in range(len(b))), a[r][0].ring.zero) for c in range(len(b[0]))]
+class TooLarge(Exception):
+    """The exact analysis would pass one of the size limits above."""
+
+
+def _mul(ring: JointRing, a, b):
+    return [[sum((ring.times(a[r][k], b[k][c]) for k in range(len(b))), ring.ring.zero) for c in range(len(b[0]))]
             for r in range(len(a))]
 
 
-def _inverse(t):
+def _inverse(ring: JointRing, t):
     """Inverse of a rigid transform (exact wherever c_i^2 + s_i^2 = 1)."""
     rotation = [[t[c][r] for c in range(3)] for r in range(3)]
-    shift = [-sum((rotation[r][k] * t[k][3] for k in range(3)), t[0][0].ring.zero) for r in range(3)]
+    shift = [-sum((ring.times(rotation[r][k], t[k][3]) for k in range(3)), ring.ring.zero) for r in range(3)]
     zero, one = t[0][0].ring.zero, t[0][0].ring.one
     return [rotation[r] + [shift[r]] for r in range(3)] + [[zero, zero, zero, one]]
 
@@ -185,17 +220,17 @@ def _inverse(t):
 def _frames_about(ring: JointRing, k: int) -> list:
     """Poses of every joint-axis frame and of the tool relative to the axis frame of joint k."""
     n = ring.robot.dof
-    step = [_mul(ring.links[j][1], ring.links[j + 1][0]) for j in range(n - 1)]  # axis j -> axis j+1
+    step = [_mul(ring, ring.links[j][1], ring.links[j + 1][0]) for j in range(n - 1)]  # axis j -> axis j+1
     identity = [[ring.ring.one if r == c else ring.ring.zero for c in range(4)] for r in range(4)]
     frames = [None] * n
     frames[k] = identity
     for i in range(k + 1, n):
-        frames[i] = _mul(frames[i - 1], step[i - 1])
+        frames[i] = _mul(ring, frames[i - 1], step[i - 1])
     back = identity
     for i in range(k - 1, -1, -1):
-        back = _mul(step[i], back)
-        frames[i] = _inverse(back)
-    tool = _mul(_mul(frames[n - 1], ring.links[n - 1][1]), ring.tool)
+        back = _mul(ring, step[i], back)
+        frames[i] = _inverse(ring, back)
+    tool = _mul(ring, _mul(ring, frames[n - 1], ring.links[n - 1][1]), ring.tool)
     return frames + [tool]
 
 
@@ -206,7 +241,8 @@ def _geometric_columns(ring: JointRing, frames: list, point) -> list[list[PolyEl
         z = [frames[i][r][2] for r in range(3)]
         if joint.revolute:
             arm = [point[r] - frames[i][r][3] for r in range(3)]
-            linear = [z[1] * arm[2] - z[2] * arm[1], z[2] * arm[0] - z[0] * arm[2], z[0] * arm[1] - z[1] * arm[0]]
+            x = ring.times
+            linear = [x(z[1], arm[2]) - x(z[2], arm[1]), x(z[2], arm[0]) - x(z[0], arm[2]), x(z[0], arm[1]) - x(z[1], arm[0])]
             column = linear + z
         else:
             column = z + [ring.ring.zero] * 3
@@ -278,9 +314,9 @@ def _permutation_sign(order) -> int:
 def _analysed_matrix(ring: JointRing):
     """(rows, sign, cos(pitch)^2 or None): a matrix with the singularity polynomial of Js.
 
-    The whole geometric Jacobian: in the smallest joint frame and about the smallest
-    reference point (always the tool point when tall, where only rotations keep
-    det(Js^T Js)); its determinant is sign * det(Js). Otherwise Js in the world frame,
+    The whole geometric Jacobian: in the joint frame and about the reference point (that
+    frame's origin or the tool point; always the tool point when tall, where only rotations
+    keep det(Js^T Js)) that make it smallest; its determinant is sign * det(Js). Otherwise Js in the world frame,
     Euler-angle rows multiplied by their denominators, which are returned as cos(pitch)^2.
     """
     robot = ring.robot
@@ -289,14 +325,14 @@ def _analysed_matrix(ring: JointRing):
         best = None
         for k in range(n):
             frames = _frames_about(ring, k)
-            points = [frames[-1]] if n < 6 else frames
+            points = [frames[-1]] if n < 6 else [frames[k], frames[-1]]  # about a wrist centre at most
             for frame in points:
                 matrix = _geometric_columns(ring, frames, [frame[r][3] for r in range(3)])
                 if best is None or _size(matrix) < _size(best):
                     best = matrix
         return best, _permutation_sign(rows), None
-    base_axis = _mul(ring.base, ring.links[0][0])
-    frames = [_mul(base_axis, frame) for frame in _frames_about(ring, 0)]
+    base_axis = _mul(ring, ring.base, ring.links[0][0])
+    frames = [_mul(ring, base_axis, frame) for frame in _frames_about(ring, 0)]
     tool = frames[-1]
     geometric = _geometric_columns(ring, frames, [tool[r][3] for r in range(3)])
     if rows is not None:
@@ -312,12 +348,13 @@ def _euler_rows(ring: JointRing, rotation, angular) -> tuple[dict, PolyElement]:
     (its product structure shows which joints make pitch reach ±90°)."""
     r00, r10, r20 = rotation[0][0], rotation[1][0], rotation[2][0]
     wx, wy, wz = angular
-    cos_pitch_sq = r00**2 + r10**2
+    x = ring.times
+    cos_pitch_sq = x(r00, r00) + x(r10, r10)
     reduced = ring.reduce(cos_pitch_sq, True)
-    roll = [r00 * wx[j] + r10 * wy[j] for j in range(ring.robot.dof)]
+    roll = [x(r00, wx[j]) + x(r10, wy[j]) for j in range(ring.robot.dof)]
     return {"roll": roll,
-            "pitch": [r00 * wy[j] - r10 * wx[j] for j in range(ring.robot.dof)],
-            "yaw": [reduced * wz[j] - r20 * roll[j] for j in range(ring.robot.dof)]}, cos_pitch_sq
+            "pitch": [x(r00, wy[j]) - x(r10, wx[j]) for j in range(ring.robot.dof)],
+            "yaw": [x(reduced, wz[j]) - x(r20, roll[j]) for j in range(ring.robot.dof)]}, cos_pitch_sq
 
 
 # ---------------------------------------------------------------------------------------
@@ -338,63 +375,76 @@ class Factor:
 
 @dataclass(frozen=True)
 class Singularities:
-    """The singularity polynomial of a robot, factored as far as the budget allows.
+    """The singularity polynomial of a robot, factored as far as the size limits allow.
 
-    For square Js: det(Js) = constant * prod(p^k for p, k in determinant) / cos(pitch)^euler_power,
-    where cos(pitch) = sqrt(r00^2 + r10^2) of the tool rotation (euler_power > 0 only when
-    Js holds Euler-angle rate rows).
+    complete: det(Js) = constant * prod(p^k for p, k in determinant) / cos(pitch)^euler_power
+    (square Js), where cos(pitch) = sqrt(r00^2 + r10^2) of the tool rotation (euler_power > 0
+    only when Js holds Euler-angle rate rows); for m != n, the factors are those of the Gram
+    determinant. Not complete: `factors` are exact factors of it, and the rest of the rank
+    condition is left to a numeric det(Js) or Gram determinant in the generated code.
+    everywhere: Js is rank-deficient in every configuration (the polynomial is 0).
     """
 
     kind: str  # "det(Js)", "det(Js Js^T)" or "det(Js^T Js)"
     factors: tuple[Factor, ...]  # the kinematic singularity conditions
-    complete: bool  # False: only the factors common to all maximal minors of Js are known
+    complete: bool
+    everywhere: bool
     constant: sympy.Expr
     determinant: tuple[tuple[sympy.Expr, int], ...]  # every factor of the polynomial, Euler ones too
     euler_power: int
     euler: tuple[Factor, ...]  # joint conditions for cos(pitch) = 0, when Js holds Euler rows
     note: str
-    seconds: float
+
+
+def _gram_factors(ring: JointRing, minors: list) -> tuple[PolyElement, list, bool, str]:
+    """(constant, factors, complete, note) of the Gram determinant sum(minor^2) (Cauchy-Binet),
+    from the factors common to every maximal minor, never from the sum itself."""
+    common = minors[0]
+    for minor in minors[1:]:
+        ring.times(common, minor)  # charged as a product: gcd costs about as much
+        common = common.gcd(minor)
+    if len(common) > FACTOR_TERM_LIMIT:
+        raise TooLarge(f"a common factor of {len(common)} terms")
+    constant, factors = _factor(ring, common)
+    # Where some minor is a constant multiple of the common factor, the rest of the sum of
+    # squares never vanishes: the common factors are the whole condition.
+    complete = any(minor and minor.exquo(common).is_ground for minor in minors)
+    note = "" if complete else (
+        f"besides the factors common to all {len(minors)} maximal minors of Js, Js loses rank where the "
+        f"Gram determinant {ring.robot.name}'s code computes numerically is 0")
+    return constant**2, [(f, 2 * k) for f, k in factors], complete, note
 
 
 def analyse(robot: Robot) -> Singularities:
-    """Factor the singularity polynomial of `robot` (see the module docstring)."""
-    start = time.perf_counter()
+    """Factor the singularity polynomial of `robot` (see the module docstring), as far as the
+    size limits allow: bounded work, the same result on every machine."""
     ring = JointRing(robot)
     n, m = robot.dof, len(robot.task)
     kind = "det(Js)" if m == n else ("det(Js Js^T)" if m < n else "det(Js^T Js)")
-    matrix, sign, cos_pitch_sq = _analysed_matrix(ring)
-    minors = maximal_minors(matrix, ring.ring.zero, ring.ring.one)
-    note, complete = "", True
-    what = f"factoring {kind} of {robot.name}"
-    if m == n:  # out of budget: the determinant itself is the one condition
-        constant, factors = budget.within_budget(lambda: _factor(ring, minors[0]),
-                                                 lambda: (ring.ring.one, [(minors[0], 1)]), what)
-        constant *= sign
-    else:
-        common = minors[0]
-        for minor in minors[1:]:
-            common = common.gcd(minor)
-        constant, factors = _factor(ring, common)
-        constant, factors = constant**2, [(f, 2 * k) for f, k in factors]
-        cofactor = ring.reduce(sum((minor.exquo(common) ** 2 for minor in minors), ring.ring.zero), True)
-        factored = (budget.within_budget(lambda: _factor(ring, cofactor), lambda: None, what)
-                     if len(cofactor) <= FACTOR_TERM_LIMIT else None)
-        if factored is not None:
-            extra_constant, extra = factored
-            constant *= extra_constant
-            merged = dict(factors)
-            for f, k in extra:
-                merged[f] = merged.get(f, 0) + k
-            factors = sorted(merged.items(), key=lambda item: [f for f, _ in factors + extra].index(item[0]))
+    constant, factors, complete, note, cos_pitch_sq = ring.ring.one, [], False, "", None
+    try:
+        matrix, sign, cos_pitch_sq = _analysed_matrix(ring)
+        if math.comb(max(m, n), min(m, n)) > MINOR_LIMIT:
+            raise TooLarge(f"C({max(m, n)}, {min(m, n)}) maximal minors")
+        minors = maximal_minors(matrix, ring.ring.zero, ring.ring.one, ring.times)
+        if all(not minor for minor in minors):
+            return Singularities(kind, (), True, True, sympy.Integer(0), (), 0, (),
+                                 f"Js has rank below {min(m, n)} in every configuration: "
+                                 f"the arm cannot move its tool along every task direction at once", )
+        if m == n:
+            if len(minors[0]) > FACTOR_TERM_LIMIT:
+                raise TooLarge(f"det(Js) has {len(minors[0])} terms")
+            constant, factors = _factor(ring, minors[0])
+            constant, complete = constant * sign, True
         else:
-            complete = False
-            note = (f"{kind} has {len(cofactor)} terms once the factors common to all {len(minors)} "
-                    f"maximal minors of Js are taken out: too many to factor within the budget, so the singularity "
-                    f"factors end with the Gram determinant itself (zero wherever the manipulability is)")
+            constant, factors, complete, note = _gram_factors(ring, minors)
+    except TooLarge as reason:
+        note = (f"the exact analysis stopped at its size limit ({reason}): "
+                f"{'det(Js)' if m == n else 'the Gram determinant'}, computed numerically, stands as the condition")
     euler_power, euler = 0, []
-    if cos_pitch_sq is not None:
+    if cos_pitch_sq is not None and complete:
         euler_power = sum({"roll": 2, "pitch": 1, "yaw": 2}.get(c, 0) for c in robot.task)
-        euler = [(f, k) for f, k in _factor(ring, cos_pitch_sq)[1]]
+        euler = _factor(ring, cos_pitch_sq)[1] if len(cos_pitch_sq) <= FACTOR_TERM_LIMIT else []
     scale = dict(euler)
     kinematic = [(f, k - euler_power * scale.get(f, 0) // 2) for f, k in factors]
     context = _Numeric(robot, ring)
@@ -402,13 +452,22 @@ def analyse(robot: Robot) -> Singularities:
         kind=kind,
         factors=tuple(context.describe(f, k) for f, k in kinematic if k > 0),
         complete=complete,
+        everywhere=False,
         constant=ring.expr(constant),
         determinant=tuple((ring.expr(f), k) for f, k in factors),
         euler_power=euler_power,
         euler=tuple(context.describe(f, k // 2 or 1) for f, k in euler),
         note=note,
-        seconds=time.perf_counter() - start,
     )
+
+
+def unanalysed(robot: Robot) -> Singularities:
+    """No exact factors: the numeric rank determinant is the whole condition (the fallback
+    of the analysis when it outlives --budget)."""
+    n, m = robot.dof, len(robot.task)
+    kind = "det(Js)" if m == n else ("det(Js Js^T)" if m < n else "det(Js^T Js)")
+    return Singularities(kind, (), False, False, sympy.Integer(1), (), 0, (),
+                         f"the exact analysis took longer than --budget: {kind}, computed numerically, is the condition")
 
 
 # ---------------------------------------------------------------------------------------
@@ -427,18 +486,41 @@ class _Numeric:
     def describe(self, f: PolyElement, multiplicity: int) -> Factor:
         joints = self.ring.joints_of(f)
         condition = self.ring.trig_expr(f)
-        roots = self._roots(condition, joints[0]) if len(joints) == 1 else None
+        roots = self._roots(f, joints[0]) if len(joints) == 1 else None
         factor = Factor(self.ring.expr(f), condition, multiplicity, joints, roots, "")
         return Factor(**{**factor.__dict__, "meaning": self._meaning(factor)})
 
-    def _roots(self, condition: sympy.Expr, joint: int) -> tuple[sympy.Expr, ...]:
-        q = self.ring.q[joint]
-        domain = (sympy.Interval(-sympy.pi, sympy.pi, left_open=True) if self.robot.joints[joint].revolute
-                  else sympy.S.Reals)
-        roots = sympy.solveset(condition.xreplace(self.nominal), q, domain)
-        if not isinstance(roots, sympy.FiniteSet):
+    def _roots(self, f: PolyElement, joint: int) -> tuple[sympy.Expr, ...]:
+        """The values of joint `joint` where the one-joint factor f vanishes, in (-pi, pi] for a
+        revolute joint: with t = tan(q/2), f(cos q, sin q) (1 + t^2)^deg is a polynomial in t
+        of degree at most 2 deg, and q = pi is a root where f(-1, 0) = 0. Closed form up to
+        degree 2, numeric roots above, each checked against f."""
+        expr, t = self.ring.expr(f).xreplace(self.nominal), sympy.Dummy("t", real=True)
+        atoms = self.ring.atoms[joint]
+        poly = sympy.Poly(expr, *atoms)
+        if len(atoms) == 1:
+            in_t, at_pi = sympy.Poly(expr, atoms[0]), []
+        else:
+            degree = poly.total_degree()
+            in_t = sympy.Poly(sum(coefficient * (1 - t**2) ** i * (2 * t) ** j * (1 + t**2) ** (degree - i - j)
+                                  for (i, j), coefficient in poly.terms()), t)
+            at_pi = [sympy.pi] if abs(poly.eval((-1, 0))) <= ROOT_TOLERANCE * _scale(poly) else []
+        if in_t.is_zero:
             return ()
-        return tuple(sorted(roots, key=lambda r: float(r)))
+        if in_t.degree() <= 2 and not in_t.has(sympy.Float):
+            values = [r for r in sympy.roots(in_t, multiple=True) if r.is_real]
+        else:
+            coefficients = [complex(c) for c in in_t.all_coeffs()]
+            values = [sympy.Float(float(r.real), 17) for r in np.roots(coefficients)
+                      if abs(r.imag) <= 1e-6 * (1 + abs(r))]
+        roots = [2 * sympy.atan(v) for v in values] if len(atoms) == 2 else list(values)
+        value = sympy.lambdify(atoms, expr, "math")
+        unique = {}
+        for root in roots + at_pi:
+            point = (math.cos(float(root)), math.sin(float(root))) if len(atoms) == 2 else (float(root),)
+            if abs(value(*point)) <= ROOT_TOLERANCE * _scale(poly) and round(float(root), 9) not in unique:
+                unique[round(float(root), 9)] = root
+        return tuple(unique[key] for key in sorted(unique))
 
     def _function(self, condition: sympy.Expr):
         return sympy.lambdify([self.ring.q], condition.xreplace(self.nominal), "numpy")
@@ -493,6 +575,10 @@ class _Numeric:
             if n >= 3 and points and all(_over_first_axis(robot, q, point(q)) for q in points):
                 return f"shoulder: {name} in the plane of the axes of joints 1 and 2 (over the axis of joint 1)"
         return ""
+
+
+def _scale(poly: sympy.Poly) -> float:
+    return max(1.0, *(abs(float(c)) for c in poly.coeffs()))
 
 
 def _solve_along(value, q: np.ndarray, joint: int, spec) -> np.ndarray | None:

@@ -25,7 +25,9 @@ def _languages(ctx, param, value: str) -> tuple[str, ...]:
 
 class JacgenGroup(click.Group):
     """Turns every JacgenError, a file that cannot be written and a usage mistake into one
-    line on stderr and exit code 2."""
+    line on stderr and exit code 2, and any other exception (a bug of jacgen's) into one
+    line and exit code 1; `jacgen --debug ...` shows its traceback. Files are written only
+    after everything has been generated, so an error leaves earlier output intact."""
 
     def main(self, *args, **kwargs):
         """click's main, except that a usage mistake is one line (click adds usage and a hint)."""
@@ -51,11 +53,21 @@ class JacgenGroup(click.Group):
         except OSError as error:
             click.echo(f"jacgen: error: {error.filename or ''}: {error.strerror or error}", err=True)
             ctx.exit(2)
+        except (click.exceptions.Exit, click.ClickException, click.Abort):
+            raise
+        except Exception as error:  # noqa: BLE001 (a bug: one line, the traceback on request)
+            if ctx.params.get("debug"):
+                raise
+            what = str(error).splitlines()[0][:200] if str(error) else ""
+            click.echo(f"jacgen: internal error: {type(error).__name__}{': ' if what else ''}{what} "
+                       f"(a bug in jacgen; run with --debug for the traceback)", err=True)
+            ctx.exit(1)
 
 
 @click.group(cls=JacgenGroup, context_settings={"help_option_names": ["-h", "--help"]})
 @click.version_option(__version__, prog_name="jacgen")
-def main():
+@click.option("--debug", is_flag=True, help="Show the traceback of an internal error.")
+def main(debug):
     """Symbolic Jacobian code generator for robot arms."""
 
 
@@ -70,8 +82,9 @@ def main():
 @click.option("--check", is_flag=True, help="Write nothing; exit 1 with a diff if a file would change.")
 @click.option("--budget", "budget_seconds", default=budget.DEFAULT_SECONDS, show_default=True,
               type=click.FloatRange(min=0), metavar="SECONDS",
-              help="Time limit of each symbolic simplification step, past which a cheaper exact "
-                   "form is used with a warning (0: no limit).")
+              help="Safety net on the exact singularity analysis of each robot, whose work is "
+                   "bounded by size limits anyway: past it the numeric rank determinant stands as the "
+                   "condition, with a warning (0: no limit).")
 def generate(robot_files, output, languages, real, check, budget_seconds):
     """Generate code for each ROBOT_FILE."""
     budget.set_seconds(budget_seconds)

@@ -27,7 +27,7 @@ C_ROW_MACROS = {"singularity_factors": "NUM_SINGULARITY_FACTORS"}
 def _common(robot: Robot) -> dict:
     return {
         "name": robot.name,
-        "description": robot.description,
+        "description": robot.description.split("\n") if robot.description else [],
         "dof": robot.dof,
         "task": list(robot.task),
         "length_unit": robot.length_unit,

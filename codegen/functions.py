@@ -6,13 +6,14 @@ that every printer turns into its own language. Temporaries are numbered in a fi
 order, so the output does not depend on hashing.
 """
 
+import heapq
 from dataclasses import dataclass
 from functools import cached_property
 
 import sympy
 from sympy.core.parameters import distribute
 
-from . import analysis, kinematics
+from . import analysis, budget, kinematics
 from .printers import fold_constants
 from .robot import Robot
 
@@ -38,6 +39,7 @@ class Output:
     rows: int
     cols: int
     scalar: bool = False
+    vector: bool = False  # a column vector: numpy shape (rows,), even for one row
     equals: str = ""  # the function whose result this is, when the function fuses several
 
     @property
@@ -46,10 +48,10 @@ class Output:
 
     @property
     def shape(self) -> tuple[int, ...]:
-        """numpy shape: matrices (rows, cols), column vectors (rows,), scalars ()."""
+        """numpy shape: matrices (rows, cols) (a one-joint Jacobian too), vectors (rows,), scalars ()."""
         if self.scalar:
             return ()
-        return (self.rows,) if self.cols == 1 else (self.rows, self.cols)
+        return (self.rows,) if self.vector else (self.rows, self.cols)
 
 
 @dataclass(frozen=True)
@@ -83,8 +85,11 @@ class Generator:
         # Trig symbols, each defined once, in an order that defines before use.
         self.definitions: list[tuple[sympy.Symbol, sympy.Expr]] = []
         self._trig: dict[tuple[int, ...], tuple[sympy.Symbol, sympy.Symbol]] = {}
+        self._named: set[sympy.Symbol] = set()
+        self._names: dict[sympy.Expr, sympy.Symbol] = {}
         with distribute(False):  # keep 0.0825*(a - b) whole, for CSE to share a - b
-            self.chain = kinematics.build_chain(robot, lambda i: self.cos_sin((i,)), self.q, angle_sum=self.cos_sin)
+            self.chain = kinematics.build_chain(robot, lambda i: self.cos_sin((i,)), self.q, simplify=self.name,
+                                               angle_sum=self.cos_sin)
 
     def cos_sin(self, joints: tuple[int, ...]) -> tuple[sympy.Symbol, sympy.Symbol]:
         """Symbols for the cos and sin of a sum of joint angles, defined on first use:
@@ -104,65 +109,113 @@ class Generator:
 
     @cached_property
     def jacobian(self) -> sympy.Matrix:
-        # Built with distribution on: p - o_i then cancels the terms the two origins share.
         return kinematics.column_jacobian(self.robot, self.chain)
 
     @cached_property
     def singularities(self) -> analysis.Singularities:
-        return analysis.analyse(self.robot)
+        return budget.within_budget(lambda: analysis.analyse(self.robot), lambda: analysis.unanalysed(self.robot),
+                                    f"the singularity analysis of {self.robot.name}")
+
+    def rank_determinant(self, js: sympy.Matrix) -> sympy.Expr:
+        """det(Js) for square Js, else the Gram determinant det(Js Js^T) or det(Js^T Js), by
+        Laplace expansion (memoised minors: division-free, at most 6 * 2^5 products) over the
+        named entries: a fixed cost on top of Js, whatever the arm."""
+        m, n = js.shape
+        matrix = js if m == n else (js * js.T if m < n else js.T * js)
+        named = [[self.name(entry) for entry in row] for row in matrix.tolist()]
+        return analysis.maximal_minors(named, sympy.Integer(0), sympy.Integer(1))[0]
+
+    def magnitude(self, value: sympy.Expr) -> sympy.Expr:
+        """|value| of a named value: sympy's sign analysis of a large determinant (at every
+        rebuild in CSE) takes seconds, or recurses past Python's limit."""
+        return sympy.Abs(self.name(value))
 
     def singularity_functions(self, js: sympy.Matrix) -> list[Function]:
-        """singularity_factors, manipulability and (square Js) jacobian_det, from Js."""
+        """singularity_factors, manipulability and (square Js) jacobian_det, from Js.
+
+        The exact factors come first; where they are not the whole condition, the numeric
+        rank determinant follows them. jacobian_det is the product of the exact factors
+        when they are complete and cheaper to compute than the expansion of det(Js)."""
         singular, (m, n) = self.singularities, js.shape
         atoms = {}
         for i, symbols in enumerate(analysis.joint_atoms(self.robot)):
             if len(symbols) == 2:
                 atoms.update(zip(symbols, self.cos_sin((i,))))
+        numeric = sympy.Integer(0) if singular.everywhere else self.rank_determinant(js)
         factors = [f.polynomial.xreplace(atoms) for f in singular.factors]
-        minors = analysis.maximal_minors(js.tolist(), sympy.Integer(0), sympy.Integer(1))
-        gram = sympy.Add(*(minor**2 for minor in minors))
-        if not singular.complete:
-            factors.append(gram)
+        if not singular.complete or singular.everywhere:
+            factors.append(numeric)
         what = "the robot is singular where one is 0" if factors else "never singular: the constant 1"
         functions = [self.function("singularity_factors", f"factors of {singular.kind}: {what}",
-                                   ("f", sympy.Matrix(factors or [1])))]
+                                   ("f", sympy.Matrix(factors or [1])), vector=True)]
         if m != n:
             return functions + [self.function("manipulability", f"manipulability sqrt({singular.kind})",
-                                              ("w", sympy.Matrix([sympy.sqrt(gram)])), scalar=True)]
-        rotation = self.chain.tool[:3, :3]
-        cos_pitch = sympy.sqrt(rotation[0, 0] ** 2 + rotation[1, 0] ** 2)
-        determinant = singular.constant.xreplace(atoms) * sympy.Mul(
-            *(p.xreplace(atoms) ** k for p, k in singular.determinant)) / cos_pitch**singular.euler_power
+                                              ("w", sympy.Matrix([sympy.sqrt(self.magnitude(numeric))])), scalar=True)]
+        determinant = numeric
+        if singular.complete and not singular.everywhere:
+            rotation = self.chain.tool[:3, :3]
+            cos_pitch = sympy.sqrt(rotation[0, 0] ** 2 + rotation[1, 0] ** 2)
+            exact = singular.constant.xreplace(atoms) * sympy.Mul(
+                *(p.xreplace(atoms) ** k for p, k in singular.determinant)) / cos_pitch**singular.euler_power
+            if self.lower(sympy.Matrix([exact])).operation_count <= self.lower(sympy.Matrix([numeric])).operation_count:
+                determinant = exact
         return functions + [
-            self.function("manipulability", "manipulability |det(Js)|", ("w", sympy.Matrix([sympy.Abs(determinant)])),
+            self.function("manipulability", "manipulability |det(Js)|", ("w", sympy.Matrix([self.magnitude(determinant)])),
                           scalar=True),
             self.function("jacobian_det", "det(Js)", ("d", sympy.Matrix([determinant])), scalar=True),
         ]
 
     def function(self, name: str, summary: str, *results: tuple[str, sympy.Matrix], scalar: bool = False,
-                 equals: tuple[str, ...] = ()) -> Function:
+                 vector: bool = False, equals: tuple[str, ...] = ()) -> Function:
         """A function of one or more named results, lowered together so they share their terms."""
-        outputs = tuple(Output(output, matrix.rows, matrix.cols, scalar, equal)
+        outputs = tuple(Output(output, matrix.rows, matrix.cols, scalar, vector, equal)
                         for (output, matrix), equal in zip(results, equals or ("",) * len(results)))
         return Function(name, summary, outputs, self.lower(sympy.Matrix.vstack(*(m.reshape(m.rows * m.cols, 1)
                                                                                  for _, m in results))))
 
+    def name(self, value: sympy.Expr) -> sympy.Expr:
+        """`value` as a symbol of its own (an atom or a number stays as it is).
+
+        Naming the chain's origins keeps the lever arms `p - o_i` three subtractions each:
+        written out, sympy flattens the nested sums and every lever repeats the chain's tail.
+        """
+        if value.is_Atom or (value.is_Mul and all(arg.is_Atom for arg in value.args)):
+            return value
+        negated = sympy.Add(*(-term for term in value.args)) if value.is_Add else -value
+        if value.could_extract_minus_sign() and not negated.could_extract_minus_sign():
+            return -self.name(negated)
+        if value in self._names:
+            return self._names[value]
+        symbol = sympy.Symbol(f"_n{len(self.definitions)}", real=True)
+        self.definitions.append((symbol, value))
+        self._named.add(symbol)
+        self._names[value] = symbol
+        return symbol
+
     def lower(self, outputs: sympy.Matrix) -> Body:
-        """The outputs as straight-line code: the trig symbols they need, then common
-        subexpressions (t0, t1, ...), then the outputs."""
+        """The outputs as straight-line code: the trig symbols and named values they need,
+        then temporaries (t0, t1, ...) after common-subexpression elimination, in an order
+        that defines before use."""
+        values = dict(self.definitions)
+        needed, frontier = set(), set().union(*(e.free_symbols for e in outputs))
+        while frontier:
+            symbol = frontier.pop()
+            if symbol in values and symbol not in needed:
+                needed.add(symbol)
+                frontier |= values[symbol].free_symbols
+        trig = [(s, fold_constants(v)) for s, v in self.definitions if s in needed and s not in self._named]
+        named = [(s, v) for s, v in self.definitions if s in needed and s in self._named]
         with distribute(False):
-            replacements, reduced = sympy.cse([fold_constants(e) for e in outputs],
-                                              symbols=sympy.numbered_symbols("t", real=True), order="canonical")
-        needed = set().union(*(e.free_symbols for e in reduced), *(e.free_symbols for _, e in replacements))
-        trig = []
-        for symbol, value in reversed(self.definitions):  # sums of angles need their terms
-            if symbol in needed:
-                trig.insert(0, (symbol, fold_constants(value)))
-                needed |= value.free_symbols
-        definitions = tuple(trig + replacements)
+            replacements, reduced = sympy.cse([fold_constants(v) for _, v in named] + [fold_constants(e) for e in outputs],
+                                              symbols=sympy.numbered_symbols("_r", real=True), order="canonical")
+        definitions = _in_dependency_order(trig + list(zip((s for s, _ in named), reduced)) + replacements)
+        temporaries = sympy.numbered_symbols("t", real=True)
+        rename = {symbol: next(temporaries) for symbol, _ in definitions if symbol.name.startswith("_")}
+        definitions = tuple((rename.get(s, s), v.xreplace(rename)) for s, v in definitions)
+        reduced = [e.xreplace(rename) for e in reduced[len(named):]]
         read = set().union(*(e.free_symbols for _, e in definitions), *(e.free_symbols for e in reduced))
         joints_used = tuple(i for i, symbol in enumerate(self.q) if symbol in read)
-        return Body(joints_used, definitions, reduced)
+        return Body(joints_used, definitions, tuple(reduced))
 
     def functions(self) -> list[Function]:
         """Every straight-line function, in the order the backends emit them."""
@@ -182,7 +235,31 @@ class Generator:
             self.function("jacobian_tool", "geometric Jacobian in the tool frame (6 x DOF, rows vx vy vz wx wy wz)",
                           ("J", kinematics.tool_frame(self.jacobian, pose))),
             self.function("task", f"task vector mu = ({', '.join(robot.task)})",
-                          ("mu", kinematics.task_vector(robot, pose))),
+                          ("mu", kinematics.task_vector(robot, pose)), vector=True),
             self.function("task_jacobian", f"analytic Jacobian d mu / d q ({m} x DOF)", ("J", task_jacobian)),
             *self.singularity_functions(analysis.singularity_jacobian(robot, self.jacobian, task_jacobian)),
         )
+
+
+def _in_dependency_order(definitions: list[tuple[sympy.Symbol, sympy.Expr]]) -> list[tuple[sympy.Symbol, sympy.Expr]]:
+    """Each definition after those it reads; among the ready ones, the earliest listed first
+    (so the order is fixed, whatever the hashing)."""
+    index = {symbol: k for k, (symbol, _) in enumerate(definitions)}
+    readers: dict[int, list[int]] = {k: [] for k in range(len(definitions))}
+    waiting = []
+    for k, (_, value) in enumerate(definitions):
+        reads = {index[s] for s in value.free_symbols if s in index}
+        waiting.append(len(reads))
+        for j in reads:
+            readers[j].append(k)
+    ready = [k for k, count in enumerate(waiting) if count == 0]
+    heapq.heapify(ready)
+    ordered = []
+    while ready:
+        k = heapq.heappop(ready)
+        ordered.append(definitions[k])
+        for reader in readers[k]:
+            waiting[reader] -= 1
+            if waiting[reader] == 0:
+                heapq.heappush(ready, reader)
+    return ordered

@@ -67,15 +67,21 @@ def link_transforms(robot: Robot, cos_sin: CosSin, q) -> list[tuple[Matrix, Matr
 
 @dataclass(frozen=True)
 class Chain:
-    """World poses of each joint's axis frame (z = joint axis) and of the tool."""
+    """World poses of each joint's axis frame (z = joint axis) and of the tool, and the
+    lever of each axis: the vector from its origin to the tool origin."""
 
     axes: tuple[Matrix, ...]
+    levers: tuple[Matrix, ...]
     tool: Matrix
 
 
 def angle_sum_products(a, b):
     """cos and sin of an angle sum from those of its two terms."""
     return a[0] * b[0] - a[1] * b[1], a[1] * b[0] + a[0] * b[1]
+
+
+def _pose(rotation: Matrix, origin: Matrix) -> Matrix:
+    return Matrix.vstack(Matrix.hstack(rotation, origin), Matrix([[0, 0, 0, 1]]))
 
 
 def build_chain(robot: Robot, cos_sin: CosSin, q, simplify=lambda e: e, angle_sum=None) -> Chain:
@@ -85,13 +91,23 @@ def build_chain(robot: Robot, cos_sin: CosSin, q, simplify=lambda e: e, angle_su
     (alpha = 0), since Rz(a) Tz(d) Tx(b) Rz(c) = Tz(d) T(b cos a, b sin a, 0) Rz(a + c):
     the chain then multiplies one rotation for the run, with the cos and sin of the
     summed angle from `angle_sum(joints)` (default: the product formulas inline).
+
+    Translations are added up in world coordinates into one step per stretch between two
+    joint axes. The lever of an axis (from its origin to the tool origin) is the sum of
+    the steps after it, added up backwards from the tool, each lever the next one plus a
+    step; the tool origin is the base origin plus every step. With `simplify` naming each
+    sum, every lever costs three additions, not a sum over the rest of the chain.
     """
-    frame = pose_transform(robot.base)  # the running frame, before the pending rotation
+    base = pose_transform(robot.base)
+    rotation = base[:3, :3]  # the running frame's rotation, before the pending rotation
+    origin, segment = base[:3, 3], sympy.zeros(3, 1)  # the last axis' origin; the translation since
     run: tuple[int, ...] = ()
     pending = (sympy.Integer(1), sympy.Integer(0))  # cos, sin of the pending rotation about z
+    steps: list[Matrix] = []
+    steps_before: list[int] = []  # per axis, the number of steps before its origin
 
     def flushed() -> Matrix:
-        return (frame * rot_z(*pending)).applyfunc(simplify)
+        return (rotation * rot_z(*pending)[:3, :3]).applyfunc(simplify)
 
     def turn(i: int):
         nonlocal run, pending
@@ -101,45 +117,60 @@ def build_chain(robot: Robot, cos_sin: CosSin, q, simplify=lambda e: e, angle_su
         else:
             pending = angle_sum(run) if angle_sum else angle_sum_products(pending, cos_sin(i))
 
-    def fixed_turn(angle):
-        nonlocal frame, run, pending
-        if angle != 0:
-            frame, run, pending = flushed() * rot_z(*_trig(angle)), (), (sympy.Integer(1), sympy.Integer(0))
+    def rotate(fixed: Matrix):  # flush the pending rotation, then turn by a constant one
+        nonlocal rotation, run, pending
+        rotation, run, pending = flushed() * fixed[:3, :3], (), (sympy.Integer(1), sympy.Integer(0))
 
-    def shift(a, d):  # frame Rz(pending) Tz(d) Tx(a), keeping the rotation pending
-        nonlocal frame
-        frame = (frame * translation(a * pending[0], a * pending[1], d)).applyfunc(simplify)
+    def shift(local: Matrix):  # Rz(pending) T(local) in the running frame
+        nonlocal segment
+        (x, y, z), (c, s) = local, pending
+        segment = segment + rotation * Matrix([x * c - y * s, x * s + y * c, z])
 
-    def twist(alpha):
-        nonlocal frame, run, pending
-        if alpha != 0:
-            frame, run, pending = flushed() * rot_x(*_trig(alpha)), (), (sympy.Integer(1), sympy.Integer(0))
+    def close_segment():
+        nonlocal origin, segment
+        step = segment.applyfunc(simplify)
+        if any(step):
+            steps.append(step)
+            origin = (origin + step).applyfunc(simplify)
+        segment = sympy.zeros(3, 1)
 
     axes = []
     for i, joint in enumerate(robot.joints):
         d = joint.d.exact if joint.revolute else q[i] + joint.offset.exact
         if robot.convention == "modified":
-            twist(joint.alpha.exact)
-            shift(joint.a.exact, 0)
-        axes.append(flushed())
+            if joint.alpha.exact != 0:
+                rotate(rot_x(*_trig(joint.alpha.exact)))
+            shift(Matrix([joint.a.exact, 0, 0]))
+        close_segment()
+        axes.append(_pose(flushed(), origin))
+        steps_before.append(len(steps))
         if joint.revolute:
             turn(i)
-        else:
-            fixed_turn(joint.theta.exact)
-        shift(0, d)
-        if robot.convention == "standard":
-            shift(joint.a.exact, 0)
-            twist(joint.alpha.exact)
-    return Chain(tuple(axes), (flushed() * pose_transform(robot.tool)).applyfunc(simplify))
+        elif joint.theta.exact != 0:
+            rotate(rot_z(*_trig(joint.theta.exact)))
+        shift(Matrix([joint.a.exact if robot.convention == "standard" else 0, 0, d]))
+        if robot.convention == "standard" and joint.alpha.exact != 0:
+            rotate(rot_x(*_trig(joint.alpha.exact)))
+    tool = pose_transform(robot.tool)
+    shift(tool[:3, 3])
+    rotate(tool)
+    close_segment()
+    levers, lever = [], sympy.zeros(3, 1)
+    for k in reversed(range(len(steps))):
+        while len(levers) < len(axes) and steps_before[len(axes) - 1 - len(levers)] > k:
+            levers.insert(0, lever)
+        lever = (lever + steps[k]).applyfunc(simplify)
+    levers = [lever] * (len(axes) - len(levers)) + levers
+    position = (base[:3, 3] + lever).applyfunc(simplify)
+    return Chain(tuple(axes), tuple(levers), _pose(rotation.applyfunc(simplify), position))
 
 
 def column_jacobian(robot: Robot, chain: Chain) -> Matrix:
     """Geometric Jacobian in the world frame by the column formula of SPEC §2."""
-    p = chain.tool[:3, 3]
     columns = []
-    for joint, axis in zip(robot.joints, chain.axes):
-        z, o = axis[:3, 2], axis[:3, 3]
-        columns.append(Matrix.vstack(z.cross(p - o), z) if joint.revolute else Matrix.vstack(z, sympy.zeros(3, 1)))
+    for joint, axis, lever in zip(robot.joints, chain.axes, chain.levers):
+        z = axis[:3, 2]
+        columns.append(Matrix.vstack(z.cross(lever), z) if joint.revolute else Matrix.vstack(z, sympy.zeros(3, 1)))
     return Matrix.hstack(*columns)
 
 

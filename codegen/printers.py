@@ -73,17 +73,19 @@ class CPrinter(C99CodePrinter):
     sympy's printer with `real` aliased to the build's type prints the type's functions
     (`sinf`, `atan2f`) and literal suffix (`F`), so a float build has no double promotion;
     unsupported nodes raise (`strict`). Overrides: literals, integer powers (`x*x`, never
-    `pow()`), and `x**(-1/2)`.
+    `pow()`), and `x**(-1/2)`. Constants are folded again at printing (sympy recreates
+    `sqrt(2)` from `sqrt(2*x**2)` after CSE), and no math macro is printed: `M_SQRT2` and
+    `M_PI` are POSIX, not C99.
     """
 
     def __init__(self, real: str):
         if real not in C_REAL_TYPES:
             raise ValueError(f"real must be one of {', '.join(C_REAL_TYPES)}, got {real!r}")
         self.real = real
-        super().__init__({"type_aliases": {ast.real: C_REAL_TYPES[real]}, "strict": True})
+        super().__init__({"type_aliases": {ast.real: C_REAL_TYPES[real]}, "strict": True, "math_macros": {}})
 
     def doprint(self, expr, assign_to=None):
-        return super().doprint(expand_integer_powers(expr), assign_to)
+        return super().doprint(expand_integer_powers(fold_constants(expr)), assign_to)
 
     def _print_Float(self, expr):
         """Shortest literal that reads back as the nearest value of the build's type."""

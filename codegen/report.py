@@ -71,7 +71,11 @@ def condition_text(robot: Robot, factor: Factor) -> str:
 
 def singularity_lines(robot: Robot, singular: Singularities) -> list[str]:
     """The singularity conditions, one per line, then notes."""
-    lines = [condition_text(robot, factor) for factor in singular.factors] or ["none: Js has full rank everywhere"]
+    lines = [condition_text(robot, factor) for factor in singular.factors]
+    if singular.everywhere:
+        lines.append("everywhere: Js has less than full rank in every configuration")
+    elif not lines and singular.complete:
+        lines.append("none: Js has full rank everywhere")
     if singular.note:
         lines.append(f"note: {singular.note}")
     if robot.symbolic_parameters and any(f.roots for f in singular.factors):

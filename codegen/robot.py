@@ -24,8 +24,8 @@ MAX_NESTING = 16  # a robot file needs 4 levels: file, joints, a joint, its limi
 NAME_PATTERN = re.compile(r"^[a-z][a-z0-9_]{0,47}$")
 IDENTIFIER_PATTERN = re.compile(r"^[A-Za-z_][A-Za-z0-9_]{0,47}$")
 # Free text (description, length_unit) is copied into generated comments, docstrings and
-# strings: one printable line without what could end or escape them there.
-MAX_TEXT_LENGTH = 200
+# strings: printable lines (one for length_unit, any number for the description) without
+# what could end or escape them there. Its length is bounded only by MAX_FILE_BYTES.
 FORBIDDEN_IN_TEXT = ('\\', '"""', "/*", "*/", "??")
 # Within this many radians of a multiple of pi/2, an angle becomes that multiple exactly.
 ANGLE_SNAP_TOLERANCE = 1e-9
@@ -215,13 +215,14 @@ class _RobotReader:
             raise self.error(node, key, f"invalid name {_shown(node.value)} (expected {pattern.pattern})")
         return node.value
 
-    def text(self, node, key: str) -> str:
-        """Free text that is copied into generated files: one line, nothing that escapes."""
-        text = self.string(node, key)
-        if len(text) > MAX_TEXT_LENGTH:
-            raise self.error(node, key, f"longer than {MAX_TEXT_LENGTH} characters")
-        if not text.isprintable():
-            raise self.error(node, key, "must be one line of printable characters")
+    def text(self, node, key: str, paragraphs: bool = False) -> str:
+        """Free text that is copied into generated files: printable lines (one unless
+        `paragraphs`), nothing that escapes; trailing white space dropped."""
+        text = self.string(node, key).rstrip()
+        lines = text.split("\n") if paragraphs else [text]
+        if not all(line.isprintable() for line in lines):
+            raise self.error(node, key, "must be lines of printable characters" if paragraphs
+                             else "must be one line of printable characters")
         bad = [part for part in FORBIDDEN_IN_TEXT if part in text]
         if bad:
             raise self.error(node, key, f"may not contain {bad[0]!r} (it is copied into generated "
@@ -261,7 +262,7 @@ class _RobotReader:
         problem = robot_name_problem(name)
         if problem:
             raise self.error(top["name"], "name", f"{name!r} {problem}: {ROBOT_NAME_RULE}")
-        description = self.text(top["description"], "description") if "description" in top else ""
+        description = self.text(top["description"], "description", paragraphs=True) if "description" in top else ""
         convention = self.string(top["convention"], "convention", ("standard", "modified"))
         if "angle_unit" in top and self.string(top["angle_unit"], "angle_unit", ("deg", "rad")) == "deg":
             self.angle_scale = Value(sympy.pi / 180, math.pi / 180)

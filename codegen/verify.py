@@ -323,6 +323,8 @@ def _velocity_ik_residual(robot: Robot, module, q: np.ndarray) -> float:
     """Largest backward error |Js q_dot - mu_dot| / (|Js| |q_dot| + |mu_dot|) of the generated
     Python velocity_ik, mu_dot random: the residual scaled by what rounding alone leaves, so
     the bound does not depend on how well conditioned Js is."""
+    if not len(q):
+        return 0.0
     mu_dot = np.random.default_rng(0).normal(size=(len(q), len(robot.task)))
     nominal = {p.name: p.value for p in robot.symbolic_parameters}
     q_dot, ok = module.velocity_ik(q, mu_dot, **nominal)

@@ -125,12 +125,16 @@ def test_generate_sets_the_budget(tmp_path):
     assert budget.seconds() == 7.5
 
 
-def test_singularity_factoring_falls_back_to_the_gram_determinant(capsys):
-    """Out of budget, the 7-axis analysis keeps the unfactored Gram determinant as its condition."""
-    from codegen import analysis
+def test_analysis_out_of_budget_falls_back_to_the_numeric_condition(capsys):
+    """The budget is a safety net on the robot's whole exact analysis: past it, the numeric
+    Gram determinant alone is the condition, with a warning."""
+    from codegen.functions import Generator
     from conftest import robot
 
     budget.set_seconds(0.01)
-    singular = analysis.analyse(robot("panda"))
-    assert not singular.complete and "within the budget" in singular.note
-    assert "factoring det(Js Js^T) of panda took longer than 0.01 s" in capsys.readouterr().err
+    try:
+        singular = Generator(robot("panda")).singularities
+    finally:
+        budget.set_seconds(budget.DEFAULT_SECONDS)
+    assert not singular.complete and not singular.factors and "--budget" in singular.note
+    assert "the singularity analysis of panda took longer than 0.01 s" in capsys.readouterr().err

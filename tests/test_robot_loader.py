@@ -140,7 +140,9 @@ CASES = [
     ("long_expression", edit("a: 0.25", "a: " + "1" * 300), "111", "joints[2].a",
      "expression longer than 200 characters in '" + "1" * 60 + "'..."),
     ("non_scalar_key", BASE + "? [a, b]\n: 1\n", "[a, b]", "file", "expected a name as key, got a list"),
-    ("multiline_description", edit("description: test arm", 'description: "one\\ntwo"'), '"one', "description",
+    ("control_in_description", edit("description: test arm", 'description: "one\\x07two"'), '"one', "description",
+     "must be lines of printable characters"),
+    ("multiline_length_unit", edit("description: test arm", 'length_unit: "m\\nm"'), '"m', "length_unit",
      "must be one line of printable characters"),
     ("comment_in_description", edit("description: test arm", "description: ends */ here"), "ends", "description",
      "may not contain '*/' (it is copied into generated comments and strings; "

@@ -35,7 +35,7 @@ typedef double iiwa_real;
 #define IIWA_NUM_SINGULARITY_FACTORS 2
 
 /* Pose of the tool frame in the world frame (4x4 homogeneous).
- * Result: T: 4 x 4 row-major, element (r, c) at T[r * 4 + c]. 121 operations. */
+ * Result: T: 4 x 4 row-major, element (r, c) at T[r * 4 + c]. 119 operations. */
 void iiwa_fk(const iiwa_real q[IIWA_DOF], iiwa_real T[16]);
 
 /* Geometric Jacobian in the world frame (6 x DOF, rows vx vy vz wx wy wz).
@@ -43,11 +43,11 @@ void iiwa_fk(const iiwa_real q[IIWA_DOF], iiwa_real T[16]);
 void iiwa_jacobian(const iiwa_real q[IIWA_DOF], iiwa_real J[6 * IIWA_DOF]);
 
 /* Fk and jacobian in one pass, sharing their terms.
- * Result: T: 4 x 4 row-major, element (r, c) at T[r * 4 + c]; J: 6 x 7 row-major, element (r, c) at J[r * 7 + c]. 167 operations. */
+ * Result: T: 4 x 4 row-major, element (r, c) at T[r * 4 + c]; J: 6 x 7 row-major, element (r, c) at J[r * 7 + c]. 168 operations. */
 void iiwa_fk_jacobian(const iiwa_real q[IIWA_DOF], iiwa_real T[16], iiwa_real J[6 * IIWA_DOF]);
 
 /* Geometric Jacobian in the tool frame (6 x DOF, rows vx vy vz wx wy wz).
- * Result: J: 6 x 7 row-major, element (r, c) at J[r * 7 + c]. 316 operations. */
+ * Result: J: 6 x 7 row-major, element (r, c) at J[r * 7 + c]. 330 operations. */
 void iiwa_jacobian_tool(const iiwa_real q[IIWA_DOF], iiwa_real J[6 * IIWA_DOF]);
 
 /* Task vector mu = (x, y, z, roll, pitch, yaw).
@@ -59,11 +59,11 @@ void iiwa_task(const iiwa_real q[IIWA_DOF], iiwa_real mu[IIWA_TASK_DIM]);
 void iiwa_task_jacobian(const iiwa_real q[IIWA_DOF], iiwa_real J[IIWA_TASK_DIM * IIWA_DOF]);
 
 /* Factors of det(Js Js^T): the robot is singular where one is 0.
- * Result: f[i], i < 2. 55 operations. */
+ * Result: f[i], i < 2. 645 operations. */
 void iiwa_singularity_factors(const iiwa_real q[IIWA_DOF], iiwa_real f[IIWA_NUM_SINGULARITY_FACTORS]);
 
 /* Manipulability sqrt(det(Js Js^T)).
- * Result: returned as a scalar. 726 operations. */
+ * Result: returned as a scalar. 648 operations. */
 iiwa_real iiwa_manipulability(const iiwa_real q[IIWA_DOF]);
 
 /* Status of iiwa_velocity_ik. */

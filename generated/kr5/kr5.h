@@ -34,7 +34,7 @@ typedef double kr5_real;
 #define KR5_NUM_SINGULARITY_FACTORS 3
 
 /* Pose of the tool frame in the world frame (4x4 homogeneous).
- * Result: T: 4 x 4 row-major, element (r, c) at T[r * 4 + c]. 99 operations. */
+ * Result: T: 4 x 4 row-major, element (r, c) at T[r * 4 + c]. 102 operations. */
 void kr5_fk(const kr5_real q[KR5_DOF], kr5_real T[16]);
 
 /* Geometric Jacobian in the world frame (6 x DOF, rows vx vy vz wx wy wz).
@@ -42,15 +42,15 @@ void kr5_fk(const kr5_real q[KR5_DOF], kr5_real T[16]);
 void kr5_jacobian(const kr5_real q[KR5_DOF], kr5_real J[6 * KR5_DOF]);
 
 /* Fk and jacobian in one pass, sharing their terms.
- * Result: T: 4 x 4 row-major, element (r, c) at T[r * 4 + c]; J: 6 x 6 row-major, element (r, c) at J[r * 6 + c]. 138 operations. */
+ * Result: T: 4 x 4 row-major, element (r, c) at T[r * 4 + c]; J: 6 x 6 row-major, element (r, c) at J[r * 6 + c]. 137 operations. */
 void kr5_fk_jacobian(const kr5_real q[KR5_DOF], kr5_real T[16], kr5_real J[6 * KR5_DOF]);
 
 /* Geometric Jacobian in the tool frame (6 x DOF, rows vx vy vz wx wy wz).
- * Result: J: 6 x 6 row-major, element (r, c) at J[r * 6 + c]. 247 operations. */
+ * Result: J: 6 x 6 row-major, element (r, c) at J[r * 6 + c]. 260 operations. */
 void kr5_jacobian_tool(const kr5_real q[KR5_DOF], kr5_real J[6 * KR5_DOF]);
 
 /* Task vector mu = (x, y, z, roll, pitch, yaw).
- * Result: mu[i], i < 6. 99 operations. */
+ * Result: mu[i], i < 6. 102 operations. */
 void kr5_task(const kr5_real q[KR5_DOF], kr5_real mu[KR5_TASK_DIM]);
 
 /* Analytic Jacobian d mu / d q (6 x DOF).

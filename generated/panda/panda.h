@@ -35,35 +35,35 @@ typedef double panda_real;
 #define PANDA_NUM_SINGULARITY_FACTORS 1
 
 /* Pose of the tool frame in the world frame (4x4 homogeneous).
- * Result: T: 4 x 4 row-major, element (r, c) at T[r * 4 + c]. 154 operations. */
+ * Result: T: 4 x 4 row-major, element (r, c) at T[r * 4 + c]. 152 operations. */
 void panda_fk(const panda_real q[PANDA_DOF], panda_real T[16]);
 
 /* Geometric Jacobian in the world frame (6 x DOF, rows vx vy vz wx wy wz).
- * Result: J: 6 x 7 row-major, element (r, c) at J[r * 7 + c]. 167 operations. */
+ * Result: J: 6 x 7 row-major, element (r, c) at J[r * 7 + c]. 168 operations. */
 void panda_jacobian(const panda_real q[PANDA_DOF], panda_real J[6 * PANDA_DOF]);
 
 /* Fk and jacobian in one pass, sharing their terms.
- * Result: T: 4 x 4 row-major, element (r, c) at T[r * 4 + c]; J: 6 x 7 row-major, element (r, c) at J[r * 7 + c]. 203 operations. */
+ * Result: T: 4 x 4 row-major, element (r, c) at T[r * 4 + c]; J: 6 x 7 row-major, element (r, c) at J[r * 7 + c]. 201 operations. */
 void panda_fk_jacobian(const panda_real q[PANDA_DOF], panda_real T[16], panda_real J[6 * PANDA_DOF]);
 
 /* Geometric Jacobian in the tool frame (6 x DOF, rows vx vy vz wx wy wz).
- * Result: J: 6 x 7 row-major, element (r, c) at J[r * 7 + c]. 348 operations. */
+ * Result: J: 6 x 7 row-major, element (r, c) at J[r * 7 + c]. 370 operations. */
 void panda_jacobian_tool(const panda_real q[PANDA_DOF], panda_real J[6 * PANDA_DOF]);
 
 /* Task vector mu = (x, y, z, roll, pitch, yaw).
- * Result: mu[i], i < 6. 156 operations. */
+ * Result: mu[i], i < 6. 157 operations. */
 void panda_task(const panda_real q[PANDA_DOF], panda_real mu[PANDA_TASK_DIM]);
 
 /* Analytic Jacobian d mu / d q (6 x DOF).
- * Result: J: 6 x 7 row-major, element (r, c) at J[r * 7 + c]. 256 operations. */
+ * Result: J: 6 x 7 row-major, element (r, c) at J[r * 7 + c]. 263 operations. */
 void panda_task_jacobian(const panda_real q[PANDA_DOF], panda_real J[PANDA_TASK_DIM * PANDA_DOF]);
 
 /* Factors of det(Js Js^T): the robot is singular where one is 0.
- * Result: f[i], i < 1. 1081 operations. */
+ * Result: f[i], i < 1. 673 operations. */
 void panda_singularity_factors(const panda_real q[PANDA_DOF], panda_real f[PANDA_NUM_SINGULARITY_FACTORS]);
 
 /* Manipulability sqrt(det(Js Js^T)).
- * Result: returned as a scalar. 753 operations. */
+ * Result: returned as a scalar. 676 operations. */
 panda_real panda_manipulability(const panda_real q[PANDA_DOF]);
 
 /* Status of panda_velocity_ik. */

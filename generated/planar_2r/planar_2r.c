@@ -19,16 +19,18 @@ void planar_2r_fk(const planar_2r_real q[PLANAR_2R_DOF], planar_2r_real T[16])
     const planar_2r_real s2 = sin(q2);
     const planar_2r_real c12 = c1*c2 - s1*s2;
     const planar_2r_real s12 = c1*s2 + c2*s1;
+    const planar_2r_real t0 = c1 + c12;
+    const planar_2r_real t1 = s1 + s12;
 
     /* Outputs */
     T[0] = c12;
     T[1] = -s12;
     T[2] = 0;
-    T[3] = c1 + c12;
+    T[3] = t0;
     T[4] = s12;
     T[5] = c12;
     T[6] = 0;
-    T[7] = s1 + s12;
+    T[7] = t1;
     T[8] = 0;
     T[9] = 0;
     T[10] = 1;
@@ -41,7 +43,7 @@ void planar_2r_fk(const planar_2r_real q[PLANAR_2R_DOF], planar_2r_real T[16])
 
 void planar_2r_jacobian(const planar_2r_real q[PLANAR_2R_DOF], planar_2r_real J[6 * PLANAR_2R_DOF])
 {
-    /* 13 operations */
+    /* 14 operations */
 
     /* Inputs */
     const planar_2r_real q1 = q[0];
@@ -54,11 +56,13 @@ void planar_2r_jacobian(const planar_2r_real q[PLANAR_2R_DOF], planar_2r_real J[
     const planar_2r_real s2 = sin(q2);
     const planar_2r_real c12 = c1*c2 - s1*s2;
     const planar_2r_real s12 = c1*s2 + c2*s1;
+    const planar_2r_real t0 = c1 + c12;
+    const planar_2r_real t1 = s1 + s12;
 
     /* Outputs */
-    J[0] = -(s1 + s12);
+    J[0] = -t1;
     J[1] = -s12;
-    J[2] = c1 + c12;
+    J[2] = t0;
     J[3] = c12;
     J[4] = 0;
     J[5] = 0;
@@ -85,19 +89,19 @@ void planar_2r_fk_jacobian(const planar_2r_real q[PLANAR_2R_DOF], planar_2r_real
     const planar_2r_real s2 = sin(q2);
     const planar_2r_real c12 = c1*c2 - s1*s2;
     const planar_2r_real s12 = c1*s2 + c2*s1;
-    const planar_2r_real t0 = -s12;
-    const planar_2r_real t1 = c1 + c12;
-    const planar_2r_real t2 = s1 + s12;
+    const planar_2r_real t0 = c1 + c12;
+    const planar_2r_real t1 = s1 + s12;
+    const planar_2r_real t2 = -s12;
 
     /* Outputs */
     T[0] = c12;
-    T[1] = t0;
+    T[1] = t2;
     T[2] = 0;
-    T[3] = t1;
+    T[3] = t0;
     T[4] = s12;
     T[5] = c12;
     T[6] = 0;
-    T[7] = t2;
+    T[7] = t1;
     T[8] = 0;
     T[9] = 0;
     T[10] = 1;
@@ -106,9 +110,9 @@ void planar_2r_fk_jacobian(const planar_2r_real q[PLANAR_2R_DOF], planar_2r_real
     T[13] = 0;
     T[14] = 0;
     T[15] = 1;
-    J[0] = -t2;
-    J[1] = t0;
-    J[2] = t1;
+    J[0] = -t1;
+    J[1] = t2;
+    J[2] = t0;
     J[3] = c12;
     J[4] = 0;
     J[5] = 0;
@@ -136,12 +140,12 @@ void planar_2r_jacobian_tool(const planar_2r_real q[PLANAR_2R_DOF], planar_2r_re
     const planar_2r_real c12 = c1*c2 - s1*s2;
     const planar_2r_real s12 = c1*s2 + c2*s1;
     const planar_2r_real t0 = c1 + c12;
-    const planar_2r_real t1 = -(s1 + s12);
+    const planar_2r_real t1 = s1 + s12;
 
     /* Outputs */
-    J[0] = c12*t1 + s12*t0;
+    J[0] = -c12*t1 + s12*t0;
     J[1] = 0;
-    J[2] = c12*t0 - s12*t1;
+    J[2] = c12*t0 + s12*t1;
     J[3] = (c12*c12) + (s12*s12);
     J[4] = 0;
     J[5] = 0;
@@ -168,15 +172,17 @@ void planar_2r_task(const planar_2r_real q[PLANAR_2R_DOF], planar_2r_real mu[PLA
     const planar_2r_real s2 = sin(q2);
     const planar_2r_real c12 = c1*c2 - s1*s2;
     const planar_2r_real s12 = c1*s2 + c2*s1;
+    const planar_2r_real t0 = c1 + c12;
+    const planar_2r_real t1 = s1 + s12;
 
     /* Outputs */
-    mu[0] = c1 + c12;
-    mu[1] = s1 + s12;
+    mu[0] = t0;
+    mu[1] = t1;
 }
 
 void planar_2r_task_jacobian(const planar_2r_real q[PLANAR_2R_DOF], planar_2r_real J[PLANAR_2R_TASK_DIM * PLANAR_2R_DOF])
 {
-    /* 13 operations */
+    /* 14 operations */
 
     /* Inputs */
     const planar_2r_real q1 = q[0];
@@ -189,11 +195,13 @@ void planar_2r_task_jacobian(const planar_2r_real q[PLANAR_2R_DOF], planar_2r_re
     const planar_2r_real s2 = sin(q2);
     const planar_2r_real c12 = c1*c2 - s1*s2;
     const planar_2r_real s12 = c1*s2 + c2*s1;
+    const planar_2r_real t0 = c1 + c12;
+    const planar_2r_real t1 = s1 + s12;
 
     /* Outputs */
-    J[0] = -(s1 + s12);
+    J[0] = -t1;
     J[1] = -s12;
-    J[2] = c1 + c12;
+    J[2] = t0;
     J[3] = c12;
 }
 

@@ -33,7 +33,7 @@ typedef double planar_2r_real;
 void planar_2r_fk(const planar_2r_real q[PLANAR_2R_DOF], planar_2r_real T[16]);
 
 /* Geometric Jacobian in the world frame (6 x DOF, rows vx vy vz wx wy wz).
- * Result: J: 6 x 2 row-major, element (r, c) at J[r * 2 + c]. 13 operations. */
+ * Result: J: 6 x 2 row-major, element (r, c) at J[r * 2 + c]. 14 operations. */
 void planar_2r_jacobian(const planar_2r_real q[PLANAR_2R_DOF], planar_2r_real J[6 * PLANAR_2R_DOF]);
 
 /* Fk and jacobian in one pass, sharing their terms.
@@ -49,7 +49,7 @@ void planar_2r_jacobian_tool(const planar_2r_real q[PLANAR_2R_DOF], planar_2r_re
 void planar_2r_task(const planar_2r_real q[PLANAR_2R_DOF], planar_2r_real mu[PLANAR_2R_TASK_DIM]);
 
 /* Analytic Jacobian d mu / d q (2 x DOF).
- * Result: J: 2 x 2 row-major, element (r, c) at J[r * 2 + c]. 13 operations. */
+ * Result: J: 2 x 2 row-major, element (r, c) at J[r * 2 + c]. 14 operations. */
 void planar_2r_task_jacobian(const planar_2r_real q[PLANAR_2R_DOF], planar_2r_real J[PLANAR_2R_TASK_DIM * PLANAR_2R_DOF]);
 
 /* Factors of det(Js): the robot is singular where one is 0.

@@ -34,15 +34,17 @@ def fk(q):
     s2 = numpy.sin(q2)
     c12 = c1*c2 - s1*s2
     s12 = c1*s2 + c2*s1
+    t0 = c1 + c12
+    t1 = s1 + s12
     T = numpy.empty(q.shape[:-1] + (4, 4))
     T[..., 0, 0] = c12
     T[..., 0, 1] = -s12
     T[..., 0, 2] = 0
-    T[..., 0, 3] = c1 + c12
+    T[..., 0, 3] = t0
     T[..., 1, 0] = s12
     T[..., 1, 1] = c12
     T[..., 1, 2] = 0
-    T[..., 1, 3] = s1 + s12
+    T[..., 1, 3] = t1
     T[..., 2, 0] = 0
     T[..., 2, 1] = 0
     T[..., 2, 2] = 1
@@ -55,7 +57,7 @@ def fk(q):
 
 
 def jacobian(q):
-    """geometric Jacobian in the world frame (6 x DOF, rows vx vy vz wx wy wz): (6 x 2), 13 operations."""
+    """geometric Jacobian in the world frame (6 x DOF, rows vx vy vz wx wy wz): (6 x 2), 14 operations."""
     q = _joints(q)
     q1 = q[..., 0]
     q2 = q[..., 1]
@@ -65,10 +67,12 @@ def jacobian(q):
     s2 = numpy.sin(q2)
     c12 = c1*c2 - s1*s2
     s12 = c1*s2 + c2*s1
+    t0 = c1 + c12
+    t1 = s1 + s12
     J = numpy.empty(q.shape[:-1] + (6, 2))
-    J[..., 0, 0] = -(s1 + s12)
+    J[..., 0, 0] = -t1
     J[..., 0, 1] = -s12
-    J[..., 1, 0] = c1 + c12
+    J[..., 1, 0] = t0
     J[..., 1, 1] = c12
     J[..., 2, 0] = 0
     J[..., 2, 1] = 0
@@ -92,18 +96,18 @@ def fk_jacobian(q):
     s2 = numpy.sin(q2)
     c12 = c1*c2 - s1*s2
     s12 = c1*s2 + c2*s1
-    t0 = -s12
-    t1 = c1 + c12
-    t2 = s1 + s12
+    t0 = c1 + c12
+    t1 = s1 + s12
+    t2 = -s12
     T = numpy.empty(q.shape[:-1] + (4, 4))
     T[..., 0, 0] = c12
-    T[..., 0, 1] = t0
+    T[..., 0, 1] = t2
     T[..., 0, 2] = 0
-    T[..., 0, 3] = t1
+    T[..., 0, 3] = t0
     T[..., 1, 0] = s12
     T[..., 1, 1] = c12
     T[..., 1, 2] = 0
-    T[..., 1, 3] = t2
+    T[..., 1, 3] = t1
     T[..., 2, 0] = 0
     T[..., 2, 1] = 0
     T[..., 2, 2] = 1
@@ -113,9 +117,9 @@ def fk_jacobian(q):
     T[..., 3, 2] = 0
     T[..., 3, 3] = 1
     J = numpy.empty(q.shape[:-1] + (6, 2))
-    J[..., 0, 0] = -t2
-    J[..., 0, 1] = t0
-    J[..., 1, 0] = t1
+    J[..., 0, 0] = -t1
+    J[..., 0, 1] = t2
+    J[..., 1, 0] = t0
     J[..., 1, 1] = c12
     J[..., 2, 0] = 0
     J[..., 2, 1] = 0
@@ -140,11 +144,11 @@ def jacobian_tool(q):
     c12 = c1*c2 - s1*s2
     s12 = c1*s2 + c2*s1
     t0 = c1 + c12
-    t1 = -(s1 + s12)
+    t1 = s1 + s12
     J = numpy.empty(q.shape[:-1] + (6, 2))
-    J[..., 0, 0] = c12*t1 + s12*t0
+    J[..., 0, 0] = -c12*t1 + s12*t0
     J[..., 0, 1] = 0
-    J[..., 1, 0] = c12*t0 - s12*t1
+    J[..., 1, 0] = c12*t0 + s12*t1
     J[..., 1, 1] = c12**2 + s12**2
     J[..., 2, 0] = 0
     J[..., 2, 1] = 0
@@ -168,14 +172,16 @@ def task(q):
     s2 = numpy.sin(q2)
     c12 = c1*c2 - s1*s2
     s12 = c1*s2 + c2*s1
+    t0 = c1 + c12
+    t1 = s1 + s12
     mu = numpy.empty(q.shape[:-1] + (2,))
-    mu[..., 0] = c1 + c12
-    mu[..., 1] = s1 + s12
+    mu[..., 0] = t0
+    mu[..., 1] = t1
     return mu
 
 
 def task_jacobian(q):
-    """analytic Jacobian d mu / d q (2 x DOF): (2 x 2), 13 operations."""
+    """analytic Jacobian d mu / d q (2 x DOF): (2 x 2), 14 operations."""
     q = _joints(q)
     q1 = q[..., 0]
     q2 = q[..., 1]
@@ -185,10 +191,12 @@ def task_jacobian(q):
     s2 = numpy.sin(q2)
     c12 = c1*c2 - s1*s2
     s12 = c1*s2 + c2*s1
+    t0 = c1 + c12
+    t1 = s1 + s12
     J = numpy.empty(q.shape[:-1] + (2, 2))
-    J[..., 0, 0] = -(s1 + s12)
+    J[..., 0, 0] = -t1
     J[..., 0, 1] = -s12
-    J[..., 1, 0] = c1 + c12
+    J[..., 1, 0] = t0
     J[..., 1, 1] = c12
     return J
 

@@ -23,20 +23,22 @@ def _fk(q):
     s2 = casadi.sin(q2)
     c12 = c1*c2 - s1*s2
     s12 = c1*s2 + c2*s1
+    t0 = c1 + c12
+    t1 = s1 + s12
     T = casadi.SX(4, 4)
     T[0, 0] = c12
     T[0, 1] = -s12
-    T[0, 3] = c1 + c12
+    T[0, 3] = t0
     T[1, 0] = s12
     T[1, 1] = c12
-    T[1, 3] = s1 + s12
+    T[1, 3] = t1
     T[2, 2] = 1
     T[3, 3] = 1
     return [T]
 
 
 def _jacobian(q):
-    """Geometric Jacobian in the world frame (6 x DOF, rows vx vy vz wx wy wz): 13 operations."""
+    """Geometric Jacobian in the world frame (6 x DOF, rows vx vy vz wx wy wz): 14 operations."""
     q1 = q[0]
     q2 = q[1]
     c1 = casadi.cos(q1)
@@ -45,10 +47,12 @@ def _jacobian(q):
     s2 = casadi.sin(q2)
     c12 = c1*c2 - s1*s2
     s12 = c1*s2 + c2*s1
+    t0 = c1 + c12
+    t1 = s1 + s12
     J = casadi.SX(6, 2)
-    J[0, 0] = -(s1 + s12)
+    J[0, 0] = -t1
     J[0, 1] = -s12
-    J[1, 0] = c1 + c12
+    J[1, 0] = t0
     J[1, 1] = c12
     J[5, 0] = 1
     J[5, 1] = 1
@@ -65,22 +69,22 @@ def _fk_jacobian(q):
     s2 = casadi.sin(q2)
     c12 = c1*c2 - s1*s2
     s12 = c1*s2 + c2*s1
-    t0 = -s12
-    t1 = c1 + c12
-    t2 = s1 + s12
+    t0 = c1 + c12
+    t1 = s1 + s12
+    t2 = -s12
     T = casadi.SX(4, 4)
     T[0, 0] = c12
-    T[0, 1] = t0
-    T[0, 3] = t1
+    T[0, 1] = t2
+    T[0, 3] = t0
     T[1, 0] = s12
     T[1, 1] = c12
-    T[1, 3] = t2
+    T[1, 3] = t1
     T[2, 2] = 1
     T[3, 3] = 1
     J = casadi.SX(6, 2)
-    J[0, 0] = -t2
-    J[0, 1] = t0
-    J[1, 0] = t1
+    J[0, 0] = -t1
+    J[0, 1] = t2
+    J[1, 0] = t0
     J[1, 1] = c12
     J[5, 0] = 1
     J[5, 1] = 1
@@ -98,10 +102,10 @@ def _jacobian_tool(q):
     c12 = c1*c2 - s1*s2
     s12 = c1*s2 + c2*s1
     t0 = c1 + c12
-    t1 = -(s1 + s12)
+    t1 = s1 + s12
     J = casadi.SX(6, 2)
-    J[0, 0] = c12*t1 + s12*t0
-    J[1, 0] = c12*t0 - s12*t1
+    J[0, 0] = -c12*t1 + s12*t0
+    J[1, 0] = c12*t0 + s12*t1
     J[1, 1] = c12**2 + s12**2
     J[5, 0] = 1
     J[5, 1] = 1
@@ -118,14 +122,16 @@ def _task(q):
     s2 = casadi.sin(q2)
     c12 = c1*c2 - s1*s2
     s12 = c1*s2 + c2*s1
+    t0 = c1 + c12
+    t1 = s1 + s12
     mu = casadi.SX(2, 1)
-    mu[0, 0] = c1 + c12
-    mu[1, 0] = s1 + s12
+    mu[0, 0] = t0
+    mu[1, 0] = t1
     return [mu]
 
 
 def _task_jacobian(q):
-    """Analytic Jacobian d mu / d q (2 x DOF): 13 operations."""
+    """Analytic Jacobian d mu / d q (2 x DOF): 14 operations."""
     q1 = q[0]
     q2 = q[1]
     c1 = casadi.cos(q1)
@@ -134,10 +140,12 @@ def _task_jacobian(q):
     s2 = casadi.sin(q2)
     c12 = c1*c2 - s1*s2
     s12 = c1*s2 + c2*s1
+    t0 = c1 + c12
+    t1 = s1 + s12
     J = casadi.SX(2, 2)
-    J[0, 0] = -(s1 + s12)
+    J[0, 0] = -t1
     J[0, 1] = -s12
-    J[1, 0] = c1 + c12
+    J[1, 0] = t0
     J[1, 1] = c12
     return [J]
 

@@ -24,16 +24,20 @@ void planar_3r_fk(const planar_3r_real q[PLANAR_3R_DOF], planar_3r_real T[16])
     const planar_3r_real s3 = sin(q3);
     const planar_3r_real c123 = c12*c3 - s12*s3;
     const planar_3r_real s123 = c12*s3 + c3*s12;
+    const planar_3r_real t0 = c12 + c123;
+    const planar_3r_real t1 = s12 + s123;
+    const planar_3r_real t2 = c1 + t0;
+    const planar_3r_real t3 = s1 + t1;
 
     /* Outputs */
     T[0] = c123;
     T[1] = -s123;
     T[2] = 0;
-    T[3] = c1 + c12 + c123;
+    T[3] = t2;
     T[4] = s123;
     T[5] = c123;
     T[6] = 0;
-    T[7] = s1 + s12 + s123;
+    T[7] = t3;
     T[8] = 0;
     T[9] = 0;
     T[10] = 1;
@@ -46,7 +50,7 @@ void planar_3r_fk(const planar_3r_real q[PLANAR_3R_DOF], planar_3r_real T[16])
 
 void planar_3r_jacobian(const planar_3r_real q[PLANAR_3R_DOF], planar_3r_real J[6 * PLANAR_3R_DOF])
 {
-    /* 24 operations */
+    /* 25 operations */
 
     /* Inputs */
     const planar_3r_real q1 = q[0];
@@ -64,15 +68,17 @@ void planar_3r_jacobian(const planar_3r_real q[PLANAR_3R_DOF], planar_3r_real J[
     const planar_3r_real s3 = sin(q3);
     const planar_3r_real c123 = c12*c3 - s12*s3;
     const planar_3r_real s123 = c12*s3 + c3*s12;
-    const planar_3r_real t0 = s12 + s123;
-    const planar_3r_real t1 = c12 + c123;
+    const planar_3r_real t0 = c12 + c123;
+    const planar_3r_real t1 = s12 + s123;
+    const planar_3r_real t2 = c1 + t0;
+    const planar_3r_real t3 = s1 + t1;
 
     /* Outputs */
-    J[0] = -(s1 + t0);
-    J[1] = -t0;
+    J[0] = -t3;
+    J[1] = -t1;
     J[2] = -s123;
-    J[3] = c1 + t1;
-    J[4] = t1;
+    J[3] = t2;
+    J[4] = t0;
     J[5] = c123;
     J[6] = 0;
     J[7] = 0;
@@ -108,21 +114,21 @@ void planar_3r_fk_jacobian(const planar_3r_real q[PLANAR_3R_DOF], planar_3r_real
     const planar_3r_real s3 = sin(q3);
     const planar_3r_real c123 = c12*c3 - s12*s3;
     const planar_3r_real s123 = c12*s3 + c3*s12;
-    const planar_3r_real t0 = -s123;
-    const planar_3r_real t1 = c12 + c123;
-    const planar_3r_real t2 = c1 + t1;
-    const planar_3r_real t3 = s12 + s123;
-    const planar_3r_real t4 = s1 + t3;
+    const planar_3r_real t0 = c12 + c123;
+    const planar_3r_real t1 = s12 + s123;
+    const planar_3r_real t2 = c1 + t0;
+    const planar_3r_real t3 = s1 + t1;
+    const planar_3r_real t4 = -s123;
 
     /* Outputs */
     T[0] = c123;
-    T[1] = t0;
+    T[1] = t4;
     T[2] = 0;
     T[3] = t2;
     T[4] = s123;
     T[5] = c123;
     T[6] = 0;
-    T[7] = t4;
+    T[7] = t3;
     T[8] = 0;
     T[9] = 0;
     T[10] = 1;
@@ -131,11 +137,11 @@ void planar_3r_fk_jacobian(const planar_3r_real q[PLANAR_3R_DOF], planar_3r_real
     T[13] = 0;
     T[14] = 0;
     T[15] = 1;
-    J[0] = -t4;
-    J[1] = -t3;
-    J[2] = t0;
+    J[0] = -t3;
+    J[1] = -t1;
+    J[2] = t4;
     J[3] = t2;
-    J[4] = t1;
+    J[4] = t0;
     J[5] = c123;
     J[6] = 0;
     J[7] = 0;
@@ -153,7 +159,7 @@ void planar_3r_fk_jacobian(const planar_3r_real q[PLANAR_3R_DOF], planar_3r_real
 
 void planar_3r_jacobian_tool(const planar_3r_real q[PLANAR_3R_DOF], planar_3r_real J[6 * PLANAR_3R_DOF])
 {
-    /* 38 operations */
+    /* 37 operations */
 
     /* Inputs */
     const planar_3r_real q1 = q[0];
@@ -172,17 +178,16 @@ void planar_3r_jacobian_tool(const planar_3r_real q[PLANAR_3R_DOF], planar_3r_re
     const planar_3r_real c123 = c12*c3 - s12*s3;
     const planar_3r_real s123 = c12*s3 + c3*s12;
     const planar_3r_real t0 = c12 + c123;
-    const planar_3r_real t1 = c1 + t0;
-    const planar_3r_real t2 = s12 + s123;
-    const planar_3r_real t3 = -(s1 + t2);
-    const planar_3r_real t4 = -t2;
+    const planar_3r_real t1 = s12 + s123;
+    const planar_3r_real t2 = c1 + t0;
+    const planar_3r_real t3 = s1 + t1;
 
     /* Outputs */
-    J[0] = c123*t3 + s123*t1;
-    J[1] = c123*t4 + s123*t0;
+    J[0] = -c123*t3 + s123*t2;
+    J[1] = -c123*t1 + s123*t0;
     J[2] = 0;
-    J[3] = c123*t1 - s123*t3;
-    J[4] = c123*t0 - s123*t4;
+    J[3] = c123*t2 + s123*t3;
+    J[4] = c123*t0 + s123*t1;
     J[5] = (c123*c123) + (s123*s123);
     J[6] = 0;
     J[7] = 0;
@@ -218,16 +223,20 @@ void planar_3r_task(const planar_3r_real q[PLANAR_3R_DOF], planar_3r_real mu[PLA
     const planar_3r_real s3 = sin(q3);
     const planar_3r_real c123 = c12*c3 - s12*s3;
     const planar_3r_real s123 = c12*s3 + c3*s12;
+    const planar_3r_real t0 = c12 + c123;
+    const planar_3r_real t1 = s12 + s123;
+    const planar_3r_real t2 = c1 + t0;
+    const planar_3r_real t3 = s1 + t1;
 
     /* Outputs */
-    mu[0] = c1 + c12 + c123;
-    mu[1] = s1 + s12 + s123;
+    mu[0] = t2;
+    mu[1] = t3;
     mu[2] = atan2(s123, c123);
 }
 
 void planar_3r_task_jacobian(const planar_3r_real q[PLANAR_3R_DOF], planar_3r_real J[PLANAR_3R_TASK_DIM * PLANAR_3R_DOF])
 {
-    /* 24 operations */
+    /* 25 operations */
 
     /* Inputs */
     const planar_3r_real q1 = q[0];
@@ -245,15 +254,17 @@ void planar_3r_task_jacobian(const planar_3r_real q[PLANAR_3R_DOF], planar_3r_re
     const planar_3r_real s3 = sin(q3);
     const planar_3r_real c123 = c12*c3 - s12*s3;
     const planar_3r_real s123 = c12*s3 + c3*s12;
-    const planar_3r_real t0 = s12 + s123;
-    const planar_3r_real t1 = c12 + c123;
+    const planar_3r_real t0 = c12 + c123;
+    const planar_3r_real t1 = s12 + s123;
+    const planar_3r_real t2 = c1 + t0;
+    const planar_3r_real t3 = s1 + t1;
 
     /* Outputs */
-    J[0] = -(s1 + t0);
-    J[1] = -t0;
+    J[0] = -t3;
+    J[1] = -t1;
     J[2] = -s123;
-    J[3] = c1 + t1;
-    J[4] = t1;
+    J[3] = t2;
+    J[4] = t0;
     J[5] = c123;
     J[6] = 1;
     J[7] = 1;
@@ -294,9 +305,10 @@ planar_3r_real planar_3r_manipulability(const planar_3r_real q[PLANAR_3R_DOF])
     const planar_3r_real s3 = sin(q3);
     const planar_3r_real c123 = c12*c3 - s12*s3;
     const planar_3r_real s123 = c12*s3 + c3*s12;
+    const planar_3r_real t0 = s2/((c123*c123) + (s123*s123));
 
     /* Outputs */
-    return fabs(s2)/((c123*c123) + (s123*s123));
+    return fabs(t0);
 }
 
 planar_3r_real planar_3r_jacobian_det(const planar_3r_real q[PLANAR_3R_DOF])

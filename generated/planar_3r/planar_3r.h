@@ -35,7 +35,7 @@ typedef double planar_3r_real;
 void planar_3r_fk(const planar_3r_real q[PLANAR_3R_DOF], planar_3r_real T[16]);
 
 /* Geometric Jacobian in the world frame (6 x DOF, rows vx vy vz wx wy wz).
- * Result: J: 6 x 3 row-major, element (r, c) at J[r * 3 + c]. 24 operations. */
+ * Result: J: 6 x 3 row-major, element (r, c) at J[r * 3 + c]. 25 operations. */
 void planar_3r_jacobian(const planar_3r_real q[PLANAR_3R_DOF], planar_3r_real J[6 * PLANAR_3R_DOF]);
 
 /* Fk and jacobian in one pass, sharing their terms.
@@ -43,7 +43,7 @@ void planar_3r_jacobian(const planar_3r_real q[PLANAR_3R_DOF], planar_3r_real J[
 void planar_3r_fk_jacobian(const planar_3r_real q[PLANAR_3R_DOF], planar_3r_real T[16], planar_3r_real J[6 * PLANAR_3R_DOF]);
 
 /* Geometric Jacobian in the tool frame (6 x DOF, rows vx vy vz wx wy wz).
- * Result: J: 6 x 3 row-major, element (r, c) at J[r * 3 + c]. 38 operations. */
+ * Result: J: 6 x 3 row-major, element (r, c) at J[r * 3 + c]. 37 operations. */
 void planar_3r_jacobian_tool(const planar_3r_real q[PLANAR_3R_DOF], planar_3r_real J[6 * PLANAR_3R_DOF]);
 
 /* Task vector mu = (x, y, yaw).
@@ -51,7 +51,7 @@ void planar_3r_jacobian_tool(const planar_3r_real q[PLANAR_3R_DOF], planar_3r_re
 void planar_3r_task(const planar_3r_real q[PLANAR_3R_DOF], planar_3r_real mu[PLANAR_3R_TASK_DIM]);
 
 /* Analytic Jacobian d mu / d q (3 x DOF).
- * Result: J: 3 x 3 row-major, element (r, c) at J[r * 3 + c]. 24 operations. */
+ * Result: J: 3 x 3 row-major, element (r, c) at J[r * 3 + c]. 25 operations. */
 void planar_3r_task_jacobian(const planar_3r_real q[PLANAR_3R_DOF], planar_3r_real J[PLANAR_3R_TASK_DIM * PLANAR_3R_DOF]);
 
 /* Factors of det(Js): the robot is singular where one is 0.

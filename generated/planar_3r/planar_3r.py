@@ -39,15 +39,19 @@ def fk(q):
     s3 = numpy.sin(q3)
     c123 = c12*c3 - s12*s3
     s123 = c12*s3 + c3*s12
+    t0 = c12 + c123
+    t1 = s12 + s123
+    t2 = c1 + t0
+    t3 = s1 + t1
     T = numpy.empty(q.shape[:-1] + (4, 4))
     T[..., 0, 0] = c123
     T[..., 0, 1] = -s123
     T[..., 0, 2] = 0
-    T[..., 0, 3] = c1 + c12 + c123
+    T[..., 0, 3] = t2
     T[..., 1, 0] = s123
     T[..., 1, 1] = c123
     T[..., 1, 2] = 0
-    T[..., 1, 3] = s1 + s12 + s123
+    T[..., 1, 3] = t3
     T[..., 2, 0] = 0
     T[..., 2, 1] = 0
     T[..., 2, 2] = 1
@@ -60,7 +64,7 @@ def fk(q):
 
 
 def jacobian(q):
-    """geometric Jacobian in the world frame (6 x DOF, rows vx vy vz wx wy wz): (6 x 3), 24 operations."""
+    """geometric Jacobian in the world frame (6 x DOF, rows vx vy vz wx wy wz): (6 x 3), 25 operations."""
     q = _joints(q)
     q1 = q[..., 0]
     q2 = q[..., 1]
@@ -75,14 +79,16 @@ def jacobian(q):
     s3 = numpy.sin(q3)
     c123 = c12*c3 - s12*s3
     s123 = c12*s3 + c3*s12
-    t0 = s12 + s123
-    t1 = c12 + c123
+    t0 = c12 + c123
+    t1 = s12 + s123
+    t2 = c1 + t0
+    t3 = s1 + t1
     J = numpy.empty(q.shape[:-1] + (6, 3))
-    J[..., 0, 0] = -(s1 + t0)
-    J[..., 0, 1] = -t0
+    J[..., 0, 0] = -t3
+    J[..., 0, 1] = -t1
     J[..., 0, 2] = -s123
-    J[..., 1, 0] = c1 + t1
-    J[..., 1, 1] = t1
+    J[..., 1, 0] = t2
+    J[..., 1, 1] = t0
     J[..., 1, 2] = c123
     J[..., 2, 0] = 0
     J[..., 2, 1] = 0
@@ -115,20 +121,20 @@ def fk_jacobian(q):
     s3 = numpy.sin(q3)
     c123 = c12*c3 - s12*s3
     s123 = c12*s3 + c3*s12
-    t0 = -s123
-    t1 = c12 + c123
-    t2 = c1 + t1
-    t3 = s12 + s123
-    t4 = s1 + t3
+    t0 = c12 + c123
+    t1 = s12 + s123
+    t2 = c1 + t0
+    t3 = s1 + t1
+    t4 = -s123
     T = numpy.empty(q.shape[:-1] + (4, 4))
     T[..., 0, 0] = c123
-    T[..., 0, 1] = t0
+    T[..., 0, 1] = t4
     T[..., 0, 2] = 0
     T[..., 0, 3] = t2
     T[..., 1, 0] = s123
     T[..., 1, 1] = c123
     T[..., 1, 2] = 0
-    T[..., 1, 3] = t4
+    T[..., 1, 3] = t3
     T[..., 2, 0] = 0
     T[..., 2, 1] = 0
     T[..., 2, 2] = 1
@@ -138,11 +144,11 @@ def fk_jacobian(q):
     T[..., 3, 2] = 0
     T[..., 3, 3] = 1
     J = numpy.empty(q.shape[:-1] + (6, 3))
-    J[..., 0, 0] = -t4
-    J[..., 0, 1] = -t3
-    J[..., 0, 2] = t0
+    J[..., 0, 0] = -t3
+    J[..., 0, 1] = -t1
+    J[..., 0, 2] = t4
     J[..., 1, 0] = t2
-    J[..., 1, 1] = t1
+    J[..., 1, 1] = t0
     J[..., 1, 2] = c123
     J[..., 2, 0] = 0
     J[..., 2, 1] = 0
@@ -160,7 +166,7 @@ def fk_jacobian(q):
 
 
 def jacobian_tool(q):
-    """geometric Jacobian in the tool frame (6 x DOF, rows vx vy vz wx wy wz): (6 x 3), 38 operations."""
+    """geometric Jacobian in the tool frame (6 x DOF, rows vx vy vz wx wy wz): (6 x 3), 37 operations."""
     q = _joints(q)
     q1 = q[..., 0]
     q2 = q[..., 1]
@@ -176,16 +182,15 @@ def jacobian_tool(q):
     c123 = c12*c3 - s12*s3
     s123 = c12*s3 + c3*s12
     t0 = c12 + c123
-    t1 = c1 + t0
-    t2 = s12 + s123
-    t3 = -(s1 + t2)
-    t4 = -t2
+    t1 = s12 + s123
+    t2 = c1 + t0
+    t3 = s1 + t1
     J = numpy.empty(q.shape[:-1] + (6, 3))
-    J[..., 0, 0] = c123*t3 + s123*t1
-    J[..., 0, 1] = c123*t4 + s123*t0
+    J[..., 0, 0] = -c123*t3 + s123*t2
+    J[..., 0, 1] = -c123*t1 + s123*t0
     J[..., 0, 2] = 0
-    J[..., 1, 0] = c123*t1 - s123*t3
-    J[..., 1, 1] = c123*t0 - s123*t4
+    J[..., 1, 0] = c123*t2 + s123*t3
+    J[..., 1, 1] = c123*t0 + s123*t1
     J[..., 1, 2] = c123**2 + s123**2
     J[..., 2, 0] = 0
     J[..., 2, 1] = 0
@@ -218,15 +223,19 @@ def task(q):
     s3 = numpy.sin(q3)
     c123 = c12*c3 - s12*s3
     s123 = c12*s3 + c3*s12
+    t0 = c12 + c123
+    t1 = s12 + s123
+    t2 = c1 + t0
+    t3 = s1 + t1
     mu = numpy.empty(q.shape[:-1] + (3,))
-    mu[..., 0] = c1 + c12 + c123
-    mu[..., 1] = s1 + s12 + s123
+    mu[..., 0] = t2
+    mu[..., 1] = t3
     mu[..., 2] = numpy.arctan2(s123, c123)
     return mu
 
 
 def task_jacobian(q):
-    """analytic Jacobian d mu / d q (3 x DOF): (3 x 3), 24 operations."""
+    """analytic Jacobian d mu / d q (3 x DOF): (3 x 3), 25 operations."""
     q = _joints(q)
     q1 = q[..., 0]
     q2 = q[..., 1]
@@ -241,14 +250,16 @@ def task_jacobian(q):
     s3 = numpy.sin(q3)
     c123 = c12*c3 - s12*s3
     s123 = c12*s3 + c3*s12
-    t0 = s12 + s123
-    t1 = c12 + c123
+    t0 = c12 + c123
+    t1 = s12 + s123
+    t2 = c1 + t0
+    t3 = s1 + t1
     J = numpy.empty(q.shape[:-1] + (3, 3))
-    J[..., 0, 0] = -(s1 + t0)
-    J[..., 0, 1] = -t0
+    J[..., 0, 0] = -t3
+    J[..., 0, 1] = -t1
     J[..., 0, 2] = -s123
-    J[..., 1, 0] = c1 + t1
-    J[..., 1, 1] = t1
+    J[..., 1, 0] = t2
+    J[..., 1, 1] = t0
     J[..., 1, 2] = c123
     J[..., 2, 0] = 1
     J[..., 2, 1] = 1
@@ -282,8 +293,9 @@ def manipulability(q):
     s3 = numpy.sin(q3)
     c123 = c12*c3 - s12*s3
     s123 = c12*s3 + c3*s12
+    t0 = s2/(c123**2 + s123**2)
     w = numpy.empty(q.shape[:-1] + ())
-    w[...] = abs(s2)/(c123**2 + s123**2)
+    w[...] = abs(t0)
     return w
 
 

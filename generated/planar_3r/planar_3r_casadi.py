@@ -28,20 +28,24 @@ def _fk(q):
     s3 = casadi.sin(q3)
     c123 = c12*c3 - s12*s3
     s123 = c12*s3 + c3*s12
+    t0 = c12 + c123
+    t1 = s12 + s123
+    t2 = c1 + t0
+    t3 = s1 + t1
     T = casadi.SX(4, 4)
     T[0, 0] = c123
     T[0, 1] = -s123
-    T[0, 3] = c1 + c12 + c123
+    T[0, 3] = t2
     T[1, 0] = s123
     T[1, 1] = c123
-    T[1, 3] = s1 + s12 + s123
+    T[1, 3] = t3
     T[2, 2] = 1
     T[3, 3] = 1
     return [T]
 
 
 def _jacobian(q):
-    """Geometric Jacobian in the world frame (6 x DOF, rows vx vy vz wx wy wz): 24 operations."""
+    """Geometric Jacobian in the world frame (6 x DOF, rows vx vy vz wx wy wz): 25 operations."""
     q1 = q[0]
     q2 = q[1]
     q3 = q[2]
@@ -55,14 +59,16 @@ def _jacobian(q):
     s3 = casadi.sin(q3)
     c123 = c12*c3 - s12*s3
     s123 = c12*s3 + c3*s12
-    t0 = s12 + s123
-    t1 = c12 + c123
+    t0 = c12 + c123
+    t1 = s12 + s123
+    t2 = c1 + t0
+    t3 = s1 + t1
     J = casadi.SX(6, 3)
-    J[0, 0] = -(s1 + t0)
-    J[0, 1] = -t0
+    J[0, 0] = -t3
+    J[0, 1] = -t1
     J[0, 2] = -s123
-    J[1, 0] = c1 + t1
-    J[1, 1] = t1
+    J[1, 0] = t2
+    J[1, 1] = t0
     J[1, 2] = c123
     J[5, 0] = 1
     J[5, 1] = 1
@@ -85,26 +91,26 @@ def _fk_jacobian(q):
     s3 = casadi.sin(q3)
     c123 = c12*c3 - s12*s3
     s123 = c12*s3 + c3*s12
-    t0 = -s123
-    t1 = c12 + c123
-    t2 = c1 + t1
-    t3 = s12 + s123
-    t4 = s1 + t3
+    t0 = c12 + c123
+    t1 = s12 + s123
+    t2 = c1 + t0
+    t3 = s1 + t1
+    t4 = -s123
     T = casadi.SX(4, 4)
     T[0, 0] = c123
-    T[0, 1] = t0
+    T[0, 1] = t4
     T[0, 3] = t2
     T[1, 0] = s123
     T[1, 1] = c123
-    T[1, 3] = t4
+    T[1, 3] = t3
     T[2, 2] = 1
     T[3, 3] = 1
     J = casadi.SX(6, 3)
-    J[0, 0] = -t4
-    J[0, 1] = -t3
-    J[0, 2] = t0
+    J[0, 0] = -t3
+    J[0, 1] = -t1
+    J[0, 2] = t4
     J[1, 0] = t2
-    J[1, 1] = t1
+    J[1, 1] = t0
     J[1, 2] = c123
     J[5, 0] = 1
     J[5, 1] = 1
@@ -113,7 +119,7 @@ def _fk_jacobian(q):
 
 
 def _jacobian_tool(q):
-    """Geometric Jacobian in the tool frame (6 x DOF, rows vx vy vz wx wy wz): 38 operations."""
+    """Geometric Jacobian in the tool frame (6 x DOF, rows vx vy vz wx wy wz): 37 operations."""
     q1 = q[0]
     q2 = q[1]
     q3 = q[2]
@@ -128,15 +134,14 @@ def _jacobian_tool(q):
     c123 = c12*c3 - s12*s3
     s123 = c12*s3 + c3*s12
     t0 = c12 + c123
-    t1 = c1 + t0
-    t2 = s12 + s123
-    t3 = -(s1 + t2)
-    t4 = -t2
+    t1 = s12 + s123
+    t2 = c1 + t0
+    t3 = s1 + t1
     J = casadi.SX(6, 3)
-    J[0, 0] = c123*t3 + s123*t1
-    J[0, 1] = c123*t4 + s123*t0
-    J[1, 0] = c123*t1 - s123*t3
-    J[1, 1] = c123*t0 - s123*t4
+    J[0, 0] = -c123*t3 + s123*t2
+    J[0, 1] = -c123*t1 + s123*t0
+    J[1, 0] = c123*t2 + s123*t3
+    J[1, 1] = c123*t0 + s123*t1
     J[1, 2] = c123**2 + s123**2
     J[5, 0] = 1
     J[5, 1] = 1
@@ -159,15 +164,19 @@ def _task(q):
     s3 = casadi.sin(q3)
     c123 = c12*c3 - s12*s3
     s123 = c12*s3 + c3*s12
+    t0 = c12 + c123
+    t1 = s12 + s123
+    t2 = c1 + t0
+    t3 = s1 + t1
     mu = casadi.SX(3, 1)
-    mu[0, 0] = c1 + c12 + c123
-    mu[1, 0] = s1 + s12 + s123
+    mu[0, 0] = t2
+    mu[1, 0] = t3
     mu[2, 0] = casadi.atan2(s123, c123)
     return [mu]
 
 
 def _task_jacobian(q):
-    """Analytic Jacobian d mu / d q (3 x DOF): 24 operations."""
+    """Analytic Jacobian d mu / d q (3 x DOF): 25 operations."""
     q1 = q[0]
     q2 = q[1]
     q3 = q[2]
@@ -181,14 +190,16 @@ def _task_jacobian(q):
     s3 = casadi.sin(q3)
     c123 = c12*c3 - s12*s3
     s123 = c12*s3 + c3*s12
-    t0 = s12 + s123
-    t1 = c12 + c123
+    t0 = c12 + c123
+    t1 = s12 + s123
+    t2 = c1 + t0
+    t3 = s1 + t1
     J = casadi.SX(3, 3)
-    J[0, 0] = -(s1 + t0)
-    J[0, 1] = -t0
+    J[0, 0] = -t3
+    J[0, 1] = -t1
     J[0, 2] = -s123
-    J[1, 0] = c1 + t1
-    J[1, 1] = t1
+    J[1, 0] = t2
+    J[1, 1] = t0
     J[1, 2] = c123
     J[2, 0] = 1
     J[2, 1] = 1
@@ -220,8 +231,9 @@ def _manipulability(q):
     s3 = casadi.sin(q3)
     c123 = c12*c3 - s12*s3
     s123 = c12*s3 + c3*s12
+    t0 = s2/(c123**2 + s123**2)
     w = casadi.SX(1, 1)
-    w[0, 0] = casadi.fabs(s2)/(c123**2 + s123**2)
+    w[0, 0] = casadi.fabs(t0)
     return [w]
 
 

@@ -6,7 +6,7 @@
 
 void puma560_fk(const puma560_real q[PUMA560_DOF], puma560_real T[16])
 {
-    /* 92 operations */
+    /* 96 operations */
 
     /* Inputs */
     const puma560_real q1 = q[0];
@@ -31,37 +31,55 @@ void puma560_fk(const puma560_real q[PUMA560_DOF], puma560_real T[16])
     const puma560_real s5 = sin(q5);
     const puma560_real c6 = cos(q6);
     const puma560_real s6 = sin(q6);
-    const puma560_real t0 = c4*s1;
-    const puma560_real t1 = c1*s4;
-    const puma560_real t2 = -(c23*t1 + t0);
-    const puma560_real t3 = c1*s23;
-    const puma560_real t4 = s1*s4;
-    const puma560_real t5 = c1*c4;
-    const puma560_real t6 = c23*t5 - t4;
-    const puma560_real t7 = c5*t6 - s5*t3;
-    const puma560_real t8 = 0.4318*c2;
-    const puma560_real t9 = 0.0203*c23;
-    const puma560_real t10 = -c23*t4 + t5;
-    const puma560_real t11 = s1*s23;
-    const puma560_real t12 = c23*t0 + t1;
-    const puma560_real t13 = c5*t12 - s5*t11;
-    const puma560_real t14 = s23*s4;
-    const puma560_real t15 = c4*s23;
-    const puma560_real t16 = c23*s5 + c5*t15;
+    const puma560_real t0 = 0.4318*c23 + 0.0203*s23;
+    const puma560_real t1 = 0.4318*s2 + t0;
+    const puma560_real t2 = t1 + 0.67183;
+    const puma560_real t3 = 0.0203*c23;
+    const puma560_real t4 = c1*t3 + 0.15005*s1;
+    const puma560_real t5 = -0.15005*c1 + s1*t3;
+    const puma560_real t6 = s1*s4;
+    const puma560_real t7 = c1*c4;
+    const puma560_real t8 = c23*t7 - t6;
+    const puma560_real t9 = -c23*t6 + t7;
+    const puma560_real t10 = c4*s1;
+    const puma560_real t11 = c1*s4;
+    const puma560_real t12 = c23*t11 + t10;
+    const puma560_real t13 = c23*t10 + t11;
+    const puma560_real t14 = c1*s23;
+    const puma560_real t15 = c5*t8 - s5*t14;
+    const puma560_real t16 = c5*t14 + s5*t8;
+    const puma560_real t17 = c6*t15 - s6*t12;
+    const puma560_real t18 = c6*t12 + s6*t15;
+    const puma560_real t19 = -0.4318*t14 + t4;
+    const puma560_real t20 = s1*s23;
+    const puma560_real t21 = c5*t13 - s5*t20;
+    const puma560_real t22 = c5*t20 + s5*t13;
+    const puma560_real t23 = c6*t21 + s6*t9;
+    const puma560_real t24 = c6*t9 - s6*t21;
+    const puma560_real t25 = -0.4318*t20 + t5;
+    const puma560_real t26 = c4*s23;
+    const puma560_real t27 = c23*s5 + c5*t26;
+    const puma560_real t28 = c23*c5 - s5*t26;
+    const puma560_real t29 = s23*s4;
+    const puma560_real t30 = c6*t27 - s6*t29;
+    const puma560_real t31 = c6*t29 + s6*t27;
+    const puma560_real t32 = 0.4318*c2;
+    const puma560_real t33 = c1*t32 + t19;
+    const puma560_real t34 = s1*t32 + t25;
 
     /* Outputs */
-    T[0] = c6*t7 + s6*t2;
-    T[1] = c6*t2 - s6*t7;
-    T[2] = -(c5*t3 + s5*t6);
-    T[3] = c1*t8 + c1*t9 + 0.15005*s1 - 0.4318*t3;
-    T[4] = c6*t13 + s6*t10;
-    T[5] = c6*t10 - s6*t13;
-    T[6] = -(c5*t11 + s5*t12);
-    T[7] = -0.15005*c1 + s1*t8 + s1*t9 - 0.4318*t11;
-    T[8] = c6*t16 - s6*t14;
-    T[9] = -(c6*t14 + s6*t16);
-    T[10] = c23*c5 - s5*t15;
-    T[11] = 0.4318*c23 + 0.4318*s2 + 0.0203*s23 + 0.67183;
+    T[0] = t17;
+    T[1] = -t18;
+    T[2] = -t16;
+    T[3] = t33;
+    T[4] = t23;
+    T[5] = t24;
+    T[6] = -t22;
+    T[7] = t34;
+    T[8] = t30;
+    T[9] = -t31;
+    T[10] = t28;
+    T[11] = t2;
     T[12] = 0;
     T[13] = 0;
     T[14] = 0;
@@ -92,67 +110,73 @@ void puma560_jacobian(const puma560_real q[PUMA560_DOF], puma560_real J[6 * PUMA
     const puma560_real s4 = sin(q4);
     const puma560_real c5 = cos(q5);
     const puma560_real s5 = sin(q5);
-    const puma560_real t0 = 0.4318*c2;
-    const puma560_real t1 = s1*t0;
-    const puma560_real t2 = 0.15005*c1;
+    const puma560_real t0 = c23*c5 - c4*s23*s5;
+    const puma560_real t1 = 0.4318*c23 + 0.0203*s23;
+    const puma560_real t2 = 0.4318*s2 + t1;
     const puma560_real t3 = 0.0203*c23;
-    const puma560_real t4 = s1*t3;
-    const puma560_real t5 = s1*s23;
-    const puma560_real t6 = 0.4318*t5;
-    const puma560_real t7 = t2 - t4 + t6;
-    const puma560_real t8 = 0.4318*c23 + 0.0203*s23;
-    const puma560_real t9 = 0.4318*s2 + t8;
-    const puma560_real t10 = c1*s23;
-    const puma560_real t11 = c1*t3 + 0.15005*s1 - 0.4318*t10;
-    const puma560_real t12 = c1*t0 + t11;
-    const puma560_real t13 = c4*s1;
-    const puma560_real t14 = c1*s4;
-    const puma560_real t15 = s1*s4;
-    const puma560_real t16 = c1*c4;
-    const puma560_real t17 = -c1;
+    const puma560_real t4 = c1*t3 + 0.15005*s1;
+    const puma560_real t5 = -0.15005*c1 + s1*t3;
+    const puma560_real t6 = s1*s4;
+    const puma560_real t7 = c1*c4;
+    const puma560_real t8 = c23*t7 - t6;
+    const puma560_real t9 = -c23*t6 + t7;
+    const puma560_real t10 = c4*s1;
+    const puma560_real t11 = c1*s4;
+    const puma560_real t12 = c23*t11 + t10;
+    const puma560_real t13 = c23*t10 + t11;
+    const puma560_real t14 = c1*s23;
+    const puma560_real t15 = c5*t14 + s5*t8;
+    const puma560_real t16 = -0.4318*t14 + t4;
+    const puma560_real t17 = s1*s23;
+    const puma560_real t18 = c5*t17 + s5*t13;
+    const puma560_real t19 = -0.4318*t17 + t5;
+    const puma560_real t20 = 0.4318*c2;
+    const puma560_real t21 = c1*t20 + t16;
+    const puma560_real t22 = s1*t20 + t19;
+    const puma560_real t23 = -c1;
 
     /* Outputs */
-    J[0] = -t1 + t7;
-    J[1] = -c1*t9;
-    J[2] = -c1*t8;
+    J[0] = -t22;
+    J[1] = -c1*t2;
+    J[2] = -c1*t1;
     J[3] = 0;
     J[4] = 0;
     J[5] = 0;
-    J[6] = t12;
-    J[7] = -s1*t9;
-    J[8] = -s1*t8;
+    J[6] = t21;
+    J[7] = -s1*t2;
+    J[8] = -s1*t1;
     J[9] = 0;
     J[10] = 0;
     J[11] = 0;
     J[12] = 0;
-    J[13] = c1*t12 + s1*(t1 - t2 + t4 - t6);
-    J[14] = c1*t11 - s1*t7;
+    J[13] = c1*t21 + s1*t22;
+    J[14] = c1*t16 + s1*t19;
     J[15] = 0;
     J[16] = 0;
     J[17] = 0;
     J[18] = 0;
     J[19] = s1;
     J[20] = s1;
-    J[21] = -t10;
-    J[22] = c23*t14 + t13;
-    J[23] = -(c5*t10 + s5*(c23*t16 - t15));
+    J[21] = -t14;
+    J[22] = t12;
+    J[23] = -t15;
     J[24] = 0;
-    J[25] = t17;
-    J[26] = t17;
-    J[27] = -t5;
-    J[28] = -(-c23*t15 + t16);
-    J[29] = -(c5*t5 + s5*(c23*t13 + t14));
+    J[25] = t23;
+    J[26] = t23;
+    J[27] = -t17;
+    J[28] = -t9;
+    J[29] = -t18;
     J[30] = 1;
     J[31] = 0;
     J[32] = 0;
     J[33] = c23;
     J[34] = s23*s4;
-    J[35] = c23*c5 - c4*s23*s5;
+    J[35] = t0;
 }
 
 void puma560_fk_jacobian(const puma560_real q[PUMA560_DOF], puma560_real T[16], puma560_real J[6 * PUMA560_DOF])
 {
-    /* 114 operations */
+    /* 115 operations */
 
     /* Inputs */
     const puma560_real q1 = q[0];
@@ -177,368 +201,392 @@ void puma560_fk_jacobian(const puma560_real q[PUMA560_DOF], puma560_real T[16], 
     const puma560_real s5 = sin(q5);
     const puma560_real c6 = cos(q6);
     const puma560_real s6 = sin(q6);
-    const puma560_real t0 = c4*s1;
-    const puma560_real t1 = c1*s4;
-    const puma560_real t2 = -(c23*t1 + t0);
-    const puma560_real t3 = c1*s23;
-    const puma560_real t4 = s1*s4;
-    const puma560_real t5 = c1*c4;
-    const puma560_real t6 = c23*t5 - t4;
-    const puma560_real t7 = c5*t6 - s5*t3;
-    const puma560_real t8 = -(c5*t3 + s5*t6);
-    const puma560_real t9 = 0.4318*c2;
-    const puma560_real t10 = 0.0203*c23;
-    const puma560_real t11 = c1*t10 + 0.15005*s1 - 0.4318*t3;
-    const puma560_real t12 = c1*t9 + t11;
-    const puma560_real t13 = -c23*t4 + t5;
-    const puma560_real t14 = s1*s23;
-    const puma560_real t15 = c23*t0 + t1;
-    const puma560_real t16 = c5*t15 - s5*t14;
-    const puma560_real t17 = -(c5*t14 + s5*t15);
-    const puma560_real t18 = 0.15005*c1;
-    const puma560_real t19 = s1*t9;
-    const puma560_real t20 = s1*t10;
-    const puma560_real t21 = 0.4318*t14;
-    const puma560_real t22 = -t18 + t19 + t20 - t21;
-    const puma560_real t23 = s23*s4;
-    const puma560_real t24 = c4*s23;
-    const puma560_real t25 = c23*s5 + c5*t24;
-    const puma560_real t26 = c23*c5 - s5*t24;
-    const puma560_real t27 = 0.4318*c23 + 0.0203*s23;
-    const puma560_real t28 = 0.4318*s2 + t27;
-    const puma560_real t29 = t18 - t20 + t21;
-    const puma560_real t30 = -c1;
+    const puma560_real t0 = 0.4318*c23 + 0.0203*s23;
+    const puma560_real t1 = 0.4318*s2 + t0;
+    const puma560_real t2 = t1 + 0.67183;
+    const puma560_real t3 = 0.0203*c23;
+    const puma560_real t4 = c1*t3 + 0.15005*s1;
+    const puma560_real t5 = -0.15005*c1 + s1*t3;
+    const puma560_real t6 = s1*s4;
+    const puma560_real t7 = c1*c4;
+    const puma560_real t8 = c23*t7 - t6;
+    const puma560_real t9 = -c23*t6 + t7;
+    const puma560_real t10 = c4*s1;
+    const puma560_real t11 = c1*s4;
+    const puma560_real t12 = c23*t11 + t10;
+    const puma560_real t13 = c23*t10 + t11;
+    const puma560_real t14 = c1*s23;
+    const puma560_real t15 = c5*t8 - s5*t14;
+    const puma560_real t16 = c5*t14 + s5*t8;
+    const puma560_real t17 = c6*t15 - s6*t12;
+    const puma560_real t18 = c6*t12 + s6*t15;
+    const puma560_real t19 = -0.4318*t14 + t4;
+    const puma560_real t20 = s1*s23;
+    const puma560_real t21 = c5*t13 - s5*t20;
+    const puma560_real t22 = c5*t20 + s5*t13;
+    const puma560_real t23 = c6*t21 + s6*t9;
+    const puma560_real t24 = c6*t9 - s6*t21;
+    const puma560_real t25 = -0.4318*t20 + t5;
+    const puma560_real t26 = c4*s23;
+    const puma560_real t27 = c23*s5 + c5*t26;
+    const puma560_real t28 = c23*c5 - s5*t26;
+    const puma560_real t29 = s23*s4;
+    const puma560_real t30 = c6*t27 - s6*t29;
+    const puma560_real t31 = c6*t29 + s6*t27;
+    const puma560_real t32 = 0.4318*c2;
+    const puma560_real t33 = c1*t32 + t19;
+    const puma560_real t34 = s1*t32 + t25;
+    const puma560_real t35 = -t16;
+    const puma560_real t36 = -t22;
+    const puma560_real t37 = -c1;
 
     /* Outputs */
-    T[0] = c6*t7 + s6*t2;
-    T[1] = c6*t2 - s6*t7;
-    T[2] = t8;
-    T[3] = t12;
-    T[4] = c6*t16 + s6*t13;
-    T[5] = c6*t13 - s6*t16;
-    T[6] = t17;
-    T[7] = t22;
-    T[8] = c6*t25 - s6*t23;
-    T[9] = -(c6*t23 + s6*t25);
-    T[10] = t26;
-    T[11] = t28 + 0.67183;
+    T[0] = t17;
+    T[1] = -t18;
+    T[2] = t35;
+    T[3] = t33;
+    T[4] = t23;
+    T[5] = t24;
+    T[6] = t36;
+    T[7] = t34;
+    T[8] = t30;
+    T[9] = -t31;
+    T[10] = t28;
+    T[11] = t2;
     T[12] = 0;
     T[13] = 0;
     T[14] = 0;
     T[15] = 1;
-    J[0] = -t19 + t29;
-    J[1] = -c1*t28;
-    J[2] = -c1*t27;
+    J[0] = -t34;
+    J[1] = -c1*t1;
+    J[2] = -c1*t0;
     J[3] = 0;
     J[4] = 0;
     J[5] = 0;
-    J[6] = t12;
-    J[7] = -s1*t28;
-    J[8] = -s1*t27;
+    J[6] = t33;
+    J[7] = -s1*t1;
+    J[8] = -s1*t0;
     J[9] = 0;
     J[10] = 0;
     J[11] = 0;
     J[12] = 0;
-    J[13] = c1*t12 + s1*t22;
-    J[14] = c1*t11 - s1*t29;
+    J[13] = c1*t33 + s1*t34;
+    J[14] = c1*t19 + s1*t25;
     J[15] = 0;
     J[16] = 0;
     J[17] = 0;
     J[18] = 0;
     J[19] = s1;
     J[20] = s1;
-    J[21] = -t3;
-    J[22] = -t2;
-    J[23] = t8;
-    J[24] = 0;
-    J[25] = t30;
-    J[26] = t30;
-    J[27] = -t14;
-    J[28] = -t13;
-    J[29] = t17;
-    J[30] = 1;
-    J[31] = 0;
-    J[32] = 0;
-    J[33] = c23;
-    J[34] = t23;
-    J[35] = t26;
-}
-
-void puma560_jacobian_tool(const puma560_real q[PUMA560_DOF], puma560_real J[6 * PUMA560_DOF])
-{
-    /* 202 operations */
-
-    /* Inputs */
-    const puma560_real q1 = q[0];
-    const puma560_real q2 = q[1];
-    const puma560_real q3 = q[2];
-    const puma560_real q4 = q[3];
-    const puma560_real q5 = q[4];
-    const puma560_real q6 = q[5];
-
-    /* Intermediate terms */
-    const puma560_real c1 = cos(q1);
-    const puma560_real s1 = sin(q1);
-    const puma560_real c2 = cos(q2);
-    const puma560_real s2 = sin(q2);
-    const puma560_real c3 = cos(q3);
-    const puma560_real s3 = sin(q3);
-    const puma560_real c23 = c2*c3 - s2*s3;
-    const puma560_real s23 = c2*s3 + c3*s2;
-    const puma560_real c4 = cos(q4);
-    const puma560_real s4 = sin(q4);
-    const puma560_real c5 = cos(q5);
-    const puma560_real s5 = sin(q5);
-    const puma560_real c6 = cos(q6);
-    const puma560_real s6 = sin(q6);
-    const puma560_real t0 = 0.4318*c1;
-    const puma560_real t1 = 0.0203*c23;
-    const puma560_real t2 = c1*t1 + 0.15005*s1 - s23*t0;
-    const puma560_real t3 = c2*t0 + t2;
-    const puma560_real t4 = c1*c4;
-    const puma560_real t5 = s1*s4;
-    const puma560_real t6 = -c23*t5 + t4;
-    const puma560_real t7 = s23*s5;
-    const puma560_real t8 = c1*s4;
-    const puma560_real t9 = c4*s1;
-    const puma560_real t10 = c23*t9 + t8;
-    const puma560_real t11 = c5*t10 - s1*t7;
-    const puma560_real t12 = c6*t11 + s6*t6;
-    const puma560_real t13 = 0.4318*s1;
-    const puma560_real t14 = c2*t13;
-    const puma560_real t15 = 0.15005*c1;
-    const puma560_real t16 = s1*t1;
-    const puma560_real t17 = s23*t13;
-    const puma560_real t18 = t15 - t16 + t17;
-    const puma560_real t19 = -t14 + t18;
-    const puma560_real t20 = -(c23*t8 + t9);
-    const puma560_real t21 = c23*t4 - t5;
-    const puma560_real t22 = -c1*t7 + c5*t21;
-    const puma560_real t23 = c6*t22 + s6*t20;
-    const puma560_real t24 = 0.4318*c23 + 0.0203*s23;
-    const puma560_real t25 = 0.4318*s2 + t24;
-    const puma560_real t26 = s1*t12;
-    const puma560_real t27 = c1*t23;
-    const puma560_real t28 = s23*s4;
-    const puma560_real t29 = c5*s23;
-    const puma560_real t30 = c23*s5 + c4*t29;
-    const puma560_real t31 = c6*t30 - s6*t28;
-    const puma560_real t32 = c1*t3 + s1*(t14 - t15 + t16 - t17);
-    const puma560_real t33 = c1*t2 - s1*t18;
-    const puma560_real t34 = c6*t6 - s6*t11;
-    const puma560_real t35 = c6*t20 - s6*t22;
-    const puma560_real t36 = s1*t34;
-    const puma560_real t37 = c1*t35;
-    const puma560_real t38 = -(c6*t28 + s6*t30);
-    const puma560_real t39 = -(s1*t29 + s5*t10);
-    const puma560_real t40 = -(c1*t29 + s5*t21);
-    const puma560_real t41 = s1*t39;
-    const puma560_real t42 = c1*t40;
-    const puma560_real t43 = c23*c5 - c4*t7;
-    const puma560_real t44 = -c1*t12 + s1*t23;
-    const puma560_real t45 = -c1*t34 + s1*t35;
-    const puma560_real t46 = -c1*t39 + s1*t40;
-
-    /* Outputs */
-    J[0] = t12*t3 + t19*t23;
-    J[1] = -(t25*t26 + t25*t27 - t31*t32);
-    J[2] = -(t24*t26 + t24*t27 - t31*t33);
-    J[3] = 0;
-    J[4] = 0;
-    J[5] = 0;
-    J[6] = t19*t35 + t3*t34;
-    J[7] = -(t25*t36 + t25*t37 - t32*t38);
-    J[8] = -(t24*t36 + t24*t37 - t33*t38);
-    J[9] = 0;
-    J[10] = 0;
-    J[11] = 0;
-    J[12] = t19*t40 + t3*t39;
-    J[13] = -(t25*t41 + t25*t42 - t32*t43);
-    J[14] = -(t24*t41 + t24*t42 - t33*t43);
-    J[15] = 0;
-    J[16] = 0;
-    J[17] = 0;
-    J[18] = t31;
-    J[19] = t44;
-    J[20] = t44;
-    J[21] = -(-c23*t31 + s23*t26 + s23*t27);
-    J[22] = -(-s23*s4*t31 + t12*t6 + t20*t23);
-    J[23] = t12*t39 + t23*t40 + t31*t43;
-    J[24] = t38;
-    J[25] = t45;
-    J[26] = t45;
-    J[27] = -(-c23*t38 + s23*t36 + s23*t37);
-    J[28] = -(-s23*s4*t38 + t20*t35 + t34*t6);
-    J[29] = t34*t39 + t35*t40 + t38*t43;
-    J[30] = t43;
-    J[31] = t46;
-    J[32] = t46;
-    J[33] = -(-c23*t43 + s23*t41 + s23*t42);
-    J[34] = -(-s23*s4*t43 + t20*t40 + t39*t6);
-    J[35] = (t39*t39) + (t40*t40) + (t43*t43);
-}
-
-void puma560_task(const puma560_real q[PUMA560_DOF], puma560_real mu[PUMA560_TASK_DIM])
-{
-    /* 88 operations */
-
-    /* Inputs */
-    const puma560_real q1 = q[0];
-    const puma560_real q2 = q[1];
-    const puma560_real q3 = q[2];
-    const puma560_real q4 = q[3];
-    const puma560_real q5 = q[4];
-    const puma560_real q6 = q[5];
-
-    /* Intermediate terms */
-    const puma560_real c1 = cos(q1);
-    const puma560_real s1 = sin(q1);
-    const puma560_real c2 = cos(q2);
-    const puma560_real s2 = sin(q2);
-    const puma560_real c3 = cos(q3);
-    const puma560_real s3 = sin(q3);
-    const puma560_real c23 = c2*c3 - s2*s3;
-    const puma560_real s23 = c2*s3 + c3*s2;
-    const puma560_real c4 = cos(q4);
-    const puma560_real s4 = sin(q4);
-    const puma560_real c5 = cos(q5);
-    const puma560_real s5 = sin(q5);
-    const puma560_real c6 = cos(q6);
-    const puma560_real s6 = sin(q6);
-    const puma560_real t0 = 0.4318*c1;
-    const puma560_real t1 = 0.0203*c23;
-    const puma560_real t2 = 0.4318*s1;
-    const puma560_real t3 = s23*s4;
-    const puma560_real t4 = c4*s23;
-    const puma560_real t5 = c23*s5 + c5*t4;
-    const puma560_real t6 = c1*c4;
-    const puma560_real t7 = s1*s4;
-    const puma560_real t8 = s23*s5;
-    const puma560_real t9 = c1*s4;
-    const puma560_real t10 = c4*s1;
-    const puma560_real t11 = c6*(c5*(c23*t10 + t9) - s1*t8) + s6*(-c23*t7 + t6);
-    const puma560_real t12 = c6*(-c1*t8 + c5*(c23*t6 - t7)) - s6*(c23*t9 + t10);
-
-    /* Outputs */
-    mu[0] = c1*t1 + c2*t0 + 0.15005*s1 - s23*t0;
-    mu[1] = -0.15005*c1 + c2*t2 + s1*t1 - s23*t2;
-    mu[2] = 0.4318*c23 + 0.4318*s2 + 0.0203*s23 + 0.67183;
-    mu[3] = atan2(-(c6*t3 + s6*t5), c23*c5 - s5*t4);
-    mu[4] = atan2(-c6*t5 + s6*t3, sqrt((t11*t11) + (t12*t12)));
-    mu[5] = atan2(t11, t12);
-}
-
-void puma560_task_jacobian(const puma560_real q[PUMA560_DOF], puma560_real J[PUMA560_TASK_DIM * PUMA560_DOF])
-{
-    /* 149 operations */
-
-    /* Inputs */
-    const puma560_real q1 = q[0];
-    const puma560_real q2 = q[1];
-    const puma560_real q3 = q[2];
-    const puma560_real q4 = q[3];
-    const puma560_real q5 = q[4];
-    const puma560_real q6 = q[5];
-
-    /* Intermediate terms */
-    const puma560_real c1 = cos(q1);
-    const puma560_real s1 = sin(q1);
-    const puma560_real c2 = cos(q2);
-    const puma560_real s2 = sin(q2);
-    const puma560_real c3 = cos(q3);
-    const puma560_real s3 = sin(q3);
-    const puma560_real c23 = c2*c3 - s2*s3;
-    const puma560_real s23 = c2*s3 + c3*s2;
-    const puma560_real c4 = cos(q4);
-    const puma560_real s4 = sin(q4);
-    const puma560_real c5 = cos(q5);
-    const puma560_real s5 = sin(q5);
-    const puma560_real c6 = cos(q6);
-    const puma560_real s6 = sin(q6);
-    const puma560_real t0 = 0.4318*s1;
-    const puma560_real t1 = c2*t0;
-    const puma560_real t2 = 0.15005*c1;
-    const puma560_real t3 = 0.0203*c23;
-    const puma560_real t4 = s1*t3;
-    const puma560_real t5 = s23*t0;
-    const puma560_real t6 = t2 - t4 + t5;
-    const puma560_real t7 = 0.4318*c23 + 0.0203*s23;
-    const puma560_real t8 = 0.4318*s2 + t7;
-    const puma560_real t9 = 0.4318*c1;
-    const puma560_real t10 = c1*t3 + 0.15005*s1 - s23*t9;
-    const puma560_real t11 = c2*t9 + t10;
-    const puma560_real t12 = c1*c4;
-    const puma560_real t13 = s1*s4;
-    const puma560_real t14 = -c23*t13 + t12;
-    const puma560_real t15 = s23*s5;
-    const puma560_real t16 = c1*s4;
-    const puma560_real t17 = c4*s1;
-    const puma560_real t18 = c23*t17 + t16;
-    const puma560_real t19 = c6*(c5*t18 - s1*t15) + s6*t14;
-    const puma560_real t20 = c1*t19;
-    const puma560_real t21 = -(c23*t16 + t17);
-    const puma560_real t22 = c23*t12 - t13;
-    const puma560_real t23 = c6*(-c1*t15 + c5*t22) + s6*t21;
-    const puma560_real t24 = s1*t23;
-    const puma560_real t25 = (t19*t19) + (t23*t23);
-    const puma560_real t26 = 1.0/t25;
-    const puma560_real t27 = t26*(-t20 + t24);
-    const puma560_real t28 = s1*t19;
-    const puma560_real t29 = c1*t23;
-    const puma560_real t30 = -t26*(s23*t28 + s23*t29);
-    const puma560_real t31 = -t26*(t14*t19 + t21*t23);
-    const puma560_real t32 = c5*s23;
-    const puma560_real t33 = -(s1*t32 + s5*t18);
-    const puma560_real t34 = -(c1*t32 + s5*t22);
-    const puma560_real t35 = t26*(t19*t33 + t23*t34);
-    const puma560_real t36 = 1.0/sqrt(t25);
-    const puma560_real t37 = -t36*(t28 + t29);
-    const puma560_real t38 = s23*s4;
-    const puma560_real t39 = c6*(c23*s5 + c4*t32) - s6*t38;
-    const puma560_real t40 = -t27*t39;
-
-    /* Outputs */
-    J[0] = -t1 + t6;
-    J[1] = -c1*t8;
-    J[2] = -c1*t7;
-    J[3] = 0;
-    J[4] = 0;
-    J[5] = 0;
-    J[6] = t11;
-    J[7] = -s1*t8;
-    J[8] = -s1*t7;
-    J[9] = 0;
-    J[10] = 0;
-    J[11] = 0;
-    J[12] = 0;
-    J[13] = c1*t11 + s1*(t1 - t2 + t4 - t5);
-    J[14] = c1*t10 - s1*t6;
-    J[15] = 0;
-    J[16] = 0;
-    J[17] = 0;
-    J[18] = 0;
-    J[19] = t27;
-    J[20] = t27;
-    J[21] = t30;
-    J[22] = t31;
+    J[21] = -t14;
+    J[22] = t12;
     J[23] = t35;
     J[24] = 0;
     J[25] = t37;
     J[26] = t37;
-    J[27] = t36*(s23*t20 - s23*t24);
-    J[28] = t36*(-t14*t23 + t19*t21);
-    J[29] = t36*(-t19*t34 + t23*t33);
+    J[27] = -t20;
+    J[28] = -t9;
+    J[29] = t36;
     J[30] = 1;
-    J[31] = t40;
-    J[32] = t40;
-    J[33] = c23 - t30*t39;
-    J[34] = -t31*t39 + t38;
-    J[35] = -(-c23*c5 + c4*t15 + t35*t39);
+    J[31] = 0;
+    J[32] = 0;
+    J[33] = c23;
+    J[34] = t29;
+    J[35] = t28;
+}
+
+void puma560_jacobian_tool(const puma560_real q[PUMA560_DOF], puma560_real J[6 * PUMA560_DOF])
+{
+    /* 201 operations */
+
+    /* Inputs */
+    const puma560_real q1 = q[0];
+    const puma560_real q2 = q[1];
+    const puma560_real q3 = q[2];
+    const puma560_real q4 = q[3];
+    const puma560_real q5 = q[4];
+    const puma560_real q6 = q[5];
+
+    /* Intermediate terms */
+    const puma560_real c1 = cos(q1);
+    const puma560_real s1 = sin(q1);
+    const puma560_real c2 = cos(q2);
+    const puma560_real s2 = sin(q2);
+    const puma560_real c3 = cos(q3);
+    const puma560_real s3 = sin(q3);
+    const puma560_real c23 = c2*c3 - s2*s3;
+    const puma560_real s23 = c2*s3 + c3*s2;
+    const puma560_real c4 = cos(q4);
+    const puma560_real s4 = sin(q4);
+    const puma560_real c5 = cos(q5);
+    const puma560_real s5 = sin(q5);
+    const puma560_real c6 = cos(q6);
+    const puma560_real s6 = sin(q6);
+    const puma560_real t0 = 0.4318*c23 + 0.0203*s23;
+    const puma560_real t1 = 0.4318*s2 + t0;
+    const puma560_real t2 = 0.0203*c23;
+    const puma560_real t3 = c1*t2 + 0.15005*s1;
+    const puma560_real t4 = -0.15005*c1 + s1*t2;
+    const puma560_real t5 = s1*s4;
+    const puma560_real t6 = c1*c4;
+    const puma560_real t7 = c23*t6 - t5;
+    const puma560_real t8 = -c23*t5 + t6;
+    const puma560_real t9 = c4*s1;
+    const puma560_real t10 = c1*s4;
+    const puma560_real t11 = c23*t10 + t9;
+    const puma560_real t12 = c23*t9 + t10;
+    const puma560_real t13 = c1*s23;
+    const puma560_real t14 = c5*t7 - s5*t13;
+    const puma560_real t15 = c5*t13 + s5*t7;
+    const puma560_real t16 = c6*t14 - s6*t11;
+    const puma560_real t17 = c6*t11 + s6*t14;
+    const puma560_real t18 = -0.4318*t13 + t3;
+    const puma560_real t19 = s1*s23;
+    const puma560_real t20 = c5*t12 - s5*t19;
+    const puma560_real t21 = c5*t19 + s5*t12;
+    const puma560_real t22 = c6*t20 + s6*t8;
+    const puma560_real t23 = c6*t8 - s6*t20;
+    const puma560_real t24 = -0.4318*t19 + t4;
+    const puma560_real t25 = c4*s23;
+    const puma560_real t26 = c23*s5 + c5*t25;
+    const puma560_real t27 = c23*c5 - s5*t25;
+    const puma560_real t28 = s23*s4;
+    const puma560_real t29 = c6*t26 - s6*t28;
+    const puma560_real t30 = c6*t28 + s6*t26;
+    const puma560_real t31 = 0.4318*c2;
+    const puma560_real t32 = c1*t31 + t18;
+    const puma560_real t33 = s1*t31 + t24;
+    const puma560_real t34 = c1*t16;
+    const puma560_real t35 = s1*t22;
+    const puma560_real t36 = c1*t32 + s1*t33;
+    const puma560_real t37 = c1*t18 + s1*t24;
+    const puma560_real t38 = s1*t23;
+    const puma560_real t39 = c1*t15;
+    const puma560_real t40 = s1*t21;
+    const puma560_real t41 = -c1*t22 + s1*t16;
+    const puma560_real t42 = -c1*t23 - s1*t17;
+    const puma560_real t43 = c1*t21 - s1*t15;
+
+    /* Outputs */
+    J[0] = -t16*t33 + t22*t32;
+    J[1] = -t1*t34 - t1*t35 + t29*t36;
+    J[2] = -t0*t34 - t0*t35 + t29*t37;
+    J[3] = 0;
+    J[4] = 0;
+    J[5] = 0;
+    J[6] = t17*t33 + t23*t32;
+    J[7] = c1*t1*t17 - t1*t38 - t30*t36;
+    J[8] = c1*t0*t17 - t0*t38 - t30*t37;
+    J[9] = 0;
+    J[10] = 0;
+    J[11] = 0;
+    J[12] = t15*t33 - t21*t32;
+    J[13] = t1*t39 + t1*t40 + t27*t36;
+    J[14] = t0*t39 + t0*t40 + t27*t37;
+    J[15] = 0;
+    J[16] = 0;
+    J[17] = 0;
+    J[18] = t29;
+    J[19] = t41;
+    J[20] = t41;
+    J[21] = c23*t29 - t13*t16 - t19*t22;
+    J[22] = t11*t16 - t22*t8 + t28*t29;
+    J[23] = -t15*t16 - t21*t22 + t27*t29;
+    J[24] = -t30;
+    J[25] = t42;
+    J[26] = t42;
+    J[27] = c1*s23*t17 - c23*t30 - t19*t23;
+    J[28] = -t11*t17 - t23*t8 - t28*t30;
+    J[29] = t15*t17 - t21*t23 - t27*t30;
+    J[30] = t27;
+    J[31] = t43;
+    J[32] = t43;
+    J[33] = c23*t27 + t13*t15 + t19*t21;
+    J[34] = -t11*t15 + t21*t8 + t27*t28;
+    J[35] = (t15*t15) + (t21*t21) + (t27*t27);
+}
+
+void puma560_task(const puma560_real q[PUMA560_DOF], puma560_real mu[PUMA560_TASK_DIM])
+{
+    /* 90 operations */
+
+    /* Inputs */
+    const puma560_real q1 = q[0];
+    const puma560_real q2 = q[1];
+    const puma560_real q3 = q[2];
+    const puma560_real q4 = q[3];
+    const puma560_real q5 = q[4];
+    const puma560_real q6 = q[5];
+
+    /* Intermediate terms */
+    const puma560_real c1 = cos(q1);
+    const puma560_real s1 = sin(q1);
+    const puma560_real c2 = cos(q2);
+    const puma560_real s2 = sin(q2);
+    const puma560_real c3 = cos(q3);
+    const puma560_real s3 = sin(q3);
+    const puma560_real c23 = c2*c3 - s2*s3;
+    const puma560_real s23 = c2*s3 + c3*s2;
+    const puma560_real c4 = cos(q4);
+    const puma560_real s4 = sin(q4);
+    const puma560_real c5 = cos(q5);
+    const puma560_real s5 = sin(q5);
+    const puma560_real c6 = cos(q6);
+    const puma560_real s6 = sin(q6);
+    const puma560_real t0 = c23*s5 + c4*c5*s23;
+    const puma560_real t1 = 0.4318*c23 + 0.0203*s23;
+    const puma560_real t2 = 0.4318*s2 + t1;
+    const puma560_real t3 = t2 + 0.67183;
+    const puma560_real t4 = 0.0203*c23;
+    const puma560_real t5 = c1*t4 + 0.15005*s1;
+    const puma560_real t6 = -0.15005*c1 + s1*t4;
+    const puma560_real t7 = s1*s4;
+    const puma560_real t8 = c1*c4;
+    const puma560_real t9 = c23*t8 - t7;
+    const puma560_real t10 = -c23*t7 + t8;
+    const puma560_real t11 = c4*s1;
+    const puma560_real t12 = c1*s4;
+    const puma560_real t13 = c23*t12 + t11;
+    const puma560_real t14 = c23*t11 + t12;
+    const puma560_real t15 = s23*s5;
+    const puma560_real t16 = -c1*t15 + c5*t9;
+    const puma560_real t17 = c5*t14 - s1*t15;
+    const puma560_real t18 = c23*c5 - c4*t15;
+    const puma560_real t19 = c6*t16 - s6*t13;
+    const puma560_real t20 = c6*t17 + s6*t10;
+    const puma560_real t21 = s23*s4;
+    const puma560_real t22 = c6*t0 - s6*t21;
+    const puma560_real t23 = c6*t21 + s6*t0;
+    const puma560_real t24 = 0.4318*s23;
+    const puma560_real t25 = -c1*t24 + t5;
+    const puma560_real t26 = -s1*t24 + t6;
+    const puma560_real t27 = 0.4318*c2;
+    const puma560_real t28 = c1*t27 + t25;
+    const puma560_real t29 = s1*t27 + t26;
+
+    /* Outputs */
+    mu[0] = t28;
+    mu[1] = t29;
+    mu[2] = t3;
+    mu[3] = atan2(-t23, t18);
+    mu[4] = atan2(-t22, sqrt((t19*t19) + (t20*t20)));
+    mu[5] = atan2(t20, t19);
+}
+
+void puma560_task_jacobian(const puma560_real q[PUMA560_DOF], puma560_real J[PUMA560_TASK_DIM * PUMA560_DOF])
+{
+    /* 148 operations */
+
+    /* Inputs */
+    const puma560_real q1 = q[0];
+    const puma560_real q2 = q[1];
+    const puma560_real q3 = q[2];
+    const puma560_real q4 = q[3];
+    const puma560_real q5 = q[4];
+    const puma560_real q6 = q[5];
+
+    /* Intermediate terms */
+    const puma560_real c1 = cos(q1);
+    const puma560_real s1 = sin(q1);
+    const puma560_real c2 = cos(q2);
+    const puma560_real s2 = sin(q2);
+    const puma560_real c3 = cos(q3);
+    const puma560_real s3 = sin(q3);
+    const puma560_real c23 = c2*c3 - s2*s3;
+    const puma560_real s23 = c2*s3 + c3*s2;
+    const puma560_real c4 = cos(q4);
+    const puma560_real s4 = sin(q4);
+    const puma560_real c5 = cos(q5);
+    const puma560_real s5 = sin(q5);
+    const puma560_real c6 = cos(q6);
+    const puma560_real s6 = sin(q6);
+    const puma560_real t0 = 0.4318*c23 + 0.0203*s23;
+    const puma560_real t1 = 0.4318*s2 + t0;
+    const puma560_real t2 = 0.0203*c23;
+    const puma560_real t3 = c1*t2 + 0.15005*s1;
+    const puma560_real t4 = -0.15005*c1 + s1*t2;
+    const puma560_real t5 = s1*s4;
+    const puma560_real t6 = c1*c4;
+    const puma560_real t7 = c23*t6 - t5;
+    const puma560_real t8 = -c23*t5 + t6;
+    const puma560_real t9 = c4*s1;
+    const puma560_real t10 = c1*s4;
+    const puma560_real t11 = c23*t10 + t9;
+    const puma560_real t12 = c23*t9 + t10;
+    const puma560_real t13 = c1*s23;
+    const puma560_real t14 = c5*t7 - s5*t13;
+    const puma560_real t15 = c5*t13 + s5*t7;
+    const puma560_real t16 = c6*t14 - s6*t11;
+    const puma560_real t17 = -0.4318*t13 + t3;
+    const puma560_real t18 = s1*s23;
+    const puma560_real t19 = c5*t12 - s5*t18;
+    const puma560_real t20 = c5*t18 + s5*t12;
+    const puma560_real t21 = c6*t19 + s6*t8;
+    const puma560_real t22 = -0.4318*t18 + t4;
+    const puma560_real t23 = c4*s23;
+    const puma560_real t24 = c23*s5 + c5*t23;
+    const puma560_real t25 = c23*c5 - s5*t23;
+    const puma560_real t26 = s23*s4;
+    const puma560_real t27 = c6*t24 - s6*t26;
+    const puma560_real t28 = 0.4318*c2;
+    const puma560_real t29 = c1*t28 + t17;
+    const puma560_real t30 = s1*t28 + t22;
+    const puma560_real t31 = s1*t16;
+    const puma560_real t32 = c1*t21;
+    const puma560_real t33 = (t16*t16) + (t21*t21);
+    const puma560_real t34 = 1.0/t33;
+    const puma560_real t35 = t34*(t31 - t32);
+    const puma560_real t36 = c1*t16;
+    const puma560_real t37 = s1*t21;
+    const puma560_real t38 = -t34*(s23*t36 + s23*t37);
+    const puma560_real t39 = t34*(t11*t16 - t21*t8);
+    const puma560_real t40 = -t34*(t15*t16 + t20*t21);
+    const puma560_real t41 = 1.0/sqrt(t33);
+    const puma560_real t42 = -t41*(t36 + t37);
+    const puma560_real t43 = -t27*t35;
+
+    /* Outputs */
+    J[0] = -t30;
+    J[1] = -c1*t1;
+    J[2] = -c1*t0;
+    J[3] = 0;
+    J[4] = 0;
+    J[5] = 0;
+    J[6] = t29;
+    J[7] = -s1*t1;
+    J[8] = -s1*t0;
+    J[9] = 0;
+    J[10] = 0;
+    J[11] = 0;
+    J[12] = 0;
+    J[13] = c1*t29 + s1*t30;
+    J[14] = c1*t17 + s1*t22;
+    J[15] = 0;
+    J[16] = 0;
+    J[17] = 0;
+    J[18] = 0;
+    J[19] = t35;
+    J[20] = t35;
+    J[21] = t38;
+    J[22] = t39;
+    J[23] = t40;
+    J[24] = 0;
+    J[25] = t42;
+    J[26] = t42;
+    J[27] = t41*(-s23*t31 + s23*t32);
+    J[28] = -t41*(t11*t21 + t16*t8);
+    J[29] = t41*(t15*t21 - t16*t20);
+    J[30] = 1;
+    J[31] = t43;
+    J[32] = t43;
+    J[33] = c23 - t27*t38;
+    J[34] = t26 - t27*t39;
+    J[35] = t25 - t27*t40;
 }
 
 void puma560_singularity_factors(const puma560_real q[PUMA560_DOF], puma560_real f[PUMA560_NUM_SINGULARITY_FACTORS])
 {
-    /* 15 operations */
+    /* 16 operations */
 
     /* Inputs */
     const puma560_real q2 = q[1];
@@ -556,12 +604,12 @@ void puma560_singularity_factors(const puma560_real q[PUMA560_DOF], puma560_real
     /* Outputs */
     f[0] = c3 + t0;
     f[1] = s5;
-    f[2] = -(-0.04701250578971746*c2*c3 + c2*s3 - c2 + c3*s2 + s2*t0);
+    f[2] = 0.04701250578971746*c2*c3 - c2*s3 + c2 - c3*s2 - s2*t0;
 }
 
 puma560_real puma560_manipulability(const puma560_real q[PUMA560_DOF])
 {
-    /* 20 operations */
+    /* 21 operations */
 
     /* Inputs */
     const puma560_real q2 = q[1];
@@ -575,9 +623,10 @@ puma560_real puma560_manipulability(const puma560_real q[PUMA560_DOF])
     const puma560_real s3 = sin(q3);
     const puma560_real s5 = sin(q5);
     const puma560_real t0 = 0.04701250578971746*s3;
+    const puma560_real t1 = -0.080509645432*s5*(c3 + t0)*(-0.04701250578971746*c2*c3 + c2*s3 - c2 + c3*s2 + s2*t0);
 
     /* Outputs */
-    return 0.080509645432*fabs(s5*(c3 + t0)*(-0.04701250578971746*c2*c3 + c2*s3 - c2 + c3*s2 + s2*t0));
+    return fabs(t1);
 }
 
 puma560_real puma560_jacobian_det(const puma560_real q[PUMA560_DOF])

@@ -34,7 +34,7 @@ typedef double puma560_real;
 #define PUMA560_NUM_SINGULARITY_FACTORS 3
 
 /* Pose of the tool frame in the world frame (4x4 homogeneous).
- * Result: T: 4 x 4 row-major, element (r, c) at T[r * 4 + c]. 92 operations. */
+ * Result: T: 4 x 4 row-major, element (r, c) at T[r * 4 + c]. 96 operations. */
 void puma560_fk(const puma560_real q[PUMA560_DOF], puma560_real T[16]);
 
 /* Geometric Jacobian in the world frame (6 x DOF, rows vx vy vz wx wy wz).
@@ -42,27 +42,27 @@ void puma560_fk(const puma560_real q[PUMA560_DOF], puma560_real T[16]);
 void puma560_jacobian(const puma560_real q[PUMA560_DOF], puma560_real J[6 * PUMA560_DOF]);
 
 /* Fk and jacobian in one pass, sharing their terms.
- * Result: T: 4 x 4 row-major, element (r, c) at T[r * 4 + c]; J: 6 x 6 row-major, element (r, c) at J[r * 6 + c]. 114 operations. */
+ * Result: T: 4 x 4 row-major, element (r, c) at T[r * 4 + c]; J: 6 x 6 row-major, element (r, c) at J[r * 6 + c]. 115 operations. */
 void puma560_fk_jacobian(const puma560_real q[PUMA560_DOF], puma560_real T[16], puma560_real J[6 * PUMA560_DOF]);
 
 /* Geometric Jacobian in the tool frame (6 x DOF, rows vx vy vz wx wy wz).
- * Result: J: 6 x 6 row-major, element (r, c) at J[r * 6 + c]. 202 operations. */
+ * Result: J: 6 x 6 row-major, element (r, c) at J[r * 6 + c]. 201 operations. */
 void puma560_jacobian_tool(const puma560_real q[PUMA560_DOF], puma560_real J[6 * PUMA560_DOF]);
 
 /* Task vector mu = (x, y, z, roll, pitch, yaw).
- * Result: mu[i], i < 6. 88 operations. */
+ * Result: mu[i], i < 6. 90 operations. */
 void puma560_task(const puma560_real q[PUMA560_DOF], puma560_real mu[PUMA560_TASK_DIM]);
 
 /* Analytic Jacobian d mu / d q (6 x DOF).
- * Result: J: 6 x 6 row-major, element (r, c) at J[r * 6 + c]. 149 operations. */
+ * Result: J: 6 x 6 row-major, element (r, c) at J[r * 6 + c]. 148 operations. */
 void puma560_task_jacobian(const puma560_real q[PUMA560_DOF], puma560_real J[PUMA560_TASK_DIM * PUMA560_DOF]);
 
 /* Factors of det(Js): the robot is singular where one is 0.
- * Result: f[i], i < 3. 15 operations. */
+ * Result: f[i], i < 3. 16 operations. */
 void puma560_singularity_factors(const puma560_real q[PUMA560_DOF], puma560_real f[PUMA560_NUM_SINGULARITY_FACTORS]);
 
 /* Manipulability |det(Js)|.
- * Result: returned as a scalar. 20 operations. */
+ * Result: returned as a scalar. 21 operations. */
 puma560_real puma560_manipulability(const puma560_real q[PUMA560_DOF]);
 
 /* Det(Js).

@@ -27,24 +27,31 @@ void rexarm_fk(const rexarm_real q[REXARM_DOF], rexarm_real T[16])
     const rexarm_real s4 = sin(q4);
     const rexarm_real c234 = c23*c4 - s23*s4;
     const rexarm_real s234 = c23*s4 + c4*s23;
-    const rexarm_real t0 = c1*c234;
-    const rexarm_real t1 = 0.1*c1;
-    const rexarm_real t2 = c234*s1;
-    const rexarm_real t3 = 0.1*s1;
+    const rexarm_real t0 = 0.1*s23 + 0.1*s234;
+    const rexarm_real t1 = 0.1*s2 + t0;
+    const rexarm_real t2 = t1 + 0.12;
+    const rexarm_real t3 = 0.1*c23;
+    const rexarm_real t4 = c1*c234;
+    const rexarm_real t5 = c1*t3 + 0.1*t4;
+    const rexarm_real t6 = c234*s1;
+    const rexarm_real t7 = s1*t3 + 0.1*t6;
+    const rexarm_real t8 = 0.1*c2;
+    const rexarm_real t9 = c1*t8 + t5;
+    const rexarm_real t10 = s1*t8 + t7;
 
     /* Outputs */
-    T[0] = t0;
+    T[0] = t4;
     T[1] = -s1;
     T[2] = -c1*s234;
-    T[3] = c2*t1 + c23*t1 + 0.1*t0;
-    T[4] = t2;
+    T[3] = t9;
+    T[4] = t6;
     T[5] = c1;
     T[6] = -s1*s234;
-    T[7] = c2*t3 + c23*t3 + 0.1*t2;
+    T[7] = t10;
     T[8] = s234;
     T[9] = 0;
     T[10] = c234;
-    T[11] = 0.1*s2 + 0.1*s23 + 0.1*s234 + 0.12;
+    T[11] = t2;
     T[12] = 0;
     T[13] = 0;
     T[14] = 0;
@@ -74,30 +81,30 @@ void rexarm_jacobian(const rexarm_real q[REXARM_DOF], rexarm_real J[6 * REXARM_D
     const rexarm_real s4 = sin(q4);
     const rexarm_real c234 = c23*c4 - s23*s4;
     const rexarm_real s234 = c23*s4 + c4*s23;
-    const rexarm_real t0 = 0.1*s1;
+    const rexarm_real t0 = 0.1*c1;
     const rexarm_real t1 = c23*t0 + c234*t0;
     const rexarm_real t2 = c2*t0 + t1;
-    const rexarm_real t3 = 0.1*s234;
-    const rexarm_real t4 = 0.1*s23 + t3;
-    const rexarm_real t5 = 0.1*s2 + t4;
-    const rexarm_real t6 = 0.1*c1;
-    const rexarm_real t7 = c23*t6 + c234*t6;
-    const rexarm_real t8 = c2*t6 + t7;
+    const rexarm_real t3 = 0.1*s1;
+    const rexarm_real t4 = c23*t3 + c234*t3;
+    const rexarm_real t5 = c2*t3 + t4;
+    const rexarm_real t6 = 0.1*s234;
+    const rexarm_real t7 = 0.1*s23 + t6;
+    const rexarm_real t8 = 0.1*s2 + t7;
     const rexarm_real t9 = 0.1*c234;
     const rexarm_real t10 = -c1;
 
     /* Outputs */
-    J[0] = -t2;
-    J[1] = -c1*t5;
-    J[2] = -c1*t4;
-    J[3] = -c1*t3;
-    J[4] = t8;
-    J[5] = -s1*t5;
-    J[6] = -s1*t4;
-    J[7] = -s1*t3;
+    J[0] = -t5;
+    J[1] = -c1*t8;
+    J[2] = -c1*t7;
+    J[3] = -c1*t6;
+    J[4] = t2;
+    J[5] = -s1*t8;
+    J[6] = -s1*t7;
+    J[7] = -s1*t6;
     J[8] = 0;
-    J[9] = c1*t8 + s1*t2;
-    J[10] = c1*t7 + s1*t1;
+    J[9] = c1*t2 + s1*t5;
+    J[10] = c1*t1 + s1*t4;
     J[11] = t9*(c1*c1) + t9*(s1*s1);
     J[12] = 0;
     J[13] = s1;
@@ -136,49 +143,49 @@ void rexarm_fk_jacobian(const rexarm_real q[REXARM_DOF], rexarm_real T[16], rexa
     const rexarm_real s4 = sin(q4);
     const rexarm_real c234 = c23*c4 - s23*s4;
     const rexarm_real s234 = c23*s4 + c4*s23;
-    const rexarm_real t0 = c1*c234;
-    const rexarm_real t1 = c1*s234;
-    const rexarm_real t2 = 0.1*c1;
-    const rexarm_real t3 = c23*t2 + 0.1*t0;
-    const rexarm_real t4 = c2*t2 + t3;
-    const rexarm_real t5 = c234*s1;
-    const rexarm_real t6 = s1*s234;
-    const rexarm_real t7 = 0.1*s1;
-    const rexarm_real t8 = c23*t7 + 0.1*t5;
-    const rexarm_real t9 = c2*t7 + t8;
-    const rexarm_real t10 = 0.1*s23 + 0.1*s234;
-    const rexarm_real t11 = 0.1*s2 + t10;
+    const rexarm_real t0 = 0.1*c23;
+    const rexarm_real t1 = c1*c234;
+    const rexarm_real t2 = c1*t0 + 0.1*t1;
+    const rexarm_real t3 = c234*s1;
+    const rexarm_real t4 = s1*t0 + 0.1*t3;
+    const rexarm_real t5 = 0.1*s234;
+    const rexarm_real t6 = 0.1*s23 + t5;
+    const rexarm_real t7 = 0.1*s2 + t6;
+    const rexarm_real t8 = t7 + 0.12;
+    const rexarm_real t9 = 0.1*c2;
+    const rexarm_real t10 = c1*t9 + t2;
+    const rexarm_real t11 = s1*t9 + t4;
     const rexarm_real t12 = 0.1*c234;
     const rexarm_real t13 = -c1;
 
     /* Outputs */
-    T[0] = t0;
+    T[0] = t1;
     T[1] = -s1;
-    T[2] = -t1;
-    T[3] = t4;
-    T[4] = t5;
+    T[2] = -c1*s234;
+    T[3] = t10;
+    T[4] = t3;
     T[5] = c1;
-    T[6] = -t6;
-    T[7] = t9;
+    T[6] = -s1*s234;
+    T[7] = t11;
     T[8] = s234;
     T[9] = 0;
     T[10] = c234;
-    T[11] = t11 + 0.12;
+    T[11] = t8;
     T[12] = 0;
     T[13] = 0;
     T[14] = 0;
     T[15] = 1;
-    J[0] = -t9;
-    J[1] = -c1*t11;
-    J[2] = -c1*t10;
-    J[3] = -0.1*t1;
-    J[4] = t4;
-    J[5] = -s1*t11;
-    J[6] = -s1*t10;
-    J[7] = -0.1*t6;
+    J[0] = -t11;
+    J[1] = -c1*t7;
+    J[2] = -c1*t6;
+    J[3] = -c1*t5;
+    J[4] = t10;
+    J[5] = -s1*t7;
+    J[6] = -s1*t6;
+    J[7] = -s1*t5;
     J[8] = 0;
-    J[9] = c1*t4 + s1*t9;
-    J[10] = c1*t3 + s1*t8;
+    J[9] = c1*t10 + s1*t11;
+    J[10] = c1*t2 + s1*t4;
     J[11] = t12*(c1*c1) + t12*(s1*s1);
     J[12] = 0;
     J[13] = s1;
@@ -196,7 +203,7 @@ void rexarm_fk_jacobian(const rexarm_real q[REXARM_DOF], rexarm_real T[16], rexa
 
 void rexarm_jacobian_tool(const rexarm_real q[REXARM_DOF], rexarm_real J[6 * REXARM_DOF])
 {
-    /* 100 operations */
+    /* 97 operations */
 
     /* Inputs */
     const rexarm_real q1 = q[0];
@@ -217,54 +224,52 @@ void rexarm_jacobian_tool(const rexarm_real q[REXARM_DOF], rexarm_real J[6 * REX
     const rexarm_real s4 = sin(q4);
     const rexarm_real c234 = c23*c4 - s23*s4;
     const rexarm_real s234 = c23*s4 + c4*s23;
-    const rexarm_real t0 = 0.1*s1;
+    const rexarm_real t0 = 0.1*c1;
     const rexarm_real t1 = c23*t0 + c234*t0;
     const rexarm_real t2 = c2*t0 + t1;
-    const rexarm_real t3 = -t2;
-    const rexarm_real t4 = c1*c234;
-    const rexarm_real t5 = 0.1*c1;
-    const rexarm_real t6 = c23*t5 + 0.1*t4;
-    const rexarm_real t7 = c2*t5 + t6;
-    const rexarm_real t8 = s1*t7;
-    const rexarm_real t9 = (c1*c1);
-    const rexarm_real t10 = 0.1*s234;
-    const rexarm_real t11 = 0.1*s23 + t10;
-    const rexarm_real t12 = 0.1*s2 + t11;
-    const rexarm_real t13 = c234*t12;
-    const rexarm_real t14 = (s1*s1);
-    const rexarm_real t15 = c1*t7;
-    const rexarm_real t16 = s1*t2 + t15;
-    const rexarm_real t17 = c234*t11;
-    const rexarm_real t18 = c1*t6 + s1*t1;
-    const rexarm_real t19 = c234*t10;
-    const rexarm_real t20 = 0.1*c234;
-    const rexarm_real t21 = t14*t20 + t20*t9;
-    const rexarm_real t22 = s234*t12;
-    const rexarm_real t23 = s234*t11;
-    const rexarm_real t24 = 0.1*(s234*s234);
-    const rexarm_real t25 = -(t14 + t9);
+    const rexarm_real t3 = 0.1*s1;
+    const rexarm_real t4 = c23*t3 + c234*t3;
+    const rexarm_real t5 = c2*t3 + t4;
+    const rexarm_real t6 = 0.1*s234;
+    const rexarm_real t7 = 0.1*s23 + t6;
+    const rexarm_real t8 = 0.1*s2 + t7;
+    const rexarm_real t9 = s1*t2;
+    const rexarm_real t10 = c1*t5;
+    const rexarm_real t11 = (c1*c1);
+    const rexarm_real t12 = c234*t8;
+    const rexarm_real t13 = (s1*s1);
+    const rexarm_real t14 = c1*t2 + s1*t5;
+    const rexarm_real t15 = c234*t7;
+    const rexarm_real t16 = c1*t1 + s1*t4;
+    const rexarm_real t17 = c234*t6;
+    const rexarm_real t18 = 0.1*c234;
+    const rexarm_real t19 = t11*t18 + t13*t18;
+    const rexarm_real t20 = s234*t8;
+    const rexarm_real t21 = s234*t7;
+    const rexarm_real t22 = 0.1*(s234*s234);
+    const rexarm_real t23 = -t11 - t13;
 
     /* Outputs */
-    J[0] = c234*t8 + t3*t4;
-    J[1] = -(-s234*t16 + t13*t14 + t13*t9);
-    J[2] = -(-s234*t18 + t14*t17 + t17*t9);
-    J[3] = -(-s234*t21 + t14*t19 + t19*t9);
-    J[4] = -s1*t3 + t15;
+    J[0] = -c234*t10 + c234*t9;
+    J[1] = s234*t14 - t11*t12 - t12*t13;
+    J[2] = s234*t16 - t11*t15 - t13*t15;
+    J[3] = s234*t19 - t11*t17 - t13*t17;
+    J[4] = t14;
     J[5] = 0;
     J[6] = 0;
     J[7] = 0;
-    J[8] = -(c1*s234*t3 + s234*t8);
-    J[9] = c234*t16 + t14*t22 + t22*t9;
-    J[10] = c234*t18 + t14*t23 + t23*t9;
-    J[11] = c234*t21 + t14*t24 + t24*t9;
+    J[8] = s234*t10 - s234*t9;
+    J[9] = c234*t14 + t11*t20 + t13*t20;
+    J[10] = c234*t16 + t11*t21 + t13*t21;
+    J[11] = c234*t19 + t11*t22 + t13*t22;
     J[12] = s234;
     J[13] = 0;
     J[14] = 0;
     J[15] = 0;
     J[16] = 0;
-    J[17] = t25;
-    J[18] = t25;
-    J[19] = t25;
+    J[17] = t23;
+    J[18] = t23;
+    J[19] = t23;
     J[20] = c234;
     J[21] = 0;
     J[22] = 0;
@@ -294,15 +299,22 @@ void rexarm_task(const rexarm_real q[REXARM_DOF], rexarm_real mu[REXARM_TASK_DIM
     const rexarm_real s4 = sin(q4);
     const rexarm_real c234 = c23*c4 - s23*s4;
     const rexarm_real s234 = c23*s4 + c4*s23;
-    const rexarm_real t0 = 0.1*c1;
-    const rexarm_real t1 = 0.1*s1;
-    const rexarm_real t2 = (c234*c234);
+    const rexarm_real t0 = 0.1*s23 + 0.1*s234;
+    const rexarm_real t1 = 0.1*s2 + t0;
+    const rexarm_real t2 = t1 + 0.12;
+    const rexarm_real t3 = 0.1*c1;
+    const rexarm_real t4 = c23*t3 + c234*t3;
+    const rexarm_real t5 = c2*t3 + t4;
+    const rexarm_real t6 = 0.1*s1;
+    const rexarm_real t7 = c23*t6 + c234*t6;
+    const rexarm_real t8 = c2*t6 + t7;
+    const rexarm_real t9 = (c234*c234);
 
     /* Outputs */
-    mu[0] = c2*t0 + c23*t0 + c234*t0;
-    mu[1] = c2*t1 + c23*t1 + c234*t1;
-    mu[2] = 0.1*s2 + 0.1*s23 + 0.1*s234 + 0.12;
-    mu[3] = atan2(-s234, sqrt(t2*(c1*c1) + t2*(s1*s1)));
+    mu[0] = t5;
+    mu[1] = t8;
+    mu[2] = t2;
+    mu[3] = atan2(-s234, sqrt(t9*(c1*c1) + t9*(s1*s1)));
 }
 
 void rexarm_task_jacobian(const rexarm_real q[REXARM_DOF], rexarm_real J[REXARM_TASK_DIM * REXARM_DOF])
@@ -328,15 +340,15 @@ void rexarm_task_jacobian(const rexarm_real q[REXARM_DOF], rexarm_real J[REXARM_
     const rexarm_real s4 = sin(q4);
     const rexarm_real c234 = c23*c4 - s23*s4;
     const rexarm_real s234 = c23*s4 + c4*s23;
-    const rexarm_real t0 = 0.1*s1;
+    const rexarm_real t0 = 0.1*c1;
     const rexarm_real t1 = c23*t0 + c234*t0;
     const rexarm_real t2 = c2*t0 + t1;
-    const rexarm_real t3 = 0.1*s234;
-    const rexarm_real t4 = 0.1*s23 + t3;
-    const rexarm_real t5 = 0.1*s2 + t4;
-    const rexarm_real t6 = 0.1*c1;
-    const rexarm_real t7 = c23*t6 + c234*t6;
-    const rexarm_real t8 = c2*t6 + t7;
+    const rexarm_real t3 = 0.1*s1;
+    const rexarm_real t4 = c23*t3 + c234*t3;
+    const rexarm_real t5 = c2*t3 + t4;
+    const rexarm_real t6 = 0.1*s234;
+    const rexarm_real t7 = 0.1*s23 + t6;
+    const rexarm_real t8 = 0.1*s2 + t7;
     const rexarm_real t9 = (c1*c1);
     const rexarm_real t10 = c234*t9;
     const rexarm_real t11 = (s1*s1);
@@ -345,17 +357,17 @@ void rexarm_task_jacobian(const rexarm_real q[REXARM_DOF], rexarm_real J[REXARM_
     const rexarm_real t14 = -(t10 + t12)/sqrt(t11*t13 + t13*t9);
 
     /* Outputs */
-    J[0] = -t2;
-    J[1] = -c1*t5;
-    J[2] = -c1*t4;
-    J[3] = -c1*t3;
-    J[4] = t8;
-    J[5] = -s1*t5;
-    J[6] = -s1*t4;
-    J[7] = -s1*t3;
+    J[0] = -t5;
+    J[1] = -c1*t8;
+    J[2] = -c1*t7;
+    J[3] = -c1*t6;
+    J[4] = t2;
+    J[5] = -s1*t8;
+    J[6] = -s1*t7;
+    J[7] = -s1*t6;
     J[8] = 0;
-    J[9] = c1*t8 + s1*t2;
-    J[10] = c1*t7 + s1*t1;
+    J[9] = c1*t2 + s1*t5;
+    J[10] = c1*t1 + s1*t4;
     J[11] = 0.1*t10 + 0.1*t12;
     J[12] = 0;
     J[13] = t14;
@@ -365,7 +377,7 @@ void rexarm_task_jacobian(const rexarm_real q[REXARM_DOF], rexarm_real J[REXARM_
 
 void rexarm_singularity_factors(const rexarm_real q[REXARM_DOF], rexarm_real f[REXARM_NUM_SINGULARITY_FACTORS])
 {
-    /* 20 operations */
+    /* 22 operations */
 
     /* Inputs */
     const rexarm_real q2 = q[1];
@@ -383,12 +395,12 @@ void rexarm_singularity_factors(const rexarm_real q[REXARM_DOF], rexarm_real f[R
 
     /* Outputs */
     f[0] = s3;
-    f[1] = -(-c2*c3*c4 - c2*c3 + c2*s3*s4 - c2 + c3*s2*s4 + c4*t0 + t0);
+    f[1] = c2*c3*c4 + c2*c3 - c2*s3*s4 + c2 - c3*s2*s4 - c4*t0 - t0;
 }
 
 rexarm_real rexarm_manipulability(const rexarm_real q[REXARM_DOF])
 {
-    /* 45 operations */
+    /* 46 operations */
 
     /* Inputs */
     const rexarm_real q1 = q[0];
@@ -410,11 +422,11 @@ rexarm_real rexarm_manipulability(const rexarm_real q[REXARM_DOF])
     const rexarm_real c234 = c23*c4 - s23*s4;
     const rexarm_real t0 = (c234*c234);
     const rexarm_real t1 = s2*s3;
-    const rexarm_real t2 = c2*c3;
-    const rexarm_real t3 = c2*s3*s4 + c3*s2*s4 + c4*t1 - c4*t2;
+    const rexarm_real t2 = -c2*c3*c4 + c2*s3*s4 + c3*s2*s4 + c4*t1;
+    const rexarm_real t3 = 0.001*s3*t2*(-c2*c3 - c2 + t1 + t2)/sqrt(t0*(c1*c1) + t0*(s1*s1));
 
     /* Outputs */
-    return 0.001*fabs(s3*t3*(-c2 + t1 - t2 + t3))/sqrt(t0*(c1*c1) + t0*(s1*s1));
+    return fabs(t3);
 }
 
 rexarm_real rexarm_jacobian_det(const rexarm_real q[REXARM_DOF])

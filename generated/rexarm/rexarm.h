@@ -44,7 +44,7 @@ void rexarm_jacobian(const rexarm_real q[REXARM_DOF], rexarm_real J[6 * REXARM_D
 void rexarm_fk_jacobian(const rexarm_real q[REXARM_DOF], rexarm_real T[16], rexarm_real J[6 * REXARM_DOF]);
 
 /* Geometric Jacobian in the tool frame (6 x DOF, rows vx vy vz wx wy wz).
- * Result: J: 6 x 4 row-major, element (r, c) at J[r * 4 + c]. 100 operations. */
+ * Result: J: 6 x 4 row-major, element (r, c) at J[r * 4 + c]. 97 operations. */
 void rexarm_jacobian_tool(const rexarm_real q[REXARM_DOF], rexarm_real J[6 * REXARM_DOF]);
 
 /* Task vector mu = (x, y, z, pitch).
@@ -56,11 +56,11 @@ void rexarm_task(const rexarm_real q[REXARM_DOF], rexarm_real mu[REXARM_TASK_DIM
 void rexarm_task_jacobian(const rexarm_real q[REXARM_DOF], rexarm_real J[REXARM_TASK_DIM * REXARM_DOF]);
 
 /* Factors of det(Js): the robot is singular where one is 0.
- * Result: f[i], i < 2. 20 operations. */
+ * Result: f[i], i < 2. 22 operations. */
 void rexarm_singularity_factors(const rexarm_real q[REXARM_DOF], rexarm_real f[REXARM_NUM_SINGULARITY_FACTORS]);
 
 /* Manipulability |det(Js)|.
- * Result: returned as a scalar. 45 operations. */
+ * Result: returned as a scalar. 46 operations. */
 rexarm_real rexarm_manipulability(const rexarm_real q[REXARM_DOF]);
 
 /* Det(Js).

@@ -31,22 +31,29 @@ def _fk(q):
     s4 = casadi.sin(q4)
     c234 = c23*c4 - s23*s4
     s234 = c23*s4 + c4*s23
-    t0 = c1*c234
-    t1 = 0.1*c1
-    t2 = c234*s1
-    t3 = 0.1*s1
+    t0 = 0.1*s23 + 0.1*s234
+    t1 = 0.1*s2 + t0
+    t2 = t1 + 0.12
+    t3 = 0.1*c23
+    t4 = c1*c234
+    t5 = c1*t3 + 0.1*t4
+    t6 = c234*s1
+    t7 = s1*t3 + 0.1*t6
+    t8 = 0.1*c2
+    t9 = c1*t8 + t5
+    t10 = s1*t8 + t7
     T = casadi.SX(4, 4)
-    T[0, 0] = t0
+    T[0, 0] = t4
     T[0, 1] = -s1
     T[0, 2] = -c1*s234
-    T[0, 3] = c2*t1 + c23*t1 + 0.1*t0
-    T[1, 0] = t2
+    T[0, 3] = t9
+    T[1, 0] = t6
     T[1, 1] = c1
     T[1, 2] = -s1*s234
-    T[1, 3] = c2*t3 + c23*t3 + 0.1*t2
+    T[1, 3] = t10
     T[2, 0] = s234
     T[2, 2] = c234
-    T[2, 3] = 0.1*s2 + 0.1*s23 + 0.1*s234 + 0.12
+    T[2, 3] = t2
     T[3, 3] = 1
     return [T]
 
@@ -69,28 +76,28 @@ def _jacobian(q):
     s4 = casadi.sin(q4)
     c234 = c23*c4 - s23*s4
     s234 = c23*s4 + c4*s23
-    t0 = 0.1*s1
+    t0 = 0.1*c1
     t1 = c23*t0 + c234*t0
     t2 = c2*t0 + t1
-    t3 = 0.1*s234
-    t4 = 0.1*s23 + t3
-    t5 = 0.1*s2 + t4
-    t6 = 0.1*c1
-    t7 = c23*t6 + c234*t6
-    t8 = c2*t6 + t7
+    t3 = 0.1*s1
+    t4 = c23*t3 + c234*t3
+    t5 = c2*t3 + t4
+    t6 = 0.1*s234
+    t7 = 0.1*s23 + t6
+    t8 = 0.1*s2 + t7
     t9 = 0.1*c234
     t10 = -c1
     J = casadi.SX(6, 4)
-    J[0, 0] = -t2
-    J[0, 1] = -c1*t5
-    J[0, 2] = -c1*t4
-    J[0, 3] = -c1*t3
-    J[1, 0] = t8
-    J[1, 1] = -s1*t5
-    J[1, 2] = -s1*t4
-    J[1, 3] = -s1*t3
-    J[2, 1] = c1*t8 + s1*t2
-    J[2, 2] = c1*t7 + s1*t1
+    J[0, 0] = -t5
+    J[0, 1] = -c1*t8
+    J[0, 2] = -c1*t7
+    J[0, 3] = -c1*t6
+    J[1, 0] = t2
+    J[1, 1] = -s1*t8
+    J[1, 2] = -s1*t7
+    J[1, 3] = -s1*t6
+    J[2, 1] = c1*t2 + s1*t5
+    J[2, 2] = c1*t1 + s1*t4
     J[2, 3] = c1**2*t9 + s1**2*t9
     J[3, 1] = s1
     J[3, 2] = s1
@@ -120,44 +127,44 @@ def _fk_jacobian(q):
     s4 = casadi.sin(q4)
     c234 = c23*c4 - s23*s4
     s234 = c23*s4 + c4*s23
-    t0 = c1*c234
-    t1 = c1*s234
-    t2 = 0.1*c1
-    t3 = c23*t2 + 0.1*t0
-    t4 = c2*t2 + t3
-    t5 = c234*s1
-    t6 = s1*s234
-    t7 = 0.1*s1
-    t8 = c23*t7 + 0.1*t5
-    t9 = c2*t7 + t8
-    t10 = 0.1*s23 + 0.1*s234
-    t11 = 0.1*s2 + t10
+    t0 = 0.1*c23
+    t1 = c1*c234
+    t2 = c1*t0 + 0.1*t1
+    t3 = c234*s1
+    t4 = s1*t0 + 0.1*t3
+    t5 = 0.1*s234
+    t6 = 0.1*s23 + t5
+    t7 = 0.1*s2 + t6
+    t8 = t7 + 0.12
+    t9 = 0.1*c2
+    t10 = c1*t9 + t2
+    t11 = s1*t9 + t4
     t12 = 0.1*c234
     t13 = -c1
     T = casadi.SX(4, 4)
-    T[0, 0] = t0
+    T[0, 0] = t1
     T[0, 1] = -s1
-    T[0, 2] = -t1
-    T[0, 3] = t4
-    T[1, 0] = t5
+    T[0, 2] = -c1*s234
+    T[0, 3] = t10
+    T[1, 0] = t3
     T[1, 1] = c1
-    T[1, 2] = -t6
-    T[1, 3] = t9
+    T[1, 2] = -s1*s234
+    T[1, 3] = t11
     T[2, 0] = s234
     T[2, 2] = c234
-    T[2, 3] = t11 + 0.12
+    T[2, 3] = t8
     T[3, 3] = 1
     J = casadi.SX(6, 4)
-    J[0, 0] = -t9
-    J[0, 1] = -c1*t11
-    J[0, 2] = -c1*t10
-    J[0, 3] = -0.1*t1
-    J[1, 0] = t4
-    J[1, 1] = -s1*t11
-    J[1, 2] = -s1*t10
-    J[1, 3] = -0.1*t6
-    J[2, 1] = c1*t4 + s1*t9
-    J[2, 2] = c1*t3 + s1*t8
+    J[0, 0] = -t11
+    J[0, 1] = -c1*t7
+    J[0, 2] = -c1*t6
+    J[0, 3] = -c1*t5
+    J[1, 0] = t10
+    J[1, 1] = -s1*t7
+    J[1, 2] = -s1*t6
+    J[1, 3] = -s1*t5
+    J[2, 1] = c1*t10 + s1*t11
+    J[2, 2] = c1*t2 + s1*t4
     J[2, 3] = c1**2*t12 + s1**2*t12
     J[3, 1] = s1
     J[3, 2] = s1
@@ -170,7 +177,7 @@ def _fk_jacobian(q):
 
 
 def _jacobian_tool(q):
-    """Geometric Jacobian in the tool frame (6 x DOF, rows vx vy vz wx wy wz): 100 operations."""
+    """Geometric Jacobian in the tool frame (6 x DOF, rows vx vy vz wx wy wz): 97 operations."""
     q1 = q[0]
     q2 = q[1]
     q3 = q[2]
@@ -187,46 +194,44 @@ def _jacobian_tool(q):
     s4 = casadi.sin(q4)
     c234 = c23*c4 - s23*s4
     s234 = c23*s4 + c4*s23
-    t0 = 0.1*s1
+    t0 = 0.1*c1
     t1 = c23*t0 + c234*t0
     t2 = c2*t0 + t1
-    t3 = -t2
-    t4 = c1*c234
-    t5 = 0.1*c1
-    t6 = c23*t5 + 0.1*t4
-    t7 = c2*t5 + t6
-    t8 = s1*t7
-    t9 = c1**2
-    t10 = 0.1*s234
-    t11 = 0.1*s23 + t10
-    t12 = 0.1*s2 + t11
-    t13 = c234*t12
-    t14 = s1**2
-    t15 = c1*t7
-    t16 = s1*t2 + t15
-    t17 = c234*t11
-    t18 = c1*t6 + s1*t1
-    t19 = c234*t10
-    t20 = 0.1*c234
-    t21 = t14*t20 + t20*t9
-    t22 = s234*t12
-    t23 = s234*t11
-    t24 = 0.1*s234**2
-    t25 = -(t14 + t9)
+    t3 = 0.1*s1
+    t4 = c23*t3 + c234*t3
+    t5 = c2*t3 + t4
+    t6 = 0.1*s234
+    t7 = 0.1*s23 + t6
+    t8 = 0.1*s2 + t7
+    t9 = s1*t2
+    t10 = c1*t5
+    t11 = c1**2
+    t12 = c234*t8
+    t13 = s1**2
+    t14 = c1*t2 + s1*t5
+    t15 = c234*t7
+    t16 = c1*t1 + s1*t4
+    t17 = c234*t6
+    t18 = 0.1*c234
+    t19 = t11*t18 + t13*t18
+    t20 = s234*t8
+    t21 = s234*t7
+    t22 = 0.1*s234**2
+    t23 = -t11 - t13
     J = casadi.SX(6, 4)
-    J[0, 0] = c234*t8 + t3*t4
-    J[0, 1] = -(-s234*t16 + t13*t14 + t13*t9)
-    J[0, 2] = -(-s234*t18 + t14*t17 + t17*t9)
-    J[0, 3] = -(-s234*t21 + t14*t19 + t19*t9)
-    J[1, 0] = -s1*t3 + t15
-    J[2, 0] = -(c1*s234*t3 + s234*t8)
-    J[2, 1] = c234*t16 + t14*t22 + t22*t9
-    J[2, 2] = c234*t18 + t14*t23 + t23*t9
-    J[2, 3] = c234*t21 + t14*t24 + t24*t9
+    J[0, 0] = -c234*t10 + c234*t9
+    J[0, 1] = s234*t14 - t11*t12 - t12*t13
+    J[0, 2] = s234*t16 - t11*t15 - t13*t15
+    J[0, 3] = s234*t19 - t11*t17 - t13*t17
+    J[1, 0] = t14
+    J[2, 0] = s234*t10 - s234*t9
+    J[2, 1] = c234*t14 + t11*t20 + t13*t20
+    J[2, 2] = c234*t16 + t11*t21 + t13*t21
+    J[2, 3] = c234*t19 + t11*t22 + t13*t22
     J[3, 0] = s234
-    J[4, 1] = t25
-    J[4, 2] = t25
-    J[4, 3] = t25
+    J[4, 1] = t23
+    J[4, 2] = t23
+    J[4, 3] = t23
     J[5, 0] = c234
     return [J]
 
@@ -249,14 +254,21 @@ def _task(q):
     s4 = casadi.sin(q4)
     c234 = c23*c4 - s23*s4
     s234 = c23*s4 + c4*s23
-    t0 = 0.1*c1
-    t1 = 0.1*s1
-    t2 = c234**2
+    t0 = 0.1*s23 + 0.1*s234
+    t1 = 0.1*s2 + t0
+    t2 = t1 + 0.12
+    t3 = 0.1*c1
+    t4 = c23*t3 + c234*t3
+    t5 = c2*t3 + t4
+    t6 = 0.1*s1
+    t7 = c23*t6 + c234*t6
+    t8 = c2*t6 + t7
+    t9 = c234**2
     mu = casadi.SX(4, 1)
-    mu[0, 0] = c2*t0 + c23*t0 + c234*t0
-    mu[1, 0] = c2*t1 + c23*t1 + c234*t1
-    mu[2, 0] = 0.1*s2 + 0.1*s23 + 0.1*s234 + 0.12
-    mu[3, 0] = casadi.atan2(-s234, casadi.sqrt(c1**2*t2 + s1**2*t2))
+    mu[0, 0] = t5
+    mu[1, 0] = t8
+    mu[2, 0] = t2
+    mu[3, 0] = casadi.atan2(-s234, casadi.sqrt(c1**2*t9 + s1**2*t9))
     return [mu]
 
 
@@ -278,15 +290,15 @@ def _task_jacobian(q):
     s4 = casadi.sin(q4)
     c234 = c23*c4 - s23*s4
     s234 = c23*s4 + c4*s23
-    t0 = 0.1*s1
+    t0 = 0.1*c1
     t1 = c23*t0 + c234*t0
     t2 = c2*t0 + t1
-    t3 = 0.1*s234
-    t4 = 0.1*s23 + t3
-    t5 = 0.1*s2 + t4
-    t6 = 0.1*c1
-    t7 = c23*t6 + c234*t6
-    t8 = c2*t6 + t7
+    t3 = 0.1*s1
+    t4 = c23*t3 + c234*t3
+    t5 = c2*t3 + t4
+    t6 = 0.1*s234
+    t7 = 0.1*s23 + t6
+    t8 = 0.1*s2 + t7
     t9 = c1**2
     t10 = c234*t9
     t11 = s1**2
@@ -294,16 +306,16 @@ def _task_jacobian(q):
     t13 = c234**2
     t14 = -(t10 + t12)/casadi.sqrt(t11*t13 + t13*t9)
     J = casadi.SX(4, 4)
-    J[0, 0] = -t2
-    J[0, 1] = -c1*t5
-    J[0, 2] = -c1*t4
-    J[0, 3] = -c1*t3
-    J[1, 0] = t8
-    J[1, 1] = -s1*t5
-    J[1, 2] = -s1*t4
-    J[1, 3] = -s1*t3
-    J[2, 1] = c1*t8 + s1*t2
-    J[2, 2] = c1*t7 + s1*t1
+    J[0, 0] = -t5
+    J[0, 1] = -c1*t8
+    J[0, 2] = -c1*t7
+    J[0, 3] = -c1*t6
+    J[1, 0] = t2
+    J[1, 1] = -s1*t8
+    J[1, 2] = -s1*t7
+    J[1, 3] = -s1*t6
+    J[2, 1] = c1*t2 + s1*t5
+    J[2, 2] = c1*t1 + s1*t4
     J[2, 3] = 0.1*t10 + 0.1*t12
     J[3, 1] = t14
     J[3, 2] = t14
@@ -312,7 +324,7 @@ def _task_jacobian(q):
 
 
 def _singularity_factors(q):
-    """Factors of det(Js): the robot is singular where one is 0: 20 operations."""
+    """Factors of det(Js): the robot is singular where one is 0: 22 operations."""
     q2 = q[1]
     q3 = q[2]
     q4 = q[3]
@@ -325,12 +337,12 @@ def _singularity_factors(q):
     t0 = s2*s3
     f = casadi.SX(2, 1)
     f[0, 0] = s3
-    f[1, 0] = -(-c2*c3*c4 - c2*c3 + c2*s3*s4 - c2 + c3*s2*s4 + c4*t0 + t0)
+    f[1, 0] = c2*c3*c4 + c2*c3 - c2*s3*s4 + c2 - c3*s2*s4 - c4*t0 - t0
     return [f]
 
 
 def _manipulability(q):
-    """Manipulability |det(Js)|: 45 operations."""
+    """Manipulability |det(Js)|: 46 operations."""
     q1 = q[0]
     q2 = q[1]
     q3 = q[2]
@@ -348,10 +360,10 @@ def _manipulability(q):
     c234 = c23*c4 - s23*s4
     t0 = c234**2
     t1 = s2*s3
-    t2 = c2*c3
-    t3 = c2*s3*s4 + c3*s2*s4 + c4*t1 - c4*t2
+    t2 = -c2*c3*c4 + c2*s3*s4 + c3*s2*s4 + c4*t1
+    t3 = 0.001*s3*t2*(-c2*c3 - c2 + t1 + t2)/casadi.sqrt(c1**2*t0 + s1**2*t0)
     w = casadi.SX(1, 1)
-    w[0, 0] = 0.001*casadi.fabs(s3*t3*(-c2 + t1 - t2 + t3))/casadi.sqrt(c1**2*t0 + s1**2*t0)
+    w[0, 0] = casadi.fabs(t3)
     return [w]
 
 

@@ -23,22 +23,25 @@ void scara_fk(const scara_real q[SCARA_DOF], scara_real T[16])
     const scara_real s12 = c1*s2 + c2*s1;
     const scara_real c4 = cos(q4);
     const scara_real s4 = sin(q4);
-    const scara_real t0 = c12*c4 + s12*s4;
-    const scara_real t1 = -c12*s4 + c4*s12;
+    const scara_real t0 = 0.325*c1 + 0.275*c12;
+    const scara_real t1 = 0.325*s1 + 0.275*s12;
+    const scara_real t2 = 0.387 - q3;
+    const scara_real t3 = c12*c4 + s12*s4;
+    const scara_real t4 = -c12*s4 + c4*s12;
 
     /* Outputs */
-    T[0] = t0;
-    T[1] = t1;
+    T[0] = t3;
+    T[1] = t4;
     T[2] = 0;
-    T[3] = 0.325*c1 + 0.275*c12;
-    T[4] = t1;
-    T[5] = -t0;
+    T[3] = t0;
+    T[4] = t4;
+    T[5] = -t3;
     T[6] = 0;
-    T[7] = 0.325*s1 + 0.275*s12;
+    T[7] = t1;
     T[8] = 0;
     T[9] = 0;
     T[10] = -1;
-    T[11] = 0.387 - q3;
+    T[11] = t2;
     T[12] = 0;
     T[13] = 0;
     T[14] = 0;
@@ -47,7 +50,7 @@ void scara_fk(const scara_real q[SCARA_DOF], scara_real T[16])
 
 void scara_jacobian(const scara_real q[SCARA_DOF], scara_real J[6 * SCARA_DOF])
 {
-    /* 19 operations */
+    /* 20 operations */
 
     /* Inputs */
     const scara_real q1 = q[0];
@@ -60,16 +63,18 @@ void scara_jacobian(const scara_real q[SCARA_DOF], scara_real J[6 * SCARA_DOF])
     const scara_real s2 = sin(q2);
     const scara_real c12 = c1*c2 - s1*s2;
     const scara_real s12 = c1*s2 + c2*s1;
-    const scara_real t0 = 0.275*s12;
-    const scara_real t1 = 0.275*c12;
+    const scara_real t0 = 0.275*c12;
+    const scara_real t1 = 0.325*c1 + t0;
+    const scara_real t2 = 0.275*s12;
+    const scara_real t3 = 0.325*s1 + t2;
 
     /* Outputs */
-    J[0] = -(0.325*s1 + t0);
-    J[1] = -t0;
+    J[0] = -t3;
+    J[1] = -t2;
     J[2] = 0;
     J[3] = 0;
-    J[4] = 0.325*c1 + t1;
-    J[5] = t1;
+    J[4] = t1;
+    J[5] = t0;
     J[6] = 0;
     J[7] = 0;
     J[8] = 0;
@@ -109,36 +114,37 @@ void scara_fk_jacobian(const scara_real q[SCARA_DOF], scara_real T[16], scara_re
     const scara_real s12 = c1*s2 + c2*s1;
     const scara_real c4 = cos(q4);
     const scara_real s4 = sin(q4);
-    const scara_real t0 = c12*c4 + s12*s4;
-    const scara_real t1 = -c12*s4 + c4*s12;
-    const scara_real t2 = 0.275*c12;
-    const scara_real t3 = 0.325*c1 + t2;
-    const scara_real t4 = 0.275*s12;
-    const scara_real t5 = 0.325*s1 + t4;
+    const scara_real t0 = 0.387 - q3;
+    const scara_real t1 = c12*c4 + s12*s4;
+    const scara_real t2 = -c12*s4 + c4*s12;
+    const scara_real t3 = 0.275*c12;
+    const scara_real t4 = 0.325*c1 + t3;
+    const scara_real t5 = 0.275*s12;
+    const scara_real t6 = 0.325*s1 + t5;
 
     /* Outputs */
-    T[0] = t0;
-    T[1] = t1;
+    T[0] = t1;
+    T[1] = t2;
     T[2] = 0;
-    T[3] = t3;
-    T[4] = t1;
-    T[5] = -t0;
+    T[3] = t4;
+    T[4] = t2;
+    T[5] = -t1;
     T[6] = 0;
-    T[7] = t5;
+    T[7] = t6;
     T[8] = 0;
     T[9] = 0;
     T[10] = -1;
-    T[11] = 0.387 - q3;
+    T[11] = t0;
     T[12] = 0;
     T[13] = 0;
     T[14] = 0;
     T[15] = 1;
-    J[0] = -t5;
-    J[1] = -t4;
+    J[0] = -t6;
+    J[1] = -t5;
     J[2] = 0;
     J[3] = 0;
-    J[4] = t3;
-    J[5] = t2;
+    J[4] = t4;
+    J[5] = t3;
     J[6] = 0;
     J[7] = 0;
     J[8] = 0;
@@ -161,7 +167,7 @@ void scara_fk_jacobian(const scara_real q[SCARA_DOF], scara_real T[16], scara_re
 
 void scara_jacobian_tool(const scara_real q[SCARA_DOF], scara_real J[6 * SCARA_DOF])
 {
-    /* 39 operations */
+    /* 40 operations */
 
     /* Inputs */
     const scara_real q1 = q[0];
@@ -177,21 +183,20 @@ void scara_jacobian_tool(const scara_real q[SCARA_DOF], scara_real J[6 * SCARA_D
     const scara_real s12 = c1*s2 + c2*s1;
     const scara_real c4 = cos(q4);
     const scara_real s4 = sin(q4);
-    const scara_real t0 = 0.275*s12;
-    const scara_real t1 = -(0.325*s1 + t0);
-    const scara_real t2 = c12*c4 + s12*s4;
-    const scara_real t3 = 0.275*c12;
-    const scara_real t4 = 0.325*c1 + t3;
-    const scara_real t5 = -c12*s4 + c4*s12;
-    const scara_real t6 = -t2;
+    const scara_real t0 = c12*c4 + s12*s4;
+    const scara_real t1 = -c12*s4 + c4*s12;
+    const scara_real t2 = 0.275*c12;
+    const scara_real t3 = 0.325*c1 + t2;
+    const scara_real t4 = 0.275*s12;
+    const scara_real t5 = 0.325*s1 + t4;
 
     /* Outputs */
-    J[0] = t1*t2 + t4*t5;
-    J[1] = -t0*t2 + t3*t5;
+    J[0] = -t0*t5 + t1*t3;
+    J[1] = -t0*t4 + t1*t2;
     J[2] = 0;
     J[3] = 0;
-    J[4] = t1*t5 + t4*t6;
-    J[5] = -t0*t5 + t3*t6;
+    J[4] = -t0*t3 - t1*t5;
+    J[5] = -t0*t2 - t1*t4;
     J[6] = 0;
     J[7] = 0;
     J[8] = 0;
@@ -231,17 +236,22 @@ void scara_task(const scara_real q[SCARA_DOF], scara_real mu[SCARA_TASK_DIM])
     const scara_real s12 = c1*s2 + c2*s1;
     const scara_real c4 = cos(q4);
     const scara_real s4 = sin(q4);
+    const scara_real t0 = 0.325*c1 + 0.275*c12;
+    const scara_real t1 = 0.325*s1 + 0.275*s12;
+    const scara_real t2 = 0.387 - q3;
+    const scara_real t3 = c12*c4 + s12*s4;
+    const scara_real t4 = -c12*s4 + c4*s12;
 
     /* Outputs */
-    mu[0] = 0.325*c1 + 0.275*c12;
-    mu[1] = 0.325*s1 + 0.275*s12;
-    mu[2] = 0.387 - q3;
-    mu[3] = atan2(-c12*s4 + c4*s12, c12*c4 + s12*s4);
+    mu[0] = t0;
+    mu[1] = t1;
+    mu[2] = t2;
+    mu[3] = atan2(t4, t3);
 }
 
 void scara_task_jacobian(const scara_real q[SCARA_DOF], scara_real J[SCARA_TASK_DIM * SCARA_DOF])
 {
-    /* 19 operations */
+    /* 20 operations */
 
     /* Inputs */
     const scara_real q1 = q[0];
@@ -254,16 +264,18 @@ void scara_task_jacobian(const scara_real q[SCARA_DOF], scara_real J[SCARA_TASK_
     const scara_real s2 = sin(q2);
     const scara_real c12 = c1*c2 - s1*s2;
     const scara_real s12 = c1*s2 + c2*s1;
-    const scara_real t0 = 0.275*s12;
-    const scara_real t1 = 0.275*c12;
+    const scara_real t0 = 0.275*c12;
+    const scara_real t1 = 0.325*c1 + t0;
+    const scara_real t2 = 0.275*s12;
+    const scara_real t3 = 0.325*s1 + t2;
 
     /* Outputs */
-    J[0] = -(0.325*s1 + t0);
-    J[1] = -t0;
+    J[0] = -t3;
+    J[1] = -t2;
     J[2] = 0;
     J[3] = 0;
-    J[4] = 0.325*c1 + t1;
-    J[5] = t1;
+    J[4] = t1;
+    J[5] = t0;
     J[6] = 0;
     J[7] = 0;
     J[8] = 0;
@@ -292,12 +304,11 @@ void scara_singularity_factors(const scara_real q[SCARA_DOF], scara_real f[SCARA
 
 scara_real scara_manipulability(const scara_real q[SCARA_DOF])
 {
-    /* 24 operations */
+    /* 20 operations */
 
     /* Inputs */
     const scara_real q1 = q[0];
     const scara_real q2 = q[1];
-    const scara_real q4 = q[3];
 
     /* Intermediate terms */
     const scara_real c1 = cos(q1);
@@ -306,21 +317,23 @@ scara_real scara_manipulability(const scara_real q[SCARA_DOF])
     const scara_real s2 = sin(q2);
     const scara_real c12 = c1*c2 - s1*s2;
     const scara_real s12 = c1*s2 + c2*s1;
-    const scara_real c4 = cos(q4);
-    const scara_real s4 = sin(q4);
+    const scara_real t0 = 0.275*c12;
+    const scara_real t1 = 0.325*c1 + t0;
+    const scara_real t2 = 0.275*s12;
+    const scara_real t3 = 0.325*s1 + t2;
+    const scara_real t4 = -t0*t3 + t1*t2;
 
     /* Outputs */
-    return 0.089375*fabs(s2)/(((c12*c4 + s12*s4)*(c12*c4 + s12*s4)) + ((c12*s4 - c4*s12)*(c12*s4 - c4*s12)));
+    return fabs(t4);
 }
 
 scara_real scara_jacobian_det(const scara_real q[SCARA_DOF])
 {
-    /* 23 operations */
+    /* 19 operations */
 
     /* Inputs */
     const scara_real q1 = q[0];
     const scara_real q2 = q[1];
-    const scara_real q4 = q[3];
 
     /* Intermediate terms */
     const scara_real c1 = cos(q1);
@@ -329,11 +342,13 @@ scara_real scara_jacobian_det(const scara_real q[SCARA_DOF])
     const scara_real s2 = sin(q2);
     const scara_real c12 = c1*c2 - s1*s2;
     const scara_real s12 = c1*s2 + c2*s1;
-    const scara_real c4 = cos(q4);
-    const scara_real s4 = sin(q4);
+    const scara_real t0 = 0.275*c12;
+    const scara_real t1 = 0.325*c1 + t0;
+    const scara_real t2 = 0.275*s12;
+    const scara_real t3 = 0.325*s1 + t2;
 
     /* Outputs */
-    return 0.089375*s2/(((c12*c4 + s12*s4)*(c12*c4 + s12*s4)) + ((-c12*s4 + c4*s12)*(-c12*s4 + c4*s12)));
+    return -t0*t3 + t1*t2;
 }
 
 int scara_velocity_ik(const scara_real q[SCARA_DOF], const scara_real mu_dot[SCARA_TASK_DIM], scara_real damping, scara_real q_dot[SCARA_DOF])

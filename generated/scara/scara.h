@@ -36,7 +36,7 @@ typedef double scara_real;
 void scara_fk(const scara_real q[SCARA_DOF], scara_real T[16]);
 
 /* Geometric Jacobian in the world frame (6 x DOF, rows vx vy vz wx wy wz).
- * Result: J: 6 x 4 row-major, element (r, c) at J[r * 4 + c]. 19 operations. */
+ * Result: J: 6 x 4 row-major, element (r, c) at J[r * 4 + c]. 20 operations. */
 void scara_jacobian(const scara_real q[SCARA_DOF], scara_real J[6 * SCARA_DOF]);
 
 /* Fk and jacobian in one pass, sharing their terms.
@@ -44,7 +44,7 @@ void scara_jacobian(const scara_real q[SCARA_DOF], scara_real J[6 * SCARA_DOF]);
 void scara_fk_jacobian(const scara_real q[SCARA_DOF], scara_real T[16], scara_real J[6 * SCARA_DOF]);
 
 /* Geometric Jacobian in the tool frame (6 x DOF, rows vx vy vz wx wy wz).
- * Result: J: 6 x 4 row-major, element (r, c) at J[r * 4 + c]. 39 operations. */
+ * Result: J: 6 x 4 row-major, element (r, c) at J[r * 4 + c]. 40 operations. */
 void scara_jacobian_tool(const scara_real q[SCARA_DOF], scara_real J[6 * SCARA_DOF]);
 
 /* Task vector mu = (x, y, z, yaw).
@@ -52,7 +52,7 @@ void scara_jacobian_tool(const scara_real q[SCARA_DOF], scara_real J[6 * SCARA_D
 void scara_task(const scara_real q[SCARA_DOF], scara_real mu[SCARA_TASK_DIM]);
 
 /* Analytic Jacobian d mu / d q (4 x DOF).
- * Result: J: 4 x 4 row-major, element (r, c) at J[r * 4 + c]. 19 operations. */
+ * Result: J: 4 x 4 row-major, element (r, c) at J[r * 4 + c]. 20 operations. */
 void scara_task_jacobian(const scara_real q[SCARA_DOF], scara_real J[SCARA_TASK_DIM * SCARA_DOF]);
 
 /* Factors of det(Js): the robot is singular where one is 0.
@@ -60,11 +60,11 @@ void scara_task_jacobian(const scara_real q[SCARA_DOF], scara_real J[SCARA_TASK_
 void scara_singularity_factors(const scara_real q[SCARA_DOF], scara_real f[SCARA_NUM_SINGULARITY_FACTORS]);
 
 /* Manipulability |det(Js)|.
- * Result: returned as a scalar. 24 operations. */
+ * Result: returned as a scalar. 20 operations. */
 scara_real scara_manipulability(const scara_real q[SCARA_DOF]);
 
 /* Det(Js).
- * Result: returned as a scalar. 23 operations. */
+ * Result: returned as a scalar. 19 operations. */
 scara_real scara_jacobian_det(const scara_real q[SCARA_DOF]);
 
 /* Status of scara_velocity_ik. */

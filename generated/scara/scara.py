@@ -38,21 +38,24 @@ def fk(q):
     s12 = c1*s2 + c2*s1
     c4 = numpy.cos(q4)
     s4 = numpy.sin(q4)
-    t0 = c12*c4 + s12*s4
-    t1 = -c12*s4 + c4*s12
+    t0 = 0.325*c1 + 0.275*c12
+    t1 = 0.325*s1 + 0.275*s12
+    t2 = 0.387 - q3
+    t3 = c12*c4 + s12*s4
+    t4 = -c12*s4 + c4*s12
     T = numpy.empty(q.shape[:-1] + (4, 4))
-    T[..., 0, 0] = t0
-    T[..., 0, 1] = t1
+    T[..., 0, 0] = t3
+    T[..., 0, 1] = t4
     T[..., 0, 2] = 0
-    T[..., 0, 3] = 0.325*c1 + 0.275*c12
-    T[..., 1, 0] = t1
-    T[..., 1, 1] = -t0
+    T[..., 0, 3] = t0
+    T[..., 1, 0] = t4
+    T[..., 1, 1] = -t3
     T[..., 1, 2] = 0
-    T[..., 1, 3] = 0.325*s1 + 0.275*s12
+    T[..., 1, 3] = t1
     T[..., 2, 0] = 0
     T[..., 2, 1] = 0
     T[..., 2, 2] = -1
-    T[..., 2, 3] = 0.387 - q3
+    T[..., 2, 3] = t2
     T[..., 3, 0] = 0
     T[..., 3, 1] = 0
     T[..., 3, 2] = 0
@@ -61,7 +64,7 @@ def fk(q):
 
 
 def jacobian(q):
-    """geometric Jacobian in the world frame (6 x DOF, rows vx vy vz wx wy wz): (6 x 4), 19 operations."""
+    """geometric Jacobian in the world frame (6 x DOF, rows vx vy vz wx wy wz): (6 x 4), 20 operations."""
     q = _joints(q)
     q1 = q[..., 0]
     q2 = q[..., 1]
@@ -71,15 +74,17 @@ def jacobian(q):
     s2 = numpy.sin(q2)
     c12 = c1*c2 - s1*s2
     s12 = c1*s2 + c2*s1
-    t0 = 0.275*s12
-    t1 = 0.275*c12
+    t0 = 0.275*c12
+    t1 = 0.325*c1 + t0
+    t2 = 0.275*s12
+    t3 = 0.325*s1 + t2
     J = numpy.empty(q.shape[:-1] + (6, 4))
-    J[..., 0, 0] = -(0.325*s1 + t0)
-    J[..., 0, 1] = -t0
+    J[..., 0, 0] = -t3
+    J[..., 0, 1] = -t2
     J[..., 0, 2] = 0
     J[..., 0, 3] = 0
-    J[..., 1, 0] = 0.325*c1 + t1
-    J[..., 1, 1] = t1
+    J[..., 1, 0] = t1
+    J[..., 1, 1] = t0
     J[..., 1, 2] = 0
     J[..., 1, 3] = 0
     J[..., 2, 0] = 0
@@ -116,36 +121,37 @@ def fk_jacobian(q):
     s12 = c1*s2 + c2*s1
     c4 = numpy.cos(q4)
     s4 = numpy.sin(q4)
-    t0 = c12*c4 + s12*s4
-    t1 = -c12*s4 + c4*s12
-    t2 = 0.275*c12
-    t3 = 0.325*c1 + t2
-    t4 = 0.275*s12
-    t5 = 0.325*s1 + t4
+    t0 = 0.387 - q3
+    t1 = c12*c4 + s12*s4
+    t2 = -c12*s4 + c4*s12
+    t3 = 0.275*c12
+    t4 = 0.325*c1 + t3
+    t5 = 0.275*s12
+    t6 = 0.325*s1 + t5
     T = numpy.empty(q.shape[:-1] + (4, 4))
-    T[..., 0, 0] = t0
-    T[..., 0, 1] = t1
+    T[..., 0, 0] = t1
+    T[..., 0, 1] = t2
     T[..., 0, 2] = 0
-    T[..., 0, 3] = t3
-    T[..., 1, 0] = t1
-    T[..., 1, 1] = -t0
+    T[..., 0, 3] = t4
+    T[..., 1, 0] = t2
+    T[..., 1, 1] = -t1
     T[..., 1, 2] = 0
-    T[..., 1, 3] = t5
+    T[..., 1, 3] = t6
     T[..., 2, 0] = 0
     T[..., 2, 1] = 0
     T[..., 2, 2] = -1
-    T[..., 2, 3] = 0.387 - q3
+    T[..., 2, 3] = t0
     T[..., 3, 0] = 0
     T[..., 3, 1] = 0
     T[..., 3, 2] = 0
     T[..., 3, 3] = 1
     J = numpy.empty(q.shape[:-1] + (6, 4))
-    J[..., 0, 0] = -t5
-    J[..., 0, 1] = -t4
+    J[..., 0, 0] = -t6
+    J[..., 0, 1] = -t5
     J[..., 0, 2] = 0
     J[..., 0, 3] = 0
-    J[..., 1, 0] = t3
-    J[..., 1, 1] = t2
+    J[..., 1, 0] = t4
+    J[..., 1, 1] = t3
     J[..., 1, 2] = 0
     J[..., 1, 3] = 0
     J[..., 2, 0] = 0
@@ -168,7 +174,7 @@ def fk_jacobian(q):
 
 
 def jacobian_tool(q):
-    """geometric Jacobian in the tool frame (6 x DOF, rows vx vy vz wx wy wz): (6 x 4), 39 operations."""
+    """geometric Jacobian in the tool frame (6 x DOF, rows vx vy vz wx wy wz): (6 x 4), 40 operations."""
     q = _joints(q)
     q1 = q[..., 0]
     q2 = q[..., 1]
@@ -181,20 +187,19 @@ def jacobian_tool(q):
     s12 = c1*s2 + c2*s1
     c4 = numpy.cos(q4)
     s4 = numpy.sin(q4)
-    t0 = 0.275*s12
-    t1 = -(0.325*s1 + t0)
-    t2 = c12*c4 + s12*s4
-    t3 = 0.275*c12
-    t4 = 0.325*c1 + t3
-    t5 = -c12*s4 + c4*s12
-    t6 = -t2
+    t0 = c12*c4 + s12*s4
+    t1 = -c12*s4 + c4*s12
+    t2 = 0.275*c12
+    t3 = 0.325*c1 + t2
+    t4 = 0.275*s12
+    t5 = 0.325*s1 + t4
     J = numpy.empty(q.shape[:-1] + (6, 4))
-    J[..., 0, 0] = t1*t2 + t4*t5
-    J[..., 0, 1] = -t0*t2 + t3*t5
+    J[..., 0, 0] = -t0*t5 + t1*t3
+    J[..., 0, 1] = -t0*t4 + t1*t2
     J[..., 0, 2] = 0
     J[..., 0, 3] = 0
-    J[..., 1, 0] = t1*t5 + t4*t6
-    J[..., 1, 1] = -t0*t5 + t3*t6
+    J[..., 1, 0] = -t0*t3 - t1*t5
+    J[..., 1, 1] = -t0*t2 - t1*t4
     J[..., 1, 2] = 0
     J[..., 1, 3] = 0
     J[..., 2, 0] = 0
@@ -231,16 +236,21 @@ def task(q):
     s12 = c1*s2 + c2*s1
     c4 = numpy.cos(q4)
     s4 = numpy.sin(q4)
+    t0 = 0.325*c1 + 0.275*c12
+    t1 = 0.325*s1 + 0.275*s12
+    t2 = 0.387 - q3
+    t3 = c12*c4 + s12*s4
+    t4 = -c12*s4 + c4*s12
     mu = numpy.empty(q.shape[:-1] + (4,))
-    mu[..., 0] = 0.325*c1 + 0.275*c12
-    mu[..., 1] = 0.325*s1 + 0.275*s12
-    mu[..., 2] = 0.387 - q3
-    mu[..., 3] = numpy.arctan2(-c12*s4 + c4*s12, c12*c4 + s12*s4)
+    mu[..., 0] = t0
+    mu[..., 1] = t1
+    mu[..., 2] = t2
+    mu[..., 3] = numpy.arctan2(t4, t3)
     return mu
 
 
 def task_jacobian(q):
-    """analytic Jacobian d mu / d q (4 x DOF): (4 x 4), 19 operations."""
+    """analytic Jacobian d mu / d q (4 x DOF): (4 x 4), 20 operations."""
     q = _joints(q)
     q1 = q[..., 0]
     q2 = q[..., 1]
@@ -250,15 +260,17 @@ def task_jacobian(q):
     s2 = numpy.sin(q2)
     c12 = c1*c2 - s1*s2
     s12 = c1*s2 + c2*s1
-    t0 = 0.275*s12
-    t1 = 0.275*c12
+    t0 = 0.275*c12
+    t1 = 0.325*c1 + t0
+    t2 = 0.275*s12
+    t3 = 0.325*s1 + t2
     J = numpy.empty(q.shape[:-1] + (4, 4))
-    J[..., 0, 0] = -(0.325*s1 + t0)
-    J[..., 0, 1] = -t0
+    J[..., 0, 0] = -t3
+    J[..., 0, 1] = -t2
     J[..., 0, 2] = 0
     J[..., 0, 3] = 0
-    J[..., 1, 0] = 0.325*c1 + t1
-    J[..., 1, 1] = t1
+    J[..., 1, 0] = t1
+    J[..., 1, 1] = t0
     J[..., 1, 2] = 0
     J[..., 1, 3] = 0
     J[..., 2, 0] = 0
@@ -283,40 +295,43 @@ def singularity_factors(q):
 
 
 def manipulability(q):
-    """manipulability |det(Js)|: (1 x 1), 24 operations."""
+    """manipulability |det(Js)|: (1 x 1), 20 operations."""
     q = _joints(q)
     q1 = q[..., 0]
     q2 = q[..., 1]
-    q4 = q[..., 3]
     c1 = numpy.cos(q1)
     s1 = numpy.sin(q1)
     c2 = numpy.cos(q2)
     s2 = numpy.sin(q2)
     c12 = c1*c2 - s1*s2
     s12 = c1*s2 + c2*s1
-    c4 = numpy.cos(q4)
-    s4 = numpy.sin(q4)
+    t0 = 0.275*c12
+    t1 = 0.325*c1 + t0
+    t2 = 0.275*s12
+    t3 = 0.325*s1 + t2
+    t4 = -t0*t3 + t1*t2
     w = numpy.empty(q.shape[:-1] + ())
-    w[...] = 0.089375*abs(s2)/((c12*c4 + s12*s4)**2 + (c12*s4 - c4*s12)**2)
+    w[...] = abs(t4)
     return w
 
 
 def jacobian_det(q):
-    """det(Js): (1 x 1), 23 operations."""
+    """det(Js): (1 x 1), 19 operations."""
     q = _joints(q)
     q1 = q[..., 0]
     q2 = q[..., 1]
-    q4 = q[..., 3]
     c1 = numpy.cos(q1)
     s1 = numpy.sin(q1)
     c2 = numpy.cos(q2)
     s2 = numpy.sin(q2)
     c12 = c1*c2 - s1*s2
     s12 = c1*s2 + c2*s1
-    c4 = numpy.cos(q4)
-    s4 = numpy.sin(q4)
+    t0 = 0.275*c12
+    t1 = 0.325*c1 + t0
+    t2 = 0.275*s12
+    t3 = 0.325*s1 + t2
     d = numpy.empty(q.shape[:-1] + ())
-    d[...] = 0.089375*s2/((c12*c4 + s12*s4)**2 + (-c12*s4 + c4*s12)**2)
+    d[...] = -t0*t3 + t1*t2
     return d
 
 

@@ -27,23 +27,26 @@ def _fk(q):
     s12 = c1*s2 + c2*s1
     c4 = casadi.cos(q4)
     s4 = casadi.sin(q4)
-    t0 = c12*c4 + s12*s4
-    t1 = -c12*s4 + c4*s12
+    t0 = 0.325*c1 + 0.275*c12
+    t1 = 0.325*s1 + 0.275*s12
+    t2 = 0.387 - q3
+    t3 = c12*c4 + s12*s4
+    t4 = -c12*s4 + c4*s12
     T = casadi.SX(4, 4)
-    T[0, 0] = t0
-    T[0, 1] = t1
-    T[0, 3] = 0.325*c1 + 0.275*c12
-    T[1, 0] = t1
-    T[1, 1] = -t0
-    T[1, 3] = 0.325*s1 + 0.275*s12
+    T[0, 0] = t3
+    T[0, 1] = t4
+    T[0, 3] = t0
+    T[1, 0] = t4
+    T[1, 1] = -t3
+    T[1, 3] = t1
     T[2, 2] = -1
-    T[2, 3] = 0.387 - q3
+    T[2, 3] = t2
     T[3, 3] = 1
     return [T]
 
 
 def _jacobian(q):
-    """Geometric Jacobian in the world frame (6 x DOF, rows vx vy vz wx wy wz): 19 operations."""
+    """Geometric Jacobian in the world frame (6 x DOF, rows vx vy vz wx wy wz): 20 operations."""
     q1 = q[0]
     q2 = q[1]
     c1 = casadi.cos(q1)
@@ -52,13 +55,15 @@ def _jacobian(q):
     s2 = casadi.sin(q2)
     c12 = c1*c2 - s1*s2
     s12 = c1*s2 + c2*s1
-    t0 = 0.275*s12
-    t1 = 0.275*c12
+    t0 = 0.275*c12
+    t1 = 0.325*c1 + t0
+    t2 = 0.275*s12
+    t3 = 0.325*s1 + t2
     J = casadi.SX(6, 4)
-    J[0, 0] = -(0.325*s1 + t0)
-    J[0, 1] = -t0
-    J[1, 0] = 0.325*c1 + t1
-    J[1, 1] = t1
+    J[0, 0] = -t3
+    J[0, 1] = -t2
+    J[1, 0] = t1
+    J[1, 1] = t0
     J[2, 2] = -1
     J[5, 0] = 1
     J[5, 1] = 1
@@ -80,27 +85,28 @@ def _fk_jacobian(q):
     s12 = c1*s2 + c2*s1
     c4 = casadi.cos(q4)
     s4 = casadi.sin(q4)
-    t0 = c12*c4 + s12*s4
-    t1 = -c12*s4 + c4*s12
-    t2 = 0.275*c12
-    t3 = 0.325*c1 + t2
-    t4 = 0.275*s12
-    t5 = 0.325*s1 + t4
+    t0 = 0.387 - q3
+    t1 = c12*c4 + s12*s4
+    t2 = -c12*s4 + c4*s12
+    t3 = 0.275*c12
+    t4 = 0.325*c1 + t3
+    t5 = 0.275*s12
+    t6 = 0.325*s1 + t5
     T = casadi.SX(4, 4)
-    T[0, 0] = t0
-    T[0, 1] = t1
-    T[0, 3] = t3
-    T[1, 0] = t1
-    T[1, 1] = -t0
-    T[1, 3] = t5
+    T[0, 0] = t1
+    T[0, 1] = t2
+    T[0, 3] = t4
+    T[1, 0] = t2
+    T[1, 1] = -t1
+    T[1, 3] = t6
     T[2, 2] = -1
-    T[2, 3] = 0.387 - q3
+    T[2, 3] = t0
     T[3, 3] = 1
     J = casadi.SX(6, 4)
-    J[0, 0] = -t5
-    J[0, 1] = -t4
-    J[1, 0] = t3
-    J[1, 1] = t2
+    J[0, 0] = -t6
+    J[0, 1] = -t5
+    J[1, 0] = t4
+    J[1, 1] = t3
     J[2, 2] = -1
     J[5, 0] = 1
     J[5, 1] = 1
@@ -109,7 +115,7 @@ def _fk_jacobian(q):
 
 
 def _jacobian_tool(q):
-    """Geometric Jacobian in the tool frame (6 x DOF, rows vx vy vz wx wy wz): 39 operations."""
+    """Geometric Jacobian in the tool frame (6 x DOF, rows vx vy vz wx wy wz): 40 operations."""
     q1 = q[0]
     q2 = q[1]
     q4 = q[3]
@@ -121,18 +127,17 @@ def _jacobian_tool(q):
     s12 = c1*s2 + c2*s1
     c4 = casadi.cos(q4)
     s4 = casadi.sin(q4)
-    t0 = 0.275*s12
-    t1 = -(0.325*s1 + t0)
-    t2 = c12*c4 + s12*s4
-    t3 = 0.275*c12
-    t4 = 0.325*c1 + t3
-    t5 = -c12*s4 + c4*s12
-    t6 = -t2
+    t0 = c12*c4 + s12*s4
+    t1 = -c12*s4 + c4*s12
+    t2 = 0.275*c12
+    t3 = 0.325*c1 + t2
+    t4 = 0.275*s12
+    t5 = 0.325*s1 + t4
     J = casadi.SX(6, 4)
-    J[0, 0] = t1*t2 + t4*t5
-    J[0, 1] = -t0*t2 + t3*t5
-    J[1, 0] = t1*t5 + t4*t6
-    J[1, 1] = -t0*t5 + t3*t6
+    J[0, 0] = -t0*t5 + t1*t3
+    J[0, 1] = -t0*t4 + t1*t2
+    J[1, 0] = -t0*t3 - t1*t5
+    J[1, 1] = -t0*t2 - t1*t4
     J[2, 2] = 1
     J[5, 0] = -1
     J[5, 1] = -1
@@ -154,16 +159,21 @@ def _task(q):
     s12 = c1*s2 + c2*s1
     c4 = casadi.cos(q4)
     s4 = casadi.sin(q4)
+    t0 = 0.325*c1 + 0.275*c12
+    t1 = 0.325*s1 + 0.275*s12
+    t2 = 0.387 - q3
+    t3 = c12*c4 + s12*s4
+    t4 = -c12*s4 + c4*s12
     mu = casadi.SX(4, 1)
-    mu[0, 0] = 0.325*c1 + 0.275*c12
-    mu[1, 0] = 0.325*s1 + 0.275*s12
-    mu[2, 0] = 0.387 - q3
-    mu[3, 0] = casadi.atan2(-c12*s4 + c4*s12, c12*c4 + s12*s4)
+    mu[0, 0] = t0
+    mu[1, 0] = t1
+    mu[2, 0] = t2
+    mu[3, 0] = casadi.atan2(t4, t3)
     return [mu]
 
 
 def _task_jacobian(q):
-    """Analytic Jacobian d mu / d q (4 x DOF): 19 operations."""
+    """Analytic Jacobian d mu / d q (4 x DOF): 20 operations."""
     q1 = q[0]
     q2 = q[1]
     c1 = casadi.cos(q1)
@@ -172,13 +182,15 @@ def _task_jacobian(q):
     s2 = casadi.sin(q2)
     c12 = c1*c2 - s1*s2
     s12 = c1*s2 + c2*s1
-    t0 = 0.275*s12
-    t1 = 0.275*c12
+    t0 = 0.275*c12
+    t1 = 0.325*c1 + t0
+    t2 = 0.275*s12
+    t3 = 0.325*s1 + t2
     J = casadi.SX(4, 4)
-    J[0, 0] = -(0.325*s1 + t0)
-    J[0, 1] = -t0
-    J[1, 0] = 0.325*c1 + t1
-    J[1, 1] = t1
+    J[0, 0] = -t3
+    J[0, 1] = -t2
+    J[1, 0] = t1
+    J[1, 1] = t0
     J[2, 2] = -1
     J[3, 0] = 1
     J[3, 1] = 1
@@ -196,38 +208,41 @@ def _singularity_factors(q):
 
 
 def _manipulability(q):
-    """Manipulability |det(Js)|: 24 operations."""
+    """Manipulability |det(Js)|: 20 operations."""
     q1 = q[0]
     q2 = q[1]
-    q4 = q[3]
     c1 = casadi.cos(q1)
     s1 = casadi.sin(q1)
     c2 = casadi.cos(q2)
     s2 = casadi.sin(q2)
     c12 = c1*c2 - s1*s2
     s12 = c1*s2 + c2*s1
-    c4 = casadi.cos(q4)
-    s4 = casadi.sin(q4)
+    t0 = 0.275*c12
+    t1 = 0.325*c1 + t0
+    t2 = 0.275*s12
+    t3 = 0.325*s1 + t2
+    t4 = -t0*t3 + t1*t2
     w = casadi.SX(1, 1)
-    w[0, 0] = 0.089375*casadi.fabs(s2)/((c12*c4 + s12*s4)**2 + (c12*s4 - c4*s12)**2)
+    w[0, 0] = casadi.fabs(t4)
     return [w]
 
 
 def _jacobian_det(q):
-    """Det(Js): 23 operations."""
+    """Det(Js): 19 operations."""
     q1 = q[0]
     q2 = q[1]
-    q4 = q[3]
     c1 = casadi.cos(q1)
     s1 = casadi.sin(q1)
     c2 = casadi.cos(q2)
     s2 = casadi.sin(q2)
     c12 = c1*c2 - s1*s2
     s12 = c1*s2 + c2*s1
-    c4 = casadi.cos(q4)
-    s4 = casadi.sin(q4)
+    t0 = 0.275*c12
+    t1 = 0.325*c1 + t0
+    t2 = 0.275*s12
+    t3 = 0.325*s1 + t2
     d = casadi.SX(1, 1)
-    d[0, 0] = 0.089375*s2/((c12*c4 + s12*s4)**2 + (-c12*s4 + c4*s12)**2)
+    d[0, 0] = -t0*t3 + t1*t2
     return [d]
 
 

@@ -34,15 +34,15 @@ typedef double ur5_real;
 #define UR5_NUM_SINGULARITY_FACTORS 3
 
 /* Pose of the tool frame in the world frame (4x4 homogeneous).
- * Result: T: 4 x 4 row-major, element (r, c) at T[r * 4 + c]. 84 operations. */
+ * Result: T: 4 x 4 row-major, element (r, c) at T[r * 4 + c]. 90 operations. */
 void ur5_fk(const ur5_real q[UR5_DOF], ur5_real T[16]);
 
 /* Geometric Jacobian in the world frame (6 x DOF, rows vx vy vz wx wy wz).
- * Result: J: 6 x 6 row-major, element (r, c) at J[r * 6 + c]. 97 operations. */
+ * Result: J: 6 x 6 row-major, element (r, c) at J[r * 6 + c]. 88 operations. */
 void ur5_jacobian(const ur5_real q[UR5_DOF], ur5_real J[6 * UR5_DOF]);
 
 /* Fk and jacobian in one pass, sharing their terms.
- * Result: T: 4 x 4 row-major, element (r, c) at T[r * 4 + c]; J: 6 x 6 row-major, element (r, c) at J[r * 6 + c]. 129 operations. */
+ * Result: T: 4 x 4 row-major, element (r, c) at T[r * 4 + c]; J: 6 x 6 row-major, element (r, c) at J[r * 6 + c]. 117 operations. */
 void ur5_fk_jacobian(const ur5_real q[UR5_DOF], ur5_real T[16], ur5_real J[6 * UR5_DOF]);
 
 /* Geometric Jacobian in the tool frame (6 x DOF, rows vx vy vz wx wy wz).
@@ -50,11 +50,11 @@ void ur5_fk_jacobian(const ur5_real q[UR5_DOF], ur5_real T[16], ur5_real J[6 * U
 void ur5_jacobian_tool(const ur5_real q[UR5_DOF], ur5_real J[6 * UR5_DOF]);
 
 /* Task vector mu = (x, y, z, roll, pitch, yaw).
- * Result: mu[i], i < 6. 85 operations. */
+ * Result: mu[i], i < 6. 90 operations. */
 void ur5_task(const ur5_real q[UR5_DOF], ur5_real mu[UR5_TASK_DIM]);
 
 /* Analytic Jacobian d mu / d q (6 x DOF).
- * Result: J: 6 x 6 row-major, element (r, c) at J[r * 6 + c]. 150 operations. */
+ * Result: J: 6 x 6 row-major, element (r, c) at J[r * 6 + c]. 144 operations. */
 void ur5_task_jacobian(const ur5_real q[UR5_DOF], ur5_real J[UR5_TASK_DIM * UR5_DOF]);
 
 /* Factors of det(Js): the robot is singular where one is 0.

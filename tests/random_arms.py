@@ -1,0 +1,69 @@
+"""Seeded random robot files: arms nobody tuned jacgen for (issue 9's stress suite and
+bench/bench_scaling.py).
+
+`random_arm(seed)` draws a whole robot file from one seed: 1 to 12 joints, either DH
+convention, revolute and prismatic joints mixed, each alpha one of 0, ±90, 180 degrees or
+an arbitrary angle, arbitrary offsets and lengths, base and tool transforms with arbitrary
+rotations, a task of any shape (fewer, as many or more components than joints; with or
+without Euler angles) and some lengths kept as symbolic runtime parameters.
+"""
+
+import random
+
+from codegen.robot import TASK_COMPONENTS
+
+SPECIAL_ALPHAS = (0.0, 90.0, -90.0, 180.0)
+
+
+def _number(rng: random.Random, low: float, high: float) -> str:
+    return f"{rng.uniform(low, high):.4f}"
+
+
+def _alpha(rng: random.Random) -> str:
+    return f"{rng.choice(SPECIAL_ALPHAS)}" if rng.random() < 0.7 else _number(rng, -180, 180)
+
+
+def _pose(rng: random.Random) -> str:
+    xyz = ", ".join(_number(rng, -0.3, 0.3) for _ in range(3))
+    rpy = ", ".join(_number(rng, -180, 180) for _ in range(3))
+    return f"{{xyz: [{xyz}], rpy: [{rpy}]}}"
+
+
+def _task(rng: random.Random, dof: int) -> list[str]:
+    """Any non-empty subset of (x, y, z, roll, pitch, yaw), in that order; its size is
+    below, at or above the joint count about equally often (as the six components allow)."""
+    shape = rng.choice(("fewer", "equal", "more"))
+    size = {"fewer": rng.randint(1, max(1, min(dof - 1, 6))), "equal": min(dof, 6),
+            "more": rng.randint(min(dof + 1, 6), 6)}[shape]
+    return sorted(rng.sample(TASK_COMPONENTS, size), key=TASK_COMPONENTS.index)
+
+
+def random_arm_text(seed: int, dof: int | None = None, revolute_only: bool = False) -> str:
+    """Robot file text of the random arm `seed` (angles in degrees, lengths in metres)."""
+    rng = random.Random(seed)
+    dof = dof or rng.randint(1, 12)
+    lines = [f"name: arm{seed}", f"description: random arm, seed {seed}",
+             f"convention: {rng.choice(('standard', 'modified'))}", "angle_unit: deg", "parameters:"]
+    symbolic = [f"len{k}" for k in range(rng.randint(0, 2))]
+    lines += [f"  {name}: {{value: {_number(rng, 0.05, 0.5)}, symbolic: true}}" for name in symbolic]
+    if not symbolic:
+        lines[-1] = "parameters: {}"
+    lines.append("joints:")
+    for _ in range(dof):
+        prismatic = not revolute_only and rng.random() < 0.2
+        a = rng.choice(symbolic) if symbolic and rng.random() < 0.2 else _number(rng, -0.5, 0.5)
+        a = "0" if rng.random() < 0.3 else a
+        d = "0" if rng.random() < 0.3 else _number(rng, -0.5, 0.5)
+        offset = "0" if rng.random() < 0.5 else _number(rng, -180, 180)
+        if prismatic:
+            theta = f"{rng.choice(SPECIAL_ALPHAS)}" if rng.random() < 0.7 else _number(rng, -180, 180)
+            lines.append(f"  - {{type: prismatic, a: {a}, alpha: {_alpha(rng)}, theta: {theta}, "
+                         f"offset: {_number(rng, 0, 0.3)}, limits: [0, 0.5]}}")
+        else:
+            lines.append(f"  - {{type: revolute, a: {a}, alpha: {_alpha(rng)}, d: {d}, offset: {offset}}}")
+    if rng.random() < 0.7:
+        lines.append(f"base: {_pose(rng)}")
+    if rng.random() < 0.7:
+        lines.append(f"tool: {_pose(rng)}")
+    lines.append(f"task: [{', '.join(_task(rng, dof))}]")
+    return "\n".join(lines) + "\n"
