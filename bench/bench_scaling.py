@@ -1,53 +1,58 @@
-"""How generation scales with the number of joints (issue 6).
+"""How generation scales with the number of joints (issue 9).
 
-For random standard-DH chains of 2..12 revolute joints (fixed seed; each alpha one of 0,
-+90, -90 degrees or a random angle; random link lengths a and d), measures the time to build
-the symbolic chain and lower fk and the geometric Jacobian to straight-line code
-(`codegen.functions.Generator`), and the operation count of the result
-(`Body.operation_count`), averaged over a few chains per size. Prints a table and the
-log-log slopes (least squares on the logs) of operations and time against n.
+For random arms of 1 to 32 joints (tests/random_arms.py: both conventions, prismatic
+joints, arbitrary twists, base and tool, any task shape; fixed seeds), renders every
+language in a fresh process and reports, averaged over the arms of each size: generation
+time (Python start-up excluded), the process's peak memory, and the operation counts of
+`fk_jacobian`, `singularity_factors` and `manipulability`; then the log-log slopes
+(least squares on the logs) of each against n, over all sizes and from 6 joints up.
 
-    PYTHONPATH=. python bench/bench_scaling.py [--seed 1] [--sizes 2,4,6,8,10,12] [--repeats 3]
+    PYTHONPATH=. python bench/bench_scaling.py [--sizes 1,2,4,6,8,12,16,24,32] [--repeats 3]
 """
 
 import argparse
+import json
 import math
-import random
-import time
+import subprocess
+import sys
+from pathlib import Path
 
-from codegen.functions import Generator
-from codegen.robot import parse_robot
-
-ALPHAS = ("0", "90", "-90", "random")
+ROOT = Path(__file__).resolve().parent.parent
+COLUMNS = ("seconds", "peak_mb", "fk_jacobian", "singularity_factors", "manipulability")
 
 
-def random_chain(n: int, rng: random.Random) -> str:
-    """Robot file text of a random n-joint revolute chain (angles in degrees)."""
+def worker(dof: int, seed: int) -> None:
+    """Render one random arm in this process; print its measurements as JSON."""
+    import resource
+    import time
+
+    sys.path[:0] = [str(ROOT), str(ROOT / "tests")]
+    from codegen.functions import Generator
+    from codegen.render import render_robot
+    from codegen.robot import parse_robot
+    from random_arms import random_arm_text
+
+    robot = parse_robot(random_arm_text(seed, dof=dof).encode(), f"arm{seed}.yaml")
+    start = time.perf_counter()
+    generator = Generator(robot)
+    render_robot(robot, generator=generator)
+    seconds = time.perf_counter() - start
+    operations = {f.name: f.body.operation_count for f in generator.functions()}
+    peak_mb = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+    print(json.dumps({"seconds": seconds, "peak_mb": peak_mb, "complete": generator.singularities.complete,
+                      **{name: operations[name] for name in COLUMNS[2:]}}))
+
+
+def measure(dof: int, repeats: int) -> dict:
     rows = []
-    for _ in range(n):
-        alpha = rng.choice(ALPHAS)
-        if alpha == "random":
-            alpha = f"{rng.uniform(-180, 180):.1f}"
-        rows.append(f"  - {{type: revolute, a: {rng.uniform(0.05, 0.5):.3f}, alpha: {alpha}, "
-                    f"d: {rng.uniform(0.05, 0.5):.3f}}}")
-    task = "task: [x, y, z]\n" if n < 6 else ""
-    return f"name: chain{n}\nconvention: standard\nangle_unit: deg\njoints:\n" + "\n".join(rows) + "\n" + task
-
-
-def measure(n: int, rng: random.Random, repeats: int) -> dict:
-    """Mean operation counts and seconds over `repeats` random chains of n joints."""
-    totals = {"fk": 0, "jacobian": 0, "seconds": 0.0}
-    for _ in range(repeats):
-        robot = parse_robot(random_chain(n, rng).encode(), f"chain{n}.yaml")
-        start = time.perf_counter()
-        generator = Generator(robot)
-        fk = generator.lower(generator.chain.tool)
-        jacobian = generator.lower(generator.jacobian)
-        totals["seconds"] += time.perf_counter() - start
-        totals["fk"] += fk.operation_count
-        totals["jacobian"] += jacobian.operation_count
-    row = {key: value / repeats for key, value in totals.items()}
-    return {"n": n, **row, "ops": row["fk"] + row["jacobian"]}
+    for repeat in range(repeats):
+        seed = 1000 * dof + repeat
+        output = subprocess.run([sys.executable, __file__, "--worker", str(dof), str(seed)], check=True,
+                                capture_output=True, text=True).stdout
+        rows.append(json.loads(output))
+    mean = {key: sum(row[key] for row in rows) / len(rows) for key in COLUMNS}
+    return {"n": dof, **mean, "peak_mb": max(row["peak_mb"] for row in rows),
+            "max_seconds": max(row["seconds"] for row in rows), "exact": sum(row["complete"] for row in rows)}
 
 
 def slope(xs, ys) -> float:
@@ -58,20 +63,28 @@ def slope(xs, ys) -> float:
 
 
 def main() -> None:
+    if sys.argv[1:2] == ["--worker"]:
+        worker(int(sys.argv[2]), int(sys.argv[3]))
+        return
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--seed", type=int, default=1)
-    parser.add_argument("--sizes", default="2,4,6,8,10,12", help="comma-separated joint counts")
-    parser.add_argument("--repeats", type=int, default=3, help="random chains per size")
+    parser.add_argument("--sizes", default="1,2,4,6,8,12,16,24,32", help="comma-separated joint counts")
+    parser.add_argument("--repeats", type=int, default=3, help="random arms per size")
     arguments = parser.parse_args()
-    rng = random.Random(arguments.seed)
-    rows = [measure(int(n), rng, arguments.repeats) for n in arguments.sizes.split(",")]
-    print(f"mean of {arguments.repeats} random chains per size (seed {arguments.seed})")
-    print(f"{'n':>3} {'fk ops':>8} {'jacobian ops':>13} {'total ops':>10} {'time s':>8}")
-    for row in rows:
-        print(f"{row['n']:>3} {row['fk']:>8.0f} {row['jacobian']:>13.0f} {row['ops']:>10.0f} {row['seconds']:>8.2f}")
-    sizes = [row["n"] for row in rows]
-    print(f"log-log slope: ops ~ n^{slope(sizes, [row['ops'] for row in rows]):.2f}, "
-          f"time ~ n^{slope(sizes, [row['seconds'] for row in rows]):.2f}")
+    rows = []
+    print(f"random arms, {arguments.repeats} per size; time and operations are means, memory the largest")
+    print(f"{'n':>3} {'time s':>7} {'max s':>7} {'peak MB':>8} {'fk_jacobian':>12} {'sing. factors':>14} "
+          f"{'manipulab.':>11} {'exact':>6}")
+    for n in (int(size) for size in arguments.sizes.split(",")):
+        row = measure(n, arguments.repeats)
+        rows.append(row)
+        print(f"{n:>3} {row['seconds']:>7.2f} {row['max_seconds']:>7.2f} {row['peak_mb']:>8.0f} "
+              f"{row['fk_jacobian']:>12.0f} {row['singularity_factors']:>14.0f} {row['manipulability']:>11.0f} "
+              f"{row['exact']:>4}/{arguments.repeats}", flush=True)
+    for label, chosen in (("all sizes", rows), ("n >= 6", [row for row in rows if row["n"] >= 6])):
+        if len(chosen) >= 2:
+            sizes = [row["n"] for row in chosen]
+            slopes = ", ".join(f"{key} n^{slope(sizes, [row[key] for row in chosen]):.2f}" for key in COLUMNS)
+            print(f"log-log slopes ({label}): {slopes}")
 
 
 if __name__ == "__main__":

@@ -7,6 +7,7 @@ order, so the output does not depend on hashing.
 """
 
 import heapq
+import math
 from dataclasses import dataclass
 from functools import cached_property
 
@@ -118,11 +119,21 @@ class Generator:
 
     def rank_determinant(self, js: sympy.Matrix) -> sympy.Expr:
         """det(Js) for square Js, else the Gram determinant det(Js Js^T) or det(Js^T Js), by
-        Laplace expansion (memoised minors: division-free, at most 6 * 2^5 products) over the
-        named entries: a fixed cost on top of Js, whatever the arm."""
+        Laplace expansion (memoised minors: division-free, at most 6 * 2^5 products per
+        determinant) over the named entries: a fixed cost on top of Js, whatever the arm.
+
+        The Gram determinant is the sum of the squared maximal minors of Js (Cauchy-Binet)
+        while there are at most analysis.MINOR_LIMIT of them: that stays accurate to
+        rounding near a singularity, where det(Js Js^T) formed from the product loses half
+        the digits (its square root, the manipulability, is then good to sqrt(eps) * |Js|^m).
+        """
         m, n = js.shape
-        matrix = js if m == n else (js * js.T if m < n else js.T * js)
-        named = [[self.name(entry) for entry in row] for row in matrix.tolist()]
+        if m == n or math.comb(max(m, n), min(m, n)) <= analysis.MINOR_LIMIT:
+            named = [[self.name(entry) for entry in row] for row in js.tolist()]
+            minors = analysis.maximal_minors(named, sympy.Integer(0), sympy.Integer(1))
+            return minors[0] if m == n else sympy.Add(*(self.name(minor) ** 2 for minor in minors))
+        gram = js * js.T if m < n else js.T * js
+        named = [[self.name(entry) for entry in row] for row in gram.tolist()]
         return analysis.maximal_minors(named, sympy.Integer(0), sympy.Integer(1))[0]
 
     def magnitude(self, value: sympy.Expr) -> sympy.Expr:

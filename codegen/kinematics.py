@@ -68,10 +68,10 @@ def link_transforms(robot: Robot, cos_sin: CosSin, q) -> list[tuple[Matrix, Matr
 @dataclass(frozen=True)
 class Chain:
     """World poses of each joint's axis frame (z = joint axis) and of the tool, and the
-    lever of each axis: the vector from its origin to the tool origin."""
+    lever of each revolute axis: the vector from its origin to the tool origin."""
 
     axes: tuple[Matrix, ...]
-    levers: tuple[Matrix, ...]
+    levers: tuple[Matrix | None, ...]  # None for a prismatic joint
     tool: Matrix
 
 
@@ -93,7 +93,7 @@ def build_chain(robot: Robot, cos_sin: CosSin, q, simplify=lambda e: e, angle_su
     summed angle from `angle_sum(joints)` (default: the product formulas inline).
 
     Translations are added up in world coordinates into one step per stretch between two
-    joint axes. The lever of an axis (from its origin to the tool origin) is the sum of
+    revolute joint axes. The lever of an axis (from its origin to the tool origin) is the sum of
     the steps after it, added up backwards from the tool, each lever the next one plus a
     step; the tool origin is the base origin plus every step. With `simplify` naming each
     sum, every lever costs three additions, not a sum over the rest of the chain.
@@ -141,8 +141,9 @@ def build_chain(robot: Robot, cos_sin: CosSin, q, simplify=lambda e: e, angle_su
             if joint.alpha.exact != 0:
                 rotate(rot_x(*_trig(joint.alpha.exact)))
             shift(Matrix([joint.a.exact, 0, 0]))
-        close_segment()
-        axes.append(_pose(flushed(), origin))
+        if joint.revolute:  # a prismatic column needs no lever: its translation joins the next step
+            close_segment()
+        axes.append(_pose(flushed(), (origin + segment).applyfunc(simplify)))
         steps_before.append(len(steps))
         if joint.revolute:
             turn(i)
@@ -161,6 +162,7 @@ def build_chain(robot: Robot, cos_sin: CosSin, q, simplify=lambda e: e, angle_su
             levers.insert(0, lever)
         lever = (lever + steps[k]).applyfunc(simplify)
     levers = [lever] * (len(axes) - len(levers)) + levers
+    levers = [lever if joint.revolute else None for lever, joint in zip(levers, robot.joints)]
     position = (base[:3, 3] + lever).applyfunc(simplify)
     return Chain(tuple(axes), tuple(levers), _pose(rotation.applyfunc(simplify), position))
 

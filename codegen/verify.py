@@ -53,6 +53,7 @@ JS_FUNCTIONS = ("manipulability", "jacobian_det")
 # velocity_ik is checked (there |q_dot| <~ 1e3 |mu_dot|, so the reference's finite-difference
 # error of 1e-11 in task_jacobian stays below the tolerance in the residual).
 SINGULAR_RANK, REGULAR_RANK = 1e-9, 1e-3
+ZERO_JACOBIAN = 1e-12
 # ik_numeric iterates in Python per target: enough targets to cover the workspace, few
 # enough to keep verify quick.
 NUMERIC_IK_SAMPLES = 20
@@ -229,7 +230,9 @@ def verify_robot(robot: Robot, backends: _Backends, functions: list[Function], q
     results += _ik_results(robot, backends, q[:random_count], tolerances)
     residual = _velocity_ik_residual(robot, backends.python, q[regular])
     results.append(Result(robot.name, "velocity_ik", {"python": residual} | dict.fromkeys(BACKENDS[1:]), tolerances,
-                          f"|Js q_dot - mu_dot| / (|Js| |q_dot| + |mu_dot|) at the {int(regular.sum())} samples where Js is regular"))
+                          (f"|Js^T (Js q_dot - mu_dot)| / |Js| (|Js| |q_dot| + |mu_dot|)" if len(robot.task) > robot.dof
+                           else "|Js q_dot - mu_dot| / (|Js| |q_dot| + |mu_dot|)")
+                          + f" at the {int(regular.sum())} samples where Js is regular"))
     return results
 
 
@@ -242,7 +245,8 @@ def _rank_ratios(robot: Robot, q: np.ndarray) -> np.ndarray:
         if analysis.singularity_rows(robot) is None and np.hypot(rotation[0, 0], rotation[1, 0]) < EULER_MARGIN:
             continue
         values = np.linalg.svd(reference.singularity_jacobian(robot, row), compute_uv=False)
-        ratios[k] = values[-1] / values[0]
+        # A Js that is zero to rounding (a 1 x 1 Js of a task the joint cannot move) is singular.
+        ratios[k] = values[-1] / values[0] if values[0] > ZERO_JACOBIAN * (1 + reach(robot)) else 0.0
     return ratios
 
 
@@ -320,9 +324,10 @@ def _c_ik_numeric(library: CLibrary, real: str, target: np.ndarray, start: np.nd
 
 
 def _velocity_ik_residual(robot: Robot, module, q: np.ndarray) -> float:
-    """Largest backward error |Js q_dot - mu_dot| / (|Js| |q_dot| + |mu_dot|) of the generated
-    Python velocity_ik, mu_dot random: the residual scaled by what rounding alone leaves, so
-    the bound does not depend on how well conditioned Js is."""
+    """Largest backward error of the generated Python velocity_ik, mu_dot random: the residual
+    |Js q_dot - mu_dot| / (|Js| |q_dot| + |mu_dot|), scaled by what rounding alone leaves so
+    the bound does not depend on how well conditioned Js is. A tall Js (m > n) has no exact
+    solution: there the residual is that of the normal equations, Js^T (Js q_dot - mu_dot)."""
     if not len(q):
         return 0.0
     mu_dot = np.random.default_rng(0).normal(size=(len(q), len(robot.task)))
@@ -331,9 +336,12 @@ def _velocity_ik_residual(robot: Robot, module, q: np.ndarray) -> float:
     if not ok.all():
         return math.inf
     js = np.array([reference.singularity_jacobian(robot, row) for row in q])
-    residual = np.linalg.norm(np.einsum("kij,kj->ki", js, q_dot) - mu_dot, axis=1)
-    scale = np.linalg.norm(js, ord=2, axis=(1, 2)) * np.linalg.norm(q_dot, axis=1) + np.linalg.norm(mu_dot, axis=1)
-    return float(np.max(residual / scale, initial=0.0))
+    residual = np.einsum("kij,kj->ki", js, q_dot) - mu_dot
+    norm = np.linalg.norm(js, ord=2, axis=(1, 2))
+    scale = norm * np.linalg.norm(q_dot, axis=1) + np.linalg.norm(mu_dot, axis=1)
+    if len(robot.task) > robot.dof:
+        residual, scale = np.einsum("kij,ki->kj", js, residual), norm * scale
+    return float(np.max(np.linalg.norm(residual, axis=1) / scale, initial=0.0))
 
 
 def verify(robots: list[Robot], samples: int, seed: int,

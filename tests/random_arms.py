@@ -31,11 +31,14 @@ def _pose(rng: random.Random) -> str:
 
 def _task(rng: random.Random, dof: int) -> list[str]:
     """Any non-empty subset of (x, y, z, roll, pitch, yaw), in that order; its size is
-    below, at or above the joint count about equally often (as the six components allow)."""
+    below, at or above the joint count about equally often (as the six components allow),
+    and a small one holds positions only about as often as it holds angles."""
     shape = rng.choice(("fewer", "equal", "more"))
     size = {"fewer": rng.randint(1, max(1, min(dof - 1, 6))), "equal": min(dof, 6),
             "more": rng.randint(min(dof + 1, 6), 6)}[shape]
-    return sorted(rng.sample(TASK_COMPONENTS, size), key=TASK_COMPONENTS.index)
+    positions_only = size <= 3 and rng.random() < 0.4
+    return sorted(rng.sample(TASK_COMPONENTS[:3] if positions_only else TASK_COMPONENTS, size),
+                  key=TASK_COMPONENTS.index)
 
 
 def random_arm_text(seed: int, dof: int | None = None, revolute_only: bool = False) -> str:

@@ -266,3 +266,23 @@ def test_report_is_independent_of_hashing():
                               env={"PYTHONHASHSEED": seed, "PYTHONPATH": str(ROOT)}).stdout for seed in ("0", "4242")}
     assert len(outputs) == 1
     assert "sin(q3) = 0  ->  q3 in {0, pi}: elbow" in outputs.pop()
+
+
+@pytest.mark.parametrize("polynomial", ["c2**3 - 1/2", "4*c2**3 - 3*c2 - 1/5", "s2*c2 + s2 - 1/3", "c2 + 1"])
+def test_roots_of_a_one_joint_factor(polynomial):
+    """Roots from the polynomial in tan(q/2) (numeric above degree 2), against a dense scan
+    of the factor over one turn: the same roots, each within 1e-9 (q = pi included)."""
+    from codegen.analysis import JointRing, _Numeric
+
+    arm = robot("planar_2r")
+    ring = JointRing(arm)
+    factor = ring.ring.from_expr(sympy.sympify(polynomial, locals={"c2": ring.atoms[1][0], "s2": ring.atoms[1][1]}))
+    roots = np.array([float(r) for r in _Numeric(arm, ring)._roots(factor, 1)])
+    value = sympy.lambdify(ring.atoms[1], ring.expr(factor), "numpy")
+    grid = np.linspace(-np.pi, np.pi, 200001)
+    values = value(np.cos(grid), np.sin(grid))
+    scanned = grid[1:][(np.sign(values[:-1]) != np.sign(values[1:])) | (np.abs(values[1:]) < 1e-12)]
+    scanned = np.unique(np.round(np.where(scanned <= -np.pi + 1e-4, np.pi, scanned), 3))
+    assert len(roots) == len(scanned), (roots, scanned)
+    assert np.allclose(np.sort(np.round(roots, 3)), scanned, atol=2e-3)
+    assert np.all(np.abs(value(np.cos(roots), np.sin(roots))) < 1e-9)

@@ -230,3 +230,13 @@ def test_output_is_independent_of_hash_seed(tmp_path):
                        env={**os.environ, "PYTHONHASHSEED": seed, "PYTHONPATH": str(ROOT)})
         outputs.append({path.name: path.read_bytes() for path in sorted(folder.glob("*/*"))})
     assert outputs[0] == outputs[1] and len(outputs[0]) == 3
+
+
+def test_no_posix_math_macros():
+    """C99 has no M_PI or M_SQRT2 (they are POSIX): constants sympy rebuilds after CSE, like
+    sqrt(2) out of sqrt(2*x**2), print as literals."""
+    x = sympy.Symbol("x", real=True)
+    assert CPrinter("double").doprint(sympy.sqrt(2 * x**2)) == "1.4142135623730951*fabs(x)"
+    assert CPrinter("float").doprint(sympy.pi * x) == "3.1415927F*x"
+    for path in sorted((ROOT / "generated").glob("*/*.[ch]")):
+        assert not re.search(r"\bM_[A-Z0-9_]+\b", path.read_text()), path

@@ -101,3 +101,25 @@ def test_output_is_identical_under_two_hash_seeds(tmp_path):
     assert len(outputs[0]) >= len(ROBOT_FILES)
     different = [path for path in outputs[0] if outputs[0][path] != outputs[1][path]]
     assert not different
+
+
+def test_internal_error_is_one_line_and_debug_shows_the_traceback(tmp_path, monkeypatch):
+    """A bug of jacgen's is one line and exit 1, the traceback only with --debug, and
+    nothing already on disk is touched (files are written after everything is generated)."""
+    import codegen.cli
+
+    def broken(*args, **kwargs):
+        raise ZeroDivisionError("polynomial division")
+
+    existing = tmp_path / "planar_2r" / "planar_2r.py"
+    existing.parent.mkdir()
+    existing.write_text("earlier output\n")
+    monkeypatch.setattr(codegen.cli, "render_robot", broken)
+    arguments = ["generate", str(ROOT / "robots" / "planar_2r.yaml"), "-o", str(tmp_path)]
+    result = CliRunner().invoke(main, arguments)
+    assert result.exit_code == 1
+    assert result.output == ("jacgen: internal error: ZeroDivisionError: polynomial division "
+                             "(a bug in jacgen; run with --debug for the traceback)\n")
+    assert existing.read_text() == "earlier output\n"
+    debug = CliRunner().invoke(main, ["--debug"] + arguments)
+    assert isinstance(debug.exception, ZeroDivisionError)

@@ -15,19 +15,16 @@ from click.testing import CliRunner
 from codegen.cli import main
 from random_arms import random_arm_text
 
-STRESS_SEEDS = int(os.environ.get("JACGEN_STRESS_SEEDS", "32"))
+STRESS_SEEDS = int(os.environ.get("JACGEN_STRESS_SEEDS", "30"))
 
 
 @pytest.mark.parametrize("seed", range(STRESS_SEEDS))
 def test_random_arm_generates_and_verifies(tmp_path, seed):
     path = tmp_path / f"arm{seed}.yaml"
     path.write_text(random_arm_text(seed))
-    runner = CliRunner()
-    generated = runner.invoke(main, ["generate", str(path), "-o", str(tmp_path / "out")], catch_exceptions=False)
-    assert generated.exit_code == 0, generated.output
-    assert "warning" not in generated.output  # no fallback: the result does not depend on the machine
-    verified = runner.invoke(main, ["verify", str(path), "--samples", "40"], catch_exceptions=False)
-    assert verified.exit_code == 0, verified.output
+    verified = CliRunner().invoke(main, ["verify", str(path), "--samples", "40"], catch_exceptions=False)
+    assert verified.exit_code == 0, verified.output  # generated every language, built, compared
+    assert "warning" not in verified.output  # no fallback: the result does not depend on the machine
     compared = [line for line in verified.output.splitlines() if re.search(r"\d\.\de-\d\d", line)]
     assert len(compared) >= 8, verified.output  # every function was evaluated, not skipped
 

@@ -59,11 +59,11 @@ void iiwa_task(const iiwa_real q[IIWA_DOF], iiwa_real mu[IIWA_TASK_DIM]);
 void iiwa_task_jacobian(const iiwa_real q[IIWA_DOF], iiwa_real J[IIWA_TASK_DIM * IIWA_DOF]);
 
 /* Factors of det(Js Js^T): the robot is singular where one is 0.
- * Result: f[i], i < 2. 645 operations. */
+ * Result: f[i], i < 2. 735 operations. */
 void iiwa_singularity_factors(const iiwa_real q[IIWA_DOF], iiwa_real f[IIWA_NUM_SINGULARITY_FACTORS]);
 
 /* Manipulability sqrt(det(Js Js^T)).
- * Result: returned as a scalar. 648 operations. */
+ * Result: returned as a scalar. 738 operations. */
 iiwa_real iiwa_manipulability(const iiwa_real q[IIWA_DOF]);
 
 /* Status of iiwa_velocity_ik. */

@@ -59,11 +59,11 @@ void panda_task(const panda_real q[PANDA_DOF], panda_real mu[PANDA_TASK_DIM]);
 void panda_task_jacobian(const panda_real q[PANDA_DOF], panda_real J[PANDA_TASK_DIM * PANDA_DOF]);
 
 /* Factors of det(Js Js^T): the robot is singular where one is 0.
- * Result: f[i], i < 1. 673 operations. */
+ * Result: f[i], i < 1. 755 operations. */
 void panda_singularity_factors(const panda_real q[PANDA_DOF], panda_real f[PANDA_NUM_SINGULARITY_FACTORS]);
 
 /* Manipulability sqrt(det(Js Js^T)).
- * Result: returned as a scalar. 676 operations. */
+ * Result: returned as a scalar. 758 operations. */
 panda_real panda_manipulability(const panda_real q[PANDA_DOF]);
 
 /* Status of panda_velocity_ik. */

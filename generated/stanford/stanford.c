@@ -6,7 +6,7 @@
 
 void stanford_fk(const stanford_real q[STANFORD_DOF], stanford_real T[16])
 {
-    /* 77 operations */
+    /* 73 operations */
 
     /* Inputs */
     const stanford_real q1 = q[0];
@@ -29,47 +29,45 @@ void stanford_fk(const stanford_real q[STANFORD_DOF], stanford_real T[16])
     const stanford_real s6 = sin(q6);
     const stanford_real t0 = c2*q3 + 0.412;
     const stanford_real t1 = q3*s2;
-    const stanford_real t2 = c1*t1 + 0.0203*s1;
-    const stanford_real t3 = -0.0203*c1 + s1*t1;
-    const stanford_real t4 = -0.154*s1 + t2;
-    const stanford_real t5 = 0.154*c1 + t3;
-    const stanford_real t6 = c4*s1;
-    const stanford_real t7 = c1*s4;
-    const stanford_real t8 = c2*t7 + t6;
-    const stanford_real t9 = c2*t6 + t7;
-    const stanford_real t10 = s1*s4;
-    const stanford_real t11 = c1*c4;
-    const stanford_real t12 = c2*t11 - t10;
-    const stanford_real t13 = c2*t10 - t11;
-    const stanford_real t14 = c1*s2;
-    const stanford_real t15 = c5*t8 - s5*t14;
-    const stanford_real t16 = c5*t14 + s5*t8;
-    const stanford_real t17 = c6*t15 + s6*t12;
-    const stanford_real t18 = c6*t12 - s6*t15;
-    const stanford_real t19 = s1*s2;
-    const stanford_real t20 = c5*t13 - s5*t19;
-    const stanford_real t21 = c5*t19 + s5*t13;
-    const stanford_real t22 = c6*t20 + s6*t9;
-    const stanford_real t23 = c6*t9 - s6*t20;
-    const stanford_real t24 = s2*s4;
-    const stanford_real t25 = c2*s5 + c5*t24;
-    const stanford_real t26 = -c2*c5 + s5*t24;
-    const stanford_real t27 = c4*s2;
-    const stanford_real t28 = c6*t25 + s6*t27;
-    const stanford_real t29 = -c6*t27 + s6*t25;
+    const stanford_real t2 = c1*t1 - 0.1337*s1;
+    const stanford_real t3 = 0.1337*c1 + s1*t1;
+    const stanford_real t4 = c4*s1;
+    const stanford_real t5 = c1*s4;
+    const stanford_real t6 = c2*t5 + t4;
+    const stanford_real t7 = c2*t4 + t5;
+    const stanford_real t8 = s1*s4;
+    const stanford_real t9 = c1*c4;
+    const stanford_real t10 = c2*t9 - t8;
+    const stanford_real t11 = c2*t8 - t9;
+    const stanford_real t12 = c1*s2;
+    const stanford_real t13 = c5*t6 - s5*t12;
+    const stanford_real t14 = c5*t12 + s5*t6;
+    const stanford_real t15 = c6*t13 + s6*t10;
+    const stanford_real t16 = c6*t10 - s6*t13;
+    const stanford_real t17 = s1*s2;
+    const stanford_real t18 = c5*t11 - s5*t17;
+    const stanford_real t19 = c5*t17 + s5*t11;
+    const stanford_real t20 = c6*t18 + s6*t7;
+    const stanford_real t21 = c6*t7 - s6*t18;
+    const stanford_real t22 = s2*s4;
+    const stanford_real t23 = c2*s5 + c5*t22;
+    const stanford_real t24 = -c2*c5 + s5*t22;
+    const stanford_real t25 = c4*s2;
+    const stanford_real t26 = c6*t23 + s6*t25;
+    const stanford_real t27 = -c6*t25 + s6*t23;
 
     /* Outputs */
-    T[0] = t17;
-    T[1] = t18;
-    T[2] = t16;
-    T[3] = t4;
-    T[4] = t22;
-    T[5] = t23;
-    T[6] = t21;
-    T[7] = t5;
-    T[8] = -t28;
-    T[9] = t29;
-    T[10] = -t26;
+    T[0] = t15;
+    T[1] = t16;
+    T[2] = t14;
+    T[3] = t2;
+    T[4] = t20;
+    T[5] = t21;
+    T[6] = t19;
+    T[7] = t3;
+    T[8] = -t26;
+    T[9] = t27;
+    T[10] = -t24;
     T[11] = t0;
     T[12] = 0;
     T[13] = 0;
@@ -79,7 +77,7 @@ void stanford_fk(const stanford_real q[STANFORD_DOF], stanford_real T[16])
 
 void stanford_jacobian(const stanford_real q[STANFORD_DOF], stanford_real J[6 * STANFORD_DOF])
 {
-    /* 54 operations */
+    /* 50 operations */
 
     /* Inputs */
     const stanford_real q1 = q[0];
@@ -99,38 +97,36 @@ void stanford_jacobian(const stanford_real q[STANFORD_DOF], stanford_real J[6 * 
     const stanford_real s5 = sin(q5);
     const stanford_real t0 = -c2*c5 + s2*s4*s5;
     const stanford_real t1 = c1*s2;
-    const stanford_real t2 = q3*t1 + 0.0203*s1;
-    const stanford_real t3 = -0.154*s1 + t2;
-    const stanford_real t4 = s1*s2;
-    const stanford_real t5 = -0.0203*c1 + q3*t4;
-    const stanford_real t6 = 0.154*c1 + t5;
-    const stanford_real t7 = c4*s1;
-    const stanford_real t8 = c1*s4;
-    const stanford_real t9 = c2*t8 + t7;
-    const stanford_real t10 = c2*t7 + t8;
-    const stanford_real t11 = c5*t1 + s5*t9;
-    const stanford_real t12 = s1*s4;
-    const stanford_real t13 = c1*c4;
-    const stanford_real t14 = c2*t13 - t12;
-    const stanford_real t15 = c2*t12 - t13;
-    const stanford_real t16 = c5*t4 + s5*t15;
-    const stanford_real t17 = c2*q3;
+    const stanford_real t2 = q3*t1 - 0.1337*s1;
+    const stanford_real t3 = s1*s2;
+    const stanford_real t4 = 0.1337*c1 + q3*t3;
+    const stanford_real t5 = c4*s1;
+    const stanford_real t6 = c1*s4;
+    const stanford_real t7 = c2*t6 + t5;
+    const stanford_real t8 = c2*t5 + t6;
+    const stanford_real t9 = c5*t1 + s5*t7;
+    const stanford_real t10 = s1*s4;
+    const stanford_real t11 = c1*c4;
+    const stanford_real t12 = c2*t11 - t10;
+    const stanford_real t13 = c2*t10 - t11;
+    const stanford_real t14 = c5*t3 + s5*t13;
+    const stanford_real t15 = c2*q3;
 
     /* Outputs */
-    J[0] = -t6;
-    J[1] = c1*t17;
+    J[0] = -t4;
+    J[1] = c1*t15;
     J[2] = t1;
     J[3] = 0;
     J[4] = 0;
     J[5] = 0;
-    J[6] = t3;
-    J[7] = s1*t17;
-    J[8] = t4;
+    J[6] = t2;
+    J[7] = s1*t15;
+    J[8] = t3;
     J[9] = 0;
     J[10] = 0;
     J[11] = 0;
     J[12] = 0;
-    J[13] = -c1*t3 - s1*t6;
+    J[13] = -c1*t2 - s1*t4;
     J[14] = c2;
     J[15] = 0;
     J[16] = 0;
@@ -139,14 +135,14 @@ void stanford_jacobian(const stanford_real q[STANFORD_DOF], stanford_real J[6 * 
     J[19] = -s1;
     J[20] = 0;
     J[21] = t1;
-    J[22] = t14;
-    J[23] = t11;
+    J[22] = t12;
+    J[23] = t9;
     J[24] = 0;
     J[25] = c1;
     J[26] = 0;
-    J[27] = t4;
-    J[28] = t10;
-    J[29] = t16;
+    J[27] = t3;
+    J[28] = t8;
+    J[29] = t14;
     J[30] = 1;
     J[31] = 0;
     J[32] = 0;
@@ -157,7 +153,7 @@ void stanford_jacobian(const stanford_real q[STANFORD_DOF], stanford_real J[6 * 
 
 void stanford_fk_jacobian(const stanford_real q[STANFORD_DOF], stanford_real T[16], stanford_real J[6 * STANFORD_DOF])
 {
-    /* 85 operations */
+    /* 81 operations */
 
     /* Inputs */
     const stanford_real q1 = q[0];
@@ -179,68 +175,66 @@ void stanford_fk_jacobian(const stanford_real q[STANFORD_DOF], stanford_real T[1
     const stanford_real c6 = cos(q6);
     const stanford_real s6 = sin(q6);
     const stanford_real t0 = c1*s2;
-    const stanford_real t1 = q3*t0 + 0.0203*s1;
-    const stanford_real t2 = -0.154*s1 + t1;
-    const stanford_real t3 = s1*s2;
-    const stanford_real t4 = -0.0203*c1 + q3*t3;
-    const stanford_real t5 = 0.154*c1 + t4;
-    const stanford_real t6 = c2*q3;
-    const stanford_real t7 = t6 + 0.412;
-    const stanford_real t8 = c4*s1;
-    const stanford_real t9 = c1*s4;
-    const stanford_real t10 = c2*t9 + t8;
-    const stanford_real t11 = c2*t8 + t9;
-    const stanford_real t12 = c5*t10 - s5*t0;
-    const stanford_real t13 = c5*t0 + s5*t10;
-    const stanford_real t14 = s1*s4;
-    const stanford_real t15 = c1*c4;
-    const stanford_real t16 = c2*t15 - t14;
-    const stanford_real t17 = c2*t14 - t15;
-    const stanford_real t18 = c5*t17 - s5*t3;
-    const stanford_real t19 = c5*t3 + s5*t17;
-    const stanford_real t20 = c6*t12 + s6*t16;
-    const stanford_real t21 = c6*t16 - s6*t12;
-    const stanford_real t22 = c6*t18 + s6*t11;
-    const stanford_real t23 = c6*t11 - s6*t18;
-    const stanford_real t24 = s2*s4;
-    const stanford_real t25 = c2*s5 + c5*t24;
-    const stanford_real t26 = -c2*c5 + s5*t24;
-    const stanford_real t27 = c4*s2;
-    const stanford_real t28 = c6*t25 + s6*t27;
-    const stanford_real t29 = -c6*t27 + s6*t25;
-    const stanford_real t30 = -t26;
+    const stanford_real t1 = q3*t0 - 0.1337*s1;
+    const stanford_real t2 = s1*s2;
+    const stanford_real t3 = 0.1337*c1 + q3*t2;
+    const stanford_real t4 = c2*q3;
+    const stanford_real t5 = t4 + 0.412;
+    const stanford_real t6 = c4*s1;
+    const stanford_real t7 = c1*s4;
+    const stanford_real t8 = c2*t7 + t6;
+    const stanford_real t9 = c2*t6 + t7;
+    const stanford_real t10 = c5*t8 - s5*t0;
+    const stanford_real t11 = c5*t0 + s5*t8;
+    const stanford_real t12 = s1*s4;
+    const stanford_real t13 = c1*c4;
+    const stanford_real t14 = c2*t13 - t12;
+    const stanford_real t15 = c2*t12 - t13;
+    const stanford_real t16 = c5*t15 - s5*t2;
+    const stanford_real t17 = c5*t2 + s5*t15;
+    const stanford_real t18 = c6*t10 + s6*t14;
+    const stanford_real t19 = c6*t14 - s6*t10;
+    const stanford_real t20 = c6*t16 + s6*t9;
+    const stanford_real t21 = c6*t9 - s6*t16;
+    const stanford_real t22 = s2*s4;
+    const stanford_real t23 = c2*s5 + c5*t22;
+    const stanford_real t24 = -c2*c5 + s5*t22;
+    const stanford_real t25 = c4*s2;
+    const stanford_real t26 = c6*t23 + s6*t25;
+    const stanford_real t27 = -c6*t25 + s6*t23;
+    const stanford_real t28 = -t24;
 
     /* Outputs */
-    T[0] = t20;
-    T[1] = t21;
-    T[2] = t13;
-    T[3] = t2;
-    T[4] = t22;
-    T[5] = t23;
-    T[6] = t19;
-    T[7] = t5;
-    T[8] = -t28;
-    T[9] = t29;
-    T[10] = t30;
-    T[11] = t7;
+    T[0] = t18;
+    T[1] = t19;
+    T[2] = t11;
+    T[3] = t1;
+    T[4] = t20;
+    T[5] = t21;
+    T[6] = t17;
+    T[7] = t3;
+    T[8] = -t26;
+    T[9] = t27;
+    T[10] = t28;
+    T[11] = t5;
     T[12] = 0;
     T[13] = 0;
     T[14] = 0;
     T[15] = 1;
-    J[0] = -t5;
-    J[1] = c1*t6;
+    J[0] = -t3;
+    J[1] = c1*t4;
     J[2] = t0;
     J[3] = 0;
     J[4] = 0;
     J[5] = 0;
-    J[6] = t2;
-    J[7] = s1*t6;
-    J[8] = t3;
+    J[6] = t1;
+    J[7] = s1*t4;
+    J[8] = t2;
     J[9] = 0;
     J[10] = 0;
     J[11] = 0;
     J[12] = 0;
-    J[13] = -c1*t2 - s1*t5;
+    J[13] = -c1*t1 - s1*t3;
     J[14] = c2;
     J[15] = 0;
     J[16] = 0;
@@ -249,25 +243,25 @@ void stanford_fk_jacobian(const stanford_real q[STANFORD_DOF], stanford_real T[1
     J[19] = -s1;
     J[20] = 0;
     J[21] = t0;
-    J[22] = t16;
-    J[23] = t13;
+    J[22] = t14;
+    J[23] = t11;
     J[24] = 0;
     J[25] = c1;
     J[26] = 0;
-    J[27] = t3;
-    J[28] = t11;
-    J[29] = t19;
+    J[27] = t2;
+    J[28] = t9;
+    J[29] = t17;
     J[30] = 1;
     J[31] = 0;
     J[32] = 0;
     J[33] = c2;
-    J[34] = -t27;
-    J[35] = t30;
+    J[34] = -t25;
+    J[35] = t28;
 }
 
 void stanford_jacobian_tool(const stanford_real q[STANFORD_DOF], stanford_real J[6 * STANFORD_DOF])
 {
-    /* 160 operations */
+    /* 156 operations */
 
     /* Inputs */
     const stanford_real q1 = q[0];
@@ -289,84 +283,82 @@ void stanford_jacobian_tool(const stanford_real q[STANFORD_DOF], stanford_real J
     const stanford_real c6 = cos(q6);
     const stanford_real s6 = sin(q6);
     const stanford_real t0 = q3*s2;
-    const stanford_real t1 = c1*t0 + 0.0203*s1;
-    const stanford_real t2 = -0.0203*c1 + s1*t0;
-    const stanford_real t3 = -0.154*s1 + t1;
-    const stanford_real t4 = 0.154*c1 + t2;
-    const stanford_real t5 = c4*s1;
-    const stanford_real t6 = c1*s4;
-    const stanford_real t7 = c2*t6 + t5;
-    const stanford_real t8 = c2*t5 + t6;
-    const stanford_real t9 = s1*s4;
-    const stanford_real t10 = c1*c4;
-    const stanford_real t11 = c2*t10 - t9;
-    const stanford_real t12 = c2*t9 - t10;
-    const stanford_real t13 = c1*s2;
-    const stanford_real t14 = c5*t7 - s5*t13;
-    const stanford_real t15 = c5*t13 + s5*t7;
-    const stanford_real t16 = c6*t14 + s6*t11;
-    const stanford_real t17 = c6*t11 - s6*t14;
-    const stanford_real t18 = s1*s2;
-    const stanford_real t19 = c5*t12 - s5*t18;
-    const stanford_real t20 = c5*t18 + s5*t12;
-    const stanford_real t21 = c6*t19 + s6*t8;
-    const stanford_real t22 = c6*t8 - s6*t19;
-    const stanford_real t23 = s2*s4;
-    const stanford_real t24 = c2*s5 + c5*t23;
-    const stanford_real t25 = -c2*c5 + s5*t23;
-    const stanford_real t26 = c4*s2;
-    const stanford_real t27 = c6*t24 + s6*t26;
-    const stanford_real t28 = -c6*t26 + s6*t24;
-    const stanford_real t29 = c2*q3;
-    const stanford_real t30 = c1*t29;
-    const stanford_real t31 = s1*t29;
-    const stanford_real t32 = -c1*t3 - s1*t4;
-    const stanford_real t33 = -c2*t27 + t13*t16 + t18*t21;
-    const stanford_real t34 = c2*t28 + t13*t17 + t18*t22;
-    const stanford_real t35 = -c2*t25 + t13*t15 + t18*t20;
+    const stanford_real t1 = c1*t0 - 0.1337*s1;
+    const stanford_real t2 = 0.1337*c1 + s1*t0;
+    const stanford_real t3 = c4*s1;
+    const stanford_real t4 = c1*s4;
+    const stanford_real t5 = c2*t4 + t3;
+    const stanford_real t6 = c2*t3 + t4;
+    const stanford_real t7 = s1*s4;
+    const stanford_real t8 = c1*c4;
+    const stanford_real t9 = c2*t8 - t7;
+    const stanford_real t10 = c2*t7 - t8;
+    const stanford_real t11 = c1*s2;
+    const stanford_real t12 = c5*t5 - s5*t11;
+    const stanford_real t13 = c5*t11 + s5*t5;
+    const stanford_real t14 = c6*t12 + s6*t9;
+    const stanford_real t15 = c6*t9 - s6*t12;
+    const stanford_real t16 = s1*s2;
+    const stanford_real t17 = c5*t10 - s5*t16;
+    const stanford_real t18 = c5*t16 + s5*t10;
+    const stanford_real t19 = c6*t17 + s6*t6;
+    const stanford_real t20 = c6*t6 - s6*t17;
+    const stanford_real t21 = s2*s4;
+    const stanford_real t22 = c2*s5 + c5*t21;
+    const stanford_real t23 = -c2*c5 + s5*t21;
+    const stanford_real t24 = c4*s2;
+    const stanford_real t25 = c6*t22 + s6*t24;
+    const stanford_real t26 = -c6*t24 + s6*t22;
+    const stanford_real t27 = c2*q3;
+    const stanford_real t28 = c1*t27;
+    const stanford_real t29 = s1*t27;
+    const stanford_real t30 = -c1*t1 - s1*t2;
+    const stanford_real t31 = -c2*t25 + t11*t14 + t16*t19;
+    const stanford_real t32 = c2*t26 + t11*t15 + t16*t20;
+    const stanford_real t33 = -c2*t23 + t11*t13 + t16*t18;
 
     /* Outputs */
-    J[0] = -t16*t4 + t21*t3;
-    J[1] = t16*t30 + t21*t31 - t27*t32;
-    J[2] = t33;
+    J[0] = t1*t19 - t14*t2;
+    J[1] = t14*t28 + t19*t29 - t25*t30;
+    J[2] = t31;
     J[3] = 0;
     J[4] = 0;
     J[5] = 0;
-    J[6] = -t17*t4 + t22*t3;
-    J[7] = t17*t30 + t22*t31 + t28*t32;
-    J[8] = t34;
+    J[6] = t1*t20 - t15*t2;
+    J[7] = t15*t28 + t20*t29 + t26*t30;
+    J[8] = t32;
     J[9] = 0;
     J[10] = 0;
     J[11] = 0;
-    J[12] = -t15*t4 + t20*t3;
-    J[13] = t15*t30 + t20*t31 - t25*t32;
-    J[14] = t35;
+    J[12] = t1*t18 - t13*t2;
+    J[13] = t13*t28 + t18*t29 - t23*t30;
+    J[14] = t33;
     J[15] = 0;
     J[16] = 0;
     J[17] = 0;
-    J[18] = -t27;
-    J[19] = c1*t21 - s1*t16;
+    J[18] = -t25;
+    J[19] = c1*t19 - s1*t14;
     J[20] = 0;
-    J[21] = t33;
-    J[22] = t11*t16 + t21*t8 + t26*t27;
-    J[23] = t15*t16 + t20*t21 + t25*t27;
-    J[24] = t28;
-    J[25] = c1*t22 - s1*t17;
+    J[21] = t31;
+    J[22] = t14*t9 + t19*t6 + t24*t25;
+    J[23] = t13*t14 + t18*t19 + t23*t25;
+    J[24] = t26;
+    J[25] = c1*t20 - s1*t15;
     J[26] = 0;
-    J[27] = t34;
-    J[28] = t11*t17 + t22*t8 - t26*t28;
-    J[29] = t15*t17 + t20*t22 - t25*t28;
-    J[30] = -t25;
-    J[31] = c1*t20 - s1*t15;
+    J[27] = t32;
+    J[28] = t15*t9 + t20*t6 - t24*t26;
+    J[29] = t13*t15 + t18*t20 - t23*t26;
+    J[30] = -t23;
+    J[31] = c1*t18 - s1*t13;
     J[32] = 0;
-    J[33] = t35;
-    J[34] = t11*t15 + t20*t8 + t25*t26;
-    J[35] = (t15*t15) + (t20*t20) + (t25*t25);
+    J[33] = t33;
+    J[34] = t13*t9 + t18*t6 + t23*t24;
+    J[35] = (t13*t13) + (t18*t18) + (t23*t23);
 }
 
 void stanford_task(const stanford_real q[STANFORD_DOF], stanford_real mu[STANFORD_TASK_DIM])
 {
-    /* 71 operations */
+    /* 67 operations */
 
     /* Inputs */
     const stanford_real q1 = q[0];
@@ -390,40 +382,38 @@ void stanford_task(const stanford_real q[STANFORD_DOF], stanford_real mu[STANFOR
     const stanford_real t0 = c2*q3 + 0.412;
     const stanford_real t1 = c2*s5 + c5*s2*s4;
     const stanford_real t2 = q3*s2;
-    const stanford_real t3 = c1*t2 + 0.0203*s1;
-    const stanford_real t4 = -0.0203*c1 + s1*t2;
-    const stanford_real t5 = -0.154*s1 + t3;
-    const stanford_real t6 = 0.154*c1 + t4;
-    const stanford_real t7 = c4*s1;
-    const stanford_real t8 = c1*s4;
-    const stanford_real t9 = c2*t8 + t7;
-    const stanford_real t10 = c2*t7 + t8;
-    const stanford_real t11 = s1*s4;
-    const stanford_real t12 = c1*c4;
-    const stanford_real t13 = c2*t12 - t11;
-    const stanford_real t14 = c2*t11 - t12;
-    const stanford_real t15 = s2*s5;
-    const stanford_real t16 = -c1*t15 + c5*t9;
-    const stanford_real t17 = c5*t14 - s1*t15;
-    const stanford_real t18 = -c2*c5 + s4*t15;
-    const stanford_real t19 = c6*t16 + s6*t13;
-    const stanford_real t20 = c6*t17 + s6*t10;
-    const stanford_real t21 = c4*s2;
-    const stanford_real t22 = c6*t1 + s6*t21;
-    const stanford_real t23 = -c6*t21 + s6*t1;
+    const stanford_real t3 = c1*t2 - 0.1337*s1;
+    const stanford_real t4 = 0.1337*c1 + s1*t2;
+    const stanford_real t5 = c4*s1;
+    const stanford_real t6 = c1*s4;
+    const stanford_real t7 = c2*t6 + t5;
+    const stanford_real t8 = c2*t5 + t6;
+    const stanford_real t9 = s1*s4;
+    const stanford_real t10 = c1*c4;
+    const stanford_real t11 = c2*t10 - t9;
+    const stanford_real t12 = c2*t9 - t10;
+    const stanford_real t13 = s2*s5;
+    const stanford_real t14 = -c1*t13 + c5*t7;
+    const stanford_real t15 = c5*t12 - s1*t13;
+    const stanford_real t16 = -c2*c5 + s4*t13;
+    const stanford_real t17 = c6*t14 + s6*t11;
+    const stanford_real t18 = c6*t15 + s6*t8;
+    const stanford_real t19 = c4*s2;
+    const stanford_real t20 = c6*t1 + s6*t19;
+    const stanford_real t21 = -c6*t19 + s6*t1;
 
     /* Outputs */
-    mu[0] = t5;
-    mu[1] = t6;
+    mu[0] = t3;
+    mu[1] = t4;
     mu[2] = t0;
-    mu[3] = atan2(t23, -t18);
-    mu[4] = atan2(t22, sqrt((t19*t19) + (t20*t20)));
-    mu[5] = atan2(t20, t19);
+    mu[3] = atan2(t21, -t16);
+    mu[4] = atan2(t20, sqrt((t17*t17) + (t18*t18)));
+    mu[5] = atan2(t18, t17);
 }
 
 void stanford_task_jacobian(const stanford_real q[STANFORD_DOF], stanford_real J[STANFORD_TASK_DIM * STANFORD_DOF])
 {
-    /* 117 operations */
+    /* 113 operations */
 
     /* Inputs */
     const stanford_real q1 = q[0];
@@ -445,76 +435,74 @@ void stanford_task_jacobian(const stanford_real q[STANFORD_DOF], stanford_real J
     const stanford_real c6 = cos(q6);
     const stanford_real s6 = sin(q6);
     const stanford_real t0 = c1*s2;
-    const stanford_real t1 = q3*t0 + 0.0203*s1;
-    const stanford_real t2 = -0.154*s1 + t1;
-    const stanford_real t3 = s1*s2;
-    const stanford_real t4 = -0.0203*c1 + q3*t3;
-    const stanford_real t5 = 0.154*c1 + t4;
-    const stanford_real t6 = c4*s1;
-    const stanford_real t7 = c1*s4;
-    const stanford_real t8 = c2*t7 + t6;
-    const stanford_real t9 = c2*t6 + t7;
-    const stanford_real t10 = c5*t8 - s5*t0;
-    const stanford_real t11 = c5*t0 + s5*t8;
-    const stanford_real t12 = s1*s4;
-    const stanford_real t13 = c1*c4;
-    const stanford_real t14 = c2*t13 - t12;
-    const stanford_real t15 = c2*t12 - t13;
-    const stanford_real t16 = c5*t15 - s5*t3;
-    const stanford_real t17 = c5*t3 + s5*t15;
-    const stanford_real t18 = c6*t10 + s6*t14;
-    const stanford_real t19 = c6*t16 + s6*t9;
-    const stanford_real t20 = s2*s4;
-    const stanford_real t21 = c2*s5 + c5*t20;
-    const stanford_real t22 = -c2*c5 + s5*t20;
-    const stanford_real t23 = c4*s2;
-    const stanford_real t24 = c6*t21 + s6*t23;
-    const stanford_real t25 = c2*q3;
-    const stanford_real t26 = (t18*t18) + (t19*t19);
-    const stanford_real t27 = 1.0/t26;
-    const stanford_real t28 = t27*(c1*t19 - s1*t18);
-    const stanford_real t29 = t27*(t0*t18 + t19*t3);
-    const stanford_real t30 = t27*(t14*t18 + t19*t9);
-    const stanford_real t31 = t27*(t11*t18 + t17*t19);
-    const stanford_real t32 = 1.0/sqrt(t26);
+    const stanford_real t1 = q3*t0 - 0.1337*s1;
+    const stanford_real t2 = s1*s2;
+    const stanford_real t3 = 0.1337*c1 + q3*t2;
+    const stanford_real t4 = c4*s1;
+    const stanford_real t5 = c1*s4;
+    const stanford_real t6 = c2*t5 + t4;
+    const stanford_real t7 = c2*t4 + t5;
+    const stanford_real t8 = c5*t6 - s5*t0;
+    const stanford_real t9 = c5*t0 + s5*t6;
+    const stanford_real t10 = s1*s4;
+    const stanford_real t11 = c1*c4;
+    const stanford_real t12 = c2*t11 - t10;
+    const stanford_real t13 = c2*t10 - t11;
+    const stanford_real t14 = c5*t13 - s5*t2;
+    const stanford_real t15 = c5*t2 + s5*t13;
+    const stanford_real t16 = c6*t8 + s6*t12;
+    const stanford_real t17 = c6*t14 + s6*t7;
+    const stanford_real t18 = s2*s4;
+    const stanford_real t19 = c2*s5 + c5*t18;
+    const stanford_real t20 = -c2*c5 + s5*t18;
+    const stanford_real t21 = c4*s2;
+    const stanford_real t22 = c6*t19 + s6*t21;
+    const stanford_real t23 = c2*q3;
+    const stanford_real t24 = (t16*t16) + (t17*t17);
+    const stanford_real t25 = 1.0/t24;
+    const stanford_real t26 = t25*(c1*t17 - s1*t16);
+    const stanford_real t27 = t25*(t0*t16 + t17*t2);
+    const stanford_real t28 = t25*(t12*t16 + t17*t7);
+    const stanford_real t29 = t25*(t15*t17 + t16*t9);
+    const stanford_real t30 = 1.0/sqrt(t24);
 
     /* Outputs */
-    J[0] = -t5;
-    J[1] = c1*t25;
+    J[0] = -t3;
+    J[1] = c1*t23;
     J[2] = t0;
     J[3] = 0;
     J[4] = 0;
     J[5] = 0;
-    J[6] = t2;
-    J[7] = s1*t25;
-    J[8] = t3;
+    J[6] = t1;
+    J[7] = s1*t23;
+    J[8] = t2;
     J[9] = 0;
     J[10] = 0;
     J[11] = 0;
     J[12] = 0;
-    J[13] = -c1*t2 - s1*t5;
+    J[13] = -c1*t1 - s1*t3;
     J[14] = c2;
     J[15] = 0;
     J[16] = 0;
     J[17] = 0;
     J[18] = 0;
-    J[19] = t28;
+    J[19] = t26;
     J[20] = 0;
-    J[21] = t29;
-    J[22] = t30;
-    J[23] = t31;
+    J[21] = t27;
+    J[22] = t28;
+    J[23] = t29;
     J[24] = 0;
-    J[25] = t32*(c1*t18 + s1*t19);
+    J[25] = t30*(c1*t16 + s1*t17);
     J[26] = 0;
-    J[27] = t32*(-t0*t19 + t18*t3);
-    J[28] = t32*(-t14*t19 + t18*t9);
-    J[29] = t32*(-t11*t19 + t17*t18);
+    J[27] = t30*(-t0*t17 + t16*t2);
+    J[28] = t30*(-t12*t17 + t16*t7);
+    J[29] = t30*(t15*t16 - t17*t9);
     J[30] = 1;
-    J[31] = t24*t28;
+    J[31] = t22*t26;
     J[32] = 0;
-    J[33] = c2 + t24*t29;
-    J[34] = -t23 + t24*t30;
-    J[35] = -t22 + t24*t31;
+    J[33] = c2 + t22*t27;
+    J[34] = -t21 + t22*t28;
+    J[35] = -t20 + t22*t29;
 }
 
 void stanford_singularity_factors(const stanford_real q[STANFORD_DOF], stanford_real f[STANFORD_NUM_SINGULARITY_FACTORS])

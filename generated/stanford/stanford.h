@@ -34,27 +34,27 @@ typedef double stanford_real;
 #define STANFORD_NUM_SINGULARITY_FACTORS 3
 
 /* Pose of the tool frame in the world frame (4x4 homogeneous).
- * Result: T: 4 x 4 row-major, element (r, c) at T[r * 4 + c]. 77 operations. */
+ * Result: T: 4 x 4 row-major, element (r, c) at T[r * 4 + c]. 73 operations. */
 void stanford_fk(const stanford_real q[STANFORD_DOF], stanford_real T[16]);
 
 /* Geometric Jacobian in the world frame (6 x DOF, rows vx vy vz wx wy wz).
- * Result: J: 6 x 6 row-major, element (r, c) at J[r * 6 + c]. 54 operations. */
+ * Result: J: 6 x 6 row-major, element (r, c) at J[r * 6 + c]. 50 operations. */
 void stanford_jacobian(const stanford_real q[STANFORD_DOF], stanford_real J[6 * STANFORD_DOF]);
 
 /* Fk and jacobian in one pass, sharing their terms.
- * Result: T: 4 x 4 row-major, element (r, c) at T[r * 4 + c]; J: 6 x 6 row-major, element (r, c) at J[r * 6 + c]. 85 operations. */
+ * Result: T: 4 x 4 row-major, element (r, c) at T[r * 4 + c]; J: 6 x 6 row-major, element (r, c) at J[r * 6 + c]. 81 operations. */
 void stanford_fk_jacobian(const stanford_real q[STANFORD_DOF], stanford_real T[16], stanford_real J[6 * STANFORD_DOF]);
 
 /* Geometric Jacobian in the tool frame (6 x DOF, rows vx vy vz wx wy wz).
- * Result: J: 6 x 6 row-major, element (r, c) at J[r * 6 + c]. 160 operations. */
+ * Result: J: 6 x 6 row-major, element (r, c) at J[r * 6 + c]. 156 operations. */
 void stanford_jacobian_tool(const stanford_real q[STANFORD_DOF], stanford_real J[6 * STANFORD_DOF]);
 
 /* Task vector mu = (x, y, z, roll, pitch, yaw).
- * Result: mu[i], i < 6. 71 operations. */
+ * Result: mu[i], i < 6. 67 operations. */
 void stanford_task(const stanford_real q[STANFORD_DOF], stanford_real mu[STANFORD_TASK_DIM]);
 
 /* Analytic Jacobian d mu / d q (6 x DOF).
- * Result: J: 6 x 6 row-major, element (r, c) at J[r * 6 + c]. 117 operations. */
+ * Result: J: 6 x 6 row-major, element (r, c) at J[r * 6 + c]. 113 operations. */
 void stanford_task_jacobian(const stanford_real q[STANFORD_DOF], stanford_real J[STANFORD_TASK_DIM * STANFORD_DOF]);
 
 /* Factors of det(Js): the robot is singular where one is 0.
