@@ -1,11 +1,13 @@
-"""A time budget for symbolic steps that can blow up (simplification, factoring).
+"""A time budget: the safety net around each robot's exact singularity analysis.
 
-    from codegen import budget
-    factors = budget.within_budget(lambda: sympy.factor_list(p), lambda: (1, [(p, 1)]),
-                                   what="factoring the singularity polynomial")
+The analysis is bounded by design (analysis.WORK_LIMIT and the other size limits); the
+budget is there only in case a limit is ever wrong, and no arm tried reaches it:
+
+    singular = budget.within_budget(lambda: analysis.analyse(robot), lambda: analysis.unanalysed(robot),
+                                    what=f"the singularity analysis of {robot.name}")
 
 runs the work for at most `budget.seconds()` (set by `jacgen generate --budget`); when time
-runs out it prints one warning on stderr and returns the cheaper exact fallback instead.
+runs out it prints one warning on stderr and returns the fallback instead.
 
 How: a real-time interval timer (`signal.setitimer`) whose SIGALRM handler raises
 `BudgetExceeded` inside the work. sympy is pure Python, so the exception lands between two

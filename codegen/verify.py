@@ -230,7 +230,7 @@ def verify_robot(robot: Robot, backends: _Backends, functions: list[Function], q
     results += _ik_results(robot, backends, q[:random_count], tolerances)
     residual = _velocity_ik_residual(robot, backends.python, q[regular])
     results.append(Result(robot.name, "velocity_ik", {"python": residual} | dict.fromkeys(BACKENDS[1:]), tolerances,
-                          (f"|Js^T (Js q_dot - mu_dot)| / |Js| (|Js| |q_dot| + |mu_dot|)" if len(robot.task) > robot.dof
+                          ("|Js^T (Js q_dot - mu_dot)| / |Js| (|Js| |q_dot| + |mu_dot|)" if len(robot.task) > robot.dof
                            else "|Js q_dot - mu_dot| / (|Js| |q_dot| + |mu_dot|)")
                           + f" at the {int(regular.sum())} samples where Js is regular"))
     return results
