@@ -38,7 +38,7 @@ from .robot import TASK_COMPONENTS, Robot
 EULER = ("roll", "pitch", "yaw")
 # The exact analysis is bounded by counts, never by a clock, so its outcome is the same on
 # every machine. WORK_LIMIT bounds the monomial products of all polynomial multiplications
-# of one robot (about 10 s of sympy's sparse arithmetic at the most); MINOR_LIMIT the
+# of one robot (about 3 s of sympy's sparse arithmetic at the most); MINOR_LIMIT the
 # maximal minors whose common factors are sought (C(n, m) of them); FACTOR_TERM_LIMIT the
 # size of a polynomial handed to sympy's factoring. Past any of them the exact factors
 # found so far stay, and the generated code computes the rest of the rank condition
@@ -237,11 +237,11 @@ def _frames_about(ring: JointRing, k: int) -> list:
 def _geometric_columns(ring: JointRing, frames: list, point) -> list[list[PolyElement]]:
     """Geometric Jacobian (6 x n rows) in the frames' coordinates about `point`, reduced."""
     rows = [[None] * ring.robot.dof for _ in range(6)]
+    x = ring.times
     for i, joint in enumerate(ring.robot.joints):
         z = [frames[i][r][2] for r in range(3)]
         if joint.revolute:
             arm = [point[r] - frames[i][r][3] for r in range(3)]
-            x = ring.times
             linear = [x(z[1], arm[2]) - x(z[2], arm[1]), x(z[2], arm[0]) - x(z[0], arm[2]), x(z[0], arm[1]) - x(z[1], arm[0])]
             column = linear + z
         else:
@@ -316,8 +316,9 @@ def _analysed_matrix(ring: JointRing):
 
     The whole geometric Jacobian: in the joint frame and about the reference point (that
     frame's origin or the tool point; always the tool point when tall, where only rotations
-    keep det(Js^T Js)) that make it smallest; its determinant is sign * det(Js). Otherwise Js in the world frame,
-    Euler-angle rows multiplied by their denominators, which are returned as cos(pitch)^2.
+    keep det(Js^T Js)) that make it smallest; its determinant is sign * det(Js). Otherwise
+    Js in the world frame, Euler-angle rows multiplied by their denominators, which are
+    returned as cos(pitch)^2.
     """
     robot = ring.robot
     n, rows = robot.dof, singularity_rows(robot)
@@ -396,6 +397,12 @@ class Singularities:
     note: str
 
 
+def singularity_kind(robot: Robot) -> str:
+    """The singularity polynomial: det(Js) (m = n), det(Js Js^T) (m < n) or det(Js^T Js) (m > n)."""
+    n, m = robot.dof, len(robot.task)
+    return "det(Js)" if m == n else ("det(Js Js^T)" if m < n else "det(Js^T Js)")
+
+
 def _gram_factors(ring: JointRing, minors: list) -> tuple[PolyElement, list, bool, str]:
     """(constant, factors, complete, note) of the Gram determinant sum(minor^2) (Cauchy-Binet),
     from the factors common to every maximal minor, never from the sum itself."""
@@ -420,7 +427,7 @@ def analyse(robot: Robot) -> Singularities:
     size limits allow: bounded work, the same result on every machine."""
     ring = JointRing(robot)
     n, m = robot.dof, len(robot.task)
-    kind = "det(Js)" if m == n else ("det(Js Js^T)" if m < n else "det(Js^T Js)")
+    kind = singularity_kind(robot)
     constant, factors, complete, note, cos_pitch_sq = ring.ring.one, [], False, "", None
     try:
         matrix, sign, cos_pitch_sq = _analysed_matrix(ring)
@@ -430,7 +437,7 @@ def analyse(robot: Robot) -> Singularities:
         if all(not minor for minor in minors):
             return Singularities(kind, (), True, True, sympy.Integer(0), (), 0, (),
                                  f"Js has rank below {min(m, n)} in every configuration: "
-                                 f"the arm cannot move its tool along every task direction at once", )
+                                 f"the arm cannot move its tool along every task direction at once")
         if m == n:
             if len(minors[0]) > FACTOR_TERM_LIMIT:
                 raise TooLarge(f"det(Js) has {len(minors[0])} terms")
@@ -464,8 +471,7 @@ def analyse(robot: Robot) -> Singularities:
 def unanalysed(robot: Robot) -> Singularities:
     """No exact factors: the numeric rank determinant is the whole condition (the fallback
     of the analysis when it outlives --budget)."""
-    n, m = robot.dof, len(robot.task)
-    kind = "det(Js)" if m == n else ("det(Js Js^T)" if m < n else "det(Js^T Js)")
+    kind = singularity_kind(robot)
     return Singularities(kind, (), False, False, sympy.Integer(1), (), 0, (),
                          f"the exact analysis took longer than --budget: {kind}, computed numerically, is the condition")
 
@@ -498,13 +504,14 @@ class _Numeric:
         expr, t = self.ring.expr(f).xreplace(self.nominal), sympy.Dummy("t", real=True)
         atoms = self.ring.atoms[joint]
         poly = sympy.Poly(expr, *atoms)
+        scale = max(1.0, *(abs(float(c)) for c in poly.coeffs()))
         if len(atoms) == 1:
-            in_t, at_pi = sympy.Poly(expr, atoms[0]), []
+            in_t, at_pi = poly, []
         else:
             degree = poly.total_degree()
             in_t = sympy.Poly(sum(coefficient * (1 - t**2) ** i * (2 * t) ** j * (1 + t**2) ** (degree - i - j)
                                   for (i, j), coefficient in poly.terms()), t)
-            at_pi = [sympy.pi] if abs(poly.eval((-1, 0))) <= ROOT_TOLERANCE * _scale(poly) else []
+            at_pi = [sympy.pi] if abs(poly.eval((-1, 0))) <= ROOT_TOLERANCE * scale else []
         if in_t.is_zero:
             return ()
         if in_t.degree() <= 2 and not in_t.has(sympy.Float):
@@ -518,7 +525,7 @@ class _Numeric:
         unique = {}
         for root in roots + at_pi:
             point = (math.cos(float(root)), math.sin(float(root))) if len(atoms) == 2 else (float(root),)
-            if abs(value(*point)) <= ROOT_TOLERANCE * _scale(poly) and round(float(root), 9) not in unique:
+            if abs(value(*point)) <= ROOT_TOLERANCE * scale and round(float(root), 9) not in unique:
                 unique[round(float(root), 9)] = root
         return tuple(unique[key] for key in sorted(unique))
 
@@ -575,10 +582,6 @@ class _Numeric:
             if n >= 3 and points and all(_over_first_axis(robot, q, point(q)) for q in points):
                 return f"shoulder: {name} in the plane of the axes of joints 1 and 2 (over the axis of joint 1)"
         return ""
-
-
-def _scale(poly: sympy.Poly) -> float:
-    return max(1.0, *(abs(float(c)) for c in poly.coeffs()))
 
 
 def _solve_along(value, q: np.ndarray, joint: int, spec) -> np.ndarray | None:

@@ -86,8 +86,7 @@ class Generator:
         # Trig symbols, each defined once, in an order that defines before use.
         self.definitions: list[tuple[sympy.Symbol, sympy.Expr]] = []
         self._trig: dict[tuple[int, ...], tuple[sympy.Symbol, sympy.Symbol]] = {}
-        self._named: set[sympy.Symbol] = set()
-        self._names: dict[sympy.Expr, sympy.Symbol] = {}
+        self._names: dict[sympy.Expr, sympy.Symbol] = {}  # named values (see `name`)
         with distribute(False):  # keep 0.0825*(a - b) whole, for CSE to share a - b
             self.chain = kinematics.build_chain(robot, lambda i: self.cos_sin((i,)), self.q, simplify=self.name,
                                                angle_sum=self.cos_sin)
@@ -185,11 +184,10 @@ class Generator:
                                                                                  for _, m in results))))
 
     def name(self, value: sympy.Expr) -> sympy.Expr:
-        """`value` as a symbol of its own (an atom or a number stays as it is).
-
-        Naming the chain's origins keeps the lever arms `p - o_i` three subtractions each:
-        written out, sympy flattens the nested sums and every lever repeats the chain's tail.
-        """
+        """`value` as a symbol of its own (an atom, a number or a product of atoms stays as it
+        is; -x is named as x). The chain names its rotations, steps and levers, so that every
+        expression CSE sees has a bounded size: written out, sympy flattens the nested sums
+        and each lever would repeat the rest of the chain."""
         if value.is_Atom or (value.is_Mul and all(arg.is_Atom for arg in value.args)):
             return value
         negated = sympy.Add(*(-term for term in value.args)) if value.is_Add else -value
@@ -199,7 +197,6 @@ class Generator:
             return self._names[value]
         symbol = sympy.Symbol(f"_n{len(self.definitions)}", real=True)
         self.definitions.append((symbol, value))
-        self._named.add(symbol)
         self._names[value] = symbol
         return symbol
 
@@ -214,8 +211,9 @@ class Generator:
             if symbol in values and symbol not in needed:
                 needed.add(symbol)
                 frontier |= values[symbol].free_symbols
-        trig = [(s, fold_constants(v)) for s, v in self.definitions if s in needed and s not in self._named]
-        named = [(s, v) for s, v in self.definitions if s in needed and s in self._named]
+        named_symbols = set(self._names.values())
+        trig = [(s, fold_constants(v)) for s, v in self.definitions if s in needed and s not in named_symbols]
+        named = [(s, v) for s, v in self.definitions if s in needed and s in named_symbols]
         with distribute(False):
             replacements, reduced = sympy.cse([fold_constants(v) for _, v in named] + [fold_constants(e) for e in outputs],
                                               symbols=sympy.numbered_symbols("_r", real=True), order="canonical")

@@ -156,14 +156,12 @@ def build_chain(robot: Robot, cos_sin: CosSin, q, simplify=lambda e: e, angle_su
     shift(tool[:3, 3])
     rotate(tool)
     close_segment()
-    levers, lever = [], sympy.zeros(3, 1)
-    for k in reversed(range(len(steps))):
-        while len(levers) < len(axes) and steps_before[len(axes) - 1 - len(levers)] > k:
-            levers.insert(0, lever)
-        lever = (lever + steps[k]).applyfunc(simplify)
-    levers = [lever] * (len(axes) - len(levers)) + levers
-    levers = [lever if joint.revolute else None for lever, joint in zip(levers, robot.joints)]
-    position = (base[:3, 3] + lever).applyfunc(simplify)
+    tails = [sympy.zeros(3, 1)]  # tails[k]: the sum of the last k steps
+    for step in reversed(steps):
+        tails.append((tails[-1] + step).applyfunc(simplify))
+    levers = [tails[len(steps) - before] if joint.revolute else None
+              for before, joint in zip(steps_before, robot.joints)]
+    position = (base[:3, 3] + tails[-1]).applyfunc(simplify)
     return Chain(tuple(axes), tuple(levers), _pose(rotation.applyfunc(simplify), position))
 
 
