@@ -6,13 +6,19 @@ import math
 import sympy
 
 from . import analysis, ik, report
-from .functions import Function, Generator, Output
+from .functions import Function, Generator, Output, is_boolean
 from .printers import CasadiPrinter, CPrinter, PythonPrinter, fold_constants
 from .robot import Robot
 
-# SPEC §3: the C array extent of each output it names, as factors that are numbers or the
-# suffixes of size macros (`6 * NAME_DOF`); any other function's output gets its size.
+# The contract's C array extent of each argument and output (`function.output`, or the function
+# when it has one), as factors that are numbers or the suffixes of size macros
+# (`6 * NAME_DOF`); any other function's output gets its size.
 C_EXTENTS = {
+    "q": ("DOF",),
+    "T": (16,),
+    "mu": ("TASK_DIM",),
+    "ik_branches.q": ("MAX_IK_SOLUTIONS", "DOF"),
+    "ik_branches.valid": ("MAX_IK_SOLUTIONS",),
     "fk": (16,),
     "jacobian": (6, "DOF"),
     "jacobian_tool": (6, "DOF"),
@@ -36,20 +42,28 @@ def _common(robot: Robot) -> dict:
     }
 
 
-def _python_function(function: Function, printer: PythonPrinter) -> dict:
+def _python_function(function: Function, printer: PythonPrinter, parameters: list[dict]) -> dict:
     body = function.body
+    shapes = [a.symbols.shape[:1] if a.vector else a.symbols.shape for a in function.arguments]
     results = []
     for output, values in function.parts(body.outputs):
         indices = [", ".join(["..."] + [str(i) for i in divmod(k, output.cols)[: len(output.shape)]])
                    for k in range(output.size)]
-        results.append({"name": output.name, "shape": repr(output.shape),
+        results.append({"name": output.name, "shape": repr(output.shape), "dtype": "bool" if output.boolean else "float",
                         "values": [(index, printer.doprint(e)) for index, e in zip(indices, values)]})
     return {
         "name": function.name,
         "summary": function.summary,
         "shape": " and ".join(" x ".join(map(str, (o.rows, o.cols))) for o in function.outputs),
         "operations": body.operation_count,
-        "inputs": [(f"q{i + 1}", f"q[..., {i}]") for i in body.joints_used],
+        "arguments": [(a.name, repr(shape)) for a, shape in zip(function.arguments, shapes)],
+        "signature": ", ".join([a.name for a in function.arguments] + ["*"] * bool(parameters)
+                               + [f"{p['name']}={p['value']}" for p in parameters]),
+        "batch": f"{function.arguments[0].name}.shape[:-{len(shapes[0])}]",
+        "selects": any(isinstance(e, sympy.Piecewise) or e.has(sympy.Piecewise)
+                       for e in [v for _, v in body.definitions] + list(body.outputs)),
+        "inputs": [(str(symbol), f"{argument.name}[..., {row}]" if argument.vector else f"{argument.name}[..., {row}, {col}]")
+                   for symbol, argument, row, col in function.inputs],
         "definitions": [(str(symbol), printer.doprint(e)) for symbol, e in body.definitions],
         "results": results,
     }
@@ -72,18 +86,24 @@ def _layout(output: Output) -> str:
 def _c_macros(robot: Robot, functions: list[Function]) -> dict[str, int]:
     macros = {"DOF": robot.dof, "TASK_DIM": len(robot.task)}
     macros.update({C_ROW_MACROS[f.name]: f.outputs[0].rows for f in functions if f.name in C_ROW_MACROS})
+    macros.update({"MAX_IK_SOLUTIONS": f.outputs[0].rows for f in functions if f.name == "ik_branches"})
     return macros
 
 
-def _c_extent(function: Function, output: Output, macros: dict[str, int], prefix: str) -> str:
-    """`6 * NAME_DOF`: the SPEC's extent of an output array, checked against its size."""
-    factors = C_EXTENTS.get(output.equals or function.name, (output.size,))
-    size = 1
+def _c_extent(key: str, size: int, macros: dict[str, int], prefix: str) -> str:
+    """`6 * NAME_DOF`: the contract's extent of an array, checked against its size."""
+    factors = C_EXTENTS.get(key, (size,))
+    product = 1
     for factor in factors:
-        size *= macros[factor] if isinstance(factor, str) else factor
-    if size != output.size:
-        raise ValueError(f"{function.name}: SPEC extent {factors} != {output.rows} x {output.cols}")
+        product *= macros[factor] if isinstance(factor, str) else factor
+    if product != size:
+        raise ValueError(f"{key}: contract extent {factors} != {size}")
     return " * ".join(f"{prefix}_{factor}" if isinstance(factor, str) else str(factor) for factor in factors)
+
+
+def _c_output_key(function: Function, output: Output) -> str:
+    key = f"{function.name}.{output.name}"
+    return key if key in C_EXTENTS else output.equals or function.name
 
 
 def _parameters_read(body, robot: Robot) -> list[str]:
@@ -93,13 +113,16 @@ def _parameters_read(body, robot: Robot) -> list[str]:
 
 def _c_function(function: Function, robot: Robot, printer: CPrinter, macros: dict[str, int]) -> dict:
     body, prefix, real = function.body, robot.name.upper(), f"{robot.name}_real"
-    arguments = [f"const {real} q[{prefix}_DOF]"]
+    arguments = [f"const {real} {a.name}[{_c_extent(a.name, a.size, macros, prefix)}]" for a in function.arguments]
     if not function.scalar:
-        arguments += [f"{real} {o.name}[{_c_extent(function, o, macros, prefix)}]" for o in function.outputs]
+        arguments += [f"{'int' if o.boolean else real} {o.name}[{_c_extent(_c_output_key(function, o), o.size, macros, prefix)}]"
+                      for o in function.outputs]
     parameters = _parameters_read(body, robot)
     if robot.symbolic_parameters:
         arguments.append(f"const {robot.name}_params *p")
-    unused = ["q"] * (not body.joints_used) + ["p"] * bool(robot.symbolic_parameters and not parameters)
+    inputs = list(function.inputs)
+    unused = [a.name for a in function.arguments if not any(argument is a for _, argument, _, _ in inputs)]
+    unused += ["p"] * bool(robot.symbolic_parameters and not parameters)
     returns = real if function.scalar else "void"
     return {
         "name": function.name,
@@ -108,8 +131,9 @@ def _c_function(function: Function, robot: Robot, printer: CPrinter, macros: dic
         "operations": body.operation_count,
         "prototype": f"{returns} {robot.name}_{function.name}({', '.join(arguments)})",
         "unused": unused,
-        "inputs": [(f"q{i + 1}", f"q[{i}]") for i in body.joints_used] + [(name, f"p->{name}") for name in parameters],
-        "definitions": [(str(symbol), printer.doprint(e)) for symbol, e in body.definitions],
+        "inputs": [(str(symbol), f"{argument.name}[{row * argument.symbols.cols + col}]")
+                   for symbol, argument, row, col in inputs] + [(name, f"p->{name}") for name in parameters],
+        "definitions": [("int" if is_boolean(e) else real, str(symbol), printer.doprint(e)) for symbol, e in body.definitions],
         "outputs": [] if function.scalar else [(f"{output.name}[{k}]", printer.doprint(e))
                                                for output, values in function.parts(body.outputs)
                                                for k, e in enumerate(values)],
@@ -166,7 +190,9 @@ def _casadi_function(function: Function, robot: Robot, printer: CasadiPrinter) -
         "name": function.name,
         "summary": _sentence(function.summary),
         "operations": body.operation_count,
-        "inputs": [(f"q{i + 1}", f"q[{i}]") for i in body.joints_used]
+        "arguments": [(a.name, a.symbols.rows, a.symbols.cols) for a in function.arguments],
+        "inputs": [(str(symbol), f"{argument.name}[{row}]" if argument.vector else f"{argument.name}[{row}, {col}]")
+                   for symbol, argument, row, col in function.inputs]
         + [(name, f"p[{[q.name for q in robot.symbolic_parameters].index(name)}]")
            for name in _parameters_read(body, robot)],
         "definitions": [(str(symbol), printer.doprint(e)) for symbol, e in body.definitions],
@@ -178,44 +204,23 @@ def _casadi_function(function: Function, robot: Robot, printer: CasadiPrinter) -
 IK_NUMERIC_DAMPING = {"start": 1e-6, "min": 1e-12, "max": 1e8}
 
 
-def _ik_context(robot: Robot, printer, language: str, real: str) -> dict | None:
-    """The closed-form solver's partial: constants printed in the language, None without one."""
-    form = ik.closed_form(robot)
+def _ik_context(robot: Robot, generator: Generator, language: str, real: str) -> dict | None:
+    """What the ik wrapper around ik_branches documents and declares, None without a closed form."""
+    form = generator.closed_form
     if form is None:
         return None
-    is_python, prefix, real_type = language == "python", robot.name.upper(), f"{robot.name}_real"
-
-    def literal(values: sympy.Matrix) -> str:
-        items = [printer.doprint(fold_constants(e)) for e in values]  # row-major
-        if len(items) == 1:
-            return items[0]
-        return f"({', '.join(items)})" if is_python else f"{{{', '.join(items)}}}"
-
+    prefix, real_type = robot.name.upper(), f"{robot.name}_real"
     pose = form.target == "pose"
-    read = set().union(*(value.free_symbols for _, value in form.constants))
-    read_names = [p.name for p in robot.symbolic_parameters if p.symbol in read]
     target = f"const {real_type} T[16]" if pose else f"const {real_type} mu[{prefix}_TASK_DIM]"
     arguments = [target, f"{real_type} q[{prefix}_MAX_IK_SOLUTIONS * {prefix}_DOF]"]
     arguments += [f"const {robot.name}_params *p"] * bool(robot.symbolic_parameters)
     return {
         "solver": form.solver,
         "max_solutions": form.info.max_solutions,
-        "doc": ik.documentation(robot, form, "MAX_IK_SOLUTIONS" if is_python else f"{prefix}_MAX_IK_SOLUTIONS"),
-        "helpers": list(form.helpers),
-        "flip": form.flip,
-        "constants": [(name, literal(value)) for name, value in form.constants],
-        "fields": [(name, len(value)) for name, value in form.constants],
-        "parameters": ", ".join(name for name, _ in form.constants),
-        "parameters_read": read_names,
-        "parameters_unused": bool(robot.symbolic_parameters) and not read_names,
-        "indices": dict(form.indices),
-        "revolute": [i for i, joint in enumerate(robot.joints) if joint.revolute],
-        "pose": pose,
-        "target_shape": "(4, 4)" if pose else f"({len(robot.task)},)",
+        "doc": ik.documentation(robot, form, "MAX_IK_SOLUTIONS" if language == "python" else f"{prefix}_MAX_IK_SOLUTIONS"),
         "target_name": "T" if pose else "mu",
-        "target_size": 12 if pose else f"{prefix}_TASK_DIM",  # the entries read (not T's last row)
+        "target_ndim": 2 if pose else 1,
         "signature": ", ".join(arguments),
-        **{name: repr(value) for name, value in ik.TOLERANCES["double" if is_python else real].items()},
     }
 
 
@@ -254,59 +259,15 @@ def _ik_numeric_context(robot: Robot, language: str, real: str) -> dict:
     }
 
 
-# atan(t) = t + t z P(z) / Q(z), z = t^2, |t| <= tan(pi/8): Cephes' minimax coefficients of P
-# and Q, highest power first (S. L. Moshier, Cephes Math Library: atan.c, atanf.c; Q = 1 for float).
-ATAN_APPROXIMATION = {
-    "double": ((-8.750608600031904122785e-1, -1.615753718733365076637e1, -7.500855792314704667340e1,
-                -1.228866684490136173410e2, -6.485021904942025371773e1),
-               (1.0, 2.485846490142306297962e1, 1.650270098316988542046e2, 4.328810604912902668951e2,
-                4.853903996359136964868e2, 1.945506571482613964425e2)),
-    "float": ((8.05374449538e-2, -1.38776856032e-1, 1.99777106478e-1, -3.33329491539e-1), ()),
-}
-
-
-def _estrin(coefficients: tuple[float, ...], printer: CPrinter) -> tuple[str, set[str]]:
-    """The polynomial in z with these coefficients (highest power first) by Estrin's scheme,
-    (a0 + a1 z) + z2 (a2 + a3 z) + z4 (a4 + a5 z), shorter dependency chains than Horner's;
-    returns the code and the powers of z it reads."""
-    ascending = list(reversed(coefficients))
-    if len(ascending) > 6:
-        raise ValueError("Estrin's scheme here takes at most 6 coefficients")
-    literal = lambda c: printer.doprint(sympy.Float(c))  # noqa: E731
-    terms, powers = [], set()
-    for j, power in enumerate(("", "z2", "z4")):
-        pair = ascending[2 * j:2 * j + 2]
-        if not pair:
-            break
-        text = literal(pair[0])
-        if len(pair) == 2:
-            slope = "z" if pair[1] == 1 else f"{literal(abs(pair[1]))} * z"
-            text += f" {'-' if pair[1] < 0 else '+'} {slope}"
-        terms.append(f"({text})" if not power else f"{power} * ({text})")
-        powers |= {power} - {""}
-    return " + ".join(terms), powers
-
-
 def _ik_math(robot: Robot, real: str) -> dict:
-    """What the hand-written C of the ik partials needs: <math.h> names, literals, and whether
-    the angle-wrapping helper is emitted (used by ik and by ik_numeric's angle errors)."""
+    """What the hand-written C of ik_numeric needs: <math.h> names and literals."""
     printer = CPrinter(real)
     suffix = "f" if real == "float" else ""
-    numerator, powers = _estrin(ATAN_APPROXIMATION[real][0], printer)
-    denominator, more_powers = _estrin(ATAN_APPROXIMATION[real][1], printer) if ATAN_APPROXIMATION[real][1] else ("", set())
-    angles = len(robot.task) < 6 and any(name in ("roll", "pitch", "yaw") for name in robot.task)
     return {
         "fn": {name: name + suffix for name in ("sqrt", "atan2", "sin", "cos", "fabs")},
         "literal_suffix": "F" if real == "float" else "",
         "pi": printer.doprint(fold_constants(sympy.pi)),
         "two_pi": printer.doprint(fold_constants(2 * sympy.pi)),
-        "half_pi": printer.doprint(fold_constants(sympy.pi / 2)),
-        "quarter_pi": printer.doprint(fold_constants(sympy.pi / 4)),
-        "tan_pi_8": printer.doprint(fold_constants(sympy.sqrt(2) - 1)),
-        "atan_numerator": numerator,
-        "atan_denominator": denominator,
-        "atan_powers": sorted(powers | more_powers),
-        "wrap": angles or ik.closed_form(robot) is not None,
     }
 
 
@@ -375,14 +336,14 @@ def template_context(robot: Robot, generator: Generator, language: str, real: st
     context = _common(robot)
     if language == "python":
         printer = PythonPrinter()
-        context["functions"] = [_python_function(f, printer) for f in generator.functions()]
-        context["ik"] = _ik_context(robot, printer, language, real)
+        context["functions"] = [_python_function(f, printer, context["parameters"]) for f in generator.functions()]
+        context["ik"] = _ik_context(robot, generator, language, real)
         context["ik_numeric"] = _ik_numeric_context(robot, language, real)
         context["ik_math"] = _ik_math(robot, "double")
         context["velocity_ik"] = _velocity_ik_context(robot, "double")
     elif language == "c":
         context.update(_c_context(robot, generator, real))
-        context["ik"] = _ik_context(robot, CPrinter(real), language, real)
+        context["ik"] = _ik_context(robot, generator, language, real)
         context["ik_numeric"] = _ik_numeric_context(robot, language, real)
         context["ik_math"] = _ik_math(robot, real)
         context["velocity_ik"] = _velocity_ik_c_context(robot, real)
@@ -390,5 +351,9 @@ def template_context(robot: Robot, generator: Generator, language: str, real: st
         context.update(_report_context(robot, generator))
     elif language == "casadi":
         printer = CasadiPrinter()
-        context["functions"] = [_casadi_function(f, robot, printer) for f in generator.functions()]
+        functions = generator.functions()
+        context["functions"] = [_casadi_function(f, robot, printer) for f in functions]
+        context["arguments"] = sorted({(a.name, a.symbols.rows, a.symbols.cols) for f in functions for a in f.arguments},
+                                      key=lambda a: ("q", "T", "mu").index(a[0]))
+        context["ik"] = generator.closed_form is not None
     return dict(sorted(context.items()))

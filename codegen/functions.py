@@ -13,23 +13,43 @@ from functools import cached_property
 
 import sympy
 from sympy.core.parameters import distribute
+from sympy.logic.boolalg import Boolean
 
-from . import analysis, budget, kinematics
+from . import analysis, budget, ik, kinematics
+from .subproblems import Subproblems
 from .printers import fold_constants
 from .robot import Robot
 
 
 @dataclass(frozen=True)
 class Body:
-    """Straight-line code: input bindings, then definitions in order, then the outputs."""
+    """Straight-line code: definitions in order, then the outputs (selects, no branches)."""
 
-    joints_used: tuple[int, ...]  # indices of q read by the body
+    read: frozenset  # the input symbols the body reads
     definitions: tuple[tuple[sympy.Symbol, sympy.Expr], ...]
     outputs: tuple[sympy.Expr, ...]  # row-major
 
     @cached_property
     def operation_count(self) -> int:
         return int(sympy.count_ops([e for _, e in self.definitions] + list(self.outputs)))
+
+
+def is_boolean(value: sympy.Basic) -> bool:
+    """A truth value (a comparison, And, Or, ...): an `int` in C, a bool array in numpy."""
+    return isinstance(value, Boolean) and not isinstance(value, sympy.Expr)
+
+
+@dataclass(frozen=True)
+class Argument:
+    """An input of a generated function: its name and its symbols, in its shape."""
+
+    name: str
+    symbols: sympy.Matrix
+    vector: bool = True  # numpy shape (..., rows); else (..., rows, cols)
+
+    @property
+    def size(self) -> int:
+        return len(self.symbols)
 
 
 @dataclass(frozen=True)
@@ -42,6 +62,7 @@ class Output:
     scalar: bool = False
     vector: bool = False  # a column vector: numpy shape (rows,), even for one row
     equals: str = ""  # the function whose result this is, when the function fuses several
+    boolean: bool = False  # truth values
 
     @property
     def size(self) -> int:
@@ -63,6 +84,15 @@ class Function:
     summary: str
     outputs: tuple[Output, ...]
     body: Body
+    arguments: tuple[Argument, ...]
+
+    @property
+    def inputs(self):
+        """(symbol, argument, row, col) of every input the body reads, in argument order."""
+        for argument in self.arguments:
+            for k, symbol in enumerate(argument.symbols):
+                if symbol in self.body.read:
+                    yield (symbol, argument, *divmod(k, argument.symbols.cols))
 
     @property
     def scalar(self) -> bool:
@@ -106,6 +136,25 @@ class Generator:
             self.definitions += [(cos, value[0]), (sin, value[1])]
             self._trig[joints] = (cos, sin)
         return self._trig[joints]
+
+    @cached_property
+    def closed_form(self) -> "ik.ClosedForm | None":
+        return ik.closed_form(self.robot)
+
+    def ik_functions(self) -> list[Function]:
+        """ik_branches: every branch of the closed-form solver with its validity, from the
+        target's symbols (none without a closed form)."""
+        form = self.closed_form
+        if form is None:
+            return []
+        if form.target == "pose":
+            target = Argument("T", sympy.Matrix(4, 4, lambda r, c: sympy.Symbol(f"T{r}{c}", real=True)), vector=False)
+        else:
+            target = Argument("mu", sympy.Matrix([sympy.Symbol(f"mu{i}", real=True) for i in range(len(self.robot.task))]))
+        with distribute(False):
+            q, valid = ik.branches(self.robot, form, Subproblems(self.name), target.symbols)
+        return [self.function("ik_branches", "every branch of the closed-form ik and whether the target allows it",
+                              ("q", q), ("valid", valid), arguments=(target,))]
 
     @cached_property
     def jacobian(self) -> sympy.Matrix:
@@ -175,13 +224,19 @@ class Generator:
             self.function("jacobian_det", "det(Js)", ("d", sympy.Matrix([determinant])), scalar=True),
         ]
 
-    def function(self, name: str, summary: str, *results: tuple[str, sympy.Matrix], scalar: bool = False,
-                 vector: bool = False, equals: tuple[str, ...] = ()) -> Function:
-        """A function of one or more named results, lowered together so they share their terms."""
-        outputs = tuple(Output(output, matrix.rows, matrix.cols, scalar, vector, equal)
-                        for (output, matrix), equal in zip(results, equals or ("",) * len(results)))
-        return Function(name, summary, outputs, self.lower(sympy.Matrix.vstack(*(m.reshape(m.rows * m.cols, 1)
-                                                                                 for _, m in results))))
+    def function(self, name: str, summary: str, *results: tuple[str, sympy.Matrix | list], scalar: bool = False,
+                 vector: bool = False, equals: tuple[str, ...] = (),
+                 arguments: tuple[Argument, ...] | None = None) -> Function:
+        """A function of one or more named results (matrices, or lists of truth values as
+        columns), lowered together so they share their terms; its arguments are q unless given."""
+        outputs, values = [], []
+        for (output, result), equal in zip(results, equals or ("",) * len(results)):
+            rows, cols = result.shape if isinstance(result, sympy.Matrix) else (len(result), 1)
+            boolean = all(map(is_boolean, result))
+            outputs.append(Output(output, rows, cols, scalar, vector or boolean, equal, boolean))
+            values += list(result)
+        return Function(name, summary, tuple(outputs), self.lower(values),
+                        arguments or (Argument("q", sympy.Matrix(self.q)),))
 
     def name(self, value: sympy.Expr) -> sympy.Expr:
         """`value` as a symbol of its own (an atom, a number or a product of atoms stays as it
@@ -200,7 +255,7 @@ class Generator:
         self._names[value] = symbol
         return symbol
 
-    def lower(self, outputs: sympy.Matrix) -> Body:
+    def lower(self, outputs: list[sympy.Basic]) -> Body:
         """The outputs as straight-line code: the trig symbols and named values they need,
         then temporaries (t0, t1, ...) after common-subexpression elimination, in an order
         that defines before use."""
@@ -223,8 +278,7 @@ class Generator:
         definitions = tuple((rename.get(s, s), v.xreplace(rename)) for s, v in definitions)
         reduced = [e.xreplace(rename) for e in reduced[len(named):]]
         read = set().union(*(e.free_symbols for _, e in definitions), *(e.free_symbols for e in reduced))
-        joints_used = tuple(i for i, symbol in enumerate(self.q) if symbol in read)
-        return Body(joints_used, definitions, tuple(reduced))
+        return Body(frozenset(read - {symbol for symbol, _ in definitions}), definitions, tuple(reduced))
 
     def functions(self) -> list[Function]:
         """Every straight-line function, in the order the backends emit them."""
@@ -247,6 +301,7 @@ class Generator:
                           ("mu", kinematics.task_vector(robot, pose)), vector=True),
             self.function("task_jacobian", f"analytic Jacobian d mu / d q ({m} x DOF)", ("J", task_jacobian)),
             *self.singularity_functions(analysis.singularity_jacobian(robot, self.jacobian, task_jacobian)),
+            *self.ik_functions(),
         )
 
 

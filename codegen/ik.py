@@ -19,6 +19,7 @@ from dataclasses import dataclass
 import sympy
 
 from .structure import E_Z, SOLVERS, Geometry, SolverInfo, classify, is_zero, squared_norm, tidy
+from .subproblems import EPS, Angle, IsFinite, Subproblems, relative, select, times, times_transposed, wrapped
 
 Matrix = sympy.Matrix
 
@@ -198,3 +199,188 @@ def documentation(robot, form: ClosedForm, max_name: str) -> list[str]:
              "root (a target on a singularity or on the workspace boundary) is returned once, and an "
              "angle the target leaves free (a singular wrist or shoulder) is set to 0.")
     return lines + textwrap.wrap(notes, DOC_WIDTH)
+
+
+# -- The solvers, as expressions (see `subproblems`) -------------------------------------------
+# Each returns the branches in the documented order: (joint values, validity), one per
+# solution the class can have; `k` holds the constants of `closed_form`.
+
+Branches = list[tuple[tuple[sympy.Expr, ...], sympy.Basic]]
+
+
+def _planar_branches(sp: Subproblems, k: dict, target, form: ClosedForm, dof: int) -> Branches:
+    """The last revolute joint takes the yaw, the first two put its axis on the wrist point
+    by SP3 (elbow) and SP1 (shoulder); rotations about z keep heights."""
+    index = dict(form.indices)
+    point = (target[0], target[1], k["tool_point"][2])
+    if "third" in index:
+        phi = sp.name(target[-1] - k["yaw0"])
+        point = sp.sub(point, sp.rot((0, 0, 1), sp.name(sympy.cos(phi)), sp.name(sympy.sin(phi)),
+                                     sp.sub(k["tool_point"], k["wrist"])))
+    d = sp.sub(point, k["p1"])
+    branches = []
+    for elbow in sp.sp3(sp.sub(k["wrist"], k["p2"]), sp.sub(k["p1"], k["p2"]), k["k2"], sp.dot(d, d)):
+        shoulder = sp.sp1(sp.sub(sp.add(k["p2"], sp.turn(k["k2"], elbow.angle, sp.sub(k["wrist"], k["p2"]))), k["p1"]),
+                          d, k["k1"])
+        q = [sympy.Integer(0)] * dof
+        q[index["first"]], q[index["second"]] = shoulder.theta, elbow.angle.theta
+        if "third" in index:
+            q[index["third"]] = k["sign3"] * (phi - k["sign1"] * shoulder.theta - k["sign2"] * elbow.angle.theta)
+        if "slide" in index:
+            q[index["slide"]] = k["sign_slide"] * (target[2] - k["tool_point"][2])
+        branches.append((tuple(q), elbow.valid))
+    return branches
+
+
+def _yaw_pitch_branches(sp: Subproblems, k: dict, target, form: ClosedForm, dof: int) -> Branches:
+    """The pitch fixes the sum phi of the pitch angles (SP4 on the tool's x axis), the base
+    yaw puts the target in the arm's plane (SP4), and the wrist point is reached by SP3
+    (elbow) and SP1 (shoulder). A pitch beyond +-pi/2 has no solution."""
+    point = tuple(target[:3])
+    pitch_valid = sympy.Abs(target[3]) <= sympy.pi / 2
+    approaches = sp.sp4((0, 0, 1), k["tool_x"], k["h2"], sp.name(-sympy.sin(target[3])))
+    branches = []
+    for base in sp.sp4(sp.sub(point, k["p1"]), k["h2"], k["h1"], k["reach"]):
+        w = sp.add(k["p1"], sp.turn(k["h1"], base.angle, sp.sub(point, k["p1"]), back=True))
+        for phi in approaches:
+            wrist = sp.sub(w, sp.turn(k["h2"], phi.angle, sp.sub(k["tool_point"], k["p4"])))
+            d = sp.sub(wrist, k["p2"])
+            for elbow in sp.sp3(sp.sub(k["p4"], k["p3"]), sp.sub(k["p2"], k["p3"]), k["h3"], sp.dot(d, d)):
+                shoulder = sp.sp1(sp.sub(sp.add(k["p3"], sp.turn(k["h3"], elbow.angle, sp.sub(k["p4"], k["p3"]))), k["p2"]),
+                                  d, k["h2"])
+                last = k["sign4"] * (phi.angle.theta - shoulder.theta - k["sign3"] * elbow.angle.theta)
+                branches.append(((base.angle.theta, shoulder.theta, elbow.angle.theta, last),
+                                 sympy.And(pitch_valid, base.valid, phi.valid, elbow.valid)))
+    return branches
+
+
+def _pose_start(sp: Subproblems, k: dict, target):
+    """R, t of T T(0)^-1, the wrist centre and the tool axes h6, v6 in the world frame."""
+    R, t = relative(sp, target, k["tool_rotation"], k["tool_position"])
+    return R, t, sp.add(times(sp, R, k["centre"]), t)
+
+
+def _wrist_branches(sp: Subproblems, k: dict, R, turns, shoulder: tuple, valid) -> Branches:
+    """The spherical wrist's solutions after the arm's `turns` (axis, angle) undone from the
+    tool axes, appended to the arm's `shoulder` joint values."""
+    a, b = times(sp, R, k["h6"]), times(sp, R, k["v6"])
+    for axis, angle in turns:
+        a, b = sp.turn(axis, angle, a, back=True), sp.turn(axis, angle, b, back=True)
+    return [(shoulder + q, sympy.And(valid, wrist_valid))
+            for q, wrist_valid in sp.wrist(a, b, k["h4"], k["h5"], k["h6"], k["v6"], k.get("wrist_flip"))]
+
+
+def _spherical_wrist_parallel_branches(sp: Subproblems, k: dict, target, form: ClosedForm, dof: int) -> Branches:
+    """The wrist centre fixes q1 (SP4: its height along axis 2 is constant), q3 (SP3) and
+    q2 (SP1); the orientation left to the wrist gives q4, q5, q6."""
+    R, _, wc = _pose_start(sp, k, target)
+    branches = []
+    for t1 in sp.sp4(sp.sub(wc, k["p1"]), k["h2"], k["h1"], k["reach"]):
+        d = sp.sub(sp.add(k["p1"], sp.turn(k["h1"], t1.angle, sp.sub(wc, k["p1"]), back=True)), k["p2"])
+        for t3 in sp.sp3(sp.sub(k["centre"], k["p3"]), sp.sub(k["p2"], k["p3"]), k["h3"], sp.dot(d, d)):
+            t2 = sp.sp1(sp.sub(sp.add(k["p3"], sp.turn(k["h3"], t3.angle, sp.sub(k["centre"], k["p3"]))), k["p2"]),
+                        d, k["h2"])
+            # R2 R3 = rot(h2, q2 + sign3 q3), h3 = sign3 h2: one turn back for both
+            c23 = t2.c * t3.angle.c - k["sign3"] * t2.s * t3.angle.s
+            s23 = t2.s * t3.angle.c + k["sign3"] * t2.c * t3.angle.s
+            turns = ((k["h1"], t1.angle), (k["h2"], Angle(None, sp.name(c23), sp.name(s23))))
+            branches += _wrist_branches(sp, k, R, turns, (t1.angle.theta, t2.theta, t3.angle.theta),
+                                        sympy.And(t1.valid, t3.valid))
+    return branches
+
+
+def _spherical_wrist_intersecting_branches(sp: Subproblems, k: dict, target, form: ClosedForm, dof: int) -> Branches:
+    """The wrist centre's distance from the shoulder point fixes q3 (SP3), its position q1
+    and q2 (SP2); the orientation left to the wrist gives q4, q5, q6."""
+    R, _, wc = _pose_start(sp, k, target)
+    d = sp.sub(wc, k["shoulder"])
+    branches = []
+    for t3 in sp.sp3(sp.sub(k["centre"], k["p3"]), sp.sub(k["shoulder"], k["p3"]), k["h3"], sp.dot(d, d)):
+        reached = sp.sub(sp.add(k["p3"], sp.turn(k["h3"], t3.angle, sp.sub(k["centre"], k["p3"]))), k["shoulder"])
+        for t1, t2, valid in sp.sp2(reached, d, k["h1"], k["h2"]):
+            turns = ((k["h1"], t1), (k["h2"], t2), (k["h3"], t3.angle))
+            branches += _wrist_branches(sp, k, R, turns, (t1.theta, t2.theta, t3.angle.theta),
+                                        sympy.And(t3.valid, valid))
+    return branches
+
+
+def _spherical_wrist_prismatic_branches(sp: Subproblems, k: dict, target, form: ClosedForm, dof: int) -> Branches:
+    """The wrist centre's distance from the shoulder point fixes q3 (|e + q3 h3| = |d|, a
+    quadratic), its position q1 and q2 (SP2); the orientation left to the wrist gives q4,
+    q5, q6."""
+    R, _, wc = _pose_start(sp, k, target)
+    d = sp.sub(wc, k["shoulder"])
+    e = sp.sub(k["centre"], k["shoulder"])
+    half, rest = sp.dot(k["h3"], e), sp.name(sp.dot(e, e) - sp.dot(d, d))
+    disc = sp.name(half**2 - rest)
+    scale = sp.name(sp.dot(e, e) + sp.dot(d, d))
+    two = disc > EPS * scale
+    root = sp.name(select(two, sympy.sqrt(disc), 0))
+    branches = []
+    for t3, valid in ((sp.name(-half + root), disc >= -EPS * scale), (sp.name(-half - root), two)):
+        reached = sp.add(e, sp.scaled(k["h3"], t3))
+        for t1, t2, shoulder_valid in sp.sp2(reached, d, k["h1"], k["h2"]):
+            branches += _wrist_branches(sp, k, R, ((k["h1"], t1), (k["h2"], t2)), (t1.theta, t2.theta, t3),
+                                        sympy.And(valid, shoulder_valid))
+    return branches
+
+
+def _three_parallel_branches(sp: Subproblems, k: dict, target, form: ClosedForm, dof: int) -> Branches:
+    """Axes 2, 3, 4 parallel to h, axes 5 and 6 meeting at the wrist centre: the centre's
+    height along h fixes q1 (SP4), the tool orientation q5 (SP4), q6 (SP1) and the sum
+    q2 + q3 + q4 (SP1), the centre's position q3 (SP3) and q2 (SP1). With axis 5
+    perpendicular to h and h6, the second q5 turns q6 and q2 + q3 + q4 by pi."""
+    R, _, wc = _pose_start(sp, k, target)
+    a = times(sp, R, k["h6"])
+    h = k["h"]
+    branches = []
+    for t1 in sp.sp4(sp.sub(wc, k["p1"]), h, k["h1"], k["reach"]):
+        g = sp.turn(k["h1"], t1.angle, h)
+        w = sp.add(k["p1"], sp.turn(k["h1"], t1.angle, sp.sub(wc, k["p1"]), back=True))
+        for j, t5 in enumerate(sp.sp4(h, k["h6"], k["h5"], sp.dot(g, a))):
+            if j == 1 and form.flip:
+                t6, total = t6.turned_half(), total.turned_half()
+            else:
+                t6 = sp.sp1(times_transposed(sp, R, g), sp.turn(k["h5"], t5.angle, h, back=True), k["h6"])
+                x = sp.turn(k["h6"], t6, sp.turn(k["h5"], t5.angle, k["v"], back=True), back=True)
+                total = sp.sp1(k["v"], sp.turn(k["h1"], t1.angle, times(sp, R, x), back=True), h)
+            d = sp.sub(sp.sub(w, sp.turn(h, total, sp.sub(k["centre"], k["p4"]))), k["p2"])
+            for t3 in sp.sp3(sp.sub(k["p4"], k["p3"]), sp.sub(k["p2"], k["p3"]), k["h3"], sp.dot(d, d)):
+                t2 = sp.sp1(sp.sub(sp.add(k["p3"], sp.turn(k["h3"], t3.angle, sp.sub(k["p4"], k["p3"]))), k["p2"]), d, h)
+                t4 = k["sign4"] * (total.theta - t2.theta - k["sign3"] * t3.angle.theta)
+                branches.append(((t1.angle.theta, t2.theta, t3.angle.theta, t4, t5.angle.theta, t6.theta),
+                                 sympy.And(t1.valid, t5.valid, t3.valid)))
+    return branches
+
+
+_BRANCHES = {
+    "planar": _planar_branches,
+    "yaw_pitch": _yaw_pitch_branches,
+    "spherical_wrist_parallel": _spherical_wrist_parallel_branches,
+    "spherical_wrist_intersecting": _spherical_wrist_intersecting_branches,
+    "spherical_wrist_prismatic": _spherical_wrist_prismatic_branches,
+    "three_parallel": _three_parallel_branches,
+}
+
+
+def _constant(value: Matrix):
+    """A constant as the solvers use it: a number, a 3-tuple, or a 3x3 matrix."""
+    if value.shape == (1, 1):
+        return value[0]
+    return tuple(value) if 1 in value.shape else value
+
+
+def branches(robot, form: ClosedForm, sp: Subproblems, target) -> tuple[sympy.Matrix, list]:
+    """Every branch of the solver (MAX_IK_SOLUTIONS x DOF, revolute angles wrapped into
+    (-pi, pi]) and its validity (MAX_IK_SOLUTIONS x 1): a branch is valid when the target
+    allows it and every entry of the target read (not a pose's last row) is finite. `target` is the 4x4 pose or the task
+    vector, as symbols."""
+    k = {name: _constant(value) for name, value in form.constants}
+    solved = _BRANCHES[form.solver](sp, k, target, form, robot.dof)
+    if len(solved) != form.info.max_solutions:
+        raise AssertionError(f"{form.solver}: {len(solved)} branches, documented {form.info.max_solutions}")
+    # One test for all entries: their sum is finite unless one is not (or they exceed 1e307).
+    finite = IsFinite(sp.name(sympy.Add(*(target[:3, :] if form.target == "pose" else target))))
+    q = sympy.Matrix([[wrapped(value) if joint.revolute else value for value, joint in zip(values, robot.joints)]
+                      for values, _ in solved])
+    return q, [sympy.And(finite, valid) for _, valid in solved]

@@ -2,7 +2,8 @@
 
 Constants are folded first (`fold_constants`), so every number that is not an integer
 is a single Float, printed as the shortest decimal that reads back as the same double
-(the same float, in float C builds).
+(the same float, in float C builds). The IK's tolerances EPS and TINY are replaced by the
+numbers of the build's real type.
 """
 
 import numpy
@@ -13,6 +14,8 @@ from sympy.printing.codeprinter import CodePrinter
 from sympy.printing.numpy import NumPyPrinter
 from sympy.printing.precedence import PRECEDENCE
 from sympy.printing.pycode import AbstractPythonCodePrinter, _print_known_const, _print_known_func
+
+from .subproblems import TOLERANCES
 
 
 def fold_constants(expr: sympy.Expr, _folded: dict | None = None) -> sympy.Expr:
@@ -39,14 +42,40 @@ def float_literal(value: sympy.Expr) -> str:
     return repr(float(value))
 
 
+def _selects(printer, expr, select: str) -> str:
+    """`select(condition, value, otherwise)` nested for each pair of a Piecewise."""
+    (value, condition), *rest = expr.args
+    otherwise = rest[0][0] if len(rest) == 1 and rest[0][1] == sympy.true else sympy.Piecewise(*rest)
+    return f"{select}({printer._print(condition)}, {printer._print(value)}, {printer._print(otherwise)})"
+
+
 class PythonPrinter(NumPyPrinter):
-    """numpy code over batched inputs."""
+    """numpy code over batched inputs; a select is `numpy.where` (both sides computed, the
+    generated function ignores the floating-point warnings of the side not taken)."""
 
     def __init__(self):
         super().__init__({"fully_qualified_modules": True, "allow_unknown_functions": False})
 
+    def doprint(self, expr, assign_to=None):
+        return super().doprint(expr.xreplace(TOLERANCES["double"]), assign_to)
+
     def _print_Float(self, expr):
         return float_literal(expr)
+
+    def _print_Piecewise(self, expr):
+        return _selects(self, expr, "numpy.where")
+
+    def _print_And(self, expr):
+        return " & ".join(self.parenthesize(a, PRECEDENCE["BitwiseAnd"] + 1) for a in expr.args)
+
+    def _print_Or(self, expr):
+        return " | ".join(self.parenthesize(a, PRECEDENCE["BitwiseOr"] + 1) for a in expr.args)
+
+    def _print_Not(self, expr):
+        return f"numpy.logical_not({self._print(expr.args[0])})"
+
+    def _print_IsFinite(self, expr):
+        return f"numpy.isfinite({self._print(expr.args[0])})"
 
 
 C_REAL_TYPES = {"double": ast.float64, "float": ast.float32}
@@ -85,7 +114,35 @@ class CPrinter(C99CodePrinter):
         super().__init__({"type_aliases": {ast.real: C_REAL_TYPES[real]}, "strict": True, "math_macros": {}})
 
     def doprint(self, expr, assign_to=None):
-        return super().doprint(expand_integer_powers(fold_constants(expr)), assign_to)
+        return super().doprint(expand_integer_powers(fold_constants(expr.xreplace(TOLERANCES[self.real]))), assign_to)
+
+    def _print_Piecewise(self, expr):
+        """`(condition ? value : otherwise)` on one line."""
+        (value, condition), *rest = expr.args
+        otherwise = rest[0][0] if len(rest) == 1 and rest[0][1] == sympy.true else sympy.Piecewise(*rest)
+        return f"({self._print(condition)} ? {self._print(value)} : {self._print(otherwise)})"
+
+    def _print_IsFinite(self, expr):
+        return f"isfinite({self._print(expr.args[0])})"
+
+    def _print_BooleanTrue(self, expr):
+        return "1"
+
+    def _print_BooleanFalse(self, expr):
+        return "0"
+
+    def _print_Or(self, expr):
+        """Every operand that is not an atom in parentheses (gcc's -Wparentheses)."""
+        return " || ".join(self._print(a) if a.is_Atom else f"({self._print(a)})" for a in expr.args)
+
+    def _print_Piecewise(self, expr):
+        """`(condition ? value : otherwise)` on one line."""
+        (value, condition), *rest = expr.args
+        otherwise = rest[0][0] if len(rest) == 1 and rest[0][1] == sympy.true else sympy.Piecewise(*rest)
+        return f"({self._print(condition)} ? {self._print(value)} : {self._print(otherwise)})"
+
+    def _print_IsFinite(self, expr):
+        return f"isfinite({self._print(expr.args[0])})"
 
     def _print_Float(self, expr):
         """Shortest literal that reads back as the nearest value of the build's type."""
@@ -129,12 +186,38 @@ class CasadiPrinter(AbstractPythonCodePrinter):
     def _print_Float(self, expr):
         return float_literal(expr)
 
+    def doprint(self, expr, assign_to=None):
+        return super().doprint(expr.xreplace(TOLERANCES["double"]), assign_to)
+
     def _print_Pow(self, expr, rational=False):
         return self._hprint_Pow(expr, rational=rational, sqrt="casadi.sqrt")
 
-    _print_Piecewise = CodePrinter._print_not_supported
+    def _print_Piecewise(self, expr):
+        return _selects(self, expr, "casadi.if_else")
+
+    def _print_Relational(self, expr):
+        return f"({self._print(expr.lhs)} {expr.rel_op} {self._print(expr.rhs)})"
+
+    def _print_And(self, expr):
+        return self._logic("casadi.logic_and", expr.args)
+
+    def _print_Or(self, expr):
+        return self._logic("casadi.logic_or", expr.args)
+
+    def _logic(self, function: str, args) -> str:
+        text = self._print(args[0])
+        for arg in args[1:]:
+            text = f"{function}({text}, {self._print(arg)})"
+        return text
+
+    def _print_Not(self, expr):
+        return f"casadi.logic_not({self._print(expr.args[0])})"
+
+    def _print_IsFinite(self, expr):
+        """NaN < inf is false, as is inf < inf."""
+        return f"(casadi.fabs({self._print(expr.args[0])}) < casadi.inf)"
+
     _print_ITE = CodePrinter._print_not_supported
-    _print_Relational = CodePrinter._print_not_supported
     _print_Mod = CodePrinter._print_not_supported
     _print_Sum = CodePrinter._print_not_supported
 

@@ -17,9 +17,7 @@ from ik_geo import Robot as IkGeoRobot
 
 from codegen import reference
 from codegen.compile import CLibrary, compile_shared
-from codegen.context import _ik_context, _ik_math
-from codegen.printers import CPrinter, PythonPrinter
-from codegen.render import _environment, render_robot
+from codegen.render import render_robot
 from codegen.robot import parse_robot
 
 from conftest import import_file, random_configurations, robot
@@ -232,39 +230,11 @@ RANDOM_CLASSES = ["planar_2r", "planar_3r", "scara", "yaw_pitch", "spherical_wri
                   "spherical_wrist_intersecting", "spherical_wrist_prismatic", "three_parallel"]
 
 
-def _ik_only(arm, folder):
-    """A module holding only the closed-form ik of `arm`: the full generated module runs a
-    singularity analysis that takes minutes for random dimensions, and is not needed here."""
-    context = {"ik": _ik_context(arm, PythonPrinter(), "python", "double"), "ik_math": _ik_math(arm, "double"),
-               "parameters": []}
-    text = "import math\n\nimport numpy\n\nDOF = %d\n" % arm.dof + _environment().get_template(
-        "python/ik.py.jinja").render(context)
-    path = folder / f"{arm.name}.py"
-    path.write_text(text)
-    return import_file(path, f"ik_only_{arm.name}")
-
-
-C_PREAMBLE = """#include <math.h>
-typedef {real} {name}_real;
-#define {prefix}_DOF {dof}
-#define {prefix}_TASK_DIM {task_dim}
-#define {prefix}_MAX_IK_SOLUTIONS {max_solutions}
-int {name}_ik({signature});
-"""
-
-
-def _c_ik_only(arm, folder, real):
-    """The closed-form ik of `arm` alone as a C shared library (compiled with SPEC's warning
-    flags), and a function target -> solutions (k, n) calling it."""
-    ik = _ik_context(arm, CPrinter(real), "c", real)
-    context = {"ik": ik, "ik_math": _ik_math(arm, real), "parameters": [], "name": arm.name,
-               "prefix": arm.name.upper()}
-    source = folder / f"{arm.name}_{real}.c"
-    source.write_text(C_PREAMBLE.format(real=real, name=arm.name, prefix=arm.name.upper(), dof=arm.dof,
-                                        task_dim=len(arm.task), max_solutions=ik["max_solutions"],
-                                        signature=ik["signature"])
-                      + _environment().get_template("c/ik.c.jinja").render(context))
-    library = CLibrary(compile_shared([source], folder / f"lib{arm.name}_{real}.so"), arm, [], real)
+def _c_ik(arm, folder, real):
+    """A function target -> solutions (k, n) calling the C NAME_ik of `arm` (compiled with the
+    contract's warning flags)."""
+    source = _generate(arm, folder / real, ("c",), real)
+    library = CLibrary(compile_shared([source], folder / real / f"lib{arm.name}.so"), arm, [], real)
     return functools.partial(library.ik, max_solutions=8)
 
 
@@ -286,17 +256,17 @@ def test_random_robots_of_each_class(kind, tmp_path):
     codegen.reference, the revolute 6R classes also against EAIK."""
     for seed in range(3):
         arm = _random_robot(kind, seed)
-        module = _ik_only(arm, tmp_path)
+        module = _generate(arm, tmp_path)
         q = np.random.default_rng(seed).uniform(-np.pi, np.pi, (100, arm.dof))
         q[:, [not joint.revolute for joint in arm.joints]] *= 0.1
         counts = _check_round_trip(arm, module.ik, _reference_targets(arm), q, _regular(arm, q))
         assert counts.max() == module.MAX_IK_SOLUTIONS
         if seed < 2:  # the C: the Python's solutions in the Python's order; float compiles cleanly
-            solve = _c_ik_only(arm, tmp_path, "double")
+            solve = _c_ik(arm, tmp_path, "double")
             for target in _reference_targets(arm)(q[:50]):
                 ours, python = solve(target), module.ik(target)
                 assert len(ours) == len(python) and (not len(ours) or _joint_distance(arm, ours, python).max() < 1e-6)
-            _c_ik_only(arm, tmp_path, "float")
+            _c_ik(arm, tmp_path, "float")
         if kind in EAIK_CLASSES:
             _compare_with_eaik(module, arm, q[:50], _reference_targets(arm))
 

@@ -16,16 +16,18 @@ DOF = 7
 TASK = ("x", "y", "z", "roll", "pitch", "yaw", )
 
 
-def _joints(q):
-    q = numpy.asarray(q, dtype=float)
-    if q.ndim == 0 or q.shape[-1] != DOF:
-        raise ValueError(f"q must have shape ({DOF},) or (..., {DOF}), got {q.shape}")
-    return q
+def _argument(name, value, shape):
+    """`value` as a float array of `shape` or a batch of them (..., *shape)."""
+    value = numpy.asarray(value, dtype=float)
+    if value.shape[value.ndim - len(shape):] != shape:
+        batch = ", ".join(map(str, shape))
+        raise ValueError(f"{name} must have shape {shape} or (..., {batch}), got {value.shape}")
+    return value
 
 
 def fk(q):
     """pose of the tool frame in the world frame (4x4 homogeneous): (4 x 4), 119 operations."""
-    q = _joints(q)
+    q = _argument("q", q, (7,))
     q1 = q[..., 0]
     q2 = q[..., 1]
     q3 = q[..., 2]
@@ -112,7 +114,7 @@ def fk(q):
 
 def jacobian(q):
     """geometric Jacobian in the world frame (6 x DOF, rows vx vy vz wx wy wz): (6 x 7), 137 operations."""
-    q = _joints(q)
+    q = _argument("q", q, (7,))
     q1 = q[..., 0]
     q2 = q[..., 1]
     q3 = q[..., 2]
@@ -217,7 +219,7 @@ def jacobian(q):
 
 def fk_jacobian(q):
     """fk and jacobian in one pass, sharing their terms: (4 x 4 and 6 x 7), 168 operations."""
-    q = _joints(q)
+    q = _argument("q", q, (7,))
     q1 = q[..., 0]
     q2 = q[..., 1]
     q3 = q[..., 2]
@@ -352,7 +354,7 @@ def fk_jacobian(q):
 
 def jacobian_tool(q):
     """geometric Jacobian in the tool frame (6 x DOF, rows vx vy vz wx wy wz): (6 x 7), 330 operations."""
-    q = _joints(q)
+    q = _argument("q", q, (7,))
     q1 = q[..., 0]
     q2 = q[..., 1]
     q3 = q[..., 2]
@@ -482,7 +484,7 @@ def jacobian_tool(q):
 
 def task(q):
     """task vector mu = (x, y, z, roll, pitch, yaw): (6 x 1), 121 operations."""
-    q = _joints(q)
+    q = _argument("q", q, (7,))
     q1 = q[..., 0]
     q2 = q[..., 1]
     q3 = q[..., 2]
@@ -557,7 +559,7 @@ def task(q):
 
 def task_jacobian(q):
     """analytic Jacobian d mu / d q (6 x DOF): (6 x 7), 222 operations."""
-    q = _joints(q)
+    q = _argument("q", q, (7,))
     q1 = q[..., 0]
     q2 = q[..., 1]
     q3 = q[..., 2]
@@ -684,7 +686,7 @@ def task_jacobian(q):
 
 def singularity_factors(q):
     """factors of det(Js Js^T): the robot is singular where one is 0: (2 x 1), 735 operations."""
-    q = _joints(q)
+    q = _argument("q", q, (7,))
     q1 = q[..., 0]
     q2 = q[..., 1]
     q3 = q[..., 2]
@@ -872,7 +874,7 @@ def singularity_factors(q):
 
 def manipulability(q):
     """manipulability sqrt(det(Js Js^T)): (1 x 1), 738 operations."""
-    q = _joints(q)
+    q = _argument("q", q, (7,))
     q1 = q[..., 0]
     q2 = q[..., 1]
     q3 = q[..., 2]
@@ -1143,7 +1145,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
     condition number below VELOCITY_IK_RCOND; take damping > 0 there). Where ok is False,
     q_dot is 0: the result never holds NaN.
     """
-    q = _joints(q)
+    q = _argument("q", q, (DOF,))
     mu_dot = numpy.asarray(mu_dot, dtype=float)
     if mu_dot.ndim == 0 or mu_dot.shape[-1] != 6:
         raise ValueError(f"mu_dot must have shape (6,) or (..., 6), got {mu_dot.shape}")

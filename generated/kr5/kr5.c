@@ -688,6 +688,460 @@ kr5_real kr5_jacobian_det(const kr5_real q[KR5_DOF])
     return -0.23064*s5*(c3 + t0)*(0.1935483870967742*c2*c3 - c2*s3 + 0.967741935483871*c2 - c3*s2 - s2*t0 + 0.2903225806451613);
 }
 
+void kr5_ik_branches(const kr5_real T[16], kr5_real q[KR5_MAX_IK_SOLUTIONS * KR5_DOF], int valid[KR5_MAX_IK_SOLUTIONS])
+{
+    /* 858 operations */
+
+    /* Inputs */
+    const kr5_real T00 = T[0];
+    const kr5_real T01 = T[1];
+    const kr5_real T02 = T[2];
+    const kr5_real T03 = T[3];
+    const kr5_real T10 = T[4];
+    const kr5_real T11 = T[5];
+    const kr5_real T12 = T[6];
+    const kr5_real T13 = T[7];
+    const kr5_real T20 = T[8];
+    const kr5_real T21 = T[9];
+    const kr5_real T22 = T[10];
+    const kr5_real T23 = T[11];
+
+    /* Intermediate terms */
+    const kr5_real t0 = 2.639193146748068;
+    const kr5_real t1 = 1.761980786391911;
+    const kr5_real t2 = T00 + T01 + T02 + T03 + T10 + T11 + T12 + T13 + T20 + T21 + T22 + T23;
+    const kr5_real t3 = 0.9*T00;
+    const kr5_real t4 = -0.335*T02 + T03 - t3;
+    const kr5_real t5 = 0.22*T02 + t3;
+    const kr5_real t6 = t4 + t5;
+    const kr5_real t7 = 0.9*T10;
+    const kr5_real t8 = -0.335*T12 + T13 - t7;
+    const kr5_real t9 = 0.22*T12 + t7;
+    const kr5_real t10 = t8 + t9;
+    const kr5_real t11 = atan2(-t6, t10);
+    const kr5_real t12 = 0.9*T20;
+    const kr5_real t13 = -0.335*T22 + T23 - t12;
+    const kr5_real t14 = 0.22*T22 + t12;
+    const kr5_real t15 = t13 + t14;
+    const kr5_real t16 = (t10*t10) + (t6*t6);
+    const kr5_real t17 = t16;
+    const kr5_real t18 = t16 + (t15*t15);
+    const kr5_real t19 = 1.0/sqrt(t17);
+    const int t20 = 1;
+    const kr5_real t21 = (t20 ? 0 : -1);
+    const kr5_real t22 = (t20 ? 1 : 0);
+    const kr5_real t23 = atan2(t22, t21);
+    const kr5_real t24 = t11 - t23;
+    const kr5_real t25 = 1e-24*t18;
+    const int t26 = t17 <= t25;
+    const kr5_real t27 = (t26 ? 0 : t11 + t23);
+    const kr5_real t28 = t19*t22;
+    const kr5_real t29 = t28*t6;
+    const kr5_real t30 = t19*t21;
+    const kr5_real t31 = t10*t30;
+    const kr5_real t32 = (t26 ? 1 : t29 + t31);
+    const kr5_real t33 = -t29 + t31;
+    const kr5_real t34 = t10*t28;
+    const kr5_real t35 = t30*t6;
+    const kr5_real t36 = (t26 ? 0 : t34 - t35);
+    const kr5_real t37 = t34 + t35;
+    const kr5_real t38 = t10*t36 + t32*t6;
+    const kr5_real t39 = t10*t32 - t36*t6;
+    const kr5_real t40 = t38 - 0.18;
+    const kr5_real t41 = T02*t32 + T12*t36;
+    const kr5_real t42 = T02*t36 - T12*t32;
+    const kr5_real t43 = T00*t32 + T10*t36;
+    const kr5_real t44 = -T00*t36 + T10*t32;
+    const kr5_real t45 = -t10*t37 + t33*t6;
+    const kr5_real t46 = t10*t33 + t37*t6;
+    const kr5_real t47 = t45 - 0.18;
+    const kr5_real t48 = -T02*t33 + T12*t37;
+    const kr5_real t49 = T02*t37 + T12*t33;
+    const kr5_real t50 = T00*t33 - T10*t37;
+    const kr5_real t51 = T00*t37 + T10*t33;
+    const kr5_real t52 = 1 - t32;
+    const kr5_real t53 = t15*t52;
+    const kr5_real t54 = t15*t32 + t53;
+    const kr5_real t55 = t54 - 0.4;
+    const kr5_real t56 = (t39*t39) + (t40*t40) + (t55*t55);
+    const kr5_real t57 = 0.3794 - 0.5*t56;
+    const kr5_real t58 = T22*t52;
+    const kr5_real t59 = T22*t32 + t58;
+    const kr5_real t60 = T20*t52;
+    const kr5_real t61 = T20*t32 + t60;
+    const kr5_real t62 = (t57*t57);
+    const kr5_real t63 = (t0*t0);
+    const kr5_real t64 = -t62*t63 + 1;
+    const kr5_real t65 = t0*t57;
+    const int t66 = 1e-12 < t64;
+    const kr5_real t67 = (t66 ? t65 : (t65 > 0 ? 1 : -1));
+    const kr5_real t68 = (t66 ? sqrt(t64) : 0);
+    const kr5_real t69 = atan2(t68, t67);
+    const kr5_real t70 = t1 - t69;
+    const int t71 = 0;
+    const kr5_real t72 = (t71 ? 0 : t1 + t69);
+    const kr5_real t73 = 0.072*t0;
+    const kr5_real t74 = t67*t73;
+    const kr5_real t75 = 0.372*t0;
+    const kr5_real t76 = t68*t75;
+    const kr5_real t77 = (t71 ? 1 : -t74 - t76);
+    const kr5_real t78 = -t74 + t76;
+    const kr5_real t79 = t67*t75;
+    const kr5_real t80 = t68*t73;
+    const kr5_real t81 = (t71 ? 0 : t79 - t80);
+    const kr5_real t82 = t79 + t80;
+    const kr5_real t83 = 0.12*t77 - 0.62*t81;
+    const kr5_real t84 = 0.62*t77 + 0.12*t81;
+    const kr5_real t85 = t83 + 0.78;
+    const kr5_real t86 = 0.4 - t84;
+    const kr5_real t87 = t85 - 0.18;
+    const kr5_real t88 = t86 - 0.4;
+    const kr5_real t89 = t40*t87 + t55*t88;
+    const kr5_real t90 = t40*t88 - t55*t87;
+    const kr5_real t91 = (t89*t89) + (t90*t90);
+    const kr5_real t92 = (t87*t87) + (t88*t88);
+    const kr5_real t93 = 1.0/sqrt(t91);
+    const kr5_real t94 = 0.12*t78 - 0.62*t82;
+    const kr5_real t95 = 0.62*t78 + 0.12*t82;
+    const kr5_real t96 = t94 + 0.78;
+    const kr5_real t97 = 0.4 - t95;
+    const kr5_real t98 = t96 - 0.18;
+    const kr5_real t99 = t97 - 0.4;
+    const kr5_real t100 = t40*t98 + t55*t99;
+    const kr5_real t101 = t40*t99 - t55*t98;
+    const kr5_real t102 = (t100*t100) + (t101*t101);
+    const kr5_real t103 = (t98*t98) + (t99*t99);
+    const kr5_real t104 = 1.0/sqrt(t102);
+    const kr5_real t105 = 1e-24*t56;
+    const int t106 = t91 <= t105*t92;
+    const kr5_real t107 = (t106 ? 1 : t89*t93);
+    const kr5_real t108 = (t106 ? 0 : t90*t93);
+    const kr5_real t109 = t107*t77 - t108*t81;
+    const kr5_real t110 = t107*t81 + t108*t77;
+    const kr5_real t111 = -t109*t41 + t110*t59;
+    const kr5_real t112 = t109*t59 + t110*t41;
+    const kr5_real t113 = t109*t43 - t110*t61;
+    const kr5_real t114 = t109*t61 + t110*t43;
+    const kr5_real t115 = 1 - t109;
+    const kr5_real t116 = t115*t42;
+    const kr5_real t117 = t109*t42 + t116;
+    const kr5_real t118 = t115*t44;
+    const kr5_real t119 = t109*t44 + t118;
+    const kr5_real t120 = (t112*t112);
+    const kr5_real t121 = -t120;
+    const kr5_real t122 = t121 + 1;
+    const kr5_real t123 = (t122 > 1e-12 ? sqrt(t122) : 0);
+    const kr5_real t124 = -t111*t123 + t120;
+    const kr5_real t125 = t121 + t124;
+    const kr5_real t126 = (t117*t117);
+    const kr5_real t127 = t120 + t126 + (t111*t111);
+    const kr5_real t128 = (t123*t123);
+    const kr5_real t129 = t126*t128 + (t125*t125);
+    const kr5_real t130 = t120 + t128;
+    const kr5_real t131 = 1.0/sqrt(t129);
+    const kr5_real t132 = 1.0/sqrt(t130);
+    const kr5_real t133 = 1e-24*t130;
+    const int t134 = t129 <= t127*t133;
+    const kr5_real t135 = (t134 ? 1 : t125*t131);
+    const kr5_real t136 = t114*(1 - t135);
+    const kr5_real t137 = t114*t135 + t136;
+    const kr5_real t138 = t117*t123;
+    const kr5_real t139 = (t134 ? 0 : -t131*t138);
+    const kr5_real t140 = t113*t135 + t119*t139;
+    const kr5_real t141 = -t113*t139 + t119*t135;
+    const int t142 = t130 <= t133;
+    const kr5_real t143 = (t142 ? 1 : -t112*t132);
+    const kr5_real t144 = (t142 ? 0 : -t123*t132);
+    const kr5_real t145 = t141*(1 - t143);
+    const kr5_real t146 = -t137*t144 + t140*t143;
+    const kr5_real t147 = t141*t143 + t145;
+    const kr5_real t148 = t137*t143 + t140*t144;
+    const kr5_real t149 = (t146*t146) + (t147*t147);
+    const kr5_real t150 = t149;
+    const kr5_real t151 = t149 + (t148*t148);
+    const int t152 = t102 <= t103*t105;
+    const kr5_real t153 = (t152 ? 1 : t100*t104);
+    const kr5_real t154 = (t152 ? 0 : t101*t104);
+    const kr5_real t155 = t153*t78 - t154*t82;
+    const kr5_real t156 = t153*t82 + t154*t78;
+    const kr5_real t157 = -t155*t41 + t156*t59;
+    const kr5_real t158 = t155*t59 + t156*t41;
+    const kr5_real t159 = t155*t43 - t156*t61;
+    const kr5_real t160 = t155*t61 + t156*t43;
+    const kr5_real t161 = 1 - t155;
+    const kr5_real t162 = t161*t42;
+    const kr5_real t163 = t155*t42 + t162;
+    const kr5_real t164 = t161*t44;
+    const kr5_real t165 = t155*t44 + t164;
+    const kr5_real t166 = (t158*t158);
+    const kr5_real t167 = -t166;
+    const kr5_real t168 = t167 + 1;
+    const kr5_real t169 = (t168 > 1e-12 ? sqrt(t168) : 0);
+    const kr5_real t170 = -t157*t169 + t166;
+    const kr5_real t171 = t167 + t170;
+    const kr5_real t172 = (t163*t163);
+    const kr5_real t173 = t166 + t172 + (t157*t157);
+    const kr5_real t174 = (t169*t169);
+    const kr5_real t175 = t172*t174 + (t171*t171);
+    const kr5_real t176 = t166 + t174;
+    const kr5_real t177 = 1.0/sqrt(t175);
+    const kr5_real t178 = 1.0/sqrt(t176);
+    const kr5_real t179 = 1e-24*t176;
+    const int t180 = t175 <= t173*t179;
+    const kr5_real t181 = (t180 ? 1 : t171*t177);
+    const kr5_real t182 = t160*(1 - t181);
+    const kr5_real t183 = t160*t181 + t182;
+    const kr5_real t184 = t163*t169;
+    const kr5_real t185 = (t180 ? 0 : -t177*t184);
+    const kr5_real t186 = t159*t181 + t165*t185;
+    const kr5_real t187 = -t159*t185 + t165*t181;
+    const int t188 = t176 <= t179;
+    const kr5_real t189 = (t188 ? 1 : -t158*t178);
+    const kr5_real t190 = (t188 ? 0 : -t169*t178);
+    const kr5_real t191 = t187*(1 - t189);
+    const kr5_real t192 = -t183*t190 + t186*t189;
+    const kr5_real t193 = t187*t189 + t191;
+    const kr5_real t194 = t183*t189 + t186*t190;
+    const kr5_real t195 = (t192*t192) + (t193*t193);
+    const kr5_real t196 = t195;
+    const kr5_real t197 = t195 + (t194*t194);
+    const kr5_real t198 = 1 - t33;
+    const kr5_real t199 = t15*t198;
+    const kr5_real t200 = t15*t33 + t199;
+    const kr5_real t201 = t200 - 0.4;
+    const kr5_real t202 = (t201*t201) + (t46*t46) + (t47*t47);
+    const kr5_real t203 = 0.3794 - 0.5*t202;
+    const kr5_real t204 = T22*t198;
+    const kr5_real t205 = T22*t33 + t204;
+    const kr5_real t206 = T20*t198;
+    const kr5_real t207 = T20*t33 + t206;
+    const kr5_real t208 = (t203*t203);
+    const kr5_real t209 = -t208*t63 + 1;
+    const kr5_real t210 = t0*t203;
+    const int t211 = 1e-12 < t209;
+    const kr5_real t212 = (t211 ? t210 : (t210 > 0 ? 1 : -1));
+    const kr5_real t213 = (t211 ? sqrt(t209) : 0);
+    const kr5_real t214 = atan2(t213, t212);
+    const kr5_real t215 = (t71 ? 0 : t1 + t214);
+    const kr5_real t216 = t1 - t214;
+    const kr5_real t217 = t212*t73;
+    const kr5_real t218 = t213*t75;
+    const kr5_real t219 = (t71 ? 1 : -t217 - t218);
+    const kr5_real t220 = -t217 + t218;
+    const kr5_real t221 = t212*t75;
+    const kr5_real t222 = t213*t73;
+    const kr5_real t223 = (t71 ? 0 : t221 - t222);
+    const kr5_real t224 = t221 + t222;
+    const kr5_real t225 = 0.12*t219 - 0.62*t223;
+    const kr5_real t226 = 0.62*t219 + 0.12*t223;
+    const kr5_real t227 = t225 + 0.78;
+    const kr5_real t228 = 0.4 - t226;
+    const kr5_real t229 = t227 - 0.18;
+    const kr5_real t230 = t228 - 0.4;
+    const kr5_real t231 = t201*t230 + t229*t47;
+    const kr5_real t232 = -t201*t229 + t230*t47;
+    const kr5_real t233 = (t231*t231) + (t232*t232);
+    const kr5_real t234 = (t229*t229) + (t230*t230);
+    const kr5_real t235 = 1.0/sqrt(t233);
+    const kr5_real t236 = 0.12*t220 - 0.62*t224;
+    const kr5_real t237 = 0.62*t220 + 0.12*t224;
+    const kr5_real t238 = t236 + 0.78;
+    const kr5_real t239 = 0.4 - t237;
+    const kr5_real t240 = t238 - 0.18;
+    const kr5_real t241 = t239 - 0.4;
+    const kr5_real t242 = t201*t241 + t240*t47;
+    const kr5_real t243 = -t201*t240 + t241*t47;
+    const kr5_real t244 = (t242*t242) + (t243*t243);
+    const kr5_real t245 = (t240*t240) + (t241*t241);
+    const kr5_real t246 = 1.0/sqrt(t244);
+    const kr5_real t247 = 1e-24*t202;
+    const int t248 = t233 <= t234*t247;
+    const kr5_real t249 = (t248 ? 1 : t231*t235);
+    const kr5_real t250 = (t248 ? 0 : t232*t235);
+    const kr5_real t251 = t219*t249 - t223*t250;
+    const kr5_real t252 = t219*t250 + t223*t249;
+    const kr5_real t253 = t205*t252 + t251*t48;
+    const kr5_real t254 = -t205*t251 + t252*t48;
+    const kr5_real t255 = -t207*t252 + t251*t50;
+    const kr5_real t256 = t207*t251 + t252*t50;
+    const kr5_real t257 = 1 - t251;
+    const kr5_real t258 = t257*t49;
+    const kr5_real t259 = t251*t49 + t258;
+    const kr5_real t260 = t257*t51;
+    const kr5_real t261 = t251*t51 + t260;
+    const kr5_real t262 = (t254*t254);
+    const kr5_real t263 = -t262;
+    const kr5_real t264 = t263 + 1;
+    const kr5_real t265 = (t264 > 1e-12 ? sqrt(t264) : 0);
+    const kr5_real t266 = -t253*t265 + t262;
+    const kr5_real t267 = t263 + t266;
+    const kr5_real t268 = (t259*t259);
+    const kr5_real t269 = t262 + t268 + (t253*t253);
+    const kr5_real t270 = (t265*t265);
+    const kr5_real t271 = t268*t270 + (t267*t267);
+    const kr5_real t272 = t262 + t270;
+    const kr5_real t273 = 1.0/sqrt(t271);
+    const kr5_real t274 = 1.0/sqrt(t272);
+    const kr5_real t275 = 1e-24*t272;
+    const int t276 = t271 <= t269*t275;
+    const kr5_real t277 = (t276 ? 1 : t267*t273);
+    const kr5_real t278 = t256*(1 - t277);
+    const kr5_real t279 = t256*t277 + t278;
+    const kr5_real t280 = t259*t265;
+    const kr5_real t281 = (t276 ? 0 : t273*t280);
+    const kr5_real t282 = t255*t277 + t261*t281;
+    const kr5_real t283 = -t255*t281 + t261*t277;
+    const int t284 = t272 <= t275;
+    const kr5_real t285 = (t284 ? 1 : t254*t274);
+    const kr5_real t286 = (t284 ? 0 : -t265*t274);
+    const kr5_real t287 = t283*(1 - t285);
+    const kr5_real t288 = -t279*t286 + t282*t285;
+    const kr5_real t289 = t283*t285 + t287;
+    const kr5_real t290 = t279*t285 + t282*t286;
+    const kr5_real t291 = (t288*t288) + (t289*t289);
+    const kr5_real t292 = t291;
+    const kr5_real t293 = t291 + (t290*t290);
+    const int t294 = t244 <= t245*t247;
+    const kr5_real t295 = (t294 ? 1 : t242*t246);
+    const kr5_real t296 = (t294 ? 0 : t243*t246);
+    const kr5_real t297 = t220*t295 - t224*t296;
+    const kr5_real t298 = t220*t296 + t224*t295;
+    const kr5_real t299 = t205*t298 + t297*t48;
+    const kr5_real t300 = -t205*t297 + t298*t48;
+    const kr5_real t301 = -t207*t298 + t297*t50;
+    const kr5_real t302 = t207*t297 + t298*t50;
+    const kr5_real t303 = 1 - t297;
+    const kr5_real t304 = t303*t49;
+    const kr5_real t305 = t297*t49 + t304;
+    const kr5_real t306 = t303*t51;
+    const kr5_real t307 = t297*t51 + t306;
+    const kr5_real t308 = (t300*t300);
+    const kr5_real t309 = -t308;
+    const kr5_real t310 = t309 + 1;
+    const kr5_real t311 = (t310 > 1e-12 ? sqrt(t310) : 0);
+    const kr5_real t312 = -t299*t311 + t308;
+    const kr5_real t313 = t309 + t312;
+    const kr5_real t314 = (t305*t305);
+    const kr5_real t315 = t308 + t314 + (t299*t299);
+    const kr5_real t316 = (t311*t311);
+    const kr5_real t317 = t314*t316 + (t313*t313);
+    const kr5_real t318 = t308 + t316;
+    const kr5_real t319 = 1.0/sqrt(t317);
+    const kr5_real t320 = 1.0/sqrt(t318);
+    const kr5_real t321 = 1e-24*t318;
+    const int t322 = t317 <= t315*t321;
+    const kr5_real t323 = (t322 ? 1 : t313*t319);
+    const kr5_real t324 = t302*(1 - t323);
+    const kr5_real t325 = t302*t323 + t324;
+    const kr5_real t326 = t305*t311;
+    const kr5_real t327 = (t322 ? 0 : t319*t326);
+    const kr5_real t328 = t301*t323 + t307*t327;
+    const kr5_real t329 = -t301*t327 + t307*t323;
+    const int t330 = t318 <= t321;
+    const kr5_real t331 = (t330 ? 1 : t300*t320);
+    const kr5_real t332 = (t330 ? 0 : -t311*t320);
+    const kr5_real t333 = t329*(1 - t331);
+    const kr5_real t334 = -t325*t332 + t328*t331;
+    const kr5_real t335 = t329*t331 + t333;
+    const kr5_real t336 = t325*t331 + t328*t332;
+    const kr5_real t337 = (t334*t334) + (t335*t335);
+    const kr5_real t338 = t337;
+    const kr5_real t339 = t337 + (t336*t336);
+    const kr5_real t340 = t27 - 6.283185307179586*ceil(0.15915494309189535*t27 - 0.5);
+    const kr5_real t341 = (t106 ? 0 : atan2(t90, t89));
+    const kr5_real t342 = t72 - 6.283185307179586*ceil(0.15915494309189535*t72 - 0.5);
+    const kr5_real t343 = (t134 ? 0 : atan2(-t138, t125));
+    const kr5_real t344 = (t142 ? 0 : atan2(-t123, -t112));
+    const kr5_real t345 = (t150 <= 1e-24*t151 ? 0 : atan2(t147, t146));
+    const kr5_real t346 = (t152 ? 0 : atan2(t101, t100));
+    const kr5_real t347 = t70 - 6.283185307179586*ceil(0.15915494309189535*t70 - 0.5);
+    const kr5_real t348 = (t180 ? 0 : atan2(-t184, t171));
+    const kr5_real t349 = (t188 ? 0 : atan2(-t169, -t158));
+    const kr5_real t350 = (t196 <= 1e-24*t197 ? 0 : atan2(t193, t192));
+    const kr5_real t351 = t24 - 6.283185307179586*ceil(0.15915494309189535*t24 - 0.5);
+    const kr5_real t352 = (t248 ? 0 : atan2(t232, t231));
+    const kr5_real t353 = t215 - 6.283185307179586*ceil(0.15915494309189535*t215 - 0.5);
+    const kr5_real t354 = (t276 ? 0 : atan2(t280, t267));
+    const kr5_real t355 = (t284 ? 0 : atan2(-t265, t254));
+    const kr5_real t356 = (t292 <= 1e-24*t293 ? 0 : atan2(t289, t288));
+    const kr5_real t357 = (t294 ? 0 : atan2(t243, t242));
+    const kr5_real t358 = t216 - 6.283185307179586*ceil(0.15915494309189535*t216 - 0.5);
+    const kr5_real t359 = (t322 ? 0 : atan2(t326, t313));
+    const kr5_real t360 = (t330 ? 0 : atan2(-t311, t300));
+    const kr5_real t361 = (t338 <= 1e-24*t339 ? 0 : atan2(t335, t334));
+    const int t362 = isfinite(t2);
+    const kr5_real t363 = -1e-12;
+    const int t364 = t17 > t25;
+    const int t365 = t364 || (t26 && 0 <= 1e-12*t18);
+    const kr5_real t366 = 1.4356799999999999e-25;
+    const int t367 = 0.143568 > t366;
+    const int t368 = 0.143568 <= t366;
+    const kr5_real t369 = 1.43568e-13;
+    const int t370 = (t367 && t64 >= t363) || (t368 && t62 <= t369);
+    const int t371 = t64 > 1e-12;
+    const int t372 = 1;
+    const int t373 = (t367 && t209 >= t363) || (t368 && t208 <= t369);
+    const int t374 = t209 > 1e-12;
+
+    /* Outputs */
+    q[0] = t340;
+    q[1] = t341;
+    q[2] = t342;
+    q[3] = t343;
+    q[4] = t344;
+    q[5] = t345;
+    q[6] = t340;
+    q[7] = t341;
+    q[8] = t342;
+    q[9] = t343 - 6.283185307179586*ceil(0.15915494309189535*t343) + 3.141592653589793;
+    q[10] = -t344 - 6.283185307179586*ceil(-0.15915494309189535*t344 - 0.5);
+    q[11] = t345 - 6.283185307179586*ceil(0.15915494309189535*t345) + 3.141592653589793;
+    q[12] = t340;
+    q[13] = t346;
+    q[14] = t347;
+    q[15] = t348;
+    q[16] = t349;
+    q[17] = t350;
+    q[18] = t340;
+    q[19] = t346;
+    q[20] = t347;
+    q[21] = t348 - 6.283185307179586*ceil(0.15915494309189535*t348) + 3.141592653589793;
+    q[22] = -t349 - 6.283185307179586*ceil(-0.15915494309189535*t349 - 0.5);
+    q[23] = t350 - 6.283185307179586*ceil(0.15915494309189535*t350) + 3.141592653589793;
+    q[24] = t351;
+    q[25] = t352;
+    q[26] = t353;
+    q[27] = t354;
+    q[28] = t355;
+    q[29] = t356;
+    q[30] = t351;
+    q[31] = t352;
+    q[32] = t353;
+    q[33] = t354 - 6.283185307179586*ceil(0.15915494309189535*t354) + 3.141592653589793;
+    q[34] = -t355 - 6.283185307179586*ceil(-0.15915494309189535*t355 - 0.5);
+    q[35] = t356 - 6.283185307179586*ceil(0.15915494309189535*t356) + 3.141592653589793;
+    q[36] = t351;
+    q[37] = t357;
+    q[38] = t358;
+    q[39] = t359;
+    q[40] = t360;
+    q[41] = t361;
+    q[42] = t351;
+    q[43] = t357;
+    q[44] = t358;
+    q[45] = t359 - 6.283185307179586*ceil(0.15915494309189535*t359) + 3.141592653589793;
+    q[46] = -t360 - 6.283185307179586*ceil(-0.15915494309189535*t360 - 0.5);
+    q[47] = t361 - 6.283185307179586*ceil(0.15915494309189535*t361) + 3.141592653589793;
+    valid[0] = t362 && t365 && t370 && t122 >= t363;
+    valid[1] = t362 && t365 && t370 && t122 > 1e-12;
+    valid[2] = t362 && t365 && t367 && t371 && t168 >= t363;
+    valid[3] = t362 && t365 && t367 && t371 && t168 > 1e-12;
+    valid[4] = t362 && t364 && t372 && t373 && t264 >= t363;
+    valid[5] = t362 && t364 && t372 && t373 && t264 > 1e-12;
+    valid[6] = t362 && t364 && t367 && t372 && t374 && t310 >= t363;
+    valid[7] = t362 && t364 && t367 && t372 && t374 && t310 > 1e-12;
+}
+
 int kr5_velocity_ik(const kr5_real q[KR5_DOF], const kr5_real mu_dot[KR5_TASK_DIM], kr5_real damping, kr5_real q_dot[KR5_DOF])
 {
     /* Rows of jacobian() forming Js (the geometric Jacobian). */
@@ -785,390 +1239,19 @@ int kr5_velocity_ik(const kr5_real q[KR5_DOF], const kr5_real mu_dot[KR5_TASK_DI
     return KR5_VELOCITY_IK_OK;
 }
 
-/* The angle wrapped into (-pi, pi], for |angle| < 1e9 (the callers' angles are sums of a few
- * atan2 results): angle - 2 pi ceil((angle - pi) / (2 pi)), ceil by truncation. */
-static kr5_real kr5_wrap(kr5_real angle)
-{
-    const kr5_real turns = (angle - 3.141592653589793) / 6.283185307179586;
-    kr5_real whole;
-    if (angle > -3.141592653589793 && angle <= 3.141592653589793) {
-        return angle;
-    }
-    whole = (kr5_real)(long)turns;
-    if (whole < turns) {
-        whole += 1.0;
-    }
-    return angle - 6.283185307179586 * whole;
-}
-
-/* -- Closed-form inverse kinematics (spherical_wrist_parallel) -- */
-
-/* The arm at q = 0 (product of exponentials): unit axis directions h, points p on the axes,
- * the tool pose and a few derived constants. */
-typedef struct {
-    kr5_real tool_rotation[9];
-    kr5_real tool_position[3];
-    kr5_real h1[3];
-    kr5_real p1[3];
-    kr5_real h2[3];
-    kr5_real p2[3];
-    kr5_real h3[3];
-    kr5_real p3[3];
-    kr5_real reach;
-    kr5_real sign3;
-    kr5_real h4[3];
-    kr5_real h5[3];
-    kr5_real h6[3];
-    kr5_real v6[3];
-    kr5_real centre[3];
-    kr5_real wrist_flip;
-} kr5_ik_geometry;
-
-/* An angle with its cosine and sine. */
-typedef struct {
-    kr5_real theta, c, s;
-} kr5_angle;
-
-static inline kr5_real kr5_dot(const kr5_real a[3], const kr5_real b[3])
-{
-    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-}
-
-static inline void kr5_cross(const kr5_real a[3], const kr5_real b[3], kr5_real out[3])
-{
-    const kr5_real x = a[1] * b[2] - a[2] * b[1];
-    const kr5_real y = a[2] * b[0] - a[0] * b[2];
-    const kr5_real z = a[0] * b[1] - a[1] * b[0];
-    out[0] = x;
-    out[1] = y;
-    out[2] = z;
-}
-
-static inline void kr5_add(const kr5_real a[3], const kr5_real b[3], kr5_real out[3])
-{
-    out[0] = a[0] + b[0];
-    out[1] = a[1] + b[1];
-    out[2] = a[2] + b[2];
-}
-
-static inline void kr5_sub(const kr5_real a[3], const kr5_real b[3], kr5_real out[3])
-{
-    out[0] = a[0] - b[0];
-    out[1] = a[1] - b[1];
-    out[2] = a[2] - b[2];
-}
-
-/* v turned about the unit axis k by the angle whose cosine and sine are c and s (Rodrigues). */
-static inline void kr5_rot(const kr5_real k[3], kr5_real c, kr5_real s, const kr5_real v[3], kr5_real out[3])
-{
-    kr5_real kxv[3];
-    const kr5_real kv = kr5_dot(k, v) * (1.0 - c);
-    kr5_cross(k, v, kxv);
-    out[0] = v[0] * c + kxv[0] * s + k[0] * kv;
-    out[1] = v[1] * c + kxv[1] * s + k[1] * kv;
-    out[2] = v[2] * c + kxv[2] * s + k[2] * kv;
-}
-
-/* atan2(y, x) in (-pi, pi] (0 at the origin), about twice as fast as the C library's: the
- * argument is reduced to t in [-tan(pi/8), tan(pi/8)] with one division and atan(t) =
- * t + t z P(z) / Q(z), z = t^2, by Cephes' minimax approximation (S. L. Moshier); error
- * within 2 ulp. */
-static inline kr5_real kr5_atan2(kr5_real y, kr5_real x)
-{
-    const kr5_real ax = fabs(x);
-    const kr5_real ay = fabs(y);
-    const kr5_real low = ax < ay ? ax : ay;
-    const kr5_real high = ax < ay ? ay : ax;
-    kr5_real t, base, r;
-    if (!(high > 0.0)) {
-        return 0.0;
-    }
-    if (low <= 0.41421356237309503 * high) {
-        t = low / high;
-        base = 0.0;
-    } else {
-        t = (low - high) / (low + high);
-        base = 0.7853981633974483;
-    }
-    {
-        const kr5_real z = t * t;
-        const kr5_real z2 = z * z;
-        const kr5_real z4 = z2 * z2;
-        r = base + (t + t * z * ((-64.85021904942025 - 122.88666844901361 * z) + z2 * (-75.00855792314705 - 16.157537187333652 * z) + z4 * (-0.8750608600031904)) / ((194.5506571482614 + 485.3903996359137 * z) + z2 * (432.88106049129027 + 165.02700983169885 * z) + z4 * (24.858464901423062 + z)));
-    }
-    if (ay > ax) {
-        r = 1.5707963267948966 - r;
-    }
-    if (x < 0.0) {
-        r = 3.141592653589793 - r;
-    }
-    return y < 0.0 ? -r : r;
-}
-
-static inline kr5_angle kr5_angle_of(kr5_real c, kr5_real s)
-{
-    kr5_angle angle;
-    angle.theta = kr5_atan2(s, c);
-    angle.c = c;
-    angle.s = s;
-    return angle;
-}
-
-/* SP1: the angle turning p into q about the unit axis k (least squares when they differ in
- * length or height along k); 0 when p or q lies on the axis (any angle would do). */
-static inline kr5_angle kr5_sp1(const kr5_real p[3], const kr5_real q[3], const kr5_real k[3])
-{
-    kr5_real pxq[3];
-    kr5_cross(p, q, pxq);
-    {
-        const kr5_real x = kr5_dot(p, q) - kr5_dot(k, p) * kr5_dot(k, q);
-        const kr5_real y = kr5_dot(k, pxq);
-        const kr5_real rr = x * x + y * y;
-        if (rr <= 1e-24 * kr5_dot(p, p) * kr5_dot(q, q)) {
-            return kr5_angle_of(1.0, 0.0);
-        }
-        {
-            const kr5_real scale = 1.0 / sqrt(rr);
-            kr5_angle angle;
-            angle.theta = kr5_atan2(y, x);
-            angle.c = x * scale;
-            angle.s = y * scale;
-            return angle;
-        }
-    }
-}
-
-/* SP4: the angles t with h . rot(k, t) p = d, out = {phi + alpha, phi - alpha}; returns
- * their count. h . rot(k, t) p = A cos t + B sin t + C. One angle for a double root
- * (sin(alpha)^2 within EPS of 0), none out of range; when the left side does not depend
- * on t, the angle 0 if it equals d. */
-static inline int kr5_sp4(const kr5_real h[3], const kr5_real p[3], const kr5_real k[3], kr5_real d, kr5_angle out[2])
-{
-    kr5_real kxp[3];
-    const kr5_real hk = kr5_dot(h, k);
-    const kr5_real kp = kr5_dot(k, p);
-    kr5_cross(k, p, kxp);
-    {
-        const kr5_real a = kr5_dot(h, p) - hk * kp;
-        const kr5_real b = kr5_dot(h, kxp);
-        const kr5_real rhs = d - hk * kp;
-        const kr5_real r2 = a * a + b * b;
-        const kr5_real scale = kr5_dot(h, h) * kr5_dot(p, p);
-        kr5_real r, cos_phi, sin_phi, cos_alpha, disc, sin_alpha;
-        if (r2 <= 1e-24 * scale) {
-            if (rhs * rhs > 1e-12 * scale) {
-                return 0;
-            }
-            out[0] = kr5_angle_of(1.0, 0.0);
-            return 1;
-        }
-        r = sqrt(r2);
-        cos_phi = a / r;
-        sin_phi = b / r;
-        cos_alpha = rhs / r;
-        disc = 1.0 - cos_alpha * cos_alpha;
-        if (disc < -1e-12) {
-            return 0;
-        }
-        if (disc <= 1e-12) {
-            const kr5_real sign = cos_alpha > 0.0 ? 1.0 : -1.0;
-            out[0] = kr5_angle_of(sign * cos_phi, sign * sin_phi);
-            return 1;
-        }
-        sin_alpha = sqrt(disc);
-        {
-            /* phi is a constant when h, p and k are (the compiler folds it) */
-            const kr5_real phi = kr5_atan2(b, a);
-            const kr5_real alpha = kr5_atan2(sin_alpha, cos_alpha);
-            out[0].theta = phi + alpha;
-            out[0].c = cos_phi * cos_alpha - sin_phi * sin_alpha;
-            out[0].s = sin_phi * cos_alpha + cos_phi * sin_alpha;
-            out[1].theta = phi - alpha;
-            out[1].c = cos_phi * cos_alpha + sin_phi * sin_alpha;
-            out[1].s = sin_phi * cos_alpha - cos_phi * sin_alpha;
-        }
-        return 2;
-    }
-}
-
-/* SP3: the angles t with |rot(k, t) p - q|^2 = dd (p, q relative to a point of the axis). */
-static inline int kr5_sp3(const kr5_real p[3], const kr5_real q[3], const kr5_real k[3], kr5_real dd, kr5_angle out[2])
-{
-    return kr5_sp4(q, p, k, 0.5 * (kr5_dot(p, p) + kr5_dot(q, q) - dd), out);
-}
-
-/* SP2: the angle pairs out[i] = (t1, t2) with rot(k1, t1) rot(k2, t2) p = q, for two axes
- * through one point (p, q relative to it); returns their count, computes at most `wanted` of
- * them. rot(k2, t2) p = rot(k1, -t1) q = c, c = alpha k1 + beta k2 +- gamma k1 x k2; one pair
- * when gamma^2 is within EPS of 0, none below. */
-static inline int kr5_sp2(const kr5_real p[3], const kr5_real q[3], const kr5_real k1[3], const kr5_real k2[3],
-        int wanted, kr5_angle out[2][2])
-{
-    const kr5_real k12 = kr5_dot(k1, k2);
-    const kr5_real nn = 1.0 - k12 * k12;
-    const kr5_real u = kr5_dot(k1, q);
-    const kr5_real v = kr5_dot(k2, p);
-    const kr5_real alpha = (u - k12 * v) / nn;
-    const kr5_real beta = (v - k12 * u) / nn;
-    const kr5_real pp = kr5_dot(p, p);
-    const kr5_real gg = (pp - alpha * alpha - beta * beta - 2.0 * alpha * beta * k12) / nn;
-    kr5_real normal[3], c[3], g;
-    int count, i;
-    if (gg < -1e-12 * pp) {
-        return 0;
-    }
-    count = gg <= 1e-12 * pp ? 1 : 2;
-    g = count == 1 ? 0.0 : sqrt(gg);
-    kr5_cross(k1, k2, normal);
-    for (i = 0; i < count && i < wanted; ++i) {
-        c[0] = alpha * k1[0] + beta * k2[0] + g * normal[0];
-        c[1] = alpha * k1[1] + beta * k2[1] + g * normal[1];
-        c[2] = alpha * k1[2] + beta * k2[2] + g * normal[2];
-        out[i][0] = kr5_sp1(c, q, k1);
-        out[i][1] = kr5_sp1(p, c, k2);
-        g = -g;
-    }
-    return count;
-}
-
-/* T T(0)^-1 = exp(xi_1 q_1) ... exp(xi_n q_n) as (R, t), T(0) = (rotation, position) the
- * tool pose at q = 0. */
-static inline void kr5_relative(const kr5_real T[16], const kr5_real rotation[9], const kr5_real position[3],
-        kr5_real R[9], kr5_real t[3])
-{
-    int i, j;
-    for (i = 0; i < 3; ++i) {
-        for (j = 0; j < 3; ++j) {
-            R[3 * i + j] = T[4 * i] * rotation[3 * j] + T[4 * i + 1] * rotation[3 * j + 1]
-                           + T[4 * i + 2] * rotation[3 * j + 2];
-        }
-        t[i] = T[4 * i + 3] - kr5_dot(&R[3 * i], position);
-    }
-}
-
-static inline void kr5_mul(const kr5_real R[9], const kr5_real v[3], kr5_real out[3])
-{
-    const kr5_real x = kr5_dot(&R[0], v);
-    const kr5_real y = kr5_dot(&R[3], v);
-    const kr5_real z = kr5_dot(&R[6], v);
-    out[0] = x;
-    out[1] = y;
-    out[2] = z;
-}
-
-/* Spherical wrist with axis 5 perpendicular to axes 4 and 6: the angles out[i] = (q4, q5, q6)
- * with R4 R5 R6 h6 = a and R4 R5 R6 v6 = b (v6 perpendicular to h6); returns their count. The
- * first by SP2 and SP1; the second is (q4 + pi, wrist_flip - q5, q6 + pi): rot(h4, pi) reflects
- * the plane perpendicular to h5 across h4, and wrist_flip = -2 angle(h4 -> h6 about h5). */
-static inline int kr5_wrist(const kr5_real a[3], const kr5_real b[3], const kr5_ik_geometry *g, kr5_real out[2][3])
-{
-    kr5_angle pairs[2][2];
-    kr5_real x[3];
-    const int count = kr5_sp2(g->h6, a, g->h4, g->h5, 1, pairs);
-    if (count == 0) {
-        return 0;
-    }
-    kr5_rot(g->h4, pairs[0][0].c, -pairs[0][0].s, b, x);
-    kr5_rot(g->h5, pairs[0][1].c, -pairs[0][1].s, x, x);
-    out[0][0] = pairs[0][0].theta;
-    out[0][1] = pairs[0][1].theta;
-    out[0][2] = kr5_sp1(g->v6, x, g->h6).theta;
-    out[1][0] = out[0][0] + 3.141592653589793;
-    out[1][1] = g->wrist_flip - out[0][1];
-    out[1][2] = out[0][2] + 3.141592653589793;
-    return count;
-}
-
-/* Spherical wrist, axes 2 and 3 parallel: the wrist centre fixes q1 (SP4: its height along
- * axis 2 is constant), q3 (SP3) and q2 (SP1); the orientation left to the wrist gives q4,
- * q5, q6. */
-static int kr5_ik_solve(const kr5_real T[16], const kr5_ik_geometry *g, kr5_real q[])
-{
-    kr5_real rotation[9], position[3], wc[3], a[3], b[3], d1[3], c3[3], b3[3];
-    kr5_angle t1[2];
-    int count = 0, n1, i, j, k;
-    kr5_relative(T, g->tool_rotation, g->tool_position, rotation, position);
-    kr5_mul(rotation, g->centre, wc);
-    kr5_add(wc, position, wc);
-    kr5_mul(rotation, g->h6, a);
-    kr5_mul(rotation, g->v6, b);
-    kr5_sub(wc, g->p1, d1);
-    kr5_sub(g->centre, g->p3, c3);
-    kr5_sub(g->p2, g->p3, b3);
-    n1 = kr5_sp4(d1, g->h2, g->h1, g->reach, t1);
-    for (i = 0; i < n1; ++i) {
-        kr5_real d[3];
-        kr5_angle t3[2];
-        int n3;
-        kr5_rot(g->h1, t1[i].c, -t1[i].s, d1, d);
-        kr5_add(d, g->p1, d);
-        kr5_sub(d, g->p2, d);
-        n3 = kr5_sp3(c3, b3, g->h3, kr5_dot(d, d), t3);
-        for (j = 0; j < n3; ++j) {
-            kr5_real e[3], aw[3], bw[3], c23, s23;
-            kr5_angle t2;
-            kr5_real wrist[2][3];
-            int n_wrist;
-            kr5_rot(g->h3, t3[j].c, t3[j].s, c3, e);
-            kr5_add(e, g->p3, e);
-            kr5_sub(e, g->p2, e);
-            t2 = kr5_sp1(e, d, g->h2);
-            /* R2 R3 = rot(h2, q2 + sign3 q3), h3 = sign3 h2: one turn back for both */
-            c23 = t2.c * t3[j].c - g->sign3 * t2.s * t3[j].s;
-            s23 = t2.s * t3[j].c + g->sign3 * t2.c * t3[j].s;
-            kr5_rot(g->h1, t1[i].c, -t1[i].s, a, aw);
-            kr5_rot(g->h2, c23, -s23, aw, aw);
-            kr5_rot(g->h1, t1[i].c, -t1[i].s, b, bw);
-            kr5_rot(g->h2, c23, -s23, bw, bw);
-            n_wrist = kr5_wrist(aw, bw, g, wrist);
-            for (k = 0; k < n_wrist; ++k) {
-                kr5_real *out = q + KR5_DOF * count++;
-                out[0] = t1[i].theta;
-                out[1] = t2.theta;
-                out[2] = t3[j].theta;
-                out[3] = wrist[k][0];
-                out[4] = wrist[k][1];
-                out[5] = wrist[k][2];
-            }
-        }
-    }
-    return count;
-}
-
 int kr5_ik(const kr5_real T[16], kr5_real q[KR5_MAX_IK_SOLUTIONS * KR5_DOF])
 {
-    const kr5_ik_geometry g = {
-        .tool_rotation = {1, 0, 0, 0, -1, 0, 0, 0, -1},
-        .tool_position = {0.9, 0, -0.335},
-        .h1 = {0, 0, 1},
-        .p1 = {0, 0, 0},
-        .h2 = {0, 1, 0},
-        .p2 = {0.18, 0, 0.4},
-        .h3 = {0, 1, 0},
-        .p3 = {0.78, 0, 0.4},
-        .reach = 0,
-        .sign3 = 1,
-        .h4 = {0, 0, 1},
-        .h5 = {0, 1, 0},
-        .h6 = {0, 0, 1},
-        .v6 = {1, 0, 0},
-        .centre = {0.9, 0, -0.22},
-        .wrist_flip = 0,
-    };
-    int count, k;
-    for (k = 0; k < 12; ++k) {
-        if (!isfinite(T[k])) {
-            return 0;
+    kr5_real branches[KR5_MAX_IK_SOLUTIONS * KR5_DOF];
+    int valid[KR5_MAX_IK_SOLUTIONS];
+    int count = 0, i, j;
+    kr5_ik_branches(T, branches, valid);
+    for (i = 0; i < KR5_MAX_IK_SOLUTIONS; ++i) {
+        if (valid[i]) {
+            for (j = 0; j < KR5_DOF; ++j) {
+                q[KR5_DOF * count + j] = branches[KR5_DOF * i + j];
+            }
+            ++count;
         }
-    }
-    count = kr5_ik_solve(T, &g, q);
-    for (k = 0; k < count; ++k) {
-        q[KR5_DOF * k + 0] = kr5_wrap(q[KR5_DOF * k + 0]);
-        q[KR5_DOF * k + 1] = kr5_wrap(q[KR5_DOF * k + 1]);
-        q[KR5_DOF * k + 2] = kr5_wrap(q[KR5_DOF * k + 2]);
-        q[KR5_DOF * k + 3] = kr5_wrap(q[KR5_DOF * k + 3]);
-        q[KR5_DOF * k + 4] = kr5_wrap(q[KR5_DOF * k + 4]);
-        q[KR5_DOF * k + 5] = kr5_wrap(q[KR5_DOF * k + 5]);
     }
     return count;
 }

@@ -32,6 +32,7 @@ typedef double kr5_real;
 #define KR5_DOF 6
 #define KR5_TASK_DIM 6
 #define KR5_NUM_SINGULARITY_FACTORS 3
+#define KR5_MAX_IK_SOLUTIONS 8
 
 /* Pose of the tool frame in the world frame (4x4 homogeneous).
  * Result: T: 4 x 4 row-major, element (r, c) at T[r * 4 + c]. 102 operations. */
@@ -69,6 +70,10 @@ kr5_real kr5_manipulability(const kr5_real q[KR5_DOF]);
  * Result: returned as a scalar. 22 operations. */
 kr5_real kr5_jacobian_det(const kr5_real q[KR5_DOF]);
 
+/* Every branch of the closed-form ik and whether the target allows it.
+ * Result: q: 8 x 6 row-major, element (r, c) at q[r * 6 + c]; valid[i], i < 8. 858 operations. */
+void kr5_ik_branches(const kr5_real T[16], kr5_real q[KR5_MAX_IK_SOLUTIONS * KR5_DOF], int valid[KR5_MAX_IK_SOLUTIONS]);
+
 /* Status of kr5_velocity_ik. */
 #define KR5_VELOCITY_IK_OK 0
 #define KR5_VELOCITY_IK_SINGULAR 1   /* a pivot below 1e-12 x the largest |entry|: take damping > 0 */
@@ -82,11 +87,9 @@ kr5_real kr5_jacobian_det(const kr5_real q[KR5_DOF]);
  * KR5_VELOCITY_IK_OK, or a status above with q_dot all 0. */
 int kr5_velocity_ik(const kr5_real q[KR5_DOF], const kr5_real mu_dot[KR5_TASK_DIM], kr5_real damping, kr5_real q_dot[KR5_DOF]);
 
-#define KR5_MAX_IK_SOLUTIONS 8
-
 /* Closed-form inverse kinematics: every joint solution that reaches the target; returns
- * their count k and writes solution i to q[i * KR5_DOF + j], i < k. Loops over
- * the branches, no allocation, no recursion.
+ * their count k and writes solution i to q[i * KR5_DOF + j], i < k: the valid
+ * rows of kr5_ik_branches, in its order. No allocation, no recursion.
  * target: the 4x4 tool pose in the world frame (rotation part orthonormal).
  * Result: k <= KR5_MAX_IK_SOLUTIONS solutions, revolute angles wrapped into (-pi, pi],
  * joint limits not applied; k = 0 when the target is out of reach or not finite.

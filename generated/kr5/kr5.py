@@ -16,16 +16,18 @@ DOF = 6
 TASK = ("x", "y", "z", "roll", "pitch", "yaw", )
 
 
-def _joints(q):
-    q = numpy.asarray(q, dtype=float)
-    if q.ndim == 0 or q.shape[-1] != DOF:
-        raise ValueError(f"q must have shape ({DOF},) or (..., {DOF}), got {q.shape}")
-    return q
+def _argument(name, value, shape):
+    """`value` as a float array of `shape` or a batch of them (..., *shape)."""
+    value = numpy.asarray(value, dtype=float)
+    if value.shape[value.ndim - len(shape):] != shape:
+        batch = ", ".join(map(str, shape))
+        raise ValueError(f"{name} must have shape {shape} or (..., {batch}), got {value.shape}")
+    return value
 
 
 def fk(q):
     """pose of the tool frame in the world frame (4x4 homogeneous): (4 x 4), 102 operations."""
-    q = _joints(q)
+    q = _argument("q", q, (6,))
     q1 = q[..., 0]
     q2 = q[..., 1]
     q3 = q[..., 2]
@@ -106,7 +108,7 @@ def fk(q):
 
 def jacobian(q):
     """geometric Jacobian in the world frame (6 x DOF, rows vx vy vz wx wy wz): (6 x 6), 103 operations."""
-    q = _joints(q)
+    q = _argument("q", q, (6,))
     q1 = q[..., 0]
     q2 = q[..., 1]
     q3 = q[..., 2]
@@ -197,7 +199,7 @@ def jacobian(q):
 
 def fk_jacobian(q):
     """fk and jacobian in one pass, sharing their terms: (4 x 4 and 6 x 6), 137 operations."""
-    q = _joints(q)
+    q = _argument("q", q, (6,))
     q1 = q[..., 0]
     q2 = q[..., 1]
     q3 = q[..., 2]
@@ -319,7 +321,7 @@ def fk_jacobian(q):
 
 def jacobian_tool(q):
     """geometric Jacobian in the tool frame (6 x DOF, rows vx vy vz wx wy wz): (6 x 6), 260 operations."""
-    q = _joints(q)
+    q = _argument("q", q, (6,))
     q1 = q[..., 0]
     q2 = q[..., 1]
     q3 = q[..., 2]
@@ -438,7 +440,7 @@ def jacobian_tool(q):
 
 def task(q):
     """task vector mu = (x, y, z, roll, pitch, yaw): (6 x 1), 102 operations."""
-    q = _joints(q)
+    q = _argument("q", q, (6,))
     q1 = q[..., 0]
     q2 = q[..., 1]
     q3 = q[..., 2]
@@ -507,7 +509,7 @@ def task(q):
 
 def task_jacobian(q):
     """analytic Jacobian d mu / d q (6 x DOF): (6 x 6), 168 operations."""
-    q = _joints(q)
+    q = _argument("q", q, (6,))
     q1 = q[..., 0]
     q2 = q[..., 1]
     q3 = q[..., 2]
@@ -620,7 +622,7 @@ def task_jacobian(q):
 
 def singularity_factors(q):
     """factors of det(Js): the robot is singular where one is 0: (3 x 1), 18 operations."""
-    q = _joints(q)
+    q = _argument("q", q, (6,))
     q2 = q[..., 1]
     q3 = q[..., 2]
     q5 = q[..., 4]
@@ -639,7 +641,7 @@ def singularity_factors(q):
 
 def manipulability(q):
     """manipulability |det(Js)|: (1 x 1), 22 operations."""
-    q = _joints(q)
+    q = _argument("q", q, (6,))
     q2 = q[..., 1]
     q3 = q[..., 2]
     q5 = q[..., 4]
@@ -657,7 +659,7 @@ def manipulability(q):
 
 def jacobian_det(q):
     """det(Js): (1 x 1), 22 operations."""
-    q = _joints(q)
+    q = _argument("q", q, (6,))
     q2 = q[..., 1]
     q3 = q[..., 2]
     q5 = q[..., 4]
@@ -672,176 +674,467 @@ def jacobian_det(q):
     return d
 
 
-def _wrap(angle):
-    """Angles wrapped into (-pi, pi]."""
-    return angle - 2.0 * math.pi * numpy.ceil((angle - math.pi) / (2.0 * math.pi))
+@numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
+def ik_branches(T):
+    """every branch of the closed-form ik and whether the target allows it: (8 x 6 and 8 x 1), 858 operations."""
+    T = _argument("T", T, (4, 4))
+    T00 = T[..., 0, 0]
+    T01 = T[..., 0, 1]
+    T02 = T[..., 0, 2]
+    T03 = T[..., 0, 3]
+    T10 = T[..., 1, 0]
+    T11 = T[..., 1, 1]
+    T12 = T[..., 1, 2]
+    T13 = T[..., 1, 3]
+    T20 = T[..., 2, 0]
+    T21 = T[..., 2, 1]
+    T22 = T[..., 2, 2]
+    T23 = T[..., 2, 3]
+    t0 = 2.639193146748068
+    t1 = 1.761980786391911
+    t2 = T00 + T01 + T02 + T03 + T10 + T11 + T12 + T13 + T20 + T21 + T22 + T23
+    t3 = 0.9*T00
+    t4 = -0.335*T02 + T03 - t3
+    t5 = 0.22*T02 + t3
+    t6 = t4 + t5
+    t7 = 0.9*T10
+    t8 = -0.335*T12 + T13 - t7
+    t9 = 0.22*T12 + t7
+    t10 = t8 + t9
+    t11 = numpy.arctan2(-t6, t10)
+    t12 = 0.9*T20
+    t13 = -0.335*T22 + T23 - t12
+    t14 = 0.22*T22 + t12
+    t15 = t13 + t14
+    t16 = t10**2 + t6**2
+    t17 = t16
+    t18 = t15**2 + t16
+    t19 = 1/numpy.sqrt(t17)
+    t20 = True
+    t21 = numpy.where(t20, 0, -1)
+    t22 = numpy.where(t20, 1, 0)
+    t23 = numpy.arctan2(t22, t21)
+    t24 = t11 - t23
+    t25 = 1e-24*t18
+    t26 = numpy.less_equal(t17, t25)
+    t27 = numpy.where(t26, 0, t11 + t23)
+    t28 = t19*t22
+    t29 = t28*t6
+    t30 = t19*t21
+    t31 = t10*t30
+    t32 = numpy.where(t26, 1, t29 + t31)
+    t33 = -t29 + t31
+    t34 = t10*t28
+    t35 = t30*t6
+    t36 = numpy.where(t26, 0, t34 - t35)
+    t37 = t34 + t35
+    t38 = t10*t36 + t32*t6
+    t39 = t10*t32 - t36*t6
+    t40 = t38 - 0.18
+    t41 = T02*t32 + T12*t36
+    t42 = T02*t36 - T12*t32
+    t43 = T00*t32 + T10*t36
+    t44 = -T00*t36 + T10*t32
+    t45 = -t10*t37 + t33*t6
+    t46 = t10*t33 + t37*t6
+    t47 = t45 - 0.18
+    t48 = -T02*t33 + T12*t37
+    t49 = T02*t37 + T12*t33
+    t50 = T00*t33 - T10*t37
+    t51 = T00*t37 + T10*t33
+    t52 = 1 - t32
+    t53 = t15*t52
+    t54 = t15*t32 + t53
+    t55 = t54 - 0.4
+    t56 = t39**2 + t40**2 + t55**2
+    t57 = 0.3794 - 0.5*t56
+    t58 = T22*t52
+    t59 = T22*t32 + t58
+    t60 = T20*t52
+    t61 = T20*t32 + t60
+    t62 = t57**2
+    t63 = t0**2
+    t64 = -t62*t63 + 1
+    t65 = t0*t57
+    t66 = numpy.less(1e-12, t64)
+    t67 = numpy.where(t66, t65, numpy.where(numpy.greater(t65, 0), 1, -1))
+    t68 = numpy.where(t66, numpy.sqrt(t64), 0)
+    t69 = numpy.arctan2(t68, t67)
+    t70 = t1 - t69
+    t71 = False
+    t72 = numpy.where(t71, 0, t1 + t69)
+    t73 = 0.072*t0
+    t74 = t67*t73
+    t75 = 0.372*t0
+    t76 = t68*t75
+    t77 = numpy.where(t71, 1, -t74 - t76)
+    t78 = -t74 + t76
+    t79 = t67*t75
+    t80 = t68*t73
+    t81 = numpy.where(t71, 0, t79 - t80)
+    t82 = t79 + t80
+    t83 = 0.12*t77 - 0.62*t81
+    t84 = 0.62*t77 + 0.12*t81
+    t85 = t83 + 0.78
+    t86 = 0.4 - t84
+    t87 = t85 - 0.18
+    t88 = t86 - 0.4
+    t89 = t40*t87 + t55*t88
+    t90 = t40*t88 - t55*t87
+    t91 = t89**2 + t90**2
+    t92 = t87**2 + t88**2
+    t93 = 1/numpy.sqrt(t91)
+    t94 = 0.12*t78 - 0.62*t82
+    t95 = 0.62*t78 + 0.12*t82
+    t96 = t94 + 0.78
+    t97 = 0.4 - t95
+    t98 = t96 - 0.18
+    t99 = t97 - 0.4
+    t100 = t40*t98 + t55*t99
+    t101 = t40*t99 - t55*t98
+    t102 = t100**2 + t101**2
+    t103 = t98**2 + t99**2
+    t104 = 1/numpy.sqrt(t102)
+    t105 = 1e-24*t56
+    t106 = numpy.less_equal(t91, t105*t92)
+    t107 = numpy.where(t106, 1, t89*t93)
+    t108 = numpy.where(t106, 0, t90*t93)
+    t109 = t107*t77 - t108*t81
+    t110 = t107*t81 + t108*t77
+    t111 = -t109*t41 + t110*t59
+    t112 = t109*t59 + t110*t41
+    t113 = t109*t43 - t110*t61
+    t114 = t109*t61 + t110*t43
+    t115 = 1 - t109
+    t116 = t115*t42
+    t117 = t109*t42 + t116
+    t118 = t115*t44
+    t119 = t109*t44 + t118
+    t120 = t112**2
+    t121 = -t120
+    t122 = t121 + 1
+    t123 = numpy.where(numpy.greater(t122, 1e-12), numpy.sqrt(t122), 0)
+    t124 = -t111*t123 + t120
+    t125 = t121 + t124
+    t126 = t117**2
+    t127 = t111**2 + t120 + t126
+    t128 = t123**2
+    t129 = t125**2 + t126*t128
+    t130 = t120 + t128
+    t131 = 1/numpy.sqrt(t129)
+    t132 = 1/numpy.sqrt(t130)
+    t133 = 1e-24*t130
+    t134 = numpy.less_equal(t129, t127*t133)
+    t135 = numpy.where(t134, 1, t125*t131)
+    t136 = t114*(1 - t135)
+    t137 = t114*t135 + t136
+    t138 = t117*t123
+    t139 = numpy.where(t134, 0, -t131*t138)
+    t140 = t113*t135 + t119*t139
+    t141 = -t113*t139 + t119*t135
+    t142 = numpy.less_equal(t130, t133)
+    t143 = numpy.where(t142, 1, -t112*t132)
+    t144 = numpy.where(t142, 0, -t123*t132)
+    t145 = t141*(1 - t143)
+    t146 = -t137*t144 + t140*t143
+    t147 = t141*t143 + t145
+    t148 = t137*t143 + t140*t144
+    t149 = t146**2 + t147**2
+    t150 = t149
+    t151 = t148**2 + t149
+    t152 = numpy.less_equal(t102, t103*t105)
+    t153 = numpy.where(t152, 1, t100*t104)
+    t154 = numpy.where(t152, 0, t101*t104)
+    t155 = t153*t78 - t154*t82
+    t156 = t153*t82 + t154*t78
+    t157 = -t155*t41 + t156*t59
+    t158 = t155*t59 + t156*t41
+    t159 = t155*t43 - t156*t61
+    t160 = t155*t61 + t156*t43
+    t161 = 1 - t155
+    t162 = t161*t42
+    t163 = t155*t42 + t162
+    t164 = t161*t44
+    t165 = t155*t44 + t164
+    t166 = t158**2
+    t167 = -t166
+    t168 = t167 + 1
+    t169 = numpy.where(numpy.greater(t168, 1e-12), numpy.sqrt(t168), 0)
+    t170 = -t157*t169 + t166
+    t171 = t167 + t170
+    t172 = t163**2
+    t173 = t157**2 + t166 + t172
+    t174 = t169**2
+    t175 = t171**2 + t172*t174
+    t176 = t166 + t174
+    t177 = 1/numpy.sqrt(t175)
+    t178 = 1/numpy.sqrt(t176)
+    t179 = 1e-24*t176
+    t180 = numpy.less_equal(t175, t173*t179)
+    t181 = numpy.where(t180, 1, t171*t177)
+    t182 = t160*(1 - t181)
+    t183 = t160*t181 + t182
+    t184 = t163*t169
+    t185 = numpy.where(t180, 0, -t177*t184)
+    t186 = t159*t181 + t165*t185
+    t187 = -t159*t185 + t165*t181
+    t188 = numpy.less_equal(t176, t179)
+    t189 = numpy.where(t188, 1, -t158*t178)
+    t190 = numpy.where(t188, 0, -t169*t178)
+    t191 = t187*(1 - t189)
+    t192 = -t183*t190 + t186*t189
+    t193 = t187*t189 + t191
+    t194 = t183*t189 + t186*t190
+    t195 = t192**2 + t193**2
+    t196 = t195
+    t197 = t194**2 + t195
+    t198 = 1 - t33
+    t199 = t15*t198
+    t200 = t15*t33 + t199
+    t201 = t200 - 0.4
+    t202 = t201**2 + t46**2 + t47**2
+    t203 = 0.3794 - 0.5*t202
+    t204 = T22*t198
+    t205 = T22*t33 + t204
+    t206 = T20*t198
+    t207 = T20*t33 + t206
+    t208 = t203**2
+    t209 = -t208*t63 + 1
+    t210 = t0*t203
+    t211 = numpy.less(1e-12, t209)
+    t212 = numpy.where(t211, t210, numpy.where(numpy.greater(t210, 0), 1, -1))
+    t213 = numpy.where(t211, numpy.sqrt(t209), 0)
+    t214 = numpy.arctan2(t213, t212)
+    t215 = numpy.where(t71, 0, t1 + t214)
+    t216 = t1 - t214
+    t217 = t212*t73
+    t218 = t213*t75
+    t219 = numpy.where(t71, 1, -t217 - t218)
+    t220 = -t217 + t218
+    t221 = t212*t75
+    t222 = t213*t73
+    t223 = numpy.where(t71, 0, t221 - t222)
+    t224 = t221 + t222
+    t225 = 0.12*t219 - 0.62*t223
+    t226 = 0.62*t219 + 0.12*t223
+    t227 = t225 + 0.78
+    t228 = 0.4 - t226
+    t229 = t227 - 0.18
+    t230 = t228 - 0.4
+    t231 = t201*t230 + t229*t47
+    t232 = -t201*t229 + t230*t47
+    t233 = t231**2 + t232**2
+    t234 = t229**2 + t230**2
+    t235 = 1/numpy.sqrt(t233)
+    t236 = 0.12*t220 - 0.62*t224
+    t237 = 0.62*t220 + 0.12*t224
+    t238 = t236 + 0.78
+    t239 = 0.4 - t237
+    t240 = t238 - 0.18
+    t241 = t239 - 0.4
+    t242 = t201*t241 + t240*t47
+    t243 = -t201*t240 + t241*t47
+    t244 = t242**2 + t243**2
+    t245 = t240**2 + t241**2
+    t246 = 1/numpy.sqrt(t244)
+    t247 = 1e-24*t202
+    t248 = numpy.less_equal(t233, t234*t247)
+    t249 = numpy.where(t248, 1, t231*t235)
+    t250 = numpy.where(t248, 0, t232*t235)
+    t251 = t219*t249 - t223*t250
+    t252 = t219*t250 + t223*t249
+    t253 = t205*t252 + t251*t48
+    t254 = -t205*t251 + t252*t48
+    t255 = -t207*t252 + t251*t50
+    t256 = t207*t251 + t252*t50
+    t257 = 1 - t251
+    t258 = t257*t49
+    t259 = t251*t49 + t258
+    t260 = t257*t51
+    t261 = t251*t51 + t260
+    t262 = t254**2
+    t263 = -t262
+    t264 = t263 + 1
+    t265 = numpy.where(numpy.greater(t264, 1e-12), numpy.sqrt(t264), 0)
+    t266 = -t253*t265 + t262
+    t267 = t263 + t266
+    t268 = t259**2
+    t269 = t253**2 + t262 + t268
+    t270 = t265**2
+    t271 = t267**2 + t268*t270
+    t272 = t262 + t270
+    t273 = 1/numpy.sqrt(t271)
+    t274 = 1/numpy.sqrt(t272)
+    t275 = 1e-24*t272
+    t276 = numpy.less_equal(t271, t269*t275)
+    t277 = numpy.where(t276, 1, t267*t273)
+    t278 = t256*(1 - t277)
+    t279 = t256*t277 + t278
+    t280 = t259*t265
+    t281 = numpy.where(t276, 0, t273*t280)
+    t282 = t255*t277 + t261*t281
+    t283 = -t255*t281 + t261*t277
+    t284 = numpy.less_equal(t272, t275)
+    t285 = numpy.where(t284, 1, t254*t274)
+    t286 = numpy.where(t284, 0, -t265*t274)
+    t287 = t283*(1 - t285)
+    t288 = -t279*t286 + t282*t285
+    t289 = t283*t285 + t287
+    t290 = t279*t285 + t282*t286
+    t291 = t288**2 + t289**2
+    t292 = t291
+    t293 = t290**2 + t291
+    t294 = numpy.less_equal(t244, t245*t247)
+    t295 = numpy.where(t294, 1, t242*t246)
+    t296 = numpy.where(t294, 0, t243*t246)
+    t297 = t220*t295 - t224*t296
+    t298 = t220*t296 + t224*t295
+    t299 = t205*t298 + t297*t48
+    t300 = -t205*t297 + t298*t48
+    t301 = -t207*t298 + t297*t50
+    t302 = t207*t297 + t298*t50
+    t303 = 1 - t297
+    t304 = t303*t49
+    t305 = t297*t49 + t304
+    t306 = t303*t51
+    t307 = t297*t51 + t306
+    t308 = t300**2
+    t309 = -t308
+    t310 = t309 + 1
+    t311 = numpy.where(numpy.greater(t310, 1e-12), numpy.sqrt(t310), 0)
+    t312 = -t299*t311 + t308
+    t313 = t309 + t312
+    t314 = t305**2
+    t315 = t299**2 + t308 + t314
+    t316 = t311**2
+    t317 = t313**2 + t314*t316
+    t318 = t308 + t316
+    t319 = 1/numpy.sqrt(t317)
+    t320 = 1/numpy.sqrt(t318)
+    t321 = 1e-24*t318
+    t322 = numpy.less_equal(t317, t315*t321)
+    t323 = numpy.where(t322, 1, t313*t319)
+    t324 = t302*(1 - t323)
+    t325 = t302*t323 + t324
+    t326 = t305*t311
+    t327 = numpy.where(t322, 0, t319*t326)
+    t328 = t301*t323 + t307*t327
+    t329 = -t301*t327 + t307*t323
+    t330 = numpy.less_equal(t318, t321)
+    t331 = numpy.where(t330, 1, t300*t320)
+    t332 = numpy.where(t330, 0, -t311*t320)
+    t333 = t329*(1 - t331)
+    t334 = -t325*t332 + t328*t331
+    t335 = t329*t331 + t333
+    t336 = t325*t331 + t328*t332
+    t337 = t334**2 + t335**2
+    t338 = t337
+    t339 = t336**2 + t337
+    t340 = t27 - 6.283185307179586*numpy.ceil(0.15915494309189535*t27 - 0.5)
+    t341 = numpy.where(t106, 0, numpy.arctan2(t90, t89))
+    t342 = t72 - 6.283185307179586*numpy.ceil(0.15915494309189535*t72 - 0.5)
+    t343 = numpy.where(t134, 0, numpy.arctan2(-t138, t125))
+    t344 = numpy.where(t142, 0, numpy.arctan2(-t123, -t112))
+    t345 = numpy.where(numpy.less_equal(t150, 1e-24*t151), 0, numpy.arctan2(t147, t146))
+    t346 = numpy.where(t152, 0, numpy.arctan2(t101, t100))
+    t347 = t70 - 6.283185307179586*numpy.ceil(0.15915494309189535*t70 - 0.5)
+    t348 = numpy.where(t180, 0, numpy.arctan2(-t184, t171))
+    t349 = numpy.where(t188, 0, numpy.arctan2(-t169, -t158))
+    t350 = numpy.where(numpy.less_equal(t196, 1e-24*t197), 0, numpy.arctan2(t193, t192))
+    t351 = t24 - 6.283185307179586*numpy.ceil(0.15915494309189535*t24 - 0.5)
+    t352 = numpy.where(t248, 0, numpy.arctan2(t232, t231))
+    t353 = t215 - 6.283185307179586*numpy.ceil(0.15915494309189535*t215 - 0.5)
+    t354 = numpy.where(t276, 0, numpy.arctan2(t280, t267))
+    t355 = numpy.where(t284, 0, numpy.arctan2(-t265, t254))
+    t356 = numpy.where(numpy.less_equal(t292, 1e-24*t293), 0, numpy.arctan2(t289, t288))
+    t357 = numpy.where(t294, 0, numpy.arctan2(t243, t242))
+    t358 = t216 - 6.283185307179586*numpy.ceil(0.15915494309189535*t216 - 0.5)
+    t359 = numpy.where(t322, 0, numpy.arctan2(t326, t313))
+    t360 = numpy.where(t330, 0, numpy.arctan2(-t311, t300))
+    t361 = numpy.where(numpy.less_equal(t338, 1e-24*t339), 0, numpy.arctan2(t335, t334))
+    t362 = numpy.isfinite(t2)
+    t363 = -1e-12
+    t364 = numpy.greater(t17, t25)
+    t365 = t364 | (t26 & (numpy.less_equal(0, 1e-12*t18)))
+    t366 = 1.4356799999999999e-25
+    t367 = numpy.greater(0.143568, t366)
+    t368 = numpy.less_equal(0.143568, t366)
+    t369 = 1.43568e-13
+    t370 = (t367 & (numpy.greater_equal(t64, t363))) | (t368 & (numpy.less_equal(t62, t369)))
+    t371 = numpy.greater(t64, 1e-12)
+    t372 = True
+    t373 = (t367 & (numpy.greater_equal(t209, t363))) | (t368 & (numpy.less_equal(t208, t369)))
+    t374 = numpy.greater(t209, 1e-12)
+    q = numpy.empty(T.shape[:-2] + (8, 6))
+    q[..., 0, 0] = t340
+    q[..., 0, 1] = t341
+    q[..., 0, 2] = t342
+    q[..., 0, 3] = t343
+    q[..., 0, 4] = t344
+    q[..., 0, 5] = t345
+    q[..., 1, 0] = t340
+    q[..., 1, 1] = t341
+    q[..., 1, 2] = t342
+    q[..., 1, 3] = t343 - 6.283185307179586*numpy.ceil(0.15915494309189535*t343) + 3.141592653589793
+    q[..., 1, 4] = -t344 - 6.283185307179586*numpy.ceil(-0.15915494309189535*t344 - 0.5)
+    q[..., 1, 5] = t345 - 6.283185307179586*numpy.ceil(0.15915494309189535*t345) + 3.141592653589793
+    q[..., 2, 0] = t340
+    q[..., 2, 1] = t346
+    q[..., 2, 2] = t347
+    q[..., 2, 3] = t348
+    q[..., 2, 4] = t349
+    q[..., 2, 5] = t350
+    q[..., 3, 0] = t340
+    q[..., 3, 1] = t346
+    q[..., 3, 2] = t347
+    q[..., 3, 3] = t348 - 6.283185307179586*numpy.ceil(0.15915494309189535*t348) + 3.141592653589793
+    q[..., 3, 4] = -t349 - 6.283185307179586*numpy.ceil(-0.15915494309189535*t349 - 0.5)
+    q[..., 3, 5] = t350 - 6.283185307179586*numpy.ceil(0.15915494309189535*t350) + 3.141592653589793
+    q[..., 4, 0] = t351
+    q[..., 4, 1] = t352
+    q[..., 4, 2] = t353
+    q[..., 4, 3] = t354
+    q[..., 4, 4] = t355
+    q[..., 4, 5] = t356
+    q[..., 5, 0] = t351
+    q[..., 5, 1] = t352
+    q[..., 5, 2] = t353
+    q[..., 5, 3] = t354 - 6.283185307179586*numpy.ceil(0.15915494309189535*t354) + 3.141592653589793
+    q[..., 5, 4] = -t355 - 6.283185307179586*numpy.ceil(-0.15915494309189535*t355 - 0.5)
+    q[..., 5, 5] = t356 - 6.283185307179586*numpy.ceil(0.15915494309189535*t356) + 3.141592653589793
+    q[..., 6, 0] = t351
+    q[..., 6, 1] = t357
+    q[..., 6, 2] = t358
+    q[..., 6, 3] = t359
+    q[..., 6, 4] = t360
+    q[..., 6, 5] = t361
+    q[..., 7, 0] = t351
+    q[..., 7, 1] = t357
+    q[..., 7, 2] = t358
+    q[..., 7, 3] = t359 - 6.283185307179586*numpy.ceil(0.15915494309189535*t359) + 3.141592653589793
+    q[..., 7, 4] = -t360 - 6.283185307179586*numpy.ceil(-0.15915494309189535*t360 - 0.5)
+    q[..., 7, 5] = t361 - 6.283185307179586*numpy.ceil(0.15915494309189535*t361) + 3.141592653589793
+    valid = numpy.empty(T.shape[:-2] + (8,), dtype=bool)
+    valid[..., 0] = t362 & t365 & t370 & (numpy.greater_equal(t122, t363))
+    valid[..., 1] = t362 & t365 & t370 & (numpy.greater(t122, 1e-12))
+    valid[..., 2] = t362 & t365 & t367 & t371 & (numpy.greater_equal(t168, t363))
+    valid[..., 3] = t362 & t365 & t367 & t371 & (numpy.greater(t168, 1e-12))
+    valid[..., 4] = t362 & t364 & t372 & t373 & (numpy.greater_equal(t264, t363))
+    valid[..., 5] = t362 & t364 & t372 & t373 & (numpy.greater(t264, 1e-12))
+    valid[..., 6] = t362 & t364 & t367 & t372 & t374 & (numpy.greater_equal(t310, t363))
+    valid[..., 7] = t362 & t364 & t367 & t372 & t374 & (numpy.greater(t310, 1e-12))
+    return q, valid
 
-
-# -- Closed-form inverse kinematics (spherical_wrist_parallel) --
 
 MAX_IK_SOLUTIONS = 8
-_EPS = 1e-12  # a squared sine within this of 0 is a double root
-_TINY = 1e-24  # relative squared length below which a vector counts as zero
 
 
-def _dot(a, b):
-    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+def ik(T):
+    """Closed-form inverse kinematics: every joint solution that reaches the target.
 
-
-def _cross(a, b):
-    return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
-
-
-def _add(a, b):
-    return (a[0] + b[0], a[1] + b[1], a[2] + b[2])
-
-
-def _sub(a, b):
-    return (a[0] - b[0], a[1] - b[1], a[2] - b[2])
-
-
-def _rot(k, c, s, v):
-    """v turned about the unit axis k by the angle whose cosine and sine are c and s (Rodrigues)."""
-    kxv = _cross(k, v)
-    kv = _dot(k, v) * (1.0 - c)
-    return (v[0] * c + kxv[0] * s + k[0] * kv, v[1] * c + kxv[1] * s + k[1] * kv,
-            v[2] * c + kxv[2] * s + k[2] * kv)
-
-
-class _Angle:
-    """An angle with its cosine and sine."""
-
-    __slots__ = ("theta", "c", "s")
-
-    def __init__(self, theta, c, s):
-        self.theta, self.c, self.s = theta, c, s
-
-
-def _angle(c, s):
-    return _Angle(math.atan2(s, c), c, s)
-
-
-def _sp1(p, q, k):
-    """SP1: the angle turning p into q about the unit axis k (least squares when they differ
-    in length or height along k). 0 when p or q lies on the axis (any angle would do)."""
-    x = _dot(p, q) - _dot(k, p) * _dot(k, q)
-    y = _dot(k, _cross(p, q))
-    r = math.hypot(x, y)
-    if r * r <= _TINY * _dot(p, p) * _dot(q, q):
-        return _Angle(0.0, 1.0, 0.0)
-    return _angle(x / r, y / r)
-
-
-def _sp4(h, p, k, d):
-    """SP4: the angles t with h . rot(k, t) p = d, as [phi + alpha, phi - alpha].
-
-    h . rot(k, t) p = A cos t + B sin t + C. One angle for a double root (|sin alpha|^2 <=
-    _EPS), none out of range; when the left side does not depend on t, [0] if it equals d.
-    """
-    hk, kp = _dot(h, k), _dot(k, p)
-    a = _dot(h, p) - hk * kp
-    b = _dot(h, _cross(k, p))
-    rhs = d - hk * kp
-    r2 = a * a + b * b
-    scale = _dot(h, h) * _dot(p, p)
-    if r2 <= _TINY * scale:
-        return [_Angle(0.0, 1.0, 0.0)] if rhs * rhs <= _EPS * scale else []
-    r = math.sqrt(r2)
-    cos_phi, sin_phi, cos_alpha = a / r, b / r, rhs / r
-    disc = 1.0 - cos_alpha * cos_alpha
-    if disc < -_EPS:
-        return []
-    if disc <= _EPS:
-        sign = 1.0 if cos_alpha > 0.0 else -1.0
-        return [_angle(sign * cos_phi, sign * sin_phi)]
-    sin_alpha = math.sqrt(disc)
-    phi, alpha = math.atan2(b, a), math.atan2(sin_alpha, cos_alpha)
-    return [_Angle(phi + alpha, cos_phi * cos_alpha - sin_phi * sin_alpha, sin_phi * cos_alpha + cos_phi * sin_alpha),
-            _Angle(phi - alpha, cos_phi * cos_alpha + sin_phi * sin_alpha, sin_phi * cos_alpha - cos_phi * sin_alpha)]
-
-
-def _sp3(p, q, k, dd):
-    """SP3: the angles t with |rot(k, t) p - q|^2 = dd (p, q relative to a point of the axis)."""
-    return _sp4(q, p, k, 0.5 * (_dot(p, p) + _dot(q, q) - dd))
-
-
-def _sp2(p, q, k1, k2, wanted=2):
-    """SP2: the angle pairs (t1, t2) with rot(k1, t1) rot(k2, t2) p = q, for two axes through
-    one point (p, q relative to it): rot(k2, t2) p = rot(k1, -t1) q = c, c = alpha k1 +
-    beta k2 +- gamma k1 x k2. One pair when gamma^2 is within _EPS of 0, none below. With
-    wanted=1 the second pair, when it exists, is None (not computed)."""
-    k12 = _dot(k1, k2)
-    normal = _cross(k1, k2)
-    nn = 1.0 - k12 * k12
-    u, v = _dot(k1, q), _dot(k2, p)
-    alpha = (u - k12 * v) / nn
-    beta = (v - k12 * u) / nn
-    pp = _dot(p, p)
-    gg = (pp - alpha * alpha - beta * beta - 2.0 * alpha * beta * k12) / nn
-    if gg < -_EPS * pp:
-        return []
-    gammas = (0.0,) if gg <= _EPS * pp else (math.sqrt(gg), -math.sqrt(gg))
-    pairs = []
-    for gamma in gammas[:wanted]:
-        c = tuple(alpha * k1[i] + beta * k2[i] + gamma * normal[i] for i in range(3))
-        pairs.append((_sp1(c, q, k1), _sp1(p, c, k2)))
-    return pairs + [None] * (len(gammas) - len(pairs))
-
-
-def _relative(T, rotation, position):
-    """T T(0)^-1 = exp(xi_1 q_1) ... exp(xi_n q_n) as (R, t), T(0) = (rotation, position)
-    the tool pose at q = 0."""
-    R = tuple(T[i][0] * rotation[3 * j] + T[i][1] * rotation[3 * j + 1] + T[i][2] * rotation[3 * j + 2]
-              for i in range(3) for j in range(3))
-    return R, tuple(T[i][3] - _dot(R[3 * i:3 * i + 3], position) for i in range(3))
-
-
-def _mul(R, v):
-    return (_dot(R[0:3], v), _dot(R[3:6], v), _dot(R[6:9], v))
-
-
-def _ik_wrist(a, b, h4, h5, h6, v6, wrist_flip):
-    """Spherical wrist with axis 5 perpendicular to axes 4 and 6: the angles (q4, q5, q6) with
-    R4 R5 R6 h6 = a and R4 R5 R6 v6 = b (v6 perpendicular to h6). The first by SP2 and SP1; the
-    second is (q4 + pi, wrist_flip - q5, q6 + pi): rot(h4, pi) reflects the plane perpendicular
-    to h5 across h4, and wrist_flip = -2 angle(h4 -> h6 about h5)."""
-    pairs = _sp2(h6, a, h4, h5, wanted=1)
-    if not pairs:
-        return []
-    t4, t5 = pairs[0]
-    t6 = _sp1(v6, _rot(h5, t5.c, -t5.s, _rot(h4, t4.c, -t4.s, b)), h6)
-    first = (t4.theta, t5.theta, t6.theta)
-    if len(pairs) == 1:
-        return [first]
-    return [first, (t4.theta + math.pi, wrist_flip - t5.theta, t6.theta + math.pi)]
-
-
-def _ik_solve(T, tool_rotation, tool_position, h1, p1, h2, p2, h3, p3, reach, sign3, h4, h5, h6, v6, centre, wrist_flip):
-    """Spherical wrist, axes 2 and 3 parallel: the wrist centre fixes q1 (SP4: its height
-    along axis 2 is constant), q3 (SP3) and q2 (SP1); the orientation left to the wrist
-    gives q4, q5, q6."""
-    R, t = _relative(T, tool_rotation, tool_position)
-    wc = _add(_mul(R, centre), t)
-    a, b = _mul(R, h6), _mul(R, v6)
-    solutions = []
-    for t1 in _sp4(_sub(wc, p1), h2, h1, reach):
-        w = _add(p1, _rot(h1, t1.c, -t1.s, _sub(wc, p1)))
-        d = _sub(w, p2)
-        for t3 in _sp3(_sub(centre, p3), _sub(p2, p3), h3, _dot(d, d)):
-            t2 = _sp1(_sub(_add(p3, _rot(h3, t3.c, t3.s, _sub(centre, p3))), p2), d, h2)
-            # R2 R3 = rot(h2, q2 + sign3 q3), h3 = sign3 h2: one turn back for both
-            c23 = t2.c * t3.c - sign3 * t2.s * t3.s
-            s23 = t2.s * t3.c + sign3 * t2.c * t3.s
-            aw = _rot(h2, c23, -s23, _rot(h1, t1.c, -t1.s, a))
-            bw = _rot(h2, c23, -s23, _rot(h1, t1.c, -t1.s, b))
-            for t4, t5, t6 in _ik_wrist(aw, bw, h4, h5, h6, v6, wrist_flip):
-                solutions.append([t1.theta, t2.theta, t3.theta, t4, t5, t6])
-    return solutions
-
-
-def ik(target):
-    """Closed-form inverse kinematics: every joint solution that reaches `target`, as (k, DOF).
-
+    One target: the solutions as (k, DOF), the valid rows of ik_branches in its order.
+    A batch of targets: ik_branches' (q, valid), (..., MAX_IK_SOLUTIONS, DOF) and
+    (..., MAX_IK_SOLUTIONS).
     target: the 4x4 tool pose in the world frame (rotation part orthonormal).
     Result: k <= MAX_IK_SOLUTIONS solutions, revolute angles wrapped into (-pi, pi], joint
     limits not applied; k = 0 when the target is out of reach or not finite.
@@ -856,33 +1149,8 @@ def ik(target):
     root (a target on a singularity or on the workspace boundary) is returned once, and an
     angle the target leaves free (a singular wrist or shoulder) is set to 0.
     """
-    target = numpy.asarray(target, dtype=float)
-    if target.shape != (4, 4):
-        raise ValueError(f"target must have shape (4, 4), got {target.shape}")
-    if not numpy.all(numpy.isfinite(target[:3])):  # the last row is not read
-        return numpy.empty((0, DOF))
-    solutions = _ik_solve(
-        target.tolist(),
-        tool_rotation=(1, 0, 0, 0, -1, 0, 0, 0, -1),
-        tool_position=(0.9, 0, -0.335),
-        h1=(0, 0, 1),
-        p1=(0, 0, 0),
-        h2=(0, 1, 0),
-        p2=(0.18, 0, 0.4),
-        h3=(0, 1, 0),
-        p3=(0.78, 0, 0.4),
-        reach=0,
-        sign3=1,
-        h4=(0, 0, 1),
-        h5=(0, 1, 0),
-        h6=(0, 0, 1),
-        v6=(1, 0, 0),
-        centre=(0.9, 0, -0.22),
-        wrist_flip=0,
-    )
-    q = numpy.array(solutions, dtype=float).reshape(-1, DOF)
-    q[:, [0, 1, 2, 3, 4, 5]] = _wrap(q[:, [0, 1, 2, 3, 4, 5]])
-    return q
+    q, valid = ik_branches(T)
+    return q[valid] if valid.ndim == 1 else (q, valid)
 
 
 # -- Iterative inverse kinematics --
@@ -970,7 +1238,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
     condition number below VELOCITY_IK_RCOND; take damping > 0 there). Where ok is False,
     q_dot is 0: the result never holds NaN.
     """
-    q = _joints(q)
+    q = _argument("q", q, (DOF,))
     mu_dot = numpy.asarray(mu_dot, dtype=float)
     if mu_dot.ndim == 0 or mu_dot.shape[-1] != 6:
         raise ValueError(f"mu_dot must have shape (6,) or (..., 6), got {mu_dot.shape}")

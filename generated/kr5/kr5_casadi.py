@@ -3,7 +3,9 @@
 
 KUKA KR5 arc (rtb KR5), standard DH
 Every function takes `q` (6 x 1: radians for revolute joints, m for
-prismatic ones) and returns a rows x cols result whose zeros are structural.
+prismatic ones) and returns a rows x cols result whose zeros are structural; ik_branches
+(also named ik) takes the target instead of q and returns every branch (MAX_IK_SOLUTIONS x
+DOF) and its validity (MAX_IK_SOLUTIONS x 1, 1 or 0).
 Task vector: (x, y, z, roll, pitch, yaw).
 """
 
@@ -622,7 +624,458 @@ def _jacobian_det(q):
     return [d]
 
 
-_q = casadi.SX.sym("q", DOF)
+def _ik_branches(T):
+    """Every branch of the closed-form ik and whether the target allows it: 858 operations."""
+    T00 = T[0, 0]
+    T01 = T[0, 1]
+    T02 = T[0, 2]
+    T03 = T[0, 3]
+    T10 = T[1, 0]
+    T11 = T[1, 1]
+    T12 = T[1, 2]
+    T13 = T[1, 3]
+    T20 = T[2, 0]
+    T21 = T[2, 1]
+    T22 = T[2, 2]
+    T23 = T[2, 3]
+    t0 = 2.639193146748068
+    t1 = 1.761980786391911
+    t2 = T00 + T01 + T02 + T03 + T10 + T11 + T12 + T13 + T20 + T21 + T22 + T23
+    t3 = 0.9*T00
+    t4 = -0.335*T02 + T03 - t3
+    t5 = 0.22*T02 + t3
+    t6 = t4 + t5
+    t7 = 0.9*T10
+    t8 = -0.335*T12 + T13 - t7
+    t9 = 0.22*T12 + t7
+    t10 = t8 + t9
+    t11 = casadi.atan2(-t6, t10)
+    t12 = 0.9*T20
+    t13 = -0.335*T22 + T23 - t12
+    t14 = 0.22*T22 + t12
+    t15 = t13 + t14
+    t16 = t10**2 + t6**2
+    t17 = t16
+    t18 = t15**2 + t16
+    t19 = 1/casadi.sqrt(t17)
+    t20 = True
+    t21 = casadi.if_else(t20, 0, -1)
+    t22 = casadi.if_else(t20, 1, 0)
+    t23 = casadi.atan2(t22, t21)
+    t24 = t11 - t23
+    t25 = 1e-24*t18
+    t26 = (t17 <= t25)
+    t27 = casadi.if_else(t26, 0, t11 + t23)
+    t28 = t19*t22
+    t29 = t28*t6
+    t30 = t19*t21
+    t31 = t10*t30
+    t32 = casadi.if_else(t26, 1, t29 + t31)
+    t33 = -t29 + t31
+    t34 = t10*t28
+    t35 = t30*t6
+    t36 = casadi.if_else(t26, 0, t34 - t35)
+    t37 = t34 + t35
+    t38 = t10*t36 + t32*t6
+    t39 = t10*t32 - t36*t6
+    t40 = t38 - 0.18
+    t41 = T02*t32 + T12*t36
+    t42 = T02*t36 - T12*t32
+    t43 = T00*t32 + T10*t36
+    t44 = -T00*t36 + T10*t32
+    t45 = -t10*t37 + t33*t6
+    t46 = t10*t33 + t37*t6
+    t47 = t45 - 0.18
+    t48 = -T02*t33 + T12*t37
+    t49 = T02*t37 + T12*t33
+    t50 = T00*t33 - T10*t37
+    t51 = T00*t37 + T10*t33
+    t52 = 1 - t32
+    t53 = t15*t52
+    t54 = t15*t32 + t53
+    t55 = t54 - 0.4
+    t56 = t39**2 + t40**2 + t55**2
+    t57 = 0.3794 - 0.5*t56
+    t58 = T22*t52
+    t59 = T22*t32 + t58
+    t60 = T20*t52
+    t61 = T20*t32 + t60
+    t62 = t57**2
+    t63 = t0**2
+    t64 = -t62*t63 + 1
+    t65 = t0*t57
+    t66 = (1e-12 < t64)
+    t67 = casadi.if_else(t66, t65, casadi.if_else((t65 > 0), 1, -1))
+    t68 = casadi.if_else(t66, casadi.sqrt(t64), 0)
+    t69 = casadi.atan2(t68, t67)
+    t70 = t1 - t69
+    t71 = False
+    t72 = casadi.if_else(t71, 0, t1 + t69)
+    t73 = 0.072*t0
+    t74 = t67*t73
+    t75 = 0.372*t0
+    t76 = t68*t75
+    t77 = casadi.if_else(t71, 1, -t74 - t76)
+    t78 = -t74 + t76
+    t79 = t67*t75
+    t80 = t68*t73
+    t81 = casadi.if_else(t71, 0, t79 - t80)
+    t82 = t79 + t80
+    t83 = 0.12*t77 - 0.62*t81
+    t84 = 0.62*t77 + 0.12*t81
+    t85 = t83 + 0.78
+    t86 = 0.4 - t84
+    t87 = t85 - 0.18
+    t88 = t86 - 0.4
+    t89 = t40*t87 + t55*t88
+    t90 = t40*t88 - t55*t87
+    t91 = t89**2 + t90**2
+    t92 = t87**2 + t88**2
+    t93 = 1/casadi.sqrt(t91)
+    t94 = 0.12*t78 - 0.62*t82
+    t95 = 0.62*t78 + 0.12*t82
+    t96 = t94 + 0.78
+    t97 = 0.4 - t95
+    t98 = t96 - 0.18
+    t99 = t97 - 0.4
+    t100 = t40*t98 + t55*t99
+    t101 = t40*t99 - t55*t98
+    t102 = t100**2 + t101**2
+    t103 = t98**2 + t99**2
+    t104 = 1/casadi.sqrt(t102)
+    t105 = 1e-24*t56
+    t106 = (t91 <= t105*t92)
+    t107 = casadi.if_else(t106, 1, t89*t93)
+    t108 = casadi.if_else(t106, 0, t90*t93)
+    t109 = t107*t77 - t108*t81
+    t110 = t107*t81 + t108*t77
+    t111 = -t109*t41 + t110*t59
+    t112 = t109*t59 + t110*t41
+    t113 = t109*t43 - t110*t61
+    t114 = t109*t61 + t110*t43
+    t115 = 1 - t109
+    t116 = t115*t42
+    t117 = t109*t42 + t116
+    t118 = t115*t44
+    t119 = t109*t44 + t118
+    t120 = t112**2
+    t121 = -t120
+    t122 = t121 + 1
+    t123 = casadi.if_else((t122 > 1e-12), casadi.sqrt(t122), 0)
+    t124 = -t111*t123 + t120
+    t125 = t121 + t124
+    t126 = t117**2
+    t127 = t111**2 + t120 + t126
+    t128 = t123**2
+    t129 = t125**2 + t126*t128
+    t130 = t120 + t128
+    t131 = 1/casadi.sqrt(t129)
+    t132 = 1/casadi.sqrt(t130)
+    t133 = 1e-24*t130
+    t134 = (t129 <= t127*t133)
+    t135 = casadi.if_else(t134, 1, t125*t131)
+    t136 = t114*(1 - t135)
+    t137 = t114*t135 + t136
+    t138 = t117*t123
+    t139 = casadi.if_else(t134, 0, -t131*t138)
+    t140 = t113*t135 + t119*t139
+    t141 = -t113*t139 + t119*t135
+    t142 = (t130 <= t133)
+    t143 = casadi.if_else(t142, 1, -t112*t132)
+    t144 = casadi.if_else(t142, 0, -t123*t132)
+    t145 = t141*(1 - t143)
+    t146 = -t137*t144 + t140*t143
+    t147 = t141*t143 + t145
+    t148 = t137*t143 + t140*t144
+    t149 = t146**2 + t147**2
+    t150 = t149
+    t151 = t148**2 + t149
+    t152 = (t102 <= t103*t105)
+    t153 = casadi.if_else(t152, 1, t100*t104)
+    t154 = casadi.if_else(t152, 0, t101*t104)
+    t155 = t153*t78 - t154*t82
+    t156 = t153*t82 + t154*t78
+    t157 = -t155*t41 + t156*t59
+    t158 = t155*t59 + t156*t41
+    t159 = t155*t43 - t156*t61
+    t160 = t155*t61 + t156*t43
+    t161 = 1 - t155
+    t162 = t161*t42
+    t163 = t155*t42 + t162
+    t164 = t161*t44
+    t165 = t155*t44 + t164
+    t166 = t158**2
+    t167 = -t166
+    t168 = t167 + 1
+    t169 = casadi.if_else((t168 > 1e-12), casadi.sqrt(t168), 0)
+    t170 = -t157*t169 + t166
+    t171 = t167 + t170
+    t172 = t163**2
+    t173 = t157**2 + t166 + t172
+    t174 = t169**2
+    t175 = t171**2 + t172*t174
+    t176 = t166 + t174
+    t177 = 1/casadi.sqrt(t175)
+    t178 = 1/casadi.sqrt(t176)
+    t179 = 1e-24*t176
+    t180 = (t175 <= t173*t179)
+    t181 = casadi.if_else(t180, 1, t171*t177)
+    t182 = t160*(1 - t181)
+    t183 = t160*t181 + t182
+    t184 = t163*t169
+    t185 = casadi.if_else(t180, 0, -t177*t184)
+    t186 = t159*t181 + t165*t185
+    t187 = -t159*t185 + t165*t181
+    t188 = (t176 <= t179)
+    t189 = casadi.if_else(t188, 1, -t158*t178)
+    t190 = casadi.if_else(t188, 0, -t169*t178)
+    t191 = t187*(1 - t189)
+    t192 = -t183*t190 + t186*t189
+    t193 = t187*t189 + t191
+    t194 = t183*t189 + t186*t190
+    t195 = t192**2 + t193**2
+    t196 = t195
+    t197 = t194**2 + t195
+    t198 = 1 - t33
+    t199 = t15*t198
+    t200 = t15*t33 + t199
+    t201 = t200 - 0.4
+    t202 = t201**2 + t46**2 + t47**2
+    t203 = 0.3794 - 0.5*t202
+    t204 = T22*t198
+    t205 = T22*t33 + t204
+    t206 = T20*t198
+    t207 = T20*t33 + t206
+    t208 = t203**2
+    t209 = -t208*t63 + 1
+    t210 = t0*t203
+    t211 = (1e-12 < t209)
+    t212 = casadi.if_else(t211, t210, casadi.if_else((t210 > 0), 1, -1))
+    t213 = casadi.if_else(t211, casadi.sqrt(t209), 0)
+    t214 = casadi.atan2(t213, t212)
+    t215 = casadi.if_else(t71, 0, t1 + t214)
+    t216 = t1 - t214
+    t217 = t212*t73
+    t218 = t213*t75
+    t219 = casadi.if_else(t71, 1, -t217 - t218)
+    t220 = -t217 + t218
+    t221 = t212*t75
+    t222 = t213*t73
+    t223 = casadi.if_else(t71, 0, t221 - t222)
+    t224 = t221 + t222
+    t225 = 0.12*t219 - 0.62*t223
+    t226 = 0.62*t219 + 0.12*t223
+    t227 = t225 + 0.78
+    t228 = 0.4 - t226
+    t229 = t227 - 0.18
+    t230 = t228 - 0.4
+    t231 = t201*t230 + t229*t47
+    t232 = -t201*t229 + t230*t47
+    t233 = t231**2 + t232**2
+    t234 = t229**2 + t230**2
+    t235 = 1/casadi.sqrt(t233)
+    t236 = 0.12*t220 - 0.62*t224
+    t237 = 0.62*t220 + 0.12*t224
+    t238 = t236 + 0.78
+    t239 = 0.4 - t237
+    t240 = t238 - 0.18
+    t241 = t239 - 0.4
+    t242 = t201*t241 + t240*t47
+    t243 = -t201*t240 + t241*t47
+    t244 = t242**2 + t243**2
+    t245 = t240**2 + t241**2
+    t246 = 1/casadi.sqrt(t244)
+    t247 = 1e-24*t202
+    t248 = (t233 <= t234*t247)
+    t249 = casadi.if_else(t248, 1, t231*t235)
+    t250 = casadi.if_else(t248, 0, t232*t235)
+    t251 = t219*t249 - t223*t250
+    t252 = t219*t250 + t223*t249
+    t253 = t205*t252 + t251*t48
+    t254 = -t205*t251 + t252*t48
+    t255 = -t207*t252 + t251*t50
+    t256 = t207*t251 + t252*t50
+    t257 = 1 - t251
+    t258 = t257*t49
+    t259 = t251*t49 + t258
+    t260 = t257*t51
+    t261 = t251*t51 + t260
+    t262 = t254**2
+    t263 = -t262
+    t264 = t263 + 1
+    t265 = casadi.if_else((t264 > 1e-12), casadi.sqrt(t264), 0)
+    t266 = -t253*t265 + t262
+    t267 = t263 + t266
+    t268 = t259**2
+    t269 = t253**2 + t262 + t268
+    t270 = t265**2
+    t271 = t267**2 + t268*t270
+    t272 = t262 + t270
+    t273 = 1/casadi.sqrt(t271)
+    t274 = 1/casadi.sqrt(t272)
+    t275 = 1e-24*t272
+    t276 = (t271 <= t269*t275)
+    t277 = casadi.if_else(t276, 1, t267*t273)
+    t278 = t256*(1 - t277)
+    t279 = t256*t277 + t278
+    t280 = t259*t265
+    t281 = casadi.if_else(t276, 0, t273*t280)
+    t282 = t255*t277 + t261*t281
+    t283 = -t255*t281 + t261*t277
+    t284 = (t272 <= t275)
+    t285 = casadi.if_else(t284, 1, t254*t274)
+    t286 = casadi.if_else(t284, 0, -t265*t274)
+    t287 = t283*(1 - t285)
+    t288 = -t279*t286 + t282*t285
+    t289 = t283*t285 + t287
+    t290 = t279*t285 + t282*t286
+    t291 = t288**2 + t289**2
+    t292 = t291
+    t293 = t290**2 + t291
+    t294 = (t244 <= t245*t247)
+    t295 = casadi.if_else(t294, 1, t242*t246)
+    t296 = casadi.if_else(t294, 0, t243*t246)
+    t297 = t220*t295 - t224*t296
+    t298 = t220*t296 + t224*t295
+    t299 = t205*t298 + t297*t48
+    t300 = -t205*t297 + t298*t48
+    t301 = -t207*t298 + t297*t50
+    t302 = t207*t297 + t298*t50
+    t303 = 1 - t297
+    t304 = t303*t49
+    t305 = t297*t49 + t304
+    t306 = t303*t51
+    t307 = t297*t51 + t306
+    t308 = t300**2
+    t309 = -t308
+    t310 = t309 + 1
+    t311 = casadi.if_else((t310 > 1e-12), casadi.sqrt(t310), 0)
+    t312 = -t299*t311 + t308
+    t313 = t309 + t312
+    t314 = t305**2
+    t315 = t299**2 + t308 + t314
+    t316 = t311**2
+    t317 = t313**2 + t314*t316
+    t318 = t308 + t316
+    t319 = 1/casadi.sqrt(t317)
+    t320 = 1/casadi.sqrt(t318)
+    t321 = 1e-24*t318
+    t322 = (t317 <= t315*t321)
+    t323 = casadi.if_else(t322, 1, t313*t319)
+    t324 = t302*(1 - t323)
+    t325 = t302*t323 + t324
+    t326 = t305*t311
+    t327 = casadi.if_else(t322, 0, t319*t326)
+    t328 = t301*t323 + t307*t327
+    t329 = -t301*t327 + t307*t323
+    t330 = (t318 <= t321)
+    t331 = casadi.if_else(t330, 1, t300*t320)
+    t332 = casadi.if_else(t330, 0, -t311*t320)
+    t333 = t329*(1 - t331)
+    t334 = -t325*t332 + t328*t331
+    t335 = t329*t331 + t333
+    t336 = t325*t331 + t328*t332
+    t337 = t334**2 + t335**2
+    t338 = t337
+    t339 = t336**2 + t337
+    t340 = t27 - 6.283185307179586*casadi.ceil(0.15915494309189535*t27 - 0.5)
+    t341 = casadi.if_else(t106, 0, casadi.atan2(t90, t89))
+    t342 = t72 - 6.283185307179586*casadi.ceil(0.15915494309189535*t72 - 0.5)
+    t343 = casadi.if_else(t134, 0, casadi.atan2(-t138, t125))
+    t344 = casadi.if_else(t142, 0, casadi.atan2(-t123, -t112))
+    t345 = casadi.if_else((t150 <= 1e-24*t151), 0, casadi.atan2(t147, t146))
+    t346 = casadi.if_else(t152, 0, casadi.atan2(t101, t100))
+    t347 = t70 - 6.283185307179586*casadi.ceil(0.15915494309189535*t70 - 0.5)
+    t348 = casadi.if_else(t180, 0, casadi.atan2(-t184, t171))
+    t349 = casadi.if_else(t188, 0, casadi.atan2(-t169, -t158))
+    t350 = casadi.if_else((t196 <= 1e-24*t197), 0, casadi.atan2(t193, t192))
+    t351 = t24 - 6.283185307179586*casadi.ceil(0.15915494309189535*t24 - 0.5)
+    t352 = casadi.if_else(t248, 0, casadi.atan2(t232, t231))
+    t353 = t215 - 6.283185307179586*casadi.ceil(0.15915494309189535*t215 - 0.5)
+    t354 = casadi.if_else(t276, 0, casadi.atan2(t280, t267))
+    t355 = casadi.if_else(t284, 0, casadi.atan2(-t265, t254))
+    t356 = casadi.if_else((t292 <= 1e-24*t293), 0, casadi.atan2(t289, t288))
+    t357 = casadi.if_else(t294, 0, casadi.atan2(t243, t242))
+    t358 = t216 - 6.283185307179586*casadi.ceil(0.15915494309189535*t216 - 0.5)
+    t359 = casadi.if_else(t322, 0, casadi.atan2(t326, t313))
+    t360 = casadi.if_else(t330, 0, casadi.atan2(-t311, t300))
+    t361 = casadi.if_else((t338 <= 1e-24*t339), 0, casadi.atan2(t335, t334))
+    t362 = (casadi.fabs(t2) < casadi.inf)
+    t363 = -1e-12
+    t364 = (t17 > t25)
+    t365 = casadi.logic_or(t364, casadi.logic_and(t26, (0 <= 1e-12*t18)))
+    t366 = 1.4356799999999999e-25
+    t367 = (0.143568 > t366)
+    t368 = (0.143568 <= t366)
+    t369 = 1.43568e-13
+    t370 = casadi.logic_or(casadi.logic_and(t367, (t64 >= t363)), casadi.logic_and(t368, (t62 <= t369)))
+    t371 = (t64 > 1e-12)
+    t372 = True
+    t373 = casadi.logic_or(casadi.logic_and(t367, (t209 >= t363)), casadi.logic_and(t368, (t208 <= t369)))
+    t374 = (t209 > 1e-12)
+    q = casadi.SX(8, 6)
+    q[0, 0] = t340
+    q[0, 1] = t341
+    q[0, 2] = t342
+    q[0, 3] = t343
+    q[0, 4] = t344
+    q[0, 5] = t345
+    q[1, 0] = t340
+    q[1, 1] = t341
+    q[1, 2] = t342
+    q[1, 3] = t343 - 6.283185307179586*casadi.ceil(0.15915494309189535*t343) + 3.141592653589793
+    q[1, 4] = -t344 - 6.283185307179586*casadi.ceil(-0.15915494309189535*t344 - 0.5)
+    q[1, 5] = t345 - 6.283185307179586*casadi.ceil(0.15915494309189535*t345) + 3.141592653589793
+    q[2, 0] = t340
+    q[2, 1] = t346
+    q[2, 2] = t347
+    q[2, 3] = t348
+    q[2, 4] = t349
+    q[2, 5] = t350
+    q[3, 0] = t340
+    q[3, 1] = t346
+    q[3, 2] = t347
+    q[3, 3] = t348 - 6.283185307179586*casadi.ceil(0.15915494309189535*t348) + 3.141592653589793
+    q[3, 4] = -t349 - 6.283185307179586*casadi.ceil(-0.15915494309189535*t349 - 0.5)
+    q[3, 5] = t350 - 6.283185307179586*casadi.ceil(0.15915494309189535*t350) + 3.141592653589793
+    q[4, 0] = t351
+    q[4, 1] = t352
+    q[4, 2] = t353
+    q[4, 3] = t354
+    q[4, 4] = t355
+    q[4, 5] = t356
+    q[5, 0] = t351
+    q[5, 1] = t352
+    q[5, 2] = t353
+    q[5, 3] = t354 - 6.283185307179586*casadi.ceil(0.15915494309189535*t354) + 3.141592653589793
+    q[5, 4] = -t355 - 6.283185307179586*casadi.ceil(-0.15915494309189535*t355 - 0.5)
+    q[5, 5] = t356 - 6.283185307179586*casadi.ceil(0.15915494309189535*t356) + 3.141592653589793
+    q[6, 0] = t351
+    q[6, 1] = t357
+    q[6, 2] = t358
+    q[6, 3] = t359
+    q[6, 4] = t360
+    q[6, 5] = t361
+    q[7, 0] = t351
+    q[7, 1] = t357
+    q[7, 2] = t358
+    q[7, 3] = t359 - 6.283185307179586*casadi.ceil(0.15915494309189535*t359) + 3.141592653589793
+    q[7, 4] = -t360 - 6.283185307179586*casadi.ceil(-0.15915494309189535*t360 - 0.5)
+    q[7, 5] = t361 - 6.283185307179586*casadi.ceil(0.15915494309189535*t361) + 3.141592653589793
+    valid = casadi.SX(8, 1)
+    valid[0, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t362, t365), t370), (t122 >= t363))
+    valid[1, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t362, t365), t370), (t122 > 1e-12))
+    valid[2, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t362, t365), t367), t371), (t168 >= t363))
+    valid[3, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t362, t365), t367), t371), (t168 > 1e-12))
+    valid[4, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t362, t364), t372), t373), (t264 >= t363))
+    valid[5, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t362, t364), t372), t373), (t264 > 1e-12))
+    valid[6, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t362, t364), t367), t372), t374), (t310 >= t363))
+    valid[7, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t362, t364), t367), t372), t374), (t310 > 1e-12))
+    return [q, valid]
+
+
+_q = casadi.SX.sym("q", 6, 1)
+_T = casadi.SX.sym("T", 4, 4)
 fk = casadi.Function("fk", [_q], _fk(_q), ["q"], ["T"])
 jacobian = casadi.Function("jacobian", [_q], _jacobian(_q), ["q"], ["J"])
 fk_jacobian = casadi.Function("fk_jacobian", [_q], _fk_jacobian(_q), ["q"], ["T", "J"])
@@ -632,8 +1085,10 @@ task_jacobian = casadi.Function("task_jacobian", [_q], _task_jacobian(_q), ["q"]
 singularity_factors = casadi.Function("singularity_factors", [_q], _singularity_factors(_q), ["q"], ["f"])
 manipulability = casadi.Function("manipulability", [_q], _manipulability(_q), ["q"], ["w"])
 jacobian_det = casadi.Function("jacobian_det", [_q], _jacobian_det(_q), ["q"], ["d"])
+ik_branches = casadi.Function("ik_branches", [_T], _ik_branches(_T), ["T"], ["q", "valid"])
+ik = ik_branches  # CasADi functions have fixed-size outputs: every branch and its validity
 
 
 def functions():
     """All functions by name."""
-    return {"fk": fk, "jacobian": jacobian, "fk_jacobian": fk_jacobian, "jacobian_tool": jacobian_tool, "task": task, "task_jacobian": task_jacobian, "singularity_factors": singularity_factors, "manipulability": manipulability, "jacobian_det": jacobian_det}
+    return {"fk": fk, "jacobian": jacobian, "fk_jacobian": fk_jacobian, "jacobian_tool": jacobian_tool, "task": task, "task_jacobian": task_jacobian, "singularity_factors": singularity_factors, "manipulability": manipulability, "jacobian_det": jacobian_det, "ik_branches": ik_branches}

@@ -3,7 +3,9 @@
 
 Franka Emika Panda with Franka Hand TCP (rtb Panda), modified DH
 Every function takes `q` (7 x 1: radians for revolute joints, m for
-prismatic ones) and returns a rows x cols result whose zeros are structural.
+prismatic ones) and returns a rows x cols result whose zeros are structural; ik_branches
+(also named ik) takes the target instead of q and returns every branch (MAX_IK_SOLUTIONS x
+DOF) and its validity (MAX_IK_SOLUTIONS x 1, 1 or 0).
 Task vector: (x, y, z, roll, pitch, yaw).
 """
 
@@ -1132,7 +1134,7 @@ def _manipulability(q):
     return [w]
 
 
-_q = casadi.SX.sym("q", DOF)
+_q = casadi.SX.sym("q", 7, 1)
 fk = casadi.Function("fk", [_q], _fk(_q), ["q"], ["T"])
 jacobian = casadi.Function("jacobian", [_q], _jacobian(_q), ["q"], ["J"])
 fk_jacobian = casadi.Function("fk_jacobian", [_q], _fk_jacobian(_q), ["q"], ["T", "J"])

@@ -247,6 +247,53 @@ planar_2r_real planar_2r_jacobian_det(const planar_2r_real q[PLANAR_2R_DOF])
     return s2;
 }
 
+void planar_2r_ik_branches(const planar_2r_real mu[PLANAR_2R_TASK_DIM], planar_2r_real q[PLANAR_2R_MAX_IK_SOLUTIONS * PLANAR_2R_DOF], int valid[PLANAR_2R_MAX_IK_SOLUTIONS])
+{
+    /* 79 operations */
+
+    /* Inputs */
+    const planar_2r_real mu0 = mu[0];
+    const planar_2r_real mu1 = mu[1];
+
+    /* Intermediate terms */
+    const planar_2r_real t0 = (mu0*mu0) + (mu1*mu1);
+    const planar_2r_real t1 = 1.0 - 0.5*t0;
+    const planar_2r_real t2 = mu0 + mu1;
+    const planar_2r_real t3 = (t1*t1);
+    const planar_2r_real t4 = 1 - t3;
+    const int t5 = 1e-12 < t4;
+    const planar_2r_real t6 = (t5 ? t1 : (t1 > 0 ? 1 : -1));
+    const planar_2r_real t7 = (t5 ? sqrt(t4) : 0);
+    const planar_2r_real t8 = atan2(t7, t6);
+    const planar_2r_real t9 = 3.141592653589793 - t8;
+    const int t10 = 0;
+    const planar_2r_real t11 = (t10 ? 0 : t8 + 3.141592653589793);
+    const planar_2r_real t12 = (t10 ? 0 : -t7);
+    const planar_2r_real t13 = -t6;
+    const planar_2r_real t14 = (t10 ? 1 : t13);
+    const planar_2r_real t15 = t14 + 1;
+    const planar_2r_real t16 = mu0*t15 + mu1*t12;
+    const planar_2r_real t17 = -mu0*t12 + mu1*t15;
+    const planar_2r_real t18 = (t16*t16) + (t17*t17);
+    const planar_2r_real t19 = (t12*t12) + (t15*t15);
+    const planar_2r_real t20 = t13 + 1;
+    const planar_2r_real t21 = mu0*t20 + mu1*t7;
+    const planar_2r_real t22 = -mu0*t7 + mu1*t20;
+    const planar_2r_real t23 = (t21*t21) + (t22*t22);
+    const planar_2r_real t24 = (t20*t20) + (t7*t7);
+    const planar_2r_real t25 = 1e-24*t0;
+    const int t26 = isfinite(t2);
+    const int t27 = 1;
+
+    /* Outputs */
+    q[0] = (t18 <= t19*t25 ? 0 : atan2(t17, t16));
+    q[1] = t11 - 6.283185307179586*ceil(0.15915494309189535*t11 - 0.5);
+    q[2] = (t23 <= t24*t25 ? 0 : atan2(t22, t21));
+    q[3] = t9 - 6.283185307179586*ceil(0.15915494309189535*t9 - 0.5);
+    valid[0] = t26 && t27 && t4 >= -1e-12;
+    valid[1] = t26 && t27 && t4 > 1e-12;
+}
+
 int planar_2r_velocity_ik(const planar_2r_real q[PLANAR_2R_DOF], const planar_2r_real mu_dot[PLANAR_2R_TASK_DIM], planar_2r_real damping, planar_2r_real q_dot[PLANAR_2R_DOF])
 {
     /* Rows of jacobian() forming Js (rows (vx, vy) of the geometric Jacobian). */
@@ -344,254 +391,19 @@ int planar_2r_velocity_ik(const planar_2r_real q[PLANAR_2R_DOF], const planar_2r
     return PLANAR_2R_VELOCITY_IK_OK;
 }
 
-/* The angle wrapped into (-pi, pi], for |angle| < 1e9 (the callers' angles are sums of a few
- * atan2 results): angle - 2 pi ceil((angle - pi) / (2 pi)), ceil by truncation. */
-static planar_2r_real planar_2r_wrap(planar_2r_real angle)
-{
-    const planar_2r_real turns = (angle - 3.141592653589793) / 6.283185307179586;
-    planar_2r_real whole;
-    if (angle > -3.141592653589793 && angle <= 3.141592653589793) {
-        return angle;
-    }
-    whole = (planar_2r_real)(long)turns;
-    if (whole < turns) {
-        whole += 1.0;
-    }
-    return angle - 6.283185307179586 * whole;
-}
-
-/* -- Closed-form inverse kinematics (planar) -- */
-
-/* The arm at q = 0 (product of exponentials): unit axis directions h, points p on the axes,
- * the tool pose and a few derived constants. */
-typedef struct {
-    planar_2r_real k1[3];
-    planar_2r_real p1[3];
-    planar_2r_real k2[3];
-    planar_2r_real p2[3];
-    planar_2r_real wrist[3];
-    planar_2r_real tool_point[3];
-} planar_2r_ik_geometry;
-
-/* An angle with its cosine and sine. */
-typedef struct {
-    planar_2r_real theta, c, s;
-} planar_2r_angle;
-
-static inline planar_2r_real planar_2r_dot(const planar_2r_real a[3], const planar_2r_real b[3])
-{
-    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-}
-
-static inline void planar_2r_cross(const planar_2r_real a[3], const planar_2r_real b[3], planar_2r_real out[3])
-{
-    const planar_2r_real x = a[1] * b[2] - a[2] * b[1];
-    const planar_2r_real y = a[2] * b[0] - a[0] * b[2];
-    const planar_2r_real z = a[0] * b[1] - a[1] * b[0];
-    out[0] = x;
-    out[1] = y;
-    out[2] = z;
-}
-
-static inline void planar_2r_add(const planar_2r_real a[3], const planar_2r_real b[3], planar_2r_real out[3])
-{
-    out[0] = a[0] + b[0];
-    out[1] = a[1] + b[1];
-    out[2] = a[2] + b[2];
-}
-
-static inline void planar_2r_sub(const planar_2r_real a[3], const planar_2r_real b[3], planar_2r_real out[3])
-{
-    out[0] = a[0] - b[0];
-    out[1] = a[1] - b[1];
-    out[2] = a[2] - b[2];
-}
-
-/* v turned about the unit axis k by the angle whose cosine and sine are c and s (Rodrigues). */
-static inline void planar_2r_rot(const planar_2r_real k[3], planar_2r_real c, planar_2r_real s, const planar_2r_real v[3], planar_2r_real out[3])
-{
-    planar_2r_real kxv[3];
-    const planar_2r_real kv = planar_2r_dot(k, v) * (1.0 - c);
-    planar_2r_cross(k, v, kxv);
-    out[0] = v[0] * c + kxv[0] * s + k[0] * kv;
-    out[1] = v[1] * c + kxv[1] * s + k[1] * kv;
-    out[2] = v[2] * c + kxv[2] * s + k[2] * kv;
-}
-
-/* atan2(y, x) in (-pi, pi] (0 at the origin), about twice as fast as the C library's: the
- * argument is reduced to t in [-tan(pi/8), tan(pi/8)] with one division and atan(t) =
- * t + t z P(z) / Q(z), z = t^2, by Cephes' minimax approximation (S. L. Moshier); error
- * within 2 ulp. */
-static inline planar_2r_real planar_2r_atan2(planar_2r_real y, planar_2r_real x)
-{
-    const planar_2r_real ax = fabs(x);
-    const planar_2r_real ay = fabs(y);
-    const planar_2r_real low = ax < ay ? ax : ay;
-    const planar_2r_real high = ax < ay ? ay : ax;
-    planar_2r_real t, base, r;
-    if (!(high > 0.0)) {
-        return 0.0;
-    }
-    if (low <= 0.41421356237309503 * high) {
-        t = low / high;
-        base = 0.0;
-    } else {
-        t = (low - high) / (low + high);
-        base = 0.7853981633974483;
-    }
-    {
-        const planar_2r_real z = t * t;
-        const planar_2r_real z2 = z * z;
-        const planar_2r_real z4 = z2 * z2;
-        r = base + (t + t * z * ((-64.85021904942025 - 122.88666844901361 * z) + z2 * (-75.00855792314705 - 16.157537187333652 * z) + z4 * (-0.8750608600031904)) / ((194.5506571482614 + 485.3903996359137 * z) + z2 * (432.88106049129027 + 165.02700983169885 * z) + z4 * (24.858464901423062 + z)));
-    }
-    if (ay > ax) {
-        r = 1.5707963267948966 - r;
-    }
-    if (x < 0.0) {
-        r = 3.141592653589793 - r;
-    }
-    return y < 0.0 ? -r : r;
-}
-
-static inline planar_2r_angle planar_2r_angle_of(planar_2r_real c, planar_2r_real s)
-{
-    planar_2r_angle angle;
-    angle.theta = planar_2r_atan2(s, c);
-    angle.c = c;
-    angle.s = s;
-    return angle;
-}
-
-/* SP1: the angle turning p into q about the unit axis k (least squares when they differ in
- * length or height along k); 0 when p or q lies on the axis (any angle would do). */
-static inline planar_2r_angle planar_2r_sp1(const planar_2r_real p[3], const planar_2r_real q[3], const planar_2r_real k[3])
-{
-    planar_2r_real pxq[3];
-    planar_2r_cross(p, q, pxq);
-    {
-        const planar_2r_real x = planar_2r_dot(p, q) - planar_2r_dot(k, p) * planar_2r_dot(k, q);
-        const planar_2r_real y = planar_2r_dot(k, pxq);
-        const planar_2r_real rr = x * x + y * y;
-        if (rr <= 1e-24 * planar_2r_dot(p, p) * planar_2r_dot(q, q)) {
-            return planar_2r_angle_of(1.0, 0.0);
-        }
-        {
-            const planar_2r_real scale = 1.0 / sqrt(rr);
-            planar_2r_angle angle;
-            angle.theta = planar_2r_atan2(y, x);
-            angle.c = x * scale;
-            angle.s = y * scale;
-            return angle;
-        }
-    }
-}
-
-/* SP4: the angles t with h . rot(k, t) p = d, out = {phi + alpha, phi - alpha}; returns
- * their count. h . rot(k, t) p = A cos t + B sin t + C. One angle for a double root
- * (sin(alpha)^2 within EPS of 0), none out of range; when the left side does not depend
- * on t, the angle 0 if it equals d. */
-static inline int planar_2r_sp4(const planar_2r_real h[3], const planar_2r_real p[3], const planar_2r_real k[3], planar_2r_real d, planar_2r_angle out[2])
-{
-    planar_2r_real kxp[3];
-    const planar_2r_real hk = planar_2r_dot(h, k);
-    const planar_2r_real kp = planar_2r_dot(k, p);
-    planar_2r_cross(k, p, kxp);
-    {
-        const planar_2r_real a = planar_2r_dot(h, p) - hk * kp;
-        const planar_2r_real b = planar_2r_dot(h, kxp);
-        const planar_2r_real rhs = d - hk * kp;
-        const planar_2r_real r2 = a * a + b * b;
-        const planar_2r_real scale = planar_2r_dot(h, h) * planar_2r_dot(p, p);
-        planar_2r_real r, cos_phi, sin_phi, cos_alpha, disc, sin_alpha;
-        if (r2 <= 1e-24 * scale) {
-            if (rhs * rhs > 1e-12 * scale) {
-                return 0;
-            }
-            out[0] = planar_2r_angle_of(1.0, 0.0);
-            return 1;
-        }
-        r = sqrt(r2);
-        cos_phi = a / r;
-        sin_phi = b / r;
-        cos_alpha = rhs / r;
-        disc = 1.0 - cos_alpha * cos_alpha;
-        if (disc < -1e-12) {
-            return 0;
-        }
-        if (disc <= 1e-12) {
-            const planar_2r_real sign = cos_alpha > 0.0 ? 1.0 : -1.0;
-            out[0] = planar_2r_angle_of(sign * cos_phi, sign * sin_phi);
-            return 1;
-        }
-        sin_alpha = sqrt(disc);
-        {
-            /* phi is a constant when h, p and k are (the compiler folds it) */
-            const planar_2r_real phi = planar_2r_atan2(b, a);
-            const planar_2r_real alpha = planar_2r_atan2(sin_alpha, cos_alpha);
-            out[0].theta = phi + alpha;
-            out[0].c = cos_phi * cos_alpha - sin_phi * sin_alpha;
-            out[0].s = sin_phi * cos_alpha + cos_phi * sin_alpha;
-            out[1].theta = phi - alpha;
-            out[1].c = cos_phi * cos_alpha + sin_phi * sin_alpha;
-            out[1].s = sin_phi * cos_alpha - cos_phi * sin_alpha;
-        }
-        return 2;
-    }
-}
-
-/* SP3: the angles t with |rot(k, t) p - q|^2 = dd (p, q relative to a point of the axis). */
-static inline int planar_2r_sp3(const planar_2r_real p[3], const planar_2r_real q[3], const planar_2r_real k[3], planar_2r_real dd, planar_2r_angle out[2])
-{
-    return planar_2r_sp4(q, p, k, 0.5 * (planar_2r_dot(p, p) + planar_2r_dot(q, q) - dd), out);
-}
-
-/* Planar arm: the last revolute joint takes the yaw, the first two put its axis on the wrist
- * point by SP3 (elbow) and SP1 (shoulder); rotations about z keep heights. */
-static int planar_2r_ik_solve(const planar_2r_real mu[PLANAR_2R_TASK_DIM], const planar_2r_ik_geometry *g, planar_2r_real q[])
-{
-    const planar_2r_real target[3] = {mu[0], mu[1], g->tool_point[2]};
-    planar_2r_real d[3], a[3], b[3];
-    planar_2r_angle elbow[2];
-    int count, i;
-    planar_2r_sub(target, g->p1, d);
-    planar_2r_sub(g->wrist, g->p2, a);
-    planar_2r_sub(g->p1, g->p2, b);
-    count = planar_2r_sp3(a, b, g->k2, planar_2r_dot(d, d), elbow);
-    for (i = 0; i < count; ++i) {
-        planar_2r_real *out = q + PLANAR_2R_DOF * i;
-        planar_2r_real e[3];
-        planar_2r_angle shoulder;
-        planar_2r_rot(g->k2, elbow[i].c, elbow[i].s, a, e);
-        planar_2r_add(e, g->p2, e);
-        planar_2r_sub(e, g->p1, e);
-        shoulder = planar_2r_sp1(e, d, g->k1);
-        out[0] = shoulder.theta;
-        out[1] = elbow[i].theta;
-    }
-    return count;
-}
-
 int planar_2r_ik(const planar_2r_real mu[PLANAR_2R_TASK_DIM], planar_2r_real q[PLANAR_2R_MAX_IK_SOLUTIONS * PLANAR_2R_DOF])
 {
-    const planar_2r_ik_geometry g = {
-        .k1 = {0, 0, 1},
-        .p1 = {0, 0, 0},
-        .k2 = {0, 0, 1},
-        .p2 = {1, 0, 0},
-        .wrist = {2, 0, 0},
-        .tool_point = {2, 0, 0},
-    };
-    int count, k;
-    for (k = 0; k < PLANAR_2R_TASK_DIM; ++k) {
-        if (!isfinite(mu[k])) {
-            return 0;
+    planar_2r_real branches[PLANAR_2R_MAX_IK_SOLUTIONS * PLANAR_2R_DOF];
+    int valid[PLANAR_2R_MAX_IK_SOLUTIONS];
+    int count = 0, i, j;
+    planar_2r_ik_branches(mu, branches, valid);
+    for (i = 0; i < PLANAR_2R_MAX_IK_SOLUTIONS; ++i) {
+        if (valid[i]) {
+            for (j = 0; j < PLANAR_2R_DOF; ++j) {
+                q[PLANAR_2R_DOF * count + j] = branches[PLANAR_2R_DOF * i + j];
+            }
+            ++count;
         }
-    }
-    count = planar_2r_ik_solve(mu, &g, q);
-    for (k = 0; k < count; ++k) {
-        q[PLANAR_2R_DOF * k + 0] = planar_2r_wrap(q[PLANAR_2R_DOF * k + 0]);
-        q[PLANAR_2R_DOF * k + 1] = planar_2r_wrap(q[PLANAR_2R_DOF * k + 1]);
     }
     return count;
 }

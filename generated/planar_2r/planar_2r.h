@@ -27,6 +27,7 @@ typedef double planar_2r_real;
 #define PLANAR_2R_DOF 2
 #define PLANAR_2R_TASK_DIM 2
 #define PLANAR_2R_NUM_SINGULARITY_FACTORS 1
+#define PLANAR_2R_MAX_IK_SOLUTIONS 2
 
 /* Pose of the tool frame in the world frame (4x4 homogeneous).
  * Result: T: 4 x 4 row-major, element (r, c) at T[r * 4 + c]. 13 operations. */
@@ -64,6 +65,10 @@ planar_2r_real planar_2r_manipulability(const planar_2r_real q[PLANAR_2R_DOF]);
  * Result: returned as a scalar. 1 operations. */
 planar_2r_real planar_2r_jacobian_det(const planar_2r_real q[PLANAR_2R_DOF]);
 
+/* Every branch of the closed-form ik and whether the target allows it.
+ * Result: q: 2 x 2 row-major, element (r, c) at q[r * 2 + c]; valid[i], i < 2. 79 operations. */
+void planar_2r_ik_branches(const planar_2r_real mu[PLANAR_2R_TASK_DIM], planar_2r_real q[PLANAR_2R_MAX_IK_SOLUTIONS * PLANAR_2R_DOF], int valid[PLANAR_2R_MAX_IK_SOLUTIONS]);
+
 /* Status of planar_2r_velocity_ik. */
 #define PLANAR_2R_VELOCITY_IK_OK 0
 #define PLANAR_2R_VELOCITY_IK_SINGULAR 1   /* a pivot below 1e-12 x the largest |entry|: take damping > 0 */
@@ -77,11 +82,9 @@ planar_2r_real planar_2r_jacobian_det(const planar_2r_real q[PLANAR_2R_DOF]);
  * PLANAR_2R_VELOCITY_IK_OK, or a status above with q_dot all 0. */
 int planar_2r_velocity_ik(const planar_2r_real q[PLANAR_2R_DOF], const planar_2r_real mu_dot[PLANAR_2R_TASK_DIM], planar_2r_real damping, planar_2r_real q_dot[PLANAR_2R_DOF]);
 
-#define PLANAR_2R_MAX_IK_SOLUTIONS 2
-
 /* Closed-form inverse kinematics: every joint solution that reaches the target; returns
- * their count k and writes solution i to q[i * PLANAR_2R_DOF + j], i < k. Loops over
- * the branches, no allocation, no recursion.
+ * their count k and writes solution i to q[i * PLANAR_2R_DOF + j], i < k: the valid
+ * rows of planar_2r_ik_branches, in its order. No allocation, no recursion.
  * target: the task vector (x, y).
  * Result: k <= PLANAR_2R_MAX_IK_SOLUTIONS solutions, revolute angles wrapped into (-pi,
  * pi], joint limits not applied; k = 0 when the target is out of reach or not finite.

@@ -16,16 +16,18 @@ DOF = 2
 TASK = ("x", "y", )
 
 
-def _joints(q):
-    q = numpy.asarray(q, dtype=float)
-    if q.ndim == 0 or q.shape[-1] != DOF:
-        raise ValueError(f"q must have shape ({DOF},) or (..., {DOF}), got {q.shape}")
-    return q
+def _argument(name, value, shape):
+    """`value` as a float array of `shape` or a batch of them (..., *shape)."""
+    value = numpy.asarray(value, dtype=float)
+    if value.shape[value.ndim - len(shape):] != shape:
+        batch = ", ".join(map(str, shape))
+        raise ValueError(f"{name} must have shape {shape} or (..., {batch}), got {value.shape}")
+    return value
 
 
 def fk(q):
     """pose of the tool frame in the world frame (4x4 homogeneous): (4 x 4), 13 operations."""
-    q = _joints(q)
+    q = _argument("q", q, (2,))
     q1 = q[..., 0]
     q2 = q[..., 1]
     c1 = numpy.cos(q1)
@@ -58,7 +60,7 @@ def fk(q):
 
 def jacobian(q):
     """geometric Jacobian in the world frame (6 x DOF, rows vx vy vz wx wy wz): (6 x 2), 14 operations."""
-    q = _joints(q)
+    q = _argument("q", q, (2,))
     q1 = q[..., 0]
     q2 = q[..., 1]
     c1 = numpy.cos(q1)
@@ -87,7 +89,7 @@ def jacobian(q):
 
 def fk_jacobian(q):
     """fk and jacobian in one pass, sharing their terms: (4 x 4 and 6 x 2), 14 operations."""
-    q = _joints(q)
+    q = _argument("q", q, (2,))
     q1 = q[..., 0]
     q2 = q[..., 1]
     c1 = numpy.cos(q1)
@@ -134,7 +136,7 @@ def fk_jacobian(q):
 
 def jacobian_tool(q):
     """geometric Jacobian in the tool frame (6 x DOF, rows vx vy vz wx wy wz): (6 x 2), 21 operations."""
-    q = _joints(q)
+    q = _argument("q", q, (2,))
     q1 = q[..., 0]
     q2 = q[..., 1]
     c1 = numpy.cos(q1)
@@ -163,7 +165,7 @@ def jacobian_tool(q):
 
 def task(q):
     """task vector mu = (x, y): (2 x 1), 12 operations."""
-    q = _joints(q)
+    q = _argument("q", q, (2,))
     q1 = q[..., 0]
     q2 = q[..., 1]
     c1 = numpy.cos(q1)
@@ -182,7 +184,7 @@ def task(q):
 
 def task_jacobian(q):
     """analytic Jacobian d mu / d q (2 x DOF): (2 x 2), 14 operations."""
-    q = _joints(q)
+    q = _argument("q", q, (2,))
     q1 = q[..., 0]
     q2 = q[..., 1]
     c1 = numpy.cos(q1)
@@ -203,7 +205,7 @@ def task_jacobian(q):
 
 def singularity_factors(q):
     """factors of det(Js): the robot is singular where one is 0: (1 x 1), 1 operations."""
-    q = _joints(q)
+    q = _argument("q", q, (2,))
     q2 = q[..., 1]
     s2 = numpy.sin(q2)
     f = numpy.empty(q.shape[:-1] + (1,))
@@ -213,7 +215,7 @@ def singularity_factors(q):
 
 def manipulability(q):
     """manipulability |det(Js)|: (1 x 1), 2 operations."""
-    q = _joints(q)
+    q = _argument("q", q, (2,))
     q2 = q[..., 1]
     s2 = numpy.sin(q2)
     w = numpy.empty(q.shape[:-1] + ())
@@ -223,7 +225,7 @@ def manipulability(q):
 
 def jacobian_det(q):
     """det(Js): (1 x 1), 1 operations."""
-    q = _joints(q)
+    q = _argument("q", q, (2,))
     q2 = q[..., 1]
     s2 = numpy.sin(q2)
     d = numpy.empty(q.shape[:-1] + ())
@@ -231,118 +233,60 @@ def jacobian_det(q):
     return d
 
 
-def _wrap(angle):
-    """Angles wrapped into (-pi, pi]."""
-    return angle - 2.0 * math.pi * numpy.ceil((angle - math.pi) / (2.0 * math.pi))
+@numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
+def ik_branches(mu):
+    """every branch of the closed-form ik and whether the target allows it: (2 x 2 and 2 x 1), 79 operations."""
+    mu = _argument("mu", mu, (2,))
+    mu0 = mu[..., 0]
+    mu1 = mu[..., 1]
+    t0 = mu0**2 + mu1**2
+    t1 = 1.0 - 0.5*t0
+    t2 = mu0 + mu1
+    t3 = t1**2
+    t4 = 1 - t3
+    t5 = numpy.less(1e-12, t4)
+    t6 = numpy.where(t5, t1, numpy.where(numpy.greater(t1, 0), 1, -1))
+    t7 = numpy.where(t5, numpy.sqrt(t4), 0)
+    t8 = numpy.arctan2(t7, t6)
+    t9 = 3.141592653589793 - t8
+    t10 = False
+    t11 = numpy.where(t10, 0, t8 + 3.141592653589793)
+    t12 = numpy.where(t10, 0, -t7)
+    t13 = -t6
+    t14 = numpy.where(t10, 1, t13)
+    t15 = t14 + 1
+    t16 = mu0*t15 + mu1*t12
+    t17 = -mu0*t12 + mu1*t15
+    t18 = t16**2 + t17**2
+    t19 = t12**2 + t15**2
+    t20 = t13 + 1
+    t21 = mu0*t20 + mu1*t7
+    t22 = -mu0*t7 + mu1*t20
+    t23 = t21**2 + t22**2
+    t24 = t20**2 + t7**2
+    t25 = 1e-24*t0
+    t26 = numpy.isfinite(t2)
+    t27 = True
+    q = numpy.empty(mu.shape[:-1] + (2, 2))
+    q[..., 0, 0] = numpy.where(numpy.less_equal(t18, t19*t25), 0, numpy.arctan2(t17, t16))
+    q[..., 0, 1] = t11 - 6.283185307179586*numpy.ceil(0.15915494309189535*t11 - 0.5)
+    q[..., 1, 0] = numpy.where(numpy.less_equal(t23, t24*t25), 0, numpy.arctan2(t22, t21))
+    q[..., 1, 1] = t9 - 6.283185307179586*numpy.ceil(0.15915494309189535*t9 - 0.5)
+    valid = numpy.empty(mu.shape[:-1] + (2,), dtype=bool)
+    valid[..., 0] = t26 & t27 & (numpy.greater_equal(t4, -1e-12))
+    valid[..., 1] = t26 & t27 & (numpy.greater(t4, 1e-12))
+    return q, valid
 
-
-# -- Closed-form inverse kinematics (planar) --
 
 MAX_IK_SOLUTIONS = 2
-_EPS = 1e-12  # a squared sine within this of 0 is a double root
-_TINY = 1e-24  # relative squared length below which a vector counts as zero
 
 
-def _dot(a, b):
-    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+def ik(mu):
+    """Closed-form inverse kinematics: every joint solution that reaches the target.
 
-
-def _cross(a, b):
-    return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
-
-
-def _add(a, b):
-    return (a[0] + b[0], a[1] + b[1], a[2] + b[2])
-
-
-def _sub(a, b):
-    return (a[0] - b[0], a[1] - b[1], a[2] - b[2])
-
-
-def _rot(k, c, s, v):
-    """v turned about the unit axis k by the angle whose cosine and sine are c and s (Rodrigues)."""
-    kxv = _cross(k, v)
-    kv = _dot(k, v) * (1.0 - c)
-    return (v[0] * c + kxv[0] * s + k[0] * kv, v[1] * c + kxv[1] * s + k[1] * kv,
-            v[2] * c + kxv[2] * s + k[2] * kv)
-
-
-class _Angle:
-    """An angle with its cosine and sine."""
-
-    __slots__ = ("theta", "c", "s")
-
-    def __init__(self, theta, c, s):
-        self.theta, self.c, self.s = theta, c, s
-
-
-def _angle(c, s):
-    return _Angle(math.atan2(s, c), c, s)
-
-
-def _sp1(p, q, k):
-    """SP1: the angle turning p into q about the unit axis k (least squares when they differ
-    in length or height along k). 0 when p or q lies on the axis (any angle would do)."""
-    x = _dot(p, q) - _dot(k, p) * _dot(k, q)
-    y = _dot(k, _cross(p, q))
-    r = math.hypot(x, y)
-    if r * r <= _TINY * _dot(p, p) * _dot(q, q):
-        return _Angle(0.0, 1.0, 0.0)
-    return _angle(x / r, y / r)
-
-
-def _sp4(h, p, k, d):
-    """SP4: the angles t with h . rot(k, t) p = d, as [phi + alpha, phi - alpha].
-
-    h . rot(k, t) p = A cos t + B sin t + C. One angle for a double root (|sin alpha|^2 <=
-    _EPS), none out of range; when the left side does not depend on t, [0] if it equals d.
-    """
-    hk, kp = _dot(h, k), _dot(k, p)
-    a = _dot(h, p) - hk * kp
-    b = _dot(h, _cross(k, p))
-    rhs = d - hk * kp
-    r2 = a * a + b * b
-    scale = _dot(h, h) * _dot(p, p)
-    if r2 <= _TINY * scale:
-        return [_Angle(0.0, 1.0, 0.0)] if rhs * rhs <= _EPS * scale else []
-    r = math.sqrt(r2)
-    cos_phi, sin_phi, cos_alpha = a / r, b / r, rhs / r
-    disc = 1.0 - cos_alpha * cos_alpha
-    if disc < -_EPS:
-        return []
-    if disc <= _EPS:
-        sign = 1.0 if cos_alpha > 0.0 else -1.0
-        return [_angle(sign * cos_phi, sign * sin_phi)]
-    sin_alpha = math.sqrt(disc)
-    phi, alpha = math.atan2(b, a), math.atan2(sin_alpha, cos_alpha)
-    return [_Angle(phi + alpha, cos_phi * cos_alpha - sin_phi * sin_alpha, sin_phi * cos_alpha + cos_phi * sin_alpha),
-            _Angle(phi - alpha, cos_phi * cos_alpha + sin_phi * sin_alpha, sin_phi * cos_alpha - cos_phi * sin_alpha)]
-
-
-def _sp3(p, q, k, dd):
-    """SP3: the angles t with |rot(k, t) p - q|^2 = dd (p, q relative to a point of the axis)."""
-    return _sp4(q, p, k, 0.5 * (_dot(p, p) + _dot(q, q) - dd))
-
-
-def _ik_solve(mu, k1, p1, k2, p2, wrist, tool_point):
-    """Planar arm: the last revolute joint takes the yaw, the first two put its axis on the
-    wrist point by SP3 (elbow) and SP1 (shoulder); rotations about z keep heights."""
-    target = (mu[0], mu[1], tool_point[2])
-    w = target
-    d = _sub(w, p1)
-    solutions = []
-    for elbow in _sp3(_sub(wrist, p2), _sub(p1, p2), k2, _dot(d, d)):
-        shoulder = _sp1(_sub(_add(p2, _rot(k2, elbow.c, elbow.s, _sub(wrist, p2))), p1), d, k1)
-        q = [0.0] * DOF
-        q[0] = shoulder.theta
-        q[1] = elbow.theta
-        solutions.append(q)
-    return solutions
-
-
-def ik(target):
-    """Closed-form inverse kinematics: every joint solution that reaches `target`, as (k, DOF).
-
+    One target: the solutions as (k, DOF), the valid rows of ik_branches in its order.
+    A batch of targets: ik_branches' (q, valid), (..., MAX_IK_SOLUTIONS, DOF) and
+    (..., MAX_IK_SOLUTIONS).
     target: the task vector (x, y).
     Result: k <= MAX_IK_SOLUTIONS solutions, revolute angles wrapped into (-pi, pi], joint
     limits not applied; k = 0 when the target is out of reach or not finite.
@@ -356,23 +300,8 @@ def ik(target):
     root (a target on a singularity or on the workspace boundary) is returned once, and an
     angle the target leaves free (a singular wrist or shoulder) is set to 0.
     """
-    target = numpy.asarray(target, dtype=float)
-    if target.shape != (2,):
-        raise ValueError(f"target must have shape (2,), got {target.shape}")
-    if not numpy.all(numpy.isfinite(target)):
-        return numpy.empty((0, DOF))
-    solutions = _ik_solve(
-        target.tolist(),
-        k1=(0, 0, 1),
-        p1=(0, 0, 0),
-        k2=(0, 0, 1),
-        p2=(1, 0, 0),
-        wrist=(2, 0, 0),
-        tool_point=(2, 0, 0),
-    )
-    q = numpy.array(solutions, dtype=float).reshape(-1, DOF)
-    q[:, [0, 1]] = _wrap(q[:, [0, 1]])
-    return q
+    q, valid = ik_branches(mu)
+    return q[valid] if valid.ndim == 1 else (q, valid)
 
 
 # -- Iterative inverse kinematics --
@@ -444,7 +373,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
     condition number below VELOCITY_IK_RCOND; take damping > 0 there). Where ok is False,
     q_dot is 0: the result never holds NaN.
     """
-    q = _joints(q)
+    q = _argument("q", q, (DOF,))
     mu_dot = numpy.asarray(mu_dot, dtype=float)
     if mu_dot.ndim == 0 or mu_dot.shape[-1] != 2:
         raise ValueError(f"mu_dot must have shape (2,) or (..., 2), got {mu_dot.shape}")

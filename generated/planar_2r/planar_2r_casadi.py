@@ -3,7 +3,9 @@
 
 Planar 2R arm with unit links (rtb Planar2), standard DH
 Every function takes `q` (2 x 1: radians for revolute joints, m for
-prismatic ones) and returns a rows x cols result whose zeros are structural.
+prismatic ones) and returns a rows x cols result whose zeros are structural; ik_branches
+(also named ik) takes the target instead of q and returns every branch (MAX_IK_SOLUTIONS x
+DOF) and its validity (MAX_IK_SOLUTIONS x 1, 1 or 0).
 Task vector: (x, y).
 """
 
@@ -177,7 +179,51 @@ def _jacobian_det(q):
     return [d]
 
 
-_q = casadi.SX.sym("q", DOF)
+def _ik_branches(mu):
+    """Every branch of the closed-form ik and whether the target allows it: 79 operations."""
+    mu0 = mu[0]
+    mu1 = mu[1]
+    t0 = mu0**2 + mu1**2
+    t1 = 1.0 - 0.5*t0
+    t2 = mu0 + mu1
+    t3 = t1**2
+    t4 = 1 - t3
+    t5 = (1e-12 < t4)
+    t6 = casadi.if_else(t5, t1, casadi.if_else((t1 > 0), 1, -1))
+    t7 = casadi.if_else(t5, casadi.sqrt(t4), 0)
+    t8 = casadi.atan2(t7, t6)
+    t9 = 3.141592653589793 - t8
+    t10 = False
+    t11 = casadi.if_else(t10, 0, t8 + 3.141592653589793)
+    t12 = casadi.if_else(t10, 0, -t7)
+    t13 = -t6
+    t14 = casadi.if_else(t10, 1, t13)
+    t15 = t14 + 1
+    t16 = mu0*t15 + mu1*t12
+    t17 = -mu0*t12 + mu1*t15
+    t18 = t16**2 + t17**2
+    t19 = t12**2 + t15**2
+    t20 = t13 + 1
+    t21 = mu0*t20 + mu1*t7
+    t22 = -mu0*t7 + mu1*t20
+    t23 = t21**2 + t22**2
+    t24 = t20**2 + t7**2
+    t25 = 1e-24*t0
+    t26 = (casadi.fabs(t2) < casadi.inf)
+    t27 = True
+    q = casadi.SX(2, 2)
+    q[0, 0] = casadi.if_else((t18 <= t19*t25), 0, casadi.atan2(t17, t16))
+    q[0, 1] = t11 - 6.283185307179586*casadi.ceil(0.15915494309189535*t11 - 0.5)
+    q[1, 0] = casadi.if_else((t23 <= t24*t25), 0, casadi.atan2(t22, t21))
+    q[1, 1] = t9 - 6.283185307179586*casadi.ceil(0.15915494309189535*t9 - 0.5)
+    valid = casadi.SX(2, 1)
+    valid[0, 0] = casadi.logic_and(casadi.logic_and(t26, t27), (t4 >= -1e-12))
+    valid[1, 0] = casadi.logic_and(casadi.logic_and(t26, t27), (t4 > 1e-12))
+    return [q, valid]
+
+
+_q = casadi.SX.sym("q", 2, 1)
+_mu = casadi.SX.sym("mu", 2, 1)
 fk = casadi.Function("fk", [_q], _fk(_q), ["q"], ["T"])
 jacobian = casadi.Function("jacobian", [_q], _jacobian(_q), ["q"], ["J"])
 fk_jacobian = casadi.Function("fk_jacobian", [_q], _fk_jacobian(_q), ["q"], ["T", "J"])
@@ -187,8 +233,10 @@ task_jacobian = casadi.Function("task_jacobian", [_q], _task_jacobian(_q), ["q"]
 singularity_factors = casadi.Function("singularity_factors", [_q], _singularity_factors(_q), ["q"], ["f"])
 manipulability = casadi.Function("manipulability", [_q], _manipulability(_q), ["q"], ["w"])
 jacobian_det = casadi.Function("jacobian_det", [_q], _jacobian_det(_q), ["q"], ["d"])
+ik_branches = casadi.Function("ik_branches", [_mu], _ik_branches(_mu), ["mu"], ["q", "valid"])
+ik = ik_branches  # CasADi functions have fixed-size outputs: every branch and its validity
 
 
 def functions():
     """All functions by name."""
-    return {"fk": fk, "jacobian": jacobian, "fk_jacobian": fk_jacobian, "jacobian_tool": jacobian_tool, "task": task, "task_jacobian": task_jacobian, "singularity_factors": singularity_factors, "manipulability": manipulability, "jacobian_det": jacobian_det}
+    return {"fk": fk, "jacobian": jacobian, "fk_jacobian": fk_jacobian, "jacobian_tool": jacobian_tool, "task": task, "task_jacobian": task_jacobian, "singularity_factors": singularity_factors, "manipulability": manipulability, "jacobian_det": jacobian_det, "ik_branches": ik_branches}

@@ -336,6 +336,66 @@ planar_3r_real planar_3r_jacobian_det(const planar_3r_real q[PLANAR_3R_DOF])
     return s2/((c123*c123) + (s123*s123));
 }
 
+void planar_3r_ik_branches(const planar_3r_real mu[PLANAR_3R_TASK_DIM], planar_3r_real q[PLANAR_3R_MAX_IK_SOLUTIONS * PLANAR_3R_DOF], int valid[PLANAR_3R_MAX_IK_SOLUTIONS])
+{
+    /* 106 operations */
+
+    /* Inputs */
+    const planar_3r_real mu0 = mu[0];
+    const planar_3r_real mu1 = mu[1];
+    const planar_3r_real mu2 = mu[2];
+
+    /* Intermediate terms */
+    const planar_3r_real t0 = cos(mu2);
+    const planar_3r_real t1 = sin(mu2);
+    const planar_3r_real t2 = mu0 - t0;
+    const planar_3r_real t3 = mu1 - t1;
+    const planar_3r_real t4 = (t2*t2) + (t3*t3);
+    const planar_3r_real t5 = 1.0 - 0.5*t4;
+    const planar_3r_real t6 = mu0 + mu1 + mu2;
+    const planar_3r_real t7 = (t5*t5);
+    const planar_3r_real t8 = 1 - t7;
+    const int t9 = 1e-12 < t8;
+    const planar_3r_real t10 = (t9 ? t5 : (t5 > 0 ? 1 : -1));
+    const planar_3r_real t11 = (t9 ? sqrt(t8) : 0);
+    const planar_3r_real t12 = atan2(t11, t10);
+    const planar_3r_real t13 = 3.141592653589793 - t12;
+    const int t14 = 0;
+    const planar_3r_real t15 = (t14 ? 0 : t12 + 3.141592653589793);
+    const planar_3r_real t16 = (t14 ? 0 : -t11);
+    const planar_3r_real t17 = -t10;
+    const planar_3r_real t18 = (t14 ? 1 : t17);
+    const planar_3r_real t19 = t18 + 1;
+    const planar_3r_real t20 = t16*t3 + t19*t2;
+    const planar_3r_real t21 = -t16*t2 + t19*t3;
+    const planar_3r_real t22 = (t20*t20) + (t21*t21);
+    const planar_3r_real t23 = (t16*t16) + (t19*t19);
+    const planar_3r_real t24 = t17 + 1;
+    const planar_3r_real t25 = t11*t3 + t2*t24;
+    const planar_3r_real t26 = -t11*t2 + t24*t3;
+    const planar_3r_real t27 = (t25*t25) + (t26*t26);
+    const planar_3r_real t28 = (t11*t11) + (t24*t24);
+    const planar_3r_real t29 = 1e-24*t4;
+    const planar_3r_real t30 = (t22 <= t23*t29 ? 0 : atan2(t21, t20));
+    const planar_3r_real t31 = -mu2;
+    const planar_3r_real t32 = t31 + 3.141592653589793;
+    const planar_3r_real t33 = t15 + t30;
+    const planar_3r_real t34 = (t27 <= t28*t29 ? 0 : atan2(t26, t25));
+    const planar_3r_real t35 = t13 + t34;
+    const int t36 = isfinite(t6);
+    const int t37 = 1;
+
+    /* Outputs */
+    q[0] = t30;
+    q[1] = t15 - 6.283185307179586*ceil(0.15915494309189535*t15 - 0.5);
+    q[2] = -t31 - t33 - 6.283185307179586*ceil(-0.15915494309189535*t32 - 0.15915494309189535*t33);
+    q[3] = t34;
+    q[4] = t13 - 6.283185307179586*ceil(0.15915494309189535*t13 - 0.5);
+    q[5] = -t31 - t35 - 6.283185307179586*ceil(-0.15915494309189535*t32 - 0.15915494309189535*t35);
+    valid[0] = t36 && t37 && t8 >= -1e-12;
+    valid[1] = t36 && t37 && t8 > 1e-12;
+}
+
 int planar_3r_velocity_ik(const planar_3r_real q[PLANAR_3R_DOF], const planar_3r_real mu_dot[PLANAR_3R_TASK_DIM], planar_3r_real damping, planar_3r_real q_dot[PLANAR_3R_DOF])
 {
     /* Rows of task_jacobian() forming Js (the task Jacobian). */
@@ -433,8 +493,27 @@ int planar_3r_velocity_ik(const planar_3r_real q[PLANAR_3R_DOF], const planar_3r
     return PLANAR_3R_VELOCITY_IK_OK;
 }
 
-/* The angle wrapped into (-pi, pi], for |angle| < 1e9 (the callers' angles are sums of a few
- * atan2 results): angle - 2 pi ceil((angle - pi) / (2 pi)), ceil by truncation. */
+int planar_3r_ik(const planar_3r_real mu[PLANAR_3R_TASK_DIM], planar_3r_real q[PLANAR_3R_MAX_IK_SOLUTIONS * PLANAR_3R_DOF])
+{
+    planar_3r_real branches[PLANAR_3R_MAX_IK_SOLUTIONS * PLANAR_3R_DOF];
+    int valid[PLANAR_3R_MAX_IK_SOLUTIONS];
+    int count = 0, i, j;
+    planar_3r_ik_branches(mu, branches, valid);
+    for (i = 0; i < PLANAR_3R_MAX_IK_SOLUTIONS; ++i) {
+        if (valid[i]) {
+            for (j = 0; j < PLANAR_3R_DOF; ++j) {
+                q[PLANAR_3R_DOF * count + j] = branches[PLANAR_3R_DOF * i + j];
+            }
+            ++count;
+        }
+    }
+    return count;
+}
+
+/* -- Iterative inverse kinematics -- */
+
+/* The angle wrapped into (-pi, pi], for |angle| < 1e9: angle - 2 pi ceil((angle - pi) / (2 pi)),
+ * ceil by truncation. */
 static planar_3r_real planar_3r_wrap(planar_3r_real angle)
 {
     const planar_3r_real turns = (angle - 3.141592653589793) / 6.283185307179586;
@@ -448,261 +527,6 @@ static planar_3r_real planar_3r_wrap(planar_3r_real angle)
     }
     return angle - 6.283185307179586 * whole;
 }
-
-/* -- Closed-form inverse kinematics (planar) -- */
-
-/* The arm at q = 0 (product of exponentials): unit axis directions h, points p on the axes,
- * the tool pose and a few derived constants. */
-typedef struct {
-    planar_3r_real k1[3];
-    planar_3r_real p1[3];
-    planar_3r_real k2[3];
-    planar_3r_real p2[3];
-    planar_3r_real wrist[3];
-    planar_3r_real tool_point[3];
-    planar_3r_real yaw0;
-    planar_3r_real sign1;
-    planar_3r_real sign2;
-    planar_3r_real sign3;
-} planar_3r_ik_geometry;
-
-/* An angle with its cosine and sine. */
-typedef struct {
-    planar_3r_real theta, c, s;
-} planar_3r_angle;
-
-static inline planar_3r_real planar_3r_dot(const planar_3r_real a[3], const planar_3r_real b[3])
-{
-    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-}
-
-static inline void planar_3r_cross(const planar_3r_real a[3], const planar_3r_real b[3], planar_3r_real out[3])
-{
-    const planar_3r_real x = a[1] * b[2] - a[2] * b[1];
-    const planar_3r_real y = a[2] * b[0] - a[0] * b[2];
-    const planar_3r_real z = a[0] * b[1] - a[1] * b[0];
-    out[0] = x;
-    out[1] = y;
-    out[2] = z;
-}
-
-static inline void planar_3r_add(const planar_3r_real a[3], const planar_3r_real b[3], planar_3r_real out[3])
-{
-    out[0] = a[0] + b[0];
-    out[1] = a[1] + b[1];
-    out[2] = a[2] + b[2];
-}
-
-static inline void planar_3r_sub(const planar_3r_real a[3], const planar_3r_real b[3], planar_3r_real out[3])
-{
-    out[0] = a[0] - b[0];
-    out[1] = a[1] - b[1];
-    out[2] = a[2] - b[2];
-}
-
-/* v turned about the unit axis k by the angle whose cosine and sine are c and s (Rodrigues). */
-static inline void planar_3r_rot(const planar_3r_real k[3], planar_3r_real c, planar_3r_real s, const planar_3r_real v[3], planar_3r_real out[3])
-{
-    planar_3r_real kxv[3];
-    const planar_3r_real kv = planar_3r_dot(k, v) * (1.0 - c);
-    planar_3r_cross(k, v, kxv);
-    out[0] = v[0] * c + kxv[0] * s + k[0] * kv;
-    out[1] = v[1] * c + kxv[1] * s + k[1] * kv;
-    out[2] = v[2] * c + kxv[2] * s + k[2] * kv;
-}
-
-/* atan2(y, x) in (-pi, pi] (0 at the origin), about twice as fast as the C library's: the
- * argument is reduced to t in [-tan(pi/8), tan(pi/8)] with one division and atan(t) =
- * t + t z P(z) / Q(z), z = t^2, by Cephes' minimax approximation (S. L. Moshier); error
- * within 2 ulp. */
-static inline planar_3r_real planar_3r_atan2(planar_3r_real y, planar_3r_real x)
-{
-    const planar_3r_real ax = fabs(x);
-    const planar_3r_real ay = fabs(y);
-    const planar_3r_real low = ax < ay ? ax : ay;
-    const planar_3r_real high = ax < ay ? ay : ax;
-    planar_3r_real t, base, r;
-    if (!(high > 0.0)) {
-        return 0.0;
-    }
-    if (low <= 0.41421356237309503 * high) {
-        t = low / high;
-        base = 0.0;
-    } else {
-        t = (low - high) / (low + high);
-        base = 0.7853981633974483;
-    }
-    {
-        const planar_3r_real z = t * t;
-        const planar_3r_real z2 = z * z;
-        const planar_3r_real z4 = z2 * z2;
-        r = base + (t + t * z * ((-64.85021904942025 - 122.88666844901361 * z) + z2 * (-75.00855792314705 - 16.157537187333652 * z) + z4 * (-0.8750608600031904)) / ((194.5506571482614 + 485.3903996359137 * z) + z2 * (432.88106049129027 + 165.02700983169885 * z) + z4 * (24.858464901423062 + z)));
-    }
-    if (ay > ax) {
-        r = 1.5707963267948966 - r;
-    }
-    if (x < 0.0) {
-        r = 3.141592653589793 - r;
-    }
-    return y < 0.0 ? -r : r;
-}
-
-static inline planar_3r_angle planar_3r_angle_of(planar_3r_real c, planar_3r_real s)
-{
-    planar_3r_angle angle;
-    angle.theta = planar_3r_atan2(s, c);
-    angle.c = c;
-    angle.s = s;
-    return angle;
-}
-
-/* SP1: the angle turning p into q about the unit axis k (least squares when they differ in
- * length or height along k); 0 when p or q lies on the axis (any angle would do). */
-static inline planar_3r_angle planar_3r_sp1(const planar_3r_real p[3], const planar_3r_real q[3], const planar_3r_real k[3])
-{
-    planar_3r_real pxq[3];
-    planar_3r_cross(p, q, pxq);
-    {
-        const planar_3r_real x = planar_3r_dot(p, q) - planar_3r_dot(k, p) * planar_3r_dot(k, q);
-        const planar_3r_real y = planar_3r_dot(k, pxq);
-        const planar_3r_real rr = x * x + y * y;
-        if (rr <= 1e-24 * planar_3r_dot(p, p) * planar_3r_dot(q, q)) {
-            return planar_3r_angle_of(1.0, 0.0);
-        }
-        {
-            const planar_3r_real scale = 1.0 / sqrt(rr);
-            planar_3r_angle angle;
-            angle.theta = planar_3r_atan2(y, x);
-            angle.c = x * scale;
-            angle.s = y * scale;
-            return angle;
-        }
-    }
-}
-
-/* SP4: the angles t with h . rot(k, t) p = d, out = {phi + alpha, phi - alpha}; returns
- * their count. h . rot(k, t) p = A cos t + B sin t + C. One angle for a double root
- * (sin(alpha)^2 within EPS of 0), none out of range; when the left side does not depend
- * on t, the angle 0 if it equals d. */
-static inline int planar_3r_sp4(const planar_3r_real h[3], const planar_3r_real p[3], const planar_3r_real k[3], planar_3r_real d, planar_3r_angle out[2])
-{
-    planar_3r_real kxp[3];
-    const planar_3r_real hk = planar_3r_dot(h, k);
-    const planar_3r_real kp = planar_3r_dot(k, p);
-    planar_3r_cross(k, p, kxp);
-    {
-        const planar_3r_real a = planar_3r_dot(h, p) - hk * kp;
-        const planar_3r_real b = planar_3r_dot(h, kxp);
-        const planar_3r_real rhs = d - hk * kp;
-        const planar_3r_real r2 = a * a + b * b;
-        const planar_3r_real scale = planar_3r_dot(h, h) * planar_3r_dot(p, p);
-        planar_3r_real r, cos_phi, sin_phi, cos_alpha, disc, sin_alpha;
-        if (r2 <= 1e-24 * scale) {
-            if (rhs * rhs > 1e-12 * scale) {
-                return 0;
-            }
-            out[0] = planar_3r_angle_of(1.0, 0.0);
-            return 1;
-        }
-        r = sqrt(r2);
-        cos_phi = a / r;
-        sin_phi = b / r;
-        cos_alpha = rhs / r;
-        disc = 1.0 - cos_alpha * cos_alpha;
-        if (disc < -1e-12) {
-            return 0;
-        }
-        if (disc <= 1e-12) {
-            const planar_3r_real sign = cos_alpha > 0.0 ? 1.0 : -1.0;
-            out[0] = planar_3r_angle_of(sign * cos_phi, sign * sin_phi);
-            return 1;
-        }
-        sin_alpha = sqrt(disc);
-        {
-            /* phi is a constant when h, p and k are (the compiler folds it) */
-            const planar_3r_real phi = planar_3r_atan2(b, a);
-            const planar_3r_real alpha = planar_3r_atan2(sin_alpha, cos_alpha);
-            out[0].theta = phi + alpha;
-            out[0].c = cos_phi * cos_alpha - sin_phi * sin_alpha;
-            out[0].s = sin_phi * cos_alpha + cos_phi * sin_alpha;
-            out[1].theta = phi - alpha;
-            out[1].c = cos_phi * cos_alpha + sin_phi * sin_alpha;
-            out[1].s = sin_phi * cos_alpha - cos_phi * sin_alpha;
-        }
-        return 2;
-    }
-}
-
-/* SP3: the angles t with |rot(k, t) p - q|^2 = dd (p, q relative to a point of the axis). */
-static inline int planar_3r_sp3(const planar_3r_real p[3], const planar_3r_real q[3], const planar_3r_real k[3], planar_3r_real dd, planar_3r_angle out[2])
-{
-    return planar_3r_sp4(q, p, k, 0.5 * (planar_3r_dot(p, p) + planar_3r_dot(q, q) - dd), out);
-}
-
-/* Planar arm: the last revolute joint takes the yaw, the first two put its axis on the wrist
- * point by SP3 (elbow) and SP1 (shoulder); rotations about z keep heights. */
-static int planar_3r_ik_solve(const planar_3r_real mu[PLANAR_3R_TASK_DIM], const planar_3r_ik_geometry *g, planar_3r_real q[])
-{
-    const planar_3r_real target[3] = {mu[0], mu[1], g->tool_point[2]};
-    planar_3r_real d[3], a[3], b[3];
-    planar_3r_angle elbow[2];
-    int count, i;
-    static const planar_3r_real up[3] = {0.0, 0.0, 1.0};
-    const planar_3r_real yaw = mu[PLANAR_3R_TASK_DIM - 1] - g->yaw0;
-    const planar_3r_angle turn = planar_3r_angle_of(cos(yaw), sin(yaw));
-    const planar_3r_real phi = turn.theta; /* the yaw turn in (-pi, pi] */
-    planar_3r_sub(g->tool_point, g->wrist, a);
-    planar_3r_rot(up, turn.c, turn.s, a, a);
-    planar_3r_sub(target, a, d);
-    planar_3r_sub(d, g->p1, d);
-    planar_3r_sub(g->wrist, g->p2, a);
-    planar_3r_sub(g->p1, g->p2, b);
-    count = planar_3r_sp3(a, b, g->k2, planar_3r_dot(d, d), elbow);
-    for (i = 0; i < count; ++i) {
-        planar_3r_real *out = q + PLANAR_3R_DOF * i;
-        planar_3r_real e[3];
-        planar_3r_angle shoulder;
-        planar_3r_rot(g->k2, elbow[i].c, elbow[i].s, a, e);
-        planar_3r_add(e, g->p2, e);
-        planar_3r_sub(e, g->p1, e);
-        shoulder = planar_3r_sp1(e, d, g->k1);
-        out[0] = shoulder.theta;
-        out[1] = elbow[i].theta;
-        out[2] = g->sign3 * (phi - g->sign1 * shoulder.theta - g->sign2 * elbow[i].theta);
-    }
-    return count;
-}
-
-int planar_3r_ik(const planar_3r_real mu[PLANAR_3R_TASK_DIM], planar_3r_real q[PLANAR_3R_MAX_IK_SOLUTIONS * PLANAR_3R_DOF])
-{
-    const planar_3r_ik_geometry g = {
-        .k1 = {0, 0, 1},
-        .p1 = {0, 0, 0},
-        .k2 = {0, 0, 1},
-        .p2 = {1, 0, 0},
-        .wrist = {2, 0, 0},
-        .tool_point = {3, 0, 0},
-        .yaw0 = 0,
-        .sign1 = 1,
-        .sign2 = 1,
-        .sign3 = 1,
-    };
-    int count, k;
-    for (k = 0; k < PLANAR_3R_TASK_DIM; ++k) {
-        if (!isfinite(mu[k])) {
-            return 0;
-        }
-    }
-    count = planar_3r_ik_solve(mu, &g, q);
-    for (k = 0; k < count; ++k) {
-        q[PLANAR_3R_DOF * k + 0] = planar_3r_wrap(q[PLANAR_3R_DOF * k + 0]);
-        q[PLANAR_3R_DOF * k + 1] = planar_3r_wrap(q[PLANAR_3R_DOF * k + 1]);
-        q[PLANAR_3R_DOF * k + 2] = planar_3r_wrap(q[PLANAR_3R_DOF * k + 2]);
-    }
-    return count;
-}
-
-/* -- Iterative inverse kinematics -- */
 
 /* Error target - mu(q) (angles wrapped into (-pi, pi]) and the task Jacobian. */
 static void planar_3r_task_error(const planar_3r_real target[PLANAR_3R_TASK_DIM], const planar_3r_real q[PLANAR_3R_DOF], planar_3r_real e[PLANAR_3R_TASK_DIM],

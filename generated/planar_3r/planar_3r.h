@@ -29,6 +29,7 @@ typedef double planar_3r_real;
 #define PLANAR_3R_DOF 3
 #define PLANAR_3R_TASK_DIM 3
 #define PLANAR_3R_NUM_SINGULARITY_FACTORS 1
+#define PLANAR_3R_MAX_IK_SOLUTIONS 2
 
 /* Pose of the tool frame in the world frame (4x4 homogeneous).
  * Result: T: 4 x 4 row-major, element (r, c) at T[r * 4 + c]. 23 operations. */
@@ -66,6 +67,10 @@ planar_3r_real planar_3r_manipulability(const planar_3r_real q[PLANAR_3R_DOF]);
  * Result: returned as a scalar. 22 operations. */
 planar_3r_real planar_3r_jacobian_det(const planar_3r_real q[PLANAR_3R_DOF]);
 
+/* Every branch of the closed-form ik and whether the target allows it.
+ * Result: q: 2 x 3 row-major, element (r, c) at q[r * 3 + c]; valid[i], i < 2. 106 operations. */
+void planar_3r_ik_branches(const planar_3r_real mu[PLANAR_3R_TASK_DIM], planar_3r_real q[PLANAR_3R_MAX_IK_SOLUTIONS * PLANAR_3R_DOF], int valid[PLANAR_3R_MAX_IK_SOLUTIONS]);
+
 /* Status of planar_3r_velocity_ik. */
 #define PLANAR_3R_VELOCITY_IK_OK 0
 #define PLANAR_3R_VELOCITY_IK_SINGULAR 1   /* a pivot below 1e-12 x the largest |entry|: take damping > 0 */
@@ -79,11 +84,9 @@ planar_3r_real planar_3r_jacobian_det(const planar_3r_real q[PLANAR_3R_DOF]);
  * PLANAR_3R_VELOCITY_IK_OK, or a status above with q_dot all 0. */
 int planar_3r_velocity_ik(const planar_3r_real q[PLANAR_3R_DOF], const planar_3r_real mu_dot[PLANAR_3R_TASK_DIM], planar_3r_real damping, planar_3r_real q_dot[PLANAR_3R_DOF]);
 
-#define PLANAR_3R_MAX_IK_SOLUTIONS 2
-
 /* Closed-form inverse kinematics: every joint solution that reaches the target; returns
- * their count k and writes solution i to q[i * PLANAR_3R_DOF + j], i < k. Loops over
- * the branches, no allocation, no recursion.
+ * their count k and writes solution i to q[i * PLANAR_3R_DOF + j], i < k: the valid
+ * rows of planar_3r_ik_branches, in its order. No allocation, no recursion.
  * target: the task vector (x, y, yaw).
  * Result: k <= PLANAR_3R_MAX_IK_SOLUTIONS solutions, revolute angles wrapped into (-pi,
  * pi], joint limits not applied; k = 0 when the target is out of reach or not finite.

@@ -3,7 +3,9 @@
 
 Planar 3R arm with unit links (rtb Planar3), standard DH
 Every function takes `q` (3 x 1: radians for revolute joints, m for
-prismatic ones) and returns a rows x cols result whose zeros are structural.
+prismatic ones) and returns a rows x cols result whose zeros are structural; ik_branches
+(also named ik) takes the target instead of q and returns every branch (MAX_IK_SOLUTIONS x
+DOF) and its validity (MAX_IK_SOLUTIONS x 1, 1 or 0).
 Task vector: (x, y, yaw).
 """
 
@@ -257,7 +259,64 @@ def _jacobian_det(q):
     return [d]
 
 
-_q = casadi.SX.sym("q", DOF)
+def _ik_branches(mu):
+    """Every branch of the closed-form ik and whether the target allows it: 106 operations."""
+    mu0 = mu[0]
+    mu1 = mu[1]
+    mu2 = mu[2]
+    t0 = casadi.cos(mu2)
+    t1 = casadi.sin(mu2)
+    t2 = mu0 - t0
+    t3 = mu1 - t1
+    t4 = t2**2 + t3**2
+    t5 = 1.0 - 0.5*t4
+    t6 = mu0 + mu1 + mu2
+    t7 = t5**2
+    t8 = 1 - t7
+    t9 = (1e-12 < t8)
+    t10 = casadi.if_else(t9, t5, casadi.if_else((t5 > 0), 1, -1))
+    t11 = casadi.if_else(t9, casadi.sqrt(t8), 0)
+    t12 = casadi.atan2(t11, t10)
+    t13 = 3.141592653589793 - t12
+    t14 = False
+    t15 = casadi.if_else(t14, 0, t12 + 3.141592653589793)
+    t16 = casadi.if_else(t14, 0, -t11)
+    t17 = -t10
+    t18 = casadi.if_else(t14, 1, t17)
+    t19 = t18 + 1
+    t20 = t16*t3 + t19*t2
+    t21 = -t16*t2 + t19*t3
+    t22 = t20**2 + t21**2
+    t23 = t16**2 + t19**2
+    t24 = t17 + 1
+    t25 = t11*t3 + t2*t24
+    t26 = -t11*t2 + t24*t3
+    t27 = t25**2 + t26**2
+    t28 = t11**2 + t24**2
+    t29 = 1e-24*t4
+    t30 = casadi.if_else((t22 <= t23*t29), 0, casadi.atan2(t21, t20))
+    t31 = -mu2
+    t32 = t31 + 3.141592653589793
+    t33 = t15 + t30
+    t34 = casadi.if_else((t27 <= t28*t29), 0, casadi.atan2(t26, t25))
+    t35 = t13 + t34
+    t36 = (casadi.fabs(t6) < casadi.inf)
+    t37 = True
+    q = casadi.SX(2, 3)
+    q[0, 0] = t30
+    q[0, 1] = t15 - 6.283185307179586*casadi.ceil(0.15915494309189535*t15 - 0.5)
+    q[0, 2] = -t31 - t33 - 6.283185307179586*casadi.ceil(-0.15915494309189535*t32 - 0.15915494309189535*t33)
+    q[1, 0] = t34
+    q[1, 1] = t13 - 6.283185307179586*casadi.ceil(0.15915494309189535*t13 - 0.5)
+    q[1, 2] = -t31 - t35 - 6.283185307179586*casadi.ceil(-0.15915494309189535*t32 - 0.15915494309189535*t35)
+    valid = casadi.SX(2, 1)
+    valid[0, 0] = casadi.logic_and(casadi.logic_and(t36, t37), (t8 >= -1e-12))
+    valid[1, 0] = casadi.logic_and(casadi.logic_and(t36, t37), (t8 > 1e-12))
+    return [q, valid]
+
+
+_q = casadi.SX.sym("q", 3, 1)
+_mu = casadi.SX.sym("mu", 3, 1)
 fk = casadi.Function("fk", [_q], _fk(_q), ["q"], ["T"])
 jacobian = casadi.Function("jacobian", [_q], _jacobian(_q), ["q"], ["J"])
 fk_jacobian = casadi.Function("fk_jacobian", [_q], _fk_jacobian(_q), ["q"], ["T", "J"])
@@ -267,8 +326,10 @@ task_jacobian = casadi.Function("task_jacobian", [_q], _task_jacobian(_q), ["q"]
 singularity_factors = casadi.Function("singularity_factors", [_q], _singularity_factors(_q), ["q"], ["f"])
 manipulability = casadi.Function("manipulability", [_q], _manipulability(_q), ["q"], ["w"])
 jacobian_det = casadi.Function("jacobian_det", [_q], _jacobian_det(_q), ["q"], ["d"])
+ik_branches = casadi.Function("ik_branches", [_mu], _ik_branches(_mu), ["mu"], ["q", "valid"])
+ik = ik_branches  # CasADi functions have fixed-size outputs: every branch and its validity
 
 
 def functions():
     """All functions by name."""
-    return {"fk": fk, "jacobian": jacobian, "fk_jacobian": fk_jacobian, "jacobian_tool": jacobian_tool, "task": task, "task_jacobian": task_jacobian, "singularity_factors": singularity_factors, "manipulability": manipulability, "jacobian_det": jacobian_det}
+    return {"fk": fk, "jacobian": jacobian, "fk_jacobian": fk_jacobian, "jacobian_tool": jacobian_tool, "task": task, "task_jacobian": task_jacobian, "singularity_factors": singularity_factors, "manipulability": manipulability, "jacobian_det": jacobian_det, "ik_branches": ik_branches}

@@ -650,6 +650,473 @@ puma560_real puma560_jacobian_det(const puma560_real q[PUMA560_DOF])
     return -0.080509645432*s5*(c3 + t0)*(-0.04701250578971746*c2*c3 + c2*s3 - c2 + c3*s2 + s2*t0);
 }
 
+void puma560_ik_branches(const puma560_real T[16], puma560_real q[PUMA560_MAX_IK_SOLUTIONS * PUMA560_DOF], int valid[PUMA560_MAX_IK_SOLUTIONS])
+{
+    /* 900 operations */
+
+    /* Inputs */
+    const puma560_real T00 = T[0];
+    const puma560_real T01 = T[1];
+    const puma560_real T02 = T[2];
+    const puma560_real T03 = T[3];
+    const puma560_real T10 = T[4];
+    const puma560_real T11 = T[5];
+    const puma560_real T12 = T[6];
+    const puma560_real T13 = T[7];
+    const puma560_real T20 = T[8];
+    const puma560_real T21 = T[9];
+    const puma560_real T22 = T[10];
+    const puma560_real T23 = T[11];
+
+    /* Intermediate terms */
+    const puma560_real t0 = 5.357415379007653;
+    const puma560_real t1 = 1.6177742431429796;
+    const puma560_real t2 = T00 + T01 + T02 + T03 + T10 + T11 + T12 + T13 + T20 + T21 + T22 + T23;
+    const puma560_real t3 = 0.4521*T00 - 0.15005*T01 + 1.10363*T02;
+    const puma560_real t4 = T03 - t3;
+    const puma560_real t5 = t3;
+    const puma560_real t6 = t4 + t5;
+    const puma560_real t7 = 0.4521*T10 - 0.15005*T11 + 1.10363*T12;
+    const puma560_real t8 = T13 - t7;
+    const puma560_real t9 = t7;
+    const puma560_real t10 = t8 + t9;
+    const puma560_real t11 = atan2(t6, -t10);
+    const puma560_real t12 = 0.4521*T20 - 0.15005*T21 + 1.10363*T22;
+    const puma560_real t13 = T23 - t12;
+    const puma560_real t14 = t12;
+    const puma560_real t15 = t13 + t14;
+    const puma560_real t16 = (t10*t10) + (t6*t6);
+    const puma560_real t17 = t16;
+    const puma560_real t18 = t16 + (t15*t15);
+    const puma560_real t19 = 1.0/sqrt(t17);
+    const puma560_real t20 = 1 - 0.0225150025*(t19*t19);
+    const int t21 = 1e-12 < t20;
+    const puma560_real t22 = (t21 ? 0.15005*t19 : (t19 > 0 ? 1 : -1));
+    const puma560_real t23 = (t21 ? sqrt(t20) : 0);
+    const puma560_real t24 = atan2(t23, t22);
+    const puma560_real t25 = t11 - t24;
+    const puma560_real t26 = 1e-24*t18;
+    const int t27 = t17 <= t26;
+    const puma560_real t28 = (t27 ? 0 : t11 + t24);
+    const puma560_real t29 = t19*t6;
+    const puma560_real t30 = t23*t29;
+    const puma560_real t31 = t10*t19;
+    const puma560_real t32 = t22*t31;
+    const puma560_real t33 = (t27 ? 1 : -t30 - t32);
+    const puma560_real t34 = t30 - t32;
+    const puma560_real t35 = t22*t29;
+    const puma560_real t36 = t23*t31;
+    const puma560_real t37 = (t27 ? 0 : t35 - t36);
+    const puma560_real t38 = t35 + t36;
+    const puma560_real t39 = t10*t37 + t33*t6;
+    const puma560_real t40 = t10*t33 - t37*t6;
+    const puma560_real t41 = T02*t33 + T12*t37;
+    const puma560_real t42 = -T02*t37 + T12*t33;
+    const puma560_real t43 = T00*t33 + T10*t37;
+    const puma560_real t44 = -T00*t37 + T10*t33;
+    const puma560_real t45 = t10*t38 + t34*t6;
+    const puma560_real t46 = t10*t34 - t38*t6;
+    const puma560_real t47 = T02*t34 + T12*t38;
+    const puma560_real t48 = -T02*t38 + T12*t34;
+    const puma560_real t49 = T00*t34 + T10*t38;
+    const puma560_real t50 = -T00*t38 + T10*t34;
+    const puma560_real t51 = 1 - t33;
+    const puma560_real t52 = t15*t51;
+    const puma560_real t53 = t15*t33 + t52;
+    const puma560_real t54 = t53 - 0.67183;
+    const puma560_real t55 = (t39*t39) + (t40*t40) + (t54*t54);
+    const puma560_real t56 = 0.19791478625 - 0.5*t55;
+    const puma560_real t57 = T22*t51;
+    const puma560_real t58 = T22*t33 + t57;
+    const puma560_real t59 = T20*t51;
+    const puma560_real t60 = T20*t33 + t59;
+    const puma560_real t61 = (t56*t56);
+    const puma560_real t62 = (t0*t0);
+    const puma560_real t63 = -t61*t62 + 1;
+    const puma560_real t64 = t0*t56;
+    const int t65 = 1e-12 < t63;
+    const puma560_real t66 = (t65 ? t64 : (t64 > 0 ? 1 : -1));
+    const puma560_real t67 = (t65 ? sqrt(t63) : 0);
+    const puma560_real t68 = atan2(t67, t66);
+    const puma560_real t69 = t1 - t68;
+    const int t70 = 0;
+    const puma560_real t71 = (t70 ? 0 : t1 + t68);
+    const puma560_real t72 = t0*t66;
+    const puma560_real t73 = 0.00876554*t72;
+    const puma560_real t74 = t0*t67;
+    const puma560_real t75 = 0.18645124*t74;
+    const puma560_real t76 = (t70 ? 1 : -t73 - t75);
+    const puma560_real t77 = -t73 + t75;
+    const puma560_real t78 = 0.15005 - 0.15005*t76;
+    const puma560_real t79 = 0.15005*t76 + t78;
+    const puma560_real t80 = 0.15005 - 0.15005*t77;
+    const puma560_real t81 = 0.15005*t77 + t80;
+    const puma560_real t82 = 0.18645124*t72;
+    const puma560_real t83 = 0.00876554*t74;
+    const puma560_real t84 = (t70 ? 0 : t82 - t83);
+    const puma560_real t85 = t82 + t83;
+    const puma560_real t86 = 0.0203*t76 - 0.4318*t84;
+    const puma560_real t87 = 0.4318*t76 + 0.0203*t84;
+    const puma560_real t88 = t86 + 0.4318;
+    const puma560_real t89 = t87 + 0.67183;
+    const puma560_real t90 = t89 - 0.67183;
+    const puma560_real t91 = t39*t90 - t54*t88;
+    const puma560_real t92 = (t79*t79) + (t88*t88) + (t90*t90);
+    const puma560_real t93 = 0.0203*t77 - 0.4318*t85;
+    const puma560_real t94 = 0.4318*t77 + 0.0203*t85;
+    const puma560_real t95 = t93 + 0.4318;
+    const puma560_real t96 = t94 + 0.67183;
+    const puma560_real t97 = t96 - 0.67183;
+    const puma560_real t98 = t39*t97 - t54*t95;
+    const puma560_real t99 = (t81*t81) + (t95*t95) + (t97*t97);
+    const puma560_real t100 = t40*t79;
+    const puma560_real t101 = -t100 + t39*t88 + t54*t90;
+    const puma560_real t102 = t100 + t101;
+    const puma560_real t103 = (t102*t102) + (t91*t91);
+    const puma560_real t104 = 1.0/sqrt(t103);
+    const puma560_real t105 = 1e-24*t55;
+    const int t106 = t103 <= t105*t92;
+    const puma560_real t107 = (t106 ? 1 : t102*t104);
+    const puma560_real t108 = (t106 ? 0 : -t104*t91);
+    const puma560_real t109 = t107*t76 - t108*t84;
+    const puma560_real t110 = t107*t84 + t108*t76;
+    const puma560_real t111 = t109*t41 + t110*t58;
+    const puma560_real t112 = t109*t58 - t110*t41;
+    const puma560_real t113 = t109*t43 + t110*t60;
+    const puma560_real t114 = t109*t60 - t110*t43;
+    const puma560_real t115 = 1 - t109;
+    const puma560_real t116 = t115*t42;
+    const puma560_real t117 = t109*t42 + t116;
+    const puma560_real t118 = t115*t44;
+    const puma560_real t119 = t109*t44 + t118;
+    const puma560_real t120 = (t112*t112);
+    const puma560_real t121 = -t120;
+    const puma560_real t122 = t121 + 1;
+    const puma560_real t123 = (t122 > 1e-12 ? sqrt(t122) : 0);
+    const puma560_real t124 = t111*t123 + t120;
+    const puma560_real t125 = t121 + t124;
+    const puma560_real t126 = (t117*t117);
+    const puma560_real t127 = t120 + t126 + (t111*t111);
+    const puma560_real t128 = (t123*t123);
+    const puma560_real t129 = t126*t128 + (t125*t125);
+    const puma560_real t130 = t120 + t128;
+    const puma560_real t131 = 1.0/sqrt(t129);
+    const puma560_real t132 = 1.0/sqrt(t130);
+    const puma560_real t133 = 1e-24*t130;
+    const int t134 = t129 <= t127*t133;
+    const puma560_real t135 = (t134 ? 1 : t125*t131);
+    const puma560_real t136 = t114*(1 - t135);
+    const puma560_real t137 = t114*t135 + t136;
+    const puma560_real t138 = t117*t123;
+    const puma560_real t139 = (t134 ? 0 : t131*t138);
+    const puma560_real t140 = t113*t135 + t119*t139;
+    const puma560_real t141 = -t113*t139 + t119*t135;
+    const int t142 = t130 <= t133;
+    const puma560_real t143 = (t142 ? 1 : t112*t132);
+    const puma560_real t144 = (t142 ? 0 : -t123*t132);
+    const puma560_real t145 = t141*(1 - t143);
+    const puma560_real t146 = t137*t144 + t140*t143;
+    const puma560_real t147 = t141*t143 + t145;
+    const puma560_real t148 = t137*t143 - t140*t144;
+    const puma560_real t149 = (t146*t146) + (t147*t147);
+    const puma560_real t150 = t149;
+    const puma560_real t151 = t149 + (t148*t148);
+    const puma560_real t152 = t40*t81;
+    const puma560_real t153 = -t152 + t39*t95 + t54*t97;
+    const puma560_real t154 = t152 + t153;
+    const puma560_real t155 = (t154*t154) + (t98*t98);
+    const puma560_real t156 = 1.0/sqrt(t155);
+    const int t157 = t155 <= t105*t99;
+    const puma560_real t158 = (t157 ? 1 : t154*t156);
+    const puma560_real t159 = (t157 ? 0 : -t156*t98);
+    const puma560_real t160 = t158*t77 - t159*t85;
+    const puma560_real t161 = t158*t85 + t159*t77;
+    const puma560_real t162 = t160*t41 + t161*t58;
+    const puma560_real t163 = t160*t58 - t161*t41;
+    const puma560_real t164 = t160*t43 + t161*t60;
+    const puma560_real t165 = t160*t60 - t161*t43;
+    const puma560_real t166 = 1 - t160;
+    const puma560_real t167 = t166*t42;
+    const puma560_real t168 = t160*t42 + t167;
+    const puma560_real t169 = t166*t44;
+    const puma560_real t170 = t160*t44 + t169;
+    const puma560_real t171 = (t163*t163);
+    const puma560_real t172 = -t171;
+    const puma560_real t173 = t172 + 1;
+    const puma560_real t174 = (t173 > 1e-12 ? sqrt(t173) : 0);
+    const puma560_real t175 = t162*t174 + t171;
+    const puma560_real t176 = t172 + t175;
+    const puma560_real t177 = (t168*t168);
+    const puma560_real t178 = t171 + t177 + (t162*t162);
+    const puma560_real t179 = (t174*t174);
+    const puma560_real t180 = t177*t179 + (t176*t176);
+    const puma560_real t181 = t171 + t179;
+    const puma560_real t182 = 1.0/sqrt(t180);
+    const puma560_real t183 = 1.0/sqrt(t181);
+    const puma560_real t184 = 1e-24*t181;
+    const int t185 = t180 <= t178*t184;
+    const puma560_real t186 = (t185 ? 1 : t176*t182);
+    const puma560_real t187 = t165*(1 - t186);
+    const puma560_real t188 = t165*t186 + t187;
+    const puma560_real t189 = t168*t174;
+    const puma560_real t190 = (t185 ? 0 : t182*t189);
+    const puma560_real t191 = t164*t186 + t170*t190;
+    const puma560_real t192 = -t164*t190 + t170*t186;
+    const int t193 = t181 <= t184;
+    const puma560_real t194 = (t193 ? 1 : t163*t183);
+    const puma560_real t195 = (t193 ? 0 : -t174*t183);
+    const puma560_real t196 = t192*(1 - t194);
+    const puma560_real t197 = t188*t195 + t191*t194;
+    const puma560_real t198 = t192*t194 + t196;
+    const puma560_real t199 = t188*t194 - t191*t195;
+    const puma560_real t200 = (t197*t197) + (t198*t198);
+    const puma560_real t201 = t200;
+    const puma560_real t202 = t200 + (t199*t199);
+    const puma560_real t203 = 1 - t34;
+    const puma560_real t204 = t15*t203;
+    const puma560_real t205 = t15*t34 + t204;
+    const puma560_real t206 = t205 - 0.67183;
+    const puma560_real t207 = (t206*t206) + (t45*t45) + (t46*t46);
+    const puma560_real t208 = 0.19791478625 - 0.5*t207;
+    const puma560_real t209 = T22*t203;
+    const puma560_real t210 = T22*t34 + t209;
+    const puma560_real t211 = T20*t203;
+    const puma560_real t212 = T20*t34 + t211;
+    const puma560_real t213 = (t208*t208);
+    const puma560_real t214 = -t213*t62 + 1;
+    const puma560_real t215 = t0*t208;
+    const int t216 = 1e-12 < t214;
+    const puma560_real t217 = (t216 ? t215 : (t215 > 0 ? 1 : -1));
+    const puma560_real t218 = (t216 ? sqrt(t214) : 0);
+    const puma560_real t219 = atan2(t218, t217);
+    const puma560_real t220 = (t70 ? 0 : t1 + t219);
+    const puma560_real t221 = t1 - t219;
+    const puma560_real t222 = t0*t217;
+    const puma560_real t223 = 0.00876554*t222;
+    const puma560_real t224 = t0*t218;
+    const puma560_real t225 = 0.18645124*t224;
+    const puma560_real t226 = (t70 ? 1 : -t223 - t225);
+    const puma560_real t227 = -t223 + t225;
+    const puma560_real t228 = 0.15005 - 0.15005*t226;
+    const puma560_real t229 = 0.15005*t226 + t228;
+    const puma560_real t230 = 0.15005 - 0.15005*t227;
+    const puma560_real t231 = 0.15005*t227 + t230;
+    const puma560_real t232 = 0.18645124*t222;
+    const puma560_real t233 = 0.00876554*t224;
+    const puma560_real t234 = (t70 ? 0 : t232 - t233);
+    const puma560_real t235 = t232 + t233;
+    const puma560_real t236 = 0.0203*t226 - 0.4318*t234;
+    const puma560_real t237 = 0.4318*t226 + 0.0203*t234;
+    const puma560_real t238 = t236 + 0.4318;
+    const puma560_real t239 = t237 + 0.67183;
+    const puma560_real t240 = t239 - 0.67183;
+    const puma560_real t241 = -t206*t238 + t240*t45;
+    const puma560_real t242 = (t229*t229) + (t238*t238) + (t240*t240);
+    const puma560_real t243 = 0.0203*t227 - 0.4318*t235;
+    const puma560_real t244 = 0.4318*t227 + 0.0203*t235;
+    const puma560_real t245 = t243 + 0.4318;
+    const puma560_real t246 = t244 + 0.67183;
+    const puma560_real t247 = t246 - 0.67183;
+    const puma560_real t248 = -t206*t245 + t247*t45;
+    const puma560_real t249 = (t231*t231) + (t245*t245) + (t247*t247);
+    const puma560_real t250 = t229*t46;
+    const puma560_real t251 = t206*t240 + t238*t45 - t250;
+    const puma560_real t252 = t250 + t251;
+    const puma560_real t253 = (t241*t241) + (t252*t252);
+    const puma560_real t254 = 1.0/sqrt(t253);
+    const puma560_real t255 = 1e-24*t207;
+    const int t256 = t253 <= t242*t255;
+    const puma560_real t257 = (t256 ? 1 : t252*t254);
+    const puma560_real t258 = (t256 ? 0 : -t241*t254);
+    const puma560_real t259 = t226*t257 - t234*t258;
+    const puma560_real t260 = t226*t258 + t234*t257;
+    const puma560_real t261 = t210*t260 + t259*t47;
+    const puma560_real t262 = t210*t259 - t260*t47;
+    const puma560_real t263 = t212*t260 + t259*t49;
+    const puma560_real t264 = t212*t259 - t260*t49;
+    const puma560_real t265 = 1 - t259;
+    const puma560_real t266 = t265*t48;
+    const puma560_real t267 = t259*t48 + t266;
+    const puma560_real t268 = t265*t50;
+    const puma560_real t269 = t259*t50 + t268;
+    const puma560_real t270 = (t262*t262);
+    const puma560_real t271 = -t270;
+    const puma560_real t272 = t271 + 1;
+    const puma560_real t273 = (t272 > 1e-12 ? sqrt(t272) : 0);
+    const puma560_real t274 = t261*t273 + t270;
+    const puma560_real t275 = t271 + t274;
+    const puma560_real t276 = (t267*t267);
+    const puma560_real t277 = t270 + t276 + (t261*t261);
+    const puma560_real t278 = (t273*t273);
+    const puma560_real t279 = t276*t278 + (t275*t275);
+    const puma560_real t280 = t270 + t278;
+    const puma560_real t281 = 1.0/sqrt(t279);
+    const puma560_real t282 = 1.0/sqrt(t280);
+    const puma560_real t283 = 1e-24*t280;
+    const int t284 = t279 <= t277*t283;
+    const puma560_real t285 = (t284 ? 1 : t275*t281);
+    const puma560_real t286 = t264*(1 - t285);
+    const puma560_real t287 = t264*t285 + t286;
+    const puma560_real t288 = t267*t273;
+    const puma560_real t289 = (t284 ? 0 : t281*t288);
+    const puma560_real t290 = t263*t285 + t269*t289;
+    const puma560_real t291 = -t263*t289 + t269*t285;
+    const int t292 = t280 <= t283;
+    const puma560_real t293 = (t292 ? 1 : t262*t282);
+    const puma560_real t294 = (t292 ? 0 : -t273*t282);
+    const puma560_real t295 = t291*(1 - t293);
+    const puma560_real t296 = t287*t294 + t290*t293;
+    const puma560_real t297 = t291*t293 + t295;
+    const puma560_real t298 = t287*t293 - t290*t294;
+    const puma560_real t299 = (t296*t296) + (t297*t297);
+    const puma560_real t300 = t299;
+    const puma560_real t301 = t299 + (t298*t298);
+    const puma560_real t302 = t231*t46;
+    const puma560_real t303 = t206*t247 + t245*t45 - t302;
+    const puma560_real t304 = t302 + t303;
+    const puma560_real t305 = (t248*t248) + (t304*t304);
+    const puma560_real t306 = 1.0/sqrt(t305);
+    const int t307 = t305 <= t249*t255;
+    const puma560_real t308 = (t307 ? 1 : t304*t306);
+    const puma560_real t309 = (t307 ? 0 : -t248*t306);
+    const puma560_real t310 = t227*t308 - t235*t309;
+    const puma560_real t311 = t227*t309 + t235*t308;
+    const puma560_real t312 = t210*t311 + t310*t47;
+    const puma560_real t313 = t210*t310 - t311*t47;
+    const puma560_real t314 = t212*t311 + t310*t49;
+    const puma560_real t315 = t212*t310 - t311*t49;
+    const puma560_real t316 = 1 - t310;
+    const puma560_real t317 = t316*t48;
+    const puma560_real t318 = t310*t48 + t317;
+    const puma560_real t319 = t316*t50;
+    const puma560_real t320 = t310*t50 + t319;
+    const puma560_real t321 = (t313*t313);
+    const puma560_real t322 = -t321;
+    const puma560_real t323 = t322 + 1;
+    const puma560_real t324 = (t323 > 1e-12 ? sqrt(t323) : 0);
+    const puma560_real t325 = t312*t324 + t321;
+    const puma560_real t326 = t322 + t325;
+    const puma560_real t327 = (t318*t318);
+    const puma560_real t328 = t321 + t327 + (t312*t312);
+    const puma560_real t329 = (t324*t324);
+    const puma560_real t330 = t327*t329 + (t326*t326);
+    const puma560_real t331 = t321 + t329;
+    const puma560_real t332 = 1.0/sqrt(t330);
+    const puma560_real t333 = 1.0/sqrt(t331);
+    const puma560_real t334 = 1e-24*t331;
+    const int t335 = t330 <= t328*t334;
+    const puma560_real t336 = (t335 ? 1 : t326*t332);
+    const puma560_real t337 = t315*(1 - t336);
+    const puma560_real t338 = t315*t336 + t337;
+    const puma560_real t339 = t318*t324;
+    const puma560_real t340 = (t335 ? 0 : t332*t339);
+    const puma560_real t341 = t314*t336 + t320*t340;
+    const puma560_real t342 = -t314*t340 + t320*t336;
+    const int t343 = t331 <= t334;
+    const puma560_real t344 = (t343 ? 1 : t313*t333);
+    const puma560_real t345 = (t343 ? 0 : -t324*t333);
+    const puma560_real t346 = t342*(1 - t344);
+    const puma560_real t347 = t338*t345 + t341*t344;
+    const puma560_real t348 = t342*t344 + t346;
+    const puma560_real t349 = t338*t344 - t341*t345;
+    const puma560_real t350 = (t347*t347) + (t348*t348);
+    const puma560_real t351 = t350;
+    const puma560_real t352 = t350 + (t349*t349);
+    const puma560_real t353 = t28 - 6.283185307179586*ceil(0.15915494309189535*t28 - 0.5);
+    const puma560_real t354 = (t106 ? 0 : atan2(-t91, t102));
+    const puma560_real t355 = t71 - 6.283185307179586*ceil(0.15915494309189535*t71 - 0.5);
+    const puma560_real t356 = (t134 ? 0 : atan2(t138, t125));
+    const puma560_real t357 = (t142 ? 0 : atan2(-t123, t112));
+    const puma560_real t358 = (t150 <= 1e-24*t151 ? 0 : atan2(t147, t146));
+    const puma560_real t359 = (t157 ? 0 : atan2(-t98, t154));
+    const puma560_real t360 = t69 - 6.283185307179586*ceil(0.15915494309189535*t69 - 0.5);
+    const puma560_real t361 = (t185 ? 0 : atan2(t189, t176));
+    const puma560_real t362 = (t193 ? 0 : atan2(-t174, t163));
+    const puma560_real t363 = (t201 <= 1e-24*t202 ? 0 : atan2(t198, t197));
+    const puma560_real t364 = t25 - 6.283185307179586*ceil(0.15915494309189535*t25 - 0.5);
+    const puma560_real t365 = (t256 ? 0 : atan2(-t241, t252));
+    const puma560_real t366 = t220 - 6.283185307179586*ceil(0.15915494309189535*t220 - 0.5);
+    const puma560_real t367 = (t284 ? 0 : atan2(t288, t275));
+    const puma560_real t368 = (t292 ? 0 : atan2(-t273, t262));
+    const puma560_real t369 = (t300 <= 1e-24*t301 ? 0 : atan2(t297, t296));
+    const puma560_real t370 = (t307 ? 0 : atan2(-t248, t304));
+    const puma560_real t371 = t221 - 6.283185307179586*ceil(0.15915494309189535*t221 - 0.5);
+    const puma560_real t372 = (t335 ? 0 : atan2(t339, t326));
+    const puma560_real t373 = (t343 ? 0 : atan2(-t324, t313));
+    const puma560_real t374 = (t351 <= 1e-24*t352 ? 0 : atan2(t348, t347));
+    const int t375 = isfinite(t2);
+    const puma560_real t376 = -1e-12;
+    const int t377 = t17 > t26;
+    const int t378 = (t377 && t20 >= t376) || (t27 && 0.0225150025 <= 1e-12*t18);
+    const puma560_real t379 = 3.9038849723757295e-26;
+    const int t380 = 0.0348408995890292 > t379;
+    const int t381 = 0.0348408995890292 <= t379;
+    const puma560_real t382 = 3.9038849723757296e-14;
+    const int t383 = (t380 && t63 >= t376) || (t381 && t61 <= t382);
+    const int t384 = t63 > 1e-12;
+    const int t385 = t20 > 1e-12;
+    const int t386 = (t380 && t214 >= t376) || (t381 && t213 <= t382);
+    const int t387 = t214 > 1e-12;
+
+    /* Outputs */
+    q[0] = t353;
+    q[1] = t354;
+    q[2] = t355;
+    q[3] = t356;
+    q[4] = t357;
+    q[5] = t358;
+    q[6] = t353;
+    q[7] = t354;
+    q[8] = t355;
+    q[9] = t356 - 6.283185307179586*ceil(0.15915494309189535*t356) + 3.141592653589793;
+    q[10] = -t357 - 6.283185307179586*ceil(-0.15915494309189535*t357 - 0.5);
+    q[11] = t358 - 6.283185307179586*ceil(0.15915494309189535*t358) + 3.141592653589793;
+    q[12] = t353;
+    q[13] = t359;
+    q[14] = t360;
+    q[15] = t361;
+    q[16] = t362;
+    q[17] = t363;
+    q[18] = t353;
+    q[19] = t359;
+    q[20] = t360;
+    q[21] = t361 - 6.283185307179586*ceil(0.15915494309189535*t361) + 3.141592653589793;
+    q[22] = -t362 - 6.283185307179586*ceil(-0.15915494309189535*t362 - 0.5);
+    q[23] = t363 - 6.283185307179586*ceil(0.15915494309189535*t363) + 3.141592653589793;
+    q[24] = t364;
+    q[25] = t365;
+    q[26] = t366;
+    q[27] = t367;
+    q[28] = t368;
+    q[29] = t369;
+    q[30] = t364;
+    q[31] = t365;
+    q[32] = t366;
+    q[33] = t367 - 6.283185307179586*ceil(0.15915494309189535*t367) + 3.141592653589793;
+    q[34] = -t368 - 6.283185307179586*ceil(-0.15915494309189535*t368 - 0.5);
+    q[35] = t369 - 6.283185307179586*ceil(0.15915494309189535*t369) + 3.141592653589793;
+    q[36] = t364;
+    q[37] = t370;
+    q[38] = t371;
+    q[39] = t372;
+    q[40] = t373;
+    q[41] = t374;
+    q[42] = t364;
+    q[43] = t370;
+    q[44] = t371;
+    q[45] = t372 - 6.283185307179586*ceil(0.15915494309189535*t372) + 3.141592653589793;
+    q[46] = -t373 - 6.283185307179586*ceil(-0.15915494309189535*t373 - 0.5);
+    q[47] = t374 - 6.283185307179586*ceil(0.15915494309189535*t374) + 3.141592653589793;
+    valid[0] = t375 && t378 && t383 && t122 >= t376;
+    valid[1] = t375 && t378 && t383 && t122 > 1e-12;
+    valid[2] = t375 && t378 && t380 && t384 && t173 >= t376;
+    valid[3] = t375 && t378 && t380 && t384 && t173 > 1e-12;
+    valid[4] = t375 && t377 && t385 && t386 && t272 >= t376;
+    valid[5] = t375 && t377 && t385 && t386 && t272 > 1e-12;
+    valid[6] = t375 && t377 && t380 && t385 && t387 && t323 >= t376;
+    valid[7] = t375 && t377 && t380 && t385 && t387 && t323 > 1e-12;
+}
+
 int puma560_velocity_ik(const puma560_real q[PUMA560_DOF], const puma560_real mu_dot[PUMA560_TASK_DIM], puma560_real damping, puma560_real q_dot[PUMA560_DOF])
 {
     /* Rows of jacobian() forming Js (the geometric Jacobian). */
@@ -747,390 +1214,19 @@ int puma560_velocity_ik(const puma560_real q[PUMA560_DOF], const puma560_real mu
     return PUMA560_VELOCITY_IK_OK;
 }
 
-/* The angle wrapped into (-pi, pi], for |angle| < 1e9 (the callers' angles are sums of a few
- * atan2 results): angle - 2 pi ceil((angle - pi) / (2 pi)), ceil by truncation. */
-static puma560_real puma560_wrap(puma560_real angle)
-{
-    const puma560_real turns = (angle - 3.141592653589793) / 6.283185307179586;
-    puma560_real whole;
-    if (angle > -3.141592653589793 && angle <= 3.141592653589793) {
-        return angle;
-    }
-    whole = (puma560_real)(long)turns;
-    if (whole < turns) {
-        whole += 1.0;
-    }
-    return angle - 6.283185307179586 * whole;
-}
-
-/* -- Closed-form inverse kinematics (spherical_wrist_parallel) -- */
-
-/* The arm at q = 0 (product of exponentials): unit axis directions h, points p on the axes,
- * the tool pose and a few derived constants. */
-typedef struct {
-    puma560_real tool_rotation[9];
-    puma560_real tool_position[3];
-    puma560_real h1[3];
-    puma560_real p1[3];
-    puma560_real h2[3];
-    puma560_real p2[3];
-    puma560_real h3[3];
-    puma560_real p3[3];
-    puma560_real reach;
-    puma560_real sign3;
-    puma560_real h4[3];
-    puma560_real h5[3];
-    puma560_real h6[3];
-    puma560_real v6[3];
-    puma560_real centre[3];
-    puma560_real wrist_flip;
-} puma560_ik_geometry;
-
-/* An angle with its cosine and sine. */
-typedef struct {
-    puma560_real theta, c, s;
-} puma560_angle;
-
-static inline puma560_real puma560_dot(const puma560_real a[3], const puma560_real b[3])
-{
-    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-}
-
-static inline void puma560_cross(const puma560_real a[3], const puma560_real b[3], puma560_real out[3])
-{
-    const puma560_real x = a[1] * b[2] - a[2] * b[1];
-    const puma560_real y = a[2] * b[0] - a[0] * b[2];
-    const puma560_real z = a[0] * b[1] - a[1] * b[0];
-    out[0] = x;
-    out[1] = y;
-    out[2] = z;
-}
-
-static inline void puma560_add(const puma560_real a[3], const puma560_real b[3], puma560_real out[3])
-{
-    out[0] = a[0] + b[0];
-    out[1] = a[1] + b[1];
-    out[2] = a[2] + b[2];
-}
-
-static inline void puma560_sub(const puma560_real a[3], const puma560_real b[3], puma560_real out[3])
-{
-    out[0] = a[0] - b[0];
-    out[1] = a[1] - b[1];
-    out[2] = a[2] - b[2];
-}
-
-/* v turned about the unit axis k by the angle whose cosine and sine are c and s (Rodrigues). */
-static inline void puma560_rot(const puma560_real k[3], puma560_real c, puma560_real s, const puma560_real v[3], puma560_real out[3])
-{
-    puma560_real kxv[3];
-    const puma560_real kv = puma560_dot(k, v) * (1.0 - c);
-    puma560_cross(k, v, kxv);
-    out[0] = v[0] * c + kxv[0] * s + k[0] * kv;
-    out[1] = v[1] * c + kxv[1] * s + k[1] * kv;
-    out[2] = v[2] * c + kxv[2] * s + k[2] * kv;
-}
-
-/* atan2(y, x) in (-pi, pi] (0 at the origin), about twice as fast as the C library's: the
- * argument is reduced to t in [-tan(pi/8), tan(pi/8)] with one division and atan(t) =
- * t + t z P(z) / Q(z), z = t^2, by Cephes' minimax approximation (S. L. Moshier); error
- * within 2 ulp. */
-static inline puma560_real puma560_atan2(puma560_real y, puma560_real x)
-{
-    const puma560_real ax = fabs(x);
-    const puma560_real ay = fabs(y);
-    const puma560_real low = ax < ay ? ax : ay;
-    const puma560_real high = ax < ay ? ay : ax;
-    puma560_real t, base, r;
-    if (!(high > 0.0)) {
-        return 0.0;
-    }
-    if (low <= 0.41421356237309503 * high) {
-        t = low / high;
-        base = 0.0;
-    } else {
-        t = (low - high) / (low + high);
-        base = 0.7853981633974483;
-    }
-    {
-        const puma560_real z = t * t;
-        const puma560_real z2 = z * z;
-        const puma560_real z4 = z2 * z2;
-        r = base + (t + t * z * ((-64.85021904942025 - 122.88666844901361 * z) + z2 * (-75.00855792314705 - 16.157537187333652 * z) + z4 * (-0.8750608600031904)) / ((194.5506571482614 + 485.3903996359137 * z) + z2 * (432.88106049129027 + 165.02700983169885 * z) + z4 * (24.858464901423062 + z)));
-    }
-    if (ay > ax) {
-        r = 1.5707963267948966 - r;
-    }
-    if (x < 0.0) {
-        r = 3.141592653589793 - r;
-    }
-    return y < 0.0 ? -r : r;
-}
-
-static inline puma560_angle puma560_angle_of(puma560_real c, puma560_real s)
-{
-    puma560_angle angle;
-    angle.theta = puma560_atan2(s, c);
-    angle.c = c;
-    angle.s = s;
-    return angle;
-}
-
-/* SP1: the angle turning p into q about the unit axis k (least squares when they differ in
- * length or height along k); 0 when p or q lies on the axis (any angle would do). */
-static inline puma560_angle puma560_sp1(const puma560_real p[3], const puma560_real q[3], const puma560_real k[3])
-{
-    puma560_real pxq[3];
-    puma560_cross(p, q, pxq);
-    {
-        const puma560_real x = puma560_dot(p, q) - puma560_dot(k, p) * puma560_dot(k, q);
-        const puma560_real y = puma560_dot(k, pxq);
-        const puma560_real rr = x * x + y * y;
-        if (rr <= 1e-24 * puma560_dot(p, p) * puma560_dot(q, q)) {
-            return puma560_angle_of(1.0, 0.0);
-        }
-        {
-            const puma560_real scale = 1.0 / sqrt(rr);
-            puma560_angle angle;
-            angle.theta = puma560_atan2(y, x);
-            angle.c = x * scale;
-            angle.s = y * scale;
-            return angle;
-        }
-    }
-}
-
-/* SP4: the angles t with h . rot(k, t) p = d, out = {phi + alpha, phi - alpha}; returns
- * their count. h . rot(k, t) p = A cos t + B sin t + C. One angle for a double root
- * (sin(alpha)^2 within EPS of 0), none out of range; when the left side does not depend
- * on t, the angle 0 if it equals d. */
-static inline int puma560_sp4(const puma560_real h[3], const puma560_real p[3], const puma560_real k[3], puma560_real d, puma560_angle out[2])
-{
-    puma560_real kxp[3];
-    const puma560_real hk = puma560_dot(h, k);
-    const puma560_real kp = puma560_dot(k, p);
-    puma560_cross(k, p, kxp);
-    {
-        const puma560_real a = puma560_dot(h, p) - hk * kp;
-        const puma560_real b = puma560_dot(h, kxp);
-        const puma560_real rhs = d - hk * kp;
-        const puma560_real r2 = a * a + b * b;
-        const puma560_real scale = puma560_dot(h, h) * puma560_dot(p, p);
-        puma560_real r, cos_phi, sin_phi, cos_alpha, disc, sin_alpha;
-        if (r2 <= 1e-24 * scale) {
-            if (rhs * rhs > 1e-12 * scale) {
-                return 0;
-            }
-            out[0] = puma560_angle_of(1.0, 0.0);
-            return 1;
-        }
-        r = sqrt(r2);
-        cos_phi = a / r;
-        sin_phi = b / r;
-        cos_alpha = rhs / r;
-        disc = 1.0 - cos_alpha * cos_alpha;
-        if (disc < -1e-12) {
-            return 0;
-        }
-        if (disc <= 1e-12) {
-            const puma560_real sign = cos_alpha > 0.0 ? 1.0 : -1.0;
-            out[0] = puma560_angle_of(sign * cos_phi, sign * sin_phi);
-            return 1;
-        }
-        sin_alpha = sqrt(disc);
-        {
-            /* phi is a constant when h, p and k are (the compiler folds it) */
-            const puma560_real phi = puma560_atan2(b, a);
-            const puma560_real alpha = puma560_atan2(sin_alpha, cos_alpha);
-            out[0].theta = phi + alpha;
-            out[0].c = cos_phi * cos_alpha - sin_phi * sin_alpha;
-            out[0].s = sin_phi * cos_alpha + cos_phi * sin_alpha;
-            out[1].theta = phi - alpha;
-            out[1].c = cos_phi * cos_alpha + sin_phi * sin_alpha;
-            out[1].s = sin_phi * cos_alpha - cos_phi * sin_alpha;
-        }
-        return 2;
-    }
-}
-
-/* SP3: the angles t with |rot(k, t) p - q|^2 = dd (p, q relative to a point of the axis). */
-static inline int puma560_sp3(const puma560_real p[3], const puma560_real q[3], const puma560_real k[3], puma560_real dd, puma560_angle out[2])
-{
-    return puma560_sp4(q, p, k, 0.5 * (puma560_dot(p, p) + puma560_dot(q, q) - dd), out);
-}
-
-/* SP2: the angle pairs out[i] = (t1, t2) with rot(k1, t1) rot(k2, t2) p = q, for two axes
- * through one point (p, q relative to it); returns their count, computes at most `wanted` of
- * them. rot(k2, t2) p = rot(k1, -t1) q = c, c = alpha k1 + beta k2 +- gamma k1 x k2; one pair
- * when gamma^2 is within EPS of 0, none below. */
-static inline int puma560_sp2(const puma560_real p[3], const puma560_real q[3], const puma560_real k1[3], const puma560_real k2[3],
-        int wanted, puma560_angle out[2][2])
-{
-    const puma560_real k12 = puma560_dot(k1, k2);
-    const puma560_real nn = 1.0 - k12 * k12;
-    const puma560_real u = puma560_dot(k1, q);
-    const puma560_real v = puma560_dot(k2, p);
-    const puma560_real alpha = (u - k12 * v) / nn;
-    const puma560_real beta = (v - k12 * u) / nn;
-    const puma560_real pp = puma560_dot(p, p);
-    const puma560_real gg = (pp - alpha * alpha - beta * beta - 2.0 * alpha * beta * k12) / nn;
-    puma560_real normal[3], c[3], g;
-    int count, i;
-    if (gg < -1e-12 * pp) {
-        return 0;
-    }
-    count = gg <= 1e-12 * pp ? 1 : 2;
-    g = count == 1 ? 0.0 : sqrt(gg);
-    puma560_cross(k1, k2, normal);
-    for (i = 0; i < count && i < wanted; ++i) {
-        c[0] = alpha * k1[0] + beta * k2[0] + g * normal[0];
-        c[1] = alpha * k1[1] + beta * k2[1] + g * normal[1];
-        c[2] = alpha * k1[2] + beta * k2[2] + g * normal[2];
-        out[i][0] = puma560_sp1(c, q, k1);
-        out[i][1] = puma560_sp1(p, c, k2);
-        g = -g;
-    }
-    return count;
-}
-
-/* T T(0)^-1 = exp(xi_1 q_1) ... exp(xi_n q_n) as (R, t), T(0) = (rotation, position) the
- * tool pose at q = 0. */
-static inline void puma560_relative(const puma560_real T[16], const puma560_real rotation[9], const puma560_real position[3],
-        puma560_real R[9], puma560_real t[3])
-{
-    int i, j;
-    for (i = 0; i < 3; ++i) {
-        for (j = 0; j < 3; ++j) {
-            R[3 * i + j] = T[4 * i] * rotation[3 * j] + T[4 * i + 1] * rotation[3 * j + 1]
-                           + T[4 * i + 2] * rotation[3 * j + 2];
-        }
-        t[i] = T[4 * i + 3] - puma560_dot(&R[3 * i], position);
-    }
-}
-
-static inline void puma560_mul(const puma560_real R[9], const puma560_real v[3], puma560_real out[3])
-{
-    const puma560_real x = puma560_dot(&R[0], v);
-    const puma560_real y = puma560_dot(&R[3], v);
-    const puma560_real z = puma560_dot(&R[6], v);
-    out[0] = x;
-    out[1] = y;
-    out[2] = z;
-}
-
-/* Spherical wrist with axis 5 perpendicular to axes 4 and 6: the angles out[i] = (q4, q5, q6)
- * with R4 R5 R6 h6 = a and R4 R5 R6 v6 = b (v6 perpendicular to h6); returns their count. The
- * first by SP2 and SP1; the second is (q4 + pi, wrist_flip - q5, q6 + pi): rot(h4, pi) reflects
- * the plane perpendicular to h5 across h4, and wrist_flip = -2 angle(h4 -> h6 about h5). */
-static inline int puma560_wrist(const puma560_real a[3], const puma560_real b[3], const puma560_ik_geometry *g, puma560_real out[2][3])
-{
-    puma560_angle pairs[2][2];
-    puma560_real x[3];
-    const int count = puma560_sp2(g->h6, a, g->h4, g->h5, 1, pairs);
-    if (count == 0) {
-        return 0;
-    }
-    puma560_rot(g->h4, pairs[0][0].c, -pairs[0][0].s, b, x);
-    puma560_rot(g->h5, pairs[0][1].c, -pairs[0][1].s, x, x);
-    out[0][0] = pairs[0][0].theta;
-    out[0][1] = pairs[0][1].theta;
-    out[0][2] = puma560_sp1(g->v6, x, g->h6).theta;
-    out[1][0] = out[0][0] + 3.141592653589793;
-    out[1][1] = g->wrist_flip - out[0][1];
-    out[1][2] = out[0][2] + 3.141592653589793;
-    return count;
-}
-
-/* Spherical wrist, axes 2 and 3 parallel: the wrist centre fixes q1 (SP4: its height along
- * axis 2 is constant), q3 (SP3) and q2 (SP1); the orientation left to the wrist gives q4,
- * q5, q6. */
-static int puma560_ik_solve(const puma560_real T[16], const puma560_ik_geometry *g, puma560_real q[])
-{
-    puma560_real rotation[9], position[3], wc[3], a[3], b[3], d1[3], c3[3], b3[3];
-    puma560_angle t1[2];
-    int count = 0, n1, i, j, k;
-    puma560_relative(T, g->tool_rotation, g->tool_position, rotation, position);
-    puma560_mul(rotation, g->centre, wc);
-    puma560_add(wc, position, wc);
-    puma560_mul(rotation, g->h6, a);
-    puma560_mul(rotation, g->v6, b);
-    puma560_sub(wc, g->p1, d1);
-    puma560_sub(g->centre, g->p3, c3);
-    puma560_sub(g->p2, g->p3, b3);
-    n1 = puma560_sp4(d1, g->h2, g->h1, g->reach, t1);
-    for (i = 0; i < n1; ++i) {
-        puma560_real d[3];
-        puma560_angle t3[2];
-        int n3;
-        puma560_rot(g->h1, t1[i].c, -t1[i].s, d1, d);
-        puma560_add(d, g->p1, d);
-        puma560_sub(d, g->p2, d);
-        n3 = puma560_sp3(c3, b3, g->h3, puma560_dot(d, d), t3);
-        for (j = 0; j < n3; ++j) {
-            puma560_real e[3], aw[3], bw[3], c23, s23;
-            puma560_angle t2;
-            puma560_real wrist[2][3];
-            int n_wrist;
-            puma560_rot(g->h3, t3[j].c, t3[j].s, c3, e);
-            puma560_add(e, g->p3, e);
-            puma560_sub(e, g->p2, e);
-            t2 = puma560_sp1(e, d, g->h2);
-            /* R2 R3 = rot(h2, q2 + sign3 q3), h3 = sign3 h2: one turn back for both */
-            c23 = t2.c * t3[j].c - g->sign3 * t2.s * t3[j].s;
-            s23 = t2.s * t3[j].c + g->sign3 * t2.c * t3[j].s;
-            puma560_rot(g->h1, t1[i].c, -t1[i].s, a, aw);
-            puma560_rot(g->h2, c23, -s23, aw, aw);
-            puma560_rot(g->h1, t1[i].c, -t1[i].s, b, bw);
-            puma560_rot(g->h2, c23, -s23, bw, bw);
-            n_wrist = puma560_wrist(aw, bw, g, wrist);
-            for (k = 0; k < n_wrist; ++k) {
-                puma560_real *out = q + PUMA560_DOF * count++;
-                out[0] = t1[i].theta;
-                out[1] = t2.theta;
-                out[2] = t3[j].theta;
-                out[3] = wrist[k][0];
-                out[4] = wrist[k][1];
-                out[5] = wrist[k][2];
-            }
-        }
-    }
-    return count;
-}
-
 int puma560_ik(const puma560_real T[16], puma560_real q[PUMA560_MAX_IK_SOLUTIONS * PUMA560_DOF])
 {
-    const puma560_ik_geometry g = {
-        .tool_rotation = {1, 0, 0, 0, 1, 0, 0, 0, 1},
-        .tool_position = {0.4521, -0.15005, 1.10363},
-        .h1 = {0, 0, 1},
-        .p1 = {0, 0, 0},
-        .h2 = {0, -1, 0},
-        .p2 = {0, 0, 0.67183},
-        .h3 = {0, -1, 0},
-        .p3 = {0.4318, 0, 0.67183},
-        .reach = 0.15005,
-        .sign3 = 1,
-        .h4 = {0, 0, 1},
-        .h5 = {0, -1, 0},
-        .h6 = {0, 0, 1},
-        .v6 = {1, 0, 0},
-        .centre = {0.4521, -0.15005, 1.10363},
-        .wrist_flip = 0,
-    };
-    int count, k;
-    for (k = 0; k < 12; ++k) {
-        if (!isfinite(T[k])) {
-            return 0;
+    puma560_real branches[PUMA560_MAX_IK_SOLUTIONS * PUMA560_DOF];
+    int valid[PUMA560_MAX_IK_SOLUTIONS];
+    int count = 0, i, j;
+    puma560_ik_branches(T, branches, valid);
+    for (i = 0; i < PUMA560_MAX_IK_SOLUTIONS; ++i) {
+        if (valid[i]) {
+            for (j = 0; j < PUMA560_DOF; ++j) {
+                q[PUMA560_DOF * count + j] = branches[PUMA560_DOF * i + j];
+            }
+            ++count;
         }
-    }
-    count = puma560_ik_solve(T, &g, q);
-    for (k = 0; k < count; ++k) {
-        q[PUMA560_DOF * k + 0] = puma560_wrap(q[PUMA560_DOF * k + 0]);
-        q[PUMA560_DOF * k + 1] = puma560_wrap(q[PUMA560_DOF * k + 1]);
-        q[PUMA560_DOF * k + 2] = puma560_wrap(q[PUMA560_DOF * k + 2]);
-        q[PUMA560_DOF * k + 3] = puma560_wrap(q[PUMA560_DOF * k + 3]);
-        q[PUMA560_DOF * k + 4] = puma560_wrap(q[PUMA560_DOF * k + 4]);
-        q[PUMA560_DOF * k + 5] = puma560_wrap(q[PUMA560_DOF * k + 5]);
     }
     return count;
 }

@@ -32,6 +32,7 @@ typedef double puma560_real;
 #define PUMA560_DOF 6
 #define PUMA560_TASK_DIM 6
 #define PUMA560_NUM_SINGULARITY_FACTORS 3
+#define PUMA560_MAX_IK_SOLUTIONS 8
 
 /* Pose of the tool frame in the world frame (4x4 homogeneous).
  * Result: T: 4 x 4 row-major, element (r, c) at T[r * 4 + c]. 96 operations. */
@@ -69,6 +70,10 @@ puma560_real puma560_manipulability(const puma560_real q[PUMA560_DOF]);
  * Result: returned as a scalar. 20 operations. */
 puma560_real puma560_jacobian_det(const puma560_real q[PUMA560_DOF]);
 
+/* Every branch of the closed-form ik and whether the target allows it.
+ * Result: q: 8 x 6 row-major, element (r, c) at q[r * 6 + c]; valid[i], i < 8. 900 operations. */
+void puma560_ik_branches(const puma560_real T[16], puma560_real q[PUMA560_MAX_IK_SOLUTIONS * PUMA560_DOF], int valid[PUMA560_MAX_IK_SOLUTIONS]);
+
 /* Status of puma560_velocity_ik. */
 #define PUMA560_VELOCITY_IK_OK 0
 #define PUMA560_VELOCITY_IK_SINGULAR 1   /* a pivot below 1e-12 x the largest |entry|: take damping > 0 */
@@ -82,11 +87,9 @@ puma560_real puma560_jacobian_det(const puma560_real q[PUMA560_DOF]);
  * PUMA560_VELOCITY_IK_OK, or a status above with q_dot all 0. */
 int puma560_velocity_ik(const puma560_real q[PUMA560_DOF], const puma560_real mu_dot[PUMA560_TASK_DIM], puma560_real damping, puma560_real q_dot[PUMA560_DOF]);
 
-#define PUMA560_MAX_IK_SOLUTIONS 8
-
 /* Closed-form inverse kinematics: every joint solution that reaches the target; returns
- * their count k and writes solution i to q[i * PUMA560_DOF + j], i < k. Loops over
- * the branches, no allocation, no recursion.
+ * their count k and writes solution i to q[i * PUMA560_DOF + j], i < k: the valid
+ * rows of puma560_ik_branches, in its order. No allocation, no recursion.
  * target: the 4x4 tool pose in the world frame (rotation part orthonormal).
  * Result: k <= PUMA560_MAX_IK_SOLUTIONS solutions, revolute angles wrapped into (-pi, pi],
  * joint limits not applied; k = 0 when the target is out of reach or not finite.

@@ -16,16 +16,18 @@ DOF = 6
 TASK = ("x", "y", "z", "roll", "pitch", "yaw", )
 
 
-def _joints(q):
-    q = numpy.asarray(q, dtype=float)
-    if q.ndim == 0 or q.shape[-1] != DOF:
-        raise ValueError(f"q must have shape ({DOF},) or (..., {DOF}), got {q.shape}")
-    return q
+def _argument(name, value, shape):
+    """`value` as a float array of `shape` or a batch of them (..., *shape)."""
+    value = numpy.asarray(value, dtype=float)
+    if value.shape[value.ndim - len(shape):] != shape:
+        batch = ", ".join(map(str, shape))
+        raise ValueError(f"{name} must have shape {shape} or (..., {batch}), got {value.shape}")
+    return value
 
 
 def fk(q):
     """pose of the tool frame in the world frame (4x4 homogeneous): (4 x 4), 96 operations."""
-    q = _joints(q)
+    q = _argument("q", q, (6,))
     q1 = q[..., 0]
     q2 = q[..., 1]
     q3 = q[..., 2]
@@ -103,7 +105,7 @@ def fk(q):
 
 def jacobian(q):
     """geometric Jacobian in the world frame (6 x DOF, rows vx vy vz wx wy wz): (6 x 6), 83 operations."""
-    q = _joints(q)
+    q = _argument("q", q, (6,))
     q1 = q[..., 0]
     q2 = q[..., 1]
     q3 = q[..., 2]
@@ -187,7 +189,7 @@ def jacobian(q):
 
 def fk_jacobian(q):
     """fk and jacobian in one pass, sharing their terms: (4 x 4 and 6 x 6), 115 operations."""
-    q = _joints(q)
+    q = _argument("q", q, (6,))
     q1 = q[..., 0]
     q2 = q[..., 1]
     q3 = q[..., 2]
@@ -305,7 +307,7 @@ def fk_jacobian(q):
 
 def jacobian_tool(q):
     """geometric Jacobian in the tool frame (6 x DOF, rows vx vy vz wx wy wz): (6 x 6), 201 operations."""
-    q = _joints(q)
+    q = _argument("q", q, (6,))
     q1 = q[..., 0]
     q2 = q[..., 1]
     q3 = q[..., 2]
@@ -412,7 +414,7 @@ def jacobian_tool(q):
 
 def task(q):
     """task vector mu = (x, y, z, roll, pitch, yaw): (6 x 1), 90 operations."""
-    q = _joints(q)
+    q = _argument("q", q, (6,))
     q1 = q[..., 0]
     q2 = q[..., 1]
     q3 = q[..., 2]
@@ -475,7 +477,7 @@ def task(q):
 
 def task_jacobian(q):
     """analytic Jacobian d mu / d q (6 x DOF): (6 x 6), 148 operations."""
-    q = _joints(q)
+    q = _argument("q", q, (6,))
     q1 = q[..., 0]
     q2 = q[..., 1]
     q3 = q[..., 2]
@@ -582,7 +584,7 @@ def task_jacobian(q):
 
 def singularity_factors(q):
     """factors of det(Js): the robot is singular where one is 0: (3 x 1), 16 operations."""
-    q = _joints(q)
+    q = _argument("q", q, (6,))
     q2 = q[..., 1]
     q3 = q[..., 2]
     q5 = q[..., 4]
@@ -601,7 +603,7 @@ def singularity_factors(q):
 
 def manipulability(q):
     """manipulability |det(Js)|: (1 x 1), 21 operations."""
-    q = _joints(q)
+    q = _argument("q", q, (6,))
     q2 = q[..., 1]
     q3 = q[..., 2]
     q5 = q[..., 4]
@@ -619,7 +621,7 @@ def manipulability(q):
 
 def jacobian_det(q):
     """det(Js): (1 x 1), 20 operations."""
-    q = _joints(q)
+    q = _argument("q", q, (6,))
     q2 = q[..., 1]
     q3 = q[..., 2]
     q5 = q[..., 4]
@@ -634,176 +636,480 @@ def jacobian_det(q):
     return d
 
 
-def _wrap(angle):
-    """Angles wrapped into (-pi, pi]."""
-    return angle - 2.0 * math.pi * numpy.ceil((angle - math.pi) / (2.0 * math.pi))
+@numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
+def ik_branches(T):
+    """every branch of the closed-form ik and whether the target allows it: (8 x 6 and 8 x 1), 900 operations."""
+    T = _argument("T", T, (4, 4))
+    T00 = T[..., 0, 0]
+    T01 = T[..., 0, 1]
+    T02 = T[..., 0, 2]
+    T03 = T[..., 0, 3]
+    T10 = T[..., 1, 0]
+    T11 = T[..., 1, 1]
+    T12 = T[..., 1, 2]
+    T13 = T[..., 1, 3]
+    T20 = T[..., 2, 0]
+    T21 = T[..., 2, 1]
+    T22 = T[..., 2, 2]
+    T23 = T[..., 2, 3]
+    t0 = 5.357415379007653
+    t1 = 1.6177742431429796
+    t2 = T00 + T01 + T02 + T03 + T10 + T11 + T12 + T13 + T20 + T21 + T22 + T23
+    t3 = 0.4521*T00 - 0.15005*T01 + 1.10363*T02
+    t4 = T03 - t3
+    t5 = t3
+    t6 = t4 + t5
+    t7 = 0.4521*T10 - 0.15005*T11 + 1.10363*T12
+    t8 = T13 - t7
+    t9 = t7
+    t10 = t8 + t9
+    t11 = numpy.arctan2(t6, -t10)
+    t12 = 0.4521*T20 - 0.15005*T21 + 1.10363*T22
+    t13 = T23 - t12
+    t14 = t12
+    t15 = t13 + t14
+    t16 = t10**2 + t6**2
+    t17 = t16
+    t18 = t15**2 + t16
+    t19 = 1/numpy.sqrt(t17)
+    t20 = 1 - 0.0225150025*t19**2
+    t21 = numpy.less(1e-12, t20)
+    t22 = numpy.where(t21, 0.15005*t19, numpy.where(numpy.greater(t19, 0), 1, -1))
+    t23 = numpy.where(t21, numpy.sqrt(t20), 0)
+    t24 = numpy.arctan2(t23, t22)
+    t25 = t11 - t24
+    t26 = 1e-24*t18
+    t27 = numpy.less_equal(t17, t26)
+    t28 = numpy.where(t27, 0, t11 + t24)
+    t29 = t19*t6
+    t30 = t23*t29
+    t31 = t10*t19
+    t32 = t22*t31
+    t33 = numpy.where(t27, 1, -t30 - t32)
+    t34 = t30 - t32
+    t35 = t22*t29
+    t36 = t23*t31
+    t37 = numpy.where(t27, 0, t35 - t36)
+    t38 = t35 + t36
+    t39 = t10*t37 + t33*t6
+    t40 = t10*t33 - t37*t6
+    t41 = T02*t33 + T12*t37
+    t42 = -T02*t37 + T12*t33
+    t43 = T00*t33 + T10*t37
+    t44 = -T00*t37 + T10*t33
+    t45 = t10*t38 + t34*t6
+    t46 = t10*t34 - t38*t6
+    t47 = T02*t34 + T12*t38
+    t48 = -T02*t38 + T12*t34
+    t49 = T00*t34 + T10*t38
+    t50 = -T00*t38 + T10*t34
+    t51 = 1 - t33
+    t52 = t15*t51
+    t53 = t15*t33 + t52
+    t54 = t53 - 0.67183
+    t55 = t39**2 + t40**2 + t54**2
+    t56 = 0.19791478625 - 0.5*t55
+    t57 = T22*t51
+    t58 = T22*t33 + t57
+    t59 = T20*t51
+    t60 = T20*t33 + t59
+    t61 = t56**2
+    t62 = t0**2
+    t63 = -t61*t62 + 1
+    t64 = t0*t56
+    t65 = numpy.less(1e-12, t63)
+    t66 = numpy.where(t65, t64, numpy.where(numpy.greater(t64, 0), 1, -1))
+    t67 = numpy.where(t65, numpy.sqrt(t63), 0)
+    t68 = numpy.arctan2(t67, t66)
+    t69 = t1 - t68
+    t70 = False
+    t71 = numpy.where(t70, 0, t1 + t68)
+    t72 = t0*t66
+    t73 = 0.00876554*t72
+    t74 = t0*t67
+    t75 = 0.18645124*t74
+    t76 = numpy.where(t70, 1, -t73 - t75)
+    t77 = -t73 + t75
+    t78 = 0.15005 - 0.15005*t76
+    t79 = 0.15005*t76 + t78
+    t80 = 0.15005 - 0.15005*t77
+    t81 = 0.15005*t77 + t80
+    t82 = 0.18645124*t72
+    t83 = 0.00876554*t74
+    t84 = numpy.where(t70, 0, t82 - t83)
+    t85 = t82 + t83
+    t86 = 0.0203*t76 - 0.4318*t84
+    t87 = 0.4318*t76 + 0.0203*t84
+    t88 = t86 + 0.4318
+    t89 = t87 + 0.67183
+    t90 = t89 - 0.67183
+    t91 = t39*t90 - t54*t88
+    t92 = t79**2 + t88**2 + t90**2
+    t93 = 0.0203*t77 - 0.4318*t85
+    t94 = 0.4318*t77 + 0.0203*t85
+    t95 = t93 + 0.4318
+    t96 = t94 + 0.67183
+    t97 = t96 - 0.67183
+    t98 = t39*t97 - t54*t95
+    t99 = t81**2 + t95**2 + t97**2
+    t100 = t40*t79
+    t101 = -t100 + t39*t88 + t54*t90
+    t102 = t100 + t101
+    t103 = t102**2 + t91**2
+    t104 = 1/numpy.sqrt(t103)
+    t105 = 1e-24*t55
+    t106 = numpy.less_equal(t103, t105*t92)
+    t107 = numpy.where(t106, 1, t102*t104)
+    t108 = numpy.where(t106, 0, -t104*t91)
+    t109 = t107*t76 - t108*t84
+    t110 = t107*t84 + t108*t76
+    t111 = t109*t41 + t110*t58
+    t112 = t109*t58 - t110*t41
+    t113 = t109*t43 + t110*t60
+    t114 = t109*t60 - t110*t43
+    t115 = 1 - t109
+    t116 = t115*t42
+    t117 = t109*t42 + t116
+    t118 = t115*t44
+    t119 = t109*t44 + t118
+    t120 = t112**2
+    t121 = -t120
+    t122 = t121 + 1
+    t123 = numpy.where(numpy.greater(t122, 1e-12), numpy.sqrt(t122), 0)
+    t124 = t111*t123 + t120
+    t125 = t121 + t124
+    t126 = t117**2
+    t127 = t111**2 + t120 + t126
+    t128 = t123**2
+    t129 = t125**2 + t126*t128
+    t130 = t120 + t128
+    t131 = 1/numpy.sqrt(t129)
+    t132 = 1/numpy.sqrt(t130)
+    t133 = 1e-24*t130
+    t134 = numpy.less_equal(t129, t127*t133)
+    t135 = numpy.where(t134, 1, t125*t131)
+    t136 = t114*(1 - t135)
+    t137 = t114*t135 + t136
+    t138 = t117*t123
+    t139 = numpy.where(t134, 0, t131*t138)
+    t140 = t113*t135 + t119*t139
+    t141 = -t113*t139 + t119*t135
+    t142 = numpy.less_equal(t130, t133)
+    t143 = numpy.where(t142, 1, t112*t132)
+    t144 = numpy.where(t142, 0, -t123*t132)
+    t145 = t141*(1 - t143)
+    t146 = t137*t144 + t140*t143
+    t147 = t141*t143 + t145
+    t148 = t137*t143 - t140*t144
+    t149 = t146**2 + t147**2
+    t150 = t149
+    t151 = t148**2 + t149
+    t152 = t40*t81
+    t153 = -t152 + t39*t95 + t54*t97
+    t154 = t152 + t153
+    t155 = t154**2 + t98**2
+    t156 = 1/numpy.sqrt(t155)
+    t157 = numpy.less_equal(t155, t105*t99)
+    t158 = numpy.where(t157, 1, t154*t156)
+    t159 = numpy.where(t157, 0, -t156*t98)
+    t160 = t158*t77 - t159*t85
+    t161 = t158*t85 + t159*t77
+    t162 = t160*t41 + t161*t58
+    t163 = t160*t58 - t161*t41
+    t164 = t160*t43 + t161*t60
+    t165 = t160*t60 - t161*t43
+    t166 = 1 - t160
+    t167 = t166*t42
+    t168 = t160*t42 + t167
+    t169 = t166*t44
+    t170 = t160*t44 + t169
+    t171 = t163**2
+    t172 = -t171
+    t173 = t172 + 1
+    t174 = numpy.where(numpy.greater(t173, 1e-12), numpy.sqrt(t173), 0)
+    t175 = t162*t174 + t171
+    t176 = t172 + t175
+    t177 = t168**2
+    t178 = t162**2 + t171 + t177
+    t179 = t174**2
+    t180 = t176**2 + t177*t179
+    t181 = t171 + t179
+    t182 = 1/numpy.sqrt(t180)
+    t183 = 1/numpy.sqrt(t181)
+    t184 = 1e-24*t181
+    t185 = numpy.less_equal(t180, t178*t184)
+    t186 = numpy.where(t185, 1, t176*t182)
+    t187 = t165*(1 - t186)
+    t188 = t165*t186 + t187
+    t189 = t168*t174
+    t190 = numpy.where(t185, 0, t182*t189)
+    t191 = t164*t186 + t170*t190
+    t192 = -t164*t190 + t170*t186
+    t193 = numpy.less_equal(t181, t184)
+    t194 = numpy.where(t193, 1, t163*t183)
+    t195 = numpy.where(t193, 0, -t174*t183)
+    t196 = t192*(1 - t194)
+    t197 = t188*t195 + t191*t194
+    t198 = t192*t194 + t196
+    t199 = t188*t194 - t191*t195
+    t200 = t197**2 + t198**2
+    t201 = t200
+    t202 = t199**2 + t200
+    t203 = 1 - t34
+    t204 = t15*t203
+    t205 = t15*t34 + t204
+    t206 = t205 - 0.67183
+    t207 = t206**2 + t45**2 + t46**2
+    t208 = 0.19791478625 - 0.5*t207
+    t209 = T22*t203
+    t210 = T22*t34 + t209
+    t211 = T20*t203
+    t212 = T20*t34 + t211
+    t213 = t208**2
+    t214 = -t213*t62 + 1
+    t215 = t0*t208
+    t216 = numpy.less(1e-12, t214)
+    t217 = numpy.where(t216, t215, numpy.where(numpy.greater(t215, 0), 1, -1))
+    t218 = numpy.where(t216, numpy.sqrt(t214), 0)
+    t219 = numpy.arctan2(t218, t217)
+    t220 = numpy.where(t70, 0, t1 + t219)
+    t221 = t1 - t219
+    t222 = t0*t217
+    t223 = 0.00876554*t222
+    t224 = t0*t218
+    t225 = 0.18645124*t224
+    t226 = numpy.where(t70, 1, -t223 - t225)
+    t227 = -t223 + t225
+    t228 = 0.15005 - 0.15005*t226
+    t229 = 0.15005*t226 + t228
+    t230 = 0.15005 - 0.15005*t227
+    t231 = 0.15005*t227 + t230
+    t232 = 0.18645124*t222
+    t233 = 0.00876554*t224
+    t234 = numpy.where(t70, 0, t232 - t233)
+    t235 = t232 + t233
+    t236 = 0.0203*t226 - 0.4318*t234
+    t237 = 0.4318*t226 + 0.0203*t234
+    t238 = t236 + 0.4318
+    t239 = t237 + 0.67183
+    t240 = t239 - 0.67183
+    t241 = -t206*t238 + t240*t45
+    t242 = t229**2 + t238**2 + t240**2
+    t243 = 0.0203*t227 - 0.4318*t235
+    t244 = 0.4318*t227 + 0.0203*t235
+    t245 = t243 + 0.4318
+    t246 = t244 + 0.67183
+    t247 = t246 - 0.67183
+    t248 = -t206*t245 + t247*t45
+    t249 = t231**2 + t245**2 + t247**2
+    t250 = t229*t46
+    t251 = t206*t240 + t238*t45 - t250
+    t252 = t250 + t251
+    t253 = t241**2 + t252**2
+    t254 = 1/numpy.sqrt(t253)
+    t255 = 1e-24*t207
+    t256 = numpy.less_equal(t253, t242*t255)
+    t257 = numpy.where(t256, 1, t252*t254)
+    t258 = numpy.where(t256, 0, -t241*t254)
+    t259 = t226*t257 - t234*t258
+    t260 = t226*t258 + t234*t257
+    t261 = t210*t260 + t259*t47
+    t262 = t210*t259 - t260*t47
+    t263 = t212*t260 + t259*t49
+    t264 = t212*t259 - t260*t49
+    t265 = 1 - t259
+    t266 = t265*t48
+    t267 = t259*t48 + t266
+    t268 = t265*t50
+    t269 = t259*t50 + t268
+    t270 = t262**2
+    t271 = -t270
+    t272 = t271 + 1
+    t273 = numpy.where(numpy.greater(t272, 1e-12), numpy.sqrt(t272), 0)
+    t274 = t261*t273 + t270
+    t275 = t271 + t274
+    t276 = t267**2
+    t277 = t261**2 + t270 + t276
+    t278 = t273**2
+    t279 = t275**2 + t276*t278
+    t280 = t270 + t278
+    t281 = 1/numpy.sqrt(t279)
+    t282 = 1/numpy.sqrt(t280)
+    t283 = 1e-24*t280
+    t284 = numpy.less_equal(t279, t277*t283)
+    t285 = numpy.where(t284, 1, t275*t281)
+    t286 = t264*(1 - t285)
+    t287 = t264*t285 + t286
+    t288 = t267*t273
+    t289 = numpy.where(t284, 0, t281*t288)
+    t290 = t263*t285 + t269*t289
+    t291 = -t263*t289 + t269*t285
+    t292 = numpy.less_equal(t280, t283)
+    t293 = numpy.where(t292, 1, t262*t282)
+    t294 = numpy.where(t292, 0, -t273*t282)
+    t295 = t291*(1 - t293)
+    t296 = t287*t294 + t290*t293
+    t297 = t291*t293 + t295
+    t298 = t287*t293 - t290*t294
+    t299 = t296**2 + t297**2
+    t300 = t299
+    t301 = t298**2 + t299
+    t302 = t231*t46
+    t303 = t206*t247 + t245*t45 - t302
+    t304 = t302 + t303
+    t305 = t248**2 + t304**2
+    t306 = 1/numpy.sqrt(t305)
+    t307 = numpy.less_equal(t305, t249*t255)
+    t308 = numpy.where(t307, 1, t304*t306)
+    t309 = numpy.where(t307, 0, -t248*t306)
+    t310 = t227*t308 - t235*t309
+    t311 = t227*t309 + t235*t308
+    t312 = t210*t311 + t310*t47
+    t313 = t210*t310 - t311*t47
+    t314 = t212*t311 + t310*t49
+    t315 = t212*t310 - t311*t49
+    t316 = 1 - t310
+    t317 = t316*t48
+    t318 = t310*t48 + t317
+    t319 = t316*t50
+    t320 = t310*t50 + t319
+    t321 = t313**2
+    t322 = -t321
+    t323 = t322 + 1
+    t324 = numpy.where(numpy.greater(t323, 1e-12), numpy.sqrt(t323), 0)
+    t325 = t312*t324 + t321
+    t326 = t322 + t325
+    t327 = t318**2
+    t328 = t312**2 + t321 + t327
+    t329 = t324**2
+    t330 = t326**2 + t327*t329
+    t331 = t321 + t329
+    t332 = 1/numpy.sqrt(t330)
+    t333 = 1/numpy.sqrt(t331)
+    t334 = 1e-24*t331
+    t335 = numpy.less_equal(t330, t328*t334)
+    t336 = numpy.where(t335, 1, t326*t332)
+    t337 = t315*(1 - t336)
+    t338 = t315*t336 + t337
+    t339 = t318*t324
+    t340 = numpy.where(t335, 0, t332*t339)
+    t341 = t314*t336 + t320*t340
+    t342 = -t314*t340 + t320*t336
+    t343 = numpy.less_equal(t331, t334)
+    t344 = numpy.where(t343, 1, t313*t333)
+    t345 = numpy.where(t343, 0, -t324*t333)
+    t346 = t342*(1 - t344)
+    t347 = t338*t345 + t341*t344
+    t348 = t342*t344 + t346
+    t349 = t338*t344 - t341*t345
+    t350 = t347**2 + t348**2
+    t351 = t350
+    t352 = t349**2 + t350
+    t353 = t28 - 6.283185307179586*numpy.ceil(0.15915494309189535*t28 - 0.5)
+    t354 = numpy.where(t106, 0, numpy.arctan2(-t91, t102))
+    t355 = t71 - 6.283185307179586*numpy.ceil(0.15915494309189535*t71 - 0.5)
+    t356 = numpy.where(t134, 0, numpy.arctan2(t138, t125))
+    t357 = numpy.where(t142, 0, numpy.arctan2(-t123, t112))
+    t358 = numpy.where(numpy.less_equal(t150, 1e-24*t151), 0, numpy.arctan2(t147, t146))
+    t359 = numpy.where(t157, 0, numpy.arctan2(-t98, t154))
+    t360 = t69 - 6.283185307179586*numpy.ceil(0.15915494309189535*t69 - 0.5)
+    t361 = numpy.where(t185, 0, numpy.arctan2(t189, t176))
+    t362 = numpy.where(t193, 0, numpy.arctan2(-t174, t163))
+    t363 = numpy.where(numpy.less_equal(t201, 1e-24*t202), 0, numpy.arctan2(t198, t197))
+    t364 = t25 - 6.283185307179586*numpy.ceil(0.15915494309189535*t25 - 0.5)
+    t365 = numpy.where(t256, 0, numpy.arctan2(-t241, t252))
+    t366 = t220 - 6.283185307179586*numpy.ceil(0.15915494309189535*t220 - 0.5)
+    t367 = numpy.where(t284, 0, numpy.arctan2(t288, t275))
+    t368 = numpy.where(t292, 0, numpy.arctan2(-t273, t262))
+    t369 = numpy.where(numpy.less_equal(t300, 1e-24*t301), 0, numpy.arctan2(t297, t296))
+    t370 = numpy.where(t307, 0, numpy.arctan2(-t248, t304))
+    t371 = t221 - 6.283185307179586*numpy.ceil(0.15915494309189535*t221 - 0.5)
+    t372 = numpy.where(t335, 0, numpy.arctan2(t339, t326))
+    t373 = numpy.where(t343, 0, numpy.arctan2(-t324, t313))
+    t374 = numpy.where(numpy.less_equal(t351, 1e-24*t352), 0, numpy.arctan2(t348, t347))
+    t375 = numpy.isfinite(t2)
+    t376 = -1e-12
+    t377 = numpy.greater(t17, t26)
+    t378 = (t377 & (numpy.greater_equal(t20, t376))) | (t27 & (numpy.less_equal(0.0225150025, 1e-12*t18)))
+    t379 = 3.9038849723757295e-26
+    t380 = numpy.greater(0.0348408995890292, t379)
+    t381 = numpy.less_equal(0.0348408995890292, t379)
+    t382 = 3.9038849723757296e-14
+    t383 = (t380 & (numpy.greater_equal(t63, t376))) | (t381 & (numpy.less_equal(t61, t382)))
+    t384 = numpy.greater(t63, 1e-12)
+    t385 = numpy.greater(t20, 1e-12)
+    t386 = (t380 & (numpy.greater_equal(t214, t376))) | (t381 & (numpy.less_equal(t213, t382)))
+    t387 = numpy.greater(t214, 1e-12)
+    q = numpy.empty(T.shape[:-2] + (8, 6))
+    q[..., 0, 0] = t353
+    q[..., 0, 1] = t354
+    q[..., 0, 2] = t355
+    q[..., 0, 3] = t356
+    q[..., 0, 4] = t357
+    q[..., 0, 5] = t358
+    q[..., 1, 0] = t353
+    q[..., 1, 1] = t354
+    q[..., 1, 2] = t355
+    q[..., 1, 3] = t356 - 6.283185307179586*numpy.ceil(0.15915494309189535*t356) + 3.141592653589793
+    q[..., 1, 4] = -t357 - 6.283185307179586*numpy.ceil(-0.15915494309189535*t357 - 0.5)
+    q[..., 1, 5] = t358 - 6.283185307179586*numpy.ceil(0.15915494309189535*t358) + 3.141592653589793
+    q[..., 2, 0] = t353
+    q[..., 2, 1] = t359
+    q[..., 2, 2] = t360
+    q[..., 2, 3] = t361
+    q[..., 2, 4] = t362
+    q[..., 2, 5] = t363
+    q[..., 3, 0] = t353
+    q[..., 3, 1] = t359
+    q[..., 3, 2] = t360
+    q[..., 3, 3] = t361 - 6.283185307179586*numpy.ceil(0.15915494309189535*t361) + 3.141592653589793
+    q[..., 3, 4] = -t362 - 6.283185307179586*numpy.ceil(-0.15915494309189535*t362 - 0.5)
+    q[..., 3, 5] = t363 - 6.283185307179586*numpy.ceil(0.15915494309189535*t363) + 3.141592653589793
+    q[..., 4, 0] = t364
+    q[..., 4, 1] = t365
+    q[..., 4, 2] = t366
+    q[..., 4, 3] = t367
+    q[..., 4, 4] = t368
+    q[..., 4, 5] = t369
+    q[..., 5, 0] = t364
+    q[..., 5, 1] = t365
+    q[..., 5, 2] = t366
+    q[..., 5, 3] = t367 - 6.283185307179586*numpy.ceil(0.15915494309189535*t367) + 3.141592653589793
+    q[..., 5, 4] = -t368 - 6.283185307179586*numpy.ceil(-0.15915494309189535*t368 - 0.5)
+    q[..., 5, 5] = t369 - 6.283185307179586*numpy.ceil(0.15915494309189535*t369) + 3.141592653589793
+    q[..., 6, 0] = t364
+    q[..., 6, 1] = t370
+    q[..., 6, 2] = t371
+    q[..., 6, 3] = t372
+    q[..., 6, 4] = t373
+    q[..., 6, 5] = t374
+    q[..., 7, 0] = t364
+    q[..., 7, 1] = t370
+    q[..., 7, 2] = t371
+    q[..., 7, 3] = t372 - 6.283185307179586*numpy.ceil(0.15915494309189535*t372) + 3.141592653589793
+    q[..., 7, 4] = -t373 - 6.283185307179586*numpy.ceil(-0.15915494309189535*t373 - 0.5)
+    q[..., 7, 5] = t374 - 6.283185307179586*numpy.ceil(0.15915494309189535*t374) + 3.141592653589793
+    valid = numpy.empty(T.shape[:-2] + (8,), dtype=bool)
+    valid[..., 0] = t375 & t378 & t383 & (numpy.greater_equal(t122, t376))
+    valid[..., 1] = t375 & t378 & t383 & (numpy.greater(t122, 1e-12))
+    valid[..., 2] = t375 & t378 & t380 & t384 & (numpy.greater_equal(t173, t376))
+    valid[..., 3] = t375 & t378 & t380 & t384 & (numpy.greater(t173, 1e-12))
+    valid[..., 4] = t375 & t377 & t385 & t386 & (numpy.greater_equal(t272, t376))
+    valid[..., 5] = t375 & t377 & t385 & t386 & (numpy.greater(t272, 1e-12))
+    valid[..., 6] = t375 & t377 & t380 & t385 & t387 & (numpy.greater_equal(t323, t376))
+    valid[..., 7] = t375 & t377 & t380 & t385 & t387 & (numpy.greater(t323, 1e-12))
+    return q, valid
 
-
-# -- Closed-form inverse kinematics (spherical_wrist_parallel) --
 
 MAX_IK_SOLUTIONS = 8
-_EPS = 1e-12  # a squared sine within this of 0 is a double root
-_TINY = 1e-24  # relative squared length below which a vector counts as zero
 
 
-def _dot(a, b):
-    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+def ik(T):
+    """Closed-form inverse kinematics: every joint solution that reaches the target.
 
-
-def _cross(a, b):
-    return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
-
-
-def _add(a, b):
-    return (a[0] + b[0], a[1] + b[1], a[2] + b[2])
-
-
-def _sub(a, b):
-    return (a[0] - b[0], a[1] - b[1], a[2] - b[2])
-
-
-def _rot(k, c, s, v):
-    """v turned about the unit axis k by the angle whose cosine and sine are c and s (Rodrigues)."""
-    kxv = _cross(k, v)
-    kv = _dot(k, v) * (1.0 - c)
-    return (v[0] * c + kxv[0] * s + k[0] * kv, v[1] * c + kxv[1] * s + k[1] * kv,
-            v[2] * c + kxv[2] * s + k[2] * kv)
-
-
-class _Angle:
-    """An angle with its cosine and sine."""
-
-    __slots__ = ("theta", "c", "s")
-
-    def __init__(self, theta, c, s):
-        self.theta, self.c, self.s = theta, c, s
-
-
-def _angle(c, s):
-    return _Angle(math.atan2(s, c), c, s)
-
-
-def _sp1(p, q, k):
-    """SP1: the angle turning p into q about the unit axis k (least squares when they differ
-    in length or height along k). 0 when p or q lies on the axis (any angle would do)."""
-    x = _dot(p, q) - _dot(k, p) * _dot(k, q)
-    y = _dot(k, _cross(p, q))
-    r = math.hypot(x, y)
-    if r * r <= _TINY * _dot(p, p) * _dot(q, q):
-        return _Angle(0.0, 1.0, 0.0)
-    return _angle(x / r, y / r)
-
-
-def _sp4(h, p, k, d):
-    """SP4: the angles t with h . rot(k, t) p = d, as [phi + alpha, phi - alpha].
-
-    h . rot(k, t) p = A cos t + B sin t + C. One angle for a double root (|sin alpha|^2 <=
-    _EPS), none out of range; when the left side does not depend on t, [0] if it equals d.
-    """
-    hk, kp = _dot(h, k), _dot(k, p)
-    a = _dot(h, p) - hk * kp
-    b = _dot(h, _cross(k, p))
-    rhs = d - hk * kp
-    r2 = a * a + b * b
-    scale = _dot(h, h) * _dot(p, p)
-    if r2 <= _TINY * scale:
-        return [_Angle(0.0, 1.0, 0.0)] if rhs * rhs <= _EPS * scale else []
-    r = math.sqrt(r2)
-    cos_phi, sin_phi, cos_alpha = a / r, b / r, rhs / r
-    disc = 1.0 - cos_alpha * cos_alpha
-    if disc < -_EPS:
-        return []
-    if disc <= _EPS:
-        sign = 1.0 if cos_alpha > 0.0 else -1.0
-        return [_angle(sign * cos_phi, sign * sin_phi)]
-    sin_alpha = math.sqrt(disc)
-    phi, alpha = math.atan2(b, a), math.atan2(sin_alpha, cos_alpha)
-    return [_Angle(phi + alpha, cos_phi * cos_alpha - sin_phi * sin_alpha, sin_phi * cos_alpha + cos_phi * sin_alpha),
-            _Angle(phi - alpha, cos_phi * cos_alpha + sin_phi * sin_alpha, sin_phi * cos_alpha - cos_phi * sin_alpha)]
-
-
-def _sp3(p, q, k, dd):
-    """SP3: the angles t with |rot(k, t) p - q|^2 = dd (p, q relative to a point of the axis)."""
-    return _sp4(q, p, k, 0.5 * (_dot(p, p) + _dot(q, q) - dd))
-
-
-def _sp2(p, q, k1, k2, wanted=2):
-    """SP2: the angle pairs (t1, t2) with rot(k1, t1) rot(k2, t2) p = q, for two axes through
-    one point (p, q relative to it): rot(k2, t2) p = rot(k1, -t1) q = c, c = alpha k1 +
-    beta k2 +- gamma k1 x k2. One pair when gamma^2 is within _EPS of 0, none below. With
-    wanted=1 the second pair, when it exists, is None (not computed)."""
-    k12 = _dot(k1, k2)
-    normal = _cross(k1, k2)
-    nn = 1.0 - k12 * k12
-    u, v = _dot(k1, q), _dot(k2, p)
-    alpha = (u - k12 * v) / nn
-    beta = (v - k12 * u) / nn
-    pp = _dot(p, p)
-    gg = (pp - alpha * alpha - beta * beta - 2.0 * alpha * beta * k12) / nn
-    if gg < -_EPS * pp:
-        return []
-    gammas = (0.0,) if gg <= _EPS * pp else (math.sqrt(gg), -math.sqrt(gg))
-    pairs = []
-    for gamma in gammas[:wanted]:
-        c = tuple(alpha * k1[i] + beta * k2[i] + gamma * normal[i] for i in range(3))
-        pairs.append((_sp1(c, q, k1), _sp1(p, c, k2)))
-    return pairs + [None] * (len(gammas) - len(pairs))
-
-
-def _relative(T, rotation, position):
-    """T T(0)^-1 = exp(xi_1 q_1) ... exp(xi_n q_n) as (R, t), T(0) = (rotation, position)
-    the tool pose at q = 0."""
-    R = tuple(T[i][0] * rotation[3 * j] + T[i][1] * rotation[3 * j + 1] + T[i][2] * rotation[3 * j + 2]
-              for i in range(3) for j in range(3))
-    return R, tuple(T[i][3] - _dot(R[3 * i:3 * i + 3], position) for i in range(3))
-
-
-def _mul(R, v):
-    return (_dot(R[0:3], v), _dot(R[3:6], v), _dot(R[6:9], v))
-
-
-def _ik_wrist(a, b, h4, h5, h6, v6, wrist_flip):
-    """Spherical wrist with axis 5 perpendicular to axes 4 and 6: the angles (q4, q5, q6) with
-    R4 R5 R6 h6 = a and R4 R5 R6 v6 = b (v6 perpendicular to h6). The first by SP2 and SP1; the
-    second is (q4 + pi, wrist_flip - q5, q6 + pi): rot(h4, pi) reflects the plane perpendicular
-    to h5 across h4, and wrist_flip = -2 angle(h4 -> h6 about h5)."""
-    pairs = _sp2(h6, a, h4, h5, wanted=1)
-    if not pairs:
-        return []
-    t4, t5 = pairs[0]
-    t6 = _sp1(v6, _rot(h5, t5.c, -t5.s, _rot(h4, t4.c, -t4.s, b)), h6)
-    first = (t4.theta, t5.theta, t6.theta)
-    if len(pairs) == 1:
-        return [first]
-    return [first, (t4.theta + math.pi, wrist_flip - t5.theta, t6.theta + math.pi)]
-
-
-def _ik_solve(T, tool_rotation, tool_position, h1, p1, h2, p2, h3, p3, reach, sign3, h4, h5, h6, v6, centre, wrist_flip):
-    """Spherical wrist, axes 2 and 3 parallel: the wrist centre fixes q1 (SP4: its height
-    along axis 2 is constant), q3 (SP3) and q2 (SP1); the orientation left to the wrist
-    gives q4, q5, q6."""
-    R, t = _relative(T, tool_rotation, tool_position)
-    wc = _add(_mul(R, centre), t)
-    a, b = _mul(R, h6), _mul(R, v6)
-    solutions = []
-    for t1 in _sp4(_sub(wc, p1), h2, h1, reach):
-        w = _add(p1, _rot(h1, t1.c, -t1.s, _sub(wc, p1)))
-        d = _sub(w, p2)
-        for t3 in _sp3(_sub(centre, p3), _sub(p2, p3), h3, _dot(d, d)):
-            t2 = _sp1(_sub(_add(p3, _rot(h3, t3.c, t3.s, _sub(centre, p3))), p2), d, h2)
-            # R2 R3 = rot(h2, q2 + sign3 q3), h3 = sign3 h2: one turn back for both
-            c23 = t2.c * t3.c - sign3 * t2.s * t3.s
-            s23 = t2.s * t3.c + sign3 * t2.c * t3.s
-            aw = _rot(h2, c23, -s23, _rot(h1, t1.c, -t1.s, a))
-            bw = _rot(h2, c23, -s23, _rot(h1, t1.c, -t1.s, b))
-            for t4, t5, t6 in _ik_wrist(aw, bw, h4, h5, h6, v6, wrist_flip):
-                solutions.append([t1.theta, t2.theta, t3.theta, t4, t5, t6])
-    return solutions
-
-
-def ik(target):
-    """Closed-form inverse kinematics: every joint solution that reaches `target`, as (k, DOF).
-
+    One target: the solutions as (k, DOF), the valid rows of ik_branches in its order.
+    A batch of targets: ik_branches' (q, valid), (..., MAX_IK_SOLUTIONS, DOF) and
+    (..., MAX_IK_SOLUTIONS).
     target: the 4x4 tool pose in the world frame (rotation part orthonormal).
     Result: k <= MAX_IK_SOLUTIONS solutions, revolute angles wrapped into (-pi, pi], joint
     limits not applied; k = 0 when the target is out of reach or not finite.
@@ -818,33 +1124,8 @@ def ik(target):
     root (a target on a singularity or on the workspace boundary) is returned once, and an
     angle the target leaves free (a singular wrist or shoulder) is set to 0.
     """
-    target = numpy.asarray(target, dtype=float)
-    if target.shape != (4, 4):
-        raise ValueError(f"target must have shape (4, 4), got {target.shape}")
-    if not numpy.all(numpy.isfinite(target[:3])):  # the last row is not read
-        return numpy.empty((0, DOF))
-    solutions = _ik_solve(
-        target.tolist(),
-        tool_rotation=(1, 0, 0, 0, 1, 0, 0, 0, 1),
-        tool_position=(0.4521, -0.15005, 1.10363),
-        h1=(0, 0, 1),
-        p1=(0, 0, 0),
-        h2=(0, -1, 0),
-        p2=(0, 0, 0.67183),
-        h3=(0, -1, 0),
-        p3=(0.4318, 0, 0.67183),
-        reach=0.15005,
-        sign3=1,
-        h4=(0, 0, 1),
-        h5=(0, -1, 0),
-        h6=(0, 0, 1),
-        v6=(1, 0, 0),
-        centre=(0.4521, -0.15005, 1.10363),
-        wrist_flip=0,
-    )
-    q = numpy.array(solutions, dtype=float).reshape(-1, DOF)
-    q[:, [0, 1, 2, 3, 4, 5]] = _wrap(q[:, [0, 1, 2, 3, 4, 5]])
-    return q
+    q, valid = ik_branches(T)
+    return q[valid] if valid.ndim == 1 else (q, valid)
 
 
 # -- Iterative inverse kinematics --
@@ -932,7 +1213,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
     condition number below VELOCITY_IK_RCOND; take damping > 0 there). Where ok is False,
     q_dot is 0: the result never holds NaN.
     """
-    q = _joints(q)
+    q = _argument("q", q, (DOF,))
     mu_dot = numpy.asarray(mu_dot, dtype=float)
     if mu_dot.ndim == 0 or mu_dot.shape[-1] != 6:
         raise ValueError(f"mu_dot must have shape (6,) or (..., 6), got {mu_dot.shape}")

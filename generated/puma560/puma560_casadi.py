@@ -3,7 +3,9 @@
 
 Unimation Puma 560 (rtb Puma560, with pedestal), standard DH
 Every function takes `q` (6 x 1: radians for revolute joints, m for
-prismatic ones) and returns a rows x cols result whose zeros are structural.
+prismatic ones) and returns a rows x cols result whose zeros are structural; ik_branches
+(also named ik) takes the target instead of q and returns every branch (MAX_IK_SOLUTIONS x
+DOF) and its validity (MAX_IK_SOLUTIONS x 1, 1 or 0).
 Task vector: (x, y, z, roll, pitch, yaw).
 """
 
@@ -560,7 +562,471 @@ def _jacobian_det(q):
     return [d]
 
 
-_q = casadi.SX.sym("q", DOF)
+def _ik_branches(T):
+    """Every branch of the closed-form ik and whether the target allows it: 900 operations."""
+    T00 = T[0, 0]
+    T01 = T[0, 1]
+    T02 = T[0, 2]
+    T03 = T[0, 3]
+    T10 = T[1, 0]
+    T11 = T[1, 1]
+    T12 = T[1, 2]
+    T13 = T[1, 3]
+    T20 = T[2, 0]
+    T21 = T[2, 1]
+    T22 = T[2, 2]
+    T23 = T[2, 3]
+    t0 = 5.357415379007653
+    t1 = 1.6177742431429796
+    t2 = T00 + T01 + T02 + T03 + T10 + T11 + T12 + T13 + T20 + T21 + T22 + T23
+    t3 = 0.4521*T00 - 0.15005*T01 + 1.10363*T02
+    t4 = T03 - t3
+    t5 = t3
+    t6 = t4 + t5
+    t7 = 0.4521*T10 - 0.15005*T11 + 1.10363*T12
+    t8 = T13 - t7
+    t9 = t7
+    t10 = t8 + t9
+    t11 = casadi.atan2(t6, -t10)
+    t12 = 0.4521*T20 - 0.15005*T21 + 1.10363*T22
+    t13 = T23 - t12
+    t14 = t12
+    t15 = t13 + t14
+    t16 = t10**2 + t6**2
+    t17 = t16
+    t18 = t15**2 + t16
+    t19 = 1/casadi.sqrt(t17)
+    t20 = 1 - 0.0225150025*t19**2
+    t21 = (1e-12 < t20)
+    t22 = casadi.if_else(t21, 0.15005*t19, casadi.if_else((t19 > 0), 1, -1))
+    t23 = casadi.if_else(t21, casadi.sqrt(t20), 0)
+    t24 = casadi.atan2(t23, t22)
+    t25 = t11 - t24
+    t26 = 1e-24*t18
+    t27 = (t17 <= t26)
+    t28 = casadi.if_else(t27, 0, t11 + t24)
+    t29 = t19*t6
+    t30 = t23*t29
+    t31 = t10*t19
+    t32 = t22*t31
+    t33 = casadi.if_else(t27, 1, -t30 - t32)
+    t34 = t30 - t32
+    t35 = t22*t29
+    t36 = t23*t31
+    t37 = casadi.if_else(t27, 0, t35 - t36)
+    t38 = t35 + t36
+    t39 = t10*t37 + t33*t6
+    t40 = t10*t33 - t37*t6
+    t41 = T02*t33 + T12*t37
+    t42 = -T02*t37 + T12*t33
+    t43 = T00*t33 + T10*t37
+    t44 = -T00*t37 + T10*t33
+    t45 = t10*t38 + t34*t6
+    t46 = t10*t34 - t38*t6
+    t47 = T02*t34 + T12*t38
+    t48 = -T02*t38 + T12*t34
+    t49 = T00*t34 + T10*t38
+    t50 = -T00*t38 + T10*t34
+    t51 = 1 - t33
+    t52 = t15*t51
+    t53 = t15*t33 + t52
+    t54 = t53 - 0.67183
+    t55 = t39**2 + t40**2 + t54**2
+    t56 = 0.19791478625 - 0.5*t55
+    t57 = T22*t51
+    t58 = T22*t33 + t57
+    t59 = T20*t51
+    t60 = T20*t33 + t59
+    t61 = t56**2
+    t62 = t0**2
+    t63 = -t61*t62 + 1
+    t64 = t0*t56
+    t65 = (1e-12 < t63)
+    t66 = casadi.if_else(t65, t64, casadi.if_else((t64 > 0), 1, -1))
+    t67 = casadi.if_else(t65, casadi.sqrt(t63), 0)
+    t68 = casadi.atan2(t67, t66)
+    t69 = t1 - t68
+    t70 = False
+    t71 = casadi.if_else(t70, 0, t1 + t68)
+    t72 = t0*t66
+    t73 = 0.00876554*t72
+    t74 = t0*t67
+    t75 = 0.18645124*t74
+    t76 = casadi.if_else(t70, 1, -t73 - t75)
+    t77 = -t73 + t75
+    t78 = 0.15005 - 0.15005*t76
+    t79 = 0.15005*t76 + t78
+    t80 = 0.15005 - 0.15005*t77
+    t81 = 0.15005*t77 + t80
+    t82 = 0.18645124*t72
+    t83 = 0.00876554*t74
+    t84 = casadi.if_else(t70, 0, t82 - t83)
+    t85 = t82 + t83
+    t86 = 0.0203*t76 - 0.4318*t84
+    t87 = 0.4318*t76 + 0.0203*t84
+    t88 = t86 + 0.4318
+    t89 = t87 + 0.67183
+    t90 = t89 - 0.67183
+    t91 = t39*t90 - t54*t88
+    t92 = t79**2 + t88**2 + t90**2
+    t93 = 0.0203*t77 - 0.4318*t85
+    t94 = 0.4318*t77 + 0.0203*t85
+    t95 = t93 + 0.4318
+    t96 = t94 + 0.67183
+    t97 = t96 - 0.67183
+    t98 = t39*t97 - t54*t95
+    t99 = t81**2 + t95**2 + t97**2
+    t100 = t40*t79
+    t101 = -t100 + t39*t88 + t54*t90
+    t102 = t100 + t101
+    t103 = t102**2 + t91**2
+    t104 = 1/casadi.sqrt(t103)
+    t105 = 1e-24*t55
+    t106 = (t103 <= t105*t92)
+    t107 = casadi.if_else(t106, 1, t102*t104)
+    t108 = casadi.if_else(t106, 0, -t104*t91)
+    t109 = t107*t76 - t108*t84
+    t110 = t107*t84 + t108*t76
+    t111 = t109*t41 + t110*t58
+    t112 = t109*t58 - t110*t41
+    t113 = t109*t43 + t110*t60
+    t114 = t109*t60 - t110*t43
+    t115 = 1 - t109
+    t116 = t115*t42
+    t117 = t109*t42 + t116
+    t118 = t115*t44
+    t119 = t109*t44 + t118
+    t120 = t112**2
+    t121 = -t120
+    t122 = t121 + 1
+    t123 = casadi.if_else((t122 > 1e-12), casadi.sqrt(t122), 0)
+    t124 = t111*t123 + t120
+    t125 = t121 + t124
+    t126 = t117**2
+    t127 = t111**2 + t120 + t126
+    t128 = t123**2
+    t129 = t125**2 + t126*t128
+    t130 = t120 + t128
+    t131 = 1/casadi.sqrt(t129)
+    t132 = 1/casadi.sqrt(t130)
+    t133 = 1e-24*t130
+    t134 = (t129 <= t127*t133)
+    t135 = casadi.if_else(t134, 1, t125*t131)
+    t136 = t114*(1 - t135)
+    t137 = t114*t135 + t136
+    t138 = t117*t123
+    t139 = casadi.if_else(t134, 0, t131*t138)
+    t140 = t113*t135 + t119*t139
+    t141 = -t113*t139 + t119*t135
+    t142 = (t130 <= t133)
+    t143 = casadi.if_else(t142, 1, t112*t132)
+    t144 = casadi.if_else(t142, 0, -t123*t132)
+    t145 = t141*(1 - t143)
+    t146 = t137*t144 + t140*t143
+    t147 = t141*t143 + t145
+    t148 = t137*t143 - t140*t144
+    t149 = t146**2 + t147**2
+    t150 = t149
+    t151 = t148**2 + t149
+    t152 = t40*t81
+    t153 = -t152 + t39*t95 + t54*t97
+    t154 = t152 + t153
+    t155 = t154**2 + t98**2
+    t156 = 1/casadi.sqrt(t155)
+    t157 = (t155 <= t105*t99)
+    t158 = casadi.if_else(t157, 1, t154*t156)
+    t159 = casadi.if_else(t157, 0, -t156*t98)
+    t160 = t158*t77 - t159*t85
+    t161 = t158*t85 + t159*t77
+    t162 = t160*t41 + t161*t58
+    t163 = t160*t58 - t161*t41
+    t164 = t160*t43 + t161*t60
+    t165 = t160*t60 - t161*t43
+    t166 = 1 - t160
+    t167 = t166*t42
+    t168 = t160*t42 + t167
+    t169 = t166*t44
+    t170 = t160*t44 + t169
+    t171 = t163**2
+    t172 = -t171
+    t173 = t172 + 1
+    t174 = casadi.if_else((t173 > 1e-12), casadi.sqrt(t173), 0)
+    t175 = t162*t174 + t171
+    t176 = t172 + t175
+    t177 = t168**2
+    t178 = t162**2 + t171 + t177
+    t179 = t174**2
+    t180 = t176**2 + t177*t179
+    t181 = t171 + t179
+    t182 = 1/casadi.sqrt(t180)
+    t183 = 1/casadi.sqrt(t181)
+    t184 = 1e-24*t181
+    t185 = (t180 <= t178*t184)
+    t186 = casadi.if_else(t185, 1, t176*t182)
+    t187 = t165*(1 - t186)
+    t188 = t165*t186 + t187
+    t189 = t168*t174
+    t190 = casadi.if_else(t185, 0, t182*t189)
+    t191 = t164*t186 + t170*t190
+    t192 = -t164*t190 + t170*t186
+    t193 = (t181 <= t184)
+    t194 = casadi.if_else(t193, 1, t163*t183)
+    t195 = casadi.if_else(t193, 0, -t174*t183)
+    t196 = t192*(1 - t194)
+    t197 = t188*t195 + t191*t194
+    t198 = t192*t194 + t196
+    t199 = t188*t194 - t191*t195
+    t200 = t197**2 + t198**2
+    t201 = t200
+    t202 = t199**2 + t200
+    t203 = 1 - t34
+    t204 = t15*t203
+    t205 = t15*t34 + t204
+    t206 = t205 - 0.67183
+    t207 = t206**2 + t45**2 + t46**2
+    t208 = 0.19791478625 - 0.5*t207
+    t209 = T22*t203
+    t210 = T22*t34 + t209
+    t211 = T20*t203
+    t212 = T20*t34 + t211
+    t213 = t208**2
+    t214 = -t213*t62 + 1
+    t215 = t0*t208
+    t216 = (1e-12 < t214)
+    t217 = casadi.if_else(t216, t215, casadi.if_else((t215 > 0), 1, -1))
+    t218 = casadi.if_else(t216, casadi.sqrt(t214), 0)
+    t219 = casadi.atan2(t218, t217)
+    t220 = casadi.if_else(t70, 0, t1 + t219)
+    t221 = t1 - t219
+    t222 = t0*t217
+    t223 = 0.00876554*t222
+    t224 = t0*t218
+    t225 = 0.18645124*t224
+    t226 = casadi.if_else(t70, 1, -t223 - t225)
+    t227 = -t223 + t225
+    t228 = 0.15005 - 0.15005*t226
+    t229 = 0.15005*t226 + t228
+    t230 = 0.15005 - 0.15005*t227
+    t231 = 0.15005*t227 + t230
+    t232 = 0.18645124*t222
+    t233 = 0.00876554*t224
+    t234 = casadi.if_else(t70, 0, t232 - t233)
+    t235 = t232 + t233
+    t236 = 0.0203*t226 - 0.4318*t234
+    t237 = 0.4318*t226 + 0.0203*t234
+    t238 = t236 + 0.4318
+    t239 = t237 + 0.67183
+    t240 = t239 - 0.67183
+    t241 = -t206*t238 + t240*t45
+    t242 = t229**2 + t238**2 + t240**2
+    t243 = 0.0203*t227 - 0.4318*t235
+    t244 = 0.4318*t227 + 0.0203*t235
+    t245 = t243 + 0.4318
+    t246 = t244 + 0.67183
+    t247 = t246 - 0.67183
+    t248 = -t206*t245 + t247*t45
+    t249 = t231**2 + t245**2 + t247**2
+    t250 = t229*t46
+    t251 = t206*t240 + t238*t45 - t250
+    t252 = t250 + t251
+    t253 = t241**2 + t252**2
+    t254 = 1/casadi.sqrt(t253)
+    t255 = 1e-24*t207
+    t256 = (t253 <= t242*t255)
+    t257 = casadi.if_else(t256, 1, t252*t254)
+    t258 = casadi.if_else(t256, 0, -t241*t254)
+    t259 = t226*t257 - t234*t258
+    t260 = t226*t258 + t234*t257
+    t261 = t210*t260 + t259*t47
+    t262 = t210*t259 - t260*t47
+    t263 = t212*t260 + t259*t49
+    t264 = t212*t259 - t260*t49
+    t265 = 1 - t259
+    t266 = t265*t48
+    t267 = t259*t48 + t266
+    t268 = t265*t50
+    t269 = t259*t50 + t268
+    t270 = t262**2
+    t271 = -t270
+    t272 = t271 + 1
+    t273 = casadi.if_else((t272 > 1e-12), casadi.sqrt(t272), 0)
+    t274 = t261*t273 + t270
+    t275 = t271 + t274
+    t276 = t267**2
+    t277 = t261**2 + t270 + t276
+    t278 = t273**2
+    t279 = t275**2 + t276*t278
+    t280 = t270 + t278
+    t281 = 1/casadi.sqrt(t279)
+    t282 = 1/casadi.sqrt(t280)
+    t283 = 1e-24*t280
+    t284 = (t279 <= t277*t283)
+    t285 = casadi.if_else(t284, 1, t275*t281)
+    t286 = t264*(1 - t285)
+    t287 = t264*t285 + t286
+    t288 = t267*t273
+    t289 = casadi.if_else(t284, 0, t281*t288)
+    t290 = t263*t285 + t269*t289
+    t291 = -t263*t289 + t269*t285
+    t292 = (t280 <= t283)
+    t293 = casadi.if_else(t292, 1, t262*t282)
+    t294 = casadi.if_else(t292, 0, -t273*t282)
+    t295 = t291*(1 - t293)
+    t296 = t287*t294 + t290*t293
+    t297 = t291*t293 + t295
+    t298 = t287*t293 - t290*t294
+    t299 = t296**2 + t297**2
+    t300 = t299
+    t301 = t298**2 + t299
+    t302 = t231*t46
+    t303 = t206*t247 + t245*t45 - t302
+    t304 = t302 + t303
+    t305 = t248**2 + t304**2
+    t306 = 1/casadi.sqrt(t305)
+    t307 = (t305 <= t249*t255)
+    t308 = casadi.if_else(t307, 1, t304*t306)
+    t309 = casadi.if_else(t307, 0, -t248*t306)
+    t310 = t227*t308 - t235*t309
+    t311 = t227*t309 + t235*t308
+    t312 = t210*t311 + t310*t47
+    t313 = t210*t310 - t311*t47
+    t314 = t212*t311 + t310*t49
+    t315 = t212*t310 - t311*t49
+    t316 = 1 - t310
+    t317 = t316*t48
+    t318 = t310*t48 + t317
+    t319 = t316*t50
+    t320 = t310*t50 + t319
+    t321 = t313**2
+    t322 = -t321
+    t323 = t322 + 1
+    t324 = casadi.if_else((t323 > 1e-12), casadi.sqrt(t323), 0)
+    t325 = t312*t324 + t321
+    t326 = t322 + t325
+    t327 = t318**2
+    t328 = t312**2 + t321 + t327
+    t329 = t324**2
+    t330 = t326**2 + t327*t329
+    t331 = t321 + t329
+    t332 = 1/casadi.sqrt(t330)
+    t333 = 1/casadi.sqrt(t331)
+    t334 = 1e-24*t331
+    t335 = (t330 <= t328*t334)
+    t336 = casadi.if_else(t335, 1, t326*t332)
+    t337 = t315*(1 - t336)
+    t338 = t315*t336 + t337
+    t339 = t318*t324
+    t340 = casadi.if_else(t335, 0, t332*t339)
+    t341 = t314*t336 + t320*t340
+    t342 = -t314*t340 + t320*t336
+    t343 = (t331 <= t334)
+    t344 = casadi.if_else(t343, 1, t313*t333)
+    t345 = casadi.if_else(t343, 0, -t324*t333)
+    t346 = t342*(1 - t344)
+    t347 = t338*t345 + t341*t344
+    t348 = t342*t344 + t346
+    t349 = t338*t344 - t341*t345
+    t350 = t347**2 + t348**2
+    t351 = t350
+    t352 = t349**2 + t350
+    t353 = t28 - 6.283185307179586*casadi.ceil(0.15915494309189535*t28 - 0.5)
+    t354 = casadi.if_else(t106, 0, casadi.atan2(-t91, t102))
+    t355 = t71 - 6.283185307179586*casadi.ceil(0.15915494309189535*t71 - 0.5)
+    t356 = casadi.if_else(t134, 0, casadi.atan2(t138, t125))
+    t357 = casadi.if_else(t142, 0, casadi.atan2(-t123, t112))
+    t358 = casadi.if_else((t150 <= 1e-24*t151), 0, casadi.atan2(t147, t146))
+    t359 = casadi.if_else(t157, 0, casadi.atan2(-t98, t154))
+    t360 = t69 - 6.283185307179586*casadi.ceil(0.15915494309189535*t69 - 0.5)
+    t361 = casadi.if_else(t185, 0, casadi.atan2(t189, t176))
+    t362 = casadi.if_else(t193, 0, casadi.atan2(-t174, t163))
+    t363 = casadi.if_else((t201 <= 1e-24*t202), 0, casadi.atan2(t198, t197))
+    t364 = t25 - 6.283185307179586*casadi.ceil(0.15915494309189535*t25 - 0.5)
+    t365 = casadi.if_else(t256, 0, casadi.atan2(-t241, t252))
+    t366 = t220 - 6.283185307179586*casadi.ceil(0.15915494309189535*t220 - 0.5)
+    t367 = casadi.if_else(t284, 0, casadi.atan2(t288, t275))
+    t368 = casadi.if_else(t292, 0, casadi.atan2(-t273, t262))
+    t369 = casadi.if_else((t300 <= 1e-24*t301), 0, casadi.atan2(t297, t296))
+    t370 = casadi.if_else(t307, 0, casadi.atan2(-t248, t304))
+    t371 = t221 - 6.283185307179586*casadi.ceil(0.15915494309189535*t221 - 0.5)
+    t372 = casadi.if_else(t335, 0, casadi.atan2(t339, t326))
+    t373 = casadi.if_else(t343, 0, casadi.atan2(-t324, t313))
+    t374 = casadi.if_else((t351 <= 1e-24*t352), 0, casadi.atan2(t348, t347))
+    t375 = (casadi.fabs(t2) < casadi.inf)
+    t376 = -1e-12
+    t377 = (t17 > t26)
+    t378 = casadi.logic_or(casadi.logic_and(t377, (t20 >= t376)), casadi.logic_and(t27, (0.0225150025 <= 1e-12*t18)))
+    t379 = 3.9038849723757295e-26
+    t380 = (0.0348408995890292 > t379)
+    t381 = (0.0348408995890292 <= t379)
+    t382 = 3.9038849723757296e-14
+    t383 = casadi.logic_or(casadi.logic_and(t380, (t63 >= t376)), casadi.logic_and(t381, (t61 <= t382)))
+    t384 = (t63 > 1e-12)
+    t385 = (t20 > 1e-12)
+    t386 = casadi.logic_or(casadi.logic_and(t380, (t214 >= t376)), casadi.logic_and(t381, (t213 <= t382)))
+    t387 = (t214 > 1e-12)
+    q = casadi.SX(8, 6)
+    q[0, 0] = t353
+    q[0, 1] = t354
+    q[0, 2] = t355
+    q[0, 3] = t356
+    q[0, 4] = t357
+    q[0, 5] = t358
+    q[1, 0] = t353
+    q[1, 1] = t354
+    q[1, 2] = t355
+    q[1, 3] = t356 - 6.283185307179586*casadi.ceil(0.15915494309189535*t356) + 3.141592653589793
+    q[1, 4] = -t357 - 6.283185307179586*casadi.ceil(-0.15915494309189535*t357 - 0.5)
+    q[1, 5] = t358 - 6.283185307179586*casadi.ceil(0.15915494309189535*t358) + 3.141592653589793
+    q[2, 0] = t353
+    q[2, 1] = t359
+    q[2, 2] = t360
+    q[2, 3] = t361
+    q[2, 4] = t362
+    q[2, 5] = t363
+    q[3, 0] = t353
+    q[3, 1] = t359
+    q[3, 2] = t360
+    q[3, 3] = t361 - 6.283185307179586*casadi.ceil(0.15915494309189535*t361) + 3.141592653589793
+    q[3, 4] = -t362 - 6.283185307179586*casadi.ceil(-0.15915494309189535*t362 - 0.5)
+    q[3, 5] = t363 - 6.283185307179586*casadi.ceil(0.15915494309189535*t363) + 3.141592653589793
+    q[4, 0] = t364
+    q[4, 1] = t365
+    q[4, 2] = t366
+    q[4, 3] = t367
+    q[4, 4] = t368
+    q[4, 5] = t369
+    q[5, 0] = t364
+    q[5, 1] = t365
+    q[5, 2] = t366
+    q[5, 3] = t367 - 6.283185307179586*casadi.ceil(0.15915494309189535*t367) + 3.141592653589793
+    q[5, 4] = -t368 - 6.283185307179586*casadi.ceil(-0.15915494309189535*t368 - 0.5)
+    q[5, 5] = t369 - 6.283185307179586*casadi.ceil(0.15915494309189535*t369) + 3.141592653589793
+    q[6, 0] = t364
+    q[6, 1] = t370
+    q[6, 2] = t371
+    q[6, 3] = t372
+    q[6, 4] = t373
+    q[6, 5] = t374
+    q[7, 0] = t364
+    q[7, 1] = t370
+    q[7, 2] = t371
+    q[7, 3] = t372 - 6.283185307179586*casadi.ceil(0.15915494309189535*t372) + 3.141592653589793
+    q[7, 4] = -t373 - 6.283185307179586*casadi.ceil(-0.15915494309189535*t373 - 0.5)
+    q[7, 5] = t374 - 6.283185307179586*casadi.ceil(0.15915494309189535*t374) + 3.141592653589793
+    valid = casadi.SX(8, 1)
+    valid[0, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t375, t378), t383), (t122 >= t376))
+    valid[1, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t375, t378), t383), (t122 > 1e-12))
+    valid[2, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t375, t378), t380), t384), (t173 >= t376))
+    valid[3, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t375, t378), t380), t384), (t173 > 1e-12))
+    valid[4, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t375, t377), t385), t386), (t272 >= t376))
+    valid[5, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t375, t377), t385), t386), (t272 > 1e-12))
+    valid[6, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t375, t377), t380), t385), t387), (t323 >= t376))
+    valid[7, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t375, t377), t380), t385), t387), (t323 > 1e-12))
+    return [q, valid]
+
+
+_q = casadi.SX.sym("q", 6, 1)
+_T = casadi.SX.sym("T", 4, 4)
 fk = casadi.Function("fk", [_q], _fk(_q), ["q"], ["T"])
 jacobian = casadi.Function("jacobian", [_q], _jacobian(_q), ["q"], ["J"])
 fk_jacobian = casadi.Function("fk_jacobian", [_q], _fk_jacobian(_q), ["q"], ["T", "J"])
@@ -570,8 +1036,10 @@ task_jacobian = casadi.Function("task_jacobian", [_q], _task_jacobian(_q), ["q"]
 singularity_factors = casadi.Function("singularity_factors", [_q], _singularity_factors(_q), ["q"], ["f"])
 manipulability = casadi.Function("manipulability", [_q], _manipulability(_q), ["q"], ["w"])
 jacobian_det = casadi.Function("jacobian_det", [_q], _jacobian_det(_q), ["q"], ["d"])
+ik_branches = casadi.Function("ik_branches", [_T], _ik_branches(_T), ["T"], ["q", "valid"])
+ik = ik_branches  # CasADi functions have fixed-size outputs: every branch and its validity
 
 
 def functions():
     """All functions by name."""
-    return {"fk": fk, "jacobian": jacobian, "fk_jacobian": fk_jacobian, "jacobian_tool": jacobian_tool, "task": task, "task_jacobian": task_jacobian, "singularity_factors": singularity_factors, "manipulability": manipulability, "jacobian_det": jacobian_det}
+    return {"fk": fk, "jacobian": jacobian, "fk_jacobian": fk_jacobian, "jacobian_tool": jacobian_tool, "task": task, "task_jacobian": task_jacobian, "singularity_factors": singularity_factors, "manipulability": manipulability, "jacobian_det": jacobian_det, "ik_branches": ik_branches}

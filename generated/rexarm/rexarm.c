@@ -459,6 +459,264 @@ rexarm_real rexarm_jacobian_det(const rexarm_real q[REXARM_DOF])
     return 0.001*s3*t2*(-c2*c3 - c2 + t1 + t2)/sqrt(t0*(c1*c1) + t0*(s1*s1));
 }
 
+void rexarm_ik_branches(const rexarm_real mu[REXARM_TASK_DIM], rexarm_real q[REXARM_MAX_IK_SOLUTIONS * REXARM_DOF], int valid[REXARM_MAX_IK_SOLUTIONS])
+{
+    /* 552 operations */
+
+    /* Inputs */
+    const rexarm_real mu0 = mu[0];
+    const rexarm_real mu1 = mu[1];
+    const rexarm_real mu2 = mu[2];
+    const rexarm_real mu3 = mu[3];
+
+    /* Intermediate terms */
+    const rexarm_real t0 = sin(mu3);
+    const rexarm_real t1 = atan2(mu0, -mu1);
+    const rexarm_real t2 = mu0 + mu1 + mu2 + mu3;
+    const rexarm_real t3 = (t0*t0);
+    const rexarm_real t4 = 1 - t3;
+    const int t5 = 1e-12 < t4;
+    const rexarm_real t6 = (t5 ? -t0 : (t0 < 0 ? 1 : -1));
+    const rexarm_real t7 = (t5 ? sqrt(t4) : 0);
+    const rexarm_real t8 = atan2(t7, t6);
+    const int t9 = 0;
+    const rexarm_real t10 = (t9 ? 0 : t8);
+    const rexarm_real t11 = (t9 ? 1 : t6);
+    const rexarm_real t12 = (t9 ? 0 : t7);
+    const rexarm_real t13 = (mu0*mu0) + (mu1*mu1);
+    const rexarm_real t14 = t13;
+    const rexarm_real t15 = t13 + (mu2*mu2);
+    const rexarm_real t16 = 1.0/sqrt(t14);
+    const int t17 = 1;
+    const rexarm_real t18 = (t17 ? 0 : -1);
+    const rexarm_real t19 = (t17 ? 1 : 0);
+    const rexarm_real t20 = atan2(t19, t18);
+    const rexarm_real t21 = t1 - t20;
+    const rexarm_real t22 = 1e-24*t15;
+    const int t23 = t14 <= t22;
+    const rexarm_real t24 = (t23 ? 0 : t1 + t20);
+    const rexarm_real t25 = t16*t18;
+    const rexarm_real t26 = mu1*t25;
+    const rexarm_real t27 = t16*t19;
+    const rexarm_real t28 = mu0*t27;
+    const rexarm_real t29 = (t23 ? 1 : -t26 - t28);
+    const rexarm_real t30 = -t26 + t28;
+    const rexarm_real t31 = mu2*(1 - t29);
+    const rexarm_real t32 = mu2*t29 + t31;
+    const rexarm_real t33 = mu2*(1 - t30);
+    const rexarm_real t34 = mu2*t30 + t33;
+    const rexarm_real t35 = mu0*t25;
+    const rexarm_real t36 = mu1*t27;
+    const rexarm_real t37 = (t23 ? 0 : t35 - t36);
+    const rexarm_real t38 = t35 + t36;
+    const rexarm_real t39 = mu0*t29 + mu1*t37;
+    const rexarm_real t40 = -mu0*t37 + mu1*t29;
+    const rexarm_real t41 = mu0*t30 + mu1*t38;
+    const rexarm_real t42 = -mu0*t38 + mu1*t30;
+    const rexarm_real t43 = 0.1*t12;
+    const rexarm_real t44 = t39 + t43;
+    const rexarm_real t45 = t41 + t43;
+    const rexarm_real t46 = -0.1*t11;
+    const rexarm_real t47 = t32 + t46;
+    const rexarm_real t48 = t47 - 0.12;
+    const rexarm_real t49 = t34 + t46;
+    const rexarm_real t50 = t49 - 0.12;
+    const rexarm_real t51 = (t40*t40);
+    const rexarm_real t52 = t51 + (t44*t44) + (t48*t48);
+    const rexarm_real t53 = 0.01 - 0.5*t52;
+    const rexarm_real t54 = (t53*t53);
+    const rexarm_real t55 = 1 - 10000*t54;
+    const int t56 = 1e-12 < t55;
+    const rexarm_real t57 = (t56 ? 100*t53 : (t53 > 0 ? 1 : -1));
+    const rexarm_real t58 = (t56 ? sqrt(t55) : 0);
+    const rexarm_real t59 = atan2(t58, t57);
+    const rexarm_real t60 = (t9 ? 0 : t59 + 3.141592653589793);
+    const rexarm_real t61 = (t9 ? 1 : -t57);
+    const rexarm_real t62 = (t9 ? 0 : -t58);
+    const rexarm_real t63 = 3.141592653589793 - t59;
+    const rexarm_real t64 = 0.1*t61 + 0.22;
+    const rexarm_real t65 = t64 - 0.12;
+    const rexarm_real t66 = 0.01*(t62*t62) + (t65*t65);
+    const rexarm_real t67 = 0.22 - 0.1*t57;
+    const rexarm_real t68 = t67 - 0.12;
+    const rexarm_real t69 = 0.01*(t58*t58) + (t68*t68);
+    const rexarm_real t70 = 0.1*t62;
+    const rexarm_real t71 = -t44*t70 + t48*t65;
+    const rexarm_real t72 = t44*t65 + t48*t70;
+    const rexarm_real t73 = (t71*t71) + (t72*t72);
+    const rexarm_real t74 = 0.1*t58;
+    const rexarm_real t75 = -t44*t74 + t48*t68;
+    const rexarm_real t76 = t44*t68 + t48*t74;
+    const rexarm_real t77 = (t75*t75) + (t76*t76);
+    const rexarm_real t78 = -0.1*t7;
+    const rexarm_real t79 = t39 + t78;
+    const rexarm_real t80 = t41 + t78;
+    const rexarm_real t81 = -0.1*t6;
+    const rexarm_real t82 = t32 + t81;
+    const rexarm_real t83 = t82 - 0.12;
+    const rexarm_real t84 = t51 + (t79*t79) + (t83*t83);
+    const rexarm_real t85 = 0.01 - 0.5*t84;
+    const rexarm_real t86 = t34 + t81;
+    const rexarm_real t87 = t86 - 0.12;
+    const rexarm_real t88 = (t85*t85);
+    const rexarm_real t89 = 1 - 10000*t88;
+    const int t90 = 1e-12 < t89;
+    const rexarm_real t91 = (t90 ? 100*t85 : (t85 > 0 ? 1 : -1));
+    const rexarm_real t92 = (t90 ? sqrt(t89) : 0);
+    const rexarm_real t93 = atan2(t92, t91);
+    const rexarm_real t94 = (t9 ? 0 : t93 + 3.141592653589793);
+    const rexarm_real t95 = (t9 ? 1 : -t91);
+    const rexarm_real t96 = (t9 ? 0 : -t92);
+    const rexarm_real t97 = 3.141592653589793 - t93;
+    const rexarm_real t98 = 0.1*t95 + 0.22;
+    const rexarm_real t99 = t98 - 0.12;
+    const rexarm_real t100 = 0.01*(t96*t96) + (t99*t99);
+    const rexarm_real t101 = 0.22 - 0.1*t91;
+    const rexarm_real t102 = t101 - 0.12;
+    const rexarm_real t103 = (t102*t102) + 0.01*(t92*t92);
+    const rexarm_real t104 = 0.1*t96;
+    const rexarm_real t105 = -t104*t79 + t83*t99;
+    const rexarm_real t106 = t104*t83 + t79*t99;
+    const rexarm_real t107 = (t105*t105) + (t106*t106);
+    const rexarm_real t108 = 0.1*t92;
+    const rexarm_real t109 = t102*t83 - t108*t79;
+    const rexarm_real t110 = t102*t79 + t108*t83;
+    const rexarm_real t111 = (t109*t109) + (t110*t110);
+    const rexarm_real t112 = (t42*t42);
+    const rexarm_real t113 = t112 + (t45*t45) + (t50*t50);
+    const rexarm_real t114 = 0.01 - 0.5*t113;
+    const rexarm_real t115 = t112 + (t80*t80) + (t87*t87);
+    const rexarm_real t116 = 0.01 - 0.5*t115;
+    const rexarm_real t117 = (t114*t114);
+    const rexarm_real t118 = 1 - 10000*t117;
+    const int t119 = 1e-12 < t118;
+    const rexarm_real t120 = (t119 ? 100*t114 : (t114 > 0 ? 1 : -1));
+    const rexarm_real t121 = (t119 ? sqrt(t118) : 0);
+    const rexarm_real t122 = atan2(t121, t120);
+    const rexarm_real t123 = (t9 ? 0 : t122 + 3.141592653589793);
+    const rexarm_real t124 = (t9 ? 1 : -t120);
+    const rexarm_real t125 = (t9 ? 0 : -t121);
+    const rexarm_real t126 = 3.141592653589793 - t122;
+    const rexarm_real t127 = 0.1*t124 + 0.22;
+    const rexarm_real t128 = t127 - 0.12;
+    const rexarm_real t129 = 0.01*(t125*t125) + (t128*t128);
+    const rexarm_real t130 = 0.22 - 0.1*t120;
+    const rexarm_real t131 = t130 - 0.12;
+    const rexarm_real t132 = 0.01*(t121*t121) + (t131*t131);
+    const rexarm_real t133 = 0.1*t125;
+    const rexarm_real t134 = t128*t50 - t133*t45;
+    const rexarm_real t135 = t128*t45 + t133*t50;
+    const rexarm_real t136 = (t134*t134) + (t135*t135);
+    const rexarm_real t137 = 0.1*t121;
+    const rexarm_real t138 = t131*t50 - t137*t45;
+    const rexarm_real t139 = t131*t45 + t137*t50;
+    const rexarm_real t140 = (t138*t138) + (t139*t139);
+    const rexarm_real t141 = (t116*t116);
+    const rexarm_real t142 = 1 - 10000*t141;
+    const int t143 = 1e-12 < t142;
+    const rexarm_real t144 = (t143 ? 100*t116 : (t116 > 0 ? 1 : -1));
+    const rexarm_real t145 = (t143 ? sqrt(t142) : 0);
+    const rexarm_real t146 = atan2(t145, t144);
+    const rexarm_real t147 = (t9 ? 0 : t146 + 3.141592653589793);
+    const rexarm_real t148 = (t9 ? 1 : -t144);
+    const rexarm_real t149 = (t9 ? 0 : -t145);
+    const rexarm_real t150 = 3.141592653589793 - t146;
+    const rexarm_real t151 = 0.1*t148 + 0.22;
+    const rexarm_real t152 = t151 - 0.12;
+    const rexarm_real t153 = 0.01*(t149*t149) + (t152*t152);
+    const rexarm_real t154 = 0.22 - 0.1*t144;
+    const rexarm_real t155 = t154 - 0.12;
+    const rexarm_real t156 = 0.01*(t145*t145) + (t155*t155);
+    const rexarm_real t157 = 0.1*t149;
+    const rexarm_real t158 = t152*t87 - t157*t80;
+    const rexarm_real t159 = t152*t80 + t157*t87;
+    const rexarm_real t160 = (t158*t158) + (t159*t159);
+    const rexarm_real t161 = 0.1*t145;
+    const rexarm_real t162 = t155*t87 - t161*t80;
+    const rexarm_real t163 = t155*t80 + t161*t87;
+    const rexarm_real t164 = (t162*t162) + (t163*t163);
+    const rexarm_real t165 = t24 - 6.283185307179586*ceil(0.15915494309189535*t24 - 0.5);
+    const rexarm_real t166 = 1e-24*t52;
+    const rexarm_real t167 = (t73 <= t166*t66 ? 0 : atan2(-t72, t71));
+    const rexarm_real t168 = -t10;
+    const rexarm_real t169 = t168 + 3.141592653589793;
+    const rexarm_real t170 = t167 + t60;
+    const rexarm_real t171 = (t77 <= t166*t69 ? 0 : atan2(-t76, t75));
+    const rexarm_real t172 = t171 + t63;
+    const rexarm_real t173 = 1e-24*t84;
+    const rexarm_real t174 = (t107 <= t100*t173 ? 0 : atan2(-t106, t105));
+    const rexarm_real t175 = t8 + 3.141592653589793;
+    const rexarm_real t176 = t174 + t94;
+    const rexarm_real t177 = (t111 <= t103*t173 ? 0 : atan2(-t110, t109));
+    const rexarm_real t178 = t177 + t97;
+    const rexarm_real t179 = t21 - 6.283185307179586*ceil(0.15915494309189535*t21 - 0.5);
+    const rexarm_real t180 = 1e-24*t113;
+    const rexarm_real t181 = (t136 <= t129*t180 ? 0 : atan2(-t135, t134));
+    const rexarm_real t182 = t123 + t181;
+    const rexarm_real t183 = (t140 <= t132*t180 ? 0 : atan2(-t139, t138));
+    const rexarm_real t184 = t126 + t183;
+    const rexarm_real t185 = 1e-24*t115;
+    const rexarm_real t186 = (t160 <= t153*t185 ? 0 : atan2(-t159, t158));
+    const rexarm_real t187 = t147 + t186;
+    const rexarm_real t188 = (t164 <= t156*t185 ? 0 : atan2(-t163, t162));
+    const rexarm_real t189 = t150 + t188;
+    const int t190 = isfinite(t2);
+    const int t191 = fabs(mu3) <= 1.5707963267948966;
+    const int t192 = t14 > t22;
+    const int t193 = t192 || (t23 && 0 <= 1e-12*t15);
+    const int t194 = 1;
+    const rexarm_real t195 = -1e-12;
+    const int t196 = t194 && t4 >= t195;
+    const rexarm_real t197 = 1e-28;
+    const int t198 = 0.0001 > t197;
+    const int t199 = 0.0001 <= t197;
+    const rexarm_real t200 = 1e-16;
+    const int t201 = t4 > 1e-12;
+    const int t202 = 1;
+
+    /* Outputs */
+    q[0] = t165;
+    q[1] = t167;
+    q[2] = t60 - 6.283185307179586*ceil(0.15915494309189535*t60 - 0.5);
+    q[3] = -t168 - t170 - 6.283185307179586*ceil(-0.15915494309189535*t169 - 0.15915494309189535*t170);
+    q[4] = t165;
+    q[5] = t171;
+    q[6] = t63 - 6.283185307179586*ceil(0.15915494309189535*t63 - 0.5);
+    q[7] = -t168 - t172 - 6.283185307179586*ceil(-0.15915494309189535*t169 - 0.15915494309189535*t172);
+    q[8] = t165;
+    q[9] = t174;
+    q[10] = t94 - 6.283185307179586*ceil(0.15915494309189535*t94 - 0.5);
+    q[11] = -t176 - t8 - 6.283185307179586*ceil(-0.15915494309189535*t175 - 0.15915494309189535*t176);
+    q[12] = t165;
+    q[13] = t177;
+    q[14] = t97 - 6.283185307179586*ceil(0.15915494309189535*t97 - 0.5);
+    q[15] = -t178 - t8 - 6.283185307179586*ceil(-0.15915494309189535*t175 - 0.15915494309189535*t178);
+    q[16] = t179;
+    q[17] = t181;
+    q[18] = t123 - 6.283185307179586*ceil(0.15915494309189535*t123 - 0.5);
+    q[19] = -t168 - t182 - 6.283185307179586*ceil(-0.15915494309189535*t169 - 0.15915494309189535*t182);
+    q[20] = t179;
+    q[21] = t183;
+    q[22] = t126 - 6.283185307179586*ceil(0.15915494309189535*t126 - 0.5);
+    q[23] = -t168 - t184 - 6.283185307179586*ceil(-0.15915494309189535*t169 - 0.15915494309189535*t184);
+    q[24] = t179;
+    q[25] = t186;
+    q[26] = t147 - 6.283185307179586*ceil(0.15915494309189535*t147 - 0.5);
+    q[27] = -t187 - t8 - 6.283185307179586*ceil(-0.15915494309189535*t175 - 0.15915494309189535*t187);
+    q[28] = t179;
+    q[29] = t188;
+    q[30] = t150 - 6.283185307179586*ceil(0.15915494309189535*t150 - 0.5);
+    q[31] = -t189 - t8 - 6.283185307179586*ceil(-0.15915494309189535*t175 - 0.15915494309189535*t189);
+    valid[0] = t190 && t191 && t193 && t196 && ((t198 && t55 >= t195) || (t199 && t54 <= t200));
+    valid[1] = t190 && t191 && t193 && t196 && t198 && t55 > 1e-12;
+    valid[2] = t190 && t191 && t193 && t194 && t201 && ((t198 && t89 >= t195) || (t199 && t88 <= t200));
+    valid[3] = t190 && t191 && t193 && t194 && t198 && t201 && t89 > 1e-12;
+    valid[4] = t190 && t191 && t192 && t196 && t202 && ((t198 && t118 >= t195) || (t199 && t117 <= t200));
+    valid[5] = t190 && t191 && t192 && t196 && t198 && t202 && t118 > 1e-12;
+    valid[6] = t190 && t191 && t192 && t194 && t201 && t202 && ((t198 && t142 >= t195) || (t199 && t141 <= t200));
+    valid[7] = t190 && t191 && t192 && t194 && t198 && t201 && t202 && t142 > 1e-12;
+}
+
 int rexarm_velocity_ik(const rexarm_real q[REXARM_DOF], const rexarm_real mu_dot[REXARM_TASK_DIM], rexarm_real damping, rexarm_real q_dot[REXARM_DOF])
 {
     /* Rows of task_jacobian() forming Js (the task Jacobian). */
@@ -556,8 +814,27 @@ int rexarm_velocity_ik(const rexarm_real q[REXARM_DOF], const rexarm_real mu_dot
     return REXARM_VELOCITY_IK_OK;
 }
 
-/* The angle wrapped into (-pi, pi], for |angle| < 1e9 (the callers' angles are sums of a few
- * atan2 results): angle - 2 pi ceil((angle - pi) / (2 pi)), ceil by truncation. */
+int rexarm_ik(const rexarm_real mu[REXARM_TASK_DIM], rexarm_real q[REXARM_MAX_IK_SOLUTIONS * REXARM_DOF])
+{
+    rexarm_real branches[REXARM_MAX_IK_SOLUTIONS * REXARM_DOF];
+    int valid[REXARM_MAX_IK_SOLUTIONS];
+    int count = 0, i, j;
+    rexarm_ik_branches(mu, branches, valid);
+    for (i = 0; i < REXARM_MAX_IK_SOLUTIONS; ++i) {
+        if (valid[i]) {
+            for (j = 0; j < REXARM_DOF; ++j) {
+                q[REXARM_DOF * count + j] = branches[REXARM_DOF * i + j];
+            }
+            ++count;
+        }
+    }
+    return count;
+}
+
+/* -- Iterative inverse kinematics -- */
+
+/* The angle wrapped into (-pi, pi], for |angle| < 1e9: angle - 2 pi ceil((angle - pi) / (2 pi)),
+ * ceil by truncation. */
 static rexarm_real rexarm_wrap(rexarm_real angle)
 {
     const rexarm_real turns = (angle - 3.141592653589793) / 6.283185307179586;
@@ -571,281 +848,6 @@ static rexarm_real rexarm_wrap(rexarm_real angle)
     }
     return angle - 6.283185307179586 * whole;
 }
-
-/* -- Closed-form inverse kinematics (yaw_pitch) -- */
-
-/* The arm at q = 0 (product of exponentials): unit axis directions h, points p on the axes,
- * the tool pose and a few derived constants. */
-typedef struct {
-    rexarm_real h1[3];
-    rexarm_real p1[3];
-    rexarm_real h2[3];
-    rexarm_real p2[3];
-    rexarm_real h3[3];
-    rexarm_real p3[3];
-    rexarm_real p4[3];
-    rexarm_real tool_x[3];
-    rexarm_real tool_point[3];
-    rexarm_real reach;
-    rexarm_real sign3;
-    rexarm_real sign4;
-} rexarm_ik_geometry;
-
-/* An angle with its cosine and sine. */
-typedef struct {
-    rexarm_real theta, c, s;
-} rexarm_angle;
-
-static inline rexarm_real rexarm_dot(const rexarm_real a[3], const rexarm_real b[3])
-{
-    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-}
-
-static inline void rexarm_cross(const rexarm_real a[3], const rexarm_real b[3], rexarm_real out[3])
-{
-    const rexarm_real x = a[1] * b[2] - a[2] * b[1];
-    const rexarm_real y = a[2] * b[0] - a[0] * b[2];
-    const rexarm_real z = a[0] * b[1] - a[1] * b[0];
-    out[0] = x;
-    out[1] = y;
-    out[2] = z;
-}
-
-static inline void rexarm_add(const rexarm_real a[3], const rexarm_real b[3], rexarm_real out[3])
-{
-    out[0] = a[0] + b[0];
-    out[1] = a[1] + b[1];
-    out[2] = a[2] + b[2];
-}
-
-static inline void rexarm_sub(const rexarm_real a[3], const rexarm_real b[3], rexarm_real out[3])
-{
-    out[0] = a[0] - b[0];
-    out[1] = a[1] - b[1];
-    out[2] = a[2] - b[2];
-}
-
-/* v turned about the unit axis k by the angle whose cosine and sine are c and s (Rodrigues). */
-static inline void rexarm_rot(const rexarm_real k[3], rexarm_real c, rexarm_real s, const rexarm_real v[3], rexarm_real out[3])
-{
-    rexarm_real kxv[3];
-    const rexarm_real kv = rexarm_dot(k, v) * (1.0 - c);
-    rexarm_cross(k, v, kxv);
-    out[0] = v[0] * c + kxv[0] * s + k[0] * kv;
-    out[1] = v[1] * c + kxv[1] * s + k[1] * kv;
-    out[2] = v[2] * c + kxv[2] * s + k[2] * kv;
-}
-
-/* atan2(y, x) in (-pi, pi] (0 at the origin), about twice as fast as the C library's: the
- * argument is reduced to t in [-tan(pi/8), tan(pi/8)] with one division and atan(t) =
- * t + t z P(z) / Q(z), z = t^2, by Cephes' minimax approximation (S. L. Moshier); error
- * within 2 ulp. */
-static inline rexarm_real rexarm_atan2(rexarm_real y, rexarm_real x)
-{
-    const rexarm_real ax = fabs(x);
-    const rexarm_real ay = fabs(y);
-    const rexarm_real low = ax < ay ? ax : ay;
-    const rexarm_real high = ax < ay ? ay : ax;
-    rexarm_real t, base, r;
-    if (!(high > 0.0)) {
-        return 0.0;
-    }
-    if (low <= 0.41421356237309503 * high) {
-        t = low / high;
-        base = 0.0;
-    } else {
-        t = (low - high) / (low + high);
-        base = 0.7853981633974483;
-    }
-    {
-        const rexarm_real z = t * t;
-        const rexarm_real z2 = z * z;
-        const rexarm_real z4 = z2 * z2;
-        r = base + (t + t * z * ((-64.85021904942025 - 122.88666844901361 * z) + z2 * (-75.00855792314705 - 16.157537187333652 * z) + z4 * (-0.8750608600031904)) / ((194.5506571482614 + 485.3903996359137 * z) + z2 * (432.88106049129027 + 165.02700983169885 * z) + z4 * (24.858464901423062 + z)));
-    }
-    if (ay > ax) {
-        r = 1.5707963267948966 - r;
-    }
-    if (x < 0.0) {
-        r = 3.141592653589793 - r;
-    }
-    return y < 0.0 ? -r : r;
-}
-
-static inline rexarm_angle rexarm_angle_of(rexarm_real c, rexarm_real s)
-{
-    rexarm_angle angle;
-    angle.theta = rexarm_atan2(s, c);
-    angle.c = c;
-    angle.s = s;
-    return angle;
-}
-
-/* SP1: the angle turning p into q about the unit axis k (least squares when they differ in
- * length or height along k); 0 when p or q lies on the axis (any angle would do). */
-static inline rexarm_angle rexarm_sp1(const rexarm_real p[3], const rexarm_real q[3], const rexarm_real k[3])
-{
-    rexarm_real pxq[3];
-    rexarm_cross(p, q, pxq);
-    {
-        const rexarm_real x = rexarm_dot(p, q) - rexarm_dot(k, p) * rexarm_dot(k, q);
-        const rexarm_real y = rexarm_dot(k, pxq);
-        const rexarm_real rr = x * x + y * y;
-        if (rr <= 1e-24 * rexarm_dot(p, p) * rexarm_dot(q, q)) {
-            return rexarm_angle_of(1.0, 0.0);
-        }
-        {
-            const rexarm_real scale = 1.0 / sqrt(rr);
-            rexarm_angle angle;
-            angle.theta = rexarm_atan2(y, x);
-            angle.c = x * scale;
-            angle.s = y * scale;
-            return angle;
-        }
-    }
-}
-
-/* SP4: the angles t with h . rot(k, t) p = d, out = {phi + alpha, phi - alpha}; returns
- * their count. h . rot(k, t) p = A cos t + B sin t + C. One angle for a double root
- * (sin(alpha)^2 within EPS of 0), none out of range; when the left side does not depend
- * on t, the angle 0 if it equals d. */
-static inline int rexarm_sp4(const rexarm_real h[3], const rexarm_real p[3], const rexarm_real k[3], rexarm_real d, rexarm_angle out[2])
-{
-    rexarm_real kxp[3];
-    const rexarm_real hk = rexarm_dot(h, k);
-    const rexarm_real kp = rexarm_dot(k, p);
-    rexarm_cross(k, p, kxp);
-    {
-        const rexarm_real a = rexarm_dot(h, p) - hk * kp;
-        const rexarm_real b = rexarm_dot(h, kxp);
-        const rexarm_real rhs = d - hk * kp;
-        const rexarm_real r2 = a * a + b * b;
-        const rexarm_real scale = rexarm_dot(h, h) * rexarm_dot(p, p);
-        rexarm_real r, cos_phi, sin_phi, cos_alpha, disc, sin_alpha;
-        if (r2 <= 1e-24 * scale) {
-            if (rhs * rhs > 1e-12 * scale) {
-                return 0;
-            }
-            out[0] = rexarm_angle_of(1.0, 0.0);
-            return 1;
-        }
-        r = sqrt(r2);
-        cos_phi = a / r;
-        sin_phi = b / r;
-        cos_alpha = rhs / r;
-        disc = 1.0 - cos_alpha * cos_alpha;
-        if (disc < -1e-12) {
-            return 0;
-        }
-        if (disc <= 1e-12) {
-            const rexarm_real sign = cos_alpha > 0.0 ? 1.0 : -1.0;
-            out[0] = rexarm_angle_of(sign * cos_phi, sign * sin_phi);
-            return 1;
-        }
-        sin_alpha = sqrt(disc);
-        {
-            /* phi is a constant when h, p and k are (the compiler folds it) */
-            const rexarm_real phi = rexarm_atan2(b, a);
-            const rexarm_real alpha = rexarm_atan2(sin_alpha, cos_alpha);
-            out[0].theta = phi + alpha;
-            out[0].c = cos_phi * cos_alpha - sin_phi * sin_alpha;
-            out[0].s = sin_phi * cos_alpha + cos_phi * sin_alpha;
-            out[1].theta = phi - alpha;
-            out[1].c = cos_phi * cos_alpha + sin_phi * sin_alpha;
-            out[1].s = sin_phi * cos_alpha - cos_phi * sin_alpha;
-        }
-        return 2;
-    }
-}
-
-/* SP3: the angles t with |rot(k, t) p - q|^2 = dd (p, q relative to a point of the axis). */
-static inline int rexarm_sp3(const rexarm_real p[3], const rexarm_real q[3], const rexarm_real k[3], rexarm_real dd, rexarm_angle out[2])
-{
-    return rexarm_sp4(q, p, k, 0.5 * (rexarm_dot(p, p) + rexarm_dot(q, q) - dd), out);
-}
-
-/* Base yaw + three parallel pitch axes: the pitch fixes the sum phi of the pitch angles (SP4
- * on the tool's x axis), the base yaw puts the target in the arm's plane (SP4), and the wrist
- * point is reached by SP3 (elbow) and SP1 (shoulder). */
-static int rexarm_ik_solve(const rexarm_real mu[REXARM_TASK_DIM], const rexarm_ik_geometry *g, rexarm_real q[])
-{
-    static const rexarm_real up[3] = {0.0, 0.0, 1.0};
-    const rexarm_real target[3] = {mu[0], mu[1], mu[2]};
-    rexarm_real d[3], a[3], b[3];
-    rexarm_angle base[2], approach[2];
-    int count = 0, n_base, n_approach, i, j, k;
-    if (fabs(mu[3]) > 1.5707963267948966) {
-        return 0;
-    }
-    n_approach = rexarm_sp4(up, g->tool_x, g->h2, -sin(mu[3]), approach);
-    rexarm_sub(target, g->p1, d);
-    rexarm_sub(g->p4, g->p3, a);
-    rexarm_sub(g->p2, g->p3, b);
-    n_base = rexarm_sp4(d, g->h2, g->h1, g->reach, base);
-    for (i = 0; i < n_base; ++i) {
-        rexarm_real w[3];
-        rexarm_rot(g->h1, base[i].c, -base[i].s, d, w);
-        rexarm_add(w, g->p1, w);
-        for (j = 0; j < n_approach; ++j) {
-            rexarm_real e[3];
-            rexarm_angle elbow[2];
-            int n_elbow;
-            rexarm_sub(g->tool_point, g->p4, e);
-            rexarm_rot(g->h2, approach[j].c, approach[j].s, e, e);
-            rexarm_sub(w, e, e);
-            rexarm_sub(e, g->p2, e);
-            n_elbow = rexarm_sp3(a, b, g->h3, rexarm_dot(e, e), elbow);
-            for (k = 0; k < n_elbow; ++k) {
-                rexarm_real *out = q + REXARM_DOF * count++;
-                rexarm_real f[3];
-                rexarm_angle shoulder;
-                rexarm_rot(g->h3, elbow[k].c, elbow[k].s, a, f);
-                rexarm_add(f, g->p3, f);
-                rexarm_sub(f, g->p2, f);
-                shoulder = rexarm_sp1(f, e, g->h2);
-                out[0] = base[i].theta;
-                out[1] = shoulder.theta;
-                out[2] = elbow[k].theta;
-                out[3] = g->sign4 * (approach[j].theta - shoulder.theta - g->sign3 * elbow[k].theta);
-            }
-        }
-    }
-    return count;
-}
-
-int rexarm_ik(const rexarm_real mu[REXARM_TASK_DIM], rexarm_real q[REXARM_MAX_IK_SOLUTIONS * REXARM_DOF])
-{
-    const rexarm_ik_geometry g = {
-        .h1 = {0, 0, 1},
-        .p1 = {0, 0, 0},
-        .h2 = {0, -1, 0},
-        .p2 = {0, 0, 0.12},
-        .h3 = {0, -1, 0},
-        .p3 = {0, 0, 0.22},
-        .p4 = {0, 0, 0.32},
-        .tool_x = {0, 0, 1},
-        .tool_point = {0, 0, 0.42},
-        .reach = 0,
-        .sign3 = 1,
-        .sign4 = 1,
-    };
-    int count, k;
-    for (k = 0; k < REXARM_TASK_DIM; ++k) {
-        if (!isfinite(mu[k])) {
-            return 0;
-        }
-    }
-    count = rexarm_ik_solve(mu, &g, q);
-    for (k = 0; k < count; ++k) {
-        q[REXARM_DOF * k + 0] = rexarm_wrap(q[REXARM_DOF * k + 0]);
-        q[REXARM_DOF * k + 1] = rexarm_wrap(q[REXARM_DOF * k + 1]);
-        q[REXARM_DOF * k + 2] = rexarm_wrap(q[REXARM_DOF * k + 2]);
-        q[REXARM_DOF * k + 3] = rexarm_wrap(q[REXARM_DOF * k + 3]);
-    }
-    return count;
-}
-
-/* -- Iterative inverse kinematics -- */
 
 /* Error target - mu(q) (angles wrapped into (-pi, pi]) and the task Jacobian. */
 static void rexarm_task_error(const rexarm_real target[REXARM_TASK_DIM], const rexarm_real q[REXARM_DOF], rexarm_real e[REXARM_TASK_DIM],

@@ -30,6 +30,7 @@ typedef double rexarm_real;
 #define REXARM_DOF 4
 #define REXARM_TASK_DIM 4
 #define REXARM_NUM_SINGULARITY_FACTORS 2
+#define REXARM_MAX_IK_SOLUTIONS 8
 
 /* Pose of the tool frame in the world frame (4x4 homogeneous).
  * Result: T: 4 x 4 row-major, element (r, c) at T[r * 4 + c]. 46 operations. */
@@ -67,6 +68,10 @@ rexarm_real rexarm_manipulability(const rexarm_real q[REXARM_DOF]);
  * Result: returned as a scalar. 45 operations. */
 rexarm_real rexarm_jacobian_det(const rexarm_real q[REXARM_DOF]);
 
+/* Every branch of the closed-form ik and whether the target allows it.
+ * Result: q: 8 x 4 row-major, element (r, c) at q[r * 4 + c]; valid[i], i < 8. 552 operations. */
+void rexarm_ik_branches(const rexarm_real mu[REXARM_TASK_DIM], rexarm_real q[REXARM_MAX_IK_SOLUTIONS * REXARM_DOF], int valid[REXARM_MAX_IK_SOLUTIONS]);
+
 /* Status of rexarm_velocity_ik. */
 #define REXARM_VELOCITY_IK_OK 0
 #define REXARM_VELOCITY_IK_SINGULAR 1   /* a pivot below 1e-12 x the largest |entry|: take damping > 0 */
@@ -80,11 +85,9 @@ rexarm_real rexarm_jacobian_det(const rexarm_real q[REXARM_DOF]);
  * REXARM_VELOCITY_IK_OK, or a status above with q_dot all 0. */
 int rexarm_velocity_ik(const rexarm_real q[REXARM_DOF], const rexarm_real mu_dot[REXARM_TASK_DIM], rexarm_real damping, rexarm_real q_dot[REXARM_DOF]);
 
-#define REXARM_MAX_IK_SOLUTIONS 8
-
 /* Closed-form inverse kinematics: every joint solution that reaches the target; returns
- * their count k and writes solution i to q[i * REXARM_DOF + j], i < k. Loops over
- * the branches, no allocation, no recursion.
+ * their count k and writes solution i to q[i * REXARM_DOF + j], i < k: the valid
+ * rows of rexarm_ik_branches, in its order. No allocation, no recursion.
  * target: the task vector (x, y, z, pitch), pitch in [-pi/2, pi/2].
  * Result: k <= REXARM_MAX_IK_SOLUTIONS solutions, revolute angles wrapped into (-pi, pi],
  * joint limits not applied; k = 0 when the target is out of reach or not finite.

@@ -16,16 +16,18 @@ DOF = 4
 TASK = ("x", "y", "z", "pitch", )
 
 
-def _joints(q):
-    q = numpy.asarray(q, dtype=float)
-    if q.ndim == 0 or q.shape[-1] != DOF:
-        raise ValueError(f"q must have shape ({DOF},) or (..., {DOF}), got {q.shape}")
-    return q
+def _argument(name, value, shape):
+    """`value` as a float array of `shape` or a batch of them (..., *shape)."""
+    value = numpy.asarray(value, dtype=float)
+    if value.shape[value.ndim - len(shape):] != shape:
+        batch = ", ".join(map(str, shape))
+        raise ValueError(f"{name} must have shape {shape} or (..., {batch}), got {value.shape}")
+    return value
 
 
 def fk(q):
     """pose of the tool frame in the world frame (4x4 homogeneous): (4 x 4), 46 operations."""
-    q = _joints(q)
+    q = _argument("q", q, (4,))
     q1 = q[..., 0]
     q2 = q[..., 1]
     q3 = q[..., 2]
@@ -75,7 +77,7 @@ def fk(q):
 
 def jacobian(q):
     """geometric Jacobian in the world frame (6 x DOF, rows vx vy vz wx wy wz): (6 x 4), 64 operations."""
-    q = _joints(q)
+    q = _argument("q", q, (4,))
     q1 = q[..., 0]
     q2 = q[..., 1]
     q3 = q[..., 2]
@@ -133,7 +135,7 @@ def jacobian(q):
 
 def fk_jacobian(q):
     """fk and jacobian in one pass, sharing their terms: (4 x 4 and 6 x 4), 72 operations."""
-    q = _joints(q)
+    q = _argument("q", q, (4,))
     q1 = q[..., 0]
     q2 = q[..., 1]
     q3 = q[..., 2]
@@ -211,7 +213,7 @@ def fk_jacobian(q):
 
 def jacobian_tool(q):
     """geometric Jacobian in the tool frame (6 x DOF, rows vx vy vz wx wy wz): (6 x 4), 97 operations."""
-    q = _joints(q)
+    q = _argument("q", q, (4,))
     q1 = q[..., 0]
     q2 = q[..., 1]
     q3 = q[..., 2]
@@ -282,7 +284,7 @@ def jacobian_tool(q):
 
 def task(q):
     """task vector mu = (x, y, z, pitch): (4 x 1), 49 operations."""
-    q = _joints(q)
+    q = _argument("q", q, (4,))
     q1 = q[..., 0]
     q2 = q[..., 1]
     q3 = q[..., 2]
@@ -319,7 +321,7 @@ def task(q):
 
 def task_jacobian(q):
     """analytic Jacobian d mu / d q (4 x DOF): (4 x 4), 73 operations."""
-    q = _joints(q)
+    q = _argument("q", q, (4,))
     q1 = q[..., 0]
     q2 = q[..., 1]
     q3 = q[..., 2]
@@ -373,7 +375,7 @@ def task_jacobian(q):
 
 def singularity_factors(q):
     """factors of det(Js): the robot is singular where one is 0: (2 x 1), 22 operations."""
-    q = _joints(q)
+    q = _argument("q", q, (4,))
     q2 = q[..., 1]
     q3 = q[..., 2]
     q4 = q[..., 3]
@@ -392,7 +394,7 @@ def singularity_factors(q):
 
 def manipulability(q):
     """manipulability |det(Js)|: (1 x 1), 46 operations."""
-    q = _joints(q)
+    q = _argument("q", q, (4,))
     q1 = q[..., 0]
     q2 = q[..., 1]
     q3 = q[..., 2]
@@ -419,7 +421,7 @@ def manipulability(q):
 
 def jacobian_det(q):
     """det(Js): (1 x 1), 45 operations."""
-    q = _joints(q)
+    q = _argument("q", q, (4,))
     q1 = q[..., 0]
     q2 = q[..., 1]
     q3 = q[..., 2]
@@ -443,123 +445,271 @@ def jacobian_det(q):
     return d
 
 
-def _wrap(angle):
-    """Angles wrapped into (-pi, pi]."""
-    return angle - 2.0 * math.pi * numpy.ceil((angle - math.pi) / (2.0 * math.pi))
+@numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
+def ik_branches(mu):
+    """every branch of the closed-form ik and whether the target allows it: (8 x 4 and 8 x 1), 552 operations."""
+    mu = _argument("mu", mu, (4,))
+    mu0 = mu[..., 0]
+    mu1 = mu[..., 1]
+    mu2 = mu[..., 2]
+    mu3 = mu[..., 3]
+    t0 = numpy.sin(mu3)
+    t1 = numpy.arctan2(mu0, -mu1)
+    t2 = mu0 + mu1 + mu2 + mu3
+    t3 = t0**2
+    t4 = 1 - t3
+    t5 = numpy.less(1e-12, t4)
+    t6 = numpy.where(t5, -t0, numpy.where(numpy.less(t0, 0), 1, -1))
+    t7 = numpy.where(t5, numpy.sqrt(t4), 0)
+    t8 = numpy.arctan2(t7, t6)
+    t9 = False
+    t10 = numpy.where(t9, 0, t8)
+    t11 = numpy.where(t9, 1, t6)
+    t12 = numpy.where(t9, 0, t7)
+    t13 = mu0**2 + mu1**2
+    t14 = t13
+    t15 = mu2**2 + t13
+    t16 = 1/numpy.sqrt(t14)
+    t17 = True
+    t18 = numpy.where(t17, 0, -1)
+    t19 = numpy.where(t17, 1, 0)
+    t20 = numpy.arctan2(t19, t18)
+    t21 = t1 - t20
+    t22 = 1e-24*t15
+    t23 = numpy.less_equal(t14, t22)
+    t24 = numpy.where(t23, 0, t1 + t20)
+    t25 = t16*t18
+    t26 = mu1*t25
+    t27 = t16*t19
+    t28 = mu0*t27
+    t29 = numpy.where(t23, 1, -t26 - t28)
+    t30 = -t26 + t28
+    t31 = mu2*(1 - t29)
+    t32 = mu2*t29 + t31
+    t33 = mu2*(1 - t30)
+    t34 = mu2*t30 + t33
+    t35 = mu0*t25
+    t36 = mu1*t27
+    t37 = numpy.where(t23, 0, t35 - t36)
+    t38 = t35 + t36
+    t39 = mu0*t29 + mu1*t37
+    t40 = -mu0*t37 + mu1*t29
+    t41 = mu0*t30 + mu1*t38
+    t42 = -mu0*t38 + mu1*t30
+    t43 = 0.1*t12
+    t44 = t39 + t43
+    t45 = t41 + t43
+    t46 = -0.1*t11
+    t47 = t32 + t46
+    t48 = t47 - 0.12
+    t49 = t34 + t46
+    t50 = t49 - 0.12
+    t51 = t40**2
+    t52 = t44**2 + t48**2 + t51
+    t53 = 0.01 - 0.5*t52
+    t54 = t53**2
+    t55 = 1 - 10000*t54
+    t56 = numpy.less(1e-12, t55)
+    t57 = numpy.where(t56, 100*t53, numpy.where(numpy.greater(t53, 0), 1, -1))
+    t58 = numpy.where(t56, numpy.sqrt(t55), 0)
+    t59 = numpy.arctan2(t58, t57)
+    t60 = numpy.where(t9, 0, t59 + 3.141592653589793)
+    t61 = numpy.where(t9, 1, -t57)
+    t62 = numpy.where(t9, 0, -t58)
+    t63 = 3.141592653589793 - t59
+    t64 = 0.1*t61 + 0.22
+    t65 = t64 - 0.12
+    t66 = 0.01*t62**2 + t65**2
+    t67 = 0.22 - 0.1*t57
+    t68 = t67 - 0.12
+    t69 = 0.01*t58**2 + t68**2
+    t70 = 0.1*t62
+    t71 = -t44*t70 + t48*t65
+    t72 = t44*t65 + t48*t70
+    t73 = t71**2 + t72**2
+    t74 = 0.1*t58
+    t75 = -t44*t74 + t48*t68
+    t76 = t44*t68 + t48*t74
+    t77 = t75**2 + t76**2
+    t78 = -0.1*t7
+    t79 = t39 + t78
+    t80 = t41 + t78
+    t81 = -0.1*t6
+    t82 = t32 + t81
+    t83 = t82 - 0.12
+    t84 = t51 + t79**2 + t83**2
+    t85 = 0.01 - 0.5*t84
+    t86 = t34 + t81
+    t87 = t86 - 0.12
+    t88 = t85**2
+    t89 = 1 - 10000*t88
+    t90 = numpy.less(1e-12, t89)
+    t91 = numpy.where(t90, 100*t85, numpy.where(numpy.greater(t85, 0), 1, -1))
+    t92 = numpy.where(t90, numpy.sqrt(t89), 0)
+    t93 = numpy.arctan2(t92, t91)
+    t94 = numpy.where(t9, 0, t93 + 3.141592653589793)
+    t95 = numpy.where(t9, 1, -t91)
+    t96 = numpy.where(t9, 0, -t92)
+    t97 = 3.141592653589793 - t93
+    t98 = 0.1*t95 + 0.22
+    t99 = t98 - 0.12
+    t100 = 0.01*t96**2 + t99**2
+    t101 = 0.22 - 0.1*t91
+    t102 = t101 - 0.12
+    t103 = t102**2 + 0.01*t92**2
+    t104 = 0.1*t96
+    t105 = -t104*t79 + t83*t99
+    t106 = t104*t83 + t79*t99
+    t107 = t105**2 + t106**2
+    t108 = 0.1*t92
+    t109 = t102*t83 - t108*t79
+    t110 = t102*t79 + t108*t83
+    t111 = t109**2 + t110**2
+    t112 = t42**2
+    t113 = t112 + t45**2 + t50**2
+    t114 = 0.01 - 0.5*t113
+    t115 = t112 + t80**2 + t87**2
+    t116 = 0.01 - 0.5*t115
+    t117 = t114**2
+    t118 = 1 - 10000*t117
+    t119 = numpy.less(1e-12, t118)
+    t120 = numpy.where(t119, 100*t114, numpy.where(numpy.greater(t114, 0), 1, -1))
+    t121 = numpy.where(t119, numpy.sqrt(t118), 0)
+    t122 = numpy.arctan2(t121, t120)
+    t123 = numpy.where(t9, 0, t122 + 3.141592653589793)
+    t124 = numpy.where(t9, 1, -t120)
+    t125 = numpy.where(t9, 0, -t121)
+    t126 = 3.141592653589793 - t122
+    t127 = 0.1*t124 + 0.22
+    t128 = t127 - 0.12
+    t129 = 0.01*t125**2 + t128**2
+    t130 = 0.22 - 0.1*t120
+    t131 = t130 - 0.12
+    t132 = 0.01*t121**2 + t131**2
+    t133 = 0.1*t125
+    t134 = t128*t50 - t133*t45
+    t135 = t128*t45 + t133*t50
+    t136 = t134**2 + t135**2
+    t137 = 0.1*t121
+    t138 = t131*t50 - t137*t45
+    t139 = t131*t45 + t137*t50
+    t140 = t138**2 + t139**2
+    t141 = t116**2
+    t142 = 1 - 10000*t141
+    t143 = numpy.less(1e-12, t142)
+    t144 = numpy.where(t143, 100*t116, numpy.where(numpy.greater(t116, 0), 1, -1))
+    t145 = numpy.where(t143, numpy.sqrt(t142), 0)
+    t146 = numpy.arctan2(t145, t144)
+    t147 = numpy.where(t9, 0, t146 + 3.141592653589793)
+    t148 = numpy.where(t9, 1, -t144)
+    t149 = numpy.where(t9, 0, -t145)
+    t150 = 3.141592653589793 - t146
+    t151 = 0.1*t148 + 0.22
+    t152 = t151 - 0.12
+    t153 = 0.01*t149**2 + t152**2
+    t154 = 0.22 - 0.1*t144
+    t155 = t154 - 0.12
+    t156 = 0.01*t145**2 + t155**2
+    t157 = 0.1*t149
+    t158 = t152*t87 - t157*t80
+    t159 = t152*t80 + t157*t87
+    t160 = t158**2 + t159**2
+    t161 = 0.1*t145
+    t162 = t155*t87 - t161*t80
+    t163 = t155*t80 + t161*t87
+    t164 = t162**2 + t163**2
+    t165 = t24 - 6.283185307179586*numpy.ceil(0.15915494309189535*t24 - 0.5)
+    t166 = 1e-24*t52
+    t167 = numpy.where(numpy.less_equal(t73, t166*t66), 0, numpy.arctan2(-t72, t71))
+    t168 = -t10
+    t169 = t168 + 3.141592653589793
+    t170 = t167 + t60
+    t171 = numpy.where(numpy.less_equal(t77, t166*t69), 0, numpy.arctan2(-t76, t75))
+    t172 = t171 + t63
+    t173 = 1e-24*t84
+    t174 = numpy.where(numpy.less_equal(t107, t100*t173), 0, numpy.arctan2(-t106, t105))
+    t175 = t8 + 3.141592653589793
+    t176 = t174 + t94
+    t177 = numpy.where(numpy.less_equal(t111, t103*t173), 0, numpy.arctan2(-t110, t109))
+    t178 = t177 + t97
+    t179 = t21 - 6.283185307179586*numpy.ceil(0.15915494309189535*t21 - 0.5)
+    t180 = 1e-24*t113
+    t181 = numpy.where(numpy.less_equal(t136, t129*t180), 0, numpy.arctan2(-t135, t134))
+    t182 = t123 + t181
+    t183 = numpy.where(numpy.less_equal(t140, t132*t180), 0, numpy.arctan2(-t139, t138))
+    t184 = t126 + t183
+    t185 = 1e-24*t115
+    t186 = numpy.where(numpy.less_equal(t160, t153*t185), 0, numpy.arctan2(-t159, t158))
+    t187 = t147 + t186
+    t188 = numpy.where(numpy.less_equal(t164, t156*t185), 0, numpy.arctan2(-t163, t162))
+    t189 = t150 + t188
+    t190 = numpy.isfinite(t2)
+    t191 = numpy.less_equal(abs(mu3), 1.5707963267948966)
+    t192 = numpy.greater(t14, t22)
+    t193 = t192 | (t23 & (numpy.less_equal(0, 1e-12*t15)))
+    t194 = True
+    t195 = -1e-12
+    t196 = t194 & (numpy.greater_equal(t4, t195))
+    t197 = 1e-28
+    t198 = numpy.greater(0.0001, t197)
+    t199 = numpy.less_equal(0.0001, t197)
+    t200 = 1e-16
+    t201 = numpy.greater(t4, 1e-12)
+    t202 = True
+    q = numpy.empty(mu.shape[:-1] + (8, 4))
+    q[..., 0, 0] = t165
+    q[..., 0, 1] = t167
+    q[..., 0, 2] = t60 - 6.283185307179586*numpy.ceil(0.15915494309189535*t60 - 0.5)
+    q[..., 0, 3] = -t168 - t170 - 6.283185307179586*numpy.ceil(-0.15915494309189535*t169 - 0.15915494309189535*t170)
+    q[..., 1, 0] = t165
+    q[..., 1, 1] = t171
+    q[..., 1, 2] = t63 - 6.283185307179586*numpy.ceil(0.15915494309189535*t63 - 0.5)
+    q[..., 1, 3] = -t168 - t172 - 6.283185307179586*numpy.ceil(-0.15915494309189535*t169 - 0.15915494309189535*t172)
+    q[..., 2, 0] = t165
+    q[..., 2, 1] = t174
+    q[..., 2, 2] = t94 - 6.283185307179586*numpy.ceil(0.15915494309189535*t94 - 0.5)
+    q[..., 2, 3] = -t176 - t8 - 6.283185307179586*numpy.ceil(-0.15915494309189535*t175 - 0.15915494309189535*t176)
+    q[..., 3, 0] = t165
+    q[..., 3, 1] = t177
+    q[..., 3, 2] = t97 - 6.283185307179586*numpy.ceil(0.15915494309189535*t97 - 0.5)
+    q[..., 3, 3] = -t178 - t8 - 6.283185307179586*numpy.ceil(-0.15915494309189535*t175 - 0.15915494309189535*t178)
+    q[..., 4, 0] = t179
+    q[..., 4, 1] = t181
+    q[..., 4, 2] = t123 - 6.283185307179586*numpy.ceil(0.15915494309189535*t123 - 0.5)
+    q[..., 4, 3] = -t168 - t182 - 6.283185307179586*numpy.ceil(-0.15915494309189535*t169 - 0.15915494309189535*t182)
+    q[..., 5, 0] = t179
+    q[..., 5, 1] = t183
+    q[..., 5, 2] = t126 - 6.283185307179586*numpy.ceil(0.15915494309189535*t126 - 0.5)
+    q[..., 5, 3] = -t168 - t184 - 6.283185307179586*numpy.ceil(-0.15915494309189535*t169 - 0.15915494309189535*t184)
+    q[..., 6, 0] = t179
+    q[..., 6, 1] = t186
+    q[..., 6, 2] = t147 - 6.283185307179586*numpy.ceil(0.15915494309189535*t147 - 0.5)
+    q[..., 6, 3] = -t187 - t8 - 6.283185307179586*numpy.ceil(-0.15915494309189535*t175 - 0.15915494309189535*t187)
+    q[..., 7, 0] = t179
+    q[..., 7, 1] = t188
+    q[..., 7, 2] = t150 - 6.283185307179586*numpy.ceil(0.15915494309189535*t150 - 0.5)
+    q[..., 7, 3] = -t189 - t8 - 6.283185307179586*numpy.ceil(-0.15915494309189535*t175 - 0.15915494309189535*t189)
+    valid = numpy.empty(mu.shape[:-1] + (8,), dtype=bool)
+    valid[..., 0] = t190 & t191 & t193 & t196 & ((t198 & (numpy.greater_equal(t55, t195))) | (t199 & (numpy.less_equal(t54, t200))))
+    valid[..., 1] = t190 & t191 & t193 & t196 & t198 & (numpy.greater(t55, 1e-12))
+    valid[..., 2] = t190 & t191 & t193 & t194 & t201 & ((t198 & (numpy.greater_equal(t89, t195))) | (t199 & (numpy.less_equal(t88, t200))))
+    valid[..., 3] = t190 & t191 & t193 & t194 & t198 & t201 & (numpy.greater(t89, 1e-12))
+    valid[..., 4] = t190 & t191 & t192 & t196 & t202 & ((t198 & (numpy.greater_equal(t118, t195))) | (t199 & (numpy.less_equal(t117, t200))))
+    valid[..., 5] = t190 & t191 & t192 & t196 & t198 & t202 & (numpy.greater(t118, 1e-12))
+    valid[..., 6] = t190 & t191 & t192 & t194 & t201 & t202 & ((t198 & (numpy.greater_equal(t142, t195))) | (t199 & (numpy.less_equal(t141, t200))))
+    valid[..., 7] = t190 & t191 & t192 & t194 & t198 & t201 & t202 & (numpy.greater(t142, 1e-12))
+    return q, valid
 
-
-# -- Closed-form inverse kinematics (yaw_pitch) --
 
 MAX_IK_SOLUTIONS = 8
-_EPS = 1e-12  # a squared sine within this of 0 is a double root
-_TINY = 1e-24  # relative squared length below which a vector counts as zero
 
 
-def _dot(a, b):
-    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+def ik(mu):
+    """Closed-form inverse kinematics: every joint solution that reaches the target.
 
-
-def _cross(a, b):
-    return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
-
-
-def _add(a, b):
-    return (a[0] + b[0], a[1] + b[1], a[2] + b[2])
-
-
-def _sub(a, b):
-    return (a[0] - b[0], a[1] - b[1], a[2] - b[2])
-
-
-def _rot(k, c, s, v):
-    """v turned about the unit axis k by the angle whose cosine and sine are c and s (Rodrigues)."""
-    kxv = _cross(k, v)
-    kv = _dot(k, v) * (1.0 - c)
-    return (v[0] * c + kxv[0] * s + k[0] * kv, v[1] * c + kxv[1] * s + k[1] * kv,
-            v[2] * c + kxv[2] * s + k[2] * kv)
-
-
-class _Angle:
-    """An angle with its cosine and sine."""
-
-    __slots__ = ("theta", "c", "s")
-
-    def __init__(self, theta, c, s):
-        self.theta, self.c, self.s = theta, c, s
-
-
-def _angle(c, s):
-    return _Angle(math.atan2(s, c), c, s)
-
-
-def _sp1(p, q, k):
-    """SP1: the angle turning p into q about the unit axis k (least squares when they differ
-    in length or height along k). 0 when p or q lies on the axis (any angle would do)."""
-    x = _dot(p, q) - _dot(k, p) * _dot(k, q)
-    y = _dot(k, _cross(p, q))
-    r = math.hypot(x, y)
-    if r * r <= _TINY * _dot(p, p) * _dot(q, q):
-        return _Angle(0.0, 1.0, 0.0)
-    return _angle(x / r, y / r)
-
-
-def _sp4(h, p, k, d):
-    """SP4: the angles t with h . rot(k, t) p = d, as [phi + alpha, phi - alpha].
-
-    h . rot(k, t) p = A cos t + B sin t + C. One angle for a double root (|sin alpha|^2 <=
-    _EPS), none out of range; when the left side does not depend on t, [0] if it equals d.
-    """
-    hk, kp = _dot(h, k), _dot(k, p)
-    a = _dot(h, p) - hk * kp
-    b = _dot(h, _cross(k, p))
-    rhs = d - hk * kp
-    r2 = a * a + b * b
-    scale = _dot(h, h) * _dot(p, p)
-    if r2 <= _TINY * scale:
-        return [_Angle(0.0, 1.0, 0.0)] if rhs * rhs <= _EPS * scale else []
-    r = math.sqrt(r2)
-    cos_phi, sin_phi, cos_alpha = a / r, b / r, rhs / r
-    disc = 1.0 - cos_alpha * cos_alpha
-    if disc < -_EPS:
-        return []
-    if disc <= _EPS:
-        sign = 1.0 if cos_alpha > 0.0 else -1.0
-        return [_angle(sign * cos_phi, sign * sin_phi)]
-    sin_alpha = math.sqrt(disc)
-    phi, alpha = math.atan2(b, a), math.atan2(sin_alpha, cos_alpha)
-    return [_Angle(phi + alpha, cos_phi * cos_alpha - sin_phi * sin_alpha, sin_phi * cos_alpha + cos_phi * sin_alpha),
-            _Angle(phi - alpha, cos_phi * cos_alpha + sin_phi * sin_alpha, sin_phi * cos_alpha - cos_phi * sin_alpha)]
-
-
-def _sp3(p, q, k, dd):
-    """SP3: the angles t with |rot(k, t) p - q|^2 = dd (p, q relative to a point of the axis)."""
-    return _sp4(q, p, k, 0.5 * (_dot(p, p) + _dot(q, q) - dd))
-
-
-def _ik_solve(mu, h1, p1, h2, p2, h3, p3, p4, tool_x, tool_point, reach, sign3, sign4):
-    """Base yaw + three parallel pitch axes: the pitch fixes the sum phi of the pitch angles
-    (SP4 on the tool's x axis), the base yaw puts the target in the arm's plane (SP4), and
-    the wrist point is reached by SP3 (elbow) and SP1 (shoulder)."""
-    target = (mu[0], mu[1], mu[2])
-    if abs(mu[3]) > 0.5 * math.pi:
-        return []
-    approaches = _sp4((0.0, 0.0, 1.0), tool_x, h2, -math.sin(mu[3]))
-    solutions = []
-    for base in _sp4(_sub(target, p1), h2, h1, reach):
-        w = _add(p1, _rot(h1, base.c, -base.s, _sub(target, p1)))
-        for phi in approaches:
-            wrist = _sub(w, _rot(h2, phi.c, phi.s, _sub(tool_point, p4)))
-            d = _sub(wrist, p2)
-            for elbow in _sp3(_sub(p4, p3), _sub(p2, p3), h3, _dot(d, d)):
-                shoulder = _sp1(_sub(_add(p3, _rot(h3, elbow.c, elbow.s, _sub(p4, p3))), p2), d, h2)
-                last = sign4 * (phi.theta - shoulder.theta - sign3 * elbow.theta)
-                solutions.append([base.theta, shoulder.theta, elbow.theta, last])
-    return solutions
-
-
-def ik(target):
-    """Closed-form inverse kinematics: every joint solution that reaches `target`, as (k, DOF).
-
+    One target: the solutions as (k, DOF), the valid rows of ik_branches in its order.
+    A batch of targets: ik_branches' (q, valid), (..., MAX_IK_SOLUTIONS, DOF) and
+    (..., MAX_IK_SOLUTIONS).
     target: the task vector (x, y, z, pitch), pitch in [-pi/2, pi/2].
     Result: k <= MAX_IK_SOLUTIONS solutions, revolute angles wrapped into (-pi, pi], joint
     limits not applied; k = 0 when the target is out of reach or not finite.
@@ -576,29 +726,8 @@ def ik(target):
     root (a target on a singularity or on the workspace boundary) is returned once, and an
     angle the target leaves free (a singular wrist or shoulder) is set to 0.
     """
-    target = numpy.asarray(target, dtype=float)
-    if target.shape != (4,):
-        raise ValueError(f"target must have shape (4,), got {target.shape}")
-    if not numpy.all(numpy.isfinite(target)):
-        return numpy.empty((0, DOF))
-    solutions = _ik_solve(
-        target.tolist(),
-        h1=(0, 0, 1),
-        p1=(0, 0, 0),
-        h2=(0, -1, 0),
-        p2=(0, 0, 0.12),
-        h3=(0, -1, 0),
-        p3=(0, 0, 0.22),
-        p4=(0, 0, 0.32),
-        tool_x=(0, 0, 1),
-        tool_point=(0, 0, 0.42),
-        reach=0,
-        sign3=1,
-        sign4=1,
-    )
-    q = numpy.array(solutions, dtype=float).reshape(-1, DOF)
-    q[:, [0, 1, 2, 3]] = _wrap(q[:, [0, 1, 2, 3]])
-    return q
+    q, valid = ik_branches(mu)
+    return q[valid] if valid.ndim == 1 else (q, valid)
 
 
 # -- Iterative inverse kinematics --
@@ -609,6 +738,11 @@ IK_NUMERIC_STALLED = 2  # no step reduces the error: unreachable target, joint l
 _LOWER = numpy.array([-3.141592653589793, -2.0943951023931953, -2.0943951023931953, -2.0943951023931953])  # joint limits (infinite: none)
 _UPPER = numpy.array([3.141592653589793, 2.0943951023931953, 2.0943951023931953, 2.0943951023931953])
 _DAMPING = (1e-06, 1e-12, 100000000.0)  # added to the diagonal: start, least, most
+
+
+def _wrap(angle):
+    """Angles wrapped into (-pi, pi]."""
+    return angle - 2.0 * math.pi * numpy.ceil((angle - math.pi) / (2.0 * math.pi))
 
 
 def _task_error(target, q):
@@ -671,7 +805,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
     condition number below VELOCITY_IK_RCOND; take damping > 0 there). Where ok is False,
     q_dot is 0: the result never holds NaN.
     """
-    q = _joints(q)
+    q = _argument("q", q, (DOF,))
     mu_dot = numpy.asarray(mu_dot, dtype=float)
     if mu_dot.ndim == 0 or mu_dot.shape[-1] != 4:
         raise ValueError(f"mu_dot must have shape (4,) or (..., 4), got {mu_dot.shape}")

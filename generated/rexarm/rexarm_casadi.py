@@ -3,7 +3,9 @@
 
 4-axis yaw + 3-pitch arm (lecture "RexArm"), standard DH
 Every function takes `q` (4 x 1: radians for revolute joints, m for
-prismatic ones) and returns a rows x cols result whose zeros are structural.
+prismatic ones) and returns a rows x cols result whose zeros are structural; ik_branches
+(also named ik) takes the target instead of q and returns every branch (MAX_IK_SOLUTIONS x
+DOF) and its validity (MAX_IK_SOLUTIONS x 1, 1 or 0).
 Task vector: (x, y, z, pitch).
 """
 
@@ -392,7 +394,262 @@ def _jacobian_det(q):
     return [d]
 
 
-_q = casadi.SX.sym("q", DOF)
+def _ik_branches(mu):
+    """Every branch of the closed-form ik and whether the target allows it: 552 operations."""
+    mu0 = mu[0]
+    mu1 = mu[1]
+    mu2 = mu[2]
+    mu3 = mu[3]
+    t0 = casadi.sin(mu3)
+    t1 = casadi.atan2(mu0, -mu1)
+    t2 = mu0 + mu1 + mu2 + mu3
+    t3 = t0**2
+    t4 = 1 - t3
+    t5 = (1e-12 < t4)
+    t6 = casadi.if_else(t5, -t0, casadi.if_else((t0 < 0), 1, -1))
+    t7 = casadi.if_else(t5, casadi.sqrt(t4), 0)
+    t8 = casadi.atan2(t7, t6)
+    t9 = False
+    t10 = casadi.if_else(t9, 0, t8)
+    t11 = casadi.if_else(t9, 1, t6)
+    t12 = casadi.if_else(t9, 0, t7)
+    t13 = mu0**2 + mu1**2
+    t14 = t13
+    t15 = mu2**2 + t13
+    t16 = 1/casadi.sqrt(t14)
+    t17 = True
+    t18 = casadi.if_else(t17, 0, -1)
+    t19 = casadi.if_else(t17, 1, 0)
+    t20 = casadi.atan2(t19, t18)
+    t21 = t1 - t20
+    t22 = 1e-24*t15
+    t23 = (t14 <= t22)
+    t24 = casadi.if_else(t23, 0, t1 + t20)
+    t25 = t16*t18
+    t26 = mu1*t25
+    t27 = t16*t19
+    t28 = mu0*t27
+    t29 = casadi.if_else(t23, 1, -t26 - t28)
+    t30 = -t26 + t28
+    t31 = mu2*(1 - t29)
+    t32 = mu2*t29 + t31
+    t33 = mu2*(1 - t30)
+    t34 = mu2*t30 + t33
+    t35 = mu0*t25
+    t36 = mu1*t27
+    t37 = casadi.if_else(t23, 0, t35 - t36)
+    t38 = t35 + t36
+    t39 = mu0*t29 + mu1*t37
+    t40 = -mu0*t37 + mu1*t29
+    t41 = mu0*t30 + mu1*t38
+    t42 = -mu0*t38 + mu1*t30
+    t43 = 0.1*t12
+    t44 = t39 + t43
+    t45 = t41 + t43
+    t46 = -0.1*t11
+    t47 = t32 + t46
+    t48 = t47 - 0.12
+    t49 = t34 + t46
+    t50 = t49 - 0.12
+    t51 = t40**2
+    t52 = t44**2 + t48**2 + t51
+    t53 = 0.01 - 0.5*t52
+    t54 = t53**2
+    t55 = 1 - 10000*t54
+    t56 = (1e-12 < t55)
+    t57 = casadi.if_else(t56, 100*t53, casadi.if_else((t53 > 0), 1, -1))
+    t58 = casadi.if_else(t56, casadi.sqrt(t55), 0)
+    t59 = casadi.atan2(t58, t57)
+    t60 = casadi.if_else(t9, 0, t59 + 3.141592653589793)
+    t61 = casadi.if_else(t9, 1, -t57)
+    t62 = casadi.if_else(t9, 0, -t58)
+    t63 = 3.141592653589793 - t59
+    t64 = 0.1*t61 + 0.22
+    t65 = t64 - 0.12
+    t66 = 0.01*t62**2 + t65**2
+    t67 = 0.22 - 0.1*t57
+    t68 = t67 - 0.12
+    t69 = 0.01*t58**2 + t68**2
+    t70 = 0.1*t62
+    t71 = -t44*t70 + t48*t65
+    t72 = t44*t65 + t48*t70
+    t73 = t71**2 + t72**2
+    t74 = 0.1*t58
+    t75 = -t44*t74 + t48*t68
+    t76 = t44*t68 + t48*t74
+    t77 = t75**2 + t76**2
+    t78 = -0.1*t7
+    t79 = t39 + t78
+    t80 = t41 + t78
+    t81 = -0.1*t6
+    t82 = t32 + t81
+    t83 = t82 - 0.12
+    t84 = t51 + t79**2 + t83**2
+    t85 = 0.01 - 0.5*t84
+    t86 = t34 + t81
+    t87 = t86 - 0.12
+    t88 = t85**2
+    t89 = 1 - 10000*t88
+    t90 = (1e-12 < t89)
+    t91 = casadi.if_else(t90, 100*t85, casadi.if_else((t85 > 0), 1, -1))
+    t92 = casadi.if_else(t90, casadi.sqrt(t89), 0)
+    t93 = casadi.atan2(t92, t91)
+    t94 = casadi.if_else(t9, 0, t93 + 3.141592653589793)
+    t95 = casadi.if_else(t9, 1, -t91)
+    t96 = casadi.if_else(t9, 0, -t92)
+    t97 = 3.141592653589793 - t93
+    t98 = 0.1*t95 + 0.22
+    t99 = t98 - 0.12
+    t100 = 0.01*t96**2 + t99**2
+    t101 = 0.22 - 0.1*t91
+    t102 = t101 - 0.12
+    t103 = t102**2 + 0.01*t92**2
+    t104 = 0.1*t96
+    t105 = -t104*t79 + t83*t99
+    t106 = t104*t83 + t79*t99
+    t107 = t105**2 + t106**2
+    t108 = 0.1*t92
+    t109 = t102*t83 - t108*t79
+    t110 = t102*t79 + t108*t83
+    t111 = t109**2 + t110**2
+    t112 = t42**2
+    t113 = t112 + t45**2 + t50**2
+    t114 = 0.01 - 0.5*t113
+    t115 = t112 + t80**2 + t87**2
+    t116 = 0.01 - 0.5*t115
+    t117 = t114**2
+    t118 = 1 - 10000*t117
+    t119 = (1e-12 < t118)
+    t120 = casadi.if_else(t119, 100*t114, casadi.if_else((t114 > 0), 1, -1))
+    t121 = casadi.if_else(t119, casadi.sqrt(t118), 0)
+    t122 = casadi.atan2(t121, t120)
+    t123 = casadi.if_else(t9, 0, t122 + 3.141592653589793)
+    t124 = casadi.if_else(t9, 1, -t120)
+    t125 = casadi.if_else(t9, 0, -t121)
+    t126 = 3.141592653589793 - t122
+    t127 = 0.1*t124 + 0.22
+    t128 = t127 - 0.12
+    t129 = 0.01*t125**2 + t128**2
+    t130 = 0.22 - 0.1*t120
+    t131 = t130 - 0.12
+    t132 = 0.01*t121**2 + t131**2
+    t133 = 0.1*t125
+    t134 = t128*t50 - t133*t45
+    t135 = t128*t45 + t133*t50
+    t136 = t134**2 + t135**2
+    t137 = 0.1*t121
+    t138 = t131*t50 - t137*t45
+    t139 = t131*t45 + t137*t50
+    t140 = t138**2 + t139**2
+    t141 = t116**2
+    t142 = 1 - 10000*t141
+    t143 = (1e-12 < t142)
+    t144 = casadi.if_else(t143, 100*t116, casadi.if_else((t116 > 0), 1, -1))
+    t145 = casadi.if_else(t143, casadi.sqrt(t142), 0)
+    t146 = casadi.atan2(t145, t144)
+    t147 = casadi.if_else(t9, 0, t146 + 3.141592653589793)
+    t148 = casadi.if_else(t9, 1, -t144)
+    t149 = casadi.if_else(t9, 0, -t145)
+    t150 = 3.141592653589793 - t146
+    t151 = 0.1*t148 + 0.22
+    t152 = t151 - 0.12
+    t153 = 0.01*t149**2 + t152**2
+    t154 = 0.22 - 0.1*t144
+    t155 = t154 - 0.12
+    t156 = 0.01*t145**2 + t155**2
+    t157 = 0.1*t149
+    t158 = t152*t87 - t157*t80
+    t159 = t152*t80 + t157*t87
+    t160 = t158**2 + t159**2
+    t161 = 0.1*t145
+    t162 = t155*t87 - t161*t80
+    t163 = t155*t80 + t161*t87
+    t164 = t162**2 + t163**2
+    t165 = t24 - 6.283185307179586*casadi.ceil(0.15915494309189535*t24 - 0.5)
+    t166 = 1e-24*t52
+    t167 = casadi.if_else((t73 <= t166*t66), 0, casadi.atan2(-t72, t71))
+    t168 = -t10
+    t169 = t168 + 3.141592653589793
+    t170 = t167 + t60
+    t171 = casadi.if_else((t77 <= t166*t69), 0, casadi.atan2(-t76, t75))
+    t172 = t171 + t63
+    t173 = 1e-24*t84
+    t174 = casadi.if_else((t107 <= t100*t173), 0, casadi.atan2(-t106, t105))
+    t175 = t8 + 3.141592653589793
+    t176 = t174 + t94
+    t177 = casadi.if_else((t111 <= t103*t173), 0, casadi.atan2(-t110, t109))
+    t178 = t177 + t97
+    t179 = t21 - 6.283185307179586*casadi.ceil(0.15915494309189535*t21 - 0.5)
+    t180 = 1e-24*t113
+    t181 = casadi.if_else((t136 <= t129*t180), 0, casadi.atan2(-t135, t134))
+    t182 = t123 + t181
+    t183 = casadi.if_else((t140 <= t132*t180), 0, casadi.atan2(-t139, t138))
+    t184 = t126 + t183
+    t185 = 1e-24*t115
+    t186 = casadi.if_else((t160 <= t153*t185), 0, casadi.atan2(-t159, t158))
+    t187 = t147 + t186
+    t188 = casadi.if_else((t164 <= t156*t185), 0, casadi.atan2(-t163, t162))
+    t189 = t150 + t188
+    t190 = (casadi.fabs(t2) < casadi.inf)
+    t191 = (casadi.fabs(mu3) <= 1.5707963267948966)
+    t192 = (t14 > t22)
+    t193 = casadi.logic_or(t192, casadi.logic_and(t23, (0 <= 1e-12*t15)))
+    t194 = True
+    t195 = -1e-12
+    t196 = casadi.logic_and(t194, (t4 >= t195))
+    t197 = 1e-28
+    t198 = (0.0001 > t197)
+    t199 = (0.0001 <= t197)
+    t200 = 1e-16
+    t201 = (t4 > 1e-12)
+    t202 = True
+    q = casadi.SX(8, 4)
+    q[0, 0] = t165
+    q[0, 1] = t167
+    q[0, 2] = t60 - 6.283185307179586*casadi.ceil(0.15915494309189535*t60 - 0.5)
+    q[0, 3] = -t168 - t170 - 6.283185307179586*casadi.ceil(-0.15915494309189535*t169 - 0.15915494309189535*t170)
+    q[1, 0] = t165
+    q[1, 1] = t171
+    q[1, 2] = t63 - 6.283185307179586*casadi.ceil(0.15915494309189535*t63 - 0.5)
+    q[1, 3] = -t168 - t172 - 6.283185307179586*casadi.ceil(-0.15915494309189535*t169 - 0.15915494309189535*t172)
+    q[2, 0] = t165
+    q[2, 1] = t174
+    q[2, 2] = t94 - 6.283185307179586*casadi.ceil(0.15915494309189535*t94 - 0.5)
+    q[2, 3] = -t176 - t8 - 6.283185307179586*casadi.ceil(-0.15915494309189535*t175 - 0.15915494309189535*t176)
+    q[3, 0] = t165
+    q[3, 1] = t177
+    q[3, 2] = t97 - 6.283185307179586*casadi.ceil(0.15915494309189535*t97 - 0.5)
+    q[3, 3] = -t178 - t8 - 6.283185307179586*casadi.ceil(-0.15915494309189535*t175 - 0.15915494309189535*t178)
+    q[4, 0] = t179
+    q[4, 1] = t181
+    q[4, 2] = t123 - 6.283185307179586*casadi.ceil(0.15915494309189535*t123 - 0.5)
+    q[4, 3] = -t168 - t182 - 6.283185307179586*casadi.ceil(-0.15915494309189535*t169 - 0.15915494309189535*t182)
+    q[5, 0] = t179
+    q[5, 1] = t183
+    q[5, 2] = t126 - 6.283185307179586*casadi.ceil(0.15915494309189535*t126 - 0.5)
+    q[5, 3] = -t168 - t184 - 6.283185307179586*casadi.ceil(-0.15915494309189535*t169 - 0.15915494309189535*t184)
+    q[6, 0] = t179
+    q[6, 1] = t186
+    q[6, 2] = t147 - 6.283185307179586*casadi.ceil(0.15915494309189535*t147 - 0.5)
+    q[6, 3] = -t187 - t8 - 6.283185307179586*casadi.ceil(-0.15915494309189535*t175 - 0.15915494309189535*t187)
+    q[7, 0] = t179
+    q[7, 1] = t188
+    q[7, 2] = t150 - 6.283185307179586*casadi.ceil(0.15915494309189535*t150 - 0.5)
+    q[7, 3] = -t189 - t8 - 6.283185307179586*casadi.ceil(-0.15915494309189535*t175 - 0.15915494309189535*t189)
+    valid = casadi.SX(8, 1)
+    valid[0, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t190, t191), t193), t196), casadi.logic_or(casadi.logic_and(t198, (t55 >= t195)), casadi.logic_and(t199, (t54 <= t200))))
+    valid[1, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t190, t191), t193), t196), t198), (t55 > 1e-12))
+    valid[2, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t190, t191), t193), t194), t201), casadi.logic_or(casadi.logic_and(t198, (t89 >= t195)), casadi.logic_and(t199, (t88 <= t200))))
+    valid[3, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t190, t191), t193), t194), t198), t201), (t89 > 1e-12))
+    valid[4, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t190, t191), t192), t196), t202), casadi.logic_or(casadi.logic_and(t198, (t118 >= t195)), casadi.logic_and(t199, (t117 <= t200))))
+    valid[5, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t190, t191), t192), t196), t198), t202), (t118 > 1e-12))
+    valid[6, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t190, t191), t192), t194), t201), t202), casadi.logic_or(casadi.logic_and(t198, (t142 >= t195)), casadi.logic_and(t199, (t141 <= t200))))
+    valid[7, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t190, t191), t192), t194), t198), t201), t202), (t142 > 1e-12))
+    return [q, valid]
+
+
+_q = casadi.SX.sym("q", 4, 1)
+_mu = casadi.SX.sym("mu", 4, 1)
 fk = casadi.Function("fk", [_q], _fk(_q), ["q"], ["T"])
 jacobian = casadi.Function("jacobian", [_q], _jacobian(_q), ["q"], ["J"])
 fk_jacobian = casadi.Function("fk_jacobian", [_q], _fk_jacobian(_q), ["q"], ["T", "J"])
@@ -402,8 +659,10 @@ task_jacobian = casadi.Function("task_jacobian", [_q], _task_jacobian(_q), ["q"]
 singularity_factors = casadi.Function("singularity_factors", [_q], _singularity_factors(_q), ["q"], ["f"])
 manipulability = casadi.Function("manipulability", [_q], _manipulability(_q), ["q"], ["w"])
 jacobian_det = casadi.Function("jacobian_det", [_q], _jacobian_det(_q), ["q"], ["d"])
+ik_branches = casadi.Function("ik_branches", [_mu], _ik_branches(_mu), ["mu"], ["q", "valid"])
+ik = ik_branches  # CasADi functions have fixed-size outputs: every branch and its validity
 
 
 def functions():
     """All functions by name."""
-    return {"fk": fk, "jacobian": jacobian, "fk_jacobian": fk_jacobian, "jacobian_tool": jacobian_tool, "task": task, "task_jacobian": task_jacobian, "singularity_factors": singularity_factors, "manipulability": manipulability, "jacobian_det": jacobian_det}
+    return {"fk": fk, "jacobian": jacobian, "fk_jacobian": fk_jacobian, "jacobian_tool": jacobian_tool, "task": task, "task_jacobian": task_jacobian, "singularity_factors": singularity_factors, "manipulability": manipulability, "jacobian_det": jacobian_det, "ik_branches": ik_branches}

@@ -351,6 +351,69 @@ scara_real scara_jacobian_det(const scara_real q[SCARA_DOF])
     return -t0*t3 + t1*t2;
 }
 
+void scara_ik_branches(const scara_real mu[SCARA_TASK_DIM], scara_real q[SCARA_MAX_IK_SOLUTIONS * SCARA_DOF], int valid[SCARA_MAX_IK_SOLUTIONS])
+{
+    /* 120 operations */
+
+    /* Inputs */
+    const scara_real mu0 = mu[0];
+    const scara_real mu1 = mu[1];
+    const scara_real mu2 = mu[2];
+    const scara_real mu3 = mu[3];
+
+    /* Intermediate terms */
+    const scara_real t0 = (mu0*mu0) + (mu1*mu1) + 0.149769;
+    const scara_real t1 = 0.1655095 - 0.5*t0;
+    const scara_real t2 = mu0 + mu1 + mu2 + mu3;
+    const scara_real t3 = (t1*t1);
+    const scara_real t4 = 1 - 125.18949581886645*t3;
+    const int t5 = 1e-12 < t4;
+    const scara_real t6 = (t5 ? 11.188811188811188*t1 : (t1 > 0 ? 1 : -1));
+    const scara_real t7 = (t5 ? sqrt(t4) : 0);
+    const scara_real t8 = atan2(t7, t6);
+    const scara_real t9 = 3.141592653589793 - t8;
+    const scara_real t10 = 0.325 - 0.275*t6;
+    const scara_real t11 = (t10*t10) + 0.075625*(t7*t7) + 0.149769;
+    const int t12 = 0;
+    const scara_real t13 = (t12 ? 0 : t8 + 3.141592653589793);
+    const scara_real t14 = (t12 ? 1 : -t6);
+    const scara_real t15 = (t12 ? 0 : -t7);
+    const scara_real t16 = 0.275*t14 + 0.325;
+    const scara_real t17 = 0.075625*(t15*t15) + (t16*t16) + 0.149769;
+    const scara_real t18 = 0.275*t15;
+    const scara_real t19 = mu0*t16 + mu1*t18 + 0.149769;
+    const scara_real t20 = t19 - 0.149769;
+    const scara_real t21 = -mu0*t18 + mu1*t16;
+    const scara_real t22 = (t20*t20) + (t21*t21);
+    const scara_real t23 = 0.275*t7;
+    const scara_real t24 = mu0*t10 + mu1*t23 + 0.149769;
+    const scara_real t25 = t24 - 0.149769;
+    const scara_real t26 = -mu0*t23 + mu1*t10;
+    const scara_real t27 = (t25*t25) + (t26*t26);
+    const scara_real t28 = 1e-24*t0;
+    const scara_real t29 = (t22 <= t17*t28 ? 0 : atan2(t21, t20));
+    const scara_real t30 = 0.387 - mu2;
+    const scara_real t31 = -mu3;
+    const scara_real t32 = -t13 - t29 - t31;
+    const scara_real t33 = (t27 <= t11*t28 ? 0 : atan2(t26, t25));
+    const scara_real t34 = -t31 - t33 - t9;
+    const int t35 = isfinite(t2);
+    const scara_real t36 = 1.9314171249999998e-26;
+    const int t37 = 0.007987890625 > t36;
+
+    /* Outputs */
+    q[0] = t29;
+    q[1] = t13 - 6.283185307179586*ceil(0.15915494309189535*t13 - 0.5);
+    q[2] = t30;
+    q[3] = -t32 - 6.283185307179586*ceil(-0.15915494309189535*t32 - 0.5);
+    q[4] = t33;
+    q[5] = t9 - 6.283185307179586*ceil(0.15915494309189535*t9 - 0.5);
+    q[6] = t30;
+    q[7] = -t34 - 6.283185307179586*ceil(-0.15915494309189535*t34 - 0.5);
+    valid[0] = t35 && ((t37 && t4 >= -1e-12) || (0.007987890625 <= t36 && t3 <= 1.931417125e-14));
+    valid[1] = t35 && t37 && t4 > 1e-12;
+}
+
 int scara_velocity_ik(const scara_real q[SCARA_DOF], const scara_real mu_dot[SCARA_TASK_DIM], scara_real damping, scara_real q_dot[SCARA_DOF])
 {
     /* Rows of task_jacobian() forming Js (the task Jacobian). */
@@ -448,8 +511,27 @@ int scara_velocity_ik(const scara_real q[SCARA_DOF], const scara_real mu_dot[SCA
     return SCARA_VELOCITY_IK_OK;
 }
 
-/* The angle wrapped into (-pi, pi], for |angle| < 1e9 (the callers' angles are sums of a few
- * atan2 results): angle - 2 pi ceil((angle - pi) / (2 pi)), ceil by truncation. */
+int scara_ik(const scara_real mu[SCARA_TASK_DIM], scara_real q[SCARA_MAX_IK_SOLUTIONS * SCARA_DOF])
+{
+    scara_real branches[SCARA_MAX_IK_SOLUTIONS * SCARA_DOF];
+    int valid[SCARA_MAX_IK_SOLUTIONS];
+    int count = 0, i, j;
+    scara_ik_branches(mu, branches, valid);
+    for (i = 0; i < SCARA_MAX_IK_SOLUTIONS; ++i) {
+        if (valid[i]) {
+            for (j = 0; j < SCARA_DOF; ++j) {
+                q[SCARA_DOF * count + j] = branches[SCARA_DOF * i + j];
+            }
+            ++count;
+        }
+    }
+    return count;
+}
+
+/* -- Iterative inverse kinematics -- */
+
+/* The angle wrapped into (-pi, pi], for |angle| < 1e9: angle - 2 pi ceil((angle - pi) / (2 pi)),
+ * ceil by truncation. */
 static scara_real scara_wrap(scara_real angle)
 {
     const scara_real turns = (angle - 3.141592653589793) / 6.283185307179586;
@@ -463,264 +545,6 @@ static scara_real scara_wrap(scara_real angle)
     }
     return angle - 6.283185307179586 * whole;
 }
-
-/* -- Closed-form inverse kinematics (planar) -- */
-
-/* The arm at q = 0 (product of exponentials): unit axis directions h, points p on the axes,
- * the tool pose and a few derived constants. */
-typedef struct {
-    scara_real k1[3];
-    scara_real p1[3];
-    scara_real k2[3];
-    scara_real p2[3];
-    scara_real wrist[3];
-    scara_real tool_point[3];
-    scara_real yaw0;
-    scara_real sign1;
-    scara_real sign2;
-    scara_real sign3;
-    scara_real sign_slide;
-} scara_ik_geometry;
-
-/* An angle with its cosine and sine. */
-typedef struct {
-    scara_real theta, c, s;
-} scara_angle;
-
-static inline scara_real scara_dot(const scara_real a[3], const scara_real b[3])
-{
-    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-}
-
-static inline void scara_cross(const scara_real a[3], const scara_real b[3], scara_real out[3])
-{
-    const scara_real x = a[1] * b[2] - a[2] * b[1];
-    const scara_real y = a[2] * b[0] - a[0] * b[2];
-    const scara_real z = a[0] * b[1] - a[1] * b[0];
-    out[0] = x;
-    out[1] = y;
-    out[2] = z;
-}
-
-static inline void scara_add(const scara_real a[3], const scara_real b[3], scara_real out[3])
-{
-    out[0] = a[0] + b[0];
-    out[1] = a[1] + b[1];
-    out[2] = a[2] + b[2];
-}
-
-static inline void scara_sub(const scara_real a[3], const scara_real b[3], scara_real out[3])
-{
-    out[0] = a[0] - b[0];
-    out[1] = a[1] - b[1];
-    out[2] = a[2] - b[2];
-}
-
-/* v turned about the unit axis k by the angle whose cosine and sine are c and s (Rodrigues). */
-static inline void scara_rot(const scara_real k[3], scara_real c, scara_real s, const scara_real v[3], scara_real out[3])
-{
-    scara_real kxv[3];
-    const scara_real kv = scara_dot(k, v) * (1.0 - c);
-    scara_cross(k, v, kxv);
-    out[0] = v[0] * c + kxv[0] * s + k[0] * kv;
-    out[1] = v[1] * c + kxv[1] * s + k[1] * kv;
-    out[2] = v[2] * c + kxv[2] * s + k[2] * kv;
-}
-
-/* atan2(y, x) in (-pi, pi] (0 at the origin), about twice as fast as the C library's: the
- * argument is reduced to t in [-tan(pi/8), tan(pi/8)] with one division and atan(t) =
- * t + t z P(z) / Q(z), z = t^2, by Cephes' minimax approximation (S. L. Moshier); error
- * within 2 ulp. */
-static inline scara_real scara_atan2(scara_real y, scara_real x)
-{
-    const scara_real ax = fabs(x);
-    const scara_real ay = fabs(y);
-    const scara_real low = ax < ay ? ax : ay;
-    const scara_real high = ax < ay ? ay : ax;
-    scara_real t, base, r;
-    if (!(high > 0.0)) {
-        return 0.0;
-    }
-    if (low <= 0.41421356237309503 * high) {
-        t = low / high;
-        base = 0.0;
-    } else {
-        t = (low - high) / (low + high);
-        base = 0.7853981633974483;
-    }
-    {
-        const scara_real z = t * t;
-        const scara_real z2 = z * z;
-        const scara_real z4 = z2 * z2;
-        r = base + (t + t * z * ((-64.85021904942025 - 122.88666844901361 * z) + z2 * (-75.00855792314705 - 16.157537187333652 * z) + z4 * (-0.8750608600031904)) / ((194.5506571482614 + 485.3903996359137 * z) + z2 * (432.88106049129027 + 165.02700983169885 * z) + z4 * (24.858464901423062 + z)));
-    }
-    if (ay > ax) {
-        r = 1.5707963267948966 - r;
-    }
-    if (x < 0.0) {
-        r = 3.141592653589793 - r;
-    }
-    return y < 0.0 ? -r : r;
-}
-
-static inline scara_angle scara_angle_of(scara_real c, scara_real s)
-{
-    scara_angle angle;
-    angle.theta = scara_atan2(s, c);
-    angle.c = c;
-    angle.s = s;
-    return angle;
-}
-
-/* SP1: the angle turning p into q about the unit axis k (least squares when they differ in
- * length or height along k); 0 when p or q lies on the axis (any angle would do). */
-static inline scara_angle scara_sp1(const scara_real p[3], const scara_real q[3], const scara_real k[3])
-{
-    scara_real pxq[3];
-    scara_cross(p, q, pxq);
-    {
-        const scara_real x = scara_dot(p, q) - scara_dot(k, p) * scara_dot(k, q);
-        const scara_real y = scara_dot(k, pxq);
-        const scara_real rr = x * x + y * y;
-        if (rr <= 1e-24 * scara_dot(p, p) * scara_dot(q, q)) {
-            return scara_angle_of(1.0, 0.0);
-        }
-        {
-            const scara_real scale = 1.0 / sqrt(rr);
-            scara_angle angle;
-            angle.theta = scara_atan2(y, x);
-            angle.c = x * scale;
-            angle.s = y * scale;
-            return angle;
-        }
-    }
-}
-
-/* SP4: the angles t with h . rot(k, t) p = d, out = {phi + alpha, phi - alpha}; returns
- * their count. h . rot(k, t) p = A cos t + B sin t + C. One angle for a double root
- * (sin(alpha)^2 within EPS of 0), none out of range; when the left side does not depend
- * on t, the angle 0 if it equals d. */
-static inline int scara_sp4(const scara_real h[3], const scara_real p[3], const scara_real k[3], scara_real d, scara_angle out[2])
-{
-    scara_real kxp[3];
-    const scara_real hk = scara_dot(h, k);
-    const scara_real kp = scara_dot(k, p);
-    scara_cross(k, p, kxp);
-    {
-        const scara_real a = scara_dot(h, p) - hk * kp;
-        const scara_real b = scara_dot(h, kxp);
-        const scara_real rhs = d - hk * kp;
-        const scara_real r2 = a * a + b * b;
-        const scara_real scale = scara_dot(h, h) * scara_dot(p, p);
-        scara_real r, cos_phi, sin_phi, cos_alpha, disc, sin_alpha;
-        if (r2 <= 1e-24 * scale) {
-            if (rhs * rhs > 1e-12 * scale) {
-                return 0;
-            }
-            out[0] = scara_angle_of(1.0, 0.0);
-            return 1;
-        }
-        r = sqrt(r2);
-        cos_phi = a / r;
-        sin_phi = b / r;
-        cos_alpha = rhs / r;
-        disc = 1.0 - cos_alpha * cos_alpha;
-        if (disc < -1e-12) {
-            return 0;
-        }
-        if (disc <= 1e-12) {
-            const scara_real sign = cos_alpha > 0.0 ? 1.0 : -1.0;
-            out[0] = scara_angle_of(sign * cos_phi, sign * sin_phi);
-            return 1;
-        }
-        sin_alpha = sqrt(disc);
-        {
-            /* phi is a constant when h, p and k are (the compiler folds it) */
-            const scara_real phi = scara_atan2(b, a);
-            const scara_real alpha = scara_atan2(sin_alpha, cos_alpha);
-            out[0].theta = phi + alpha;
-            out[0].c = cos_phi * cos_alpha - sin_phi * sin_alpha;
-            out[0].s = sin_phi * cos_alpha + cos_phi * sin_alpha;
-            out[1].theta = phi - alpha;
-            out[1].c = cos_phi * cos_alpha + sin_phi * sin_alpha;
-            out[1].s = sin_phi * cos_alpha - cos_phi * sin_alpha;
-        }
-        return 2;
-    }
-}
-
-/* SP3: the angles t with |rot(k, t) p - q|^2 = dd (p, q relative to a point of the axis). */
-static inline int scara_sp3(const scara_real p[3], const scara_real q[3], const scara_real k[3], scara_real dd, scara_angle out[2])
-{
-    return scara_sp4(q, p, k, 0.5 * (scara_dot(p, p) + scara_dot(q, q) - dd), out);
-}
-
-/* Planar arm: the last revolute joint takes the yaw, the first two put its axis on the wrist
- * point by SP3 (elbow) and SP1 (shoulder); rotations about z keep heights. */
-static int scara_ik_solve(const scara_real mu[SCARA_TASK_DIM], const scara_ik_geometry *g, scara_real q[])
-{
-    const scara_real target[3] = {mu[0], mu[1], g->tool_point[2]};
-    scara_real d[3], a[3], b[3];
-    scara_angle elbow[2];
-    int count, i;
-    static const scara_real up[3] = {0.0, 0.0, 1.0};
-    const scara_real yaw = mu[SCARA_TASK_DIM - 1] - g->yaw0;
-    const scara_angle turn = scara_angle_of(cos(yaw), sin(yaw));
-    const scara_real phi = turn.theta; /* the yaw turn in (-pi, pi] */
-    scara_sub(g->tool_point, g->wrist, a);
-    scara_rot(up, turn.c, turn.s, a, a);
-    scara_sub(target, a, d);
-    scara_sub(d, g->p1, d);
-    scara_sub(g->wrist, g->p2, a);
-    scara_sub(g->p1, g->p2, b);
-    count = scara_sp3(a, b, g->k2, scara_dot(d, d), elbow);
-    for (i = 0; i < count; ++i) {
-        scara_real *out = q + SCARA_DOF * i;
-        scara_real e[3];
-        scara_angle shoulder;
-        scara_rot(g->k2, elbow[i].c, elbow[i].s, a, e);
-        scara_add(e, g->p2, e);
-        scara_sub(e, g->p1, e);
-        shoulder = scara_sp1(e, d, g->k1);
-        out[0] = shoulder.theta;
-        out[1] = elbow[i].theta;
-        out[3] = g->sign3 * (phi - g->sign1 * shoulder.theta - g->sign2 * elbow[i].theta);
-        out[2] = g->sign_slide * (mu[2] - g->tool_point[2]);
-    }
-    return count;
-}
-
-int scara_ik(const scara_real mu[SCARA_TASK_DIM], scara_real q[SCARA_MAX_IK_SOLUTIONS * SCARA_DOF])
-{
-    const scara_ik_geometry g = {
-        .k1 = {0, 0, 1},
-        .p1 = {0, 0, 0},
-        .k2 = {0, 0, 1},
-        .p2 = {0.325, 0, 0.387},
-        .wrist = {0.6, 0, 0.387},
-        .tool_point = {0.6, 0, 0.387},
-        .yaw0 = 0,
-        .sign1 = 1,
-        .sign2 = 1,
-        .sign3 = -1,
-        .sign_slide = -1,
-    };
-    int count, k;
-    for (k = 0; k < SCARA_TASK_DIM; ++k) {
-        if (!isfinite(mu[k])) {
-            return 0;
-        }
-    }
-    count = scara_ik_solve(mu, &g, q);
-    for (k = 0; k < count; ++k) {
-        q[SCARA_DOF * k + 0] = scara_wrap(q[SCARA_DOF * k + 0]);
-        q[SCARA_DOF * k + 1] = scara_wrap(q[SCARA_DOF * k + 1]);
-        q[SCARA_DOF * k + 3] = scara_wrap(q[SCARA_DOF * k + 3]);
-    }
-    return count;
-}
-
-/* -- Iterative inverse kinematics -- */
 
 /* Error target - mu(q) (angles wrapped into (-pi, pi]) and the task Jacobian. */
 static void scara_task_error(const scara_real target[SCARA_TASK_DIM], const scara_real q[SCARA_DOF], scara_real e[SCARA_TASK_DIM],

@@ -30,6 +30,7 @@ typedef double scara_real;
 #define SCARA_DOF 4
 #define SCARA_TASK_DIM 4
 #define SCARA_NUM_SINGULARITY_FACTORS 1
+#define SCARA_MAX_IK_SOLUTIONS 2
 
 /* Pose of the tool frame in the world frame (4x4 homogeneous).
  * Result: T: 4 x 4 row-major, element (r, c) at T[r * 4 + c]. 27 operations. */
@@ -67,6 +68,10 @@ scara_real scara_manipulability(const scara_real q[SCARA_DOF]);
  * Result: returned as a scalar. 19 operations. */
 scara_real scara_jacobian_det(const scara_real q[SCARA_DOF]);
 
+/* Every branch of the closed-form ik and whether the target allows it.
+ * Result: q: 2 x 4 row-major, element (r, c) at q[r * 4 + c]; valid[i], i < 2. 120 operations. */
+void scara_ik_branches(const scara_real mu[SCARA_TASK_DIM], scara_real q[SCARA_MAX_IK_SOLUTIONS * SCARA_DOF], int valid[SCARA_MAX_IK_SOLUTIONS]);
+
 /* Status of scara_velocity_ik. */
 #define SCARA_VELOCITY_IK_OK 0
 #define SCARA_VELOCITY_IK_SINGULAR 1   /* a pivot below 1e-12 x the largest |entry|: take damping > 0 */
@@ -80,11 +85,9 @@ scara_real scara_jacobian_det(const scara_real q[SCARA_DOF]);
  * SCARA_VELOCITY_IK_OK, or a status above with q_dot all 0. */
 int scara_velocity_ik(const scara_real q[SCARA_DOF], const scara_real mu_dot[SCARA_TASK_DIM], scara_real damping, scara_real q_dot[SCARA_DOF]);
 
-#define SCARA_MAX_IK_SOLUTIONS 2
-
 /* Closed-form inverse kinematics: every joint solution that reaches the target; returns
- * their count k and writes solution i to q[i * SCARA_DOF + j], i < k. Loops over
- * the branches, no allocation, no recursion.
+ * their count k and writes solution i to q[i * SCARA_DOF + j], i < k: the valid
+ * rows of scara_ik_branches, in its order. No allocation, no recursion.
  * target: the task vector (x, y, z, yaw).
  * Result: k <= SCARA_MAX_IK_SOLUTIONS solutions, revolute angles wrapped into (-pi, pi],
  * joint limits not applied; k = 0 when the target is out of reach or not finite.

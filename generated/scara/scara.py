@@ -16,16 +16,18 @@ DOF = 4
 TASK = ("x", "y", "z", "yaw", )
 
 
-def _joints(q):
-    q = numpy.asarray(q, dtype=float)
-    if q.ndim == 0 or q.shape[-1] != DOF:
-        raise ValueError(f"q must have shape ({DOF},) or (..., {DOF}), got {q.shape}")
-    return q
+def _argument(name, value, shape):
+    """`value` as a float array of `shape` or a batch of them (..., *shape)."""
+    value = numpy.asarray(value, dtype=float)
+    if value.shape[value.ndim - len(shape):] != shape:
+        batch = ", ".join(map(str, shape))
+        raise ValueError(f"{name} must have shape {shape} or (..., {batch}), got {value.shape}")
+    return value
 
 
 def fk(q):
     """pose of the tool frame in the world frame (4x4 homogeneous): (4 x 4), 27 operations."""
-    q = _joints(q)
+    q = _argument("q", q, (4,))
     q1 = q[..., 0]
     q2 = q[..., 1]
     q3 = q[..., 2]
@@ -65,7 +67,7 @@ def fk(q):
 
 def jacobian(q):
     """geometric Jacobian in the world frame (6 x DOF, rows vx vy vz wx wy wz): (6 x 4), 20 operations."""
-    q = _joints(q)
+    q = _argument("q", q, (4,))
     q1 = q[..., 0]
     q2 = q[..., 1]
     c1 = numpy.cos(q1)
@@ -108,7 +110,7 @@ def jacobian(q):
 
 def fk_jacobian(q):
     """fk and jacobian in one pass, sharing their terms: (4 x 4 and 6 x 4), 31 operations."""
-    q = _joints(q)
+    q = _argument("q", q, (4,))
     q1 = q[..., 0]
     q2 = q[..., 1]
     q3 = q[..., 2]
@@ -175,7 +177,7 @@ def fk_jacobian(q):
 
 def jacobian_tool(q):
     """geometric Jacobian in the tool frame (6 x DOF, rows vx vy vz wx wy wz): (6 x 4), 40 operations."""
-    q = _joints(q)
+    q = _argument("q", q, (4,))
     q1 = q[..., 0]
     q2 = q[..., 1]
     q4 = q[..., 3]
@@ -223,7 +225,7 @@ def jacobian_tool(q):
 
 def task(q):
     """task vector mu = (x, y, z, yaw): (4 x 1), 26 operations."""
-    q = _joints(q)
+    q = _argument("q", q, (4,))
     q1 = q[..., 0]
     q2 = q[..., 1]
     q3 = q[..., 2]
@@ -251,7 +253,7 @@ def task(q):
 
 def task_jacobian(q):
     """analytic Jacobian d mu / d q (4 x DOF): (4 x 4), 20 operations."""
-    q = _joints(q)
+    q = _argument("q", q, (4,))
     q1 = q[..., 0]
     q2 = q[..., 1]
     c1 = numpy.cos(q1)
@@ -286,7 +288,7 @@ def task_jacobian(q):
 
 def singularity_factors(q):
     """factors of det(Js): the robot is singular where one is 0: (1 x 1), 1 operations."""
-    q = _joints(q)
+    q = _argument("q", q, (4,))
     q2 = q[..., 1]
     s2 = numpy.sin(q2)
     f = numpy.empty(q.shape[:-1] + (1,))
@@ -296,7 +298,7 @@ def singularity_factors(q):
 
 def manipulability(q):
     """manipulability |det(Js)|: (1 x 1), 20 operations."""
-    q = _joints(q)
+    q = _argument("q", q, (4,))
     q1 = q[..., 0]
     q2 = q[..., 1]
     c1 = numpy.cos(q1)
@@ -317,7 +319,7 @@ def manipulability(q):
 
 def jacobian_det(q):
     """det(Js): (1 x 1), 19 operations."""
-    q = _joints(q)
+    q = _argument("q", q, (4,))
     q1 = q[..., 0]
     q2 = q[..., 1]
     c1 = numpy.cos(q1)
@@ -335,121 +337,76 @@ def jacobian_det(q):
     return d
 
 
-def _wrap(angle):
-    """Angles wrapped into (-pi, pi]."""
-    return angle - 2.0 * math.pi * numpy.ceil((angle - math.pi) / (2.0 * math.pi))
+@numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
+def ik_branches(mu):
+    """every branch of the closed-form ik and whether the target allows it: (2 x 4 and 2 x 1), 120 operations."""
+    mu = _argument("mu", mu, (4,))
+    mu0 = mu[..., 0]
+    mu1 = mu[..., 1]
+    mu2 = mu[..., 2]
+    mu3 = mu[..., 3]
+    t0 = mu0**2 + mu1**2 + 0.149769
+    t1 = 0.1655095 - 0.5*t0
+    t2 = mu0 + mu1 + mu2 + mu3
+    t3 = t1**2
+    t4 = 1 - 125.18949581886645*t3
+    t5 = numpy.less(1e-12, t4)
+    t6 = numpy.where(t5, 11.188811188811188*t1, numpy.where(numpy.greater(t1, 0), 1, -1))
+    t7 = numpy.where(t5, numpy.sqrt(t4), 0)
+    t8 = numpy.arctan2(t7, t6)
+    t9 = 3.141592653589793 - t8
+    t10 = 0.325 - 0.275*t6
+    t11 = t10**2 + 0.075625*t7**2 + 0.149769
+    t12 = False
+    t13 = numpy.where(t12, 0, t8 + 3.141592653589793)
+    t14 = numpy.where(t12, 1, -t6)
+    t15 = numpy.where(t12, 0, -t7)
+    t16 = 0.275*t14 + 0.325
+    t17 = 0.075625*t15**2 + t16**2 + 0.149769
+    t18 = 0.275*t15
+    t19 = mu0*t16 + mu1*t18 + 0.149769
+    t20 = t19 - 0.149769
+    t21 = -mu0*t18 + mu1*t16
+    t22 = t20**2 + t21**2
+    t23 = 0.275*t7
+    t24 = mu0*t10 + mu1*t23 + 0.149769
+    t25 = t24 - 0.149769
+    t26 = -mu0*t23 + mu1*t10
+    t27 = t25**2 + t26**2
+    t28 = 1e-24*t0
+    t29 = numpy.where(numpy.less_equal(t22, t17*t28), 0, numpy.arctan2(t21, t20))
+    t30 = -(mu2 - 0.387)
+    t31 = -mu3
+    t32 = -t13 - t29 - t31
+    t33 = numpy.where(numpy.less_equal(t27, t11*t28), 0, numpy.arctan2(t26, t25))
+    t34 = -t31 - t33 - t9
+    t35 = numpy.isfinite(t2)
+    t36 = 1.9314171249999998e-26
+    t37 = numpy.greater(0.007987890625, t36)
+    q = numpy.empty(mu.shape[:-1] + (2, 4))
+    q[..., 0, 0] = t29
+    q[..., 0, 1] = t13 - 6.283185307179586*numpy.ceil(0.15915494309189535*t13 - 0.5)
+    q[..., 0, 2] = t30
+    q[..., 0, 3] = -t32 - 6.283185307179586*numpy.ceil(-0.15915494309189535*t32 - 0.5)
+    q[..., 1, 0] = t33
+    q[..., 1, 1] = t9 - 6.283185307179586*numpy.ceil(0.15915494309189535*t9 - 0.5)
+    q[..., 1, 2] = t30
+    q[..., 1, 3] = -t34 - 6.283185307179586*numpy.ceil(-0.15915494309189535*t34 - 0.5)
+    valid = numpy.empty(mu.shape[:-1] + (2,), dtype=bool)
+    valid[..., 0] = t35 & ((t37 & (numpy.greater_equal(t4, -1e-12))) | ((numpy.less_equal(0.007987890625, t36)) & (numpy.less_equal(t3, 1.931417125e-14))))
+    valid[..., 1] = t35 & t37 & (numpy.greater(t4, 1e-12))
+    return q, valid
 
-
-# -- Closed-form inverse kinematics (planar) --
 
 MAX_IK_SOLUTIONS = 2
-_EPS = 1e-12  # a squared sine within this of 0 is a double root
-_TINY = 1e-24  # relative squared length below which a vector counts as zero
 
 
-def _dot(a, b):
-    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+def ik(mu):
+    """Closed-form inverse kinematics: every joint solution that reaches the target.
 
-
-def _cross(a, b):
-    return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
-
-
-def _add(a, b):
-    return (a[0] + b[0], a[1] + b[1], a[2] + b[2])
-
-
-def _sub(a, b):
-    return (a[0] - b[0], a[1] - b[1], a[2] - b[2])
-
-
-def _rot(k, c, s, v):
-    """v turned about the unit axis k by the angle whose cosine and sine are c and s (Rodrigues)."""
-    kxv = _cross(k, v)
-    kv = _dot(k, v) * (1.0 - c)
-    return (v[0] * c + kxv[0] * s + k[0] * kv, v[1] * c + kxv[1] * s + k[1] * kv,
-            v[2] * c + kxv[2] * s + k[2] * kv)
-
-
-class _Angle:
-    """An angle with its cosine and sine."""
-
-    __slots__ = ("theta", "c", "s")
-
-    def __init__(self, theta, c, s):
-        self.theta, self.c, self.s = theta, c, s
-
-
-def _angle(c, s):
-    return _Angle(math.atan2(s, c), c, s)
-
-
-def _sp1(p, q, k):
-    """SP1: the angle turning p into q about the unit axis k (least squares when they differ
-    in length or height along k). 0 when p or q lies on the axis (any angle would do)."""
-    x = _dot(p, q) - _dot(k, p) * _dot(k, q)
-    y = _dot(k, _cross(p, q))
-    r = math.hypot(x, y)
-    if r * r <= _TINY * _dot(p, p) * _dot(q, q):
-        return _Angle(0.0, 1.0, 0.0)
-    return _angle(x / r, y / r)
-
-
-def _sp4(h, p, k, d):
-    """SP4: the angles t with h . rot(k, t) p = d, as [phi + alpha, phi - alpha].
-
-    h . rot(k, t) p = A cos t + B sin t + C. One angle for a double root (|sin alpha|^2 <=
-    _EPS), none out of range; when the left side does not depend on t, [0] if it equals d.
-    """
-    hk, kp = _dot(h, k), _dot(k, p)
-    a = _dot(h, p) - hk * kp
-    b = _dot(h, _cross(k, p))
-    rhs = d - hk * kp
-    r2 = a * a + b * b
-    scale = _dot(h, h) * _dot(p, p)
-    if r2 <= _TINY * scale:
-        return [_Angle(0.0, 1.0, 0.0)] if rhs * rhs <= _EPS * scale else []
-    r = math.sqrt(r2)
-    cos_phi, sin_phi, cos_alpha = a / r, b / r, rhs / r
-    disc = 1.0 - cos_alpha * cos_alpha
-    if disc < -_EPS:
-        return []
-    if disc <= _EPS:
-        sign = 1.0 if cos_alpha > 0.0 else -1.0
-        return [_angle(sign * cos_phi, sign * sin_phi)]
-    sin_alpha = math.sqrt(disc)
-    phi, alpha = math.atan2(b, a), math.atan2(sin_alpha, cos_alpha)
-    return [_Angle(phi + alpha, cos_phi * cos_alpha - sin_phi * sin_alpha, sin_phi * cos_alpha + cos_phi * sin_alpha),
-            _Angle(phi - alpha, cos_phi * cos_alpha + sin_phi * sin_alpha, sin_phi * cos_alpha - cos_phi * sin_alpha)]
-
-
-def _sp3(p, q, k, dd):
-    """SP3: the angles t with |rot(k, t) p - q|^2 = dd (p, q relative to a point of the axis)."""
-    return _sp4(q, p, k, 0.5 * (_dot(p, p) + _dot(q, q) - dd))
-
-
-def _ik_solve(mu, k1, p1, k2, p2, wrist, tool_point, yaw0, sign1, sign2, sign3, sign_slide):
-    """Planar arm: the last revolute joint takes the yaw, the first two put its axis on the
-    wrist point by SP3 (elbow) and SP1 (shoulder); rotations about z keep heights."""
-    target = (mu[0], mu[1], tool_point[2])
-    phi = mu[-1] - yaw0
-    w = _sub(target, _rot((0.0, 0.0, 1.0), math.cos(phi), math.sin(phi), _sub(tool_point, wrist)))
-    d = _sub(w, p1)
-    solutions = []
-    for elbow in _sp3(_sub(wrist, p2), _sub(p1, p2), k2, _dot(d, d)):
-        shoulder = _sp1(_sub(_add(p2, _rot(k2, elbow.c, elbow.s, _sub(wrist, p2))), p1), d, k1)
-        q = [0.0] * DOF
-        q[0] = shoulder.theta
-        q[1] = elbow.theta
-        q[3] = sign3 * (phi - sign1 * shoulder.theta - sign2 * elbow.theta)
-        q[2] = sign_slide * (mu[2] - tool_point[2])
-        solutions.append(q)
-    return solutions
-
-
-def ik(target):
-    """Closed-form inverse kinematics: every joint solution that reaches `target`, as (k, DOF).
-
+    One target: the solutions as (k, DOF), the valid rows of ik_branches in its order.
+    A batch of targets: ik_branches' (q, valid), (..., MAX_IK_SOLUTIONS, DOF) and
+    (..., MAX_IK_SOLUTIONS).
     target: the task vector (x, y, z, yaw).
     Result: k <= MAX_IK_SOLUTIONS solutions, revolute angles wrapped into (-pi, pi], joint
     limits not applied; k = 0 when the target is out of reach or not finite.
@@ -463,28 +420,8 @@ def ik(target):
     root (a target on a singularity or on the workspace boundary) is returned once, and an
     angle the target leaves free (a singular wrist or shoulder) is set to 0.
     """
-    target = numpy.asarray(target, dtype=float)
-    if target.shape != (4,):
-        raise ValueError(f"target must have shape (4,), got {target.shape}")
-    if not numpy.all(numpy.isfinite(target)):
-        return numpy.empty((0, DOF))
-    solutions = _ik_solve(
-        target.tolist(),
-        k1=(0, 0, 1),
-        p1=(0, 0, 0),
-        k2=(0, 0, 1),
-        p2=(0.325, 0, 0.387),
-        wrist=(0.6, 0, 0.387),
-        tool_point=(0.6, 0, 0.387),
-        yaw0=0,
-        sign1=1,
-        sign2=1,
-        sign3=-1,
-        sign_slide=-1,
-    )
-    q = numpy.array(solutions, dtype=float).reshape(-1, DOF)
-    q[:, [0, 1, 3]] = _wrap(q[:, [0, 1, 3]])
-    return q
+    q, valid = ik_branches(mu)
+    return q[valid] if valid.ndim == 1 else (q, valid)
 
 
 # -- Iterative inverse kinematics --
@@ -495,6 +432,11 @@ IK_NUMERIC_STALLED = 2  # no step reduces the error: unreachable target, joint l
 _LOWER = numpy.array([-0.8726646259971648, -1.53588974175501, 0.0, -6.283185307179586])  # joint limits (infinite: none)
 _UPPER = numpy.array([0.8726646259971648, 1.53588974175501, 0.21, 6.283185307179586])
 _DAMPING = (1e-06, 1e-12, 100000000.0)  # added to the diagonal: start, least, most
+
+
+def _wrap(angle):
+    """Angles wrapped into (-pi, pi]."""
+    return angle - 2.0 * math.pi * numpy.ceil((angle - math.pi) / (2.0 * math.pi))
 
 
 def _task_error(target, q):
@@ -557,7 +499,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
     condition number below VELOCITY_IK_RCOND; take damping > 0 there). Where ok is False,
     q_dot is 0: the result never holds NaN.
     """
-    q = _joints(q)
+    q = _argument("q", q, (DOF,))
     mu_dot = numpy.asarray(mu_dot, dtype=float)
     if mu_dot.ndim == 0 or mu_dot.shape[-1] != 4:
         raise ValueError(f"mu_dot must have shape (4,) or (..., 4), got {mu_dot.shape}")

@@ -3,7 +3,9 @@
 
 Adept Cobra 600 RRPR SCARA (rtb Cobra600), standard DH
 Every function takes `q` (4 x 1: radians for revolute joints, m for
-prismatic ones) and returns a rows x cols result whose zeros are structural.
+prismatic ones) and returns a rows x cols result whose zeros are structural; ik_branches
+(also named ik) takes the target instead of q and returns every branch (MAX_IK_SOLUTIONS x
+DOF) and its validity (MAX_IK_SOLUTIONS x 1, 1 or 0).
 Task vector: (x, y, z, yaw).
 """
 
@@ -246,7 +248,67 @@ def _jacobian_det(q):
     return [d]
 
 
-_q = casadi.SX.sym("q", DOF)
+def _ik_branches(mu):
+    """Every branch of the closed-form ik and whether the target allows it: 120 operations."""
+    mu0 = mu[0]
+    mu1 = mu[1]
+    mu2 = mu[2]
+    mu3 = mu[3]
+    t0 = mu0**2 + mu1**2 + 0.149769
+    t1 = 0.1655095 - 0.5*t0
+    t2 = mu0 + mu1 + mu2 + mu3
+    t3 = t1**2
+    t4 = 1 - 125.18949581886645*t3
+    t5 = (1e-12 < t4)
+    t6 = casadi.if_else(t5, 11.188811188811188*t1, casadi.if_else((t1 > 0), 1, -1))
+    t7 = casadi.if_else(t5, casadi.sqrt(t4), 0)
+    t8 = casadi.atan2(t7, t6)
+    t9 = 3.141592653589793 - t8
+    t10 = 0.325 - 0.275*t6
+    t11 = t10**2 + 0.075625*t7**2 + 0.149769
+    t12 = False
+    t13 = casadi.if_else(t12, 0, t8 + 3.141592653589793)
+    t14 = casadi.if_else(t12, 1, -t6)
+    t15 = casadi.if_else(t12, 0, -t7)
+    t16 = 0.275*t14 + 0.325
+    t17 = 0.075625*t15**2 + t16**2 + 0.149769
+    t18 = 0.275*t15
+    t19 = mu0*t16 + mu1*t18 + 0.149769
+    t20 = t19 - 0.149769
+    t21 = -mu0*t18 + mu1*t16
+    t22 = t20**2 + t21**2
+    t23 = 0.275*t7
+    t24 = mu0*t10 + mu1*t23 + 0.149769
+    t25 = t24 - 0.149769
+    t26 = -mu0*t23 + mu1*t10
+    t27 = t25**2 + t26**2
+    t28 = 1e-24*t0
+    t29 = casadi.if_else((t22 <= t17*t28), 0, casadi.atan2(t21, t20))
+    t30 = -(mu2 - 0.387)
+    t31 = -mu3
+    t32 = -t13 - t29 - t31
+    t33 = casadi.if_else((t27 <= t11*t28), 0, casadi.atan2(t26, t25))
+    t34 = -t31 - t33 - t9
+    t35 = (casadi.fabs(t2) < casadi.inf)
+    t36 = 1.9314171249999998e-26
+    t37 = (0.007987890625 > t36)
+    q = casadi.SX(2, 4)
+    q[0, 0] = t29
+    q[0, 1] = t13 - 6.283185307179586*casadi.ceil(0.15915494309189535*t13 - 0.5)
+    q[0, 2] = t30
+    q[0, 3] = -t32 - 6.283185307179586*casadi.ceil(-0.15915494309189535*t32 - 0.5)
+    q[1, 0] = t33
+    q[1, 1] = t9 - 6.283185307179586*casadi.ceil(0.15915494309189535*t9 - 0.5)
+    q[1, 2] = t30
+    q[1, 3] = -t34 - 6.283185307179586*casadi.ceil(-0.15915494309189535*t34 - 0.5)
+    valid = casadi.SX(2, 1)
+    valid[0, 0] = casadi.logic_and(t35, casadi.logic_or(casadi.logic_and(t37, (t4 >= -1e-12)), casadi.logic_and((0.007987890625 <= t36), (t3 <= 1.931417125e-14))))
+    valid[1, 0] = casadi.logic_and(casadi.logic_and(t35, t37), (t4 > 1e-12))
+    return [q, valid]
+
+
+_q = casadi.SX.sym("q", 4, 1)
+_mu = casadi.SX.sym("mu", 4, 1)
 fk = casadi.Function("fk", [_q], _fk(_q), ["q"], ["T"])
 jacobian = casadi.Function("jacobian", [_q], _jacobian(_q), ["q"], ["J"])
 fk_jacobian = casadi.Function("fk_jacobian", [_q], _fk_jacobian(_q), ["q"], ["T", "J"])
@@ -256,8 +318,10 @@ task_jacobian = casadi.Function("task_jacobian", [_q], _task_jacobian(_q), ["q"]
 singularity_factors = casadi.Function("singularity_factors", [_q], _singularity_factors(_q), ["q"], ["f"])
 manipulability = casadi.Function("manipulability", [_q], _manipulability(_q), ["q"], ["w"])
 jacobian_det = casadi.Function("jacobian_det", [_q], _jacobian_det(_q), ["q"], ["d"])
+ik_branches = casadi.Function("ik_branches", [_mu], _ik_branches(_mu), ["mu"], ["q", "valid"])
+ik = ik_branches  # CasADi functions have fixed-size outputs: every branch and its validity
 
 
 def functions():
     """All functions by name."""
-    return {"fk": fk, "jacobian": jacobian, "fk_jacobian": fk_jacobian, "jacobian_tool": jacobian_tool, "task": task, "task_jacobian": task_jacobian, "singularity_factors": singularity_factors, "manipulability": manipulability, "jacobian_det": jacobian_det}
+    return {"fk": fk, "jacobian": jacobian, "fk_jacobian": fk_jacobian, "jacobian_tool": jacobian_tool, "task": task, "task_jacobian": task_jacobian, "singularity_factors": singularity_factors, "manipulability": manipulability, "jacobian_det": jacobian_det, "ik_branches": ik_branches}

@@ -559,6 +559,368 @@ stanford_real stanford_jacobian_det(const stanford_real q[STANFORD_DOF])
     return s2*s5*(q3*q3);
 }
 
+void stanford_ik_branches(const stanford_real T[16], stanford_real q[STANFORD_MAX_IK_SOLUTIONS * STANFORD_DOF], int valid[STANFORD_MAX_IK_SOLUTIONS])
+{
+    /* 630 operations */
+
+    /* Inputs */
+    const stanford_real T00 = T[0];
+    const stanford_real T01 = T[1];
+    const stanford_real T02 = T[2];
+    const stanford_real T03 = T[3];
+    const stanford_real T10 = T[4];
+    const stanford_real T11 = T[5];
+    const stanford_real T12 = T[6];
+    const stanford_real T13 = T[7];
+    const stanford_real T20 = T[8];
+    const stanford_real T21 = T[9];
+    const stanford_real T22 = T[10];
+    const stanford_real T23 = T[11];
+
+    /* Intermediate terms */
+    const stanford_real t0 = T00 + T01 + T02 + T03 + T10 + T11 + T12 + T13 + T20 + T21 + T22 + T23;
+    const stanford_real t1 = -0.1337*T00 + 0.412*T02;
+    const stanford_real t2 = T03 - t1;
+    const stanford_real t3 = t1;
+    const stanford_real t4 = t2 + t3;
+    const stanford_real t5 = -0.1337*T10 + 0.412*T12;
+    const stanford_real t6 = T13 - t5;
+    const stanford_real t7 = t5;
+    const stanford_real t8 = t6 + t7;
+    const stanford_real t9 = -0.1337*T20 + 0.412*T22;
+    const stanford_real t10 = T23 - t9;
+    const stanford_real t11 = t9;
+    const stanford_real t12 = t10 + t11;
+    const stanford_real t13 = t12 - 0.412;
+    const stanford_real t14 = (t13*t13);
+    const stanford_real t15 = t14 + (t4*t4) + (t8*t8);
+    const stanford_real t16 = 0.01787569 - t15;
+    const stanford_real t17 = t15 + 0.01787569;
+    const stanford_real t18 = -t16;
+    const stanford_real t19 = 1e-12*t17;
+    const stanford_real t20 = -t19;
+    const stanford_real t21 = (t16 < t20 ? sqrt(t18) : 0);
+    const stanford_real t22 = (t21*t21);
+    const stanford_real t23 = t22 + 0.01787569;
+    const stanford_real t24 = t14 + 0.01787569;
+    const stanford_real t25 = -t23 + t24;
+    const stanford_real t26 = -t25;
+    const stanford_real t27 = 1e-12*t23;
+    const stanford_real t28 = -t27;
+    const stanford_real t29 = (t25 < t28 ? sqrt(t26) : 0);
+    const stanford_real t30 = t29*t4;
+    const stanford_real t31 = t14 + 0.1337*t8;
+    const stanford_real t32 = -t30 + t31;
+    const stanford_real t33 = t30 + t31;
+    const stanford_real t34 = -t14;
+    const stanford_real t35 = t32 + t34;
+    const stanford_real t36 = t33 + t34;
+    const stanford_real t37 = 0.1337*t4;
+    const stanford_real t38 = t29*t8;
+    const stanford_real t39 = t37 + t38;
+    const stanford_real t40 = (t35*t35) + (t39*t39);
+    const stanford_real t41 = 1.0/sqrt(t40);
+    const stanford_real t42 = -t37 + t38;
+    const stanford_real t43 = (t36*t36) + (t42*t42);
+    const stanford_real t44 = 1.0/sqrt(t43);
+    const stanford_real t45 = (t29*t29);
+    const stanford_real t46 = t24 + t45;
+    const stanford_real t47 = 1e-24*t46;
+    const stanford_real t48 = t15*t47;
+    const int t49 = t40 <= t48;
+    const stanford_real t50 = (t49 ? 1 : t35*t41);
+    const stanford_real t51 = (t49 ? 0 : -t39*t41);
+    const stanford_real t52 = T02*t50 + T12*t51;
+    const stanford_real t53 = -T02*t51 + T12*t50;
+    const stanford_real t54 = T01*t50 + T11*t51;
+    const stanford_real t55 = -T01*t51 + T11*t50;
+    const stanford_real t56 = t13*t21;
+    const stanford_real t57 = t56 + 0.01787569;
+    const stanford_real t58 = t57 - 0.01787569;
+    const stanford_real t59 = 0.01787569 - t56;
+    const stanford_real t60 = t59 - 0.01787569;
+    const stanford_real t61 = t22*t45;
+    const stanford_real t62 = t61 + (t58*t58);
+    const stanford_real t63 = 1.0/sqrt(t62);
+    const stanford_real t64 = t61 + (t60*t60);
+    const stanford_real t65 = 1.0/sqrt(t64);
+    const stanford_real t66 = t23*t47;
+    const int t67 = t62 <= t66;
+    const stanford_real t68 = (t67 ? 1 : t58*t63);
+    const stanford_real t69 = t21*t29;
+    const stanford_real t70 = t63*t69;
+    const stanford_real t71 = (t67 ? 0 : -t70);
+    const stanford_real t72 = (t67 ? 0 : t70);
+    const int t73 = t43 <= t48;
+    const stanford_real t74 = (t73 ? 1 : t36*t44);
+    const stanford_real t75 = (t73 ? 0 : t42*t44);
+    const stanford_real t76 = T02*t74 + T12*t75;
+    const stanford_real t77 = -T02*t75 + T12*t74;
+    const stanford_real t78 = T01*t74 + T11*t75;
+    const stanford_real t79 = -T01*t75 + T11*t74;
+    const stanford_real t80 = 1 - t50;
+    const stanford_real t81 = T22*t80;
+    const stanford_real t82 = T22*t50 + t81;
+    const stanford_real t83 = T21*t80;
+    const stanford_real t84 = T21*t50 + t83;
+    const stanford_real t85 = t52*t68 - t71*t82;
+    const stanford_real t86 = t52*t71 + t68*t82;
+    const stanford_real t87 = t54*t68 - t71*t84;
+    const stanford_real t88 = t54*t71 + t68*t84;
+    const stanford_real t89 = 1 - t68;
+    const stanford_real t90 = t53*t89;
+    const stanford_real t91 = t53*t68 + t90;
+    const stanford_real t92 = t55*t89;
+    const stanford_real t93 = t55*t68 + t92;
+    const stanford_real t94 = t77*t89;
+    const stanford_real t95 = t68*t77 + t94;
+    const stanford_real t96 = t79*t89;
+    const stanford_real t97 = t68*t79 + t96;
+    const stanford_real t98 = (t86*t86);
+    const stanford_real t99 = -t98;
+    const stanford_real t100 = t99 + 1;
+    const stanford_real t101 = (t100 > 1e-12 ? sqrt(t100) : 0);
+    const stanford_real t102 = t101*t91 + t98;
+    const stanford_real t103 = t102 + t99;
+    const stanford_real t104 = (t85*t85);
+    const stanford_real t105 = t104 + t98 + (t91*t91);
+    const stanford_real t106 = (t101*t101);
+    const stanford_real t107 = t104*t106 + (t103*t103);
+    const stanford_real t108 = t106 + t98;
+    const stanford_real t109 = 1.0/sqrt(t107);
+    const stanford_real t110 = 1.0/sqrt(t108);
+    const stanford_real t111 = 1e-24*t108;
+    const int t112 = t107 <= t105*t111;
+    const stanford_real t113 = (t112 ? 1 : t103*t109);
+    const stanford_real t114 = t88*(1 - t113);
+    const stanford_real t115 = t113*t88 + t114;
+    const stanford_real t116 = t101*t85;
+    const stanford_real t117 = (t112 ? 0 : -t109*t116);
+    const stanford_real t118 = t113*t87 + t117*t93;
+    const stanford_real t119 = t113*t93 - t117*t87;
+    const int t120 = t108 <= t111;
+    const stanford_real t121 = (t120 ? 1 : t110*t86);
+    const stanford_real t122 = (t120 ? 0 : -t101*t110);
+    const stanford_real t123 = t118*(1 - t121);
+    const stanford_real t124 = t118*t121 + t123;
+    const stanford_real t125 = t115*t122 + t119*t121;
+    const stanford_real t126 = t115*t121 - t119*t122;
+    const stanford_real t127 = (t124*t124) + (t125*t125);
+    const stanford_real t128 = t127;
+    const stanford_real t129 = t127 + (t126*t126);
+    const stanford_real t130 = 1 - t74;
+    const stanford_real t131 = T22*t130;
+    const stanford_real t132 = T22*t74 + t131;
+    const stanford_real t133 = T21*t130;
+    const stanford_real t134 = T21*t74 + t133;
+    const stanford_real t135 = -t132*t72 + t68*t76;
+    const stanford_real t136 = t132*t68 + t72*t76;
+    const stanford_real t137 = -t134*t72 + t68*t78;
+    const stanford_real t138 = t134*t68 + t72*t78;
+    const stanford_real t139 = (t136*t136);
+    const stanford_real t140 = -t139;
+    const stanford_real t141 = t140 + 1;
+    const stanford_real t142 = (t141 > 1e-12 ? sqrt(t141) : 0);
+    const stanford_real t143 = t139 + t142*t95;
+    const stanford_real t144 = t140 + t143;
+    const stanford_real t145 = (t135*t135);
+    const stanford_real t146 = t139 + t145 + (t95*t95);
+    const stanford_real t147 = (t142*t142);
+    const stanford_real t148 = t145*t147 + (t144*t144);
+    const stanford_real t149 = t139 + t147;
+    const stanford_real t150 = 1.0/sqrt(t148);
+    const stanford_real t151 = 1.0/sqrt(t149);
+    const stanford_real t152 = 1e-24*t149;
+    const int t153 = t148 <= t146*t152;
+    const stanford_real t154 = (t153 ? 1 : t144*t150);
+    const stanford_real t155 = t138*(1 - t154);
+    const stanford_real t156 = t138*t154 + t155;
+    const stanford_real t157 = t135*t142;
+    const stanford_real t158 = (t153 ? 0 : -t150*t157);
+    const stanford_real t159 = t137*t154 + t158*t97;
+    const stanford_real t160 = -t137*t158 + t154*t97;
+    const int t161 = t149 <= t152;
+    const stanford_real t162 = (t161 ? 1 : t136*t151);
+    const stanford_real t163 = (t161 ? 0 : -t142*t151);
+    const stanford_real t164 = t159*(1 - t162);
+    const stanford_real t165 = t159*t162 + t164;
+    const stanford_real t166 = t156*t163 + t160*t162;
+    const stanford_real t167 = t156*t162 - t160*t163;
+    const stanford_real t168 = (t165*t165) + (t166*t166);
+    const stanford_real t169 = t168;
+    const stanford_real t170 = t168 + (t167*t167);
+    const int t171 = t64 <= t66;
+    const stanford_real t172 = (t171 ? 1 : t60*t65);
+    const stanford_real t173 = t65*t69;
+    const stanford_real t174 = (t171 ? 0 : t173);
+    const stanford_real t175 = (t171 ? 0 : -t173);
+    const stanford_real t176 = t172*t52 - t174*t82;
+    const stanford_real t177 = t172*t82 + t174*t52;
+    const stanford_real t178 = t172*t54 - t174*t84;
+    const stanford_real t179 = t172*t84 + t174*t54;
+    const stanford_real t180 = -t132*t175 + t172*t76;
+    const stanford_real t181 = t132*t172 + t175*t76;
+    const stanford_real t182 = -t134*t175 + t172*t78;
+    const stanford_real t183 = t134*t172 + t175*t78;
+    const stanford_real t184 = 1 - t172;
+    const stanford_real t185 = t184*t53;
+    const stanford_real t186 = t172*t53 + t185;
+    const stanford_real t187 = t184*t55;
+    const stanford_real t188 = t172*t55 + t187;
+    const stanford_real t189 = t184*t77;
+    const stanford_real t190 = t172*t77 + t189;
+    const stanford_real t191 = t184*t79;
+    const stanford_real t192 = t172*t79 + t191;
+    const stanford_real t193 = (t177*t177);
+    const stanford_real t194 = -t193;
+    const stanford_real t195 = t194 + 1;
+    const stanford_real t196 = (t195 > 1e-12 ? sqrt(t195) : 0);
+    const stanford_real t197 = t186*t196 + t193;
+    const stanford_real t198 = t194 + t197;
+    const stanford_real t199 = (t176*t176);
+    const stanford_real t200 = t193 + t199 + (t186*t186);
+    const stanford_real t201 = (t196*t196);
+    const stanford_real t202 = t199*t201 + (t198*t198);
+    const stanford_real t203 = t193 + t201;
+    const stanford_real t204 = 1.0/sqrt(t202);
+    const stanford_real t205 = 1.0/sqrt(t203);
+    const stanford_real t206 = 1e-24*t203;
+    const int t207 = t202 <= t200*t206;
+    const stanford_real t208 = (t207 ? 1 : t198*t204);
+    const stanford_real t209 = t179*(1 - t208);
+    const stanford_real t210 = t179*t208 + t209;
+    const stanford_real t211 = t176*t196;
+    const stanford_real t212 = (t207 ? 0 : -t204*t211);
+    const stanford_real t213 = t178*t208 + t188*t212;
+    const stanford_real t214 = -t178*t212 + t188*t208;
+    const int t215 = t203 <= t206;
+    const stanford_real t216 = (t215 ? 1 : t177*t205);
+    const stanford_real t217 = (t215 ? 0 : -t196*t205);
+    const stanford_real t218 = t213*(1 - t216);
+    const stanford_real t219 = t213*t216 + t218;
+    const stanford_real t220 = t210*t217 + t214*t216;
+    const stanford_real t221 = t210*t216 - t214*t217;
+    const stanford_real t222 = (t219*t219) + (t220*t220);
+    const stanford_real t223 = t222;
+    const stanford_real t224 = t222 + (t221*t221);
+    const stanford_real t225 = (t181*t181);
+    const stanford_real t226 = -t225;
+    const stanford_real t227 = t226 + 1;
+    const stanford_real t228 = (t227 > 1e-12 ? sqrt(t227) : 0);
+    const stanford_real t229 = t190*t228 + t225;
+    const stanford_real t230 = t226 + t229;
+    const stanford_real t231 = (t180*t180);
+    const stanford_real t232 = t225 + t231 + (t190*t190);
+    const stanford_real t233 = (t228*t228);
+    const stanford_real t234 = t231*t233 + (t230*t230);
+    const stanford_real t235 = t225 + t233;
+    const stanford_real t236 = 1.0/sqrt(t234);
+    const stanford_real t237 = 1.0/sqrt(t235);
+    const stanford_real t238 = 1e-24*t235;
+    const int t239 = t234 <= t232*t238;
+    const stanford_real t240 = (t239 ? 1 : t230*t236);
+    const stanford_real t241 = t183*(1 - t240);
+    const stanford_real t242 = t183*t240 + t241;
+    const stanford_real t243 = t180*t228;
+    const stanford_real t244 = (t239 ? 0 : -t236*t243);
+    const stanford_real t245 = t182*t240 + t192*t244;
+    const stanford_real t246 = -t182*t244 + t192*t240;
+    const int t247 = t235 <= t238;
+    const stanford_real t248 = (t247 ? 1 : t181*t237);
+    const stanford_real t249 = (t247 ? 0 : -t228*t237);
+    const stanford_real t250 = t245*(1 - t248);
+    const stanford_real t251 = t245*t248 + t250;
+    const stanford_real t252 = t242*t249 + t246*t248;
+    const stanford_real t253 = t242*t248 - t246*t249;
+    const stanford_real t254 = (t251*t251) + (t252*t252);
+    const stanford_real t255 = t254;
+    const stanford_real t256 = t254 + (t253*t253);
+    const stanford_real t257 = (t49 ? 0 : atan2(-t39, t35));
+    const stanford_real t258 = -t69;
+    const stanford_real t259 = (t67 ? 0 : atan2(t258, t58));
+    const stanford_real t260 = (t112 ? 0 : atan2(-t116, t103));
+    const stanford_real t261 = (t120 ? 0 : atan2(-t101, t86));
+    const stanford_real t262 = (t128 <= 1e-24*t129 ? 0 : atan2(t125, t124));
+    const stanford_real t263 = (t73 ? 0 : atan2(t42, t36));
+    const stanford_real t264 = (t67 ? 0 : atan2(t69, t58));
+    const stanford_real t265 = (t153 ? 0 : atan2(-t157, t144));
+    const stanford_real t266 = (t161 ? 0 : atan2(-t142, t136));
+    const stanford_real t267 = (t169 <= 1e-24*t170 ? 0 : atan2(t166, t165));
+    const stanford_real t268 = (t171 ? 0 : atan2(t69, t60));
+    const stanford_real t269 = -t21;
+    const stanford_real t270 = (t207 ? 0 : atan2(-t211, t198));
+    const stanford_real t271 = (t215 ? 0 : atan2(-t196, t177));
+    const stanford_real t272 = (t223 <= 1e-24*t224 ? 0 : atan2(t220, t219));
+    const stanford_real t273 = (t171 ? 0 : atan2(t258, t60));
+    const stanford_real t274 = (t239 ? 0 : atan2(-t243, t230));
+    const stanford_real t275 = (t247 ? 0 : atan2(-t228, t181));
+    const stanford_real t276 = (t255 <= 1e-24*t256 ? 0 : atan2(t252, t251));
+    const int t277 = isfinite(t0);
+    const stanford_real t278 = -1e-12;
+    const int t279 = t18 >= t20;
+    const int t280 = t26 >= t28;
+    const int t281 = t26 > t27;
+    const int t282 = t18 > t19;
+
+    /* Outputs */
+    q[0] = t257;
+    q[1] = t259;
+    q[2] = t21;
+    q[3] = t260;
+    q[4] = t261;
+    q[5] = t262;
+    q[6] = t257;
+    q[7] = t259;
+    q[8] = t21;
+    q[9] = t260 - 6.283185307179586*ceil(0.15915494309189535*t260) + 3.141592653589793;
+    q[10] = -t261 - 6.283185307179586*ceil(-0.15915494309189535*t261 - 0.5);
+    q[11] = t262 - 6.283185307179586*ceil(0.15915494309189535*t262) + 3.141592653589793;
+    q[12] = t263;
+    q[13] = t264;
+    q[14] = t21;
+    q[15] = t265;
+    q[16] = t266;
+    q[17] = t267;
+    q[18] = t263;
+    q[19] = t264;
+    q[20] = t21;
+    q[21] = t265 - 6.283185307179586*ceil(0.15915494309189535*t265) + 3.141592653589793;
+    q[22] = -t266 - 6.283185307179586*ceil(-0.15915494309189535*t266 - 0.5);
+    q[23] = t267 - 6.283185307179586*ceil(0.15915494309189535*t267) + 3.141592653589793;
+    q[24] = t257;
+    q[25] = t268;
+    q[26] = t269;
+    q[27] = t270;
+    q[28] = t271;
+    q[29] = t272;
+    q[30] = t257;
+    q[31] = t268;
+    q[32] = t269;
+    q[33] = t270 - 6.283185307179586*ceil(0.15915494309189535*t270) + 3.141592653589793;
+    q[34] = -t271 - 6.283185307179586*ceil(-0.15915494309189535*t271 - 0.5);
+    q[35] = t272 - 6.283185307179586*ceil(0.15915494309189535*t272) + 3.141592653589793;
+    q[36] = t263;
+    q[37] = t273;
+    q[38] = t269;
+    q[39] = t274;
+    q[40] = t275;
+    q[41] = t276;
+    q[42] = t263;
+    q[43] = t273;
+    q[44] = t269;
+    q[45] = t274 - 6.283185307179586*ceil(0.15915494309189535*t274) + 3.141592653589793;
+    q[46] = -t275 - 6.283185307179586*ceil(-0.15915494309189535*t275 - 0.5);
+    q[47] = t276 - 6.283185307179586*ceil(0.15915494309189535*t276) + 3.141592653589793;
+    valid[0] = t277 && t279 && t280 && t100 >= t278;
+    valid[1] = t277 && t279 && t280 && t100 > 1e-12;
+    valid[2] = t277 && t279 && t281 && t141 >= t278;
+    valid[3] = t277 && t279 && t281 && t141 > 1e-12;
+    valid[4] = t277 && t280 && t282 && t195 >= t278;
+    valid[5] = t277 && t280 && t282 && t195 > 1e-12;
+    valid[6] = t277 && t281 && t282 && t227 >= t278;
+    valid[7] = t277 && t281 && t282 && t227 > 1e-12;
+}
+
 int stanford_velocity_ik(const stanford_real q[STANFORD_DOF], const stanford_real mu_dot[STANFORD_TASK_DIM], stanford_real damping, stanford_real q_dot[STANFORD_DOF])
 {
     /* Rows of jacobian() forming Js (the geometric Jacobian). */
@@ -656,328 +1018,19 @@ int stanford_velocity_ik(const stanford_real q[STANFORD_DOF], const stanford_rea
     return STANFORD_VELOCITY_IK_OK;
 }
 
-/* The angle wrapped into (-pi, pi], for |angle| < 1e9 (the callers' angles are sums of a few
- * atan2 results): angle - 2 pi ceil((angle - pi) / (2 pi)), ceil by truncation. */
-static stanford_real stanford_wrap(stanford_real angle)
-{
-    const stanford_real turns = (angle - 3.141592653589793) / 6.283185307179586;
-    stanford_real whole;
-    if (angle > -3.141592653589793 && angle <= 3.141592653589793) {
-        return angle;
-    }
-    whole = (stanford_real)(long)turns;
-    if (whole < turns) {
-        whole += 1.0;
-    }
-    return angle - 6.283185307179586 * whole;
-}
-
-/* -- Closed-form inverse kinematics (spherical_wrist_prismatic) -- */
-
-/* The arm at q = 0 (product of exponentials): unit axis directions h, points p on the axes,
- * the tool pose and a few derived constants. */
-typedef struct {
-    stanford_real tool_rotation[9];
-    stanford_real tool_position[3];
-    stanford_real h1[3];
-    stanford_real h2[3];
-    stanford_real shoulder[3];
-    stanford_real h3[3];
-    stanford_real h4[3];
-    stanford_real h5[3];
-    stanford_real h6[3];
-    stanford_real v6[3];
-    stanford_real centre[3];
-    stanford_real wrist_flip;
-} stanford_ik_geometry;
-
-/* An angle with its cosine and sine. */
-typedef struct {
-    stanford_real theta, c, s;
-} stanford_angle;
-
-static inline stanford_real stanford_dot(const stanford_real a[3], const stanford_real b[3])
-{
-    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-}
-
-static inline void stanford_cross(const stanford_real a[3], const stanford_real b[3], stanford_real out[3])
-{
-    const stanford_real x = a[1] * b[2] - a[2] * b[1];
-    const stanford_real y = a[2] * b[0] - a[0] * b[2];
-    const stanford_real z = a[0] * b[1] - a[1] * b[0];
-    out[0] = x;
-    out[1] = y;
-    out[2] = z;
-}
-
-static inline void stanford_add(const stanford_real a[3], const stanford_real b[3], stanford_real out[3])
-{
-    out[0] = a[0] + b[0];
-    out[1] = a[1] + b[1];
-    out[2] = a[2] + b[2];
-}
-
-static inline void stanford_sub(const stanford_real a[3], const stanford_real b[3], stanford_real out[3])
-{
-    out[0] = a[0] - b[0];
-    out[1] = a[1] - b[1];
-    out[2] = a[2] - b[2];
-}
-
-/* v turned about the unit axis k by the angle whose cosine and sine are c and s (Rodrigues). */
-static inline void stanford_rot(const stanford_real k[3], stanford_real c, stanford_real s, const stanford_real v[3], stanford_real out[3])
-{
-    stanford_real kxv[3];
-    const stanford_real kv = stanford_dot(k, v) * (1.0 - c);
-    stanford_cross(k, v, kxv);
-    out[0] = v[0] * c + kxv[0] * s + k[0] * kv;
-    out[1] = v[1] * c + kxv[1] * s + k[1] * kv;
-    out[2] = v[2] * c + kxv[2] * s + k[2] * kv;
-}
-
-/* atan2(y, x) in (-pi, pi] (0 at the origin), about twice as fast as the C library's: the
- * argument is reduced to t in [-tan(pi/8), tan(pi/8)] with one division and atan(t) =
- * t + t z P(z) / Q(z), z = t^2, by Cephes' minimax approximation (S. L. Moshier); error
- * within 2 ulp. */
-static inline stanford_real stanford_atan2(stanford_real y, stanford_real x)
-{
-    const stanford_real ax = fabs(x);
-    const stanford_real ay = fabs(y);
-    const stanford_real low = ax < ay ? ax : ay;
-    const stanford_real high = ax < ay ? ay : ax;
-    stanford_real t, base, r;
-    if (!(high > 0.0)) {
-        return 0.0;
-    }
-    if (low <= 0.41421356237309503 * high) {
-        t = low / high;
-        base = 0.0;
-    } else {
-        t = (low - high) / (low + high);
-        base = 0.7853981633974483;
-    }
-    {
-        const stanford_real z = t * t;
-        const stanford_real z2 = z * z;
-        const stanford_real z4 = z2 * z2;
-        r = base + (t + t * z * ((-64.85021904942025 - 122.88666844901361 * z) + z2 * (-75.00855792314705 - 16.157537187333652 * z) + z4 * (-0.8750608600031904)) / ((194.5506571482614 + 485.3903996359137 * z) + z2 * (432.88106049129027 + 165.02700983169885 * z) + z4 * (24.858464901423062 + z)));
-    }
-    if (ay > ax) {
-        r = 1.5707963267948966 - r;
-    }
-    if (x < 0.0) {
-        r = 3.141592653589793 - r;
-    }
-    return y < 0.0 ? -r : r;
-}
-
-static inline stanford_angle stanford_angle_of(stanford_real c, stanford_real s)
-{
-    stanford_angle angle;
-    angle.theta = stanford_atan2(s, c);
-    angle.c = c;
-    angle.s = s;
-    return angle;
-}
-
-/* SP1: the angle turning p into q about the unit axis k (least squares when they differ in
- * length or height along k); 0 when p or q lies on the axis (any angle would do). */
-static inline stanford_angle stanford_sp1(const stanford_real p[3], const stanford_real q[3], const stanford_real k[3])
-{
-    stanford_real pxq[3];
-    stanford_cross(p, q, pxq);
-    {
-        const stanford_real x = stanford_dot(p, q) - stanford_dot(k, p) * stanford_dot(k, q);
-        const stanford_real y = stanford_dot(k, pxq);
-        const stanford_real rr = x * x + y * y;
-        if (rr <= 1e-24 * stanford_dot(p, p) * stanford_dot(q, q)) {
-            return stanford_angle_of(1.0, 0.0);
-        }
-        {
-            const stanford_real scale = 1.0 / sqrt(rr);
-            stanford_angle angle;
-            angle.theta = stanford_atan2(y, x);
-            angle.c = x * scale;
-            angle.s = y * scale;
-            return angle;
-        }
-    }
-}
-
-/* SP2: the angle pairs out[i] = (t1, t2) with rot(k1, t1) rot(k2, t2) p = q, for two axes
- * through one point (p, q relative to it); returns their count, computes at most `wanted` of
- * them. rot(k2, t2) p = rot(k1, -t1) q = c, c = alpha k1 + beta k2 +- gamma k1 x k2; one pair
- * when gamma^2 is within EPS of 0, none below. */
-static inline int stanford_sp2(const stanford_real p[3], const stanford_real q[3], const stanford_real k1[3], const stanford_real k2[3],
-        int wanted, stanford_angle out[2][2])
-{
-    const stanford_real k12 = stanford_dot(k1, k2);
-    const stanford_real nn = 1.0 - k12 * k12;
-    const stanford_real u = stanford_dot(k1, q);
-    const stanford_real v = stanford_dot(k2, p);
-    const stanford_real alpha = (u - k12 * v) / nn;
-    const stanford_real beta = (v - k12 * u) / nn;
-    const stanford_real pp = stanford_dot(p, p);
-    const stanford_real gg = (pp - alpha * alpha - beta * beta - 2.0 * alpha * beta * k12) / nn;
-    stanford_real normal[3], c[3], g;
-    int count, i;
-    if (gg < -1e-12 * pp) {
-        return 0;
-    }
-    count = gg <= 1e-12 * pp ? 1 : 2;
-    g = count == 1 ? 0.0 : sqrt(gg);
-    stanford_cross(k1, k2, normal);
-    for (i = 0; i < count && i < wanted; ++i) {
-        c[0] = alpha * k1[0] + beta * k2[0] + g * normal[0];
-        c[1] = alpha * k1[1] + beta * k2[1] + g * normal[1];
-        c[2] = alpha * k1[2] + beta * k2[2] + g * normal[2];
-        out[i][0] = stanford_sp1(c, q, k1);
-        out[i][1] = stanford_sp1(p, c, k2);
-        g = -g;
-    }
-    return count;
-}
-
-/* T T(0)^-1 = exp(xi_1 q_1) ... exp(xi_n q_n) as (R, t), T(0) = (rotation, position) the
- * tool pose at q = 0. */
-static inline void stanford_relative(const stanford_real T[16], const stanford_real rotation[9], const stanford_real position[3],
-        stanford_real R[9], stanford_real t[3])
-{
-    int i, j;
-    for (i = 0; i < 3; ++i) {
-        for (j = 0; j < 3; ++j) {
-            R[3 * i + j] = T[4 * i] * rotation[3 * j] + T[4 * i + 1] * rotation[3 * j + 1]
-                           + T[4 * i + 2] * rotation[3 * j + 2];
-        }
-        t[i] = T[4 * i + 3] - stanford_dot(&R[3 * i], position);
-    }
-}
-
-static inline void stanford_mul(const stanford_real R[9], const stanford_real v[3], stanford_real out[3])
-{
-    const stanford_real x = stanford_dot(&R[0], v);
-    const stanford_real y = stanford_dot(&R[3], v);
-    const stanford_real z = stanford_dot(&R[6], v);
-    out[0] = x;
-    out[1] = y;
-    out[2] = z;
-}
-
-/* Spherical wrist with axis 5 perpendicular to axes 4 and 6: the angles out[i] = (q4, q5, q6)
- * with R4 R5 R6 h6 = a and R4 R5 R6 v6 = b (v6 perpendicular to h6); returns their count. The
- * first by SP2 and SP1; the second is (q4 + pi, wrist_flip - q5, q6 + pi): rot(h4, pi) reflects
- * the plane perpendicular to h5 across h4, and wrist_flip = -2 angle(h4 -> h6 about h5). */
-static inline int stanford_wrist(const stanford_real a[3], const stanford_real b[3], const stanford_ik_geometry *g, stanford_real out[2][3])
-{
-    stanford_angle pairs[2][2];
-    stanford_real x[3];
-    const int count = stanford_sp2(g->h6, a, g->h4, g->h5, 1, pairs);
-    if (count == 0) {
-        return 0;
-    }
-    stanford_rot(g->h4, pairs[0][0].c, -pairs[0][0].s, b, x);
-    stanford_rot(g->h5, pairs[0][1].c, -pairs[0][1].s, x, x);
-    out[0][0] = pairs[0][0].theta;
-    out[0][1] = pairs[0][1].theta;
-    out[0][2] = stanford_sp1(g->v6, x, g->h6).theta;
-    out[1][0] = out[0][0] + 3.141592653589793;
-    out[1][1] = g->wrist_flip - out[0][1];
-    out[1][2] = out[0][2] + 3.141592653589793;
-    return count;
-}
-
-/* Spherical wrist, axes 1 and 2 intersecting at the shoulder point, joint 3 prismatic: the
- * wrist centre's distance from the shoulder point fixes q3 (a quadratic), its position q1 and
- * q2 (SP2); the orientation left to the wrist gives q4, q5, q6. */
-static int stanford_ik_solve(const stanford_real T[16], const stanford_ik_geometry *g, stanford_real q[])
-{
-    stanford_real rotation[9], position[3], wc[3], a[3], b[3], d[3], e[3], slide[2];
-    stanford_real half, rest, disc, scale;
-    int count = 0, n3, i, j, k;
-    stanford_relative(T, g->tool_rotation, g->tool_position, rotation, position);
-    stanford_mul(rotation, g->centre, wc);
-    stanford_add(wc, position, wc);
-    stanford_mul(rotation, g->h6, a);
-    stanford_mul(rotation, g->v6, b);
-    stanford_sub(wc, g->shoulder, d);
-    stanford_sub(g->centre, g->shoulder, e);
-    /* |e + q3 h3|^2 = |d|^2: q3^2 + 2 half q3 + rest = 0 */
-    half = stanford_dot(g->h3, e);
-    rest = stanford_dot(e, e) - stanford_dot(d, d);
-    disc = half * half - rest;
-    scale = stanford_dot(e, e) + stanford_dot(d, d);
-    if (disc < -1e-12 * scale) {
-        return 0;
-    }
-    if (disc <= 1e-12 * scale) {
-        n3 = 1;
-        slide[0] = -half;
-    } else {
-        n3 = 2;
-        slide[0] = -half + sqrt(disc);
-        slide[1] = -half - sqrt(disc);
-    }
-    for (i = 0; i < n3; ++i) {
-        stanford_real reached[3];
-        stanford_angle shoulder[2][2];
-        int n12;
-        reached[0] = e[0] + slide[i] * g->h3[0];
-        reached[1] = e[1] + slide[i] * g->h3[1];
-        reached[2] = e[2] + slide[i] * g->h3[2];
-        n12 = stanford_sp2(reached, d, g->h1, g->h2, 2, shoulder);
-        for (j = 0; j < n12; ++j) {
-            stanford_real aw[3], bw[3];
-            stanford_real wrist[2][3];
-            int n_wrist;
-            stanford_rot(g->h1, shoulder[j][0].c, -shoulder[j][0].s, a, aw);
-            stanford_rot(g->h2, shoulder[j][1].c, -shoulder[j][1].s, aw, aw);
-            stanford_rot(g->h1, shoulder[j][0].c, -shoulder[j][0].s, b, bw);
-            stanford_rot(g->h2, shoulder[j][1].c, -shoulder[j][1].s, bw, bw);
-            n_wrist = stanford_wrist(aw, bw, g, wrist);
-            for (k = 0; k < n_wrist; ++k) {
-                stanford_real *out = q + STANFORD_DOF * count++;
-                out[0] = shoulder[j][0].theta;
-                out[1] = shoulder[j][1].theta;
-                out[2] = slide[i];
-                out[3] = wrist[k][0];
-                out[4] = wrist[k][1];
-                out[5] = wrist[k][2];
-            }
-        }
-    }
-    return count;
-}
-
 int stanford_ik(const stanford_real T[16], stanford_real q[STANFORD_MAX_IK_SOLUTIONS * STANFORD_DOF])
 {
-    const stanford_ik_geometry g = {
-        .tool_rotation = {0, 1, 0, -1, 0, 0, 0, 0, 1},
-        .tool_position = {0, 0.1337, 0.412},
-        .h1 = {0, 0, 1},
-        .h2 = {0, 1, 0},
-        .shoulder = {0, 0, 0.412},
-        .h3 = {0, 0, 1},
-        .h4 = {0, 0, 1},
-        .h5 = {1, 0, 0},
-        .h6 = {0, 0, 1},
-        .v6 = {1, 0, 0},
-        .centre = {0, 0.1337, 0.412},
-        .wrist_flip = 0,
-    };
-    int count, k;
-    for (k = 0; k < 12; ++k) {
-        if (!isfinite(T[k])) {
-            return 0;
+    stanford_real branches[STANFORD_MAX_IK_SOLUTIONS * STANFORD_DOF];
+    int valid[STANFORD_MAX_IK_SOLUTIONS];
+    int count = 0, i, j;
+    stanford_ik_branches(T, branches, valid);
+    for (i = 0; i < STANFORD_MAX_IK_SOLUTIONS; ++i) {
+        if (valid[i]) {
+            for (j = 0; j < STANFORD_DOF; ++j) {
+                q[STANFORD_DOF * count + j] = branches[STANFORD_DOF * i + j];
+            }
+            ++count;
         }
-    }
-    count = stanford_ik_solve(T, &g, q);
-    for (k = 0; k < count; ++k) {
-        q[STANFORD_DOF * k + 0] = stanford_wrap(q[STANFORD_DOF * k + 0]);
-        q[STANFORD_DOF * k + 1] = stanford_wrap(q[STANFORD_DOF * k + 1]);
-        q[STANFORD_DOF * k + 3] = stanford_wrap(q[STANFORD_DOF * k + 3]);
-        q[STANFORD_DOF * k + 4] = stanford_wrap(q[STANFORD_DOF * k + 4]);
-        q[STANFORD_DOF * k + 5] = stanford_wrap(q[STANFORD_DOF * k + 5]);
     }
     return count;
 }

@@ -32,6 +32,7 @@ typedef double stanford_real;
 #define STANFORD_DOF 6
 #define STANFORD_TASK_DIM 6
 #define STANFORD_NUM_SINGULARITY_FACTORS 3
+#define STANFORD_MAX_IK_SOLUTIONS 8
 
 /* Pose of the tool frame in the world frame (4x4 homogeneous).
  * Result: T: 4 x 4 row-major, element (r, c) at T[r * 4 + c]. 73 operations. */
@@ -69,6 +70,10 @@ stanford_real stanford_manipulability(const stanford_real q[STANFORD_DOF]);
  * Result: returned as a scalar. 5 operations. */
 stanford_real stanford_jacobian_det(const stanford_real q[STANFORD_DOF]);
 
+/* Every branch of the closed-form ik and whether the target allows it.
+ * Result: q: 8 x 6 row-major, element (r, c) at q[r * 6 + c]; valid[i], i < 8. 630 operations. */
+void stanford_ik_branches(const stanford_real T[16], stanford_real q[STANFORD_MAX_IK_SOLUTIONS * STANFORD_DOF], int valid[STANFORD_MAX_IK_SOLUTIONS]);
+
 /* Status of stanford_velocity_ik. */
 #define STANFORD_VELOCITY_IK_OK 0
 #define STANFORD_VELOCITY_IK_SINGULAR 1   /* a pivot below 1e-12 x the largest |entry|: take damping > 0 */
@@ -82,11 +87,9 @@ stanford_real stanford_jacobian_det(const stanford_real q[STANFORD_DOF]);
  * STANFORD_VELOCITY_IK_OK, or a status above with q_dot all 0. */
 int stanford_velocity_ik(const stanford_real q[STANFORD_DOF], const stanford_real mu_dot[STANFORD_TASK_DIM], stanford_real damping, stanford_real q_dot[STANFORD_DOF]);
 
-#define STANFORD_MAX_IK_SOLUTIONS 8
-
 /* Closed-form inverse kinematics: every joint solution that reaches the target; returns
- * their count k and writes solution i to q[i * STANFORD_DOF + j], i < k. Loops over
- * the branches, no allocation, no recursion.
+ * their count k and writes solution i to q[i * STANFORD_DOF + j], i < k: the valid
+ * rows of stanford_ik_branches, in its order. No allocation, no recursion.
  * target: the 4x4 tool pose in the world frame (rotation part orthonormal).
  * Result: k <= STANFORD_MAX_IK_SOLUTIONS solutions, revolute angles wrapped into (-pi,
  * pi], joint limits not applied; k = 0 when the target is out of reach or not finite.

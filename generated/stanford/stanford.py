@@ -16,16 +16,18 @@ DOF = 6
 TASK = ("x", "y", "z", "roll", "pitch", "yaw", )
 
 
-def _joints(q):
-    q = numpy.asarray(q, dtype=float)
-    if q.ndim == 0 or q.shape[-1] != DOF:
-        raise ValueError(f"q must have shape ({DOF},) or (..., {DOF}), got {q.shape}")
-    return q
+def _argument(name, value, shape):
+    """`value` as a float array of `shape` or a batch of them (..., *shape)."""
+    value = numpy.asarray(value, dtype=float)
+    if value.shape[value.ndim - len(shape):] != shape:
+        batch = ", ".join(map(str, shape))
+        raise ValueError(f"{name} must have shape {shape} or (..., {batch}), got {value.shape}")
+    return value
 
 
 def fk(q):
     """pose of the tool frame in the world frame (4x4 homogeneous): (4 x 4), 73 operations."""
-    q = _joints(q)
+    q = _argument("q", q, (6,))
     q1 = q[..., 0]
     q2 = q[..., 1]
     q3 = q[..., 2]
@@ -92,7 +94,7 @@ def fk(q):
 
 def jacobian(q):
     """geometric Jacobian in the world frame (6 x DOF, rows vx vy vz wx wy wz): (6 x 6), 50 operations."""
-    q = _joints(q)
+    q = _argument("q", q, (6,))
     q1 = q[..., 0]
     q2 = q[..., 1]
     q3 = q[..., 2]
@@ -164,7 +166,7 @@ def jacobian(q):
 
 def fk_jacobian(q):
     """fk and jacobian in one pass, sharing their terms: (4 x 4 and 6 x 6), 81 operations."""
-    q = _joints(q)
+    q = _argument("q", q, (6,))
     q1 = q[..., 0]
     q2 = q[..., 1]
     q3 = q[..., 2]
@@ -269,7 +271,7 @@ def fk_jacobian(q):
 
 def jacobian_tool(q):
     """geometric Jacobian in the tool frame (6 x DOF, rows vx vy vz wx wy wz): (6 x 6), 156 operations."""
-    q = _joints(q)
+    q = _argument("q", q, (6,))
     q1 = q[..., 0]
     q2 = q[..., 1]
     q3 = q[..., 2]
@@ -362,7 +364,7 @@ def jacobian_tool(q):
 
 def task(q):
     """task vector mu = (x, y, z, roll, pitch, yaw): (6 x 1), 67 operations."""
-    q = _joints(q)
+    q = _argument("q", q, (6,))
     q1 = q[..., 0]
     q2 = q[..., 1]
     q3 = q[..., 2]
@@ -413,7 +415,7 @@ def task(q):
 
 def task_jacobian(q):
     """analytic Jacobian d mu / d q (6 x DOF): (6 x 6), 113 operations."""
-    q = _joints(q)
+    q = _argument("q", q, (6,))
     q1 = q[..., 0]
     q2 = q[..., 1]
     q3 = q[..., 2]
@@ -503,7 +505,7 @@ def task_jacobian(q):
 
 def singularity_factors(q):
     """factors of det(Js): the robot is singular where one is 0: (3 x 1), 2 operations."""
-    q = _joints(q)
+    q = _argument("q", q, (6,))
     q2 = q[..., 1]
     q3 = q[..., 2]
     q5 = q[..., 4]
@@ -518,7 +520,7 @@ def singularity_factors(q):
 
 def manipulability(q):
     """manipulability |det(Js)|: (1 x 1), 6 operations."""
-    q = _joints(q)
+    q = _argument("q", q, (6,))
     q2 = q[..., 1]
     q3 = q[..., 2]
     q5 = q[..., 4]
@@ -532,7 +534,7 @@ def manipulability(q):
 
 def jacobian_det(q):
     """det(Js): (1 x 1), 5 operations."""
-    q = _joints(q)
+    q = _argument("q", q, (6,))
     q2 = q[..., 1]
     q3 = q[..., 2]
     q5 = q[..., 4]
@@ -543,148 +545,375 @@ def jacobian_det(q):
     return d
 
 
-def _wrap(angle):
-    """Angles wrapped into (-pi, pi]."""
-    return angle - 2.0 * math.pi * numpy.ceil((angle - math.pi) / (2.0 * math.pi))
+@numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
+def ik_branches(T):
+    """every branch of the closed-form ik and whether the target allows it: (8 x 6 and 8 x 1), 630 operations."""
+    T = _argument("T", T, (4, 4))
+    T00 = T[..., 0, 0]
+    T01 = T[..., 0, 1]
+    T02 = T[..., 0, 2]
+    T03 = T[..., 0, 3]
+    T10 = T[..., 1, 0]
+    T11 = T[..., 1, 1]
+    T12 = T[..., 1, 2]
+    T13 = T[..., 1, 3]
+    T20 = T[..., 2, 0]
+    T21 = T[..., 2, 1]
+    T22 = T[..., 2, 2]
+    T23 = T[..., 2, 3]
+    t0 = T00 + T01 + T02 + T03 + T10 + T11 + T12 + T13 + T20 + T21 + T22 + T23
+    t1 = -0.1337*T00 + 0.412*T02
+    t2 = T03 - t1
+    t3 = t1
+    t4 = t2 + t3
+    t5 = -0.1337*T10 + 0.412*T12
+    t6 = T13 - t5
+    t7 = t5
+    t8 = t6 + t7
+    t9 = -0.1337*T20 + 0.412*T22
+    t10 = T23 - t9
+    t11 = t9
+    t12 = t10 + t11
+    t13 = t12 - 0.412
+    t14 = t13**2
+    t15 = t14 + t4**2 + t8**2
+    t16 = 0.01787569 - t15
+    t17 = t15 + 0.01787569
+    t18 = -t16
+    t19 = 1e-12*t17
+    t20 = -t19
+    t21 = numpy.where(numpy.less(t16, t20), numpy.sqrt(t18), 0)
+    t22 = t21**2
+    t23 = t22 + 0.01787569
+    t24 = t14 + 0.01787569
+    t25 = -t23 + t24
+    t26 = -t25
+    t27 = 1e-12*t23
+    t28 = -t27
+    t29 = numpy.where(numpy.less(t25, t28), numpy.sqrt(t26), 0)
+    t30 = t29*t4
+    t31 = t14 + 0.1337*t8
+    t32 = -t30 + t31
+    t33 = t30 + t31
+    t34 = -t14
+    t35 = t32 + t34
+    t36 = t33 + t34
+    t37 = 0.1337*t4
+    t38 = t29*t8
+    t39 = t37 + t38
+    t40 = t35**2 + t39**2
+    t41 = 1/numpy.sqrt(t40)
+    t42 = -t37 + t38
+    t43 = t36**2 + t42**2
+    t44 = 1/numpy.sqrt(t43)
+    t45 = t29**2
+    t46 = t24 + t45
+    t47 = 1e-24*t46
+    t48 = t15*t47
+    t49 = numpy.less_equal(t40, t48)
+    t50 = numpy.where(t49, 1, t35*t41)
+    t51 = numpy.where(t49, 0, -t39*t41)
+    t52 = T02*t50 + T12*t51
+    t53 = -T02*t51 + T12*t50
+    t54 = T01*t50 + T11*t51
+    t55 = -T01*t51 + T11*t50
+    t56 = t13*t21
+    t57 = t56 + 0.01787569
+    t58 = t57 - 0.01787569
+    t59 = 0.01787569 - t56
+    t60 = t59 - 0.01787569
+    t61 = t22*t45
+    t62 = t58**2 + t61
+    t63 = 1/numpy.sqrt(t62)
+    t64 = t60**2 + t61
+    t65 = 1/numpy.sqrt(t64)
+    t66 = t23*t47
+    t67 = numpy.less_equal(t62, t66)
+    t68 = numpy.where(t67, 1, t58*t63)
+    t69 = t21*t29
+    t70 = t63*t69
+    t71 = numpy.where(t67, 0, -t70)
+    t72 = numpy.where(t67, 0, t70)
+    t73 = numpy.less_equal(t43, t48)
+    t74 = numpy.where(t73, 1, t36*t44)
+    t75 = numpy.where(t73, 0, t42*t44)
+    t76 = T02*t74 + T12*t75
+    t77 = -T02*t75 + T12*t74
+    t78 = T01*t74 + T11*t75
+    t79 = -T01*t75 + T11*t74
+    t80 = 1 - t50
+    t81 = T22*t80
+    t82 = T22*t50 + t81
+    t83 = T21*t80
+    t84 = T21*t50 + t83
+    t85 = t52*t68 - t71*t82
+    t86 = t52*t71 + t68*t82
+    t87 = t54*t68 - t71*t84
+    t88 = t54*t71 + t68*t84
+    t89 = 1 - t68
+    t90 = t53*t89
+    t91 = t53*t68 + t90
+    t92 = t55*t89
+    t93 = t55*t68 + t92
+    t94 = t77*t89
+    t95 = t68*t77 + t94
+    t96 = t79*t89
+    t97 = t68*t79 + t96
+    t98 = t86**2
+    t99 = -t98
+    t100 = t99 + 1
+    t101 = numpy.where(numpy.greater(t100, 1e-12), numpy.sqrt(t100), 0)
+    t102 = t101*t91 + t98
+    t103 = t102 + t99
+    t104 = t85**2
+    t105 = t104 + t91**2 + t98
+    t106 = t101**2
+    t107 = t103**2 + t104*t106
+    t108 = t106 + t98
+    t109 = 1/numpy.sqrt(t107)
+    t110 = 1/numpy.sqrt(t108)
+    t111 = 1e-24*t108
+    t112 = numpy.less_equal(t107, t105*t111)
+    t113 = numpy.where(t112, 1, t103*t109)
+    t114 = t88*(1 - t113)
+    t115 = t113*t88 + t114
+    t116 = t101*t85
+    t117 = numpy.where(t112, 0, -t109*t116)
+    t118 = t113*t87 + t117*t93
+    t119 = t113*t93 - t117*t87
+    t120 = numpy.less_equal(t108, t111)
+    t121 = numpy.where(t120, 1, t110*t86)
+    t122 = numpy.where(t120, 0, -t101*t110)
+    t123 = t118*(1 - t121)
+    t124 = t118*t121 + t123
+    t125 = t115*t122 + t119*t121
+    t126 = t115*t121 - t119*t122
+    t127 = t124**2 + t125**2
+    t128 = t127
+    t129 = t126**2 + t127
+    t130 = 1 - t74
+    t131 = T22*t130
+    t132 = T22*t74 + t131
+    t133 = T21*t130
+    t134 = T21*t74 + t133
+    t135 = -t132*t72 + t68*t76
+    t136 = t132*t68 + t72*t76
+    t137 = -t134*t72 + t68*t78
+    t138 = t134*t68 + t72*t78
+    t139 = t136**2
+    t140 = -t139
+    t141 = t140 + 1
+    t142 = numpy.where(numpy.greater(t141, 1e-12), numpy.sqrt(t141), 0)
+    t143 = t139 + t142*t95
+    t144 = t140 + t143
+    t145 = t135**2
+    t146 = t139 + t145 + t95**2
+    t147 = t142**2
+    t148 = t144**2 + t145*t147
+    t149 = t139 + t147
+    t150 = 1/numpy.sqrt(t148)
+    t151 = 1/numpy.sqrt(t149)
+    t152 = 1e-24*t149
+    t153 = numpy.less_equal(t148, t146*t152)
+    t154 = numpy.where(t153, 1, t144*t150)
+    t155 = t138*(1 - t154)
+    t156 = t138*t154 + t155
+    t157 = t135*t142
+    t158 = numpy.where(t153, 0, -t150*t157)
+    t159 = t137*t154 + t158*t97
+    t160 = -t137*t158 + t154*t97
+    t161 = numpy.less_equal(t149, t152)
+    t162 = numpy.where(t161, 1, t136*t151)
+    t163 = numpy.where(t161, 0, -t142*t151)
+    t164 = t159*(1 - t162)
+    t165 = t159*t162 + t164
+    t166 = t156*t163 + t160*t162
+    t167 = t156*t162 - t160*t163
+    t168 = t165**2 + t166**2
+    t169 = t168
+    t170 = t167**2 + t168
+    t171 = numpy.less_equal(t64, t66)
+    t172 = numpy.where(t171, 1, t60*t65)
+    t173 = t65*t69
+    t174 = numpy.where(t171, 0, t173)
+    t175 = numpy.where(t171, 0, -t173)
+    t176 = t172*t52 - t174*t82
+    t177 = t172*t82 + t174*t52
+    t178 = t172*t54 - t174*t84
+    t179 = t172*t84 + t174*t54
+    t180 = -t132*t175 + t172*t76
+    t181 = t132*t172 + t175*t76
+    t182 = -t134*t175 + t172*t78
+    t183 = t134*t172 + t175*t78
+    t184 = 1 - t172
+    t185 = t184*t53
+    t186 = t172*t53 + t185
+    t187 = t184*t55
+    t188 = t172*t55 + t187
+    t189 = t184*t77
+    t190 = t172*t77 + t189
+    t191 = t184*t79
+    t192 = t172*t79 + t191
+    t193 = t177**2
+    t194 = -t193
+    t195 = t194 + 1
+    t196 = numpy.where(numpy.greater(t195, 1e-12), numpy.sqrt(t195), 0)
+    t197 = t186*t196 + t193
+    t198 = t194 + t197
+    t199 = t176**2
+    t200 = t186**2 + t193 + t199
+    t201 = t196**2
+    t202 = t198**2 + t199*t201
+    t203 = t193 + t201
+    t204 = 1/numpy.sqrt(t202)
+    t205 = 1/numpy.sqrt(t203)
+    t206 = 1e-24*t203
+    t207 = numpy.less_equal(t202, t200*t206)
+    t208 = numpy.where(t207, 1, t198*t204)
+    t209 = t179*(1 - t208)
+    t210 = t179*t208 + t209
+    t211 = t176*t196
+    t212 = numpy.where(t207, 0, -t204*t211)
+    t213 = t178*t208 + t188*t212
+    t214 = -t178*t212 + t188*t208
+    t215 = numpy.less_equal(t203, t206)
+    t216 = numpy.where(t215, 1, t177*t205)
+    t217 = numpy.where(t215, 0, -t196*t205)
+    t218 = t213*(1 - t216)
+    t219 = t213*t216 + t218
+    t220 = t210*t217 + t214*t216
+    t221 = t210*t216 - t214*t217
+    t222 = t219**2 + t220**2
+    t223 = t222
+    t224 = t221**2 + t222
+    t225 = t181**2
+    t226 = -t225
+    t227 = t226 + 1
+    t228 = numpy.where(numpy.greater(t227, 1e-12), numpy.sqrt(t227), 0)
+    t229 = t190*t228 + t225
+    t230 = t226 + t229
+    t231 = t180**2
+    t232 = t190**2 + t225 + t231
+    t233 = t228**2
+    t234 = t230**2 + t231*t233
+    t235 = t225 + t233
+    t236 = 1/numpy.sqrt(t234)
+    t237 = 1/numpy.sqrt(t235)
+    t238 = 1e-24*t235
+    t239 = numpy.less_equal(t234, t232*t238)
+    t240 = numpy.where(t239, 1, t230*t236)
+    t241 = t183*(1 - t240)
+    t242 = t183*t240 + t241
+    t243 = t180*t228
+    t244 = numpy.where(t239, 0, -t236*t243)
+    t245 = t182*t240 + t192*t244
+    t246 = -t182*t244 + t192*t240
+    t247 = numpy.less_equal(t235, t238)
+    t248 = numpy.where(t247, 1, t181*t237)
+    t249 = numpy.where(t247, 0, -t228*t237)
+    t250 = t245*(1 - t248)
+    t251 = t245*t248 + t250
+    t252 = t242*t249 + t246*t248
+    t253 = t242*t248 - t246*t249
+    t254 = t251**2 + t252**2
+    t255 = t254
+    t256 = t253**2 + t254
+    t257 = numpy.where(t49, 0, numpy.arctan2(-t39, t35))
+    t258 = -t69
+    t259 = numpy.where(t67, 0, numpy.arctan2(t258, t58))
+    t260 = numpy.where(t112, 0, numpy.arctan2(-t116, t103))
+    t261 = numpy.where(t120, 0, numpy.arctan2(-t101, t86))
+    t262 = numpy.where(numpy.less_equal(t128, 1e-24*t129), 0, numpy.arctan2(t125, t124))
+    t263 = numpy.where(t73, 0, numpy.arctan2(t42, t36))
+    t264 = numpy.where(t67, 0, numpy.arctan2(t69, t58))
+    t265 = numpy.where(t153, 0, numpy.arctan2(-t157, t144))
+    t266 = numpy.where(t161, 0, numpy.arctan2(-t142, t136))
+    t267 = numpy.where(numpy.less_equal(t169, 1e-24*t170), 0, numpy.arctan2(t166, t165))
+    t268 = numpy.where(t171, 0, numpy.arctan2(t69, t60))
+    t269 = -t21
+    t270 = numpy.where(t207, 0, numpy.arctan2(-t211, t198))
+    t271 = numpy.where(t215, 0, numpy.arctan2(-t196, t177))
+    t272 = numpy.where(numpy.less_equal(t223, 1e-24*t224), 0, numpy.arctan2(t220, t219))
+    t273 = numpy.where(t171, 0, numpy.arctan2(t258, t60))
+    t274 = numpy.where(t239, 0, numpy.arctan2(-t243, t230))
+    t275 = numpy.where(t247, 0, numpy.arctan2(-t228, t181))
+    t276 = numpy.where(numpy.less_equal(t255, 1e-24*t256), 0, numpy.arctan2(t252, t251))
+    t277 = numpy.isfinite(t0)
+    t278 = -1e-12
+    t279 = numpy.greater_equal(t18, t20)
+    t280 = numpy.greater_equal(t26, t28)
+    t281 = numpy.greater(t26, t27)
+    t282 = numpy.greater(t18, t19)
+    q = numpy.empty(T.shape[:-2] + (8, 6))
+    q[..., 0, 0] = t257
+    q[..., 0, 1] = t259
+    q[..., 0, 2] = t21
+    q[..., 0, 3] = t260
+    q[..., 0, 4] = t261
+    q[..., 0, 5] = t262
+    q[..., 1, 0] = t257
+    q[..., 1, 1] = t259
+    q[..., 1, 2] = t21
+    q[..., 1, 3] = t260 - 6.283185307179586*numpy.ceil(0.15915494309189535*t260) + 3.141592653589793
+    q[..., 1, 4] = -t261 - 6.283185307179586*numpy.ceil(-0.15915494309189535*t261 - 0.5)
+    q[..., 1, 5] = t262 - 6.283185307179586*numpy.ceil(0.15915494309189535*t262) + 3.141592653589793
+    q[..., 2, 0] = t263
+    q[..., 2, 1] = t264
+    q[..., 2, 2] = t21
+    q[..., 2, 3] = t265
+    q[..., 2, 4] = t266
+    q[..., 2, 5] = t267
+    q[..., 3, 0] = t263
+    q[..., 3, 1] = t264
+    q[..., 3, 2] = t21
+    q[..., 3, 3] = t265 - 6.283185307179586*numpy.ceil(0.15915494309189535*t265) + 3.141592653589793
+    q[..., 3, 4] = -t266 - 6.283185307179586*numpy.ceil(-0.15915494309189535*t266 - 0.5)
+    q[..., 3, 5] = t267 - 6.283185307179586*numpy.ceil(0.15915494309189535*t267) + 3.141592653589793
+    q[..., 4, 0] = t257
+    q[..., 4, 1] = t268
+    q[..., 4, 2] = t269
+    q[..., 4, 3] = t270
+    q[..., 4, 4] = t271
+    q[..., 4, 5] = t272
+    q[..., 5, 0] = t257
+    q[..., 5, 1] = t268
+    q[..., 5, 2] = t269
+    q[..., 5, 3] = t270 - 6.283185307179586*numpy.ceil(0.15915494309189535*t270) + 3.141592653589793
+    q[..., 5, 4] = -t271 - 6.283185307179586*numpy.ceil(-0.15915494309189535*t271 - 0.5)
+    q[..., 5, 5] = t272 - 6.283185307179586*numpy.ceil(0.15915494309189535*t272) + 3.141592653589793
+    q[..., 6, 0] = t263
+    q[..., 6, 1] = t273
+    q[..., 6, 2] = t269
+    q[..., 6, 3] = t274
+    q[..., 6, 4] = t275
+    q[..., 6, 5] = t276
+    q[..., 7, 0] = t263
+    q[..., 7, 1] = t273
+    q[..., 7, 2] = t269
+    q[..., 7, 3] = t274 - 6.283185307179586*numpy.ceil(0.15915494309189535*t274) + 3.141592653589793
+    q[..., 7, 4] = -t275 - 6.283185307179586*numpy.ceil(-0.15915494309189535*t275 - 0.5)
+    q[..., 7, 5] = t276 - 6.283185307179586*numpy.ceil(0.15915494309189535*t276) + 3.141592653589793
+    valid = numpy.empty(T.shape[:-2] + (8,), dtype=bool)
+    valid[..., 0] = t277 & t279 & t280 & (numpy.greater_equal(t100, t278))
+    valid[..., 1] = t277 & t279 & t280 & (numpy.greater(t100, 1e-12))
+    valid[..., 2] = t277 & t279 & t281 & (numpy.greater_equal(t141, t278))
+    valid[..., 3] = t277 & t279 & t281 & (numpy.greater(t141, 1e-12))
+    valid[..., 4] = t277 & t280 & t282 & (numpy.greater_equal(t195, t278))
+    valid[..., 5] = t277 & t280 & t282 & (numpy.greater(t195, 1e-12))
+    valid[..., 6] = t277 & t281 & t282 & (numpy.greater_equal(t227, t278))
+    valid[..., 7] = t277 & t281 & t282 & (numpy.greater(t227, 1e-12))
+    return q, valid
 
-
-# -- Closed-form inverse kinematics (spherical_wrist_prismatic) --
 
 MAX_IK_SOLUTIONS = 8
-_EPS = 1e-12  # a squared sine within this of 0 is a double root
-_TINY = 1e-24  # relative squared length below which a vector counts as zero
 
 
-def _dot(a, b):
-    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+def ik(T):
+    """Closed-form inverse kinematics: every joint solution that reaches the target.
 
-
-def _cross(a, b):
-    return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
-
-
-def _add(a, b):
-    return (a[0] + b[0], a[1] + b[1], a[2] + b[2])
-
-
-def _sub(a, b):
-    return (a[0] - b[0], a[1] - b[1], a[2] - b[2])
-
-
-def _rot(k, c, s, v):
-    """v turned about the unit axis k by the angle whose cosine and sine are c and s (Rodrigues)."""
-    kxv = _cross(k, v)
-    kv = _dot(k, v) * (1.0 - c)
-    return (v[0] * c + kxv[0] * s + k[0] * kv, v[1] * c + kxv[1] * s + k[1] * kv,
-            v[2] * c + kxv[2] * s + k[2] * kv)
-
-
-class _Angle:
-    """An angle with its cosine and sine."""
-
-    __slots__ = ("theta", "c", "s")
-
-    def __init__(self, theta, c, s):
-        self.theta, self.c, self.s = theta, c, s
-
-
-def _angle(c, s):
-    return _Angle(math.atan2(s, c), c, s)
-
-
-def _sp1(p, q, k):
-    """SP1: the angle turning p into q about the unit axis k (least squares when they differ
-    in length or height along k). 0 when p or q lies on the axis (any angle would do)."""
-    x = _dot(p, q) - _dot(k, p) * _dot(k, q)
-    y = _dot(k, _cross(p, q))
-    r = math.hypot(x, y)
-    if r * r <= _TINY * _dot(p, p) * _dot(q, q):
-        return _Angle(0.0, 1.0, 0.0)
-    return _angle(x / r, y / r)
-
-
-def _sp2(p, q, k1, k2, wanted=2):
-    """SP2: the angle pairs (t1, t2) with rot(k1, t1) rot(k2, t2) p = q, for two axes through
-    one point (p, q relative to it): rot(k2, t2) p = rot(k1, -t1) q = c, c = alpha k1 +
-    beta k2 +- gamma k1 x k2. One pair when gamma^2 is within _EPS of 0, none below. With
-    wanted=1 the second pair, when it exists, is None (not computed)."""
-    k12 = _dot(k1, k2)
-    normal = _cross(k1, k2)
-    nn = 1.0 - k12 * k12
-    u, v = _dot(k1, q), _dot(k2, p)
-    alpha = (u - k12 * v) / nn
-    beta = (v - k12 * u) / nn
-    pp = _dot(p, p)
-    gg = (pp - alpha * alpha - beta * beta - 2.0 * alpha * beta * k12) / nn
-    if gg < -_EPS * pp:
-        return []
-    gammas = (0.0,) if gg <= _EPS * pp else (math.sqrt(gg), -math.sqrt(gg))
-    pairs = []
-    for gamma in gammas[:wanted]:
-        c = tuple(alpha * k1[i] + beta * k2[i] + gamma * normal[i] for i in range(3))
-        pairs.append((_sp1(c, q, k1), _sp1(p, c, k2)))
-    return pairs + [None] * (len(gammas) - len(pairs))
-
-
-def _relative(T, rotation, position):
-    """T T(0)^-1 = exp(xi_1 q_1) ... exp(xi_n q_n) as (R, t), T(0) = (rotation, position)
-    the tool pose at q = 0."""
-    R = tuple(T[i][0] * rotation[3 * j] + T[i][1] * rotation[3 * j + 1] + T[i][2] * rotation[3 * j + 2]
-              for i in range(3) for j in range(3))
-    return R, tuple(T[i][3] - _dot(R[3 * i:3 * i + 3], position) for i in range(3))
-
-
-def _mul(R, v):
-    return (_dot(R[0:3], v), _dot(R[3:6], v), _dot(R[6:9], v))
-
-
-def _ik_wrist(a, b, h4, h5, h6, v6, wrist_flip):
-    """Spherical wrist with axis 5 perpendicular to axes 4 and 6: the angles (q4, q5, q6) with
-    R4 R5 R6 h6 = a and R4 R5 R6 v6 = b (v6 perpendicular to h6). The first by SP2 and SP1; the
-    second is (q4 + pi, wrist_flip - q5, q6 + pi): rot(h4, pi) reflects the plane perpendicular
-    to h5 across h4, and wrist_flip = -2 angle(h4 -> h6 about h5)."""
-    pairs = _sp2(h6, a, h4, h5, wanted=1)
-    if not pairs:
-        return []
-    t4, t5 = pairs[0]
-    t6 = _sp1(v6, _rot(h5, t5.c, -t5.s, _rot(h4, t4.c, -t4.s, b)), h6)
-    first = (t4.theta, t5.theta, t6.theta)
-    if len(pairs) == 1:
-        return [first]
-    return [first, (t4.theta + math.pi, wrist_flip - t5.theta, t6.theta + math.pi)]
-
-
-def _ik_solve(T, tool_rotation, tool_position, h1, h2, shoulder, h3, h4, h5, h6, v6, centre, wrist_flip):
-    """Spherical wrist, axes 1 and 2 intersecting at the shoulder point, joint 3 prismatic:
-    the wrist centre's distance from the shoulder point fixes q3 (a quadratic), its position
-    q1 and q2 (SP2); the orientation left to the wrist gives q4, q5, q6."""
-    R, t = _relative(T, tool_rotation, tool_position)
-    wc = _add(_mul(R, centre), t)
-    a, b = _mul(R, h6), _mul(R, v6)
-    d = _sub(wc, shoulder)
-    e = _sub(centre, shoulder)
-    # |e + q3 h3|^2 = |d|^2: q3^2 + 2 half q3 + rest = 0
-    half, rest = _dot(h3, e), _dot(e, e) - _dot(d, d)
-    disc = half * half - rest
-    scale = _dot(e, e) + _dot(d, d)
-    if disc < -_EPS * scale:
-        return []
-    slides = (-half,) if disc <= _EPS * scale else (-half + math.sqrt(disc), -half - math.sqrt(disc))
-    solutions = []
-    for t3 in slides:
-        reached = tuple(e[i] + t3 * h3[i] for i in range(3))
-        for t1, t2 in _sp2(reached, d, h1, h2):
-            aw, bw = a, b
-            for axis, angle in ((h1, t1), (h2, t2)):
-                aw, bw = _rot(axis, angle.c, -angle.s, aw), _rot(axis, angle.c, -angle.s, bw)
-            for t4, t5, t6 in _ik_wrist(aw, bw, h4, h5, h6, v6, wrist_flip):
-                solutions.append([t1.theta, t2.theta, t3, t4, t5, t6])
-    return solutions
-
-
-def ik(target):
-    """Closed-form inverse kinematics: every joint solution that reaches `target`, as (k, DOF).
-
+    One target: the solutions as (k, DOF), the valid rows of ik_branches in its order.
+    A batch of targets: ik_branches' (q, valid), (..., MAX_IK_SOLUTIONS, DOF) and
+    (..., MAX_IK_SOLUTIONS).
     target: the 4x4 tool pose in the world frame (rotation part orthonormal).
     Result: k <= MAX_IK_SOLUTIONS solutions, revolute angles wrapped into (-pi, pi], joint
     limits not applied; k = 0 when the target is out of reach or not finite.
@@ -700,29 +929,8 @@ def ik(target):
     root (a target on a singularity or on the workspace boundary) is returned once, and an
     angle the target leaves free (a singular wrist or shoulder) is set to 0.
     """
-    target = numpy.asarray(target, dtype=float)
-    if target.shape != (4, 4):
-        raise ValueError(f"target must have shape (4, 4), got {target.shape}")
-    if not numpy.all(numpy.isfinite(target[:3])):  # the last row is not read
-        return numpy.empty((0, DOF))
-    solutions = _ik_solve(
-        target.tolist(),
-        tool_rotation=(0, 1, 0, -1, 0, 0, 0, 0, 1),
-        tool_position=(0, 0.1337, 0.412),
-        h1=(0, 0, 1),
-        h2=(0, 1, 0),
-        shoulder=(0, 0, 0.412),
-        h3=(0, 0, 1),
-        h4=(0, 0, 1),
-        h5=(1, 0, 0),
-        h6=(0, 0, 1),
-        v6=(1, 0, 0),
-        centre=(0, 0.1337, 0.412),
-        wrist_flip=0,
-    )
-    q = numpy.array(solutions, dtype=float).reshape(-1, DOF)
-    q[:, [0, 1, 3, 4, 5]] = _wrap(q[:, [0, 1, 3, 4, 5]])
-    return q
+    q, valid = ik_branches(T)
+    return q[valid] if valid.ndim == 1 else (q, valid)
 
 
 # -- Iterative inverse kinematics --
@@ -810,7 +1018,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
     condition number below VELOCITY_IK_RCOND; take damping > 0 there). Where ok is False,
     q_dot is 0: the result never holds NaN.
     """
-    q = _joints(q)
+    q = _argument("q", q, (DOF,))
     mu_dot = numpy.asarray(mu_dot, dtype=float)
     if mu_dot.ndim == 0 or mu_dot.shape[-1] != 6:
         raise ValueError(f"mu_dot must have shape (6,) or (..., 6), got {mu_dot.shape}")

@@ -3,7 +3,9 @@
 
 Stanford arm RRPRRR (rtb Stanford), standard DH
 Every function takes `q` (6 x 1: radians for revolute joints, m for
-prismatic ones) and returns a rows x cols result whose zeros are structural.
+prismatic ones) and returns a rows x cols result whose zeros are structural; ik_branches
+(also named ik) takes the target instead of q and returns every branch (MAX_IK_SOLUTIONS x
+DOF) and its validity (MAX_IK_SOLUTIONS x 1, 1 or 0).
 Task vector: (x, y, z, roll, pitch, yaw).
 """
 
@@ -459,7 +461,366 @@ def _jacobian_det(q):
     return [d]
 
 
-_q = casadi.SX.sym("q", DOF)
+def _ik_branches(T):
+    """Every branch of the closed-form ik and whether the target allows it: 630 operations."""
+    T00 = T[0, 0]
+    T01 = T[0, 1]
+    T02 = T[0, 2]
+    T03 = T[0, 3]
+    T10 = T[1, 0]
+    T11 = T[1, 1]
+    T12 = T[1, 2]
+    T13 = T[1, 3]
+    T20 = T[2, 0]
+    T21 = T[2, 1]
+    T22 = T[2, 2]
+    T23 = T[2, 3]
+    t0 = T00 + T01 + T02 + T03 + T10 + T11 + T12 + T13 + T20 + T21 + T22 + T23
+    t1 = -0.1337*T00 + 0.412*T02
+    t2 = T03 - t1
+    t3 = t1
+    t4 = t2 + t3
+    t5 = -0.1337*T10 + 0.412*T12
+    t6 = T13 - t5
+    t7 = t5
+    t8 = t6 + t7
+    t9 = -0.1337*T20 + 0.412*T22
+    t10 = T23 - t9
+    t11 = t9
+    t12 = t10 + t11
+    t13 = t12 - 0.412
+    t14 = t13**2
+    t15 = t14 + t4**2 + t8**2
+    t16 = 0.01787569 - t15
+    t17 = t15 + 0.01787569
+    t18 = -t16
+    t19 = 1e-12*t17
+    t20 = -t19
+    t21 = casadi.if_else((t16 < t20), casadi.sqrt(t18), 0)
+    t22 = t21**2
+    t23 = t22 + 0.01787569
+    t24 = t14 + 0.01787569
+    t25 = -t23 + t24
+    t26 = -t25
+    t27 = 1e-12*t23
+    t28 = -t27
+    t29 = casadi.if_else((t25 < t28), casadi.sqrt(t26), 0)
+    t30 = t29*t4
+    t31 = t14 + 0.1337*t8
+    t32 = -t30 + t31
+    t33 = t30 + t31
+    t34 = -t14
+    t35 = t32 + t34
+    t36 = t33 + t34
+    t37 = 0.1337*t4
+    t38 = t29*t8
+    t39 = t37 + t38
+    t40 = t35**2 + t39**2
+    t41 = 1/casadi.sqrt(t40)
+    t42 = -t37 + t38
+    t43 = t36**2 + t42**2
+    t44 = 1/casadi.sqrt(t43)
+    t45 = t29**2
+    t46 = t24 + t45
+    t47 = 1e-24*t46
+    t48 = t15*t47
+    t49 = (t40 <= t48)
+    t50 = casadi.if_else(t49, 1, t35*t41)
+    t51 = casadi.if_else(t49, 0, -t39*t41)
+    t52 = T02*t50 + T12*t51
+    t53 = -T02*t51 + T12*t50
+    t54 = T01*t50 + T11*t51
+    t55 = -T01*t51 + T11*t50
+    t56 = t13*t21
+    t57 = t56 + 0.01787569
+    t58 = t57 - 0.01787569
+    t59 = 0.01787569 - t56
+    t60 = t59 - 0.01787569
+    t61 = t22*t45
+    t62 = t58**2 + t61
+    t63 = 1/casadi.sqrt(t62)
+    t64 = t60**2 + t61
+    t65 = 1/casadi.sqrt(t64)
+    t66 = t23*t47
+    t67 = (t62 <= t66)
+    t68 = casadi.if_else(t67, 1, t58*t63)
+    t69 = t21*t29
+    t70 = t63*t69
+    t71 = casadi.if_else(t67, 0, -t70)
+    t72 = casadi.if_else(t67, 0, t70)
+    t73 = (t43 <= t48)
+    t74 = casadi.if_else(t73, 1, t36*t44)
+    t75 = casadi.if_else(t73, 0, t42*t44)
+    t76 = T02*t74 + T12*t75
+    t77 = -T02*t75 + T12*t74
+    t78 = T01*t74 + T11*t75
+    t79 = -T01*t75 + T11*t74
+    t80 = 1 - t50
+    t81 = T22*t80
+    t82 = T22*t50 + t81
+    t83 = T21*t80
+    t84 = T21*t50 + t83
+    t85 = t52*t68 - t71*t82
+    t86 = t52*t71 + t68*t82
+    t87 = t54*t68 - t71*t84
+    t88 = t54*t71 + t68*t84
+    t89 = 1 - t68
+    t90 = t53*t89
+    t91 = t53*t68 + t90
+    t92 = t55*t89
+    t93 = t55*t68 + t92
+    t94 = t77*t89
+    t95 = t68*t77 + t94
+    t96 = t79*t89
+    t97 = t68*t79 + t96
+    t98 = t86**2
+    t99 = -t98
+    t100 = t99 + 1
+    t101 = casadi.if_else((t100 > 1e-12), casadi.sqrt(t100), 0)
+    t102 = t101*t91 + t98
+    t103 = t102 + t99
+    t104 = t85**2
+    t105 = t104 + t91**2 + t98
+    t106 = t101**2
+    t107 = t103**2 + t104*t106
+    t108 = t106 + t98
+    t109 = 1/casadi.sqrt(t107)
+    t110 = 1/casadi.sqrt(t108)
+    t111 = 1e-24*t108
+    t112 = (t107 <= t105*t111)
+    t113 = casadi.if_else(t112, 1, t103*t109)
+    t114 = t88*(1 - t113)
+    t115 = t113*t88 + t114
+    t116 = t101*t85
+    t117 = casadi.if_else(t112, 0, -t109*t116)
+    t118 = t113*t87 + t117*t93
+    t119 = t113*t93 - t117*t87
+    t120 = (t108 <= t111)
+    t121 = casadi.if_else(t120, 1, t110*t86)
+    t122 = casadi.if_else(t120, 0, -t101*t110)
+    t123 = t118*(1 - t121)
+    t124 = t118*t121 + t123
+    t125 = t115*t122 + t119*t121
+    t126 = t115*t121 - t119*t122
+    t127 = t124**2 + t125**2
+    t128 = t127
+    t129 = t126**2 + t127
+    t130 = 1 - t74
+    t131 = T22*t130
+    t132 = T22*t74 + t131
+    t133 = T21*t130
+    t134 = T21*t74 + t133
+    t135 = -t132*t72 + t68*t76
+    t136 = t132*t68 + t72*t76
+    t137 = -t134*t72 + t68*t78
+    t138 = t134*t68 + t72*t78
+    t139 = t136**2
+    t140 = -t139
+    t141 = t140 + 1
+    t142 = casadi.if_else((t141 > 1e-12), casadi.sqrt(t141), 0)
+    t143 = t139 + t142*t95
+    t144 = t140 + t143
+    t145 = t135**2
+    t146 = t139 + t145 + t95**2
+    t147 = t142**2
+    t148 = t144**2 + t145*t147
+    t149 = t139 + t147
+    t150 = 1/casadi.sqrt(t148)
+    t151 = 1/casadi.sqrt(t149)
+    t152 = 1e-24*t149
+    t153 = (t148 <= t146*t152)
+    t154 = casadi.if_else(t153, 1, t144*t150)
+    t155 = t138*(1 - t154)
+    t156 = t138*t154 + t155
+    t157 = t135*t142
+    t158 = casadi.if_else(t153, 0, -t150*t157)
+    t159 = t137*t154 + t158*t97
+    t160 = -t137*t158 + t154*t97
+    t161 = (t149 <= t152)
+    t162 = casadi.if_else(t161, 1, t136*t151)
+    t163 = casadi.if_else(t161, 0, -t142*t151)
+    t164 = t159*(1 - t162)
+    t165 = t159*t162 + t164
+    t166 = t156*t163 + t160*t162
+    t167 = t156*t162 - t160*t163
+    t168 = t165**2 + t166**2
+    t169 = t168
+    t170 = t167**2 + t168
+    t171 = (t64 <= t66)
+    t172 = casadi.if_else(t171, 1, t60*t65)
+    t173 = t65*t69
+    t174 = casadi.if_else(t171, 0, t173)
+    t175 = casadi.if_else(t171, 0, -t173)
+    t176 = t172*t52 - t174*t82
+    t177 = t172*t82 + t174*t52
+    t178 = t172*t54 - t174*t84
+    t179 = t172*t84 + t174*t54
+    t180 = -t132*t175 + t172*t76
+    t181 = t132*t172 + t175*t76
+    t182 = -t134*t175 + t172*t78
+    t183 = t134*t172 + t175*t78
+    t184 = 1 - t172
+    t185 = t184*t53
+    t186 = t172*t53 + t185
+    t187 = t184*t55
+    t188 = t172*t55 + t187
+    t189 = t184*t77
+    t190 = t172*t77 + t189
+    t191 = t184*t79
+    t192 = t172*t79 + t191
+    t193 = t177**2
+    t194 = -t193
+    t195 = t194 + 1
+    t196 = casadi.if_else((t195 > 1e-12), casadi.sqrt(t195), 0)
+    t197 = t186*t196 + t193
+    t198 = t194 + t197
+    t199 = t176**2
+    t200 = t186**2 + t193 + t199
+    t201 = t196**2
+    t202 = t198**2 + t199*t201
+    t203 = t193 + t201
+    t204 = 1/casadi.sqrt(t202)
+    t205 = 1/casadi.sqrt(t203)
+    t206 = 1e-24*t203
+    t207 = (t202 <= t200*t206)
+    t208 = casadi.if_else(t207, 1, t198*t204)
+    t209 = t179*(1 - t208)
+    t210 = t179*t208 + t209
+    t211 = t176*t196
+    t212 = casadi.if_else(t207, 0, -t204*t211)
+    t213 = t178*t208 + t188*t212
+    t214 = -t178*t212 + t188*t208
+    t215 = (t203 <= t206)
+    t216 = casadi.if_else(t215, 1, t177*t205)
+    t217 = casadi.if_else(t215, 0, -t196*t205)
+    t218 = t213*(1 - t216)
+    t219 = t213*t216 + t218
+    t220 = t210*t217 + t214*t216
+    t221 = t210*t216 - t214*t217
+    t222 = t219**2 + t220**2
+    t223 = t222
+    t224 = t221**2 + t222
+    t225 = t181**2
+    t226 = -t225
+    t227 = t226 + 1
+    t228 = casadi.if_else((t227 > 1e-12), casadi.sqrt(t227), 0)
+    t229 = t190*t228 + t225
+    t230 = t226 + t229
+    t231 = t180**2
+    t232 = t190**2 + t225 + t231
+    t233 = t228**2
+    t234 = t230**2 + t231*t233
+    t235 = t225 + t233
+    t236 = 1/casadi.sqrt(t234)
+    t237 = 1/casadi.sqrt(t235)
+    t238 = 1e-24*t235
+    t239 = (t234 <= t232*t238)
+    t240 = casadi.if_else(t239, 1, t230*t236)
+    t241 = t183*(1 - t240)
+    t242 = t183*t240 + t241
+    t243 = t180*t228
+    t244 = casadi.if_else(t239, 0, -t236*t243)
+    t245 = t182*t240 + t192*t244
+    t246 = -t182*t244 + t192*t240
+    t247 = (t235 <= t238)
+    t248 = casadi.if_else(t247, 1, t181*t237)
+    t249 = casadi.if_else(t247, 0, -t228*t237)
+    t250 = t245*(1 - t248)
+    t251 = t245*t248 + t250
+    t252 = t242*t249 + t246*t248
+    t253 = t242*t248 - t246*t249
+    t254 = t251**2 + t252**2
+    t255 = t254
+    t256 = t253**2 + t254
+    t257 = casadi.if_else(t49, 0, casadi.atan2(-t39, t35))
+    t258 = -t69
+    t259 = casadi.if_else(t67, 0, casadi.atan2(t258, t58))
+    t260 = casadi.if_else(t112, 0, casadi.atan2(-t116, t103))
+    t261 = casadi.if_else(t120, 0, casadi.atan2(-t101, t86))
+    t262 = casadi.if_else((t128 <= 1e-24*t129), 0, casadi.atan2(t125, t124))
+    t263 = casadi.if_else(t73, 0, casadi.atan2(t42, t36))
+    t264 = casadi.if_else(t67, 0, casadi.atan2(t69, t58))
+    t265 = casadi.if_else(t153, 0, casadi.atan2(-t157, t144))
+    t266 = casadi.if_else(t161, 0, casadi.atan2(-t142, t136))
+    t267 = casadi.if_else((t169 <= 1e-24*t170), 0, casadi.atan2(t166, t165))
+    t268 = casadi.if_else(t171, 0, casadi.atan2(t69, t60))
+    t269 = -t21
+    t270 = casadi.if_else(t207, 0, casadi.atan2(-t211, t198))
+    t271 = casadi.if_else(t215, 0, casadi.atan2(-t196, t177))
+    t272 = casadi.if_else((t223 <= 1e-24*t224), 0, casadi.atan2(t220, t219))
+    t273 = casadi.if_else(t171, 0, casadi.atan2(t258, t60))
+    t274 = casadi.if_else(t239, 0, casadi.atan2(-t243, t230))
+    t275 = casadi.if_else(t247, 0, casadi.atan2(-t228, t181))
+    t276 = casadi.if_else((t255 <= 1e-24*t256), 0, casadi.atan2(t252, t251))
+    t277 = (casadi.fabs(t0) < casadi.inf)
+    t278 = -1e-12
+    t279 = (t18 >= t20)
+    t280 = (t26 >= t28)
+    t281 = (t26 > t27)
+    t282 = (t18 > t19)
+    q = casadi.SX(8, 6)
+    q[0, 0] = t257
+    q[0, 1] = t259
+    q[0, 2] = t21
+    q[0, 3] = t260
+    q[0, 4] = t261
+    q[0, 5] = t262
+    q[1, 0] = t257
+    q[1, 1] = t259
+    q[1, 2] = t21
+    q[1, 3] = t260 - 6.283185307179586*casadi.ceil(0.15915494309189535*t260) + 3.141592653589793
+    q[1, 4] = -t261 - 6.283185307179586*casadi.ceil(-0.15915494309189535*t261 - 0.5)
+    q[1, 5] = t262 - 6.283185307179586*casadi.ceil(0.15915494309189535*t262) + 3.141592653589793
+    q[2, 0] = t263
+    q[2, 1] = t264
+    q[2, 2] = t21
+    q[2, 3] = t265
+    q[2, 4] = t266
+    q[2, 5] = t267
+    q[3, 0] = t263
+    q[3, 1] = t264
+    q[3, 2] = t21
+    q[3, 3] = t265 - 6.283185307179586*casadi.ceil(0.15915494309189535*t265) + 3.141592653589793
+    q[3, 4] = -t266 - 6.283185307179586*casadi.ceil(-0.15915494309189535*t266 - 0.5)
+    q[3, 5] = t267 - 6.283185307179586*casadi.ceil(0.15915494309189535*t267) + 3.141592653589793
+    q[4, 0] = t257
+    q[4, 1] = t268
+    q[4, 2] = t269
+    q[4, 3] = t270
+    q[4, 4] = t271
+    q[4, 5] = t272
+    q[5, 0] = t257
+    q[5, 1] = t268
+    q[5, 2] = t269
+    q[5, 3] = t270 - 6.283185307179586*casadi.ceil(0.15915494309189535*t270) + 3.141592653589793
+    q[5, 4] = -t271 - 6.283185307179586*casadi.ceil(-0.15915494309189535*t271 - 0.5)
+    q[5, 5] = t272 - 6.283185307179586*casadi.ceil(0.15915494309189535*t272) + 3.141592653589793
+    q[6, 0] = t263
+    q[6, 1] = t273
+    q[6, 2] = t269
+    q[6, 3] = t274
+    q[6, 4] = t275
+    q[6, 5] = t276
+    q[7, 0] = t263
+    q[7, 1] = t273
+    q[7, 2] = t269
+    q[7, 3] = t274 - 6.283185307179586*casadi.ceil(0.15915494309189535*t274) + 3.141592653589793
+    q[7, 4] = -t275 - 6.283185307179586*casadi.ceil(-0.15915494309189535*t275 - 0.5)
+    q[7, 5] = t276 - 6.283185307179586*casadi.ceil(0.15915494309189535*t276) + 3.141592653589793
+    valid = casadi.SX(8, 1)
+    valid[0, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t277, t279), t280), (t100 >= t278))
+    valid[1, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t277, t279), t280), (t100 > 1e-12))
+    valid[2, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t277, t279), t281), (t141 >= t278))
+    valid[3, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t277, t279), t281), (t141 > 1e-12))
+    valid[4, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t277, t280), t282), (t195 >= t278))
+    valid[5, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t277, t280), t282), (t195 > 1e-12))
+    valid[6, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t277, t281), t282), (t227 >= t278))
+    valid[7, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t277, t281), t282), (t227 > 1e-12))
+    return [q, valid]
+
+
+_q = casadi.SX.sym("q", 6, 1)
+_T = casadi.SX.sym("T", 4, 4)
 fk = casadi.Function("fk", [_q], _fk(_q), ["q"], ["T"])
 jacobian = casadi.Function("jacobian", [_q], _jacobian(_q), ["q"], ["J"])
 fk_jacobian = casadi.Function("fk_jacobian", [_q], _fk_jacobian(_q), ["q"], ["T", "J"])
@@ -469,8 +830,10 @@ task_jacobian = casadi.Function("task_jacobian", [_q], _task_jacobian(_q), ["q"]
 singularity_factors = casadi.Function("singularity_factors", [_q], _singularity_factors(_q), ["q"], ["f"])
 manipulability = casadi.Function("manipulability", [_q], _manipulability(_q), ["q"], ["w"])
 jacobian_det = casadi.Function("jacobian_det", [_q], _jacobian_det(_q), ["q"], ["d"])
+ik_branches = casadi.Function("ik_branches", [_T], _ik_branches(_T), ["T"], ["q", "valid"])
+ik = ik_branches  # CasADi functions have fixed-size outputs: every branch and its validity
 
 
 def functions():
     """All functions by name."""
-    return {"fk": fk, "jacobian": jacobian, "fk_jacobian": fk_jacobian, "jacobian_tool": jacobian_tool, "task": task, "task_jacobian": task_jacobian, "singularity_factors": singularity_factors, "manipulability": manipulability, "jacobian_det": jacobian_det}
+    return {"fk": fk, "jacobian": jacobian, "fk_jacobian": fk_jacobian, "jacobian_tool": jacobian_tool, "task": task, "task_jacobian": task_jacobian, "singularity_factors": singularity_factors, "manipulability": manipulability, "jacobian_det": jacobian_det, "ik_branches": ik_branches}

@@ -671,6 +671,412 @@ ur5_real ur5_jacobian_det(const ur5_real q[UR5_DOF])
     return 0.07085015625*s3*s5*(c2*s3*t3 - c2 + c3*s2*t3 + t0*t2 - 0.9229411764705883*t0 - t1*t2 + 0.9229411764705883*t1);
 }
 
+void ur5_ik_branches(const ur5_real T[16], ur5_real q[UR5_MAX_IK_SOLUTIONS * UR5_DOF], int valid[UR5_MAX_IK_SOLUTIONS])
+{
+    /* 843 operations */
+
+    /* Inputs */
+    const ur5_real T00 = T[0];
+    const ur5_real T01 = T[1];
+    const ur5_real T02 = T[2];
+    const ur5_real T03 = T[3];
+    const ur5_real T10 = T[4];
+    const ur5_real T11 = T[5];
+    const ur5_real T12 = T[6];
+    const ur5_real T13 = T[7];
+    const ur5_real T20 = T[8];
+    const ur5_real T21 = T[9];
+    const ur5_real T22 = T[10];
+    const ur5_real T23 = T[11];
+
+    /* Intermediate terms */
+    const ur5_real t0 = T00 + T01 + T02 + T03 + T10 + T11 + T12 + T13 + T20 + T21 + T22 + T23;
+    const ur5_real t1 = 0.81725*T00 + 0.005191*T01;
+    const ur5_real t2 = -0.19145*T02 + T03 + t1;
+    const ur5_real t3 = -0.10915*T02 + t1;
+    const ur5_real t4 = t2 - t3;
+    const ur5_real t5 = 0.81725*T10 + 0.005191*T11;
+    const ur5_real t6 = -0.19145*T12 + T13 + t5;
+    const ur5_real t7 = -0.10915*T12 + t5;
+    const ur5_real t8 = t6 - t7;
+    const ur5_real t9 = atan2(t4, -t8);
+    const ur5_real t10 = 0.81725*T20 + 0.005191*T21;
+    const ur5_real t11 = -0.19145*T22 + T23 + t10;
+    const ur5_real t12 = -0.10915*T22 + t10;
+    const ur5_real t13 = t11 - t12;
+    const ur5_real t14 = (t4*t4) + (t8*t8);
+    const ur5_real t15 = t14;
+    const ur5_real t16 = t14 + (t13*t13);
+    const ur5_real t17 = 1.0/sqrt(t15);
+    const ur5_real t18 = 1 - 0.0119137225*(t17*t17);
+    const int t19 = 1e-12 < t18;
+    const ur5_real t20 = (t19 ? 0.10915*t17 : (t17 > 0 ? 1 : -1));
+    const ur5_real t21 = (t19 ? sqrt(t18) : 0);
+    const ur5_real t22 = atan2(t21, t20);
+    const ur5_real t23 = -t22 + t9;
+    const ur5_real t24 = 1e-24*t16;
+    const int t25 = t15 <= t24;
+    const ur5_real t26 = (t25 ? 0 : t22 + t9);
+    const ur5_real t27 = t17*t4;
+    const ur5_real t28 = t21*t27;
+    const ur5_real t29 = t17*t8;
+    const ur5_real t30 = t20*t29;
+    const ur5_real t31 = (t25 ? 1 : -t28 - t30);
+    const ur5_real t32 = t28 - t30;
+    const ur5_real t33 = t20*t27;
+    const ur5_real t34 = t21*t29;
+    const ur5_real t35 = (t25 ? 0 : t33 - t34);
+    const ur5_real t36 = t33 + t34;
+    const ur5_real t37 = t31*t4 + t35*t8;
+    const ur5_real t38 = t31*t8 - t35*t4;
+    const ur5_real t39 = T00*t35 - T10*t31;
+    const ur5_real t40 = T01*t35 - T11*t31;
+    const ur5_real t41 = t32*t4 + t36*t8;
+    const ur5_real t42 = t32*t8 - t36*t4;
+    const ur5_real t43 = T00*t36 - T10*t32;
+    const ur5_real t44 = T01*t36 - T11*t32;
+    const ur5_real t45 = 1 - t31;
+    const ur5_real t46 = t13*t45;
+    const ur5_real t47 = t13*t31 + t46;
+    const ur5_real t48 = T02*t35;
+    const ur5_real t49 = T12*t31;
+    const ur5_real t50 = t48 - t49;
+    const ur5_real t51 = -t48 + t49;
+    const ur5_real t52 = (t50*t50);
+    const ur5_real t53 = 1 - t52;
+    const int t54 = 1e-12 < t53;
+    const ur5_real t55 = (t54 ? t50 : (t50 > 0 ? 1 : -1));
+    const ur5_real t56 = (t54 ? sqrt(t53) : 0);
+    const ur5_real t57 = atan2(t56, t55);
+    const int t58 = 0;
+    const ur5_real t59 = (t58 ? 0 : t57);
+    const ur5_real t60 = (t58 ? 1 : t55);
+    const ur5_real t61 = (t58 ? 0 : t56);
+    const ur5_real t62 = t51*t60;
+    const ur5_real t63 = t39*t61 - t62;
+    const ur5_real t64 = t62 + t63;
+    const ur5_real t65 = (t61*t61);
+    const ur5_real t66 = t65 + (t60*t60);
+    const ur5_real t67 = (t40*t40);
+    const ur5_real t68 = t65*t67 + (t64*t64);
+    const ur5_real t69 = t67 + (t39*t39) + (t51*t51);
+    const ur5_real t70 = 1.0/sqrt(t68);
+    const int t71 = t68 <= 1e-24*t66*t69;
+    const ur5_real t72 = (t71 ? 1 : t64*t70);
+    const ur5_real t73 = t61*(1 - t72);
+    const ur5_real t74 = t61*t72 + t73;
+    const ur5_real t75 = t40*t61;
+    const ur5_real t76 = (t71 ? 0 : -t70*t75);
+    const ur5_real t77 = t60*t76;
+    const ur5_real t78 = t60*t72;
+    const ur5_real t79 = -T00*t78 + T01*t77 + T02*t74;
+    const ur5_real t80 = -T10*t78 + T11*t77 + T12*t74;
+    const ur5_real t81 = -T20*t78 + T21*t77 + T22*t74;
+    const ur5_real t82 = t45*t81;
+    const ur5_real t83 = t31*t79 + t35*t80;
+    const ur5_real t84 = -t31*t80 + t35*t79;
+    const ur5_real t85 = t31*t81 + t82;
+    const ur5_real t86 = (t83*t83) + (t85*t85);
+    const ur5_real t87 = t86;
+    const ur5_real t88 = t86 + (t84*t84);
+    const ur5_real t89 = 1.0/sqrt(t87);
+    const int t90 = t87 <= 1e-24*t88;
+    const ur5_real t91 = (t90 ? 1 : -t83*t89);
+    const ur5_real t92 = (t90 ? 0 : -t85*t89);
+    const ur5_real t93 = 0.10915 - 0.10915*t91;
+    const ur5_real t94 = 0.10915*t91 + 0.10915;
+    const ur5_real t95 = 0.10915*t91;
+    const ur5_real t96 = t93 + t95;
+    const ur5_real t97 = t38 + t96;
+    const ur5_real t98 = -t94 + t95;
+    const ur5_real t99 = t38 - t98;
+    const ur5_real t100 = 0.09465*t92;
+    const ur5_real t101 = -t100 + t37;
+    const ur5_real t102 = t100 + t37;
+    const ur5_real t103 = 0.09465*t91;
+    const ur5_real t104 = t103 + t47;
+    const ur5_real t105 = t104 - 0.089459;
+    const ur5_real t106 = (t101*t101) + (t105*t105) + (t97*t97);
+    const ur5_real t107 = 0.16724253125 - 0.5*t106;
+    const ur5_real t108 = -t103 + t47;
+    const ur5_real t109 = t108 - 0.089459;
+    const ur5_real t110 = (t102*t102) + (t109*t109) + (t99*t99);
+    const ur5_real t111 = 0.16724253125 - 0.5*t110;
+    const ur5_real t112 = (t107*t107);
+    const ur5_real t113 = 1 - 35.98290608994648*t112;
+    const int t114 = 1e-12 < t113;
+    const ur5_real t115 = (t114 ? 5.99857533835714*t107 : (t107 > 0 ? 1 : -1));
+    const ur5_real t116 = (t114 ? sqrt(t113) : 0);
+    const ur5_real t117 = atan2(t116, t115);
+    const ur5_real t118 = (t58 ? 0 : t117 + 3.141592653589793);
+    const ur5_real t119 = (t58 ? 1 : -t115);
+    const ur5_real t120 = (t58 ? 0 : -t116);
+    const ur5_real t121 = 3.141592653589793 - t117;
+    const ur5_real t122 = 0.39225*t119 + 0.425;
+    const ur5_real t123 = 0.089459 - 0.39225*t120;
+    const ur5_real t124 = t123 - 0.089459;
+    const ur5_real t125 = -t101*t122 + t105*t124;
+    const ur5_real t126 = t101*t124 + t105*t122;
+    const ur5_real t127 = (t125*t125) + (t126*t126);
+    const ur5_real t128 = (t122*t122) + (t124*t124);
+    const ur5_real t129 = 0.39225*t115 - 0.425;
+    const ur5_real t130 = 0.089459 - 0.39225*t116;
+    const ur5_real t131 = t130 - 0.089459;
+    const ur5_real t132 = t101*t129 + t105*t131;
+    const ur5_real t133 = t101*t131 - t105*t129;
+    const ur5_real t134 = (t132*t132) + (t133*t133);
+    const ur5_real t135 = (t129*t129) + (t131*t131);
+    const ur5_real t136 = (t111*t111);
+    const ur5_real t137 = 1 - 35.98290608994648*t136;
+    const int t138 = 1e-12 < t137;
+    const ur5_real t139 = (t138 ? 5.99857533835714*t111 : (t111 > 0 ? 1 : -1));
+    const ur5_real t140 = (t138 ? sqrt(t137) : 0);
+    const ur5_real t141 = atan2(t140, t139);
+    const ur5_real t142 = (t58 ? 0 : t141 + 3.141592653589793);
+    const ur5_real t143 = (t58 ? 1 : -t139);
+    const ur5_real t144 = (t58 ? 0 : -t140);
+    const ur5_real t145 = 3.141592653589793 - t141;
+    const ur5_real t146 = 0.39225*t143 + 0.425;
+    const ur5_real t147 = 0.089459 - 0.39225*t144;
+    const ur5_real t148 = t147 - 0.089459;
+    const ur5_real t149 = -t102*t146 + t109*t148;
+    const ur5_real t150 = t102*t148 + t109*t146;
+    const ur5_real t151 = (t149*t149) + (t150*t150);
+    const ur5_real t152 = (t146*t146) + (t148*t148);
+    const ur5_real t153 = 0.39225*t139 - 0.425;
+    const ur5_real t154 = 0.089459 - 0.39225*t140;
+    const ur5_real t155 = t154 - 0.089459;
+    const ur5_real t156 = t102*t153 + t109*t155;
+    const ur5_real t157 = t102*t155 - t109*t153;
+    const ur5_real t158 = (t156*t156) + (t157*t157);
+    const ur5_real t159 = (t153*t153) + (t155*t155);
+    const ur5_real t160 = 1 - t32;
+    const ur5_real t161 = t13*t160;
+    const ur5_real t162 = t13*t32 + t161;
+    const ur5_real t163 = T02*t36;
+    const ur5_real t164 = T12*t32;
+    const ur5_real t165 = t163 - t164;
+    const ur5_real t166 = -t163 + t164;
+    const ur5_real t167 = (t165*t165);
+    const ur5_real t168 = 1 - t167;
+    const int t169 = 1e-12 < t168;
+    const ur5_real t170 = (t169 ? t165 : (t165 > 0 ? 1 : -1));
+    const ur5_real t171 = (t169 ? sqrt(t168) : 0);
+    const ur5_real t172 = atan2(t171, t170);
+    const ur5_real t173 = (t58 ? 0 : t172);
+    const ur5_real t174 = (t58 ? 1 : t170);
+    const ur5_real t175 = (t58 ? 0 : t171);
+    const ur5_real t176 = t166*t174;
+    const ur5_real t177 = t175*t43 - t176;
+    const ur5_real t178 = t176 + t177;
+    const ur5_real t179 = (t175*t175);
+    const ur5_real t180 = t179 + (t174*t174);
+    const ur5_real t181 = (t44*t44);
+    const ur5_real t182 = t179*t181 + (t178*t178);
+    const ur5_real t183 = t181 + (t166*t166) + (t43*t43);
+    const ur5_real t184 = 1.0/sqrt(t182);
+    const int t185 = t182 <= 1e-24*t180*t183;
+    const ur5_real t186 = (t185 ? 1 : t178*t184);
+    const ur5_real t187 = t175*(1 - t186);
+    const ur5_real t188 = t175*t186 + t187;
+    const ur5_real t189 = t175*t44;
+    const ur5_real t190 = (t185 ? 0 : -t184*t189);
+    const ur5_real t191 = t174*t190;
+    const ur5_real t192 = t174*t186;
+    const ur5_real t193 = -T00*t192 + T01*t191 + T02*t188;
+    const ur5_real t194 = -T10*t192 + T11*t191 + T12*t188;
+    const ur5_real t195 = -T20*t192 + T21*t191 + T22*t188;
+    const ur5_real t196 = t160*t195;
+    const ur5_real t197 = t193*t32 + t194*t36;
+    const ur5_real t198 = t193*t36 - t194*t32;
+    const ur5_real t199 = t195*t32 + t196;
+    const ur5_real t200 = (t197*t197) + (t199*t199);
+    const ur5_real t201 = t200;
+    const ur5_real t202 = t200 + (t198*t198);
+    const ur5_real t203 = 1.0/sqrt(t201);
+    const int t204 = t201 <= 1e-24*t202;
+    const ur5_real t205 = (t204 ? 1 : -t197*t203);
+    const ur5_real t206 = (t204 ? 0 : -t199*t203);
+    const ur5_real t207 = 0.10915 - 0.10915*t205;
+    const ur5_real t208 = 0.10915*t205 + 0.10915;
+    const ur5_real t209 = 0.10915*t205;
+    const ur5_real t210 = t207 + t209;
+    const ur5_real t211 = t210 + t42;
+    const ur5_real t212 = -t208 + t209;
+    const ur5_real t213 = -t212 + t42;
+    const ur5_real t214 = 0.09465*t206;
+    const ur5_real t215 = -t214 + t41;
+    const ur5_real t216 = t214 + t41;
+    const ur5_real t217 = 0.09465*t205;
+    const ur5_real t218 = t162 + t217;
+    const ur5_real t219 = t218 - 0.089459;
+    const ur5_real t220 = (t211*t211) + (t215*t215) + (t219*t219);
+    const ur5_real t221 = 0.16724253125 - 0.5*t220;
+    const ur5_real t222 = t162 - t217;
+    const ur5_real t223 = t222 - 0.089459;
+    const ur5_real t224 = (t213*t213) + (t216*t216) + (t223*t223);
+    const ur5_real t225 = 0.16724253125 - 0.5*t224;
+    const ur5_real t226 = (t221*t221);
+    const ur5_real t227 = 1 - 35.98290608994648*t226;
+    const int t228 = 1e-12 < t227;
+    const ur5_real t229 = (t228 ? 5.99857533835714*t221 : (t221 > 0 ? 1 : -1));
+    const ur5_real t230 = (t228 ? sqrt(t227) : 0);
+    const ur5_real t231 = atan2(t230, t229);
+    const ur5_real t232 = (t58 ? 0 : t231 + 3.141592653589793);
+    const ur5_real t233 = (t58 ? 1 : -t229);
+    const ur5_real t234 = (t58 ? 0 : -t230);
+    const ur5_real t235 = 3.141592653589793 - t231;
+    const ur5_real t236 = 0.39225*t233 + 0.425;
+    const ur5_real t237 = 0.089459 - 0.39225*t234;
+    const ur5_real t238 = t237 - 0.089459;
+    const ur5_real t239 = -t215*t236 + t219*t238;
+    const ur5_real t240 = t215*t238 + t219*t236;
+    const ur5_real t241 = (t239*t239) + (t240*t240);
+    const ur5_real t242 = (t236*t236) + (t238*t238);
+    const ur5_real t243 = 0.39225*t229 - 0.425;
+    const ur5_real t244 = 0.089459 - 0.39225*t230;
+    const ur5_real t245 = t244 - 0.089459;
+    const ur5_real t246 = t215*t243 + t219*t245;
+    const ur5_real t247 = t215*t245 - t219*t243;
+    const ur5_real t248 = (t246*t246) + (t247*t247);
+    const ur5_real t249 = (t243*t243) + (t245*t245);
+    const ur5_real t250 = (t225*t225);
+    const ur5_real t251 = 1 - 35.98290608994648*t250;
+    const int t252 = 1e-12 < t251;
+    const ur5_real t253 = (t252 ? 5.99857533835714*t225 : (t225 > 0 ? 1 : -1));
+    const ur5_real t254 = (t252 ? sqrt(t251) : 0);
+    const ur5_real t255 = atan2(t254, t253);
+    const ur5_real t256 = (t58 ? 0 : t255 + 3.141592653589793);
+    const ur5_real t257 = (t58 ? 1 : -t253);
+    const ur5_real t258 = (t58 ? 0 : -t254);
+    const ur5_real t259 = 3.141592653589793 - t255;
+    const ur5_real t260 = 0.39225*t257 + 0.425;
+    const ur5_real t261 = 0.089459 - 0.39225*t258;
+    const ur5_real t262 = t261 - 0.089459;
+    const ur5_real t263 = -t216*t260 + t223*t262;
+    const ur5_real t264 = t216*t262 + t223*t260;
+    const ur5_real t265 = (t263*t263) + (t264*t264);
+    const ur5_real t266 = (t260*t260) + (t262*t262);
+    const ur5_real t267 = 0.39225*t253 - 0.425;
+    const ur5_real t268 = 0.089459 - 0.39225*t254;
+    const ur5_real t269 = t268 - 0.089459;
+    const ur5_real t270 = t216*t267 + t223*t269;
+    const ur5_real t271 = t216*t269 - t223*t267;
+    const ur5_real t272 = (t270*t270) + (t271*t271);
+    const ur5_real t273 = (t267*t267) + (t269*t269);
+    const ur5_real t274 = t26 - 6.283185307179586*ceil(0.15915494309189535*t26 - 0.5);
+    const ur5_real t275 = 1e-24*t106;
+    const ur5_real t276 = (t127 <= t128*t275 ? 0 : atan2(-t126, t125));
+    const ur5_real t277 = -(t90 ? 0 : atan2(-t85, -t83));
+    const ur5_real t278 = t277 + 3.141592653589793;
+    const ur5_real t279 = t118 + t276;
+    const ur5_real t280 = t59 - 6.283185307179586*ceil(0.15915494309189535*t59 - 0.5);
+    const ur5_real t281 = (t71 ? 0 : atan2(-t75, t64));
+    const ur5_real t282 = (t134 <= t135*t275 ? 0 : atan2(-t133, t132));
+    const ur5_real t283 = t121 + t282;
+    const ur5_real t284 = 1e-24*t110;
+    const ur5_real t285 = (t151 <= t152*t284 ? 0 : atan2(-t150, t149));
+    const ur5_real t286 = t142 - 3.141592653589793;
+    const ur5_real t287 = t277 + t285;
+    const ur5_real t288 = -t57 - 6.283185307179586*ceil(-0.15915494309189535*t57 - 0.5);
+    const ur5_real t289 = t281 - 6.283185307179586*ceil(0.15915494309189535*t281) + 3.141592653589793;
+    const ur5_real t290 = (t158 <= t159*t284 ? 0 : atan2(-t157, t156));
+    const ur5_real t291 = t145 - 3.141592653589793;
+    const ur5_real t292 = t277 + t290;
+    const ur5_real t293 = t23 - 6.283185307179586*ceil(0.15915494309189535*t23 - 0.5);
+    const ur5_real t294 = 1e-24*t220;
+    const ur5_real t295 = (t241 <= t242*t294 ? 0 : atan2(-t240, t239));
+    const ur5_real t296 = -(t204 ? 0 : atan2(-t199, -t197));
+    const ur5_real t297 = t296 + 3.141592653589793;
+    const ur5_real t298 = t232 + t295;
+    const ur5_real t299 = t173 - 6.283185307179586*ceil(0.15915494309189535*t173 - 0.5);
+    const ur5_real t300 = (t185 ? 0 : atan2(-t189, t178));
+    const ur5_real t301 = (t248 <= t249*t294 ? 0 : atan2(-t247, t246));
+    const ur5_real t302 = t235 + t301;
+    const ur5_real t303 = 1e-24*t224;
+    const ur5_real t304 = (t265 <= t266*t303 ? 0 : atan2(-t264, t263));
+    const ur5_real t305 = t256 - 3.141592653589793;
+    const ur5_real t306 = t296 + t304;
+    const ur5_real t307 = -t172 - 6.283185307179586*ceil(-0.15915494309189535*t172 - 0.5);
+    const ur5_real t308 = t300 - 6.283185307179586*ceil(0.15915494309189535*t300) + 3.141592653589793;
+    const ur5_real t309 = (t272 <= t273*t303 ? 0 : atan2(-t271, t270));
+    const ur5_real t310 = t259 - 3.141592653589793;
+    const ur5_real t311 = t296 + t309;
+    const int t312 = isfinite(t0);
+    const int t313 = 0;
+    const int t314 = 1;
+    const ur5_real t315 = -1e-12;
+    const int t316 = (t313 && t52 <= 1e-12) || (t314 && t53 >= t315);
+    const int t317 = t15 > t24;
+    const int t318 = (t317 && t18 >= t315) || (t25 && 0.0119137225 <= 1e-12*t16);
+    const ur5_real t319 = 2.77909737890625e-26;
+    const int t320 = 0.0277909737890625 > t319;
+    const int t321 = 0.0277909737890625 <= t319;
+    const ur5_real t322 = 2.77909737890625e-14;
+    const int t323 = t53 > 1e-12;
+    const int t324 = t18 > 1e-12;
+    const int t325 = (t313 && t167 <= 1e-12) || (t314 && t168 >= t315);
+    const int t326 = t168 > 1e-12;
+
+    /* Outputs */
+    q[0] = t274;
+    q[1] = t276;
+    q[2] = t118 - 6.283185307179586*ceil(0.15915494309189535*t118 - 0.5);
+    q[3] = -t277 - t279 - 6.283185307179586*ceil(-0.15915494309189535*t278 - 0.15915494309189535*t279);
+    q[4] = t280;
+    q[5] = t281;
+    q[6] = t274;
+    q[7] = t282;
+    q[8] = t121 - 6.283185307179586*ceil(0.15915494309189535*t121 - 0.5);
+    q[9] = -t277 - t283 - 6.283185307179586*ceil(-0.15915494309189535*t278 - 0.15915494309189535*t283);
+    q[10] = t280;
+    q[11] = t281;
+    q[12] = t274;
+    q[13] = t285;
+    q[14] = t142 - 6.283185307179586*ceil(0.15915494309189535*t286);
+    q[15] = -t286 - t287 - 6.283185307179586*ceil(-0.15915494309189535*t142 - 0.15915494309189535*t287);
+    q[16] = t288;
+    q[17] = t289;
+    q[18] = t274;
+    q[19] = t290;
+    q[20] = t145 - 6.283185307179586*ceil(0.15915494309189535*t291);
+    q[21] = -t291 - t292 - 6.283185307179586*ceil(-0.15915494309189535*t145 - 0.15915494309189535*t292);
+    q[22] = t288;
+    q[23] = t289;
+    q[24] = t293;
+    q[25] = t295;
+    q[26] = t232 - 6.283185307179586*ceil(0.15915494309189535*t232 - 0.5);
+    q[27] = -t296 - t298 - 6.283185307179586*ceil(-0.15915494309189535*t297 - 0.15915494309189535*t298);
+    q[28] = t299;
+    q[29] = t300;
+    q[30] = t293;
+    q[31] = t301;
+    q[32] = t235 - 6.283185307179586*ceil(0.15915494309189535*t235 - 0.5);
+    q[33] = -t296 - t302 - 6.283185307179586*ceil(-0.15915494309189535*t297 - 0.15915494309189535*t302);
+    q[34] = t299;
+    q[35] = t300;
+    q[36] = t293;
+    q[37] = t304;
+    q[38] = t256 - 6.283185307179586*ceil(0.15915494309189535*t305);
+    q[39] = -t305 - t306 - 6.283185307179586*ceil(-0.15915494309189535*t256 - 0.15915494309189535*t306);
+    q[40] = t307;
+    q[41] = t308;
+    q[42] = t293;
+    q[43] = t309;
+    q[44] = t259 - 6.283185307179586*ceil(0.15915494309189535*t310);
+    q[45] = -t310 - t311 - 6.283185307179586*ceil(-0.15915494309189535*t259 - 0.15915494309189535*t311);
+    q[46] = t307;
+    q[47] = t308;
+    valid[0] = t312 && t316 && t318 && ((t320 && t113 >= t315) || (t321 && t112 <= t322));
+    valid[1] = t312 && t316 && t318 && t320 && t113 > 1e-12;
+    valid[2] = t312 && t314 && t318 && t323 && ((t320 && t137 >= t315) || (t321 && t136 <= t322));
+    valid[3] = t312 && t314 && t318 && t320 && t323 && t137 > 1e-12;
+    valid[4] = t312 && t317 && t324 && t325 && ((t320 && t227 >= t315) || (t321 && t226 <= t322));
+    valid[5] = t312 && t317 && t320 && t324 && t325 && t227 > 1e-12;
+    valid[6] = t312 && t314 && t317 && t324 && t326 && ((t320 && t251 >= t315) || (t321 && t250 <= t322));
+    valid[7] = t312 && t314 && t317 && t320 && t324 && t326 && t251 > 1e-12;
+}
+
 int ur5_velocity_ik(const ur5_real q[UR5_DOF], const ur5_real mu_dot[UR5_TASK_DIM], ur5_real damping, ur5_real q_dot[UR5_DOF])
 {
     /* Rows of jacobian() forming Js (the geometric Jacobian). */
@@ -768,356 +1174,19 @@ int ur5_velocity_ik(const ur5_real q[UR5_DOF], const ur5_real mu_dot[UR5_TASK_DI
     return UR5_VELOCITY_IK_OK;
 }
 
-/* The angle wrapped into (-pi, pi], for |angle| < 1e9 (the callers' angles are sums of a few
- * atan2 results): angle - 2 pi ceil((angle - pi) / (2 pi)), ceil by truncation. */
-static ur5_real ur5_wrap(ur5_real angle)
-{
-    const ur5_real turns = (angle - 3.141592653589793) / 6.283185307179586;
-    ur5_real whole;
-    if (angle > -3.141592653589793 && angle <= 3.141592653589793) {
-        return angle;
-    }
-    whole = (ur5_real)(long)turns;
-    if (whole < turns) {
-        whole += 1.0;
-    }
-    return angle - 6.283185307179586 * whole;
-}
-
-/* -- Closed-form inverse kinematics (three_parallel) -- */
-
-/* The arm at q = 0 (product of exponentials): unit axis directions h, points p on the axes,
- * the tool pose and a few derived constants. */
-typedef struct {
-    ur5_real tool_rotation[9];
-    ur5_real tool_position[3];
-    ur5_real h1[3];
-    ur5_real p1[3];
-    ur5_real h[3];
-    ur5_real v[3];
-    ur5_real p2[3];
-    ur5_real h3[3];
-    ur5_real p3[3];
-    ur5_real p4[3];
-    ur5_real h5[3];
-    ur5_real h6[3];
-    ur5_real centre[3];
-    ur5_real reach;
-    ur5_real sign3;
-    ur5_real sign4;
-} ur5_ik_geometry;
-
-/* An angle with its cosine and sine. */
-typedef struct {
-    ur5_real theta, c, s;
-} ur5_angle;
-
-static inline ur5_real ur5_dot(const ur5_real a[3], const ur5_real b[3])
-{
-    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-}
-
-static inline void ur5_cross(const ur5_real a[3], const ur5_real b[3], ur5_real out[3])
-{
-    const ur5_real x = a[1] * b[2] - a[2] * b[1];
-    const ur5_real y = a[2] * b[0] - a[0] * b[2];
-    const ur5_real z = a[0] * b[1] - a[1] * b[0];
-    out[0] = x;
-    out[1] = y;
-    out[2] = z;
-}
-
-static inline void ur5_add(const ur5_real a[3], const ur5_real b[3], ur5_real out[3])
-{
-    out[0] = a[0] + b[0];
-    out[1] = a[1] + b[1];
-    out[2] = a[2] + b[2];
-}
-
-static inline void ur5_sub(const ur5_real a[3], const ur5_real b[3], ur5_real out[3])
-{
-    out[0] = a[0] - b[0];
-    out[1] = a[1] - b[1];
-    out[2] = a[2] - b[2];
-}
-
-/* v turned about the unit axis k by the angle whose cosine and sine are c and s (Rodrigues). */
-static inline void ur5_rot(const ur5_real k[3], ur5_real c, ur5_real s, const ur5_real v[3], ur5_real out[3])
-{
-    ur5_real kxv[3];
-    const ur5_real kv = ur5_dot(k, v) * (1.0 - c);
-    ur5_cross(k, v, kxv);
-    out[0] = v[0] * c + kxv[0] * s + k[0] * kv;
-    out[1] = v[1] * c + kxv[1] * s + k[1] * kv;
-    out[2] = v[2] * c + kxv[2] * s + k[2] * kv;
-}
-
-/* atan2(y, x) in (-pi, pi] (0 at the origin), about twice as fast as the C library's: the
- * argument is reduced to t in [-tan(pi/8), tan(pi/8)] with one division and atan(t) =
- * t + t z P(z) / Q(z), z = t^2, by Cephes' minimax approximation (S. L. Moshier); error
- * within 2 ulp. */
-static inline ur5_real ur5_atan2(ur5_real y, ur5_real x)
-{
-    const ur5_real ax = fabs(x);
-    const ur5_real ay = fabs(y);
-    const ur5_real low = ax < ay ? ax : ay;
-    const ur5_real high = ax < ay ? ay : ax;
-    ur5_real t, base, r;
-    if (!(high > 0.0)) {
-        return 0.0;
-    }
-    if (low <= 0.41421356237309503 * high) {
-        t = low / high;
-        base = 0.0;
-    } else {
-        t = (low - high) / (low + high);
-        base = 0.7853981633974483;
-    }
-    {
-        const ur5_real z = t * t;
-        const ur5_real z2 = z * z;
-        const ur5_real z4 = z2 * z2;
-        r = base + (t + t * z * ((-64.85021904942025 - 122.88666844901361 * z) + z2 * (-75.00855792314705 - 16.157537187333652 * z) + z4 * (-0.8750608600031904)) / ((194.5506571482614 + 485.3903996359137 * z) + z2 * (432.88106049129027 + 165.02700983169885 * z) + z4 * (24.858464901423062 + z)));
-    }
-    if (ay > ax) {
-        r = 1.5707963267948966 - r;
-    }
-    if (x < 0.0) {
-        r = 3.141592653589793 - r;
-    }
-    return y < 0.0 ? -r : r;
-}
-
-static inline ur5_angle ur5_angle_of(ur5_real c, ur5_real s)
-{
-    ur5_angle angle;
-    angle.theta = ur5_atan2(s, c);
-    angle.c = c;
-    angle.s = s;
-    return angle;
-}
-
-/* SP1: the angle turning p into q about the unit axis k (least squares when they differ in
- * length or height along k); 0 when p or q lies on the axis (any angle would do). */
-static inline ur5_angle ur5_sp1(const ur5_real p[3], const ur5_real q[3], const ur5_real k[3])
-{
-    ur5_real pxq[3];
-    ur5_cross(p, q, pxq);
-    {
-        const ur5_real x = ur5_dot(p, q) - ur5_dot(k, p) * ur5_dot(k, q);
-        const ur5_real y = ur5_dot(k, pxq);
-        const ur5_real rr = x * x + y * y;
-        if (rr <= 1e-24 * ur5_dot(p, p) * ur5_dot(q, q)) {
-            return ur5_angle_of(1.0, 0.0);
-        }
-        {
-            const ur5_real scale = 1.0 / sqrt(rr);
-            ur5_angle angle;
-            angle.theta = ur5_atan2(y, x);
-            angle.c = x * scale;
-            angle.s = y * scale;
-            return angle;
-        }
-    }
-}
-
-/* SP4: the angles t with h . rot(k, t) p = d, out = {phi + alpha, phi - alpha}; returns
- * their count. h . rot(k, t) p = A cos t + B sin t + C. One angle for a double root
- * (sin(alpha)^2 within EPS of 0), none out of range; when the left side does not depend
- * on t, the angle 0 if it equals d. */
-static inline int ur5_sp4(const ur5_real h[3], const ur5_real p[3], const ur5_real k[3], ur5_real d, ur5_angle out[2])
-{
-    ur5_real kxp[3];
-    const ur5_real hk = ur5_dot(h, k);
-    const ur5_real kp = ur5_dot(k, p);
-    ur5_cross(k, p, kxp);
-    {
-        const ur5_real a = ur5_dot(h, p) - hk * kp;
-        const ur5_real b = ur5_dot(h, kxp);
-        const ur5_real rhs = d - hk * kp;
-        const ur5_real r2 = a * a + b * b;
-        const ur5_real scale = ur5_dot(h, h) * ur5_dot(p, p);
-        ur5_real r, cos_phi, sin_phi, cos_alpha, disc, sin_alpha;
-        if (r2 <= 1e-24 * scale) {
-            if (rhs * rhs > 1e-12 * scale) {
-                return 0;
-            }
-            out[0] = ur5_angle_of(1.0, 0.0);
-            return 1;
-        }
-        r = sqrt(r2);
-        cos_phi = a / r;
-        sin_phi = b / r;
-        cos_alpha = rhs / r;
-        disc = 1.0 - cos_alpha * cos_alpha;
-        if (disc < -1e-12) {
-            return 0;
-        }
-        if (disc <= 1e-12) {
-            const ur5_real sign = cos_alpha > 0.0 ? 1.0 : -1.0;
-            out[0] = ur5_angle_of(sign * cos_phi, sign * sin_phi);
-            return 1;
-        }
-        sin_alpha = sqrt(disc);
-        {
-            /* phi is a constant when h, p and k are (the compiler folds it) */
-            const ur5_real phi = ur5_atan2(b, a);
-            const ur5_real alpha = ur5_atan2(sin_alpha, cos_alpha);
-            out[0].theta = phi + alpha;
-            out[0].c = cos_phi * cos_alpha - sin_phi * sin_alpha;
-            out[0].s = sin_phi * cos_alpha + cos_phi * sin_alpha;
-            out[1].theta = phi - alpha;
-            out[1].c = cos_phi * cos_alpha + sin_phi * sin_alpha;
-            out[1].s = sin_phi * cos_alpha - cos_phi * sin_alpha;
-        }
-        return 2;
-    }
-}
-
-/* SP3: the angles t with |rot(k, t) p - q|^2 = dd (p, q relative to a point of the axis). */
-static inline int ur5_sp3(const ur5_real p[3], const ur5_real q[3], const ur5_real k[3], ur5_real dd, ur5_angle out[2])
-{
-    return ur5_sp4(q, p, k, 0.5 * (ur5_dot(p, p) + ur5_dot(q, q) - dd), out);
-}
-
-/* T T(0)^-1 = exp(xi_1 q_1) ... exp(xi_n q_n) as (R, t), T(0) = (rotation, position) the
- * tool pose at q = 0. */
-static inline void ur5_relative(const ur5_real T[16], const ur5_real rotation[9], const ur5_real position[3],
-        ur5_real R[9], ur5_real t[3])
-{
-    int i, j;
-    for (i = 0; i < 3; ++i) {
-        for (j = 0; j < 3; ++j) {
-            R[3 * i + j] = T[4 * i] * rotation[3 * j] + T[4 * i + 1] * rotation[3 * j + 1]
-                           + T[4 * i + 2] * rotation[3 * j + 2];
-        }
-        t[i] = T[4 * i + 3] - ur5_dot(&R[3 * i], position);
-    }
-}
-
-static inline void ur5_mul(const ur5_real R[9], const ur5_real v[3], ur5_real out[3])
-{
-    const ur5_real x = ur5_dot(&R[0], v);
-    const ur5_real y = ur5_dot(&R[3], v);
-    const ur5_real z = ur5_dot(&R[6], v);
-    out[0] = x;
-    out[1] = y;
-    out[2] = z;
-}
-
-static inline void ur5_mul_t(const ur5_real R[9], const ur5_real v[3], ur5_real out[3])
-{
-    const ur5_real x = R[0] * v[0] + R[3] * v[1] + R[6] * v[2];
-    const ur5_real y = R[1] * v[0] + R[4] * v[1] + R[7] * v[2];
-    const ur5_real z = R[2] * v[0] + R[5] * v[1] + R[8] * v[2];
-    out[0] = x;
-    out[1] = y;
-    out[2] = z;
-}
-
-/* Axes 2, 3, 4 parallel to h, axes 5 and 6 meeting at the wrist centre: the centre's height
- * along h fixes q1 (SP4), the tool orientation q5 (SP4), q6 (SP1) and the sum q2 + q3 + q4
- * (SP1), the centre's position q3 (SP3) and q2 (SP1). */
-static int ur5_ik_solve(const ur5_real T[16], const ur5_ik_geometry *g, ur5_real q[])
-{
-    ur5_real rotation[9], position[3], wc[3], a[3], d1[3], c4[3], b3[3];
-    ur5_angle t1[2];
-    int count = 0, n1, i, j, k;
-    ur5_relative(T, g->tool_rotation, g->tool_position, rotation, position);
-    ur5_mul(rotation, g->centre, wc);
-    ur5_add(wc, position, wc);
-    ur5_mul(rotation, g->h6, a);
-    ur5_sub(wc, g->p1, d1);
-    ur5_sub(g->p4, g->p3, c4);
-    ur5_sub(g->p2, g->p3, b3);
-    n1 = ur5_sp4(d1, g->h, g->h1, g->reach, t1);
-    for (i = 0; i < n1; ++i) {
-        ur5_real up[3], w[3], mh[3];
-        ur5_angle t5[2], t6 = {0.0, 1.0, 0.0}, total = t6;
-        int n5;
-        ur5_rot(g->h1, t1[i].c, t1[i].s, g->h, up);
-        ur5_mul_t(rotation, up, mh);
-        ur5_rot(g->h1, t1[i].c, -t1[i].s, d1, w);
-        ur5_add(w, g->p1, w);
-        n5 = ur5_sp4(g->h, g->h6, g->h5, ur5_dot(up, a), t5);
-        for (j = 0; j < n5; ++j) {
-            ur5_real x[3], d[3];
-            ur5_angle t3[2];
-            int n3;
-            if (j == 1) {
-                /* axis 5 perpendicular to h and h6: the second q5 turns q6 and q2 + q3 + q4 by pi */
-                t6.theta += 3.141592653589793;
-                total.theta += 3.141592653589793;
-                total.c = -total.c;
-                total.s = -total.s;
-            } else {
-                ur5_rot(g->h5, t5[j].c, -t5[j].s, g->h, x);
-                t6 = ur5_sp1(mh, x, g->h6);
-                ur5_rot(g->h5, t5[j].c, -t5[j].s, g->v, x);
-                ur5_rot(g->h6, t6.c, -t6.s, x, x);
-                ur5_mul(rotation, x, x);
-                ur5_rot(g->h1, t1[i].c, -t1[i].s, x, x);
-                total = ur5_sp1(g->v, x, g->h);
-            }
-            ur5_sub(g->centre, g->p4, d);
-            ur5_rot(g->h, total.c, total.s, d, d);
-            ur5_sub(w, d, d);
-            ur5_sub(d, g->p2, d);
-            n3 = ur5_sp3(c4, b3, g->h3, ur5_dot(d, d), t3);
-            for (k = 0; k < n3; ++k) {
-                ur5_real *out = q + UR5_DOF * count++;
-                ur5_real e[3];
-                ur5_angle t2;
-                ur5_rot(g->h3, t3[k].c, t3[k].s, c4, e);
-                ur5_add(e, g->p3, e);
-                ur5_sub(e, g->p2, e);
-                t2 = ur5_sp1(e, d, g->h);
-                out[0] = t1[i].theta;
-                out[1] = t2.theta;
-                out[2] = t3[k].theta;
-                out[3] = g->sign4 * (total.theta - t2.theta - g->sign3 * t3[k].theta);
-                out[4] = t5[j].theta;
-                out[5] = t6.theta;
-            }
-        }
-    }
-    return count;
-}
-
 int ur5_ik(const ur5_real T[16], ur5_real q[UR5_MAX_IK_SOLUTIONS * UR5_DOF])
 {
-    const ur5_ik_geometry g = {
-        .tool_rotation = {1, 0, 0, 0, 0, -1, 0, 1, 0},
-        .tool_position = {-0.81725, -0.19145, -0.005191},
-        .h1 = {0, 0, 1},
-        .p1 = {0, 0, 0},
-        .h = {0, -1, 0},
-        .v = {1, 0, 0},
-        .p2 = {0, 0, 0.089459},
-        .h3 = {0, -1, 0},
-        .p3 = {-0.425, 0, 0.089459},
-        .p4 = {-0.81725, 0, 0.089459},
-        .h5 = {0, 0, -1},
-        .h6 = {0, -1, 0},
-        .centre = {-0.81725, -0.10915, -0.005191},
-        .reach = 0.10915,
-        .sign3 = 1,
-        .sign4 = 1,
-    };
-    int count, k;
-    for (k = 0; k < 12; ++k) {
-        if (!isfinite(T[k])) {
-            return 0;
+    ur5_real branches[UR5_MAX_IK_SOLUTIONS * UR5_DOF];
+    int valid[UR5_MAX_IK_SOLUTIONS];
+    int count = 0, i, j;
+    ur5_ik_branches(T, branches, valid);
+    for (i = 0; i < UR5_MAX_IK_SOLUTIONS; ++i) {
+        if (valid[i]) {
+            for (j = 0; j < UR5_DOF; ++j) {
+                q[UR5_DOF * count + j] = branches[UR5_DOF * i + j];
+            }
+            ++count;
         }
-    }
-    count = ur5_ik_solve(T, &g, q);
-    for (k = 0; k < count; ++k) {
-        q[UR5_DOF * k + 0] = ur5_wrap(q[UR5_DOF * k + 0]);
-        q[UR5_DOF * k + 1] = ur5_wrap(q[UR5_DOF * k + 1]);
-        q[UR5_DOF * k + 2] = ur5_wrap(q[UR5_DOF * k + 2]);
-        q[UR5_DOF * k + 3] = ur5_wrap(q[UR5_DOF * k + 3]);
-        q[UR5_DOF * k + 4] = ur5_wrap(q[UR5_DOF * k + 4]);
-        q[UR5_DOF * k + 5] = ur5_wrap(q[UR5_DOF * k + 5]);
     }
     return count;
 }

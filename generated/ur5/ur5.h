@@ -32,6 +32,7 @@ typedef double ur5_real;
 #define UR5_DOF 6
 #define UR5_TASK_DIM 6
 #define UR5_NUM_SINGULARITY_FACTORS 3
+#define UR5_MAX_IK_SOLUTIONS 8
 
 /* Pose of the tool frame in the world frame (4x4 homogeneous).
  * Result: T: 4 x 4 row-major, element (r, c) at T[r * 4 + c]. 90 operations. */
@@ -69,6 +70,10 @@ ur5_real ur5_manipulability(const ur5_real q[UR5_DOF]);
  * Result: returned as a scalar. 28 operations. */
 ur5_real ur5_jacobian_det(const ur5_real q[UR5_DOF]);
 
+/* Every branch of the closed-form ik and whether the target allows it.
+ * Result: q: 8 x 6 row-major, element (r, c) at q[r * 6 + c]; valid[i], i < 8. 843 operations. */
+void ur5_ik_branches(const ur5_real T[16], ur5_real q[UR5_MAX_IK_SOLUTIONS * UR5_DOF], int valid[UR5_MAX_IK_SOLUTIONS]);
+
 /* Status of ur5_velocity_ik. */
 #define UR5_VELOCITY_IK_OK 0
 #define UR5_VELOCITY_IK_SINGULAR 1   /* a pivot below 1e-12 x the largest |entry|: take damping > 0 */
@@ -82,11 +87,9 @@ ur5_real ur5_jacobian_det(const ur5_real q[UR5_DOF]);
  * UR5_VELOCITY_IK_OK, or a status above with q_dot all 0. */
 int ur5_velocity_ik(const ur5_real q[UR5_DOF], const ur5_real mu_dot[UR5_TASK_DIM], ur5_real damping, ur5_real q_dot[UR5_DOF]);
 
-#define UR5_MAX_IK_SOLUTIONS 8
-
 /* Closed-form inverse kinematics: every joint solution that reaches the target; returns
- * their count k and writes solution i to q[i * UR5_DOF + j], i < k. Loops over
- * the branches, no allocation, no recursion.
+ * their count k and writes solution i to q[i * UR5_DOF + j], i < k: the valid
+ * rows of ur5_ik_branches, in its order. No allocation, no recursion.
  * target: the 4x4 tool pose in the world frame (rotation part orthonormal).
  * Result: k <= UR5_MAX_IK_SOLUTIONS solutions, revolute angles wrapped into (-pi, pi],
  * joint limits not applied; k = 0 when the target is out of reach or not finite.

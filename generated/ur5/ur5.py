@@ -16,16 +16,18 @@ DOF = 6
 TASK = ("x", "y", "z", "roll", "pitch", "yaw", )
 
 
-def _joints(q):
-    q = numpy.asarray(q, dtype=float)
-    if q.ndim == 0 or q.shape[-1] != DOF:
-        raise ValueError(f"q must have shape ({DOF},) or (..., {DOF}), got {q.shape}")
-    return q
+def _argument(name, value, shape):
+    """`value` as a float array of `shape` or a batch of them (..., *shape)."""
+    value = numpy.asarray(value, dtype=float)
+    if value.shape[value.ndim - len(shape):] != shape:
+        batch = ", ".join(map(str, shape))
+        raise ValueError(f"{name} must have shape {shape} or (..., {batch}), got {value.shape}")
+    return value
 
 
 def fk(q):
     """pose of the tool frame in the world frame (4x4 homogeneous): (4 x 4), 90 operations."""
-    q = _joints(q)
+    q = _argument("q", q, (6,))
     q1 = q[..., 0]
     q2 = q[..., 1]
     q3 = q[..., 2]
@@ -102,7 +104,7 @@ def fk(q):
 
 def jacobian(q):
     """geometric Jacobian in the world frame (6 x DOF, rows vx vy vz wx wy wz): (6 x 6), 88 operations."""
-    q = _joints(q)
+    q = _argument("q", q, (6,))
     q1 = q[..., 0]
     q2 = q[..., 1]
     q3 = q[..., 2]
@@ -186,7 +188,7 @@ def jacobian(q):
 
 def fk_jacobian(q):
     """fk and jacobian in one pass, sharing their terms: (4 x 4 and 6 x 6), 117 operations."""
-    q = _joints(q)
+    q = _argument("q", q, (6,))
     q1 = q[..., 0]
     q2 = q[..., 1]
     q3 = q[..., 2]
@@ -305,7 +307,7 @@ def fk_jacobian(q):
 
 def jacobian_tool(q):
     """geometric Jacobian in the tool frame (6 x DOF, rows vx vy vz wx wy wz): (6 x 6), 224 operations."""
-    q = _joints(q)
+    q = _argument("q", q, (6,))
     q1 = q[..., 0]
     q2 = q[..., 1]
     q3 = q[..., 2]
@@ -415,7 +417,7 @@ def jacobian_tool(q):
 
 def task(q):
     """task vector mu = (x, y, z, roll, pitch, yaw): (6 x 1), 90 operations."""
-    q = _joints(q)
+    q = _argument("q", q, (6,))
     q1 = q[..., 0]
     q2 = q[..., 1]
     q3 = q[..., 2]
@@ -479,7 +481,7 @@ def task(q):
 
 def task_jacobian(q):
     """analytic Jacobian d mu / d q (6 x DOF): (6 x 6), 144 operations."""
-    q = _joints(q)
+    q = _argument("q", q, (6,))
     q1 = q[..., 0]
     q2 = q[..., 1]
     q3 = q[..., 2]
@@ -585,7 +587,7 @@ def task_jacobian(q):
 
 def singularity_factors(q):
     """factors of det(Js): the robot is singular where one is 0: (3 x 1), 25 operations."""
-    q = _joints(q)
+    q = _argument("q", q, (6,))
     q2 = q[..., 1]
     q3 = q[..., 2]
     q4 = q[..., 3]
@@ -610,7 +612,7 @@ def singularity_factors(q):
 
 def manipulability(q):
     """manipulability |det(Js)|: (1 x 1), 29 operations."""
-    q = _joints(q)
+    q = _argument("q", q, (6,))
     q2 = q[..., 1]
     q3 = q[..., 2]
     q4 = q[..., 3]
@@ -634,7 +636,7 @@ def manipulability(q):
 
 def jacobian_det(q):
     """det(Js): (1 x 1), 28 operations."""
-    q = _joints(q)
+    q = _argument("q", q, (6,))
     q2 = q[..., 1]
     q3 = q[..., 2]
     q4 = q[..., 3]
@@ -655,147 +657,419 @@ def jacobian_det(q):
     return d
 
 
-def _wrap(angle):
-    """Angles wrapped into (-pi, pi]."""
-    return angle - 2.0 * math.pi * numpy.ceil((angle - math.pi) / (2.0 * math.pi))
+@numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
+def ik_branches(T):
+    """every branch of the closed-form ik and whether the target allows it: (8 x 6 and 8 x 1), 843 operations."""
+    T = _argument("T", T, (4, 4))
+    T00 = T[..., 0, 0]
+    T01 = T[..., 0, 1]
+    T02 = T[..., 0, 2]
+    T03 = T[..., 0, 3]
+    T10 = T[..., 1, 0]
+    T11 = T[..., 1, 1]
+    T12 = T[..., 1, 2]
+    T13 = T[..., 1, 3]
+    T20 = T[..., 2, 0]
+    T21 = T[..., 2, 1]
+    T22 = T[..., 2, 2]
+    T23 = T[..., 2, 3]
+    t0 = T00 + T01 + T02 + T03 + T10 + T11 + T12 + T13 + T20 + T21 + T22 + T23
+    t1 = 0.81725*T00 + 0.005191*T01
+    t2 = -0.19145*T02 + T03 + t1
+    t3 = -0.10915*T02 + t1
+    t4 = t2 - t3
+    t5 = 0.81725*T10 + 0.005191*T11
+    t6 = -0.19145*T12 + T13 + t5
+    t7 = -0.10915*T12 + t5
+    t8 = t6 - t7
+    t9 = numpy.arctan2(t4, -t8)
+    t10 = 0.81725*T20 + 0.005191*T21
+    t11 = -0.19145*T22 + T23 + t10
+    t12 = -0.10915*T22 + t10
+    t13 = t11 - t12
+    t14 = t4**2 + t8**2
+    t15 = t14
+    t16 = t13**2 + t14
+    t17 = 1/numpy.sqrt(t15)
+    t18 = 1 - 0.0119137225*t17**2
+    t19 = numpy.less(1e-12, t18)
+    t20 = numpy.where(t19, 0.10915*t17, numpy.where(numpy.greater(t17, 0), 1, -1))
+    t21 = numpy.where(t19, numpy.sqrt(t18), 0)
+    t22 = numpy.arctan2(t21, t20)
+    t23 = -t22 + t9
+    t24 = 1e-24*t16
+    t25 = numpy.less_equal(t15, t24)
+    t26 = numpy.where(t25, 0, t22 + t9)
+    t27 = t17*t4
+    t28 = t21*t27
+    t29 = t17*t8
+    t30 = t20*t29
+    t31 = numpy.where(t25, 1, -t28 - t30)
+    t32 = t28 - t30
+    t33 = t20*t27
+    t34 = t21*t29
+    t35 = numpy.where(t25, 0, t33 - t34)
+    t36 = t33 + t34
+    t37 = t31*t4 + t35*t8
+    t38 = t31*t8 - t35*t4
+    t39 = T00*t35 - T10*t31
+    t40 = T01*t35 - T11*t31
+    t41 = t32*t4 + t36*t8
+    t42 = t32*t8 - t36*t4
+    t43 = T00*t36 - T10*t32
+    t44 = T01*t36 - T11*t32
+    t45 = 1 - t31
+    t46 = t13*t45
+    t47 = t13*t31 + t46
+    t48 = T02*t35
+    t49 = T12*t31
+    t50 = t48 - t49
+    t51 = -t48 + t49
+    t52 = t50**2
+    t53 = 1 - t52
+    t54 = numpy.less(1e-12, t53)
+    t55 = numpy.where(t54, t50, numpy.where(numpy.greater(t50, 0), 1, -1))
+    t56 = numpy.where(t54, numpy.sqrt(t53), 0)
+    t57 = numpy.arctan2(t56, t55)
+    t58 = False
+    t59 = numpy.where(t58, 0, t57)
+    t60 = numpy.where(t58, 1, t55)
+    t61 = numpy.where(t58, 0, t56)
+    t62 = t51*t60
+    t63 = t39*t61 - t62
+    t64 = t62 + t63
+    t65 = t61**2
+    t66 = t60**2 + t65
+    t67 = t40**2
+    t68 = t64**2 + t65*t67
+    t69 = t39**2 + t51**2 + t67
+    t70 = 1/numpy.sqrt(t68)
+    t71 = numpy.less_equal(t68, 1e-24*t66*t69)
+    t72 = numpy.where(t71, 1, t64*t70)
+    t73 = t61*(1 - t72)
+    t74 = t61*t72 + t73
+    t75 = t40*t61
+    t76 = numpy.where(t71, 0, -t70*t75)
+    t77 = t60*t76
+    t78 = t60*t72
+    t79 = -T00*t78 + T01*t77 + T02*t74
+    t80 = -T10*t78 + T11*t77 + T12*t74
+    t81 = -T20*t78 + T21*t77 + T22*t74
+    t82 = t45*t81
+    t83 = t31*t79 + t35*t80
+    t84 = -t31*t80 + t35*t79
+    t85 = t31*t81 + t82
+    t86 = t83**2 + t85**2
+    t87 = t86
+    t88 = t84**2 + t86
+    t89 = 1/numpy.sqrt(t87)
+    t90 = numpy.less_equal(t87, 1e-24*t88)
+    t91 = numpy.where(t90, 1, -t83*t89)
+    t92 = numpy.where(t90, 0, -t85*t89)
+    t93 = 0.10915 - 0.10915*t91
+    t94 = 0.10915*t91 + 0.10915
+    t95 = 0.10915*t91
+    t96 = t93 + t95
+    t97 = t38 + t96
+    t98 = -t94 + t95
+    t99 = t38 - t98
+    t100 = 0.09465*t92
+    t101 = -t100 + t37
+    t102 = t100 + t37
+    t103 = 0.09465*t91
+    t104 = t103 + t47
+    t105 = t104 - 0.089459
+    t106 = t101**2 + t105**2 + t97**2
+    t107 = 0.16724253125 - 0.5*t106
+    t108 = -t103 + t47
+    t109 = t108 - 0.089459
+    t110 = t102**2 + t109**2 + t99**2
+    t111 = 0.16724253125 - 0.5*t110
+    t112 = t107**2
+    t113 = 1 - 35.98290608994648*t112
+    t114 = numpy.less(1e-12, t113)
+    t115 = numpy.where(t114, 5.99857533835714*t107, numpy.where(numpy.greater(t107, 0), 1, -1))
+    t116 = numpy.where(t114, numpy.sqrt(t113), 0)
+    t117 = numpy.arctan2(t116, t115)
+    t118 = numpy.where(t58, 0, t117 + 3.141592653589793)
+    t119 = numpy.where(t58, 1, -t115)
+    t120 = numpy.where(t58, 0, -t116)
+    t121 = 3.141592653589793 - t117
+    t122 = 0.39225*t119 + 0.425
+    t123 = 0.089459 - 0.39225*t120
+    t124 = t123 - 0.089459
+    t125 = -t101*t122 + t105*t124
+    t126 = t101*t124 + t105*t122
+    t127 = t125**2 + t126**2
+    t128 = t122**2 + t124**2
+    t129 = 0.39225*t115 - 0.425
+    t130 = 0.089459 - 0.39225*t116
+    t131 = t130 - 0.089459
+    t132 = t101*t129 + t105*t131
+    t133 = t101*t131 - t105*t129
+    t134 = t132**2 + t133**2
+    t135 = t129**2 + t131**2
+    t136 = t111**2
+    t137 = 1 - 35.98290608994648*t136
+    t138 = numpy.less(1e-12, t137)
+    t139 = numpy.where(t138, 5.99857533835714*t111, numpy.where(numpy.greater(t111, 0), 1, -1))
+    t140 = numpy.where(t138, numpy.sqrt(t137), 0)
+    t141 = numpy.arctan2(t140, t139)
+    t142 = numpy.where(t58, 0, t141 + 3.141592653589793)
+    t143 = numpy.where(t58, 1, -t139)
+    t144 = numpy.where(t58, 0, -t140)
+    t145 = 3.141592653589793 - t141
+    t146 = 0.39225*t143 + 0.425
+    t147 = 0.089459 - 0.39225*t144
+    t148 = t147 - 0.089459
+    t149 = -t102*t146 + t109*t148
+    t150 = t102*t148 + t109*t146
+    t151 = t149**2 + t150**2
+    t152 = t146**2 + t148**2
+    t153 = 0.39225*t139 - 0.425
+    t154 = 0.089459 - 0.39225*t140
+    t155 = t154 - 0.089459
+    t156 = t102*t153 + t109*t155
+    t157 = t102*t155 - t109*t153
+    t158 = t156**2 + t157**2
+    t159 = t153**2 + t155**2
+    t160 = 1 - t32
+    t161 = t13*t160
+    t162 = t13*t32 + t161
+    t163 = T02*t36
+    t164 = T12*t32
+    t165 = t163 - t164
+    t166 = -t163 + t164
+    t167 = t165**2
+    t168 = 1 - t167
+    t169 = numpy.less(1e-12, t168)
+    t170 = numpy.where(t169, t165, numpy.where(numpy.greater(t165, 0), 1, -1))
+    t171 = numpy.where(t169, numpy.sqrt(t168), 0)
+    t172 = numpy.arctan2(t171, t170)
+    t173 = numpy.where(t58, 0, t172)
+    t174 = numpy.where(t58, 1, t170)
+    t175 = numpy.where(t58, 0, t171)
+    t176 = t166*t174
+    t177 = t175*t43 - t176
+    t178 = t176 + t177
+    t179 = t175**2
+    t180 = t174**2 + t179
+    t181 = t44**2
+    t182 = t178**2 + t179*t181
+    t183 = t166**2 + t181 + t43**2
+    t184 = 1/numpy.sqrt(t182)
+    t185 = numpy.less_equal(t182, 1e-24*t180*t183)
+    t186 = numpy.where(t185, 1, t178*t184)
+    t187 = t175*(1 - t186)
+    t188 = t175*t186 + t187
+    t189 = t175*t44
+    t190 = numpy.where(t185, 0, -t184*t189)
+    t191 = t174*t190
+    t192 = t174*t186
+    t193 = -T00*t192 + T01*t191 + T02*t188
+    t194 = -T10*t192 + T11*t191 + T12*t188
+    t195 = -T20*t192 + T21*t191 + T22*t188
+    t196 = t160*t195
+    t197 = t193*t32 + t194*t36
+    t198 = t193*t36 - t194*t32
+    t199 = t195*t32 + t196
+    t200 = t197**2 + t199**2
+    t201 = t200
+    t202 = t198**2 + t200
+    t203 = 1/numpy.sqrt(t201)
+    t204 = numpy.less_equal(t201, 1e-24*t202)
+    t205 = numpy.where(t204, 1, -t197*t203)
+    t206 = numpy.where(t204, 0, -t199*t203)
+    t207 = 0.10915 - 0.10915*t205
+    t208 = 0.10915*t205 + 0.10915
+    t209 = 0.10915*t205
+    t210 = t207 + t209
+    t211 = t210 + t42
+    t212 = -t208 + t209
+    t213 = -t212 + t42
+    t214 = 0.09465*t206
+    t215 = -t214 + t41
+    t216 = t214 + t41
+    t217 = 0.09465*t205
+    t218 = t162 + t217
+    t219 = t218 - 0.089459
+    t220 = t211**2 + t215**2 + t219**2
+    t221 = 0.16724253125 - 0.5*t220
+    t222 = t162 - t217
+    t223 = t222 - 0.089459
+    t224 = t213**2 + t216**2 + t223**2
+    t225 = 0.16724253125 - 0.5*t224
+    t226 = t221**2
+    t227 = 1 - 35.98290608994648*t226
+    t228 = numpy.less(1e-12, t227)
+    t229 = numpy.where(t228, 5.99857533835714*t221, numpy.where(numpy.greater(t221, 0), 1, -1))
+    t230 = numpy.where(t228, numpy.sqrt(t227), 0)
+    t231 = numpy.arctan2(t230, t229)
+    t232 = numpy.where(t58, 0, t231 + 3.141592653589793)
+    t233 = numpy.where(t58, 1, -t229)
+    t234 = numpy.where(t58, 0, -t230)
+    t235 = 3.141592653589793 - t231
+    t236 = 0.39225*t233 + 0.425
+    t237 = 0.089459 - 0.39225*t234
+    t238 = t237 - 0.089459
+    t239 = -t215*t236 + t219*t238
+    t240 = t215*t238 + t219*t236
+    t241 = t239**2 + t240**2
+    t242 = t236**2 + t238**2
+    t243 = 0.39225*t229 - 0.425
+    t244 = 0.089459 - 0.39225*t230
+    t245 = t244 - 0.089459
+    t246 = t215*t243 + t219*t245
+    t247 = t215*t245 - t219*t243
+    t248 = t246**2 + t247**2
+    t249 = t243**2 + t245**2
+    t250 = t225**2
+    t251 = 1 - 35.98290608994648*t250
+    t252 = numpy.less(1e-12, t251)
+    t253 = numpy.where(t252, 5.99857533835714*t225, numpy.where(numpy.greater(t225, 0), 1, -1))
+    t254 = numpy.where(t252, numpy.sqrt(t251), 0)
+    t255 = numpy.arctan2(t254, t253)
+    t256 = numpy.where(t58, 0, t255 + 3.141592653589793)
+    t257 = numpy.where(t58, 1, -t253)
+    t258 = numpy.where(t58, 0, -t254)
+    t259 = 3.141592653589793 - t255
+    t260 = 0.39225*t257 + 0.425
+    t261 = 0.089459 - 0.39225*t258
+    t262 = t261 - 0.089459
+    t263 = -t216*t260 + t223*t262
+    t264 = t216*t262 + t223*t260
+    t265 = t263**2 + t264**2
+    t266 = t260**2 + t262**2
+    t267 = 0.39225*t253 - 0.425
+    t268 = 0.089459 - 0.39225*t254
+    t269 = t268 - 0.089459
+    t270 = t216*t267 + t223*t269
+    t271 = t216*t269 - t223*t267
+    t272 = t270**2 + t271**2
+    t273 = t267**2 + t269**2
+    t274 = t26 - 6.283185307179586*numpy.ceil(0.15915494309189535*t26 - 0.5)
+    t275 = 1e-24*t106
+    t276 = numpy.where(numpy.less_equal(t127, t128*t275), 0, numpy.arctan2(-t126, t125))
+    t277 = -numpy.where(t90, 0, numpy.arctan2(-t85, -t83))
+    t278 = t277 + 3.141592653589793
+    t279 = t118 + t276
+    t280 = t59 - 6.283185307179586*numpy.ceil(0.15915494309189535*t59 - 0.5)
+    t281 = numpy.where(t71, 0, numpy.arctan2(-t75, t64))
+    t282 = numpy.where(numpy.less_equal(t134, t135*t275), 0, numpy.arctan2(-t133, t132))
+    t283 = t121 + t282
+    t284 = 1e-24*t110
+    t285 = numpy.where(numpy.less_equal(t151, t152*t284), 0, numpy.arctan2(-t150, t149))
+    t286 = t142 - 3.141592653589793
+    t287 = t277 + t285
+    t288 = -t57 - 6.283185307179586*numpy.ceil(-0.15915494309189535*t57 - 0.5)
+    t289 = t281 - 6.283185307179586*numpy.ceil(0.15915494309189535*t281) + 3.141592653589793
+    t290 = numpy.where(numpy.less_equal(t158, t159*t284), 0, numpy.arctan2(-t157, t156))
+    t291 = t145 - 3.141592653589793
+    t292 = t277 + t290
+    t293 = t23 - 6.283185307179586*numpy.ceil(0.15915494309189535*t23 - 0.5)
+    t294 = 1e-24*t220
+    t295 = numpy.where(numpy.less_equal(t241, t242*t294), 0, numpy.arctan2(-t240, t239))
+    t296 = -numpy.where(t204, 0, numpy.arctan2(-t199, -t197))
+    t297 = t296 + 3.141592653589793
+    t298 = t232 + t295
+    t299 = t173 - 6.283185307179586*numpy.ceil(0.15915494309189535*t173 - 0.5)
+    t300 = numpy.where(t185, 0, numpy.arctan2(-t189, t178))
+    t301 = numpy.where(numpy.less_equal(t248, t249*t294), 0, numpy.arctan2(-t247, t246))
+    t302 = t235 + t301
+    t303 = 1e-24*t224
+    t304 = numpy.where(numpy.less_equal(t265, t266*t303), 0, numpy.arctan2(-t264, t263))
+    t305 = t256 - 3.141592653589793
+    t306 = t296 + t304
+    t307 = -t172 - 6.283185307179586*numpy.ceil(-0.15915494309189535*t172 - 0.5)
+    t308 = t300 - 6.283185307179586*numpy.ceil(0.15915494309189535*t300) + 3.141592653589793
+    t309 = numpy.where(numpy.less_equal(t272, t273*t303), 0, numpy.arctan2(-t271, t270))
+    t310 = t259 - 3.141592653589793
+    t311 = t296 + t309
+    t312 = numpy.isfinite(t0)
+    t313 = False
+    t314 = True
+    t315 = -1e-12
+    t316 = (t313 & (numpy.less_equal(t52, 1e-12))) | (t314 & (numpy.greater_equal(t53, t315)))
+    t317 = numpy.greater(t15, t24)
+    t318 = (t317 & (numpy.greater_equal(t18, t315))) | (t25 & (numpy.less_equal(0.0119137225, 1e-12*t16)))
+    t319 = 2.77909737890625e-26
+    t320 = numpy.greater(0.0277909737890625, t319)
+    t321 = numpy.less_equal(0.0277909737890625, t319)
+    t322 = 2.77909737890625e-14
+    t323 = numpy.greater(t53, 1e-12)
+    t324 = numpy.greater(t18, 1e-12)
+    t325 = (t313 & (numpy.less_equal(t167, 1e-12))) | (t314 & (numpy.greater_equal(t168, t315)))
+    t326 = numpy.greater(t168, 1e-12)
+    q = numpy.empty(T.shape[:-2] + (8, 6))
+    q[..., 0, 0] = t274
+    q[..., 0, 1] = t276
+    q[..., 0, 2] = t118 - 6.283185307179586*numpy.ceil(0.15915494309189535*t118 - 0.5)
+    q[..., 0, 3] = -t277 - t279 - 6.283185307179586*numpy.ceil(-0.15915494309189535*t278 - 0.15915494309189535*t279)
+    q[..., 0, 4] = t280
+    q[..., 0, 5] = t281
+    q[..., 1, 0] = t274
+    q[..., 1, 1] = t282
+    q[..., 1, 2] = t121 - 6.283185307179586*numpy.ceil(0.15915494309189535*t121 - 0.5)
+    q[..., 1, 3] = -t277 - t283 - 6.283185307179586*numpy.ceil(-0.15915494309189535*t278 - 0.15915494309189535*t283)
+    q[..., 1, 4] = t280
+    q[..., 1, 5] = t281
+    q[..., 2, 0] = t274
+    q[..., 2, 1] = t285
+    q[..., 2, 2] = t142 - 6.283185307179586*numpy.ceil(0.15915494309189535*t286)
+    q[..., 2, 3] = -t286 - t287 - 6.283185307179586*numpy.ceil(-0.15915494309189535*t142 - 0.15915494309189535*t287)
+    q[..., 2, 4] = t288
+    q[..., 2, 5] = t289
+    q[..., 3, 0] = t274
+    q[..., 3, 1] = t290
+    q[..., 3, 2] = t145 - 6.283185307179586*numpy.ceil(0.15915494309189535*t291)
+    q[..., 3, 3] = -t291 - t292 - 6.283185307179586*numpy.ceil(-0.15915494309189535*t145 - 0.15915494309189535*t292)
+    q[..., 3, 4] = t288
+    q[..., 3, 5] = t289
+    q[..., 4, 0] = t293
+    q[..., 4, 1] = t295
+    q[..., 4, 2] = t232 - 6.283185307179586*numpy.ceil(0.15915494309189535*t232 - 0.5)
+    q[..., 4, 3] = -t296 - t298 - 6.283185307179586*numpy.ceil(-0.15915494309189535*t297 - 0.15915494309189535*t298)
+    q[..., 4, 4] = t299
+    q[..., 4, 5] = t300
+    q[..., 5, 0] = t293
+    q[..., 5, 1] = t301
+    q[..., 5, 2] = t235 - 6.283185307179586*numpy.ceil(0.15915494309189535*t235 - 0.5)
+    q[..., 5, 3] = -t296 - t302 - 6.283185307179586*numpy.ceil(-0.15915494309189535*t297 - 0.15915494309189535*t302)
+    q[..., 5, 4] = t299
+    q[..., 5, 5] = t300
+    q[..., 6, 0] = t293
+    q[..., 6, 1] = t304
+    q[..., 6, 2] = t256 - 6.283185307179586*numpy.ceil(0.15915494309189535*t305)
+    q[..., 6, 3] = -t305 - t306 - 6.283185307179586*numpy.ceil(-0.15915494309189535*t256 - 0.15915494309189535*t306)
+    q[..., 6, 4] = t307
+    q[..., 6, 5] = t308
+    q[..., 7, 0] = t293
+    q[..., 7, 1] = t309
+    q[..., 7, 2] = t259 - 6.283185307179586*numpy.ceil(0.15915494309189535*t310)
+    q[..., 7, 3] = -t310 - t311 - 6.283185307179586*numpy.ceil(-0.15915494309189535*t259 - 0.15915494309189535*t311)
+    q[..., 7, 4] = t307
+    q[..., 7, 5] = t308
+    valid = numpy.empty(T.shape[:-2] + (8,), dtype=bool)
+    valid[..., 0] = t312 & t316 & t318 & ((t320 & (numpy.greater_equal(t113, t315))) | (t321 & (numpy.less_equal(t112, t322))))
+    valid[..., 1] = t312 & t316 & t318 & t320 & (numpy.greater(t113, 1e-12))
+    valid[..., 2] = t312 & t314 & t318 & t323 & ((t320 & (numpy.greater_equal(t137, t315))) | (t321 & (numpy.less_equal(t136, t322))))
+    valid[..., 3] = t312 & t314 & t318 & t320 & t323 & (numpy.greater(t137, 1e-12))
+    valid[..., 4] = t312 & t317 & t324 & t325 & ((t320 & (numpy.greater_equal(t227, t315))) | (t321 & (numpy.less_equal(t226, t322))))
+    valid[..., 5] = t312 & t317 & t320 & t324 & t325 & (numpy.greater(t227, 1e-12))
+    valid[..., 6] = t312 & t314 & t317 & t324 & t326 & ((t320 & (numpy.greater_equal(t251, t315))) | (t321 & (numpy.less_equal(t250, t322))))
+    valid[..., 7] = t312 & t314 & t317 & t320 & t324 & t326 & (numpy.greater(t251, 1e-12))
+    return q, valid
 
-
-# -- Closed-form inverse kinematics (three_parallel) --
 
 MAX_IK_SOLUTIONS = 8
-_EPS = 1e-12  # a squared sine within this of 0 is a double root
-_TINY = 1e-24  # relative squared length below which a vector counts as zero
 
 
-def _dot(a, b):
-    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+def ik(T):
+    """Closed-form inverse kinematics: every joint solution that reaches the target.
 
-
-def _cross(a, b):
-    return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
-
-
-def _add(a, b):
-    return (a[0] + b[0], a[1] + b[1], a[2] + b[2])
-
-
-def _sub(a, b):
-    return (a[0] - b[0], a[1] - b[1], a[2] - b[2])
-
-
-def _rot(k, c, s, v):
-    """v turned about the unit axis k by the angle whose cosine and sine are c and s (Rodrigues)."""
-    kxv = _cross(k, v)
-    kv = _dot(k, v) * (1.0 - c)
-    return (v[0] * c + kxv[0] * s + k[0] * kv, v[1] * c + kxv[1] * s + k[1] * kv,
-            v[2] * c + kxv[2] * s + k[2] * kv)
-
-
-class _Angle:
-    """An angle with its cosine and sine."""
-
-    __slots__ = ("theta", "c", "s")
-
-    def __init__(self, theta, c, s):
-        self.theta, self.c, self.s = theta, c, s
-
-
-def _angle(c, s):
-    return _Angle(math.atan2(s, c), c, s)
-
-
-def _sp1(p, q, k):
-    """SP1: the angle turning p into q about the unit axis k (least squares when they differ
-    in length or height along k). 0 when p or q lies on the axis (any angle would do)."""
-    x = _dot(p, q) - _dot(k, p) * _dot(k, q)
-    y = _dot(k, _cross(p, q))
-    r = math.hypot(x, y)
-    if r * r <= _TINY * _dot(p, p) * _dot(q, q):
-        return _Angle(0.0, 1.0, 0.0)
-    return _angle(x / r, y / r)
-
-
-def _sp4(h, p, k, d):
-    """SP4: the angles t with h . rot(k, t) p = d, as [phi + alpha, phi - alpha].
-
-    h . rot(k, t) p = A cos t + B sin t + C. One angle for a double root (|sin alpha|^2 <=
-    _EPS), none out of range; when the left side does not depend on t, [0] if it equals d.
-    """
-    hk, kp = _dot(h, k), _dot(k, p)
-    a = _dot(h, p) - hk * kp
-    b = _dot(h, _cross(k, p))
-    rhs = d - hk * kp
-    r2 = a * a + b * b
-    scale = _dot(h, h) * _dot(p, p)
-    if r2 <= _TINY * scale:
-        return [_Angle(0.0, 1.0, 0.0)] if rhs * rhs <= _EPS * scale else []
-    r = math.sqrt(r2)
-    cos_phi, sin_phi, cos_alpha = a / r, b / r, rhs / r
-    disc = 1.0 - cos_alpha * cos_alpha
-    if disc < -_EPS:
-        return []
-    if disc <= _EPS:
-        sign = 1.0 if cos_alpha > 0.0 else -1.0
-        return [_angle(sign * cos_phi, sign * sin_phi)]
-    sin_alpha = math.sqrt(disc)
-    phi, alpha = math.atan2(b, a), math.atan2(sin_alpha, cos_alpha)
-    return [_Angle(phi + alpha, cos_phi * cos_alpha - sin_phi * sin_alpha, sin_phi * cos_alpha + cos_phi * sin_alpha),
-            _Angle(phi - alpha, cos_phi * cos_alpha + sin_phi * sin_alpha, sin_phi * cos_alpha - cos_phi * sin_alpha)]
-
-
-def _sp3(p, q, k, dd):
-    """SP3: the angles t with |rot(k, t) p - q|^2 = dd (p, q relative to a point of the axis)."""
-    return _sp4(q, p, k, 0.5 * (_dot(p, p) + _dot(q, q) - dd))
-
-
-def _relative(T, rotation, position):
-    """T T(0)^-1 = exp(xi_1 q_1) ... exp(xi_n q_n) as (R, t), T(0) = (rotation, position)
-    the tool pose at q = 0."""
-    R = tuple(T[i][0] * rotation[3 * j] + T[i][1] * rotation[3 * j + 1] + T[i][2] * rotation[3 * j + 2]
-              for i in range(3) for j in range(3))
-    return R, tuple(T[i][3] - _dot(R[3 * i:3 * i + 3], position) for i in range(3))
-
-
-def _mul(R, v):
-    return (_dot(R[0:3], v), _dot(R[3:6], v), _dot(R[6:9], v))
-
-
-def _mul_t(R, v):
-    return (R[0] * v[0] + R[3] * v[1] + R[6] * v[2], R[1] * v[0] + R[4] * v[1] + R[7] * v[2],
-            R[2] * v[0] + R[5] * v[1] + R[8] * v[2])
-
-
-def _ik_solve(T, tool_rotation, tool_position, h1, p1, h, v, p2, h3, p3, p4, h5, h6, centre, reach, sign3, sign4):
-    """Axes 2, 3, 4 parallel to h, axes 5 and 6 meeting at the wrist centre: the centre's
-    height along h fixes q1 (SP4), the tool orientation q5 (SP4) and q6 (SP1) and the sum
-    q2 + q3 + q4 (SP1), the centre's position q3 (SP3) and q2 (SP1)."""
-    R, t = _relative(T, tool_rotation, tool_position)
-    wc = _add(_mul(R, centre), t)
-    a = _mul(R, h6)
-    solutions = []
-    for t1 in _sp4(_sub(wc, p1), h, h1, reach):
-        g = _rot(h1, t1.c, t1.s, h)
-        w = _add(p1, _rot(h1, t1.c, -t1.s, _sub(wc, p1)))
-        for j, t5 in enumerate(_sp4(h, h6, h5, _dot(g, a))):
-            if j == 1:  # axis 5 perpendicular to h and h6: the second q5 turns q6 and q2 + q3 + q4 by pi
-                t6 = _Angle(t6.theta + math.pi, -t6.c, -t6.s)
-                total = _Angle(total.theta + math.pi, -total.c, -total.s)
-            else:
-                t6 = _sp1(_mul_t(R, g), _rot(h5, t5.c, -t5.s, h), h6)
-                x = _rot(h1, t1.c, -t1.s, _mul(R, _rot(h6, t6.c, -t6.s, _rot(h5, t5.c, -t5.s, v))))
-                total = _sp1(v, x, h)
-            wrist = _sub(w, _rot(h, total.c, total.s, _sub(centre, p4)))
-            d = _sub(wrist, p2)
-            for t3 in _sp3(_sub(p4, p3), _sub(p2, p3), h3, _dot(d, d)):
-                t2 = _sp1(_sub(_add(p3, _rot(h3, t3.c, t3.s, _sub(p4, p3))), p2), d, h)
-                t4 = sign4 * (total.theta - t2.theta - sign3 * t3.theta)
-                solutions.append([t1.theta, t2.theta, t3.theta, t4, t5.theta, t6.theta])
-    return solutions
-
-
-def ik(target):
-    """Closed-form inverse kinematics: every joint solution that reaches `target`, as (k, DOF).
-
+    One target: the solutions as (k, DOF), the valid rows of ik_branches in its order.
+    A batch of targets: ik_branches' (q, valid), (..., MAX_IK_SOLUTIONS, DOF) and
+    (..., MAX_IK_SOLUTIONS).
     target: the 4x4 tool pose in the world frame (rotation part orthonormal).
     Result: k <= MAX_IK_SOLUTIONS solutions, revolute angles wrapped into (-pi, pi], joint
     limits not applied; k = 0 when the target is out of reach or not finite.
@@ -811,33 +1085,8 @@ def ik(target):
     root (a target on a singularity or on the workspace boundary) is returned once, and an
     angle the target leaves free (a singular wrist or shoulder) is set to 0.
     """
-    target = numpy.asarray(target, dtype=float)
-    if target.shape != (4, 4):
-        raise ValueError(f"target must have shape (4, 4), got {target.shape}")
-    if not numpy.all(numpy.isfinite(target[:3])):  # the last row is not read
-        return numpy.empty((0, DOF))
-    solutions = _ik_solve(
-        target.tolist(),
-        tool_rotation=(1, 0, 0, 0, 0, -1, 0, 1, 0),
-        tool_position=(-0.81725, -0.19145, -0.005191),
-        h1=(0, 0, 1),
-        p1=(0, 0, 0),
-        h=(0, -1, 0),
-        v=(1, 0, 0),
-        p2=(0, 0, 0.089459),
-        h3=(0, -1, 0),
-        p3=(-0.425, 0, 0.089459),
-        p4=(-0.81725, 0, 0.089459),
-        h5=(0, 0, -1),
-        h6=(0, -1, 0),
-        centre=(-0.81725, -0.10915, -0.005191),
-        reach=0.10915,
-        sign3=1,
-        sign4=1,
-    )
-    q = numpy.array(solutions, dtype=float).reshape(-1, DOF)
-    q[:, [0, 1, 2, 3, 4, 5]] = _wrap(q[:, [0, 1, 2, 3, 4, 5]])
-    return q
+    q, valid = ik_branches(T)
+    return q[valid] if valid.ndim == 1 else (q, valid)
 
 
 # -- Iterative inverse kinematics --
@@ -925,7 +1174,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
     condition number below VELOCITY_IK_RCOND; take damping > 0 there). Where ok is False,
     q_dot is 0: the result never holds NaN.
     """
-    q = _joints(q)
+    q = _argument("q", q, (DOF,))
     mu_dot = numpy.asarray(mu_dot, dtype=float)
     if mu_dot.ndim == 0 or mu_dot.shape[-1] != 6:
         raise ValueError(f"mu_dot must have shape (6,) or (..., 6), got {mu_dot.shape}")

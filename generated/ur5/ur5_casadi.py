@@ -3,7 +3,9 @@
 
 Universal Robots UR5 (rtb UR5), standard DH
 Every function takes `q` (6 x 1: radians for revolute joints, m for
-prismatic ones) and returns a rows x cols result whose zeros are structural.
+prismatic ones) and returns a rows x cols result whose zeros are structural; ik_branches
+(also named ik) takes the target instead of q and returns every branch (MAX_IK_SOLUTIONS x
+DOF) and its validity (MAX_IK_SOLUTIONS x 1, 1 or 0).
 Task vector: (x, y, z, roll, pitch, yaw).
 """
 
@@ -603,7 +605,410 @@ def _jacobian_det(q):
     return [d]
 
 
-_q = casadi.SX.sym("q", DOF)
+def _ik_branches(T):
+    """Every branch of the closed-form ik and whether the target allows it: 843 operations."""
+    T00 = T[0, 0]
+    T01 = T[0, 1]
+    T02 = T[0, 2]
+    T03 = T[0, 3]
+    T10 = T[1, 0]
+    T11 = T[1, 1]
+    T12 = T[1, 2]
+    T13 = T[1, 3]
+    T20 = T[2, 0]
+    T21 = T[2, 1]
+    T22 = T[2, 2]
+    T23 = T[2, 3]
+    t0 = T00 + T01 + T02 + T03 + T10 + T11 + T12 + T13 + T20 + T21 + T22 + T23
+    t1 = 0.81725*T00 + 0.005191*T01
+    t2 = -0.19145*T02 + T03 + t1
+    t3 = -0.10915*T02 + t1
+    t4 = t2 - t3
+    t5 = 0.81725*T10 + 0.005191*T11
+    t6 = -0.19145*T12 + T13 + t5
+    t7 = -0.10915*T12 + t5
+    t8 = t6 - t7
+    t9 = casadi.atan2(t4, -t8)
+    t10 = 0.81725*T20 + 0.005191*T21
+    t11 = -0.19145*T22 + T23 + t10
+    t12 = -0.10915*T22 + t10
+    t13 = t11 - t12
+    t14 = t4**2 + t8**2
+    t15 = t14
+    t16 = t13**2 + t14
+    t17 = 1/casadi.sqrt(t15)
+    t18 = 1 - 0.0119137225*t17**2
+    t19 = (1e-12 < t18)
+    t20 = casadi.if_else(t19, 0.10915*t17, casadi.if_else((t17 > 0), 1, -1))
+    t21 = casadi.if_else(t19, casadi.sqrt(t18), 0)
+    t22 = casadi.atan2(t21, t20)
+    t23 = -t22 + t9
+    t24 = 1e-24*t16
+    t25 = (t15 <= t24)
+    t26 = casadi.if_else(t25, 0, t22 + t9)
+    t27 = t17*t4
+    t28 = t21*t27
+    t29 = t17*t8
+    t30 = t20*t29
+    t31 = casadi.if_else(t25, 1, -t28 - t30)
+    t32 = t28 - t30
+    t33 = t20*t27
+    t34 = t21*t29
+    t35 = casadi.if_else(t25, 0, t33 - t34)
+    t36 = t33 + t34
+    t37 = t31*t4 + t35*t8
+    t38 = t31*t8 - t35*t4
+    t39 = T00*t35 - T10*t31
+    t40 = T01*t35 - T11*t31
+    t41 = t32*t4 + t36*t8
+    t42 = t32*t8 - t36*t4
+    t43 = T00*t36 - T10*t32
+    t44 = T01*t36 - T11*t32
+    t45 = 1 - t31
+    t46 = t13*t45
+    t47 = t13*t31 + t46
+    t48 = T02*t35
+    t49 = T12*t31
+    t50 = t48 - t49
+    t51 = -t48 + t49
+    t52 = t50**2
+    t53 = 1 - t52
+    t54 = (1e-12 < t53)
+    t55 = casadi.if_else(t54, t50, casadi.if_else((t50 > 0), 1, -1))
+    t56 = casadi.if_else(t54, casadi.sqrt(t53), 0)
+    t57 = casadi.atan2(t56, t55)
+    t58 = False
+    t59 = casadi.if_else(t58, 0, t57)
+    t60 = casadi.if_else(t58, 1, t55)
+    t61 = casadi.if_else(t58, 0, t56)
+    t62 = t51*t60
+    t63 = t39*t61 - t62
+    t64 = t62 + t63
+    t65 = t61**2
+    t66 = t60**2 + t65
+    t67 = t40**2
+    t68 = t64**2 + t65*t67
+    t69 = t39**2 + t51**2 + t67
+    t70 = 1/casadi.sqrt(t68)
+    t71 = (t68 <= 1e-24*t66*t69)
+    t72 = casadi.if_else(t71, 1, t64*t70)
+    t73 = t61*(1 - t72)
+    t74 = t61*t72 + t73
+    t75 = t40*t61
+    t76 = casadi.if_else(t71, 0, -t70*t75)
+    t77 = t60*t76
+    t78 = t60*t72
+    t79 = -T00*t78 + T01*t77 + T02*t74
+    t80 = -T10*t78 + T11*t77 + T12*t74
+    t81 = -T20*t78 + T21*t77 + T22*t74
+    t82 = t45*t81
+    t83 = t31*t79 + t35*t80
+    t84 = -t31*t80 + t35*t79
+    t85 = t31*t81 + t82
+    t86 = t83**2 + t85**2
+    t87 = t86
+    t88 = t84**2 + t86
+    t89 = 1/casadi.sqrt(t87)
+    t90 = (t87 <= 1e-24*t88)
+    t91 = casadi.if_else(t90, 1, -t83*t89)
+    t92 = casadi.if_else(t90, 0, -t85*t89)
+    t93 = 0.10915 - 0.10915*t91
+    t94 = 0.10915*t91 + 0.10915
+    t95 = 0.10915*t91
+    t96 = t93 + t95
+    t97 = t38 + t96
+    t98 = -t94 + t95
+    t99 = t38 - t98
+    t100 = 0.09465*t92
+    t101 = -t100 + t37
+    t102 = t100 + t37
+    t103 = 0.09465*t91
+    t104 = t103 + t47
+    t105 = t104 - 0.089459
+    t106 = t101**2 + t105**2 + t97**2
+    t107 = 0.16724253125 - 0.5*t106
+    t108 = -t103 + t47
+    t109 = t108 - 0.089459
+    t110 = t102**2 + t109**2 + t99**2
+    t111 = 0.16724253125 - 0.5*t110
+    t112 = t107**2
+    t113 = 1 - 35.98290608994648*t112
+    t114 = (1e-12 < t113)
+    t115 = casadi.if_else(t114, 5.99857533835714*t107, casadi.if_else((t107 > 0), 1, -1))
+    t116 = casadi.if_else(t114, casadi.sqrt(t113), 0)
+    t117 = casadi.atan2(t116, t115)
+    t118 = casadi.if_else(t58, 0, t117 + 3.141592653589793)
+    t119 = casadi.if_else(t58, 1, -t115)
+    t120 = casadi.if_else(t58, 0, -t116)
+    t121 = 3.141592653589793 - t117
+    t122 = 0.39225*t119 + 0.425
+    t123 = 0.089459 - 0.39225*t120
+    t124 = t123 - 0.089459
+    t125 = -t101*t122 + t105*t124
+    t126 = t101*t124 + t105*t122
+    t127 = t125**2 + t126**2
+    t128 = t122**2 + t124**2
+    t129 = 0.39225*t115 - 0.425
+    t130 = 0.089459 - 0.39225*t116
+    t131 = t130 - 0.089459
+    t132 = t101*t129 + t105*t131
+    t133 = t101*t131 - t105*t129
+    t134 = t132**2 + t133**2
+    t135 = t129**2 + t131**2
+    t136 = t111**2
+    t137 = 1 - 35.98290608994648*t136
+    t138 = (1e-12 < t137)
+    t139 = casadi.if_else(t138, 5.99857533835714*t111, casadi.if_else((t111 > 0), 1, -1))
+    t140 = casadi.if_else(t138, casadi.sqrt(t137), 0)
+    t141 = casadi.atan2(t140, t139)
+    t142 = casadi.if_else(t58, 0, t141 + 3.141592653589793)
+    t143 = casadi.if_else(t58, 1, -t139)
+    t144 = casadi.if_else(t58, 0, -t140)
+    t145 = 3.141592653589793 - t141
+    t146 = 0.39225*t143 + 0.425
+    t147 = 0.089459 - 0.39225*t144
+    t148 = t147 - 0.089459
+    t149 = -t102*t146 + t109*t148
+    t150 = t102*t148 + t109*t146
+    t151 = t149**2 + t150**2
+    t152 = t146**2 + t148**2
+    t153 = 0.39225*t139 - 0.425
+    t154 = 0.089459 - 0.39225*t140
+    t155 = t154 - 0.089459
+    t156 = t102*t153 + t109*t155
+    t157 = t102*t155 - t109*t153
+    t158 = t156**2 + t157**2
+    t159 = t153**2 + t155**2
+    t160 = 1 - t32
+    t161 = t13*t160
+    t162 = t13*t32 + t161
+    t163 = T02*t36
+    t164 = T12*t32
+    t165 = t163 - t164
+    t166 = -t163 + t164
+    t167 = t165**2
+    t168 = 1 - t167
+    t169 = (1e-12 < t168)
+    t170 = casadi.if_else(t169, t165, casadi.if_else((t165 > 0), 1, -1))
+    t171 = casadi.if_else(t169, casadi.sqrt(t168), 0)
+    t172 = casadi.atan2(t171, t170)
+    t173 = casadi.if_else(t58, 0, t172)
+    t174 = casadi.if_else(t58, 1, t170)
+    t175 = casadi.if_else(t58, 0, t171)
+    t176 = t166*t174
+    t177 = t175*t43 - t176
+    t178 = t176 + t177
+    t179 = t175**2
+    t180 = t174**2 + t179
+    t181 = t44**2
+    t182 = t178**2 + t179*t181
+    t183 = t166**2 + t181 + t43**2
+    t184 = 1/casadi.sqrt(t182)
+    t185 = (t182 <= 1e-24*t180*t183)
+    t186 = casadi.if_else(t185, 1, t178*t184)
+    t187 = t175*(1 - t186)
+    t188 = t175*t186 + t187
+    t189 = t175*t44
+    t190 = casadi.if_else(t185, 0, -t184*t189)
+    t191 = t174*t190
+    t192 = t174*t186
+    t193 = -T00*t192 + T01*t191 + T02*t188
+    t194 = -T10*t192 + T11*t191 + T12*t188
+    t195 = -T20*t192 + T21*t191 + T22*t188
+    t196 = t160*t195
+    t197 = t193*t32 + t194*t36
+    t198 = t193*t36 - t194*t32
+    t199 = t195*t32 + t196
+    t200 = t197**2 + t199**2
+    t201 = t200
+    t202 = t198**2 + t200
+    t203 = 1/casadi.sqrt(t201)
+    t204 = (t201 <= 1e-24*t202)
+    t205 = casadi.if_else(t204, 1, -t197*t203)
+    t206 = casadi.if_else(t204, 0, -t199*t203)
+    t207 = 0.10915 - 0.10915*t205
+    t208 = 0.10915*t205 + 0.10915
+    t209 = 0.10915*t205
+    t210 = t207 + t209
+    t211 = t210 + t42
+    t212 = -t208 + t209
+    t213 = -t212 + t42
+    t214 = 0.09465*t206
+    t215 = -t214 + t41
+    t216 = t214 + t41
+    t217 = 0.09465*t205
+    t218 = t162 + t217
+    t219 = t218 - 0.089459
+    t220 = t211**2 + t215**2 + t219**2
+    t221 = 0.16724253125 - 0.5*t220
+    t222 = t162 - t217
+    t223 = t222 - 0.089459
+    t224 = t213**2 + t216**2 + t223**2
+    t225 = 0.16724253125 - 0.5*t224
+    t226 = t221**2
+    t227 = 1 - 35.98290608994648*t226
+    t228 = (1e-12 < t227)
+    t229 = casadi.if_else(t228, 5.99857533835714*t221, casadi.if_else((t221 > 0), 1, -1))
+    t230 = casadi.if_else(t228, casadi.sqrt(t227), 0)
+    t231 = casadi.atan2(t230, t229)
+    t232 = casadi.if_else(t58, 0, t231 + 3.141592653589793)
+    t233 = casadi.if_else(t58, 1, -t229)
+    t234 = casadi.if_else(t58, 0, -t230)
+    t235 = 3.141592653589793 - t231
+    t236 = 0.39225*t233 + 0.425
+    t237 = 0.089459 - 0.39225*t234
+    t238 = t237 - 0.089459
+    t239 = -t215*t236 + t219*t238
+    t240 = t215*t238 + t219*t236
+    t241 = t239**2 + t240**2
+    t242 = t236**2 + t238**2
+    t243 = 0.39225*t229 - 0.425
+    t244 = 0.089459 - 0.39225*t230
+    t245 = t244 - 0.089459
+    t246 = t215*t243 + t219*t245
+    t247 = t215*t245 - t219*t243
+    t248 = t246**2 + t247**2
+    t249 = t243**2 + t245**2
+    t250 = t225**2
+    t251 = 1 - 35.98290608994648*t250
+    t252 = (1e-12 < t251)
+    t253 = casadi.if_else(t252, 5.99857533835714*t225, casadi.if_else((t225 > 0), 1, -1))
+    t254 = casadi.if_else(t252, casadi.sqrt(t251), 0)
+    t255 = casadi.atan2(t254, t253)
+    t256 = casadi.if_else(t58, 0, t255 + 3.141592653589793)
+    t257 = casadi.if_else(t58, 1, -t253)
+    t258 = casadi.if_else(t58, 0, -t254)
+    t259 = 3.141592653589793 - t255
+    t260 = 0.39225*t257 + 0.425
+    t261 = 0.089459 - 0.39225*t258
+    t262 = t261 - 0.089459
+    t263 = -t216*t260 + t223*t262
+    t264 = t216*t262 + t223*t260
+    t265 = t263**2 + t264**2
+    t266 = t260**2 + t262**2
+    t267 = 0.39225*t253 - 0.425
+    t268 = 0.089459 - 0.39225*t254
+    t269 = t268 - 0.089459
+    t270 = t216*t267 + t223*t269
+    t271 = t216*t269 - t223*t267
+    t272 = t270**2 + t271**2
+    t273 = t267**2 + t269**2
+    t274 = t26 - 6.283185307179586*casadi.ceil(0.15915494309189535*t26 - 0.5)
+    t275 = 1e-24*t106
+    t276 = casadi.if_else((t127 <= t128*t275), 0, casadi.atan2(-t126, t125))
+    t277 = -casadi.if_else(t90, 0, casadi.atan2(-t85, -t83))
+    t278 = t277 + 3.141592653589793
+    t279 = t118 + t276
+    t280 = t59 - 6.283185307179586*casadi.ceil(0.15915494309189535*t59 - 0.5)
+    t281 = casadi.if_else(t71, 0, casadi.atan2(-t75, t64))
+    t282 = casadi.if_else((t134 <= t135*t275), 0, casadi.atan2(-t133, t132))
+    t283 = t121 + t282
+    t284 = 1e-24*t110
+    t285 = casadi.if_else((t151 <= t152*t284), 0, casadi.atan2(-t150, t149))
+    t286 = t142 - 3.141592653589793
+    t287 = t277 + t285
+    t288 = -t57 - 6.283185307179586*casadi.ceil(-0.15915494309189535*t57 - 0.5)
+    t289 = t281 - 6.283185307179586*casadi.ceil(0.15915494309189535*t281) + 3.141592653589793
+    t290 = casadi.if_else((t158 <= t159*t284), 0, casadi.atan2(-t157, t156))
+    t291 = t145 - 3.141592653589793
+    t292 = t277 + t290
+    t293 = t23 - 6.283185307179586*casadi.ceil(0.15915494309189535*t23 - 0.5)
+    t294 = 1e-24*t220
+    t295 = casadi.if_else((t241 <= t242*t294), 0, casadi.atan2(-t240, t239))
+    t296 = -casadi.if_else(t204, 0, casadi.atan2(-t199, -t197))
+    t297 = t296 + 3.141592653589793
+    t298 = t232 + t295
+    t299 = t173 - 6.283185307179586*casadi.ceil(0.15915494309189535*t173 - 0.5)
+    t300 = casadi.if_else(t185, 0, casadi.atan2(-t189, t178))
+    t301 = casadi.if_else((t248 <= t249*t294), 0, casadi.atan2(-t247, t246))
+    t302 = t235 + t301
+    t303 = 1e-24*t224
+    t304 = casadi.if_else((t265 <= t266*t303), 0, casadi.atan2(-t264, t263))
+    t305 = t256 - 3.141592653589793
+    t306 = t296 + t304
+    t307 = -t172 - 6.283185307179586*casadi.ceil(-0.15915494309189535*t172 - 0.5)
+    t308 = t300 - 6.283185307179586*casadi.ceil(0.15915494309189535*t300) + 3.141592653589793
+    t309 = casadi.if_else((t272 <= t273*t303), 0, casadi.atan2(-t271, t270))
+    t310 = t259 - 3.141592653589793
+    t311 = t296 + t309
+    t312 = (casadi.fabs(t0) < casadi.inf)
+    t313 = False
+    t314 = True
+    t315 = -1e-12
+    t316 = casadi.logic_or(casadi.logic_and(t313, (t52 <= 1e-12)), casadi.logic_and(t314, (t53 >= t315)))
+    t317 = (t15 > t24)
+    t318 = casadi.logic_or(casadi.logic_and(t317, (t18 >= t315)), casadi.logic_and(t25, (0.0119137225 <= 1e-12*t16)))
+    t319 = 2.77909737890625e-26
+    t320 = (0.0277909737890625 > t319)
+    t321 = (0.0277909737890625 <= t319)
+    t322 = 2.77909737890625e-14
+    t323 = (t53 > 1e-12)
+    t324 = (t18 > 1e-12)
+    t325 = casadi.logic_or(casadi.logic_and(t313, (t167 <= 1e-12)), casadi.logic_and(t314, (t168 >= t315)))
+    t326 = (t168 > 1e-12)
+    q = casadi.SX(8, 6)
+    q[0, 0] = t274
+    q[0, 1] = t276
+    q[0, 2] = t118 - 6.283185307179586*casadi.ceil(0.15915494309189535*t118 - 0.5)
+    q[0, 3] = -t277 - t279 - 6.283185307179586*casadi.ceil(-0.15915494309189535*t278 - 0.15915494309189535*t279)
+    q[0, 4] = t280
+    q[0, 5] = t281
+    q[1, 0] = t274
+    q[1, 1] = t282
+    q[1, 2] = t121 - 6.283185307179586*casadi.ceil(0.15915494309189535*t121 - 0.5)
+    q[1, 3] = -t277 - t283 - 6.283185307179586*casadi.ceil(-0.15915494309189535*t278 - 0.15915494309189535*t283)
+    q[1, 4] = t280
+    q[1, 5] = t281
+    q[2, 0] = t274
+    q[2, 1] = t285
+    q[2, 2] = t142 - 6.283185307179586*casadi.ceil(0.15915494309189535*t286)
+    q[2, 3] = -t286 - t287 - 6.283185307179586*casadi.ceil(-0.15915494309189535*t142 - 0.15915494309189535*t287)
+    q[2, 4] = t288
+    q[2, 5] = t289
+    q[3, 0] = t274
+    q[3, 1] = t290
+    q[3, 2] = t145 - 6.283185307179586*casadi.ceil(0.15915494309189535*t291)
+    q[3, 3] = -t291 - t292 - 6.283185307179586*casadi.ceil(-0.15915494309189535*t145 - 0.15915494309189535*t292)
+    q[3, 4] = t288
+    q[3, 5] = t289
+    q[4, 0] = t293
+    q[4, 1] = t295
+    q[4, 2] = t232 - 6.283185307179586*casadi.ceil(0.15915494309189535*t232 - 0.5)
+    q[4, 3] = -t296 - t298 - 6.283185307179586*casadi.ceil(-0.15915494309189535*t297 - 0.15915494309189535*t298)
+    q[4, 4] = t299
+    q[4, 5] = t300
+    q[5, 0] = t293
+    q[5, 1] = t301
+    q[5, 2] = t235 - 6.283185307179586*casadi.ceil(0.15915494309189535*t235 - 0.5)
+    q[5, 3] = -t296 - t302 - 6.283185307179586*casadi.ceil(-0.15915494309189535*t297 - 0.15915494309189535*t302)
+    q[5, 4] = t299
+    q[5, 5] = t300
+    q[6, 0] = t293
+    q[6, 1] = t304
+    q[6, 2] = t256 - 6.283185307179586*casadi.ceil(0.15915494309189535*t305)
+    q[6, 3] = -t305 - t306 - 6.283185307179586*casadi.ceil(-0.15915494309189535*t256 - 0.15915494309189535*t306)
+    q[6, 4] = t307
+    q[6, 5] = t308
+    q[7, 0] = t293
+    q[7, 1] = t309
+    q[7, 2] = t259 - 6.283185307179586*casadi.ceil(0.15915494309189535*t310)
+    q[7, 3] = -t310 - t311 - 6.283185307179586*casadi.ceil(-0.15915494309189535*t259 - 0.15915494309189535*t311)
+    q[7, 4] = t307
+    q[7, 5] = t308
+    valid = casadi.SX(8, 1)
+    valid[0, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t312, t316), t318), casadi.logic_or(casadi.logic_and(t320, (t113 >= t315)), casadi.logic_and(t321, (t112 <= t322))))
+    valid[1, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t312, t316), t318), t320), (t113 > 1e-12))
+    valid[2, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t312, t314), t318), t323), casadi.logic_or(casadi.logic_and(t320, (t137 >= t315)), casadi.logic_and(t321, (t136 <= t322))))
+    valid[3, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t312, t314), t318), t320), t323), (t137 > 1e-12))
+    valid[4, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t312, t317), t324), t325), casadi.logic_or(casadi.logic_and(t320, (t227 >= t315)), casadi.logic_and(t321, (t226 <= t322))))
+    valid[5, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t312, t317), t320), t324), t325), (t227 > 1e-12))
+    valid[6, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t312, t314), t317), t324), t326), casadi.logic_or(casadi.logic_and(t320, (t251 >= t315)), casadi.logic_and(t321, (t250 <= t322))))
+    valid[7, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t312, t314), t317), t320), t324), t326), (t251 > 1e-12))
+    return [q, valid]
+
+
+_q = casadi.SX.sym("q", 6, 1)
+_T = casadi.SX.sym("T", 4, 4)
 fk = casadi.Function("fk", [_q], _fk(_q), ["q"], ["T"])
 jacobian = casadi.Function("jacobian", [_q], _jacobian(_q), ["q"], ["J"])
 fk_jacobian = casadi.Function("fk_jacobian", [_q], _fk_jacobian(_q), ["q"], ["T", "J"])
@@ -613,8 +1018,10 @@ task_jacobian = casadi.Function("task_jacobian", [_q], _task_jacobian(_q), ["q"]
 singularity_factors = casadi.Function("singularity_factors", [_q], _singularity_factors(_q), ["q"], ["f"])
 manipulability = casadi.Function("manipulability", [_q], _manipulability(_q), ["q"], ["w"])
 jacobian_det = casadi.Function("jacobian_det", [_q], _jacobian_det(_q), ["q"], ["d"])
+ik_branches = casadi.Function("ik_branches", [_T], _ik_branches(_T), ["T"], ["q", "valid"])
+ik = ik_branches  # CasADi functions have fixed-size outputs: every branch and its validity
 
 
 def functions():
     """All functions by name."""
-    return {"fk": fk, "jacobian": jacobian, "fk_jacobian": fk_jacobian, "jacobian_tool": jacobian_tool, "task": task, "task_jacobian": task_jacobian, "singularity_factors": singularity_factors, "manipulability": manipulability, "jacobian_det": jacobian_det}
+    return {"fk": fk, "jacobian": jacobian, "fk_jacobian": fk_jacobian, "jacobian_tool": jacobian_tool, "task": task, "task_jacobian": task_jacobian, "singularity_factors": singularity_factors, "manipulability": manipulability, "jacobian_det": jacobian_det, "ik_branches": ik_branches}
