@@ -68,7 +68,9 @@ class CLibrary:
             extra = [ctypes.POINTER(self._parameters)]
         for function in functions:
             symbol = getattr(self._library, f"{robot.name}_{function.name}")
-            symbol.argtypes = [pointer] + ([] if function.scalar else [pointer] * len(function.outputs)) + extra
+            outputs = [] if function.scalar else [ctypes.POINTER(ctypes.c_int) if o.boolean else pointer
+                                                  for o in function.outputs]
+            symbol.argtypes = [pointer] * len(function.arguments) + outputs + extra
             symbol.restype = scalar if function.scalar else None
 
     def evaluate(self, name: str, q: np.ndarray, parameters: dict[str, float] | None = None) -> np.ndarray:

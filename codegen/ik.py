@@ -337,6 +337,7 @@ def _three_parallel_branches(sp: Subproblems, k: dict, target, form: ClosedForm,
     for t1 in sp.sp4(sp.sub(wc, k["p1"]), h, k["h1"], k["reach"]):
         g = sp.turn(k["h1"], t1.angle, h)
         w = sp.add(k["p1"], sp.turn(k["h1"], t1.angle, sp.sub(wc, k["p1"]), back=True))
+        t6 = total = None  # set by the first root of q5
         for j, t5 in enumerate(sp.sp4(h, k["h6"], k["h5"], sp.dot(g, a))):
             if j == 1 and form.flip:
                 t6, total = t6.turned_half(), total.turned_half()

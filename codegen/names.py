@@ -67,22 +67,21 @@ GENERATED_IMPORTS = frozenset({"numpy", "casadi", "math"})
 # '_', which no parameter name can).
 GENERATED_NAMES = frozenset("""
     pi sqrt q p T J mu f damping target q0 max_iter tol q_dot mu_dot
-    fk jacobian jacobian_tool task task_jacobian singularity_factors manipulability ik
+    fk jacobian jacobian_tool task task_jacobian singularity_factors manipulability ik ik_branches
     jacobian_det velocity_ik ik_numeric fk_jacobian functions DOF TASK PARAMETERS MAX_IK_SOLUTIONS
     IK_NUMERIC_CONVERGED IK_NUMERIC_ITERATION_LIMIT IK_NUMERIC_STALLED VELOCITY_IK_RCOND
     A Jt b d w x angles batch cost error identity least most ok revolute singular_values solutions step
-    trial trial_J trial_cost trial_error
-    centre count g h k reach shoulder tool_point tool_position tool_rotation tool_x v wrist yaw0 wrist_flip
+    trial trial_J trial_cost trial_error branches count valid i j EPS TINY
 """.split())
-# Temporaries t0.., trig terms c1.. s1.., joint variables q1.., the closed-form IK's axes h1..,
-# points p1.., unit vectors k1.. v6 and signs; names starting with '_'; <math.h>'s M_PI, FP_NAN...
-_GENERATED_PATTERN = re.compile(r"^(?:[tcsqhkpv]\d+(?:_\d+)*|sign\w*|_.*|M_\w+|FP_\w+)$")
+# Temporaries t0.., trig terms c1.. s1.., joint variables q1.., the entries of an ik target
+# T00.. and mu0..; names starting with '_'; <math.h>'s M_PI, FP_NAN...
+_GENERATED_PATTERN = re.compile(r"^(?:[tcsqT]\d+(?:_\d+)*|mu\d+|_.*|M_\w+|FP_\w+)$")
 
 ROBOT_NAME_RULE = ("a robot name may not be a C or Python keyword, a C standard header or a "
                    "Python module name, since it names the generated files and modules")
 PARAMETER_NAME_RULE = ("parameter names may not be C, C++ or Python keywords, Python builtins, "
                        "<math.h> names, names the generated code uses (q, p, fk, t0, c1, s1, q1, "
-                       "h1, k1, p1, v1, see codegen/names.py), start with '_' or with the robot's "
+                       "T00, mu0, see codegen/names.py), start with '_' or with the robot's "
                        "name and '_'")
 
 

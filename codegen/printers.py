@@ -116,15 +116,6 @@ class CPrinter(C99CodePrinter):
     def doprint(self, expr, assign_to=None):
         return super().doprint(expand_integer_powers(fold_constants(expr.xreplace(TOLERANCES[self.real]))), assign_to)
 
-    def _print_Piecewise(self, expr):
-        """`(condition ? value : otherwise)` on one line."""
-        (value, condition), *rest = expr.args
-        otherwise = rest[0][0] if len(rest) == 1 and rest[0][1] == sympy.true else sympy.Piecewise(*rest)
-        return f"({self._print(condition)} ? {self._print(value)} : {self._print(otherwise)})"
-
-    def _print_IsFinite(self, expr):
-        return f"isfinite({self._print(expr.args[0])})"
-
     def _print_BooleanTrue(self, expr):
         return "1"
 

@@ -14,6 +14,10 @@ ROBOT_NAMES = [path.stem for path in ROBOT_FILES]
 GENERATED = ROOT / "generated"
 
 
+def pytest_addoption(parser):
+    parser.addoption("--update", action="store_true", help="tests/test_golden.py: rewrite generated/ instead of comparing")
+
+
 def robot(name: str):
     return load_robot(ROOT / "robots" / f"{name}.yaml")
 

@@ -113,7 +113,7 @@ def test_keywords_as_names_generate_correct_code(tmp_path):
     ("numpy", "is used by the generated code"), ("q", "is used by the generated code"),
     ("p", "is used by the generated code"), ("t0", "is used by the generated code"),
     ("c1", "is used by the generated code"), ("s2", "is used by the generated code"),
-    ("c10_11", "is used by the generated code"), ("h1", "is used by the generated code"),
+    ("c10_11", "is used by the generated code"), ("T03", "is used by the generated code"), ("mu0", "is used by the generated code"),
     ("q3", "is used by the generated code"), ("fk", "is used by the generated code"),
     ("solutions", "is used by the generated code"), ("M_PI", "is used by the generated code"),
     ("_x", "is used by the generated code"),

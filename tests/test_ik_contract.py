@@ -1,0 +1,196 @@
+"""One behaviour for the closed-form ik: a table of cases, each run on every backend with
+the same expectations (C double through ctypes, numpy one target at a time, numpy over a
+batch, CasADi). Targets and checks come from codegen.reference, never from a backend.
+
+Every backend is a function `solve(targets) -> [solutions (k, n) per target]`.
+"""
+
+import functools
+
+import numpy as np
+import pytest
+
+from codegen import reference
+from codegen.compile import CLibrary, compile_shared
+from codegen.render import render_robot, write_files
+
+from conftest import import_file, random_configurations, robot
+
+ROBOTS = ["puma560", "ur5", "stanford", "rexarm", "planar_3r", "scara"]
+BACKENDS = ["c", "numpy", "numpy_batch", "casadi"]
+TOLERANCE = 1e-9
+
+
+@pytest.fixture(scope="module")
+def backends(tmp_path_factory):
+    """name -> {backend: solve}, each robot generated and compiled once."""
+    folder = tmp_path_factory.mktemp("contract")
+
+    @functools.cache
+    def load(name):
+        arm = robot(name)
+        write_files(render_robot(arm, ("c", "python", "casadi")), folder)
+        numpy_module = import_file(folder / name / f"{name}.py", f"contract_{name}")
+        casadi_module = import_file(folder / name / f"{name}_casadi.py", f"contract_{name}_casadi")
+        library = CLibrary(compile_shared([folder / name / f"{name}.c"], folder / name / f"lib{name}.so"), arm, [],
+                           "double")
+
+        def batch(targets):
+            q, valid = numpy_module.ik(np.asarray(targets)[None])  # a batch of one batch
+            return [rows[mask] for rows, mask in zip(q[0], valid[0])]
+
+        def casadi(targets):
+            found = []
+            for target in targets:
+                q, valid = casadi_module.ik(target if target.ndim == 2 else target[:, None])
+                found.append(np.asarray(q)[np.asarray(valid).ravel() == 1])
+            return found
+
+        return arm, {
+            "c": lambda targets: [library.ik(t, max_solutions=numpy_module.MAX_IK_SOLUTIONS) for t in targets],
+            "numpy": lambda targets: [numpy_module.ik(t) for t in targets],
+            "numpy_batch": batch,
+            "casadi": casadi,
+        }
+
+    return load
+
+
+def _targets(arm, q):
+    """The reference's pose (6-component tasks) or task vector of each row of q."""
+    single = reference.fk if len(arm.task) == 6 else reference.task
+    return np.array([single(arm, row) for row in np.atleast_2d(q)])
+
+
+def _target_errors(arm, solutions, target):
+    reached = _targets(arm, solutions)
+    difference = np.abs(reached - target)
+    if len(arm.task) < 6:
+        angles = [i for i, name in enumerate(arm.task) if name in ("roll", "pitch", "yaw")]
+        difference[..., angles] = np.abs((difference[..., angles] + np.pi) % (2 * np.pi) - np.pi)
+    return difference.reshape(len(difference), -1).max(axis=1)
+
+
+def _wrapped_distance(arm, a, b):
+    difference = np.abs(np.asarray(a) - b)
+    revolute = [joint.revolute for joint in arm.joints]
+    difference[..., revolute] = np.abs((difference[..., revolute] + np.pi) % (2 * np.pi) - np.pi)
+    return difference.max(axis=-1)
+
+
+def _check_solutions(arm, solutions, target, count=None, original=None):
+    """Every solution finite, revolute angles in (-pi, pi], reaching the target to 1e-9,
+    distinct; the expected count; the original configuration among them."""
+    assert np.all(np.isfinite(solutions)), solutions
+    if count is not None:
+        assert len(solutions) == count, (arm.name, len(solutions), count)
+    if len(solutions):
+        revolute = solutions[:, [joint.revolute for joint in arm.joints]]
+        assert np.all((revolute > -np.pi) & (revolute <= np.pi))
+        assert _target_errors(arm, solutions, target).max() < TOLERANCE
+        distances = [_wrapped_distance(arm, a, b) for i, a in enumerate(solutions) for b in solutions[i + 1:]]
+        assert min(distances, default=1.0) > 1e-6
+    if original is not None:
+        assert len(solutions) and _wrapped_distance(arm, solutions, original).min() < 1e-7
+
+
+def _regular(arm, q):
+    jacobian = reference.jacobian if len(arm.task) == 6 else reference.task_jacobian
+    return np.linalg.svd(jacobian(arm, q), compute_uv=False).min() > 1e-3
+
+
+@pytest.mark.parametrize("backend", BACKENDS)
+@pytest.mark.parametrize("name", ROBOTS)
+def test_round_trips(backends, name, backend):
+    """Random configurations inside the limits: the target of each is reached by every
+    solution, and the configuration itself is among them where the arm is regular."""
+    arm, solvers = backends(name)
+    q = random_configurations(arm, 60, seed=21)
+    targets = _targets(arm, q)
+    for row, target, solutions in zip(q, targets, solvers[backend](targets)):
+        _check_solutions(arm, solutions, target, original=row if _regular(arm, row) else None)
+
+
+@pytest.mark.parametrize("backend", BACKENDS)
+@pytest.mark.parametrize("name", ROBOTS)
+def test_not_finite_and_out_of_reach(backends, name, backend):
+    """NaN or inf anywhere in the entries read, or a target beyond reach: no solution."""
+    arm, solvers = backends(name)
+    target = _targets(arm, random_configurations(arm, 1, seed=22))[0]
+    cases = []
+    for k in range(3 * 4 if len(arm.task) == 6 else len(arm.task)):
+        for bad in (np.nan, np.inf, -np.inf):
+            broken = target.copy()
+            broken.flat[k] = bad
+            cases.append(broken)
+    if name != "stanford":  # its prismatic joint has no limit: unbounded reach
+        far = target.copy()
+        if len(arm.task) == 6:
+            far[:3, 3] += 10.0
+        else:
+            far[:2] += 10.0
+        cases.append(far)
+    if name == "rexarm":
+        cases.append(np.array([0.2, 0.0, 0.1, 2.0]))  # pitch beyond 90 degrees
+    for case, solutions in zip(cases, solvers[backend](np.array(cases))):
+        assert solutions.shape == (0, arm.dof), (case, solutions)
+
+
+# Targets on singularities: (robot, configuration, solutions expected). A double root is
+# returned once and an angle the target leaves free is 0.
+SINGULAR = {
+    "wrist (puma q5 = 0): 3 regular arm branches x 2 + 1": ("puma560", [0.3, 0.5, -0.4, 0.6, 0.0, -0.2], 7),
+    "elbow stretched (puma): 2 shoulders x 1 elbow x 2 wrists": (
+        "puma560", [0.3, 0.5, np.arctan2(0.0203, 0.4318) - np.pi / 2, 0.6, 0.4, -0.2], 4),
+    "wrist (ur5 q5 = 0)": ("ur5", [0.3, -1.0, 1.2, 0.4, 0.0, 0.7], 6),
+    "stretched planar arm": ("planar_3r", [0.3, 0.0, 1.0], 1),
+}
+
+
+@pytest.mark.parametrize("backend", BACKENDS)
+@pytest.mark.parametrize("case", SINGULAR)
+def test_singular_targets(backends, case, backend):
+    name, q, count = SINGULAR[case]
+    arm, solvers = backends(name)
+    target = _targets(arm, np.array(q))[0]
+    _check_solutions(arm, solvers[backend]([target])[0], target, count=count)
+
+
+def _puma_on_shoulder_singularity():
+    """Puma with its wrist centre (origin of the frame of joint 5) in the plane of axes 1 and
+    2 (q1 is then a double root): q2 by bisection on the centre's signed distance from that
+    plane, measured with the reference's frames."""
+    arm = robot("puma560")
+
+    def distance(q2):
+        axes, _ = reference.frames(arm, np.array([0.2, q2, -0.4, 0.6, 0.5, -0.2]))
+        normal = np.cross(axes[0][:3, 2], axes[1][:3, 2])
+        return np.dot(axes[4][:3, 3] - axes[0][:3, 3], normal)
+
+    grid = np.linspace(-np.pi, np.pi, 73)
+    k = next(i for i in range(len(grid) - 1) if distance(grid[i]) * distance(grid[i + 1]) < 0)
+    low, high = grid[k], grid[k + 1]
+    for _ in range(100):
+        mid = 0.5 * (low + high)
+        low, high = (mid, high) if distance(mid) * distance(low) > 0 else (low, mid)
+    assert abs(distance(low)) < 1e-12
+    return arm, np.array([0.2, low, -0.4, 0.6, 0.5, -0.2])
+
+
+@pytest.mark.parametrize("backend", BACKENDS)
+def test_shoulder_singularity(backends, backend):
+    """The two shoulder branches meet: 1 x 2 elbows x 2 wrists, all reaching the target."""
+    arm, q = _puma_on_shoulder_singularity()
+    target = _targets(arm, q)[0]
+    _check_solutions(arm, backends("puma560")[1][backend]([target])[0], target, count=4, original=q)
+
+
+def test_batched_numpy_finds_the_c_solution_sets(backends):
+    """10^5 ur5 poses: batched numpy and C return the same solutions in the same order."""
+    arm, solvers = backends("ur5")
+    q = random_configurations(arm, 100_000, seed=23)
+    targets = _targets(arm, q)
+    batch, c = solvers["numpy_batch"](targets), solvers["c"](targets)
+    assert sum(map(len, batch)) > 4 * len(q)
+    for ours, theirs in zip(batch, c):
+        assert ours.shape == theirs.shape and (not len(ours) or np.abs(ours - theirs).max() < 1e-9)
