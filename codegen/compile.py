@@ -68,10 +68,10 @@ class CLibrary:
             extra = [ctypes.POINTER(self._parameters)]
         for function in functions:
             symbol = getattr(self._library, f"{robot.name}_{function.name}")
-            outputs = [] if function.scalar else [ctypes.POINTER(ctypes.c_int) if o.boolean else pointer
-                                                  for o in function.outputs]
-            symbol.argtypes = [pointer] * len(function.arguments) + outputs + extra
-            symbol.restype = scalar if function.scalar else None
+            returned = function.returned
+            outputs = [ctypes.POINTER(ctypes.c_int) if o.boolean else pointer for o in function.outputs if o is not returned]
+            symbol.argtypes = [scalar if a.scalar else pointer for a in function.arguments] + outputs + extra
+            symbol.restype = None if returned is None else ctypes.c_int if returned.integer else scalar
 
     def evaluate(self, name: str, q: np.ndarray, parameters: dict[str, float] | None = None) -> np.ndarray:
         """Function `name` at each row of q (k, dof): results (k, size), each output row-major
@@ -110,6 +110,17 @@ class CLibrary:
                                                                  solutions.ctypes.data_as(pointer),
                                                                  *self._extra(parameters))
         return solutions[: count * self.robot.dof].reshape(count, self.robot.dof).astype(np.float64)
+
+    def velocity_ik(self, q: np.ndarray, mu_dot: np.ndarray, damping: float) -> tuple[np.ndarray, int]:
+        """`NAME_velocity_ik`: (q_dot, status)."""
+        pointer = ctypes.POINTER(C_TYPES[self.real])
+        q = np.ascontiguousarray(q, dtype=self.dtype)
+        mu_dot = np.ascontiguousarray(mu_dot, dtype=self.dtype)
+        q_dot = np.zeros(self.robot.dof, dtype=self.dtype)
+        status = getattr(self._library, f"{self.robot.name}_velocity_ik")(
+            q.ctypes.data_as(pointer), mu_dot.ctypes.data_as(pointer), C_TYPES[self.real](damping),
+            q_dot.ctypes.data_as(pointer), *self._extra())
+        return q_dot.astype(np.float64), int(status)
 
     def ik_numeric(self, target: np.ndarray, q0: np.ndarray, max_iter: int = 100,
                    tol: float = 1e-10) -> tuple[np.ndarray, int]:

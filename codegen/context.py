@@ -5,10 +5,11 @@ import math
 
 import sympy
 
-from . import analysis, ik, report
+from . import analysis, differential, ik, report
 from .functions import Function, Generator, Output, is_boolean
 from .printers import CasadiPrinter, CPrinter, PythonPrinter, fold_constants
 from .robot import Robot
+from .subproblems import RANK, TOLERANCES
 
 # The contract's C array extent of each argument and output (`function.output`, or the function
 # when it has one), as factors that are numbers or the suffixes of size macros
@@ -19,6 +20,8 @@ C_EXTENTS = {
     "mu": ("TASK_DIM",),
     "ik_branches.q": ("MAX_IK_SOLUTIONS", "DOF"),
     "ik_branches.valid": ("MAX_IK_SOLUTIONS",),
+    "mu_dot": ("TASK_DIM",),
+    "velocity_ik.q_dot": ("DOF",),
     "fk": (16,),
     "jacobian": (6, "DOF"),
     "jacobian_tool": (6, "DOF"),
@@ -44,12 +47,15 @@ def _common(robot: Robot) -> dict:
 
 def _python_function(function: Function, printer: PythonPrinter, parameters: list[dict]) -> dict:
     body = function.body
-    shapes = [a.symbols.shape[:1] if a.vector else a.symbols.shape for a in function.arguments]
+    shapes = [() if a.scalar else a.symbols.shape[:1] if a.vector else a.symbols.shape for a in function.arguments]
+    batches = [f"{a.name}.shape[:-{len(shape)}]" if shape else f"{a.name}.shape"
+               for a, shape in zip(function.arguments, shapes)]
     results = []
     for output, values in function.parts(body.outputs):
         indices = [", ".join(["..."] + [str(i) for i in divmod(k, output.cols)[: len(output.shape)]])
                    for k in range(output.size)]
-        results.append({"name": output.name, "shape": repr(output.shape), "dtype": "bool" if output.boolean else "float",
+        dtype = "bool" if output.boolean else "int" if output.integer else "float"
+        results.append({"name": output.name, "shape": repr(output.shape), "dtype": dtype,
                         "values": [(index, printer.doprint(e)) for index, e in zip(indices, values)]})
     return {
         "name": function.name,
@@ -57,11 +63,10 @@ def _python_function(function: Function, printer: PythonPrinter, parameters: lis
         "shape": " and ".join(" x ".join(map(str, (o.rows, o.cols))) for o in function.outputs),
         "operations": body.operation_count,
         "arguments": [(a.name, repr(shape)) for a, shape in zip(function.arguments, shapes)],
-        "signature": ", ".join([a.name for a in function.arguments] + ["*"] * bool(parameters)
+        "signature": ", ".join([f"{a.name}=0.0" if a.scalar else a.name for a in function.arguments] + ["*"] * bool(parameters)
                                + [f"{p['name']}={p['value']}" for p in parameters]),
-        "batch": f"{function.arguments[0].name}.shape[:-{len(shapes[0])}]",
-        "selects": any(isinstance(e, sympy.Piecewise) or e.has(sympy.Piecewise)
-                       for e in [v for _, v in body.definitions] + list(body.outputs)),
+        "batch": batches[0] if len(batches) == 1 else f"numpy.broadcast_shapes({', '.join(batches)})",
+        "selects": any(e.has(sympy.Piecewise) for e in [v for _, v in body.definitions] + list(body.outputs)),
         "inputs": [(str(symbol), f"{argument.name}[..., {row}]" if argument.vector else f"{argument.name}[..., {row}, {col}]")
                    for symbol, argument, row, col in function.inputs],
         "definitions": [(str(symbol), printer.doprint(e)) for symbol, e in body.definitions],
@@ -111,33 +116,39 @@ def _parameters_read(body, robot: Robot) -> list[str]:
     return [p.name for p in robot.symbolic_parameters if p.symbol in read]
 
 
+def _c_type(output: Output, real: str) -> str:
+    return "int" if output.boolean or output.integer else real
+
+
 def _c_function(function: Function, robot: Robot, printer: CPrinter, macros: dict[str, int]) -> dict:
     body, prefix, real = function.body, robot.name.upper(), f"{robot.name}_real"
-    arguments = [f"const {real} {a.name}[{_c_extent(a.name, a.size, macros, prefix)}]" for a in function.arguments]
-    if not function.scalar:
-        arguments += [f"{'int' if o.boolean else real} {o.name}[{_c_extent(_c_output_key(function, o), o.size, macros, prefix)}]"
-                      for o in function.outputs]
+    arguments = [f"{real} {a.name}" if a.scalar else f"const {real} {a.name}[{_c_extent(a.name, a.size, macros, prefix)}]"
+                 for a in function.arguments]
+    returned = function.returned
+    arrays = [o for o in function.outputs if o is not returned]
+    arguments += [f"{_c_type(o, real)} {o.name}[{_c_extent(_c_output_key(function, o), o.size, macros, prefix)}]"
+                  for o in arrays]
     parameters = _parameters_read(body, robot)
     if robot.symbolic_parameters:
         arguments.append(f"const {robot.name}_params *p")
     inputs = list(function.inputs)
-    unused = [a.name for a in function.arguments if not any(argument is a for _, argument, _, _ in inputs)]
+    unused = [a.name for a in function.arguments
+              if not any(argument is a for _, argument, _, _ in inputs) and not (a.scalar and a.symbols[0] in body.read)]
     unused += ["p"] * bool(robot.symbolic_parameters and not parameters)
-    returns = real if function.scalar else "void"
+    values = dict(function.parts(body.outputs))
     return {
         "name": function.name,
         "summary": _sentence(function.summary),
         "layouts": [_layout(output) for output in function.outputs],
         "operations": body.operation_count,
-        "prototype": f"{returns} {robot.name}_{function.name}({', '.join(arguments)})",
+        "prototype": f"{_c_type(returned, real) if returned else 'void'} {robot.name}_{function.name}({', '.join(arguments)})",
         "unused": unused,
         "inputs": [(str(symbol), f"{argument.name}[{row * argument.symbols.cols + col}]")
                    for symbol, argument, row, col in inputs] + [(name, f"p->{name}") for name in parameters],
         "definitions": [("int" if is_boolean(e) else real, str(symbol), printer.doprint(e)) for symbol, e in body.definitions],
-        "outputs": [] if function.scalar else [(f"{output.name}[{k}]", printer.doprint(e))
-                                               for output, values in function.parts(body.outputs)
-                                               for k, e in enumerate(values)],
-        "result": printer.doprint(body.outputs[0]) if function.scalar else None,
+        "outputs": [(f"{output.name}[{k}]", printer.doprint(e)) for output in arrays
+                    for k, e in enumerate(values[output])],
+        "result": printer.doprint(values[returned][0]) if returned else None,
     }
 
 
@@ -271,44 +282,21 @@ def _ik_math(robot: Robot, real: str) -> dict:
     }
 
 
-# velocity_ik: the system counts as singular below this reciprocal condition number (Python)
-# or relative pivot (C, LU with partial pivoting).
-VELOCITY_IK_TOLERANCE = {"double": 1e-12, "float": 1e-5}
-
-
 def _velocity_ik_context(robot: Robot, real: str) -> dict:
-    """velocity_ik's partial: which generated Jacobian gives Js, the system's shape."""
+    """What the documentation of velocity_ik says: Js, mu_dot, the system and its statuses."""
     m, n = len(robot.task), robot.dof
     rows = analysis.singularity_rows(robot)
     names = ", ".join(("vx", "vy", "vz", "wx", "wy", "wz")[r] for r in rows) if rows is not None else ""
     return {
-        "m": m,
-        "form": "square" if m == n else ("wide" if m < n else "tall"),
         "system": min(m, n),
-        "source": "task_jacobian" if rows is None else "jacobian",
-        "rows": list(rows) if rows is not None else list(range(m)),
-        "row_index": "" if rows is None or list(rows) == list(range(6)) else f"[..., {list(rows)}, :]",
         "js_text": "the task Jacobian" if rows is None else
         ("the geometric Jacobian" if len(rows) == 6 and list(rows) == list(range(6))
          else f"rows ({names}) of the geometric Jacobian"),
         "mu_text": f"({names}): components of the tool's linear (v) and angular (w) velocity in the world frame"
         if rows is not None else f"the rate of the task vector ({', '.join(robot.task)})",
-        "tolerance": repr(VELOCITY_IK_TOLERANCE[real]),
-    }
-
-
-def _velocity_ik_c_context(robot: Robot, real: str) -> dict:
-    """The C partial of velocity_ik: its prototype, Jacobian buffer and literals."""
-    context, prefix, real_type = _velocity_ik_context(robot, real), robot.name.upper(), f"{robot.name}_real"
-    arguments = [f"const {real_type} q[{prefix}_DOF]", f"const {real_type} mu_dot[{prefix}_TASK_DIM]",
-                 f"{real_type} damping", f"{real_type} q_dot[{prefix}_DOF]"]
-    arguments += [f"const {robot.name}_params *p"] * bool(robot.symbolic_parameters)
-    return {
-        **context,
-        "prototype": f"int {robot.name}_velocity_ik({', '.join(arguments)})",
-        "jacobian_size": f"6 * {prefix}_DOF" if context["source"] == "jacobian" else f"{prefix}_TASK_DIM * {prefix}_DOF",
-        "fabs": "fabsf" if real == "float" else "fabs",
-        "tolerance_literal": CPrinter(real).doprint(sympy.Float(VELOCITY_IK_TOLERANCE[real])),
+        "rank": repr(float(TOLERANCES[real][RANK])),
+        "statuses": [("OK", differential.VELOCITY_IK_OK), ("SINGULAR", differential.VELOCITY_IK_SINGULAR),
+                     ("NOT_FINITE", differential.VELOCITY_IK_NOT_FINITE)],
     }
 
 
@@ -328,7 +316,6 @@ def _report_context(robot: Robot, generator: Generator) -> dict:
         "operations": [{"name": f.name, "operations": f.body.operation_count,
                         "shape": "scalar" if f.scalar else " and ".join(f"{o.rows} x {o.cols}" for o in f.outputs)}
                        for f in generator.functions()],
-        "velocity_ik": _velocity_ik_context(robot, "double"),
     }
 
 
@@ -346,7 +333,7 @@ def template_context(robot: Robot, generator: Generator, language: str, real: st
         context["ik"] = _ik_context(robot, generator, language, real)
         context["ik_numeric"] = _ik_numeric_context(robot, language, real)
         context["ik_math"] = _ik_math(robot, real)
-        context["velocity_ik"] = _velocity_ik_c_context(robot, real)
+        context["velocity_ik"] = _velocity_ik_context(robot, real)
     elif language == "report":
         context.update(_report_context(robot, generator))
     elif language == "casadi":
@@ -354,6 +341,6 @@ def template_context(robot: Robot, generator: Generator, language: str, real: st
         functions = generator.functions()
         context["functions"] = [_casadi_function(f, robot, printer) for f in functions]
         context["arguments"] = sorted({(a.name, a.symbols.rows, a.symbols.cols) for f in functions for a in f.arguments},
-                                      key=lambda a: ("q", "T", "mu").index(a[0]))
+                                      key=lambda a: ("q", "mu_dot", "damping", "T", "mu").index(a[0]))
         context["ik"] = generator.closed_form is not None
     return dict(sorted(context.items()))

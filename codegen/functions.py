@@ -15,7 +15,7 @@ import sympy
 from sympy.core.parameters import distribute
 from sympy.logic.boolalg import Boolean
 
-from . import analysis, budget, ik, kinematics
+from . import analysis, budget, differential, ik, kinematics
 from .subproblems import Subproblems
 from .printers import fold_constants
 from .robot import Robot
@@ -46,6 +46,7 @@ class Argument:
     name: str
     symbols: sympy.Matrix
     vector: bool = True  # numpy shape (..., rows); else (..., rows, cols)
+    scalar: bool = False  # one number: by value in C, shape (...) in numpy, its symbol named as the argument
 
     @property
     def size(self) -> int:
@@ -63,6 +64,7 @@ class Output:
     vector: bool = False  # a column vector: numpy shape (rows,), even for one row
     equals: str = ""  # the function whose result this is, when the function fuses several
     boolean: bool = False  # truth values
+    integer: bool = False  # a status: an int in C and numpy
 
     @property
     def size(self) -> int:
@@ -91,13 +93,18 @@ class Function:
         """(symbol, argument, row, col) of every input the body reads, in argument order."""
         for argument in self.arguments:
             for k, symbol in enumerate(argument.symbols):
-                if symbol in self.body.read:
+                if symbol in self.body.read and not argument.scalar:
                     yield (symbol, argument, *divmod(k, argument.symbols.cols))
 
     @property
     def scalar(self) -> bool:
         """Returns its one result by value."""
-        return self.outputs[0].scalar
+        return len(self.outputs) == 1 and self.outputs[0].scalar
+
+    @property
+    def returned(self) -> Output | None:
+        """The result C returns by value (a scalar), the others being arrays."""
+        return next((output for output in self.outputs if output.scalar), None)
 
     def parts(self, values: tuple[sympy.Expr, ...]):
         """The body's outputs split per output: (Output, its values row-major)."""
@@ -155,6 +162,19 @@ class Generator:
             q, valid = ik.branches(self.robot, form, Subproblems(self.name), target.symbols)
         return [self.function("ik_branches", "every branch of the closed-form ik and whether the target allows it",
                               ("q", q), ("valid", valid), arguments=(target,))]
+
+    def velocity_ik_function(self, js: sympy.Matrix) -> Function:
+        """velocity_ik: q_dot solving Js q_dot = mu_dot, and the status (`differential`)."""
+        m, n = js.shape
+        mu_dot = Argument("mu_dot", sympy.Matrix([sympy.Symbol(f"mu_dot{i}", real=True) for i in range(m)]))
+        damping = Argument("damping", sympy.Matrix([sympy.Symbol("damping", real=True)]), scalar=True)
+        with distribute(False):
+            q_dot, status = differential.velocity_ik(js, list(self.q), list(mu_dot.symbols), damping.symbols[0], self.name)
+        form = "Js^-1 mu_dot (damping 0) or " if m == n else ""
+        form += ("Js^T (Js Js^T + damping^2 I)^-1 mu_dot" if m <= n else "(Js^T Js + damping^2 I)^-1 Js^T mu_dot")
+        return self.function("velocity_ik", f"joint rates q_dot solving Js q_dot = mu_dot: {form}; and the status",
+                             ("q_dot", sympy.Matrix(q_dot)), ("status", sympy.Matrix([status])), vector=True,
+                             status="status", arguments=(Argument("q", sympy.Matrix(self.q)), mu_dot, damping))
 
     @cached_property
     def jacobian(self) -> sympy.Matrix:
@@ -226,14 +246,16 @@ class Generator:
 
     def function(self, name: str, summary: str, *results: tuple[str, sympy.Matrix | list], scalar: bool = False,
                  vector: bool = False, equals: tuple[str, ...] = (),
-                 arguments: tuple[Argument, ...] | None = None) -> Function:
+                 arguments: tuple[Argument, ...] | None = None, status: str = "") -> Function:
         """A function of one or more named results (matrices, or lists of truth values as
-        columns), lowered together so they share their terms; its arguments are q unless given."""
+        columns), lowered together so they share their terms; its arguments are q unless
+        given. The result named `status` is an integer scalar."""
         outputs, values = [], []
         for (output, result), equal in zip(results, equals or ("",) * len(results)):
             rows, cols = result.shape if isinstance(result, sympy.Matrix) else (len(result), 1)
             boolean = all(map(is_boolean, result))
-            outputs.append(Output(output, rows, cols, scalar, vector or boolean, equal, boolean))
+            integer = output == status
+            outputs.append(Output(output, rows, cols, scalar or integer, vector or boolean, equal, boolean, integer))
             values += list(result)
         return Function(name, summary, tuple(outputs), self.lower(values),
                         arguments or (Argument("q", sympy.Matrix(self.q)),))
@@ -289,6 +311,7 @@ class Generator:
         robot, m = self.robot, len(self.robot.task)
         pose = self.chain.tool
         task_jacobian = kinematics.task_jacobian(robot, pose, self.jacobian)
+        js = analysis.singularity_jacobian(robot, self.jacobian, task_jacobian)
         return (
             self.function("fk", "pose of the tool frame in the world frame (4x4 homogeneous)", ("T", pose)),
             self.function("jacobian", "geometric Jacobian in the world frame (6 x DOF, rows vx vy vz wx wy wz)",
@@ -300,7 +323,8 @@ class Generator:
             self.function("task", f"task vector mu = ({', '.join(robot.task)})",
                           ("mu", kinematics.task_vector(robot, pose)), vector=True),
             self.function("task_jacobian", f"analytic Jacobian d mu / d q ({m} x DOF)", ("J", task_jacobian)),
-            *self.singularity_functions(analysis.singularity_jacobian(robot, self.jacobian, task_jacobian)),
+            *self.singularity_functions(js),
+            self.velocity_ik_function(js),
             *self.ik_functions(),
         )
 

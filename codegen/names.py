@@ -69,13 +69,14 @@ GENERATED_NAMES = frozenset("""
     pi sqrt q p T J mu f damping target q0 max_iter tol q_dot mu_dot
     fk jacobian jacobian_tool task task_jacobian singularity_factors manipulability ik ik_branches
     jacobian_det velocity_ik ik_numeric fk_jacobian functions DOF TASK PARAMETERS MAX_IK_SOLUTIONS
-    IK_NUMERIC_CONVERGED IK_NUMERIC_ITERATION_LIMIT IK_NUMERIC_STALLED VELOCITY_IK_RCOND
+    IK_NUMERIC_CONVERGED IK_NUMERIC_ITERATION_LIMIT IK_NUMERIC_STALLED VELOCITY_IK_OK VELOCITY_IK_SINGULAR
+    VELOCITY_IK_NOT_FINITE status
     A Jt b d w x angles batch cost error identity least most ok revolute singular_values solutions step
     trial trial_J trial_cost trial_error branches count valid i j EPS TINY
 """.split())
 # Temporaries t0.., trig terms c1.. s1.., joint variables q1.., the entries of an ik target
 # T00.. and mu0..; names starting with '_'; <math.h>'s M_PI, FP_NAN...
-_GENERATED_PATTERN = re.compile(r"^(?:[tcsqT]\d+(?:_\d+)*|mu\d+|_.*|M_\w+|FP_\w+)$")
+_GENERATED_PATTERN = re.compile(r"^(?:[tcsqT]\d+(?:_\d+)*|mu(?:_dot)?\d+|_.*|M_\w+|FP_\w+)$")
 
 ROBOT_NAME_RULE = ("a robot name may not be a C or Python keyword, a C standard header or a "
                    "Python module name, since it names the generated files and modules")

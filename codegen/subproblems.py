@@ -23,9 +23,10 @@ import sympy
 from sympy.logic.boolalg import BooleanFunction
 
 EPS, TINY = sympy.symbols("EPS TINY", positive=True)
+RANK = sympy.Symbol("RANK", positive=True)  # velocity_ik's singularity threshold (see `differential`)
 # Their values by real type, replaced by the printers.
-TOLERANCES = {"double": {EPS: sympy.Float(1e-12), TINY: sympy.Float(1e-24)},
-              "float": {EPS: sympy.Float(1e-6), TINY: sympy.Float(1e-12)}}
+TOLERANCES = {"double": {EPS: sympy.Float(1e-12), TINY: sympy.Float(1e-24), RANK: sympy.Float(1e-12)},
+              "float": {EPS: sympy.Float(1e-6), TINY: sympy.Float(1e-12), RANK: sympy.Float(1e-5)}}
 
 Vector = tuple[sympy.Expr, sympy.Expr, sympy.Expr]
 

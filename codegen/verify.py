@@ -159,6 +159,20 @@ class _Backends:
         return self.c[backend.split()[1]].evaluate(name, q)
 
 
+    def velocity_ik(self, backend: str, q: np.ndarray, mu_dot: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """velocity_ik without damping at each row of q and mu_dot: (q_dot (k, dof), status (k,))."""
+        nominal = {p.name: p.value for p in self.robot.symbolic_parameters}
+        if backend == "python":
+            return self.python.velocity_ik(q, mu_dot, **nominal)
+        if backend == "casadi":
+            extra = [list(self.casadi.PARAMETERS.values())] if nominal else []
+            rows = [self.casadi.velocity_ik(x, rates, 0.0, *extra) for x, rates in zip(q, mu_dot)]
+            return (np.array([q_dot.full().ravel() for q_dot, _ in rows]).reshape(len(q), -1),
+                    np.array([float(status) for _, status in rows]))
+        rows = [self.c[backend.split()[1]].velocity_ik(x, rates, 0.0) for x, rates in zip(q, mu_dot)]
+        return np.array([q_dot for q_dot, _ in rows]).reshape(len(q), -1), np.array([status for _, status in rows])
+
+
 def _side_by_side(results, count: int) -> np.ndarray:
     """One result array, or a tuple of them (a fused function), as (count, size)."""
     parts = results if isinstance(results, tuple) else (results,)
@@ -207,7 +221,7 @@ def verify_robot(robot: Robot, backends: _Backends, functions: list[Function], q
     tolerances["c float"] = FLOAT_TOLERANCE * (1 + reach(robot))
     results = []
     ranks = _rank_ratios(robot, q)
-    for function in [f for f in functions if f.arguments[0].name == "q"]:  # ik_branches: by round trip below
+    for function in [f for f in functions if [a.name for a in f.arguments] == ["q"]]:  # the IK: below
         if function.name == "singularity_factors":
             errors = {backend: _vanishing_error(backends.evaluate(backend, function.name, q), ranks)
                       for backend in BACKENDS}
@@ -228,8 +242,10 @@ def verify_robot(robot: Robot, backends: _Backends, functions: list[Function], q
         results.append(Result(robot.name, function.name, errors, tolerances, note))
     regular = ranks > REGULAR_RANK
     results += _ik_results(robot, backends, q[:random_count], tolerances)
-    residual = _velocity_ik_residual(robot, backends.python, q[regular])
-    results.append(Result(robot.name, "velocity_ik", {"python": residual} | dict.fromkeys(BACKENDS[1:]), tolerances,
+    mu_dot = np.random.default_rng(0).normal(size=(int(regular.sum()), len(robot.task)))
+    residuals = {backend: _velocity_ik_residual(robot, backends.velocity_ik(backend, q[regular], mu_dot), q[regular], mu_dot)
+                 for backend in BACKENDS}
+    results.append(Result(robot.name, "velocity_ik", residuals, tolerances,
                           ("|Js^T (Js q_dot - mu_dot)| / |Js| (|Js| |q_dot| + |mu_dot|)" if len(robot.task) > robot.dof
                            else "|Js q_dot - mu_dot| / (|Js| |q_dot| + |mu_dot|)")
                           + f" at the {int(regular.sum())} samples where Js is regular"))
@@ -324,24 +340,24 @@ def _casadi_ik(module, nominal: dict, target: np.ndarray) -> np.ndarray:
     """The CasADi ik's valid branches, (k, dof)."""
     extra = [list(module.PARAMETERS.values())] if nominal else []
     q, valid = module.ik(target if target.ndim == 2 else target[:, None], *extra)
-    return np.asarray(q)[np.asarray(valid).ravel() == 1]
+    return q.full()[valid.full().ravel() == 1]
 
 
 def _c_ik_numeric(library: CLibrary, real: str, target: np.ndarray, start: np.ndarray) -> tuple[np.ndarray, int]:
     return library.ik_numeric(target, start, 200, 1e-12 if real == "double" else 1e-5)
 
 
-def _velocity_ik_residual(robot: Robot, module, q: np.ndarray) -> float:
-    """Largest backward error of the generated Python velocity_ik, mu_dot random: the residual
+def _velocity_ik_residual(robot: Robot, solved: tuple[np.ndarray, np.ndarray], q: np.ndarray,
+                          mu_dot: np.ndarray) -> float:
+    """Largest backward error of velocity_ik's (q_dot, status) at q for mu_dot: the residual
     |Js q_dot - mu_dot| / (|Js| |q_dot| + |mu_dot|), scaled by what rounding alone leaves so
-    the bound does not depend on how well conditioned Js is. A tall Js (m > n) has no exact
-    solution: there the residual is that of the normal equations, Js^T (Js q_dot - mu_dot)."""
+    the bound does not depend on how well conditioned Js is; a status other than OK is an
+    infinite error. A tall Js (m > n) has no exact solution: there the residual is that of
+    the normal equations, Js^T (Js q_dot - mu_dot)."""
+    q_dot, status = solved
     if not len(q):
         return 0.0
-    mu_dot = np.random.default_rng(0).normal(size=(len(q), len(robot.task)))
-    nominal = {p.name: p.value for p in robot.symbolic_parameters}
-    q_dot, ok = module.velocity_ik(q, mu_dot, **nominal)
-    if not ok.all():
+    if np.any(status != 0):
         return math.inf
     js = np.array([reference.singularity_jacobian(robot, row) for row in q])
     residual = np.einsum("kij,kj->ki", js, q_dot) - mu_dot

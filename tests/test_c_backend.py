@@ -162,7 +162,7 @@ def test_runtime_parameters(tmp_path, real):
     assert "typedef struct {\n    lifted_real height; /* nominal 0.25 */\n    lifted_real shift; /* nominal -0.1 */\n} lifted_params;" in header
     functions = Generator(robot).functions()
     for function in functions:
-        prototype = re.search(rf"^(?:void|lifted_real) lifted_{function.name}\(.*\);$", header, flags=re.MULTILINE)
+        prototype = re.search(rf"^(?:void|int|lifted_real) lifted_{function.name}\(.*\);$", header, flags=re.MULTILINE)
         assert prototype.group().endswith(", const lifted_params *p);")
     write_files(files, tmp_path)
     library = CLibrary(compile_shared([tmp_path / "lifted" / "lifted.c"], tmp_path / "lifted.so"), robot,

@@ -1,8 +1,10 @@
-"""One behaviour for the closed-form ik: a table of cases, each run on every backend with
-the same expectations (C double through ctypes, numpy one target at a time, numpy over a
-batch, CasADi). Targets and checks come from codegen.reference, never from a backend.
+"""One behaviour for the closed-form ik and velocity_ik: tables of cases, each run on every
+backend with the same expectations (C double through ctypes, numpy one target at a time,
+numpy over a batch, CasADi). Targets and checks come from codegen.reference and numpy's
+linear algebra, never from a backend.
 
-Every backend is a function `solve(targets) -> [solutions (k, n) per target]`.
+For ik every backend is a function `solve(targets) -> [solutions (k, n) per target]`; for
+velocity_ik a function `(q, mu_dot, damping) -> (q_dot, status)`.
 """
 
 import functools
@@ -43,14 +45,27 @@ def backends(tmp_path_factory):
             found = []
             for target in targets:
                 q, valid = casadi_module.ik(target if target.ndim == 2 else target[:, None])
-                found.append(np.asarray(q)[np.asarray(valid).ravel() == 1])
+                found.append(q.full()[valid.full().ravel() == 1])
             return found
+
+        def casadi_velocity(q, mu_dot, damping):
+            q_dot, status = casadi_module.velocity_ik(q, mu_dot, damping)
+            return q_dot.full().ravel(), int(status)
+
+        def batch_velocity(q, mu_dot, damping):
+            q_dot, status = numpy_module.velocity_ik(np.asarray(q)[None], np.asarray(mu_dot)[None], damping)
+            return q_dot[0], int(status[0])
 
         return arm, {
             "c": lambda targets: [library.ik(t, max_solutions=numpy_module.MAX_IK_SOLUTIONS) for t in targets],
             "numpy": lambda targets: [numpy_module.ik(t) for t in targets],
             "numpy_batch": batch,
             "casadi": casadi,
+        }, {
+            "c": library.velocity_ik,
+            "numpy": lambda q, mu_dot, damping: tuple(np.asarray(v) for v in numpy_module.velocity_ik(q, mu_dot, damping)),
+            "numpy_batch": batch_velocity,
+            "casadi": casadi_velocity,
         }
 
     return load
@@ -104,7 +119,7 @@ def _regular(arm, q):
 def test_round_trips(backends, name, backend):
     """Random configurations inside the limits: the target of each is reached by every
     solution, and the configuration itself is among them where the arm is regular."""
-    arm, solvers = backends(name)
+    arm, solvers, _ = backends(name)
     q = random_configurations(arm, 60, seed=21)
     targets = _targets(arm, q)
     for row, target, solutions in zip(q, targets, solvers[backend](targets)):
@@ -115,7 +130,7 @@ def test_round_trips(backends, name, backend):
 @pytest.mark.parametrize("name", ROBOTS)
 def test_not_finite_and_out_of_reach(backends, name, backend):
     """NaN or inf anywhere in the entries read, or a target beyond reach: no solution."""
-    arm, solvers = backends(name)
+    arm, solvers, _ = backends(name)
     target = _targets(arm, random_configurations(arm, 1, seed=22))[0]
     cases = []
     for k in range(3 * 4 if len(arm.task) == 6 else len(arm.task)):
@@ -151,7 +166,7 @@ SINGULAR = {
 @pytest.mark.parametrize("case", SINGULAR)
 def test_singular_targets(backends, case, backend):
     name, q, count = SINGULAR[case]
-    arm, solvers = backends(name)
+    arm, solvers, _ = backends(name)
     target = _targets(arm, np.array(q))[0]
     _check_solutions(arm, solvers[backend]([target])[0], target, count=count)
 
@@ -187,10 +202,67 @@ def test_shoulder_singularity(backends, backend):
 
 def test_batched_numpy_finds_the_c_solution_sets(backends):
     """10^5 ur5 poses: batched numpy and C return the same solutions in the same order."""
-    arm, solvers = backends("ur5")
+    arm, solvers, _ = backends("ur5")
     q = random_configurations(arm, 100_000, seed=23)
     targets = _targets(arm, q)
     batch, c = solvers["numpy_batch"](targets), solvers["c"](targets)
     assert sum(map(len, batch)) > 4 * len(q)
     for ours, theirs in zip(batch, c):
         assert ours.shape == theirs.shape and (not len(ours) or np.abs(ours - theirs).max() < 1e-9)
+
+
+# -- velocity_ik ------------------------------------------------------------------------------
+
+
+def _expected_rates(js, mu_dot, damping):
+    """The closed forms of the contract, with numpy."""
+    m, n = js.shape
+    if m == n and damping == 0:
+        return np.linalg.solve(js, mu_dot)
+    if m <= n:
+        return js.T @ np.linalg.solve(js @ js.T + damping**2 * np.eye(m), mu_dot)
+    return np.linalg.solve(js.T @ js + damping**2 * np.eye(n), js.T @ mu_dot)
+
+
+VELOCITY_ROBOTS = ["puma560", "ur5", "rexarm", "planar_2r", "iiwa"]
+# Configurations where Js is singular (checked with the reference's SVD below).
+SINGULAR_JS = {"puma560": [0.1, 0.5, -0.3, 0.2, 0.0, 0.4], "ur5": [0.3, -1.0, 1.2, 0.4, 0.0, 0.7],
+               "planar_2r": [0.4, 0.0], "iiwa": [0.1, 0.5, 0.2, 0.0, 0.3, 0.4, 0.3]}
+
+
+@pytest.mark.parametrize("backend", BACKENDS)
+@pytest.mark.parametrize("name", VELOCITY_ROBOTS)
+def test_velocity_ik_cases(backends, name, backend):
+    """Regular Js with damping 0 and 0.1; singular Js: status 1 and q_dot 0 without damping,
+    the damped solution with; NaN or inf in q, mu_dot or damping, or damping < 0: status 2."""
+    arm, _, velocity = backends(name)
+    solve = velocity[backend]
+    rng = np.random.default_rng(24)
+    for q in random_configurations(arm, 5, seed=24):
+        mu_dot = rng.normal(size=len(arm.task))
+        js = reference.singularity_jacobian(arm, q)
+        for damping in (0.0, 0.1):
+            q_dot, status = solve(q, mu_dot, damping)
+            assert status == 0
+            np.testing.assert_allclose(q_dot, _expected_rates(js, mu_dot, damping), atol=1e-9)
+    mu_dot = np.ones(len(arm.task))
+    if name in SINGULAR_JS:
+        q = np.array(SINGULAR_JS[name])
+        js = reference.singularity_jacobian(arm, q)
+        assert np.linalg.svd(js, compute_uv=False)[-1] < 1e-12
+        q_dot, status = solve(q, mu_dot, 0.0)
+        assert status == 1 and np.all(np.asarray(q_dot) == 0)
+        q_dot, status = solve(q, mu_dot, 0.1)
+        assert status == 0
+        np.testing.assert_allclose(q_dot, _expected_rates(js, mu_dot, 0.1), atol=1e-9)
+    q = random_configurations(arm, 1, seed=25)[0]
+    for bad in (np.nan, np.inf):
+        broken = q.copy()
+        broken[-1] = bad  # the last joint: often absent from Js, and still checked
+        assert solve(broken, mu_dot, 0.0)[1] == 2
+        broken = mu_dot.copy()
+        broken[0] = bad
+        assert solve(q, broken, 0.0)[1] == 2
+        assert solve(q, mu_dot, bad)[1] == 2
+    q_dot, status = solve(q, mu_dot, -0.1)
+    assert status == 2 and np.all(np.asarray(q_dot) == 0)

@@ -1,5 +1,5 @@
 """velocity_ik (Python and C) against numpy: Js q_dot = mu_dot, pseudo-inverse, damped least
-squares, and the singular status."""
+squares, and the statuses (the same in both)."""
 
 import ctypes
 
@@ -57,8 +57,8 @@ def test_solves_the_rates_away_from_singularities(name, generated):
     module, library = generated(name)
     q = random_configurations(arm, 20, seed=8)
     mu_dot = np.random.default_rng(1).normal(size=(20, len(arm.task)))
-    q_dot, ok = module.velocity_ik(q, mu_dot)
-    assert ok.all() and q_dot.shape == (20, arm.dof)
+    q_dot, status = module.velocity_ik(q, mu_dot)
+    assert (status == module.VELOCITY_IK_OK).all() and q_dot.shape == (20, arm.dof)
     for x, target, rates in zip(q, mu_dot, q_dot):
         js = reference_js(arm, x)
         assert np.abs(js @ rates - target).max() < 1e-9
@@ -67,8 +67,8 @@ def test_solves_the_rates_away_from_singularities(name, generated):
             c_rates, status = c_velocity_ik(library, name, x, target, damping)
             assert status == 0
             np.testing.assert_allclose(c_rates, expected(js, target, damping), atol=1e-9)
-    damped, ok = module.velocity_ik(q, mu_dot, DAMPING)
-    assert ok.all()
+    damped, status = module.velocity_ik(q, mu_dot, DAMPING)
+    assert (status == 0).all()
     want = [expected(reference_js(arm, x), target, DAMPING) for x, target in zip(q, mu_dot)]
     np.testing.assert_allclose(damped, want, atol=1e-9)
 
@@ -80,15 +80,16 @@ def test_singular_configuration_gives_the_status(name, singular, generated):
     module, library = generated(name)
     assert np.linalg.svd(reference_js(arm, singular), compute_uv=False)[-1] < 1e-12  # independently singular
     mu_dot = np.ones(len(arm.task))
-    q_dot, ok = module.velocity_ik(singular, mu_dot)
-    assert not ok and np.all(q_dot == 0)
+    q_dot, status = module.velocity_ik(singular, mu_dot)
+    assert status == module.VELOCITY_IK_SINGULAR and np.all(q_dot == 0)
     c_rates, status = c_velocity_ik(library, name, singular, mu_dot, 0.0)
     assert status == 1 and np.all(c_rates == 0)
-    damped, ok = module.velocity_ik(singular, mu_dot, DAMPING)  # damping makes it solvable
-    assert ok and np.all(np.isfinite(damped))
+    damped, status = module.velocity_ik(singular, mu_dot, DAMPING)  # damping makes it solvable
+    assert status == 0 and np.all(np.isfinite(damped))
     assert c_velocity_ik(library, name, singular, mu_dot, DAMPING)[1] == 0
     bad = np.array(singular, dtype=float)
     bad[0] = np.nan
     assert c_velocity_ik(library, name, bad, mu_dot, 0.0)[1] == 2
-    assert not module.velocity_ik(bad, mu_dot)[1]
+    assert module.velocity_ik(bad, mu_dot)[1] == module.VELOCITY_IK_NOT_FINITE
     assert c_velocity_ik(library, name, singular, mu_dot, -1.0)[1] == 2
+    assert module.velocity_ik(singular, mu_dot, -1.0)[1] == 2

@@ -1072,92 +1072,296 @@ iiwa_real iiwa_manipulability(const iiwa_real q[IIWA_DOF])
 
 int iiwa_velocity_ik(const iiwa_real q[IIWA_DOF], const iiwa_real mu_dot[IIWA_TASK_DIM], iiwa_real damping, iiwa_real q_dot[IIWA_DOF])
 {
-    /* Rows of jacobian() forming Js (the geometric Jacobian). */
-    static const int rows[IIWA_TASK_DIM] = {0, 1, 2, 3, 4, 5};
-    iiwa_real J[6 * IIWA_DOF];
-    iiwa_real A[6 * 6];
-    iiwa_real x[6];
-    iiwa_real scale = 0;
-    int r, c, k;
+    /* 1029 operations */
 
-    for (c = 0; c < IIWA_DOF; ++c) {
-        q_dot[c] = 0;
-        if (!isfinite(q[c])) {
-            return IIWA_VELOCITY_IK_NOT_FINITE;
-        }
-    }
-    for (r = 0; r < IIWA_TASK_DIM; ++r) {
-        if (!isfinite(mu_dot[r])) {
-            return IIWA_VELOCITY_IK_NOT_FINITE;
-        }
-        x[r] = mu_dot[r]; /* b; copied here, not in a loop of its own (which becomes memcpy) */
-    }
-    if (!(damping >= 0) || !isfinite(damping)) {
-        return IIWA_VELOCITY_IK_NOT_FINITE;
-    }
-    iiwa_jacobian(q, J);
+    /* Inputs */
+    const iiwa_real q1 = q[0];
+    const iiwa_real q2 = q[1];
+    const iiwa_real q3 = q[2];
+    const iiwa_real q4 = q[3];
+    const iiwa_real q5 = q[4];
+    const iiwa_real q6 = q[5];
+    const iiwa_real q7 = q[6];
+    const iiwa_real mu_dot0 = mu_dot[0];
+    const iiwa_real mu_dot1 = mu_dot[1];
+    const iiwa_real mu_dot2 = mu_dot[2];
+    const iiwa_real mu_dot3 = mu_dot[3];
+    const iiwa_real mu_dot4 = mu_dot[4];
+    const iiwa_real mu_dot5 = mu_dot[5];
 
-    /* The system A x = b (6 x 6), b in x. */
-    for (r = 0; r < 6; ++r) {
-        for (c = 0; c < 6; ++c) {
-            iiwa_real sum = r == c ? damping * damping : 0;
-            for (k = 0; k < IIWA_DOF; ++k) {
-                sum += J[rows[r] * IIWA_DOF + k] * J[rows[c] * IIWA_DOF + k];
-            }
-            A[r * 6 + c] = sum;
-            if (!isfinite(sum)) {
-                return IIWA_VELOCITY_IK_NOT_FINITE;
-            }
-            if (fabs(sum) > scale) {
-                scale = fabs(sum);
-            }
-        }
-    }
+    /* Intermediate terms */
+    const iiwa_real c1 = cos(q1);
+    const iiwa_real s1 = sin(q1);
+    const iiwa_real c2 = cos(q2);
+    const iiwa_real s2 = sin(q2);
+    const iiwa_real c3 = cos(q3);
+    const iiwa_real s3 = sin(q3);
+    const iiwa_real c4 = cos(q4);
+    const iiwa_real s4 = sin(q4);
+    const iiwa_real c5 = cos(q5);
+    const iiwa_real s5 = sin(q5);
+    const iiwa_real c6 = cos(q6);
+    const iiwa_real s6 = sin(q6);
+    const iiwa_real t0 = s1*s3;
+    const iiwa_real t1 = c1*c3;
+    const iiwa_real t2 = c2*t1 - t0;
+    const iiwa_real t3 = -c2*t0 + t1;
+    const iiwa_real t4 = c3*s1;
+    const iiwa_real t5 = c1*s3;
+    const iiwa_real t6 = c2*t5 + t4;
+    const iiwa_real t7 = c2*t4 + t5;
+    const iiwa_real t8 = c1*s2;
+    const iiwa_real t9 = c4*t2 + s4*t8;
+    const iiwa_real t10 = c4*t8 - s4*t2;
+    const iiwa_real t11 = c5*t9 - s5*t6;
+    const iiwa_real t12 = c5*t6 + s5*t9;
+    const iiwa_real t13 = c6*t10 + s6*t11;
+    const iiwa_real t14 = s1*s2;
+    const iiwa_real t15 = c4*t7 + s4*t14;
+    const iiwa_real t16 = c4*t14 - s4*t7;
+    const iiwa_real t17 = c5*t15 + s5*t3;
+    const iiwa_real t18 = c5*t3 - s5*t15;
+    const iiwa_real t19 = c6*t16 + s6*t17;
+    const iiwa_real t20 = c3*s2;
+    const iiwa_real t21 = c2*s4 - c4*t20;
+    const iiwa_real t22 = c2*c4 + s4*t20;
+    const iiwa_real t23 = s2*s3;
+    const iiwa_real t24 = c5*t21 + s5*t23;
+    const iiwa_real t25 = c5*t23 - s5*t21;
+    const iiwa_real t26 = c6*t22 + s6*t24;
+    const iiwa_real t27 = c2*t8 + t10*t22 - t12*t25 + t13*t26 - t23*t6;
+    const iiwa_real t28 = c2*t14 + t16*t22 + t18*t25 + t19*t26 + t23*t3;
+    const iiwa_real t29 = 0.126*t13;
+    const iiwa_real t30 = 0.4*t10 + t29;
+    const iiwa_real t31 = t30 + 0.42*t8;
+    const iiwa_real t32 = 0.126*t19;
+    const iiwa_real t33 = 0.4*t16 + t32;
+    const iiwa_real t34 = 0.42*t14 + t33;
+    const iiwa_real t35 = c1*t31 + s1*t34;
+    const iiwa_real t36 = t3*t30 + t33*t6;
+    const iiwa_real t37 = t10*t33 - t16*t30;
+    const iiwa_real t38 = t12*t32 + t18*t29;
+    const iiwa_real t39 = -t14*t31 + t34*t8;
+    const iiwa_real t40 = (t35*t35) + (t36*t36) + (t37*t37) + (t38*t38) + (t39*t39);
+    const iiwa_real t41 = c2*t39 + t22*t37 - t23*t36 - t25*t38;
+    const iiwa_real t42 = 0.126*t26;
+    const iiwa_real t43 = 0.4*t22 + t42;
+    const iiwa_real t44 = 0.42*c2 + t43;
+    const iiwa_real t45 = t23*t33 - t3*t43;
+    const iiwa_real t46 = t16*t43 - t22*t33;
+    const iiwa_real t47 = t18*t42 - t25*t32;
+    const iiwa_real t48 = t23*t30 + t43*t6;
+    const iiwa_real t49 = t12*t42 + t25*t29;
+    const iiwa_real t50 = -t10*t43 + t22*t30;
+    const iiwa_real t51 = c1*t44;
+    const iiwa_real t52 = c2*t31 - s2*t51;
+    const iiwa_real t53 = c2*t52 + t22*t50 + t23*t48 + t25*t49 + t31;
+    const iiwa_real t54 = s1*t44;
+    const iiwa_real t55 = -c2*t34 + s2*t54;
+    const iiwa_real t56 = (t44*t44);
+    const iiwa_real t57 = (c1*c1);
+    const iiwa_real t58 = t56*t57 + (t34*t34) + (t45*t45) + (t46*t46) + (t47*t47) + (t55*t55);
+    const iiwa_real t59 = t14*t55 + t16*t46 + t18*t47 - t3*t45 + t44*t57;
+    const iiwa_real t60 = c1*s1;
+    const iiwa_real t61 = -t31*t34 - t45*t48 + t46*t50 + t47*t49 + t52*t55 + t56*t60;
+    const iiwa_real t62 = -t34;
+    const iiwa_real t63 = c2*t55 + t22*t46 - t23*t45 + t25*t47 + t62;
+    const iiwa_real t64 = c1 + c2 + damping + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + q1 + q2 + q3 + q4 + q5 + q6 + q7 - s1 + t10 - t12 + t13 + t14 + t16 + t18 + t19 + t22 - t23 + t25 + t26 - t3 + t31 - t35 + t36 + t37 - t38 + t39 + t45 + t46 + t47 - t48 + t49 + t50 + t51 + t52 + t54 + t55 + t6 + t62 + t8 + 1;
+    const iiwa_real t65 = c1*t35;
+    const iiwa_real t66 = t36*t45 + t37*t46 - t38*t47 + t39*t55 - t44*t65;
+    const iiwa_real t67 = -t14*t39 - t16*t37 + t18*t38 + t3*t36 + t65;
+    const iiwa_real t68 = t44*t60;
+    const iiwa_real t69 = t10*t46 - t12*t47 + t45*t6 + t55*t8 - t68;
+    const iiwa_real t70 = t14*t52 + t16*t50 + t18*t49 + t3*t48 + t68;
+    const iiwa_real t71 = (s1*s1);
+    const iiwa_real t72 = t56*t71 + (t31*t31) + (t48*t48) + (t49*t49) + (t50*t50) + (t52*t52);
+    const iiwa_real t73 = -t10*t50 + t12*t49 + t44*t71 + t48*t6 - t52*t8;
+    const iiwa_real t74 = s1*t35;
+    const iiwa_real t75 = t36*t48 - t37*t50 + t38*t49 - t39*t52 + t44*t74;
+    const iiwa_real t76 = t10*t37 + t12*t38 + t36*t6 + t39*t8 + t74;
+    const iiwa_real t77 = (s2*s2);
+    const iiwa_real t78 = t57*t77 + t71 + (t10*t10) + (t12*t12) + (t13*t13) + (t6*t6);
+    const iiwa_real t79 = t10*t16 - t12*t18 + t13*t19 - t3*t6 + t60*t77 - t60;
+    const iiwa_real t80 = t57 + t71*t77 + (t16*t16) + (t18*t18) + (t19*t19) + (t3*t3);
+    const iiwa_real t81 = t77*(s3*s3) + (c2*c2) + (t22*t22) + (t25*t25) + (t26*t26) + 1;
+    const iiwa_real t82 = (t61*t61);
+    const iiwa_real t83 = (t63*t63);
+    const iiwa_real t84 = (t66*t66);
+    const iiwa_real t85 = (t69*t69);
+    const iiwa_real t86 = (t59*t59);
+    const iiwa_real t87 = (damping*damping);
+    const iiwa_real t88 = t81 + t87;
+    const iiwa_real t89 = t58 + t87;
+    const iiwa_real t90 = (t89*t89);
+    const iiwa_real t91 = sqrt(t82 + t83 + t84 + t85 + t86 + t90);
+    const iiwa_real t92 = t91*(t89 >= 0 ? 1 : -1);
+    const iiwa_real t93 = t89 + t92;
+    const iiwa_real t94 = (t91 > 0 ? 1/(t91*(t91 + fabs(t89))) : 0);
+    const iiwa_real t95 = t94*(t27*t69 + t28*t59 + t41*t66 + t53*t61 + t63*t88 + t63*t93);
+    const iiwa_real t96 = t63 - t93*t95;
+    const iiwa_real t97 = t53 - t61*t95;
+    const iiwa_real t98 = t41 - t66*t95;
+    const iiwa_real t99 = t27 - t69*t95;
+    const iiwa_real t100 = t28 - t59*t95;
+    const iiwa_real t101 = -t63*t95 + t88;
+    const iiwa_real t102 = t94*(mu_dot0*t93 + mu_dot1*t61 + mu_dot2*t66 + mu_dot3*t69 + mu_dot4*t59 + mu_dot5*t63);
+    const iiwa_real t103 = mu_dot0 - t102*t93;
+    const iiwa_real t104 = mu_dot1 - t102*t61;
+    const iiwa_real t105 = mu_dot2 - t102*t66;
+    const iiwa_real t106 = mu_dot3 - t102*t69;
+    const iiwa_real t107 = mu_dot4 - t102*t59;
+    const iiwa_real t108 = mu_dot5 - t102*t63;
+    const iiwa_real t109 = t72 + t87;
+    const iiwa_real t110 = t94*(t109*t61 + t53*t63 + t59*t70 + t61*t93 - t66*t75 - t69*t73);
+    const iiwa_real t111 = -t110*t93 + t61;
+    const iiwa_real t112 = t109 - t110*t61;
+    const iiwa_real t113 = t110*t66 + t75;
+    const iiwa_real t114 = t110*t69 + t73;
+    const iiwa_real t115 = -t110*t59 + t70;
+    const iiwa_real t116 = -t110*t63 + t53;
+    const iiwa_real t117 = sqrt((t112*t112) + (t113*t113) + (t114*t114) + (t115*t115) + (t116*t116));
+    const iiwa_real t118 = t117*(t112 >= 0 ? 1 : -1);
+    const iiwa_real t119 = t112 + t118;
+    const iiwa_real t120 = (t117 > 0 ? 1/(t117*(t117 + fabs(t112))) : 0);
+    const iiwa_real t121 = t120*(t100*t115 + t101*t116 - t113*t98 - t114*t99 + t119*t97);
+    const iiwa_real t122 = -t119*t121 + t97;
+    const iiwa_real t123 = t113*t121 + t98;
+    const iiwa_real t124 = t114*t121 + t99;
+    const iiwa_real t125 = t100 - t115*t121;
+    const iiwa_real t126 = t101 - t116*t121;
+    const iiwa_real t127 = t120*(t104*t119 - t105*t113 - t106*t114 + t107*t115 + t108*t116);
+    const iiwa_real t128 = t104 - t119*t127;
+    const iiwa_real t129 = t105 + t113*t127;
+    const iiwa_real t130 = t106 + t114*t127;
+    const iiwa_real t131 = t107 - t115*t127;
+    const iiwa_real t132 = t108 - t116*t127;
+    const iiwa_real t133 = t40 + t87;
+    const iiwa_real t134 = t94*(t133*t66 + t41*t63 - t59*t67 - t61*t75 + t66*t93 + t69*t76);
+    const iiwa_real t135 = -t134*t93 + t66;
+    const iiwa_real t136 = t134*t61 + t75;
+    const iiwa_real t137 = t133 - t134*t66;
+    const iiwa_real t138 = -t134*t69 + t76;
+    const iiwa_real t139 = t134*t59 + t67;
+    const iiwa_real t140 = -t134*t63 + t41;
+    const iiwa_real t141 = -t120*(t113*t137 + t114*t138 + t115*t139 - t116*t140 + t119*t136);
+    const iiwa_real t142 = t119*t141 + t136;
+    const iiwa_real t143 = t113*t141 + t137;
+    const iiwa_real t144 = t114*t141 + t138;
+    const iiwa_real t145 = t115*t141 + t139;
+    const iiwa_real t146 = -t116*t141 + t140;
+    const iiwa_real t147 = sqrt((t143*t143) + (t144*t144) + (t145*t145) + (t146*t146));
+    const iiwa_real t148 = t147*(t143 >= 0 ? 1 : -1);
+    const iiwa_real t149 = t143 + t148;
+    const iiwa_real t150 = (t147 > 0 ? 1/(t147*(t147 + fabs(t143))) : 0);
+    const iiwa_real t151 = t150*(t123*t149 + t124*t144 - t125*t145 + t126*t146);
+    const iiwa_real t152 = t123 - t149*t151;
+    const iiwa_real t153 = t124 - t144*t151;
+    const iiwa_real t154 = t125 + t145*t151;
+    const iiwa_real t155 = t126 - t146*t151;
+    const iiwa_real t156 = t150*(t129*t149 + t130*t144 - t131*t145 + t132*t146);
+    const iiwa_real t157 = t129 - t149*t156;
+    const iiwa_real t158 = t130 - t144*t156;
+    const iiwa_real t159 = t131 + t145*t156;
+    const iiwa_real t160 = t132 - t146*t156;
+    const iiwa_real t161 = t78 + t87;
+    const iiwa_real t162 = t94*(t161*t69 + t27*t63 + t59*t79 - t61*t73 + t66*t76 + t69*t93);
+    const iiwa_real t163 = -t162*t93 + t69;
+    const iiwa_real t164 = t162*t61 + t73;
+    const iiwa_real t165 = -t162*t66 + t76;
+    const iiwa_real t166 = t161 - t162*t69;
+    const iiwa_real t167 = -t162*t59 + t79;
+    const iiwa_real t168 = -t162*t63 + t27;
+    const iiwa_real t169 = -t120*(t113*t165 + t114*t166 - t115*t167 - t116*t168 + t119*t164);
+    const iiwa_real t170 = t119*t169 + t164;
+    const iiwa_real t171 = t113*t169 + t165;
+    const iiwa_real t172 = t114*t169 + t166;
+    const iiwa_real t173 = -t115*t169 + t167;
+    const iiwa_real t174 = -t116*t169 + t168;
+    const iiwa_real t175 = t150*(t144*t172 - t145*t173 + t146*t174 + t149*t171);
+    const iiwa_real t176 = -t149*t175 + t171;
+    const iiwa_real t177 = -t144*t175 + t172;
+    const iiwa_real t178 = t145*t175 + t173;
+    const iiwa_real t179 = -t146*t175 + t174;
+    const iiwa_real t180 = sqrt((t177*t177) + (t178*t178) + (t179*t179));
+    const iiwa_real t181 = t180*(t177 >= 0 ? 1 : -1);
+    const iiwa_real t182 = t177 + t181;
+    const iiwa_real t183 = (t180 > 0 ? 1/(t180*(t180 + fabs(t177))) : 0);
+    const iiwa_real t184 = t183*(t153*t182 + t154*t178 + t155*t179);
+    const iiwa_real t185 = t153 - t182*t184;
+    const iiwa_real t186 = t154 - t178*t184;
+    const iiwa_real t187 = t155 - t179*t184;
+    const iiwa_real t188 = t183*(t158*t182 + t159*t178 + t160*t179);
+    const iiwa_real t189 = t158 - t182*t188;
+    const iiwa_real t190 = t159 - t178*t188;
+    const iiwa_real t191 = t160 - t179*t188;
+    const iiwa_real t192 = t80 + t87;
+    const iiwa_real t193 = sqrt(2*t82 + 2*t83 + 2*t84 + 2*t85 + 2*t86 + t90 + (t109*t109) + (t133*t133) + (t161*t161) + (t192*t192) + 2*(t27*t27) + 2*(t28*t28) + 2*(t41*t41) + 2*(t53*t53) + 2*(t67*t67) + 2*(t70*t70) + 2*(t73*t73) + 2*(t75*t75) + 2*(t76*t76) + 2*(t79*t79) + (t88*t88));
+    const iiwa_real t194 = t94*(t192*t59 + t28*t63 + t59*t93 + t61*t70 - t66*t67 + t69*t79);
+    const iiwa_real t195 = -t194*t93 + t59;
+    const iiwa_real t196 = -t194*t61 + t70;
+    const iiwa_real t197 = t194*t66 + t67;
+    const iiwa_real t198 = -t194*t69 + t79;
+    const iiwa_real t199 = t192 - t194*t59;
+    const iiwa_real t200 = -t194*t63 + t28;
+    const iiwa_real t201 = t120*(t113*t197 - t114*t198 + t115*t199 + t116*t200 + t119*t196);
+    const iiwa_real t202 = -t119*t201 + t196;
+    const iiwa_real t203 = t113*t201 - t197;
+    const iiwa_real t204 = t114*t201 + t198;
+    const iiwa_real t205 = -t115*t201 + t199;
+    const iiwa_real t206 = -t116*t201 + t200;
+    const iiwa_real t207 = t150*(t144*t204 - t145*t205 + t146*t206 + t149*t203);
+    const iiwa_real t208 = -t149*t207 + t203;
+    const iiwa_real t209 = -t144*t207 + t204;
+    const iiwa_real t210 = t145*t207 + t205;
+    const iiwa_real t211 = -t146*t207 + t206;
+    const iiwa_real t212 = t183*(t178*t210 + t179*t211 + t182*t209);
+    const iiwa_real t213 = -t182*t212 + t209;
+    const iiwa_real t214 = -t178*t212 + t210;
+    const iiwa_real t215 = -t179*t212 + t211;
+    const iiwa_real t216 = sqrt((t214*t214) + (t215*t215));
+    const iiwa_real t217 = t216*(t214 >= 0 ? 1 : -1);
+    const iiwa_real t218 = t214 + t217;
+    const iiwa_real t219 = (t216 > 0 ? 1/(t216*(t216 + fabs(t214))) : 0);
+    const iiwa_real t220 = t219*(t186*t218 + t187*t215);
+    const iiwa_real t221 = t186 - t218*t220;
+    const iiwa_real t222 = t187 - t215*t220;
+    const iiwa_real t223 = t219*(t190*t218 + t191*t215);
+    const iiwa_real t224 = t190 - t218*t223;
+    const iiwa_real t225 = t191 - t215*t223;
+    const iiwa_real t226 = fabs(t222);
+    const iiwa_real t227 = t226;
+    const iiwa_real t228 = t227*(t222 >= 0 ? 1 : -1);
+    const iiwa_real t229 = t222 + t228;
+    const iiwa_real t230 = (t227 > 0 ? 1/(t227*(t226 + t227)) : 0);
+    const iiwa_real t231 = -t225*t230*(t229*t229) + t225;
+    const iiwa_real t232 = t231/t228;
+    const iiwa_real t233 = (t221*t232 + t224)/t217;
+    const iiwa_real t234 = (t185*t232 + t189 + t213*t233)/t181;
+    const iiwa_real t235 = (t152*t232 + t157 + t176*t234 + t208*t233)/t148;
+    const iiwa_real t236 = (t122*t232 + t128 - t142*t235 - t170*t234 + t202*t233)/t118;
+    const iiwa_real t237 = (t103 + t111*t236 + t135*t235 + t163*t234 + t195*t233 + t232*t96)/t92;
+    const iiwa_real t238 = t232 + t236*t31 - t237*t34;
+    const iiwa_real t239 = c1*t233 - s1*t234 - t235*t35 + t236*t54 + t237*t51;
+    const iiwa_real t240 = c2*t232 + t14*t233 + t234*t8 + t235*t39 + t236*t52 + t237*t55;
+    const iiwa_real t241 = t23*t232 + t233*t3 - t234*t6 - t235*t36 + t236*t48 - t237*t45;
+    const iiwa_real t242 = t10*t234 + t16*t233 + t22*t232 + t235*t37 + t236*t50 + t237*t46;
+    const iiwa_real t243 = -t12*t234 + t18*t233 + t232*t25 - t235*t38 + t236*t49 + t237*t47;
+    const iiwa_real t244 = t13*t234 + t19*t233 + t232*t26;
+    const int t245 = isfinite(t64);
+    const int t246 = damping >= 0;
+    const iiwa_real t247 = 1e-12*t193;
+    const int t248 = (t117 <= t247) || (t147 <= t247) || (t180 <= t247) || (t216 <= t247) || (t227 <= t247) || (t91 <= t247);
+    const int t249 = t245 && t246 && !t248;
 
-    /* LU with partial pivoting, applied to x as it goes. */
-    for (k = 0; k < 6; ++k) {
-        int pivot = k;
-        for (r = k + 1; r < 6; ++r) {
-            if (fabs(A[r * 6 + k]) > fabs(A[pivot * 6 + k])) {
-                pivot = r;
-            }
-        }
-        if (!(fabs(A[pivot * 6 + k]) > 1e-12 * scale)) {
-            return IIWA_VELOCITY_IK_SINGULAR;
-        }
-        if (pivot != k) {
-            iiwa_real swap;
-            for (c = k; c < 6; ++c) {
-                swap = A[k * 6 + c];
-                A[k * 6 + c] = A[pivot * 6 + c];
-                A[pivot * 6 + c] = swap;
-            }
-            swap = x[k];
-            x[k] = x[pivot];
-            x[pivot] = swap;
-        }
-        for (r = k + 1; r < 6; ++r) {
-            const iiwa_real factor = A[r * 6 + k] / A[k * 6 + k];
-            for (c = k + 1; c < 6; ++c) {
-                A[r * 6 + c] -= factor * A[k * 6 + c];
-            }
-            x[r] -= factor * x[k];
-        }
-    }
-    for (k = 6 - 1; k >= 0; --k) {
-        for (c = k + 1; c < 6; ++c) {
-            x[k] -= A[k * 6 + c] * x[c];
-        }
-        x[k] /= A[k * 6 + k];
-    }
-
-    /* q_dot = Js^T x */
-    for (c = 0; c < IIWA_DOF; ++c) {
-        for (r = 0; r < IIWA_TASK_DIM; ++r) {
-            q_dot[c] += J[rows[r] * IIWA_DOF + c] * x[r];
-        }
-    }
-    return IIWA_VELOCITY_IK_OK;
+    /* Outputs */
+    q_dot[0] = (t249 ? -t238 : 0);
+    q_dot[1] = (t249 ? -t239 : 0);
+    q_dot[2] = (t249 ? -t240 : 0);
+    q_dot[3] = (t249 ? t241 : 0);
+    q_dot[4] = (t249 ? -t242 : 0);
+    q_dot[5] = (t249 ? -t243 : 0);
+    q_dot[6] = (t249 ? -t244 : 0);
+    return (!(t245 && t246) ? 2 : (t248 ? 1 : 0));
 }
 
 /* -- Iterative inverse kinematics -- */

@@ -1060,6 +1060,300 @@ def manipulability(q):
     return w
 
 
+@numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
+def velocity_ik(q, mu_dot, damping=0.0):
+    """joint rates q_dot solving Js q_dot = mu_dot: Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: (7 x 1 and 1 x 1), 1029 operations."""
+    q = _argument("q", q, (7,))
+    mu_dot = _argument("mu_dot", mu_dot, (6,))
+    damping = _argument("damping", damping, ())
+    q1 = q[..., 0]
+    q2 = q[..., 1]
+    q3 = q[..., 2]
+    q4 = q[..., 3]
+    q5 = q[..., 4]
+    q6 = q[..., 5]
+    q7 = q[..., 6]
+    mu_dot0 = mu_dot[..., 0]
+    mu_dot1 = mu_dot[..., 1]
+    mu_dot2 = mu_dot[..., 2]
+    mu_dot3 = mu_dot[..., 3]
+    mu_dot4 = mu_dot[..., 4]
+    mu_dot5 = mu_dot[..., 5]
+    c1 = numpy.cos(q1)
+    s1 = numpy.sin(q1)
+    c2 = numpy.cos(q2)
+    s2 = numpy.sin(q2)
+    c3 = numpy.cos(q3)
+    s3 = numpy.sin(q3)
+    c4 = numpy.cos(q4)
+    s4 = numpy.sin(q4)
+    c5 = numpy.cos(q5)
+    s5 = numpy.sin(q5)
+    c6 = numpy.cos(q6)
+    s6 = numpy.sin(q6)
+    t0 = s1*s3
+    t1 = c1*c3
+    t2 = c2*t1 - t0
+    t3 = -c2*t0 + t1
+    t4 = c3*s1
+    t5 = c1*s3
+    t6 = c2*t5 + t4
+    t7 = c2*t4 + t5
+    t8 = c1*s2
+    t9 = c4*t2 + s4*t8
+    t10 = c4*t8 - s4*t2
+    t11 = c5*t9 - s5*t6
+    t12 = c5*t6 + s5*t9
+    t13 = c6*t10 + s6*t11
+    t14 = s1*s2
+    t15 = c4*t7 + s4*t14
+    t16 = c4*t14 - s4*t7
+    t17 = c5*t15 + s5*t3
+    t18 = c5*t3 - s5*t15
+    t19 = c6*t16 + s6*t17
+    t20 = c3*s2
+    t21 = c2*s4 - c4*t20
+    t22 = c2*c4 + s4*t20
+    t23 = s2*s3
+    t24 = c5*t21 + s5*t23
+    t25 = c5*t23 - s5*t21
+    t26 = c6*t22 + s6*t24
+    t27 = c2*t8 + t10*t22 - t12*t25 + t13*t26 - t23*t6
+    t28 = c2*t14 + t16*t22 + t18*t25 + t19*t26 + t23*t3
+    t29 = 0.126*t13
+    t30 = 0.4*t10 + t29
+    t31 = t30 + 0.42*t8
+    t32 = 0.126*t19
+    t33 = 0.4*t16 + t32
+    t34 = 0.42*t14 + t33
+    t35 = c1*t31 + s1*t34
+    t36 = t3*t30 + t33*t6
+    t37 = t10*t33 - t16*t30
+    t38 = t12*t32 + t18*t29
+    t39 = -t14*t31 + t34*t8
+    t40 = t35**2 + t36**2 + t37**2 + t38**2 + t39**2
+    t41 = c2*t39 + t22*t37 - t23*t36 - t25*t38
+    t42 = 0.126*t26
+    t43 = 0.4*t22 + t42
+    t44 = 0.42*c2 + t43
+    t45 = t23*t33 - t3*t43
+    t46 = t16*t43 - t22*t33
+    t47 = t18*t42 - t25*t32
+    t48 = t23*t30 + t43*t6
+    t49 = t12*t42 + t25*t29
+    t50 = -t10*t43 + t22*t30
+    t51 = c1*t44
+    t52 = c2*t31 - s2*t51
+    t53 = c2*t52 + t22*t50 + t23*t48 + t25*t49 + t31
+    t54 = s1*t44
+    t55 = -c2*t34 + s2*t54
+    t56 = t44**2
+    t57 = c1**2
+    t58 = t34**2 + t45**2 + t46**2 + t47**2 + t55**2 + t56*t57
+    t59 = t14*t55 + t16*t46 + t18*t47 - t3*t45 + t44*t57
+    t60 = c1*s1
+    t61 = -t31*t34 - t45*t48 + t46*t50 + t47*t49 + t52*t55 + t56*t60
+    t62 = -t34
+    t63 = c2*t55 + t22*t46 - t23*t45 + t25*t47 + t62
+    t64 = c1 + c2 + damping + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + q1 + q2 + q3 + q4 + q5 + q6 + q7 - s1 + t10 - t12 + t13 + t14 + t16 + t18 + t19 + t22 - t23 + t25 + t26 - t3 + t31 - t35 + t36 + t37 - t38 + t39 + t45 + t46 + t47 - t48 + t49 + t50 + t51 + t52 + t54 + t55 + t6 + t62 + t8 + 1
+    t65 = c1*t35
+    t66 = t36*t45 + t37*t46 - t38*t47 + t39*t55 - t44*t65
+    t67 = -t14*t39 - t16*t37 + t18*t38 + t3*t36 + t65
+    t68 = t44*t60
+    t69 = t10*t46 - t12*t47 + t45*t6 + t55*t8 - t68
+    t70 = t14*t52 + t16*t50 + t18*t49 + t3*t48 + t68
+    t71 = s1**2
+    t72 = t31**2 + t48**2 + t49**2 + t50**2 + t52**2 + t56*t71
+    t73 = -t10*t50 + t12*t49 + t44*t71 + t48*t6 - t52*t8
+    t74 = s1*t35
+    t75 = t36*t48 - t37*t50 + t38*t49 - t39*t52 + t44*t74
+    t76 = t10*t37 + t12*t38 + t36*t6 + t39*t8 + t74
+    t77 = s2**2
+    t78 = t10**2 + t12**2 + t13**2 + t57*t77 + t6**2 + t71
+    t79 = t10*t16 - t12*t18 + t13*t19 - t3*t6 + t60*t77 - t60
+    t80 = t16**2 + t18**2 + t19**2 + t3**2 + t57 + t71*t77
+    t81 = c2**2 + s3**2*t77 + t22**2 + t25**2 + t26**2 + 1
+    t82 = t61**2
+    t83 = t63**2
+    t84 = t66**2
+    t85 = t69**2
+    t86 = t59**2
+    t87 = damping**2
+    t88 = t81 + t87
+    t89 = t58 + t87
+    t90 = t89**2
+    t91 = numpy.sqrt(t82 + t83 + t84 + t85 + t86 + t90)
+    t92 = t91*numpy.where(numpy.greater_equal(t89, 0), 1, -1)
+    t93 = t89 + t92
+    t94 = numpy.where(numpy.greater(t91, 0), 1/(t91*(t91 + abs(t89))), 0)
+    t95 = t94*(t27*t69 + t28*t59 + t41*t66 + t53*t61 + t63*t88 + t63*t93)
+    t96 = t63 - t93*t95
+    t97 = t53 - t61*t95
+    t98 = t41 - t66*t95
+    t99 = t27 - t69*t95
+    t100 = t28 - t59*t95
+    t101 = -t63*t95 + t88
+    t102 = t94*(mu_dot0*t93 + mu_dot1*t61 + mu_dot2*t66 + mu_dot3*t69 + mu_dot4*t59 + mu_dot5*t63)
+    t103 = mu_dot0 - t102*t93
+    t104 = mu_dot1 - t102*t61
+    t105 = mu_dot2 - t102*t66
+    t106 = mu_dot3 - t102*t69
+    t107 = mu_dot4 - t102*t59
+    t108 = mu_dot5 - t102*t63
+    t109 = t72 + t87
+    t110 = t94*(t109*t61 + t53*t63 + t59*t70 + t61*t93 - t66*t75 - t69*t73)
+    t111 = -t110*t93 + t61
+    t112 = t109 - t110*t61
+    t113 = t110*t66 + t75
+    t114 = t110*t69 + t73
+    t115 = -t110*t59 + t70
+    t116 = -t110*t63 + t53
+    t117 = numpy.sqrt(t112**2 + t113**2 + t114**2 + t115**2 + t116**2)
+    t118 = t117*numpy.where(numpy.greater_equal(t112, 0), 1, -1)
+    t119 = t112 + t118
+    t120 = numpy.where(numpy.greater(t117, 0), 1/(t117*(t117 + abs(t112))), 0)
+    t121 = t120*(t100*t115 + t101*t116 - t113*t98 - t114*t99 + t119*t97)
+    t122 = -t119*t121 + t97
+    t123 = t113*t121 + t98
+    t124 = t114*t121 + t99
+    t125 = t100 - t115*t121
+    t126 = t101 - t116*t121
+    t127 = t120*(t104*t119 - t105*t113 - t106*t114 + t107*t115 + t108*t116)
+    t128 = t104 - t119*t127
+    t129 = t105 + t113*t127
+    t130 = t106 + t114*t127
+    t131 = t107 - t115*t127
+    t132 = t108 - t116*t127
+    t133 = t40 + t87
+    t134 = t94*(t133*t66 + t41*t63 - t59*t67 - t61*t75 + t66*t93 + t69*t76)
+    t135 = -t134*t93 + t66
+    t136 = t134*t61 + t75
+    t137 = t133 - t134*t66
+    t138 = -t134*t69 + t76
+    t139 = t134*t59 + t67
+    t140 = -t134*t63 + t41
+    t141 = -t120*(t113*t137 + t114*t138 + t115*t139 - t116*t140 + t119*t136)
+    t142 = t119*t141 + t136
+    t143 = t113*t141 + t137
+    t144 = t114*t141 + t138
+    t145 = t115*t141 + t139
+    t146 = -t116*t141 + t140
+    t147 = numpy.sqrt(t143**2 + t144**2 + t145**2 + t146**2)
+    t148 = t147*numpy.where(numpy.greater_equal(t143, 0), 1, -1)
+    t149 = t143 + t148
+    t150 = numpy.where(numpy.greater(t147, 0), 1/(t147*(t147 + abs(t143))), 0)
+    t151 = t150*(t123*t149 + t124*t144 - t125*t145 + t126*t146)
+    t152 = t123 - t149*t151
+    t153 = t124 - t144*t151
+    t154 = t125 + t145*t151
+    t155 = t126 - t146*t151
+    t156 = t150*(t129*t149 + t130*t144 - t131*t145 + t132*t146)
+    t157 = t129 - t149*t156
+    t158 = t130 - t144*t156
+    t159 = t131 + t145*t156
+    t160 = t132 - t146*t156
+    t161 = t78 + t87
+    t162 = t94*(t161*t69 + t27*t63 + t59*t79 - t61*t73 + t66*t76 + t69*t93)
+    t163 = -t162*t93 + t69
+    t164 = t162*t61 + t73
+    t165 = -t162*t66 + t76
+    t166 = t161 - t162*t69
+    t167 = -t162*t59 + t79
+    t168 = -t162*t63 + t27
+    t169 = -t120*(t113*t165 + t114*t166 - t115*t167 - t116*t168 + t119*t164)
+    t170 = t119*t169 + t164
+    t171 = t113*t169 + t165
+    t172 = t114*t169 + t166
+    t173 = -t115*t169 + t167
+    t174 = -t116*t169 + t168
+    t175 = t150*(t144*t172 - t145*t173 + t146*t174 + t149*t171)
+    t176 = -t149*t175 + t171
+    t177 = -t144*t175 + t172
+    t178 = t145*t175 + t173
+    t179 = -t146*t175 + t174
+    t180 = numpy.sqrt(t177**2 + t178**2 + t179**2)
+    t181 = t180*numpy.where(numpy.greater_equal(t177, 0), 1, -1)
+    t182 = t177 + t181
+    t183 = numpy.where(numpy.greater(t180, 0), 1/(t180*(t180 + abs(t177))), 0)
+    t184 = t183*(t153*t182 + t154*t178 + t155*t179)
+    t185 = t153 - t182*t184
+    t186 = t154 - t178*t184
+    t187 = t155 - t179*t184
+    t188 = t183*(t158*t182 + t159*t178 + t160*t179)
+    t189 = t158 - t182*t188
+    t190 = t159 - t178*t188
+    t191 = t160 - t179*t188
+    t192 = t80 + t87
+    t193 = numpy.sqrt(t109**2 + t133**2 + t161**2 + t192**2 + 2*t27**2 + 2*t28**2 + 2*t41**2 + 2*t53**2 + 2*t67**2 + 2*t70**2 + 2*t73**2 + 2*t75**2 + 2*t76**2 + 2*t79**2 + 2*t82 + 2*t83 + 2*t84 + 2*t85 + 2*t86 + t88**2 + t90)
+    t194 = t94*(t192*t59 + t28*t63 + t59*t93 + t61*t70 - t66*t67 + t69*t79)
+    t195 = -t194*t93 + t59
+    t196 = -t194*t61 + t70
+    t197 = t194*t66 + t67
+    t198 = -t194*t69 + t79
+    t199 = t192 - t194*t59
+    t200 = -t194*t63 + t28
+    t201 = t120*(t113*t197 - t114*t198 + t115*t199 + t116*t200 + t119*t196)
+    t202 = -t119*t201 + t196
+    t203 = t113*t201 - t197
+    t204 = t114*t201 + t198
+    t205 = -t115*t201 + t199
+    t206 = -t116*t201 + t200
+    t207 = t150*(t144*t204 - t145*t205 + t146*t206 + t149*t203)
+    t208 = -t149*t207 + t203
+    t209 = -t144*t207 + t204
+    t210 = t145*t207 + t205
+    t211 = -t146*t207 + t206
+    t212 = t183*(t178*t210 + t179*t211 + t182*t209)
+    t213 = -t182*t212 + t209
+    t214 = -t178*t212 + t210
+    t215 = -t179*t212 + t211
+    t216 = numpy.sqrt(t214**2 + t215**2)
+    t217 = t216*numpy.where(numpy.greater_equal(t214, 0), 1, -1)
+    t218 = t214 + t217
+    t219 = numpy.where(numpy.greater(t216, 0), 1/(t216*(t216 + abs(t214))), 0)
+    t220 = t219*(t186*t218 + t187*t215)
+    t221 = t186 - t218*t220
+    t222 = t187 - t215*t220
+    t223 = t219*(t190*t218 + t191*t215)
+    t224 = t190 - t218*t223
+    t225 = t191 - t215*t223
+    t226 = abs(t222)
+    t227 = t226
+    t228 = t227*numpy.where(numpy.greater_equal(t222, 0), 1, -1)
+    t229 = t222 + t228
+    t230 = numpy.where(numpy.greater(t227, 0), 1/(t227*(t226 + t227)), 0)
+    t231 = -t225*t229**2*t230 + t225
+    t232 = t231/t228
+    t233 = (t221*t232 + t224)/t217
+    t234 = (t185*t232 + t189 + t213*t233)/t181
+    t235 = (t152*t232 + t157 + t176*t234 + t208*t233)/t148
+    t236 = (t122*t232 + t128 - t142*t235 - t170*t234 + t202*t233)/t118
+    t237 = (t103 + t111*t236 + t135*t235 + t163*t234 + t195*t233 + t232*t96)/t92
+    t238 = t232 + t236*t31 - t237*t34
+    t239 = c1*t233 - s1*t234 - t235*t35 + t236*t54 + t237*t51
+    t240 = c2*t232 + t14*t233 + t234*t8 + t235*t39 + t236*t52 + t237*t55
+    t241 = t23*t232 + t233*t3 - t234*t6 - t235*t36 + t236*t48 - t237*t45
+    t242 = t10*t234 + t16*t233 + t22*t232 + t235*t37 + t236*t50 + t237*t46
+    t243 = -t12*t234 + t18*t233 + t232*t25 - t235*t38 + t236*t49 + t237*t47
+    t244 = t13*t234 + t19*t233 + t232*t26
+    t245 = numpy.isfinite(t64)
+    t246 = numpy.greater_equal(damping, 0)
+    t247 = 1e-12*t193
+    t248 = (numpy.less_equal(t117, t247)) | (numpy.less_equal(t147, t247)) | (numpy.less_equal(t180, t247)) | (numpy.less_equal(t216, t247)) | (numpy.less_equal(t227, t247)) | (numpy.less_equal(t91, t247))
+    t249 = t245 & t246 & numpy.logical_not(t248)
+    q_dot = numpy.empty(numpy.broadcast_shapes(q.shape[:-1], mu_dot.shape[:-1], damping.shape) + (7,))
+    q_dot[..., 0] = numpy.where(t249, -t238, 0)
+    q_dot[..., 1] = numpy.where(t249, -t239, 0)
+    q_dot[..., 2] = numpy.where(t249, -t240, 0)
+    q_dot[..., 3] = numpy.where(t249, t241, 0)
+    q_dot[..., 4] = numpy.where(t249, -t242, 0)
+    q_dot[..., 5] = numpy.where(t249, -t243, 0)
+    q_dot[..., 6] = numpy.where(t249, -t244, 0)
+    status = numpy.empty(numpy.broadcast_shapes(q.shape[:-1], mu_dot.shape[:-1], damping.shape) + (), dtype=int)
+    status[...] = numpy.where(numpy.logical_not(t245 & t246), 2, numpy.where(t248, 1, 0))
+    return q_dot, status
+
+
 # -- Iterative inverse kinematics --
 
 IK_NUMERIC_CONVERGED = 0  # |error| <= tol
@@ -1129,39 +1423,10 @@ def ik_numeric(target, q0, max_iter=100, tol=1e-10):
     return q, IK_NUMERIC_CONVERGED if cost <= tol * tol else IK_NUMERIC_ITERATION_LIMIT
 
 
-# Reciprocal condition number below which the system of velocity_ik counts as singular.
-VELOCITY_IK_RCOND = 1e-12
-
-
-def velocity_ik(q, mu_dot, damping=0.0):
-    """Joint rates solving Js q_dot = mu_dot, and where that succeeded: (q_dot, ok).
-
-    Js is the geometric Jacobian, so mu_dot (6,) or (..., 6) is (vx, vy, vz, wx, wy, wz): components of the tool's linear (v) and angular (w) velocity in the world frame.
-    The minimum-norm solution q_dot = Js^T (Js Js^T + damping^2 I)^-1 mu_dot (right
-    pseudo-inverse for damping = 0, damped least squares for damping > 0).
-
-    Returns q_dot (..., 7) and ok (...), a boolean array: False where an input is not
-    finite or the 6 x 6 system solved is numerically singular (reciprocal
-    condition number below VELOCITY_IK_RCOND; take damping > 0 there). Where ok is False,
-    q_dot is 0: the result never holds NaN.
-    """
-    q = _argument("q", q, (DOF,))
-    mu_dot = numpy.asarray(mu_dot, dtype=float)
-    if mu_dot.ndim == 0 or mu_dot.shape[-1] != 6:
-        raise ValueError(f"mu_dot must have shape (6,) or (..., 6), got {mu_dot.shape}")
-    damping = float(damping)
-    if not damping >= 0.0:
-        raise ValueError(f"damping must be >= 0, got {damping}")
-    J = jacobian(q)
-    batch = numpy.broadcast_shapes(J.shape[:-2], mu_dot.shape[:-1])
-    J = numpy.broadcast_to(J, batch + J.shape[-2:])
-    mu_dot = numpy.broadcast_to(mu_dot, batch + mu_dot.shape[-1:])
-    Jt = numpy.swapaxes(J, -1, -2)
-    A, b = J @ Jt + damping**2 * numpy.eye(6), mu_dot
-    ok = numpy.isfinite(A).all(axis=(-2, -1)) & numpy.isfinite(b).all(axis=-1)
-    identity = numpy.eye(6)
-    singular_values = numpy.linalg.svd(numpy.where(ok[..., None, None], A, identity), compute_uv=False)
-    ok &= singular_values[..., -1] > VELOCITY_IK_RCOND * singular_values[..., 0]
-    x = numpy.linalg.solve(numpy.where(ok[..., None, None], A, identity), numpy.where(ok[..., None], b, 0.0)[..., None])[..., 0]
-    q_dot = (Jt @ x[..., None])[..., 0]
-    return numpy.where(ok[..., None], q_dot, 0.0), ok
+# Statuses of velocity_ik: OK, singular (a diagonal entry of the QR factor R of the
+# 6 x 6 system at most 1e-12 times its Frobenius norm: take damping > 0), or
+# not finite (q, mu_dot, damping or Js not finite, or damping < 0); q_dot is 0 unless OK.
+# Js is the geometric Jacobian; mu_dot is (vx, vy, vz, wx, wy, wz): components of the tool's linear (v) and angular (w) velocity in the world frame.
+VELOCITY_IK_OK = 0
+VELOCITY_IK_SINGULAR = 1
+VELOCITY_IK_NOT_FINITE = 2

@@ -688,6 +688,431 @@ kr5_real kr5_jacobian_det(const kr5_real q[KR5_DOF])
     return -0.23064*s5*(c3 + t0)*(0.1935483870967742*c2*c3 - c2*s3 + 0.967741935483871*c2 - c3*s2 - s2*t0 + 0.2903225806451613);
 }
 
+int kr5_velocity_ik(const kr5_real q[KR5_DOF], const kr5_real mu_dot[KR5_TASK_DIM], kr5_real damping, kr5_real q_dot[KR5_DOF])
+{
+    /* 1334 operations */
+
+    /* Inputs */
+    const kr5_real q1 = q[0];
+    const kr5_real q2 = q[1];
+    const kr5_real q3 = q[2];
+    const kr5_real q4 = q[3];
+    const kr5_real q5 = q[4];
+    const kr5_real q6 = q[5];
+    const kr5_real mu_dot0 = mu_dot[0];
+    const kr5_real mu_dot1 = mu_dot[1];
+    const kr5_real mu_dot2 = mu_dot[2];
+    const kr5_real mu_dot3 = mu_dot[3];
+    const kr5_real mu_dot4 = mu_dot[4];
+    const kr5_real mu_dot5 = mu_dot[5];
+
+    /* Intermediate terms */
+    const kr5_real c1 = cos(q1);
+    const kr5_real s1 = sin(q1);
+    const kr5_real c2 = cos(q2);
+    const kr5_real s2 = sin(q2);
+    const kr5_real c3 = cos(q3);
+    const kr5_real s3 = sin(q3);
+    const kr5_real c23 = c2*c3 - s2*s3;
+    const kr5_real s23 = c2*s3 + c3*s2;
+    const kr5_real c4 = cos(q4);
+    const kr5_real s4 = sin(q4);
+    const kr5_real c5 = cos(q5);
+    const kr5_real s5 = sin(q5);
+    const kr5_real t0 = -c23*c5 + c4*s23*s5;
+    const kr5_real t1 = s1*s4;
+    const kr5_real t2 = c1*c4;
+    const kr5_real t3 = c23*t2 - t1;
+    const kr5_real t4 = -c23*t1 + t2;
+    const kr5_real t5 = c4*s1;
+    const kr5_real t6 = c1*s4;
+    const kr5_real t7 = c23*t6 + t5;
+    const kr5_real t8 = c23*t5 + t6;
+    const kr5_real t9 = c1*s23;
+    const kr5_real t10 = c5*t9 + s5*t3;
+    const kr5_real t11 = s1*s23;
+    const kr5_real t12 = c5*t11 + s5*t8;
+    const kr5_real t13 = 0.115*t10;
+    const kr5_real t14 = t13 + 0.62*t9;
+    const kr5_real t15 = 0.115*t12;
+    const kr5_real t16 = 0.62*t11 + t15;
+    const kr5_real t17 = t11*t14 - t16*t9;
+    const kr5_real t18 = t13*t4 + t15*t7;
+    const kr5_real t19 = 0.115*t0;
+    const kr5_real t20 = -0.62*c23 + t19;
+    const kr5_real t21 = -0.12*s23 + t20;
+    const kr5_real t22 = -0.6*s2 + t21;
+    const kr5_real t23 = c23*t16 + t11*t20;
+    const kr5_real t24 = c23*t14 + t20*t9;
+    const kr5_real t25 = 0.12*c23;
+    const kr5_real t26 = c1*t25 - t14;
+    const kr5_real t27 = s1*t25 - t16;
+    const kr5_real t28 = c1*t26 + s1*t27;
+    const kr5_real t29 = 0.6*c2;
+    const kr5_real t30 = c1*t29 + t26;
+    const kr5_real t31 = s1*t29 + t27;
+    const kr5_real t32 = 0.18*c1 + t30;
+    const kr5_real t33 = 0.18*s1 + t31;
+    const kr5_real t34 = c1*t30 + s1*t31;
+    const kr5_real t35 = s23*s4;
+    const kr5_real t36 = t15*t35 + t19*t4;
+    const kr5_real t37 = -t13*t35 + t19*t7;
+    const kr5_real t38 = -c23*t24 + t32 + t35*t37;
+    const kr5_real t39 = c23*t17 + t18*t35;
+    const kr5_real t40 = -c23*t9 + t0*t10 + t35*t7;
+    const kr5_real t41 = c23*t11 - t0*t12 + t35*t4;
+    const kr5_real t42 = (t33*t33);
+    const kr5_real t43 = (t21*t21);
+    const kr5_real t44 = (c1*c1);
+    const kr5_real t45 = t11*t23 + t21*t44 + t22*t44 + t36*t4;
+    const kr5_real t46 = (t22*t22);
+    const kr5_real t47 = t43*t44 + t44*t46 + (t23*t23) + (t36*t36);
+    const kr5_real t48 = t42 + t47;
+    const kr5_real t49 = c1*s1;
+    const kr5_real t50 = -t23*t24 - t32*t33 + t36*t37 + t43*t49 + t46*t49;
+    const kr5_real t51 = -t33;
+    const kr5_real t52 = c23*t23 + t35*t36 + t51;
+    const kr5_real t53 = c1*t28;
+    const kr5_real t54 = c1*t34;
+    const kr5_real t55 = t17*t23 + t18*t36 - t21*t53 - t22*t54;
+    const kr5_real t56 = t11*t17 + t18*t4 - t53 - t54;
+    const kr5_real t57 = c1*t21;
+    const kr5_real t58 = c1*t22;
+    const kr5_real t59 = s1*t57 + s1*t58;
+    const kr5_real t60 = -t23*t9 + t36*t7 + t59;
+    const kr5_real t61 = -t11*t24 + t37*t4 + t59;
+    const kr5_real t62 = (t32*t32);
+    const kr5_real t63 = (s1*s1);
+    const kr5_real t64 = t21*t63 + t22*t63 + t24*t9 + t37*t7;
+    const kr5_real t65 = t43*t63 + t46*t63 + (t24*t24) + (t37*t37);
+    const kr5_real t66 = t62 + t65;
+    const kr5_real t67 = s1*t28;
+    const kr5_real t68 = s1*t34;
+    const kr5_real t69 = t17*t24 - t18*t37 + t21*t67 + t22*t68;
+    const kr5_real t70 = t17*t9 - t18*t7 + t67 + t68;
+    const kr5_real t71 = (t34*t34);
+    const kr5_real t72 = t71 + (t17*t17) + (t18*t18) + (t28*t28);
+    const kr5_real t73 = t72;
+    const kr5_real t74 = (s23*s23);
+    const kr5_real t75 = t44*t74 + 2*t63 + (t10*t10) + (t7*t7);
+    const kr5_real t76 = t75;
+    const kr5_real t77 = 2*s1;
+    const kr5_real t78 = -c1*t77 + t10*t12 - t4*t7 + t49*t74;
+    const kr5_real t79 = 2*t44 + t63*t74 + (t12*t12) + (t4*t4);
+    const kr5_real t80 = t79;
+    const kr5_real t81 = t74*(s4*s4) + (c23*c23) + (t0*t0);
+    const kr5_real t82 = t81 + 1;
+    const kr5_real t83 = (t50*t50);
+    const kr5_real t84 = (t52*t52);
+    const kr5_real t85 = (t55*t55);
+    const kr5_real t86 = (t60*t60);
+    const kr5_real t87 = (t45*t45);
+    const kr5_real t88 = (damping*damping);
+    const kr5_real t89 = t48 + t88;
+    const kr5_real t90 = (t89*t89);
+    const kr5_real t91 = sqrt(t83 + t84 + t85 + t86 + t87 + t90);
+    const kr5_real t92 = t91*(t89 >= 0 ? 1 : -1);
+    const kr5_real t93 = t89 + t92;
+    const kr5_real t94 = (t91 > 0 ? 1/(t91*(t91 + fabs(t89))) : 0);
+    const kr5_real t95 = t94*(mu_dot0*t93 + mu_dot1*t50 + mu_dot2*t55 - mu_dot3*t60 + mu_dot4*t45 + mu_dot5*t52);
+    const kr5_real t96 = mu_dot0 - t93*t95;
+    const kr5_real t97 = mu_dot1 - t50*t95;
+    const kr5_real t98 = mu_dot2 - t55*t95;
+    const kr5_real t99 = mu_dot3 + t60*t95;
+    const kr5_real t100 = mu_dot4 - t45*t95;
+    const kr5_real t101 = mu_dot5 - t52*t95;
+    const kr5_real t102 = t66 + t88;
+    const kr5_real t103 = t94*(t102*t50 + t38*t52 + t45*t61 + t50*t93 - t55*t69 + t60*t64);
+    const kr5_real t104 = -t103*t93 + t50;
+    const kr5_real t105 = t102 - t103*t50;
+    const kr5_real t106 = t103*t55 + t69;
+    const kr5_real t107 = t103*t60 - t64;
+    const kr5_real t108 = -t103*t45 + t61;
+    const kr5_real t109 = -t103*t52 + t38;
+    const kr5_real t110 = sqrt((t105*t105) + (t106*t106) + (t107*t107) + (t108*t108) + (t109*t109));
+    const kr5_real t111 = t110*(t105 >= 0 ? 1 : -1);
+    const kr5_real t112 = t105 + t111;
+    const kr5_real t113 = (t110 > 0 ? 1/(t110*(t110 + fabs(t105))) : 0);
+    const kr5_real t114 = t113*(t100*t108 + t101*t109 - t106*t98 + t107*t99 + t112*t97);
+    const kr5_real t115 = -t112*t114 + t97;
+    const kr5_real t116 = t106*t114 + t98;
+    const kr5_real t117 = -t107*t114 + t99;
+    const kr5_real t118 = t100 - t108*t114;
+    const kr5_real t119 = t101 - t109*t114;
+    const kr5_real t120 = t73 + t88;
+    const kr5_real t121 = t94*(t120*t55 + t39*t52 + t45*t56 - t50*t69 + t55*t93 - t60*t70);
+    const kr5_real t122 = -t121*t93 + t55;
+    const kr5_real t123 = t121*t50 + t69;
+    const kr5_real t124 = t120 - t121*t55;
+    const kr5_real t125 = t121*t60 + t70;
+    const kr5_real t126 = -t121*t45 + t56;
+    const kr5_real t127 = -t121*t52 + t39;
+    const kr5_real t128 = t113*(-t106*t124 + t107*t125 + t108*t126 + t109*t127 - t112*t123);
+    const kr5_real t129 = t112*t128 + t123;
+    const kr5_real t130 = t106*t128 + t124;
+    const kr5_real t131 = -t107*t128 + t125;
+    const kr5_real t132 = -t108*t128 + t126;
+    const kr5_real t133 = -t109*t128 + t127;
+    const kr5_real t134 = sqrt((t130*t130) + (t131*t131) + (t132*t132) + (t133*t133));
+    const kr5_real t135 = t134*(t130 >= 0 ? 1 : -1);
+    const kr5_real t136 = t130 + t135;
+    const kr5_real t137 = (t134 > 0 ? 1/(t134*(t134 + fabs(t130))) : 0);
+    const kr5_real t138 = t137*(t116*t136 + t117*t131 + t118*t132 + t119*t133);
+    const kr5_real t139 = t116 - t136*t138;
+    const kr5_real t140 = t117 - t131*t138;
+    const kr5_real t141 = t118 - t132*t138;
+    const kr5_real t142 = t119 - t133*t138;
+    const kr5_real t143 = t76 + t88;
+    const kr5_real t144 = -t94*(t143*t60 + t40*t52 - t45*t78 + t50*t64 - t55*t70 + t60*t93);
+    const kr5_real t145 = t144*t93 + t60;
+    const kr5_real t146 = t144*t50 + t64;
+    const kr5_real t147 = -t144*t55 + t70;
+    const kr5_real t148 = t143 + t144*t60;
+    const kr5_real t149 = -t144*t45 + t78;
+    const kr5_real t150 = t144*t52 + t40;
+    const kr5_real t151 = -t113*(t106*t147 - t107*t148 - t108*t149 + t109*t150 + t112*t146);
+    const kr5_real t152 = t112*t151 + t146;
+    const kr5_real t153 = t106*t151 + t147;
+    const kr5_real t154 = -t107*t151 + t148;
+    const kr5_real t155 = -t108*t151 + t149;
+    const kr5_real t156 = t109*t151 + t150;
+    const kr5_real t157 = t137*(t131*t154 + t132*t155 - t133*t156 + t136*t153);
+    const kr5_real t158 = -t136*t157 + t153;
+    const kr5_real t159 = -t131*t157 + t154;
+    const kr5_real t160 = -t132*t157 + t155;
+    const kr5_real t161 = t133*t157 + t156;
+    const kr5_real t162 = sqrt((t159*t159) + (t160*t160) + (t161*t161));
+    const kr5_real t163 = t162*(t159 >= 0 ? 1 : -1);
+    const kr5_real t164 = t159 + t163;
+    const kr5_real t165 = (t162 > 0 ? 1/(t162*(t162 + fabs(t159))) : 0);
+    const kr5_real t166 = t165*(t140*t164 + t141*t160 - t142*t161);
+    const kr5_real t167 = t140 - t164*t166;
+    const kr5_real t168 = t141 - t160*t166;
+    const kr5_real t169 = t142 + t161*t166;
+    const kr5_real t170 = t80 + t88;
+    const kr5_real t171 = t94*(t170*t45 + t41*t52 + t45*t93 + t50*t61 + t55*t56 - t60*t78);
+    const kr5_real t172 = -t171*t93 + t45;
+    const kr5_real t173 = -t171*t50 + t61;
+    const kr5_real t174 = -t171*t55 + t56;
+    const kr5_real t175 = t171*t60 + t78;
+    const kr5_real t176 = t170 - t171*t45;
+    const kr5_real t177 = -t171*t52 + t41;
+    const kr5_real t178 = t113*(-t106*t174 + t107*t175 + t108*t176 + t109*t177 + t112*t173);
+    const kr5_real t179 = -t112*t178 + t173;
+    const kr5_real t180 = t106*t178 + t174;
+    const kr5_real t181 = -t107*t178 + t175;
+    const kr5_real t182 = -t108*t178 + t176;
+    const kr5_real t183 = -t109*t178 + t177;
+    const kr5_real t184 = t137*(t131*t181 + t132*t182 + t133*t183 + t136*t180);
+    const kr5_real t185 = -t136*t184 + t180;
+    const kr5_real t186 = -t131*t184 + t181;
+    const kr5_real t187 = -t132*t184 + t182;
+    const kr5_real t188 = -t133*t184 + t183;
+    const kr5_real t189 = t165*(t160*t187 - t161*t188 + t164*t186);
+    const kr5_real t190 = -t164*t189 + t186;
+    const kr5_real t191 = -t160*t189 + t187;
+    const kr5_real t192 = t161*t189 + t188;
+    const kr5_real t193 = sqrt((t191*t191) + (t192*t192));
+    const kr5_real t194 = t193*(t191 >= 0 ? 1 : -1);
+    const kr5_real t195 = t191 + t194;
+    const kr5_real t196 = (t193 > 0 ? 1/(t193*(t193 + fabs(t191))) : 0);
+    const kr5_real t197 = t196*(t168*t195 + t169*t192);
+    const kr5_real t198 = t168 - t195*t197;
+    const kr5_real t199 = t169 - t192*t197;
+    const kr5_real t200 = t82 + t88;
+    const kr5_real t201 = sqrt(2*t83 + 2*t84 + 2*t85 + 2*t86 + 2*t87 + t90 + (t102*t102) + (t120*t120) + (t143*t143) + (t170*t170) + (t200*t200) + 2*(t38*t38) + 2*(t39*t39) + 2*(t40*t40) + 2*(t41*t41) + 2*(t56*t56) + 2*(t61*t61) + 2*(t64*t64) + 2*(t69*t69) + 2*(t70*t70) + 2*(t78*t78));
+    const kr5_real t202 = t94*(t200*t52 + t38*t50 + t39*t55 + t40*t60 + t41*t45 + t52*t93);
+    const kr5_real t203 = -t202*t93 + t52;
+    const kr5_real t204 = -t202*t50 + t38;
+    const kr5_real t205 = -t202*t55 + t39;
+    const kr5_real t206 = t202*t60 - t40;
+    const kr5_real t207 = -t202*t45 + t41;
+    const kr5_real t208 = t200 - t202*t52;
+    const kr5_real t209 = t113*(-t106*t205 + t107*t206 + t108*t207 + t109*t208 + t112*t204);
+    const kr5_real t210 = -t112*t209 + t204;
+    const kr5_real t211 = t106*t209 + t205;
+    const kr5_real t212 = -t107*t209 + t206;
+    const kr5_real t213 = -t108*t209 + t207;
+    const kr5_real t214 = -t109*t209 + t208;
+    const kr5_real t215 = t137*(t131*t212 + t132*t213 + t133*t214 + t136*t211);
+    const kr5_real t216 = -t136*t215 + t211;
+    const kr5_real t217 = -t131*t215 + t212;
+    const kr5_real t218 = -t132*t215 + t213;
+    const kr5_real t219 = -t133*t215 + t214;
+    const kr5_real t220 = t165*(t160*t218 - t161*t219 + t164*t217);
+    const kr5_real t221 = -t164*t220 + t217;
+    const kr5_real t222 = -t160*t220 + t218;
+    const kr5_real t223 = t161*t220 + t219;
+    const kr5_real t224 = t196*(t192*t223 + t195*t222);
+    const kr5_real t225 = -t195*t224 + t222;
+    const kr5_real t226 = -t192*t224 + t223;
+    const kr5_real t227 = fabs(t226);
+    const kr5_real t228 = t227;
+    const kr5_real t229 = t228*(t226 >= 0 ? 1 : -1);
+    const kr5_real t230 = t226 + t229;
+    const kr5_real t231 = (t228 > 0 ? 1/(t228*(t227 + t228)) : 0);
+    const kr5_real t232 = -t199*t231*(t230*t230) + t199;
+    const kr5_real t233 = t232/t229;
+    const kr5_real t234 = (t198 + t225*t233)/t194;
+    const kr5_real t235 = (t167 + t190*t234 + t221*t233)/t163;
+    const kr5_real t236 = (t139 + t158*t235 + t185*t234 + t216*t233)/t135;
+    const kr5_real t237 = (t115 - t129*t236 - t152*t235 + t179*t234 + t210*t233)/t111;
+    const kr5_real t238 = (t104*t237 + t122*t236 - t145*t235 + t172*t234 + t203*t233 + t96)/t92;
+    const kr5_real t239 = t233 + t237*t32 - t238*t33;
+    const kr5_real t240 = c23*t233 + t11*t234 + t17*t236 + t23*t238 + t235*t9 - t237*t24;
+    const kr5_real t241 = t18*t236 + t233*t35 + t234*t4 - t235*t7 + t237*t37 + t238*t36;
+    const kr5_real t242 = -t0*t233 + t10*t235 + t12*t234;
+    const kr5_real t243 = s1*t22;
+    const kr5_real t244 = c1*t234 - s1*t235;
+    const kr5_real t245 = -t236*t34 + t237*t243 + t238*t58 + t244;
+    const kr5_real t246 = s1*t21;
+    const kr5_real t247 = -t236*t28 + t237*t246 + t238*t57 + t244;
+    const kr5_real t248 = t42 + t62 + 1;
+    const kr5_real t249 = sqrt(t248 + t47 + t65 + t72 + t75 + t79 + t81);
+    const kr5_real t250 = sqrt(t248);
+    const kr5_real t251 = t250*(t33 <= 0 ? 1 : -1);
+    const kr5_real t252 = t251 + t51;
+    const kr5_real t253 = (t250 > 0 ? 1/(t250*(t250 + fabs(t33))) : 0);
+    const kr5_real t254 = t253*(t243*t32 + t252*t58);
+    const kr5_real t255 = -t252*t254 + t58;
+    const kr5_real t256 = t243 - t254*t32;
+    const kr5_real t257 = t253*(t246*t32 + t252*t57);
+    const kr5_real t258 = -t252*t257 + t57;
+    const kr5_real t259 = t246 - t257*t32;
+    const kr5_real t260 = t253*(c23 + t23*t252 - t24*t32);
+    const kr5_real t261 = t23 - t252*t260;
+    const kr5_real t262 = t24 + t260*t32;
+    const kr5_real t263 = c23 - t260;
+    const kr5_real t264 = t253*(t252*t36 + t32*t37 + t35);
+    const kr5_real t265 = -t252*t264 + t36;
+    const kr5_real t266 = -t264*t32 + t37;
+    const kr5_real t267 = -t264 + t35;
+    const kr5_real t268 = t253*(mu_dot0*t252 + mu_dot1*t32 + mu_dot5);
+    const kr5_real t269 = mu_dot0 - t252*t268;
+    const kr5_real t270 = mu_dot1 - t268*t32;
+    const kr5_real t271 = mu_dot5 - t268;
+    const kr5_real t272 = -t0;
+    const kr5_real t273 = t0*t253;
+    const kr5_real t274 = t272 + t273;
+    const kr5_real t275 = t44 + t63;
+    const kr5_real t276 = sqrt(t275 + t71 + (t254*t254) + (t256*t256));
+    const kr5_real t277 = t276*(t256 >= 0 ? 1 : -1);
+    const kr5_real t278 = t256 + t277;
+    const kr5_real t279 = (t276 > 0 ? 1/(t276*(t276 + fabs(t256))) : 0);
+    const kr5_real t280 = t279*(t254*t257 + t259*t278 + t275 + t28*t34);
+    const kr5_real t281 = t259 - t278*t280;
+    const kr5_real t282 = s1*t280 - s1;
+    const kr5_real t283 = -c1*t280 + c1;
+    const kr5_real t284 = t254*t280 - t257;
+    const kr5_real t285 = -t279*(t17*t34 + t254*t263 + t262*t278);
+    const kr5_real t286 = t262 + t278*t285;
+    const kr5_real t287 = t17 + t285*t34;
+    const kr5_real t288 = s1*t285 + t9;
+    const kr5_real t289 = -c1*t285 + t11;
+    const kr5_real t290 = t254*t285 + t263;
+    const kr5_real t291 = t279*(c1*t4 + s1*t7 - t18*t34 - t254*t267 + t266*t278);
+    const kr5_real t292 = t266 - t278*t291;
+    const kr5_real t293 = t18 + t291*t34;
+    const kr5_real t294 = -c1*t291 + t4;
+    const kr5_real t295 = t254*t291 + t267;
+    const kr5_real t296 = -t279*(-c1*mu_dot4 + mu_dot2*t34 + mu_dot3*s1 + t254*t271 - t270*t278);
+    const kr5_real t297 = t270 - t278*t296;
+    const kr5_real t298 = mu_dot2 + t296*t34;
+    const kr5_real t299 = mu_dot3 + s1*t296;
+    const kr5_real t300 = -c1*t296 + mu_dot4;
+    const kr5_real t301 = t254*t296 + t271;
+    const kr5_real t302 = -t28;
+    const kr5_real t303 = t280*t34 + t302;
+    const kr5_real t304 = sqrt((t282*t282) + (t283*t283) + (t284*t284) + (t303*t303));
+    const kr5_real t305 = t304*(t303 >= 0 ? 1 : -1);
+    const kr5_real t306 = t303 + t305;
+    const kr5_real t307 = (t304 > 0 ? 1/(t304*(t304 + fabs(t303))) : 0);
+    const kr5_real t308 = t307*(t282*t288 + t283*t289 + t284*t290 + t287*t306);
+    const kr5_real t309 = t287 - t306*t308;
+    const kr5_real t310 = -t282*t308 + t288;
+    const kr5_real t311 = -t283*t308 + t289;
+    const kr5_real t312 = -t284*t308 + t290;
+    const kr5_real t313 = t307*(t282*t299 + t283*t300 + t284*t301 + t298*t306);
+    const kr5_real t314 = t298 - t306*t313;
+    const kr5_real t315 = -t282*t313 + t299;
+    const kr5_real t316 = -t283*t313 + t300;
+    const kr5_real t317 = -t284*t313 + t301;
+    const kr5_real t318 = sqrt((t310*t310) + (t311*t311) + (t312*t312));
+    const kr5_real t319 = t318*(t310 >= 0 ? 1 : -1);
+    const kr5_real t320 = t310 + t319;
+    const kr5_real t321 = (t318 > 0 ? 1/(t318*(t318 + fabs(t310))) : 0);
+    const kr5_real t322 = t321*(t311*t316 + t312*t317 + t315*t320);
+    const kr5_real t323 = t315 - t320*t322;
+    const kr5_real t324 = -t311*t322 + t316;
+    const kr5_real t325 = -t312*t322 + t317;
+    const kr5_real t326 = -t7;
+    const kr5_real t327 = s1*t291 + t326;
+    const kr5_real t328 = t307*(t282*t327 + t283*t294 + t284*t295 + t293*t306);
+    const kr5_real t329 = t293 - t306*t328;
+    const kr5_real t330 = -t282*t328 + t327;
+    const kr5_real t331 = -t283*t328 + t294;
+    const kr5_real t332 = -t284*t328 + t295;
+    const kr5_real t333 = t321*(t311*t331 + t312*t332 + t320*t330);
+    const kr5_real t334 = -t320*t333 + t330;
+    const kr5_real t335 = -t311*t333 + t331;
+    const kr5_real t336 = -t312*t333 + t332;
+    const kr5_real t337 = sqrt((t335*t335) + (t336*t336));
+    const kr5_real t338 = t337*(t335 >= 0 ? 1 : -1);
+    const kr5_real t339 = t335 + t338;
+    const kr5_real t340 = (t337 > 0 ? 1/(t337*(t337 + fabs(t335))) : 0);
+    const kr5_real t341 = t340*(t324*t339 + t325*t336);
+    const kr5_real t342 = t324 - t339*t341;
+    const kr5_real t343 = t325 - t336*t341;
+    const kr5_real t344 = 2*c1 + c23 + damping + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + q1 + q2 + q3 + q4 + q5 + q6 + t10 + t11 + t12 + t17 + t18 + t23 - t24 + t243 + t246 + t272 + t302 + t32 + t326 - t34 + t35 + t36 + t37 + t4 + t51 + t57 + t58 - t77 + t9 + 1;
+    const kr5_real t345 = t273*t32;
+    const kr5_real t346 = t279*(c1*t12 - s1*t10 - t254*t274 + t278*t345);
+    const kr5_real t347 = -t278*t346 + t345;
+    const kr5_real t348 = s1*t346 + t10;
+    const kr5_real t349 = -c1*t346 + t12;
+    const kr5_real t350 = t254*t346 + t274;
+    const kr5_real t351 = t34*t346;
+    const kr5_real t352 = t307*(t282*t348 + t283*t349 + t284*t350 + t306*t351);
+    const kr5_real t353 = -t306*t352 + t351;
+    const kr5_real t354 = -t282*t352 + t348;
+    const kr5_real t355 = -t283*t352 + t349;
+    const kr5_real t356 = -t284*t352 + t350;
+    const kr5_real t357 = t321*(t311*t355 + t312*t356 + t320*t354);
+    const kr5_real t358 = -t320*t357 + t354;
+    const kr5_real t359 = -t311*t357 + t355;
+    const kr5_real t360 = -t312*t357 + t356;
+    const kr5_real t361 = t340*(t336*t360 + t339*t359);
+    const kr5_real t362 = -t339*t361 + t359;
+    const kr5_real t363 = -t336*t361 + t360;
+    const kr5_real t364 = fabs(t363);
+    const kr5_real t365 = t364;
+    const kr5_real t366 = t365*(t363 >= 0 ? 1 : -1);
+    const kr5_real t367 = t363 + t366;
+    const kr5_real t368 = (t365 > 0 ? 1/(t365*(t364 + t365)) : 0);
+    const kr5_real t369 = -t343*t368*(t367*t367) + t343;
+    const kr5_real t370 = t369/t366;
+    const kr5_real t371 = (t342 + t362*t370)/t338;
+    const kr5_real t372 = (t323 + t334*t371 + t358*t370)/t319;
+    const kr5_real t373 = (t309*t372 + t314 + t329*t371 + t353*t370)/t305;
+    const kr5_real t374 = (t281*t373 - t286*t372 + t292*t371 + t297 + t347*t370)/t277;
+    const kr5_real t375 = (t252*t273*t370 + t255*t374 + t258*t373 + t261*t372 + t265*t371 + t269)/t251;
+    const int t376 = damping > 0;
+    const int t377 = isfinite(t344);
+    const int t378 = damping >= 0;
+    const kr5_real t379 = 1e-12*t249;
+    const kr5_real t380 = 1e-12*t201;
+    const int t381 = (t376 && ((t110 <= t380) || (t134 <= t380) || (t162 <= t380) || (t193 <= t380) || (t228 <= t380) || (t91 <= t380))) || (damping <= 0 && ((t250 <= t379) || (t276 <= t379) || (t304 <= t379) || (t318 <= t379) || (t337 <= t379) || (t365 <= t379)));
+    const int t382 = t377 && t378 && !t381;
+
+    /* Outputs */
+    q_dot[0] = (t382 ? (t376 ? -t239 : -t375) : 0);
+    q_dot[1] = (t382 ? (t376 ? -t245 : -t374) : 0);
+    q_dot[2] = (t382 ? (t376 ? -t247 : -t373) : 0);
+    q_dot[3] = (t382 ? (t376 ? -t240 : -t372) : 0);
+    q_dot[4] = (t382 ? (t376 ? -t241 : -t371) : 0);
+    q_dot[5] = (t382 ? (t376 ? -t242 : -t370) : 0);
+    return (!(t377 && t378) ? 2 : (t381 ? 1 : 0));
+}
+
 void kr5_ik_branches(const kr5_real T[16], kr5_real q[KR5_MAX_IK_SOLUTIONS * KR5_DOF], int valid[KR5_MAX_IK_SOLUTIONS])
 {
     /* 858 operations */
@@ -1140,103 +1565,6 @@ void kr5_ik_branches(const kr5_real T[16], kr5_real q[KR5_MAX_IK_SOLUTIONS * KR5
     valid[5] = t362 && t364 && t372 && t373 && t264 > 1e-12;
     valid[6] = t362 && t364 && t367 && t372 && t374 && t310 >= t363;
     valid[7] = t362 && t364 && t367 && t372 && t374 && t310 > 1e-12;
-}
-
-int kr5_velocity_ik(const kr5_real q[KR5_DOF], const kr5_real mu_dot[KR5_TASK_DIM], kr5_real damping, kr5_real q_dot[KR5_DOF])
-{
-    /* Rows of jacobian() forming Js (the geometric Jacobian). */
-    static const int rows[KR5_TASK_DIM] = {0, 1, 2, 3, 4, 5};
-    kr5_real J[6 * KR5_DOF];
-    kr5_real A[6 * 6];
-    kr5_real x[6];
-    kr5_real scale = 0;
-    const int normal = damping > 0; /* damped: solve (Js Js^T + damping^2 I) x = mu_dot */
-    int r, c, k;
-
-    for (c = 0; c < KR5_DOF; ++c) {
-        q_dot[c] = 0;
-        if (!isfinite(q[c])) {
-            return KR5_VELOCITY_IK_NOT_FINITE;
-        }
-    }
-    for (r = 0; r < KR5_TASK_DIM; ++r) {
-        if (!isfinite(mu_dot[r])) {
-            return KR5_VELOCITY_IK_NOT_FINITE;
-        }
-        x[r] = mu_dot[r]; /* b; copied here, not in a loop of its own (which becomes memcpy) */
-    }
-    if (!(damping >= 0) || !isfinite(damping)) {
-        return KR5_VELOCITY_IK_NOT_FINITE;
-    }
-    kr5_jacobian(q, J);
-
-    /* The system A x = b (6 x 6), b in x. */
-    for (r = 0; r < 6; ++r) {
-        for (c = 0; c < 6; ++c) {
-            kr5_real sum = r == c ? damping * damping : 0;
-            if (!normal) {
-                sum = J[rows[r] * KR5_DOF + c];
-            }
-            for (k = 0; normal && k < KR5_DOF; ++k) {
-                sum += J[rows[r] * KR5_DOF + k] * J[rows[c] * KR5_DOF + k];
-            }
-            A[r * 6 + c] = sum;
-            if (!isfinite(sum)) {
-                return KR5_VELOCITY_IK_NOT_FINITE;
-            }
-            if (fabs(sum) > scale) {
-                scale = fabs(sum);
-            }
-        }
-    }
-
-    /* LU with partial pivoting, applied to x as it goes. */
-    for (k = 0; k < 6; ++k) {
-        int pivot = k;
-        for (r = k + 1; r < 6; ++r) {
-            if (fabs(A[r * 6 + k]) > fabs(A[pivot * 6 + k])) {
-                pivot = r;
-            }
-        }
-        if (!(fabs(A[pivot * 6 + k]) > 1e-12 * scale)) {
-            return KR5_VELOCITY_IK_SINGULAR;
-        }
-        if (pivot != k) {
-            kr5_real swap;
-            for (c = k; c < 6; ++c) {
-                swap = A[k * 6 + c];
-                A[k * 6 + c] = A[pivot * 6 + c];
-                A[pivot * 6 + c] = swap;
-            }
-            swap = x[k];
-            x[k] = x[pivot];
-            x[pivot] = swap;
-        }
-        for (r = k + 1; r < 6; ++r) {
-            const kr5_real factor = A[r * 6 + k] / A[k * 6 + k];
-            for (c = k + 1; c < 6; ++c) {
-                A[r * 6 + c] -= factor * A[k * 6 + c];
-            }
-            x[r] -= factor * x[k];
-        }
-    }
-    for (k = 6 - 1; k >= 0; --k) {
-        for (c = k + 1; c < 6; ++c) {
-            x[k] -= A[k * 6 + c] * x[c];
-        }
-        x[k] /= A[k * 6 + k];
-        if (!normal) {
-            q_dot[k] = x[k];
-        }
-    }
-
-    /* q_dot = Js^T x when damped (else x, written above) */
-    for (c = 0; normal && c < KR5_DOF; ++c) {
-        for (r = 0; r < KR5_TASK_DIM; ++r) {
-            q_dot[c] += J[rows[r] * KR5_DOF + c] * x[r];
-        }
-    }
-    return KR5_VELOCITY_IK_OK;
 }
 
 int kr5_ik(const kr5_real T[16], kr5_real q[KR5_MAX_IK_SOLUTIONS * KR5_DOF])

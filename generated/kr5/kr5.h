@@ -70,22 +70,21 @@ kr5_real kr5_manipulability(const kr5_real q[KR5_DOF]);
  * Result: returned as a scalar. 22 operations. */
 kr5_real kr5_jacobian_det(const kr5_real q[KR5_DOF]);
 
+/* Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status.
+ * Result: q_dot[i], i < 6; returned as a scalar. 1334 operations. */
+int kr5_velocity_ik(const kr5_real q[KR5_DOF], const kr5_real mu_dot[KR5_TASK_DIM], kr5_real damping, kr5_real q_dot[KR5_DOF]);
+
 /* Every branch of the closed-form ik and whether the target allows it.
  * Result: q: 8 x 6 row-major, element (r, c) at q[r * 6 + c]; valid[i], i < 8. 858 operations. */
 void kr5_ik_branches(const kr5_real T[16], kr5_real q[KR5_MAX_IK_SOLUTIONS * KR5_DOF], int valid[KR5_MAX_IK_SOLUTIONS]);
 
-/* Status of kr5_velocity_ik. */
+/* Statuses of kr5_velocity_ik: OK, singular (a diagonal entry of the QR factor R of the
+ * 6 x 6 system at most 1e-12 times its Frobenius norm: take damping > 0), or
+ * not finite (q, mu_dot, damping or Js not finite, or damping < 0); q_dot is 0 unless OK.
+ * Js is the geometric Jacobian; mu_dot is (vx, vy, vz, wx, wy, wz): components of the tool's linear (v) and angular (w) velocity in the world frame. */
 #define KR5_VELOCITY_IK_OK 0
-#define KR5_VELOCITY_IK_SINGULAR 1   /* a pivot below 1e-12 x the largest |entry|: take damping > 0 */
-#define KR5_VELOCITY_IK_NOT_FINITE 2 /* q, mu_dot, damping (must be >= 0) or Js not finite */
-
-/* Joint rates q_dot[KR5_DOF] solving Js q_dot = mu_dot.
- * Js is the geometric Jacobian; mu_dot[KR5_TASK_DIM] is (vx, vy, vz, wx, wy, wz): components of the tool's linear (v) and angular (w) velocity in the world frame.
- * damping = 0: q_dot = Js^-1 mu_dot; damping > 0 (damped least squares near singularities):
- * q_dot = Js^T (Js Js^T + damping^2 I)^-1 mu_dot.
- * LU with partial pivoting of the 6 x 6 system on the stack. Returns
- * KR5_VELOCITY_IK_OK, or a status above with q_dot all 0. */
-int kr5_velocity_ik(const kr5_real q[KR5_DOF], const kr5_real mu_dot[KR5_TASK_DIM], kr5_real damping, kr5_real q_dot[KR5_DOF]);
+#define KR5_VELOCITY_IK_SINGULAR 1
+#define KR5_VELOCITY_IK_NOT_FINITE 2
 
 /* Closed-form inverse kinematics: every joint solution that reaches the target; returns
  * their count k and writes solution i to q[i * KR5_DOF + j], i < k: the valid

@@ -1193,92 +1193,304 @@ panda_real panda_manipulability(const panda_real q[PANDA_DOF])
 
 int panda_velocity_ik(const panda_real q[PANDA_DOF], const panda_real mu_dot[PANDA_TASK_DIM], panda_real damping, panda_real q_dot[PANDA_DOF])
 {
-    /* Rows of jacobian() forming Js (the geometric Jacobian). */
-    static const int rows[PANDA_TASK_DIM] = {0, 1, 2, 3, 4, 5};
-    panda_real J[6 * PANDA_DOF];
-    panda_real A[6 * 6];
-    panda_real x[6];
-    panda_real scale = 0;
-    int r, c, k;
+    /* 1053 operations */
 
-    for (c = 0; c < PANDA_DOF; ++c) {
-        q_dot[c] = 0;
-        if (!isfinite(q[c])) {
-            return PANDA_VELOCITY_IK_NOT_FINITE;
-        }
-    }
-    for (r = 0; r < PANDA_TASK_DIM; ++r) {
-        if (!isfinite(mu_dot[r])) {
-            return PANDA_VELOCITY_IK_NOT_FINITE;
-        }
-        x[r] = mu_dot[r]; /* b; copied here, not in a loop of its own (which becomes memcpy) */
-    }
-    if (!(damping >= 0) || !isfinite(damping)) {
-        return PANDA_VELOCITY_IK_NOT_FINITE;
-    }
-    panda_jacobian(q, J);
+    /* Inputs */
+    const panda_real q1 = q[0];
+    const panda_real q2 = q[1];
+    const panda_real q3 = q[2];
+    const panda_real q4 = q[3];
+    const panda_real q5 = q[4];
+    const panda_real q6 = q[5];
+    const panda_real q7 = q[6];
+    const panda_real mu_dot0 = mu_dot[0];
+    const panda_real mu_dot1 = mu_dot[1];
+    const panda_real mu_dot2 = mu_dot[2];
+    const panda_real mu_dot3 = mu_dot[3];
+    const panda_real mu_dot4 = mu_dot[4];
+    const panda_real mu_dot5 = mu_dot[5];
 
-    /* The system A x = b (6 x 6), b in x. */
-    for (r = 0; r < 6; ++r) {
-        for (c = 0; c < 6; ++c) {
-            panda_real sum = r == c ? damping * damping : 0;
-            for (k = 0; k < PANDA_DOF; ++k) {
-                sum += J[rows[r] * PANDA_DOF + k] * J[rows[c] * PANDA_DOF + k];
-            }
-            A[r * 6 + c] = sum;
-            if (!isfinite(sum)) {
-                return PANDA_VELOCITY_IK_NOT_FINITE;
-            }
-            if (fabs(sum) > scale) {
-                scale = fabs(sum);
-            }
-        }
-    }
+    /* Intermediate terms */
+    const panda_real c1 = cos(q1);
+    const panda_real s1 = sin(q1);
+    const panda_real c2 = cos(q2);
+    const panda_real s2 = sin(q2);
+    const panda_real c3 = cos(q3);
+    const panda_real s3 = sin(q3);
+    const panda_real c4 = cos(q4);
+    const panda_real s4 = sin(q4);
+    const panda_real c5 = cos(q5);
+    const panda_real s5 = sin(q5);
+    const panda_real c6 = cos(q6);
+    const panda_real s6 = sin(q6);
+    const panda_real t0 = s1*s3;
+    const panda_real t1 = c1*c3;
+    const panda_real t2 = c2*t1 - t0;
+    const panda_real t3 = -c2*t0 + t1;
+    const panda_real t4 = c3*s1;
+    const panda_real t5 = c1*s3;
+    const panda_real t6 = c2*t5 + t4;
+    const panda_real t7 = c2*t4 + t5;
+    const panda_real t8 = c1*s2;
+    const panda_real t9 = 0.0825*t2 + 0.316*t8;
+    const panda_real t10 = c4*t2 + s4*t8;
+    const panda_real t11 = c4*t8 - s4*t2;
+    const panda_real t12 = c5*t10 - s5*t6;
+    const panda_real t13 = c5*t6 + s5*t10;
+    const panda_real t14 = c6*t12 + s6*t11;
+    const panda_real t15 = c6*t11 - s6*t12;
+    const panda_real t16 = 0.088*t14 - 0.21*t15;
+    const panda_real t17 = 0.384*t11 + t16;
+    const panda_real t18 = -0.0825*t10 + t17;
+    const panda_real t19 = t18 + t9;
+    const panda_real t20 = s1*s2;
+    const panda_real t21 = 0.316*t20 + 0.0825*t7;
+    const panda_real t22 = c4*t7 + s4*t20;
+    const panda_real t23 = c4*t20 - s4*t7;
+    const panda_real t24 = c5*t22 + s5*t3;
+    const panda_real t25 = c5*t3 - s5*t22;
+    const panda_real t26 = c6*t24 + s6*t23;
+    const panda_real t27 = c6*t23 - s6*t24;
+    const panda_real t28 = 0.088*t26 - 0.21*t27;
+    const panda_real t29 = 0.384*t23 + t28;
+    const panda_real t30 = -0.0825*t22 + t29;
+    const panda_real t31 = t21 + t30;
+    const panda_real t32 = c1*t19 + s1*t31;
+    const panda_real t33 = t18*t3 + t30*t6;
+    const panda_real t34 = t11*t29 - t17*t23;
+    const panda_real t35 = t13*t28 + t16*t25;
+    const panda_real t36 = -t19*t20 + t31*t8;
+    const panda_real t37 = (t32*t32) + (t33*t33) + (t34*t34) + (t35*t35) + (t36*t36);
+    const panda_real t38 = c3*s2;
+    const panda_real t39 = 0.316*c2 - 0.0825*t38;
+    const panda_real t40 = c2*s4 - c4*t38;
+    const panda_real t41 = c2*c4 + s4*t38;
+    const panda_real t42 = s2*s3;
+    const panda_real t43 = c5*t40 + s5*t42;
+    const panda_real t44 = c5*t42 - s5*t40;
+    const panda_real t45 = c6*t43 + s6*t41;
+    const panda_real t46 = c6*t41 - s6*t43;
+    const panda_real t47 = 0.088*t45 - 0.21*t46;
+    const panda_real t48 = 0.384*t41 + t47;
+    const panda_real t49 = -0.0825*t40 + t48;
+    const panda_real t50 = t39 + t49;
+    const panda_real t51 = -t3*t49 + t30*t42;
+    const panda_real t52 = t23*t48 - t29*t41;
+    const panda_real t53 = t18*t42 + t49*t6;
+    const panda_real t54 = t13*t47 + t16*t44;
+    const panda_real t55 = -t25*t47 + t28*t44;
+    const panda_real t56 = -t11*t48 + t17*t41;
+    const panda_real t57 = c2*t36 - t33*t42 + t34*t41 - t35*t44;
+    const panda_real t58 = c2*t8 + t11*t41 - t13*t44 + t15*t46 - t42*t6;
+    const panda_real t59 = c2*t20 + t23*t41 + t25*t44 + t27*t46 + t3*t42;
+    const panda_real t60 = c1*t50;
+    const panda_real t61 = c2*t19 - s2*t60;
+    const panda_real t62 = c2*t61 + t19 + t41*t56 + t42*t53 + t44*t54;
+    const panda_real t63 = s1*t50;
+    const panda_real t64 = -c2*t31 + s2*t63;
+    const panda_real t65 = -c2*t64 + t31 - t41*t52 + t42*t51 + t44*t55;
+    const panda_real t66 = c1 + c2 + damping + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + q1 + q2 + q3 + q4 + q5 + q6 + q7 - s1 + t11 + t13 - t15 + t19 + t20 + t23 - t25 - t27 - t3 - t31 - t32 + t33 + t34 + t35 + t36 + t41 - t42 - t44 - t46 + t51 + t52 - t53 - t54 + t55 + t56 + t6 + t60 + t61 + t63 + t64 + t8 + 1;
+    const panda_real t67 = (t50*t50);
+    const panda_real t68 = (c1*c1);
+    const panda_real t69 = t67*t68 + (t31*t31) + (t51*t51) + (t52*t52) + (t55*t55) + (t64*t64);
+    const panda_real t70 = t20*t64 + t23*t52 - t25*t55 - t3*t51 + t50*t68;
+    const panda_real t71 = c1*s1;
+    const panda_real t72 = -t19*t31 - t51*t53 + t52*t56 - t54*t55 + t61*t64 + t67*t71;
+    const panda_real t73 = c1*t32;
+    const panda_real t74 = t33*t51 + t34*t52 + t35*t55 + t36*t64 - t50*t73;
+    const panda_real t75 = -t20*t36 - t23*t34 + t25*t35 + t3*t33 + t73;
+    const panda_real t76 = t50*t71;
+    const panda_real t77 = t11*t52 + t13*t55 + t51*t6 + t64*t8 - t76;
+    const panda_real t78 = t20*t61 + t23*t56 + t25*t54 + t3*t53 + t76;
+    const panda_real t79 = (s1*s1);
+    const panda_real t80 = t67*t79 + (t19*t19) + (t53*t53) + (t54*t54) + (t56*t56) + (t61*t61);
+    const panda_real t81 = -t11*t56 + t13*t54 + t50*t79 + t53*t6 - t61*t8;
+    const panda_real t82 = s1*t32;
+    const panda_real t83 = t33*t53 - t34*t56 + t35*t54 - t36*t61 + t50*t82;
+    const panda_real t84 = t11*t34 + t13*t35 + t33*t6 + t36*t8 + t82;
+    const panda_real t85 = (s2*s2);
+    const panda_real t86 = t68*t85 + t79 + (t11*t11) + (t13*t13) + (t15*t15) + (t6*t6);
+    const panda_real t87 = t11*t23 - t13*t25 + t15*t27 - t3*t6 + t71*t85 - t71;
+    const panda_real t88 = t68 + t79*t85 + (t23*t23) + (t25*t25) + (t27*t27) + (t3*t3);
+    const panda_real t89 = t85*(s3*s3) + (c2*c2) + (t41*t41) + (t44*t44) + (t46*t46) + 1;
+    const panda_real t90 = (t72*t72);
+    const panda_real t91 = (t65*t65);
+    const panda_real t92 = (t74*t74);
+    const panda_real t93 = (t77*t77);
+    const panda_real t94 = (t70*t70);
+    const panda_real t95 = (damping*damping);
+    const panda_real t96 = t69 + t95;
+    const panda_real t97 = (t96*t96);
+    const panda_real t98 = sqrt(t90 + t91 + t92 + t93 + t94 + t97);
+    const panda_real t99 = t98*(t96 >= 0 ? 1 : -1);
+    const panda_real t100 = t96 + t99;
+    const panda_real t101 = (t98 > 0 ? 1/(t98*(t98 + fabs(t96))) : 0);
+    const panda_real t102 = t101*(mu_dot0*t100 + mu_dot1*t72 + mu_dot2*t74 + mu_dot3*t77 + mu_dot4*t70 - mu_dot5*t65);
+    const panda_real t103 = mu_dot0 - t100*t102;
+    const panda_real t104 = mu_dot1 - t102*t72;
+    const panda_real t105 = mu_dot2 - t102*t74;
+    const panda_real t106 = mu_dot3 - t102*t77;
+    const panda_real t107 = mu_dot4 - t102*t70;
+    const panda_real t108 = mu_dot5 + t102*t65;
+    const panda_real t109 = t80 + t95;
+    const panda_real t110 = t101*(t100*t72 + t109*t72 - t62*t65 + t70*t78 - t74*t83 - t77*t81);
+    const panda_real t111 = -t100*t110 + t72;
+    const panda_real t112 = t109 - t110*t72;
+    const panda_real t113 = t110*t74 + t83;
+    const panda_real t114 = t110*t77 + t81;
+    const panda_real t115 = -t110*t70 + t78;
+    const panda_real t116 = t110*t65 + t62;
+    const panda_real t117 = sqrt((t112*t112) + (t113*t113) + (t114*t114) + (t115*t115) + (t116*t116));
+    const panda_real t118 = t117*(t112 >= 0 ? 1 : -1);
+    const panda_real t119 = t112 + t118;
+    const panda_real t120 = (t117 > 0 ? 1/(t117*(t117 + fabs(t112))) : 0);
+    const panda_real t121 = t120*(t104*t119 - t105*t113 - t106*t114 + t107*t115 + t108*t116);
+    const panda_real t122 = t104 - t119*t121;
+    const panda_real t123 = t105 + t113*t121;
+    const panda_real t124 = t106 + t114*t121;
+    const panda_real t125 = t107 - t115*t121;
+    const panda_real t126 = t108 - t116*t121;
+    const panda_real t127 = t37 + t95;
+    const panda_real t128 = t101*(t100*t74 + t127*t74 - t57*t65 - t70*t75 - t72*t83 + t77*t84);
+    const panda_real t129 = -t100*t128 + t74;
+    const panda_real t130 = t128*t72 + t83;
+    const panda_real t131 = t127 - t128*t74;
+    const panda_real t132 = -t128*t77 + t84;
+    const panda_real t133 = t128*t70 + t75;
+    const panda_real t134 = t128*t65 + t57;
+    const panda_real t135 = -t120*(t113*t131 + t114*t132 + t115*t133 - t116*t134 + t119*t130);
+    const panda_real t136 = t119*t135 + t130;
+    const panda_real t137 = t113*t135 + t131;
+    const panda_real t138 = t114*t135 + t132;
+    const panda_real t139 = t115*t135 + t133;
+    const panda_real t140 = -t116*t135 + t134;
+    const panda_real t141 = sqrt((t137*t137) + (t138*t138) + (t139*t139) + (t140*t140));
+    const panda_real t142 = t141*(t137 >= 0 ? 1 : -1);
+    const panda_real t143 = t137 + t142;
+    const panda_real t144 = (t141 > 0 ? 1/(t141*(t141 + fabs(t137))) : 0);
+    const panda_real t145 = t144*(t123*t143 + t124*t138 - t125*t139 + t126*t140);
+    const panda_real t146 = t123 - t143*t145;
+    const panda_real t147 = t124 - t138*t145;
+    const panda_real t148 = t125 + t139*t145;
+    const panda_real t149 = t126 - t140*t145;
+    const panda_real t150 = t86 + t95;
+    const panda_real t151 = t101*(t100*t77 + t150*t77 - t58*t65 + t70*t87 - t72*t81 + t74*t84);
+    const panda_real t152 = -t100*t151 + t77;
+    const panda_real t153 = t151*t72 + t81;
+    const panda_real t154 = -t151*t74 + t84;
+    const panda_real t155 = t150 - t151*t77;
+    const panda_real t156 = -t151*t70 + t87;
+    const panda_real t157 = t151*t65 + t58;
+    const panda_real t158 = -t120*(t113*t154 + t114*t155 - t115*t156 - t116*t157 + t119*t153);
+    const panda_real t159 = t119*t158 + t153;
+    const panda_real t160 = t113*t158 + t154;
+    const panda_real t161 = t114*t158 + t155;
+    const panda_real t162 = -t115*t158 + t156;
+    const panda_real t163 = -t116*t158 + t157;
+    const panda_real t164 = t144*(t138*t161 - t139*t162 + t140*t163 + t143*t160);
+    const panda_real t165 = -t143*t164 + t160;
+    const panda_real t166 = -t138*t164 + t161;
+    const panda_real t167 = t139*t164 + t162;
+    const panda_real t168 = -t140*t164 + t163;
+    const panda_real t169 = sqrt((t166*t166) + (t167*t167) + (t168*t168));
+    const panda_real t170 = t169*(t166 >= 0 ? 1 : -1);
+    const panda_real t171 = t166 + t170;
+    const panda_real t172 = (t169 > 0 ? 1/(t169*(t169 + fabs(t166))) : 0);
+    const panda_real t173 = t172*(t147*t171 + t148*t167 + t149*t168);
+    const panda_real t174 = t147 - t171*t173;
+    const panda_real t175 = t148 - t167*t173;
+    const panda_real t176 = t149 - t168*t173;
+    const panda_real t177 = t88 + t95;
+    const panda_real t178 = t101*(t100*t70 + t177*t70 - t59*t65 + t72*t78 - t74*t75 + t77*t87);
+    const panda_real t179 = -t100*t178 + t70;
+    const panda_real t180 = -t178*t72 + t78;
+    const panda_real t181 = t178*t74 + t75;
+    const panda_real t182 = -t178*t77 + t87;
+    const panda_real t183 = t177 - t178*t70;
+    const panda_real t184 = t178*t65 + t59;
+    const panda_real t185 = t120*(t113*t181 - t114*t182 + t115*t183 + t116*t184 + t119*t180);
+    const panda_real t186 = -t119*t185 + t180;
+    const panda_real t187 = t113*t185 - t181;
+    const panda_real t188 = t114*t185 + t182;
+    const panda_real t189 = -t115*t185 + t183;
+    const panda_real t190 = -t116*t185 + t184;
+    const panda_real t191 = t144*(t138*t188 - t139*t189 + t140*t190 + t143*t187);
+    const panda_real t192 = -t143*t191 + t187;
+    const panda_real t193 = -t138*t191 + t188;
+    const panda_real t194 = t139*t191 + t189;
+    const panda_real t195 = -t140*t191 + t190;
+    const panda_real t196 = t172*(t167*t194 + t168*t195 + t171*t193);
+    const panda_real t197 = -t171*t196 + t193;
+    const panda_real t198 = -t167*t196 + t194;
+    const panda_real t199 = -t168*t196 + t195;
+    const panda_real t200 = sqrt((t198*t198) + (t199*t199));
+    const panda_real t201 = t200*(t198 >= 0 ? 1 : -1);
+    const panda_real t202 = t198 + t201;
+    const panda_real t203 = (t200 > 0 ? 1/(t200*(t200 + fabs(t198))) : 0);
+    const panda_real t204 = t203*(t175*t202 + t176*t199);
+    const panda_real t205 = t175 - t202*t204;
+    const panda_real t206 = t176 - t199*t204;
+    const panda_real t207 = t89 + t95;
+    const panda_real t208 = sqrt(2*t90 + 2*t91 + 2*t92 + 2*t93 + 2*t94 + t97 + (t109*t109) + (t127*t127) + (t150*t150) + (t177*t177) + (t207*t207) + 2*(t57*t57) + 2*(t58*t58) + 2*(t59*t59) + 2*(t62*t62) + 2*(t75*t75) + 2*(t78*t78) + 2*(t81*t81) + 2*(t83*t83) + 2*(t84*t84) + 2*(t87*t87));
+    const panda_real t209 = t101*(-t100*t65 - t207*t65 + t57*t74 + t58*t77 + t59*t70 + t62*t72);
+    const panda_real t210 = t100*t209 + t65;
+    const panda_real t211 = -t209*t72 + t62;
+    const panda_real t212 = -t209*t74 + t57;
+    const panda_real t213 = -t209*t77 + t58;
+    const panda_real t214 = -t209*t70 + t59;
+    const panda_real t215 = t207 + t209*t65;
+    const panda_real t216 = t120*(-t113*t212 - t114*t213 + t115*t214 + t116*t215 + t119*t211);
+    const panda_real t217 = -t119*t216 + t211;
+    const panda_real t218 = t113*t216 + t212;
+    const panda_real t219 = t114*t216 + t213;
+    const panda_real t220 = -t115*t216 + t214;
+    const panda_real t221 = -t116*t216 + t215;
+    const panda_real t222 = t144*(t138*t219 - t139*t220 + t140*t221 + t143*t218);
+    const panda_real t223 = -t143*t222 + t218;
+    const panda_real t224 = -t138*t222 + t219;
+    const panda_real t225 = t139*t222 + t220;
+    const panda_real t226 = -t140*t222 + t221;
+    const panda_real t227 = t172*(t167*t225 + t168*t226 + t171*t224);
+    const panda_real t228 = -t171*t227 + t224;
+    const panda_real t229 = -t167*t227 + t225;
+    const panda_real t230 = -t168*t227 + t226;
+    const panda_real t231 = t203*(t199*t230 + t202*t229);
+    const panda_real t232 = -t202*t231 + t229;
+    const panda_real t233 = -t199*t231 + t230;
+    const panda_real t234 = fabs(t233);
+    const panda_real t235 = t234;
+    const panda_real t236 = t235*(t233 >= 0 ? 1 : -1);
+    const panda_real t237 = t233 + t236;
+    const panda_real t238 = (t235 > 0 ? 1/(t235*(t234 + t235)) : 0);
+    const panda_real t239 = -t206*t238*(t237*t237) + t206;
+    const panda_real t240 = t239/t236;
+    const panda_real t241 = (t205 + t232*t240)/t201;
+    const panda_real t242 = (t174 + t197*t241 + t228*t240)/t170;
+    const panda_real t243 = (t146 + t165*t242 + t192*t241 + t223*t240)/t142;
+    const panda_real t244 = (t122 - t136*t243 - t159*t242 + t186*t241 + t217*t240)/t118;
+    const panda_real t245 = (t103 + t111*t244 + t129*t243 + t152*t242 + t179*t241 - t210*t240)/t99;
+    const panda_real t246 = t19*t244 + t240 - t245*t31;
+    const panda_real t247 = c1*t241 - s1*t242 - t243*t32 + t244*t63 + t245*t60;
+    const panda_real t248 = c2*t240 + t20*t241 + t242*t8 + t243*t36 + t244*t61 + t245*t64;
+    const panda_real t249 = t240*t42 + t241*t3 - t242*t6 - t243*t33 + t244*t53 - t245*t51;
+    const panda_real t250 = t11*t242 + t23*t241 + t240*t41 + t243*t34 + t244*t56 + t245*t52;
+    const panda_real t251 = -t13*t242 + t240*t44 + t241*t25 - t243*t35 + t244*t54 - t245*t55;
+    const panda_real t252 = t15*t242 + t240*t46 + t241*t27;
+    const int t253 = isfinite(t66);
+    const int t254 = damping >= 0;
+    const panda_real t255 = 1e-12*t208;
+    const int t256 = (t117 <= t255) || (t141 <= t255) || (t169 <= t255) || (t200 <= t255) || (t235 <= t255) || (t98 <= t255);
+    const int t257 = t253 && t254 && !t256;
 
-    /* LU with partial pivoting, applied to x as it goes. */
-    for (k = 0; k < 6; ++k) {
-        int pivot = k;
-        for (r = k + 1; r < 6; ++r) {
-            if (fabs(A[r * 6 + k]) > fabs(A[pivot * 6 + k])) {
-                pivot = r;
-            }
-        }
-        if (!(fabs(A[pivot * 6 + k]) > 1e-12 * scale)) {
-            return PANDA_VELOCITY_IK_SINGULAR;
-        }
-        if (pivot != k) {
-            panda_real swap;
-            for (c = k; c < 6; ++c) {
-                swap = A[k * 6 + c];
-                A[k * 6 + c] = A[pivot * 6 + c];
-                A[pivot * 6 + c] = swap;
-            }
-            swap = x[k];
-            x[k] = x[pivot];
-            x[pivot] = swap;
-        }
-        for (r = k + 1; r < 6; ++r) {
-            const panda_real factor = A[r * 6 + k] / A[k * 6 + k];
-            for (c = k + 1; c < 6; ++c) {
-                A[r * 6 + c] -= factor * A[k * 6 + c];
-            }
-            x[r] -= factor * x[k];
-        }
-    }
-    for (k = 6 - 1; k >= 0; --k) {
-        for (c = k + 1; c < 6; ++c) {
-            x[k] -= A[k * 6 + c] * x[c];
-        }
-        x[k] /= A[k * 6 + k];
-    }
-
-    /* q_dot = Js^T x */
-    for (c = 0; c < PANDA_DOF; ++c) {
-        for (r = 0; r < PANDA_TASK_DIM; ++r) {
-            q_dot[c] += J[rows[r] * PANDA_DOF + c] * x[r];
-        }
-    }
-    return PANDA_VELOCITY_IK_OK;
+    /* Outputs */
+    q_dot[0] = (t257 ? -t246 : 0);
+    q_dot[1] = (t257 ? -t247 : 0);
+    q_dot[2] = (t257 ? -t248 : 0);
+    q_dot[3] = (t257 ? t249 : 0);
+    q_dot[4] = (t257 ? -t250 : 0);
+    q_dot[5] = (t257 ? t251 : 0);
+    q_dot[6] = (t257 ? t252 : 0);
+    return (!(t253 && t254) ? 2 : (t256 ? 1 : 0));
 }
 
 /* -- Iterative inverse kinematics -- */

@@ -66,18 +66,17 @@ void panda_singularity_factors(const panda_real q[PANDA_DOF], panda_real f[PANDA
  * Result: returned as a scalar. 758 operations. */
 panda_real panda_manipulability(const panda_real q[PANDA_DOF]);
 
-/* Status of panda_velocity_ik. */
-#define PANDA_VELOCITY_IK_OK 0
-#define PANDA_VELOCITY_IK_SINGULAR 1   /* a pivot below 1e-12 x the largest |entry|: take damping > 0 */
-#define PANDA_VELOCITY_IK_NOT_FINITE 2 /* q, mu_dot, damping (must be >= 0) or Js not finite */
-
-/* Joint rates q_dot[PANDA_DOF] solving Js q_dot = mu_dot.
- * Js is the geometric Jacobian; mu_dot[PANDA_TASK_DIM] is (vx, vy, vz, wx, wy, wz): components of the tool's linear (v) and angular (w) velocity in the world frame.
- * Minimum-norm solution q_dot = Js^T (Js Js^T + damping^2 I)^-1 mu_dot (right pseudo-inverse
- * for damping = 0, damped least squares for damping > 0).
- * LU with partial pivoting of the 6 x 6 system on the stack. Returns
- * PANDA_VELOCITY_IK_OK, or a status above with q_dot all 0. */
+/* Joint rates q_dot solving Js q_dot = mu_dot: Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status.
+ * Result: q_dot[i], i < 7; returned as a scalar. 1053 operations. */
 int panda_velocity_ik(const panda_real q[PANDA_DOF], const panda_real mu_dot[PANDA_TASK_DIM], panda_real damping, panda_real q_dot[PANDA_DOF]);
+
+/* Statuses of panda_velocity_ik: OK, singular (a diagonal entry of the QR factor R of the
+ * 6 x 6 system at most 1e-12 times its Frobenius norm: take damping > 0), or
+ * not finite (q, mu_dot, damping or Js not finite, or damping < 0); q_dot is 0 unless OK.
+ * Js is the geometric Jacobian; mu_dot is (vx, vy, vz, wx, wy, wz): components of the tool's linear (v) and angular (w) velocity in the world frame. */
+#define PANDA_VELOCITY_IK_OK 0
+#define PANDA_VELOCITY_IK_SINGULAR 1
+#define PANDA_VELOCITY_IK_NOT_FINITE 2
 
 /* ik_numeric status codes. */
 #define PANDA_IK_NUMERIC_CONVERGED 0       /* |error| <= tol */

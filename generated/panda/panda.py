@@ -1181,6 +1181,308 @@ def manipulability(q):
     return w
 
 
+@numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
+def velocity_ik(q, mu_dot, damping=0.0):
+    """joint rates q_dot solving Js q_dot = mu_dot: Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: (7 x 1 and 1 x 1), 1053 operations."""
+    q = _argument("q", q, (7,))
+    mu_dot = _argument("mu_dot", mu_dot, (6,))
+    damping = _argument("damping", damping, ())
+    q1 = q[..., 0]
+    q2 = q[..., 1]
+    q3 = q[..., 2]
+    q4 = q[..., 3]
+    q5 = q[..., 4]
+    q6 = q[..., 5]
+    q7 = q[..., 6]
+    mu_dot0 = mu_dot[..., 0]
+    mu_dot1 = mu_dot[..., 1]
+    mu_dot2 = mu_dot[..., 2]
+    mu_dot3 = mu_dot[..., 3]
+    mu_dot4 = mu_dot[..., 4]
+    mu_dot5 = mu_dot[..., 5]
+    c1 = numpy.cos(q1)
+    s1 = numpy.sin(q1)
+    c2 = numpy.cos(q2)
+    s2 = numpy.sin(q2)
+    c3 = numpy.cos(q3)
+    s3 = numpy.sin(q3)
+    c4 = numpy.cos(q4)
+    s4 = numpy.sin(q4)
+    c5 = numpy.cos(q5)
+    s5 = numpy.sin(q5)
+    c6 = numpy.cos(q6)
+    s6 = numpy.sin(q6)
+    t0 = s1*s3
+    t1 = c1*c3
+    t2 = c2*t1 - t0
+    t3 = -c2*t0 + t1
+    t4 = c3*s1
+    t5 = c1*s3
+    t6 = c2*t5 + t4
+    t7 = c2*t4 + t5
+    t8 = c1*s2
+    t9 = 0.0825*t2 + 0.316*t8
+    t10 = c4*t2 + s4*t8
+    t11 = c4*t8 - s4*t2
+    t12 = c5*t10 - s5*t6
+    t13 = c5*t6 + s5*t10
+    t14 = c6*t12 + s6*t11
+    t15 = c6*t11 - s6*t12
+    t16 = 0.088*t14 - 0.21*t15
+    t17 = 0.384*t11 + t16
+    t18 = -0.0825*t10 + t17
+    t19 = t18 + t9
+    t20 = s1*s2
+    t21 = 0.316*t20 + 0.0825*t7
+    t22 = c4*t7 + s4*t20
+    t23 = c4*t20 - s4*t7
+    t24 = c5*t22 + s5*t3
+    t25 = c5*t3 - s5*t22
+    t26 = c6*t24 + s6*t23
+    t27 = c6*t23 - s6*t24
+    t28 = 0.088*t26 - 0.21*t27
+    t29 = 0.384*t23 + t28
+    t30 = -0.0825*t22 + t29
+    t31 = t21 + t30
+    t32 = c1*t19 + s1*t31
+    t33 = t18*t3 + t30*t6
+    t34 = t11*t29 - t17*t23
+    t35 = t13*t28 + t16*t25
+    t36 = -t19*t20 + t31*t8
+    t37 = t32**2 + t33**2 + t34**2 + t35**2 + t36**2
+    t38 = c3*s2
+    t39 = 0.316*c2 - 0.0825*t38
+    t40 = c2*s4 - c4*t38
+    t41 = c2*c4 + s4*t38
+    t42 = s2*s3
+    t43 = c5*t40 + s5*t42
+    t44 = c5*t42 - s5*t40
+    t45 = c6*t43 + s6*t41
+    t46 = c6*t41 - s6*t43
+    t47 = 0.088*t45 - 0.21*t46
+    t48 = 0.384*t41 + t47
+    t49 = -0.0825*t40 + t48
+    t50 = t39 + t49
+    t51 = -t3*t49 + t30*t42
+    t52 = t23*t48 - t29*t41
+    t53 = t18*t42 + t49*t6
+    t54 = t13*t47 + t16*t44
+    t55 = -t25*t47 + t28*t44
+    t56 = -t11*t48 + t17*t41
+    t57 = c2*t36 - t33*t42 + t34*t41 - t35*t44
+    t58 = c2*t8 + t11*t41 - t13*t44 + t15*t46 - t42*t6
+    t59 = c2*t20 + t23*t41 + t25*t44 + t27*t46 + t3*t42
+    t60 = c1*t50
+    t61 = c2*t19 - s2*t60
+    t62 = c2*t61 + t19 + t41*t56 + t42*t53 + t44*t54
+    t63 = s1*t50
+    t64 = -c2*t31 + s2*t63
+    t65 = -c2*t64 + t31 - t41*t52 + t42*t51 + t44*t55
+    t66 = c1 + c2 + damping + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + q1 + q2 + q3 + q4 + q5 + q6 + q7 - s1 + t11 + t13 - t15 + t19 + t20 + t23 - t25 - t27 - t3 - t31 - t32 + t33 + t34 + t35 + t36 + t41 - t42 - t44 - t46 + t51 + t52 - t53 - t54 + t55 + t56 + t6 + t60 + t61 + t63 + t64 + t8 + 1
+    t67 = t50**2
+    t68 = c1**2
+    t69 = t31**2 + t51**2 + t52**2 + t55**2 + t64**2 + t67*t68
+    t70 = t20*t64 + t23*t52 - t25*t55 - t3*t51 + t50*t68
+    t71 = c1*s1
+    t72 = -t19*t31 - t51*t53 + t52*t56 - t54*t55 + t61*t64 + t67*t71
+    t73 = c1*t32
+    t74 = t33*t51 + t34*t52 + t35*t55 + t36*t64 - t50*t73
+    t75 = -t20*t36 - t23*t34 + t25*t35 + t3*t33 + t73
+    t76 = t50*t71
+    t77 = t11*t52 + t13*t55 + t51*t6 + t64*t8 - t76
+    t78 = t20*t61 + t23*t56 + t25*t54 + t3*t53 + t76
+    t79 = s1**2
+    t80 = t19**2 + t53**2 + t54**2 + t56**2 + t61**2 + t67*t79
+    t81 = -t11*t56 + t13*t54 + t50*t79 + t53*t6 - t61*t8
+    t82 = s1*t32
+    t83 = t33*t53 - t34*t56 + t35*t54 - t36*t61 + t50*t82
+    t84 = t11*t34 + t13*t35 + t33*t6 + t36*t8 + t82
+    t85 = s2**2
+    t86 = t11**2 + t13**2 + t15**2 + t6**2 + t68*t85 + t79
+    t87 = t11*t23 - t13*t25 + t15*t27 - t3*t6 + t71*t85 - t71
+    t88 = t23**2 + t25**2 + t27**2 + t3**2 + t68 + t79*t85
+    t89 = c2**2 + s3**2*t85 + t41**2 + t44**2 + t46**2 + 1
+    t90 = t72**2
+    t91 = t65**2
+    t92 = t74**2
+    t93 = t77**2
+    t94 = t70**2
+    t95 = damping**2
+    t96 = t69 + t95
+    t97 = t96**2
+    t98 = numpy.sqrt(t90 + t91 + t92 + t93 + t94 + t97)
+    t99 = t98*numpy.where(numpy.greater_equal(t96, 0), 1, -1)
+    t100 = t96 + t99
+    t101 = numpy.where(numpy.greater(t98, 0), 1/(t98*(t98 + abs(t96))), 0)
+    t102 = t101*(mu_dot0*t100 + mu_dot1*t72 + mu_dot2*t74 + mu_dot3*t77 + mu_dot4*t70 - mu_dot5*t65)
+    t103 = mu_dot0 - t100*t102
+    t104 = mu_dot1 - t102*t72
+    t105 = mu_dot2 - t102*t74
+    t106 = mu_dot3 - t102*t77
+    t107 = mu_dot4 - t102*t70
+    t108 = mu_dot5 + t102*t65
+    t109 = t80 + t95
+    t110 = t101*(t100*t72 + t109*t72 - t62*t65 + t70*t78 - t74*t83 - t77*t81)
+    t111 = -t100*t110 + t72
+    t112 = t109 - t110*t72
+    t113 = t110*t74 + t83
+    t114 = t110*t77 + t81
+    t115 = -t110*t70 + t78
+    t116 = t110*t65 + t62
+    t117 = numpy.sqrt(t112**2 + t113**2 + t114**2 + t115**2 + t116**2)
+    t118 = t117*numpy.where(numpy.greater_equal(t112, 0), 1, -1)
+    t119 = t112 + t118
+    t120 = numpy.where(numpy.greater(t117, 0), 1/(t117*(t117 + abs(t112))), 0)
+    t121 = t120*(t104*t119 - t105*t113 - t106*t114 + t107*t115 + t108*t116)
+    t122 = t104 - t119*t121
+    t123 = t105 + t113*t121
+    t124 = t106 + t114*t121
+    t125 = t107 - t115*t121
+    t126 = t108 - t116*t121
+    t127 = t37 + t95
+    t128 = t101*(t100*t74 + t127*t74 - t57*t65 - t70*t75 - t72*t83 + t77*t84)
+    t129 = -t100*t128 + t74
+    t130 = t128*t72 + t83
+    t131 = t127 - t128*t74
+    t132 = -t128*t77 + t84
+    t133 = t128*t70 + t75
+    t134 = t128*t65 + t57
+    t135 = -t120*(t113*t131 + t114*t132 + t115*t133 - t116*t134 + t119*t130)
+    t136 = t119*t135 + t130
+    t137 = t113*t135 + t131
+    t138 = t114*t135 + t132
+    t139 = t115*t135 + t133
+    t140 = -t116*t135 + t134
+    t141 = numpy.sqrt(t137**2 + t138**2 + t139**2 + t140**2)
+    t142 = t141*numpy.where(numpy.greater_equal(t137, 0), 1, -1)
+    t143 = t137 + t142
+    t144 = numpy.where(numpy.greater(t141, 0), 1/(t141*(t141 + abs(t137))), 0)
+    t145 = t144*(t123*t143 + t124*t138 - t125*t139 + t126*t140)
+    t146 = t123 - t143*t145
+    t147 = t124 - t138*t145
+    t148 = t125 + t139*t145
+    t149 = t126 - t140*t145
+    t150 = t86 + t95
+    t151 = t101*(t100*t77 + t150*t77 - t58*t65 + t70*t87 - t72*t81 + t74*t84)
+    t152 = -t100*t151 + t77
+    t153 = t151*t72 + t81
+    t154 = -t151*t74 + t84
+    t155 = t150 - t151*t77
+    t156 = -t151*t70 + t87
+    t157 = t151*t65 + t58
+    t158 = -t120*(t113*t154 + t114*t155 - t115*t156 - t116*t157 + t119*t153)
+    t159 = t119*t158 + t153
+    t160 = t113*t158 + t154
+    t161 = t114*t158 + t155
+    t162 = -t115*t158 + t156
+    t163 = -t116*t158 + t157
+    t164 = t144*(t138*t161 - t139*t162 + t140*t163 + t143*t160)
+    t165 = -t143*t164 + t160
+    t166 = -t138*t164 + t161
+    t167 = t139*t164 + t162
+    t168 = -t140*t164 + t163
+    t169 = numpy.sqrt(t166**2 + t167**2 + t168**2)
+    t170 = t169*numpy.where(numpy.greater_equal(t166, 0), 1, -1)
+    t171 = t166 + t170
+    t172 = numpy.where(numpy.greater(t169, 0), 1/(t169*(t169 + abs(t166))), 0)
+    t173 = t172*(t147*t171 + t148*t167 + t149*t168)
+    t174 = t147 - t171*t173
+    t175 = t148 - t167*t173
+    t176 = t149 - t168*t173
+    t177 = t88 + t95
+    t178 = t101*(t100*t70 + t177*t70 - t59*t65 + t72*t78 - t74*t75 + t77*t87)
+    t179 = -t100*t178 + t70
+    t180 = -t178*t72 + t78
+    t181 = t178*t74 + t75
+    t182 = -t178*t77 + t87
+    t183 = t177 - t178*t70
+    t184 = t178*t65 + t59
+    t185 = t120*(t113*t181 - t114*t182 + t115*t183 + t116*t184 + t119*t180)
+    t186 = -t119*t185 + t180
+    t187 = t113*t185 - t181
+    t188 = t114*t185 + t182
+    t189 = -t115*t185 + t183
+    t190 = -t116*t185 + t184
+    t191 = t144*(t138*t188 - t139*t189 + t140*t190 + t143*t187)
+    t192 = -t143*t191 + t187
+    t193 = -t138*t191 + t188
+    t194 = t139*t191 + t189
+    t195 = -t140*t191 + t190
+    t196 = t172*(t167*t194 + t168*t195 + t171*t193)
+    t197 = -t171*t196 + t193
+    t198 = -t167*t196 + t194
+    t199 = -t168*t196 + t195
+    t200 = numpy.sqrt(t198**2 + t199**2)
+    t201 = t200*numpy.where(numpy.greater_equal(t198, 0), 1, -1)
+    t202 = t198 + t201
+    t203 = numpy.where(numpy.greater(t200, 0), 1/(t200*(t200 + abs(t198))), 0)
+    t204 = t203*(t175*t202 + t176*t199)
+    t205 = t175 - t202*t204
+    t206 = t176 - t199*t204
+    t207 = t89 + t95
+    t208 = numpy.sqrt(t109**2 + t127**2 + t150**2 + t177**2 + t207**2 + 2*t57**2 + 2*t58**2 + 2*t59**2 + 2*t62**2 + 2*t75**2 + 2*t78**2 + 2*t81**2 + 2*t83**2 + 2*t84**2 + 2*t87**2 + 2*t90 + 2*t91 + 2*t92 + 2*t93 + 2*t94 + t97)
+    t209 = t101*(-t100*t65 - t207*t65 + t57*t74 + t58*t77 + t59*t70 + t62*t72)
+    t210 = t100*t209 + t65
+    t211 = -t209*t72 + t62
+    t212 = -t209*t74 + t57
+    t213 = -t209*t77 + t58
+    t214 = -t209*t70 + t59
+    t215 = t207 + t209*t65
+    t216 = t120*(-t113*t212 - t114*t213 + t115*t214 + t116*t215 + t119*t211)
+    t217 = -t119*t216 + t211
+    t218 = t113*t216 + t212
+    t219 = t114*t216 + t213
+    t220 = -t115*t216 + t214
+    t221 = -t116*t216 + t215
+    t222 = t144*(t138*t219 - t139*t220 + t140*t221 + t143*t218)
+    t223 = -t143*t222 + t218
+    t224 = -t138*t222 + t219
+    t225 = t139*t222 + t220
+    t226 = -t140*t222 + t221
+    t227 = t172*(t167*t225 + t168*t226 + t171*t224)
+    t228 = -t171*t227 + t224
+    t229 = -t167*t227 + t225
+    t230 = -t168*t227 + t226
+    t231 = t203*(t199*t230 + t202*t229)
+    t232 = -t202*t231 + t229
+    t233 = -t199*t231 + t230
+    t234 = abs(t233)
+    t235 = t234
+    t236 = t235*numpy.where(numpy.greater_equal(t233, 0), 1, -1)
+    t237 = t233 + t236
+    t238 = numpy.where(numpy.greater(t235, 0), 1/(t235*(t234 + t235)), 0)
+    t239 = -t206*t237**2*t238 + t206
+    t240 = t239/t236
+    t241 = (t205 + t232*t240)/t201
+    t242 = (t174 + t197*t241 + t228*t240)/t170
+    t243 = (t146 + t165*t242 + t192*t241 + t223*t240)/t142
+    t244 = (t122 - t136*t243 - t159*t242 + t186*t241 + t217*t240)/t118
+    t245 = (t103 + t111*t244 + t129*t243 + t152*t242 + t179*t241 - t210*t240)/t99
+    t246 = t19*t244 + t240 - t245*t31
+    t247 = c1*t241 - s1*t242 - t243*t32 + t244*t63 + t245*t60
+    t248 = c2*t240 + t20*t241 + t242*t8 + t243*t36 + t244*t61 + t245*t64
+    t249 = t240*t42 + t241*t3 - t242*t6 - t243*t33 + t244*t53 - t245*t51
+    t250 = t11*t242 + t23*t241 + t240*t41 + t243*t34 + t244*t56 + t245*t52
+    t251 = -t13*t242 + t240*t44 + t241*t25 - t243*t35 + t244*t54 - t245*t55
+    t252 = t15*t242 + t240*t46 + t241*t27
+    t253 = numpy.isfinite(t66)
+    t254 = numpy.greater_equal(damping, 0)
+    t255 = 1e-12*t208
+    t256 = (numpy.less_equal(t117, t255)) | (numpy.less_equal(t141, t255)) | (numpy.less_equal(t169, t255)) | (numpy.less_equal(t200, t255)) | (numpy.less_equal(t235, t255)) | (numpy.less_equal(t98, t255))
+    t257 = t253 & t254 & numpy.logical_not(t256)
+    q_dot = numpy.empty(numpy.broadcast_shapes(q.shape[:-1], mu_dot.shape[:-1], damping.shape) + (7,))
+    q_dot[..., 0] = numpy.where(t257, -t246, 0)
+    q_dot[..., 1] = numpy.where(t257, -t247, 0)
+    q_dot[..., 2] = numpy.where(t257, -t248, 0)
+    q_dot[..., 3] = numpy.where(t257, t249, 0)
+    q_dot[..., 4] = numpy.where(t257, -t250, 0)
+    q_dot[..., 5] = numpy.where(t257, t251, 0)
+    q_dot[..., 6] = numpy.where(t257, t252, 0)
+    status = numpy.empty(numpy.broadcast_shapes(q.shape[:-1], mu_dot.shape[:-1], damping.shape) + (), dtype=int)
+    status[...] = numpy.where(numpy.logical_not(t253 & t254), 2, numpy.where(t256, 1, 0))
+    return q_dot, status
+
+
 # -- Iterative inverse kinematics --
 
 IK_NUMERIC_CONVERGED = 0  # |error| <= tol
@@ -1250,39 +1552,10 @@ def ik_numeric(target, q0, max_iter=100, tol=1e-10):
     return q, IK_NUMERIC_CONVERGED if cost <= tol * tol else IK_NUMERIC_ITERATION_LIMIT
 
 
-# Reciprocal condition number below which the system of velocity_ik counts as singular.
-VELOCITY_IK_RCOND = 1e-12
-
-
-def velocity_ik(q, mu_dot, damping=0.0):
-    """Joint rates solving Js q_dot = mu_dot, and where that succeeded: (q_dot, ok).
-
-    Js is the geometric Jacobian, so mu_dot (6,) or (..., 6) is (vx, vy, vz, wx, wy, wz): components of the tool's linear (v) and angular (w) velocity in the world frame.
-    The minimum-norm solution q_dot = Js^T (Js Js^T + damping^2 I)^-1 mu_dot (right
-    pseudo-inverse for damping = 0, damped least squares for damping > 0).
-
-    Returns q_dot (..., 7) and ok (...), a boolean array: False where an input is not
-    finite or the 6 x 6 system solved is numerically singular (reciprocal
-    condition number below VELOCITY_IK_RCOND; take damping > 0 there). Where ok is False,
-    q_dot is 0: the result never holds NaN.
-    """
-    q = _argument("q", q, (DOF,))
-    mu_dot = numpy.asarray(mu_dot, dtype=float)
-    if mu_dot.ndim == 0 or mu_dot.shape[-1] != 6:
-        raise ValueError(f"mu_dot must have shape (6,) or (..., 6), got {mu_dot.shape}")
-    damping = float(damping)
-    if not damping >= 0.0:
-        raise ValueError(f"damping must be >= 0, got {damping}")
-    J = jacobian(q)
-    batch = numpy.broadcast_shapes(J.shape[:-2], mu_dot.shape[:-1])
-    J = numpy.broadcast_to(J, batch + J.shape[-2:])
-    mu_dot = numpy.broadcast_to(mu_dot, batch + mu_dot.shape[-1:])
-    Jt = numpy.swapaxes(J, -1, -2)
-    A, b = J @ Jt + damping**2 * numpy.eye(6), mu_dot
-    ok = numpy.isfinite(A).all(axis=(-2, -1)) & numpy.isfinite(b).all(axis=-1)
-    identity = numpy.eye(6)
-    singular_values = numpy.linalg.svd(numpy.where(ok[..., None, None], A, identity), compute_uv=False)
-    ok &= singular_values[..., -1] > VELOCITY_IK_RCOND * singular_values[..., 0]
-    x = numpy.linalg.solve(numpy.where(ok[..., None, None], A, identity), numpy.where(ok[..., None], b, 0.0)[..., None])[..., 0]
-    q_dot = (Jt @ x[..., None])[..., 0]
-    return numpy.where(ok[..., None], q_dot, 0.0), ok
+# Statuses of velocity_ik: OK, singular (a diagonal entry of the QR factor R of the
+# 6 x 6 system at most 1e-12 times its Frobenius norm: take damping > 0), or
+# not finite (q, mu_dot, damping or Js not finite, or damping < 0); q_dot is 0 unless OK.
+# Js is the geometric Jacobian; mu_dot is (vx, vy, vz, wx, wy, wz): components of the tool's linear (v) and angular (w) velocity in the world frame.
+VELOCITY_IK_OK = 0
+VELOCITY_IK_SINGULAR = 1
+VELOCITY_IK_NOT_FINITE = 2

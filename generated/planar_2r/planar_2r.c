@@ -247,6 +247,93 @@ planar_2r_real planar_2r_jacobian_det(const planar_2r_real q[PLANAR_2R_DOF])
     return s2;
 }
 
+int planar_2r_velocity_ik(const planar_2r_real q[PLANAR_2R_DOF], const planar_2r_real mu_dot[PLANAR_2R_TASK_DIM], planar_2r_real damping, planar_2r_real q_dot[PLANAR_2R_DOF])
+{
+    /* 168 operations */
+
+    /* Inputs */
+    const planar_2r_real q1 = q[0];
+    const planar_2r_real q2 = q[1];
+    const planar_2r_real mu_dot0 = mu_dot[0];
+    const planar_2r_real mu_dot1 = mu_dot[1];
+
+    /* Intermediate terms */
+    const planar_2r_real c1 = cos(q1);
+    const planar_2r_real s1 = sin(q1);
+    const planar_2r_real c2 = cos(q2);
+    const planar_2r_real s2 = sin(q2);
+    const planar_2r_real c12 = c1*c2 - s1*s2;
+    const planar_2r_real s12 = c1*s2 + c2*s1;
+    const planar_2r_real t0 = c1 + c12;
+    const planar_2r_real t1 = s1 + s12;
+    const planar_2r_real t2 = c12*s12 + t0*t1;
+    const planar_2r_real t3 = (t1*t1);
+    const planar_2r_real t4 = t3 + (s12*s12);
+    const planar_2r_real t5 = t4;
+    const planar_2r_real t6 = (t0*t0);
+    const planar_2r_real t7 = sqrt(t3 + t6);
+    const planar_2r_real t8 = t7*(t1 <= 0 ? 1 : -1);
+    const planar_2r_real t9 = (t7 > 0 ? 1/(t7*(t7 + fabs(t1))) : 0);
+    const planar_2r_real t10 = t6 + (c12*c12);
+    const planar_2r_real t11 = t10;
+    const planar_2r_real t12 = sqrt(t10 + t4);
+    const planar_2r_real t13 = (t2*t2);
+    const planar_2r_real t14 = (damping*damping);
+    const planar_2r_real t15 = t11 + t14;
+    const planar_2r_real t16 = t14 + t5;
+    const planar_2r_real t17 = (t16*t16);
+    const planar_2r_real t18 = sqrt(2*t13 + t17 + (t15*t15));
+    const planar_2r_real t19 = sqrt(t13 + t17);
+    const planar_2r_real t20 = t19*(t16 >= 0 ? 1 : -1);
+    const planar_2r_real t21 = t16 + t20;
+    const planar_2r_real t22 = (t19 > 0 ? 1/(t19*(t19 + fabs(t16))) : 0);
+    const planar_2r_real t23 = -t22*(t15*t2 + t2*t21);
+    const planar_2r_real t24 = t2 + t21*t23;
+    const planar_2r_real t25 = t15 + t2*t23;
+    const planar_2r_real t26 = t22*(mu_dot0*t21 - mu_dot1*t2);
+    const planar_2r_real t27 = mu_dot0 - t21*t26;
+    const planar_2r_real t28 = mu_dot1 + t2*t26;
+    const planar_2r_real t29 = fabs(t25);
+    const planar_2r_real t30 = t29;
+    const planar_2r_real t31 = t30*(t25 >= 0 ? 1 : -1);
+    const planar_2r_real t32 = t25 + t31;
+    const planar_2r_real t33 = (t30 > 0 ? 1/(t30*(t29 + t30)) : 0);
+    const planar_2r_real t34 = -t28*t33*(t32*t32) + t28;
+    const planar_2r_real t35 = t34/t31;
+    const planar_2r_real t36 = (-t24*t35 + t27)/t20;
+    const planar_2r_real t37 = -t0*t35 + t1*t36;
+    const planar_2r_real t38 = -c12*t35 + s12*t36;
+    const planar_2r_real t39 = -t1;
+    const planar_2r_real t40 = t39 + t8;
+    const planar_2r_real t41 = t9*(c12*t0 - s12*t40);
+    const planar_2r_real t42 = s12 + t40*t41;
+    const planar_2r_real t43 = c12 - t0*t41;
+    const planar_2r_real t44 = t9*(mu_dot0*t40 + mu_dot1*t0);
+    const planar_2r_real t45 = mu_dot0 - t40*t44;
+    const planar_2r_real t46 = mu_dot1 - t0*t44;
+    const planar_2r_real t47 = c12 + damping + mu_dot0 + mu_dot1 + q1 + q2 - s12 + t0 + t39;
+    const planar_2r_real t48 = fabs(t43);
+    const planar_2r_real t49 = t48;
+    const planar_2r_real t50 = t49*(t43 >= 0 ? 1 : -1);
+    const planar_2r_real t51 = t43 + t50;
+    const planar_2r_real t52 = (t49 > 0 ? 1/(t49*(t48 + t49)) : 0);
+    const planar_2r_real t53 = -t46*t52*(t51*t51) + t46;
+    const planar_2r_real t54 = t53/t50;
+    const planar_2r_real t55 = (-t42*t54 + t45)/t8;
+    const int t56 = damping > 0;
+    const int t57 = isfinite(t47);
+    const int t58 = damping >= 0;
+    const planar_2r_real t59 = 1e-12*t12;
+    const planar_2r_real t60 = 1e-12*t18;
+    const int t61 = (t56 && ((t19 <= t60) || (t30 <= t60))) || (damping <= 0 && ((t49 <= t59) || (t7 <= t59)));
+    const int t62 = t57 && t58 && !t61;
+
+    /* Outputs */
+    q_dot[0] = (t62 ? (t56 ? t37 : -t55) : 0);
+    q_dot[1] = (t62 ? (t56 ? t38 : -t54) : 0);
+    return (!(t57 && t58) ? 2 : (t61 ? 1 : 0));
+}
+
 void planar_2r_ik_branches(const planar_2r_real mu[PLANAR_2R_TASK_DIM], planar_2r_real q[PLANAR_2R_MAX_IK_SOLUTIONS * PLANAR_2R_DOF], int valid[PLANAR_2R_MAX_IK_SOLUTIONS])
 {
     /* 79 operations */
@@ -292,103 +379,6 @@ void planar_2r_ik_branches(const planar_2r_real mu[PLANAR_2R_TASK_DIM], planar_2
     q[3] = t9 - 6.283185307179586*ceil(0.15915494309189535*t9 - 0.5);
     valid[0] = t26 && t27 && t4 >= -1e-12;
     valid[1] = t26 && t27 && t4 > 1e-12;
-}
-
-int planar_2r_velocity_ik(const planar_2r_real q[PLANAR_2R_DOF], const planar_2r_real mu_dot[PLANAR_2R_TASK_DIM], planar_2r_real damping, planar_2r_real q_dot[PLANAR_2R_DOF])
-{
-    /* Rows of jacobian() forming Js (rows (vx, vy) of the geometric Jacobian). */
-    static const int rows[PLANAR_2R_TASK_DIM] = {0, 1};
-    planar_2r_real J[6 * PLANAR_2R_DOF];
-    planar_2r_real A[2 * 2];
-    planar_2r_real x[2];
-    planar_2r_real scale = 0;
-    const int normal = damping > 0; /* damped: solve (Js Js^T + damping^2 I) x = mu_dot */
-    int r, c, k;
-
-    for (c = 0; c < PLANAR_2R_DOF; ++c) {
-        q_dot[c] = 0;
-        if (!isfinite(q[c])) {
-            return PLANAR_2R_VELOCITY_IK_NOT_FINITE;
-        }
-    }
-    for (r = 0; r < PLANAR_2R_TASK_DIM; ++r) {
-        if (!isfinite(mu_dot[r])) {
-            return PLANAR_2R_VELOCITY_IK_NOT_FINITE;
-        }
-        x[r] = mu_dot[r]; /* b; copied here, not in a loop of its own (which becomes memcpy) */
-    }
-    if (!(damping >= 0) || !isfinite(damping)) {
-        return PLANAR_2R_VELOCITY_IK_NOT_FINITE;
-    }
-    planar_2r_jacobian(q, J);
-
-    /* The system A x = b (2 x 2), b in x. */
-    for (r = 0; r < 2; ++r) {
-        for (c = 0; c < 2; ++c) {
-            planar_2r_real sum = r == c ? damping * damping : 0;
-            if (!normal) {
-                sum = J[rows[r] * PLANAR_2R_DOF + c];
-            }
-            for (k = 0; normal && k < PLANAR_2R_DOF; ++k) {
-                sum += J[rows[r] * PLANAR_2R_DOF + k] * J[rows[c] * PLANAR_2R_DOF + k];
-            }
-            A[r * 2 + c] = sum;
-            if (!isfinite(sum)) {
-                return PLANAR_2R_VELOCITY_IK_NOT_FINITE;
-            }
-            if (fabs(sum) > scale) {
-                scale = fabs(sum);
-            }
-        }
-    }
-
-    /* LU with partial pivoting, applied to x as it goes. */
-    for (k = 0; k < 2; ++k) {
-        int pivot = k;
-        for (r = k + 1; r < 2; ++r) {
-            if (fabs(A[r * 2 + k]) > fabs(A[pivot * 2 + k])) {
-                pivot = r;
-            }
-        }
-        if (!(fabs(A[pivot * 2 + k]) > 1e-12 * scale)) {
-            return PLANAR_2R_VELOCITY_IK_SINGULAR;
-        }
-        if (pivot != k) {
-            planar_2r_real swap;
-            for (c = k; c < 2; ++c) {
-                swap = A[k * 2 + c];
-                A[k * 2 + c] = A[pivot * 2 + c];
-                A[pivot * 2 + c] = swap;
-            }
-            swap = x[k];
-            x[k] = x[pivot];
-            x[pivot] = swap;
-        }
-        for (r = k + 1; r < 2; ++r) {
-            const planar_2r_real factor = A[r * 2 + k] / A[k * 2 + k];
-            for (c = k + 1; c < 2; ++c) {
-                A[r * 2 + c] -= factor * A[k * 2 + c];
-            }
-            x[r] -= factor * x[k];
-        }
-    }
-    for (k = 2 - 1; k >= 0; --k) {
-        for (c = k + 1; c < 2; ++c) {
-            x[k] -= A[k * 2 + c] * x[c];
-        }
-        x[k] /= A[k * 2 + k];
-        if (!normal) {
-            q_dot[k] = x[k];
-        }
-    }
-
-    /* q_dot = Js^T x when damped (else x, written above) */
-    for (c = 0; normal && c < PLANAR_2R_DOF; ++c) {
-        for (r = 0; r < PLANAR_2R_TASK_DIM; ++r) {
-            q_dot[c] += J[rows[r] * PLANAR_2R_DOF + c] * x[r];
-        }
-    }
-    return PLANAR_2R_VELOCITY_IK_OK;
 }
 
 int planar_2r_ik(const planar_2r_real mu[PLANAR_2R_TASK_DIM], planar_2r_real q[PLANAR_2R_MAX_IK_SOLUTIONS * PLANAR_2R_DOF])

@@ -65,22 +65,21 @@ planar_2r_real planar_2r_manipulability(const planar_2r_real q[PLANAR_2R_DOF]);
  * Result: returned as a scalar. 1 operations. */
 planar_2r_real planar_2r_jacobian_det(const planar_2r_real q[PLANAR_2R_DOF]);
 
+/* Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status.
+ * Result: q_dot[i], i < 2; returned as a scalar. 168 operations. */
+int planar_2r_velocity_ik(const planar_2r_real q[PLANAR_2R_DOF], const planar_2r_real mu_dot[PLANAR_2R_TASK_DIM], planar_2r_real damping, planar_2r_real q_dot[PLANAR_2R_DOF]);
+
 /* Every branch of the closed-form ik and whether the target allows it.
  * Result: q: 2 x 2 row-major, element (r, c) at q[r * 2 + c]; valid[i], i < 2. 79 operations. */
 void planar_2r_ik_branches(const planar_2r_real mu[PLANAR_2R_TASK_DIM], planar_2r_real q[PLANAR_2R_MAX_IK_SOLUTIONS * PLANAR_2R_DOF], int valid[PLANAR_2R_MAX_IK_SOLUTIONS]);
 
-/* Status of planar_2r_velocity_ik. */
+/* Statuses of planar_2r_velocity_ik: OK, singular (a diagonal entry of the QR factor R of the
+ * 2 x 2 system at most 1e-12 times its Frobenius norm: take damping > 0), or
+ * not finite (q, mu_dot, damping or Js not finite, or damping < 0); q_dot is 0 unless OK.
+ * Js is rows (vx, vy) of the geometric Jacobian; mu_dot is (vx, vy): components of the tool's linear (v) and angular (w) velocity in the world frame. */
 #define PLANAR_2R_VELOCITY_IK_OK 0
-#define PLANAR_2R_VELOCITY_IK_SINGULAR 1   /* a pivot below 1e-12 x the largest |entry|: take damping > 0 */
-#define PLANAR_2R_VELOCITY_IK_NOT_FINITE 2 /* q, mu_dot, damping (must be >= 0) or Js not finite */
-
-/* Joint rates q_dot[PLANAR_2R_DOF] solving Js q_dot = mu_dot.
- * Js is rows (vx, vy) of the geometric Jacobian; mu_dot[PLANAR_2R_TASK_DIM] is (vx, vy): components of the tool's linear (v) and angular (w) velocity in the world frame.
- * damping = 0: q_dot = Js^-1 mu_dot; damping > 0 (damped least squares near singularities):
- * q_dot = Js^T (Js Js^T + damping^2 I)^-1 mu_dot.
- * LU with partial pivoting of the 2 x 2 system on the stack. Returns
- * PLANAR_2R_VELOCITY_IK_OK, or a status above with q_dot all 0. */
-int planar_2r_velocity_ik(const planar_2r_real q[PLANAR_2R_DOF], const planar_2r_real mu_dot[PLANAR_2R_TASK_DIM], planar_2r_real damping, planar_2r_real q_dot[PLANAR_2R_DOF]);
+#define PLANAR_2R_VELOCITY_IK_SINGULAR 1
+#define PLANAR_2R_VELOCITY_IK_NOT_FINITE 2
 
 /* Closed-form inverse kinematics: every joint solution that reaches the target; returns
  * their count k and writes solution i to q[i * PLANAR_2R_DOF + j], i < k: the valid

@@ -234,6 +234,93 @@ def jacobian_det(q):
 
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
+def velocity_ik(q, mu_dot, damping=0.0):
+    """joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: (2 x 1 and 1 x 1), 168 operations."""
+    q = _argument("q", q, (2,))
+    mu_dot = _argument("mu_dot", mu_dot, (2,))
+    damping = _argument("damping", damping, ())
+    q1 = q[..., 0]
+    q2 = q[..., 1]
+    mu_dot0 = mu_dot[..., 0]
+    mu_dot1 = mu_dot[..., 1]
+    c1 = numpy.cos(q1)
+    s1 = numpy.sin(q1)
+    c2 = numpy.cos(q2)
+    s2 = numpy.sin(q2)
+    c12 = c1*c2 - s1*s2
+    s12 = c1*s2 + c2*s1
+    t0 = c1 + c12
+    t1 = s1 + s12
+    t2 = c12*s12 + t0*t1
+    t3 = t1**2
+    t4 = s12**2 + t3
+    t5 = t4
+    t6 = t0**2
+    t7 = numpy.sqrt(t3 + t6)
+    t8 = t7*numpy.where(numpy.less_equal(t1, 0), 1, -1)
+    t9 = numpy.where(numpy.greater(t7, 0), 1/(t7*(t7 + abs(t1))), 0)
+    t10 = c12**2 + t6
+    t11 = t10
+    t12 = numpy.sqrt(t10 + t4)
+    t13 = t2**2
+    t14 = damping**2
+    t15 = t11 + t14
+    t16 = t14 + t5
+    t17 = t16**2
+    t18 = numpy.sqrt(2*t13 + t15**2 + t17)
+    t19 = numpy.sqrt(t13 + t17)
+    t20 = t19*numpy.where(numpy.greater_equal(t16, 0), 1, -1)
+    t21 = t16 + t20
+    t22 = numpy.where(numpy.greater(t19, 0), 1/(t19*(t19 + abs(t16))), 0)
+    t23 = -t22*(t15*t2 + t2*t21)
+    t24 = t2 + t21*t23
+    t25 = t15 + t2*t23
+    t26 = t22*(mu_dot0*t21 - mu_dot1*t2)
+    t27 = mu_dot0 - t21*t26
+    t28 = mu_dot1 + t2*t26
+    t29 = abs(t25)
+    t30 = t29
+    t31 = t30*numpy.where(numpy.greater_equal(t25, 0), 1, -1)
+    t32 = t25 + t31
+    t33 = numpy.where(numpy.greater(t30, 0), 1/(t30*(t29 + t30)), 0)
+    t34 = -t28*t32**2*t33 + t28
+    t35 = t34/t31
+    t36 = (-t24*t35 + t27)/t20
+    t37 = -t0*t35 + t1*t36
+    t38 = -c12*t35 + s12*t36
+    t39 = -t1
+    t40 = t39 + t8
+    t41 = t9*(c12*t0 - s12*t40)
+    t42 = s12 + t40*t41
+    t43 = c12 - t0*t41
+    t44 = t9*(mu_dot0*t40 + mu_dot1*t0)
+    t45 = mu_dot0 - t40*t44
+    t46 = mu_dot1 - t0*t44
+    t47 = c12 + damping + mu_dot0 + mu_dot1 + q1 + q2 - s12 + t0 + t39
+    t48 = abs(t43)
+    t49 = t48
+    t50 = t49*numpy.where(numpy.greater_equal(t43, 0), 1, -1)
+    t51 = t43 + t50
+    t52 = numpy.where(numpy.greater(t49, 0), 1/(t49*(t48 + t49)), 0)
+    t53 = -t46*t51**2*t52 + t46
+    t54 = t53/t50
+    t55 = (-t42*t54 + t45)/t8
+    t56 = numpy.greater(damping, 0)
+    t57 = numpy.isfinite(t47)
+    t58 = numpy.greater_equal(damping, 0)
+    t59 = 1e-12*t12
+    t60 = 1e-12*t18
+    t61 = (t56 & ((numpy.less_equal(t19, t60)) | (numpy.less_equal(t30, t60)))) | ((numpy.less_equal(damping, 0)) & ((numpy.less_equal(t49, t59)) | (numpy.less_equal(t7, t59))))
+    t62 = t57 & t58 & numpy.logical_not(t61)
+    q_dot = numpy.empty(numpy.broadcast_shapes(q.shape[:-1], mu_dot.shape[:-1], damping.shape) + (2,))
+    q_dot[..., 0] = numpy.where(t62, numpy.where(t56, t37, -t55), 0)
+    q_dot[..., 1] = numpy.where(t62, numpy.where(t56, t38, -t54), 0)
+    status = numpy.empty(numpy.broadcast_shapes(q.shape[:-1], mu_dot.shape[:-1], damping.shape) + (), dtype=int)
+    status[...] = numpy.where(numpy.logical_not(t57 & t58), 2, numpy.where(t61, 1, 0))
+    return q_dot, status
+
+
+@numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def ik_branches(mu):
     """every branch of the closed-form ik and whether the target allows it: (2 x 2 and 2 x 1), 79 operations."""
     mu = _argument("mu", mu, (2,))
@@ -357,42 +444,10 @@ def ik_numeric(target, q0, max_iter=100, tol=1e-10):
     return q, IK_NUMERIC_CONVERGED if cost <= tol * tol else IK_NUMERIC_ITERATION_LIMIT
 
 
-# Reciprocal condition number below which the system of velocity_ik counts as singular.
-VELOCITY_IK_RCOND = 1e-12
-
-
-def velocity_ik(q, mu_dot, damping=0.0):
-    """Joint rates solving Js q_dot = mu_dot, and where that succeeded: (q_dot, ok).
-
-    Js is rows (vx, vy) of the geometric Jacobian, so mu_dot (2,) or (..., 2) is (vx, vy): components of the tool's linear (v) and angular (w) velocity in the world frame.
-    damping = 0: q_dot = Js^-1 mu_dot. damping > 0 (damped least squares, near
-    singularities): q_dot = Js^T (Js Js^T + damping^2 I)^-1 mu_dot.
-
-    Returns q_dot (..., 2) and ok (...), a boolean array: False where an input is not
-    finite or the 2 x 2 system solved is numerically singular (reciprocal
-    condition number below VELOCITY_IK_RCOND; take damping > 0 there). Where ok is False,
-    q_dot is 0: the result never holds NaN.
-    """
-    q = _argument("q", q, (DOF,))
-    mu_dot = numpy.asarray(mu_dot, dtype=float)
-    if mu_dot.ndim == 0 or mu_dot.shape[-1] != 2:
-        raise ValueError(f"mu_dot must have shape (2,) or (..., 2), got {mu_dot.shape}")
-    damping = float(damping)
-    if not damping >= 0.0:
-        raise ValueError(f"damping must be >= 0, got {damping}")
-    J = jacobian(q)[..., [0, 1], :]
-    batch = numpy.broadcast_shapes(J.shape[:-2], mu_dot.shape[:-1])
-    J = numpy.broadcast_to(J, batch + J.shape[-2:])
-    mu_dot = numpy.broadcast_to(mu_dot, batch + mu_dot.shape[-1:])
-    Jt = numpy.swapaxes(J, -1, -2)
-    if damping == 0.0:
-        A, b = J, mu_dot
-    else:
-        A, b = J @ Jt + damping**2 * numpy.eye(2), mu_dot
-    ok = numpy.isfinite(A).all(axis=(-2, -1)) & numpy.isfinite(b).all(axis=-1)
-    identity = numpy.eye(2)
-    singular_values = numpy.linalg.svd(numpy.where(ok[..., None, None], A, identity), compute_uv=False)
-    ok &= singular_values[..., -1] > VELOCITY_IK_RCOND * singular_values[..., 0]
-    x = numpy.linalg.solve(numpy.where(ok[..., None, None], A, identity), numpy.where(ok[..., None], b, 0.0)[..., None])[..., 0]
-    q_dot = x if damping == 0.0 else (Jt @ x[..., None])[..., 0]
-    return numpy.where(ok[..., None], q_dot, 0.0), ok
+# Statuses of velocity_ik: OK, singular (a diagonal entry of the QR factor R of the
+# 2 x 2 system at most 1e-12 times its Frobenius norm: take damping > 0), or
+# not finite (q, mu_dot, damping or Js not finite, or damping < 0); q_dot is 0 unless OK.
+# Js is rows (vx, vy) of the geometric Jacobian; mu_dot is (vx, vy): components of the tool's linear (v) and angular (w) velocity in the world frame.
+VELOCITY_IK_OK = 0
+VELOCITY_IK_SINGULAR = 1
+VELOCITY_IK_NOT_FINITE = 2

@@ -179,6 +179,89 @@ def _jacobian_det(q):
     return [d]
 
 
+def _velocity_ik(q, mu_dot, damping):
+    """Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: 168 operations."""
+    q1 = q[0]
+    q2 = q[1]
+    mu_dot0 = mu_dot[0]
+    mu_dot1 = mu_dot[1]
+    c1 = casadi.cos(q1)
+    s1 = casadi.sin(q1)
+    c2 = casadi.cos(q2)
+    s2 = casadi.sin(q2)
+    c12 = c1*c2 - s1*s2
+    s12 = c1*s2 + c2*s1
+    t0 = c1 + c12
+    t1 = s1 + s12
+    t2 = c12*s12 + t0*t1
+    t3 = t1**2
+    t4 = s12**2 + t3
+    t5 = t4
+    t6 = t0**2
+    t7 = casadi.sqrt(t3 + t6)
+    t8 = t7*casadi.if_else((t1 <= 0), 1, -1)
+    t9 = casadi.if_else((t7 > 0), 1/(t7*(t7 + casadi.fabs(t1))), 0)
+    t10 = c12**2 + t6
+    t11 = t10
+    t12 = casadi.sqrt(t10 + t4)
+    t13 = t2**2
+    t14 = damping**2
+    t15 = t11 + t14
+    t16 = t14 + t5
+    t17 = t16**2
+    t18 = casadi.sqrt(2*t13 + t15**2 + t17)
+    t19 = casadi.sqrt(t13 + t17)
+    t20 = t19*casadi.if_else((t16 >= 0), 1, -1)
+    t21 = t16 + t20
+    t22 = casadi.if_else((t19 > 0), 1/(t19*(t19 + casadi.fabs(t16))), 0)
+    t23 = -t22*(t15*t2 + t2*t21)
+    t24 = t2 + t21*t23
+    t25 = t15 + t2*t23
+    t26 = t22*(mu_dot0*t21 - mu_dot1*t2)
+    t27 = mu_dot0 - t21*t26
+    t28 = mu_dot1 + t2*t26
+    t29 = casadi.fabs(t25)
+    t30 = t29
+    t31 = t30*casadi.if_else((t25 >= 0), 1, -1)
+    t32 = t25 + t31
+    t33 = casadi.if_else((t30 > 0), 1/(t30*(t29 + t30)), 0)
+    t34 = -t28*t32**2*t33 + t28
+    t35 = t34/t31
+    t36 = (-t24*t35 + t27)/t20
+    t37 = -t0*t35 + t1*t36
+    t38 = -c12*t35 + s12*t36
+    t39 = -t1
+    t40 = t39 + t8
+    t41 = t9*(c12*t0 - s12*t40)
+    t42 = s12 + t40*t41
+    t43 = c12 - t0*t41
+    t44 = t9*(mu_dot0*t40 + mu_dot1*t0)
+    t45 = mu_dot0 - t40*t44
+    t46 = mu_dot1 - t0*t44
+    t47 = c12 + damping + mu_dot0 + mu_dot1 + q1 + q2 - s12 + t0 + t39
+    t48 = casadi.fabs(t43)
+    t49 = t48
+    t50 = t49*casadi.if_else((t43 >= 0), 1, -1)
+    t51 = t43 + t50
+    t52 = casadi.if_else((t49 > 0), 1/(t49*(t48 + t49)), 0)
+    t53 = -t46*t51**2*t52 + t46
+    t54 = t53/t50
+    t55 = (-t42*t54 + t45)/t8
+    t56 = (damping > 0)
+    t57 = (casadi.fabs(t47) < casadi.inf)
+    t58 = (damping >= 0)
+    t59 = 1e-12*t12
+    t60 = 1e-12*t18
+    t61 = casadi.logic_or(casadi.logic_and(t56, casadi.logic_or((t19 <= t60), (t30 <= t60))), casadi.logic_and((damping <= 0), casadi.logic_or((t49 <= t59), (t7 <= t59))))
+    t62 = casadi.logic_and(casadi.logic_and(t57, t58), casadi.logic_not(t61))
+    q_dot = casadi.SX(2, 1)
+    q_dot[0, 0] = casadi.if_else(t62, casadi.if_else(t56, t37, -t55), 0)
+    q_dot[1, 0] = casadi.if_else(t62, casadi.if_else(t56, t38, -t54), 0)
+    status = casadi.SX(1, 1)
+    status[0, 0] = casadi.if_else(casadi.logic_not(casadi.logic_and(t57, t58)), 2, casadi.if_else(t61, 1, 0))
+    return [q_dot, status]
+
+
 def _ik_branches(mu):
     """Every branch of the closed-form ik and whether the target allows it: 79 operations."""
     mu0 = mu[0]
@@ -223,6 +306,8 @@ def _ik_branches(mu):
 
 
 _q = casadi.SX.sym("q", 2, 1)
+_mu_dot = casadi.SX.sym("mu_dot", 2, 1)
+_damping = casadi.SX.sym("damping", 1, 1)
 _mu = casadi.SX.sym("mu", 2, 1)
 fk = casadi.Function("fk", [_q], _fk(_q), ["q"], ["T"])
 jacobian = casadi.Function("jacobian", [_q], _jacobian(_q), ["q"], ["J"])
@@ -233,10 +318,11 @@ task_jacobian = casadi.Function("task_jacobian", [_q], _task_jacobian(_q), ["q"]
 singularity_factors = casadi.Function("singularity_factors", [_q], _singularity_factors(_q), ["q"], ["f"])
 manipulability = casadi.Function("manipulability", [_q], _manipulability(_q), ["q"], ["w"])
 jacobian_det = casadi.Function("jacobian_det", [_q], _jacobian_det(_q), ["q"], ["d"])
+velocity_ik = casadi.Function("velocity_ik", [_q, _mu_dot, _damping], _velocity_ik(_q, _mu_dot, _damping), ["q", "mu_dot", "damping"], ["q_dot", "status"])
 ik_branches = casadi.Function("ik_branches", [_mu], _ik_branches(_mu), ["mu"], ["q", "valid"])
 ik = ik_branches  # CasADi functions have fixed-size outputs: every branch and its validity
 
 
 def functions():
     """All functions by name."""
-    return {"fk": fk, "jacobian": jacobian, "fk_jacobian": fk_jacobian, "jacobian_tool": jacobian_tool, "task": task, "task_jacobian": task_jacobian, "singularity_factors": singularity_factors, "manipulability": manipulability, "jacobian_det": jacobian_det, "ik_branches": ik_branches}
+    return {"fk": fk, "jacobian": jacobian, "fk_jacobian": fk_jacobian, "jacobian_tool": jacobian_tool, "task": task, "task_jacobian": task_jacobian, "singularity_factors": singularity_factors, "manipulability": manipulability, "jacobian_det": jacobian_det, "velocity_ik": velocity_ik, "ik_branches": ik_branches}

@@ -336,6 +336,142 @@ planar_3r_real planar_3r_jacobian_det(const planar_3r_real q[PLANAR_3R_DOF])
     return s2/((c123*c123) + (s123*s123));
 }
 
+int planar_3r_velocity_ik(const planar_3r_real q[PLANAR_3R_DOF], const planar_3r_real mu_dot[PLANAR_3R_TASK_DIM], planar_3r_real damping, planar_3r_real q_dot[PLANAR_3R_DOF])
+{
+    /* 323 operations */
+
+    /* Inputs */
+    const planar_3r_real q1 = q[0];
+    const planar_3r_real q2 = q[1];
+    const planar_3r_real q3 = q[2];
+    const planar_3r_real mu_dot0 = mu_dot[0];
+    const planar_3r_real mu_dot1 = mu_dot[1];
+    const planar_3r_real mu_dot2 = mu_dot[2];
+
+    /* Intermediate terms */
+    const planar_3r_real c1 = cos(q1);
+    const planar_3r_real s1 = sin(q1);
+    const planar_3r_real c2 = cos(q2);
+    const planar_3r_real s2 = sin(q2);
+    const planar_3r_real c12 = c1*c2 - s1*s2;
+    const planar_3r_real s12 = c1*s2 + c2*s1;
+    const planar_3r_real c3 = cos(q3);
+    const planar_3r_real s3 = sin(q3);
+    const planar_3r_real c123 = c12*c3 - s12*s3;
+    const planar_3r_real s123 = c12*s3 + c3*s12;
+    const planar_3r_real t0 = c12 + c123;
+    const planar_3r_real t1 = s12 + s123;
+    const planar_3r_real t2 = c1 + t0;
+    const planar_3r_real t3 = s1 + t1;
+    const planar_3r_real t4 = c123*s123 + t0*t1 + t2*t3;
+    const planar_3r_real t5 = s123 + t1 + t3;
+    const planar_3r_real t6 = (t3*t3);
+    const planar_3r_real t7 = t6 + (s123*s123) + (t1*t1);
+    const planar_3r_real t8 = t7;
+    const planar_3r_real t9 = (t2*t2);
+    const planar_3r_real t10 = sqrt(t6 + t9 + 1);
+    const planar_3r_real t11 = t10*(t3 <= 0 ? 1 : -1);
+    const planar_3r_real t12 = (t10 > 0 ? 1/(t10*(t10 + fabs(t3))) : 0);
+    const planar_3r_real t13 = t9 + (c123*c123) + (t0*t0);
+    const planar_3r_real t14 = t13;
+    const planar_3r_real t15 = sqrt(t13 + t7 + 3);
+    const planar_3r_real t16 = c123 + t0 + t2;
+    const planar_3r_real t17 = t16;
+    const planar_3r_real t18 = (t4*t4);
+    const planar_3r_real t19 = (t5*t5);
+    const planar_3r_real t20 = (damping*damping);
+    const planar_3r_real t21 = t20 + t8;
+    const planar_3r_real t22 = (t21*t21);
+    const planar_3r_real t23 = sqrt(t18 + t19 + t22);
+    const planar_3r_real t24 = t23*(t21 >= 0 ? 1 : -1);
+    const planar_3r_real t25 = t21 + t24;
+    const planar_3r_real t26 = (t23 > 0 ? 1/(t23*(t23 + fabs(t21))) : 0);
+    const planar_3r_real t27 = -t26*(-mu_dot0*t25 + mu_dot1*t4 + mu_dot2*t5);
+    const planar_3r_real t28 = mu_dot0 - t25*t27;
+    const planar_3r_real t29 = mu_dot1 + t27*t4;
+    const planar_3r_real t30 = mu_dot2 + t27*t5;
+    const planar_3r_real t31 = t14 + t20;
+    const planar_3r_real t32 = -t26*(t17*t5 + t25*t4 + t31*t4);
+    const planar_3r_real t33 = t25*t32 + t4;
+    const planar_3r_real t34 = t31 + t32*t4;
+    const planar_3r_real t35 = t17 + t32*t5;
+    const planar_3r_real t36 = sqrt((t34*t34) + (t35*t35));
+    const planar_3r_real t37 = t36*(t34 >= 0 ? 1 : -1);
+    const planar_3r_real t38 = t34 + t37;
+    const planar_3r_real t39 = (t36 > 0 ? 1/(t36*(t36 + fabs(t34))) : 0);
+    const planar_3r_real t40 = t39*(t29*t38 + t30*t35);
+    const planar_3r_real t41 = t29 - t38*t40;
+    const planar_3r_real t42 = t30 - t35*t40;
+    const planar_3r_real t43 = t20 + 3;
+    const planar_3r_real t44 = sqrt(2*t18 + 2*t19 + t22 + 2*(t17*t17) + (t31*t31) + (t43*t43));
+    const planar_3r_real t45 = -t26*(t17*t4 + t25*t5 + t43*t5);
+    const planar_3r_real t46 = t25*t45 + t5;
+    const planar_3r_real t47 = t17 + t4*t45;
+    const planar_3r_real t48 = t43 + t45*t5;
+    const planar_3r_real t49 = t39*(t35*t48 + t38*t47);
+    const planar_3r_real t50 = -t38*t49 + t47;
+    const planar_3r_real t51 = -t35*t49 + t48;
+    const planar_3r_real t52 = fabs(t51);
+    const planar_3r_real t53 = t52;
+    const planar_3r_real t54 = t53*(t51 >= 0 ? 1 : -1);
+    const planar_3r_real t55 = t51 + t54;
+    const planar_3r_real t56 = (t53 > 0 ? 1/(t53*(t52 + t53)) : 0);
+    const planar_3r_real t57 = -t42*t56*(t55*t55) + t42;
+    const planar_3r_real t58 = t57/t54;
+    const planar_3r_real t59 = (t41 + t50*t58)/t37;
+    const planar_3r_real t60 = (t28 - t33*t59 - t46*t58)/t24;
+    const planar_3r_real t61 = t2*t59 - t3*t60 + t58;
+    const planar_3r_real t62 = t0*t59 - t1*t60 + t58;
+    const planar_3r_real t63 = c123*t59 - s123*t60 + t58;
+    const planar_3r_real t64 = -t3;
+    const planar_3r_real t65 = t11 + t64;
+    const planar_3r_real t66 = t12*(t0*t2 - t1*t65 + 1);
+    const planar_3r_real t67 = t1 + t65*t66;
+    const planar_3r_real t68 = t0 - t2*t66;
+    const planar_3r_real t69 = 1 - t66;
+    const planar_3r_real t70 = t12*(c123*t2 - s123*t65 + 1);
+    const planar_3r_real t71 = s123 + t65*t70;
+    const planar_3r_real t72 = c123 - t2*t70;
+    const planar_3r_real t73 = 1 - t70;
+    const planar_3r_real t74 = t12*(mu_dot0*t65 + mu_dot1*t2 + mu_dot2);
+    const planar_3r_real t75 = mu_dot0 - t65*t74;
+    const planar_3r_real t76 = mu_dot1 - t2*t74;
+    const planar_3r_real t77 = mu_dot2 - t74;
+    const planar_3r_real t78 = sqrt((t68*t68) + (t69*t69));
+    const planar_3r_real t79 = t78*(t68 >= 0 ? 1 : -1);
+    const planar_3r_real t80 = t68 + t79;
+    const planar_3r_real t81 = (t78 > 0 ? 1/(t78*(t78 + fabs(t68))) : 0);
+    const planar_3r_real t82 = t81*(t69*t73 + t72*t80);
+    const planar_3r_real t83 = t72 - t80*t82;
+    const planar_3r_real t84 = -t69*t82 + t73;
+    const planar_3r_real t85 = t81*(t69*t77 + t76*t80);
+    const planar_3r_real t86 = t76 - t80*t85;
+    const planar_3r_real t87 = -t69*t85 + t77;
+    const planar_3r_real t88 = damping + mu_dot0 + mu_dot1 + mu_dot2 + q1 + q2 + q3 - s123 - t1 + t16 + t64 + 3;
+    const planar_3r_real t89 = fabs(t84);
+    const planar_3r_real t90 = t89;
+    const planar_3r_real t91 = t90*(t84 >= 0 ? 1 : -1);
+    const planar_3r_real t92 = t84 + t91;
+    const planar_3r_real t93 = (t90 > 0 ? 1/(t90*(t89 + t90)) : 0);
+    const planar_3r_real t94 = -t87*t93*(t92*t92) + t87;
+    const planar_3r_real t95 = t94/t91;
+    const planar_3r_real t96 = (t83*t95 + t86)/t79;
+    const planar_3r_real t97 = (-t67*t96 - t71*t95 + t75)/t11;
+    const int t98 = damping > 0;
+    const int t99 = isfinite(t88);
+    const int t100 = damping >= 0;
+    const planar_3r_real t101 = 1e-12*t15;
+    const planar_3r_real t102 = 1e-12*t44;
+    const int t103 = (t98 && ((t23 <= t102) || (t36 <= t102) || (t53 <= t102))) || (damping <= 0 && ((t10 <= t101) || (t78 <= t101) || (t90 <= t101)));
+    const int t104 = t100 && t99 && !t103;
+
+    /* Outputs */
+    q_dot[0] = (t104 ? (t98 ? -t61 : -t97) : 0);
+    q_dot[1] = (t104 ? (t98 ? -t62 : -t96) : 0);
+    q_dot[2] = (t104 ? (t98 ? -t63 : -t95) : 0);
+    return (!(t100 && t99) ? 2 : (t103 ? 1 : 0));
+}
+
 void planar_3r_ik_branches(const planar_3r_real mu[PLANAR_3R_TASK_DIM], planar_3r_real q[PLANAR_3R_MAX_IK_SOLUTIONS * PLANAR_3R_DOF], int valid[PLANAR_3R_MAX_IK_SOLUTIONS])
 {
     /* 106 operations */
@@ -394,103 +530,6 @@ void planar_3r_ik_branches(const planar_3r_real mu[PLANAR_3R_TASK_DIM], planar_3
     q[5] = -t31 - t35 - 6.283185307179586*ceil(-0.15915494309189535*t32 - 0.15915494309189535*t35);
     valid[0] = t36 && t37 && t8 >= -1e-12;
     valid[1] = t36 && t37 && t8 > 1e-12;
-}
-
-int planar_3r_velocity_ik(const planar_3r_real q[PLANAR_3R_DOF], const planar_3r_real mu_dot[PLANAR_3R_TASK_DIM], planar_3r_real damping, planar_3r_real q_dot[PLANAR_3R_DOF])
-{
-    /* Rows of task_jacobian() forming Js (the task Jacobian). */
-    static const int rows[PLANAR_3R_TASK_DIM] = {0, 1, 2};
-    planar_3r_real J[PLANAR_3R_TASK_DIM * PLANAR_3R_DOF];
-    planar_3r_real A[3 * 3];
-    planar_3r_real x[3];
-    planar_3r_real scale = 0;
-    const int normal = damping > 0; /* damped: solve (Js Js^T + damping^2 I) x = mu_dot */
-    int r, c, k;
-
-    for (c = 0; c < PLANAR_3R_DOF; ++c) {
-        q_dot[c] = 0;
-        if (!isfinite(q[c])) {
-            return PLANAR_3R_VELOCITY_IK_NOT_FINITE;
-        }
-    }
-    for (r = 0; r < PLANAR_3R_TASK_DIM; ++r) {
-        if (!isfinite(mu_dot[r])) {
-            return PLANAR_3R_VELOCITY_IK_NOT_FINITE;
-        }
-        x[r] = mu_dot[r]; /* b; copied here, not in a loop of its own (which becomes memcpy) */
-    }
-    if (!(damping >= 0) || !isfinite(damping)) {
-        return PLANAR_3R_VELOCITY_IK_NOT_FINITE;
-    }
-    planar_3r_task_jacobian(q, J);
-
-    /* The system A x = b (3 x 3), b in x. */
-    for (r = 0; r < 3; ++r) {
-        for (c = 0; c < 3; ++c) {
-            planar_3r_real sum = r == c ? damping * damping : 0;
-            if (!normal) {
-                sum = J[rows[r] * PLANAR_3R_DOF + c];
-            }
-            for (k = 0; normal && k < PLANAR_3R_DOF; ++k) {
-                sum += J[rows[r] * PLANAR_3R_DOF + k] * J[rows[c] * PLANAR_3R_DOF + k];
-            }
-            A[r * 3 + c] = sum;
-            if (!isfinite(sum)) {
-                return PLANAR_3R_VELOCITY_IK_NOT_FINITE;
-            }
-            if (fabs(sum) > scale) {
-                scale = fabs(sum);
-            }
-        }
-    }
-
-    /* LU with partial pivoting, applied to x as it goes. */
-    for (k = 0; k < 3; ++k) {
-        int pivot = k;
-        for (r = k + 1; r < 3; ++r) {
-            if (fabs(A[r * 3 + k]) > fabs(A[pivot * 3 + k])) {
-                pivot = r;
-            }
-        }
-        if (!(fabs(A[pivot * 3 + k]) > 1e-12 * scale)) {
-            return PLANAR_3R_VELOCITY_IK_SINGULAR;
-        }
-        if (pivot != k) {
-            planar_3r_real swap;
-            for (c = k; c < 3; ++c) {
-                swap = A[k * 3 + c];
-                A[k * 3 + c] = A[pivot * 3 + c];
-                A[pivot * 3 + c] = swap;
-            }
-            swap = x[k];
-            x[k] = x[pivot];
-            x[pivot] = swap;
-        }
-        for (r = k + 1; r < 3; ++r) {
-            const planar_3r_real factor = A[r * 3 + k] / A[k * 3 + k];
-            for (c = k + 1; c < 3; ++c) {
-                A[r * 3 + c] -= factor * A[k * 3 + c];
-            }
-            x[r] -= factor * x[k];
-        }
-    }
-    for (k = 3 - 1; k >= 0; --k) {
-        for (c = k + 1; c < 3; ++c) {
-            x[k] -= A[k * 3 + c] * x[c];
-        }
-        x[k] /= A[k * 3 + k];
-        if (!normal) {
-            q_dot[k] = x[k];
-        }
-    }
-
-    /* q_dot = Js^T x when damped (else x, written above) */
-    for (c = 0; normal && c < PLANAR_3R_DOF; ++c) {
-        for (r = 0; r < PLANAR_3R_TASK_DIM; ++r) {
-            q_dot[c] += J[rows[r] * PLANAR_3R_DOF + c] * x[r];
-        }
-    }
-    return PLANAR_3R_VELOCITY_IK_OK;
 }
 
 int planar_3r_ik(const planar_3r_real mu[PLANAR_3R_TASK_DIM], planar_3r_real q[PLANAR_3R_MAX_IK_SOLUTIONS * PLANAR_3R_DOF])

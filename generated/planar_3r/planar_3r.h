@@ -67,22 +67,21 @@ planar_3r_real planar_3r_manipulability(const planar_3r_real q[PLANAR_3R_DOF]);
  * Result: returned as a scalar. 22 operations. */
 planar_3r_real planar_3r_jacobian_det(const planar_3r_real q[PLANAR_3R_DOF]);
 
+/* Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status.
+ * Result: q_dot[i], i < 3; returned as a scalar. 323 operations. */
+int planar_3r_velocity_ik(const planar_3r_real q[PLANAR_3R_DOF], const planar_3r_real mu_dot[PLANAR_3R_TASK_DIM], planar_3r_real damping, planar_3r_real q_dot[PLANAR_3R_DOF]);
+
 /* Every branch of the closed-form ik and whether the target allows it.
  * Result: q: 2 x 3 row-major, element (r, c) at q[r * 3 + c]; valid[i], i < 2. 106 operations. */
 void planar_3r_ik_branches(const planar_3r_real mu[PLANAR_3R_TASK_DIM], planar_3r_real q[PLANAR_3R_MAX_IK_SOLUTIONS * PLANAR_3R_DOF], int valid[PLANAR_3R_MAX_IK_SOLUTIONS]);
 
-/* Status of planar_3r_velocity_ik. */
+/* Statuses of planar_3r_velocity_ik: OK, singular (a diagonal entry of the QR factor R of the
+ * 3 x 3 system at most 1e-12 times its Frobenius norm: take damping > 0), or
+ * not finite (q, mu_dot, damping or Js not finite, or damping < 0); q_dot is 0 unless OK.
+ * Js is the task Jacobian; mu_dot is the rate of the task vector (x, y, yaw). */
 #define PLANAR_3R_VELOCITY_IK_OK 0
-#define PLANAR_3R_VELOCITY_IK_SINGULAR 1   /* a pivot below 1e-12 x the largest |entry|: take damping > 0 */
-#define PLANAR_3R_VELOCITY_IK_NOT_FINITE 2 /* q, mu_dot, damping (must be >= 0) or Js not finite */
-
-/* Joint rates q_dot[PLANAR_3R_DOF] solving Js q_dot = mu_dot.
- * Js is the task Jacobian; mu_dot[PLANAR_3R_TASK_DIM] is the rate of the task vector (x, y, yaw).
- * damping = 0: q_dot = Js^-1 mu_dot; damping > 0 (damped least squares near singularities):
- * q_dot = Js^T (Js Js^T + damping^2 I)^-1 mu_dot.
- * LU with partial pivoting of the 3 x 3 system on the stack. Returns
- * PLANAR_3R_VELOCITY_IK_OK, or a status above with q_dot all 0. */
-int planar_3r_velocity_ik(const planar_3r_real q[PLANAR_3R_DOF], const planar_3r_real mu_dot[PLANAR_3R_TASK_DIM], planar_3r_real damping, planar_3r_real q_dot[PLANAR_3R_DOF]);
+#define PLANAR_3R_VELOCITY_IK_SINGULAR 1
+#define PLANAR_3R_VELOCITY_IK_NOT_FINITE 2
 
 /* Closed-form inverse kinematics: every joint solution that reaches the target; returns
  * their count k and writes solution i to q[i * PLANAR_3R_DOF + j], i < k: the valid

@@ -323,6 +323,142 @@ def jacobian_det(q):
 
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
+def velocity_ik(q, mu_dot, damping=0.0):
+    """joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: (3 x 1 and 1 x 1), 323 operations."""
+    q = _argument("q", q, (3,))
+    mu_dot = _argument("mu_dot", mu_dot, (3,))
+    damping = _argument("damping", damping, ())
+    q1 = q[..., 0]
+    q2 = q[..., 1]
+    q3 = q[..., 2]
+    mu_dot0 = mu_dot[..., 0]
+    mu_dot1 = mu_dot[..., 1]
+    mu_dot2 = mu_dot[..., 2]
+    c1 = numpy.cos(q1)
+    s1 = numpy.sin(q1)
+    c2 = numpy.cos(q2)
+    s2 = numpy.sin(q2)
+    c12 = c1*c2 - s1*s2
+    s12 = c1*s2 + c2*s1
+    c3 = numpy.cos(q3)
+    s3 = numpy.sin(q3)
+    c123 = c12*c3 - s12*s3
+    s123 = c12*s3 + c3*s12
+    t0 = c12 + c123
+    t1 = s12 + s123
+    t2 = c1 + t0
+    t3 = s1 + t1
+    t4 = c123*s123 + t0*t1 + t2*t3
+    t5 = s123 + t1 + t3
+    t6 = t3**2
+    t7 = s123**2 + t1**2 + t6
+    t8 = t7
+    t9 = t2**2
+    t10 = numpy.sqrt(t6 + t9 + 1)
+    t11 = t10*numpy.where(numpy.less_equal(t3, 0), 1, -1)
+    t12 = numpy.where(numpy.greater(t10, 0), 1/(t10*(t10 + abs(t3))), 0)
+    t13 = c123**2 + t0**2 + t9
+    t14 = t13
+    t15 = numpy.sqrt(t13 + t7 + 3)
+    t16 = c123 + t0 + t2
+    t17 = t16
+    t18 = t4**2
+    t19 = t5**2
+    t20 = damping**2
+    t21 = t20 + t8
+    t22 = t21**2
+    t23 = numpy.sqrt(t18 + t19 + t22)
+    t24 = t23*numpy.where(numpy.greater_equal(t21, 0), 1, -1)
+    t25 = t21 + t24
+    t26 = numpy.where(numpy.greater(t23, 0), 1/(t23*(t23 + abs(t21))), 0)
+    t27 = -t26*(-mu_dot0*t25 + mu_dot1*t4 + mu_dot2*t5)
+    t28 = mu_dot0 - t25*t27
+    t29 = mu_dot1 + t27*t4
+    t30 = mu_dot2 + t27*t5
+    t31 = t14 + t20
+    t32 = -t26*(t17*t5 + t25*t4 + t31*t4)
+    t33 = t25*t32 + t4
+    t34 = t31 + t32*t4
+    t35 = t17 + t32*t5
+    t36 = numpy.sqrt(t34**2 + t35**2)
+    t37 = t36*numpy.where(numpy.greater_equal(t34, 0), 1, -1)
+    t38 = t34 + t37
+    t39 = numpy.where(numpy.greater(t36, 0), 1/(t36*(t36 + abs(t34))), 0)
+    t40 = t39*(t29*t38 + t30*t35)
+    t41 = t29 - t38*t40
+    t42 = t30 - t35*t40
+    t43 = t20 + 3
+    t44 = numpy.sqrt(2*t17**2 + 2*t18 + 2*t19 + t22 + t31**2 + t43**2)
+    t45 = -t26*(t17*t4 + t25*t5 + t43*t5)
+    t46 = t25*t45 + t5
+    t47 = t17 + t4*t45
+    t48 = t43 + t45*t5
+    t49 = t39*(t35*t48 + t38*t47)
+    t50 = -t38*t49 + t47
+    t51 = -t35*t49 + t48
+    t52 = abs(t51)
+    t53 = t52
+    t54 = t53*numpy.where(numpy.greater_equal(t51, 0), 1, -1)
+    t55 = t51 + t54
+    t56 = numpy.where(numpy.greater(t53, 0), 1/(t53*(t52 + t53)), 0)
+    t57 = -t42*t55**2*t56 + t42
+    t58 = t57/t54
+    t59 = (t41 + t50*t58)/t37
+    t60 = (t28 - t33*t59 - t46*t58)/t24
+    t61 = t2*t59 - t3*t60 + t58
+    t62 = t0*t59 - t1*t60 + t58
+    t63 = c123*t59 - s123*t60 + t58
+    t64 = -t3
+    t65 = t11 + t64
+    t66 = t12*(t0*t2 - t1*t65 + 1)
+    t67 = t1 + t65*t66
+    t68 = t0 - t2*t66
+    t69 = 1 - t66
+    t70 = t12*(c123*t2 - s123*t65 + 1)
+    t71 = s123 + t65*t70
+    t72 = c123 - t2*t70
+    t73 = 1 - t70
+    t74 = t12*(mu_dot0*t65 + mu_dot1*t2 + mu_dot2)
+    t75 = mu_dot0 - t65*t74
+    t76 = mu_dot1 - t2*t74
+    t77 = mu_dot2 - t74
+    t78 = numpy.sqrt(t68**2 + t69**2)
+    t79 = t78*numpy.where(numpy.greater_equal(t68, 0), 1, -1)
+    t80 = t68 + t79
+    t81 = numpy.where(numpy.greater(t78, 0), 1/(t78*(t78 + abs(t68))), 0)
+    t82 = t81*(t69*t73 + t72*t80)
+    t83 = t72 - t80*t82
+    t84 = -t69*t82 + t73
+    t85 = t81*(t69*t77 + t76*t80)
+    t86 = t76 - t80*t85
+    t87 = -t69*t85 + t77
+    t88 = damping + mu_dot0 + mu_dot1 + mu_dot2 + q1 + q2 + q3 - s123 - t1 + t16 + t64 + 3
+    t89 = abs(t84)
+    t90 = t89
+    t91 = t90*numpy.where(numpy.greater_equal(t84, 0), 1, -1)
+    t92 = t84 + t91
+    t93 = numpy.where(numpy.greater(t90, 0), 1/(t90*(t89 + t90)), 0)
+    t94 = -t87*t92**2*t93 + t87
+    t95 = t94/t91
+    t96 = (t83*t95 + t86)/t79
+    t97 = (-t67*t96 - t71*t95 + t75)/t11
+    t98 = numpy.greater(damping, 0)
+    t99 = numpy.isfinite(t88)
+    t100 = numpy.greater_equal(damping, 0)
+    t101 = 1e-12*t15
+    t102 = 1e-12*t44
+    t103 = (t98 & ((numpy.less_equal(t23, t102)) | (numpy.less_equal(t36, t102)) | (numpy.less_equal(t53, t102)))) | ((numpy.less_equal(damping, 0)) & ((numpy.less_equal(t10, t101)) | (numpy.less_equal(t78, t101)) | (numpy.less_equal(t90, t101))))
+    t104 = t100 & t99 & numpy.logical_not(t103)
+    q_dot = numpy.empty(numpy.broadcast_shapes(q.shape[:-1], mu_dot.shape[:-1], damping.shape) + (3,))
+    q_dot[..., 0] = numpy.where(t104, numpy.where(t98, -t61, -t97), 0)
+    q_dot[..., 1] = numpy.where(t104, numpy.where(t98, -t62, -t96), 0)
+    q_dot[..., 2] = numpy.where(t104, numpy.where(t98, -t63, -t95), 0)
+    status = numpy.empty(numpy.broadcast_shapes(q.shape[:-1], mu_dot.shape[:-1], damping.shape) + (), dtype=int)
+    status[...] = numpy.where(numpy.logical_not(t100 & t99), 2, numpy.where(t103, 1, 0))
+    return q_dot, status
+
+
+@numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def ik_branches(mu):
     """every branch of the closed-form ik and whether the target allows it: (2 x 3 and 2 x 1), 106 operations."""
     mu = _argument("mu", mu, (3,))
@@ -465,42 +601,10 @@ def ik_numeric(target, q0, max_iter=100, tol=1e-10):
     return q, IK_NUMERIC_CONVERGED if cost <= tol * tol else IK_NUMERIC_ITERATION_LIMIT
 
 
-# Reciprocal condition number below which the system of velocity_ik counts as singular.
-VELOCITY_IK_RCOND = 1e-12
-
-
-def velocity_ik(q, mu_dot, damping=0.0):
-    """Joint rates solving Js q_dot = mu_dot, and where that succeeded: (q_dot, ok).
-
-    Js is the task Jacobian, so mu_dot (3,) or (..., 3) is the rate of the task vector (x, y, yaw).
-    damping = 0: q_dot = Js^-1 mu_dot. damping > 0 (damped least squares, near
-    singularities): q_dot = Js^T (Js Js^T + damping^2 I)^-1 mu_dot.
-
-    Returns q_dot (..., 3) and ok (...), a boolean array: False where an input is not
-    finite or the 3 x 3 system solved is numerically singular (reciprocal
-    condition number below VELOCITY_IK_RCOND; take damping > 0 there). Where ok is False,
-    q_dot is 0: the result never holds NaN.
-    """
-    q = _argument("q", q, (DOF,))
-    mu_dot = numpy.asarray(mu_dot, dtype=float)
-    if mu_dot.ndim == 0 or mu_dot.shape[-1] != 3:
-        raise ValueError(f"mu_dot must have shape (3,) or (..., 3), got {mu_dot.shape}")
-    damping = float(damping)
-    if not damping >= 0.0:
-        raise ValueError(f"damping must be >= 0, got {damping}")
-    J = task_jacobian(q)
-    batch = numpy.broadcast_shapes(J.shape[:-2], mu_dot.shape[:-1])
-    J = numpy.broadcast_to(J, batch + J.shape[-2:])
-    mu_dot = numpy.broadcast_to(mu_dot, batch + mu_dot.shape[-1:])
-    Jt = numpy.swapaxes(J, -1, -2)
-    if damping == 0.0:
-        A, b = J, mu_dot
-    else:
-        A, b = J @ Jt + damping**2 * numpy.eye(3), mu_dot
-    ok = numpy.isfinite(A).all(axis=(-2, -1)) & numpy.isfinite(b).all(axis=-1)
-    identity = numpy.eye(3)
-    singular_values = numpy.linalg.svd(numpy.where(ok[..., None, None], A, identity), compute_uv=False)
-    ok &= singular_values[..., -1] > VELOCITY_IK_RCOND * singular_values[..., 0]
-    x = numpy.linalg.solve(numpy.where(ok[..., None, None], A, identity), numpy.where(ok[..., None], b, 0.0)[..., None])[..., 0]
-    q_dot = x if damping == 0.0 else (Jt @ x[..., None])[..., 0]
-    return numpy.where(ok[..., None], q_dot, 0.0), ok
+# Statuses of velocity_ik: OK, singular (a diagonal entry of the QR factor R of the
+# 3 x 3 system at most 1e-12 times its Frobenius norm: take damping > 0), or
+# not finite (q, mu_dot, damping or Js not finite, or damping < 0); q_dot is 0 unless OK.
+# Js is the task Jacobian; mu_dot is the rate of the task vector (x, y, yaw).
+VELOCITY_IK_OK = 0
+VELOCITY_IK_SINGULAR = 1
+VELOCITY_IK_NOT_FINITE = 2

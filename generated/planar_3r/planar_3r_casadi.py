@@ -259,6 +259,138 @@ def _jacobian_det(q):
     return [d]
 
 
+def _velocity_ik(q, mu_dot, damping):
+    """Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: 323 operations."""
+    q1 = q[0]
+    q2 = q[1]
+    q3 = q[2]
+    mu_dot0 = mu_dot[0]
+    mu_dot1 = mu_dot[1]
+    mu_dot2 = mu_dot[2]
+    c1 = casadi.cos(q1)
+    s1 = casadi.sin(q1)
+    c2 = casadi.cos(q2)
+    s2 = casadi.sin(q2)
+    c12 = c1*c2 - s1*s2
+    s12 = c1*s2 + c2*s1
+    c3 = casadi.cos(q3)
+    s3 = casadi.sin(q3)
+    c123 = c12*c3 - s12*s3
+    s123 = c12*s3 + c3*s12
+    t0 = c12 + c123
+    t1 = s12 + s123
+    t2 = c1 + t0
+    t3 = s1 + t1
+    t4 = c123*s123 + t0*t1 + t2*t3
+    t5 = s123 + t1 + t3
+    t6 = t3**2
+    t7 = s123**2 + t1**2 + t6
+    t8 = t7
+    t9 = t2**2
+    t10 = casadi.sqrt(t6 + t9 + 1)
+    t11 = t10*casadi.if_else((t3 <= 0), 1, -1)
+    t12 = casadi.if_else((t10 > 0), 1/(t10*(t10 + casadi.fabs(t3))), 0)
+    t13 = c123**2 + t0**2 + t9
+    t14 = t13
+    t15 = casadi.sqrt(t13 + t7 + 3)
+    t16 = c123 + t0 + t2
+    t17 = t16
+    t18 = t4**2
+    t19 = t5**2
+    t20 = damping**2
+    t21 = t20 + t8
+    t22 = t21**2
+    t23 = casadi.sqrt(t18 + t19 + t22)
+    t24 = t23*casadi.if_else((t21 >= 0), 1, -1)
+    t25 = t21 + t24
+    t26 = casadi.if_else((t23 > 0), 1/(t23*(t23 + casadi.fabs(t21))), 0)
+    t27 = -t26*(-mu_dot0*t25 + mu_dot1*t4 + mu_dot2*t5)
+    t28 = mu_dot0 - t25*t27
+    t29 = mu_dot1 + t27*t4
+    t30 = mu_dot2 + t27*t5
+    t31 = t14 + t20
+    t32 = -t26*(t17*t5 + t25*t4 + t31*t4)
+    t33 = t25*t32 + t4
+    t34 = t31 + t32*t4
+    t35 = t17 + t32*t5
+    t36 = casadi.sqrt(t34**2 + t35**2)
+    t37 = t36*casadi.if_else((t34 >= 0), 1, -1)
+    t38 = t34 + t37
+    t39 = casadi.if_else((t36 > 0), 1/(t36*(t36 + casadi.fabs(t34))), 0)
+    t40 = t39*(t29*t38 + t30*t35)
+    t41 = t29 - t38*t40
+    t42 = t30 - t35*t40
+    t43 = t20 + 3
+    t44 = casadi.sqrt(2*t17**2 + 2*t18 + 2*t19 + t22 + t31**2 + t43**2)
+    t45 = -t26*(t17*t4 + t25*t5 + t43*t5)
+    t46 = t25*t45 + t5
+    t47 = t17 + t4*t45
+    t48 = t43 + t45*t5
+    t49 = t39*(t35*t48 + t38*t47)
+    t50 = -t38*t49 + t47
+    t51 = -t35*t49 + t48
+    t52 = casadi.fabs(t51)
+    t53 = t52
+    t54 = t53*casadi.if_else((t51 >= 0), 1, -1)
+    t55 = t51 + t54
+    t56 = casadi.if_else((t53 > 0), 1/(t53*(t52 + t53)), 0)
+    t57 = -t42*t55**2*t56 + t42
+    t58 = t57/t54
+    t59 = (t41 + t50*t58)/t37
+    t60 = (t28 - t33*t59 - t46*t58)/t24
+    t61 = t2*t59 - t3*t60 + t58
+    t62 = t0*t59 - t1*t60 + t58
+    t63 = c123*t59 - s123*t60 + t58
+    t64 = -t3
+    t65 = t11 + t64
+    t66 = t12*(t0*t2 - t1*t65 + 1)
+    t67 = t1 + t65*t66
+    t68 = t0 - t2*t66
+    t69 = 1 - t66
+    t70 = t12*(c123*t2 - s123*t65 + 1)
+    t71 = s123 + t65*t70
+    t72 = c123 - t2*t70
+    t73 = 1 - t70
+    t74 = t12*(mu_dot0*t65 + mu_dot1*t2 + mu_dot2)
+    t75 = mu_dot0 - t65*t74
+    t76 = mu_dot1 - t2*t74
+    t77 = mu_dot2 - t74
+    t78 = casadi.sqrt(t68**2 + t69**2)
+    t79 = t78*casadi.if_else((t68 >= 0), 1, -1)
+    t80 = t68 + t79
+    t81 = casadi.if_else((t78 > 0), 1/(t78*(t78 + casadi.fabs(t68))), 0)
+    t82 = t81*(t69*t73 + t72*t80)
+    t83 = t72 - t80*t82
+    t84 = -t69*t82 + t73
+    t85 = t81*(t69*t77 + t76*t80)
+    t86 = t76 - t80*t85
+    t87 = -t69*t85 + t77
+    t88 = damping + mu_dot0 + mu_dot1 + mu_dot2 + q1 + q2 + q3 - s123 - t1 + t16 + t64 + 3
+    t89 = casadi.fabs(t84)
+    t90 = t89
+    t91 = t90*casadi.if_else((t84 >= 0), 1, -1)
+    t92 = t84 + t91
+    t93 = casadi.if_else((t90 > 0), 1/(t90*(t89 + t90)), 0)
+    t94 = -t87*t92**2*t93 + t87
+    t95 = t94/t91
+    t96 = (t83*t95 + t86)/t79
+    t97 = (-t67*t96 - t71*t95 + t75)/t11
+    t98 = (damping > 0)
+    t99 = (casadi.fabs(t88) < casadi.inf)
+    t100 = (damping >= 0)
+    t101 = 1e-12*t15
+    t102 = 1e-12*t44
+    t103 = casadi.logic_or(casadi.logic_and(t98, casadi.logic_or(casadi.logic_or((t23 <= t102), (t36 <= t102)), (t53 <= t102))), casadi.logic_and((damping <= 0), casadi.logic_or(casadi.logic_or((t10 <= t101), (t78 <= t101)), (t90 <= t101))))
+    t104 = casadi.logic_and(casadi.logic_and(t100, t99), casadi.logic_not(t103))
+    q_dot = casadi.SX(3, 1)
+    q_dot[0, 0] = casadi.if_else(t104, casadi.if_else(t98, -t61, -t97), 0)
+    q_dot[1, 0] = casadi.if_else(t104, casadi.if_else(t98, -t62, -t96), 0)
+    q_dot[2, 0] = casadi.if_else(t104, casadi.if_else(t98, -t63, -t95), 0)
+    status = casadi.SX(1, 1)
+    status[0, 0] = casadi.if_else(casadi.logic_not(casadi.logic_and(t100, t99)), 2, casadi.if_else(t103, 1, 0))
+    return [q_dot, status]
+
+
 def _ik_branches(mu):
     """Every branch of the closed-form ik and whether the target allows it: 106 operations."""
     mu0 = mu[0]
@@ -316,6 +448,8 @@ def _ik_branches(mu):
 
 
 _q = casadi.SX.sym("q", 3, 1)
+_mu_dot = casadi.SX.sym("mu_dot", 3, 1)
+_damping = casadi.SX.sym("damping", 1, 1)
 _mu = casadi.SX.sym("mu", 3, 1)
 fk = casadi.Function("fk", [_q], _fk(_q), ["q"], ["T"])
 jacobian = casadi.Function("jacobian", [_q], _jacobian(_q), ["q"], ["J"])
@@ -326,10 +460,11 @@ task_jacobian = casadi.Function("task_jacobian", [_q], _task_jacobian(_q), ["q"]
 singularity_factors = casadi.Function("singularity_factors", [_q], _singularity_factors(_q), ["q"], ["f"])
 manipulability = casadi.Function("manipulability", [_q], _manipulability(_q), ["q"], ["w"])
 jacobian_det = casadi.Function("jacobian_det", [_q], _jacobian_det(_q), ["q"], ["d"])
+velocity_ik = casadi.Function("velocity_ik", [_q, _mu_dot, _damping], _velocity_ik(_q, _mu_dot, _damping), ["q", "mu_dot", "damping"], ["q_dot", "status"])
 ik_branches = casadi.Function("ik_branches", [_mu], _ik_branches(_mu), ["mu"], ["q", "valid"])
 ik = ik_branches  # CasADi functions have fixed-size outputs: every branch and its validity
 
 
 def functions():
     """All functions by name."""
-    return {"fk": fk, "jacobian": jacobian, "fk_jacobian": fk_jacobian, "jacobian_tool": jacobian_tool, "task": task, "task_jacobian": task_jacobian, "singularity_factors": singularity_factors, "manipulability": manipulability, "jacobian_det": jacobian_det, "ik_branches": ik_branches}
+    return {"fk": fk, "jacobian": jacobian, "fk_jacobian": fk_jacobian, "jacobian_tool": jacobian_tool, "task": task, "task_jacobian": task_jacobian, "singularity_factors": singularity_factors, "manipulability": manipulability, "jacobian_det": jacobian_det, "velocity_ik": velocity_ik, "ik_branches": ik_branches}

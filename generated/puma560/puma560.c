@@ -650,6 +650,412 @@ puma560_real puma560_jacobian_det(const puma560_real q[PUMA560_DOF])
     return -0.080509645432*s5*(c3 + t0)*(-0.04701250578971746*c2*c3 + c2*s3 - c2 + c3*s2 + s2*t0);
 }
 
+int puma560_velocity_ik(const puma560_real q[PUMA560_DOF], const puma560_real mu_dot[PUMA560_TASK_DIM], puma560_real damping, puma560_real q_dot[PUMA560_DOF])
+{
+    /* 1200 operations */
+
+    /* Inputs */
+    const puma560_real q1 = q[0];
+    const puma560_real q2 = q[1];
+    const puma560_real q3 = q[2];
+    const puma560_real q4 = q[3];
+    const puma560_real q5 = q[4];
+    const puma560_real q6 = q[5];
+    const puma560_real mu_dot0 = mu_dot[0];
+    const puma560_real mu_dot1 = mu_dot[1];
+    const puma560_real mu_dot2 = mu_dot[2];
+    const puma560_real mu_dot3 = mu_dot[3];
+    const puma560_real mu_dot4 = mu_dot[4];
+    const puma560_real mu_dot5 = mu_dot[5];
+
+    /* Intermediate terms */
+    const puma560_real c1 = cos(q1);
+    const puma560_real s1 = sin(q1);
+    const puma560_real c2 = cos(q2);
+    const puma560_real s2 = sin(q2);
+    const puma560_real c3 = cos(q3);
+    const puma560_real s3 = sin(q3);
+    const puma560_real c23 = c2*c3 - s2*s3;
+    const puma560_real s23 = c2*s3 + c3*s2;
+    const puma560_real c4 = cos(q4);
+    const puma560_real s4 = sin(q4);
+    const puma560_real c5 = cos(q5);
+    const puma560_real s5 = sin(q5);
+    const puma560_real t0 = c23*c5 - c4*s23*s5;
+    const puma560_real t1 = 0.4318*c23 + 0.0203*s23;
+    const puma560_real t2 = 0.4318*s2 + t1;
+    const puma560_real t3 = 0.0203*c23;
+    const puma560_real t4 = c1*t3 + 0.15005*s1;
+    const puma560_real t5 = -0.15005*c1 + s1*t3;
+    const puma560_real t6 = s1*s4;
+    const puma560_real t7 = c1*c4;
+    const puma560_real t8 = c23*t7 - t6;
+    const puma560_real t9 = -c23*t6 + t7;
+    const puma560_real t10 = c4*s1;
+    const puma560_real t11 = c1*s4;
+    const puma560_real t12 = c23*t11 + t10;
+    const puma560_real t13 = c23*t10 + t11;
+    const puma560_real t14 = c1*s23;
+    const puma560_real t15 = c5*t14 + s5*t8;
+    const puma560_real t16 = -0.4318*t14 + t4;
+    const puma560_real t17 = s1*s23;
+    const puma560_real t18 = c5*t17 + s5*t13;
+    const puma560_real t19 = -0.4318*t17 + t5;
+    const puma560_real t20 = c1*t16 + s1*t19;
+    const puma560_real t21 = 0.4318*c2;
+    const puma560_real t22 = c1*t21 + t16;
+    const puma560_real t23 = s1*t21 + t19;
+    const puma560_real t24 = c1*t22 + s1*t23;
+    const puma560_real t25 = (t23*t23);
+    const puma560_real t26 = (t1*t1);
+    const puma560_real t27 = (c1*c1);
+    const puma560_real t28 = t1*t27 + t2*t27;
+    const puma560_real t29 = (t2*t2);
+    const puma560_real t30 = t25 + t26*t27 + t27*t29;
+    const puma560_real t31 = t30;
+    const puma560_real t32 = -t22*t23;
+    const puma560_real t33 = c1*s1;
+    const puma560_real t34 = t26*t33 + t29*t33 + t32;
+    const puma560_real t35 = c1*t20;
+    const puma560_real t36 = c1*t24;
+    const puma560_real t37 = t1*t35 + t2*t36;
+    const puma560_real t38 = t35 + t36;
+    const puma560_real t39 = c1*t1;
+    const puma560_real t40 = c1*t2;
+    const puma560_real t41 = s1*t39 + s1*t40;
+    const puma560_real t42 = (t22*t22);
+    const puma560_real t43 = sqrt(t25 + t42 + 1);
+    const puma560_real t44 = t43*(t23 <= 0 ? 1 : -1);
+    const puma560_real t45 = (t43 > 0 ? 1/(t43*(t43 + fabs(t23))) : 0);
+    const puma560_real t46 = (s1*s1);
+    const puma560_real t47 = t1*t46 + t2*t46;
+    const puma560_real t48 = t26*t46 + t29*t46 + t42;
+    const puma560_real t49 = t48;
+    const puma560_real t50 = s1*t20;
+    const puma560_real t51 = s1*t24;
+    const puma560_real t52 = t1*t50 + t2*t51;
+    const puma560_real t53 = t50 + t51;
+    const puma560_real t54 = (t24*t24);
+    const puma560_real t55 = t54 + (t20*t20);
+    const puma560_real t56 = t55;
+    const puma560_real t57 = (s23*s23);
+    const puma560_real t58 = t27*t57 + 2*t46 + (t12*t12) + (t15*t15);
+    const puma560_real t59 = t58;
+    const puma560_real t60 = 2*c1;
+    const puma560_real t61 = -s1*t60 - t12*t9 + t15*t18 + t33*t57;
+    const puma560_real t62 = s23*s4;
+    const puma560_real t63 = c23*t14 + t0*t15 - t12*t62;
+    const puma560_real t64 = c23*t17 + t0*t18 + t62*t9;
+    const puma560_real t65 = 2*t27 + t46*t57 + (t18*t18) + (t9*t9);
+    const puma560_real t66 = t65;
+    const puma560_real t67 = t57*(s4*s4) + (c23*c23) + (t0*t0) + 1;
+    const puma560_real t68 = t67;
+    const puma560_real t69 = sqrt(t30 + t48 + t55 + t58 + t65 + t67);
+    const puma560_real t70 = (t34*t34);
+    const puma560_real t71 = (t37*t37);
+    const puma560_real t72 = (t41*t41);
+    const puma560_real t73 = (t28*t28);
+    const puma560_real t74 = (damping*damping);
+    const puma560_real t75 = t31 + t74;
+    const puma560_real t76 = (t75*t75);
+    const puma560_real t77 = sqrt(t25 + t70 + t71 + t72 + t73 + t76);
+    const puma560_real t78 = t77*(t75 >= 0 ? 1 : -1);
+    const puma560_real t79 = t75 + t78;
+    const puma560_real t80 = (t77 > 0 ? 1/(t77*(t77 + fabs(t75))) : 0);
+    const puma560_real t81 = t80*(mu_dot0*t79 + mu_dot1*t34 - mu_dot2*t37 - mu_dot3*t41 + mu_dot4*t28 - mu_dot5*t23);
+    const puma560_real t82 = mu_dot0 - t79*t81;
+    const puma560_real t83 = mu_dot1 - t34*t81;
+    const puma560_real t84 = mu_dot2 + t37*t81;
+    const puma560_real t85 = mu_dot3 + t41*t81;
+    const puma560_real t86 = mu_dot4 - t28*t81;
+    const puma560_real t87 = mu_dot5 + t23*t81;
+    const puma560_real t88 = t49 + t74;
+    const puma560_real t89 = t80*(t28*t41 + t32 + t34*t79 + t34*t88 + t37*t52 + t41*t47);
+    const puma560_real t90 = t34 - t79*t89;
+    const puma560_real t91 = -t34*t89 + t88;
+    const puma560_real t92 = t37*t89 - t52;
+    const puma560_real t93 = t41*t89 - t47;
+    const puma560_real t94 = -t28*t89 + t41;
+    const puma560_real t95 = t22 + t23*t89;
+    const puma560_real t96 = sqrt((t91*t91) + (t92*t92) + (t93*t93) + (t94*t94) + (t95*t95));
+    const puma560_real t97 = t96*(t91 >= 0 ? 1 : -1);
+    const puma560_real t98 = t91 + t97;
+    const puma560_real t99 = (t96 > 0 ? 1/(t96*(t96 + fabs(t91))) : 0);
+    const puma560_real t100 = t99*(t83*t98 + t84*t92 + t85*t93 + t86*t94 + t87*t95);
+    const puma560_real t101 = -t100*t98 + t83;
+    const puma560_real t102 = -t100*t92 + t84;
+    const puma560_real t103 = -t100*t93 + t85;
+    const puma560_real t104 = -t100*t94 + t86;
+    const puma560_real t105 = -t100*t95 + t87;
+    const puma560_real t106 = t56 + t74;
+    const puma560_real t107 = -t80*(t106*t37 + t28*t38 + t34*t52 + t37*t79 + t41*t53);
+    const puma560_real t108 = t107*t79 + t37;
+    const puma560_real t109 = t107*t34 + t52;
+    const puma560_real t110 = t106 + t107*t37;
+    const puma560_real t111 = t107*t41 + t53;
+    const puma560_real t112 = t107*t28 + t38;
+    const puma560_real t113 = t59 + t74;
+    const puma560_real t114 = -t80*(t113*t41 - t23*t63 - t28*t61 + t34*t47 + t37*t53 + t41*t79);
+    const puma560_real t115 = t114*t79 + t41;
+    const puma560_real t116 = t114*t34 + t47;
+    const puma560_real t117 = t114*t37 + t53;
+    const puma560_real t118 = t113 + t114*t41;
+    const puma560_real t119 = -t114*t28 + t61;
+    const puma560_real t120 = t66 + t74;
+    const puma560_real t121 = t80*(t120*t28 + t23*t64 + t28*t79 + t34*t41 + t37*t38 - t41*t61);
+    const puma560_real t122 = -t121*t79 + t28;
+    const puma560_real t123 = -t121*t34 + t41;
+    const puma560_real t124 = t121*t37 - t38;
+    const puma560_real t125 = t121*t41 + t61;
+    const puma560_real t126 = t120 - t121*t28;
+    const puma560_real t127 = t121*t23 - t64;
+    const puma560_real t128 = t99*(t123*t98 + t124*t92 + t125*t93 + t126*t94 + t127*t95);
+    const puma560_real t129 = t123 - t128*t98;
+    const puma560_real t130 = t124 - t128*t92;
+    const puma560_real t131 = t125 - t128*t93;
+    const puma560_real t132 = t126 - t128*t94;
+    const puma560_real t133 = t127 - t128*t95;
+    const puma560_real t134 = t68 + t74;
+    const puma560_real t135 = sqrt(2*t25 + 2*t42 + 2*t70 + 2*t71 + 4*t72 + 2*t73 + t76 + (t106*t106) + (t113*t113) + (t120*t120) + (t134*t134) + 2*(t38*t38) + 2*(t47*t47) + 2*(t52*t52) + 2*(t53*t53) + 2*(t61*t61) + 2*(t63*t63) + 2*(t64*t64) + (t88*t88));
+    const puma560_real t136 = -t80*(t134*t23 - t22*t34 + t23*t79 + t28*t64 - t41*t63);
+    const puma560_real t137 = t136*t79 + t23;
+    const puma560_real t138 = -t136*t34 + t22;
+    const puma560_real t139 = t136*t28 + t64;
+    const puma560_real t140 = t134 + t136*t23;
+    const puma560_real t141 = -t63;
+    const puma560_real t142 = t114*t23 + t141;
+    const puma560_real t143 = t136*t41 + t141;
+    const puma560_real t144 = t99*(-t116*t98 + t117*t92 + t118*t93 + t119*t94 + t142*t95);
+    const puma560_real t145 = t116 + t144*t98;
+    const puma560_real t146 = t117 - t144*t92;
+    const puma560_real t147 = t118 - t144*t93;
+    const puma560_real t148 = t119 - t144*t94;
+    const puma560_real t149 = t142 - t144*t95;
+    const puma560_real t150 = t107*t23;
+    const puma560_real t151 = t99*(-t109*t98 + t110*t92 + t111*t93 - t112*t94 + t150*t95);
+    const puma560_real t152 = t109 + t151*t98;
+    const puma560_real t153 = t110 - t151*t92;
+    const puma560_real t154 = t111 - t151*t93;
+    const puma560_real t155 = t112 + t151*t94;
+    const puma560_real t156 = t150 - t151*t95;
+    const puma560_real t157 = sqrt((t153*t153) + (t154*t154) + (t155*t155) + (t156*t156));
+    const puma560_real t158 = t157*(t153 >= 0 ? 1 : -1);
+    const puma560_real t159 = t153 + t158;
+    const puma560_real t160 = (t157 > 0 ? 1/(t157*(t157 + fabs(t153))) : 0);
+    const puma560_real t161 = t160*(t146*t159 + t147*t154 - t148*t155 + t149*t156);
+    const puma560_real t162 = t146 - t159*t161;
+    const puma560_real t163 = t147 - t154*t161;
+    const puma560_real t164 = t148 + t155*t161;
+    const puma560_real t165 = t149 - t156*t161;
+    const puma560_real t166 = t160*(t130*t159 + t131*t154 - t132*t155 + t133*t156);
+    const puma560_real t167 = t130 - t159*t166;
+    const puma560_real t168 = t131 - t154*t166;
+    const puma560_real t169 = t132 + t155*t166;
+    const puma560_real t170 = t133 - t156*t166;
+    const puma560_real t171 = t160*(t102*t159 + t103*t154 - t104*t155 + t105*t156);
+    const puma560_real t172 = t102 - t159*t171;
+    const puma560_real t173 = t103 - t154*t171;
+    const puma560_real t174 = t104 + t155*t171;
+    const puma560_real t175 = t105 - t156*t171;
+    const puma560_real t176 = sqrt((t163*t163) + (t164*t164) + (t165*t165));
+    const puma560_real t177 = t176*(t163 >= 0 ? 1 : -1);
+    const puma560_real t178 = t163 + t177;
+    const puma560_real t179 = (t176 > 0 ? 1/(t176*(t176 + fabs(t163))) : 0);
+    const puma560_real t180 = t179*(t164*t169 + t165*t170 + t168*t178);
+    const puma560_real t181 = t168 - t178*t180;
+    const puma560_real t182 = -t164*t180 + t169;
+    const puma560_real t183 = -t165*t180 + t170;
+    const puma560_real t184 = t179*(t164*t174 + t165*t175 + t173*t178);
+    const puma560_real t185 = t173 - t178*t184;
+    const puma560_real t186 = -t164*t184 + t174;
+    const puma560_real t187 = -t165*t184 + t175;
+    const puma560_real t188 = sqrt((t182*t182) + (t183*t183));
+    const puma560_real t189 = t188*(t182 >= 0 ? 1 : -1);
+    const puma560_real t190 = t182 + t189;
+    const puma560_real t191 = (t188 > 0 ? 1/(t188*(t188 + fabs(t182))) : 0);
+    const puma560_real t192 = t191*(t183*t187 + t186*t190);
+    const puma560_real t193 = t186 - t190*t192;
+    const puma560_real t194 = -t183*t192 + t187;
+    const puma560_real t195 = t136*t37;
+    const puma560_real t196 = t99*(t138*t98 - t139*t94 + t140*t95 + t143*t93 + t195*t92);
+    const puma560_real t197 = t138 - t196*t98;
+    const puma560_real t198 = t195 - t196*t92;
+    const puma560_real t199 = t143 - t196*t93;
+    const puma560_real t200 = t139 + t196*t94;
+    const puma560_real t201 = t140 - t196*t95;
+    const puma560_real t202 = t160*(t154*t199 + t155*t200 + t156*t201 + t159*t198);
+    const puma560_real t203 = -t159*t202 + t198;
+    const puma560_real t204 = -t154*t202 + t199;
+    const puma560_real t205 = t155*t202 - t200;
+    const puma560_real t206 = -t156*t202 + t201;
+    const puma560_real t207 = t179*(t164*t205 + t165*t206 + t178*t204);
+    const puma560_real t208 = -t178*t207 + t204;
+    const puma560_real t209 = -t164*t207 + t205;
+    const puma560_real t210 = -t165*t207 + t206;
+    const puma560_real t211 = t191*(t183*t210 + t190*t209);
+    const puma560_real t212 = -t190*t211 + t209;
+    const puma560_real t213 = -t183*t211 + t210;
+    const puma560_real t214 = fabs(t213);
+    const puma560_real t215 = t214;
+    const puma560_real t216 = t215*(t213 >= 0 ? 1 : -1);
+    const puma560_real t217 = t213 + t216;
+    const puma560_real t218 = (t215 > 0 ? 1/(t215*(t214 + t215)) : 0);
+    const puma560_real t219 = -t194*t218*(t217*t217) + t194;
+    const puma560_real t220 = t219/t216;
+    const puma560_real t221 = (t193 + t212*t220)/t189;
+    const puma560_real t222 = (t181*t221 + t185 + t208*t220)/t177;
+    const puma560_real t223 = (t162*t222 + t167*t221 + t172 + t203*t220)/t158;
+    const puma560_real t224 = (t101 + t129*t221 - t145*t222 - t152*t223 + t197*t220)/t97;
+    const puma560_real t225 = (-t108*t223 - t115*t222 + t122*t221 - t137*t220 + t224*t90 + t82)/t78;
+    const puma560_real t226 = t22*t224 + t220 - t225*t23;
+    const puma560_real t227 = -c23*t220 + t14*t222 + t17*t221;
+    const puma560_real t228 = t12*t222 + t220*t62 - t221*t9;
+    const puma560_real t229 = -t0*t220 + t15*t222 + t18*t221;
+    const puma560_real t230 = s1*t2;
+    const puma560_real t231 = c1*t221 - s1*t222;
+    const puma560_real t232 = -t223*t24 + t224*t230 + t225*t40 + t231;
+    const puma560_real t233 = s1*t1;
+    const puma560_real t234 = -t20*t223 + t224*t233 + t225*t39 + t231;
+    const puma560_real t235 = -t23;
+    const puma560_real t236 = t235 + t44;
+    const puma560_real t237 = -t45*(t22*t230 + t236*t40);
+    const puma560_real t238 = t236*t237 + t40;
+    const puma560_real t239 = t22*t237 + t230;
+    const puma560_real t240 = -t45*(t22*t233 + t236*t39);
+    const puma560_real t241 = t236*t240 + t39;
+    const puma560_real t242 = t22*t240 + t233;
+    const puma560_real t243 = t45*(mu_dot0*t236 + mu_dot1*t22 + mu_dot5);
+    const puma560_real t244 = mu_dot0 - t236*t243;
+    const puma560_real t245 = mu_dot1 - t22*t243;
+    const puma560_real t246 = mu_dot5 - t243;
+    const puma560_real t247 = c23*t45;
+    const puma560_real t248 = c23 - t247;
+    const puma560_real t249 = t45*t62;
+    const puma560_real t250 = -t249 + t62;
+    const puma560_real t251 = t0*t45;
+    const puma560_real t252 = t0 - t251;
+    const puma560_real t253 = t27 + t46;
+    const puma560_real t254 = sqrt(t253 + t54 + (t237*t237) + (t239*t239));
+    const puma560_real t255 = t254*(t239 <= 0 ? 1 : -1);
+    const puma560_real t256 = -t239 + t255;
+    const puma560_real t257 = (t254 > 0 ? 1/(t254*(t254 + fabs(t239))) : 0);
+    const puma560_real t258 = t257*(t20*t24 + t237*t240 - t242*t256 + t253);
+    const puma560_real t259 = t242 + t256*t258;
+    const puma560_real t260 = t20 - t24*t258;
+    const puma560_real t261 = -s1*t258 + s1;
+    const puma560_real t262 = c1*t258 - c1;
+    const puma560_real t263 = t237*t258 - t240;
+    const puma560_real t264 = t257*(-c1*mu_dot4 + mu_dot2*t24 + mu_dot3*s1 - t237*t246 + t245*t256);
+    const puma560_real t265 = t245 - t256*t264;
+    const puma560_real t266 = mu_dot2 - t24*t264;
+    const puma560_real t267 = mu_dot3 - s1*t264;
+    const puma560_real t268 = c1*t264 + mu_dot4;
+    const puma560_real t269 = t237*t264 + t246;
+    const puma560_real t270 = sqrt((t260*t260) + (t261*t261) + (t262*t262) + (t263*t263));
+    const puma560_real t271 = t270*(t260 >= 0 ? 1 : -1);
+    const puma560_real t272 = t260 + t271;
+    const puma560_real t273 = (t270 > 0 ? 1/(t270*(t270 + fabs(t260))) : 0);
+    const puma560_real t274 = t273*(t261*t267 + t262*t268 + t263*t269 + t266*t272);
+    const puma560_real t275 = t266 - t272*t274;
+    const puma560_real t276 = -t261*t274 + t267;
+    const puma560_real t277 = -t262*t274 + t268;
+    const puma560_real t278 = -t263*t274 + t269;
+    const puma560_real t279 = t22*t247;
+    const puma560_real t280 = -t257*(t237*t248 + t256*t279);
+    const puma560_real t281 = t256*t280 + t279;
+    const puma560_real t282 = s1*t280 + t14;
+    const puma560_real t283 = t237*t280 + t248;
+    const puma560_real t284 = -t17;
+    const puma560_real t285 = c1*t280 + t284;
+    const puma560_real t286 = t22*t249;
+    const puma560_real t287 = t257*(c1*t9 + s1*t12 - t237*t250 - t256*t286);
+    const puma560_real t288 = t256*t287 + t286;
+    const puma560_real t289 = -s1*t287 + t12;
+    const puma560_real t290 = t237*t287 + t250;
+    const puma560_real t291 = -t9;
+    const puma560_real t292 = c1*t287 + t291;
+    const puma560_real t293 = t22*t251;
+    const puma560_real t294 = -t257*(-c1*t18 + s1*t15 + t237*t252 + t256*t293);
+    const puma560_real t295 = t256*t294 + t293;
+    const puma560_real t296 = s1*t294 + t15;
+    const puma560_real t297 = t237*t294 + t252;
+    const puma560_real t298 = -t18;
+    const puma560_real t299 = c1*t294 + t298;
+    const puma560_real t300 = c23 + damping + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + q1 + q2 + q3 + q4 + q5 + q6 + 2*s1 + t0 + t12 - t14 - t15 + t20 + t22 - t230 - t233 + t235 + t24 + t284 + t291 + t298 - t39 - t40 - t60 + t62 + 1;
+    const puma560_real t301 = t24*t280;
+    const puma560_real t302 = t273*(-t261*t282 + t262*t285 + t263*t283 - t272*t301);
+    const puma560_real t303 = t272*t302 + t301;
+    const puma560_real t304 = t261*t302 + t282;
+    const puma560_real t305 = -t262*t302 + t285;
+    const puma560_real t306 = -t263*t302 + t283;
+    const puma560_real t307 = sqrt((t304*t304) + (t305*t305) + (t306*t306));
+    const puma560_real t308 = t307*(t304 <= 0 ? 1 : -1);
+    const puma560_real t309 = -t304 + t308;
+    const puma560_real t310 = (t307 > 0 ? 1/(t307*(t307 + fabs(t304))) : 0);
+    const puma560_real t311 = t310*(t276*t309 + t277*t305 + t278*t306);
+    const puma560_real t312 = t276 - t309*t311;
+    const puma560_real t313 = t277 - t305*t311;
+    const puma560_real t314 = t278 - t306*t311;
+    const puma560_real t315 = t24*t287;
+    const puma560_real t316 = t273*(t261*t289 + t262*t292 + t263*t290 - t272*t315);
+    const puma560_real t317 = t272*t316 + t315;
+    const puma560_real t318 = -t261*t316 + t289;
+    const puma560_real t319 = -t262*t316 + t292;
+    const puma560_real t320 = -t263*t316 + t290;
+    const puma560_real t321 = t310*(t305*t319 + t306*t320 + t309*t318);
+    const puma560_real t322 = -t309*t321 + t318;
+    const puma560_real t323 = -t305*t321 + t319;
+    const puma560_real t324 = -t306*t321 + t320;
+    const puma560_real t325 = sqrt((t323*t323) + (t324*t324));
+    const puma560_real t326 = t325*(t323 >= 0 ? 1 : -1);
+    const puma560_real t327 = t323 + t326;
+    const puma560_real t328 = (t325 > 0 ? 1/(t325*(t325 + fabs(t323))) : 0);
+    const puma560_real t329 = t328*(t313*t327 + t314*t324);
+    const puma560_real t330 = t313 - t327*t329;
+    const puma560_real t331 = t314 - t324*t329;
+    const puma560_real t332 = t24*t294;
+    const puma560_real t333 = t273*(-t261*t296 + t262*t299 + t263*t297 - t272*t332);
+    const puma560_real t334 = t272*t333 + t332;
+    const puma560_real t335 = t261*t333 + t296;
+    const puma560_real t336 = -t262*t333 + t299;
+    const puma560_real t337 = -t263*t333 + t297;
+    const puma560_real t338 = t310*(t305*t336 + t306*t337 - t309*t335);
+    const puma560_real t339 = t309*t338 + t335;
+    const puma560_real t340 = -t305*t338 + t336;
+    const puma560_real t341 = -t306*t338 + t337;
+    const puma560_real t342 = t328*(t324*t341 + t327*t340);
+    const puma560_real t343 = -t327*t342 + t340;
+    const puma560_real t344 = -t324*t342 + t341;
+    const puma560_real t345 = fabs(t344);
+    const puma560_real t346 = t345;
+    const puma560_real t347 = t346*(t344 >= 0 ? 1 : -1);
+    const puma560_real t348 = t344 + t347;
+    const puma560_real t349 = (t346 > 0 ? 1/(t346*(t345 + t346)) : 0);
+    const puma560_real t350 = -t331*t349*(t348*t348) + t331;
+    const puma560_real t351 = t350/t347;
+    const puma560_real t352 = (t330 + t343*t351)/t326;
+    const puma560_real t353 = (t312 + t322*t352 - t339*t351)/t308;
+    const puma560_real t354 = (t275 - t303*t353 - t317*t352 - t334*t351)/t271;
+    const puma560_real t355 = (-t259*t354 + t265 - t281*t353 - t288*t352 - t295*t351)/t255;
+    const puma560_real t356 = (-t236*t247*t353 - t236*t249*t352 - t236*t251*t351 - t238*t355 - t241*t354 + t244)/t44;
+    const int t357 = damping > 0;
+    const int t358 = isfinite(t300);
+    const int t359 = damping >= 0;
+    const puma560_real t360 = 1e-12*t69;
+    const puma560_real t361 = 1e-12*t135;
+    const int t362 = (t357 && ((t157 <= t361) || (t176 <= t361) || (t188 <= t361) || (t215 <= t361) || (t77 <= t361) || (t96 <= t361))) || (damping <= 0 && ((t254 <= t360) || (t270 <= t360) || (t307 <= t360) || (t325 <= t360) || (t346 <= t360) || (t43 <= t360)));
+    const int t363 = t358 && t359 && !t362;
+
+    /* Outputs */
+    q_dot[0] = (t363 ? (t357 ? -t226 : -t356) : 0);
+    q_dot[1] = (t363 ? (t357 ? t232 : -t355) : 0);
+    q_dot[2] = (t363 ? (t357 ? t234 : -t354) : 0);
+    q_dot[3] = (t363 ? (t357 ? t227 : -t353) : 0);
+    q_dot[4] = (t363 ? (t357 ? -t228 : -t352) : 0);
+    q_dot[5] = (t363 ? (t357 ? t229 : -t351) : 0);
+    return (!(t358 && t359) ? 2 : (t362 ? 1 : 0));
+}
+
 void puma560_ik_branches(const puma560_real T[16], puma560_real q[PUMA560_MAX_IK_SOLUTIONS * PUMA560_DOF], int valid[PUMA560_MAX_IK_SOLUTIONS])
 {
     /* 900 operations */
@@ -1115,103 +1521,6 @@ void puma560_ik_branches(const puma560_real T[16], puma560_real q[PUMA560_MAX_IK
     valid[5] = t375 && t377 && t385 && t386 && t272 > 1e-12;
     valid[6] = t375 && t377 && t380 && t385 && t387 && t323 >= t376;
     valid[7] = t375 && t377 && t380 && t385 && t387 && t323 > 1e-12;
-}
-
-int puma560_velocity_ik(const puma560_real q[PUMA560_DOF], const puma560_real mu_dot[PUMA560_TASK_DIM], puma560_real damping, puma560_real q_dot[PUMA560_DOF])
-{
-    /* Rows of jacobian() forming Js (the geometric Jacobian). */
-    static const int rows[PUMA560_TASK_DIM] = {0, 1, 2, 3, 4, 5};
-    puma560_real J[6 * PUMA560_DOF];
-    puma560_real A[6 * 6];
-    puma560_real x[6];
-    puma560_real scale = 0;
-    const int normal = damping > 0; /* damped: solve (Js Js^T + damping^2 I) x = mu_dot */
-    int r, c, k;
-
-    for (c = 0; c < PUMA560_DOF; ++c) {
-        q_dot[c] = 0;
-        if (!isfinite(q[c])) {
-            return PUMA560_VELOCITY_IK_NOT_FINITE;
-        }
-    }
-    for (r = 0; r < PUMA560_TASK_DIM; ++r) {
-        if (!isfinite(mu_dot[r])) {
-            return PUMA560_VELOCITY_IK_NOT_FINITE;
-        }
-        x[r] = mu_dot[r]; /* b; copied here, not in a loop of its own (which becomes memcpy) */
-    }
-    if (!(damping >= 0) || !isfinite(damping)) {
-        return PUMA560_VELOCITY_IK_NOT_FINITE;
-    }
-    puma560_jacobian(q, J);
-
-    /* The system A x = b (6 x 6), b in x. */
-    for (r = 0; r < 6; ++r) {
-        for (c = 0; c < 6; ++c) {
-            puma560_real sum = r == c ? damping * damping : 0;
-            if (!normal) {
-                sum = J[rows[r] * PUMA560_DOF + c];
-            }
-            for (k = 0; normal && k < PUMA560_DOF; ++k) {
-                sum += J[rows[r] * PUMA560_DOF + k] * J[rows[c] * PUMA560_DOF + k];
-            }
-            A[r * 6 + c] = sum;
-            if (!isfinite(sum)) {
-                return PUMA560_VELOCITY_IK_NOT_FINITE;
-            }
-            if (fabs(sum) > scale) {
-                scale = fabs(sum);
-            }
-        }
-    }
-
-    /* LU with partial pivoting, applied to x as it goes. */
-    for (k = 0; k < 6; ++k) {
-        int pivot = k;
-        for (r = k + 1; r < 6; ++r) {
-            if (fabs(A[r * 6 + k]) > fabs(A[pivot * 6 + k])) {
-                pivot = r;
-            }
-        }
-        if (!(fabs(A[pivot * 6 + k]) > 1e-12 * scale)) {
-            return PUMA560_VELOCITY_IK_SINGULAR;
-        }
-        if (pivot != k) {
-            puma560_real swap;
-            for (c = k; c < 6; ++c) {
-                swap = A[k * 6 + c];
-                A[k * 6 + c] = A[pivot * 6 + c];
-                A[pivot * 6 + c] = swap;
-            }
-            swap = x[k];
-            x[k] = x[pivot];
-            x[pivot] = swap;
-        }
-        for (r = k + 1; r < 6; ++r) {
-            const puma560_real factor = A[r * 6 + k] / A[k * 6 + k];
-            for (c = k + 1; c < 6; ++c) {
-                A[r * 6 + c] -= factor * A[k * 6 + c];
-            }
-            x[r] -= factor * x[k];
-        }
-    }
-    for (k = 6 - 1; k >= 0; --k) {
-        for (c = k + 1; c < 6; ++c) {
-            x[k] -= A[k * 6 + c] * x[c];
-        }
-        x[k] /= A[k * 6 + k];
-        if (!normal) {
-            q_dot[k] = x[k];
-        }
-    }
-
-    /* q_dot = Js^T x when damped (else x, written above) */
-    for (c = 0; normal && c < PUMA560_DOF; ++c) {
-        for (r = 0; r < PUMA560_TASK_DIM; ++r) {
-            q_dot[c] += J[rows[r] * PUMA560_DOF + c] * x[r];
-        }
-    }
-    return PUMA560_VELOCITY_IK_OK;
 }
 
 int puma560_ik(const puma560_real T[16], puma560_real q[PUMA560_MAX_IK_SOLUTIONS * PUMA560_DOF])

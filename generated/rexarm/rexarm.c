@@ -459,6 +459,226 @@ rexarm_real rexarm_jacobian_det(const rexarm_real q[REXARM_DOF])
     return 0.001*s3*t2*(-c2*c3 - c2 + t1 + t2)/sqrt(t0*(c1*c1) + t0*(s1*s1));
 }
 
+int rexarm_velocity_ik(const rexarm_real q[REXARM_DOF], const rexarm_real mu_dot[REXARM_TASK_DIM], rexarm_real damping, rexarm_real q_dot[REXARM_DOF])
+{
+    /* 589 operations */
+
+    /* Inputs */
+    const rexarm_real q1 = q[0];
+    const rexarm_real q2 = q[1];
+    const rexarm_real q3 = q[2];
+    const rexarm_real q4 = q[3];
+    const rexarm_real mu_dot0 = mu_dot[0];
+    const rexarm_real mu_dot1 = mu_dot[1];
+    const rexarm_real mu_dot2 = mu_dot[2];
+    const rexarm_real mu_dot3 = mu_dot[3];
+
+    /* Intermediate terms */
+    const rexarm_real c1 = cos(q1);
+    const rexarm_real s1 = sin(q1);
+    const rexarm_real c2 = -sin(q2);
+    const rexarm_real s2 = cos(q2);
+    const rexarm_real c3 = cos(q3);
+    const rexarm_real s3 = sin(q3);
+    const rexarm_real c23 = c2*c3 - s2*s3;
+    const rexarm_real s23 = c2*s3 + c3*s2;
+    const rexarm_real c4 = cos(q4);
+    const rexarm_real s4 = sin(q4);
+    const rexarm_real c234 = c23*c4 - s23*s4;
+    const rexarm_real s234 = c23*s4 + c4*s23;
+    const rexarm_real t0 = 0.1*c1;
+    const rexarm_real t1 = c23*t0 + c234*t0;
+    const rexarm_real t2 = c2*t0 + t1;
+    const rexarm_real t3 = 0.1*s1;
+    const rexarm_real t4 = c23*t3 + c234*t3;
+    const rexarm_real t5 = c2*t3 + t4;
+    const rexarm_real t6 = c1*t2 + s1*t5;
+    const rexarm_real t7 = c1*t1 + s1*t4;
+    const rexarm_real t8 = 0.1*s234;
+    const rexarm_real t9 = 0.1*s23 + t8;
+    const rexarm_real t10 = 0.1*s2 + t9;
+    const rexarm_real t11 = (c1*c1);
+    const rexarm_real t12 = c234*t11;
+    const rexarm_real t13 = (s1*s1);
+    const rexarm_real t14 = c234*t13;
+    const rexarm_real t15 = 0.1*t12 + 0.1*t14;
+    const rexarm_real t16 = (c234*c234);
+    const rexarm_real t17 = -(t12 + t14)/sqrt(t11*t16 + t13*t16);
+    const rexarm_real t18 = t15*t17 + t17*t6 + t17*t7;
+    const rexarm_real t19 = (t5*t5);
+    const rexarm_real t20 = (t9*t9);
+    const rexarm_real t21 = (t10*t10);
+    const rexarm_real t22 = 0.01*(s234*s234);
+    const rexarm_real t23 = t11*t20 + t11*t21 + t11*t22;
+    const rexarm_real t24 = t19 + t23;
+    const rexarm_real t25 = c1*s1;
+    const rexarm_real t26 = -t2*t5 + t20*t25 + t21*t25 + t22*t25;
+    const rexarm_real t27 = c1*t9;
+    const rexarm_real t28 = c1*t10;
+    const rexarm_real t29 = c1*t8;
+    const rexarm_real t30 = t15*t29 + t27*t7 + t28*t6;
+    const rexarm_real t31 = t17*t27 + t17*t28 + t17*t29;
+    const rexarm_real t32 = (t2*t2);
+    const rexarm_real t33 = t13*t20 + t13*t21 + t13*t22;
+    const rexarm_real t34 = t32 + t33;
+    const rexarm_real t35 = s1*t9;
+    const rexarm_real t36 = s1*t10;
+    const rexarm_real t37 = s1*t8;
+    const rexarm_real t38 = t15*t37 + t35*t7 + t36*t6;
+    const rexarm_real t39 = t17*t35 + t17*t36 + t17*t37;
+    const rexarm_real t40 = (t6*t6);
+    const rexarm_real t41 = t40 + (t15*t15) + (t7*t7);
+    const rexarm_real t42 = t41;
+    const rexarm_real t43 = (t17*t17);
+    const rexarm_real t44 = 3*t43;
+    const rexarm_real t45 = t44;
+    const rexarm_real t46 = (t26*t26);
+    const rexarm_real t47 = (t30*t30);
+    const rexarm_real t48 = (t31*t31);
+    const rexarm_real t49 = (damping*damping);
+    const rexarm_real t50 = t24 + t49;
+    const rexarm_real t51 = (t50*t50);
+    const rexarm_real t52 = sqrt(t46 + t47 + t48 + t51);
+    const rexarm_real t53 = t52*(t50 >= 0 ? 1 : -1);
+    const rexarm_real t54 = t50 + t53;
+    const rexarm_real t55 = (t52 > 0 ? 1/(t52*(t52 + fabs(t50))) : 0);
+    const rexarm_real t56 = t55*(mu_dot0*t54 + mu_dot1*t26 - mu_dot2*t30 - mu_dot3*t31);
+    const rexarm_real t57 = mu_dot0 - t54*t56;
+    const rexarm_real t58 = mu_dot1 - t26*t56;
+    const rexarm_real t59 = mu_dot2 + t30*t56;
+    const rexarm_real t60 = mu_dot3 + t31*t56;
+    const rexarm_real t61 = t34 + t49;
+    const rexarm_real t62 = t55*(t26*t54 + t26*t61 + t30*t38 + t31*t39);
+    const rexarm_real t63 = t26 - t54*t62;
+    const rexarm_real t64 = -t26*t62 + t61;
+    const rexarm_real t65 = t30*t62 - t38;
+    const rexarm_real t66 = t31*t62 - t39;
+    const rexarm_real t67 = sqrt((t64*t64) + (t65*t65) + (t66*t66));
+    const rexarm_real t68 = t67*(t64 >= 0 ? 1 : -1);
+    const rexarm_real t69 = t64 + t68;
+    const rexarm_real t70 = (t67 > 0 ? 1/(t67*(t67 + fabs(t64))) : 0);
+    const rexarm_real t71 = t70*(t58*t69 + t59*t65 + t60*t66);
+    const rexarm_real t72 = t58 - t69*t71;
+    const rexarm_real t73 = t59 - t65*t71;
+    const rexarm_real t74 = t60 - t66*t71;
+    const rexarm_real t75 = t42 + t49;
+    const rexarm_real t76 = -t55*(t18*t31 + t26*t38 + t30*t54 + t30*t75);
+    const rexarm_real t77 = t30 + t54*t76;
+    const rexarm_real t78 = t26*t76 + t38;
+    const rexarm_real t79 = t30*t76 + t75;
+    const rexarm_real t80 = t18 + t31*t76;
+    const rexarm_real t81 = t70*(t65*t79 + t66*t80 - t69*t78);
+    const rexarm_real t82 = t69*t81 + t78;
+    const rexarm_real t83 = -t65*t81 + t79;
+    const rexarm_real t84 = -t66*t81 + t80;
+    const rexarm_real t85 = sqrt((t83*t83) + (t84*t84));
+    const rexarm_real t86 = t85*(t83 >= 0 ? 1 : -1);
+    const rexarm_real t87 = t83 + t86;
+    const rexarm_real t88 = (t85 > 0 ? 1/(t85*(t85 + fabs(t83))) : 0);
+    const rexarm_real t89 = t88*(t73*t87 + t74*t84);
+    const rexarm_real t90 = t73 - t87*t89;
+    const rexarm_real t91 = t74 - t84*t89;
+    const rexarm_real t92 = t45 + t49;
+    const rexarm_real t93 = sqrt(2*t46 + 2*t47 + 2*t48 + t51 + 2*(t18*t18) + 2*(t38*t38) + 2*(t39*t39) + (t61*t61) + (t75*t75) + (t92*t92));
+    const rexarm_real t94 = -t55*(t18*t30 + t26*t39 + t31*t54 + t31*t92);
+    const rexarm_real t95 = t31 + t54*t94;
+    const rexarm_real t96 = t26*t94 + t39;
+    const rexarm_real t97 = t18 + t30*t94;
+    const rexarm_real t98 = t31*t94 + t92;
+    const rexarm_real t99 = t70*(t65*t97 + t66*t98 - t69*t96);
+    const rexarm_real t100 = t69*t99 + t96;
+    const rexarm_real t101 = -t65*t99 + t97;
+    const rexarm_real t102 = -t66*t99 + t98;
+    const rexarm_real t103 = t88*(t101*t87 + t102*t84);
+    const rexarm_real t104 = t101 - t103*t87;
+    const rexarm_real t105 = t102 - t103*t84;
+    const rexarm_real t106 = fabs(t105);
+    const rexarm_real t107 = t106;
+    const rexarm_real t108 = t107*(t105 >= 0 ? 1 : -1);
+    const rexarm_real t109 = t105 + t108;
+    const rexarm_real t110 = (t107 > 0 ? 1/(t107*(t106 + t107)) : 0);
+    const rexarm_real t111 = -t110*t91*(t109*t109) + t91;
+    const rexarm_real t112 = t111/t108;
+    const rexarm_real t113 = (t104*t112 + t90)/t86;
+    const rexarm_real t114 = (-t100*t112 - t113*t82 + t72)/t68;
+    const rexarm_real t115 = (-t112*t95 - t113*t77 + t114*t63 + t57)/t53;
+    const rexarm_real t116 = -t114*t2 + t115*t5;
+    const rexarm_real t117 = -t112*t17;
+    const rexarm_real t118 = -t113*t6 + t114*t36 + t115*t28 + t117;
+    const rexarm_real t119 = -t113*t7 + t114*t35 + t115*t27 + t117;
+    const rexarm_real t120 = -t113*t15 + t114*t37 + t115*t29 + t117;
+    const rexarm_real t121 = t19 + t32;
+    const rexarm_real t122 = sqrt(t121 + t23 + t33 + t41 + t44);
+    const rexarm_real t123 = sqrt(t121);
+    const rexarm_real t124 = t123*(t5 <= 0 ? 1 : -1);
+    const rexarm_real t125 = (t123 > 0 ? 1/(t123*(t123 + fabs(t5))) : 0);
+    const rexarm_real t126 = -t5;
+    const rexarm_real t127 = t124 + t126;
+    const rexarm_real t128 = -t125*(t127*t28 + t2*t36);
+    const rexarm_real t129 = t127*t128 + t28;
+    const rexarm_real t130 = t128*t2 + t36;
+    const rexarm_real t131 = -t125*(t127*t27 + t2*t35);
+    const rexarm_real t132 = t127*t131 + t27;
+    const rexarm_real t133 = t131*t2 + t35;
+    const rexarm_real t134 = -t125*(t127*t29 + t2*t37);
+    const rexarm_real t135 = t127*t134 + t29;
+    const rexarm_real t136 = t134*t2 + t37;
+    const rexarm_real t137 = t125*(mu_dot0*t127 + mu_dot1*t2);
+    const rexarm_real t138 = mu_dot0 - t127*t137;
+    const rexarm_real t139 = mu_dot1 - t137*t2;
+    const rexarm_real t140 = sqrt(t40 + t43 + (t130*t130));
+    const rexarm_real t141 = t140*(t130 <= 0 ? 1 : -1);
+    const rexarm_real t142 = -t130 + t141;
+    const rexarm_real t143 = (t140 > 0 ? 1/(t140*(t140 + fabs(t130))) : 0);
+    const rexarm_real t144 = t143*(-t133*t142 + t43 + t6*t7);
+    const rexarm_real t145 = t133 + t142*t144;
+    const rexarm_real t146 = -t144*t6 + t7;
+    const rexarm_real t147 = -t144*t17 + t17;
+    const rexarm_real t148 = t143*(-t136*t142 + t15*t6 + t43);
+    const rexarm_real t149 = t136 + t142*t148;
+    const rexarm_real t150 = -t148*t6 + t15;
+    const rexarm_real t151 = -t148*t17 + t17;
+    const rexarm_real t152 = t143*(mu_dot2*t6 + mu_dot3*t17 + t139*t142);
+    const rexarm_real t153 = t139 - t142*t152;
+    const rexarm_real t154 = mu_dot2 - t152*t6;
+    const rexarm_real t155 = mu_dot3 - t152*t17;
+    const rexarm_real t156 = sqrt((t146*t146) + (t147*t147));
+    const rexarm_real t157 = t156*(t146 >= 0 ? 1 : -1);
+    const rexarm_real t158 = t146 + t157;
+    const rexarm_real t159 = (t156 > 0 ? 1/(t156*(t156 + fabs(t146))) : 0);
+    const rexarm_real t160 = t159*(t147*t151 + t150*t158);
+    const rexarm_real t161 = t150 - t158*t160;
+    const rexarm_real t162 = -t147*t160 + t151;
+    const rexarm_real t163 = t159*(t147*t155 + t154*t158);
+    const rexarm_real t164 = t154 - t158*t163;
+    const rexarm_real t165 = -t147*t163 + t155;
+    const rexarm_real t166 = damping + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + q1 + q2 + q3 + q4 + t126 + t15 + 3*t17 + t2 - t27 - t28 - t29 - t35 - t36 - t37 + t6 + t7;
+    const rexarm_real t167 = fabs(t162);
+    const rexarm_real t168 = t167;
+    const rexarm_real t169 = t168*(t162 >= 0 ? 1 : -1);
+    const rexarm_real t170 = t162 + t169;
+    const rexarm_real t171 = (t168 > 0 ? 1/(t168*(t167 + t168)) : 0);
+    const rexarm_real t172 = -t165*t171*(t170*t170) + t165;
+    const rexarm_real t173 = t172/t169;
+    const rexarm_real t174 = (t161*t173 + t164)/t157;
+    const rexarm_real t175 = (-t145*t174 - t149*t173 + t153)/t141;
+    const rexarm_real t176 = (-t129*t175 - t132*t174 - t135*t173 + t138)/t124;
+    const int t177 = damping > 0;
+    const int t178 = isfinite(t166);
+    const int t179 = damping >= 0;
+    const rexarm_real t180 = 1e-12*t122;
+    const rexarm_real t181 = 1e-12*t93;
+    const int t182 = (t177 && ((t107 <= t181) || (t52 <= t181) || (t67 <= t181) || (t85 <= t181))) || (damping <= 0 && ((t123 <= t180) || (t140 <= t180) || (t156 <= t180) || (t168 <= t180)));
+    const int t183 = t178 && t179 && !t182;
+
+    /* Outputs */
+    q_dot[0] = (t183 ? (t177 ? t116 : -t176) : 0);
+    q_dot[1] = (t183 ? (t177 ? t118 : -t175) : 0);
+    q_dot[2] = (t183 ? (t177 ? t119 : -t174) : 0);
+    q_dot[3] = (t183 ? (t177 ? t120 : -t173) : 0);
+    return (!(t178 && t179) ? 2 : (t182 ? 1 : 0));
+}
+
 void rexarm_ik_branches(const rexarm_real mu[REXARM_TASK_DIM], rexarm_real q[REXARM_MAX_IK_SOLUTIONS * REXARM_DOF], int valid[REXARM_MAX_IK_SOLUTIONS])
 {
     /* 552 operations */
@@ -715,103 +935,6 @@ void rexarm_ik_branches(const rexarm_real mu[REXARM_TASK_DIM], rexarm_real q[REX
     valid[5] = t190 && t191 && t192 && t196 && t198 && t202 && t118 > 1e-12;
     valid[6] = t190 && t191 && t192 && t194 && t201 && t202 && ((t198 && t142 >= t195) || (t199 && t141 <= t200));
     valid[7] = t190 && t191 && t192 && t194 && t198 && t201 && t202 && t142 > 1e-12;
-}
-
-int rexarm_velocity_ik(const rexarm_real q[REXARM_DOF], const rexarm_real mu_dot[REXARM_TASK_DIM], rexarm_real damping, rexarm_real q_dot[REXARM_DOF])
-{
-    /* Rows of task_jacobian() forming Js (the task Jacobian). */
-    static const int rows[REXARM_TASK_DIM] = {0, 1, 2, 3};
-    rexarm_real J[REXARM_TASK_DIM * REXARM_DOF];
-    rexarm_real A[4 * 4];
-    rexarm_real x[4];
-    rexarm_real scale = 0;
-    const int normal = damping > 0; /* damped: solve (Js Js^T + damping^2 I) x = mu_dot */
-    int r, c, k;
-
-    for (c = 0; c < REXARM_DOF; ++c) {
-        q_dot[c] = 0;
-        if (!isfinite(q[c])) {
-            return REXARM_VELOCITY_IK_NOT_FINITE;
-        }
-    }
-    for (r = 0; r < REXARM_TASK_DIM; ++r) {
-        if (!isfinite(mu_dot[r])) {
-            return REXARM_VELOCITY_IK_NOT_FINITE;
-        }
-        x[r] = mu_dot[r]; /* b; copied here, not in a loop of its own (which becomes memcpy) */
-    }
-    if (!(damping >= 0) || !isfinite(damping)) {
-        return REXARM_VELOCITY_IK_NOT_FINITE;
-    }
-    rexarm_task_jacobian(q, J);
-
-    /* The system A x = b (4 x 4), b in x. */
-    for (r = 0; r < 4; ++r) {
-        for (c = 0; c < 4; ++c) {
-            rexarm_real sum = r == c ? damping * damping : 0;
-            if (!normal) {
-                sum = J[rows[r] * REXARM_DOF + c];
-            }
-            for (k = 0; normal && k < REXARM_DOF; ++k) {
-                sum += J[rows[r] * REXARM_DOF + k] * J[rows[c] * REXARM_DOF + k];
-            }
-            A[r * 4 + c] = sum;
-            if (!isfinite(sum)) {
-                return REXARM_VELOCITY_IK_NOT_FINITE;
-            }
-            if (fabs(sum) > scale) {
-                scale = fabs(sum);
-            }
-        }
-    }
-
-    /* LU with partial pivoting, applied to x as it goes. */
-    for (k = 0; k < 4; ++k) {
-        int pivot = k;
-        for (r = k + 1; r < 4; ++r) {
-            if (fabs(A[r * 4 + k]) > fabs(A[pivot * 4 + k])) {
-                pivot = r;
-            }
-        }
-        if (!(fabs(A[pivot * 4 + k]) > 1e-12 * scale)) {
-            return REXARM_VELOCITY_IK_SINGULAR;
-        }
-        if (pivot != k) {
-            rexarm_real swap;
-            for (c = k; c < 4; ++c) {
-                swap = A[k * 4 + c];
-                A[k * 4 + c] = A[pivot * 4 + c];
-                A[pivot * 4 + c] = swap;
-            }
-            swap = x[k];
-            x[k] = x[pivot];
-            x[pivot] = swap;
-        }
-        for (r = k + 1; r < 4; ++r) {
-            const rexarm_real factor = A[r * 4 + k] / A[k * 4 + k];
-            for (c = k + 1; c < 4; ++c) {
-                A[r * 4 + c] -= factor * A[k * 4 + c];
-            }
-            x[r] -= factor * x[k];
-        }
-    }
-    for (k = 4 - 1; k >= 0; --k) {
-        for (c = k + 1; c < 4; ++c) {
-            x[k] -= A[k * 4 + c] * x[c];
-        }
-        x[k] /= A[k * 4 + k];
-        if (!normal) {
-            q_dot[k] = x[k];
-        }
-    }
-
-    /* q_dot = Js^T x when damped (else x, written above) */
-    for (c = 0; normal && c < REXARM_DOF; ++c) {
-        for (r = 0; r < REXARM_TASK_DIM; ++r) {
-            q_dot[c] += J[rows[r] * REXARM_DOF + c] * x[r];
-        }
-    }
-    return REXARM_VELOCITY_IK_OK;
 }
 
 int rexarm_ik(const rexarm_real mu[REXARM_TASK_DIM], rexarm_real q[REXARM_MAX_IK_SOLUTIONS * REXARM_DOF])

@@ -68,22 +68,21 @@ rexarm_real rexarm_manipulability(const rexarm_real q[REXARM_DOF]);
  * Result: returned as a scalar. 45 operations. */
 rexarm_real rexarm_jacobian_det(const rexarm_real q[REXARM_DOF]);
 
+/* Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status.
+ * Result: q_dot[i], i < 4; returned as a scalar. 589 operations. */
+int rexarm_velocity_ik(const rexarm_real q[REXARM_DOF], const rexarm_real mu_dot[REXARM_TASK_DIM], rexarm_real damping, rexarm_real q_dot[REXARM_DOF]);
+
 /* Every branch of the closed-form ik and whether the target allows it.
  * Result: q: 8 x 4 row-major, element (r, c) at q[r * 4 + c]; valid[i], i < 8. 552 operations. */
 void rexarm_ik_branches(const rexarm_real mu[REXARM_TASK_DIM], rexarm_real q[REXARM_MAX_IK_SOLUTIONS * REXARM_DOF], int valid[REXARM_MAX_IK_SOLUTIONS]);
 
-/* Status of rexarm_velocity_ik. */
+/* Statuses of rexarm_velocity_ik: OK, singular (a diagonal entry of the QR factor R of the
+ * 4 x 4 system at most 1e-12 times its Frobenius norm: take damping > 0), or
+ * not finite (q, mu_dot, damping or Js not finite, or damping < 0); q_dot is 0 unless OK.
+ * Js is the task Jacobian; mu_dot is the rate of the task vector (x, y, z, pitch). */
 #define REXARM_VELOCITY_IK_OK 0
-#define REXARM_VELOCITY_IK_SINGULAR 1   /* a pivot below 1e-12 x the largest |entry|: take damping > 0 */
-#define REXARM_VELOCITY_IK_NOT_FINITE 2 /* q, mu_dot, damping (must be >= 0) or Js not finite */
-
-/* Joint rates q_dot[REXARM_DOF] solving Js q_dot = mu_dot.
- * Js is the task Jacobian; mu_dot[REXARM_TASK_DIM] is the rate of the task vector (x, y, z, pitch).
- * damping = 0: q_dot = Js^-1 mu_dot; damping > 0 (damped least squares near singularities):
- * q_dot = Js^T (Js Js^T + damping^2 I)^-1 mu_dot.
- * LU with partial pivoting of the 4 x 4 system on the stack. Returns
- * REXARM_VELOCITY_IK_OK, or a status above with q_dot all 0. */
-int rexarm_velocity_ik(const rexarm_real q[REXARM_DOF], const rexarm_real mu_dot[REXARM_TASK_DIM], rexarm_real damping, rexarm_real q_dot[REXARM_DOF]);
+#define REXARM_VELOCITY_IK_SINGULAR 1
+#define REXARM_VELOCITY_IK_NOT_FINITE 2
 
 /* Closed-form inverse kinematics: every joint solution that reaches the target; returns
  * their count k and writes solution i to q[i * REXARM_DOF + j], i < k: the valid

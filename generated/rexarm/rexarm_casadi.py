@@ -394,6 +394,222 @@ def _jacobian_det(q):
     return [d]
 
 
+def _velocity_ik(q, mu_dot, damping):
+    """Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: 589 operations."""
+    q1 = q[0]
+    q2 = q[1]
+    q3 = q[2]
+    q4 = q[3]
+    mu_dot0 = mu_dot[0]
+    mu_dot1 = mu_dot[1]
+    mu_dot2 = mu_dot[2]
+    mu_dot3 = mu_dot[3]
+    c1 = casadi.cos(q1)
+    s1 = casadi.sin(q1)
+    c2 = -casadi.sin(q2)
+    s2 = casadi.cos(q2)
+    c3 = casadi.cos(q3)
+    s3 = casadi.sin(q3)
+    c23 = c2*c3 - s2*s3
+    s23 = c2*s3 + c3*s2
+    c4 = casadi.cos(q4)
+    s4 = casadi.sin(q4)
+    c234 = c23*c4 - s23*s4
+    s234 = c23*s4 + c4*s23
+    t0 = 0.1*c1
+    t1 = c23*t0 + c234*t0
+    t2 = c2*t0 + t1
+    t3 = 0.1*s1
+    t4 = c23*t3 + c234*t3
+    t5 = c2*t3 + t4
+    t6 = c1*t2 + s1*t5
+    t7 = c1*t1 + s1*t4
+    t8 = 0.1*s234
+    t9 = 0.1*s23 + t8
+    t10 = 0.1*s2 + t9
+    t11 = c1**2
+    t12 = c234*t11
+    t13 = s1**2
+    t14 = c234*t13
+    t15 = 0.1*t12 + 0.1*t14
+    t16 = c234**2
+    t17 = -(t12 + t14)/casadi.sqrt(t11*t16 + t13*t16)
+    t18 = t15*t17 + t17*t6 + t17*t7
+    t19 = t5**2
+    t20 = t9**2
+    t21 = t10**2
+    t22 = 0.01*s234**2
+    t23 = t11*t20 + t11*t21 + t11*t22
+    t24 = t19 + t23
+    t25 = c1*s1
+    t26 = -t2*t5 + t20*t25 + t21*t25 + t22*t25
+    t27 = c1*t9
+    t28 = c1*t10
+    t29 = c1*t8
+    t30 = t15*t29 + t27*t7 + t28*t6
+    t31 = t17*t27 + t17*t28 + t17*t29
+    t32 = t2**2
+    t33 = t13*t20 + t13*t21 + t13*t22
+    t34 = t32 + t33
+    t35 = s1*t9
+    t36 = s1*t10
+    t37 = s1*t8
+    t38 = t15*t37 + t35*t7 + t36*t6
+    t39 = t17*t35 + t17*t36 + t17*t37
+    t40 = t6**2
+    t41 = t15**2 + t40 + t7**2
+    t42 = t41
+    t43 = t17**2
+    t44 = 3*t43
+    t45 = t44
+    t46 = t26**2
+    t47 = t30**2
+    t48 = t31**2
+    t49 = damping**2
+    t50 = t24 + t49
+    t51 = t50**2
+    t52 = casadi.sqrt(t46 + t47 + t48 + t51)
+    t53 = t52*casadi.if_else((t50 >= 0), 1, -1)
+    t54 = t50 + t53
+    t55 = casadi.if_else((t52 > 0), 1/(t52*(t52 + casadi.fabs(t50))), 0)
+    t56 = t55*(mu_dot0*t54 + mu_dot1*t26 - mu_dot2*t30 - mu_dot3*t31)
+    t57 = mu_dot0 - t54*t56
+    t58 = mu_dot1 - t26*t56
+    t59 = mu_dot2 + t30*t56
+    t60 = mu_dot3 + t31*t56
+    t61 = t34 + t49
+    t62 = t55*(t26*t54 + t26*t61 + t30*t38 + t31*t39)
+    t63 = t26 - t54*t62
+    t64 = -t26*t62 + t61
+    t65 = t30*t62 - t38
+    t66 = t31*t62 - t39
+    t67 = casadi.sqrt(t64**2 + t65**2 + t66**2)
+    t68 = t67*casadi.if_else((t64 >= 0), 1, -1)
+    t69 = t64 + t68
+    t70 = casadi.if_else((t67 > 0), 1/(t67*(t67 + casadi.fabs(t64))), 0)
+    t71 = t70*(t58*t69 + t59*t65 + t60*t66)
+    t72 = t58 - t69*t71
+    t73 = t59 - t65*t71
+    t74 = t60 - t66*t71
+    t75 = t42 + t49
+    t76 = -t55*(t18*t31 + t26*t38 + t30*t54 + t30*t75)
+    t77 = t30 + t54*t76
+    t78 = t26*t76 + t38
+    t79 = t30*t76 + t75
+    t80 = t18 + t31*t76
+    t81 = t70*(t65*t79 + t66*t80 - t69*t78)
+    t82 = t69*t81 + t78
+    t83 = -t65*t81 + t79
+    t84 = -t66*t81 + t80
+    t85 = casadi.sqrt(t83**2 + t84**2)
+    t86 = t85*casadi.if_else((t83 >= 0), 1, -1)
+    t87 = t83 + t86
+    t88 = casadi.if_else((t85 > 0), 1/(t85*(t85 + casadi.fabs(t83))), 0)
+    t89 = t88*(t73*t87 + t74*t84)
+    t90 = t73 - t87*t89
+    t91 = t74 - t84*t89
+    t92 = t45 + t49
+    t93 = casadi.sqrt(2*t18**2 + 2*t38**2 + 2*t39**2 + 2*t46 + 2*t47 + 2*t48 + t51 + t61**2 + t75**2 + t92**2)
+    t94 = -t55*(t18*t30 + t26*t39 + t31*t54 + t31*t92)
+    t95 = t31 + t54*t94
+    t96 = t26*t94 + t39
+    t97 = t18 + t30*t94
+    t98 = t31*t94 + t92
+    t99 = t70*(t65*t97 + t66*t98 - t69*t96)
+    t100 = t69*t99 + t96
+    t101 = -t65*t99 + t97
+    t102 = -t66*t99 + t98
+    t103 = t88*(t101*t87 + t102*t84)
+    t104 = t101 - t103*t87
+    t105 = t102 - t103*t84
+    t106 = casadi.fabs(t105)
+    t107 = t106
+    t108 = t107*casadi.if_else((t105 >= 0), 1, -1)
+    t109 = t105 + t108
+    t110 = casadi.if_else((t107 > 0), 1/(t107*(t106 + t107)), 0)
+    t111 = -t109**2*t110*t91 + t91
+    t112 = t111/t108
+    t113 = (t104*t112 + t90)/t86
+    t114 = (-t100*t112 - t113*t82 + t72)/t68
+    t115 = (-t112*t95 - t113*t77 + t114*t63 + t57)/t53
+    t116 = -t114*t2 + t115*t5
+    t117 = -t112*t17
+    t118 = -t113*t6 + t114*t36 + t115*t28 + t117
+    t119 = -t113*t7 + t114*t35 + t115*t27 + t117
+    t120 = -t113*t15 + t114*t37 + t115*t29 + t117
+    t121 = t19 + t32
+    t122 = casadi.sqrt(t121 + t23 + t33 + t41 + t44)
+    t123 = casadi.sqrt(t121)
+    t124 = t123*casadi.if_else((t5 <= 0), 1, -1)
+    t125 = casadi.if_else((t123 > 0), 1/(t123*(t123 + casadi.fabs(t5))), 0)
+    t126 = -t5
+    t127 = t124 + t126
+    t128 = -t125*(t127*t28 + t2*t36)
+    t129 = t127*t128 + t28
+    t130 = t128*t2 + t36
+    t131 = -t125*(t127*t27 + t2*t35)
+    t132 = t127*t131 + t27
+    t133 = t131*t2 + t35
+    t134 = -t125*(t127*t29 + t2*t37)
+    t135 = t127*t134 + t29
+    t136 = t134*t2 + t37
+    t137 = t125*(mu_dot0*t127 + mu_dot1*t2)
+    t138 = mu_dot0 - t127*t137
+    t139 = mu_dot1 - t137*t2
+    t140 = casadi.sqrt(t130**2 + t40 + t43)
+    t141 = t140*casadi.if_else((t130 <= 0), 1, -1)
+    t142 = -t130 + t141
+    t143 = casadi.if_else((t140 > 0), 1/(t140*(t140 + casadi.fabs(t130))), 0)
+    t144 = t143*(-t133*t142 + t43 + t6*t7)
+    t145 = t133 + t142*t144
+    t146 = -t144*t6 + t7
+    t147 = -t144*t17 + t17
+    t148 = t143*(-t136*t142 + t15*t6 + t43)
+    t149 = t136 + t142*t148
+    t150 = -t148*t6 + t15
+    t151 = -t148*t17 + t17
+    t152 = t143*(mu_dot2*t6 + mu_dot3*t17 + t139*t142)
+    t153 = t139 - t142*t152
+    t154 = mu_dot2 - t152*t6
+    t155 = mu_dot3 - t152*t17
+    t156 = casadi.sqrt(t146**2 + t147**2)
+    t157 = t156*casadi.if_else((t146 >= 0), 1, -1)
+    t158 = t146 + t157
+    t159 = casadi.if_else((t156 > 0), 1/(t156*(t156 + casadi.fabs(t146))), 0)
+    t160 = t159*(t147*t151 + t150*t158)
+    t161 = t150 - t158*t160
+    t162 = -t147*t160 + t151
+    t163 = t159*(t147*t155 + t154*t158)
+    t164 = t154 - t158*t163
+    t165 = -t147*t163 + t155
+    t166 = damping + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + q1 + q2 + q3 + q4 + t126 + t15 + 3*t17 + t2 - t27 - t28 - t29 - t35 - t36 - t37 + t6 + t7
+    t167 = casadi.fabs(t162)
+    t168 = t167
+    t169 = t168*casadi.if_else((t162 >= 0), 1, -1)
+    t170 = t162 + t169
+    t171 = casadi.if_else((t168 > 0), 1/(t168*(t167 + t168)), 0)
+    t172 = -t165*t170**2*t171 + t165
+    t173 = t172/t169
+    t174 = (t161*t173 + t164)/t157
+    t175 = (-t145*t174 - t149*t173 + t153)/t141
+    t176 = (-t129*t175 - t132*t174 - t135*t173 + t138)/t124
+    t177 = (damping > 0)
+    t178 = (casadi.fabs(t166) < casadi.inf)
+    t179 = (damping >= 0)
+    t180 = 1e-12*t122
+    t181 = 1e-12*t93
+    t182 = casadi.logic_or(casadi.logic_and(t177, casadi.logic_or(casadi.logic_or(casadi.logic_or((t107 <= t181), (t52 <= t181)), (t67 <= t181)), (t85 <= t181))), casadi.logic_and((damping <= 0), casadi.logic_or(casadi.logic_or(casadi.logic_or((t123 <= t180), (t140 <= t180)), (t156 <= t180)), (t168 <= t180))))
+    t183 = casadi.logic_and(casadi.logic_and(t178, t179), casadi.logic_not(t182))
+    q_dot = casadi.SX(4, 1)
+    q_dot[0, 0] = casadi.if_else(t183, casadi.if_else(t177, t116, -t176), 0)
+    q_dot[1, 0] = casadi.if_else(t183, casadi.if_else(t177, t118, -t175), 0)
+    q_dot[2, 0] = casadi.if_else(t183, casadi.if_else(t177, t119, -t174), 0)
+    q_dot[3, 0] = casadi.if_else(t183, casadi.if_else(t177, t120, -t173), 0)
+    status = casadi.SX(1, 1)
+    status[0, 0] = casadi.if_else(casadi.logic_not(casadi.logic_and(t178, t179)), 2, casadi.if_else(t182, 1, 0))
+    return [q_dot, status]
+
+
 def _ik_branches(mu):
     """Every branch of the closed-form ik and whether the target allows it: 552 operations."""
     mu0 = mu[0]
@@ -649,6 +865,8 @@ def _ik_branches(mu):
 
 
 _q = casadi.SX.sym("q", 4, 1)
+_mu_dot = casadi.SX.sym("mu_dot", 4, 1)
+_damping = casadi.SX.sym("damping", 1, 1)
 _mu = casadi.SX.sym("mu", 4, 1)
 fk = casadi.Function("fk", [_q], _fk(_q), ["q"], ["T"])
 jacobian = casadi.Function("jacobian", [_q], _jacobian(_q), ["q"], ["J"])
@@ -659,10 +877,11 @@ task_jacobian = casadi.Function("task_jacobian", [_q], _task_jacobian(_q), ["q"]
 singularity_factors = casadi.Function("singularity_factors", [_q], _singularity_factors(_q), ["q"], ["f"])
 manipulability = casadi.Function("manipulability", [_q], _manipulability(_q), ["q"], ["w"])
 jacobian_det = casadi.Function("jacobian_det", [_q], _jacobian_det(_q), ["q"], ["d"])
+velocity_ik = casadi.Function("velocity_ik", [_q, _mu_dot, _damping], _velocity_ik(_q, _mu_dot, _damping), ["q", "mu_dot", "damping"], ["q_dot", "status"])
 ik_branches = casadi.Function("ik_branches", [_mu], _ik_branches(_mu), ["mu"], ["q", "valid"])
 ik = ik_branches  # CasADi functions have fixed-size outputs: every branch and its validity
 
 
 def functions():
     """All functions by name."""
-    return {"fk": fk, "jacobian": jacobian, "fk_jacobian": fk_jacobian, "jacobian_tool": jacobian_tool, "task": task, "task_jacobian": task_jacobian, "singularity_factors": singularity_factors, "manipulability": manipulability, "jacobian_det": jacobian_det, "ik_branches": ik_branches}
+    return {"fk": fk, "jacobian": jacobian, "fk_jacobian": fk_jacobian, "jacobian_tool": jacobian_tool, "task": task, "task_jacobian": task_jacobian, "singularity_factors": singularity_factors, "manipulability": manipulability, "jacobian_det": jacobian_det, "velocity_ik": velocity_ik, "ik_branches": ik_branches}

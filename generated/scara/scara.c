@@ -351,6 +351,147 @@ scara_real scara_jacobian_det(const scara_real q[SCARA_DOF])
     return -t0*t3 + t1*t2;
 }
 
+int scara_velocity_ik(const scara_real q[SCARA_DOF], const scara_real mu_dot[SCARA_TASK_DIM], scara_real damping, scara_real q_dot[SCARA_DOF])
+{
+    /* 322 operations */
+
+    /* Inputs */
+    const scara_real q1 = q[0];
+    const scara_real q2 = q[1];
+    const scara_real q3 = q[2];
+    const scara_real q4 = q[3];
+    const scara_real mu_dot0 = mu_dot[0];
+    const scara_real mu_dot1 = mu_dot[1];
+    const scara_real mu_dot2 = mu_dot[2];
+    const scara_real mu_dot3 = mu_dot[3];
+
+    /* Intermediate terms */
+    const scara_real c1 = cos(q1);
+    const scara_real s1 = sin(q1);
+    const scara_real c2 = cos(q2);
+    const scara_real s2 = sin(q2);
+    const scara_real c12 = c1*c2 - s1*s2;
+    const scara_real s12 = c1*s2 + c2*s1;
+    const scara_real t0 = 0.275*c12;
+    const scara_real t1 = 0.325*c1 + t0;
+    const scara_real t2 = 0.275*s12;
+    const scara_real t3 = 0.325*s1 + t2;
+    const scara_real t4 = 0.075625*c12*s12 + t1*t3;
+    const scara_real t5 = t2 + t3;
+    const scara_real t6 = (t3*t3);
+    const scara_real t7 = t6 + 0.075625*(s12*s12);
+    const scara_real t8 = t7;
+    const scara_real t9 = (t1*t1);
+    const scara_real t10 = sqrt(t6 + t9 + 1);
+    const scara_real t11 = t10*(t3 <= 0 ? 1 : -1);
+    const scara_real t12 = (t10 > 0 ? 1/(t10*(t10 + fabs(t3))) : 0);
+    const scara_real t13 = t12 - 1;
+    const scara_real t14 = t9 + 0.075625*(c12*c12);
+    const scara_real t15 = t14;
+    const scara_real t16 = sqrt(t14 + t7 + 4);
+    const scara_real t17 = t0 + t1;
+    const scara_real t18 = t17;
+    const scara_real t19 = (t4*t4);
+    const scara_real t20 = (t5*t5);
+    const scara_real t21 = (damping*damping);
+    const scara_real t22 = t21 + t8;
+    const scara_real t23 = (t22*t22);
+    const scara_real t24 = sqrt(t19 + t20 + t23);
+    const scara_real t25 = t24*(t22 >= 0 ? 1 : -1);
+    const scara_real t26 = t22 + t25;
+    const scara_real t27 = (t24 > 0 ? 1/(t24*(t24 + fabs(t22))) : 0);
+    const scara_real t28 = -t27*(-mu_dot0*t26 + mu_dot1*t4 + mu_dot3*t5);
+    const scara_real t29 = mu_dot0 - t26*t28;
+    const scara_real t30 = mu_dot1 + t28*t4;
+    const scara_real t31 = mu_dot3 + t28*t5;
+    const scara_real t32 = t15 + t21;
+    const scara_real t33 = -t27*(t18*t5 + t26*t4 + t32*t4);
+    const scara_real t34 = t26*t33 + t4;
+    const scara_real t35 = t32 + t33*t4;
+    const scara_real t36 = t18 + t33*t5;
+    const scara_real t37 = sqrt((t35*t35) + (t36*t36));
+    const scara_real t38 = t37*(t35 >= 0 ? 1 : -1);
+    const scara_real t39 = t35 + t38;
+    const scara_real t40 = (t37 > 0 ? 1/(t37*(t37 + fabs(t35))) : 0);
+    const scara_real t41 = t40*(t30*t39 + t31*t36);
+    const scara_real t42 = t30 - t39*t41;
+    const scara_real t43 = t31 - t36*t41;
+    const scara_real t44 = t21 + 1;
+    const scara_real t45 = t44;
+    const scara_real t46 = t21 + 3;
+    const scara_real t47 = sqrt(2*t19 + 2*t20 + t23 + 2*(t18*t18) + (t32*t32) + (t44*t44) + (t46*t46));
+    const scara_real t48 = -t27*(t18*t4 + t26*t5 + t46*t5);
+    const scara_real t49 = t26*t48 + t5;
+    const scara_real t50 = t18 + t4*t48;
+    const scara_real t51 = t46 + t48*t5;
+    const scara_real t52 = t40*(t36*t51 + t39*t50);
+    const scara_real t53 = -t39*t52 + t50;
+    const scara_real t54 = -t36*t52 + t51;
+    const scara_real t55 = fabs(t45);
+    const scara_real t56 = t55;
+    const scara_real t57 = t56*(t45 >= 0 ? 1 : -1);
+    const scara_real t58 = t45 + t57;
+    const scara_real t59 = (t56 > 0 ? 1/(t56*(t55 + t56)) : 0);
+    const scara_real t60 = -mu_dot2*t59*(t58*t58) + mu_dot2;
+    const scara_real t61 = t60/t57;
+    const scara_real t62 = fabs(t54);
+    const scara_real t63 = t62;
+    const scara_real t64 = t63*(t54 >= 0 ? 1 : -1);
+    const scara_real t65 = t54 + t64;
+    const scara_real t66 = (t63 > 0 ? 1/(t63*(t62 + t63)) : 0);
+    const scara_real t67 = -t43*t66*(t65*t65) + t43;
+    const scara_real t68 = t67/t64;
+    const scara_real t69 = (t42 + t53*t68)/t38;
+    const scara_real t70 = (t29 - t34*t69 - t49*t68)/t25;
+    const scara_real t71 = t1*t69 - t3*t70 + t68;
+    const scara_real t72 = t0*t69 - t2*t70 + t68;
+    const scara_real t73 = -t3;
+    const scara_real t74 = t11 + t73;
+    const scara_real t75 = t12*(t0*t1 - t2*t74 + 1);
+    const scara_real t76 = t2 + t74*t75;
+    const scara_real t77 = t0 - t1*t75;
+    const scara_real t78 = 1 - t75;
+    const scara_real t79 = t12*(mu_dot0*t74 + mu_dot1*t1 + mu_dot3);
+    const scara_real t80 = mu_dot0 - t74*t79;
+    const scara_real t81 = mu_dot1 - t1*t79;
+    const scara_real t82 = mu_dot3 - t79;
+    const scara_real t83 = sqrt((t77*t77) + (t78*t78));
+    const scara_real t84 = t83*(t77 >= 0 ? 1 : -1);
+    const scara_real t85 = t77 + t84;
+    const scara_real t86 = (t83 > 0 ? 1/(t83*(t83 + fabs(t77))) : 0);
+    const scara_real t87 = t86*(t78*t82 + t81*t85);
+    const scara_real t88 = t81 - t85*t87;
+    const scara_real t89 = -t78*t87 + t82;
+    const scara_real t90 = damping + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + q1 + q2 + q3 + q4 + t17 - t2 + t73;
+    const scara_real t91 = t1*t12;
+    const scara_real t92 = t86*(t13*t78 + t85*t91);
+    const scara_real t93 = -t85*t92 + t91;
+    const scara_real t94 = t13 - t78*t92;
+    const scara_real t95 = fabs(t94);
+    const scara_real t96 = t95;
+    const scara_real t97 = t96*(t94 >= 0 ? 1 : -1);
+    const scara_real t98 = t94 + t97;
+    const scara_real t99 = (t96 > 0 ? 1/(t96*(t95 + t96)) : 0);
+    const scara_real t100 = -t89*t99*(t98*t98) + t89;
+    const scara_real t101 = t100/t97;
+    const scara_real t102 = (t101*t93 + t88)/t84;
+    const scara_real t103 = (t101*t12*t74 - t102*t76 + t80)/t11;
+    const int t104 = damping > 0;
+    const int t105 = isfinite(t90);
+    const int t106 = damping >= 0;
+    const scara_real t107 = 1e-12*t16;
+    const scara_real t108 = 1e-12*t47;
+    const int t109 = (t104 && ((t24 <= t108) || (t37 <= t108) || (t56 <= t108) || (t63 <= t108))) || (damping <= 0 && ((t107 >= 1) || (t10 <= t107) || (t83 <= t107) || (t96 <= t107)));
+    const int t110 = t105 && t106 && !t109;
+
+    /* Outputs */
+    q_dot[0] = (t110 ? (t104 ? -t71 : -t103) : 0);
+    q_dot[1] = (t110 ? (t104 ? -t72 : -t102) : 0);
+    q_dot[2] = (t110 ? (t104 ? t61 : -mu_dot2) : 0);
+    q_dot[3] = (t110 ? (t104 ? t68 : -t101) : 0);
+    return (!(t105 && t106) ? 2 : (t109 ? 1 : 0));
+}
+
 void scara_ik_branches(const scara_real mu[SCARA_TASK_DIM], scara_real q[SCARA_MAX_IK_SOLUTIONS * SCARA_DOF], int valid[SCARA_MAX_IK_SOLUTIONS])
 {
     /* 120 operations */
@@ -412,103 +553,6 @@ void scara_ik_branches(const scara_real mu[SCARA_TASK_DIM], scara_real q[SCARA_M
     q[7] = -t34 - 6.283185307179586*ceil(-0.15915494309189535*t34 - 0.5);
     valid[0] = t35 && ((t37 && t4 >= -1e-12) || (0.007987890625 <= t36 && t3 <= 1.931417125e-14));
     valid[1] = t35 && t37 && t4 > 1e-12;
-}
-
-int scara_velocity_ik(const scara_real q[SCARA_DOF], const scara_real mu_dot[SCARA_TASK_DIM], scara_real damping, scara_real q_dot[SCARA_DOF])
-{
-    /* Rows of task_jacobian() forming Js (the task Jacobian). */
-    static const int rows[SCARA_TASK_DIM] = {0, 1, 2, 3};
-    scara_real J[SCARA_TASK_DIM * SCARA_DOF];
-    scara_real A[4 * 4];
-    scara_real x[4];
-    scara_real scale = 0;
-    const int normal = damping > 0; /* damped: solve (Js Js^T + damping^2 I) x = mu_dot */
-    int r, c, k;
-
-    for (c = 0; c < SCARA_DOF; ++c) {
-        q_dot[c] = 0;
-        if (!isfinite(q[c])) {
-            return SCARA_VELOCITY_IK_NOT_FINITE;
-        }
-    }
-    for (r = 0; r < SCARA_TASK_DIM; ++r) {
-        if (!isfinite(mu_dot[r])) {
-            return SCARA_VELOCITY_IK_NOT_FINITE;
-        }
-        x[r] = mu_dot[r]; /* b; copied here, not in a loop of its own (which becomes memcpy) */
-    }
-    if (!(damping >= 0) || !isfinite(damping)) {
-        return SCARA_VELOCITY_IK_NOT_FINITE;
-    }
-    scara_task_jacobian(q, J);
-
-    /* The system A x = b (4 x 4), b in x. */
-    for (r = 0; r < 4; ++r) {
-        for (c = 0; c < 4; ++c) {
-            scara_real sum = r == c ? damping * damping : 0;
-            if (!normal) {
-                sum = J[rows[r] * SCARA_DOF + c];
-            }
-            for (k = 0; normal && k < SCARA_DOF; ++k) {
-                sum += J[rows[r] * SCARA_DOF + k] * J[rows[c] * SCARA_DOF + k];
-            }
-            A[r * 4 + c] = sum;
-            if (!isfinite(sum)) {
-                return SCARA_VELOCITY_IK_NOT_FINITE;
-            }
-            if (fabs(sum) > scale) {
-                scale = fabs(sum);
-            }
-        }
-    }
-
-    /* LU with partial pivoting, applied to x as it goes. */
-    for (k = 0; k < 4; ++k) {
-        int pivot = k;
-        for (r = k + 1; r < 4; ++r) {
-            if (fabs(A[r * 4 + k]) > fabs(A[pivot * 4 + k])) {
-                pivot = r;
-            }
-        }
-        if (!(fabs(A[pivot * 4 + k]) > 1e-12 * scale)) {
-            return SCARA_VELOCITY_IK_SINGULAR;
-        }
-        if (pivot != k) {
-            scara_real swap;
-            for (c = k; c < 4; ++c) {
-                swap = A[k * 4 + c];
-                A[k * 4 + c] = A[pivot * 4 + c];
-                A[pivot * 4 + c] = swap;
-            }
-            swap = x[k];
-            x[k] = x[pivot];
-            x[pivot] = swap;
-        }
-        for (r = k + 1; r < 4; ++r) {
-            const scara_real factor = A[r * 4 + k] / A[k * 4 + k];
-            for (c = k + 1; c < 4; ++c) {
-                A[r * 4 + c] -= factor * A[k * 4 + c];
-            }
-            x[r] -= factor * x[k];
-        }
-    }
-    for (k = 4 - 1; k >= 0; --k) {
-        for (c = k + 1; c < 4; ++c) {
-            x[k] -= A[k * 4 + c] * x[c];
-        }
-        x[k] /= A[k * 4 + k];
-        if (!normal) {
-            q_dot[k] = x[k];
-        }
-    }
-
-    /* q_dot = Js^T x when damped (else x, written above) */
-    for (c = 0; normal && c < SCARA_DOF; ++c) {
-        for (r = 0; r < SCARA_TASK_DIM; ++r) {
-            q_dot[c] += J[rows[r] * SCARA_DOF + c] * x[r];
-        }
-    }
-    return SCARA_VELOCITY_IK_OK;
 }
 
 int scara_ik(const scara_real mu[SCARA_TASK_DIM], scara_real q[SCARA_MAX_IK_SOLUTIONS * SCARA_DOF])

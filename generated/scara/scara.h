@@ -68,22 +68,21 @@ scara_real scara_manipulability(const scara_real q[SCARA_DOF]);
  * Result: returned as a scalar. 19 operations. */
 scara_real scara_jacobian_det(const scara_real q[SCARA_DOF]);
 
+/* Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status.
+ * Result: q_dot[i], i < 4; returned as a scalar. 322 operations. */
+int scara_velocity_ik(const scara_real q[SCARA_DOF], const scara_real mu_dot[SCARA_TASK_DIM], scara_real damping, scara_real q_dot[SCARA_DOF]);
+
 /* Every branch of the closed-form ik and whether the target allows it.
  * Result: q: 2 x 4 row-major, element (r, c) at q[r * 4 + c]; valid[i], i < 2. 120 operations. */
 void scara_ik_branches(const scara_real mu[SCARA_TASK_DIM], scara_real q[SCARA_MAX_IK_SOLUTIONS * SCARA_DOF], int valid[SCARA_MAX_IK_SOLUTIONS]);
 
-/* Status of scara_velocity_ik. */
+/* Statuses of scara_velocity_ik: OK, singular (a diagonal entry of the QR factor R of the
+ * 4 x 4 system at most 1e-12 times its Frobenius norm: take damping > 0), or
+ * not finite (q, mu_dot, damping or Js not finite, or damping < 0); q_dot is 0 unless OK.
+ * Js is the task Jacobian; mu_dot is the rate of the task vector (x, y, z, yaw). */
 #define SCARA_VELOCITY_IK_OK 0
-#define SCARA_VELOCITY_IK_SINGULAR 1   /* a pivot below 1e-12 x the largest |entry|: take damping > 0 */
-#define SCARA_VELOCITY_IK_NOT_FINITE 2 /* q, mu_dot, damping (must be >= 0) or Js not finite */
-
-/* Joint rates q_dot[SCARA_DOF] solving Js q_dot = mu_dot.
- * Js is the task Jacobian; mu_dot[SCARA_TASK_DIM] is the rate of the task vector (x, y, z, yaw).
- * damping = 0: q_dot = Js^-1 mu_dot; damping > 0 (damped least squares near singularities):
- * q_dot = Js^T (Js Js^T + damping^2 I)^-1 mu_dot.
- * LU with partial pivoting of the 4 x 4 system on the stack. Returns
- * SCARA_VELOCITY_IK_OK, or a status above with q_dot all 0. */
-int scara_velocity_ik(const scara_real q[SCARA_DOF], const scara_real mu_dot[SCARA_TASK_DIM], scara_real damping, scara_real q_dot[SCARA_DOF]);
+#define SCARA_VELOCITY_IK_SINGULAR 1
+#define SCARA_VELOCITY_IK_NOT_FINITE 2
 
 /* Closed-form inverse kinematics: every joint solution that reaches the target; returns
  * their count k and writes solution i to q[i * SCARA_DOF + j], i < k: the valid

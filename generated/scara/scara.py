@@ -338,6 +338,147 @@ def jacobian_det(q):
 
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
+def velocity_ik(q, mu_dot, damping=0.0):
+    """joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: (4 x 1 and 1 x 1), 322 operations."""
+    q = _argument("q", q, (4,))
+    mu_dot = _argument("mu_dot", mu_dot, (4,))
+    damping = _argument("damping", damping, ())
+    q1 = q[..., 0]
+    q2 = q[..., 1]
+    q3 = q[..., 2]
+    q4 = q[..., 3]
+    mu_dot0 = mu_dot[..., 0]
+    mu_dot1 = mu_dot[..., 1]
+    mu_dot2 = mu_dot[..., 2]
+    mu_dot3 = mu_dot[..., 3]
+    c1 = numpy.cos(q1)
+    s1 = numpy.sin(q1)
+    c2 = numpy.cos(q2)
+    s2 = numpy.sin(q2)
+    c12 = c1*c2 - s1*s2
+    s12 = c1*s2 + c2*s1
+    t0 = 0.275*c12
+    t1 = 0.325*c1 + t0
+    t2 = 0.275*s12
+    t3 = 0.325*s1 + t2
+    t4 = 0.075625*c12*s12 + t1*t3
+    t5 = t2 + t3
+    t6 = t3**2
+    t7 = 0.075625*s12**2 + t6
+    t8 = t7
+    t9 = t1**2
+    t10 = numpy.sqrt(t6 + t9 + 1)
+    t11 = t10*numpy.where(numpy.less_equal(t3, 0), 1, -1)
+    t12 = numpy.where(numpy.greater(t10, 0), 1/(t10*(t10 + abs(t3))), 0)
+    t13 = t12 - 1
+    t14 = 0.075625*c12**2 + t9
+    t15 = t14
+    t16 = numpy.sqrt(t14 + t7 + 4)
+    t17 = t0 + t1
+    t18 = t17
+    t19 = t4**2
+    t20 = t5**2
+    t21 = damping**2
+    t22 = t21 + t8
+    t23 = t22**2
+    t24 = numpy.sqrt(t19 + t20 + t23)
+    t25 = t24*numpy.where(numpy.greater_equal(t22, 0), 1, -1)
+    t26 = t22 + t25
+    t27 = numpy.where(numpy.greater(t24, 0), 1/(t24*(t24 + abs(t22))), 0)
+    t28 = -t27*(-mu_dot0*t26 + mu_dot1*t4 + mu_dot3*t5)
+    t29 = mu_dot0 - t26*t28
+    t30 = mu_dot1 + t28*t4
+    t31 = mu_dot3 + t28*t5
+    t32 = t15 + t21
+    t33 = -t27*(t18*t5 + t26*t4 + t32*t4)
+    t34 = t26*t33 + t4
+    t35 = t32 + t33*t4
+    t36 = t18 + t33*t5
+    t37 = numpy.sqrt(t35**2 + t36**2)
+    t38 = t37*numpy.where(numpy.greater_equal(t35, 0), 1, -1)
+    t39 = t35 + t38
+    t40 = numpy.where(numpy.greater(t37, 0), 1/(t37*(t37 + abs(t35))), 0)
+    t41 = t40*(t30*t39 + t31*t36)
+    t42 = t30 - t39*t41
+    t43 = t31 - t36*t41
+    t44 = t21 + 1
+    t45 = t44
+    t46 = t21 + 3
+    t47 = numpy.sqrt(2*t18**2 + 2*t19 + 2*t20 + t23 + t32**2 + t44**2 + t46**2)
+    t48 = -t27*(t18*t4 + t26*t5 + t46*t5)
+    t49 = t26*t48 + t5
+    t50 = t18 + t4*t48
+    t51 = t46 + t48*t5
+    t52 = t40*(t36*t51 + t39*t50)
+    t53 = -t39*t52 + t50
+    t54 = -t36*t52 + t51
+    t55 = abs(t45)
+    t56 = t55
+    t57 = t56*numpy.where(numpy.greater_equal(t45, 0), 1, -1)
+    t58 = t45 + t57
+    t59 = numpy.where(numpy.greater(t56, 0), 1/(t56*(t55 + t56)), 0)
+    t60 = -mu_dot2*t58**2*t59 + mu_dot2
+    t61 = t60/t57
+    t62 = abs(t54)
+    t63 = t62
+    t64 = t63*numpy.where(numpy.greater_equal(t54, 0), 1, -1)
+    t65 = t54 + t64
+    t66 = numpy.where(numpy.greater(t63, 0), 1/(t63*(t62 + t63)), 0)
+    t67 = -t43*t65**2*t66 + t43
+    t68 = t67/t64
+    t69 = (t42 + t53*t68)/t38
+    t70 = (t29 - t34*t69 - t49*t68)/t25
+    t71 = t1*t69 - t3*t70 + t68
+    t72 = t0*t69 - t2*t70 + t68
+    t73 = -t3
+    t74 = t11 + t73
+    t75 = t12*(t0*t1 - t2*t74 + 1)
+    t76 = t2 + t74*t75
+    t77 = t0 - t1*t75
+    t78 = 1 - t75
+    t79 = t12*(mu_dot0*t74 + mu_dot1*t1 + mu_dot3)
+    t80 = mu_dot0 - t74*t79
+    t81 = mu_dot1 - t1*t79
+    t82 = mu_dot3 - t79
+    t83 = numpy.sqrt(t77**2 + t78**2)
+    t84 = t83*numpy.where(numpy.greater_equal(t77, 0), 1, -1)
+    t85 = t77 + t84
+    t86 = numpy.where(numpy.greater(t83, 0), 1/(t83*(t83 + abs(t77))), 0)
+    t87 = t86*(t78*t82 + t81*t85)
+    t88 = t81 - t85*t87
+    t89 = -t78*t87 + t82
+    t90 = damping + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + q1 + q2 + q3 + q4 + t17 - t2 + t73
+    t91 = t1*t12
+    t92 = t86*(t13*t78 + t85*t91)
+    t93 = -t85*t92 + t91
+    t94 = t13 - t78*t92
+    t95 = abs(t94)
+    t96 = t95
+    t97 = t96*numpy.where(numpy.greater_equal(t94, 0), 1, -1)
+    t98 = t94 + t97
+    t99 = numpy.where(numpy.greater(t96, 0), 1/(t96*(t95 + t96)), 0)
+    t100 = -t89*t98**2*t99 + t89
+    t101 = t100/t97
+    t102 = (t101*t93 + t88)/t84
+    t103 = (t101*t12*t74 - t102*t76 + t80)/t11
+    t104 = numpy.greater(damping, 0)
+    t105 = numpy.isfinite(t90)
+    t106 = numpy.greater_equal(damping, 0)
+    t107 = 1e-12*t16
+    t108 = 1e-12*t47
+    t109 = (t104 & ((numpy.less_equal(t24, t108)) | (numpy.less_equal(t37, t108)) | (numpy.less_equal(t56, t108)) | (numpy.less_equal(t63, t108)))) | ((numpy.less_equal(damping, 0)) & ((numpy.greater_equal(t107, 1)) | (numpy.less_equal(t10, t107)) | (numpy.less_equal(t83, t107)) | (numpy.less_equal(t96, t107))))
+    t110 = t105 & t106 & numpy.logical_not(t109)
+    q_dot = numpy.empty(numpy.broadcast_shapes(q.shape[:-1], mu_dot.shape[:-1], damping.shape) + (4,))
+    q_dot[..., 0] = numpy.where(t110, numpy.where(t104, -t71, -t103), 0)
+    q_dot[..., 1] = numpy.where(t110, numpy.where(t104, -t72, -t102), 0)
+    q_dot[..., 2] = numpy.where(t110, numpy.where(t104, t61, -mu_dot2), 0)
+    q_dot[..., 3] = numpy.where(t110, numpy.where(t104, t68, -t101), 0)
+    status = numpy.empty(numpy.broadcast_shapes(q.shape[:-1], mu_dot.shape[:-1], damping.shape) + (), dtype=int)
+    status[...] = numpy.where(numpy.logical_not(t105 & t106), 2, numpy.where(t109, 1, 0))
+    return q_dot, status
+
+
+@numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def ik_branches(mu):
     """every branch of the closed-form ik and whether the target allows it: (2 x 4 and 2 x 1), 120 operations."""
     mu = _argument("mu", mu, (4,))
@@ -483,42 +624,10 @@ def ik_numeric(target, q0, max_iter=100, tol=1e-10):
     return q, IK_NUMERIC_CONVERGED if cost <= tol * tol else IK_NUMERIC_ITERATION_LIMIT
 
 
-# Reciprocal condition number below which the system of velocity_ik counts as singular.
-VELOCITY_IK_RCOND = 1e-12
-
-
-def velocity_ik(q, mu_dot, damping=0.0):
-    """Joint rates solving Js q_dot = mu_dot, and where that succeeded: (q_dot, ok).
-
-    Js is the task Jacobian, so mu_dot (4,) or (..., 4) is the rate of the task vector (x, y, z, yaw).
-    damping = 0: q_dot = Js^-1 mu_dot. damping > 0 (damped least squares, near
-    singularities): q_dot = Js^T (Js Js^T + damping^2 I)^-1 mu_dot.
-
-    Returns q_dot (..., 4) and ok (...), a boolean array: False where an input is not
-    finite or the 4 x 4 system solved is numerically singular (reciprocal
-    condition number below VELOCITY_IK_RCOND; take damping > 0 there). Where ok is False,
-    q_dot is 0: the result never holds NaN.
-    """
-    q = _argument("q", q, (DOF,))
-    mu_dot = numpy.asarray(mu_dot, dtype=float)
-    if mu_dot.ndim == 0 or mu_dot.shape[-1] != 4:
-        raise ValueError(f"mu_dot must have shape (4,) or (..., 4), got {mu_dot.shape}")
-    damping = float(damping)
-    if not damping >= 0.0:
-        raise ValueError(f"damping must be >= 0, got {damping}")
-    J = task_jacobian(q)
-    batch = numpy.broadcast_shapes(J.shape[:-2], mu_dot.shape[:-1])
-    J = numpy.broadcast_to(J, batch + J.shape[-2:])
-    mu_dot = numpy.broadcast_to(mu_dot, batch + mu_dot.shape[-1:])
-    Jt = numpy.swapaxes(J, -1, -2)
-    if damping == 0.0:
-        A, b = J, mu_dot
-    else:
-        A, b = J @ Jt + damping**2 * numpy.eye(4), mu_dot
-    ok = numpy.isfinite(A).all(axis=(-2, -1)) & numpy.isfinite(b).all(axis=-1)
-    identity = numpy.eye(4)
-    singular_values = numpy.linalg.svd(numpy.where(ok[..., None, None], A, identity), compute_uv=False)
-    ok &= singular_values[..., -1] > VELOCITY_IK_RCOND * singular_values[..., 0]
-    x = numpy.linalg.solve(numpy.where(ok[..., None, None], A, identity), numpy.where(ok[..., None], b, 0.0)[..., None])[..., 0]
-    q_dot = x if damping == 0.0 else (Jt @ x[..., None])[..., 0]
-    return numpy.where(ok[..., None], q_dot, 0.0), ok
+# Statuses of velocity_ik: OK, singular (a diagonal entry of the QR factor R of the
+# 4 x 4 system at most 1e-12 times its Frobenius norm: take damping > 0), or
+# not finite (q, mu_dot, damping or Js not finite, or damping < 0); q_dot is 0 unless OK.
+# Js is the task Jacobian; mu_dot is the rate of the task vector (x, y, z, yaw).
+VELOCITY_IK_OK = 0
+VELOCITY_IK_SINGULAR = 1
+VELOCITY_IK_NOT_FINITE = 2

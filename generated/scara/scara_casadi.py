@@ -248,6 +248,143 @@ def _jacobian_det(q):
     return [d]
 
 
+def _velocity_ik(q, mu_dot, damping):
+    """Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: 322 operations."""
+    q1 = q[0]
+    q2 = q[1]
+    q3 = q[2]
+    q4 = q[3]
+    mu_dot0 = mu_dot[0]
+    mu_dot1 = mu_dot[1]
+    mu_dot2 = mu_dot[2]
+    mu_dot3 = mu_dot[3]
+    c1 = casadi.cos(q1)
+    s1 = casadi.sin(q1)
+    c2 = casadi.cos(q2)
+    s2 = casadi.sin(q2)
+    c12 = c1*c2 - s1*s2
+    s12 = c1*s2 + c2*s1
+    t0 = 0.275*c12
+    t1 = 0.325*c1 + t0
+    t2 = 0.275*s12
+    t3 = 0.325*s1 + t2
+    t4 = 0.075625*c12*s12 + t1*t3
+    t5 = t2 + t3
+    t6 = t3**2
+    t7 = 0.075625*s12**2 + t6
+    t8 = t7
+    t9 = t1**2
+    t10 = casadi.sqrt(t6 + t9 + 1)
+    t11 = t10*casadi.if_else((t3 <= 0), 1, -1)
+    t12 = casadi.if_else((t10 > 0), 1/(t10*(t10 + casadi.fabs(t3))), 0)
+    t13 = t12 - 1
+    t14 = 0.075625*c12**2 + t9
+    t15 = t14
+    t16 = casadi.sqrt(t14 + t7 + 4)
+    t17 = t0 + t1
+    t18 = t17
+    t19 = t4**2
+    t20 = t5**2
+    t21 = damping**2
+    t22 = t21 + t8
+    t23 = t22**2
+    t24 = casadi.sqrt(t19 + t20 + t23)
+    t25 = t24*casadi.if_else((t22 >= 0), 1, -1)
+    t26 = t22 + t25
+    t27 = casadi.if_else((t24 > 0), 1/(t24*(t24 + casadi.fabs(t22))), 0)
+    t28 = -t27*(-mu_dot0*t26 + mu_dot1*t4 + mu_dot3*t5)
+    t29 = mu_dot0 - t26*t28
+    t30 = mu_dot1 + t28*t4
+    t31 = mu_dot3 + t28*t5
+    t32 = t15 + t21
+    t33 = -t27*(t18*t5 + t26*t4 + t32*t4)
+    t34 = t26*t33 + t4
+    t35 = t32 + t33*t4
+    t36 = t18 + t33*t5
+    t37 = casadi.sqrt(t35**2 + t36**2)
+    t38 = t37*casadi.if_else((t35 >= 0), 1, -1)
+    t39 = t35 + t38
+    t40 = casadi.if_else((t37 > 0), 1/(t37*(t37 + casadi.fabs(t35))), 0)
+    t41 = t40*(t30*t39 + t31*t36)
+    t42 = t30 - t39*t41
+    t43 = t31 - t36*t41
+    t44 = t21 + 1
+    t45 = t44
+    t46 = t21 + 3
+    t47 = casadi.sqrt(2*t18**2 + 2*t19 + 2*t20 + t23 + t32**2 + t44**2 + t46**2)
+    t48 = -t27*(t18*t4 + t26*t5 + t46*t5)
+    t49 = t26*t48 + t5
+    t50 = t18 + t4*t48
+    t51 = t46 + t48*t5
+    t52 = t40*(t36*t51 + t39*t50)
+    t53 = -t39*t52 + t50
+    t54 = -t36*t52 + t51
+    t55 = casadi.fabs(t45)
+    t56 = t55
+    t57 = t56*casadi.if_else((t45 >= 0), 1, -1)
+    t58 = t45 + t57
+    t59 = casadi.if_else((t56 > 0), 1/(t56*(t55 + t56)), 0)
+    t60 = -mu_dot2*t58**2*t59 + mu_dot2
+    t61 = t60/t57
+    t62 = casadi.fabs(t54)
+    t63 = t62
+    t64 = t63*casadi.if_else((t54 >= 0), 1, -1)
+    t65 = t54 + t64
+    t66 = casadi.if_else((t63 > 0), 1/(t63*(t62 + t63)), 0)
+    t67 = -t43*t65**2*t66 + t43
+    t68 = t67/t64
+    t69 = (t42 + t53*t68)/t38
+    t70 = (t29 - t34*t69 - t49*t68)/t25
+    t71 = t1*t69 - t3*t70 + t68
+    t72 = t0*t69 - t2*t70 + t68
+    t73 = -t3
+    t74 = t11 + t73
+    t75 = t12*(t0*t1 - t2*t74 + 1)
+    t76 = t2 + t74*t75
+    t77 = t0 - t1*t75
+    t78 = 1 - t75
+    t79 = t12*(mu_dot0*t74 + mu_dot1*t1 + mu_dot3)
+    t80 = mu_dot0 - t74*t79
+    t81 = mu_dot1 - t1*t79
+    t82 = mu_dot3 - t79
+    t83 = casadi.sqrt(t77**2 + t78**2)
+    t84 = t83*casadi.if_else((t77 >= 0), 1, -1)
+    t85 = t77 + t84
+    t86 = casadi.if_else((t83 > 0), 1/(t83*(t83 + casadi.fabs(t77))), 0)
+    t87 = t86*(t78*t82 + t81*t85)
+    t88 = t81 - t85*t87
+    t89 = -t78*t87 + t82
+    t90 = damping + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + q1 + q2 + q3 + q4 + t17 - t2 + t73
+    t91 = t1*t12
+    t92 = t86*(t13*t78 + t85*t91)
+    t93 = -t85*t92 + t91
+    t94 = t13 - t78*t92
+    t95 = casadi.fabs(t94)
+    t96 = t95
+    t97 = t96*casadi.if_else((t94 >= 0), 1, -1)
+    t98 = t94 + t97
+    t99 = casadi.if_else((t96 > 0), 1/(t96*(t95 + t96)), 0)
+    t100 = -t89*t98**2*t99 + t89
+    t101 = t100/t97
+    t102 = (t101*t93 + t88)/t84
+    t103 = (t101*t12*t74 - t102*t76 + t80)/t11
+    t104 = (damping > 0)
+    t105 = (casadi.fabs(t90) < casadi.inf)
+    t106 = (damping >= 0)
+    t107 = 1e-12*t16
+    t108 = 1e-12*t47
+    t109 = casadi.logic_or(casadi.logic_and(t104, casadi.logic_or(casadi.logic_or(casadi.logic_or((t24 <= t108), (t37 <= t108)), (t56 <= t108)), (t63 <= t108))), casadi.logic_and((damping <= 0), casadi.logic_or(casadi.logic_or(casadi.logic_or((t107 >= 1), (t10 <= t107)), (t83 <= t107)), (t96 <= t107))))
+    t110 = casadi.logic_and(casadi.logic_and(t105, t106), casadi.logic_not(t109))
+    q_dot = casadi.SX(4, 1)
+    q_dot[0, 0] = casadi.if_else(t110, casadi.if_else(t104, -t71, -t103), 0)
+    q_dot[1, 0] = casadi.if_else(t110, casadi.if_else(t104, -t72, -t102), 0)
+    q_dot[2, 0] = casadi.if_else(t110, casadi.if_else(t104, t61, -mu_dot2), 0)
+    q_dot[3, 0] = casadi.if_else(t110, casadi.if_else(t104, t68, -t101), 0)
+    status = casadi.SX(1, 1)
+    status[0, 0] = casadi.if_else(casadi.logic_not(casadi.logic_and(t105, t106)), 2, casadi.if_else(t109, 1, 0))
+    return [q_dot, status]
+
+
 def _ik_branches(mu):
     """Every branch of the closed-form ik and whether the target allows it: 120 operations."""
     mu0 = mu[0]
@@ -308,6 +445,8 @@ def _ik_branches(mu):
 
 
 _q = casadi.SX.sym("q", 4, 1)
+_mu_dot = casadi.SX.sym("mu_dot", 4, 1)
+_damping = casadi.SX.sym("damping", 1, 1)
 _mu = casadi.SX.sym("mu", 4, 1)
 fk = casadi.Function("fk", [_q], _fk(_q), ["q"], ["T"])
 jacobian = casadi.Function("jacobian", [_q], _jacobian(_q), ["q"], ["J"])
@@ -318,10 +457,11 @@ task_jacobian = casadi.Function("task_jacobian", [_q], _task_jacobian(_q), ["q"]
 singularity_factors = casadi.Function("singularity_factors", [_q], _singularity_factors(_q), ["q"], ["f"])
 manipulability = casadi.Function("manipulability", [_q], _manipulability(_q), ["q"], ["w"])
 jacobian_det = casadi.Function("jacobian_det", [_q], _jacobian_det(_q), ["q"], ["d"])
+velocity_ik = casadi.Function("velocity_ik", [_q, _mu_dot, _damping], _velocity_ik(_q, _mu_dot, _damping), ["q", "mu_dot", "damping"], ["q_dot", "status"])
 ik_branches = casadi.Function("ik_branches", [_mu], _ik_branches(_mu), ["mu"], ["q", "valid"])
 ik = ik_branches  # CasADi functions have fixed-size outputs: every branch and its validity
 
 
 def functions():
     """All functions by name."""
-    return {"fk": fk, "jacobian": jacobian, "fk_jacobian": fk_jacobian, "jacobian_tool": jacobian_tool, "task": task, "task_jacobian": task_jacobian, "singularity_factors": singularity_factors, "manipulability": manipulability, "jacobian_det": jacobian_det, "ik_branches": ik_branches}
+    return {"fk": fk, "jacobian": jacobian, "fk_jacobian": fk_jacobian, "jacobian_tool": jacobian_tool, "task": task, "task_jacobian": task_jacobian, "singularity_factors": singularity_factors, "manipulability": manipulability, "jacobian_det": jacobian_det, "velocity_ik": velocity_ik, "ik_branches": ik_branches}

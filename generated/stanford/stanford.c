@@ -559,6 +559,398 @@ stanford_real stanford_jacobian_det(const stanford_real q[STANFORD_DOF])
     return s2*s5*(q3*q3);
 }
 
+int stanford_velocity_ik(const stanford_real q[STANFORD_DOF], const stanford_real mu_dot[STANFORD_TASK_DIM], stanford_real damping, stanford_real q_dot[STANFORD_DOF])
+{
+    /* 1157 operations */
+
+    /* Inputs */
+    const stanford_real q1 = q[0];
+    const stanford_real q2 = q[1];
+    const stanford_real q3 = q[2];
+    const stanford_real q4 = q[3];
+    const stanford_real q5 = q[4];
+    const stanford_real q6 = q[5];
+    const stanford_real mu_dot0 = mu_dot[0];
+    const stanford_real mu_dot1 = mu_dot[1];
+    const stanford_real mu_dot2 = mu_dot[2];
+    const stanford_real mu_dot3 = mu_dot[3];
+    const stanford_real mu_dot4 = mu_dot[4];
+    const stanford_real mu_dot5 = mu_dot[5];
+
+    /* Intermediate terms */
+    const stanford_real c1 = cos(q1);
+    const stanford_real s1 = sin(q1);
+    const stanford_real c2 = cos(q2);
+    const stanford_real s2 = sin(q2);
+    const stanford_real c4 = cos(q4);
+    const stanford_real s4 = sin(q4);
+    const stanford_real c5 = cos(q5);
+    const stanford_real s5 = sin(q5);
+    const stanford_real t0 = -c2*c5 + s2*s4*s5;
+    const stanford_real t1 = c1*s2;
+    const stanford_real t2 = q3*t1 - 0.1337*s1;
+    const stanford_real t3 = s1*s2;
+    const stanford_real t4 = 0.1337*c1 + q3*t3;
+    const stanford_real t5 = c1*t2 + s1*t4;
+    const stanford_real t6 = c4*s1;
+    const stanford_real t7 = c1*s4;
+    const stanford_real t8 = c2*t7 + t6;
+    const stanford_real t9 = c2*t6 + t7;
+    const stanford_real t10 = c5*t1 + s5*t8;
+    const stanford_real t11 = s1*s4;
+    const stanford_real t12 = c1*c4;
+    const stanford_real t13 = c2*t12 - t11;
+    const stanford_real t14 = c2*t11 - t12;
+    const stanford_real t15 = c5*t3 + s5*t14;
+    const stanford_real t16 = (c1*c1);
+    const stanford_real t17 = (s2*s2);
+    const stanford_real t18 = t16*t17;
+    const stanford_real t19 = (t4*t4);
+    const stanford_real t20 = (c2*c2);
+    const stanford_real t21 = t20*(q3*q3);
+    const stanford_real t22 = t16*t21;
+    const stanford_real t23 = t19 + t22;
+    const stanford_real t24 = t18 + t23;
+    const stanford_real t25 = -t2*t4;
+    const stanford_real t26 = c1*s1;
+    const stanford_real t27 = t17*t26;
+    const stanford_real t28 = t21*t26 + t25 + t27;
+    const stanford_real t29 = t10*t15 + t13*t9 - t26 + t27;
+    const stanford_real t30 = c2*t1;
+    const stanford_real t31 = c1*t5;
+    const stanford_real t32 = c2*q3;
+    const stanford_real t33 = t30 - t31*t32;
+    const stanford_real t34 = t16*t32;
+    const stanford_real t35 = (s1*s1);
+    const stanford_real t36 = t17*t35;
+    const stanford_real t37 = (t2*t2);
+    const stanford_real t38 = sqrt(t19 + t37 + 1);
+    const stanford_real t39 = t38*(t4 <= 0 ? 1 : -1);
+    const stanford_real t40 = (t38 > 0 ? 1/(t38*(t38 + fabs(t4))) : 0);
+    const stanford_real t41 = t21*t35 + t37;
+    const stanford_real t42 = t36 + t41;
+    const stanford_real t43 = c2*t3;
+    const stanford_real t44 = s1*t5;
+    const stanford_real t45 = -t32*t44 + t43;
+    const stanford_real t46 = t32*t35;
+    const stanford_real t47 = t46;
+    const stanford_real t48 = (t5*t5);
+    const stanford_real t49 = t20 + t48;
+    const stanford_real t50 = t35 + (t10*t10) + (t13*t13);
+    const stanford_real t51 = t18 + t50;
+    const stanford_real t52 = c4*s2;
+    const stanford_real t53 = t0*t10 + t13*t52 - t30;
+    const stanford_real t54 = t0*t15 - t43 + t52*t9;
+    const stanford_real t55 = t16 + (t15*t15) + (t9*t9);
+    const stanford_real t56 = t36 + t55;
+    const stanford_real t57 = t17*(c4*c4) + (t0*t0) + 1;
+    const stanford_real t58 = t20 + t57;
+    const stanford_real t59 = sqrt(2*t18 + 2*t20 + t23 + 2*t36 + t41 + t48 + t50 + t55 + t57);
+    const stanford_real t60 = (t28*t28);
+    const stanford_real t61 = (t33*t33);
+    const stanford_real t62 = (t34*t34);
+    const stanford_real t63 = (damping*damping);
+    const stanford_real t64 = t24 + t63;
+    const stanford_real t65 = (t64*t64);
+    const stanford_real t66 = t42 + t63;
+    const stanford_real t67 = t49 + t63;
+    const stanford_real t68 = t51 + t63;
+    const stanford_real t69 = t56 + t63;
+    const stanford_real t70 = t58 + t63;
+    const stanford_real t71 = 2*t48;
+    const stanford_real t72 = t22*t35;
+    const stanford_real t73 = sqrt(t16*t71 + 2*t19 + t35*t71 + 2*t37 + 2*t60 + 2*t61 + 2*t62 + t65 + 4*t72 + 2*(t29*t29) + 2*(t45*t45) + 2*(t47*t47) + 2*(t53*t53) + 2*(t54*t54) + (t66*t66) + (t67*t67) + (t68*t68) + (t69*t69) + (t70*t70));
+    const stanford_real t74 = sqrt(t19 + t60 + t61 + t62 + t65 + t72);
+    const stanford_real t75 = t74*(t64 >= 0 ? 1 : -1);
+    const stanford_real t76 = t64 + t75;
+    const stanford_real t77 = (t74 > 0 ? 1/(t74*(t74 + fabs(t64))) : 0);
+    const stanford_real t78 = t77*(t28*t45 - t31*t34 - t31*t46 + t33*t67 + t33*t76);
+    const stanford_real t79 = t33 - t76*t78;
+    const stanford_real t80 = -t28*t78 + t45;
+    const stanford_real t81 = -t33*t78 + t67;
+    const stanford_real t82 = t31 + t34*t78;
+    const stanford_real t83 = -t77*(-c1*c2*q3*s1*t53 - t2*t28 + t34*t54 + t4*t70 + t4*t76);
+    const stanford_real t84 = t4 + t76*t83;
+    const stanford_real t85 = t2 - t28*t83;
+    const stanford_real t86 = t34*t83 + t54;
+    const stanford_real t87 = t4*t83 + t70;
+    const stanford_real t88 = t26*t32;
+    const stanford_real t89 = t77*(t25 + t28*t66 + t28*t76 + t33*t45 + t34*t88 + t47*t88);
+    const stanford_real t90 = t28 - t76*t89;
+    const stanford_real t91 = -t28*t89 + t66;
+    const stanford_real t92 = -t33*t89 + t45;
+    const stanford_real t93 = -t47 + t88*t89;
+    const stanford_real t94 = -t34*t89 + t88;
+    const stanford_real t95 = t2 + t4*t89;
+    const stanford_real t96 = t44 + t78*t88;
+    const stanford_real t97 = t77*(-t28*t47 + t29*t34 + t33*t44 + t4*t53 - t68*t88 - t76*t88);
+    const stanford_real t98 = t76*t97 + t88;
+    const stanford_real t99 = t28*t97 + t47;
+    const stanford_real t100 = -t33*t97 + t44;
+    const stanford_real t101 = t68 + t88*t97;
+    const stanford_real t102 = t29 - t34*t97;
+    const stanford_real t103 = t77*(t28*t88 - t29*t88 - t31*t33 + t34*t69 + t34*t76 + t4*t54);
+    const stanford_real t104 = -t103*t76 + t34;
+    const stanford_real t105 = -t103*t28 + t88;
+    const stanford_real t106 = t103*t33 + t31;
+    const stanford_real t107 = t103*t88 + t29;
+    const stanford_real t108 = -t103*t34 + t69;
+    const stanford_real t109 = t103*t4 - t54;
+    const stanford_real t110 = t77*(mu_dot0*t76 + mu_dot1*t28 + mu_dot2*t33 - mu_dot3*t88 + mu_dot4*t34 - mu_dot5*t4);
+    const stanford_real t111 = mu_dot0 - t110*t76;
+    const stanford_real t112 = mu_dot1 - t110*t28;
+    const stanford_real t113 = mu_dot2 - t110*t33;
+    const stanford_real t114 = mu_dot3 + t110*t88;
+    const stanford_real t115 = mu_dot4 - t110*t34;
+    const stanford_real t116 = mu_dot5 + t110*t4;
+    const stanford_real t117 = sqrt((t91*t91) + (t92*t92) + (t93*t93) + (t94*t94) + (t95*t95));
+    const stanford_real t118 = t117*(t91 >= 0 ? 1 : -1);
+    const stanford_real t119 = t118 + t91;
+    const stanford_real t120 = (t117 > 0 ? 1/(t117*(t117 + fabs(t91))) : 0);
+    const stanford_real t121 = t120*(t105*t119 - t106*t92 + t107*t93 + t108*t94 + t109*t95);
+    const stanford_real t122 = t105 - t119*t121;
+    const stanford_real t123 = t106 + t121*t92;
+    const stanford_real t124 = t107 - t121*t93;
+    const stanford_real t125 = t108 - t121*t94;
+    const stanford_real t126 = t109 - t121*t95;
+    const stanford_real t127 = t120*(t112*t119 + t113*t92 + t114*t93 + t115*t94 + t116*t95);
+    const stanford_real t128 = t112 - t119*t127;
+    const stanford_real t129 = t113 - t127*t92;
+    const stanford_real t130 = t114 - t127*t93;
+    const stanford_real t131 = t115 - t127*t94;
+    const stanford_real t132 = t116 - t127*t95;
+    const stanford_real t133 = -t53;
+    const stanford_real t134 = t133 + t4*t97;
+    const stanford_real t135 = t133 + t83*t88;
+    const stanford_real t136 = t120*(t100*t92 + t101*t93 + t102*t94 - t119*t99 + t134*t95);
+    const stanford_real t137 = t119*t136 + t99;
+    const stanford_real t138 = t100 - t136*t92;
+    const stanford_real t139 = t101 - t136*t93;
+    const stanford_real t140 = t102 - t136*t94;
+    const stanford_real t141 = t134 - t136*t95;
+    const stanford_real t142 = t4*t78;
+    const stanford_real t143 = t120*(t119*t80 + t142*t95 + t81*t92 - t82*t94 + t93*t96);
+    const stanford_real t144 = -t119*t143 + t80;
+    const stanford_real t145 = -t143*t92 + t81;
+    const stanford_real t146 = -t143*t93 + t96;
+    const stanford_real t147 = t143*t94 + t82;
+    const stanford_real t148 = t142 - t143*t95;
+    const stanford_real t149 = sqrt((t145*t145) + (t146*t146) + (t147*t147) + (t148*t148));
+    const stanford_real t150 = t149*(t145 >= 0 ? 1 : -1);
+    const stanford_real t151 = t145 + t150;
+    const stanford_real t152 = (t149 > 0 ? 1/(t149*(t149 + fabs(t145))) : 0);
+    const stanford_real t153 = t152*(t138*t151 + t139*t146 - t140*t147 + t141*t148);
+    const stanford_real t154 = t138 - t151*t153;
+    const stanford_real t155 = t139 - t146*t153;
+    const stanford_real t156 = t140 + t147*t153;
+    const stanford_real t157 = t141 - t148*t153;
+    const stanford_real t158 = t152*(-t123*t151 + t124*t146 - t125*t147 + t126*t148);
+    const stanford_real t159 = t123 + t151*t158;
+    const stanford_real t160 = t124 - t146*t158;
+    const stanford_real t161 = t125 + t147*t158;
+    const stanford_real t162 = t126 - t148*t158;
+    const stanford_real t163 = t152*(t129*t151 + t130*t146 - t131*t147 + t132*t148);
+    const stanford_real t164 = t129 - t151*t163;
+    const stanford_real t165 = t130 - t146*t163;
+    const stanford_real t166 = t131 + t147*t163;
+    const stanford_real t167 = t132 - t148*t163;
+    const stanford_real t168 = sqrt((t155*t155) + (t156*t156) + (t157*t157));
+    const stanford_real t169 = t168*(t155 >= 0 ? 1 : -1);
+    const stanford_real t170 = t155 + t169;
+    const stanford_real t171 = (t168 > 0 ? 1/(t168*(t168 + fabs(t155))) : 0);
+    const stanford_real t172 = t171*(t156*t161 + t157*t162 + t160*t170);
+    const stanford_real t173 = t160 - t170*t172;
+    const stanford_real t174 = -t156*t172 + t161;
+    const stanford_real t175 = -t157*t172 + t162;
+    const stanford_real t176 = t171*(t156*t166 + t157*t167 + t165*t170);
+    const stanford_real t177 = t165 - t170*t176;
+    const stanford_real t178 = -t156*t176 + t166;
+    const stanford_real t179 = -t157*t176 + t167;
+    const stanford_real t180 = sqrt((t174*t174) + (t175*t175));
+    const stanford_real t181 = t180*(t174 >= 0 ? 1 : -1);
+    const stanford_real t182 = t174 + t181;
+    const stanford_real t183 = (t180 > 0 ? 1/(t180*(t180 + fabs(t174))) : 0);
+    const stanford_real t184 = t183*(t175*t179 + t178*t182);
+    const stanford_real t185 = t178 - t182*t184;
+    const stanford_real t186 = -t175*t184 + t179;
+    const stanford_real t187 = t33*t83;
+    const stanford_real t188 = t120*(t119*t85 + t135*t93 - t187*t92 - t86*t94 + t87*t95);
+    const stanford_real t189 = -t119*t188 + t85;
+    const stanford_real t190 = t187 + t188*t92;
+    const stanford_real t191 = t135 - t188*t93;
+    const stanford_real t192 = t188*t94 + t86;
+    const stanford_real t193 = -t188*t95 + t87;
+    const stanford_real t194 = t152*(t146*t191 + t147*t192 + t148*t193 - t151*t190);
+    const stanford_real t195 = t151*t194 + t190;
+    const stanford_real t196 = -t146*t194 + t191;
+    const stanford_real t197 = t147*t194 - t192;
+    const stanford_real t198 = -t148*t194 + t193;
+    const stanford_real t199 = t171*(t156*t197 + t157*t198 + t170*t196);
+    const stanford_real t200 = -t170*t199 + t196;
+    const stanford_real t201 = -t156*t199 + t197;
+    const stanford_real t202 = -t157*t199 + t198;
+    const stanford_real t203 = t183*(t175*t202 + t182*t201);
+    const stanford_real t204 = -t182*t203 + t201;
+    const stanford_real t205 = -t175*t203 + t202;
+    const stanford_real t206 = fabs(t205);
+    const stanford_real t207 = t206;
+    const stanford_real t208 = t207*(t205 >= 0 ? 1 : -1);
+    const stanford_real t209 = t205 + t208;
+    const stanford_real t210 = (t207 > 0 ? 1/(t207*(t206 + t207)) : 0);
+    const stanford_real t211 = -t186*t210*(t209*t209) + t186;
+    const stanford_real t212 = t211/t208;
+    const stanford_real t213 = (t185 + t204*t212)/t181;
+    const stanford_real t214 = (t173*t213 + t177 + t200*t212)/t169;
+    const stanford_real t215 = (t154*t214 - t159*t213 + t164 - t195*t212)/t150;
+    const stanford_real t216 = (t122*t213 + t128 - t137*t214 + t144*t215 + t189*t212)/t118;
+    const stanford_real t217 = (t104*t213 + t111 - t212*t84 - t214*t98 + t215*t79 + t216*t90)/t75;
+    const stanford_real t218 = t2*t216 + t212 - t217*t4;
+    const stanford_real t219 = c2*t215 + t1*t217 + t216*t3;
+    const stanford_real t220 = c2*t212 + t1*t214 + t213*t3;
+    const stanford_real t221 = t13*t214 - t212*t52 + t213*t9;
+    const stanford_real t222 = -t0*t212 + t10*t214 + t15*t213;
+    const stanford_real t223 = s1*t32;
+    const stanford_real t224 = c1*t32;
+    const stanford_real t225 = c1*t213 - s1*t214 - t215*t5 + t216*t223 + t217*t224;
+    const stanford_real t226 = -t4;
+    const stanford_real t227 = t226 + t39;
+    const stanford_real t228 = t40*(t2*t223 + t224*t227);
+    const stanford_real t229 = t224 - t227*t228;
+    const stanford_real t230 = -t2*t228 + t223;
+    const stanford_real t231 = t40*(t1*t227 + t2*t3);
+    const stanford_real t232 = t1 - t227*t231;
+    const stanford_real t233 = -t2*t231 + t3;
+    const stanford_real t234 = t40*(mu_dot0*t227 + mu_dot1*t2 + mu_dot5);
+    const stanford_real t235 = mu_dot0 - t227*t234;
+    const stanford_real t236 = mu_dot1 - t2*t234;
+    const stanford_real t237 = mu_dot5 - t234;
+    const stanford_real t238 = sqrt(t16 + t35 + t48 + (t228*t228) + (t230*t230));
+    const stanford_real t239 = t238*(t230 >= 0 ? 1 : -1);
+    const stanford_real t240 = t230 + t239;
+    const stanford_real t241 = (t238 > 0 ? 1/(t238*(t238 + fabs(t230))) : 0);
+    const stanford_real t242 = t241*(-c2*t5 + t228*t231 + t233*t240);
+    const stanford_real t243 = t233 - t240*t242;
+    const stanford_real t244 = c2 + t242*t5;
+    const stanford_real t245 = t228*t242 - t231;
+    const stanford_real t246 = -t241*(-c1*mu_dot4 + mu_dot2*t5 + mu_dot3*s1 + t228*t237 - t236*t240);
+    const stanford_real t247 = t236 - t240*t246;
+    const stanford_real t248 = mu_dot2 + t246*t5;
+    const stanford_real t249 = mu_dot3 + s1*t246;
+    const stanford_real t250 = -c1*t246 + mu_dot4;
+    const stanford_real t251 = t228*t246 + t237;
+    const stanford_real t252 = c2*t40;
+    const stanford_real t253 = c2 - t252;
+    const stanford_real t254 = -t52;
+    const stanford_real t255 = t40*t52;
+    const stanford_real t256 = t254 + t255;
+    const stanford_real t257 = -t0;
+    const stanford_real t258 = c1 + 2*c2 + damping + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + q1 + q2 + q3 + q4 + q5 + q6 - s1 + 2*t1 + t10 + t13 + t15 + t2 + t223 + t224 + t226 + t254 + t257 + 2*t3 - t5 + t9 + 1;
+    const stanford_real t259 = t0*t40;
+    const stanford_real t260 = t257 + t259;
+    const stanford_real t261 = t2*t252;
+    const stanford_real t262 = -t241*(t228*t253 + t240*t261);
+    const stanford_real t263 = t240*t262 + t261;
+    const stanford_real t264 = s1*t262 + t1;
+    const stanford_real t265 = -c1*t262 + t3;
+    const stanford_real t266 = t228*t262 + t253;
+    const stanford_real t267 = t2*t255;
+    const stanford_real t268 = t241*(c1*t9 - s1*t13 - t228*t256 + t240*t267);
+    const stanford_real t269 = -t240*t268 + t267;
+    const stanford_real t270 = s1*t268 + t13;
+    const stanford_real t271 = -c1*t268 + t9;
+    const stanford_real t272 = t228*t268 + t256;
+    const stanford_real t273 = t2*t259;
+    const stanford_real t274 = t241*(c1*t15 - s1*t10 - t228*t260 + t240*t273);
+    const stanford_real t275 = -t240*t274 + t273;
+    const stanford_real t276 = s1*t274 + t10;
+    const stanford_real t277 = -c1*t274 + t15;
+    const stanford_real t278 = t228*t274 + t260;
+    const stanford_real t279 = (t242*t242);
+    const stanford_real t280 = sqrt(t16*t279 + t279*t35 + (t244*t244) + (t245*t245));
+    const stanford_real t281 = t280*(t244 >= 0 ? 1 : -1);
+    const stanford_real t282 = t244 + t281;
+    const stanford_real t283 = (t280 > 0 ? 1/(t280*(t280 + fabs(t244))) : 0);
+    const stanford_real t284 = s1*t242;
+    const stanford_real t285 = t262*t5;
+    const stanford_real t286 = c1*t242;
+    const stanford_real t287 = t283*(t245*t266 + t264*t284 - t265*t286 + t282*t285);
+    const stanford_real t288 = -t282*t287 + t285;
+    const stanford_real t289 = t264 - t284*t287;
+    const stanford_real t290 = t265 + t286*t287;
+    const stanford_real t291 = -t245*t287 + t266;
+    const stanford_real t292 = t283*(t245*t251 + t248*t282 + t249*t284 - t250*t286);
+    const stanford_real t293 = t248 - t282*t292;
+    const stanford_real t294 = t249 - t284*t292;
+    const stanford_real t295 = t250 + t286*t292;
+    const stanford_real t296 = -t245*t292 + t251;
+    const stanford_real t297 = sqrt((t289*t289) + (t290*t290) + (t291*t291));
+    const stanford_real t298 = t297*(t289 >= 0 ? 1 : -1);
+    const stanford_real t299 = t289 + t298;
+    const stanford_real t300 = (t297 > 0 ? 1/(t297*(t297 + fabs(t289))) : 0);
+    const stanford_real t301 = t300*(t290*t295 + t291*t296 + t294*t299);
+    const stanford_real t302 = t294 - t299*t301;
+    const stanford_real t303 = -t290*t301 + t295;
+    const stanford_real t304 = -t291*t301 + t296;
+    const stanford_real t305 = t268*t5;
+    const stanford_real t306 = t283*(t245*t272 + t270*t284 - t271*t286 + t282*t305);
+    const stanford_real t307 = -t282*t306 + t305;
+    const stanford_real t308 = t270 - t284*t306;
+    const stanford_real t309 = t271 + t286*t306;
+    const stanford_real t310 = -t245*t306 + t272;
+    const stanford_real t311 = t300*(t290*t309 + t291*t310 + t299*t308);
+    const stanford_real t312 = -t299*t311 + t308;
+    const stanford_real t313 = -t290*t311 + t309;
+    const stanford_real t314 = -t291*t311 + t310;
+    const stanford_real t315 = sqrt((t313*t313) + (t314*t314));
+    const stanford_real t316 = t315*(t313 >= 0 ? 1 : -1);
+    const stanford_real t317 = t313 + t316;
+    const stanford_real t318 = (t315 > 0 ? 1/(t315*(t315 + fabs(t313))) : 0);
+    const stanford_real t319 = t318*(t303*t317 + t304*t314);
+    const stanford_real t320 = t303 - t317*t319;
+    const stanford_real t321 = t304 - t314*t319;
+    const stanford_real t322 = t274*t5;
+    const stanford_real t323 = t283*(t245*t278 + t276*t284 - t277*t286 + t282*t322);
+    const stanford_real t324 = -t282*t323 + t322;
+    const stanford_real t325 = t276 - t284*t323;
+    const stanford_real t326 = t277 + t286*t323;
+    const stanford_real t327 = -t245*t323 + t278;
+    const stanford_real t328 = t300*(t290*t326 + t291*t327 + t299*t325);
+    const stanford_real t329 = -t299*t328 + t325;
+    const stanford_real t330 = -t290*t328 + t326;
+    const stanford_real t331 = -t291*t328 + t327;
+    const stanford_real t332 = t318*(t314*t331 + t317*t330);
+    const stanford_real t333 = -t317*t332 + t330;
+    const stanford_real t334 = -t314*t332 + t331;
+    const stanford_real t335 = fabs(t334);
+    const stanford_real t336 = t335;
+    const stanford_real t337 = t336*(t334 >= 0 ? 1 : -1);
+    const stanford_real t338 = t334 + t337;
+    const stanford_real t339 = (t336 > 0 ? 1/(t336*(t335 + t336)) : 0);
+    const stanford_real t340 = -t321*t339*(t338*t338) + t321;
+    const stanford_real t341 = t340/t337;
+    const stanford_real t342 = (t320 + t333*t341)/t316;
+    const stanford_real t343 = (t302 + t312*t342 + t329*t341)/t298;
+    const stanford_real t344 = (t288*t343 + t293 + t307*t342 + t324*t341)/t281;
+    const stanford_real t345 = (t243*t344 + t247 - t263*t343 + t269*t342 + t275*t341)/t239;
+    const stanford_real t346 = (-c2*t227*t343*t40 + t227*t255*t342 + t227*t259*t341 + t229*t345 + t232*t344 + t235)/t39;
+    const int t347 = damping > 0;
+    const int t348 = isfinite(t258);
+    const int t349 = damping >= 0;
+    const stanford_real t350 = 1e-12*t59;
+    const stanford_real t351 = 1e-12*t73;
+    const int t352 = (t347 && ((t117 <= t351) || (t149 <= t351) || (t168 <= t351) || (t180 <= t351) || (t207 <= t351) || (t74 <= t351))) || (damping <= 0 && ((t238 <= t350) || (t280 <= t350) || (t297 <= t350) || (t315 <= t350) || (t336 <= t350) || (t38 <= t350)));
+    const int t353 = t348 && t349 && !t352;
+
+    /* Outputs */
+    q_dot[0] = (t353 ? (t347 ? -t218 : -t346) : 0);
+    q_dot[1] = (t353 ? (t347 ? -t225 : -t345) : 0);
+    q_dot[2] = (t353 ? (t347 ? -t219 : -t344) : 0);
+    q_dot[3] = (t353 ? (t347 ? -t220 : -t343) : 0);
+    q_dot[4] = (t353 ? (t347 ? -t221 : -t342) : 0);
+    q_dot[5] = (t353 ? (t347 ? -t222 : -t341) : 0);
+    return (!(t348 && t349) ? 2 : (t352 ? 1 : 0));
+}
+
 void stanford_ik_branches(const stanford_real T[16], stanford_real q[STANFORD_MAX_IK_SOLUTIONS * STANFORD_DOF], int valid[STANFORD_MAX_IK_SOLUTIONS])
 {
     /* 630 operations */
@@ -919,103 +1311,6 @@ void stanford_ik_branches(const stanford_real T[16], stanford_real q[STANFORD_MA
     valid[5] = t277 && t280 && t282 && t195 > 1e-12;
     valid[6] = t277 && t281 && t282 && t227 >= t278;
     valid[7] = t277 && t281 && t282 && t227 > 1e-12;
-}
-
-int stanford_velocity_ik(const stanford_real q[STANFORD_DOF], const stanford_real mu_dot[STANFORD_TASK_DIM], stanford_real damping, stanford_real q_dot[STANFORD_DOF])
-{
-    /* Rows of jacobian() forming Js (the geometric Jacobian). */
-    static const int rows[STANFORD_TASK_DIM] = {0, 1, 2, 3, 4, 5};
-    stanford_real J[6 * STANFORD_DOF];
-    stanford_real A[6 * 6];
-    stanford_real x[6];
-    stanford_real scale = 0;
-    const int normal = damping > 0; /* damped: solve (Js Js^T + damping^2 I) x = mu_dot */
-    int r, c, k;
-
-    for (c = 0; c < STANFORD_DOF; ++c) {
-        q_dot[c] = 0;
-        if (!isfinite(q[c])) {
-            return STANFORD_VELOCITY_IK_NOT_FINITE;
-        }
-    }
-    for (r = 0; r < STANFORD_TASK_DIM; ++r) {
-        if (!isfinite(mu_dot[r])) {
-            return STANFORD_VELOCITY_IK_NOT_FINITE;
-        }
-        x[r] = mu_dot[r]; /* b; copied here, not in a loop of its own (which becomes memcpy) */
-    }
-    if (!(damping >= 0) || !isfinite(damping)) {
-        return STANFORD_VELOCITY_IK_NOT_FINITE;
-    }
-    stanford_jacobian(q, J);
-
-    /* The system A x = b (6 x 6), b in x. */
-    for (r = 0; r < 6; ++r) {
-        for (c = 0; c < 6; ++c) {
-            stanford_real sum = r == c ? damping * damping : 0;
-            if (!normal) {
-                sum = J[rows[r] * STANFORD_DOF + c];
-            }
-            for (k = 0; normal && k < STANFORD_DOF; ++k) {
-                sum += J[rows[r] * STANFORD_DOF + k] * J[rows[c] * STANFORD_DOF + k];
-            }
-            A[r * 6 + c] = sum;
-            if (!isfinite(sum)) {
-                return STANFORD_VELOCITY_IK_NOT_FINITE;
-            }
-            if (fabs(sum) > scale) {
-                scale = fabs(sum);
-            }
-        }
-    }
-
-    /* LU with partial pivoting, applied to x as it goes. */
-    for (k = 0; k < 6; ++k) {
-        int pivot = k;
-        for (r = k + 1; r < 6; ++r) {
-            if (fabs(A[r * 6 + k]) > fabs(A[pivot * 6 + k])) {
-                pivot = r;
-            }
-        }
-        if (!(fabs(A[pivot * 6 + k]) > 1e-12 * scale)) {
-            return STANFORD_VELOCITY_IK_SINGULAR;
-        }
-        if (pivot != k) {
-            stanford_real swap;
-            for (c = k; c < 6; ++c) {
-                swap = A[k * 6 + c];
-                A[k * 6 + c] = A[pivot * 6 + c];
-                A[pivot * 6 + c] = swap;
-            }
-            swap = x[k];
-            x[k] = x[pivot];
-            x[pivot] = swap;
-        }
-        for (r = k + 1; r < 6; ++r) {
-            const stanford_real factor = A[r * 6 + k] / A[k * 6 + k];
-            for (c = k + 1; c < 6; ++c) {
-                A[r * 6 + c] -= factor * A[k * 6 + c];
-            }
-            x[r] -= factor * x[k];
-        }
-    }
-    for (k = 6 - 1; k >= 0; --k) {
-        for (c = k + 1; c < 6; ++c) {
-            x[k] -= A[k * 6 + c] * x[c];
-        }
-        x[k] /= A[k * 6 + k];
-        if (!normal) {
-            q_dot[k] = x[k];
-        }
-    }
-
-    /* q_dot = Js^T x when damped (else x, written above) */
-    for (c = 0; normal && c < STANFORD_DOF; ++c) {
-        for (r = 0; r < STANFORD_TASK_DIM; ++r) {
-            q_dot[c] += J[rows[r] * STANFORD_DOF + c] * x[r];
-        }
-    }
-    return STANFORD_VELOCITY_IK_OK;
 }
 
 int stanford_ik(const stanford_real T[16], stanford_real q[STANFORD_MAX_IK_SOLUTIONS * STANFORD_DOF])

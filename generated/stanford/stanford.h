@@ -70,22 +70,21 @@ stanford_real stanford_manipulability(const stanford_real q[STANFORD_DOF]);
  * Result: returned as a scalar. 5 operations. */
 stanford_real stanford_jacobian_det(const stanford_real q[STANFORD_DOF]);
 
+/* Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status.
+ * Result: q_dot[i], i < 6; returned as a scalar. 1157 operations. */
+int stanford_velocity_ik(const stanford_real q[STANFORD_DOF], const stanford_real mu_dot[STANFORD_TASK_DIM], stanford_real damping, stanford_real q_dot[STANFORD_DOF]);
+
 /* Every branch of the closed-form ik and whether the target allows it.
  * Result: q: 8 x 6 row-major, element (r, c) at q[r * 6 + c]; valid[i], i < 8. 630 operations. */
 void stanford_ik_branches(const stanford_real T[16], stanford_real q[STANFORD_MAX_IK_SOLUTIONS * STANFORD_DOF], int valid[STANFORD_MAX_IK_SOLUTIONS]);
 
-/* Status of stanford_velocity_ik. */
+/* Statuses of stanford_velocity_ik: OK, singular (a diagonal entry of the QR factor R of the
+ * 6 x 6 system at most 1e-12 times its Frobenius norm: take damping > 0), or
+ * not finite (q, mu_dot, damping or Js not finite, or damping < 0); q_dot is 0 unless OK.
+ * Js is the geometric Jacobian; mu_dot is (vx, vy, vz, wx, wy, wz): components of the tool's linear (v) and angular (w) velocity in the world frame. */
 #define STANFORD_VELOCITY_IK_OK 0
-#define STANFORD_VELOCITY_IK_SINGULAR 1   /* a pivot below 1e-12 x the largest |entry|: take damping > 0 */
-#define STANFORD_VELOCITY_IK_NOT_FINITE 2 /* q, mu_dot, damping (must be >= 0) or Js not finite */
-
-/* Joint rates q_dot[STANFORD_DOF] solving Js q_dot = mu_dot.
- * Js is the geometric Jacobian; mu_dot[STANFORD_TASK_DIM] is (vx, vy, vz, wx, wy, wz): components of the tool's linear (v) and angular (w) velocity in the world frame.
- * damping = 0: q_dot = Js^-1 mu_dot; damping > 0 (damped least squares near singularities):
- * q_dot = Js^T (Js Js^T + damping^2 I)^-1 mu_dot.
- * LU with partial pivoting of the 6 x 6 system on the stack. Returns
- * STANFORD_VELOCITY_IK_OK, or a status above with q_dot all 0. */
-int stanford_velocity_ik(const stanford_real q[STANFORD_DOF], const stanford_real mu_dot[STANFORD_TASK_DIM], stanford_real damping, stanford_real q_dot[STANFORD_DOF]);
+#define STANFORD_VELOCITY_IK_SINGULAR 1
+#define STANFORD_VELOCITY_IK_NOT_FINITE 2
 
 /* Closed-form inverse kinematics: every joint solution that reaches the target; returns
  * their count k and writes solution i to q[i * STANFORD_DOF + j], i < k: the valid

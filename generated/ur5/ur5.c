@@ -671,6 +671,427 @@ ur5_real ur5_jacobian_det(const ur5_real q[UR5_DOF])
     return 0.07085015625*s3*s5*(c2*s3*t3 - c2 + c3*s2*t3 + t0*t2 - 0.9229411764705883*t0 - t1*t2 + 0.9229411764705883*t1);
 }
 
+int ur5_velocity_ik(const ur5_real q[UR5_DOF], const ur5_real mu_dot[UR5_TASK_DIM], ur5_real damping, ur5_real q_dot[UR5_DOF])
+{
+    /* 1288 operations */
+
+    /* Inputs */
+    const ur5_real q1 = q[0];
+    const ur5_real q2 = q[1];
+    const ur5_real q3 = q[2];
+    const ur5_real q4 = q[3];
+    const ur5_real q5 = q[4];
+    const ur5_real q6 = q[5];
+    const ur5_real mu_dot0 = mu_dot[0];
+    const ur5_real mu_dot1 = mu_dot[1];
+    const ur5_real mu_dot2 = mu_dot[2];
+    const ur5_real mu_dot3 = mu_dot[3];
+    const ur5_real mu_dot4 = mu_dot[4];
+    const ur5_real mu_dot5 = mu_dot[5];
+
+    /* Intermediate terms */
+    const ur5_real c1 = cos(q1);
+    const ur5_real s1 = sin(q1);
+    const ur5_real c2 = cos(q2);
+    const ur5_real s2 = sin(q2);
+    const ur5_real c3 = cos(q3);
+    const ur5_real s3 = sin(q3);
+    const ur5_real c23 = c2*c3 - s2*s3;
+    const ur5_real s23 = c2*s3 + c3*s2;
+    const ur5_real c4 = cos(q4);
+    const ur5_real s4 = sin(q4);
+    const ur5_real c234 = c23*c4 - s23*s4;
+    const ur5_real s234 = c23*s4 + c4*s23;
+    const ur5_real c5 = cos(q5);
+    const ur5_real s5 = sin(q5);
+    const ur5_real t0 = c234*s5;
+    const ur5_real t1 = -c1*t0 + c5*s1;
+    const ur5_real t2 = c1*c5 + s1*t0;
+    const ur5_real t3 = c1*s234;
+    const ur5_real t4 = 0.0823*t1 + 0.09465*t3;
+    const ur5_real t5 = 0.10915*s1 + t4;
+    const ur5_real t6 = s1*s234;
+    const ur5_real t7 = -0.0823*t2 + 0.09465*t6;
+    const ur5_real t8 = -0.10915*c1 + t7;
+    const ur5_real t9 = c1*t5 + s1*t8;
+    const ur5_real t10 = t3*t7 - t4*t6;
+    const ur5_real t11 = s234*s5;
+    const ur5_real t12 = 0.09465*c234 + 0.0823*t11;
+    const ur5_real t13 = 0.39225*s23 + t12;
+    const ur5_real t14 = 0.425*s2 + t13;
+    const ur5_real t15 = c234*t3 + t1*t11;
+    const ur5_real t16 = -c234*t6 + t11*t2;
+    const ur5_real t17 = 0.39225*c23;
+    const ur5_real t18 = -c1*t17 + t5;
+    const ur5_real t19 = -s1*t17 + t8;
+    const ur5_real t20 = c1*t18 + s1*t19;
+    const ur5_real t21 = 0.425*c2;
+    const ur5_real t22 = -c1*t21 + t18;
+    const ur5_real t23 = -s1*t21 + t19;
+    const ur5_real t24 = c1*t22 + s1*t23;
+    const ur5_real t25 = s1*t12;
+    const ur5_real t26 = c234*t7 - s234*t25;
+    const ur5_real t27 = c234*t26 + t23;
+    const ur5_real t28 = c1*t12;
+    const ur5_real t29 = -c234*t4 + s234*t28;
+    const ur5_real t30 = -c234*t29 + t22;
+    const ur5_real t31 = (t23*t23);
+    const ur5_real t32 = (t12*t12);
+    const ur5_real t33 = (c1*c1);
+    const ur5_real t34 = t12*t33 + t13*t33 + t14*t33 - t26*t6;
+    const ur5_real t35 = (t13*t13);
+    const ur5_real t36 = (t14*t14);
+    const ur5_real t37 = t32*t33 + t33*t35 + t33*t36 + (t26*t26);
+    const ur5_real t38 = t31 + t37;
+    const ur5_real t39 = c1*s1;
+    const ur5_real t40 = -t22*t23 + t26*t29 + t32*t39 + t35*t39 + t36*t39;
+    const ur5_real t41 = c1*t9;
+    const ur5_real t42 = c1*t20;
+    const ur5_real t43 = c1*t24;
+    const ur5_real t44 = t10*t26 + t12*t41 + t13*t42 + t14*t43;
+    const ur5_real t45 = -t10*t6 + t41 + t42 + t43;
+    const ur5_real t46 = c1*t13;
+    const ur5_real t47 = c1*t14;
+    const ur5_real t48 = s1*t28 + s1*t46 + s1*t47;
+    const ur5_real t49 = t26*t3 + t48;
+    const ur5_real t50 = -t29*t6 + t48;
+    const ur5_real t51 = (t22*t22);
+    const ur5_real t52 = (s1*s1);
+    const ur5_real t53 = t12*t52 + t13*t52 + t14*t52 + t29*t3;
+    const ur5_real t54 = t32*t52 + t35*t52 + t36*t52 + (t29*t29);
+    const ur5_real t55 = t51 + t54;
+    const ur5_real t56 = s1*t9;
+    const ur5_real t57 = s1*t20;
+    const ur5_real t58 = s1*t24;
+    const ur5_real t59 = t10*t29 + t12*t56 + t13*t57 + t14*t58;
+    const ur5_real t60 = t10*t3 + t56 + t57 + t58;
+    const ur5_real t61 = (t24*t24);
+    const ur5_real t62 = (t10*t10);
+    const ur5_real t63 = t61 + t62 + (t20*t20) + (t9*t9);
+    const ur5_real t64 = t63;
+    const ur5_real t65 = (s234*s234);
+    const ur5_real t66 = t33*t65 + 3*t52 + (t1*t1);
+    const ur5_real t67 = t66;
+    const ur5_real t68 = 3*c1;
+    const ur5_real t69 = s1*t68 + t1*t2 - t39*t65;
+    const ur5_real t70 = 3*t33 + t52*t65 + (t2*t2);
+    const ur5_real t71 = t70;
+    const ur5_real t72 = (c234*c234);
+    const ur5_real t73 = t65*(s5*s5) + t72 + 1;
+    const ur5_real t74 = t73;
+    const ur5_real t75 = (t40*t40);
+    const ur5_real t76 = (t27*t27);
+    const ur5_real t77 = (t44*t44);
+    const ur5_real t78 = (t49*t49);
+    const ur5_real t79 = (t34*t34);
+    const ur5_real t80 = (damping*damping);
+    const ur5_real t81 = t38 + t80;
+    const ur5_real t82 = (t81*t81);
+    const ur5_real t83 = sqrt(t75 + t76 + t77 + t78 + t79 + t82);
+    const ur5_real t84 = t83*(t81 >= 0 ? 1 : -1);
+    const ur5_real t85 = t81 + t84;
+    const ur5_real t86 = (t83 > 0 ? 1/(t83*(t83 + fabs(t81))) : 0);
+    const ur5_real t87 = t86*(mu_dot0*t85 + mu_dot1*t40 + mu_dot2*t44 + mu_dot3*t49 - mu_dot4*t34 - mu_dot5*t27);
+    const ur5_real t88 = mu_dot0 - t85*t87;
+    const ur5_real t89 = mu_dot1 - t40*t87;
+    const ur5_real t90 = mu_dot2 - t44*t87;
+    const ur5_real t91 = mu_dot3 - t49*t87;
+    const ur5_real t92 = mu_dot4 + t34*t87;
+    const ur5_real t93 = mu_dot5 + t27*t87;
+    const ur5_real t94 = t55 + t80;
+    const ur5_real t95 = t86*(-t27*t30 + t34*t50 + t40*t85 + t40*t94 + t44*t59 + t49*t53);
+    const ur5_real t96 = t40 - t85*t95;
+    const ur5_real t97 = -t40*t95 + t94;
+    const ur5_real t98 = -t44*t95 + t59;
+    const ur5_real t99 = -t49*t95 + t53;
+    const ur5_real t100 = t34*t95 - t50;
+    const ur5_real t101 = t27*t95 + t30;
+    const ur5_real t102 = sqrt((t100*t100) + (t101*t101) + (t97*t97) + (t98*t98) + (t99*t99));
+    const ur5_real t103 = t102*(t97 >= 0 ? 1 : -1);
+    const ur5_real t104 = t103 + t97;
+    const ur5_real t105 = (t102 > 0 ? 1/(t102*(t102 + fabs(t97))) : 0);
+    const ur5_real t106 = t105*(t100*t92 + t101*t93 + t104*t89 + t90*t98 + t91*t99);
+    const ur5_real t107 = -t104*t106 + t89;
+    const ur5_real t108 = -t106*t98 + t90;
+    const ur5_real t109 = -t106*t99 + t91;
+    const ur5_real t110 = -t100*t106 + t92;
+    const ur5_real t111 = -t101*t106 + t93;
+    const ur5_real t112 = t64 + t80;
+    const ur5_real t113 = t67 + t80;
+    const ur5_real t114 = t86*(t113*t49 + t15*t27 + t34*t69 + t40*t53 + t44*t60 + t49*t85);
+    const ur5_real t115 = -t114*t85 + t49;
+    const ur5_real t116 = -t114*t40 + t53;
+    const ur5_real t117 = -t114*t44 + t60;
+    const ur5_real t118 = t113 - t114*t49;
+    const ur5_real t119 = t114*t34 - t69;
+    const ur5_real t120 = t114*t27 - t15;
+    const ur5_real t121 = t105*(t100*t119 + t101*t120 + t104*t116 + t117*t98 + t118*t99);
+    const ur5_real t122 = -t104*t121 + t116;
+    const ur5_real t123 = t117 - t121*t98;
+    const ur5_real t124 = t118 - t121*t99;
+    const ur5_real t125 = -t100*t121 + t119;
+    const ur5_real t126 = -t101*t121 + t120;
+    const ur5_real t127 = t71 + t80;
+    const ur5_real t128 = -t86*(t127*t34 + t16*t27 + t34*t85 + t40*t50 + t44*t45 + t49*t69);
+    const ur5_real t129 = t128*t85 + t34;
+    const ur5_real t130 = t128*t40 + t50;
+    const ur5_real t131 = t128*t44 + t45;
+    const ur5_real t132 = t128*t49 + t69;
+    const ur5_real t133 = t127 + t128*t34;
+    const ur5_real t134 = t128*t27 + t16;
+    const ur5_real t135 = -t105*(-t100*t133 - t101*t134 + t104*t130 + t131*t98 + t132*t99);
+    const ur5_real t136 = t104*t135 + t130;
+    const ur5_real t137 = t131 + t135*t98;
+    const ur5_real t138 = t132 + t135*t99;
+    const ur5_real t139 = -t100*t135 + t133;
+    const ur5_real t140 = -t101*t135 + t134;
+    const ur5_real t141 = t74 + t80;
+    const ur5_real t142 = sqrt(2*t62*t72 + 2*t75 + 2*t76 + 2*t77 + 2*t78 + 2*t79 + t82 + (t112*t112) + (t113*t113) + (t127*t127) + (t141*t141) + 2*(t15*t15) + 2*(t16*t16) + 2*(t30*t30) + 2*(t45*t45) + 2*(t50*t50) + 2*(t53*t53) + 2*(t59*t59) + 2*(t60*t60) + 2*(t69*t69) + (t94*t94));
+    const ur5_real t143 = c234*t10;
+    const ur5_real t144 = t86*(t112*t44 + t143*t27 + t34*t45 + t40*t59 + t44*t85 + t49*t60);
+    const ur5_real t145 = -t144*t85 + t44;
+    const ur5_real t146 = -t144*t40 + t59;
+    const ur5_real t147 = t112 - t144*t44;
+    const ur5_real t148 = -t144*t49 + t60;
+    const ur5_real t149 = t144*t34 - t45;
+    const ur5_real t150 = -t143 + t144*t27;
+    const ur5_real t151 = -t86*(t141*t27 + t143*t44 + t15*t49 + t16*t34 + t27*t85 - t30*t40);
+    const ur5_real t152 = t151*t85 + t27;
+    const ur5_real t153 = -t151*t40 + t30;
+    const ur5_real t154 = t143 + t151*t44;
+    const ur5_real t155 = t15 + t151*t49;
+    const ur5_real t156 = t151*t34 + t16;
+    const ur5_real t157 = t141 + t151*t27;
+    const ur5_real t158 = t105*(t100*t149 + t101*t150 + t104*t146 + t147*t98 + t148*t99);
+    const ur5_real t159 = -t104*t158 + t146;
+    const ur5_real t160 = t147 - t158*t98;
+    const ur5_real t161 = t148 - t158*t99;
+    const ur5_real t162 = -t100*t158 + t149;
+    const ur5_real t163 = -t101*t158 + t150;
+    const ur5_real t164 = t105*(t100*t156 + t101*t157 + t104*t153 - t154*t98 - t155*t99);
+    const ur5_real t165 = -t104*t164 + t153;
+    const ur5_real t166 = t154 + t164*t98;
+    const ur5_real t167 = t155 + t164*t99;
+    const ur5_real t168 = -t100*t164 + t156;
+    const ur5_real t169 = -t101*t164 + t157;
+    const ur5_real t170 = sqrt((t160*t160) + (t161*t161) + (t162*t162) + (t163*t163));
+    const ur5_real t171 = t170*(t160 >= 0 ? 1 : -1);
+    const ur5_real t172 = t160 + t171;
+    const ur5_real t173 = (t170 > 0 ? 1/(t170*(t170 + fabs(t160))) : 0);
+    const ur5_real t174 = t173*(t123*t172 + t124*t161 + t125*t162 + t126*t163);
+    const ur5_real t175 = t123 - t172*t174;
+    const ur5_real t176 = t124 - t161*t174;
+    const ur5_real t177 = t125 - t162*t174;
+    const ur5_real t178 = t126 - t163*t174;
+    const ur5_real t179 = t173*(-t137*t172 - t138*t161 + t139*t162 + t140*t163);
+    const ur5_real t180 = t137 + t172*t179;
+    const ur5_real t181 = t138 + t161*t179;
+    const ur5_real t182 = t139 - t162*t179;
+    const ur5_real t183 = t140 - t163*t179;
+    const ur5_real t184 = t173*(-t161*t167 + t162*t168 + t163*t169 - t166*t172);
+    const ur5_real t185 = t166 + t172*t184;
+    const ur5_real t186 = t161*t184 + t167;
+    const ur5_real t187 = -t162*t184 + t168;
+    const ur5_real t188 = -t163*t184 + t169;
+    const ur5_real t189 = t173*(t108*t172 + t109*t161 + t110*t162 + t111*t163);
+    const ur5_real t190 = t108 - t172*t189;
+    const ur5_real t191 = t109 - t161*t189;
+    const ur5_real t192 = t110 - t162*t189;
+    const ur5_real t193 = t111 - t163*t189;
+    const ur5_real t194 = sqrt((t176*t176) + (t177*t177) + (t178*t178));
+    const ur5_real t195 = t194*(t176 >= 0 ? 1 : -1);
+    const ur5_real t196 = t176 + t195;
+    const ur5_real t197 = (t194 > 0 ? 1/(t194*(t194 + fabs(t176))) : 0);
+    const ur5_real t198 = t197*(t177*t182 + t178*t183 - t181*t196);
+    const ur5_real t199 = t181 + t196*t198;
+    const ur5_real t200 = -t177*t198 + t182;
+    const ur5_real t201 = -t178*t198 + t183;
+    const ur5_real t202 = t197*(t177*t187 + t178*t188 - t186*t196);
+    const ur5_real t203 = t186 + t196*t202;
+    const ur5_real t204 = -t177*t202 + t187;
+    const ur5_real t205 = -t178*t202 + t188;
+    const ur5_real t206 = t197*(t177*t192 + t178*t193 + t191*t196);
+    const ur5_real t207 = t191 - t196*t206;
+    const ur5_real t208 = -t177*t206 + t192;
+    const ur5_real t209 = -t178*t206 + t193;
+    const ur5_real t210 = sqrt((t200*t200) + (t201*t201));
+    const ur5_real t211 = t210*(t200 >= 0 ? 1 : -1);
+    const ur5_real t212 = t200 + t211;
+    const ur5_real t213 = (t210 > 0 ? 1/(t210*(t210 + fabs(t200))) : 0);
+    const ur5_real t214 = t213*(t201*t205 + t204*t212);
+    const ur5_real t215 = t204 - t212*t214;
+    const ur5_real t216 = -t201*t214 + t205;
+    const ur5_real t217 = t213*(t201*t209 + t208*t212);
+    const ur5_real t218 = t208 - t212*t217;
+    const ur5_real t219 = -t201*t217 + t209;
+    const ur5_real t220 = fabs(t216);
+    const ur5_real t221 = t220;
+    const ur5_real t222 = t221*(t216 >= 0 ? 1 : -1);
+    const ur5_real t223 = t216 + t222;
+    const ur5_real t224 = (t221 > 0 ? 1/(t221*(t220 + t221)) : 0);
+    const ur5_real t225 = -t219*t224*(t223*t223) + t219;
+    const ur5_real t226 = t225/t222;
+    const ur5_real t227 = (t215*t226 + t218)/t211;
+    const ur5_real t228 = (-t199*t227 - t203*t226 + t207)/t195;
+    const ur5_real t229 = (t175*t228 - t180*t227 - t185*t226 + t190)/t171;
+    const ur5_real t230 = (t107 + t122*t228 - t136*t227 + t159*t229 + t165*t226)/t103;
+    const ur5_real t231 = (t115*t228 - t129*t227 + t145*t229 - t152*t226 + t230*t96 + t88)/t84;
+    const ur5_real t232 = t22*t230 + t226 - t23*t231;
+    const ur5_real t233 = -c234*t226 + t10*t229 + t227*t6 + t228*t3 + t230*t29 + t231*t26;
+    const ur5_real t234 = -t1*t228 + t11*t226 + t2*t227;
+    const ur5_real t235 = s1*t14;
+    const ur5_real t236 = -c1*t227 + s1*t228;
+    const ur5_real t237 = t229*t24 + t230*t235 + t231*t47 + t236;
+    const ur5_real t238 = t229*t9 + t230*t25 + t231*t28 + t236;
+    const ur5_real t239 = s1*t13;
+    const ur5_real t240 = t20*t229 + t230*t239 + t231*t46 + t236;
+    const ur5_real t241 = t31 + t51;
+    const ur5_real t242 = sqrt(t241 + t37 + t54 + t63 + t66 + t70 + t73);
+    const ur5_real t243 = sqrt(t241 + 1);
+    const ur5_real t244 = t243*(t23 <= 0 ? 1 : -1);
+    const ur5_real t245 = (t243 > 0 ? 1/(t243*(t243 + fabs(t23))) : 0);
+    const ur5_real t246 = -t23;
+    const ur5_real t247 = t244 + t246;
+    const ur5_real t248 = t245*(t22*t235 + t247*t47);
+    const ur5_real t249 = -t247*t248 + t47;
+    const ur5_real t250 = -t22*t248 + t235;
+    const ur5_real t251 = t245*(t22*t239 + t247*t46);
+    const ur5_real t252 = -t247*t251 + t46;
+    const ur5_real t253 = -t22*t251 + t239;
+    const ur5_real t254 = t245*(t22*t25 + t247*t28);
+    const ur5_real t255 = -t247*t254 + t28;
+    const ur5_real t256 = -t22*t254 + t25;
+    const ur5_real t257 = t245*(mu_dot0*t247 + mu_dot1*t22 + mu_dot5);
+    const ur5_real t258 = mu_dot0 - t247*t257;
+    const ur5_real t259 = mu_dot1 - t22*t257;
+    const ur5_real t260 = mu_dot5 - t257;
+    const ur5_real t261 = -c234;
+    const ur5_real t262 = t245*(t22*t29 + t247*t26 + t261);
+    const ur5_real t263 = -t247*t262 + t26;
+    const ur5_real t264 = -t22*t262 + t29;
+    const ur5_real t265 = c234 + t262;
+    const ur5_real t266 = -t11;
+    const ur5_real t267 = t11*t245;
+    const ur5_real t268 = t266 + t267;
+    const ur5_real t269 = t33 + t52;
+    const ur5_real t270 = sqrt(t269 + t61 + (t248*t248) + (t250*t250));
+    const ur5_real t271 = t270*(t250 >= 0 ? 1 : -1);
+    const ur5_real t272 = t250 + t271;
+    const ur5_real t273 = (t270 > 0 ? 1/(t270*(t270 + fabs(t250))) : 0);
+    const ur5_real t274 = t273*(t20*t24 + t248*t251 + t253*t272 + t269);
+    const ur5_real t275 = t253 - t272*t274;
+    const ur5_real t276 = t20 - t24*t274;
+    const ur5_real t277 = -s1*t274 + s1;
+    const ur5_real t278 = t248*t274 - t251;
+    const ur5_real t279 = t273*(t24*t9 + t248*t254 + t256*t272 + t269);
+    const ur5_real t280 = t256 - t272*t279;
+    const ur5_real t281 = -t24*t279 + t9;
+    const ur5_real t282 = -s1*t279 + s1;
+    const ur5_real t283 = t248*t279 - t254;
+    const ur5_real t284 = t273*(t10*t24 + t248*t265 + t264*t272);
+    const ur5_real t285 = t264 - t272*t284;
+    const ur5_real t286 = t10 - t24*t284;
+    const ur5_real t287 = -s1*t284 + t3;
+    const ur5_real t288 = c1*t284 + t6;
+    const ur5_real t289 = t248*t284 - t265;
+    const ur5_real t290 = t273*(-c1*mu_dot4 + mu_dot2*t24 + mu_dot3*s1 - t248*t260 + t259*t272);
+    const ur5_real t291 = t259 - t272*t290;
+    const ur5_real t292 = mu_dot2 - t24*t290;
+    const ur5_real t293 = mu_dot3 - s1*t290;
+    const ur5_real t294 = c1*t290 + mu_dot4;
+    const ur5_real t295 = t248*t290 + t260;
+    const ur5_real t296 = -c1;
+    const ur5_real t297 = c1*t274 + t296;
+    const ur5_real t298 = c1*t279 + t296;
+    const ur5_real t299 = sqrt((t276*t276) + (t277*t277) + (t278*t278) + (t297*t297));
+    const ur5_real t300 = t299*(t276 >= 0 ? 1 : -1);
+    const ur5_real t301 = t276 + t300;
+    const ur5_real t302 = (t299 > 0 ? 1/(t299*(t299 + fabs(t276))) : 0);
+    const ur5_real t303 = t302*(t277*t282 + t278*t283 + t281*t301 + t297*t298);
+    const ur5_real t304 = t281 - t301*t303;
+    const ur5_real t305 = -t277*t303 + t282;
+    const ur5_real t306 = -t297*t303 + t298;
+    const ur5_real t307 = -t278*t303 + t283;
+    const ur5_real t308 = t302*(t277*t287 + t278*t289 + t286*t301 + t288*t297);
+    const ur5_real t309 = t286 - t301*t308;
+    const ur5_real t310 = -t277*t308 + t287;
+    const ur5_real t311 = t288 - t297*t308;
+    const ur5_real t312 = -t278*t308 + t289;
+    const ur5_real t313 = t302*(t277*t293 + t278*t295 + t292*t301 + t294*t297);
+    const ur5_real t314 = t292 - t301*t313;
+    const ur5_real t315 = -t277*t313 + t293;
+    const ur5_real t316 = t294 - t297*t313;
+    const ur5_real t317 = -t278*t313 + t295;
+    const ur5_real t318 = sqrt((t305*t305) + (t306*t306) + (t307*t307));
+    const ur5_real t319 = t318*(t305 >= 0 ? 1 : -1);
+    const ur5_real t320 = t305 + t319;
+    const ur5_real t321 = (t318 > 0 ? 1/(t318*(t318 + fabs(t305))) : 0);
+    const ur5_real t322 = t321*(t306*t311 + t307*t312 + t310*t320);
+    const ur5_real t323 = t310 - t320*t322;
+    const ur5_real t324 = -t306*t322 + t311;
+    const ur5_real t325 = -t307*t322 + t312;
+    const ur5_real t326 = t321*(t306*t316 + t307*t317 + t315*t320);
+    const ur5_real t327 = t315 - t320*t326;
+    const ur5_real t328 = -t306*t326 + t316;
+    const ur5_real t329 = -t307*t326 + t317;
+    const ur5_real t330 = sqrt((t324*t324) + (t325*t325));
+    const ur5_real t331 = t330*(t324 >= 0 ? 1 : -1);
+    const ur5_real t332 = t324 + t331;
+    const ur5_real t333 = (t330 > 0 ? 1/(t330*(t330 + fabs(t324))) : 0);
+    const ur5_real t334 = t333*(t325*t329 + t328*t332);
+    const ur5_real t335 = t328 - t332*t334;
+    const ur5_real t336 = -t325*t334 + t329;
+    const ur5_real t337 = t22*t267;
+    const ur5_real t338 = t273*(c1*t2 + s1*t1 - t248*t268 + t272*t337);
+    const ur5_real t339 = -t272*t338 + t337;
+    const ur5_real t340 = -s1*t338 + t1;
+    const ur5_real t341 = t248*t338 + t268;
+    const ur5_real t342 = -t2;
+    const ur5_real t343 = c1*t338 + t342;
+    const ur5_real t344 = damping + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + q1 + q2 + q3 + q4 + q5 + q6 + 3*s1 + t1 + t10 + t20 + t22 + t235 + t239 + t24 + t246 + t25 + t26 + t261 + t266 + t28 + t29 + t3 + t342 + t46 + t47 + t6 - t68 + t9 + 1;
+    const ur5_real t345 = t24*t338;
+    const ur5_real t346 = t302*(t277*t340 + t278*t341 + t297*t343 - t301*t345);
+    const ur5_real t347 = t301*t346 + t345;
+    const ur5_real t348 = -t277*t346 + t340;
+    const ur5_real t349 = -t297*t346 + t343;
+    const ur5_real t350 = -t278*t346 + t341;
+    const ur5_real t351 = t321*(t306*t349 + t307*t350 + t320*t348);
+    const ur5_real t352 = -t320*t351 + t348;
+    const ur5_real t353 = -t306*t351 + t349;
+    const ur5_real t354 = -t307*t351 + t350;
+    const ur5_real t355 = t333*(t325*t354 + t332*t353);
+    const ur5_real t356 = -t332*t355 + t353;
+    const ur5_real t357 = -t325*t355 + t354;
+    const ur5_real t358 = fabs(t357);
+    const ur5_real t359 = t358;
+    const ur5_real t360 = t359*(t357 >= 0 ? 1 : -1);
+    const ur5_real t361 = t357 + t360;
+    const ur5_real t362 = (t359 > 0 ? 1/(t359*(t358 + t359)) : 0);
+    const ur5_real t363 = -t336*t362*(t361*t361) + t336;
+    const ur5_real t364 = t363/t360;
+    const ur5_real t365 = (t335 + t356*t364)/t331;
+    const ur5_real t366 = (t323*t365 + t327 + t352*t364)/t319;
+    const ur5_real t367 = (t304*t366 + t309*t365 + t314 - t347*t364)/t300;
+    const ur5_real t368 = (t275*t367 + t280*t366 + t285*t365 + t291 + t339*t364)/t271;
+    const ur5_real t369 = (t247*t267*t364 + t249*t368 + t252*t367 + t255*t366 + t258 + t263*t365)/t244;
+    const int t370 = damping > 0;
+    const int t371 = isfinite(t344);
+    const int t372 = damping >= 0;
+    const ur5_real t373 = 1e-12*t242;
+    const ur5_real t374 = 1e-12*t142;
+    const int t375 = (t370 && ((t102 <= t374) || (t170 <= t374) || (t194 <= t374) || (t210 <= t374) || (t221 <= t374) || (t83 <= t374))) || (damping <= 0 && ((t243 <= t373) || (t270 <= t373) || (t299 <= t373) || (t318 <= t373) || (t330 <= t373) || (t359 <= t373)));
+    const int t376 = t371 && t372 && !t375;
+
+    /* Outputs */
+    q_dot[0] = (t376 ? (t370 ? -t232 : -t369) : 0);
+    q_dot[1] = (t376 ? (t370 ? -t237 : -t368) : 0);
+    q_dot[2] = (t376 ? (t370 ? -t240 : -t367) : 0);
+    q_dot[3] = (t376 ? (t370 ? -t238 : -t366) : 0);
+    q_dot[4] = (t376 ? (t370 ? -t233 : -t365) : 0);
+    q_dot[5] = (t376 ? (t370 ? t234 : -t364) : 0);
+    return (!(t371 && t372) ? 2 : (t375 ? 1 : 0));
+}
+
 void ur5_ik_branches(const ur5_real T[16], ur5_real q[UR5_MAX_IK_SOLUTIONS * UR5_DOF], int valid[UR5_MAX_IK_SOLUTIONS])
 {
     /* 843 operations */
@@ -1075,103 +1496,6 @@ void ur5_ik_branches(const ur5_real T[16], ur5_real q[UR5_MAX_IK_SOLUTIONS * UR5
     valid[5] = t312 && t317 && t320 && t324 && t325 && t227 > 1e-12;
     valid[6] = t312 && t314 && t317 && t324 && t326 && ((t320 && t251 >= t315) || (t321 && t250 <= t322));
     valid[7] = t312 && t314 && t317 && t320 && t324 && t326 && t251 > 1e-12;
-}
-
-int ur5_velocity_ik(const ur5_real q[UR5_DOF], const ur5_real mu_dot[UR5_TASK_DIM], ur5_real damping, ur5_real q_dot[UR5_DOF])
-{
-    /* Rows of jacobian() forming Js (the geometric Jacobian). */
-    static const int rows[UR5_TASK_DIM] = {0, 1, 2, 3, 4, 5};
-    ur5_real J[6 * UR5_DOF];
-    ur5_real A[6 * 6];
-    ur5_real x[6];
-    ur5_real scale = 0;
-    const int normal = damping > 0; /* damped: solve (Js Js^T + damping^2 I) x = mu_dot */
-    int r, c, k;
-
-    for (c = 0; c < UR5_DOF; ++c) {
-        q_dot[c] = 0;
-        if (!isfinite(q[c])) {
-            return UR5_VELOCITY_IK_NOT_FINITE;
-        }
-    }
-    for (r = 0; r < UR5_TASK_DIM; ++r) {
-        if (!isfinite(mu_dot[r])) {
-            return UR5_VELOCITY_IK_NOT_FINITE;
-        }
-        x[r] = mu_dot[r]; /* b; copied here, not in a loop of its own (which becomes memcpy) */
-    }
-    if (!(damping >= 0) || !isfinite(damping)) {
-        return UR5_VELOCITY_IK_NOT_FINITE;
-    }
-    ur5_jacobian(q, J);
-
-    /* The system A x = b (6 x 6), b in x. */
-    for (r = 0; r < 6; ++r) {
-        for (c = 0; c < 6; ++c) {
-            ur5_real sum = r == c ? damping * damping : 0;
-            if (!normal) {
-                sum = J[rows[r] * UR5_DOF + c];
-            }
-            for (k = 0; normal && k < UR5_DOF; ++k) {
-                sum += J[rows[r] * UR5_DOF + k] * J[rows[c] * UR5_DOF + k];
-            }
-            A[r * 6 + c] = sum;
-            if (!isfinite(sum)) {
-                return UR5_VELOCITY_IK_NOT_FINITE;
-            }
-            if (fabs(sum) > scale) {
-                scale = fabs(sum);
-            }
-        }
-    }
-
-    /* LU with partial pivoting, applied to x as it goes. */
-    for (k = 0; k < 6; ++k) {
-        int pivot = k;
-        for (r = k + 1; r < 6; ++r) {
-            if (fabs(A[r * 6 + k]) > fabs(A[pivot * 6 + k])) {
-                pivot = r;
-            }
-        }
-        if (!(fabs(A[pivot * 6 + k]) > 1e-12 * scale)) {
-            return UR5_VELOCITY_IK_SINGULAR;
-        }
-        if (pivot != k) {
-            ur5_real swap;
-            for (c = k; c < 6; ++c) {
-                swap = A[k * 6 + c];
-                A[k * 6 + c] = A[pivot * 6 + c];
-                A[pivot * 6 + c] = swap;
-            }
-            swap = x[k];
-            x[k] = x[pivot];
-            x[pivot] = swap;
-        }
-        for (r = k + 1; r < 6; ++r) {
-            const ur5_real factor = A[r * 6 + k] / A[k * 6 + k];
-            for (c = k + 1; c < 6; ++c) {
-                A[r * 6 + c] -= factor * A[k * 6 + c];
-            }
-            x[r] -= factor * x[k];
-        }
-    }
-    for (k = 6 - 1; k >= 0; --k) {
-        for (c = k + 1; c < 6; ++c) {
-            x[k] -= A[k * 6 + c] * x[c];
-        }
-        x[k] /= A[k * 6 + k];
-        if (!normal) {
-            q_dot[k] = x[k];
-        }
-    }
-
-    /* q_dot = Js^T x when damped (else x, written above) */
-    for (c = 0; normal && c < UR5_DOF; ++c) {
-        for (r = 0; r < UR5_TASK_DIM; ++r) {
-            q_dot[c] += J[rows[r] * UR5_DOF + c] * x[r];
-        }
-    }
-    return UR5_VELOCITY_IK_OK;
 }
 
 int ur5_ik(const ur5_real T[16], ur5_real q[UR5_MAX_IK_SOLUTIONS * UR5_DOF])

@@ -70,22 +70,21 @@ ur5_real ur5_manipulability(const ur5_real q[UR5_DOF]);
  * Result: returned as a scalar. 28 operations. */
 ur5_real ur5_jacobian_det(const ur5_real q[UR5_DOF]);
 
+/* Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status.
+ * Result: q_dot[i], i < 6; returned as a scalar. 1288 operations. */
+int ur5_velocity_ik(const ur5_real q[UR5_DOF], const ur5_real mu_dot[UR5_TASK_DIM], ur5_real damping, ur5_real q_dot[UR5_DOF]);
+
 /* Every branch of the closed-form ik and whether the target allows it.
  * Result: q: 8 x 6 row-major, element (r, c) at q[r * 6 + c]; valid[i], i < 8. 843 operations. */
 void ur5_ik_branches(const ur5_real T[16], ur5_real q[UR5_MAX_IK_SOLUTIONS * UR5_DOF], int valid[UR5_MAX_IK_SOLUTIONS]);
 
-/* Status of ur5_velocity_ik. */
+/* Statuses of ur5_velocity_ik: OK, singular (a diagonal entry of the QR factor R of the
+ * 6 x 6 system at most 1e-12 times its Frobenius norm: take damping > 0), or
+ * not finite (q, mu_dot, damping or Js not finite, or damping < 0); q_dot is 0 unless OK.
+ * Js is the geometric Jacobian; mu_dot is (vx, vy, vz, wx, wy, wz): components of the tool's linear (v) and angular (w) velocity in the world frame. */
 #define UR5_VELOCITY_IK_OK 0
-#define UR5_VELOCITY_IK_SINGULAR 1   /* a pivot below 1e-12 x the largest |entry|: take damping > 0 */
-#define UR5_VELOCITY_IK_NOT_FINITE 2 /* q, mu_dot, damping (must be >= 0) or Js not finite */
-
-/* Joint rates q_dot[UR5_DOF] solving Js q_dot = mu_dot.
- * Js is the geometric Jacobian; mu_dot[UR5_TASK_DIM] is (vx, vy, vz, wx, wy, wz): components of the tool's linear (v) and angular (w) velocity in the world frame.
- * damping = 0: q_dot = Js^-1 mu_dot; damping > 0 (damped least squares near singularities):
- * q_dot = Js^T (Js Js^T + damping^2 I)^-1 mu_dot.
- * LU with partial pivoting of the 6 x 6 system on the stack. Returns
- * UR5_VELOCITY_IK_OK, or a status above with q_dot all 0. */
-int ur5_velocity_ik(const ur5_real q[UR5_DOF], const ur5_real mu_dot[UR5_TASK_DIM], ur5_real damping, ur5_real q_dot[UR5_DOF]);
+#define UR5_VELOCITY_IK_SINGULAR 1
+#define UR5_VELOCITY_IK_NOT_FINITE 2
 
 /* Closed-form inverse kinematics: every joint solution that reaches the target; returns
  * their count k and writes solution i to q[i * UR5_DOF + j], i < k: the valid

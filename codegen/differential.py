@@ -1,0 +1,71 @@
+"""Inverse differential kinematics as expressions: the fixed-size solve of velocity_ik.
+
+Written once and printed for every backend like fk. The k x k system (k = min(m, n)) is
+solved by Householder QR, which is backward stable without pivoting, so the code has no
+branch: a zero column is a select, not an `if`. The system counts as singular when a
+diagonal entry of R is at most RANK times the Frobenius norm of the system (R's smallest
+diagonal entry bounds its smallest singular value from above), or when an input is not
+finite; then q_dot is 0.
+"""
+
+from typing import Callable
+
+import sympy
+
+from .subproblems import RANK, IsFinite, select
+
+# Statuses of velocity_ik, the same in every backend.
+VELOCITY_IK_OK, VELOCITY_IK_SINGULAR, VELOCITY_IK_NOT_FINITE = 0, 1, 2
+
+
+def householder_solve(A: list[list[sympy.Expr]], b: list[sympy.Expr], name: Callable) -> tuple[list, sympy.Basic]:
+    """x with A x = b, and whether A is numerically singular (see the module's rule)."""
+    k = len(A)
+    scale = name(sympy.sqrt(sympy.Add(*(e**2 for row in A for e in row))))  # |A|_F, kept by the reflections
+    A, b = [list(row) for row in A], list(b)
+    norms = []
+    for j in range(k):
+        column = [A[i][j] for i in range(j, k)]
+        norm = name(sympy.sqrt(sympy.Add(*(c**2 for c in column))))
+        alpha = name(-select(column[0] >= 0, 1, -1) * norm)  # R[j][j]; the sign avoids cancellation
+        v = [name(column[0] - alpha)] + column[1:]
+        beta = name(select(norm > 0, 1 / (norm * (norm + sympy.Abs(column[0]))), 0))  # 2 / |v|^2
+        for c in range(j + 1, k):
+            s = name(beta * sympy.Add(*(v[i - j] * A[i][c] for i in range(j, k))))
+            for i in range(j, k):
+                A[i][c] = name(A[i][c] - s * v[i - j])
+        s = name(beta * sympy.Add(*(v[i - j] * b[i] for i in range(j, k))))
+        for i in range(j, k):
+            b[i] = name(b[i] - s * v[i - j])
+        A[j][j] = alpha
+        norms.append(norm)
+    x = [sympy.Integer(0)] * k
+    for j in reversed(range(k)):
+        x[j] = name((b[j] - sympy.Add(*(A[j][c] * x[c] for c in range(j + 1, k)))) / A[j][j])
+    return x, sympy.Or(*(norm <= RANK * scale for norm in norms))
+
+
+def velocity_ik(js: sympy.Matrix, q: list, mu_dot: list, damping: sympy.Symbol,
+                name: Callable) -> tuple[list, sympy.Expr]:
+    """q_dot solving Js q_dot = mu_dot (Js at q) and the status.
+
+    m = n: Js^-1 mu_dot for damping 0, else Js^T (Js Js^T + damping^2 I)^-1 mu_dot (both
+    computed, one selected); m < n: Js^T (Js Js^T + damping^2 I)^-1 mu_dot; m > n:
+    (Js^T Js + damping^2 I)^-1 Js^T mu_dot."""
+    m, n = js.shape
+    js = js.applyfunc(name)
+    k = min(m, n)
+    gram = (js * js.T if m <= n else js.T * js).applyfunc(name) + damping**2 * sympy.eye(k)
+    rhs = list(mu_dot) if m <= n else [name(e) for e in js.T * sympy.Matrix(mu_dot)]
+    x, singular = householder_solve(gram.tolist(), rhs, name)
+    q_dot = [name(e) for e in js.T * sympy.Matrix(x)] if m <= n else x
+    if m == n:
+        direct, direct_singular = householder_solve(js.tolist(), list(mu_dot), name)
+        damped = damping > 0
+        q_dot = [select(damped, a, b) for a, b in zip(q_dot, direct)]
+        singular = sympy.Or(sympy.And(damped, singular), sympy.And(sympy.Not(damped), direct_singular))
+    inputs = [*q, *mu_dot, damping, *(e for e in js)]
+    finite = sympy.And(IsFinite(name(sympy.Add(*inputs))), damping >= 0)
+    status = select(sympy.Not(finite), VELOCITY_IK_NOT_FINITE, select(singular, VELOCITY_IK_SINGULAR, VELOCITY_IK_OK))
+    ok = sympy.And(finite, sympy.Not(singular))
+    return [select(ok, e, 0) for e in q_dot], status
