@@ -1,13 +1,12 @@
 """The data each template receives: a plain, sorted dict per language, decided here so
 that templates only lay text out."""
 
-import math
 
 import sympy
 
 from . import analysis, differential, ik, report
 from .functions import Function, Generator, Output, is_boolean
-from .printers import CasadiPrinter, CPrinter, PythonPrinter, fold_constants
+from .printers import CasadiPrinter, CPrinter, PythonPrinter
 from .robot import Robot
 from .subproblems import RANK, TOLERANCES
 
@@ -22,6 +21,8 @@ C_EXTENTS = {
     "ik_branches.valid": ("MAX_IK_SOLUTIONS",),
     "mu_dot": ("TASK_DIM",),
     "velocity_ik.q_dot": ("DOF",),
+    "ik_numeric_step.q_start": ("DOF",),
+    "ik_numeric_step.q_next": ("DOF",),
     "fk": (16,),
     "jacobian": (6, "DOF"),
     "jacobian_tool": (6, "DOF"),
@@ -97,7 +98,7 @@ def _c_macros(robot: Robot, functions: list[Function]) -> dict[str, int]:
 
 def _c_extent(key: str, size: int, macros: dict[str, int], prefix: str) -> str:
     """`6 * NAME_DOF`: the contract's extent of an array, checked against its size."""
-    factors = C_EXTENTS.get(key, (size,))
+    factors = C_EXTENTS.get(key, (16,) if size == 16 else ("TASK_DIM",) if key == "target" else (size,))
     product = 1
     for factor in factors:
         product *= macros[factor] if isinstance(factor, str) else factor
@@ -211,6 +212,8 @@ def _casadi_function(function: Function, robot: Robot, printer: CasadiPrinter) -
     }
 
 
+# CasADi's ik_numeric takes this many steps (a fixed graph; the C and numpy stop when done).
+IK_NUMERIC_ITERATIONS = 100
 # ik_numeric's Levenberg-Marquardt damping (added to the diagonal): start, least, most.
 IK_NUMERIC_DAMPING = {"start": 1e-6, "min": 1e-12, "max": 1e8}
 
@@ -236,7 +239,7 @@ def _ik_context(robot: Robot, generator: Generator, language: str, real: str) ->
 
 
 def _ik_numeric_context(robot: Robot, language: str, real: str) -> dict:
-    """The iterative solver's partial."""
+    """What the loop of ik_numeric declares and documents."""
     pose = len(robot.task) == 6
     m, n = (6 if pose else len(robot.task)), robot.dof
     prefix, real_type = robot.name.upper(), f"{robot.name}_real"
@@ -245,40 +248,24 @@ def _ik_numeric_context(robot: Robot, language: str, real: str) -> dict:
     parameters = [f"const {robot.name}_params *p"] * bool(robot.symbolic_parameters)
     arguments = [target, f"const {real_type} q0[{prefix}_DOF]", "int max_iter", f"{real_type} tol",
                  f"{real_type} q[{prefix}_DOF]"] + parameters
-    limits = [joint.limits or (-math.inf, math.inf) for joint in robot.joints]
     return {
-        "target": "pose" if pose else "task",
-        "target_shape": "(4, 4)" if pose else f"({m},)",
-        "target_size": 12 if pose else f"{prefix}_TASK_DIM",
         "target_text": "the 4x4 tool pose in the world frame" if pose
         else f"the task vector ({', '.join(robot.task)})",
         "error_text": "position error and rotation vector of R_target R^T, world frame" if pose
         else "target - mu(q), angles wrapped into (-pi, pi]",
         "jacobian": "the geometric Jacobian" if pose else "the task Jacobian",
-        "m": m,
-        "k": min(m, n),
-        "rows_first": m <= n,
         "step_text": "q += J^T (J J^T + damping I)^-1 e" if m <= n else "q += (J^T J + damping I)^-1 J^T e",
-        "angles": [] if pose else [i for i, name in enumerate(robot.task) if name in ("roll", "pitch", "yaw")],
-        "lower": "[" + ", ".join("-numpy.inf" if math.isinf(low) else repr(low) for low, _ in limits) + "]",
-        "upper": "[" + ", ".join("numpy.inf" if math.isinf(high) else repr(high) for _, high in limits) + "]",
-        "clamps": [(j, number(sympy.Float(low)), number(sympy.Float(high)))
-                   for j, (low, high) in enumerate(limits) if not math.isinf(low)],
         "damping": {key: number(sympy.Float(value)) for key, value in IK_NUMERIC_DAMPING.items()},
+        "tenth": number(sympy.Float(0.1)),
+        "iterations": IK_NUMERIC_ITERATIONS,
+        "numpy": {"where": "numpy.where", "logical_and": "numpy.logical_and", "maximum": "numpy.maximum",
+                  "finite": "(cost >= 0.0) & (max_iter >= 0)", "iterations": "max(max_iter, 0)",
+                  "widen": "[..., None]", "q0": "numpy.asarray(q0, dtype=float)", "fixed": False},
+        "casadi": {"where": "casadi.if_else", "logical_and": "casadi.logic_and", "maximum": "casadi.fmax",
+                   "finite": "cost >= 0.0", "iterations": "IK_NUMERIC_ITERATIONS",
+                   "widen": "", "q0": "q0", "fixed": True},
+        "ten": number(sympy.Float(10)),
         "signature": ", ".join(arguments),
-        "params_argument": "".join(f", {argument}" for argument in parameters),
-    }
-
-
-def _ik_math(robot: Robot, real: str) -> dict:
-    """What the hand-written C of ik_numeric needs: <math.h> names and literals."""
-    printer = CPrinter(real)
-    suffix = "f" if real == "float" else ""
-    return {
-        "fn": {name: name + suffix for name in ("sqrt", "atan2", "sin", "cos", "fabs")},
-        "literal_suffix": "F" if real == "float" else "",
-        "pi": printer.doprint(fold_constants(sympy.pi)),
-        "two_pi": printer.doprint(fold_constants(2 * sympy.pi)),
     }
 
 
@@ -326,13 +313,11 @@ def template_context(robot: Robot, generator: Generator, language: str, real: st
         context["functions"] = [_python_function(f, printer, context["parameters"]) for f in generator.functions()]
         context["ik"] = _ik_context(robot, generator, language, real)
         context["ik_numeric"] = _ik_numeric_context(robot, language, real)
-        context["ik_math"] = _ik_math(robot, "double")
         context["velocity_ik"] = _velocity_ik_context(robot, "double")
     elif language == "c":
         context.update(_c_context(robot, generator, real))
         context["ik"] = _ik_context(robot, generator, language, real)
         context["ik_numeric"] = _ik_numeric_context(robot, language, real)
-        context["ik_math"] = _ik_math(robot, real)
         context["velocity_ik"] = _velocity_ik_context(robot, real)
     elif language == "report":
         context.update(_report_context(robot, generator))
@@ -341,6 +326,7 @@ def template_context(robot: Robot, generator: Generator, language: str, real: st
         functions = generator.functions()
         context["functions"] = [_casadi_function(f, robot, printer) for f in functions]
         context["arguments"] = sorted({(a.name, a.symbols.rows, a.symbols.cols) for f in functions for a in f.arguments},
-                                      key=lambda a: ("q", "mu_dot", "damping", "T", "mu").index(a[0]))
+                                      key=lambda a: ("q", "mu_dot", "damping", "target", "T", "mu").index(a[0]))
         context["ik"] = generator.closed_form is not None
+        context["ik_numeric"] = _ik_numeric_context(robot, "python", "double")
     return dict(sorted(context.items()))

@@ -69,3 +69,57 @@ def velocity_ik(js: sympy.Matrix, q: list, mu_dot: list, damping: sympy.Symbol,
     status = select(sympy.Not(finite), VELOCITY_IK_NOT_FINITE, select(singular, VELOCITY_IK_SINGULAR, VELOCITY_IK_OK))
     ok = sympy.And(finite, sympy.Not(singular))
     return [select(ok, e, 0) for e in q_dot], status
+
+
+def rotation_vector(E: sympy.Matrix, name: Callable) -> list[sympy.Expr]:
+    """The rotation vector (axis times angle in [0, pi]) of the rotation matrix E.
+
+    Away from a half turn it is v angle / sin(angle), v the axial vector of (E - E^T) / 2;
+    near one (sin(angle) <= 1e-6 with cos(angle) <= 0) v vanishes and the axis is the
+    column of (E + I) / 2 = u u^T with the largest diagonal entry (the first of equals),
+    signed along v. Both are computed; a select takes one."""
+    v = [name((E[2, 1] - E[1, 2]) / 2), name((E[0, 2] - E[2, 0]) / 2), name((E[1, 0] - E[0, 1]) / 2)]
+    cos = name((E[0, 0] + E[1, 1] + E[2, 2] - 1) / 2)
+    sin = name(sympy.sqrt(v[0]**2 + v[1]**2 + v[2]**2))
+    angle = name(sympy.atan2(sin, cos))
+    regular = sympy.Or(sin > sympy.Float(1e-6), cos > 0)
+    scale = name(select(sin > 0, angle / sin, 1))
+    first = [sympy.And(E[0, 0] >= E[1, 1], E[0, 0] >= E[2, 2]), E[1, 1] >= E[2, 2]]
+    column = [name(select(first[0], (E[i, 0] + int(i == 0)) / 2, select(first[1], (E[i, 1] + int(i == 1)) / 2,
+                                                                       (E[i, 2] + int(i == 2)) / 2))) for i in range(3)]
+    length = name(sympy.sqrt(column[0]**2 + column[1]**2 + column[2]**2))
+    sign = name(select(column[0] * v[0] + column[1] * v[1] + column[2] * v[2] >= 0, 1, -1))
+    return [name(select(regular, scale * v[i], sign * angle * column[i] / length)) for i in range(3)]
+
+
+def ik_numeric_step(error: list[sympy.Expr], jacobian: sympy.Matrix, q: list, damping: sympy.Symbol,
+                    limits: list, name: Callable) -> tuple[list, list, sympy.Expr]:
+    """One damped least-squares step on the task error e at q: (clamp(clamp(q) + step), |e|^2),
+    the step J^T (J J^T + damping I)^-1 e (m <= n) or (J^T J + damping I)^-1 J^T e,
+    the joints clamped to `limits` ((low, high), None: none). `error` and `jacobian` are
+    those of clamp(q), which the caller substitutes."""
+    m, n = jacobian.shape
+    jacobian = jacobian.applyfunc(name)
+    error = [name(e) for e in error]
+    if m <= n:
+        gram = (jacobian * jacobian.T).applyfunc(name) + damping * sympy.eye(m)
+        x, _ = householder_solve(gram.tolist(), error, name)
+        step = jacobian.T * sympy.Matrix(x)
+    else:
+        gram = (jacobian.T * jacobian).applyfunc(name) + damping * sympy.eye(n)
+        step, _ = householder_solve(gram.tolist(), [name(e) for e in jacobian.T * sympy.Matrix(error)], name)
+    trial = [clamp(name(qi + si), bounds) for qi, si, bounds in zip(q, step, limits)]
+    return trial, name(sympy.Add(*(e**2 for e in error)))
+
+
+def flagged_cost(cost: sympy.Expr, inputs: list, name: Callable) -> sympy.Expr:
+    """The cost, or -1 when an input is not finite (a clamp would hide an infinite joint)."""
+    return select(IsFinite(name(sympy.Add(*inputs))), cost, -1)
+
+
+def clamp(value: sympy.Expr, bounds) -> sympy.Expr:
+    """value limited to bounds = (low, high), or unchanged for None."""
+    if bounds is None:
+        return value
+    low, high = (sympy.Float(b) for b in bounds)
+    return select(value < low, low, select(value > high, high, value))

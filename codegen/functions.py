@@ -15,10 +15,12 @@ import sympy
 from sympy.core.parameters import distribute
 from sympy.logic.boolalg import Boolean
 
-from . import analysis, budget, differential, ik, kinematics
+from . import analysis, budget, differential, ik, kinematics, subproblems
 from .subproblems import Subproblems
 from .printers import fold_constants
 from .robot import Robot
+
+ANGLES = ("roll", "pitch", "yaw")
 
 
 @dataclass(frozen=True)
@@ -174,7 +176,41 @@ class Generator:
         form += ("Js^T (Js Js^T + damping^2 I)^-1 mu_dot" if m <= n else "(Js^T Js + damping^2 I)^-1 Js^T mu_dot")
         return self.function("velocity_ik", f"joint rates q_dot solving Js q_dot = mu_dot: {form}; and the status",
                              ("q_dot", sympy.Matrix(q_dot)), ("status", sympy.Matrix([status])), vector=True,
-                             status="status", arguments=(Argument("q", sympy.Matrix(self.q)), mu_dot, damping))
+                             integers=("status",), arguments=(Argument("q", sympy.Matrix(self.q)), mu_dot, damping))
+
+    def ik_numeric_step_function(self, task_jacobian: sympy.Matrix) -> Function:
+        """ik_numeric_step: one damped least-squares step of ik_numeric from q (`differential`)."""
+        robot, n = self.robot, self.robot.dof
+        pose = len(robot.task) == 6
+        if pose:
+            target = Argument("target", sympy.Matrix(4, 4, lambda r, c: sympy.Symbol(f"T{r}{c}", real=True)), vector=False)
+        else:
+            target = Argument("target", sympy.Matrix([sympy.Symbol(f"mu{i}", real=True) for i in range(len(robot.task))]))
+        given = Argument("q", sympy.Matrix([sympy.Symbol(f"qs{i + 1}", real=True) for i in range(n)]))
+        damping = Argument("damping", sympy.Matrix([sympy.Symbol("damping", real=True)]), scalar=True)
+        limits = [joint.limits for joint in robot.joints]
+        bindings = {qi: differential.clamp(given_i, bounds) for qi, given_i, bounds in zip(self.q, given.symbols, limits)}
+        with distribute(False):
+            if pose:
+                tool, goal = self.chain.tool, target.symbols
+                rotation = (goal[:3, :3] * tool[:3, :3].T).applyfunc(self.name)
+                error = [goal[i, 3] - tool[i, 3] for i in range(3)] + differential.rotation_vector(rotation, self.name)
+                jacobian = self.jacobian
+            else:
+                mu = kinematics.task_vector(robot, self.chain.tool)
+                error = [subproblems.wrapped(goal - value) if component in ANGLES else goal - value
+                         for goal, value, component in zip(target.symbols, mu, robot.task)]
+                jacobian = task_jacobian
+            trial, cost = differential.ik_numeric_step(error, jacobian, list(self.q), damping.symbols[0], limits,
+                                                       self.name)
+            read = target.symbols[:3, :] if pose else target.symbols
+            cost = differential.flagged_cost(cost, [*given.symbols, *read], self.name)
+        step = "J^T (J J^T + damping I)^-1 e" if jacobian.rows <= n else "(J^T J + damping I)^-1 J^T e"
+        summary = (f"one step of ik_numeric: q clamped to the limits, then q + {step} clamped, and |e|^2 at the "
+                   "clamped q (-1 when target or q is not finite)")
+        return self.function("ik_numeric_step", summary, ("q_start", sympy.Matrix(self.q)),
+                             ("q_next", sympy.Matrix(trial)), ("cost", sympy.Matrix([cost])), vector=True,
+                             scalars=("cost",), arguments=(target, given, damping), bindings=bindings)
 
     @cached_property
     def jacobian(self) -> sympy.Matrix:
@@ -246,18 +282,22 @@ class Generator:
 
     def function(self, name: str, summary: str, *results: tuple[str, sympy.Matrix | list], scalar: bool = False,
                  vector: bool = False, equals: tuple[str, ...] = (),
-                 arguments: tuple[Argument, ...] | None = None, status: str = "") -> Function:
+                 arguments: tuple[Argument, ...] | None = None, scalars: tuple[str, ...] = (),
+                 integers: tuple[str, ...] = (), bindings: dict | None = None) -> Function:
         """A function of one or more named results (matrices, or lists of truth values as
         columns), lowered together so they share their terms; its arguments are q unless
-        given. The result named `status` is an integer scalar."""
+        given. The results named in `scalars` are scalars, those in `integers` integer
+        scalars (statuses); `bindings` define symbols (the joints) from the arguments for
+        this function alone."""
         outputs, values = [], []
         for (output, result), equal in zip(results, equals or ("",) * len(results)):
             rows, cols = result.shape if isinstance(result, sympy.Matrix) else (len(result), 1)
             boolean = all(map(is_boolean, result))
-            integer = output == status
-            outputs.append(Output(output, rows, cols, scalar or integer, vector or boolean, equal, boolean, integer))
+            integer = output in integers
+            outputs.append(Output(output, rows, cols, scalar or integer or output in scalars, vector or boolean, equal,
+                                  boolean, integer))
             values += list(result)
-        return Function(name, summary, tuple(outputs), self.lower(values),
+        return Function(name, summary, tuple(outputs), self.lower(values, bindings or {}),
                         arguments or (Argument("q", sympy.Matrix(self.q)),))
 
     def name(self, value: sympy.Expr) -> sympy.Expr:
@@ -277,11 +317,12 @@ class Generator:
         self._names[value] = symbol
         return symbol
 
-    def lower(self, outputs: list[sympy.Basic]) -> Body:
+    def lower(self, outputs: list[sympy.Basic], bindings: dict | None = None) -> Body:
         """The outputs as straight-line code: the trig symbols and named values they need,
         then temporaries (t0, t1, ...) after common-subexpression elimination, in an order
         that defines before use."""
-        values = dict(self.definitions)
+        bindings = bindings or {}
+        values = dict(self.definitions) | bindings
         needed, frontier = set(), set().union(*(e.free_symbols for e in outputs))
         while frontier:
             symbol = frontier.pop()
@@ -289,12 +330,14 @@ class Generator:
                 needed.add(symbol)
                 frontier |= values[symbol].free_symbols
         named_symbols = set(self._names.values())
-        trig = [(s, fold_constants(v)) for s, v in self.definitions if s in needed and s not in named_symbols]
+        trig = [(s, fold_constants(v)) for s, v in self.definitions
+                if s in needed and s not in named_symbols and s not in bindings]
         named = [(s, v) for s, v in self.definitions if s in needed and s in named_symbols]
         with distribute(False):
             replacements, reduced = sympy.cse([fold_constants(v) for _, v in named] + [fold_constants(e) for e in outputs],
                                               symbols=sympy.numbered_symbols("_r", real=True), order="canonical")
-        definitions = _in_dependency_order(trig + list(zip((s for s, _ in named), reduced)) + replacements)
+        bound = [(s, fold_constants(v)) for s, v in bindings.items() if s in needed]
+        definitions = _in_dependency_order(bound + trig + list(zip((s for s, _ in named), reduced)) + replacements)
         temporaries = sympy.numbered_symbols("t", real=True)
         rename = {symbol: next(temporaries) for symbol, _ in definitions if symbol.name.startswith("_")}
         definitions = tuple((rename.get(s, s), v.xreplace(rename)) for s, v in definitions)
@@ -325,6 +368,7 @@ class Generator:
             self.function("task_jacobian", f"analytic Jacobian d mu / d q ({m} x DOF)", ("J", task_jacobian)),
             *self.singularity_functions(js),
             self.velocity_ik_function(js),
+            self.ik_numeric_step_function(task_jacobian),
             *self.ik_functions(),
         )
 

@@ -76,7 +76,7 @@ GENERATED_NAMES = frozenset("""
 """.split())
 # Temporaries t0.., trig terms c1.. s1.., joint variables q1.., the entries of an ik target
 # T00.. and mu0..; names starting with '_'; <math.h>'s M_PI, FP_NAN...
-_GENERATED_PATTERN = re.compile(r"^(?:[tcsqT]\d+(?:_\d+)*|mu(?:_dot)?\d+|_.*|M_\w+|FP_\w+)$")
+_GENERATED_PATTERN = re.compile(r"^(?:[tcsqT]\d+(?:_\d+)*|mu(?:_dot)?\d+|qs\d+|_.*|M_\w+|FP_\w+)$")
 
 ROBOT_NAME_RULE = ("a robot name may not be a C or Python keyword, a C standard header or a "
                    "Python module name, since it names the generated files and modules")

@@ -323,6 +323,7 @@ def _ik_results(robot: Robot, backends: _Backends, q: np.ndarray, tolerances: di
     numeric = {"python": lambda target, start: backends.python.ik_numeric(target, start, 200, 1e-12, **nominal)}
     numeric.update({f"c {real}": functools.partial(_c_ik_numeric, library, real)
                     for real, library in backends.c.items()})
+    numeric["casadi"] = functools.partial(_casadi_ik_numeric, backends.casadi, nominal)
     errors, converged = {}, {}
     for backend, solve in numeric.items():
         runs = [(solve(target, start), target) for target, start in zip(targets[:count], starts[:count])]
@@ -330,7 +331,7 @@ def _ik_results(robot: Robot, backends: _Backends, q: np.ndarray, tolerances: di
         reached = [_target_error(robot, q_found, target) for (q_found, status), target in runs if status == 0]
         errors[backend] = max(reached, default=0.0)
         converged[backend] = len(reached)
-    results.append(Result(robot.name, "ik_numeric", errors | {"casadi": None}, tolerances,
+    results.append(Result(robot.name, "ik_numeric", errors, tolerances,
                           "error where it reports convergence, from 0.1 away; converged at "
                           + ", ".join(f"{n}/{count} ({backend})" for backend, n in converged.items())))
     return results
@@ -341,6 +342,13 @@ def _casadi_ik(module, nominal: dict, target: np.ndarray) -> np.ndarray:
     extra = [list(module.PARAMETERS.values())] if nominal else []
     q, valid = module.ik(target if target.ndim == 2 else target[:, None], *extra)
     return q.full()[valid.full().ravel() == 1]
+
+
+def _casadi_ik_numeric(module, nominal: dict, target: np.ndarray, start: np.ndarray) -> tuple[np.ndarray, int]:
+    """CasADi's ik_numeric (a fixed number of steps): (q, status)."""
+    extra = [list(module.PARAMETERS.values())] if nominal else []
+    q, status = module.ik_numeric(target if target.ndim == 2 else target[:, None], start, 1e-12, *extra)
+    return q.full().ravel(), int(status)
 
 
 def _c_ik_numeric(library: CLibrary, real: str, target: np.ndarray, start: np.ndarray) -> tuple[np.ndarray, int]:

@@ -62,6 +62,12 @@ def backends(tmp_path_factory):
             "numpy_batch": batch,
             "casadi": casadi,
         }, {
+            "c": library.ik_numeric,
+            "numpy": lambda target, q0, max_iter=100, tol=1e-10: numpy_module.ik_numeric(target, q0, max_iter, tol),
+            "numpy_batch": lambda target, q0, max_iter=100, tol=1e-10: tuple(
+                v[0] for v in numpy_module.ik_numeric(np.asarray(target)[None], np.asarray(q0)[None], max_iter, tol)),
+            "casadi": lambda target, q0, max_iter=100, tol=1e-10: _casadi_numeric(casadi_module, target, q0, tol),
+        }, {
             "c": library.velocity_ik,
             "numpy": lambda q, mu_dot, damping: tuple(np.asarray(v) for v in numpy_module.velocity_ik(q, mu_dot, damping)),
             "numpy_batch": batch_velocity,
@@ -119,7 +125,7 @@ def _regular(arm, q):
 def test_round_trips(backends, name, backend):
     """Random configurations inside the limits: the target of each is reached by every
     solution, and the configuration itself is among them where the arm is regular."""
-    arm, solvers, _ = backends(name)
+    arm, solvers, _, _ = backends(name)
     q = random_configurations(arm, 60, seed=21)
     targets = _targets(arm, q)
     for row, target, solutions in zip(q, targets, solvers[backend](targets)):
@@ -130,7 +136,7 @@ def test_round_trips(backends, name, backend):
 @pytest.mark.parametrize("name", ROBOTS)
 def test_not_finite_and_out_of_reach(backends, name, backend):
     """NaN or inf anywhere in the entries read, or a target beyond reach: no solution."""
-    arm, solvers, _ = backends(name)
+    arm, solvers, _, _ = backends(name)
     target = _targets(arm, random_configurations(arm, 1, seed=22))[0]
     cases = []
     for k in range(3 * 4 if len(arm.task) == 6 else len(arm.task)):
@@ -166,7 +172,7 @@ SINGULAR = {
 @pytest.mark.parametrize("case", SINGULAR)
 def test_singular_targets(backends, case, backend):
     name, q, count = SINGULAR[case]
-    arm, solvers, _ = backends(name)
+    arm, solvers, _, _ = backends(name)
     target = _targets(arm, np.array(q))[0]
     _check_solutions(arm, solvers[backend]([target])[0], target, count=count)
 
@@ -202,7 +208,7 @@ def test_shoulder_singularity(backends, backend):
 
 def test_batched_numpy_finds_the_c_solution_sets(backends):
     """10^5 ur5 poses: batched numpy and C return the same solutions in the same order."""
-    arm, solvers, _ = backends("ur5")
+    arm, solvers, _, _ = backends("ur5")
     q = random_configurations(arm, 100_000, seed=23)
     targets = _targets(arm, q)
     batch, c = solvers["numpy_batch"](targets), solvers["c"](targets)
@@ -235,7 +241,7 @@ SINGULAR_JS = {"puma560": [0.1, 0.5, -0.3, 0.2, 0.0, 0.4], "ur5": [0.3, -1.0, 1.
 def test_velocity_ik_cases(backends, name, backend):
     """Regular Js with damping 0 and 0.1; singular Js: status 1 and q_dot 0 without damping,
     the damped solution with; NaN or inf in q, mu_dot or damping, or damping < 0: status 2."""
-    arm, _, velocity = backends(name)
+    arm, _, _, velocity = backends(name)
     solve = velocity[backend]
     rng = np.random.default_rng(24)
     for q in random_configurations(arm, 5, seed=24):
@@ -266,3 +272,46 @@ def test_velocity_ik_cases(backends, name, backend):
         assert solve(q, mu_dot, bad)[1] == 2
     q_dot, status = solve(q, mu_dot, -0.1)
     assert status == 2 and np.all(np.asarray(q_dot) == 0)
+
+
+# -- ik_numeric -------------------------------------------------------------------------------
+
+
+def _casadi_numeric(module, target, q0, tol):
+    """CasADi's ik_numeric (IK_NUMERIC_ITERATIONS steps, no max_iter)."""
+    q, status = module.ik_numeric(target if np.ndim(target) == 2 else np.reshape(target, (-1, 1)), q0, tol)
+    return q.full().ravel(), int(status)
+
+
+@pytest.mark.parametrize("backend", BACKENDS)
+@pytest.mark.parametrize("name", ["puma560", "rexarm", "iiwa", "planar_2r"])
+def test_ik_numeric_cases(backends, name, backend):
+    """Converged from 0.1 away (and the target reached, by the reference); NaN or inf in the
+    target or q0: status 3 and q = q0; a target out of reach: stalled or at the iteration
+    limit, never converged, q finite and inside the limits."""
+    arm, _, numeric, _ = backends(name)
+    solve = numeric[backend]
+    q = random_configurations(arm, 4, seed=26)
+    for row, target in zip(q, _targets(arm, q)):
+        start = np.clip(row + 0.1, *np.array([j.limits or (-np.inf, np.inf) for j in arm.joints]).T)
+        found, status = solve(target, start)
+        assert status == 0
+        assert _target_errors(arm, np.array([found]), target).max() < 1e-8
+    target = _targets(arm, q[:1])[0]
+    for bad in (np.nan, np.inf):
+        broken = target.copy()
+        broken.flat[0] = bad
+        found, status = solve(broken, q[1])
+        assert status == 3 and np.array_equal(found, q[1])
+        start = q[1].copy()
+        start[0] = bad
+        found, status = solve(target, start)
+        assert status == 3 and np.array_equal(found, start, equal_nan=True)
+    far = target.copy()
+    if len(arm.task) == 6:
+        far[:3, 3] += 10.0
+    else:
+        far[:2] += 10.0
+    found, status = solve(far, q[1])
+    low, high = np.array([j.limits or (-np.inf, np.inf) for j in arm.joints]).T
+    assert status in (1, 2) and np.all(np.isfinite(found)) and np.all((found >= low) & (found <= high))

@@ -1364,180 +1364,382 @@ int iiwa_velocity_ik(const iiwa_real q[IIWA_DOF], const iiwa_real mu_dot[IIWA_TA
     return (!(t245 && t246) ? 2 : (t248 ? 1 : 0));
 }
 
-/* -- Iterative inverse kinematics -- */
-
-/* The rotation vector (axis times angle in [0, pi]) of the rotation matrix E (row-major). */
-static void iiwa_rotation_vector(const iiwa_real E[9], iiwa_real out[3])
+iiwa_real iiwa_ik_numeric_step(const iiwa_real target[16], const iiwa_real q[IIWA_DOF], iiwa_real damping, iiwa_real q_start[IIWA_DOF], iiwa_real q_next[IIWA_DOF])
 {
-    const iiwa_real v[3] = {0.5 * (E[7] - E[5]), 0.5 * (E[2] - E[6]), 0.5 * (E[3] - E[1])};
-    const iiwa_real cos_angle = 0.5 * (E[0] + E[4] + E[8] - 1.0);
-    const iiwa_real sin_angle = sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
-    const iiwa_real angle = atan2(sin_angle, cos_angle);
-    iiwa_real axis[3], length, sign;
-    int i, column = 0;
-    if (sin_angle > 1e-6 || cos_angle > 0.0) {
-        const iiwa_real scale = sin_angle > 0.0 ? angle / sin_angle : 1.0;
-        for (i = 0; i < 3; ++i) {
-            out[i] = scale * v[i];
-        }
-        return;
-    }
-    /* Near a half turn: the axis from the largest column of (E + I) / 2 = u u^T. */
-    for (i = 1; i < 3; ++i) {
-        if (E[4 * i] > E[4 * column]) {
-            column = i;
-        }
-    }
-    for (i = 0; i < 3; ++i) {
-        axis[i] = 0.5 * (E[3 * i + column] + (i == column ? 1.0 : 0.0));
-    }
-    length = sqrt(axis[0] * axis[0] + axis[1] * axis[1] + axis[2] * axis[2]);
-    sign = axis[0] * v[0] + axis[1] * v[1] + axis[2] * v[2] >= 0.0 ? 1.0 : -1.0;
-    for (i = 0; i < 3; ++i) {
-        out[i] = sign * angle * axis[i] / length;
-    }
+    /* 1123 operations */
+
+    /* Inputs */
+    const iiwa_real T00 = target[0];
+    const iiwa_real T01 = target[1];
+    const iiwa_real T02 = target[2];
+    const iiwa_real T03 = target[3];
+    const iiwa_real T10 = target[4];
+    const iiwa_real T11 = target[5];
+    const iiwa_real T12 = target[6];
+    const iiwa_real T13 = target[7];
+    const iiwa_real T20 = target[8];
+    const iiwa_real T21 = target[9];
+    const iiwa_real T22 = target[10];
+    const iiwa_real T23 = target[11];
+    const iiwa_real qs1 = q[0];
+    const iiwa_real qs2 = q[1];
+    const iiwa_real qs3 = q[2];
+    const iiwa_real qs4 = q[3];
+    const iiwa_real qs5 = q[4];
+    const iiwa_real qs6 = q[5];
+    const iiwa_real qs7 = q[6];
+
+    /* Intermediate terms */
+    const iiwa_real q1 = (qs1 < -2.9670597283903604 ? -2.9670597283903604 : (qs1 > 2.9670597283903604 ? 2.9670597283903604 : qs1));
+    const iiwa_real q2 = (qs2 < -2.0943951023931953 ? -2.0943951023931953 : (qs2 > 2.0943951023931953 ? 2.0943951023931953 : qs2));
+    const iiwa_real q3 = (qs3 < -2.9670597283903604 ? -2.9670597283903604 : (qs3 > 2.9670597283903604 ? 2.9670597283903604 : qs3));
+    const iiwa_real q4 = (qs4 < -2.0943951023931953 ? -2.0943951023931953 : (qs4 > 2.0943951023931953 ? 2.0943951023931953 : qs4));
+    const iiwa_real q5 = (qs5 < -2.9670597283903604 ? -2.9670597283903604 : (qs5 > 2.9670597283903604 ? 2.9670597283903604 : qs5));
+    const iiwa_real q6 = (qs6 < -2.0943951023931953 ? -2.0943951023931953 : (qs6 > 2.0943951023931953 ? 2.0943951023931953 : qs6));
+    const iiwa_real q7 = (qs7 < -3.0543261909900767 ? -3.0543261909900767 : (qs7 > 3.0543261909900767 ? 3.0543261909900767 : qs7));
+    const iiwa_real c1 = cos(q1);
+    const iiwa_real s1 = sin(q1);
+    const iiwa_real c2 = cos(q2);
+    const iiwa_real s2 = sin(q2);
+    const iiwa_real c3 = cos(q3);
+    const iiwa_real s3 = sin(q3);
+    const iiwa_real c4 = cos(q4);
+    const iiwa_real s4 = sin(q4);
+    const iiwa_real c5 = cos(q5);
+    const iiwa_real s5 = sin(q5);
+    const iiwa_real c6 = cos(q6);
+    const iiwa_real s6 = sin(q6);
+    const iiwa_real c7 = cos(q7);
+    const iiwa_real s7 = sin(q7);
+    const iiwa_real t0 = T00 + T01 + T02 + T03 + T10 + T11 + T12 + T13 + T20 + T21 + T22 + T23 + qs1 + qs2 + qs3 + qs4 + qs5 + qs6 + qs7;
+    const iiwa_real t1 = s1*s3;
+    const iiwa_real t2 = c1*c3;
+    const iiwa_real t3 = c2*t2 - t1;
+    const iiwa_real t4 = -c2*t1 + t2;
+    const iiwa_real t5 = c3*s1;
+    const iiwa_real t6 = c1*s3;
+    const iiwa_real t7 = c2*t6 + t5;
+    const iiwa_real t8 = c2*t5 + t6;
+    const iiwa_real t9 = c1*s2;
+    const iiwa_real t10 = c4*t3 + s4*t9;
+    const iiwa_real t11 = c4*t9 - s4*t3;
+    const iiwa_real t12 = c5*t10 - s5*t7;
+    const iiwa_real t13 = c5*t7 + s5*t10;
+    const iiwa_real t14 = c6*t12 - s6*t11;
+    const iiwa_real t15 = c6*t11 + s6*t12;
+    const iiwa_real t16 = c7*t14 - s7*t13;
+    const iiwa_real t17 = c7*t13 + s7*t14;
+    const iiwa_real t18 = T00*t16 - T01*t17 + T02*t15;
+    const iiwa_real t19 = T10*t16 - T11*t17 + T12*t15;
+    const iiwa_real t20 = T20*t16 - T21*t17 + T22*t15;
+    const iiwa_real t21 = s1*s2;
+    const iiwa_real t22 = c4*t8 + s4*t21;
+    const iiwa_real t23 = c4*t21 - s4*t8;
+    const iiwa_real t24 = c5*t22 + s5*t4;
+    const iiwa_real t25 = c5*t4 - s5*t22;
+    const iiwa_real t26 = c6*t24 - s6*t23;
+    const iiwa_real t27 = c6*t23 + s6*t24;
+    const iiwa_real t28 = c7*t26 + s7*t25;
+    const iiwa_real t29 = c7*t25 - s7*t26;
+    const iiwa_real t30 = T00*t28 + T01*t29 + T02*t27;
+    const iiwa_real t31 = T10*t28 + T11*t29 + T12*t27;
+    const iiwa_real t32 = T20*t28 + T21*t29 + T22*t27;
+    const iiwa_real t33 = 0.5*t19 - 0.5*t30;
+    const iiwa_real t34 = c3*s2;
+    const iiwa_real t35 = c2*s4 - c4*t34;
+    const iiwa_real t36 = c2*c4 + s4*t34;
+    const iiwa_real t37 = s2*s3;
+    const iiwa_real t38 = c5*t35 + s5*t37;
+    const iiwa_real t39 = c5*t37 - s5*t35;
+    const iiwa_real t40 = c6*t38 - s6*t36;
+    const iiwa_real t41 = c6*t36 + s6*t38;
+    const iiwa_real t42 = c7*t40 + s7*t39;
+    const iiwa_real t43 = c7*t39 - s7*t40;
+    const iiwa_real t44 = c2*t9 + t11*t36 - t13*t39 + t15*t41 - t37*t7;
+    const iiwa_real t45 = c2*t21 + t23*t36 + t25*t39 + t27*t41 + t37*t4;
+    const iiwa_real t46 = T00*t42 + T01*t43 + T02*t41;
+    const iiwa_real t47 = T10*t42 + T11*t43 + T12*t41;
+    const iiwa_real t48 = T20*t42 + T21*t43 + T22*t41;
+    const iiwa_real t49 = 0.5*t32 - 0.5*t47;
+    const iiwa_real t50 = -0.5*t20 + 0.5*t46;
+    const iiwa_real t51 = 0.5*t18 + 0.5*t31 + 0.5*t48 - 0.5;
+    const iiwa_real t52 = sqrt((t33*t33) + (t49*t49) + (t50*t50));
+    const iiwa_real t53 = atan2(t52, t51);
+    const iiwa_real t54 = (t52 > 0 ? t53/t52 : 1);
+    const iiwa_real t55 = 0.126*t15;
+    const iiwa_real t56 = 0.4*t11 + t55;
+    const iiwa_real t57 = t56 + 0.42*t9;
+    const iiwa_real t58 = T03 - t57;
+    const iiwa_real t59 = 0.126*t27;
+    const iiwa_real t60 = 0.4*t23 + t59;
+    const iiwa_real t61 = 0.42*t21 + t60;
+    const iiwa_real t62 = c1*t57 + s1*t61;
+    const iiwa_real t63 = t4*t56 + t60*t7;
+    const iiwa_real t64 = t11*t60 - t23*t56;
+    const iiwa_real t65 = t13*t59 + t25*t55;
+    const iiwa_real t66 = -t21*t57 + t61*t9;
+    const iiwa_real t67 = (t62*t62) + (t63*t63) + (t64*t64) + (t65*t65) + (t66*t66);
+    const iiwa_real t68 = c2*t66 + t36*t64 - t37*t63 - t39*t65;
+    const iiwa_real t69 = 0.126*t41;
+    const iiwa_real t70 = 0.4*t36 + t69;
+    const iiwa_real t71 = 0.42*c2 + t70;
+    const iiwa_real t72 = t71 + 0.36;
+    const iiwa_real t73 = t37*t60 - t4*t70;
+    const iiwa_real t74 = t23*t70 - t36*t60;
+    const iiwa_real t75 = t25*t69 - t39*t59;
+    const iiwa_real t76 = c2*t57 - t71*t9;
+    const iiwa_real t77 = t37*t56 + t7*t70;
+    const iiwa_real t78 = t13*t69 + t39*t55;
+    const iiwa_real t79 = -c2*t61 + t21*t71;
+    const iiwa_real t80 = -t11*t70 + t36*t56;
+    const iiwa_real t81 = c2*t76 + t36*t80 + t37*t77 + t39*t78 + t57;
+    const iiwa_real t82 = T23 - t72;
+    const iiwa_real t83 = (t71*t71);
+    const iiwa_real t84 = (c1*c1);
+    const iiwa_real t85 = t83*t84 + (t61*t61) + (t73*t73) + (t74*t74) + (t75*t75) + (t79*t79);
+    const iiwa_real t86 = t21*t79 + t23*t74 + t25*t75 - t4*t73 + t71*t84;
+    const iiwa_real t87 = c1*s1;
+    const iiwa_real t88 = -t57*t61 - t73*t77 + t74*t80 + t75*t78 + t76*t79 + t83*t87;
+    const iiwa_real t89 = -t61;
+    const iiwa_real t90 = c2*t79 + t36*t74 - t37*t73 + t39*t75 + t89;
+    const iiwa_real t91 = T13 + t89;
+    const iiwa_real t92 = c1*t62;
+    const iiwa_real t93 = t63*t73 + t64*t74 - t65*t75 + t66*t79 - t71*t92;
+    const iiwa_real t94 = -t21*t66 - t23*t64 + t25*t65 + t4*t63 + t92;
+    const iiwa_real t95 = t71*t87;
+    const iiwa_real t96 = t11*t74 - t13*t75 + t7*t73 + t79*t9 - t95;
+    const iiwa_real t97 = t21*t76 + t23*t80 + t25*t78 + t4*t77 + t95;
+    const iiwa_real t98 = (s1*s1);
+    const iiwa_real t99 = t83*t98 + (t57*t57) + (t76*t76) + (t77*t77) + (t78*t78) + (t80*t80);
+    const iiwa_real t100 = -t11*t80 + t13*t78 + t7*t77 + t71*t98 - t76*t9;
+    const iiwa_real t101 = s1*t62;
+    const iiwa_real t102 = t101*t71 + t63*t77 - t64*t80 + t65*t78 - t66*t76;
+    const iiwa_real t103 = t101 + t11*t64 + t13*t65 + t63*t7 + t66*t9;
+    const iiwa_real t104 = (s2*s2);
+    const iiwa_real t105 = t104*t84 + t98 + (t11*t11) + (t13*t13) + (t15*t15) + (t7*t7);
+    const iiwa_real t106 = t104*t87 + t11*t23 - t13*t25 + t15*t27 - t4*t7 - t87;
+    const iiwa_real t107 = t104*t98 + t84 + (t23*t23) + (t25*t25) + (t27*t27) + (t4*t4);
+    const iiwa_real t108 = t104*(s3*s3) + (c2*c2) + (t36*t36) + (t39*t39) + (t41*t41) + 1;
+    const int t109 = t18 >= t31 && t18 >= t48;
+    const int t110 = t31 >= t48;
+    const iiwa_real t111 = (t109 ? 0.5*t18 + 0.5 : (t110 ? 0.5*t30 : 0.5*t46));
+    const iiwa_real t112 = (t109 ? 0.5*t19 : (t110 ? 0.5*t31 + 0.5 : 0.5*t47));
+    const iiwa_real t113 = (t109 ? 0.5*t20 : (t110 ? 0.5*t32 : 0.5*t48 + 0.5));
+    const iiwa_real t114 = sqrt((t111*t111) + (t112*t112) + (t113*t113));
+    const iiwa_real t115 = (t111*t49 + t112*t50 + t113*t33 >= 0 ? 1 : -1);
+    const int t116 = (t52 > 1e-06) || (t51 > 0);
+    const iiwa_real t117 = t115*t53/t114;
+    const iiwa_real t118 = (t116 ? t49*t54 : t111*t117);
+    const iiwa_real t119 = (t116 ? t50*t54 : t112*t117);
+    const iiwa_real t120 = (t116 ? t33*t54 : t113*t117);
+    const iiwa_real t121 = (t118*t118) + (t119*t119) + (t120*t120) + (t58*t58) + (t82*t82) + (t91*t91);
+    const iiwa_real t122 = damping + t85;
+    const iiwa_real t123 = sqrt((t122*t122) + (t86*t86) + (t88*t88) + (t90*t90) + (t93*t93) + (t96*t96));
+    const iiwa_real t124 = t123*(t122 >= 0 ? 1 : -1);
+    const iiwa_real t125 = t122 + t124;
+    const iiwa_real t126 = (t123 > 0 ? 1/(t123*(t123 + fabs(t122))) : 0);
+    const iiwa_real t127 = t126*(t118*t96 + t119*t86 + t120*t90 + t125*t58 + t82*t93 + t88*t91);
+    const iiwa_real t128 = -t125*t127 + t58;
+    const iiwa_real t129 = -t127*t88 + t91;
+    const iiwa_real t130 = -t127*t93 + t82;
+    const iiwa_real t131 = t118 - t127*t96;
+    const iiwa_real t132 = t119 - t127*t86;
+    const iiwa_real t133 = t120 - t127*t90;
+    const iiwa_real t134 = damping + t99;
+    const iiwa_real t135 = t126*(-t100*t96 - t102*t93 + t125*t88 + t134*t88 + t81*t90 + t86*t97);
+    const iiwa_real t136 = -t125*t135 + t88;
+    const iiwa_real t137 = t134 - t135*t88;
+    const iiwa_real t138 = t102 + t135*t93;
+    const iiwa_real t139 = t100 + t135*t96;
+    const iiwa_real t140 = -t135*t86 + t97;
+    const iiwa_real t141 = -t135*t90 + t81;
+    const iiwa_real t142 = sqrt((t137*t137) + (t138*t138) + (t139*t139) + (t140*t140) + (t141*t141));
+    const iiwa_real t143 = t142*(t137 >= 0 ? 1 : -1);
+    const iiwa_real t144 = t137 + t143;
+    const iiwa_real t145 = (t142 > 0 ? 1/(t142*(t142 + fabs(t137))) : 0);
+    const iiwa_real t146 = t145*(t129*t144 - t130*t138 - t131*t139 + t132*t140 + t133*t141);
+    const iiwa_real t147 = t129 - t144*t146;
+    const iiwa_real t148 = t130 + t138*t146;
+    const iiwa_real t149 = t131 + t139*t146;
+    const iiwa_real t150 = t132 - t140*t146;
+    const iiwa_real t151 = t133 - t141*t146;
+    const iiwa_real t152 = damping + t67;
+    const iiwa_real t153 = t126*(-t102*t88 + t103*t96 + t125*t93 + t152*t93 + t68*t90 - t86*t94);
+    const iiwa_real t154 = -t125*t153 + t93;
+    const iiwa_real t155 = t102 + t153*t88;
+    const iiwa_real t156 = t152 - t153*t93;
+    const iiwa_real t157 = t103 - t153*t96;
+    const iiwa_real t158 = t153*t86 + t94;
+    const iiwa_real t159 = -t153*t90 + t68;
+    const iiwa_real t160 = -t145*(t138*t156 + t139*t157 + t140*t158 - t141*t159 + t144*t155);
+    const iiwa_real t161 = t144*t160 + t155;
+    const iiwa_real t162 = t138*t160 + t156;
+    const iiwa_real t163 = t139*t160 + t157;
+    const iiwa_real t164 = t140*t160 + t158;
+    const iiwa_real t165 = -t141*t160 + t159;
+    const iiwa_real t166 = sqrt((t162*t162) + (t163*t163) + (t164*t164) + (t165*t165));
+    const iiwa_real t167 = t166*(t162 >= 0 ? 1 : -1);
+    const iiwa_real t168 = t162 + t167;
+    const iiwa_real t169 = (t166 > 0 ? 1/(t166*(t166 + fabs(t162))) : 0);
+    const iiwa_real t170 = t169*(t148*t168 + t149*t163 - t150*t164 + t151*t165);
+    const iiwa_real t171 = t148 - t168*t170;
+    const iiwa_real t172 = t149 - t163*t170;
+    const iiwa_real t173 = t150 + t164*t170;
+    const iiwa_real t174 = t151 - t165*t170;
+    const iiwa_real t175 = damping + t105;
+    const iiwa_real t176 = t126*(-t100*t88 + t103*t93 + t106*t86 + t125*t96 + t175*t96 + t44*t90);
+    const iiwa_real t177 = -t125*t176 + t96;
+    const iiwa_real t178 = t100 + t176*t88;
+    const iiwa_real t179 = t103 - t176*t93;
+    const iiwa_real t180 = t175 - t176*t96;
+    const iiwa_real t181 = t106 - t176*t86;
+    const iiwa_real t182 = -t176*t90 + t44;
+    const iiwa_real t183 = -t145*(t138*t179 + t139*t180 - t140*t181 - t141*t182 + t144*t178);
+    const iiwa_real t184 = t144*t183 + t178;
+    const iiwa_real t185 = t138*t183 + t179;
+    const iiwa_real t186 = t139*t183 + t180;
+    const iiwa_real t187 = -t140*t183 + t181;
+    const iiwa_real t188 = -t141*t183 + t182;
+    const iiwa_real t189 = t169*(t163*t186 - t164*t187 + t165*t188 + t168*t185);
+    const iiwa_real t190 = -t168*t189 + t185;
+    const iiwa_real t191 = -t163*t189 + t186;
+    const iiwa_real t192 = t164*t189 + t187;
+    const iiwa_real t193 = -t165*t189 + t188;
+    const iiwa_real t194 = sqrt((t191*t191) + (t192*t192) + (t193*t193));
+    const iiwa_real t195 = t194*(t191 >= 0 ? 1 : -1);
+    const iiwa_real t196 = t191 + t195;
+    const iiwa_real t197 = (t194 > 0 ? 1/(t194*(t194 + fabs(t191))) : 0);
+    const iiwa_real t198 = t197*(t172*t196 + t173*t192 + t174*t193);
+    const iiwa_real t199 = t172 - t196*t198;
+    const iiwa_real t200 = t173 - t192*t198;
+    const iiwa_real t201 = t174 - t193*t198;
+    const iiwa_real t202 = damping + t107;
+    const iiwa_real t203 = t126*(t106*t96 + t125*t86 + t202*t86 + t45*t90 + t88*t97 - t93*t94);
+    const iiwa_real t204 = -t125*t203 + t86;
+    const iiwa_real t205 = -t203*t88 + t97;
+    const iiwa_real t206 = t203*t93 + t94;
+    const iiwa_real t207 = t106 - t203*t96;
+    const iiwa_real t208 = t202 - t203*t86;
+    const iiwa_real t209 = -t203*t90 + t45;
+    const iiwa_real t210 = t145*(t138*t206 - t139*t207 + t140*t208 + t141*t209 + t144*t205);
+    const iiwa_real t211 = -t144*t210 + t205;
+    const iiwa_real t212 = t138*t210 - t206;
+    const iiwa_real t213 = t139*t210 + t207;
+    const iiwa_real t214 = -t140*t210 + t208;
+    const iiwa_real t215 = -t141*t210 + t209;
+    const iiwa_real t216 = t169*(t163*t213 - t164*t214 + t165*t215 + t168*t212);
+    const iiwa_real t217 = -t168*t216 + t212;
+    const iiwa_real t218 = -t163*t216 + t213;
+    const iiwa_real t219 = t164*t216 + t214;
+    const iiwa_real t220 = -t165*t216 + t215;
+    const iiwa_real t221 = t197*(t192*t219 + t193*t220 + t196*t218);
+    const iiwa_real t222 = -t196*t221 + t218;
+    const iiwa_real t223 = -t192*t221 + t219;
+    const iiwa_real t224 = -t193*t221 + t220;
+    const iiwa_real t225 = sqrt((t223*t223) + (t224*t224));
+    const iiwa_real t226 = t225*(t223 >= 0 ? 1 : -1);
+    const iiwa_real t227 = t223 + t226;
+    const iiwa_real t228 = (t225 > 0 ? 1/(t225*(t225 + fabs(t223))) : 0);
+    const iiwa_real t229 = t228*(t200*t227 + t201*t224);
+    const iiwa_real t230 = t200 - t227*t229;
+    const iiwa_real t231 = t201 - t224*t229;
+    const iiwa_real t232 = damping + t108;
+    const iiwa_real t233 = t126*(t125*t90 + t232*t90 + t44*t96 + t45*t86 + t68*t93 + t81*t88);
+    const iiwa_real t234 = -t125*t233 + t90;
+    const iiwa_real t235 = -t233*t88 + t81;
+    const iiwa_real t236 = -t233*t93 + t68;
+    const iiwa_real t237 = -t233*t96 + t44;
+    const iiwa_real t238 = -t233*t86 + t45;
+    const iiwa_real t239 = t232 - t233*t90;
+    const iiwa_real t240 = t145*(-t138*t236 - t139*t237 + t140*t238 + t141*t239 + t144*t235);
+    const iiwa_real t241 = -t144*t240 + t235;
+    const iiwa_real t242 = t138*t240 + t236;
+    const iiwa_real t243 = t139*t240 + t237;
+    const iiwa_real t244 = -t140*t240 + t238;
+    const iiwa_real t245 = -t141*t240 + t239;
+    const iiwa_real t246 = t169*(t163*t243 - t164*t244 + t165*t245 + t168*t242);
+    const iiwa_real t247 = -t168*t246 + t242;
+    const iiwa_real t248 = -t163*t246 + t243;
+    const iiwa_real t249 = t164*t246 + t244;
+    const iiwa_real t250 = -t165*t246 + t245;
+    const iiwa_real t251 = t197*(t192*t249 + t193*t250 + t196*t248);
+    const iiwa_real t252 = -t196*t251 + t248;
+    const iiwa_real t253 = -t192*t251 + t249;
+    const iiwa_real t254 = -t193*t251 + t250;
+    const iiwa_real t255 = t228*(t224*t254 + t227*t253);
+    const iiwa_real t256 = -t227*t255 + t253;
+    const iiwa_real t257 = -t224*t255 + t254;
+    const iiwa_real t258 = fabs(t257);
+    const iiwa_real t259 = t258;
+    const iiwa_real t260 = t259*(t257 >= 0 ? 1 : -1);
+    const iiwa_real t261 = t257 + t260;
+    const iiwa_real t262 = (t259 > 0 ? 1/(t259*(t258 + t259)) : 0);
+    const iiwa_real t263 = -t231*t262*(t261*t261) + t231;
+    const iiwa_real t264 = t263/t260;
+    const iiwa_real t265 = (t230 + t256*t264)/t226;
+    const iiwa_real t266 = (t199 + t222*t265 + t252*t264)/t195;
+    const iiwa_real t267 = (t171 + t190*t266 + t217*t265 + t247*t264)/t167;
+    const iiwa_real t268 = (t147 - t161*t267 - t184*t266 + t211*t265 + t241*t264)/t143;
+    const iiwa_real t269 = (t128 + t136*t268 + t154*t267 + t177*t266 + t204*t265 + t234*t264)/t124;
+    const iiwa_real t270 = q1 - t264 - t268*t57 + t269*t61;
+    const iiwa_real t271 = -c1*t265 - c1*t269*t71 + q2 + s1*t266 - s1*t268*t71 + t267*t62;
+    const iiwa_real t272 = c2*t264 - q3 + t21*t265 + t266*t9 + t267*t66 + t268*t76 + t269*t79;
+    const iiwa_real t273 = q4 + t264*t37 + t265*t4 - t266*t7 - t267*t63 + t268*t77 - t269*t73;
+    const iiwa_real t274 = -q5 + t11*t266 + t23*t265 + t264*t36 + t267*t64 + t268*t80 + t269*t74;
+    const iiwa_real t275 = -q6 - t13*t266 + t25*t265 + t264*t39 - t267*t65 + t268*t78 + t269*t75;
+    const iiwa_real t276 = -q7 + t15*t266 + t264*t41 + t265*t27;
+
+    /* Outputs */
+    q_start[0] = q1;
+    q_start[1] = q2;
+    q_start[2] = q3;
+    q_start[3] = q4;
+    q_start[4] = q5;
+    q_start[5] = q6;
+    q_start[6] = q7;
+    q_next[0] = (t270 < -2.9670597283903604 ? -2.9670597283903604 : (t270 > 2.9670597283903604 ? 2.9670597283903604 : t270));
+    q_next[1] = (t271 < -2.0943951023931953 ? -2.0943951023931953 : (t271 > 2.0943951023931953 ? 2.0943951023931953 : t271));
+    q_next[2] = (t272 > 2.9670597283903604 ? -2.9670597283903604 : (t272 < -2.9670597283903604 ? 2.9670597283903604 : -t272));
+    q_next[3] = (t273 < -2.0943951023931953 ? -2.0943951023931953 : (t273 > 2.0943951023931953 ? 2.0943951023931953 : t273));
+    q_next[4] = (t274 > 2.9670597283903604 ? -2.9670597283903604 : (t274 < -2.9670597283903604 ? 2.9670597283903604 : -t274));
+    q_next[5] = (t275 > 2.0943951023931953 ? -2.0943951023931953 : (t275 < -2.0943951023931953 ? 2.0943951023931953 : -t275));
+    q_next[6] = (t276 > 3.0543261909900767 ? -3.0543261909900767 : (t276 < -3.0543261909900767 ? 3.0543261909900767 : -t276));
+    return (isfinite(t0) ? t121 : -1);
 }
 
-/* Error [target position - position; rotation vector of target R^T] and the geometric Jacobian. */
-static void iiwa_task_error(const iiwa_real target[16], const iiwa_real q[IIWA_DOF], iiwa_real e[6], iiwa_real J[6 * IIWA_DOF])
-{
-    iiwa_real T[16], E[9];
-    int i, j;
-    iiwa_fk(q, T);
-    iiwa_jacobian(q, J);
-    for (i = 0; i < 3; ++i) {
-        e[i] = target[4 * i + 3] - T[4 * i + 3];
-        for (j = 0; j < 3; ++j) {
-            E[3 * i + j] = target[4 * i] * T[4 * j] + target[4 * i + 1] * T[4 * j + 1] + target[4 * i + 2] * T[4 * j + 2];
-        }
-    }
-    iiwa_rotation_vector(E, e + 3);
-}
-
-/* Joints clamped to their limits. */
-static void iiwa_clamp(iiwa_real q[IIWA_DOF])
-{
-    q[0] = q[0] < -2.9670597283903604 ? -2.9670597283903604 : q[0] > 2.9670597283903604 ? 2.9670597283903604 : q[0];
-    q[1] = q[1] < -2.0943951023931953 ? -2.0943951023931953 : q[1] > 2.0943951023931953 ? 2.0943951023931953 : q[1];
-    q[2] = q[2] < -2.9670597283903604 ? -2.9670597283903604 : q[2] > 2.9670597283903604 ? 2.9670597283903604 : q[2];
-    q[3] = q[3] < -2.0943951023931953 ? -2.0943951023931953 : q[3] > 2.0943951023931953 ? 2.0943951023931953 : q[3];
-    q[4] = q[4] < -2.9670597283903604 ? -2.9670597283903604 : q[4] > 2.9670597283903604 ? 2.9670597283903604 : q[4];
-    q[5] = q[5] < -2.0943951023931953 ? -2.0943951023931953 : q[5] > 2.0943951023931953 ? 2.0943951023931953 : q[5];
-    q[6] = q[6] < -3.0543261909900767 ? -3.0543261909900767 : q[6] > 3.0543261909900767 ? 3.0543261909900767 : q[6];
-}
-
-/* Solves A x = b in place (b becomes x) for the symmetric positive definite K x K matrix A by
- * Cholesky; returns 0 when A is not numerically positive definite. */
-static int iiwa_cholesky_solve(iiwa_real A[36], iiwa_real b[6])
-{
-    int i, j, k;
-    for (j = 0; j < 6; ++j) {
-        iiwa_real diagonal = A[6 * j + j];
-        for (k = 0; k < j; ++k) {
-            diagonal -= A[6 * j + k] * A[6 * j + k];
-        }
-        if (!(diagonal > 0.0)) {
-            return 0;
-        }
-        A[6 * j + j] = sqrt(diagonal);
-        for (i = j + 1; i < 6; ++i) {
-            iiwa_real sum = A[6 * i + j];
-            for (k = 0; k < j; ++k) {
-                sum -= A[6 * i + k] * A[6 * j + k];
-            }
-            A[6 * i + j] = sum / A[6 * j + j];
-        }
-    }
-    for (i = 0; i < 6; ++i) {
-        for (k = 0; k < i; ++k) {
-            b[i] -= A[6 * i + k] * b[k];
-        }
-        b[i] /= A[6 * i + i];
-    }
-    for (i = 6 - 1; i >= 0; --i) {
-        for (k = i + 1; k < 6; ++k) {
-            b[i] -= A[6 * k + i] * b[k];
-        }
-        b[i] /= A[6 * i + i];
-    }
-    return 1;
-}
+/* -- Iterative inverse kinematics: the loop around iiwa_ik_numeric_step -- */
 
 int iiwa_ik_numeric(const iiwa_real target[16], const iiwa_real q0[IIWA_DOF], int max_iter, iiwa_real tol, iiwa_real q[IIWA_DOF])
 {
-    iiwa_real e[6], J[6 * IIWA_DOF], trial[IIWA_DOF], trial_e[6];
-    iiwa_real trial_J[6 * IIWA_DOF], A[36], x[6];
-    iiwa_real cost, trial_cost, damping = 1e-06;
-    int i, j, k, iteration;
-    for (j = 0; j < IIWA_DOF; ++j) {
-        q[j] = q0[j];
-    }
-    for (i = 0; i < 12; ++i) {
-        if (!isfinite(target[i])) {
-            return IIWA_IK_NUMERIC_INVALID;
+    iiwa_real trial[IIWA_DOF], after[IIWA_DOF], start[IIWA_DOF];
+    iiwa_real cost, trial_cost, lighter, damping = 1e-06;
+    int j, iteration;
+    cost = iiwa_ik_numeric_step(target, q0, damping, q, trial);
+    if (!(cost >= 0) || max_iter < 0) { /* -1: target or q0 not finite */
+        for (j = 0; j < IIWA_DOF; ++j) {
+            q[j] = q0[j];
         }
-    }
-    for (j = 0; j < IIWA_DOF; ++j) {
-        if (!isfinite(q0[j])) {
-            return IIWA_IK_NUMERIC_INVALID;
-        }
-    }
-    if (max_iter < 0) {
         return IIWA_IK_NUMERIC_INVALID;
-    }
-    iiwa_clamp(q);
-    iiwa_task_error(target, q, e, J);
-    cost = 0.0;
-    for (i = 0; i < 6; ++i) {
-        cost += e[i] * e[i];
     }
     for (iteration = 0; iteration < max_iter; ++iteration) {
         if (cost <= tol * tol) {
             return IIWA_IK_NUMERIC_CONVERGED;
         }
-        /* A = J J^T + damping I, x = A^-1 e, step J^T x */
-        for (i = 0; i < 6; ++i) {
-            x[i] = e[i];
-            for (k = 0; k < 6; ++k) {
-                iiwa_real sum = i == k ? damping : 0.0;
-                for (j = 0; j < IIWA_DOF; ++j) {
-                    sum += J[IIWA_DOF * i + j] * J[IIWA_DOF * k + j];
-                }
-                A[6 * i + k] = sum;
-            }
-        }
-        if (!iiwa_cholesky_solve(A, x)) {
-            return IIWA_IK_NUMERIC_STALLED;
-        }
-        for (j = 0; j < IIWA_DOF; ++j) {
-            trial[j] = q[j];
-            for (i = 0; i < 6; ++i) {
-                trial[j] += J[IIWA_DOF * i + j] * x[i];
-            }
-        }
-        iiwa_clamp(trial);
-        iiwa_task_error(target, trial, trial_e, trial_J);
-        trial_cost = 0.0;
-        for (i = 0; i < 6; ++i) {
-            trial_cost += trial_e[i] * trial_e[i];
-        }
+        lighter = damping * 0.1 > 1e-12 ? damping * 0.1 : 1e-12;
+        trial_cost = iiwa_ik_numeric_step(target, trial, lighter, start, after);
         if (trial_cost < cost) {
             for (j = 0; j < IIWA_DOF; ++j) {
                 q[j] = trial[j];
-            }
-            for (i = 0; i < 6; ++i) {
-                e[i] = trial_e[i];
-            }
-            for (i = 0; i < 6 * IIWA_DOF; ++i) {
-                J[i] = trial_J[i];
+                trial[j] = after[j];
             }
             cost = trial_cost;
-            damping = damping * 0.1 > 1e-12 ? damping * 0.1 : 1e-12;
+            damping = lighter;
         } else {
             damping *= 10.0;
             if (damping > 100000000.0) {
                 return IIWA_IK_NUMERIC_STALLED;
             }
+            (void)iiwa_ik_numeric_step(target, q, damping, start, trial);
         }
     }
     return cost <= tol * tol ? IIWA_IK_NUMERIC_CONVERGED : IIWA_IK_NUMERIC_ITERATION_LIMIT;

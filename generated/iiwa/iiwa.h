@@ -70,6 +70,10 @@ iiwa_real iiwa_manipulability(const iiwa_real q[IIWA_DOF]);
  * Result: q_dot[i], i < 7; returned as a scalar. 1029 operations. */
 int iiwa_velocity_ik(const iiwa_real q[IIWA_DOF], const iiwa_real mu_dot[IIWA_TASK_DIM], iiwa_real damping, iiwa_real q_dot[IIWA_DOF]);
 
+/* One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite).
+ * Result: q_start[i], i < 7; q_next[i], i < 7; returned as a scalar. 1123 operations. */
+iiwa_real iiwa_ik_numeric_step(const iiwa_real target[16], const iiwa_real q[IIWA_DOF], iiwa_real damping, iiwa_real q_start[IIWA_DOF], iiwa_real q_next[IIWA_DOF]);
+
 /* Statuses of iiwa_velocity_ik: OK, singular (a diagonal entry of the QR factor R of the
  * 6 x 6 system at most 1e-12 times its Frobenius norm: take damping > 0), or
  * not finite (q, mu_dot, damping or Js not finite, or damping < 0); q_dot is 0 unless OK.

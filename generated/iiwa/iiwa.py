@@ -1354,73 +1354,392 @@ def velocity_ik(q, mu_dot, damping=0.0):
     return q_dot, status
 
 
-# -- Iterative inverse kinematics --
+@numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
+def ik_numeric_step(target, q, damping=0.0):
+    """one step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite): (7 x 1 and 7 x 1 and 1 x 1), 1123 operations."""
+    target = _argument("target", target, (4, 4))
+    q = _argument("q", q, (7,))
+    damping = _argument("damping", damping, ())
+    T00 = target[..., 0, 0]
+    T01 = target[..., 0, 1]
+    T02 = target[..., 0, 2]
+    T03 = target[..., 0, 3]
+    T10 = target[..., 1, 0]
+    T11 = target[..., 1, 1]
+    T12 = target[..., 1, 2]
+    T13 = target[..., 1, 3]
+    T20 = target[..., 2, 0]
+    T21 = target[..., 2, 1]
+    T22 = target[..., 2, 2]
+    T23 = target[..., 2, 3]
+    qs1 = q[..., 0]
+    qs2 = q[..., 1]
+    qs3 = q[..., 2]
+    qs4 = q[..., 3]
+    qs5 = q[..., 4]
+    qs6 = q[..., 5]
+    qs7 = q[..., 6]
+    q1 = numpy.where(numpy.less(qs1, -2.9670597283903604), -2.9670597283903604, numpy.where(numpy.greater(qs1, 2.9670597283903604), 2.9670597283903604, qs1))
+    q2 = numpy.where(numpy.less(qs2, -2.0943951023931953), -2.0943951023931953, numpy.where(numpy.greater(qs2, 2.0943951023931953), 2.0943951023931953, qs2))
+    q3 = numpy.where(numpy.less(qs3, -2.9670597283903604), -2.9670597283903604, numpy.where(numpy.greater(qs3, 2.9670597283903604), 2.9670597283903604, qs3))
+    q4 = numpy.where(numpy.less(qs4, -2.0943951023931953), -2.0943951023931953, numpy.where(numpy.greater(qs4, 2.0943951023931953), 2.0943951023931953, qs4))
+    q5 = numpy.where(numpy.less(qs5, -2.9670597283903604), -2.9670597283903604, numpy.where(numpy.greater(qs5, 2.9670597283903604), 2.9670597283903604, qs5))
+    q6 = numpy.where(numpy.less(qs6, -2.0943951023931953), -2.0943951023931953, numpy.where(numpy.greater(qs6, 2.0943951023931953), 2.0943951023931953, qs6))
+    q7 = numpy.where(numpy.less(qs7, -3.0543261909900767), -3.0543261909900767, numpy.where(numpy.greater(qs7, 3.0543261909900767), 3.0543261909900767, qs7))
+    c1 = numpy.cos(q1)
+    s1 = numpy.sin(q1)
+    c2 = numpy.cos(q2)
+    s2 = numpy.sin(q2)
+    c3 = numpy.cos(q3)
+    s3 = numpy.sin(q3)
+    c4 = numpy.cos(q4)
+    s4 = numpy.sin(q4)
+    c5 = numpy.cos(q5)
+    s5 = numpy.sin(q5)
+    c6 = numpy.cos(q6)
+    s6 = numpy.sin(q6)
+    c7 = numpy.cos(q7)
+    s7 = numpy.sin(q7)
+    t0 = T00 + T01 + T02 + T03 + T10 + T11 + T12 + T13 + T20 + T21 + T22 + T23 + qs1 + qs2 + qs3 + qs4 + qs5 + qs6 + qs7
+    t1 = s1*s3
+    t2 = c1*c3
+    t3 = c2*t2 - t1
+    t4 = -c2*t1 + t2
+    t5 = c3*s1
+    t6 = c1*s3
+    t7 = c2*t6 + t5
+    t8 = c2*t5 + t6
+    t9 = c1*s2
+    t10 = c4*t3 + s4*t9
+    t11 = c4*t9 - s4*t3
+    t12 = c5*t10 - s5*t7
+    t13 = c5*t7 + s5*t10
+    t14 = c6*t12 - s6*t11
+    t15 = c6*t11 + s6*t12
+    t16 = c7*t14 - s7*t13
+    t17 = c7*t13 + s7*t14
+    t18 = T00*t16 - T01*t17 + T02*t15
+    t19 = T10*t16 - T11*t17 + T12*t15
+    t20 = T20*t16 - T21*t17 + T22*t15
+    t21 = s1*s2
+    t22 = c4*t8 + s4*t21
+    t23 = c4*t21 - s4*t8
+    t24 = c5*t22 + s5*t4
+    t25 = c5*t4 - s5*t22
+    t26 = c6*t24 - s6*t23
+    t27 = c6*t23 + s6*t24
+    t28 = c7*t26 + s7*t25
+    t29 = c7*t25 - s7*t26
+    t30 = T00*t28 + T01*t29 + T02*t27
+    t31 = T10*t28 + T11*t29 + T12*t27
+    t32 = T20*t28 + T21*t29 + T22*t27
+    t33 = 0.5*t19 - 0.5*t30
+    t34 = c3*s2
+    t35 = c2*s4 - c4*t34
+    t36 = c2*c4 + s4*t34
+    t37 = s2*s3
+    t38 = c5*t35 + s5*t37
+    t39 = c5*t37 - s5*t35
+    t40 = c6*t38 - s6*t36
+    t41 = c6*t36 + s6*t38
+    t42 = c7*t40 + s7*t39
+    t43 = c7*t39 - s7*t40
+    t44 = c2*t9 + t11*t36 - t13*t39 + t15*t41 - t37*t7
+    t45 = c2*t21 + t23*t36 + t25*t39 + t27*t41 + t37*t4
+    t46 = T00*t42 + T01*t43 + T02*t41
+    t47 = T10*t42 + T11*t43 + T12*t41
+    t48 = T20*t42 + T21*t43 + T22*t41
+    t49 = 0.5*t32 - 0.5*t47
+    t50 = -0.5*t20 + 0.5*t46
+    t51 = 0.5*t18 + 0.5*t31 + 0.5*t48 - 0.5
+    t52 = numpy.sqrt(t33**2 + t49**2 + t50**2)
+    t53 = numpy.arctan2(t52, t51)
+    t54 = numpy.where(numpy.greater(t52, 0), t53/t52, 1)
+    t55 = 0.126*t15
+    t56 = 0.4*t11 + t55
+    t57 = t56 + 0.42*t9
+    t58 = T03 - t57
+    t59 = 0.126*t27
+    t60 = 0.4*t23 + t59
+    t61 = 0.42*t21 + t60
+    t62 = c1*t57 + s1*t61
+    t63 = t4*t56 + t60*t7
+    t64 = t11*t60 - t23*t56
+    t65 = t13*t59 + t25*t55
+    t66 = -t21*t57 + t61*t9
+    t67 = t62**2 + t63**2 + t64**2 + t65**2 + t66**2
+    t68 = c2*t66 + t36*t64 - t37*t63 - t39*t65
+    t69 = 0.126*t41
+    t70 = 0.4*t36 + t69
+    t71 = 0.42*c2 + t70
+    t72 = t71 + 0.36
+    t73 = t37*t60 - t4*t70
+    t74 = t23*t70 - t36*t60
+    t75 = t25*t69 - t39*t59
+    t76 = c2*t57 - t71*t9
+    t77 = t37*t56 + t7*t70
+    t78 = t13*t69 + t39*t55
+    t79 = -c2*t61 + t21*t71
+    t80 = -t11*t70 + t36*t56
+    t81 = c2*t76 + t36*t80 + t37*t77 + t39*t78 + t57
+    t82 = T23 - t72
+    t83 = t71**2
+    t84 = c1**2
+    t85 = t61**2 + t73**2 + t74**2 + t75**2 + t79**2 + t83*t84
+    t86 = t21*t79 + t23*t74 + t25*t75 - t4*t73 + t71*t84
+    t87 = c1*s1
+    t88 = -t57*t61 - t73*t77 + t74*t80 + t75*t78 + t76*t79 + t83*t87
+    t89 = -t61
+    t90 = c2*t79 + t36*t74 - t37*t73 + t39*t75 + t89
+    t91 = T13 + t89
+    t92 = c1*t62
+    t93 = t63*t73 + t64*t74 - t65*t75 + t66*t79 - t71*t92
+    t94 = -t21*t66 - t23*t64 + t25*t65 + t4*t63 + t92
+    t95 = t71*t87
+    t96 = t11*t74 - t13*t75 + t7*t73 + t79*t9 - t95
+    t97 = t21*t76 + t23*t80 + t25*t78 + t4*t77 + t95
+    t98 = s1**2
+    t99 = t57**2 + t76**2 + t77**2 + t78**2 + t80**2 + t83*t98
+    t100 = -t11*t80 + t13*t78 + t7*t77 + t71*t98 - t76*t9
+    t101 = s1*t62
+    t102 = t101*t71 + t63*t77 - t64*t80 + t65*t78 - t66*t76
+    t103 = t101 + t11*t64 + t13*t65 + t63*t7 + t66*t9
+    t104 = s2**2
+    t105 = t104*t84 + t11**2 + t13**2 + t15**2 + t7**2 + t98
+    t106 = t104*t87 + t11*t23 - t13*t25 + t15*t27 - t4*t7 - t87
+    t107 = t104*t98 + t23**2 + t25**2 + t27**2 + t4**2 + t84
+    t108 = c2**2 + s3**2*t104 + t36**2 + t39**2 + t41**2 + 1
+    t109 = (numpy.greater_equal(t18, t31)) & (numpy.greater_equal(t18, t48))
+    t110 = numpy.greater_equal(t31, t48)
+    t111 = numpy.where(t109, 0.5*t18 + 0.5, numpy.where(t110, 0.5*t30, 0.5*t46))
+    t112 = numpy.where(t109, 0.5*t19, numpy.where(t110, 0.5*t31 + 0.5, 0.5*t47))
+    t113 = numpy.where(t109, 0.5*t20, numpy.where(t110, 0.5*t32, 0.5*t48 + 0.5))
+    t114 = numpy.sqrt(t111**2 + t112**2 + t113**2)
+    t115 = numpy.where(numpy.greater_equal(t111*t49 + t112*t50 + t113*t33, 0), 1, -1)
+    t116 = (numpy.greater(t52, 1e-06)) | (numpy.greater(t51, 0))
+    t117 = t115*t53/t114
+    t118 = numpy.where(t116, t49*t54, t111*t117)
+    t119 = numpy.where(t116, t50*t54, t112*t117)
+    t120 = numpy.where(t116, t33*t54, t113*t117)
+    t121 = t118**2 + t119**2 + t120**2 + t58**2 + t82**2 + t91**2
+    t122 = damping + t85
+    t123 = numpy.sqrt(t122**2 + t86**2 + t88**2 + t90**2 + t93**2 + t96**2)
+    t124 = t123*numpy.where(numpy.greater_equal(t122, 0), 1, -1)
+    t125 = t122 + t124
+    t126 = numpy.where(numpy.greater(t123, 0), 1/(t123*(t123 + abs(t122))), 0)
+    t127 = t126*(t118*t96 + t119*t86 + t120*t90 + t125*t58 + t82*t93 + t88*t91)
+    t128 = -t125*t127 + t58
+    t129 = -t127*t88 + t91
+    t130 = -t127*t93 + t82
+    t131 = t118 - t127*t96
+    t132 = t119 - t127*t86
+    t133 = t120 - t127*t90
+    t134 = damping + t99
+    t135 = t126*(-t100*t96 - t102*t93 + t125*t88 + t134*t88 + t81*t90 + t86*t97)
+    t136 = -t125*t135 + t88
+    t137 = t134 - t135*t88
+    t138 = t102 + t135*t93
+    t139 = t100 + t135*t96
+    t140 = -t135*t86 + t97
+    t141 = -t135*t90 + t81
+    t142 = numpy.sqrt(t137**2 + t138**2 + t139**2 + t140**2 + t141**2)
+    t143 = t142*numpy.where(numpy.greater_equal(t137, 0), 1, -1)
+    t144 = t137 + t143
+    t145 = numpy.where(numpy.greater(t142, 0), 1/(t142*(t142 + abs(t137))), 0)
+    t146 = t145*(t129*t144 - t130*t138 - t131*t139 + t132*t140 + t133*t141)
+    t147 = t129 - t144*t146
+    t148 = t130 + t138*t146
+    t149 = t131 + t139*t146
+    t150 = t132 - t140*t146
+    t151 = t133 - t141*t146
+    t152 = damping + t67
+    t153 = t126*(-t102*t88 + t103*t96 + t125*t93 + t152*t93 + t68*t90 - t86*t94)
+    t154 = -t125*t153 + t93
+    t155 = t102 + t153*t88
+    t156 = t152 - t153*t93
+    t157 = t103 - t153*t96
+    t158 = t153*t86 + t94
+    t159 = -t153*t90 + t68
+    t160 = -t145*(t138*t156 + t139*t157 + t140*t158 - t141*t159 + t144*t155)
+    t161 = t144*t160 + t155
+    t162 = t138*t160 + t156
+    t163 = t139*t160 + t157
+    t164 = t140*t160 + t158
+    t165 = -t141*t160 + t159
+    t166 = numpy.sqrt(t162**2 + t163**2 + t164**2 + t165**2)
+    t167 = t166*numpy.where(numpy.greater_equal(t162, 0), 1, -1)
+    t168 = t162 + t167
+    t169 = numpy.where(numpy.greater(t166, 0), 1/(t166*(t166 + abs(t162))), 0)
+    t170 = t169*(t148*t168 + t149*t163 - t150*t164 + t151*t165)
+    t171 = t148 - t168*t170
+    t172 = t149 - t163*t170
+    t173 = t150 + t164*t170
+    t174 = t151 - t165*t170
+    t175 = damping + t105
+    t176 = t126*(-t100*t88 + t103*t93 + t106*t86 + t125*t96 + t175*t96 + t44*t90)
+    t177 = -t125*t176 + t96
+    t178 = t100 + t176*t88
+    t179 = t103 - t176*t93
+    t180 = t175 - t176*t96
+    t181 = t106 - t176*t86
+    t182 = -t176*t90 + t44
+    t183 = -t145*(t138*t179 + t139*t180 - t140*t181 - t141*t182 + t144*t178)
+    t184 = t144*t183 + t178
+    t185 = t138*t183 + t179
+    t186 = t139*t183 + t180
+    t187 = -t140*t183 + t181
+    t188 = -t141*t183 + t182
+    t189 = t169*(t163*t186 - t164*t187 + t165*t188 + t168*t185)
+    t190 = -t168*t189 + t185
+    t191 = -t163*t189 + t186
+    t192 = t164*t189 + t187
+    t193 = -t165*t189 + t188
+    t194 = numpy.sqrt(t191**2 + t192**2 + t193**2)
+    t195 = t194*numpy.where(numpy.greater_equal(t191, 0), 1, -1)
+    t196 = t191 + t195
+    t197 = numpy.where(numpy.greater(t194, 0), 1/(t194*(t194 + abs(t191))), 0)
+    t198 = t197*(t172*t196 + t173*t192 + t174*t193)
+    t199 = t172 - t196*t198
+    t200 = t173 - t192*t198
+    t201 = t174 - t193*t198
+    t202 = damping + t107
+    t203 = t126*(t106*t96 + t125*t86 + t202*t86 + t45*t90 + t88*t97 - t93*t94)
+    t204 = -t125*t203 + t86
+    t205 = -t203*t88 + t97
+    t206 = t203*t93 + t94
+    t207 = t106 - t203*t96
+    t208 = t202 - t203*t86
+    t209 = -t203*t90 + t45
+    t210 = t145*(t138*t206 - t139*t207 + t140*t208 + t141*t209 + t144*t205)
+    t211 = -t144*t210 + t205
+    t212 = t138*t210 - t206
+    t213 = t139*t210 + t207
+    t214 = -t140*t210 + t208
+    t215 = -t141*t210 + t209
+    t216 = t169*(t163*t213 - t164*t214 + t165*t215 + t168*t212)
+    t217 = -t168*t216 + t212
+    t218 = -t163*t216 + t213
+    t219 = t164*t216 + t214
+    t220 = -t165*t216 + t215
+    t221 = t197*(t192*t219 + t193*t220 + t196*t218)
+    t222 = -t196*t221 + t218
+    t223 = -t192*t221 + t219
+    t224 = -t193*t221 + t220
+    t225 = numpy.sqrt(t223**2 + t224**2)
+    t226 = t225*numpy.where(numpy.greater_equal(t223, 0), 1, -1)
+    t227 = t223 + t226
+    t228 = numpy.where(numpy.greater(t225, 0), 1/(t225*(t225 + abs(t223))), 0)
+    t229 = t228*(t200*t227 + t201*t224)
+    t230 = t200 - t227*t229
+    t231 = t201 - t224*t229
+    t232 = damping + t108
+    t233 = t126*(t125*t90 + t232*t90 + t44*t96 + t45*t86 + t68*t93 + t81*t88)
+    t234 = -t125*t233 + t90
+    t235 = -t233*t88 + t81
+    t236 = -t233*t93 + t68
+    t237 = -t233*t96 + t44
+    t238 = -t233*t86 + t45
+    t239 = t232 - t233*t90
+    t240 = t145*(-t138*t236 - t139*t237 + t140*t238 + t141*t239 + t144*t235)
+    t241 = -t144*t240 + t235
+    t242 = t138*t240 + t236
+    t243 = t139*t240 + t237
+    t244 = -t140*t240 + t238
+    t245 = -t141*t240 + t239
+    t246 = t169*(t163*t243 - t164*t244 + t165*t245 + t168*t242)
+    t247 = -t168*t246 + t242
+    t248 = -t163*t246 + t243
+    t249 = t164*t246 + t244
+    t250 = -t165*t246 + t245
+    t251 = t197*(t192*t249 + t193*t250 + t196*t248)
+    t252 = -t196*t251 + t248
+    t253 = -t192*t251 + t249
+    t254 = -t193*t251 + t250
+    t255 = t228*(t224*t254 + t227*t253)
+    t256 = -t227*t255 + t253
+    t257 = -t224*t255 + t254
+    t258 = abs(t257)
+    t259 = t258
+    t260 = t259*numpy.where(numpy.greater_equal(t257, 0), 1, -1)
+    t261 = t257 + t260
+    t262 = numpy.where(numpy.greater(t259, 0), 1/(t259*(t258 + t259)), 0)
+    t263 = -t231*t261**2*t262 + t231
+    t264 = t263/t260
+    t265 = (t230 + t256*t264)/t226
+    t266 = (t199 + t222*t265 + t252*t264)/t195
+    t267 = (t171 + t190*t266 + t217*t265 + t247*t264)/t167
+    t268 = (t147 - t161*t267 - t184*t266 + t211*t265 + t241*t264)/t143
+    t269 = (t128 + t136*t268 + t154*t267 + t177*t266 + t204*t265 + t234*t264)/t124
+    t270 = q1 - t264 - t268*t57 + t269*t61
+    t271 = -c1*t265 - c1*t269*t71 + q2 + s1*t266 - s1*t268*t71 + t267*t62
+    t272 = c2*t264 - q3 + t21*t265 + t266*t9 + t267*t66 + t268*t76 + t269*t79
+    t273 = q4 + t264*t37 + t265*t4 - t266*t7 - t267*t63 + t268*t77 - t269*t73
+    t274 = -q5 + t11*t266 + t23*t265 + t264*t36 + t267*t64 + t268*t80 + t269*t74
+    t275 = -q6 - t13*t266 + t25*t265 + t264*t39 - t267*t65 + t268*t78 + t269*t75
+    t276 = -q7 + t15*t266 + t264*t41 + t265*t27
+    q_start = numpy.empty(numpy.broadcast_shapes(target.shape[:-2], q.shape[:-1], damping.shape) + (7,))
+    q_start[..., 0] = q1
+    q_start[..., 1] = q2
+    q_start[..., 2] = q3
+    q_start[..., 3] = q4
+    q_start[..., 4] = q5
+    q_start[..., 5] = q6
+    q_start[..., 6] = q7
+    q_next = numpy.empty(numpy.broadcast_shapes(target.shape[:-2], q.shape[:-1], damping.shape) + (7,))
+    q_next[..., 0] = numpy.where(numpy.less(t270, -2.9670597283903604), -2.9670597283903604, numpy.where(numpy.greater(t270, 2.9670597283903604), 2.9670597283903604, t270))
+    q_next[..., 1] = numpy.where(numpy.less(t271, -2.0943951023931953), -2.0943951023931953, numpy.where(numpy.greater(t271, 2.0943951023931953), 2.0943951023931953, t271))
+    q_next[..., 2] = numpy.where(numpy.greater(t272, 2.9670597283903604), -2.9670597283903604, numpy.where(numpy.less(t272, -2.9670597283903604), 2.9670597283903604, -t272))
+    q_next[..., 3] = numpy.where(numpy.less(t273, -2.0943951023931953), -2.0943951023931953, numpy.where(numpy.greater(t273, 2.0943951023931953), 2.0943951023931953, t273))
+    q_next[..., 4] = numpy.where(numpy.greater(t274, 2.9670597283903604), -2.9670597283903604, numpy.where(numpy.less(t274, -2.9670597283903604), 2.9670597283903604, -t274))
+    q_next[..., 5] = numpy.where(numpy.greater(t275, 2.0943951023931953), -2.0943951023931953, numpy.where(numpy.less(t275, -2.0943951023931953), 2.0943951023931953, -t275))
+    q_next[..., 6] = numpy.where(numpy.greater(t276, 3.0543261909900767), -3.0543261909900767, numpy.where(numpy.less(t276, -3.0543261909900767), 3.0543261909900767, -t276))
+    cost = numpy.empty(numpy.broadcast_shapes(target.shape[:-2], q.shape[:-1], damping.shape) + ())
+    cost[...] = numpy.where(numpy.isfinite(t0), t121, -1)
+    return q_start, q_next, cost
+
+
+# -- Iterative inverse kinematics: the loop around ik_numeric_step --
 
 IK_NUMERIC_CONVERGED = 0  # |error| <= tol
 IK_NUMERIC_ITERATION_LIMIT = 1  # max_iter steps tried, |error| still above tol
 IK_NUMERIC_STALLED = 2  # no step reduces the error: unreachable target, joint limit or local minimum
-_LOWER = numpy.array([-2.9670597283903604, -2.0943951023931953, -2.9670597283903604, -2.0943951023931953, -2.9670597283903604, -2.0943951023931953, -3.0543261909900767])  # joint limits (infinite: none)
-_UPPER = numpy.array([2.9670597283903604, 2.0943951023931953, 2.9670597283903604, 2.0943951023931953, 2.9670597283903604, 2.0943951023931953, 3.0543261909900767])
+IK_NUMERIC_INVALID = 3  # target or q0 not finite, or max_iter < 0: q = q0
 _DAMPING = (1e-06, 1e-12, 100000000.0)  # added to the diagonal: start, least, most
-
-
-def _rotation_vector(E):
-    """The rotation vector (axis times angle in [0, pi]) of the rotation matrix E."""
-    v = 0.5 * numpy.array([E[2, 1] - E[1, 2], E[0, 2] - E[2, 0], E[1, 0] - E[0, 1]])
-    cos = 0.5 * (numpy.trace(E) - 1.0)
-    sin = numpy.linalg.norm(v)
-    angle = math.atan2(sin, cos)
-    if sin > 1e-6 or cos > 0.0:
-        return v * (angle / sin) if sin > 0.0 else v
-    # Near a half turn: the axis from the largest column of (E + I) / 2 = u u^T.
-    column = int(numpy.argmax(numpy.diag(E)))
-    axis = 0.5 * (E[:, column] + numpy.eye(3)[column])
-    axis /= numpy.linalg.norm(axis)
-    return angle * (axis if axis @ v >= 0.0 else -axis)
-
-
-def _task_error(target, q):
-    """Error [target position - position; rotation vector of target R^T] and the geometric Jacobian."""
-    T = fk(q)
-    error = numpy.concatenate([target[:3, 3] - T[:3, 3], _rotation_vector(target[:3, :3] @ T[:3, :3].T)])
-    return error, jacobian(q)
 
 
 def ik_numeric(target, q0, max_iter=100, tol=1e-10):
     """Iterative inverse kinematics from q0: damped least squares on the task error.
 
-    target: the 4x4 tool pose in the world frame.
-    Each step is q += J^T (J J^T + damping I)^-1 e, with e the task error
+    target: the 4x4 tool pose in the world frame, or a batch of them with q0 (..., DOF).
+    Each step is ik_numeric_step: q += J^T (J J^T + damping I)^-1 e, with e the task error
     (position error and rotation vector of R_target R^T, world frame) and J its Jacobian; joints are clamped to their limits.
     The damping adapts (Levenberg-Marquardt): divided by 10 after a step that lowers |e|,
     multiplied by 10 and the step discarded otherwise.
-    Returns (q, status): status IK_NUMERIC_CONVERGED (|e| <= tol), IK_NUMERIC_ITERATION_LIMIT
-    (max_iter steps tried) or IK_NUMERIC_STALLED (no step lowers |e|: out of reach, a joint
-    limit or a local minimum); q is the best configuration found.
+    Returns (q, status), status an IK_NUMERIC_* code per target; q is the best configuration
+    found.
     """
-    target = numpy.asarray(target, dtype=float)
-    q = numpy.asarray(q0, dtype=float)
-    if target.shape != (4, 4) or q.shape != (DOF,):
-        raise ValueError(f"expected target (4, 4) and q0 ({DOF},), got {target.shape} and {q.shape}")
-    q = numpy.clip(q, _LOWER, _UPPER)
-    error, J = _task_error(target, q)
-    cost = error @ error
-    damping, least, most = _DAMPING
-    for _ in range(max_iter):
-        if cost <= tol * tol:
-            return q, IK_NUMERIC_CONVERGED
-        step = J.T @ numpy.linalg.solve(J @ J.T + damping * numpy.eye(J.shape[0]), error)
-        trial = numpy.clip(q + step, _LOWER, _UPPER)
-        trial_error, trial_J = _task_error(target, trial)
-        trial_cost = trial_error @ trial_error
-        if trial_cost < cost:
-            q, error, J, cost = trial, trial_error, trial_J, trial_cost
-            damping = max(damping * 0.1, least)
-        else:
-            damping *= 10.0
-            if damping > most:
-                return q, IK_NUMERIC_STALLED
-    return q, IK_NUMERIC_CONVERGED if cost <= tol * tol else IK_NUMERIC_ITERATION_LIMIT
+    least, most = _DAMPING[1:]
+    q, trial, cost = ik_numeric_step(target, q0, _DAMPING[0])
+    damping = cost * 0.0 + _DAMPING[0]
+    status = numpy.where((cost >= 0.0) & (max_iter >= 0), IK_NUMERIC_ITERATION_LIMIT, IK_NUMERIC_INVALID)
+    for _ in range(max(max_iter, 0)):
+        status = numpy.where(numpy.logical_and(status == IK_NUMERIC_ITERATION_LIMIT, cost <= tol * tol), IK_NUMERIC_CONVERGED, status)
+        active = status == IK_NUMERIC_ITERATION_LIMIT
+        if not active.any():
+            break
+        lighter = numpy.maximum(damping * 0.1, least)
+        _, after, trial_cost = ik_numeric_step(target, trial, lighter)
+        better = numpy.logical_and(active, trial_cost < cost)
+        worse = numpy.logical_and(active, trial_cost >= cost)
+        q = numpy.where(better[..., None], trial, q)
+        cost = numpy.where(better, trial_cost, cost)
+        damping = numpy.where(better, lighter, numpy.where(worse, damping * 10.0, damping))
+        status = numpy.where(numpy.logical_and(worse, damping > most), IK_NUMERIC_STALLED, status)
+        _, retry, _ = ik_numeric_step(target, q, damping)
+        trial = numpy.where(better[..., None], after, numpy.where(worse[..., None], retry, trial))
+    status = numpy.where(numpy.logical_and(status == IK_NUMERIC_ITERATION_LIMIT, cost <= tol * tol), IK_NUMERIC_CONVERGED, status)
+    q = numpy.where((status == IK_NUMERIC_INVALID)[..., None], numpy.asarray(q0, dtype=float), q)
+    return q, status[()] if status.ndim == 0 else status
 
 
 # Statuses of velocity_ik: OK, singular (a diagonal entry of the QR factor R of the

@@ -1303,9 +1303,350 @@ def _velocity_ik(q, mu_dot, damping):
     return [q_dot, status]
 
 
+def _ik_numeric_step(target, q, damping):
+    """One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite): 1123 operations."""
+    T00 = target[0, 0]
+    T01 = target[0, 1]
+    T02 = target[0, 2]
+    T03 = target[0, 3]
+    T10 = target[1, 0]
+    T11 = target[1, 1]
+    T12 = target[1, 2]
+    T13 = target[1, 3]
+    T20 = target[2, 0]
+    T21 = target[2, 1]
+    T22 = target[2, 2]
+    T23 = target[2, 3]
+    qs1 = q[0]
+    qs2 = q[1]
+    qs3 = q[2]
+    qs4 = q[3]
+    qs5 = q[4]
+    qs6 = q[5]
+    qs7 = q[6]
+    q1 = casadi.if_else((qs1 < -2.9670597283903604), -2.9670597283903604, casadi.if_else((qs1 > 2.9670597283903604), 2.9670597283903604, qs1))
+    q2 = casadi.if_else((qs2 < -2.0943951023931953), -2.0943951023931953, casadi.if_else((qs2 > 2.0943951023931953), 2.0943951023931953, qs2))
+    q3 = casadi.if_else((qs3 < -2.9670597283903604), -2.9670597283903604, casadi.if_else((qs3 > 2.9670597283903604), 2.9670597283903604, qs3))
+    q4 = casadi.if_else((qs4 < -2.0943951023931953), -2.0943951023931953, casadi.if_else((qs4 > 2.0943951023931953), 2.0943951023931953, qs4))
+    q5 = casadi.if_else((qs5 < -2.9670597283903604), -2.9670597283903604, casadi.if_else((qs5 > 2.9670597283903604), 2.9670597283903604, qs5))
+    q6 = casadi.if_else((qs6 < -2.0943951023931953), -2.0943951023931953, casadi.if_else((qs6 > 2.0943951023931953), 2.0943951023931953, qs6))
+    q7 = casadi.if_else((qs7 < -3.0543261909900767), -3.0543261909900767, casadi.if_else((qs7 > 3.0543261909900767), 3.0543261909900767, qs7))
+    c1 = casadi.cos(q1)
+    s1 = casadi.sin(q1)
+    c2 = casadi.cos(q2)
+    s2 = casadi.sin(q2)
+    c3 = casadi.cos(q3)
+    s3 = casadi.sin(q3)
+    c4 = casadi.cos(q4)
+    s4 = casadi.sin(q4)
+    c5 = casadi.cos(q5)
+    s5 = casadi.sin(q5)
+    c6 = casadi.cos(q6)
+    s6 = casadi.sin(q6)
+    c7 = casadi.cos(q7)
+    s7 = casadi.sin(q7)
+    t0 = T00 + T01 + T02 + T03 + T10 + T11 + T12 + T13 + T20 + T21 + T22 + T23 + qs1 + qs2 + qs3 + qs4 + qs5 + qs6 + qs7
+    t1 = s1*s3
+    t2 = c1*c3
+    t3 = c2*t2 - t1
+    t4 = -c2*t1 + t2
+    t5 = c3*s1
+    t6 = c1*s3
+    t7 = c2*t6 + t5
+    t8 = c2*t5 + t6
+    t9 = c1*s2
+    t10 = c4*t3 + s4*t9
+    t11 = c4*t9 - s4*t3
+    t12 = c5*t10 - s5*t7
+    t13 = c5*t7 + s5*t10
+    t14 = c6*t12 - s6*t11
+    t15 = c6*t11 + s6*t12
+    t16 = c7*t14 - s7*t13
+    t17 = c7*t13 + s7*t14
+    t18 = T00*t16 - T01*t17 + T02*t15
+    t19 = T10*t16 - T11*t17 + T12*t15
+    t20 = T20*t16 - T21*t17 + T22*t15
+    t21 = s1*s2
+    t22 = c4*t8 + s4*t21
+    t23 = c4*t21 - s4*t8
+    t24 = c5*t22 + s5*t4
+    t25 = c5*t4 - s5*t22
+    t26 = c6*t24 - s6*t23
+    t27 = c6*t23 + s6*t24
+    t28 = c7*t26 + s7*t25
+    t29 = c7*t25 - s7*t26
+    t30 = T00*t28 + T01*t29 + T02*t27
+    t31 = T10*t28 + T11*t29 + T12*t27
+    t32 = T20*t28 + T21*t29 + T22*t27
+    t33 = 0.5*t19 - 0.5*t30
+    t34 = c3*s2
+    t35 = c2*s4 - c4*t34
+    t36 = c2*c4 + s4*t34
+    t37 = s2*s3
+    t38 = c5*t35 + s5*t37
+    t39 = c5*t37 - s5*t35
+    t40 = c6*t38 - s6*t36
+    t41 = c6*t36 + s6*t38
+    t42 = c7*t40 + s7*t39
+    t43 = c7*t39 - s7*t40
+    t44 = c2*t9 + t11*t36 - t13*t39 + t15*t41 - t37*t7
+    t45 = c2*t21 + t23*t36 + t25*t39 + t27*t41 + t37*t4
+    t46 = T00*t42 + T01*t43 + T02*t41
+    t47 = T10*t42 + T11*t43 + T12*t41
+    t48 = T20*t42 + T21*t43 + T22*t41
+    t49 = 0.5*t32 - 0.5*t47
+    t50 = -0.5*t20 + 0.5*t46
+    t51 = 0.5*t18 + 0.5*t31 + 0.5*t48 - 0.5
+    t52 = casadi.sqrt(t33**2 + t49**2 + t50**2)
+    t53 = casadi.atan2(t52, t51)
+    t54 = casadi.if_else((t52 > 0), t53/t52, 1)
+    t55 = 0.126*t15
+    t56 = 0.4*t11 + t55
+    t57 = t56 + 0.42*t9
+    t58 = T03 - t57
+    t59 = 0.126*t27
+    t60 = 0.4*t23 + t59
+    t61 = 0.42*t21 + t60
+    t62 = c1*t57 + s1*t61
+    t63 = t4*t56 + t60*t7
+    t64 = t11*t60 - t23*t56
+    t65 = t13*t59 + t25*t55
+    t66 = -t21*t57 + t61*t9
+    t67 = t62**2 + t63**2 + t64**2 + t65**2 + t66**2
+    t68 = c2*t66 + t36*t64 - t37*t63 - t39*t65
+    t69 = 0.126*t41
+    t70 = 0.4*t36 + t69
+    t71 = 0.42*c2 + t70
+    t72 = t71 + 0.36
+    t73 = t37*t60 - t4*t70
+    t74 = t23*t70 - t36*t60
+    t75 = t25*t69 - t39*t59
+    t76 = c2*t57 - t71*t9
+    t77 = t37*t56 + t7*t70
+    t78 = t13*t69 + t39*t55
+    t79 = -c2*t61 + t21*t71
+    t80 = -t11*t70 + t36*t56
+    t81 = c2*t76 + t36*t80 + t37*t77 + t39*t78 + t57
+    t82 = T23 - t72
+    t83 = t71**2
+    t84 = c1**2
+    t85 = t61**2 + t73**2 + t74**2 + t75**2 + t79**2 + t83*t84
+    t86 = t21*t79 + t23*t74 + t25*t75 - t4*t73 + t71*t84
+    t87 = c1*s1
+    t88 = -t57*t61 - t73*t77 + t74*t80 + t75*t78 + t76*t79 + t83*t87
+    t89 = -t61
+    t90 = c2*t79 + t36*t74 - t37*t73 + t39*t75 + t89
+    t91 = T13 + t89
+    t92 = c1*t62
+    t93 = t63*t73 + t64*t74 - t65*t75 + t66*t79 - t71*t92
+    t94 = -t21*t66 - t23*t64 + t25*t65 + t4*t63 + t92
+    t95 = t71*t87
+    t96 = t11*t74 - t13*t75 + t7*t73 + t79*t9 - t95
+    t97 = t21*t76 + t23*t80 + t25*t78 + t4*t77 + t95
+    t98 = s1**2
+    t99 = t57**2 + t76**2 + t77**2 + t78**2 + t80**2 + t83*t98
+    t100 = -t11*t80 + t13*t78 + t7*t77 + t71*t98 - t76*t9
+    t101 = s1*t62
+    t102 = t101*t71 + t63*t77 - t64*t80 + t65*t78 - t66*t76
+    t103 = t101 + t11*t64 + t13*t65 + t63*t7 + t66*t9
+    t104 = s2**2
+    t105 = t104*t84 + t11**2 + t13**2 + t15**2 + t7**2 + t98
+    t106 = t104*t87 + t11*t23 - t13*t25 + t15*t27 - t4*t7 - t87
+    t107 = t104*t98 + t23**2 + t25**2 + t27**2 + t4**2 + t84
+    t108 = c2**2 + s3**2*t104 + t36**2 + t39**2 + t41**2 + 1
+    t109 = casadi.logic_and((t18 >= t31), (t18 >= t48))
+    t110 = (t31 >= t48)
+    t111 = casadi.if_else(t109, 0.5*t18 + 0.5, casadi.if_else(t110, 0.5*t30, 0.5*t46))
+    t112 = casadi.if_else(t109, 0.5*t19, casadi.if_else(t110, 0.5*t31 + 0.5, 0.5*t47))
+    t113 = casadi.if_else(t109, 0.5*t20, casadi.if_else(t110, 0.5*t32, 0.5*t48 + 0.5))
+    t114 = casadi.sqrt(t111**2 + t112**2 + t113**2)
+    t115 = casadi.if_else((t111*t49 + t112*t50 + t113*t33 >= 0), 1, -1)
+    t116 = casadi.logic_or((t52 > 1e-06), (t51 > 0))
+    t117 = t115*t53/t114
+    t118 = casadi.if_else(t116, t49*t54, t111*t117)
+    t119 = casadi.if_else(t116, t50*t54, t112*t117)
+    t120 = casadi.if_else(t116, t33*t54, t113*t117)
+    t121 = t118**2 + t119**2 + t120**2 + t58**2 + t82**2 + t91**2
+    t122 = damping + t85
+    t123 = casadi.sqrt(t122**2 + t86**2 + t88**2 + t90**2 + t93**2 + t96**2)
+    t124 = t123*casadi.if_else((t122 >= 0), 1, -1)
+    t125 = t122 + t124
+    t126 = casadi.if_else((t123 > 0), 1/(t123*(t123 + casadi.fabs(t122))), 0)
+    t127 = t126*(t118*t96 + t119*t86 + t120*t90 + t125*t58 + t82*t93 + t88*t91)
+    t128 = -t125*t127 + t58
+    t129 = -t127*t88 + t91
+    t130 = -t127*t93 + t82
+    t131 = t118 - t127*t96
+    t132 = t119 - t127*t86
+    t133 = t120 - t127*t90
+    t134 = damping + t99
+    t135 = t126*(-t100*t96 - t102*t93 + t125*t88 + t134*t88 + t81*t90 + t86*t97)
+    t136 = -t125*t135 + t88
+    t137 = t134 - t135*t88
+    t138 = t102 + t135*t93
+    t139 = t100 + t135*t96
+    t140 = -t135*t86 + t97
+    t141 = -t135*t90 + t81
+    t142 = casadi.sqrt(t137**2 + t138**2 + t139**2 + t140**2 + t141**2)
+    t143 = t142*casadi.if_else((t137 >= 0), 1, -1)
+    t144 = t137 + t143
+    t145 = casadi.if_else((t142 > 0), 1/(t142*(t142 + casadi.fabs(t137))), 0)
+    t146 = t145*(t129*t144 - t130*t138 - t131*t139 + t132*t140 + t133*t141)
+    t147 = t129 - t144*t146
+    t148 = t130 + t138*t146
+    t149 = t131 + t139*t146
+    t150 = t132 - t140*t146
+    t151 = t133 - t141*t146
+    t152 = damping + t67
+    t153 = t126*(-t102*t88 + t103*t96 + t125*t93 + t152*t93 + t68*t90 - t86*t94)
+    t154 = -t125*t153 + t93
+    t155 = t102 + t153*t88
+    t156 = t152 - t153*t93
+    t157 = t103 - t153*t96
+    t158 = t153*t86 + t94
+    t159 = -t153*t90 + t68
+    t160 = -t145*(t138*t156 + t139*t157 + t140*t158 - t141*t159 + t144*t155)
+    t161 = t144*t160 + t155
+    t162 = t138*t160 + t156
+    t163 = t139*t160 + t157
+    t164 = t140*t160 + t158
+    t165 = -t141*t160 + t159
+    t166 = casadi.sqrt(t162**2 + t163**2 + t164**2 + t165**2)
+    t167 = t166*casadi.if_else((t162 >= 0), 1, -1)
+    t168 = t162 + t167
+    t169 = casadi.if_else((t166 > 0), 1/(t166*(t166 + casadi.fabs(t162))), 0)
+    t170 = t169*(t148*t168 + t149*t163 - t150*t164 + t151*t165)
+    t171 = t148 - t168*t170
+    t172 = t149 - t163*t170
+    t173 = t150 + t164*t170
+    t174 = t151 - t165*t170
+    t175 = damping + t105
+    t176 = t126*(-t100*t88 + t103*t93 + t106*t86 + t125*t96 + t175*t96 + t44*t90)
+    t177 = -t125*t176 + t96
+    t178 = t100 + t176*t88
+    t179 = t103 - t176*t93
+    t180 = t175 - t176*t96
+    t181 = t106 - t176*t86
+    t182 = -t176*t90 + t44
+    t183 = -t145*(t138*t179 + t139*t180 - t140*t181 - t141*t182 + t144*t178)
+    t184 = t144*t183 + t178
+    t185 = t138*t183 + t179
+    t186 = t139*t183 + t180
+    t187 = -t140*t183 + t181
+    t188 = -t141*t183 + t182
+    t189 = t169*(t163*t186 - t164*t187 + t165*t188 + t168*t185)
+    t190 = -t168*t189 + t185
+    t191 = -t163*t189 + t186
+    t192 = t164*t189 + t187
+    t193 = -t165*t189 + t188
+    t194 = casadi.sqrt(t191**2 + t192**2 + t193**2)
+    t195 = t194*casadi.if_else((t191 >= 0), 1, -1)
+    t196 = t191 + t195
+    t197 = casadi.if_else((t194 > 0), 1/(t194*(t194 + casadi.fabs(t191))), 0)
+    t198 = t197*(t172*t196 + t173*t192 + t174*t193)
+    t199 = t172 - t196*t198
+    t200 = t173 - t192*t198
+    t201 = t174 - t193*t198
+    t202 = damping + t107
+    t203 = t126*(t106*t96 + t125*t86 + t202*t86 + t45*t90 + t88*t97 - t93*t94)
+    t204 = -t125*t203 + t86
+    t205 = -t203*t88 + t97
+    t206 = t203*t93 + t94
+    t207 = t106 - t203*t96
+    t208 = t202 - t203*t86
+    t209 = -t203*t90 + t45
+    t210 = t145*(t138*t206 - t139*t207 + t140*t208 + t141*t209 + t144*t205)
+    t211 = -t144*t210 + t205
+    t212 = t138*t210 - t206
+    t213 = t139*t210 + t207
+    t214 = -t140*t210 + t208
+    t215 = -t141*t210 + t209
+    t216 = t169*(t163*t213 - t164*t214 + t165*t215 + t168*t212)
+    t217 = -t168*t216 + t212
+    t218 = -t163*t216 + t213
+    t219 = t164*t216 + t214
+    t220 = -t165*t216 + t215
+    t221 = t197*(t192*t219 + t193*t220 + t196*t218)
+    t222 = -t196*t221 + t218
+    t223 = -t192*t221 + t219
+    t224 = -t193*t221 + t220
+    t225 = casadi.sqrt(t223**2 + t224**2)
+    t226 = t225*casadi.if_else((t223 >= 0), 1, -1)
+    t227 = t223 + t226
+    t228 = casadi.if_else((t225 > 0), 1/(t225*(t225 + casadi.fabs(t223))), 0)
+    t229 = t228*(t200*t227 + t201*t224)
+    t230 = t200 - t227*t229
+    t231 = t201 - t224*t229
+    t232 = damping + t108
+    t233 = t126*(t125*t90 + t232*t90 + t44*t96 + t45*t86 + t68*t93 + t81*t88)
+    t234 = -t125*t233 + t90
+    t235 = -t233*t88 + t81
+    t236 = -t233*t93 + t68
+    t237 = -t233*t96 + t44
+    t238 = -t233*t86 + t45
+    t239 = t232 - t233*t90
+    t240 = t145*(-t138*t236 - t139*t237 + t140*t238 + t141*t239 + t144*t235)
+    t241 = -t144*t240 + t235
+    t242 = t138*t240 + t236
+    t243 = t139*t240 + t237
+    t244 = -t140*t240 + t238
+    t245 = -t141*t240 + t239
+    t246 = t169*(t163*t243 - t164*t244 + t165*t245 + t168*t242)
+    t247 = -t168*t246 + t242
+    t248 = -t163*t246 + t243
+    t249 = t164*t246 + t244
+    t250 = -t165*t246 + t245
+    t251 = t197*(t192*t249 + t193*t250 + t196*t248)
+    t252 = -t196*t251 + t248
+    t253 = -t192*t251 + t249
+    t254 = -t193*t251 + t250
+    t255 = t228*(t224*t254 + t227*t253)
+    t256 = -t227*t255 + t253
+    t257 = -t224*t255 + t254
+    t258 = casadi.fabs(t257)
+    t259 = t258
+    t260 = t259*casadi.if_else((t257 >= 0), 1, -1)
+    t261 = t257 + t260
+    t262 = casadi.if_else((t259 > 0), 1/(t259*(t258 + t259)), 0)
+    t263 = -t231*t261**2*t262 + t231
+    t264 = t263/t260
+    t265 = (t230 + t256*t264)/t226
+    t266 = (t199 + t222*t265 + t252*t264)/t195
+    t267 = (t171 + t190*t266 + t217*t265 + t247*t264)/t167
+    t268 = (t147 - t161*t267 - t184*t266 + t211*t265 + t241*t264)/t143
+    t269 = (t128 + t136*t268 + t154*t267 + t177*t266 + t204*t265 + t234*t264)/t124
+    t270 = q1 - t264 - t268*t57 + t269*t61
+    t271 = -c1*t265 - c1*t269*t71 + q2 + s1*t266 - s1*t268*t71 + t267*t62
+    t272 = c2*t264 - q3 + t21*t265 + t266*t9 + t267*t66 + t268*t76 + t269*t79
+    t273 = q4 + t264*t37 + t265*t4 - t266*t7 - t267*t63 + t268*t77 - t269*t73
+    t274 = -q5 + t11*t266 + t23*t265 + t264*t36 + t267*t64 + t268*t80 + t269*t74
+    t275 = -q6 - t13*t266 + t25*t265 + t264*t39 - t267*t65 + t268*t78 + t269*t75
+    t276 = -q7 + t15*t266 + t264*t41 + t265*t27
+    q_start = casadi.SX(7, 1)
+    q_start[0, 0] = q1
+    q_start[1, 0] = q2
+    q_start[2, 0] = q3
+    q_start[3, 0] = q4
+    q_start[4, 0] = q5
+    q_start[5, 0] = q6
+    q_start[6, 0] = q7
+    q_next = casadi.SX(7, 1)
+    q_next[0, 0] = casadi.if_else((t270 < -2.9670597283903604), -2.9670597283903604, casadi.if_else((t270 > 2.9670597283903604), 2.9670597283903604, t270))
+    q_next[1, 0] = casadi.if_else((t271 < -2.0943951023931953), -2.0943951023931953, casadi.if_else((t271 > 2.0943951023931953), 2.0943951023931953, t271))
+    q_next[2, 0] = casadi.if_else((t272 > 2.9670597283903604), -2.9670597283903604, casadi.if_else((t272 < -2.9670597283903604), 2.9670597283903604, -t272))
+    q_next[3, 0] = casadi.if_else((t273 < -2.0943951023931953), -2.0943951023931953, casadi.if_else((t273 > 2.0943951023931953), 2.0943951023931953, t273))
+    q_next[4, 0] = casadi.if_else((t274 > 2.9670597283903604), -2.9670597283903604, casadi.if_else((t274 < -2.9670597283903604), 2.9670597283903604, -t274))
+    q_next[5, 0] = casadi.if_else((t275 > 2.0943951023931953), -2.0943951023931953, casadi.if_else((t275 < -2.0943951023931953), 2.0943951023931953, -t275))
+    q_next[6, 0] = casadi.if_else((t276 > 3.0543261909900767), -3.0543261909900767, casadi.if_else((t276 < -3.0543261909900767), 3.0543261909900767, -t276))
+    cost = casadi.SX(1, 1)
+    cost[0, 0] = casadi.if_else((casadi.fabs(t0) < casadi.inf), t121, -1)
+    return [q_start, q_next, cost]
+
+
 _q = casadi.SX.sym("q", 7, 1)
 _mu_dot = casadi.SX.sym("mu_dot", 6, 1)
 _damping = casadi.SX.sym("damping", 1, 1)
+_target = casadi.SX.sym("target", 4, 4)
 fk = casadi.Function("fk", [_q], _fk(_q), ["q"], ["T"])
 jacobian = casadi.Function("jacobian", [_q], _jacobian(_q), ["q"], ["J"])
 fk_jacobian = casadi.Function("fk_jacobian", [_q], _fk_jacobian(_q), ["q"], ["T", "J"])
@@ -1315,8 +1656,46 @@ task_jacobian = casadi.Function("task_jacobian", [_q], _task_jacobian(_q), ["q"]
 singularity_factors = casadi.Function("singularity_factors", [_q], _singularity_factors(_q), ["q"], ["f"])
 manipulability = casadi.Function("manipulability", [_q], _manipulability(_q), ["q"], ["w"])
 velocity_ik = casadi.Function("velocity_ik", [_q, _mu_dot, _damping], _velocity_ik(_q, _mu_dot, _damping), ["q", "mu_dot", "damping"], ["q_dot", "status"])
+ik_numeric_step = casadi.Function("ik_numeric_step", [_target, _q, _damping], _ik_numeric_step(_target, _q, _damping), ["target", "q", "damping"], ["q_start", "q_next", "cost"])
+
+IK_NUMERIC_CONVERGED = 0  # |error| <= tol
+IK_NUMERIC_ITERATION_LIMIT = 1  # IK_NUMERIC_ITERATIONS steps taken, |error| still above tol
+IK_NUMERIC_STALLED = 2  # no step reduces the error: unreachable target, joint limit or local minimum
+IK_NUMERIC_INVALID = 3  # target or q0 not finite: q = q0
+IK_NUMERIC_ITERATIONS = 100
+_DAMPING = (1e-06, 1e-12, 100000000.0)  # added to the diagonal: start, least, most
+
+
+def _ik_numeric(target, q0, tol):
+    """ik_numeric of the C and numpy modules with a fixed number of steps: every branch of
+    the loop is a select, so the graph is the same for every input."""
+    least, most = _DAMPING[1:]
+    q, trial, cost = ik_numeric_step(target, q0, _DAMPING[0])
+    damping = cost * 0.0 + _DAMPING[0]
+    status = casadi.if_else(cost >= 0.0, IK_NUMERIC_ITERATION_LIMIT, IK_NUMERIC_INVALID)
+    for _ in range(IK_NUMERIC_ITERATIONS):
+        status = casadi.if_else(casadi.logic_and(status == IK_NUMERIC_ITERATION_LIMIT, cost <= tol * tol), IK_NUMERIC_CONVERGED, status)
+        active = status == IK_NUMERIC_ITERATION_LIMIT
+        lighter = casadi.fmax(damping * 0.1, least)
+        _, after, trial_cost = ik_numeric_step(target, trial, lighter)
+        better = casadi.logic_and(active, trial_cost < cost)
+        worse = casadi.logic_and(active, trial_cost >= cost)
+        q = casadi.if_else(better, trial, q)
+        cost = casadi.if_else(better, trial_cost, cost)
+        damping = casadi.if_else(better, lighter, casadi.if_else(worse, damping * 10.0, damping))
+        status = casadi.if_else(casadi.logic_and(worse, damping > most), IK_NUMERIC_STALLED, status)
+        _, retry, _ = ik_numeric_step(target, q, damping)
+        trial = casadi.if_else(better, after, casadi.if_else(worse, retry, trial))
+    status = casadi.if_else(casadi.logic_and(status == IK_NUMERIC_ITERATION_LIMIT, cost <= tol * tol), IK_NUMERIC_CONVERGED, status)
+    q = casadi.if_else((status == IK_NUMERIC_INVALID), q0, q)
+    return [q, status]
+
+
+_tol = casadi.SX.sym("tol")
+ik_numeric = casadi.Function("ik_numeric", [_target, _q, _tol], _ik_numeric(_target, _q, _tol),
+                             ["target", "q0", "tol"], ["q", "status"])
 
 
 def functions():
     """All functions by name."""
-    return {"fk": fk, "jacobian": jacobian, "fk_jacobian": fk_jacobian, "jacobian_tool": jacobian_tool, "task": task, "task_jacobian": task_jacobian, "singularity_factors": singularity_factors, "manipulability": manipulability, "velocity_ik": velocity_ik}
+    return {"fk": fk, "jacobian": jacobian, "fk_jacobian": fk_jacobian, "jacobian_tool": jacobian_tool, "task": task, "task_jacobian": task_jacobian, "singularity_factors": singularity_factors, "manipulability": manipulability, "velocity_ik": velocity_ik, "ik_numeric_step": ik_numeric_step}

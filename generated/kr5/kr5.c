@@ -1113,6 +1113,341 @@ int kr5_velocity_ik(const kr5_real q[KR5_DOF], const kr5_real mu_dot[KR5_TASK_DI
     return (!(t377 && t378) ? 2 : (t381 ? 1 : 0));
 }
 
+kr5_real kr5_ik_numeric_step(const kr5_real target[16], const kr5_real q[KR5_DOF], kr5_real damping, kr5_real q_start[KR5_DOF], kr5_real q_next[KR5_DOF])
+{
+    /* 1011 operations */
+
+    /* Inputs */
+    const kr5_real T00 = target[0];
+    const kr5_real T01 = target[1];
+    const kr5_real T02 = target[2];
+    const kr5_real T03 = target[3];
+    const kr5_real T10 = target[4];
+    const kr5_real T11 = target[5];
+    const kr5_real T12 = target[6];
+    const kr5_real T13 = target[7];
+    const kr5_real T20 = target[8];
+    const kr5_real T21 = target[9];
+    const kr5_real T22 = target[10];
+    const kr5_real T23 = target[11];
+    const kr5_real qs1 = q[0];
+    const kr5_real qs2 = q[1];
+    const kr5_real qs3 = q[2];
+    const kr5_real qs4 = q[3];
+    const kr5_real qs5 = q[4];
+    const kr5_real qs6 = q[5];
+
+    /* Intermediate terms */
+    const kr5_real q1 = (qs1 < -2.705260340591211 ? -2.705260340591211 : (qs1 > 2.705260340591211 ? 2.705260340591211 : qs1));
+    const kr5_real q2 = (qs2 < -3.141592653589793 ? -3.141592653589793 : (qs2 > 1.1344640137963142 ? 1.1344640137963142 : qs2));
+    const kr5_real q3 = (qs3 < -0.2617993877991494 ? -0.2617993877991494 : (qs3 > 2.7576202181510405 ? 2.7576202181510405 : qs3));
+    const kr5_real q4 = (qs4 < -6.1086523819801535 ? -6.1086523819801535 : (qs4 > 6.1086523819801535 ? 6.1086523819801535 : qs4));
+    const kr5_real q5 = (qs5 < -2.2689280275926285 ? -2.2689280275926285 : (qs5 > 2.2689280275926285 ? 2.2689280275926285 : qs5));
+    const kr5_real q6 = (qs6 < -6.1086523819801535 ? -6.1086523819801535 : (qs6 > 6.1086523819801535 ? 6.1086523819801535 : qs6));
+    const kr5_real c1 = cos(q1);
+    const kr5_real s1 = sin(q1);
+    const kr5_real c2 = cos(q2);
+    const kr5_real s2 = sin(q2);
+    const kr5_real c3 = cos(q3);
+    const kr5_real s3 = sin(q3);
+    const kr5_real c23 = c2*c3 - s2*s3;
+    const kr5_real s23 = c2*s3 + c3*s2;
+    const kr5_real c4 = cos(q4);
+    const kr5_real s4 = sin(q4);
+    const kr5_real c5 = cos(q5);
+    const kr5_real s5 = sin(q5);
+    const kr5_real c6 = cos(q6);
+    const kr5_real s6 = sin(q6);
+    const kr5_real t0 = T00 + T01 + T02 + T03 + T10 + T11 + T12 + T13 + T20 + T21 + T22 + T23 + qs1 + qs2 + qs3 + qs4 + qs5 + qs6;
+    const kr5_real t1 = s1*s4;
+    const kr5_real t2 = c1*c4;
+    const kr5_real t3 = c23*t2 - t1;
+    const kr5_real t4 = -c23*t1 + t2;
+    const kr5_real t5 = c4*s1;
+    const kr5_real t6 = c1*s4;
+    const kr5_real t7 = c23*t6 + t5;
+    const kr5_real t8 = c23*t5 + t6;
+    const kr5_real t9 = c1*s23;
+    const kr5_real t10 = c5*t3 - s5*t9;
+    const kr5_real t11 = c5*t9 + s5*t3;
+    const kr5_real t12 = c6*t10 - s6*t7;
+    const kr5_real t13 = c6*t7 + s6*t10;
+    const kr5_real t14 = T00*t12 + T01*t13 - T02*t11;
+    const kr5_real t15 = T10*t12 + T11*t13 - T12*t11;
+    const kr5_real t16 = T20*t12 + T21*t13 - T22*t11;
+    const kr5_real t17 = s1*s23;
+    const kr5_real t18 = c5*t8 - s5*t17;
+    const kr5_real t19 = c5*t17 + s5*t8;
+    const kr5_real t20 = c6*t18 + s6*t4;
+    const kr5_real t21 = c6*t4 - s6*t18;
+    const kr5_real t22 = -T00*t20 + T01*t21 + T02*t19;
+    const kr5_real t23 = -T10*t20 + T11*t21 + T12*t19;
+    const kr5_real t24 = -T20*t20 + T21*t21 + T22*t19;
+    const kr5_real t25 = 0.5*t15 + 0.5*t22;
+    const kr5_real t26 = c4*s23;
+    const kr5_real t27 = c23*s5 + c5*t26;
+    const kr5_real t28 = -c23*c5 + s5*t26;
+    const kr5_real t29 = s23*s4;
+    const kr5_real t30 = -c6*t27 + s6*t29;
+    const kr5_real t31 = c6*t29 + s6*t27;
+    const kr5_real t32 = -c23*t9 + t11*t28 + t29*t7;
+    const kr5_real t33 = c23*t17 - t19*t28 + t29*t4;
+    const kr5_real t34 = T00*t30 - T01*t31 + T02*t28;
+    const kr5_real t35 = T10*t30 - T11*t31 + T12*t28;
+    const kr5_real t36 = T20*t30 - T21*t31 + T22*t28;
+    const kr5_real t37 = -0.5*t24 - 0.5*t35;
+    const kr5_real t38 = -0.5*t16 + 0.5*t34;
+    const kr5_real t39 = sqrt((t25*t25) + (t37*t37) + (t38*t38));
+    const kr5_real t40 = 0.115*t11;
+    const kr5_real t41 = t40 + 0.62*t9;
+    const kr5_real t42 = 0.115*t19;
+    const kr5_real t43 = 0.62*t17 + t42;
+    const kr5_real t44 = t17*t41 - t43*t9;
+    const kr5_real t45 = t4*t40 + t42*t7;
+    const kr5_real t46 = c23*t44 + t29*t45;
+    const kr5_real t47 = 0.115*t28;
+    const kr5_real t48 = -0.62*c23 + t47;
+    const kr5_real t49 = -0.12*s23 + t48;
+    const kr5_real t50 = -0.6*s2 + t49;
+    const kr5_real t51 = t50 + 0.4;
+    const kr5_real t52 = c23*t43 + t17*t48;
+    const kr5_real t53 = t29*t42 + t4*t47;
+    const kr5_real t54 = c23*t41 + t48*t9;
+    const kr5_real t55 = -t29*t40 + t47*t7;
+    const kr5_real t56 = T23 - t51;
+    const kr5_real t57 = 0.12*c23;
+    const kr5_real t58 = c1*t57 - t41;
+    const kr5_real t59 = s1*t57 - t43;
+    const kr5_real t60 = c1*t58 + s1*t59;
+    const kr5_real t61 = 0.6*c2;
+    const kr5_real t62 = c1*t61 + t58;
+    const kr5_real t63 = s1*t61 + t59;
+    const kr5_real t64 = 0.18*c1 + t62;
+    const kr5_real t65 = 0.18*s1 + t63;
+    const kr5_real t66 = c1*t62 + s1*t63;
+    const kr5_real t67 = -c23*t54 + t29*t55 + t64;
+    const kr5_real t68 = (t44*t44) + (t45*t45) + (t60*t60) + (t66*t66);
+    const kr5_real t69 = T03 - t64;
+    const kr5_real t70 = (t49*t49);
+    const kr5_real t71 = (c1*c1);
+    const kr5_real t72 = t17*t52 + t4*t53 + t49*t71 + t50*t71;
+    const kr5_real t73 = (t50*t50);
+    const kr5_real t74 = t70*t71 + t71*t73 + (t52*t52) + (t53*t53) + (t65*t65);
+    const kr5_real t75 = c1*s1;
+    const kr5_real t76 = -t52*t54 + t53*t55 - t64*t65 + t70*t75 + t73*t75;
+    const kr5_real t77 = -t65;
+    const kr5_real t78 = c23*t52 + t29*t53 + t77;
+    const kr5_real t79 = T13 + t77;
+    const kr5_real t80 = c1*t60;
+    const kr5_real t81 = c1*t66;
+    const kr5_real t82 = t44*t52 + t45*t53 - t49*t80 - t50*t81;
+    const kr5_real t83 = t17*t44 + t4*t45 - t80 - t81;
+    const kr5_real t84 = t49*t75 + t50*t75;
+    const kr5_real t85 = -t52*t9 + t53*t7 + t84;
+    const kr5_real t86 = -t17*t54 + t4*t55 + t84;
+    const kr5_real t87 = (s1*s1);
+    const kr5_real t88 = t70*t87 + t73*t87 + (t54*t54) + (t55*t55) + (t64*t64);
+    const kr5_real t89 = t49*t87 + t50*t87 + t54*t9 + t55*t7;
+    const kr5_real t90 = s1*t60;
+    const kr5_real t91 = s1*t66;
+    const kr5_real t92 = t44*t54 - t45*t55 + t49*t90 + t50*t91;
+    const kr5_real t93 = t44*t9 - t45*t7 + t90 + t91;
+    const kr5_real t94 = (s23*s23);
+    const kr5_real t95 = t71*t94 + 2*t87 + (t11*t11) + (t7*t7);
+    const kr5_real t96 = t11*t19 - t4*t7 + t75*t94 - 2*t75;
+    const kr5_real t97 = 2*t71 + t87*t94 + (t19*t19) + (t4*t4);
+    const kr5_real t98 = t94*(s4*s4) + (c23*c23) + (t28*t28) + 1;
+    const kr5_real t99 = -t23;
+    const kr5_real t100 = 0.5*t14 + 0.5*t36 + 0.5*t99 - 0.5;
+    const kr5_real t101 = atan2(t39, t100);
+    const kr5_real t102 = (t39 > 0 ? t101/t39 : 1);
+    const int t103 = t14 >= t36 && t14 >= t99;
+    const int t104 = t23 <= -t36;
+    const kr5_real t105 = (t103 ? 0.5*t14 + 0.5 : (t104 ? -0.5*t22 : 0.5*t34));
+    const kr5_real t106 = (t103 ? 0.5*t15 : (t104 ? 0.5*t99 + 0.5 : 0.5*t35));
+    const kr5_real t107 = (t103 ? 0.5*t16 : (t104 ? -0.5*t24 : 0.5*t36 + 0.5));
+    const kr5_real t108 = sqrt((t105*t105) + (t106*t106) + (t107*t107));
+    const kr5_real t109 = (t105*t37 + t106*t38 + t107*t25 >= 0 ? 1 : -1);
+    const int t110 = (t39 > 1e-06) || (t100 > 0);
+    const kr5_real t111 = t101*t109/t108;
+    const kr5_real t112 = (t110 ? t102*t37 : t105*t111);
+    const kr5_real t113 = (t110 ? t102*t38 : t106*t111);
+    const kr5_real t114 = (t110 ? t102*t25 : t107*t111);
+    const kr5_real t115 = (t112*t112) + (t113*t113) + (t114*t114) + (t56*t56) + (t69*t69) + (t79*t79);
+    const kr5_real t116 = damping + t74;
+    const kr5_real t117 = sqrt((t116*t116) + (t72*t72) + (t76*t76) + (t78*t78) + (t82*t82) + (t85*t85));
+    const kr5_real t118 = t117*(t116 >= 0 ? 1 : -1);
+    const kr5_real t119 = t116 + t118;
+    const kr5_real t120 = (t117 > 0 ? 1/(t117*(t117 + fabs(t116))) : 0);
+    const kr5_real t121 = t120*(-t112*t85 + t113*t72 + t114*t78 + t119*t69 + t56*t82 + t76*t79);
+    const kr5_real t122 = -t119*t121 + t69;
+    const kr5_real t123 = -t121*t76 + t79;
+    const kr5_real t124 = -t121*t82 + t56;
+    const kr5_real t125 = t112 + t121*t85;
+    const kr5_real t126 = t113 - t121*t72;
+    const kr5_real t127 = t114 - t121*t78;
+    const kr5_real t128 = damping + t88;
+    const kr5_real t129 = t120*(t119*t76 + t128*t76 + t67*t78 + t72*t86 - t82*t92 + t85*t89);
+    const kr5_real t130 = -t119*t129 + t76;
+    const kr5_real t131 = t128 - t129*t76;
+    const kr5_real t132 = t129*t82 + t92;
+    const kr5_real t133 = t129*t85 - t89;
+    const kr5_real t134 = -t129*t72 + t86;
+    const kr5_real t135 = -t129*t78 + t67;
+    const kr5_real t136 = sqrt((t131*t131) + (t132*t132) + (t133*t133) + (t134*t134) + (t135*t135));
+    const kr5_real t137 = t136*(t131 >= 0 ? 1 : -1);
+    const kr5_real t138 = t131 + t137;
+    const kr5_real t139 = (t136 > 0 ? 1/(t136*(t136 + fabs(t131))) : 0);
+    const kr5_real t140 = t139*(t123*t138 - t124*t132 + t125*t133 + t126*t134 + t127*t135);
+    const kr5_real t141 = t123 - t138*t140;
+    const kr5_real t142 = t124 + t132*t140;
+    const kr5_real t143 = t125 - t133*t140;
+    const kr5_real t144 = t126 - t134*t140;
+    const kr5_real t145 = t127 - t135*t140;
+    const kr5_real t146 = damping + t68;
+    const kr5_real t147 = t120*(t119*t82 + t146*t82 + t46*t78 + t72*t83 - t76*t92 - t85*t93);
+    const kr5_real t148 = -t119*t147 + t82;
+    const kr5_real t149 = t147*t76 + t92;
+    const kr5_real t150 = t146 - t147*t82;
+    const kr5_real t151 = t147*t85 + t93;
+    const kr5_real t152 = -t147*t72 + t83;
+    const kr5_real t153 = -t147*t78 + t46;
+    const kr5_real t154 = t139*(-t132*t150 + t133*t151 + t134*t152 + t135*t153 - t138*t149);
+    const kr5_real t155 = t138*t154 + t149;
+    const kr5_real t156 = t132*t154 + t150;
+    const kr5_real t157 = -t133*t154 + t151;
+    const kr5_real t158 = -t134*t154 + t152;
+    const kr5_real t159 = -t135*t154 + t153;
+    const kr5_real t160 = sqrt((t156*t156) + (t157*t157) + (t158*t158) + (t159*t159));
+    const kr5_real t161 = t160*(t156 >= 0 ? 1 : -1);
+    const kr5_real t162 = t156 + t161;
+    const kr5_real t163 = (t160 > 0 ? 1/(t160*(t160 + fabs(t156))) : 0);
+    const kr5_real t164 = t163*(t142*t162 + t143*t157 + t144*t158 + t145*t159);
+    const kr5_real t165 = t142 - t162*t164;
+    const kr5_real t166 = t143 - t157*t164;
+    const kr5_real t167 = t144 - t158*t164;
+    const kr5_real t168 = t145 - t159*t164;
+    const kr5_real t169 = damping + t95;
+    const kr5_real t170 = -t120*(t119*t85 + t169*t85 + t32*t78 - t72*t96 + t76*t89 - t82*t93);
+    const kr5_real t171 = t119*t170 + t85;
+    const kr5_real t172 = t170*t76 + t89;
+    const kr5_real t173 = -t170*t82 + t93;
+    const kr5_real t174 = t169 + t170*t85;
+    const kr5_real t175 = -t170*t72 + t96;
+    const kr5_real t176 = t170*t78 + t32;
+    const kr5_real t177 = -t139*(t132*t173 - t133*t174 - t134*t175 + t135*t176 + t138*t172);
+    const kr5_real t178 = t138*t177 + t172;
+    const kr5_real t179 = t132*t177 + t173;
+    const kr5_real t180 = -t133*t177 + t174;
+    const kr5_real t181 = -t134*t177 + t175;
+    const kr5_real t182 = t135*t177 + t176;
+    const kr5_real t183 = t163*(t157*t180 + t158*t181 - t159*t182 + t162*t179);
+    const kr5_real t184 = -t162*t183 + t179;
+    const kr5_real t185 = -t157*t183 + t180;
+    const kr5_real t186 = -t158*t183 + t181;
+    const kr5_real t187 = t159*t183 + t182;
+    const kr5_real t188 = sqrt((t185*t185) + (t186*t186) + (t187*t187));
+    const kr5_real t189 = t188*(t185 >= 0 ? 1 : -1);
+    const kr5_real t190 = t185 + t189;
+    const kr5_real t191 = (t188 > 0 ? 1/(t188*(t188 + fabs(t185))) : 0);
+    const kr5_real t192 = t191*(t166*t190 + t167*t186 - t168*t187);
+    const kr5_real t193 = t166 - t190*t192;
+    const kr5_real t194 = t167 - t186*t192;
+    const kr5_real t195 = t168 + t187*t192;
+    const kr5_real t196 = damping + t97;
+    const kr5_real t197 = t120*(t119*t72 + t196*t72 + t33*t78 + t76*t86 + t82*t83 - t85*t96);
+    const kr5_real t198 = -t119*t197 + t72;
+    const kr5_real t199 = -t197*t76 + t86;
+    const kr5_real t200 = -t197*t82 + t83;
+    const kr5_real t201 = t197*t85 + t96;
+    const kr5_real t202 = t196 - t197*t72;
+    const kr5_real t203 = -t197*t78 + t33;
+    const kr5_real t204 = t139*(-t132*t200 + t133*t201 + t134*t202 + t135*t203 + t138*t199);
+    const kr5_real t205 = -t138*t204 + t199;
+    const kr5_real t206 = t132*t204 + t200;
+    const kr5_real t207 = -t133*t204 + t201;
+    const kr5_real t208 = -t134*t204 + t202;
+    const kr5_real t209 = -t135*t204 + t203;
+    const kr5_real t210 = t163*(t157*t207 + t158*t208 + t159*t209 + t162*t206);
+    const kr5_real t211 = -t162*t210 + t206;
+    const kr5_real t212 = -t157*t210 + t207;
+    const kr5_real t213 = -t158*t210 + t208;
+    const kr5_real t214 = -t159*t210 + t209;
+    const kr5_real t215 = t191*(t186*t213 - t187*t214 + t190*t212);
+    const kr5_real t216 = -t190*t215 + t212;
+    const kr5_real t217 = -t186*t215 + t213;
+    const kr5_real t218 = t187*t215 + t214;
+    const kr5_real t219 = sqrt((t217*t217) + (t218*t218));
+    const kr5_real t220 = t219*(t217 >= 0 ? 1 : -1);
+    const kr5_real t221 = t217 + t220;
+    const kr5_real t222 = (t219 > 0 ? 1/(t219*(t219 + fabs(t217))) : 0);
+    const kr5_real t223 = t222*(t194*t221 + t195*t218);
+    const kr5_real t224 = t194 - t221*t223;
+    const kr5_real t225 = t195 - t218*t223;
+    const kr5_real t226 = damping + t98;
+    const kr5_real t227 = t120*(t119*t78 + t226*t78 + t32*t85 + t33*t72 + t46*t82 + t67*t76);
+    const kr5_real t228 = -t119*t227 + t78;
+    const kr5_real t229 = -t227*t76 + t67;
+    const kr5_real t230 = -t227*t82 + t46;
+    const kr5_real t231 = t227*t85 - t32;
+    const kr5_real t232 = -t227*t72 + t33;
+    const kr5_real t233 = t226 - t227*t78;
+    const kr5_real t234 = t139*(-t132*t230 + t133*t231 + t134*t232 + t135*t233 + t138*t229);
+    const kr5_real t235 = -t138*t234 + t229;
+    const kr5_real t236 = t132*t234 + t230;
+    const kr5_real t237 = -t133*t234 + t231;
+    const kr5_real t238 = -t134*t234 + t232;
+    const kr5_real t239 = -t135*t234 + t233;
+    const kr5_real t240 = t163*(t157*t237 + t158*t238 + t159*t239 + t162*t236);
+    const kr5_real t241 = -t162*t240 + t236;
+    const kr5_real t242 = -t157*t240 + t237;
+    const kr5_real t243 = -t158*t240 + t238;
+    const kr5_real t244 = -t159*t240 + t239;
+    const kr5_real t245 = t191*(t186*t243 - t187*t244 + t190*t242);
+    const kr5_real t246 = -t190*t245 + t242;
+    const kr5_real t247 = -t186*t245 + t243;
+    const kr5_real t248 = t187*t245 + t244;
+    const kr5_real t249 = t222*(t218*t248 + t221*t247);
+    const kr5_real t250 = -t221*t249 + t247;
+    const kr5_real t251 = -t218*t249 + t248;
+    const kr5_real t252 = fabs(t251);
+    const kr5_real t253 = t252;
+    const kr5_real t254 = t253*(t251 >= 0 ? 1 : -1);
+    const kr5_real t255 = t251 + t254;
+    const kr5_real t256 = (t253 > 0 ? 1/(t253*(t252 + t253)) : 0);
+    const kr5_real t257 = -t225*t256*(t255*t255) + t225;
+    const kr5_real t258 = t257/t254;
+    const kr5_real t259 = (t224 + t250*t258)/t220;
+    const kr5_real t260 = (t193 + t216*t259 + t246*t258)/t189;
+    const kr5_real t261 = (t165 + t184*t260 + t211*t259 + t241*t258)/t161;
+    const kr5_real t262 = (t141 - t155*t261 - t178*t260 + t205*t259 + t235*t258)/t137;
+    const kr5_real t263 = (t122 + t130*t262 + t148*t261 - t171*t260 + t198*t259 + t228*t258)/t118;
+    const kr5_real t264 = q1 - t258 - t262*t64 + t263*t65;
+    const kr5_real t265 = c23*t258 - q4 + t17*t259 + t260*t9 + t261*t44 - t262*t54 + t263*t52;
+    const kr5_real t266 = -q5 + t258*t29 + t259*t4 - t260*t7 + t261*t45 + t262*t55 + t263*t53;
+    const kr5_real t267 = q6 - t11*t260 - t19*t259 + t258*t28;
+    const kr5_real t268 = s1*t262;
+    const kr5_real t269 = c1*t263;
+    const kr5_real t270 = -c1*t259 + s1*t260;
+    const kr5_real t271 = q2 + t261*t66 - t268*t50 - t269*t50 + t270;
+    const kr5_real t272 = q3 + t261*t60 - t268*t49 - t269*t49 + t270;
+
+    /* Outputs */
+    q_start[0] = q1;
+    q_start[1] = q2;
+    q_start[2] = q3;
+    q_start[3] = q4;
+    q_start[4] = q5;
+    q_start[5] = q6;
+    q_next[0] = (t264 < -2.705260340591211 ? -2.705260340591211 : (t264 > 2.705260340591211 ? 2.705260340591211 : t264));
+    q_next[1] = (t271 < -3.141592653589793 ? -3.141592653589793 : (t271 > 1.1344640137963142 ? 1.1344640137963142 : t271));
+    q_next[2] = (t272 < -0.2617993877991494 ? -0.2617993877991494 : (t272 > 2.7576202181510405 ? 2.7576202181510405 : t272));
+    q_next[3] = (t265 > 6.1086523819801535 ? -6.1086523819801535 : (t265 < -6.1086523819801535 ? 6.1086523819801535 : -t265));
+    q_next[4] = (t266 > 2.2689280275926285 ? -2.2689280275926285 : (t266 < -2.2689280275926285 ? 2.2689280275926285 : -t266));
+    q_next[5] = (t267 < -6.1086523819801535 ? -6.1086523819801535 : (t267 > 6.1086523819801535 ? 6.1086523819801535 : t267));
+    return (isfinite(t0) ? t115 : -1);
+}
+
 void kr5_ik_branches(const kr5_real T[16], kr5_real q[KR5_MAX_IK_SOLUTIONS * KR5_DOF], int valid[KR5_MAX_IK_SOLUTIONS])
 {
     /* 858 operations */
@@ -1584,179 +1919,39 @@ int kr5_ik(const kr5_real T[16], kr5_real q[KR5_MAX_IK_SOLUTIONS * KR5_DOF])
     return count;
 }
 
-/* -- Iterative inverse kinematics -- */
-
-/* The rotation vector (axis times angle in [0, pi]) of the rotation matrix E (row-major). */
-static void kr5_rotation_vector(const kr5_real E[9], kr5_real out[3])
-{
-    const kr5_real v[3] = {0.5 * (E[7] - E[5]), 0.5 * (E[2] - E[6]), 0.5 * (E[3] - E[1])};
-    const kr5_real cos_angle = 0.5 * (E[0] + E[4] + E[8] - 1.0);
-    const kr5_real sin_angle = sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
-    const kr5_real angle = atan2(sin_angle, cos_angle);
-    kr5_real axis[3], length, sign;
-    int i, column = 0;
-    if (sin_angle > 1e-6 || cos_angle > 0.0) {
-        const kr5_real scale = sin_angle > 0.0 ? angle / sin_angle : 1.0;
-        for (i = 0; i < 3; ++i) {
-            out[i] = scale * v[i];
-        }
-        return;
-    }
-    /* Near a half turn: the axis from the largest column of (E + I) / 2 = u u^T. */
-    for (i = 1; i < 3; ++i) {
-        if (E[4 * i] > E[4 * column]) {
-            column = i;
-        }
-    }
-    for (i = 0; i < 3; ++i) {
-        axis[i] = 0.5 * (E[3 * i + column] + (i == column ? 1.0 : 0.0));
-    }
-    length = sqrt(axis[0] * axis[0] + axis[1] * axis[1] + axis[2] * axis[2]);
-    sign = axis[0] * v[0] + axis[1] * v[1] + axis[2] * v[2] >= 0.0 ? 1.0 : -1.0;
-    for (i = 0; i < 3; ++i) {
-        out[i] = sign * angle * axis[i] / length;
-    }
-}
-
-/* Error [target position - position; rotation vector of target R^T] and the geometric Jacobian. */
-static void kr5_task_error(const kr5_real target[16], const kr5_real q[KR5_DOF], kr5_real e[6], kr5_real J[6 * KR5_DOF])
-{
-    kr5_real T[16], E[9];
-    int i, j;
-    kr5_fk(q, T);
-    kr5_jacobian(q, J);
-    for (i = 0; i < 3; ++i) {
-        e[i] = target[4 * i + 3] - T[4 * i + 3];
-        for (j = 0; j < 3; ++j) {
-            E[3 * i + j] = target[4 * i] * T[4 * j] + target[4 * i + 1] * T[4 * j + 1] + target[4 * i + 2] * T[4 * j + 2];
-        }
-    }
-    kr5_rotation_vector(E, e + 3);
-}
-
-/* Joints clamped to their limits. */
-static void kr5_clamp(kr5_real q[KR5_DOF])
-{
-    q[0] = q[0] < -2.705260340591211 ? -2.705260340591211 : q[0] > 2.705260340591211 ? 2.705260340591211 : q[0];
-    q[1] = q[1] < -3.141592653589793 ? -3.141592653589793 : q[1] > 1.1344640137963142 ? 1.1344640137963142 : q[1];
-    q[2] = q[2] < -0.2617993877991494 ? -0.2617993877991494 : q[2] > 2.7576202181510405 ? 2.7576202181510405 : q[2];
-    q[3] = q[3] < -6.1086523819801535 ? -6.1086523819801535 : q[3] > 6.1086523819801535 ? 6.1086523819801535 : q[3];
-    q[4] = q[4] < -2.2689280275926285 ? -2.2689280275926285 : q[4] > 2.2689280275926285 ? 2.2689280275926285 : q[4];
-    q[5] = q[5] < -6.1086523819801535 ? -6.1086523819801535 : q[5] > 6.1086523819801535 ? 6.1086523819801535 : q[5];
-}
-
-/* Solves A x = b in place (b becomes x) for the symmetric positive definite K x K matrix A by
- * Cholesky; returns 0 when A is not numerically positive definite. */
-static int kr5_cholesky_solve(kr5_real A[36], kr5_real b[6])
-{
-    int i, j, k;
-    for (j = 0; j < 6; ++j) {
-        kr5_real diagonal = A[6 * j + j];
-        for (k = 0; k < j; ++k) {
-            diagonal -= A[6 * j + k] * A[6 * j + k];
-        }
-        if (!(diagonal > 0.0)) {
-            return 0;
-        }
-        A[6 * j + j] = sqrt(diagonal);
-        for (i = j + 1; i < 6; ++i) {
-            kr5_real sum = A[6 * i + j];
-            for (k = 0; k < j; ++k) {
-                sum -= A[6 * i + k] * A[6 * j + k];
-            }
-            A[6 * i + j] = sum / A[6 * j + j];
-        }
-    }
-    for (i = 0; i < 6; ++i) {
-        for (k = 0; k < i; ++k) {
-            b[i] -= A[6 * i + k] * b[k];
-        }
-        b[i] /= A[6 * i + i];
-    }
-    for (i = 6 - 1; i >= 0; --i) {
-        for (k = i + 1; k < 6; ++k) {
-            b[i] -= A[6 * k + i] * b[k];
-        }
-        b[i] /= A[6 * i + i];
-    }
-    return 1;
-}
+/* -- Iterative inverse kinematics: the loop around kr5_ik_numeric_step -- */
 
 int kr5_ik_numeric(const kr5_real target[16], const kr5_real q0[KR5_DOF], int max_iter, kr5_real tol, kr5_real q[KR5_DOF])
 {
-    kr5_real e[6], J[6 * KR5_DOF], trial[KR5_DOF], trial_e[6];
-    kr5_real trial_J[6 * KR5_DOF], A[36], x[6];
-    kr5_real cost, trial_cost, damping = 1e-06;
-    int i, j, k, iteration;
-    for (j = 0; j < KR5_DOF; ++j) {
-        q[j] = q0[j];
-    }
-    for (i = 0; i < 12; ++i) {
-        if (!isfinite(target[i])) {
-            return KR5_IK_NUMERIC_INVALID;
+    kr5_real trial[KR5_DOF], after[KR5_DOF], start[KR5_DOF];
+    kr5_real cost, trial_cost, lighter, damping = 1e-06;
+    int j, iteration;
+    cost = kr5_ik_numeric_step(target, q0, damping, q, trial);
+    if (!(cost >= 0) || max_iter < 0) { /* -1: target or q0 not finite */
+        for (j = 0; j < KR5_DOF; ++j) {
+            q[j] = q0[j];
         }
-    }
-    for (j = 0; j < KR5_DOF; ++j) {
-        if (!isfinite(q0[j])) {
-            return KR5_IK_NUMERIC_INVALID;
-        }
-    }
-    if (max_iter < 0) {
         return KR5_IK_NUMERIC_INVALID;
-    }
-    kr5_clamp(q);
-    kr5_task_error(target, q, e, J);
-    cost = 0.0;
-    for (i = 0; i < 6; ++i) {
-        cost += e[i] * e[i];
     }
     for (iteration = 0; iteration < max_iter; ++iteration) {
         if (cost <= tol * tol) {
             return KR5_IK_NUMERIC_CONVERGED;
         }
-        /* A = J J^T + damping I, x = A^-1 e, step J^T x */
-        for (i = 0; i < 6; ++i) {
-            x[i] = e[i];
-            for (k = 0; k < 6; ++k) {
-                kr5_real sum = i == k ? damping : 0.0;
-                for (j = 0; j < KR5_DOF; ++j) {
-                    sum += J[KR5_DOF * i + j] * J[KR5_DOF * k + j];
-                }
-                A[6 * i + k] = sum;
-            }
-        }
-        if (!kr5_cholesky_solve(A, x)) {
-            return KR5_IK_NUMERIC_STALLED;
-        }
-        for (j = 0; j < KR5_DOF; ++j) {
-            trial[j] = q[j];
-            for (i = 0; i < 6; ++i) {
-                trial[j] += J[KR5_DOF * i + j] * x[i];
-            }
-        }
-        kr5_clamp(trial);
-        kr5_task_error(target, trial, trial_e, trial_J);
-        trial_cost = 0.0;
-        for (i = 0; i < 6; ++i) {
-            trial_cost += trial_e[i] * trial_e[i];
-        }
+        lighter = damping * 0.1 > 1e-12 ? damping * 0.1 : 1e-12;
+        trial_cost = kr5_ik_numeric_step(target, trial, lighter, start, after);
         if (trial_cost < cost) {
             for (j = 0; j < KR5_DOF; ++j) {
                 q[j] = trial[j];
-            }
-            for (i = 0; i < 6; ++i) {
-                e[i] = trial_e[i];
-            }
-            for (i = 0; i < 6 * KR5_DOF; ++i) {
-                J[i] = trial_J[i];
+                trial[j] = after[j];
             }
             cost = trial_cost;
-            damping = damping * 0.1 > 1e-12 ? damping * 0.1 : 1e-12;
+            damping = lighter;
         } else {
             damping *= 10.0;
             if (damping > 100000000.0) {
                 return KR5_IK_NUMERIC_STALLED;
             }
+            (void)kr5_ik_numeric_step(target, q, damping, start, trial);
         }
     }
     return cost <= tol * tol ? KR5_IK_NUMERIC_CONVERGED : KR5_IK_NUMERIC_ITERATION_LIMIT;

@@ -1045,6 +1045,338 @@ def _velocity_ik(q, mu_dot, damping):
     return [q_dot, status]
 
 
+def _ik_numeric_step(target, q, damping):
+    """One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite): 1011 operations."""
+    T00 = target[0, 0]
+    T01 = target[0, 1]
+    T02 = target[0, 2]
+    T03 = target[0, 3]
+    T10 = target[1, 0]
+    T11 = target[1, 1]
+    T12 = target[1, 2]
+    T13 = target[1, 3]
+    T20 = target[2, 0]
+    T21 = target[2, 1]
+    T22 = target[2, 2]
+    T23 = target[2, 3]
+    qs1 = q[0]
+    qs2 = q[1]
+    qs3 = q[2]
+    qs4 = q[3]
+    qs5 = q[4]
+    qs6 = q[5]
+    q1 = casadi.if_else((qs1 < -2.705260340591211), -2.705260340591211, casadi.if_else((qs1 > 2.705260340591211), 2.705260340591211, qs1))
+    q2 = casadi.if_else((qs2 < -3.141592653589793), -3.141592653589793, casadi.if_else((qs2 > 1.1344640137963142), 1.1344640137963142, qs2))
+    q3 = casadi.if_else((qs3 < -0.2617993877991494), -0.2617993877991494, casadi.if_else((qs3 > 2.7576202181510405), 2.7576202181510405, qs3))
+    q4 = casadi.if_else((qs4 < -6.1086523819801535), -6.1086523819801535, casadi.if_else((qs4 > 6.1086523819801535), 6.1086523819801535, qs4))
+    q5 = casadi.if_else((qs5 < -2.2689280275926285), -2.2689280275926285, casadi.if_else((qs5 > 2.2689280275926285), 2.2689280275926285, qs5))
+    q6 = casadi.if_else((qs6 < -6.1086523819801535), -6.1086523819801535, casadi.if_else((qs6 > 6.1086523819801535), 6.1086523819801535, qs6))
+    c1 = casadi.cos(q1)
+    s1 = casadi.sin(q1)
+    c2 = casadi.cos(q2)
+    s2 = casadi.sin(q2)
+    c3 = casadi.cos(q3)
+    s3 = casadi.sin(q3)
+    c23 = c2*c3 - s2*s3
+    s23 = c2*s3 + c3*s2
+    c4 = casadi.cos(q4)
+    s4 = casadi.sin(q4)
+    c5 = casadi.cos(q5)
+    s5 = casadi.sin(q5)
+    c6 = casadi.cos(q6)
+    s6 = casadi.sin(q6)
+    t0 = T00 + T01 + T02 + T03 + T10 + T11 + T12 + T13 + T20 + T21 + T22 + T23 + qs1 + qs2 + qs3 + qs4 + qs5 + qs6
+    t1 = s1*s4
+    t2 = c1*c4
+    t3 = c23*t2 - t1
+    t4 = -c23*t1 + t2
+    t5 = c4*s1
+    t6 = c1*s4
+    t7 = c23*t6 + t5
+    t8 = c23*t5 + t6
+    t9 = c1*s23
+    t10 = c5*t3 - s5*t9
+    t11 = c5*t9 + s5*t3
+    t12 = c6*t10 - s6*t7
+    t13 = c6*t7 + s6*t10
+    t14 = T00*t12 + T01*t13 - T02*t11
+    t15 = T10*t12 + T11*t13 - T12*t11
+    t16 = T20*t12 + T21*t13 - T22*t11
+    t17 = s1*s23
+    t18 = c5*t8 - s5*t17
+    t19 = c5*t17 + s5*t8
+    t20 = c6*t18 + s6*t4
+    t21 = c6*t4 - s6*t18
+    t22 = -T00*t20 + T01*t21 + T02*t19
+    t23 = -T10*t20 + T11*t21 + T12*t19
+    t24 = -T20*t20 + T21*t21 + T22*t19
+    t25 = 0.5*t15 + 0.5*t22
+    t26 = c4*s23
+    t27 = c23*s5 + c5*t26
+    t28 = -c23*c5 + s5*t26
+    t29 = s23*s4
+    t30 = -c6*t27 + s6*t29
+    t31 = c6*t29 + s6*t27
+    t32 = -c23*t9 + t11*t28 + t29*t7
+    t33 = c23*t17 - t19*t28 + t29*t4
+    t34 = T00*t30 - T01*t31 + T02*t28
+    t35 = T10*t30 - T11*t31 + T12*t28
+    t36 = T20*t30 - T21*t31 + T22*t28
+    t37 = -0.5*t24 - 0.5*t35
+    t38 = -0.5*t16 + 0.5*t34
+    t39 = casadi.sqrt(t25**2 + t37**2 + t38**2)
+    t40 = 0.115*t11
+    t41 = t40 + 0.62*t9
+    t42 = 0.115*t19
+    t43 = 0.62*t17 + t42
+    t44 = t17*t41 - t43*t9
+    t45 = t4*t40 + t42*t7
+    t46 = c23*t44 + t29*t45
+    t47 = 0.115*t28
+    t48 = -0.62*c23 + t47
+    t49 = -0.12*s23 + t48
+    t50 = -0.6*s2 + t49
+    t51 = t50 + 0.4
+    t52 = c23*t43 + t17*t48
+    t53 = t29*t42 + t4*t47
+    t54 = c23*t41 + t48*t9
+    t55 = -t29*t40 + t47*t7
+    t56 = T23 - t51
+    t57 = 0.12*c23
+    t58 = c1*t57 - t41
+    t59 = s1*t57 - t43
+    t60 = c1*t58 + s1*t59
+    t61 = 0.6*c2
+    t62 = c1*t61 + t58
+    t63 = s1*t61 + t59
+    t64 = 0.18*c1 + t62
+    t65 = 0.18*s1 + t63
+    t66 = c1*t62 + s1*t63
+    t67 = -c23*t54 + t29*t55 + t64
+    t68 = t44**2 + t45**2 + t60**2 + t66**2
+    t69 = T03 - t64
+    t70 = t49**2
+    t71 = c1**2
+    t72 = t17*t52 + t4*t53 + t49*t71 + t50*t71
+    t73 = t50**2
+    t74 = t52**2 + t53**2 + t65**2 + t70*t71 + t71*t73
+    t75 = c1*s1
+    t76 = -t52*t54 + t53*t55 - t64*t65 + t70*t75 + t73*t75
+    t77 = -t65
+    t78 = c23*t52 + t29*t53 + t77
+    t79 = T13 + t77
+    t80 = c1*t60
+    t81 = c1*t66
+    t82 = t44*t52 + t45*t53 - t49*t80 - t50*t81
+    t83 = t17*t44 + t4*t45 - t80 - t81
+    t84 = t49*t75 + t50*t75
+    t85 = -t52*t9 + t53*t7 + t84
+    t86 = -t17*t54 + t4*t55 + t84
+    t87 = s1**2
+    t88 = t54**2 + t55**2 + t64**2 + t70*t87 + t73*t87
+    t89 = t49*t87 + t50*t87 + t54*t9 + t55*t7
+    t90 = s1*t60
+    t91 = s1*t66
+    t92 = t44*t54 - t45*t55 + t49*t90 + t50*t91
+    t93 = t44*t9 - t45*t7 + t90 + t91
+    t94 = s23**2
+    t95 = t11**2 + t7**2 + t71*t94 + 2*t87
+    t96 = t11*t19 - t4*t7 + t75*t94 - 2*t75
+    t97 = t19**2 + t4**2 + 2*t71 + t87*t94
+    t98 = c23**2 + s4**2*t94 + t28**2 + 1
+    t99 = -t23
+    t100 = 0.5*t14 + 0.5*t36 + 0.5*t99 - 0.5
+    t101 = casadi.atan2(t39, t100)
+    t102 = casadi.if_else((t39 > 0), t101/t39, 1)
+    t103 = casadi.logic_and((t14 >= t36), (t14 >= t99))
+    t104 = (t23 <= -t36)
+    t105 = casadi.if_else(t103, 0.5*t14 + 0.5, casadi.if_else(t104, -0.5*t22, 0.5*t34))
+    t106 = casadi.if_else(t103, 0.5*t15, casadi.if_else(t104, 0.5*t99 + 0.5, 0.5*t35))
+    t107 = casadi.if_else(t103, 0.5*t16, casadi.if_else(t104, -0.5*t24, 0.5*t36 + 0.5))
+    t108 = casadi.sqrt(t105**2 + t106**2 + t107**2)
+    t109 = casadi.if_else((t105*t37 + t106*t38 + t107*t25 >= 0), 1, -1)
+    t110 = casadi.logic_or((t39 > 1e-06), (t100 > 0))
+    t111 = t101*t109/t108
+    t112 = casadi.if_else(t110, t102*t37, t105*t111)
+    t113 = casadi.if_else(t110, t102*t38, t106*t111)
+    t114 = casadi.if_else(t110, t102*t25, t107*t111)
+    t115 = t112**2 + t113**2 + t114**2 + t56**2 + t69**2 + t79**2
+    t116 = damping + t74
+    t117 = casadi.sqrt(t116**2 + t72**2 + t76**2 + t78**2 + t82**2 + t85**2)
+    t118 = t117*casadi.if_else((t116 >= 0), 1, -1)
+    t119 = t116 + t118
+    t120 = casadi.if_else((t117 > 0), 1/(t117*(t117 + casadi.fabs(t116))), 0)
+    t121 = t120*(-t112*t85 + t113*t72 + t114*t78 + t119*t69 + t56*t82 + t76*t79)
+    t122 = -t119*t121 + t69
+    t123 = -t121*t76 + t79
+    t124 = -t121*t82 + t56
+    t125 = t112 + t121*t85
+    t126 = t113 - t121*t72
+    t127 = t114 - t121*t78
+    t128 = damping + t88
+    t129 = t120*(t119*t76 + t128*t76 + t67*t78 + t72*t86 - t82*t92 + t85*t89)
+    t130 = -t119*t129 + t76
+    t131 = t128 - t129*t76
+    t132 = t129*t82 + t92
+    t133 = t129*t85 - t89
+    t134 = -t129*t72 + t86
+    t135 = -t129*t78 + t67
+    t136 = casadi.sqrt(t131**2 + t132**2 + t133**2 + t134**2 + t135**2)
+    t137 = t136*casadi.if_else((t131 >= 0), 1, -1)
+    t138 = t131 + t137
+    t139 = casadi.if_else((t136 > 0), 1/(t136*(t136 + casadi.fabs(t131))), 0)
+    t140 = t139*(t123*t138 - t124*t132 + t125*t133 + t126*t134 + t127*t135)
+    t141 = t123 - t138*t140
+    t142 = t124 + t132*t140
+    t143 = t125 - t133*t140
+    t144 = t126 - t134*t140
+    t145 = t127 - t135*t140
+    t146 = damping + t68
+    t147 = t120*(t119*t82 + t146*t82 + t46*t78 + t72*t83 - t76*t92 - t85*t93)
+    t148 = -t119*t147 + t82
+    t149 = t147*t76 + t92
+    t150 = t146 - t147*t82
+    t151 = t147*t85 + t93
+    t152 = -t147*t72 + t83
+    t153 = -t147*t78 + t46
+    t154 = t139*(-t132*t150 + t133*t151 + t134*t152 + t135*t153 - t138*t149)
+    t155 = t138*t154 + t149
+    t156 = t132*t154 + t150
+    t157 = -t133*t154 + t151
+    t158 = -t134*t154 + t152
+    t159 = -t135*t154 + t153
+    t160 = casadi.sqrt(t156**2 + t157**2 + t158**2 + t159**2)
+    t161 = t160*casadi.if_else((t156 >= 0), 1, -1)
+    t162 = t156 + t161
+    t163 = casadi.if_else((t160 > 0), 1/(t160*(t160 + casadi.fabs(t156))), 0)
+    t164 = t163*(t142*t162 + t143*t157 + t144*t158 + t145*t159)
+    t165 = t142 - t162*t164
+    t166 = t143 - t157*t164
+    t167 = t144 - t158*t164
+    t168 = t145 - t159*t164
+    t169 = damping + t95
+    t170 = -t120*(t119*t85 + t169*t85 + t32*t78 - t72*t96 + t76*t89 - t82*t93)
+    t171 = t119*t170 + t85
+    t172 = t170*t76 + t89
+    t173 = -t170*t82 + t93
+    t174 = t169 + t170*t85
+    t175 = -t170*t72 + t96
+    t176 = t170*t78 + t32
+    t177 = -t139*(t132*t173 - t133*t174 - t134*t175 + t135*t176 + t138*t172)
+    t178 = t138*t177 + t172
+    t179 = t132*t177 + t173
+    t180 = -t133*t177 + t174
+    t181 = -t134*t177 + t175
+    t182 = t135*t177 + t176
+    t183 = t163*(t157*t180 + t158*t181 - t159*t182 + t162*t179)
+    t184 = -t162*t183 + t179
+    t185 = -t157*t183 + t180
+    t186 = -t158*t183 + t181
+    t187 = t159*t183 + t182
+    t188 = casadi.sqrt(t185**2 + t186**2 + t187**2)
+    t189 = t188*casadi.if_else((t185 >= 0), 1, -1)
+    t190 = t185 + t189
+    t191 = casadi.if_else((t188 > 0), 1/(t188*(t188 + casadi.fabs(t185))), 0)
+    t192 = t191*(t166*t190 + t167*t186 - t168*t187)
+    t193 = t166 - t190*t192
+    t194 = t167 - t186*t192
+    t195 = t168 + t187*t192
+    t196 = damping + t97
+    t197 = t120*(t119*t72 + t196*t72 + t33*t78 + t76*t86 + t82*t83 - t85*t96)
+    t198 = -t119*t197 + t72
+    t199 = -t197*t76 + t86
+    t200 = -t197*t82 + t83
+    t201 = t197*t85 + t96
+    t202 = t196 - t197*t72
+    t203 = -t197*t78 + t33
+    t204 = t139*(-t132*t200 + t133*t201 + t134*t202 + t135*t203 + t138*t199)
+    t205 = -t138*t204 + t199
+    t206 = t132*t204 + t200
+    t207 = -t133*t204 + t201
+    t208 = -t134*t204 + t202
+    t209 = -t135*t204 + t203
+    t210 = t163*(t157*t207 + t158*t208 + t159*t209 + t162*t206)
+    t211 = -t162*t210 + t206
+    t212 = -t157*t210 + t207
+    t213 = -t158*t210 + t208
+    t214 = -t159*t210 + t209
+    t215 = t191*(t186*t213 - t187*t214 + t190*t212)
+    t216 = -t190*t215 + t212
+    t217 = -t186*t215 + t213
+    t218 = t187*t215 + t214
+    t219 = casadi.sqrt(t217**2 + t218**2)
+    t220 = t219*casadi.if_else((t217 >= 0), 1, -1)
+    t221 = t217 + t220
+    t222 = casadi.if_else((t219 > 0), 1/(t219*(t219 + casadi.fabs(t217))), 0)
+    t223 = t222*(t194*t221 + t195*t218)
+    t224 = t194 - t221*t223
+    t225 = t195 - t218*t223
+    t226 = damping + t98
+    t227 = t120*(t119*t78 + t226*t78 + t32*t85 + t33*t72 + t46*t82 + t67*t76)
+    t228 = -t119*t227 + t78
+    t229 = -t227*t76 + t67
+    t230 = -t227*t82 + t46
+    t231 = t227*t85 - t32
+    t232 = -t227*t72 + t33
+    t233 = t226 - t227*t78
+    t234 = t139*(-t132*t230 + t133*t231 + t134*t232 + t135*t233 + t138*t229)
+    t235 = -t138*t234 + t229
+    t236 = t132*t234 + t230
+    t237 = -t133*t234 + t231
+    t238 = -t134*t234 + t232
+    t239 = -t135*t234 + t233
+    t240 = t163*(t157*t237 + t158*t238 + t159*t239 + t162*t236)
+    t241 = -t162*t240 + t236
+    t242 = -t157*t240 + t237
+    t243 = -t158*t240 + t238
+    t244 = -t159*t240 + t239
+    t245 = t191*(t186*t243 - t187*t244 + t190*t242)
+    t246 = -t190*t245 + t242
+    t247 = -t186*t245 + t243
+    t248 = t187*t245 + t244
+    t249 = t222*(t218*t248 + t221*t247)
+    t250 = -t221*t249 + t247
+    t251 = -t218*t249 + t248
+    t252 = casadi.fabs(t251)
+    t253 = t252
+    t254 = t253*casadi.if_else((t251 >= 0), 1, -1)
+    t255 = t251 + t254
+    t256 = casadi.if_else((t253 > 0), 1/(t253*(t252 + t253)), 0)
+    t257 = -t225*t255**2*t256 + t225
+    t258 = t257/t254
+    t259 = (t224 + t250*t258)/t220
+    t260 = (t193 + t216*t259 + t246*t258)/t189
+    t261 = (t165 + t184*t260 + t211*t259 + t241*t258)/t161
+    t262 = (t141 - t155*t261 - t178*t260 + t205*t259 + t235*t258)/t137
+    t263 = (t122 + t130*t262 + t148*t261 - t171*t260 + t198*t259 + t228*t258)/t118
+    t264 = q1 - t258 - t262*t64 + t263*t65
+    t265 = c23*t258 - q4 + t17*t259 + t260*t9 + t261*t44 - t262*t54 + t263*t52
+    t266 = -q5 + t258*t29 + t259*t4 - t260*t7 + t261*t45 + t262*t55 + t263*t53
+    t267 = q6 - t11*t260 - t19*t259 + t258*t28
+    t268 = s1*t262
+    t269 = c1*t263
+    t270 = -c1*t259 + s1*t260
+    t271 = q2 + t261*t66 - t268*t50 - t269*t50 + t270
+    t272 = q3 + t261*t60 - t268*t49 - t269*t49 + t270
+    q_start = casadi.SX(6, 1)
+    q_start[0, 0] = q1
+    q_start[1, 0] = q2
+    q_start[2, 0] = q3
+    q_start[3, 0] = q4
+    q_start[4, 0] = q5
+    q_start[5, 0] = q6
+    q_next = casadi.SX(6, 1)
+    q_next[0, 0] = casadi.if_else((t264 < -2.705260340591211), -2.705260340591211, casadi.if_else((t264 > 2.705260340591211), 2.705260340591211, t264))
+    q_next[1, 0] = casadi.if_else((t271 < -3.141592653589793), -3.141592653589793, casadi.if_else((t271 > 1.1344640137963142), 1.1344640137963142, t271))
+    q_next[2, 0] = casadi.if_else((t272 < -0.2617993877991494), -0.2617993877991494, casadi.if_else((t272 > 2.7576202181510405), 2.7576202181510405, t272))
+    q_next[3, 0] = casadi.if_else((t265 > 6.1086523819801535), -6.1086523819801535, casadi.if_else((t265 < -6.1086523819801535), 6.1086523819801535, -t265))
+    q_next[4, 0] = casadi.if_else((t266 > 2.2689280275926285), -2.2689280275926285, casadi.if_else((t266 < -2.2689280275926285), 2.2689280275926285, -t266))
+    q_next[5, 0] = casadi.if_else((t267 < -6.1086523819801535), -6.1086523819801535, casadi.if_else((t267 > 6.1086523819801535), 6.1086523819801535, t267))
+    cost = casadi.SX(1, 1)
+    cost[0, 0] = casadi.if_else((casadi.fabs(t0) < casadi.inf), t115, -1)
+    return [q_start, q_next, cost]
+
+
 def _ik_branches(T):
     """Every branch of the closed-form ik and whether the target allows it: 858 operations."""
     T00 = T[0, 0]
@@ -1498,6 +1830,7 @@ def _ik_branches(T):
 _q = casadi.SX.sym("q", 6, 1)
 _mu_dot = casadi.SX.sym("mu_dot", 6, 1)
 _damping = casadi.SX.sym("damping", 1, 1)
+_target = casadi.SX.sym("target", 4, 4)
 _T = casadi.SX.sym("T", 4, 4)
 fk = casadi.Function("fk", [_q], _fk(_q), ["q"], ["T"])
 jacobian = casadi.Function("jacobian", [_q], _jacobian(_q), ["q"], ["J"])
@@ -1509,10 +1842,48 @@ singularity_factors = casadi.Function("singularity_factors", [_q], _singularity_
 manipulability = casadi.Function("manipulability", [_q], _manipulability(_q), ["q"], ["w"])
 jacobian_det = casadi.Function("jacobian_det", [_q], _jacobian_det(_q), ["q"], ["d"])
 velocity_ik = casadi.Function("velocity_ik", [_q, _mu_dot, _damping], _velocity_ik(_q, _mu_dot, _damping), ["q", "mu_dot", "damping"], ["q_dot", "status"])
+ik_numeric_step = casadi.Function("ik_numeric_step", [_target, _q, _damping], _ik_numeric_step(_target, _q, _damping), ["target", "q", "damping"], ["q_start", "q_next", "cost"])
 ik_branches = casadi.Function("ik_branches", [_T], _ik_branches(_T), ["T"], ["q", "valid"])
 ik = ik_branches  # CasADi functions have fixed-size outputs: every branch and its validity
+
+IK_NUMERIC_CONVERGED = 0  # |error| <= tol
+IK_NUMERIC_ITERATION_LIMIT = 1  # IK_NUMERIC_ITERATIONS steps taken, |error| still above tol
+IK_NUMERIC_STALLED = 2  # no step reduces the error: unreachable target, joint limit or local minimum
+IK_NUMERIC_INVALID = 3  # target or q0 not finite: q = q0
+IK_NUMERIC_ITERATIONS = 100
+_DAMPING = (1e-06, 1e-12, 100000000.0)  # added to the diagonal: start, least, most
+
+
+def _ik_numeric(target, q0, tol):
+    """ik_numeric of the C and numpy modules with a fixed number of steps: every branch of
+    the loop is a select, so the graph is the same for every input."""
+    least, most = _DAMPING[1:]
+    q, trial, cost = ik_numeric_step(target, q0, _DAMPING[0])
+    damping = cost * 0.0 + _DAMPING[0]
+    status = casadi.if_else(cost >= 0.0, IK_NUMERIC_ITERATION_LIMIT, IK_NUMERIC_INVALID)
+    for _ in range(IK_NUMERIC_ITERATIONS):
+        status = casadi.if_else(casadi.logic_and(status == IK_NUMERIC_ITERATION_LIMIT, cost <= tol * tol), IK_NUMERIC_CONVERGED, status)
+        active = status == IK_NUMERIC_ITERATION_LIMIT
+        lighter = casadi.fmax(damping * 0.1, least)
+        _, after, trial_cost = ik_numeric_step(target, trial, lighter)
+        better = casadi.logic_and(active, trial_cost < cost)
+        worse = casadi.logic_and(active, trial_cost >= cost)
+        q = casadi.if_else(better, trial, q)
+        cost = casadi.if_else(better, trial_cost, cost)
+        damping = casadi.if_else(better, lighter, casadi.if_else(worse, damping * 10.0, damping))
+        status = casadi.if_else(casadi.logic_and(worse, damping > most), IK_NUMERIC_STALLED, status)
+        _, retry, _ = ik_numeric_step(target, q, damping)
+        trial = casadi.if_else(better, after, casadi.if_else(worse, retry, trial))
+    status = casadi.if_else(casadi.logic_and(status == IK_NUMERIC_ITERATION_LIMIT, cost <= tol * tol), IK_NUMERIC_CONVERGED, status)
+    q = casadi.if_else((status == IK_NUMERIC_INVALID), q0, q)
+    return [q, status]
+
+
+_tol = casadi.SX.sym("tol")
+ik_numeric = casadi.Function("ik_numeric", [_target, _q, _tol], _ik_numeric(_target, _q, _tol),
+                             ["target", "q0", "tol"], ["q", "status"])
 
 
 def functions():
     """All functions by name."""
-    return {"fk": fk, "jacobian": jacobian, "fk_jacobian": fk_jacobian, "jacobian_tool": jacobian_tool, "task": task, "task_jacobian": task_jacobian, "singularity_factors": singularity_factors, "manipulability": manipulability, "jacobian_det": jacobian_det, "velocity_ik": velocity_ik, "ik_branches": ik_branches}
+    return {"fk": fk, "jacobian": jacobian, "fk_jacobian": fk_jacobian, "jacobian_tool": jacobian_tool, "task": task, "task_jacobian": task_jacobian, "singularity_factors": singularity_factors, "manipulability": manipulability, "jacobian_det": jacobian_det, "velocity_ik": velocity_ik, "ik_numeric_step": ik_numeric_step, "ik_branches": ik_branches}

@@ -1493,180 +1493,400 @@ int panda_velocity_ik(const panda_real q[PANDA_DOF], const panda_real mu_dot[PAN
     return (!(t253 && t254) ? 2 : (t256 ? 1 : 0));
 }
 
-/* -- Iterative inverse kinematics -- */
-
-/* The rotation vector (axis times angle in [0, pi]) of the rotation matrix E (row-major). */
-static void panda_rotation_vector(const panda_real E[9], panda_real out[3])
+panda_real panda_ik_numeric_step(const panda_real target[16], const panda_real q[PANDA_DOF], panda_real damping, panda_real q_start[PANDA_DOF], panda_real q_next[PANDA_DOF])
 {
-    const panda_real v[3] = {0.5 * (E[7] - E[5]), 0.5 * (E[2] - E[6]), 0.5 * (E[3] - E[1])};
-    const panda_real cos_angle = 0.5 * (E[0] + E[4] + E[8] - 1.0);
-    const panda_real sin_angle = sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
-    const panda_real angle = atan2(sin_angle, cos_angle);
-    panda_real axis[3], length, sign;
-    int i, column = 0;
-    if (sin_angle > 1e-6 || cos_angle > 0.0) {
-        const panda_real scale = sin_angle > 0.0 ? angle / sin_angle : 1.0;
-        for (i = 0; i < 3; ++i) {
-            out[i] = scale * v[i];
-        }
-        return;
-    }
-    /* Near a half turn: the axis from the largest column of (E + I) / 2 = u u^T. */
-    for (i = 1; i < 3; ++i) {
-        if (E[4 * i] > E[4 * column]) {
-            column = i;
-        }
-    }
-    for (i = 0; i < 3; ++i) {
-        axis[i] = 0.5 * (E[3 * i + column] + (i == column ? 1.0 : 0.0));
-    }
-    length = sqrt(axis[0] * axis[0] + axis[1] * axis[1] + axis[2] * axis[2]);
-    sign = axis[0] * v[0] + axis[1] * v[1] + axis[2] * v[2] >= 0.0 ? 1.0 : -1.0;
-    for (i = 0; i < 3; ++i) {
-        out[i] = sign * angle * axis[i] / length;
-    }
+    /* 1151 operations */
+
+    /* Inputs */
+    const panda_real T00 = target[0];
+    const panda_real T01 = target[1];
+    const panda_real T02 = target[2];
+    const panda_real T03 = target[3];
+    const panda_real T10 = target[4];
+    const panda_real T11 = target[5];
+    const panda_real T12 = target[6];
+    const panda_real T13 = target[7];
+    const panda_real T20 = target[8];
+    const panda_real T21 = target[9];
+    const panda_real T22 = target[10];
+    const panda_real T23 = target[11];
+    const panda_real qs1 = q[0];
+    const panda_real qs2 = q[1];
+    const panda_real qs3 = q[2];
+    const panda_real qs4 = q[3];
+    const panda_real qs5 = q[4];
+    const panda_real qs6 = q[5];
+    const panda_real qs7 = q[6];
+
+    /* Intermediate terms */
+    const panda_real q1 = (qs1 < -2.8973 ? -2.8973 : (qs1 > 2.8973 ? 2.8973 : qs1));
+    const panda_real q2 = (qs2 < -1.7627999999999997 ? -1.7627999999999997 : (qs2 > 1.7627999999999997 ? 1.7627999999999997 : qs2));
+    const panda_real q3 = (qs3 < -2.8973 ? -2.8973 : (qs3 > 2.8973 ? 2.8973 : qs3));
+    const panda_real q4 = (qs4 < -3.0718 ? -3.0718 : (qs4 > -0.0698 ? -0.0698 : qs4));
+    const panda_real q5 = (qs5 < -2.8973 ? -2.8973 : (qs5 > 2.8973 ? 2.8973 : qs5));
+    const panda_real q6 = (qs6 < -0.0175 ? -0.0175 : (qs6 > 3.7525000000000004 ? 3.7525000000000004 : qs6));
+    const panda_real q7 = (qs7 < -2.8973 ? -2.8973 : (qs7 > 2.8973 ? 2.8973 : qs7));
+    const panda_real c1 = cos(q1);
+    const panda_real s1 = sin(q1);
+    const panda_real c2 = cos(q2);
+    const panda_real s2 = sin(q2);
+    const panda_real c3 = cos(q3);
+    const panda_real s3 = sin(q3);
+    const panda_real c4 = cos(q4);
+    const panda_real s4 = sin(q4);
+    const panda_real c5 = cos(q5);
+    const panda_real s5 = sin(q5);
+    const panda_real c6 = cos(q6);
+    const panda_real s6 = sin(q6);
+    const panda_real c7 = cos(q7);
+    const panda_real s7 = sin(q7);
+    const panda_real t0 = T00 + T01 + T02 + T03 + T10 + T11 + T12 + T13 + T20 + T21 + T22 + T23 + qs1 + qs2 + qs3 + qs4 + qs5 + qs6 + qs7;
+    const panda_real t1 = s1*s3;
+    const panda_real t2 = c1*c3;
+    const panda_real t3 = c2*t2 - t1;
+    const panda_real t4 = -c2*t1 + t2;
+    const panda_real t5 = c3*s1;
+    const panda_real t6 = c1*s3;
+    const panda_real t7 = c2*t6 + t5;
+    const panda_real t8 = c2*t5 + t6;
+    const panda_real t9 = 0.316*s2;
+    const panda_real t10 = c1*t9 + 0.0825*t3;
+    const panda_real t11 = s1*t9 + 0.0825*t8;
+    const panda_real t12 = c3*s2;
+    const panda_real t13 = 0.316*c2 - 0.0825*t12;
+    const panda_real t14 = c2*s4 - c4*t12;
+    const panda_real t15 = c2*c4 + s4*t12;
+    const panda_real t16 = c1*s2;
+    const panda_real t17 = c4*t3 + s4*t16;
+    const panda_real t18 = c4*t16 - s4*t3;
+    const panda_real t19 = c5*t17 - s5*t7;
+    const panda_real t20 = c5*t7 + s5*t17;
+    const panda_real t21 = c6*t19 + s6*t18;
+    const panda_real t22 = c6*t18 - s6*t19;
+    const panda_real t23 = c7*t21 + s7*t20;
+    const panda_real t24 = c7*t20 - s7*t21;
+    const panda_real t25 = 0.088*t21 - 0.21*t22;
+    const panda_real t26 = 0.384*t18 + t25;
+    const panda_real t27 = -0.0825*t17 + t26;
+    const panda_real t28 = t10 + t27;
+    const panda_real t29 = T03 - t28;
+    const panda_real t30 = s1*s2;
+    const panda_real t31 = c4*t8 + s4*t30;
+    const panda_real t32 = c4*t30 - s4*t8;
+    const panda_real t33 = c5*t31 + s5*t4;
+    const panda_real t34 = c5*t4 - s5*t31;
+    const panda_real t35 = c6*t33 + s6*t32;
+    const panda_real t36 = c6*t32 - s6*t33;
+    const panda_real t37 = c7*t35 - s7*t34;
+    const panda_real t38 = c7*t34 + s7*t35;
+    const panda_real t39 = 0.088*t35 - 0.21*t36;
+    const panda_real t40 = 0.384*t32 + t39;
+    const panda_real t41 = -0.0825*t31 + t40;
+    const panda_real t42 = t11 + t41;
+    const panda_real t43 = c1*t28 + s1*t42;
+    const panda_real t44 = t27*t4 + t41*t7;
+    const panda_real t45 = t18*t40 - t26*t32;
+    const panda_real t46 = t20*t39 + t25*t34;
+    const panda_real t47 = t16*t42 - t28*t30;
+    const panda_real t48 = (t43*t43) + (t44*t44) + (t45*t45) + (t46*t46) + (t47*t47);
+    const panda_real t49 = T13 - t42;
+    const panda_real t50 = s2*s3;
+    const panda_real t51 = c5*t14 + s5*t50;
+    const panda_real t52 = c5*t50 - s5*t14;
+    const panda_real t53 = c6*t51 + s6*t15;
+    const panda_real t54 = c6*t15 - s6*t51;
+    const panda_real t55 = c7*t53 - s7*t52;
+    const panda_real t56 = c7*t52 + s7*t53;
+    const panda_real t57 = 0.088*t53 - 0.21*t54;
+    const panda_real t58 = 0.384*t15 + t57;
+    const panda_real t59 = -0.0825*t14 + t58;
+    const panda_real t60 = t13 + t59;
+    const panda_real t61 = t60 + 0.333;
+    const panda_real t62 = -t4*t59 + t41*t50;
+    const panda_real t63 = -t15*t40 + t32*t58;
+    const panda_real t64 = c2*t28 - t16*t60;
+    const panda_real t65 = t27*t50 + t59*t7;
+    const panda_real t66 = t20*t57 + t25*t52;
+    const panda_real t67 = -c2*t42 + t30*t60;
+    const panda_real t68 = -t34*t57 + t39*t52;
+    const panda_real t69 = t15*t26 - t18*t58;
+    const panda_real t70 = -c2*t67 - t15*t63 + t42 + t50*t62 + t52*t68;
+    const panda_real t71 = c2*t64 + t15*t69 + t28 + t50*t65 + t52*t66;
+    const panda_real t72 = c2*t47 + t15*t45 - t44*t50 - t46*t52;
+    const panda_real t73 = c2*t16 + t15*t18 - t20*t52 + t22*t54 - t50*t7;
+    const panda_real t74 = c2*t30 + t15*t32 + t34*t52 + t36*t54 + t4*t50;
+    const panda_real t75 = T23 - t61;
+    const panda_real t76 = 0.7071067811865476*t23;
+    const panda_real t77 = 0.7071067811865476*t24;
+    const panda_real t78 = t76 - t77;
+    const panda_real t79 = t76 + t77;
+    const panda_real t80 = T00*t78 + T01*t79 - T02*t22;
+    const panda_real t81 = T10*t78 + T11*t79 - T12*t22;
+    const panda_real t82 = T20*t78 + T21*t79 - T22*t22;
+    const panda_real t83 = 0.7071067811865476*t37;
+    const panda_real t84 = 0.7071067811865476*t38;
+    const panda_real t85 = t83 + t84;
+    const panda_real t86 = t83 - t84;
+    const panda_real t87 = T00*t85 + T01*t86 - T02*t36;
+    const panda_real t88 = T10*t85 + T11*t86 - T12*t36;
+    const panda_real t89 = T20*t85 + T21*t86 - T22*t36;
+    const panda_real t90 = 0.5*t81 - 0.5*t87;
+    const panda_real t91 = 0.7071067811865476*t55;
+    const panda_real t92 = 0.7071067811865476*t56;
+    const panda_real t93 = t91 + t92;
+    const panda_real t94 = t91 - t92;
+    const panda_real t95 = T00*t93 + T01*t94 - T02*t54;
+    const panda_real t96 = T10*t93 + T11*t94 - T12*t54;
+    const panda_real t97 = T20*t93 + T21*t94 - T22*t54;
+    const panda_real t98 = 0.5*t89 - 0.5*t96;
+    const panda_real t99 = -0.5*t82 + 0.5*t95;
+    const panda_real t100 = 0.5*t80 + 0.5*t88 + 0.5*t97 - 0.5;
+    const panda_real t101 = sqrt((t90*t90) + (t98*t98) + (t99*t99));
+    const panda_real t102 = atan2(t101, t100);
+    const panda_real t103 = (t101 > 0 ? t102/t101 : 1);
+    const panda_real t104 = (t60*t60);
+    const panda_real t105 = (c1*c1);
+    const panda_real t106 = t104*t105 + (t42*t42) + (t62*t62) + (t63*t63) + (t67*t67) + (t68*t68);
+    const panda_real t107 = t105*t60 + t30*t67 + t32*t63 - t34*t68 - t4*t62;
+    const panda_real t108 = c1*s1;
+    const panda_real t109 = t104*t108 - t28*t42 - t62*t65 + t63*t69 + t64*t67 - t66*t68;
+    const panda_real t110 = c1*t43;
+    const panda_real t111 = -t110*t60 + t44*t62 + t45*t63 + t46*t68 + t47*t67;
+    const panda_real t112 = t110 - t30*t47 - t32*t45 + t34*t46 + t4*t44;
+    const panda_real t113 = t108*t60;
+    const panda_real t114 = -t113 + t16*t67 + t18*t63 + t20*t68 + t62*t7;
+    const panda_real t115 = t113 + t30*t64 + t32*t69 + t34*t66 + t4*t65;
+    const panda_real t116 = (s1*s1);
+    const panda_real t117 = t104*t116 + (t28*t28) + (t64*t64) + (t65*t65) + (t66*t66) + (t69*t69);
+    const panda_real t118 = t116*t60 - t16*t64 - t18*t69 + t20*t66 + t65*t7;
+    const panda_real t119 = s1*t43;
+    const panda_real t120 = t119*t60 + t44*t65 - t45*t69 + t46*t66 - t47*t64;
+    const panda_real t121 = t119 + t16*t47 + t18*t45 + t20*t46 + t44*t7;
+    const panda_real t122 = (s2*s2);
+    const panda_real t123 = t105*t122 + t116 + (t18*t18) + (t20*t20) + (t22*t22) + (t7*t7);
+    const panda_real t124 = t108*t122 - t108 + t18*t32 - t20*t34 + t22*t36 - t4*t7;
+    const panda_real t125 = t105 + t116*t122 + (t32*t32) + (t34*t34) + (t36*t36) + (t4*t4);
+    const panda_real t126 = t122*(s3*s3) + (c2*c2) + (t15*t15) + (t52*t52) + (t54*t54) + 1;
+    const int t127 = t80 >= t88 && t80 >= t97;
+    const int t128 = t88 >= t97;
+    const panda_real t129 = (t127 ? 0.5*t80 + 0.5 : (t128 ? 0.5*t87 : 0.5*t95));
+    const panda_real t130 = (t127 ? 0.5*t81 : (t128 ? 0.5*t88 + 0.5 : 0.5*t96));
+    const panda_real t131 = (t127 ? 0.5*t82 : (t128 ? 0.5*t89 : 0.5*t97 + 0.5));
+    const panda_real t132 = sqrt((t129*t129) + (t130*t130) + (t131*t131));
+    const panda_real t133 = (t129*t98 + t130*t99 + t131*t90 >= 0 ? 1 : -1);
+    const int t134 = (t101 > 1e-06) || (t100 > 0);
+    const panda_real t135 = t102*t133/t132;
+    const panda_real t136 = (t134 ? t103*t98 : t129*t135);
+    const panda_real t137 = (t134 ? t103*t99 : t130*t135);
+    const panda_real t138 = (t134 ? t103*t90 : t131*t135);
+    const panda_real t139 = (t136*t136) + (t137*t137) + (t138*t138) + (t29*t29) + (t49*t49) + (t75*t75);
+    const panda_real t140 = damping + t106;
+    const panda_real t141 = sqrt((t107*t107) + (t109*t109) + (t111*t111) + (t114*t114) + (t140*t140) + (t70*t70));
+    const panda_real t142 = t141*(t140 >= 0 ? 1 : -1);
+    const panda_real t143 = t140 + t142;
+    const panda_real t144 = (t141 > 0 ? 1/(t141*(t141 + fabs(t140))) : 0);
+    const panda_real t145 = t144*(t107*t137 + t109*t49 + t111*t75 + t114*t136 - t138*t70 + t143*t29);
+    const panda_real t146 = -t143*t145 + t29;
+    const panda_real t147 = -t109*t145 + t49;
+    const panda_real t148 = -t111*t145 + t75;
+    const panda_real t149 = -t114*t145 + t136;
+    const panda_real t150 = -t107*t145 + t137;
+    const panda_real t151 = t138 + t145*t70;
+    const panda_real t152 = damping + t117;
+    const panda_real t153 = t144*(t107*t115 + t109*t143 + t109*t152 - t111*t120 - t114*t118 - t70*t71);
+    const panda_real t154 = t109 - t143*t153;
+    const panda_real t155 = -t109*t153 + t152;
+    const panda_real t156 = t111*t153 + t120;
+    const panda_real t157 = t114*t153 + t118;
+    const panda_real t158 = -t107*t153 + t115;
+    const panda_real t159 = t153*t70 + t71;
+    const panda_real t160 = sqrt((t155*t155) + (t156*t156) + (t157*t157) + (t158*t158) + (t159*t159));
+    const panda_real t161 = t160*(t155 >= 0 ? 1 : -1);
+    const panda_real t162 = t155 + t161;
+    const panda_real t163 = (t160 > 0 ? 1/(t160*(t160 + fabs(t155))) : 0);
+    const panda_real t164 = t163*(t147*t162 - t148*t156 - t149*t157 + t150*t158 + t151*t159);
+    const panda_real t165 = t147 - t162*t164;
+    const panda_real t166 = t148 + t156*t164;
+    const panda_real t167 = t149 + t157*t164;
+    const panda_real t168 = t150 - t158*t164;
+    const panda_real t169 = t151 - t159*t164;
+    const panda_real t170 = damping + t48;
+    const panda_real t171 = t144*(-t107*t112 - t109*t120 + t111*t143 + t111*t170 + t114*t121 - t70*t72);
+    const panda_real t172 = t111 - t143*t171;
+    const panda_real t173 = t109*t171 + t120;
+    const panda_real t174 = -t111*t171 + t170;
+    const panda_real t175 = -t114*t171 + t121;
+    const panda_real t176 = t107*t171 + t112;
+    const panda_real t177 = t171*t70 + t72;
+    const panda_real t178 = -t163*(t156*t174 + t157*t175 + t158*t176 - t159*t177 + t162*t173);
+    const panda_real t179 = t162*t178 + t173;
+    const panda_real t180 = t156*t178 + t174;
+    const panda_real t181 = t157*t178 + t175;
+    const panda_real t182 = t158*t178 + t176;
+    const panda_real t183 = -t159*t178 + t177;
+    const panda_real t184 = sqrt((t180*t180) + (t181*t181) + (t182*t182) + (t183*t183));
+    const panda_real t185 = t184*(t180 >= 0 ? 1 : -1);
+    const panda_real t186 = t180 + t185;
+    const panda_real t187 = (t184 > 0 ? 1/(t184*(t184 + fabs(t180))) : 0);
+    const panda_real t188 = t187*(t166*t186 + t167*t181 - t168*t182 + t169*t183);
+    const panda_real t189 = t166 - t186*t188;
+    const panda_real t190 = t167 - t181*t188;
+    const panda_real t191 = t168 + t182*t188;
+    const panda_real t192 = t169 - t183*t188;
+    const panda_real t193 = damping + t123;
+    const panda_real t194 = t144*(t107*t124 - t109*t118 + t111*t121 + t114*t143 + t114*t193 - t70*t73);
+    const panda_real t195 = t114 - t143*t194;
+    const panda_real t196 = t109*t194 + t118;
+    const panda_real t197 = -t111*t194 + t121;
+    const panda_real t198 = -t114*t194 + t193;
+    const panda_real t199 = -t107*t194 + t124;
+    const panda_real t200 = t194*t70 + t73;
+    const panda_real t201 = -t163*(t156*t197 + t157*t198 - t158*t199 - t159*t200 + t162*t196);
+    const panda_real t202 = t162*t201 + t196;
+    const panda_real t203 = t156*t201 + t197;
+    const panda_real t204 = t157*t201 + t198;
+    const panda_real t205 = -t158*t201 + t199;
+    const panda_real t206 = -t159*t201 + t200;
+    const panda_real t207 = t187*(t181*t204 - t182*t205 + t183*t206 + t186*t203);
+    const panda_real t208 = -t186*t207 + t203;
+    const panda_real t209 = -t181*t207 + t204;
+    const panda_real t210 = t182*t207 + t205;
+    const panda_real t211 = -t183*t207 + t206;
+    const panda_real t212 = sqrt((t209*t209) + (t210*t210) + (t211*t211));
+    const panda_real t213 = t212*(t209 >= 0 ? 1 : -1);
+    const panda_real t214 = t209 + t213;
+    const panda_real t215 = (t212 > 0 ? 1/(t212*(t212 + fabs(t209))) : 0);
+    const panda_real t216 = t215*(t190*t214 + t191*t210 + t192*t211);
+    const panda_real t217 = t190 - t214*t216;
+    const panda_real t218 = t191 - t210*t216;
+    const panda_real t219 = t192 - t211*t216;
+    const panda_real t220 = damping + t125;
+    const panda_real t221 = t144*(t107*t143 + t107*t220 + t109*t115 - t111*t112 + t114*t124 - t70*t74);
+    const panda_real t222 = t107 - t143*t221;
+    const panda_real t223 = -t109*t221 + t115;
+    const panda_real t224 = t111*t221 + t112;
+    const panda_real t225 = -t114*t221 + t124;
+    const panda_real t226 = -t107*t221 + t220;
+    const panda_real t227 = t221*t70 + t74;
+    const panda_real t228 = t163*(t156*t224 - t157*t225 + t158*t226 + t159*t227 + t162*t223);
+    const panda_real t229 = -t162*t228 + t223;
+    const panda_real t230 = t156*t228 - t224;
+    const panda_real t231 = t157*t228 + t225;
+    const panda_real t232 = -t158*t228 + t226;
+    const panda_real t233 = -t159*t228 + t227;
+    const panda_real t234 = t187*(t181*t231 - t182*t232 + t183*t233 + t186*t230);
+    const panda_real t235 = -t186*t234 + t230;
+    const panda_real t236 = -t181*t234 + t231;
+    const panda_real t237 = t182*t234 + t232;
+    const panda_real t238 = -t183*t234 + t233;
+    const panda_real t239 = t215*(t210*t237 + t211*t238 + t214*t236);
+    const panda_real t240 = -t214*t239 + t236;
+    const panda_real t241 = -t210*t239 + t237;
+    const panda_real t242 = -t211*t239 + t238;
+    const panda_real t243 = sqrt((t241*t241) + (t242*t242));
+    const panda_real t244 = t243*(t241 >= 0 ? 1 : -1);
+    const panda_real t245 = t241 + t244;
+    const panda_real t246 = (t243 > 0 ? 1/(t243*(t243 + fabs(t241))) : 0);
+    const panda_real t247 = t246*(t218*t245 + t219*t242);
+    const panda_real t248 = t218 - t245*t247;
+    const panda_real t249 = t219 - t242*t247;
+    const panda_real t250 = damping + t126;
+    const panda_real t251 = t144*(t107*t74 + t109*t71 + t111*t72 + t114*t73 - t143*t70 - t250*t70);
+    const panda_real t252 = t143*t251 + t70;
+    const panda_real t253 = -t109*t251 + t71;
+    const panda_real t254 = -t111*t251 + t72;
+    const panda_real t255 = -t114*t251 + t73;
+    const panda_real t256 = -t107*t251 + t74;
+    const panda_real t257 = t250 + t251*t70;
+    const panda_real t258 = t163*(-t156*t254 - t157*t255 + t158*t256 + t159*t257 + t162*t253);
+    const panda_real t259 = -t162*t258 + t253;
+    const panda_real t260 = t156*t258 + t254;
+    const panda_real t261 = t157*t258 + t255;
+    const panda_real t262 = -t158*t258 + t256;
+    const panda_real t263 = -t159*t258 + t257;
+    const panda_real t264 = t187*(t181*t261 - t182*t262 + t183*t263 + t186*t260);
+    const panda_real t265 = -t186*t264 + t260;
+    const panda_real t266 = -t181*t264 + t261;
+    const panda_real t267 = t182*t264 + t262;
+    const panda_real t268 = -t183*t264 + t263;
+    const panda_real t269 = t215*(t210*t267 + t211*t268 + t214*t266);
+    const panda_real t270 = -t214*t269 + t266;
+    const panda_real t271 = -t210*t269 + t267;
+    const panda_real t272 = -t211*t269 + t268;
+    const panda_real t273 = t246*(t242*t272 + t245*t271);
+    const panda_real t274 = -t245*t273 + t271;
+    const panda_real t275 = -t242*t273 + t272;
+    const panda_real t276 = fabs(t275);
+    const panda_real t277 = t276;
+    const panda_real t278 = t277*(t275 >= 0 ? 1 : -1);
+    const panda_real t279 = t275 + t278;
+    const panda_real t280 = (t277 > 0 ? 1/(t277*(t276 + t277)) : 0);
+    const panda_real t281 = -t249*t280*(t279*t279) + t249;
+    const panda_real t282 = t281/t278;
+    const panda_real t283 = (t248 + t274*t282)/t244;
+    const panda_real t284 = (t217 + t240*t283 + t270*t282)/t213;
+    const panda_real t285 = (t189 + t208*t284 + t235*t283 + t265*t282)/t185;
+    const panda_real t286 = (t165 - t179*t285 - t202*t284 + t229*t283 + t259*t282)/t161;
+    const panda_real t287 = (t146 + t154*t286 + t172*t285 + t195*t284 + t222*t283 - t252*t282)/t142;
+    const panda_real t288 = q1 - t28*t286 - t282 + t287*t42;
+    const panda_real t289 = -c1*t283 - c1*t287*t60 + q2 + s1*t284 - s1*t286*t60 + t285*t43;
+    const panda_real t290 = c2*t282 - q3 + t16*t284 + t283*t30 + t285*t47 + t286*t64 + t287*t67;
+    const panda_real t291 = q4 + t282*t50 + t283*t4 - t284*t7 - t285*t44 + t286*t65 - t287*t62;
+    const panda_real t292 = -q5 + t15*t282 + t18*t284 + t283*t32 + t285*t45 + t286*t69 + t287*t63;
+    const panda_real t293 = q6 - t20*t284 + t282*t52 + t283*t34 - t285*t46 + t286*t66 - t287*t68;
+    const panda_real t294 = q7 + t22*t284 + t282*t54 + t283*t36;
+
+    /* Outputs */
+    q_start[0] = q1;
+    q_start[1] = q2;
+    q_start[2] = q3;
+    q_start[3] = q4;
+    q_start[4] = q5;
+    q_start[5] = q6;
+    q_start[6] = q7;
+    q_next[0] = (t288 < -2.8973 ? -2.8973 : (t288 > 2.8973 ? 2.8973 : t288));
+    q_next[1] = (t289 < -1.7627999999999997 ? -1.7627999999999997 : (t289 > 1.7627999999999997 ? 1.7627999999999997 : t289));
+    q_next[2] = (t290 > 2.8973 ? -2.8973 : (t290 < -2.8973 ? 2.8973 : -t290));
+    q_next[3] = (t291 < -3.0718 ? -3.0718 : (t291 > -0.0698 ? -0.0698 : t291));
+    q_next[4] = (t292 > 2.8973 ? -2.8973 : (t292 < -2.8973 ? 2.8973 : -t292));
+    q_next[5] = (t293 < -0.0175 ? -0.0175 : (t293 > 3.7525000000000004 ? 3.7525000000000004 : t293));
+    q_next[6] = (t294 < -2.8973 ? -2.8973 : (t294 > 2.8973 ? 2.8973 : t294));
+    return (isfinite(t0) ? t139 : -1);
 }
 
-/* Error [target position - position; rotation vector of target R^T] and the geometric Jacobian. */
-static void panda_task_error(const panda_real target[16], const panda_real q[PANDA_DOF], panda_real e[6], panda_real J[6 * PANDA_DOF])
-{
-    panda_real T[16], E[9];
-    int i, j;
-    panda_fk(q, T);
-    panda_jacobian(q, J);
-    for (i = 0; i < 3; ++i) {
-        e[i] = target[4 * i + 3] - T[4 * i + 3];
-        for (j = 0; j < 3; ++j) {
-            E[3 * i + j] = target[4 * i] * T[4 * j] + target[4 * i + 1] * T[4 * j + 1] + target[4 * i + 2] * T[4 * j + 2];
-        }
-    }
-    panda_rotation_vector(E, e + 3);
-}
-
-/* Joints clamped to their limits. */
-static void panda_clamp(panda_real q[PANDA_DOF])
-{
-    q[0] = q[0] < -2.8973 ? -2.8973 : q[0] > 2.8973 ? 2.8973 : q[0];
-    q[1] = q[1] < -1.7627999999999997 ? -1.7627999999999997 : q[1] > 1.7627999999999997 ? 1.7627999999999997 : q[1];
-    q[2] = q[2] < -2.8973 ? -2.8973 : q[2] > 2.8973 ? 2.8973 : q[2];
-    q[3] = q[3] < -3.0718 ? -3.0718 : q[3] > -0.0698 ? -0.0698 : q[3];
-    q[4] = q[4] < -2.8973 ? -2.8973 : q[4] > 2.8973 ? 2.8973 : q[4];
-    q[5] = q[5] < -0.0175 ? -0.0175 : q[5] > 3.7525000000000004 ? 3.7525000000000004 : q[5];
-    q[6] = q[6] < -2.8973 ? -2.8973 : q[6] > 2.8973 ? 2.8973 : q[6];
-}
-
-/* Solves A x = b in place (b becomes x) for the symmetric positive definite K x K matrix A by
- * Cholesky; returns 0 when A is not numerically positive definite. */
-static int panda_cholesky_solve(panda_real A[36], panda_real b[6])
-{
-    int i, j, k;
-    for (j = 0; j < 6; ++j) {
-        panda_real diagonal = A[6 * j + j];
-        for (k = 0; k < j; ++k) {
-            diagonal -= A[6 * j + k] * A[6 * j + k];
-        }
-        if (!(diagonal > 0.0)) {
-            return 0;
-        }
-        A[6 * j + j] = sqrt(diagonal);
-        for (i = j + 1; i < 6; ++i) {
-            panda_real sum = A[6 * i + j];
-            for (k = 0; k < j; ++k) {
-                sum -= A[6 * i + k] * A[6 * j + k];
-            }
-            A[6 * i + j] = sum / A[6 * j + j];
-        }
-    }
-    for (i = 0; i < 6; ++i) {
-        for (k = 0; k < i; ++k) {
-            b[i] -= A[6 * i + k] * b[k];
-        }
-        b[i] /= A[6 * i + i];
-    }
-    for (i = 6 - 1; i >= 0; --i) {
-        for (k = i + 1; k < 6; ++k) {
-            b[i] -= A[6 * k + i] * b[k];
-        }
-        b[i] /= A[6 * i + i];
-    }
-    return 1;
-}
+/* -- Iterative inverse kinematics: the loop around panda_ik_numeric_step -- */
 
 int panda_ik_numeric(const panda_real target[16], const panda_real q0[PANDA_DOF], int max_iter, panda_real tol, panda_real q[PANDA_DOF])
 {
-    panda_real e[6], J[6 * PANDA_DOF], trial[PANDA_DOF], trial_e[6];
-    panda_real trial_J[6 * PANDA_DOF], A[36], x[6];
-    panda_real cost, trial_cost, damping = 1e-06;
-    int i, j, k, iteration;
-    for (j = 0; j < PANDA_DOF; ++j) {
-        q[j] = q0[j];
-    }
-    for (i = 0; i < 12; ++i) {
-        if (!isfinite(target[i])) {
-            return PANDA_IK_NUMERIC_INVALID;
+    panda_real trial[PANDA_DOF], after[PANDA_DOF], start[PANDA_DOF];
+    panda_real cost, trial_cost, lighter, damping = 1e-06;
+    int j, iteration;
+    cost = panda_ik_numeric_step(target, q0, damping, q, trial);
+    if (!(cost >= 0) || max_iter < 0) { /* -1: target or q0 not finite */
+        for (j = 0; j < PANDA_DOF; ++j) {
+            q[j] = q0[j];
         }
-    }
-    for (j = 0; j < PANDA_DOF; ++j) {
-        if (!isfinite(q0[j])) {
-            return PANDA_IK_NUMERIC_INVALID;
-        }
-    }
-    if (max_iter < 0) {
         return PANDA_IK_NUMERIC_INVALID;
-    }
-    panda_clamp(q);
-    panda_task_error(target, q, e, J);
-    cost = 0.0;
-    for (i = 0; i < 6; ++i) {
-        cost += e[i] * e[i];
     }
     for (iteration = 0; iteration < max_iter; ++iteration) {
         if (cost <= tol * tol) {
             return PANDA_IK_NUMERIC_CONVERGED;
         }
-        /* A = J J^T + damping I, x = A^-1 e, step J^T x */
-        for (i = 0; i < 6; ++i) {
-            x[i] = e[i];
-            for (k = 0; k < 6; ++k) {
-                panda_real sum = i == k ? damping : 0.0;
-                for (j = 0; j < PANDA_DOF; ++j) {
-                    sum += J[PANDA_DOF * i + j] * J[PANDA_DOF * k + j];
-                }
-                A[6 * i + k] = sum;
-            }
-        }
-        if (!panda_cholesky_solve(A, x)) {
-            return PANDA_IK_NUMERIC_STALLED;
-        }
-        for (j = 0; j < PANDA_DOF; ++j) {
-            trial[j] = q[j];
-            for (i = 0; i < 6; ++i) {
-                trial[j] += J[PANDA_DOF * i + j] * x[i];
-            }
-        }
-        panda_clamp(trial);
-        panda_task_error(target, trial, trial_e, trial_J);
-        trial_cost = 0.0;
-        for (i = 0; i < 6; ++i) {
-            trial_cost += trial_e[i] * trial_e[i];
-        }
+        lighter = damping * 0.1 > 1e-12 ? damping * 0.1 : 1e-12;
+        trial_cost = panda_ik_numeric_step(target, trial, lighter, start, after);
         if (trial_cost < cost) {
             for (j = 0; j < PANDA_DOF; ++j) {
                 q[j] = trial[j];
-            }
-            for (i = 0; i < 6; ++i) {
-                e[i] = trial_e[i];
-            }
-            for (i = 0; i < 6 * PANDA_DOF; ++i) {
-                J[i] = trial_J[i];
+                trial[j] = after[j];
             }
             cost = trial_cost;
-            damping = damping * 0.1 > 1e-12 ? damping * 0.1 : 1e-12;
+            damping = lighter;
         } else {
             damping *= 10.0;
             if (damping > 100000000.0) {
                 return PANDA_IK_NUMERIC_STALLED;
             }
+            (void)panda_ik_numeric_step(target, q, damping, start, trial);
         }
     }
     return cost <= tol * tol ? PANDA_IK_NUMERIC_CONVERGED : PANDA_IK_NUMERIC_ITERATION_LIMIT;

@@ -70,6 +70,10 @@ panda_real panda_manipulability(const panda_real q[PANDA_DOF]);
  * Result: q_dot[i], i < 7; returned as a scalar. 1053 operations. */
 int panda_velocity_ik(const panda_real q[PANDA_DOF], const panda_real mu_dot[PANDA_TASK_DIM], panda_real damping, panda_real q_dot[PANDA_DOF]);
 
+/* One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite).
+ * Result: q_start[i], i < 7; q_next[i], i < 7; returned as a scalar. 1151 operations. */
+panda_real panda_ik_numeric_step(const panda_real target[16], const panda_real q[PANDA_DOF], panda_real damping, panda_real q_start[PANDA_DOF], panda_real q_next[PANDA_DOF]);
+
 /* Statuses of panda_velocity_ik: OK, singular (a diagonal entry of the QR factor R of the
  * 6 x 6 system at most 1e-12 times its Frobenius norm: take damping > 0), or
  * not finite (q, mu_dot, damping or Js not finite, or damping < 0); q_dot is 0 unless OK.

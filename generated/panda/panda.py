@@ -1483,73 +1483,410 @@ def velocity_ik(q, mu_dot, damping=0.0):
     return q_dot, status
 
 
-# -- Iterative inverse kinematics --
+@numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
+def ik_numeric_step(target, q, damping=0.0):
+    """one step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite): (7 x 1 and 7 x 1 and 1 x 1), 1151 operations."""
+    target = _argument("target", target, (4, 4))
+    q = _argument("q", q, (7,))
+    damping = _argument("damping", damping, ())
+    T00 = target[..., 0, 0]
+    T01 = target[..., 0, 1]
+    T02 = target[..., 0, 2]
+    T03 = target[..., 0, 3]
+    T10 = target[..., 1, 0]
+    T11 = target[..., 1, 1]
+    T12 = target[..., 1, 2]
+    T13 = target[..., 1, 3]
+    T20 = target[..., 2, 0]
+    T21 = target[..., 2, 1]
+    T22 = target[..., 2, 2]
+    T23 = target[..., 2, 3]
+    qs1 = q[..., 0]
+    qs2 = q[..., 1]
+    qs3 = q[..., 2]
+    qs4 = q[..., 3]
+    qs5 = q[..., 4]
+    qs6 = q[..., 5]
+    qs7 = q[..., 6]
+    q1 = numpy.where(numpy.less(qs1, -2.8973), -2.8973, numpy.where(numpy.greater(qs1, 2.8973), 2.8973, qs1))
+    q2 = numpy.where(numpy.less(qs2, -1.7627999999999997), -1.7627999999999997, numpy.where(numpy.greater(qs2, 1.7627999999999997), 1.7627999999999997, qs2))
+    q3 = numpy.where(numpy.less(qs3, -2.8973), -2.8973, numpy.where(numpy.greater(qs3, 2.8973), 2.8973, qs3))
+    q4 = numpy.where(numpy.less(qs4, -3.0718), -3.0718, numpy.where(numpy.greater(qs4, -0.0698), -0.0698, qs4))
+    q5 = numpy.where(numpy.less(qs5, -2.8973), -2.8973, numpy.where(numpy.greater(qs5, 2.8973), 2.8973, qs5))
+    q6 = numpy.where(numpy.less(qs6, -0.0175), -0.0175, numpy.where(numpy.greater(qs6, 3.7525000000000004), 3.7525000000000004, qs6))
+    q7 = numpy.where(numpy.less(qs7, -2.8973), -2.8973, numpy.where(numpy.greater(qs7, 2.8973), 2.8973, qs7))
+    c1 = numpy.cos(q1)
+    s1 = numpy.sin(q1)
+    c2 = numpy.cos(q2)
+    s2 = numpy.sin(q2)
+    c3 = numpy.cos(q3)
+    s3 = numpy.sin(q3)
+    c4 = numpy.cos(q4)
+    s4 = numpy.sin(q4)
+    c5 = numpy.cos(q5)
+    s5 = numpy.sin(q5)
+    c6 = numpy.cos(q6)
+    s6 = numpy.sin(q6)
+    c7 = numpy.cos(q7)
+    s7 = numpy.sin(q7)
+    t0 = T00 + T01 + T02 + T03 + T10 + T11 + T12 + T13 + T20 + T21 + T22 + T23 + qs1 + qs2 + qs3 + qs4 + qs5 + qs6 + qs7
+    t1 = s1*s3
+    t2 = c1*c3
+    t3 = c2*t2 - t1
+    t4 = -c2*t1 + t2
+    t5 = c3*s1
+    t6 = c1*s3
+    t7 = c2*t6 + t5
+    t8 = c2*t5 + t6
+    t9 = 0.316*s2
+    t10 = c1*t9 + 0.0825*t3
+    t11 = s1*t9 + 0.0825*t8
+    t12 = c3*s2
+    t13 = 0.316*c2 - 0.0825*t12
+    t14 = c2*s4 - c4*t12
+    t15 = c2*c4 + s4*t12
+    t16 = c1*s2
+    t17 = c4*t3 + s4*t16
+    t18 = c4*t16 - s4*t3
+    t19 = c5*t17 - s5*t7
+    t20 = c5*t7 + s5*t17
+    t21 = c6*t19 + s6*t18
+    t22 = c6*t18 - s6*t19
+    t23 = c7*t21 + s7*t20
+    t24 = c7*t20 - s7*t21
+    t25 = 0.088*t21 - 0.21*t22
+    t26 = 0.384*t18 + t25
+    t27 = -0.0825*t17 + t26
+    t28 = t10 + t27
+    t29 = T03 - t28
+    t30 = s1*s2
+    t31 = c4*t8 + s4*t30
+    t32 = c4*t30 - s4*t8
+    t33 = c5*t31 + s5*t4
+    t34 = c5*t4 - s5*t31
+    t35 = c6*t33 + s6*t32
+    t36 = c6*t32 - s6*t33
+    t37 = c7*t35 - s7*t34
+    t38 = c7*t34 + s7*t35
+    t39 = 0.088*t35 - 0.21*t36
+    t40 = 0.384*t32 + t39
+    t41 = -0.0825*t31 + t40
+    t42 = t11 + t41
+    t43 = c1*t28 + s1*t42
+    t44 = t27*t4 + t41*t7
+    t45 = t18*t40 - t26*t32
+    t46 = t20*t39 + t25*t34
+    t47 = t16*t42 - t28*t30
+    t48 = t43**2 + t44**2 + t45**2 + t46**2 + t47**2
+    t49 = T13 - t42
+    t50 = s2*s3
+    t51 = c5*t14 + s5*t50
+    t52 = c5*t50 - s5*t14
+    t53 = c6*t51 + s6*t15
+    t54 = c6*t15 - s6*t51
+    t55 = c7*t53 - s7*t52
+    t56 = c7*t52 + s7*t53
+    t57 = 0.088*t53 - 0.21*t54
+    t58 = 0.384*t15 + t57
+    t59 = -0.0825*t14 + t58
+    t60 = t13 + t59
+    t61 = t60 + 0.333
+    t62 = -t4*t59 + t41*t50
+    t63 = -t15*t40 + t32*t58
+    t64 = c2*t28 - t16*t60
+    t65 = t27*t50 + t59*t7
+    t66 = t20*t57 + t25*t52
+    t67 = -c2*t42 + t30*t60
+    t68 = -t34*t57 + t39*t52
+    t69 = t15*t26 - t18*t58
+    t70 = -c2*t67 - t15*t63 + t42 + t50*t62 + t52*t68
+    t71 = c2*t64 + t15*t69 + t28 + t50*t65 + t52*t66
+    t72 = c2*t47 + t15*t45 - t44*t50 - t46*t52
+    t73 = c2*t16 + t15*t18 - t20*t52 + t22*t54 - t50*t7
+    t74 = c2*t30 + t15*t32 + t34*t52 + t36*t54 + t4*t50
+    t75 = T23 - t61
+    t76 = 0.7071067811865476*t23
+    t77 = 0.7071067811865476*t24
+    t78 = t76 - t77
+    t79 = t76 + t77
+    t80 = T00*t78 + T01*t79 - T02*t22
+    t81 = T10*t78 + T11*t79 - T12*t22
+    t82 = T20*t78 + T21*t79 - T22*t22
+    t83 = 0.7071067811865476*t37
+    t84 = 0.7071067811865476*t38
+    t85 = t83 + t84
+    t86 = t83 - t84
+    t87 = T00*t85 + T01*t86 - T02*t36
+    t88 = T10*t85 + T11*t86 - T12*t36
+    t89 = T20*t85 + T21*t86 - T22*t36
+    t90 = 0.5*t81 - 0.5*t87
+    t91 = 0.7071067811865476*t55
+    t92 = 0.7071067811865476*t56
+    t93 = t91 + t92
+    t94 = t91 - t92
+    t95 = T00*t93 + T01*t94 - T02*t54
+    t96 = T10*t93 + T11*t94 - T12*t54
+    t97 = T20*t93 + T21*t94 - T22*t54
+    t98 = 0.5*t89 - 0.5*t96
+    t99 = -0.5*t82 + 0.5*t95
+    t100 = 0.5*t80 + 0.5*t88 + 0.5*t97 - 0.5
+    t101 = numpy.sqrt(t90**2 + t98**2 + t99**2)
+    t102 = numpy.arctan2(t101, t100)
+    t103 = numpy.where(numpy.greater(t101, 0), t102/t101, 1)
+    t104 = t60**2
+    t105 = c1**2
+    t106 = t104*t105 + t42**2 + t62**2 + t63**2 + t67**2 + t68**2
+    t107 = t105*t60 + t30*t67 + t32*t63 - t34*t68 - t4*t62
+    t108 = c1*s1
+    t109 = t104*t108 - t28*t42 - t62*t65 + t63*t69 + t64*t67 - t66*t68
+    t110 = c1*t43
+    t111 = -t110*t60 + t44*t62 + t45*t63 + t46*t68 + t47*t67
+    t112 = t110 - t30*t47 - t32*t45 + t34*t46 + t4*t44
+    t113 = t108*t60
+    t114 = -t113 + t16*t67 + t18*t63 + t20*t68 + t62*t7
+    t115 = t113 + t30*t64 + t32*t69 + t34*t66 + t4*t65
+    t116 = s1**2
+    t117 = t104*t116 + t28**2 + t64**2 + t65**2 + t66**2 + t69**2
+    t118 = t116*t60 - t16*t64 - t18*t69 + t20*t66 + t65*t7
+    t119 = s1*t43
+    t120 = t119*t60 + t44*t65 - t45*t69 + t46*t66 - t47*t64
+    t121 = t119 + t16*t47 + t18*t45 + t20*t46 + t44*t7
+    t122 = s2**2
+    t123 = t105*t122 + t116 + t18**2 + t20**2 + t22**2 + t7**2
+    t124 = t108*t122 - t108 + t18*t32 - t20*t34 + t22*t36 - t4*t7
+    t125 = t105 + t116*t122 + t32**2 + t34**2 + t36**2 + t4**2
+    t126 = c2**2 + s3**2*t122 + t15**2 + t52**2 + t54**2 + 1
+    t127 = (numpy.greater_equal(t80, t88)) & (numpy.greater_equal(t80, t97))
+    t128 = numpy.greater_equal(t88, t97)
+    t129 = numpy.where(t127, 0.5*t80 + 0.5, numpy.where(t128, 0.5*t87, 0.5*t95))
+    t130 = numpy.where(t127, 0.5*t81, numpy.where(t128, 0.5*t88 + 0.5, 0.5*t96))
+    t131 = numpy.where(t127, 0.5*t82, numpy.where(t128, 0.5*t89, 0.5*t97 + 0.5))
+    t132 = numpy.sqrt(t129**2 + t130**2 + t131**2)
+    t133 = numpy.where(numpy.greater_equal(t129*t98 + t130*t99 + t131*t90, 0), 1, -1)
+    t134 = (numpy.greater(t101, 1e-06)) | (numpy.greater(t100, 0))
+    t135 = t102*t133/t132
+    t136 = numpy.where(t134, t103*t98, t129*t135)
+    t137 = numpy.where(t134, t103*t99, t130*t135)
+    t138 = numpy.where(t134, t103*t90, t131*t135)
+    t139 = t136**2 + t137**2 + t138**2 + t29**2 + t49**2 + t75**2
+    t140 = damping + t106
+    t141 = numpy.sqrt(t107**2 + t109**2 + t111**2 + t114**2 + t140**2 + t70**2)
+    t142 = t141*numpy.where(numpy.greater_equal(t140, 0), 1, -1)
+    t143 = t140 + t142
+    t144 = numpy.where(numpy.greater(t141, 0), 1/(t141*(t141 + abs(t140))), 0)
+    t145 = t144*(t107*t137 + t109*t49 + t111*t75 + t114*t136 - t138*t70 + t143*t29)
+    t146 = -t143*t145 + t29
+    t147 = -t109*t145 + t49
+    t148 = -t111*t145 + t75
+    t149 = -t114*t145 + t136
+    t150 = -t107*t145 + t137
+    t151 = t138 + t145*t70
+    t152 = damping + t117
+    t153 = t144*(t107*t115 + t109*t143 + t109*t152 - t111*t120 - t114*t118 - t70*t71)
+    t154 = t109 - t143*t153
+    t155 = -t109*t153 + t152
+    t156 = t111*t153 + t120
+    t157 = t114*t153 + t118
+    t158 = -t107*t153 + t115
+    t159 = t153*t70 + t71
+    t160 = numpy.sqrt(t155**2 + t156**2 + t157**2 + t158**2 + t159**2)
+    t161 = t160*numpy.where(numpy.greater_equal(t155, 0), 1, -1)
+    t162 = t155 + t161
+    t163 = numpy.where(numpy.greater(t160, 0), 1/(t160*(t160 + abs(t155))), 0)
+    t164 = t163*(t147*t162 - t148*t156 - t149*t157 + t150*t158 + t151*t159)
+    t165 = t147 - t162*t164
+    t166 = t148 + t156*t164
+    t167 = t149 + t157*t164
+    t168 = t150 - t158*t164
+    t169 = t151 - t159*t164
+    t170 = damping + t48
+    t171 = t144*(-t107*t112 - t109*t120 + t111*t143 + t111*t170 + t114*t121 - t70*t72)
+    t172 = t111 - t143*t171
+    t173 = t109*t171 + t120
+    t174 = -t111*t171 + t170
+    t175 = -t114*t171 + t121
+    t176 = t107*t171 + t112
+    t177 = t171*t70 + t72
+    t178 = -t163*(t156*t174 + t157*t175 + t158*t176 - t159*t177 + t162*t173)
+    t179 = t162*t178 + t173
+    t180 = t156*t178 + t174
+    t181 = t157*t178 + t175
+    t182 = t158*t178 + t176
+    t183 = -t159*t178 + t177
+    t184 = numpy.sqrt(t180**2 + t181**2 + t182**2 + t183**2)
+    t185 = t184*numpy.where(numpy.greater_equal(t180, 0), 1, -1)
+    t186 = t180 + t185
+    t187 = numpy.where(numpy.greater(t184, 0), 1/(t184*(t184 + abs(t180))), 0)
+    t188 = t187*(t166*t186 + t167*t181 - t168*t182 + t169*t183)
+    t189 = t166 - t186*t188
+    t190 = t167 - t181*t188
+    t191 = t168 + t182*t188
+    t192 = t169 - t183*t188
+    t193 = damping + t123
+    t194 = t144*(t107*t124 - t109*t118 + t111*t121 + t114*t143 + t114*t193 - t70*t73)
+    t195 = t114 - t143*t194
+    t196 = t109*t194 + t118
+    t197 = -t111*t194 + t121
+    t198 = -t114*t194 + t193
+    t199 = -t107*t194 + t124
+    t200 = t194*t70 + t73
+    t201 = -t163*(t156*t197 + t157*t198 - t158*t199 - t159*t200 + t162*t196)
+    t202 = t162*t201 + t196
+    t203 = t156*t201 + t197
+    t204 = t157*t201 + t198
+    t205 = -t158*t201 + t199
+    t206 = -t159*t201 + t200
+    t207 = t187*(t181*t204 - t182*t205 + t183*t206 + t186*t203)
+    t208 = -t186*t207 + t203
+    t209 = -t181*t207 + t204
+    t210 = t182*t207 + t205
+    t211 = -t183*t207 + t206
+    t212 = numpy.sqrt(t209**2 + t210**2 + t211**2)
+    t213 = t212*numpy.where(numpy.greater_equal(t209, 0), 1, -1)
+    t214 = t209 + t213
+    t215 = numpy.where(numpy.greater(t212, 0), 1/(t212*(t212 + abs(t209))), 0)
+    t216 = t215*(t190*t214 + t191*t210 + t192*t211)
+    t217 = t190 - t214*t216
+    t218 = t191 - t210*t216
+    t219 = t192 - t211*t216
+    t220 = damping + t125
+    t221 = t144*(t107*t143 + t107*t220 + t109*t115 - t111*t112 + t114*t124 - t70*t74)
+    t222 = t107 - t143*t221
+    t223 = -t109*t221 + t115
+    t224 = t111*t221 + t112
+    t225 = -t114*t221 + t124
+    t226 = -t107*t221 + t220
+    t227 = t221*t70 + t74
+    t228 = t163*(t156*t224 - t157*t225 + t158*t226 + t159*t227 + t162*t223)
+    t229 = -t162*t228 + t223
+    t230 = t156*t228 - t224
+    t231 = t157*t228 + t225
+    t232 = -t158*t228 + t226
+    t233 = -t159*t228 + t227
+    t234 = t187*(t181*t231 - t182*t232 + t183*t233 + t186*t230)
+    t235 = -t186*t234 + t230
+    t236 = -t181*t234 + t231
+    t237 = t182*t234 + t232
+    t238 = -t183*t234 + t233
+    t239 = t215*(t210*t237 + t211*t238 + t214*t236)
+    t240 = -t214*t239 + t236
+    t241 = -t210*t239 + t237
+    t242 = -t211*t239 + t238
+    t243 = numpy.sqrt(t241**2 + t242**2)
+    t244 = t243*numpy.where(numpy.greater_equal(t241, 0), 1, -1)
+    t245 = t241 + t244
+    t246 = numpy.where(numpy.greater(t243, 0), 1/(t243*(t243 + abs(t241))), 0)
+    t247 = t246*(t218*t245 + t219*t242)
+    t248 = t218 - t245*t247
+    t249 = t219 - t242*t247
+    t250 = damping + t126
+    t251 = t144*(t107*t74 + t109*t71 + t111*t72 + t114*t73 - t143*t70 - t250*t70)
+    t252 = t143*t251 + t70
+    t253 = -t109*t251 + t71
+    t254 = -t111*t251 + t72
+    t255 = -t114*t251 + t73
+    t256 = -t107*t251 + t74
+    t257 = t250 + t251*t70
+    t258 = t163*(-t156*t254 - t157*t255 + t158*t256 + t159*t257 + t162*t253)
+    t259 = -t162*t258 + t253
+    t260 = t156*t258 + t254
+    t261 = t157*t258 + t255
+    t262 = -t158*t258 + t256
+    t263 = -t159*t258 + t257
+    t264 = t187*(t181*t261 - t182*t262 + t183*t263 + t186*t260)
+    t265 = -t186*t264 + t260
+    t266 = -t181*t264 + t261
+    t267 = t182*t264 + t262
+    t268 = -t183*t264 + t263
+    t269 = t215*(t210*t267 + t211*t268 + t214*t266)
+    t270 = -t214*t269 + t266
+    t271 = -t210*t269 + t267
+    t272 = -t211*t269 + t268
+    t273 = t246*(t242*t272 + t245*t271)
+    t274 = -t245*t273 + t271
+    t275 = -t242*t273 + t272
+    t276 = abs(t275)
+    t277 = t276
+    t278 = t277*numpy.where(numpy.greater_equal(t275, 0), 1, -1)
+    t279 = t275 + t278
+    t280 = numpy.where(numpy.greater(t277, 0), 1/(t277*(t276 + t277)), 0)
+    t281 = -t249*t279**2*t280 + t249
+    t282 = t281/t278
+    t283 = (t248 + t274*t282)/t244
+    t284 = (t217 + t240*t283 + t270*t282)/t213
+    t285 = (t189 + t208*t284 + t235*t283 + t265*t282)/t185
+    t286 = (t165 - t179*t285 - t202*t284 + t229*t283 + t259*t282)/t161
+    t287 = (t146 + t154*t286 + t172*t285 + t195*t284 + t222*t283 - t252*t282)/t142
+    t288 = q1 - t28*t286 - t282 + t287*t42
+    t289 = -c1*t283 - c1*t287*t60 + q2 + s1*t284 - s1*t286*t60 + t285*t43
+    t290 = c2*t282 - q3 + t16*t284 + t283*t30 + t285*t47 + t286*t64 + t287*t67
+    t291 = q4 + t282*t50 + t283*t4 - t284*t7 - t285*t44 + t286*t65 - t287*t62
+    t292 = -q5 + t15*t282 + t18*t284 + t283*t32 + t285*t45 + t286*t69 + t287*t63
+    t293 = q6 - t20*t284 + t282*t52 + t283*t34 - t285*t46 + t286*t66 - t287*t68
+    t294 = q7 + t22*t284 + t282*t54 + t283*t36
+    q_start = numpy.empty(numpy.broadcast_shapes(target.shape[:-2], q.shape[:-1], damping.shape) + (7,))
+    q_start[..., 0] = q1
+    q_start[..., 1] = q2
+    q_start[..., 2] = q3
+    q_start[..., 3] = q4
+    q_start[..., 4] = q5
+    q_start[..., 5] = q6
+    q_start[..., 6] = q7
+    q_next = numpy.empty(numpy.broadcast_shapes(target.shape[:-2], q.shape[:-1], damping.shape) + (7,))
+    q_next[..., 0] = numpy.where(numpy.less(t288, -2.8973), -2.8973, numpy.where(numpy.greater(t288, 2.8973), 2.8973, t288))
+    q_next[..., 1] = numpy.where(numpy.less(t289, -1.7627999999999997), -1.7627999999999997, numpy.where(numpy.greater(t289, 1.7627999999999997), 1.7627999999999997, t289))
+    q_next[..., 2] = numpy.where(numpy.greater(t290, 2.8973), -2.8973, numpy.where(numpy.less(t290, -2.8973), 2.8973, -t290))
+    q_next[..., 3] = numpy.where(numpy.less(t291, -3.0718), -3.0718, numpy.where(numpy.greater(t291, -0.0698), -0.0698, t291))
+    q_next[..., 4] = numpy.where(numpy.greater(t292, 2.8973), -2.8973, numpy.where(numpy.less(t292, -2.8973), 2.8973, -t292))
+    q_next[..., 5] = numpy.where(numpy.less(t293, -0.0175), -0.0175, numpy.where(numpy.greater(t293, 3.7525000000000004), 3.7525000000000004, t293))
+    q_next[..., 6] = numpy.where(numpy.less(t294, -2.8973), -2.8973, numpy.where(numpy.greater(t294, 2.8973), 2.8973, t294))
+    cost = numpy.empty(numpy.broadcast_shapes(target.shape[:-2], q.shape[:-1], damping.shape) + ())
+    cost[...] = numpy.where(numpy.isfinite(t0), t139, -1)
+    return q_start, q_next, cost
+
+
+# -- Iterative inverse kinematics: the loop around ik_numeric_step --
 
 IK_NUMERIC_CONVERGED = 0  # |error| <= tol
 IK_NUMERIC_ITERATION_LIMIT = 1  # max_iter steps tried, |error| still above tol
 IK_NUMERIC_STALLED = 2  # no step reduces the error: unreachable target, joint limit or local minimum
-_LOWER = numpy.array([-2.8973, -1.7627999999999997, -2.8973, -3.0718, -2.8973, -0.0175, -2.8973])  # joint limits (infinite: none)
-_UPPER = numpy.array([2.8973, 1.7627999999999997, 2.8973, -0.0698, 2.8973, 3.7525000000000004, 2.8973])
+IK_NUMERIC_INVALID = 3  # target or q0 not finite, or max_iter < 0: q = q0
 _DAMPING = (1e-06, 1e-12, 100000000.0)  # added to the diagonal: start, least, most
-
-
-def _rotation_vector(E):
-    """The rotation vector (axis times angle in [0, pi]) of the rotation matrix E."""
-    v = 0.5 * numpy.array([E[2, 1] - E[1, 2], E[0, 2] - E[2, 0], E[1, 0] - E[0, 1]])
-    cos = 0.5 * (numpy.trace(E) - 1.0)
-    sin = numpy.linalg.norm(v)
-    angle = math.atan2(sin, cos)
-    if sin > 1e-6 or cos > 0.0:
-        return v * (angle / sin) if sin > 0.0 else v
-    # Near a half turn: the axis from the largest column of (E + I) / 2 = u u^T.
-    column = int(numpy.argmax(numpy.diag(E)))
-    axis = 0.5 * (E[:, column] + numpy.eye(3)[column])
-    axis /= numpy.linalg.norm(axis)
-    return angle * (axis if axis @ v >= 0.0 else -axis)
-
-
-def _task_error(target, q):
-    """Error [target position - position; rotation vector of target R^T] and the geometric Jacobian."""
-    T = fk(q)
-    error = numpy.concatenate([target[:3, 3] - T[:3, 3], _rotation_vector(target[:3, :3] @ T[:3, :3].T)])
-    return error, jacobian(q)
 
 
 def ik_numeric(target, q0, max_iter=100, tol=1e-10):
     """Iterative inverse kinematics from q0: damped least squares on the task error.
 
-    target: the 4x4 tool pose in the world frame.
-    Each step is q += J^T (J J^T + damping I)^-1 e, with e the task error
+    target: the 4x4 tool pose in the world frame, or a batch of them with q0 (..., DOF).
+    Each step is ik_numeric_step: q += J^T (J J^T + damping I)^-1 e, with e the task error
     (position error and rotation vector of R_target R^T, world frame) and J its Jacobian; joints are clamped to their limits.
     The damping adapts (Levenberg-Marquardt): divided by 10 after a step that lowers |e|,
     multiplied by 10 and the step discarded otherwise.
-    Returns (q, status): status IK_NUMERIC_CONVERGED (|e| <= tol), IK_NUMERIC_ITERATION_LIMIT
-    (max_iter steps tried) or IK_NUMERIC_STALLED (no step lowers |e|: out of reach, a joint
-    limit or a local minimum); q is the best configuration found.
+    Returns (q, status), status an IK_NUMERIC_* code per target; q is the best configuration
+    found.
     """
-    target = numpy.asarray(target, dtype=float)
-    q = numpy.asarray(q0, dtype=float)
-    if target.shape != (4, 4) or q.shape != (DOF,):
-        raise ValueError(f"expected target (4, 4) and q0 ({DOF},), got {target.shape} and {q.shape}")
-    q = numpy.clip(q, _LOWER, _UPPER)
-    error, J = _task_error(target, q)
-    cost = error @ error
-    damping, least, most = _DAMPING
-    for _ in range(max_iter):
-        if cost <= tol * tol:
-            return q, IK_NUMERIC_CONVERGED
-        step = J.T @ numpy.linalg.solve(J @ J.T + damping * numpy.eye(J.shape[0]), error)
-        trial = numpy.clip(q + step, _LOWER, _UPPER)
-        trial_error, trial_J = _task_error(target, trial)
-        trial_cost = trial_error @ trial_error
-        if trial_cost < cost:
-            q, error, J, cost = trial, trial_error, trial_J, trial_cost
-            damping = max(damping * 0.1, least)
-        else:
-            damping *= 10.0
-            if damping > most:
-                return q, IK_NUMERIC_STALLED
-    return q, IK_NUMERIC_CONVERGED if cost <= tol * tol else IK_NUMERIC_ITERATION_LIMIT
+    least, most = _DAMPING[1:]
+    q, trial, cost = ik_numeric_step(target, q0, _DAMPING[0])
+    damping = cost * 0.0 + _DAMPING[0]
+    status = numpy.where((cost >= 0.0) & (max_iter >= 0), IK_NUMERIC_ITERATION_LIMIT, IK_NUMERIC_INVALID)
+    for _ in range(max(max_iter, 0)):
+        status = numpy.where(numpy.logical_and(status == IK_NUMERIC_ITERATION_LIMIT, cost <= tol * tol), IK_NUMERIC_CONVERGED, status)
+        active = status == IK_NUMERIC_ITERATION_LIMIT
+        if not active.any():
+            break
+        lighter = numpy.maximum(damping * 0.1, least)
+        _, after, trial_cost = ik_numeric_step(target, trial, lighter)
+        better = numpy.logical_and(active, trial_cost < cost)
+        worse = numpy.logical_and(active, trial_cost >= cost)
+        q = numpy.where(better[..., None], trial, q)
+        cost = numpy.where(better, trial_cost, cost)
+        damping = numpy.where(better, lighter, numpy.where(worse, damping * 10.0, damping))
+        status = numpy.where(numpy.logical_and(worse, damping > most), IK_NUMERIC_STALLED, status)
+        _, retry, _ = ik_numeric_step(target, q, damping)
+        trial = numpy.where(better[..., None], after, numpy.where(worse[..., None], retry, trial))
+    status = numpy.where(numpy.logical_and(status == IK_NUMERIC_ITERATION_LIMIT, cost <= tol * tol), IK_NUMERIC_CONVERGED, status)
+    q = numpy.where((status == IK_NUMERIC_INVALID)[..., None], numpy.asarray(q0, dtype=float), q)
+    return q, status[()] if status.ndim == 0 else status
 
 
 # Statuses of velocity_ik: OK, singular (a diagonal entry of the QR factor R of the

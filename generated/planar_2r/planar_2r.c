@@ -334,6 +334,65 @@ int planar_2r_velocity_ik(const planar_2r_real q[PLANAR_2R_DOF], const planar_2r
     return (!(t57 && t58) ? 2 : (t61 ? 1 : 0));
 }
 
+planar_2r_real planar_2r_ik_numeric_step(const planar_2r_real target[PLANAR_2R_TASK_DIM], const planar_2r_real q[PLANAR_2R_DOF], planar_2r_real damping, planar_2r_real q_start[PLANAR_2R_DOF], planar_2r_real q_next[PLANAR_2R_DOF])
+{
+    /* 90 operations */
+
+    /* Inputs */
+    const planar_2r_real mu0 = target[0];
+    const planar_2r_real mu1 = target[1];
+    const planar_2r_real qs1 = q[0];
+    const planar_2r_real qs2 = q[1];
+
+    /* Intermediate terms */
+    const planar_2r_real q1 = qs1;
+    const planar_2r_real q2 = qs2;
+    const planar_2r_real c1 = cos(q1);
+    const planar_2r_real s1 = sin(q1);
+    const planar_2r_real c2 = cos(q2);
+    const planar_2r_real s2 = sin(q2);
+    const planar_2r_real c12 = c1*c2 - s1*s2;
+    const planar_2r_real s12 = c1*s2 + c2*s1;
+    const planar_2r_real t0 = c1 + c12;
+    const planar_2r_real t1 = s1 + s12;
+    const planar_2r_real t2 = (s12*s12) + (t1*t1);
+    const planar_2r_real t3 = c12*s12 + t0*t1;
+    const planar_2r_real t4 = (c12*c12) + (t0*t0);
+    const planar_2r_real t5 = mu0 - t0;
+    const planar_2r_real t6 = mu1 - t1;
+    const planar_2r_real t7 = (t5*t5) + (t6*t6);
+    const planar_2r_real t8 = mu0 + mu1 + qs1 + qs2;
+    const planar_2r_real t9 = damping + t2;
+    const planar_2r_real t10 = sqrt((t3*t3) + (t9*t9));
+    const planar_2r_real t11 = t10*(t9 >= 0 ? 1 : -1);
+    const planar_2r_real t12 = t11 + t9;
+    const planar_2r_real t13 = (t10 > 0 ? 1/(t10*(t10 + fabs(t9))) : 0);
+    const planar_2r_real t14 = t13*(t12*t5 - t3*t6);
+    const planar_2r_real t15 = -t12*t14 + t5;
+    const planar_2r_real t16 = t14*t3 + t6;
+    const planar_2r_real t17 = damping + t4;
+    const planar_2r_real t18 = -t13*(t12*t3 + t17*t3);
+    const planar_2r_real t19 = t12*t18 + t3;
+    const planar_2r_real t20 = t17 + t18*t3;
+    const planar_2r_real t21 = fabs(t20);
+    const planar_2r_real t22 = t21;
+    const planar_2r_real t23 = t22*(t20 >= 0 ? 1 : -1);
+    const planar_2r_real t24 = t20 + t23;
+    const planar_2r_real t25 = (t22 > 0 ? 1/(t22*(t21 + t22)) : 0);
+    const planar_2r_real t26 = -t16*t25*(t24*t24) + t16;
+    const planar_2r_real t27 = t26/t23;
+    const planar_2r_real t28 = (t15 - t19*t27)/t11;
+    const planar_2r_real t29 = q1 - t0*t27 + t1*t28;
+    const planar_2r_real t30 = -c12*t27 + q2 + s12*t28;
+
+    /* Outputs */
+    q_start[0] = q1;
+    q_start[1] = q2;
+    q_next[0] = t29;
+    q_next[1] = t30;
+    return (isfinite(t8) ? t7 : -1);
+}
+
 void planar_2r_ik_branches(const planar_2r_real mu[PLANAR_2R_TASK_DIM], planar_2r_real q[PLANAR_2R_MAX_IK_SOLUTIONS * PLANAR_2R_DOF], int valid[PLANAR_2R_MAX_IK_SOLUTIONS])
 {
     /* 79 operations */
@@ -398,138 +457,39 @@ int planar_2r_ik(const planar_2r_real mu[PLANAR_2R_TASK_DIM], planar_2r_real q[P
     return count;
 }
 
-/* -- Iterative inverse kinematics -- */
-
-/* Error target - mu(q) (angles wrapped into (-pi, pi]) and the task Jacobian. */
-static void planar_2r_task_error(const planar_2r_real target[PLANAR_2R_TASK_DIM], const planar_2r_real q[PLANAR_2R_DOF], planar_2r_real e[PLANAR_2R_TASK_DIM],
-        planar_2r_real J[PLANAR_2R_TASK_DIM * PLANAR_2R_DOF])
-{
-    int i;
-    planar_2r_task(q, e);
-    planar_2r_task_jacobian(q, J);
-    for (i = 0; i < PLANAR_2R_TASK_DIM; ++i) {
-        e[i] = target[i] - e[i];
-    }
-}
-
-/* Joints clamped to their limits. */
-static void planar_2r_clamp(planar_2r_real q[PLANAR_2R_DOF])
-{
-    (void)q;
-}
-
-/* Solves A x = b in place (b becomes x) for the symmetric positive definite K x K matrix A by
- * Cholesky; returns 0 when A is not numerically positive definite. */
-static int planar_2r_cholesky_solve(planar_2r_real A[4], planar_2r_real b[2])
-{
-    int i, j, k;
-    for (j = 0; j < 2; ++j) {
-        planar_2r_real diagonal = A[2 * j + j];
-        for (k = 0; k < j; ++k) {
-            diagonal -= A[2 * j + k] * A[2 * j + k];
-        }
-        if (!(diagonal > 0.0)) {
-            return 0;
-        }
-        A[2 * j + j] = sqrt(diagonal);
-        for (i = j + 1; i < 2; ++i) {
-            planar_2r_real sum = A[2 * i + j];
-            for (k = 0; k < j; ++k) {
-                sum -= A[2 * i + k] * A[2 * j + k];
-            }
-            A[2 * i + j] = sum / A[2 * j + j];
-        }
-    }
-    for (i = 0; i < 2; ++i) {
-        for (k = 0; k < i; ++k) {
-            b[i] -= A[2 * i + k] * b[k];
-        }
-        b[i] /= A[2 * i + i];
-    }
-    for (i = 2 - 1; i >= 0; --i) {
-        for (k = i + 1; k < 2; ++k) {
-            b[i] -= A[2 * k + i] * b[k];
-        }
-        b[i] /= A[2 * i + i];
-    }
-    return 1;
-}
+/* -- Iterative inverse kinematics: the loop around planar_2r_ik_numeric_step -- */
 
 int planar_2r_ik_numeric(const planar_2r_real target[PLANAR_2R_TASK_DIM], const planar_2r_real q0[PLANAR_2R_DOF], int max_iter, planar_2r_real tol, planar_2r_real q[PLANAR_2R_DOF])
 {
-    planar_2r_real e[2], J[2 * PLANAR_2R_DOF], trial[PLANAR_2R_DOF], trial_e[2];
-    planar_2r_real trial_J[2 * PLANAR_2R_DOF], A[4], x[2];
-    planar_2r_real cost, trial_cost, damping = 1e-06;
-    int i, j, k, iteration;
-    for (j = 0; j < PLANAR_2R_DOF; ++j) {
-        q[j] = q0[j];
-    }
-    for (i = 0; i < PLANAR_2R_TASK_DIM; ++i) {
-        if (!isfinite(target[i])) {
-            return PLANAR_2R_IK_NUMERIC_INVALID;
+    planar_2r_real trial[PLANAR_2R_DOF], after[PLANAR_2R_DOF], start[PLANAR_2R_DOF];
+    planar_2r_real cost, trial_cost, lighter, damping = 1e-06;
+    int j, iteration;
+    cost = planar_2r_ik_numeric_step(target, q0, damping, q, trial);
+    if (!(cost >= 0) || max_iter < 0) { /* -1: target or q0 not finite */
+        for (j = 0; j < PLANAR_2R_DOF; ++j) {
+            q[j] = q0[j];
         }
-    }
-    for (j = 0; j < PLANAR_2R_DOF; ++j) {
-        if (!isfinite(q0[j])) {
-            return PLANAR_2R_IK_NUMERIC_INVALID;
-        }
-    }
-    if (max_iter < 0) {
         return PLANAR_2R_IK_NUMERIC_INVALID;
-    }
-    planar_2r_clamp(q);
-    planar_2r_task_error(target, q, e, J);
-    cost = 0.0;
-    for (i = 0; i < 2; ++i) {
-        cost += e[i] * e[i];
     }
     for (iteration = 0; iteration < max_iter; ++iteration) {
         if (cost <= tol * tol) {
             return PLANAR_2R_IK_NUMERIC_CONVERGED;
         }
-        /* A = J J^T + damping I, x = A^-1 e, step J^T x */
-        for (i = 0; i < 2; ++i) {
-            x[i] = e[i];
-            for (k = 0; k < 2; ++k) {
-                planar_2r_real sum = i == k ? damping : 0.0;
-                for (j = 0; j < PLANAR_2R_DOF; ++j) {
-                    sum += J[PLANAR_2R_DOF * i + j] * J[PLANAR_2R_DOF * k + j];
-                }
-                A[2 * i + k] = sum;
-            }
-        }
-        if (!planar_2r_cholesky_solve(A, x)) {
-            return PLANAR_2R_IK_NUMERIC_STALLED;
-        }
-        for (j = 0; j < PLANAR_2R_DOF; ++j) {
-            trial[j] = q[j];
-            for (i = 0; i < 2; ++i) {
-                trial[j] += J[PLANAR_2R_DOF * i + j] * x[i];
-            }
-        }
-        planar_2r_clamp(trial);
-        planar_2r_task_error(target, trial, trial_e, trial_J);
-        trial_cost = 0.0;
-        for (i = 0; i < 2; ++i) {
-            trial_cost += trial_e[i] * trial_e[i];
-        }
+        lighter = damping * 0.1 > 1e-12 ? damping * 0.1 : 1e-12;
+        trial_cost = planar_2r_ik_numeric_step(target, trial, lighter, start, after);
         if (trial_cost < cost) {
             for (j = 0; j < PLANAR_2R_DOF; ++j) {
                 q[j] = trial[j];
-            }
-            for (i = 0; i < 2; ++i) {
-                e[i] = trial_e[i];
-            }
-            for (i = 0; i < 2 * PLANAR_2R_DOF; ++i) {
-                J[i] = trial_J[i];
+                trial[j] = after[j];
             }
             cost = trial_cost;
-            damping = damping * 0.1 > 1e-12 ? damping * 0.1 : 1e-12;
+            damping = lighter;
         } else {
             damping *= 10.0;
             if (damping > 100000000.0) {
                 return PLANAR_2R_IK_NUMERIC_STALLED;
             }
+            (void)planar_2r_ik_numeric_step(target, q, damping, start, trial);
         }
     }
     return cost <= tol * tol ? PLANAR_2R_IK_NUMERIC_CONVERGED : PLANAR_2R_IK_NUMERIC_ITERATION_LIMIT;

@@ -321,6 +321,66 @@ def velocity_ik(q, mu_dot, damping=0.0):
 
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
+def ik_numeric_step(target, q, damping=0.0):
+    """one step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite): (2 x 1 and 2 x 1 and 1 x 1), 90 operations."""
+    target = _argument("target", target, (2,))
+    q = _argument("q", q, (2,))
+    damping = _argument("damping", damping, ())
+    mu0 = target[..., 0]
+    mu1 = target[..., 1]
+    qs1 = q[..., 0]
+    qs2 = q[..., 1]
+    q1 = qs1
+    q2 = qs2
+    c1 = numpy.cos(q1)
+    s1 = numpy.sin(q1)
+    c2 = numpy.cos(q2)
+    s2 = numpy.sin(q2)
+    c12 = c1*c2 - s1*s2
+    s12 = c1*s2 + c2*s1
+    t0 = c1 + c12
+    t1 = s1 + s12
+    t2 = s12**2 + t1**2
+    t3 = c12*s12 + t0*t1
+    t4 = c12**2 + t0**2
+    t5 = mu0 - t0
+    t6 = mu1 - t1
+    t7 = t5**2 + t6**2
+    t8 = mu0 + mu1 + qs1 + qs2
+    t9 = damping + t2
+    t10 = numpy.sqrt(t3**2 + t9**2)
+    t11 = t10*numpy.where(numpy.greater_equal(t9, 0), 1, -1)
+    t12 = t11 + t9
+    t13 = numpy.where(numpy.greater(t10, 0), 1/(t10*(t10 + abs(t9))), 0)
+    t14 = t13*(t12*t5 - t3*t6)
+    t15 = -t12*t14 + t5
+    t16 = t14*t3 + t6
+    t17 = damping + t4
+    t18 = -t13*(t12*t3 + t17*t3)
+    t19 = t12*t18 + t3
+    t20 = t17 + t18*t3
+    t21 = abs(t20)
+    t22 = t21
+    t23 = t22*numpy.where(numpy.greater_equal(t20, 0), 1, -1)
+    t24 = t20 + t23
+    t25 = numpy.where(numpy.greater(t22, 0), 1/(t22*(t21 + t22)), 0)
+    t26 = -t16*t24**2*t25 + t16
+    t27 = t26/t23
+    t28 = (t15 - t19*t27)/t11
+    t29 = q1 - t0*t27 + t1*t28
+    t30 = -c12*t27 + q2 + s12*t28
+    q_start = numpy.empty(numpy.broadcast_shapes(target.shape[:-1], q.shape[:-1], damping.shape) + (2,))
+    q_start[..., 0] = q1
+    q_start[..., 1] = q2
+    q_next = numpy.empty(numpy.broadcast_shapes(target.shape[:-1], q.shape[:-1], damping.shape) + (2,))
+    q_next[..., 0] = t29
+    q_next[..., 1] = t30
+    cost = numpy.empty(numpy.broadcast_shapes(target.shape[:-1], q.shape[:-1], damping.shape) + ())
+    cost[...] = numpy.where(numpy.isfinite(t8), t7, -1)
+    return q_start, q_next, cost
+
+
+@numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def ik_branches(mu):
     """every branch of the closed-form ik and whether the target allows it: (2 x 2 and 2 x 1), 79 operations."""
     mu = _argument("mu", mu, (2,))
@@ -391,57 +451,48 @@ def ik(mu):
     return q[valid] if valid.ndim == 1 else (q, valid)
 
 
-# -- Iterative inverse kinematics --
+# -- Iterative inverse kinematics: the loop around ik_numeric_step --
 
 IK_NUMERIC_CONVERGED = 0  # |error| <= tol
 IK_NUMERIC_ITERATION_LIMIT = 1  # max_iter steps tried, |error| still above tol
 IK_NUMERIC_STALLED = 2  # no step reduces the error: unreachable target, joint limit or local minimum
-_LOWER = numpy.array([-numpy.inf, -numpy.inf])  # joint limits (infinite: none)
-_UPPER = numpy.array([numpy.inf, numpy.inf])
+IK_NUMERIC_INVALID = 3  # target or q0 not finite, or max_iter < 0: q = q0
 _DAMPING = (1e-06, 1e-12, 100000000.0)  # added to the diagonal: start, least, most
-
-
-def _task_error(target, q):
-    """Error target - mu(q) (angles wrapped into (-pi, pi]) and the task Jacobian."""
-    error = target - task(q)
-    return error, task_jacobian(q)
 
 
 def ik_numeric(target, q0, max_iter=100, tol=1e-10):
     """Iterative inverse kinematics from q0: damped least squares on the task error.
 
-    target: the task vector (x, y).
-    Each step is q += J^T (J J^T + damping I)^-1 e, with e the task error
+    target: the task vector (x, y), or a batch of them with q0 (..., DOF).
+    Each step is ik_numeric_step: q += J^T (J J^T + damping I)^-1 e, with e the task error
     (target - mu(q), angles wrapped into (-pi, pi]) and J its Jacobian; joints are clamped to their limits.
     The damping adapts (Levenberg-Marquardt): divided by 10 after a step that lowers |e|,
     multiplied by 10 and the step discarded otherwise.
-    Returns (q, status): status IK_NUMERIC_CONVERGED (|e| <= tol), IK_NUMERIC_ITERATION_LIMIT
-    (max_iter steps tried) or IK_NUMERIC_STALLED (no step lowers |e|: out of reach, a joint
-    limit or a local minimum); q is the best configuration found.
+    Returns (q, status), status an IK_NUMERIC_* code per target; q is the best configuration
+    found.
     """
-    target = numpy.asarray(target, dtype=float)
-    q = numpy.asarray(q0, dtype=float)
-    if target.shape != (2,) or q.shape != (DOF,):
-        raise ValueError(f"expected target (2,) and q0 ({DOF},), got {target.shape} and {q.shape}")
-    q = numpy.clip(q, _LOWER, _UPPER)
-    error, J = _task_error(target, q)
-    cost = error @ error
-    damping, least, most = _DAMPING
-    for _ in range(max_iter):
-        if cost <= tol * tol:
-            return q, IK_NUMERIC_CONVERGED
-        step = J.T @ numpy.linalg.solve(J @ J.T + damping * numpy.eye(J.shape[0]), error)
-        trial = numpy.clip(q + step, _LOWER, _UPPER)
-        trial_error, trial_J = _task_error(target, trial)
-        trial_cost = trial_error @ trial_error
-        if trial_cost < cost:
-            q, error, J, cost = trial, trial_error, trial_J, trial_cost
-            damping = max(damping * 0.1, least)
-        else:
-            damping *= 10.0
-            if damping > most:
-                return q, IK_NUMERIC_STALLED
-    return q, IK_NUMERIC_CONVERGED if cost <= tol * tol else IK_NUMERIC_ITERATION_LIMIT
+    least, most = _DAMPING[1:]
+    q, trial, cost = ik_numeric_step(target, q0, _DAMPING[0])
+    damping = cost * 0.0 + _DAMPING[0]
+    status = numpy.where((cost >= 0.0) & (max_iter >= 0), IK_NUMERIC_ITERATION_LIMIT, IK_NUMERIC_INVALID)
+    for _ in range(max(max_iter, 0)):
+        status = numpy.where(numpy.logical_and(status == IK_NUMERIC_ITERATION_LIMIT, cost <= tol * tol), IK_NUMERIC_CONVERGED, status)
+        active = status == IK_NUMERIC_ITERATION_LIMIT
+        if not active.any():
+            break
+        lighter = numpy.maximum(damping * 0.1, least)
+        _, after, trial_cost = ik_numeric_step(target, trial, lighter)
+        better = numpy.logical_and(active, trial_cost < cost)
+        worse = numpy.logical_and(active, trial_cost >= cost)
+        q = numpy.where(better[..., None], trial, q)
+        cost = numpy.where(better, trial_cost, cost)
+        damping = numpy.where(better, lighter, numpy.where(worse, damping * 10.0, damping))
+        status = numpy.where(numpy.logical_and(worse, damping > most), IK_NUMERIC_STALLED, status)
+        _, retry, _ = ik_numeric_step(target, q, damping)
+        trial = numpy.where(better[..., None], after, numpy.where(worse[..., None], retry, trial))
+    status = numpy.where(numpy.logical_and(status == IK_NUMERIC_ITERATION_LIMIT, cost <= tol * tol), IK_NUMERIC_CONVERGED, status)
+    q = numpy.where((status == IK_NUMERIC_INVALID)[..., None], numpy.asarray(q0, dtype=float), q)
+    return q, status[()] if status.ndim == 0 else status
 
 
 # Statuses of velocity_ik: OK, singular (a diagonal entry of the QR factor R of the

@@ -262,6 +262,62 @@ def _velocity_ik(q, mu_dot, damping):
     return [q_dot, status]
 
 
+def _ik_numeric_step(target, q, damping):
+    """One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite): 90 operations."""
+    mu0 = target[0]
+    mu1 = target[1]
+    qs1 = q[0]
+    qs2 = q[1]
+    q1 = qs1
+    q2 = qs2
+    c1 = casadi.cos(q1)
+    s1 = casadi.sin(q1)
+    c2 = casadi.cos(q2)
+    s2 = casadi.sin(q2)
+    c12 = c1*c2 - s1*s2
+    s12 = c1*s2 + c2*s1
+    t0 = c1 + c12
+    t1 = s1 + s12
+    t2 = s12**2 + t1**2
+    t3 = c12*s12 + t0*t1
+    t4 = c12**2 + t0**2
+    t5 = mu0 - t0
+    t6 = mu1 - t1
+    t7 = t5**2 + t6**2
+    t8 = mu0 + mu1 + qs1 + qs2
+    t9 = damping + t2
+    t10 = casadi.sqrt(t3**2 + t9**2)
+    t11 = t10*casadi.if_else((t9 >= 0), 1, -1)
+    t12 = t11 + t9
+    t13 = casadi.if_else((t10 > 0), 1/(t10*(t10 + casadi.fabs(t9))), 0)
+    t14 = t13*(t12*t5 - t3*t6)
+    t15 = -t12*t14 + t5
+    t16 = t14*t3 + t6
+    t17 = damping + t4
+    t18 = -t13*(t12*t3 + t17*t3)
+    t19 = t12*t18 + t3
+    t20 = t17 + t18*t3
+    t21 = casadi.fabs(t20)
+    t22 = t21
+    t23 = t22*casadi.if_else((t20 >= 0), 1, -1)
+    t24 = t20 + t23
+    t25 = casadi.if_else((t22 > 0), 1/(t22*(t21 + t22)), 0)
+    t26 = -t16*t24**2*t25 + t16
+    t27 = t26/t23
+    t28 = (t15 - t19*t27)/t11
+    t29 = q1 - t0*t27 + t1*t28
+    t30 = -c12*t27 + q2 + s12*t28
+    q_start = casadi.SX(2, 1)
+    q_start[0, 0] = q1
+    q_start[1, 0] = q2
+    q_next = casadi.SX(2, 1)
+    q_next[0, 0] = t29
+    q_next[1, 0] = t30
+    cost = casadi.SX(1, 1)
+    cost[0, 0] = casadi.if_else((casadi.fabs(t8) < casadi.inf), t7, -1)
+    return [q_start, q_next, cost]
+
+
 def _ik_branches(mu):
     """Every branch of the closed-form ik and whether the target allows it: 79 operations."""
     mu0 = mu[0]
@@ -308,6 +364,7 @@ def _ik_branches(mu):
 _q = casadi.SX.sym("q", 2, 1)
 _mu_dot = casadi.SX.sym("mu_dot", 2, 1)
 _damping = casadi.SX.sym("damping", 1, 1)
+_target = casadi.SX.sym("target", 2, 1)
 _mu = casadi.SX.sym("mu", 2, 1)
 fk = casadi.Function("fk", [_q], _fk(_q), ["q"], ["T"])
 jacobian = casadi.Function("jacobian", [_q], _jacobian(_q), ["q"], ["J"])
@@ -319,10 +376,48 @@ singularity_factors = casadi.Function("singularity_factors", [_q], _singularity_
 manipulability = casadi.Function("manipulability", [_q], _manipulability(_q), ["q"], ["w"])
 jacobian_det = casadi.Function("jacobian_det", [_q], _jacobian_det(_q), ["q"], ["d"])
 velocity_ik = casadi.Function("velocity_ik", [_q, _mu_dot, _damping], _velocity_ik(_q, _mu_dot, _damping), ["q", "mu_dot", "damping"], ["q_dot", "status"])
+ik_numeric_step = casadi.Function("ik_numeric_step", [_target, _q, _damping], _ik_numeric_step(_target, _q, _damping), ["target", "q", "damping"], ["q_start", "q_next", "cost"])
 ik_branches = casadi.Function("ik_branches", [_mu], _ik_branches(_mu), ["mu"], ["q", "valid"])
 ik = ik_branches  # CasADi functions have fixed-size outputs: every branch and its validity
+
+IK_NUMERIC_CONVERGED = 0  # |error| <= tol
+IK_NUMERIC_ITERATION_LIMIT = 1  # IK_NUMERIC_ITERATIONS steps taken, |error| still above tol
+IK_NUMERIC_STALLED = 2  # no step reduces the error: unreachable target, joint limit or local minimum
+IK_NUMERIC_INVALID = 3  # target or q0 not finite: q = q0
+IK_NUMERIC_ITERATIONS = 100
+_DAMPING = (1e-06, 1e-12, 100000000.0)  # added to the diagonal: start, least, most
+
+
+def _ik_numeric(target, q0, tol):
+    """ik_numeric of the C and numpy modules with a fixed number of steps: every branch of
+    the loop is a select, so the graph is the same for every input."""
+    least, most = _DAMPING[1:]
+    q, trial, cost = ik_numeric_step(target, q0, _DAMPING[0])
+    damping = cost * 0.0 + _DAMPING[0]
+    status = casadi.if_else(cost >= 0.0, IK_NUMERIC_ITERATION_LIMIT, IK_NUMERIC_INVALID)
+    for _ in range(IK_NUMERIC_ITERATIONS):
+        status = casadi.if_else(casadi.logic_and(status == IK_NUMERIC_ITERATION_LIMIT, cost <= tol * tol), IK_NUMERIC_CONVERGED, status)
+        active = status == IK_NUMERIC_ITERATION_LIMIT
+        lighter = casadi.fmax(damping * 0.1, least)
+        _, after, trial_cost = ik_numeric_step(target, trial, lighter)
+        better = casadi.logic_and(active, trial_cost < cost)
+        worse = casadi.logic_and(active, trial_cost >= cost)
+        q = casadi.if_else(better, trial, q)
+        cost = casadi.if_else(better, trial_cost, cost)
+        damping = casadi.if_else(better, lighter, casadi.if_else(worse, damping * 10.0, damping))
+        status = casadi.if_else(casadi.logic_and(worse, damping > most), IK_NUMERIC_STALLED, status)
+        _, retry, _ = ik_numeric_step(target, q, damping)
+        trial = casadi.if_else(better, after, casadi.if_else(worse, retry, trial))
+    status = casadi.if_else(casadi.logic_and(status == IK_NUMERIC_ITERATION_LIMIT, cost <= tol * tol), IK_NUMERIC_CONVERGED, status)
+    q = casadi.if_else((status == IK_NUMERIC_INVALID), q0, q)
+    return [q, status]
+
+
+_tol = casadi.SX.sym("tol")
+ik_numeric = casadi.Function("ik_numeric", [_target, _q, _tol], _ik_numeric(_target, _q, _tol),
+                             ["target", "q0", "tol"], ["q", "status"])
 
 
 def functions():
     """All functions by name."""
-    return {"fk": fk, "jacobian": jacobian, "fk_jacobian": fk_jacobian, "jacobian_tool": jacobian_tool, "task": task, "task_jacobian": task_jacobian, "singularity_factors": singularity_factors, "manipulability": manipulability, "jacobian_det": jacobian_det, "velocity_ik": velocity_ik, "ik_branches": ik_branches}
+    return {"fk": fk, "jacobian": jacobian, "fk_jacobian": fk_jacobian, "jacobian_tool": jacobian_tool, "task": task, "task_jacobian": task_jacobian, "singularity_factors": singularity_factors, "manipulability": manipulability, "jacobian_det": jacobian_det, "velocity_ik": velocity_ik, "ik_numeric_step": ik_numeric_step, "ik_branches": ik_branches}

@@ -472,6 +472,100 @@ int planar_3r_velocity_ik(const planar_3r_real q[PLANAR_3R_DOF], const planar_3r
     return (!(t100 && t99) ? 2 : (t103 ? 1 : 0));
 }
 
+planar_3r_real planar_3r_ik_numeric_step(const planar_3r_real target[PLANAR_3R_TASK_DIM], const planar_3r_real q[PLANAR_3R_DOF], planar_3r_real damping, planar_3r_real q_start[PLANAR_3R_DOF], planar_3r_real q_next[PLANAR_3R_DOF])
+{
+    /* 189 operations */
+
+    /* Inputs */
+    const planar_3r_real mu0 = target[0];
+    const planar_3r_real mu1 = target[1];
+    const planar_3r_real mu2 = target[2];
+    const planar_3r_real qs1 = q[0];
+    const planar_3r_real qs2 = q[1];
+    const planar_3r_real qs3 = q[2];
+
+    /* Intermediate terms */
+    const planar_3r_real q1 = qs1;
+    const planar_3r_real q2 = qs2;
+    const planar_3r_real q3 = qs3;
+    const planar_3r_real c1 = cos(q1);
+    const planar_3r_real s1 = sin(q1);
+    const planar_3r_real c2 = cos(q2);
+    const planar_3r_real s2 = sin(q2);
+    const planar_3r_real c12 = c1*c2 - s1*s2;
+    const planar_3r_real s12 = c1*s2 + c2*s1;
+    const planar_3r_real c3 = cos(q3);
+    const planar_3r_real s3 = sin(q3);
+    const planar_3r_real c123 = c12*c3 - s12*s3;
+    const planar_3r_real s123 = c12*s3 + c3*s12;
+    const planar_3r_real t0 = c12 + c123;
+    const planar_3r_real t1 = s12 + s123;
+    const planar_3r_real t2 = c1 + t0;
+    const planar_3r_real t3 = s1 + t1;
+    const planar_3r_real t4 = (s123*s123) + (t1*t1) + (t3*t3);
+    const planar_3r_real t5 = c123*s123 + t0*t1 + t2*t3;
+    const planar_3r_real t6 = s123 + t1 + t3;
+    const planar_3r_real t7 = (c123*c123) + (t0*t0) + (t2*t2);
+    const planar_3r_real t8 = c123 + t0 + t2;
+    const planar_3r_real t9 = mu0 - t2;
+    const planar_3r_real t10 = mu1 - t3;
+    const planar_3r_real t11 = mu0 + mu1 + mu2 + qs1 + qs2 + qs3;
+    const planar_3r_real t12 = -mu2 + atan2(s123, c123);
+    const planar_3r_real t13 = t12 + 6.283185307179586*ceil(-0.15915494309189535*t12 - 0.5);
+    const planar_3r_real t14 = (t10*t10) + (t13*t13) + (t9*t9);
+    const planar_3r_real t15 = damping + t4;
+    const planar_3r_real t16 = sqrt((t15*t15) + (t5*t5) + (t6*t6));
+    const planar_3r_real t17 = t16*(t15 >= 0 ? 1 : -1);
+    const planar_3r_real t18 = t15 + t17;
+    const planar_3r_real t19 = (t16 > 0 ? 1/(t16*(t16 + fabs(t15))) : 0);
+    const planar_3r_real t20 = t19*(-t10*t5 + t13*t6 + t18*t9);
+    const planar_3r_real t21 = -t18*t20 + t9;
+    const planar_3r_real t22 = t10 + t20*t5;
+    const planar_3r_real t23 = -t13 + t20*t6;
+    const planar_3r_real t24 = damping + t7;
+    const planar_3r_real t25 = -t19*(t18*t5 + t24*t5 + t6*t8);
+    const planar_3r_real t26 = t18*t25 + t5;
+    const planar_3r_real t27 = t24 + t25*t5;
+    const planar_3r_real t28 = t25*t6 + t8;
+    const planar_3r_real t29 = sqrt((t27*t27) + (t28*t28));
+    const planar_3r_real t30 = t29*(t27 >= 0 ? 1 : -1);
+    const planar_3r_real t31 = t27 + t30;
+    const planar_3r_real t32 = (t29 > 0 ? 1/(t29*(t29 + fabs(t27))) : 0);
+    const planar_3r_real t33 = t32*(t22*t31 + t23*t28);
+    const planar_3r_real t34 = t22 - t31*t33;
+    const planar_3r_real t35 = t23 - t28*t33;
+    const planar_3r_real t36 = damping + 3;
+    const planar_3r_real t37 = -t19*(t18*t6 + t36*t6 + t5*t8);
+    const planar_3r_real t38 = t18*t37 + t6;
+    const planar_3r_real t39 = t37*t5 + t8;
+    const planar_3r_real t40 = t36 + t37*t6;
+    const planar_3r_real t41 = t32*(t28*t40 + t31*t39);
+    const planar_3r_real t42 = -t31*t41 + t39;
+    const planar_3r_real t43 = -t28*t41 + t40;
+    const planar_3r_real t44 = fabs(t43);
+    const planar_3r_real t45 = t44;
+    const planar_3r_real t46 = t45*(t43 >= 0 ? 1 : -1);
+    const planar_3r_real t47 = t43 + t46;
+    const planar_3r_real t48 = (t45 > 0 ? 1/(t45*(t44 + t45)) : 0);
+    const planar_3r_real t49 = -t35*t48*(t47*t47) + t35;
+    const planar_3r_real t50 = t49/t46;
+    const planar_3r_real t51 = (t34 + t42*t50)/t30;
+    const planar_3r_real t52 = (t21 - t26*t51 - t38*t50)/t17;
+    const planar_3r_real t53 = -t50;
+    const planar_3r_real t54 = q1 - t2*t51 + t3*t52 + t53;
+    const planar_3r_real t55 = q2 - t0*t51 + t1*t52 + t53;
+    const planar_3r_real t56 = -c123*t51 + q3 + s123*t52 + t53;
+
+    /* Outputs */
+    q_start[0] = q1;
+    q_start[1] = q2;
+    q_start[2] = q3;
+    q_next[0] = t54;
+    q_next[1] = t55;
+    q_next[2] = t56;
+    return (isfinite(t11) ? t14 : -1);
+}
+
 void planar_3r_ik_branches(const planar_3r_real mu[PLANAR_3R_TASK_DIM], planar_3r_real q[PLANAR_3R_MAX_IK_SOLUTIONS * PLANAR_3R_DOF], int valid[PLANAR_3R_MAX_IK_SOLUTIONS])
 {
     /* 106 operations */
@@ -549,161 +643,39 @@ int planar_3r_ik(const planar_3r_real mu[PLANAR_3R_TASK_DIM], planar_3r_real q[P
     return count;
 }
 
-/* -- Iterative inverse kinematics -- */
-
-/* The angle wrapped into (-pi, pi], for |angle| < 1e9: angle - 2 pi ceil((angle - pi) / (2 pi)),
- * ceil by truncation. */
-static planar_3r_real planar_3r_wrap(planar_3r_real angle)
-{
-    const planar_3r_real turns = (angle - 3.141592653589793) / 6.283185307179586;
-    planar_3r_real whole;
-    if (angle > -3.141592653589793 && angle <= 3.141592653589793) {
-        return angle;
-    }
-    whole = (planar_3r_real)(long)turns;
-    if (whole < turns) {
-        whole += 1.0;
-    }
-    return angle - 6.283185307179586 * whole;
-}
-
-/* Error target - mu(q) (angles wrapped into (-pi, pi]) and the task Jacobian. */
-static void planar_3r_task_error(const planar_3r_real target[PLANAR_3R_TASK_DIM], const planar_3r_real q[PLANAR_3R_DOF], planar_3r_real e[PLANAR_3R_TASK_DIM],
-        planar_3r_real J[PLANAR_3R_TASK_DIM * PLANAR_3R_DOF])
-{
-    int i;
-    planar_3r_task(q, e);
-    planar_3r_task_jacobian(q, J);
-    for (i = 0; i < PLANAR_3R_TASK_DIM; ++i) {
-        e[i] = target[i] - e[i];
-    }
-    e[2] = planar_3r_wrap(e[2]);
-}
-
-/* Joints clamped to their limits. */
-static void planar_3r_clamp(planar_3r_real q[PLANAR_3R_DOF])
-{
-    (void)q;
-}
-
-/* Solves A x = b in place (b becomes x) for the symmetric positive definite K x K matrix A by
- * Cholesky; returns 0 when A is not numerically positive definite. */
-static int planar_3r_cholesky_solve(planar_3r_real A[9], planar_3r_real b[3])
-{
-    int i, j, k;
-    for (j = 0; j < 3; ++j) {
-        planar_3r_real diagonal = A[3 * j + j];
-        for (k = 0; k < j; ++k) {
-            diagonal -= A[3 * j + k] * A[3 * j + k];
-        }
-        if (!(diagonal > 0.0)) {
-            return 0;
-        }
-        A[3 * j + j] = sqrt(diagonal);
-        for (i = j + 1; i < 3; ++i) {
-            planar_3r_real sum = A[3 * i + j];
-            for (k = 0; k < j; ++k) {
-                sum -= A[3 * i + k] * A[3 * j + k];
-            }
-            A[3 * i + j] = sum / A[3 * j + j];
-        }
-    }
-    for (i = 0; i < 3; ++i) {
-        for (k = 0; k < i; ++k) {
-            b[i] -= A[3 * i + k] * b[k];
-        }
-        b[i] /= A[3 * i + i];
-    }
-    for (i = 3 - 1; i >= 0; --i) {
-        for (k = i + 1; k < 3; ++k) {
-            b[i] -= A[3 * k + i] * b[k];
-        }
-        b[i] /= A[3 * i + i];
-    }
-    return 1;
-}
+/* -- Iterative inverse kinematics: the loop around planar_3r_ik_numeric_step -- */
 
 int planar_3r_ik_numeric(const planar_3r_real target[PLANAR_3R_TASK_DIM], const planar_3r_real q0[PLANAR_3R_DOF], int max_iter, planar_3r_real tol, planar_3r_real q[PLANAR_3R_DOF])
 {
-    planar_3r_real e[3], J[3 * PLANAR_3R_DOF], trial[PLANAR_3R_DOF], trial_e[3];
-    planar_3r_real trial_J[3 * PLANAR_3R_DOF], A[9], x[3];
-    planar_3r_real cost, trial_cost, damping = 1e-06;
-    planar_3r_real goal[PLANAR_3R_TASK_DIM];
-    int i, j, k, iteration;
-    for (j = 0; j < PLANAR_3R_DOF; ++j) {
-        q[j] = q0[j];
-    }
-    for (i = 0; i < PLANAR_3R_TASK_DIM; ++i) {
-        if (!isfinite(target[i])) {
-            return PLANAR_3R_IK_NUMERIC_INVALID;
+    planar_3r_real trial[PLANAR_3R_DOF], after[PLANAR_3R_DOF], start[PLANAR_3R_DOF];
+    planar_3r_real cost, trial_cost, lighter, damping = 1e-06;
+    int j, iteration;
+    cost = planar_3r_ik_numeric_step(target, q0, damping, q, trial);
+    if (!(cost >= 0) || max_iter < 0) { /* -1: target or q0 not finite */
+        for (j = 0; j < PLANAR_3R_DOF; ++j) {
+            q[j] = q0[j];
         }
-    }
-    for (j = 0; j < PLANAR_3R_DOF; ++j) {
-        if (!isfinite(q0[j])) {
-            return PLANAR_3R_IK_NUMERIC_INVALID;
-        }
-    }
-    if (max_iter < 0) {
         return PLANAR_3R_IK_NUMERIC_INVALID;
-    }
-    /* the target's angles reduced to (-pi, pi], so that errors stay within (-2 pi, 2 pi] */
-    for (i = 0; i < PLANAR_3R_TASK_DIM; ++i) {
-        goal[i] = target[i];
-    }
-    goal[2] = atan2(sin(goal[2]), cos(goal[2]));
-    planar_3r_clamp(q);
-    planar_3r_task_error(goal, q, e, J);
-    cost = 0.0;
-    for (i = 0; i < 3; ++i) {
-        cost += e[i] * e[i];
     }
     for (iteration = 0; iteration < max_iter; ++iteration) {
         if (cost <= tol * tol) {
             return PLANAR_3R_IK_NUMERIC_CONVERGED;
         }
-        /* A = J J^T + damping I, x = A^-1 e, step J^T x */
-        for (i = 0; i < 3; ++i) {
-            x[i] = e[i];
-            for (k = 0; k < 3; ++k) {
-                planar_3r_real sum = i == k ? damping : 0.0;
-                for (j = 0; j < PLANAR_3R_DOF; ++j) {
-                    sum += J[PLANAR_3R_DOF * i + j] * J[PLANAR_3R_DOF * k + j];
-                }
-                A[3 * i + k] = sum;
-            }
-        }
-        if (!planar_3r_cholesky_solve(A, x)) {
-            return PLANAR_3R_IK_NUMERIC_STALLED;
-        }
-        for (j = 0; j < PLANAR_3R_DOF; ++j) {
-            trial[j] = q[j];
-            for (i = 0; i < 3; ++i) {
-                trial[j] += J[PLANAR_3R_DOF * i + j] * x[i];
-            }
-        }
-        planar_3r_clamp(trial);
-        planar_3r_task_error(goal, trial, trial_e, trial_J);
-        trial_cost = 0.0;
-        for (i = 0; i < 3; ++i) {
-            trial_cost += trial_e[i] * trial_e[i];
-        }
+        lighter = damping * 0.1 > 1e-12 ? damping * 0.1 : 1e-12;
+        trial_cost = planar_3r_ik_numeric_step(target, trial, lighter, start, after);
         if (trial_cost < cost) {
             for (j = 0; j < PLANAR_3R_DOF; ++j) {
                 q[j] = trial[j];
-            }
-            for (i = 0; i < 3; ++i) {
-                e[i] = trial_e[i];
-            }
-            for (i = 0; i < 3 * PLANAR_3R_DOF; ++i) {
-                J[i] = trial_J[i];
+                trial[j] = after[j];
             }
             cost = trial_cost;
-            damping = damping * 0.1 > 1e-12 ? damping * 0.1 : 1e-12;
+            damping = lighter;
         } else {
             damping *= 10.0;
             if (damping > 100000000.0) {
                 return PLANAR_3R_IK_NUMERIC_STALLED;
             }
+            (void)planar_3r_ik_numeric_step(target, q, damping, start, trial);
         }
     }
     return cost <= tol * tol ? PLANAR_3R_IK_NUMERIC_CONVERGED : PLANAR_3R_IK_NUMERIC_ITERATION_LIMIT;

@@ -459,6 +459,101 @@ def velocity_ik(q, mu_dot, damping=0.0):
 
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
+def ik_numeric_step(target, q, damping=0.0):
+    """one step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite): (3 x 1 and 3 x 1 and 1 x 1), 189 operations."""
+    target = _argument("target", target, (3,))
+    q = _argument("q", q, (3,))
+    damping = _argument("damping", damping, ())
+    mu0 = target[..., 0]
+    mu1 = target[..., 1]
+    mu2 = target[..., 2]
+    qs1 = q[..., 0]
+    qs2 = q[..., 1]
+    qs3 = q[..., 2]
+    q1 = qs1
+    q2 = qs2
+    q3 = qs3
+    c1 = numpy.cos(q1)
+    s1 = numpy.sin(q1)
+    c2 = numpy.cos(q2)
+    s2 = numpy.sin(q2)
+    c12 = c1*c2 - s1*s2
+    s12 = c1*s2 + c2*s1
+    c3 = numpy.cos(q3)
+    s3 = numpy.sin(q3)
+    c123 = c12*c3 - s12*s3
+    s123 = c12*s3 + c3*s12
+    t0 = c12 + c123
+    t1 = s12 + s123
+    t2 = c1 + t0
+    t3 = s1 + t1
+    t4 = s123**2 + t1**2 + t3**2
+    t5 = c123*s123 + t0*t1 + t2*t3
+    t6 = s123 + t1 + t3
+    t7 = c123**2 + t0**2 + t2**2
+    t8 = c123 + t0 + t2
+    t9 = mu0 - t2
+    t10 = mu1 - t3
+    t11 = mu0 + mu1 + mu2 + qs1 + qs2 + qs3
+    t12 = -mu2 + numpy.arctan2(s123, c123)
+    t13 = t12 + 6.283185307179586*numpy.ceil(-0.15915494309189535*t12 - 0.5)
+    t14 = t10**2 + t13**2 + t9**2
+    t15 = damping + t4
+    t16 = numpy.sqrt(t15**2 + t5**2 + t6**2)
+    t17 = t16*numpy.where(numpy.greater_equal(t15, 0), 1, -1)
+    t18 = t15 + t17
+    t19 = numpy.where(numpy.greater(t16, 0), 1/(t16*(t16 + abs(t15))), 0)
+    t20 = t19*(-t10*t5 + t13*t6 + t18*t9)
+    t21 = -t18*t20 + t9
+    t22 = t10 + t20*t5
+    t23 = -t13 + t20*t6
+    t24 = damping + t7
+    t25 = -t19*(t18*t5 + t24*t5 + t6*t8)
+    t26 = t18*t25 + t5
+    t27 = t24 + t25*t5
+    t28 = t25*t6 + t8
+    t29 = numpy.sqrt(t27**2 + t28**2)
+    t30 = t29*numpy.where(numpy.greater_equal(t27, 0), 1, -1)
+    t31 = t27 + t30
+    t32 = numpy.where(numpy.greater(t29, 0), 1/(t29*(t29 + abs(t27))), 0)
+    t33 = t32*(t22*t31 + t23*t28)
+    t34 = t22 - t31*t33
+    t35 = t23 - t28*t33
+    t36 = damping + 3
+    t37 = -t19*(t18*t6 + t36*t6 + t5*t8)
+    t38 = t18*t37 + t6
+    t39 = t37*t5 + t8
+    t40 = t36 + t37*t6
+    t41 = t32*(t28*t40 + t31*t39)
+    t42 = -t31*t41 + t39
+    t43 = -t28*t41 + t40
+    t44 = abs(t43)
+    t45 = t44
+    t46 = t45*numpy.where(numpy.greater_equal(t43, 0), 1, -1)
+    t47 = t43 + t46
+    t48 = numpy.where(numpy.greater(t45, 0), 1/(t45*(t44 + t45)), 0)
+    t49 = -t35*t47**2*t48 + t35
+    t50 = t49/t46
+    t51 = (t34 + t42*t50)/t30
+    t52 = (t21 - t26*t51 - t38*t50)/t17
+    t53 = -t50
+    t54 = q1 - t2*t51 + t3*t52 + t53
+    t55 = q2 - t0*t51 + t1*t52 + t53
+    t56 = -c123*t51 + q3 + s123*t52 + t53
+    q_start = numpy.empty(numpy.broadcast_shapes(target.shape[:-1], q.shape[:-1], damping.shape) + (3,))
+    q_start[..., 0] = q1
+    q_start[..., 1] = q2
+    q_start[..., 2] = q3
+    q_next = numpy.empty(numpy.broadcast_shapes(target.shape[:-1], q.shape[:-1], damping.shape) + (3,))
+    q_next[..., 0] = t54
+    q_next[..., 1] = t55
+    q_next[..., 2] = t56
+    cost = numpy.empty(numpy.broadcast_shapes(target.shape[:-1], q.shape[:-1], damping.shape) + ())
+    cost[...] = numpy.where(numpy.isfinite(t11), t14, -1)
+    return q_start, q_next, cost
+
+
+@numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def ik_branches(mu):
     """every branch of the closed-form ik and whether the target allows it: (2 x 3 and 2 x 1), 106 operations."""
     mu = _argument("mu", mu, (3,))
@@ -542,63 +637,48 @@ def ik(mu):
     return q[valid] if valid.ndim == 1 else (q, valid)
 
 
-# -- Iterative inverse kinematics --
+# -- Iterative inverse kinematics: the loop around ik_numeric_step --
 
 IK_NUMERIC_CONVERGED = 0  # |error| <= tol
 IK_NUMERIC_ITERATION_LIMIT = 1  # max_iter steps tried, |error| still above tol
 IK_NUMERIC_STALLED = 2  # no step reduces the error: unreachable target, joint limit or local minimum
-_LOWER = numpy.array([-numpy.inf, -numpy.inf, -numpy.inf])  # joint limits (infinite: none)
-_UPPER = numpy.array([numpy.inf, numpy.inf, numpy.inf])
+IK_NUMERIC_INVALID = 3  # target or q0 not finite, or max_iter < 0: q = q0
 _DAMPING = (1e-06, 1e-12, 100000000.0)  # added to the diagonal: start, least, most
-
-
-def _wrap(angle):
-    """Angles wrapped into (-pi, pi]."""
-    return angle - 2.0 * math.pi * numpy.ceil((angle - math.pi) / (2.0 * math.pi))
-
-
-def _task_error(target, q):
-    """Error target - mu(q) (angles wrapped into (-pi, pi]) and the task Jacobian."""
-    error = target - task(q)
-    error[[2]] = _wrap(error[[2]])
-    return error, task_jacobian(q)
 
 
 def ik_numeric(target, q0, max_iter=100, tol=1e-10):
     """Iterative inverse kinematics from q0: damped least squares on the task error.
 
-    target: the task vector (x, y, yaw).
-    Each step is q += J^T (J J^T + damping I)^-1 e, with e the task error
+    target: the task vector (x, y, yaw), or a batch of them with q0 (..., DOF).
+    Each step is ik_numeric_step: q += J^T (J J^T + damping I)^-1 e, with e the task error
     (target - mu(q), angles wrapped into (-pi, pi]) and J its Jacobian; joints are clamped to their limits.
     The damping adapts (Levenberg-Marquardt): divided by 10 after a step that lowers |e|,
     multiplied by 10 and the step discarded otherwise.
-    Returns (q, status): status IK_NUMERIC_CONVERGED (|e| <= tol), IK_NUMERIC_ITERATION_LIMIT
-    (max_iter steps tried) or IK_NUMERIC_STALLED (no step lowers |e|: out of reach, a joint
-    limit or a local minimum); q is the best configuration found.
+    Returns (q, status), status an IK_NUMERIC_* code per target; q is the best configuration
+    found.
     """
-    target = numpy.asarray(target, dtype=float)
-    q = numpy.asarray(q0, dtype=float)
-    if target.shape != (3,) or q.shape != (DOF,):
-        raise ValueError(f"expected target (3,) and q0 ({DOF},), got {target.shape} and {q.shape}")
-    q = numpy.clip(q, _LOWER, _UPPER)
-    error, J = _task_error(target, q)
-    cost = error @ error
-    damping, least, most = _DAMPING
-    for _ in range(max_iter):
-        if cost <= tol * tol:
-            return q, IK_NUMERIC_CONVERGED
-        step = J.T @ numpy.linalg.solve(J @ J.T + damping * numpy.eye(J.shape[0]), error)
-        trial = numpy.clip(q + step, _LOWER, _UPPER)
-        trial_error, trial_J = _task_error(target, trial)
-        trial_cost = trial_error @ trial_error
-        if trial_cost < cost:
-            q, error, J, cost = trial, trial_error, trial_J, trial_cost
-            damping = max(damping * 0.1, least)
-        else:
-            damping *= 10.0
-            if damping > most:
-                return q, IK_NUMERIC_STALLED
-    return q, IK_NUMERIC_CONVERGED if cost <= tol * tol else IK_NUMERIC_ITERATION_LIMIT
+    least, most = _DAMPING[1:]
+    q, trial, cost = ik_numeric_step(target, q0, _DAMPING[0])
+    damping = cost * 0.0 + _DAMPING[0]
+    status = numpy.where((cost >= 0.0) & (max_iter >= 0), IK_NUMERIC_ITERATION_LIMIT, IK_NUMERIC_INVALID)
+    for _ in range(max(max_iter, 0)):
+        status = numpy.where(numpy.logical_and(status == IK_NUMERIC_ITERATION_LIMIT, cost <= tol * tol), IK_NUMERIC_CONVERGED, status)
+        active = status == IK_NUMERIC_ITERATION_LIMIT
+        if not active.any():
+            break
+        lighter = numpy.maximum(damping * 0.1, least)
+        _, after, trial_cost = ik_numeric_step(target, trial, lighter)
+        better = numpy.logical_and(active, trial_cost < cost)
+        worse = numpy.logical_and(active, trial_cost >= cost)
+        q = numpy.where(better[..., None], trial, q)
+        cost = numpy.where(better, trial_cost, cost)
+        damping = numpy.where(better, lighter, numpy.where(worse, damping * 10.0, damping))
+        status = numpy.where(numpy.logical_and(worse, damping > most), IK_NUMERIC_STALLED, status)
+        _, retry, _ = ik_numeric_step(target, q, damping)
+        trial = numpy.where(better[..., None], after, numpy.where(worse[..., None], retry, trial))
+    status = numpy.where(numpy.logical_and(status == IK_NUMERIC_ITERATION_LIMIT, cost <= tol * tol), IK_NUMERIC_CONVERGED, status)
+    q = numpy.where((status == IK_NUMERIC_INVALID)[..., None], numpy.asarray(q0, dtype=float), q)
+    return q, status[()] if status.ndim == 0 else status
 
 
 # Statuses of velocity_ik: OK, singular (a diagonal entry of the QR factor R of the

@@ -391,6 +391,97 @@ def _velocity_ik(q, mu_dot, damping):
     return [q_dot, status]
 
 
+def _ik_numeric_step(target, q, damping):
+    """One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite): 189 operations."""
+    mu0 = target[0]
+    mu1 = target[1]
+    mu2 = target[2]
+    qs1 = q[0]
+    qs2 = q[1]
+    qs3 = q[2]
+    q1 = qs1
+    q2 = qs2
+    q3 = qs3
+    c1 = casadi.cos(q1)
+    s1 = casadi.sin(q1)
+    c2 = casadi.cos(q2)
+    s2 = casadi.sin(q2)
+    c12 = c1*c2 - s1*s2
+    s12 = c1*s2 + c2*s1
+    c3 = casadi.cos(q3)
+    s3 = casadi.sin(q3)
+    c123 = c12*c3 - s12*s3
+    s123 = c12*s3 + c3*s12
+    t0 = c12 + c123
+    t1 = s12 + s123
+    t2 = c1 + t0
+    t3 = s1 + t1
+    t4 = s123**2 + t1**2 + t3**2
+    t5 = c123*s123 + t0*t1 + t2*t3
+    t6 = s123 + t1 + t3
+    t7 = c123**2 + t0**2 + t2**2
+    t8 = c123 + t0 + t2
+    t9 = mu0 - t2
+    t10 = mu1 - t3
+    t11 = mu0 + mu1 + mu2 + qs1 + qs2 + qs3
+    t12 = -mu2 + casadi.atan2(s123, c123)
+    t13 = t12 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t12 - 0.5)
+    t14 = t10**2 + t13**2 + t9**2
+    t15 = damping + t4
+    t16 = casadi.sqrt(t15**2 + t5**2 + t6**2)
+    t17 = t16*casadi.if_else((t15 >= 0), 1, -1)
+    t18 = t15 + t17
+    t19 = casadi.if_else((t16 > 0), 1/(t16*(t16 + casadi.fabs(t15))), 0)
+    t20 = t19*(-t10*t5 + t13*t6 + t18*t9)
+    t21 = -t18*t20 + t9
+    t22 = t10 + t20*t5
+    t23 = -t13 + t20*t6
+    t24 = damping + t7
+    t25 = -t19*(t18*t5 + t24*t5 + t6*t8)
+    t26 = t18*t25 + t5
+    t27 = t24 + t25*t5
+    t28 = t25*t6 + t8
+    t29 = casadi.sqrt(t27**2 + t28**2)
+    t30 = t29*casadi.if_else((t27 >= 0), 1, -1)
+    t31 = t27 + t30
+    t32 = casadi.if_else((t29 > 0), 1/(t29*(t29 + casadi.fabs(t27))), 0)
+    t33 = t32*(t22*t31 + t23*t28)
+    t34 = t22 - t31*t33
+    t35 = t23 - t28*t33
+    t36 = damping + 3
+    t37 = -t19*(t18*t6 + t36*t6 + t5*t8)
+    t38 = t18*t37 + t6
+    t39 = t37*t5 + t8
+    t40 = t36 + t37*t6
+    t41 = t32*(t28*t40 + t31*t39)
+    t42 = -t31*t41 + t39
+    t43 = -t28*t41 + t40
+    t44 = casadi.fabs(t43)
+    t45 = t44
+    t46 = t45*casadi.if_else((t43 >= 0), 1, -1)
+    t47 = t43 + t46
+    t48 = casadi.if_else((t45 > 0), 1/(t45*(t44 + t45)), 0)
+    t49 = -t35*t47**2*t48 + t35
+    t50 = t49/t46
+    t51 = (t34 + t42*t50)/t30
+    t52 = (t21 - t26*t51 - t38*t50)/t17
+    t53 = -t50
+    t54 = q1 - t2*t51 + t3*t52 + t53
+    t55 = q2 - t0*t51 + t1*t52 + t53
+    t56 = -c123*t51 + q3 + s123*t52 + t53
+    q_start = casadi.SX(3, 1)
+    q_start[0, 0] = q1
+    q_start[1, 0] = q2
+    q_start[2, 0] = q3
+    q_next = casadi.SX(3, 1)
+    q_next[0, 0] = t54
+    q_next[1, 0] = t55
+    q_next[2, 0] = t56
+    cost = casadi.SX(1, 1)
+    cost[0, 0] = casadi.if_else((casadi.fabs(t11) < casadi.inf), t14, -1)
+    return [q_start, q_next, cost]
+
+
 def _ik_branches(mu):
     """Every branch of the closed-form ik and whether the target allows it: 106 operations."""
     mu0 = mu[0]
@@ -450,6 +541,7 @@ def _ik_branches(mu):
 _q = casadi.SX.sym("q", 3, 1)
 _mu_dot = casadi.SX.sym("mu_dot", 3, 1)
 _damping = casadi.SX.sym("damping", 1, 1)
+_target = casadi.SX.sym("target", 3, 1)
 _mu = casadi.SX.sym("mu", 3, 1)
 fk = casadi.Function("fk", [_q], _fk(_q), ["q"], ["T"])
 jacobian = casadi.Function("jacobian", [_q], _jacobian(_q), ["q"], ["J"])
@@ -461,10 +553,48 @@ singularity_factors = casadi.Function("singularity_factors", [_q], _singularity_
 manipulability = casadi.Function("manipulability", [_q], _manipulability(_q), ["q"], ["w"])
 jacobian_det = casadi.Function("jacobian_det", [_q], _jacobian_det(_q), ["q"], ["d"])
 velocity_ik = casadi.Function("velocity_ik", [_q, _mu_dot, _damping], _velocity_ik(_q, _mu_dot, _damping), ["q", "mu_dot", "damping"], ["q_dot", "status"])
+ik_numeric_step = casadi.Function("ik_numeric_step", [_target, _q, _damping], _ik_numeric_step(_target, _q, _damping), ["target", "q", "damping"], ["q_start", "q_next", "cost"])
 ik_branches = casadi.Function("ik_branches", [_mu], _ik_branches(_mu), ["mu"], ["q", "valid"])
 ik = ik_branches  # CasADi functions have fixed-size outputs: every branch and its validity
+
+IK_NUMERIC_CONVERGED = 0  # |error| <= tol
+IK_NUMERIC_ITERATION_LIMIT = 1  # IK_NUMERIC_ITERATIONS steps taken, |error| still above tol
+IK_NUMERIC_STALLED = 2  # no step reduces the error: unreachable target, joint limit or local minimum
+IK_NUMERIC_INVALID = 3  # target or q0 not finite: q = q0
+IK_NUMERIC_ITERATIONS = 100
+_DAMPING = (1e-06, 1e-12, 100000000.0)  # added to the diagonal: start, least, most
+
+
+def _ik_numeric(target, q0, tol):
+    """ik_numeric of the C and numpy modules with a fixed number of steps: every branch of
+    the loop is a select, so the graph is the same for every input."""
+    least, most = _DAMPING[1:]
+    q, trial, cost = ik_numeric_step(target, q0, _DAMPING[0])
+    damping = cost * 0.0 + _DAMPING[0]
+    status = casadi.if_else(cost >= 0.0, IK_NUMERIC_ITERATION_LIMIT, IK_NUMERIC_INVALID)
+    for _ in range(IK_NUMERIC_ITERATIONS):
+        status = casadi.if_else(casadi.logic_and(status == IK_NUMERIC_ITERATION_LIMIT, cost <= tol * tol), IK_NUMERIC_CONVERGED, status)
+        active = status == IK_NUMERIC_ITERATION_LIMIT
+        lighter = casadi.fmax(damping * 0.1, least)
+        _, after, trial_cost = ik_numeric_step(target, trial, lighter)
+        better = casadi.logic_and(active, trial_cost < cost)
+        worse = casadi.logic_and(active, trial_cost >= cost)
+        q = casadi.if_else(better, trial, q)
+        cost = casadi.if_else(better, trial_cost, cost)
+        damping = casadi.if_else(better, lighter, casadi.if_else(worse, damping * 10.0, damping))
+        status = casadi.if_else(casadi.logic_and(worse, damping > most), IK_NUMERIC_STALLED, status)
+        _, retry, _ = ik_numeric_step(target, q, damping)
+        trial = casadi.if_else(better, after, casadi.if_else(worse, retry, trial))
+    status = casadi.if_else(casadi.logic_and(status == IK_NUMERIC_ITERATION_LIMIT, cost <= tol * tol), IK_NUMERIC_CONVERGED, status)
+    q = casadi.if_else((status == IK_NUMERIC_INVALID), q0, q)
+    return [q, status]
+
+
+_tol = casadi.SX.sym("tol")
+ik_numeric = casadi.Function("ik_numeric", [_target, _q, _tol], _ik_numeric(_target, _q, _tol),
+                             ["target", "q0", "tol"], ["q", "status"])
 
 
 def functions():
     """All functions by name."""
-    return {"fk": fk, "jacobian": jacobian, "fk_jacobian": fk_jacobian, "jacobian_tool": jacobian_tool, "task": task, "task_jacobian": task_jacobian, "singularity_factors": singularity_factors, "manipulability": manipulability, "jacobian_det": jacobian_det, "velocity_ik": velocity_ik, "ik_branches": ik_branches}
+    return {"fk": fk, "jacobian": jacobian, "fk_jacobian": fk_jacobian, "jacobian_tool": jacobian_tool, "task": task, "task_jacobian": task_jacobian, "singularity_factors": singularity_factors, "manipulability": manipulability, "jacobian_det": jacobian_det, "velocity_ik": velocity_ik, "ik_numeric_step": ik_numeric_step, "ik_branches": ik_branches}

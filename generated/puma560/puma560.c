@@ -1056,6 +1056,326 @@ int puma560_velocity_ik(const puma560_real q[PUMA560_DOF], const puma560_real mu
     return (!(t358 && t359) ? 2 : (t362 ? 1 : 0));
 }
 
+puma560_real puma560_ik_numeric_step(const puma560_real target[16], const puma560_real q[PUMA560_DOF], puma560_real damping, puma560_real q_start[PUMA560_DOF], puma560_real q_next[PUMA560_DOF])
+{
+    /* 909 operations */
+
+    /* Inputs */
+    const puma560_real T00 = target[0];
+    const puma560_real T01 = target[1];
+    const puma560_real T02 = target[2];
+    const puma560_real T03 = target[3];
+    const puma560_real T10 = target[4];
+    const puma560_real T11 = target[5];
+    const puma560_real T12 = target[6];
+    const puma560_real T13 = target[7];
+    const puma560_real T20 = target[8];
+    const puma560_real T21 = target[9];
+    const puma560_real T22 = target[10];
+    const puma560_real T23 = target[11];
+    const puma560_real qs1 = q[0];
+    const puma560_real qs2 = q[1];
+    const puma560_real qs3 = q[2];
+    const puma560_real qs4 = q[3];
+    const puma560_real qs5 = q[4];
+    const puma560_real qs6 = q[5];
+
+    /* Intermediate terms */
+    const puma560_real q1 = (qs1 < -2.792526803190927 ? -2.792526803190927 : (qs1 > 2.792526803190927 ? 2.792526803190927 : qs1));
+    const puma560_real q2 = (qs2 < -0.7853981633974483 ? -0.7853981633974483 : (qs2 > 3.9269908169872414 ? 3.9269908169872414 : qs2));
+    const puma560_real q3 = (qs3 < -3.9269908169872414 ? -3.9269908169872414 : (qs3 > 0.7853981633974483 ? 0.7853981633974483 : qs3));
+    const puma560_real q4 = (qs4 < -1.9198621771937625 ? -1.9198621771937625 : (qs4 > 2.9670597283903604 ? 2.9670597283903604 : qs4));
+    const puma560_real q5 = (qs5 < -1.7453292519943295 ? -1.7453292519943295 : (qs5 > 1.7453292519943295 ? 1.7453292519943295 : qs5));
+    const puma560_real q6 = (qs6 < -4.642575810304916 ? -4.642575810304916 : (qs6 > 4.642575810304916 ? 4.642575810304916 : qs6));
+    const puma560_real c1 = cos(q1);
+    const puma560_real s1 = sin(q1);
+    const puma560_real c2 = cos(q2);
+    const puma560_real s2 = sin(q2);
+    const puma560_real c3 = cos(q3);
+    const puma560_real s3 = sin(q3);
+    const puma560_real c23 = c2*c3 - s2*s3;
+    const puma560_real s23 = c2*s3 + c3*s2;
+    const puma560_real c4 = cos(q4);
+    const puma560_real s4 = sin(q4);
+    const puma560_real c5 = cos(q5);
+    const puma560_real s5 = sin(q5);
+    const puma560_real c6 = cos(q6);
+    const puma560_real s6 = sin(q6);
+    const puma560_real t0 = 0.4318*c23 + 0.0203*s23;
+    const puma560_real t1 = 0.4318*s2 + t0;
+    const puma560_real t2 = t1 + 0.67183;
+    const puma560_real t3 = T23 - t2;
+    const puma560_real t4 = T00 + T01 + T02 + T03 + T10 + T11 + T12 + T13 + T20 + T21 + T22 + T23 + qs1 + qs2 + qs3 + qs4 + qs5 + qs6;
+    const puma560_real t5 = 0.0203*c23;
+    const puma560_real t6 = c1*t5 + 0.15005*s1;
+    const puma560_real t7 = -0.15005*c1 + s1*t5;
+    const puma560_real t8 = s1*s4;
+    const puma560_real t9 = c1*c4;
+    const puma560_real t10 = c23*t9 - t8;
+    const puma560_real t11 = -c23*t8 + t9;
+    const puma560_real t12 = c4*s1;
+    const puma560_real t13 = c1*s4;
+    const puma560_real t14 = c23*t13 + t12;
+    const puma560_real t15 = c23*t12 + t13;
+    const puma560_real t16 = c1*s23;
+    const puma560_real t17 = c5*t10 - s5*t16;
+    const puma560_real t18 = c5*t16 + s5*t10;
+    const puma560_real t19 = c6*t17 - s6*t14;
+    const puma560_real t20 = c6*t14 + s6*t17;
+    const puma560_real t21 = -0.4318*t16 + t6;
+    const puma560_real t22 = -T00*t19 + T01*t20 + T02*t18;
+    const puma560_real t23 = -T10*t19 + T11*t20 + T12*t18;
+    const puma560_real t24 = -T20*t19 + T21*t20 + T22*t18;
+    const puma560_real t25 = s1*s23;
+    const puma560_real t26 = c5*t15 - s5*t25;
+    const puma560_real t27 = c5*t25 + s5*t15;
+    const puma560_real t28 = c6*t26 + s6*t11;
+    const puma560_real t29 = c6*t11 - s6*t26;
+    const puma560_real t30 = -0.4318*t25 + t7;
+    const puma560_real t31 = c1*t21 + s1*t30;
+    const puma560_real t32 = T00*t28 + T01*t29 - T02*t27;
+    const puma560_real t33 = T10*t28 + T11*t29 - T12*t27;
+    const puma560_real t34 = T20*t28 + T21*t29 - T22*t27;
+    const puma560_real t35 = -0.5*t23 - 0.5*t32;
+    const puma560_real t36 = c4*s23;
+    const puma560_real t37 = c23*s5 + c5*t36;
+    const puma560_real t38 = c23*c5 - s5*t36;
+    const puma560_real t39 = s23*s4;
+    const puma560_real t40 = c6*t37 - s6*t39;
+    const puma560_real t41 = c6*t39 + s6*t37;
+    const puma560_real t42 = c23*t16 - t14*t39 + t18*t38;
+    const puma560_real t43 = c23*t25 + t11*t39 + t27*t38;
+    const puma560_real t44 = T00*t40 - T01*t41 + T02*t38;
+    const puma560_real t45 = T10*t40 - T11*t41 + T12*t38;
+    const puma560_real t46 = T20*t40 - T21*t41 + T22*t38;
+    const puma560_real t47 = 0.5*t34 - 0.5*t45;
+    const puma560_real t48 = 0.5*t24 + 0.5*t44;
+    const puma560_real t49 = sqrt((t35*t35) + (t47*t47) + (t48*t48));
+    const puma560_real t50 = 0.4318*c2;
+    const puma560_real t51 = c1*t50 + t21;
+    const puma560_real t52 = s1*t50 + t30;
+    const puma560_real t53 = c1*t51 + s1*t52;
+    const puma560_real t54 = (t31*t31) + (t53*t53);
+    const puma560_real t55 = T03 - t51;
+    const puma560_real t56 = T13 - t52;
+    const puma560_real t57 = (t52*t52);
+    const puma560_real t58 = (t0*t0);
+    const puma560_real t59 = (c1*c1);
+    const puma560_real t60 = t0*t59 + t1*t59;
+    const puma560_real t61 = (t1*t1);
+    const puma560_real t62 = t57 + t58*t59 + t59*t61;
+    const puma560_real t63 = -t51*t52;
+    const puma560_real t64 = c1*s1;
+    const puma560_real t65 = t58*t64 + t61*t64 + t63;
+    const puma560_real t66 = t0*t64 + t1*t64;
+    const puma560_real t67 = c1*t31;
+    const puma560_real t68 = c1*t53;
+    const puma560_real t69 = t0*t67 + t1*t68;
+    const puma560_real t70 = t67 + t68;
+    const puma560_real t71 = (s1*s1);
+    const puma560_real t72 = t58*t71 + t61*t71 + (t51*t51);
+    const puma560_real t73 = t0*t71 + t1*t71;
+    const puma560_real t74 = s1*t31;
+    const puma560_real t75 = s1*t53;
+    const puma560_real t76 = t0*t74 + t1*t75;
+    const puma560_real t77 = t74 + t75;
+    const puma560_real t78 = (s23*s23);
+    const puma560_real t79 = t59*t78 + 2*t71 + (t14*t14) + (t18*t18);
+    const puma560_real t80 = -t11*t14 + t18*t27 + t64*t78 - 2*t64;
+    const puma560_real t81 = 2*t59 + t71*t78 + (t11*t11) + (t27*t27);
+    const puma560_real t82 = t78*(s4*s4) + (c23*c23) + (t38*t38) + 1;
+    const puma560_real t83 = -t22;
+    const puma560_real t84 = 0.5*t33 + 0.5*t46 + 0.5*t83 - 0.5;
+    const puma560_real t85 = atan2(t49, t84);
+    const puma560_real t86 = (t49 > 0 ? t85/t49 : 1);
+    const int t87 = t22 <= -t33 && t22 <= -t46;
+    const int t88 = t33 >= t46;
+    const puma560_real t89 = (t87 ? 0.5*t83 + 0.5 : (t88 ? 0.5*t32 : 0.5*t44));
+    const puma560_real t90 = (t87 ? -0.5*t23 : (t88 ? 0.5*t33 + 0.5 : 0.5*t45));
+    const puma560_real t91 = (t87 ? -0.5*t24 : (t88 ? 0.5*t34 : 0.5*t46 + 0.5));
+    const puma560_real t92 = sqrt((t89*t89) + (t90*t90) + (t91*t91));
+    const puma560_real t93 = (t35*t91 + t47*t89 + t48*t90 >= 0 ? 1 : -1);
+    const int t94 = (t49 > 1e-06) || (t84 > 0);
+    const puma560_real t95 = t85*t93/t92;
+    const puma560_real t96 = (t94 ? t47*t86 : t89*t95);
+    const puma560_real t97 = (t94 ? t48*t86 : t90*t95);
+    const puma560_real t98 = (t94 ? t35*t86 : t91*t95);
+    const puma560_real t99 = (t3*t3) + (t55*t55) + (t56*t56) + (t96*t96) + (t97*t97) + (t98*t98);
+    const puma560_real t100 = damping + t62;
+    const puma560_real t101 = sqrt(t57 + (t100*t100) + (t60*t60) + (t65*t65) + (t66*t66) + (t69*t69));
+    const puma560_real t102 = t101*(t100 >= 0 ? 1 : -1);
+    const puma560_real t103 = t100 + t102;
+    const puma560_real t104 = (t101 > 0 ? 1/(t101*(t101 + fabs(t100))) : 0);
+    const puma560_real t105 = t104*(t103*t55 - t3*t69 - t52*t98 + t56*t65 + t60*t97 - t66*t96);
+    const puma560_real t106 = -t103*t105 + t55;
+    const puma560_real t107 = -t105*t65 + t56;
+    const puma560_real t108 = t105*t69 + t3;
+    const puma560_real t109 = t105*t66 + t96;
+    const puma560_real t110 = -t105*t60 + t97;
+    const puma560_real t111 = t105*t52 + t98;
+    const puma560_real t112 = damping + t72;
+    const puma560_real t113 = t104*(t103*t65 + t112*t65 + t60*t66 + t63 + t66*t73 + t69*t76);
+    const puma560_real t114 = -t103*t113 + t65;
+    const puma560_real t115 = t112 - t113*t65;
+    const puma560_real t116 = t113*t69 - t76;
+    const puma560_real t117 = t113*t66 - t73;
+    const puma560_real t118 = -t113*t60 + t66;
+    const puma560_real t119 = t113*t52 + t51;
+    const puma560_real t120 = sqrt((t115*t115) + (t116*t116) + (t117*t117) + (t118*t118) + (t119*t119));
+    const puma560_real t121 = t120*(t115 >= 0 ? 1 : -1);
+    const puma560_real t122 = t115 + t121;
+    const puma560_real t123 = (t120 > 0 ? 1/(t120*(t120 + fabs(t115))) : 0);
+    const puma560_real t124 = t123*(t107*t122 + t108*t116 + t109*t117 + t110*t118 + t111*t119);
+    const puma560_real t125 = t107 - t122*t124;
+    const puma560_real t126 = t108 - t116*t124;
+    const puma560_real t127 = t109 - t117*t124;
+    const puma560_real t128 = t110 - t118*t124;
+    const puma560_real t129 = t111 - t119*t124;
+    const puma560_real t130 = damping + t54;
+    const puma560_real t131 = -t104*(t103*t69 + t130*t69 + t60*t70 + t65*t76 + t66*t77);
+    const puma560_real t132 = t103*t131 + t69;
+    const puma560_real t133 = t131*t65 + t76;
+    const puma560_real t134 = t130 + t131*t69;
+    const puma560_real t135 = t131*t66 + t77;
+    const puma560_real t136 = t131*t60 + t70;
+    const puma560_real t137 = damping + t79;
+    const puma560_real t138 = -t104*(t103*t66 + t137*t66 - t42*t52 - t60*t80 + t65*t73 + t69*t77);
+    const puma560_real t139 = t103*t138 + t66;
+    const puma560_real t140 = t138*t65 + t73;
+    const puma560_real t141 = t138*t69 + t77;
+    const puma560_real t142 = t137 + t138*t66;
+    const puma560_real t143 = -t138*t60 + t80;
+    const puma560_real t144 = -t42;
+    const puma560_real t145 = t138*t52 + t144;
+    const puma560_real t146 = t123*(t116*t141 + t117*t142 + t118*t143 + t119*t145 - t122*t140);
+    const puma560_real t147 = t122*t146 + t140;
+    const puma560_real t148 = -t116*t146 + t141;
+    const puma560_real t149 = -t117*t146 + t142;
+    const puma560_real t150 = -t118*t146 + t143;
+    const puma560_real t151 = -t119*t146 + t145;
+    const puma560_real t152 = damping + t81;
+    const puma560_real t153 = t104*(t103*t60 + t152*t60 + t43*t52 + t65*t66 - t66*t80 + t69*t70);
+    const puma560_real t154 = -t103*t153 + t60;
+    const puma560_real t155 = -t153*t65 + t66;
+    const puma560_real t156 = t153*t69 - t70;
+    const puma560_real t157 = t153*t66 + t80;
+    const puma560_real t158 = t152 - t153*t60;
+    const puma560_real t159 = t153*t52 - t43;
+    const puma560_real t160 = t123*(t116*t156 + t117*t157 + t118*t158 + t119*t159 + t122*t155);
+    const puma560_real t161 = -t122*t160 + t155;
+    const puma560_real t162 = -t116*t160 + t156;
+    const puma560_real t163 = -t117*t160 + t157;
+    const puma560_real t164 = -t118*t160 + t158;
+    const puma560_real t165 = -t119*t160 + t159;
+    const puma560_real t166 = damping + t82;
+    const puma560_real t167 = -t104*(t103*t52 + t166*t52 - t42*t66 + t43*t60 - t51*t65);
+    const puma560_real t168 = t103*t167 + t52;
+    const puma560_real t169 = -t167*t65 + t51;
+    const puma560_real t170 = t144 + t167*t66;
+    const puma560_real t171 = t167*t60 + t43;
+    const puma560_real t172 = t166 + t167*t52;
+    const puma560_real t173 = t131*t52;
+    const puma560_real t174 = t123*(t116*t134 + t117*t135 - t118*t136 + t119*t173 - t122*t133);
+    const puma560_real t175 = t122*t174 + t133;
+    const puma560_real t176 = -t116*t174 + t134;
+    const puma560_real t177 = -t117*t174 + t135;
+    const puma560_real t178 = t118*t174 + t136;
+    const puma560_real t179 = -t119*t174 + t173;
+    const puma560_real t180 = sqrt((t176*t176) + (t177*t177) + (t178*t178) + (t179*t179));
+    const puma560_real t181 = t180*(t176 >= 0 ? 1 : -1);
+    const puma560_real t182 = t176 + t181;
+    const puma560_real t183 = (t180 > 0 ? 1/(t180*(t180 + fabs(t176))) : 0);
+    const puma560_real t184 = t183*(t148*t182 + t149*t177 - t150*t178 + t151*t179);
+    const puma560_real t185 = t148 - t182*t184;
+    const puma560_real t186 = t149 - t177*t184;
+    const puma560_real t187 = t150 + t178*t184;
+    const puma560_real t188 = t151 - t179*t184;
+    const puma560_real t189 = t183*(t162*t182 + t163*t177 - t164*t178 + t165*t179);
+    const puma560_real t190 = t162 - t182*t189;
+    const puma560_real t191 = t163 - t177*t189;
+    const puma560_real t192 = t164 + t178*t189;
+    const puma560_real t193 = t165 - t179*t189;
+    const puma560_real t194 = t183*(t126*t182 + t127*t177 - t128*t178 + t129*t179);
+    const puma560_real t195 = t126 - t182*t194;
+    const puma560_real t196 = t127 - t177*t194;
+    const puma560_real t197 = t128 + t178*t194;
+    const puma560_real t198 = t129 - t179*t194;
+    const puma560_real t199 = sqrt((t186*t186) + (t187*t187) + (t188*t188));
+    const puma560_real t200 = t199*(t186 >= 0 ? 1 : -1);
+    const puma560_real t201 = t186 + t200;
+    const puma560_real t202 = (t199 > 0 ? 1/(t199*(t199 + fabs(t186))) : 0);
+    const puma560_real t203 = t202*(t187*t192 + t188*t193 + t191*t201);
+    const puma560_real t204 = t191 - t201*t203;
+    const puma560_real t205 = -t187*t203 + t192;
+    const puma560_real t206 = -t188*t203 + t193;
+    const puma560_real t207 = t202*(t187*t197 + t188*t198 + t196*t201);
+    const puma560_real t208 = t196 - t201*t207;
+    const puma560_real t209 = -t187*t207 + t197;
+    const puma560_real t210 = -t188*t207 + t198;
+    const puma560_real t211 = sqrt((t205*t205) + (t206*t206));
+    const puma560_real t212 = t211*(t205 >= 0 ? 1 : -1);
+    const puma560_real t213 = t205 + t212;
+    const puma560_real t214 = (t211 > 0 ? 1/(t211*(t211 + fabs(t205))) : 0);
+    const puma560_real t215 = t214*(t206*t210 + t209*t213);
+    const puma560_real t216 = t209 - t213*t215;
+    const puma560_real t217 = -t206*t215 + t210;
+    const puma560_real t218 = t167*t69;
+    const puma560_real t219 = t123*(t116*t218 + t117*t170 - t118*t171 + t119*t172 + t122*t169);
+    const puma560_real t220 = -t122*t219 + t169;
+    const puma560_real t221 = -t116*t219 + t218;
+    const puma560_real t222 = -t117*t219 + t170;
+    const puma560_real t223 = t118*t219 + t171;
+    const puma560_real t224 = -t119*t219 + t172;
+    const puma560_real t225 = t183*(t177*t222 + t178*t223 + t179*t224 + t182*t221);
+    const puma560_real t226 = -t182*t225 + t221;
+    const puma560_real t227 = -t177*t225 + t222;
+    const puma560_real t228 = t178*t225 - t223;
+    const puma560_real t229 = -t179*t225 + t224;
+    const puma560_real t230 = t202*(t187*t228 + t188*t229 + t201*t227);
+    const puma560_real t231 = -t201*t230 + t227;
+    const puma560_real t232 = -t187*t230 + t228;
+    const puma560_real t233 = -t188*t230 + t229;
+    const puma560_real t234 = t214*(t206*t233 + t213*t232);
+    const puma560_real t235 = -t213*t234 + t232;
+    const puma560_real t236 = -t206*t234 + t233;
+    const puma560_real t237 = fabs(t236);
+    const puma560_real t238 = t237;
+    const puma560_real t239 = t238*(t236 >= 0 ? 1 : -1);
+    const puma560_real t240 = t236 + t239;
+    const puma560_real t241 = (t238 > 0 ? 1/(t238*(t237 + t238)) : 0);
+    const puma560_real t242 = -t217*t241*(t240*t240) + t217;
+    const puma560_real t243 = t242/t239;
+    const puma560_real t244 = (t216 + t235*t243)/t212;
+    const puma560_real t245 = (t204*t244 + t208 + t231*t243)/t200;
+    const puma560_real t246 = (t185*t245 + t190*t244 + t195 + t226*t243)/t181;
+    const puma560_real t247 = (t125 - t147*t245 + t161*t244 - t175*t246 + t220*t243)/t121;
+    const puma560_real t248 = (t106 + t114*t247 - t132*t246 - t139*t245 + t154*t244 - t168*t243)/t102;
+    const puma560_real t249 = q1 - t243 - t247*t51 + t248*t52;
+    const puma560_real t250 = -c23*t243 + q4 + t16*t245 + t244*t25;
+    const puma560_real t251 = q5 + t11*t244 - t14*t245 - t243*t39;
+    const puma560_real t252 = q6 + t18*t245 - t243*t38 + t244*t27;
+    const puma560_real t253 = s1*t247;
+    const puma560_real t254 = c1*t248;
+    const puma560_real t255 = c1*t244 - s1*t245;
+    const puma560_real t256 = q2 + t1*t253 + t1*t254 - t246*t53 + t255;
+    const puma560_real t257 = q3 + t0*t253 + t0*t254 - t246*t31 + t255;
+
+    /* Outputs */
+    q_start[0] = q1;
+    q_start[1] = q2;
+    q_start[2] = q3;
+    q_start[3] = q4;
+    q_start[4] = q5;
+    q_start[5] = q6;
+    q_next[0] = (t249 < -2.792526803190927 ? -2.792526803190927 : (t249 > 2.792526803190927 ? 2.792526803190927 : t249));
+    q_next[1] = (t256 < -0.7853981633974483 ? -0.7853981633974483 : (t256 > 3.9269908169872414 ? 3.9269908169872414 : t256));
+    q_next[2] = (t257 < -3.9269908169872414 ? -3.9269908169872414 : (t257 > 0.7853981633974483 ? 0.7853981633974483 : t257));
+    q_next[3] = (t250 < -1.9198621771937625 ? -1.9198621771937625 : (t250 > 2.9670597283903604 ? 2.9670597283903604 : t250));
+    q_next[4] = (t251 < -1.7453292519943295 ? -1.7453292519943295 : (t251 > 1.7453292519943295 ? 1.7453292519943295 : t251));
+    q_next[5] = (t252 < -4.642575810304916 ? -4.642575810304916 : (t252 > 4.642575810304916 ? 4.642575810304916 : t252));
+    return (isfinite(t4) ? t99 : -1);
+}
+
 void puma560_ik_branches(const puma560_real T[16], puma560_real q[PUMA560_MAX_IK_SOLUTIONS * PUMA560_DOF], int valid[PUMA560_MAX_IK_SOLUTIONS])
 {
     /* 900 operations */
@@ -1540,179 +1860,39 @@ int puma560_ik(const puma560_real T[16], puma560_real q[PUMA560_MAX_IK_SOLUTIONS
     return count;
 }
 
-/* -- Iterative inverse kinematics -- */
-
-/* The rotation vector (axis times angle in [0, pi]) of the rotation matrix E (row-major). */
-static void puma560_rotation_vector(const puma560_real E[9], puma560_real out[3])
-{
-    const puma560_real v[3] = {0.5 * (E[7] - E[5]), 0.5 * (E[2] - E[6]), 0.5 * (E[3] - E[1])};
-    const puma560_real cos_angle = 0.5 * (E[0] + E[4] + E[8] - 1.0);
-    const puma560_real sin_angle = sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
-    const puma560_real angle = atan2(sin_angle, cos_angle);
-    puma560_real axis[3], length, sign;
-    int i, column = 0;
-    if (sin_angle > 1e-6 || cos_angle > 0.0) {
-        const puma560_real scale = sin_angle > 0.0 ? angle / sin_angle : 1.0;
-        for (i = 0; i < 3; ++i) {
-            out[i] = scale * v[i];
-        }
-        return;
-    }
-    /* Near a half turn: the axis from the largest column of (E + I) / 2 = u u^T. */
-    for (i = 1; i < 3; ++i) {
-        if (E[4 * i] > E[4 * column]) {
-            column = i;
-        }
-    }
-    for (i = 0; i < 3; ++i) {
-        axis[i] = 0.5 * (E[3 * i + column] + (i == column ? 1.0 : 0.0));
-    }
-    length = sqrt(axis[0] * axis[0] + axis[1] * axis[1] + axis[2] * axis[2]);
-    sign = axis[0] * v[0] + axis[1] * v[1] + axis[2] * v[2] >= 0.0 ? 1.0 : -1.0;
-    for (i = 0; i < 3; ++i) {
-        out[i] = sign * angle * axis[i] / length;
-    }
-}
-
-/* Error [target position - position; rotation vector of target R^T] and the geometric Jacobian. */
-static void puma560_task_error(const puma560_real target[16], const puma560_real q[PUMA560_DOF], puma560_real e[6], puma560_real J[6 * PUMA560_DOF])
-{
-    puma560_real T[16], E[9];
-    int i, j;
-    puma560_fk(q, T);
-    puma560_jacobian(q, J);
-    for (i = 0; i < 3; ++i) {
-        e[i] = target[4 * i + 3] - T[4 * i + 3];
-        for (j = 0; j < 3; ++j) {
-            E[3 * i + j] = target[4 * i] * T[4 * j] + target[4 * i + 1] * T[4 * j + 1] + target[4 * i + 2] * T[4 * j + 2];
-        }
-    }
-    puma560_rotation_vector(E, e + 3);
-}
-
-/* Joints clamped to their limits. */
-static void puma560_clamp(puma560_real q[PUMA560_DOF])
-{
-    q[0] = q[0] < -2.792526803190927 ? -2.792526803190927 : q[0] > 2.792526803190927 ? 2.792526803190927 : q[0];
-    q[1] = q[1] < -0.7853981633974483 ? -0.7853981633974483 : q[1] > 3.9269908169872414 ? 3.9269908169872414 : q[1];
-    q[2] = q[2] < -3.9269908169872414 ? -3.9269908169872414 : q[2] > 0.7853981633974483 ? 0.7853981633974483 : q[2];
-    q[3] = q[3] < -1.9198621771937625 ? -1.9198621771937625 : q[3] > 2.9670597283903604 ? 2.9670597283903604 : q[3];
-    q[4] = q[4] < -1.7453292519943295 ? -1.7453292519943295 : q[4] > 1.7453292519943295 ? 1.7453292519943295 : q[4];
-    q[5] = q[5] < -4.642575810304916 ? -4.642575810304916 : q[5] > 4.642575810304916 ? 4.642575810304916 : q[5];
-}
-
-/* Solves A x = b in place (b becomes x) for the symmetric positive definite K x K matrix A by
- * Cholesky; returns 0 when A is not numerically positive definite. */
-static int puma560_cholesky_solve(puma560_real A[36], puma560_real b[6])
-{
-    int i, j, k;
-    for (j = 0; j < 6; ++j) {
-        puma560_real diagonal = A[6 * j + j];
-        for (k = 0; k < j; ++k) {
-            diagonal -= A[6 * j + k] * A[6 * j + k];
-        }
-        if (!(diagonal > 0.0)) {
-            return 0;
-        }
-        A[6 * j + j] = sqrt(diagonal);
-        for (i = j + 1; i < 6; ++i) {
-            puma560_real sum = A[6 * i + j];
-            for (k = 0; k < j; ++k) {
-                sum -= A[6 * i + k] * A[6 * j + k];
-            }
-            A[6 * i + j] = sum / A[6 * j + j];
-        }
-    }
-    for (i = 0; i < 6; ++i) {
-        for (k = 0; k < i; ++k) {
-            b[i] -= A[6 * i + k] * b[k];
-        }
-        b[i] /= A[6 * i + i];
-    }
-    for (i = 6 - 1; i >= 0; --i) {
-        for (k = i + 1; k < 6; ++k) {
-            b[i] -= A[6 * k + i] * b[k];
-        }
-        b[i] /= A[6 * i + i];
-    }
-    return 1;
-}
+/* -- Iterative inverse kinematics: the loop around puma560_ik_numeric_step -- */
 
 int puma560_ik_numeric(const puma560_real target[16], const puma560_real q0[PUMA560_DOF], int max_iter, puma560_real tol, puma560_real q[PUMA560_DOF])
 {
-    puma560_real e[6], J[6 * PUMA560_DOF], trial[PUMA560_DOF], trial_e[6];
-    puma560_real trial_J[6 * PUMA560_DOF], A[36], x[6];
-    puma560_real cost, trial_cost, damping = 1e-06;
-    int i, j, k, iteration;
-    for (j = 0; j < PUMA560_DOF; ++j) {
-        q[j] = q0[j];
-    }
-    for (i = 0; i < 12; ++i) {
-        if (!isfinite(target[i])) {
-            return PUMA560_IK_NUMERIC_INVALID;
+    puma560_real trial[PUMA560_DOF], after[PUMA560_DOF], start[PUMA560_DOF];
+    puma560_real cost, trial_cost, lighter, damping = 1e-06;
+    int j, iteration;
+    cost = puma560_ik_numeric_step(target, q0, damping, q, trial);
+    if (!(cost >= 0) || max_iter < 0) { /* -1: target or q0 not finite */
+        for (j = 0; j < PUMA560_DOF; ++j) {
+            q[j] = q0[j];
         }
-    }
-    for (j = 0; j < PUMA560_DOF; ++j) {
-        if (!isfinite(q0[j])) {
-            return PUMA560_IK_NUMERIC_INVALID;
-        }
-    }
-    if (max_iter < 0) {
         return PUMA560_IK_NUMERIC_INVALID;
-    }
-    puma560_clamp(q);
-    puma560_task_error(target, q, e, J);
-    cost = 0.0;
-    for (i = 0; i < 6; ++i) {
-        cost += e[i] * e[i];
     }
     for (iteration = 0; iteration < max_iter; ++iteration) {
         if (cost <= tol * tol) {
             return PUMA560_IK_NUMERIC_CONVERGED;
         }
-        /* A = J J^T + damping I, x = A^-1 e, step J^T x */
-        for (i = 0; i < 6; ++i) {
-            x[i] = e[i];
-            for (k = 0; k < 6; ++k) {
-                puma560_real sum = i == k ? damping : 0.0;
-                for (j = 0; j < PUMA560_DOF; ++j) {
-                    sum += J[PUMA560_DOF * i + j] * J[PUMA560_DOF * k + j];
-                }
-                A[6 * i + k] = sum;
-            }
-        }
-        if (!puma560_cholesky_solve(A, x)) {
-            return PUMA560_IK_NUMERIC_STALLED;
-        }
-        for (j = 0; j < PUMA560_DOF; ++j) {
-            trial[j] = q[j];
-            for (i = 0; i < 6; ++i) {
-                trial[j] += J[PUMA560_DOF * i + j] * x[i];
-            }
-        }
-        puma560_clamp(trial);
-        puma560_task_error(target, trial, trial_e, trial_J);
-        trial_cost = 0.0;
-        for (i = 0; i < 6; ++i) {
-            trial_cost += trial_e[i] * trial_e[i];
-        }
+        lighter = damping * 0.1 > 1e-12 ? damping * 0.1 : 1e-12;
+        trial_cost = puma560_ik_numeric_step(target, trial, lighter, start, after);
         if (trial_cost < cost) {
             for (j = 0; j < PUMA560_DOF; ++j) {
                 q[j] = trial[j];
-            }
-            for (i = 0; i < 6; ++i) {
-                e[i] = trial_e[i];
-            }
-            for (i = 0; i < 6 * PUMA560_DOF; ++i) {
-                J[i] = trial_J[i];
+                trial[j] = after[j];
             }
             cost = trial_cost;
-            damping = damping * 0.1 > 1e-12 ? damping * 0.1 : 1e-12;
+            damping = lighter;
         } else {
             damping *= 10.0;
             if (damping > 100000000.0) {
                 return PUMA560_IK_NUMERIC_STALLED;
             }
+            (void)puma560_ik_numeric_step(target, q, damping, start, trial);
         }
     }
     return cost <= tol * tol ? PUMA560_IK_NUMERIC_CONVERGED : PUMA560_IK_NUMERIC_ITERATION_LIMIT;

@@ -1043,6 +1043,327 @@ def velocity_ik(q, mu_dot, damping=0.0):
 
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
+def ik_numeric_step(target, q, damping=0.0):
+    """one step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite): (6 x 1 and 6 x 1 and 1 x 1), 909 operations."""
+    target = _argument("target", target, (4, 4))
+    q = _argument("q", q, (6,))
+    damping = _argument("damping", damping, ())
+    T00 = target[..., 0, 0]
+    T01 = target[..., 0, 1]
+    T02 = target[..., 0, 2]
+    T03 = target[..., 0, 3]
+    T10 = target[..., 1, 0]
+    T11 = target[..., 1, 1]
+    T12 = target[..., 1, 2]
+    T13 = target[..., 1, 3]
+    T20 = target[..., 2, 0]
+    T21 = target[..., 2, 1]
+    T22 = target[..., 2, 2]
+    T23 = target[..., 2, 3]
+    qs1 = q[..., 0]
+    qs2 = q[..., 1]
+    qs3 = q[..., 2]
+    qs4 = q[..., 3]
+    qs5 = q[..., 4]
+    qs6 = q[..., 5]
+    q1 = numpy.where(numpy.less(qs1, -2.792526803190927), -2.792526803190927, numpy.where(numpy.greater(qs1, 2.792526803190927), 2.792526803190927, qs1))
+    q2 = numpy.where(numpy.less(qs2, -0.7853981633974483), -0.7853981633974483, numpy.where(numpy.greater(qs2, 3.9269908169872414), 3.9269908169872414, qs2))
+    q3 = numpy.where(numpy.less(qs3, -3.9269908169872414), -3.9269908169872414, numpy.where(numpy.greater(qs3, 0.7853981633974483), 0.7853981633974483, qs3))
+    q4 = numpy.where(numpy.less(qs4, -1.9198621771937625), -1.9198621771937625, numpy.where(numpy.greater(qs4, 2.9670597283903604), 2.9670597283903604, qs4))
+    q5 = numpy.where(numpy.less(qs5, -1.7453292519943295), -1.7453292519943295, numpy.where(numpy.greater(qs5, 1.7453292519943295), 1.7453292519943295, qs5))
+    q6 = numpy.where(numpy.less(qs6, -4.642575810304916), -4.642575810304916, numpy.where(numpy.greater(qs6, 4.642575810304916), 4.642575810304916, qs6))
+    c1 = numpy.cos(q1)
+    s1 = numpy.sin(q1)
+    c2 = numpy.cos(q2)
+    s2 = numpy.sin(q2)
+    c3 = numpy.cos(q3)
+    s3 = numpy.sin(q3)
+    c23 = c2*c3 - s2*s3
+    s23 = c2*s3 + c3*s2
+    c4 = numpy.cos(q4)
+    s4 = numpy.sin(q4)
+    c5 = numpy.cos(q5)
+    s5 = numpy.sin(q5)
+    c6 = numpy.cos(q6)
+    s6 = numpy.sin(q6)
+    t0 = 0.4318*c23 + 0.0203*s23
+    t1 = 0.4318*s2 + t0
+    t2 = t1 + 0.67183
+    t3 = T23 - t2
+    t4 = T00 + T01 + T02 + T03 + T10 + T11 + T12 + T13 + T20 + T21 + T22 + T23 + qs1 + qs2 + qs3 + qs4 + qs5 + qs6
+    t5 = 0.0203*c23
+    t6 = c1*t5 + 0.15005*s1
+    t7 = -0.15005*c1 + s1*t5
+    t8 = s1*s4
+    t9 = c1*c4
+    t10 = c23*t9 - t8
+    t11 = -c23*t8 + t9
+    t12 = c4*s1
+    t13 = c1*s4
+    t14 = c23*t13 + t12
+    t15 = c23*t12 + t13
+    t16 = c1*s23
+    t17 = c5*t10 - s5*t16
+    t18 = c5*t16 + s5*t10
+    t19 = c6*t17 - s6*t14
+    t20 = c6*t14 + s6*t17
+    t21 = -0.4318*t16 + t6
+    t22 = -T00*t19 + T01*t20 + T02*t18
+    t23 = -T10*t19 + T11*t20 + T12*t18
+    t24 = -T20*t19 + T21*t20 + T22*t18
+    t25 = s1*s23
+    t26 = c5*t15 - s5*t25
+    t27 = c5*t25 + s5*t15
+    t28 = c6*t26 + s6*t11
+    t29 = c6*t11 - s6*t26
+    t30 = -0.4318*t25 + t7
+    t31 = c1*t21 + s1*t30
+    t32 = T00*t28 + T01*t29 - T02*t27
+    t33 = T10*t28 + T11*t29 - T12*t27
+    t34 = T20*t28 + T21*t29 - T22*t27
+    t35 = -0.5*t23 - 0.5*t32
+    t36 = c4*s23
+    t37 = c23*s5 + c5*t36
+    t38 = c23*c5 - s5*t36
+    t39 = s23*s4
+    t40 = c6*t37 - s6*t39
+    t41 = c6*t39 + s6*t37
+    t42 = c23*t16 - t14*t39 + t18*t38
+    t43 = c23*t25 + t11*t39 + t27*t38
+    t44 = T00*t40 - T01*t41 + T02*t38
+    t45 = T10*t40 - T11*t41 + T12*t38
+    t46 = T20*t40 - T21*t41 + T22*t38
+    t47 = 0.5*t34 - 0.5*t45
+    t48 = 0.5*t24 + 0.5*t44
+    t49 = numpy.sqrt(t35**2 + t47**2 + t48**2)
+    t50 = 0.4318*c2
+    t51 = c1*t50 + t21
+    t52 = s1*t50 + t30
+    t53 = c1*t51 + s1*t52
+    t54 = t31**2 + t53**2
+    t55 = T03 - t51
+    t56 = T13 - t52
+    t57 = t52**2
+    t58 = t0**2
+    t59 = c1**2
+    t60 = t0*t59 + t1*t59
+    t61 = t1**2
+    t62 = t57 + t58*t59 + t59*t61
+    t63 = -t51*t52
+    t64 = c1*s1
+    t65 = t58*t64 + t61*t64 + t63
+    t66 = t0*t64 + t1*t64
+    t67 = c1*t31
+    t68 = c1*t53
+    t69 = t0*t67 + t1*t68
+    t70 = t67 + t68
+    t71 = s1**2
+    t72 = t51**2 + t58*t71 + t61*t71
+    t73 = t0*t71 + t1*t71
+    t74 = s1*t31
+    t75 = s1*t53
+    t76 = t0*t74 + t1*t75
+    t77 = t74 + t75
+    t78 = s23**2
+    t79 = t14**2 + t18**2 + t59*t78 + 2*t71
+    t80 = -t11*t14 + t18*t27 + t64*t78 - 2*t64
+    t81 = t11**2 + t27**2 + 2*t59 + t71*t78
+    t82 = c23**2 + s4**2*t78 + t38**2 + 1
+    t83 = -t22
+    t84 = 0.5*t33 + 0.5*t46 + 0.5*t83 - 0.5
+    t85 = numpy.arctan2(t49, t84)
+    t86 = numpy.where(numpy.greater(t49, 0), t85/t49, 1)
+    t87 = (numpy.less_equal(t22, -t33)) & (numpy.less_equal(t22, -t46))
+    t88 = numpy.greater_equal(t33, t46)
+    t89 = numpy.where(t87, 0.5*t83 + 0.5, numpy.where(t88, 0.5*t32, 0.5*t44))
+    t90 = numpy.where(t87, -0.5*t23, numpy.where(t88, 0.5*t33 + 0.5, 0.5*t45))
+    t91 = numpy.where(t87, -0.5*t24, numpy.where(t88, 0.5*t34, 0.5*t46 + 0.5))
+    t92 = numpy.sqrt(t89**2 + t90**2 + t91**2)
+    t93 = numpy.where(numpy.greater_equal(t35*t91 + t47*t89 + t48*t90, 0), 1, -1)
+    t94 = (numpy.greater(t49, 1e-06)) | (numpy.greater(t84, 0))
+    t95 = t85*t93/t92
+    t96 = numpy.where(t94, t47*t86, t89*t95)
+    t97 = numpy.where(t94, t48*t86, t90*t95)
+    t98 = numpy.where(t94, t35*t86, t91*t95)
+    t99 = t3**2 + t55**2 + t56**2 + t96**2 + t97**2 + t98**2
+    t100 = damping + t62
+    t101 = numpy.sqrt(t100**2 + t57 + t60**2 + t65**2 + t66**2 + t69**2)
+    t102 = t101*numpy.where(numpy.greater_equal(t100, 0), 1, -1)
+    t103 = t100 + t102
+    t104 = numpy.where(numpy.greater(t101, 0), 1/(t101*(t101 + abs(t100))), 0)
+    t105 = t104*(t103*t55 - t3*t69 - t52*t98 + t56*t65 + t60*t97 - t66*t96)
+    t106 = -t103*t105 + t55
+    t107 = -t105*t65 + t56
+    t108 = t105*t69 + t3
+    t109 = t105*t66 + t96
+    t110 = -t105*t60 + t97
+    t111 = t105*t52 + t98
+    t112 = damping + t72
+    t113 = t104*(t103*t65 + t112*t65 + t60*t66 + t63 + t66*t73 + t69*t76)
+    t114 = -t103*t113 + t65
+    t115 = t112 - t113*t65
+    t116 = t113*t69 - t76
+    t117 = t113*t66 - t73
+    t118 = -t113*t60 + t66
+    t119 = t113*t52 + t51
+    t120 = numpy.sqrt(t115**2 + t116**2 + t117**2 + t118**2 + t119**2)
+    t121 = t120*numpy.where(numpy.greater_equal(t115, 0), 1, -1)
+    t122 = t115 + t121
+    t123 = numpy.where(numpy.greater(t120, 0), 1/(t120*(t120 + abs(t115))), 0)
+    t124 = t123*(t107*t122 + t108*t116 + t109*t117 + t110*t118 + t111*t119)
+    t125 = t107 - t122*t124
+    t126 = t108 - t116*t124
+    t127 = t109 - t117*t124
+    t128 = t110 - t118*t124
+    t129 = t111 - t119*t124
+    t130 = damping + t54
+    t131 = -t104*(t103*t69 + t130*t69 + t60*t70 + t65*t76 + t66*t77)
+    t132 = t103*t131 + t69
+    t133 = t131*t65 + t76
+    t134 = t130 + t131*t69
+    t135 = t131*t66 + t77
+    t136 = t131*t60 + t70
+    t137 = damping + t79
+    t138 = -t104*(t103*t66 + t137*t66 - t42*t52 - t60*t80 + t65*t73 + t69*t77)
+    t139 = t103*t138 + t66
+    t140 = t138*t65 + t73
+    t141 = t138*t69 + t77
+    t142 = t137 + t138*t66
+    t143 = -t138*t60 + t80
+    t144 = -t42
+    t145 = t138*t52 + t144
+    t146 = t123*(t116*t141 + t117*t142 + t118*t143 + t119*t145 - t122*t140)
+    t147 = t122*t146 + t140
+    t148 = -t116*t146 + t141
+    t149 = -t117*t146 + t142
+    t150 = -t118*t146 + t143
+    t151 = -t119*t146 + t145
+    t152 = damping + t81
+    t153 = t104*(t103*t60 + t152*t60 + t43*t52 + t65*t66 - t66*t80 + t69*t70)
+    t154 = -t103*t153 + t60
+    t155 = -t153*t65 + t66
+    t156 = t153*t69 - t70
+    t157 = t153*t66 + t80
+    t158 = t152 - t153*t60
+    t159 = t153*t52 - t43
+    t160 = t123*(t116*t156 + t117*t157 + t118*t158 + t119*t159 + t122*t155)
+    t161 = -t122*t160 + t155
+    t162 = -t116*t160 + t156
+    t163 = -t117*t160 + t157
+    t164 = -t118*t160 + t158
+    t165 = -t119*t160 + t159
+    t166 = damping + t82
+    t167 = -t104*(t103*t52 + t166*t52 - t42*t66 + t43*t60 - t51*t65)
+    t168 = t103*t167 + t52
+    t169 = -t167*t65 + t51
+    t170 = t144 + t167*t66
+    t171 = t167*t60 + t43
+    t172 = t166 + t167*t52
+    t173 = t131*t52
+    t174 = t123*(t116*t134 + t117*t135 - t118*t136 + t119*t173 - t122*t133)
+    t175 = t122*t174 + t133
+    t176 = -t116*t174 + t134
+    t177 = -t117*t174 + t135
+    t178 = t118*t174 + t136
+    t179 = -t119*t174 + t173
+    t180 = numpy.sqrt(t176**2 + t177**2 + t178**2 + t179**2)
+    t181 = t180*numpy.where(numpy.greater_equal(t176, 0), 1, -1)
+    t182 = t176 + t181
+    t183 = numpy.where(numpy.greater(t180, 0), 1/(t180*(t180 + abs(t176))), 0)
+    t184 = t183*(t148*t182 + t149*t177 - t150*t178 + t151*t179)
+    t185 = t148 - t182*t184
+    t186 = t149 - t177*t184
+    t187 = t150 + t178*t184
+    t188 = t151 - t179*t184
+    t189 = t183*(t162*t182 + t163*t177 - t164*t178 + t165*t179)
+    t190 = t162 - t182*t189
+    t191 = t163 - t177*t189
+    t192 = t164 + t178*t189
+    t193 = t165 - t179*t189
+    t194 = t183*(t126*t182 + t127*t177 - t128*t178 + t129*t179)
+    t195 = t126 - t182*t194
+    t196 = t127 - t177*t194
+    t197 = t128 + t178*t194
+    t198 = t129 - t179*t194
+    t199 = numpy.sqrt(t186**2 + t187**2 + t188**2)
+    t200 = t199*numpy.where(numpy.greater_equal(t186, 0), 1, -1)
+    t201 = t186 + t200
+    t202 = numpy.where(numpy.greater(t199, 0), 1/(t199*(t199 + abs(t186))), 0)
+    t203 = t202*(t187*t192 + t188*t193 + t191*t201)
+    t204 = t191 - t201*t203
+    t205 = -t187*t203 + t192
+    t206 = -t188*t203 + t193
+    t207 = t202*(t187*t197 + t188*t198 + t196*t201)
+    t208 = t196 - t201*t207
+    t209 = -t187*t207 + t197
+    t210 = -t188*t207 + t198
+    t211 = numpy.sqrt(t205**2 + t206**2)
+    t212 = t211*numpy.where(numpy.greater_equal(t205, 0), 1, -1)
+    t213 = t205 + t212
+    t214 = numpy.where(numpy.greater(t211, 0), 1/(t211*(t211 + abs(t205))), 0)
+    t215 = t214*(t206*t210 + t209*t213)
+    t216 = t209 - t213*t215
+    t217 = -t206*t215 + t210
+    t218 = t167*t69
+    t219 = t123*(t116*t218 + t117*t170 - t118*t171 + t119*t172 + t122*t169)
+    t220 = -t122*t219 + t169
+    t221 = -t116*t219 + t218
+    t222 = -t117*t219 + t170
+    t223 = t118*t219 + t171
+    t224 = -t119*t219 + t172
+    t225 = t183*(t177*t222 + t178*t223 + t179*t224 + t182*t221)
+    t226 = -t182*t225 + t221
+    t227 = -t177*t225 + t222
+    t228 = t178*t225 - t223
+    t229 = -t179*t225 + t224
+    t230 = t202*(t187*t228 + t188*t229 + t201*t227)
+    t231 = -t201*t230 + t227
+    t232 = -t187*t230 + t228
+    t233 = -t188*t230 + t229
+    t234 = t214*(t206*t233 + t213*t232)
+    t235 = -t213*t234 + t232
+    t236 = -t206*t234 + t233
+    t237 = abs(t236)
+    t238 = t237
+    t239 = t238*numpy.where(numpy.greater_equal(t236, 0), 1, -1)
+    t240 = t236 + t239
+    t241 = numpy.where(numpy.greater(t238, 0), 1/(t238*(t237 + t238)), 0)
+    t242 = -t217*t240**2*t241 + t217
+    t243 = t242/t239
+    t244 = (t216 + t235*t243)/t212
+    t245 = (t204*t244 + t208 + t231*t243)/t200
+    t246 = (t185*t245 + t190*t244 + t195 + t226*t243)/t181
+    t247 = (t125 - t147*t245 + t161*t244 - t175*t246 + t220*t243)/t121
+    t248 = (t106 + t114*t247 - t132*t246 - t139*t245 + t154*t244 - t168*t243)/t102
+    t249 = q1 - t243 - t247*t51 + t248*t52
+    t250 = -c23*t243 + q4 + t16*t245 + t244*t25
+    t251 = q5 + t11*t244 - t14*t245 - t243*t39
+    t252 = q6 + t18*t245 - t243*t38 + t244*t27
+    t253 = s1*t247
+    t254 = c1*t248
+    t255 = c1*t244 - s1*t245
+    t256 = q2 + t1*t253 + t1*t254 - t246*t53 + t255
+    t257 = q3 + t0*t253 + t0*t254 - t246*t31 + t255
+    q_start = numpy.empty(numpy.broadcast_shapes(target.shape[:-2], q.shape[:-1], damping.shape) + (6,))
+    q_start[..., 0] = q1
+    q_start[..., 1] = q2
+    q_start[..., 2] = q3
+    q_start[..., 3] = q4
+    q_start[..., 4] = q5
+    q_start[..., 5] = q6
+    q_next = numpy.empty(numpy.broadcast_shapes(target.shape[:-2], q.shape[:-1], damping.shape) + (6,))
+    q_next[..., 0] = numpy.where(numpy.less(t249, -2.792526803190927), -2.792526803190927, numpy.where(numpy.greater(t249, 2.792526803190927), 2.792526803190927, t249))
+    q_next[..., 1] = numpy.where(numpy.less(t256, -0.7853981633974483), -0.7853981633974483, numpy.where(numpy.greater(t256, 3.9269908169872414), 3.9269908169872414, t256))
+    q_next[..., 2] = numpy.where(numpy.less(t257, -3.9269908169872414), -3.9269908169872414, numpy.where(numpy.greater(t257, 0.7853981633974483), 0.7853981633974483, t257))
+    q_next[..., 3] = numpy.where(numpy.less(t250, -1.9198621771937625), -1.9198621771937625, numpy.where(numpy.greater(t250, 2.9670597283903604), 2.9670597283903604, t250))
+    q_next[..., 4] = numpy.where(numpy.less(t251, -1.7453292519943295), -1.7453292519943295, numpy.where(numpy.greater(t251, 1.7453292519943295), 1.7453292519943295, t251))
+    q_next[..., 5] = numpy.where(numpy.less(t252, -4.642575810304916), -4.642575810304916, numpy.where(numpy.greater(t252, 4.642575810304916), 4.642575810304916, t252))
+    cost = numpy.empty(numpy.broadcast_shapes(target.shape[:-2], q.shape[:-1], damping.shape) + ())
+    cost[...] = numpy.where(numpy.isfinite(t4), t99, -1)
+    return q_start, q_next, cost
+
+
+@numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def ik_branches(T):
     """every branch of the closed-form ik and whether the target allows it: (8 x 6 and 8 x 1), 900 operations."""
     T = _argument("T", T, (4, 4))
@@ -1534,73 +1855,48 @@ def ik(T):
     return q[valid] if valid.ndim == 1 else (q, valid)
 
 
-# -- Iterative inverse kinematics --
+# -- Iterative inverse kinematics: the loop around ik_numeric_step --
 
 IK_NUMERIC_CONVERGED = 0  # |error| <= tol
 IK_NUMERIC_ITERATION_LIMIT = 1  # max_iter steps tried, |error| still above tol
 IK_NUMERIC_STALLED = 2  # no step reduces the error: unreachable target, joint limit or local minimum
-_LOWER = numpy.array([-2.792526803190927, -0.7853981633974483, -3.9269908169872414, -1.9198621771937625, -1.7453292519943295, -4.642575810304916])  # joint limits (infinite: none)
-_UPPER = numpy.array([2.792526803190927, 3.9269908169872414, 0.7853981633974483, 2.9670597283903604, 1.7453292519943295, 4.642575810304916])
+IK_NUMERIC_INVALID = 3  # target or q0 not finite, or max_iter < 0: q = q0
 _DAMPING = (1e-06, 1e-12, 100000000.0)  # added to the diagonal: start, least, most
-
-
-def _rotation_vector(E):
-    """The rotation vector (axis times angle in [0, pi]) of the rotation matrix E."""
-    v = 0.5 * numpy.array([E[2, 1] - E[1, 2], E[0, 2] - E[2, 0], E[1, 0] - E[0, 1]])
-    cos = 0.5 * (numpy.trace(E) - 1.0)
-    sin = numpy.linalg.norm(v)
-    angle = math.atan2(sin, cos)
-    if sin > 1e-6 or cos > 0.0:
-        return v * (angle / sin) if sin > 0.0 else v
-    # Near a half turn: the axis from the largest column of (E + I) / 2 = u u^T.
-    column = int(numpy.argmax(numpy.diag(E)))
-    axis = 0.5 * (E[:, column] + numpy.eye(3)[column])
-    axis /= numpy.linalg.norm(axis)
-    return angle * (axis if axis @ v >= 0.0 else -axis)
-
-
-def _task_error(target, q):
-    """Error [target position - position; rotation vector of target R^T] and the geometric Jacobian."""
-    T = fk(q)
-    error = numpy.concatenate([target[:3, 3] - T[:3, 3], _rotation_vector(target[:3, :3] @ T[:3, :3].T)])
-    return error, jacobian(q)
 
 
 def ik_numeric(target, q0, max_iter=100, tol=1e-10):
     """Iterative inverse kinematics from q0: damped least squares on the task error.
 
-    target: the 4x4 tool pose in the world frame.
-    Each step is q += J^T (J J^T + damping I)^-1 e, with e the task error
+    target: the 4x4 tool pose in the world frame, or a batch of them with q0 (..., DOF).
+    Each step is ik_numeric_step: q += J^T (J J^T + damping I)^-1 e, with e the task error
     (position error and rotation vector of R_target R^T, world frame) and J its Jacobian; joints are clamped to their limits.
     The damping adapts (Levenberg-Marquardt): divided by 10 after a step that lowers |e|,
     multiplied by 10 and the step discarded otherwise.
-    Returns (q, status): status IK_NUMERIC_CONVERGED (|e| <= tol), IK_NUMERIC_ITERATION_LIMIT
-    (max_iter steps tried) or IK_NUMERIC_STALLED (no step lowers |e|: out of reach, a joint
-    limit or a local minimum); q is the best configuration found.
+    Returns (q, status), status an IK_NUMERIC_* code per target; q is the best configuration
+    found.
     """
-    target = numpy.asarray(target, dtype=float)
-    q = numpy.asarray(q0, dtype=float)
-    if target.shape != (4, 4) or q.shape != (DOF,):
-        raise ValueError(f"expected target (4, 4) and q0 ({DOF},), got {target.shape} and {q.shape}")
-    q = numpy.clip(q, _LOWER, _UPPER)
-    error, J = _task_error(target, q)
-    cost = error @ error
-    damping, least, most = _DAMPING
-    for _ in range(max_iter):
-        if cost <= tol * tol:
-            return q, IK_NUMERIC_CONVERGED
-        step = J.T @ numpy.linalg.solve(J @ J.T + damping * numpy.eye(J.shape[0]), error)
-        trial = numpy.clip(q + step, _LOWER, _UPPER)
-        trial_error, trial_J = _task_error(target, trial)
-        trial_cost = trial_error @ trial_error
-        if trial_cost < cost:
-            q, error, J, cost = trial, trial_error, trial_J, trial_cost
-            damping = max(damping * 0.1, least)
-        else:
-            damping *= 10.0
-            if damping > most:
-                return q, IK_NUMERIC_STALLED
-    return q, IK_NUMERIC_CONVERGED if cost <= tol * tol else IK_NUMERIC_ITERATION_LIMIT
+    least, most = _DAMPING[1:]
+    q, trial, cost = ik_numeric_step(target, q0, _DAMPING[0])
+    damping = cost * 0.0 + _DAMPING[0]
+    status = numpy.where((cost >= 0.0) & (max_iter >= 0), IK_NUMERIC_ITERATION_LIMIT, IK_NUMERIC_INVALID)
+    for _ in range(max(max_iter, 0)):
+        status = numpy.where(numpy.logical_and(status == IK_NUMERIC_ITERATION_LIMIT, cost <= tol * tol), IK_NUMERIC_CONVERGED, status)
+        active = status == IK_NUMERIC_ITERATION_LIMIT
+        if not active.any():
+            break
+        lighter = numpy.maximum(damping * 0.1, least)
+        _, after, trial_cost = ik_numeric_step(target, trial, lighter)
+        better = numpy.logical_and(active, trial_cost < cost)
+        worse = numpy.logical_and(active, trial_cost >= cost)
+        q = numpy.where(better[..., None], trial, q)
+        cost = numpy.where(better, trial_cost, cost)
+        damping = numpy.where(better, lighter, numpy.where(worse, damping * 10.0, damping))
+        status = numpy.where(numpy.logical_and(worse, damping > most), IK_NUMERIC_STALLED, status)
+        _, retry, _ = ik_numeric_step(target, q, damping)
+        trial = numpy.where(better[..., None], after, numpy.where(worse[..., None], retry, trial))
+    status = numpy.where(numpy.logical_and(status == IK_NUMERIC_ITERATION_LIMIT, cost <= tol * tol), IK_NUMERIC_CONVERGED, status)
+    q = numpy.where((status == IK_NUMERIC_INVALID)[..., None], numpy.asarray(q0, dtype=float), q)
+    return q, status[()] if status.ndim == 0 else status
 
 
 # Statuses of velocity_ik: OK, singular (a diagonal entry of the QR factor R of the

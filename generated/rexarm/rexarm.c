@@ -679,6 +679,166 @@ int rexarm_velocity_ik(const rexarm_real q[REXARM_DOF], const rexarm_real mu_dot
     return (!(t178 && t179) ? 2 : (t182 ? 1 : 0));
 }
 
+rexarm_real rexarm_ik_numeric_step(const rexarm_real target[REXARM_TASK_DIM], const rexarm_real q[REXARM_DOF], rexarm_real damping, rexarm_real q_start[REXARM_DOF], rexarm_real q_next[REXARM_DOF])
+{
+    /* 396 operations */
+
+    /* Inputs */
+    const rexarm_real mu0 = target[0];
+    const rexarm_real mu1 = target[1];
+    const rexarm_real mu2 = target[2];
+    const rexarm_real mu3 = target[3];
+    const rexarm_real qs1 = q[0];
+    const rexarm_real qs2 = q[1];
+    const rexarm_real qs3 = q[2];
+    const rexarm_real qs4 = q[3];
+
+    /* Intermediate terms */
+    const rexarm_real q1 = (qs1 < -3.141592653589793 ? -3.141592653589793 : (qs1 > 3.141592653589793 ? 3.141592653589793 : qs1));
+    const rexarm_real q2 = (qs2 < -2.0943951023931953 ? -2.0943951023931953 : (qs2 > 2.0943951023931953 ? 2.0943951023931953 : qs2));
+    const rexarm_real q3 = (qs3 < -2.0943951023931953 ? -2.0943951023931953 : (qs3 > 2.0943951023931953 ? 2.0943951023931953 : qs3));
+    const rexarm_real q4 = (qs4 < -2.0943951023931953 ? -2.0943951023931953 : (qs4 > 2.0943951023931953 ? 2.0943951023931953 : qs4));
+    const rexarm_real c1 = cos(q1);
+    const rexarm_real s1 = sin(q1);
+    const rexarm_real c2 = -sin(q2);
+    const rexarm_real s2 = cos(q2);
+    const rexarm_real c3 = cos(q3);
+    const rexarm_real s3 = sin(q3);
+    const rexarm_real c23 = c2*c3 - s2*s3;
+    const rexarm_real s23 = c2*s3 + c3*s2;
+    const rexarm_real c4 = cos(q4);
+    const rexarm_real s4 = sin(q4);
+    const rexarm_real c234 = c23*c4 - s23*s4;
+    const rexarm_real s234 = c23*s4 + c4*s23;
+    const rexarm_real t0 = mu0 + mu1 + mu2 + mu3 + qs1 + qs2 + qs3 + qs4;
+    const rexarm_real t1 = 0.1*c1;
+    const rexarm_real t2 = c23*t1 + c234*t1;
+    const rexarm_real t3 = c2*t1 + t2;
+    const rexarm_real t4 = mu0 - t3;
+    const rexarm_real t5 = 0.1*s1;
+    const rexarm_real t6 = c23*t5 + c234*t5;
+    const rexarm_real t7 = c2*t5 + t6;
+    const rexarm_real t8 = c1*t3 + s1*t7;
+    const rexarm_real t9 = c1*t2 + s1*t6;
+    const rexarm_real t10 = mu1 - t7;
+    const rexarm_real t11 = 0.1*s234;
+    const rexarm_real t12 = 0.1*s23 + t11;
+    const rexarm_real t13 = 0.1*s2 + t12;
+    const rexarm_real t14 = t13 + 0.12;
+    const rexarm_real t15 = mu2 - t14;
+    const rexarm_real t16 = (c1*c1);
+    const rexarm_real t17 = c234*t16;
+    const rexarm_real t18 = (s1*s1);
+    const rexarm_real t19 = c234*t18;
+    const rexarm_real t20 = 0.1*t17 + 0.1*t19;
+    const rexarm_real t21 = (t20*t20) + (t8*t8) + (t9*t9);
+    const rexarm_real t22 = (c234*c234);
+    const rexarm_real t23 = sqrt(t16*t22 + t18*t22);
+    const rexarm_real t24 = -(t17 + t19)/t23;
+    const rexarm_real t25 = t20*t24 + t24*t8 + t24*t9;
+    const rexarm_real t26 = 3*(t24*t24);
+    const rexarm_real t27 = (t12*t12);
+    const rexarm_real t28 = (t13*t13);
+    const rexarm_real t29 = 0.01*(s234*s234);
+    const rexarm_real t30 = t16*t27 + t16*t28 + t16*t29 + (t7*t7);
+    const rexarm_real t31 = t18*t27 + t18*t28 + t18*t29 + (t3*t3);
+    const rexarm_real t32 = c1*s1;
+    const rexarm_real t33 = t27*t32 + t28*t32 + t29*t32 - t3*t7;
+    const rexarm_real t34 = c1*t12;
+    const rexarm_real t35 = c1*t13;
+    const rexarm_real t36 = c1*t11;
+    const rexarm_real t37 = t20*t36 + t34*t9 + t35*t8;
+    const rexarm_real t38 = t24*t34 + t24*t35 + t24*t36;
+    const rexarm_real t39 = s1*t12;
+    const rexarm_real t40 = s1*t13;
+    const rexarm_real t41 = s1*t11;
+    const rexarm_real t42 = t20*t41 + t39*t9 + t40*t8;
+    const rexarm_real t43 = t24*t39 + t24*t40 + t24*t41;
+    const rexarm_real t44 = -mu3 + atan2(-s234, t23);
+    const rexarm_real t45 = t44 + 6.283185307179586*ceil(-0.15915494309189535*t44 - 0.5);
+    const rexarm_real t46 = (t10*t10) + (t15*t15) + (t4*t4) + (t45*t45);
+    const rexarm_real t47 = damping + t30;
+    const rexarm_real t48 = sqrt((t33*t33) + (t37*t37) + (t38*t38) + (t47*t47));
+    const rexarm_real t49 = t48*(t47 >= 0 ? 1 : -1);
+    const rexarm_real t50 = t47 + t49;
+    const rexarm_real t51 = (t48 > 0 ? 1/(t48*(t48 + fabs(t47))) : 0);
+    const rexarm_real t52 = t51*(t10*t33 - t15*t37 + t38*t45 + t4*t50);
+    const rexarm_real t53 = t4 - t50*t52;
+    const rexarm_real t54 = t10 - t33*t52;
+    const rexarm_real t55 = t15 + t37*t52;
+    const rexarm_real t56 = t38*t52 - t45;
+    const rexarm_real t57 = damping + t31;
+    const rexarm_real t58 = t51*(t33*t50 + t33*t57 + t37*t42 + t38*t43);
+    const rexarm_real t59 = t33 - t50*t58;
+    const rexarm_real t60 = -t33*t58 + t57;
+    const rexarm_real t61 = t37*t58 - t42;
+    const rexarm_real t62 = t38*t58 - t43;
+    const rexarm_real t63 = sqrt((t60*t60) + (t61*t61) + (t62*t62));
+    const rexarm_real t64 = t63*(t60 >= 0 ? 1 : -1);
+    const rexarm_real t65 = t60 + t64;
+    const rexarm_real t66 = (t63 > 0 ? 1/(t63*(t63 + fabs(t60))) : 0);
+    const rexarm_real t67 = t66*(t54*t65 + t55*t61 + t56*t62);
+    const rexarm_real t68 = t54 - t65*t67;
+    const rexarm_real t69 = t55 - t61*t67;
+    const rexarm_real t70 = t56 - t62*t67;
+    const rexarm_real t71 = damping + t21;
+    const rexarm_real t72 = -t51*(t25*t38 + t33*t42 + t37*t50 + t37*t71);
+    const rexarm_real t73 = t37 + t50*t72;
+    const rexarm_real t74 = t33*t72 + t42;
+    const rexarm_real t75 = t37*t72 + t71;
+    const rexarm_real t76 = t25 + t38*t72;
+    const rexarm_real t77 = t66*(t61*t75 + t62*t76 - t65*t74);
+    const rexarm_real t78 = t65*t77 + t74;
+    const rexarm_real t79 = -t61*t77 + t75;
+    const rexarm_real t80 = -t62*t77 + t76;
+    const rexarm_real t81 = sqrt((t79*t79) + (t80*t80));
+    const rexarm_real t82 = t81*(t79 >= 0 ? 1 : -1);
+    const rexarm_real t83 = t79 + t82;
+    const rexarm_real t84 = (t81 > 0 ? 1/(t81*(t81 + fabs(t79))) : 0);
+    const rexarm_real t85 = t84*(t69*t83 + t70*t80);
+    const rexarm_real t86 = t69 - t83*t85;
+    const rexarm_real t87 = t70 - t80*t85;
+    const rexarm_real t88 = damping + t26;
+    const rexarm_real t89 = -t51*(t25*t37 + t33*t43 + t38*t50 + t38*t88);
+    const rexarm_real t90 = t38 + t50*t89;
+    const rexarm_real t91 = t33*t89 + t43;
+    const rexarm_real t92 = t25 + t37*t89;
+    const rexarm_real t93 = t38*t89 + t88;
+    const rexarm_real t94 = t66*(t61*t92 + t62*t93 - t65*t91);
+    const rexarm_real t95 = t65*t94 + t91;
+    const rexarm_real t96 = -t61*t94 + t92;
+    const rexarm_real t97 = -t62*t94 + t93;
+    const rexarm_real t98 = t84*(t80*t97 + t83*t96);
+    const rexarm_real t99 = -t83*t98 + t96;
+    const rexarm_real t100 = -t80*t98 + t97;
+    const rexarm_real t101 = fabs(t100);
+    const rexarm_real t102 = t101;
+    const rexarm_real t103 = t102*(t100 >= 0 ? 1 : -1);
+    const rexarm_real t104 = t100 + t103;
+    const rexarm_real t105 = (t102 > 0 ? 1/(t102*(t101 + t102)) : 0);
+    const rexarm_real t106 = -t105*t87*(t104*t104) + t87;
+    const rexarm_real t107 = t106/t103;
+    const rexarm_real t108 = (t107*t99 + t86)/t82;
+    const rexarm_real t109 = (-t107*t95 - t108*t78 + t68)/t64;
+    const rexarm_real t110 = (-t107*t90 - t108*t73 + t109*t59 + t53)/t49;
+    const rexarm_real t111 = q1 - t109*t3 + t110*t7;
+    const rexarm_real t112 = -t107*t24;
+    const rexarm_real t113 = q2 - t108*t8 + t109*t40 + t110*t35 + t112;
+    const rexarm_real t114 = q3 - t108*t9 + t109*t39 + t110*t34 + t112;
+    const rexarm_real t115 = q4 - t108*t20 + t109*t41 + t110*t36 + t112;
+
+    /* Outputs */
+    q_start[0] = q1;
+    q_start[1] = q2;
+    q_start[2] = q3;
+    q_start[3] = q4;
+    q_next[0] = (t111 < -3.141592653589793 ? -3.141592653589793 : (t111 > 3.141592653589793 ? 3.141592653589793 : t111));
+    q_next[1] = (t113 < -2.0943951023931953 ? -2.0943951023931953 : (t113 > 2.0943951023931953 ? 2.0943951023931953 : t113));
+    q_next[2] = (t114 < -2.0943951023931953 ? -2.0943951023931953 : (t114 > 2.0943951023931953 ? 2.0943951023931953 : t114));
+    q_next[3] = (t115 < -2.0943951023931953 ? -2.0943951023931953 : (t115 > 2.0943951023931953 ? 2.0943951023931953 : t115));
+    return (isfinite(t0) ? t46 : -1);
+}
+
 void rexarm_ik_branches(const rexarm_real mu[REXARM_TASK_DIM], rexarm_real q[REXARM_MAX_IK_SOLUTIONS * REXARM_DOF], int valid[REXARM_MAX_IK_SOLUTIONS])
 {
     /* 552 operations */
@@ -954,164 +1114,39 @@ int rexarm_ik(const rexarm_real mu[REXARM_TASK_DIM], rexarm_real q[REXARM_MAX_IK
     return count;
 }
 
-/* -- Iterative inverse kinematics -- */
-
-/* The angle wrapped into (-pi, pi], for |angle| < 1e9: angle - 2 pi ceil((angle - pi) / (2 pi)),
- * ceil by truncation. */
-static rexarm_real rexarm_wrap(rexarm_real angle)
-{
-    const rexarm_real turns = (angle - 3.141592653589793) / 6.283185307179586;
-    rexarm_real whole;
-    if (angle > -3.141592653589793 && angle <= 3.141592653589793) {
-        return angle;
-    }
-    whole = (rexarm_real)(long)turns;
-    if (whole < turns) {
-        whole += 1.0;
-    }
-    return angle - 6.283185307179586 * whole;
-}
-
-/* Error target - mu(q) (angles wrapped into (-pi, pi]) and the task Jacobian. */
-static void rexarm_task_error(const rexarm_real target[REXARM_TASK_DIM], const rexarm_real q[REXARM_DOF], rexarm_real e[REXARM_TASK_DIM],
-        rexarm_real J[REXARM_TASK_DIM * REXARM_DOF])
-{
-    int i;
-    rexarm_task(q, e);
-    rexarm_task_jacobian(q, J);
-    for (i = 0; i < REXARM_TASK_DIM; ++i) {
-        e[i] = target[i] - e[i];
-    }
-    e[3] = rexarm_wrap(e[3]);
-}
-
-/* Joints clamped to their limits. */
-static void rexarm_clamp(rexarm_real q[REXARM_DOF])
-{
-    q[0] = q[0] < -3.141592653589793 ? -3.141592653589793 : q[0] > 3.141592653589793 ? 3.141592653589793 : q[0];
-    q[1] = q[1] < -2.0943951023931953 ? -2.0943951023931953 : q[1] > 2.0943951023931953 ? 2.0943951023931953 : q[1];
-    q[2] = q[2] < -2.0943951023931953 ? -2.0943951023931953 : q[2] > 2.0943951023931953 ? 2.0943951023931953 : q[2];
-    q[3] = q[3] < -2.0943951023931953 ? -2.0943951023931953 : q[3] > 2.0943951023931953 ? 2.0943951023931953 : q[3];
-}
-
-/* Solves A x = b in place (b becomes x) for the symmetric positive definite K x K matrix A by
- * Cholesky; returns 0 when A is not numerically positive definite. */
-static int rexarm_cholesky_solve(rexarm_real A[16], rexarm_real b[4])
-{
-    int i, j, k;
-    for (j = 0; j < 4; ++j) {
-        rexarm_real diagonal = A[4 * j + j];
-        for (k = 0; k < j; ++k) {
-            diagonal -= A[4 * j + k] * A[4 * j + k];
-        }
-        if (!(diagonal > 0.0)) {
-            return 0;
-        }
-        A[4 * j + j] = sqrt(diagonal);
-        for (i = j + 1; i < 4; ++i) {
-            rexarm_real sum = A[4 * i + j];
-            for (k = 0; k < j; ++k) {
-                sum -= A[4 * i + k] * A[4 * j + k];
-            }
-            A[4 * i + j] = sum / A[4 * j + j];
-        }
-    }
-    for (i = 0; i < 4; ++i) {
-        for (k = 0; k < i; ++k) {
-            b[i] -= A[4 * i + k] * b[k];
-        }
-        b[i] /= A[4 * i + i];
-    }
-    for (i = 4 - 1; i >= 0; --i) {
-        for (k = i + 1; k < 4; ++k) {
-            b[i] -= A[4 * k + i] * b[k];
-        }
-        b[i] /= A[4 * i + i];
-    }
-    return 1;
-}
+/* -- Iterative inverse kinematics: the loop around rexarm_ik_numeric_step -- */
 
 int rexarm_ik_numeric(const rexarm_real target[REXARM_TASK_DIM], const rexarm_real q0[REXARM_DOF], int max_iter, rexarm_real tol, rexarm_real q[REXARM_DOF])
 {
-    rexarm_real e[4], J[4 * REXARM_DOF], trial[REXARM_DOF], trial_e[4];
-    rexarm_real trial_J[4 * REXARM_DOF], A[16], x[4];
-    rexarm_real cost, trial_cost, damping = 1e-06;
-    rexarm_real goal[REXARM_TASK_DIM];
-    int i, j, k, iteration;
-    for (j = 0; j < REXARM_DOF; ++j) {
-        q[j] = q0[j];
-    }
-    for (i = 0; i < REXARM_TASK_DIM; ++i) {
-        if (!isfinite(target[i])) {
-            return REXARM_IK_NUMERIC_INVALID;
+    rexarm_real trial[REXARM_DOF], after[REXARM_DOF], start[REXARM_DOF];
+    rexarm_real cost, trial_cost, lighter, damping = 1e-06;
+    int j, iteration;
+    cost = rexarm_ik_numeric_step(target, q0, damping, q, trial);
+    if (!(cost >= 0) || max_iter < 0) { /* -1: target or q0 not finite */
+        for (j = 0; j < REXARM_DOF; ++j) {
+            q[j] = q0[j];
         }
-    }
-    for (j = 0; j < REXARM_DOF; ++j) {
-        if (!isfinite(q0[j])) {
-            return REXARM_IK_NUMERIC_INVALID;
-        }
-    }
-    if (max_iter < 0) {
         return REXARM_IK_NUMERIC_INVALID;
-    }
-    /* the target's angles reduced to (-pi, pi], so that errors stay within (-2 pi, 2 pi] */
-    for (i = 0; i < REXARM_TASK_DIM; ++i) {
-        goal[i] = target[i];
-    }
-    goal[3] = atan2(sin(goal[3]), cos(goal[3]));
-    rexarm_clamp(q);
-    rexarm_task_error(goal, q, e, J);
-    cost = 0.0;
-    for (i = 0; i < 4; ++i) {
-        cost += e[i] * e[i];
     }
     for (iteration = 0; iteration < max_iter; ++iteration) {
         if (cost <= tol * tol) {
             return REXARM_IK_NUMERIC_CONVERGED;
         }
-        /* A = J J^T + damping I, x = A^-1 e, step J^T x */
-        for (i = 0; i < 4; ++i) {
-            x[i] = e[i];
-            for (k = 0; k < 4; ++k) {
-                rexarm_real sum = i == k ? damping : 0.0;
-                for (j = 0; j < REXARM_DOF; ++j) {
-                    sum += J[REXARM_DOF * i + j] * J[REXARM_DOF * k + j];
-                }
-                A[4 * i + k] = sum;
-            }
-        }
-        if (!rexarm_cholesky_solve(A, x)) {
-            return REXARM_IK_NUMERIC_STALLED;
-        }
-        for (j = 0; j < REXARM_DOF; ++j) {
-            trial[j] = q[j];
-            for (i = 0; i < 4; ++i) {
-                trial[j] += J[REXARM_DOF * i + j] * x[i];
-            }
-        }
-        rexarm_clamp(trial);
-        rexarm_task_error(goal, trial, trial_e, trial_J);
-        trial_cost = 0.0;
-        for (i = 0; i < 4; ++i) {
-            trial_cost += trial_e[i] * trial_e[i];
-        }
+        lighter = damping * 0.1 > 1e-12 ? damping * 0.1 : 1e-12;
+        trial_cost = rexarm_ik_numeric_step(target, trial, lighter, start, after);
         if (trial_cost < cost) {
             for (j = 0; j < REXARM_DOF; ++j) {
                 q[j] = trial[j];
-            }
-            for (i = 0; i < 4; ++i) {
-                e[i] = trial_e[i];
-            }
-            for (i = 0; i < 4 * REXARM_DOF; ++i) {
-                J[i] = trial_J[i];
+                trial[j] = after[j];
             }
             cost = trial_cost;
-            damping = damping * 0.1 > 1e-12 ? damping * 0.1 : 1e-12;
+            damping = lighter;
         } else {
             damping *= 10.0;
             if (damping > 100000000.0) {
                 return REXARM_IK_NUMERIC_STALLED;
             }
+            (void)rexarm_ik_numeric_step(target, q, damping, start, trial);
         }
     }
     return cost <= tol * tol ? REXARM_IK_NUMERIC_CONVERGED : REXARM_IK_NUMERIC_ITERATION_LIMIT;

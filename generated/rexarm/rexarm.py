@@ -666,6 +666,167 @@ def velocity_ik(q, mu_dot, damping=0.0):
 
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
+def ik_numeric_step(target, q, damping=0.0):
+    """one step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite): (4 x 1 and 4 x 1 and 1 x 1), 396 operations."""
+    target = _argument("target", target, (4,))
+    q = _argument("q", q, (4,))
+    damping = _argument("damping", damping, ())
+    mu0 = target[..., 0]
+    mu1 = target[..., 1]
+    mu2 = target[..., 2]
+    mu3 = target[..., 3]
+    qs1 = q[..., 0]
+    qs2 = q[..., 1]
+    qs3 = q[..., 2]
+    qs4 = q[..., 3]
+    q1 = numpy.where(numpy.less(qs1, -3.141592653589793), -3.141592653589793, numpy.where(numpy.greater(qs1, 3.141592653589793), 3.141592653589793, qs1))
+    q2 = numpy.where(numpy.less(qs2, -2.0943951023931953), -2.0943951023931953, numpy.where(numpy.greater(qs2, 2.0943951023931953), 2.0943951023931953, qs2))
+    q3 = numpy.where(numpy.less(qs3, -2.0943951023931953), -2.0943951023931953, numpy.where(numpy.greater(qs3, 2.0943951023931953), 2.0943951023931953, qs3))
+    q4 = numpy.where(numpy.less(qs4, -2.0943951023931953), -2.0943951023931953, numpy.where(numpy.greater(qs4, 2.0943951023931953), 2.0943951023931953, qs4))
+    c1 = numpy.cos(q1)
+    s1 = numpy.sin(q1)
+    c2 = -numpy.sin(q2)
+    s2 = numpy.cos(q2)
+    c3 = numpy.cos(q3)
+    s3 = numpy.sin(q3)
+    c23 = c2*c3 - s2*s3
+    s23 = c2*s3 + c3*s2
+    c4 = numpy.cos(q4)
+    s4 = numpy.sin(q4)
+    c234 = c23*c4 - s23*s4
+    s234 = c23*s4 + c4*s23
+    t0 = mu0 + mu1 + mu2 + mu3 + qs1 + qs2 + qs3 + qs4
+    t1 = 0.1*c1
+    t2 = c23*t1 + c234*t1
+    t3 = c2*t1 + t2
+    t4 = mu0 - t3
+    t5 = 0.1*s1
+    t6 = c23*t5 + c234*t5
+    t7 = c2*t5 + t6
+    t8 = c1*t3 + s1*t7
+    t9 = c1*t2 + s1*t6
+    t10 = mu1 - t7
+    t11 = 0.1*s234
+    t12 = 0.1*s23 + t11
+    t13 = 0.1*s2 + t12
+    t14 = t13 + 0.12
+    t15 = mu2 - t14
+    t16 = c1**2
+    t17 = c234*t16
+    t18 = s1**2
+    t19 = c234*t18
+    t20 = 0.1*t17 + 0.1*t19
+    t21 = t20**2 + t8**2 + t9**2
+    t22 = c234**2
+    t23 = numpy.sqrt(t16*t22 + t18*t22)
+    t24 = -(t17 + t19)/t23
+    t25 = t20*t24 + t24*t8 + t24*t9
+    t26 = 3*t24**2
+    t27 = t12**2
+    t28 = t13**2
+    t29 = 0.01*s234**2
+    t30 = t16*t27 + t16*t28 + t16*t29 + t7**2
+    t31 = t18*t27 + t18*t28 + t18*t29 + t3**2
+    t32 = c1*s1
+    t33 = t27*t32 + t28*t32 + t29*t32 - t3*t7
+    t34 = c1*t12
+    t35 = c1*t13
+    t36 = c1*t11
+    t37 = t20*t36 + t34*t9 + t35*t8
+    t38 = t24*t34 + t24*t35 + t24*t36
+    t39 = s1*t12
+    t40 = s1*t13
+    t41 = s1*t11
+    t42 = t20*t41 + t39*t9 + t40*t8
+    t43 = t24*t39 + t24*t40 + t24*t41
+    t44 = -mu3 + numpy.arctan2(-s234, t23)
+    t45 = t44 + 6.283185307179586*numpy.ceil(-0.15915494309189535*t44 - 0.5)
+    t46 = t10**2 + t15**2 + t4**2 + t45**2
+    t47 = damping + t30
+    t48 = numpy.sqrt(t33**2 + t37**2 + t38**2 + t47**2)
+    t49 = t48*numpy.where(numpy.greater_equal(t47, 0), 1, -1)
+    t50 = t47 + t49
+    t51 = numpy.where(numpy.greater(t48, 0), 1/(t48*(t48 + abs(t47))), 0)
+    t52 = t51*(t10*t33 - t15*t37 + t38*t45 + t4*t50)
+    t53 = t4 - t50*t52
+    t54 = t10 - t33*t52
+    t55 = t15 + t37*t52
+    t56 = t38*t52 - t45
+    t57 = damping + t31
+    t58 = t51*(t33*t50 + t33*t57 + t37*t42 + t38*t43)
+    t59 = t33 - t50*t58
+    t60 = -t33*t58 + t57
+    t61 = t37*t58 - t42
+    t62 = t38*t58 - t43
+    t63 = numpy.sqrt(t60**2 + t61**2 + t62**2)
+    t64 = t63*numpy.where(numpy.greater_equal(t60, 0), 1, -1)
+    t65 = t60 + t64
+    t66 = numpy.where(numpy.greater(t63, 0), 1/(t63*(t63 + abs(t60))), 0)
+    t67 = t66*(t54*t65 + t55*t61 + t56*t62)
+    t68 = t54 - t65*t67
+    t69 = t55 - t61*t67
+    t70 = t56 - t62*t67
+    t71 = damping + t21
+    t72 = -t51*(t25*t38 + t33*t42 + t37*t50 + t37*t71)
+    t73 = t37 + t50*t72
+    t74 = t33*t72 + t42
+    t75 = t37*t72 + t71
+    t76 = t25 + t38*t72
+    t77 = t66*(t61*t75 + t62*t76 - t65*t74)
+    t78 = t65*t77 + t74
+    t79 = -t61*t77 + t75
+    t80 = -t62*t77 + t76
+    t81 = numpy.sqrt(t79**2 + t80**2)
+    t82 = t81*numpy.where(numpy.greater_equal(t79, 0), 1, -1)
+    t83 = t79 + t82
+    t84 = numpy.where(numpy.greater(t81, 0), 1/(t81*(t81 + abs(t79))), 0)
+    t85 = t84*(t69*t83 + t70*t80)
+    t86 = t69 - t83*t85
+    t87 = t70 - t80*t85
+    t88 = damping + t26
+    t89 = -t51*(t25*t37 + t33*t43 + t38*t50 + t38*t88)
+    t90 = t38 + t50*t89
+    t91 = t33*t89 + t43
+    t92 = t25 + t37*t89
+    t93 = t38*t89 + t88
+    t94 = t66*(t61*t92 + t62*t93 - t65*t91)
+    t95 = t65*t94 + t91
+    t96 = -t61*t94 + t92
+    t97 = -t62*t94 + t93
+    t98 = t84*(t80*t97 + t83*t96)
+    t99 = -t83*t98 + t96
+    t100 = -t80*t98 + t97
+    t101 = abs(t100)
+    t102 = t101
+    t103 = t102*numpy.where(numpy.greater_equal(t100, 0), 1, -1)
+    t104 = t100 + t103
+    t105 = numpy.where(numpy.greater(t102, 0), 1/(t102*(t101 + t102)), 0)
+    t106 = -t104**2*t105*t87 + t87
+    t107 = t106/t103
+    t108 = (t107*t99 + t86)/t82
+    t109 = (-t107*t95 - t108*t78 + t68)/t64
+    t110 = (-t107*t90 - t108*t73 + t109*t59 + t53)/t49
+    t111 = q1 - t109*t3 + t110*t7
+    t112 = -t107*t24
+    t113 = q2 - t108*t8 + t109*t40 + t110*t35 + t112
+    t114 = q3 - t108*t9 + t109*t39 + t110*t34 + t112
+    t115 = q4 - t108*t20 + t109*t41 + t110*t36 + t112
+    q_start = numpy.empty(numpy.broadcast_shapes(target.shape[:-1], q.shape[:-1], damping.shape) + (4,))
+    q_start[..., 0] = q1
+    q_start[..., 1] = q2
+    q_start[..., 2] = q3
+    q_start[..., 3] = q4
+    q_next = numpy.empty(numpy.broadcast_shapes(target.shape[:-1], q.shape[:-1], damping.shape) + (4,))
+    q_next[..., 0] = numpy.where(numpy.less(t111, -3.141592653589793), -3.141592653589793, numpy.where(numpy.greater(t111, 3.141592653589793), 3.141592653589793, t111))
+    q_next[..., 1] = numpy.where(numpy.less(t113, -2.0943951023931953), -2.0943951023931953, numpy.where(numpy.greater(t113, 2.0943951023931953), 2.0943951023931953, t113))
+    q_next[..., 2] = numpy.where(numpy.less(t114, -2.0943951023931953), -2.0943951023931953, numpy.where(numpy.greater(t114, 2.0943951023931953), 2.0943951023931953, t114))
+    q_next[..., 3] = numpy.where(numpy.less(t115, -2.0943951023931953), -2.0943951023931953, numpy.where(numpy.greater(t115, 2.0943951023931953), 2.0943951023931953, t115))
+    cost = numpy.empty(numpy.broadcast_shapes(target.shape[:-1], q.shape[:-1], damping.shape) + ())
+    cost[...] = numpy.where(numpy.isfinite(t0), t46, -1)
+    return q_start, q_next, cost
+
+
+@numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def ik_branches(mu):
     """every branch of the closed-form ik and whether the target allows it: (8 x 4 and 8 x 1), 552 operations."""
     mu = _argument("mu", mu, (4,))
@@ -950,63 +1111,48 @@ def ik(mu):
     return q[valid] if valid.ndim == 1 else (q, valid)
 
 
-# -- Iterative inverse kinematics --
+# -- Iterative inverse kinematics: the loop around ik_numeric_step --
 
 IK_NUMERIC_CONVERGED = 0  # |error| <= tol
 IK_NUMERIC_ITERATION_LIMIT = 1  # max_iter steps tried, |error| still above tol
 IK_NUMERIC_STALLED = 2  # no step reduces the error: unreachable target, joint limit or local minimum
-_LOWER = numpy.array([-3.141592653589793, -2.0943951023931953, -2.0943951023931953, -2.0943951023931953])  # joint limits (infinite: none)
-_UPPER = numpy.array([3.141592653589793, 2.0943951023931953, 2.0943951023931953, 2.0943951023931953])
+IK_NUMERIC_INVALID = 3  # target or q0 not finite, or max_iter < 0: q = q0
 _DAMPING = (1e-06, 1e-12, 100000000.0)  # added to the diagonal: start, least, most
-
-
-def _wrap(angle):
-    """Angles wrapped into (-pi, pi]."""
-    return angle - 2.0 * math.pi * numpy.ceil((angle - math.pi) / (2.0 * math.pi))
-
-
-def _task_error(target, q):
-    """Error target - mu(q) (angles wrapped into (-pi, pi]) and the task Jacobian."""
-    error = target - task(q)
-    error[[3]] = _wrap(error[[3]])
-    return error, task_jacobian(q)
 
 
 def ik_numeric(target, q0, max_iter=100, tol=1e-10):
     """Iterative inverse kinematics from q0: damped least squares on the task error.
 
-    target: the task vector (x, y, z, pitch).
-    Each step is q += J^T (J J^T + damping I)^-1 e, with e the task error
+    target: the task vector (x, y, z, pitch), or a batch of them with q0 (..., DOF).
+    Each step is ik_numeric_step: q += J^T (J J^T + damping I)^-1 e, with e the task error
     (target - mu(q), angles wrapped into (-pi, pi]) and J its Jacobian; joints are clamped to their limits.
     The damping adapts (Levenberg-Marquardt): divided by 10 after a step that lowers |e|,
     multiplied by 10 and the step discarded otherwise.
-    Returns (q, status): status IK_NUMERIC_CONVERGED (|e| <= tol), IK_NUMERIC_ITERATION_LIMIT
-    (max_iter steps tried) or IK_NUMERIC_STALLED (no step lowers |e|: out of reach, a joint
-    limit or a local minimum); q is the best configuration found.
+    Returns (q, status), status an IK_NUMERIC_* code per target; q is the best configuration
+    found.
     """
-    target = numpy.asarray(target, dtype=float)
-    q = numpy.asarray(q0, dtype=float)
-    if target.shape != (4,) or q.shape != (DOF,):
-        raise ValueError(f"expected target (4,) and q0 ({DOF},), got {target.shape} and {q.shape}")
-    q = numpy.clip(q, _LOWER, _UPPER)
-    error, J = _task_error(target, q)
-    cost = error @ error
-    damping, least, most = _DAMPING
-    for _ in range(max_iter):
-        if cost <= tol * tol:
-            return q, IK_NUMERIC_CONVERGED
-        step = J.T @ numpy.linalg.solve(J @ J.T + damping * numpy.eye(J.shape[0]), error)
-        trial = numpy.clip(q + step, _LOWER, _UPPER)
-        trial_error, trial_J = _task_error(target, trial)
-        trial_cost = trial_error @ trial_error
-        if trial_cost < cost:
-            q, error, J, cost = trial, trial_error, trial_J, trial_cost
-            damping = max(damping * 0.1, least)
-        else:
-            damping *= 10.0
-            if damping > most:
-                return q, IK_NUMERIC_STALLED
-    return q, IK_NUMERIC_CONVERGED if cost <= tol * tol else IK_NUMERIC_ITERATION_LIMIT
+    least, most = _DAMPING[1:]
+    q, trial, cost = ik_numeric_step(target, q0, _DAMPING[0])
+    damping = cost * 0.0 + _DAMPING[0]
+    status = numpy.where((cost >= 0.0) & (max_iter >= 0), IK_NUMERIC_ITERATION_LIMIT, IK_NUMERIC_INVALID)
+    for _ in range(max(max_iter, 0)):
+        status = numpy.where(numpy.logical_and(status == IK_NUMERIC_ITERATION_LIMIT, cost <= tol * tol), IK_NUMERIC_CONVERGED, status)
+        active = status == IK_NUMERIC_ITERATION_LIMIT
+        if not active.any():
+            break
+        lighter = numpy.maximum(damping * 0.1, least)
+        _, after, trial_cost = ik_numeric_step(target, trial, lighter)
+        better = numpy.logical_and(active, trial_cost < cost)
+        worse = numpy.logical_and(active, trial_cost >= cost)
+        q = numpy.where(better[..., None], trial, q)
+        cost = numpy.where(better, trial_cost, cost)
+        damping = numpy.where(better, lighter, numpy.where(worse, damping * 10.0, damping))
+        status = numpy.where(numpy.logical_and(worse, damping > most), IK_NUMERIC_STALLED, status)
+        _, retry, _ = ik_numeric_step(target, q, damping)
+        trial = numpy.where(better[..., None], after, numpy.where(worse[..., None], retry, trial))
+    status = numpy.where(numpy.logical_and(status == IK_NUMERIC_ITERATION_LIMIT, cost <= tol * tol), IK_NUMERIC_CONVERGED, status)
+    q = numpy.where((status == IK_NUMERIC_INVALID)[..., None], numpy.asarray(q0, dtype=float), q)
+    return q, status[()] if status.ndim == 0 else status
 
 
 # Statuses of velocity_ik: OK, singular (a diagonal entry of the QR factor R of the

@@ -610,6 +610,163 @@ def _velocity_ik(q, mu_dot, damping):
     return [q_dot, status]
 
 
+def _ik_numeric_step(target, q, damping):
+    """One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite): 396 operations."""
+    mu0 = target[0]
+    mu1 = target[1]
+    mu2 = target[2]
+    mu3 = target[3]
+    qs1 = q[0]
+    qs2 = q[1]
+    qs3 = q[2]
+    qs4 = q[3]
+    q1 = casadi.if_else((qs1 < -3.141592653589793), -3.141592653589793, casadi.if_else((qs1 > 3.141592653589793), 3.141592653589793, qs1))
+    q2 = casadi.if_else((qs2 < -2.0943951023931953), -2.0943951023931953, casadi.if_else((qs2 > 2.0943951023931953), 2.0943951023931953, qs2))
+    q3 = casadi.if_else((qs3 < -2.0943951023931953), -2.0943951023931953, casadi.if_else((qs3 > 2.0943951023931953), 2.0943951023931953, qs3))
+    q4 = casadi.if_else((qs4 < -2.0943951023931953), -2.0943951023931953, casadi.if_else((qs4 > 2.0943951023931953), 2.0943951023931953, qs4))
+    c1 = casadi.cos(q1)
+    s1 = casadi.sin(q1)
+    c2 = -casadi.sin(q2)
+    s2 = casadi.cos(q2)
+    c3 = casadi.cos(q3)
+    s3 = casadi.sin(q3)
+    c23 = c2*c3 - s2*s3
+    s23 = c2*s3 + c3*s2
+    c4 = casadi.cos(q4)
+    s4 = casadi.sin(q4)
+    c234 = c23*c4 - s23*s4
+    s234 = c23*s4 + c4*s23
+    t0 = mu0 + mu1 + mu2 + mu3 + qs1 + qs2 + qs3 + qs4
+    t1 = 0.1*c1
+    t2 = c23*t1 + c234*t1
+    t3 = c2*t1 + t2
+    t4 = mu0 - t3
+    t5 = 0.1*s1
+    t6 = c23*t5 + c234*t5
+    t7 = c2*t5 + t6
+    t8 = c1*t3 + s1*t7
+    t9 = c1*t2 + s1*t6
+    t10 = mu1 - t7
+    t11 = 0.1*s234
+    t12 = 0.1*s23 + t11
+    t13 = 0.1*s2 + t12
+    t14 = t13 + 0.12
+    t15 = mu2 - t14
+    t16 = c1**2
+    t17 = c234*t16
+    t18 = s1**2
+    t19 = c234*t18
+    t20 = 0.1*t17 + 0.1*t19
+    t21 = t20**2 + t8**2 + t9**2
+    t22 = c234**2
+    t23 = casadi.sqrt(t16*t22 + t18*t22)
+    t24 = -(t17 + t19)/t23
+    t25 = t20*t24 + t24*t8 + t24*t9
+    t26 = 3*t24**2
+    t27 = t12**2
+    t28 = t13**2
+    t29 = 0.01*s234**2
+    t30 = t16*t27 + t16*t28 + t16*t29 + t7**2
+    t31 = t18*t27 + t18*t28 + t18*t29 + t3**2
+    t32 = c1*s1
+    t33 = t27*t32 + t28*t32 + t29*t32 - t3*t7
+    t34 = c1*t12
+    t35 = c1*t13
+    t36 = c1*t11
+    t37 = t20*t36 + t34*t9 + t35*t8
+    t38 = t24*t34 + t24*t35 + t24*t36
+    t39 = s1*t12
+    t40 = s1*t13
+    t41 = s1*t11
+    t42 = t20*t41 + t39*t9 + t40*t8
+    t43 = t24*t39 + t24*t40 + t24*t41
+    t44 = -mu3 + casadi.atan2(-s234, t23)
+    t45 = t44 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t44 - 0.5)
+    t46 = t10**2 + t15**2 + t4**2 + t45**2
+    t47 = damping + t30
+    t48 = casadi.sqrt(t33**2 + t37**2 + t38**2 + t47**2)
+    t49 = t48*casadi.if_else((t47 >= 0), 1, -1)
+    t50 = t47 + t49
+    t51 = casadi.if_else((t48 > 0), 1/(t48*(t48 + casadi.fabs(t47))), 0)
+    t52 = t51*(t10*t33 - t15*t37 + t38*t45 + t4*t50)
+    t53 = t4 - t50*t52
+    t54 = t10 - t33*t52
+    t55 = t15 + t37*t52
+    t56 = t38*t52 - t45
+    t57 = damping + t31
+    t58 = t51*(t33*t50 + t33*t57 + t37*t42 + t38*t43)
+    t59 = t33 - t50*t58
+    t60 = -t33*t58 + t57
+    t61 = t37*t58 - t42
+    t62 = t38*t58 - t43
+    t63 = casadi.sqrt(t60**2 + t61**2 + t62**2)
+    t64 = t63*casadi.if_else((t60 >= 0), 1, -1)
+    t65 = t60 + t64
+    t66 = casadi.if_else((t63 > 0), 1/(t63*(t63 + casadi.fabs(t60))), 0)
+    t67 = t66*(t54*t65 + t55*t61 + t56*t62)
+    t68 = t54 - t65*t67
+    t69 = t55 - t61*t67
+    t70 = t56 - t62*t67
+    t71 = damping + t21
+    t72 = -t51*(t25*t38 + t33*t42 + t37*t50 + t37*t71)
+    t73 = t37 + t50*t72
+    t74 = t33*t72 + t42
+    t75 = t37*t72 + t71
+    t76 = t25 + t38*t72
+    t77 = t66*(t61*t75 + t62*t76 - t65*t74)
+    t78 = t65*t77 + t74
+    t79 = -t61*t77 + t75
+    t80 = -t62*t77 + t76
+    t81 = casadi.sqrt(t79**2 + t80**2)
+    t82 = t81*casadi.if_else((t79 >= 0), 1, -1)
+    t83 = t79 + t82
+    t84 = casadi.if_else((t81 > 0), 1/(t81*(t81 + casadi.fabs(t79))), 0)
+    t85 = t84*(t69*t83 + t70*t80)
+    t86 = t69 - t83*t85
+    t87 = t70 - t80*t85
+    t88 = damping + t26
+    t89 = -t51*(t25*t37 + t33*t43 + t38*t50 + t38*t88)
+    t90 = t38 + t50*t89
+    t91 = t33*t89 + t43
+    t92 = t25 + t37*t89
+    t93 = t38*t89 + t88
+    t94 = t66*(t61*t92 + t62*t93 - t65*t91)
+    t95 = t65*t94 + t91
+    t96 = -t61*t94 + t92
+    t97 = -t62*t94 + t93
+    t98 = t84*(t80*t97 + t83*t96)
+    t99 = -t83*t98 + t96
+    t100 = -t80*t98 + t97
+    t101 = casadi.fabs(t100)
+    t102 = t101
+    t103 = t102*casadi.if_else((t100 >= 0), 1, -1)
+    t104 = t100 + t103
+    t105 = casadi.if_else((t102 > 0), 1/(t102*(t101 + t102)), 0)
+    t106 = -t104**2*t105*t87 + t87
+    t107 = t106/t103
+    t108 = (t107*t99 + t86)/t82
+    t109 = (-t107*t95 - t108*t78 + t68)/t64
+    t110 = (-t107*t90 - t108*t73 + t109*t59 + t53)/t49
+    t111 = q1 - t109*t3 + t110*t7
+    t112 = -t107*t24
+    t113 = q2 - t108*t8 + t109*t40 + t110*t35 + t112
+    t114 = q3 - t108*t9 + t109*t39 + t110*t34 + t112
+    t115 = q4 - t108*t20 + t109*t41 + t110*t36 + t112
+    q_start = casadi.SX(4, 1)
+    q_start[0, 0] = q1
+    q_start[1, 0] = q2
+    q_start[2, 0] = q3
+    q_start[3, 0] = q4
+    q_next = casadi.SX(4, 1)
+    q_next[0, 0] = casadi.if_else((t111 < -3.141592653589793), -3.141592653589793, casadi.if_else((t111 > 3.141592653589793), 3.141592653589793, t111))
+    q_next[1, 0] = casadi.if_else((t113 < -2.0943951023931953), -2.0943951023931953, casadi.if_else((t113 > 2.0943951023931953), 2.0943951023931953, t113))
+    q_next[2, 0] = casadi.if_else((t114 < -2.0943951023931953), -2.0943951023931953, casadi.if_else((t114 > 2.0943951023931953), 2.0943951023931953, t114))
+    q_next[3, 0] = casadi.if_else((t115 < -2.0943951023931953), -2.0943951023931953, casadi.if_else((t115 > 2.0943951023931953), 2.0943951023931953, t115))
+    cost = casadi.SX(1, 1)
+    cost[0, 0] = casadi.if_else((casadi.fabs(t0) < casadi.inf), t46, -1)
+    return [q_start, q_next, cost]
+
+
 def _ik_branches(mu):
     """Every branch of the closed-form ik and whether the target allows it: 552 operations."""
     mu0 = mu[0]
@@ -867,6 +1024,7 @@ def _ik_branches(mu):
 _q = casadi.SX.sym("q", 4, 1)
 _mu_dot = casadi.SX.sym("mu_dot", 4, 1)
 _damping = casadi.SX.sym("damping", 1, 1)
+_target = casadi.SX.sym("target", 4, 1)
 _mu = casadi.SX.sym("mu", 4, 1)
 fk = casadi.Function("fk", [_q], _fk(_q), ["q"], ["T"])
 jacobian = casadi.Function("jacobian", [_q], _jacobian(_q), ["q"], ["J"])
@@ -878,10 +1036,48 @@ singularity_factors = casadi.Function("singularity_factors", [_q], _singularity_
 manipulability = casadi.Function("manipulability", [_q], _manipulability(_q), ["q"], ["w"])
 jacobian_det = casadi.Function("jacobian_det", [_q], _jacobian_det(_q), ["q"], ["d"])
 velocity_ik = casadi.Function("velocity_ik", [_q, _mu_dot, _damping], _velocity_ik(_q, _mu_dot, _damping), ["q", "mu_dot", "damping"], ["q_dot", "status"])
+ik_numeric_step = casadi.Function("ik_numeric_step", [_target, _q, _damping], _ik_numeric_step(_target, _q, _damping), ["target", "q", "damping"], ["q_start", "q_next", "cost"])
 ik_branches = casadi.Function("ik_branches", [_mu], _ik_branches(_mu), ["mu"], ["q", "valid"])
 ik = ik_branches  # CasADi functions have fixed-size outputs: every branch and its validity
+
+IK_NUMERIC_CONVERGED = 0  # |error| <= tol
+IK_NUMERIC_ITERATION_LIMIT = 1  # IK_NUMERIC_ITERATIONS steps taken, |error| still above tol
+IK_NUMERIC_STALLED = 2  # no step reduces the error: unreachable target, joint limit or local minimum
+IK_NUMERIC_INVALID = 3  # target or q0 not finite: q = q0
+IK_NUMERIC_ITERATIONS = 100
+_DAMPING = (1e-06, 1e-12, 100000000.0)  # added to the diagonal: start, least, most
+
+
+def _ik_numeric(target, q0, tol):
+    """ik_numeric of the C and numpy modules with a fixed number of steps: every branch of
+    the loop is a select, so the graph is the same for every input."""
+    least, most = _DAMPING[1:]
+    q, trial, cost = ik_numeric_step(target, q0, _DAMPING[0])
+    damping = cost * 0.0 + _DAMPING[0]
+    status = casadi.if_else(cost >= 0.0, IK_NUMERIC_ITERATION_LIMIT, IK_NUMERIC_INVALID)
+    for _ in range(IK_NUMERIC_ITERATIONS):
+        status = casadi.if_else(casadi.logic_and(status == IK_NUMERIC_ITERATION_LIMIT, cost <= tol * tol), IK_NUMERIC_CONVERGED, status)
+        active = status == IK_NUMERIC_ITERATION_LIMIT
+        lighter = casadi.fmax(damping * 0.1, least)
+        _, after, trial_cost = ik_numeric_step(target, trial, lighter)
+        better = casadi.logic_and(active, trial_cost < cost)
+        worse = casadi.logic_and(active, trial_cost >= cost)
+        q = casadi.if_else(better, trial, q)
+        cost = casadi.if_else(better, trial_cost, cost)
+        damping = casadi.if_else(better, lighter, casadi.if_else(worse, damping * 10.0, damping))
+        status = casadi.if_else(casadi.logic_and(worse, damping > most), IK_NUMERIC_STALLED, status)
+        _, retry, _ = ik_numeric_step(target, q, damping)
+        trial = casadi.if_else(better, after, casadi.if_else(worse, retry, trial))
+    status = casadi.if_else(casadi.logic_and(status == IK_NUMERIC_ITERATION_LIMIT, cost <= tol * tol), IK_NUMERIC_CONVERGED, status)
+    q = casadi.if_else((status == IK_NUMERIC_INVALID), q0, q)
+    return [q, status]
+
+
+_tol = casadi.SX.sym("tol")
+ik_numeric = casadi.Function("ik_numeric", [_target, _q, _tol], _ik_numeric(_target, _q, _tol),
+                             ["target", "q0", "tol"], ["q", "status"])
 
 
 def functions():
     """All functions by name."""
-    return {"fk": fk, "jacobian": jacobian, "fk_jacobian": fk_jacobian, "jacobian_tool": jacobian_tool, "task": task, "task_jacobian": task_jacobian, "singularity_factors": singularity_factors, "manipulability": manipulability, "jacobian_det": jacobian_det, "velocity_ik": velocity_ik, "ik_branches": ik_branches}
+    return {"fk": fk, "jacobian": jacobian, "fk_jacobian": fk_jacobian, "jacobian_tool": jacobian_tool, "task": task, "task_jacobian": task_jacobian, "singularity_factors": singularity_factors, "manipulability": manipulability, "jacobian_det": jacobian_det, "velocity_ik": velocity_ik, "ik_numeric_step": ik_numeric_step, "ik_branches": ik_branches}

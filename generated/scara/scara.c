@@ -492,6 +492,116 @@ int scara_velocity_ik(const scara_real q[SCARA_DOF], const scara_real mu_dot[SCA
     return (!(t105 && t106) ? 2 : (t109 ? 1 : 0));
 }
 
+scara_real scara_ik_numeric_step(const scara_real target[SCARA_TASK_DIM], const scara_real q[SCARA_DOF], scara_real damping, scara_real q_start[SCARA_DOF], scara_real q_next[SCARA_DOF])
+{
+    /* 220 operations */
+
+    /* Inputs */
+    const scara_real mu0 = target[0];
+    const scara_real mu1 = target[1];
+    const scara_real mu2 = target[2];
+    const scara_real mu3 = target[3];
+    const scara_real qs1 = q[0];
+    const scara_real qs2 = q[1];
+    const scara_real qs3 = q[2];
+    const scara_real qs4 = q[3];
+
+    /* Intermediate terms */
+    const scara_real q1 = (qs1 < -0.8726646259971648 ? -0.8726646259971648 : (qs1 > 0.8726646259971648 ? 0.8726646259971648 : qs1));
+    const scara_real q2 = (qs2 < -1.53588974175501 ? -1.53588974175501 : (qs2 > 1.53588974175501 ? 1.53588974175501 : qs2));
+    const scara_real q3 = (qs3 < 0 ? 0.0 : (qs3 > 0.21 ? 0.21 : qs3));
+    const scara_real q4 = (qs4 < -6.283185307179586 ? -6.283185307179586 : (qs4 > 6.283185307179586 ? 6.283185307179586 : qs4));
+    const scara_real c1 = cos(q1);
+    const scara_real s1 = sin(q1);
+    const scara_real c2 = cos(q2);
+    const scara_real s2 = sin(q2);
+    const scara_real c12 = c1*c2 - s1*s2;
+    const scara_real s12 = c1*s2 + c2*s1;
+    const scara_real c4 = cos(q4);
+    const scara_real s4 = sin(q4);
+    const scara_real t0 = 0.387 - q3;
+    const scara_real t1 = c12*c4 + s12*s4;
+    const scara_real t2 = -c12*s4 + c4*s12;
+    const scara_real t3 = mu2 - t0;
+    const scara_real t4 = damping + 1;
+    const scara_real t5 = mu0 + mu1 + mu2 + mu3 + qs1 + qs2 + qs3 + qs4;
+    const scara_real t6 = 0.275*c12;
+    const scara_real t7 = 0.325*c1 + t6;
+    const scara_real t8 = 0.075625*(c12*c12) + (t7*t7);
+    const scara_real t9 = t6 + t7;
+    const scara_real t10 = mu0 - t7;
+    const scara_real t11 = 0.275*s12;
+    const scara_real t12 = 0.325*s1 + t11;
+    const scara_real t13 = 0.075625*(s12*s12) + (t12*t12);
+    const scara_real t14 = 0.075625*c12*s12 + t12*t7;
+    const scara_real t15 = t11 + t12;
+    const scara_real t16 = mu1 - t12;
+    const scara_real t17 = -mu3 + atan2(t2, t1);
+    const scara_real t18 = t17 + 6.283185307179586*ceil(-0.15915494309189535*t17 - 0.5);
+    const scara_real t19 = (t10*t10) + (t16*t16) + (t18*t18) + (t3*t3);
+    const scara_real t20 = damping + t13;
+    const scara_real t21 = sqrt((t14*t14) + (t15*t15) + (t20*t20));
+    const scara_real t22 = t21*(t20 >= 0 ? 1 : -1);
+    const scara_real t23 = t20 + t22;
+    const scara_real t24 = (t21 > 0 ? 1/(t21*(t21 + fabs(t20))) : 0);
+    const scara_real t25 = t24*(t10*t23 - t14*t16 + t15*t18);
+    const scara_real t26 = t10 - t23*t25;
+    const scara_real t27 = t14*t25 + t16;
+    const scara_real t28 = t15*t25 - t18;
+    const scara_real t29 = damping + t8;
+    const scara_real t30 = -t24*(t14*t23 + t14*t29 + t15*t9);
+    const scara_real t31 = t14 + t23*t30;
+    const scara_real t32 = t14*t30 + t29;
+    const scara_real t33 = t15*t30 + t9;
+    const scara_real t34 = sqrt((t32*t32) + (t33*t33));
+    const scara_real t35 = t34*(t32 >= 0 ? 1 : -1);
+    const scara_real t36 = t32 + t35;
+    const scara_real t37 = (t34 > 0 ? 1/(t34*(t34 + fabs(t32))) : 0);
+    const scara_real t38 = t37*(t27*t36 + t28*t33);
+    const scara_real t39 = t27 - t36*t38;
+    const scara_real t40 = t28 - t33*t38;
+    const scara_real t41 = damping + 3;
+    const scara_real t42 = -t24*(t14*t9 + t15*t23 + t15*t41);
+    const scara_real t43 = t15 + t23*t42;
+    const scara_real t44 = t14*t42 + t9;
+    const scara_real t45 = t15*t42 + t41;
+    const scara_real t46 = t37*(t33*t45 + t36*t44);
+    const scara_real t47 = -t36*t46 + t44;
+    const scara_real t48 = -t33*t46 + t45;
+    const scara_real t49 = fabs(t4);
+    const scara_real t50 = t49;
+    const scara_real t51 = t50*(t4 >= 0 ? 1 : -1);
+    const scara_real t52 = t4 + t51;
+    const scara_real t53 = (t50 > 0 ? 1/(t50*(t49 + t50)) : 0);
+    const scara_real t54 = -t3*t53*(t52*t52) + t3;
+    const scara_real t55 = t54/t51;
+    const scara_real t56 = q3 + t55;
+    const scara_real t57 = fabs(t48);
+    const scara_real t58 = t57;
+    const scara_real t59 = t58*(t48 >= 0 ? 1 : -1);
+    const scara_real t60 = t48 + t59;
+    const scara_real t61 = (t58 > 0 ? 1/(t58*(t57 + t58)) : 0);
+    const scara_real t62 = -t40*t61*(t60*t60) + t40;
+    const scara_real t63 = t62/t59;
+    const scara_real t64 = (t39 + t47*t63)/t35;
+    const scara_real t65 = (t26 - t31*t64 - t43*t63)/t22;
+    const scara_real t66 = q4 + t63;
+    const scara_real t67 = -t63;
+    const scara_real t68 = q1 + t12*t65 - t64*t7 + t67;
+    const scara_real t69 = q2 + t11*t65 - t6*t64 + t67;
+
+    /* Outputs */
+    q_start[0] = q1;
+    q_start[1] = q2;
+    q_start[2] = q3;
+    q_start[3] = q4;
+    q_next[0] = (t68 < -0.8726646259971648 ? -0.8726646259971648 : (t68 > 0.8726646259971648 ? 0.8726646259971648 : t68));
+    q_next[1] = (t69 < -1.53588974175501 ? -1.53588974175501 : (t69 > 1.53588974175501 ? 1.53588974175501 : t69));
+    q_next[2] = (t56 < 0 ? 0.0 : (t56 > 0.21 ? 0.21 : t56));
+    q_next[3] = (t66 < -6.283185307179586 ? -6.283185307179586 : (t66 > 6.283185307179586 ? 6.283185307179586 : t66));
+    return (isfinite(t5) ? t19 : -1);
+}
+
 void scara_ik_branches(const scara_real mu[SCARA_TASK_DIM], scara_real q[SCARA_MAX_IK_SOLUTIONS * SCARA_DOF], int valid[SCARA_MAX_IK_SOLUTIONS])
 {
     /* 120 operations */
@@ -572,164 +682,39 @@ int scara_ik(const scara_real mu[SCARA_TASK_DIM], scara_real q[SCARA_MAX_IK_SOLU
     return count;
 }
 
-/* -- Iterative inverse kinematics -- */
-
-/* The angle wrapped into (-pi, pi], for |angle| < 1e9: angle - 2 pi ceil((angle - pi) / (2 pi)),
- * ceil by truncation. */
-static scara_real scara_wrap(scara_real angle)
-{
-    const scara_real turns = (angle - 3.141592653589793) / 6.283185307179586;
-    scara_real whole;
-    if (angle > -3.141592653589793 && angle <= 3.141592653589793) {
-        return angle;
-    }
-    whole = (scara_real)(long)turns;
-    if (whole < turns) {
-        whole += 1.0;
-    }
-    return angle - 6.283185307179586 * whole;
-}
-
-/* Error target - mu(q) (angles wrapped into (-pi, pi]) and the task Jacobian. */
-static void scara_task_error(const scara_real target[SCARA_TASK_DIM], const scara_real q[SCARA_DOF], scara_real e[SCARA_TASK_DIM],
-        scara_real J[SCARA_TASK_DIM * SCARA_DOF])
-{
-    int i;
-    scara_task(q, e);
-    scara_task_jacobian(q, J);
-    for (i = 0; i < SCARA_TASK_DIM; ++i) {
-        e[i] = target[i] - e[i];
-    }
-    e[3] = scara_wrap(e[3]);
-}
-
-/* Joints clamped to their limits. */
-static void scara_clamp(scara_real q[SCARA_DOF])
-{
-    q[0] = q[0] < -0.8726646259971648 ? -0.8726646259971648 : q[0] > 0.8726646259971648 ? 0.8726646259971648 : q[0];
-    q[1] = q[1] < -1.53588974175501 ? -1.53588974175501 : q[1] > 1.53588974175501 ? 1.53588974175501 : q[1];
-    q[2] = q[2] < 0.0 ? 0.0 : q[2] > 0.21 ? 0.21 : q[2];
-    q[3] = q[3] < -6.283185307179586 ? -6.283185307179586 : q[3] > 6.283185307179586 ? 6.283185307179586 : q[3];
-}
-
-/* Solves A x = b in place (b becomes x) for the symmetric positive definite K x K matrix A by
- * Cholesky; returns 0 when A is not numerically positive definite. */
-static int scara_cholesky_solve(scara_real A[16], scara_real b[4])
-{
-    int i, j, k;
-    for (j = 0; j < 4; ++j) {
-        scara_real diagonal = A[4 * j + j];
-        for (k = 0; k < j; ++k) {
-            diagonal -= A[4 * j + k] * A[4 * j + k];
-        }
-        if (!(diagonal > 0.0)) {
-            return 0;
-        }
-        A[4 * j + j] = sqrt(diagonal);
-        for (i = j + 1; i < 4; ++i) {
-            scara_real sum = A[4 * i + j];
-            for (k = 0; k < j; ++k) {
-                sum -= A[4 * i + k] * A[4 * j + k];
-            }
-            A[4 * i + j] = sum / A[4 * j + j];
-        }
-    }
-    for (i = 0; i < 4; ++i) {
-        for (k = 0; k < i; ++k) {
-            b[i] -= A[4 * i + k] * b[k];
-        }
-        b[i] /= A[4 * i + i];
-    }
-    for (i = 4 - 1; i >= 0; --i) {
-        for (k = i + 1; k < 4; ++k) {
-            b[i] -= A[4 * k + i] * b[k];
-        }
-        b[i] /= A[4 * i + i];
-    }
-    return 1;
-}
+/* -- Iterative inverse kinematics: the loop around scara_ik_numeric_step -- */
 
 int scara_ik_numeric(const scara_real target[SCARA_TASK_DIM], const scara_real q0[SCARA_DOF], int max_iter, scara_real tol, scara_real q[SCARA_DOF])
 {
-    scara_real e[4], J[4 * SCARA_DOF], trial[SCARA_DOF], trial_e[4];
-    scara_real trial_J[4 * SCARA_DOF], A[16], x[4];
-    scara_real cost, trial_cost, damping = 1e-06;
-    scara_real goal[SCARA_TASK_DIM];
-    int i, j, k, iteration;
-    for (j = 0; j < SCARA_DOF; ++j) {
-        q[j] = q0[j];
-    }
-    for (i = 0; i < SCARA_TASK_DIM; ++i) {
-        if (!isfinite(target[i])) {
-            return SCARA_IK_NUMERIC_INVALID;
+    scara_real trial[SCARA_DOF], after[SCARA_DOF], start[SCARA_DOF];
+    scara_real cost, trial_cost, lighter, damping = 1e-06;
+    int j, iteration;
+    cost = scara_ik_numeric_step(target, q0, damping, q, trial);
+    if (!(cost >= 0) || max_iter < 0) { /* -1: target or q0 not finite */
+        for (j = 0; j < SCARA_DOF; ++j) {
+            q[j] = q0[j];
         }
-    }
-    for (j = 0; j < SCARA_DOF; ++j) {
-        if (!isfinite(q0[j])) {
-            return SCARA_IK_NUMERIC_INVALID;
-        }
-    }
-    if (max_iter < 0) {
         return SCARA_IK_NUMERIC_INVALID;
-    }
-    /* the target's angles reduced to (-pi, pi], so that errors stay within (-2 pi, 2 pi] */
-    for (i = 0; i < SCARA_TASK_DIM; ++i) {
-        goal[i] = target[i];
-    }
-    goal[3] = atan2(sin(goal[3]), cos(goal[3]));
-    scara_clamp(q);
-    scara_task_error(goal, q, e, J);
-    cost = 0.0;
-    for (i = 0; i < 4; ++i) {
-        cost += e[i] * e[i];
     }
     for (iteration = 0; iteration < max_iter; ++iteration) {
         if (cost <= tol * tol) {
             return SCARA_IK_NUMERIC_CONVERGED;
         }
-        /* A = J J^T + damping I, x = A^-1 e, step J^T x */
-        for (i = 0; i < 4; ++i) {
-            x[i] = e[i];
-            for (k = 0; k < 4; ++k) {
-                scara_real sum = i == k ? damping : 0.0;
-                for (j = 0; j < SCARA_DOF; ++j) {
-                    sum += J[SCARA_DOF * i + j] * J[SCARA_DOF * k + j];
-                }
-                A[4 * i + k] = sum;
-            }
-        }
-        if (!scara_cholesky_solve(A, x)) {
-            return SCARA_IK_NUMERIC_STALLED;
-        }
-        for (j = 0; j < SCARA_DOF; ++j) {
-            trial[j] = q[j];
-            for (i = 0; i < 4; ++i) {
-                trial[j] += J[SCARA_DOF * i + j] * x[i];
-            }
-        }
-        scara_clamp(trial);
-        scara_task_error(goal, trial, trial_e, trial_J);
-        trial_cost = 0.0;
-        for (i = 0; i < 4; ++i) {
-            trial_cost += trial_e[i] * trial_e[i];
-        }
+        lighter = damping * 0.1 > 1e-12 ? damping * 0.1 : 1e-12;
+        trial_cost = scara_ik_numeric_step(target, trial, lighter, start, after);
         if (trial_cost < cost) {
             for (j = 0; j < SCARA_DOF; ++j) {
                 q[j] = trial[j];
-            }
-            for (i = 0; i < 4; ++i) {
-                e[i] = trial_e[i];
-            }
-            for (i = 0; i < 4 * SCARA_DOF; ++i) {
-                J[i] = trial_J[i];
+                trial[j] = after[j];
             }
             cost = trial_cost;
-            damping = damping * 0.1 > 1e-12 ? damping * 0.1 : 1e-12;
+            damping = lighter;
         } else {
             damping *= 10.0;
             if (damping > 100000000.0) {
                 return SCARA_IK_NUMERIC_STALLED;
             }
+            (void)scara_ik_numeric_step(target, q, damping, start, trial);
         }
     }
     return cost <= tol * tol ? SCARA_IK_NUMERIC_CONVERGED : SCARA_IK_NUMERIC_ITERATION_LIMIT;

@@ -479,6 +479,117 @@ def velocity_ik(q, mu_dot, damping=0.0):
 
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
+def ik_numeric_step(target, q, damping=0.0):
+    """one step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite): (4 x 1 and 4 x 1 and 1 x 1), 220 operations."""
+    target = _argument("target", target, (4,))
+    q = _argument("q", q, (4,))
+    damping = _argument("damping", damping, ())
+    mu0 = target[..., 0]
+    mu1 = target[..., 1]
+    mu2 = target[..., 2]
+    mu3 = target[..., 3]
+    qs1 = q[..., 0]
+    qs2 = q[..., 1]
+    qs3 = q[..., 2]
+    qs4 = q[..., 3]
+    q1 = numpy.where(numpy.less(qs1, -0.8726646259971648), -0.8726646259971648, numpy.where(numpy.greater(qs1, 0.8726646259971648), 0.8726646259971648, qs1))
+    q2 = numpy.where(numpy.less(qs2, -1.53588974175501), -1.53588974175501, numpy.where(numpy.greater(qs2, 1.53588974175501), 1.53588974175501, qs2))
+    q3 = numpy.where(numpy.less(qs3, 0), 0.0, numpy.where(numpy.greater(qs3, 0.21), 0.21, qs3))
+    q4 = numpy.where(numpy.less(qs4, -6.283185307179586), -6.283185307179586, numpy.where(numpy.greater(qs4, 6.283185307179586), 6.283185307179586, qs4))
+    c1 = numpy.cos(q1)
+    s1 = numpy.sin(q1)
+    c2 = numpy.cos(q2)
+    s2 = numpy.sin(q2)
+    c12 = c1*c2 - s1*s2
+    s12 = c1*s2 + c2*s1
+    c4 = numpy.cos(q4)
+    s4 = numpy.sin(q4)
+    t0 = 0.387 - q3
+    t1 = c12*c4 + s12*s4
+    t2 = -c12*s4 + c4*s12
+    t3 = mu2 - t0
+    t4 = damping + 1
+    t5 = mu0 + mu1 + mu2 + mu3 + qs1 + qs2 + qs3 + qs4
+    t6 = 0.275*c12
+    t7 = 0.325*c1 + t6
+    t8 = 0.075625*c12**2 + t7**2
+    t9 = t6 + t7
+    t10 = mu0 - t7
+    t11 = 0.275*s12
+    t12 = 0.325*s1 + t11
+    t13 = 0.075625*s12**2 + t12**2
+    t14 = 0.075625*c12*s12 + t12*t7
+    t15 = t11 + t12
+    t16 = mu1 - t12
+    t17 = -mu3 + numpy.arctan2(t2, t1)
+    t18 = t17 + 6.283185307179586*numpy.ceil(-0.15915494309189535*t17 - 0.5)
+    t19 = t10**2 + t16**2 + t18**2 + t3**2
+    t20 = damping + t13
+    t21 = numpy.sqrt(t14**2 + t15**2 + t20**2)
+    t22 = t21*numpy.where(numpy.greater_equal(t20, 0), 1, -1)
+    t23 = t20 + t22
+    t24 = numpy.where(numpy.greater(t21, 0), 1/(t21*(t21 + abs(t20))), 0)
+    t25 = t24*(t10*t23 - t14*t16 + t15*t18)
+    t26 = t10 - t23*t25
+    t27 = t14*t25 + t16
+    t28 = t15*t25 - t18
+    t29 = damping + t8
+    t30 = -t24*(t14*t23 + t14*t29 + t15*t9)
+    t31 = t14 + t23*t30
+    t32 = t14*t30 + t29
+    t33 = t15*t30 + t9
+    t34 = numpy.sqrt(t32**2 + t33**2)
+    t35 = t34*numpy.where(numpy.greater_equal(t32, 0), 1, -1)
+    t36 = t32 + t35
+    t37 = numpy.where(numpy.greater(t34, 0), 1/(t34*(t34 + abs(t32))), 0)
+    t38 = t37*(t27*t36 + t28*t33)
+    t39 = t27 - t36*t38
+    t40 = t28 - t33*t38
+    t41 = damping + 3
+    t42 = -t24*(t14*t9 + t15*t23 + t15*t41)
+    t43 = t15 + t23*t42
+    t44 = t14*t42 + t9
+    t45 = t15*t42 + t41
+    t46 = t37*(t33*t45 + t36*t44)
+    t47 = -t36*t46 + t44
+    t48 = -t33*t46 + t45
+    t49 = abs(t4)
+    t50 = t49
+    t51 = t50*numpy.where(numpy.greater_equal(t4, 0), 1, -1)
+    t52 = t4 + t51
+    t53 = numpy.where(numpy.greater(t50, 0), 1/(t50*(t49 + t50)), 0)
+    t54 = -t3*t52**2*t53 + t3
+    t55 = t54/t51
+    t56 = q3 + t55
+    t57 = abs(t48)
+    t58 = t57
+    t59 = t58*numpy.where(numpy.greater_equal(t48, 0), 1, -1)
+    t60 = t48 + t59
+    t61 = numpy.where(numpy.greater(t58, 0), 1/(t58*(t57 + t58)), 0)
+    t62 = -t40*t60**2*t61 + t40
+    t63 = t62/t59
+    t64 = (t39 + t47*t63)/t35
+    t65 = (t26 - t31*t64 - t43*t63)/t22
+    t66 = q4 + t63
+    t67 = -t63
+    t68 = q1 + t12*t65 - t64*t7 + t67
+    t69 = q2 + t11*t65 - t6*t64 + t67
+    q_start = numpy.empty(numpy.broadcast_shapes(target.shape[:-1], q.shape[:-1], damping.shape) + (4,))
+    q_start[..., 0] = q1
+    q_start[..., 1] = q2
+    q_start[..., 2] = q3
+    q_start[..., 3] = q4
+    q_next = numpy.empty(numpy.broadcast_shapes(target.shape[:-1], q.shape[:-1], damping.shape) + (4,))
+    q_next[..., 0] = numpy.where(numpy.less(t68, -0.8726646259971648), -0.8726646259971648, numpy.where(numpy.greater(t68, 0.8726646259971648), 0.8726646259971648, t68))
+    q_next[..., 1] = numpy.where(numpy.less(t69, -1.53588974175501), -1.53588974175501, numpy.where(numpy.greater(t69, 1.53588974175501), 1.53588974175501, t69))
+    q_next[..., 2] = numpy.where(numpy.less(t56, 0), 0.0, numpy.where(numpy.greater(t56, 0.21), 0.21, t56))
+    q_next[..., 3] = numpy.where(numpy.less(t66, -6.283185307179586), -6.283185307179586, numpy.where(numpy.greater(t66, 6.283185307179586), 6.283185307179586, t66))
+    cost = numpy.empty(numpy.broadcast_shapes(target.shape[:-1], q.shape[:-1], damping.shape) + ())
+    cost[...] = numpy.where(numpy.isfinite(t5), t19, -1)
+    return q_start, q_next, cost
+
+
+@numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def ik_branches(mu):
     """every branch of the closed-form ik and whether the target allows it: (2 x 4 and 2 x 1), 120 operations."""
     mu = _argument("mu", mu, (4,))
@@ -565,63 +676,48 @@ def ik(mu):
     return q[valid] if valid.ndim == 1 else (q, valid)
 
 
-# -- Iterative inverse kinematics --
+# -- Iterative inverse kinematics: the loop around ik_numeric_step --
 
 IK_NUMERIC_CONVERGED = 0  # |error| <= tol
 IK_NUMERIC_ITERATION_LIMIT = 1  # max_iter steps tried, |error| still above tol
 IK_NUMERIC_STALLED = 2  # no step reduces the error: unreachable target, joint limit or local minimum
-_LOWER = numpy.array([-0.8726646259971648, -1.53588974175501, 0.0, -6.283185307179586])  # joint limits (infinite: none)
-_UPPER = numpy.array([0.8726646259971648, 1.53588974175501, 0.21, 6.283185307179586])
+IK_NUMERIC_INVALID = 3  # target or q0 not finite, or max_iter < 0: q = q0
 _DAMPING = (1e-06, 1e-12, 100000000.0)  # added to the diagonal: start, least, most
-
-
-def _wrap(angle):
-    """Angles wrapped into (-pi, pi]."""
-    return angle - 2.0 * math.pi * numpy.ceil((angle - math.pi) / (2.0 * math.pi))
-
-
-def _task_error(target, q):
-    """Error target - mu(q) (angles wrapped into (-pi, pi]) and the task Jacobian."""
-    error = target - task(q)
-    error[[3]] = _wrap(error[[3]])
-    return error, task_jacobian(q)
 
 
 def ik_numeric(target, q0, max_iter=100, tol=1e-10):
     """Iterative inverse kinematics from q0: damped least squares on the task error.
 
-    target: the task vector (x, y, z, yaw).
-    Each step is q += J^T (J J^T + damping I)^-1 e, with e the task error
+    target: the task vector (x, y, z, yaw), or a batch of them with q0 (..., DOF).
+    Each step is ik_numeric_step: q += J^T (J J^T + damping I)^-1 e, with e the task error
     (target - mu(q), angles wrapped into (-pi, pi]) and J its Jacobian; joints are clamped to their limits.
     The damping adapts (Levenberg-Marquardt): divided by 10 after a step that lowers |e|,
     multiplied by 10 and the step discarded otherwise.
-    Returns (q, status): status IK_NUMERIC_CONVERGED (|e| <= tol), IK_NUMERIC_ITERATION_LIMIT
-    (max_iter steps tried) or IK_NUMERIC_STALLED (no step lowers |e|: out of reach, a joint
-    limit or a local minimum); q is the best configuration found.
+    Returns (q, status), status an IK_NUMERIC_* code per target; q is the best configuration
+    found.
     """
-    target = numpy.asarray(target, dtype=float)
-    q = numpy.asarray(q0, dtype=float)
-    if target.shape != (4,) or q.shape != (DOF,):
-        raise ValueError(f"expected target (4,) and q0 ({DOF},), got {target.shape} and {q.shape}")
-    q = numpy.clip(q, _LOWER, _UPPER)
-    error, J = _task_error(target, q)
-    cost = error @ error
-    damping, least, most = _DAMPING
-    for _ in range(max_iter):
-        if cost <= tol * tol:
-            return q, IK_NUMERIC_CONVERGED
-        step = J.T @ numpy.linalg.solve(J @ J.T + damping * numpy.eye(J.shape[0]), error)
-        trial = numpy.clip(q + step, _LOWER, _UPPER)
-        trial_error, trial_J = _task_error(target, trial)
-        trial_cost = trial_error @ trial_error
-        if trial_cost < cost:
-            q, error, J, cost = trial, trial_error, trial_J, trial_cost
-            damping = max(damping * 0.1, least)
-        else:
-            damping *= 10.0
-            if damping > most:
-                return q, IK_NUMERIC_STALLED
-    return q, IK_NUMERIC_CONVERGED if cost <= tol * tol else IK_NUMERIC_ITERATION_LIMIT
+    least, most = _DAMPING[1:]
+    q, trial, cost = ik_numeric_step(target, q0, _DAMPING[0])
+    damping = cost * 0.0 + _DAMPING[0]
+    status = numpy.where((cost >= 0.0) & (max_iter >= 0), IK_NUMERIC_ITERATION_LIMIT, IK_NUMERIC_INVALID)
+    for _ in range(max(max_iter, 0)):
+        status = numpy.where(numpy.logical_and(status == IK_NUMERIC_ITERATION_LIMIT, cost <= tol * tol), IK_NUMERIC_CONVERGED, status)
+        active = status == IK_NUMERIC_ITERATION_LIMIT
+        if not active.any():
+            break
+        lighter = numpy.maximum(damping * 0.1, least)
+        _, after, trial_cost = ik_numeric_step(target, trial, lighter)
+        better = numpy.logical_and(active, trial_cost < cost)
+        worse = numpy.logical_and(active, trial_cost >= cost)
+        q = numpy.where(better[..., None], trial, q)
+        cost = numpy.where(better, trial_cost, cost)
+        damping = numpy.where(better, lighter, numpy.where(worse, damping * 10.0, damping))
+        status = numpy.where(numpy.logical_and(worse, damping > most), IK_NUMERIC_STALLED, status)
+        _, retry, _ = ik_numeric_step(target, q, damping)
+        trial = numpy.where(better[..., None], after, numpy.where(worse[..., None], retry, trial))
+    status = numpy.where(numpy.logical_and(status == IK_NUMERIC_ITERATION_LIMIT, cost <= tol * tol), IK_NUMERIC_CONVERGED, status)
+    q = numpy.where((status == IK_NUMERIC_INVALID)[..., None], numpy.asarray(q0, dtype=float), q)
+    return q, status[()] if status.ndim == 0 else status
 
 
 # Statuses of velocity_ik: OK, singular (a diagonal entry of the QR factor R of the

@@ -385,6 +385,113 @@ def _velocity_ik(q, mu_dot, damping):
     return [q_dot, status]
 
 
+def _ik_numeric_step(target, q, damping):
+    """One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite): 220 operations."""
+    mu0 = target[0]
+    mu1 = target[1]
+    mu2 = target[2]
+    mu3 = target[3]
+    qs1 = q[0]
+    qs2 = q[1]
+    qs3 = q[2]
+    qs4 = q[3]
+    q1 = casadi.if_else((qs1 < -0.8726646259971648), -0.8726646259971648, casadi.if_else((qs1 > 0.8726646259971648), 0.8726646259971648, qs1))
+    q2 = casadi.if_else((qs2 < -1.53588974175501), -1.53588974175501, casadi.if_else((qs2 > 1.53588974175501), 1.53588974175501, qs2))
+    q3 = casadi.if_else((qs3 < 0), 0.0, casadi.if_else((qs3 > 0.21), 0.21, qs3))
+    q4 = casadi.if_else((qs4 < -6.283185307179586), -6.283185307179586, casadi.if_else((qs4 > 6.283185307179586), 6.283185307179586, qs4))
+    c1 = casadi.cos(q1)
+    s1 = casadi.sin(q1)
+    c2 = casadi.cos(q2)
+    s2 = casadi.sin(q2)
+    c12 = c1*c2 - s1*s2
+    s12 = c1*s2 + c2*s1
+    c4 = casadi.cos(q4)
+    s4 = casadi.sin(q4)
+    t0 = 0.387 - q3
+    t1 = c12*c4 + s12*s4
+    t2 = -c12*s4 + c4*s12
+    t3 = mu2 - t0
+    t4 = damping + 1
+    t5 = mu0 + mu1 + mu2 + mu3 + qs1 + qs2 + qs3 + qs4
+    t6 = 0.275*c12
+    t7 = 0.325*c1 + t6
+    t8 = 0.075625*c12**2 + t7**2
+    t9 = t6 + t7
+    t10 = mu0 - t7
+    t11 = 0.275*s12
+    t12 = 0.325*s1 + t11
+    t13 = 0.075625*s12**2 + t12**2
+    t14 = 0.075625*c12*s12 + t12*t7
+    t15 = t11 + t12
+    t16 = mu1 - t12
+    t17 = -mu3 + casadi.atan2(t2, t1)
+    t18 = t17 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t17 - 0.5)
+    t19 = t10**2 + t16**2 + t18**2 + t3**2
+    t20 = damping + t13
+    t21 = casadi.sqrt(t14**2 + t15**2 + t20**2)
+    t22 = t21*casadi.if_else((t20 >= 0), 1, -1)
+    t23 = t20 + t22
+    t24 = casadi.if_else((t21 > 0), 1/(t21*(t21 + casadi.fabs(t20))), 0)
+    t25 = t24*(t10*t23 - t14*t16 + t15*t18)
+    t26 = t10 - t23*t25
+    t27 = t14*t25 + t16
+    t28 = t15*t25 - t18
+    t29 = damping + t8
+    t30 = -t24*(t14*t23 + t14*t29 + t15*t9)
+    t31 = t14 + t23*t30
+    t32 = t14*t30 + t29
+    t33 = t15*t30 + t9
+    t34 = casadi.sqrt(t32**2 + t33**2)
+    t35 = t34*casadi.if_else((t32 >= 0), 1, -1)
+    t36 = t32 + t35
+    t37 = casadi.if_else((t34 > 0), 1/(t34*(t34 + casadi.fabs(t32))), 0)
+    t38 = t37*(t27*t36 + t28*t33)
+    t39 = t27 - t36*t38
+    t40 = t28 - t33*t38
+    t41 = damping + 3
+    t42 = -t24*(t14*t9 + t15*t23 + t15*t41)
+    t43 = t15 + t23*t42
+    t44 = t14*t42 + t9
+    t45 = t15*t42 + t41
+    t46 = t37*(t33*t45 + t36*t44)
+    t47 = -t36*t46 + t44
+    t48 = -t33*t46 + t45
+    t49 = casadi.fabs(t4)
+    t50 = t49
+    t51 = t50*casadi.if_else((t4 >= 0), 1, -1)
+    t52 = t4 + t51
+    t53 = casadi.if_else((t50 > 0), 1/(t50*(t49 + t50)), 0)
+    t54 = -t3*t52**2*t53 + t3
+    t55 = t54/t51
+    t56 = q3 + t55
+    t57 = casadi.fabs(t48)
+    t58 = t57
+    t59 = t58*casadi.if_else((t48 >= 0), 1, -1)
+    t60 = t48 + t59
+    t61 = casadi.if_else((t58 > 0), 1/(t58*(t57 + t58)), 0)
+    t62 = -t40*t60**2*t61 + t40
+    t63 = t62/t59
+    t64 = (t39 + t47*t63)/t35
+    t65 = (t26 - t31*t64 - t43*t63)/t22
+    t66 = q4 + t63
+    t67 = -t63
+    t68 = q1 + t12*t65 - t64*t7 + t67
+    t69 = q2 + t11*t65 - t6*t64 + t67
+    q_start = casadi.SX(4, 1)
+    q_start[0, 0] = q1
+    q_start[1, 0] = q2
+    q_start[2, 0] = q3
+    q_start[3, 0] = q4
+    q_next = casadi.SX(4, 1)
+    q_next[0, 0] = casadi.if_else((t68 < -0.8726646259971648), -0.8726646259971648, casadi.if_else((t68 > 0.8726646259971648), 0.8726646259971648, t68))
+    q_next[1, 0] = casadi.if_else((t69 < -1.53588974175501), -1.53588974175501, casadi.if_else((t69 > 1.53588974175501), 1.53588974175501, t69))
+    q_next[2, 0] = casadi.if_else((t56 < 0), 0.0, casadi.if_else((t56 > 0.21), 0.21, t56))
+    q_next[3, 0] = casadi.if_else((t66 < -6.283185307179586), -6.283185307179586, casadi.if_else((t66 > 6.283185307179586), 6.283185307179586, t66))
+    cost = casadi.SX(1, 1)
+    cost[0, 0] = casadi.if_else((casadi.fabs(t5) < casadi.inf), t19, -1)
+    return [q_start, q_next, cost]
+
+
 def _ik_branches(mu):
     """Every branch of the closed-form ik and whether the target allows it: 120 operations."""
     mu0 = mu[0]
@@ -447,6 +554,7 @@ def _ik_branches(mu):
 _q = casadi.SX.sym("q", 4, 1)
 _mu_dot = casadi.SX.sym("mu_dot", 4, 1)
 _damping = casadi.SX.sym("damping", 1, 1)
+_target = casadi.SX.sym("target", 4, 1)
 _mu = casadi.SX.sym("mu", 4, 1)
 fk = casadi.Function("fk", [_q], _fk(_q), ["q"], ["T"])
 jacobian = casadi.Function("jacobian", [_q], _jacobian(_q), ["q"], ["J"])
@@ -458,10 +566,48 @@ singularity_factors = casadi.Function("singularity_factors", [_q], _singularity_
 manipulability = casadi.Function("manipulability", [_q], _manipulability(_q), ["q"], ["w"])
 jacobian_det = casadi.Function("jacobian_det", [_q], _jacobian_det(_q), ["q"], ["d"])
 velocity_ik = casadi.Function("velocity_ik", [_q, _mu_dot, _damping], _velocity_ik(_q, _mu_dot, _damping), ["q", "mu_dot", "damping"], ["q_dot", "status"])
+ik_numeric_step = casadi.Function("ik_numeric_step", [_target, _q, _damping], _ik_numeric_step(_target, _q, _damping), ["target", "q", "damping"], ["q_start", "q_next", "cost"])
 ik_branches = casadi.Function("ik_branches", [_mu], _ik_branches(_mu), ["mu"], ["q", "valid"])
 ik = ik_branches  # CasADi functions have fixed-size outputs: every branch and its validity
+
+IK_NUMERIC_CONVERGED = 0  # |error| <= tol
+IK_NUMERIC_ITERATION_LIMIT = 1  # IK_NUMERIC_ITERATIONS steps taken, |error| still above tol
+IK_NUMERIC_STALLED = 2  # no step reduces the error: unreachable target, joint limit or local minimum
+IK_NUMERIC_INVALID = 3  # target or q0 not finite: q = q0
+IK_NUMERIC_ITERATIONS = 100
+_DAMPING = (1e-06, 1e-12, 100000000.0)  # added to the diagonal: start, least, most
+
+
+def _ik_numeric(target, q0, tol):
+    """ik_numeric of the C and numpy modules with a fixed number of steps: every branch of
+    the loop is a select, so the graph is the same for every input."""
+    least, most = _DAMPING[1:]
+    q, trial, cost = ik_numeric_step(target, q0, _DAMPING[0])
+    damping = cost * 0.0 + _DAMPING[0]
+    status = casadi.if_else(cost >= 0.0, IK_NUMERIC_ITERATION_LIMIT, IK_NUMERIC_INVALID)
+    for _ in range(IK_NUMERIC_ITERATIONS):
+        status = casadi.if_else(casadi.logic_and(status == IK_NUMERIC_ITERATION_LIMIT, cost <= tol * tol), IK_NUMERIC_CONVERGED, status)
+        active = status == IK_NUMERIC_ITERATION_LIMIT
+        lighter = casadi.fmax(damping * 0.1, least)
+        _, after, trial_cost = ik_numeric_step(target, trial, lighter)
+        better = casadi.logic_and(active, trial_cost < cost)
+        worse = casadi.logic_and(active, trial_cost >= cost)
+        q = casadi.if_else(better, trial, q)
+        cost = casadi.if_else(better, trial_cost, cost)
+        damping = casadi.if_else(better, lighter, casadi.if_else(worse, damping * 10.0, damping))
+        status = casadi.if_else(casadi.logic_and(worse, damping > most), IK_NUMERIC_STALLED, status)
+        _, retry, _ = ik_numeric_step(target, q, damping)
+        trial = casadi.if_else(better, after, casadi.if_else(worse, retry, trial))
+    status = casadi.if_else(casadi.logic_and(status == IK_NUMERIC_ITERATION_LIMIT, cost <= tol * tol), IK_NUMERIC_CONVERGED, status)
+    q = casadi.if_else((status == IK_NUMERIC_INVALID), q0, q)
+    return [q, status]
+
+
+_tol = casadi.SX.sym("tol")
+ik_numeric = casadi.Function("ik_numeric", [_target, _q, _tol], _ik_numeric(_target, _q, _tol),
+                             ["target", "q0", "tol"], ["q", "status"])
 
 
 def functions():
     """All functions by name."""
-    return {"fk": fk, "jacobian": jacobian, "fk_jacobian": fk_jacobian, "jacobian_tool": jacobian_tool, "task": task, "task_jacobian": task_jacobian, "singularity_factors": singularity_factors, "manipulability": manipulability, "jacobian_det": jacobian_det, "velocity_ik": velocity_ik, "ik_branches": ik_branches}
+    return {"fk": fk, "jacobian": jacobian, "fk_jacobian": fk_jacobian, "jacobian_tool": jacobian_tool, "task": task, "task_jacobian": task_jacobian, "singularity_factors": singularity_factors, "manipulability": manipulability, "jacobian_det": jacobian_det, "velocity_ik": velocity_ik, "ik_numeric_step": ik_numeric_step, "ik_branches": ik_branches}

@@ -951,6 +951,315 @@ int stanford_velocity_ik(const stanford_real q[STANFORD_DOF], const stanford_rea
     return (!(t348 && t349) ? 2 : (t352 ? 1 : 0));
 }
 
+stanford_real stanford_ik_numeric_step(const stanford_real target[16], const stanford_real q[STANFORD_DOF], stanford_real damping, stanford_real q_start[STANFORD_DOF], stanford_real q_next[STANFORD_DOF])
+{
+    /* 866 operations */
+
+    /* Inputs */
+    const stanford_real T00 = target[0];
+    const stanford_real T01 = target[1];
+    const stanford_real T02 = target[2];
+    const stanford_real T03 = target[3];
+    const stanford_real T10 = target[4];
+    const stanford_real T11 = target[5];
+    const stanford_real T12 = target[6];
+    const stanford_real T13 = target[7];
+    const stanford_real T20 = target[8];
+    const stanford_real T21 = target[9];
+    const stanford_real T22 = target[10];
+    const stanford_real T23 = target[11];
+    const stanford_real qs1 = q[0];
+    const stanford_real qs2 = q[1];
+    const stanford_real qs3 = q[2];
+    const stanford_real qs4 = q[3];
+    const stanford_real qs5 = q[4];
+    const stanford_real qs6 = q[5];
+
+    /* Intermediate terms */
+    const stanford_real q1 = (qs1 < -2.9670597283903604 ? -2.9670597283903604 : (qs1 > 2.9670597283903604 ? 2.9670597283903604 : qs1));
+    const stanford_real q2 = (qs2 < -2.9670597283903604 ? -2.9670597283903604 : (qs2 > 2.9670597283903604 ? 2.9670597283903604 : qs2));
+    const stanford_real q3 = (qs3 < 0.30479999999999996 ? 0.30479999999999996 : (qs3 > 1.27 ? 1.27 : qs3));
+    const stanford_real q4 = (qs4 < -2.9670597283903604 ? -2.9670597283903604 : (qs4 > 2.9670597283903604 ? 2.9670597283903604 : qs4));
+    const stanford_real q5 = (qs5 < -1.5707963267948966 ? -1.5707963267948966 : (qs5 > 1.5707963267948966 ? 1.5707963267948966 : qs5));
+    const stanford_real q6 = (qs6 < -2.9670597283903604 ? -2.9670597283903604 : (qs6 > 2.9670597283903604 ? 2.9670597283903604 : qs6));
+    const stanford_real c1 = cos(q1);
+    const stanford_real s1 = sin(q1);
+    const stanford_real c2 = cos(q2);
+    const stanford_real s2 = sin(q2);
+    const stanford_real c4 = cos(q4);
+    const stanford_real s4 = sin(q4);
+    const stanford_real c5 = cos(q5);
+    const stanford_real s5 = sin(q5);
+    const stanford_real c6 = cos(q6);
+    const stanford_real s6 = sin(q6);
+    const stanford_real t0 = T00 + T01 + T02 + T03 + T10 + T11 + T12 + T13 + T20 + T21 + T22 + T23 + qs1 + qs2 + qs3 + qs4 + qs5 + qs6;
+    const stanford_real t1 = q3*s2;
+    const stanford_real t2 = c1*t1 - 0.1337*s1;
+    const stanford_real t3 = 0.1337*c1 + s1*t1;
+    const stanford_real t4 = c1*t2 + s1*t3;
+    const stanford_real t5 = T03 - t2;
+    const stanford_real t6 = T13 - t3;
+    const stanford_real t7 = c2*q3;
+    const stanford_real t8 = t7 + 0.412;
+    const stanford_real t9 = T23 - t8;
+    const stanford_real t10 = c4*s1;
+    const stanford_real t11 = c1*s4;
+    const stanford_real t12 = c2*t11 + t10;
+    const stanford_real t13 = c2*t10 + t11;
+    const stanford_real t14 = s1*s4;
+    const stanford_real t15 = c1*c4;
+    const stanford_real t16 = c2*t15 - t14;
+    const stanford_real t17 = c2*t14 - t15;
+    const stanford_real t18 = c1*s2;
+    const stanford_real t19 = c5*t12 - s5*t18;
+    const stanford_real t20 = c5*t18 + s5*t12;
+    const stanford_real t21 = c6*t19 + s6*t16;
+    const stanford_real t22 = c6*t16 - s6*t19;
+    const stanford_real t23 = T00*t21 + T01*t22 + T02*t20;
+    const stanford_real t24 = T10*t21 + T11*t22 + T12*t20;
+    const stanford_real t25 = T20*t21 + T21*t22 + T22*t20;
+    const stanford_real t26 = s1*s2;
+    const stanford_real t27 = c5*t17 - s5*t26;
+    const stanford_real t28 = c5*t26 + s5*t17;
+    const stanford_real t29 = c6*t27 + s6*t13;
+    const stanford_real t30 = c6*t13 - s6*t27;
+    const stanford_real t31 = T00*t29 + T01*t30 + T02*t28;
+    const stanford_real t32 = T10*t29 + T11*t30 + T12*t28;
+    const stanford_real t33 = T20*t29 + T21*t30 + T22*t28;
+    const stanford_real t34 = 0.5*t24 - 0.5*t31;
+    const stanford_real t35 = s2*s4;
+    const stanford_real t36 = c2*s5 + c5*t35;
+    const stanford_real t37 = -c2*c5 + s5*t35;
+    const stanford_real t38 = c4*s2;
+    const stanford_real t39 = c6*t36 + s6*t38;
+    const stanford_real t40 = -c6*t38 + s6*t36;
+    const stanford_real t41 = T00*t39 - T01*t40 + T02*t37;
+    const stanford_real t42 = T10*t39 - T11*t40 + T12*t37;
+    const stanford_real t43 = T20*t39 - T21*t40 + T22*t37;
+    const stanford_real t44 = 0.5*t33 + 0.5*t42;
+    const stanford_real t45 = -0.5*t25 - 0.5*t41;
+    const stanford_real t46 = sqrt((t34*t34) + (t44*t44) + (t45*t45));
+    const stanford_real t47 = (t3*t3);
+    const stanford_real t48 = (c1*c1);
+    const stanford_real t49 = t48*t7;
+    const stanford_real t50 = (s2*s2);
+    const stanford_real t51 = t48*t50;
+    const stanford_real t52 = (c2*c2);
+    const stanford_real t53 = t52 + (t4*t4);
+    const stanford_real t54 = t50*(c4*c4) + t52 + (t37*t37) + 1;
+    const stanford_real t55 = t52*(q3*q3);
+    const stanford_real t56 = t48*t55;
+    const stanford_real t57 = t47 + t51 + t56;
+    const stanford_real t58 = -t2*t3;
+    const stanford_real t59 = c1*s1;
+    const stanford_real t60 = t50*t59;
+    const stanford_real t61 = t55*t59 + t58 + t60;
+    const stanford_real t62 = t13*t16 + t20*t28 - t59 + t60;
+    const stanford_real t63 = c2*t18;
+    const stanford_real t64 = t16*t38 + t20*t37 - t63;
+    const stanford_real t65 = c1*t4;
+    const stanford_real t66 = t63 - t65*t7;
+    const stanford_real t67 = (s1*s1);
+    const stanford_real t68 = t51 + t67 + (t16*t16) + (t20*t20);
+    const stanford_real t69 = t50*t67;
+    const stanford_real t70 = t55*t67 + t69 + (t2*t2);
+    const stanford_real t71 = t48 + t69 + (t13*t13) + (t28*t28);
+    const stanford_real t72 = c2*t26;
+    const stanford_real t73 = t13*t38 + t28*t37 - t72;
+    const stanford_real t74 = s1*t4;
+    const stanford_real t75 = -t7*t74 + t72;
+    const stanford_real t76 = t67*t7;
+    const stanford_real t77 = t76;
+    const stanford_real t78 = -t43;
+    const stanford_real t79 = 0.5*t23 + 0.5*t32 + 0.5*t78 - 0.5;
+    const stanford_real t80 = atan2(t46, t79);
+    const stanford_real t81 = (t46 > 0 ? t80/t46 : 1);
+    const int t82 = t23 >= t32 && t23 >= t78;
+    const int t83 = t32 >= t78;
+    const stanford_real t84 = (t82 ? 0.5*t23 + 0.5 : (t83 ? 0.5*t31 : -0.5*t41));
+    const stanford_real t85 = (t82 ? 0.5*t24 : (t83 ? 0.5*t32 + 0.5 : -0.5*t42));
+    const stanford_real t86 = (t82 ? 0.5*t25 : (t83 ? 0.5*t33 : 0.5*t78 + 0.5));
+    const stanford_real t87 = sqrt((t84*t84) + (t85*t85) + (t86*t86));
+    const stanford_real t88 = (t34*t86 + t44*t84 + t45*t85 >= 0 ? 1 : -1);
+    const int t89 = (t46 > 1e-06) || (t79 > 0);
+    const stanford_real t90 = t80*t88/t87;
+    const stanford_real t91 = (t89 ? t44*t81 : t84*t90);
+    const stanford_real t92 = (t89 ? t45*t81 : t85*t90);
+    const stanford_real t93 = (t89 ? t34*t81 : t86*t90);
+    const stanford_real t94 = (t5*t5) + (t6*t6) + (t9*t9) + (t91*t91) + (t92*t92) + (t93*t93);
+    const stanford_real t95 = damping + t57;
+    const stanford_real t96 = sqrt(t47 + t56*t67 + (t49*t49) + (t61*t61) + (t66*t66) + (t95*t95));
+    const stanford_real t97 = t96*(t95 >= 0 ? 1 : -1);
+    const stanford_real t98 = t95 + t97;
+    const stanford_real t99 = (t96 > 0 ? 1/(t96*(t96 + fabs(t95))) : 0);
+    const stanford_real t100 = damping + t70;
+    const stanford_real t101 = t59*t7;
+    const stanford_real t102 = t99*(t100*t61 + t101*t49 + t101*t77 + t58 + t61*t98 + t66*t75);
+    const stanford_real t103 = -t102*t98 + t61;
+    const stanford_real t104 = t100 - t102*t61;
+    const stanford_real t105 = -t102*t66 + t75;
+    const stanford_real t106 = t101*t102 - t77;
+    const stanford_real t107 = t101 - t102*t49;
+    const stanford_real t108 = t102*t3 + t2;
+    const stanford_real t109 = t99*(-t101*t91 - t3*t93 + t49*t92 + t5*t98 + t6*t61 + t66*t9);
+    const stanford_real t110 = -t109*t98 + t5;
+    const stanford_real t111 = -t109*t61 + t6;
+    const stanford_real t112 = -t109*t66 + t9;
+    const stanford_real t113 = t101*t109 + t91;
+    const stanford_real t114 = -t109*t49 + t92;
+    const stanford_real t115 = t109*t3 + t93;
+    const stanford_real t116 = sqrt((t104*t104) + (t105*t105) + (t106*t106) + (t107*t107) + (t108*t108));
+    const stanford_real t117 = t116*(t104 >= 0 ? 1 : -1);
+    const stanford_real t118 = t104 + t117;
+    const stanford_real t119 = (t116 > 0 ? 1/(t116*(t116 + fabs(t104))) : 0);
+    const stanford_real t120 = t119*(t105*t112 + t106*t113 + t107*t114 + t108*t115 + t111*t118);
+    const stanford_real t121 = t111 - t118*t120;
+    const stanford_real t122 = -t105*t120 + t112;
+    const stanford_real t123 = -t106*t120 + t113;
+    const stanford_real t124 = -t107*t120 + t114;
+    const stanford_real t125 = -t108*t120 + t115;
+    const stanford_real t126 = damping + t53;
+    const stanford_real t127 = t99*(t126*t66 - t49*t65 + t61*t75 - t65*t76 + t66*t98);
+    const stanford_real t128 = -t127*t98 + t66;
+    const stanford_real t129 = -t127*t61 + t75;
+    const stanford_real t130 = t126 - t127*t66;
+    const stanford_real t131 = t101*t127 + t74;
+    const stanford_real t132 = t127*t49 + t65;
+    const stanford_real t133 = damping + t68;
+    const stanford_real t134 = t99*(-t101*t133 - t101*t98 + t3*t64 + t49*t62 - t61*t77 + t66*t74);
+    const stanford_real t135 = t101 + t134*t98;
+    const stanford_real t136 = t134*t61 + t77;
+    const stanford_real t137 = -t134*t66 + t74;
+    const stanford_real t138 = t101*t134 + t133;
+    const stanford_real t139 = -t134*t49 + t62;
+    const stanford_real t140 = -t64;
+    const stanford_real t141 = t134*t3 + t140;
+    const stanford_real t142 = t119*(t105*t137 + t106*t138 + t107*t139 + t108*t141 - t118*t136);
+    const stanford_real t143 = t118*t142 + t136;
+    const stanford_real t144 = -t105*t142 + t137;
+    const stanford_real t145 = -t106*t142 + t138;
+    const stanford_real t146 = -t107*t142 + t139;
+    const stanford_real t147 = -t108*t142 + t141;
+    const stanford_real t148 = damping + t71;
+    const stanford_real t149 = t99*(t101*t61 - t101*t62 + t148*t49 + t3*t73 + t49*t98 - t65*t66);
+    const stanford_real t150 = -t149*t98 + t49;
+    const stanford_real t151 = t101 - t149*t61;
+    const stanford_real t152 = t149*t66 + t65;
+    const stanford_real t153 = t101*t149 + t62;
+    const stanford_real t154 = t148 - t149*t49;
+    const stanford_real t155 = t149*t3 - t73;
+    const stanford_real t156 = t119*(-t105*t152 + t106*t153 + t107*t154 + t108*t155 + t118*t151);
+    const stanford_real t157 = -t118*t156 + t151;
+    const stanford_real t158 = t105*t156 + t152;
+    const stanford_real t159 = -t106*t156 + t153;
+    const stanford_real t160 = -t107*t156 + t154;
+    const stanford_real t161 = -t108*t156 + t155;
+    const stanford_real t162 = damping + t54;
+    const stanford_real t163 = -t99*(-c1*c2*q3*s1*t64 + t162*t3 - t2*t61 + t3*t98 + t49*t73);
+    const stanford_real t164 = t163*t98 + t3;
+    const stanford_real t165 = -t163*t61 + t2;
+    const stanford_real t166 = t101*t163 + t140;
+    const stanford_real t167 = t163*t49 + t73;
+    const stanford_real t168 = t162 + t163*t3;
+    const stanford_real t169 = t127*t3;
+    const stanford_real t170 = t119*(t105*t130 + t106*t131 - t107*t132 + t108*t169 + t118*t129);
+    const stanford_real t171 = -t118*t170 + t129;
+    const stanford_real t172 = -t105*t170 + t130;
+    const stanford_real t173 = -t106*t170 + t131;
+    const stanford_real t174 = t107*t170 + t132;
+    const stanford_real t175 = -t108*t170 + t169;
+    const stanford_real t176 = sqrt((t172*t172) + (t173*t173) + (t174*t174) + (t175*t175));
+    const stanford_real t177 = t176*(t172 >= 0 ? 1 : -1);
+    const stanford_real t178 = t172 + t177;
+    const stanford_real t179 = (t176 > 0 ? 1/(t176*(t176 + fabs(t172))) : 0);
+    const stanford_real t180 = t179*(t144*t178 + t145*t173 - t146*t174 + t147*t175);
+    const stanford_real t181 = t144 - t178*t180;
+    const stanford_real t182 = t145 - t173*t180;
+    const stanford_real t183 = t146 + t174*t180;
+    const stanford_real t184 = t147 - t175*t180;
+    const stanford_real t185 = t179*(-t158*t178 + t159*t173 - t160*t174 + t161*t175);
+    const stanford_real t186 = t158 + t178*t185;
+    const stanford_real t187 = t159 - t173*t185;
+    const stanford_real t188 = t160 + t174*t185;
+    const stanford_real t189 = t161 - t175*t185;
+    const stanford_real t190 = t179*(t122*t178 + t123*t173 - t124*t174 + t125*t175);
+    const stanford_real t191 = t122 - t178*t190;
+    const stanford_real t192 = t123 - t173*t190;
+    const stanford_real t193 = t124 + t174*t190;
+    const stanford_real t194 = t125 - t175*t190;
+    const stanford_real t195 = sqrt((t182*t182) + (t183*t183) + (t184*t184));
+    const stanford_real t196 = t195*(t182 >= 0 ? 1 : -1);
+    const stanford_real t197 = t182 + t196;
+    const stanford_real t198 = (t195 > 0 ? 1/(t195*(t195 + fabs(t182))) : 0);
+    const stanford_real t199 = t198*(t183*t188 + t184*t189 + t187*t197);
+    const stanford_real t200 = t187 - t197*t199;
+    const stanford_real t201 = -t183*t199 + t188;
+    const stanford_real t202 = -t184*t199 + t189;
+    const stanford_real t203 = t198*(t183*t193 + t184*t194 + t192*t197);
+    const stanford_real t204 = t192 - t197*t203;
+    const stanford_real t205 = -t183*t203 + t193;
+    const stanford_real t206 = -t184*t203 + t194;
+    const stanford_real t207 = sqrt((t201*t201) + (t202*t202));
+    const stanford_real t208 = t207*(t201 >= 0 ? 1 : -1);
+    const stanford_real t209 = t201 + t208;
+    const stanford_real t210 = (t207 > 0 ? 1/(t207*(t207 + fabs(t201))) : 0);
+    const stanford_real t211 = t210*(t202*t206 + t205*t209);
+    const stanford_real t212 = t205 - t209*t211;
+    const stanford_real t213 = -t202*t211 + t206;
+    const stanford_real t214 = t163*t66;
+    const stanford_real t215 = t119*(-t105*t214 + t106*t166 - t107*t167 + t108*t168 + t118*t165);
+    const stanford_real t216 = -t118*t215 + t165;
+    const stanford_real t217 = t105*t215 + t214;
+    const stanford_real t218 = -t106*t215 + t166;
+    const stanford_real t219 = t107*t215 + t167;
+    const stanford_real t220 = -t108*t215 + t168;
+    const stanford_real t221 = t179*(t173*t218 + t174*t219 + t175*t220 - t178*t217);
+    const stanford_real t222 = t178*t221 + t217;
+    const stanford_real t223 = -t173*t221 + t218;
+    const stanford_real t224 = t174*t221 - t219;
+    const stanford_real t225 = -t175*t221 + t220;
+    const stanford_real t226 = t198*(t183*t224 + t184*t225 + t197*t223);
+    const stanford_real t227 = -t197*t226 + t223;
+    const stanford_real t228 = -t183*t226 + t224;
+    const stanford_real t229 = -t184*t226 + t225;
+    const stanford_real t230 = t210*(t202*t229 + t209*t228);
+    const stanford_real t231 = -t209*t230 + t228;
+    const stanford_real t232 = -t202*t230 + t229;
+    const stanford_real t233 = fabs(t232);
+    const stanford_real t234 = t233;
+    const stanford_real t235 = t234*(t232 >= 0 ? 1 : -1);
+    const stanford_real t236 = t232 + t235;
+    const stanford_real t237 = (t234 > 0 ? 1/(t234*(t233 + t234)) : 0);
+    const stanford_real t238 = -t213*t237*(t236*t236) + t213;
+    const stanford_real t239 = t238/t235;
+    const stanford_real t240 = (t212 + t231*t239)/t208;
+    const stanford_real t241 = (t200*t240 + t204 + t227*t239)/t196;
+    const stanford_real t242 = (t181*t241 - t186*t240 + t191 - t222*t239)/t177;
+    const stanford_real t243 = (t121 - t143*t241 + t157*t240 + t171*t242 + t216*t239)/t117;
+    const stanford_real t244 = (t103*t243 + t110 + t128*t242 - t135*t241 + t150*t240 - t164*t239)/t97;
+    const stanford_real t245 = q1 - t2*t243 - t239 + t244*t3;
+    const stanford_real t246 = -c1*t240 - c1*t244*t7 + q2 + s1*t241 - s1*t243*t7 + t242*t4;
+    const stanford_real t247 = c2*t242 - q3 + t18*t244 + t243*t26;
+    const stanford_real t248 = c2*t239 - q4 + t18*t241 + t240*t26;
+    const stanford_real t249 = q5 - t13*t240 - t16*t241 + t239*t38;
+    const stanford_real t250 = q6 - t20*t241 + t239*t37 - t240*t28;
+
+    /* Outputs */
+    q_start[0] = q1;
+    q_start[1] = q2;
+    q_start[2] = q3;
+    q_start[3] = q4;
+    q_start[4] = q5;
+    q_start[5] = q6;
+    q_next[0] = (t245 < -2.9670597283903604 ? -2.9670597283903604 : (t245 > 2.9670597283903604 ? 2.9670597283903604 : t245));
+    q_next[1] = (t246 < -2.9670597283903604 ? -2.9670597283903604 : (t246 > 2.9670597283903604 ? 2.9670597283903604 : t246));
+    q_next[2] = (t247 > -0.30479999999999996 ? 0.30479999999999996 : (t247 < -1.27 ? 1.27 : -t247));
+    q_next[3] = (t248 > 2.9670597283903604 ? -2.9670597283903604 : (t248 < -2.9670597283903604 ? 2.9670597283903604 : -t248));
+    q_next[4] = (t249 < -1.5707963267948966 ? -1.5707963267948966 : (t249 > 1.5707963267948966 ? 1.5707963267948966 : t249));
+    q_next[5] = (t250 < -2.9670597283903604 ? -2.9670597283903604 : (t250 > 2.9670597283903604 ? 2.9670597283903604 : t250));
+    return (isfinite(t0) ? t94 : -1);
+}
+
 void stanford_ik_branches(const stanford_real T[16], stanford_real q[STANFORD_MAX_IK_SOLUTIONS * STANFORD_DOF], int valid[STANFORD_MAX_IK_SOLUTIONS])
 {
     /* 630 operations */
@@ -1330,179 +1639,39 @@ int stanford_ik(const stanford_real T[16], stanford_real q[STANFORD_MAX_IK_SOLUT
     return count;
 }
 
-/* -- Iterative inverse kinematics -- */
-
-/* The rotation vector (axis times angle in [0, pi]) of the rotation matrix E (row-major). */
-static void stanford_rotation_vector(const stanford_real E[9], stanford_real out[3])
-{
-    const stanford_real v[3] = {0.5 * (E[7] - E[5]), 0.5 * (E[2] - E[6]), 0.5 * (E[3] - E[1])};
-    const stanford_real cos_angle = 0.5 * (E[0] + E[4] + E[8] - 1.0);
-    const stanford_real sin_angle = sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
-    const stanford_real angle = atan2(sin_angle, cos_angle);
-    stanford_real axis[3], length, sign;
-    int i, column = 0;
-    if (sin_angle > 1e-6 || cos_angle > 0.0) {
-        const stanford_real scale = sin_angle > 0.0 ? angle / sin_angle : 1.0;
-        for (i = 0; i < 3; ++i) {
-            out[i] = scale * v[i];
-        }
-        return;
-    }
-    /* Near a half turn: the axis from the largest column of (E + I) / 2 = u u^T. */
-    for (i = 1; i < 3; ++i) {
-        if (E[4 * i] > E[4 * column]) {
-            column = i;
-        }
-    }
-    for (i = 0; i < 3; ++i) {
-        axis[i] = 0.5 * (E[3 * i + column] + (i == column ? 1.0 : 0.0));
-    }
-    length = sqrt(axis[0] * axis[0] + axis[1] * axis[1] + axis[2] * axis[2]);
-    sign = axis[0] * v[0] + axis[1] * v[1] + axis[2] * v[2] >= 0.0 ? 1.0 : -1.0;
-    for (i = 0; i < 3; ++i) {
-        out[i] = sign * angle * axis[i] / length;
-    }
-}
-
-/* Error [target position - position; rotation vector of target R^T] and the geometric Jacobian. */
-static void stanford_task_error(const stanford_real target[16], const stanford_real q[STANFORD_DOF], stanford_real e[6], stanford_real J[6 * STANFORD_DOF])
-{
-    stanford_real T[16], E[9];
-    int i, j;
-    stanford_fk(q, T);
-    stanford_jacobian(q, J);
-    for (i = 0; i < 3; ++i) {
-        e[i] = target[4 * i + 3] - T[4 * i + 3];
-        for (j = 0; j < 3; ++j) {
-            E[3 * i + j] = target[4 * i] * T[4 * j] + target[4 * i + 1] * T[4 * j + 1] + target[4 * i + 2] * T[4 * j + 2];
-        }
-    }
-    stanford_rotation_vector(E, e + 3);
-}
-
-/* Joints clamped to their limits. */
-static void stanford_clamp(stanford_real q[STANFORD_DOF])
-{
-    q[0] = q[0] < -2.9670597283903604 ? -2.9670597283903604 : q[0] > 2.9670597283903604 ? 2.9670597283903604 : q[0];
-    q[1] = q[1] < -2.9670597283903604 ? -2.9670597283903604 : q[1] > 2.9670597283903604 ? 2.9670597283903604 : q[1];
-    q[2] = q[2] < 0.30479999999999996 ? 0.30479999999999996 : q[2] > 1.27 ? 1.27 : q[2];
-    q[3] = q[3] < -2.9670597283903604 ? -2.9670597283903604 : q[3] > 2.9670597283903604 ? 2.9670597283903604 : q[3];
-    q[4] = q[4] < -1.5707963267948966 ? -1.5707963267948966 : q[4] > 1.5707963267948966 ? 1.5707963267948966 : q[4];
-    q[5] = q[5] < -2.9670597283903604 ? -2.9670597283903604 : q[5] > 2.9670597283903604 ? 2.9670597283903604 : q[5];
-}
-
-/* Solves A x = b in place (b becomes x) for the symmetric positive definite K x K matrix A by
- * Cholesky; returns 0 when A is not numerically positive definite. */
-static int stanford_cholesky_solve(stanford_real A[36], stanford_real b[6])
-{
-    int i, j, k;
-    for (j = 0; j < 6; ++j) {
-        stanford_real diagonal = A[6 * j + j];
-        for (k = 0; k < j; ++k) {
-            diagonal -= A[6 * j + k] * A[6 * j + k];
-        }
-        if (!(diagonal > 0.0)) {
-            return 0;
-        }
-        A[6 * j + j] = sqrt(diagonal);
-        for (i = j + 1; i < 6; ++i) {
-            stanford_real sum = A[6 * i + j];
-            for (k = 0; k < j; ++k) {
-                sum -= A[6 * i + k] * A[6 * j + k];
-            }
-            A[6 * i + j] = sum / A[6 * j + j];
-        }
-    }
-    for (i = 0; i < 6; ++i) {
-        for (k = 0; k < i; ++k) {
-            b[i] -= A[6 * i + k] * b[k];
-        }
-        b[i] /= A[6 * i + i];
-    }
-    for (i = 6 - 1; i >= 0; --i) {
-        for (k = i + 1; k < 6; ++k) {
-            b[i] -= A[6 * k + i] * b[k];
-        }
-        b[i] /= A[6 * i + i];
-    }
-    return 1;
-}
+/* -- Iterative inverse kinematics: the loop around stanford_ik_numeric_step -- */
 
 int stanford_ik_numeric(const stanford_real target[16], const stanford_real q0[STANFORD_DOF], int max_iter, stanford_real tol, stanford_real q[STANFORD_DOF])
 {
-    stanford_real e[6], J[6 * STANFORD_DOF], trial[STANFORD_DOF], trial_e[6];
-    stanford_real trial_J[6 * STANFORD_DOF], A[36], x[6];
-    stanford_real cost, trial_cost, damping = 1e-06;
-    int i, j, k, iteration;
-    for (j = 0; j < STANFORD_DOF; ++j) {
-        q[j] = q0[j];
-    }
-    for (i = 0; i < 12; ++i) {
-        if (!isfinite(target[i])) {
-            return STANFORD_IK_NUMERIC_INVALID;
+    stanford_real trial[STANFORD_DOF], after[STANFORD_DOF], start[STANFORD_DOF];
+    stanford_real cost, trial_cost, lighter, damping = 1e-06;
+    int j, iteration;
+    cost = stanford_ik_numeric_step(target, q0, damping, q, trial);
+    if (!(cost >= 0) || max_iter < 0) { /* -1: target or q0 not finite */
+        for (j = 0; j < STANFORD_DOF; ++j) {
+            q[j] = q0[j];
         }
-    }
-    for (j = 0; j < STANFORD_DOF; ++j) {
-        if (!isfinite(q0[j])) {
-            return STANFORD_IK_NUMERIC_INVALID;
-        }
-    }
-    if (max_iter < 0) {
         return STANFORD_IK_NUMERIC_INVALID;
-    }
-    stanford_clamp(q);
-    stanford_task_error(target, q, e, J);
-    cost = 0.0;
-    for (i = 0; i < 6; ++i) {
-        cost += e[i] * e[i];
     }
     for (iteration = 0; iteration < max_iter; ++iteration) {
         if (cost <= tol * tol) {
             return STANFORD_IK_NUMERIC_CONVERGED;
         }
-        /* A = J J^T + damping I, x = A^-1 e, step J^T x */
-        for (i = 0; i < 6; ++i) {
-            x[i] = e[i];
-            for (k = 0; k < 6; ++k) {
-                stanford_real sum = i == k ? damping : 0.0;
-                for (j = 0; j < STANFORD_DOF; ++j) {
-                    sum += J[STANFORD_DOF * i + j] * J[STANFORD_DOF * k + j];
-                }
-                A[6 * i + k] = sum;
-            }
-        }
-        if (!stanford_cholesky_solve(A, x)) {
-            return STANFORD_IK_NUMERIC_STALLED;
-        }
-        for (j = 0; j < STANFORD_DOF; ++j) {
-            trial[j] = q[j];
-            for (i = 0; i < 6; ++i) {
-                trial[j] += J[STANFORD_DOF * i + j] * x[i];
-            }
-        }
-        stanford_clamp(trial);
-        stanford_task_error(target, trial, trial_e, trial_J);
-        trial_cost = 0.0;
-        for (i = 0; i < 6; ++i) {
-            trial_cost += trial_e[i] * trial_e[i];
-        }
+        lighter = damping * 0.1 > 1e-12 ? damping * 0.1 : 1e-12;
+        trial_cost = stanford_ik_numeric_step(target, trial, lighter, start, after);
         if (trial_cost < cost) {
             for (j = 0; j < STANFORD_DOF; ++j) {
                 q[j] = trial[j];
-            }
-            for (i = 0; i < 6; ++i) {
-                e[i] = trial_e[i];
-            }
-            for (i = 0; i < 6 * STANFORD_DOF; ++i) {
-                J[i] = trial_J[i];
+                trial[j] = after[j];
             }
             cost = trial_cost;
-            damping = damping * 0.1 > 1e-12 ? damping * 0.1 : 1e-12;
+            damping = lighter;
         } else {
             damping *= 10.0;
             if (damping > 100000000.0) {
                 return STANFORD_IK_NUMERIC_STALLED;
             }
+            (void)stanford_ik_numeric_step(target, q, damping, start, trial);
         }
     }
     return cost <= tol * tol ? STANFORD_IK_NUMERIC_CONVERGED : STANFORD_IK_NUMERIC_ITERATION_LIMIT;

@@ -849,6 +849,312 @@ def _velocity_ik(q, mu_dot, damping):
     return [q_dot, status]
 
 
+def _ik_numeric_step(target, q, damping):
+    """One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite): 866 operations."""
+    T00 = target[0, 0]
+    T01 = target[0, 1]
+    T02 = target[0, 2]
+    T03 = target[0, 3]
+    T10 = target[1, 0]
+    T11 = target[1, 1]
+    T12 = target[1, 2]
+    T13 = target[1, 3]
+    T20 = target[2, 0]
+    T21 = target[2, 1]
+    T22 = target[2, 2]
+    T23 = target[2, 3]
+    qs1 = q[0]
+    qs2 = q[1]
+    qs3 = q[2]
+    qs4 = q[3]
+    qs5 = q[4]
+    qs6 = q[5]
+    q1 = casadi.if_else((qs1 < -2.9670597283903604), -2.9670597283903604, casadi.if_else((qs1 > 2.9670597283903604), 2.9670597283903604, qs1))
+    q2 = casadi.if_else((qs2 < -2.9670597283903604), -2.9670597283903604, casadi.if_else((qs2 > 2.9670597283903604), 2.9670597283903604, qs2))
+    q3 = casadi.if_else((qs3 < 0.30479999999999996), 0.30479999999999996, casadi.if_else((qs3 > 1.27), 1.27, qs3))
+    q4 = casadi.if_else((qs4 < -2.9670597283903604), -2.9670597283903604, casadi.if_else((qs4 > 2.9670597283903604), 2.9670597283903604, qs4))
+    q5 = casadi.if_else((qs5 < -1.5707963267948966), -1.5707963267948966, casadi.if_else((qs5 > 1.5707963267948966), 1.5707963267948966, qs5))
+    q6 = casadi.if_else((qs6 < -2.9670597283903604), -2.9670597283903604, casadi.if_else((qs6 > 2.9670597283903604), 2.9670597283903604, qs6))
+    c1 = casadi.cos(q1)
+    s1 = casadi.sin(q1)
+    c2 = casadi.cos(q2)
+    s2 = casadi.sin(q2)
+    c4 = casadi.cos(q4)
+    s4 = casadi.sin(q4)
+    c5 = casadi.cos(q5)
+    s5 = casadi.sin(q5)
+    c6 = casadi.cos(q6)
+    s6 = casadi.sin(q6)
+    t0 = T00 + T01 + T02 + T03 + T10 + T11 + T12 + T13 + T20 + T21 + T22 + T23 + qs1 + qs2 + qs3 + qs4 + qs5 + qs6
+    t1 = q3*s2
+    t2 = c1*t1 - 0.1337*s1
+    t3 = 0.1337*c1 + s1*t1
+    t4 = c1*t2 + s1*t3
+    t5 = T03 - t2
+    t6 = T13 - t3
+    t7 = c2*q3
+    t8 = t7 + 0.412
+    t9 = T23 - t8
+    t10 = c4*s1
+    t11 = c1*s4
+    t12 = c2*t11 + t10
+    t13 = c2*t10 + t11
+    t14 = s1*s4
+    t15 = c1*c4
+    t16 = c2*t15 - t14
+    t17 = c2*t14 - t15
+    t18 = c1*s2
+    t19 = c5*t12 - s5*t18
+    t20 = c5*t18 + s5*t12
+    t21 = c6*t19 + s6*t16
+    t22 = c6*t16 - s6*t19
+    t23 = T00*t21 + T01*t22 + T02*t20
+    t24 = T10*t21 + T11*t22 + T12*t20
+    t25 = T20*t21 + T21*t22 + T22*t20
+    t26 = s1*s2
+    t27 = c5*t17 - s5*t26
+    t28 = c5*t26 + s5*t17
+    t29 = c6*t27 + s6*t13
+    t30 = c6*t13 - s6*t27
+    t31 = T00*t29 + T01*t30 + T02*t28
+    t32 = T10*t29 + T11*t30 + T12*t28
+    t33 = T20*t29 + T21*t30 + T22*t28
+    t34 = 0.5*t24 - 0.5*t31
+    t35 = s2*s4
+    t36 = c2*s5 + c5*t35
+    t37 = -c2*c5 + s5*t35
+    t38 = c4*s2
+    t39 = c6*t36 + s6*t38
+    t40 = -c6*t38 + s6*t36
+    t41 = T00*t39 - T01*t40 + T02*t37
+    t42 = T10*t39 - T11*t40 + T12*t37
+    t43 = T20*t39 - T21*t40 + T22*t37
+    t44 = 0.5*t33 + 0.5*t42
+    t45 = -0.5*t25 - 0.5*t41
+    t46 = casadi.sqrt(t34**2 + t44**2 + t45**2)
+    t47 = t3**2
+    t48 = c1**2
+    t49 = t48*t7
+    t50 = s2**2
+    t51 = t48*t50
+    t52 = c2**2
+    t53 = t4**2 + t52
+    t54 = c4**2*t50 + t37**2 + t52 + 1
+    t55 = q3**2*t52
+    t56 = t48*t55
+    t57 = t47 + t51 + t56
+    t58 = -t2*t3
+    t59 = c1*s1
+    t60 = t50*t59
+    t61 = t55*t59 + t58 + t60
+    t62 = t13*t16 + t20*t28 - t59 + t60
+    t63 = c2*t18
+    t64 = t16*t38 + t20*t37 - t63
+    t65 = c1*t4
+    t66 = t63 - t65*t7
+    t67 = s1**2
+    t68 = t16**2 + t20**2 + t51 + t67
+    t69 = t50*t67
+    t70 = t2**2 + t55*t67 + t69
+    t71 = t13**2 + t28**2 + t48 + t69
+    t72 = c2*t26
+    t73 = t13*t38 + t28*t37 - t72
+    t74 = s1*t4
+    t75 = -t7*t74 + t72
+    t76 = t67*t7
+    t77 = t76
+    t78 = -t43
+    t79 = 0.5*t23 + 0.5*t32 + 0.5*t78 - 0.5
+    t80 = casadi.atan2(t46, t79)
+    t81 = casadi.if_else((t46 > 0), t80/t46, 1)
+    t82 = casadi.logic_and((t23 >= t32), (t23 >= t78))
+    t83 = (t32 >= t78)
+    t84 = casadi.if_else(t82, 0.5*t23 + 0.5, casadi.if_else(t83, 0.5*t31, -0.5*t41))
+    t85 = casadi.if_else(t82, 0.5*t24, casadi.if_else(t83, 0.5*t32 + 0.5, -0.5*t42))
+    t86 = casadi.if_else(t82, 0.5*t25, casadi.if_else(t83, 0.5*t33, 0.5*t78 + 0.5))
+    t87 = casadi.sqrt(t84**2 + t85**2 + t86**2)
+    t88 = casadi.if_else((t34*t86 + t44*t84 + t45*t85 >= 0), 1, -1)
+    t89 = casadi.logic_or((t46 > 1e-06), (t79 > 0))
+    t90 = t80*t88/t87
+    t91 = casadi.if_else(t89, t44*t81, t84*t90)
+    t92 = casadi.if_else(t89, t45*t81, t85*t90)
+    t93 = casadi.if_else(t89, t34*t81, t86*t90)
+    t94 = t5**2 + t6**2 + t9**2 + t91**2 + t92**2 + t93**2
+    t95 = damping + t57
+    t96 = casadi.sqrt(t47 + t49**2 + t56*t67 + t61**2 + t66**2 + t95**2)
+    t97 = t96*casadi.if_else((t95 >= 0), 1, -1)
+    t98 = t95 + t97
+    t99 = casadi.if_else((t96 > 0), 1/(t96*(t96 + casadi.fabs(t95))), 0)
+    t100 = damping + t70
+    t101 = t59*t7
+    t102 = t99*(t100*t61 + t101*t49 + t101*t77 + t58 + t61*t98 + t66*t75)
+    t103 = -t102*t98 + t61
+    t104 = t100 - t102*t61
+    t105 = -t102*t66 + t75
+    t106 = t101*t102 - t77
+    t107 = t101 - t102*t49
+    t108 = t102*t3 + t2
+    t109 = t99*(-t101*t91 - t3*t93 + t49*t92 + t5*t98 + t6*t61 + t66*t9)
+    t110 = -t109*t98 + t5
+    t111 = -t109*t61 + t6
+    t112 = -t109*t66 + t9
+    t113 = t101*t109 + t91
+    t114 = -t109*t49 + t92
+    t115 = t109*t3 + t93
+    t116 = casadi.sqrt(t104**2 + t105**2 + t106**2 + t107**2 + t108**2)
+    t117 = t116*casadi.if_else((t104 >= 0), 1, -1)
+    t118 = t104 + t117
+    t119 = casadi.if_else((t116 > 0), 1/(t116*(t116 + casadi.fabs(t104))), 0)
+    t120 = t119*(t105*t112 + t106*t113 + t107*t114 + t108*t115 + t111*t118)
+    t121 = t111 - t118*t120
+    t122 = -t105*t120 + t112
+    t123 = -t106*t120 + t113
+    t124 = -t107*t120 + t114
+    t125 = -t108*t120 + t115
+    t126 = damping + t53
+    t127 = t99*(t126*t66 - t49*t65 + t61*t75 - t65*t76 + t66*t98)
+    t128 = -t127*t98 + t66
+    t129 = -t127*t61 + t75
+    t130 = t126 - t127*t66
+    t131 = t101*t127 + t74
+    t132 = t127*t49 + t65
+    t133 = damping + t68
+    t134 = t99*(-t101*t133 - t101*t98 + t3*t64 + t49*t62 - t61*t77 + t66*t74)
+    t135 = t101 + t134*t98
+    t136 = t134*t61 + t77
+    t137 = -t134*t66 + t74
+    t138 = t101*t134 + t133
+    t139 = -t134*t49 + t62
+    t140 = -t64
+    t141 = t134*t3 + t140
+    t142 = t119*(t105*t137 + t106*t138 + t107*t139 + t108*t141 - t118*t136)
+    t143 = t118*t142 + t136
+    t144 = -t105*t142 + t137
+    t145 = -t106*t142 + t138
+    t146 = -t107*t142 + t139
+    t147 = -t108*t142 + t141
+    t148 = damping + t71
+    t149 = t99*(t101*t61 - t101*t62 + t148*t49 + t3*t73 + t49*t98 - t65*t66)
+    t150 = -t149*t98 + t49
+    t151 = t101 - t149*t61
+    t152 = t149*t66 + t65
+    t153 = t101*t149 + t62
+    t154 = t148 - t149*t49
+    t155 = t149*t3 - t73
+    t156 = t119*(-t105*t152 + t106*t153 + t107*t154 + t108*t155 + t118*t151)
+    t157 = -t118*t156 + t151
+    t158 = t105*t156 + t152
+    t159 = -t106*t156 + t153
+    t160 = -t107*t156 + t154
+    t161 = -t108*t156 + t155
+    t162 = damping + t54
+    t163 = -t99*(-c1*c2*q3*s1*t64 + t162*t3 - t2*t61 + t3*t98 + t49*t73)
+    t164 = t163*t98 + t3
+    t165 = -t163*t61 + t2
+    t166 = t101*t163 + t140
+    t167 = t163*t49 + t73
+    t168 = t162 + t163*t3
+    t169 = t127*t3
+    t170 = t119*(t105*t130 + t106*t131 - t107*t132 + t108*t169 + t118*t129)
+    t171 = -t118*t170 + t129
+    t172 = -t105*t170 + t130
+    t173 = -t106*t170 + t131
+    t174 = t107*t170 + t132
+    t175 = -t108*t170 + t169
+    t176 = casadi.sqrt(t172**2 + t173**2 + t174**2 + t175**2)
+    t177 = t176*casadi.if_else((t172 >= 0), 1, -1)
+    t178 = t172 + t177
+    t179 = casadi.if_else((t176 > 0), 1/(t176*(t176 + casadi.fabs(t172))), 0)
+    t180 = t179*(t144*t178 + t145*t173 - t146*t174 + t147*t175)
+    t181 = t144 - t178*t180
+    t182 = t145 - t173*t180
+    t183 = t146 + t174*t180
+    t184 = t147 - t175*t180
+    t185 = t179*(-t158*t178 + t159*t173 - t160*t174 + t161*t175)
+    t186 = t158 + t178*t185
+    t187 = t159 - t173*t185
+    t188 = t160 + t174*t185
+    t189 = t161 - t175*t185
+    t190 = t179*(t122*t178 + t123*t173 - t124*t174 + t125*t175)
+    t191 = t122 - t178*t190
+    t192 = t123 - t173*t190
+    t193 = t124 + t174*t190
+    t194 = t125 - t175*t190
+    t195 = casadi.sqrt(t182**2 + t183**2 + t184**2)
+    t196 = t195*casadi.if_else((t182 >= 0), 1, -1)
+    t197 = t182 + t196
+    t198 = casadi.if_else((t195 > 0), 1/(t195*(t195 + casadi.fabs(t182))), 0)
+    t199 = t198*(t183*t188 + t184*t189 + t187*t197)
+    t200 = t187 - t197*t199
+    t201 = -t183*t199 + t188
+    t202 = -t184*t199 + t189
+    t203 = t198*(t183*t193 + t184*t194 + t192*t197)
+    t204 = t192 - t197*t203
+    t205 = -t183*t203 + t193
+    t206 = -t184*t203 + t194
+    t207 = casadi.sqrt(t201**2 + t202**2)
+    t208 = t207*casadi.if_else((t201 >= 0), 1, -1)
+    t209 = t201 + t208
+    t210 = casadi.if_else((t207 > 0), 1/(t207*(t207 + casadi.fabs(t201))), 0)
+    t211 = t210*(t202*t206 + t205*t209)
+    t212 = t205 - t209*t211
+    t213 = -t202*t211 + t206
+    t214 = t163*t66
+    t215 = t119*(-t105*t214 + t106*t166 - t107*t167 + t108*t168 + t118*t165)
+    t216 = -t118*t215 + t165
+    t217 = t105*t215 + t214
+    t218 = -t106*t215 + t166
+    t219 = t107*t215 + t167
+    t220 = -t108*t215 + t168
+    t221 = t179*(t173*t218 + t174*t219 + t175*t220 - t178*t217)
+    t222 = t178*t221 + t217
+    t223 = -t173*t221 + t218
+    t224 = t174*t221 - t219
+    t225 = -t175*t221 + t220
+    t226 = t198*(t183*t224 + t184*t225 + t197*t223)
+    t227 = -t197*t226 + t223
+    t228 = -t183*t226 + t224
+    t229 = -t184*t226 + t225
+    t230 = t210*(t202*t229 + t209*t228)
+    t231 = -t209*t230 + t228
+    t232 = -t202*t230 + t229
+    t233 = casadi.fabs(t232)
+    t234 = t233
+    t235 = t234*casadi.if_else((t232 >= 0), 1, -1)
+    t236 = t232 + t235
+    t237 = casadi.if_else((t234 > 0), 1/(t234*(t233 + t234)), 0)
+    t238 = -t213*t236**2*t237 + t213
+    t239 = t238/t235
+    t240 = (t212 + t231*t239)/t208
+    t241 = (t200*t240 + t204 + t227*t239)/t196
+    t242 = (t181*t241 - t186*t240 + t191 - t222*t239)/t177
+    t243 = (t121 - t143*t241 + t157*t240 + t171*t242 + t216*t239)/t117
+    t244 = (t103*t243 + t110 + t128*t242 - t135*t241 + t150*t240 - t164*t239)/t97
+    t245 = q1 - t2*t243 - t239 + t244*t3
+    t246 = -c1*t240 - c1*t244*t7 + q2 + s1*t241 - s1*t243*t7 + t242*t4
+    t247 = c2*t242 - q3 + t18*t244 + t243*t26
+    t248 = c2*t239 - q4 + t18*t241 + t240*t26
+    t249 = q5 - t13*t240 - t16*t241 + t239*t38
+    t250 = q6 - t20*t241 + t239*t37 - t240*t28
+    q_start = casadi.SX(6, 1)
+    q_start[0, 0] = q1
+    q_start[1, 0] = q2
+    q_start[2, 0] = q3
+    q_start[3, 0] = q4
+    q_start[4, 0] = q5
+    q_start[5, 0] = q6
+    q_next = casadi.SX(6, 1)
+    q_next[0, 0] = casadi.if_else((t245 < -2.9670597283903604), -2.9670597283903604, casadi.if_else((t245 > 2.9670597283903604), 2.9670597283903604, t245))
+    q_next[1, 0] = casadi.if_else((t246 < -2.9670597283903604), -2.9670597283903604, casadi.if_else((t246 > 2.9670597283903604), 2.9670597283903604, t246))
+    q_next[2, 0] = casadi.if_else((t247 > -0.30479999999999996), 0.30479999999999996, casadi.if_else((t247 < -1.27), 1.27, -t247))
+    q_next[3, 0] = casadi.if_else((t248 > 2.9670597283903604), -2.9670597283903604, casadi.if_else((t248 < -2.9670597283903604), 2.9670597283903604, -t248))
+    q_next[4, 0] = casadi.if_else((t249 < -1.5707963267948966), -1.5707963267948966, casadi.if_else((t249 > 1.5707963267948966), 1.5707963267948966, t249))
+    q_next[5, 0] = casadi.if_else((t250 < -2.9670597283903604), -2.9670597283903604, casadi.if_else((t250 > 2.9670597283903604), 2.9670597283903604, t250))
+    cost = casadi.SX(1, 1)
+    cost[0, 0] = casadi.if_else((casadi.fabs(t0) < casadi.inf), t94, -1)
+    return [q_start, q_next, cost]
+
+
 def _ik_branches(T):
     """Every branch of the closed-form ik and whether the target allows it: 630 operations."""
     T00 = T[0, 0]
@@ -1210,6 +1516,7 @@ def _ik_branches(T):
 _q = casadi.SX.sym("q", 6, 1)
 _mu_dot = casadi.SX.sym("mu_dot", 6, 1)
 _damping = casadi.SX.sym("damping", 1, 1)
+_target = casadi.SX.sym("target", 4, 4)
 _T = casadi.SX.sym("T", 4, 4)
 fk = casadi.Function("fk", [_q], _fk(_q), ["q"], ["T"])
 jacobian = casadi.Function("jacobian", [_q], _jacobian(_q), ["q"], ["J"])
@@ -1221,10 +1528,48 @@ singularity_factors = casadi.Function("singularity_factors", [_q], _singularity_
 manipulability = casadi.Function("manipulability", [_q], _manipulability(_q), ["q"], ["w"])
 jacobian_det = casadi.Function("jacobian_det", [_q], _jacobian_det(_q), ["q"], ["d"])
 velocity_ik = casadi.Function("velocity_ik", [_q, _mu_dot, _damping], _velocity_ik(_q, _mu_dot, _damping), ["q", "mu_dot", "damping"], ["q_dot", "status"])
+ik_numeric_step = casadi.Function("ik_numeric_step", [_target, _q, _damping], _ik_numeric_step(_target, _q, _damping), ["target", "q", "damping"], ["q_start", "q_next", "cost"])
 ik_branches = casadi.Function("ik_branches", [_T], _ik_branches(_T), ["T"], ["q", "valid"])
 ik = ik_branches  # CasADi functions have fixed-size outputs: every branch and its validity
+
+IK_NUMERIC_CONVERGED = 0  # |error| <= tol
+IK_NUMERIC_ITERATION_LIMIT = 1  # IK_NUMERIC_ITERATIONS steps taken, |error| still above tol
+IK_NUMERIC_STALLED = 2  # no step reduces the error: unreachable target, joint limit or local minimum
+IK_NUMERIC_INVALID = 3  # target or q0 not finite: q = q0
+IK_NUMERIC_ITERATIONS = 100
+_DAMPING = (1e-06, 1e-12, 100000000.0)  # added to the diagonal: start, least, most
+
+
+def _ik_numeric(target, q0, tol):
+    """ik_numeric of the C and numpy modules with a fixed number of steps: every branch of
+    the loop is a select, so the graph is the same for every input."""
+    least, most = _DAMPING[1:]
+    q, trial, cost = ik_numeric_step(target, q0, _DAMPING[0])
+    damping = cost * 0.0 + _DAMPING[0]
+    status = casadi.if_else(cost >= 0.0, IK_NUMERIC_ITERATION_LIMIT, IK_NUMERIC_INVALID)
+    for _ in range(IK_NUMERIC_ITERATIONS):
+        status = casadi.if_else(casadi.logic_and(status == IK_NUMERIC_ITERATION_LIMIT, cost <= tol * tol), IK_NUMERIC_CONVERGED, status)
+        active = status == IK_NUMERIC_ITERATION_LIMIT
+        lighter = casadi.fmax(damping * 0.1, least)
+        _, after, trial_cost = ik_numeric_step(target, trial, lighter)
+        better = casadi.logic_and(active, trial_cost < cost)
+        worse = casadi.logic_and(active, trial_cost >= cost)
+        q = casadi.if_else(better, trial, q)
+        cost = casadi.if_else(better, trial_cost, cost)
+        damping = casadi.if_else(better, lighter, casadi.if_else(worse, damping * 10.0, damping))
+        status = casadi.if_else(casadi.logic_and(worse, damping > most), IK_NUMERIC_STALLED, status)
+        _, retry, _ = ik_numeric_step(target, q, damping)
+        trial = casadi.if_else(better, after, casadi.if_else(worse, retry, trial))
+    status = casadi.if_else(casadi.logic_and(status == IK_NUMERIC_ITERATION_LIMIT, cost <= tol * tol), IK_NUMERIC_CONVERGED, status)
+    q = casadi.if_else((status == IK_NUMERIC_INVALID), q0, q)
+    return [q, status]
+
+
+_tol = casadi.SX.sym("tol")
+ik_numeric = casadi.Function("ik_numeric", [_target, _q, _tol], _ik_numeric(_target, _q, _tol),
+                             ["target", "q0", "tol"], ["q", "status"])
 
 
 def functions():
     """All functions by name."""
-    return {"fk": fk, "jacobian": jacobian, "fk_jacobian": fk_jacobian, "jacobian_tool": jacobian_tool, "task": task, "task_jacobian": task_jacobian, "singularity_factors": singularity_factors, "manipulability": manipulability, "jacobian_det": jacobian_det, "velocity_ik": velocity_ik, "ik_branches": ik_branches}
+    return {"fk": fk, "jacobian": jacobian, "fk_jacobian": fk_jacobian, "jacobian_tool": jacobian_tool, "task": task, "task_jacobian": task_jacobian, "singularity_factors": singularity_factors, "manipulability": manipulability, "jacobian_det": jacobian_det, "velocity_ik": velocity_ik, "ik_numeric_step": ik_numeric_step, "ik_branches": ik_branches}

@@ -1092,6 +1092,334 @@ int ur5_velocity_ik(const ur5_real q[UR5_DOF], const ur5_real mu_dot[UR5_TASK_DI
     return (!(t371 && t372) ? 2 : (t375 ? 1 : 0));
 }
 
+ur5_real ur5_ik_numeric_step(const ur5_real target[16], const ur5_real q[UR5_DOF], ur5_real damping, ur5_real q_start[UR5_DOF], ur5_real q_next[UR5_DOF])
+{
+    /* 971 operations */
+
+    /* Inputs */
+    const ur5_real T00 = target[0];
+    const ur5_real T01 = target[1];
+    const ur5_real T02 = target[2];
+    const ur5_real T03 = target[3];
+    const ur5_real T10 = target[4];
+    const ur5_real T11 = target[5];
+    const ur5_real T12 = target[6];
+    const ur5_real T13 = target[7];
+    const ur5_real T20 = target[8];
+    const ur5_real T21 = target[9];
+    const ur5_real T22 = target[10];
+    const ur5_real T23 = target[11];
+    const ur5_real qs1 = q[0];
+    const ur5_real qs2 = q[1];
+    const ur5_real qs3 = q[2];
+    const ur5_real qs4 = q[3];
+    const ur5_real qs5 = q[4];
+    const ur5_real qs6 = q[5];
+
+    /* Intermediate terms */
+    const ur5_real q1 = (qs1 < -6.283185307179586 ? -6.283185307179586 : (qs1 > 6.283185307179586 ? 6.283185307179586 : qs1));
+    const ur5_real q2 = (qs2 < -6.283185307179586 ? -6.283185307179586 : (qs2 > 6.283185307179586 ? 6.283185307179586 : qs2));
+    const ur5_real q3 = (qs3 < -6.283185307179586 ? -6.283185307179586 : (qs3 > 6.283185307179586 ? 6.283185307179586 : qs3));
+    const ur5_real q4 = (qs4 < -6.283185307179586 ? -6.283185307179586 : (qs4 > 6.283185307179586 ? 6.283185307179586 : qs4));
+    const ur5_real q5 = (qs5 < -6.283185307179586 ? -6.283185307179586 : (qs5 > 6.283185307179586 ? 6.283185307179586 : qs5));
+    const ur5_real q6 = (qs6 < -6.283185307179586 ? -6.283185307179586 : (qs6 > 6.283185307179586 ? 6.283185307179586 : qs6));
+    const ur5_real c1 = cos(q1);
+    const ur5_real s1 = sin(q1);
+    const ur5_real c2 = cos(q2);
+    const ur5_real s2 = sin(q2);
+    const ur5_real c3 = cos(q3);
+    const ur5_real s3 = sin(q3);
+    const ur5_real c23 = c2*c3 - s2*s3;
+    const ur5_real s23 = c2*s3 + c3*s2;
+    const ur5_real c4 = cos(q4);
+    const ur5_real s4 = sin(q4);
+    const ur5_real c234 = c23*c4 - s23*s4;
+    const ur5_real s234 = c23*s4 + c4*s23;
+    const ur5_real c5 = cos(q5);
+    const ur5_real s5 = sin(q5);
+    const ur5_real c6 = cos(q6);
+    const ur5_real s6 = sin(q6);
+    const ur5_real t0 = T00 + T01 + T02 + T03 + T10 + T11 + T12 + T13 + T20 + T21 + T22 + T23 + qs1 + qs2 + qs3 + qs4 + qs5 + qs6;
+    const ur5_real t1 = s1*s5;
+    const ur5_real t2 = c1*c5;
+    const ur5_real t3 = c234*t2 + t1;
+    const ur5_real t4 = c234*t1 + t2;
+    const ur5_real t5 = c5*s1;
+    const ur5_real t6 = c1*s5;
+    const ur5_real t7 = -c234*t6 + t5;
+    const ur5_real t8 = c234*t5 - t6;
+    const ur5_real t9 = c1*s234;
+    const ur5_real t10 = c6*t3 - s6*t9;
+    const ur5_real t11 = c6*t9 + s6*t3;
+    const ur5_real t12 = 0.0823*t7 + 0.09465*t9;
+    const ur5_real t13 = 0.10915*s1 + t12;
+    const ur5_real t14 = T00*t10 - T01*t11 + T02*t7;
+    const ur5_real t15 = T10*t10 - T11*t11 + T12*t7;
+    const ur5_real t16 = T20*t10 - T21*t11 + T22*t7;
+    const ur5_real t17 = s1*s234;
+    const ur5_real t18 = c6*t8 - s6*t17;
+    const ur5_real t19 = c6*t17 + s6*t8;
+    const ur5_real t20 = 0.09465*t17 - 0.0823*t4;
+    const ur5_real t21 = -0.10915*c1 + t20;
+    const ur5_real t22 = c1*t13 + s1*t21;
+    const ur5_real t23 = -t12*t17 + t20*t9;
+    const ur5_real t24 = -T00*t18 + T01*t19 + T02*t4;
+    const ur5_real t25 = -T10*t18 + T11*t19 + T12*t4;
+    const ur5_real t26 = -T20*t18 + T21*t19 + T22*t4;
+    const ur5_real t27 = 0.5*t15 + 0.5*t24;
+    const ur5_real t28 = c5*s234;
+    const ur5_real t29 = c234*s6 + c6*t28;
+    const ur5_real t30 = c234*c6 - s6*t28;
+    const ur5_real t31 = s234*s5;
+    const ur5_real t32 = 0.09465*c234 + 0.0823*t31;
+    const ur5_real t33 = 0.39225*s23 + t32;
+    const ur5_real t34 = 0.425*s2 + t33;
+    const ur5_real t35 = 0.089459 - t34;
+    const ur5_real t36 = c234*t20 - t17*t32;
+    const ur5_real t37 = -c234*t12 + t32*t9;
+    const ur5_real t38 = c234*t9 + t31*t7;
+    const ur5_real t39 = -c234*t17 + t31*t4;
+    const ur5_real t40 = T00*t29 + T01*t30 - T02*t31;
+    const ur5_real t41 = T10*t29 + T11*t30 - T12*t31;
+    const ur5_real t42 = T20*t29 + T21*t30 - T22*t31;
+    const ur5_real t43 = -0.5*t26 - 0.5*t41;
+    const ur5_real t44 = -0.5*t16 + 0.5*t40;
+    const ur5_real t45 = sqrt((t27*t27) + (t43*t43) + (t44*t44));
+    const ur5_real t46 = T23 - t35;
+    const ur5_real t47 = 0.39225*c23;
+    const ur5_real t48 = -c1*t47 + t13;
+    const ur5_real t49 = -s1*t47 + t21;
+    const ur5_real t50 = c1*t48 + s1*t49;
+    const ur5_real t51 = 0.425*c2;
+    const ur5_real t52 = -c1*t51 + t48;
+    const ur5_real t53 = -s1*t51 + t49;
+    const ur5_real t54 = c1*t52 + s1*t53;
+    const ur5_real t55 = c234*t36 + t53;
+    const ur5_real t56 = -c234*t37 + t52;
+    const ur5_real t57 = (t22*t22) + (t23*t23) + (t50*t50) + (t54*t54);
+    const ur5_real t58 = T03 - t52;
+    const ur5_real t59 = T13 - t53;
+    const ur5_real t60 = (t32*t32);
+    const ur5_real t61 = (c1*c1);
+    const ur5_real t62 = -t17*t36 + t32*t61 + t33*t61 + t34*t61;
+    const ur5_real t63 = (t33*t33);
+    const ur5_real t64 = (t34*t34);
+    const ur5_real t65 = t60*t61 + t61*t63 + t61*t64 + (t36*t36) + (t53*t53);
+    const ur5_real t66 = c1*s1;
+    const ur5_real t67 = t36*t37 - t52*t53 + t60*t66 + t63*t66 + t64*t66;
+    const ur5_real t68 = c1*t22;
+    const ur5_real t69 = c1*t50;
+    const ur5_real t70 = c1*t54;
+    const ur5_real t71 = t23*t36 + t32*t68 + t33*t69 + t34*t70;
+    const ur5_real t72 = -t17*t23 + t68 + t69 + t70;
+    const ur5_real t73 = t32*t66 + t33*t66 + t34*t66;
+    const ur5_real t74 = t36*t9 + t73;
+    const ur5_real t75 = -t17*t37 + t73;
+    const ur5_real t76 = (s1*s1);
+    const ur5_real t77 = t60*t76 + t63*t76 + t64*t76 + (t37*t37) + (t52*t52);
+    const ur5_real t78 = t32*t76 + t33*t76 + t34*t76 + t37*t9;
+    const ur5_real t79 = s1*t22;
+    const ur5_real t80 = s1*t50;
+    const ur5_real t81 = s1*t54;
+    const ur5_real t82 = t23*t37 + t32*t79 + t33*t80 + t34*t81;
+    const ur5_real t83 = t23*t9 + t79 + t80 + t81;
+    const ur5_real t84 = (s234*s234);
+    const ur5_real t85 = t61*t84 + 3*t76 + (t7*t7);
+    const ur5_real t86 = t4*t7 - t66*t84 + 3*t66;
+    const ur5_real t87 = 3*t61 + t76*t84 + (t4*t4);
+    const ur5_real t88 = t84*(s5*s5) + (c234*c234) + 1;
+    const ur5_real t89 = -t25;
+    const ur5_real t90 = 0.5*t14 + 0.5*t42 + 0.5*t89 - 0.5;
+    const ur5_real t91 = atan2(t45, t90);
+    const ur5_real t92 = (t45 > 0 ? t91/t45 : 1);
+    const int t93 = t14 >= t42 && t14 >= t89;
+    const int t94 = t25 <= -t42;
+    const ur5_real t95 = (t93 ? 0.5*t14 + 0.5 : (t94 ? -0.5*t24 : 0.5*t40));
+    const ur5_real t96 = (t93 ? 0.5*t15 : (t94 ? 0.5*t89 + 0.5 : 0.5*t41));
+    const ur5_real t97 = (t93 ? 0.5*t16 : (t94 ? -0.5*t26 : 0.5*t42 + 0.5));
+    const ur5_real t98 = sqrt((t95*t95) + (t96*t96) + (t97*t97));
+    const ur5_real t99 = (t27*t97 + t43*t95 + t44*t96 >= 0 ? 1 : -1);
+    const int t100 = (t45 > 1e-06) || (t90 > 0);
+    const ur5_real t101 = t91*t99/t98;
+    const ur5_real t102 = (t100 ? t43*t92 : t101*t95);
+    const ur5_real t103 = (t100 ? t44*t92 : t101*t96);
+    const ur5_real t104 = (t100 ? t27*t92 : t101*t97);
+    const ur5_real t105 = (t102*t102) + (t103*t103) + (t104*t104) + (t46*t46) + (t58*t58) + (t59*t59);
+    const ur5_real t106 = damping + t65;
+    const ur5_real t107 = sqrt((t106*t106) + (t55*t55) + (t62*t62) + (t67*t67) + (t71*t71) + (t74*t74));
+    const ur5_real t108 = t107*(t106 >= 0 ? 1 : -1);
+    const ur5_real t109 = t106 + t108;
+    const ur5_real t110 = (t107 > 0 ? 1/(t107*(t107 + fabs(t106))) : 0);
+    const ur5_real t111 = t110*(t102*t74 - t103*t62 - t104*t55 + t109*t58 + t46*t71 + t59*t67);
+    const ur5_real t112 = -t109*t111 + t58;
+    const ur5_real t113 = -t111*t67 + t59;
+    const ur5_real t114 = -t111*t71 + t46;
+    const ur5_real t115 = t102 - t111*t74;
+    const ur5_real t116 = t103 + t111*t62;
+    const ur5_real t117 = t104 + t111*t55;
+    const ur5_real t118 = damping + t77;
+    const ur5_real t119 = t110*(t109*t67 + t118*t67 - t55*t56 + t62*t75 + t71*t82 + t74*t78);
+    const ur5_real t120 = -t109*t119 + t67;
+    const ur5_real t121 = t118 - t119*t67;
+    const ur5_real t122 = -t119*t71 + t82;
+    const ur5_real t123 = -t119*t74 + t78;
+    const ur5_real t124 = t119*t62 - t75;
+    const ur5_real t125 = t119*t55 + t56;
+    const ur5_real t126 = sqrt((t121*t121) + (t122*t122) + (t123*t123) + (t124*t124) + (t125*t125));
+    const ur5_real t127 = t126*(t121 >= 0 ? 1 : -1);
+    const ur5_real t128 = t121 + t127;
+    const ur5_real t129 = (t126 > 0 ? 1/(t126*(t126 + fabs(t121))) : 0);
+    const ur5_real t130 = t129*(t113*t128 + t114*t122 + t115*t123 + t116*t124 + t117*t125);
+    const ur5_real t131 = t113 - t128*t130;
+    const ur5_real t132 = t114 - t122*t130;
+    const ur5_real t133 = t115 - t123*t130;
+    const ur5_real t134 = t116 - t124*t130;
+    const ur5_real t135 = t117 - t125*t130;
+    const ur5_real t136 = c234*t23;
+    const ur5_real t137 = damping + t57;
+    const ur5_real t138 = t110*(t109*t71 + t136*t55 + t137*t71 + t62*t72 + t67*t82 + t74*t83);
+    const ur5_real t139 = -t109*t138 + t71;
+    const ur5_real t140 = -t138*t67 + t82;
+    const ur5_real t141 = t137 - t138*t71;
+    const ur5_real t142 = -t138*t74 + t83;
+    const ur5_real t143 = t138*t62 - t72;
+    const ur5_real t144 = -t136 + t138*t55;
+    const ur5_real t145 = t129*(t122*t141 + t123*t142 + t124*t143 + t125*t144 + t128*t140);
+    const ur5_real t146 = -t128*t145 + t140;
+    const ur5_real t147 = -t122*t145 + t141;
+    const ur5_real t148 = -t123*t145 + t142;
+    const ur5_real t149 = -t124*t145 + t143;
+    const ur5_real t150 = -t125*t145 + t144;
+    const ur5_real t151 = sqrt((t147*t147) + (t148*t148) + (t149*t149) + (t150*t150));
+    const ur5_real t152 = t151*(t147 >= 0 ? 1 : -1);
+    const ur5_real t153 = t147 + t152;
+    const ur5_real t154 = (t151 > 0 ? 1/(t151*(t151 + fabs(t147))) : 0);
+    const ur5_real t155 = t154*(t132*t153 + t133*t148 + t134*t149 + t135*t150);
+    const ur5_real t156 = t132 - t153*t155;
+    const ur5_real t157 = t133 - t148*t155;
+    const ur5_real t158 = t134 - t149*t155;
+    const ur5_real t159 = t135 - t150*t155;
+    const ur5_real t160 = damping + t85;
+    const ur5_real t161 = t110*(t109*t74 + t160*t74 + t38*t55 + t62*t86 + t67*t78 + t71*t83);
+    const ur5_real t162 = -t109*t161 + t74;
+    const ur5_real t163 = -t161*t67 + t78;
+    const ur5_real t164 = -t161*t71 + t83;
+    const ur5_real t165 = t160 - t161*t74;
+    const ur5_real t166 = t161*t62 - t86;
+    const ur5_real t167 = t161*t55 - t38;
+    const ur5_real t168 = t129*(t122*t164 + t123*t165 + t124*t166 + t125*t167 + t128*t163);
+    const ur5_real t169 = -t128*t168 + t163;
+    const ur5_real t170 = -t122*t168 + t164;
+    const ur5_real t171 = -t123*t168 + t165;
+    const ur5_real t172 = -t124*t168 + t166;
+    const ur5_real t173 = -t125*t168 + t167;
+    const ur5_real t174 = t154*(t148*t171 + t149*t172 + t150*t173 + t153*t170);
+    const ur5_real t175 = -t153*t174 + t170;
+    const ur5_real t176 = -t148*t174 + t171;
+    const ur5_real t177 = -t149*t174 + t172;
+    const ur5_real t178 = -t150*t174 + t173;
+    const ur5_real t179 = sqrt((t176*t176) + (t177*t177) + (t178*t178));
+    const ur5_real t180 = t179*(t176 >= 0 ? 1 : -1);
+    const ur5_real t181 = t176 + t180;
+    const ur5_real t182 = (t179 > 0 ? 1/(t179*(t179 + fabs(t176))) : 0);
+    const ur5_real t183 = t182*(t157*t181 + t158*t177 + t159*t178);
+    const ur5_real t184 = t157 - t181*t183;
+    const ur5_real t185 = t158 - t177*t183;
+    const ur5_real t186 = t159 - t178*t183;
+    const ur5_real t187 = damping + t87;
+    const ur5_real t188 = -t110*(t109*t62 + t187*t62 + t39*t55 + t67*t75 + t71*t72 + t74*t86);
+    const ur5_real t189 = t109*t188 + t62;
+    const ur5_real t190 = t188*t67 + t75;
+    const ur5_real t191 = t188*t71 + t72;
+    const ur5_real t192 = t188*t74 + t86;
+    const ur5_real t193 = t187 + t188*t62;
+    const ur5_real t194 = t188*t55 + t39;
+    const ur5_real t195 = -t129*(t122*t191 + t123*t192 - t124*t193 - t125*t194 + t128*t190);
+    const ur5_real t196 = t128*t195 + t190;
+    const ur5_real t197 = t122*t195 + t191;
+    const ur5_real t198 = t123*t195 + t192;
+    const ur5_real t199 = -t124*t195 + t193;
+    const ur5_real t200 = -t125*t195 + t194;
+    const ur5_real t201 = t154*(-t148*t198 + t149*t199 + t150*t200 - t153*t197);
+    const ur5_real t202 = t153*t201 + t197;
+    const ur5_real t203 = t148*t201 + t198;
+    const ur5_real t204 = -t149*t201 + t199;
+    const ur5_real t205 = -t150*t201 + t200;
+    const ur5_real t206 = t182*(t177*t204 + t178*t205 - t181*t203);
+    const ur5_real t207 = t181*t206 + t203;
+    const ur5_real t208 = -t177*t206 + t204;
+    const ur5_real t209 = -t178*t206 + t205;
+    const ur5_real t210 = sqrt((t208*t208) + (t209*t209));
+    const ur5_real t211 = t210*(t208 >= 0 ? 1 : -1);
+    const ur5_real t212 = t208 + t211;
+    const ur5_real t213 = (t210 > 0 ? 1/(t210*(t210 + fabs(t208))) : 0);
+    const ur5_real t214 = t213*(t185*t212 + t186*t209);
+    const ur5_real t215 = t185 - t212*t214;
+    const ur5_real t216 = t186 - t209*t214;
+    const ur5_real t217 = damping + t88;
+    const ur5_real t218 = -t110*(t109*t55 + t136*t71 + t217*t55 + t38*t74 + t39*t62 - t56*t67);
+    const ur5_real t219 = t109*t218 + t55;
+    const ur5_real t220 = -t218*t67 + t56;
+    const ur5_real t221 = t136 + t218*t71;
+    const ur5_real t222 = t218*t74 + t38;
+    const ur5_real t223 = t218*t62 + t39;
+    const ur5_real t224 = t217 + t218*t55;
+    const ur5_real t225 = t129*(-t122*t221 - t123*t222 + t124*t223 + t125*t224 + t128*t220);
+    const ur5_real t226 = -t128*t225 + t220;
+    const ur5_real t227 = t122*t225 + t221;
+    const ur5_real t228 = t123*t225 + t222;
+    const ur5_real t229 = -t124*t225 + t223;
+    const ur5_real t230 = -t125*t225 + t224;
+    const ur5_real t231 = t154*(-t148*t228 + t149*t229 + t150*t230 - t153*t227);
+    const ur5_real t232 = t153*t231 + t227;
+    const ur5_real t233 = t148*t231 + t228;
+    const ur5_real t234 = -t149*t231 + t229;
+    const ur5_real t235 = -t150*t231 + t230;
+    const ur5_real t236 = t182*(t177*t234 + t178*t235 - t181*t233);
+    const ur5_real t237 = t181*t236 + t233;
+    const ur5_real t238 = -t177*t236 + t234;
+    const ur5_real t239 = -t178*t236 + t235;
+    const ur5_real t240 = t213*(t209*t239 + t212*t238);
+    const ur5_real t241 = -t212*t240 + t238;
+    const ur5_real t242 = -t209*t240 + t239;
+    const ur5_real t243 = fabs(t242);
+    const ur5_real t244 = t243;
+    const ur5_real t245 = t244*(t242 >= 0 ? 1 : -1);
+    const ur5_real t246 = t242 + t245;
+    const ur5_real t247 = (t244 > 0 ? 1/(t244*(t243 + t244)) : 0);
+    const ur5_real t248 = -t216*t247*(t246*t246) + t216;
+    const ur5_real t249 = t248/t245;
+    const ur5_real t250 = (t215 + t241*t249)/t211;
+    const ur5_real t251 = (t184 - t207*t250 - t237*t249)/t180;
+    const ur5_real t252 = (t156 + t175*t251 - t202*t250 - t232*t249)/t152;
+    const ur5_real t253 = (t131 + t146*t252 + t169*t251 - t196*t250 + t226*t249)/t127;
+    const ur5_real t254 = (t112 + t120*t253 + t139*t252 + t162*t251 - t189*t250 - t219*t249)/t108;
+    const ur5_real t255 = q1 - t249 - t253*t52 + t254*t53;
+    const ur5_real t256 = -c234*t249 - q5 + t17*t250 + t23*t252 + t251*t9 + t253*t37 + t254*t36;
+    const ur5_real t257 = q6 + t249*t31 + t250*t4 - t251*t7;
+    const ur5_real t258 = s1*t253;
+    const ur5_real t259 = c1*t254;
+    const ur5_real t260 = -c1*t250 + s1*t251;
+    const ur5_real t261 = -q2 + t252*t54 + t258*t34 + t259*t34 + t260;
+    const ur5_real t262 = -q3 + t252*t50 + t258*t33 + t259*t33 + t260;
+    const ur5_real t263 = -q4 + t22*t252 + t258*t32 + t259*t32 + t260;
+
+    /* Outputs */
+    q_start[0] = q1;
+    q_start[1] = q2;
+    q_start[2] = q3;
+    q_start[3] = q4;
+    q_start[4] = q5;
+    q_start[5] = q6;
+    q_next[0] = (t255 < -6.283185307179586 ? -6.283185307179586 : (t255 > 6.283185307179586 ? 6.283185307179586 : t255));
+    q_next[1] = (t261 > 6.283185307179586 ? -6.283185307179586 : (t261 < -6.283185307179586 ? 6.283185307179586 : -t261));
+    q_next[2] = (t262 > 6.283185307179586 ? -6.283185307179586 : (t262 < -6.283185307179586 ? 6.283185307179586 : -t262));
+    q_next[3] = (t263 > 6.283185307179586 ? -6.283185307179586 : (t263 < -6.283185307179586 ? 6.283185307179586 : -t263));
+    q_next[4] = (t256 > 6.283185307179586 ? -6.283185307179586 : (t256 < -6.283185307179586 ? 6.283185307179586 : -t256));
+    q_next[5] = (t257 < -6.283185307179586 ? -6.283185307179586 : (t257 > 6.283185307179586 ? 6.283185307179586 : t257));
+    return (isfinite(t0) ? t105 : -1);
+}
+
 void ur5_ik_branches(const ur5_real T[16], ur5_real q[UR5_MAX_IK_SOLUTIONS * UR5_DOF], int valid[UR5_MAX_IK_SOLUTIONS])
 {
     /* 843 operations */
@@ -1515,179 +1843,39 @@ int ur5_ik(const ur5_real T[16], ur5_real q[UR5_MAX_IK_SOLUTIONS * UR5_DOF])
     return count;
 }
 
-/* -- Iterative inverse kinematics -- */
-
-/* The rotation vector (axis times angle in [0, pi]) of the rotation matrix E (row-major). */
-static void ur5_rotation_vector(const ur5_real E[9], ur5_real out[3])
-{
-    const ur5_real v[3] = {0.5 * (E[7] - E[5]), 0.5 * (E[2] - E[6]), 0.5 * (E[3] - E[1])};
-    const ur5_real cos_angle = 0.5 * (E[0] + E[4] + E[8] - 1.0);
-    const ur5_real sin_angle = sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
-    const ur5_real angle = atan2(sin_angle, cos_angle);
-    ur5_real axis[3], length, sign;
-    int i, column = 0;
-    if (sin_angle > 1e-6 || cos_angle > 0.0) {
-        const ur5_real scale = sin_angle > 0.0 ? angle / sin_angle : 1.0;
-        for (i = 0; i < 3; ++i) {
-            out[i] = scale * v[i];
-        }
-        return;
-    }
-    /* Near a half turn: the axis from the largest column of (E + I) / 2 = u u^T. */
-    for (i = 1; i < 3; ++i) {
-        if (E[4 * i] > E[4 * column]) {
-            column = i;
-        }
-    }
-    for (i = 0; i < 3; ++i) {
-        axis[i] = 0.5 * (E[3 * i + column] + (i == column ? 1.0 : 0.0));
-    }
-    length = sqrt(axis[0] * axis[0] + axis[1] * axis[1] + axis[2] * axis[2]);
-    sign = axis[0] * v[0] + axis[1] * v[1] + axis[2] * v[2] >= 0.0 ? 1.0 : -1.0;
-    for (i = 0; i < 3; ++i) {
-        out[i] = sign * angle * axis[i] / length;
-    }
-}
-
-/* Error [target position - position; rotation vector of target R^T] and the geometric Jacobian. */
-static void ur5_task_error(const ur5_real target[16], const ur5_real q[UR5_DOF], ur5_real e[6], ur5_real J[6 * UR5_DOF])
-{
-    ur5_real T[16], E[9];
-    int i, j;
-    ur5_fk(q, T);
-    ur5_jacobian(q, J);
-    for (i = 0; i < 3; ++i) {
-        e[i] = target[4 * i + 3] - T[4 * i + 3];
-        for (j = 0; j < 3; ++j) {
-            E[3 * i + j] = target[4 * i] * T[4 * j] + target[4 * i + 1] * T[4 * j + 1] + target[4 * i + 2] * T[4 * j + 2];
-        }
-    }
-    ur5_rotation_vector(E, e + 3);
-}
-
-/* Joints clamped to their limits. */
-static void ur5_clamp(ur5_real q[UR5_DOF])
-{
-    q[0] = q[0] < -6.283185307179586 ? -6.283185307179586 : q[0] > 6.283185307179586 ? 6.283185307179586 : q[0];
-    q[1] = q[1] < -6.283185307179586 ? -6.283185307179586 : q[1] > 6.283185307179586 ? 6.283185307179586 : q[1];
-    q[2] = q[2] < -6.283185307179586 ? -6.283185307179586 : q[2] > 6.283185307179586 ? 6.283185307179586 : q[2];
-    q[3] = q[3] < -6.283185307179586 ? -6.283185307179586 : q[3] > 6.283185307179586 ? 6.283185307179586 : q[3];
-    q[4] = q[4] < -6.283185307179586 ? -6.283185307179586 : q[4] > 6.283185307179586 ? 6.283185307179586 : q[4];
-    q[5] = q[5] < -6.283185307179586 ? -6.283185307179586 : q[5] > 6.283185307179586 ? 6.283185307179586 : q[5];
-}
-
-/* Solves A x = b in place (b becomes x) for the symmetric positive definite K x K matrix A by
- * Cholesky; returns 0 when A is not numerically positive definite. */
-static int ur5_cholesky_solve(ur5_real A[36], ur5_real b[6])
-{
-    int i, j, k;
-    for (j = 0; j < 6; ++j) {
-        ur5_real diagonal = A[6 * j + j];
-        for (k = 0; k < j; ++k) {
-            diagonal -= A[6 * j + k] * A[6 * j + k];
-        }
-        if (!(diagonal > 0.0)) {
-            return 0;
-        }
-        A[6 * j + j] = sqrt(diagonal);
-        for (i = j + 1; i < 6; ++i) {
-            ur5_real sum = A[6 * i + j];
-            for (k = 0; k < j; ++k) {
-                sum -= A[6 * i + k] * A[6 * j + k];
-            }
-            A[6 * i + j] = sum / A[6 * j + j];
-        }
-    }
-    for (i = 0; i < 6; ++i) {
-        for (k = 0; k < i; ++k) {
-            b[i] -= A[6 * i + k] * b[k];
-        }
-        b[i] /= A[6 * i + i];
-    }
-    for (i = 6 - 1; i >= 0; --i) {
-        for (k = i + 1; k < 6; ++k) {
-            b[i] -= A[6 * k + i] * b[k];
-        }
-        b[i] /= A[6 * i + i];
-    }
-    return 1;
-}
+/* -- Iterative inverse kinematics: the loop around ur5_ik_numeric_step -- */
 
 int ur5_ik_numeric(const ur5_real target[16], const ur5_real q0[UR5_DOF], int max_iter, ur5_real tol, ur5_real q[UR5_DOF])
 {
-    ur5_real e[6], J[6 * UR5_DOF], trial[UR5_DOF], trial_e[6];
-    ur5_real trial_J[6 * UR5_DOF], A[36], x[6];
-    ur5_real cost, trial_cost, damping = 1e-06;
-    int i, j, k, iteration;
-    for (j = 0; j < UR5_DOF; ++j) {
-        q[j] = q0[j];
-    }
-    for (i = 0; i < 12; ++i) {
-        if (!isfinite(target[i])) {
-            return UR5_IK_NUMERIC_INVALID;
+    ur5_real trial[UR5_DOF], after[UR5_DOF], start[UR5_DOF];
+    ur5_real cost, trial_cost, lighter, damping = 1e-06;
+    int j, iteration;
+    cost = ur5_ik_numeric_step(target, q0, damping, q, trial);
+    if (!(cost >= 0) || max_iter < 0) { /* -1: target or q0 not finite */
+        for (j = 0; j < UR5_DOF; ++j) {
+            q[j] = q0[j];
         }
-    }
-    for (j = 0; j < UR5_DOF; ++j) {
-        if (!isfinite(q0[j])) {
-            return UR5_IK_NUMERIC_INVALID;
-        }
-    }
-    if (max_iter < 0) {
         return UR5_IK_NUMERIC_INVALID;
-    }
-    ur5_clamp(q);
-    ur5_task_error(target, q, e, J);
-    cost = 0.0;
-    for (i = 0; i < 6; ++i) {
-        cost += e[i] * e[i];
     }
     for (iteration = 0; iteration < max_iter; ++iteration) {
         if (cost <= tol * tol) {
             return UR5_IK_NUMERIC_CONVERGED;
         }
-        /* A = J J^T + damping I, x = A^-1 e, step J^T x */
-        for (i = 0; i < 6; ++i) {
-            x[i] = e[i];
-            for (k = 0; k < 6; ++k) {
-                ur5_real sum = i == k ? damping : 0.0;
-                for (j = 0; j < UR5_DOF; ++j) {
-                    sum += J[UR5_DOF * i + j] * J[UR5_DOF * k + j];
-                }
-                A[6 * i + k] = sum;
-            }
-        }
-        if (!ur5_cholesky_solve(A, x)) {
-            return UR5_IK_NUMERIC_STALLED;
-        }
-        for (j = 0; j < UR5_DOF; ++j) {
-            trial[j] = q[j];
-            for (i = 0; i < 6; ++i) {
-                trial[j] += J[UR5_DOF * i + j] * x[i];
-            }
-        }
-        ur5_clamp(trial);
-        ur5_task_error(target, trial, trial_e, trial_J);
-        trial_cost = 0.0;
-        for (i = 0; i < 6; ++i) {
-            trial_cost += trial_e[i] * trial_e[i];
-        }
+        lighter = damping * 0.1 > 1e-12 ? damping * 0.1 : 1e-12;
+        trial_cost = ur5_ik_numeric_step(target, trial, lighter, start, after);
         if (trial_cost < cost) {
             for (j = 0; j < UR5_DOF; ++j) {
                 q[j] = trial[j];
-            }
-            for (i = 0; i < 6; ++i) {
-                e[i] = trial_e[i];
-            }
-            for (i = 0; i < 6 * UR5_DOF; ++i) {
-                J[i] = trial_J[i];
+                trial[j] = after[j];
             }
             cost = trial_cost;
-            damping = damping * 0.1 > 1e-12 ? damping * 0.1 : 1e-12;
+            damping = lighter;
         } else {
             damping *= 10.0;
             if (damping > 100000000.0) {
                 return UR5_IK_NUMERIC_STALLED;
             }
+            (void)ur5_ik_numeric_step(target, q, damping, start, trial);
         }
     }
     return cost <= tol * tol ? UR5_IK_NUMERIC_CONVERGED : UR5_IK_NUMERIC_ITERATION_LIMIT;

@@ -1079,6 +1079,335 @@ def velocity_ik(q, mu_dot, damping=0.0):
 
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
+def ik_numeric_step(target, q, damping=0.0):
+    """one step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite): (6 x 1 and 6 x 1 and 1 x 1), 971 operations."""
+    target = _argument("target", target, (4, 4))
+    q = _argument("q", q, (6,))
+    damping = _argument("damping", damping, ())
+    T00 = target[..., 0, 0]
+    T01 = target[..., 0, 1]
+    T02 = target[..., 0, 2]
+    T03 = target[..., 0, 3]
+    T10 = target[..., 1, 0]
+    T11 = target[..., 1, 1]
+    T12 = target[..., 1, 2]
+    T13 = target[..., 1, 3]
+    T20 = target[..., 2, 0]
+    T21 = target[..., 2, 1]
+    T22 = target[..., 2, 2]
+    T23 = target[..., 2, 3]
+    qs1 = q[..., 0]
+    qs2 = q[..., 1]
+    qs3 = q[..., 2]
+    qs4 = q[..., 3]
+    qs5 = q[..., 4]
+    qs6 = q[..., 5]
+    q1 = numpy.where(numpy.less(qs1, -6.283185307179586), -6.283185307179586, numpy.where(numpy.greater(qs1, 6.283185307179586), 6.283185307179586, qs1))
+    q2 = numpy.where(numpy.less(qs2, -6.283185307179586), -6.283185307179586, numpy.where(numpy.greater(qs2, 6.283185307179586), 6.283185307179586, qs2))
+    q3 = numpy.where(numpy.less(qs3, -6.283185307179586), -6.283185307179586, numpy.where(numpy.greater(qs3, 6.283185307179586), 6.283185307179586, qs3))
+    q4 = numpy.where(numpy.less(qs4, -6.283185307179586), -6.283185307179586, numpy.where(numpy.greater(qs4, 6.283185307179586), 6.283185307179586, qs4))
+    q5 = numpy.where(numpy.less(qs5, -6.283185307179586), -6.283185307179586, numpy.where(numpy.greater(qs5, 6.283185307179586), 6.283185307179586, qs5))
+    q6 = numpy.where(numpy.less(qs6, -6.283185307179586), -6.283185307179586, numpy.where(numpy.greater(qs6, 6.283185307179586), 6.283185307179586, qs6))
+    c1 = numpy.cos(q1)
+    s1 = numpy.sin(q1)
+    c2 = numpy.cos(q2)
+    s2 = numpy.sin(q2)
+    c3 = numpy.cos(q3)
+    s3 = numpy.sin(q3)
+    c23 = c2*c3 - s2*s3
+    s23 = c2*s3 + c3*s2
+    c4 = numpy.cos(q4)
+    s4 = numpy.sin(q4)
+    c234 = c23*c4 - s23*s4
+    s234 = c23*s4 + c4*s23
+    c5 = numpy.cos(q5)
+    s5 = numpy.sin(q5)
+    c6 = numpy.cos(q6)
+    s6 = numpy.sin(q6)
+    t0 = T00 + T01 + T02 + T03 + T10 + T11 + T12 + T13 + T20 + T21 + T22 + T23 + qs1 + qs2 + qs3 + qs4 + qs5 + qs6
+    t1 = s1*s5
+    t2 = c1*c5
+    t3 = c234*t2 + t1
+    t4 = c234*t1 + t2
+    t5 = c5*s1
+    t6 = c1*s5
+    t7 = -c234*t6 + t5
+    t8 = c234*t5 - t6
+    t9 = c1*s234
+    t10 = c6*t3 - s6*t9
+    t11 = c6*t9 + s6*t3
+    t12 = 0.0823*t7 + 0.09465*t9
+    t13 = 0.10915*s1 + t12
+    t14 = T00*t10 - T01*t11 + T02*t7
+    t15 = T10*t10 - T11*t11 + T12*t7
+    t16 = T20*t10 - T21*t11 + T22*t7
+    t17 = s1*s234
+    t18 = c6*t8 - s6*t17
+    t19 = c6*t17 + s6*t8
+    t20 = 0.09465*t17 - 0.0823*t4
+    t21 = -0.10915*c1 + t20
+    t22 = c1*t13 + s1*t21
+    t23 = -t12*t17 + t20*t9
+    t24 = -T00*t18 + T01*t19 + T02*t4
+    t25 = -T10*t18 + T11*t19 + T12*t4
+    t26 = -T20*t18 + T21*t19 + T22*t4
+    t27 = 0.5*t15 + 0.5*t24
+    t28 = c5*s234
+    t29 = c234*s6 + c6*t28
+    t30 = c234*c6 - s6*t28
+    t31 = s234*s5
+    t32 = 0.09465*c234 + 0.0823*t31
+    t33 = 0.39225*s23 + t32
+    t34 = 0.425*s2 + t33
+    t35 = 0.089459 - t34
+    t36 = c234*t20 - t17*t32
+    t37 = -c234*t12 + t32*t9
+    t38 = c234*t9 + t31*t7
+    t39 = -c234*t17 + t31*t4
+    t40 = T00*t29 + T01*t30 - T02*t31
+    t41 = T10*t29 + T11*t30 - T12*t31
+    t42 = T20*t29 + T21*t30 - T22*t31
+    t43 = -0.5*t26 - 0.5*t41
+    t44 = -0.5*t16 + 0.5*t40
+    t45 = numpy.sqrt(t27**2 + t43**2 + t44**2)
+    t46 = T23 - t35
+    t47 = 0.39225*c23
+    t48 = -c1*t47 + t13
+    t49 = -s1*t47 + t21
+    t50 = c1*t48 + s1*t49
+    t51 = 0.425*c2
+    t52 = -c1*t51 + t48
+    t53 = -s1*t51 + t49
+    t54 = c1*t52 + s1*t53
+    t55 = c234*t36 + t53
+    t56 = -c234*t37 + t52
+    t57 = t22**2 + t23**2 + t50**2 + t54**2
+    t58 = T03 - t52
+    t59 = T13 - t53
+    t60 = t32**2
+    t61 = c1**2
+    t62 = -t17*t36 + t32*t61 + t33*t61 + t34*t61
+    t63 = t33**2
+    t64 = t34**2
+    t65 = t36**2 + t53**2 + t60*t61 + t61*t63 + t61*t64
+    t66 = c1*s1
+    t67 = t36*t37 - t52*t53 + t60*t66 + t63*t66 + t64*t66
+    t68 = c1*t22
+    t69 = c1*t50
+    t70 = c1*t54
+    t71 = t23*t36 + t32*t68 + t33*t69 + t34*t70
+    t72 = -t17*t23 + t68 + t69 + t70
+    t73 = t32*t66 + t33*t66 + t34*t66
+    t74 = t36*t9 + t73
+    t75 = -t17*t37 + t73
+    t76 = s1**2
+    t77 = t37**2 + t52**2 + t60*t76 + t63*t76 + t64*t76
+    t78 = t32*t76 + t33*t76 + t34*t76 + t37*t9
+    t79 = s1*t22
+    t80 = s1*t50
+    t81 = s1*t54
+    t82 = t23*t37 + t32*t79 + t33*t80 + t34*t81
+    t83 = t23*t9 + t79 + t80 + t81
+    t84 = s234**2
+    t85 = t61*t84 + t7**2 + 3*t76
+    t86 = t4*t7 - t66*t84 + 3*t66
+    t87 = t4**2 + 3*t61 + t76*t84
+    t88 = c234**2 + s5**2*t84 + 1
+    t89 = -t25
+    t90 = 0.5*t14 + 0.5*t42 + 0.5*t89 - 0.5
+    t91 = numpy.arctan2(t45, t90)
+    t92 = numpy.where(numpy.greater(t45, 0), t91/t45, 1)
+    t93 = (numpy.greater_equal(t14, t42)) & (numpy.greater_equal(t14, t89))
+    t94 = numpy.less_equal(t25, -t42)
+    t95 = numpy.where(t93, 0.5*t14 + 0.5, numpy.where(t94, -0.5*t24, 0.5*t40))
+    t96 = numpy.where(t93, 0.5*t15, numpy.where(t94, 0.5*t89 + 0.5, 0.5*t41))
+    t97 = numpy.where(t93, 0.5*t16, numpy.where(t94, -0.5*t26, 0.5*t42 + 0.5))
+    t98 = numpy.sqrt(t95**2 + t96**2 + t97**2)
+    t99 = numpy.where(numpy.greater_equal(t27*t97 + t43*t95 + t44*t96, 0), 1, -1)
+    t100 = (numpy.greater(t45, 1e-06)) | (numpy.greater(t90, 0))
+    t101 = t91*t99/t98
+    t102 = numpy.where(t100, t43*t92, t101*t95)
+    t103 = numpy.where(t100, t44*t92, t101*t96)
+    t104 = numpy.where(t100, t27*t92, t101*t97)
+    t105 = t102**2 + t103**2 + t104**2 + t46**2 + t58**2 + t59**2
+    t106 = damping + t65
+    t107 = numpy.sqrt(t106**2 + t55**2 + t62**2 + t67**2 + t71**2 + t74**2)
+    t108 = t107*numpy.where(numpy.greater_equal(t106, 0), 1, -1)
+    t109 = t106 + t108
+    t110 = numpy.where(numpy.greater(t107, 0), 1/(t107*(t107 + abs(t106))), 0)
+    t111 = t110*(t102*t74 - t103*t62 - t104*t55 + t109*t58 + t46*t71 + t59*t67)
+    t112 = -t109*t111 + t58
+    t113 = -t111*t67 + t59
+    t114 = -t111*t71 + t46
+    t115 = t102 - t111*t74
+    t116 = t103 + t111*t62
+    t117 = t104 + t111*t55
+    t118 = damping + t77
+    t119 = t110*(t109*t67 + t118*t67 - t55*t56 + t62*t75 + t71*t82 + t74*t78)
+    t120 = -t109*t119 + t67
+    t121 = t118 - t119*t67
+    t122 = -t119*t71 + t82
+    t123 = -t119*t74 + t78
+    t124 = t119*t62 - t75
+    t125 = t119*t55 + t56
+    t126 = numpy.sqrt(t121**2 + t122**2 + t123**2 + t124**2 + t125**2)
+    t127 = t126*numpy.where(numpy.greater_equal(t121, 0), 1, -1)
+    t128 = t121 + t127
+    t129 = numpy.where(numpy.greater(t126, 0), 1/(t126*(t126 + abs(t121))), 0)
+    t130 = t129*(t113*t128 + t114*t122 + t115*t123 + t116*t124 + t117*t125)
+    t131 = t113 - t128*t130
+    t132 = t114 - t122*t130
+    t133 = t115 - t123*t130
+    t134 = t116 - t124*t130
+    t135 = t117 - t125*t130
+    t136 = c234*t23
+    t137 = damping + t57
+    t138 = t110*(t109*t71 + t136*t55 + t137*t71 + t62*t72 + t67*t82 + t74*t83)
+    t139 = -t109*t138 + t71
+    t140 = -t138*t67 + t82
+    t141 = t137 - t138*t71
+    t142 = -t138*t74 + t83
+    t143 = t138*t62 - t72
+    t144 = -t136 + t138*t55
+    t145 = t129*(t122*t141 + t123*t142 + t124*t143 + t125*t144 + t128*t140)
+    t146 = -t128*t145 + t140
+    t147 = -t122*t145 + t141
+    t148 = -t123*t145 + t142
+    t149 = -t124*t145 + t143
+    t150 = -t125*t145 + t144
+    t151 = numpy.sqrt(t147**2 + t148**2 + t149**2 + t150**2)
+    t152 = t151*numpy.where(numpy.greater_equal(t147, 0), 1, -1)
+    t153 = t147 + t152
+    t154 = numpy.where(numpy.greater(t151, 0), 1/(t151*(t151 + abs(t147))), 0)
+    t155 = t154*(t132*t153 + t133*t148 + t134*t149 + t135*t150)
+    t156 = t132 - t153*t155
+    t157 = t133 - t148*t155
+    t158 = t134 - t149*t155
+    t159 = t135 - t150*t155
+    t160 = damping + t85
+    t161 = t110*(t109*t74 + t160*t74 + t38*t55 + t62*t86 + t67*t78 + t71*t83)
+    t162 = -t109*t161 + t74
+    t163 = -t161*t67 + t78
+    t164 = -t161*t71 + t83
+    t165 = t160 - t161*t74
+    t166 = t161*t62 - t86
+    t167 = t161*t55 - t38
+    t168 = t129*(t122*t164 + t123*t165 + t124*t166 + t125*t167 + t128*t163)
+    t169 = -t128*t168 + t163
+    t170 = -t122*t168 + t164
+    t171 = -t123*t168 + t165
+    t172 = -t124*t168 + t166
+    t173 = -t125*t168 + t167
+    t174 = t154*(t148*t171 + t149*t172 + t150*t173 + t153*t170)
+    t175 = -t153*t174 + t170
+    t176 = -t148*t174 + t171
+    t177 = -t149*t174 + t172
+    t178 = -t150*t174 + t173
+    t179 = numpy.sqrt(t176**2 + t177**2 + t178**2)
+    t180 = t179*numpy.where(numpy.greater_equal(t176, 0), 1, -1)
+    t181 = t176 + t180
+    t182 = numpy.where(numpy.greater(t179, 0), 1/(t179*(t179 + abs(t176))), 0)
+    t183 = t182*(t157*t181 + t158*t177 + t159*t178)
+    t184 = t157 - t181*t183
+    t185 = t158 - t177*t183
+    t186 = t159 - t178*t183
+    t187 = damping + t87
+    t188 = -t110*(t109*t62 + t187*t62 + t39*t55 + t67*t75 + t71*t72 + t74*t86)
+    t189 = t109*t188 + t62
+    t190 = t188*t67 + t75
+    t191 = t188*t71 + t72
+    t192 = t188*t74 + t86
+    t193 = t187 + t188*t62
+    t194 = t188*t55 + t39
+    t195 = -t129*(t122*t191 + t123*t192 - t124*t193 - t125*t194 + t128*t190)
+    t196 = t128*t195 + t190
+    t197 = t122*t195 + t191
+    t198 = t123*t195 + t192
+    t199 = -t124*t195 + t193
+    t200 = -t125*t195 + t194
+    t201 = t154*(-t148*t198 + t149*t199 + t150*t200 - t153*t197)
+    t202 = t153*t201 + t197
+    t203 = t148*t201 + t198
+    t204 = -t149*t201 + t199
+    t205 = -t150*t201 + t200
+    t206 = t182*(t177*t204 + t178*t205 - t181*t203)
+    t207 = t181*t206 + t203
+    t208 = -t177*t206 + t204
+    t209 = -t178*t206 + t205
+    t210 = numpy.sqrt(t208**2 + t209**2)
+    t211 = t210*numpy.where(numpy.greater_equal(t208, 0), 1, -1)
+    t212 = t208 + t211
+    t213 = numpy.where(numpy.greater(t210, 0), 1/(t210*(t210 + abs(t208))), 0)
+    t214 = t213*(t185*t212 + t186*t209)
+    t215 = t185 - t212*t214
+    t216 = t186 - t209*t214
+    t217 = damping + t88
+    t218 = -t110*(t109*t55 + t136*t71 + t217*t55 + t38*t74 + t39*t62 - t56*t67)
+    t219 = t109*t218 + t55
+    t220 = -t218*t67 + t56
+    t221 = t136 + t218*t71
+    t222 = t218*t74 + t38
+    t223 = t218*t62 + t39
+    t224 = t217 + t218*t55
+    t225 = t129*(-t122*t221 - t123*t222 + t124*t223 + t125*t224 + t128*t220)
+    t226 = -t128*t225 + t220
+    t227 = t122*t225 + t221
+    t228 = t123*t225 + t222
+    t229 = -t124*t225 + t223
+    t230 = -t125*t225 + t224
+    t231 = t154*(-t148*t228 + t149*t229 + t150*t230 - t153*t227)
+    t232 = t153*t231 + t227
+    t233 = t148*t231 + t228
+    t234 = -t149*t231 + t229
+    t235 = -t150*t231 + t230
+    t236 = t182*(t177*t234 + t178*t235 - t181*t233)
+    t237 = t181*t236 + t233
+    t238 = -t177*t236 + t234
+    t239 = -t178*t236 + t235
+    t240 = t213*(t209*t239 + t212*t238)
+    t241 = -t212*t240 + t238
+    t242 = -t209*t240 + t239
+    t243 = abs(t242)
+    t244 = t243
+    t245 = t244*numpy.where(numpy.greater_equal(t242, 0), 1, -1)
+    t246 = t242 + t245
+    t247 = numpy.where(numpy.greater(t244, 0), 1/(t244*(t243 + t244)), 0)
+    t248 = -t216*t246**2*t247 + t216
+    t249 = t248/t245
+    t250 = (t215 + t241*t249)/t211
+    t251 = (t184 - t207*t250 - t237*t249)/t180
+    t252 = (t156 + t175*t251 - t202*t250 - t232*t249)/t152
+    t253 = (t131 + t146*t252 + t169*t251 - t196*t250 + t226*t249)/t127
+    t254 = (t112 + t120*t253 + t139*t252 + t162*t251 - t189*t250 - t219*t249)/t108
+    t255 = q1 - t249 - t253*t52 + t254*t53
+    t256 = -c234*t249 - q5 + t17*t250 + t23*t252 + t251*t9 + t253*t37 + t254*t36
+    t257 = q6 + t249*t31 + t250*t4 - t251*t7
+    t258 = s1*t253
+    t259 = c1*t254
+    t260 = -c1*t250 + s1*t251
+    t261 = -q2 + t252*t54 + t258*t34 + t259*t34 + t260
+    t262 = -q3 + t252*t50 + t258*t33 + t259*t33 + t260
+    t263 = -q4 + t22*t252 + t258*t32 + t259*t32 + t260
+    q_start = numpy.empty(numpy.broadcast_shapes(target.shape[:-2], q.shape[:-1], damping.shape) + (6,))
+    q_start[..., 0] = q1
+    q_start[..., 1] = q2
+    q_start[..., 2] = q3
+    q_start[..., 3] = q4
+    q_start[..., 4] = q5
+    q_start[..., 5] = q6
+    q_next = numpy.empty(numpy.broadcast_shapes(target.shape[:-2], q.shape[:-1], damping.shape) + (6,))
+    q_next[..., 0] = numpy.where(numpy.less(t255, -6.283185307179586), -6.283185307179586, numpy.where(numpy.greater(t255, 6.283185307179586), 6.283185307179586, t255))
+    q_next[..., 1] = numpy.where(numpy.greater(t261, 6.283185307179586), -6.283185307179586, numpy.where(numpy.less(t261, -6.283185307179586), 6.283185307179586, -t261))
+    q_next[..., 2] = numpy.where(numpy.greater(t262, 6.283185307179586), -6.283185307179586, numpy.where(numpy.less(t262, -6.283185307179586), 6.283185307179586, -t262))
+    q_next[..., 3] = numpy.where(numpy.greater(t263, 6.283185307179586), -6.283185307179586, numpy.where(numpy.less(t263, -6.283185307179586), 6.283185307179586, -t263))
+    q_next[..., 4] = numpy.where(numpy.greater(t256, 6.283185307179586), -6.283185307179586, numpy.where(numpy.less(t256, -6.283185307179586), 6.283185307179586, -t256))
+    q_next[..., 5] = numpy.where(numpy.less(t257, -6.283185307179586), -6.283185307179586, numpy.where(numpy.greater(t257, 6.283185307179586), 6.283185307179586, t257))
+    cost = numpy.empty(numpy.broadcast_shapes(target.shape[:-2], q.shape[:-1], damping.shape) + ())
+    cost[...] = numpy.where(numpy.isfinite(t0), t105, -1)
+    return q_start, q_next, cost
+
+
+@numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def ik_branches(T):
     """every branch of the closed-form ik and whether the target allows it: (8 x 6 and 8 x 1), 843 operations."""
     T = _argument("T", T, (4, 4))
@@ -1510,73 +1839,48 @@ def ik(T):
     return q[valid] if valid.ndim == 1 else (q, valid)
 
 
-# -- Iterative inverse kinematics --
+# -- Iterative inverse kinematics: the loop around ik_numeric_step --
 
 IK_NUMERIC_CONVERGED = 0  # |error| <= tol
 IK_NUMERIC_ITERATION_LIMIT = 1  # max_iter steps tried, |error| still above tol
 IK_NUMERIC_STALLED = 2  # no step reduces the error: unreachable target, joint limit or local minimum
-_LOWER = numpy.array([-6.283185307179586, -6.283185307179586, -6.283185307179586, -6.283185307179586, -6.283185307179586, -6.283185307179586])  # joint limits (infinite: none)
-_UPPER = numpy.array([6.283185307179586, 6.283185307179586, 6.283185307179586, 6.283185307179586, 6.283185307179586, 6.283185307179586])
+IK_NUMERIC_INVALID = 3  # target or q0 not finite, or max_iter < 0: q = q0
 _DAMPING = (1e-06, 1e-12, 100000000.0)  # added to the diagonal: start, least, most
-
-
-def _rotation_vector(E):
-    """The rotation vector (axis times angle in [0, pi]) of the rotation matrix E."""
-    v = 0.5 * numpy.array([E[2, 1] - E[1, 2], E[0, 2] - E[2, 0], E[1, 0] - E[0, 1]])
-    cos = 0.5 * (numpy.trace(E) - 1.0)
-    sin = numpy.linalg.norm(v)
-    angle = math.atan2(sin, cos)
-    if sin > 1e-6 or cos > 0.0:
-        return v * (angle / sin) if sin > 0.0 else v
-    # Near a half turn: the axis from the largest column of (E + I) / 2 = u u^T.
-    column = int(numpy.argmax(numpy.diag(E)))
-    axis = 0.5 * (E[:, column] + numpy.eye(3)[column])
-    axis /= numpy.linalg.norm(axis)
-    return angle * (axis if axis @ v >= 0.0 else -axis)
-
-
-def _task_error(target, q):
-    """Error [target position - position; rotation vector of target R^T] and the geometric Jacobian."""
-    T = fk(q)
-    error = numpy.concatenate([target[:3, 3] - T[:3, 3], _rotation_vector(target[:3, :3] @ T[:3, :3].T)])
-    return error, jacobian(q)
 
 
 def ik_numeric(target, q0, max_iter=100, tol=1e-10):
     """Iterative inverse kinematics from q0: damped least squares on the task error.
 
-    target: the 4x4 tool pose in the world frame.
-    Each step is q += J^T (J J^T + damping I)^-1 e, with e the task error
+    target: the 4x4 tool pose in the world frame, or a batch of them with q0 (..., DOF).
+    Each step is ik_numeric_step: q += J^T (J J^T + damping I)^-1 e, with e the task error
     (position error and rotation vector of R_target R^T, world frame) and J its Jacobian; joints are clamped to their limits.
     The damping adapts (Levenberg-Marquardt): divided by 10 after a step that lowers |e|,
     multiplied by 10 and the step discarded otherwise.
-    Returns (q, status): status IK_NUMERIC_CONVERGED (|e| <= tol), IK_NUMERIC_ITERATION_LIMIT
-    (max_iter steps tried) or IK_NUMERIC_STALLED (no step lowers |e|: out of reach, a joint
-    limit or a local minimum); q is the best configuration found.
+    Returns (q, status), status an IK_NUMERIC_* code per target; q is the best configuration
+    found.
     """
-    target = numpy.asarray(target, dtype=float)
-    q = numpy.asarray(q0, dtype=float)
-    if target.shape != (4, 4) or q.shape != (DOF,):
-        raise ValueError(f"expected target (4, 4) and q0 ({DOF},), got {target.shape} and {q.shape}")
-    q = numpy.clip(q, _LOWER, _UPPER)
-    error, J = _task_error(target, q)
-    cost = error @ error
-    damping, least, most = _DAMPING
-    for _ in range(max_iter):
-        if cost <= tol * tol:
-            return q, IK_NUMERIC_CONVERGED
-        step = J.T @ numpy.linalg.solve(J @ J.T + damping * numpy.eye(J.shape[0]), error)
-        trial = numpy.clip(q + step, _LOWER, _UPPER)
-        trial_error, trial_J = _task_error(target, trial)
-        trial_cost = trial_error @ trial_error
-        if trial_cost < cost:
-            q, error, J, cost = trial, trial_error, trial_J, trial_cost
-            damping = max(damping * 0.1, least)
-        else:
-            damping *= 10.0
-            if damping > most:
-                return q, IK_NUMERIC_STALLED
-    return q, IK_NUMERIC_CONVERGED if cost <= tol * tol else IK_NUMERIC_ITERATION_LIMIT
+    least, most = _DAMPING[1:]
+    q, trial, cost = ik_numeric_step(target, q0, _DAMPING[0])
+    damping = cost * 0.0 + _DAMPING[0]
+    status = numpy.where((cost >= 0.0) & (max_iter >= 0), IK_NUMERIC_ITERATION_LIMIT, IK_NUMERIC_INVALID)
+    for _ in range(max(max_iter, 0)):
+        status = numpy.where(numpy.logical_and(status == IK_NUMERIC_ITERATION_LIMIT, cost <= tol * tol), IK_NUMERIC_CONVERGED, status)
+        active = status == IK_NUMERIC_ITERATION_LIMIT
+        if not active.any():
+            break
+        lighter = numpy.maximum(damping * 0.1, least)
+        _, after, trial_cost = ik_numeric_step(target, trial, lighter)
+        better = numpy.logical_and(active, trial_cost < cost)
+        worse = numpy.logical_and(active, trial_cost >= cost)
+        q = numpy.where(better[..., None], trial, q)
+        cost = numpy.where(better, trial_cost, cost)
+        damping = numpy.where(better, lighter, numpy.where(worse, damping * 10.0, damping))
+        status = numpy.where(numpy.logical_and(worse, damping > most), IK_NUMERIC_STALLED, status)
+        _, retry, _ = ik_numeric_step(target, q, damping)
+        trial = numpy.where(better[..., None], after, numpy.where(worse[..., None], retry, trial))
+    status = numpy.where(numpy.logical_and(status == IK_NUMERIC_ITERATION_LIMIT, cost <= tol * tol), IK_NUMERIC_CONVERGED, status)
+    q = numpy.where((status == IK_NUMERIC_INVALID)[..., None], numpy.asarray(q0, dtype=float), q)
+    return q, status[()] if status.ndim == 0 else status
 
 
 # Statuses of velocity_ik: OK, singular (a diagonal entry of the QR factor R of the

@@ -1022,6 +1022,331 @@ def _velocity_ik(q, mu_dot, damping):
     return [q_dot, status]
 
 
+def _ik_numeric_step(target, q, damping):
+    """One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite): 971 operations."""
+    T00 = target[0, 0]
+    T01 = target[0, 1]
+    T02 = target[0, 2]
+    T03 = target[0, 3]
+    T10 = target[1, 0]
+    T11 = target[1, 1]
+    T12 = target[1, 2]
+    T13 = target[1, 3]
+    T20 = target[2, 0]
+    T21 = target[2, 1]
+    T22 = target[2, 2]
+    T23 = target[2, 3]
+    qs1 = q[0]
+    qs2 = q[1]
+    qs3 = q[2]
+    qs4 = q[3]
+    qs5 = q[4]
+    qs6 = q[5]
+    q1 = casadi.if_else((qs1 < -6.283185307179586), -6.283185307179586, casadi.if_else((qs1 > 6.283185307179586), 6.283185307179586, qs1))
+    q2 = casadi.if_else((qs2 < -6.283185307179586), -6.283185307179586, casadi.if_else((qs2 > 6.283185307179586), 6.283185307179586, qs2))
+    q3 = casadi.if_else((qs3 < -6.283185307179586), -6.283185307179586, casadi.if_else((qs3 > 6.283185307179586), 6.283185307179586, qs3))
+    q4 = casadi.if_else((qs4 < -6.283185307179586), -6.283185307179586, casadi.if_else((qs4 > 6.283185307179586), 6.283185307179586, qs4))
+    q5 = casadi.if_else((qs5 < -6.283185307179586), -6.283185307179586, casadi.if_else((qs5 > 6.283185307179586), 6.283185307179586, qs5))
+    q6 = casadi.if_else((qs6 < -6.283185307179586), -6.283185307179586, casadi.if_else((qs6 > 6.283185307179586), 6.283185307179586, qs6))
+    c1 = casadi.cos(q1)
+    s1 = casadi.sin(q1)
+    c2 = casadi.cos(q2)
+    s2 = casadi.sin(q2)
+    c3 = casadi.cos(q3)
+    s3 = casadi.sin(q3)
+    c23 = c2*c3 - s2*s3
+    s23 = c2*s3 + c3*s2
+    c4 = casadi.cos(q4)
+    s4 = casadi.sin(q4)
+    c234 = c23*c4 - s23*s4
+    s234 = c23*s4 + c4*s23
+    c5 = casadi.cos(q5)
+    s5 = casadi.sin(q5)
+    c6 = casadi.cos(q6)
+    s6 = casadi.sin(q6)
+    t0 = T00 + T01 + T02 + T03 + T10 + T11 + T12 + T13 + T20 + T21 + T22 + T23 + qs1 + qs2 + qs3 + qs4 + qs5 + qs6
+    t1 = s1*s5
+    t2 = c1*c5
+    t3 = c234*t2 + t1
+    t4 = c234*t1 + t2
+    t5 = c5*s1
+    t6 = c1*s5
+    t7 = -c234*t6 + t5
+    t8 = c234*t5 - t6
+    t9 = c1*s234
+    t10 = c6*t3 - s6*t9
+    t11 = c6*t9 + s6*t3
+    t12 = 0.0823*t7 + 0.09465*t9
+    t13 = 0.10915*s1 + t12
+    t14 = T00*t10 - T01*t11 + T02*t7
+    t15 = T10*t10 - T11*t11 + T12*t7
+    t16 = T20*t10 - T21*t11 + T22*t7
+    t17 = s1*s234
+    t18 = c6*t8 - s6*t17
+    t19 = c6*t17 + s6*t8
+    t20 = 0.09465*t17 - 0.0823*t4
+    t21 = -0.10915*c1 + t20
+    t22 = c1*t13 + s1*t21
+    t23 = -t12*t17 + t20*t9
+    t24 = -T00*t18 + T01*t19 + T02*t4
+    t25 = -T10*t18 + T11*t19 + T12*t4
+    t26 = -T20*t18 + T21*t19 + T22*t4
+    t27 = 0.5*t15 + 0.5*t24
+    t28 = c5*s234
+    t29 = c234*s6 + c6*t28
+    t30 = c234*c6 - s6*t28
+    t31 = s234*s5
+    t32 = 0.09465*c234 + 0.0823*t31
+    t33 = 0.39225*s23 + t32
+    t34 = 0.425*s2 + t33
+    t35 = 0.089459 - t34
+    t36 = c234*t20 - t17*t32
+    t37 = -c234*t12 + t32*t9
+    t38 = c234*t9 + t31*t7
+    t39 = -c234*t17 + t31*t4
+    t40 = T00*t29 + T01*t30 - T02*t31
+    t41 = T10*t29 + T11*t30 - T12*t31
+    t42 = T20*t29 + T21*t30 - T22*t31
+    t43 = -0.5*t26 - 0.5*t41
+    t44 = -0.5*t16 + 0.5*t40
+    t45 = casadi.sqrt(t27**2 + t43**2 + t44**2)
+    t46 = T23 - t35
+    t47 = 0.39225*c23
+    t48 = -c1*t47 + t13
+    t49 = -s1*t47 + t21
+    t50 = c1*t48 + s1*t49
+    t51 = 0.425*c2
+    t52 = -c1*t51 + t48
+    t53 = -s1*t51 + t49
+    t54 = c1*t52 + s1*t53
+    t55 = c234*t36 + t53
+    t56 = -c234*t37 + t52
+    t57 = t22**2 + t23**2 + t50**2 + t54**2
+    t58 = T03 - t52
+    t59 = T13 - t53
+    t60 = t32**2
+    t61 = c1**2
+    t62 = -t17*t36 + t32*t61 + t33*t61 + t34*t61
+    t63 = t33**2
+    t64 = t34**2
+    t65 = t36**2 + t53**2 + t60*t61 + t61*t63 + t61*t64
+    t66 = c1*s1
+    t67 = t36*t37 - t52*t53 + t60*t66 + t63*t66 + t64*t66
+    t68 = c1*t22
+    t69 = c1*t50
+    t70 = c1*t54
+    t71 = t23*t36 + t32*t68 + t33*t69 + t34*t70
+    t72 = -t17*t23 + t68 + t69 + t70
+    t73 = t32*t66 + t33*t66 + t34*t66
+    t74 = t36*t9 + t73
+    t75 = -t17*t37 + t73
+    t76 = s1**2
+    t77 = t37**2 + t52**2 + t60*t76 + t63*t76 + t64*t76
+    t78 = t32*t76 + t33*t76 + t34*t76 + t37*t9
+    t79 = s1*t22
+    t80 = s1*t50
+    t81 = s1*t54
+    t82 = t23*t37 + t32*t79 + t33*t80 + t34*t81
+    t83 = t23*t9 + t79 + t80 + t81
+    t84 = s234**2
+    t85 = t61*t84 + t7**2 + 3*t76
+    t86 = t4*t7 - t66*t84 + 3*t66
+    t87 = t4**2 + 3*t61 + t76*t84
+    t88 = c234**2 + s5**2*t84 + 1
+    t89 = -t25
+    t90 = 0.5*t14 + 0.5*t42 + 0.5*t89 - 0.5
+    t91 = casadi.atan2(t45, t90)
+    t92 = casadi.if_else((t45 > 0), t91/t45, 1)
+    t93 = casadi.logic_and((t14 >= t42), (t14 >= t89))
+    t94 = (t25 <= -t42)
+    t95 = casadi.if_else(t93, 0.5*t14 + 0.5, casadi.if_else(t94, -0.5*t24, 0.5*t40))
+    t96 = casadi.if_else(t93, 0.5*t15, casadi.if_else(t94, 0.5*t89 + 0.5, 0.5*t41))
+    t97 = casadi.if_else(t93, 0.5*t16, casadi.if_else(t94, -0.5*t26, 0.5*t42 + 0.5))
+    t98 = casadi.sqrt(t95**2 + t96**2 + t97**2)
+    t99 = casadi.if_else((t27*t97 + t43*t95 + t44*t96 >= 0), 1, -1)
+    t100 = casadi.logic_or((t45 > 1e-06), (t90 > 0))
+    t101 = t91*t99/t98
+    t102 = casadi.if_else(t100, t43*t92, t101*t95)
+    t103 = casadi.if_else(t100, t44*t92, t101*t96)
+    t104 = casadi.if_else(t100, t27*t92, t101*t97)
+    t105 = t102**2 + t103**2 + t104**2 + t46**2 + t58**2 + t59**2
+    t106 = damping + t65
+    t107 = casadi.sqrt(t106**2 + t55**2 + t62**2 + t67**2 + t71**2 + t74**2)
+    t108 = t107*casadi.if_else((t106 >= 0), 1, -1)
+    t109 = t106 + t108
+    t110 = casadi.if_else((t107 > 0), 1/(t107*(t107 + casadi.fabs(t106))), 0)
+    t111 = t110*(t102*t74 - t103*t62 - t104*t55 + t109*t58 + t46*t71 + t59*t67)
+    t112 = -t109*t111 + t58
+    t113 = -t111*t67 + t59
+    t114 = -t111*t71 + t46
+    t115 = t102 - t111*t74
+    t116 = t103 + t111*t62
+    t117 = t104 + t111*t55
+    t118 = damping + t77
+    t119 = t110*(t109*t67 + t118*t67 - t55*t56 + t62*t75 + t71*t82 + t74*t78)
+    t120 = -t109*t119 + t67
+    t121 = t118 - t119*t67
+    t122 = -t119*t71 + t82
+    t123 = -t119*t74 + t78
+    t124 = t119*t62 - t75
+    t125 = t119*t55 + t56
+    t126 = casadi.sqrt(t121**2 + t122**2 + t123**2 + t124**2 + t125**2)
+    t127 = t126*casadi.if_else((t121 >= 0), 1, -1)
+    t128 = t121 + t127
+    t129 = casadi.if_else((t126 > 0), 1/(t126*(t126 + casadi.fabs(t121))), 0)
+    t130 = t129*(t113*t128 + t114*t122 + t115*t123 + t116*t124 + t117*t125)
+    t131 = t113 - t128*t130
+    t132 = t114 - t122*t130
+    t133 = t115 - t123*t130
+    t134 = t116 - t124*t130
+    t135 = t117 - t125*t130
+    t136 = c234*t23
+    t137 = damping + t57
+    t138 = t110*(t109*t71 + t136*t55 + t137*t71 + t62*t72 + t67*t82 + t74*t83)
+    t139 = -t109*t138 + t71
+    t140 = -t138*t67 + t82
+    t141 = t137 - t138*t71
+    t142 = -t138*t74 + t83
+    t143 = t138*t62 - t72
+    t144 = -t136 + t138*t55
+    t145 = t129*(t122*t141 + t123*t142 + t124*t143 + t125*t144 + t128*t140)
+    t146 = -t128*t145 + t140
+    t147 = -t122*t145 + t141
+    t148 = -t123*t145 + t142
+    t149 = -t124*t145 + t143
+    t150 = -t125*t145 + t144
+    t151 = casadi.sqrt(t147**2 + t148**2 + t149**2 + t150**2)
+    t152 = t151*casadi.if_else((t147 >= 0), 1, -1)
+    t153 = t147 + t152
+    t154 = casadi.if_else((t151 > 0), 1/(t151*(t151 + casadi.fabs(t147))), 0)
+    t155 = t154*(t132*t153 + t133*t148 + t134*t149 + t135*t150)
+    t156 = t132 - t153*t155
+    t157 = t133 - t148*t155
+    t158 = t134 - t149*t155
+    t159 = t135 - t150*t155
+    t160 = damping + t85
+    t161 = t110*(t109*t74 + t160*t74 + t38*t55 + t62*t86 + t67*t78 + t71*t83)
+    t162 = -t109*t161 + t74
+    t163 = -t161*t67 + t78
+    t164 = -t161*t71 + t83
+    t165 = t160 - t161*t74
+    t166 = t161*t62 - t86
+    t167 = t161*t55 - t38
+    t168 = t129*(t122*t164 + t123*t165 + t124*t166 + t125*t167 + t128*t163)
+    t169 = -t128*t168 + t163
+    t170 = -t122*t168 + t164
+    t171 = -t123*t168 + t165
+    t172 = -t124*t168 + t166
+    t173 = -t125*t168 + t167
+    t174 = t154*(t148*t171 + t149*t172 + t150*t173 + t153*t170)
+    t175 = -t153*t174 + t170
+    t176 = -t148*t174 + t171
+    t177 = -t149*t174 + t172
+    t178 = -t150*t174 + t173
+    t179 = casadi.sqrt(t176**2 + t177**2 + t178**2)
+    t180 = t179*casadi.if_else((t176 >= 0), 1, -1)
+    t181 = t176 + t180
+    t182 = casadi.if_else((t179 > 0), 1/(t179*(t179 + casadi.fabs(t176))), 0)
+    t183 = t182*(t157*t181 + t158*t177 + t159*t178)
+    t184 = t157 - t181*t183
+    t185 = t158 - t177*t183
+    t186 = t159 - t178*t183
+    t187 = damping + t87
+    t188 = -t110*(t109*t62 + t187*t62 + t39*t55 + t67*t75 + t71*t72 + t74*t86)
+    t189 = t109*t188 + t62
+    t190 = t188*t67 + t75
+    t191 = t188*t71 + t72
+    t192 = t188*t74 + t86
+    t193 = t187 + t188*t62
+    t194 = t188*t55 + t39
+    t195 = -t129*(t122*t191 + t123*t192 - t124*t193 - t125*t194 + t128*t190)
+    t196 = t128*t195 + t190
+    t197 = t122*t195 + t191
+    t198 = t123*t195 + t192
+    t199 = -t124*t195 + t193
+    t200 = -t125*t195 + t194
+    t201 = t154*(-t148*t198 + t149*t199 + t150*t200 - t153*t197)
+    t202 = t153*t201 + t197
+    t203 = t148*t201 + t198
+    t204 = -t149*t201 + t199
+    t205 = -t150*t201 + t200
+    t206 = t182*(t177*t204 + t178*t205 - t181*t203)
+    t207 = t181*t206 + t203
+    t208 = -t177*t206 + t204
+    t209 = -t178*t206 + t205
+    t210 = casadi.sqrt(t208**2 + t209**2)
+    t211 = t210*casadi.if_else((t208 >= 0), 1, -1)
+    t212 = t208 + t211
+    t213 = casadi.if_else((t210 > 0), 1/(t210*(t210 + casadi.fabs(t208))), 0)
+    t214 = t213*(t185*t212 + t186*t209)
+    t215 = t185 - t212*t214
+    t216 = t186 - t209*t214
+    t217 = damping + t88
+    t218 = -t110*(t109*t55 + t136*t71 + t217*t55 + t38*t74 + t39*t62 - t56*t67)
+    t219 = t109*t218 + t55
+    t220 = -t218*t67 + t56
+    t221 = t136 + t218*t71
+    t222 = t218*t74 + t38
+    t223 = t218*t62 + t39
+    t224 = t217 + t218*t55
+    t225 = t129*(-t122*t221 - t123*t222 + t124*t223 + t125*t224 + t128*t220)
+    t226 = -t128*t225 + t220
+    t227 = t122*t225 + t221
+    t228 = t123*t225 + t222
+    t229 = -t124*t225 + t223
+    t230 = -t125*t225 + t224
+    t231 = t154*(-t148*t228 + t149*t229 + t150*t230 - t153*t227)
+    t232 = t153*t231 + t227
+    t233 = t148*t231 + t228
+    t234 = -t149*t231 + t229
+    t235 = -t150*t231 + t230
+    t236 = t182*(t177*t234 + t178*t235 - t181*t233)
+    t237 = t181*t236 + t233
+    t238 = -t177*t236 + t234
+    t239 = -t178*t236 + t235
+    t240 = t213*(t209*t239 + t212*t238)
+    t241 = -t212*t240 + t238
+    t242 = -t209*t240 + t239
+    t243 = casadi.fabs(t242)
+    t244 = t243
+    t245 = t244*casadi.if_else((t242 >= 0), 1, -1)
+    t246 = t242 + t245
+    t247 = casadi.if_else((t244 > 0), 1/(t244*(t243 + t244)), 0)
+    t248 = -t216*t246**2*t247 + t216
+    t249 = t248/t245
+    t250 = (t215 + t241*t249)/t211
+    t251 = (t184 - t207*t250 - t237*t249)/t180
+    t252 = (t156 + t175*t251 - t202*t250 - t232*t249)/t152
+    t253 = (t131 + t146*t252 + t169*t251 - t196*t250 + t226*t249)/t127
+    t254 = (t112 + t120*t253 + t139*t252 + t162*t251 - t189*t250 - t219*t249)/t108
+    t255 = q1 - t249 - t253*t52 + t254*t53
+    t256 = -c234*t249 - q5 + t17*t250 + t23*t252 + t251*t9 + t253*t37 + t254*t36
+    t257 = q6 + t249*t31 + t250*t4 - t251*t7
+    t258 = s1*t253
+    t259 = c1*t254
+    t260 = -c1*t250 + s1*t251
+    t261 = -q2 + t252*t54 + t258*t34 + t259*t34 + t260
+    t262 = -q3 + t252*t50 + t258*t33 + t259*t33 + t260
+    t263 = -q4 + t22*t252 + t258*t32 + t259*t32 + t260
+    q_start = casadi.SX(6, 1)
+    q_start[0, 0] = q1
+    q_start[1, 0] = q2
+    q_start[2, 0] = q3
+    q_start[3, 0] = q4
+    q_start[4, 0] = q5
+    q_start[5, 0] = q6
+    q_next = casadi.SX(6, 1)
+    q_next[0, 0] = casadi.if_else((t255 < -6.283185307179586), -6.283185307179586, casadi.if_else((t255 > 6.283185307179586), 6.283185307179586, t255))
+    q_next[1, 0] = casadi.if_else((t261 > 6.283185307179586), -6.283185307179586, casadi.if_else((t261 < -6.283185307179586), 6.283185307179586, -t261))
+    q_next[2, 0] = casadi.if_else((t262 > 6.283185307179586), -6.283185307179586, casadi.if_else((t262 < -6.283185307179586), 6.283185307179586, -t262))
+    q_next[3, 0] = casadi.if_else((t263 > 6.283185307179586), -6.283185307179586, casadi.if_else((t263 < -6.283185307179586), 6.283185307179586, -t263))
+    q_next[4, 0] = casadi.if_else((t256 > 6.283185307179586), -6.283185307179586, casadi.if_else((t256 < -6.283185307179586), 6.283185307179586, -t256))
+    q_next[5, 0] = casadi.if_else((t257 < -6.283185307179586), -6.283185307179586, casadi.if_else((t257 > 6.283185307179586), 6.283185307179586, t257))
+    cost = casadi.SX(1, 1)
+    cost[0, 0] = casadi.if_else((casadi.fabs(t0) < casadi.inf), t105, -1)
+    return [q_start, q_next, cost]
+
+
 def _ik_branches(T):
     """Every branch of the closed-form ik and whether the target allows it: 843 operations."""
     T00 = T[0, 0]
@@ -1427,6 +1752,7 @@ def _ik_branches(T):
 _q = casadi.SX.sym("q", 6, 1)
 _mu_dot = casadi.SX.sym("mu_dot", 6, 1)
 _damping = casadi.SX.sym("damping", 1, 1)
+_target = casadi.SX.sym("target", 4, 4)
 _T = casadi.SX.sym("T", 4, 4)
 fk = casadi.Function("fk", [_q], _fk(_q), ["q"], ["T"])
 jacobian = casadi.Function("jacobian", [_q], _jacobian(_q), ["q"], ["J"])
@@ -1438,10 +1764,48 @@ singularity_factors = casadi.Function("singularity_factors", [_q], _singularity_
 manipulability = casadi.Function("manipulability", [_q], _manipulability(_q), ["q"], ["w"])
 jacobian_det = casadi.Function("jacobian_det", [_q], _jacobian_det(_q), ["q"], ["d"])
 velocity_ik = casadi.Function("velocity_ik", [_q, _mu_dot, _damping], _velocity_ik(_q, _mu_dot, _damping), ["q", "mu_dot", "damping"], ["q_dot", "status"])
+ik_numeric_step = casadi.Function("ik_numeric_step", [_target, _q, _damping], _ik_numeric_step(_target, _q, _damping), ["target", "q", "damping"], ["q_start", "q_next", "cost"])
 ik_branches = casadi.Function("ik_branches", [_T], _ik_branches(_T), ["T"], ["q", "valid"])
 ik = ik_branches  # CasADi functions have fixed-size outputs: every branch and its validity
+
+IK_NUMERIC_CONVERGED = 0  # |error| <= tol
+IK_NUMERIC_ITERATION_LIMIT = 1  # IK_NUMERIC_ITERATIONS steps taken, |error| still above tol
+IK_NUMERIC_STALLED = 2  # no step reduces the error: unreachable target, joint limit or local minimum
+IK_NUMERIC_INVALID = 3  # target or q0 not finite: q = q0
+IK_NUMERIC_ITERATIONS = 100
+_DAMPING = (1e-06, 1e-12, 100000000.0)  # added to the diagonal: start, least, most
+
+
+def _ik_numeric(target, q0, tol):
+    """ik_numeric of the C and numpy modules with a fixed number of steps: every branch of
+    the loop is a select, so the graph is the same for every input."""
+    least, most = _DAMPING[1:]
+    q, trial, cost = ik_numeric_step(target, q0, _DAMPING[0])
+    damping = cost * 0.0 + _DAMPING[0]
+    status = casadi.if_else(cost >= 0.0, IK_NUMERIC_ITERATION_LIMIT, IK_NUMERIC_INVALID)
+    for _ in range(IK_NUMERIC_ITERATIONS):
+        status = casadi.if_else(casadi.logic_and(status == IK_NUMERIC_ITERATION_LIMIT, cost <= tol * tol), IK_NUMERIC_CONVERGED, status)
+        active = status == IK_NUMERIC_ITERATION_LIMIT
+        lighter = casadi.fmax(damping * 0.1, least)
+        _, after, trial_cost = ik_numeric_step(target, trial, lighter)
+        better = casadi.logic_and(active, trial_cost < cost)
+        worse = casadi.logic_and(active, trial_cost >= cost)
+        q = casadi.if_else(better, trial, q)
+        cost = casadi.if_else(better, trial_cost, cost)
+        damping = casadi.if_else(better, lighter, casadi.if_else(worse, damping * 10.0, damping))
+        status = casadi.if_else(casadi.logic_and(worse, damping > most), IK_NUMERIC_STALLED, status)
+        _, retry, _ = ik_numeric_step(target, q, damping)
+        trial = casadi.if_else(better, after, casadi.if_else(worse, retry, trial))
+    status = casadi.if_else(casadi.logic_and(status == IK_NUMERIC_ITERATION_LIMIT, cost <= tol * tol), IK_NUMERIC_CONVERGED, status)
+    q = casadi.if_else((status == IK_NUMERIC_INVALID), q0, q)
+    return [q, status]
+
+
+_tol = casadi.SX.sym("tol")
+ik_numeric = casadi.Function("ik_numeric", [_target, _q, _tol], _ik_numeric(_target, _q, _tol),
+                             ["target", "q0", "tol"], ["q", "status"])
 
 
 def functions():
     """All functions by name."""
-    return {"fk": fk, "jacobian": jacobian, "fk_jacobian": fk_jacobian, "jacobian_tool": jacobian_tool, "task": task, "task_jacobian": task_jacobian, "singularity_factors": singularity_factors, "manipulability": manipulability, "jacobian_det": jacobian_det, "velocity_ik": velocity_ik, "ik_branches": ik_branches}
+    return {"fk": fk, "jacobian": jacobian, "fk_jacobian": fk_jacobian, "jacobian_tool": jacobian_tool, "task": task, "task_jacobian": task_jacobian, "singularity_factors": singularity_factors, "manipulability": manipulability, "jacobian_det": jacobian_det, "velocity_ik": velocity_ik, "ik_numeric_step": ik_numeric_step, "ik_branches": ik_branches}
