@@ -7,6 +7,7 @@ import click
 
 from . import __version__, budget
 from .errors import JacgenError
+from .model import Model
 from .render import DEFAULT_LANGUAGES, LANGUAGES, render_robot, stale_files, write_files
 from .report import describe, plot_workspace
 from .robot import load_robot
@@ -124,7 +125,7 @@ def validate(robot_files):
 def show(robot_file, plot_file):
     """Describe a robot in words: DH table, task, singularities, inverse kinematics."""
     robot = load_robot(robot_file)
-    click.echo(describe(robot))
+    click.echo(describe(Model(robot)))
     if plot_file:
         plot_workspace(robot, plot_file)
         click.echo(f"jacgen: wrote {plot_file}", err=True)

@@ -299,7 +299,7 @@ def _report_context(robot: Robot, generator: Generator) -> dict:
         "singularities": report.singularity_lines(robot, singular),
         "euler": report.euler_lines(robot, singular),
         "isotropy": report.isotropy_lines(robot),
-        "ik": report.ik_lines(robot),
+        "ik": report.ik_lines(generator.model.structure),
         "operations": [{"name": f.name, "operations": f.body.operation_count,
                         "shape": "scalar" if f.scalar else " and ".join(f"{o.rows} x {o.cols}" for o in f.outputs)}
                        for f in generator.functions()],

@@ -15,7 +15,8 @@ import sympy
 from sympy.core.parameters import distribute
 from sympy.logic.boolalg import Boolean
 
-from . import analysis, budget, differential, ik, kinematics, subproblems
+from . import analysis, differential, ik, kinematics, subproblems
+from .model import Model
 from .subproblems import Subproblems
 from .printers import fold_constants
 from .robot import Robot
@@ -119,8 +120,9 @@ class Function:
 class Generator:
     """Builds the emitted functions of one robot, sharing the symbolic chain between them."""
 
-    def __init__(self, robot: Robot):
+    def __init__(self, robot: Robot, model: Model | None = None):
         self.robot = robot
+        self.model = model or Model(robot)
         self.q = kinematics.joint_symbols(robot)
         # Trig symbols, each defined once, in an order that defines before use.
         self.definitions: list[tuple[sympy.Symbol, sympy.Expr]] = []
@@ -146,9 +148,9 @@ class Generator:
             self._trig[joints] = (cos, sin)
         return self._trig[joints]
 
-    @cached_property
+    @property
     def closed_form(self) -> "ik.ClosedForm | None":
-        return ik.closed_form(self.robot)
+        return self.model.closed_form
 
     def ik_functions(self) -> list[Function]:
         """ik_branches: every branch of the closed-form solver with its validity, from the
@@ -216,10 +218,9 @@ class Generator:
     def jacobian(self) -> sympy.Matrix:
         return kinematics.column_jacobian(self.robot, self.chain)
 
-    @cached_property
+    @property
     def singularities(self) -> analysis.Singularities:
-        return budget.within_budget(lambda: analysis.analyse(self.robot), lambda: analysis.unanalysed(self.robot),
-                                    f"the singularity analysis of {self.robot.name}")
+        return self.model.singularities
 
     def rank_determinant(self, js: sympy.Matrix) -> sympy.Expr:
         """det(Js) for square Js, else the Gram determinant det(Js Js^T) or det(Js^T Js), by

@@ -1,16 +1,12 @@
-"""Closed-form inverse kinematics: the exact constants each solver class needs.
+"""Closed-form inverse kinematics: each solver class, written once as expressions.
 
-One solver per structure class (see `structure.SOLVERS`) serves every robot of that class:
-the algorithm is a template (`templates/*/ik*.jinja`) built from Paden-Kahan subproblems,
-and what differs between robots is only their geometry at q = 0 (axis directions, points on
-the axes, the tool pose), computed here with sympy (exactly; irrational numbers to 60 digits,
-see `structure.Geometry`) and emitted as literals, or as expressions in the symbolic parameters. The subproblems, on vectors relative to a point of
-the axis:
-
-- SP1: the angle turning p into q about the unit axis k;
-- SP2: the angles (t1, t2) with rot(k1, t1) rot(k2, t2) p = q (axes through one point);
-- SP3: the angles turning p about k to the distance d from q (reduces to SP4);
-- SP4: the angles with h . rot(k, t) p = d.
+One solver per structure class (see `structure.SOLVERS`) serves every robot of that class.
+What differs between robots is only their geometry at q = 0 (axis directions, points on
+the axes, the tool pose), computed here with sympy (exactly; irrational numbers to 60
+digits, see `structure.Geometry`) as the solver's constants, or as expressions in the
+symbolic parameters. The solvers (below the constants) build every branch from the
+Paden-Kahan subproblems of `subproblems.py`, and the fk pipeline prints them for every
+backend as `ik_branches`.
 """
 
 import textwrap
@@ -18,18 +14,12 @@ from dataclasses import dataclass
 
 import sympy
 
-from .structure import E_Z, SOLVERS, Geometry, SolverInfo, classify, is_zero, squared_norm, tidy
+from .structure import E_Z, SOLVERS, Geometry, SolverInfo, Structure, classify, is_zero, squared_norm, tidy
 from .subproblems import EPS, Angle, IsFinite, Subproblems, relative, select, times, times_transposed, wrapped
 
 Matrix = sympy.Matrix
 
 DOC_WIDTH = 88  # characters per line of the generated documentation
-# Relative tolerances of the generated solvers, by real type. A discriminant (a squared sine)
-# within EPS of 0 is one double root: tangent targets and targets on a singularity give one
-# solution, not two copies, and a target out of reach by less than that still gets it. A
-# vector whose squared length is below TINY times its scale is treated as zero (an SP1 with
-# a free angle returns 0).
-TOLERANCES = {"double": {"eps": 1e-12, "tiny": 1e-24}, "float": {"eps": 1e-6, "tiny": 1e-12}}
 
 
 @dataclass(frozen=True)
@@ -41,7 +31,6 @@ class ClosedForm:
     target: str  # "pose" (4x4) or "task" (the task vector mu)
     constants: tuple[tuple[str, sympy.Matrix], ...]  # name -> 3x1, 3x3 or 1x1 exact values
     indices: tuple[tuple[str, int], ...]  # named joint indices the planar skeleton places
-    helpers: tuple[str, ...]  # the template's helper functions, in dependency order
     flip: bool  # axis 5 perpendicular to its neighbours: a second wrist root follows from the first
 
 
@@ -131,17 +120,6 @@ def _three_parallel(g: Geometry) -> tuple[list, list]:
     ], []
 
 
-# The helper functions each solver's template calls, in dependency order ("wrist" becomes
-# "wrist_perpendicular" when the solver can flip, see _FLIPS).
-HELPERS = {
-    "planar": ("vectors", "sp1", "sp4", "sp3"),
-    "yaw_pitch": ("vectors", "sp1", "sp4", "sp3"),
-    "spherical_wrist_parallel": ("vectors", "sp1", "sp4", "sp3", "sp2", "relative", "wrist"),
-    "spherical_wrist_intersecting": ("vectors", "sp1", "sp4", "sp3", "sp2", "relative", "wrist"),
-    "spherical_wrist_prismatic": ("vectors", "sp1", "sp2", "relative", "wrist"),
-    "three_parallel": ("vectors", "sp1", "sp4", "sp3", "relative", "transpose"),
-}
-
 # Solvers whose wrist has a second root that follows from the first when axis 5 is
 # perpendicular to the axes listed (0-based): rot(a, pi) rot(h5, x) = rot(h5, -x) rot(a, pi) for
 # a perpendicular to h5. Spherical wrist: (q4 + pi, wrist_flip - q5, q6 + pi), wrist_flip =
@@ -159,23 +137,22 @@ _CONSTANTS = {
 }
 
 
-def closed_form(robot) -> ClosedForm | None:
-    """The closed-form solver of `robot` with its exact constants, None when no class applies."""
-    geometry = Geometry(robot)
-    structure = classify(robot, geometry)
+def closed_form(robot, geometry: Geometry | None = None, structure: Structure | None = None) -> ClosedForm | None:
+    """The closed-form solver of `robot` with its exact constants, None when no class applies
+    (pass the robot's geometry and structure when they are known: see `model.Model`)."""
+    geometry = geometry or Geometry(robot)
+    structure = structure or classify(robot, geometry)
     if structure.solver is None:
         return None
     constants, indices = _CONSTANTS[structure.solver](geometry)
     target = "pose" if len(robot.task) == 6 else "task"
     h = geometry.axes
     flip = structure.solver in _FLIPS and all(is_zero(h[4].dot(h[i])) for i in _FLIPS[structure.solver])
-    helpers = tuple("wrist_perpendicular" if helper == "wrist" and flip else helper
-                    for helper in HELPERS[structure.solver])
-    if flip and "wrist" in HELPERS[structure.solver]:
+    if flip and structure.solver.startswith("spherical_wrist"):
         turn = sympy.atan2(h[4].dot(h[3].cross(h[5])), h[3].dot(h[5]))  # h6 = rot(h5, turn) h4
         constants.append(("wrist_flip", _scalar(-2 * turn)))
     return ClosedForm(structure.solver, SOLVERS[structure.solver], target,
-                      tuple((name, Matrix(value)) for name, value in constants), tuple(indices), helpers, flip)
+                      tuple((name, Matrix(value)) for name, value in constants), tuple(indices), flip)
 
 
 def documentation(robot, form: ClosedForm, max_name: str) -> list[str]:

@@ -66,13 +66,14 @@ GENERATED_IMPORTS = frozenset({"numpy", "casadi", "math"})
 # (tests/test_adversarial.py finds any the templates add; new locals had better start with
 # '_', which no parameter name can).
 GENERATED_NAMES = frozenset("""
-    pi sqrt q p T J mu f damping target q0 max_iter tol q_dot mu_dot
-    fk jacobian jacobian_tool task task_jacobian singularity_factors manipulability ik ik_branches
-    jacobian_det velocity_ik ik_numeric fk_jacobian functions DOF TASK PARAMETERS MAX_IK_SOLUTIONS
-    IK_NUMERIC_CONVERGED IK_NUMERIC_ITERATION_LIMIT IK_NUMERIC_STALLED VELOCITY_IK_OK VELOCITY_IK_SINGULAR
-    VELOCITY_IK_NOT_FINITE status
-    A Jt b d w x angles batch cost error identity least most ok revolute singular_values solutions step
-    trial trial_J trial_cost trial_error branches count valid i j EPS TINY
+    pi sqrt q p T J mu f damping target q0 max_iter tol q_dot mu_dot fk jacobian jacobian_tool
+    task task_jacobian singularity_factors manipulability ik ik_branches jacobian_det
+    velocity_ik ik_numeric fk_jacobian functions DOF TASK PARAMETERS MAX_IK_SOLUTIONS
+    IK_NUMERIC_CONVERGED IK_NUMERIC_ITERATION_LIMIT IK_NUMERIC_STALLED VELOCITY_IK_OK
+    VELOCITY_IK_SINGULAR VELOCITY_IK_NOT_FINITE status A d w x angles batch cost error least
+    most revolute solutions step trial trial_cost branches count valid i j q_next q_start
+    ik_numeric_step IK_NUMERIC_INVALID IK_NUMERIC_ITERATIONS active after better lighter retry
+    worse
 """.split())
 # Temporaries t0.., trig terms c1.. s1.., joint variables q1.., the entries of an ik target
 # T00.. and mu0..; names starting with '_'; <math.h>'s M_PI, FP_NAN...

@@ -5,10 +5,11 @@ import numpy as np
 import sympy
 
 from . import reference
-from .analysis import READABLE_TERMS, Factor, Singularities, analyse, singularity_rows
+from .analysis import READABLE_TERMS, Factor, Singularities, singularity_rows
 from .errors import JacgenError
+from .model import Model
 from .robot import TASK_COMPONENTS, Robot
-from .structure import SOLVERS, classify
+from .structure import SOLVERS, Structure
 
 DH_HEADER = ["#", "name", "type", "a", "alpha", "d", "theta", "offset", "limits"]
 
@@ -130,8 +131,7 @@ def isotropy_lines(robot: Robot) -> list[str]:
             f"best conditioned at {where}, condition number {condition:.6g}"]
 
 
-def ik_lines(robot: Robot) -> list[str]:
-    structure = classify(robot)
+def ik_lines(structure: Structure) -> list[str]:
     if structure.solver is None:
         return [f"no closed form ({structure.reason}); ik_numeric only"]
     info = SOLVERS[structure.solver]
@@ -139,9 +139,9 @@ def ik_lines(robot: Robot) -> list[str]:
             f"(outermost first): {'; '.join(info.branches)}"]
 
 
-def describe(robot: Robot) -> str:
+def describe(model: Model) -> str:
     """`jacgen show`: everything above as plain text."""
-    singular = analyse(robot)
+    robot, singular = model.robot, model.singularities
     rows = [DH_HEADER] + dh_table(robot)
     widths = [max(len(row[c]) for row in rows) for c in range(len(DH_HEADER))]
     lines = [f"{robot.name}: {robot.description}".rstrip(": "),
@@ -156,7 +156,7 @@ def describe(robot: Robot) -> str:
     isotropy = isotropy_lines(robot)
     if isotropy:
         lines += ["", "isotropy:"] + [f"  {line}" for line in isotropy]
-    lines += ["", "inverse kinematics:"] + [f"  {line}" for line in ik_lines(robot)]
+    lines += ["", "inverse kinematics:"] + [f"  {line}" for line in ik_lines(model.structure)]
     return "\n".join(lines)
 
 

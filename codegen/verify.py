@@ -215,7 +215,7 @@ def compare(robot: Robot, function: Function, value: np.ndarray, expected: np.nd
 
 
 def verify_robot(robot: Robot, backends: _Backends, functions: list[Function], q: np.ndarray,
-                 random_count: int) -> list[Result]:
+                 random_count: int, form: ik.ClosedForm | None) -> list[Result]:
     """Every function at q, whose first `random_count` rows are random (not singular) samples."""
     tolerances = {backend: DOUBLE_TOLERANCE for backend in BACKENDS}
     tolerances["c float"] = FLOAT_TOLERANCE * (1 + reach(robot))
@@ -241,7 +241,7 @@ def verify_robot(robot: Robot, backends: _Backends, functions: list[Function], q
                 if skipped else "")
         results.append(Result(robot.name, function.name, errors, tolerances, note))
     regular = ranks > REGULAR_RANK
-    results += _ik_results(robot, backends, q[:random_count], tolerances)
+    results += _ik_results(robot, backends, q[:random_count], tolerances, form)
     mu_dot = np.random.default_rng(0).normal(size=(int(regular.sum()), len(robot.task)))
     residuals = {backend: _velocity_ik_residual(robot, backends.velocity_ik(backend, q[regular], mu_dot), q[regular], mu_dot)
                  for backend in BACKENDS}
@@ -286,14 +286,14 @@ def _target_error(robot: Robot, q: np.ndarray, target: np.ndarray) -> float:
     return float(np.max(np.abs(difference)))
 
 
-def _ik_results(robot: Robot, backends: _Backends, q: np.ndarray, tolerances: dict) -> list[Result]:
+def _ik_results(robot: Robot, backends: _Backends, q: np.ndarray, tolerances: dict,
+                form: ik.ClosedForm | None) -> list[Result]:
     """`ik` and `ik_numeric` by round trip on targets reached at random configurations q.
 
     ik: every solution must reach the target, and there must be one (k = 0 is an infinite
     error); ik_numeric: started 0.1 rad (or length unit) away from q, wherever it reports
     convergence it must have reached the target (the note says how often it converged).
     """
-    form = ik.closed_form(robot)
     targets = [_target(robot, row) for row in q]
     nominal = {p.name: p.value for p in robot.symbolic_parameters}
     results = []
@@ -401,7 +401,8 @@ def verify(robots: list[Robot], samples: int, seed: int,
             random = random_configurations(robot, samples, rng).astype(np.float32).astype(np.float64)
             q = np.vstack([random, singular_configurations(robot, generator.singularities)])
             libraries = {real: build.result() for real, build in builds.items()}
-            results += verify_robot(robot, _Backends(robot, functions, work, libraries), functions, q, len(random))
+            results += verify_robot(robot, _Backends(robot, functions, work, libraries), functions, q, len(random),
+                                    generator.closed_form)
     return results
 
 
