@@ -8,7 +8,8 @@ import click
 from . import __version__, budget
 from .errors import JacgenError
 from .model import Model
-from .render import DEFAULT_LANGUAGES, LANGUAGES, render_robot, stale_files, write_files
+from .backends import BACKENDS, DEFAULT_LANGUAGES
+from .render import render_robot, stale_files, write_files
 from .report import describe, plot_workspace
 from .robot import load_robot
 
@@ -17,10 +18,10 @@ robot_files = click.argument("robot_files", nargs=-1, required=True, type=click.
 
 def _languages(ctx, param, value: str) -> tuple[str, ...]:
     names = tuple(dict.fromkeys(part.strip() for part in value.split(",") if part.strip()))
-    unknown = [name for name in names if name not in LANGUAGES]
+    unknown = [name for name in names if name not in BACKENDS]
     if unknown or not names:
         what = f"unknown language {unknown[0]!r}; " if unknown else ""
-        raise click.BadParameter(f"{what}expected a comma-separated list of {', '.join(LANGUAGES)}")
+        raise click.BadParameter(f"{what}expected a comma-separated list of {', '.join(BACKENDS)}")
     return names
 
 

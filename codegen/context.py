@@ -1,5 +1,5 @@
 """The data each template receives: a plain, sorted dict per language, decided here so
-that templates only lay text out."""
+that templates only lay text out. `backends.py` names the builder of each language."""
 
 
 import sympy
@@ -175,20 +175,6 @@ def _task_lines(robot: Robot) -> list[str]:
     return lines
 
 
-def _c_context(robot: Robot, generator: Generator, real: str) -> dict:
-    functions = generator.functions()
-    macros = _c_macros(robot, functions)
-    printer = CPrinter(real)
-    return {
-        "prefix": robot.name.upper(),
-        "real": real,
-        "macros": list(macros.items()),
-        "joint_lines": _joint_lines(robot),
-        "task_lines": _task_lines(robot),
-        "functions": [_c_function(f, robot, printer, macros) for f in functions],
-    }
-
-
 def _casadi_function(function: Function, robot: Robot, printer: CasadiPrinter) -> dict:
     body = function.body
     results = []
@@ -306,27 +292,47 @@ def _report_context(robot: Robot, generator: Generator) -> dict:
     }
 
 
-def template_context(robot: Robot, generator: Generator, language: str, real: str) -> dict:
+def python_context(robot: Robot, generator: Generator, printer: PythonPrinter, real: str) -> dict:
+    """The numpy module's templates: every function and the IK documentation (double only)."""
     context = _common(robot)
-    if language == "python":
-        printer = PythonPrinter()
-        context["functions"] = [_python_function(f, printer, context["parameters"]) for f in generator.functions()]
-        context["ik"] = _ik_context(robot, generator, language, real)
-        context["ik_numeric"] = _ik_numeric_context(robot, language, real)
-        context["velocity_ik"] = _velocity_ik_context(robot, "double")
-    elif language == "c":
-        context.update(_c_context(robot, generator, real))
-        context["ik"] = _ik_context(robot, generator, language, real)
-        context["ik_numeric"] = _ik_numeric_context(robot, language, real)
-        context["velocity_ik"] = _velocity_ik_context(robot, real)
-    elif language == "report":
-        context.update(_report_context(robot, generator))
-    elif language == "casadi":
-        printer = CasadiPrinter()
-        functions = generator.functions()
-        context["functions"] = [_casadi_function(f, robot, printer) for f in functions]
-        context["arguments"] = sorted({(a.name, a.symbols.rows, a.symbols.cols) for f in functions for a in f.arguments},
-                                      key=lambda a: ("q", "mu_dot", "damping", "target", "T", "mu").index(a[0]))
-        context["ik"] = generator.closed_form is not None
-        context["ik_numeric"] = _ik_numeric_context(robot, "python", "double")
+    context["functions"] = [_python_function(f, printer, context["parameters"]) for f in generator.functions()]
+    context["ik"] = _ik_context(robot, generator, "python", "double")
+    context["ik_numeric"] = _ik_numeric_context(robot, "python", "double")
+    context["velocity_ik"] = _velocity_ik_context(robot, "double")
     return dict(sorted(context.items()))
+
+
+def c_context(robot: Robot, generator: Generator, printer: CPrinter, real: str) -> dict:
+    """The C header and source: functions with prototypes and size macros, in `real`."""
+    context = _common(robot)
+    functions = generator.functions()
+    macros = _c_macros(robot, functions)
+    context.update({
+        "prefix": robot.name.upper(),
+        "real": real,
+        "macros": list(macros.items()),
+        "joint_lines": _joint_lines(robot),
+        "task_lines": _task_lines(robot),
+        "functions": [_c_function(f, robot, printer, macros) for f in functions],
+        "ik": _ik_context(robot, generator, "c", real),
+        "ik_numeric": _ik_numeric_context(robot, "c", real),
+        "velocity_ik": _velocity_ik_context(robot, real),
+    })
+    return dict(sorted(context.items()))
+
+
+def casadi_context(robot: Robot, generator: Generator, printer: CasadiPrinter, real: str) -> dict:
+    """The CasADi module: every function as an SX graph, with the symbols of its inputs."""
+    context = _common(robot)
+    functions = generator.functions()
+    context["functions"] = [_casadi_function(f, robot, printer) for f in functions]
+    context["arguments"] = sorted({(a.name, a.symbols.rows, a.symbols.cols) for f in functions for a in f.arguments},
+                                  key=lambda a: ("q", "mu_dot", "damping", "target", "T", "mu").index(a[0]))
+    context["ik"] = generator.closed_form is not None
+    context["ik_numeric"] = _ik_numeric_context(robot, "python", "double")
+    return dict(sorted(context.items()))
+
+
+def report_context(robot: Robot, generator: Generator, printer: None, real: str) -> dict:
+    """The Markdown report."""
+    return dict(sorted((_common(robot) | _report_context(robot, generator)).items()))

@@ -8,14 +8,12 @@ not by each template, and holds no date, host or absolute path.
 import difflib
 import os
 import tempfile
-from dataclasses import dataclass
 from pathlib import Path
-from typing import Callable
 
 import jinja2
 
 from . import __version__
-from .context import template_context
+from .backends import BACKENDS, DEFAULT_LANGUAGES
 from .functions import Generator
 from .robot import Robot
 
@@ -23,26 +21,6 @@ TEMPLATE_DIR_CANDIDATES = (
     Path(__file__).resolve().parent.parent / "templates",  # a source checkout
     Path(__file__).resolve().parent / "templates",  # an installed package
 )
-
-
-@dataclass(frozen=True)
-class Language:
-    """One target: its templates, the file each renders to, and its comment syntax."""
-
-    name: str
-    templates: tuple[tuple[str, str], ...]  # (template, output file pattern with {name})
-    comment: Callable[[str], str]
-
-
-LANGUAGES = {
-    "c": Language("c", (("c/robot.h.jinja", "{name}.h"), ("c/robot.c.jinja", "{name}.c")),
-                  lambda text: f"/* {text} */"),
-    "python": Language("python", (("python/robot.py.jinja", "{name}.py"),), lambda text: f"# {text}"),
-    "casadi": Language("casadi", (("casadi/robot_casadi.py.jinja", "{name}_casadi.py"),),
-                       lambda text: f"# {text}"),
-    "report": Language("report", (("report/robot.md.jinja", "{name}.md"),), lambda text: f"<!-- {text} -->"),
-}
-DEFAULT_LANGUAGES = tuple(LANGUAGES)
 
 
 def _environment() -> jinja2.Environment:
@@ -73,12 +51,12 @@ def render_robot(robot: Robot, languages=DEFAULT_LANGUAGES, real: str = "double"
     generator = generator or Generator(robot)
     files = {}
     for name in languages:
-        language = LANGUAGES[name]
-        context = template_context(robot, generator, name, real)
-        for template, pattern in language.templates:
+        backend = BACKENDS[name]
+        context = backend.context(robot, generator, backend.printer(real) if backend.printer else None, real)
+        for template, pattern in backend.templates:
             text = environment.get_template(template).render(context)
             path = f"{robot.name}/{pattern.format(name=robot.name)}"
-            files[path] = language.comment(header(robot)) + "\n" + text
+            files[path] = backend.comment.format(header(robot)) + "\n" + text
     return files
 
 
