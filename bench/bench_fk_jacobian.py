@@ -39,10 +39,10 @@ import sympy
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
-from codegen import reference  # noqa: E402
-from codegen.functions import Generator  # noqa: E402
-from codegen.render import render_robot, write_files  # noqa: E402
-from codegen.robot import load_robot  # noqa: E402
+from jacgen import reference  # noqa: E402
+from jacgen.functions import Generator  # noqa: E402
+from jacgen.render import render_robot, write_files  # noqa: E402
+from jacgen.robot import load_robot  # noqa: E402
 
 ROBOTS = ("puma560", "ur5", "panda")
 VARIANTS = ("ours", "ours_fk", "ours_jac", "separate", "casadi", "casadi_cse", "floor")

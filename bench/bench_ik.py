@@ -15,7 +15,7 @@ inside the limits) are solved by:
 Every solver returns all branches; the table gives microseconds per pose (median over
 rounds), the real solutions found (EAIK and ik-geo also return least-squares candidates,
 not counted) and each time over the C-via-ctypes one. The derivation time of every shipped
-robot's closed form (structure detection and exact constants, `codegen.ik.closed_form`) is
+robot's closed form (structure detection and exact constants, `jacgen.ik.closed_form`) is
 printed first.
 """
 
@@ -36,11 +36,11 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(ROOT / "tests"))
 
-from codegen import reference  # noqa: E402
-from codegen.compile import WARNING_FLAGS, compile_shared  # noqa: E402
-from codegen.ik import closed_form  # noqa: E402
-from codegen.render import render_robot, write_files  # noqa: E402
-from codegen.robot import load_robot  # noqa: E402
+from jacgen import reference  # noqa: E402
+from jacgen.compile import WARNING_FLAGS, compile_shared  # noqa: E402
+from jacgen.ik import closed_form  # noqa: E402
+from jacgen.render import render_robot, write_files  # noqa: E402
+from jacgen.robot import load_robot  # noqa: E402
 from test_ik import kinematic_chain  # noqa: E402
 
 ROBOTS = {"ur5": IkGeoRobot.three_parallel_two_intersecting, "puma560": IkGeoRobot.spherical_two_parallel}

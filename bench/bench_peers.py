@@ -48,8 +48,8 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path[:0] = [str(ROOT), str(ROOT / "bench"), str(ROOT / "tests")]
 
 from bench_fk_jacobian import native_times  # noqa: E402
-from codegen.render import render_robot, write_files  # noqa: E402
-from codegen.robot import load_robot  # noqa: E402
+from jacgen.render import render_robot, write_files  # noqa: E402
+from jacgen.robot import load_robot  # noqa: E402
 
 with warnings.catch_warnings():
     warnings.simplefilter("ignore")

@@ -27,9 +27,9 @@ def worker(dof: int, seed: int) -> None:
     import time
 
     sys.path[:0] = [str(ROOT), str(ROOT / "tests")]
-    from codegen.functions import Generator
-    from codegen.render import render_robot
-    from codegen.robot import parse_robot
+    from jacgen.functions import Generator
+    from jacgen.render import render_robot
+    from jacgen.robot import parse_robot
     from random_arms import random_arm_text
 
     robot = parse_robot(random_arm_text(seed, dof=dof).encode(), f"arm{seed}.yaml")

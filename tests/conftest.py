@@ -6,7 +6,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from codegen import load_robot
+from jacgen import load_robot
 
 ROOT = Path(__file__).resolve().parent.parent
 ROBOT_FILES = sorted((ROOT / "robots").glob("*.yaml"))

@@ -10,7 +10,7 @@ without Euler angles) and some lengths kept as symbolic runtime parameters.
 
 import random
 
-from codegen.robot import TASK_COMPONENTS
+from jacgen.robot import TASK_COMPONENTS
 
 SPECIAL_ALPHAS = (0.0, 90.0, -90.0, 180.0)
 

@@ -22,10 +22,10 @@ from pathlib import Path
 import pytest
 from click.testing import CliRunner
 
-from codegen.cli import main
-from codegen.names import PARAMETER_NAME_RULE, ROBOT_NAME_RULE, parameter_name_problem
-from codegen.render import DEFAULT_LANGUAGES, render_robot
-from codegen.robot import parse_robot
+from jacgen.cli import main
+from jacgen.names import PARAMETER_NAME_RULE, ROBOT_NAME_RULE, parameter_name_problem
+from jacgen.render import DEFAULT_LANGUAGES, render_robot
+from jacgen.robot import parse_robot
 
 from conftest import ROOT
 
@@ -186,7 +186,7 @@ def test_reserved_parameter_names_cover_the_generated_code(robot_name):
         loose = sorted(name for name in names - parameters if not parameter_name_problem(name, robot.name))
         if loose:
             unreserved[path] = loose
-    assert not unreserved, f"names a parameter could take (add them to codegen/names.py): {unreserved}"
+    assert not unreserved, f"names a parameter could take (add them to jacgen/names.py): {unreserved}"
 
 
 # -- free text ------------------------------------------------------------------------------------------

@@ -16,10 +16,10 @@ import sympy
 from click.testing import CliRunner
 from scipy.optimize import brentq, minimize, minimize_scalar
 
-from codegen import kinematics, load_robot, reference
-from codegen.analysis import analyse
-from codegen.cli import main
-from codegen.render import render_robot, write_files
+from jacgen import kinematics, load_robot, reference
+from jacgen.analysis import analyse
+from jacgen.cli import main
+from jacgen.render import render_robot, write_files
 
 from conftest import ROOT, ROBOT_NAMES, import_file, random_configurations, robot
 
@@ -28,7 +28,7 @@ RANK_TOLERANCE = 1e-9  # smallest / largest singular value of Js at a singular c
 
 
 def reference_js(arm, q):
-    """Js from codegen.reference alone: geometric rows, or the ZYX Euler-angle rates
+    """Js from jacgen.reference alone: geometric rows, or the ZYX Euler-angle rates
     omega = E(roll, pitch, yaw) rpy_dot solved for rpy_dot when the task has some angles."""
     J = reference.jacobian(arm, q)
     angles = [c for c in arm.task if c in EULER]
@@ -260,7 +260,7 @@ def test_show_plot_writes_a_png(tmp_path):
 
 
 def test_report_is_independent_of_hashing():
-    script = ("from codegen import load_robot, render_robot; import sys; "
+    script = ("from jacgen import load_robot, render_robot; import sys; "
               "sys.stdout.write(render_robot(load_robot('robots/rexarm.yaml'), ('report',))['rexarm/rexarm.md'])")
     outputs = {subprocess.run([sys.executable, "-c", script], cwd=ROOT, capture_output=True, text=True, check=True,
                               env={"PYTHONHASHSEED": seed, "PYTHONPATH": str(ROOT)}).stdout for seed in ("0", "4242")}
@@ -272,7 +272,7 @@ def test_report_is_independent_of_hashing():
 def test_roots_of_a_one_joint_factor(polynomial):
     """Roots from the polynomial in tan(q/2) (numeric above degree 2), against a dense scan
     of the factor over one turn: the same roots, each within 1e-9 (q = pi included)."""
-    from codegen.analysis import JointRing, _Numeric
+    from jacgen.analysis import JointRing, _Numeric
 
     arm = robot("planar_2r")
     ring = JointRing(arm)

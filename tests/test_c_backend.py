@@ -3,7 +3,7 @@
 Numbers: the C of every shipped robot is compared with the reference by `jacgen verify`
 (tests/test_verify.py); here the C of test robots with runtime parameters, a function
 that reads no joint, a scalar result and a function SPEC does not name is checked
-against codegen.reference.
+against jacgen.reference.
 """
 
 import os
@@ -17,12 +17,12 @@ import pytest
 import sympy
 from numpy.testing import assert_allclose
 
-from codegen import reference
-from codegen.compile import WARNING_FLAGS, CLibrary, compile_shared
-from codegen.functions import Generator
-from codegen.printers import CPrinter
-from codegen.render import render_robot, write_files
-from codegen.robot import load_robot
+from jacgen import reference
+from jacgen.compile import WARNING_FLAGS, CLibrary, compile_shared
+from jacgen.functions import Generator
+from jacgen.printers import CPrinter
+from jacgen.render import render_robot, write_files
+from jacgen.robot import load_robot
 
 from conftest import ROBOT_FILES, ROOT, random_configurations
 
@@ -225,7 +225,7 @@ def test_output_is_independent_of_hash_seed(tmp_path):
     outputs = []
     for seed in ("0", "1"):
         folder = tmp_path / seed
-        subprocess.run([sys.executable, "-m", "codegen", "generate", "robots/ur5.yaml", "-o", str(folder),
+        subprocess.run([sys.executable, "-m", "jacgen", "generate", "robots/ur5.yaml", "-o", str(folder),
                         "--lang", "c,casadi", "--real", "float"], cwd=ROOT, check=True, capture_output=True,
                        env={**os.environ, "PYTHONHASHSEED": seed, "PYTHONPATH": str(ROOT)})
         outputs.append({path.name: path.read_bytes() for path in sorted(folder.glob("*/*"))})

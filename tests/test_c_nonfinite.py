@@ -6,8 +6,8 @@ import subprocess
 
 import pytest
 
-from codegen.compile import WARNING_FLAGS
-from codegen.render import render_robot, write_files
+from jacgen.compile import WARNING_FLAGS
+from jacgen.render import render_robot, write_files
 
 from conftest import robot
 

@@ -1,4 +1,4 @@
-"""The CasADi backend: casadi.Function objects that match codegen.reference, and whose
+"""The CasADi backend: casadi.Function objects that match jacgen.reference, and whose
 symbolic derivatives agree with the generated Jacobians."""
 
 import functools
@@ -9,12 +9,12 @@ import pytest
 import sympy
 from numpy.testing import assert_allclose
 
-from codegen import reference
-from codegen.functions import Generator
-from codegen.printers import CasadiPrinter
-from codegen.render import render_robot, write_files
-from codegen.robot import load_robot
-from codegen.verify import compare
+from jacgen import reference
+from jacgen.functions import Generator
+from jacgen.printers import CasadiPrinter
+from jacgen.render import render_robot, write_files
+from jacgen.robot import load_robot
+from jacgen.verify import compare
 
 from conftest import ROBOT_NAMES, import_file, random_configurations, robot as shipped_robot
 from test_c_backend import PARAMETRIC
@@ -50,7 +50,7 @@ def _as_list(result):
 
 @pytest.mark.parametrize("name", ROBOT_NAMES)
 def test_functions_match_reference(name, generated):
-    """Every function against codegen.reference; one the reference lacks (manipulability...)
+    """Every function against jacgen.reference; one the reference lacks (manipulability...)
     against the generated numpy module, which prints the same expressions another way."""
     robot, functions, module, numpy_module = generated(name)
     assert list(module.functions()) == [f.name for f in functions]

@@ -7,8 +7,8 @@ import sys
 
 from click.testing import CliRunner
 
-from codegen import __version__
-from codegen.cli import main
+from jacgen import __version__
+from jacgen.cli import main
 
 from conftest import ROBOT_FILES, ROOT
 
@@ -89,7 +89,7 @@ def test_output_is_identical_under_two_hash_seeds(tmp_path):
     processes = {}
     for seed in ("0", "12345"):
         environment = dict(os.environ, PYTHONHASHSEED=seed, PYTHONPATH=str(ROOT))
-        command = [sys.executable, "-m", "codegen", "generate", *map(str, ROBOT_FILES), "-o", str(tmp_path / seed)]
+        command = [sys.executable, "-m", "jacgen", "generate", *map(str, ROBOT_FILES), "-o", str(tmp_path / seed)]
         processes[seed] = subprocess.Popen(command, cwd=ROOT, env=environment, stdout=subprocess.PIPE,
                                            stderr=subprocess.PIPE, text=True)
     outputs = []
@@ -106,7 +106,7 @@ def test_output_is_identical_under_two_hash_seeds(tmp_path):
 def test_internal_error_is_one_line_and_debug_shows_the_traceback(tmp_path, monkeypatch):
     """A bug of jacgen's is one line and exit 1, the traceback only with --debug, and
     nothing already on disk is touched (files are written after everything is generated)."""
-    import codegen.cli
+    import jacgen.cli
 
     def broken(*args, **kwargs):
         raise ZeroDivisionError("polynomial division")
@@ -114,7 +114,7 @@ def test_internal_error_is_one_line_and_debug_shows_the_traceback(tmp_path, monk
     existing = tmp_path / "planar_2r" / "planar_2r.py"
     existing.parent.mkdir()
     existing.write_text("earlier output\n")
-    monkeypatch.setattr(codegen.cli, "render_robot", broken)
+    monkeypatch.setattr(jacgen.cli, "render_robot", broken)
     arguments = ["generate", str(ROOT / "robots" / "planar_2r.yaml"), "-o", str(tmp_path)]
     result = CliRunner().invoke(main, arguments)
     assert result.exit_code == 1

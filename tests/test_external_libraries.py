@@ -27,8 +27,8 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 
-from codegen import reference
-from codegen.robot import load_robot
+from jacgen import reference
+from jacgen.robot import load_robot
 
 with warnings.catch_warnings():
     warnings.simplefilter("ignore")

@@ -26,10 +26,10 @@ import yaml
 from hypothesis import HealthCheck, assume, given, settings
 from hypothesis import strategies as st
 
-from codegen import expr
-from codegen.errors import RobotFileError
-from codegen.expr import ExpressionError, Value
-from codegen.robot import TASK_COMPONENTS, Robot, parse_robot
+from jacgen import expr
+from jacgen.errors import RobotFileError
+from jacgen.expr import ExpressionError, Value
+from jacgen.robot import TASK_COMPONENTS, Robot, parse_robot
 
 from conftest import ROBOT_FILES
 

@@ -1,9 +1,9 @@
-"""Every function of the generated Python (generated/NAME/NAME.py) against codegen.reference."""
+"""Every function of the generated Python (generated/NAME/NAME.py) against jacgen.reference."""
 
 import numpy as np
 import pytest
 
-from codegen import reference
+from jacgen import reference
 
 from conftest import generated_module, random_configurations, robot
 

@@ -7,7 +7,7 @@ files instead (then review the diff with git and commit it with the change that 
 
 import pytest
 
-from codegen.render import render_robot, stale_files, write_files
+from jacgen.render import render_robot, stale_files, write_files
 
 from conftest import GENERATED, ROBOT_NAMES, robot
 

@@ -3,8 +3,8 @@
 Round trips on random configurations (every solution reproduces fk(q), the original q is
 among them), solution counts against EAIK and ik-geo on the arms they solve, random robots
 of every class, unreachable and singular targets, and the C (double and float) against the
-Python. Forward kinematics is the generated fk, itself checked against codegen.reference
-elsewhere; the random robots are checked against codegen.reference.fk directly.
+Python. Forward kinematics is the generated fk, itself checked against jacgen.reference
+elsewhere; the random robots are checked against jacgen.reference.fk directly.
 """
 
 import functools
@@ -15,10 +15,10 @@ import pytest
 from eaik.IK_HP import HPRobot
 from ik_geo import Robot as IkGeoRobot
 
-from codegen import reference
-from codegen.compile import CLibrary, compile_shared
-from codegen.render import render_robot
-from codegen.robot import parse_robot
+from jacgen import reference
+from jacgen.compile import CLibrary, compile_shared
+from jacgen.render import render_robot
+from jacgen.robot import parse_robot
 
 from conftest import import_file, random_configurations, robot
 
@@ -110,7 +110,7 @@ def test_round_trip_of_random_configurations(modules, name):
 
 
 def kinematic_chain(arm):
-    """The arm as EAIK and ik-geo take it, from codegen.reference at q = 0: axes H, offsets P
+    """The arm as EAIK and ik-geo take it, from jacgen.reference at q = 0: axes H, offsets P
     between points on consecutive axes, and the tool rotation (theirs is the identity at q = 0).
     When axes 4, 5, 6 meet, their points are moved to the common point (ik-geo needs that)."""
     frames, tool = reference.frames(arm, np.zeros(arm.dof))
@@ -248,7 +248,7 @@ def _c_ik(arm, folder, real):
 
 
 def _reference_targets(arm):
-    """Batched fk (pose tasks) or task vector of codegen.reference."""
+    """Batched fk (pose tasks) or task vector of jacgen.reference."""
     single = reference.fk if _pose_task(arm) else reference.task
     return lambda q: np.array([single(arm, row) for row in q])
 
@@ -262,7 +262,7 @@ def _regular(arm, q):
 @pytest.mark.parametrize("kind", RANDOM_CLASSES)
 def test_random_robots_of_each_class(kind, tmp_path):
     """Random dimensions, offsets, axis directions, base and tool: round trips through
-    codegen.reference, the revolute 6R classes also against EAIK."""
+    jacgen.reference, the revolute 6R classes also against EAIK."""
     for seed in range(2):
         arm = _random_robot(kind, seed)
         module = _generate(arm, tmp_path)

@@ -1,6 +1,6 @@
 """One behaviour for the closed-form ik and velocity_ik: tables of cases, each run on every
 backend with the same expectations (C double through ctypes, numpy one target at a time,
-numpy over a batch, CasADi). Targets and checks come from codegen.reference and numpy's
+numpy over a batch, CasADi). Targets and checks come from jacgen.reference and numpy's
 linear algebra, never from a backend.
 
 For ik every backend is a function `solve(targets) -> [solutions (k, n) per target]`; for
@@ -12,9 +12,9 @@ import functools
 import numpy as np
 import pytest
 
-from codegen import reference
-from codegen.compile import CLibrary, compile_shared
-from codegen.render import render_robot, write_files
+from jacgen import reference
+from jacgen.compile import CLibrary, compile_shared
+from jacgen.render import render_robot, write_files
 
 from conftest import import_file, random_configurations, robot
 

@@ -4,8 +4,8 @@ import numpy as np
 import pytest
 import sympy
 
-from codegen import Kinematics, kinematics, reference
-from codegen.functions import Generator
+from jacgen import Kinematics, kinematics, reference
+from jacgen.functions import Generator
 
 from conftest import ROBOT_NAMES, random_configurations, robot
 

@@ -12,7 +12,7 @@ import re
 import pytest
 from click.testing import CliRunner
 
-from codegen.cli import main
+from jacgen.cli import main
 from random_arms import random_arm_text
 
 STRESS_SEEDS = int(os.environ.get("JACGEN_STRESS_SEEDS", "30"))

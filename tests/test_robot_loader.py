@@ -13,10 +13,10 @@ import pytest
 import sympy
 from click.testing import CliRunner
 
-from codegen.cli import main
-from codegen.errors import RobotFileError
-from codegen.expr import ExpressionError, Value, parse
-from codegen.robot import MAX_NESTING, parse_robot
+from jacgen.cli import main
+from jacgen.errors import RobotFileError
+from jacgen.expr import ExpressionError, Value, parse
+from jacgen.robot import MAX_NESTING, parse_robot
 
 from conftest import ROOT
 
@@ -222,7 +222,7 @@ def test_valid_base_and_first_error_of_several(tmp_path):
 def test_subprocess_prints_one_line_without_traceback(tmp_path):
     path = tmp_path / "x.yaml"
     path.write_text(edit("alpha: -90", "alpha: [1, 2]"))
-    run = subprocess.run([sys.executable, "-m", "codegen", "validate", str(path)], cwd=ROOT,
+    run = subprocess.run([sys.executable, "-m", "jacgen", "validate", str(path)], cwd=ROOT,
                          capture_output=True, text=True, timeout=120)
     line, column = position(path.read_text(), "[1, 2]")
     assert run.returncode == 2

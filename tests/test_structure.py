@@ -6,9 +6,9 @@ import time
 import numpy as np
 import pytest
 
-from codegen import reference
-from codegen.robot import parse_robot
-from codegen.structure import SOLVERS, Geometry, classify, describe_structure
+from jacgen import reference
+from jacgen.robot import parse_robot
+from jacgen.structure import SOLVERS, Geometry, classify, describe_structure
 
 from conftest import ROBOT_NAMES, robot
 

@@ -18,7 +18,7 @@ rtb = pytest.importorskip("roboticstoolbox")
 
 from click.testing import CliRunner  # noqa: E402
 
-from codegen.cli import main  # noqa: E402
+from jacgen.cli import main  # noqa: E402
 from conftest import import_file  # noqa: E402
 
 MODELS = ["AL5D", "Ball", "Baxter", "Cobra600", "Coil", "Hyper", "Hyper3d", "IRB140", "Jaco", "KR5", "LWR4",

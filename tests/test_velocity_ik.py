@@ -6,8 +6,8 @@ import ctypes
 import numpy as np
 import pytest
 
-from codegen.compile import compile_shared
-from codegen.render import render_robot, write_files
+from jacgen.compile import compile_shared
+from jacgen.render import render_robot, write_files
 
 from conftest import ROBOT_NAMES, import_file, random_configurations, robot
 from test_analysis import reference_js

@@ -7,10 +7,10 @@ import pytest
 import sympy
 from click.testing import CliRunner
 
-from codegen import reference, verify
-from codegen.cli import main
-from codegen.compile import CompileError, compile_shared
-from codegen.functions import Generator
+from jacgen import reference, verify
+from jacgen.cli import main
+from jacgen.compile import CompileError, compile_shared
+from jacgen.functions import Generator
 
 from conftest import robot as shipped_robot
 

@@ -2,10 +2,10 @@
 
 Scripting entry points::
 
-    import codegen
-    robot = codegen.load_robot("robots/puma560.yaml")
-    kin = codegen.Kinematics(robot)          # readable sympy matrices: kin.fk, kin.jacobian, ...
-    files = codegen.render_robot(robot)      # {"puma560/puma560.py": text, ...}
+    import jacgen
+    robot = jacgen.load_robot("robots/puma560.yaml")
+    kin = jacgen.Kinematics(robot)          # readable sympy matrices: kin.fk, kin.jacobian, ...
+    files = jacgen.render_robot(robot)      # {"puma560/puma560.py": text, ...}
 """
 
 __version__ = "0.1.0"

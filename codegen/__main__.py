@@ -1,5 +1,0 @@
-"""`python -m codegen` runs the same CLI as `jacgen`."""
-
-from .cli import main
-
-main(prog_name="jacgen")
