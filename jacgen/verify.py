@@ -162,7 +162,7 @@ class _Backends:
     def velocity_ik(self, backend: str, q: np.ndarray, mu_dot: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """velocity_ik without damping at each row of q and mu_dot: (q_dot (k, dof), status (k,))."""
         nominal = {p.name: p.value for p in self.robot.symbolic_parameters}
-        if backend == "python":
+        if backend == "python" or not len(q):
             return self.python.velocity_ik(q, mu_dot, **nominal)
         if backend == "casadi":
             extra = [list(self.casadi.PARAMETERS.values())] if nominal else []
@@ -243,12 +243,17 @@ def verify_robot(robot: Robot, backends: _Backends, functions: list[Function], q
     regular = ranks > REGULAR_RANK
     results += _ik_results(robot, backends, q[:random_count], tolerances, form)
     mu_dot = np.random.default_rng(0).normal(size=(int(regular.sum()), len(robot.task)))
-    residuals = {backend: _velocity_ik_residual(robot, backends.velocity_ik(backend, q[regular], mu_dot), q[regular], mu_dot)
-                 for backend in BACKENDS}
+    residuals, flagged = {}, {}
+    for backend in BACKENDS:
+        residuals[backend], flagged[backend] = _velocity_ik_residual(
+            robot, backends.velocity_ik(backend, q[regular], mu_dot), q[regular], mu_dot,
+            allow_singular=backend == "c float")
     results.append(Result(robot.name, "velocity_ik", residuals, tolerances,
                           ("|Js^T (Js q_dot - mu_dot)| / |Js| (|Js| |q_dot| + |mu_dot|)" if len(robot.task) > robot.dof
                            else "|Js q_dot - mu_dot| / (|Js| |q_dot| + |mu_dot|)")
-                          + f" at the {int(regular.sum())} samples where Js is regular"))
+                          + f" at the {int(regular.sum())} samples where Js is regular"
+                          + (f"; c float: {flagged['c float']} reported singular (float's threshold)"
+                             if flagged["c float"] else "")))
     return results
 
 
@@ -356,24 +361,29 @@ def _c_ik_numeric(library: CLibrary, real: str, target: np.ndarray, start: np.nd
 
 
 def _velocity_ik_residual(robot: Robot, solved: tuple[np.ndarray, np.ndarray], q: np.ndarray,
-                          mu_dot: np.ndarray) -> float:
-    """Largest backward error of velocity_ik's (q_dot, status) at q for mu_dot: the residual
-    |Js q_dot - mu_dot| / (|Js| |q_dot| + |mu_dot|), scaled by what rounding alone leaves so
-    the bound does not depend on how well conditioned Js is; a status other than OK is an
-    infinite error. A tall Js (m > n) has no exact solution: there the residual is that of
-    the normal equations, Js^T (Js q_dot - mu_dot)."""
+                          mu_dot: np.ndarray, allow_singular: bool = False) -> tuple[float, int]:
+    """Largest backward error of velocity_ik's (q_dot, status) at q for mu_dot, and how many
+    samples reported singular: the residual |Js q_dot - mu_dot| / (|Js| |q_dot| + |mu_dot|),
+    scaled by what rounding alone leaves so the bound does not depend on how well
+    conditioned Js is. A tall Js (m > n) has no exact solution: there the residual is that of
+    the normal equations, Js^T (Js q_dot - mu_dot). A status other than OK is an infinite
+    error, except that `allow_singular` lets a sample be reported singular: in float, a
+    system whose R has a diagonal ratio below 1e-5 is, and the Gram matrix of a Js sampled
+    here (condition number up to 1e3) reaches 1e6."""
     q_dot, status = solved
+    singular = (status == 1) if allow_singular else np.zeros(len(q), dtype=bool)
+    if np.any((status != 0) & ~singular):
+        return math.inf, int(singular.sum())
+    q, q_dot, mu_dot = q[~singular], q_dot[~singular], mu_dot[~singular]
     if not len(q):
-        return 0.0
-    if np.any(status != 0):
-        return math.inf
+        return 0.0, int(singular.sum())
     js = np.array([reference.singularity_jacobian(robot, row) for row in q])
     residual = np.einsum("kij,kj->ki", js, q_dot) - mu_dot
     norm = np.linalg.norm(js, ord=2, axis=(1, 2))
     scale = norm * np.linalg.norm(q_dot, axis=1) + np.linalg.norm(mu_dot, axis=1)
     if len(robot.task) > robot.dof:
         residual, scale = np.einsum("kij,ki->kj", js, residual), norm * scale
-    return float(np.max(np.linalg.norm(residual, axis=1) / scale, initial=0.0))
+    return float(np.max(np.linalg.norm(residual, axis=1) / scale, initial=0.0)), int(singular.sum())
 
 
 def verify(robots: list[Robot], samples: int, seed: int,
