@@ -41,7 +41,7 @@ def householder_solve(A: list[list[sympy.Expr]], b: list[sympy.Expr], name: Call
         norms.append(norm)
     x = [sympy.Integer(0)] * k
     for j in reversed(range(k)):
-        x[j] = name((b[j] - sympy.Add(*(A[j][c] * x[c] for c in range(j + 1, k)))) / A[j][j])
+        x[j] = name(select(sympy.Ne(A[j][j], 0), (b[j] - sympy.Add(*(A[j][c] * x[c] for c in range(j + 1, k)))) / A[j][j], 0))
     return x, sympy.Or(*(norm <= RANK * scale for norm in norms))
 
 

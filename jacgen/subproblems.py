@@ -112,7 +112,7 @@ class Subproblems:
         y = self.dot(k, self.cross(p, q))
         rr = self.name(x * x + y * y)
         free = rr <= TINY * self.dot(p, p) * self.dot(q, q)
-        scale = self.name(1 / sympy.sqrt(rr))
+        scale = self.name(select(free, 1, 1 / sympy.sqrt(rr)))  # never 1/0, even for constant vectors
         return Angle(select(free, 0, sympy.atan2(y, x)), self.name(select(free, 1, x * scale)),
                      self.name(select(free, 0, y * scale)))
 
@@ -129,7 +129,7 @@ class Subproblems:
         r2 = self.name(a * a + b * b)
         scale = self.name(self.dot(h, h) * self.dot(p, p))
         constant = r2 <= TINY * scale
-        inverse_r = self.name(1 / sympy.sqrt(r2))
+        inverse_r = self.name(select(constant, 1, 1 / sympy.sqrt(r2)))
         cos_phi, sin_phi = self.name(a * inverse_r), self.name(b * inverse_r)
         cos_alpha = self.name(rhs * inverse_r)
         disc = self.name(1 - cos_alpha**2)

@@ -1072,7 +1072,7 @@ iiwa_real iiwa_manipulability(const iiwa_real q[IIWA_DOF])
 
 int iiwa_velocity_ik(const iiwa_real q[IIWA_DOF], const iiwa_real mu_dot[IIWA_TASK_DIM], iiwa_real damping, iiwa_real q_dot[IIWA_DOF])
 {
-    /* 1029 operations */
+    /* 1035 operations */
 
     /* Inputs */
     const iiwa_real q1 = q[0];
@@ -1334,16 +1334,16 @@ int iiwa_velocity_ik(const iiwa_real q[IIWA_DOF], const iiwa_real mu_dot[IIWA_TA
     const iiwa_real t229 = t222 + t228;
     const iiwa_real t230 = (t227 > 0 ? 1/(t227*(t226 + t227)) : 0);
     const iiwa_real t231 = -t225*t230*(t229*t229) + t225;
-    const iiwa_real t232 = t231/t228;
-    const iiwa_real t233 = (t221*t232 + t224)/t217;
-    const iiwa_real t234 = (t185*t232 + t189 + t213*t233)/t181;
-    const iiwa_real t235 = (t152*t232 + t157 + t176*t234 + t208*t233)/t148;
-    const iiwa_real t236 = (t122*t232 + t128 - t142*t235 - t170*t234 + t202*t233)/t118;
-    const iiwa_real t237 = (t103 + t111*t236 + t135*t235 + t163*t234 + t195*t233 + t232*t96)/t92;
+    const iiwa_real t232 = (t228 != 0 ? -t231/t228 : 0);
+    const iiwa_real t233 = (t217 != 0 ? -(-t221*t232 + t224)/t217 : 0);
+    const iiwa_real t234 = (t181 != 0 ? -(-t185*t232 + t189 - t213*t233)/t181 : 0);
+    const iiwa_real t235 = (t148 != 0 ? -(-t152*t232 + t157 - t176*t234 - t208*t233)/t148 : 0);
+    const iiwa_real t236 = (t118 != 0 ? -(-t122*t232 + t128 + t142*t235 + t170*t234 - t202*t233)/t118 : 0);
+    const iiwa_real t237 = (t92 != 0 ? -(t103 - t111*t236 - t135*t235 - t163*t234 - t195*t233 - t232*t96)/t92 : 0);
     const iiwa_real t238 = t232 + t236*t31 - t237*t34;
     const iiwa_real t239 = c1*t233 - s1*t234 - t235*t35 + t236*t54 + t237*t51;
     const iiwa_real t240 = c2*t232 + t14*t233 + t234*t8 + t235*t39 + t236*t52 + t237*t55;
-    const iiwa_real t241 = t23*t232 + t233*t3 - t234*t6 - t235*t36 + t236*t48 - t237*t45;
+    const iiwa_real t241 = -t23*t232 - t233*t3 + t234*t6 + t235*t36 - t236*t48 + t237*t45;
     const iiwa_real t242 = t10*t234 + t16*t233 + t22*t232 + t235*t37 + t236*t50 + t237*t46;
     const iiwa_real t243 = -t12*t234 + t18*t233 + t232*t25 - t235*t38 + t236*t49 + t237*t47;
     const iiwa_real t244 = t13*t234 + t19*t233 + t232*t26;
@@ -1354,19 +1354,19 @@ int iiwa_velocity_ik(const iiwa_real q[IIWA_DOF], const iiwa_real mu_dot[IIWA_TA
     const int t249 = t245 && t246 && !t248;
 
     /* Outputs */
-    q_dot[0] = (t249 ? -t238 : 0);
-    q_dot[1] = (t249 ? -t239 : 0);
-    q_dot[2] = (t249 ? -t240 : 0);
+    q_dot[0] = (t249 ? t238 : 0);
+    q_dot[1] = (t249 ? t239 : 0);
+    q_dot[2] = (t249 ? t240 : 0);
     q_dot[3] = (t249 ? t241 : 0);
-    q_dot[4] = (t249 ? -t242 : 0);
-    q_dot[5] = (t249 ? -t243 : 0);
-    q_dot[6] = (t249 ? -t244 : 0);
+    q_dot[4] = (t249 ? t242 : 0);
+    q_dot[5] = (t249 ? t243 : 0);
+    q_dot[6] = (t249 ? t244 : 0);
     return (!(t245 && t246) ? 2 : (t248 ? 1 : 0));
 }
 
 iiwa_real iiwa_ik_numeric_step(const iiwa_real target[16], const iiwa_real q[IIWA_DOF], iiwa_real damping, iiwa_real q_start[IIWA_DOF], iiwa_real q_next[IIWA_DOF])
 {
-    /* 1123 operations */
+    /* 1131 operations */
 
     /* Inputs */
     const iiwa_real T00 = target[0];
@@ -1675,19 +1675,19 @@ iiwa_real iiwa_ik_numeric_step(const iiwa_real target[16], const iiwa_real q[IIW
     const iiwa_real t261 = t257 + t260;
     const iiwa_real t262 = (t259 > 0 ? 1/(t259*(t258 + t259)) : 0);
     const iiwa_real t263 = -t231*t262*(t261*t261) + t231;
-    const iiwa_real t264 = t263/t260;
-    const iiwa_real t265 = (t230 + t256*t264)/t226;
-    const iiwa_real t266 = (t199 + t222*t265 + t252*t264)/t195;
-    const iiwa_real t267 = (t171 + t190*t266 + t217*t265 + t247*t264)/t167;
-    const iiwa_real t268 = (t147 - t161*t267 - t184*t266 + t211*t265 + t241*t264)/t143;
-    const iiwa_real t269 = (t128 + t136*t268 + t154*t267 + t177*t266 + t204*t265 + t234*t264)/t124;
-    const iiwa_real t270 = q1 - t264 - t268*t57 + t269*t61;
-    const iiwa_real t271 = -c1*t265 - c1*t269*t71 + q2 + s1*t266 - s1*t268*t71 + t267*t62;
-    const iiwa_real t272 = c2*t264 - q3 + t21*t265 + t266*t9 + t267*t66 + t268*t76 + t269*t79;
-    const iiwa_real t273 = q4 + t264*t37 + t265*t4 - t266*t7 - t267*t63 + t268*t77 - t269*t73;
-    const iiwa_real t274 = -q5 + t11*t266 + t23*t265 + t264*t36 + t267*t64 + t268*t80 + t269*t74;
-    const iiwa_real t275 = -q6 - t13*t266 + t25*t265 + t264*t39 - t267*t65 + t268*t78 + t269*t75;
-    const iiwa_real t276 = -q7 + t15*t266 + t264*t41 + t265*t27;
+    const iiwa_real t264 = (t260 != 0 ? -t263/t260 : 0);
+    const iiwa_real t265 = (t226 != 0 ? -(t230 - t256*t264)/t226 : 0);
+    const iiwa_real t266 = (t195 != 0 ? -(t199 - t222*t265 - t252*t264)/t195 : 0);
+    const iiwa_real t267 = (t167 != 0 ? -(t171 - t190*t266 - t217*t265 - t247*t264)/t167 : 0);
+    const iiwa_real t268 = (t143 != 0 ? -(t147 + t161*t267 + t184*t266 - t211*t265 - t241*t264)/t143 : 0);
+    const iiwa_real t269 = (t124 != 0 ? -(t128 - t136*t268 - t154*t267 - t177*t266 - t204*t265 - t234*t264)/t124 : 0);
+    const iiwa_real t270 = q1 + t264 + t268*t57 - t269*t61;
+    const iiwa_real t271 = c1*t265 + c1*t269*t71 + q2 - s1*t266 + s1*t268*t71 - t267*t62;
+    const iiwa_real t272 = c2*t264 + q3 + t21*t265 + t266*t9 + t267*t66 + t268*t76 + t269*t79;
+    const iiwa_real t273 = q4 - t264*t37 - t265*t4 + t266*t7 + t267*t63 - t268*t77 + t269*t73;
+    const iiwa_real t274 = q5 + t11*t266 + t23*t265 + t264*t36 + t267*t64 + t268*t80 + t269*t74;
+    const iiwa_real t275 = q6 - t13*t266 + t25*t265 + t264*t39 - t267*t65 + t268*t78 + t269*t75;
+    const iiwa_real t276 = q7 + t15*t266 + t264*t41 + t265*t27;
 
     /* Outputs */
     q_start[0] = q1;
@@ -1699,11 +1699,11 @@ iiwa_real iiwa_ik_numeric_step(const iiwa_real target[16], const iiwa_real q[IIW
     q_start[6] = q7;
     q_next[0] = (t270 < -2.9670597283903604 ? -2.9670597283903604 : (t270 > 2.9670597283903604 ? 2.9670597283903604 : t270));
     q_next[1] = (t271 < -2.0943951023931953 ? -2.0943951023931953 : (t271 > 2.0943951023931953 ? 2.0943951023931953 : t271));
-    q_next[2] = (t272 > 2.9670597283903604 ? -2.9670597283903604 : (t272 < -2.9670597283903604 ? 2.9670597283903604 : -t272));
+    q_next[2] = (t272 < -2.9670597283903604 ? -2.9670597283903604 : (t272 > 2.9670597283903604 ? 2.9670597283903604 : t272));
     q_next[3] = (t273 < -2.0943951023931953 ? -2.0943951023931953 : (t273 > 2.0943951023931953 ? 2.0943951023931953 : t273));
-    q_next[4] = (t274 > 2.9670597283903604 ? -2.9670597283903604 : (t274 < -2.9670597283903604 ? 2.9670597283903604 : -t274));
-    q_next[5] = (t275 > 2.0943951023931953 ? -2.0943951023931953 : (t275 < -2.0943951023931953 ? 2.0943951023931953 : -t275));
-    q_next[6] = (t276 > 3.0543261909900767 ? -3.0543261909900767 : (t276 < -3.0543261909900767 ? 3.0543261909900767 : -t276));
+    q_next[4] = (t274 < -2.9670597283903604 ? -2.9670597283903604 : (t274 > 2.9670597283903604 ? 2.9670597283903604 : t274));
+    q_next[5] = (t275 < -2.0943951023931953 ? -2.0943951023931953 : (t275 > 2.0943951023931953 ? 2.0943951023931953 : t275));
+    q_next[6] = (t276 < -3.0543261909900767 ? -3.0543261909900767 : (t276 > 3.0543261909900767 ? 3.0543261909900767 : t276));
     return (isfinite(t0) ? t121 : -1);
 }
 

@@ -67,11 +67,11 @@ void iiwa_singularity_factors(const iiwa_real q[IIWA_DOF], iiwa_real f[IIWA_NUM_
 iiwa_real iiwa_manipulability(const iiwa_real q[IIWA_DOF]);
 
 /* Joint rates q_dot solving Js q_dot = mu_dot: Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status.
- * Result: q_dot[i], i < 7; returned as a scalar. 1029 operations. */
+ * Result: q_dot[i], i < 7; returned as a scalar. 1035 operations. */
 int iiwa_velocity_ik(const iiwa_real q[IIWA_DOF], const iiwa_real mu_dot[IIWA_TASK_DIM], iiwa_real damping, iiwa_real q_dot[IIWA_DOF]);
 
 /* One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite).
- * Result: q_start[i], i < 7; q_next[i], i < 7; returned as a scalar. 1123 operations. */
+ * Result: q_start[i], i < 7; q_next[i], i < 7; returned as a scalar. 1131 operations. */
 iiwa_real iiwa_ik_numeric_step(const iiwa_real target[16], const iiwa_real q[IIWA_DOF], iiwa_real damping, iiwa_real q_start[IIWA_DOF], iiwa_real q_next[IIWA_DOF]);
 
 /* Statuses of iiwa_velocity_ik: OK, singular (a diagonal entry of the QR factor R of the

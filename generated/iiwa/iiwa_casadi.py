@@ -1014,7 +1014,7 @@ def _manipulability(q):
 
 
 def _velocity_ik(q, mu_dot, damping):
-    """Joint rates q_dot solving Js q_dot = mu_dot: Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: 1029 operations."""
+    """Joint rates q_dot solving Js q_dot = mu_dot: Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: 1035 operations."""
     q1 = q[0]
     q2 = q[1]
     q3 = q[2]
@@ -1272,16 +1272,16 @@ def _velocity_ik(q, mu_dot, damping):
     t229 = t222 + t228
     t230 = casadi.if_else((t227 > 0), 1/(t227*(t226 + t227)), 0)
     t231 = -t225*t229**2*t230 + t225
-    t232 = t231/t228
-    t233 = (t221*t232 + t224)/t217
-    t234 = (t185*t232 + t189 + t213*t233)/t181
-    t235 = (t152*t232 + t157 + t176*t234 + t208*t233)/t148
-    t236 = (t122*t232 + t128 - t142*t235 - t170*t234 + t202*t233)/t118
-    t237 = (t103 + t111*t236 + t135*t235 + t163*t234 + t195*t233 + t232*t96)/t92
+    t232 = casadi.if_else((t228 != 0), -t231/t228, 0)
+    t233 = casadi.if_else((t217 != 0), -(-t221*t232 + t224)/t217, 0)
+    t234 = casadi.if_else((t181 != 0), -(-t185*t232 + t189 - t213*t233)/t181, 0)
+    t235 = casadi.if_else((t148 != 0), -(-t152*t232 + t157 - t176*t234 - t208*t233)/t148, 0)
+    t236 = casadi.if_else((t118 != 0), -(-t122*t232 + t128 + t142*t235 + t170*t234 - t202*t233)/t118, 0)
+    t237 = casadi.if_else((t92 != 0), -(t103 - t111*t236 - t135*t235 - t163*t234 - t195*t233 - t232*t96)/t92, 0)
     t238 = t232 + t236*t31 - t237*t34
     t239 = c1*t233 - s1*t234 - t235*t35 + t236*t54 + t237*t51
     t240 = c2*t232 + t14*t233 + t234*t8 + t235*t39 + t236*t52 + t237*t55
-    t241 = t23*t232 + t233*t3 - t234*t6 - t235*t36 + t236*t48 - t237*t45
+    t241 = -t23*t232 - t233*t3 + t234*t6 + t235*t36 - t236*t48 + t237*t45
     t242 = t10*t234 + t16*t233 + t22*t232 + t235*t37 + t236*t50 + t237*t46
     t243 = -t12*t234 + t18*t233 + t232*t25 - t235*t38 + t236*t49 + t237*t47
     t244 = t13*t234 + t19*t233 + t232*t26
@@ -1291,20 +1291,20 @@ def _velocity_ik(q, mu_dot, damping):
     t248 = casadi.logic_or(casadi.logic_or(casadi.logic_or(casadi.logic_or(casadi.logic_or((t117 <= t247), (t147 <= t247)), (t180 <= t247)), (t216 <= t247)), (t227 <= t247)), (t91 <= t247))
     t249 = casadi.logic_and(casadi.logic_and(t245, t246), casadi.logic_not(t248))
     q_dot = casadi.SX(7, 1)
-    q_dot[0, 0] = casadi.if_else(t249, -t238, 0)
-    q_dot[1, 0] = casadi.if_else(t249, -t239, 0)
-    q_dot[2, 0] = casadi.if_else(t249, -t240, 0)
+    q_dot[0, 0] = casadi.if_else(t249, t238, 0)
+    q_dot[1, 0] = casadi.if_else(t249, t239, 0)
+    q_dot[2, 0] = casadi.if_else(t249, t240, 0)
     q_dot[3, 0] = casadi.if_else(t249, t241, 0)
-    q_dot[4, 0] = casadi.if_else(t249, -t242, 0)
-    q_dot[5, 0] = casadi.if_else(t249, -t243, 0)
-    q_dot[6, 0] = casadi.if_else(t249, -t244, 0)
+    q_dot[4, 0] = casadi.if_else(t249, t242, 0)
+    q_dot[5, 0] = casadi.if_else(t249, t243, 0)
+    q_dot[6, 0] = casadi.if_else(t249, t244, 0)
     status = casadi.SX(1, 1)
     status[0, 0] = casadi.if_else(casadi.logic_not(casadi.logic_and(t245, t246)), 2, casadi.if_else(t248, 1, 0))
     return [q_dot, status]
 
 
 def _ik_numeric_step(target, q, damping):
-    """One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite): 1123 operations."""
+    """One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite): 1131 operations."""
     T00 = target[0, 0]
     T01 = target[0, 1]
     T02 = target[0, 2]
@@ -1609,19 +1609,19 @@ def _ik_numeric_step(target, q, damping):
     t261 = t257 + t260
     t262 = casadi.if_else((t259 > 0), 1/(t259*(t258 + t259)), 0)
     t263 = -t231*t261**2*t262 + t231
-    t264 = t263/t260
-    t265 = (t230 + t256*t264)/t226
-    t266 = (t199 + t222*t265 + t252*t264)/t195
-    t267 = (t171 + t190*t266 + t217*t265 + t247*t264)/t167
-    t268 = (t147 - t161*t267 - t184*t266 + t211*t265 + t241*t264)/t143
-    t269 = (t128 + t136*t268 + t154*t267 + t177*t266 + t204*t265 + t234*t264)/t124
-    t270 = q1 - t264 - t268*t57 + t269*t61
-    t271 = -c1*t265 - c1*t269*t71 + q2 + s1*t266 - s1*t268*t71 + t267*t62
-    t272 = c2*t264 - q3 + t21*t265 + t266*t9 + t267*t66 + t268*t76 + t269*t79
-    t273 = q4 + t264*t37 + t265*t4 - t266*t7 - t267*t63 + t268*t77 - t269*t73
-    t274 = -q5 + t11*t266 + t23*t265 + t264*t36 + t267*t64 + t268*t80 + t269*t74
-    t275 = -q6 - t13*t266 + t25*t265 + t264*t39 - t267*t65 + t268*t78 + t269*t75
-    t276 = -q7 + t15*t266 + t264*t41 + t265*t27
+    t264 = casadi.if_else((t260 != 0), -t263/t260, 0)
+    t265 = casadi.if_else((t226 != 0), -(t230 - t256*t264)/t226, 0)
+    t266 = casadi.if_else((t195 != 0), -(t199 - t222*t265 - t252*t264)/t195, 0)
+    t267 = casadi.if_else((t167 != 0), -(t171 - t190*t266 - t217*t265 - t247*t264)/t167, 0)
+    t268 = casadi.if_else((t143 != 0), -(t147 + t161*t267 + t184*t266 - t211*t265 - t241*t264)/t143, 0)
+    t269 = casadi.if_else((t124 != 0), -(t128 - t136*t268 - t154*t267 - t177*t266 - t204*t265 - t234*t264)/t124, 0)
+    t270 = q1 + t264 + t268*t57 - t269*t61
+    t271 = c1*t265 + c1*t269*t71 + q2 - s1*t266 + s1*t268*t71 - t267*t62
+    t272 = c2*t264 + q3 + t21*t265 + t266*t9 + t267*t66 + t268*t76 + t269*t79
+    t273 = q4 - t264*t37 - t265*t4 + t266*t7 + t267*t63 - t268*t77 + t269*t73
+    t274 = q5 + t11*t266 + t23*t265 + t264*t36 + t267*t64 + t268*t80 + t269*t74
+    t275 = q6 - t13*t266 + t25*t265 + t264*t39 - t267*t65 + t268*t78 + t269*t75
+    t276 = q7 + t15*t266 + t264*t41 + t265*t27
     q_start = casadi.SX(7, 1)
     q_start[0, 0] = q1
     q_start[1, 0] = q2
@@ -1633,11 +1633,11 @@ def _ik_numeric_step(target, q, damping):
     q_next = casadi.SX(7, 1)
     q_next[0, 0] = casadi.if_else((t270 < -2.9670597283903604), -2.9670597283903604, casadi.if_else((t270 > 2.9670597283903604), 2.9670597283903604, t270))
     q_next[1, 0] = casadi.if_else((t271 < -2.0943951023931953), -2.0943951023931953, casadi.if_else((t271 > 2.0943951023931953), 2.0943951023931953, t271))
-    q_next[2, 0] = casadi.if_else((t272 > 2.9670597283903604), -2.9670597283903604, casadi.if_else((t272 < -2.9670597283903604), 2.9670597283903604, -t272))
+    q_next[2, 0] = casadi.if_else((t272 < -2.9670597283903604), -2.9670597283903604, casadi.if_else((t272 > 2.9670597283903604), 2.9670597283903604, t272))
     q_next[3, 0] = casadi.if_else((t273 < -2.0943951023931953), -2.0943951023931953, casadi.if_else((t273 > 2.0943951023931953), 2.0943951023931953, t273))
-    q_next[4, 0] = casadi.if_else((t274 > 2.9670597283903604), -2.9670597283903604, casadi.if_else((t274 < -2.9670597283903604), 2.9670597283903604, -t274))
-    q_next[5, 0] = casadi.if_else((t275 > 2.0943951023931953), -2.0943951023931953, casadi.if_else((t275 < -2.0943951023931953), 2.0943951023931953, -t275))
-    q_next[6, 0] = casadi.if_else((t276 > 3.0543261909900767), -3.0543261909900767, casadi.if_else((t276 < -3.0543261909900767), 3.0543261909900767, -t276))
+    q_next[4, 0] = casadi.if_else((t274 < -2.9670597283903604), -2.9670597283903604, casadi.if_else((t274 > 2.9670597283903604), 2.9670597283903604, t274))
+    q_next[5, 0] = casadi.if_else((t275 < -2.0943951023931953), -2.0943951023931953, casadi.if_else((t275 > 2.0943951023931953), 2.0943951023931953, t275))
+    q_next[6, 0] = casadi.if_else((t276 < -3.0543261909900767), -3.0543261909900767, casadi.if_else((t276 > 3.0543261909900767), 3.0543261909900767, t276))
     cost = casadi.SX(1, 1)
     cost[0, 0] = casadi.if_else((casadi.fabs(t0) < casadi.inf), t121, -1)
     return [q_start, q_next, cost]

@@ -625,7 +625,7 @@ def _jacobian_det(q):
 
 
 def _velocity_ik(q, mu_dot, damping):
-    """Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: 1334 operations."""
+    """Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: 1346 operations."""
     q1 = q[0]
     q2 = q[1]
     q3 = q[2]
@@ -883,12 +883,12 @@ def _velocity_ik(q, mu_dot, damping):
     t230 = t226 + t229
     t231 = casadi.if_else((t228 > 0), 1/(t228*(t227 + t228)), 0)
     t232 = -t199*t230**2*t231 + t199
-    t233 = t232/t229
-    t234 = (t198 + t225*t233)/t194
-    t235 = (t167 + t190*t234 + t221*t233)/t163
-    t236 = (t139 + t158*t235 + t185*t234 + t216*t233)/t135
-    t237 = (t115 - t129*t236 - t152*t235 + t179*t234 + t210*t233)/t111
-    t238 = (t104*t237 + t122*t236 - t145*t235 + t172*t234 + t203*t233 + t96)/t92
+    t233 = casadi.if_else((t229 != 0), -t232/t229, 0)
+    t234 = casadi.if_else((t194 != 0), -(t198 - t225*t233)/t194, 0)
+    t235 = casadi.if_else((t163 != 0), -(t167 - t190*t234 - t221*t233)/t163, 0)
+    t236 = casadi.if_else((t135 != 0), -(t139 - t158*t235 - t185*t234 - t216*t233)/t135, 0)
+    t237 = casadi.if_else((t111 != 0), -(t115 + t129*t236 + t152*t235 - t179*t234 - t210*t233)/t111, 0)
+    t238 = casadi.if_else((t92 != 0), -(-t104*t237 - t122*t236 + t145*t235 - t172*t234 - t203*t233 + t96)/t92, 0)
     t239 = t233 + t237*t32 - t238*t33
     t240 = c23*t233 + t11*t234 + t17*t236 + t23*t238 + t235*t9 - t237*t24
     t241 = t18*t236 + t233*t35 + t234*t4 - t235*t7 + t237*t37 + t238*t36
@@ -1020,12 +1020,12 @@ def _velocity_ik(q, mu_dot, damping):
     t367 = t363 + t366
     t368 = casadi.if_else((t365 > 0), 1/(t365*(t364 + t365)), 0)
     t369 = -t343*t367**2*t368 + t343
-    t370 = t369/t366
-    t371 = (t342 + t362*t370)/t338
-    t372 = (t323 + t334*t371 + t358*t370)/t319
-    t373 = (t309*t372 + t314 + t329*t371 + t353*t370)/t305
-    t374 = (t281*t373 - t286*t372 + t292*t371 + t297 + t347*t370)/t277
-    t375 = (t252*t273*t370 + t255*t374 + t258*t373 + t261*t372 + t265*t371 + t269)/t251
+    t370 = casadi.if_else((t366 != 0), -t369/t366, 0)
+    t371 = casadi.if_else((t338 != 0), -(t342 - t362*t370)/t338, 0)
+    t372 = casadi.if_else((t319 != 0), -(t323 - t334*t371 - t358*t370)/t319, 0)
+    t373 = casadi.if_else((t305 != 0), -(-t309*t372 + t314 - t329*t371 - t353*t370)/t305, 0)
+    t374 = casadi.if_else((t277 != 0), -(-t281*t373 + t286*t372 - t292*t371 + t297 - t347*t370)/t277, 0)
+    t375 = casadi.if_else((t251 != 0), -(-t252*t273*t370 - t255*t374 - t258*t373 - t261*t372 - t265*t371 + t269)/t251, 0)
     t376 = (damping > 0)
     t377 = (casadi.fabs(t344) < casadi.inf)
     t378 = (damping >= 0)
@@ -1034,19 +1034,19 @@ def _velocity_ik(q, mu_dot, damping):
     t381 = casadi.logic_or(casadi.logic_and(t376, casadi.logic_or(casadi.logic_or(casadi.logic_or(casadi.logic_or(casadi.logic_or((t110 <= t380), (t134 <= t380)), (t162 <= t380)), (t193 <= t380)), (t228 <= t380)), (t91 <= t380))), casadi.logic_and((damping <= 0), casadi.logic_or(casadi.logic_or(casadi.logic_or(casadi.logic_or(casadi.logic_or((t250 <= t379), (t276 <= t379)), (t304 <= t379)), (t318 <= t379)), (t337 <= t379)), (t365 <= t379))))
     t382 = casadi.logic_and(casadi.logic_and(t377, t378), casadi.logic_not(t381))
     q_dot = casadi.SX(6, 1)
-    q_dot[0, 0] = casadi.if_else(t382, casadi.if_else(t376, -t239, -t375), 0)
-    q_dot[1, 0] = casadi.if_else(t382, casadi.if_else(t376, -t245, -t374), 0)
-    q_dot[2, 0] = casadi.if_else(t382, casadi.if_else(t376, -t247, -t373), 0)
-    q_dot[3, 0] = casadi.if_else(t382, casadi.if_else(t376, -t240, -t372), 0)
-    q_dot[4, 0] = casadi.if_else(t382, casadi.if_else(t376, -t241, -t371), 0)
-    q_dot[5, 0] = casadi.if_else(t382, casadi.if_else(t376, -t242, -t370), 0)
+    q_dot[0, 0] = casadi.if_else(t382, casadi.if_else(t376, t239, t375), 0)
+    q_dot[1, 0] = casadi.if_else(t382, casadi.if_else(t376, t245, t374), 0)
+    q_dot[2, 0] = casadi.if_else(t382, casadi.if_else(t376, t247, t373), 0)
+    q_dot[3, 0] = casadi.if_else(t382, casadi.if_else(t376, t240, t372), 0)
+    q_dot[4, 0] = casadi.if_else(t382, casadi.if_else(t376, t241, t371), 0)
+    q_dot[5, 0] = casadi.if_else(t382, casadi.if_else(t376, t242, t370), 0)
     status = casadi.SX(1, 1)
     status[0, 0] = casadi.if_else(casadi.logic_not(casadi.logic_and(t377, t378)), 2, casadi.if_else(t381, 1, 0))
     return [q_dot, status]
 
 
 def _ik_numeric_step(target, q, damping):
-    """One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite): 1011 operations."""
+    """One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite): 1021 operations."""
     T00 = target[0, 0]
     T01 = target[0, 1]
     T02 = target[0, 2]
@@ -1343,21 +1343,21 @@ def _ik_numeric_step(target, q, damping):
     t255 = t251 + t254
     t256 = casadi.if_else((t253 > 0), 1/(t253*(t252 + t253)), 0)
     t257 = -t225*t255**2*t256 + t225
-    t258 = t257/t254
-    t259 = (t224 + t250*t258)/t220
-    t260 = (t193 + t216*t259 + t246*t258)/t189
-    t261 = (t165 + t184*t260 + t211*t259 + t241*t258)/t161
-    t262 = (t141 - t155*t261 - t178*t260 + t205*t259 + t235*t258)/t137
-    t263 = (t122 + t130*t262 + t148*t261 - t171*t260 + t198*t259 + t228*t258)/t118
-    t264 = q1 - t258 - t262*t64 + t263*t65
-    t265 = c23*t258 - q4 + t17*t259 + t260*t9 + t261*t44 - t262*t54 + t263*t52
-    t266 = -q5 + t258*t29 + t259*t4 - t260*t7 + t261*t45 + t262*t55 + t263*t53
-    t267 = q6 - t11*t260 - t19*t259 + t258*t28
+    t258 = casadi.if_else((t254 != 0), -t257/t254, 0)
+    t259 = casadi.if_else((t220 != 0), -(t224 - t250*t258)/t220, 0)
+    t260 = casadi.if_else((t189 != 0), -(t193 - t216*t259 - t246*t258)/t189, 0)
+    t261 = casadi.if_else((t161 != 0), -(t165 - t184*t260 - t211*t259 - t241*t258)/t161, 0)
+    t262 = casadi.if_else((t137 != 0), -(t141 + t155*t261 + t178*t260 - t205*t259 - t235*t258)/t137, 0)
+    t263 = casadi.if_else((t118 != 0), -(t122 - t130*t262 - t148*t261 + t171*t260 - t198*t259 - t228*t258)/t118, 0)
+    t264 = q1 + t258 + t262*t64 - t263*t65
+    t265 = c23*t258 + q4 + t17*t259 + t260*t9 + t261*t44 - t262*t54 + t263*t52
+    t266 = q5 + t258*t29 + t259*t4 - t260*t7 + t261*t45 + t262*t55 + t263*t53
+    t267 = q6 + t11*t260 + t19*t259 - t258*t28
     t268 = s1*t262
     t269 = c1*t263
-    t270 = -c1*t259 + s1*t260
-    t271 = q2 + t261*t66 - t268*t50 - t269*t50 + t270
-    t272 = q3 + t261*t60 - t268*t49 - t269*t49 + t270
+    t270 = c1*t259 - s1*t260
+    t271 = q2 - t261*t66 + t268*t50 + t269*t50 + t270
+    t272 = q3 - t261*t60 + t268*t49 + t269*t49 + t270
     q_start = casadi.SX(6, 1)
     q_start[0, 0] = q1
     q_start[1, 0] = q2
@@ -1369,8 +1369,8 @@ def _ik_numeric_step(target, q, damping):
     q_next[0, 0] = casadi.if_else((t264 < -2.705260340591211), -2.705260340591211, casadi.if_else((t264 > 2.705260340591211), 2.705260340591211, t264))
     q_next[1, 0] = casadi.if_else((t271 < -3.141592653589793), -3.141592653589793, casadi.if_else((t271 > 1.1344640137963142), 1.1344640137963142, t271))
     q_next[2, 0] = casadi.if_else((t272 < -0.2617993877991494), -0.2617993877991494, casadi.if_else((t272 > 2.7576202181510405), 2.7576202181510405, t272))
-    q_next[3, 0] = casadi.if_else((t265 > 6.1086523819801535), -6.1086523819801535, casadi.if_else((t265 < -6.1086523819801535), 6.1086523819801535, -t265))
-    q_next[4, 0] = casadi.if_else((t266 > 2.2689280275926285), -2.2689280275926285, casadi.if_else((t266 < -2.2689280275926285), 2.2689280275926285, -t266))
+    q_next[3, 0] = casadi.if_else((t265 < -6.1086523819801535), -6.1086523819801535, casadi.if_else((t265 > 6.1086523819801535), 6.1086523819801535, t265))
+    q_next[4, 0] = casadi.if_else((t266 < -2.2689280275926285), -2.2689280275926285, casadi.if_else((t266 > 2.2689280275926285), 2.2689280275926285, t266))
     q_next[5, 0] = casadi.if_else((t267 < -6.1086523819801535), -6.1086523819801535, casadi.if_else((t267 > 6.1086523819801535), 6.1086523819801535, t267))
     cost = casadi.SX(1, 1)
     cost[0, 0] = casadi.if_else((casadi.fabs(t0) < casadi.inf), t115, -1)
@@ -1378,7 +1378,7 @@ def _ik_numeric_step(target, q, damping):
 
 
 def _ik_branches(T):
-    """Every branch of the closed-form ik and whether the target allows it: 858 operations."""
+    """Every branch of the closed-form ik and whether the target allows it: 872 operations."""
     T00 = T[0, 0]
     T01 = T[0, 1]
     T02 = T[0, 2]
@@ -1391,88 +1391,88 @@ def _ik_branches(T):
     T21 = T[2, 1]
     T22 = T[2, 2]
     T23 = T[2, 3]
-    t0 = 2.639193146748068
-    t1 = 1.761980786391911
-    t2 = T00 + T01 + T02 + T03 + T10 + T11 + T12 + T13 + T20 + T21 + T22 + T23
-    t3 = 0.9*T00
-    t4 = -0.335*T02 + T03 - t3
-    t5 = 0.22*T02 + t3
-    t6 = t4 + t5
-    t7 = 0.9*T10
-    t8 = -0.335*T12 + T13 - t7
-    t9 = 0.22*T12 + t7
-    t10 = t8 + t9
-    t11 = casadi.atan2(-t6, t10)
-    t12 = 0.9*T20
-    t13 = -0.335*T22 + T23 - t12
-    t14 = 0.22*T22 + t12
-    t15 = t13 + t14
-    t16 = t10**2 + t6**2
-    t17 = t16
-    t18 = t15**2 + t16
-    t19 = 1/casadi.sqrt(t17)
-    t20 = True
-    t21 = casadi.if_else(t20, 0, -1)
-    t22 = casadi.if_else(t20, 1, 0)
-    t23 = casadi.atan2(t22, t21)
-    t24 = t11 - t23
-    t25 = 1e-24*t18
-    t26 = (t17 <= t25)
-    t27 = casadi.if_else(t26, 0, t11 + t23)
-    t28 = t19*t22
-    t29 = t28*t6
-    t30 = t19*t21
-    t31 = t10*t30
-    t32 = casadi.if_else(t26, 1, t29 + t31)
-    t33 = -t29 + t31
-    t34 = t10*t28
-    t35 = t30*t6
-    t36 = casadi.if_else(t26, 0, t34 - t35)
-    t37 = t34 + t35
-    t38 = t10*t36 + t32*t6
-    t39 = t10*t32 - t36*t6
-    t40 = t38 - 0.18
-    t41 = T02*t32 + T12*t36
-    t42 = T02*t36 - T12*t32
-    t43 = T00*t32 + T10*t36
-    t44 = -T00*t36 + T10*t32
-    t45 = -t10*t37 + t33*t6
-    t46 = t10*t33 + t37*t6
-    t47 = t45 - 0.18
-    t48 = -T02*t33 + T12*t37
-    t49 = T02*t37 + T12*t33
-    t50 = T00*t33 - T10*t37
-    t51 = T00*t37 + T10*t33
-    t52 = 1 - t32
-    t53 = t15*t52
-    t54 = t15*t32 + t53
-    t55 = t54 - 0.4
-    t56 = t39**2 + t40**2 + t55**2
-    t57 = 0.3794 - 0.5*t56
-    t58 = T22*t52
-    t59 = T22*t32 + t58
-    t60 = T20*t52
-    t61 = T20*t32 + t60
-    t62 = t57**2
-    t63 = t0**2
-    t64 = -t62*t63 + 1
-    t65 = t0*t57
-    t66 = (1e-12 < t64)
-    t67 = casadi.if_else(t66, t65, casadi.if_else((t65 > 0), 1, -1))
-    t68 = casadi.if_else(t66, casadi.sqrt(t64), 0)
-    t69 = casadi.atan2(t68, t67)
-    t70 = t1 - t69
-    t71 = False
-    t72 = casadi.if_else(t71, 0, t1 + t69)
-    t73 = 0.072*t0
-    t74 = t67*t73
-    t75 = 0.372*t0
-    t76 = t68*t75
-    t77 = casadi.if_else(t71, 1, -t74 - t76)
+    t0 = 1.761980786391911
+    t1 = T00 + T01 + T02 + T03 + T10 + T11 + T12 + T13 + T20 + T21 + T22 + T23
+    t2 = 0.9*T00
+    t3 = -0.335*T02 + T03 - t2
+    t4 = 0.22*T02 + t2
+    t5 = t3 + t4
+    t6 = 0.9*T10
+    t7 = -0.335*T12 + T13 - t6
+    t8 = 0.22*T12 + t6
+    t9 = t7 + t8
+    t10 = casadi.atan2(-t5, t9)
+    t11 = 0.9*T20
+    t12 = -0.335*T22 + T23 - t11
+    t13 = 0.22*T22 + t11
+    t14 = t12 + t13
+    t15 = t5**2 + t9**2
+    t16 = t15
+    t17 = t14**2 + t15
+    t18 = 1e-24*t17
+    t19 = (t16 <= t18)
+    t20 = casadi.if_else(t19, 1, 1/casadi.sqrt(t16))
+    t21 = True
+    t22 = casadi.if_else(t21, 0, -1)
+    t23 = casadi.if_else(t21, 1, 0)
+    t24 = casadi.atan2(t23, t22)
+    t25 = casadi.if_else(t19, 0, t10 + t24)
+    t26 = t10 - t24
+    t27 = t20*t23
+    t28 = t27*t5
+    t29 = t20*t22
+    t30 = t29*t9
+    t31 = casadi.if_else(t19, 1, t28 + t30)
+    t32 = -t28 + t30
+    t33 = t27*t9
+    t34 = t29*t5
+    t35 = casadi.if_else(t19, 0, t33 - t34)
+    t36 = t33 + t34
+    t37 = t31*t5 + t35*t9
+    t38 = t31*t9 - t35*t5
+    t39 = t37 - 0.18
+    t40 = T02*t31 + T12*t35
+    t41 = T02*t35 - T12*t31
+    t42 = T00*t31 + T10*t35
+    t43 = -T00*t35 + T10*t31
+    t44 = t32*t5 - t36*t9
+    t45 = t32*t9 + t36*t5
+    t46 = t44 - 0.18
+    t47 = -T02*t32 + T12*t36
+    t48 = T02*t36 + T12*t32
+    t49 = T00*t32 - T10*t36
+    t50 = T00*t36 + T10*t32
+    t51 = 1 - t31
+    t52 = t14*t51
+    t53 = t14*t31 + t52
+    t54 = t53 - 0.4
+    t55 = t38**2 + t39**2 + t54**2
+    t56 = 0.3794 - 0.5*t55
+    t57 = T22*t51
+    t58 = T22*t31 + t57
+    t59 = T20*t51
+    t60 = T20*t31 + t59
+    t61 = False
+    t62 = casadi.if_else(t61, 1, 2.639193146748068)
+    t63 = t56**2
+    t64 = t62**2
+    t65 = -t63*t64 + 1
+    t66 = t56*t62
+    t67 = (1e-12 < t65)
+    t68 = casadi.if_else(t67, t66, casadi.if_else((t66 > 0), 1, -1))
+    t69 = casadi.if_else(t67, casadi.sqrt(t65), 0)
+    t70 = casadi.atan2(t69, t68)
+    t71 = casadi.if_else(t61, 0, t0 + t70)
+    t72 = t0 - t70
+    t73 = 0.072*t62
+    t74 = t68*t73
+    t75 = 0.372*t62
+    t76 = t69*t75
+    t77 = casadi.if_else(t61, 1, -t74 - t76)
     t78 = -t74 + t76
-    t79 = t67*t75
-    t80 = t68*t73
-    t81 = casadi.if_else(t71, 0, t79 - t80)
+    t79 = t68*t75
+    t80 = t69*t73
+    t81 = casadi.if_else(t61, 0, t79 - t80)
     t82 = t79 + t80
     t83 = 0.12*t77 - 0.62*t81
     t84 = 0.62*t77 + 0.12*t81
@@ -1480,83 +1480,83 @@ def _ik_branches(T):
     t86 = 0.4 - t84
     t87 = t85 - 0.18
     t88 = t86 - 0.4
-    t89 = t40*t87 + t55*t88
-    t90 = t40*t88 - t55*t87
+    t89 = t39*t87 + t54*t88
+    t90 = t39*t88 - t54*t87
     t91 = t89**2 + t90**2
     t92 = t87**2 + t88**2
-    t93 = 1/casadi.sqrt(t91)
-    t94 = 0.12*t78 - 0.62*t82
-    t95 = 0.62*t78 + 0.12*t82
-    t96 = t94 + 0.78
-    t97 = 0.4 - t95
-    t98 = t96 - 0.18
-    t99 = t97 - 0.4
-    t100 = t40*t98 + t55*t99
-    t101 = t40*t99 - t55*t98
-    t102 = t100**2 + t101**2
-    t103 = t98**2 + t99**2
-    t104 = 1/casadi.sqrt(t102)
-    t105 = 1e-24*t56
-    t106 = (t91 <= t105*t92)
-    t107 = casadi.if_else(t106, 1, t89*t93)
-    t108 = casadi.if_else(t106, 0, t90*t93)
-    t109 = t107*t77 - t108*t81
-    t110 = t107*t81 + t108*t77
-    t111 = -t109*t41 + t110*t59
-    t112 = t109*t59 + t110*t41
-    t113 = t109*t43 - t110*t61
-    t114 = t109*t61 + t110*t43
-    t115 = 1 - t109
-    t116 = t115*t42
-    t117 = t109*t42 + t116
-    t118 = t115*t44
-    t119 = t109*t44 + t118
-    t120 = t112**2
-    t121 = -t120
-    t122 = t121 + 1
-    t123 = casadi.if_else((t122 > 1e-12), casadi.sqrt(t122), 0)
-    t124 = -t111*t123 + t120
-    t125 = t121 + t124
-    t126 = t117**2
-    t127 = t111**2 + t120 + t126
-    t128 = t123**2
-    t129 = t125**2 + t126*t128
-    t130 = t120 + t128
-    t131 = 1/casadi.sqrt(t129)
-    t132 = 1/casadi.sqrt(t130)
-    t133 = 1e-24*t130
-    t134 = (t129 <= t127*t133)
-    t135 = casadi.if_else(t134, 1, t125*t131)
-    t136 = t114*(1 - t135)
-    t137 = t114*t135 + t136
-    t138 = t117*t123
-    t139 = casadi.if_else(t134, 0, -t131*t138)
-    t140 = t113*t135 + t119*t139
-    t141 = -t113*t139 + t119*t135
-    t142 = (t130 <= t133)
-    t143 = casadi.if_else(t142, 1, -t112*t132)
-    t144 = casadi.if_else(t142, 0, -t123*t132)
-    t145 = t141*(1 - t143)
-    t146 = -t137*t144 + t140*t143
-    t147 = t141*t143 + t145
-    t148 = t137*t143 + t140*t144
-    t149 = t146**2 + t147**2
-    t150 = t149
-    t151 = t148**2 + t149
-    t152 = (t102 <= t103*t105)
-    t153 = casadi.if_else(t152, 1, t100*t104)
-    t154 = casadi.if_else(t152, 0, t101*t104)
+    t93 = 0.12*t78 - 0.62*t82
+    t94 = 0.62*t78 + 0.12*t82
+    t95 = t93 + 0.78
+    t96 = 0.4 - t94
+    t97 = t95 - 0.18
+    t98 = t96 - 0.4
+    t99 = t39*t97 + t54*t98
+    t100 = t39*t98 - t54*t97
+    t101 = t100**2 + t99**2
+    t102 = t97**2 + t98**2
+    t103 = 1e-24*t55
+    t104 = (t91 <= t103*t92)
+    t105 = casadi.if_else(t104, 1, 1/casadi.sqrt(t91))
+    t106 = casadi.if_else(t104, 1, t105*t89)
+    t107 = casadi.if_else(t104, 0, t105*t90)
+    t108 = t106*t77 - t107*t81
+    t109 = t106*t81 + t107*t77
+    t110 = -t108*t40 + t109*t58
+    t111 = t108*t58 + t109*t40
+    t112 = t108*t42 - t109*t60
+    t113 = t108*t60 + t109*t42
+    t114 = 1 - t108
+    t115 = t114*t41
+    t116 = t108*t41 + t115
+    t117 = t114*t43
+    t118 = t108*t43 + t117
+    t119 = t111**2
+    t120 = -t119
+    t121 = t120 + 1
+    t122 = casadi.if_else((t121 > 1e-12), casadi.sqrt(t121), 0)
+    t123 = -t110*t122 + t119
+    t124 = t120 + t123
+    t125 = t116**2
+    t126 = t110**2 + t119 + t125
+    t127 = t122**2
+    t128 = t124**2 + t125*t127
+    t129 = t119 + t127
+    t130 = 1e-24*t129
+    t131 = (t128 <= t126*t130)
+    t132 = casadi.if_else(t131, 1, 1/casadi.sqrt(t128))
+    t133 = casadi.if_else(t131, 1, t124*t132)
+    t134 = t113*(1 - t133)
+    t135 = t113*t133 + t134
+    t136 = t116*t122
+    t137 = casadi.if_else(t131, 0, -t132*t136)
+    t138 = t112*t133 + t118*t137
+    t139 = -t112*t137 + t118*t133
+    t140 = (t129 <= t130)
+    t141 = casadi.if_else(t140, 1, 1/casadi.sqrt(t129))
+    t142 = casadi.if_else(t140, 1, -t111*t141)
+    t143 = casadi.if_else(t140, 0, -t122*t141)
+    t144 = t139*(1 - t142)
+    t145 = -t135*t143 + t138*t142
+    t146 = t139*t142 + t144
+    t147 = t135*t142 + t138*t143
+    t148 = t145**2 + t146**2
+    t149 = t148
+    t150 = t147**2 + t148
+    t151 = (t101 <= t102*t103)
+    t152 = casadi.if_else(t151, 1, 1/casadi.sqrt(t101))
+    t153 = casadi.if_else(t151, 1, t152*t99)
+    t154 = casadi.if_else(t151, 0, t100*t152)
     t155 = t153*t78 - t154*t82
     t156 = t153*t82 + t154*t78
-    t157 = -t155*t41 + t156*t59
-    t158 = t155*t59 + t156*t41
-    t159 = t155*t43 - t156*t61
-    t160 = t155*t61 + t156*t43
+    t157 = -t155*t40 + t156*t58
+    t158 = t155*t58 + t156*t40
+    t159 = t155*t42 - t156*t60
+    t160 = t155*t60 + t156*t42
     t161 = 1 - t155
-    t162 = t161*t42
-    t163 = t155*t42 + t162
-    t164 = t161*t44
-    t165 = t155*t44 + t164
+    t162 = t161*t41
+    t163 = t155*t41 + t162
+    t164 = t161*t43
+    t165 = t155*t43 + t164
     t166 = t158**2
     t167 = -t166
     t168 = t167 + 1
@@ -1568,53 +1568,53 @@ def _ik_branches(T):
     t174 = t169**2
     t175 = t171**2 + t172*t174
     t176 = t166 + t174
-    t177 = 1/casadi.sqrt(t175)
-    t178 = 1/casadi.sqrt(t176)
-    t179 = 1e-24*t176
-    t180 = (t175 <= t173*t179)
-    t181 = casadi.if_else(t180, 1, t171*t177)
-    t182 = t160*(1 - t181)
-    t183 = t160*t181 + t182
-    t184 = t163*t169
-    t185 = casadi.if_else(t180, 0, -t177*t184)
-    t186 = t159*t181 + t165*t185
-    t187 = -t159*t185 + t165*t181
-    t188 = (t176 <= t179)
-    t189 = casadi.if_else(t188, 1, -t158*t178)
-    t190 = casadi.if_else(t188, 0, -t169*t178)
-    t191 = t187*(1 - t189)
-    t192 = -t183*t190 + t186*t189
-    t193 = t187*t189 + t191
-    t194 = t183*t189 + t186*t190
+    t177 = 1e-24*t176
+    t178 = (t175 <= t173*t177)
+    t179 = casadi.if_else(t178, 1, 1/casadi.sqrt(t175))
+    t180 = casadi.if_else(t178, 1, t171*t179)
+    t181 = t160*(1 - t180)
+    t182 = t160*t180 + t181
+    t183 = t163*t169
+    t184 = casadi.if_else(t178, 0, -t179*t183)
+    t185 = t159*t180 + t165*t184
+    t186 = -t159*t184 + t165*t180
+    t187 = (t176 <= t177)
+    t188 = casadi.if_else(t187, 1, 1/casadi.sqrt(t176))
+    t189 = casadi.if_else(t187, 1, -t158*t188)
+    t190 = casadi.if_else(t187, 0, -t169*t188)
+    t191 = t186*(1 - t189)
+    t192 = -t182*t190 + t185*t189
+    t193 = t186*t189 + t191
+    t194 = t182*t189 + t185*t190
     t195 = t192**2 + t193**2
     t196 = t195
     t197 = t194**2 + t195
-    t198 = 1 - t33
-    t199 = t15*t198
-    t200 = t15*t33 + t199
+    t198 = 1 - t32
+    t199 = t14*t198
+    t200 = t14*t32 + t199
     t201 = t200 - 0.4
-    t202 = t201**2 + t46**2 + t47**2
+    t202 = t201**2 + t45**2 + t46**2
     t203 = 0.3794 - 0.5*t202
     t204 = T22*t198
-    t205 = T22*t33 + t204
+    t205 = T22*t32 + t204
     t206 = T20*t198
-    t207 = T20*t33 + t206
+    t207 = T20*t32 + t206
     t208 = t203**2
-    t209 = -t208*t63 + 1
-    t210 = t0*t203
+    t209 = -t208*t64 + 1
+    t210 = t203*t62
     t211 = (1e-12 < t209)
     t212 = casadi.if_else(t211, t210, casadi.if_else((t210 > 0), 1, -1))
     t213 = casadi.if_else(t211, casadi.sqrt(t209), 0)
     t214 = casadi.atan2(t213, t212)
-    t215 = casadi.if_else(t71, 0, t1 + t214)
-    t216 = t1 - t214
+    t215 = casadi.if_else(t61, 0, t0 + t214)
+    t216 = t0 - t214
     t217 = t212*t73
     t218 = t213*t75
-    t219 = casadi.if_else(t71, 1, -t217 - t218)
+    t219 = casadi.if_else(t61, 1, -t217 - t218)
     t220 = -t217 + t218
     t221 = t212*t75
     t222 = t213*t73
-    t223 = casadi.if_else(t71, 0, t221 - t222)
+    t223 = casadi.if_else(t61, 0, t221 - t222)
     t224 = t221 + t222
     t225 = 0.12*t219 - 0.62*t223
     t226 = 0.62*t219 + 0.12*t223
@@ -1622,83 +1622,83 @@ def _ik_branches(T):
     t228 = 0.4 - t226
     t229 = t227 - 0.18
     t230 = t228 - 0.4
-    t231 = t201*t230 + t229*t47
-    t232 = -t201*t229 + t230*t47
+    t231 = t201*t230 + t229*t46
+    t232 = -t201*t229 + t230*t46
     t233 = t231**2 + t232**2
     t234 = t229**2 + t230**2
-    t235 = 1/casadi.sqrt(t233)
-    t236 = 0.12*t220 - 0.62*t224
-    t237 = 0.62*t220 + 0.12*t224
-    t238 = t236 + 0.78
-    t239 = 0.4 - t237
-    t240 = t238 - 0.18
-    t241 = t239 - 0.4
-    t242 = t201*t241 + t240*t47
-    t243 = -t201*t240 + t241*t47
-    t244 = t242**2 + t243**2
-    t245 = t240**2 + t241**2
-    t246 = 1/casadi.sqrt(t244)
-    t247 = 1e-24*t202
-    t248 = (t233 <= t234*t247)
-    t249 = casadi.if_else(t248, 1, t231*t235)
-    t250 = casadi.if_else(t248, 0, t232*t235)
-    t251 = t219*t249 - t223*t250
-    t252 = t219*t250 + t223*t249
-    t253 = t205*t252 + t251*t48
-    t254 = -t205*t251 + t252*t48
-    t255 = -t207*t252 + t251*t50
-    t256 = t207*t251 + t252*t50
-    t257 = 1 - t251
-    t258 = t257*t49
-    t259 = t251*t49 + t258
-    t260 = t257*t51
-    t261 = t251*t51 + t260
-    t262 = t254**2
-    t263 = -t262
-    t264 = t263 + 1
-    t265 = casadi.if_else((t264 > 1e-12), casadi.sqrt(t264), 0)
-    t266 = -t253*t265 + t262
-    t267 = t263 + t266
-    t268 = t259**2
-    t269 = t253**2 + t262 + t268
-    t270 = t265**2
-    t271 = t267**2 + t268*t270
-    t272 = t262 + t270
-    t273 = 1/casadi.sqrt(t271)
-    t274 = 1/casadi.sqrt(t272)
-    t275 = 1e-24*t272
-    t276 = (t271 <= t269*t275)
-    t277 = casadi.if_else(t276, 1, t267*t273)
-    t278 = t256*(1 - t277)
-    t279 = t256*t277 + t278
-    t280 = t259*t265
-    t281 = casadi.if_else(t276, 0, t273*t280)
-    t282 = t255*t277 + t261*t281
-    t283 = -t255*t281 + t261*t277
-    t284 = (t272 <= t275)
-    t285 = casadi.if_else(t284, 1, t254*t274)
-    t286 = casadi.if_else(t284, 0, -t265*t274)
-    t287 = t283*(1 - t285)
-    t288 = -t279*t286 + t282*t285
-    t289 = t283*t285 + t287
-    t290 = t279*t285 + t282*t286
-    t291 = t288**2 + t289**2
-    t292 = t291
-    t293 = t290**2 + t291
-    t294 = (t244 <= t245*t247)
-    t295 = casadi.if_else(t294, 1, t242*t246)
-    t296 = casadi.if_else(t294, 0, t243*t246)
+    t235 = 0.12*t220 - 0.62*t224
+    t236 = 0.62*t220 + 0.12*t224
+    t237 = t235 + 0.78
+    t238 = 0.4 - t236
+    t239 = t237 - 0.18
+    t240 = t238 - 0.4
+    t241 = t201*t240 + t239*t46
+    t242 = -t201*t239 + t240*t46
+    t243 = t241**2 + t242**2
+    t244 = t239**2 + t240**2
+    t245 = 1e-24*t202
+    t246 = (t233 <= t234*t245)
+    t247 = casadi.if_else(t246, 1, 1/casadi.sqrt(t233))
+    t248 = casadi.if_else(t246, 1, t231*t247)
+    t249 = casadi.if_else(t246, 0, t232*t247)
+    t250 = t219*t248 - t223*t249
+    t251 = t219*t249 + t223*t248
+    t252 = t205*t251 + t250*t47
+    t253 = -t205*t250 + t251*t47
+    t254 = -t207*t251 + t250*t49
+    t255 = t207*t250 + t251*t49
+    t256 = 1 - t250
+    t257 = t256*t48
+    t258 = t250*t48 + t257
+    t259 = t256*t50
+    t260 = t250*t50 + t259
+    t261 = t253**2
+    t262 = -t261
+    t263 = t262 + 1
+    t264 = casadi.if_else((t263 > 1e-12), casadi.sqrt(t263), 0)
+    t265 = -t252*t264 + t261
+    t266 = t262 + t265
+    t267 = t258**2
+    t268 = t252**2 + t261 + t267
+    t269 = t264**2
+    t270 = t266**2 + t267*t269
+    t271 = t261 + t269
+    t272 = 1e-24*t271
+    t273 = (t270 <= t268*t272)
+    t274 = casadi.if_else(t273, 1, 1/casadi.sqrt(t270))
+    t275 = casadi.if_else(t273, 1, t266*t274)
+    t276 = t255*(1 - t275)
+    t277 = t255*t275 + t276
+    t278 = t258*t264
+    t279 = casadi.if_else(t273, 0, t274*t278)
+    t280 = t254*t275 + t260*t279
+    t281 = -t254*t279 + t260*t275
+    t282 = (t271 <= t272)
+    t283 = casadi.if_else(t282, 1, 1/casadi.sqrt(t271))
+    t284 = casadi.if_else(t282, 1, t253*t283)
+    t285 = casadi.if_else(t282, 0, -t264*t283)
+    t286 = t281*(1 - t284)
+    t287 = -t277*t285 + t280*t284
+    t288 = t281*t284 + t286
+    t289 = t277*t284 + t280*t285
+    t290 = t287**2 + t288**2
+    t291 = t290
+    t292 = t289**2 + t290
+    t293 = (t243 <= t244*t245)
+    t294 = casadi.if_else(t293, 1, 1/casadi.sqrt(t243))
+    t295 = casadi.if_else(t293, 1, t241*t294)
+    t296 = casadi.if_else(t293, 0, t242*t294)
     t297 = t220*t295 - t224*t296
     t298 = t220*t296 + t224*t295
-    t299 = t205*t298 + t297*t48
-    t300 = -t205*t297 + t298*t48
-    t301 = -t207*t298 + t297*t50
-    t302 = t207*t297 + t298*t50
+    t299 = t205*t298 + t297*t47
+    t300 = -t205*t297 + t298*t47
+    t301 = -t207*t298 + t297*t49
+    t302 = t207*t297 + t298*t49
     t303 = 1 - t297
-    t304 = t303*t49
-    t305 = t297*t49 + t304
-    t306 = t303*t51
-    t307 = t297*t51 + t306
+    t304 = t303*t48
+    t305 = t297*t48 + t304
+    t306 = t303*t50
+    t307 = t297*t50 + t306
     t308 = t300**2
     t309 = -t308
     t310 = t309 + 1
@@ -1710,59 +1710,59 @@ def _ik_branches(T):
     t316 = t311**2
     t317 = t313**2 + t314*t316
     t318 = t308 + t316
-    t319 = 1/casadi.sqrt(t317)
-    t320 = 1/casadi.sqrt(t318)
-    t321 = 1e-24*t318
-    t322 = (t317 <= t315*t321)
-    t323 = casadi.if_else(t322, 1, t313*t319)
-    t324 = t302*(1 - t323)
-    t325 = t302*t323 + t324
-    t326 = t305*t311
-    t327 = casadi.if_else(t322, 0, t319*t326)
-    t328 = t301*t323 + t307*t327
-    t329 = -t301*t327 + t307*t323
-    t330 = (t318 <= t321)
-    t331 = casadi.if_else(t330, 1, t300*t320)
-    t332 = casadi.if_else(t330, 0, -t311*t320)
-    t333 = t329*(1 - t331)
-    t334 = -t325*t332 + t328*t331
-    t335 = t329*t331 + t333
-    t336 = t325*t331 + t328*t332
+    t319 = 1e-24*t318
+    t320 = (t317 <= t315*t319)
+    t321 = casadi.if_else(t320, 1, 1/casadi.sqrt(t317))
+    t322 = casadi.if_else(t320, 1, t313*t321)
+    t323 = t302*(1 - t322)
+    t324 = t302*t322 + t323
+    t325 = t305*t311
+    t326 = casadi.if_else(t320, 0, t321*t325)
+    t327 = t301*t322 + t307*t326
+    t328 = -t301*t326 + t307*t322
+    t329 = (t318 <= t319)
+    t330 = casadi.if_else(t329, 1, 1/casadi.sqrt(t318))
+    t331 = casadi.if_else(t329, 1, t300*t330)
+    t332 = casadi.if_else(t329, 0, -t311*t330)
+    t333 = t328*(1 - t331)
+    t334 = -t324*t332 + t327*t331
+    t335 = t328*t331 + t333
+    t336 = t324*t331 + t327*t332
     t337 = t334**2 + t335**2
     t338 = t337
     t339 = t336**2 + t337
-    t340 = t27 - 6.283185307179586*casadi.ceil(0.15915494309189535*t27 - 0.5)
-    t341 = casadi.if_else(t106, 0, casadi.atan2(t90, t89))
-    t342 = t72 - 6.283185307179586*casadi.ceil(0.15915494309189535*t72 - 0.5)
-    t343 = casadi.if_else(t134, 0, casadi.atan2(-t138, t125))
-    t344 = casadi.if_else(t142, 0, casadi.atan2(-t123, -t112))
-    t345 = casadi.if_else((t150 <= 1e-24*t151), 0, casadi.atan2(t147, t146))
-    t346 = casadi.if_else(t152, 0, casadi.atan2(t101, t100))
-    t347 = t70 - 6.283185307179586*casadi.ceil(0.15915494309189535*t70 - 0.5)
-    t348 = casadi.if_else(t180, 0, casadi.atan2(-t184, t171))
-    t349 = casadi.if_else(t188, 0, casadi.atan2(-t169, -t158))
+    t340 = t25 - 6.283185307179586*casadi.ceil(0.15915494309189535*t25 - 0.5)
+    t341 = casadi.if_else(t104, 0, casadi.atan2(t90, t89))
+    t342 = t71 - 6.283185307179586*casadi.ceil(0.15915494309189535*t71 - 0.5)
+    t343 = casadi.if_else(t131, 0, casadi.atan2(-t136, t124))
+    t344 = casadi.if_else(t140, 0, casadi.atan2(-t122, -t111))
+    t345 = casadi.if_else((t149 <= 1e-24*t150), 0, casadi.atan2(t146, t145))
+    t346 = casadi.if_else(t151, 0, casadi.atan2(t100, t99))
+    t347 = t72 - 6.283185307179586*casadi.ceil(0.15915494309189535*t72 - 0.5)
+    t348 = casadi.if_else(t178, 0, casadi.atan2(-t183, t171))
+    t349 = casadi.if_else(t187, 0, casadi.atan2(-t169, -t158))
     t350 = casadi.if_else((t196 <= 1e-24*t197), 0, casadi.atan2(t193, t192))
-    t351 = t24 - 6.283185307179586*casadi.ceil(0.15915494309189535*t24 - 0.5)
-    t352 = casadi.if_else(t248, 0, casadi.atan2(t232, t231))
+    t351 = t26 - 6.283185307179586*casadi.ceil(0.15915494309189535*t26 - 0.5)
+    t352 = casadi.if_else(t246, 0, casadi.atan2(t232, t231))
     t353 = t215 - 6.283185307179586*casadi.ceil(0.15915494309189535*t215 - 0.5)
-    t354 = casadi.if_else(t276, 0, casadi.atan2(t280, t267))
-    t355 = casadi.if_else(t284, 0, casadi.atan2(-t265, t254))
-    t356 = casadi.if_else((t292 <= 1e-24*t293), 0, casadi.atan2(t289, t288))
-    t357 = casadi.if_else(t294, 0, casadi.atan2(t243, t242))
+    t354 = casadi.if_else(t273, 0, casadi.atan2(t278, t266))
+    t355 = casadi.if_else(t282, 0, casadi.atan2(-t264, t253))
+    t356 = casadi.if_else((t291 <= 1e-24*t292), 0, casadi.atan2(t288, t287))
+    t357 = casadi.if_else(t293, 0, casadi.atan2(t242, t241))
     t358 = t216 - 6.283185307179586*casadi.ceil(0.15915494309189535*t216 - 0.5)
-    t359 = casadi.if_else(t322, 0, casadi.atan2(t326, t313))
-    t360 = casadi.if_else(t330, 0, casadi.atan2(-t311, t300))
+    t359 = casadi.if_else(t320, 0, casadi.atan2(t325, t313))
+    t360 = casadi.if_else(t329, 0, casadi.atan2(-t311, t300))
     t361 = casadi.if_else((t338 <= 1e-24*t339), 0, casadi.atan2(t335, t334))
-    t362 = (casadi.fabs(t2) < casadi.inf)
+    t362 = (casadi.fabs(t1) < casadi.inf)
     t363 = -1e-12
-    t364 = (t17 > t25)
-    t365 = casadi.logic_or(t364, casadi.logic_and(t26, (0 <= 1e-12*t18)))
+    t364 = (t16 > t18)
+    t365 = casadi.logic_or(t364, casadi.logic_and(t19, (0 <= 1e-12*t17)))
     t366 = 1.4356799999999999e-25
     t367 = (0.143568 > t366)
     t368 = (0.143568 <= t366)
     t369 = 1.43568e-13
-    t370 = casadi.logic_or(casadi.logic_and(t367, (t64 >= t363)), casadi.logic_and(t368, (t62 <= t369)))
-    t371 = (t64 > 1e-12)
+    t370 = casadi.logic_or(casadi.logic_and(t367, (t65 >= t363)), casadi.logic_and(t368, (t63 <= t369)))
+    t371 = (t65 > 1e-12)
     t372 = True
     t373 = casadi.logic_or(casadi.logic_and(t367, (t209 >= t363)), casadi.logic_and(t368, (t208 <= t369)))
     t374 = (t209 > 1e-12)
@@ -1816,12 +1816,12 @@ def _ik_branches(T):
     q[7, 4] = -t360 - 6.283185307179586*casadi.ceil(-0.15915494309189535*t360 - 0.5)
     q[7, 5] = t361 - 6.283185307179586*casadi.ceil(0.15915494309189535*t361) + 3.141592653589793
     valid = casadi.SX(8, 1)
-    valid[0, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t362, t365), t370), (t122 >= t363))
-    valid[1, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t362, t365), t370), (t122 > 1e-12))
+    valid[0, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t362, t365), t370), (t121 >= t363))
+    valid[1, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t362, t365), t370), (t121 > 1e-12))
     valid[2, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t362, t365), t367), t371), (t168 >= t363))
     valid[3, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t362, t365), t367), t371), (t168 > 1e-12))
-    valid[4, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t362, t364), t372), t373), (t264 >= t363))
-    valid[5, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t362, t364), t372), t373), (t264 > 1e-12))
+    valid[4, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t362, t364), t372), t373), (t263 >= t363))
+    valid[5, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t362, t364), t372), t373), (t263 > 1e-12))
     valid[6, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t362, t364), t367), t372), t374), (t310 >= t363))
     valid[7, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t362, t364), t367), t372), t374), (t310 > 1e-12))
     return [q, valid]

@@ -1193,7 +1193,7 @@ panda_real panda_manipulability(const panda_real q[PANDA_DOF])
 
 int panda_velocity_ik(const panda_real q[PANDA_DOF], const panda_real mu_dot[PANDA_TASK_DIM], panda_real damping, panda_real q_dot[PANDA_DOF])
 {
-    /* 1053 operations */
+    /* 1062 operations */
 
     /* Inputs */
     const panda_real q1 = q[0];
@@ -1463,18 +1463,18 @@ int panda_velocity_ik(const panda_real q[PANDA_DOF], const panda_real mu_dot[PAN
     const panda_real t237 = t233 + t236;
     const panda_real t238 = (t235 > 0 ? 1/(t235*(t234 + t235)) : 0);
     const panda_real t239 = -t206*t238*(t237*t237) + t206;
-    const panda_real t240 = t239/t236;
-    const panda_real t241 = (t205 + t232*t240)/t201;
-    const panda_real t242 = (t174 + t197*t241 + t228*t240)/t170;
-    const panda_real t243 = (t146 + t165*t242 + t192*t241 + t223*t240)/t142;
-    const panda_real t244 = (t122 - t136*t243 - t159*t242 + t186*t241 + t217*t240)/t118;
-    const panda_real t245 = (t103 + t111*t244 + t129*t243 + t152*t242 + t179*t241 - t210*t240)/t99;
+    const panda_real t240 = (t236 != 0 ? -t239/t236 : 0);
+    const panda_real t241 = (t201 != 0 ? -(t205 - t232*t240)/t201 : 0);
+    const panda_real t242 = (t170 != 0 ? -(t174 - t197*t241 - t228*t240)/t170 : 0);
+    const panda_real t243 = (t142 != 0 ? -(t146 - t165*t242 - t192*t241 - t223*t240)/t142 : 0);
+    const panda_real t244 = (t118 != 0 ? -(t122 + t136*t243 + t159*t242 - t186*t241 - t217*t240)/t118 : 0);
+    const panda_real t245 = (t99 != 0 ? -(t103 - t111*t244 - t129*t243 - t152*t242 - t179*t241 + t210*t240)/t99 : 0);
     const panda_real t246 = t19*t244 + t240 - t245*t31;
     const panda_real t247 = c1*t241 - s1*t242 - t243*t32 + t244*t63 + t245*t60;
     const panda_real t248 = c2*t240 + t20*t241 + t242*t8 + t243*t36 + t244*t61 + t245*t64;
-    const panda_real t249 = t240*t42 + t241*t3 - t242*t6 - t243*t33 + t244*t53 - t245*t51;
+    const panda_real t249 = -t240*t42 - t241*t3 + t242*t6 + t243*t33 - t244*t53 + t245*t51;
     const panda_real t250 = t11*t242 + t23*t241 + t240*t41 + t243*t34 + t244*t56 + t245*t52;
-    const panda_real t251 = -t13*t242 + t240*t44 + t241*t25 - t243*t35 + t244*t54 - t245*t55;
+    const panda_real t251 = t13*t242 - t240*t44 - t241*t25 + t243*t35 - t244*t54 + t245*t55;
     const panda_real t252 = t15*t242 + t240*t46 + t241*t27;
     const int t253 = isfinite(t66);
     const int t254 = damping >= 0;
@@ -1483,19 +1483,19 @@ int panda_velocity_ik(const panda_real q[PANDA_DOF], const panda_real mu_dot[PAN
     const int t257 = t253 && t254 && !t256;
 
     /* Outputs */
-    q_dot[0] = (t257 ? -t246 : 0);
-    q_dot[1] = (t257 ? -t247 : 0);
-    q_dot[2] = (t257 ? -t248 : 0);
+    q_dot[0] = (t257 ? t246 : 0);
+    q_dot[1] = (t257 ? t247 : 0);
+    q_dot[2] = (t257 ? t248 : 0);
     q_dot[3] = (t257 ? t249 : 0);
-    q_dot[4] = (t257 ? -t250 : 0);
+    q_dot[4] = (t257 ? t250 : 0);
     q_dot[5] = (t257 ? t251 : 0);
-    q_dot[6] = (t257 ? t252 : 0);
+    q_dot[6] = (t257 ? -t252 : 0);
     return (!(t253 && t254) ? 2 : (t256 ? 1 : 0));
 }
 
 panda_real panda_ik_numeric_step(const panda_real target[16], const panda_real q[PANDA_DOF], panda_real damping, panda_real q_start[PANDA_DOF], panda_real q_next[PANDA_DOF])
 {
-    /* 1151 operations */
+    /* 1162 operations */
 
     /* Inputs */
     const panda_real T00 = target[0];
@@ -1822,19 +1822,19 @@ panda_real panda_ik_numeric_step(const panda_real target[16], const panda_real q
     const panda_real t279 = t275 + t278;
     const panda_real t280 = (t277 > 0 ? 1/(t277*(t276 + t277)) : 0);
     const panda_real t281 = -t249*t280*(t279*t279) + t249;
-    const panda_real t282 = t281/t278;
-    const panda_real t283 = (t248 + t274*t282)/t244;
-    const panda_real t284 = (t217 + t240*t283 + t270*t282)/t213;
-    const panda_real t285 = (t189 + t208*t284 + t235*t283 + t265*t282)/t185;
-    const panda_real t286 = (t165 - t179*t285 - t202*t284 + t229*t283 + t259*t282)/t161;
-    const panda_real t287 = (t146 + t154*t286 + t172*t285 + t195*t284 + t222*t283 - t252*t282)/t142;
-    const panda_real t288 = q1 - t28*t286 - t282 + t287*t42;
-    const panda_real t289 = -c1*t283 - c1*t287*t60 + q2 + s1*t284 - s1*t286*t60 + t285*t43;
-    const panda_real t290 = c2*t282 - q3 + t16*t284 + t283*t30 + t285*t47 + t286*t64 + t287*t67;
-    const panda_real t291 = q4 + t282*t50 + t283*t4 - t284*t7 - t285*t44 + t286*t65 - t287*t62;
-    const panda_real t292 = -q5 + t15*t282 + t18*t284 + t283*t32 + t285*t45 + t286*t69 + t287*t63;
-    const panda_real t293 = q6 - t20*t284 + t282*t52 + t283*t34 - t285*t46 + t286*t66 - t287*t68;
-    const panda_real t294 = q7 + t22*t284 + t282*t54 + t283*t36;
+    const panda_real t282 = (t278 != 0 ? -t281/t278 : 0);
+    const panda_real t283 = (t244 != 0 ? -(t248 - t274*t282)/t244 : 0);
+    const panda_real t284 = (t213 != 0 ? -(t217 - t240*t283 - t270*t282)/t213 : 0);
+    const panda_real t285 = (t185 != 0 ? -(t189 - t208*t284 - t235*t283 - t265*t282)/t185 : 0);
+    const panda_real t286 = (t161 != 0 ? -(t165 + t179*t285 + t202*t284 - t229*t283 - t259*t282)/t161 : 0);
+    const panda_real t287 = (t142 != 0 ? -(t146 - t154*t286 - t172*t285 - t195*t284 - t222*t283 + t252*t282)/t142 : 0);
+    const panda_real t288 = q1 + t28*t286 + t282 - t287*t42;
+    const panda_real t289 = c1*t283 + c1*t287*t60 + q2 - s1*t284 + s1*t286*t60 - t285*t43;
+    const panda_real t290 = c2*t282 + q3 + t16*t284 + t283*t30 + t285*t47 + t286*t64 + t287*t67;
+    const panda_real t291 = q4 - t282*t50 - t283*t4 + t284*t7 + t285*t44 - t286*t65 + t287*t62;
+    const panda_real t292 = q5 + t15*t282 + t18*t284 + t283*t32 + t285*t45 + t286*t69 + t287*t63;
+    const panda_real t293 = q6 + t20*t284 - t282*t52 - t283*t34 + t285*t46 - t286*t66 + t287*t68;
+    const panda_real t294 = -q7 + t22*t284 + t282*t54 + t283*t36;
 
     /* Outputs */
     q_start[0] = q1;
@@ -1846,11 +1846,11 @@ panda_real panda_ik_numeric_step(const panda_real target[16], const panda_real q
     q_start[6] = q7;
     q_next[0] = (t288 < -2.8973 ? -2.8973 : (t288 > 2.8973 ? 2.8973 : t288));
     q_next[1] = (t289 < -1.7627999999999997 ? -1.7627999999999997 : (t289 > 1.7627999999999997 ? 1.7627999999999997 : t289));
-    q_next[2] = (t290 > 2.8973 ? -2.8973 : (t290 < -2.8973 ? 2.8973 : -t290));
+    q_next[2] = (t290 < -2.8973 ? -2.8973 : (t290 > 2.8973 ? 2.8973 : t290));
     q_next[3] = (t291 < -3.0718 ? -3.0718 : (t291 > -0.0698 ? -0.0698 : t291));
-    q_next[4] = (t292 > 2.8973 ? -2.8973 : (t292 < -2.8973 ? 2.8973 : -t292));
+    q_next[4] = (t292 < -2.8973 ? -2.8973 : (t292 > 2.8973 ? 2.8973 : t292));
     q_next[5] = (t293 < -0.0175 ? -0.0175 : (t293 > 3.7525000000000004 ? 3.7525000000000004 : t293));
-    q_next[6] = (t294 < -2.8973 ? -2.8973 : (t294 > 2.8973 ? 2.8973 : t294));
+    q_next[6] = (t294 > 2.8973 ? -2.8973 : (t294 < -2.8973 ? 2.8973 : -t294));
     return (isfinite(t0) ? t139 : -1);
 }
 

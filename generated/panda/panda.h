@@ -67,11 +67,11 @@ void panda_singularity_factors(const panda_real q[PANDA_DOF], panda_real f[PANDA
 panda_real panda_manipulability(const panda_real q[PANDA_DOF]);
 
 /* Joint rates q_dot solving Js q_dot = mu_dot: Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status.
- * Result: q_dot[i], i < 7; returned as a scalar. 1053 operations. */
+ * Result: q_dot[i], i < 7; returned as a scalar. 1062 operations. */
 int panda_velocity_ik(const panda_real q[PANDA_DOF], const panda_real mu_dot[PANDA_TASK_DIM], panda_real damping, panda_real q_dot[PANDA_DOF]);
 
 /* One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite).
- * Result: q_start[i], i < 7; q_next[i], i < 7; returned as a scalar. 1151 operations. */
+ * Result: q_start[i], i < 7; q_next[i], i < 7; returned as a scalar. 1162 operations. */
 panda_real panda_ik_numeric_step(const panda_real target[16], const panda_real q[PANDA_DOF], panda_real damping, panda_real q_start[PANDA_DOF], panda_real q_next[PANDA_DOF]);
 
 /* Statuses of panda_velocity_ik: OK, singular (a diagonal entry of the QR factor R of the

@@ -1135,7 +1135,7 @@ def _manipulability(q):
 
 
 def _velocity_ik(q, mu_dot, damping):
-    """Joint rates q_dot solving Js q_dot = mu_dot: Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: 1053 operations."""
+    """Joint rates q_dot solving Js q_dot = mu_dot: Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: 1062 operations."""
     q1 = q[0]
     q2 = q[1]
     q3 = q[2]
@@ -1401,18 +1401,18 @@ def _velocity_ik(q, mu_dot, damping):
     t237 = t233 + t236
     t238 = casadi.if_else((t235 > 0), 1/(t235*(t234 + t235)), 0)
     t239 = -t206*t237**2*t238 + t206
-    t240 = t239/t236
-    t241 = (t205 + t232*t240)/t201
-    t242 = (t174 + t197*t241 + t228*t240)/t170
-    t243 = (t146 + t165*t242 + t192*t241 + t223*t240)/t142
-    t244 = (t122 - t136*t243 - t159*t242 + t186*t241 + t217*t240)/t118
-    t245 = (t103 + t111*t244 + t129*t243 + t152*t242 + t179*t241 - t210*t240)/t99
+    t240 = casadi.if_else((t236 != 0), -t239/t236, 0)
+    t241 = casadi.if_else((t201 != 0), -(t205 - t232*t240)/t201, 0)
+    t242 = casadi.if_else((t170 != 0), -(t174 - t197*t241 - t228*t240)/t170, 0)
+    t243 = casadi.if_else((t142 != 0), -(t146 - t165*t242 - t192*t241 - t223*t240)/t142, 0)
+    t244 = casadi.if_else((t118 != 0), -(t122 + t136*t243 + t159*t242 - t186*t241 - t217*t240)/t118, 0)
+    t245 = casadi.if_else((t99 != 0), -(t103 - t111*t244 - t129*t243 - t152*t242 - t179*t241 + t210*t240)/t99, 0)
     t246 = t19*t244 + t240 - t245*t31
     t247 = c1*t241 - s1*t242 - t243*t32 + t244*t63 + t245*t60
     t248 = c2*t240 + t20*t241 + t242*t8 + t243*t36 + t244*t61 + t245*t64
-    t249 = t240*t42 + t241*t3 - t242*t6 - t243*t33 + t244*t53 - t245*t51
+    t249 = -t240*t42 - t241*t3 + t242*t6 + t243*t33 - t244*t53 + t245*t51
     t250 = t11*t242 + t23*t241 + t240*t41 + t243*t34 + t244*t56 + t245*t52
-    t251 = -t13*t242 + t240*t44 + t241*t25 - t243*t35 + t244*t54 - t245*t55
+    t251 = t13*t242 - t240*t44 - t241*t25 + t243*t35 - t244*t54 + t245*t55
     t252 = t15*t242 + t240*t46 + t241*t27
     t253 = (casadi.fabs(t66) < casadi.inf)
     t254 = (damping >= 0)
@@ -1420,20 +1420,20 @@ def _velocity_ik(q, mu_dot, damping):
     t256 = casadi.logic_or(casadi.logic_or(casadi.logic_or(casadi.logic_or(casadi.logic_or((t117 <= t255), (t141 <= t255)), (t169 <= t255)), (t200 <= t255)), (t235 <= t255)), (t98 <= t255))
     t257 = casadi.logic_and(casadi.logic_and(t253, t254), casadi.logic_not(t256))
     q_dot = casadi.SX(7, 1)
-    q_dot[0, 0] = casadi.if_else(t257, -t246, 0)
-    q_dot[1, 0] = casadi.if_else(t257, -t247, 0)
-    q_dot[2, 0] = casadi.if_else(t257, -t248, 0)
+    q_dot[0, 0] = casadi.if_else(t257, t246, 0)
+    q_dot[1, 0] = casadi.if_else(t257, t247, 0)
+    q_dot[2, 0] = casadi.if_else(t257, t248, 0)
     q_dot[3, 0] = casadi.if_else(t257, t249, 0)
-    q_dot[4, 0] = casadi.if_else(t257, -t250, 0)
+    q_dot[4, 0] = casadi.if_else(t257, t250, 0)
     q_dot[5, 0] = casadi.if_else(t257, t251, 0)
-    q_dot[6, 0] = casadi.if_else(t257, t252, 0)
+    q_dot[6, 0] = casadi.if_else(t257, -t252, 0)
     status = casadi.SX(1, 1)
     status[0, 0] = casadi.if_else(casadi.logic_not(casadi.logic_and(t253, t254)), 2, casadi.if_else(t256, 1, 0))
     return [q_dot, status]
 
 
 def _ik_numeric_step(target, q, damping):
-    """One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite): 1151 operations."""
+    """One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite): 1162 operations."""
     T00 = target[0, 0]
     T01 = target[0, 1]
     T02 = target[0, 2]
@@ -1756,19 +1756,19 @@ def _ik_numeric_step(target, q, damping):
     t279 = t275 + t278
     t280 = casadi.if_else((t277 > 0), 1/(t277*(t276 + t277)), 0)
     t281 = -t249*t279**2*t280 + t249
-    t282 = t281/t278
-    t283 = (t248 + t274*t282)/t244
-    t284 = (t217 + t240*t283 + t270*t282)/t213
-    t285 = (t189 + t208*t284 + t235*t283 + t265*t282)/t185
-    t286 = (t165 - t179*t285 - t202*t284 + t229*t283 + t259*t282)/t161
-    t287 = (t146 + t154*t286 + t172*t285 + t195*t284 + t222*t283 - t252*t282)/t142
-    t288 = q1 - t28*t286 - t282 + t287*t42
-    t289 = -c1*t283 - c1*t287*t60 + q2 + s1*t284 - s1*t286*t60 + t285*t43
-    t290 = c2*t282 - q3 + t16*t284 + t283*t30 + t285*t47 + t286*t64 + t287*t67
-    t291 = q4 + t282*t50 + t283*t4 - t284*t7 - t285*t44 + t286*t65 - t287*t62
-    t292 = -q5 + t15*t282 + t18*t284 + t283*t32 + t285*t45 + t286*t69 + t287*t63
-    t293 = q6 - t20*t284 + t282*t52 + t283*t34 - t285*t46 + t286*t66 - t287*t68
-    t294 = q7 + t22*t284 + t282*t54 + t283*t36
+    t282 = casadi.if_else((t278 != 0), -t281/t278, 0)
+    t283 = casadi.if_else((t244 != 0), -(t248 - t274*t282)/t244, 0)
+    t284 = casadi.if_else((t213 != 0), -(t217 - t240*t283 - t270*t282)/t213, 0)
+    t285 = casadi.if_else((t185 != 0), -(t189 - t208*t284 - t235*t283 - t265*t282)/t185, 0)
+    t286 = casadi.if_else((t161 != 0), -(t165 + t179*t285 + t202*t284 - t229*t283 - t259*t282)/t161, 0)
+    t287 = casadi.if_else((t142 != 0), -(t146 - t154*t286 - t172*t285 - t195*t284 - t222*t283 + t252*t282)/t142, 0)
+    t288 = q1 + t28*t286 + t282 - t287*t42
+    t289 = c1*t283 + c1*t287*t60 + q2 - s1*t284 + s1*t286*t60 - t285*t43
+    t290 = c2*t282 + q3 + t16*t284 + t283*t30 + t285*t47 + t286*t64 + t287*t67
+    t291 = q4 - t282*t50 - t283*t4 + t284*t7 + t285*t44 - t286*t65 + t287*t62
+    t292 = q5 + t15*t282 + t18*t284 + t283*t32 + t285*t45 + t286*t69 + t287*t63
+    t293 = q6 + t20*t284 - t282*t52 - t283*t34 + t285*t46 - t286*t66 + t287*t68
+    t294 = -q7 + t22*t284 + t282*t54 + t283*t36
     q_start = casadi.SX(7, 1)
     q_start[0, 0] = q1
     q_start[1, 0] = q2
@@ -1780,11 +1780,11 @@ def _ik_numeric_step(target, q, damping):
     q_next = casadi.SX(7, 1)
     q_next[0, 0] = casadi.if_else((t288 < -2.8973), -2.8973, casadi.if_else((t288 > 2.8973), 2.8973, t288))
     q_next[1, 0] = casadi.if_else((t289 < -1.7627999999999997), -1.7627999999999997, casadi.if_else((t289 > 1.7627999999999997), 1.7627999999999997, t289))
-    q_next[2, 0] = casadi.if_else((t290 > 2.8973), -2.8973, casadi.if_else((t290 < -2.8973), 2.8973, -t290))
+    q_next[2, 0] = casadi.if_else((t290 < -2.8973), -2.8973, casadi.if_else((t290 > 2.8973), 2.8973, t290))
     q_next[3, 0] = casadi.if_else((t291 < -3.0718), -3.0718, casadi.if_else((t291 > -0.0698), -0.0698, t291))
-    q_next[4, 0] = casadi.if_else((t292 > 2.8973), -2.8973, casadi.if_else((t292 < -2.8973), 2.8973, -t292))
+    q_next[4, 0] = casadi.if_else((t292 < -2.8973), -2.8973, casadi.if_else((t292 > 2.8973), 2.8973, t292))
     q_next[5, 0] = casadi.if_else((t293 < -0.0175), -0.0175, casadi.if_else((t293 > 3.7525000000000004), 3.7525000000000004, t293))
-    q_next[6, 0] = casadi.if_else((t294 < -2.8973), -2.8973, casadi.if_else((t294 > 2.8973), 2.8973, t294))
+    q_next[6, 0] = casadi.if_else((t294 > 2.8973), -2.8973, casadi.if_else((t294 < -2.8973), 2.8973, -t294))
     cost = casadi.SX(1, 1)
     cost[0, 0] = casadi.if_else((casadi.fabs(t0) < casadi.inf), t139, -1)
     return [q_start, q_next, cost]

@@ -249,7 +249,7 @@ planar_2r_real planar_2r_jacobian_det(const planar_2r_real q[PLANAR_2R_DOF])
 
 int planar_2r_velocity_ik(const planar_2r_real q[PLANAR_2R_DOF], const planar_2r_real mu_dot[PLANAR_2R_TASK_DIM], planar_2r_real damping, planar_2r_real q_dot[PLANAR_2R_DOF])
 {
-    /* 168 operations */
+    /* 174 operations */
 
     /* Inputs */
     const planar_2r_real q1 = q[0];
@@ -299,10 +299,10 @@ int planar_2r_velocity_ik(const planar_2r_real q[PLANAR_2R_DOF], const planar_2r
     const planar_2r_real t32 = t25 + t31;
     const planar_2r_real t33 = (t30 > 0 ? 1/(t30*(t29 + t30)) : 0);
     const planar_2r_real t34 = -t28*t33*(t32*t32) + t28;
-    const planar_2r_real t35 = t34/t31;
-    const planar_2r_real t36 = (-t24*t35 + t27)/t20;
-    const planar_2r_real t37 = -t0*t35 + t1*t36;
-    const planar_2r_real t38 = -c12*t35 + s12*t36;
+    const planar_2r_real t35 = (t31 != 0 ? -t34/t31 : 0);
+    const planar_2r_real t36 = (t20 != 0 ? -(t24*t35 + t27)/t20 : 0);
+    const planar_2r_real t37 = t0*t35 - t1*t36;
+    const planar_2r_real t38 = c12*t35 - s12*t36;
     const planar_2r_real t39 = -t1;
     const planar_2r_real t40 = t39 + t8;
     const planar_2r_real t41 = t9*(c12*t0 - s12*t40);
@@ -318,8 +318,8 @@ int planar_2r_velocity_ik(const planar_2r_real q[PLANAR_2R_DOF], const planar_2r
     const planar_2r_real t51 = t43 + t50;
     const planar_2r_real t52 = (t49 > 0 ? 1/(t49*(t48 + t49)) : 0);
     const planar_2r_real t53 = -t46*t52*(t51*t51) + t46;
-    const planar_2r_real t54 = t53/t50;
-    const planar_2r_real t55 = (-t42*t54 + t45)/t8;
+    const planar_2r_real t54 = (t50 != 0 ? -t53/t50 : 0);
+    const planar_2r_real t55 = (t8 != 0 ? -(t42*t54 + t45)/t8 : 0);
     const int t56 = damping > 0;
     const int t57 = isfinite(t47);
     const int t58 = damping >= 0;
@@ -329,14 +329,14 @@ int planar_2r_velocity_ik(const planar_2r_real q[PLANAR_2R_DOF], const planar_2r
     const int t62 = t57 && t58 && !t61;
 
     /* Outputs */
-    q_dot[0] = (t62 ? (t56 ? t37 : -t55) : 0);
-    q_dot[1] = (t62 ? (t56 ? t38 : -t54) : 0);
+    q_dot[0] = (t62 ? (t56 ? t37 : t55) : 0);
+    q_dot[1] = (t62 ? (t56 ? t38 : t54) : 0);
     return (!(t57 && t58) ? 2 : (t61 ? 1 : 0));
 }
 
 planar_2r_real planar_2r_ik_numeric_step(const planar_2r_real target[PLANAR_2R_TASK_DIM], const planar_2r_real q[PLANAR_2R_DOF], planar_2r_real damping, planar_2r_real q_start[PLANAR_2R_DOF], planar_2r_real q_next[PLANAR_2R_DOF])
 {
-    /* 90 operations */
+    /* 94 operations */
 
     /* Inputs */
     const planar_2r_real mu0 = target[0];
@@ -380,10 +380,10 @@ planar_2r_real planar_2r_ik_numeric_step(const planar_2r_real target[PLANAR_2R_T
     const planar_2r_real t24 = t20 + t23;
     const planar_2r_real t25 = (t22 > 0 ? 1/(t22*(t21 + t22)) : 0);
     const planar_2r_real t26 = -t16*t25*(t24*t24) + t16;
-    const planar_2r_real t27 = t26/t23;
-    const planar_2r_real t28 = (t15 - t19*t27)/t11;
-    const planar_2r_real t29 = q1 - t0*t27 + t1*t28;
-    const planar_2r_real t30 = -c12*t27 + q2 + s12*t28;
+    const planar_2r_real t27 = (t23 != 0 ? -t26/t23 : 0);
+    const planar_2r_real t28 = (t11 != 0 ? -(t15 + t19*t27)/t11 : 0);
+    const planar_2r_real t29 = q1 + t0*t27 - t1*t28;
+    const planar_2r_real t30 = c12*t27 + q2 - s12*t28;
 
     /* Outputs */
     q_start[0] = q1;

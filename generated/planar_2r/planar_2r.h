@@ -66,11 +66,11 @@ planar_2r_real planar_2r_manipulability(const planar_2r_real q[PLANAR_2R_DOF]);
 planar_2r_real planar_2r_jacobian_det(const planar_2r_real q[PLANAR_2R_DOF]);
 
 /* Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status.
- * Result: q_dot[i], i < 2; returned as a scalar. 168 operations. */
+ * Result: q_dot[i], i < 2; returned as a scalar. 174 operations. */
 int planar_2r_velocity_ik(const planar_2r_real q[PLANAR_2R_DOF], const planar_2r_real mu_dot[PLANAR_2R_TASK_DIM], planar_2r_real damping, planar_2r_real q_dot[PLANAR_2R_DOF]);
 
 /* One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite).
- * Result: q_start[i], i < 2; q_next[i], i < 2; returned as a scalar. 90 operations. */
+ * Result: q_start[i], i < 2; q_next[i], i < 2; returned as a scalar. 94 operations. */
 planar_2r_real planar_2r_ik_numeric_step(const planar_2r_real target[PLANAR_2R_TASK_DIM], const planar_2r_real q[PLANAR_2R_DOF], planar_2r_real damping, planar_2r_real q_start[PLANAR_2R_DOF], planar_2r_real q_next[PLANAR_2R_DOF]);
 
 /* Every branch of the closed-form ik and whether the target allows it.

@@ -235,7 +235,7 @@ def jacobian_det(q):
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def velocity_ik(q, mu_dot, damping=0.0):
-    """joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: (2 x 1 and 1 x 1), 168 operations."""
+    """joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: (2 x 1 and 1 x 1), 174 operations."""
     q = _argument("q", q, (2,))
     mu_dot = _argument("mu_dot", mu_dot, (2,))
     damping = _argument("damping", damping, ())
@@ -284,10 +284,10 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t32 = t25 + t31
     t33 = numpy.where(numpy.greater(t30, 0), 1/(t30*(t29 + t30)), 0)
     t34 = -t28*t32**2*t33 + t28
-    t35 = t34/t31
-    t36 = (-t24*t35 + t27)/t20
-    t37 = -t0*t35 + t1*t36
-    t38 = -c12*t35 + s12*t36
+    t35 = numpy.where(numpy.not_equal(t31, 0), -t34/t31, 0)
+    t36 = numpy.where(numpy.not_equal(t20, 0), -(t24*t35 + t27)/t20, 0)
+    t37 = t0*t35 - t1*t36
+    t38 = c12*t35 - s12*t36
     t39 = -t1
     t40 = t39 + t8
     t41 = t9*(c12*t0 - s12*t40)
@@ -303,8 +303,8 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t51 = t43 + t50
     t52 = numpy.where(numpy.greater(t49, 0), 1/(t49*(t48 + t49)), 0)
     t53 = -t46*t51**2*t52 + t46
-    t54 = t53/t50
-    t55 = (-t42*t54 + t45)/t8
+    t54 = numpy.where(numpy.not_equal(t50, 0), -t53/t50, 0)
+    t55 = numpy.where(numpy.not_equal(t8, 0), -(t42*t54 + t45)/t8, 0)
     t56 = numpy.greater(damping, 0)
     t57 = numpy.isfinite(t47)
     t58 = numpy.greater_equal(damping, 0)
@@ -313,8 +313,8 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t61 = (t56 & ((numpy.less_equal(t19, t60)) | (numpy.less_equal(t30, t60)))) | ((numpy.less_equal(damping, 0)) & ((numpy.less_equal(t49, t59)) | (numpy.less_equal(t7, t59))))
     t62 = t57 & t58 & numpy.logical_not(t61)
     q_dot = numpy.empty(numpy.broadcast_shapes(q.shape[:-1], mu_dot.shape[:-1], damping.shape) + (2,))
-    q_dot[..., 0] = numpy.where(t62, numpy.where(t56, t37, -t55), 0)
-    q_dot[..., 1] = numpy.where(t62, numpy.where(t56, t38, -t54), 0)
+    q_dot[..., 0] = numpy.where(t62, numpy.where(t56, t37, t55), 0)
+    q_dot[..., 1] = numpy.where(t62, numpy.where(t56, t38, t54), 0)
     status = numpy.empty(numpy.broadcast_shapes(q.shape[:-1], mu_dot.shape[:-1], damping.shape) + (), dtype=int)
     status[...] = numpy.where(numpy.logical_not(t57 & t58), 2, numpy.where(t61, 1, 0))
     return q_dot, status
@@ -322,7 +322,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def ik_numeric_step(target, q, damping=0.0):
-    """one step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite): (2 x 1 and 2 x 1 and 1 x 1), 90 operations."""
+    """one step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite): (2 x 1 and 2 x 1 and 1 x 1), 94 operations."""
     target = _argument("target", target, (2,))
     q = _argument("q", q, (2,))
     damping = _argument("damping", damping, ())
@@ -365,10 +365,10 @@ def ik_numeric_step(target, q, damping=0.0):
     t24 = t20 + t23
     t25 = numpy.where(numpy.greater(t22, 0), 1/(t22*(t21 + t22)), 0)
     t26 = -t16*t24**2*t25 + t16
-    t27 = t26/t23
-    t28 = (t15 - t19*t27)/t11
-    t29 = q1 - t0*t27 + t1*t28
-    t30 = -c12*t27 + q2 + s12*t28
+    t27 = numpy.where(numpy.not_equal(t23, 0), -t26/t23, 0)
+    t28 = numpy.where(numpy.not_equal(t11, 0), -(t15 + t19*t27)/t11, 0)
+    t29 = q1 + t0*t27 - t1*t28
+    t30 = c12*t27 + q2 - s12*t28
     q_start = numpy.empty(numpy.broadcast_shapes(target.shape[:-1], q.shape[:-1], damping.shape) + (2,))
     q_start[..., 0] = q1
     q_start[..., 1] = q2

@@ -180,7 +180,7 @@ def _jacobian_det(q):
 
 
 def _velocity_ik(q, mu_dot, damping):
-    """Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: 168 operations."""
+    """Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: 174 operations."""
     q1 = q[0]
     q2 = q[1]
     mu_dot0 = mu_dot[0]
@@ -226,10 +226,10 @@ def _velocity_ik(q, mu_dot, damping):
     t32 = t25 + t31
     t33 = casadi.if_else((t30 > 0), 1/(t30*(t29 + t30)), 0)
     t34 = -t28*t32**2*t33 + t28
-    t35 = t34/t31
-    t36 = (-t24*t35 + t27)/t20
-    t37 = -t0*t35 + t1*t36
-    t38 = -c12*t35 + s12*t36
+    t35 = casadi.if_else((t31 != 0), -t34/t31, 0)
+    t36 = casadi.if_else((t20 != 0), -(t24*t35 + t27)/t20, 0)
+    t37 = t0*t35 - t1*t36
+    t38 = c12*t35 - s12*t36
     t39 = -t1
     t40 = t39 + t8
     t41 = t9*(c12*t0 - s12*t40)
@@ -245,8 +245,8 @@ def _velocity_ik(q, mu_dot, damping):
     t51 = t43 + t50
     t52 = casadi.if_else((t49 > 0), 1/(t49*(t48 + t49)), 0)
     t53 = -t46*t51**2*t52 + t46
-    t54 = t53/t50
-    t55 = (-t42*t54 + t45)/t8
+    t54 = casadi.if_else((t50 != 0), -t53/t50, 0)
+    t55 = casadi.if_else((t8 != 0), -(t42*t54 + t45)/t8, 0)
     t56 = (damping > 0)
     t57 = (casadi.fabs(t47) < casadi.inf)
     t58 = (damping >= 0)
@@ -255,15 +255,15 @@ def _velocity_ik(q, mu_dot, damping):
     t61 = casadi.logic_or(casadi.logic_and(t56, casadi.logic_or((t19 <= t60), (t30 <= t60))), casadi.logic_and((damping <= 0), casadi.logic_or((t49 <= t59), (t7 <= t59))))
     t62 = casadi.logic_and(casadi.logic_and(t57, t58), casadi.logic_not(t61))
     q_dot = casadi.SX(2, 1)
-    q_dot[0, 0] = casadi.if_else(t62, casadi.if_else(t56, t37, -t55), 0)
-    q_dot[1, 0] = casadi.if_else(t62, casadi.if_else(t56, t38, -t54), 0)
+    q_dot[0, 0] = casadi.if_else(t62, casadi.if_else(t56, t37, t55), 0)
+    q_dot[1, 0] = casadi.if_else(t62, casadi.if_else(t56, t38, t54), 0)
     status = casadi.SX(1, 1)
     status[0, 0] = casadi.if_else(casadi.logic_not(casadi.logic_and(t57, t58)), 2, casadi.if_else(t61, 1, 0))
     return [q_dot, status]
 
 
 def _ik_numeric_step(target, q, damping):
-    """One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite): 90 operations."""
+    """One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite): 94 operations."""
     mu0 = target[0]
     mu1 = target[1]
     qs1 = q[0]
@@ -303,10 +303,10 @@ def _ik_numeric_step(target, q, damping):
     t24 = t20 + t23
     t25 = casadi.if_else((t22 > 0), 1/(t22*(t21 + t22)), 0)
     t26 = -t16*t24**2*t25 + t16
-    t27 = t26/t23
-    t28 = (t15 - t19*t27)/t11
-    t29 = q1 - t0*t27 + t1*t28
-    t30 = -c12*t27 + q2 + s12*t28
+    t27 = casadi.if_else((t23 != 0), -t26/t23, 0)
+    t28 = casadi.if_else((t11 != 0), -(t15 + t19*t27)/t11, 0)
+    t29 = q1 + t0*t27 - t1*t28
+    t30 = c12*t27 + q2 - s12*t28
     q_start = casadi.SX(2, 1)
     q_start[0, 0] = q1
     q_start[1, 0] = q2

@@ -338,7 +338,7 @@ planar_3r_real planar_3r_jacobian_det(const planar_3r_real q[PLANAR_3R_DOF])
 
 int planar_3r_velocity_ik(const planar_3r_real q[PLANAR_3R_DOF], const planar_3r_real mu_dot[PLANAR_3R_TASK_DIM], planar_3r_real damping, planar_3r_real q_dot[PLANAR_3R_DOF])
 {
-    /* 323 operations */
+    /* 329 operations */
 
     /* Inputs */
     const planar_3r_real q1 = q[0];
@@ -417,9 +417,9 @@ int planar_3r_velocity_ik(const planar_3r_real q[PLANAR_3R_DOF], const planar_3r
     const planar_3r_real t55 = t51 + t54;
     const planar_3r_real t56 = (t53 > 0 ? 1/(t53*(t52 + t53)) : 0);
     const planar_3r_real t57 = -t42*t56*(t55*t55) + t42;
-    const planar_3r_real t58 = t57/t54;
-    const planar_3r_real t59 = (t41 + t50*t58)/t37;
-    const planar_3r_real t60 = (t28 - t33*t59 - t46*t58)/t24;
+    const planar_3r_real t58 = (t54 != 0 ? -t57/t54 : 0);
+    const planar_3r_real t59 = (t37 != 0 ? -(t41 - t50*t58)/t37 : 0);
+    const planar_3r_real t60 = (t24 != 0 ? -(t28 + t33*t59 + t46*t58)/t24 : 0);
     const planar_3r_real t61 = t2*t59 - t3*t60 + t58;
     const planar_3r_real t62 = t0*t59 - t1*t60 + t58;
     const planar_3r_real t63 = c123*t59 - s123*t60 + t58;
@@ -454,9 +454,9 @@ int planar_3r_velocity_ik(const planar_3r_real q[PLANAR_3R_DOF], const planar_3r
     const planar_3r_real t92 = t84 + t91;
     const planar_3r_real t93 = (t90 > 0 ? 1/(t90*(t89 + t90)) : 0);
     const planar_3r_real t94 = -t87*t93*(t92*t92) + t87;
-    const planar_3r_real t95 = t94/t91;
-    const planar_3r_real t96 = (t83*t95 + t86)/t79;
-    const planar_3r_real t97 = (-t67*t96 - t71*t95 + t75)/t11;
+    const planar_3r_real t95 = (t91 != 0 ? -t94/t91 : 0);
+    const planar_3r_real t96 = (t79 != 0 ? -(-t83*t95 + t86)/t79 : 0);
+    const planar_3r_real t97 = (t11 != 0 ? -(t67*t96 + t71*t95 + t75)/t11 : 0);
     const int t98 = damping > 0;
     const int t99 = isfinite(t88);
     const int t100 = damping >= 0;
@@ -466,15 +466,15 @@ int planar_3r_velocity_ik(const planar_3r_real q[PLANAR_3R_DOF], const planar_3r
     const int t104 = t100 && t99 && !t103;
 
     /* Outputs */
-    q_dot[0] = (t104 ? (t98 ? -t61 : -t97) : 0);
-    q_dot[1] = (t104 ? (t98 ? -t62 : -t96) : 0);
-    q_dot[2] = (t104 ? (t98 ? -t63 : -t95) : 0);
+    q_dot[0] = (t104 ? (t98 ? t61 : t97) : 0);
+    q_dot[1] = (t104 ? (t98 ? t62 : t96) : 0);
+    q_dot[2] = (t104 ? (t98 ? t63 : t95) : 0);
     return (!(t100 && t99) ? 2 : (t103 ? 1 : 0));
 }
 
 planar_3r_real planar_3r_ik_numeric_step(const planar_3r_real target[PLANAR_3R_TASK_DIM], const planar_3r_real q[PLANAR_3R_DOF], planar_3r_real damping, planar_3r_real q_start[PLANAR_3R_DOF], planar_3r_real q_next[PLANAR_3R_DOF])
 {
-    /* 189 operations */
+    /* 194 operations */
 
     /* Inputs */
     const planar_3r_real mu0 = target[0];
@@ -548,21 +548,20 @@ planar_3r_real planar_3r_ik_numeric_step(const planar_3r_real target[PLANAR_3R_T
     const planar_3r_real t47 = t43 + t46;
     const planar_3r_real t48 = (t45 > 0 ? 1/(t45*(t44 + t45)) : 0);
     const planar_3r_real t49 = -t35*t48*(t47*t47) + t35;
-    const planar_3r_real t50 = t49/t46;
-    const planar_3r_real t51 = (t34 + t42*t50)/t30;
-    const planar_3r_real t52 = (t21 - t26*t51 - t38*t50)/t17;
-    const planar_3r_real t53 = -t50;
-    const planar_3r_real t54 = q1 - t2*t51 + t3*t52 + t53;
-    const planar_3r_real t55 = q2 - t0*t51 + t1*t52 + t53;
-    const planar_3r_real t56 = -c123*t51 + q3 + s123*t52 + t53;
+    const planar_3r_real t50 = (t46 != 0 ? -t49/t46 : 0);
+    const planar_3r_real t51 = (t30 != 0 ? -(t34 - t42*t50)/t30 : 0);
+    const planar_3r_real t52 = (t17 != 0 ? -(t21 + t26*t51 + t38*t50)/t17 : 0);
+    const planar_3r_real t53 = q1 + t2*t51 - t3*t52 + t50;
+    const planar_3r_real t54 = q2 + t0*t51 - t1*t52 + t50;
+    const planar_3r_real t55 = c123*t51 + q3 - s123*t52 + t50;
 
     /* Outputs */
     q_start[0] = q1;
     q_start[1] = q2;
     q_start[2] = q3;
-    q_next[0] = t54;
-    q_next[1] = t55;
-    q_next[2] = t56;
+    q_next[0] = t53;
+    q_next[1] = t54;
+    q_next[2] = t55;
     return (isfinite(t11) ? t14 : -1);
 }
 

@@ -68,11 +68,11 @@ planar_3r_real planar_3r_manipulability(const planar_3r_real q[PLANAR_3R_DOF]);
 planar_3r_real planar_3r_jacobian_det(const planar_3r_real q[PLANAR_3R_DOF]);
 
 /* Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status.
- * Result: q_dot[i], i < 3; returned as a scalar. 323 operations. */
+ * Result: q_dot[i], i < 3; returned as a scalar. 329 operations. */
 int planar_3r_velocity_ik(const planar_3r_real q[PLANAR_3R_DOF], const planar_3r_real mu_dot[PLANAR_3R_TASK_DIM], planar_3r_real damping, planar_3r_real q_dot[PLANAR_3R_DOF]);
 
 /* One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite).
- * Result: q_start[i], i < 3; q_next[i], i < 3; returned as a scalar. 189 operations. */
+ * Result: q_start[i], i < 3; q_next[i], i < 3; returned as a scalar. 194 operations. */
 planar_3r_real planar_3r_ik_numeric_step(const planar_3r_real target[PLANAR_3R_TASK_DIM], const planar_3r_real q[PLANAR_3R_DOF], planar_3r_real damping, planar_3r_real q_start[PLANAR_3R_DOF], planar_3r_real q_next[PLANAR_3R_DOF]);
 
 /* Every branch of the closed-form ik and whether the target allows it.

@@ -324,7 +324,7 @@ def jacobian_det(q):
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def velocity_ik(q, mu_dot, damping=0.0):
-    """joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: (3 x 1 and 1 x 1), 323 operations."""
+    """joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: (3 x 1 and 1 x 1), 329 operations."""
     q = _argument("q", q, (3,))
     mu_dot = _argument("mu_dot", mu_dot, (3,))
     damping = _argument("damping", damping, ())
@@ -402,9 +402,9 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t55 = t51 + t54
     t56 = numpy.where(numpy.greater(t53, 0), 1/(t53*(t52 + t53)), 0)
     t57 = -t42*t55**2*t56 + t42
-    t58 = t57/t54
-    t59 = (t41 + t50*t58)/t37
-    t60 = (t28 - t33*t59 - t46*t58)/t24
+    t58 = numpy.where(numpy.not_equal(t54, 0), -t57/t54, 0)
+    t59 = numpy.where(numpy.not_equal(t37, 0), -(t41 - t50*t58)/t37, 0)
+    t60 = numpy.where(numpy.not_equal(t24, 0), -(t28 + t33*t59 + t46*t58)/t24, 0)
     t61 = t2*t59 - t3*t60 + t58
     t62 = t0*t59 - t1*t60 + t58
     t63 = c123*t59 - s123*t60 + t58
@@ -439,9 +439,9 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t92 = t84 + t91
     t93 = numpy.where(numpy.greater(t90, 0), 1/(t90*(t89 + t90)), 0)
     t94 = -t87*t92**2*t93 + t87
-    t95 = t94/t91
-    t96 = (t83*t95 + t86)/t79
-    t97 = (-t67*t96 - t71*t95 + t75)/t11
+    t95 = numpy.where(numpy.not_equal(t91, 0), -t94/t91, 0)
+    t96 = numpy.where(numpy.not_equal(t79, 0), -(-t83*t95 + t86)/t79, 0)
+    t97 = numpy.where(numpy.not_equal(t11, 0), -(t67*t96 + t71*t95 + t75)/t11, 0)
     t98 = numpy.greater(damping, 0)
     t99 = numpy.isfinite(t88)
     t100 = numpy.greater_equal(damping, 0)
@@ -450,9 +450,9 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t103 = (t98 & ((numpy.less_equal(t23, t102)) | (numpy.less_equal(t36, t102)) | (numpy.less_equal(t53, t102)))) | ((numpy.less_equal(damping, 0)) & ((numpy.less_equal(t10, t101)) | (numpy.less_equal(t78, t101)) | (numpy.less_equal(t90, t101))))
     t104 = t100 & t99 & numpy.logical_not(t103)
     q_dot = numpy.empty(numpy.broadcast_shapes(q.shape[:-1], mu_dot.shape[:-1], damping.shape) + (3,))
-    q_dot[..., 0] = numpy.where(t104, numpy.where(t98, -t61, -t97), 0)
-    q_dot[..., 1] = numpy.where(t104, numpy.where(t98, -t62, -t96), 0)
-    q_dot[..., 2] = numpy.where(t104, numpy.where(t98, -t63, -t95), 0)
+    q_dot[..., 0] = numpy.where(t104, numpy.where(t98, t61, t97), 0)
+    q_dot[..., 1] = numpy.where(t104, numpy.where(t98, t62, t96), 0)
+    q_dot[..., 2] = numpy.where(t104, numpy.where(t98, t63, t95), 0)
     status = numpy.empty(numpy.broadcast_shapes(q.shape[:-1], mu_dot.shape[:-1], damping.shape) + (), dtype=int)
     status[...] = numpy.where(numpy.logical_not(t100 & t99), 2, numpy.where(t103, 1, 0))
     return q_dot, status
@@ -460,7 +460,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def ik_numeric_step(target, q, damping=0.0):
-    """one step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite): (3 x 1 and 3 x 1 and 1 x 1), 189 operations."""
+    """one step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite): (3 x 1 and 3 x 1 and 1 x 1), 194 operations."""
     target = _argument("target", target, (3,))
     q = _argument("q", q, (3,))
     damping = _argument("damping", damping, ())
@@ -533,21 +533,20 @@ def ik_numeric_step(target, q, damping=0.0):
     t47 = t43 + t46
     t48 = numpy.where(numpy.greater(t45, 0), 1/(t45*(t44 + t45)), 0)
     t49 = -t35*t47**2*t48 + t35
-    t50 = t49/t46
-    t51 = (t34 + t42*t50)/t30
-    t52 = (t21 - t26*t51 - t38*t50)/t17
-    t53 = -t50
-    t54 = q1 - t2*t51 + t3*t52 + t53
-    t55 = q2 - t0*t51 + t1*t52 + t53
-    t56 = -c123*t51 + q3 + s123*t52 + t53
+    t50 = numpy.where(numpy.not_equal(t46, 0), -t49/t46, 0)
+    t51 = numpy.where(numpy.not_equal(t30, 0), -(t34 - t42*t50)/t30, 0)
+    t52 = numpy.where(numpy.not_equal(t17, 0), -(t21 + t26*t51 + t38*t50)/t17, 0)
+    t53 = q1 + t2*t51 - t3*t52 + t50
+    t54 = q2 + t0*t51 - t1*t52 + t50
+    t55 = c123*t51 + q3 - s123*t52 + t50
     q_start = numpy.empty(numpy.broadcast_shapes(target.shape[:-1], q.shape[:-1], damping.shape) + (3,))
     q_start[..., 0] = q1
     q_start[..., 1] = q2
     q_start[..., 2] = q3
     q_next = numpy.empty(numpy.broadcast_shapes(target.shape[:-1], q.shape[:-1], damping.shape) + (3,))
-    q_next[..., 0] = t54
-    q_next[..., 1] = t55
-    q_next[..., 2] = t56
+    q_next[..., 0] = t53
+    q_next[..., 1] = t54
+    q_next[..., 2] = t55
     cost = numpy.empty(numpy.broadcast_shapes(target.shape[:-1], q.shape[:-1], damping.shape) + ())
     cost[...] = numpy.where(numpy.isfinite(t11), t14, -1)
     return q_start, q_next, cost

@@ -260,7 +260,7 @@ def _jacobian_det(q):
 
 
 def _velocity_ik(q, mu_dot, damping):
-    """Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: 323 operations."""
+    """Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: 329 operations."""
     q1 = q[0]
     q2 = q[1]
     q3 = q[2]
@@ -335,9 +335,9 @@ def _velocity_ik(q, mu_dot, damping):
     t55 = t51 + t54
     t56 = casadi.if_else((t53 > 0), 1/(t53*(t52 + t53)), 0)
     t57 = -t42*t55**2*t56 + t42
-    t58 = t57/t54
-    t59 = (t41 + t50*t58)/t37
-    t60 = (t28 - t33*t59 - t46*t58)/t24
+    t58 = casadi.if_else((t54 != 0), -t57/t54, 0)
+    t59 = casadi.if_else((t37 != 0), -(t41 - t50*t58)/t37, 0)
+    t60 = casadi.if_else((t24 != 0), -(t28 + t33*t59 + t46*t58)/t24, 0)
     t61 = t2*t59 - t3*t60 + t58
     t62 = t0*t59 - t1*t60 + t58
     t63 = c123*t59 - s123*t60 + t58
@@ -372,9 +372,9 @@ def _velocity_ik(q, mu_dot, damping):
     t92 = t84 + t91
     t93 = casadi.if_else((t90 > 0), 1/(t90*(t89 + t90)), 0)
     t94 = -t87*t92**2*t93 + t87
-    t95 = t94/t91
-    t96 = (t83*t95 + t86)/t79
-    t97 = (-t67*t96 - t71*t95 + t75)/t11
+    t95 = casadi.if_else((t91 != 0), -t94/t91, 0)
+    t96 = casadi.if_else((t79 != 0), -(-t83*t95 + t86)/t79, 0)
+    t97 = casadi.if_else((t11 != 0), -(t67*t96 + t71*t95 + t75)/t11, 0)
     t98 = (damping > 0)
     t99 = (casadi.fabs(t88) < casadi.inf)
     t100 = (damping >= 0)
@@ -383,16 +383,16 @@ def _velocity_ik(q, mu_dot, damping):
     t103 = casadi.logic_or(casadi.logic_and(t98, casadi.logic_or(casadi.logic_or((t23 <= t102), (t36 <= t102)), (t53 <= t102))), casadi.logic_and((damping <= 0), casadi.logic_or(casadi.logic_or((t10 <= t101), (t78 <= t101)), (t90 <= t101))))
     t104 = casadi.logic_and(casadi.logic_and(t100, t99), casadi.logic_not(t103))
     q_dot = casadi.SX(3, 1)
-    q_dot[0, 0] = casadi.if_else(t104, casadi.if_else(t98, -t61, -t97), 0)
-    q_dot[1, 0] = casadi.if_else(t104, casadi.if_else(t98, -t62, -t96), 0)
-    q_dot[2, 0] = casadi.if_else(t104, casadi.if_else(t98, -t63, -t95), 0)
+    q_dot[0, 0] = casadi.if_else(t104, casadi.if_else(t98, t61, t97), 0)
+    q_dot[1, 0] = casadi.if_else(t104, casadi.if_else(t98, t62, t96), 0)
+    q_dot[2, 0] = casadi.if_else(t104, casadi.if_else(t98, t63, t95), 0)
     status = casadi.SX(1, 1)
     status[0, 0] = casadi.if_else(casadi.logic_not(casadi.logic_and(t100, t99)), 2, casadi.if_else(t103, 1, 0))
     return [q_dot, status]
 
 
 def _ik_numeric_step(target, q, damping):
-    """One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite): 189 operations."""
+    """One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite): 194 operations."""
     mu0 = target[0]
     mu1 = target[1]
     mu2 = target[2]
@@ -462,21 +462,20 @@ def _ik_numeric_step(target, q, damping):
     t47 = t43 + t46
     t48 = casadi.if_else((t45 > 0), 1/(t45*(t44 + t45)), 0)
     t49 = -t35*t47**2*t48 + t35
-    t50 = t49/t46
-    t51 = (t34 + t42*t50)/t30
-    t52 = (t21 - t26*t51 - t38*t50)/t17
-    t53 = -t50
-    t54 = q1 - t2*t51 + t3*t52 + t53
-    t55 = q2 - t0*t51 + t1*t52 + t53
-    t56 = -c123*t51 + q3 + s123*t52 + t53
+    t50 = casadi.if_else((t46 != 0), -t49/t46, 0)
+    t51 = casadi.if_else((t30 != 0), -(t34 - t42*t50)/t30, 0)
+    t52 = casadi.if_else((t17 != 0), -(t21 + t26*t51 + t38*t50)/t17, 0)
+    t53 = q1 + t2*t51 - t3*t52 + t50
+    t54 = q2 + t0*t51 - t1*t52 + t50
+    t55 = c123*t51 + q3 - s123*t52 + t50
     q_start = casadi.SX(3, 1)
     q_start[0, 0] = q1
     q_start[1, 0] = q2
     q_start[2, 0] = q3
     q_next = casadi.SX(3, 1)
-    q_next[0, 0] = t54
-    q_next[1, 0] = t55
-    q_next[2, 0] = t56
+    q_next[0, 0] = t53
+    q_next[1, 0] = t54
+    q_next[2, 0] = t55
     cost = casadi.SX(1, 1)
     cost[0, 0] = casadi.if_else((casadi.fabs(t11) < casadi.inf), t14, -1)
     return [q_start, q_next, cost]

@@ -71,15 +71,15 @@ puma560_real puma560_manipulability(const puma560_real q[PUMA560_DOF]);
 puma560_real puma560_jacobian_det(const puma560_real q[PUMA560_DOF]);
 
 /* Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status.
- * Result: q_dot[i], i < 6; returned as a scalar. 1200 operations. */
+ * Result: q_dot[i], i < 6; returned as a scalar. 1220 operations. */
 int puma560_velocity_ik(const puma560_real q[PUMA560_DOF], const puma560_real mu_dot[PUMA560_TASK_DIM], puma560_real damping, puma560_real q_dot[PUMA560_DOF]);
 
 /* One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite).
- * Result: q_start[i], i < 6; q_next[i], i < 6; returned as a scalar. 909 operations. */
+ * Result: q_start[i], i < 6; q_next[i], i < 6; returned as a scalar. 921 operations. */
 puma560_real puma560_ik_numeric_step(const puma560_real target[16], const puma560_real q[PUMA560_DOF], puma560_real damping, puma560_real q_start[PUMA560_DOF], puma560_real q_next[PUMA560_DOF]);
 
 /* Every branch of the closed-form ik and whether the target allows it.
- * Result: q: 8 x 6 row-major, element (r, c) at q[r * 6 + c]; valid[i], i < 8. 900 operations. */
+ * Result: q: 8 x 6 row-major, element (r, c) at q[r * 6 + c]; valid[i], i < 8. 914 operations. */
 void puma560_ik_branches(const puma560_real T[16], puma560_real q[PUMA560_MAX_IK_SOLUTIONS * PUMA560_DOF], int valid[PUMA560_MAX_IK_SOLUTIONS]);
 
 /* Statuses of puma560_velocity_ik: OK, singular (a diagonal entry of the QR factor R of the

@@ -563,7 +563,7 @@ def _jacobian_det(q):
 
 
 def _velocity_ik(q, mu_dot, damping):
-    """Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: 1200 operations."""
+    """Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: 1220 operations."""
     q1 = q[0]
     q2 = q[1]
     q3 = q[2]
@@ -808,12 +808,12 @@ def _velocity_ik(q, mu_dot, damping):
     t217 = t213 + t216
     t218 = casadi.if_else((t215 > 0), 1/(t215*(t214 + t215)), 0)
     t219 = -t194*t217**2*t218 + t194
-    t220 = t219/t216
-    t221 = (t193 + t212*t220)/t189
-    t222 = (t181*t221 + t185 + t208*t220)/t177
-    t223 = (t162*t222 + t167*t221 + t172 + t203*t220)/t158
-    t224 = (t101 + t129*t221 - t145*t222 - t152*t223 + t197*t220)/t97
-    t225 = (-t108*t223 - t115*t222 + t122*t221 - t137*t220 + t224*t90 + t82)/t78
+    t220 = casadi.if_else((t216 != 0), -t219/t216, 0)
+    t221 = casadi.if_else((t189 != 0), -(t193 - t212*t220)/t189, 0)
+    t222 = casadi.if_else((t177 != 0), -(-t181*t221 + t185 - t208*t220)/t177, 0)
+    t223 = casadi.if_else((t158 != 0), -(-t162*t222 - t167*t221 + t172 - t203*t220)/t158, 0)
+    t224 = casadi.if_else((t97 != 0), -(t101 - t129*t221 + t145*t222 + t152*t223 - t197*t220)/t97, 0)
+    t225 = casadi.if_else((t78 != 0), -(t108*t223 + t115*t222 - t122*t221 + t137*t220 - t224*t90 + t82)/t78, 0)
     t226 = t22*t224 + t220 - t225*t23
     t227 = -c23*t220 + t14*t222 + t17*t221
     t228 = t12*t222 + t220*t62 - t221*t9
@@ -939,12 +939,12 @@ def _velocity_ik(q, mu_dot, damping):
     t348 = t344 + t347
     t349 = casadi.if_else((t346 > 0), 1/(t346*(t345 + t346)), 0)
     t350 = -t331*t348**2*t349 + t331
-    t351 = t350/t347
-    t352 = (t330 + t343*t351)/t326
-    t353 = (t312 + t322*t352 - t339*t351)/t308
-    t354 = (t275 - t303*t353 - t317*t352 - t334*t351)/t271
-    t355 = (-t259*t354 + t265 - t281*t353 - t288*t352 - t295*t351)/t255
-    t356 = (-t236*t247*t353 - t236*t249*t352 - t236*t251*t351 - t238*t355 - t241*t354 + t244)/t44
+    t351 = casadi.if_else((t347 != 0), -t350/t347, 0)
+    t352 = casadi.if_else((t326 != 0), -(t330 - t343*t351)/t326, 0)
+    t353 = casadi.if_else((t308 != 0), -(t312 - t322*t352 + t339*t351)/t308, 0)
+    t354 = casadi.if_else((t271 != 0), -(t275 + t303*t353 + t317*t352 + t334*t351)/t271, 0)
+    t355 = casadi.if_else((t255 != 0), -(t259*t354 + t265 + t281*t353 + t288*t352 + t295*t351)/t255, 0)
+    t356 = casadi.if_else((t44 != 0), -(t236*t247*t353 + t236*t249*t352 + t236*t251*t351 + t238*t355 + t241*t354 + t244)/t44, 0)
     t357 = (damping > 0)
     t358 = (casadi.fabs(t300) < casadi.inf)
     t359 = (damping >= 0)
@@ -953,19 +953,19 @@ def _velocity_ik(q, mu_dot, damping):
     t362 = casadi.logic_or(casadi.logic_and(t357, casadi.logic_or(casadi.logic_or(casadi.logic_or(casadi.logic_or(casadi.logic_or((t157 <= t361), (t176 <= t361)), (t188 <= t361)), (t215 <= t361)), (t77 <= t361)), (t96 <= t361))), casadi.logic_and((damping <= 0), casadi.logic_or(casadi.logic_or(casadi.logic_or(casadi.logic_or(casadi.logic_or((t254 <= t360), (t270 <= t360)), (t307 <= t360)), (t325 <= t360)), (t346 <= t360)), (t43 <= t360))))
     t363 = casadi.logic_and(casadi.logic_and(t358, t359), casadi.logic_not(t362))
     q_dot = casadi.SX(6, 1)
-    q_dot[0, 0] = casadi.if_else(t363, casadi.if_else(t357, -t226, -t356), 0)
-    q_dot[1, 0] = casadi.if_else(t363, casadi.if_else(t357, t232, -t355), 0)
-    q_dot[2, 0] = casadi.if_else(t363, casadi.if_else(t357, t234, -t354), 0)
-    q_dot[3, 0] = casadi.if_else(t363, casadi.if_else(t357, t227, -t353), 0)
-    q_dot[4, 0] = casadi.if_else(t363, casadi.if_else(t357, -t228, -t352), 0)
-    q_dot[5, 0] = casadi.if_else(t363, casadi.if_else(t357, t229, -t351), 0)
+    q_dot[0, 0] = casadi.if_else(t363, casadi.if_else(t357, t226, t356), 0)
+    q_dot[1, 0] = casadi.if_else(t363, casadi.if_else(t357, -t232, t355), 0)
+    q_dot[2, 0] = casadi.if_else(t363, casadi.if_else(t357, -t234, t354), 0)
+    q_dot[3, 0] = casadi.if_else(t363, casadi.if_else(t357, -t227, t353), 0)
+    q_dot[4, 0] = casadi.if_else(t363, casadi.if_else(t357, t228, t352), 0)
+    q_dot[5, 0] = casadi.if_else(t363, casadi.if_else(t357, -t229, t351), 0)
     status = casadi.SX(1, 1)
     status[0, 0] = casadi.if_else(casadi.logic_not(casadi.logic_and(t358, t359)), 2, casadi.if_else(t362, 1, 0))
     return [q_dot, status]
 
 
 def _ik_numeric_step(target, q, damping):
-    """One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite): 909 operations."""
+    """One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite): 921 operations."""
     T00 = target[0, 0]
     T01 = target[0, 1]
     T02 = target[0, 2]
@@ -1247,21 +1247,21 @@ def _ik_numeric_step(target, q, damping):
     t240 = t236 + t239
     t241 = casadi.if_else((t238 > 0), 1/(t238*(t237 + t238)), 0)
     t242 = -t217*t240**2*t241 + t217
-    t243 = t242/t239
-    t244 = (t216 + t235*t243)/t212
-    t245 = (t204*t244 + t208 + t231*t243)/t200
-    t246 = (t185*t245 + t190*t244 + t195 + t226*t243)/t181
-    t247 = (t125 - t147*t245 + t161*t244 - t175*t246 + t220*t243)/t121
-    t248 = (t106 + t114*t247 - t132*t246 - t139*t245 + t154*t244 - t168*t243)/t102
-    t249 = q1 - t243 - t247*t51 + t248*t52
-    t250 = -c23*t243 + q4 + t16*t245 + t244*t25
-    t251 = q5 + t11*t244 - t14*t245 - t243*t39
-    t252 = q6 + t18*t245 - t243*t38 + t244*t27
+    t243 = casadi.if_else((t239 != 0), -t242/t239, 0)
+    t244 = casadi.if_else((t212 != 0), -(t216 - t235*t243)/t212, 0)
+    t245 = casadi.if_else((t200 != 0), -(-t204*t244 + t208 - t231*t243)/t200, 0)
+    t246 = casadi.if_else((t181 != 0), -(-t185*t245 - t190*t244 + t195 - t226*t243)/t181, 0)
+    t247 = casadi.if_else((t121 != 0), -(t125 + t147*t245 - t161*t244 + t175*t246 - t220*t243)/t121, 0)
+    t248 = casadi.if_else((t102 != 0), -(t106 - t114*t247 + t132*t246 + t139*t245 - t154*t244 + t168*t243)/t102, 0)
+    t249 = q1 + t243 + t247*t51 - t248*t52
+    t250 = c23*t243 + q4 - t16*t245 - t244*t25
+    t251 = q5 - t11*t244 + t14*t245 + t243*t39
+    t252 = q6 - t18*t245 + t243*t38 - t244*t27
     t253 = s1*t247
     t254 = c1*t248
-    t255 = c1*t244 - s1*t245
-    t256 = q2 + t1*t253 + t1*t254 - t246*t53 + t255
-    t257 = q3 + t0*t253 + t0*t254 - t246*t31 + t255
+    t255 = -c1*t244 + s1*t245
+    t256 = q2 - t1*t253 - t1*t254 + t246*t53 + t255
+    t257 = q3 - t0*t253 - t0*t254 + t246*t31 + t255
     q_start = casadi.SX(6, 1)
     q_start[0, 0] = q1
     q_start[1, 0] = q2
@@ -1282,7 +1282,7 @@ def _ik_numeric_step(target, q, damping):
 
 
 def _ik_branches(T):
-    """Every branch of the closed-form ik and whether the target allows it: 900 operations."""
+    """Every branch of the closed-form ik and whether the target allows it: 914 operations."""
     T00 = T[0, 0]
     T01 = T[0, 1]
     T02 = T[0, 2]
@@ -1295,83 +1295,83 @@ def _ik_branches(T):
     T21 = T[2, 1]
     T22 = T[2, 2]
     T23 = T[2, 3]
-    t0 = 5.357415379007653
-    t1 = 1.6177742431429796
-    t2 = T00 + T01 + T02 + T03 + T10 + T11 + T12 + T13 + T20 + T21 + T22 + T23
-    t3 = 0.4521*T00 - 0.15005*T01 + 1.10363*T02
-    t4 = T03 - t3
-    t5 = t3
-    t6 = t4 + t5
-    t7 = 0.4521*T10 - 0.15005*T11 + 1.10363*T12
-    t8 = T13 - t7
-    t9 = t7
-    t10 = t8 + t9
-    t11 = casadi.atan2(t6, -t10)
-    t12 = 0.4521*T20 - 0.15005*T21 + 1.10363*T22
-    t13 = T23 - t12
-    t14 = t12
-    t15 = t13 + t14
-    t16 = t10**2 + t6**2
-    t17 = t16
-    t18 = t15**2 + t16
-    t19 = 1/casadi.sqrt(t17)
-    t20 = 1 - 0.0225150025*t19**2
-    t21 = (1e-12 < t20)
-    t22 = casadi.if_else(t21, 0.15005*t19, casadi.if_else((t19 > 0), 1, -1))
-    t23 = casadi.if_else(t21, casadi.sqrt(t20), 0)
-    t24 = casadi.atan2(t23, t22)
-    t25 = t11 - t24
-    t26 = 1e-24*t18
-    t27 = (t17 <= t26)
-    t28 = casadi.if_else(t27, 0, t11 + t24)
-    t29 = t19*t6
-    t30 = t23*t29
-    t31 = t10*t19
-    t32 = t22*t31
-    t33 = casadi.if_else(t27, 1, -t30 - t32)
-    t34 = t30 - t32
-    t35 = t22*t29
-    t36 = t23*t31
-    t37 = casadi.if_else(t27, 0, t35 - t36)
-    t38 = t35 + t36
-    t39 = t10*t37 + t33*t6
-    t40 = t10*t33 - t37*t6
-    t41 = T02*t33 + T12*t37
-    t42 = -T02*t37 + T12*t33
-    t43 = T00*t33 + T10*t37
-    t44 = -T00*t37 + T10*t33
-    t45 = t10*t38 + t34*t6
-    t46 = t10*t34 - t38*t6
-    t47 = T02*t34 + T12*t38
-    t48 = -T02*t38 + T12*t34
-    t49 = T00*t34 + T10*t38
-    t50 = -T00*t38 + T10*t34
-    t51 = 1 - t33
-    t52 = t15*t51
-    t53 = t15*t33 + t52
-    t54 = t53 - 0.67183
-    t55 = t39**2 + t40**2 + t54**2
-    t56 = 0.19791478625 - 0.5*t55
-    t57 = T22*t51
-    t58 = T22*t33 + t57
-    t59 = T20*t51
-    t60 = T20*t33 + t59
-    t61 = t56**2
-    t62 = t0**2
-    t63 = -t61*t62 + 1
-    t64 = t0*t56
-    t65 = (1e-12 < t63)
-    t66 = casadi.if_else(t65, t64, casadi.if_else((t64 > 0), 1, -1))
-    t67 = casadi.if_else(t65, casadi.sqrt(t63), 0)
-    t68 = casadi.atan2(t67, t66)
-    t69 = t1 - t68
-    t70 = False
-    t71 = casadi.if_else(t70, 0, t1 + t68)
-    t72 = t0*t66
+    t0 = 1.6177742431429796
+    t1 = T00 + T01 + T02 + T03 + T10 + T11 + T12 + T13 + T20 + T21 + T22 + T23
+    t2 = 0.4521*T00 - 0.15005*T01 + 1.10363*T02
+    t3 = T03 - t2
+    t4 = t2
+    t5 = t3 + t4
+    t6 = 0.4521*T10 - 0.15005*T11 + 1.10363*T12
+    t7 = T13 - t6
+    t8 = t6
+    t9 = t7 + t8
+    t10 = casadi.atan2(t5, -t9)
+    t11 = 0.4521*T20 - 0.15005*T21 + 1.10363*T22
+    t12 = T23 - t11
+    t13 = t11
+    t14 = t12 + t13
+    t15 = t5**2 + t9**2
+    t16 = t15
+    t17 = t14**2 + t15
+    t18 = 1e-24*t17
+    t19 = (t16 <= t18)
+    t20 = casadi.if_else(t19, 1, 1/casadi.sqrt(t16))
+    t21 = 1 - 0.0225150025*t20**2
+    t22 = (1e-12 < t21)
+    t23 = casadi.if_else(t22, 0.15005*t20, casadi.if_else((t20 > 0), 1, -1))
+    t24 = casadi.if_else(t22, casadi.sqrt(t21), 0)
+    t25 = casadi.atan2(t24, t23)
+    t26 = casadi.if_else(t19, 0, t10 + t25)
+    t27 = t10 - t25
+    t28 = t20*t5
+    t29 = t24*t28
+    t30 = t20*t9
+    t31 = t23*t30
+    t32 = casadi.if_else(t19, 1, -t29 - t31)
+    t33 = t29 - t31
+    t34 = t23*t28
+    t35 = t24*t30
+    t36 = casadi.if_else(t19, 0, t34 - t35)
+    t37 = t34 + t35
+    t38 = t32*t5 + t36*t9
+    t39 = t32*t9 - t36*t5
+    t40 = T02*t32 + T12*t36
+    t41 = -T02*t36 + T12*t32
+    t42 = T00*t32 + T10*t36
+    t43 = -T00*t36 + T10*t32
+    t44 = t33*t5 + t37*t9
+    t45 = t33*t9 - t37*t5
+    t46 = T02*t33 + T12*t37
+    t47 = -T02*t37 + T12*t33
+    t48 = T00*t33 + T10*t37
+    t49 = -T00*t37 + T10*t33
+    t50 = 1 - t32
+    t51 = t14*t50
+    t52 = t14*t32 + t51
+    t53 = t52 - 0.67183
+    t54 = t38**2 + t39**2 + t53**2
+    t55 = 0.19791478625 - 0.5*t54
+    t56 = T22*t50
+    t57 = T22*t32 + t56
+    t58 = T20*t50
+    t59 = T20*t32 + t58
+    t60 = False
+    t61 = casadi.if_else(t60, 1, 5.357415379007653)
+    t62 = t55**2
+    t63 = t61**2
+    t64 = -t62*t63 + 1
+    t65 = t55*t61
+    t66 = (1e-12 < t64)
+    t67 = casadi.if_else(t66, t65, casadi.if_else((t65 > 0), 1, -1))
+    t68 = casadi.if_else(t66, casadi.sqrt(t64), 0)
+    t69 = casadi.atan2(t68, t67)
+    t70 = casadi.if_else(t60, 0, t0 + t69)
+    t71 = t0 - t69
+    t72 = t61*t67
     t73 = 0.00876554*t72
-    t74 = t0*t67
+    t74 = t61*t68
     t75 = 0.18645124*t74
-    t76 = casadi.if_else(t70, 1, -t73 - t75)
+    t76 = casadi.if_else(t60, 1, -t73 - t75)
     t77 = -t73 + t75
     t78 = 0.15005 - 0.15005*t76
     t79 = 0.15005*t76 + t78
@@ -1379,42 +1379,42 @@ def _ik_branches(T):
     t81 = 0.15005*t77 + t80
     t82 = 0.18645124*t72
     t83 = 0.00876554*t74
-    t84 = casadi.if_else(t70, 0, t82 - t83)
+    t84 = casadi.if_else(t60, 0, t82 - t83)
     t85 = t82 + t83
     t86 = 0.0203*t76 - 0.4318*t84
     t87 = 0.4318*t76 + 0.0203*t84
     t88 = t86 + 0.4318
     t89 = t87 + 0.67183
     t90 = t89 - 0.67183
-    t91 = t39*t90 - t54*t88
+    t91 = t38*t90 - t53*t88
     t92 = t79**2 + t88**2 + t90**2
     t93 = 0.0203*t77 - 0.4318*t85
     t94 = 0.4318*t77 + 0.0203*t85
     t95 = t93 + 0.4318
     t96 = t94 + 0.67183
     t97 = t96 - 0.67183
-    t98 = t39*t97 - t54*t95
+    t98 = t38*t97 - t53*t95
     t99 = t81**2 + t95**2 + t97**2
-    t100 = t40*t79
-    t101 = -t100 + t39*t88 + t54*t90
+    t100 = t39*t79
+    t101 = -t100 + t38*t88 + t53*t90
     t102 = t100 + t101
     t103 = t102**2 + t91**2
-    t104 = 1/casadi.sqrt(t103)
-    t105 = 1e-24*t55
-    t106 = (t103 <= t105*t92)
-    t107 = casadi.if_else(t106, 1, t102*t104)
-    t108 = casadi.if_else(t106, 0, -t104*t91)
+    t104 = 1e-24*t54
+    t105 = (t103 <= t104*t92)
+    t106 = casadi.if_else(t105, 1, 1/casadi.sqrt(t103))
+    t107 = casadi.if_else(t105, 1, t102*t106)
+    t108 = casadi.if_else(t105, 0, -t106*t91)
     t109 = t107*t76 - t108*t84
     t110 = t107*t84 + t108*t76
-    t111 = t109*t41 + t110*t58
-    t112 = t109*t58 - t110*t41
-    t113 = t109*t43 + t110*t60
-    t114 = t109*t60 - t110*t43
+    t111 = t109*t40 + t110*t57
+    t112 = t109*t57 - t110*t40
+    t113 = t109*t42 + t110*t59
+    t114 = t109*t59 - t110*t42
     t115 = 1 - t109
-    t116 = t115*t42
-    t117 = t109*t42 + t116
-    t118 = t115*t44
-    t119 = t109*t44 + t118
+    t116 = t115*t41
+    t117 = t109*t41 + t116
+    t118 = t115*t43
+    t119 = t109*t43 + t118
     t120 = t112**2
     t121 = -t120
     t122 = t121 + 1
@@ -1426,46 +1426,46 @@ def _ik_branches(T):
     t128 = t123**2
     t129 = t125**2 + t126*t128
     t130 = t120 + t128
-    t131 = 1/casadi.sqrt(t129)
-    t132 = 1/casadi.sqrt(t130)
-    t133 = 1e-24*t130
-    t134 = (t129 <= t127*t133)
-    t135 = casadi.if_else(t134, 1, t125*t131)
-    t136 = t114*(1 - t135)
-    t137 = t114*t135 + t136
-    t138 = t117*t123
-    t139 = casadi.if_else(t134, 0, t131*t138)
-    t140 = t113*t135 + t119*t139
-    t141 = -t113*t139 + t119*t135
-    t142 = (t130 <= t133)
-    t143 = casadi.if_else(t142, 1, t112*t132)
-    t144 = casadi.if_else(t142, 0, -t123*t132)
-    t145 = t141*(1 - t143)
-    t146 = t137*t144 + t140*t143
-    t147 = t141*t143 + t145
-    t148 = t137*t143 - t140*t144
+    t131 = 1e-24*t130
+    t132 = (t129 <= t127*t131)
+    t133 = casadi.if_else(t132, 1, 1/casadi.sqrt(t129))
+    t134 = casadi.if_else(t132, 1, t125*t133)
+    t135 = t114*(1 - t134)
+    t136 = t114*t134 + t135
+    t137 = t117*t123
+    t138 = casadi.if_else(t132, 0, t133*t137)
+    t139 = t113*t134 + t119*t138
+    t140 = -t113*t138 + t119*t134
+    t141 = (t130 <= t131)
+    t142 = casadi.if_else(t141, 1, 1/casadi.sqrt(t130))
+    t143 = casadi.if_else(t141, 1, t112*t142)
+    t144 = casadi.if_else(t141, 0, -t123*t142)
+    t145 = t140*(1 - t143)
+    t146 = t136*t144 + t139*t143
+    t147 = t140*t143 + t145
+    t148 = t136*t143 - t139*t144
     t149 = t146**2 + t147**2
     t150 = t149
     t151 = t148**2 + t149
-    t152 = t40*t81
-    t153 = -t152 + t39*t95 + t54*t97
+    t152 = t39*t81
+    t153 = -t152 + t38*t95 + t53*t97
     t154 = t152 + t153
     t155 = t154**2 + t98**2
-    t156 = 1/casadi.sqrt(t155)
-    t157 = (t155 <= t105*t99)
-    t158 = casadi.if_else(t157, 1, t154*t156)
-    t159 = casadi.if_else(t157, 0, -t156*t98)
+    t156 = (t155 <= t104*t99)
+    t157 = casadi.if_else(t156, 1, 1/casadi.sqrt(t155))
+    t158 = casadi.if_else(t156, 1, t154*t157)
+    t159 = casadi.if_else(t156, 0, -t157*t98)
     t160 = t158*t77 - t159*t85
     t161 = t158*t85 + t159*t77
-    t162 = t160*t41 + t161*t58
-    t163 = t160*t58 - t161*t41
-    t164 = t160*t43 + t161*t60
-    t165 = t160*t60 - t161*t43
+    t162 = t160*t40 + t161*t57
+    t163 = t160*t57 - t161*t40
+    t164 = t160*t42 + t161*t59
+    t165 = t160*t59 - t161*t42
     t166 = 1 - t160
-    t167 = t166*t42
-    t168 = t160*t42 + t167
-    t169 = t166*t44
-    t170 = t160*t44 + t169
+    t167 = t166*t41
+    t168 = t160*t41 + t167
+    t169 = t166*t43
+    t170 = t160*t43 + t169
     t171 = t163**2
     t172 = -t171
     t173 = t172 + 1
@@ -1477,51 +1477,51 @@ def _ik_branches(T):
     t179 = t174**2
     t180 = t176**2 + t177*t179
     t181 = t171 + t179
-    t182 = 1/casadi.sqrt(t180)
-    t183 = 1/casadi.sqrt(t181)
-    t184 = 1e-24*t181
-    t185 = (t180 <= t178*t184)
-    t186 = casadi.if_else(t185, 1, t176*t182)
-    t187 = t165*(1 - t186)
-    t188 = t165*t186 + t187
-    t189 = t168*t174
-    t190 = casadi.if_else(t185, 0, t182*t189)
-    t191 = t164*t186 + t170*t190
-    t192 = -t164*t190 + t170*t186
-    t193 = (t181 <= t184)
-    t194 = casadi.if_else(t193, 1, t163*t183)
-    t195 = casadi.if_else(t193, 0, -t174*t183)
-    t196 = t192*(1 - t194)
-    t197 = t188*t195 + t191*t194
-    t198 = t192*t194 + t196
-    t199 = t188*t194 - t191*t195
+    t182 = 1e-24*t181
+    t183 = (t180 <= t178*t182)
+    t184 = casadi.if_else(t183, 1, 1/casadi.sqrt(t180))
+    t185 = casadi.if_else(t183, 1, t176*t184)
+    t186 = t165*(1 - t185)
+    t187 = t165*t185 + t186
+    t188 = t168*t174
+    t189 = casadi.if_else(t183, 0, t184*t188)
+    t190 = t164*t185 + t170*t189
+    t191 = -t164*t189 + t170*t185
+    t192 = (t181 <= t182)
+    t193 = casadi.if_else(t192, 1, 1/casadi.sqrt(t181))
+    t194 = casadi.if_else(t192, 1, t163*t193)
+    t195 = casadi.if_else(t192, 0, -t174*t193)
+    t196 = t191*(1 - t194)
+    t197 = t187*t195 + t190*t194
+    t198 = t191*t194 + t196
+    t199 = t187*t194 - t190*t195
     t200 = t197**2 + t198**2
     t201 = t200
     t202 = t199**2 + t200
-    t203 = 1 - t34
-    t204 = t15*t203
-    t205 = t15*t34 + t204
+    t203 = 1 - t33
+    t204 = t14*t203
+    t205 = t14*t33 + t204
     t206 = t205 - 0.67183
-    t207 = t206**2 + t45**2 + t46**2
+    t207 = t206**2 + t44**2 + t45**2
     t208 = 0.19791478625 - 0.5*t207
     t209 = T22*t203
-    t210 = T22*t34 + t209
+    t210 = T22*t33 + t209
     t211 = T20*t203
-    t212 = T20*t34 + t211
+    t212 = T20*t33 + t211
     t213 = t208**2
-    t214 = -t213*t62 + 1
-    t215 = t0*t208
+    t214 = -t213*t63 + 1
+    t215 = t208*t61
     t216 = (1e-12 < t214)
     t217 = casadi.if_else(t216, t215, casadi.if_else((t215 > 0), 1, -1))
     t218 = casadi.if_else(t216, casadi.sqrt(t214), 0)
     t219 = casadi.atan2(t218, t217)
-    t220 = casadi.if_else(t70, 0, t1 + t219)
-    t221 = t1 - t219
-    t222 = t0*t217
+    t220 = casadi.if_else(t60, 0, t0 + t219)
+    t221 = t0 - t219
+    t222 = t217*t61
     t223 = 0.00876554*t222
-    t224 = t0*t218
+    t224 = t218*t61
     t225 = 0.18645124*t224
-    t226 = casadi.if_else(t70, 1, -t223 - t225)
+    t226 = casadi.if_else(t60, 1, -t223 - t225)
     t227 = -t223 + t225
     t228 = 0.15005 - 0.15005*t226
     t229 = 0.15005*t226 + t228
@@ -1529,42 +1529,42 @@ def _ik_branches(T):
     t231 = 0.15005*t227 + t230
     t232 = 0.18645124*t222
     t233 = 0.00876554*t224
-    t234 = casadi.if_else(t70, 0, t232 - t233)
+    t234 = casadi.if_else(t60, 0, t232 - t233)
     t235 = t232 + t233
     t236 = 0.0203*t226 - 0.4318*t234
     t237 = 0.4318*t226 + 0.0203*t234
     t238 = t236 + 0.4318
     t239 = t237 + 0.67183
     t240 = t239 - 0.67183
-    t241 = -t206*t238 + t240*t45
+    t241 = -t206*t238 + t240*t44
     t242 = t229**2 + t238**2 + t240**2
     t243 = 0.0203*t227 - 0.4318*t235
     t244 = 0.4318*t227 + 0.0203*t235
     t245 = t243 + 0.4318
     t246 = t244 + 0.67183
     t247 = t246 - 0.67183
-    t248 = -t206*t245 + t247*t45
+    t248 = -t206*t245 + t247*t44
     t249 = t231**2 + t245**2 + t247**2
-    t250 = t229*t46
-    t251 = t206*t240 + t238*t45 - t250
+    t250 = t229*t45
+    t251 = t206*t240 + t238*t44 - t250
     t252 = t250 + t251
     t253 = t241**2 + t252**2
-    t254 = 1/casadi.sqrt(t253)
-    t255 = 1e-24*t207
-    t256 = (t253 <= t242*t255)
-    t257 = casadi.if_else(t256, 1, t252*t254)
-    t258 = casadi.if_else(t256, 0, -t241*t254)
+    t254 = 1e-24*t207
+    t255 = (t253 <= t242*t254)
+    t256 = casadi.if_else(t255, 1, 1/casadi.sqrt(t253))
+    t257 = casadi.if_else(t255, 1, t252*t256)
+    t258 = casadi.if_else(t255, 0, -t241*t256)
     t259 = t226*t257 - t234*t258
     t260 = t226*t258 + t234*t257
-    t261 = t210*t260 + t259*t47
-    t262 = t210*t259 - t260*t47
-    t263 = t212*t260 + t259*t49
-    t264 = t212*t259 - t260*t49
+    t261 = t210*t260 + t259*t46
+    t262 = t210*t259 - t260*t46
+    t263 = t212*t260 + t259*t48
+    t264 = t212*t259 - t260*t48
     t265 = 1 - t259
-    t266 = t265*t48
-    t267 = t259*t48 + t266
-    t268 = t265*t50
-    t269 = t259*t50 + t268
+    t266 = t265*t47
+    t267 = t259*t47 + t266
+    t268 = t265*t49
+    t269 = t259*t49 + t268
     t270 = t262**2
     t271 = -t270
     t272 = t271 + 1
@@ -1576,46 +1576,46 @@ def _ik_branches(T):
     t278 = t273**2
     t279 = t275**2 + t276*t278
     t280 = t270 + t278
-    t281 = 1/casadi.sqrt(t279)
-    t282 = 1/casadi.sqrt(t280)
-    t283 = 1e-24*t280
-    t284 = (t279 <= t277*t283)
-    t285 = casadi.if_else(t284, 1, t275*t281)
-    t286 = t264*(1 - t285)
-    t287 = t264*t285 + t286
-    t288 = t267*t273
-    t289 = casadi.if_else(t284, 0, t281*t288)
-    t290 = t263*t285 + t269*t289
-    t291 = -t263*t289 + t269*t285
-    t292 = (t280 <= t283)
-    t293 = casadi.if_else(t292, 1, t262*t282)
-    t294 = casadi.if_else(t292, 0, -t273*t282)
-    t295 = t291*(1 - t293)
-    t296 = t287*t294 + t290*t293
-    t297 = t291*t293 + t295
-    t298 = t287*t293 - t290*t294
+    t281 = 1e-24*t280
+    t282 = (t279 <= t277*t281)
+    t283 = casadi.if_else(t282, 1, 1/casadi.sqrt(t279))
+    t284 = casadi.if_else(t282, 1, t275*t283)
+    t285 = t264*(1 - t284)
+    t286 = t264*t284 + t285
+    t287 = t267*t273
+    t288 = casadi.if_else(t282, 0, t283*t287)
+    t289 = t263*t284 + t269*t288
+    t290 = -t263*t288 + t269*t284
+    t291 = (t280 <= t281)
+    t292 = casadi.if_else(t291, 1, 1/casadi.sqrt(t280))
+    t293 = casadi.if_else(t291, 1, t262*t292)
+    t294 = casadi.if_else(t291, 0, -t273*t292)
+    t295 = t290*(1 - t293)
+    t296 = t286*t294 + t289*t293
+    t297 = t290*t293 + t295
+    t298 = t286*t293 - t289*t294
     t299 = t296**2 + t297**2
     t300 = t299
     t301 = t298**2 + t299
-    t302 = t231*t46
-    t303 = t206*t247 + t245*t45 - t302
+    t302 = t231*t45
+    t303 = t206*t247 + t245*t44 - t302
     t304 = t302 + t303
     t305 = t248**2 + t304**2
-    t306 = 1/casadi.sqrt(t305)
-    t307 = (t305 <= t249*t255)
-    t308 = casadi.if_else(t307, 1, t304*t306)
-    t309 = casadi.if_else(t307, 0, -t248*t306)
+    t306 = (t305 <= t249*t254)
+    t307 = casadi.if_else(t306, 1, 1/casadi.sqrt(t305))
+    t308 = casadi.if_else(t306, 1, t304*t307)
+    t309 = casadi.if_else(t306, 0, -t248*t307)
     t310 = t227*t308 - t235*t309
     t311 = t227*t309 + t235*t308
-    t312 = t210*t311 + t310*t47
-    t313 = t210*t310 - t311*t47
-    t314 = t212*t311 + t310*t49
-    t315 = t212*t310 - t311*t49
+    t312 = t210*t311 + t310*t46
+    t313 = t210*t310 - t311*t46
+    t314 = t212*t311 + t310*t48
+    t315 = t212*t310 - t311*t48
     t316 = 1 - t310
-    t317 = t316*t48
-    t318 = t310*t48 + t317
-    t319 = t316*t50
-    t320 = t310*t50 + t319
+    t317 = t316*t47
+    t318 = t310*t47 + t317
+    t319 = t316*t49
+    t320 = t310*t49 + t319
     t321 = t313**2
     t322 = -t321
     t323 = t322 + 1
@@ -1627,60 +1627,60 @@ def _ik_branches(T):
     t329 = t324**2
     t330 = t326**2 + t327*t329
     t331 = t321 + t329
-    t332 = 1/casadi.sqrt(t330)
-    t333 = 1/casadi.sqrt(t331)
-    t334 = 1e-24*t331
-    t335 = (t330 <= t328*t334)
-    t336 = casadi.if_else(t335, 1, t326*t332)
-    t337 = t315*(1 - t336)
-    t338 = t315*t336 + t337
-    t339 = t318*t324
-    t340 = casadi.if_else(t335, 0, t332*t339)
-    t341 = t314*t336 + t320*t340
-    t342 = -t314*t340 + t320*t336
-    t343 = (t331 <= t334)
-    t344 = casadi.if_else(t343, 1, t313*t333)
-    t345 = casadi.if_else(t343, 0, -t324*t333)
-    t346 = t342*(1 - t344)
-    t347 = t338*t345 + t341*t344
-    t348 = t342*t344 + t346
-    t349 = t338*t344 - t341*t345
+    t332 = 1e-24*t331
+    t333 = (t330 <= t328*t332)
+    t334 = casadi.if_else(t333, 1, 1/casadi.sqrt(t330))
+    t335 = casadi.if_else(t333, 1, t326*t334)
+    t336 = t315*(1 - t335)
+    t337 = t315*t335 + t336
+    t338 = t318*t324
+    t339 = casadi.if_else(t333, 0, t334*t338)
+    t340 = t314*t335 + t320*t339
+    t341 = -t314*t339 + t320*t335
+    t342 = (t331 <= t332)
+    t343 = casadi.if_else(t342, 1, 1/casadi.sqrt(t331))
+    t344 = casadi.if_else(t342, 1, t313*t343)
+    t345 = casadi.if_else(t342, 0, -t324*t343)
+    t346 = t341*(1 - t344)
+    t347 = t337*t345 + t340*t344
+    t348 = t341*t344 + t346
+    t349 = t337*t344 - t340*t345
     t350 = t347**2 + t348**2
     t351 = t350
     t352 = t349**2 + t350
-    t353 = t28 - 6.283185307179586*casadi.ceil(0.15915494309189535*t28 - 0.5)
-    t354 = casadi.if_else(t106, 0, casadi.atan2(-t91, t102))
-    t355 = t71 - 6.283185307179586*casadi.ceil(0.15915494309189535*t71 - 0.5)
-    t356 = casadi.if_else(t134, 0, casadi.atan2(t138, t125))
-    t357 = casadi.if_else(t142, 0, casadi.atan2(-t123, t112))
+    t353 = t26 - 6.283185307179586*casadi.ceil(0.15915494309189535*t26 - 0.5)
+    t354 = casadi.if_else(t105, 0, casadi.atan2(-t91, t102))
+    t355 = t70 - 6.283185307179586*casadi.ceil(0.15915494309189535*t70 - 0.5)
+    t356 = casadi.if_else(t132, 0, casadi.atan2(t137, t125))
+    t357 = casadi.if_else(t141, 0, casadi.atan2(-t123, t112))
     t358 = casadi.if_else((t150 <= 1e-24*t151), 0, casadi.atan2(t147, t146))
-    t359 = casadi.if_else(t157, 0, casadi.atan2(-t98, t154))
-    t360 = t69 - 6.283185307179586*casadi.ceil(0.15915494309189535*t69 - 0.5)
-    t361 = casadi.if_else(t185, 0, casadi.atan2(t189, t176))
-    t362 = casadi.if_else(t193, 0, casadi.atan2(-t174, t163))
+    t359 = casadi.if_else(t156, 0, casadi.atan2(-t98, t154))
+    t360 = t71 - 6.283185307179586*casadi.ceil(0.15915494309189535*t71 - 0.5)
+    t361 = casadi.if_else(t183, 0, casadi.atan2(t188, t176))
+    t362 = casadi.if_else(t192, 0, casadi.atan2(-t174, t163))
     t363 = casadi.if_else((t201 <= 1e-24*t202), 0, casadi.atan2(t198, t197))
-    t364 = t25 - 6.283185307179586*casadi.ceil(0.15915494309189535*t25 - 0.5)
-    t365 = casadi.if_else(t256, 0, casadi.atan2(-t241, t252))
+    t364 = t27 - 6.283185307179586*casadi.ceil(0.15915494309189535*t27 - 0.5)
+    t365 = casadi.if_else(t255, 0, casadi.atan2(-t241, t252))
     t366 = t220 - 6.283185307179586*casadi.ceil(0.15915494309189535*t220 - 0.5)
-    t367 = casadi.if_else(t284, 0, casadi.atan2(t288, t275))
-    t368 = casadi.if_else(t292, 0, casadi.atan2(-t273, t262))
+    t367 = casadi.if_else(t282, 0, casadi.atan2(t287, t275))
+    t368 = casadi.if_else(t291, 0, casadi.atan2(-t273, t262))
     t369 = casadi.if_else((t300 <= 1e-24*t301), 0, casadi.atan2(t297, t296))
-    t370 = casadi.if_else(t307, 0, casadi.atan2(-t248, t304))
+    t370 = casadi.if_else(t306, 0, casadi.atan2(-t248, t304))
     t371 = t221 - 6.283185307179586*casadi.ceil(0.15915494309189535*t221 - 0.5)
-    t372 = casadi.if_else(t335, 0, casadi.atan2(t339, t326))
-    t373 = casadi.if_else(t343, 0, casadi.atan2(-t324, t313))
+    t372 = casadi.if_else(t333, 0, casadi.atan2(t338, t326))
+    t373 = casadi.if_else(t342, 0, casadi.atan2(-t324, t313))
     t374 = casadi.if_else((t351 <= 1e-24*t352), 0, casadi.atan2(t348, t347))
-    t375 = (casadi.fabs(t2) < casadi.inf)
+    t375 = (casadi.fabs(t1) < casadi.inf)
     t376 = -1e-12
-    t377 = (t17 > t26)
-    t378 = casadi.logic_or(casadi.logic_and(t377, (t20 >= t376)), casadi.logic_and(t27, (0.0225150025 <= 1e-12*t18)))
+    t377 = (t16 > t18)
+    t378 = casadi.logic_or(casadi.logic_and(t377, (t21 >= t376)), casadi.logic_and(t19, (0.0225150025 <= 1e-12*t17)))
     t379 = 3.9038849723757295e-26
     t380 = (0.0348408995890292 > t379)
     t381 = (0.0348408995890292 <= t379)
     t382 = 3.9038849723757296e-14
-    t383 = casadi.logic_or(casadi.logic_and(t380, (t63 >= t376)), casadi.logic_and(t381, (t61 <= t382)))
-    t384 = (t63 > 1e-12)
-    t385 = (t20 > 1e-12)
+    t383 = casadi.logic_or(casadi.logic_and(t380, (t64 >= t376)), casadi.logic_and(t381, (t62 <= t382)))
+    t384 = (t64 > 1e-12)
+    t385 = (t21 > 1e-12)
     t386 = casadi.logic_or(casadi.logic_and(t380, (t214 >= t376)), casadi.logic_and(t381, (t213 <= t382)))
     t387 = (t214 > 1e-12)
     q = casadi.SX(8, 6)

@@ -395,7 +395,7 @@ def _jacobian_det(q):
 
 
 def _velocity_ik(q, mu_dot, damping):
-    """Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: 589 operations."""
+    """Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: 600 operations."""
     q1 = q[0]
     q2 = q[1]
     q3 = q[2]
@@ -528,15 +528,15 @@ def _velocity_ik(q, mu_dot, damping):
     t109 = t105 + t108
     t110 = casadi.if_else((t107 > 0), 1/(t107*(t106 + t107)), 0)
     t111 = -t109**2*t110*t91 + t91
-    t112 = t111/t108
-    t113 = (t104*t112 + t90)/t86
-    t114 = (-t100*t112 - t113*t82 + t72)/t68
-    t115 = (-t112*t95 - t113*t77 + t114*t63 + t57)/t53
-    t116 = -t114*t2 + t115*t5
-    t117 = -t112*t17
-    t118 = -t113*t6 + t114*t36 + t115*t28 + t117
-    t119 = -t113*t7 + t114*t35 + t115*t27 + t117
-    t120 = -t113*t15 + t114*t37 + t115*t29 + t117
+    t112 = casadi.if_else((t108 != 0), -t111/t108, 0)
+    t113 = casadi.if_else((t86 != 0), -(-t104*t112 + t90)/t86, 0)
+    t114 = casadi.if_else((t68 != 0), -(t100*t112 + t113*t82 + t72)/t68, 0)
+    t115 = casadi.if_else((t53 != 0), -(t112*t95 + t113*t77 - t114*t63 + t57)/t53, 0)
+    t116 = t114*t2 - t115*t5
+    t117 = t112*t17
+    t118 = t113*t6 - t114*t36 - t115*t28 + t117
+    t119 = t113*t7 - t114*t35 - t115*t27 + t117
+    t120 = t113*t15 - t114*t37 - t115*t29 + t117
     t121 = t19 + t32
     t122 = casadi.sqrt(t121 + t23 + t33 + t41 + t44)
     t123 = casadi.sqrt(t121)
@@ -589,10 +589,10 @@ def _velocity_ik(q, mu_dot, damping):
     t170 = t162 + t169
     t171 = casadi.if_else((t168 > 0), 1/(t168*(t167 + t168)), 0)
     t172 = -t165*t170**2*t171 + t165
-    t173 = t172/t169
-    t174 = (t161*t173 + t164)/t157
-    t175 = (-t145*t174 - t149*t173 + t153)/t141
-    t176 = (-t129*t175 - t132*t174 - t135*t173 + t138)/t124
+    t173 = casadi.if_else((t169 != 0), -t172/t169, 0)
+    t174 = casadi.if_else((t157 != 0), -(-t161*t173 + t164)/t157, 0)
+    t175 = casadi.if_else((t141 != 0), -(t145*t174 + t149*t173 + t153)/t141, 0)
+    t176 = casadi.if_else((t124 != 0), -(t129*t175 + t132*t174 + t135*t173 + t138)/t124, 0)
     t177 = (damping > 0)
     t178 = (casadi.fabs(t166) < casadi.inf)
     t179 = (damping >= 0)
@@ -601,17 +601,17 @@ def _velocity_ik(q, mu_dot, damping):
     t182 = casadi.logic_or(casadi.logic_and(t177, casadi.logic_or(casadi.logic_or(casadi.logic_or((t107 <= t181), (t52 <= t181)), (t67 <= t181)), (t85 <= t181))), casadi.logic_and((damping <= 0), casadi.logic_or(casadi.logic_or(casadi.logic_or((t123 <= t180), (t140 <= t180)), (t156 <= t180)), (t168 <= t180))))
     t183 = casadi.logic_and(casadi.logic_and(t178, t179), casadi.logic_not(t182))
     q_dot = casadi.SX(4, 1)
-    q_dot[0, 0] = casadi.if_else(t183, casadi.if_else(t177, t116, -t176), 0)
-    q_dot[1, 0] = casadi.if_else(t183, casadi.if_else(t177, t118, -t175), 0)
-    q_dot[2, 0] = casadi.if_else(t183, casadi.if_else(t177, t119, -t174), 0)
-    q_dot[3, 0] = casadi.if_else(t183, casadi.if_else(t177, t120, -t173), 0)
+    q_dot[0, 0] = casadi.if_else(t183, casadi.if_else(t177, t116, t176), 0)
+    q_dot[1, 0] = casadi.if_else(t183, casadi.if_else(t177, t118, t175), 0)
+    q_dot[2, 0] = casadi.if_else(t183, casadi.if_else(t177, t119, t174), 0)
+    q_dot[3, 0] = casadi.if_else(t183, casadi.if_else(t177, t120, t173), 0)
     status = casadi.SX(1, 1)
     status[0, 0] = casadi.if_else(casadi.logic_not(casadi.logic_and(t178, t179)), 2, casadi.if_else(t182, 1, 0))
     return [q_dot, status]
 
 
 def _ik_numeric_step(target, q, damping):
-    """One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite): 396 operations."""
+    """One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite): 403 operations."""
     mu0 = target[0]
     mu1 = target[1]
     mu2 = target[2]
@@ -743,15 +743,15 @@ def _ik_numeric_step(target, q, damping):
     t104 = t100 + t103
     t105 = casadi.if_else((t102 > 0), 1/(t102*(t101 + t102)), 0)
     t106 = -t104**2*t105*t87 + t87
-    t107 = t106/t103
-    t108 = (t107*t99 + t86)/t82
-    t109 = (-t107*t95 - t108*t78 + t68)/t64
-    t110 = (-t107*t90 - t108*t73 + t109*t59 + t53)/t49
-    t111 = q1 - t109*t3 + t110*t7
-    t112 = -t107*t24
-    t113 = q2 - t108*t8 + t109*t40 + t110*t35 + t112
-    t114 = q3 - t108*t9 + t109*t39 + t110*t34 + t112
-    t115 = q4 - t108*t20 + t109*t41 + t110*t36 + t112
+    t107 = casadi.if_else((t103 != 0), -t106/t103, 0)
+    t108 = casadi.if_else((t82 != 0), -(-t107*t99 + t86)/t82, 0)
+    t109 = casadi.if_else((t64 != 0), -(t107*t95 + t108*t78 + t68)/t64, 0)
+    t110 = casadi.if_else((t49 != 0), -(t107*t90 + t108*t73 - t109*t59 + t53)/t49, 0)
+    t111 = q1 + t109*t3 - t110*t7
+    t112 = t107*t24
+    t113 = q2 + t108*t8 - t109*t40 - t110*t35 + t112
+    t114 = q3 + t108*t9 - t109*t39 - t110*t34 + t112
+    t115 = q4 + t108*t20 - t109*t41 - t110*t36 + t112
     q_start = casadi.SX(4, 1)
     q_start[0, 0] = q1
     q_start[1, 0] = q2
@@ -768,7 +768,7 @@ def _ik_numeric_step(target, q, damping):
 
 
 def _ik_branches(mu):
-    """Every branch of the closed-form ik and whether the target allows it: 552 operations."""
+    """Every branch of the closed-form ik and whether the target allows it: 566 operations."""
     mu0 = mu[0]
     mu1 = mu[1]
     mu2 = mu[2]
@@ -786,238 +786,247 @@ def _ik_branches(mu):
     t10 = casadi.if_else(t9, 0, t8)
     t11 = casadi.if_else(t9, 1, t6)
     t12 = casadi.if_else(t9, 0, t7)
-    t13 = mu0**2 + mu1**2
-    t14 = t13
-    t15 = mu2**2 + t13
-    t16 = 1/casadi.sqrt(t14)
-    t17 = True
-    t18 = casadi.if_else(t17, 0, -1)
-    t19 = casadi.if_else(t17, 1, 0)
-    t20 = casadi.atan2(t19, t18)
-    t21 = t1 - t20
-    t22 = 1e-24*t15
-    t23 = (t14 <= t22)
-    t24 = casadi.if_else(t23, 0, t1 + t20)
-    t25 = t16*t18
-    t26 = mu1*t25
-    t27 = t16*t19
-    t28 = mu0*t27
-    t29 = casadi.if_else(t23, 1, -t26 - t28)
-    t30 = -t26 + t28
-    t31 = mu2*(1 - t29)
-    t32 = mu2*t29 + t31
-    t33 = mu2*(1 - t30)
-    t34 = mu2*t30 + t33
-    t35 = mu0*t25
-    t36 = mu1*t27
-    t37 = casadi.if_else(t23, 0, t35 - t36)
-    t38 = t35 + t36
-    t39 = mu0*t29 + mu1*t37
-    t40 = -mu0*t37 + mu1*t29
-    t41 = mu0*t30 + mu1*t38
-    t42 = -mu0*t38 + mu1*t30
-    t43 = 0.1*t12
-    t44 = t39 + t43
-    t45 = t41 + t43
-    t46 = -0.1*t11
-    t47 = t32 + t46
-    t48 = t47 - 0.12
-    t49 = t34 + t46
-    t50 = t49 - 0.12
-    t51 = t40**2
-    t52 = t44**2 + t48**2 + t51
-    t53 = 0.01 - 0.5*t52
-    t54 = t53**2
-    t55 = 1 - 10000*t54
-    t56 = (1e-12 < t55)
-    t57 = casadi.if_else(t56, 100*t53, casadi.if_else((t53 > 0), 1, -1))
-    t58 = casadi.if_else(t56, casadi.sqrt(t55), 0)
-    t59 = casadi.atan2(t58, t57)
-    t60 = casadi.if_else(t9, 0, t59 + 3.141592653589793)
-    t61 = casadi.if_else(t9, 1, -t57)
-    t62 = casadi.if_else(t9, 0, -t58)
-    t63 = 3.141592653589793 - t59
-    t64 = 0.1*t61 + 0.22
-    t65 = t64 - 0.12
-    t66 = 0.01*t62**2 + t65**2
-    t67 = 0.22 - 0.1*t57
-    t68 = t67 - 0.12
-    t69 = 0.01*t58**2 + t68**2
-    t70 = 0.1*t62
-    t71 = -t44*t70 + t48*t65
-    t72 = t44*t65 + t48*t70
-    t73 = t71**2 + t72**2
-    t74 = 0.1*t58
-    t75 = -t44*t74 + t48*t68
-    t76 = t44*t68 + t48*t74
-    t77 = t75**2 + t76**2
-    t78 = -0.1*t7
-    t79 = t39 + t78
-    t80 = t41 + t78
-    t81 = -0.1*t6
-    t82 = t32 + t81
-    t83 = t82 - 0.12
-    t84 = t51 + t79**2 + t83**2
-    t85 = 0.01 - 0.5*t84
-    t86 = t34 + t81
-    t87 = t86 - 0.12
-    t88 = t85**2
-    t89 = 1 - 10000*t88
-    t90 = (1e-12 < t89)
-    t91 = casadi.if_else(t90, 100*t85, casadi.if_else((t85 > 0), 1, -1))
-    t92 = casadi.if_else(t90, casadi.sqrt(t89), 0)
-    t93 = casadi.atan2(t92, t91)
-    t94 = casadi.if_else(t9, 0, t93 + 3.141592653589793)
-    t95 = casadi.if_else(t9, 1, -t91)
-    t96 = casadi.if_else(t9, 0, -t92)
-    t97 = 3.141592653589793 - t93
-    t98 = 0.1*t95 + 0.22
-    t99 = t98 - 0.12
-    t100 = 0.01*t96**2 + t99**2
-    t101 = 0.22 - 0.1*t91
-    t102 = t101 - 0.12
-    t103 = t102**2 + 0.01*t92**2
-    t104 = 0.1*t96
-    t105 = -t104*t79 + t83*t99
-    t106 = t104*t83 + t79*t99
-    t107 = t105**2 + t106**2
-    t108 = 0.1*t92
-    t109 = t102*t83 - t108*t79
-    t110 = t102*t79 + t108*t83
-    t111 = t109**2 + t110**2
-    t112 = t42**2
-    t113 = t112 + t45**2 + t50**2
-    t114 = 0.01 - 0.5*t113
-    t115 = t112 + t80**2 + t87**2
-    t116 = 0.01 - 0.5*t115
-    t117 = t114**2
-    t118 = 1 - 10000*t117
-    t119 = (1e-12 < t118)
-    t120 = casadi.if_else(t119, 100*t114, casadi.if_else((t114 > 0), 1, -1))
-    t121 = casadi.if_else(t119, casadi.sqrt(t118), 0)
-    t122 = casadi.atan2(t121, t120)
-    t123 = casadi.if_else(t9, 0, t122 + 3.141592653589793)
-    t124 = casadi.if_else(t9, 1, -t120)
-    t125 = casadi.if_else(t9, 0, -t121)
-    t126 = 3.141592653589793 - t122
-    t127 = 0.1*t124 + 0.22
-    t128 = t127 - 0.12
-    t129 = 0.01*t125**2 + t128**2
-    t130 = 0.22 - 0.1*t120
-    t131 = t130 - 0.12
-    t132 = 0.01*t121**2 + t131**2
-    t133 = 0.1*t125
-    t134 = t128*t50 - t133*t45
-    t135 = t128*t45 + t133*t50
-    t136 = t134**2 + t135**2
-    t137 = 0.1*t121
-    t138 = t131*t50 - t137*t45
-    t139 = t131*t45 + t137*t50
-    t140 = t138**2 + t139**2
-    t141 = t116**2
-    t142 = 1 - 10000*t141
-    t143 = (1e-12 < t142)
-    t144 = casadi.if_else(t143, 100*t116, casadi.if_else((t116 > 0), 1, -1))
-    t145 = casadi.if_else(t143, casadi.sqrt(t142), 0)
-    t146 = casadi.atan2(t145, t144)
-    t147 = casadi.if_else(t9, 0, t146 + 3.141592653589793)
-    t148 = casadi.if_else(t9, 1, -t144)
-    t149 = casadi.if_else(t9, 0, -t145)
-    t150 = 3.141592653589793 - t146
-    t151 = 0.1*t148 + 0.22
-    t152 = t151 - 0.12
-    t153 = 0.01*t149**2 + t152**2
-    t154 = 0.22 - 0.1*t144
-    t155 = t154 - 0.12
-    t156 = 0.01*t145**2 + t155**2
-    t157 = 0.1*t149
-    t158 = t152*t87 - t157*t80
-    t159 = t152*t80 + t157*t87
-    t160 = t158**2 + t159**2
-    t161 = 0.1*t145
-    t162 = t155*t87 - t161*t80
-    t163 = t155*t80 + t161*t87
-    t164 = t162**2 + t163**2
-    t165 = t24 - 6.283185307179586*casadi.ceil(0.15915494309189535*t24 - 0.5)
-    t166 = 1e-24*t52
-    t167 = casadi.if_else((t73 <= t166*t66), 0, casadi.atan2(-t72, t71))
-    t168 = -t10
-    t169 = t168 + 3.141592653589793
-    t170 = t167 + t60
-    t171 = casadi.if_else((t77 <= t166*t69), 0, casadi.atan2(-t76, t75))
-    t172 = t171 + t63
-    t173 = 1e-24*t84
-    t174 = casadi.if_else((t107 <= t100*t173), 0, casadi.atan2(-t106, t105))
-    t175 = t8 + 3.141592653589793
-    t176 = t174 + t94
-    t177 = casadi.if_else((t111 <= t103*t173), 0, casadi.atan2(-t110, t109))
-    t178 = t177 + t97
-    t179 = t21 - 6.283185307179586*casadi.ceil(0.15915494309189535*t21 - 0.5)
-    t180 = 1e-24*t113
-    t181 = casadi.if_else((t136 <= t129*t180), 0, casadi.atan2(-t135, t134))
-    t182 = t123 + t181
-    t183 = casadi.if_else((t140 <= t132*t180), 0, casadi.atan2(-t139, t138))
-    t184 = t126 + t183
-    t185 = 1e-24*t115
-    t186 = casadi.if_else((t160 <= t153*t185), 0, casadi.atan2(-t159, t158))
-    t187 = t147 + t186
-    t188 = casadi.if_else((t164 <= t156*t185), 0, casadi.atan2(-t163, t162))
-    t189 = t150 + t188
-    t190 = (casadi.fabs(t2) < casadi.inf)
-    t191 = (casadi.fabs(mu3) <= 1.5707963267948966)
-    t192 = (t14 > t22)
-    t193 = casadi.logic_or(t192, casadi.logic_and(t23, (0 <= 1e-12*t15)))
-    t194 = True
-    t195 = -1e-12
-    t196 = casadi.logic_and(t194, (t4 >= t195))
-    t197 = 1e-28
-    t198 = (0.0001 > t197)
-    t199 = (0.0001 <= t197)
-    t200 = 1e-16
-    t201 = (t4 > 1e-12)
-    t202 = True
+    t13 = casadi.if_else(t9, 1, 100)
+    t14 = mu0**2 + mu1**2
+    t15 = t14
+    t16 = mu2**2 + t14
+    t17 = 1e-24*t16
+    t18 = (t15 <= t17)
+    t19 = casadi.if_else(t18, 1, 1/casadi.sqrt(t15))
+    t20 = True
+    t21 = casadi.if_else(t20, 0, -1)
+    t22 = casadi.if_else(t20, 1, 0)
+    t23 = casadi.atan2(t22, t21)
+    t24 = casadi.if_else(t18, 0, t1 + t23)
+    t25 = t1 - t23
+    t26 = t19*t21
+    t27 = mu1*t26
+    t28 = t19*t22
+    t29 = mu0*t28
+    t30 = casadi.if_else(t18, 1, -t27 - t29)
+    t31 = -t27 + t29
+    t32 = mu2*(1 - t30)
+    t33 = mu2*t30 + t32
+    t34 = mu2*(1 - t31)
+    t35 = mu2*t31 + t34
+    t36 = mu0*t26
+    t37 = mu1*t28
+    t38 = casadi.if_else(t18, 0, t36 - t37)
+    t39 = t36 + t37
+    t40 = mu0*t30 + mu1*t38
+    t41 = -mu0*t38 + mu1*t30
+    t42 = mu0*t31 + mu1*t39
+    t43 = -mu0*t39 + mu1*t31
+    t44 = 0.1*t12
+    t45 = t40 + t44
+    t46 = t42 + t44
+    t47 = -0.1*t11
+    t48 = t33 + t47
+    t49 = t48 - 0.12
+    t50 = t35 + t47
+    t51 = t50 - 0.12
+    t52 = t41**2
+    t53 = t45**2 + t49**2 + t52
+    t54 = 0.01 - 0.5*t53
+    t55 = t54**2
+    t56 = t13**2
+    t57 = -t55*t56 + 1
+    t58 = t13*t54
+    t59 = (1e-12 < t57)
+    t60 = casadi.if_else(t59, t58, casadi.if_else((t58 > 0), 1, -1))
+    t61 = casadi.if_else(t59, casadi.sqrt(t57), 0)
+    t62 = casadi.atan2(t61, t60)
+    t63 = casadi.if_else(t9, 0, t62 + 3.141592653589793)
+    t64 = 3.141592653589793 - t62
+    t65 = 0.01*t13
+    t66 = casadi.if_else(t9, 1, -t60*t65)
+    t67 = casadi.if_else(t9, 0, -t61*t65)
+    t68 = 0.1*t66 + 0.22
+    t69 = t68 - 0.12
+    t70 = 0.01*t67**2 + t69**2
+    t71 = 0.1*t67
+    t72 = -t45*t71 + t49*t69
+    t73 = t45*t69 + t49*t71
+    t74 = t72**2 + t73**2
+    t75 = 0.001*t13
+    t76 = -t60*t75 + 0.22
+    t77 = t76 - 0.12
+    t78 = t61*t75
+    t79 = -t45*t78 + t49*t77
+    t80 = t45*t77 + t49*t78
+    t81 = t79**2 + t80**2
+    t82 = 1e-06*t56
+    t83 = t61**2*t82 + t77**2
+    t84 = -0.1*t7
+    t85 = t40 + t84
+    t86 = t42 + t84
+    t87 = -0.1*t6
+    t88 = t33 + t87
+    t89 = t88 - 0.12
+    t90 = t52 + t85**2 + t89**2
+    t91 = 0.01 - 0.5*t90
+    t92 = t35 + t87
+    t93 = t92 - 0.12
+    t94 = t91**2
+    t95 = -t56*t94 + 1
+    t96 = t13*t91
+    t97 = (1e-12 < t95)
+    t98 = casadi.if_else(t97, t96, casadi.if_else((t96 > 0), 1, -1))
+    t99 = casadi.if_else(t97, casadi.sqrt(t95), 0)
+    t100 = casadi.atan2(t99, t98)
+    t101 = casadi.if_else(t9, 0, t100 + 3.141592653589793)
+    t102 = casadi.if_else(t9, 1, -t65*t98)
+    t103 = casadi.if_else(t9, 0, -t65*t99)
+    t104 = 3.141592653589793 - t100
+    t105 = 0.1*t102 + 0.22
+    t106 = t105 - 0.12
+    t107 = 0.01*t103**2 + t106**2
+    t108 = -t75*t98 + 0.22
+    t109 = t108 - 0.12
+    t110 = t109**2 + t82*t99**2
+    t111 = 0.1*t103
+    t112 = t106*t89 - t111*t85
+    t113 = t106*t85 + t111*t89
+    t114 = t112**2 + t113**2
+    t115 = t75*t99
+    t116 = t109*t89 - t115*t85
+    t117 = t109*t85 + t115*t89
+    t118 = t116**2 + t117**2
+    t119 = t43**2
+    t120 = t119 + t46**2 + t51**2
+    t121 = 0.01 - 0.5*t120
+    t122 = t119 + t86**2 + t93**2
+    t123 = 0.01 - 0.5*t122
+    t124 = t121**2
+    t125 = -t124*t56 + 1
+    t126 = t121*t13
+    t127 = (1e-12 < t125)
+    t128 = casadi.if_else(t127, t126, casadi.if_else((t126 > 0), 1, -1))
+    t129 = casadi.if_else(t127, casadi.sqrt(t125), 0)
+    t130 = casadi.atan2(t129, t128)
+    t131 = casadi.if_else(t9, 0, t130 + 3.141592653589793)
+    t132 = casadi.if_else(t9, 1, -t128*t65)
+    t133 = casadi.if_else(t9, 0, -t129*t65)
+    t134 = 3.141592653589793 - t130
+    t135 = 0.1*t132 + 0.22
+    t136 = t135 - 0.12
+    t137 = 0.01*t133**2 + t136**2
+    t138 = -t128*t75 + 0.22
+    t139 = t138 - 0.12
+    t140 = t129**2*t82 + t139**2
+    t141 = 0.1*t133
+    t142 = t136*t51 - t141*t46
+    t143 = t136*t46 + t141*t51
+    t144 = t142**2 + t143**2
+    t145 = t129*t75
+    t146 = t139*t51 - t145*t46
+    t147 = t139*t46 + t145*t51
+    t148 = t146**2 + t147**2
+    t149 = t123**2
+    t150 = -t149*t56 + 1
+    t151 = t123*t13
+    t152 = (1e-12 < t150)
+    t153 = casadi.if_else(t152, t151, casadi.if_else((t151 > 0), 1, -1))
+    t154 = casadi.if_else(t152, casadi.sqrt(t150), 0)
+    t155 = casadi.atan2(t154, t153)
+    t156 = casadi.if_else(t9, 0, t155 + 3.141592653589793)
+    t157 = casadi.if_else(t9, 1, -t153*t65)
+    t158 = casadi.if_else(t9, 0, -t154*t65)
+    t159 = 3.141592653589793 - t155
+    t160 = 0.1*t157 + 0.22
+    t161 = t160 - 0.12
+    t162 = 0.01*t158**2 + t161**2
+    t163 = -t153*t75 + 0.22
+    t164 = t163 - 0.12
+    t165 = t154**2*t82 + t164**2
+    t166 = 0.1*t158
+    t167 = t161*t93 - t166*t86
+    t168 = t161*t86 + t166*t93
+    t169 = t167**2 + t168**2
+    t170 = t154*t75
+    t171 = t164*t93 - t170*t86
+    t172 = t164*t86 + t170*t93
+    t173 = t171**2 + t172**2
+    t174 = t24 - 6.283185307179586*casadi.ceil(0.15915494309189535*t24 - 0.5)
+    t175 = 1e-24*t53
+    t176 = casadi.if_else((t74 <= t175*t70), 0, casadi.atan2(-t73, t72))
+    t177 = -t10
+    t178 = t177 + 3.141592653589793
+    t179 = t176 + t63
+    t180 = casadi.if_else((t81 <= t175*t83), 0, casadi.atan2(-t80, t79))
+    t181 = t180 + t64
+    t182 = 1e-24*t90
+    t183 = casadi.if_else((t114 <= t107*t182), 0, casadi.atan2(-t113, t112))
+    t184 = t8 + 3.141592653589793
+    t185 = t101 + t183
+    t186 = casadi.if_else((t118 <= t110*t182), 0, casadi.atan2(-t117, t116))
+    t187 = t104 + t186
+    t188 = t25 - 6.283185307179586*casadi.ceil(0.15915494309189535*t25 - 0.5)
+    t189 = 1e-24*t120
+    t190 = casadi.if_else((t144 <= t137*t189), 0, casadi.atan2(-t143, t142))
+    t191 = t131 + t190
+    t192 = casadi.if_else((t148 <= t140*t189), 0, casadi.atan2(-t147, t146))
+    t193 = t134 + t192
+    t194 = 1e-24*t122
+    t195 = casadi.if_else((t169 <= t162*t194), 0, casadi.atan2(-t168, t167))
+    t196 = t156 + t195
+    t197 = casadi.if_else((t173 <= t165*t194), 0, casadi.atan2(-t172, t171))
+    t198 = t159 + t197
+    t199 = (casadi.fabs(t2) < casadi.inf)
+    t200 = (casadi.fabs(mu3) <= 1.5707963267948966)
+    t201 = (t15 > t17)
+    t202 = casadi.logic_or(t201, casadi.logic_and(t18, (0 <= 1e-12*t16)))
+    t203 = True
+    t204 = -1e-12
+    t205 = casadi.logic_and(t203, (t4 >= t204))
+    t206 = 1e-28
+    t207 = (0.0001 > t206)
+    t208 = (0.0001 <= t206)
+    t209 = 1e-16
+    t210 = (t4 > 1e-12)
+    t211 = True
     q = casadi.SX(8, 4)
-    q[0, 0] = t165
-    q[0, 1] = t167
-    q[0, 2] = t60 - 6.283185307179586*casadi.ceil(0.15915494309189535*t60 - 0.5)
-    q[0, 3] = -t168 - t170 - 6.283185307179586*casadi.ceil(-0.15915494309189535*t169 - 0.15915494309189535*t170)
-    q[1, 0] = t165
-    q[1, 1] = t171
-    q[1, 2] = t63 - 6.283185307179586*casadi.ceil(0.15915494309189535*t63 - 0.5)
-    q[1, 3] = -t168 - t172 - 6.283185307179586*casadi.ceil(-0.15915494309189535*t169 - 0.15915494309189535*t172)
-    q[2, 0] = t165
-    q[2, 1] = t174
-    q[2, 2] = t94 - 6.283185307179586*casadi.ceil(0.15915494309189535*t94 - 0.5)
-    q[2, 3] = -t176 - t8 - 6.283185307179586*casadi.ceil(-0.15915494309189535*t175 - 0.15915494309189535*t176)
-    q[3, 0] = t165
-    q[3, 1] = t177
-    q[3, 2] = t97 - 6.283185307179586*casadi.ceil(0.15915494309189535*t97 - 0.5)
-    q[3, 3] = -t178 - t8 - 6.283185307179586*casadi.ceil(-0.15915494309189535*t175 - 0.15915494309189535*t178)
-    q[4, 0] = t179
-    q[4, 1] = t181
-    q[4, 2] = t123 - 6.283185307179586*casadi.ceil(0.15915494309189535*t123 - 0.5)
-    q[4, 3] = -t168 - t182 - 6.283185307179586*casadi.ceil(-0.15915494309189535*t169 - 0.15915494309189535*t182)
-    q[5, 0] = t179
-    q[5, 1] = t183
-    q[5, 2] = t126 - 6.283185307179586*casadi.ceil(0.15915494309189535*t126 - 0.5)
-    q[5, 3] = -t168 - t184 - 6.283185307179586*casadi.ceil(-0.15915494309189535*t169 - 0.15915494309189535*t184)
-    q[6, 0] = t179
-    q[6, 1] = t186
-    q[6, 2] = t147 - 6.283185307179586*casadi.ceil(0.15915494309189535*t147 - 0.5)
-    q[6, 3] = -t187 - t8 - 6.283185307179586*casadi.ceil(-0.15915494309189535*t175 - 0.15915494309189535*t187)
-    q[7, 0] = t179
-    q[7, 1] = t188
-    q[7, 2] = t150 - 6.283185307179586*casadi.ceil(0.15915494309189535*t150 - 0.5)
-    q[7, 3] = -t189 - t8 - 6.283185307179586*casadi.ceil(-0.15915494309189535*t175 - 0.15915494309189535*t189)
+    q[0, 0] = t174
+    q[0, 1] = t176
+    q[0, 2] = t63 - 6.283185307179586*casadi.ceil(0.15915494309189535*t63 - 0.5)
+    q[0, 3] = -t177 - t179 - 6.283185307179586*casadi.ceil(-0.15915494309189535*t178 - 0.15915494309189535*t179)
+    q[1, 0] = t174
+    q[1, 1] = t180
+    q[1, 2] = t64 - 6.283185307179586*casadi.ceil(0.15915494309189535*t64 - 0.5)
+    q[1, 3] = -t177 - t181 - 6.283185307179586*casadi.ceil(-0.15915494309189535*t178 - 0.15915494309189535*t181)
+    q[2, 0] = t174
+    q[2, 1] = t183
+    q[2, 2] = t101 - 6.283185307179586*casadi.ceil(0.15915494309189535*t101 - 0.5)
+    q[2, 3] = -t185 - t8 - 6.283185307179586*casadi.ceil(-0.15915494309189535*t184 - 0.15915494309189535*t185)
+    q[3, 0] = t174
+    q[3, 1] = t186
+    q[3, 2] = t104 - 6.283185307179586*casadi.ceil(0.15915494309189535*t104 - 0.5)
+    q[3, 3] = -t187 - t8 - 6.283185307179586*casadi.ceil(-0.15915494309189535*t184 - 0.15915494309189535*t187)
+    q[4, 0] = t188
+    q[4, 1] = t190
+    q[4, 2] = t131 - 6.283185307179586*casadi.ceil(0.15915494309189535*t131 - 0.5)
+    q[4, 3] = -t177 - t191 - 6.283185307179586*casadi.ceil(-0.15915494309189535*t178 - 0.15915494309189535*t191)
+    q[5, 0] = t188
+    q[5, 1] = t192
+    q[5, 2] = t134 - 6.283185307179586*casadi.ceil(0.15915494309189535*t134 - 0.5)
+    q[5, 3] = -t177 - t193 - 6.283185307179586*casadi.ceil(-0.15915494309189535*t178 - 0.15915494309189535*t193)
+    q[6, 0] = t188
+    q[6, 1] = t195
+    q[6, 2] = t156 - 6.283185307179586*casadi.ceil(0.15915494309189535*t156 - 0.5)
+    q[6, 3] = -t196 - t8 - 6.283185307179586*casadi.ceil(-0.15915494309189535*t184 - 0.15915494309189535*t196)
+    q[7, 0] = t188
+    q[7, 1] = t197
+    q[7, 2] = t159 - 6.283185307179586*casadi.ceil(0.15915494309189535*t159 - 0.5)
+    q[7, 3] = -t198 - t8 - 6.283185307179586*casadi.ceil(-0.15915494309189535*t184 - 0.15915494309189535*t198)
     valid = casadi.SX(8, 1)
-    valid[0, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t190, t191), t193), t196), casadi.logic_or(casadi.logic_and(t198, (t55 >= t195)), casadi.logic_and(t199, (t54 <= t200))))
-    valid[1, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t190, t191), t193), t196), t198), (t55 > 1e-12))
-    valid[2, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t190, t191), t193), t194), t201), casadi.logic_or(casadi.logic_and(t198, (t89 >= t195)), casadi.logic_and(t199, (t88 <= t200))))
-    valid[3, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t190, t191), t193), t194), t198), t201), (t89 > 1e-12))
-    valid[4, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t190, t191), t192), t196), t202), casadi.logic_or(casadi.logic_and(t198, (t118 >= t195)), casadi.logic_and(t199, (t117 <= t200))))
-    valid[5, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t190, t191), t192), t196), t198), t202), (t118 > 1e-12))
-    valid[6, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t190, t191), t192), t194), t201), t202), casadi.logic_or(casadi.logic_and(t198, (t142 >= t195)), casadi.logic_and(t199, (t141 <= t200))))
-    valid[7, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t190, t191), t192), t194), t198), t201), t202), (t142 > 1e-12))
+    valid[0, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t199, t200), t202), t205), casadi.logic_or(casadi.logic_and(t207, (t57 >= t204)), casadi.logic_and(t208, (t55 <= t209))))
+    valid[1, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t199, t200), t202), t205), t207), (t57 > 1e-12))
+    valid[2, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t199, t200), t202), t203), t210), casadi.logic_or(casadi.logic_and(t207, (t95 >= t204)), casadi.logic_and(t208, (t94 <= t209))))
+    valid[3, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t199, t200), t202), t203), t207), t210), (t95 > 1e-12))
+    valid[4, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t199, t200), t201), t205), t211), casadi.logic_or(casadi.logic_and(t207, (t125 >= t204)), casadi.logic_and(t208, (t124 <= t209))))
+    valid[5, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t199, t200), t201), t205), t207), t211), (t125 > 1e-12))
+    valid[6, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t199, t200), t201), t203), t210), t211), casadi.logic_or(casadi.logic_and(t207, (t150 >= t204)), casadi.logic_and(t208, (t149 <= t209))))
+    valid[7, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t199, t200), t201), t203), t207), t210), t211), (t150 > 1e-12))
     return [q, valid]
 
 

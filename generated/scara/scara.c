@@ -353,7 +353,7 @@ scara_real scara_jacobian_det(const scara_real q[SCARA_DOF])
 
 int scara_velocity_ik(const scara_real q[SCARA_DOF], const scara_real mu_dot[SCARA_TASK_DIM], scara_real damping, scara_real q_dot[SCARA_DOF])
 {
-    /* 322 operations */
+    /* 333 operations */
 
     /* Inputs */
     const scara_real q1 = q[0];
@@ -433,16 +433,16 @@ int scara_velocity_ik(const scara_real q[SCARA_DOF], const scara_real mu_dot[SCA
     const scara_real t58 = t45 + t57;
     const scara_real t59 = (t56 > 0 ? 1/(t56*(t55 + t56)) : 0);
     const scara_real t60 = -mu_dot2*t59*(t58*t58) + mu_dot2;
-    const scara_real t61 = t60/t57;
+    const scara_real t61 = (t57 != 0 ? -t60/t57 : 0);
     const scara_real t62 = fabs(t54);
     const scara_real t63 = t62;
     const scara_real t64 = t63*(t54 >= 0 ? 1 : -1);
     const scara_real t65 = t54 + t64;
     const scara_real t66 = (t63 > 0 ? 1/(t63*(t62 + t63)) : 0);
     const scara_real t67 = -t43*t66*(t65*t65) + t43;
-    const scara_real t68 = t67/t64;
-    const scara_real t69 = (t42 + t53*t68)/t38;
-    const scara_real t70 = (t29 - t34*t69 - t49*t68)/t25;
+    const scara_real t68 = (t64 != 0 ? -t67/t64 : 0);
+    const scara_real t69 = (t38 != 0 ? -(t42 - t53*t68)/t38 : 0);
+    const scara_real t70 = (t25 != 0 ? -(t29 + t34*t69 + t49*t68)/t25 : 0);
     const scara_real t71 = t1*t69 - t3*t70 + t68;
     const scara_real t72 = t0*t69 - t2*t70 + t68;
     const scara_real t73 = -t3;
@@ -473,9 +473,9 @@ int scara_velocity_ik(const scara_real q[SCARA_DOF], const scara_real mu_dot[SCA
     const scara_real t98 = t94 + t97;
     const scara_real t99 = (t96 > 0 ? 1/(t96*(t95 + t96)) : 0);
     const scara_real t100 = -t89*t99*(t98*t98) + t89;
-    const scara_real t101 = t100/t97;
-    const scara_real t102 = (t101*t93 + t88)/t84;
-    const scara_real t103 = (t101*t12*t74 - t102*t76 + t80)/t11;
+    const scara_real t101 = (t97 != 0 ? -t100/t97 : 0);
+    const scara_real t102 = (t84 != 0 ? -(-t101*t93 + t88)/t84 : 0);
+    const scara_real t103 = (t11 != 0 ? -(-t101*t12*t74 + t102*t76 + t80)/t11 : 0);
     const int t104 = damping > 0;
     const int t105 = isfinite(t90);
     const int t106 = damping >= 0;
@@ -485,16 +485,16 @@ int scara_velocity_ik(const scara_real q[SCARA_DOF], const scara_real mu_dot[SCA
     const int t110 = t105 && t106 && !t109;
 
     /* Outputs */
-    q_dot[0] = (t110 ? (t104 ? -t71 : -t103) : 0);
-    q_dot[1] = (t110 ? (t104 ? -t72 : -t102) : 0);
-    q_dot[2] = (t110 ? (t104 ? t61 : -mu_dot2) : 0);
-    q_dot[3] = (t110 ? (t104 ? t68 : -t101) : 0);
+    q_dot[0] = (t110 ? (t104 ? t71 : t103) : 0);
+    q_dot[1] = (t110 ? (t104 ? t72 : t102) : 0);
+    q_dot[2] = (t110 ? (t104 ? -t61 : -mu_dot2) : 0);
+    q_dot[3] = (t110 ? (t104 ? -t68 : t101) : 0);
     return (!(t105 && t106) ? 2 : (t109 ? 1 : 0));
 }
 
 scara_real scara_ik_numeric_step(const scara_real target[SCARA_TASK_DIM], const scara_real q[SCARA_DOF], scara_real damping, scara_real q_start[SCARA_DOF], scara_real q_next[SCARA_DOF])
 {
-    /* 220 operations */
+    /* 227 operations */
 
     /* Inputs */
     const scara_real mu0 = target[0];
@@ -574,37 +574,36 @@ scara_real scara_ik_numeric_step(const scara_real target[SCARA_TASK_DIM], const 
     const scara_real t52 = t4 + t51;
     const scara_real t53 = (t50 > 0 ? 1/(t50*(t49 + t50)) : 0);
     const scara_real t54 = -t3*t53*(t52*t52) + t3;
-    const scara_real t55 = t54/t51;
-    const scara_real t56 = q3 + t55;
+    const scara_real t55 = (t51 != 0 ? -t54/t51 : 0);
+    const scara_real t56 = q3 - t55;
     const scara_real t57 = fabs(t48);
     const scara_real t58 = t57;
     const scara_real t59 = t58*(t48 >= 0 ? 1 : -1);
     const scara_real t60 = t48 + t59;
     const scara_real t61 = (t58 > 0 ? 1/(t58*(t57 + t58)) : 0);
     const scara_real t62 = -t40*t61*(t60*t60) + t40;
-    const scara_real t63 = t62/t59;
-    const scara_real t64 = (t39 + t47*t63)/t35;
-    const scara_real t65 = (t26 - t31*t64 - t43*t63)/t22;
-    const scara_real t66 = q4 + t63;
-    const scara_real t67 = -t63;
-    const scara_real t68 = q1 + t12*t65 - t64*t7 + t67;
-    const scara_real t69 = q2 + t11*t65 - t6*t64 + t67;
+    const scara_real t63 = (t59 != 0 ? -t62/t59 : 0);
+    const scara_real t64 = (t35 != 0 ? -(t39 - t47*t63)/t35 : 0);
+    const scara_real t65 = (t22 != 0 ? -(t26 + t31*t64 + t43*t63)/t22 : 0);
+    const scara_real t66 = q1 - t12*t65 + t63 + t64*t7;
+    const scara_real t67 = q2 - t11*t65 + t6*t64 + t63;
+    const scara_real t68 = q4 - t63;
 
     /* Outputs */
     q_start[0] = q1;
     q_start[1] = q2;
     q_start[2] = q3;
     q_start[3] = q4;
-    q_next[0] = (t68 < -0.8726646259971648 ? -0.8726646259971648 : (t68 > 0.8726646259971648 ? 0.8726646259971648 : t68));
-    q_next[1] = (t69 < -1.53588974175501 ? -1.53588974175501 : (t69 > 1.53588974175501 ? 1.53588974175501 : t69));
+    q_next[0] = (t66 < -0.8726646259971648 ? -0.8726646259971648 : (t66 > 0.8726646259971648 ? 0.8726646259971648 : t66));
+    q_next[1] = (t67 < -1.53588974175501 ? -1.53588974175501 : (t67 > 1.53588974175501 ? 1.53588974175501 : t67));
     q_next[2] = (t56 < 0 ? 0.0 : (t56 > 0.21 ? 0.21 : t56));
-    q_next[3] = (t66 < -6.283185307179586 ? -6.283185307179586 : (t66 > 6.283185307179586 ? 6.283185307179586 : t66));
+    q_next[3] = (t68 < -6.283185307179586 ? -6.283185307179586 : (t68 > 6.283185307179586 ? 6.283185307179586 : t68));
     return (isfinite(t5) ? t19 : -1);
 }
 
 void scara_ik_branches(const scara_real mu[SCARA_TASK_DIM], scara_real q[SCARA_MAX_IK_SOLUTIONS * SCARA_DOF], int valid[SCARA_MAX_IK_SOLUTIONS])
 {
-    /* 120 operations */
+    /* 127 operations */
 
     /* Inputs */
     const scara_real mu0 = mu[0];
@@ -616,53 +615,58 @@ void scara_ik_branches(const scara_real mu[SCARA_TASK_DIM], scara_real q[SCARA_M
     const scara_real t0 = (mu0*mu0) + (mu1*mu1) + 0.149769;
     const scara_real t1 = 0.1655095 - 0.5*t0;
     const scara_real t2 = mu0 + mu1 + mu2 + mu3;
-    const scara_real t3 = (t1*t1);
-    const scara_real t4 = 1 - 125.18949581886645*t3;
-    const int t5 = 1e-12 < t4;
-    const scara_real t6 = (t5 ? 11.188811188811188*t1 : (t1 > 0 ? 1 : -1));
-    const scara_real t7 = (t5 ? sqrt(t4) : 0);
-    const scara_real t8 = atan2(t7, t6);
-    const scara_real t9 = 3.141592653589793 - t8;
-    const scara_real t10 = 0.325 - 0.275*t6;
-    const scara_real t11 = (t10*t10) + 0.075625*(t7*t7) + 0.149769;
-    const int t12 = 0;
-    const scara_real t13 = (t12 ? 0 : t8 + 3.141592653589793);
-    const scara_real t14 = (t12 ? 1 : -t6);
-    const scara_real t15 = (t12 ? 0 : -t7);
-    const scara_real t16 = 0.275*t14 + 0.325;
-    const scara_real t17 = 0.075625*(t15*t15) + (t16*t16) + 0.149769;
-    const scara_real t18 = 0.275*t15;
-    const scara_real t19 = mu0*t16 + mu1*t18 + 0.149769;
-    const scara_real t20 = t19 - 0.149769;
-    const scara_real t21 = -mu0*t18 + mu1*t16;
-    const scara_real t22 = (t20*t20) + (t21*t21);
-    const scara_real t23 = 0.275*t7;
-    const scara_real t24 = mu0*t10 + mu1*t23 + 0.149769;
-    const scara_real t25 = t24 - 0.149769;
-    const scara_real t26 = -mu0*t23 + mu1*t10;
-    const scara_real t27 = (t25*t25) + (t26*t26);
-    const scara_real t28 = 1e-24*t0;
-    const scara_real t29 = (t22 <= t17*t28 ? 0 : atan2(t21, t20));
-    const scara_real t30 = 0.387 - mu2;
-    const scara_real t31 = -mu3;
-    const scara_real t32 = -t13 - t29 - t31;
-    const scara_real t33 = (t27 <= t11*t28 ? 0 : atan2(t26, t25));
-    const scara_real t34 = -t31 - t33 - t9;
-    const int t35 = isfinite(t2);
-    const scara_real t36 = 1.9314171249999998e-26;
-    const int t37 = 0.007987890625 > t36;
+    const int t3 = 0;
+    const scara_real t4 = (t3 ? 1 : 11.188811188811188);
+    const scara_real t5 = (t1*t1);
+    const scara_real t6 = (t4*t4);
+    const scara_real t7 = -t5*t6 + 1;
+    const scara_real t8 = t1*t4;
+    const int t9 = 1e-12 < t7;
+    const scara_real t10 = (t9 ? t8 : (t8 > 0 ? 1 : -1));
+    const scara_real t11 = (t9 ? sqrt(t7) : 0);
+    const scara_real t12 = atan2(t11, t10);
+    const scara_real t13 = (t3 ? 0 : t12 + 3.141592653589793);
+    const scara_real t14 = 3.141592653589793 - t12;
+    const scara_real t15 = 0.089375*t4;
+    const scara_real t16 = (t3 ? 1 : -t10*t15);
+    const scara_real t17 = (t3 ? 0 : -t11*t15);
+    const scara_real t18 = 0.275*t16 + 0.325;
+    const scara_real t19 = 0.075625*(t17*t17) + (t18*t18) + 0.149769;
+    const scara_real t20 = 0.275*t17;
+    const scara_real t21 = mu0*t18 + mu1*t20 + 0.149769;
+    const scara_real t22 = t21 - 0.149769;
+    const scara_real t23 = -mu0*t20 + mu1*t18;
+    const scara_real t24 = (t22*t22) + (t23*t23);
+    const scara_real t25 = 0.024578125*t4;
+    const scara_real t26 = -t10*t25 + 0.325;
+    const scara_real t27 = 0.000604084228515625*t6*(t11*t11) + (t26*t26) + 0.149769;
+    const scara_real t28 = t11*t25;
+    const scara_real t29 = mu0*t26 + mu1*t28 + 0.149769;
+    const scara_real t30 = t29 - 0.149769;
+    const scara_real t31 = -mu0*t28 + mu1*t26;
+    const scara_real t32 = (t30*t30) + (t31*t31);
+    const scara_real t33 = 1e-24*t0;
+    const scara_real t34 = (t24 <= t19*t33 ? 0 : atan2(t23, t22));
+    const scara_real t35 = 0.387 - mu2;
+    const scara_real t36 = -mu3;
+    const scara_real t37 = -t13 - t34 - t36;
+    const scara_real t38 = (t32 <= t27*t33 ? 0 : atan2(t31, t30));
+    const scara_real t39 = -t14 - t36 - t38;
+    const int t40 = isfinite(t2);
+    const scara_real t41 = 1.9314171249999998e-26;
+    const int t42 = 0.007987890625 > t41;
 
     /* Outputs */
-    q[0] = t29;
+    q[0] = t34;
     q[1] = t13 - 6.283185307179586*ceil(0.15915494309189535*t13 - 0.5);
-    q[2] = t30;
-    q[3] = -t32 - 6.283185307179586*ceil(-0.15915494309189535*t32 - 0.5);
-    q[4] = t33;
-    q[5] = t9 - 6.283185307179586*ceil(0.15915494309189535*t9 - 0.5);
-    q[6] = t30;
-    q[7] = -t34 - 6.283185307179586*ceil(-0.15915494309189535*t34 - 0.5);
-    valid[0] = t35 && ((t37 && t4 >= -1e-12) || (0.007987890625 <= t36 && t3 <= 1.931417125e-14));
-    valid[1] = t35 && t37 && t4 > 1e-12;
+    q[2] = t35;
+    q[3] = -t37 - 6.283185307179586*ceil(-0.15915494309189535*t37 - 0.5);
+    q[4] = t38;
+    q[5] = t14 - 6.283185307179586*ceil(0.15915494309189535*t14 - 0.5);
+    q[6] = t35;
+    q[7] = -t39 - 6.283185307179586*ceil(-0.15915494309189535*t39 - 0.5);
+    valid[0] = t40 && ((t42 && t7 >= -1e-12) || (0.007987890625 <= t41 && t5 <= 1.931417125e-14));
+    valid[1] = t40 && t42 && t7 > 1e-12;
 }
 
 int scara_ik(const scara_real mu[SCARA_TASK_DIM], scara_real q[SCARA_MAX_IK_SOLUTIONS * SCARA_DOF])

@@ -249,7 +249,7 @@ def _jacobian_det(q):
 
 
 def _velocity_ik(q, mu_dot, damping):
-    """Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: 322 operations."""
+    """Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: 333 operations."""
     q1 = q[0]
     q2 = q[1]
     q3 = q[2]
@@ -325,16 +325,16 @@ def _velocity_ik(q, mu_dot, damping):
     t58 = t45 + t57
     t59 = casadi.if_else((t56 > 0), 1/(t56*(t55 + t56)), 0)
     t60 = -mu_dot2*t58**2*t59 + mu_dot2
-    t61 = t60/t57
+    t61 = casadi.if_else((t57 != 0), -t60/t57, 0)
     t62 = casadi.fabs(t54)
     t63 = t62
     t64 = t63*casadi.if_else((t54 >= 0), 1, -1)
     t65 = t54 + t64
     t66 = casadi.if_else((t63 > 0), 1/(t63*(t62 + t63)), 0)
     t67 = -t43*t65**2*t66 + t43
-    t68 = t67/t64
-    t69 = (t42 + t53*t68)/t38
-    t70 = (t29 - t34*t69 - t49*t68)/t25
+    t68 = casadi.if_else((t64 != 0), -t67/t64, 0)
+    t69 = casadi.if_else((t38 != 0), -(t42 - t53*t68)/t38, 0)
+    t70 = casadi.if_else((t25 != 0), -(t29 + t34*t69 + t49*t68)/t25, 0)
     t71 = t1*t69 - t3*t70 + t68
     t72 = t0*t69 - t2*t70 + t68
     t73 = -t3
@@ -365,9 +365,9 @@ def _velocity_ik(q, mu_dot, damping):
     t98 = t94 + t97
     t99 = casadi.if_else((t96 > 0), 1/(t96*(t95 + t96)), 0)
     t100 = -t89*t98**2*t99 + t89
-    t101 = t100/t97
-    t102 = (t101*t93 + t88)/t84
-    t103 = (t101*t12*t74 - t102*t76 + t80)/t11
+    t101 = casadi.if_else((t97 != 0), -t100/t97, 0)
+    t102 = casadi.if_else((t84 != 0), -(-t101*t93 + t88)/t84, 0)
+    t103 = casadi.if_else((t11 != 0), -(-t101*t12*t74 + t102*t76 + t80)/t11, 0)
     t104 = (damping > 0)
     t105 = (casadi.fabs(t90) < casadi.inf)
     t106 = (damping >= 0)
@@ -376,17 +376,17 @@ def _velocity_ik(q, mu_dot, damping):
     t109 = casadi.logic_or(casadi.logic_and(t104, casadi.logic_or(casadi.logic_or(casadi.logic_or((t24 <= t108), (t37 <= t108)), (t56 <= t108)), (t63 <= t108))), casadi.logic_and((damping <= 0), casadi.logic_or(casadi.logic_or(casadi.logic_or((t107 >= 1), (t10 <= t107)), (t83 <= t107)), (t96 <= t107))))
     t110 = casadi.logic_and(casadi.logic_and(t105, t106), casadi.logic_not(t109))
     q_dot = casadi.SX(4, 1)
-    q_dot[0, 0] = casadi.if_else(t110, casadi.if_else(t104, -t71, -t103), 0)
-    q_dot[1, 0] = casadi.if_else(t110, casadi.if_else(t104, -t72, -t102), 0)
-    q_dot[2, 0] = casadi.if_else(t110, casadi.if_else(t104, t61, -mu_dot2), 0)
-    q_dot[3, 0] = casadi.if_else(t110, casadi.if_else(t104, t68, -t101), 0)
+    q_dot[0, 0] = casadi.if_else(t110, casadi.if_else(t104, t71, t103), 0)
+    q_dot[1, 0] = casadi.if_else(t110, casadi.if_else(t104, t72, t102), 0)
+    q_dot[2, 0] = casadi.if_else(t110, casadi.if_else(t104, -t61, -mu_dot2), 0)
+    q_dot[3, 0] = casadi.if_else(t110, casadi.if_else(t104, -t68, t101), 0)
     status = casadi.SX(1, 1)
     status[0, 0] = casadi.if_else(casadi.logic_not(casadi.logic_and(t105, t106)), 2, casadi.if_else(t109, 1, 0))
     return [q_dot, status]
 
 
 def _ik_numeric_step(target, q, damping):
-    """One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite): 220 operations."""
+    """One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite): 227 operations."""
     mu0 = target[0]
     mu1 = target[1]
     mu2 = target[2]
@@ -462,38 +462,37 @@ def _ik_numeric_step(target, q, damping):
     t52 = t4 + t51
     t53 = casadi.if_else((t50 > 0), 1/(t50*(t49 + t50)), 0)
     t54 = -t3*t52**2*t53 + t3
-    t55 = t54/t51
-    t56 = q3 + t55
+    t55 = casadi.if_else((t51 != 0), -t54/t51, 0)
+    t56 = q3 - t55
     t57 = casadi.fabs(t48)
     t58 = t57
     t59 = t58*casadi.if_else((t48 >= 0), 1, -1)
     t60 = t48 + t59
     t61 = casadi.if_else((t58 > 0), 1/(t58*(t57 + t58)), 0)
     t62 = -t40*t60**2*t61 + t40
-    t63 = t62/t59
-    t64 = (t39 + t47*t63)/t35
-    t65 = (t26 - t31*t64 - t43*t63)/t22
-    t66 = q4 + t63
-    t67 = -t63
-    t68 = q1 + t12*t65 - t64*t7 + t67
-    t69 = q2 + t11*t65 - t6*t64 + t67
+    t63 = casadi.if_else((t59 != 0), -t62/t59, 0)
+    t64 = casadi.if_else((t35 != 0), -(t39 - t47*t63)/t35, 0)
+    t65 = casadi.if_else((t22 != 0), -(t26 + t31*t64 + t43*t63)/t22, 0)
+    t66 = q1 - t12*t65 + t63 + t64*t7
+    t67 = q2 - t11*t65 + t6*t64 + t63
+    t68 = q4 - t63
     q_start = casadi.SX(4, 1)
     q_start[0, 0] = q1
     q_start[1, 0] = q2
     q_start[2, 0] = q3
     q_start[3, 0] = q4
     q_next = casadi.SX(4, 1)
-    q_next[0, 0] = casadi.if_else((t68 < -0.8726646259971648), -0.8726646259971648, casadi.if_else((t68 > 0.8726646259971648), 0.8726646259971648, t68))
-    q_next[1, 0] = casadi.if_else((t69 < -1.53588974175501), -1.53588974175501, casadi.if_else((t69 > 1.53588974175501), 1.53588974175501, t69))
+    q_next[0, 0] = casadi.if_else((t66 < -0.8726646259971648), -0.8726646259971648, casadi.if_else((t66 > 0.8726646259971648), 0.8726646259971648, t66))
+    q_next[1, 0] = casadi.if_else((t67 < -1.53588974175501), -1.53588974175501, casadi.if_else((t67 > 1.53588974175501), 1.53588974175501, t67))
     q_next[2, 0] = casadi.if_else((t56 < 0), 0.0, casadi.if_else((t56 > 0.21), 0.21, t56))
-    q_next[3, 0] = casadi.if_else((t66 < -6.283185307179586), -6.283185307179586, casadi.if_else((t66 > 6.283185307179586), 6.283185307179586, t66))
+    q_next[3, 0] = casadi.if_else((t68 < -6.283185307179586), -6.283185307179586, casadi.if_else((t68 > 6.283185307179586), 6.283185307179586, t68))
     cost = casadi.SX(1, 1)
     cost[0, 0] = casadi.if_else((casadi.fabs(t5) < casadi.inf), t19, -1)
     return [q_start, q_next, cost]
 
 
 def _ik_branches(mu):
-    """Every branch of the closed-form ik and whether the target allows it: 120 operations."""
+    """Every branch of the closed-form ik and whether the target allows it: 127 operations."""
     mu0 = mu[0]
     mu1 = mu[1]
     mu2 = mu[2]
@@ -501,53 +500,58 @@ def _ik_branches(mu):
     t0 = mu0**2 + mu1**2 + 0.149769
     t1 = 0.1655095 - 0.5*t0
     t2 = mu0 + mu1 + mu2 + mu3
-    t3 = t1**2
-    t4 = 1 - 125.18949581886645*t3
-    t5 = (1e-12 < t4)
-    t6 = casadi.if_else(t5, 11.188811188811188*t1, casadi.if_else((t1 > 0), 1, -1))
-    t7 = casadi.if_else(t5, casadi.sqrt(t4), 0)
-    t8 = casadi.atan2(t7, t6)
-    t9 = 3.141592653589793 - t8
-    t10 = 0.325 - 0.275*t6
-    t11 = t10**2 + 0.075625*t7**2 + 0.149769
-    t12 = False
-    t13 = casadi.if_else(t12, 0, t8 + 3.141592653589793)
-    t14 = casadi.if_else(t12, 1, -t6)
-    t15 = casadi.if_else(t12, 0, -t7)
-    t16 = 0.275*t14 + 0.325
-    t17 = 0.075625*t15**2 + t16**2 + 0.149769
-    t18 = 0.275*t15
-    t19 = mu0*t16 + mu1*t18 + 0.149769
-    t20 = t19 - 0.149769
-    t21 = -mu0*t18 + mu1*t16
-    t22 = t20**2 + t21**2
-    t23 = 0.275*t7
-    t24 = mu0*t10 + mu1*t23 + 0.149769
-    t25 = t24 - 0.149769
-    t26 = -mu0*t23 + mu1*t10
-    t27 = t25**2 + t26**2
-    t28 = 1e-24*t0
-    t29 = casadi.if_else((t22 <= t17*t28), 0, casadi.atan2(t21, t20))
-    t30 = -(mu2 - 0.387)
-    t31 = -mu3
-    t32 = -t13 - t29 - t31
-    t33 = casadi.if_else((t27 <= t11*t28), 0, casadi.atan2(t26, t25))
-    t34 = -t31 - t33 - t9
-    t35 = (casadi.fabs(t2) < casadi.inf)
-    t36 = 1.9314171249999998e-26
-    t37 = (0.007987890625 > t36)
+    t3 = False
+    t4 = casadi.if_else(t3, 1, 11.188811188811188)
+    t5 = t1**2
+    t6 = t4**2
+    t7 = -t5*t6 + 1
+    t8 = t1*t4
+    t9 = (1e-12 < t7)
+    t10 = casadi.if_else(t9, t8, casadi.if_else((t8 > 0), 1, -1))
+    t11 = casadi.if_else(t9, casadi.sqrt(t7), 0)
+    t12 = casadi.atan2(t11, t10)
+    t13 = casadi.if_else(t3, 0, t12 + 3.141592653589793)
+    t14 = 3.141592653589793 - t12
+    t15 = 0.089375*t4
+    t16 = casadi.if_else(t3, 1, -t10*t15)
+    t17 = casadi.if_else(t3, 0, -t11*t15)
+    t18 = 0.275*t16 + 0.325
+    t19 = 0.075625*t17**2 + t18**2 + 0.149769
+    t20 = 0.275*t17
+    t21 = mu0*t18 + mu1*t20 + 0.149769
+    t22 = t21 - 0.149769
+    t23 = -mu0*t20 + mu1*t18
+    t24 = t22**2 + t23**2
+    t25 = 0.024578125*t4
+    t26 = -t10*t25 + 0.325
+    t27 = 0.000604084228515625*t11**2*t6 + t26**2 + 0.149769
+    t28 = t11*t25
+    t29 = mu0*t26 + mu1*t28 + 0.149769
+    t30 = t29 - 0.149769
+    t31 = -mu0*t28 + mu1*t26
+    t32 = t30**2 + t31**2
+    t33 = 1e-24*t0
+    t34 = casadi.if_else((t24 <= t19*t33), 0, casadi.atan2(t23, t22))
+    t35 = -(mu2 - 0.387)
+    t36 = -mu3
+    t37 = -t13 - t34 - t36
+    t38 = casadi.if_else((t32 <= t27*t33), 0, casadi.atan2(t31, t30))
+    t39 = -t14 - t36 - t38
+    t40 = (casadi.fabs(t2) < casadi.inf)
+    t41 = 1.9314171249999998e-26
+    t42 = (0.007987890625 > t41)
     q = casadi.SX(2, 4)
-    q[0, 0] = t29
+    q[0, 0] = t34
     q[0, 1] = t13 - 6.283185307179586*casadi.ceil(0.15915494309189535*t13 - 0.5)
-    q[0, 2] = t30
-    q[0, 3] = -t32 - 6.283185307179586*casadi.ceil(-0.15915494309189535*t32 - 0.5)
-    q[1, 0] = t33
-    q[1, 1] = t9 - 6.283185307179586*casadi.ceil(0.15915494309189535*t9 - 0.5)
-    q[1, 2] = t30
-    q[1, 3] = -t34 - 6.283185307179586*casadi.ceil(-0.15915494309189535*t34 - 0.5)
+    q[0, 2] = t35
+    q[0, 3] = -t37 - 6.283185307179586*casadi.ceil(-0.15915494309189535*t37 - 0.5)
+    q[1, 0] = t38
+    q[1, 1] = t14 - 6.283185307179586*casadi.ceil(0.15915494309189535*t14 - 0.5)
+    q[1, 2] = t35
+    q[1, 3] = -t39 - 6.283185307179586*casadi.ceil(-0.15915494309189535*t39 - 0.5)
     valid = casadi.SX(2, 1)
-    valid[0, 0] = casadi.logic_and(t35, casadi.logic_or(casadi.logic_and(t37, (t4 >= -1e-12)), casadi.logic_and((0.007987890625 <= t36), (t3 <= 1.931417125e-14))))
-    valid[1, 0] = casadi.logic_and(casadi.logic_and(t35, t37), (t4 > 1e-12))
+    valid[0, 0] = casadi.logic_and(t40, casadi.logic_or(casadi.logic_and(t42, (t7 >= -1e-12)), casadi.logic_and((0.007987890625 <= t41), (t5 <= 1.931417125e-14))))
+    valid[1, 0] = casadi.logic_and(casadi.logic_and(t40, t42), (t7 > 1e-12))
     return [q, valid]
 
 

@@ -71,15 +71,15 @@ stanford_real stanford_manipulability(const stanford_real q[STANFORD_DOF]);
 stanford_real stanford_jacobian_det(const stanford_real q[STANFORD_DOF]);
 
 /* Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status.
- * Result: q_dot[i], i < 6; returned as a scalar. 1157 operations. */
+ * Result: q_dot[i], i < 6; returned as a scalar. 1168 operations. */
 int stanford_velocity_ik(const stanford_real q[STANFORD_DOF], const stanford_real mu_dot[STANFORD_TASK_DIM], stanford_real damping, stanford_real q_dot[STANFORD_DOF]);
 
 /* One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite).
- * Result: q_start[i], i < 6; q_next[i], i < 6; returned as a scalar. 866 operations. */
+ * Result: q_start[i], i < 6; q_next[i], i < 6; returned as a scalar. 876 operations. */
 stanford_real stanford_ik_numeric_step(const stanford_real target[16], const stanford_real q[STANFORD_DOF], stanford_real damping, stanford_real q_start[STANFORD_DOF], stanford_real q_next[STANFORD_DOF]);
 
 /* Every branch of the closed-form ik and whether the target allows it.
- * Result: q: 8 x 6 row-major, element (r, c) at q[r * 6 + c]; valid[i], i < 8. 630 operations. */
+ * Result: q: 8 x 6 row-major, element (r, c) at q[r * 6 + c]; valid[i], i < 8. 642 operations. */
 void stanford_ik_branches(const stanford_real T[16], stanford_real q[STANFORD_MAX_IK_SOLUTIONS * STANFORD_DOF], int valid[STANFORD_MAX_IK_SOLUTIONS]);
 
 /* Statuses of stanford_velocity_ik: OK, singular (a diagonal entry of the QR factor R of the

@@ -462,7 +462,7 @@ def _jacobian_det(q):
 
 
 def _velocity_ik(q, mu_dot, damping):
-    """Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: 1157 operations."""
+    """Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: 1168 operations."""
     q1 = q[0]
     q2 = q[1]
     q3 = q[2]
@@ -695,12 +695,12 @@ def _velocity_ik(q, mu_dot, damping):
     t209 = t205 + t208
     t210 = casadi.if_else((t207 > 0), 1/(t207*(t206 + t207)), 0)
     t211 = -t186*t209**2*t210 + t186
-    t212 = t211/t208
-    t213 = (t185 + t204*t212)/t181
-    t214 = (t173*t213 + t177 + t200*t212)/t169
-    t215 = (t154*t214 - t159*t213 + t164 - t195*t212)/t150
-    t216 = (t122*t213 + t128 - t137*t214 + t144*t215 + t189*t212)/t118
-    t217 = (t104*t213 + t111 - t212*t84 - t214*t98 + t215*t79 + t216*t90)/t75
+    t212 = casadi.if_else((t208 != 0), -t211/t208, 0)
+    t213 = casadi.if_else((t181 != 0), -(t185 - t204*t212)/t181, 0)
+    t214 = casadi.if_else((t169 != 0), -(-t173*t213 + t177 - t200*t212)/t169, 0)
+    t215 = casadi.if_else((t150 != 0), -(-t154*t214 + t159*t213 + t164 + t195*t212)/t150, 0)
+    t216 = casadi.if_else((t118 != 0), -(-t122*t213 + t128 + t137*t214 - t144*t215 - t189*t212)/t118, 0)
+    t217 = casadi.if_else((t75 != 0), -(-t104*t213 + t111 + t212*t84 + t214*t98 - t215*t79 - t216*t90)/t75, 0)
     t218 = t2*t216 + t212 - t217*t4
     t219 = c2*t215 + t1*t217 + t216*t3
     t220 = c2*t212 + t1*t214 + t213*t3
@@ -824,12 +824,12 @@ def _velocity_ik(q, mu_dot, damping):
     t338 = t334 + t337
     t339 = casadi.if_else((t336 > 0), 1/(t336*(t335 + t336)), 0)
     t340 = -t321*t338**2*t339 + t321
-    t341 = t340/t337
-    t342 = (t320 + t333*t341)/t316
-    t343 = (t302 + t312*t342 + t329*t341)/t298
-    t344 = (t288*t343 + t293 + t307*t342 + t324*t341)/t281
-    t345 = (t243*t344 + t247 - t263*t343 + t269*t342 + t275*t341)/t239
-    t346 = (-c2*t227*t343*t40 + t227*t255*t342 + t227*t259*t341 + t229*t345 + t232*t344 + t235)/t39
+    t341 = casadi.if_else((t337 != 0), -t340/t337, 0)
+    t342 = casadi.if_else((t316 != 0), -(t320 - t333*t341)/t316, 0)
+    t343 = casadi.if_else((t298 != 0), -(t302 - t312*t342 - t329*t341)/t298, 0)
+    t344 = casadi.if_else((t281 != 0), -(-t288*t343 + t293 - t307*t342 - t324*t341)/t281, 0)
+    t345 = casadi.if_else((t239 != 0), -(-t243*t344 + t247 + t263*t343 - t269*t342 - t275*t341)/t239, 0)
+    t346 = casadi.if_else((t39 != 0), -(t227*t252*t343 - t227*t255*t342 - t227*t259*t341 - t229*t345 - t232*t344 + t235)/t39, 0)
     t347 = (damping > 0)
     t348 = (casadi.fabs(t258) < casadi.inf)
     t349 = (damping >= 0)
@@ -838,19 +838,19 @@ def _velocity_ik(q, mu_dot, damping):
     t352 = casadi.logic_or(casadi.logic_and(t347, casadi.logic_or(casadi.logic_or(casadi.logic_or(casadi.logic_or(casadi.logic_or((t117 <= t351), (t149 <= t351)), (t168 <= t351)), (t180 <= t351)), (t207 <= t351)), (t74 <= t351))), casadi.logic_and((damping <= 0), casadi.logic_or(casadi.logic_or(casadi.logic_or(casadi.logic_or(casadi.logic_or((t238 <= t350), (t280 <= t350)), (t297 <= t350)), (t315 <= t350)), (t336 <= t350)), (t38 <= t350))))
     t353 = casadi.logic_and(casadi.logic_and(t348, t349), casadi.logic_not(t352))
     q_dot = casadi.SX(6, 1)
-    q_dot[0, 0] = casadi.if_else(t353, casadi.if_else(t347, -t218, -t346), 0)
-    q_dot[1, 0] = casadi.if_else(t353, casadi.if_else(t347, -t225, -t345), 0)
-    q_dot[2, 0] = casadi.if_else(t353, casadi.if_else(t347, -t219, -t344), 0)
-    q_dot[3, 0] = casadi.if_else(t353, casadi.if_else(t347, -t220, -t343), 0)
-    q_dot[4, 0] = casadi.if_else(t353, casadi.if_else(t347, -t221, -t342), 0)
-    q_dot[5, 0] = casadi.if_else(t353, casadi.if_else(t347, -t222, -t341), 0)
+    q_dot[0, 0] = casadi.if_else(t353, casadi.if_else(t347, t218, t346), 0)
+    q_dot[1, 0] = casadi.if_else(t353, casadi.if_else(t347, t225, t345), 0)
+    q_dot[2, 0] = casadi.if_else(t353, casadi.if_else(t347, t219, t344), 0)
+    q_dot[3, 0] = casadi.if_else(t353, casadi.if_else(t347, t220, t343), 0)
+    q_dot[4, 0] = casadi.if_else(t353, casadi.if_else(t347, t221, t342), 0)
+    q_dot[5, 0] = casadi.if_else(t353, casadi.if_else(t347, t222, t341), 0)
     status = casadi.SX(1, 1)
     status[0, 0] = casadi.if_else(casadi.logic_not(casadi.logic_and(t348, t349)), 2, casadi.if_else(t352, 1, 0))
     return [q_dot, status]
 
 
 def _ik_numeric_step(target, q, damping):
-    """One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite): 866 operations."""
+    """One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite): 876 operations."""
     T00 = target[0, 0]
     T01 = target[0, 1]
     T02 = target[0, 2]
@@ -1124,18 +1124,18 @@ def _ik_numeric_step(target, q, damping):
     t236 = t232 + t235
     t237 = casadi.if_else((t234 > 0), 1/(t234*(t233 + t234)), 0)
     t238 = -t213*t236**2*t237 + t213
-    t239 = t238/t235
-    t240 = (t212 + t231*t239)/t208
-    t241 = (t200*t240 + t204 + t227*t239)/t196
-    t242 = (t181*t241 - t186*t240 + t191 - t222*t239)/t177
-    t243 = (t121 - t143*t241 + t157*t240 + t171*t242 + t216*t239)/t117
-    t244 = (t103*t243 + t110 + t128*t242 - t135*t241 + t150*t240 - t164*t239)/t97
-    t245 = q1 - t2*t243 - t239 + t244*t3
-    t246 = -c1*t240 - c1*t244*t7 + q2 + s1*t241 - s1*t243*t7 + t242*t4
-    t247 = c2*t242 - q3 + t18*t244 + t243*t26
-    t248 = c2*t239 - q4 + t18*t241 + t240*t26
-    t249 = q5 - t13*t240 - t16*t241 + t239*t38
-    t250 = q6 - t20*t241 + t239*t37 - t240*t28
+    t239 = casadi.if_else((t235 != 0), -t238/t235, 0)
+    t240 = casadi.if_else((t208 != 0), -(t212 - t231*t239)/t208, 0)
+    t241 = casadi.if_else((t196 != 0), -(-t200*t240 + t204 - t227*t239)/t196, 0)
+    t242 = casadi.if_else((t177 != 0), -(-t181*t241 + t186*t240 + t191 + t222*t239)/t177, 0)
+    t243 = casadi.if_else((t117 != 0), -(t121 + t143*t241 - t157*t240 - t171*t242 - t216*t239)/t117, 0)
+    t244 = casadi.if_else((t97 != 0), -(-t103*t243 + t110 - t128*t242 + t135*t241 - t150*t240 + t164*t239)/t97, 0)
+    t245 = q1 + t2*t243 + t239 - t244*t3
+    t246 = c1*t240 + c1*t244*t7 + q2 - s1*t241 + s1*t243*t7 - t242*t4
+    t247 = c2*t242 + q3 + t18*t244 + t243*t26
+    t248 = c2*t239 + q4 + t18*t241 + t240*t26
+    t249 = q5 + t13*t240 + t16*t241 - t239*t38
+    t250 = q6 + t20*t241 - t239*t37 + t240*t28
     q_start = casadi.SX(6, 1)
     q_start[0, 0] = q1
     q_start[1, 0] = q2
@@ -1146,8 +1146,8 @@ def _ik_numeric_step(target, q, damping):
     q_next = casadi.SX(6, 1)
     q_next[0, 0] = casadi.if_else((t245 < -2.9670597283903604), -2.9670597283903604, casadi.if_else((t245 > 2.9670597283903604), 2.9670597283903604, t245))
     q_next[1, 0] = casadi.if_else((t246 < -2.9670597283903604), -2.9670597283903604, casadi.if_else((t246 > 2.9670597283903604), 2.9670597283903604, t246))
-    q_next[2, 0] = casadi.if_else((t247 > -0.30479999999999996), 0.30479999999999996, casadi.if_else((t247 < -1.27), 1.27, -t247))
-    q_next[3, 0] = casadi.if_else((t248 > 2.9670597283903604), -2.9670597283903604, casadi.if_else((t248 < -2.9670597283903604), 2.9670597283903604, -t248))
+    q_next[2, 0] = casadi.if_else((t247 < 0.30479999999999996), 0.30479999999999996, casadi.if_else((t247 > 1.27), 1.27, t247))
+    q_next[3, 0] = casadi.if_else((t248 < -2.9670597283903604), -2.9670597283903604, casadi.if_else((t248 > 2.9670597283903604), 2.9670597283903604, t248))
     q_next[4, 0] = casadi.if_else((t249 < -1.5707963267948966), -1.5707963267948966, casadi.if_else((t249 > 1.5707963267948966), 1.5707963267948966, t249))
     q_next[5, 0] = casadi.if_else((t250 < -2.9670597283903604), -2.9670597283903604, casadi.if_else((t250 > 2.9670597283903604), 2.9670597283903604, t250))
     cost = casadi.SX(1, 1)
@@ -1156,7 +1156,7 @@ def _ik_numeric_step(target, q, damping):
 
 
 def _ik_branches(T):
-    """Every branch of the closed-form ik and whether the target allows it: 630 operations."""
+    """Every branch of the closed-form ik and whether the target allows it: 642 operations."""
     T00 = T[0, 0]
     T01 = T[0, 1]
     T02 = T[0, 2]
@@ -1210,158 +1210,158 @@ def _ik_branches(T):
     t38 = t29*t8
     t39 = t37 + t38
     t40 = t35**2 + t39**2
-    t41 = 1/casadi.sqrt(t40)
-    t42 = -t37 + t38
-    t43 = t36**2 + t42**2
-    t44 = 1/casadi.sqrt(t43)
-    t45 = t29**2
-    t46 = t24 + t45
-    t47 = 1e-24*t46
-    t48 = t15*t47
-    t49 = (t40 <= t48)
-    t50 = casadi.if_else(t49, 1, t35*t41)
-    t51 = casadi.if_else(t49, 0, -t39*t41)
-    t52 = T02*t50 + T12*t51
-    t53 = -T02*t51 + T12*t50
-    t54 = T01*t50 + T11*t51
-    t55 = -T01*t51 + T11*t50
-    t56 = t13*t21
-    t57 = t56 + 0.01787569
-    t58 = t57 - 0.01787569
-    t59 = 0.01787569 - t56
-    t60 = t59 - 0.01787569
-    t61 = t22*t45
-    t62 = t58**2 + t61
-    t63 = 1/casadi.sqrt(t62)
-    t64 = t60**2 + t61
-    t65 = 1/casadi.sqrt(t64)
-    t66 = t23*t47
-    t67 = (t62 <= t66)
-    t68 = casadi.if_else(t67, 1, t58*t63)
-    t69 = t21*t29
-    t70 = t63*t69
-    t71 = casadi.if_else(t67, 0, -t70)
-    t72 = casadi.if_else(t67, 0, t70)
-    t73 = (t43 <= t48)
-    t74 = casadi.if_else(t73, 1, t36*t44)
-    t75 = casadi.if_else(t73, 0, t42*t44)
-    t76 = T02*t74 + T12*t75
-    t77 = -T02*t75 + T12*t74
-    t78 = T01*t74 + T11*t75
-    t79 = -T01*t75 + T11*t74
-    t80 = 1 - t50
-    t81 = T22*t80
-    t82 = T22*t50 + t81
-    t83 = T21*t80
-    t84 = T21*t50 + t83
-    t85 = t52*t68 - t71*t82
-    t86 = t52*t71 + t68*t82
-    t87 = t54*t68 - t71*t84
-    t88 = t54*t71 + t68*t84
-    t89 = 1 - t68
-    t90 = t53*t89
-    t91 = t53*t68 + t90
-    t92 = t55*t89
-    t93 = t55*t68 + t92
-    t94 = t77*t89
-    t95 = t68*t77 + t94
-    t96 = t79*t89
-    t97 = t68*t79 + t96
-    t98 = t86**2
-    t99 = -t98
-    t100 = t99 + 1
-    t101 = casadi.if_else((t100 > 1e-12), casadi.sqrt(t100), 0)
-    t102 = t101*t91 + t98
-    t103 = t102 + t99
-    t104 = t85**2
-    t105 = t104 + t91**2 + t98
-    t106 = t101**2
-    t107 = t103**2 + t104*t106
-    t108 = t106 + t98
-    t109 = 1/casadi.sqrt(t107)
-    t110 = 1/casadi.sqrt(t108)
-    t111 = 1e-24*t108
-    t112 = (t107 <= t105*t111)
-    t113 = casadi.if_else(t112, 1, t103*t109)
-    t114 = t88*(1 - t113)
-    t115 = t113*t88 + t114
-    t116 = t101*t85
-    t117 = casadi.if_else(t112, 0, -t109*t116)
-    t118 = t113*t87 + t117*t93
-    t119 = t113*t93 - t117*t87
-    t120 = (t108 <= t111)
-    t121 = casadi.if_else(t120, 1, t110*t86)
-    t122 = casadi.if_else(t120, 0, -t101*t110)
-    t123 = t118*(1 - t121)
-    t124 = t118*t121 + t123
-    t125 = t115*t122 + t119*t121
-    t126 = t115*t121 - t119*t122
-    t127 = t124**2 + t125**2
-    t128 = t127
-    t129 = t126**2 + t127
-    t130 = 1 - t74
-    t131 = T22*t130
-    t132 = T22*t74 + t131
-    t133 = T21*t130
-    t134 = T21*t74 + t133
-    t135 = -t132*t72 + t68*t76
-    t136 = t132*t68 + t72*t76
-    t137 = -t134*t72 + t68*t78
-    t138 = t134*t68 + t72*t78
-    t139 = t136**2
-    t140 = -t139
-    t141 = t140 + 1
-    t142 = casadi.if_else((t141 > 1e-12), casadi.sqrt(t141), 0)
-    t143 = t139 + t142*t95
-    t144 = t140 + t143
-    t145 = t135**2
-    t146 = t139 + t145 + t95**2
-    t147 = t142**2
-    t148 = t144**2 + t145*t147
-    t149 = t139 + t147
-    t150 = 1/casadi.sqrt(t148)
-    t151 = 1/casadi.sqrt(t149)
-    t152 = 1e-24*t149
-    t153 = (t148 <= t146*t152)
-    t154 = casadi.if_else(t153, 1, t144*t150)
-    t155 = t138*(1 - t154)
-    t156 = t138*t154 + t155
-    t157 = t135*t142
-    t158 = casadi.if_else(t153, 0, -t150*t157)
-    t159 = t137*t154 + t158*t97
-    t160 = -t137*t158 + t154*t97
-    t161 = (t149 <= t152)
-    t162 = casadi.if_else(t161, 1, t136*t151)
-    t163 = casadi.if_else(t161, 0, -t142*t151)
-    t164 = t159*(1 - t162)
-    t165 = t159*t162 + t164
-    t166 = t156*t163 + t160*t162
-    t167 = t156*t162 - t160*t163
-    t168 = t165**2 + t166**2
-    t169 = t168
-    t170 = t167**2 + t168
-    t171 = (t64 <= t66)
-    t172 = casadi.if_else(t171, 1, t60*t65)
-    t173 = t65*t69
-    t174 = casadi.if_else(t171, 0, t173)
-    t175 = casadi.if_else(t171, 0, -t173)
-    t176 = t172*t52 - t174*t82
-    t177 = t172*t82 + t174*t52
-    t178 = t172*t54 - t174*t84
-    t179 = t172*t84 + t174*t54
-    t180 = -t132*t175 + t172*t76
-    t181 = t132*t172 + t175*t76
-    t182 = -t134*t175 + t172*t78
-    t183 = t134*t172 + t175*t78
+    t41 = -t37 + t38
+    t42 = t36**2 + t41**2
+    t43 = t29**2
+    t44 = t24 + t43
+    t45 = 1e-24*t44
+    t46 = t15*t45
+    t47 = (t40 <= t46)
+    t48 = casadi.if_else(t47, 1, 1/casadi.sqrt(t40))
+    t49 = casadi.if_else(t47, 1, t35*t48)
+    t50 = casadi.if_else(t47, 0, -t39*t48)
+    t51 = T02*t49 + T12*t50
+    t52 = -T02*t50 + T12*t49
+    t53 = T01*t49 + T11*t50
+    t54 = -T01*t50 + T11*t49
+    t55 = t13*t21
+    t56 = t55 + 0.01787569
+    t57 = t56 - 0.01787569
+    t58 = 0.01787569 - t55
+    t59 = t58 - 0.01787569
+    t60 = t22*t43
+    t61 = t57**2 + t60
+    t62 = t59**2 + t60
+    t63 = t23*t45
+    t64 = (t61 <= t63)
+    t65 = casadi.if_else(t64, 1, 1/casadi.sqrt(t61))
+    t66 = casadi.if_else(t64, 1, t57*t65)
+    t67 = t21*t29
+    t68 = t65*t67
+    t69 = casadi.if_else(t64, 0, -t68)
+    t70 = casadi.if_else(t64, 0, t68)
+    t71 = (t42 <= t46)
+    t72 = casadi.if_else(t71, 1, 1/casadi.sqrt(t42))
+    t73 = casadi.if_else(t71, 1, t36*t72)
+    t74 = casadi.if_else(t71, 0, t41*t72)
+    t75 = T02*t73 + T12*t74
+    t76 = -T02*t74 + T12*t73
+    t77 = T01*t73 + T11*t74
+    t78 = -T01*t74 + T11*t73
+    t79 = 1 - t49
+    t80 = T22*t79
+    t81 = T22*t49 + t80
+    t82 = T21*t79
+    t83 = T21*t49 + t82
+    t84 = t51*t66 - t69*t81
+    t85 = t51*t69 + t66*t81
+    t86 = t53*t66 - t69*t83
+    t87 = t53*t69 + t66*t83
+    t88 = 1 - t66
+    t89 = t52*t88
+    t90 = t52*t66 + t89
+    t91 = t54*t88
+    t92 = t54*t66 + t91
+    t93 = t76*t88
+    t94 = t66*t76 + t93
+    t95 = t78*t88
+    t96 = t66*t78 + t95
+    t97 = t85**2
+    t98 = -t97
+    t99 = t98 + 1
+    t100 = casadi.if_else((t99 > 1e-12), casadi.sqrt(t99), 0)
+    t101 = t100*t90 + t97
+    t102 = t101 + t98
+    t103 = t84**2
+    t104 = t103 + t90**2 + t97
+    t105 = t100**2
+    t106 = t102**2 + t103*t105
+    t107 = t105 + t97
+    t108 = 1e-24*t107
+    t109 = (t106 <= t104*t108)
+    t110 = casadi.if_else(t109, 1, 1/casadi.sqrt(t106))
+    t111 = casadi.if_else(t109, 1, t102*t110)
+    t112 = t87*(1 - t111)
+    t113 = t111*t87 + t112
+    t114 = t100*t84
+    t115 = casadi.if_else(t109, 0, -t110*t114)
+    t116 = t111*t86 + t115*t92
+    t117 = t111*t92 - t115*t86
+    t118 = (t107 <= t108)
+    t119 = casadi.if_else(t118, 1, 1/casadi.sqrt(t107))
+    t120 = casadi.if_else(t118, 1, t119*t85)
+    t121 = casadi.if_else(t118, 0, -t100*t119)
+    t122 = t116*(1 - t120)
+    t123 = t116*t120 + t122
+    t124 = t113*t121 + t117*t120
+    t125 = t113*t120 - t117*t121
+    t126 = t123**2 + t124**2
+    t127 = t126
+    t128 = t125**2 + t126
+    t129 = 1 - t73
+    t130 = T22*t129
+    t131 = T22*t73 + t130
+    t132 = T21*t129
+    t133 = T21*t73 + t132
+    t134 = -t131*t70 + t66*t75
+    t135 = t131*t66 + t70*t75
+    t136 = -t133*t70 + t66*t77
+    t137 = t133*t66 + t70*t77
+    t138 = t135**2
+    t139 = -t138
+    t140 = t139 + 1
+    t141 = casadi.if_else((t140 > 1e-12), casadi.sqrt(t140), 0)
+    t142 = t138 + t141*t94
+    t143 = t139 + t142
+    t144 = t134**2
+    t145 = t138 + t144 + t94**2
+    t146 = t141**2
+    t147 = t143**2 + t144*t146
+    t148 = t138 + t146
+    t149 = 1e-24*t148
+    t150 = (t147 <= t145*t149)
+    t151 = casadi.if_else(t150, 1, 1/casadi.sqrt(t147))
+    t152 = casadi.if_else(t150, 1, t143*t151)
+    t153 = t137*(1 - t152)
+    t154 = t137*t152 + t153
+    t155 = t134*t141
+    t156 = casadi.if_else(t150, 0, -t151*t155)
+    t157 = t136*t152 + t156*t96
+    t158 = -t136*t156 + t152*t96
+    t159 = (t148 <= t149)
+    t160 = casadi.if_else(t159, 1, 1/casadi.sqrt(t148))
+    t161 = casadi.if_else(t159, 1, t135*t160)
+    t162 = casadi.if_else(t159, 0, -t141*t160)
+    t163 = t157*(1 - t161)
+    t164 = t157*t161 + t163
+    t165 = t154*t162 + t158*t161
+    t166 = t154*t161 - t158*t162
+    t167 = t164**2 + t165**2
+    t168 = t167
+    t169 = t166**2 + t167
+    t170 = (t62 <= t63)
+    t171 = casadi.if_else(t170, 1, 1/casadi.sqrt(t62))
+    t172 = casadi.if_else(t170, 1, t171*t59)
+    t173 = t171*t67
+    t174 = casadi.if_else(t170, 0, t173)
+    t175 = casadi.if_else(t170, 0, -t173)
+    t176 = t172*t51 - t174*t81
+    t177 = t172*t81 + t174*t51
+    t178 = t172*t53 - t174*t83
+    t179 = t172*t83 + t174*t53
+    t180 = -t131*t175 + t172*t75
+    t181 = t131*t172 + t175*t75
+    t182 = -t133*t175 + t172*t77
+    t183 = t133*t172 + t175*t77
     t184 = 1 - t172
-    t185 = t184*t53
-    t186 = t172*t53 + t185
-    t187 = t184*t55
-    t188 = t172*t55 + t187
-    t189 = t184*t77
-    t190 = t172*t77 + t189
-    t191 = t184*t79
-    t192 = t172*t79 + t191
+    t185 = t184*t52
+    t186 = t172*t52 + t185
+    t187 = t184*t54
+    t188 = t172*t54 + t187
+    t189 = t184*t76
+    t190 = t172*t76 + t189
+    t191 = t184*t78
+    t192 = t172*t78 + t191
     t193 = t177**2
     t194 = -t193
     t195 = t194 + 1
@@ -1373,24 +1373,24 @@ def _ik_branches(T):
     t201 = t196**2
     t202 = t198**2 + t199*t201
     t203 = t193 + t201
-    t204 = 1/casadi.sqrt(t202)
-    t205 = 1/casadi.sqrt(t203)
-    t206 = 1e-24*t203
-    t207 = (t202 <= t200*t206)
-    t208 = casadi.if_else(t207, 1, t198*t204)
-    t209 = t179*(1 - t208)
-    t210 = t179*t208 + t209
-    t211 = t176*t196
-    t212 = casadi.if_else(t207, 0, -t204*t211)
-    t213 = t178*t208 + t188*t212
-    t214 = -t178*t212 + t188*t208
-    t215 = (t203 <= t206)
-    t216 = casadi.if_else(t215, 1, t177*t205)
-    t217 = casadi.if_else(t215, 0, -t196*t205)
-    t218 = t213*(1 - t216)
-    t219 = t213*t216 + t218
-    t220 = t210*t217 + t214*t216
-    t221 = t210*t216 - t214*t217
+    t204 = 1e-24*t203
+    t205 = (t202 <= t200*t204)
+    t206 = casadi.if_else(t205, 1, 1/casadi.sqrt(t202))
+    t207 = casadi.if_else(t205, 1, t198*t206)
+    t208 = t179*(1 - t207)
+    t209 = t179*t207 + t208
+    t210 = t176*t196
+    t211 = casadi.if_else(t205, 0, -t206*t210)
+    t212 = t178*t207 + t188*t211
+    t213 = -t178*t211 + t188*t207
+    t214 = (t203 <= t204)
+    t215 = casadi.if_else(t214, 1, 1/casadi.sqrt(t203))
+    t216 = casadi.if_else(t214, 1, t177*t215)
+    t217 = casadi.if_else(t214, 0, -t196*t215)
+    t218 = t212*(1 - t216)
+    t219 = t212*t216 + t218
+    t220 = t209*t217 + t213*t216
+    t221 = t209*t216 - t213*t217
     t222 = t219**2 + t220**2
     t223 = t222
     t224 = t221**2 + t222
@@ -1405,46 +1405,46 @@ def _ik_branches(T):
     t233 = t228**2
     t234 = t230**2 + t231*t233
     t235 = t225 + t233
-    t236 = 1/casadi.sqrt(t234)
-    t237 = 1/casadi.sqrt(t235)
-    t238 = 1e-24*t235
-    t239 = (t234 <= t232*t238)
-    t240 = casadi.if_else(t239, 1, t230*t236)
-    t241 = t183*(1 - t240)
-    t242 = t183*t240 + t241
-    t243 = t180*t228
-    t244 = casadi.if_else(t239, 0, -t236*t243)
-    t245 = t182*t240 + t192*t244
-    t246 = -t182*t244 + t192*t240
-    t247 = (t235 <= t238)
-    t248 = casadi.if_else(t247, 1, t181*t237)
-    t249 = casadi.if_else(t247, 0, -t228*t237)
-    t250 = t245*(1 - t248)
-    t251 = t245*t248 + t250
-    t252 = t242*t249 + t246*t248
-    t253 = t242*t248 - t246*t249
+    t236 = 1e-24*t235
+    t237 = (t234 <= t232*t236)
+    t238 = casadi.if_else(t237, 1, 1/casadi.sqrt(t234))
+    t239 = casadi.if_else(t237, 1, t230*t238)
+    t240 = t183*(1 - t239)
+    t241 = t183*t239 + t240
+    t242 = t180*t228
+    t243 = casadi.if_else(t237, 0, -t238*t242)
+    t244 = t182*t239 + t192*t243
+    t245 = -t182*t243 + t192*t239
+    t246 = (t235 <= t236)
+    t247 = casadi.if_else(t246, 1, 1/casadi.sqrt(t235))
+    t248 = casadi.if_else(t246, 1, t181*t247)
+    t249 = casadi.if_else(t246, 0, -t228*t247)
+    t250 = t244*(1 - t248)
+    t251 = t244*t248 + t250
+    t252 = t241*t249 + t245*t248
+    t253 = t241*t248 - t245*t249
     t254 = t251**2 + t252**2
     t255 = t254
     t256 = t253**2 + t254
-    t257 = casadi.if_else(t49, 0, casadi.atan2(-t39, t35))
-    t258 = -t69
-    t259 = casadi.if_else(t67, 0, casadi.atan2(t258, t58))
-    t260 = casadi.if_else(t112, 0, casadi.atan2(-t116, t103))
-    t261 = casadi.if_else(t120, 0, casadi.atan2(-t101, t86))
-    t262 = casadi.if_else((t128 <= 1e-24*t129), 0, casadi.atan2(t125, t124))
-    t263 = casadi.if_else(t73, 0, casadi.atan2(t42, t36))
-    t264 = casadi.if_else(t67, 0, casadi.atan2(t69, t58))
-    t265 = casadi.if_else(t153, 0, casadi.atan2(-t157, t144))
-    t266 = casadi.if_else(t161, 0, casadi.atan2(-t142, t136))
-    t267 = casadi.if_else((t169 <= 1e-24*t170), 0, casadi.atan2(t166, t165))
-    t268 = casadi.if_else(t171, 0, casadi.atan2(t69, t60))
+    t257 = casadi.if_else(t47, 0, casadi.atan2(-t39, t35))
+    t258 = -t67
+    t259 = casadi.if_else(t64, 0, casadi.atan2(t258, t57))
+    t260 = casadi.if_else(t109, 0, casadi.atan2(-t114, t102))
+    t261 = casadi.if_else(t118, 0, casadi.atan2(-t100, t85))
+    t262 = casadi.if_else((t127 <= 1e-24*t128), 0, casadi.atan2(t124, t123))
+    t263 = casadi.if_else(t71, 0, casadi.atan2(t41, t36))
+    t264 = casadi.if_else(t64, 0, casadi.atan2(t67, t57))
+    t265 = casadi.if_else(t150, 0, casadi.atan2(-t155, t143))
+    t266 = casadi.if_else(t159, 0, casadi.atan2(-t141, t135))
+    t267 = casadi.if_else((t168 <= 1e-24*t169), 0, casadi.atan2(t165, t164))
+    t268 = casadi.if_else(t170, 0, casadi.atan2(t67, t59))
     t269 = -t21
-    t270 = casadi.if_else(t207, 0, casadi.atan2(-t211, t198))
-    t271 = casadi.if_else(t215, 0, casadi.atan2(-t196, t177))
+    t270 = casadi.if_else(t205, 0, casadi.atan2(-t210, t198))
+    t271 = casadi.if_else(t214, 0, casadi.atan2(-t196, t177))
     t272 = casadi.if_else((t223 <= 1e-24*t224), 0, casadi.atan2(t220, t219))
-    t273 = casadi.if_else(t171, 0, casadi.atan2(t258, t60))
-    t274 = casadi.if_else(t239, 0, casadi.atan2(-t243, t230))
-    t275 = casadi.if_else(t247, 0, casadi.atan2(-t228, t181))
+    t273 = casadi.if_else(t170, 0, casadi.atan2(t258, t59))
+    t274 = casadi.if_else(t237, 0, casadi.atan2(-t242, t230))
+    t275 = casadi.if_else(t246, 0, casadi.atan2(-t228, t181))
     t276 = casadi.if_else((t255 <= 1e-24*t256), 0, casadi.atan2(t252, t251))
     t277 = (casadi.fabs(t0) < casadi.inf)
     t278 = -1e-12
@@ -1502,10 +1502,10 @@ def _ik_branches(T):
     q[7, 4] = -t275 - 6.283185307179586*casadi.ceil(-0.15915494309189535*t275 - 0.5)
     q[7, 5] = t276 - 6.283185307179586*casadi.ceil(0.15915494309189535*t276) + 3.141592653589793
     valid = casadi.SX(8, 1)
-    valid[0, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t277, t279), t280), (t100 >= t278))
-    valid[1, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t277, t279), t280), (t100 > 1e-12))
-    valid[2, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t277, t279), t281), (t141 >= t278))
-    valid[3, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t277, t279), t281), (t141 > 1e-12))
+    valid[0, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t277, t279), t280), (t99 >= t278))
+    valid[1, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t277, t279), t280), (t99 > 1e-12))
+    valid[2, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t277, t279), t281), (t140 >= t278))
+    valid[3, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t277, t279), t281), (t140 > 1e-12))
     valid[4, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t277, t280), t282), (t195 >= t278))
     valid[5, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t277, t280), t282), (t195 > 1e-12))
     valid[6, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t277, t281), t282), (t227 >= t278))

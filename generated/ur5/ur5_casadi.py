@@ -606,7 +606,7 @@ def _jacobian_det(q):
 
 
 def _velocity_ik(q, mu_dot, damping):
-    """Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: 1288 operations."""
+    """Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: 1302 operations."""
     q1 = q[0]
     q2 = q[1]
     q3 = q[2]
@@ -859,12 +859,12 @@ def _velocity_ik(q, mu_dot, damping):
     t223 = t216 + t222
     t224 = casadi.if_else((t221 > 0), 1/(t221*(t220 + t221)), 0)
     t225 = -t219*t223**2*t224 + t219
-    t226 = t225/t222
-    t227 = (t215*t226 + t218)/t211
-    t228 = (-t199*t227 - t203*t226 + t207)/t195
-    t229 = (t175*t228 - t180*t227 - t185*t226 + t190)/t171
-    t230 = (t107 + t122*t228 - t136*t227 + t159*t229 + t165*t226)/t103
-    t231 = (t115*t228 - t129*t227 + t145*t229 - t152*t226 + t230*t96 + t88)/t84
+    t226 = casadi.if_else((t222 != 0), -t225/t222, 0)
+    t227 = casadi.if_else((t211 != 0), -(-t215*t226 + t218)/t211, 0)
+    t228 = casadi.if_else((t195 != 0), -(t199*t227 + t203*t226 + t207)/t195, 0)
+    t229 = casadi.if_else((t171 != 0), -(-t175*t228 + t180*t227 + t185*t226 + t190)/t171, 0)
+    t230 = casadi.if_else((t103 != 0), -(t107 - t122*t228 + t136*t227 - t159*t229 - t165*t226)/t103, 0)
+    t231 = casadi.if_else((t84 != 0), -(-t115*t228 + t129*t227 - t145*t229 + t152*t226 - t230*t96 + t88)/t84, 0)
     t232 = t22*t230 + t226 - t23*t231
     t233 = -c234*t226 + t10*t229 + t227*t6 + t228*t3 + t230*t29 + t231*t26
     t234 = -t1*t228 + t11*t226 + t2*t227
@@ -997,12 +997,12 @@ def _velocity_ik(q, mu_dot, damping):
     t361 = t357 + t360
     t362 = casadi.if_else((t359 > 0), 1/(t359*(t358 + t359)), 0)
     t363 = -t336*t361**2*t362 + t336
-    t364 = t363/t360
-    t365 = (t335 + t356*t364)/t331
-    t366 = (t323*t365 + t327 + t352*t364)/t319
-    t367 = (t304*t366 + t309*t365 + t314 - t347*t364)/t300
-    t368 = (t275*t367 + t280*t366 + t285*t365 + t291 + t339*t364)/t271
-    t369 = (t247*t267*t364 + t249*t368 + t252*t367 + t255*t366 + t258 + t263*t365)/t244
+    t364 = casadi.if_else((t360 != 0), -t363/t360, 0)
+    t365 = casadi.if_else((t331 != 0), -(t335 - t356*t364)/t331, 0)
+    t366 = casadi.if_else((t319 != 0), -(-t323*t365 + t327 - t352*t364)/t319, 0)
+    t367 = casadi.if_else((t300 != 0), -(-t304*t366 - t309*t365 + t314 + t347*t364)/t300, 0)
+    t368 = casadi.if_else((t271 != 0), -(-t275*t367 - t280*t366 - t285*t365 + t291 - t339*t364)/t271, 0)
+    t369 = casadi.if_else((t244 != 0), -(-t247*t267*t364 - t249*t368 - t252*t367 - t255*t366 + t258 - t263*t365)/t244, 0)
     t370 = (damping > 0)
     t371 = (casadi.fabs(t344) < casadi.inf)
     t372 = (damping >= 0)
@@ -1011,19 +1011,19 @@ def _velocity_ik(q, mu_dot, damping):
     t375 = casadi.logic_or(casadi.logic_and(t370, casadi.logic_or(casadi.logic_or(casadi.logic_or(casadi.logic_or(casadi.logic_or((t102 <= t374), (t170 <= t374)), (t194 <= t374)), (t210 <= t374)), (t221 <= t374)), (t83 <= t374))), casadi.logic_and((damping <= 0), casadi.logic_or(casadi.logic_or(casadi.logic_or(casadi.logic_or(casadi.logic_or((t243 <= t373), (t270 <= t373)), (t299 <= t373)), (t318 <= t373)), (t330 <= t373)), (t359 <= t373))))
     t376 = casadi.logic_and(casadi.logic_and(t371, t372), casadi.logic_not(t375))
     q_dot = casadi.SX(6, 1)
-    q_dot[0, 0] = casadi.if_else(t376, casadi.if_else(t370, -t232, -t369), 0)
-    q_dot[1, 0] = casadi.if_else(t376, casadi.if_else(t370, -t237, -t368), 0)
-    q_dot[2, 0] = casadi.if_else(t376, casadi.if_else(t370, -t240, -t367), 0)
-    q_dot[3, 0] = casadi.if_else(t376, casadi.if_else(t370, -t238, -t366), 0)
-    q_dot[4, 0] = casadi.if_else(t376, casadi.if_else(t370, -t233, -t365), 0)
-    q_dot[5, 0] = casadi.if_else(t376, casadi.if_else(t370, t234, -t364), 0)
+    q_dot[0, 0] = casadi.if_else(t376, casadi.if_else(t370, t232, t369), 0)
+    q_dot[1, 0] = casadi.if_else(t376, casadi.if_else(t370, t237, t368), 0)
+    q_dot[2, 0] = casadi.if_else(t376, casadi.if_else(t370, t240, t367), 0)
+    q_dot[3, 0] = casadi.if_else(t376, casadi.if_else(t370, t238, t366), 0)
+    q_dot[4, 0] = casadi.if_else(t376, casadi.if_else(t370, t233, t365), 0)
+    q_dot[5, 0] = casadi.if_else(t376, casadi.if_else(t370, -t234, t364), 0)
     status = casadi.SX(1, 1)
     status[0, 0] = casadi.if_else(casadi.logic_not(casadi.logic_and(t371, t372)), 2, casadi.if_else(t375, 1, 0))
     return [q_dot, status]
 
 
 def _ik_numeric_step(target, q, damping):
-    """One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite): 971 operations."""
+    """One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite): 979 operations."""
     T00 = target[0, 0]
     T01 = target[0, 1]
     T02 = target[0, 2]
@@ -1313,21 +1313,21 @@ def _ik_numeric_step(target, q, damping):
     t246 = t242 + t245
     t247 = casadi.if_else((t244 > 0), 1/(t244*(t243 + t244)), 0)
     t248 = -t216*t246**2*t247 + t216
-    t249 = t248/t245
-    t250 = (t215 + t241*t249)/t211
-    t251 = (t184 - t207*t250 - t237*t249)/t180
-    t252 = (t156 + t175*t251 - t202*t250 - t232*t249)/t152
-    t253 = (t131 + t146*t252 + t169*t251 - t196*t250 + t226*t249)/t127
-    t254 = (t112 + t120*t253 + t139*t252 + t162*t251 - t189*t250 - t219*t249)/t108
-    t255 = q1 - t249 - t253*t52 + t254*t53
-    t256 = -c234*t249 - q5 + t17*t250 + t23*t252 + t251*t9 + t253*t37 + t254*t36
-    t257 = q6 + t249*t31 + t250*t4 - t251*t7
+    t249 = casadi.if_else((t245 != 0), -t248/t245, 0)
+    t250 = casadi.if_else((t211 != 0), -(t215 - t241*t249)/t211, 0)
+    t251 = casadi.if_else((t180 != 0), -(t184 + t207*t250 + t237*t249)/t180, 0)
+    t252 = casadi.if_else((t152 != 0), -(t156 - t175*t251 + t202*t250 + t232*t249)/t152, 0)
+    t253 = casadi.if_else((t127 != 0), -(t131 - t146*t252 - t169*t251 + t196*t250 - t226*t249)/t127, 0)
+    t254 = casadi.if_else((t108 != 0), -(t112 - t120*t253 - t139*t252 - t162*t251 + t189*t250 + t219*t249)/t108, 0)
+    t255 = q1 + t249 + t253*t52 - t254*t53
+    t256 = -c234*t249 + q5 + t17*t250 + t23*t252 + t251*t9 + t253*t37 + t254*t36
+    t257 = q6 - t249*t31 - t250*t4 + t251*t7
     t258 = s1*t253
     t259 = c1*t254
     t260 = -c1*t250 + s1*t251
-    t261 = -q2 + t252*t54 + t258*t34 + t259*t34 + t260
-    t262 = -q3 + t252*t50 + t258*t33 + t259*t33 + t260
-    t263 = -q4 + t22*t252 + t258*t32 + t259*t32 + t260
+    t261 = q2 + t252*t54 + t258*t34 + t259*t34 + t260
+    t262 = q3 + t252*t50 + t258*t33 + t259*t33 + t260
+    t263 = q4 + t22*t252 + t258*t32 + t259*t32 + t260
     q_start = casadi.SX(6, 1)
     q_start[0, 0] = q1
     q_start[1, 0] = q2
@@ -1337,10 +1337,10 @@ def _ik_numeric_step(target, q, damping):
     q_start[5, 0] = q6
     q_next = casadi.SX(6, 1)
     q_next[0, 0] = casadi.if_else((t255 < -6.283185307179586), -6.283185307179586, casadi.if_else((t255 > 6.283185307179586), 6.283185307179586, t255))
-    q_next[1, 0] = casadi.if_else((t261 > 6.283185307179586), -6.283185307179586, casadi.if_else((t261 < -6.283185307179586), 6.283185307179586, -t261))
-    q_next[2, 0] = casadi.if_else((t262 > 6.283185307179586), -6.283185307179586, casadi.if_else((t262 < -6.283185307179586), 6.283185307179586, -t262))
-    q_next[3, 0] = casadi.if_else((t263 > 6.283185307179586), -6.283185307179586, casadi.if_else((t263 < -6.283185307179586), 6.283185307179586, -t263))
-    q_next[4, 0] = casadi.if_else((t256 > 6.283185307179586), -6.283185307179586, casadi.if_else((t256 < -6.283185307179586), 6.283185307179586, -t256))
+    q_next[1, 0] = casadi.if_else((t261 < -6.283185307179586), -6.283185307179586, casadi.if_else((t261 > 6.283185307179586), 6.283185307179586, t261))
+    q_next[2, 0] = casadi.if_else((t262 < -6.283185307179586), -6.283185307179586, casadi.if_else((t262 > 6.283185307179586), 6.283185307179586, t262))
+    q_next[3, 0] = casadi.if_else((t263 < -6.283185307179586), -6.283185307179586, casadi.if_else((t263 > 6.283185307179586), 6.283185307179586, t263))
+    q_next[4, 0] = casadi.if_else((t256 < -6.283185307179586), -6.283185307179586, casadi.if_else((t256 > 6.283185307179586), 6.283185307179586, t256))
     q_next[5, 0] = casadi.if_else((t257 < -6.283185307179586), -6.283185307179586, casadi.if_else((t257 > 6.283185307179586), 6.283185307179586, t257))
     cost = casadi.SX(1, 1)
     cost[0, 0] = casadi.if_else((casadi.fabs(t0) < casadi.inf), t105, -1)
@@ -1348,7 +1348,7 @@ def _ik_numeric_step(target, q, damping):
 
 
 def _ik_branches(T):
-    """Every branch of the closed-form ik and whether the target allows it: 843 operations."""
+    """Every branch of the closed-form ik and whether the target allows it: 860 operations."""
     T00 = T[0, 0]
     T01 = T[0, 1]
     T02 = T[0, 2]
@@ -1378,25 +1378,25 @@ def _ik_branches(T):
     t14 = t4**2 + t8**2
     t15 = t14
     t16 = t13**2 + t14
-    t17 = 1/casadi.sqrt(t15)
-    t18 = 1 - 0.0119137225*t17**2
-    t19 = (1e-12 < t18)
-    t20 = casadi.if_else(t19, 0.10915*t17, casadi.if_else((t17 > 0), 1, -1))
-    t21 = casadi.if_else(t19, casadi.sqrt(t18), 0)
-    t22 = casadi.atan2(t21, t20)
-    t23 = -t22 + t9
-    t24 = 1e-24*t16
-    t25 = (t15 <= t24)
-    t26 = casadi.if_else(t25, 0, t22 + t9)
-    t27 = t17*t4
-    t28 = t21*t27
-    t29 = t17*t8
-    t30 = t20*t29
-    t31 = casadi.if_else(t25, 1, -t28 - t30)
+    t17 = 1e-24*t16
+    t18 = (t15 <= t17)
+    t19 = casadi.if_else(t18, 1, 1/casadi.sqrt(t15))
+    t20 = 1 - 0.0119137225*t19**2
+    t21 = (1e-12 < t20)
+    t22 = casadi.if_else(t21, 0.10915*t19, casadi.if_else((t19 > 0), 1, -1))
+    t23 = casadi.if_else(t21, casadi.sqrt(t20), 0)
+    t24 = casadi.atan2(t23, t22)
+    t25 = casadi.if_else(t18, 0, t24 + t9)
+    t26 = -t24 + t9
+    t27 = t19*t4
+    t28 = t23*t27
+    t29 = t19*t8
+    t30 = t22*t29
+    t31 = casadi.if_else(t18, 1, -t28 - t30)
     t32 = t28 - t30
-    t33 = t20*t27
-    t34 = t21*t29
-    t35 = casadi.if_else(t25, 0, t33 - t34)
+    t33 = t22*t27
+    t34 = t23*t29
+    t35 = casadi.if_else(t18, 0, t33 - t34)
     t36 = t33 + t34
     t37 = t31*t4 + t35*t8
     t38 = t31*t8 - t35*t4
@@ -1423,329 +1423,337 @@ def _ik_branches(T):
     t59 = casadi.if_else(t58, 0, t57)
     t60 = casadi.if_else(t58, 1, t55)
     t61 = casadi.if_else(t58, 0, t56)
-    t62 = t51*t60
-    t63 = t39*t61 - t62
-    t64 = t62 + t63
-    t65 = t61**2
-    t66 = t60**2 + t65
-    t67 = t40**2
-    t68 = t64**2 + t65*t67
-    t69 = t39**2 + t51**2 + t67
-    t70 = 1/casadi.sqrt(t68)
-    t71 = (t68 <= 1e-24*t66*t69)
-    t72 = casadi.if_else(t71, 1, t64*t70)
-    t73 = t61*(1 - t72)
-    t74 = t61*t72 + t73
-    t75 = t40*t61
-    t76 = casadi.if_else(t71, 0, -t70*t75)
-    t77 = t60*t76
-    t78 = t60*t72
-    t79 = -T00*t78 + T01*t77 + T02*t74
-    t80 = -T10*t78 + T11*t77 + T12*t74
-    t81 = -T20*t78 + T21*t77 + T22*t74
-    t82 = t45*t81
-    t83 = t31*t79 + t35*t80
-    t84 = -t31*t80 + t35*t79
-    t85 = t31*t81 + t82
-    t86 = t83**2 + t85**2
-    t87 = t86
-    t88 = t84**2 + t86
-    t89 = 1/casadi.sqrt(t87)
-    t90 = (t87 <= 1e-24*t88)
-    t91 = casadi.if_else(t90, 1, -t83*t89)
-    t92 = casadi.if_else(t90, 0, -t85*t89)
-    t93 = 0.10915 - 0.10915*t91
-    t94 = 0.10915*t91 + 0.10915
-    t95 = 0.10915*t91
-    t96 = t93 + t95
-    t97 = t38 + t96
-    t98 = -t94 + t95
-    t99 = t38 - t98
-    t100 = 0.09465*t92
-    t101 = -t100 + t37
-    t102 = t100 + t37
-    t103 = 0.09465*t91
-    t104 = t103 + t47
-    t105 = t104 - 0.089459
-    t106 = t101**2 + t105**2 + t97**2
-    t107 = 0.16724253125 - 0.5*t106
-    t108 = -t103 + t47
-    t109 = t108 - 0.089459
-    t110 = t102**2 + t109**2 + t99**2
-    t111 = 0.16724253125 - 0.5*t110
-    t112 = t107**2
-    t113 = 1 - 35.98290608994648*t112
-    t114 = (1e-12 < t113)
-    t115 = casadi.if_else(t114, 5.99857533835714*t107, casadi.if_else((t107 > 0), 1, -1))
-    t116 = casadi.if_else(t114, casadi.sqrt(t113), 0)
-    t117 = casadi.atan2(t116, t115)
-    t118 = casadi.if_else(t58, 0, t117 + 3.141592653589793)
-    t119 = casadi.if_else(t58, 1, -t115)
-    t120 = casadi.if_else(t58, 0, -t116)
-    t121 = 3.141592653589793 - t117
-    t122 = 0.39225*t119 + 0.425
-    t123 = 0.089459 - 0.39225*t120
-    t124 = t123 - 0.089459
-    t125 = -t101*t122 + t105*t124
-    t126 = t101*t124 + t105*t122
-    t127 = t125**2 + t126**2
-    t128 = t122**2 + t124**2
-    t129 = 0.39225*t115 - 0.425
-    t130 = 0.089459 - 0.39225*t116
-    t131 = t130 - 0.089459
-    t132 = t101*t129 + t105*t131
-    t133 = t101*t131 - t105*t129
-    t134 = t132**2 + t133**2
-    t135 = t129**2 + t131**2
-    t136 = t111**2
-    t137 = 1 - 35.98290608994648*t136
-    t138 = (1e-12 < t137)
-    t139 = casadi.if_else(t138, 5.99857533835714*t111, casadi.if_else((t111 > 0), 1, -1))
-    t140 = casadi.if_else(t138, casadi.sqrt(t137), 0)
-    t141 = casadi.atan2(t140, t139)
-    t142 = casadi.if_else(t58, 0, t141 + 3.141592653589793)
-    t143 = casadi.if_else(t58, 1, -t139)
-    t144 = casadi.if_else(t58, 0, -t140)
-    t145 = 3.141592653589793 - t141
-    t146 = 0.39225*t143 + 0.425
-    t147 = 0.089459 - 0.39225*t144
-    t148 = t147 - 0.089459
-    t149 = -t102*t146 + t109*t148
-    t150 = t102*t148 + t109*t146
-    t151 = t149**2 + t150**2
-    t152 = t146**2 + t148**2
-    t153 = 0.39225*t139 - 0.425
-    t154 = 0.089459 - 0.39225*t140
-    t155 = t154 - 0.089459
-    t156 = t102*t153 + t109*t155
-    t157 = t102*t155 - t109*t153
-    t158 = t156**2 + t157**2
-    t159 = t153**2 + t155**2
-    t160 = 1 - t32
-    t161 = t13*t160
-    t162 = t13*t32 + t161
-    t163 = T02*t36
-    t164 = T12*t32
-    t165 = t163 - t164
-    t166 = -t163 + t164
-    t167 = t165**2
-    t168 = 1 - t167
-    t169 = (1e-12 < t168)
-    t170 = casadi.if_else(t169, t165, casadi.if_else((t165 > 0), 1, -1))
-    t171 = casadi.if_else(t169, casadi.sqrt(t168), 0)
-    t172 = casadi.atan2(t171, t170)
-    t173 = casadi.if_else(t58, 0, t172)
-    t174 = casadi.if_else(t58, 1, t170)
-    t175 = casadi.if_else(t58, 0, t171)
-    t176 = t166*t174
-    t177 = t175*t43 - t176
-    t178 = t176 + t177
-    t179 = t175**2
-    t180 = t174**2 + t179
-    t181 = t44**2
-    t182 = t178**2 + t179*t181
-    t183 = t166**2 + t181 + t43**2
-    t184 = 1/casadi.sqrt(t182)
-    t185 = (t182 <= 1e-24*t180*t183)
-    t186 = casadi.if_else(t185, 1, t178*t184)
-    t187 = t175*(1 - t186)
-    t188 = t175*t186 + t187
-    t189 = t175*t44
-    t190 = casadi.if_else(t185, 0, -t184*t189)
-    t191 = t174*t190
-    t192 = t174*t186
-    t193 = -T00*t192 + T01*t191 + T02*t188
-    t194 = -T10*t192 + T11*t191 + T12*t188
-    t195 = -T20*t192 + T21*t191 + T22*t188
-    t196 = t160*t195
-    t197 = t193*t32 + t194*t36
-    t198 = t193*t36 - t194*t32
-    t199 = t195*t32 + t196
-    t200 = t197**2 + t199**2
-    t201 = t200
-    t202 = t198**2 + t200
-    t203 = 1/casadi.sqrt(t201)
-    t204 = (t201 <= 1e-24*t202)
-    t205 = casadi.if_else(t204, 1, -t197*t203)
-    t206 = casadi.if_else(t204, 0, -t199*t203)
-    t207 = 0.10915 - 0.10915*t205
-    t208 = 0.10915*t205 + 0.10915
-    t209 = 0.10915*t205
-    t210 = t207 + t209
-    t211 = t210 + t42
-    t212 = -t208 + t209
-    t213 = -t212 + t42
-    t214 = 0.09465*t206
-    t215 = -t214 + t41
-    t216 = t214 + t41
-    t217 = 0.09465*t205
-    t218 = t162 + t217
-    t219 = t218 - 0.089459
-    t220 = t211**2 + t215**2 + t219**2
-    t221 = 0.16724253125 - 0.5*t220
-    t222 = t162 - t217
-    t223 = t222 - 0.089459
-    t224 = t213**2 + t216**2 + t223**2
-    t225 = 0.16724253125 - 0.5*t224
-    t226 = t221**2
-    t227 = 1 - 35.98290608994648*t226
-    t228 = (1e-12 < t227)
-    t229 = casadi.if_else(t228, 5.99857533835714*t221, casadi.if_else((t221 > 0), 1, -1))
-    t230 = casadi.if_else(t228, casadi.sqrt(t227), 0)
-    t231 = casadi.atan2(t230, t229)
-    t232 = casadi.if_else(t58, 0, t231 + 3.141592653589793)
-    t233 = casadi.if_else(t58, 1, -t229)
-    t234 = casadi.if_else(t58, 0, -t230)
-    t235 = 3.141592653589793 - t231
-    t236 = 0.39225*t233 + 0.425
-    t237 = 0.089459 - 0.39225*t234
-    t238 = t237 - 0.089459
-    t239 = -t215*t236 + t219*t238
-    t240 = t215*t238 + t219*t236
-    t241 = t239**2 + t240**2
-    t242 = t236**2 + t238**2
-    t243 = 0.39225*t229 - 0.425
-    t244 = 0.089459 - 0.39225*t230
+    t62 = casadi.if_else(t58, 1, 5.99857533835714)
+    t63 = t51*t60
+    t64 = t39*t61 - t63
+    t65 = t63 + t64
+    t66 = t61**2
+    t67 = t60**2 + t66
+    t68 = t40**2
+    t69 = t65**2 + t66*t68
+    t70 = t39**2 + t51**2 + t68
+    t71 = (t69 <= 1e-24*t67*t70)
+    t72 = casadi.if_else(t71, 1, 1/casadi.sqrt(t69))
+    t73 = casadi.if_else(t71, 1, t65*t72)
+    t74 = t61*(1 - t73)
+    t75 = t61*t73 + t74
+    t76 = t40*t61
+    t77 = casadi.if_else(t71, 0, -t72*t76)
+    t78 = t60*t77
+    t79 = t60*t73
+    t80 = -T00*t79 + T01*t78 + T02*t75
+    t81 = -T10*t79 + T11*t78 + T12*t75
+    t82 = -T20*t79 + T21*t78 + T22*t75
+    t83 = t45*t82
+    t84 = t31*t80 + t35*t81
+    t85 = -t31*t81 + t35*t80
+    t86 = t31*t82 + t83
+    t87 = t84**2 + t86**2
+    t88 = t87
+    t89 = t85**2 + t87
+    t90 = (t88 <= 1e-24*t89)
+    t91 = casadi.if_else(t90, 1, 1/casadi.sqrt(t88))
+    t92 = casadi.if_else(t90, 1, -t84*t91)
+    t93 = casadi.if_else(t90, 0, -t86*t91)
+    t94 = 0.10915 - 0.10915*t92
+    t95 = 0.10915*t92 + 0.10915
+    t96 = 0.10915*t92
+    t97 = t94 + t96
+    t98 = t38 + t97
+    t99 = -t95 + t96
+    t100 = t38 - t99
+    t101 = 0.09465*t93
+    t102 = -t101 + t37
+    t103 = t101 + t37
+    t104 = 0.09465*t92
+    t105 = t104 + t47
+    t106 = t105 - 0.089459
+    t107 = t102**2 + t106**2 + t98**2
+    t108 = 0.16724253125 - 0.5*t107
+    t109 = -t104 + t47
+    t110 = t109 - 0.089459
+    t111 = t100**2 + t103**2 + t110**2
+    t112 = 0.16724253125 - 0.5*t111
+    t113 = t108**2
+    t114 = t62**2
+    t115 = -t113*t114 + 1
+    t116 = t108*t62
+    t117 = (1e-12 < t115)
+    t118 = casadi.if_else(t117, t116, casadi.if_else((t116 > 0), 1, -1))
+    t119 = casadi.if_else(t117, casadi.sqrt(t115), 0)
+    t120 = casadi.atan2(t119, t118)
+    t121 = casadi.if_else(t58, 0, t120 + 3.141592653589793)
+    t122 = 3.141592653589793 - t120
+    t123 = 0.16670625*t62
+    t124 = casadi.if_else(t58, 1, -t118*t123)
+    t125 = casadi.if_else(t58, 0, -t119*t123)
+    t126 = 0.39225*t124 + 0.425
+    t127 = 0.089459 - 0.39225*t125
+    t128 = t127 - 0.089459
+    t129 = -t102*t126 + t106*t128
+    t130 = t102*t128 + t106*t126
+    t131 = t129**2 + t130**2
+    t132 = t126**2 + t128**2
+    t133 = 0.0653905265625*t62
+    t134 = t118*t133 - 0.425
+    t135 = -t119*t133 + 0.089459
+    t136 = t135 - 0.089459
+    t137 = t102*t134 + t106*t136
+    t138 = t102*t136 - t106*t134
+    t139 = t137**2 + t138**2
+    t140 = t134**2 + t136**2
+    t141 = t112**2
+    t142 = -t114*t141 + 1
+    t143 = t112*t62
+    t144 = (1e-12 < t142)
+    t145 = casadi.if_else(t144, t143, casadi.if_else((t143 > 0), 1, -1))
+    t146 = casadi.if_else(t144, casadi.sqrt(t142), 0)
+    t147 = casadi.atan2(t146, t145)
+    t148 = casadi.if_else(t58, 0, t147 + 3.141592653589793)
+    t149 = casadi.if_else(t58, 1, -t123*t145)
+    t150 = casadi.if_else(t58, 0, -t123*t146)
+    t151 = 3.141592653589793 - t147
+    t152 = 0.39225*t149 + 0.425
+    t153 = 0.089459 - 0.39225*t150
+    t154 = t153 - 0.089459
+    t155 = -t103*t152 + t110*t154
+    t156 = t103*t154 + t110*t152
+    t157 = t155**2 + t156**2
+    t158 = t152**2 + t154**2
+    t159 = t133*t145 - 0.425
+    t160 = -t133*t146 + 0.089459
+    t161 = t160 - 0.089459
+    t162 = t103*t159 + t110*t161
+    t163 = t103*t161 - t110*t159
+    t164 = t162**2 + t163**2
+    t165 = t159**2 + t161**2
+    t166 = 1 - t32
+    t167 = t13*t166
+    t168 = t13*t32 + t167
+    t169 = T02*t36
+    t170 = T12*t32
+    t171 = t169 - t170
+    t172 = -t169 + t170
+    t173 = t171**2
+    t174 = 1 - t173
+    t175 = (1e-12 < t174)
+    t176 = casadi.if_else(t175, t171, casadi.if_else((t171 > 0), 1, -1))
+    t177 = casadi.if_else(t175, casadi.sqrt(t174), 0)
+    t178 = casadi.atan2(t177, t176)
+    t179 = casadi.if_else(t58, 0, t178)
+    t180 = casadi.if_else(t58, 1, t176)
+    t181 = casadi.if_else(t58, 0, t177)
+    t182 = t172*t180
+    t183 = t181*t43 - t182
+    t184 = t182 + t183
+    t185 = t181**2
+    t186 = t180**2 + t185
+    t187 = t44**2
+    t188 = t184**2 + t185*t187
+    t189 = t172**2 + t187 + t43**2
+    t190 = (t188 <= 1e-24*t186*t189)
+    t191 = casadi.if_else(t190, 1, 1/casadi.sqrt(t188))
+    t192 = casadi.if_else(t190, 1, t184*t191)
+    t193 = t181*(1 - t192)
+    t194 = t181*t192 + t193
+    t195 = t181*t44
+    t196 = casadi.if_else(t190, 0, -t191*t195)
+    t197 = t180*t196
+    t198 = t180*t192
+    t199 = -T00*t198 + T01*t197 + T02*t194
+    t200 = -T10*t198 + T11*t197 + T12*t194
+    t201 = -T20*t198 + T21*t197 + T22*t194
+    t202 = t166*t201
+    t203 = t199*t32 + t200*t36
+    t204 = t199*t36 - t200*t32
+    t205 = t201*t32 + t202
+    t206 = t203**2 + t205**2
+    t207 = t206
+    t208 = t204**2 + t206
+    t209 = (t207 <= 1e-24*t208)
+    t210 = casadi.if_else(t209, 1, 1/casadi.sqrt(t207))
+    t211 = casadi.if_else(t209, 1, -t203*t210)
+    t212 = casadi.if_else(t209, 0, -t205*t210)
+    t213 = 0.10915 - 0.10915*t211
+    t214 = 0.10915*t211 + 0.10915
+    t215 = 0.10915*t211
+    t216 = t213 + t215
+    t217 = t216 + t42
+    t218 = -t214 + t215
+    t219 = -t218 + t42
+    t220 = 0.09465*t212
+    t221 = -t220 + t41
+    t222 = t220 + t41
+    t223 = 0.09465*t211
+    t224 = t168 + t223
+    t225 = t224 - 0.089459
+    t226 = t217**2 + t221**2 + t225**2
+    t227 = 0.16724253125 - 0.5*t226
+    t228 = t168 - t223
+    t229 = t228 - 0.089459
+    t230 = t219**2 + t222**2 + t229**2
+    t231 = 0.16724253125 - 0.5*t230
+    t232 = t227**2
+    t233 = -t114*t232 + 1
+    t234 = t227*t62
+    t235 = (1e-12 < t233)
+    t236 = casadi.if_else(t235, t234, casadi.if_else((t234 > 0), 1, -1))
+    t237 = casadi.if_else(t235, casadi.sqrt(t233), 0)
+    t238 = casadi.atan2(t237, t236)
+    t239 = casadi.if_else(t58, 0, t238 + 3.141592653589793)
+    t240 = casadi.if_else(t58, 1, -t123*t236)
+    t241 = casadi.if_else(t58, 0, -t123*t237)
+    t242 = 3.141592653589793 - t238
+    t243 = 0.39225*t240 + 0.425
+    t244 = 0.089459 - 0.39225*t241
     t245 = t244 - 0.089459
-    t246 = t215*t243 + t219*t245
-    t247 = t215*t245 - t219*t243
+    t246 = -t221*t243 + t225*t245
+    t247 = t221*t245 + t225*t243
     t248 = t246**2 + t247**2
     t249 = t243**2 + t245**2
-    t250 = t225**2
-    t251 = 1 - 35.98290608994648*t250
-    t252 = (1e-12 < t251)
-    t253 = casadi.if_else(t252, 5.99857533835714*t225, casadi.if_else((t225 > 0), 1, -1))
-    t254 = casadi.if_else(t252, casadi.sqrt(t251), 0)
-    t255 = casadi.atan2(t254, t253)
-    t256 = casadi.if_else(t58, 0, t255 + 3.141592653589793)
-    t257 = casadi.if_else(t58, 1, -t253)
-    t258 = casadi.if_else(t58, 0, -t254)
-    t259 = 3.141592653589793 - t255
-    t260 = 0.39225*t257 + 0.425
-    t261 = 0.089459 - 0.39225*t258
-    t262 = t261 - 0.089459
-    t263 = -t216*t260 + t223*t262
-    t264 = t216*t262 + t223*t260
-    t265 = t263**2 + t264**2
-    t266 = t260**2 + t262**2
-    t267 = 0.39225*t253 - 0.425
-    t268 = 0.089459 - 0.39225*t254
-    t269 = t268 - 0.089459
-    t270 = t216*t267 + t223*t269
-    t271 = t216*t269 - t223*t267
-    t272 = t270**2 + t271**2
-    t273 = t267**2 + t269**2
-    t274 = t26 - 6.283185307179586*casadi.ceil(0.15915494309189535*t26 - 0.5)
-    t275 = 1e-24*t106
-    t276 = casadi.if_else((t127 <= t128*t275), 0, casadi.atan2(-t126, t125))
-    t277 = -casadi.if_else(t90, 0, casadi.atan2(-t85, -t83))
-    t278 = t277 + 3.141592653589793
-    t279 = t118 + t276
-    t280 = t59 - 6.283185307179586*casadi.ceil(0.15915494309189535*t59 - 0.5)
-    t281 = casadi.if_else(t71, 0, casadi.atan2(-t75, t64))
-    t282 = casadi.if_else((t134 <= t135*t275), 0, casadi.atan2(-t133, t132))
-    t283 = t121 + t282
-    t284 = 1e-24*t110
-    t285 = casadi.if_else((t151 <= t152*t284), 0, casadi.atan2(-t150, t149))
-    t286 = t142 - 3.141592653589793
-    t287 = t277 + t285
-    t288 = -t57 - 6.283185307179586*casadi.ceil(-0.15915494309189535*t57 - 0.5)
-    t289 = t281 - 6.283185307179586*casadi.ceil(0.15915494309189535*t281) + 3.141592653589793
-    t290 = casadi.if_else((t158 <= t159*t284), 0, casadi.atan2(-t157, t156))
-    t291 = t145 - 3.141592653589793
-    t292 = t277 + t290
-    t293 = t23 - 6.283185307179586*casadi.ceil(0.15915494309189535*t23 - 0.5)
-    t294 = 1e-24*t220
-    t295 = casadi.if_else((t241 <= t242*t294), 0, casadi.atan2(-t240, t239))
-    t296 = -casadi.if_else(t204, 0, casadi.atan2(-t199, -t197))
-    t297 = t296 + 3.141592653589793
-    t298 = t232 + t295
-    t299 = t173 - 6.283185307179586*casadi.ceil(0.15915494309189535*t173 - 0.5)
-    t300 = casadi.if_else(t185, 0, casadi.atan2(-t189, t178))
-    t301 = casadi.if_else((t248 <= t249*t294), 0, casadi.atan2(-t247, t246))
-    t302 = t235 + t301
-    t303 = 1e-24*t224
-    t304 = casadi.if_else((t265 <= t266*t303), 0, casadi.atan2(-t264, t263))
-    t305 = t256 - 3.141592653589793
-    t306 = t296 + t304
-    t307 = -t172 - 6.283185307179586*casadi.ceil(-0.15915494309189535*t172 - 0.5)
-    t308 = t300 - 6.283185307179586*casadi.ceil(0.15915494309189535*t300) + 3.141592653589793
-    t309 = casadi.if_else((t272 <= t273*t303), 0, casadi.atan2(-t271, t270))
-    t310 = t259 - 3.141592653589793
-    t311 = t296 + t309
-    t312 = (casadi.fabs(t0) < casadi.inf)
-    t313 = False
-    t314 = True
-    t315 = -1e-12
-    t316 = casadi.logic_or(casadi.logic_and(t313, (t52 <= 1e-12)), casadi.logic_and(t314, (t53 >= t315)))
-    t317 = (t15 > t24)
-    t318 = casadi.logic_or(casadi.logic_and(t317, (t18 >= t315)), casadi.logic_and(t25, (0.0119137225 <= 1e-12*t16)))
-    t319 = 2.77909737890625e-26
-    t320 = (0.0277909737890625 > t319)
-    t321 = (0.0277909737890625 <= t319)
-    t322 = 2.77909737890625e-14
-    t323 = (t53 > 1e-12)
-    t324 = (t18 > 1e-12)
-    t325 = casadi.logic_or(casadi.logic_and(t313, (t167 <= 1e-12)), casadi.logic_and(t314, (t168 >= t315)))
-    t326 = (t168 > 1e-12)
+    t250 = t133*t236 - 0.425
+    t251 = -t133*t237 + 0.089459
+    t252 = t251 - 0.089459
+    t253 = t221*t250 + t225*t252
+    t254 = t221*t252 - t225*t250
+    t255 = t253**2 + t254**2
+    t256 = t250**2 + t252**2
+    t257 = t231**2
+    t258 = -t114*t257 + 1
+    t259 = t231*t62
+    t260 = (1e-12 < t258)
+    t261 = casadi.if_else(t260, t259, casadi.if_else((t259 > 0), 1, -1))
+    t262 = casadi.if_else(t260, casadi.sqrt(t258), 0)
+    t263 = casadi.atan2(t262, t261)
+    t264 = casadi.if_else(t58, 0, t263 + 3.141592653589793)
+    t265 = casadi.if_else(t58, 1, -t123*t261)
+    t266 = casadi.if_else(t58, 0, -t123*t262)
+    t267 = 3.141592653589793 - t263
+    t268 = 0.39225*t265 + 0.425
+    t269 = 0.089459 - 0.39225*t266
+    t270 = t269 - 0.089459
+    t271 = -t222*t268 + t229*t270
+    t272 = t222*t270 + t229*t268
+    t273 = t271**2 + t272**2
+    t274 = t268**2 + t270**2
+    t275 = t133*t261 - 0.425
+    t276 = -t133*t262 + 0.089459
+    t277 = t276 - 0.089459
+    t278 = t222*t275 + t229*t277
+    t279 = t222*t277 - t229*t275
+    t280 = t278**2 + t279**2
+    t281 = t275**2 + t277**2
+    t282 = t25 - 6.283185307179586*casadi.ceil(0.15915494309189535*t25 - 0.5)
+    t283 = 1e-24*t107
+    t284 = casadi.if_else((t131 <= t132*t283), 0, casadi.atan2(-t130, t129))
+    t285 = -casadi.if_else(t90, 0, casadi.atan2(-t86, -t84))
+    t286 = t285 + 3.141592653589793
+    t287 = t121 + t284
+    t288 = t59 - 6.283185307179586*casadi.ceil(0.15915494309189535*t59 - 0.5)
+    t289 = casadi.if_else(t71, 0, casadi.atan2(-t76, t65))
+    t290 = casadi.if_else((t139 <= t140*t283), 0, casadi.atan2(-t138, t137))
+    t291 = t122 + t290
+    t292 = 1e-24*t111
+    t293 = casadi.if_else((t157 <= t158*t292), 0, casadi.atan2(-t156, t155))
+    t294 = t148 - 3.141592653589793
+    t295 = t285 + t293
+    t296 = -t57 - 6.283185307179586*casadi.ceil(-0.15915494309189535*t57 - 0.5)
+    t297 = t289 - 6.283185307179586*casadi.ceil(0.15915494309189535*t289) + 3.141592653589793
+    t298 = casadi.if_else((t164 <= t165*t292), 0, casadi.atan2(-t163, t162))
+    t299 = t151 - 3.141592653589793
+    t300 = t285 + t298
+    t301 = t26 - 6.283185307179586*casadi.ceil(0.15915494309189535*t26 - 0.5)
+    t302 = 1e-24*t226
+    t303 = casadi.if_else((t248 <= t249*t302), 0, casadi.atan2(-t247, t246))
+    t304 = -casadi.if_else(t209, 0, casadi.atan2(-t205, -t203))
+    t305 = t304 + 3.141592653589793
+    t306 = t239 + t303
+    t307 = t179 - 6.283185307179586*casadi.ceil(0.15915494309189535*t179 - 0.5)
+    t308 = casadi.if_else(t190, 0, casadi.atan2(-t195, t184))
+    t309 = casadi.if_else((t255 <= t256*t302), 0, casadi.atan2(-t254, t253))
+    t310 = t242 + t309
+    t311 = 1e-24*t230
+    t312 = casadi.if_else((t273 <= t274*t311), 0, casadi.atan2(-t272, t271))
+    t313 = t264 - 3.141592653589793
+    t314 = t304 + t312
+    t315 = -t178 - 6.283185307179586*casadi.ceil(-0.15915494309189535*t178 - 0.5)
+    t316 = t308 - 6.283185307179586*casadi.ceil(0.15915494309189535*t308) + 3.141592653589793
+    t317 = casadi.if_else((t280 <= t281*t311), 0, casadi.atan2(-t279, t278))
+    t318 = t267 - 3.141592653589793
+    t319 = t304 + t317
+    t320 = (casadi.fabs(t0) < casadi.inf)
+    t321 = False
+    t322 = True
+    t323 = -1e-12
+    t324 = casadi.logic_or(casadi.logic_and(t321, (t52 <= 1e-12)), casadi.logic_and(t322, (t53 >= t323)))
+    t325 = (t15 > t17)
+    t326 = casadi.logic_or(casadi.logic_and(t325, (t20 >= t323)), casadi.logic_and(t18, (0.0119137225 <= 1e-12*t16)))
+    t327 = 2.77909737890625e-26
+    t328 = (0.0277909737890625 > t327)
+    t329 = (0.0277909737890625 <= t327)
+    t330 = 2.77909737890625e-14
+    t331 = (t53 > 1e-12)
+    t332 = (t20 > 1e-12)
+    t333 = casadi.logic_or(casadi.logic_and(t321, (t173 <= 1e-12)), casadi.logic_and(t322, (t174 >= t323)))
+    t334 = (t174 > 1e-12)
     q = casadi.SX(8, 6)
-    q[0, 0] = t274
-    q[0, 1] = t276
-    q[0, 2] = t118 - 6.283185307179586*casadi.ceil(0.15915494309189535*t118 - 0.5)
-    q[0, 3] = -t277 - t279 - 6.283185307179586*casadi.ceil(-0.15915494309189535*t278 - 0.15915494309189535*t279)
-    q[0, 4] = t280
-    q[0, 5] = t281
-    q[1, 0] = t274
-    q[1, 1] = t282
-    q[1, 2] = t121 - 6.283185307179586*casadi.ceil(0.15915494309189535*t121 - 0.5)
-    q[1, 3] = -t277 - t283 - 6.283185307179586*casadi.ceil(-0.15915494309189535*t278 - 0.15915494309189535*t283)
-    q[1, 4] = t280
-    q[1, 5] = t281
-    q[2, 0] = t274
-    q[2, 1] = t285
-    q[2, 2] = t142 - 6.283185307179586*casadi.ceil(0.15915494309189535*t286)
-    q[2, 3] = -t286 - t287 - 6.283185307179586*casadi.ceil(-0.15915494309189535*t142 - 0.15915494309189535*t287)
-    q[2, 4] = t288
-    q[2, 5] = t289
-    q[3, 0] = t274
-    q[3, 1] = t290
-    q[3, 2] = t145 - 6.283185307179586*casadi.ceil(0.15915494309189535*t291)
-    q[3, 3] = -t291 - t292 - 6.283185307179586*casadi.ceil(-0.15915494309189535*t145 - 0.15915494309189535*t292)
-    q[3, 4] = t288
-    q[3, 5] = t289
-    q[4, 0] = t293
-    q[4, 1] = t295
-    q[4, 2] = t232 - 6.283185307179586*casadi.ceil(0.15915494309189535*t232 - 0.5)
-    q[4, 3] = -t296 - t298 - 6.283185307179586*casadi.ceil(-0.15915494309189535*t297 - 0.15915494309189535*t298)
-    q[4, 4] = t299
-    q[4, 5] = t300
-    q[5, 0] = t293
-    q[5, 1] = t301
-    q[5, 2] = t235 - 6.283185307179586*casadi.ceil(0.15915494309189535*t235 - 0.5)
-    q[5, 3] = -t296 - t302 - 6.283185307179586*casadi.ceil(-0.15915494309189535*t297 - 0.15915494309189535*t302)
-    q[5, 4] = t299
-    q[5, 5] = t300
-    q[6, 0] = t293
-    q[6, 1] = t304
-    q[6, 2] = t256 - 6.283185307179586*casadi.ceil(0.15915494309189535*t305)
-    q[6, 3] = -t305 - t306 - 6.283185307179586*casadi.ceil(-0.15915494309189535*t256 - 0.15915494309189535*t306)
-    q[6, 4] = t307
-    q[6, 5] = t308
-    q[7, 0] = t293
-    q[7, 1] = t309
-    q[7, 2] = t259 - 6.283185307179586*casadi.ceil(0.15915494309189535*t310)
-    q[7, 3] = -t310 - t311 - 6.283185307179586*casadi.ceil(-0.15915494309189535*t259 - 0.15915494309189535*t311)
-    q[7, 4] = t307
-    q[7, 5] = t308
+    q[0, 0] = t282
+    q[0, 1] = t284
+    q[0, 2] = t121 - 6.283185307179586*casadi.ceil(0.15915494309189535*t121 - 0.5)
+    q[0, 3] = -t285 - t287 - 6.283185307179586*casadi.ceil(-0.15915494309189535*t286 - 0.15915494309189535*t287)
+    q[0, 4] = t288
+    q[0, 5] = t289
+    q[1, 0] = t282
+    q[1, 1] = t290
+    q[1, 2] = t122 - 6.283185307179586*casadi.ceil(0.15915494309189535*t122 - 0.5)
+    q[1, 3] = -t285 - t291 - 6.283185307179586*casadi.ceil(-0.15915494309189535*t286 - 0.15915494309189535*t291)
+    q[1, 4] = t288
+    q[1, 5] = t289
+    q[2, 0] = t282
+    q[2, 1] = t293
+    q[2, 2] = t148 - 6.283185307179586*casadi.ceil(0.15915494309189535*t294)
+    q[2, 3] = -t294 - t295 - 6.283185307179586*casadi.ceil(-0.15915494309189535*t148 - 0.15915494309189535*t295)
+    q[2, 4] = t296
+    q[2, 5] = t297
+    q[3, 0] = t282
+    q[3, 1] = t298
+    q[3, 2] = t151 - 6.283185307179586*casadi.ceil(0.15915494309189535*t299)
+    q[3, 3] = -t299 - t300 - 6.283185307179586*casadi.ceil(-0.15915494309189535*t151 - 0.15915494309189535*t300)
+    q[3, 4] = t296
+    q[3, 5] = t297
+    q[4, 0] = t301
+    q[4, 1] = t303
+    q[4, 2] = t239 - 6.283185307179586*casadi.ceil(0.15915494309189535*t239 - 0.5)
+    q[4, 3] = -t304 - t306 - 6.283185307179586*casadi.ceil(-0.15915494309189535*t305 - 0.15915494309189535*t306)
+    q[4, 4] = t307
+    q[4, 5] = t308
+    q[5, 0] = t301
+    q[5, 1] = t309
+    q[5, 2] = t242 - 6.283185307179586*casadi.ceil(0.15915494309189535*t242 - 0.5)
+    q[5, 3] = -t304 - t310 - 6.283185307179586*casadi.ceil(-0.15915494309189535*t305 - 0.15915494309189535*t310)
+    q[5, 4] = t307
+    q[5, 5] = t308
+    q[6, 0] = t301
+    q[6, 1] = t312
+    q[6, 2] = t264 - 6.283185307179586*casadi.ceil(0.15915494309189535*t313)
+    q[6, 3] = -t313 - t314 - 6.283185307179586*casadi.ceil(-0.15915494309189535*t264 - 0.15915494309189535*t314)
+    q[6, 4] = t315
+    q[6, 5] = t316
+    q[7, 0] = t301
+    q[7, 1] = t317
+    q[7, 2] = t267 - 6.283185307179586*casadi.ceil(0.15915494309189535*t318)
+    q[7, 3] = -t318 - t319 - 6.283185307179586*casadi.ceil(-0.15915494309189535*t267 - 0.15915494309189535*t319)
+    q[7, 4] = t315
+    q[7, 5] = t316
     valid = casadi.SX(8, 1)
-    valid[0, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t312, t316), t318), casadi.logic_or(casadi.logic_and(t320, (t113 >= t315)), casadi.logic_and(t321, (t112 <= t322))))
-    valid[1, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t312, t316), t318), t320), (t113 > 1e-12))
-    valid[2, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t312, t314), t318), t323), casadi.logic_or(casadi.logic_and(t320, (t137 >= t315)), casadi.logic_and(t321, (t136 <= t322))))
-    valid[3, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t312, t314), t318), t320), t323), (t137 > 1e-12))
-    valid[4, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t312, t317), t324), t325), casadi.logic_or(casadi.logic_and(t320, (t227 >= t315)), casadi.logic_and(t321, (t226 <= t322))))
-    valid[5, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t312, t317), t320), t324), t325), (t227 > 1e-12))
-    valid[6, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t312, t314), t317), t324), t326), casadi.logic_or(casadi.logic_and(t320, (t251 >= t315)), casadi.logic_and(t321, (t250 <= t322))))
-    valid[7, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t312, t314), t317), t320), t324), t326), (t251 > 1e-12))
+    valid[0, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t320, t324), t326), casadi.logic_or(casadi.logic_and(t328, (t115 >= t323)), casadi.logic_and(t329, (t113 <= t330))))
+    valid[1, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t320, t324), t326), t328), (t115 > 1e-12))
+    valid[2, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t320, t322), t326), t331), casadi.logic_or(casadi.logic_and(t328, (t142 >= t323)), casadi.logic_and(t329, (t141 <= t330))))
+    valid[3, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t320, t322), t326), t328), t331), (t142 > 1e-12))
+    valid[4, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t320, t325), t332), t333), casadi.logic_or(casadi.logic_and(t328, (t233 >= t323)), casadi.logic_and(t329, (t232 <= t330))))
+    valid[5, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t320, t325), t328), t332), t333), (t233 > 1e-12))
+    valid[6, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t320, t322), t325), t332), t334), casadi.logic_or(casadi.logic_and(t328, (t258 >= t323)), casadi.logic_and(t329, (t257 <= t330))))
+    valid[7, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t320, t322), t325), t328), t332), t334), (t258 > 1e-12))
     return [q, valid]
 
 
