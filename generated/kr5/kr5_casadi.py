@@ -1879,9 +1879,9 @@ def _ik_numeric(target, q0, tol):
     return [q, status]
 
 
-_tol = casadi.SX.sym("tol")
-ik_numeric = casadi.Function("ik_numeric", [_target, _q, _tol], _ik_numeric(_target, _q, _tol),
-                             ["target", "q0", "tol"], ["q", "status"])
+# MX symbols: each step stays one call node (SX would inline every step into one huge graph).
+_inputs = [casadi.MX.sym("target", *_target.shape), casadi.MX.sym("q0", DOF), casadi.MX.sym("tol")]
+ik_numeric = casadi.Function("ik_numeric", _inputs, _ik_numeric(*_inputs), ["target", "q0", "tol"], ["q", "status"])
 
 
 def functions():
