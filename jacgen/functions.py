@@ -128,6 +128,8 @@ class Generator:
         self.definitions: list[tuple[sympy.Symbol, sympy.Expr]] = []
         self._trig: dict[tuple[int, ...], tuple[sympy.Symbol, sympy.Symbol]] = {}
         self._names: dict[sympy.Expr, sympy.Symbol] = {}  # named values (see `name`)
+        self._folded: dict[sympy.Expr, sympy.Expr] = {}  # fold_constants' results, shared by every lowering
+        self._lowered: dict[tuple, Body] = {}
         with distribute(False):  # keep 0.0825*(a - b) whole, for CSE to share a - b
             self.chain = kinematics.build_chain(robot, lambda i: self.cos_sin((i,)), self.q, simplify=self.name,
                                                angle_sum=self.cos_sin)
@@ -319,6 +321,14 @@ class Generator:
         return symbol
 
     def lower(self, outputs: list[sympy.Basic], bindings: dict | None = None) -> Body:
+        """`_lower`, once per outputs and bindings (jacobian_det's determinant is lowered to
+        compare its two forms, then again as a function)."""
+        key = (tuple(outputs), tuple((bindings or {}).items()))
+        if key not in self._lowered:
+            self._lowered[key] = self._lower(outputs, bindings)
+        return self._lowered[key]
+
+    def _lower(self, outputs: list[sympy.Basic], bindings: dict | None = None) -> Body:
         """The outputs as straight-line code: the trig symbols and named values they need,
         then temporaries (t0, t1, ...) after common-subexpression elimination, in an order
         that defines before use."""
@@ -331,13 +341,14 @@ class Generator:
                 needed.add(symbol)
                 frontier |= values[symbol].free_symbols
         named_symbols = set(self._names.values())
-        trig = [(s, fold_constants(v)) for s, v in self.definitions
+        fold = lambda value: fold_constants(value, self._folded)  # noqa: E731
+        trig = [(s, fold(v)) for s, v in self.definitions
                 if s in needed and s not in named_symbols and s not in bindings]
         named = [(s, v) for s, v in self.definitions if s in needed and s in named_symbols]
         with distribute(False):
-            replacements, reduced = sympy.cse([fold_constants(v) for _, v in named] + [fold_constants(e) for e in outputs],
+            replacements, reduced = sympy.cse([fold(v) for _, v in named] + [fold(e) for e in outputs],
                                               symbols=sympy.numbered_symbols("_r", real=True), order="canonical")
-        bound = [(s, fold_constants(v)) for s, v in bindings.items() if s in needed]
+        bound = [(s, fold(v)) for s, v in bindings.items() if s in needed]
         definitions = _in_dependency_order(bound + trig + list(zip((s for s, _ in named), reduced)) + replacements)
         temporaries = sympy.numbered_symbols("t", real=True)
         rename = {symbol: next(temporaries) for symbol, _ in definitions if symbol.name.startswith("_")}

@@ -111,10 +111,12 @@ class CPrinter(C99CodePrinter):
         if real not in C_REAL_TYPES:
             raise ValueError(f"real must be one of {', '.join(C_REAL_TYPES)}, got {real!r}")
         self.real = real
+        self._folded = {}  # one fold per shared subtree across everything this printer prints
         super().__init__({"type_aliases": {ast.real: C_REAL_TYPES[real]}, "strict": True, "math_macros": {}})
 
     def doprint(self, expr, assign_to=None):
-        return super().doprint(expand_integer_powers(fold_constants(expr.xreplace(TOLERANCES[self.real]))), assign_to)
+        folded = fold_constants(expr.xreplace(TOLERANCES[self.real]), self._folded)
+        return super().doprint(expand_integer_powers(folded), assign_to)
 
     def _print_BooleanTrue(self, expr):
         return "1"
