@@ -149,6 +149,36 @@ def verify(robot_files, samples, seed):
         sys.exit(1)
 
 
+@main.command("import-urdf")
+@click.argument("urdf_file", type=click.Path(dir_okay=False))
+@click.option("--base", default=None, metavar="LINK", help="First link of the chain (default: the root).")
+@click.option("--tip", default=None, metavar="LINK", help="Last link of the chain (default: the one leaf below the base).")
+@click.option("--convention", type=click.Choice(["standard", "modified"]), default="standard", show_default=True,
+              help="DH convention of the robot file.")
+@click.option("--name", default=None, help="Robot name (default: the URDF's, made a valid name).")
+@click.option("--task", default=None, metavar="x,y,...",
+              help="Task components (default: all six, or for fewer than six joints the first independent ones).")
+@click.option("--snap", default=1e-9, show_default=True, type=click.FloatRange(0, 0.01), metavar="RADIANS",
+              help="Angles and axes this close to a multiple of 90 degrees become exact (1e-5 takes a URDF's 1.5708).")
+@click.option("-o", "--output", default=None, type=click.Path(dir_okay=False), metavar="FILE.yaml",
+              help="Write the robot file here (default: standard output).")
+def import_urdf_command(urdf_file, base, tip, convention, name, task, snap, output):
+    """Convert the serial chain of a URDF into a DH robot file, exactly."""
+    from .import_urdf import CHECK_CONFIGURATIONS, import_urdf
+
+    components = tuple(part.strip() for part in task.split(",")) if task else None
+    imported = import_urdf(urdf_file, base, tip, convention, name, components, snap)
+    if output:
+        write_files({Path(output).name: imported.text}, Path(output).parent)
+        click.echo(f"jacgen: wrote {output}", err=True)
+    else:
+        click.echo(imported.text, nl=False)
+    click.echo(f"jacgen: {imported.robot.name}: {imported.robot.dof} joints; fk within "
+               f"{imported.fk_difference:.1g} of the URDF chain as read, at {CHECK_CONFIGURATIONS} random configurations"
+               f"{'' if imported.snapped == 0 else f' (angles made exact moved it by up to {imported.snapped:.1g} rad)'}",
+               err=True)
+
+
 def _check_unique_names(robots) -> None:
     """Each robot writes NAME/: two files naming the same robot would overwrite each other."""
     first = {}

@@ -39,12 +39,18 @@ def _trig(angle) -> tuple[sympy.Expr, sympy.Expr]:
     return sympy.cos(angle), sympy.sin(angle)
 
 
-def pose_transform(pose: Pose) -> Matrix:
-    """Exact transform of a base/tool pose: translation, then Rz(yaw) Ry(pitch) Rx(roll)."""
-    roll, pitch, yaw = (v.exact for v in pose.rpy)
-    cp, sp = _trig(pitch)
+def xyz_rpy_transform(xyz, rpy, trig=_trig) -> Matrix:
+    """Translation xyz, then Rz(yaw) Ry(pitch) Rx(roll) (robot files and URDF alike);
+    `trig(angle)` gives (cos, sin)."""
+    roll, pitch, yaw = rpy
+    cp, sp = trig(pitch)
     rot_y = Matrix([[cp, 0, sp, 0], [0, 1, 0, 0], [-sp, 0, cp, 0], [0, 0, 0, 1]])
-    return translation(*(v.exact for v in pose.xyz)) * rot_z(*_trig(yaw)) * rot_y * rot_x(*_trig(roll))
+    return translation(*xyz) * rot_z(*trig(yaw)) * rot_y * rot_x(*trig(roll))
+
+
+def pose_transform(pose: Pose) -> Matrix:
+    """Exact transform of a base/tool pose."""
+    return xyz_rpy_transform([v.exact for v in pose.xyz], [v.exact for v in pose.rpy])
 
 
 def link_transforms(robot: Robot, cos_sin: CosSin, q) -> list[tuple[Matrix, Matrix]]:

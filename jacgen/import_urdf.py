@@ -1,0 +1,225 @@
+"""`jacgen import-urdf`: a URDF chain -> the text of a robot file, checked before it is written.
+
+Stages: urdf.read_chain (XML -> exact joint transforms), dh_fit.fit (axes -> DH table),
+then this module writes the robot file, chooses the task of an arm with fewer than six
+joints, and compares the file's fk with a plain walk of the URDF chain.
+"""
+
+import hashlib
+import re
+from dataclasses import dataclass
+from decimal import Context, Decimal
+from pathlib import Path
+
+import numpy as np
+import sympy
+import yaml
+
+from . import __version__, reference
+from .dh_fit import Axis, fit, tidy
+from .errors import JacgenError
+from .names import robot_name_problem
+from .robot import FORBIDDEN_IN_TEXT, IDENTIFIER_PATTERN, NAME_PATTERN, TASK_COMPONENTS, Robot, parse_robot
+from .urdf import MOVABLE, SNAP_TOLERANCE, Chain, read_chain
+
+CHECK_CONFIGURATIONS = 20
+CHECK_SEED = 0
+
+
+@dataclass(frozen=True)
+class Imported:
+    """A robot file made from a URDF: its text, the robot it reads as, the largest fk
+    difference from the URDF chain at CHECK_CONFIGURATIONS random configurations, and the
+    largest change (radians) that making angles exact caused."""
+
+    text: str
+    robot: Robot
+    fk_difference: float
+    snapped: float
+
+
+def import_urdf(path: str, base: str | None = None, tip: str | None = None, convention: str = "standard",
+                name: str | None = None, task: tuple[str, ...] | None = None,
+                snap: float = SNAP_TOLERANCE) -> Imported:
+    """The robot file for the chain of `path`, checked against the URDF's own fk."""
+    chain = read_chain(path, base, tip, snap)
+    axes, tip_frame = _axes(chain)
+    table = fit(axes, tip_frame, convention, snap)
+    name = name or _robot_name(chain.robot_name)
+    problem = robot_name_problem(name) if NAME_PATTERN.match(name) else f"does not match {NAME_PATTERN.pattern}"
+    if problem:
+        raise JacgenError(f"{path}: robot name {name!r} {problem}; choose another with --name")
+    snapped = max(chain.snapped, table.snapped)
+    digest = hashlib.sha256(Path(path).read_bytes()).hexdigest()[:16]
+    source = _text(Path(path).name)
+    header = [
+        f"Imported by jacgen {__version__} import-urdf from {source} (sha256 {digest}), "
+        f"robot {_text(chain.robot_name)!r}, links {_text(chain.base)} -> {_text(chain.tip)}.",
+        f"{len(axes)} moving joint(s); fixed joints folded into the DH, base and tool transforms: "
+        f"{_text(', '.join(chain.folded)) or 'none'}. DH frames as in docs/urdf.md.",
+        f"Angles and axes within {snap:g} rad of a multiple of 90 deg were made exact; "
+        f"largest change {snapped:.2g} rad.",
+    ]
+    description = f"{_text(chain.robot_name)} imported from {source} (links {_text(chain.base)} -> {_text(chain.tip)})"
+
+    def text(components):
+        return _robot_file(name, description, header, convention, table, components)
+
+    if task is None:
+        task = () if len(axes) >= 6 else _independent_task(parse_robot(text(TASK_COMPONENTS).encode()))
+    elif not task or any(component not in TASK_COMPONENTS for component in task):
+        raise JacgenError(f"--task: expected components of {', '.join(TASK_COMPONENTS)}, got {','.join(task)!r}")
+    result = text(task)
+    robot = parse_robot(result.encode(), path)
+    return Imported(result, robot, _fk_difference(robot, chain), snapped)
+
+
+def _axes(chain: Chain) -> tuple[list[Axis], sympy.Matrix]:
+    """The moving joints' axis lines at q = 0 in the base link's frame, and the tip frame."""
+    frame, axes = chain.start, []
+    for joint in chain.joints:
+        frame = (frame * joint.origin).applyfunc(tidy)
+        if joint.kind in MOVABLE:
+            axes.append(Axis(joint.name, "prismatic" if joint.kind == "prismatic" else "revolute",
+                             frame[:3, 3].applyfunc(tidy), (frame[:3, :3] * joint.axis).applyfunc(tidy),
+                             joint.limits))
+    return axes, frame
+
+
+def _robot_name(urdf_name: str) -> str:
+    name = re.sub(r"[^a-z0-9_]+", "_", urdf_name.lower()).strip("_")
+    name = re.sub(r"^[^a-z]+", "", name)[:48]
+    return name or "robot"
+
+
+def _joint_names(axes: list[Axis]) -> list[str]:
+    """The URDF names, made identifiers and unique."""
+    names: list[str] = []
+    for axis in axes:
+        name = re.sub(r"\W+", "_", axis.name, flags=re.ASCII).strip("_") or "joint"
+        name = name if not name[0].isdigit() else f"j{name}"
+        name, candidate, k = name[:44], name[:44], 2
+        while candidate in names:
+            candidate, k = f"{name}_{k}", k + 1
+        assert IDENTIFIER_PATTERN.match(candidate)
+        names.append(candidate)
+    return names
+
+
+def _text(text: str) -> str:
+    """URDF text for a comment or the description: printable, one line, nothing that escapes."""
+    text = "".join(c if c.isprintable() else "_" for c in text)
+    for bad in FORBIDDEN_IN_TEXT:
+        text = text.replace(bad, "_" * len(bad))
+    return text
+
+
+def literal(value: sympy.Expr) -> str:
+    """A robot-file value: an exact decimal, "p/q", "r*sqrt(s)" or "k*pi/m" when exact, else
+    the shortest decimal that round-trips the double."""
+    value = sympy.sympify(value)
+    if value.has(sympy.Float):
+        return repr(float(value)) if value != 0 else "0"
+    if value.is_Rational:
+        return _rational(value)
+    coefficient, rest = value.as_coeff_Mul()
+    if rest is sympy.pi:
+        p, q = coefficient.p, coefficient.q
+        text = "pi" if abs(p) == 1 else f"{abs(p)}*pi"
+        return f'"{"-" if p < 0 else ""}{text}{f"/{q}" if q != 1 else ""}"'
+    radicand = _rational(rest.base).strip('"')
+    return f'"{"" if coefficient == 1 else _rational(coefficient).strip(chr(34)) + "*"}sqrt({radicand})"'
+
+
+def _rational(value: sympy.Rational) -> str:
+    p, q = int(value.p), int(value.q)
+    stripped = q
+    for prime in (2, 5):
+        while stripped % prime == 0:
+            stripped //= prime
+    if stripped != 1:
+        return f'"{p}/{q}"'
+    decimal = Context(prec=100).divide(Decimal(p), Decimal(q)).normalize()
+    if -7 < decimal.adjusted() < 16:
+        return format(decimal, "f")
+    return str(decimal).lower().replace("e+", "e")
+
+
+def _limits(text: tuple[str, str] | None) -> str | None:
+    return None if text is None else f"[{_rational(sympy.Rational(text[0]))}, {_rational(sympy.Rational(text[1]))}]"
+
+
+def _robot_file(name, description, header, convention, table, task) -> str:
+    lines = [f"# {line}" for line in header]
+    lines += [f"name: {name}", f"description: {_quoted(description)}", f"convention: {convention}",
+              "angle_unit: rad", "length_unit: m", "joints:"]
+    rows = []
+    for joint_name, row in zip(_joint_names([r.axis for r in table.rows]), table.rows):
+        fields = [("name", _quoted(joint_name)), ("type", row.axis.kind), ("a", literal(row.a)),
+                  ("alpha", literal(row.alpha))]
+        fields += ([("d", literal(row.d)), ("offset", literal(row.theta))] if row.axis.kind == "revolute"
+                   else [("theta", literal(row.theta)), ("offset", literal(row.d))])
+        if row.axis.limits is not None:
+            fields.append(("limits", _limits(row.axis.limits)))
+        rows.append([f"{key}: {value}" for key, value in fields])
+    widths = [max(len(row[k]) for row in rows if k < len(row)) for k in range(max(map(len, rows)))]
+    for row in rows:
+        cells = [cell + ("," if k < len(row) - 1 else "") for k, cell in enumerate(row)]
+        padded = " ".join(cell.ljust(widths[k] + 1) for k, cell in enumerate(cells)).rstrip()
+        lines.append(f"  - {{{padded}}}")
+    for key, (xyz, rpy) in (("base", table.base), ("tool", table.tool)):
+        if any(v != 0 for v in xyz + rpy):
+            lines.append(f"{key}: {{xyz: [{', '.join(map(literal, xyz))}], rpy: [{', '.join(map(literal, rpy))}]}}")
+    if task:
+        lines.append(f"task: [{', '.join(task)}]")
+    return "\n".join(lines) + "\n"
+
+
+def _quoted(text: str) -> str:
+    """A YAML scalar that reads back as the string `text` (which _text has made safe)."""
+    plain = re.fullmatch(r"[A-Za-z_]\w*", text, re.ASCII) and isinstance(yaml.safe_load(text), str)
+    return text if plain else '"' + text.replace('"', "'") + '"'
+
+
+def _independent_task(robot) -> tuple[str, ...]:
+    """The first components in the order x, y, z, roll, pitch, yaw whose task-Jacobian rows are
+    independent of those taken before, at two random configurations: one per joint at most."""
+    rng = np.random.default_rng(CHECK_SEED)
+    jacobians = [reference.task_jacobian(robot, rng.uniform(-1, 1, robot.dof)) for _ in range(2)]
+    chosen: list[int] = []
+    for k in range(len(TASK_COMPONENTS)):
+        rows = chosen + [k]
+        stacked = np.hstack([J[rows] for J in jacobians])
+        if len(chosen) < robot.dof and np.linalg.matrix_rank(stacked, tol=1e-6 * max(1.0, np.abs(stacked).max())) == len(rows):
+            chosen.append(k)
+    return tuple(TASK_COMPONENTS[k] for k in chosen)
+
+
+def urdf_fk(chain: Chain, q) -> np.ndarray:
+    """The URDF's own fk: its joint transforms multiplied out in floats (no DH involved)."""
+    frame = np.array(chain.start.evalf(), dtype=float)
+    movable = iter(q)
+    for joint in chain.joints:
+        frame = frame @ np.array(joint.origin.evalf(), dtype=float)
+        if joint.kind in MOVABLE:
+            value = next(movable)
+            axis = np.array(joint.axis.evalf(), dtype=float).ravel()
+            motion = np.eye(4)
+            if joint.kind == "prismatic":
+                motion[:3, 3] = value * axis
+            else:  # Rodrigues
+                skew = np.array([[0, -axis[2], axis[1]], [axis[2], 0, -axis[0]], [-axis[1], axis[0], 0]])
+                motion[:3, :3] = np.eye(3) + np.sin(value) * skew + (1 - np.cos(value)) * skew @ skew
+            frame = frame @ motion
+    return frame
+
+
+def _fk_difference(robot, chain: Chain) -> float:
+    rng = np.random.default_rng(CHECK_SEED)
+    low = np.array([j.limits[0] if j.limits else -np.pi for j in robot.joints])
+    high = np.array([j.limits[1] if j.limits else np.pi for j in robot.joints])
+    worst = 0.0
+    for _ in range(CHECK_CONFIGURATIONS):
+        q = rng.uniform(low, high)
+        worst = max(worst, float(np.abs(reference.fk(robot, q) - urdf_fk(chain, q)).max()))
+    return worst
