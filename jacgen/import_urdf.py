@@ -65,13 +65,21 @@ def import_urdf(path: str, base: str | None = None, tip: str | None = None, conv
     def text(components):
         return _robot_file(name, description, header, convention, table, components)
 
-    if task is None:
-        task = () if len(axes) >= 6 else _independent_task(parse_robot(text(TASK_COMPONENTS).encode()))
-    elif not task or any(component not in TASK_COMPONENTS for component in task):
+    if task is not None and (not task or any(component not in TASK_COMPONENTS for component in task)):
         raise JacgenError(f"--task: expected components of {', '.join(TASK_COMPONENTS)}, got {','.join(task)!r}")
+    if task is None:
+        task = () if len(axes) >= 6 else _independent_task(_read_back(text(TASK_COMPONENTS)))
     result = text(task)
-    robot = parse_robot(result.encode(), path)
+    robot = _read_back(result)
     return Imported(result, robot, _fk_difference(robot, chain), snapped)
+
+
+def _read_back(text: str) -> Robot:
+    """The robot of a file we wrote; one that does not read back is a bug of ours."""
+    try:
+        return parse_robot(text.encode(), "<imported robot file>")
+    except JacgenError as error:
+        raise RuntimeError(f"the imported robot file does not read back: {error}") from None
 
 
 def _axes(chain: Chain) -> tuple[list[Axis], sympy.Matrix]:
@@ -87,9 +95,11 @@ def _axes(chain: Chain) -> tuple[list[Axis], sympy.Matrix]:
 
 
 def _robot_name(urdf_name: str) -> str:
+    """The URDF's name made a valid robot name; `_robot` is added to one that would hide
+    a keyword, header or module ("random" -> "random_robot")."""
     name = re.sub(r"[^a-z0-9_]+", "_", urdf_name.lower()).strip("_")
-    name = re.sub(r"^[^a-z]+", "", name)[:48]
-    return name or "robot"
+    name = re.sub(r"^[^a-z]+", "", name)[:41] or "robot"
+    return f"{name}_robot" if robot_name_problem(name) else name
 
 
 def _joint_names(axes: list[Axis]) -> list[str]:
@@ -127,8 +137,8 @@ def literal(value: sympy.Expr) -> str:
         p, q = coefficient.p, coefficient.q
         text = "pi" if abs(p) == 1 else f"{abs(p)}*pi"
         return f'"{"-" if p < 0 else ""}{text}{f"/{q}" if q != 1 else ""}"'
-    radicand = _rational(rest.base).strip('"')
-    return f'"{"" if coefficient == 1 else _rational(coefficient).strip(chr(34)) + "*"}sqrt({radicand})"'
+    radicand = _rational(coefficient**2 * rest.base).strip('"')  # r*sqrt(s) = sign(r)*sqrt(r**2*s)
+    return f'"{"-" if coefficient < 0 else ""}sqrt({radicand})"'
 
 
 def _rational(value: sympy.Rational) -> str:

@@ -122,6 +122,57 @@ def test_structure_and_ik_class_survive_import(name):
     assert classify(imported(name).robot).solver == URDFS[name][3]
 
 
+def random_urdf(seed: int) -> str:
+    """A random serial URDF nobody tuned for: 1 to 8 moving joints (revolute, continuous,
+    prismatic) with fixed joints between, offsets of 0 or up to 0.5 m, angles of 0, k*90
+    degrees or anything, axes along +-x/y/z or anywhere, and a fixed tool."""
+    rng = np.random.default_rng(seed)
+
+    def length():
+        return "0" if rng.random() < 0.4 else f"{rng.uniform(-0.5, 0.5):.4f}"
+
+    def angle():
+        kind = rng.random()
+        return ("0" if kind < 0.35 else repr(int(rng.integers(-2, 3)) * math.pi / 2) if kind < 0.75
+                else f"{rng.uniform(-3, 3):.6f}")
+
+    def axis():
+        if rng.random() < 0.8:
+            along, sign = rng.integers(3), int(rng.choice([-1, 1]))
+            return " ".join(str(sign if k == along else 0) for k in range(3))
+        return " ".join(f"{x:.5f}" for x in rng.normal(size=3))
+
+    def origin():
+        return f'<origin xyz="{length()} {length()} {length()}" rpy="{angle()} {angle()} {angle()}"/>'
+
+    lines, moving, k = ['<robot name="random">', '<link name="l0"/>'], 0, 0
+    count = int(rng.integers(1, 9))
+    while moving < count:
+        k += 1
+        kind = rng.choice(["revolute", "revolute", "revolute", "prismatic", "continuous", "fixed"])
+        limit = (f'<limit lower="-{rng.uniform(0.5, 3):.3f}" upper="{rng.uniform(0.5, 3):.3f}" effort="1" velocity="1"/>'
+                 if kind in ("revolute", "prismatic") else "")
+        lines += [f'<link name="l{k}"/>', f'<joint name="j{k}" type="{kind}"><parent link="l{k - 1}"/>'
+                  f'<child link="l{k}"/>{origin()}<axis xyz="{axis()}"/>{limit}</joint>']
+        moving += kind != "fixed"
+    lines += [f'<link name="l{k + 1}"/>', f'<joint name="tool" type="fixed"><parent link="l{k}"/>'
+              f'<child link="l{k + 1}"/>{origin()}</joint>', "</robot>"]
+    return "\n".join(lines)
+
+
+@pytest.mark.parametrize("seed", range(40))
+def test_random_urdf_fk_equals_pinocchio(seed, tmp_path):
+    path = tmp_path / "random.urdf"
+    path.write_text(random_urdf(seed))
+    for convention in ("standard", "modified"):
+        result = import_urdf(str(path), convention=convention)
+        assert result.robot.name == "random_robot"
+        tip = re.search(r"-> (\w+)\)", result.robot.description).group(1)
+        qs = configurations(result.robot, 10, seed)
+        poses = pinocchio_fk(path.read_text(), tmp_path, result.robot, None, tip, qs)
+        assert max(np.abs(reference.fk(result.robot, q) - pose).max() for q, pose in zip(qs, poses)) < 1e-12
+
+
 def test_ur5_is_universal_robots_published_table():
     """UR's published DH table of the UR5 (Universal Robots, "DH parameters for calculations
     of kinematics and dynamics"), exactly: its base frame is the URDF's `base`, its flange `tool0`."""
@@ -181,6 +232,7 @@ def test_degenerate_geometry_takes_the_documented_choices():
 
 def test_literals_read_back_exactly():
     values = [sympy.Rational("0.089159"), sympy.Rational(-1, 3), sympy.Rational(3, 1000) * sympy.sqrt(50773),
+              sympy.Rational("-0.0001") * sympy.sqrt(8068765),
               sympy.sqrt(2), -sympy.pi / 2, 3 * sympy.pi / 4, sympy.pi, sympy.Rational("5.55112e-17")]
     for value in values:
         assert parse(literal(value).strip('"'), lambda name: None).exact == value
