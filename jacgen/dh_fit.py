@@ -16,7 +16,7 @@ from dataclasses import dataclass
 import sympy
 from sympy import Matrix
 
-from .urdf import DIGITS, inverse_transform
+from .urdf import DIGITS, Snapper, inverse_transform
 
 NOISE = 1e-25  # a 30-digit result below this is the rounding of a zero
 
@@ -48,7 +48,6 @@ class Table:
     rows: tuple[Row, ...]
     base: tuple[tuple, tuple]  # (xyz, rpy)
     tool: tuple[tuple, tuple]
-    snapped: float  # the largest change made by snapping an angle to a multiple of pi/2
 
 
 def tidy(x) -> sympy.Expr:
@@ -83,30 +82,19 @@ def is_zero_vector(v: Matrix) -> bool:
 
 
 class _Fit:
-    def __init__(self, snap: float):
-        self.snap = snap
-        self.snapped = 0.0
+    def __init__(self, snapper: Snapper):
+        self.snapper = snapper
 
     def angle(self, y, x) -> sympy.Expr:
-        """atan2(y, x), exactly k*pi/2 when within `snap` of it (robot files snap at 1e-9 anyway)."""
+        """atan2(y, x), exactly k*pi/2 when nearly so (robot files snap such angles anyway)."""
         value = tidy(sympy.atan2(y, x))
-        if value.has(sympy.Float):
-            quarter_turns = round(float(value) / (math.pi / 2))
-            change = abs(float(value) - quarter_turns * math.pi / 2)
-            if change < self.snap:
-                self.snapped = max(self.snapped, change)
-                return quarter_turns * sympy.pi / 2
-        return value
+        return self.snapper.angle(value) if value.has(sympy.Float) else value
 
     def parallel(self, z: Matrix, w: Matrix) -> bool:
-        """Parallel exactly, or (30-digit directions) within `snap` radians."""
+        """Parallel exactly, or (30-digit directions) within the snapper's tolerance."""
         sine = cross(z, w)
         if any(e.has(sympy.Float) for e in sine):
-            size = math.sqrt(sum(float(e) ** 2 for e in sine))
-            if size < self.snap:
-                self.snapped = max(self.snapped, size)
-                return True
-            return False
+            return self.snapper.close(math.sqrt(sum(float(e) ** 2 for e in sine)))
         return is_zero_vector(sine)
 
     def rpy(self, rotation: Matrix) -> tuple:
@@ -160,9 +148,9 @@ def _frame(origin: Matrix, x: Matrix, z: Matrix) -> Matrix:
     return frame
 
 
-def fit(axes: list[Axis], tip: Matrix, convention: str, snap: float) -> Table:
+def fit(axes: list[Axis], tip: Matrix, convention: str, snapper: Snapper) -> Table:
     """The DH table of the chain of `axes` whose tool frame at q = 0 is `tip`."""
-    fitting = _Fit(snap)
+    fitting = _Fit(snapper)
     axes = _placed(axes, tip, fitting)
     n = len(axes)
     first = axes[0]
@@ -210,4 +198,4 @@ def fit(axes: list[Axis], tip: Matrix, convention: str, snap: float) -> Table:
         rows.append(Row(axis, a, alpha, d, theta))
     base = _frame(origin, x[0], first.direction)
     tool = inverse_transform(_frame(end, x[n], last.direction)) * tip
-    return Table(tuple(rows), fitting.pose(base), fitting.pose(tool.applyfunc(tidy)), fitting.snapped)
+    return Table(tuple(rows), fitting.pose(base), fitting.pose(tool.applyfunc(tidy)))

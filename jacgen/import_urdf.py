@@ -20,7 +20,7 @@ from .dh_fit import Axis, fit, tidy
 from .errors import JacgenError
 from .names import robot_name_problem
 from .robot import FORBIDDEN_IN_TEXT, IDENTIFIER_PATTERN, NAME_PATTERN, TASK_COMPONENTS, Robot, parse_robot
-from .urdf import MOVABLE, SNAP_TOLERANCE, Chain, read_chain
+from .urdf import MOVABLE, SNAP_TOLERANCE, Chain, Snapper, read_chain
 
 CHECK_CONFIGURATIONS = 20
 CHECK_SEED = 0
@@ -42,14 +42,15 @@ def import_urdf(path: str, base: str | None = None, tip: str | None = None, conv
                 name: str | None = None, task: tuple[str, ...] | None = None,
                 snap: float = SNAP_TOLERANCE) -> Imported:
     """The robot file for the chain of `path`, checked against the URDF's own fk."""
-    chain = read_chain(path, base, tip, snap)
+    snapper = Snapper(snap)
+    chain = read_chain(path, base, tip, snapper)
     axes, tip_frame = _axes(chain)
-    table = fit(axes, tip_frame, convention, snap)
+    table = fit(axes, tip_frame, convention, snapper)
     name = name or _robot_name(chain.robot_name)
     problem = robot_name_problem(name) if NAME_PATTERN.match(name) else f"does not match {NAME_PATTERN.pattern}"
     if problem:
         raise JacgenError(f"{path}: robot name {name!r} {problem}; choose another with --name")
-    snapped = max(chain.snapped, table.snapped)
+    snapped = snapper.largest
     digest = hashlib.sha256(Path(path).read_bytes()).hexdigest()[:16]
     source = _text(Path(path).name)
     header = [

@@ -61,8 +61,7 @@ class UrdfJoint:
 @dataclass(frozen=True)
 class Chain:
     """The joints from `base` to `tip`: `start` is the transform from `base` to the first
-    joint's parent link (the identity unless `base` hangs below it on fixed joints).
-    `snapped` is the largest change snapping made (radians)."""
+    joint's parent link (the identity unless `base` hangs below it on fixed joints)."""
 
     robot_name: str
     base: str
@@ -70,7 +69,26 @@ class Chain:
     start: Matrix
     joints: tuple[UrdfJoint, ...]
     folded: tuple[str, ...]  # the fixed joints on the way, whose transforms are folded in
-    snapped: float
+
+
+class Snapper:
+    """Makes angles and directions within `tolerance` of exact (a multiple of pi/2, a
+    coordinate axis) exact, and remembers the largest change that made."""
+
+    def __init__(self, tolerance: float = SNAP_TOLERANCE):
+        self.tolerance, self.largest = tolerance, 0.0
+
+    def close(self, change: float) -> bool:
+        """Whether a value `change` away from exact is to be made exact (recorded if so)."""
+        if change < self.tolerance:
+            self.largest = max(self.largest, change)
+            return True
+        return False
+
+    def angle(self, value: sympy.Expr) -> sympy.Expr:
+        """Exactly k*pi/2 when within the tolerance of it; otherwise the value itself."""
+        quarter_turns = round(float(value) / (math.pi / 2))
+        return quarter_turns * sympy.pi / 2 if self.close(abs(float(value) - quarter_turns * math.pi / 2)) else value
 
 
 def parse_xml(data: bytes, path: str) -> Element:
@@ -103,22 +121,21 @@ def parse_xml(data: bytes, path: str) -> Element:
     return roots[0]
 
 
-def read_chain(path: str, base: str | None = None, tip: str | None = None, snap: float = SNAP_TOLERANCE) -> Chain:
+def read_chain(path: str, base: str | None = None, tip: str | None = None, snapper: Snapper | None = None) -> Chain:
     """The chain of the URDF file at `path` from `base` (default: the root) to `tip`
-    (default: the one leaf below `base`); angles and axes within `snap` of exact are made exact."""
+    (default: the one leaf below `base`); `snapper` makes nearly exact angles and axes exact."""
     try:
         data = Path(path).read_bytes()
     except OSError as error:
         raise RobotFileError(path, 1, 1, "", f"cannot read file: {error.strerror or error}") from None
     if len(data) > MAX_URDF_BYTES:
         raise RobotFileError(path, 1, 1, "", f"file larger than {MAX_URDF_BYTES} bytes")
-    return _UrdfReader(path, snap).chain(parse_xml(data, path), base, tip)
+    return _UrdfReader(path, snapper or Snapper()).chain(parse_xml(data, path), base, tip)
 
 
 class _UrdfReader:
-    def __init__(self, path: str, snap: float):
-        self.path, self.snap = path, snap
-        self.snapped = 0.0
+    def __init__(self, path: str, snapper: Snapper):
+        self.path, self.snapper = path, snapper
 
     def error(self, element: Element, key: str, message: str) -> RobotFileError:
         return RobotFileError(self.path, element.line, element.column, key, message)
@@ -179,7 +196,7 @@ class _UrdfReader:
             raise RobotFileError(self.path, root.line, root.column, "", f"no moving joint between "
                                  f"links {base!r} and {tip!r}")
         folded = tuple(j.attributes["name"] for j in up) + tuple(j.name for j in chain if j.kind == "fixed")
-        return Chain(root.attributes.get("name", ""), base, tip, start, tuple(chain), folded, self.snapped)
+        return Chain(root.attributes.get("name", ""), base, tip, start, tuple(chain), folded)
 
     def declared(self, root: Element, tag: str) -> dict[str, Element]:
         found: dict[str, Element] = {}
@@ -248,7 +265,7 @@ class _UrdfReader:
                              "another joint's, and a DH row needs a joint of its own")
         origin = element.child("origin")
         xyz = self.numbers(origin, f"{key}.origin", "xyz")
-        rpy = [self.angle(value, origin) for value in self.numbers(origin, f"{key}.origin", "rpy")]
+        rpy = [self.snapper.angle(value) for value in self.numbers(origin, f"{key}.origin", "rpy")]
         transform = xyz_rpy_transform(xyz, rpy, _cos_sin)
         axis = Matrix([1, 0, 0])
         limits = None
@@ -281,15 +298,6 @@ class _UrdfReader:
             raise self.error(element, f"{key}.{attribute}", f"expected 3 numbers, got {len(parts)}")
         return [self.number(part, element, f"{key}.{attribute}") for part in parts]
 
-    def angle(self, value: sympy.Rational, element) -> sympy.Expr:
-        """Exactly k*pi/2 when within `snap` of it; otherwise the decimal itself."""
-        quarter_turns = round(float(value) / (math.pi / 2))
-        change = abs(float(value) - quarter_turns * math.pi / 2)
-        if change < self.snap:
-            self.snapped = max(self.snapped, change)
-            return quarter_turns * sympy.pi / 2
-        return value
-
     def axis(self, element: Element, key: str) -> Matrix:
         vector = Matrix(self.numbers(element, key, "xyz"))
         length = math.sqrt(sum(float(v) ** 2 for v in vector))
@@ -298,9 +306,7 @@ class _UrdfReader:
         unit = [float(v) / length for v in vector]
         for k in range(3):
             for sign in (1, -1):
-                change = math.dist(unit, [sign * (i == k) for i in range(3)])
-                if change < self.snap:
-                    self.snapped = max(self.snapped, change)
+                if self.snapper.close(math.dist(unit, [sign * (i == k) for i in range(3)])):
                     return Matrix([sign * int(i == k) for i in range(3)])
         return (vector / sympy.sqrt(sum(v**2 for v in vector))).evalf(DIGITS)
 
