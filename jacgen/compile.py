@@ -73,25 +73,27 @@ class CLibrary:
             symbol.argtypes = [scalar if a.scalar else pointer for a in function.arguments] + outputs + extra
             symbol.restype = None if returned is None else ctypes.c_int if returned.integer else scalar
 
-    def evaluate(self, name: str, q: np.ndarray, parameters: dict[str, float] | None = None) -> np.ndarray:
-        """Function `name` at each row of q (k, dof): results (k, size), each output row-major
-        and the outputs of a fused function side by side.
+    def evaluate(self, name: str, q: np.ndarray, *more: np.ndarray,
+                 parameters: dict[str, float] | None = None) -> np.ndarray:
+        """Function `name` at each row of q (k, dof) and of any further array arguments
+        (q_dot): results (k, size), each output row-major and the outputs of a fused function
+        side by side.
 
         Symbolic parameters take their nominal values unless given in `parameters`.
         """
         function = self._functions[name]
         symbol = getattr(self._library, f"{self.robot.name}_{name}")
         extra = self._extra(parameters)
-        joints = np.ascontiguousarray(q, dtype=self.dtype)
+        inputs = [np.ascontiguousarray(array, dtype=self.dtype) for array in (q, *more)]
         starts = np.cumsum([0] + [output.size for output in function.outputs])
-        results = np.empty((len(joints), starts[-1]), dtype=self.dtype)
+        results = np.empty((len(inputs[0]), starts[-1]), dtype=self.dtype)
         pointer = ctypes.POINTER(C_TYPES[self.real])
-        for row, out in zip(joints, results):
+        for k, out in enumerate(results):
+            arguments = [array[k].ctypes.data_as(pointer) for array in inputs]
             if function.scalar:
-                out[0] = symbol(row.ctypes.data_as(pointer), *extra)
+                out[0] = symbol(*arguments, *extra)
             else:
-                symbol(row.ctypes.data_as(pointer), *(out[start:].ctypes.data_as(pointer) for start in starts[:-1]),
-                       *extra)
+                symbol(*arguments, *(out[start:].ctypes.data_as(pointer) for start in starts[:-1]), *extra)
         return results.astype(np.float64)
 
     def _extra(self, parameters: dict[str, float] | None = None) -> list:

@@ -2,6 +2,7 @@
 that templates only lay text out. `backends.py` names the builder of each language."""
 
 
+import numpy
 import sympy
 
 from . import analysis, differential, ik, report
@@ -28,6 +29,11 @@ C_EXTENTS = {
     "jacobian_tool": (6, "DOF"),
     "task": ("TASK_DIM",),
     "task_jacobian": ("TASK_DIM", "DOF"),
+    "q_dot": ("DOF",),
+    "jacobian_dot": (6, "DOF"),
+    "bias_acceleration": (6,),
+    "task_jacobian_dot": ("TASK_DIM", "DOF"),
+    "hessian": ("DOF", 6, "DOF"),
     "singularity_factors": ("NUM_SINGULARITY_FACTORS",),
 }
 # SPEC §3 size macros that are the row count of a function, defined when it is generated.
@@ -53,7 +59,7 @@ def _python_function(function: Function, printer: PythonPrinter, parameters: lis
                for a, shape in zip(function.arguments, shapes)]
     results = []
     for output, values in function.parts(body.outputs):
-        indices = [", ".join(["..."] + [str(i) for i in divmod(k, output.cols)[: len(output.shape)]])
+        indices = [", ".join(["..."] + [str(i) for i in numpy.unravel_index(k, output.shape)])
                    for k in range(output.size)]
         dtype = "bool" if output.boolean else "int" if output.integer else "float"
         results.append({"name": output.name, "shape": repr(output.shape), "dtype": dtype,
@@ -61,7 +67,7 @@ def _python_function(function: Function, printer: PythonPrinter, parameters: lis
     return {
         "name": function.name,
         "summary": function.summary,
-        "shape": " and ".join(" x ".join(map(str, (o.rows, o.cols))) for o in function.outputs),
+        "shape": " and ".join(_dimensions(o) for o in function.outputs),
         "operations": body.operation_count,
         "arguments": [(a.name, repr(shape)) for a, shape in zip(function.arguments, shapes)],
         "signature": ", ".join([f"{a.name}=0.0" if a.scalar else a.name for a in function.arguments] + ["*"] * bool(parameters)
@@ -75,6 +81,11 @@ def _python_function(function: Function, printer: PythonPrinter, parameters: lis
     }
 
 
+def _dimensions(output: Output) -> str:
+    """`6 x 7`, or `7 x 6 x 7` for a stack."""
+    return " x ".join(map(str, output.shape if output.layers > 1 else (output.rows, output.cols)))
+
+
 def _sentence(text: str) -> str:
     """First letter upper case, the rest as written (jinja's `capitalize` lowers `DOF`)."""
     return text[:1].upper() + text[1:]
@@ -84,6 +95,10 @@ def _layout(output: Output) -> str:
     """How a result is laid out, for the C header."""
     if output.scalar:
         return "returned as a scalar"
+    if output.layers > 1:
+        layers, rows, cols = output.shape
+        return (f"{output.name}: {layers} x {rows} x {cols} row-major, element (k, r, c) at "
+                f"{output.name}[k * {rows * cols} + r * {cols} + c]")
     if output.cols == 1:
         return f"{output.name}[i], i < {output.rows}"
     return f"{output.name}: {output.rows} x {output.cols} row-major, element (r, c) at {output.name}[r * {output.cols} + c]"
@@ -287,7 +302,7 @@ def _report_context(robot: Robot, generator: Generator) -> dict:
         "isotropy": report.isotropy_lines(robot),
         "ik": report.ik_lines(generator.model.structure),
         "operations": [{"name": f.name, "operations": f.body.operation_count,
-                        "shape": "scalar" if f.scalar else " and ".join(f"{o.rows} x {o.cols}" for o in f.outputs)}
+                        "shape": "scalar" if f.scalar else " and ".join(_dimensions(o) for o in f.outputs)}
                        for f in generator.functions()],
     }
 
@@ -327,7 +342,7 @@ def casadi_context(robot: Robot, generator: Generator, printer: CasadiPrinter, r
     functions = generator.functions()
     context["functions"] = [_casadi_function(f, robot, printer) for f in functions]
     context["arguments"] = sorted({(a.name, a.symbols.rows, a.symbols.cols) for f in functions for a in f.arguments},
-                                  key=lambda a: ("q", "mu_dot", "damping", "target", "T", "mu").index(a[0]))
+                                  key=lambda a: ("q", "q_dot", "mu_dot", "damping", "target", "T", "mu").index(a[0]))
     context["ik"] = generator.closed_form is not None
     context["ik_numeric"] = _ik_numeric_context(robot, "python", "double")
     return dict(sorted(context.items()))

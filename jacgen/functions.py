@@ -68,6 +68,7 @@ class Output:
     equals: str = ""  # the function whose result this is, when the function fuses several
     boolean: bool = False  # truth values
     integer: bool = False  # a status: an int in C and numpy
+    layers: int = 1  # > 1: a stack of `layers` matrices of rows / layers x cols (the hessian)
 
     @property
     def size(self) -> int:
@@ -75,9 +76,12 @@ class Output:
 
     @property
     def shape(self) -> tuple[int, ...]:
-        """numpy shape: matrices (rows, cols) (a one-joint Jacobian too), vectors (rows,), scalars ()."""
+        """numpy shape: matrices (rows, cols) (a one-joint Jacobian too), vectors (rows,), scalars (),
+        stacks (layers, rows / layers, cols)."""
         if self.scalar:
             return ()
+        if self.layers > 1:
+            return (self.layers, self.rows // self.layers, self.cols)
         return (self.rows,) if self.vector else (self.rows, self.cols)
 
 
@@ -220,6 +224,34 @@ class Generator:
     def jacobian(self) -> sympy.Matrix:
         return kinematics.column_jacobian(self.robot, self.chain)
 
+    def second_order_functions(self) -> list[Function]:
+        """fk_jacobian_dot, jacobian_dot, bias_acceleration, task_jacobian_dot and hessian, from
+        the chain and the named columns of J (`kinematics`): O(1) per entry on top of J."""
+        robot, n, m = self.robot, self.robot.dof, len(self.robot.task)
+        q_dot = Argument("q_dot", sympy.Matrix([sympy.Symbol(f"qd{i + 1}", real=True) for i in range(n)]))
+        arguments = (Argument("q", sympy.Matrix(self.q)), q_dot)
+        with distribute(False):
+            columns = self.jacobian.applyfunc(self.name)
+            rates = list(q_dot.symbols)
+            jacobian_dot = kinematics.jacobian_dot(robot, self.chain, columns, rates, self.name)
+            bias = jacobian_dot * q_dot.symbols
+            task_jacobian_dot = kinematics.task_jacobian_dot(robot, self.chain.tool, columns,
+                                                             jacobian_dot.applyfunc(self.name), rates, self.name)
+            hessian = sympy.Matrix.vstack(*kinematics.hessian(robot, columns))
+        return [
+            self.function("fk_jacobian_dot", "fk, jacobian and bias_acceleration in one pass, sharing their terms",
+                          ("T", self.chain.tool), ("J", self.jacobian), ("a", bias),
+                          equals=("fk", "jacobian", "bias_acceleration"), vectors=("a",), arguments=arguments),
+            self.function("jacobian_dot", "dJ/dt of the world geometric Jacobian along q_dot (6 x DOF)",
+                          ("Jd", jacobian_dot), arguments=arguments),
+            self.function("bias_acceleration", "J' q_dot: the tool's classical linear and angular acceleration "
+                          "at zero joint acceleration, world frame (6)", ("a", bias), vector=True, arguments=arguments),
+            self.function("task_jacobian_dot", f"d/dt of the analytic Jacobian along q_dot ({m} x DOF): "
+                          "mu'' = J_a q'' + J_a' q'", ("Jd", task_jacobian_dot), arguments=arguments),
+            self.function("hessian", "d J / d q_k for each k (DOF x 6 x DOF, indexed [k, r, c])",
+                          ("H", hessian), layers=n),
+        ]
+
     @property
     def singularities(self) -> analysis.Singularities:
         return self.model.singularities
@@ -286,19 +318,20 @@ class Generator:
     def function(self, name: str, summary: str, *results: tuple[str, sympy.Matrix | list], scalar: bool = False,
                  vector: bool = False, equals: tuple[str, ...] = (),
                  arguments: tuple[Argument, ...] | None = None, scalars: tuple[str, ...] = (),
-                 integers: tuple[str, ...] = (), bindings: dict | None = None) -> Function:
+                 integers: tuple[str, ...] = (), bindings: dict | None = None, layers: int = 1,
+                 vectors: tuple[str, ...] = ()) -> Function:
         """A function of one or more named results (matrices, or lists of truth values as
         columns), lowered together so they share their terms; its arguments are q unless
         given. The results named in `scalars` are scalars, those in `integers` integer
-        scalars (statuses); `bindings` define symbols (the joints) from the arguments for
-        this function alone."""
+        scalars (statuses), those in `vectors` (or all, with `vector`) column vectors; `bindings` define symbols (the joints) from the arguments for
+        this function alone; `layers` > 1 makes the results stacks of that many matrices."""
         outputs, values = [], []
         for (output, result), equal in zip(results, equals or ("",) * len(results)):
             rows, cols = result.shape if isinstance(result, sympy.Matrix) else (len(result), 1)
             boolean = all(map(is_boolean, result))
             integer = output in integers
-            outputs.append(Output(output, rows, cols, scalar or integer or output in scalars, vector or boolean, equal,
-                                  boolean, integer))
+            outputs.append(Output(output, rows, cols, scalar or integer or output in scalars,
+                                  vector or boolean or output in vectors, equal, boolean, integer, layers))
             values += list(result)
         return Function(name, summary, tuple(outputs), self.lower(values, bindings or {}),
                         arguments or (Argument("q", sympy.Matrix(self.q)),))
@@ -378,6 +411,7 @@ class Generator:
             self.function("task", f"task vector mu = ({', '.join(robot.task)})",
                           ("mu", kinematics.task_vector(robot, pose)), vector=True),
             self.function("task_jacobian", f"analytic Jacobian d mu / d q ({m} x DOF)", ("J", task_jacobian)),
+            *self.second_order_functions(),
             *self.singularity_functions(js),
             self.velocity_ik_function(js),
             self.ik_numeric_step_function(task_jacobian),

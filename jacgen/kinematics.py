@@ -180,6 +180,62 @@ def column_jacobian(robot: Robot, chain: Chain) -> Matrix:
     return Matrix.hstack(*columns)
 
 
+def _prefix_angular(robot: Robot, chain: Chain, q_dot, name) -> list[Matrix]:
+    """omega_i: the angular velocity of the link that carries axis i (the sum of z_j qd_j
+    over the revolute joints before i), each sum named once."""
+    omegas, omega = [], sympy.zeros(3, 1)
+    for joint, axis, rate in zip(robot.joints, chain.axes, q_dot):
+        omegas.append(omega)
+        if joint.revolute:
+            omega = (omega + axis[:3, 2] * rate).applyfunc(name)
+    return omegas
+
+
+def jacobian_dot(robot: Robot, chain: Chain, jacobian: Matrix, q_dot, name=lambda e: e) -> Matrix:
+    """dJ/dt of the world geometric Jacobian along q_dot, column by column from the chain:
+    z_i' = w_i x z_i and (p - o_i)' = w_i x (p - o_i) + S_i, where w_i is the angular velocity
+    of the link carrying axis i and S_i = sum_{j >= i} Jv_j qd_j the velocity of the tool
+    origin relative to that link. By the Jacobi identity a revolute column is then
+    [w_i x Jv_i + z_i x S_i; w_i x z_i], a prismatic one [w_i x z_i; 0]. Prefix and suffix
+    sums are named once, so each column costs O(1) on top of J."""
+    n = robot.dof
+    omegas = _prefix_angular(robot, chain, q_dot, name)
+    suffix, sums = sympy.zeros(3, 1), [None] * n
+    for i in reversed(range(n)):
+        suffix = (suffix + jacobian[:3, i] * q_dot[i]).applyfunc(name)
+        sums[i] = suffix
+    columns = []
+    for i, joint in enumerate(robot.joints):
+        z, omega = chain.axes[i][:3, 2], omegas[i]
+        turn = omega.cross(z)
+        if joint.revolute:
+            columns.append(Matrix.vstack(omega.cross(jacobian[:3, i]) + z.cross(sums[i]), turn))
+        else:
+            columns.append(Matrix.vstack(turn, sympy.zeros(3, 1)))
+    return Matrix.hstack(*columns)
+
+
+def hessian(robot: Robot, jacobian: Matrix) -> list[Matrix]:
+    """d J / d q_k for each k (6 x n each), from the columns of J alone: rotating about axis k
+    turns every column after it (z_k x each half), and a joint k at or after a revolute
+    column c moves the tool point, so c's linear part changes by z_c x Jv_k."""
+    layers = []
+    for k, moving in enumerate(robot.joints):
+        columns = []
+        for c, joint in enumerate(robot.joints):
+            if k < c:
+                z_k = jacobian[3:, k]
+                column = (Matrix.vstack(z_k.cross(jacobian[:3, c]), z_k.cross(jacobian[3:, c])) if moving.revolute
+                          else sympy.zeros(6, 1))
+            elif joint.revolute:
+                column = Matrix.vstack(jacobian[3:, c].cross(jacobian[:3, k]), sympy.zeros(3, 1))
+            else:
+                column = sympy.zeros(6, 1)
+            columns.append(column)
+        layers.append(Matrix.hstack(*columns))
+    return layers
+
+
 def tool_frame(jacobian: Matrix, pose: Matrix) -> Matrix:
     """The same twist expressed in the frame whose world pose is `pose`."""
     rotation_t = pose[:3, :3].T
@@ -242,6 +298,27 @@ def task_jacobian(robot: Robot, pose: Matrix, jacobian: Matrix) -> Matrix:
     rows = {name: jacobian[i, :] for i, name in enumerate(("x", "y", "z"))}
     rows.update({name: rates[i, :] for i, name in enumerate(("roll", "pitch", "yaw"))})
     return Matrix.vstack(*(rows[name] for name in robot.task))
+
+
+def task_jacobian_dot(robot: Robot, pose: Matrix, jacobian: Matrix, jacobian_dot: Matrix, q_dot,
+                      name=lambda e: e) -> Matrix:
+    """d/dt of task_jacobian: the position rows of J', and for the angles the Euler-angle rates
+    differentiated through what they read, the first column r of R (r' = w x r with
+    w = Jw q_dot) and the angular rows of J (whose rate is that of J')."""
+    r, w = sympy.symbols("_r0:3", real=True), sympy.symbols("_w0:3", real=True)
+    rates = rpy_rates(Matrix([[r[0], 0, 0], [r[1], 0, 0], [r[2], 0, 0]]), Matrix(w))
+    by_r, by_w = rates.jacobian(r), rates.jacobian(w)
+    column = pose[:3, 0]
+    omega = (jacobian[3:, :] * Matrix(q_dot)).applyfunc(name)
+    column_rate = omega.cross(column).applyfunc(name)
+    angle_rows = []
+    for c in range(robot.dof):
+        values = dict(zip(r, column)) | dict(zip(w, jacobian[3:, c]))
+        angle_rows.append((by_r.xreplace(values) * column_rate + by_w.xreplace(values) * jacobian_dot[3:, c]))
+    rates_dot = Matrix.hstack(*angle_rows)
+    rows = {name_: jacobian_dot[i, :] for i, name_ in enumerate(("x", "y", "z"))}
+    rows.update({name_: rates_dot[i, :] for i, name_ in enumerate(("roll", "pitch", "yaw"))})
+    return Matrix.vstack(*(rows[component] for component in robot.task))
 
 
 def simplify_trig(expression: sympy.Expr) -> sympy.Expr:

@@ -54,7 +54,7 @@ class PythonPrinter(NumPyPrinter):
     generated function ignores the floating-point warnings of the side not taken)."""
 
     def __init__(self):
-        super().__init__({"fully_qualified_modules": True, "allow_unknown_functions": False})
+        super().__init__({"fully_qualified_modules": True, "allow_unknown_functions": False, "order": "none"})
 
     def doprint(self, expr, assign_to=None):
         return super().doprint(expr.xreplace(TOLERANCES["double"]), assign_to)
@@ -83,7 +83,8 @@ _FLOAT_MAX = float(numpy.finfo(numpy.float32).max)
 
 
 class _Power(sympy.Function):
-    """`base**n` for a small integer n >= 2, printed in C as `(base*base*...)` rather than `pow()`.
+    """`base**n` for a small n >= 3/2, integer or half-integer, printed in C as
+    `(base*base*...)`, with `sqrt(base)*` in front for a half, rather than `pow()`.
 
     sympy's `create_expand_pow_optimization` does the same with an `UnevaluatedExpr`, which
     is not commutative, so its reciprocals print as `y*1.0/(x*x)` instead of `y/(x*x)`.
@@ -91,8 +92,10 @@ class _Power(sympy.Function):
 
 
 def expand_integer_powers(expr: sympy.Expr, limit: int = 8) -> sympy.Expr:
-    """x**2 -> _Power(x, 2), x**-3 -> 1/_Power(x, 3) (up to `limit`); other powers unchanged."""
-    return expr.replace(lambda e: e.is_Pow and e.exp.is_Integer and 2 <= abs(e.exp) <= limit,
+    """x**2 -> _Power(x, 2), x**-3 -> 1/_Power(x, 3), x**(-3/2) -> 1/_Power(x, 3/2) (up to
+    `limit`); other powers unchanged."""
+    return expr.replace(lambda e: e.is_Pow and e.exp.is_Rational and e.exp.q in (1, 2)
+                        and sympy.Rational(3, 2) <= abs(e.exp) <= limit,
                         lambda e: _Power(e.base, abs(e.exp)) ** sympy.sign(e.exp))
 
 
@@ -112,7 +115,8 @@ class CPrinter(C99CodePrinter):
             raise ValueError(f"real must be one of {', '.join(C_REAL_TYPES)}, got {real!r}")
         self.real = real
         self._folded = {}  # one fold per shared subtree across everything this printer prints
-        super().__init__({"type_aliases": {ast.real: C_REAL_TYPES[real]}, "strict": True, "math_macros": {}})
+        super().__init__({"type_aliases": {ast.real: C_REAL_TYPES[real]}, "strict": True, "math_macros": {},
+                          "order": "none"})
 
     def doprint(self, expr, assign_to=None):
         folded = fold_constants(expr.xreplace(TOLERANCES[self.real]), self._folded)
@@ -148,7 +152,8 @@ class CPrinter(C99CodePrinter):
     def _print__Power(self, expr):
         base, exponent = expr.args
         factor = self.parenthesize(base, PRECEDENCE["Mul"], strict=True)
-        return "(" + "*".join([factor] * int(exponent)) + ")"
+        root = [self._print(sympy.sqrt(base))] if not exponent.is_Integer else []
+        return "(" + "*".join(root + [factor] * int(exponent)) + ")"
 
     def _print_Pow(self, expr):
         """`1.0/sqrt(x)` rather than sympy's `pow(x, -1.0/2.0)`."""
@@ -174,7 +179,8 @@ class CasadiPrinter(AbstractPythonCodePrinter):
     _kc = {"Pi": "casadi.pi"}
 
     def __init__(self):
-        super().__init__({"fully_qualified_modules": True, "allow_unknown_functions": False, "strict": True})
+        super().__init__({"fully_qualified_modules": True, "allow_unknown_functions": False, "strict": True,
+                          "order": "none"})
 
     def _print_Float(self, expr):
         return float_literal(expr)

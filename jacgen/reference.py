@@ -22,7 +22,7 @@ def _rot_z(angle):
 
 
 def _translation(x, y, z):
-    transform = np.eye(4)
+    transform = np.eye(4, dtype=np.result_type(x, y, z, float))
     transform[:3, 3] = (x, y, z)
     return transform
 
@@ -49,8 +49,10 @@ def frames(robot, q):
 
     Standard DH: joint i moves about z_{i-1}, so the axes are frames 0..n-1.
     Modified DH: joint i moves about z_i, the frame after the row's Rx Tx.
+    Complex q is carried through (for complex-step derivatives).
     """
-    q = np.asarray(q, dtype=float)
+    q = np.asarray(q)
+    q = q if np.iscomplexobj(q) else q.astype(float)
     current = _pose(robot.base)
     axes = []
     for joint, qi in zip(robot.joints, q):
@@ -87,6 +89,26 @@ def jacobian_tool(robot, q):
     return np.vstack([rotation.T @ J[:3], rotation.T @ J[3:]])
 
 
+COMPLEX_STEP = 1e-30
+
+
+def jacobian_dot(robot, q, q_dot):
+    """dJ/dt along q_dot: the complex-step derivative of `jacobian` (J(q + i h q_dot).imag / h),
+    which has no cancellation, so it is exact to rounding."""
+    q, q_dot = np.asarray(q, dtype=float), np.asarray(q_dot, dtype=float)
+    return jacobian(robot, q + 1j * COMPLEX_STEP * q_dot).imag / COMPLEX_STEP
+
+
+def hessian(robot, q):
+    """d J / d q_k for each k, shape (n, 6, n): `jacobian_dot` along each joint."""
+    return np.array([jacobian_dot(robot, q, unit) for unit in np.eye(len(q))])
+
+
+def bias_acceleration(robot, q, q_dot):
+    """J' q_dot: the tool's classical acceleration at zero joint acceleration."""
+    return jacobian_dot(robot, q, q_dot) @ np.asarray(q_dot, dtype=float)
+
+
 def rpy(rotation):
     """roll, pitch, yaw with R = Rz(yaw) Ry(pitch) Rx(roll)."""
     pitch = np.arctan2(-rotation[2, 0], np.hypot(rotation[0, 0], rotation[1, 0]))
@@ -113,6 +135,26 @@ def task_jacobian(robot, q, step=1e-4):
 
     return np.array([(8 * (offset(i, step) - offset(i, -step)) - (offset(i, 2 * step) - offset(i, -2 * step)))
                      / (12 * step) for i in range(len(q))]).T
+
+
+def _euler_rates_jacobian(robot, q):
+    """d mu / d q from the geometric Jacobian: the angle rows solve E(rpy) rpy_dot = omega,
+    E's columns being the world axes of the roll, pitch and yaw rotations, with cos and sin
+    of pitch and yaw read off R (no arctan2, so complex q is carried through)."""
+    pose, J = fk(robot, q), jacobian(robot, q)
+    r = pose[:3, :3]
+    cos_pitch = np.sqrt(r[0, 0] ** 2 + r[1, 0] ** 2)
+    cos_yaw, sin_yaw, sin_pitch = r[0, 0] / cos_pitch, r[1, 0] / cos_pitch, -r[2, 0]
+    axes = np.array([[cos_yaw * cos_pitch, -sin_yaw, 0], [sin_yaw * cos_pitch, cos_yaw, 0], [-sin_pitch, 0, 1]])
+    rows = np.vstack([J[:3], np.linalg.solve(axes, J[3:])])
+    return rows[[TASK_COMPONENTS.index(name) for name in robot.task]]
+
+
+def task_jacobian_dot(robot, q, q_dot):
+    """d/dt of d mu / d q along q_dot: the complex-step derivative of the Euler-rate form of
+    the task Jacobian (exact to rounding, away from cos(pitch) = 0)."""
+    q, q_dot = np.asarray(q, dtype=float), np.asarray(q_dot, dtype=float)
+    return _euler_rates_jacobian(robot, q + 1j * COMPLEX_STEP * q_dot).imag / COMPLEX_STEP
 
 
 def singularity_jacobian(robot, q):

@@ -15,6 +15,7 @@ checked by round trip, `velocity_ik` by its backward error.
 
 import functools
 import importlib.util
+import inspect
 import itertools
 import math
 import tempfile
@@ -37,7 +38,8 @@ DOUBLE_TOLERANCE = 1e-9
 # chain of at most 32 links, so its rounding error is a few tens of roundings of values no
 # larger than the reach (positions, Jacobian entries) or 1 (rotations): ~1e-6 * (1 + reach)
 # for the shipped arms. 1e-4 * (1 + reach) leaves a margin of ~100 for long chains and
-# cancellation, and is still far below any modelling error (a wrong term is >= 1e-3).
+# cancellation, and is still far below any modelling error (a wrong term is >= 1e-3). Each
+# float error is divided by 1 + |expected| (`compare`): float rounds relative to the value.
 FLOAT_TOLERANCE = 1e-4
 # Where cos(pitch) < this, roll and yaw and the Euler-angle rates are ill-conditioned (they
 # are undefined at pitch = +-90 deg): the angle rows of `task` and `task_jacobian` are not
@@ -46,7 +48,7 @@ FLOAT_TOLERANCE = 1e-4
 # the exact rates to 3e-11; at 0.01 they were measured 4e-9 off (stanford).
 EULER_MARGIN = 0.05
 ANGLES = ("roll", "pitch", "yaw")
-EULER_FUNCTIONS = ("task", "task_jacobian")
+EULER_FUNCTIONS = ("task", "task_jacobian", "task_jacobian_dot")
 # Functions of Js: undefined where cos(pitch) = 0 when Js is the task Jacobian.
 JS_FUNCTIONS = ("manipulability", "jacobian_det")
 # Smallest / largest singular value of Js below which factors must vanish, and above which
@@ -145,18 +147,18 @@ class _Backends:
                               f"_jacgen_verify_{robot.name}_casadi")
         self.c = {real: CLibrary(path, robot, functions, real) for real, path in libraries.items()}
 
-    def evaluate(self, backend: str, name: str, q: np.ndarray) -> np.ndarray:
-        """(k, size) results, each output row-major, several outputs side by side, at the
-        nominal parameter values."""
+    def evaluate(self, backend: str, name: str, q: np.ndarray, *more: np.ndarray) -> np.ndarray:
+        """(k, size) results at the rows of q (and of q_dot, for the functions that take it),
+        each output row-major, several outputs side by side, at the nominal parameter values."""
         nominal = {p.name: p.value for p in self.robot.symbolic_parameters}
         if backend == "python":
             with np.errstate(divide="ignore", invalid="ignore"):  # NaN at Euler singularities
-                return _side_by_side(getattr(self.python, name)(q, **nominal), len(q))
+                return _side_by_side(getattr(self.python, name)(q, *more, **nominal), len(q))
         if backend == "casadi":
             function = getattr(self.casadi, name)
             extra = [list(self.casadi.PARAMETERS.values())] if nominal else []
-            return np.vstack([_side_by_side(function(row, *extra), 1) for row in q])
-        return self.c[backend.split()[1]].evaluate(name, q)
+            return np.vstack([_side_by_side(function(*rows, *extra), 1) for rows in zip(q, *more)])
+        return self.c[backend.split()[1]].evaluate(name, q, *more)
 
 
     def velocity_ik(self, backend: str, q: np.ndarray, mu_dot: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -179,21 +181,27 @@ def _side_by_side(results, count: int) -> np.ndarray:
     return np.hstack([np.reshape(np.asarray(part), (count, -1)) for part in parts])
 
 
-def _reference(robot: Robot, function: Function, q: np.ndarray) -> np.ndarray | None:
-    """The reference's values of each output side by side, None where it has no counterpart."""
+def _reference(robot: Robot, function: Function, q: np.ndarray, *more: np.ndarray) -> np.ndarray | None:
+    """The reference's values of each output side by side, None where it has no counterpart.
+    Each reference function takes the arguments it needs: q, or q and q_dot."""
     evaluators = [getattr(reference, output.equals or function.name, None) for output in function.outputs]
     if not all(callable(evaluate) for evaluate in evaluators):
         return None
-    return np.array([np.concatenate([np.reshape(evaluate(robot, row), -1) for evaluate in evaluators]) for row in q])
+    needs = [sum(p.default is inspect.Parameter.empty for p in inspect.signature(e).parameters.values()) - 1
+             for e in evaluators]
+    return np.array([np.concatenate([np.reshape(evaluate(robot, *rows[:count]), -1)
+                                     for evaluate, count in zip(evaluators, needs)]) for rows in zip(q, *more)])
 
 
 def compare(robot: Robot, function: Function, value: np.ndarray, expected: np.ndarray,
-            q: np.ndarray) -> tuple[float, int]:
+            q: np.ndarray, relative: bool = False) -> tuple[float, int]:
     """Largest error of results (k, rows * cols) against the reference at q (k, dof), and the
     number of samples whose Euler-angle rows were not compared.
 
     Angles of the task vector are compared modulo 2 pi; a NaN or infinity that is compared
-    is an infinite error.
+    is an infinite error. `relative` (float builds) divides each error by 1 + |expected|:
+    float rounds relative to the value, and the Euler-rate rows of task_jacobian_dot reach
+    |q_dot|^2 / cos(pitch)^2 near the margin.
     """
     elements = np.zeros(value.shape[1], dtype=bool)  # the entries undefined where cos(pitch) = 0
     if function.name in EULER_FUNCTIONS:
@@ -211,6 +219,8 @@ def compare(robot: Robot, function: Function, value: np.ndarray, expected: np.nd
     skipped = int((~compared.all(axis=1)).sum())
     if not np.isfinite(value[compared]).all():
         return math.inf, skipped
+    if relative:
+        difference = difference / (1 + np.abs(expected))
     return float(np.max(np.abs(difference[compared]), initial=0.0)), skipped
 
 
@@ -221,22 +231,25 @@ def verify_robot(robot: Robot, backends: _Backends, functions: list[Function], q
     tolerances["c float"] = FLOAT_TOLERANCE * (1 + reach(robot))
     results = []
     ranks = _rank_ratios(robot, q)
-    for function in [f for f in functions if [a.name for a in f.arguments] == ["q"]]:  # the IK: below
+    q_dot = np.random.default_rng(1).normal(size=q.shape)  # joint rates, for the second-order functions
+    compared = [f for f in functions if [a.name for a in f.arguments] in (["q"], ["q", "q_dot"])]  # the IK: below
+    for function in compared:
+        more = (q_dot,) if len(function.arguments) == 2 else ()
         if function.name == "singularity_factors":
             errors = {backend: _vanishing_error(backends.evaluate(backend, function.name, q), ranks)
                       for backend in BACKENDS}
             results.append(Result(robot.name, function.name, errors, tolerances,
                                   f"min |factor| at the {int((ranks < SINGULAR_RANK).sum())} samples where Js is singular"))
             continue
-        expected = _reference(robot, function, q)
+        expected = _reference(robot, function, q, *more)
         if expected is None or expected.shape[1] != sum(output.size for output in function.outputs):
             note = "not compared: " + ("no reference" if expected is None else "reference has another shape")
             results.append(Result(robot.name, function.name, dict.fromkeys(BACKENDS), tolerances, note))
             continue
         errors = {}
         for backend in BACKENDS:
-            errors[backend], skipped = compare(robot, function, backends.evaluate(backend, function.name, q),
-                                               expected, q)
+            errors[backend], skipped = compare(robot, function, backends.evaluate(backend, function.name, q, *more),
+                                               expected, q, relative=backend == "c float")
         note = (f"angle rows not compared at {skipped} of {len(q)} samples (cos(pitch) < {EULER_MARGIN})"
                 if skipped else "")
         results.append(Result(robot.name, function.name, errors, tolerances, note))

@@ -175,7 +175,7 @@ def test_runtime_parameters(tmp_path, real):
         expected = np.array([getattr(reference, name)(robot, row).ravel() for row in q])
         assert_allclose(library.evaluate(name, q), expected, atol=tolerance)
         expected = np.array([getattr(reference, name)(moved, row).ravel() for row in q])
-        assert_allclose(library.evaluate(name, q, {"height": 0.75, "shift": 0.5}), expected, atol=tolerance)
+        assert_allclose(library.evaluate(name, q, parameters={"height": 0.75, "shift": 0.5}), expected, atol=tolerance)
 
 
 def test_functions_beyond_spec_render_generically(tmp_path, monkeypatch):
@@ -214,7 +214,9 @@ def test_printer():
     assert double.doprint(x**2 + y / x**3) == "y/(x*x*x) + (x*x)"
     assert double.doprint(0.4318 * sympy.cos(x) / sympy.sqrt(y)) == "0.4318*cos(x)/sqrt(y)"
     assert double.doprint(1 / sympy.sqrt(x + y)) == "1.0/sqrt(x + y)"
-    assert single.doprint(0.4318 * sympy.atan2(x, sympy.sqrt(y)) + 1 / x) == "0.4318F*atan2f(x, sqrtf(y)) + 1.0F/x"
+    assert single.doprint(0.4318 * sympy.atan2(x, sympy.sqrt(y)) + 1 / x) == "1.0F/x + 0.4318F*atan2f(x, sqrtf(y))"
+    assert double.doprint(x ** sympy.Rational(-3, 2) + y ** sympy.Rational(5, 2)) == \
+        "1.0/(sqrt(x)*x) + (sqrt(y)*y*y)"  # no pow(): half-integer powers through sqrt
     with pytest.raises(Exception, match="[Uu]nsupported|not supported"):
         double.doprint(sympy.Function("mystery")(x))
     with pytest.raises(ValueError):

@@ -58,6 +58,26 @@ void kr5_task(const kr5_real q[KR5_DOF], kr5_real mu[KR5_TASK_DIM]);
  * Result: J: 6 x 6 row-major, element (r, c) at J[r * 6 + c]. 168 operations. */
 void kr5_task_jacobian(const kr5_real q[KR5_DOF], kr5_real J[KR5_TASK_DIM * KR5_DOF]);
 
+/* Fk, jacobian and bias_acceleration in one pass, sharing their terms.
+ * Result: T: 4 x 4 row-major, element (r, c) at T[r * 4 + c]; J: 6 x 6 row-major, element (r, c) at J[r * 6 + c]; a[i], i < 6. 326 operations. */
+void kr5_fk_jacobian_dot(const kr5_real q[KR5_DOF], const kr5_real q_dot[KR5_DOF], kr5_real T[16], kr5_real J[6 * KR5_DOF], kr5_real a[6]);
+
+/* DJ/dt of the world geometric Jacobian along q_dot (6 x DOF).
+ * Result: Jd: 6 x 6 row-major, element (r, c) at Jd[r * 6 + c]. 246 operations. */
+void kr5_jacobian_dot(const kr5_real q[KR5_DOF], const kr5_real q_dot[KR5_DOF], kr5_real Jd[6 * KR5_DOF]);
+
+/* J' q_dot: the tool's classical linear and angular acceleration at zero joint acceleration, world frame (6).
+ * Result: a[i], i < 6. 286 operations. */
+void kr5_bias_acceleration(const kr5_real q[KR5_DOF], const kr5_real q_dot[KR5_DOF], kr5_real a[6]);
+
+/* D/dt of the analytic Jacobian along q_dot (6 x DOF): mu'' = J_a q'' + J_a' q'.
+ * Result: Jd: 6 x 6 row-major, element (r, c) at Jd[r * 6 + c]. 499 operations. */
+void kr5_task_jacobian_dot(const kr5_real q[KR5_DOF], const kr5_real q_dot[KR5_DOF], kr5_real Jd[KR5_TASK_DIM * KR5_DOF]);
+
+/* D J / d q_k for each k (DOF x 6 x DOF, indexed [k, r, c]).
+ * Result: H: 6 x 6 x 6 row-major, element (k, r, c) at H[k * 36 + r * 6 + c]. 215 operations. */
+void kr5_hessian(const kr5_real q[KR5_DOF], kr5_real H[KR5_DOF * 6 * KR5_DOF]);
+
 /* Factors of det(Js): the robot is singular where one is 0.
  * Result: f[i], i < 3. 18 operations. */
 void kr5_singularity_factors(const kr5_real q[KR5_DOF], kr5_real f[KR5_NUM_SINGULARITY_FACTORS]);

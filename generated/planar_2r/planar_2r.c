@@ -143,7 +143,7 @@ void planar_2r_jacobian_tool(const planar_2r_real q[PLANAR_2R_DOF], planar_2r_re
     const planar_2r_real t1 = s1 + s12;
 
     /* Outputs */
-    J[0] = -c12*t1 + s12*t0;
+    J[0] = s12*t0 - c12*t1;
     J[1] = 0;
     J[2] = c12*t0 + s12*t1;
     J[3] = (c12*c12) + (s12*s12);
@@ -203,6 +203,220 @@ void planar_2r_task_jacobian(const planar_2r_real q[PLANAR_2R_DOF], planar_2r_re
     J[1] = -s12;
     J[2] = t0;
     J[3] = c12;
+}
+
+void planar_2r_fk_jacobian_dot(const planar_2r_real q[PLANAR_2R_DOF], const planar_2r_real q_dot[PLANAR_2R_DOF], planar_2r_real T[16], planar_2r_real J[6 * PLANAR_2R_DOF], planar_2r_real a[6])
+{
+    /* 32 operations */
+
+    /* Inputs */
+    const planar_2r_real q1 = q[0];
+    const planar_2r_real q2 = q[1];
+    const planar_2r_real qd1 = q_dot[0];
+    const planar_2r_real qd2 = q_dot[1];
+
+    /* Intermediate terms */
+    const planar_2r_real c1 = cos(q1);
+    const planar_2r_real s1 = sin(q1);
+    const planar_2r_real c2 = cos(q2);
+    const planar_2r_real s2 = sin(q2);
+    const planar_2r_real c12 = c1*c2 - s1*s2;
+    const planar_2r_real s12 = c1*s2 + c2*s1;
+    const planar_2r_real t0 = c1 + c12;
+    const planar_2r_real t1 = s1 + s12;
+    const planar_2r_real t2 = qd2*s12;
+    const planar_2r_real t3 = t2 + qd1*t1;
+    const planar_2r_real t4 = c12*qd2;
+    const planar_2r_real t5 = t4 + qd1*t0;
+    const planar_2r_real t6 = -s12;
+
+    /* Outputs */
+    T[0] = c12;
+    T[1] = t6;
+    T[2] = 0;
+    T[3] = t0;
+    T[4] = s12;
+    T[5] = c12;
+    T[6] = 0;
+    T[7] = t1;
+    T[8] = 0;
+    T[9] = 0;
+    T[10] = 1;
+    T[11] = 0;
+    T[12] = 0;
+    T[13] = 0;
+    T[14] = 0;
+    T[15] = 1;
+    J[0] = -t1;
+    J[1] = t6;
+    J[2] = t0;
+    J[3] = c12;
+    J[4] = 0;
+    J[5] = 0;
+    J[6] = 0;
+    J[7] = 0;
+    J[8] = 0;
+    J[9] = 0;
+    J[10] = 1;
+    J[11] = 1;
+    a[0] = -qd1*t5 - qd2*(t4 + c12*qd1);
+    a[1] = -qd1*t3 - qd2*(t2 + qd1*s12);
+    a[2] = 0;
+    a[3] = 0;
+    a[4] = 0;
+    a[5] = 0;
+}
+
+void planar_2r_jacobian_dot(const planar_2r_real q[PLANAR_2R_DOF], const planar_2r_real q_dot[PLANAR_2R_DOF], planar_2r_real Jd[6 * PLANAR_2R_DOF])
+{
+    /* 26 operations */
+
+    /* Inputs */
+    const planar_2r_real q1 = q[0];
+    const planar_2r_real q2 = q[1];
+    const planar_2r_real qd1 = q_dot[0];
+    const planar_2r_real qd2 = q_dot[1];
+
+    /* Intermediate terms */
+    const planar_2r_real c1 = cos(q1);
+    const planar_2r_real s1 = sin(q1);
+    const planar_2r_real c2 = cos(q2);
+    const planar_2r_real s2 = sin(q2);
+    const planar_2r_real c12 = c1*c2 - s1*s2;
+    const planar_2r_real s12 = c1*s2 + c2*s1;
+    const planar_2r_real t0 = c1 + c12;
+    const planar_2r_real t1 = s1 + s12;
+    const planar_2r_real t2 = qd2*s12;
+    const planar_2r_real t3 = t2 + qd1*t1;
+    const planar_2r_real t4 = c12*qd2;
+    const planar_2r_real t5 = t4 + qd1*t0;
+
+    /* Outputs */
+    Jd[0] = -t5;
+    Jd[1] = -t4 - c12*qd1;
+    Jd[2] = -t3;
+    Jd[3] = -t2 - qd1*s12;
+    Jd[4] = 0;
+    Jd[5] = 0;
+    Jd[6] = 0;
+    Jd[7] = 0;
+    Jd[8] = 0;
+    Jd[9] = 0;
+    Jd[10] = 0;
+    Jd[11] = 0;
+}
+
+void planar_2r_bias_acceleration(const planar_2r_real q[PLANAR_2R_DOF], const planar_2r_real q_dot[PLANAR_2R_DOF], planar_2r_real a[6])
+{
+    /* 30 operations */
+
+    /* Inputs */
+    const planar_2r_real q1 = q[0];
+    const planar_2r_real q2 = q[1];
+    const planar_2r_real qd1 = q_dot[0];
+    const planar_2r_real qd2 = q_dot[1];
+
+    /* Intermediate terms */
+    const planar_2r_real c1 = cos(q1);
+    const planar_2r_real s1 = sin(q1);
+    const planar_2r_real c2 = cos(q2);
+    const planar_2r_real s2 = sin(q2);
+    const planar_2r_real c12 = c1*c2 - s1*s2;
+    const planar_2r_real s12 = c1*s2 + c2*s1;
+    const planar_2r_real t0 = c1 + c12;
+    const planar_2r_real t1 = s1 + s12;
+    const planar_2r_real t2 = qd2*s12;
+    const planar_2r_real t3 = t2 + qd1*t1;
+    const planar_2r_real t4 = c12*qd2;
+    const planar_2r_real t5 = t4 + qd1*t0;
+
+    /* Outputs */
+    a[0] = -qd1*t5 - qd2*(t4 + c12*qd1);
+    a[1] = -qd1*t3 - qd2*(t2 + qd1*s12);
+    a[2] = 0;
+    a[3] = 0;
+    a[4] = 0;
+    a[5] = 0;
+}
+
+void planar_2r_task_jacobian_dot(const planar_2r_real q[PLANAR_2R_DOF], const planar_2r_real q_dot[PLANAR_2R_DOF], planar_2r_real Jd[PLANAR_2R_TASK_DIM * PLANAR_2R_DOF])
+{
+    /* 26 operations */
+
+    /* Inputs */
+    const planar_2r_real q1 = q[0];
+    const planar_2r_real q2 = q[1];
+    const planar_2r_real qd1 = q_dot[0];
+    const planar_2r_real qd2 = q_dot[1];
+
+    /* Intermediate terms */
+    const planar_2r_real c1 = cos(q1);
+    const planar_2r_real s1 = sin(q1);
+    const planar_2r_real c2 = cos(q2);
+    const planar_2r_real s2 = sin(q2);
+    const planar_2r_real c12 = c1*c2 - s1*s2;
+    const planar_2r_real s12 = c1*s2 + c2*s1;
+    const planar_2r_real t0 = c1 + c12;
+    const planar_2r_real t1 = s1 + s12;
+    const planar_2r_real t2 = qd2*s12;
+    const planar_2r_real t3 = t2 + qd1*t1;
+    const planar_2r_real t4 = t2 + qd1*s12;
+    const planar_2r_real t5 = c12*qd2;
+    const planar_2r_real t6 = t5 + qd1*t0;
+    const planar_2r_real t7 = t5 + c12*qd1;
+
+    /* Outputs */
+    Jd[0] = -t6;
+    Jd[1] = -t7;
+    Jd[2] = -t3;
+    Jd[3] = -t4;
+}
+
+void planar_2r_hessian(const planar_2r_real q[PLANAR_2R_DOF], planar_2r_real H[PLANAR_2R_DOF * 6 * PLANAR_2R_DOF])
+{
+    /* 16 operations */
+
+    /* Inputs */
+    const planar_2r_real q1 = q[0];
+    const planar_2r_real q2 = q[1];
+
+    /* Intermediate terms */
+    const planar_2r_real c1 = cos(q1);
+    const planar_2r_real s1 = sin(q1);
+    const planar_2r_real c2 = cos(q2);
+    const planar_2r_real s2 = sin(q2);
+    const planar_2r_real c12 = c1*c2 - s1*s2;
+    const planar_2r_real s12 = c1*s2 + c2*s1;
+    const planar_2r_real t0 = c1 + c12;
+    const planar_2r_real t1 = s1 + s12;
+    const planar_2r_real t2 = -c12;
+    const planar_2r_real t3 = -s12;
+
+    /* Outputs */
+    H[0] = -t0;
+    H[1] = t2;
+    H[2] = -t1;
+    H[3] = t3;
+    H[4] = 0;
+    H[5] = 0;
+    H[6] = 0;
+    H[7] = 0;
+    H[8] = 0;
+    H[9] = 0;
+    H[10] = 0;
+    H[11] = 0;
+    H[12] = t2;
+    H[13] = t2;
+    H[14] = t3;
+    H[15] = t3;
+    H[16] = 0;
+    H[17] = 0;
+    H[18] = 0;
+    H[19] = 0;
+    H[20] = 0;
+    H[21] = 0;
+    H[22] = 0;
+    H[23] = 0;
 }
 
 void planar_2r_singularity_factors(const planar_2r_real q[PLANAR_2R_DOF], planar_2r_real f[PLANAR_2R_NUM_SINGULARITY_FACTORS])
@@ -279,28 +493,28 @@ int planar_2r_velocity_ik(const planar_2r_real q[PLANAR_2R_DOF], const planar_2r
     const planar_2r_real t12 = sqrt(t10 + t4);
     const planar_2r_real t13 = (t2*t2);
     const planar_2r_real t14 = (damping*damping);
-    const planar_2r_real t15 = t11 + t14;
-    const planar_2r_real t16 = t14 + t5;
-    const planar_2r_real t17 = (t16*t16);
-    const planar_2r_real t18 = sqrt(2*t13 + t17 + (t15*t15));
-    const planar_2r_real t19 = sqrt(t13 + t17);
-    const planar_2r_real t20 = t19*(t16 >= 0 ? 1 : -1);
-    const planar_2r_real t21 = t16 + t20;
-    const planar_2r_real t22 = (t19 > 0 ? 1/(t19*(t19 + fabs(t16))) : 0);
-    const planar_2r_real t23 = -t22*(t15*t2 + t2*t21);
-    const planar_2r_real t24 = t2 + t21*t23;
-    const planar_2r_real t25 = t15 + t2*t23;
-    const planar_2r_real t26 = t22*(mu_dot0*t21 - mu_dot1*t2);
-    const planar_2r_real t27 = mu_dot0 - t21*t26;
-    const planar_2r_real t28 = mu_dot1 + t2*t26;
-    const planar_2r_real t29 = fabs(t25);
+    const planar_2r_real t15 = t14 + t5;
+    const planar_2r_real t16 = (t15*t15);
+    const planar_2r_real t17 = sqrt(t13 + t16);
+    const planar_2r_real t18 = t17*(t15 >= 0 ? 1 : -1);
+    const planar_2r_real t19 = t15 + t18;
+    const planar_2r_real t20 = (t17 > 0 ? 1/(t17*(t17 + fabs(t15))) : 0);
+    const planar_2r_real t21 = t20*(mu_dot0*t19 - mu_dot1*t2);
+    const planar_2r_real t22 = mu_dot0 - t19*t21;
+    const planar_2r_real t23 = mu_dot1 + t2*t21;
+    const planar_2r_real t24 = t11 + t14;
+    const planar_2r_real t25 = sqrt(t16 + 2*t13 + (t24*t24));
+    const planar_2r_real t26 = -t20*(t19*t2 + t2*t24);
+    const planar_2r_real t27 = t2 + t19*t26;
+    const planar_2r_real t28 = t24 + t2*t26;
+    const planar_2r_real t29 = fabs(t28);
     const planar_2r_real t30 = t29;
-    const planar_2r_real t31 = t30*(t25 >= 0 ? 1 : -1);
-    const planar_2r_real t32 = t25 + t31;
+    const planar_2r_real t31 = t30*(t28 >= 0 ? 1 : -1);
+    const planar_2r_real t32 = t28 + t31;
     const planar_2r_real t33 = (t30 > 0 ? 1/(t30*(t29 + t30)) : 0);
-    const planar_2r_real t34 = -t28*t33*(t32*t32) + t28;
+    const planar_2r_real t34 = t23 - t23*t33*(t32*t32);
     const planar_2r_real t35 = (t31 != 0 ? -t34/t31 : 0);
-    const planar_2r_real t36 = (t20 != 0 ? -(t24*t35 + t27)/t20 : 0);
+    const planar_2r_real t36 = (t18 != 0 ? -(t22 + t27*t35)/t18 : 0);
     const planar_2r_real t37 = t0*t35 - t1*t36;
     const planar_2r_real t38 = c12*t35 - s12*t36;
     const planar_2r_real t39 = -t1;
@@ -311,21 +525,21 @@ int planar_2r_velocity_ik(const planar_2r_real q[PLANAR_2R_DOF], const planar_2r
     const planar_2r_real t44 = t9*(mu_dot0*t40 + mu_dot1*t0);
     const planar_2r_real t45 = mu_dot0 - t40*t44;
     const planar_2r_real t46 = mu_dot1 - t0*t44;
-    const planar_2r_real t47 = c12 + damping + mu_dot0 + mu_dot1 + q1 + q2 - s12 + t0 + t39;
+    const planar_2r_real t47 = c12 + damping + mu_dot0 + mu_dot1 + q1 + q2 + t0 + t39 - s12;
     const planar_2r_real t48 = fabs(t43);
     const planar_2r_real t49 = t48;
     const planar_2r_real t50 = t49*(t43 >= 0 ? 1 : -1);
     const planar_2r_real t51 = t43 + t50;
     const planar_2r_real t52 = (t49 > 0 ? 1/(t49*(t48 + t49)) : 0);
-    const planar_2r_real t53 = -t46*t52*(t51*t51) + t46;
+    const planar_2r_real t53 = t46 - t46*t52*(t51*t51);
     const planar_2r_real t54 = (t50 != 0 ? -t53/t50 : 0);
-    const planar_2r_real t55 = (t8 != 0 ? -(t42*t54 + t45)/t8 : 0);
+    const planar_2r_real t55 = (t8 != 0 ? -(t45 + t42*t54)/t8 : 0);
     const int t56 = damping > 0;
     const int t57 = isfinite(t47);
     const int t58 = damping >= 0;
     const planar_2r_real t59 = 1e-12*t12;
-    const planar_2r_real t60 = 1e-12*t18;
-    const int t61 = (t56 && ((t19 <= t60) || (t30 <= t60))) || (damping <= 0 && ((t49 <= t59) || (t7 <= t59)));
+    const planar_2r_real t60 = 1e-12*t25;
+    const int t61 = (t56 && ((t17 <= t60) || (t30 <= t60))) || (damping <= 0 && ((t49 <= t59) || (t7 <= t59)));
     const int t62 = t57 && t58 && !t61;
 
     /* Outputs */
@@ -368,22 +582,22 @@ planar_2r_real planar_2r_ik_numeric_step(const planar_2r_real target[PLANAR_2R_T
     const planar_2r_real t12 = t11 + t9;
     const planar_2r_real t13 = (t10 > 0 ? 1/(t10*(t10 + fabs(t9))) : 0);
     const planar_2r_real t14 = t13*(t12*t5 - t3*t6);
-    const planar_2r_real t15 = -t12*t14 + t5;
-    const planar_2r_real t16 = t14*t3 + t6;
+    const planar_2r_real t15 = t5 - t12*t14;
+    const planar_2r_real t16 = t6 + t14*t3;
     const planar_2r_real t17 = damping + t4;
     const planar_2r_real t18 = -t13*(t12*t3 + t17*t3);
-    const planar_2r_real t19 = t12*t18 + t3;
+    const planar_2r_real t19 = t3 + t12*t18;
     const planar_2r_real t20 = t17 + t18*t3;
     const planar_2r_real t21 = fabs(t20);
     const planar_2r_real t22 = t21;
     const planar_2r_real t23 = t22*(t20 >= 0 ? 1 : -1);
     const planar_2r_real t24 = t20 + t23;
     const planar_2r_real t25 = (t22 > 0 ? 1/(t22*(t21 + t22)) : 0);
-    const planar_2r_real t26 = -t16*t25*(t24*t24) + t16;
+    const planar_2r_real t26 = t16 - t16*t25*(t24*t24);
     const planar_2r_real t27 = (t23 != 0 ? -t26/t23 : 0);
     const planar_2r_real t28 = (t11 != 0 ? -(t15 + t19*t27)/t11 : 0);
     const planar_2r_real t29 = q1 + t0*t27 - t1*t28;
-    const planar_2r_real t30 = c12*t27 + q2 - s12*t28;
+    const planar_2r_real t30 = q2 + c12*t27 - s12*t28;
 
     /* Outputs */
     q_start[0] = q1;
@@ -413,18 +627,18 @@ void planar_2r_ik_branches(const planar_2r_real mu[PLANAR_2R_TASK_DIM], planar_2
     const planar_2r_real t8 = atan2(t7, t6);
     const planar_2r_real t9 = 3.141592653589793 - t8;
     const int t10 = 0;
-    const planar_2r_real t11 = (t10 ? 0 : t8 + 3.141592653589793);
+    const planar_2r_real t11 = (t10 ? 0 : 3.141592653589793 + t8);
     const planar_2r_real t12 = (t10 ? 0 : -t7);
     const planar_2r_real t13 = -t6;
     const planar_2r_real t14 = (t10 ? 1 : t13);
-    const planar_2r_real t15 = t14 + 1;
+    const planar_2r_real t15 = 1 + t14;
     const planar_2r_real t16 = mu0*t15 + mu1*t12;
-    const planar_2r_real t17 = -mu0*t12 + mu1*t15;
+    const planar_2r_real t17 = mu1*t15 - mu0*t12;
     const planar_2r_real t18 = (t16*t16) + (t17*t17);
     const planar_2r_real t19 = (t12*t12) + (t15*t15);
-    const planar_2r_real t20 = t13 + 1;
+    const planar_2r_real t20 = 1 + t13;
     const planar_2r_real t21 = mu0*t20 + mu1*t7;
-    const planar_2r_real t22 = -mu0*t7 + mu1*t20;
+    const planar_2r_real t22 = mu1*t20 - mu0*t7;
     const planar_2r_real t23 = (t21*t21) + (t22*t22);
     const planar_2r_real t24 = (t20*t20) + (t7*t7);
     const planar_2r_real t25 = 1e-24*t0;
@@ -433,9 +647,9 @@ void planar_2r_ik_branches(const planar_2r_real mu[PLANAR_2R_TASK_DIM], planar_2
 
     /* Outputs */
     q[0] = (t18 <= t19*t25 ? 0 : atan2(t17, t16));
-    q[1] = t11 - 6.283185307179586*ceil(0.15915494309189535*t11 - 0.5);
+    q[1] = t11 - 6.283185307179586*ceil(-0.5 + 0.15915494309189535*t11);
     q[2] = (t23 <= t24*t25 ? 0 : atan2(t22, t21));
-    q[3] = t9 - 6.283185307179586*ceil(0.15915494309189535*t9 - 0.5);
+    q[3] = t9 - 6.283185307179586*ceil(-0.5 + 0.15915494309189535*t9);
     valid[0] = t26 && t27 && t4 >= -1e-12;
     valid[1] = t26 && t27 && t4 > 1e-12;
 }

@@ -106,7 +106,7 @@ def _jacobian_tool(q):
     t0 = c1 + c12
     t1 = s1 + s12
     J = casadi.SX(6, 2)
-    J[0, 0] = -c12*t1 + s12*t0
+    J[0, 0] = s12*t0 - c12*t1
     J[1, 0] = c12*t0 + s12*t1
     J[1, 1] = c12**2 + s12**2
     J[5, 0] = 1
@@ -152,6 +152,151 @@ def _task_jacobian(q):
     return [J]
 
 
+def _fk_jacobian_dot(q, q_dot):
+    """Fk, jacobian and bias_acceleration in one pass, sharing their terms: 32 operations."""
+    q1 = q[0]
+    q2 = q[1]
+    qd1 = q_dot[0]
+    qd2 = q_dot[1]
+    c1 = casadi.cos(q1)
+    s1 = casadi.sin(q1)
+    c2 = casadi.cos(q2)
+    s2 = casadi.sin(q2)
+    c12 = c1*c2 - s1*s2
+    s12 = c1*s2 + c2*s1
+    t0 = c1 + c12
+    t1 = s1 + s12
+    t2 = qd2*s12
+    t3 = t2 + qd1*t1
+    t4 = c12*qd2
+    t5 = t4 + qd1*t0
+    t6 = -s12
+    T = casadi.SX(4, 4)
+    T[0, 0] = c12
+    T[0, 1] = t6
+    T[0, 3] = t0
+    T[1, 0] = s12
+    T[1, 1] = c12
+    T[1, 3] = t1
+    T[2, 2] = 1
+    T[3, 3] = 1
+    J = casadi.SX(6, 2)
+    J[0, 0] = -t1
+    J[0, 1] = t6
+    J[1, 0] = t0
+    J[1, 1] = c12
+    J[5, 0] = 1
+    J[5, 1] = 1
+    a = casadi.SX(6, 1)
+    a[0, 0] = -qd1*t5 - qd2*(t4 + c12*qd1)
+    a[1, 0] = -qd1*t3 - qd2*(t2 + qd1*s12)
+    return [T, J, a]
+
+
+def _jacobian_dot(q, q_dot):
+    """DJ/dt of the world geometric Jacobian along q_dot (6 x DOF): 26 operations."""
+    q1 = q[0]
+    q2 = q[1]
+    qd1 = q_dot[0]
+    qd2 = q_dot[1]
+    c1 = casadi.cos(q1)
+    s1 = casadi.sin(q1)
+    c2 = casadi.cos(q2)
+    s2 = casadi.sin(q2)
+    c12 = c1*c2 - s1*s2
+    s12 = c1*s2 + c2*s1
+    t0 = c1 + c12
+    t1 = s1 + s12
+    t2 = qd2*s12
+    t3 = t2 + qd1*t1
+    t4 = c12*qd2
+    t5 = t4 + qd1*t0
+    Jd = casadi.SX(6, 2)
+    Jd[0, 0] = -t5
+    Jd[0, 1] = -t4 - c12*qd1
+    Jd[1, 0] = -t3
+    Jd[1, 1] = -t2 - qd1*s12
+    return [Jd]
+
+
+def _bias_acceleration(q, q_dot):
+    """J' q_dot: the tool's classical linear and angular acceleration at zero joint acceleration, world frame (6): 30 operations."""
+    q1 = q[0]
+    q2 = q[1]
+    qd1 = q_dot[0]
+    qd2 = q_dot[1]
+    c1 = casadi.cos(q1)
+    s1 = casadi.sin(q1)
+    c2 = casadi.cos(q2)
+    s2 = casadi.sin(q2)
+    c12 = c1*c2 - s1*s2
+    s12 = c1*s2 + c2*s1
+    t0 = c1 + c12
+    t1 = s1 + s12
+    t2 = qd2*s12
+    t3 = t2 + qd1*t1
+    t4 = c12*qd2
+    t5 = t4 + qd1*t0
+    a = casadi.SX(6, 1)
+    a[0, 0] = -qd1*t5 - qd2*(t4 + c12*qd1)
+    a[1, 0] = -qd1*t3 - qd2*(t2 + qd1*s12)
+    return [a]
+
+
+def _task_jacobian_dot(q, q_dot):
+    """D/dt of the analytic Jacobian along q_dot (2 x DOF): mu'' = J_a q'' + J_a' q': 26 operations."""
+    q1 = q[0]
+    q2 = q[1]
+    qd1 = q_dot[0]
+    qd2 = q_dot[1]
+    c1 = casadi.cos(q1)
+    s1 = casadi.sin(q1)
+    c2 = casadi.cos(q2)
+    s2 = casadi.sin(q2)
+    c12 = c1*c2 - s1*s2
+    s12 = c1*s2 + c2*s1
+    t0 = c1 + c12
+    t1 = s1 + s12
+    t2 = qd2*s12
+    t3 = t2 + qd1*t1
+    t4 = t2 + qd1*s12
+    t5 = c12*qd2
+    t6 = t5 + qd1*t0
+    t7 = t5 + c12*qd1
+    Jd = casadi.SX(2, 2)
+    Jd[0, 0] = -t6
+    Jd[0, 1] = -t7
+    Jd[1, 0] = -t3
+    Jd[1, 1] = -t4
+    return [Jd]
+
+
+def _hessian(q):
+    """D J / d q_k for each k (DOF x 6 x DOF, indexed [k, r, c]): 16 operations."""
+    q1 = q[0]
+    q2 = q[1]
+    c1 = casadi.cos(q1)
+    s1 = casadi.sin(q1)
+    c2 = casadi.cos(q2)
+    s2 = casadi.sin(q2)
+    c12 = c1*c2 - s1*s2
+    s12 = c1*s2 + c2*s1
+    t0 = c1 + c12
+    t1 = s1 + s12
+    t2 = -c12
+    t3 = -s12
+    H = casadi.SX(12, 2)
+    H[0, 0] = -t0
+    H[0, 1] = t2
+    H[1, 0] = -t1
+    H[1, 1] = t3
+    H[6, 0] = t2
+    H[6, 1] = t2
+    H[7, 0] = t3
+    H[7, 1] = t3
+    return [H]
+
+
 def _singularity_factors(q):
     """Factors of det(Js): the robot is singular where one is 0: 1 operations."""
     q2 = q[1]
@@ -195,39 +340,39 @@ def _velocity_ik(q, mu_dot, damping):
     t1 = s1 + s12
     t2 = c12*s12 + t0*t1
     t3 = t1**2
-    t4 = s12**2 + t3
+    t4 = t3 + s12**2
     t5 = t4
     t6 = t0**2
     t7 = casadi.sqrt(t3 + t6)
     t8 = t7*casadi.if_else((t1 <= 0), 1, -1)
     t9 = casadi.if_else((t7 > 0), 1/(t7*(t7 + casadi.fabs(t1))), 0)
-    t10 = c12**2 + t6
+    t10 = t6 + c12**2
     t11 = t10
     t12 = casadi.sqrt(t10 + t4)
     t13 = t2**2
     t14 = damping**2
-    t15 = t11 + t14
-    t16 = t14 + t5
-    t17 = t16**2
-    t18 = casadi.sqrt(2*t13 + t15**2 + t17)
-    t19 = casadi.sqrt(t13 + t17)
-    t20 = t19*casadi.if_else((t16 >= 0), 1, -1)
-    t21 = t16 + t20
-    t22 = casadi.if_else((t19 > 0), 1/(t19*(t19 + casadi.fabs(t16))), 0)
-    t23 = -t22*(t15*t2 + t2*t21)
-    t24 = t2 + t21*t23
-    t25 = t15 + t2*t23
-    t26 = t22*(mu_dot0*t21 - mu_dot1*t2)
-    t27 = mu_dot0 - t21*t26
-    t28 = mu_dot1 + t2*t26
-    t29 = casadi.fabs(t25)
+    t15 = t14 + t5
+    t16 = t15**2
+    t17 = casadi.sqrt(t13 + t16)
+    t18 = t17*casadi.if_else((t15 >= 0), 1, -1)
+    t19 = t15 + t18
+    t20 = casadi.if_else((t17 > 0), 1/(t17*(t17 + casadi.fabs(t15))), 0)
+    t21 = t20*(mu_dot0*t19 - mu_dot1*t2)
+    t22 = mu_dot0 - t19*t21
+    t23 = mu_dot1 + t2*t21
+    t24 = t11 + t14
+    t25 = casadi.sqrt(t16 + t24**2 + 2*t13)
+    t26 = -t20*(t19*t2 + t2*t24)
+    t27 = t2 + t19*t26
+    t28 = t24 + t2*t26
+    t29 = casadi.fabs(t28)
     t30 = t29
-    t31 = t30*casadi.if_else((t25 >= 0), 1, -1)
-    t32 = t25 + t31
+    t31 = t30*casadi.if_else((t28 >= 0), 1, -1)
+    t32 = t28 + t31
     t33 = casadi.if_else((t30 > 0), 1/(t30*(t29 + t30)), 0)
-    t34 = -t28*t32**2*t33 + t28
+    t34 = t23 - t23*t33*t32**2
     t35 = casadi.if_else((t31 != 0), -t34/t31, 0)
-    t36 = casadi.if_else((t20 != 0), -(t24*t35 + t27)/t20, 0)
+    t36 = casadi.if_else((t18 != 0), -(t22 + t27*t35)/t18, 0)
     t37 = t0*t35 - t1*t36
     t38 = c12*t35 - s12*t36
     t39 = -t1
@@ -238,21 +383,21 @@ def _velocity_ik(q, mu_dot, damping):
     t44 = t9*(mu_dot0*t40 + mu_dot1*t0)
     t45 = mu_dot0 - t40*t44
     t46 = mu_dot1 - t0*t44
-    t47 = c12 + damping + mu_dot0 + mu_dot1 + q1 + q2 - s12 + t0 + t39
+    t47 = c12 + damping + mu_dot0 + mu_dot1 + q1 + q2 + t0 + t39 - s12
     t48 = casadi.fabs(t43)
     t49 = t48
     t50 = t49*casadi.if_else((t43 >= 0), 1, -1)
     t51 = t43 + t50
     t52 = casadi.if_else((t49 > 0), 1/(t49*(t48 + t49)), 0)
-    t53 = -t46*t51**2*t52 + t46
+    t53 = t46 - t46*t52*t51**2
     t54 = casadi.if_else((t50 != 0), -t53/t50, 0)
-    t55 = casadi.if_else((t8 != 0), -(t42*t54 + t45)/t8, 0)
+    t55 = casadi.if_else((t8 != 0), -(t45 + t42*t54)/t8, 0)
     t56 = (damping > 0)
     t57 = (casadi.fabs(t47) < casadi.inf)
     t58 = (damping >= 0)
     t59 = 1e-12*t12
-    t60 = 1e-12*t18
-    t61 = casadi.logic_or(casadi.logic_and(t56, casadi.logic_or((t19 <= t60), (t30 <= t60))), casadi.logic_and((damping <= 0), casadi.logic_or((t49 <= t59), (t7 <= t59))))
+    t60 = 1e-12*t25
+    t61 = casadi.logic_or(casadi.logic_and(t56, casadi.logic_or((t17 <= t60), (t30 <= t60))), casadi.logic_and((damping <= 0), casadi.logic_or((t49 <= t59), (t7 <= t59))))
     t62 = casadi.logic_and(casadi.logic_and(t57, t58), casadi.logic_not(t61))
     q_dot = casadi.SX(2, 1)
     q_dot[0, 0] = casadi.if_else(t62, casadi.if_else(t56, t37, t55), 0)
@@ -291,22 +436,22 @@ def _ik_numeric_step(target, q, damping):
     t12 = t11 + t9
     t13 = casadi.if_else((t10 > 0), 1/(t10*(t10 + casadi.fabs(t9))), 0)
     t14 = t13*(t12*t5 - t3*t6)
-    t15 = -t12*t14 + t5
-    t16 = t14*t3 + t6
+    t15 = t5 - t12*t14
+    t16 = t6 + t14*t3
     t17 = damping + t4
     t18 = -t13*(t12*t3 + t17*t3)
-    t19 = t12*t18 + t3
+    t19 = t3 + t12*t18
     t20 = t17 + t18*t3
     t21 = casadi.fabs(t20)
     t22 = t21
     t23 = t22*casadi.if_else((t20 >= 0), 1, -1)
     t24 = t20 + t23
     t25 = casadi.if_else((t22 > 0), 1/(t22*(t21 + t22)), 0)
-    t26 = -t16*t24**2*t25 + t16
+    t26 = t16 - t16*t25*t24**2
     t27 = casadi.if_else((t23 != 0), -t26/t23, 0)
     t28 = casadi.if_else((t11 != 0), -(t15 + t19*t27)/t11, 0)
     t29 = q1 + t0*t27 - t1*t28
-    t30 = c12*t27 + q2 - s12*t28
+    t30 = q2 + c12*t27 - s12*t28
     q_start = casadi.SX(2, 1)
     q_start[0, 0] = q1
     q_start[1, 0] = q2
@@ -333,18 +478,18 @@ def _ik_branches(mu):
     t8 = casadi.atan2(t7, t6)
     t9 = 3.141592653589793 - t8
     t10 = False
-    t11 = casadi.if_else(t10, 0, t8 + 3.141592653589793)
+    t11 = casadi.if_else(t10, 0, 3.141592653589793 + t8)
     t12 = casadi.if_else(t10, 0, -t7)
     t13 = -t6
     t14 = casadi.if_else(t10, 1, t13)
-    t15 = t14 + 1
+    t15 = 1 + t14
     t16 = mu0*t15 + mu1*t12
-    t17 = -mu0*t12 + mu1*t15
+    t17 = mu1*t15 - mu0*t12
     t18 = t16**2 + t17**2
     t19 = t12**2 + t15**2
-    t20 = t13 + 1
+    t20 = 1 + t13
     t21 = mu0*t20 + mu1*t7
-    t22 = -mu0*t7 + mu1*t20
+    t22 = mu1*t20 - mu0*t7
     t23 = t21**2 + t22**2
     t24 = t20**2 + t7**2
     t25 = 1e-24*t0
@@ -352,9 +497,9 @@ def _ik_branches(mu):
     t27 = True
     q = casadi.SX(2, 2)
     q[0, 0] = casadi.if_else((t18 <= t19*t25), 0, casadi.atan2(t17, t16))
-    q[0, 1] = t11 - 6.283185307179586*casadi.ceil(0.15915494309189535*t11 - 0.5)
+    q[0, 1] = t11 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t11)
     q[1, 0] = casadi.if_else((t23 <= t24*t25), 0, casadi.atan2(t22, t21))
-    q[1, 1] = t9 - 6.283185307179586*casadi.ceil(0.15915494309189535*t9 - 0.5)
+    q[1, 1] = t9 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t9)
     valid = casadi.SX(2, 1)
     valid[0, 0] = casadi.logic_and(casadi.logic_and(t26, t27), (t4 >= -1e-12))
     valid[1, 0] = casadi.logic_and(casadi.logic_and(t26, t27), (t4 > 1e-12))
@@ -362,6 +507,7 @@ def _ik_branches(mu):
 
 
 _q = casadi.SX.sym("q", 2, 1)
+_q_dot = casadi.SX.sym("q_dot", 2, 1)
 _mu_dot = casadi.SX.sym("mu_dot", 2, 1)
 _damping = casadi.SX.sym("damping", 1, 1)
 _target = casadi.SX.sym("target", 2, 1)
@@ -372,6 +518,11 @@ fk_jacobian = casadi.Function("fk_jacobian", [_q], _fk_jacobian(_q), ["q"], ["T"
 jacobian_tool = casadi.Function("jacobian_tool", [_q], _jacobian_tool(_q), ["q"], ["J"])
 task = casadi.Function("task", [_q], _task(_q), ["q"], ["mu"])
 task_jacobian = casadi.Function("task_jacobian", [_q], _task_jacobian(_q), ["q"], ["J"])
+fk_jacobian_dot = casadi.Function("fk_jacobian_dot", [_q, _q_dot], _fk_jacobian_dot(_q, _q_dot), ["q", "q_dot"], ["T", "J", "a"])
+jacobian_dot = casadi.Function("jacobian_dot", [_q, _q_dot], _jacobian_dot(_q, _q_dot), ["q", "q_dot"], ["Jd"])
+bias_acceleration = casadi.Function("bias_acceleration", [_q, _q_dot], _bias_acceleration(_q, _q_dot), ["q", "q_dot"], ["a"])
+task_jacobian_dot = casadi.Function("task_jacobian_dot", [_q, _q_dot], _task_jacobian_dot(_q, _q_dot), ["q", "q_dot"], ["Jd"])
+hessian = casadi.Function("hessian", [_q], _hessian(_q), ["q"], ["H"])
 singularity_factors = casadi.Function("singularity_factors", [_q], _singularity_factors(_q), ["q"], ["f"])
 manipulability = casadi.Function("manipulability", [_q], _manipulability(_q), ["q"], ["w"])
 jacobian_det = casadi.Function("jacobian_det", [_q], _jacobian_det(_q), ["q"], ["d"])
@@ -420,4 +571,4 @@ ik_numeric = casadi.Function("ik_numeric", _inputs, _ik_numeric(*_inputs), ["tar
 
 def functions():
     """All functions by name."""
-    return {"fk": fk, "jacobian": jacobian, "fk_jacobian": fk_jacobian, "jacobian_tool": jacobian_tool, "task": task, "task_jacobian": task_jacobian, "singularity_factors": singularity_factors, "manipulability": manipulability, "jacobian_det": jacobian_det, "velocity_ik": velocity_ik, "ik_numeric_step": ik_numeric_step, "ik_branches": ik_branches}
+    return {"fk": fk, "jacobian": jacobian, "fk_jacobian": fk_jacobian, "jacobian_tool": jacobian_tool, "task": task, "task_jacobian": task_jacobian, "fk_jacobian_dot": fk_jacobian_dot, "jacobian_dot": jacobian_dot, "bias_acceleration": bias_acceleration, "task_jacobian_dot": task_jacobian_dot, "hessian": hessian, "singularity_factors": singularity_factors, "manipulability": manipulability, "jacobian_det": jacobian_det, "velocity_ik": velocity_ik, "ik_numeric_step": ik_numeric_step, "ik_branches": ik_branches}

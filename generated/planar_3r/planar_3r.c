@@ -183,8 +183,8 @@ void planar_3r_jacobian_tool(const planar_3r_real q[PLANAR_3R_DOF], planar_3r_re
     const planar_3r_real t3 = s1 + t1;
 
     /* Outputs */
-    J[0] = -c123*t3 + s123*t2;
-    J[1] = -c123*t1 + s123*t0;
+    J[0] = s123*t2 - c123*t3;
+    J[1] = s123*t0 - c123*t1;
     J[2] = 0;
     J[3] = c123*t2 + s123*t3;
     J[4] = c123*t0 + s123*t1;
@@ -269,6 +269,322 @@ void planar_3r_task_jacobian(const planar_3r_real q[PLANAR_3R_DOF], planar_3r_re
     J[6] = 1;
     J[7] = 1;
     J[8] = 1;
+}
+
+void planar_3r_fk_jacobian_dot(const planar_3r_real q[PLANAR_3R_DOF], const planar_3r_real q_dot[PLANAR_3R_DOF], planar_3r_real T[16], planar_3r_real J[6 * PLANAR_3R_DOF], planar_3r_real a[6])
+{
+    /* 56 operations */
+
+    /* Inputs */
+    const planar_3r_real q1 = q[0];
+    const planar_3r_real q2 = q[1];
+    const planar_3r_real q3 = q[2];
+    const planar_3r_real qd1 = q_dot[0];
+    const planar_3r_real qd2 = q_dot[1];
+    const planar_3r_real qd3 = q_dot[2];
+
+    /* Intermediate terms */
+    const planar_3r_real c1 = cos(q1);
+    const planar_3r_real s1 = sin(q1);
+    const planar_3r_real c2 = cos(q2);
+    const planar_3r_real s2 = sin(q2);
+    const planar_3r_real c12 = c1*c2 - s1*s2;
+    const planar_3r_real s12 = c1*s2 + c2*s1;
+    const planar_3r_real c3 = cos(q3);
+    const planar_3r_real s3 = sin(q3);
+    const planar_3r_real c123 = c12*c3 - s12*s3;
+    const planar_3r_real s123 = c12*s3 + c3*s12;
+    const planar_3r_real t0 = c12 + c123;
+    const planar_3r_real t1 = s12 + s123;
+    const planar_3r_real t2 = c1 + t0;
+    const planar_3r_real t3 = s1 + t1;
+    const planar_3r_real t4 = qd1 + qd2;
+    const planar_3r_real t5 = qd3*s123;
+    const planar_3r_real t6 = t5 + qd2*t1;
+    const planar_3r_real t7 = t6 + qd1*t3;
+    const planar_3r_real t8 = c123*qd3;
+    const planar_3r_real t9 = t8 + qd2*t0;
+    const planar_3r_real t10 = t9 + qd1*t2;
+    const planar_3r_real t11 = -s123;
+
+    /* Outputs */
+    T[0] = c123;
+    T[1] = t11;
+    T[2] = 0;
+    T[3] = t2;
+    T[4] = s123;
+    T[5] = c123;
+    T[6] = 0;
+    T[7] = t3;
+    T[8] = 0;
+    T[9] = 0;
+    T[10] = 1;
+    T[11] = 0;
+    T[12] = 0;
+    T[13] = 0;
+    T[14] = 0;
+    T[15] = 1;
+    J[0] = -t3;
+    J[1] = -t1;
+    J[2] = t11;
+    J[3] = t2;
+    J[4] = t0;
+    J[5] = c123;
+    J[6] = 0;
+    J[7] = 0;
+    J[8] = 0;
+    J[9] = 0;
+    J[10] = 0;
+    J[11] = 0;
+    J[12] = 0;
+    J[13] = 0;
+    J[14] = 0;
+    J[15] = 1;
+    J[16] = 1;
+    J[17] = 1;
+    a[0] = -qd1*t10 - qd2*(t9 + qd1*t0) - qd3*(t8 + c123*t4);
+    a[1] = -qd1*t7 - qd2*(t6 + qd1*t1) - qd3*(t5 + s123*t4);
+    a[2] = 0;
+    a[3] = 0;
+    a[4] = 0;
+    a[5] = 0;
+}
+
+void planar_3r_jacobian_dot(const planar_3r_real q[PLANAR_3R_DOF], const planar_3r_real q_dot[PLANAR_3R_DOF], planar_3r_real Jd[6 * PLANAR_3R_DOF])
+{
+    /* 47 operations */
+
+    /* Inputs */
+    const planar_3r_real q1 = q[0];
+    const planar_3r_real q2 = q[1];
+    const planar_3r_real q3 = q[2];
+    const planar_3r_real qd1 = q_dot[0];
+    const planar_3r_real qd2 = q_dot[1];
+    const planar_3r_real qd3 = q_dot[2];
+
+    /* Intermediate terms */
+    const planar_3r_real c1 = cos(q1);
+    const planar_3r_real s1 = sin(q1);
+    const planar_3r_real c2 = cos(q2);
+    const planar_3r_real s2 = sin(q2);
+    const planar_3r_real c12 = c1*c2 - s1*s2;
+    const planar_3r_real s12 = c1*s2 + c2*s1;
+    const planar_3r_real c3 = cos(q3);
+    const planar_3r_real s3 = sin(q3);
+    const planar_3r_real c123 = c12*c3 - s12*s3;
+    const planar_3r_real s123 = c12*s3 + c3*s12;
+    const planar_3r_real t0 = c12 + c123;
+    const planar_3r_real t1 = s12 + s123;
+    const planar_3r_real t2 = c1 + t0;
+    const planar_3r_real t3 = s1 + t1;
+    const planar_3r_real t4 = qd1 + qd2;
+    const planar_3r_real t5 = qd3*s123;
+    const planar_3r_real t6 = t5 + qd2*t1;
+    const planar_3r_real t7 = t6 + qd1*t3;
+    const planar_3r_real t8 = c123*qd3;
+    const planar_3r_real t9 = t8 + qd2*t0;
+    const planar_3r_real t10 = t9 + qd1*t2;
+
+    /* Outputs */
+    Jd[0] = -t10;
+    Jd[1] = -t9 - qd1*t0;
+    Jd[2] = -t8 - c123*t4;
+    Jd[3] = -t7;
+    Jd[4] = -t6 - qd1*t1;
+    Jd[5] = -t5 - s123*t4;
+    Jd[6] = 0;
+    Jd[7] = 0;
+    Jd[8] = 0;
+    Jd[9] = 0;
+    Jd[10] = 0;
+    Jd[11] = 0;
+    Jd[12] = 0;
+    Jd[13] = 0;
+    Jd[14] = 0;
+    Jd[15] = 0;
+    Jd[16] = 0;
+    Jd[17] = 0;
+}
+
+void planar_3r_bias_acceleration(const planar_3r_real q[PLANAR_3R_DOF], const planar_3r_real q_dot[PLANAR_3R_DOF], planar_3r_real a[6])
+{
+    /* 53 operations */
+
+    /* Inputs */
+    const planar_3r_real q1 = q[0];
+    const planar_3r_real q2 = q[1];
+    const planar_3r_real q3 = q[2];
+    const planar_3r_real qd1 = q_dot[0];
+    const planar_3r_real qd2 = q_dot[1];
+    const planar_3r_real qd3 = q_dot[2];
+
+    /* Intermediate terms */
+    const planar_3r_real c1 = cos(q1);
+    const planar_3r_real s1 = sin(q1);
+    const planar_3r_real c2 = cos(q2);
+    const planar_3r_real s2 = sin(q2);
+    const planar_3r_real c12 = c1*c2 - s1*s2;
+    const planar_3r_real s12 = c1*s2 + c2*s1;
+    const planar_3r_real c3 = cos(q3);
+    const planar_3r_real s3 = sin(q3);
+    const planar_3r_real c123 = c12*c3 - s12*s3;
+    const planar_3r_real s123 = c12*s3 + c3*s12;
+    const planar_3r_real t0 = c12 + c123;
+    const planar_3r_real t1 = s12 + s123;
+    const planar_3r_real t2 = c1 + t0;
+    const planar_3r_real t3 = s1 + t1;
+    const planar_3r_real t4 = qd1 + qd2;
+    const planar_3r_real t5 = qd3*s123;
+    const planar_3r_real t6 = t5 + qd2*t1;
+    const planar_3r_real t7 = t6 + qd1*t3;
+    const planar_3r_real t8 = c123*qd3;
+    const planar_3r_real t9 = t8 + qd2*t0;
+    const planar_3r_real t10 = t9 + qd1*t2;
+
+    /* Outputs */
+    a[0] = -qd1*t10 - qd2*(t9 + qd1*t0) - qd3*(t8 + c123*t4);
+    a[1] = -qd1*t7 - qd2*(t6 + qd1*t1) - qd3*(t5 + s123*t4);
+    a[2] = 0;
+    a[3] = 0;
+    a[4] = 0;
+    a[5] = 0;
+}
+
+void planar_3r_task_jacobian_dot(const planar_3r_real q[PLANAR_3R_DOF], const planar_3r_real q_dot[PLANAR_3R_DOF], planar_3r_real Jd[PLANAR_3R_TASK_DIM * PLANAR_3R_DOF])
+{
+    /* 47 operations */
+
+    /* Inputs */
+    const planar_3r_real q1 = q[0];
+    const planar_3r_real q2 = q[1];
+    const planar_3r_real q3 = q[2];
+    const planar_3r_real qd1 = q_dot[0];
+    const planar_3r_real qd2 = q_dot[1];
+    const planar_3r_real qd3 = q_dot[2];
+
+    /* Intermediate terms */
+    const planar_3r_real c1 = cos(q1);
+    const planar_3r_real s1 = sin(q1);
+    const planar_3r_real c2 = cos(q2);
+    const planar_3r_real s2 = sin(q2);
+    const planar_3r_real c12 = c1*c2 - s1*s2;
+    const planar_3r_real s12 = c1*s2 + c2*s1;
+    const planar_3r_real c3 = cos(q3);
+    const planar_3r_real s3 = sin(q3);
+    const planar_3r_real c123 = c12*c3 - s12*s3;
+    const planar_3r_real s123 = c12*s3 + c3*s12;
+    const planar_3r_real t0 = c12 + c123;
+    const planar_3r_real t1 = s12 + s123;
+    const planar_3r_real t2 = c1 + t0;
+    const planar_3r_real t3 = s1 + t1;
+    const planar_3r_real t4 = qd1 + qd2;
+    const planar_3r_real t5 = qd3*s123;
+    const planar_3r_real t6 = t5 + qd2*t1;
+    const planar_3r_real t7 = t6 + qd1*t3;
+    const planar_3r_real t8 = t6 + qd1*t1;
+    const planar_3r_real t9 = t5 + s123*t4;
+    const planar_3r_real t10 = c123*qd3;
+    const planar_3r_real t11 = t10 + qd2*t0;
+    const planar_3r_real t12 = t11 + qd1*t2;
+    const planar_3r_real t13 = t11 + qd1*t0;
+    const planar_3r_real t14 = t10 + c123*t4;
+
+    /* Outputs */
+    Jd[0] = -t12;
+    Jd[1] = -t13;
+    Jd[2] = -t14;
+    Jd[3] = -t7;
+    Jd[4] = -t8;
+    Jd[5] = -t9;
+    Jd[6] = 0;
+    Jd[7] = 0;
+    Jd[8] = 0;
+}
+
+void planar_3r_hessian(const planar_3r_real q[PLANAR_3R_DOF], planar_3r_real H[PLANAR_3R_DOF * 6 * PLANAR_3R_DOF])
+{
+    /* 28 operations */
+
+    /* Inputs */
+    const planar_3r_real q1 = q[0];
+    const planar_3r_real q2 = q[1];
+    const planar_3r_real q3 = q[2];
+
+    /* Intermediate terms */
+    const planar_3r_real c1 = cos(q1);
+    const planar_3r_real s1 = sin(q1);
+    const planar_3r_real c2 = cos(q2);
+    const planar_3r_real s2 = sin(q2);
+    const planar_3r_real c12 = c1*c2 - s1*s2;
+    const planar_3r_real s12 = c1*s2 + c2*s1;
+    const planar_3r_real c3 = cos(q3);
+    const planar_3r_real s3 = sin(q3);
+    const planar_3r_real c123 = c12*c3 - s12*s3;
+    const planar_3r_real s123 = c12*s3 + c3*s12;
+    const planar_3r_real t0 = c12 + c123;
+    const planar_3r_real t1 = s12 + s123;
+    const planar_3r_real t2 = c1 + t0;
+    const planar_3r_real t3 = s1 + t1;
+    const planar_3r_real t4 = -t0;
+    const planar_3r_real t5 = -c123;
+    const planar_3r_real t6 = -t1;
+    const planar_3r_real t7 = -s123;
+
+    /* Outputs */
+    H[0] = -t2;
+    H[1] = t4;
+    H[2] = t5;
+    H[3] = -t3;
+    H[4] = t6;
+    H[5] = t7;
+    H[6] = 0;
+    H[7] = 0;
+    H[8] = 0;
+    H[9] = 0;
+    H[10] = 0;
+    H[11] = 0;
+    H[12] = 0;
+    H[13] = 0;
+    H[14] = 0;
+    H[15] = 0;
+    H[16] = 0;
+    H[17] = 0;
+    H[18] = t4;
+    H[19] = t4;
+    H[20] = t5;
+    H[21] = t6;
+    H[22] = t6;
+    H[23] = t7;
+    H[24] = 0;
+    H[25] = 0;
+    H[26] = 0;
+    H[27] = 0;
+    H[28] = 0;
+    H[29] = 0;
+    H[30] = 0;
+    H[31] = 0;
+    H[32] = 0;
+    H[33] = 0;
+    H[34] = 0;
+    H[35] = 0;
+    H[36] = t5;
+    H[37] = t5;
+    H[38] = t5;
+    H[39] = t7;
+    H[40] = t7;
+    H[41] = t7;
+    H[42] = 0;
+    H[43] = 0;
+    H[44] = 0;
+    H[45] = 0;
+    H[46] = 0;
+    H[47] = 0;
+    H[48] = 0;
+    H[49] = 0;
+    H[50] = 0;
+    H[51] = 0;
+    H[52] = 0;
+    H[53] = 0;
 }
 
 void planar_3r_singularity_factors(const planar_3r_real q[PLANAR_3R_DOF], planar_3r_real f[PLANAR_3R_NUM_SINGULARITY_FACTORS])
@@ -369,12 +685,12 @@ int planar_3r_velocity_ik(const planar_3r_real q[PLANAR_3R_DOF], const planar_3r
     const planar_3r_real t7 = t6 + (s123*s123) + (t1*t1);
     const planar_3r_real t8 = t7;
     const planar_3r_real t9 = (t2*t2);
-    const planar_3r_real t10 = sqrt(t6 + t9 + 1);
+    const planar_3r_real t10 = sqrt(1 + t6 + t9);
     const planar_3r_real t11 = t10*(t3 <= 0 ? 1 : -1);
     const planar_3r_real t12 = (t10 > 0 ? 1/(t10*(t10 + fabs(t3))) : 0);
     const planar_3r_real t13 = t9 + (c123*c123) + (t0*t0);
     const planar_3r_real t14 = t13;
-    const planar_3r_real t15 = sqrt(t13 + t7 + 3);
+    const planar_3r_real t15 = sqrt(3 + t13 + t7);
     const planar_3r_real t16 = c123 + t0 + t2;
     const planar_3r_real t17 = t16;
     const planar_3r_real t18 = (t4*t4);
@@ -386,13 +702,13 @@ int planar_3r_velocity_ik(const planar_3r_real q[PLANAR_3R_DOF], const planar_3r
     const planar_3r_real t24 = t23*(t21 >= 0 ? 1 : -1);
     const planar_3r_real t25 = t21 + t24;
     const planar_3r_real t26 = (t23 > 0 ? 1/(t23*(t23 + fabs(t21))) : 0);
-    const planar_3r_real t27 = -t26*(-mu_dot0*t25 + mu_dot1*t4 + mu_dot2*t5);
+    const planar_3r_real t27 = -t26*(mu_dot1*t4 + mu_dot2*t5 - mu_dot0*t25);
     const planar_3r_real t28 = mu_dot0 - t25*t27;
     const planar_3r_real t29 = mu_dot1 + t27*t4;
     const planar_3r_real t30 = mu_dot2 + t27*t5;
     const planar_3r_real t31 = t14 + t20;
     const planar_3r_real t32 = -t26*(t17*t5 + t25*t4 + t31*t4);
-    const planar_3r_real t33 = t25*t32 + t4;
+    const planar_3r_real t33 = t4 + t25*t32;
     const planar_3r_real t34 = t31 + t32*t4;
     const planar_3r_real t35 = t17 + t32*t5;
     const planar_3r_real t36 = sqrt((t34*t34) + (t35*t35));
@@ -402,38 +718,38 @@ int planar_3r_velocity_ik(const planar_3r_real q[PLANAR_3R_DOF], const planar_3r
     const planar_3r_real t40 = t39*(t29*t38 + t30*t35);
     const planar_3r_real t41 = t29 - t38*t40;
     const planar_3r_real t42 = t30 - t35*t40;
-    const planar_3r_real t43 = t20 + 3;
-    const planar_3r_real t44 = sqrt(2*t18 + 2*t19 + t22 + 2*(t17*t17) + (t31*t31) + (t43*t43));
+    const planar_3r_real t43 = 3 + t20;
+    const planar_3r_real t44 = sqrt(t22 + 2*t18 + 2*t19 + 2*(t17*t17) + (t31*t31) + (t43*t43));
     const planar_3r_real t45 = -t26*(t17*t4 + t25*t5 + t43*t5);
-    const planar_3r_real t46 = t25*t45 + t5;
+    const planar_3r_real t46 = t5 + t25*t45;
     const planar_3r_real t47 = t17 + t4*t45;
     const planar_3r_real t48 = t43 + t45*t5;
     const planar_3r_real t49 = t39*(t35*t48 + t38*t47);
-    const planar_3r_real t50 = -t38*t49 + t47;
-    const planar_3r_real t51 = -t35*t49 + t48;
+    const planar_3r_real t50 = t47 - t38*t49;
+    const planar_3r_real t51 = t48 - t35*t49;
     const planar_3r_real t52 = fabs(t51);
     const planar_3r_real t53 = t52;
     const planar_3r_real t54 = t53*(t51 >= 0 ? 1 : -1);
     const planar_3r_real t55 = t51 + t54;
     const planar_3r_real t56 = (t53 > 0 ? 1/(t53*(t52 + t53)) : 0);
-    const planar_3r_real t57 = -t42*t56*(t55*t55) + t42;
+    const planar_3r_real t57 = t42 - t42*t56*(t55*t55);
     const planar_3r_real t58 = (t54 != 0 ? -t57/t54 : 0);
     const planar_3r_real t59 = (t37 != 0 ? -(t41 - t50*t58)/t37 : 0);
     const planar_3r_real t60 = (t24 != 0 ? -(t28 + t33*t59 + t46*t58)/t24 : 0);
-    const planar_3r_real t61 = t2*t59 - t3*t60 + t58;
-    const planar_3r_real t62 = t0*t59 - t1*t60 + t58;
-    const planar_3r_real t63 = c123*t59 - s123*t60 + t58;
+    const planar_3r_real t61 = t58 + t2*t59 - t3*t60;
+    const planar_3r_real t62 = t58 + t0*t59 - t1*t60;
+    const planar_3r_real t63 = t58 + c123*t59 - s123*t60;
     const planar_3r_real t64 = -t3;
     const planar_3r_real t65 = t11 + t64;
-    const planar_3r_real t66 = t12*(t0*t2 - t1*t65 + 1);
+    const planar_3r_real t66 = t12*(1 + t0*t2 - t1*t65);
     const planar_3r_real t67 = t1 + t65*t66;
     const planar_3r_real t68 = t0 - t2*t66;
     const planar_3r_real t69 = 1 - t66;
-    const planar_3r_real t70 = t12*(c123*t2 - s123*t65 + 1);
+    const planar_3r_real t70 = t12*(1 + c123*t2 - s123*t65);
     const planar_3r_real t71 = s123 + t65*t70;
     const planar_3r_real t72 = c123 - t2*t70;
     const planar_3r_real t73 = 1 - t70;
-    const planar_3r_real t74 = t12*(mu_dot0*t65 + mu_dot1*t2 + mu_dot2);
+    const planar_3r_real t74 = t12*(mu_dot2 + mu_dot0*t65 + mu_dot1*t2);
     const planar_3r_real t75 = mu_dot0 - t65*t74;
     const planar_3r_real t76 = mu_dot1 - t2*t74;
     const planar_3r_real t77 = mu_dot2 - t74;
@@ -443,20 +759,20 @@ int planar_3r_velocity_ik(const planar_3r_real q[PLANAR_3R_DOF], const planar_3r
     const planar_3r_real t81 = (t78 > 0 ? 1/(t78*(t78 + fabs(t68))) : 0);
     const planar_3r_real t82 = t81*(t69*t73 + t72*t80);
     const planar_3r_real t83 = t72 - t80*t82;
-    const planar_3r_real t84 = -t69*t82 + t73;
+    const planar_3r_real t84 = t73 - t69*t82;
     const planar_3r_real t85 = t81*(t69*t77 + t76*t80);
     const planar_3r_real t86 = t76 - t80*t85;
-    const planar_3r_real t87 = -t69*t85 + t77;
-    const planar_3r_real t88 = damping + mu_dot0 + mu_dot1 + mu_dot2 + q1 + q2 + q3 - s123 - t1 + t16 + t64 + 3;
+    const planar_3r_real t87 = t77 - t69*t85;
+    const planar_3r_real t88 = 3 + damping + mu_dot0 + mu_dot1 + mu_dot2 + q1 + q2 + q3 + t16 + t64 - s123 - t1;
     const planar_3r_real t89 = fabs(t84);
     const planar_3r_real t90 = t89;
     const planar_3r_real t91 = t90*(t84 >= 0 ? 1 : -1);
     const planar_3r_real t92 = t84 + t91;
     const planar_3r_real t93 = (t90 > 0 ? 1/(t90*(t89 + t90)) : 0);
-    const planar_3r_real t94 = -t87*t93*(t92*t92) + t87;
+    const planar_3r_real t94 = t87 - t87*t93*(t92*t92);
     const planar_3r_real t95 = (t91 != 0 ? -t94/t91 : 0);
-    const planar_3r_real t96 = (t79 != 0 ? -(-t83*t95 + t86)/t79 : 0);
-    const planar_3r_real t97 = (t11 != 0 ? -(t67*t96 + t71*t95 + t75)/t11 : 0);
+    const planar_3r_real t96 = (t79 != 0 ? -(t86 - t83*t95)/t79 : 0);
+    const planar_3r_real t97 = (t11 != 0 ? -(t75 + t67*t96 + t71*t95)/t11 : 0);
     const int t98 = damping > 0;
     const int t99 = isfinite(t88);
     const int t100 = damping >= 0;
@@ -511,22 +827,22 @@ planar_3r_real planar_3r_ik_numeric_step(const planar_3r_real target[PLANAR_3R_T
     const planar_3r_real t10 = mu1 - t3;
     const planar_3r_real t11 = mu0 + mu1 + mu2 + qs1 + qs2 + qs3;
     const planar_3r_real t12 = -mu2 + atan2(s123, c123);
-    const planar_3r_real t13 = t12 + 6.283185307179586*ceil(-0.15915494309189535*t12 - 0.5);
+    const planar_3r_real t13 = t12 + 6.283185307179586*ceil(-0.5 - 0.15915494309189535*t12);
     const planar_3r_real t14 = (t10*t10) + (t13*t13) + (t9*t9);
     const planar_3r_real t15 = damping + t4;
     const planar_3r_real t16 = sqrt((t15*t15) + (t5*t5) + (t6*t6));
     const planar_3r_real t17 = t16*(t15 >= 0 ? 1 : -1);
     const planar_3r_real t18 = t15 + t17;
     const planar_3r_real t19 = (t16 > 0 ? 1/(t16*(t16 + fabs(t15))) : 0);
-    const planar_3r_real t20 = t19*(-t10*t5 + t13*t6 + t18*t9);
-    const planar_3r_real t21 = -t18*t20 + t9;
+    const planar_3r_real t20 = t19*(t13*t6 + t18*t9 - t10*t5);
+    const planar_3r_real t21 = t9 - t18*t20;
     const planar_3r_real t22 = t10 + t20*t5;
     const planar_3r_real t23 = -t13 + t20*t6;
     const planar_3r_real t24 = damping + t7;
     const planar_3r_real t25 = -t19*(t18*t5 + t24*t5 + t6*t8);
-    const planar_3r_real t26 = t18*t25 + t5;
+    const planar_3r_real t26 = t5 + t18*t25;
     const planar_3r_real t27 = t24 + t25*t5;
-    const planar_3r_real t28 = t25*t6 + t8;
+    const planar_3r_real t28 = t8 + t25*t6;
     const planar_3r_real t29 = sqrt((t27*t27) + (t28*t28));
     const planar_3r_real t30 = t29*(t27 >= 0 ? 1 : -1);
     const planar_3r_real t31 = t27 + t30;
@@ -534,26 +850,26 @@ planar_3r_real planar_3r_ik_numeric_step(const planar_3r_real target[PLANAR_3R_T
     const planar_3r_real t33 = t32*(t22*t31 + t23*t28);
     const planar_3r_real t34 = t22 - t31*t33;
     const planar_3r_real t35 = t23 - t28*t33;
-    const planar_3r_real t36 = damping + 3;
+    const planar_3r_real t36 = 3 + damping;
     const planar_3r_real t37 = -t19*(t18*t6 + t36*t6 + t5*t8);
-    const planar_3r_real t38 = t18*t37 + t6;
-    const planar_3r_real t39 = t37*t5 + t8;
+    const planar_3r_real t38 = t6 + t18*t37;
+    const planar_3r_real t39 = t8 + t37*t5;
     const planar_3r_real t40 = t36 + t37*t6;
     const planar_3r_real t41 = t32*(t28*t40 + t31*t39);
-    const planar_3r_real t42 = -t31*t41 + t39;
-    const planar_3r_real t43 = -t28*t41 + t40;
+    const planar_3r_real t42 = t39 - t31*t41;
+    const planar_3r_real t43 = t40 - t28*t41;
     const planar_3r_real t44 = fabs(t43);
     const planar_3r_real t45 = t44;
     const planar_3r_real t46 = t45*(t43 >= 0 ? 1 : -1);
     const planar_3r_real t47 = t43 + t46;
     const planar_3r_real t48 = (t45 > 0 ? 1/(t45*(t44 + t45)) : 0);
-    const planar_3r_real t49 = -t35*t48*(t47*t47) + t35;
+    const planar_3r_real t49 = t35 - t35*t48*(t47*t47);
     const planar_3r_real t50 = (t46 != 0 ? -t49/t46 : 0);
     const planar_3r_real t51 = (t30 != 0 ? -(t34 - t42*t50)/t30 : 0);
     const planar_3r_real t52 = (t17 != 0 ? -(t21 + t26*t51 + t38*t50)/t17 : 0);
-    const planar_3r_real t53 = q1 + t2*t51 - t3*t52 + t50;
-    const planar_3r_real t54 = q2 + t0*t51 - t1*t52 + t50;
-    const planar_3r_real t55 = c123*t51 + q3 - s123*t52 + t50;
+    const planar_3r_real t53 = q1 + t50 + t2*t51 - t3*t52;
+    const planar_3r_real t54 = q2 + t50 + t0*t51 - t1*t52;
+    const planar_3r_real t55 = q3 + t50 + c123*t51 - s123*t52;
 
     /* Outputs */
     q_start[0] = q1;
@@ -590,24 +906,24 @@ void planar_3r_ik_branches(const planar_3r_real mu[PLANAR_3R_TASK_DIM], planar_3
     const planar_3r_real t12 = atan2(t11, t10);
     const planar_3r_real t13 = 3.141592653589793 - t12;
     const int t14 = 0;
-    const planar_3r_real t15 = (t14 ? 0 : t12 + 3.141592653589793);
+    const planar_3r_real t15 = (t14 ? 0 : 3.141592653589793 + t12);
     const planar_3r_real t16 = (t14 ? 0 : -t11);
     const planar_3r_real t17 = -t10;
     const planar_3r_real t18 = (t14 ? 1 : t17);
-    const planar_3r_real t19 = t18 + 1;
+    const planar_3r_real t19 = 1 + t18;
     const planar_3r_real t20 = t16*t3 + t19*t2;
-    const planar_3r_real t21 = -t16*t2 + t19*t3;
+    const planar_3r_real t21 = t19*t3 - t16*t2;
     const planar_3r_real t22 = (t20*t20) + (t21*t21);
     const planar_3r_real t23 = (t16*t16) + (t19*t19);
-    const planar_3r_real t24 = t17 + 1;
+    const planar_3r_real t24 = 1 + t17;
     const planar_3r_real t25 = t11*t3 + t2*t24;
-    const planar_3r_real t26 = -t11*t2 + t24*t3;
+    const planar_3r_real t26 = t24*t3 - t11*t2;
     const planar_3r_real t27 = (t25*t25) + (t26*t26);
     const planar_3r_real t28 = (t11*t11) + (t24*t24);
     const planar_3r_real t29 = 1e-24*t4;
     const planar_3r_real t30 = (t22 <= t23*t29 ? 0 : atan2(t21, t20));
     const planar_3r_real t31 = -mu2;
-    const planar_3r_real t32 = t31 + 3.141592653589793;
+    const planar_3r_real t32 = 3.141592653589793 + t31;
     const planar_3r_real t33 = t15 + t30;
     const planar_3r_real t34 = (t27 <= t28*t29 ? 0 : atan2(t26, t25));
     const planar_3r_real t35 = t13 + t34;
@@ -616,10 +932,10 @@ void planar_3r_ik_branches(const planar_3r_real mu[PLANAR_3R_TASK_DIM], planar_3
 
     /* Outputs */
     q[0] = t30;
-    q[1] = t15 - 6.283185307179586*ceil(0.15915494309189535*t15 - 0.5);
+    q[1] = t15 - 6.283185307179586*ceil(-0.5 + 0.15915494309189535*t15);
     q[2] = -t31 - t33 - 6.283185307179586*ceil(-0.15915494309189535*t32 - 0.15915494309189535*t33);
     q[3] = t34;
-    q[4] = t13 - 6.283185307179586*ceil(0.15915494309189535*t13 - 0.5);
+    q[4] = t13 - 6.283185307179586*ceil(-0.5 + 0.15915494309189535*t13);
     q[5] = -t31 - t35 - 6.283185307179586*ceil(-0.15915494309189535*t32 - 0.15915494309189535*t35);
     valid[0] = t36 && t37 && t8 >= -1e-12;
     valid[1] = t36 && t37 && t8 > 1e-12;

@@ -140,8 +140,8 @@ def _jacobian_tool(q):
     t2 = c1 + t0
     t3 = s1 + t1
     J = casadi.SX(6, 3)
-    J[0, 0] = -c123*t3 + s123*t2
-    J[0, 1] = -c123*t1 + s123*t0
+    J[0, 0] = s123*t2 - c123*t3
+    J[0, 1] = s123*t0 - c123*t1
     J[1, 0] = c123*t2 + s123*t3
     J[1, 1] = c123*t0 + s123*t1
     J[1, 2] = c123**2 + s123**2
@@ -207,6 +207,223 @@ def _task_jacobian(q):
     J[2, 1] = 1
     J[2, 2] = 1
     return [J]
+
+
+def _fk_jacobian_dot(q, q_dot):
+    """Fk, jacobian and bias_acceleration in one pass, sharing their terms: 56 operations."""
+    q1 = q[0]
+    q2 = q[1]
+    q3 = q[2]
+    qd1 = q_dot[0]
+    qd2 = q_dot[1]
+    qd3 = q_dot[2]
+    c1 = casadi.cos(q1)
+    s1 = casadi.sin(q1)
+    c2 = casadi.cos(q2)
+    s2 = casadi.sin(q2)
+    c12 = c1*c2 - s1*s2
+    s12 = c1*s2 + c2*s1
+    c3 = casadi.cos(q3)
+    s3 = casadi.sin(q3)
+    c123 = c12*c3 - s12*s3
+    s123 = c12*s3 + c3*s12
+    t0 = c12 + c123
+    t1 = s12 + s123
+    t2 = c1 + t0
+    t3 = s1 + t1
+    t4 = qd1 + qd2
+    t5 = qd3*s123
+    t6 = t5 + qd2*t1
+    t7 = t6 + qd1*t3
+    t8 = c123*qd3
+    t9 = t8 + qd2*t0
+    t10 = t9 + qd1*t2
+    t11 = -s123
+    T = casadi.SX(4, 4)
+    T[0, 0] = c123
+    T[0, 1] = t11
+    T[0, 3] = t2
+    T[1, 0] = s123
+    T[1, 1] = c123
+    T[1, 3] = t3
+    T[2, 2] = 1
+    T[3, 3] = 1
+    J = casadi.SX(6, 3)
+    J[0, 0] = -t3
+    J[0, 1] = -t1
+    J[0, 2] = t11
+    J[1, 0] = t2
+    J[1, 1] = t0
+    J[1, 2] = c123
+    J[5, 0] = 1
+    J[5, 1] = 1
+    J[5, 2] = 1
+    a = casadi.SX(6, 1)
+    a[0, 0] = -qd1*t10 - qd2*(t9 + qd1*t0) - qd3*(t8 + c123*t4)
+    a[1, 0] = -qd1*t7 - qd2*(t6 + qd1*t1) - qd3*(t5 + s123*t4)
+    return [T, J, a]
+
+
+def _jacobian_dot(q, q_dot):
+    """DJ/dt of the world geometric Jacobian along q_dot (6 x DOF): 47 operations."""
+    q1 = q[0]
+    q2 = q[1]
+    q3 = q[2]
+    qd1 = q_dot[0]
+    qd2 = q_dot[1]
+    qd3 = q_dot[2]
+    c1 = casadi.cos(q1)
+    s1 = casadi.sin(q1)
+    c2 = casadi.cos(q2)
+    s2 = casadi.sin(q2)
+    c12 = c1*c2 - s1*s2
+    s12 = c1*s2 + c2*s1
+    c3 = casadi.cos(q3)
+    s3 = casadi.sin(q3)
+    c123 = c12*c3 - s12*s3
+    s123 = c12*s3 + c3*s12
+    t0 = c12 + c123
+    t1 = s12 + s123
+    t2 = c1 + t0
+    t3 = s1 + t1
+    t4 = qd1 + qd2
+    t5 = qd3*s123
+    t6 = t5 + qd2*t1
+    t7 = t6 + qd1*t3
+    t8 = c123*qd3
+    t9 = t8 + qd2*t0
+    t10 = t9 + qd1*t2
+    Jd = casadi.SX(6, 3)
+    Jd[0, 0] = -t10
+    Jd[0, 1] = -t9 - qd1*t0
+    Jd[0, 2] = -t8 - c123*t4
+    Jd[1, 0] = -t7
+    Jd[1, 1] = -t6 - qd1*t1
+    Jd[1, 2] = -t5 - s123*t4
+    return [Jd]
+
+
+def _bias_acceleration(q, q_dot):
+    """J' q_dot: the tool's classical linear and angular acceleration at zero joint acceleration, world frame (6): 53 operations."""
+    q1 = q[0]
+    q2 = q[1]
+    q3 = q[2]
+    qd1 = q_dot[0]
+    qd2 = q_dot[1]
+    qd3 = q_dot[2]
+    c1 = casadi.cos(q1)
+    s1 = casadi.sin(q1)
+    c2 = casadi.cos(q2)
+    s2 = casadi.sin(q2)
+    c12 = c1*c2 - s1*s2
+    s12 = c1*s2 + c2*s1
+    c3 = casadi.cos(q3)
+    s3 = casadi.sin(q3)
+    c123 = c12*c3 - s12*s3
+    s123 = c12*s3 + c3*s12
+    t0 = c12 + c123
+    t1 = s12 + s123
+    t2 = c1 + t0
+    t3 = s1 + t1
+    t4 = qd1 + qd2
+    t5 = qd3*s123
+    t6 = t5 + qd2*t1
+    t7 = t6 + qd1*t3
+    t8 = c123*qd3
+    t9 = t8 + qd2*t0
+    t10 = t9 + qd1*t2
+    a = casadi.SX(6, 1)
+    a[0, 0] = -qd1*t10 - qd2*(t9 + qd1*t0) - qd3*(t8 + c123*t4)
+    a[1, 0] = -qd1*t7 - qd2*(t6 + qd1*t1) - qd3*(t5 + s123*t4)
+    return [a]
+
+
+def _task_jacobian_dot(q, q_dot):
+    """D/dt of the analytic Jacobian along q_dot (3 x DOF): mu'' = J_a q'' + J_a' q': 47 operations."""
+    q1 = q[0]
+    q2 = q[1]
+    q3 = q[2]
+    qd1 = q_dot[0]
+    qd2 = q_dot[1]
+    qd3 = q_dot[2]
+    c1 = casadi.cos(q1)
+    s1 = casadi.sin(q1)
+    c2 = casadi.cos(q2)
+    s2 = casadi.sin(q2)
+    c12 = c1*c2 - s1*s2
+    s12 = c1*s2 + c2*s1
+    c3 = casadi.cos(q3)
+    s3 = casadi.sin(q3)
+    c123 = c12*c3 - s12*s3
+    s123 = c12*s3 + c3*s12
+    t0 = c12 + c123
+    t1 = s12 + s123
+    t2 = c1 + t0
+    t3 = s1 + t1
+    t4 = qd1 + qd2
+    t5 = qd3*s123
+    t6 = t5 + qd2*t1
+    t7 = t6 + qd1*t3
+    t8 = t6 + qd1*t1
+    t9 = t5 + s123*t4
+    t10 = c123*qd3
+    t11 = t10 + qd2*t0
+    t12 = t11 + qd1*t2
+    t13 = t11 + qd1*t0
+    t14 = t10 + c123*t4
+    Jd = casadi.SX(3, 3)
+    Jd[0, 0] = -t12
+    Jd[0, 1] = -t13
+    Jd[0, 2] = -t14
+    Jd[1, 0] = -t7
+    Jd[1, 1] = -t8
+    Jd[1, 2] = -t9
+    return [Jd]
+
+
+def _hessian(q):
+    """D J / d q_k for each k (DOF x 6 x DOF, indexed [k, r, c]): 28 operations."""
+    q1 = q[0]
+    q2 = q[1]
+    q3 = q[2]
+    c1 = casadi.cos(q1)
+    s1 = casadi.sin(q1)
+    c2 = casadi.cos(q2)
+    s2 = casadi.sin(q2)
+    c12 = c1*c2 - s1*s2
+    s12 = c1*s2 + c2*s1
+    c3 = casadi.cos(q3)
+    s3 = casadi.sin(q3)
+    c123 = c12*c3 - s12*s3
+    s123 = c12*s3 + c3*s12
+    t0 = c12 + c123
+    t1 = s12 + s123
+    t2 = c1 + t0
+    t3 = s1 + t1
+    t4 = -t0
+    t5 = -c123
+    t6 = -t1
+    t7 = -s123
+    H = casadi.SX(18, 3)
+    H[0, 0] = -t2
+    H[0, 1] = t4
+    H[0, 2] = t5
+    H[1, 0] = -t3
+    H[1, 1] = t6
+    H[1, 2] = t7
+    H[6, 0] = t4
+    H[6, 1] = t4
+    H[6, 2] = t5
+    H[7, 0] = t6
+    H[7, 1] = t6
+    H[7, 2] = t7
+    H[12, 0] = t5
+    H[12, 1] = t5
+    H[12, 2] = t5
+    H[13, 0] = t7
+    H[13, 1] = t7
+    H[13, 2] = t7
+    return [H]
 
 
 def _singularity_factors(q):
@@ -284,15 +501,15 @@ def _velocity_ik(q, mu_dot, damping):
     t4 = c123*s123 + t0*t1 + t2*t3
     t5 = s123 + t1 + t3
     t6 = t3**2
-    t7 = s123**2 + t1**2 + t6
+    t7 = t6 + s123**2 + t1**2
     t8 = t7
     t9 = t2**2
-    t10 = casadi.sqrt(t6 + t9 + 1)
+    t10 = casadi.sqrt(1 + t6 + t9)
     t11 = t10*casadi.if_else((t3 <= 0), 1, -1)
     t12 = casadi.if_else((t10 > 0), 1/(t10*(t10 + casadi.fabs(t3))), 0)
-    t13 = c123**2 + t0**2 + t9
+    t13 = t9 + c123**2 + t0**2
     t14 = t13
-    t15 = casadi.sqrt(t13 + t7 + 3)
+    t15 = casadi.sqrt(3 + t13 + t7)
     t16 = c123 + t0 + t2
     t17 = t16
     t18 = t4**2
@@ -304,13 +521,13 @@ def _velocity_ik(q, mu_dot, damping):
     t24 = t23*casadi.if_else((t21 >= 0), 1, -1)
     t25 = t21 + t24
     t26 = casadi.if_else((t23 > 0), 1/(t23*(t23 + casadi.fabs(t21))), 0)
-    t27 = -t26*(-mu_dot0*t25 + mu_dot1*t4 + mu_dot2*t5)
+    t27 = -t26*(mu_dot1*t4 + mu_dot2*t5 - mu_dot0*t25)
     t28 = mu_dot0 - t25*t27
     t29 = mu_dot1 + t27*t4
     t30 = mu_dot2 + t27*t5
     t31 = t14 + t20
     t32 = -t26*(t17*t5 + t25*t4 + t31*t4)
-    t33 = t25*t32 + t4
+    t33 = t4 + t25*t32
     t34 = t31 + t32*t4
     t35 = t17 + t32*t5
     t36 = casadi.sqrt(t34**2 + t35**2)
@@ -320,38 +537,38 @@ def _velocity_ik(q, mu_dot, damping):
     t40 = t39*(t29*t38 + t30*t35)
     t41 = t29 - t38*t40
     t42 = t30 - t35*t40
-    t43 = t20 + 3
-    t44 = casadi.sqrt(2*t17**2 + 2*t18 + 2*t19 + t22 + t31**2 + t43**2)
+    t43 = 3 + t20
+    t44 = casadi.sqrt(t22 + t31**2 + t43**2 + 2*t18 + 2*t19 + 2*t17**2)
     t45 = -t26*(t17*t4 + t25*t5 + t43*t5)
-    t46 = t25*t45 + t5
+    t46 = t5 + t25*t45
     t47 = t17 + t4*t45
     t48 = t43 + t45*t5
     t49 = t39*(t35*t48 + t38*t47)
-    t50 = -t38*t49 + t47
-    t51 = -t35*t49 + t48
+    t50 = t47 - t38*t49
+    t51 = t48 - t35*t49
     t52 = casadi.fabs(t51)
     t53 = t52
     t54 = t53*casadi.if_else((t51 >= 0), 1, -1)
     t55 = t51 + t54
     t56 = casadi.if_else((t53 > 0), 1/(t53*(t52 + t53)), 0)
-    t57 = -t42*t55**2*t56 + t42
+    t57 = t42 - t42*t56*t55**2
     t58 = casadi.if_else((t54 != 0), -t57/t54, 0)
     t59 = casadi.if_else((t37 != 0), -(t41 - t50*t58)/t37, 0)
     t60 = casadi.if_else((t24 != 0), -(t28 + t33*t59 + t46*t58)/t24, 0)
-    t61 = t2*t59 - t3*t60 + t58
-    t62 = t0*t59 - t1*t60 + t58
-    t63 = c123*t59 - s123*t60 + t58
+    t61 = t58 + t2*t59 - t3*t60
+    t62 = t58 + t0*t59 - t1*t60
+    t63 = t58 + c123*t59 - s123*t60
     t64 = -t3
     t65 = t11 + t64
-    t66 = t12*(t0*t2 - t1*t65 + 1)
+    t66 = t12*(1 + t0*t2 - t1*t65)
     t67 = t1 + t65*t66
     t68 = t0 - t2*t66
     t69 = 1 - t66
-    t70 = t12*(c123*t2 - s123*t65 + 1)
+    t70 = t12*(1 + c123*t2 - s123*t65)
     t71 = s123 + t65*t70
     t72 = c123 - t2*t70
     t73 = 1 - t70
-    t74 = t12*(mu_dot0*t65 + mu_dot1*t2 + mu_dot2)
+    t74 = t12*(mu_dot2 + mu_dot0*t65 + mu_dot1*t2)
     t75 = mu_dot0 - t65*t74
     t76 = mu_dot1 - t2*t74
     t77 = mu_dot2 - t74
@@ -361,20 +578,20 @@ def _velocity_ik(q, mu_dot, damping):
     t81 = casadi.if_else((t78 > 0), 1/(t78*(t78 + casadi.fabs(t68))), 0)
     t82 = t81*(t69*t73 + t72*t80)
     t83 = t72 - t80*t82
-    t84 = -t69*t82 + t73
+    t84 = t73 - t69*t82
     t85 = t81*(t69*t77 + t76*t80)
     t86 = t76 - t80*t85
-    t87 = -t69*t85 + t77
-    t88 = damping + mu_dot0 + mu_dot1 + mu_dot2 + q1 + q2 + q3 - s123 - t1 + t16 + t64 + 3
+    t87 = t77 - t69*t85
+    t88 = 3 + damping + mu_dot0 + mu_dot1 + mu_dot2 + q1 + q2 + q3 + t16 + t64 - s123 - t1
     t89 = casadi.fabs(t84)
     t90 = t89
     t91 = t90*casadi.if_else((t84 >= 0), 1, -1)
     t92 = t84 + t91
     t93 = casadi.if_else((t90 > 0), 1/(t90*(t89 + t90)), 0)
-    t94 = -t87*t92**2*t93 + t87
+    t94 = t87 - t87*t93*t92**2
     t95 = casadi.if_else((t91 != 0), -t94/t91, 0)
-    t96 = casadi.if_else((t79 != 0), -(-t83*t95 + t86)/t79, 0)
-    t97 = casadi.if_else((t11 != 0), -(t67*t96 + t71*t95 + t75)/t11, 0)
+    t96 = casadi.if_else((t79 != 0), -(t86 - t83*t95)/t79, 0)
+    t97 = casadi.if_else((t11 != 0), -(t75 + t67*t96 + t71*t95)/t11, 0)
     t98 = (damping > 0)
     t99 = (casadi.fabs(t88) < casadi.inf)
     t100 = (damping >= 0)
@@ -425,22 +642,22 @@ def _ik_numeric_step(target, q, damping):
     t10 = mu1 - t3
     t11 = mu0 + mu1 + mu2 + qs1 + qs2 + qs3
     t12 = -mu2 + casadi.atan2(s123, c123)
-    t13 = t12 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t12 - 0.5)
+    t13 = t12 + 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t12)
     t14 = t10**2 + t13**2 + t9**2
     t15 = damping + t4
     t16 = casadi.sqrt(t15**2 + t5**2 + t6**2)
     t17 = t16*casadi.if_else((t15 >= 0), 1, -1)
     t18 = t15 + t17
     t19 = casadi.if_else((t16 > 0), 1/(t16*(t16 + casadi.fabs(t15))), 0)
-    t20 = t19*(-t10*t5 + t13*t6 + t18*t9)
-    t21 = -t18*t20 + t9
+    t20 = t19*(t13*t6 + t18*t9 - t10*t5)
+    t21 = t9 - t18*t20
     t22 = t10 + t20*t5
     t23 = -t13 + t20*t6
     t24 = damping + t7
     t25 = -t19*(t18*t5 + t24*t5 + t6*t8)
-    t26 = t18*t25 + t5
+    t26 = t5 + t18*t25
     t27 = t24 + t25*t5
-    t28 = t25*t6 + t8
+    t28 = t8 + t25*t6
     t29 = casadi.sqrt(t27**2 + t28**2)
     t30 = t29*casadi.if_else((t27 >= 0), 1, -1)
     t31 = t27 + t30
@@ -448,26 +665,26 @@ def _ik_numeric_step(target, q, damping):
     t33 = t32*(t22*t31 + t23*t28)
     t34 = t22 - t31*t33
     t35 = t23 - t28*t33
-    t36 = damping + 3
+    t36 = 3 + damping
     t37 = -t19*(t18*t6 + t36*t6 + t5*t8)
-    t38 = t18*t37 + t6
-    t39 = t37*t5 + t8
+    t38 = t6 + t18*t37
+    t39 = t8 + t37*t5
     t40 = t36 + t37*t6
     t41 = t32*(t28*t40 + t31*t39)
-    t42 = -t31*t41 + t39
-    t43 = -t28*t41 + t40
+    t42 = t39 - t31*t41
+    t43 = t40 - t28*t41
     t44 = casadi.fabs(t43)
     t45 = t44
     t46 = t45*casadi.if_else((t43 >= 0), 1, -1)
     t47 = t43 + t46
     t48 = casadi.if_else((t45 > 0), 1/(t45*(t44 + t45)), 0)
-    t49 = -t35*t47**2*t48 + t35
+    t49 = t35 - t35*t48*t47**2
     t50 = casadi.if_else((t46 != 0), -t49/t46, 0)
     t51 = casadi.if_else((t30 != 0), -(t34 - t42*t50)/t30, 0)
     t52 = casadi.if_else((t17 != 0), -(t21 + t26*t51 + t38*t50)/t17, 0)
-    t53 = q1 + t2*t51 - t3*t52 + t50
-    t54 = q2 + t0*t51 - t1*t52 + t50
-    t55 = c123*t51 + q3 - s123*t52 + t50
+    t53 = q1 + t50 + t2*t51 - t3*t52
+    t54 = q2 + t50 + t0*t51 - t1*t52
+    t55 = q3 + t50 + c123*t51 - s123*t52
     q_start = casadi.SX(3, 1)
     q_start[0, 0] = q1
     q_start[1, 0] = q2
@@ -501,24 +718,24 @@ def _ik_branches(mu):
     t12 = casadi.atan2(t11, t10)
     t13 = 3.141592653589793 - t12
     t14 = False
-    t15 = casadi.if_else(t14, 0, t12 + 3.141592653589793)
+    t15 = casadi.if_else(t14, 0, 3.141592653589793 + t12)
     t16 = casadi.if_else(t14, 0, -t11)
     t17 = -t10
     t18 = casadi.if_else(t14, 1, t17)
-    t19 = t18 + 1
+    t19 = 1 + t18
     t20 = t16*t3 + t19*t2
-    t21 = -t16*t2 + t19*t3
+    t21 = t19*t3 - t16*t2
     t22 = t20**2 + t21**2
     t23 = t16**2 + t19**2
-    t24 = t17 + 1
+    t24 = 1 + t17
     t25 = t11*t3 + t2*t24
-    t26 = -t11*t2 + t24*t3
+    t26 = t24*t3 - t11*t2
     t27 = t25**2 + t26**2
     t28 = t11**2 + t24**2
     t29 = 1e-24*t4
     t30 = casadi.if_else((t22 <= t23*t29), 0, casadi.atan2(t21, t20))
     t31 = -mu2
-    t32 = t31 + 3.141592653589793
+    t32 = 3.141592653589793 + t31
     t33 = t15 + t30
     t34 = casadi.if_else((t27 <= t28*t29), 0, casadi.atan2(t26, t25))
     t35 = t13 + t34
@@ -526,10 +743,10 @@ def _ik_branches(mu):
     t37 = True
     q = casadi.SX(2, 3)
     q[0, 0] = t30
-    q[0, 1] = t15 - 6.283185307179586*casadi.ceil(0.15915494309189535*t15 - 0.5)
+    q[0, 1] = t15 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t15)
     q[0, 2] = -t31 - t33 - 6.283185307179586*casadi.ceil(-0.15915494309189535*t32 - 0.15915494309189535*t33)
     q[1, 0] = t34
-    q[1, 1] = t13 - 6.283185307179586*casadi.ceil(0.15915494309189535*t13 - 0.5)
+    q[1, 1] = t13 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t13)
     q[1, 2] = -t31 - t35 - 6.283185307179586*casadi.ceil(-0.15915494309189535*t32 - 0.15915494309189535*t35)
     valid = casadi.SX(2, 1)
     valid[0, 0] = casadi.logic_and(casadi.logic_and(t36, t37), (t8 >= -1e-12))
@@ -538,6 +755,7 @@ def _ik_branches(mu):
 
 
 _q = casadi.SX.sym("q", 3, 1)
+_q_dot = casadi.SX.sym("q_dot", 3, 1)
 _mu_dot = casadi.SX.sym("mu_dot", 3, 1)
 _damping = casadi.SX.sym("damping", 1, 1)
 _target = casadi.SX.sym("target", 3, 1)
@@ -548,6 +766,11 @@ fk_jacobian = casadi.Function("fk_jacobian", [_q], _fk_jacobian(_q), ["q"], ["T"
 jacobian_tool = casadi.Function("jacobian_tool", [_q], _jacobian_tool(_q), ["q"], ["J"])
 task = casadi.Function("task", [_q], _task(_q), ["q"], ["mu"])
 task_jacobian = casadi.Function("task_jacobian", [_q], _task_jacobian(_q), ["q"], ["J"])
+fk_jacobian_dot = casadi.Function("fk_jacobian_dot", [_q, _q_dot], _fk_jacobian_dot(_q, _q_dot), ["q", "q_dot"], ["T", "J", "a"])
+jacobian_dot = casadi.Function("jacobian_dot", [_q, _q_dot], _jacobian_dot(_q, _q_dot), ["q", "q_dot"], ["Jd"])
+bias_acceleration = casadi.Function("bias_acceleration", [_q, _q_dot], _bias_acceleration(_q, _q_dot), ["q", "q_dot"], ["a"])
+task_jacobian_dot = casadi.Function("task_jacobian_dot", [_q, _q_dot], _task_jacobian_dot(_q, _q_dot), ["q", "q_dot"], ["Jd"])
+hessian = casadi.Function("hessian", [_q], _hessian(_q), ["q"], ["H"])
 singularity_factors = casadi.Function("singularity_factors", [_q], _singularity_factors(_q), ["q"], ["f"])
 manipulability = casadi.Function("manipulability", [_q], _manipulability(_q), ["q"], ["w"])
 jacobian_det = casadi.Function("jacobian_det", [_q], _jacobian_det(_q), ["q"], ["d"])
@@ -596,4 +819,4 @@ ik_numeric = casadi.Function("ik_numeric", _inputs, _ik_numeric(*_inputs), ["tar
 
 def functions():
     """All functions by name."""
-    return {"fk": fk, "jacobian": jacobian, "fk_jacobian": fk_jacobian, "jacobian_tool": jacobian_tool, "task": task, "task_jacobian": task_jacobian, "singularity_factors": singularity_factors, "manipulability": manipulability, "jacobian_det": jacobian_det, "velocity_ik": velocity_ik, "ik_numeric_step": ik_numeric_step, "ik_branches": ik_branches}
+    return {"fk": fk, "jacobian": jacobian, "fk_jacobian": fk_jacobian, "jacobian_tool": jacobian_tool, "task": task, "task_jacobian": task_jacobian, "fk_jacobian_dot": fk_jacobian_dot, "jacobian_dot": jacobian_dot, "bias_acceleration": bias_acceleration, "task_jacobian_dot": task_jacobian_dot, "hessian": hessian, "singularity_factors": singularity_factors, "manipulability": manipulability, "jacobian_det": jacobian_det, "velocity_ik": velocity_ik, "ik_numeric_step": ik_numeric_step, "ik_branches": ik_branches}

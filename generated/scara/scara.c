@@ -23,11 +23,11 @@ void scara_fk(const scara_real q[SCARA_DOF], scara_real T[16])
     const scara_real s12 = c1*s2 + c2*s1;
     const scara_real c4 = cos(q4);
     const scara_real s4 = sin(q4);
-    const scara_real t0 = 0.325*c1 + 0.275*c12;
-    const scara_real t1 = 0.325*s1 + 0.275*s12;
+    const scara_real t0 = 0.275*c12 + 0.325*c1;
+    const scara_real t1 = 0.275*s12 + 0.325*s1;
     const scara_real t2 = 0.387 - q3;
     const scara_real t3 = c12*c4 + s12*s4;
-    const scara_real t4 = -c12*s4 + c4*s12;
+    const scara_real t4 = c4*s12 - c12*s4;
 
     /* Outputs */
     T[0] = t3;
@@ -64,9 +64,9 @@ void scara_jacobian(const scara_real q[SCARA_DOF], scara_real J[6 * SCARA_DOF])
     const scara_real c12 = c1*c2 - s1*s2;
     const scara_real s12 = c1*s2 + c2*s1;
     const scara_real t0 = 0.275*c12;
-    const scara_real t1 = 0.325*c1 + t0;
+    const scara_real t1 = t0 + 0.325*c1;
     const scara_real t2 = 0.275*s12;
-    const scara_real t3 = 0.325*s1 + t2;
+    const scara_real t3 = t2 + 0.325*s1;
 
     /* Outputs */
     J[0] = -t3;
@@ -116,11 +116,11 @@ void scara_fk_jacobian(const scara_real q[SCARA_DOF], scara_real T[16], scara_re
     const scara_real s4 = sin(q4);
     const scara_real t0 = 0.387 - q3;
     const scara_real t1 = c12*c4 + s12*s4;
-    const scara_real t2 = -c12*s4 + c4*s12;
+    const scara_real t2 = c4*s12 - c12*s4;
     const scara_real t3 = 0.275*c12;
-    const scara_real t4 = 0.325*c1 + t3;
+    const scara_real t4 = t3 + 0.325*c1;
     const scara_real t5 = 0.275*s12;
-    const scara_real t6 = 0.325*s1 + t5;
+    const scara_real t6 = t5 + 0.325*s1;
 
     /* Outputs */
     T[0] = t1;
@@ -184,15 +184,15 @@ void scara_jacobian_tool(const scara_real q[SCARA_DOF], scara_real J[6 * SCARA_D
     const scara_real c4 = cos(q4);
     const scara_real s4 = sin(q4);
     const scara_real t0 = c12*c4 + s12*s4;
-    const scara_real t1 = -c12*s4 + c4*s12;
+    const scara_real t1 = c4*s12 - c12*s4;
     const scara_real t2 = 0.275*c12;
-    const scara_real t3 = 0.325*c1 + t2;
+    const scara_real t3 = t2 + 0.325*c1;
     const scara_real t4 = 0.275*s12;
-    const scara_real t5 = 0.325*s1 + t4;
+    const scara_real t5 = t4 + 0.325*s1;
 
     /* Outputs */
-    J[0] = -t0*t5 + t1*t3;
-    J[1] = -t0*t4 + t1*t2;
+    J[0] = t1*t3 - t0*t5;
+    J[1] = t1*t2 - t0*t4;
     J[2] = 0;
     J[3] = 0;
     J[4] = -t0*t3 - t1*t5;
@@ -236,11 +236,11 @@ void scara_task(const scara_real q[SCARA_DOF], scara_real mu[SCARA_TASK_DIM])
     const scara_real s12 = c1*s2 + c2*s1;
     const scara_real c4 = cos(q4);
     const scara_real s4 = sin(q4);
-    const scara_real t0 = 0.325*c1 + 0.275*c12;
-    const scara_real t1 = 0.325*s1 + 0.275*s12;
+    const scara_real t0 = 0.275*c12 + 0.325*c1;
+    const scara_real t1 = 0.275*s12 + 0.325*s1;
     const scara_real t2 = 0.387 - q3;
     const scara_real t3 = c12*c4 + s12*s4;
-    const scara_real t4 = -c12*s4 + c4*s12;
+    const scara_real t4 = c4*s12 - c12*s4;
 
     /* Outputs */
     mu[0] = t0;
@@ -265,9 +265,9 @@ void scara_task_jacobian(const scara_real q[SCARA_DOF], scara_real J[SCARA_TASK_
     const scara_real c12 = c1*c2 - s1*s2;
     const scara_real s12 = c1*s2 + c2*s1;
     const scara_real t0 = 0.275*c12;
-    const scara_real t1 = 0.325*c1 + t0;
+    const scara_real t1 = t0 + 0.325*c1;
     const scara_real t2 = 0.275*s12;
-    const scara_real t3 = 0.325*s1 + t2;
+    const scara_real t3 = t2 + 0.325*s1;
 
     /* Outputs */
     J[0] = -t3;
@@ -286,6 +286,344 @@ void scara_task_jacobian(const scara_real q[SCARA_DOF], scara_real J[SCARA_TASK_
     J[13] = 1;
     J[14] = 0;
     J[15] = -1;
+}
+
+void scara_fk_jacobian_dot(const scara_real q[SCARA_DOF], const scara_real q_dot[SCARA_DOF], scara_real T[16], scara_real J[6 * SCARA_DOF], scara_real a[6])
+{
+    /* 49 operations */
+
+    /* Inputs */
+    const scara_real q1 = q[0];
+    const scara_real q2 = q[1];
+    const scara_real q3 = q[2];
+    const scara_real q4 = q[3];
+    const scara_real qd1 = q_dot[0];
+    const scara_real qd2 = q_dot[1];
+
+    /* Intermediate terms */
+    const scara_real c1 = cos(q1);
+    const scara_real s1 = sin(q1);
+    const scara_real c2 = cos(q2);
+    const scara_real s2 = sin(q2);
+    const scara_real c12 = c1*c2 - s1*s2;
+    const scara_real s12 = c1*s2 + c2*s1;
+    const scara_real c4 = cos(q4);
+    const scara_real s4 = sin(q4);
+    const scara_real t0 = 0.387 - q3;
+    const scara_real t1 = c12*c4 + s12*s4;
+    const scara_real t2 = c4*s12 - c12*s4;
+    const scara_real t3 = 0.275*c12;
+    const scara_real t4 = t3 + 0.325*c1;
+    const scara_real t5 = 0.275*s12;
+    const scara_real t6 = t5 + 0.325*s1;
+    const scara_real t7 = qd2*t5;
+    const scara_real t8 = t7 + qd1*t6;
+    const scara_real t9 = qd2*t3;
+    const scara_real t10 = t9 + qd1*t4;
+
+    /* Outputs */
+    T[0] = t1;
+    T[1] = t2;
+    T[2] = 0;
+    T[3] = t4;
+    T[4] = t2;
+    T[5] = -t1;
+    T[6] = 0;
+    T[7] = t6;
+    T[8] = 0;
+    T[9] = 0;
+    T[10] = -1;
+    T[11] = t0;
+    T[12] = 0;
+    T[13] = 0;
+    T[14] = 0;
+    T[15] = 1;
+    J[0] = -t6;
+    J[1] = -t5;
+    J[2] = 0;
+    J[3] = 0;
+    J[4] = t4;
+    J[5] = t3;
+    J[6] = 0;
+    J[7] = 0;
+    J[8] = 0;
+    J[9] = 0;
+    J[10] = -1;
+    J[11] = 0;
+    J[12] = 0;
+    J[13] = 0;
+    J[14] = 0;
+    J[15] = 0;
+    J[16] = 0;
+    J[17] = 0;
+    J[18] = 0;
+    J[19] = 0;
+    J[20] = 1;
+    J[21] = 1;
+    J[22] = 0;
+    J[23] = -1;
+    a[0] = -qd1*t10 - qd2*(t9 + qd1*t3);
+    a[1] = -qd1*t8 - qd2*(t7 + qd1*t5);
+    a[2] = 0;
+    a[3] = 0;
+    a[4] = 0;
+    a[5] = 0;
+}
+
+void scara_jacobian_dot(const scara_real q[SCARA_DOF], const scara_real q_dot[SCARA_DOF], scara_real Jd[6 * SCARA_DOF])
+{
+    /* 30 operations */
+
+    /* Inputs */
+    const scara_real q1 = q[0];
+    const scara_real q2 = q[1];
+    const scara_real qd1 = q_dot[0];
+    const scara_real qd2 = q_dot[1];
+
+    /* Intermediate terms */
+    const scara_real c1 = cos(q1);
+    const scara_real s1 = sin(q1);
+    const scara_real c2 = cos(q2);
+    const scara_real s2 = sin(q2);
+    const scara_real c12 = c1*c2 - s1*s2;
+    const scara_real s12 = c1*s2 + c2*s1;
+    const scara_real t0 = 0.275*c12;
+    const scara_real t1 = t0 + 0.325*c1;
+    const scara_real t2 = 0.275*s12;
+    const scara_real t3 = t2 + 0.325*s1;
+    const scara_real t4 = qd2*t2;
+    const scara_real t5 = t4 + qd1*t3;
+    const scara_real t6 = qd2*t0;
+    const scara_real t7 = t6 + qd1*t1;
+
+    /* Outputs */
+    Jd[0] = -t7;
+    Jd[1] = -t6 - qd1*t0;
+    Jd[2] = 0;
+    Jd[3] = 0;
+    Jd[4] = -t5;
+    Jd[5] = -t4 - qd1*t2;
+    Jd[6] = 0;
+    Jd[7] = 0;
+    Jd[8] = 0;
+    Jd[9] = 0;
+    Jd[10] = 0;
+    Jd[11] = 0;
+    Jd[12] = 0;
+    Jd[13] = 0;
+    Jd[14] = 0;
+    Jd[15] = 0;
+    Jd[16] = 0;
+    Jd[17] = 0;
+    Jd[18] = 0;
+    Jd[19] = 0;
+    Jd[20] = 0;
+    Jd[21] = 0;
+    Jd[22] = 0;
+    Jd[23] = 0;
+}
+
+void scara_bias_acceleration(const scara_real q[SCARA_DOF], const scara_real q_dot[SCARA_DOF], scara_real a[6])
+{
+    /* 34 operations */
+
+    /* Inputs */
+    const scara_real q1 = q[0];
+    const scara_real q2 = q[1];
+    const scara_real qd1 = q_dot[0];
+    const scara_real qd2 = q_dot[1];
+
+    /* Intermediate terms */
+    const scara_real c1 = cos(q1);
+    const scara_real s1 = sin(q1);
+    const scara_real c2 = cos(q2);
+    const scara_real s2 = sin(q2);
+    const scara_real c12 = c1*c2 - s1*s2;
+    const scara_real s12 = c1*s2 + c2*s1;
+    const scara_real t0 = 0.275*c12;
+    const scara_real t1 = t0 + 0.325*c1;
+    const scara_real t2 = 0.275*s12;
+    const scara_real t3 = t2 + 0.325*s1;
+    const scara_real t4 = qd2*t2;
+    const scara_real t5 = t4 + qd1*t3;
+    const scara_real t6 = qd2*t0;
+    const scara_real t7 = t6 + qd1*t1;
+
+    /* Outputs */
+    a[0] = -qd1*t7 - qd2*(t6 + qd1*t0);
+    a[1] = -qd1*t5 - qd2*(t4 + qd1*t2);
+    a[2] = 0;
+    a[3] = 0;
+    a[4] = 0;
+    a[5] = 0;
+}
+
+void scara_task_jacobian_dot(const scara_real q[SCARA_DOF], const scara_real q_dot[SCARA_DOF], scara_real Jd[SCARA_TASK_DIM * SCARA_DOF])
+{
+    /* 30 operations */
+
+    /* Inputs */
+    const scara_real q1 = q[0];
+    const scara_real q2 = q[1];
+    const scara_real qd1 = q_dot[0];
+    const scara_real qd2 = q_dot[1];
+
+    /* Intermediate terms */
+    const scara_real c1 = cos(q1);
+    const scara_real s1 = sin(q1);
+    const scara_real c2 = cos(q2);
+    const scara_real s2 = sin(q2);
+    const scara_real c12 = c1*c2 - s1*s2;
+    const scara_real s12 = c1*s2 + c2*s1;
+    const scara_real t0 = 0.275*c12;
+    const scara_real t1 = t0 + 0.325*c1;
+    const scara_real t2 = 0.275*s12;
+    const scara_real t3 = t2 + 0.325*s1;
+    const scara_real t4 = qd2*t2;
+    const scara_real t5 = t4 + qd1*t3;
+    const scara_real t6 = t4 + qd1*t2;
+    const scara_real t7 = qd2*t0;
+    const scara_real t8 = t7 + qd1*t1;
+    const scara_real t9 = t7 + qd1*t0;
+
+    /* Outputs */
+    Jd[0] = -t8;
+    Jd[1] = -t9;
+    Jd[2] = 0;
+    Jd[3] = 0;
+    Jd[4] = -t5;
+    Jd[5] = -t6;
+    Jd[6] = 0;
+    Jd[7] = 0;
+    Jd[8] = 0;
+    Jd[9] = 0;
+    Jd[10] = 0;
+    Jd[11] = 0;
+    Jd[12] = 0;
+    Jd[13] = 0;
+    Jd[14] = 0;
+    Jd[15] = 0;
+}
+
+void scara_hessian(const scara_real q[SCARA_DOF], scara_real H[SCARA_DOF * 6 * SCARA_DOF])
+{
+    /* 20 operations */
+
+    /* Inputs */
+    const scara_real q1 = q[0];
+    const scara_real q2 = q[1];
+
+    /* Intermediate terms */
+    const scara_real c1 = cos(q1);
+    const scara_real s1 = sin(q1);
+    const scara_real c2 = cos(q2);
+    const scara_real s2 = sin(q2);
+    const scara_real c12 = c1*c2 - s1*s2;
+    const scara_real s12 = c1*s2 + c2*s1;
+    const scara_real t0 = 0.275*c12;
+    const scara_real t1 = t0 + 0.325*c1;
+    const scara_real t2 = 0.275*s12;
+    const scara_real t3 = t2 + 0.325*s1;
+    const scara_real t4 = -t0;
+    const scara_real t5 = -t2;
+
+    /* Outputs */
+    H[0] = -t1;
+    H[1] = t4;
+    H[2] = 0;
+    H[3] = 0;
+    H[4] = -t3;
+    H[5] = t5;
+    H[6] = 0;
+    H[7] = 0;
+    H[8] = 0;
+    H[9] = 0;
+    H[10] = 0;
+    H[11] = 0;
+    H[12] = 0;
+    H[13] = 0;
+    H[14] = 0;
+    H[15] = 0;
+    H[16] = 0;
+    H[17] = 0;
+    H[18] = 0;
+    H[19] = 0;
+    H[20] = 0;
+    H[21] = 0;
+    H[22] = 0;
+    H[23] = 0;
+    H[24] = t4;
+    H[25] = t4;
+    H[26] = 0;
+    H[27] = 0;
+    H[28] = t5;
+    H[29] = t5;
+    H[30] = 0;
+    H[31] = 0;
+    H[32] = 0;
+    H[33] = 0;
+    H[34] = 0;
+    H[35] = 0;
+    H[36] = 0;
+    H[37] = 0;
+    H[38] = 0;
+    H[39] = 0;
+    H[40] = 0;
+    H[41] = 0;
+    H[42] = 0;
+    H[43] = 0;
+    H[44] = 0;
+    H[45] = 0;
+    H[46] = 0;
+    H[47] = 0;
+    H[48] = 0;
+    H[49] = 0;
+    H[50] = 0;
+    H[51] = 0;
+    H[52] = 0;
+    H[53] = 0;
+    H[54] = 0;
+    H[55] = 0;
+    H[56] = 0;
+    H[57] = 0;
+    H[58] = 0;
+    H[59] = 0;
+    H[60] = 0;
+    H[61] = 0;
+    H[62] = 0;
+    H[63] = 0;
+    H[64] = 0;
+    H[65] = 0;
+    H[66] = 0;
+    H[67] = 0;
+    H[68] = 0;
+    H[69] = 0;
+    H[70] = 0;
+    H[71] = 0;
+    H[72] = 0;
+    H[73] = 0;
+    H[74] = 0;
+    H[75] = 0;
+    H[76] = 0;
+    H[77] = 0;
+    H[78] = 0;
+    H[79] = 0;
+    H[80] = 0;
+    H[81] = 0;
+    H[82] = 0;
+    H[83] = 0;
+    H[84] = 0;
+    H[85] = 0;
+    H[86] = 0;
+    H[87] = 0;
+    H[88] = 0;
+    H[89] = 0;
+    H[90] = 0;
+    H[91] = 0;
+    H[92] = 0;
+    H[93] = 0;
+    H[94] = 0;
+    H[95] = 0;
 }
 
 void scara_singularity_factors(const scara_real q[SCARA_DOF], scara_real f[SCARA_NUM_SINGULARITY_FACTORS])
@@ -318,10 +656,10 @@ scara_real scara_manipulability(const scara_real q[SCARA_DOF])
     const scara_real c12 = c1*c2 - s1*s2;
     const scara_real s12 = c1*s2 + c2*s1;
     const scara_real t0 = 0.275*c12;
-    const scara_real t1 = 0.325*c1 + t0;
+    const scara_real t1 = t0 + 0.325*c1;
     const scara_real t2 = 0.275*s12;
-    const scara_real t3 = 0.325*s1 + t2;
-    const scara_real t4 = -t0*t3 + t1*t2;
+    const scara_real t3 = t2 + 0.325*s1;
+    const scara_real t4 = t1*t2 - t0*t3;
 
     /* Outputs */
     return fabs(t4);
@@ -343,12 +681,12 @@ scara_real scara_jacobian_det(const scara_real q[SCARA_DOF])
     const scara_real c12 = c1*c2 - s1*s2;
     const scara_real s12 = c1*s2 + c2*s1;
     const scara_real t0 = 0.275*c12;
-    const scara_real t1 = 0.325*c1 + t0;
+    const scara_real t1 = t0 + 0.325*c1;
     const scara_real t2 = 0.275*s12;
-    const scara_real t3 = 0.325*s1 + t2;
+    const scara_real t3 = t2 + 0.325*s1;
 
     /* Outputs */
-    return -t0*t3 + t1*t2;
+    return t1*t2 - t0*t3;
 }
 
 int scara_velocity_ik(const scara_real q[SCARA_DOF], const scara_real mu_dot[SCARA_TASK_DIM], scara_real damping, scara_real q_dot[SCARA_DOF])
@@ -373,22 +711,22 @@ int scara_velocity_ik(const scara_real q[SCARA_DOF], const scara_real mu_dot[SCA
     const scara_real c12 = c1*c2 - s1*s2;
     const scara_real s12 = c1*s2 + c2*s1;
     const scara_real t0 = 0.275*c12;
-    const scara_real t1 = 0.325*c1 + t0;
+    const scara_real t1 = t0 + 0.325*c1;
     const scara_real t2 = 0.275*s12;
-    const scara_real t3 = 0.325*s1 + t2;
-    const scara_real t4 = 0.075625*c12*s12 + t1*t3;
+    const scara_real t3 = t2 + 0.325*s1;
+    const scara_real t4 = t1*t3 + 0.075625*c12*s12;
     const scara_real t5 = t2 + t3;
     const scara_real t6 = (t3*t3);
     const scara_real t7 = t6 + 0.075625*(s12*s12);
     const scara_real t8 = t7;
     const scara_real t9 = (t1*t1);
-    const scara_real t10 = sqrt(t6 + t9 + 1);
+    const scara_real t10 = sqrt(1 + t6 + t9);
     const scara_real t11 = t10*(t3 <= 0 ? 1 : -1);
     const scara_real t12 = (t10 > 0 ? 1/(t10*(t10 + fabs(t3))) : 0);
-    const scara_real t13 = t12 - 1;
+    const scara_real t13 = -1 + t12;
     const scara_real t14 = t9 + 0.075625*(c12*c12);
     const scara_real t15 = t14;
-    const scara_real t16 = sqrt(t14 + t7 + 4);
+    const scara_real t16 = sqrt(4 + t14 + t7);
     const scara_real t17 = t0 + t1;
     const scara_real t18 = t17;
     const scara_real t19 = (t4*t4);
@@ -400,13 +738,13 @@ int scara_velocity_ik(const scara_real q[SCARA_DOF], const scara_real mu_dot[SCA
     const scara_real t25 = t24*(t22 >= 0 ? 1 : -1);
     const scara_real t26 = t22 + t25;
     const scara_real t27 = (t24 > 0 ? 1/(t24*(t24 + fabs(t22))) : 0);
-    const scara_real t28 = -t27*(-mu_dot0*t26 + mu_dot1*t4 + mu_dot3*t5);
+    const scara_real t28 = -t27*(mu_dot1*t4 + mu_dot3*t5 - mu_dot0*t26);
     const scara_real t29 = mu_dot0 - t26*t28;
     const scara_real t30 = mu_dot1 + t28*t4;
     const scara_real t31 = mu_dot3 + t28*t5;
     const scara_real t32 = t15 + t21;
     const scara_real t33 = -t27*(t18*t5 + t26*t4 + t32*t4);
-    const scara_real t34 = t26*t33 + t4;
+    const scara_real t34 = t4 + t26*t33;
     const scara_real t35 = t32 + t33*t4;
     const scara_real t36 = t18 + t33*t5;
     const scara_real t37 = sqrt((t35*t35) + (t36*t36));
@@ -416,42 +754,42 @@ int scara_velocity_ik(const scara_real q[SCARA_DOF], const scara_real mu_dot[SCA
     const scara_real t41 = t40*(t30*t39 + t31*t36);
     const scara_real t42 = t30 - t39*t41;
     const scara_real t43 = t31 - t36*t41;
-    const scara_real t44 = t21 + 1;
+    const scara_real t44 = 1 + t21;
     const scara_real t45 = t44;
-    const scara_real t46 = t21 + 3;
-    const scara_real t47 = sqrt(2*t19 + 2*t20 + t23 + 2*(t18*t18) + (t32*t32) + (t44*t44) + (t46*t46));
+    const scara_real t46 = 3 + t21;
+    const scara_real t47 = sqrt(t23 + 2*t19 + 2*t20 + 2*(t18*t18) + (t32*t32) + (t44*t44) + (t46*t46));
     const scara_real t48 = -t27*(t18*t4 + t26*t5 + t46*t5);
-    const scara_real t49 = t26*t48 + t5;
+    const scara_real t49 = t5 + t26*t48;
     const scara_real t50 = t18 + t4*t48;
     const scara_real t51 = t46 + t48*t5;
     const scara_real t52 = t40*(t36*t51 + t39*t50);
-    const scara_real t53 = -t39*t52 + t50;
-    const scara_real t54 = -t36*t52 + t51;
+    const scara_real t53 = t50 - t39*t52;
+    const scara_real t54 = t51 - t36*t52;
     const scara_real t55 = fabs(t45);
     const scara_real t56 = t55;
     const scara_real t57 = t56*(t45 >= 0 ? 1 : -1);
     const scara_real t58 = t45 + t57;
     const scara_real t59 = (t56 > 0 ? 1/(t56*(t55 + t56)) : 0);
-    const scara_real t60 = -mu_dot2*t59*(t58*t58) + mu_dot2;
+    const scara_real t60 = mu_dot2 - mu_dot2*t59*(t58*t58);
     const scara_real t61 = (t57 != 0 ? -t60/t57 : 0);
     const scara_real t62 = fabs(t54);
     const scara_real t63 = t62;
     const scara_real t64 = t63*(t54 >= 0 ? 1 : -1);
     const scara_real t65 = t54 + t64;
     const scara_real t66 = (t63 > 0 ? 1/(t63*(t62 + t63)) : 0);
-    const scara_real t67 = -t43*t66*(t65*t65) + t43;
+    const scara_real t67 = t43 - t43*t66*(t65*t65);
     const scara_real t68 = (t64 != 0 ? -t67/t64 : 0);
     const scara_real t69 = (t38 != 0 ? -(t42 - t53*t68)/t38 : 0);
     const scara_real t70 = (t25 != 0 ? -(t29 + t34*t69 + t49*t68)/t25 : 0);
-    const scara_real t71 = t1*t69 - t3*t70 + t68;
-    const scara_real t72 = t0*t69 - t2*t70 + t68;
+    const scara_real t71 = t68 + t1*t69 - t3*t70;
+    const scara_real t72 = t68 + t0*t69 - t2*t70;
     const scara_real t73 = -t3;
     const scara_real t74 = t11 + t73;
-    const scara_real t75 = t12*(t0*t1 - t2*t74 + 1);
+    const scara_real t75 = t12*(1 + t0*t1 - t2*t74);
     const scara_real t76 = t2 + t74*t75;
     const scara_real t77 = t0 - t1*t75;
     const scara_real t78 = 1 - t75;
-    const scara_real t79 = t12*(mu_dot0*t74 + mu_dot1*t1 + mu_dot3);
+    const scara_real t79 = t12*(mu_dot3 + mu_dot0*t74 + mu_dot1*t1);
     const scara_real t80 = mu_dot0 - t74*t79;
     const scara_real t81 = mu_dot1 - t1*t79;
     const scara_real t82 = mu_dot3 - t79;
@@ -461,21 +799,21 @@ int scara_velocity_ik(const scara_real q[SCARA_DOF], const scara_real mu_dot[SCA
     const scara_real t86 = (t83 > 0 ? 1/(t83*(t83 + fabs(t77))) : 0);
     const scara_real t87 = t86*(t78*t82 + t81*t85);
     const scara_real t88 = t81 - t85*t87;
-    const scara_real t89 = -t78*t87 + t82;
-    const scara_real t90 = damping + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + q1 + q2 + q3 + q4 + t17 - t2 + t73;
+    const scara_real t89 = t82 - t78*t87;
+    const scara_real t90 = damping + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + q1 + q2 + q3 + q4 + t17 + t73 - t2;
     const scara_real t91 = t1*t12;
     const scara_real t92 = t86*(t13*t78 + t85*t91);
-    const scara_real t93 = -t85*t92 + t91;
+    const scara_real t93 = t91 - t85*t92;
     const scara_real t94 = t13 - t78*t92;
     const scara_real t95 = fabs(t94);
     const scara_real t96 = t95;
     const scara_real t97 = t96*(t94 >= 0 ? 1 : -1);
     const scara_real t98 = t94 + t97;
     const scara_real t99 = (t96 > 0 ? 1/(t96*(t95 + t96)) : 0);
-    const scara_real t100 = -t89*t99*(t98*t98) + t89;
+    const scara_real t100 = t89 - t89*t99*(t98*t98);
     const scara_real t101 = (t97 != 0 ? -t100/t97 : 0);
-    const scara_real t102 = (t84 != 0 ? -(-t101*t93 + t88)/t84 : 0);
-    const scara_real t103 = (t11 != 0 ? -(-t101*t12*t74 + t102*t76 + t80)/t11 : 0);
+    const scara_real t102 = (t84 != 0 ? -(t88 - t101*t93)/t84 : 0);
+    const scara_real t103 = (t11 != 0 ? -(t80 + t102*t76 - t101*t12*t74)/t11 : 0);
     const int t104 = damping > 0;
     const int t105 = isfinite(t90);
     const int t106 = damping >= 0;
@@ -521,38 +859,38 @@ scara_real scara_ik_numeric_step(const scara_real target[SCARA_TASK_DIM], const 
     const scara_real s4 = sin(q4);
     const scara_real t0 = 0.387 - q3;
     const scara_real t1 = c12*c4 + s12*s4;
-    const scara_real t2 = -c12*s4 + c4*s12;
+    const scara_real t2 = c4*s12 - c12*s4;
     const scara_real t3 = mu2 - t0;
-    const scara_real t4 = damping + 1;
+    const scara_real t4 = 1 + damping;
     const scara_real t5 = mu0 + mu1 + mu2 + mu3 + qs1 + qs2 + qs3 + qs4;
     const scara_real t6 = 0.275*c12;
-    const scara_real t7 = 0.325*c1 + t6;
+    const scara_real t7 = t6 + 0.325*c1;
     const scara_real t8 = 0.075625*(c12*c12) + (t7*t7);
     const scara_real t9 = t6 + t7;
     const scara_real t10 = mu0 - t7;
     const scara_real t11 = 0.275*s12;
-    const scara_real t12 = 0.325*s1 + t11;
+    const scara_real t12 = t11 + 0.325*s1;
     const scara_real t13 = 0.075625*(s12*s12) + (t12*t12);
-    const scara_real t14 = 0.075625*c12*s12 + t12*t7;
+    const scara_real t14 = t12*t7 + 0.075625*c12*s12;
     const scara_real t15 = t11 + t12;
     const scara_real t16 = mu1 - t12;
     const scara_real t17 = -mu3 + atan2(t2, t1);
-    const scara_real t18 = t17 + 6.283185307179586*ceil(-0.15915494309189535*t17 - 0.5);
+    const scara_real t18 = t17 + 6.283185307179586*ceil(-0.5 - 0.15915494309189535*t17);
     const scara_real t19 = (t10*t10) + (t16*t16) + (t18*t18) + (t3*t3);
     const scara_real t20 = damping + t13;
     const scara_real t21 = sqrt((t14*t14) + (t15*t15) + (t20*t20));
     const scara_real t22 = t21*(t20 >= 0 ? 1 : -1);
     const scara_real t23 = t20 + t22;
     const scara_real t24 = (t21 > 0 ? 1/(t21*(t21 + fabs(t20))) : 0);
-    const scara_real t25 = t24*(t10*t23 - t14*t16 + t15*t18);
+    const scara_real t25 = t24*(t10*t23 + t15*t18 - t14*t16);
     const scara_real t26 = t10 - t23*t25;
-    const scara_real t27 = t14*t25 + t16;
-    const scara_real t28 = t15*t25 - t18;
+    const scara_real t27 = t16 + t14*t25;
+    const scara_real t28 = -t18 + t15*t25;
     const scara_real t29 = damping + t8;
     const scara_real t30 = -t24*(t14*t23 + t14*t29 + t15*t9);
     const scara_real t31 = t14 + t23*t30;
-    const scara_real t32 = t14*t30 + t29;
-    const scara_real t33 = t15*t30 + t9;
+    const scara_real t32 = t29 + t14*t30;
+    const scara_real t33 = t9 + t15*t30;
     const scara_real t34 = sqrt((t32*t32) + (t33*t33));
     const scara_real t35 = t34*(t32 >= 0 ? 1 : -1);
     const scara_real t36 = t32 + t35;
@@ -560,20 +898,20 @@ scara_real scara_ik_numeric_step(const scara_real target[SCARA_TASK_DIM], const 
     const scara_real t38 = t37*(t27*t36 + t28*t33);
     const scara_real t39 = t27 - t36*t38;
     const scara_real t40 = t28 - t33*t38;
-    const scara_real t41 = damping + 3;
+    const scara_real t41 = 3 + damping;
     const scara_real t42 = -t24*(t14*t9 + t15*t23 + t15*t41);
     const scara_real t43 = t15 + t23*t42;
-    const scara_real t44 = t14*t42 + t9;
-    const scara_real t45 = t15*t42 + t41;
+    const scara_real t44 = t9 + t14*t42;
+    const scara_real t45 = t41 + t15*t42;
     const scara_real t46 = t37*(t33*t45 + t36*t44);
-    const scara_real t47 = -t36*t46 + t44;
-    const scara_real t48 = -t33*t46 + t45;
+    const scara_real t47 = t44 - t36*t46;
+    const scara_real t48 = t45 - t33*t46;
     const scara_real t49 = fabs(t4);
     const scara_real t50 = t49;
     const scara_real t51 = t50*(t4 >= 0 ? 1 : -1);
     const scara_real t52 = t4 + t51;
     const scara_real t53 = (t50 > 0 ? 1/(t50*(t49 + t50)) : 0);
-    const scara_real t54 = -t3*t53*(t52*t52) + t3;
+    const scara_real t54 = t3 - t3*t53*(t52*t52);
     const scara_real t55 = (t51 != 0 ? -t54/t51 : 0);
     const scara_real t56 = q3 - t55;
     const scara_real t57 = fabs(t48);
@@ -581,12 +919,12 @@ scara_real scara_ik_numeric_step(const scara_real target[SCARA_TASK_DIM], const 
     const scara_real t59 = t58*(t48 >= 0 ? 1 : -1);
     const scara_real t60 = t48 + t59;
     const scara_real t61 = (t58 > 0 ? 1/(t58*(t57 + t58)) : 0);
-    const scara_real t62 = -t40*t61*(t60*t60) + t40;
+    const scara_real t62 = t40 - t40*t61*(t60*t60);
     const scara_real t63 = (t59 != 0 ? -t62/t59 : 0);
     const scara_real t64 = (t35 != 0 ? -(t39 - t47*t63)/t35 : 0);
     const scara_real t65 = (t22 != 0 ? -(t26 + t31*t64 + t43*t63)/t22 : 0);
-    const scara_real t66 = q1 - t12*t65 + t63 + t64*t7;
-    const scara_real t67 = q2 - t11*t65 + t6*t64 + t63;
+    const scara_real t66 = q1 + t63 + t64*t7 - t12*t65;
+    const scara_real t67 = q2 + t63 + t6*t64 - t11*t65;
     const scara_real t68 = q4 - t63;
 
     /* Outputs */
@@ -612,38 +950,38 @@ void scara_ik_branches(const scara_real mu[SCARA_TASK_DIM], scara_real q[SCARA_M
     const scara_real mu3 = mu[3];
 
     /* Intermediate terms */
-    const scara_real t0 = (mu0*mu0) + (mu1*mu1) + 0.149769;
+    const scara_real t0 = 0.149769 + (mu0*mu0) + (mu1*mu1);
     const scara_real t1 = 0.1655095 - 0.5*t0;
     const scara_real t2 = mu0 + mu1 + mu2 + mu3;
     const int t3 = 0;
     const scara_real t4 = (t3 ? 1 : 11.188811188811188);
     const scara_real t5 = (t1*t1);
     const scara_real t6 = (t4*t4);
-    const scara_real t7 = -t5*t6 + 1;
+    const scara_real t7 = 1 - t5*t6;
     const scara_real t8 = t1*t4;
     const int t9 = 1e-12 < t7;
     const scara_real t10 = (t9 ? t8 : (t8 > 0 ? 1 : -1));
     const scara_real t11 = (t9 ? sqrt(t7) : 0);
     const scara_real t12 = atan2(t11, t10);
-    const scara_real t13 = (t3 ? 0 : t12 + 3.141592653589793);
+    const scara_real t13 = (t3 ? 0 : 3.141592653589793 + t12);
     const scara_real t14 = 3.141592653589793 - t12;
     const scara_real t15 = 0.089375*t4;
     const scara_real t16 = (t3 ? 1 : -t10*t15);
     const scara_real t17 = (t3 ? 0 : -t11*t15);
-    const scara_real t18 = 0.275*t16 + 0.325;
-    const scara_real t19 = 0.075625*(t17*t17) + (t18*t18) + 0.149769;
+    const scara_real t18 = 0.325 + 0.275*t16;
+    const scara_real t19 = 0.149769 + 0.075625*(t17*t17) + (t18*t18);
     const scara_real t20 = 0.275*t17;
-    const scara_real t21 = mu0*t18 + mu1*t20 + 0.149769;
-    const scara_real t22 = t21 - 0.149769;
-    const scara_real t23 = -mu0*t20 + mu1*t18;
+    const scara_real t21 = 0.149769 + mu0*t18 + mu1*t20;
+    const scara_real t22 = -0.149769 + t21;
+    const scara_real t23 = mu1*t18 - mu0*t20;
     const scara_real t24 = (t22*t22) + (t23*t23);
     const scara_real t25 = 0.024578125*t4;
-    const scara_real t26 = -t10*t25 + 0.325;
-    const scara_real t27 = 0.000604084228515625*t6*(t11*t11) + (t26*t26) + 0.149769;
+    const scara_real t26 = 0.325 - t10*t25;
+    const scara_real t27 = 0.149769 + 0.000604084228515625*t6*(t11*t11) + (t26*t26);
     const scara_real t28 = t11*t25;
-    const scara_real t29 = mu0*t26 + mu1*t28 + 0.149769;
-    const scara_real t30 = t29 - 0.149769;
-    const scara_real t31 = -mu0*t28 + mu1*t26;
+    const scara_real t29 = 0.149769 + mu0*t26 + mu1*t28;
+    const scara_real t30 = -0.149769 + t29;
+    const scara_real t31 = mu1*t26 - mu0*t28;
     const scara_real t32 = (t30*t30) + (t31*t31);
     const scara_real t33 = 1e-24*t0;
     const scara_real t34 = (t24 <= t19*t33 ? 0 : atan2(t23, t22));
@@ -658,13 +996,13 @@ void scara_ik_branches(const scara_real mu[SCARA_TASK_DIM], scara_real q[SCARA_M
 
     /* Outputs */
     q[0] = t34;
-    q[1] = t13 - 6.283185307179586*ceil(0.15915494309189535*t13 - 0.5);
+    q[1] = t13 - 6.283185307179586*ceil(-0.5 + 0.15915494309189535*t13);
     q[2] = t35;
-    q[3] = -t37 - 6.283185307179586*ceil(-0.15915494309189535*t37 - 0.5);
+    q[3] = -t37 - 6.283185307179586*ceil(-0.5 - 0.15915494309189535*t37);
     q[4] = t38;
-    q[5] = t14 - 6.283185307179586*ceil(0.15915494309189535*t14 - 0.5);
+    q[5] = t14 - 6.283185307179586*ceil(-0.5 + 0.15915494309189535*t14);
     q[6] = t35;
-    q[7] = -t39 - 6.283185307179586*ceil(-0.15915494309189535*t39 - 0.5);
+    q[7] = -t39 - 6.283185307179586*ceil(-0.5 - 0.15915494309189535*t39);
     valid[0] = t40 && ((t42 && t7 >= -1e-12) || (0.007987890625 <= t41 && t5 <= 1.931417125e-14));
     valid[1] = t40 && t42 && t7 > 1e-12;
 }

@@ -29,11 +29,11 @@ def _fk(q):
     s12 = c1*s2 + c2*s1
     c4 = casadi.cos(q4)
     s4 = casadi.sin(q4)
-    t0 = 0.325*c1 + 0.275*c12
-    t1 = 0.325*s1 + 0.275*s12
+    t0 = 0.275*c12 + 0.325*c1
+    t1 = 0.275*s12 + 0.325*s1
     t2 = 0.387 - q3
     t3 = c12*c4 + s12*s4
-    t4 = -c12*s4 + c4*s12
+    t4 = c4*s12 - c12*s4
     T = casadi.SX(4, 4)
     T[0, 0] = t3
     T[0, 1] = t4
@@ -58,9 +58,9 @@ def _jacobian(q):
     c12 = c1*c2 - s1*s2
     s12 = c1*s2 + c2*s1
     t0 = 0.275*c12
-    t1 = 0.325*c1 + t0
+    t1 = t0 + 0.325*c1
     t2 = 0.275*s12
-    t3 = 0.325*s1 + t2
+    t3 = t2 + 0.325*s1
     J = casadi.SX(6, 4)
     J[0, 0] = -t3
     J[0, 1] = -t2
@@ -89,11 +89,11 @@ def _fk_jacobian(q):
     s4 = casadi.sin(q4)
     t0 = 0.387 - q3
     t1 = c12*c4 + s12*s4
-    t2 = -c12*s4 + c4*s12
+    t2 = c4*s12 - c12*s4
     t3 = 0.275*c12
-    t4 = 0.325*c1 + t3
+    t4 = t3 + 0.325*c1
     t5 = 0.275*s12
-    t6 = 0.325*s1 + t5
+    t6 = t5 + 0.325*s1
     T = casadi.SX(4, 4)
     T[0, 0] = t1
     T[0, 1] = t2
@@ -130,14 +130,14 @@ def _jacobian_tool(q):
     c4 = casadi.cos(q4)
     s4 = casadi.sin(q4)
     t0 = c12*c4 + s12*s4
-    t1 = -c12*s4 + c4*s12
+    t1 = c4*s12 - c12*s4
     t2 = 0.275*c12
-    t3 = 0.325*c1 + t2
+    t3 = t2 + 0.325*c1
     t4 = 0.275*s12
-    t5 = 0.325*s1 + t4
+    t5 = t4 + 0.325*s1
     J = casadi.SX(6, 4)
-    J[0, 0] = -t0*t5 + t1*t3
-    J[0, 1] = -t0*t4 + t1*t2
+    J[0, 0] = t1*t3 - t0*t5
+    J[0, 1] = t1*t2 - t0*t4
     J[1, 0] = -t0*t3 - t1*t5
     J[1, 1] = -t0*t2 - t1*t4
     J[2, 2] = 1
@@ -161,11 +161,11 @@ def _task(q):
     s12 = c1*s2 + c2*s1
     c4 = casadi.cos(q4)
     s4 = casadi.sin(q4)
-    t0 = 0.325*c1 + 0.275*c12
-    t1 = 0.325*s1 + 0.275*s12
+    t0 = 0.275*c12 + 0.325*c1
+    t1 = 0.275*s12 + 0.325*s1
     t2 = 0.387 - q3
     t3 = c12*c4 + s12*s4
-    t4 = -c12*s4 + c4*s12
+    t4 = c4*s12 - c12*s4
     mu = casadi.SX(4, 1)
     mu[0, 0] = t0
     mu[1, 0] = t1
@@ -185,9 +185,9 @@ def _task_jacobian(q):
     c12 = c1*c2 - s1*s2
     s12 = c1*s2 + c2*s1
     t0 = 0.275*c12
-    t1 = 0.325*c1 + t0
+    t1 = t0 + 0.325*c1
     t2 = 0.275*s12
-    t3 = 0.325*s1 + t2
+    t3 = t2 + 0.325*s1
     J = casadi.SX(4, 4)
     J[0, 0] = -t3
     J[0, 1] = -t2
@@ -198,6 +198,170 @@ def _task_jacobian(q):
     J[3, 1] = 1
     J[3, 3] = -1
     return [J]
+
+
+def _fk_jacobian_dot(q, q_dot):
+    """Fk, jacobian and bias_acceleration in one pass, sharing their terms: 49 operations."""
+    q1 = q[0]
+    q2 = q[1]
+    q3 = q[2]
+    q4 = q[3]
+    qd1 = q_dot[0]
+    qd2 = q_dot[1]
+    c1 = casadi.cos(q1)
+    s1 = casadi.sin(q1)
+    c2 = casadi.cos(q2)
+    s2 = casadi.sin(q2)
+    c12 = c1*c2 - s1*s2
+    s12 = c1*s2 + c2*s1
+    c4 = casadi.cos(q4)
+    s4 = casadi.sin(q4)
+    t0 = 0.387 - q3
+    t1 = c12*c4 + s12*s4
+    t2 = c4*s12 - c12*s4
+    t3 = 0.275*c12
+    t4 = t3 + 0.325*c1
+    t5 = 0.275*s12
+    t6 = t5 + 0.325*s1
+    t7 = qd2*t5
+    t8 = t7 + qd1*t6
+    t9 = qd2*t3
+    t10 = t9 + qd1*t4
+    T = casadi.SX(4, 4)
+    T[0, 0] = t1
+    T[0, 1] = t2
+    T[0, 3] = t4
+    T[1, 0] = t2
+    T[1, 1] = -t1
+    T[1, 3] = t6
+    T[2, 2] = -1
+    T[2, 3] = t0
+    T[3, 3] = 1
+    J = casadi.SX(6, 4)
+    J[0, 0] = -t6
+    J[0, 1] = -t5
+    J[1, 0] = t4
+    J[1, 1] = t3
+    J[2, 2] = -1
+    J[5, 0] = 1
+    J[5, 1] = 1
+    J[5, 3] = -1
+    a = casadi.SX(6, 1)
+    a[0, 0] = -qd1*t10 - qd2*(t9 + qd1*t3)
+    a[1, 0] = -qd1*t8 - qd2*(t7 + qd1*t5)
+    return [T, J, a]
+
+
+def _jacobian_dot(q, q_dot):
+    """DJ/dt of the world geometric Jacobian along q_dot (6 x DOF): 30 operations."""
+    q1 = q[0]
+    q2 = q[1]
+    qd1 = q_dot[0]
+    qd2 = q_dot[1]
+    c1 = casadi.cos(q1)
+    s1 = casadi.sin(q1)
+    c2 = casadi.cos(q2)
+    s2 = casadi.sin(q2)
+    c12 = c1*c2 - s1*s2
+    s12 = c1*s2 + c2*s1
+    t0 = 0.275*c12
+    t1 = t0 + 0.325*c1
+    t2 = 0.275*s12
+    t3 = t2 + 0.325*s1
+    t4 = qd2*t2
+    t5 = t4 + qd1*t3
+    t6 = qd2*t0
+    t7 = t6 + qd1*t1
+    Jd = casadi.SX(6, 4)
+    Jd[0, 0] = -t7
+    Jd[0, 1] = -t6 - qd1*t0
+    Jd[1, 0] = -t5
+    Jd[1, 1] = -t4 - qd1*t2
+    return [Jd]
+
+
+def _bias_acceleration(q, q_dot):
+    """J' q_dot: the tool's classical linear and angular acceleration at zero joint acceleration, world frame (6): 34 operations."""
+    q1 = q[0]
+    q2 = q[1]
+    qd1 = q_dot[0]
+    qd2 = q_dot[1]
+    c1 = casadi.cos(q1)
+    s1 = casadi.sin(q1)
+    c2 = casadi.cos(q2)
+    s2 = casadi.sin(q2)
+    c12 = c1*c2 - s1*s2
+    s12 = c1*s2 + c2*s1
+    t0 = 0.275*c12
+    t1 = t0 + 0.325*c1
+    t2 = 0.275*s12
+    t3 = t2 + 0.325*s1
+    t4 = qd2*t2
+    t5 = t4 + qd1*t3
+    t6 = qd2*t0
+    t7 = t6 + qd1*t1
+    a = casadi.SX(6, 1)
+    a[0, 0] = -qd1*t7 - qd2*(t6 + qd1*t0)
+    a[1, 0] = -qd1*t5 - qd2*(t4 + qd1*t2)
+    return [a]
+
+
+def _task_jacobian_dot(q, q_dot):
+    """D/dt of the analytic Jacobian along q_dot (4 x DOF): mu'' = J_a q'' + J_a' q': 30 operations."""
+    q1 = q[0]
+    q2 = q[1]
+    qd1 = q_dot[0]
+    qd2 = q_dot[1]
+    c1 = casadi.cos(q1)
+    s1 = casadi.sin(q1)
+    c2 = casadi.cos(q2)
+    s2 = casadi.sin(q2)
+    c12 = c1*c2 - s1*s2
+    s12 = c1*s2 + c2*s1
+    t0 = 0.275*c12
+    t1 = t0 + 0.325*c1
+    t2 = 0.275*s12
+    t3 = t2 + 0.325*s1
+    t4 = qd2*t2
+    t5 = t4 + qd1*t3
+    t6 = t4 + qd1*t2
+    t7 = qd2*t0
+    t8 = t7 + qd1*t1
+    t9 = t7 + qd1*t0
+    Jd = casadi.SX(4, 4)
+    Jd[0, 0] = -t8
+    Jd[0, 1] = -t9
+    Jd[1, 0] = -t5
+    Jd[1, 1] = -t6
+    return [Jd]
+
+
+def _hessian(q):
+    """D J / d q_k for each k (DOF x 6 x DOF, indexed [k, r, c]): 20 operations."""
+    q1 = q[0]
+    q2 = q[1]
+    c1 = casadi.cos(q1)
+    s1 = casadi.sin(q1)
+    c2 = casadi.cos(q2)
+    s2 = casadi.sin(q2)
+    c12 = c1*c2 - s1*s2
+    s12 = c1*s2 + c2*s1
+    t0 = 0.275*c12
+    t1 = t0 + 0.325*c1
+    t2 = 0.275*s12
+    t3 = t2 + 0.325*s1
+    t4 = -t0
+    t5 = -t2
+    H = casadi.SX(24, 4)
+    H[0, 0] = -t1
+    H[0, 1] = t4
+    H[1, 0] = -t3
+    H[1, 1] = t5
+    H[6, 0] = t4
+    H[6, 1] = t4
+    H[7, 0] = t5
+    H[7, 1] = t5
+    return [H]
 
 
 def _singularity_factors(q):
@@ -220,10 +384,10 @@ def _manipulability(q):
     c12 = c1*c2 - s1*s2
     s12 = c1*s2 + c2*s1
     t0 = 0.275*c12
-    t1 = 0.325*c1 + t0
+    t1 = t0 + 0.325*c1
     t2 = 0.275*s12
-    t3 = 0.325*s1 + t2
-    t4 = -t0*t3 + t1*t2
+    t3 = t2 + 0.325*s1
+    t4 = t1*t2 - t0*t3
     w = casadi.SX(1, 1)
     w[0, 0] = casadi.fabs(t4)
     return [w]
@@ -240,11 +404,11 @@ def _jacobian_det(q):
     c12 = c1*c2 - s1*s2
     s12 = c1*s2 + c2*s1
     t0 = 0.275*c12
-    t1 = 0.325*c1 + t0
+    t1 = t0 + 0.325*c1
     t2 = 0.275*s12
-    t3 = 0.325*s1 + t2
+    t3 = t2 + 0.325*s1
     d = casadi.SX(1, 1)
-    d[0, 0] = -t0*t3 + t1*t2
+    d[0, 0] = t1*t2 - t0*t3
     return [d]
 
 
@@ -265,22 +429,22 @@ def _velocity_ik(q, mu_dot, damping):
     c12 = c1*c2 - s1*s2
     s12 = c1*s2 + c2*s1
     t0 = 0.275*c12
-    t1 = 0.325*c1 + t0
+    t1 = t0 + 0.325*c1
     t2 = 0.275*s12
-    t3 = 0.325*s1 + t2
-    t4 = 0.075625*c12*s12 + t1*t3
+    t3 = t2 + 0.325*s1
+    t4 = t1*t3 + 0.075625*c12*s12
     t5 = t2 + t3
     t6 = t3**2
-    t7 = 0.075625*s12**2 + t6
+    t7 = t6 + 0.075625*s12**2
     t8 = t7
     t9 = t1**2
-    t10 = casadi.sqrt(t6 + t9 + 1)
+    t10 = casadi.sqrt(1 + t6 + t9)
     t11 = t10*casadi.if_else((t3 <= 0), 1, -1)
     t12 = casadi.if_else((t10 > 0), 1/(t10*(t10 + casadi.fabs(t3))), 0)
-    t13 = t12 - 1
-    t14 = 0.075625*c12**2 + t9
+    t13 = -1 + t12
+    t14 = t9 + 0.075625*c12**2
     t15 = t14
-    t16 = casadi.sqrt(t14 + t7 + 4)
+    t16 = casadi.sqrt(4 + t14 + t7)
     t17 = t0 + t1
     t18 = t17
     t19 = t4**2
@@ -292,13 +456,13 @@ def _velocity_ik(q, mu_dot, damping):
     t25 = t24*casadi.if_else((t22 >= 0), 1, -1)
     t26 = t22 + t25
     t27 = casadi.if_else((t24 > 0), 1/(t24*(t24 + casadi.fabs(t22))), 0)
-    t28 = -t27*(-mu_dot0*t26 + mu_dot1*t4 + mu_dot3*t5)
+    t28 = -t27*(mu_dot1*t4 + mu_dot3*t5 - mu_dot0*t26)
     t29 = mu_dot0 - t26*t28
     t30 = mu_dot1 + t28*t4
     t31 = mu_dot3 + t28*t5
     t32 = t15 + t21
     t33 = -t27*(t18*t5 + t26*t4 + t32*t4)
-    t34 = t26*t33 + t4
+    t34 = t4 + t26*t33
     t35 = t32 + t33*t4
     t36 = t18 + t33*t5
     t37 = casadi.sqrt(t35**2 + t36**2)
@@ -308,42 +472,42 @@ def _velocity_ik(q, mu_dot, damping):
     t41 = t40*(t30*t39 + t31*t36)
     t42 = t30 - t39*t41
     t43 = t31 - t36*t41
-    t44 = t21 + 1
+    t44 = 1 + t21
     t45 = t44
-    t46 = t21 + 3
-    t47 = casadi.sqrt(2*t18**2 + 2*t19 + 2*t20 + t23 + t32**2 + t44**2 + t46**2)
+    t46 = 3 + t21
+    t47 = casadi.sqrt(t23 + t32**2 + t44**2 + t46**2 + 2*t19 + 2*t20 + 2*t18**2)
     t48 = -t27*(t18*t4 + t26*t5 + t46*t5)
-    t49 = t26*t48 + t5
+    t49 = t5 + t26*t48
     t50 = t18 + t4*t48
     t51 = t46 + t48*t5
     t52 = t40*(t36*t51 + t39*t50)
-    t53 = -t39*t52 + t50
-    t54 = -t36*t52 + t51
+    t53 = t50 - t39*t52
+    t54 = t51 - t36*t52
     t55 = casadi.fabs(t45)
     t56 = t55
     t57 = t56*casadi.if_else((t45 >= 0), 1, -1)
     t58 = t45 + t57
     t59 = casadi.if_else((t56 > 0), 1/(t56*(t55 + t56)), 0)
-    t60 = -mu_dot2*t58**2*t59 + mu_dot2
+    t60 = mu_dot2 - mu_dot2*t59*t58**2
     t61 = casadi.if_else((t57 != 0), -t60/t57, 0)
     t62 = casadi.fabs(t54)
     t63 = t62
     t64 = t63*casadi.if_else((t54 >= 0), 1, -1)
     t65 = t54 + t64
     t66 = casadi.if_else((t63 > 0), 1/(t63*(t62 + t63)), 0)
-    t67 = -t43*t65**2*t66 + t43
+    t67 = t43 - t43*t66*t65**2
     t68 = casadi.if_else((t64 != 0), -t67/t64, 0)
     t69 = casadi.if_else((t38 != 0), -(t42 - t53*t68)/t38, 0)
     t70 = casadi.if_else((t25 != 0), -(t29 + t34*t69 + t49*t68)/t25, 0)
-    t71 = t1*t69 - t3*t70 + t68
-    t72 = t0*t69 - t2*t70 + t68
+    t71 = t68 + t1*t69 - t3*t70
+    t72 = t68 + t0*t69 - t2*t70
     t73 = -t3
     t74 = t11 + t73
-    t75 = t12*(t0*t1 - t2*t74 + 1)
+    t75 = t12*(1 + t0*t1 - t2*t74)
     t76 = t2 + t74*t75
     t77 = t0 - t1*t75
     t78 = 1 - t75
-    t79 = t12*(mu_dot0*t74 + mu_dot1*t1 + mu_dot3)
+    t79 = t12*(mu_dot3 + mu_dot0*t74 + mu_dot1*t1)
     t80 = mu_dot0 - t74*t79
     t81 = mu_dot1 - t1*t79
     t82 = mu_dot3 - t79
@@ -353,21 +517,21 @@ def _velocity_ik(q, mu_dot, damping):
     t86 = casadi.if_else((t83 > 0), 1/(t83*(t83 + casadi.fabs(t77))), 0)
     t87 = t86*(t78*t82 + t81*t85)
     t88 = t81 - t85*t87
-    t89 = -t78*t87 + t82
-    t90 = damping + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + q1 + q2 + q3 + q4 + t17 - t2 + t73
+    t89 = t82 - t78*t87
+    t90 = damping + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + q1 + q2 + q3 + q4 + t17 + t73 - t2
     t91 = t1*t12
     t92 = t86*(t13*t78 + t85*t91)
-    t93 = -t85*t92 + t91
+    t93 = t91 - t85*t92
     t94 = t13 - t78*t92
     t95 = casadi.fabs(t94)
     t96 = t95
     t97 = t96*casadi.if_else((t94 >= 0), 1, -1)
     t98 = t94 + t97
     t99 = casadi.if_else((t96 > 0), 1/(t96*(t95 + t96)), 0)
-    t100 = -t89*t98**2*t99 + t89
+    t100 = t89 - t89*t99*t98**2
     t101 = casadi.if_else((t97 != 0), -t100/t97, 0)
-    t102 = casadi.if_else((t84 != 0), -(-t101*t93 + t88)/t84, 0)
-    t103 = casadi.if_else((t11 != 0), -(-t101*t12*t74 + t102*t76 + t80)/t11, 0)
+    t102 = casadi.if_else((t84 != 0), -(t88 - t101*t93)/t84, 0)
+    t103 = casadi.if_else((t11 != 0), -(t80 + t102*t76 - t101*t12*t74)/t11, 0)
     t104 = (damping > 0)
     t105 = (casadi.fabs(t90) < casadi.inf)
     t106 = (damping >= 0)
@@ -409,38 +573,38 @@ def _ik_numeric_step(target, q, damping):
     s4 = casadi.sin(q4)
     t0 = 0.387 - q3
     t1 = c12*c4 + s12*s4
-    t2 = -c12*s4 + c4*s12
+    t2 = c4*s12 - c12*s4
     t3 = mu2 - t0
-    t4 = damping + 1
+    t4 = 1 + damping
     t5 = mu0 + mu1 + mu2 + mu3 + qs1 + qs2 + qs3 + qs4
     t6 = 0.275*c12
-    t7 = 0.325*c1 + t6
-    t8 = 0.075625*c12**2 + t7**2
+    t7 = t6 + 0.325*c1
+    t8 = t7**2 + 0.075625*c12**2
     t9 = t6 + t7
     t10 = mu0 - t7
     t11 = 0.275*s12
-    t12 = 0.325*s1 + t11
-    t13 = 0.075625*s12**2 + t12**2
-    t14 = 0.075625*c12*s12 + t12*t7
+    t12 = t11 + 0.325*s1
+    t13 = t12**2 + 0.075625*s12**2
+    t14 = t12*t7 + 0.075625*c12*s12
     t15 = t11 + t12
     t16 = mu1 - t12
     t17 = -mu3 + casadi.atan2(t2, t1)
-    t18 = t17 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t17 - 0.5)
+    t18 = t17 + 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t17)
     t19 = t10**2 + t16**2 + t18**2 + t3**2
     t20 = damping + t13
     t21 = casadi.sqrt(t14**2 + t15**2 + t20**2)
     t22 = t21*casadi.if_else((t20 >= 0), 1, -1)
     t23 = t20 + t22
     t24 = casadi.if_else((t21 > 0), 1/(t21*(t21 + casadi.fabs(t20))), 0)
-    t25 = t24*(t10*t23 - t14*t16 + t15*t18)
+    t25 = t24*(t10*t23 + t15*t18 - t14*t16)
     t26 = t10 - t23*t25
-    t27 = t14*t25 + t16
-    t28 = t15*t25 - t18
+    t27 = t16 + t14*t25
+    t28 = -t18 + t15*t25
     t29 = damping + t8
     t30 = -t24*(t14*t23 + t14*t29 + t15*t9)
     t31 = t14 + t23*t30
-    t32 = t14*t30 + t29
-    t33 = t15*t30 + t9
+    t32 = t29 + t14*t30
+    t33 = t9 + t15*t30
     t34 = casadi.sqrt(t32**2 + t33**2)
     t35 = t34*casadi.if_else((t32 >= 0), 1, -1)
     t36 = t32 + t35
@@ -448,20 +612,20 @@ def _ik_numeric_step(target, q, damping):
     t38 = t37*(t27*t36 + t28*t33)
     t39 = t27 - t36*t38
     t40 = t28 - t33*t38
-    t41 = damping + 3
+    t41 = 3 + damping
     t42 = -t24*(t14*t9 + t15*t23 + t15*t41)
     t43 = t15 + t23*t42
-    t44 = t14*t42 + t9
-    t45 = t15*t42 + t41
+    t44 = t9 + t14*t42
+    t45 = t41 + t15*t42
     t46 = t37*(t33*t45 + t36*t44)
-    t47 = -t36*t46 + t44
-    t48 = -t33*t46 + t45
+    t47 = t44 - t36*t46
+    t48 = t45 - t33*t46
     t49 = casadi.fabs(t4)
     t50 = t49
     t51 = t50*casadi.if_else((t4 >= 0), 1, -1)
     t52 = t4 + t51
     t53 = casadi.if_else((t50 > 0), 1/(t50*(t49 + t50)), 0)
-    t54 = -t3*t52**2*t53 + t3
+    t54 = t3 - t3*t53*t52**2
     t55 = casadi.if_else((t51 != 0), -t54/t51, 0)
     t56 = q3 - t55
     t57 = casadi.fabs(t48)
@@ -469,12 +633,12 @@ def _ik_numeric_step(target, q, damping):
     t59 = t58*casadi.if_else((t48 >= 0), 1, -1)
     t60 = t48 + t59
     t61 = casadi.if_else((t58 > 0), 1/(t58*(t57 + t58)), 0)
-    t62 = -t40*t60**2*t61 + t40
+    t62 = t40 - t40*t61*t60**2
     t63 = casadi.if_else((t59 != 0), -t62/t59, 0)
     t64 = casadi.if_else((t35 != 0), -(t39 - t47*t63)/t35, 0)
     t65 = casadi.if_else((t22 != 0), -(t26 + t31*t64 + t43*t63)/t22, 0)
-    t66 = q1 - t12*t65 + t63 + t64*t7
-    t67 = q2 - t11*t65 + t6*t64 + t63
+    t66 = q1 + t63 + t64*t7 - t12*t65
+    t67 = q2 + t63 + t6*t64 - t11*t65
     t68 = q4 - t63
     q_start = casadi.SX(4, 1)
     q_start[0, 0] = q1
@@ -497,42 +661,42 @@ def _ik_branches(mu):
     mu1 = mu[1]
     mu2 = mu[2]
     mu3 = mu[3]
-    t0 = mu0**2 + mu1**2 + 0.149769
+    t0 = 0.149769 + mu0**2 + mu1**2
     t1 = 0.1655095 - 0.5*t0
     t2 = mu0 + mu1 + mu2 + mu3
     t3 = False
     t4 = casadi.if_else(t3, 1, 11.188811188811188)
     t5 = t1**2
     t6 = t4**2
-    t7 = -t5*t6 + 1
+    t7 = 1 - t5*t6
     t8 = t1*t4
     t9 = (1e-12 < t7)
     t10 = casadi.if_else(t9, t8, casadi.if_else((t8 > 0), 1, -1))
     t11 = casadi.if_else(t9, casadi.sqrt(t7), 0)
     t12 = casadi.atan2(t11, t10)
-    t13 = casadi.if_else(t3, 0, t12 + 3.141592653589793)
+    t13 = casadi.if_else(t3, 0, 3.141592653589793 + t12)
     t14 = 3.141592653589793 - t12
     t15 = 0.089375*t4
     t16 = casadi.if_else(t3, 1, -t10*t15)
     t17 = casadi.if_else(t3, 0, -t11*t15)
-    t18 = 0.275*t16 + 0.325
-    t19 = 0.075625*t17**2 + t18**2 + 0.149769
+    t18 = 0.325 + 0.275*t16
+    t19 = 0.149769 + t18**2 + 0.075625*t17**2
     t20 = 0.275*t17
-    t21 = mu0*t18 + mu1*t20 + 0.149769
-    t22 = t21 - 0.149769
-    t23 = -mu0*t20 + mu1*t18
+    t21 = 0.149769 + mu0*t18 + mu1*t20
+    t22 = -0.149769 + t21
+    t23 = mu1*t18 - mu0*t20
     t24 = t22**2 + t23**2
     t25 = 0.024578125*t4
-    t26 = -t10*t25 + 0.325
-    t27 = 0.000604084228515625*t11**2*t6 + t26**2 + 0.149769
+    t26 = 0.325 - t10*t25
+    t27 = 0.149769 + t26**2 + 0.000604084228515625*t6*t11**2
     t28 = t11*t25
-    t29 = mu0*t26 + mu1*t28 + 0.149769
-    t30 = t29 - 0.149769
-    t31 = -mu0*t28 + mu1*t26
+    t29 = 0.149769 + mu0*t26 + mu1*t28
+    t30 = -0.149769 + t29
+    t31 = mu1*t26 - mu0*t28
     t32 = t30**2 + t31**2
     t33 = 1e-24*t0
     t34 = casadi.if_else((t24 <= t19*t33), 0, casadi.atan2(t23, t22))
-    t35 = -(mu2 - 0.387)
+    t35 = -(-0.387 + mu2)
     t36 = -mu3
     t37 = -t13 - t34 - t36
     t38 = casadi.if_else((t32 <= t27*t33), 0, casadi.atan2(t31, t30))
@@ -542,13 +706,13 @@ def _ik_branches(mu):
     t42 = (0.007987890625 > t41)
     q = casadi.SX(2, 4)
     q[0, 0] = t34
-    q[0, 1] = t13 - 6.283185307179586*casadi.ceil(0.15915494309189535*t13 - 0.5)
+    q[0, 1] = t13 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t13)
     q[0, 2] = t35
-    q[0, 3] = -t37 - 6.283185307179586*casadi.ceil(-0.15915494309189535*t37 - 0.5)
+    q[0, 3] = -t37 - 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t37)
     q[1, 0] = t38
-    q[1, 1] = t14 - 6.283185307179586*casadi.ceil(0.15915494309189535*t14 - 0.5)
+    q[1, 1] = t14 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t14)
     q[1, 2] = t35
-    q[1, 3] = -t39 - 6.283185307179586*casadi.ceil(-0.15915494309189535*t39 - 0.5)
+    q[1, 3] = -t39 - 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t39)
     valid = casadi.SX(2, 1)
     valid[0, 0] = casadi.logic_and(t40, casadi.logic_or(casadi.logic_and(t42, (t7 >= -1e-12)), casadi.logic_and((0.007987890625 <= t41), (t5 <= 1.931417125e-14))))
     valid[1, 0] = casadi.logic_and(casadi.logic_and(t40, t42), (t7 > 1e-12))
@@ -556,6 +720,7 @@ def _ik_branches(mu):
 
 
 _q = casadi.SX.sym("q", 4, 1)
+_q_dot = casadi.SX.sym("q_dot", 4, 1)
 _mu_dot = casadi.SX.sym("mu_dot", 4, 1)
 _damping = casadi.SX.sym("damping", 1, 1)
 _target = casadi.SX.sym("target", 4, 1)
@@ -566,6 +731,11 @@ fk_jacobian = casadi.Function("fk_jacobian", [_q], _fk_jacobian(_q), ["q"], ["T"
 jacobian_tool = casadi.Function("jacobian_tool", [_q], _jacobian_tool(_q), ["q"], ["J"])
 task = casadi.Function("task", [_q], _task(_q), ["q"], ["mu"])
 task_jacobian = casadi.Function("task_jacobian", [_q], _task_jacobian(_q), ["q"], ["J"])
+fk_jacobian_dot = casadi.Function("fk_jacobian_dot", [_q, _q_dot], _fk_jacobian_dot(_q, _q_dot), ["q", "q_dot"], ["T", "J", "a"])
+jacobian_dot = casadi.Function("jacobian_dot", [_q, _q_dot], _jacobian_dot(_q, _q_dot), ["q", "q_dot"], ["Jd"])
+bias_acceleration = casadi.Function("bias_acceleration", [_q, _q_dot], _bias_acceleration(_q, _q_dot), ["q", "q_dot"], ["a"])
+task_jacobian_dot = casadi.Function("task_jacobian_dot", [_q, _q_dot], _task_jacobian_dot(_q, _q_dot), ["q", "q_dot"], ["Jd"])
+hessian = casadi.Function("hessian", [_q], _hessian(_q), ["q"], ["H"])
 singularity_factors = casadi.Function("singularity_factors", [_q], _singularity_factors(_q), ["q"], ["f"])
 manipulability = casadi.Function("manipulability", [_q], _manipulability(_q), ["q"], ["w"])
 jacobian_det = casadi.Function("jacobian_det", [_q], _jacobian_det(_q), ["q"], ["d"])
@@ -614,4 +784,4 @@ ik_numeric = casadi.Function("ik_numeric", _inputs, _ik_numeric(*_inputs), ["tar
 
 def functions():
     """All functions by name."""
-    return {"fk": fk, "jacobian": jacobian, "fk_jacobian": fk_jacobian, "jacobian_tool": jacobian_tool, "task": task, "task_jacobian": task_jacobian, "singularity_factors": singularity_factors, "manipulability": manipulability, "jacobian_det": jacobian_det, "velocity_ik": velocity_ik, "ik_numeric_step": ik_numeric_step, "ik_branches": ik_branches}
+    return {"fk": fk, "jacobian": jacobian, "fk_jacobian": fk_jacobian, "jacobian_tool": jacobian_tool, "task": task, "task_jacobian": task_jacobian, "fk_jacobian_dot": fk_jacobian_dot, "jacobian_dot": jacobian_dot, "bias_acceleration": bias_acceleration, "task_jacobian_dot": task_jacobian_dot, "hessian": hessian, "singularity_factors": singularity_factors, "manipulability": manipulability, "jacobian_det": jacobian_det, "velocity_ik": velocity_ik, "ik_numeric_step": ik_numeric_step, "ik_branches": ik_branches}
