@@ -125,14 +125,18 @@ def _placed(axes: list[Axis], tip: Matrix, fitting: "_Fit") -> list[Axis]:
             point = tip[:3, 3]
         else:
             after = placed[i + 1]
-            point = after.point
-            if not fitting.parallel(axis.direction, after.direction):  # where the two come closest
-                b = dot(axis.direction, after.direction)
-                r = (after.point - axis.point).applyfunc(tidy)
-                t = tidy((b * dot(axis.direction, r) - dot(after.direction, r)) / (1 - b * b))
-                point = (after.point + t * after.direction).applyfunc(tidy)
+            point = after.point if fitting.parallel(axis.direction, after.direction) else _closest_points(axis, after)[1]
         placed[i] = Axis(axis.name, axis.kind, point, axis.direction, axis.limits)
     return placed
+
+
+def _closest_points(here: Axis, there: Axis) -> tuple[Matrix, Matrix]:
+    """The points of two axis lines that are not parallel nearest each other: the feet of
+    their common normal on `here` and on `there`."""
+    r = (there.point - here.point).applyfunc(tidy)
+    b, d1, d2 = dot(here.direction, there.direction), dot(here.direction, r), dot(there.direction, r)
+    s, t = tidy((d1 - b * d2) / (1 - b * b)), tidy((b * d1 - d2) / (1 - b * b))
+    return (here.point + s * here.direction).applyfunc(tidy), (there.point + t * there.direction).applyfunc(tidy)
 
 
 def _oriented(x: Matrix, previous: Matrix, z: Matrix) -> Matrix:
@@ -166,14 +170,8 @@ def fit(axes: list[Axis], tip: Matrix, convention: str, snapper: Snapper) -> Tab
             between = (end - start).applyfunc(tidy)
             direction = previous_x if is_zero_vector(between) else unit(between)
         else:
-            normal = cross(here.direction, there.direction)
-            r = (there.point - here.point).applyfunc(tidy)
-            b, d1, d2 = dot(here.direction, there.direction), dot(here.direction, r), dot(there.direction, r)
-            denominator = 1 - b * b
-            s, t = tidy((d1 - b * d2) / denominator), tidy((b * d1 - d2) / denominator)
-            start = (here.point + s * here.direction).applyfunc(tidy)
-            end = (there.point + t * there.direction).applyfunc(tidy)
-            direction = unit(normal)
+            start, end = _closest_points(here, there)
+            direction = unit(cross(here.direction, there.direction))
         feet.append((start, end))
         x.append(_oriented(direction, previous_x, here.direction))
     if n > 1:
