@@ -242,14 +242,14 @@ class Generator:
             self.function("fk_jacobian_dot", "fk, jacobian and bias_acceleration in one pass, sharing their terms",
                           ("T", self.chain.tool), ("J", self.jacobian), ("a", bias),
                           equals=("fk", "jacobian", "bias_acceleration"), vectors=("a",), arguments=arguments),
-            self.function("jacobian_dot", "dJ/dt of the world geometric Jacobian along q_dot (6 x DOF)",
+            self.function("jacobian_dot", "time derivative dJ/dt of the world geometric Jacobian along q_dot (6 x DOF)",
                           ("Jd", jacobian_dot), arguments=arguments),
             self.function("bias_acceleration", "J' q_dot: the tool's classical linear and angular acceleration "
                           "at zero joint acceleration, world frame (6)", ("a", bias), vector=True, arguments=arguments),
-            self.function("task_jacobian_dot", f"d/dt of the analytic Jacobian along q_dot ({m} x DOF): "
+            self.function("task_jacobian_dot", f"time derivative of the analytic Jacobian along q_dot ({m} x DOF): "
                           "mu'' = J_a q'' + J_a' q'", ("Jd", task_jacobian_dot), arguments=arguments),
-            self.function("hessian", "d J / d q_k for each k (DOF x 6 x DOF, indexed [k, r, c])",
-                          ("H", hessian), layers=n),
+            self.function("hessian", "partial derivatives dJ/dq_k of the world geometric Jacobian "
+                          "(DOF x 6 x DOF, indexed [k, r, c])", ("H", hessian), layers=n),
         ]
 
     @property

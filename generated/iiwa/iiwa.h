@@ -62,7 +62,7 @@ void iiwa_task_jacobian(const iiwa_real q[IIWA_DOF], iiwa_real J[IIWA_TASK_DIM *
  * Result: T: 4 x 4 row-major, element (r, c) at T[r * 4 + c]; J: 6 x 7 row-major, element (r, c) at J[r * 7 + c]; a[i], i < 6. 429 operations. */
 void iiwa_fk_jacobian_dot(const iiwa_real q[IIWA_DOF], const iiwa_real q_dot[IIWA_DOF], iiwa_real T[16], iiwa_real J[6 * IIWA_DOF], iiwa_real a[6]);
 
-/* DJ/dt of the world geometric Jacobian along q_dot (6 x DOF).
+/* Time derivative dJ/dt of the world geometric Jacobian along q_dot (6 x DOF).
  * Result: Jd: 6 x 7 row-major, element (r, c) at Jd[r * 7 + c]. 336 operations. */
 void iiwa_jacobian_dot(const iiwa_real q[IIWA_DOF], const iiwa_real q_dot[IIWA_DOF], iiwa_real Jd[6 * IIWA_DOF]);
 
@@ -70,11 +70,11 @@ void iiwa_jacobian_dot(const iiwa_real q[IIWA_DOF], const iiwa_real q_dot[IIWA_D
  * Result: a[i], i < 6. 389 operations. */
 void iiwa_bias_acceleration(const iiwa_real q[IIWA_DOF], const iiwa_real q_dot[IIWA_DOF], iiwa_real a[6]);
 
-/* D/dt of the analytic Jacobian along q_dot (6 x DOF): mu'' = J_a q'' + J_a' q'.
+/* Time derivative of the analytic Jacobian along q_dot (6 x DOF): mu'' = J_a q'' + J_a' q'.
  * Result: Jd: 6 x 7 row-major, element (r, c) at Jd[r * 7 + c]. 699 operations. */
 void iiwa_task_jacobian_dot(const iiwa_real q[IIWA_DOF], const iiwa_real q_dot[IIWA_DOF], iiwa_real Jd[IIWA_TASK_DIM * IIWA_DOF]);
 
-/* D J / d q_k for each k (DOF x 6 x DOF, indexed [k, r, c]).
+/* Partial derivatives dJ/dq_k of the world geometric Jacobian (DOF x 6 x DOF, indexed [k, r, c]).
  * Result: H: 7 x 6 x 7 row-major, element (k, r, c) at H[k * 42 + r * 7 + c]. 402 operations. */
 void iiwa_hessian(const iiwa_real q[IIWA_DOF], iiwa_real H[IIWA_DOF * 6 * IIWA_DOF]);
 

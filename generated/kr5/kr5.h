@@ -62,7 +62,7 @@ void kr5_task_jacobian(const kr5_real q[KR5_DOF], kr5_real J[KR5_TASK_DIM * KR5_
  * Result: T: 4 x 4 row-major, element (r, c) at T[r * 4 + c]; J: 6 x 6 row-major, element (r, c) at J[r * 6 + c]; a[i], i < 6. 326 operations. */
 void kr5_fk_jacobian_dot(const kr5_real q[KR5_DOF], const kr5_real q_dot[KR5_DOF], kr5_real T[16], kr5_real J[6 * KR5_DOF], kr5_real a[6]);
 
-/* DJ/dt of the world geometric Jacobian along q_dot (6 x DOF).
+/* Time derivative dJ/dt of the world geometric Jacobian along q_dot (6 x DOF).
  * Result: Jd: 6 x 6 row-major, element (r, c) at Jd[r * 6 + c]. 246 operations. */
 void kr5_jacobian_dot(const kr5_real q[KR5_DOF], const kr5_real q_dot[KR5_DOF], kr5_real Jd[6 * KR5_DOF]);
 
@@ -70,11 +70,11 @@ void kr5_jacobian_dot(const kr5_real q[KR5_DOF], const kr5_real q_dot[KR5_DOF], 
  * Result: a[i], i < 6. 286 operations. */
 void kr5_bias_acceleration(const kr5_real q[KR5_DOF], const kr5_real q_dot[KR5_DOF], kr5_real a[6]);
 
-/* D/dt of the analytic Jacobian along q_dot (6 x DOF): mu'' = J_a q'' + J_a' q'.
+/* Time derivative of the analytic Jacobian along q_dot (6 x DOF): mu'' = J_a q'' + J_a' q'.
  * Result: Jd: 6 x 6 row-major, element (r, c) at Jd[r * 6 + c]. 499 operations. */
 void kr5_task_jacobian_dot(const kr5_real q[KR5_DOF], const kr5_real q_dot[KR5_DOF], kr5_real Jd[KR5_TASK_DIM * KR5_DOF]);
 
-/* D J / d q_k for each k (DOF x 6 x DOF, indexed [k, r, c]).
+/* Partial derivatives dJ/dq_k of the world geometric Jacobian (DOF x 6 x DOF, indexed [k, r, c]).
  * Result: H: 6 x 6 x 6 row-major, element (k, r, c) at H[k * 36 + r * 6 + c]. 215 operations. */
 void kr5_hessian(const kr5_real q[KR5_DOF], kr5_real H[KR5_DOF * 6 * KR5_DOF]);
 

@@ -57,7 +57,7 @@ void planar_2r_task_jacobian(const planar_2r_real q[PLANAR_2R_DOF], planar_2r_re
  * Result: T: 4 x 4 row-major, element (r, c) at T[r * 4 + c]; J: 6 x 2 row-major, element (r, c) at J[r * 2 + c]; a[i], i < 6. 32 operations. */
 void planar_2r_fk_jacobian_dot(const planar_2r_real q[PLANAR_2R_DOF], const planar_2r_real q_dot[PLANAR_2R_DOF], planar_2r_real T[16], planar_2r_real J[6 * PLANAR_2R_DOF], planar_2r_real a[6]);
 
-/* DJ/dt of the world geometric Jacobian along q_dot (6 x DOF).
+/* Time derivative dJ/dt of the world geometric Jacobian along q_dot (6 x DOF).
  * Result: Jd: 6 x 2 row-major, element (r, c) at Jd[r * 2 + c]. 26 operations. */
 void planar_2r_jacobian_dot(const planar_2r_real q[PLANAR_2R_DOF], const planar_2r_real q_dot[PLANAR_2R_DOF], planar_2r_real Jd[6 * PLANAR_2R_DOF]);
 
@@ -65,11 +65,11 @@ void planar_2r_jacobian_dot(const planar_2r_real q[PLANAR_2R_DOF], const planar_
  * Result: a[i], i < 6. 30 operations. */
 void planar_2r_bias_acceleration(const planar_2r_real q[PLANAR_2R_DOF], const planar_2r_real q_dot[PLANAR_2R_DOF], planar_2r_real a[6]);
 
-/* D/dt of the analytic Jacobian along q_dot (2 x DOF): mu'' = J_a q'' + J_a' q'.
+/* Time derivative of the analytic Jacobian along q_dot (2 x DOF): mu'' = J_a q'' + J_a' q'.
  * Result: Jd: 2 x 2 row-major, element (r, c) at Jd[r * 2 + c]. 26 operations. */
 void planar_2r_task_jacobian_dot(const planar_2r_real q[PLANAR_2R_DOF], const planar_2r_real q_dot[PLANAR_2R_DOF], planar_2r_real Jd[PLANAR_2R_TASK_DIM * PLANAR_2R_DOF]);
 
-/* D J / d q_k for each k (DOF x 6 x DOF, indexed [k, r, c]).
+/* Partial derivatives dJ/dq_k of the world geometric Jacobian (DOF x 6 x DOF, indexed [k, r, c]).
  * Result: H: 2 x 6 x 2 row-major, element (k, r, c) at H[k * 12 + r * 2 + c]. 16 operations. */
 void planar_2r_hessian(const planar_2r_real q[PLANAR_2R_DOF], planar_2r_real H[PLANAR_2R_DOF * 6 * PLANAR_2R_DOF]);
 

@@ -265,7 +265,7 @@ def fk_jacobian_dot(q, q_dot):
 
 
 def jacobian_dot(q, q_dot):
-    """dJ/dt of the world geometric Jacobian along q_dot (6 x DOF): (6 x 2), 26 operations."""
+    """time derivative dJ/dt of the world geometric Jacobian along q_dot (6 x DOF): (6 x 2), 26 operations."""
     q = _argument("q", q, (2,))
     q_dot = _argument("q_dot", q_dot, (2,))
     q1 = q[..., 0]
@@ -331,7 +331,7 @@ def bias_acceleration(q, q_dot):
 
 
 def task_jacobian_dot(q, q_dot):
-    """d/dt of the analytic Jacobian along q_dot (2 x DOF): mu'' = J_a q'' + J_a' q': (2 x 2), 26 operations."""
+    """time derivative of the analytic Jacobian along q_dot (2 x DOF): mu'' = J_a q'' + J_a' q': (2 x 2), 26 operations."""
     q = _argument("q", q, (2,))
     q_dot = _argument("q_dot", q_dot, (2,))
     q1 = q[..., 0]
@@ -361,7 +361,7 @@ def task_jacobian_dot(q, q_dot):
 
 
 def hessian(q):
-    """d J / d q_k for each k (DOF x 6 x DOF, indexed [k, r, c]): (2 x 6 x 2), 16 operations."""
+    """partial derivatives dJ/dq_k of the world geometric Jacobian (DOF x 6 x DOF, indexed [k, r, c]): (2 x 6 x 2), 16 operations."""
     q = _argument("q", q, (2,))
     q1 = q[..., 0]
     q2 = q[..., 1]

@@ -59,7 +59,7 @@ void planar_3r_task_jacobian(const planar_3r_real q[PLANAR_3R_DOF], planar_3r_re
  * Result: T: 4 x 4 row-major, element (r, c) at T[r * 4 + c]; J: 6 x 3 row-major, element (r, c) at J[r * 3 + c]; a[i], i < 6. 56 operations. */
 void planar_3r_fk_jacobian_dot(const planar_3r_real q[PLANAR_3R_DOF], const planar_3r_real q_dot[PLANAR_3R_DOF], planar_3r_real T[16], planar_3r_real J[6 * PLANAR_3R_DOF], planar_3r_real a[6]);
 
-/* DJ/dt of the world geometric Jacobian along q_dot (6 x DOF).
+/* Time derivative dJ/dt of the world geometric Jacobian along q_dot (6 x DOF).
  * Result: Jd: 6 x 3 row-major, element (r, c) at Jd[r * 3 + c]. 47 operations. */
 void planar_3r_jacobian_dot(const planar_3r_real q[PLANAR_3R_DOF], const planar_3r_real q_dot[PLANAR_3R_DOF], planar_3r_real Jd[6 * PLANAR_3R_DOF]);
 
@@ -67,11 +67,11 @@ void planar_3r_jacobian_dot(const planar_3r_real q[PLANAR_3R_DOF], const planar_
  * Result: a[i], i < 6. 53 operations. */
 void planar_3r_bias_acceleration(const planar_3r_real q[PLANAR_3R_DOF], const planar_3r_real q_dot[PLANAR_3R_DOF], planar_3r_real a[6]);
 
-/* D/dt of the analytic Jacobian along q_dot (3 x DOF): mu'' = J_a q'' + J_a' q'.
+/* Time derivative of the analytic Jacobian along q_dot (3 x DOF): mu'' = J_a q'' + J_a' q'.
  * Result: Jd: 3 x 3 row-major, element (r, c) at Jd[r * 3 + c]. 47 operations. */
 void planar_3r_task_jacobian_dot(const planar_3r_real q[PLANAR_3R_DOF], const planar_3r_real q_dot[PLANAR_3R_DOF], planar_3r_real Jd[PLANAR_3R_TASK_DIM * PLANAR_3R_DOF]);
 
-/* D J / d q_k for each k (DOF x 6 x DOF, indexed [k, r, c]).
+/* Partial derivatives dJ/dq_k of the world geometric Jacobian (DOF x 6 x DOF, indexed [k, r, c]).
  * Result: H: 3 x 6 x 3 row-major, element (k, r, c) at H[k * 18 + r * 3 + c]. 28 operations. */
 void planar_3r_hessian(const planar_3r_real q[PLANAR_3R_DOF], planar_3r_real H[PLANAR_3R_DOF * 6 * PLANAR_3R_DOF]);
 

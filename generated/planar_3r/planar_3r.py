@@ -348,7 +348,7 @@ def fk_jacobian_dot(q, q_dot):
 
 
 def jacobian_dot(q, q_dot):
-    """dJ/dt of the world geometric Jacobian along q_dot (6 x DOF): (6 x 3), 47 operations."""
+    """time derivative dJ/dt of the world geometric Jacobian along q_dot (6 x DOF): (6 x 3), 47 operations."""
     q = _argument("q", q, (3,))
     q_dot = _argument("q_dot", q_dot, (3,))
     q1 = q[..., 0]
@@ -442,7 +442,7 @@ def bias_acceleration(q, q_dot):
 
 
 def task_jacobian_dot(q, q_dot):
-    """d/dt of the analytic Jacobian along q_dot (3 x DOF): mu'' = J_a q'' + J_a' q': (3 x 3), 47 operations."""
+    """time derivative of the analytic Jacobian along q_dot (3 x DOF): mu'' = J_a q'' + J_a' q': (3 x 3), 47 operations."""
     q = _argument("q", q, (3,))
     q_dot = _argument("q_dot", q_dot, (3,))
     q1 = q[..., 0]
@@ -490,7 +490,7 @@ def task_jacobian_dot(q, q_dot):
 
 
 def hessian(q):
-    """d J / d q_k for each k (DOF x 6 x DOF, indexed [k, r, c]): (3 x 6 x 3), 28 operations."""
+    """partial derivatives dJ/dq_k of the world geometric Jacobian (DOF x 6 x DOF, indexed [k, r, c]): (3 x 6 x 3), 28 operations."""
     q = _argument("q", q, (3,))
     q1 = q[..., 0]
     q2 = q[..., 1]

@@ -265,7 +265,7 @@ def _fk_jacobian_dot(q, q_dot):
 
 
 def _jacobian_dot(q, q_dot):
-    """DJ/dt of the world geometric Jacobian along q_dot (6 x DOF): 47 operations."""
+    """Time derivative dJ/dt of the world geometric Jacobian along q_dot (6 x DOF): 47 operations."""
     q1 = q[0]
     q2 = q[1]
     q3 = q[2]
@@ -339,7 +339,7 @@ def _bias_acceleration(q, q_dot):
 
 
 def _task_jacobian_dot(q, q_dot):
-    """D/dt of the analytic Jacobian along q_dot (3 x DOF): mu'' = J_a q'' + J_a' q': 47 operations."""
+    """Time derivative of the analytic Jacobian along q_dot (3 x DOF): mu'' = J_a q'' + J_a' q': 47 operations."""
     q1 = q[0]
     q2 = q[1]
     q3 = q[2]
@@ -382,7 +382,7 @@ def _task_jacobian_dot(q, q_dot):
 
 
 def _hessian(q):
-    """D J / d q_k for each k (DOF x 6 x DOF, indexed [k, r, c]): 28 operations."""
+    """Partial derivatives dJ/dq_k of the world geometric Jacobian (DOF x 6 x DOF, indexed [k, r, c]): 28 operations."""
     q1 = q[0]
     q2 = q[1]
     q3 = q[2]

@@ -62,7 +62,7 @@ void puma560_task_jacobian(const puma560_real q[PUMA560_DOF], puma560_real J[PUM
  * Result: T: 4 x 4 row-major, element (r, c) at T[r * 4 + c]; J: 6 x 6 row-major, element (r, c) at J[r * 6 + c]; a[i], i < 6. 242 operations. */
 void puma560_fk_jacobian_dot(const puma560_real q[PUMA560_DOF], const puma560_real q_dot[PUMA560_DOF], puma560_real T[16], puma560_real J[6 * PUMA560_DOF], puma560_real a[6]);
 
-/* DJ/dt of the world geometric Jacobian along q_dot (6 x DOF).
+/* Time derivative dJ/dt of the world geometric Jacobian along q_dot (6 x DOF).
  * Result: Jd: 6 x 6 row-major, element (r, c) at Jd[r * 6 + c]. 172 operations. */
 void puma560_jacobian_dot(const puma560_real q[PUMA560_DOF], const puma560_real q_dot[PUMA560_DOF], puma560_real Jd[6 * PUMA560_DOF]);
 
@@ -70,11 +70,11 @@ void puma560_jacobian_dot(const puma560_real q[PUMA560_DOF], const puma560_real 
  * Result: a[i], i < 6. 200 operations. */
 void puma560_bias_acceleration(const puma560_real q[PUMA560_DOF], const puma560_real q_dot[PUMA560_DOF], puma560_real a[6]);
 
-/* D/dt of the analytic Jacobian along q_dot (6 x DOF): mu'' = J_a q'' + J_a' q'.
+/* Time derivative of the analytic Jacobian along q_dot (6 x DOF): mu'' = J_a q'' + J_a' q'.
  * Result: Jd: 6 x 6 row-major, element (r, c) at Jd[r * 6 + c]. 433 operations. */
 void puma560_task_jacobian_dot(const puma560_real q[PUMA560_DOF], const puma560_real q_dot[PUMA560_DOF], puma560_real Jd[PUMA560_TASK_DIM * PUMA560_DOF]);
 
-/* D J / d q_k for each k (DOF x 6 x DOF, indexed [k, r, c]).
+/* Partial derivatives dJ/dq_k of the world geometric Jacobian (DOF x 6 x DOF, indexed [k, r, c]).
  * Result: H: 6 x 6 x 6 row-major, element (k, r, c) at H[k * 36 + r * 6 + c]. 148 operations. */
 void puma560_hessian(const puma560_real q[PUMA560_DOF], puma560_real H[PUMA560_DOF * 6 * PUMA560_DOF]);
 

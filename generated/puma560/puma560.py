@@ -743,7 +743,7 @@ def fk_jacobian_dot(q, q_dot):
 
 
 def jacobian_dot(q, q_dot):
-    """dJ/dt of the world geometric Jacobian along q_dot (6 x DOF): (6 x 6), 172 operations."""
+    """time derivative dJ/dt of the world geometric Jacobian along q_dot (6 x DOF): (6 x 6), 172 operations."""
     q = _argument("q", q, (6,))
     q_dot = _argument("q_dot", q_dot, (6,))
     q1 = q[..., 0]
@@ -946,7 +946,7 @@ def bias_acceleration(q, q_dot):
 
 
 def task_jacobian_dot(q, q_dot):
-    """d/dt of the analytic Jacobian along q_dot (6 x DOF): mu'' = J_a q'' + J_a' q': (6 x 6), 433 operations."""
+    """time derivative of the analytic Jacobian along q_dot (6 x DOF): mu'' = J_a q'' + J_a' q': (6 x 6), 433 operations."""
     q = _argument("q", q, (6,))
     q_dot = _argument("q_dot", q_dot, (6,))
     q1 = q[..., 0]
@@ -1157,7 +1157,7 @@ def task_jacobian_dot(q, q_dot):
 
 
 def hessian(q):
-    """d J / d q_k for each k (DOF x 6 x DOF, indexed [k, r, c]): (6 x 6 x 6), 148 operations."""
+    """partial derivatives dJ/dq_k of the world geometric Jacobian (DOF x 6 x DOF, indexed [k, r, c]): (6 x 6 x 6), 148 operations."""
     q = _argument("q", q, (6,))
     q1 = q[..., 0]
     q2 = q[..., 1]

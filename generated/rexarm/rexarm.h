@@ -60,7 +60,7 @@ void rexarm_task_jacobian(const rexarm_real q[REXARM_DOF], rexarm_real J[REXARM_
  * Result: T: 4 x 4 row-major, element (r, c) at T[r * 4 + c]; J: 6 x 4 row-major, element (r, c) at J[r * 4 + c]; a[i], i < 6. 181 operations. */
 void rexarm_fk_jacobian_dot(const rexarm_real q[REXARM_DOF], const rexarm_real q_dot[REXARM_DOF], rexarm_real T[16], rexarm_real J[6 * REXARM_DOF], rexarm_real a[6]);
 
-/* DJ/dt of the world geometric Jacobian along q_dot (6 x DOF).
+/* Time derivative dJ/dt of the world geometric Jacobian along q_dot (6 x DOF).
  * Result: Jd: 6 x 4 row-major, element (r, c) at Jd[r * 4 + c]. 138 operations. */
 void rexarm_jacobian_dot(const rexarm_real q[REXARM_DOF], const rexarm_real q_dot[REXARM_DOF], rexarm_real Jd[6 * REXARM_DOF]);
 
@@ -68,11 +68,11 @@ void rexarm_jacobian_dot(const rexarm_real q[REXARM_DOF], const rexarm_real q_do
  * Result: a[i], i < 6. 162 operations. */
 void rexarm_bias_acceleration(const rexarm_real q[REXARM_DOF], const rexarm_real q_dot[REXARM_DOF], rexarm_real a[6]);
 
-/* D/dt of the analytic Jacobian along q_dot (4 x DOF): mu'' = J_a q'' + J_a' q'.
+/* Time derivative of the analytic Jacobian along q_dot (4 x DOF): mu'' = J_a q'' + J_a' q'.
  * Result: Jd: 4 x 4 row-major, element (r, c) at Jd[r * 4 + c]. 167 operations. */
 void rexarm_task_jacobian_dot(const rexarm_real q[REXARM_DOF], const rexarm_real q_dot[REXARM_DOF], rexarm_real Jd[REXARM_TASK_DIM * REXARM_DOF]);
 
-/* D J / d q_k for each k (DOF x 6 x DOF, indexed [k, r, c]).
+/* Partial derivatives dJ/dq_k of the world geometric Jacobian (DOF x 6 x DOF, indexed [k, r, c]).
  * Result: H: 4 x 6 x 4 row-major, element (k, r, c) at H[k * 24 + r * 4 + c]. 85 operations. */
 void rexarm_hessian(const rexarm_real q[REXARM_DOF], rexarm_real H[REXARM_DOF * 6 * REXARM_DOF]);
 

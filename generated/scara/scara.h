@@ -60,7 +60,7 @@ void scara_task_jacobian(const scara_real q[SCARA_DOF], scara_real J[SCARA_TASK_
  * Result: T: 4 x 4 row-major, element (r, c) at T[r * 4 + c]; J: 6 x 4 row-major, element (r, c) at J[r * 4 + c]; a[i], i < 6. 49 operations. */
 void scara_fk_jacobian_dot(const scara_real q[SCARA_DOF], const scara_real q_dot[SCARA_DOF], scara_real T[16], scara_real J[6 * SCARA_DOF], scara_real a[6]);
 
-/* DJ/dt of the world geometric Jacobian along q_dot (6 x DOF).
+/* Time derivative dJ/dt of the world geometric Jacobian along q_dot (6 x DOF).
  * Result: Jd: 6 x 4 row-major, element (r, c) at Jd[r * 4 + c]. 30 operations. */
 void scara_jacobian_dot(const scara_real q[SCARA_DOF], const scara_real q_dot[SCARA_DOF], scara_real Jd[6 * SCARA_DOF]);
 
@@ -68,11 +68,11 @@ void scara_jacobian_dot(const scara_real q[SCARA_DOF], const scara_real q_dot[SC
  * Result: a[i], i < 6. 34 operations. */
 void scara_bias_acceleration(const scara_real q[SCARA_DOF], const scara_real q_dot[SCARA_DOF], scara_real a[6]);
 
-/* D/dt of the analytic Jacobian along q_dot (4 x DOF): mu'' = J_a q'' + J_a' q'.
+/* Time derivative of the analytic Jacobian along q_dot (4 x DOF): mu'' = J_a q'' + J_a' q'.
  * Result: Jd: 4 x 4 row-major, element (r, c) at Jd[r * 4 + c]. 30 operations. */
 void scara_task_jacobian_dot(const scara_real q[SCARA_DOF], const scara_real q_dot[SCARA_DOF], scara_real Jd[SCARA_TASK_DIM * SCARA_DOF]);
 
-/* D J / d q_k for each k (DOF x 6 x DOF, indexed [k, r, c]).
+/* Partial derivatives dJ/dq_k of the world geometric Jacobian (DOF x 6 x DOF, indexed [k, r, c]).
  * Result: H: 4 x 6 x 4 row-major, element (k, r, c) at H[k * 24 + r * 4 + c]. 20 operations. */
 void scara_hessian(const scara_real q[SCARA_DOF], scara_real H[SCARA_DOF * 6 * SCARA_DOF]);
 

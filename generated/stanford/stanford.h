@@ -62,7 +62,7 @@ void stanford_task_jacobian(const stanford_real q[STANFORD_DOF], stanford_real J
  * Result: T: 4 x 4 row-major, element (r, c) at T[r * 4 + c]; J: 6 x 6 row-major, element (r, c) at J[r * 6 + c]; a[i], i < 6. 180 operations. */
 void stanford_fk_jacobian_dot(const stanford_real q[STANFORD_DOF], const stanford_real q_dot[STANFORD_DOF], stanford_real T[16], stanford_real J[6 * STANFORD_DOF], stanford_real a[6]);
 
-/* DJ/dt of the world geometric Jacobian along q_dot (6 x DOF).
+/* Time derivative dJ/dt of the world geometric Jacobian along q_dot (6 x DOF).
  * Result: Jd: 6 x 6 row-major, element (r, c) at Jd[r * 6 + c]. 120 operations. */
 void stanford_jacobian_dot(const stanford_real q[STANFORD_DOF], const stanford_real q_dot[STANFORD_DOF], stanford_real Jd[6 * STANFORD_DOF]);
 
@@ -70,11 +70,11 @@ void stanford_jacobian_dot(const stanford_real q[STANFORD_DOF], const stanford_r
  * Result: a[i], i < 6. 146 operations. */
 void stanford_bias_acceleration(const stanford_real q[STANFORD_DOF], const stanford_real q_dot[STANFORD_DOF], stanford_real a[6]);
 
-/* D/dt of the analytic Jacobian along q_dot (6 x DOF): mu'' = J_a q'' + J_a' q'.
+/* Time derivative of the analytic Jacobian along q_dot (6 x DOF): mu'' = J_a q'' + J_a' q'.
  * Result: Jd: 6 x 6 row-major, element (r, c) at Jd[r * 6 + c]. 372 operations. */
 void stanford_task_jacobian_dot(const stanford_real q[STANFORD_DOF], const stanford_real q_dot[STANFORD_DOF], stanford_real Jd[STANFORD_TASK_DIM * STANFORD_DOF]);
 
-/* D J / d q_k for each k (DOF x 6 x DOF, indexed [k, r, c]).
+/* Partial derivatives dJ/dq_k of the world geometric Jacobian (DOF x 6 x DOF, indexed [k, r, c]).
  * Result: H: 6 x 6 x 6 row-major, element (k, r, c) at H[k * 36 + r * 6 + c]. 115 operations. */
 void stanford_hessian(const stanford_real q[STANFORD_DOF], stanford_real H[STANFORD_DOF * 6 * STANFORD_DOF]);
 

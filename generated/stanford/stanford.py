@@ -644,7 +644,7 @@ def fk_jacobian_dot(q, q_dot):
 
 
 def jacobian_dot(q, q_dot):
-    """dJ/dt of the world geometric Jacobian along q_dot (6 x DOF): (6 x 6), 120 operations."""
+    """time derivative dJ/dt of the world geometric Jacobian along q_dot (6 x DOF): (6 x 6), 120 operations."""
     q = _argument("q", q, (6,))
     q_dot = _argument("q_dot", q_dot, (6,))
     q1 = q[..., 0]
@@ -820,7 +820,7 @@ def bias_acceleration(q, q_dot):
 
 
 def task_jacobian_dot(q, q_dot):
-    """d/dt of the analytic Jacobian along q_dot (6 x DOF): mu'' = J_a q'' + J_a' q': (6 x 6), 372 operations."""
+    """time derivative of the analytic Jacobian along q_dot (6 x DOF): mu'' = J_a q'' + J_a' q': (6 x 6), 372 operations."""
     q = _argument("q", q, (6,))
     q_dot = _argument("q_dot", q_dot, (6,))
     q1 = q[..., 0]
@@ -1008,7 +1008,7 @@ def task_jacobian_dot(q, q_dot):
 
 
 def hessian(q):
-    """d J / d q_k for each k (DOF x 6 x DOF, indexed [k, r, c]): (6 x 6 x 6), 115 operations."""
+    """partial derivatives dJ/dq_k of the world geometric Jacobian (DOF x 6 x DOF, indexed [k, r, c]): (6 x 6 x 6), 115 operations."""
     q = _argument("q", q, (6,))
     q1 = q[..., 0]
     q2 = q[..., 1]

@@ -62,7 +62,7 @@ void ur5_task_jacobian(const ur5_real q[UR5_DOF], ur5_real J[UR5_TASK_DIM * UR5_
  * Result: T: 4 x 4 row-major, element (r, c) at T[r * 4 + c]; J: 6 x 6 row-major, element (r, c) at J[r * 6 + c]; a[i], i < 6. 296 operations. */
 void ur5_fk_jacobian_dot(const ur5_real q[UR5_DOF], const ur5_real q_dot[UR5_DOF], ur5_real T[16], ur5_real J[6 * UR5_DOF], ur5_real a[6]);
 
-/* DJ/dt of the world geometric Jacobian along q_dot (6 x DOF).
+/* Time derivative dJ/dt of the world geometric Jacobian along q_dot (6 x DOF).
  * Result: Jd: 6 x 6 row-major, element (r, c) at Jd[r * 6 + c]. 219 operations. */
 void ur5_jacobian_dot(const ur5_real q[UR5_DOF], const ur5_real q_dot[UR5_DOF], ur5_real Jd[6 * UR5_DOF]);
 
@@ -70,11 +70,11 @@ void ur5_jacobian_dot(const ur5_real q[UR5_DOF], const ur5_real q_dot[UR5_DOF], 
  * Result: a[i], i < 6. 262 operations. */
 void ur5_bias_acceleration(const ur5_real q[UR5_DOF], const ur5_real q_dot[UR5_DOF], ur5_real a[6]);
 
-/* D/dt of the analytic Jacobian along q_dot (6 x DOF): mu'' = J_a q'' + J_a' q'.
+/* Time derivative of the analytic Jacobian along q_dot (6 x DOF): mu'' = J_a q'' + J_a' q'.
  * Result: Jd: 6 x 6 row-major, element (r, c) at Jd[r * 6 + c]. 430 operations. */
 void ur5_task_jacobian_dot(const ur5_real q[UR5_DOF], const ur5_real q_dot[UR5_DOF], ur5_real Jd[UR5_TASK_DIM * UR5_DOF]);
 
-/* D J / d q_k for each k (DOF x 6 x DOF, indexed [k, r, c]).
+/* Partial derivatives dJ/dq_k of the world geometric Jacobian (DOF x 6 x DOF, indexed [k, r, c]).
  * Result: H: 6 x 6 x 6 row-major, element (k, r, c) at H[k * 36 + r * 6 + c]. 152 operations. */
 void ur5_hessian(const ur5_real q[UR5_DOF], ur5_real H[UR5_DOF * 6 * UR5_DOF]);
 

@@ -700,7 +700,7 @@ def _fk_jacobian_dot(q, q_dot):
 
 
 def _jacobian_dot(q, q_dot):
-    """DJ/dt of the world geometric Jacobian along q_dot (6 x DOF): 219 operations."""
+    """Time derivative dJ/dt of the world geometric Jacobian along q_dot (6 x DOF): 219 operations."""
     q1 = q[0]
     q2 = q[1]
     q3 = q[2]
@@ -909,7 +909,7 @@ def _bias_acceleration(q, q_dot):
 
 
 def _task_jacobian_dot(q, q_dot):
-    """D/dt of the analytic Jacobian along q_dot (6 x DOF): mu'' = J_a q'' + J_a' q': 430 operations."""
+    """Time derivative of the analytic Jacobian along q_dot (6 x DOF): mu'' = J_a q'' + J_a' q': 430 operations."""
     q1 = q[0]
     q2 = q[1]
     q3 = q[2]
@@ -1118,7 +1118,7 @@ def _task_jacobian_dot(q, q_dot):
 
 
 def _hessian(q):
-    """D J / d q_k for each k (DOF x 6 x DOF, indexed [k, r, c]): 152 operations."""
+    """Partial derivatives dJ/dq_k of the world geometric Jacobian (DOF x 6 x DOF, indexed [k, r, c]): 152 operations."""
     q1 = q[0]
     q2 = q[1]
     q3 = q[2]
