@@ -21,6 +21,7 @@ from .errors import JacgenError
 from .names import robot_name_problem
 from .robot import FORBIDDEN_IN_TEXT, IDENTIFIER_PATTERN, NAME_PATTERN, TASK_COMPONENTS, Robot, parse_robot
 from .urdf import MOVABLE, SNAP_TOLERANCE, Chain, Snapper, read_chain
+from .verify import bounds
 
 CHECK_CONFIGURATIONS = 20
 CHECK_SEED = 0
@@ -227,8 +228,7 @@ def urdf_fk(chain: Chain, q) -> np.ndarray:
 
 def _fk_difference(robot, chain: Chain) -> float:
     rng = np.random.default_rng(CHECK_SEED)
-    low = np.array([j.limits[0] if j.limits else -np.pi for j in robot.joints])
-    high = np.array([j.limits[1] if j.limits else np.pi for j in robot.joints])
+    low, high = bounds(robot).T
     worst = 0.0
     for _ in range(CHECK_CONFIGURATIONS):
         q = rng.uniform(low, high)
