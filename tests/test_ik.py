@@ -20,7 +20,7 @@ from jacgen.compile import CLibrary, compile_shared
 from jacgen.render import render_robot
 from jacgen.robot import parse_robot
 
-from conftest import import_file, random_configurations, robot
+from conftest import GENERATED, generated_module, import_file, random_configurations, robot
 
 WITH_IK = ["planar_2r", "planar_3r", "scara", "rexarm", "puma560", "kr5", "stanford", "ur5"]
 WITHOUT_IK = ["iiwa", "panda"]
@@ -41,9 +41,9 @@ def _generate(arm, folder, languages=("python",), real="double"):
 
 
 @pytest.fixture(scope="module")
-def modules(tmp_path_factory):
-    folder = tmp_path_factory.mktemp("python")
-    return {name: _generate(robot(name), folder) for name in WITH_IK + WITHOUT_IK}
+def modules():
+    """The committed generated modules of the shipped robots (test_golden checks they are current)."""
+    return {name: generated_module(name) for name in WITH_IK + WITHOUT_IK}
 
 
 def _pose_task(arm) -> bool:
@@ -345,7 +345,8 @@ def c_solvers(request, tmp_path_factory):
     solvers = {}
     for name in WITH_IK + WITHOUT_IK:
         arm = robot(name)
-        library = CLibrary(compile_shared([_generate(arm, folder, ("c",), real)], folder / f"lib{name}.so"), arm, [], real)
+        source = GENERATED / name / f"{name}.c" if real == "double" else _generate(arm, folder, ("c",), real)
+        library = CLibrary(compile_shared([source], folder / f"lib{name}.so"), arm, [], real)
         closed = functools.partial(library.ik, max_solutions=8) if name in WITH_IK else None
         solvers[name] = (closed, library.ik_numeric)
     return real, solvers
