@@ -52,41 +52,61 @@ HARNESS = r"""
 #include <time.h>
 #include "NAME.h"
 
+#ifdef NAME_UPPER_IK_FREE_JOINT /* a 7-joint arm: the free joint's angle per target, from argv[4] */
+#define FREE(i) frees[i],
+#else
+#define FREE(i)
+#endif
+
 static double now(void) { struct timespec t; clock_gettime(CLOCK_MONOTONIC, &t); return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec; }
+
+static int load(const char *path, double *values, long count)
+{
+    FILE *file = fopen(path, "rb");
+    int ok = file && fread(values, sizeof(double), (size_t)count, file) == (size_t)count;
+    if (file) fclose(file);
+    return ok;
+}
 
 int main(int argc, char **argv)
 {
-    const long count = atol(argv[2]);
-    const int rounds = atoi(argv[3]);
-    double *targets = malloc(sizeof(double) * 16 * (size_t)count);
+    const long count = argc >= 4 ? atol(argv[2]) : 0;
+    const int rounds = argc >= 4 ? atoi(argv[3]) : 0;
+    double *targets = malloc(sizeof(double) * 16 * (size_t)count), *frees = malloc(sizeof(double) * (size_t)count);
     double q[NAME_UPPER_MAX_IK_SOLUTIONS * NAME_UPPER_DOF];
-    FILE *file = fopen(argv[1], "rb");
     long solutions = 0;
-    if (argc != 4 || !targets || !file || fread(targets, sizeof(double) * 16, (size_t)count, file) != (size_t)count) {
+    if (!targets || !frees || !load(argv[1], targets, 16 * count) || (argc > 4 && !load(argv[4], frees, count))) {
         return 2;
     }
-    fclose(file);
+    (void)frees;
     for (int round = 0; round < rounds; ++round) {
         const double t0 = now();
         solutions = 0;
-        for (long i = 0; i < count; ++i) solutions += NAME_ik(targets + 16 * i, q);
+        for (long i = 0; i < count; ++i) solutions += NAME_ik(targets + 16 * i, FREE(i) q);
         printf("%.4f %ld\n", (now() - t0) * 1e6 / (double)count, solutions);
     }
     free(targets);
+    free(frees);
     return 0;
 }
 """
 
 
-def native(robot, source: Path, targets: np.ndarray, rounds: int, folder: Path) -> tuple[float, int]:
-    """Median microseconds per pose of NAME_ik in a native loop, and the solutions found."""
+def native(robot, source: Path, targets: np.ndarray, rounds: int, folder: Path,
+           frees: np.ndarray | None = None) -> tuple[float, int]:
+    """Median microseconds per pose of NAME_ik in a native loop (with the free joint's angle per
+    target for a 7-joint arm), and the solutions found."""
     harness = folder / f"harness_{robot.name}.c"
     harness.write_text(HARNESS.replace("NAME_UPPER", robot.name.upper()).replace("NAME", robot.name))
     binary, data = folder / f"harness_{robot.name}", folder / f"targets_{robot.name}.bin"
     targets.astype(np.float64).tofile(data)
+    extra = []
+    if frees is not None:
+        extra = [folder / f"frees_{robot.name}.bin"]
+        frees.astype(np.float64).tofile(extra[0])
     subprocess.run(["gcc", *WARNING_FLAGS, "-O2", "-I", source.parent, "-o", binary, harness, source, "-lm"],
                    check=True)
-    output = subprocess.run([binary, data, str(len(targets)), str(rounds)], check=True, capture_output=True,
+    output = subprocess.run([binary, data, str(len(targets)), str(rounds), *extra], check=True, capture_output=True,
                             text=True).stdout.split("\n")
     rows = [line.split() for line in output if line]
     return statistics.median(float(row[0]) for row in rows), int(rows[-1][1])

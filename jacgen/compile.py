@@ -103,12 +103,15 @@ class CLibrary:
         values = {p.name: p.value for p in self.robot.symbolic_parameters} | (parameters or {})
         return [ctypes.byref(self._parameters(*(values[p.name] for p in self.robot.symbolic_parameters)))]
 
-    def ik(self, target: np.ndarray, max_solutions: int, parameters: dict[str, float] | None = None) -> np.ndarray:
-        """`NAME_ik` for one target (4x4 pose or task vector): the solutions, (k, dof)."""
+    def ik(self, target: np.ndarray, max_solutions: int, parameters: dict[str, float] | None = None,
+           q_free: float | None = None) -> np.ndarray:
+        """`NAME_ik` for one target (4x4 pose or task vector) and, with a free joint, its
+        angle: the solutions, (k, dof)."""
         pointer = ctypes.POINTER(C_TYPES[self.real])
         target = np.ascontiguousarray(np.ravel(target), dtype=self.dtype)
         solutions = np.zeros(max_solutions * self.robot.dof, dtype=self.dtype)
-        count = getattr(self._library, f"{self.robot.name}_ik")(target.ctypes.data_as(pointer),
+        free = [] if q_free is None else [C_TYPES[self.real](q_free)]
+        count = getattr(self._library, f"{self.robot.name}_ik")(target.ctypes.data_as(pointer), *free,
                                                                  solutions.ctypes.data_as(pointer),
                                                                  *self._extra(parameters))
         return solutions[: count * self.robot.dof].reshape(count, self.robot.dof).astype(np.float64)

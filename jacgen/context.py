@@ -70,7 +70,7 @@ def _python_function(function: Function, printer: PythonPrinter, parameters: lis
         "shape": " and ".join(_dimensions(o) for o in function.outputs),
         "operations": body.operation_count,
         "arguments": [(a.name, repr(shape)) for a, shape in zip(function.arguments, shapes)],
-        "signature": ", ".join([f"{a.name}=0.0" if a.scalar else a.name for a in function.arguments] + ["*"] * bool(parameters)
+        "signature": ", ".join([f"{a.name}={a.default}" if a.default else a.name for a in function.arguments] + ["*"] * bool(parameters)
                                + [f"{p['name']}={p['value']}" for p in parameters]),
         "batch": batches[0] if len(batches) == 1 else f"numpy.broadcast_shapes({', '.join(batches)})",
         "selects": any(e.has(sympy.Piecewise) for e in [v for _, v in body.definitions] + list(body.outputs)),
@@ -227,14 +227,16 @@ def _ik_context(robot: Robot, generator: Generator, language: str, real: str) ->
     prefix, real_type = robot.name.upper(), f"{robot.name}_real"
     pose = form.target == "pose"
     target = f"const {real_type} T[16]" if pose else f"const {real_type} mu[{prefix}_TASK_DIM]"
-    arguments = [target, f"{real_type} q[{prefix}_MAX_IK_SOLUTIONS * {prefix}_DOF]"]
+    inputs = ["T" if pose else "mu"] + ["q_free"] * (form.free is not None)
+    arguments = [target] + [f"{real_type} q_free"] * (form.free is not None)
+    arguments += [f"{real_type} q[{prefix}_MAX_IK_SOLUTIONS * {prefix}_DOF]"]
     arguments += [f"const {robot.name}_params *p"] * bool(robot.symbolic_parameters)
     return {
         "solver": form.solver,
         "max_solutions": form.info.max_solutions,
         "doc": ik.documentation(robot, form, "MAX_IK_SOLUTIONS" if language == "python" else f"{prefix}_MAX_IK_SOLUTIONS"),
-        "target_name": "T" if pose else "mu",
-        "target_ndim": 2 if pose else 1,
+        "inputs": ", ".join(inputs),
+        "free_joint": form.free,
         "signature": ", ".join(arguments),
     }
 
@@ -322,6 +324,8 @@ def c_context(robot: Robot, generator: Generator, printer: CPrinter, real: str) 
     context = _common(robot)
     functions = generator.functions()
     macros = _c_macros(robot, functions)
+    if generator.closed_form and generator.closed_form.free is not None:
+        macros["IK_FREE_JOINT"] = generator.closed_form.free  # 0-based index into q of ik's q_free
     context.update({
         "prefix": robot.name.upper(),
         "real": real,
@@ -342,7 +346,7 @@ def casadi_context(robot: Robot, generator: Generator, printer: CasadiPrinter, r
     functions = generator.functions()
     context["functions"] = [_casadi_function(f, robot, printer) for f in functions]
     context["arguments"] = sorted({(a.name, a.symbols.rows, a.symbols.cols) for f in functions for a in f.arguments},
-                                  key=lambda a: ("q", "q_dot", "mu_dot", "damping", "target", "T", "mu").index(a[0]))
+                                  key=lambda a: ("q", "q_dot", "mu_dot", "damping", "target", "T", "mu", "q_free").index(a[0]))
     context["ik"] = generator.closed_form is not None
     context["ik_numeric"] = _ik_numeric_context(robot, "python", "double")
     return dict(sorted(context.items()))

@@ -50,6 +50,7 @@ class Argument:
     symbols: sympy.Matrix
     vector: bool = True  # numpy shape (..., rows); else (..., rows, cols)
     scalar: bool = False  # one number: by value in C, shape (...) in numpy, its symbol named as the argument
+    default: str | None = None  # a scalar's default in Python
 
     @property
     def size(self) -> int:
@@ -142,9 +143,7 @@ class Generator:
         """Symbols for the cos and sin of a sum of joint angles, defined on first use:
         `c2 = cos(q2)` for one joint, `c23 = c2*c3 - s2*s3` for a run of parallel joints."""
         if joints not in self._trig:
-            separator = "_" if any(i >= 9 for i in joints) else ""
-            label = separator.join(str(i + 1) for i in joints)
-            cos, sin = sympy.symbols(f"c{label} s{label}", real=True)
+            cos, sin = kinematics.trig_symbols(joints)
             if len(joints) == 1:
                 angle = self.q[joints[0]] + self.robot.joints[joints[0]].offset.exact
                 value = (sympy.cos(angle), sympy.sin(angle))
@@ -168,16 +167,23 @@ class Generator:
             target = Argument("T", sympy.Matrix(4, 4, lambda r, c: sympy.Symbol(f"T{r}{c}", real=True)), vector=False)
         else:
             target = Argument("mu", sympy.Matrix([sympy.Symbol(f"mu{i}", real=True) for i in range(len(self.robot.task))]))
+        arguments, bindings, free_angle = (target,), {}, None
+        if form.free is not None:  # the free joint's angle is an input; its cos and sin are the usual c_k, s_k
+            free = Argument("q_free", sympy.Matrix([sympy.Symbol("q_free", real=True)]), scalar=True)
+            arguments += (free,)
+            free_angle = self.q[form.free]
+            bindings = {free_angle: free.symbols[0]}
+            self.cos_sin((form.free,))
         with distribute(False):
-            q, valid = ik.branches(self.robot, form, Subproblems(self.name), target.symbols)
+            q, valid = ik.branches(self.robot, form, Subproblems(self.name), target.symbols, free_angle)
         return [self.function("ik_branches", "every branch of the closed-form ik and whether the target allows it",
-                              ("q", q), ("valid", valid), arguments=(target,))]
+                              ("q", q), ("valid", valid), arguments=arguments, bindings=bindings)]
 
     def velocity_ik_function(self, js: sympy.Matrix) -> Function:
         """velocity_ik: q_dot solving Js q_dot = mu_dot, and the status (`differential`)."""
         m, n = js.shape
         mu_dot = Argument("mu_dot", sympy.Matrix([sympy.Symbol(f"mu_dot{i}", real=True) for i in range(m)]))
-        damping = Argument("damping", sympy.Matrix([sympy.Symbol("damping", real=True)]), scalar=True)
+        damping = Argument("damping", sympy.Matrix([sympy.Symbol("damping", real=True)]), scalar=True, default="0.0")
         with distribute(False):
             q_dot, status = differential.velocity_ik(js, list(self.q), list(mu_dot.symbols), damping.symbols[0], self.name)
         form = "Js^-1 mu_dot (damping 0) or " if m == n else ""
@@ -195,7 +201,7 @@ class Generator:
         else:
             target = Argument("target", sympy.Matrix([sympy.Symbol(f"mu{i}", real=True) for i in range(len(robot.task))]))
         given = Argument("q", sympy.Matrix([sympy.Symbol(f"qs{i + 1}", real=True) for i in range(n)]))
-        damping = Argument("damping", sympy.Matrix([sympy.Symbol("damping", real=True)]), scalar=True)
+        damping = Argument("damping", sympy.Matrix([sympy.Symbol("damping", real=True)]), scalar=True, default="0.0")
         limits = [joint.limits for joint in robot.joints]
         bindings = {qi: differential.clamp(given_i, bounds) for qi, given_i, bounds in zip(self.q, given.symbols, limits)}
         with distribute(False):

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 import sympy
 
-from .structure import E_Z, SOLVERS, Geometry, SolverInfo, Structure, classify, is_zero, squared_norm, tidy
+from .structure import E_Z, SOLVERS, Geometry, SolverInfo, Structure, classify, is_zero, tidy
 from .subproblems import EPS, Angle, IsFinite, Subproblems, relative, select, times, times_transposed, wrapped
 
 Matrix = sympy.Matrix
@@ -32,18 +32,9 @@ class ClosedForm:
     constants: tuple[tuple[str, sympy.Matrix], ...]  # name -> 3x1, 3x3 or 1x1 exact values
     indices: tuple[tuple[str, int], ...]  # named joint indices the planar skeleton places
     flip: bool  # axis 5 perpendicular to its neighbours: a second wrist root follows from the first
-
-
-def _unit(v: Matrix) -> Matrix:
-    return (v / sympy.sqrt(squared_norm(v))).applyfunc(tidy)
-
-
-def perpendicular(h: Matrix, nominal: dict) -> Matrix:
-    """A unit vector perpendicular to the unit vector h: from the world axis least along h
-    (at the parameters' nominal values)."""
-    basis = [Matrix([1, 0, 0]), Matrix([0, 1, 0]), E_Z]
-    e = min(basis, key=lambda b: abs(float(sympy.N(b.dot(h).subs(nominal)))))
-    return _unit(e - e.dot(h) * h)
+    joints: tuple[int, ...]  # the robot's joint of each of the solver's joints
+    signs: tuple[int, ...]  # -1 where the solver turns the robot's joint the other way (a reversed chain)
+    free: int | None  # the joint ik takes as an input (a 7-joint arm), else None
 
 
 def _scalar(value) -> Matrix:
@@ -57,7 +48,7 @@ def _pose(g: Geometry) -> list[tuple[str, Matrix]]:
 
 def _wrist(g: Geometry) -> list[tuple[str, Matrix]]:
     h = g.axes
-    return [("h4", h[3]), ("h5", h[4]), ("h6", h[5]), ("v6", perpendicular(h[5], g.nominal)),
+    return [("h4", h[3]), ("h5", h[4]), ("h6", h[5]), ("v6", g.normals[5]),
             ("centre", g.wrist_centre(3))]
 
 
@@ -113,7 +104,7 @@ def _three_parallel(g: Geometry) -> tuple[list, list]:
     h, p = g.axes, g.points
     centre = g.intersection(4, 5)
     return _pose(g) + [
-        ("h1", h[0]), ("p1", p[0]), ("h", h[1]), ("v", perpendicular(h[1], g.nominal)), ("p2", p[1]),
+        ("h1", h[0]), ("p1", p[0]), ("h", h[1]), ("v", g.normals[1]), ("p2", p[1]),
         ("h3", h[2]), ("p3", p[2]), ("p4", p[3]), ("h5", h[4]), ("h6", h[5]), ("centre", centre),
         ("reach", _scalar(h[1].dot(centre - p[0]))),
         ("sign3", _scalar(h[1].dot(h[2]))), ("sign4", _scalar(h[1].dot(h[3]))),
@@ -140,19 +131,39 @@ _CONSTANTS = {
 def closed_form(robot, geometry: Geometry | None = None, structure: Structure | None = None) -> ClosedForm | None:
     """The closed-form solver of `robot` with its exact constants, None when no class applies
     (pass the robot's geometry and structure when they are known: see `model.Model`)."""
-    geometry = geometry or Geometry(robot)
     structure = structure or classify(robot, geometry)
     if structure.solver is None:
         return None
-    constants, indices = _CONSTANTS[structure.solver](geometry)
+    chain = structure.chain
+    constants, indices = _CONSTANTS[structure.solver](chain)
+    if chain.start is not None:  # a reversed chain: its target is T(0) T^-1
+        constants += [("start_rotation", chain.start[:3, :3]), ("start_position", chain.start[:3, 3])]
     target = "pose" if len(robot.task) == 6 else "task"
-    h = geometry.axes
+    h = chain.axes
     flip = structure.solver in _FLIPS and all(is_zero(h[4].dot(h[i])) for i in _FLIPS[structure.solver])
     if flip and structure.solver.startswith("spherical_wrist"):
-        turn = sympy.atan2(h[4].dot(h[3].cross(h[5])), h[3].dot(h[5]))  # h6 = rot(h5, turn) h4
+        turn = sympy.atan2(tidy(h[4].dot(h[3].cross(h[5]))), tidy(h[3].dot(h[5])))  # h6 = rot(h5, turn) h4
         constants.append(("wrist_flip", _scalar(-2 * turn)))
     return ClosedForm(structure.solver, SOLVERS[structure.solver], target,
-                      tuple((name, Matrix(value)) for name, value in constants), tuple(indices), flip)
+                      tuple((name, Matrix(value)) for name, value in constants), tuple(indices), flip,
+                      chain.joints, chain.signs, chain.free)
+
+
+def _chain_text(form: ClosedForm) -> list[str]:
+    """How the solver's joints are the robot's: a free joint left out, a chain solved backwards."""
+    if form.free is None and form.joints == tuple(range(len(form.joints))):
+        return []
+    text = []
+    if form.free is not None:
+        text.append(f"q_free: the angle of joint {form.free + 1} (rad); every solution keeps it as given "
+                    "and solves the other six joints for it.")
+    numbers = ", ".join(str(j + 1) for j in form.joints)
+    if form.signs[0] < 0:
+        text.append(f"The solver's joints 1-6 below are the robot's joints {numbers}, each turned the other way: "
+                    "the chain is solved from the tool back to the base.")
+    else:
+        text.append(f"The solver's joints 1-6 below are the robot's joints {numbers}.")
+    return text
 
 
 def documentation(robot, form: ClosedForm, max_name: str) -> list[str]:
@@ -167,6 +178,7 @@ def documentation(robot, form: ClosedForm, max_name: str) -> list[str]:
         f"Result: k <= {max_name} solutions, revolute angles wrapped into (-pi, pi], joint limits "
         "not applied; k = 0 when the target is out of reach or not finite.",
         f"Solver: {form.info.title}.",
+        *_chain_text(form),
         "Order: nested loops over the branches, outermost first; where a subproblem has two roots "
         "phi +- alpha (alpha in (0, pi)), phi + alpha ('+') comes first:",
     ]
@@ -348,17 +360,30 @@ def _constant(value: Matrix):
     return tuple(value) if 1 in value.shape else value
 
 
-def branches(robot, form: ClosedForm, sp: Subproblems, target) -> tuple[sympy.Matrix, list]:
+def _reversed_target(sp: Subproblems, k: dict, T) -> sympy.Matrix:
+    """T(0) T^-1, the target of a reversed chain (see `structure.Geometry.reversed`)."""
+    start, position = k["start_rotation"], k["start_position"]
+    rotation = [[sp.name(sum(start[i, m] * T[j, m] for m in range(3))) for j in range(3)] for i in range(3)]
+    offset = [sp.name(position[i] - sum(rotation[i][j] * T[j, 3] for j in range(3))) for i in range(3)]
+    return sympy.Matrix([row + [offset[i]] for i, row in enumerate(rotation)] + [[0, 0, 0, 1]])
+
+
+def branches(robot, form: ClosedForm, sp: Subproblems, target, free_angle=None) -> tuple[sympy.Matrix, list]:
     """Every branch of the solver (MAX_IK_SOLUTIONS x DOF, revolute angles wrapped into
-    (-pi, pi]) and its validity (MAX_IK_SOLUTIONS x 1): a branch is valid when the target
-    allows it and every entry of the target read (not a pose's last row) is finite. `target` is the 4x4 pose or the task
-    vector, as symbols."""
+    (-pi, pi], the free joint `free_angle` as given) and its validity (MAX_IK_SOLUTIONS x 1):
+    a branch is valid when the target allows it and every entry of the target read (not a
+    pose's last row) is finite. `target` is the 4x4 pose or the task vector, as symbols."""
     k = {name: _constant(value) for name, value in form.constants}
-    solved = _BRANCHES[form.solver](sp, k, target, form, robot.dof)
+    solved = _BRANCHES[form.solver](sp, k, _reversed_target(sp, k, target) if "start_rotation" in k else target,
+                                    form, len(form.joints))
     if len(solved) != form.info.max_solutions:
         raise AssertionError(f"{form.solver}: {len(solved)} branches, documented {form.info.max_solutions}")
     # One test for all entries: their sum is finite unless one is not (or they exceed 1e307).
     finite = IsFinite(sp.name(sympy.Add(*(target[:3, :] if form.target == "pose" else target))))
-    q = sympy.Matrix([[wrapped(value) if joint.revolute else value for value, joint in zip(values, robot.joints)]
-                      for values, _ in solved])
-    return q, [sympy.And(finite, valid) for _, valid in solved]
+    rows = []
+    for values, _ in solved:
+        q = [free_angle] * robot.dof
+        for joint, sign, value in zip(form.joints, form.signs, values):
+            q[joint] = wrapped(sign * value) if robot.joints[joint].revolute else sign * value
+        rows.append(q)
+    return sympy.Matrix(rows), [sympy.And(finite, valid) for _, valid in solved]

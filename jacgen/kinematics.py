@@ -23,6 +23,14 @@ def joint_symbols(robot: Robot) -> tuple[sympy.Symbol, ...]:
     return sympy.symbols(f"q1:{robot.dof + 1}", real=True)
 
 
+def trig_symbols(joints: tuple[int, ...]) -> tuple[sympy.Symbol, sympy.Symbol]:
+    """The symbols of the cos and sin of a sum of joint angles (0-based joints): c2, s2 for
+    joint 2, c23, s23 for joints 2 and 3, c9_10 once a joint number has two digits."""
+    separator = "_" if any(i >= 9 for i in joints) else ""
+    label = separator.join(str(i + 1) for i in joints)
+    return sympy.symbols(f"c{label} s{label}", real=True)
+
+
 def rot_x(c, s) -> Matrix:
     return Matrix([[1, 0, 0, 0], [0, c, -s, 0], [0, s, c, 0], [0, 0, 0, 1]])
 

@@ -89,6 +89,7 @@ class Robot:
     task: tuple[str, ...]
     source: str  # the path as given, for messages
     digest: str  # sha256 of the file's bytes, first 16 hex digits
+    free_joint: int | None = None  # `ik: {free_joint: k}`, 0-based: the joint the closed-form ik takes as input
 
     @property
     def dof(self) -> int:
@@ -255,7 +256,7 @@ class _RobotReader:
         top = self.mapping(
             root, "",
             ("name", "description", "convention", "angle_unit", "length_unit", "parameters",
-             "joints", "base", "tool", "task"),
+             "joints", "base", "tool", "task", "ik"),
             ("name", "convention", "joints"),
         )
         name = self.string(top["name"], "name", pattern=NAME_PATTERN)
@@ -272,8 +273,9 @@ class _RobotReader:
         base = self.pose(top["base"], "base") if "base" in top else IDENTITY_POSE
         tool = self.pose(top["tool"], "tool") if "tool" in top else IDENTITY_POSE
         task = self.task(top.get("task"), root, len(joints))
+        free_joint = self.free_joint(top["ik"], joints, task) if "ik" in top else None
         return Robot(name, description, convention, length_unit, parameters, joints, base, tool,
-                     task, self.path, hashlib.sha256(self.data).hexdigest()[:16])
+                     task, self.path, hashlib.sha256(self.data).hexdigest()[:16], free_joint)
 
     def parameters(self, node, robot_name: str) -> tuple[Parameter, ...]:
         if not isinstance(node, yaml.MappingNode):
@@ -372,6 +374,25 @@ class _RobotReader:
             raise self.error(node, "task", f"components must be distinct and in the order "
                              f"x, y, z, roll, pitch, yaw: write [{canonical}]")
         return tuple(names)
+
+
+    def free_joint(self, node, joints: tuple[Joint, ...], task: tuple[str, ...]) -> int:
+        """`ik: {free_joint: k}` (1-based, as the joint table is read): a revolute joint of a
+        7-joint arm with the full pose task. Returned 0-based."""
+        entries = self.mapping(node, "ik", ("free_joint",), ("free_joint",))
+        item = entries["free_joint"]
+        number = item.value if isinstance(item, yaml.ScalarNode) and item.tag == "tag:yaml.org,2002:int" else ""
+        if not number.isdigit():
+            raise self.error(item, "ik.free_joint", f"expected a joint number 1 to {len(joints)}, got {_describe(item)}")
+        number = int(number)
+        if not 1 <= number <= len(joints):
+            raise self.error(item, "ik.free_joint", f"expected a joint number 1 to {len(joints)}, got {number}")
+        if len(joints) != 7 or task != TASK_COMPONENTS:
+            raise self.error(item, "ik.free_joint", f"a free joint needs 7 joints and the full pose task "
+                             f"(one joint more than the task), not {len(joints)} joints for {len(task)} components")
+        if not joints[number - 1].revolute:
+            raise self.error(item, "ik.free_joint", f"joint {number} is prismatic: the free joint must be revolute")
+        return number - 1
 
 
 def _scaled(value: Value, scale: Value) -> Value:

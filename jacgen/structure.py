@@ -7,9 +7,18 @@ product-of-exponentials description T(q) = exp(xi_1 q_1) ... exp(xi_n q_n) T(0) 
 closed-form solvers of `ik.py` work on. Relations between axes (parallel, intersecting,
 meeting in one point) are decided exactly, so a structure is recognised only when it holds
 for the robot's dimensions (with symbolic parameters: for every value of them).
+
+A 7-joint arm is solved as a 6-joint chain with one joint free (an input of ik): the
+geometry then holds that joint at the angle whose cos and sin are the symbols c_k, s_k, the
+axes after it depend on them, and a relation is decided for every angle of the free joint
+(exactly: polynomials in c_k, s_k reduced by c_k^2 + s_k^2 = 1). A chain whose first axes
+meet in a point (a spherical shoulder) is solved backwards: `Geometry.reversed`.
 """
 
-from dataclasses import dataclass, replace
+import re
+
+import copy
+from dataclasses import dataclass, field, replace
 
 import sympy
 
@@ -81,19 +90,52 @@ class Structure:
     solver: str | None
     features: tuple[str, ...]  # what was found, in words
     reason: str  # why the solver applies, or why no solver does
+    chain: "Geometry | None" = field(default=None, compare=False)  # what the solver solves (see Geometry)
+
+
+_FREE_TRIG = re.compile(r"[cs](\d+)")  # the free joint's cos and sin (kinematics.trig_symbols); no parameter is named so
+
+
+def _circle(expr: sympy.Expr) -> tuple[sympy.Symbol, sympy.Symbol] | None:
+    """The cos and sin symbols of the free joint when `expr` depends on them."""
+    match = next((m for x in expr.free_symbols if (m := _FREE_TRIG.fullmatch(x.name))), None)
+    return None if match is None else sympy.symbols(f"c{match[1]} s{match[1]}", real=True)
+
+
+def _on_circle(polynomial: sympy.Expr, cos: sympy.Symbol, sin: sympy.Symbol) -> sympy.Expr:
+    """The polynomial with sin^2 = 1 - cos^2: a(cos) + sin b(cos), one form per function on the
+    circle; numeric coefficients below 1e-40 (the rounding of 60-digit numbers) dropped."""
+    terms = sympy.Poly(sympy.expand(polynomial), sin).terms()
+    reduced = sympy.Poly(sympy.Add(*(c * sin ** (k % 2) * (1 - cos**2) ** (k // 2) for (k,), c in terms)), cos, sin)
+    return sympy.Add(*(c * cos**i * sin**j for (i, j), c in reduced.terms() if c.free_symbols or not is_zero(c)))
+
+
+def _rational(expr: sympy.Expr, circle: tuple[sympy.Symbol, sympy.Symbol]) -> bool:
+    """A rational function of the free joint's cos and sin (the geometry's relations are)."""
+    return all(not atom.has(*circle) or atom in circle for atom in expr.atoms(sympy.Function, sympy.Pow)
+               if not (isinstance(atom, sympy.Pow) and atom.exp.is_Integer))
 
 
 def is_zero(expr) -> bool:
-    """Zero: simplified when symbolic, else evaluated (exact or 60-digit inputs) below 1e-40."""
+    """Zero: simplified when symbolic, else evaluated (exact or 60-digit inputs) below 1e-40;
+    a function of the free joint is zero when it is for every angle of it."""
     expr = sympy.sympify(expr)
+    circle = _circle(expr)
+    if circle and _rational(expr, circle):
+        return _on_circle(sympy.fraction(sympy.together(expr))[0], *circle) == 0
     if expr.free_symbols:
         return sympy.simplify(expr) == 0
     return abs(complex(sympy.N(expr, PRECISION))) < 1e-40
 
 
 def tidy(expr: sympy.Expr) -> sympy.Expr:
-    """Simplified when symbolic (for readable reports); numbers stay as they are, since
-    simplifying exact trigonometric numbers is slow and their value is all that is used."""
+    """Simplified when symbolic (for readable reports), reduced on the circle when a function of
+    the free joint; numbers stay as they are, since simplifying exact trigonometric numbers
+    is slow and their value is all that is used."""
+    circle = _circle(expr)
+    if circle and _rational(expr, circle):
+        numerator, denominator = sympy.fraction(sympy.together(expr))
+        return _on_circle(numerator, *circle) / _on_circle(denominator, *circle)
     return sympy.simplify(expr) if expr.free_symbols else expr
 
 
@@ -126,21 +168,44 @@ def squared_norm(v: Matrix) -> sympy.Expr:
 
 class Geometry:
     """Joint axes (unit directions, a point on each) and tool pose at q = 0, in the world frame,
-    exact (irrational numbers to 60 digits), and the relations between the axes."""
+    exact (irrational numbers to 60 digits), and the relations between the axes.
 
-    def __init__(self, robot: Robot):
-        self.robot = robot
+    With a `free` joint, that joint is held at the angle of the symbols (c_k, s_k) and left
+    out of the axes: the geometry is that of the remaining chain. `joints` gives the robot's
+    joint of each axis, `signs` whether the solver's angle is the robot's (1) or its negative."""
+
+    def __init__(self, robot: Robot, free: int | None = None):
         n = robot.dof
         precise = _precise_robot(robot)
-        cos_sin = [(sympy.cos(j.offset.exact), sympy.sin(j.offset.exact)) if j.revolute else None
-                   for j in precise.joints]
-        chain = kinematics.build_chain(precise, lambda i: cos_sin[i], [sympy.Integer(0)] * n)
-        self.revolute = tuple(j.revolute for j in robot.joints)
-        self.nominal = {p.symbol: p.value for p in robot.symbolic_parameters}
-        self.axes = tuple(frame[:3, 2] for frame in chain.axes)
-        self.points = tuple(frame[:3, 3] for frame in chain.axes)
+
+        def cos_sin(i):
+            if i == free:
+                return kinematics.trig_symbols((i,))
+            return (sympy.cos(precise.joints[i].offset.exact), sympy.sin(precise.joints[i].offset.exact))
+
+        chain = kinematics.build_chain(precise, cos_sin, [sympy.Integer(0)] * n)
+        self.joints = tuple(i for i in range(n) if i != free)
+        self.signs = (1,) * len(self.joints)
+        self.free = free
+        self.revolute = tuple(robot.joints[i].revolute for i in self.joints)
+        self.axes = tuple(chain.axes[i][:3, 2] for i in self.joints)
+        self.points = tuple(chain.axes[i][:3, 3] for i in self.joints)
+        self.normals = tuple(chain.axes[i][:3, 0] for i in self.joints)  # unit, across each axis
         self.tool = chain.tool
-        self.tool_point = chain.tool[:3, 3]
+        self.tool_point = self.tool[:3, 3]
+        self.start = None  # reversed: the pose T(0) of the chain forwards (the target is T(0) T^-1)
+
+    def reversed(self) -> "Geometry":
+        """The chain from the tool back to the base. With T(q) = exp(xi_1 q_1) ... exp(xi_n q_n)
+        T(0), T(0) T(q)^-1 = exp(xi_n (-q_n)) ... exp(xi_1 (-q_1)): the same axes in reverse
+        order, angles negated, target T(0) T^-1 and the identity as the tool."""
+        other = copy.copy(self)
+        for name in ("joints", "signs", "revolute", "axes", "points", "normals"):
+            setattr(other, name, getattr(self, name)[::-1])
+        other.signs = tuple(-sign for sign in other.signs)
+        other.tool, other.start = sympy.eye(4), self.tool
+        other.tool_point = other.tool[:3, 3]
+        return other
 
     def parallel(self, i: int, j: int) -> bool:
         return is_zero(squared_norm(self.axes[i].cross(self.axes[j])))
@@ -242,15 +307,33 @@ def _three_parallel(g: Geometry) -> tuple[str | None, str]:
     return "three_parallel", f"axes 2, 3, 4 parallel; axes 5 and 6 intersect at {point_text(point)}"
 
 
-def _six_dof(g: Geometry) -> tuple[str | None, str]:
-    """Solver and reason for a six-joint arm with a full-pose task: the first class that applies."""
+def _six_dof(g: Geometry) -> tuple[str | None, str, Geometry | None]:
+    """Solver, reason and the chain it solves for a six-joint arm with a full-pose task: the
+    first class that applies to the chain, else to the chain reversed (a spherical shoulder)."""
     reasons = []
-    for candidate in (_spherical_wrist, _three_parallel):
-        solver, reason = candidate(g)
+    for chain, how in ((g, ""), (g.reversed(), "reversed (axes numbered from the tool): ")):
+        for candidate in (_spherical_wrist, _three_parallel):
+            solver, reason = candidate(chain)
+            if solver is not None:
+                return solver, how + reason, chain
+            reasons.append(how + reason)
+    return None, "; ".join(reasons), None
+
+
+def _free_joint(robot: Robot) -> tuple[str | None, str, Geometry | None]:
+    """Solver, reason and chain for a seven-joint arm: the six-joint chain left when the free
+    joint (the file's `ik.free_joint`, else the first of joints 7, 6, ..., 1 that leaves a
+    solvable chain) is an input."""
+    candidates = (robot.free_joint,) if robot.free_joint is not None else range(robot.dof - 1, -1, -1)
+    reasons = []
+    for free in candidates:
+        if not robot.joints[free].revolute:
+            continue
+        solver, reason, chain = _six_dof(Geometry(robot, free))
         if solver is not None:
-            return solver, reason
-        reasons.append(reason)
-    return None, "; ".join(reasons)
+            return solver, f"joint {free + 1} free (an input of ik), the other six: {reason}", chain
+        reasons.append(f"joint {free + 1} free: {reason}")
+    return None, "; ".join(reasons) or "no revolute joint to leave free", None
 
 
 def _planar(g: Geometry, task: tuple[str, ...]) -> tuple[str | None, str] | None:
@@ -299,16 +382,18 @@ def classify(robot: Robot, geometry: Geometry | None = None) -> Structure:
     features = tuple(_features(g))
     if task == TASK_COMPONENTS:
         if n == 6:
-            solver, reason = _six_dof(g)
-        elif n > 6:
-            solver, reason = None, f"{n} joints for a 6-component task: redundant, infinitely many solutions"
+            solver, reason, chain = _six_dof(g)
+        elif n == 7:
+            solver, reason, chain = _free_joint(robot)
+        elif n > 7:
+            solver, reason, chain = None, f"{n} joints for a 6-component task: redundant, infinitely many solutions", None
         else:
-            solver, reason = None, f"{n} joints cannot reach every pose of a 6-component task"
-        return Structure(solver, features, reason)
+            solver, reason, chain = None, f"{n} joints cannot reach every pose of a 6-component task", None
+        return Structure(solver, features, reason, chain)
     for candidate in (_planar, _yaw_pitch):
         found = candidate(g, task)
         if found is not None:
-            return Structure(found[0], features, found[1])
+            return Structure(found[0], features, found[1], g)
     return Structure(None, features, (
         f"{n} joints with task ({', '.join(task)}): closed forms exist for planar arms (axes parallel "
         f"to world z, task x, y[, z][, yaw]) and base yaw + three parallel pitch axes (task x, y, z, pitch)"))

@@ -316,16 +316,19 @@ def _ik_results(robot: Robot, backends: _Backends, q: np.ndarray, tolerances: di
     nominal = {p.name: p.value for p in robot.symbolic_parameters}
     results = []
     if form is not None:
-        solvers = {"python": lambda target: backends.python.ik(target, **nominal)}
-        solvers.update({f"c {real}": functools.partial(library.ik, max_solutions=form.info.max_solutions)
-                        for real, library in backends.c.items()})
+        # With a free joint, ik takes its angle: q's, which every solution must keep.
+        free = [[] if form.free is None else [row[form.free]] for row in q]
+        solvers = {"python": lambda target, *free: backends.python.ik(target, *free, **nominal)}
+        solvers.update({f"c {real}": lambda target, *free, library=library: library.ik(
+            target, form.info.max_solutions, None, *free) for real, library in backends.c.items()})
         solvers["casadi"] = functools.partial(_casadi_ik, backends.casadi, nominal)
         errors = {}
         for backend, solve in solvers.items():
             worst = 0.0
-            for target in targets:
-                solutions = solve(target)
-                worst = max([worst, math.inf if not len(solutions) else 0.0]
+            for target, given in zip(targets, free):
+                solutions = solve(target, *given)
+                kept = all(solution[form.free] == given[0] for solution in solutions) if given else True
+                worst = max([worst, math.inf if not len(solutions) or not kept else 0.0]
                             + [_target_error(robot, solution, target) for solution in solutions])
             errors[backend] = worst
         # The closed form divides by sines that vanish at singularities, so float rounding is
@@ -333,7 +336,8 @@ def _ik_results(robot: Robot, backends: _Backends, q: np.ndarray, tolerances: di
         # tolerance of straight-line functions for the float build.
         ik_tolerances = tolerances | {"c float": 10 * tolerances["c float"]}
         results.append(Result(robot.name, "ik", errors, ik_tolerances,
-                              f"every solution of {len(targets)} targets fk(q) reaches the target"))
+                              f"every solution of {len(targets)} targets fk(q) reaches the target"
+                          + (f", with joint {form.free + 1} as given" if form.free is not None else "")))
     starts = q + 0.1 * np.random.default_rng(1).choice([-1.0, 1.0], size=q.shape)
     limits = bounds(robot)
     starts = np.clip(starts, limits[:, 0], limits[:, 1])
@@ -355,10 +359,10 @@ def _ik_results(robot: Robot, backends: _Backends, q: np.ndarray, tolerances: di
     return results
 
 
-def _casadi_ik(module, nominal: dict, target: np.ndarray) -> np.ndarray:
+def _casadi_ik(module, nominal: dict, target: np.ndarray, *free: float) -> np.ndarray:
     """The CasADi ik's valid branches, (k, dof)."""
     extra = [list(module.PARAMETERS.values())] if nominal else []
-    q, valid = module.ik(target if target.ndim == 2 else target[:, None], *extra)
+    q, valid = module.ik(target if target.ndim == 2 else target[:, None], *free, *extra)
     return q.full()[valid.full().ravel() == 1]
 
 

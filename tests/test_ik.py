@@ -23,7 +23,7 @@ from jacgen.robot import parse_robot
 from conftest import GENERATED, generated_module, import_file, random_configurations, robot
 
 WITH_IK = ["planar_2r", "planar_3r", "scara", "rexarm", "puma560", "kr5", "stanford", "ur5"]
-WITHOUT_IK = ["iiwa", "panda"]
+FREE_JOINT = ["iiwa", "panda"]  # closed form with a free joint: tests/test_free_joint.py
 SAMPLES = 1000  # random configurations per shipped robot (Python); the C takes 4 times as many
 TOLERANCE = 1e-9
 
@@ -43,7 +43,7 @@ def _generate(arm, folder, languages=("python",), real="double"):
 @pytest.fixture(scope="module")
 def modules():
     """The committed generated modules of the shipped robots (test_golden checks they are current)."""
-    return {name: generated_module(name) for name in WITH_IK + WITHOUT_IK}
+    return {name: generated_module(name) for name in WITH_IK + FREE_JOINT}
 
 
 def _pose_task(arm) -> bool:
@@ -343,11 +343,11 @@ def c_solvers(request, tmp_path_factory):
     real = request.param
     folder = tmp_path_factory.mktemp(f"c_{real}")
     solvers = {}
-    for name in WITH_IK + WITHOUT_IK:
+    for name in WITH_IK + FREE_JOINT:
         arm = robot(name)
         source = GENERATED / name / f"{name}.c" if real == "double" else _generate(arm, folder, ("c",), real)
         library = CLibrary(compile_shared([source], folder / f"lib{name}.so"), arm, [], real)
-        closed = functools.partial(library.ik, max_solutions=8) if name in WITH_IK else None
+        closed = functools.partial(library.ik, max_solutions=8) if name in WITH_IK else None  # see test_free_joint
         solvers[name] = (closed, library.ik_numeric)
     return real, solvers
 
@@ -382,7 +382,7 @@ def test_c_ik_agrees_with_python(modules, c_solvers, name):
 # -- ik_numeric -----------------------------------------------------------------------------------
 
 
-@pytest.mark.parametrize("name", WITH_IK + WITHOUT_IK)
+@pytest.mark.parametrize("name", WITH_IK + FREE_JOINT)
 def test_ik_numeric_converges_from_nearby(modules, c_solvers, name):
     real, solvers = c_solvers
     arm, module, numeric = robot(name), modules[name], solvers[name][1]
@@ -412,11 +412,6 @@ def test_ik_numeric_statuses_and_limits(modules, c_solvers):
     assert numeric(np.full(16, np.nan), np.zeros(6))[1] == 3
     assert numeric(module.fk(np.zeros(6)), np.zeros(6), -1)[1] == 3
     assert module.ik_numeric(module.fk(np.zeros(6)), np.zeros(6), 0)[1] == 0
-
-
-def test_robots_without_closed_form_have_no_ik(modules):
-    for name in WITHOUT_IK:
-        assert not hasattr(modules[name], "ik") and hasattr(modules[name], "ik_numeric")
 
 
 def test_runtime_parameters(tmp_path):

@@ -46,7 +46,7 @@ joints:
     limits: [-170, 170]
 task: [x, y, z]
 """
-TOP_KEYS = "name, description, convention, angle_unit, length_unit, parameters, joints, base, tool, task"
+TOP_KEYS = "name, description, convention, angle_unit, length_unit, parameters, joints, base, tool, task, ik"
 JOINT_KEYS = "name, type, a, alpha, d, theta, offset, limits"
 
 
@@ -147,6 +147,15 @@ CASES = [
     ("comment_in_description", edit("description: test arm", "description: ends */ here"), "ends", "description",
      "may not contain '*/' (it is copied into generated comments and strings; "
      "not allowed: \\ \"\"\" /* */ ??)"),
+    ("free_joint_needs_seven", BASE + "ik: {free_joint: 2}\n", "2}", "ik.free_joint",
+     "a free joint needs 7 joints and the full pose task (one joint more than the task), not 3 joints for 3 components"),
+    ("free_joint_out_of_range", BASE + "ik: {free_joint: 4}\n", "4}", "ik.free_joint", "expected a joint number 1 to 3, got 4"),
+    ("free_joint_not_a_number", BASE + "ik: {free_joint: last}\n", "last", "ik.free_joint",
+     "expected a joint number 1 to 3, got a string ('last')"),
+    ("free_joint_misspelt", BASE + "ik: {free: 2}\n", "free", "ik.free", "unknown key; expected one of: free_joint"),
+    ("free_joint_prismatic", "name: slide7\nconvention: standard\njoints:\n" + rows(6)
+     + "  - {type: prismatic, a: 0, alpha: 0, theta: 0}\nik: {free_joint: 7}\n", "7}", "ik.free_joint",
+     "joint 7 is prismatic: the free joint must be revolute"),
 ]
 # Mistakes found while reading the YAML, reported without a key path: (id, text, where, message),
 # `where` a token of the text or a (line, column) the YAML parser gives.

@@ -21,8 +21,8 @@ EXPECTED = {
     "kr5": "spherical_wrist_parallel",
     "stanford": "spherical_wrist_prismatic",
     "ur5": "three_parallel",
-    "iiwa": None,
-    "panda": None,
+    "iiwa": "spherical_wrist_intersecting",  # joint 3 free
+    "panda": "spherical_wrist_intersecting",  # joint 7 free, solved from the tool back
 }
 
 # Craig's Puma 560 table (modified DH): the same arm class whatever the convention.
@@ -77,7 +77,10 @@ def test_shipped_robots_are_classified(name):
 
 
 def test_reasons_name_what_is_missing():
-    assert "redundant" in classify(robot("iiwa")).reason
+    seven = open(robot("iiwa").source).read().replace("ik: {free_joint: 3}", "")
+    a7 = next(line for line in seven.splitlines() if "name: a7" in line)
+    eight = seven.replace(a7, a7 + "\n  - {name: a8, type: revolute, a: 0, alpha: 90, d: 0.1, offset: 0}")
+    assert "redundant" in classify(parse_robot(eight.encode())).reason
     skewed = classify(parse_robot(NO_STRUCTURE.encode()))
     assert skewed.solver is None
     assert "no spherical wrist" in skewed.reason and "no three parallel" in skewed.reason

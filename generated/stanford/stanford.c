@@ -2043,7 +2043,7 @@ stanford_real stanford_ik_numeric_step(const stanford_real target[16], const sta
 
 void stanford_ik_branches(const stanford_real T[16], stanford_real q[STANFORD_MAX_IK_SOLUTIONS * STANFORD_DOF], int valid[STANFORD_MAX_IK_SOLUTIONS])
 {
-    /* 642 operations */
+    /* 646 operations */
 
     /* Inputs */
     const stanford_real T00 = T[0];
@@ -2113,8 +2113,8 @@ void stanford_ik_branches(const stanford_real T[16], stanford_real q[STANFORD_MA
     const stanford_real t50 = (t47 ? 0 : -t39*t48);
     const stanford_real t51 = T02*t49 + T12*t50;
     const stanford_real t52 = T12*t49 - T02*t50;
-    const stanford_real t53 = T01*t49 + T11*t50;
-    const stanford_real t54 = T11*t49 - T01*t50;
+    const stanford_real t53 = T00*t49 + T10*t50;
+    const stanford_real t54 = T10*t49 - T00*t50;
     const stanford_real t55 = t13*t21;
     const stanford_real t56 = 0.01787569 + t55;
     const stanford_real t57 = -0.01787569 + t56;
@@ -2137,13 +2137,13 @@ void stanford_ik_branches(const stanford_real T[16], stanford_real q[STANFORD_MA
     const stanford_real t74 = (t71 ? 0 : t41*t72);
     const stanford_real t75 = T02*t73 + T12*t74;
     const stanford_real t76 = T12*t73 - T02*t74;
-    const stanford_real t77 = T01*t73 + T11*t74;
-    const stanford_real t78 = T11*t73 - T01*t74;
+    const stanford_real t77 = T00*t73 + T10*t74;
+    const stanford_real t78 = T10*t73 - T00*t74;
     const stanford_real t79 = 1 - t49;
     const stanford_real t80 = T22*t79;
     const stanford_real t81 = t80 + T22*t49;
-    const stanford_real t82 = T21*t79;
-    const stanford_real t83 = t82 + T21*t49;
+    const stanford_real t82 = T20*t79;
+    const stanford_real t83 = t82 + T20*t49;
     const stanford_real t84 = t51*t66 - t69*t81;
     const stanford_real t85 = t51*t69 + t66*t81;
     const stanford_real t86 = t53*t66 - t69*t83;
@@ -2192,8 +2192,8 @@ void stanford_ik_branches(const stanford_real T[16], stanford_real q[STANFORD_MA
     const stanford_real t129 = 1 - t73;
     const stanford_real t130 = T22*t129;
     const stanford_real t131 = t130 + T22*t73;
-    const stanford_real t132 = T21*t129;
-    const stanford_real t133 = t132 + T21*t73;
+    const stanford_real t132 = T20*t129;
+    const stanford_real t133 = t132 + T20*t73;
     const stanford_real t134 = t66*t75 - t131*t70;
     const stanford_real t135 = t131*t66 + t70*t75;
     const stanford_real t136 = t66*t77 - t133*t70;
@@ -2322,21 +2322,21 @@ void stanford_ik_branches(const stanford_real T[16], stanford_real q[STANFORD_MA
     const stanford_real t259 = (t64 ? 0 : atan2(t258, t57));
     const stanford_real t260 = (t109 ? 0 : atan2(-t114, t102));
     const stanford_real t261 = (t118 ? 0 : atan2(-t100, t85));
-    const stanford_real t262 = (t127 <= 1e-24*t128 ? 0 : atan2(t124, t123));
+    const stanford_real t262 = (t127 <= 1e-24*t128 ? 0 : atan2(t123, -t124));
     const stanford_real t263 = (t71 ? 0 : atan2(t41, t36));
     const stanford_real t264 = (t64 ? 0 : atan2(t67, t57));
     const stanford_real t265 = (t150 ? 0 : atan2(-t155, t143));
     const stanford_real t266 = (t159 ? 0 : atan2(-t141, t135));
-    const stanford_real t267 = (t168 <= 1e-24*t169 ? 0 : atan2(t165, t164));
+    const stanford_real t267 = (t168 <= 1e-24*t169 ? 0 : atan2(t164, -t165));
     const stanford_real t268 = (t170 ? 0 : atan2(t67, t59));
     const stanford_real t269 = -t21;
     const stanford_real t270 = (t205 ? 0 : atan2(-t210, t198));
     const stanford_real t271 = (t214 ? 0 : atan2(-t196, t177));
-    const stanford_real t272 = (t223 <= 1e-24*t224 ? 0 : atan2(t220, t219));
+    const stanford_real t272 = (t223 <= 1e-24*t224 ? 0 : atan2(t219, -t220));
     const stanford_real t273 = (t170 ? 0 : atan2(t258, t59));
     const stanford_real t274 = (t237 ? 0 : atan2(-t242, t230));
     const stanford_real t275 = (t246 ? 0 : atan2(-t228, t181));
-    const stanford_real t276 = (t255 <= 1e-24*t256 ? 0 : atan2(t252, t251));
+    const stanford_real t276 = (t255 <= 1e-24*t256 ? 0 : atan2(t251, -t252));
     const int t277 = isfinite(t0);
     const stanford_real t278 = -1e-12;
     const int t279 = t18 >= t20;

@@ -2016,7 +2016,7 @@ def ik_numeric_step(target, q, damping=0.0):
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def ik_branches(T):
-    """every branch of the closed-form ik and whether the target allows it: (8 x 6 and 8 x 1), 642 operations."""
+    """every branch of the closed-form ik and whether the target allows it: (8 x 6 and 8 x 1), 646 operations."""
     T = _argument("T", T, (4, 4))
     T00 = T[..., 0, 0]
     T01 = T[..., 0, 1]
@@ -2083,8 +2083,8 @@ def ik_branches(T):
     t50 = numpy.where(t47, 0, -t39*t48)
     t51 = T02*t49 + T12*t50
     t52 = T12*t49 - T02*t50
-    t53 = T01*t49 + T11*t50
-    t54 = T11*t49 - T01*t50
+    t53 = T00*t49 + T10*t50
+    t54 = T10*t49 - T00*t50
     t55 = t13*t21
     t56 = 0.01787569 + t55
     t57 = -0.01787569 + t56
@@ -2107,13 +2107,13 @@ def ik_branches(T):
     t74 = numpy.where(t71, 0, t41*t72)
     t75 = T02*t73 + T12*t74
     t76 = T12*t73 - T02*t74
-    t77 = T01*t73 + T11*t74
-    t78 = T11*t73 - T01*t74
+    t77 = T00*t73 + T10*t74
+    t78 = T10*t73 - T00*t74
     t79 = 1 - t49
     t80 = T22*t79
     t81 = t80 + T22*t49
-    t82 = T21*t79
-    t83 = t82 + T21*t49
+    t82 = T20*t79
+    t83 = t82 + T20*t49
     t84 = t51*t66 - t69*t81
     t85 = t51*t69 + t66*t81
     t86 = t53*t66 - t69*t83
@@ -2162,8 +2162,8 @@ def ik_branches(T):
     t129 = 1 - t73
     t130 = T22*t129
     t131 = t130 + T22*t73
-    t132 = T21*t129
-    t133 = t132 + T21*t73
+    t132 = T20*t129
+    t133 = t132 + T20*t73
     t134 = t66*t75 - t131*t70
     t135 = t131*t66 + t70*t75
     t136 = t66*t77 - t133*t70
@@ -2292,21 +2292,21 @@ def ik_branches(T):
     t259 = numpy.where(t64, 0, numpy.arctan2(t258, t57))
     t260 = numpy.where(t109, 0, numpy.arctan2(-t114, t102))
     t261 = numpy.where(t118, 0, numpy.arctan2(-t100, t85))
-    t262 = numpy.where(numpy.less_equal(t127, 1e-24*t128), 0, numpy.arctan2(t124, t123))
+    t262 = numpy.where(numpy.less_equal(t127, 1e-24*t128), 0, numpy.arctan2(t123, -t124))
     t263 = numpy.where(t71, 0, numpy.arctan2(t41, t36))
     t264 = numpy.where(t64, 0, numpy.arctan2(t67, t57))
     t265 = numpy.where(t150, 0, numpy.arctan2(-t155, t143))
     t266 = numpy.where(t159, 0, numpy.arctan2(-t141, t135))
-    t267 = numpy.where(numpy.less_equal(t168, 1e-24*t169), 0, numpy.arctan2(t165, t164))
+    t267 = numpy.where(numpy.less_equal(t168, 1e-24*t169), 0, numpy.arctan2(t164, -t165))
     t268 = numpy.where(t170, 0, numpy.arctan2(t67, t59))
     t269 = -t21
     t270 = numpy.where(t205, 0, numpy.arctan2(-t210, t198))
     t271 = numpy.where(t214, 0, numpy.arctan2(-t196, t177))
-    t272 = numpy.where(numpy.less_equal(t223, 1e-24*t224), 0, numpy.arctan2(t220, t219))
+    t272 = numpy.where(numpy.less_equal(t223, 1e-24*t224), 0, numpy.arctan2(t219, -t220))
     t273 = numpy.where(t170, 0, numpy.arctan2(t258, t59))
     t274 = numpy.where(t237, 0, numpy.arctan2(-t242, t230))
     t275 = numpy.where(t246, 0, numpy.arctan2(-t228, t181))
-    t276 = numpy.where(numpy.less_equal(t255, 1e-24*t256), 0, numpy.arctan2(t252, t251))
+    t276 = numpy.where(numpy.less_equal(t255, 1e-24*t256), 0, numpy.arctan2(t251, -t252))
     t277 = numpy.isfinite(t0)
     t278 = -1e-12
     t279 = numpy.greater_equal(t18, t20)

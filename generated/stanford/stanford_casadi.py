@@ -1691,7 +1691,7 @@ def _ik_numeric_step(target, q, damping):
 
 
 def _ik_branches(T):
-    """Every branch of the closed-form ik and whether the target allows it: 642 operations."""
+    """Every branch of the closed-form ik and whether the target allows it: 646 operations."""
     T00 = T[0, 0]
     T01 = T[0, 1]
     T02 = T[0, 2]
@@ -1757,8 +1757,8 @@ def _ik_branches(T):
     t50 = casadi.if_else(t47, 0, -t39*t48)
     t51 = T02*t49 + T12*t50
     t52 = T12*t49 - T02*t50
-    t53 = T01*t49 + T11*t50
-    t54 = T11*t49 - T01*t50
+    t53 = T00*t49 + T10*t50
+    t54 = T10*t49 - T00*t50
     t55 = t13*t21
     t56 = 0.01787569 + t55
     t57 = -0.01787569 + t56
@@ -1781,13 +1781,13 @@ def _ik_branches(T):
     t74 = casadi.if_else(t71, 0, t41*t72)
     t75 = T02*t73 + T12*t74
     t76 = T12*t73 - T02*t74
-    t77 = T01*t73 + T11*t74
-    t78 = T11*t73 - T01*t74
+    t77 = T00*t73 + T10*t74
+    t78 = T10*t73 - T00*t74
     t79 = 1 - t49
     t80 = T22*t79
     t81 = t80 + T22*t49
-    t82 = T21*t79
-    t83 = t82 + T21*t49
+    t82 = T20*t79
+    t83 = t82 + T20*t49
     t84 = t51*t66 - t69*t81
     t85 = t51*t69 + t66*t81
     t86 = t53*t66 - t69*t83
@@ -1836,8 +1836,8 @@ def _ik_branches(T):
     t129 = 1 - t73
     t130 = T22*t129
     t131 = t130 + T22*t73
-    t132 = T21*t129
-    t133 = t132 + T21*t73
+    t132 = T20*t129
+    t133 = t132 + T20*t73
     t134 = t66*t75 - t131*t70
     t135 = t131*t66 + t70*t75
     t136 = t66*t77 - t133*t70
@@ -1966,21 +1966,21 @@ def _ik_branches(T):
     t259 = casadi.if_else(t64, 0, casadi.atan2(t258, t57))
     t260 = casadi.if_else(t109, 0, casadi.atan2(-t114, t102))
     t261 = casadi.if_else(t118, 0, casadi.atan2(-t100, t85))
-    t262 = casadi.if_else((t127 <= 1e-24*t128), 0, casadi.atan2(t124, t123))
+    t262 = casadi.if_else((t127 <= 1e-24*t128), 0, casadi.atan2(t123, -t124))
     t263 = casadi.if_else(t71, 0, casadi.atan2(t41, t36))
     t264 = casadi.if_else(t64, 0, casadi.atan2(t67, t57))
     t265 = casadi.if_else(t150, 0, casadi.atan2(-t155, t143))
     t266 = casadi.if_else(t159, 0, casadi.atan2(-t141, t135))
-    t267 = casadi.if_else((t168 <= 1e-24*t169), 0, casadi.atan2(t165, t164))
+    t267 = casadi.if_else((t168 <= 1e-24*t169), 0, casadi.atan2(t164, -t165))
     t268 = casadi.if_else(t170, 0, casadi.atan2(t67, t59))
     t269 = -t21
     t270 = casadi.if_else(t205, 0, casadi.atan2(-t210, t198))
     t271 = casadi.if_else(t214, 0, casadi.atan2(-t196, t177))
-    t272 = casadi.if_else((t223 <= 1e-24*t224), 0, casadi.atan2(t220, t219))
+    t272 = casadi.if_else((t223 <= 1e-24*t224), 0, casadi.atan2(t219, -t220))
     t273 = casadi.if_else(t170, 0, casadi.atan2(t258, t59))
     t274 = casadi.if_else(t237, 0, casadi.atan2(-t242, t230))
     t275 = casadi.if_else(t246, 0, casadi.atan2(-t228, t181))
-    t276 = casadi.if_else((t255 <= 1e-24*t256), 0, casadi.atan2(t252, t251))
+    t276 = casadi.if_else((t255 <= 1e-24*t256), 0, casadi.atan2(t251, -t252))
     t277 = (casadi.fabs(t0) < casadi.inf)
     t278 = -1e-12
     t279 = (t18 >= t20)
