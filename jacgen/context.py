@@ -20,6 +20,10 @@ C_EXTENTS = {
     "mu": ("TASK_DIM",),
     "ik_branches.q": ("MAX_IK_SOLUTIONS", "DOF"),
     "ik_branches.valid": ("MAX_IK_SOLUTIONS",),
+    "ik_branches.in_limits": ("MAX_IK_SOLUTIONS",),
+    "ik_nearest.q": ("DOF",),
+    "q_seed": ("DOF",),
+    "weights": ("DOF",),
     "mu_dot": ("TASK_DIM",),
     "velocity_ik.q_dot": ("DOF",),
     "ik_numeric_step.q_start": ("DOF",),
@@ -237,6 +241,8 @@ def _ik_context(robot: Robot, generator: Generator, language: str, real: str) ->
         "doc": ik.documentation(robot, form, "MAX_IK_SOLUTIONS" if language == "python" else f"{prefix}_MAX_IK_SOLUTIONS"),
         "inputs": ", ".join(inputs),
         "free_joint": form.free,
+        "nearest_statuses": [("OK", ik.IK_NEAREST_OK), ("NO_SOLUTION", ik.IK_NEAREST_NO_SOLUTION),
+                             ("NOT_FINITE", ik.IK_NEAREST_NOT_FINITE)],
         "signature": ", ".join(arguments),
     }
 
@@ -346,7 +352,7 @@ def casadi_context(robot: Robot, generator: Generator, printer: CasadiPrinter, r
     functions = generator.functions()
     context["functions"] = [_casadi_function(f, robot, printer) for f in functions]
     context["arguments"] = sorted({(a.name, a.symbols.rows, a.symbols.cols) for f in functions for a in f.arguments},
-                                  key=lambda a: ("q", "q_dot", "mu_dot", "damping", "target", "T", "mu", "q_free").index(a[0]))
+                                  key=lambda a: ("q", "q_dot", "mu_dot", "damping", "target", "T", "mu", "q_seed", "q_free", "weights").index(a[0]))
     context["ik"] = generator.closed_form is not None
     context["ik_numeric"] = _ik_numeric_context(robot, "python", "double")
     return dict(sorted(context.items()))

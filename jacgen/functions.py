@@ -158,8 +158,9 @@ class Generator:
         return self.model.closed_form
 
     def ik_functions(self) -> list[Function]:
-        """ik_branches: every branch of the closed-form solver with its validity, from the
-        target's symbols (none without a closed form)."""
+        """ik_branches (every branch of the closed-form solver, whether the target allows it and
+        whether it is inside the joint limits) and ik_nearest (the solution nearest a seed), from
+        the target's symbols (none without a closed form)."""
         form = self.closed_form
         if form is None:
             return []
@@ -167,17 +168,31 @@ class Generator:
             target = Argument("T", sympy.Matrix(4, 4, lambda r, c: sympy.Symbol(f"T{r}{c}", real=True)), vector=False)
         else:
             target = Argument("mu", sympy.Matrix([sympy.Symbol(f"mu{i}", real=True) for i in range(len(self.robot.task))]))
-        arguments, bindings, free_angle = (target,), {}, None
+        free, bindings, free_angle = (), {}, None
         if form.free is not None:  # the free joint's angle is an input; its cos and sin are the usual c_k, s_k
-            free = Argument("q_free", sympy.Matrix([sympy.Symbol("q_free", real=True)]), scalar=True)
-            arguments += (free,)
+            free = (Argument("q_free", sympy.Matrix([sympy.Symbol("q_free", real=True)]), scalar=True),)
             free_angle = self.q[form.free]
-            bindings = {free_angle: free.symbols[0]}
+            bindings = {free_angle: free[0].symbols[0]}
             self.cos_sin((form.free,))
+        n = self.robot.dof
+        seed = Argument("q_seed", sympy.Matrix([sympy.Symbol(f"qn{i + 1}", real=True) for i in range(n)]))
+        weights = Argument("weights", sympy.Matrix([sympy.Symbol(f"qw{i + 1}", real=True) for i in range(n)]),
+                           default="(1.0,) * DOF")
+        sp = Subproblems(self.name)
         with distribute(False):
-            q, valid = ik.branches(self.robot, form, Subproblems(self.name), target.symbols, free_angle)
-        return [self.function("ik_branches", "every branch of the closed-form ik and whether the target allows it",
-                              ("q", q), ("valid", valid), arguments=arguments, bindings=bindings)]
+            q, valid, inside = ik.branches(self.robot, form, sp, target.symbols, free_angle)
+            read = target.symbols[:3, :] if form.target == "pose" else target.symbols
+            closest, status = ik.nearest(self.robot, sp, q, valid, inside, list(seed.symbols), list(weights.symbols),
+                                         form.free, list(read))
+        return [
+            self.function("ik_branches", "every branch of the closed-form ik, whether the target allows it and "
+                          "whether it is inside the joint limits", ("q", q), ("valid", valid), ("in_limits", inside),
+                          arguments=(target, *free), bindings=bindings),
+            self.function("ik_nearest", "the closed-form ik solution inside the joint limits nearest q_seed "
+                          "(sum of weights_j (q_j - q_seed_j)^2), and the status", ("q", sympy.Matrix(closest)),
+                          ("status", sympy.Matrix([status])), vector=True, integers=("status",),
+                          arguments=(target, seed, *free, weights), bindings=bindings),
+        ]
 
     def velocity_ik_function(self, js: sympy.Matrix) -> Function:
         """velocity_ik: q_dot solving Js q_dot = mu_dot, and the status (`differential`)."""

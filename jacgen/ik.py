@@ -175,8 +175,10 @@ def documentation(robot, form: ClosedForm, max_name: str) -> list[str]:
             ", pitch in [-pi/2, pi/2]." if "pitch" in robot.task else ".")
     text = [
         target,
-        f"Result: k <= {max_name} solutions, revolute angles wrapped into (-pi, pi], joint limits "
-        "not applied; k = 0 when the target is out of reach or not finite.",
+        f"Result: k <= {max_name} solutions inside the joint limits, revolute angles wrapped into "
+        "(-pi, pi] or, where that is outside the limits, their lowest equivalent inside them; k = 0 "
+        "when the target is out of reach or not finite. ik_branches also gives the solutions outside "
+        "the limits (in_limits 0).",
         f"Solver: {form.info.title}.",
         *_chain_text(form),
         "Order: nested loops over the branches, outermost first; where a subproblem has two roots "
@@ -368,11 +370,40 @@ def _reversed_target(sp: Subproblems, k: dict, T) -> sympy.Matrix:
     return sympy.Matrix([row + [offset[i]] for i, row in enumerate(rotation)] + [[0, 0, 0, 1]])
 
 
-def branches(robot, form: ClosedForm, sp: Subproblems, target, free_angle=None) -> tuple[sympy.Matrix, list]:
-    """Every branch of the solver (MAX_IK_SOLUTIONS x DOF, revolute angles wrapped into
-    (-pi, pi], the free joint `free_angle` as given) and its validity (MAX_IK_SOLUTIONS x 1):
-    a branch is valid when the target allows it and every entry of the target read (not a
-    pose's last row) is finite. `target` is the 4x4 pose or the task vector, as symbols."""
+# ik_nearest's statuses
+IK_NEAREST_OK, IK_NEAREST_NO_SOLUTION, IK_NEAREST_NOT_FINITE = 0, 1, 2
+TURN = 2 * sympy.pi
+
+
+def _inside(value, limits) -> sympy.Basic:
+    return sympy.And(value >= limits[0], value <= limits[1])
+
+
+def _in_limits(sp: Subproblems, value, joint) -> tuple[sympy.Expr, sympy.Basic]:
+    """A joint's value as ik returns it, and whether it is inside the joint's limits.
+
+    A revolute angle stays wrapped into (-pi, pi] unless that is outside the limits and its
+    lowest equivalent above the lower limit, lower + (angle - lower) mod 2 pi, is inside them
+    (the Panda's joint 6, -0.0175 to 3.7525 rad, needs it); a joint without limits is always
+    inside."""
+    if joint.limits is None:
+        return value, sympy.true
+    limits = tuple(sympy.Float(limit) for limit in joint.limits)
+    if not joint.revolute:
+        return value, _inside(value, limits)
+    value = sp.name(value)
+    shifted = sp.name(value - TURN * sympy.floor((value - limits[0]) / TURN))
+    wrapped_inside, shifted_inside = _inside(value, limits), shifted <= limits[1]
+    return select(sympy.And(sympy.Not(wrapped_inside), shifted_inside), shifted, value), \
+        sympy.Or(wrapped_inside, shifted_inside)
+
+
+def branches(robot, form: ClosedForm, sp: Subproblems, target, free_angle=None) -> tuple[sympy.Matrix, list, list]:
+    """Every branch of the solver (MAX_IK_SOLUTIONS x DOF; revolute angles wrapped into
+    (-pi, pi] or else into the limits, see `_in_limits`; the free joint `free_angle` as given),
+    whether the target allows it and whether it is inside the joint limits (MAX_IK_SOLUTIONS
+    each). A branch is valid when the target allows it and every entry of the target read
+    (not a pose's last row) is finite. `target` is the 4x4 pose or the task vector, as symbols."""
     k = {name: _constant(value) for name, value in form.constants}
     solved = _BRANCHES[form.solver](sp, k, _reversed_target(sp, k, target) if "start_rotation" in k else target,
                                     form, len(form.joints))
@@ -380,10 +411,54 @@ def branches(robot, form: ClosedForm, sp: Subproblems, target, free_angle=None) 
         raise AssertionError(f"{form.solver}: {len(solved)} branches, documented {form.info.max_solutions}")
     # One test for all entries: their sum is finite unless one is not (or they exceed 1e307).
     finite = IsFinite(sp.name(sympy.Add(*(target[:3, :] if form.target == "pose" else target))))
-    rows = []
+    free_limits = robot.joints[form.free].limits if form.free is not None else None
+    rows, inside = [], []
     for values, _ in solved:
-        q = [free_angle] * robot.dof
+        q, limited = [free_angle] * robot.dof, [_inside(free_angle, free_limits) if free_limits else sympy.true]
         for joint, sign, value in zip(form.joints, form.signs, values):
-            q[joint] = wrapped(sign * value) if robot.joints[joint].revolute else sign * value
+            q[joint], joint_inside = _in_limits(sp, wrapped(sign * value) if robot.joints[joint].revolute
+                                                else sign * value, robot.joints[joint])
+            limited.append(joint_inside)
         rows.append(q)
-    return sympy.Matrix(rows), [sympy.And(finite, valid) for _, valid in solved]
+        inside.append(sympy.And(*limited))
+    return sympy.Matrix(rows), [sympy.And(finite, valid) for _, valid in solved], inside
+
+
+def _nearest_equivalent(sp: Subproblems, value, given, seed, joint):
+    """The equivalent (modulo 2 pi) of a revolute angle nearest the seed inside the limits: of
+    the nearest one and its neighbours on either side, the first inside; else `given` (the
+    lowest inside, `_in_limits`). A prismatic joint's value as it is."""
+    if not joint.revolute:
+        return value
+    nearest = sp.name(value + TURN * sympy.floor((seed - value) / TURN + sympy.Rational(1, 2)))
+    if joint.limits is None:
+        return nearest
+    limits = tuple(sympy.Float(limit) for limit in joint.limits)
+    below = nearest < seed
+    second, third = sp.name(nearest + select(below, TURN, -TURN)), sp.name(nearest - select(below, TURN, -TURN))
+    return select(_inside(nearest, limits), nearest,
+                  select(_inside(second, limits), second, select(_inside(third, limits), third, given)))
+
+
+def nearest(robot, sp: Subproblems, q: sympy.Matrix, valid: list, inside: list, seed, weights,
+            free: int | None, read: list) -> tuple[list, sympy.Expr]:
+    """ik_nearest: of the valid branches inside the limits, the one nearest the seed by
+    sum_j weights_j (q_j - seed_j)^2, each revolute joint at its equivalent nearest the seed
+    inside the limits; and the status. No solution, or an entry of the target `read`, a seed
+    or a weight that is not finite: q = seed."""
+    # The running minimum over the rows; truth values carried as named 0/1 numbers, so that
+    # no condition grows with the number of rows.
+    best, found, distance = list(seed), sympy.Integer(0), sympy.Integer(0)
+    for row, row_valid, row_inside in zip(q.tolist(), valid, inside):
+        candidate = [sp.name(value if j == free else _nearest_equivalent(sp, sp.name(value), value, seed[j], joint))
+                     for j, (value, joint) in enumerate(zip(row, robot.joints))]
+        cost = sp.name(sympy.Add(*(w * (x - s) ** 2 for w, x, s in zip(weights, candidate, seed))))
+        allowed = sp.name(select(sympy.And(row_valid, row_inside), 1, 0)) > 0
+        take = sp.name(select(sympy.And(allowed, sympy.Or(found < 1, cost < distance)), 1, 0)) > 0
+        best = [sp.name(select(take, x, b)) for x, b in zip(candidate, best)]
+        distance = sp.name(select(take, cost, distance))
+        found = sp.name(select(allowed, 1, found))
+    inputs_finite = IsFinite(sp.name(sympy.Add(*read, *seed, *weights)))
+    status = select(sympy.Not(inputs_finite), IK_NEAREST_NOT_FINITE,
+                    select(found > 0, IK_NEAREST_OK, IK_NEAREST_NO_SOLUTION))
+    return [select(sympy.And(found > 0, inputs_finite), x, s) for x, s in zip(best, seed)], status

@@ -362,8 +362,8 @@ def _ik_results(robot: Robot, backends: _Backends, q: np.ndarray, tolerances: di
 def _casadi_ik(module, nominal: dict, target: np.ndarray, *free: float) -> np.ndarray:
     """The CasADi ik's valid branches, (k, dof)."""
     extra = [list(module.PARAMETERS.values())] if nominal else []
-    q, valid = module.ik(target if target.ndim == 2 else target[:, None], *free, *extra)
-    return q.full()[valid.full().ravel() == 1]
+    q, valid, in_limits = module.ik(target if target.ndim == 2 else target[:, None], *free, *extra)
+    return q.full()[(valid.full() * in_limits.full()).ravel() == 1]
 
 
 def _casadi_ik_numeric(module, nominal: dict, target: np.ndarray, start: np.ndarray) -> tuple[np.ndarray, int]:

@@ -37,11 +37,12 @@ def _regular(arm, q, free):
 
 
 def _check_round_trips(arm, module, q, free):
-    """Batched ik at fk(q) with q[free] given: no miss, the free joint kept, at most 8
-    solutions, the original q among them where the other six are well conditioned.
+    """Batched ik at fk(q) with q[free] given, every branch (limits=False): no miss, the free
+    joint kept, at most 8 solutions, the original q among them where the other six are well
+    conditioned.
     Returns (solutions, valid)."""
     targets = _reference_fk(arm, q)
-    solutions, valid = module.ik(targets, q[:, free])
+    solutions, valid = module.ik(targets, q[:, free], limits=False)
     assert solutions.shape == (len(q), 8, 7) and valid.shape == (len(q), 8)
     found = solutions[valid]
     misses = np.abs(_reference_fk(arm, found) - np.repeat(targets, valid.sum(axis=1), axis=0)).max(axis=(1, 2))
@@ -75,8 +76,8 @@ def test_c_and_casadi_give_the_numpy_solutions(name, tmp_path):
         in_c = library.ik(target, 8, None, row[free])
         assert in_c.shape == ours.shape and np.abs(in_c - ours).max(initial=0) < 1e-9
     for row, target in zip(q[:40], _reference_fk(arm, q[:40])):
-        branches, valid = casadi.ik(target, row[free])
-        in_casadi = branches.full()[valid.full().ravel() == 1]
+        branches, valid, in_limits = casadi.ik(target, row[free])
+        in_casadi = branches.full()[(valid.full() * in_limits.full()).ravel() == 1]
         assert np.abs(in_casadi - module.ik(target, row[free])).max(initial=0) < 1e-9
 
 
@@ -95,7 +96,7 @@ def test_panda_contains_frankik_solutions(tmp_path):
     for row in q:
         assert np.abs(frankik.fk(row) - reference.fk(tcp, row)).max() < 1e-12  # the same arm
         target = reference.fk(flange, row)
-        ours = module.ik(target, row[6])
+        ours = module.ik(target, row[6], limits=False)
         for theirs in frankik.ik_full(target, row, row[6]):
             if np.all(np.isfinite(theirs)) and np.abs(reference.fk(flange, theirs) - target).max() < MISS:
                 assert _wrapped(ours - theirs).max(axis=1).min() < 1e-7, (row, theirs)

@@ -5,7 +5,8 @@ KUKA KR5 arc (rtb KR5), standard DH
 Every function takes `q` (6 x 1: radians for revolute joints, m for
 prismatic ones) and returns a rows x cols result whose zeros are structural; ik_branches
 (also named ik) takes the target instead of q and returns every branch (MAX_IK_SOLUTIONS x
-DOF) and its validity (MAX_IK_SOLUTIONS x 1, 1 or 0).
+DOF), its validity and whether it is inside the joint limits (MAX_IK_SOLUTIONS x 1 each, 1
+or 0); ik_nearest takes the target and q_seed and returns the solution nearest q_seed.
 Task vector: (x, y, z, roll, pitch, yaw).
 """
 
@@ -2204,7 +2205,7 @@ def _ik_numeric_step(target, q, damping):
 
 
 def _ik_branches(T):
-    """Every branch of the closed-form ik and whether the target allows it: 872 operations."""
+    """Every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits: 1330 operations."""
     T00 = T[0, 0]
     T01 = T[0, 1]
     T02 = T[0, 2]
@@ -2244,413 +2245,1474 @@ def _ik_branches(T):
     t24 = casadi.atan2(t23, t22)
     t25 = casadi.if_else(t19, 0, t10 + t24)
     t26 = t10 - t24
-    t27 = t20*t23
-    t28 = t27*t5
-    t29 = t20*t22
-    t30 = t29*t9
-    t31 = casadi.if_else(t19, 1, t28 + t30)
-    t32 = t30 - t28
-    t33 = t27*t9
-    t34 = t29*t5
-    t35 = casadi.if_else(t19, 0, t33 - t34)
-    t36 = t33 + t34
-    t37 = t31*t5 + t35*t9
-    t38 = t31*t9 - t35*t5
-    t39 = -0.18 + t37
-    t40 = T02*t31 + T12*t35
-    t41 = T02*t35 - T12*t31
-    t42 = T00*t31 + T10*t35
-    t43 = T10*t31 - T00*t35
-    t44 = t32*t5 - t36*t9
-    t45 = t32*t9 + t36*t5
-    t46 = -0.18 + t44
-    t47 = T12*t36 - T02*t32
-    t48 = T02*t36 + T12*t32
-    t49 = T00*t32 - T10*t36
-    t50 = T00*t36 + T10*t32
-    t51 = 1 - t31
-    t52 = t14*t51
-    t53 = t52 + t14*t31
-    t54 = -0.4 + t53
-    t55 = t38**2 + t39**2 + t54**2
-    t56 = 0.3794 - 0.5*t55
-    t57 = T22*t51
-    t58 = t57 + T22*t31
-    t59 = T20*t51
-    t60 = t59 + T20*t31
-    t61 = False
-    t62 = casadi.if_else(t61, 1, 2.639193146748068)
-    t63 = t56**2
-    t64 = t62**2
-    t65 = 1 - t63*t64
-    t66 = t56*t62
-    t67 = (1e-12 < t65)
-    t68 = casadi.if_else(t67, t66, casadi.if_else((t66 > 0), 1, -1))
-    t69 = casadi.if_else(t67, casadi.sqrt(t65), 0)
-    t70 = casadi.atan2(t69, t68)
-    t71 = casadi.if_else(t61, 0, t0 + t70)
-    t72 = t0 - t70
-    t73 = 0.072*t62
-    t74 = t68*t73
-    t75 = 0.372*t62
-    t76 = t69*t75
-    t77 = casadi.if_else(t61, 1, -t74 - t76)
-    t78 = t76 - t74
-    t79 = t68*t75
-    t80 = t69*t73
-    t81 = casadi.if_else(t61, 0, t79 - t80)
-    t82 = t79 + t80
-    t83 = 0.12*t77 - 0.62*t81
-    t84 = 0.12*t81 + 0.62*t77
-    t85 = 0.78 + t83
-    t86 = 0.4 - t84
-    t87 = -0.18 + t85
-    t88 = -0.4 + t86
-    t89 = t39*t87 + t54*t88
-    t90 = t39*t88 - t54*t87
-    t91 = t89**2 + t90**2
-    t92 = t87**2 + t88**2
-    t93 = 0.12*t78 - 0.62*t82
-    t94 = 0.12*t82 + 0.62*t78
-    t95 = 0.78 + t93
-    t96 = 0.4 - t94
-    t97 = -0.18 + t95
-    t98 = -0.4 + t96
-    t99 = t39*t97 + t54*t98
-    t100 = t39*t98 - t54*t97
-    t101 = t100**2 + t99**2
-    t102 = t97**2 + t98**2
-    t103 = 1e-24*t55
-    t104 = (t91 <= t103*t92)
-    t105 = casadi.if_else(t104, 1, 1/casadi.sqrt(t91))
-    t106 = casadi.if_else(t104, 1, t105*t89)
-    t107 = casadi.if_else(t104, 0, t105*t90)
-    t108 = t106*t77 - t107*t81
-    t109 = t106*t81 + t107*t77
-    t110 = t109*t58 - t108*t40
-    t111 = t108*t58 + t109*t40
-    t112 = t108*t42 - t109*t60
-    t113 = t108*t60 + t109*t42
-    t114 = 1 - t108
-    t115 = t114*t41
-    t116 = t115 + t108*t41
-    t117 = t114*t43
-    t118 = t117 + t108*t43
-    t119 = t111**2
-    t120 = -t119
-    t121 = 1 + t120
-    t122 = casadi.if_else((t121 > 1e-12), casadi.sqrt(t121), 0)
-    t123 = t119 - t110*t122
-    t124 = t120 + t123
-    t125 = t116**2
-    t126 = t119 + t125 + t110**2
-    t127 = t122**2
-    t128 = t124**2 + t125*t127
-    t129 = t119 + t127
-    t130 = 1e-24*t129
-    t131 = (t128 <= t126*t130)
-    t132 = casadi.if_else(t131, 1, 1/casadi.sqrt(t128))
-    t133 = casadi.if_else(t131, 1, t124*t132)
-    t134 = t113*(1 - t133)
-    t135 = t134 + t113*t133
-    t136 = t116*t122
-    t137 = casadi.if_else(t131, 0, -t132*t136)
-    t138 = t112*t133 + t118*t137
-    t139 = t118*t133 - t112*t137
-    t140 = (t129 <= t130)
-    t141 = casadi.if_else(t140, 1, 1/casadi.sqrt(t129))
-    t142 = casadi.if_else(t140, 1, -t111*t141)
-    t143 = casadi.if_else(t140, 0, -t122*t141)
-    t144 = t139*(1 - t142)
-    t145 = t138*t142 - t135*t143
-    t146 = t144 + t139*t142
-    t147 = t135*t142 + t138*t143
-    t148 = t145**2 + t146**2
-    t149 = t148
-    t150 = t148 + t147**2
-    t151 = (t101 <= t102*t103)
-    t152 = casadi.if_else(t151, 1, 1/casadi.sqrt(t101))
-    t153 = casadi.if_else(t151, 1, t152*t99)
-    t154 = casadi.if_else(t151, 0, t100*t152)
-    t155 = t153*t78 - t154*t82
-    t156 = t153*t82 + t154*t78
-    t157 = t156*t58 - t155*t40
-    t158 = t155*t58 + t156*t40
-    t159 = t155*t42 - t156*t60
-    t160 = t155*t60 + t156*t42
-    t161 = 1 - t155
-    t162 = t161*t41
-    t163 = t162 + t155*t41
-    t164 = t161*t43
-    t165 = t164 + t155*t43
-    t166 = t158**2
-    t167 = -t166
-    t168 = 1 + t167
-    t169 = casadi.if_else((t168 > 1e-12), casadi.sqrt(t168), 0)
-    t170 = t166 - t157*t169
-    t171 = t167 + t170
-    t172 = t163**2
-    t173 = t166 + t172 + t157**2
-    t174 = t169**2
-    t175 = t171**2 + t172*t174
-    t176 = t166 + t174
-    t177 = 1e-24*t176
-    t178 = (t175 <= t173*t177)
-    t179 = casadi.if_else(t178, 1, 1/casadi.sqrt(t175))
-    t180 = casadi.if_else(t178, 1, t171*t179)
-    t181 = t160*(1 - t180)
-    t182 = t181 + t160*t180
-    t183 = t163*t169
-    t184 = casadi.if_else(t178, 0, -t179*t183)
-    t185 = t159*t180 + t165*t184
-    t186 = t165*t180 - t159*t184
-    t187 = (t176 <= t177)
-    t188 = casadi.if_else(t187, 1, 1/casadi.sqrt(t176))
-    t189 = casadi.if_else(t187, 1, -t158*t188)
-    t190 = casadi.if_else(t187, 0, -t169*t188)
-    t191 = t186*(1 - t189)
-    t192 = t185*t189 - t182*t190
-    t193 = t191 + t186*t189
-    t194 = t182*t189 + t185*t190
-    t195 = t192**2 + t193**2
-    t196 = t195
-    t197 = t195 + t194**2
-    t198 = 1 - t32
-    t199 = t14*t198
-    t200 = t199 + t14*t32
-    t201 = -0.4 + t200
-    t202 = t201**2 + t45**2 + t46**2
-    t203 = 0.3794 - 0.5*t202
-    t204 = T22*t198
-    t205 = t204 + T22*t32
-    t206 = T20*t198
-    t207 = t206 + T20*t32
-    t208 = t203**2
-    t209 = 1 - t208*t64
-    t210 = t203*t62
-    t211 = (1e-12 < t209)
-    t212 = casadi.if_else(t211, t210, casadi.if_else((t210 > 0), 1, -1))
-    t213 = casadi.if_else(t211, casadi.sqrt(t209), 0)
-    t214 = casadi.atan2(t213, t212)
-    t215 = casadi.if_else(t61, 0, t0 + t214)
-    t216 = t0 - t214
-    t217 = t212*t73
-    t218 = t213*t75
-    t219 = casadi.if_else(t61, 1, -t217 - t218)
-    t220 = t218 - t217
-    t221 = t212*t75
-    t222 = t213*t73
-    t223 = casadi.if_else(t61, 0, t221 - t222)
-    t224 = t221 + t222
-    t225 = 0.12*t219 - 0.62*t223
-    t226 = 0.12*t223 + 0.62*t219
-    t227 = 0.78 + t225
-    t228 = 0.4 - t226
-    t229 = -0.18 + t227
-    t230 = -0.4 + t228
-    t231 = t201*t230 + t229*t46
-    t232 = t230*t46 - t201*t229
-    t233 = t231**2 + t232**2
-    t234 = t229**2 + t230**2
-    t235 = 0.12*t220 - 0.62*t224
-    t236 = 0.12*t224 + 0.62*t220
-    t237 = 0.78 + t235
-    t238 = 0.4 - t236
-    t239 = -0.18 + t237
-    t240 = -0.4 + t238
-    t241 = t201*t240 + t239*t46
-    t242 = t240*t46 - t201*t239
-    t243 = t241**2 + t242**2
-    t244 = t239**2 + t240**2
-    t245 = 1e-24*t202
-    t246 = (t233 <= t234*t245)
-    t247 = casadi.if_else(t246, 1, 1/casadi.sqrt(t233))
-    t248 = casadi.if_else(t246, 1, t231*t247)
-    t249 = casadi.if_else(t246, 0, t232*t247)
-    t250 = t219*t248 - t223*t249
-    t251 = t219*t249 + t223*t248
-    t252 = t205*t251 + t250*t47
-    t253 = t251*t47 - t205*t250
-    t254 = t250*t49 - t207*t251
-    t255 = t207*t250 + t251*t49
-    t256 = 1 - t250
-    t257 = t256*t48
-    t258 = t257 + t250*t48
-    t259 = t256*t50
-    t260 = t259 + t250*t50
-    t261 = t253**2
-    t262 = -t261
-    t263 = 1 + t262
-    t264 = casadi.if_else((t263 > 1e-12), casadi.sqrt(t263), 0)
-    t265 = t261 - t252*t264
-    t266 = t262 + t265
-    t267 = t258**2
-    t268 = t261 + t267 + t252**2
-    t269 = t264**2
-    t270 = t266**2 + t267*t269
-    t271 = t261 + t269
-    t272 = 1e-24*t271
-    t273 = (t270 <= t268*t272)
-    t274 = casadi.if_else(t273, 1, 1/casadi.sqrt(t270))
-    t275 = casadi.if_else(t273, 1, t266*t274)
-    t276 = t255*(1 - t275)
-    t277 = t276 + t255*t275
-    t278 = t258*t264
-    t279 = casadi.if_else(t273, 0, t274*t278)
-    t280 = t254*t275 + t260*t279
-    t281 = t260*t275 - t254*t279
-    t282 = (t271 <= t272)
-    t283 = casadi.if_else(t282, 1, 1/casadi.sqrt(t271))
-    t284 = casadi.if_else(t282, 1, t253*t283)
-    t285 = casadi.if_else(t282, 0, -t264*t283)
-    t286 = t281*(1 - t284)
-    t287 = t280*t284 - t277*t285
-    t288 = t286 + t281*t284
-    t289 = t277*t284 + t280*t285
-    t290 = t287**2 + t288**2
-    t291 = t290
-    t292 = t290 + t289**2
-    t293 = (t243 <= t244*t245)
-    t294 = casadi.if_else(t293, 1, 1/casadi.sqrt(t243))
-    t295 = casadi.if_else(t293, 1, t241*t294)
-    t296 = casadi.if_else(t293, 0, t242*t294)
-    t297 = t220*t295 - t224*t296
-    t298 = t220*t296 + t224*t295
-    t299 = t205*t298 + t297*t47
-    t300 = t298*t47 - t205*t297
-    t301 = t297*t49 - t207*t298
-    t302 = t207*t297 + t298*t49
-    t303 = 1 - t297
-    t304 = t303*t48
-    t305 = t304 + t297*t48
-    t306 = t303*t50
-    t307 = t306 + t297*t50
-    t308 = t300**2
-    t309 = -t308
-    t310 = 1 + t309
-    t311 = casadi.if_else((t310 > 1e-12), casadi.sqrt(t310), 0)
-    t312 = t308 - t299*t311
-    t313 = t309 + t312
-    t314 = t305**2
-    t315 = t308 + t314 + t299**2
-    t316 = t311**2
-    t317 = t313**2 + t314*t316
-    t318 = t308 + t316
-    t319 = 1e-24*t318
-    t320 = (t317 <= t315*t319)
-    t321 = casadi.if_else(t320, 1, 1/casadi.sqrt(t317))
-    t322 = casadi.if_else(t320, 1, t313*t321)
-    t323 = t302*(1 - t322)
-    t324 = t323 + t302*t322
-    t325 = t305*t311
-    t326 = casadi.if_else(t320, 0, t321*t325)
-    t327 = t301*t322 + t307*t326
-    t328 = t307*t322 - t301*t326
-    t329 = (t318 <= t319)
-    t330 = casadi.if_else(t329, 1, 1/casadi.sqrt(t318))
-    t331 = casadi.if_else(t329, 1, t300*t330)
-    t332 = casadi.if_else(t329, 0, -t311*t330)
-    t333 = t328*(1 - t331)
-    t334 = t327*t331 - t324*t332
-    t335 = t333 + t328*t331
-    t336 = t324*t331 + t327*t332
-    t337 = t334**2 + t335**2
-    t338 = t337
-    t339 = t337 + t336**2
-    t340 = t25 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t25)
-    t341 = casadi.if_else(t104, 0, casadi.atan2(t90, t89))
-    t342 = t71 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t71)
-    t343 = casadi.if_else(t131, 0, casadi.atan2(-t136, t124))
-    t344 = casadi.if_else(t140, 0, casadi.atan2(-t122, -t111))
-    t345 = casadi.if_else((t149 <= 1e-24*t150), 0, casadi.atan2(t146, t145))
-    t346 = casadi.if_else(t151, 0, casadi.atan2(t100, t99))
-    t347 = t72 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t72)
-    t348 = casadi.if_else(t178, 0, casadi.atan2(-t183, t171))
-    t349 = casadi.if_else(t187, 0, casadi.atan2(-t169, -t158))
-    t350 = casadi.if_else((t196 <= 1e-24*t197), 0, casadi.atan2(t193, t192))
-    t351 = t26 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t26)
-    t352 = casadi.if_else(t246, 0, casadi.atan2(t232, t231))
-    t353 = t215 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t215)
-    t354 = casadi.if_else(t273, 0, casadi.atan2(t278, t266))
-    t355 = casadi.if_else(t282, 0, casadi.atan2(-t264, t253))
-    t356 = casadi.if_else((t291 <= 1e-24*t292), 0, casadi.atan2(t288, t287))
-    t357 = casadi.if_else(t293, 0, casadi.atan2(t242, t241))
-    t358 = t216 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t216)
-    t359 = casadi.if_else(t320, 0, casadi.atan2(t325, t313))
-    t360 = casadi.if_else(t329, 0, casadi.atan2(-t311, t300))
-    t361 = casadi.if_else((t338 <= 1e-24*t339), 0, casadi.atan2(t335, t334))
-    t362 = (casadi.fabs(t1) < casadi.inf)
-    t363 = -1e-12
-    t364 = (t16 > t18)
-    t365 = casadi.logic_or(t364, casadi.logic_and(t19, (0 <= 1e-12*t17)))
-    t366 = 1.4356799999999999e-25
-    t367 = (0.143568 > t366)
-    t368 = (0.143568 <= t366)
-    t369 = 1.43568e-13
-    t370 = casadi.logic_or(casadi.logic_and(t367, (t65 >= t363)), casadi.logic_and(t368, (t63 <= t369)))
-    t371 = (t65 > 1e-12)
-    t372 = True
-    t373 = casadi.logic_or(casadi.logic_and(t367, (t209 >= t363)), casadi.logic_and(t368, (t208 <= t369)))
-    t374 = (t209 > 1e-12)
+    t27 = t25 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t25)
+    t28 = t27 - 6.283185307179586*casadi.floor(0.4305555555555555 + 0.15915494309189535*t27)
+    t29 = t26 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t26)
+    t30 = t29 - 6.283185307179586*casadi.floor(0.4305555555555555 + 0.15915494309189535*t29)
+    t31 = t20*t23
+    t32 = t31*t5
+    t33 = t20*t22
+    t34 = t33*t9
+    t35 = casadi.if_else(t19, 1, t32 + t34)
+    t36 = t34 - t32
+    t37 = t31*t9
+    t38 = t33*t5
+    t39 = casadi.if_else(t19, 0, t37 - t38)
+    t40 = t37 + t38
+    t41 = t35*t5 + t39*t9
+    t42 = t35*t9 - t39*t5
+    t43 = -0.18 + t41
+    t44 = T02*t35 + T12*t39
+    t45 = T02*t39 - T12*t35
+    t46 = T00*t35 + T10*t39
+    t47 = T10*t35 - T00*t39
+    t48 = t36*t5 - t40*t9
+    t49 = t36*t9 + t40*t5
+    t50 = -0.18 + t48
+    t51 = T12*t40 - T02*t36
+    t52 = T02*t40 + T12*t36
+    t53 = T00*t36 - T10*t40
+    t54 = T00*t40 + T10*t36
+    t55 = 1 - t35
+    t56 = t14*t55
+    t57 = t56 + t14*t35
+    t58 = -0.4 + t57
+    t59 = t42**2 + t43**2 + t58**2
+    t60 = 0.3794 - 0.5*t59
+    t61 = T22*t55
+    t62 = t61 + T22*t35
+    t63 = T20*t55
+    t64 = t63 + T20*t35
+    t65 = False
+    t66 = casadi.if_else(t65, 1, 2.639193146748068)
+    t67 = t60**2
+    t68 = t66**2
+    t69 = 1 - t67*t68
+    t70 = t60*t66
+    t71 = (1e-12 < t69)
+    t72 = casadi.if_else(t71, t70, casadi.if_else((t70 > 0), 1, -1))
+    t73 = casadi.if_else(t71, casadi.sqrt(t69), 0)
+    t74 = casadi.atan2(t73, t72)
+    t75 = casadi.if_else(t65, 0, t0 + t74)
+    t76 = t0 - t74
+    t77 = t75 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t75)
+    t78 = t77 - 6.283185307179586*casadi.floor(0.041666666666666664 + 0.15915494309189535*t77)
+    t79 = t76 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t76)
+    t80 = t79 - 6.283185307179586*casadi.floor(0.041666666666666664 + 0.15915494309189535*t79)
+    t81 = 0.072*t66
+    t82 = t72*t81
+    t83 = 0.372*t66
+    t84 = t73*t83
+    t85 = casadi.if_else(t65, 1, -t82 - t84)
+    t86 = t84 - t82
+    t87 = t72*t83
+    t88 = t73*t81
+    t89 = casadi.if_else(t65, 0, t87 - t88)
+    t90 = t87 + t88
+    t91 = 0.12*t85 - 0.62*t89
+    t92 = 0.12*t89 + 0.62*t85
+    t93 = 0.78 + t91
+    t94 = 0.4 - t92
+    t95 = -0.18 + t93
+    t96 = -0.4 + t94
+    t97 = t43*t95 + t58*t96
+    t98 = t43*t96 - t58*t95
+    t99 = t97**2 + t98**2
+    t100 = t95**2 + t96**2
+    t101 = 0.12*t86 - 0.62*t90
+    t102 = 0.12*t90 + 0.62*t86
+    t103 = 0.78 + t101
+    t104 = 0.4 - t102
+    t105 = -0.18 + t103
+    t106 = -0.4 + t104
+    t107 = t105*t43 + t106*t58
+    t108 = t106*t43 - t105*t58
+    t109 = t107**2 + t108**2
+    t110 = t105**2 + t106**2
+    t111 = 1e-24*t59
+    t112 = (t99 <= t100*t111)
+    t113 = casadi.if_else(t112, 1, 1/casadi.sqrt(t99))
+    t114 = casadi.if_else(t112, 1, t113*t97)
+    t115 = casadi.if_else(t112, 0, t113*t98)
+    t116 = t114*t85 - t115*t89
+    t117 = t114*t89 + t115*t85
+    t118 = t117*t62 - t116*t44
+    t119 = t116*t62 + t117*t44
+    t120 = t116*t46 - t117*t64
+    t121 = t116*t64 + t117*t46
+    t122 = casadi.if_else(t112, 0, casadi.atan2(t98, t97))
+    t123 = t122 - 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*t122)
+    t124 = 1 - t116
+    t125 = t124*t45
+    t126 = t125 + t116*t45
+    t127 = t124*t47
+    t128 = t127 + t116*t47
+    t129 = t119**2
+    t130 = -t129
+    t131 = 1 + t130
+    t132 = casadi.if_else((t131 > 1e-12), casadi.sqrt(t131), 0)
+    t133 = t129 - t118*t132
+    t134 = t130 + t133
+    t135 = t126**2
+    t136 = t129 + t135 + t118**2
+    t137 = t132**2
+    t138 = t134**2 + t135*t137
+    t139 = t129 + t137
+    t140 = 1e-24*t139
+    t141 = (t138 <= t136*t140)
+    t142 = casadi.if_else(t141, 1, 1/casadi.sqrt(t138))
+    t143 = casadi.if_else(t141, 1, t134*t142)
+    t144 = t121*(1 - t143)
+    t145 = t144 + t121*t143
+    t146 = t126*t132
+    t147 = casadi.if_else(t141, 0, -t142*t146)
+    t148 = t120*t143 + t128*t147
+    t149 = t128*t143 - t120*t147
+    t150 = (t139 <= t140)
+    t151 = casadi.if_else(t150, 1, 1/casadi.sqrt(t139))
+    t152 = casadi.if_else(t150, 1, -t119*t151)
+    t153 = casadi.if_else(t150, 0, -t132*t151)
+    t154 = t149*(1 - t152)
+    t155 = t148*t152 - t145*t153
+    t156 = t154 + t149*t152
+    t157 = t145*t152 + t148*t153
+    t158 = t155**2 + t156**2
+    t159 = t158
+    t160 = t158 + t157**2
+    t161 = (t109 <= t110*t111)
+    t162 = casadi.if_else(t161, 1, 1/casadi.sqrt(t109))
+    t163 = casadi.if_else(t161, 1, t107*t162)
+    t164 = casadi.if_else(t161, 0, t108*t162)
+    t165 = t163*t86 - t164*t90
+    t166 = t163*t90 + t164*t86
+    t167 = t166*t62 - t165*t44
+    t168 = t165*t62 + t166*t44
+    t169 = t165*t46 - t166*t64
+    t170 = t165*t64 + t166*t46
+    t171 = casadi.if_else(t161, 0, casadi.atan2(t108, t107))
+    t172 = t171 - 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*t171)
+    t173 = 1 - t165
+    t174 = t173*t45
+    t175 = t174 + t165*t45
+    t176 = t173*t47
+    t177 = t176 + t165*t47
+    t178 = t168**2
+    t179 = -t178
+    t180 = 1 + t179
+    t181 = casadi.if_else((t180 > 1e-12), casadi.sqrt(t180), 0)
+    t182 = t178 - t167*t181
+    t183 = t179 + t182
+    t184 = t175**2
+    t185 = t178 + t184 + t167**2
+    t186 = t181**2
+    t187 = t183**2 + t184*t186
+    t188 = t178 + t186
+    t189 = 1e-24*t188
+    t190 = (t187 <= t185*t189)
+    t191 = casadi.if_else(t190, 1, 1/casadi.sqrt(t187))
+    t192 = casadi.if_else(t190, 1, t183*t191)
+    t193 = t170*(1 - t192)
+    t194 = t193 + t170*t192
+    t195 = t175*t181
+    t196 = casadi.if_else(t190, 0, -t191*t195)
+    t197 = t169*t192 + t177*t196
+    t198 = t177*t192 - t169*t196
+    t199 = (t188 <= t189)
+    t200 = casadi.if_else(t199, 1, 1/casadi.sqrt(t188))
+    t201 = casadi.if_else(t199, 1, -t168*t200)
+    t202 = casadi.if_else(t199, 0, -t181*t200)
+    t203 = t198*(1 - t201)
+    t204 = t197*t201 - t194*t202
+    t205 = t203 + t198*t201
+    t206 = t194*t201 + t197*t202
+    t207 = t204**2 + t205**2
+    t208 = t207
+    t209 = t207 + t206**2
+    t210 = 1 - t36
+    t211 = t14*t210
+    t212 = t211 + t14*t36
+    t213 = -0.4 + t212
+    t214 = t213**2 + t49**2 + t50**2
+    t215 = 0.3794 - 0.5*t214
+    t216 = T22*t210
+    t217 = t216 + T22*t36
+    t218 = T20*t210
+    t219 = t218 + T20*t36
+    t220 = t215**2
+    t221 = 1 - t220*t68
+    t222 = t215*t66
+    t223 = (1e-12 < t221)
+    t224 = casadi.if_else(t223, t222, casadi.if_else((t222 > 0), 1, -1))
+    t225 = casadi.if_else(t223, casadi.sqrt(t221), 0)
+    t226 = casadi.atan2(t225, t224)
+    t227 = casadi.if_else(t65, 0, t0 + t226)
+    t228 = t0 - t226
+    t229 = t227 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t227)
+    t230 = t229 - 6.283185307179586*casadi.floor(0.041666666666666664 + 0.15915494309189535*t229)
+    t231 = t228 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t228)
+    t232 = t231 - 6.283185307179586*casadi.floor(0.041666666666666664 + 0.15915494309189535*t231)
+    t233 = t224*t81
+    t234 = t225*t83
+    t235 = casadi.if_else(t65, 1, -t233 - t234)
+    t236 = t234 - t233
+    t237 = t224*t83
+    t238 = t225*t81
+    t239 = casadi.if_else(t65, 0, t237 - t238)
+    t240 = t237 + t238
+    t241 = 0.12*t235 - 0.62*t239
+    t242 = 0.12*t239 + 0.62*t235
+    t243 = 0.78 + t241
+    t244 = 0.4 - t242
+    t245 = -0.18 + t243
+    t246 = -0.4 + t244
+    t247 = t213*t246 + t245*t50
+    t248 = t246*t50 - t213*t245
+    t249 = t247**2 + t248**2
+    t250 = t245**2 + t246**2
+    t251 = 0.12*t236 - 0.62*t240
+    t252 = 0.12*t240 + 0.62*t236
+    t253 = 0.78 + t251
+    t254 = 0.4 - t252
+    t255 = -0.18 + t253
+    t256 = -0.4 + t254
+    t257 = t213*t256 + t255*t50
+    t258 = t256*t50 - t213*t255
+    t259 = t257**2 + t258**2
+    t260 = t255**2 + t256**2
+    t261 = 1e-24*t214
+    t262 = (t249 <= t250*t261)
+    t263 = casadi.if_else(t262, 1, 1/casadi.sqrt(t249))
+    t264 = casadi.if_else(t262, 1, t247*t263)
+    t265 = casadi.if_else(t262, 0, t248*t263)
+    t266 = t235*t264 - t239*t265
+    t267 = t235*t265 + t239*t264
+    t268 = t217*t267 + t266*t51
+    t269 = t267*t51 - t217*t266
+    t270 = t266*t53 - t219*t267
+    t271 = t219*t266 + t267*t53
+    t272 = casadi.if_else(t262, 0, casadi.atan2(t248, t247))
+    t273 = t272 - 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*t272)
+    t274 = 1 - t266
+    t275 = t274*t52
+    t276 = t275 + t266*t52
+    t277 = t274*t54
+    t278 = t277 + t266*t54
+    t279 = t269**2
+    t280 = -t279
+    t281 = 1 + t280
+    t282 = casadi.if_else((t281 > 1e-12), casadi.sqrt(t281), 0)
+    t283 = t279 - t268*t282
+    t284 = t280 + t283
+    t285 = t276**2
+    t286 = t279 + t285 + t268**2
+    t287 = t282**2
+    t288 = t284**2 + t285*t287
+    t289 = t279 + t287
+    t290 = 1e-24*t289
+    t291 = (t288 <= t286*t290)
+    t292 = casadi.if_else(t291, 1, 1/casadi.sqrt(t288))
+    t293 = casadi.if_else(t291, 1, t284*t292)
+    t294 = t271*(1 - t293)
+    t295 = t294 + t271*t293
+    t296 = t276*t282
+    t297 = casadi.if_else(t291, 0, t292*t296)
+    t298 = t270*t293 + t278*t297
+    t299 = t278*t293 - t270*t297
+    t300 = (t289 <= t290)
+    t301 = casadi.if_else(t300, 1, 1/casadi.sqrt(t289))
+    t302 = casadi.if_else(t300, 1, t269*t301)
+    t303 = casadi.if_else(t300, 0, -t282*t301)
+    t304 = t299*(1 - t302)
+    t305 = t298*t302 - t295*t303
+    t306 = t304 + t299*t302
+    t307 = t295*t302 + t298*t303
+    t308 = t305**2 + t306**2
+    t309 = t308
+    t310 = t308 + t307**2
+    t311 = (t259 <= t260*t261)
+    t312 = casadi.if_else(t311, 1, 1/casadi.sqrt(t259))
+    t313 = casadi.if_else(t311, 1, t257*t312)
+    t314 = casadi.if_else(t311, 0, t258*t312)
+    t315 = t236*t313 - t240*t314
+    t316 = t236*t314 + t240*t313
+    t317 = t217*t316 + t315*t51
+    t318 = t316*t51 - t217*t315
+    t319 = t315*t53 - t219*t316
+    t320 = t219*t315 + t316*t53
+    t321 = casadi.if_else(t311, 0, casadi.atan2(t258, t257))
+    t322 = t321 - 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*t321)
+    t323 = 1 - t315
+    t324 = t323*t52
+    t325 = t324 + t315*t52
+    t326 = t323*t54
+    t327 = t326 + t315*t54
+    t328 = t318**2
+    t329 = -t328
+    t330 = 1 + t329
+    t331 = casadi.if_else((t330 > 1e-12), casadi.sqrt(t330), 0)
+    t332 = t328 - t317*t331
+    t333 = t329 + t332
+    t334 = t325**2
+    t335 = t328 + t334 + t317**2
+    t336 = t331**2
+    t337 = t333**2 + t334*t336
+    t338 = t328 + t336
+    t339 = 1e-24*t338
+    t340 = (t337 <= t335*t339)
+    t341 = casadi.if_else(t340, 1, 1/casadi.sqrt(t337))
+    t342 = casadi.if_else(t340, 1, t333*t341)
+    t343 = t320*(1 - t342)
+    t344 = t343 + t320*t342
+    t345 = t325*t331
+    t346 = casadi.if_else(t340, 0, t341*t345)
+    t347 = t319*t342 + t327*t346
+    t348 = t327*t342 - t319*t346
+    t349 = (t338 <= t339)
+    t350 = casadi.if_else(t349, 1, 1/casadi.sqrt(t338))
+    t351 = casadi.if_else(t349, 1, t318*t350)
+    t352 = casadi.if_else(t349, 0, -t331*t350)
+    t353 = t348*(1 - t351)
+    t354 = t347*t351 - t344*t352
+    t355 = t353 + t348*t351
+    t356 = t344*t351 + t347*t352
+    t357 = t354**2 + t355**2
+    t358 = t357
+    t359 = t357 + t356**2
+    t360 = casadi.if_else(t141, 0, casadi.atan2(-t146, t134))
+    t361 = t360
+    t362 = t361 - 6.283185307179586*casadi.floor(0.9722222222222222 + 0.15915494309189535*t361)
+    t363 = 3.141592653589793 + t360 - 6.283185307179586*casadi.ceil(0.15915494309189535*t360)
+    t364 = t363 - 6.283185307179586*casadi.floor(0.9722222222222222 + 0.15915494309189535*t363)
+    t365 = casadi.if_else(t150, 0, casadi.atan2(-t132, -t119))
+    t366 = t365
+    t367 = t366 - 6.283185307179586*casadi.floor(0.3611111111111111 + 0.15915494309189535*t366)
+    t368 = t365 + 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t365)
+    t369 = casadi.if_else((t159 <= 1e-24*t160), 0, casadi.atan2(t156, t155))
+    t370 = t369
+    t371 = t370 - 6.283185307179586*casadi.floor(0.9722222222222222 + 0.15915494309189535*t370)
+    t372 = 3.141592653589793 + t369 - 6.283185307179586*casadi.ceil(0.15915494309189535*t369)
+    t373 = t372 - 6.283185307179586*casadi.floor(0.9722222222222222 + 0.15915494309189535*t372)
+    t374 = -t368
+    t375 = t368 + 6.283185307179586*casadi.floor(0.3611111111111111 + 0.15915494309189535*t374)
+    t376 = casadi.if_else(t190, 0, casadi.atan2(-t195, t183))
+    t377 = t376
+    t378 = t377 - 6.283185307179586*casadi.floor(0.9722222222222222 + 0.15915494309189535*t377)
+    t379 = 3.141592653589793 + t376 - 6.283185307179586*casadi.ceil(0.15915494309189535*t376)
+    t380 = t379 - 6.283185307179586*casadi.floor(0.9722222222222222 + 0.15915494309189535*t379)
+    t381 = casadi.if_else(t199, 0, casadi.atan2(-t181, -t168))
+    t382 = t381
+    t383 = t382 - 6.283185307179586*casadi.floor(0.3611111111111111 + 0.15915494309189535*t382)
+    t384 = t381 + 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t381)
+    t385 = casadi.if_else((t208 <= 1e-24*t209), 0, casadi.atan2(t205, t204))
+    t386 = t385
+    t387 = t386 - 6.283185307179586*casadi.floor(0.9722222222222222 + 0.15915494309189535*t386)
+    t388 = 3.141592653589793 + t385 - 6.283185307179586*casadi.ceil(0.15915494309189535*t385)
+    t389 = t388 - 6.283185307179586*casadi.floor(0.9722222222222222 + 0.15915494309189535*t388)
+    t390 = -t384
+    t391 = t384 + 6.283185307179586*casadi.floor(0.3611111111111111 + 0.15915494309189535*t390)
+    t392 = casadi.if_else(t291, 0, casadi.atan2(t296, t284))
+    t393 = t392
+    t394 = t393 - 6.283185307179586*casadi.floor(0.9722222222222222 + 0.15915494309189535*t393)
+    t395 = 3.141592653589793 + t392 - 6.283185307179586*casadi.ceil(0.15915494309189535*t392)
+    t396 = t395 - 6.283185307179586*casadi.floor(0.9722222222222222 + 0.15915494309189535*t395)
+    t397 = casadi.if_else(t300, 0, casadi.atan2(-t282, t269))
+    t398 = t397
+    t399 = t398 - 6.283185307179586*casadi.floor(0.3611111111111111 + 0.15915494309189535*t398)
+    t400 = t397 + 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t397)
+    t401 = casadi.if_else((t309 <= 1e-24*t310), 0, casadi.atan2(t306, t305))
+    t402 = t401
+    t403 = t402 - 6.283185307179586*casadi.floor(0.9722222222222222 + 0.15915494309189535*t402)
+    t404 = 3.141592653589793 + t401 - 6.283185307179586*casadi.ceil(0.15915494309189535*t401)
+    t405 = t404 - 6.283185307179586*casadi.floor(0.9722222222222222 + 0.15915494309189535*t404)
+    t406 = -t400
+    t407 = t400 + 6.283185307179586*casadi.floor(0.3611111111111111 + 0.15915494309189535*t406)
+    t408 = casadi.if_else(t340, 0, casadi.atan2(t345, t333))
+    t409 = t408
+    t410 = t409 - 6.283185307179586*casadi.floor(0.9722222222222222 + 0.15915494309189535*t409)
+    t411 = 3.141592653589793 + t408 - 6.283185307179586*casadi.ceil(0.15915494309189535*t408)
+    t412 = t411 - 6.283185307179586*casadi.floor(0.9722222222222222 + 0.15915494309189535*t411)
+    t413 = casadi.if_else(t349, 0, casadi.atan2(-t331, t318))
+    t414 = t413
+    t415 = t414 - 6.283185307179586*casadi.floor(0.3611111111111111 + 0.15915494309189535*t414)
+    t416 = t413 + 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t413)
+    t417 = casadi.if_else((t358 <= 1e-24*t359), 0, casadi.atan2(t355, t354))
+    t418 = t417
+    t419 = t418 - 6.283185307179586*casadi.floor(0.9722222222222222 + 0.15915494309189535*t418)
+    t420 = 3.141592653589793 + t417 - 6.283185307179586*casadi.ceil(0.15915494309189535*t417)
+    t421 = t420 - 6.283185307179586*casadi.floor(0.9722222222222222 + 0.15915494309189535*t420)
+    t422 = -t416
+    t423 = t416 + 6.283185307179586*casadi.floor(0.3611111111111111 + 0.15915494309189535*t422)
+    t424 = (t28 <= 2.705260340591211)
+    t425 = casadi.logic_and((t27 >= -2.705260340591211), (t27 <= 2.705260340591211))
+    t426 = casadi.if_else(casadi.logic_and(t424, casadi.logic_not(t425)), t28, t27)
+    t427 = (t123 <= 1.1344640137963142)
+    t428 = casadi.logic_and((t122 >= -3.141592653589793), (t122 <= 1.1344640137963142))
+    t429 = casadi.if_else(casadi.logic_and(t427, casadi.logic_not(t428)), t123, t122)
+    t430 = (t78 <= 2.7576202181510405)
+    t431 = casadi.logic_and((t77 >= -0.2617993877991494), (t77 <= 2.7576202181510405))
+    t432 = casadi.if_else(casadi.logic_and(t430, casadi.logic_not(t431)), t78, t77)
+    t433 = (t362 <= 6.1086523819801535)
+    t434 = casadi.logic_and((t361 >= -6.1086523819801535), (t361 <= 6.1086523819801535))
+    t435 = (t367 <= 2.2689280275926285)
+    t436 = casadi.logic_and((t366 >= -2.2689280275926285), (t366 <= 2.2689280275926285))
+    t437 = (t371 <= 6.1086523819801535)
+    t438 = casadi.logic_and((t370 >= -6.1086523819801535), (t370 <= 6.1086523819801535))
+    t439 = (t364 <= 6.1086523819801535)
+    t440 = casadi.logic_and((t363 >= -6.1086523819801535), (t363 <= 6.1086523819801535))
+    t441 = -t375
+    t442 = (t373 <= 6.1086523819801535)
+    t443 = casadi.logic_and((t372 >= -6.1086523819801535), (t372 <= 6.1086523819801535))
+    t444 = (t172 <= 1.1344640137963142)
+    t445 = casadi.logic_and((t171 >= -3.141592653589793), (t171 <= 1.1344640137963142))
+    t446 = casadi.if_else(casadi.logic_and(t444, casadi.logic_not(t445)), t172, t171)
+    t447 = (t80 <= 2.7576202181510405)
+    t448 = casadi.logic_and((t79 >= -0.2617993877991494), (t79 <= 2.7576202181510405))
+    t449 = casadi.if_else(casadi.logic_and(t447, casadi.logic_not(t448)), t80, t79)
+    t450 = (t378 <= 6.1086523819801535)
+    t451 = casadi.logic_and((t377 >= -6.1086523819801535), (t377 <= 6.1086523819801535))
+    t452 = (t383 <= 2.2689280275926285)
+    t453 = casadi.logic_and((t382 >= -2.2689280275926285), (t382 <= 2.2689280275926285))
+    t454 = (t387 <= 6.1086523819801535)
+    t455 = casadi.logic_and((t386 >= -6.1086523819801535), (t386 <= 6.1086523819801535))
+    t456 = (t380 <= 6.1086523819801535)
+    t457 = casadi.logic_and((t379 >= -6.1086523819801535), (t379 <= 6.1086523819801535))
+    t458 = -t391
+    t459 = (t389 <= 6.1086523819801535)
+    t460 = casadi.logic_and((t388 >= -6.1086523819801535), (t388 <= 6.1086523819801535))
+    t461 = (t30 <= 2.705260340591211)
+    t462 = casadi.logic_and((t29 >= -2.705260340591211), (t29 <= 2.705260340591211))
+    t463 = casadi.if_else(casadi.logic_and(t461, casadi.logic_not(t462)), t30, t29)
+    t464 = (t273 <= 1.1344640137963142)
+    t465 = casadi.logic_and((t272 >= -3.141592653589793), (t272 <= 1.1344640137963142))
+    t466 = casadi.if_else(casadi.logic_and(t464, casadi.logic_not(t465)), t273, t272)
+    t467 = (t230 <= 2.7576202181510405)
+    t468 = casadi.logic_and((t229 >= -0.2617993877991494), (t229 <= 2.7576202181510405))
+    t469 = casadi.if_else(casadi.logic_and(t467, casadi.logic_not(t468)), t230, t229)
+    t470 = (t394 <= 6.1086523819801535)
+    t471 = casadi.logic_and((t393 >= -6.1086523819801535), (t393 <= 6.1086523819801535))
+    t472 = (t399 <= 2.2689280275926285)
+    t473 = casadi.logic_and((t398 >= -2.2689280275926285), (t398 <= 2.2689280275926285))
+    t474 = (t403 <= 6.1086523819801535)
+    t475 = casadi.logic_and((t402 >= -6.1086523819801535), (t402 <= 6.1086523819801535))
+    t476 = (t396 <= 6.1086523819801535)
+    t477 = casadi.logic_and((t395 >= -6.1086523819801535), (t395 <= 6.1086523819801535))
+    t478 = -t407
+    t479 = (t405 <= 6.1086523819801535)
+    t480 = casadi.logic_and((t404 >= -6.1086523819801535), (t404 <= 6.1086523819801535))
+    t481 = (t322 <= 1.1344640137963142)
+    t482 = casadi.logic_and((t321 >= -3.141592653589793), (t321 <= 1.1344640137963142))
+    t483 = casadi.if_else(casadi.logic_and(t481, casadi.logic_not(t482)), t322, t321)
+    t484 = (t232 <= 2.7576202181510405)
+    t485 = casadi.logic_and((t231 >= -0.2617993877991494), (t231 <= 2.7576202181510405))
+    t486 = casadi.if_else(casadi.logic_and(t484, casadi.logic_not(t485)), t232, t231)
+    t487 = (t410 <= 6.1086523819801535)
+    t488 = casadi.logic_and((t409 >= -6.1086523819801535), (t409 <= 6.1086523819801535))
+    t489 = (t415 <= 2.2689280275926285)
+    t490 = casadi.logic_and((t414 >= -2.2689280275926285), (t414 <= 2.2689280275926285))
+    t491 = (t419 <= 6.1086523819801535)
+    t492 = casadi.logic_and((t418 >= -6.1086523819801535), (t418 <= 6.1086523819801535))
+    t493 = (t412 <= 6.1086523819801535)
+    t494 = casadi.logic_and((t411 >= -6.1086523819801535), (t411 <= 6.1086523819801535))
+    t495 = -t423
+    t496 = (t421 <= 6.1086523819801535)
+    t497 = casadi.logic_and((t420 >= -6.1086523819801535), (t420 <= 6.1086523819801535))
+    t498 = (casadi.fabs(t1) < casadi.inf)
+    t499 = -1e-12
+    t500 = (t16 > t18)
+    t501 = casadi.logic_or(t500, casadi.logic_and(t19, (0 <= 1e-12*t17)))
+    t502 = 1.4356799999999999e-25
+    t503 = (0.143568 > t502)
+    t504 = (0.143568 <= t502)
+    t505 = 1.43568e-13
+    t506 = casadi.logic_or(casadi.logic_and(t503, (t69 >= t499)), casadi.logic_and(t504, (t67 <= t505)))
+    t507 = (t69 > 1e-12)
+    t508 = True
+    t509 = casadi.logic_or(casadi.logic_and(t503, (t221 >= t499)), casadi.logic_and(t504, (t220 <= t505)))
+    t510 = (t221 > 1e-12)
+    t511 = casadi.logic_or(t424, t425)
+    t512 = casadi.logic_or(t427, t428)
+    t513 = casadi.logic_or(t430, t431)
+    t514 = casadi.logic_or(t444, t445)
+    t515 = casadi.logic_or(t447, t448)
+    t516 = casadi.logic_or(t461, t462)
+    t517 = casadi.logic_or(t464, t465)
+    t518 = casadi.logic_or(t467, t468)
+    t519 = casadi.logic_or(t481, t482)
+    t520 = casadi.logic_or(t484, t485)
     q = casadi.SX(8, 6)
-    q[0, 0] = t340
-    q[0, 1] = t341
-    q[0, 2] = t342
-    q[0, 3] = t343
-    q[0, 4] = t344
-    q[0, 5] = t345
-    q[1, 0] = t340
-    q[1, 1] = t341
-    q[1, 2] = t342
-    q[1, 3] = 3.141592653589793 + t343 - 6.283185307179586*casadi.ceil(0.15915494309189535*t343)
-    q[1, 4] = -t344 - 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t344)
-    q[1, 5] = 3.141592653589793 + t345 - 6.283185307179586*casadi.ceil(0.15915494309189535*t345)
-    q[2, 0] = t340
-    q[2, 1] = t346
-    q[2, 2] = t347
-    q[2, 3] = t348
-    q[2, 4] = t349
-    q[2, 5] = t350
-    q[3, 0] = t340
-    q[3, 1] = t346
-    q[3, 2] = t347
-    q[3, 3] = 3.141592653589793 + t348 - 6.283185307179586*casadi.ceil(0.15915494309189535*t348)
-    q[3, 4] = -t349 - 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t349)
-    q[3, 5] = 3.141592653589793 + t350 - 6.283185307179586*casadi.ceil(0.15915494309189535*t350)
-    q[4, 0] = t351
-    q[4, 1] = t352
-    q[4, 2] = t353
-    q[4, 3] = t354
-    q[4, 4] = t355
-    q[4, 5] = t356
-    q[5, 0] = t351
-    q[5, 1] = t352
-    q[5, 2] = t353
-    q[5, 3] = 3.141592653589793 + t354 - 6.283185307179586*casadi.ceil(0.15915494309189535*t354)
-    q[5, 4] = -t355 - 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t355)
-    q[5, 5] = 3.141592653589793 + t356 - 6.283185307179586*casadi.ceil(0.15915494309189535*t356)
-    q[6, 0] = t351
-    q[6, 1] = t357
-    q[6, 2] = t358
-    q[6, 3] = t359
-    q[6, 4] = t360
-    q[6, 5] = t361
-    q[7, 0] = t351
-    q[7, 1] = t357
-    q[7, 2] = t358
-    q[7, 3] = 3.141592653589793 + t359 - 6.283185307179586*casadi.ceil(0.15915494309189535*t359)
-    q[7, 4] = -t360 - 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t360)
-    q[7, 5] = 3.141592653589793 + t361 - 6.283185307179586*casadi.ceil(0.15915494309189535*t361)
+    q[0, 0] = t426
+    q[0, 1] = t429
+    q[0, 2] = t432
+    q[0, 3] = casadi.if_else(casadi.logic_and(t433, casadi.logic_not(t434)), t362, t361)
+    q[0, 4] = casadi.if_else(casadi.logic_and(t435, casadi.logic_not(t436)), t367, t366)
+    q[0, 5] = casadi.if_else(casadi.logic_and(t437, casadi.logic_not(t438)), t371, t370)
+    q[1, 0] = t426
+    q[1, 1] = t429
+    q[1, 2] = t432
+    q[1, 3] = casadi.if_else(casadi.logic_and(t439, casadi.logic_not(t440)), t364, t363)
+    q[1, 4] = casadi.if_else(casadi.logic_and((t375 >= -2.2689280275926285), casadi.logic_not(casadi.logic_and((t368 >= -2.2689280275926285), (t368 <= 2.2689280275926285)))), t441, t374)
+    q[1, 5] = casadi.if_else(casadi.logic_and(t442, casadi.logic_not(t443)), t373, t372)
+    q[2, 0] = t426
+    q[2, 1] = t446
+    q[2, 2] = t449
+    q[2, 3] = casadi.if_else(casadi.logic_and(t450, casadi.logic_not(t451)), t378, t377)
+    q[2, 4] = casadi.if_else(casadi.logic_and(t452, casadi.logic_not(t453)), t383, t382)
+    q[2, 5] = casadi.if_else(casadi.logic_and(t454, casadi.logic_not(t455)), t387, t386)
+    q[3, 0] = t426
+    q[3, 1] = t446
+    q[3, 2] = t449
+    q[3, 3] = casadi.if_else(casadi.logic_and(t456, casadi.logic_not(t457)), t380, t379)
+    q[3, 4] = casadi.if_else(casadi.logic_and((t391 >= -2.2689280275926285), casadi.logic_not(casadi.logic_and((t384 >= -2.2689280275926285), (t384 <= 2.2689280275926285)))), t458, t390)
+    q[3, 5] = casadi.if_else(casadi.logic_and(t459, casadi.logic_not(t460)), t389, t388)
+    q[4, 0] = t463
+    q[4, 1] = t466
+    q[4, 2] = t469
+    q[4, 3] = casadi.if_else(casadi.logic_and(t470, casadi.logic_not(t471)), t394, t393)
+    q[4, 4] = casadi.if_else(casadi.logic_and(t472, casadi.logic_not(t473)), t399, t398)
+    q[4, 5] = casadi.if_else(casadi.logic_and(t474, casadi.logic_not(t475)), t403, t402)
+    q[5, 0] = t463
+    q[5, 1] = t466
+    q[5, 2] = t469
+    q[5, 3] = casadi.if_else(casadi.logic_and(t476, casadi.logic_not(t477)), t396, t395)
+    q[5, 4] = casadi.if_else(casadi.logic_and((t407 >= -2.2689280275926285), casadi.logic_not(casadi.logic_and((t400 >= -2.2689280275926285), (t400 <= 2.2689280275926285)))), t478, t406)
+    q[5, 5] = casadi.if_else(casadi.logic_and(t479, casadi.logic_not(t480)), t405, t404)
+    q[6, 0] = t463
+    q[6, 1] = t483
+    q[6, 2] = t486
+    q[6, 3] = casadi.if_else(casadi.logic_and(t487, casadi.logic_not(t488)), t410, t409)
+    q[6, 4] = casadi.if_else(casadi.logic_and(t489, casadi.logic_not(t490)), t415, t414)
+    q[6, 5] = casadi.if_else(casadi.logic_and(t491, casadi.logic_not(t492)), t419, t418)
+    q[7, 0] = t463
+    q[7, 1] = t483
+    q[7, 2] = t486
+    q[7, 3] = casadi.if_else(casadi.logic_and(t493, casadi.logic_not(t494)), t412, t411)
+    q[7, 4] = casadi.if_else(casadi.logic_and((t423 >= -2.2689280275926285), casadi.logic_not(casadi.logic_and((t416 >= -2.2689280275926285), (t416 <= 2.2689280275926285)))), t495, t422)
+    q[7, 5] = casadi.if_else(casadi.logic_and(t496, casadi.logic_not(t497)), t421, t420)
     valid = casadi.SX(8, 1)
-    valid[0, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t362, t365), t370), (t121 >= t363))
-    valid[1, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t362, t365), t370), (t121 > 1e-12))
-    valid[2, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t362, t365), t367), t371), (t168 >= t363))
-    valid[3, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t362, t365), t367), t371), (t168 > 1e-12))
-    valid[4, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t362, t364), t372), t373), (t263 >= t363))
-    valid[5, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t362, t364), t372), t373), (t263 > 1e-12))
-    valid[6, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t362, t364), t367), t372), t374), (t310 >= t363))
-    valid[7, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t362, t364), t367), t372), t374), (t310 > 1e-12))
-    return [q, valid]
+    valid[0, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t498, t501), t506), (t131 >= t499))
+    valid[1, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t498, t501), t506), (t131 > 1e-12))
+    valid[2, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t498, t501), t503), t507), (t180 >= t499))
+    valid[3, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t498, t501), t503), t507), (t180 > 1e-12))
+    valid[4, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t498, t500), t508), t509), (t281 >= t499))
+    valid[5, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t498, t500), t508), t509), (t281 > 1e-12))
+    valid[6, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t498, t500), t503), t508), t510), (t330 >= t499))
+    valid[7, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t498, t500), t503), t508), t510), (t330 > 1e-12))
+    in_limits = casadi.SX(8, 1)
+    in_limits[0, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t511, t512), t513), casadi.logic_or(t433, t434)), casadi.logic_or(t435, t436)), casadi.logic_or(t437, t438))
+    in_limits[1, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t511, t512), t513), casadi.logic_or(t439, t440)), casadi.logic_or(t442, t443)), casadi.logic_or((t441 <= 2.2689280275926285), casadi.logic_and((t374 >= -2.2689280275926285), (t374 <= 2.2689280275926285))))
+    in_limits[2, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t511, t514), t515), casadi.logic_or(t450, t451)), casadi.logic_or(t452, t453)), casadi.logic_or(t454, t455))
+    in_limits[3, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t511, t514), t515), casadi.logic_or(t456, t457)), casadi.logic_or(t459, t460)), casadi.logic_or((t458 <= 2.2689280275926285), casadi.logic_and((t390 >= -2.2689280275926285), (t390 <= 2.2689280275926285))))
+    in_limits[4, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t516, t517), t518), casadi.logic_or(t470, t471)), casadi.logic_or(t472, t473)), casadi.logic_or(t474, t475))
+    in_limits[5, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t516, t517), t518), casadi.logic_or(t476, t477)), casadi.logic_or(t479, t480)), casadi.logic_or((t478 <= 2.2689280275926285), casadi.logic_and((t406 >= -2.2689280275926285), (t406 <= 2.2689280275926285))))
+    in_limits[6, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t516, t519), t520), casadi.logic_or(t487, t488)), casadi.logic_or(t489, t490)), casadi.logic_or(t491, t492))
+    in_limits[7, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t516, t519), t520), casadi.logic_or(t493, t494)), casadi.logic_or(t496, t497)), casadi.logic_or((t495 <= 2.2689280275926285), casadi.logic_and((t422 >= -2.2689280275926285), (t422 <= 2.2689280275926285))))
+    return [q, valid, in_limits]
+
+
+def _ik_nearest(T, q_seed, weights):
+    """The closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status: 2202 operations."""
+    T00 = T[0, 0]
+    T01 = T[0, 1]
+    T02 = T[0, 2]
+    T03 = T[0, 3]
+    T10 = T[1, 0]
+    T11 = T[1, 1]
+    T12 = T[1, 2]
+    T13 = T[1, 3]
+    T20 = T[2, 0]
+    T21 = T[2, 1]
+    T22 = T[2, 2]
+    T23 = T[2, 3]
+    qn1 = q_seed[0]
+    qn2 = q_seed[1]
+    qn3 = q_seed[2]
+    qn4 = q_seed[3]
+    qn5 = q_seed[4]
+    qn6 = q_seed[5]
+    qw1 = weights[0]
+    qw2 = weights[1]
+    qw3 = weights[2]
+    qw4 = weights[3]
+    qw5 = weights[4]
+    qw6 = weights[5]
+    t0 = 1.761980786391911
+    t1 = 0.9*T00
+    t2 = T03 - t1 - 0.335*T02
+    t3 = t1 + 0.22*T02
+    t4 = t2 + t3
+    t5 = 0.9*T10
+    t6 = T13 - t5 - 0.335*T12
+    t7 = t5 + 0.22*T12
+    t8 = t6 + t7
+    t9 = casadi.atan2(-t4, t8)
+    t10 = 0.9*T20
+    t11 = T23 - t10 - 0.335*T22
+    t12 = t10 + 0.22*T22
+    t13 = t11 + t12
+    t14 = t4**2 + t8**2
+    t15 = t14
+    t16 = t14 + t13**2
+    t17 = 1e-24*t16
+    t18 = (t15 <= t17)
+    t19 = casadi.if_else(t18, 1, 1/casadi.sqrt(t15))
+    t20 = True
+    t21 = casadi.if_else(t20, 0, -1)
+    t22 = casadi.if_else(t20, 1, 0)
+    t23 = casadi.atan2(t22, t21)
+    t24 = casadi.if_else(t18, 0, t23 + t9)
+    t25 = t9 - t23
+    t26 = t24 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t24)
+    t27 = t26 - 6.283185307179586*casadi.floor(0.4305555555555555 + 0.15915494309189535*t26)
+    t28 = t25 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t25)
+    t29 = t28 - 6.283185307179586*casadi.floor(0.4305555555555555 + 0.15915494309189535*t28)
+    t30 = t19*t22
+    t31 = t30*t4
+    t32 = t19*t21
+    t33 = t32*t8
+    t34 = casadi.if_else(t18, 1, t31 + t33)
+    t35 = t33 - t31
+    t36 = t30*t8
+    t37 = t32*t4
+    t38 = casadi.if_else(t18, 0, t36 - t37)
+    t39 = t36 + t37
+    t40 = t34*t4 + t38*t8
+    t41 = t34*t8 - t38*t4
+    t42 = -0.18 + t40
+    t43 = T02*t34 + T12*t38
+    t44 = T02*t38 - T12*t34
+    t45 = T00*t34 + T10*t38
+    t46 = T10*t34 - T00*t38
+    t47 = t35*t4 - t39*t8
+    t48 = t35*t8 + t39*t4
+    t49 = -0.18 + t47
+    t50 = T12*t39 - T02*t35
+    t51 = T02*t39 + T12*t35
+    t52 = T00*t35 - T10*t39
+    t53 = T00*t39 + T10*t35
+    t54 = 1 - t34
+    t55 = t13*t54
+    t56 = t55 + t13*t34
+    t57 = -0.4 + t56
+    t58 = t41**2 + t42**2 + t57**2
+    t59 = 0.3794 - 0.5*t58
+    t60 = T22*t54
+    t61 = t60 + T22*t34
+    t62 = T20*t54
+    t63 = t62 + T20*t34
+    t64 = False
+    t65 = casadi.if_else(t64, 1, 2.639193146748068)
+    t66 = t59**2
+    t67 = t65**2
+    t68 = 1 - t66*t67
+    t69 = t59*t65
+    t70 = (1e-12 < t68)
+    t71 = casadi.if_else(t70, t69, casadi.if_else((t69 > 0), 1, -1))
+    t72 = casadi.if_else(t70, casadi.sqrt(t68), 0)
+    t73 = casadi.atan2(t72, t71)
+    t74 = casadi.if_else(t64, 0, t0 + t73)
+    t75 = t0 - t73
+    t76 = t74 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t74)
+    t77 = t76 - 6.283185307179586*casadi.floor(0.041666666666666664 + 0.15915494309189535*t76)
+    t78 = t75 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t75)
+    t79 = t78 - 6.283185307179586*casadi.floor(0.041666666666666664 + 0.15915494309189535*t78)
+    t80 = 0.072*t65
+    t81 = t71*t80
+    t82 = 0.372*t65
+    t83 = t72*t82
+    t84 = casadi.if_else(t64, 1, -t81 - t83)
+    t85 = t83 - t81
+    t86 = t71*t82
+    t87 = t72*t80
+    t88 = casadi.if_else(t64, 0, t86 - t87)
+    t89 = t86 + t87
+    t90 = 0.12*t84 - 0.62*t88
+    t91 = 0.12*t88 + 0.62*t84
+    t92 = 0.78 + t90
+    t93 = 0.4 - t91
+    t94 = -0.18 + t92
+    t95 = -0.4 + t93
+    t96 = t42*t94 + t57*t95
+    t97 = t42*t95 - t57*t94
+    t98 = t96**2 + t97**2
+    t99 = t94**2 + t95**2
+    t100 = 0.12*t85 - 0.62*t89
+    t101 = 0.12*t89 + 0.62*t85
+    t102 = 0.78 + t100
+    t103 = 0.4 - t101
+    t104 = -0.18 + t102
+    t105 = -0.4 + t103
+    t106 = t104*t42 + t105*t57
+    t107 = t105*t42 - t104*t57
+    t108 = t106**2 + t107**2
+    t109 = t104**2 + t105**2
+    t110 = 1e-24*t58
+    t111 = (t98 <= t110*t99)
+    t112 = casadi.if_else(t111, 1, 1/casadi.sqrt(t98))
+    t113 = casadi.if_else(t111, 1, t112*t96)
+    t114 = casadi.if_else(t111, 0, t112*t97)
+    t115 = t113*t84 - t114*t88
+    t116 = t113*t88 + t114*t84
+    t117 = t116*t61 - t115*t43
+    t118 = t115*t61 + t116*t43
+    t119 = t115*t45 - t116*t63
+    t120 = t115*t63 + t116*t45
+    t121 = casadi.if_else(t111, 0, casadi.atan2(t97, t96))
+    t122 = t121 - 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*t121)
+    t123 = 1 - t115
+    t124 = t123*t44
+    t125 = t124 + t115*t44
+    t126 = t123*t46
+    t127 = t126 + t115*t46
+    t128 = t118**2
+    t129 = -t128
+    t130 = 1 + t129
+    t131 = (1e-12 < t130)
+    t132 = casadi.if_else(t131, casadi.sqrt(t130), 0)
+    t133 = t128 - t117*t132
+    t134 = t129 + t133
+    t135 = t125**2
+    t136 = t128 + t135 + t117**2
+    t137 = t132**2
+    t138 = t134**2 + t135*t137
+    t139 = t128 + t137
+    t140 = 1e-24*t139
+    t141 = (t138 <= t136*t140)
+    t142 = casadi.if_else(t141, 1, 1/casadi.sqrt(t138))
+    t143 = casadi.if_else(t141, 1, t134*t142)
+    t144 = t120*(1 - t143)
+    t145 = t144 + t120*t143
+    t146 = t125*t132
+    t147 = casadi.if_else(t141, 0, -t142*t146)
+    t148 = t119*t143 + t127*t147
+    t149 = t127*t143 - t119*t147
+    t150 = (t139 <= t140)
+    t151 = casadi.if_else(t150, 1, 1/casadi.sqrt(t139))
+    t152 = casadi.if_else(t150, 1, -t118*t151)
+    t153 = casadi.if_else(t150, 0, -t132*t151)
+    t154 = t149*(1 - t152)
+    t155 = t148*t152 - t145*t153
+    t156 = t154 + t149*t152
+    t157 = t145*t152 + t148*t153
+    t158 = t155**2 + t156**2
+    t159 = t158
+    t160 = t158 + t157**2
+    t161 = (t108 <= t109*t110)
+    t162 = casadi.if_else(t161, 1, 1/casadi.sqrt(t108))
+    t163 = casadi.if_else(t161, 1, t106*t162)
+    t164 = casadi.if_else(t161, 0, t107*t162)
+    t165 = t163*t85 - t164*t89
+    t166 = t163*t89 + t164*t85
+    t167 = t166*t61 - t165*t43
+    t168 = t165*t61 + t166*t43
+    t169 = t165*t45 - t166*t63
+    t170 = t165*t63 + t166*t45
+    t171 = casadi.if_else(t161, 0, casadi.atan2(t107, t106))
+    t172 = t171 - 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*t171)
+    t173 = 1 - t165
+    t174 = t173*t44
+    t175 = t174 + t165*t44
+    t176 = t173*t46
+    t177 = t176 + t165*t46
+    t178 = t168**2
+    t179 = -t178
+    t180 = 1 + t179
+    t181 = (1e-12 < t180)
+    t182 = casadi.if_else(t181, casadi.sqrt(t180), 0)
+    t183 = t178 - t167*t182
+    t184 = t179 + t183
+    t185 = t175**2
+    t186 = t178 + t185 + t167**2
+    t187 = t182**2
+    t188 = t184**2 + t185*t187
+    t189 = t178 + t187
+    t190 = 1e-24*t189
+    t191 = (t188 <= t186*t190)
+    t192 = casadi.if_else(t191, 1, 1/casadi.sqrt(t188))
+    t193 = casadi.if_else(t191, 1, t184*t192)
+    t194 = t170*(1 - t193)
+    t195 = t194 + t170*t193
+    t196 = t175*t182
+    t197 = casadi.if_else(t191, 0, -t192*t196)
+    t198 = t169*t193 + t177*t197
+    t199 = t177*t193 - t169*t197
+    t200 = (t189 <= t190)
+    t201 = casadi.if_else(t200, 1, 1/casadi.sqrt(t189))
+    t202 = casadi.if_else(t200, 1, -t168*t201)
+    t203 = casadi.if_else(t200, 0, -t182*t201)
+    t204 = t199*(1 - t202)
+    t205 = t198*t202 - t195*t203
+    t206 = t204 + t199*t202
+    t207 = t195*t202 + t198*t203
+    t208 = t205**2 + t206**2
+    t209 = t208
+    t210 = t208 + t207**2
+    t211 = 1 - t35
+    t212 = t13*t211
+    t213 = t212 + t13*t35
+    t214 = -0.4 + t213
+    t215 = t214**2 + t48**2 + t49**2
+    t216 = 0.3794 - 0.5*t215
+    t217 = T22*t211
+    t218 = t217 + T22*t35
+    t219 = T20*t211
+    t220 = t219 + T20*t35
+    t221 = t216**2
+    t222 = 1 - t221*t67
+    t223 = t216*t65
+    t224 = (1e-12 < t222)
+    t225 = casadi.if_else(t224, t223, casadi.if_else((t223 > 0), 1, -1))
+    t226 = casadi.if_else(t224, casadi.sqrt(t222), 0)
+    t227 = casadi.atan2(t226, t225)
+    t228 = casadi.if_else(t64, 0, t0 + t227)
+    t229 = t0 - t227
+    t230 = t228 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t228)
+    t231 = t230 - 6.283185307179586*casadi.floor(0.041666666666666664 + 0.15915494309189535*t230)
+    t232 = t229 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t229)
+    t233 = t232 - 6.283185307179586*casadi.floor(0.041666666666666664 + 0.15915494309189535*t232)
+    t234 = t225*t80
+    t235 = t226*t82
+    t236 = casadi.if_else(t64, 1, -t234 - t235)
+    t237 = t235 - t234
+    t238 = t225*t82
+    t239 = t226*t80
+    t240 = casadi.if_else(t64, 0, t238 - t239)
+    t241 = t238 + t239
+    t242 = 0.12*t236 - 0.62*t240
+    t243 = 0.12*t240 + 0.62*t236
+    t244 = 0.78 + t242
+    t245 = 0.4 - t243
+    t246 = -0.18 + t244
+    t247 = -0.4 + t245
+    t248 = t214*t247 + t246*t49
+    t249 = t247*t49 - t214*t246
+    t250 = t248**2 + t249**2
+    t251 = t246**2 + t247**2
+    t252 = 0.12*t237 - 0.62*t241
+    t253 = 0.12*t241 + 0.62*t237
+    t254 = 0.78 + t252
+    t255 = 0.4 - t253
+    t256 = -0.18 + t254
+    t257 = -0.4 + t255
+    t258 = t214*t257 + t256*t49
+    t259 = t257*t49 - t214*t256
+    t260 = t258**2 + t259**2
+    t261 = t256**2 + t257**2
+    t262 = 1e-24*t215
+    t263 = (t250 <= t251*t262)
+    t264 = casadi.if_else(t263, 1, 1/casadi.sqrt(t250))
+    t265 = casadi.if_else(t263, 1, t248*t264)
+    t266 = casadi.if_else(t263, 0, t249*t264)
+    t267 = t236*t265 - t240*t266
+    t268 = t236*t266 + t240*t265
+    t269 = t218*t268 + t267*t50
+    t270 = t268*t50 - t218*t267
+    t271 = t267*t52 - t220*t268
+    t272 = t220*t267 + t268*t52
+    t273 = casadi.if_else(t263, 0, casadi.atan2(t249, t248))
+    t274 = t273 - 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*t273)
+    t275 = 1 - t267
+    t276 = t275*t51
+    t277 = t276 + t267*t51
+    t278 = t275*t53
+    t279 = t278 + t267*t53
+    t280 = t270**2
+    t281 = -t280
+    t282 = 1 + t281
+    t283 = (1e-12 < t282)
+    t284 = casadi.if_else(t283, casadi.sqrt(t282), 0)
+    t285 = t280 - t269*t284
+    t286 = t281 + t285
+    t287 = t277**2
+    t288 = t280 + t287 + t269**2
+    t289 = t284**2
+    t290 = t286**2 + t287*t289
+    t291 = t280 + t289
+    t292 = 1e-24*t291
+    t293 = (t290 <= t288*t292)
+    t294 = casadi.if_else(t293, 1, 1/casadi.sqrt(t290))
+    t295 = casadi.if_else(t293, 1, t286*t294)
+    t296 = t272*(1 - t295)
+    t297 = t296 + t272*t295
+    t298 = t277*t284
+    t299 = casadi.if_else(t293, 0, t294*t298)
+    t300 = t271*t295 + t279*t299
+    t301 = t279*t295 - t271*t299
+    t302 = (t291 <= t292)
+    t303 = casadi.if_else(t302, 1, 1/casadi.sqrt(t291))
+    t304 = casadi.if_else(t302, 1, t270*t303)
+    t305 = casadi.if_else(t302, 0, -t284*t303)
+    t306 = t301*(1 - t304)
+    t307 = t300*t304 - t297*t305
+    t308 = t306 + t301*t304
+    t309 = t297*t304 + t300*t305
+    t310 = t307**2 + t308**2
+    t311 = t310
+    t312 = t310 + t309**2
+    t313 = (t260 <= t261*t262)
+    t314 = casadi.if_else(t313, 1, 1/casadi.sqrt(t260))
+    t315 = casadi.if_else(t313, 1, t258*t314)
+    t316 = casadi.if_else(t313, 0, t259*t314)
+    t317 = t237*t315 - t241*t316
+    t318 = t237*t316 + t241*t315
+    t319 = t218*t318 + t317*t50
+    t320 = t318*t50 - t218*t317
+    t321 = t317*t52 - t220*t318
+    t322 = t220*t317 + t318*t52
+    t323 = casadi.if_else(t313, 0, casadi.atan2(t259, t258))
+    t324 = t323 - 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*t323)
+    t325 = 1 - t317
+    t326 = t325*t51
+    t327 = t326 + t317*t51
+    t328 = t325*t53
+    t329 = t328 + t317*t53
+    t330 = t320**2
+    t331 = -t330
+    t332 = 1 + t331
+    t333 = (1e-12 < t332)
+    t334 = casadi.if_else(t333, casadi.sqrt(t332), 0)
+    t335 = t330 - t319*t334
+    t336 = t331 + t335
+    t337 = t327**2
+    t338 = t330 + t337 + t319**2
+    t339 = t334**2
+    t340 = t336**2 + t337*t339
+    t341 = t330 + t339
+    t342 = 1e-24*t341
+    t343 = (t340 <= t338*t342)
+    t344 = casadi.if_else(t343, 1, 1/casadi.sqrt(t340))
+    t345 = casadi.if_else(t343, 1, t336*t344)
+    t346 = t322*(1 - t345)
+    t347 = t346 + t322*t345
+    t348 = t327*t334
+    t349 = casadi.if_else(t343, 0, t344*t348)
+    t350 = t321*t345 + t329*t349
+    t351 = t329*t345 - t321*t349
+    t352 = (t341 <= t342)
+    t353 = casadi.if_else(t352, 1, 1/casadi.sqrt(t341))
+    t354 = casadi.if_else(t352, 1, t320*t353)
+    t355 = casadi.if_else(t352, 0, -t334*t353)
+    t356 = t351*(1 - t354)
+    t357 = t350*t354 - t347*t355
+    t358 = t356 + t351*t354
+    t359 = t347*t354 + t350*t355
+    t360 = t357**2 + t358**2
+    t361 = t360
+    t362 = t360 + t359**2
+    t363 = T00 + T01 + T02 + T03 + T10 + T11 + T12 + T13 + T20 + T21 + T22 + T23
+    t364 = t363
+    t365 = qn1 + qn2 + qn3 + qn4 + qn5 + qn6 + qw1 + qw2 + qw3 + qw4 + qw5 + qw6 + t363
+    t366 = casadi.if_else(t141, 0, casadi.atan2(-t146, t134))
+    t367 = t366
+    t368 = t367 - 6.283185307179586*casadi.floor(0.9722222222222222 + 0.15915494309189535*t367)
+    t369 = 3.141592653589793 + t366 - 6.283185307179586*casadi.ceil(0.15915494309189535*t366)
+    t370 = t369 - 6.283185307179586*casadi.floor(0.9722222222222222 + 0.15915494309189535*t369)
+    t371 = casadi.if_else(t150, 0, casadi.atan2(-t132, -t118))
+    t372 = t371
+    t373 = t372 - 6.283185307179586*casadi.floor(0.3611111111111111 + 0.15915494309189535*t372)
+    t374 = t371 + 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t371)
+    t375 = casadi.if_else((t159 <= 1e-24*t160), 0, casadi.atan2(t156, t155))
+    t376 = t375
+    t377 = t376 - 6.283185307179586*casadi.floor(0.9722222222222222 + 0.15915494309189535*t376)
+    t378 = 3.141592653589793 + t375 - 6.283185307179586*casadi.ceil(0.15915494309189535*t375)
+    t379 = t378 - 6.283185307179586*casadi.floor(0.9722222222222222 + 0.15915494309189535*t378)
+    t380 = -t374
+    t381 = t374 + 6.283185307179586*casadi.floor(0.3611111111111111 + 0.15915494309189535*t380)
+    t382 = casadi.if_else(t191, 0, casadi.atan2(-t196, t184))
+    t383 = t382
+    t384 = t383 - 6.283185307179586*casadi.floor(0.9722222222222222 + 0.15915494309189535*t383)
+    t385 = 3.141592653589793 + t382 - 6.283185307179586*casadi.ceil(0.15915494309189535*t382)
+    t386 = t385 - 6.283185307179586*casadi.floor(0.9722222222222222 + 0.15915494309189535*t385)
+    t387 = casadi.if_else(t200, 0, casadi.atan2(-t182, -t168))
+    t388 = t387
+    t389 = t388 - 6.283185307179586*casadi.floor(0.3611111111111111 + 0.15915494309189535*t388)
+    t390 = t387 + 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t387)
+    t391 = casadi.if_else((t209 <= 1e-24*t210), 0, casadi.atan2(t206, t205))
+    t392 = t391
+    t393 = t392 - 6.283185307179586*casadi.floor(0.9722222222222222 + 0.15915494309189535*t392)
+    t394 = 3.141592653589793 + t391 - 6.283185307179586*casadi.ceil(0.15915494309189535*t391)
+    t395 = t394 - 6.283185307179586*casadi.floor(0.9722222222222222 + 0.15915494309189535*t394)
+    t396 = -t390
+    t397 = t390 + 6.283185307179586*casadi.floor(0.3611111111111111 + 0.15915494309189535*t396)
+    t398 = casadi.if_else(t293, 0, casadi.atan2(t298, t286))
+    t399 = t398
+    t400 = t399 - 6.283185307179586*casadi.floor(0.9722222222222222 + 0.15915494309189535*t399)
+    t401 = 3.141592653589793 + t398 - 6.283185307179586*casadi.ceil(0.15915494309189535*t398)
+    t402 = t401 - 6.283185307179586*casadi.floor(0.9722222222222222 + 0.15915494309189535*t401)
+    t403 = casadi.if_else(t302, 0, casadi.atan2(-t284, t270))
+    t404 = t403
+    t405 = t404 - 6.283185307179586*casadi.floor(0.3611111111111111 + 0.15915494309189535*t404)
+    t406 = t403 + 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t403)
+    t407 = casadi.if_else((t311 <= 1e-24*t312), 0, casadi.atan2(t308, t307))
+    t408 = t407
+    t409 = t408 - 6.283185307179586*casadi.floor(0.9722222222222222 + 0.15915494309189535*t408)
+    t410 = 3.141592653589793 + t407 - 6.283185307179586*casadi.ceil(0.15915494309189535*t407)
+    t411 = t410 - 6.283185307179586*casadi.floor(0.9722222222222222 + 0.15915494309189535*t410)
+    t412 = -t406
+    t413 = t406 + 6.283185307179586*casadi.floor(0.3611111111111111 + 0.15915494309189535*t412)
+    t414 = casadi.if_else(t343, 0, casadi.atan2(t348, t336))
+    t415 = t414
+    t416 = t415 - 6.283185307179586*casadi.floor(0.9722222222222222 + 0.15915494309189535*t415)
+    t417 = 3.141592653589793 + t414 - 6.283185307179586*casadi.ceil(0.15915494309189535*t414)
+    t418 = t417 - 6.283185307179586*casadi.floor(0.9722222222222222 + 0.15915494309189535*t417)
+    t419 = casadi.if_else(t352, 0, casadi.atan2(-t334, t320))
+    t420 = t419
+    t421 = t420 - 6.283185307179586*casadi.floor(0.3611111111111111 + 0.15915494309189535*t420)
+    t422 = t419 + 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t419)
+    t423 = casadi.if_else((t361 <= 1e-24*t362), 0, casadi.atan2(t358, t357))
+    t424 = t423
+    t425 = t424 - 6.283185307179586*casadi.floor(0.9722222222222222 + 0.15915494309189535*t424)
+    t426 = 3.141592653589793 + t423 - 6.283185307179586*casadi.ceil(0.15915494309189535*t423)
+    t427 = t426 - 6.283185307179586*casadi.floor(0.9722222222222222 + 0.15915494309189535*t426)
+    t428 = -t422
+    t429 = t422 + 6.283185307179586*casadi.floor(0.3611111111111111 + 0.15915494309189535*t428)
+    t430 = (t27 <= 2.705260340591211)
+    t431 = casadi.logic_and((t26 >= -2.705260340591211), (t26 <= 2.705260340591211))
+    t432 = casadi.if_else(casadi.logic_and(t430, casadi.logic_not(t431)), t27, t26)
+    t433 = t432
+    t434 = t433 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn1 - 0.15915494309189535*t433)
+    t435 = casadi.if_else((qn1 > t434), 6.283185307179586, -6.283185307179586)
+    t436 = t434 + t435
+    t437 = t434 - t435
+    t438 = casadi.if_else(casadi.logic_and((t434 >= -2.705260340591211), (t434 <= 2.705260340591211)), t434, casadi.if_else(casadi.logic_and((t436 >= -2.705260340591211), (t436 <= 2.705260340591211)), t436, casadi.if_else(casadi.logic_and((t437 >= -2.705260340591211), (t437 <= 2.705260340591211)), t437, t432)))
+    t439 = (t122 <= 1.1344640137963142)
+    t440 = casadi.logic_and((t121 >= -3.141592653589793), (t121 <= 1.1344640137963142))
+    t441 = casadi.if_else(casadi.logic_and(t439, casadi.logic_not(t440)), t122, t121)
+    t442 = t441
+    t443 = t442 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t442)
+    t444 = casadi.if_else((qn2 > t443), 6.283185307179586, -6.283185307179586)
+    t445 = t443 + t444
+    t446 = t443 - t444
+    t447 = casadi.if_else(casadi.logic_and((t443 >= -3.141592653589793), (t443 <= 1.1344640137963142)), t443, casadi.if_else(casadi.logic_and((t445 >= -3.141592653589793), (t445 <= 1.1344640137963142)), t445, casadi.if_else(casadi.logic_and((t446 >= -3.141592653589793), (t446 <= 1.1344640137963142)), t446, t441)))
+    t448 = (t77 <= 2.7576202181510405)
+    t449 = casadi.logic_and((t76 >= -0.2617993877991494), (t76 <= 2.7576202181510405))
+    t450 = casadi.if_else(casadi.logic_and(t448, casadi.logic_not(t449)), t77, t76)
+    t451 = t450
+    t452 = t451 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn3 - 0.15915494309189535*t451)
+    t453 = casadi.if_else((qn3 > t452), 6.283185307179586, -6.283185307179586)
+    t454 = t452 + t453
+    t455 = t452 - t453
+    t456 = casadi.if_else(casadi.logic_and((t452 >= -0.2617993877991494), (t452 <= 2.7576202181510405)), t452, casadi.if_else(casadi.logic_and((t454 >= -0.2617993877991494), (t454 <= 2.7576202181510405)), t454, casadi.if_else(casadi.logic_and((t455 >= -0.2617993877991494), (t455 <= 2.7576202181510405)), t455, t450)))
+    t457 = (t368 <= 6.1086523819801535)
+    t458 = casadi.logic_and((t367 >= -6.1086523819801535), (t367 <= 6.1086523819801535))
+    t459 = casadi.if_else(casadi.logic_and(t457, casadi.logic_not(t458)), t368, t367)
+    t460 = t459
+    t461 = t460 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t460)
+    t462 = casadi.if_else((qn4 > t461), 6.283185307179586, -6.283185307179586)
+    t463 = t461 + t462
+    t464 = t461 - t462
+    t465 = casadi.if_else(casadi.logic_and((t461 >= -6.1086523819801535), (t461 <= 6.1086523819801535)), t461, casadi.if_else(casadi.logic_and((t463 >= -6.1086523819801535), (t463 <= 6.1086523819801535)), t463, casadi.if_else(casadi.logic_and((t464 >= -6.1086523819801535), (t464 <= 6.1086523819801535)), t464, t459)))
+    t466 = (t373 <= 2.2689280275926285)
+    t467 = casadi.logic_and((t372 >= -2.2689280275926285), (t372 <= 2.2689280275926285))
+    t468 = casadi.if_else(casadi.logic_and(t466, casadi.logic_not(t467)), t373, t372)
+    t469 = t468
+    t470 = t469 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn5 - 0.15915494309189535*t469)
+    t471 = casadi.if_else((qn5 > t470), 6.283185307179586, -6.283185307179586)
+    t472 = t470 + t471
+    t473 = t470 - t471
+    t474 = casadi.if_else(casadi.logic_and((t470 >= -2.2689280275926285), (t470 <= 2.2689280275926285)), t470, casadi.if_else(casadi.logic_and((t472 >= -2.2689280275926285), (t472 <= 2.2689280275926285)), t472, casadi.if_else(casadi.logic_and((t473 >= -2.2689280275926285), (t473 <= 2.2689280275926285)), t473, t468)))
+    t475 = (t377 <= 6.1086523819801535)
+    t476 = casadi.logic_and((t376 >= -6.1086523819801535), (t376 <= 6.1086523819801535))
+    t477 = casadi.if_else(casadi.logic_and(t475, casadi.logic_not(t476)), t377, t376)
+    t478 = t477
+    t479 = t478 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn6 - 0.15915494309189535*t478)
+    t480 = casadi.if_else((qn6 > t479), 6.283185307179586, -6.283185307179586)
+    t481 = t479 + t480
+    t482 = t479 - t480
+    t483 = casadi.if_else(casadi.logic_and((t479 >= -6.1086523819801535), (t479 <= 6.1086523819801535)), t479, casadi.if_else(casadi.logic_and((t481 >= -6.1086523819801535), (t481 <= 6.1086523819801535)), t481, casadi.if_else(casadi.logic_and((t482 >= -6.1086523819801535), (t482 <= 6.1086523819801535)), t482, t477)))
+    t484 = -qn4
+    t485 = -qn5
+    t486 = -qn6
+    t487 = -qn1
+    t488 = qw1*(t438 + t487)**2
+    t489 = -qn2
+    t490 = -qn3
+    t491 = t488 + qw2*(t447 + t489)**2 + qw3*(t456 + t490)**2
+    t492 = t491 + qw4*(t465 + t484)**2 + qw5*(t474 + t485)**2 + qw6*(t483 + t486)**2
+    t493 = (casadi.fabs(t364) < casadi.inf)
+    t494 = casadi.logic_or(t430, t431)
+    t495 = casadi.logic_or(t439, t440)
+    t496 = casadi.logic_or(t448, t449)
+    t497 = (t15 > t17)
+    t498 = casadi.logic_or(t497, casadi.logic_and(t18, (1e-12*t16 >= 0)))
+    t499 = True
+    t500 = casadi.logic_or(casadi.logic_and(t64, (1e-12 >= 6.965340465841971*t66)), casadi.logic_and(t499, (1e-12 >= -t68)))
+    t501 = casadi.if_else(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t493, t494), t495), t496), t498), t500), (t130 >= -1e-12)), casadi.logic_or(t457, t458)), casadi.logic_or(t466, t467)), casadi.logic_or(t475, t476)), 1, 0)
+    t502 = casadi.if_else((t501 > 0), 1, 0)
+    t503 = (t502 > 0)
+    t504 = casadi.if_else(t503, t438, qn1)
+    t505 = casadi.if_else(t503, t447, qn2)
+    t506 = casadi.if_else(t503, t456, qn3)
+    t507 = casadi.if_else(t503, t465, qn4)
+    t508 = casadi.if_else(t503, t474, qn5)
+    t509 = casadi.if_else(t503, t483, qn6)
+    t510 = casadi.if_else(t503, t492, 0)
+    t511 = (t370 <= 6.1086523819801535)
+    t512 = casadi.logic_and((t369 >= -6.1086523819801535), (t369 <= 6.1086523819801535))
+    t513 = casadi.if_else(casadi.logic_and(t511, casadi.logic_not(t512)), t370, t369)
+    t514 = t513
+    t515 = t514 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t514)
+    t516 = casadi.if_else((qn4 > t515), 6.283185307179586, -6.283185307179586)
+    t517 = t515 + t516
+    t518 = t515 - t516
+    t519 = casadi.if_else(casadi.logic_and((t515 >= -6.1086523819801535), (t515 <= 6.1086523819801535)), t515, casadi.if_else(casadi.logic_and((t517 >= -6.1086523819801535), (t517 <= 6.1086523819801535)), t517, casadi.if_else(casadi.logic_and((t518 >= -6.1086523819801535), (t518 <= 6.1086523819801535)), t518, t513)))
+    t520 = (t381 >= -2.2689280275926285)
+    t521 = casadi.logic_and((t374 >= -2.2689280275926285), (t374 <= 2.2689280275926285))
+    t522 = casadi.if_else(casadi.logic_and(t520, casadi.logic_not(t521)), -t381, t380)
+    t523 = t522
+    t524 = t523 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn5 - 0.15915494309189535*t523)
+    t525 = casadi.if_else((qn5 > t524), 6.283185307179586, -6.283185307179586)
+    t526 = t524 + t525
+    t527 = t524 - t525
+    t528 = casadi.if_else(casadi.logic_and((t524 >= -2.2689280275926285), (t524 <= 2.2689280275926285)), t524, casadi.if_else(casadi.logic_and((t526 >= -2.2689280275926285), (t526 <= 2.2689280275926285)), t526, casadi.if_else(casadi.logic_and((t527 >= -2.2689280275926285), (t527 <= 2.2689280275926285)), t527, t522)))
+    t529 = (t379 <= 6.1086523819801535)
+    t530 = casadi.logic_and((t378 >= -6.1086523819801535), (t378 <= 6.1086523819801535))
+    t531 = casadi.if_else(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t131, t493), t494), t495), t496), t498), t500), casadi.logic_or(t511, t512)), casadi.logic_or(t520, t521)), casadi.logic_or(t529, t530)), 1, 0)
+    t532 = casadi.if_else(casadi.logic_and(t529, casadi.logic_not(t530)), t379, t378)
+    t533 = t532
+    t534 = t533 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn6 - 0.15915494309189535*t533)
+    t535 = casadi.if_else((qn6 > t534), 6.283185307179586, -6.283185307179586)
+    t536 = t534 + t535
+    t537 = t534 - t535
+    t538 = casadi.if_else(casadi.logic_and((t534 >= -6.1086523819801535), (t534 <= 6.1086523819801535)), t534, casadi.if_else(casadi.logic_and((t536 >= -6.1086523819801535), (t536 <= 6.1086523819801535)), t536, casadi.if_else(casadi.logic_and((t537 >= -6.1086523819801535), (t537 <= 6.1086523819801535)), t537, t532)))
+    t539 = t491 + qw4*(t484 + t519)**2 + qw5*(t485 + t528)**2 + qw6*(t486 + t538)**2
+    t540 = (t531 > 0)
+    t541 = casadi.if_else(casadi.logic_and(t540, casadi.logic_or((t510 > t539), (t502 < 1))), 1, 0)
+    t542 = casadi.if_else(t540, 1, t502)
+    t543 = (t541 > 0)
+    t544 = casadi.if_else(t543, t438, t504)
+    t545 = casadi.if_else(t543, t447, t505)
+    t546 = casadi.if_else(t543, t456, t506)
+    t547 = casadi.if_else(t543, t519, t507)
+    t548 = casadi.if_else(t543, t528, t508)
+    t549 = casadi.if_else(t543, t538, t509)
+    t550 = casadi.if_else(t543, t539, t510)
+    t551 = (t172 <= 1.1344640137963142)
+    t552 = casadi.logic_and((t171 >= -3.141592653589793), (t171 <= 1.1344640137963142))
+    t553 = casadi.if_else(casadi.logic_and(t551, casadi.logic_not(t552)), t172, t171)
+    t554 = t553
+    t555 = t554 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t554)
+    t556 = casadi.if_else((qn2 > t555), 6.283185307179586, -6.283185307179586)
+    t557 = t555 + t556
+    t558 = t555 - t556
+    t559 = casadi.if_else(casadi.logic_and((t555 >= -3.141592653589793), (t555 <= 1.1344640137963142)), t555, casadi.if_else(casadi.logic_and((t557 >= -3.141592653589793), (t557 <= 1.1344640137963142)), t557, casadi.if_else(casadi.logic_and((t558 >= -3.141592653589793), (t558 <= 1.1344640137963142)), t558, t553)))
+    t560 = (t79 <= 2.7576202181510405)
+    t561 = casadi.logic_and((t78 >= -0.2617993877991494), (t78 <= 2.7576202181510405))
+    t562 = casadi.if_else(casadi.logic_and(t560, casadi.logic_not(t561)), t79, t78)
+    t563 = t562
+    t564 = t563 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn3 - 0.15915494309189535*t563)
+    t565 = casadi.if_else((qn3 > t564), 6.283185307179586, -6.283185307179586)
+    t566 = t564 + t565
+    t567 = t564 - t565
+    t568 = casadi.if_else(casadi.logic_and((t564 >= -0.2617993877991494), (t564 <= 2.7576202181510405)), t564, casadi.if_else(casadi.logic_and((t566 >= -0.2617993877991494), (t566 <= 2.7576202181510405)), t566, casadi.if_else(casadi.logic_and((t567 >= -0.2617993877991494), (t567 <= 2.7576202181510405)), t567, t562)))
+    t569 = (t384 <= 6.1086523819801535)
+    t570 = casadi.logic_and((t383 >= -6.1086523819801535), (t383 <= 6.1086523819801535))
+    t571 = casadi.if_else(casadi.logic_and(t569, casadi.logic_not(t570)), t384, t383)
+    t572 = t571
+    t573 = t572 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t572)
+    t574 = casadi.if_else((qn4 > t573), 6.283185307179586, -6.283185307179586)
+    t575 = t573 + t574
+    t576 = t573 - t574
+    t577 = casadi.if_else(casadi.logic_and((t573 >= -6.1086523819801535), (t573 <= 6.1086523819801535)), t573, casadi.if_else(casadi.logic_and((t575 >= -6.1086523819801535), (t575 <= 6.1086523819801535)), t575, casadi.if_else(casadi.logic_and((t576 >= -6.1086523819801535), (t576 <= 6.1086523819801535)), t576, t571)))
+    t578 = (t389 <= 2.2689280275926285)
+    t579 = casadi.logic_and((t388 >= -2.2689280275926285), (t388 <= 2.2689280275926285))
+    t580 = casadi.if_else(casadi.logic_and(t578, casadi.logic_not(t579)), t389, t388)
+    t581 = t580
+    t582 = t581 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn5 - 0.15915494309189535*t581)
+    t583 = casadi.if_else((qn5 > t582), 6.283185307179586, -6.283185307179586)
+    t584 = t582 + t583
+    t585 = t582 - t583
+    t586 = casadi.if_else(casadi.logic_and((t582 >= -2.2689280275926285), (t582 <= 2.2689280275926285)), t582, casadi.if_else(casadi.logic_and((t584 >= -2.2689280275926285), (t584 <= 2.2689280275926285)), t584, casadi.if_else(casadi.logic_and((t585 >= -2.2689280275926285), (t585 <= 2.2689280275926285)), t585, t580)))
+    t587 = (t393 <= 6.1086523819801535)
+    t588 = casadi.logic_and((t392 >= -6.1086523819801535), (t392 <= 6.1086523819801535))
+    t589 = casadi.if_else(casadi.logic_and(t587, casadi.logic_not(t588)), t393, t392)
+    t590 = t589
+    t591 = t590 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn6 - 0.15915494309189535*t590)
+    t592 = casadi.if_else((qn6 > t591), 6.283185307179586, -6.283185307179586)
+    t593 = t591 + t592
+    t594 = t591 - t592
+    t595 = casadi.if_else(casadi.logic_and((t591 >= -6.1086523819801535), (t591 <= 6.1086523819801535)), t591, casadi.if_else(casadi.logic_and((t593 >= -6.1086523819801535), (t593 <= 6.1086523819801535)), t593, casadi.if_else(casadi.logic_and((t594 >= -6.1086523819801535), (t594 <= 6.1086523819801535)), t594, t589)))
+    t596 = t488 + qw2*(t489 + t559)**2 + qw3*(t490 + t568)**2
+    t597 = t596 + qw4*(t484 + t577)**2 + qw5*(t485 + t586)**2 + qw6*(t486 + t595)**2
+    t598 = casadi.logic_or(t551, t552)
+    t599 = casadi.logic_or(t560, t561)
+    t600 = casadi.if_else(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t493, t494), t498), t499), t598), t599), t70), (t180 >= -1e-12)), casadi.logic_or(t569, t570)), casadi.logic_or(t578, t579)), casadi.logic_or(t587, t588)), 1, 0)
+    t601 = (t600 > 0)
+    t602 = casadi.if_else(casadi.logic_and(t601, casadi.logic_or((t550 > t597), (t542 < 1))), 1, 0)
+    t603 = casadi.if_else(t601, 1, t542)
+    t604 = (t602 > 0)
+    t605 = casadi.if_else(t604, t438, t544)
+    t606 = casadi.if_else(t604, t559, t545)
+    t607 = casadi.if_else(t604, t568, t546)
+    t608 = casadi.if_else(t604, t577, t547)
+    t609 = casadi.if_else(t604, t586, t548)
+    t610 = casadi.if_else(t604, t595, t549)
+    t611 = casadi.if_else(t604, t597, t550)
+    t612 = (t386 <= 6.1086523819801535)
+    t613 = casadi.logic_and((t385 >= -6.1086523819801535), (t385 <= 6.1086523819801535))
+    t614 = casadi.if_else(casadi.logic_and(t612, casadi.logic_not(t613)), t386, t385)
+    t615 = t614
+    t616 = t615 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t615)
+    t617 = casadi.if_else((qn4 > t616), 6.283185307179586, -6.283185307179586)
+    t618 = t616 + t617
+    t619 = t616 - t617
+    t620 = casadi.if_else(casadi.logic_and((t616 >= -6.1086523819801535), (t616 <= 6.1086523819801535)), t616, casadi.if_else(casadi.logic_and((t618 >= -6.1086523819801535), (t618 <= 6.1086523819801535)), t618, casadi.if_else(casadi.logic_and((t619 >= -6.1086523819801535), (t619 <= 6.1086523819801535)), t619, t614)))
+    t621 = (t397 >= -2.2689280275926285)
+    t622 = casadi.logic_and((t390 >= -2.2689280275926285), (t390 <= 2.2689280275926285))
+    t623 = casadi.if_else(casadi.logic_and(t621, casadi.logic_not(t622)), -t397, t396)
+    t624 = t623
+    t625 = t624 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn5 - 0.15915494309189535*t624)
+    t626 = casadi.if_else((qn5 > t625), 6.283185307179586, -6.283185307179586)
+    t627 = t625 + t626
+    t628 = t625 - t626
+    t629 = casadi.if_else(casadi.logic_and((t625 >= -2.2689280275926285), (t625 <= 2.2689280275926285)), t625, casadi.if_else(casadi.logic_and((t627 >= -2.2689280275926285), (t627 <= 2.2689280275926285)), t627, casadi.if_else(casadi.logic_and((t628 >= -2.2689280275926285), (t628 <= 2.2689280275926285)), t628, t623)))
+    t630 = (t395 <= 6.1086523819801535)
+    t631 = casadi.logic_and((t394 >= -6.1086523819801535), (t394 <= 6.1086523819801535))
+    t632 = casadi.if_else(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t181, t493), t494), t498), t499), t598), t599), t70), casadi.logic_or(t612, t613)), casadi.logic_or(t621, t622)), casadi.logic_or(t630, t631)), 1, 0)
+    t633 = casadi.if_else(casadi.logic_and(t630, casadi.logic_not(t631)), t395, t394)
+    t634 = t633
+    t635 = t634 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn6 - 0.15915494309189535*t634)
+    t636 = casadi.if_else((qn6 > t635), 6.283185307179586, -6.283185307179586)
+    t637 = t635 + t636
+    t638 = t635 - t636
+    t639 = casadi.if_else(casadi.logic_and((t635 >= -6.1086523819801535), (t635 <= 6.1086523819801535)), t635, casadi.if_else(casadi.logic_and((t637 >= -6.1086523819801535), (t637 <= 6.1086523819801535)), t637, casadi.if_else(casadi.logic_and((t638 >= -6.1086523819801535), (t638 <= 6.1086523819801535)), t638, t633)))
+    t640 = t596 + qw4*(t484 + t620)**2 + qw5*(t485 + t629)**2 + qw6*(t486 + t639)**2
+    t641 = (t632 > 0)
+    t642 = casadi.if_else(casadi.logic_and(t641, casadi.logic_or((t611 > t640), (t603 < 1))), 1, 0)
+    t643 = casadi.if_else(t641, 1, t603)
+    t644 = (t642 > 0)
+    t645 = casadi.if_else(t644, t438, t605)
+    t646 = casadi.if_else(t644, t559, t606)
+    t647 = casadi.if_else(t644, t568, t607)
+    t648 = casadi.if_else(t644, t620, t608)
+    t649 = casadi.if_else(t644, t629, t609)
+    t650 = casadi.if_else(t644, t639, t610)
+    t651 = casadi.if_else(t644, t640, t611)
+    t652 = (t29 <= 2.705260340591211)
+    t653 = casadi.logic_and((t28 >= -2.705260340591211), (t28 <= 2.705260340591211))
+    t654 = casadi.if_else(casadi.logic_and(t652, casadi.logic_not(t653)), t29, t28)
+    t655 = t654
+    t656 = t655 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn1 - 0.15915494309189535*t655)
+    t657 = casadi.if_else((qn1 > t656), 6.283185307179586, -6.283185307179586)
+    t658 = t656 + t657
+    t659 = t656 - t657
+    t660 = casadi.if_else(casadi.logic_and((t656 >= -2.705260340591211), (t656 <= 2.705260340591211)), t656, casadi.if_else(casadi.logic_and((t658 >= -2.705260340591211), (t658 <= 2.705260340591211)), t658, casadi.if_else(casadi.logic_and((t659 >= -2.705260340591211), (t659 <= 2.705260340591211)), t659, t654)))
+    t661 = (t274 <= 1.1344640137963142)
+    t662 = casadi.logic_and((t273 >= -3.141592653589793), (t273 <= 1.1344640137963142))
+    t663 = casadi.if_else(casadi.logic_and(t661, casadi.logic_not(t662)), t274, t273)
+    t664 = t663
+    t665 = t664 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t664)
+    t666 = casadi.if_else((qn2 > t665), 6.283185307179586, -6.283185307179586)
+    t667 = t665 + t666
+    t668 = t665 - t666
+    t669 = casadi.if_else(casadi.logic_and((t665 >= -3.141592653589793), (t665 <= 1.1344640137963142)), t665, casadi.if_else(casadi.logic_and((t667 >= -3.141592653589793), (t667 <= 1.1344640137963142)), t667, casadi.if_else(casadi.logic_and((t668 >= -3.141592653589793), (t668 <= 1.1344640137963142)), t668, t663)))
+    t670 = (t231 <= 2.7576202181510405)
+    t671 = casadi.logic_and((t230 >= -0.2617993877991494), (t230 <= 2.7576202181510405))
+    t672 = casadi.if_else(casadi.logic_and(t670, casadi.logic_not(t671)), t231, t230)
+    t673 = t672
+    t674 = t673 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn3 - 0.15915494309189535*t673)
+    t675 = casadi.if_else((qn3 > t674), 6.283185307179586, -6.283185307179586)
+    t676 = t674 + t675
+    t677 = t674 - t675
+    t678 = casadi.if_else(casadi.logic_and((t674 >= -0.2617993877991494), (t674 <= 2.7576202181510405)), t674, casadi.if_else(casadi.logic_and((t676 >= -0.2617993877991494), (t676 <= 2.7576202181510405)), t676, casadi.if_else(casadi.logic_and((t677 >= -0.2617993877991494), (t677 <= 2.7576202181510405)), t677, t672)))
+    t679 = (t400 <= 6.1086523819801535)
+    t680 = casadi.logic_and((t399 >= -6.1086523819801535), (t399 <= 6.1086523819801535))
+    t681 = casadi.if_else(casadi.logic_and(t679, casadi.logic_not(t680)), t400, t399)
+    t682 = t681
+    t683 = t682 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t682)
+    t684 = casadi.if_else((qn4 > t683), 6.283185307179586, -6.283185307179586)
+    t685 = t683 + t684
+    t686 = t683 - t684
+    t687 = casadi.if_else(casadi.logic_and((t683 >= -6.1086523819801535), (t683 <= 6.1086523819801535)), t683, casadi.if_else(casadi.logic_and((t685 >= -6.1086523819801535), (t685 <= 6.1086523819801535)), t685, casadi.if_else(casadi.logic_and((t686 >= -6.1086523819801535), (t686 <= 6.1086523819801535)), t686, t681)))
+    t688 = (t405 <= 2.2689280275926285)
+    t689 = casadi.logic_and((t404 >= -2.2689280275926285), (t404 <= 2.2689280275926285))
+    t690 = casadi.if_else(casadi.logic_and(t688, casadi.logic_not(t689)), t405, t404)
+    t691 = t690
+    t692 = t691 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn5 - 0.15915494309189535*t691)
+    t693 = casadi.if_else((qn5 > t692), 6.283185307179586, -6.283185307179586)
+    t694 = t692 + t693
+    t695 = t692 - t693
+    t696 = casadi.if_else(casadi.logic_and((t692 >= -2.2689280275926285), (t692 <= 2.2689280275926285)), t692, casadi.if_else(casadi.logic_and((t694 >= -2.2689280275926285), (t694 <= 2.2689280275926285)), t694, casadi.if_else(casadi.logic_and((t695 >= -2.2689280275926285), (t695 <= 2.2689280275926285)), t695, t690)))
+    t697 = (t409 <= 6.1086523819801535)
+    t698 = casadi.logic_and((t408 >= -6.1086523819801535), (t408 <= 6.1086523819801535))
+    t699 = casadi.if_else(casadi.logic_and(t697, casadi.logic_not(t698)), t409, t408)
+    t700 = t699
+    t701 = t700 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn6 - 0.15915494309189535*t700)
+    t702 = casadi.if_else((qn6 > t701), 6.283185307179586, -6.283185307179586)
+    t703 = t701 + t702
+    t704 = t701 - t702
+    t705 = casadi.if_else(casadi.logic_and((t701 >= -6.1086523819801535), (t701 <= 6.1086523819801535)), t701, casadi.if_else(casadi.logic_and((t703 >= -6.1086523819801535), (t703 <= 6.1086523819801535)), t703, casadi.if_else(casadi.logic_and((t704 >= -6.1086523819801535), (t704 <= 6.1086523819801535)), t704, t699)))
+    t706 = qw1*(t487 + t660)**2
+    t707 = t706 + qw2*(t489 + t669)**2 + qw3*(t490 + t678)**2
+    t708 = t707 + qw4*(t484 + t687)**2 + qw5*(t485 + t696)**2 + qw6*(t486 + t705)**2
+    t709 = casadi.logic_or(t652, t653)
+    t710 = casadi.logic_or(t661, t662)
+    t711 = casadi.logic_or(t670, t671)
+    t712 = casadi.logic_or(casadi.logic_and(t64, (1e-12 >= 6.965340465841971*t221)), casadi.logic_and(t499, (1e-12 >= -t222)))
+    t713 = casadi.if_else(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t20, t493), t497), t709), t710), t711), t712), (t282 >= -1e-12)), casadi.logic_or(t679, t680)), casadi.logic_or(t688, t689)), casadi.logic_or(t697, t698)), 1, 0)
+    t714 = (t713 > 0)
+    t715 = casadi.if_else(casadi.logic_and(t714, casadi.logic_or((t651 > t708), (t643 < 1))), 1, 0)
+    t716 = casadi.if_else(t714, 1, t643)
+    t717 = (t715 > 0)
+    t718 = casadi.if_else(t717, t660, t645)
+    t719 = casadi.if_else(t717, t669, t646)
+    t720 = casadi.if_else(t717, t678, t647)
+    t721 = casadi.if_else(t717, t687, t648)
+    t722 = casadi.if_else(t717, t696, t649)
+    t723 = casadi.if_else(t717, t705, t650)
+    t724 = casadi.if_else(t717, t708, t651)
+    t725 = (t402 <= 6.1086523819801535)
+    t726 = casadi.logic_and((t401 >= -6.1086523819801535), (t401 <= 6.1086523819801535))
+    t727 = casadi.if_else(casadi.logic_and(t725, casadi.logic_not(t726)), t402, t401)
+    t728 = t727
+    t729 = t728 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t728)
+    t730 = casadi.if_else((qn4 > t729), 6.283185307179586, -6.283185307179586)
+    t731 = t729 + t730
+    t732 = t729 - t730
+    t733 = casadi.if_else(casadi.logic_and((t729 >= -6.1086523819801535), (t729 <= 6.1086523819801535)), t729, casadi.if_else(casadi.logic_and((t731 >= -6.1086523819801535), (t731 <= 6.1086523819801535)), t731, casadi.if_else(casadi.logic_and((t732 >= -6.1086523819801535), (t732 <= 6.1086523819801535)), t732, t727)))
+    t734 = (t413 >= -2.2689280275926285)
+    t735 = casadi.logic_and((t406 >= -2.2689280275926285), (t406 <= 2.2689280275926285))
+    t736 = casadi.if_else(casadi.logic_and(t734, casadi.logic_not(t735)), -t413, t412)
+    t737 = t736
+    t738 = t737 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn5 - 0.15915494309189535*t737)
+    t739 = casadi.if_else((qn5 > t738), 6.283185307179586, -6.283185307179586)
+    t740 = t738 + t739
+    t741 = t738 - t739
+    t742 = casadi.if_else(casadi.logic_and((t738 >= -2.2689280275926285), (t738 <= 2.2689280275926285)), t738, casadi.if_else(casadi.logic_and((t740 >= -2.2689280275926285), (t740 <= 2.2689280275926285)), t740, casadi.if_else(casadi.logic_and((t741 >= -2.2689280275926285), (t741 <= 2.2689280275926285)), t741, t736)))
+    t743 = (t411 <= 6.1086523819801535)
+    t744 = casadi.logic_and((t410 >= -6.1086523819801535), (t410 <= 6.1086523819801535))
+    t745 = casadi.if_else(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t20, t283), t493), t497), t709), t710), t711), t712), casadi.logic_or(t725, t726)), casadi.logic_or(t734, t735)), casadi.logic_or(t743, t744)), 1, 0)
+    t746 = casadi.if_else(casadi.logic_and(t743, casadi.logic_not(t744)), t411, t410)
+    t747 = t746
+    t748 = t747 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn6 - 0.15915494309189535*t747)
+    t749 = casadi.if_else((qn6 > t748), 6.283185307179586, -6.283185307179586)
+    t750 = t748 + t749
+    t751 = t748 - t749
+    t752 = casadi.if_else(casadi.logic_and((t748 >= -6.1086523819801535), (t748 <= 6.1086523819801535)), t748, casadi.if_else(casadi.logic_and((t750 >= -6.1086523819801535), (t750 <= 6.1086523819801535)), t750, casadi.if_else(casadi.logic_and((t751 >= -6.1086523819801535), (t751 <= 6.1086523819801535)), t751, t746)))
+    t753 = t707 + qw4*(t484 + t733)**2 + qw5*(t485 + t742)**2 + qw6*(t486 + t752)**2
+    t754 = (t745 > 0)
+    t755 = casadi.if_else(casadi.logic_and(t754, casadi.logic_or((t724 > t753), (t716 < 1))), 1, 0)
+    t756 = casadi.if_else(t754, 1, t716)
+    t757 = (t755 > 0)
+    t758 = casadi.if_else(t757, t660, t718)
+    t759 = casadi.if_else(t757, t669, t719)
+    t760 = casadi.if_else(t757, t678, t720)
+    t761 = casadi.if_else(t757, t733, t721)
+    t762 = casadi.if_else(t757, t742, t722)
+    t763 = casadi.if_else(t757, t752, t723)
+    t764 = casadi.if_else(t757, t753, t724)
+    t765 = (t324 <= 1.1344640137963142)
+    t766 = casadi.logic_and((t323 >= -3.141592653589793), (t323 <= 1.1344640137963142))
+    t767 = casadi.if_else(casadi.logic_and(t765, casadi.logic_not(t766)), t324, t323)
+    t768 = t767
+    t769 = t768 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t768)
+    t770 = casadi.if_else((qn2 > t769), 6.283185307179586, -6.283185307179586)
+    t771 = t769 + t770
+    t772 = t769 - t770
+    t773 = casadi.if_else(casadi.logic_and((t769 >= -3.141592653589793), (t769 <= 1.1344640137963142)), t769, casadi.if_else(casadi.logic_and((t771 >= -3.141592653589793), (t771 <= 1.1344640137963142)), t771, casadi.if_else(casadi.logic_and((t772 >= -3.141592653589793), (t772 <= 1.1344640137963142)), t772, t767)))
+    t774 = (t233 <= 2.7576202181510405)
+    t775 = casadi.logic_and((t232 >= -0.2617993877991494), (t232 <= 2.7576202181510405))
+    t776 = casadi.if_else(casadi.logic_and(t774, casadi.logic_not(t775)), t233, t232)
+    t777 = t776
+    t778 = t777 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn3 - 0.15915494309189535*t777)
+    t779 = casadi.if_else((qn3 > t778), 6.283185307179586, -6.283185307179586)
+    t780 = t778 + t779
+    t781 = t778 - t779
+    t782 = casadi.if_else(casadi.logic_and((t778 >= -0.2617993877991494), (t778 <= 2.7576202181510405)), t778, casadi.if_else(casadi.logic_and((t780 >= -0.2617993877991494), (t780 <= 2.7576202181510405)), t780, casadi.if_else(casadi.logic_and((t781 >= -0.2617993877991494), (t781 <= 2.7576202181510405)), t781, t776)))
+    t783 = (t416 <= 6.1086523819801535)
+    t784 = casadi.logic_and((t415 >= -6.1086523819801535), (t415 <= 6.1086523819801535))
+    t785 = casadi.if_else(casadi.logic_and(t783, casadi.logic_not(t784)), t416, t415)
+    t786 = t785
+    t787 = t786 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t786)
+    t788 = casadi.if_else((qn4 > t787), 6.283185307179586, -6.283185307179586)
+    t789 = t787 + t788
+    t790 = t787 - t788
+    t791 = casadi.if_else(casadi.logic_and((t787 >= -6.1086523819801535), (t787 <= 6.1086523819801535)), t787, casadi.if_else(casadi.logic_and((t789 >= -6.1086523819801535), (t789 <= 6.1086523819801535)), t789, casadi.if_else(casadi.logic_and((t790 >= -6.1086523819801535), (t790 <= 6.1086523819801535)), t790, t785)))
+    t792 = (t421 <= 2.2689280275926285)
+    t793 = casadi.logic_and((t420 >= -2.2689280275926285), (t420 <= 2.2689280275926285))
+    t794 = casadi.if_else(casadi.logic_and(t792, casadi.logic_not(t793)), t421, t420)
+    t795 = t794
+    t796 = t795 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn5 - 0.15915494309189535*t795)
+    t797 = casadi.if_else((qn5 > t796), 6.283185307179586, -6.283185307179586)
+    t798 = t796 + t797
+    t799 = t796 - t797
+    t800 = casadi.if_else(casadi.logic_and((t796 >= -2.2689280275926285), (t796 <= 2.2689280275926285)), t796, casadi.if_else(casadi.logic_and((t798 >= -2.2689280275926285), (t798 <= 2.2689280275926285)), t798, casadi.if_else(casadi.logic_and((t799 >= -2.2689280275926285), (t799 <= 2.2689280275926285)), t799, t794)))
+    t801 = (t425 <= 6.1086523819801535)
+    t802 = casadi.logic_and((t424 >= -6.1086523819801535), (t424 <= 6.1086523819801535))
+    t803 = casadi.if_else(casadi.logic_and(t801, casadi.logic_not(t802)), t425, t424)
+    t804 = t803
+    t805 = t804 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn6 - 0.15915494309189535*t804)
+    t806 = casadi.if_else((qn6 > t805), 6.283185307179586, -6.283185307179586)
+    t807 = t805 + t806
+    t808 = t805 - t806
+    t809 = casadi.if_else(casadi.logic_and((t805 >= -6.1086523819801535), (t805 <= 6.1086523819801535)), t805, casadi.if_else(casadi.logic_and((t807 >= -6.1086523819801535), (t807 <= 6.1086523819801535)), t807, casadi.if_else(casadi.logic_and((t808 >= -6.1086523819801535), (t808 <= 6.1086523819801535)), t808, t803)))
+    t810 = t706 + qw2*(t489 + t773)**2 + qw3*(t490 + t782)**2
+    t811 = t810 + qw4*(t484 + t791)**2 + qw5*(t485 + t800)**2 + qw6*(t486 + t809)**2
+    t812 = casadi.logic_or(t765, t766)
+    t813 = casadi.logic_or(t774, t775)
+    t814 = casadi.if_else(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t20, t224), t493), t497), t499), t709), t812), t813), (t332 >= -1e-12)), casadi.logic_or(t783, t784)), casadi.logic_or(t792, t793)), casadi.logic_or(t801, t802)), 1, 0)
+    t815 = (t814 > 0)
+    t816 = casadi.if_else(casadi.logic_and(t815, casadi.logic_or((t764 > t811), (t756 < 1))), 1, 0)
+    t817 = casadi.if_else(t815, 1, t756)
+    t818 = (t816 > 0)
+    t819 = casadi.if_else(t818, t660, t758)
+    t820 = casadi.if_else(t818, t773, t759)
+    t821 = casadi.if_else(t818, t782, t760)
+    t822 = casadi.if_else(t818, t791, t761)
+    t823 = casadi.if_else(t818, t800, t762)
+    t824 = casadi.if_else(t818, t809, t763)
+    t825 = casadi.if_else(t818, t811, t764)
+    t826 = (t418 <= 6.1086523819801535)
+    t827 = casadi.logic_and((t417 >= -6.1086523819801535), (t417 <= 6.1086523819801535))
+    t828 = casadi.if_else(casadi.logic_and(t826, casadi.logic_not(t827)), t418, t417)
+    t829 = t828
+    t830 = t829 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t829)
+    t831 = casadi.if_else((qn4 > t830), 6.283185307179586, -6.283185307179586)
+    t832 = t830 + t831
+    t833 = t830 - t831
+    t834 = casadi.if_else(casadi.logic_and((t830 >= -6.1086523819801535), (t830 <= 6.1086523819801535)), t830, casadi.if_else(casadi.logic_and((t832 >= -6.1086523819801535), (t832 <= 6.1086523819801535)), t832, casadi.if_else(casadi.logic_and((t833 >= -6.1086523819801535), (t833 <= 6.1086523819801535)), t833, t828)))
+    t835 = (t429 >= -2.2689280275926285)
+    t836 = casadi.logic_and((t422 >= -2.2689280275926285), (t422 <= 2.2689280275926285))
+    t837 = casadi.if_else(casadi.logic_and(t835, casadi.logic_not(t836)), -t429, t428)
+    t838 = t837
+    t839 = t838 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn5 - 0.15915494309189535*t838)
+    t840 = casadi.if_else((qn5 > t839), 6.283185307179586, -6.283185307179586)
+    t841 = t839 + t840
+    t842 = t839 - t840
+    t843 = casadi.if_else(casadi.logic_and((t839 >= -2.2689280275926285), (t839 <= 2.2689280275926285)), t839, casadi.if_else(casadi.logic_and((t841 >= -2.2689280275926285), (t841 <= 2.2689280275926285)), t841, casadi.if_else(casadi.logic_and((t842 >= -2.2689280275926285), (t842 <= 2.2689280275926285)), t842, t837)))
+    t844 = (t427 <= 6.1086523819801535)
+    t845 = casadi.logic_and((t426 >= -6.1086523819801535), (t426 <= 6.1086523819801535))
+    t846 = casadi.if_else(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t20, t224), t333), t493), t497), t499), t709), t812), t813), casadi.logic_or(t826, t827)), casadi.logic_or(t835, t836)), casadi.logic_or(t844, t845)), 1, 0)
+    t847 = casadi.if_else(casadi.logic_and(t844, casadi.logic_not(t845)), t427, t426)
+    t848 = t847
+    t849 = t848 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn6 - 0.15915494309189535*t848)
+    t850 = casadi.if_else((qn6 > t849), 6.283185307179586, -6.283185307179586)
+    t851 = t849 + t850
+    t852 = t849 - t850
+    t853 = casadi.if_else(casadi.logic_and((t849 >= -6.1086523819801535), (t849 <= 6.1086523819801535)), t849, casadi.if_else(casadi.logic_and((t851 >= -6.1086523819801535), (t851 <= 6.1086523819801535)), t851, casadi.if_else(casadi.logic_and((t852 >= -6.1086523819801535), (t852 <= 6.1086523819801535)), t852, t847)))
+    t854 = t810 + qw4*(t484 + t834)**2 + qw5*(t485 + t843)**2 + qw6*(t486 + t853)**2
+    t855 = (t846 > 0)
+    t856 = casadi.if_else(casadi.logic_and(t855, casadi.logic_or((t825 > t854), (t817 < 1))), 1, 0)
+    t857 = casadi.if_else(t855, 1, t817)
+    t858 = (t856 > 0)
+    t859 = casadi.if_else(t858, t660, t819)
+    t860 = casadi.if_else(t858, t773, t820)
+    t861 = casadi.if_else(t858, t782, t821)
+    t862 = casadi.if_else(t858, t834, t822)
+    t863 = casadi.if_else(t858, t843, t823)
+    t864 = casadi.if_else(t858, t853, t824)
+    t865 = (casadi.fabs(t365) < casadi.inf)
+    t866 = (t857 > 0)
+    t867 = casadi.logic_and(t865, t866)
+    q = casadi.SX(6, 1)
+    q[0, 0] = casadi.if_else(t867, t859, qn1)
+    q[1, 0] = casadi.if_else(t867, t860, qn2)
+    q[2, 0] = casadi.if_else(t867, t861, qn3)
+    q[3, 0] = casadi.if_else(t867, t862, qn4)
+    q[4, 0] = casadi.if_else(t867, t863, qn5)
+    q[5, 0] = casadi.if_else(t867, t864, qn6)
+    status = casadi.SX(1, 1)
+    status[0, 0] = casadi.if_else(casadi.logic_not(t865), 2, casadi.if_else(t866, 0, 1))
+    return [q, status]
 
 
 _q = casadi.SX.sym("q", 6, 1)
@@ -2659,6 +3721,8 @@ _mu_dot = casadi.SX.sym("mu_dot", 6, 1)
 _damping = casadi.SX.sym("damping", 1, 1)
 _target = casadi.SX.sym("target", 4, 4)
 _T = casadi.SX.sym("T", 4, 4)
+_q_seed = casadi.SX.sym("q_seed", 6, 1)
+_weights = casadi.SX.sym("weights", 6, 1)
 fk = casadi.Function("fk", [_q], _fk(_q), ["q"], ["T"])
 jacobian = casadi.Function("jacobian", [_q], _jacobian(_q), ["q"], ["J"])
 fk_jacobian = casadi.Function("fk_jacobian", [_q], _fk_jacobian(_q), ["q"], ["T", "J"])
@@ -2675,8 +3739,9 @@ manipulability = casadi.Function("manipulability", [_q], _manipulability(_q), ["
 jacobian_det = casadi.Function("jacobian_det", [_q], _jacobian_det(_q), ["q"], ["d"])
 velocity_ik = casadi.Function("velocity_ik", [_q, _mu_dot, _damping], _velocity_ik(_q, _mu_dot, _damping), ["q", "mu_dot", "damping"], ["q_dot", "status"])
 ik_numeric_step = casadi.Function("ik_numeric_step", [_target, _q, _damping], _ik_numeric_step(_target, _q, _damping), ["target", "q", "damping"], ["q_start", "q_next", "cost"])
-ik_branches = casadi.Function("ik_branches", [_T], _ik_branches(_T), ["T"], ["q", "valid"])
-ik = ik_branches  # CasADi functions have fixed-size outputs: every branch and its validity
+ik_branches = casadi.Function("ik_branches", [_T], _ik_branches(_T), ["T"], ["q", "valid", "in_limits"])
+ik_nearest = casadi.Function("ik_nearest", [_T, _q_seed, _weights], _ik_nearest(_T, _q_seed, _weights), ["T", "q_seed", "weights"], ["q", "status"])
+ik = ik_branches  # CasADi functions have fixed-size outputs: every branch, its validity and its limits
 
 IK_NUMERIC_CONVERGED = 0  # |error| <= tol
 IK_NUMERIC_ITERATION_LIMIT = 1  # IK_NUMERIC_ITERATIONS steps taken, |error| still above tol
@@ -2718,4 +3783,4 @@ ik_numeric = casadi.Function("ik_numeric", _inputs, _ik_numeric(*_inputs), ["tar
 
 def functions():
     """All functions by name."""
-    return {"fk": fk, "jacobian": jacobian, "fk_jacobian": fk_jacobian, "jacobian_tool": jacobian_tool, "task": task, "task_jacobian": task_jacobian, "fk_jacobian_dot": fk_jacobian_dot, "jacobian_dot": jacobian_dot, "bias_acceleration": bias_acceleration, "task_jacobian_dot": task_jacobian_dot, "hessian": hessian, "singularity_factors": singularity_factors, "manipulability": manipulability, "jacobian_det": jacobian_det, "velocity_ik": velocity_ik, "ik_numeric_step": ik_numeric_step, "ik_branches": ik_branches}
+    return {"fk": fk, "jacobian": jacobian, "fk_jacobian": fk_jacobian, "jacobian_tool": jacobian_tool, "task": task, "task_jacobian": task_jacobian, "fk_jacobian_dot": fk_jacobian_dot, "jacobian_dot": jacobian_dot, "bias_acceleration": bias_acceleration, "task_jacobian_dot": task_jacobian_dot, "hessian": hessian, "singularity_factors": singularity_factors, "manipulability": manipulability, "jacobian_det": jacobian_det, "velocity_ik": velocity_ik, "ik_numeric_step": ik_numeric_step, "ik_branches": ik_branches, "ik_nearest": ik_nearest}

@@ -96,9 +96,13 @@ int panda_velocity_ik(const panda_real q[PANDA_DOF], const panda_real mu_dot[PAN
  * Result: q_start[i], i < 7; q_next[i], i < 7; returned as a scalar. 1162 operations. */
 panda_real panda_ik_numeric_step(const panda_real target[16], const panda_real q[PANDA_DOF], panda_real damping, panda_real q_start[PANDA_DOF], panda_real q_next[PANDA_DOF]);
 
-/* Every branch of the closed-form ik and whether the target allows it.
- * Result: q: 8 x 7 row-major, element (r, c) at q[r * 7 + c]; valid[i], i < 8. 1067 operations. */
-void panda_ik_branches(const panda_real T[16], panda_real q_free, panda_real q[PANDA_MAX_IK_SOLUTIONS * PANDA_DOF], int valid[PANDA_MAX_IK_SOLUTIONS]);
+/* Every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits.
+ * Result: q: 8 x 7 row-major, element (r, c) at q[r * 7 + c]; valid[i], i < 8; in_limits[i], i < 8. 1587 operations. */
+void panda_ik_branches(const panda_real T[16], panda_real q_free, panda_real q[PANDA_MAX_IK_SOLUTIONS * PANDA_DOF], int valid[PANDA_MAX_IK_SOLUTIONS], int in_limits[PANDA_MAX_IK_SOLUTIONS]);
+
+/* The closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status.
+ * Result: q[i], i < 7; returned as a scalar. 2461 operations. */
+int panda_ik_nearest(const panda_real T[16], const panda_real q_seed[PANDA_DOF], panda_real q_free, const panda_real weights[PANDA_DOF], panda_real q[PANDA_DOF]);
 
 /* Statuses of panda_velocity_ik: OK, singular (a diagonal entry of the QR factor R of the
  * 6 x 6 system at most 1e-12 times its Frobenius norm: take damping > 0), or
@@ -108,12 +112,15 @@ void panda_ik_branches(const panda_real T[16], panda_real q_free, panda_real q[P
 #define PANDA_VELOCITY_IK_SINGULAR 1
 #define PANDA_VELOCITY_IK_NOT_FINITE 2
 
-/* Closed-form inverse kinematics: every joint solution that reaches the target; returns
- * their count k and writes solution i to q[i * PANDA_DOF + j], i < k: the valid
- * rows of panda_ik_branches, in its order. No allocation, no recursion.
+/* Closed-form inverse kinematics: every joint solution inside the joint limits that reaches
+ * the target; returns their count k and writes solution i to q[i * PANDA_DOF + j],
+ * i < k: the rows of panda_ik_branches that are valid and in_limits, in its order
+ * (panda_ik_branches also gives those outside the limits). No allocation, no recursion.
  * target: the 4x4 tool pose in the world frame (rotation part orthonormal).
- * Result: k <= PANDA_MAX_IK_SOLUTIONS solutions, revolute angles wrapped into (-pi, pi],
- * joint limits not applied; k = 0 when the target is out of reach or not finite.
+ * Result: k <= PANDA_MAX_IK_SOLUTIONS solutions inside the joint limits, revolute angles
+ * wrapped into (-pi, pi] or, where that is outside the limits, their lowest equivalent
+ * inside them; k = 0 when the target is out of reach or not finite. ik_branches also gives
+ * the solutions outside the limits (in_limits 0).
  * Solver: 6R with a spherical wrist and axes 1, 2 intersecting (Pieper): wrist centre,
  * elbow (SP3), base and shoulder together (SP2), then the wrist orientation (SP2, SP1).
  * q_free: the angle of joint 7 (rad); every solution keeps it as given and solves the
@@ -130,6 +137,12 @@ void panda_ik_branches(const panda_real T[16], panda_real q_free, panda_real q[P
  * angle the target leaves free (a singular wrist or shoulder) is set to 0.
  */
 int panda_ik(const panda_real T[16], panda_real q_free, panda_real q[PANDA_MAX_IK_SOLUTIONS * PANDA_DOF]);
+
+/* Statuses of panda_ik_nearest: a solution found; no solution inside the limits (out of
+ * reach); the target (its first three rows), q_seed or weights not finite. q = q_seed unless OK. */
+#define PANDA_IK_NEAREST_OK 0
+#define PANDA_IK_NEAREST_NO_SOLUTION 1
+#define PANDA_IK_NEAREST_NOT_FINITE 2
 
 /* ik_numeric status codes. */
 #define PANDA_IK_NUMERIC_CONVERGED 0       /* |error| <= tol */

@@ -5,7 +5,8 @@ Franka Emika Panda with Franka Hand TCP (rtb Panda), modified DH
 Every function takes `q` (7 x 1: radians for revolute joints, m for
 prismatic ones) and returns a rows x cols result whose zeros are structural; ik_branches
 (also named ik) takes the target instead of q and returns every branch (MAX_IK_SOLUTIONS x
-DOF) and its validity (MAX_IK_SOLUTIONS x 1, 1 or 0).
+DOF), its validity and whether it is inside the joint limits (MAX_IK_SOLUTIONS x 1 each, 1
+or 0); ik_nearest takes the target and q_seed and returns the solution nearest q_seed.
 Task vector: (x, y, z, roll, pitch, yaw).
 """
 
@@ -2858,7 +2859,7 @@ def _ik_numeric_step(target, q, damping):
 
 
 def _ik_branches(T, q_free):
-    """Every branch of the closed-form ik and whether the target allows it: 1067 operations."""
+    """Every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits: 1587 operations."""
     T00 = T[0, 0]
     T01 = T[0, 1]
     T02 = T[0, 2]
@@ -2908,91 +2909,787 @@ def _ik_branches(T, q_free):
     t31 = casadi.atan2(t30, t29)
     t32 = casadi.if_else(t23, 0, t3 + t31)
     t33 = t3 - t31
-    t34 = t24*t29
-    t35 = 0.11453775*t34
-    t36 = t24*t30
-    t37 = 0.05775*t36
-    t38 = casadi.if_else(t23, 1, t37 - t35)
-    t39 = t35 + t37
-    t40 = 0.05775*t34
-    t41 = 0.11453775*t36
-    t42 = casadi.if_else(t23, 0, -t40 - t41)
-    t43 = t41 - t40
-    t44 = 0.316*t42 - 0.0825*t38
-    t45 = 0.316*t38 + 0.0825*t42
-    t46 = 0.0825 + t44
-    t47 = 0.649 - t45
-    t48 = -1.033 + t47
-    t49 = 0.316*t43 + 0.0825*t39
-    t50 = 0.316*t39 - 0.0825*t43
-    t51 = 0.0825 + t49
-    t52 = 0.649 + t50
-    t53 = -1.033 + t52
-    t54 = t46**2
-    t55 = t48**2
-    t56 = t54 + t55
-    t57 = t20 + t55
-    t58 = t57 - t56
-    t59 = -t58
-    t60 = 1e-12*t56
+    t34 = t32 + 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t32)
+    t35 = t33 + 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t33)
+    t36 = t24*t29
+    t37 = 0.11453775*t36
+    t38 = t24*t30
+    t39 = 0.05775*t38
+    t40 = casadi.if_else(t23, 1, t39 - t37)
+    t41 = t37 + t39
+    t42 = 0.05775*t36
+    t43 = 0.11453775*t38
+    t44 = casadi.if_else(t23, 0, -t42 - t43)
+    t45 = t43 - t42
+    t46 = 0.316*t44 - 0.0825*t40
+    t47 = 0.316*t40 + 0.0825*t44
+    t48 = 0.0825 + t46
+    t49 = 0.649 - t47
+    t50 = -1.033 + t49
+    t51 = 0.316*t45 + 0.0825*t41
+    t52 = 0.316*t41 - 0.0825*t45
+    t53 = 0.0825 + t51
+    t54 = 0.649 + t52
+    t55 = -1.033 + t54
+    t56 = t48**2
+    t57 = t50**2
+    t58 = t56 + t57
+    t59 = t20 + t57
+    t60 = t59 - t58
     t61 = -t60
-    t62 = casadi.if_else((t58 < t61), casadi.sqrt(t59), 0)
-    t63 = t57 + t62**2
-    t64 = t13*t62
-    t65 = t20 + t2*t48
+    t62 = 1e-12*t58
+    t63 = -t62
+    t64 = casadi.if_else((t60 < t63), casadi.sqrt(t61), 0)
+    t65 = t59 + t64**2
+    t66 = t13*t64
+    t67 = t20 + t2*t50
+    t68 = t67 - t66
+    t69 = t66 + t67
+    t70 = -t20
+    t71 = t68 + t70
+    t72 = t69 + t70
+    t73 = t13*t50
+    t74 = t2*t64
+    t75 = t73 + t74
+    t76 = t71**2 + t75**2
+    t77 = t73 - t74
+    t78 = t72**2 + t77**2
+    t79 = 1e-24*t65
+    t80 = t21*t79
+    t81 = (t76 <= t80)
+    t82 = casadi.if_else(t81, 1, 1/casadi.sqrt(t76))
+    t83 = casadi.if_else(t81, 1, t71*t82)
+    t84 = casadi.if_else(t81, 0, -t75*t82)
+    t85 = t11*t83 - T22*t84
+    t86 = T22*t83 + t11*t84
+    t87 = t83*t9 - T02*t84
+    t88 = T02*t83 + t84*t9
+    t89 = t48*t64
+    t90 = t57 - t89
+    t91 = t57 + t89
+    t92 = -t57
+    t93 = t90 + t92
+    t94 = t91 + t92
+    t95 = t20*t56
+    t96 = t95 + t93**2
+    t97 = t95 + t94**2
+    t98 = t58*t79
+    t99 = (t96 <= t98)
+    t100 = casadi.if_else(t99, 1, 1/casadi.sqrt(t96))
+    t101 = casadi.if_else(t99, 1, t100*t93)
+    t102 = t19*t48
+    t103 = casadi.if_else(t99, 0, t100*t102)
+    t104 = (t78 <= t80)
+    t105 = casadi.if_else(t104, 1, 1/casadi.sqrt(t78))
+    t106 = casadi.if_else(t104, 1, t105*t72)
+    t107 = casadi.if_else(t104, 0, -t105*t77)
+    t108 = t106*t11 - T22*t107
+    t109 = T22*t106 + t107*t11
+    t110 = t106*t9 - T02*t107
+    t111 = T02*t106 + t107*t9
+    t112 = (t97 <= t98)
+    t113 = casadi.if_else(t112, 1, 1/casadi.sqrt(t97))
+    t114 = casadi.if_else(t112, 1, t113*t94)
+    t115 = casadi.if_else(t112, 0, t102*t113)
+    t116 = 1 - t83
+    t117 = t116*t17
+    t118 = t117 + t17*t83
+    t119 = t116*t15
+    t120 = t119 + t15*t83
+    t121 = t101*t85 + t103*t118
+    t122 = t101*t118 - t103*t85
+    t123 = t101*t87 + t103*t120
+    t124 = t101*t120 - t103*t87
+    t125 = 1 - t101
+    t126 = t125*t86
+    t127 = t126 + t101*t86
+    t128 = t125*t88
+    t129 = t128 + t101*t88
+    t130 = t121*t40 - t127*t44
+    t131 = t121*t44 + t127*t40
+    t132 = t123*t40 - t129*t44
+    t133 = t123*t44 + t129*t40
+    t134 = 1 - t40
+    t135 = t122*t134
+    t136 = t135 + t122*t40
+    t137 = t124*t134
+    t138 = t137 + t124*t40
+    t139 = t131**2
+    t140 = -t139
+    t141 = 1 + t140
+    t142 = casadi.if_else((t141 > 1e-12), casadi.sqrt(t141), 0)
+    t143 = t139 - t130*t142
+    t144 = t140 + t143
+    t145 = t136**2
+    t146 = t139 + t145 + t130**2
+    t147 = t142**2
+    t148 = t144**2 + t145*t147
+    t149 = t139 + t147
+    t150 = 1e-24*t149
+    t151 = (t148 <= t146*t150)
+    t152 = casadi.if_else(t151, 1, 1/casadi.sqrt(t148))
+    t153 = casadi.if_else(t151, 1, t144*t152)
+    t154 = t133*(1 - t153)
+    t155 = t154 + t133*t153
+    t156 = t136*t142
+    t157 = casadi.if_else(t151, 0, -t152*t156)
+    t158 = t132*t153 + t138*t157
+    t159 = t138*t153 - t132*t157
+    t160 = (t149 <= t150)
+    t161 = casadi.if_else(t160, 1, 1/casadi.sqrt(t149))
+    t162 = casadi.if_else(t160, 1, -t131*t161)
+    t163 = casadi.if_else(t160, 0, -t142*t161)
+    t164 = t159*(1 - t162)
+    t165 = t155*t163 + t158*t162
+    t166 = t164 + t159*t162
+    t167 = t158*t163 - t155*t162
+    t168 = t165**2 + t166**2
+    t169 = t168
+    t170 = t168 + t167**2
+    t171 = 1 - t106
+    t172 = t17*t171
+    t173 = t172 + t106*t17
+    t174 = t15*t171
+    t175 = t174 + t106*t15
+    t176 = t108*t114 + t115*t173
+    t177 = t114*t173 - t108*t115
+    t178 = t110*t114 + t115*t175
+    t179 = t114*t175 - t110*t115
+    t180 = t134*t177
+    t181 = t180 + t177*t40
+    t182 = t134*t179
+    t183 = t182 + t179*t40
+    t184 = 1 - t114
+    t185 = t109*t184
+    t186 = t185 + t109*t114
+    t187 = t111*t184
+    t188 = t187 + t111*t114
+    t189 = t176*t40 - t186*t44
+    t190 = t176*t44 + t186*t40
+    t191 = t178*t40 - t188*t44
+    t192 = t178*t44 + t188*t40
+    t193 = t190**2
+    t194 = -t193
+    t195 = 1 + t194
+    t196 = casadi.if_else((t195 > 1e-12), casadi.sqrt(t195), 0)
+    t197 = t193 - t189*t196
+    t198 = t194 + t197
+    t199 = t181**2
+    t200 = t193 + t199 + t189**2
+    t201 = t196**2
+    t202 = t198**2 + t199*t201
+    t203 = t193 + t201
+    t204 = 1e-24*t203
+    t205 = (t202 <= t200*t204)
+    t206 = casadi.if_else(t205, 1, 1/casadi.sqrt(t202))
+    t207 = casadi.if_else(t205, 1, t198*t206)
+    t208 = t192*(1 - t207)
+    t209 = t208 + t192*t207
+    t210 = t181*t196
+    t211 = casadi.if_else(t205, 0, -t206*t210)
+    t212 = t183*t211 + t191*t207
+    t213 = t183*t207 - t191*t211
+    t214 = (t203 <= t204)
+    t215 = casadi.if_else(t214, 1, 1/casadi.sqrt(t203))
+    t216 = casadi.if_else(t214, 1, -t190*t215)
+    t217 = casadi.if_else(t214, 0, -t196*t215)
+    t218 = t213*(1 - t216)
+    t219 = t209*t217 + t212*t216
+    t220 = t218 + t213*t216
+    t221 = t212*t217 - t209*t216
+    t222 = t219**2 + t220**2
+    t223 = t222
+    t224 = t222 + t221**2
+    t225 = t53**2
+    t226 = t55**2
+    t227 = t225 + t226
+    t228 = t20 + t226
+    t229 = t228 - t227
+    t230 = -t229
+    t231 = 1e-12*t227
+    t232 = -t231
+    t233 = casadi.if_else((t229 < t232), casadi.sqrt(t230), 0)
+    t234 = t228 + t233**2
+    t235 = t13*t233
+    t236 = t20 + t2*t55
+    t237 = t236 - t235
+    t238 = t237 + t70
+    t239 = t235 + t236
+    t240 = t239 + t70
+    t241 = t13*t55
+    t242 = t2*t233
+    t243 = t241 + t242
+    t244 = t238**2 + t243**2
+    t245 = t241 - t242
+    t246 = t240**2 + t245**2
+    t247 = 1e-24*t234
+    t248 = t21*t247
+    t249 = (t244 <= t248)
+    t250 = casadi.if_else(t249, 1, 1/casadi.sqrt(t244))
+    t251 = casadi.if_else(t249, 1, t238*t250)
+    t252 = casadi.if_else(t249, 0, -t243*t250)
+    t253 = t11*t251 - T22*t252
+    t254 = T22*t251 + t11*t252
+    t255 = t251*t9 - T02*t252
+    t256 = T02*t251 + t252*t9
+    t257 = t233*t53
+    t258 = t226 - t257
+    t259 = t226 + t257
+    t260 = -t226
+    t261 = t258 + t260
+    t262 = t259 + t260
+    t263 = t20*t225
+    t264 = t263 + t261**2
+    t265 = t263 + t262**2
+    t266 = t227*t247
+    t267 = (t264 <= t266)
+    t268 = casadi.if_else(t267, 1, 1/casadi.sqrt(t264))
+    t269 = casadi.if_else(t267, 1, t261*t268)
+    t270 = t19*t53
+    t271 = casadi.if_else(t267, 0, t268*t270)
+    t272 = (t246 <= t248)
+    t273 = casadi.if_else(t272, 1, 1/casadi.sqrt(t246))
+    t274 = casadi.if_else(t272, 1, t240*t273)
+    t275 = casadi.if_else(t272, 0, -t245*t273)
+    t276 = t11*t274 - T22*t275
+    t277 = T22*t274 + t11*t275
+    t278 = t274*t9 - T02*t275
+    t279 = T02*t274 + t275*t9
+    t280 = (t265 <= t266)
+    t281 = casadi.if_else(t280, 1, 1/casadi.sqrt(t265))
+    t282 = casadi.if_else(t280, 1, t262*t281)
+    t283 = casadi.if_else(t280, 0, t270*t281)
+    t284 = 1 - t251
+    t285 = t17*t284
+    t286 = t285 + t17*t251
+    t287 = t15*t284
+    t288 = t287 + t15*t251
+    t289 = t253*t269 + t271*t286
+    t290 = t269*t286 - t253*t271
+    t291 = t255*t269 + t271*t288
+    t292 = t269*t288 - t255*t271
+    t293 = 1 - t269
+    t294 = t254*t293
+    t295 = t294 + t254*t269
+    t296 = t256*t293
+    t297 = t296 + t256*t269
+    t298 = t289*t41 + t295*t45
+    t299 = t295*t41 - t289*t45
+    t300 = t291*t41 + t297*t45
+    t301 = t297*t41 - t291*t45
+    t302 = 1 + t41
+    t303 = t290*t302
+    t304 = t303 - t290*t41
+    t305 = t292*t302
+    t306 = t305 - t292*t41
+    t307 = t299**2
+    t308 = -t307
+    t309 = 1 + t308
+    t310 = casadi.if_else((t309 > 1e-12), casadi.sqrt(t309), 0)
+    t311 = t307 + t298*t310
+    t312 = t308 + t311
+    t313 = t304**2
+    t314 = t307 + t313 + t298**2
+    t315 = t310**2
+    t316 = t312**2 + t313*t315
+    t317 = t307 + t315
+    t318 = 1e-24*t317
+    t319 = (t316 <= t314*t318)
+    t320 = casadi.if_else(t319, 1, 1/casadi.sqrt(t316))
+    t321 = casadi.if_else(t319, 1, t312*t320)
+    t322 = t301*(1 - t321)
+    t323 = t322 + t301*t321
+    t324 = t304*t310
+    t325 = casadi.if_else(t319, 0, -t320*t324)
+    t326 = t306*t325 - t300*t321
+    t327 = t300*t325 + t306*t321
+    t328 = (t317 <= t318)
+    t329 = casadi.if_else(t328, 1, 1/casadi.sqrt(t317))
+    t330 = casadi.if_else(t328, 1, t299*t329)
+    t331 = casadi.if_else(t328, 0, -t310*t329)
+    t332 = t327*(1 - t330)
+    t333 = t326*t330 - t323*t331
+    t334 = t332 + t327*t330
+    t335 = t323*t330 + t326*t331
+    t336 = t333**2 + t334**2
+    t337 = t336
+    t338 = t336 + t335**2
+    t339 = 1 - t274
+    t340 = t17*t339
+    t341 = t340 + t17*t274
+    t342 = t15*t339
+    t343 = t342 + t15*t274
+    t344 = t276*t282 + t283*t341
+    t345 = t282*t341 - t276*t283
+    t346 = t278*t282 + t283*t343
+    t347 = t282*t343 - t278*t283
+    t348 = t302*t345
+    t349 = t348 - t345*t41
+    t350 = t302*t347
+    t351 = t350 - t347*t41
+    t352 = 1 - t282
+    t353 = t277*t352
+    t354 = t353 + t277*t282
+    t355 = t279*t352
+    t356 = t355 + t279*t282
+    t357 = t344*t41 + t354*t45
+    t358 = t354*t41 - t344*t45
+    t359 = t346*t41 + t356*t45
+    t360 = t356*t41 - t346*t45
+    t361 = t358**2
+    t362 = -t361
+    t363 = 1 + t362
+    t364 = casadi.if_else((t363 > 1e-12), casadi.sqrt(t363), 0)
+    t365 = t361 + t357*t364
+    t366 = t362 + t365
+    t367 = t349**2
+    t368 = t361 + t367 + t357**2
+    t369 = t364**2
+    t370 = t366**2 + t367*t369
+    t371 = t361 + t369
+    t372 = 1e-24*t371
+    t373 = (t370 <= t368*t372)
+    t374 = casadi.if_else(t373, 1, 1/casadi.sqrt(t370))
+    t375 = casadi.if_else(t373, 1, t366*t374)
+    t376 = t360*(1 - t375)
+    t377 = t376 + t360*t375
+    t378 = t349*t364
+    t379 = casadi.if_else(t373, 0, -t374*t378)
+    t380 = t351*t379 - t359*t375
+    t381 = t351*t375 + t359*t379
+    t382 = (t371 <= t372)
+    t383 = casadi.if_else(t382, 1, 1/casadi.sqrt(t371))
+    t384 = casadi.if_else(t382, 1, t358*t383)
+    t385 = casadi.if_else(t382, 0, -t364*t383)
+    t386 = t381*(1 - t384)
+    t387 = t380*t384 - t377*t385
+    t388 = t386 + t381*t384
+    t389 = t377*t384 + t380*t385
+    t390 = t387**2 + t388**2
+    t391 = t390
+    t392 = t390 + t389**2
+    t393 = casadi.if_else(t81, 0, casadi.atan2(-t75, t71))
+    t394 = t393 + 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t393)
+    t395 = -t394
+    t396 = t394 + 6.283185307179586*casadi.floor(0.0027852115041081685 + 0.15915494309189535*t395)
+    t397 = casadi.if_else(t99, 0, casadi.atan2(t102, t93))
+    t398 = t397 + 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t397)
+    t399 = -t398
+    t400 = t398 + 6.283185307179586*casadi.floor(0.46111961662014833 + 0.15915494309189535*t399)
+    t401 = -t34
+    t402 = t34 + 6.283185307179586*casadi.floor(0.4888921541896841 + 0.15915494309189535*t401)
+    t403 = casadi.if_else(t151, 0, casadi.atan2(-t156, t144))
+    t404 = 3.141592653589793 + t403
+    t405 = t403 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t404)
+    t406 = -6.283185307179586 + t404 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t403)
+    t407 = -t405
+    t408 = t405 + 6.283185307179586*casadi.floor(0.46111961662014833 + 0.15915494309189535*t407)
+    t409 = casadi.if_else(t160, 0, casadi.atan2(-t142, -t131))
+    t410 = t409 + 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t409)
+    t411 = t409
+    t412 = t411 - 6.283185307179586*casadi.floor(0.280558333682393 + 0.15915494309189535*t411)
+    t413 = -t410
+    t414 = t410 + 6.283185307179586*casadi.floor(0.280558333682393 + 0.15915494309189535*t413)
+    t415 = casadi.if_else((t169 <= 1e-24*t170), 0, casadi.atan2(t166, t165))
+    t416 = 3.141592653589793 + t415
+    t417 = t415 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t416)
+    t418 = -6.283185307179586 + t416 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t415)
+    t419 = -t417
+    t420 = t417 + 6.283185307179586*casadi.floor(0.46111961662014833 + 0.15915494309189535*t419)
+    t421 = -t406
+    t422 = t406 + 6.283185307179586*casadi.floor(0.46111961662014833 + 0.15915494309189535*t421)
+    t423 = -t418
+    t424 = t418 + 6.283185307179586*casadi.floor(0.46111961662014833 + 0.15915494309189535*t423)
+    t425 = casadi.if_else(t104, 0, casadi.atan2(-t77, t72))
+    t426 = t425 + 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t425)
+    t427 = -t426
+    t428 = t426 + 6.283185307179586*casadi.floor(0.0027852115041081685 + 0.15915494309189535*t427)
+    t429 = casadi.if_else(t112, 0, casadi.atan2(t102, t94))
+    t430 = t429 + 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t429)
+    t431 = -t430
+    t432 = t430 + 6.283185307179586*casadi.floor(0.46111961662014833 + 0.15915494309189535*t431)
+    t433 = casadi.if_else(t205, 0, casadi.atan2(-t210, t198))
+    t434 = 3.141592653589793 + t433
+    t435 = t433 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t434)
+    t436 = -6.283185307179586 + t434 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t433)
+    t437 = -t435
+    t438 = t435 + 6.283185307179586*casadi.floor(0.46111961662014833 + 0.15915494309189535*t437)
+    t439 = casadi.if_else(t214, 0, casadi.atan2(-t196, -t190))
+    t440 = t439 + 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t439)
+    t441 = t439
+    t442 = t441 - 6.283185307179586*casadi.floor(0.280558333682393 + 0.15915494309189535*t441)
+    t443 = -t440
+    t444 = t440 + 6.283185307179586*casadi.floor(0.280558333682393 + 0.15915494309189535*t443)
+    t445 = casadi.if_else((t223 <= 1e-24*t224), 0, casadi.atan2(t220, t219))
+    t446 = 3.141592653589793 + t445
+    t447 = t445 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t446)
+    t448 = -6.283185307179586 + t446 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t445)
+    t449 = -t447
+    t450 = t447 + 6.283185307179586*casadi.floor(0.46111961662014833 + 0.15915494309189535*t449)
+    t451 = -t436
+    t452 = t436 + 6.283185307179586*casadi.floor(0.46111961662014833 + 0.15915494309189535*t451)
+    t453 = -t448
+    t454 = t448 + 6.283185307179586*casadi.floor(0.46111961662014833 + 0.15915494309189535*t453)
+    t455 = casadi.if_else(t249, 0, casadi.atan2(-t243, t238))
+    t456 = t455 + 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t455)
+    t457 = -t456
+    t458 = t456 + 6.283185307179586*casadi.floor(0.0027852115041081685 + 0.15915494309189535*t457)
+    t459 = casadi.if_else(t267, 0, casadi.atan2(t270, t261))
+    t460 = t459 + 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t459)
+    t461 = -t460
+    t462 = t460 + 6.283185307179586*casadi.floor(0.46111961662014833 + 0.15915494309189535*t461)
+    t463 = -t35
+    t464 = t35 + 6.283185307179586*casadi.floor(0.4888921541896841 + 0.15915494309189535*t463)
+    t465 = casadi.if_else(t319, 0, casadi.atan2(-t324, t312))
+    t466 = 3.141592653589793 + t465
+    t467 = t465 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t466)
+    t468 = -6.283185307179586 + t466 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t465)
+    t469 = -t467
+    t470 = t467 + 6.283185307179586*casadi.floor(0.46111961662014833 + 0.15915494309189535*t469)
+    t471 = casadi.if_else(t328, 0, casadi.atan2(-t310, t299))
+    t472 = t471 + 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t471)
+    t473 = t471
+    t474 = t473 - 6.283185307179586*casadi.floor(0.280558333682393 + 0.15915494309189535*t473)
+    t475 = -t472
+    t476 = t472 + 6.283185307179586*casadi.floor(0.280558333682393 + 0.15915494309189535*t475)
+    t477 = casadi.if_else((t337 <= 1e-24*t338), 0, casadi.atan2(t334, t333))
+    t478 = 3.141592653589793 + t477
+    t479 = t477 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t478)
+    t480 = -6.283185307179586 + t478 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t477)
+    t481 = -t479
+    t482 = t479 + 6.283185307179586*casadi.floor(0.46111961662014833 + 0.15915494309189535*t481)
+    t483 = -t468
+    t484 = t468 + 6.283185307179586*casadi.floor(0.46111961662014833 + 0.15915494309189535*t483)
+    t485 = -t480
+    t486 = t480 + 6.283185307179586*casadi.floor(0.46111961662014833 + 0.15915494309189535*t485)
+    t487 = casadi.if_else(t272, 0, casadi.atan2(-t245, t240))
+    t488 = t487 + 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t487)
+    t489 = -t488
+    t490 = t488 + 6.283185307179586*casadi.floor(0.0027852115041081685 + 0.15915494309189535*t489)
+    t491 = casadi.if_else(t280, 0, casadi.atan2(t270, t262))
+    t492 = t491 + 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t491)
+    t493 = -t492
+    t494 = t492 + 6.283185307179586*casadi.floor(0.46111961662014833 + 0.15915494309189535*t493)
+    t495 = casadi.if_else(t373, 0, casadi.atan2(-t378, t366))
+    t496 = 3.141592653589793 + t495
+    t497 = t495 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t496)
+    t498 = -6.283185307179586 + t496 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t495)
+    t499 = -t497
+    t500 = t497 + 6.283185307179586*casadi.floor(0.46111961662014833 + 0.15915494309189535*t499)
+    t501 = casadi.if_else(t382, 0, casadi.atan2(-t364, t358))
+    t502 = t501 + 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t501)
+    t503 = t501
+    t504 = t503 - 6.283185307179586*casadi.floor(0.280558333682393 + 0.15915494309189535*t503)
+    t505 = -t502
+    t506 = t502 + 6.283185307179586*casadi.floor(0.280558333682393 + 0.15915494309189535*t505)
+    t507 = casadi.if_else((t391 <= 1e-24*t392), 0, casadi.atan2(t388, t387))
+    t508 = 3.141592653589793 + t507
+    t509 = t507 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t508)
+    t510 = -6.283185307179586 + t508 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t507)
+    t511 = -t509
+    t512 = t509 + 6.283185307179586*casadi.floor(0.46111961662014833 + 0.15915494309189535*t511)
+    t513 = -t498
+    t514 = t498 + 6.283185307179586*casadi.floor(0.46111961662014833 + 0.15915494309189535*t513)
+    t515 = -t510
+    t516 = t510 + 6.283185307179586*casadi.floor(0.46111961662014833 + 0.15915494309189535*t515)
+    t517 = -t420
+    t518 = -t414
+    t519 = -t408
+    t520 = -t402
+    t521 = casadi.if_else(casadi.logic_and((t402 >= 0.0698), casadi.logic_not(casadi.logic_and((t34 >= 0.0698), (t34 <= 3.0718)))), t520, t401)
+    t522 = -t400
+    t523 = casadi.if_else(casadi.logic_and((t400 >= -2.8973), casadi.logic_not(casadi.logic_and((t398 >= -2.8973), (t398 <= 2.8973)))), t522, t399)
+    t524 = -t396
+    t525 = casadi.if_else(casadi.logic_and((t396 >= -3.7525000000000004), casadi.logic_not(casadi.logic_and((t394 >= -3.7525000000000004), (t394 <= 0.0175)))), t524, t395)
+    t526 = -t424
+    t527 = (t412 <= 1.7627999999999997)
+    t528 = casadi.logic_and((t411 >= -1.7627999999999997), (t411 <= 1.7627999999999997))
+    t529 = -t422
+    t530 = -t450
+    t531 = -t444
+    t532 = -t438
+    t533 = -t432
+    t534 = casadi.if_else(casadi.logic_and((t432 >= -2.8973), casadi.logic_not(casadi.logic_and((t430 >= -2.8973), (t430 <= 2.8973)))), t533, t431)
+    t535 = -t428
+    t536 = casadi.if_else(casadi.logic_and((t428 >= -3.7525000000000004), casadi.logic_not(casadi.logic_and((t426 >= -3.7525000000000004), (t426 <= 0.0175)))), t535, t427)
+    t537 = -t454
+    t538 = (t442 <= 1.7627999999999997)
+    t539 = casadi.logic_and((t441 >= -1.7627999999999997), (t441 <= 1.7627999999999997))
+    t540 = -t452
+    t541 = -t482
+    t542 = -t476
+    t543 = -t470
+    t544 = -t464
+    t545 = casadi.if_else(casadi.logic_and((t464 >= 0.0698), casadi.logic_not(casadi.logic_and((t35 >= 0.0698), (t35 <= 3.0718)))), t544, t463)
+    t546 = -t462
+    t547 = casadi.if_else(casadi.logic_and((t462 >= -2.8973), casadi.logic_not(casadi.logic_and((t460 >= -2.8973), (t460 <= 2.8973)))), t546, t461)
+    t548 = -t458
+    t549 = casadi.if_else(casadi.logic_and((t458 >= -3.7525000000000004), casadi.logic_not(casadi.logic_and((t456 >= -3.7525000000000004), (t456 <= 0.0175)))), t548, t457)
+    t550 = -t486
+    t551 = (t474 <= 1.7627999999999997)
+    t552 = casadi.logic_and((t473 >= -1.7627999999999997), (t473 <= 1.7627999999999997))
+    t553 = -t484
+    t554 = -t512
+    t555 = -t506
+    t556 = -t500
+    t557 = -t494
+    t558 = casadi.if_else(casadi.logic_and((t494 >= -2.8973), casadi.logic_not(casadi.logic_and((t492 >= -2.8973), (t492 <= 2.8973)))), t557, t493)
+    t559 = -t490
+    t560 = casadi.if_else(casadi.logic_and((t490 >= -3.7525000000000004), casadi.logic_not(casadi.logic_and((t488 >= -3.7525000000000004), (t488 <= 0.0175)))), t559, t489)
+    t561 = -t516
+    t562 = (t504 <= 1.7627999999999997)
+    t563 = casadi.logic_and((t503 >= -1.7627999999999997), (t503 <= 1.7627999999999997))
+    t564 = -t514
+    t565 = (casadi.fabs(t4) < casadi.inf)
+    t566 = -1e-12
+    t567 = (t61 >= t63)
+    t568 = 1.64539586750625e-26
+    t569 = (0.0164539586750625 > t568)
+    t570 = casadi.logic_or(casadi.logic_and(t569, (t26 >= t566)), casadi.logic_and((0.0164539586750625 <= t568), (t25 <= 1.64539586750625e-14)))
+    t571 = (t61 > t62)
+    t572 = (t26 > 1e-12)
+    t573 = (t230 >= t232)
+    t574 = (t230 > t231)
+    t575 = (q7 >= -2.8973)
+    t576 = (q7 <= 2.8973)
+    t577 = casadi.logic_or((t524 <= 3.7525000000000004), casadi.logic_and((t395 >= -0.0175), (t395 <= 3.7525000000000004)))
+    t578 = casadi.logic_or((t522 <= 2.8973), casadi.logic_and((t399 >= -2.8973), (t399 <= 2.8973)))
+    t579 = casadi.logic_or((t520 <= -0.0698), casadi.logic_and((t401 >= -3.0718), (t401 <= -0.0698)))
+    t580 = casadi.logic_or((t535 <= 3.7525000000000004), casadi.logic_and((t427 >= -0.0175), (t427 <= 3.7525000000000004)))
+    t581 = casadi.logic_or((t533 <= 2.8973), casadi.logic_and((t431 >= -2.8973), (t431 <= 2.8973)))
+    t582 = casadi.logic_or((t548 <= 3.7525000000000004), casadi.logic_and((t457 >= -0.0175), (t457 <= 3.7525000000000004)))
+    t583 = casadi.logic_or((t546 <= 2.8973), casadi.logic_and((t461 >= -2.8973), (t461 <= 2.8973)))
+    t584 = casadi.logic_or((t544 <= -0.0698), casadi.logic_and((t463 >= -3.0718), (t463 <= -0.0698)))
+    t585 = casadi.logic_or((t559 <= 3.7525000000000004), casadi.logic_and((t489 >= -0.0175), (t489 <= 3.7525000000000004)))
+    t586 = casadi.logic_or((t557 <= 2.8973), casadi.logic_and((t493 >= -2.8973), (t493 <= 2.8973)))
+    q = casadi.SX(8, 7)
+    q[0, 0] = casadi.if_else(casadi.logic_and((t420 >= -2.8973), casadi.logic_not(casadi.logic_and((t417 >= -2.8973), (t417 <= 2.8973)))), t517, t419)
+    q[0, 1] = casadi.if_else(casadi.logic_and((t414 >= -1.7627999999999997), casadi.logic_not(casadi.logic_and((t410 >= -1.7627999999999997), (t410 <= 1.7627999999999997)))), t518, t413)
+    q[0, 2] = casadi.if_else(casadi.logic_and((t408 >= -2.8973), casadi.logic_not(casadi.logic_and((t405 >= -2.8973), (t405 <= 2.8973)))), t519, t407)
+    q[0, 3] = t521
+    q[0, 4] = t523
+    q[0, 5] = t525
+    q[0, 6] = q7
+    q[1, 0] = casadi.if_else(casadi.logic_and((t424 >= -2.8973), casadi.logic_not(casadi.logic_and((t418 >= -2.8973), (t418 <= 2.8973)))), t526, t423)
+    q[1, 1] = casadi.if_else(casadi.logic_and(t527, casadi.logic_not(t528)), t412, t411)
+    q[1, 2] = casadi.if_else(casadi.logic_and((t422 >= -2.8973), casadi.logic_not(casadi.logic_and((t406 >= -2.8973), (t406 <= 2.8973)))), t529, t421)
+    q[1, 3] = t521
+    q[1, 4] = t523
+    q[1, 5] = t525
+    q[1, 6] = q7
+    q[2, 0] = casadi.if_else(casadi.logic_and((t450 >= -2.8973), casadi.logic_not(casadi.logic_and((t447 >= -2.8973), (t447 <= 2.8973)))), t530, t449)
+    q[2, 1] = casadi.if_else(casadi.logic_and((t444 >= -1.7627999999999997), casadi.logic_not(casadi.logic_and((t440 >= -1.7627999999999997), (t440 <= 1.7627999999999997)))), t531, t443)
+    q[2, 2] = casadi.if_else(casadi.logic_and((t438 >= -2.8973), casadi.logic_not(casadi.logic_and((t435 >= -2.8973), (t435 <= 2.8973)))), t532, t437)
+    q[2, 3] = t521
+    q[2, 4] = t534
+    q[2, 5] = t536
+    q[2, 6] = q7
+    q[3, 0] = casadi.if_else(casadi.logic_and((t454 >= -2.8973), casadi.logic_not(casadi.logic_and((t448 >= -2.8973), (t448 <= 2.8973)))), t537, t453)
+    q[3, 1] = casadi.if_else(casadi.logic_and(t538, casadi.logic_not(t539)), t442, t441)
+    q[3, 2] = casadi.if_else(casadi.logic_and((t452 >= -2.8973), casadi.logic_not(casadi.logic_and((t436 >= -2.8973), (t436 <= 2.8973)))), t540, t451)
+    q[3, 3] = t521
+    q[3, 4] = t534
+    q[3, 5] = t536
+    q[3, 6] = q7
+    q[4, 0] = casadi.if_else(casadi.logic_and((t482 >= -2.8973), casadi.logic_not(casadi.logic_and((t479 >= -2.8973), (t479 <= 2.8973)))), t541, t481)
+    q[4, 1] = casadi.if_else(casadi.logic_and((t476 >= -1.7627999999999997), casadi.logic_not(casadi.logic_and((t472 >= -1.7627999999999997), (t472 <= 1.7627999999999997)))), t542, t475)
+    q[4, 2] = casadi.if_else(casadi.logic_and((t470 >= -2.8973), casadi.logic_not(casadi.logic_and((t467 >= -2.8973), (t467 <= 2.8973)))), t543, t469)
+    q[4, 3] = t545
+    q[4, 4] = t547
+    q[4, 5] = t549
+    q[4, 6] = q7
+    q[5, 0] = casadi.if_else(casadi.logic_and((t486 >= -2.8973), casadi.logic_not(casadi.logic_and((t480 >= -2.8973), (t480 <= 2.8973)))), t550, t485)
+    q[5, 1] = casadi.if_else(casadi.logic_and(t551, casadi.logic_not(t552)), t474, t473)
+    q[5, 2] = casadi.if_else(casadi.logic_and((t484 >= -2.8973), casadi.logic_not(casadi.logic_and((t468 >= -2.8973), (t468 <= 2.8973)))), t553, t483)
+    q[5, 3] = t545
+    q[5, 4] = t547
+    q[5, 5] = t549
+    q[5, 6] = q7
+    q[6, 0] = casadi.if_else(casadi.logic_and((t512 >= -2.8973), casadi.logic_not(casadi.logic_and((t509 >= -2.8973), (t509 <= 2.8973)))), t554, t511)
+    q[6, 1] = casadi.if_else(casadi.logic_and((t506 >= -1.7627999999999997), casadi.logic_not(casadi.logic_and((t502 >= -1.7627999999999997), (t502 <= 1.7627999999999997)))), t555, t505)
+    q[6, 2] = casadi.if_else(casadi.logic_and((t500 >= -2.8973), casadi.logic_not(casadi.logic_and((t497 >= -2.8973), (t497 <= 2.8973)))), t556, t499)
+    q[6, 3] = t545
+    q[6, 4] = t558
+    q[6, 5] = t560
+    q[6, 6] = q7
+    q[7, 0] = casadi.if_else(casadi.logic_and((t516 >= -2.8973), casadi.logic_not(casadi.logic_and((t510 >= -2.8973), (t510 <= 2.8973)))), t561, t515)
+    q[7, 1] = casadi.if_else(casadi.logic_and(t562, casadi.logic_not(t563)), t504, t503)
+    q[7, 2] = casadi.if_else(casadi.logic_and((t514 >= -2.8973), casadi.logic_not(casadi.logic_and((t498 >= -2.8973), (t498 <= 2.8973)))), t564, t513)
+    q[7, 3] = t545
+    q[7, 4] = t558
+    q[7, 5] = t560
+    q[7, 6] = q7
+    valid = casadi.SX(8, 1)
+    valid[0, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t565, t567), t570), (t141 >= t566))
+    valid[1, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t565, t567), t570), (t141 > 1e-12))
+    valid[2, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t565, t570), t571), (t195 >= t566))
+    valid[3, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t565, t570), t571), (t195 > 1e-12))
+    valid[4, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t565, t569), t572), t573), (t309 >= t566))
+    valid[5, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t565, t569), t572), t573), (t309 > 1e-12))
+    valid[6, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t565, t569), t572), t574), (t363 >= t566))
+    valid[7, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t565, t569), t572), t574), (t363 > 1e-12))
+    in_limits = casadi.SX(8, 1)
+    in_limits[0, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t575, t576), t577), t578), t579), casadi.logic_or((t517 <= 2.8973), casadi.logic_and((t419 >= -2.8973), (t419 <= 2.8973)))), casadi.logic_or((t518 <= 1.7627999999999997), casadi.logic_and((t413 >= -1.7627999999999997), (t413 <= 1.7627999999999997)))), casadi.logic_or((t519 <= 2.8973), casadi.logic_and((t407 >= -2.8973), (t407 <= 2.8973))))
+    in_limits[1, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t575, t576), t577), t578), t579), casadi.logic_or(t527, t528)), casadi.logic_or((t526 <= 2.8973), casadi.logic_and((t423 >= -2.8973), (t423 <= 2.8973)))), casadi.logic_or((t529 <= 2.8973), casadi.logic_and((t421 >= -2.8973), (t421 <= 2.8973))))
+    in_limits[2, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t575, t576), t579), t580), t581), casadi.logic_or((t530 <= 2.8973), casadi.logic_and((t449 >= -2.8973), (t449 <= 2.8973)))), casadi.logic_or((t531 <= 1.7627999999999997), casadi.logic_and((t443 >= -1.7627999999999997), (t443 <= 1.7627999999999997)))), casadi.logic_or((t532 <= 2.8973), casadi.logic_and((t437 >= -2.8973), (t437 <= 2.8973))))
+    in_limits[3, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t575, t576), t579), t580), t581), casadi.logic_or(t538, t539)), casadi.logic_or((t537 <= 2.8973), casadi.logic_and((t453 >= -2.8973), (t453 <= 2.8973)))), casadi.logic_or((t540 <= 2.8973), casadi.logic_and((t451 >= -2.8973), (t451 <= 2.8973))))
+    in_limits[4, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t575, t576), t582), t583), t584), casadi.logic_or((t541 <= 2.8973), casadi.logic_and((t481 >= -2.8973), (t481 <= 2.8973)))), casadi.logic_or((t542 <= 1.7627999999999997), casadi.logic_and((t475 >= -1.7627999999999997), (t475 <= 1.7627999999999997)))), casadi.logic_or((t543 <= 2.8973), casadi.logic_and((t469 >= -2.8973), (t469 <= 2.8973))))
+    in_limits[5, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t575, t576), t582), t583), t584), casadi.logic_or(t551, t552)), casadi.logic_or((t550 <= 2.8973), casadi.logic_and((t485 >= -2.8973), (t485 <= 2.8973)))), casadi.logic_or((t553 <= 2.8973), casadi.logic_and((t483 >= -2.8973), (t483 <= 2.8973))))
+    in_limits[6, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t575, t576), t584), t585), t586), casadi.logic_or((t554 <= 2.8973), casadi.logic_and((t511 >= -2.8973), (t511 <= 2.8973)))), casadi.logic_or((t555 <= 1.7627999999999997), casadi.logic_and((t505 >= -1.7627999999999997), (t505 <= 1.7627999999999997)))), casadi.logic_or((t556 <= 2.8973), casadi.logic_and((t499 >= -2.8973), (t499 <= 2.8973))))
+    in_limits[7, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t575, t576), t584), t585), t586), casadi.logic_or(t562, t563)), casadi.logic_or((t561 <= 2.8973), casadi.logic_and((t515 >= -2.8973), (t515 <= 2.8973)))), casadi.logic_or((t564 <= 2.8973), casadi.logic_and((t513 >= -2.8973), (t513 <= 2.8973))))
+    return [q, valid, in_limits]
+
+
+def _ik_nearest(T, q_seed, q_free, weights):
+    """The closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status: 2461 operations."""
+    T00 = T[0, 0]
+    T01 = T[0, 1]
+    T02 = T[0, 2]
+    T03 = T[0, 3]
+    T10 = T[1, 0]
+    T11 = T[1, 1]
+    T12 = T[1, 2]
+    T13 = T[1, 3]
+    T20 = T[2, 0]
+    T21 = T[2, 1]
+    T22 = T[2, 2]
+    T23 = T[2, 3]
+    qn1 = q_seed[0]
+    qn2 = q_seed[1]
+    qn3 = q_seed[2]
+    qn4 = q_seed[3]
+    qn5 = q_seed[4]
+    qn6 = q_seed[5]
+    qn7 = q_seed[6]
+    qw1 = weights[0]
+    qw2 = weights[1]
+    qw3 = weights[2]
+    qw4 = weights[3]
+    qw5 = weights[4]
+    qw6 = weights[5]
+    qw7 = weights[6]
+    q7 = q_free
+    c7 = casadi.cos(q7)
+    s7 = casadi.sin(q7)
+    t0 = 0.823 + T02*T03 + T12*T13 + T22*T23
+    t1 = t0 - 0.333*T22
+    t2 = -1.033 + t1
+    t3 = -2.6745902299367814
+    t4 = 0.7071067811865476*c7
+    t5 = 0.7071067811865476*s7
+    t6 = t4 + t5
+    t7 = t4 - t5
+    t8 = T00*t6 + T01*t7
+    t9 = T10*t6 + T11*t7
+    t10 = T20*t6 + T21*t7
+    t11 = 0.088 - T03*t8 - T13*t9 - T23*t10
+    t12 = t11 + 0.333*t10
+    t13 = -t6
+    t14 = T00*t7 + T01*t13
+    t15 = T10*t7 + T11*t13
+    t16 = T20*t7 + T21*t13
+    t17 = T03*t14 + T13*t15 + T23*t16
+    t18 = -t17 + 0.333*t16
+    t19 = t18**2
+    t20 = t19 + t12**2 + t2**2
+    t21 = 0.13046225 - 0.5*t20
+    t22 = False
+    t23 = casadi.if_else(t22, 1, 7.795873777901566)
+    t24 = t21**2
+    t25 = 1 - t24*t23**2
+    t26 = t21*t23
+    t27 = (1e-12 < t25)
+    t28 = casadi.if_else(t27, t26, casadi.if_else((t26 > 0), 1, -1))
+    t29 = casadi.if_else(t27, casadi.sqrt(t25), 0)
+    t30 = casadi.atan2(t29, t28)
+    t31 = casadi.if_else(t22, 0, t3 + t30)
+    t32 = t3 - t30
+    t33 = t31 + 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t31)
+    t34 = t32 + 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t32)
+    t35 = t23*t28
+    t36 = 0.11453775*t35
+    t37 = t23*t29
+    t38 = 0.05775*t37
+    t39 = casadi.if_else(t22, 1, t38 - t36)
+    t40 = t36 + t38
+    t41 = 0.05775*t35
+    t42 = 0.11453775*t37
+    t43 = casadi.if_else(t22, 0, -t41 - t42)
+    t44 = t42 - t41
+    t45 = 0.316*t43 - 0.0825*t39
+    t46 = 0.316*t39 + 0.0825*t43
+    t47 = 0.0825 + t45
+    t48 = 0.649 - t46
+    t49 = -1.033 + t48
+    t50 = 0.316*t44 + 0.0825*t40
+    t51 = 0.316*t40 - 0.0825*t44
+    t52 = 0.0825 + t50
+    t53 = 0.649 + t51
+    t54 = -1.033 + t53
+    t55 = t47**2
+    t56 = t49**2
+    t57 = t55 + t56
+    t58 = t19 + t56
+    t59 = t58 - t57
+    t60 = 1e-12*t57
+    t61 = (t59 < -t60)
+    t62 = casadi.if_else(t61, casadi.sqrt(-t59), 0)
+    t63 = t58 + t62**2
+    t64 = t12*t62
+    t65 = t19 + t2*t49
     t66 = t65 - t64
     t67 = t64 + t65
-    t68 = -t20
+    t68 = -t19
     t69 = t66 + t68
     t70 = t67 + t68
-    t71 = t13*t48
+    t71 = t12*t49
     t72 = t2*t62
     t73 = t71 + t72
     t74 = t69**2 + t73**2
     t75 = t71 - t72
     t76 = t70**2 + t75**2
     t77 = 1e-24*t63
-    t78 = t21*t77
+    t78 = t20*t77
     t79 = (t74 <= t78)
     t80 = casadi.if_else(t79, 1, 1/casadi.sqrt(t74))
     t81 = casadi.if_else(t79, 1, t69*t80)
     t82 = casadi.if_else(t79, 0, -t73*t80)
-    t83 = t11*t81 - T22*t82
-    t84 = T22*t81 + t11*t82
-    t85 = t81*t9 - T02*t82
-    t86 = T02*t81 + t82*t9
-    t87 = t46*t62
-    t88 = t55 - t87
-    t89 = t55 + t87
-    t90 = -t55
+    t83 = t10*t81 - T22*t82
+    t84 = T22*t81 + t10*t82
+    t85 = t8*t81 - T02*t82
+    t86 = T02*t81 + t8*t82
+    t87 = t47*t62
+    t88 = t56 - t87
+    t89 = t56 + t87
+    t90 = -t56
     t91 = t88 + t90
     t92 = t89 + t90
-    t93 = t20*t54
+    t93 = t19*t55
     t94 = t93 + t91**2
     t95 = t93 + t92**2
-    t96 = t56*t77
+    t96 = t57*t77
     t97 = (t94 <= t96)
     t98 = casadi.if_else(t97, 1, 1/casadi.sqrt(t94))
     t99 = casadi.if_else(t97, 1, t91*t98)
-    t100 = t19*t46
+    t100 = t18*t47
     t101 = casadi.if_else(t97, 0, t100*t98)
     t102 = (t76 <= t78)
     t103 = casadi.if_else(t102, 1, 1/casadi.sqrt(t76))
     t104 = casadi.if_else(t102, 1, t103*t70)
     t105 = casadi.if_else(t102, 0, -t103*t75)
-    t106 = t104*t11 - T22*t105
-    t107 = T22*t104 + t105*t11
-    t108 = t104*t9 - T02*t105
-    t109 = T02*t104 + t105*t9
+    t106 = t10*t104 - T22*t105
+    t107 = T22*t104 + t10*t105
+    t108 = t104*t8 - T02*t105
+    t109 = T02*t104 + t105*t8
     t110 = (t95 <= t96)
     t111 = casadi.if_else(t110, 1, 1/casadi.sqrt(t95))
     t112 = casadi.if_else(t110, 1, t111*t92)
     t113 = casadi.if_else(t110, 0, t100*t111)
     t114 = 1 - t81
-    t115 = t114*t17
-    t116 = t115 + t17*t81
-    t117 = t114*t15
-    t118 = t117 + t15*t81
+    t115 = t114*t16
+    t116 = t115 + t16*t81
+    t117 = t114*t14
+    t118 = t117 + t14*t81
     t119 = t101*t116 + t83*t99
     t120 = t116*t99 - t101*t83
     t121 = t101*t118 + t85*t99
@@ -3002,384 +3699,858 @@ def _ik_branches(T, q_free):
     t125 = t124 + t84*t99
     t126 = t123*t86
     t127 = t126 + t86*t99
-    t128 = t119*t38 - t125*t42
-    t129 = t119*t42 + t125*t38
-    t130 = t121*t38 - t127*t42
-    t131 = t121*t42 + t127*t38
-    t132 = 1 - t38
+    t128 = t119*t39 - t125*t43
+    t129 = t119*t43 + t125*t39
+    t130 = t121*t39 - t127*t43
+    t131 = t121*t43 + t127*t39
+    t132 = 1 - t39
     t133 = t120*t132
-    t134 = t133 + t120*t38
+    t134 = t133 + t120*t39
     t135 = t122*t132
-    t136 = t135 + t122*t38
+    t136 = t135 + t122*t39
     t137 = t129**2
     t138 = -t137
     t139 = 1 + t138
-    t140 = casadi.if_else((t139 > 1e-12), casadi.sqrt(t139), 0)
-    t141 = t137 - t128*t140
-    t142 = t138 + t141
-    t143 = t134**2
-    t144 = t137 + t143 + t128**2
-    t145 = t140**2
-    t146 = t142**2 + t143*t145
-    t147 = t137 + t145
-    t148 = 1e-24*t147
-    t149 = (t146 <= t144*t148)
-    t150 = casadi.if_else(t149, 1, 1/casadi.sqrt(t146))
-    t151 = casadi.if_else(t149, 1, t142*t150)
-    t152 = t131*(1 - t151)
-    t153 = t152 + t131*t151
-    t154 = t134*t140
-    t155 = casadi.if_else(t149, 0, -t150*t154)
-    t156 = t130*t151 + t136*t155
-    t157 = t136*t151 - t130*t155
-    t158 = (t147 <= t148)
-    t159 = casadi.if_else(t158, 1, 1/casadi.sqrt(t147))
-    t160 = casadi.if_else(t158, 1, -t129*t159)
-    t161 = casadi.if_else(t158, 0, -t140*t159)
-    t162 = t157*(1 - t160)
-    t163 = t153*t161 + t156*t160
-    t164 = t162 + t157*t160
-    t165 = t156*t161 - t153*t160
-    t166 = t163**2 + t164**2
-    t167 = t166
-    t168 = t166 + t165**2
-    t169 = 1 - t104
-    t170 = t169*t17
-    t171 = t170 + t104*t17
-    t172 = t15*t169
-    t173 = t172 + t104*t15
-    t174 = t106*t112 + t113*t171
-    t175 = t112*t171 - t106*t113
-    t176 = t108*t112 + t113*t173
-    t177 = t112*t173 - t108*t113
-    t178 = t132*t175
-    t179 = t178 + t175*t38
-    t180 = t132*t177
-    t181 = t180 + t177*t38
-    t182 = 1 - t112
-    t183 = t107*t182
-    t184 = t183 + t107*t112
-    t185 = t109*t182
-    t186 = t185 + t109*t112
-    t187 = t174*t38 - t184*t42
-    t188 = t174*t42 + t184*t38
-    t189 = t176*t38 - t186*t42
-    t190 = t176*t42 + t186*t38
-    t191 = t188**2
-    t192 = -t191
-    t193 = 1 + t192
-    t194 = casadi.if_else((t193 > 1e-12), casadi.sqrt(t193), 0)
-    t195 = t191 - t187*t194
-    t196 = t192 + t195
-    t197 = t179**2
-    t198 = t191 + t197 + t187**2
-    t199 = t194**2
-    t200 = t196**2 + t197*t199
-    t201 = t191 + t199
-    t202 = 1e-24*t201
-    t203 = (t200 <= t198*t202)
-    t204 = casadi.if_else(t203, 1, 1/casadi.sqrt(t200))
-    t205 = casadi.if_else(t203, 1, t196*t204)
-    t206 = t190*(1 - t205)
-    t207 = t206 + t190*t205
-    t208 = t179*t194
-    t209 = casadi.if_else(t203, 0, -t204*t208)
-    t210 = t181*t209 + t189*t205
-    t211 = t181*t205 - t189*t209
-    t212 = (t201 <= t202)
-    t213 = casadi.if_else(t212, 1, 1/casadi.sqrt(t201))
-    t214 = casadi.if_else(t212, 1, -t188*t213)
-    t215 = casadi.if_else(t212, 0, -t194*t213)
-    t216 = t211*(1 - t214)
-    t217 = t207*t215 + t210*t214
-    t218 = t216 + t211*t214
-    t219 = t210*t215 - t207*t214
-    t220 = t217**2 + t218**2
-    t221 = t220
-    t222 = t220 + t219**2
-    t223 = t51**2
-    t224 = t53**2
-    t225 = t223 + t224
-    t226 = t20 + t224
-    t227 = t226 - t225
-    t228 = -t227
-    t229 = 1e-12*t225
-    t230 = -t229
-    t231 = casadi.if_else((t227 < t230), casadi.sqrt(t228), 0)
-    t232 = t226 + t231**2
-    t233 = t13*t231
-    t234 = t20 + t2*t53
-    t235 = t234 - t233
-    t236 = t235 + t68
-    t237 = t233 + t234
-    t238 = t237 + t68
-    t239 = t13*t53
-    t240 = t2*t231
-    t241 = t239 + t240
-    t242 = t236**2 + t241**2
-    t243 = t239 - t240
-    t244 = t238**2 + t243**2
-    t245 = 1e-24*t232
-    t246 = t21*t245
-    t247 = (t242 <= t246)
-    t248 = casadi.if_else(t247, 1, 1/casadi.sqrt(t242))
-    t249 = casadi.if_else(t247, 1, t236*t248)
-    t250 = casadi.if_else(t247, 0, -t241*t248)
-    t251 = t11*t249 - T22*t250
-    t252 = T22*t249 + t11*t250
-    t253 = t249*t9 - T02*t250
-    t254 = T02*t249 + t250*t9
-    t255 = t231*t51
-    t256 = t224 - t255
-    t257 = t224 + t255
-    t258 = -t224
-    t259 = t256 + t258
-    t260 = t257 + t258
-    t261 = t20*t223
-    t262 = t261 + t259**2
-    t263 = t261 + t260**2
-    t264 = t225*t245
-    t265 = (t262 <= t264)
-    t266 = casadi.if_else(t265, 1, 1/casadi.sqrt(t262))
-    t267 = casadi.if_else(t265, 1, t259*t266)
-    t268 = t19*t51
-    t269 = casadi.if_else(t265, 0, t266*t268)
-    t270 = (t244 <= t246)
-    t271 = casadi.if_else(t270, 1, 1/casadi.sqrt(t244))
-    t272 = casadi.if_else(t270, 1, t238*t271)
-    t273 = casadi.if_else(t270, 0, -t243*t271)
-    t274 = t11*t272 - T22*t273
-    t275 = T22*t272 + t11*t273
-    t276 = t272*t9 - T02*t273
-    t277 = T02*t272 + t273*t9
-    t278 = (t263 <= t264)
-    t279 = casadi.if_else(t278, 1, 1/casadi.sqrt(t263))
-    t280 = casadi.if_else(t278, 1, t260*t279)
-    t281 = casadi.if_else(t278, 0, t268*t279)
-    t282 = 1 - t249
-    t283 = t17*t282
-    t284 = t283 + t17*t249
-    t285 = t15*t282
-    t286 = t285 + t15*t249
-    t287 = t251*t267 + t269*t284
-    t288 = t267*t284 - t251*t269
-    t289 = t253*t267 + t269*t286
-    t290 = t267*t286 - t253*t269
-    t291 = 1 - t267
-    t292 = t252*t291
-    t293 = t292 + t252*t267
-    t294 = t254*t291
-    t295 = t294 + t254*t267
-    t296 = t287*t39 + t293*t43
-    t297 = t293*t39 - t287*t43
-    t298 = t289*t39 + t295*t43
-    t299 = t295*t39 - t289*t43
-    t300 = 1 + t39
-    t301 = t288*t300
-    t302 = t301 - t288*t39
-    t303 = t290*t300
-    t304 = t303 - t290*t39
-    t305 = t297**2
-    t306 = -t305
-    t307 = 1 + t306
-    t308 = casadi.if_else((t307 > 1e-12), casadi.sqrt(t307), 0)
-    t309 = t305 + t296*t308
-    t310 = t306 + t309
-    t311 = t302**2
-    t312 = t305 + t311 + t296**2
-    t313 = t308**2
-    t314 = t310**2 + t311*t313
-    t315 = t305 + t313
-    t316 = 1e-24*t315
-    t317 = (t314 <= t312*t316)
-    t318 = casadi.if_else(t317, 1, 1/casadi.sqrt(t314))
-    t319 = casadi.if_else(t317, 1, t310*t318)
-    t320 = t299*(1 - t319)
-    t321 = t320 + t299*t319
-    t322 = t302*t308
-    t323 = casadi.if_else(t317, 0, -t318*t322)
-    t324 = t304*t323 - t298*t319
-    t325 = t298*t323 + t304*t319
-    t326 = (t315 <= t316)
-    t327 = casadi.if_else(t326, 1, 1/casadi.sqrt(t315))
-    t328 = casadi.if_else(t326, 1, t297*t327)
-    t329 = casadi.if_else(t326, 0, -t308*t327)
-    t330 = t325*(1 - t328)
-    t331 = t324*t328 - t321*t329
-    t332 = t330 + t325*t328
-    t333 = t321*t328 + t324*t329
-    t334 = t331**2 + t332**2
-    t335 = t334
-    t336 = t334 + t333**2
-    t337 = 1 - t272
-    t338 = t17*t337
-    t339 = t338 + t17*t272
-    t340 = t15*t337
-    t341 = t340 + t15*t272
-    t342 = t274*t280 + t281*t339
-    t343 = t280*t339 - t274*t281
-    t344 = t276*t280 + t281*t341
-    t345 = t280*t341 - t276*t281
-    t346 = t300*t343
-    t347 = t346 - t343*t39
-    t348 = t300*t345
-    t349 = t348 - t345*t39
-    t350 = 1 - t280
-    t351 = t275*t350
-    t352 = t351 + t275*t280
-    t353 = t277*t350
-    t354 = t353 + t277*t280
-    t355 = t342*t39 + t352*t43
-    t356 = t352*t39 - t342*t43
-    t357 = t344*t39 + t354*t43
-    t358 = t354*t39 - t344*t43
-    t359 = t356**2
-    t360 = -t359
-    t361 = 1 + t360
-    t362 = casadi.if_else((t361 > 1e-12), casadi.sqrt(t361), 0)
-    t363 = t359 + t355*t362
-    t364 = t360 + t363
-    t365 = t347**2
-    t366 = t359 + t365 + t355**2
-    t367 = t362**2
-    t368 = t364**2 + t365*t367
-    t369 = t359 + t367
-    t370 = 1e-24*t369
-    t371 = (t368 <= t366*t370)
-    t372 = casadi.if_else(t371, 1, 1/casadi.sqrt(t368))
-    t373 = casadi.if_else(t371, 1, t364*t372)
-    t374 = t358*(1 - t373)
-    t375 = t374 + t358*t373
-    t376 = t347*t362
-    t377 = casadi.if_else(t371, 0, -t372*t376)
-    t378 = t349*t377 - t357*t373
-    t379 = t349*t373 + t357*t377
-    t380 = (t369 <= t370)
-    t381 = casadi.if_else(t380, 1, 1/casadi.sqrt(t369))
-    t382 = casadi.if_else(t380, 1, t356*t381)
-    t383 = casadi.if_else(t380, 0, -t362*t381)
-    t384 = t379*(1 - t382)
-    t385 = t378*t382 - t375*t383
-    t386 = t384 + t379*t382
-    t387 = t375*t382 + t378*t383
-    t388 = t385**2 + t386**2
-    t389 = t388
-    t390 = t388 + t387**2
-    t391 = casadi.if_else((t167 <= 1e-24*t168), 0, casadi.atan2(t164, t163))
-    t392 = 3.141592653589793 + t391
-    t393 = casadi.if_else(t158, 0, casadi.atan2(-t140, -t129))
-    t394 = casadi.if_else(t149, 0, casadi.atan2(-t154, t142))
-    t395 = 3.141592653589793 + t394
-    t396 = -t32 - 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t32)
-    t397 = casadi.if_else(t97, 0, casadi.atan2(t100, t91))
-    t398 = -t397 - 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t397)
-    t399 = casadi.if_else(t79, 0, casadi.atan2(-t73, t69))
-    t400 = -t399 - 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t399)
-    t401 = casadi.if_else((t221 <= 1e-24*t222), 0, casadi.atan2(t218, t217))
-    t402 = 3.141592653589793 + t401
-    t403 = casadi.if_else(t212, 0, casadi.atan2(-t194, -t188))
-    t404 = casadi.if_else(t203, 0, casadi.atan2(-t208, t196))
-    t405 = 3.141592653589793 + t404
-    t406 = casadi.if_else(t110, 0, casadi.atan2(t100, t92))
-    t407 = -t406 - 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t406)
-    t408 = casadi.if_else(t102, 0, casadi.atan2(-t75, t70))
-    t409 = -t408 - 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t408)
-    t410 = casadi.if_else((t335 <= 1e-24*t336), 0, casadi.atan2(t332, t331))
-    t411 = 3.141592653589793 + t410
-    t412 = casadi.if_else(t326, 0, casadi.atan2(-t308, t297))
-    t413 = casadi.if_else(t317, 0, casadi.atan2(-t322, t310))
-    t414 = 3.141592653589793 + t413
-    t415 = -t33 - 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t33)
-    t416 = casadi.if_else(t265, 0, casadi.atan2(t268, t259))
-    t417 = -t416 - 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t416)
-    t418 = casadi.if_else(t247, 0, casadi.atan2(-t241, t236))
-    t419 = -t418 - 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t418)
-    t420 = casadi.if_else((t389 <= 1e-24*t390), 0, casadi.atan2(t386, t385))
-    t421 = 3.141592653589793 + t420
-    t422 = casadi.if_else(t380, 0, casadi.atan2(-t362, t356))
-    t423 = casadi.if_else(t371, 0, casadi.atan2(-t376, t364))
-    t424 = 3.141592653589793 + t423
-    t425 = casadi.if_else(t278, 0, casadi.atan2(t268, t260))
-    t426 = -t425 - 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t425)
-    t427 = casadi.if_else(t270, 0, casadi.atan2(-t243, t238))
-    t428 = -t427 - 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t427)
-    t429 = (casadi.fabs(t4) < casadi.inf)
-    t430 = -1e-12
-    t431 = (t59 >= t61)
-    t432 = 1.64539586750625e-26
-    t433 = (0.0164539586750625 > t432)
-    t434 = casadi.logic_or(casadi.logic_and(t433, (t26 >= t430)), casadi.logic_and((0.0164539586750625 <= t432), (t25 <= 1.64539586750625e-14)))
-    t435 = (t59 > t60)
-    t436 = (t26 > 1e-12)
-    t437 = (t228 >= t230)
-    t438 = (t228 > t229)
-    q = casadi.SX(8, 7)
-    q[0, 0] = -t391 - 6.283185307179586*casadi.ceil(-0.15915494309189535*t392)
-    q[0, 1] = -t393 - 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t393)
-    q[0, 2] = -t394 - 6.283185307179586*casadi.ceil(-0.15915494309189535*t395)
-    q[0, 3] = t396
-    q[0, 4] = t398
-    q[0, 5] = t400
-    q[0, 6] = q7
-    q[1, 0] = 6.283185307179586 - t392 - 6.283185307179586*casadi.ceil(-0.15915494309189535*t391)
-    q[1, 1] = t393
-    q[1, 2] = 6.283185307179586 - t395 - 6.283185307179586*casadi.ceil(-0.15915494309189535*t394)
-    q[1, 3] = t396
-    q[1, 4] = t398
-    q[1, 5] = t400
-    q[1, 6] = q7
-    q[2, 0] = -t401 - 6.283185307179586*casadi.ceil(-0.15915494309189535*t402)
-    q[2, 1] = -t403 - 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t403)
-    q[2, 2] = -t404 - 6.283185307179586*casadi.ceil(-0.15915494309189535*t405)
-    q[2, 3] = t396
-    q[2, 4] = t407
-    q[2, 5] = t409
-    q[2, 6] = q7
-    q[3, 0] = 6.283185307179586 - t402 - 6.283185307179586*casadi.ceil(-0.15915494309189535*t401)
-    q[3, 1] = t403
-    q[3, 2] = 6.283185307179586 - t405 - 6.283185307179586*casadi.ceil(-0.15915494309189535*t404)
-    q[3, 3] = t396
-    q[3, 4] = t407
-    q[3, 5] = t409
-    q[3, 6] = q7
-    q[4, 0] = -t410 - 6.283185307179586*casadi.ceil(-0.15915494309189535*t411)
-    q[4, 1] = -t412 - 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t412)
-    q[4, 2] = -t413 - 6.283185307179586*casadi.ceil(-0.15915494309189535*t414)
-    q[4, 3] = t415
-    q[4, 4] = t417
-    q[4, 5] = t419
-    q[4, 6] = q7
-    q[5, 0] = 6.283185307179586 - t411 - 6.283185307179586*casadi.ceil(-0.15915494309189535*t410)
-    q[5, 1] = t412
-    q[5, 2] = 6.283185307179586 - t414 - 6.283185307179586*casadi.ceil(-0.15915494309189535*t413)
-    q[5, 3] = t415
-    q[5, 4] = t417
-    q[5, 5] = t419
-    q[5, 6] = q7
-    q[6, 0] = -t420 - 6.283185307179586*casadi.ceil(-0.15915494309189535*t421)
-    q[6, 1] = -t422 - 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t422)
-    q[6, 2] = -t423 - 6.283185307179586*casadi.ceil(-0.15915494309189535*t424)
-    q[6, 3] = t415
-    q[6, 4] = t426
-    q[6, 5] = t428
-    q[6, 6] = q7
-    q[7, 0] = 6.283185307179586 - t421 - 6.283185307179586*casadi.ceil(-0.15915494309189535*t420)
-    q[7, 1] = t422
-    q[7, 2] = 6.283185307179586 - t424 - 6.283185307179586*casadi.ceil(-0.15915494309189535*t423)
-    q[7, 3] = t415
-    q[7, 4] = t426
-    q[7, 5] = t428
-    q[7, 6] = q7
-    valid = casadi.SX(8, 1)
-    valid[0, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t429, t431), t434), (t139 >= t430))
-    valid[1, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t429, t431), t434), (t139 > 1e-12))
-    valid[2, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t429, t434), t435), (t193 >= t430))
-    valid[3, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t429, t434), t435), (t193 > 1e-12))
-    valid[4, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t429, t433), t436), t437), (t307 >= t430))
-    valid[5, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t429, t433), t436), t437), (t307 > 1e-12))
-    valid[6, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t429, t433), t436), t438), (t361 >= t430))
-    valid[7, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t429, t433), t436), t438), (t361 > 1e-12))
-    return [q, valid]
+    t140 = (1e-12 < t139)
+    t141 = casadi.if_else(t140, casadi.sqrt(t139), 0)
+    t142 = t137 - t128*t141
+    t143 = t138 + t142
+    t144 = t134**2
+    t145 = t137 + t144 + t128**2
+    t146 = t141**2
+    t147 = t143**2 + t144*t146
+    t148 = t137 + t146
+    t149 = 1e-24*t148
+    t150 = (t147 <= t145*t149)
+    t151 = casadi.if_else(t150, 1, 1/casadi.sqrt(t147))
+    t152 = casadi.if_else(t150, 1, t143*t151)
+    t153 = t131*(1 - t152)
+    t154 = t153 + t131*t152
+    t155 = t134*t141
+    t156 = casadi.if_else(t150, 0, -t151*t155)
+    t157 = t130*t152 + t136*t156
+    t158 = t136*t152 - t130*t156
+    t159 = (t148 <= t149)
+    t160 = casadi.if_else(t159, 1, 1/casadi.sqrt(t148))
+    t161 = casadi.if_else(t159, 1, -t129*t160)
+    t162 = casadi.if_else(t159, 0, -t141*t160)
+    t163 = t158*(1 - t161)
+    t164 = t154*t162 + t157*t161
+    t165 = t163 + t158*t161
+    t166 = t157*t162 - t154*t161
+    t167 = t164**2 + t165**2
+    t168 = t167
+    t169 = t167 + t166**2
+    t170 = 1 - t104
+    t171 = t16*t170
+    t172 = t171 + t104*t16
+    t173 = t14*t170
+    t174 = t173 + t104*t14
+    t175 = t106*t112 + t113*t172
+    t176 = t112*t172 - t106*t113
+    t177 = t108*t112 + t113*t174
+    t178 = t112*t174 - t108*t113
+    t179 = t132*t176
+    t180 = t179 + t176*t39
+    t181 = t132*t178
+    t182 = t181 + t178*t39
+    t183 = 1 - t112
+    t184 = t107*t183
+    t185 = t184 + t107*t112
+    t186 = t109*t183
+    t187 = t186 + t109*t112
+    t188 = t175*t39 - t185*t43
+    t189 = t175*t43 + t185*t39
+    t190 = t177*t39 - t187*t43
+    t191 = t177*t43 + t187*t39
+    t192 = t189**2
+    t193 = -t192
+    t194 = 1 + t193
+    t195 = (1e-12 < t194)
+    t196 = casadi.if_else(t195, casadi.sqrt(t194), 0)
+    t197 = t192 - t188*t196
+    t198 = t193 + t197
+    t199 = t180**2
+    t200 = t192 + t199 + t188**2
+    t201 = t196**2
+    t202 = t198**2 + t199*t201
+    t203 = t192 + t201
+    t204 = 1e-24*t203
+    t205 = (t202 <= t200*t204)
+    t206 = casadi.if_else(t205, 1, 1/casadi.sqrt(t202))
+    t207 = casadi.if_else(t205, 1, t198*t206)
+    t208 = t191*(1 - t207)
+    t209 = t208 + t191*t207
+    t210 = t180*t196
+    t211 = casadi.if_else(t205, 0, -t206*t210)
+    t212 = t182*t211 + t190*t207
+    t213 = t182*t207 - t190*t211
+    t214 = (t203 <= t204)
+    t215 = casadi.if_else(t214, 1, 1/casadi.sqrt(t203))
+    t216 = casadi.if_else(t214, 1, -t189*t215)
+    t217 = casadi.if_else(t214, 0, -t196*t215)
+    t218 = t213*(1 - t216)
+    t219 = t209*t217 + t212*t216
+    t220 = t218 + t213*t216
+    t221 = t212*t217 - t209*t216
+    t222 = t219**2 + t220**2
+    t223 = t222
+    t224 = t222 + t221**2
+    t225 = t52**2
+    t226 = t54**2
+    t227 = t225 + t226
+    t228 = t19 + t226
+    t229 = t228 - t227
+    t230 = 1e-12*t227
+    t231 = (t229 < -t230)
+    t232 = casadi.if_else(t231, casadi.sqrt(-t229), 0)
+    t233 = t228 + t232**2
+    t234 = t12*t232
+    t235 = t19 + t2*t54
+    t236 = t235 - t234
+    t237 = t236 + t68
+    t238 = t234 + t235
+    t239 = t238 + t68
+    t240 = t12*t54
+    t241 = t2*t232
+    t242 = t240 + t241
+    t243 = t237**2 + t242**2
+    t244 = t240 - t241
+    t245 = t239**2 + t244**2
+    t246 = 1e-24*t233
+    t247 = t20*t246
+    t248 = (t243 <= t247)
+    t249 = casadi.if_else(t248, 1, 1/casadi.sqrt(t243))
+    t250 = casadi.if_else(t248, 1, t237*t249)
+    t251 = casadi.if_else(t248, 0, -t242*t249)
+    t252 = t10*t250 - T22*t251
+    t253 = T22*t250 + t10*t251
+    t254 = t250*t8 - T02*t251
+    t255 = T02*t250 + t251*t8
+    t256 = t232*t52
+    t257 = t226 - t256
+    t258 = t226 + t256
+    t259 = -t226
+    t260 = t257 + t259
+    t261 = t258 + t259
+    t262 = t19*t225
+    t263 = t262 + t260**2
+    t264 = t262 + t261**2
+    t265 = t227*t246
+    t266 = (t263 <= t265)
+    t267 = casadi.if_else(t266, 1, 1/casadi.sqrt(t263))
+    t268 = casadi.if_else(t266, 1, t260*t267)
+    t269 = t18*t52
+    t270 = casadi.if_else(t266, 0, t267*t269)
+    t271 = (t245 <= t247)
+    t272 = casadi.if_else(t271, 1, 1/casadi.sqrt(t245))
+    t273 = casadi.if_else(t271, 1, t239*t272)
+    t274 = casadi.if_else(t271, 0, -t244*t272)
+    t275 = t10*t273 - T22*t274
+    t276 = T22*t273 + t10*t274
+    t277 = t273*t8 - T02*t274
+    t278 = T02*t273 + t274*t8
+    t279 = (t264 <= t265)
+    t280 = casadi.if_else(t279, 1, 1/casadi.sqrt(t264))
+    t281 = casadi.if_else(t279, 1, t261*t280)
+    t282 = casadi.if_else(t279, 0, t269*t280)
+    t283 = 1 - t250
+    t284 = t16*t283
+    t285 = t284 + t16*t250
+    t286 = t14*t283
+    t287 = t286 + t14*t250
+    t288 = t252*t268 + t270*t285
+    t289 = t268*t285 - t252*t270
+    t290 = t254*t268 + t270*t287
+    t291 = t268*t287 - t254*t270
+    t292 = 1 - t268
+    t293 = t253*t292
+    t294 = t293 + t253*t268
+    t295 = t255*t292
+    t296 = t295 + t255*t268
+    t297 = t288*t40 + t294*t44
+    t298 = t294*t40 - t288*t44
+    t299 = t290*t40 + t296*t44
+    t300 = t296*t40 - t290*t44
+    t301 = 1 + t40
+    t302 = t289*t301
+    t303 = t302 - t289*t40
+    t304 = t291*t301
+    t305 = t304 - t291*t40
+    t306 = t298**2
+    t307 = -t306
+    t308 = 1 + t307
+    t309 = (1e-12 < t308)
+    t310 = casadi.if_else(t309, casadi.sqrt(t308), 0)
+    t311 = t306 + t297*t310
+    t312 = t307 + t311
+    t313 = t303**2
+    t314 = t306 + t313 + t297**2
+    t315 = t310**2
+    t316 = t312**2 + t313*t315
+    t317 = t306 + t315
+    t318 = 1e-24*t317
+    t319 = (t316 <= t314*t318)
+    t320 = casadi.if_else(t319, 1, 1/casadi.sqrt(t316))
+    t321 = casadi.if_else(t319, 1, t312*t320)
+    t322 = t300*(1 - t321)
+    t323 = t322 + t300*t321
+    t324 = t303*t310
+    t325 = casadi.if_else(t319, 0, -t320*t324)
+    t326 = t305*t325 - t299*t321
+    t327 = t299*t325 + t305*t321
+    t328 = (t317 <= t318)
+    t329 = casadi.if_else(t328, 1, 1/casadi.sqrt(t317))
+    t330 = casadi.if_else(t328, 1, t298*t329)
+    t331 = casadi.if_else(t328, 0, -t310*t329)
+    t332 = t327*(1 - t330)
+    t333 = t326*t330 - t323*t331
+    t334 = t332 + t327*t330
+    t335 = t323*t330 + t326*t331
+    t336 = t333**2 + t334**2
+    t337 = t336
+    t338 = t336 + t335**2
+    t339 = 1 - t273
+    t340 = t16*t339
+    t341 = t340 + t16*t273
+    t342 = t14*t339
+    t343 = t342 + t14*t273
+    t344 = t275*t281 + t282*t341
+    t345 = t281*t341 - t275*t282
+    t346 = t277*t281 + t282*t343
+    t347 = t281*t343 - t277*t282
+    t348 = t301*t345
+    t349 = t348 - t345*t40
+    t350 = t301*t347
+    t351 = t350 - t347*t40
+    t352 = 1 - t281
+    t353 = t276*t352
+    t354 = t353 + t276*t281
+    t355 = t278*t352
+    t356 = t355 + t278*t281
+    t357 = t344*t40 + t354*t44
+    t358 = t354*t40 - t344*t44
+    t359 = t346*t40 + t356*t44
+    t360 = t356*t40 - t346*t44
+    t361 = t358**2
+    t362 = -t361
+    t363 = 1 + t362
+    t364 = (1e-12 < t363)
+    t365 = casadi.if_else(t364, casadi.sqrt(t363), 0)
+    t366 = t361 + t357*t365
+    t367 = t362 + t366
+    t368 = t349**2
+    t369 = t361 + t368 + t357**2
+    t370 = t365**2
+    t371 = t367**2 + t368*t370
+    t372 = t361 + t370
+    t373 = 1e-24*t372
+    t374 = (t371 <= t369*t373)
+    t375 = casadi.if_else(t374, 1, 1/casadi.sqrt(t371))
+    t376 = casadi.if_else(t374, 1, t367*t375)
+    t377 = t360*(1 - t376)
+    t378 = t377 + t360*t376
+    t379 = t349*t365
+    t380 = casadi.if_else(t374, 0, -t375*t379)
+    t381 = t351*t380 - t359*t376
+    t382 = t351*t376 + t359*t380
+    t383 = (t372 <= t373)
+    t384 = casadi.if_else(t383, 1, 1/casadi.sqrt(t372))
+    t385 = casadi.if_else(t383, 1, t358*t384)
+    t386 = casadi.if_else(t383, 0, -t365*t384)
+    t387 = t382*(1 - t385)
+    t388 = t381*t385 - t378*t386
+    t389 = t387 + t382*t385
+    t390 = t378*t385 + t381*t386
+    t391 = t388**2 + t389**2
+    t392 = t391
+    t393 = t391 + t390**2
+    t394 = T00 + T01 + T02 + T03 + T10 + T11 + T12 + T13 + T20 + T21 + T22 + T23
+    t395 = t394
+    t396 = qn1 + qn2 + qn3 + qn4 + qn5 + qn6 + qn7 + qw1 + qw2 + qw3 + qw4 + qw5 + qw6 + qw7 + t394
+    t397 = casadi.if_else(t79, 0, casadi.atan2(-t73, t69))
+    t398 = t397 + 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t397)
+    t399 = -t398
+    t400 = t398 + 6.283185307179586*casadi.floor(0.0027852115041081685 + 0.15915494309189535*t399)
+    t401 = casadi.if_else(t97, 0, casadi.atan2(t100, t91))
+    t402 = t401 + 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t401)
+    t403 = -t402
+    t404 = t402 + 6.283185307179586*casadi.floor(0.46111961662014833 + 0.15915494309189535*t403)
+    t405 = -t33
+    t406 = t33 + 6.283185307179586*casadi.floor(0.4888921541896841 + 0.15915494309189535*t405)
+    t407 = casadi.if_else(t150, 0, casadi.atan2(-t155, t143))
+    t408 = 3.141592653589793 + t407
+    t409 = t407 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t408)
+    t410 = -6.283185307179586 + t408 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t407)
+    t411 = -t409
+    t412 = t409 + 6.283185307179586*casadi.floor(0.46111961662014833 + 0.15915494309189535*t411)
+    t413 = casadi.if_else(t159, 0, casadi.atan2(-t141, -t129))
+    t414 = t413 + 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t413)
+    t415 = t413
+    t416 = t415 - 6.283185307179586*casadi.floor(0.280558333682393 + 0.15915494309189535*t415)
+    t417 = -t414
+    t418 = t414 + 6.283185307179586*casadi.floor(0.280558333682393 + 0.15915494309189535*t417)
+    t419 = casadi.if_else((t168 <= 1e-24*t169), 0, casadi.atan2(t165, t164))
+    t420 = 3.141592653589793 + t419
+    t421 = t419 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t420)
+    t422 = -6.283185307179586 + t420 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t419)
+    t423 = -t421
+    t424 = t421 + 6.283185307179586*casadi.floor(0.46111961662014833 + 0.15915494309189535*t423)
+    t425 = -t410
+    t426 = t410 + 6.283185307179586*casadi.floor(0.46111961662014833 + 0.15915494309189535*t425)
+    t427 = -t422
+    t428 = t422 + 6.283185307179586*casadi.floor(0.46111961662014833 + 0.15915494309189535*t427)
+    t429 = casadi.if_else(t102, 0, casadi.atan2(-t75, t70))
+    t430 = t429 + 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t429)
+    t431 = -t430
+    t432 = t430 + 6.283185307179586*casadi.floor(0.0027852115041081685 + 0.15915494309189535*t431)
+    t433 = casadi.if_else(t110, 0, casadi.atan2(t100, t92))
+    t434 = t433 + 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t433)
+    t435 = -t434
+    t436 = t434 + 6.283185307179586*casadi.floor(0.46111961662014833 + 0.15915494309189535*t435)
+    t437 = casadi.if_else(t205, 0, casadi.atan2(-t210, t198))
+    t438 = 3.141592653589793 + t437
+    t439 = t437 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t438)
+    t440 = -6.283185307179586 + t438 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t437)
+    t441 = -t439
+    t442 = t439 + 6.283185307179586*casadi.floor(0.46111961662014833 + 0.15915494309189535*t441)
+    t443 = casadi.if_else(t214, 0, casadi.atan2(-t196, -t189))
+    t444 = t443 + 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t443)
+    t445 = t443
+    t446 = t445 - 6.283185307179586*casadi.floor(0.280558333682393 + 0.15915494309189535*t445)
+    t447 = -t444
+    t448 = t444 + 6.283185307179586*casadi.floor(0.280558333682393 + 0.15915494309189535*t447)
+    t449 = casadi.if_else((t223 <= 1e-24*t224), 0, casadi.atan2(t220, t219))
+    t450 = 3.141592653589793 + t449
+    t451 = t449 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t450)
+    t452 = -6.283185307179586 + t450 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t449)
+    t453 = -t451
+    t454 = t451 + 6.283185307179586*casadi.floor(0.46111961662014833 + 0.15915494309189535*t453)
+    t455 = -t440
+    t456 = t440 + 6.283185307179586*casadi.floor(0.46111961662014833 + 0.15915494309189535*t455)
+    t457 = -t452
+    t458 = t452 + 6.283185307179586*casadi.floor(0.46111961662014833 + 0.15915494309189535*t457)
+    t459 = casadi.if_else(t248, 0, casadi.atan2(-t242, t237))
+    t460 = t459 + 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t459)
+    t461 = -t460
+    t462 = t460 + 6.283185307179586*casadi.floor(0.0027852115041081685 + 0.15915494309189535*t461)
+    t463 = casadi.if_else(t266, 0, casadi.atan2(t269, t260))
+    t464 = t463 + 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t463)
+    t465 = -t464
+    t466 = t464 + 6.283185307179586*casadi.floor(0.46111961662014833 + 0.15915494309189535*t465)
+    t467 = -t34
+    t468 = t34 + 6.283185307179586*casadi.floor(0.4888921541896841 + 0.15915494309189535*t467)
+    t469 = casadi.if_else(t319, 0, casadi.atan2(-t324, t312))
+    t470 = 3.141592653589793 + t469
+    t471 = t469 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t470)
+    t472 = -6.283185307179586 + t470 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t469)
+    t473 = -t471
+    t474 = t471 + 6.283185307179586*casadi.floor(0.46111961662014833 + 0.15915494309189535*t473)
+    t475 = casadi.if_else(t328, 0, casadi.atan2(-t310, t298))
+    t476 = t475 + 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t475)
+    t477 = t475
+    t478 = t477 - 6.283185307179586*casadi.floor(0.280558333682393 + 0.15915494309189535*t477)
+    t479 = -t476
+    t480 = t476 + 6.283185307179586*casadi.floor(0.280558333682393 + 0.15915494309189535*t479)
+    t481 = casadi.if_else((t337 <= 1e-24*t338), 0, casadi.atan2(t334, t333))
+    t482 = 3.141592653589793 + t481
+    t483 = t481 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t482)
+    t484 = -6.283185307179586 + t482 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t481)
+    t485 = -t483
+    t486 = t483 + 6.283185307179586*casadi.floor(0.46111961662014833 + 0.15915494309189535*t485)
+    t487 = -t472
+    t488 = t472 + 6.283185307179586*casadi.floor(0.46111961662014833 + 0.15915494309189535*t487)
+    t489 = -t484
+    t490 = t484 + 6.283185307179586*casadi.floor(0.46111961662014833 + 0.15915494309189535*t489)
+    t491 = casadi.if_else(t271, 0, casadi.atan2(-t244, t239))
+    t492 = t491 + 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t491)
+    t493 = -t492
+    t494 = t492 + 6.283185307179586*casadi.floor(0.0027852115041081685 + 0.15915494309189535*t493)
+    t495 = casadi.if_else(t279, 0, casadi.atan2(t269, t261))
+    t496 = t495 + 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t495)
+    t497 = -t496
+    t498 = t496 + 6.283185307179586*casadi.floor(0.46111961662014833 + 0.15915494309189535*t497)
+    t499 = casadi.if_else(t374, 0, casadi.atan2(-t379, t367))
+    t500 = 3.141592653589793 + t499
+    t501 = t499 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t500)
+    t502 = -6.283185307179586 + t500 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t499)
+    t503 = -t501
+    t504 = t501 + 6.283185307179586*casadi.floor(0.46111961662014833 + 0.15915494309189535*t503)
+    t505 = casadi.if_else(t383, 0, casadi.atan2(-t365, t358))
+    t506 = t505 + 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t505)
+    t507 = t505
+    t508 = t507 - 6.283185307179586*casadi.floor(0.280558333682393 + 0.15915494309189535*t507)
+    t509 = -t506
+    t510 = t506 + 6.283185307179586*casadi.floor(0.280558333682393 + 0.15915494309189535*t509)
+    t511 = casadi.if_else((t392 <= 1e-24*t393), 0, casadi.atan2(t389, t388))
+    t512 = 3.141592653589793 + t511
+    t513 = t511 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t512)
+    t514 = -6.283185307179586 + t512 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t511)
+    t515 = -t513
+    t516 = t513 + 6.283185307179586*casadi.floor(0.46111961662014833 + 0.15915494309189535*t515)
+    t517 = -t502
+    t518 = t502 + 6.283185307179586*casadi.floor(0.46111961662014833 + 0.15915494309189535*t517)
+    t519 = -t514
+    t520 = t514 + 6.283185307179586*casadi.floor(0.46111961662014833 + 0.15915494309189535*t519)
+    t521 = (t424 >= -2.8973)
+    t522 = casadi.logic_and((t421 >= -2.8973), (t421 <= 2.8973))
+    t523 = casadi.if_else(casadi.logic_and(t521, casadi.logic_not(t522)), -t424, t423)
+    t524 = t523
+    t525 = t524 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn1 - 0.15915494309189535*t524)
+    t526 = casadi.if_else((qn1 > t525), 6.283185307179586, -6.283185307179586)
+    t527 = t525 + t526
+    t528 = t525 - t526
+    t529 = casadi.if_else(casadi.logic_and((t525 >= -2.8973), (t525 <= 2.8973)), t525, casadi.if_else(casadi.logic_and((t527 >= -2.8973), (t527 <= 2.8973)), t527, casadi.if_else(casadi.logic_and((t528 >= -2.8973), (t528 <= 2.8973)), t528, t523)))
+    t530 = (t418 >= -1.7627999999999997)
+    t531 = casadi.logic_and((t414 >= -1.7627999999999997), (t414 <= 1.7627999999999997))
+    t532 = casadi.if_else(casadi.logic_and(t530, casadi.logic_not(t531)), -t418, t417)
+    t533 = t532
+    t534 = t533 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t533)
+    t535 = casadi.if_else((qn2 > t534), 6.283185307179586, -6.283185307179586)
+    t536 = t534 + t535
+    t537 = t534 - t535
+    t538 = casadi.if_else(casadi.logic_and((t534 >= -1.7627999999999997), (t534 <= 1.7627999999999997)), t534, casadi.if_else(casadi.logic_and((t536 >= -1.7627999999999997), (t536 <= 1.7627999999999997)), t536, casadi.if_else(casadi.logic_and((t537 >= -1.7627999999999997), (t537 <= 1.7627999999999997)), t537, t532)))
+    t539 = (t412 >= -2.8973)
+    t540 = casadi.logic_and((t409 >= -2.8973), (t409 <= 2.8973))
+    t541 = casadi.if_else(casadi.logic_and(t539, casadi.logic_not(t540)), -t412, t411)
+    t542 = t541
+    t543 = t542 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn3 - 0.15915494309189535*t542)
+    t544 = casadi.if_else((qn3 > t543), 6.283185307179586, -6.283185307179586)
+    t545 = t543 + t544
+    t546 = t543 - t544
+    t547 = casadi.if_else(casadi.logic_and((t543 >= -2.8973), (t543 <= 2.8973)), t543, casadi.if_else(casadi.logic_and((t545 >= -2.8973), (t545 <= 2.8973)), t545, casadi.if_else(casadi.logic_and((t546 >= -2.8973), (t546 <= 2.8973)), t546, t541)))
+    t548 = (t406 >= 0.0698)
+    t549 = casadi.logic_and((t33 >= 0.0698), (t33 <= 3.0718))
+    t550 = casadi.if_else(casadi.logic_and(t548, casadi.logic_not(t549)), -t406, t405)
+    t551 = t550
+    t552 = t551 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t551)
+    t553 = casadi.if_else((qn4 > t552), 6.283185307179586, -6.283185307179586)
+    t554 = t552 + t553
+    t555 = t552 - t553
+    t556 = casadi.if_else(casadi.logic_and((t552 >= -3.0718), (t552 <= -0.0698)), t552, casadi.if_else(casadi.logic_and((t554 >= -3.0718), (t554 <= -0.0698)), t554, casadi.if_else(casadi.logic_and((t555 >= -3.0718), (t555 <= -0.0698)), t555, t550)))
+    t557 = (t404 >= -2.8973)
+    t558 = casadi.logic_and((t402 >= -2.8973), (t402 <= 2.8973))
+    t559 = casadi.if_else(casadi.logic_and(t557, casadi.logic_not(t558)), -t404, t403)
+    t560 = t559
+    t561 = t560 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn5 - 0.15915494309189535*t560)
+    t562 = casadi.if_else((qn5 > t561), 6.283185307179586, -6.283185307179586)
+    t563 = t561 + t562
+    t564 = t561 - t562
+    t565 = casadi.if_else(casadi.logic_and((t561 >= -2.8973), (t561 <= 2.8973)), t561, casadi.if_else(casadi.logic_and((t563 >= -2.8973), (t563 <= 2.8973)), t563, casadi.if_else(casadi.logic_and((t564 >= -2.8973), (t564 <= 2.8973)), t564, t559)))
+    t566 = (t400 >= -3.7525000000000004)
+    t567 = casadi.logic_and((t398 >= -3.7525000000000004), (t398 <= 0.0175))
+    t568 = casadi.if_else(casadi.logic_and(t566, casadi.logic_not(t567)), -t400, t399)
+    t569 = t568
+    t570 = t569 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn6 - 0.15915494309189535*t569)
+    t571 = casadi.if_else((qn6 > t570), 6.283185307179586, -6.283185307179586)
+    t572 = t570 + t571
+    t573 = t570 - t571
+    t574 = casadi.if_else(casadi.logic_and((t570 >= -0.0175), (t570 <= 3.7525000000000004)), t570, casadi.if_else(casadi.logic_and((t572 >= -0.0175), (t572 <= 3.7525000000000004)), t572, casadi.if_else(casadi.logic_and((t573 >= -0.0175), (t573 <= 3.7525000000000004)), t573, t568)))
+    t575 = -qn1
+    t576 = -qn2
+    t577 = -qn3
+    t578 = -qn5
+    t579 = -qn6
+    t580 = -qn4
+    t581 = qw7*(q7 - qn7)**2
+    t582 = t581 + qw4*(t556 + t580)**2
+    t583 = t582 + qw5*(t565 + t578)**2 + qw6*(t574 + t579)**2
+    t584 = t583 + qw1*(t529 + t575)**2 + qw2*(t538 + t576)**2 + qw3*(t547 + t577)**2
+    t585 = (casadi.fabs(t395) < casadi.inf)
+    t586 = (q7 >= -2.8973)
+    t587 = (q7 <= 2.8973)
+    t588 = (t59 <= t60)
+    t589 = casadi.logic_or(t566, t567)
+    t590 = casadi.logic_or(t557, t558)
+    t591 = casadi.logic_or(t548, t549)
+    t592 = True
+    t593 = casadi.logic_or(casadi.logic_and(t22, (1e-12 >= 60.77564796097323*t24)), casadi.logic_and(t592, (1e-12 >= -t25)))
+    t594 = casadi.if_else(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t585, t586), t587), t588), t589), t590), t591), t593), (t139 >= -1e-12)), casadi.logic_or(t521, t522)), casadi.logic_or(t530, t531)), casadi.logic_or(t539, t540)), 1, 0)
+    t595 = casadi.if_else((t594 > 0), 1, 0)
+    t596 = (t595 > 0)
+    t597 = casadi.if_else(t596, t529, qn1)
+    t598 = casadi.if_else(t596, t538, qn2)
+    t599 = casadi.if_else(t596, t547, qn3)
+    t600 = casadi.if_else(t596, t556, qn4)
+    t601 = casadi.if_else(t596, t565, qn5)
+    t602 = casadi.if_else(t596, t574, qn6)
+    t603 = casadi.if_else(t596, q7, qn7)
+    t604 = casadi.if_else(t596, t584, 0)
+    t605 = (t428 >= -2.8973)
+    t606 = casadi.logic_and((t422 >= -2.8973), (t422 <= 2.8973))
+    t607 = casadi.if_else(casadi.logic_and(t605, casadi.logic_not(t606)), -t428, t427)
+    t608 = t607
+    t609 = t608 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn1 - 0.15915494309189535*t608)
+    t610 = casadi.if_else((qn1 > t609), 6.283185307179586, -6.283185307179586)
+    t611 = t609 + t610
+    t612 = t609 - t610
+    t613 = casadi.if_else(casadi.logic_and((t609 >= -2.8973), (t609 <= 2.8973)), t609, casadi.if_else(casadi.logic_and((t611 >= -2.8973), (t611 <= 2.8973)), t611, casadi.if_else(casadi.logic_and((t612 >= -2.8973), (t612 <= 2.8973)), t612, t607)))
+    t614 = (t416 <= 1.7627999999999997)
+    t615 = casadi.logic_and((t415 >= -1.7627999999999997), (t415 <= 1.7627999999999997))
+    t616 = casadi.if_else(casadi.logic_and(t614, casadi.logic_not(t615)), t416, t415)
+    t617 = t616
+    t618 = t617 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t617)
+    t619 = casadi.if_else((qn2 > t618), 6.283185307179586, -6.283185307179586)
+    t620 = t618 + t619
+    t621 = t618 - t619
+    t622 = casadi.if_else(casadi.logic_and((t618 >= -1.7627999999999997), (t618 <= 1.7627999999999997)), t618, casadi.if_else(casadi.logic_and((t620 >= -1.7627999999999997), (t620 <= 1.7627999999999997)), t620, casadi.if_else(casadi.logic_and((t621 >= -1.7627999999999997), (t621 <= 1.7627999999999997)), t621, t616)))
+    t623 = (t426 >= -2.8973)
+    t624 = casadi.logic_and((t410 >= -2.8973), (t410 <= 2.8973))
+    t625 = casadi.if_else(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t140, t585), t586), t587), t588), t589), t590), t591), t593), casadi.logic_or(t605, t606)), casadi.logic_or(t614, t615)), casadi.logic_or(t623, t624)), 1, 0)
+    t626 = casadi.if_else(casadi.logic_and(t623, casadi.logic_not(t624)), -t426, t425)
+    t627 = t626
+    t628 = t627 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn3 - 0.15915494309189535*t627)
+    t629 = casadi.if_else((qn3 > t628), 6.283185307179586, -6.283185307179586)
+    t630 = t628 + t629
+    t631 = t628 - t629
+    t632 = casadi.if_else(casadi.logic_and((t628 >= -2.8973), (t628 <= 2.8973)), t628, casadi.if_else(casadi.logic_and((t630 >= -2.8973), (t630 <= 2.8973)), t630, casadi.if_else(casadi.logic_and((t631 >= -2.8973), (t631 <= 2.8973)), t631, t626)))
+    t633 = t583 + qw1*(t575 + t613)**2 + qw2*(t576 + t622)**2 + qw3*(t577 + t632)**2
+    t634 = (t625 > 0)
+    t635 = casadi.if_else(casadi.logic_and(t634, casadi.logic_or((t604 > t633), (t595 < 1))), 1, 0)
+    t636 = casadi.if_else(t634, 1, t595)
+    t637 = (t635 > 0)
+    t638 = casadi.if_else(t637, t613, t597)
+    t639 = casadi.if_else(t637, t622, t598)
+    t640 = casadi.if_else(t637, t632, t599)
+    t641 = casadi.if_else(t637, t556, t600)
+    t642 = casadi.if_else(t637, t565, t601)
+    t643 = casadi.if_else(t637, t574, t602)
+    t644 = casadi.if_else(t637, q7, t603)
+    t645 = casadi.if_else(t637, t633, t604)
+    t646 = (t454 >= -2.8973)
+    t647 = casadi.logic_and((t451 >= -2.8973), (t451 <= 2.8973))
+    t648 = casadi.if_else(casadi.logic_and(t646, casadi.logic_not(t647)), -t454, t453)
+    t649 = t648
+    t650 = t649 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn1 - 0.15915494309189535*t649)
+    t651 = casadi.if_else((qn1 > t650), 6.283185307179586, -6.283185307179586)
+    t652 = t650 + t651
+    t653 = t650 - t651
+    t654 = casadi.if_else(casadi.logic_and((t650 >= -2.8973), (t650 <= 2.8973)), t650, casadi.if_else(casadi.logic_and((t652 >= -2.8973), (t652 <= 2.8973)), t652, casadi.if_else(casadi.logic_and((t653 >= -2.8973), (t653 <= 2.8973)), t653, t648)))
+    t655 = (t448 >= -1.7627999999999997)
+    t656 = casadi.logic_and((t444 >= -1.7627999999999997), (t444 <= 1.7627999999999997))
+    t657 = casadi.if_else(casadi.logic_and(t655, casadi.logic_not(t656)), -t448, t447)
+    t658 = t657
+    t659 = t658 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t658)
+    t660 = casadi.if_else((qn2 > t659), 6.283185307179586, -6.283185307179586)
+    t661 = t659 + t660
+    t662 = t659 - t660
+    t663 = casadi.if_else(casadi.logic_and((t659 >= -1.7627999999999997), (t659 <= 1.7627999999999997)), t659, casadi.if_else(casadi.logic_and((t661 >= -1.7627999999999997), (t661 <= 1.7627999999999997)), t661, casadi.if_else(casadi.logic_and((t662 >= -1.7627999999999997), (t662 <= 1.7627999999999997)), t662, t657)))
+    t664 = (t442 >= -2.8973)
+    t665 = casadi.logic_and((t439 >= -2.8973), (t439 <= 2.8973))
+    t666 = casadi.if_else(casadi.logic_and(t664, casadi.logic_not(t665)), -t442, t441)
+    t667 = t666
+    t668 = t667 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn3 - 0.15915494309189535*t667)
+    t669 = casadi.if_else((qn3 > t668), 6.283185307179586, -6.283185307179586)
+    t670 = t668 + t669
+    t671 = t668 - t669
+    t672 = casadi.if_else(casadi.logic_and((t668 >= -2.8973), (t668 <= 2.8973)), t668, casadi.if_else(casadi.logic_and((t670 >= -2.8973), (t670 <= 2.8973)), t670, casadi.if_else(casadi.logic_and((t671 >= -2.8973), (t671 <= 2.8973)), t671, t666)))
+    t673 = (t436 >= -2.8973)
+    t674 = casadi.logic_and((t434 >= -2.8973), (t434 <= 2.8973))
+    t675 = casadi.if_else(casadi.logic_and(t673, casadi.logic_not(t674)), -t436, t435)
+    t676 = t675
+    t677 = t676 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn5 - 0.15915494309189535*t676)
+    t678 = casadi.if_else((qn5 > t677), 6.283185307179586, -6.283185307179586)
+    t679 = t677 + t678
+    t680 = t677 - t678
+    t681 = casadi.if_else(casadi.logic_and((t677 >= -2.8973), (t677 <= 2.8973)), t677, casadi.if_else(casadi.logic_and((t679 >= -2.8973), (t679 <= 2.8973)), t679, casadi.if_else(casadi.logic_and((t680 >= -2.8973), (t680 <= 2.8973)), t680, t675)))
+    t682 = (t432 >= -3.7525000000000004)
+    t683 = casadi.logic_and((t430 >= -3.7525000000000004), (t430 <= 0.0175))
+    t684 = casadi.if_else(casadi.logic_and(t682, casadi.logic_not(t683)), -t432, t431)
+    t685 = t684
+    t686 = t685 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn6 - 0.15915494309189535*t685)
+    t687 = casadi.if_else((qn6 > t686), 6.283185307179586, -6.283185307179586)
+    t688 = t686 + t687
+    t689 = t686 - t687
+    t690 = casadi.if_else(casadi.logic_and((t686 >= -0.0175), (t686 <= 3.7525000000000004)), t686, casadi.if_else(casadi.logic_and((t688 >= -0.0175), (t688 <= 3.7525000000000004)), t688, casadi.if_else(casadi.logic_and((t689 >= -0.0175), (t689 <= 3.7525000000000004)), t689, t684)))
+    t691 = t582 + qw5*(t578 + t681)**2 + qw6*(t579 + t690)**2
+    t692 = t691 + qw1*(t575 + t654)**2 + qw2*(t576 + t663)**2 + qw3*(t577 + t672)**2
+    t693 = casadi.logic_or(t682, t683)
+    t694 = casadi.logic_or(t673, t674)
+    t695 = casadi.if_else(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t585, t586), t587), t591), t593), t61), t693), t694), (t194 >= -1e-12)), casadi.logic_or(t646, t647)), casadi.logic_or(t655, t656)), casadi.logic_or(t664, t665)), 1, 0)
+    t696 = (t695 > 0)
+    t697 = casadi.if_else(casadi.logic_and(t696, casadi.logic_or((t645 > t692), (t636 < 1))), 1, 0)
+    t698 = casadi.if_else(t696, 1, t636)
+    t699 = (t697 > 0)
+    t700 = casadi.if_else(t699, t654, t638)
+    t701 = casadi.if_else(t699, t663, t639)
+    t702 = casadi.if_else(t699, t672, t640)
+    t703 = casadi.if_else(t699, t556, t641)
+    t704 = casadi.if_else(t699, t681, t642)
+    t705 = casadi.if_else(t699, t690, t643)
+    t706 = casadi.if_else(t699, q7, t644)
+    t707 = casadi.if_else(t699, t692, t645)
+    t708 = (t458 >= -2.8973)
+    t709 = casadi.logic_and((t452 >= -2.8973), (t452 <= 2.8973))
+    t710 = casadi.if_else(casadi.logic_and(t708, casadi.logic_not(t709)), -t458, t457)
+    t711 = t710
+    t712 = t711 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn1 - 0.15915494309189535*t711)
+    t713 = casadi.if_else((qn1 > t712), 6.283185307179586, -6.283185307179586)
+    t714 = t712 + t713
+    t715 = t712 - t713
+    t716 = casadi.if_else(casadi.logic_and((t712 >= -2.8973), (t712 <= 2.8973)), t712, casadi.if_else(casadi.logic_and((t714 >= -2.8973), (t714 <= 2.8973)), t714, casadi.if_else(casadi.logic_and((t715 >= -2.8973), (t715 <= 2.8973)), t715, t710)))
+    t717 = (t446 <= 1.7627999999999997)
+    t718 = casadi.logic_and((t445 >= -1.7627999999999997), (t445 <= 1.7627999999999997))
+    t719 = casadi.if_else(casadi.logic_and(t717, casadi.logic_not(t718)), t446, t445)
+    t720 = t719
+    t721 = t720 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t720)
+    t722 = casadi.if_else((qn2 > t721), 6.283185307179586, -6.283185307179586)
+    t723 = t721 + t722
+    t724 = t721 - t722
+    t725 = casadi.if_else(casadi.logic_and((t721 >= -1.7627999999999997), (t721 <= 1.7627999999999997)), t721, casadi.if_else(casadi.logic_and((t723 >= -1.7627999999999997), (t723 <= 1.7627999999999997)), t723, casadi.if_else(casadi.logic_and((t724 >= -1.7627999999999997), (t724 <= 1.7627999999999997)), t724, t719)))
+    t726 = (t456 >= -2.8973)
+    t727 = casadi.logic_and((t440 >= -2.8973), (t440 <= 2.8973))
+    t728 = casadi.if_else(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t195, t585), t586), t587), t591), t593), t61), t693), t694), casadi.logic_or(t708, t709)), casadi.logic_or(t717, t718)), casadi.logic_or(t726, t727)), 1, 0)
+    t729 = casadi.if_else(casadi.logic_and(t726, casadi.logic_not(t727)), -t456, t455)
+    t730 = t729
+    t731 = t730 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn3 - 0.15915494309189535*t730)
+    t732 = casadi.if_else((qn3 > t731), 6.283185307179586, -6.283185307179586)
+    t733 = t731 + t732
+    t734 = t731 - t732
+    t735 = casadi.if_else(casadi.logic_and((t731 >= -2.8973), (t731 <= 2.8973)), t731, casadi.if_else(casadi.logic_and((t733 >= -2.8973), (t733 <= 2.8973)), t733, casadi.if_else(casadi.logic_and((t734 >= -2.8973), (t734 <= 2.8973)), t734, t729)))
+    t736 = t691 + qw1*(t575 + t716)**2 + qw2*(t576 + t725)**2 + qw3*(t577 + t735)**2
+    t737 = (t728 > 0)
+    t738 = casadi.if_else(casadi.logic_and(t737, casadi.logic_or((t707 > t736), (t698 < 1))), 1, 0)
+    t739 = casadi.if_else(t737, 1, t698)
+    t740 = (t738 > 0)
+    t741 = casadi.if_else(t740, t716, t700)
+    t742 = casadi.if_else(t740, t725, t701)
+    t743 = casadi.if_else(t740, t735, t702)
+    t744 = casadi.if_else(t740, t556, t703)
+    t745 = casadi.if_else(t740, t681, t704)
+    t746 = casadi.if_else(t740, t690, t705)
+    t747 = casadi.if_else(t740, q7, t706)
+    t748 = casadi.if_else(t740, t736, t707)
+    t749 = (t486 >= -2.8973)
+    t750 = casadi.logic_and((t483 >= -2.8973), (t483 <= 2.8973))
+    t751 = casadi.if_else(casadi.logic_and(t749, casadi.logic_not(t750)), -t486, t485)
+    t752 = t751
+    t753 = t752 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn1 - 0.15915494309189535*t752)
+    t754 = casadi.if_else((qn1 > t753), 6.283185307179586, -6.283185307179586)
+    t755 = t753 + t754
+    t756 = t753 - t754
+    t757 = casadi.if_else(casadi.logic_and((t753 >= -2.8973), (t753 <= 2.8973)), t753, casadi.if_else(casadi.logic_and((t755 >= -2.8973), (t755 <= 2.8973)), t755, casadi.if_else(casadi.logic_and((t756 >= -2.8973), (t756 <= 2.8973)), t756, t751)))
+    t758 = (t480 >= -1.7627999999999997)
+    t759 = casadi.logic_and((t476 >= -1.7627999999999997), (t476 <= 1.7627999999999997))
+    t760 = casadi.if_else(casadi.logic_and(t758, casadi.logic_not(t759)), -t480, t479)
+    t761 = t760
+    t762 = t761 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t761)
+    t763 = casadi.if_else((qn2 > t762), 6.283185307179586, -6.283185307179586)
+    t764 = t762 + t763
+    t765 = t762 - t763
+    t766 = casadi.if_else(casadi.logic_and((t762 >= -1.7627999999999997), (t762 <= 1.7627999999999997)), t762, casadi.if_else(casadi.logic_and((t764 >= -1.7627999999999997), (t764 <= 1.7627999999999997)), t764, casadi.if_else(casadi.logic_and((t765 >= -1.7627999999999997), (t765 <= 1.7627999999999997)), t765, t760)))
+    t767 = (t474 >= -2.8973)
+    t768 = casadi.logic_and((t471 >= -2.8973), (t471 <= 2.8973))
+    t769 = casadi.if_else(casadi.logic_and(t767, casadi.logic_not(t768)), -t474, t473)
+    t770 = t769
+    t771 = t770 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn3 - 0.15915494309189535*t770)
+    t772 = casadi.if_else((qn3 > t771), 6.283185307179586, -6.283185307179586)
+    t773 = t771 + t772
+    t774 = t771 - t772
+    t775 = casadi.if_else(casadi.logic_and((t771 >= -2.8973), (t771 <= 2.8973)), t771, casadi.if_else(casadi.logic_and((t773 >= -2.8973), (t773 <= 2.8973)), t773, casadi.if_else(casadi.logic_and((t774 >= -2.8973), (t774 <= 2.8973)), t774, t769)))
+    t776 = (t468 >= 0.0698)
+    t777 = casadi.logic_and((t34 >= 0.0698), (t34 <= 3.0718))
+    t778 = casadi.if_else(casadi.logic_and(t776, casadi.logic_not(t777)), -t468, t467)
+    t779 = t778
+    t780 = t779 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t779)
+    t781 = casadi.if_else((qn4 > t780), 6.283185307179586, -6.283185307179586)
+    t782 = t780 + t781
+    t783 = t780 - t781
+    t784 = casadi.if_else(casadi.logic_and((t780 >= -3.0718), (t780 <= -0.0698)), t780, casadi.if_else(casadi.logic_and((t782 >= -3.0718), (t782 <= -0.0698)), t782, casadi.if_else(casadi.logic_and((t783 >= -3.0718), (t783 <= -0.0698)), t783, t778)))
+    t785 = (t466 >= -2.8973)
+    t786 = casadi.logic_and((t464 >= -2.8973), (t464 <= 2.8973))
+    t787 = casadi.if_else(casadi.logic_and(t785, casadi.logic_not(t786)), -t466, t465)
+    t788 = t787
+    t789 = t788 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn5 - 0.15915494309189535*t788)
+    t790 = casadi.if_else((qn5 > t789), 6.283185307179586, -6.283185307179586)
+    t791 = t789 + t790
+    t792 = t789 - t790
+    t793 = casadi.if_else(casadi.logic_and((t789 >= -2.8973), (t789 <= 2.8973)), t789, casadi.if_else(casadi.logic_and((t791 >= -2.8973), (t791 <= 2.8973)), t791, casadi.if_else(casadi.logic_and((t792 >= -2.8973), (t792 <= 2.8973)), t792, t787)))
+    t794 = (t462 >= -3.7525000000000004)
+    t795 = casadi.logic_and((t460 >= -3.7525000000000004), (t460 <= 0.0175))
+    t796 = casadi.if_else(casadi.logic_and(t794, casadi.logic_not(t795)), -t462, t461)
+    t797 = t796
+    t798 = t797 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn6 - 0.15915494309189535*t797)
+    t799 = casadi.if_else((qn6 > t798), 6.283185307179586, -6.283185307179586)
+    t800 = t798 + t799
+    t801 = t798 - t799
+    t802 = casadi.if_else(casadi.logic_and((t798 >= -0.0175), (t798 <= 3.7525000000000004)), t798, casadi.if_else(casadi.logic_and((t800 >= -0.0175), (t800 <= 3.7525000000000004)), t800, casadi.if_else(casadi.logic_and((t801 >= -0.0175), (t801 <= 3.7525000000000004)), t801, t796)))
+    t803 = t581 + qw4*(t580 + t784)**2
+    t804 = t803 + qw5*(t578 + t793)**2 + qw6*(t579 + t802)**2
+    t805 = t804 + qw1*(t575 + t757)**2 + qw2*(t576 + t766)**2 + qw3*(t577 + t775)**2
+    t806 = (t229 <= t230)
+    t807 = casadi.logic_or(t794, t795)
+    t808 = casadi.logic_or(t785, t786)
+    t809 = casadi.logic_or(t776, t777)
+    t810 = casadi.if_else(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t27, t585), t586), t587), t592), t806), t807), t808), t809), (t308 >= -1e-12)), casadi.logic_or(t749, t750)), casadi.logic_or(t758, t759)), casadi.logic_or(t767, t768)), 1, 0)
+    t811 = (t810 > 0)
+    t812 = casadi.if_else(casadi.logic_and(t811, casadi.logic_or((t748 > t805), (t739 < 1))), 1, 0)
+    t813 = casadi.if_else(t811, 1, t739)
+    t814 = (t812 > 0)
+    t815 = casadi.if_else(t814, t757, t741)
+    t816 = casadi.if_else(t814, t766, t742)
+    t817 = casadi.if_else(t814, t775, t743)
+    t818 = casadi.if_else(t814, t784, t744)
+    t819 = casadi.if_else(t814, t793, t745)
+    t820 = casadi.if_else(t814, t802, t746)
+    t821 = casadi.if_else(t814, q7, t747)
+    t822 = casadi.if_else(t814, t805, t748)
+    t823 = (t490 >= -2.8973)
+    t824 = casadi.logic_and((t484 >= -2.8973), (t484 <= 2.8973))
+    t825 = casadi.if_else(casadi.logic_and(t823, casadi.logic_not(t824)), -t490, t489)
+    t826 = t825
+    t827 = t826 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn1 - 0.15915494309189535*t826)
+    t828 = casadi.if_else((qn1 > t827), 6.283185307179586, -6.283185307179586)
+    t829 = t827 + t828
+    t830 = t827 - t828
+    t831 = casadi.if_else(casadi.logic_and((t827 >= -2.8973), (t827 <= 2.8973)), t827, casadi.if_else(casadi.logic_and((t829 >= -2.8973), (t829 <= 2.8973)), t829, casadi.if_else(casadi.logic_and((t830 >= -2.8973), (t830 <= 2.8973)), t830, t825)))
+    t832 = (t478 <= 1.7627999999999997)
+    t833 = casadi.logic_and((t477 >= -1.7627999999999997), (t477 <= 1.7627999999999997))
+    t834 = casadi.if_else(casadi.logic_and(t832, casadi.logic_not(t833)), t478, t477)
+    t835 = t834
+    t836 = t835 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t835)
+    t837 = casadi.if_else((qn2 > t836), 6.283185307179586, -6.283185307179586)
+    t838 = t836 + t837
+    t839 = t836 - t837
+    t840 = casadi.if_else(casadi.logic_and((t836 >= -1.7627999999999997), (t836 <= 1.7627999999999997)), t836, casadi.if_else(casadi.logic_and((t838 >= -1.7627999999999997), (t838 <= 1.7627999999999997)), t838, casadi.if_else(casadi.logic_and((t839 >= -1.7627999999999997), (t839 <= 1.7627999999999997)), t839, t834)))
+    t841 = (t488 >= -2.8973)
+    t842 = casadi.logic_and((t472 >= -2.8973), (t472 <= 2.8973))
+    t843 = casadi.if_else(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t27, t309), t585), t586), t587), t592), t806), t807), t808), t809), casadi.logic_or(t823, t824)), casadi.logic_or(t832, t833)), casadi.logic_or(t841, t842)), 1, 0)
+    t844 = casadi.if_else(casadi.logic_and(t841, casadi.logic_not(t842)), -t488, t487)
+    t845 = t844
+    t846 = t845 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn3 - 0.15915494309189535*t845)
+    t847 = casadi.if_else((qn3 > t846), 6.283185307179586, -6.283185307179586)
+    t848 = t846 + t847
+    t849 = t846 - t847
+    t850 = casadi.if_else(casadi.logic_and((t846 >= -2.8973), (t846 <= 2.8973)), t846, casadi.if_else(casadi.logic_and((t848 >= -2.8973), (t848 <= 2.8973)), t848, casadi.if_else(casadi.logic_and((t849 >= -2.8973), (t849 <= 2.8973)), t849, t844)))
+    t851 = t804 + qw1*(t575 + t831)**2 + qw2*(t576 + t840)**2 + qw3*(t577 + t850)**2
+    t852 = (t843 > 0)
+    t853 = casadi.if_else(casadi.logic_and(t852, casadi.logic_or((t822 > t851), (t813 < 1))), 1, 0)
+    t854 = casadi.if_else(t852, 1, t813)
+    t855 = (t853 > 0)
+    t856 = casadi.if_else(t855, t831, t815)
+    t857 = casadi.if_else(t855, t840, t816)
+    t858 = casadi.if_else(t855, t850, t817)
+    t859 = casadi.if_else(t855, t784, t818)
+    t860 = casadi.if_else(t855, t793, t819)
+    t861 = casadi.if_else(t855, t802, t820)
+    t862 = casadi.if_else(t855, q7, t821)
+    t863 = casadi.if_else(t855, t851, t822)
+    t864 = (t516 >= -2.8973)
+    t865 = casadi.logic_and((t513 >= -2.8973), (t513 <= 2.8973))
+    t866 = casadi.if_else(casadi.logic_and(t864, casadi.logic_not(t865)), -t516, t515)
+    t867 = t866
+    t868 = t867 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn1 - 0.15915494309189535*t867)
+    t869 = casadi.if_else((qn1 > t868), 6.283185307179586, -6.283185307179586)
+    t870 = t868 + t869
+    t871 = t868 - t869
+    t872 = casadi.if_else(casadi.logic_and((t868 >= -2.8973), (t868 <= 2.8973)), t868, casadi.if_else(casadi.logic_and((t870 >= -2.8973), (t870 <= 2.8973)), t870, casadi.if_else(casadi.logic_and((t871 >= -2.8973), (t871 <= 2.8973)), t871, t866)))
+    t873 = (t510 >= -1.7627999999999997)
+    t874 = casadi.logic_and((t506 >= -1.7627999999999997), (t506 <= 1.7627999999999997))
+    t875 = casadi.if_else(casadi.logic_and(t873, casadi.logic_not(t874)), -t510, t509)
+    t876 = t875
+    t877 = t876 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t876)
+    t878 = casadi.if_else((qn2 > t877), 6.283185307179586, -6.283185307179586)
+    t879 = t877 + t878
+    t880 = t877 - t878
+    t881 = casadi.if_else(casadi.logic_and((t877 >= -1.7627999999999997), (t877 <= 1.7627999999999997)), t877, casadi.if_else(casadi.logic_and((t879 >= -1.7627999999999997), (t879 <= 1.7627999999999997)), t879, casadi.if_else(casadi.logic_and((t880 >= -1.7627999999999997), (t880 <= 1.7627999999999997)), t880, t875)))
+    t882 = (t504 >= -2.8973)
+    t883 = casadi.logic_and((t501 >= -2.8973), (t501 <= 2.8973))
+    t884 = casadi.if_else(casadi.logic_and(t882, casadi.logic_not(t883)), -t504, t503)
+    t885 = t884
+    t886 = t885 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn3 - 0.15915494309189535*t885)
+    t887 = casadi.if_else((qn3 > t886), 6.283185307179586, -6.283185307179586)
+    t888 = t886 + t887
+    t889 = t886 - t887
+    t890 = casadi.if_else(casadi.logic_and((t886 >= -2.8973), (t886 <= 2.8973)), t886, casadi.if_else(casadi.logic_and((t888 >= -2.8973), (t888 <= 2.8973)), t888, casadi.if_else(casadi.logic_and((t889 >= -2.8973), (t889 <= 2.8973)), t889, t884)))
+    t891 = (t498 >= -2.8973)
+    t892 = casadi.logic_and((t496 >= -2.8973), (t496 <= 2.8973))
+    t893 = casadi.if_else(casadi.logic_and(t891, casadi.logic_not(t892)), -t498, t497)
+    t894 = t893
+    t895 = t894 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn5 - 0.15915494309189535*t894)
+    t896 = casadi.if_else((qn5 > t895), 6.283185307179586, -6.283185307179586)
+    t897 = t895 + t896
+    t898 = t895 - t896
+    t899 = casadi.if_else(casadi.logic_and((t895 >= -2.8973), (t895 <= 2.8973)), t895, casadi.if_else(casadi.logic_and((t897 >= -2.8973), (t897 <= 2.8973)), t897, casadi.if_else(casadi.logic_and((t898 >= -2.8973), (t898 <= 2.8973)), t898, t893)))
+    t900 = (t494 >= -3.7525000000000004)
+    t901 = casadi.logic_and((t492 >= -3.7525000000000004), (t492 <= 0.0175))
+    t902 = casadi.if_else(casadi.logic_and(t900, casadi.logic_not(t901)), -t494, t493)
+    t903 = t902
+    t904 = t903 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn6 - 0.15915494309189535*t903)
+    t905 = casadi.if_else((qn6 > t904), 6.283185307179586, -6.283185307179586)
+    t906 = t904 + t905
+    t907 = t904 - t905
+    t908 = casadi.if_else(casadi.logic_and((t904 >= -0.0175), (t904 <= 3.7525000000000004)), t904, casadi.if_else(casadi.logic_and((t906 >= -0.0175), (t906 <= 3.7525000000000004)), t906, casadi.if_else(casadi.logic_and((t907 >= -0.0175), (t907 <= 3.7525000000000004)), t907, t902)))
+    t909 = t803 + qw5*(t578 + t899)**2 + qw6*(t579 + t908)**2
+    t910 = t909 + qw1*(t575 + t872)**2 + qw2*(t576 + t881)**2 + qw3*(t577 + t890)**2
+    t911 = casadi.logic_or(t900, t901)
+    t912 = casadi.logic_or(t891, t892)
+    t913 = casadi.if_else(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t231, t27), t585), t586), t587), t592), t809), t911), t912), (t363 >= -1e-12)), casadi.logic_or(t864, t865)), casadi.logic_or(t873, t874)), casadi.logic_or(t882, t883)), 1, 0)
+    t914 = (t913 > 0)
+    t915 = casadi.if_else(casadi.logic_and(t914, casadi.logic_or((t863 > t910), (t854 < 1))), 1, 0)
+    t916 = casadi.if_else(t914, 1, t854)
+    t917 = (t915 > 0)
+    t918 = casadi.if_else(t917, t872, t856)
+    t919 = casadi.if_else(t917, t881, t857)
+    t920 = casadi.if_else(t917, t890, t858)
+    t921 = casadi.if_else(t917, t784, t859)
+    t922 = casadi.if_else(t917, t899, t860)
+    t923 = casadi.if_else(t917, t908, t861)
+    t924 = casadi.if_else(t917, q7, t862)
+    t925 = casadi.if_else(t917, t910, t863)
+    t926 = (t520 >= -2.8973)
+    t927 = casadi.logic_and((t514 >= -2.8973), (t514 <= 2.8973))
+    t928 = casadi.if_else(casadi.logic_and(t926, casadi.logic_not(t927)), -t520, t519)
+    t929 = t928
+    t930 = t929 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn1 - 0.15915494309189535*t929)
+    t931 = casadi.if_else((qn1 > t930), 6.283185307179586, -6.283185307179586)
+    t932 = t930 + t931
+    t933 = t930 - t931
+    t934 = casadi.if_else(casadi.logic_and((t930 >= -2.8973), (t930 <= 2.8973)), t930, casadi.if_else(casadi.logic_and((t932 >= -2.8973), (t932 <= 2.8973)), t932, casadi.if_else(casadi.logic_and((t933 >= -2.8973), (t933 <= 2.8973)), t933, t928)))
+    t935 = (t508 <= 1.7627999999999997)
+    t936 = casadi.logic_and((t507 >= -1.7627999999999997), (t507 <= 1.7627999999999997))
+    t937 = casadi.if_else(casadi.logic_and(t935, casadi.logic_not(t936)), t508, t507)
+    t938 = t937
+    t939 = t938 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t938)
+    t940 = casadi.if_else((qn2 > t939), 6.283185307179586, -6.283185307179586)
+    t941 = t939 + t940
+    t942 = t939 - t940
+    t943 = casadi.if_else(casadi.logic_and((t939 >= -1.7627999999999997), (t939 <= 1.7627999999999997)), t939, casadi.if_else(casadi.logic_and((t941 >= -1.7627999999999997), (t941 <= 1.7627999999999997)), t941, casadi.if_else(casadi.logic_and((t942 >= -1.7627999999999997), (t942 <= 1.7627999999999997)), t942, t937)))
+    t944 = (t518 >= -2.8973)
+    t945 = casadi.logic_and((t502 >= -2.8973), (t502 <= 2.8973))
+    t946 = casadi.if_else(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t231, t27), t364), t585), t586), t587), t592), t809), t911), t912), casadi.logic_or(t926, t927)), casadi.logic_or(t935, t936)), casadi.logic_or(t944, t945)), 1, 0)
+    t947 = casadi.if_else(casadi.logic_and(t944, casadi.logic_not(t945)), -t518, t517)
+    t948 = t947
+    t949 = t948 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn3 - 0.15915494309189535*t948)
+    t950 = casadi.if_else((qn3 > t949), 6.283185307179586, -6.283185307179586)
+    t951 = t949 + t950
+    t952 = t949 - t950
+    t953 = casadi.if_else(casadi.logic_and((t949 >= -2.8973), (t949 <= 2.8973)), t949, casadi.if_else(casadi.logic_and((t951 >= -2.8973), (t951 <= 2.8973)), t951, casadi.if_else(casadi.logic_and((t952 >= -2.8973), (t952 <= 2.8973)), t952, t947)))
+    t954 = t909 + qw1*(t575 + t934)**2 + qw2*(t576 + t943)**2 + qw3*(t577 + t953)**2
+    t955 = (t946 > 0)
+    t956 = casadi.if_else(casadi.logic_and(t955, casadi.logic_or((t925 > t954), (t916 < 1))), 1, 0)
+    t957 = casadi.if_else(t955, 1, t916)
+    t958 = (t956 > 0)
+    t959 = casadi.if_else(t958, t934, t918)
+    t960 = casadi.if_else(t958, t943, t919)
+    t961 = casadi.if_else(t958, t953, t920)
+    t962 = casadi.if_else(t958, t784, t921)
+    t963 = casadi.if_else(t958, t899, t922)
+    t964 = casadi.if_else(t958, t908, t923)
+    t965 = casadi.if_else(t958, q7, t924)
+    t966 = (casadi.fabs(t396) < casadi.inf)
+    t967 = (t957 > 0)
+    t968 = casadi.logic_and(t966, t967)
+    q = casadi.SX(7, 1)
+    q[0, 0] = casadi.if_else(t968, t959, qn1)
+    q[1, 0] = casadi.if_else(t968, t960, qn2)
+    q[2, 0] = casadi.if_else(t968, t961, qn3)
+    q[3, 0] = casadi.if_else(t968, t962, qn4)
+    q[4, 0] = casadi.if_else(t968, t963, qn5)
+    q[5, 0] = casadi.if_else(t968, t964, qn6)
+    q[6, 0] = casadi.if_else(t968, t965, qn7)
+    status = casadi.SX(1, 1)
+    status[0, 0] = casadi.if_else(casadi.logic_not(t966), 2, casadi.if_else(t967, 0, 1))
+    return [q, status]
 
 
 _q = casadi.SX.sym("q", 7, 1)
@@ -3388,7 +4559,9 @@ _mu_dot = casadi.SX.sym("mu_dot", 6, 1)
 _damping = casadi.SX.sym("damping", 1, 1)
 _target = casadi.SX.sym("target", 4, 4)
 _T = casadi.SX.sym("T", 4, 4)
+_q_seed = casadi.SX.sym("q_seed", 7, 1)
 _q_free = casadi.SX.sym("q_free", 1, 1)
+_weights = casadi.SX.sym("weights", 7, 1)
 fk = casadi.Function("fk", [_q], _fk(_q), ["q"], ["T"])
 jacobian = casadi.Function("jacobian", [_q], _jacobian(_q), ["q"], ["J"])
 fk_jacobian = casadi.Function("fk_jacobian", [_q], _fk_jacobian(_q), ["q"], ["T", "J"])
@@ -3404,8 +4577,9 @@ singularity_factors = casadi.Function("singularity_factors", [_q], _singularity_
 manipulability = casadi.Function("manipulability", [_q], _manipulability(_q), ["q"], ["w"])
 velocity_ik = casadi.Function("velocity_ik", [_q, _mu_dot, _damping], _velocity_ik(_q, _mu_dot, _damping), ["q", "mu_dot", "damping"], ["q_dot", "status"])
 ik_numeric_step = casadi.Function("ik_numeric_step", [_target, _q, _damping], _ik_numeric_step(_target, _q, _damping), ["target", "q", "damping"], ["q_start", "q_next", "cost"])
-ik_branches = casadi.Function("ik_branches", [_T, _q_free], _ik_branches(_T, _q_free), ["T", "q_free"], ["q", "valid"])
-ik = ik_branches  # CasADi functions have fixed-size outputs: every branch and its validity
+ik_branches = casadi.Function("ik_branches", [_T, _q_free], _ik_branches(_T, _q_free), ["T", "q_free"], ["q", "valid", "in_limits"])
+ik_nearest = casadi.Function("ik_nearest", [_T, _q_seed, _q_free, _weights], _ik_nearest(_T, _q_seed, _q_free, _weights), ["T", "q_seed", "q_free", "weights"], ["q", "status"])
+ik = ik_branches  # CasADi functions have fixed-size outputs: every branch, its validity and its limits
 
 IK_NUMERIC_CONVERGED = 0  # |error| <= tol
 IK_NUMERIC_ITERATION_LIMIT = 1  # IK_NUMERIC_ITERATIONS steps taken, |error| still above tol
@@ -3447,4 +4621,4 @@ ik_numeric = casadi.Function("ik_numeric", _inputs, _ik_numeric(*_inputs), ["tar
 
 def functions():
     """All functions by name."""
-    return {"fk": fk, "jacobian": jacobian, "fk_jacobian": fk_jacobian, "jacobian_tool": jacobian_tool, "task": task, "task_jacobian": task_jacobian, "fk_jacobian_dot": fk_jacobian_dot, "jacobian_dot": jacobian_dot, "bias_acceleration": bias_acceleration, "task_jacobian_dot": task_jacobian_dot, "hessian": hessian, "singularity_factors": singularity_factors, "manipulability": manipulability, "velocity_ik": velocity_ik, "ik_numeric_step": ik_numeric_step, "ik_branches": ik_branches}
+    return {"fk": fk, "jacobian": jacobian, "fk_jacobian": fk_jacobian, "jacobian_tool": jacobian_tool, "task": task, "task_jacobian": task_jacobian, "fk_jacobian_dot": fk_jacobian_dot, "jacobian_dot": jacobian_dot, "bias_acceleration": bias_acceleration, "task_jacobian_dot": task_jacobian_dot, "hessian": hessian, "singularity_factors": singularity_factors, "manipulability": manipulability, "velocity_ik": velocity_ik, "ik_numeric_step": ik_numeric_step, "ik_branches": ik_branches, "ik_nearest": ik_nearest}

@@ -607,7 +607,7 @@ planar_2r_real planar_2r_ik_numeric_step(const planar_2r_real target[PLANAR_2R_T
     return (isfinite(t8) ? t7 : -1);
 }
 
-void planar_2r_ik_branches(const planar_2r_real mu[PLANAR_2R_TASK_DIM], planar_2r_real q[PLANAR_2R_MAX_IK_SOLUTIONS * PLANAR_2R_DOF], int valid[PLANAR_2R_MAX_IK_SOLUTIONS])
+void planar_2r_ik_branches(const planar_2r_real mu[PLANAR_2R_TASK_DIM], planar_2r_real q[PLANAR_2R_MAX_IK_SOLUTIONS * PLANAR_2R_DOF], int valid[PLANAR_2R_MAX_IK_SOLUTIONS], int in_limits[PLANAR_2R_MAX_IK_SOLUTIONS])
 {
     /* 79 operations */
 
@@ -652,16 +652,96 @@ void planar_2r_ik_branches(const planar_2r_real mu[PLANAR_2R_TASK_DIM], planar_2
     q[3] = t9 - 6.283185307179586*ceil(-0.5 + 0.15915494309189535*t9);
     valid[0] = t26 && t27 && t4 >= -1e-12;
     valid[1] = t26 && t27 && t4 > 1e-12;
+    in_limits[0] = 1;
+    in_limits[1] = 1;
+}
+
+int planar_2r_ik_nearest(const planar_2r_real mu[PLANAR_2R_TASK_DIM], const planar_2r_real q_seed[PLANAR_2R_DOF], const planar_2r_real weights[PLANAR_2R_DOF], planar_2r_real q[PLANAR_2R_DOF])
+{
+    /* 147 operations */
+
+    /* Inputs */
+    const planar_2r_real mu0 = mu[0];
+    const planar_2r_real mu1 = mu[1];
+    const planar_2r_real qn1 = q_seed[0];
+    const planar_2r_real qn2 = q_seed[1];
+    const planar_2r_real qw1 = weights[0];
+    const planar_2r_real qw2 = weights[1];
+
+    /* Intermediate terms */
+    const planar_2r_real t0 = (mu0*mu0) + (mu1*mu1);
+    const planar_2r_real t1 = 1.0 - 0.5*t0;
+    const planar_2r_real t2 = (t1*t1);
+    const planar_2r_real t3 = 1 - t2;
+    const int t4 = 1e-12 < t3;
+    const planar_2r_real t5 = (t4 ? t1 : (t1 > 0 ? 1 : -1));
+    const planar_2r_real t6 = (t4 ? sqrt(t3) : 0);
+    const planar_2r_real t7 = atan2(t6, t5);
+    const planar_2r_real t8 = 3.141592653589793 - t7;
+    const planar_2r_real t9 = t8 - 6.283185307179586*ceil(-0.5 + 0.15915494309189535*t8);
+    const planar_2r_real t10 = t9 + 6.283185307179586*floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t9);
+    const int t11 = 0;
+    const planar_2r_real t12 = (t11 ? 0 : 3.141592653589793 + t7);
+    const planar_2r_real t13 = (t11 ? 0 : -t6);
+    const planar_2r_real t14 = t12 - 6.283185307179586*ceil(-0.5 + 0.15915494309189535*t12);
+    const planar_2r_real t15 = t14 + 6.283185307179586*floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t14);
+    const planar_2r_real t16 = -t5;
+    const planar_2r_real t17 = (t11 ? 1 : t16);
+    const planar_2r_real t18 = 1 + t17;
+    const planar_2r_real t19 = mu0*t18 + mu1*t13;
+    const planar_2r_real t20 = mu1*t18 - mu0*t13;
+    const planar_2r_real t21 = (t19*t19) + (t20*t20);
+    const planar_2r_real t22 = (t13*t13) + (t18*t18);
+    const planar_2r_real t23 = 1 + t16;
+    const planar_2r_real t24 = mu0*t23 + mu1*t6;
+    const planar_2r_real t25 = mu1*t23 - mu0*t6;
+    const planar_2r_real t26 = (t24*t24) + (t25*t25);
+    const planar_2r_real t27 = (t23*t23) + (t6*t6);
+    const planar_2r_real t28 = mu0 + mu1;
+    const planar_2r_real t29 = t28;
+    const planar_2r_real t30 = qn1 + qn2 + qw1 + qw2 + t28;
+    const planar_2r_real t31 = 1e-24*t0;
+    const planar_2r_real t32 = (t21 <= t22*t31 ? 0 : atan2(t20, t19));
+    const planar_2r_real t33 = t32 + 6.283185307179586*floor(0.5 + 0.15915494309189535*qn1 - 0.15915494309189535*t32);
+    const planar_2r_real t34 = (t26 <= t27*t31 ? 0 : atan2(t25, t24));
+    const planar_2r_real t35 = t34 + 6.283185307179586*floor(0.5 + 0.15915494309189535*qn1 - 0.15915494309189535*t34);
+    const planar_2r_real t36 = -qn1;
+    const planar_2r_real t37 = -qn2;
+    const planar_2r_real t38 = qw1*((t33 + t36)*(t33 + t36)) + qw2*((t15 + t37)*(t15 + t37));
+    const planar_2r_real t39 = qw1*((t35 + t36)*(t35 + t36)) + qw2*((t10 + t37)*(t10 + t37));
+    const int t40 = isfinite(t29);
+    const int t41 = 1;
+    const planar_2r_real t42 = (t40 && ((t11 && t2 <= 1e-12) || (t41 && t3 >= -1e-12)) ? 1 : 0);
+    const planar_2r_real t43 = (t42 > 0 ? 1 : 0);
+    const planar_2r_real t44 = (t4 && t40 && t41 ? 1 : 0);
+    const int t45 = t43 > 0;
+    const planar_2r_real t46 = (t45 ? t33 : qn1);
+    const planar_2r_real t47 = (t45 ? t15 : qn2);
+    const planar_2r_real t48 = (t45 ? t38 : 0);
+    const int t49 = t44 > 0;
+    const planar_2r_real t50 = (t49 && ((t39 < t48) || (t43 < 1)) ? 1 : 0);
+    const planar_2r_real t51 = (t49 ? 1 : t43);
+    const int t52 = t50 > 0;
+    const planar_2r_real t53 = (t52 ? t35 : t46);
+    const planar_2r_real t54 = (t52 ? t10 : t47);
+    const int t55 = isfinite(t30);
+    const int t56 = t51 > 0;
+    const int t57 = t55 && t56;
+
+    /* Outputs */
+    q[0] = (t57 ? t53 : qn1);
+    q[1] = (t57 ? t54 : qn2);
+    return (!t55 ? 2 : (t56 ? 0 : 1));
 }
 
 int planar_2r_ik(const planar_2r_real mu[PLANAR_2R_TASK_DIM], planar_2r_real q[PLANAR_2R_MAX_IK_SOLUTIONS * PLANAR_2R_DOF])
 {
     planar_2r_real branches[PLANAR_2R_MAX_IK_SOLUTIONS * PLANAR_2R_DOF];
-    int valid[PLANAR_2R_MAX_IK_SOLUTIONS];
+    int valid[PLANAR_2R_MAX_IK_SOLUTIONS], in_limits[PLANAR_2R_MAX_IK_SOLUTIONS];
     int count = 0, i, j;
-    planar_2r_ik_branches(mu, branches, valid);
+    planar_2r_ik_branches(mu, branches, valid, in_limits);
     for (i = 0; i < PLANAR_2R_MAX_IK_SOLUTIONS; ++i) {
-        if (valid[i]) {
+        if (valid[i] && in_limits[i]) {
             for (j = 0; j < PLANAR_2R_DOF; ++j) {
                 q[PLANAR_2R_DOF * count + j] = branches[PLANAR_2R_DOF * i + j];
             }

@@ -93,9 +93,13 @@ int planar_2r_velocity_ik(const planar_2r_real q[PLANAR_2R_DOF], const planar_2r
  * Result: q_start[i], i < 2; q_next[i], i < 2; returned as a scalar. 94 operations. */
 planar_2r_real planar_2r_ik_numeric_step(const planar_2r_real target[PLANAR_2R_TASK_DIM], const planar_2r_real q[PLANAR_2R_DOF], planar_2r_real damping, planar_2r_real q_start[PLANAR_2R_DOF], planar_2r_real q_next[PLANAR_2R_DOF]);
 
-/* Every branch of the closed-form ik and whether the target allows it.
- * Result: q: 2 x 2 row-major, element (r, c) at q[r * 2 + c]; valid[i], i < 2. 79 operations. */
-void planar_2r_ik_branches(const planar_2r_real mu[PLANAR_2R_TASK_DIM], planar_2r_real q[PLANAR_2R_MAX_IK_SOLUTIONS * PLANAR_2R_DOF], int valid[PLANAR_2R_MAX_IK_SOLUTIONS]);
+/* Every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits.
+ * Result: q: 2 x 2 row-major, element (r, c) at q[r * 2 + c]; valid[i], i < 2; in_limits[i], i < 2. 79 operations. */
+void planar_2r_ik_branches(const planar_2r_real mu[PLANAR_2R_TASK_DIM], planar_2r_real q[PLANAR_2R_MAX_IK_SOLUTIONS * PLANAR_2R_DOF], int valid[PLANAR_2R_MAX_IK_SOLUTIONS], int in_limits[PLANAR_2R_MAX_IK_SOLUTIONS]);
+
+/* The closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status.
+ * Result: q[i], i < 2; returned as a scalar. 147 operations. */
+int planar_2r_ik_nearest(const planar_2r_real mu[PLANAR_2R_TASK_DIM], const planar_2r_real q_seed[PLANAR_2R_DOF], const planar_2r_real weights[PLANAR_2R_DOF], planar_2r_real q[PLANAR_2R_DOF]);
 
 /* Statuses of planar_2r_velocity_ik: OK, singular (a diagonal entry of the QR factor R of the
  * 2 x 2 system at most 1e-12 times its Frobenius norm: take damping > 0), or
@@ -105,12 +109,15 @@ void planar_2r_ik_branches(const planar_2r_real mu[PLANAR_2R_TASK_DIM], planar_2
 #define PLANAR_2R_VELOCITY_IK_SINGULAR 1
 #define PLANAR_2R_VELOCITY_IK_NOT_FINITE 2
 
-/* Closed-form inverse kinematics: every joint solution that reaches the target; returns
- * their count k and writes solution i to q[i * PLANAR_2R_DOF + j], i < k: the valid
- * rows of planar_2r_ik_branches, in its order. No allocation, no recursion.
+/* Closed-form inverse kinematics: every joint solution inside the joint limits that reaches
+ * the target; returns their count k and writes solution i to q[i * PLANAR_2R_DOF + j],
+ * i < k: the rows of planar_2r_ik_branches that are valid and in_limits, in its order
+ * (planar_2r_ik_branches also gives those outside the limits). No allocation, no recursion.
  * target: the task vector (x, y).
- * Result: k <= PLANAR_2R_MAX_IK_SOLUTIONS solutions, revolute angles wrapped into (-pi,
- * pi], joint limits not applied; k = 0 when the target is out of reach or not finite.
+ * Result: k <= PLANAR_2R_MAX_IK_SOLUTIONS solutions inside the joint limits, revolute
+ * angles wrapped into (-pi, pi] or, where that is outside the limits, their lowest
+ * equivalent inside them; k = 0 when the target is out of reach or not finite. ik_branches
+ * also gives the solutions outside the limits (in_limits 0).
  * Solver: planar arm: revolute axes (and any prismatic axis) parallel to world z; the last
  * revolute joint sets the yaw, the first two place the wrist point (SP3, SP1).
  * Order: nested loops over the branches, outermost first; where a subproblem has two roots
@@ -122,6 +129,12 @@ void planar_2r_ik_branches(const planar_2r_real mu[PLANAR_2R_TASK_DIM], planar_2
  * angle the target leaves free (a singular wrist or shoulder) is set to 0.
  */
 int planar_2r_ik(const planar_2r_real mu[PLANAR_2R_TASK_DIM], planar_2r_real q[PLANAR_2R_MAX_IK_SOLUTIONS * PLANAR_2R_DOF]);
+
+/* Statuses of planar_2r_ik_nearest: a solution found; no solution inside the limits (out of
+ * reach); the target (its first three rows), q_seed or weights not finite. q = q_seed unless OK. */
+#define PLANAR_2R_IK_NEAREST_OK 0
+#define PLANAR_2R_IK_NEAREST_NO_SOLUTION 1
+#define PLANAR_2R_IK_NEAREST_NOT_FINITE 2
 
 /* ik_numeric status codes. */
 #define PLANAR_2R_IK_NUMERIC_CONVERGED 0       /* |error| <= tol */

@@ -582,7 +582,7 @@ def ik_numeric_step(target, q, damping=0.0):
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def ik_branches(mu):
-    """every branch of the closed-form ik and whether the target allows it: (2 x 2 and 2 x 1), 79 operations."""
+    """every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits: (2 x 2 and 2 x 1 and 2 x 1), 79 operations."""
     mu = _argument("mu", mu, (2,))
     mu0 = mu[..., 0]
     mu1 = mu[..., 1]
@@ -622,21 +622,110 @@ def ik_branches(mu):
     valid = numpy.empty(mu.shape[:-1] + (2,), dtype=bool)
     valid[..., 0] = t26 & t27 & (numpy.greater_equal(t4, -1e-12))
     valid[..., 1] = t26 & t27 & (numpy.greater(t4, 1e-12))
-    return q, valid
+    in_limits = numpy.empty(mu.shape[:-1] + (2,), dtype=bool)
+    in_limits[..., 0] = True
+    in_limits[..., 1] = True
+    return q, valid, in_limits
+
+
+@numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
+def ik_nearest(mu, q_seed, weights=(1.0,) * DOF):
+    """the closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status: (2 x 1 and 1 x 1), 147 operations."""
+    mu = _argument("mu", mu, (2,))
+    q_seed = _argument("q_seed", q_seed, (2,))
+    weights = _argument("weights", weights, (2,))
+    mu0 = mu[..., 0]
+    mu1 = mu[..., 1]
+    qn1 = q_seed[..., 0]
+    qn2 = q_seed[..., 1]
+    qw1 = weights[..., 0]
+    qw2 = weights[..., 1]
+    t0 = mu0**2 + mu1**2
+    t1 = 1.0 - 0.5*t0
+    t2 = t1**2
+    t3 = 1 - t2
+    t4 = numpy.less(1e-12, t3)
+    t5 = numpy.where(t4, t1, numpy.where(numpy.greater(t1, 0), 1, -1))
+    t6 = numpy.where(t4, numpy.sqrt(t3), 0)
+    t7 = numpy.arctan2(t6, t5)
+    t8 = 3.141592653589793 - t7
+    t9 = t8 - 6.283185307179586*numpy.ceil(-0.5 + 0.15915494309189535*t8)
+    t10 = t9 + 6.283185307179586*numpy.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t9)
+    t11 = False
+    t12 = numpy.where(t11, 0, 3.141592653589793 + t7)
+    t13 = numpy.where(t11, 0, -t6)
+    t14 = t12 - 6.283185307179586*numpy.ceil(-0.5 + 0.15915494309189535*t12)
+    t15 = t14 + 6.283185307179586*numpy.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t14)
+    t16 = -t5
+    t17 = numpy.where(t11, 1, t16)
+    t18 = 1 + t17
+    t19 = mu0*t18 + mu1*t13
+    t20 = mu1*t18 - mu0*t13
+    t21 = t19**2 + t20**2
+    t22 = t13**2 + t18**2
+    t23 = 1 + t16
+    t24 = mu0*t23 + mu1*t6
+    t25 = mu1*t23 - mu0*t6
+    t26 = t24**2 + t25**2
+    t27 = t23**2 + t6**2
+    t28 = mu0 + mu1
+    t29 = t28
+    t30 = qn1 + qn2 + qw1 + qw2 + t28
+    t31 = 1e-24*t0
+    t32 = numpy.where(numpy.less_equal(t21, t22*t31), 0, numpy.arctan2(t20, t19))
+    t33 = t32 + 6.283185307179586*numpy.floor(0.5 + 0.15915494309189535*qn1 - 0.15915494309189535*t32)
+    t34 = numpy.where(numpy.less_equal(t26, t27*t31), 0, numpy.arctan2(t25, t24))
+    t35 = t34 + 6.283185307179586*numpy.floor(0.5 + 0.15915494309189535*qn1 - 0.15915494309189535*t34)
+    t36 = -qn1
+    t37 = -qn2
+    t38 = qw1*(t33 + t36)**2 + qw2*(t15 + t37)**2
+    t39 = qw1*(t35 + t36)**2 + qw2*(t10 + t37)**2
+    t40 = numpy.isfinite(t29)
+    t41 = True
+    t42 = numpy.where(t40 & ((t11 & (numpy.less_equal(t2, 1e-12))) | (t41 & (numpy.greater_equal(t3, -1e-12)))), 1, 0)
+    t43 = numpy.where(numpy.greater(t42, 0), 1, 0)
+    t44 = numpy.where(t4 & t40 & t41, 1, 0)
+    t45 = numpy.greater(t43, 0)
+    t46 = numpy.where(t45, t33, qn1)
+    t47 = numpy.where(t45, t15, qn2)
+    t48 = numpy.where(t45, t38, 0)
+    t49 = numpy.greater(t44, 0)
+    t50 = numpy.where(t49 & ((numpy.less(t39, t48)) | (numpy.less(t43, 1))), 1, 0)
+    t51 = numpy.where(t49, 1, t43)
+    t52 = numpy.greater(t50, 0)
+    t53 = numpy.where(t52, t35, t46)
+    t54 = numpy.where(t52, t10, t47)
+    t55 = numpy.isfinite(t30)
+    t56 = numpy.greater(t51, 0)
+    t57 = t55 & t56
+    q = numpy.empty(numpy.broadcast_shapes(mu.shape[:-1], q_seed.shape[:-1], weights.shape[:-1]) + (2,))
+    q[..., 0] = numpy.where(t57, t53, qn1)
+    q[..., 1] = numpy.where(t57, t54, qn2)
+    status = numpy.empty(numpy.broadcast_shapes(mu.shape[:-1], q_seed.shape[:-1], weights.shape[:-1]) + (), dtype=int)
+    status[...] = numpy.where(numpy.logical_not(t55), 2, numpy.where(t56, 0, 1))
+    return q, status
 
 
 MAX_IK_SOLUTIONS = 2
+# Statuses of ik_nearest: a solution found; no solution inside the limits (out of reach); the
+# target (its first three rows), q_seed or weights not finite. q = q_seed unless OK.
+IK_NEAREST_OK = 0
+IK_NEAREST_NO_SOLUTION = 1
+IK_NEAREST_NOT_FINITE = 2
 
 
-def ik(mu):
-    """Closed-form inverse kinematics: every joint solution that reaches the target.
+def ik(mu, limits=True):
+    """Closed-form inverse kinematics: every joint solution that reaches the target, inside
+    the joint limits unless `limits` is False.
 
-    One target: the solutions as (k, DOF), the valid rows of ik_branches in its order.
-    A batch of targets: ik_branches' (q, valid), (..., MAX_IK_SOLUTIONS, DOF) and
-    (..., MAX_IK_SOLUTIONS).
+    One target: the solutions as (k, DOF), the rows of ik_branches that are valid (and
+    in_limits), in its order. A batch of targets: (q, keep), (..., MAX_IK_SOLUTIONS, DOF)
+    and (..., MAX_IK_SOLUTIONS).
     target: the task vector (x, y).
-    Result: k <= MAX_IK_SOLUTIONS solutions, revolute angles wrapped into (-pi, pi], joint
-    limits not applied; k = 0 when the target is out of reach or not finite.
+    Result: k <= MAX_IK_SOLUTIONS solutions inside the joint limits, revolute angles wrapped
+    into (-pi, pi] or, where that is outside the limits, their lowest equivalent inside
+    them; k = 0 when the target is out of reach or not finite. ik_branches also gives the
+    solutions outside the limits (in_limits 0).
     Solver: planar arm: revolute axes (and any prismatic axis) parallel to world z; the last
     revolute joint sets the yaw, the first two place the wrist point (SP3, SP1).
     Order: nested loops over the branches, outermost first; where a subproblem has two roots
@@ -647,8 +736,9 @@ def ik(mu):
     root (a target on a singularity or on the workspace boundary) is returned once, and an
     angle the target leaves free (a singular wrist or shoulder) is set to 0.
     """
-    q, valid = ik_branches(mu)
-    return q[valid] if valid.ndim == 1 else (q, valid)
+    q, valid, in_limits = ik_branches(mu)
+    keep = valid & in_limits if limits else valid
+    return q[keep] if keep.ndim == 1 else (q, keep)
 
 
 # -- Iterative inverse kinematics: the loop around ik_numeric_step --

@@ -5,7 +5,8 @@ Planar 2R arm with unit links (rtb Planar2), standard DH
 Every function takes `q` (2 x 1: radians for revolute joints, m for
 prismatic ones) and returns a rows x cols result whose zeros are structural; ik_branches
 (also named ik) takes the target instead of q and returns every branch (MAX_IK_SOLUTIONS x
-DOF) and its validity (MAX_IK_SOLUTIONS x 1, 1 or 0).
+DOF), its validity and whether it is inside the joint limits (MAX_IK_SOLUTIONS x 1 each, 1
+or 0); ik_nearest takes the target and q_seed and returns the solution nearest q_seed.
 Task vector: (x, y).
 """
 
@@ -464,7 +465,7 @@ def _ik_numeric_step(target, q, damping):
 
 
 def _ik_branches(mu):
-    """Every branch of the closed-form ik and whether the target allows it: 79 operations."""
+    """Every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits: 79 operations."""
     mu0 = mu[0]
     mu1 = mu[1]
     t0 = mu0**2 + mu1**2
@@ -503,7 +504,84 @@ def _ik_branches(mu):
     valid = casadi.SX(2, 1)
     valid[0, 0] = casadi.logic_and(casadi.logic_and(t26, t27), (t4 >= -1e-12))
     valid[1, 0] = casadi.logic_and(casadi.logic_and(t26, t27), (t4 > 1e-12))
-    return [q, valid]
+    in_limits = casadi.SX(2, 1)
+    in_limits[0, 0] = True
+    in_limits[1, 0] = True
+    return [q, valid, in_limits]
+
+
+def _ik_nearest(mu, q_seed, weights):
+    """The closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status: 147 operations."""
+    mu0 = mu[0]
+    mu1 = mu[1]
+    qn1 = q_seed[0]
+    qn2 = q_seed[1]
+    qw1 = weights[0]
+    qw2 = weights[1]
+    t0 = mu0**2 + mu1**2
+    t1 = 1.0 - 0.5*t0
+    t2 = t1**2
+    t3 = 1 - t2
+    t4 = (1e-12 < t3)
+    t5 = casadi.if_else(t4, t1, casadi.if_else((t1 > 0), 1, -1))
+    t6 = casadi.if_else(t4, casadi.sqrt(t3), 0)
+    t7 = casadi.atan2(t6, t5)
+    t8 = 3.141592653589793 - t7
+    t9 = t8 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t8)
+    t10 = t9 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t9)
+    t11 = False
+    t12 = casadi.if_else(t11, 0, 3.141592653589793 + t7)
+    t13 = casadi.if_else(t11, 0, -t6)
+    t14 = t12 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t12)
+    t15 = t14 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t14)
+    t16 = -t5
+    t17 = casadi.if_else(t11, 1, t16)
+    t18 = 1 + t17
+    t19 = mu0*t18 + mu1*t13
+    t20 = mu1*t18 - mu0*t13
+    t21 = t19**2 + t20**2
+    t22 = t13**2 + t18**2
+    t23 = 1 + t16
+    t24 = mu0*t23 + mu1*t6
+    t25 = mu1*t23 - mu0*t6
+    t26 = t24**2 + t25**2
+    t27 = t23**2 + t6**2
+    t28 = mu0 + mu1
+    t29 = t28
+    t30 = qn1 + qn2 + qw1 + qw2 + t28
+    t31 = 1e-24*t0
+    t32 = casadi.if_else((t21 <= t22*t31), 0, casadi.atan2(t20, t19))
+    t33 = t32 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn1 - 0.15915494309189535*t32)
+    t34 = casadi.if_else((t26 <= t27*t31), 0, casadi.atan2(t25, t24))
+    t35 = t34 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn1 - 0.15915494309189535*t34)
+    t36 = -qn1
+    t37 = -qn2
+    t38 = qw1*(t33 + t36)**2 + qw2*(t15 + t37)**2
+    t39 = qw1*(t35 + t36)**2 + qw2*(t10 + t37)**2
+    t40 = (casadi.fabs(t29) < casadi.inf)
+    t41 = True
+    t42 = casadi.if_else(casadi.logic_and(t40, casadi.logic_or(casadi.logic_and(t11, (t2 <= 1e-12)), casadi.logic_and(t41, (t3 >= -1e-12)))), 1, 0)
+    t43 = casadi.if_else((t42 > 0), 1, 0)
+    t44 = casadi.if_else(casadi.logic_and(casadi.logic_and(t4, t40), t41), 1, 0)
+    t45 = (t43 > 0)
+    t46 = casadi.if_else(t45, t33, qn1)
+    t47 = casadi.if_else(t45, t15, qn2)
+    t48 = casadi.if_else(t45, t38, 0)
+    t49 = (t44 > 0)
+    t50 = casadi.if_else(casadi.logic_and(t49, casadi.logic_or((t39 < t48), (t43 < 1))), 1, 0)
+    t51 = casadi.if_else(t49, 1, t43)
+    t52 = (t50 > 0)
+    t53 = casadi.if_else(t52, t35, t46)
+    t54 = casadi.if_else(t52, t10, t47)
+    t55 = (casadi.fabs(t30) < casadi.inf)
+    t56 = (t51 > 0)
+    t57 = casadi.logic_and(t55, t56)
+    q = casadi.SX(2, 1)
+    q[0, 0] = casadi.if_else(t57, t53, qn1)
+    q[1, 0] = casadi.if_else(t57, t54, qn2)
+    status = casadi.SX(1, 1)
+    status[0, 0] = casadi.if_else(casadi.logic_not(t55), 2, casadi.if_else(t56, 0, 1))
+    return [q, status]
 
 
 _q = casadi.SX.sym("q", 2, 1)
@@ -512,6 +590,8 @@ _mu_dot = casadi.SX.sym("mu_dot", 2, 1)
 _damping = casadi.SX.sym("damping", 1, 1)
 _target = casadi.SX.sym("target", 2, 1)
 _mu = casadi.SX.sym("mu", 2, 1)
+_q_seed = casadi.SX.sym("q_seed", 2, 1)
+_weights = casadi.SX.sym("weights", 2, 1)
 fk = casadi.Function("fk", [_q], _fk(_q), ["q"], ["T"])
 jacobian = casadi.Function("jacobian", [_q], _jacobian(_q), ["q"], ["J"])
 fk_jacobian = casadi.Function("fk_jacobian", [_q], _fk_jacobian(_q), ["q"], ["T", "J"])
@@ -528,8 +608,9 @@ manipulability = casadi.Function("manipulability", [_q], _manipulability(_q), ["
 jacobian_det = casadi.Function("jacobian_det", [_q], _jacobian_det(_q), ["q"], ["d"])
 velocity_ik = casadi.Function("velocity_ik", [_q, _mu_dot, _damping], _velocity_ik(_q, _mu_dot, _damping), ["q", "mu_dot", "damping"], ["q_dot", "status"])
 ik_numeric_step = casadi.Function("ik_numeric_step", [_target, _q, _damping], _ik_numeric_step(_target, _q, _damping), ["target", "q", "damping"], ["q_start", "q_next", "cost"])
-ik_branches = casadi.Function("ik_branches", [_mu], _ik_branches(_mu), ["mu"], ["q", "valid"])
-ik = ik_branches  # CasADi functions have fixed-size outputs: every branch and its validity
+ik_branches = casadi.Function("ik_branches", [_mu], _ik_branches(_mu), ["mu"], ["q", "valid", "in_limits"])
+ik_nearest = casadi.Function("ik_nearest", [_mu, _q_seed, _weights], _ik_nearest(_mu, _q_seed, _weights), ["mu", "q_seed", "weights"], ["q", "status"])
+ik = ik_branches  # CasADi functions have fixed-size outputs: every branch, its validity and its limits
 
 IK_NUMERIC_CONVERGED = 0  # |error| <= tol
 IK_NUMERIC_ITERATION_LIMIT = 1  # IK_NUMERIC_ITERATIONS steps taken, |error| still above tol
@@ -571,4 +652,4 @@ ik_numeric = casadi.Function("ik_numeric", _inputs, _ik_numeric(*_inputs), ["tar
 
 def functions():
     """All functions by name."""
-    return {"fk": fk, "jacobian": jacobian, "fk_jacobian": fk_jacobian, "jacobian_tool": jacobian_tool, "task": task, "task_jacobian": task_jacobian, "fk_jacobian_dot": fk_jacobian_dot, "jacobian_dot": jacobian_dot, "bias_acceleration": bias_acceleration, "task_jacobian_dot": task_jacobian_dot, "hessian": hessian, "singularity_factors": singularity_factors, "manipulability": manipulability, "jacobian_det": jacobian_det, "velocity_ik": velocity_ik, "ik_numeric_step": ik_numeric_step, "ik_branches": ik_branches}
+    return {"fk": fk, "jacobian": jacobian, "fk_jacobian": fk_jacobian, "jacobian_tool": jacobian_tool, "task": task, "task_jacobian": task_jacobian, "fk_jacobian_dot": fk_jacobian_dot, "jacobian_dot": jacobian_dot, "bias_acceleration": bias_acceleration, "task_jacobian_dot": task_jacobian_dot, "hessian": hessian, "singularity_factors": singularity_factors, "manipulability": manipulability, "jacobian_det": jacobian_det, "velocity_ik": velocity_ik, "ik_numeric_step": ik_numeric_step, "ik_branches": ik_branches, "ik_nearest": ik_nearest}

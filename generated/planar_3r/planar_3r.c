@@ -881,7 +881,7 @@ planar_3r_real planar_3r_ik_numeric_step(const planar_3r_real target[PLANAR_3R_T
     return (isfinite(t11) ? t14 : -1);
 }
 
-void planar_3r_ik_branches(const planar_3r_real mu[PLANAR_3R_TASK_DIM], planar_3r_real q[PLANAR_3R_MAX_IK_SOLUTIONS * PLANAR_3R_DOF], int valid[PLANAR_3R_MAX_IK_SOLUTIONS])
+void planar_3r_ik_branches(const planar_3r_real mu[PLANAR_3R_TASK_DIM], planar_3r_real q[PLANAR_3R_MAX_IK_SOLUTIONS * PLANAR_3R_DOF], int valid[PLANAR_3R_MAX_IK_SOLUTIONS], int in_limits[PLANAR_3R_MAX_IK_SOLUTIONS])
 {
     /* 106 operations */
 
@@ -939,16 +939,117 @@ void planar_3r_ik_branches(const planar_3r_real mu[PLANAR_3R_TASK_DIM], planar_3
     q[5] = -t31 - t35 - 6.283185307179586*ceil(-0.15915494309189535*t32 - 0.15915494309189535*t35);
     valid[0] = t36 && t37 && t8 >= -1e-12;
     valid[1] = t36 && t37 && t8 > 1e-12;
+    in_limits[0] = 1;
+    in_limits[1] = 1;
+}
+
+int planar_3r_ik_nearest(const planar_3r_real mu[PLANAR_3R_TASK_DIM], const planar_3r_real q_seed[PLANAR_3R_DOF], const planar_3r_real weights[PLANAR_3R_DOF], planar_3r_real q[PLANAR_3R_DOF])
+{
+    /* 200 operations */
+
+    /* Inputs */
+    const planar_3r_real mu0 = mu[0];
+    const planar_3r_real mu1 = mu[1];
+    const planar_3r_real mu2 = mu[2];
+    const planar_3r_real qn1 = q_seed[0];
+    const planar_3r_real qn2 = q_seed[1];
+    const planar_3r_real qn3 = q_seed[2];
+    const planar_3r_real qw1 = weights[0];
+    const planar_3r_real qw2 = weights[1];
+    const planar_3r_real qw3 = weights[2];
+
+    /* Intermediate terms */
+    const planar_3r_real t0 = cos(mu2);
+    const planar_3r_real t1 = sin(mu2);
+    const planar_3r_real t2 = mu0 - t0;
+    const planar_3r_real t3 = mu1 - t1;
+    const planar_3r_real t4 = (t2*t2) + (t3*t3);
+    const planar_3r_real t5 = 1.0 - 0.5*t4;
+    const planar_3r_real t6 = (t5*t5);
+    const planar_3r_real t7 = 1 - t6;
+    const int t8 = 1e-12 < t7;
+    const planar_3r_real t9 = (t8 ? t5 : (t5 > 0 ? 1 : -1));
+    const planar_3r_real t10 = (t8 ? sqrt(t7) : 0);
+    const planar_3r_real t11 = atan2(t10, t9);
+    const planar_3r_real t12 = 3.141592653589793 - t11;
+    const planar_3r_real t13 = t12 - 6.283185307179586*ceil(-0.5 + 0.15915494309189535*t12);
+    const planar_3r_real t14 = t13 + 6.283185307179586*floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t13);
+    const int t15 = 0;
+    const planar_3r_real t16 = (t15 ? 0 : 3.141592653589793 + t11);
+    const planar_3r_real t17 = (t15 ? 0 : -t10);
+    const planar_3r_real t18 = t16 - 6.283185307179586*ceil(-0.5 + 0.15915494309189535*t16);
+    const planar_3r_real t19 = t18 + 6.283185307179586*floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t18);
+    const planar_3r_real t20 = -t9;
+    const planar_3r_real t21 = (t15 ? 1 : t20);
+    const planar_3r_real t22 = 1 + t21;
+    const planar_3r_real t23 = t17*t3 + t2*t22;
+    const planar_3r_real t24 = t22*t3 - t17*t2;
+    const planar_3r_real t25 = (t23*t23) + (t24*t24);
+    const planar_3r_real t26 = (t17*t17) + (t22*t22);
+    const planar_3r_real t27 = 1 + t20;
+    const planar_3r_real t28 = t10*t3 + t2*t27;
+    const planar_3r_real t29 = t27*t3 - t10*t2;
+    const planar_3r_real t30 = (t28*t28) + (t29*t29);
+    const planar_3r_real t31 = (t10*t10) + (t27*t27);
+    const planar_3r_real t32 = mu0 + mu1 + mu2;
+    const planar_3r_real t33 = t32;
+    const planar_3r_real t34 = qn1 + qn2 + qn3 + qw1 + qw2 + qw3 + t32;
+    const planar_3r_real t35 = 1e-24*t4;
+    const planar_3r_real t36 = (t25 <= t26*t35 ? 0 : atan2(t24, t23));
+    const planar_3r_real t37 = t36;
+    const planar_3r_real t38 = t37 + 6.283185307179586*floor(0.5 + 0.15915494309189535*qn1 - 0.15915494309189535*t37);
+    const planar_3r_real t39 = -mu2;
+    const planar_3r_real t40 = 3.141592653589793 + t39;
+    const planar_3r_real t41 = t16 + t36;
+    const planar_3r_real t42 = t39 + t41 + 6.283185307179586*ceil(-0.15915494309189535*t40 - 0.15915494309189535*t41);
+    const planar_3r_real t43 = -t42 + 6.283185307179586*floor(0.5 + 0.15915494309189535*qn3 + 0.15915494309189535*t42);
+    const planar_3r_real t44 = -qn1;
+    const planar_3r_real t45 = -qn2;
+    const planar_3r_real t46 = -qn3;
+    const planar_3r_real t47 = qw1*((t38 + t44)*(t38 + t44)) + qw2*((t19 + t45)*(t19 + t45)) + qw3*((t43 + t46)*(t43 + t46));
+    const int t48 = isfinite(t33);
+    const int t49 = 1;
+    const planar_3r_real t50 = (t48 && ((t15 && t6 <= 1e-12) || (t49 && t7 >= -1e-12)) ? 1 : 0);
+    const planar_3r_real t51 = (t50 > 0 ? 1 : 0);
+    const planar_3r_real t52 = (t48 && t49 && t8 ? 1 : 0);
+    const int t53 = t51 > 0;
+    const planar_3r_real t54 = (t53 ? t38 : qn1);
+    const planar_3r_real t55 = (t53 ? t19 : qn2);
+    const planar_3r_real t56 = (t53 ? t43 : qn3);
+    const planar_3r_real t57 = (t53 ? t47 : 0);
+    const planar_3r_real t58 = (t30 <= t31*t35 ? 0 : atan2(t29, t28));
+    const planar_3r_real t59 = t58;
+    const planar_3r_real t60 = t59 + 6.283185307179586*floor(0.5 + 0.15915494309189535*qn1 - 0.15915494309189535*t59);
+    const planar_3r_real t61 = t12 + t58;
+    const planar_3r_real t62 = t39 + t61 + 6.283185307179586*ceil(-0.15915494309189535*t40 - 0.15915494309189535*t61);
+    const planar_3r_real t63 = -t62 + 6.283185307179586*floor(0.5 + 0.15915494309189535*qn3 + 0.15915494309189535*t62);
+    const planar_3r_real t64 = qw1*((t44 + t60)*(t44 + t60)) + qw2*((t14 + t45)*(t14 + t45)) + qw3*((t46 + t63)*(t46 + t63));
+    const int t65 = t52 > 0;
+    const planar_3r_real t66 = (t65 && ((t57 > t64) || (t51 < 1)) ? 1 : 0);
+    const planar_3r_real t67 = (t65 ? 1 : t51);
+    const int t68 = t66 > 0;
+    const planar_3r_real t69 = (t68 ? t60 : t54);
+    const planar_3r_real t70 = (t68 ? t14 : t55);
+    const planar_3r_real t71 = (t68 ? t63 : t56);
+    const int t72 = isfinite(t34);
+    const int t73 = t67 > 0;
+    const int t74 = t72 && t73;
+
+    /* Outputs */
+    q[0] = (t74 ? t69 : qn1);
+    q[1] = (t74 ? t70 : qn2);
+    q[2] = (t74 ? t71 : qn3);
+    return (!t72 ? 2 : (t73 ? 0 : 1));
 }
 
 int planar_3r_ik(const planar_3r_real mu[PLANAR_3R_TASK_DIM], planar_3r_real q[PLANAR_3R_MAX_IK_SOLUTIONS * PLANAR_3R_DOF])
 {
     planar_3r_real branches[PLANAR_3R_MAX_IK_SOLUTIONS * PLANAR_3R_DOF];
-    int valid[PLANAR_3R_MAX_IK_SOLUTIONS];
+    int valid[PLANAR_3R_MAX_IK_SOLUTIONS], in_limits[PLANAR_3R_MAX_IK_SOLUTIONS];
     int count = 0, i, j;
-    planar_3r_ik_branches(mu, branches, valid);
+    planar_3r_ik_branches(mu, branches, valid, in_limits);
     for (i = 0; i < PLANAR_3R_MAX_IK_SOLUTIONS; ++i) {
-        if (valid[i]) {
+        if (valid[i] && in_limits[i]) {
             for (j = 0; j < PLANAR_3R_DOF; ++j) {
                 q[PLANAR_3R_DOF * count + j] = branches[PLANAR_3R_DOF * i + j];
             }

@@ -95,9 +95,13 @@ int planar_3r_velocity_ik(const planar_3r_real q[PLANAR_3R_DOF], const planar_3r
  * Result: q_start[i], i < 3; q_next[i], i < 3; returned as a scalar. 194 operations. */
 planar_3r_real planar_3r_ik_numeric_step(const planar_3r_real target[PLANAR_3R_TASK_DIM], const planar_3r_real q[PLANAR_3R_DOF], planar_3r_real damping, planar_3r_real q_start[PLANAR_3R_DOF], planar_3r_real q_next[PLANAR_3R_DOF]);
 
-/* Every branch of the closed-form ik and whether the target allows it.
- * Result: q: 2 x 3 row-major, element (r, c) at q[r * 3 + c]; valid[i], i < 2. 106 operations. */
-void planar_3r_ik_branches(const planar_3r_real mu[PLANAR_3R_TASK_DIM], planar_3r_real q[PLANAR_3R_MAX_IK_SOLUTIONS * PLANAR_3R_DOF], int valid[PLANAR_3R_MAX_IK_SOLUTIONS]);
+/* Every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits.
+ * Result: q: 2 x 3 row-major, element (r, c) at q[r * 3 + c]; valid[i], i < 2; in_limits[i], i < 2. 106 operations. */
+void planar_3r_ik_branches(const planar_3r_real mu[PLANAR_3R_TASK_DIM], planar_3r_real q[PLANAR_3R_MAX_IK_SOLUTIONS * PLANAR_3R_DOF], int valid[PLANAR_3R_MAX_IK_SOLUTIONS], int in_limits[PLANAR_3R_MAX_IK_SOLUTIONS]);
+
+/* The closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status.
+ * Result: q[i], i < 3; returned as a scalar. 200 operations. */
+int planar_3r_ik_nearest(const planar_3r_real mu[PLANAR_3R_TASK_DIM], const planar_3r_real q_seed[PLANAR_3R_DOF], const planar_3r_real weights[PLANAR_3R_DOF], planar_3r_real q[PLANAR_3R_DOF]);
 
 /* Statuses of planar_3r_velocity_ik: OK, singular (a diagonal entry of the QR factor R of the
  * 3 x 3 system at most 1e-12 times its Frobenius norm: take damping > 0), or
@@ -107,12 +111,15 @@ void planar_3r_ik_branches(const planar_3r_real mu[PLANAR_3R_TASK_DIM], planar_3
 #define PLANAR_3R_VELOCITY_IK_SINGULAR 1
 #define PLANAR_3R_VELOCITY_IK_NOT_FINITE 2
 
-/* Closed-form inverse kinematics: every joint solution that reaches the target; returns
- * their count k and writes solution i to q[i * PLANAR_3R_DOF + j], i < k: the valid
- * rows of planar_3r_ik_branches, in its order. No allocation, no recursion.
+/* Closed-form inverse kinematics: every joint solution inside the joint limits that reaches
+ * the target; returns their count k and writes solution i to q[i * PLANAR_3R_DOF + j],
+ * i < k: the rows of planar_3r_ik_branches that are valid and in_limits, in its order
+ * (planar_3r_ik_branches also gives those outside the limits). No allocation, no recursion.
  * target: the task vector (x, y, yaw).
- * Result: k <= PLANAR_3R_MAX_IK_SOLUTIONS solutions, revolute angles wrapped into (-pi,
- * pi], joint limits not applied; k = 0 when the target is out of reach or not finite.
+ * Result: k <= PLANAR_3R_MAX_IK_SOLUTIONS solutions inside the joint limits, revolute
+ * angles wrapped into (-pi, pi] or, where that is outside the limits, their lowest
+ * equivalent inside them; k = 0 when the target is out of reach or not finite. ik_branches
+ * also gives the solutions outside the limits (in_limits 0).
  * Solver: planar arm: revolute axes (and any prismatic axis) parallel to world z; the last
  * revolute joint sets the yaw, the first two place the wrist point (SP3, SP1).
  * Order: nested loops over the branches, outermost first; where a subproblem has two roots
@@ -124,6 +131,12 @@ void planar_3r_ik_branches(const planar_3r_real mu[PLANAR_3R_TASK_DIM], planar_3
  * angle the target leaves free (a singular wrist or shoulder) is set to 0.
  */
 int planar_3r_ik(const planar_3r_real mu[PLANAR_3R_TASK_DIM], planar_3r_real q[PLANAR_3R_MAX_IK_SOLUTIONS * PLANAR_3R_DOF]);
+
+/* Statuses of planar_3r_ik_nearest: a solution found; no solution inside the limits (out of
+ * reach); the target (its first three rows), q_seed or weights not finite. q = q_seed unless OK. */
+#define PLANAR_3R_IK_NEAREST_OK 0
+#define PLANAR_3R_IK_NEAREST_NO_SOLUTION 1
+#define PLANAR_3R_IK_NEAREST_NOT_FINITE 2
 
 /* ik_numeric status codes. */
 #define PLANAR_3R_IK_NUMERIC_CONVERGED 0       /* |error| <= tol */

@@ -856,7 +856,7 @@ def ik_numeric_step(target, q, damping=0.0):
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def ik_branches(mu):
-    """every branch of the closed-form ik and whether the target allows it: (2 x 3 and 2 x 1), 106 operations."""
+    """every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits: (2 x 3 and 2 x 1 and 2 x 1), 106 operations."""
     mu = _argument("mu", mu, (3,))
     mu0 = mu[..., 0]
     mu1 = mu[..., 1]
@@ -909,21 +909,131 @@ def ik_branches(mu):
     valid = numpy.empty(mu.shape[:-1] + (2,), dtype=bool)
     valid[..., 0] = t36 & t37 & (numpy.greater_equal(t8, -1e-12))
     valid[..., 1] = t36 & t37 & (numpy.greater(t8, 1e-12))
-    return q, valid
+    in_limits = numpy.empty(mu.shape[:-1] + (2,), dtype=bool)
+    in_limits[..., 0] = True
+    in_limits[..., 1] = True
+    return q, valid, in_limits
+
+
+@numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
+def ik_nearest(mu, q_seed, weights=(1.0,) * DOF):
+    """the closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status: (3 x 1 and 1 x 1), 200 operations."""
+    mu = _argument("mu", mu, (3,))
+    q_seed = _argument("q_seed", q_seed, (3,))
+    weights = _argument("weights", weights, (3,))
+    mu0 = mu[..., 0]
+    mu1 = mu[..., 1]
+    mu2 = mu[..., 2]
+    qn1 = q_seed[..., 0]
+    qn2 = q_seed[..., 1]
+    qn3 = q_seed[..., 2]
+    qw1 = weights[..., 0]
+    qw2 = weights[..., 1]
+    qw3 = weights[..., 2]
+    t0 = numpy.cos(mu2)
+    t1 = numpy.sin(mu2)
+    t2 = mu0 - t0
+    t3 = mu1 - t1
+    t4 = t2**2 + t3**2
+    t5 = 1.0 - 0.5*t4
+    t6 = t5**2
+    t7 = 1 - t6
+    t8 = numpy.less(1e-12, t7)
+    t9 = numpy.where(t8, t5, numpy.where(numpy.greater(t5, 0), 1, -1))
+    t10 = numpy.where(t8, numpy.sqrt(t7), 0)
+    t11 = numpy.arctan2(t10, t9)
+    t12 = 3.141592653589793 - t11
+    t13 = t12 - 6.283185307179586*numpy.ceil(-0.5 + 0.15915494309189535*t12)
+    t14 = t13 + 6.283185307179586*numpy.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t13)
+    t15 = False
+    t16 = numpy.where(t15, 0, 3.141592653589793 + t11)
+    t17 = numpy.where(t15, 0, -t10)
+    t18 = t16 - 6.283185307179586*numpy.ceil(-0.5 + 0.15915494309189535*t16)
+    t19 = t18 + 6.283185307179586*numpy.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t18)
+    t20 = -t9
+    t21 = numpy.where(t15, 1, t20)
+    t22 = 1 + t21
+    t23 = t17*t3 + t2*t22
+    t24 = t22*t3 - t17*t2
+    t25 = t23**2 + t24**2
+    t26 = t17**2 + t22**2
+    t27 = 1 + t20
+    t28 = t10*t3 + t2*t27
+    t29 = t27*t3 - t10*t2
+    t30 = t28**2 + t29**2
+    t31 = t10**2 + t27**2
+    t32 = mu0 + mu1 + mu2
+    t33 = t32
+    t34 = qn1 + qn2 + qn3 + qw1 + qw2 + qw3 + t32
+    t35 = 1e-24*t4
+    t36 = numpy.where(numpy.less_equal(t25, t26*t35), 0, numpy.arctan2(t24, t23))
+    t37 = t36
+    t38 = t37 + 6.283185307179586*numpy.floor(0.5 + 0.15915494309189535*qn1 - 0.15915494309189535*t37)
+    t39 = -mu2
+    t40 = 3.141592653589793 + t39
+    t41 = t16 + t36
+    t42 = t39 + t41 + 6.283185307179586*numpy.ceil(-0.15915494309189535*t40 - 0.15915494309189535*t41)
+    t43 = -t42 + 6.283185307179586*numpy.floor(0.5 + 0.15915494309189535*qn3 + 0.15915494309189535*t42)
+    t44 = -qn1
+    t45 = -qn2
+    t46 = -qn3
+    t47 = qw1*(t38 + t44)**2 + qw2*(t19 + t45)**2 + qw3*(t43 + t46)**2
+    t48 = numpy.isfinite(t33)
+    t49 = True
+    t50 = numpy.where(t48 & ((t15 & (numpy.less_equal(t6, 1e-12))) | (t49 & (numpy.greater_equal(t7, -1e-12)))), 1, 0)
+    t51 = numpy.where(numpy.greater(t50, 0), 1, 0)
+    t52 = numpy.where(t48 & t49 & t8, 1, 0)
+    t53 = numpy.greater(t51, 0)
+    t54 = numpy.where(t53, t38, qn1)
+    t55 = numpy.where(t53, t19, qn2)
+    t56 = numpy.where(t53, t43, qn3)
+    t57 = numpy.where(t53, t47, 0)
+    t58 = numpy.where(numpy.less_equal(t30, t31*t35), 0, numpy.arctan2(t29, t28))
+    t59 = t58
+    t60 = t59 + 6.283185307179586*numpy.floor(0.5 + 0.15915494309189535*qn1 - 0.15915494309189535*t59)
+    t61 = t12 + t58
+    t62 = t39 + t61 + 6.283185307179586*numpy.ceil(-0.15915494309189535*t40 - 0.15915494309189535*t61)
+    t63 = -t62 + 6.283185307179586*numpy.floor(0.5 + 0.15915494309189535*qn3 + 0.15915494309189535*t62)
+    t64 = qw1*(t44 + t60)**2 + qw2*(t14 + t45)**2 + qw3*(t46 + t63)**2
+    t65 = numpy.greater(t52, 0)
+    t66 = numpy.where(t65 & ((numpy.greater(t57, t64)) | (numpy.less(t51, 1))), 1, 0)
+    t67 = numpy.where(t65, 1, t51)
+    t68 = numpy.greater(t66, 0)
+    t69 = numpy.where(t68, t60, t54)
+    t70 = numpy.where(t68, t14, t55)
+    t71 = numpy.where(t68, t63, t56)
+    t72 = numpy.isfinite(t34)
+    t73 = numpy.greater(t67, 0)
+    t74 = t72 & t73
+    q = numpy.empty(numpy.broadcast_shapes(mu.shape[:-1], q_seed.shape[:-1], weights.shape[:-1]) + (3,))
+    q[..., 0] = numpy.where(t74, t69, qn1)
+    q[..., 1] = numpy.where(t74, t70, qn2)
+    q[..., 2] = numpy.where(t74, t71, qn3)
+    status = numpy.empty(numpy.broadcast_shapes(mu.shape[:-1], q_seed.shape[:-1], weights.shape[:-1]) + (), dtype=int)
+    status[...] = numpy.where(numpy.logical_not(t72), 2, numpy.where(t73, 0, 1))
+    return q, status
 
 
 MAX_IK_SOLUTIONS = 2
+# Statuses of ik_nearest: a solution found; no solution inside the limits (out of reach); the
+# target (its first three rows), q_seed or weights not finite. q = q_seed unless OK.
+IK_NEAREST_OK = 0
+IK_NEAREST_NO_SOLUTION = 1
+IK_NEAREST_NOT_FINITE = 2
 
 
-def ik(mu):
-    """Closed-form inverse kinematics: every joint solution that reaches the target.
+def ik(mu, limits=True):
+    """Closed-form inverse kinematics: every joint solution that reaches the target, inside
+    the joint limits unless `limits` is False.
 
-    One target: the solutions as (k, DOF), the valid rows of ik_branches in its order.
-    A batch of targets: ik_branches' (q, valid), (..., MAX_IK_SOLUTIONS, DOF) and
-    (..., MAX_IK_SOLUTIONS).
+    One target: the solutions as (k, DOF), the rows of ik_branches that are valid (and
+    in_limits), in its order. A batch of targets: (q, keep), (..., MAX_IK_SOLUTIONS, DOF)
+    and (..., MAX_IK_SOLUTIONS).
     target: the task vector (x, y, yaw).
-    Result: k <= MAX_IK_SOLUTIONS solutions, revolute angles wrapped into (-pi, pi], joint
-    limits not applied; k = 0 when the target is out of reach or not finite.
+    Result: k <= MAX_IK_SOLUTIONS solutions inside the joint limits, revolute angles wrapped
+    into (-pi, pi] or, where that is outside the limits, their lowest equivalent inside
+    them; k = 0 when the target is out of reach or not finite. ik_branches also gives the
+    solutions outside the limits (in_limits 0).
     Solver: planar arm: revolute axes (and any prismatic axis) parallel to world z; the last
     revolute joint sets the yaw, the first two place the wrist point (SP3, SP1).
     Order: nested loops over the branches, outermost first; where a subproblem has two roots
@@ -934,8 +1044,9 @@ def ik(mu):
     root (a target on a singularity or on the workspace boundary) is returned once, and an
     angle the target leaves free (a singular wrist or shoulder) is set to 0.
     """
-    q, valid = ik_branches(mu)
-    return q[valid] if valid.ndim == 1 else (q, valid)
+    q, valid, in_limits = ik_branches(mu)
+    keep = valid & in_limits if limits else valid
+    return q[keep] if keep.ndim == 1 else (q, keep)
 
 
 # -- Iterative inverse kinematics: the loop around ik_numeric_step --

@@ -5,7 +5,8 @@ Planar 3R arm with unit links (rtb Planar3), standard DH
 Every function takes `q` (3 x 1: radians for revolute joints, m for
 prismatic ones) and returns a rows x cols result whose zeros are structural; ik_branches
 (also named ik) takes the target instead of q and returns every branch (MAX_IK_SOLUTIONS x
-DOF) and its validity (MAX_IK_SOLUTIONS x 1, 1 or 0).
+DOF), its validity and whether it is inside the joint limits (MAX_IK_SOLUTIONS x 1 each, 1
+or 0); ik_nearest takes the target and q_seed and returns the solution nearest q_seed.
 Task vector: (x, y, yaw).
 """
 
@@ -699,7 +700,7 @@ def _ik_numeric_step(target, q, damping):
 
 
 def _ik_branches(mu):
-    """Every branch of the closed-form ik and whether the target allows it: 106 operations."""
+    """Every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits: 106 operations."""
     mu0 = mu[0]
     mu1 = mu[1]
     mu2 = mu[2]
@@ -751,7 +752,105 @@ def _ik_branches(mu):
     valid = casadi.SX(2, 1)
     valid[0, 0] = casadi.logic_and(casadi.logic_and(t36, t37), (t8 >= -1e-12))
     valid[1, 0] = casadi.logic_and(casadi.logic_and(t36, t37), (t8 > 1e-12))
-    return [q, valid]
+    in_limits = casadi.SX(2, 1)
+    in_limits[0, 0] = True
+    in_limits[1, 0] = True
+    return [q, valid, in_limits]
+
+
+def _ik_nearest(mu, q_seed, weights):
+    """The closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status: 200 operations."""
+    mu0 = mu[0]
+    mu1 = mu[1]
+    mu2 = mu[2]
+    qn1 = q_seed[0]
+    qn2 = q_seed[1]
+    qn3 = q_seed[2]
+    qw1 = weights[0]
+    qw2 = weights[1]
+    qw3 = weights[2]
+    t0 = casadi.cos(mu2)
+    t1 = casadi.sin(mu2)
+    t2 = mu0 - t0
+    t3 = mu1 - t1
+    t4 = t2**2 + t3**2
+    t5 = 1.0 - 0.5*t4
+    t6 = t5**2
+    t7 = 1 - t6
+    t8 = (1e-12 < t7)
+    t9 = casadi.if_else(t8, t5, casadi.if_else((t5 > 0), 1, -1))
+    t10 = casadi.if_else(t8, casadi.sqrt(t7), 0)
+    t11 = casadi.atan2(t10, t9)
+    t12 = 3.141592653589793 - t11
+    t13 = t12 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t12)
+    t14 = t13 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t13)
+    t15 = False
+    t16 = casadi.if_else(t15, 0, 3.141592653589793 + t11)
+    t17 = casadi.if_else(t15, 0, -t10)
+    t18 = t16 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t16)
+    t19 = t18 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t18)
+    t20 = -t9
+    t21 = casadi.if_else(t15, 1, t20)
+    t22 = 1 + t21
+    t23 = t17*t3 + t2*t22
+    t24 = t22*t3 - t17*t2
+    t25 = t23**2 + t24**2
+    t26 = t17**2 + t22**2
+    t27 = 1 + t20
+    t28 = t10*t3 + t2*t27
+    t29 = t27*t3 - t10*t2
+    t30 = t28**2 + t29**2
+    t31 = t10**2 + t27**2
+    t32 = mu0 + mu1 + mu2
+    t33 = t32
+    t34 = qn1 + qn2 + qn3 + qw1 + qw2 + qw3 + t32
+    t35 = 1e-24*t4
+    t36 = casadi.if_else((t25 <= t26*t35), 0, casadi.atan2(t24, t23))
+    t37 = t36
+    t38 = t37 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn1 - 0.15915494309189535*t37)
+    t39 = -mu2
+    t40 = 3.141592653589793 + t39
+    t41 = t16 + t36
+    t42 = t39 + t41 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t40 - 0.15915494309189535*t41)
+    t43 = -t42 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn3 + 0.15915494309189535*t42)
+    t44 = -qn1
+    t45 = -qn2
+    t46 = -qn3
+    t47 = qw1*(t38 + t44)**2 + qw2*(t19 + t45)**2 + qw3*(t43 + t46)**2
+    t48 = (casadi.fabs(t33) < casadi.inf)
+    t49 = True
+    t50 = casadi.if_else(casadi.logic_and(t48, casadi.logic_or(casadi.logic_and(t15, (t6 <= 1e-12)), casadi.logic_and(t49, (t7 >= -1e-12)))), 1, 0)
+    t51 = casadi.if_else((t50 > 0), 1, 0)
+    t52 = casadi.if_else(casadi.logic_and(casadi.logic_and(t48, t49), t8), 1, 0)
+    t53 = (t51 > 0)
+    t54 = casadi.if_else(t53, t38, qn1)
+    t55 = casadi.if_else(t53, t19, qn2)
+    t56 = casadi.if_else(t53, t43, qn3)
+    t57 = casadi.if_else(t53, t47, 0)
+    t58 = casadi.if_else((t30 <= t31*t35), 0, casadi.atan2(t29, t28))
+    t59 = t58
+    t60 = t59 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn1 - 0.15915494309189535*t59)
+    t61 = t12 + t58
+    t62 = t39 + t61 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t40 - 0.15915494309189535*t61)
+    t63 = -t62 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn3 + 0.15915494309189535*t62)
+    t64 = qw1*(t44 + t60)**2 + qw2*(t14 + t45)**2 + qw3*(t46 + t63)**2
+    t65 = (t52 > 0)
+    t66 = casadi.if_else(casadi.logic_and(t65, casadi.logic_or((t57 > t64), (t51 < 1))), 1, 0)
+    t67 = casadi.if_else(t65, 1, t51)
+    t68 = (t66 > 0)
+    t69 = casadi.if_else(t68, t60, t54)
+    t70 = casadi.if_else(t68, t14, t55)
+    t71 = casadi.if_else(t68, t63, t56)
+    t72 = (casadi.fabs(t34) < casadi.inf)
+    t73 = (t67 > 0)
+    t74 = casadi.logic_and(t72, t73)
+    q = casadi.SX(3, 1)
+    q[0, 0] = casadi.if_else(t74, t69, qn1)
+    q[1, 0] = casadi.if_else(t74, t70, qn2)
+    q[2, 0] = casadi.if_else(t74, t71, qn3)
+    status = casadi.SX(1, 1)
+    status[0, 0] = casadi.if_else(casadi.logic_not(t72), 2, casadi.if_else(t73, 0, 1))
+    return [q, status]
 
 
 _q = casadi.SX.sym("q", 3, 1)
@@ -760,6 +859,8 @@ _mu_dot = casadi.SX.sym("mu_dot", 3, 1)
 _damping = casadi.SX.sym("damping", 1, 1)
 _target = casadi.SX.sym("target", 3, 1)
 _mu = casadi.SX.sym("mu", 3, 1)
+_q_seed = casadi.SX.sym("q_seed", 3, 1)
+_weights = casadi.SX.sym("weights", 3, 1)
 fk = casadi.Function("fk", [_q], _fk(_q), ["q"], ["T"])
 jacobian = casadi.Function("jacobian", [_q], _jacobian(_q), ["q"], ["J"])
 fk_jacobian = casadi.Function("fk_jacobian", [_q], _fk_jacobian(_q), ["q"], ["T", "J"])
@@ -776,8 +877,9 @@ manipulability = casadi.Function("manipulability", [_q], _manipulability(_q), ["
 jacobian_det = casadi.Function("jacobian_det", [_q], _jacobian_det(_q), ["q"], ["d"])
 velocity_ik = casadi.Function("velocity_ik", [_q, _mu_dot, _damping], _velocity_ik(_q, _mu_dot, _damping), ["q", "mu_dot", "damping"], ["q_dot", "status"])
 ik_numeric_step = casadi.Function("ik_numeric_step", [_target, _q, _damping], _ik_numeric_step(_target, _q, _damping), ["target", "q", "damping"], ["q_start", "q_next", "cost"])
-ik_branches = casadi.Function("ik_branches", [_mu], _ik_branches(_mu), ["mu"], ["q", "valid"])
-ik = ik_branches  # CasADi functions have fixed-size outputs: every branch and its validity
+ik_branches = casadi.Function("ik_branches", [_mu], _ik_branches(_mu), ["mu"], ["q", "valid", "in_limits"])
+ik_nearest = casadi.Function("ik_nearest", [_mu, _q_seed, _weights], _ik_nearest(_mu, _q_seed, _weights), ["mu", "q_seed", "weights"], ["q", "status"])
+ik = ik_branches  # CasADi functions have fixed-size outputs: every branch, its validity and its limits
 
 IK_NUMERIC_CONVERGED = 0  # |error| <= tol
 IK_NUMERIC_ITERATION_LIMIT = 1  # IK_NUMERIC_ITERATIONS steps taken, |error| still above tol
@@ -819,4 +921,4 @@ ik_numeric = casadi.Function("ik_numeric", _inputs, _ik_numeric(*_inputs), ["tar
 
 def functions():
     """All functions by name."""
-    return {"fk": fk, "jacobian": jacobian, "fk_jacobian": fk_jacobian, "jacobian_tool": jacobian_tool, "task": task, "task_jacobian": task_jacobian, "fk_jacobian_dot": fk_jacobian_dot, "jacobian_dot": jacobian_dot, "bias_acceleration": bias_acceleration, "task_jacobian_dot": task_jacobian_dot, "hessian": hessian, "singularity_factors": singularity_factors, "manipulability": manipulability, "jacobian_det": jacobian_det, "velocity_ik": velocity_ik, "ik_numeric_step": ik_numeric_step, "ik_branches": ik_branches}
+    return {"fk": fk, "jacobian": jacobian, "fk_jacobian": fk_jacobian, "jacobian_tool": jacobian_tool, "task": task, "task_jacobian": task_jacobian, "fk_jacobian_dot": fk_jacobian_dot, "jacobian_dot": jacobian_dot, "bias_acceleration": bias_acceleration, "task_jacobian_dot": task_jacobian_dot, "hessian": hessian, "singularity_factors": singularity_factors, "manipulability": manipulability, "jacobian_det": jacobian_det, "velocity_ik": velocity_ik, "ik_numeric_step": ik_numeric_step, "ik_branches": ik_branches, "ik_nearest": ik_nearest}

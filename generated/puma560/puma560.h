@@ -98,9 +98,13 @@ int puma560_velocity_ik(const puma560_real q[PUMA560_DOF], const puma560_real mu
  * Result: q_start[i], i < 6; q_next[i], i < 6; returned as a scalar. 921 operations. */
 puma560_real puma560_ik_numeric_step(const puma560_real target[16], const puma560_real q[PUMA560_DOF], puma560_real damping, puma560_real q_start[PUMA560_DOF], puma560_real q_next[PUMA560_DOF]);
 
-/* Every branch of the closed-form ik and whether the target allows it.
- * Result: q: 8 x 6 row-major, element (r, c) at q[r * 6 + c]; valid[i], i < 8. 914 operations. */
-void puma560_ik_branches(const puma560_real T[16], puma560_real q[PUMA560_MAX_IK_SOLUTIONS * PUMA560_DOF], int valid[PUMA560_MAX_IK_SOLUTIONS]);
+/* Every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits.
+ * Result: q: 8 x 6 row-major, element (r, c) at q[r * 6 + c]; valid[i], i < 8; in_limits[i], i < 8. 1372 operations. */
+void puma560_ik_branches(const puma560_real T[16], puma560_real q[PUMA560_MAX_IK_SOLUTIONS * PUMA560_DOF], int valid[PUMA560_MAX_IK_SOLUTIONS], int in_limits[PUMA560_MAX_IK_SOLUTIONS]);
+
+/* The closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status.
+ * Result: q[i], i < 6; returned as a scalar. 2245 operations. */
+int puma560_ik_nearest(const puma560_real T[16], const puma560_real q_seed[PUMA560_DOF], const puma560_real weights[PUMA560_DOF], puma560_real q[PUMA560_DOF]);
 
 /* Statuses of puma560_velocity_ik: OK, singular (a diagonal entry of the QR factor R of the
  * 6 x 6 system at most 1e-12 times its Frobenius norm: take damping > 0), or
@@ -110,12 +114,15 @@ void puma560_ik_branches(const puma560_real T[16], puma560_real q[PUMA560_MAX_IK
 #define PUMA560_VELOCITY_IK_SINGULAR 1
 #define PUMA560_VELOCITY_IK_NOT_FINITE 2
 
-/* Closed-form inverse kinematics: every joint solution that reaches the target; returns
- * their count k and writes solution i to q[i * PUMA560_DOF + j], i < k: the valid
- * rows of puma560_ik_branches, in its order. No allocation, no recursion.
+/* Closed-form inverse kinematics: every joint solution inside the joint limits that reaches
+ * the target; returns their count k and writes solution i to q[i * PUMA560_DOF + j],
+ * i < k: the rows of puma560_ik_branches that are valid and in_limits, in its order
+ * (puma560_ik_branches also gives those outside the limits). No allocation, no recursion.
  * target: the 4x4 tool pose in the world frame (rotation part orthonormal).
- * Result: k <= PUMA560_MAX_IK_SOLUTIONS solutions, revolute angles wrapped into (-pi, pi],
- * joint limits not applied; k = 0 when the target is out of reach or not finite.
+ * Result: k <= PUMA560_MAX_IK_SOLUTIONS solutions inside the joint limits, revolute angles
+ * wrapped into (-pi, pi] or, where that is outside the limits, their lowest equivalent
+ * inside them; k = 0 when the target is out of reach or not finite. ik_branches also gives
+ * the solutions outside the limits (in_limits 0).
  * Solver: 6R with a spherical wrist and axes 2, 3 parallel (Pieper): wrist centre, base
  * angle (SP4), elbow (SP3), shoulder (SP1), then the wrist orientation (SP2, SP1).
  * Order: nested loops over the branches, outermost first; where a subproblem has two roots
@@ -128,6 +135,12 @@ void puma560_ik_branches(const puma560_real T[16], puma560_real q[PUMA560_MAX_IK
  * angle the target leaves free (a singular wrist or shoulder) is set to 0.
  */
 int puma560_ik(const puma560_real T[16], puma560_real q[PUMA560_MAX_IK_SOLUTIONS * PUMA560_DOF]);
+
+/* Statuses of puma560_ik_nearest: a solution found; no solution inside the limits (out of
+ * reach); the target (its first three rows), q_seed or weights not finite. q = q_seed unless OK. */
+#define PUMA560_IK_NEAREST_OK 0
+#define PUMA560_IK_NEAREST_NO_SOLUTION 1
+#define PUMA560_IK_NEAREST_NOT_FINITE 2
 
 /* ik_numeric status codes. */
 #define PUMA560_IK_NUMERIC_CONVERGED 0       /* |error| <= tol */

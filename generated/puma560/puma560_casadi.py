@@ -5,7 +5,8 @@ Unimation Puma 560 (rtb Puma560, with pedestal), standard DH
 Every function takes `q` (6 x 1: radians for revolute joints, m for
 prismatic ones) and returns a rows x cols result whose zeros are structural; ik_branches
 (also named ik) takes the target instead of q and returns every branch (MAX_IK_SOLUTIONS x
-DOF) and its validity (MAX_IK_SOLUTIONS x 1, 1 or 0).
+DOF), its validity and whether it is inside the joint limits (MAX_IK_SOLUTIONS x 1 each, 1
+or 0); ik_nearest takes the target and q_seed and returns the solution nearest q_seed.
 Task vector: (x, y, z, roll, pitch, yaw).
 """
 
@@ -1931,7 +1932,7 @@ def _ik_numeric_step(target, q, damping):
 
 
 def _ik_branches(T):
-    """Every branch of the closed-form ik and whether the target allows it: 914 operations."""
+    """Every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits: 1372 operations."""
     T00 = T[0, 0]
     T01 = T[0, 1]
     T02 = T[0, 2]
@@ -1972,425 +1973,1499 @@ def _ik_branches(T):
     t25 = casadi.atan2(t24, t23)
     t26 = casadi.if_else(t19, 0, t10 + t25)
     t27 = t10 - t25
-    t28 = t20*t5
-    t29 = t24*t28
-    t30 = t20*t9
-    t31 = t23*t30
-    t32 = casadi.if_else(t19, 1, -t29 - t31)
-    t33 = t29 - t31
-    t34 = t23*t28
-    t35 = t24*t30
-    t36 = casadi.if_else(t19, 0, t34 - t35)
-    t37 = t34 + t35
-    t38 = t32*t5 + t36*t9
-    t39 = t32*t9 - t36*t5
-    t40 = T02*t32 + T12*t36
-    t41 = T12*t32 - T02*t36
-    t42 = T00*t32 + T10*t36
-    t43 = T10*t32 - T00*t36
-    t44 = t33*t5 + t37*t9
-    t45 = t33*t9 - t37*t5
-    t46 = T02*t33 + T12*t37
-    t47 = T12*t33 - T02*t37
-    t48 = T00*t33 + T10*t37
-    t49 = T10*t33 - T00*t37
-    t50 = 1 - t32
-    t51 = t14*t50
-    t52 = t51 + t14*t32
-    t53 = -0.67183 + t52
-    t54 = t38**2 + t39**2 + t53**2
-    t55 = 0.19791478625 - 0.5*t54
-    t56 = T22*t50
-    t57 = t56 + T22*t32
-    t58 = T20*t50
-    t59 = t58 + T20*t32
-    t60 = False
-    t61 = casadi.if_else(t60, 1, 5.357415379007653)
-    t62 = t55**2
-    t63 = t61**2
-    t64 = 1 - t62*t63
-    t65 = t55*t61
-    t66 = (1e-12 < t64)
-    t67 = casadi.if_else(t66, t65, casadi.if_else((t65 > 0), 1, -1))
-    t68 = casadi.if_else(t66, casadi.sqrt(t64), 0)
-    t69 = casadi.atan2(t68, t67)
-    t70 = casadi.if_else(t60, 0, t0 + t69)
-    t71 = t0 - t69
-    t72 = t61*t67
-    t73 = 0.00876554*t72
-    t74 = t61*t68
-    t75 = 0.18645124*t74
-    t76 = casadi.if_else(t60, 1, -t73 - t75)
-    t77 = t75 - t73
-    t78 = 0.15005 - 0.15005*t76
-    t79 = t78 + 0.15005*t76
-    t80 = 0.15005 - 0.15005*t77
-    t81 = t80 + 0.15005*t77
-    t82 = 0.18645124*t72
-    t83 = 0.00876554*t74
-    t84 = casadi.if_else(t60, 0, t82 - t83)
-    t85 = t82 + t83
-    t86 = 0.0203*t76 - 0.4318*t84
-    t87 = 0.0203*t84 + 0.4318*t76
-    t88 = 0.4318 + t86
-    t89 = 0.67183 + t87
-    t90 = -0.67183 + t89
-    t91 = t38*t90 - t53*t88
-    t92 = t79**2 + t88**2 + t90**2
-    t93 = 0.0203*t77 - 0.4318*t85
-    t94 = 0.0203*t85 + 0.4318*t77
+    t28 = t26 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t26)
+    t29 = t28 - 6.283185307179586*casadi.floor(0.4444444444444444 + 0.15915494309189535*t28)
+    t30 = t27 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t27)
+    t31 = t30 - 6.283185307179586*casadi.floor(0.4444444444444444 + 0.15915494309189535*t30)
+    t32 = t20*t5
+    t33 = t24*t32
+    t34 = t20*t9
+    t35 = t23*t34
+    t36 = casadi.if_else(t19, 1, -t33 - t35)
+    t37 = t33 - t35
+    t38 = t23*t32
+    t39 = t24*t34
+    t40 = casadi.if_else(t19, 0, t38 - t39)
+    t41 = t38 + t39
+    t42 = t36*t5 + t40*t9
+    t43 = t36*t9 - t40*t5
+    t44 = T02*t36 + T12*t40
+    t45 = T12*t36 - T02*t40
+    t46 = T00*t36 + T10*t40
+    t47 = T10*t36 - T00*t40
+    t48 = t37*t5 + t41*t9
+    t49 = t37*t9 - t41*t5
+    t50 = T02*t37 + T12*t41
+    t51 = T12*t37 - T02*t41
+    t52 = T00*t37 + T10*t41
+    t53 = T10*t37 - T00*t41
+    t54 = 1 - t36
+    t55 = t14*t54
+    t56 = t55 + t14*t36
+    t57 = -0.67183 + t56
+    t58 = t42**2 + t43**2 + t57**2
+    t59 = 0.19791478625 - 0.5*t58
+    t60 = T22*t54
+    t61 = t60 + T22*t36
+    t62 = T20*t54
+    t63 = t62 + T20*t36
+    t64 = False
+    t65 = casadi.if_else(t64, 1, 5.357415379007653)
+    t66 = t59**2
+    t67 = t65**2
+    t68 = 1 - t66*t67
+    t69 = t59*t65
+    t70 = (1e-12 < t68)
+    t71 = casadi.if_else(t70, t69, casadi.if_else((t69 > 0), 1, -1))
+    t72 = casadi.if_else(t70, casadi.sqrt(t68), 0)
+    t73 = casadi.atan2(t72, t71)
+    t74 = casadi.if_else(t64, 0, t0 + t73)
+    t75 = t0 - t73
+    t76 = t74 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t74)
+    t77 = t76 - 6.283185307179586*casadi.floor(0.625 + 0.15915494309189535*t76)
+    t78 = t75 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t75)
+    t79 = t78 - 6.283185307179586*casadi.floor(0.625 + 0.15915494309189535*t78)
+    t80 = t65*t71
+    t81 = 0.00876554*t80
+    t82 = t65*t72
+    t83 = 0.18645124*t82
+    t84 = casadi.if_else(t64, 1, -t81 - t83)
+    t85 = t83 - t81
+    t86 = 0.15005 - 0.15005*t84
+    t87 = t86 + 0.15005*t84
+    t88 = 0.15005 - 0.15005*t85
+    t89 = t88 + 0.15005*t85
+    t90 = 0.18645124*t80
+    t91 = 0.00876554*t82
+    t92 = casadi.if_else(t64, 0, t90 - t91)
+    t93 = t90 + t91
+    t94 = 0.0203*t84 - 0.4318*t92
+    t95 = 0.0203*t92 + 0.4318*t84
+    t96 = 0.4318 + t94
+    t97 = 0.67183 + t95
+    t98 = -0.67183 + t97
+    t99 = t42*t98 - t57*t96
+    t100 = t87**2 + t96**2 + t98**2
+    t101 = 0.0203*t85 - 0.4318*t93
+    t102 = 0.0203*t93 + 0.4318*t85
+    t103 = 0.4318 + t101
+    t104 = 0.67183 + t102
+    t105 = -0.67183 + t104
+    t106 = t105*t42 - t103*t57
+    t107 = t103**2 + t105**2 + t89**2
+    t108 = t43*t87
+    t109 = -t108 + t42*t96 + t57*t98
+    t110 = t108 + t109
+    t111 = t110**2 + t99**2
+    t112 = 1e-24*t58
+    t113 = (t111 <= t100*t112)
+    t114 = casadi.if_else(t113, 1, 1/casadi.sqrt(t111))
+    t115 = casadi.if_else(t113, 1, t110*t114)
+    t116 = casadi.if_else(t113, 0, -t114*t99)
+    t117 = t115*t84 - t116*t92
+    t118 = t115*t92 + t116*t84
+    t119 = t117*t44 + t118*t61
+    t120 = t117*t61 - t118*t44
+    t121 = t117*t46 + t118*t63
+    t122 = t117*t63 - t118*t46
+    t123 = casadi.if_else(t113, 0, casadi.atan2(-t99, t110))
+    t124 = t123 - 6.283185307179586*casadi.floor(0.125 + 0.15915494309189535*t123)
+    t125 = 1 - t117
+    t126 = t125*t45
+    t127 = t126 + t117*t45
+    t128 = t125*t47
+    t129 = t128 + t117*t47
+    t130 = t120**2
+    t131 = -t130
+    t132 = 1 + t131
+    t133 = casadi.if_else((t132 > 1e-12), casadi.sqrt(t132), 0)
+    t134 = t130 + t119*t133
+    t135 = t131 + t134
+    t136 = t127**2
+    t137 = t130 + t136 + t119**2
+    t138 = t133**2
+    t139 = t135**2 + t136*t138
+    t140 = t130 + t138
+    t141 = 1e-24*t140
+    t142 = (t139 <= t137*t141)
+    t143 = casadi.if_else(t142, 1, 1/casadi.sqrt(t139))
+    t144 = casadi.if_else(t142, 1, t135*t143)
+    t145 = t122*(1 - t144)
+    t146 = t145 + t122*t144
+    t147 = t127*t133
+    t148 = casadi.if_else(t142, 0, t143*t147)
+    t149 = t121*t144 + t129*t148
+    t150 = t129*t144 - t121*t148
+    t151 = (t140 <= t141)
+    t152 = casadi.if_else(t151, 1, 1/casadi.sqrt(t140))
+    t153 = casadi.if_else(t151, 1, t120*t152)
+    t154 = casadi.if_else(t151, 0, -t133*t152)
+    t155 = t150*(1 - t153)
+    t156 = t146*t154 + t149*t153
+    t157 = t155 + t150*t153
+    t158 = t146*t153 - t149*t154
+    t159 = t156**2 + t157**2
+    t160 = t159
+    t161 = t159 + t158**2
+    t162 = t43*t89
+    t163 = -t162 + t103*t42 + t105*t57
+    t164 = t162 + t163
+    t165 = t106**2 + t164**2
+    t166 = (t165 <= t107*t112)
+    t167 = casadi.if_else(t166, 1, 1/casadi.sqrt(t165))
+    t168 = casadi.if_else(t166, 1, t164*t167)
+    t169 = casadi.if_else(t166, 0, -t106*t167)
+    t170 = t168*t85 - t169*t93
+    t171 = t168*t93 + t169*t85
+    t172 = t170*t44 + t171*t61
+    t173 = t170*t61 - t171*t44
+    t174 = t170*t46 + t171*t63
+    t175 = t170*t63 - t171*t46
+    t176 = casadi.if_else(t166, 0, casadi.atan2(-t106, t164))
+    t177 = t176 - 6.283185307179586*casadi.floor(0.125 + 0.15915494309189535*t176)
+    t178 = 1 - t170
+    t179 = t178*t45
+    t180 = t179 + t170*t45
+    t181 = t178*t47
+    t182 = t181 + t170*t47
+    t183 = t173**2
+    t184 = -t183
+    t185 = 1 + t184
+    t186 = casadi.if_else((t185 > 1e-12), casadi.sqrt(t185), 0)
+    t187 = t183 + t172*t186
+    t188 = t184 + t187
+    t189 = t180**2
+    t190 = t183 + t189 + t172**2
+    t191 = t186**2
+    t192 = t188**2 + t189*t191
+    t193 = t183 + t191
+    t194 = 1e-24*t193
+    t195 = (t192 <= t190*t194)
+    t196 = casadi.if_else(t195, 1, 1/casadi.sqrt(t192))
+    t197 = casadi.if_else(t195, 1, t188*t196)
+    t198 = t175*(1 - t197)
+    t199 = t198 + t175*t197
+    t200 = t180*t186
+    t201 = casadi.if_else(t195, 0, t196*t200)
+    t202 = t174*t197 + t182*t201
+    t203 = t182*t197 - t174*t201
+    t204 = (t193 <= t194)
+    t205 = casadi.if_else(t204, 1, 1/casadi.sqrt(t193))
+    t206 = casadi.if_else(t204, 1, t173*t205)
+    t207 = casadi.if_else(t204, 0, -t186*t205)
+    t208 = t203*(1 - t206)
+    t209 = t199*t207 + t202*t206
+    t210 = t208 + t203*t206
+    t211 = t199*t206 - t202*t207
+    t212 = t209**2 + t210**2
+    t213 = t212
+    t214 = t212 + t211**2
+    t215 = 1 - t37
+    t216 = t14*t215
+    t217 = t216 + t14*t37
+    t218 = -0.67183 + t217
+    t219 = t218**2 + t48**2 + t49**2
+    t220 = 0.19791478625 - 0.5*t219
+    t221 = T22*t215
+    t222 = t221 + T22*t37
+    t223 = T20*t215
+    t224 = t223 + T20*t37
+    t225 = t220**2
+    t226 = 1 - t225*t67
+    t227 = t220*t65
+    t228 = (1e-12 < t226)
+    t229 = casadi.if_else(t228, t227, casadi.if_else((t227 > 0), 1, -1))
+    t230 = casadi.if_else(t228, casadi.sqrt(t226), 0)
+    t231 = casadi.atan2(t230, t229)
+    t232 = casadi.if_else(t64, 0, t0 + t231)
+    t233 = t0 - t231
+    t234 = t232 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t232)
+    t235 = t234 - 6.283185307179586*casadi.floor(0.625 + 0.15915494309189535*t234)
+    t236 = t233 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t233)
+    t237 = t236 - 6.283185307179586*casadi.floor(0.625 + 0.15915494309189535*t236)
+    t238 = t229*t65
+    t239 = 0.00876554*t238
+    t240 = t230*t65
+    t241 = 0.18645124*t240
+    t242 = casadi.if_else(t64, 1, -t239 - t241)
+    t243 = t241 - t239
+    t244 = 0.15005 - 0.15005*t242
+    t245 = t244 + 0.15005*t242
+    t246 = 0.15005 - 0.15005*t243
+    t247 = t246 + 0.15005*t243
+    t248 = 0.18645124*t238
+    t249 = 0.00876554*t240
+    t250 = casadi.if_else(t64, 0, t248 - t249)
+    t251 = t248 + t249
+    t252 = 0.0203*t242 - 0.4318*t250
+    t253 = 0.0203*t250 + 0.4318*t242
+    t254 = 0.4318 + t252
+    t255 = 0.67183 + t253
+    t256 = -0.67183 + t255
+    t257 = t256*t48 - t218*t254
+    t258 = t245**2 + t254**2 + t256**2
+    t259 = 0.0203*t243 - 0.4318*t251
+    t260 = 0.0203*t251 + 0.4318*t243
+    t261 = 0.4318 + t259
+    t262 = 0.67183 + t260
+    t263 = -0.67183 + t262
+    t264 = t263*t48 - t218*t261
+    t265 = t247**2 + t261**2 + t263**2
+    t266 = t245*t49
+    t267 = -t266 + t218*t256 + t254*t48
+    t268 = t266 + t267
+    t269 = t257**2 + t268**2
+    t270 = 1e-24*t219
+    t271 = (t269 <= t258*t270)
+    t272 = casadi.if_else(t271, 1, 1/casadi.sqrt(t269))
+    t273 = casadi.if_else(t271, 1, t268*t272)
+    t274 = casadi.if_else(t271, 0, -t257*t272)
+    t275 = t242*t273 - t250*t274
+    t276 = t242*t274 + t250*t273
+    t277 = t222*t276 + t275*t50
+    t278 = t222*t275 - t276*t50
+    t279 = t224*t276 + t275*t52
+    t280 = t224*t275 - t276*t52
+    t281 = casadi.if_else(t271, 0, casadi.atan2(-t257, t268))
+    t282 = t281 - 6.283185307179586*casadi.floor(0.125 + 0.15915494309189535*t281)
+    t283 = 1 - t275
+    t284 = t283*t51
+    t285 = t284 + t275*t51
+    t286 = t283*t53
+    t287 = t286 + t275*t53
+    t288 = t278**2
+    t289 = -t288
+    t290 = 1 + t289
+    t291 = casadi.if_else((t290 > 1e-12), casadi.sqrt(t290), 0)
+    t292 = t288 + t277*t291
+    t293 = t289 + t292
+    t294 = t285**2
+    t295 = t288 + t294 + t277**2
+    t296 = t291**2
+    t297 = t293**2 + t294*t296
+    t298 = t288 + t296
+    t299 = 1e-24*t298
+    t300 = (t297 <= t295*t299)
+    t301 = casadi.if_else(t300, 1, 1/casadi.sqrt(t297))
+    t302 = casadi.if_else(t300, 1, t293*t301)
+    t303 = t280*(1 - t302)
+    t304 = t303 + t280*t302
+    t305 = t285*t291
+    t306 = casadi.if_else(t300, 0, t301*t305)
+    t307 = t279*t302 + t287*t306
+    t308 = t287*t302 - t279*t306
+    t309 = (t298 <= t299)
+    t310 = casadi.if_else(t309, 1, 1/casadi.sqrt(t298))
+    t311 = casadi.if_else(t309, 1, t278*t310)
+    t312 = casadi.if_else(t309, 0, -t291*t310)
+    t313 = t308*(1 - t311)
+    t314 = t304*t312 + t307*t311
+    t315 = t313 + t308*t311
+    t316 = t304*t311 - t307*t312
+    t317 = t314**2 + t315**2
+    t318 = t317
+    t319 = t317 + t316**2
+    t320 = t247*t49
+    t321 = -t320 + t218*t263 + t261*t48
+    t322 = t320 + t321
+    t323 = t264**2 + t322**2
+    t324 = (t323 <= t265*t270)
+    t325 = casadi.if_else(t324, 1, 1/casadi.sqrt(t323))
+    t326 = casadi.if_else(t324, 1, t322*t325)
+    t327 = casadi.if_else(t324, 0, -t264*t325)
+    t328 = t243*t326 - t251*t327
+    t329 = t243*t327 + t251*t326
+    t330 = t222*t329 + t328*t50
+    t331 = t222*t328 - t329*t50
+    t332 = t224*t329 + t328*t52
+    t333 = t224*t328 - t329*t52
+    t334 = casadi.if_else(t324, 0, casadi.atan2(-t264, t322))
+    t335 = t334 - 6.283185307179586*casadi.floor(0.125 + 0.15915494309189535*t334)
+    t336 = 1 - t328
+    t337 = t336*t51
+    t338 = t337 + t328*t51
+    t339 = t336*t53
+    t340 = t339 + t328*t53
+    t341 = t331**2
+    t342 = -t341
+    t343 = 1 + t342
+    t344 = casadi.if_else((t343 > 1e-12), casadi.sqrt(t343), 0)
+    t345 = t341 + t330*t344
+    t346 = t342 + t345
+    t347 = t338**2
+    t348 = t341 + t347 + t330**2
+    t349 = t344**2
+    t350 = t346**2 + t347*t349
+    t351 = t341 + t349
+    t352 = 1e-24*t351
+    t353 = (t350 <= t348*t352)
+    t354 = casadi.if_else(t353, 1, 1/casadi.sqrt(t350))
+    t355 = casadi.if_else(t353, 1, t346*t354)
+    t356 = t333*(1 - t355)
+    t357 = t356 + t333*t355
+    t358 = t338*t344
+    t359 = casadi.if_else(t353, 0, t354*t358)
+    t360 = t332*t355 + t340*t359
+    t361 = t340*t355 - t332*t359
+    t362 = (t351 <= t352)
+    t363 = casadi.if_else(t362, 1, 1/casadi.sqrt(t351))
+    t364 = casadi.if_else(t362, 1, t331*t363)
+    t365 = casadi.if_else(t362, 0, -t344*t363)
+    t366 = t361*(1 - t364)
+    t367 = t357*t365 + t360*t364
+    t368 = t366 + t361*t364
+    t369 = t357*t364 - t360*t365
+    t370 = t367**2 + t368**2
+    t371 = t370
+    t372 = t370 + t369**2
+    t373 = casadi.if_else(t142, 0, casadi.atan2(t147, t135))
+    t374 = t373
+    t375 = t374 - 6.283185307179586*casadi.floor(0.3055555555555555 + 0.15915494309189535*t374)
+    t376 = 3.141592653589793 + t373 - 6.283185307179586*casadi.ceil(0.15915494309189535*t373)
+    t377 = t376 - 6.283185307179586*casadi.floor(0.3055555555555555 + 0.15915494309189535*t376)
+    t378 = casadi.if_else(t151, 0, casadi.atan2(-t133, t120))
+    t379 = t378
+    t380 = t379 - 6.283185307179586*casadi.floor(0.2777777777777778 + 0.15915494309189535*t379)
+    t381 = t378 + 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t378)
+    t382 = casadi.if_else((t160 <= 1e-24*t161), 0, casadi.atan2(t157, t156))
+    t383 = t382
+    t384 = t383 - 6.283185307179586*casadi.floor(0.7388888888888888 + 0.15915494309189535*t383)
+    t385 = 3.141592653589793 + t382 - 6.283185307179586*casadi.ceil(0.15915494309189535*t382)
+    t386 = t385 - 6.283185307179586*casadi.floor(0.7388888888888888 + 0.15915494309189535*t385)
+    t387 = -t381
+    t388 = t381 + 6.283185307179586*casadi.floor(0.2777777777777778 + 0.15915494309189535*t387)
+    t389 = casadi.if_else(t195, 0, casadi.atan2(t200, t188))
+    t390 = t389
+    t391 = t390 - 6.283185307179586*casadi.floor(0.3055555555555555 + 0.15915494309189535*t390)
+    t392 = 3.141592653589793 + t389 - 6.283185307179586*casadi.ceil(0.15915494309189535*t389)
+    t393 = t392 - 6.283185307179586*casadi.floor(0.3055555555555555 + 0.15915494309189535*t392)
+    t394 = casadi.if_else(t204, 0, casadi.atan2(-t186, t173))
+    t395 = t394
+    t396 = t395 - 6.283185307179586*casadi.floor(0.2777777777777778 + 0.15915494309189535*t395)
+    t397 = t394 + 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t394)
+    t398 = casadi.if_else((t213 <= 1e-24*t214), 0, casadi.atan2(t210, t209))
+    t399 = t398
+    t400 = t399 - 6.283185307179586*casadi.floor(0.7388888888888888 + 0.15915494309189535*t399)
+    t401 = 3.141592653589793 + t398 - 6.283185307179586*casadi.ceil(0.15915494309189535*t398)
+    t402 = t401 - 6.283185307179586*casadi.floor(0.7388888888888888 + 0.15915494309189535*t401)
+    t403 = -t397
+    t404 = t397 + 6.283185307179586*casadi.floor(0.2777777777777778 + 0.15915494309189535*t403)
+    t405 = casadi.if_else(t300, 0, casadi.atan2(t305, t293))
+    t406 = t405
+    t407 = t406 - 6.283185307179586*casadi.floor(0.3055555555555555 + 0.15915494309189535*t406)
+    t408 = 3.141592653589793 + t405 - 6.283185307179586*casadi.ceil(0.15915494309189535*t405)
+    t409 = t408 - 6.283185307179586*casadi.floor(0.3055555555555555 + 0.15915494309189535*t408)
+    t410 = casadi.if_else(t309, 0, casadi.atan2(-t291, t278))
+    t411 = t410
+    t412 = t411 - 6.283185307179586*casadi.floor(0.2777777777777778 + 0.15915494309189535*t411)
+    t413 = t410 + 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t410)
+    t414 = casadi.if_else((t318 <= 1e-24*t319), 0, casadi.atan2(t315, t314))
+    t415 = t414
+    t416 = t415 - 6.283185307179586*casadi.floor(0.7388888888888888 + 0.15915494309189535*t415)
+    t417 = 3.141592653589793 + t414 - 6.283185307179586*casadi.ceil(0.15915494309189535*t414)
+    t418 = t417 - 6.283185307179586*casadi.floor(0.7388888888888888 + 0.15915494309189535*t417)
+    t419 = -t413
+    t420 = t413 + 6.283185307179586*casadi.floor(0.2777777777777778 + 0.15915494309189535*t419)
+    t421 = casadi.if_else(t353, 0, casadi.atan2(t358, t346))
+    t422 = t421
+    t423 = t422 - 6.283185307179586*casadi.floor(0.3055555555555555 + 0.15915494309189535*t422)
+    t424 = 3.141592653589793 + t421 - 6.283185307179586*casadi.ceil(0.15915494309189535*t421)
+    t425 = t424 - 6.283185307179586*casadi.floor(0.3055555555555555 + 0.15915494309189535*t424)
+    t426 = casadi.if_else(t362, 0, casadi.atan2(-t344, t331))
+    t427 = t426
+    t428 = t427 - 6.283185307179586*casadi.floor(0.2777777777777778 + 0.15915494309189535*t427)
+    t429 = t426 + 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t426)
+    t430 = casadi.if_else((t371 <= 1e-24*t372), 0, casadi.atan2(t368, t367))
+    t431 = t430
+    t432 = t431 - 6.283185307179586*casadi.floor(0.7388888888888888 + 0.15915494309189535*t431)
+    t433 = 3.141592653589793 + t430 - 6.283185307179586*casadi.ceil(0.15915494309189535*t430)
+    t434 = t433 - 6.283185307179586*casadi.floor(0.7388888888888888 + 0.15915494309189535*t433)
+    t435 = -t429
+    t436 = t429 + 6.283185307179586*casadi.floor(0.2777777777777778 + 0.15915494309189535*t435)
+    t437 = (t29 <= 2.792526803190927)
+    t438 = casadi.logic_and((t28 >= -2.792526803190927), (t28 <= 2.792526803190927))
+    t439 = casadi.if_else(casadi.logic_and(t437, casadi.logic_not(t438)), t29, t28)
+    t440 = (t124 <= 3.9269908169872414)
+    t441 = casadi.logic_and((t123 >= -0.7853981633974483), (t123 <= 3.9269908169872414))
+    t442 = casadi.if_else(casadi.logic_and(t440, casadi.logic_not(t441)), t124, t123)
+    t443 = (t77 <= 0.7853981633974483)
+    t444 = casadi.logic_and((t76 >= -3.9269908169872414), (t76 <= 0.7853981633974483))
+    t445 = casadi.if_else(casadi.logic_and(t443, casadi.logic_not(t444)), t77, t76)
+    t446 = (t375 <= 2.9670597283903604)
+    t447 = casadi.logic_and((t374 >= -1.9198621771937625), (t374 <= 2.9670597283903604))
+    t448 = (t380 <= 1.7453292519943295)
+    t449 = casadi.logic_and((t379 >= -1.7453292519943295), (t379 <= 1.7453292519943295))
+    t450 = (t384 <= 4.642575810304916)
+    t451 = casadi.logic_and((t383 >= -4.642575810304916), (t383 <= 4.642575810304916))
+    t452 = (t377 <= 2.9670597283903604)
+    t453 = casadi.logic_and((t376 >= -1.9198621771937625), (t376 <= 2.9670597283903604))
+    t454 = -t388
+    t455 = (t386 <= 4.642575810304916)
+    t456 = casadi.logic_and((t385 >= -4.642575810304916), (t385 <= 4.642575810304916))
+    t457 = (t177 <= 3.9269908169872414)
+    t458 = casadi.logic_and((t176 >= -0.7853981633974483), (t176 <= 3.9269908169872414))
+    t459 = casadi.if_else(casadi.logic_and(t457, casadi.logic_not(t458)), t177, t176)
+    t460 = (t79 <= 0.7853981633974483)
+    t461 = casadi.logic_and((t78 >= -3.9269908169872414), (t78 <= 0.7853981633974483))
+    t462 = casadi.if_else(casadi.logic_and(t460, casadi.logic_not(t461)), t79, t78)
+    t463 = (t391 <= 2.9670597283903604)
+    t464 = casadi.logic_and((t390 >= -1.9198621771937625), (t390 <= 2.9670597283903604))
+    t465 = (t396 <= 1.7453292519943295)
+    t466 = casadi.logic_and((t395 >= -1.7453292519943295), (t395 <= 1.7453292519943295))
+    t467 = (t400 <= 4.642575810304916)
+    t468 = casadi.logic_and((t399 >= -4.642575810304916), (t399 <= 4.642575810304916))
+    t469 = (t393 <= 2.9670597283903604)
+    t470 = casadi.logic_and((t392 >= -1.9198621771937625), (t392 <= 2.9670597283903604))
+    t471 = -t404
+    t472 = (t402 <= 4.642575810304916)
+    t473 = casadi.logic_and((t401 >= -4.642575810304916), (t401 <= 4.642575810304916))
+    t474 = (t31 <= 2.792526803190927)
+    t475 = casadi.logic_and((t30 >= -2.792526803190927), (t30 <= 2.792526803190927))
+    t476 = casadi.if_else(casadi.logic_and(t474, casadi.logic_not(t475)), t31, t30)
+    t477 = (t282 <= 3.9269908169872414)
+    t478 = casadi.logic_and((t281 >= -0.7853981633974483), (t281 <= 3.9269908169872414))
+    t479 = casadi.if_else(casadi.logic_and(t477, casadi.logic_not(t478)), t282, t281)
+    t480 = (t235 <= 0.7853981633974483)
+    t481 = casadi.logic_and((t234 >= -3.9269908169872414), (t234 <= 0.7853981633974483))
+    t482 = casadi.if_else(casadi.logic_and(t480, casadi.logic_not(t481)), t235, t234)
+    t483 = (t407 <= 2.9670597283903604)
+    t484 = casadi.logic_and((t406 >= -1.9198621771937625), (t406 <= 2.9670597283903604))
+    t485 = (t412 <= 1.7453292519943295)
+    t486 = casadi.logic_and((t411 >= -1.7453292519943295), (t411 <= 1.7453292519943295))
+    t487 = (t416 <= 4.642575810304916)
+    t488 = casadi.logic_and((t415 >= -4.642575810304916), (t415 <= 4.642575810304916))
+    t489 = (t409 <= 2.9670597283903604)
+    t490 = casadi.logic_and((t408 >= -1.9198621771937625), (t408 <= 2.9670597283903604))
+    t491 = -t420
+    t492 = (t418 <= 4.642575810304916)
+    t493 = casadi.logic_and((t417 >= -4.642575810304916), (t417 <= 4.642575810304916))
+    t494 = (t335 <= 3.9269908169872414)
+    t495 = casadi.logic_and((t334 >= -0.7853981633974483), (t334 <= 3.9269908169872414))
+    t496 = casadi.if_else(casadi.logic_and(t494, casadi.logic_not(t495)), t335, t334)
+    t497 = (t237 <= 0.7853981633974483)
+    t498 = casadi.logic_and((t236 >= -3.9269908169872414), (t236 <= 0.7853981633974483))
+    t499 = casadi.if_else(casadi.logic_and(t497, casadi.logic_not(t498)), t237, t236)
+    t500 = (t423 <= 2.9670597283903604)
+    t501 = casadi.logic_and((t422 >= -1.9198621771937625), (t422 <= 2.9670597283903604))
+    t502 = (t428 <= 1.7453292519943295)
+    t503 = casadi.logic_and((t427 >= -1.7453292519943295), (t427 <= 1.7453292519943295))
+    t504 = (t432 <= 4.642575810304916)
+    t505 = casadi.logic_and((t431 >= -4.642575810304916), (t431 <= 4.642575810304916))
+    t506 = (t425 <= 2.9670597283903604)
+    t507 = casadi.logic_and((t424 >= -1.9198621771937625), (t424 <= 2.9670597283903604))
+    t508 = -t436
+    t509 = (t434 <= 4.642575810304916)
+    t510 = casadi.logic_and((t433 >= -4.642575810304916), (t433 <= 4.642575810304916))
+    t511 = (casadi.fabs(t1) < casadi.inf)
+    t512 = -1e-12
+    t513 = (t16 > t18)
+    t514 = casadi.logic_or(casadi.logic_and(t513, (t21 >= t512)), casadi.logic_and(t19, (0.0225150025 <= 1e-12*t17)))
+    t515 = 3.9038849723757295e-26
+    t516 = (0.0348408995890292 > t515)
+    t517 = (0.0348408995890292 <= t515)
+    t518 = 3.9038849723757296e-14
+    t519 = casadi.logic_or(casadi.logic_and(t516, (t68 >= t512)), casadi.logic_and(t517, (t66 <= t518)))
+    t520 = (t68 > 1e-12)
+    t521 = (t21 > 1e-12)
+    t522 = casadi.logic_or(casadi.logic_and(t516, (t226 >= t512)), casadi.logic_and(t517, (t225 <= t518)))
+    t523 = (t226 > 1e-12)
+    t524 = casadi.logic_or(t437, t438)
+    t525 = casadi.logic_or(t440, t441)
+    t526 = casadi.logic_or(t443, t444)
+    t527 = casadi.logic_or(t457, t458)
+    t528 = casadi.logic_or(t460, t461)
+    t529 = casadi.logic_or(t474, t475)
+    t530 = casadi.logic_or(t477, t478)
+    t531 = casadi.logic_or(t480, t481)
+    t532 = casadi.logic_or(t494, t495)
+    t533 = casadi.logic_or(t497, t498)
+    q = casadi.SX(8, 6)
+    q[0, 0] = t439
+    q[0, 1] = t442
+    q[0, 2] = t445
+    q[0, 3] = casadi.if_else(casadi.logic_and(t446, casadi.logic_not(t447)), t375, t374)
+    q[0, 4] = casadi.if_else(casadi.logic_and(t448, casadi.logic_not(t449)), t380, t379)
+    q[0, 5] = casadi.if_else(casadi.logic_and(t450, casadi.logic_not(t451)), t384, t383)
+    q[1, 0] = t439
+    q[1, 1] = t442
+    q[1, 2] = t445
+    q[1, 3] = casadi.if_else(casadi.logic_and(t452, casadi.logic_not(t453)), t377, t376)
+    q[1, 4] = casadi.if_else(casadi.logic_and((t388 >= -1.7453292519943295), casadi.logic_not(casadi.logic_and((t381 >= -1.7453292519943295), (t381 <= 1.7453292519943295)))), t454, t387)
+    q[1, 5] = casadi.if_else(casadi.logic_and(t455, casadi.logic_not(t456)), t386, t385)
+    q[2, 0] = t439
+    q[2, 1] = t459
+    q[2, 2] = t462
+    q[2, 3] = casadi.if_else(casadi.logic_and(t463, casadi.logic_not(t464)), t391, t390)
+    q[2, 4] = casadi.if_else(casadi.logic_and(t465, casadi.logic_not(t466)), t396, t395)
+    q[2, 5] = casadi.if_else(casadi.logic_and(t467, casadi.logic_not(t468)), t400, t399)
+    q[3, 0] = t439
+    q[3, 1] = t459
+    q[3, 2] = t462
+    q[3, 3] = casadi.if_else(casadi.logic_and(t469, casadi.logic_not(t470)), t393, t392)
+    q[3, 4] = casadi.if_else(casadi.logic_and((t404 >= -1.7453292519943295), casadi.logic_not(casadi.logic_and((t397 >= -1.7453292519943295), (t397 <= 1.7453292519943295)))), t471, t403)
+    q[3, 5] = casadi.if_else(casadi.logic_and(t472, casadi.logic_not(t473)), t402, t401)
+    q[4, 0] = t476
+    q[4, 1] = t479
+    q[4, 2] = t482
+    q[4, 3] = casadi.if_else(casadi.logic_and(t483, casadi.logic_not(t484)), t407, t406)
+    q[4, 4] = casadi.if_else(casadi.logic_and(t485, casadi.logic_not(t486)), t412, t411)
+    q[4, 5] = casadi.if_else(casadi.logic_and(t487, casadi.logic_not(t488)), t416, t415)
+    q[5, 0] = t476
+    q[5, 1] = t479
+    q[5, 2] = t482
+    q[5, 3] = casadi.if_else(casadi.logic_and(t489, casadi.logic_not(t490)), t409, t408)
+    q[5, 4] = casadi.if_else(casadi.logic_and((t420 >= -1.7453292519943295), casadi.logic_not(casadi.logic_and((t413 >= -1.7453292519943295), (t413 <= 1.7453292519943295)))), t491, t419)
+    q[5, 5] = casadi.if_else(casadi.logic_and(t492, casadi.logic_not(t493)), t418, t417)
+    q[6, 0] = t476
+    q[6, 1] = t496
+    q[6, 2] = t499
+    q[6, 3] = casadi.if_else(casadi.logic_and(t500, casadi.logic_not(t501)), t423, t422)
+    q[6, 4] = casadi.if_else(casadi.logic_and(t502, casadi.logic_not(t503)), t428, t427)
+    q[6, 5] = casadi.if_else(casadi.logic_and(t504, casadi.logic_not(t505)), t432, t431)
+    q[7, 0] = t476
+    q[7, 1] = t496
+    q[7, 2] = t499
+    q[7, 3] = casadi.if_else(casadi.logic_and(t506, casadi.logic_not(t507)), t425, t424)
+    q[7, 4] = casadi.if_else(casadi.logic_and((t436 >= -1.7453292519943295), casadi.logic_not(casadi.logic_and((t429 >= -1.7453292519943295), (t429 <= 1.7453292519943295)))), t508, t435)
+    q[7, 5] = casadi.if_else(casadi.logic_and(t509, casadi.logic_not(t510)), t434, t433)
+    valid = casadi.SX(8, 1)
+    valid[0, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t511, t514), t519), (t132 >= t512))
+    valid[1, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t511, t514), t519), (t132 > 1e-12))
+    valid[2, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t511, t514), t516), t520), (t185 >= t512))
+    valid[3, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t511, t514), t516), t520), (t185 > 1e-12))
+    valid[4, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t511, t513), t521), t522), (t290 >= t512))
+    valid[5, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t511, t513), t521), t522), (t290 > 1e-12))
+    valid[6, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t511, t513), t516), t521), t523), (t343 >= t512))
+    valid[7, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t511, t513), t516), t521), t523), (t343 > 1e-12))
+    in_limits = casadi.SX(8, 1)
+    in_limits[0, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t524, t525), t526), casadi.logic_or(t446, t447)), casadi.logic_or(t448, t449)), casadi.logic_or(t450, t451))
+    in_limits[1, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t524, t525), t526), casadi.logic_or(t452, t453)), casadi.logic_or(t455, t456)), casadi.logic_or((t454 <= 1.7453292519943295), casadi.logic_and((t387 >= -1.7453292519943295), (t387 <= 1.7453292519943295))))
+    in_limits[2, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t524, t527), t528), casadi.logic_or(t463, t464)), casadi.logic_or(t465, t466)), casadi.logic_or(t467, t468))
+    in_limits[3, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t524, t527), t528), casadi.logic_or(t469, t470)), casadi.logic_or(t472, t473)), casadi.logic_or((t471 <= 1.7453292519943295), casadi.logic_and((t403 >= -1.7453292519943295), (t403 <= 1.7453292519943295))))
+    in_limits[4, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t529, t530), t531), casadi.logic_or(t483, t484)), casadi.logic_or(t485, t486)), casadi.logic_or(t487, t488))
+    in_limits[5, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t529, t530), t531), casadi.logic_or(t489, t490)), casadi.logic_or(t492, t493)), casadi.logic_or((t491 <= 1.7453292519943295), casadi.logic_and((t419 >= -1.7453292519943295), (t419 <= 1.7453292519943295))))
+    in_limits[6, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t529, t532), t533), casadi.logic_or(t500, t501)), casadi.logic_or(t502, t503)), casadi.logic_or(t504, t505))
+    in_limits[7, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t529, t532), t533), casadi.logic_or(t506, t507)), casadi.logic_or(t509, t510)), casadi.logic_or((t508 <= 1.7453292519943295), casadi.logic_and((t435 >= -1.7453292519943295), (t435 <= 1.7453292519943295))))
+    return [q, valid, in_limits]
+
+
+def _ik_nearest(T, q_seed, weights):
+    """The closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status: 2245 operations."""
+    T00 = T[0, 0]
+    T01 = T[0, 1]
+    T02 = T[0, 2]
+    T03 = T[0, 3]
+    T10 = T[1, 0]
+    T11 = T[1, 1]
+    T12 = T[1, 2]
+    T13 = T[1, 3]
+    T20 = T[2, 0]
+    T21 = T[2, 1]
+    T22 = T[2, 2]
+    T23 = T[2, 3]
+    qn1 = q_seed[0]
+    qn2 = q_seed[1]
+    qn3 = q_seed[2]
+    qn4 = q_seed[3]
+    qn5 = q_seed[4]
+    qn6 = q_seed[5]
+    qw1 = weights[0]
+    qw2 = weights[1]
+    qw3 = weights[2]
+    qw4 = weights[3]
+    qw5 = weights[4]
+    qw6 = weights[5]
+    t0 = 1.6177742431429796
+    t1 = 0.4521*T00 + 1.10363*T02 - 0.15005*T01
+    t2 = T03 - t1
+    t3 = t1
+    t4 = t2 + t3
+    t5 = 0.4521*T10 + 1.10363*T12 - 0.15005*T11
+    t6 = T13 - t5
+    t7 = t5
+    t8 = t6 + t7
+    t9 = casadi.atan2(t4, -t8)
+    t10 = 0.4521*T20 + 1.10363*T22 - 0.15005*T21
+    t11 = T23 - t10
+    t12 = t10
+    t13 = t11 + t12
+    t14 = t4**2 + t8**2
+    t15 = t14
+    t16 = t14 + t13**2
+    t17 = 1e-24*t16
+    t18 = (t15 <= t17)
+    t19 = casadi.if_else(t18, 1, 1/casadi.sqrt(t15))
+    t20 = 1 - 0.0225150025*t19**2
+    t21 = (1e-12 < t20)
+    t22 = casadi.if_else(t21, 0.15005*t19, casadi.if_else((t19 > 0), 1, -1))
+    t23 = casadi.if_else(t21, casadi.sqrt(t20), 0)
+    t24 = casadi.atan2(t23, t22)
+    t25 = casadi.if_else(t18, 0, t24 + t9)
+    t26 = t9 - t24
+    t27 = t25 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t25)
+    t28 = t27 - 6.283185307179586*casadi.floor(0.4444444444444444 + 0.15915494309189535*t27)
+    t29 = t26 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t26)
+    t30 = t29 - 6.283185307179586*casadi.floor(0.4444444444444444 + 0.15915494309189535*t29)
+    t31 = t19*t4
+    t32 = t23*t31
+    t33 = t19*t8
+    t34 = t22*t33
+    t35 = casadi.if_else(t18, 1, -t32 - t34)
+    t36 = t32 - t34
+    t37 = t22*t31
+    t38 = t23*t33
+    t39 = casadi.if_else(t18, 0, t37 - t38)
+    t40 = t37 + t38
+    t41 = t35*t4 + t39*t8
+    t42 = t35*t8 - t39*t4
+    t43 = T02*t35 + T12*t39
+    t44 = T12*t35 - T02*t39
+    t45 = T00*t35 + T10*t39
+    t46 = T10*t35 - T00*t39
+    t47 = t36*t4 + t40*t8
+    t48 = t36*t8 - t4*t40
+    t49 = T02*t36 + T12*t40
+    t50 = T12*t36 - T02*t40
+    t51 = T00*t36 + T10*t40
+    t52 = T10*t36 - T00*t40
+    t53 = 1 - t35
+    t54 = t13*t53
+    t55 = t54 + t13*t35
+    t56 = -0.67183 + t55
+    t57 = t41**2 + t42**2 + t56**2
+    t58 = 0.19791478625 - 0.5*t57
+    t59 = T22*t53
+    t60 = t59 + T22*t35
+    t61 = T20*t53
+    t62 = t61 + T20*t35
+    t63 = False
+    t64 = casadi.if_else(t63, 1, 5.357415379007653)
+    t65 = t58**2
+    t66 = t64**2
+    t67 = 1 - t65*t66
+    t68 = t58*t64
+    t69 = (1e-12 < t67)
+    t70 = casadi.if_else(t69, t68, casadi.if_else((t68 > 0), 1, -1))
+    t71 = casadi.if_else(t69, casadi.sqrt(t67), 0)
+    t72 = casadi.atan2(t71, t70)
+    t73 = casadi.if_else(t63, 0, t0 + t72)
+    t74 = t0 - t72
+    t75 = t73 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t73)
+    t76 = t75 - 6.283185307179586*casadi.floor(0.625 + 0.15915494309189535*t75)
+    t77 = t74 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t74)
+    t78 = t77 - 6.283185307179586*casadi.floor(0.625 + 0.15915494309189535*t77)
+    t79 = t64*t70
+    t80 = 0.00876554*t79
+    t81 = t64*t71
+    t82 = 0.18645124*t81
+    t83 = casadi.if_else(t63, 1, -t80 - t82)
+    t84 = t82 - t80
+    t85 = 0.15005 - 0.15005*t83
+    t86 = t85 + 0.15005*t83
+    t87 = 0.15005 - 0.15005*t84
+    t88 = t87 + 0.15005*t84
+    t89 = 0.18645124*t79
+    t90 = 0.00876554*t81
+    t91 = casadi.if_else(t63, 0, t89 - t90)
+    t92 = t89 + t90
+    t93 = 0.0203*t83 - 0.4318*t91
+    t94 = 0.0203*t91 + 0.4318*t83
     t95 = 0.4318 + t93
     t96 = 0.67183 + t94
     t97 = -0.67183 + t96
-    t98 = t38*t97 - t53*t95
-    t99 = t81**2 + t95**2 + t97**2
-    t100 = t39*t79
-    t101 = -t100 + t38*t88 + t53*t90
-    t102 = t100 + t101
-    t103 = t102**2 + t91**2
-    t104 = 1e-24*t54
-    t105 = (t103 <= t104*t92)
-    t106 = casadi.if_else(t105, 1, 1/casadi.sqrt(t103))
-    t107 = casadi.if_else(t105, 1, t102*t106)
-    t108 = casadi.if_else(t105, 0, -t106*t91)
-    t109 = t107*t76 - t108*t84
-    t110 = t107*t84 + t108*t76
-    t111 = t109*t40 + t110*t57
-    t112 = t109*t57 - t110*t40
-    t113 = t109*t42 + t110*t59
-    t114 = t109*t59 - t110*t42
-    t115 = 1 - t109
-    t116 = t115*t41
-    t117 = t116 + t109*t41
-    t118 = t115*t43
-    t119 = t118 + t109*t43
-    t120 = t112**2
-    t121 = -t120
-    t122 = 1 + t121
-    t123 = casadi.if_else((t122 > 1e-12), casadi.sqrt(t122), 0)
-    t124 = t120 + t111*t123
-    t125 = t121 + t124
-    t126 = t117**2
-    t127 = t120 + t126 + t111**2
-    t128 = t123**2
-    t129 = t125**2 + t126*t128
-    t130 = t120 + t128
-    t131 = 1e-24*t130
-    t132 = (t129 <= t127*t131)
-    t133 = casadi.if_else(t132, 1, 1/casadi.sqrt(t129))
-    t134 = casadi.if_else(t132, 1, t125*t133)
-    t135 = t114*(1 - t134)
-    t136 = t135 + t114*t134
-    t137 = t117*t123
-    t138 = casadi.if_else(t132, 0, t133*t137)
-    t139 = t113*t134 + t119*t138
-    t140 = t119*t134 - t113*t138
-    t141 = (t130 <= t131)
-    t142 = casadi.if_else(t141, 1, 1/casadi.sqrt(t130))
-    t143 = casadi.if_else(t141, 1, t112*t142)
-    t144 = casadi.if_else(t141, 0, -t123*t142)
-    t145 = t140*(1 - t143)
-    t146 = t136*t144 + t139*t143
-    t147 = t145 + t140*t143
-    t148 = t136*t143 - t139*t144
-    t149 = t146**2 + t147**2
-    t150 = t149
-    t151 = t149 + t148**2
-    t152 = t39*t81
-    t153 = -t152 + t38*t95 + t53*t97
-    t154 = t152 + t153
-    t155 = t154**2 + t98**2
-    t156 = (t155 <= t104*t99)
-    t157 = casadi.if_else(t156, 1, 1/casadi.sqrt(t155))
-    t158 = casadi.if_else(t156, 1, t154*t157)
-    t159 = casadi.if_else(t156, 0, -t157*t98)
-    t160 = t158*t77 - t159*t85
-    t161 = t158*t85 + t159*t77
-    t162 = t160*t40 + t161*t57
-    t163 = t160*t57 - t161*t40
-    t164 = t160*t42 + t161*t59
-    t165 = t160*t59 - t161*t42
-    t166 = 1 - t160
-    t167 = t166*t41
-    t168 = t167 + t160*t41
-    t169 = t166*t43
-    t170 = t169 + t160*t43
-    t171 = t163**2
-    t172 = -t171
-    t173 = 1 + t172
-    t174 = casadi.if_else((t173 > 1e-12), casadi.sqrt(t173), 0)
-    t175 = t171 + t162*t174
-    t176 = t172 + t175
-    t177 = t168**2
-    t178 = t171 + t177 + t162**2
-    t179 = t174**2
-    t180 = t176**2 + t177*t179
-    t181 = t171 + t179
-    t182 = 1e-24*t181
-    t183 = (t180 <= t178*t182)
-    t184 = casadi.if_else(t183, 1, 1/casadi.sqrt(t180))
-    t185 = casadi.if_else(t183, 1, t176*t184)
-    t186 = t165*(1 - t185)
-    t187 = t186 + t165*t185
-    t188 = t168*t174
-    t189 = casadi.if_else(t183, 0, t184*t188)
-    t190 = t164*t185 + t170*t189
-    t191 = t170*t185 - t164*t189
-    t192 = (t181 <= t182)
-    t193 = casadi.if_else(t192, 1, 1/casadi.sqrt(t181))
-    t194 = casadi.if_else(t192, 1, t163*t193)
-    t195 = casadi.if_else(t192, 0, -t174*t193)
-    t196 = t191*(1 - t194)
-    t197 = t187*t195 + t190*t194
-    t198 = t196 + t191*t194
-    t199 = t187*t194 - t190*t195
-    t200 = t197**2 + t198**2
-    t201 = t200
-    t202 = t200 + t199**2
-    t203 = 1 - t33
-    t204 = t14*t203
-    t205 = t204 + t14*t33
-    t206 = -0.67183 + t205
-    t207 = t206**2 + t44**2 + t45**2
-    t208 = 0.19791478625 - 0.5*t207
-    t209 = T22*t203
-    t210 = t209 + T22*t33
-    t211 = T20*t203
-    t212 = t211 + T20*t33
-    t213 = t208**2
-    t214 = 1 - t213*t63
-    t215 = t208*t61
-    t216 = (1e-12 < t214)
-    t217 = casadi.if_else(t216, t215, casadi.if_else((t215 > 0), 1, -1))
-    t218 = casadi.if_else(t216, casadi.sqrt(t214), 0)
-    t219 = casadi.atan2(t218, t217)
-    t220 = casadi.if_else(t60, 0, t0 + t219)
-    t221 = t0 - t219
-    t222 = t217*t61
-    t223 = 0.00876554*t222
-    t224 = t218*t61
-    t225 = 0.18645124*t224
-    t226 = casadi.if_else(t60, 1, -t223 - t225)
-    t227 = t225 - t223
-    t228 = 0.15005 - 0.15005*t226
-    t229 = t228 + 0.15005*t226
-    t230 = 0.15005 - 0.15005*t227
-    t231 = t230 + 0.15005*t227
-    t232 = 0.18645124*t222
-    t233 = 0.00876554*t224
-    t234 = casadi.if_else(t60, 0, t232 - t233)
-    t235 = t232 + t233
-    t236 = 0.0203*t226 - 0.4318*t234
-    t237 = 0.0203*t234 + 0.4318*t226
-    t238 = 0.4318 + t236
-    t239 = 0.67183 + t237
-    t240 = -0.67183 + t239
-    t241 = t240*t44 - t206*t238
-    t242 = t229**2 + t238**2 + t240**2
-    t243 = 0.0203*t227 - 0.4318*t235
-    t244 = 0.0203*t235 + 0.4318*t227
-    t245 = 0.4318 + t243
-    t246 = 0.67183 + t244
-    t247 = -0.67183 + t246
-    t248 = t247*t44 - t206*t245
-    t249 = t231**2 + t245**2 + t247**2
-    t250 = t229*t45
-    t251 = -t250 + t206*t240 + t238*t44
-    t252 = t250 + t251
-    t253 = t241**2 + t252**2
-    t254 = 1e-24*t207
-    t255 = (t253 <= t242*t254)
-    t256 = casadi.if_else(t255, 1, 1/casadi.sqrt(t253))
-    t257 = casadi.if_else(t255, 1, t252*t256)
-    t258 = casadi.if_else(t255, 0, -t241*t256)
-    t259 = t226*t257 - t234*t258
-    t260 = t226*t258 + t234*t257
-    t261 = t210*t260 + t259*t46
-    t262 = t210*t259 - t260*t46
-    t263 = t212*t260 + t259*t48
-    t264 = t212*t259 - t260*t48
-    t265 = 1 - t259
-    t266 = t265*t47
-    t267 = t266 + t259*t47
-    t268 = t265*t49
-    t269 = t268 + t259*t49
-    t270 = t262**2
-    t271 = -t270
-    t272 = 1 + t271
-    t273 = casadi.if_else((t272 > 1e-12), casadi.sqrt(t272), 0)
-    t274 = t270 + t261*t273
-    t275 = t271 + t274
-    t276 = t267**2
-    t277 = t270 + t276 + t261**2
-    t278 = t273**2
-    t279 = t275**2 + t276*t278
-    t280 = t270 + t278
-    t281 = 1e-24*t280
-    t282 = (t279 <= t277*t281)
-    t283 = casadi.if_else(t282, 1, 1/casadi.sqrt(t279))
-    t284 = casadi.if_else(t282, 1, t275*t283)
-    t285 = t264*(1 - t284)
-    t286 = t285 + t264*t284
-    t287 = t267*t273
-    t288 = casadi.if_else(t282, 0, t283*t287)
-    t289 = t263*t284 + t269*t288
-    t290 = t269*t284 - t263*t288
-    t291 = (t280 <= t281)
-    t292 = casadi.if_else(t291, 1, 1/casadi.sqrt(t280))
-    t293 = casadi.if_else(t291, 1, t262*t292)
-    t294 = casadi.if_else(t291, 0, -t273*t292)
-    t295 = t290*(1 - t293)
-    t296 = t286*t294 + t289*t293
-    t297 = t295 + t290*t293
-    t298 = t286*t293 - t289*t294
-    t299 = t296**2 + t297**2
-    t300 = t299
-    t301 = t299 + t298**2
-    t302 = t231*t45
-    t303 = -t302 + t206*t247 + t245*t44
-    t304 = t302 + t303
-    t305 = t248**2 + t304**2
-    t306 = (t305 <= t249*t254)
-    t307 = casadi.if_else(t306, 1, 1/casadi.sqrt(t305))
-    t308 = casadi.if_else(t306, 1, t304*t307)
-    t309 = casadi.if_else(t306, 0, -t248*t307)
-    t310 = t227*t308 - t235*t309
-    t311 = t227*t309 + t235*t308
-    t312 = t210*t311 + t310*t46
-    t313 = t210*t310 - t311*t46
-    t314 = t212*t311 + t310*t48
-    t315 = t212*t310 - t311*t48
-    t316 = 1 - t310
-    t317 = t316*t47
-    t318 = t317 + t310*t47
-    t319 = t316*t49
-    t320 = t319 + t310*t49
-    t321 = t313**2
-    t322 = -t321
-    t323 = 1 + t322
-    t324 = casadi.if_else((t323 > 1e-12), casadi.sqrt(t323), 0)
-    t325 = t321 + t312*t324
-    t326 = t322 + t325
-    t327 = t318**2
-    t328 = t321 + t327 + t312**2
-    t329 = t324**2
-    t330 = t326**2 + t327*t329
-    t331 = t321 + t329
-    t332 = 1e-24*t331
-    t333 = (t330 <= t328*t332)
-    t334 = casadi.if_else(t333, 1, 1/casadi.sqrt(t330))
-    t335 = casadi.if_else(t333, 1, t326*t334)
-    t336 = t315*(1 - t335)
-    t337 = t336 + t315*t335
-    t338 = t318*t324
-    t339 = casadi.if_else(t333, 0, t334*t338)
-    t340 = t314*t335 + t320*t339
-    t341 = t320*t335 - t314*t339
-    t342 = (t331 <= t332)
-    t343 = casadi.if_else(t342, 1, 1/casadi.sqrt(t331))
-    t344 = casadi.if_else(t342, 1, t313*t343)
-    t345 = casadi.if_else(t342, 0, -t324*t343)
-    t346 = t341*(1 - t344)
-    t347 = t337*t345 + t340*t344
-    t348 = t346 + t341*t344
-    t349 = t337*t344 - t340*t345
-    t350 = t347**2 + t348**2
-    t351 = t350
-    t352 = t350 + t349**2
-    t353 = t26 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t26)
-    t354 = casadi.if_else(t105, 0, casadi.atan2(-t91, t102))
-    t355 = t70 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t70)
-    t356 = casadi.if_else(t132, 0, casadi.atan2(t137, t125))
-    t357 = casadi.if_else(t141, 0, casadi.atan2(-t123, t112))
-    t358 = casadi.if_else((t150 <= 1e-24*t151), 0, casadi.atan2(t147, t146))
-    t359 = casadi.if_else(t156, 0, casadi.atan2(-t98, t154))
-    t360 = t71 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t71)
-    t361 = casadi.if_else(t183, 0, casadi.atan2(t188, t176))
-    t362 = casadi.if_else(t192, 0, casadi.atan2(-t174, t163))
-    t363 = casadi.if_else((t201 <= 1e-24*t202), 0, casadi.atan2(t198, t197))
-    t364 = t27 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t27)
-    t365 = casadi.if_else(t255, 0, casadi.atan2(-t241, t252))
-    t366 = t220 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t220)
-    t367 = casadi.if_else(t282, 0, casadi.atan2(t287, t275))
-    t368 = casadi.if_else(t291, 0, casadi.atan2(-t273, t262))
-    t369 = casadi.if_else((t300 <= 1e-24*t301), 0, casadi.atan2(t297, t296))
-    t370 = casadi.if_else(t306, 0, casadi.atan2(-t248, t304))
-    t371 = t221 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t221)
-    t372 = casadi.if_else(t333, 0, casadi.atan2(t338, t326))
-    t373 = casadi.if_else(t342, 0, casadi.atan2(-t324, t313))
-    t374 = casadi.if_else((t351 <= 1e-24*t352), 0, casadi.atan2(t348, t347))
-    t375 = (casadi.fabs(t1) < casadi.inf)
-    t376 = -1e-12
-    t377 = (t16 > t18)
-    t378 = casadi.logic_or(casadi.logic_and(t377, (t21 >= t376)), casadi.logic_and(t19, (0.0225150025 <= 1e-12*t17)))
-    t379 = 3.9038849723757295e-26
-    t380 = (0.0348408995890292 > t379)
-    t381 = (0.0348408995890292 <= t379)
-    t382 = 3.9038849723757296e-14
-    t383 = casadi.logic_or(casadi.logic_and(t380, (t64 >= t376)), casadi.logic_and(t381, (t62 <= t382)))
-    t384 = (t64 > 1e-12)
-    t385 = (t21 > 1e-12)
-    t386 = casadi.logic_or(casadi.logic_and(t380, (t214 >= t376)), casadi.logic_and(t381, (t213 <= t382)))
-    t387 = (t214 > 1e-12)
-    q = casadi.SX(8, 6)
-    q[0, 0] = t353
-    q[0, 1] = t354
-    q[0, 2] = t355
-    q[0, 3] = t356
-    q[0, 4] = t357
-    q[0, 5] = t358
-    q[1, 0] = t353
-    q[1, 1] = t354
-    q[1, 2] = t355
-    q[1, 3] = 3.141592653589793 + t356 - 6.283185307179586*casadi.ceil(0.15915494309189535*t356)
-    q[1, 4] = -t357 - 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t357)
-    q[1, 5] = 3.141592653589793 + t358 - 6.283185307179586*casadi.ceil(0.15915494309189535*t358)
-    q[2, 0] = t353
-    q[2, 1] = t359
-    q[2, 2] = t360
-    q[2, 3] = t361
-    q[2, 4] = t362
-    q[2, 5] = t363
-    q[3, 0] = t353
-    q[3, 1] = t359
-    q[3, 2] = t360
-    q[3, 3] = 3.141592653589793 + t361 - 6.283185307179586*casadi.ceil(0.15915494309189535*t361)
-    q[3, 4] = -t362 - 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t362)
-    q[3, 5] = 3.141592653589793 + t363 - 6.283185307179586*casadi.ceil(0.15915494309189535*t363)
-    q[4, 0] = t364
-    q[4, 1] = t365
-    q[4, 2] = t366
-    q[4, 3] = t367
-    q[4, 4] = t368
-    q[4, 5] = t369
-    q[5, 0] = t364
-    q[5, 1] = t365
-    q[5, 2] = t366
-    q[5, 3] = 3.141592653589793 + t367 - 6.283185307179586*casadi.ceil(0.15915494309189535*t367)
-    q[5, 4] = -t368 - 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t368)
-    q[5, 5] = 3.141592653589793 + t369 - 6.283185307179586*casadi.ceil(0.15915494309189535*t369)
-    q[6, 0] = t364
-    q[6, 1] = t370
-    q[6, 2] = t371
-    q[6, 3] = t372
-    q[6, 4] = t373
-    q[6, 5] = t374
-    q[7, 0] = t364
-    q[7, 1] = t370
-    q[7, 2] = t371
-    q[7, 3] = 3.141592653589793 + t372 - 6.283185307179586*casadi.ceil(0.15915494309189535*t372)
-    q[7, 4] = -t373 - 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t373)
-    q[7, 5] = 3.141592653589793 + t374 - 6.283185307179586*casadi.ceil(0.15915494309189535*t374)
-    valid = casadi.SX(8, 1)
-    valid[0, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t375, t378), t383), (t122 >= t376))
-    valid[1, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t375, t378), t383), (t122 > 1e-12))
-    valid[2, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t375, t378), t380), t384), (t173 >= t376))
-    valid[3, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t375, t378), t380), t384), (t173 > 1e-12))
-    valid[4, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t375, t377), t385), t386), (t272 >= t376))
-    valid[5, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t375, t377), t385), t386), (t272 > 1e-12))
-    valid[6, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t375, t377), t380), t385), t387), (t323 >= t376))
-    valid[7, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t375, t377), t380), t385), t387), (t323 > 1e-12))
-    return [q, valid]
+    t98 = t41*t97 - t56*t95
+    t99 = t86**2 + t95**2 + t97**2
+    t100 = 0.0203*t84 - 0.4318*t92
+    t101 = 0.0203*t92 + 0.4318*t84
+    t102 = 0.4318 + t100
+    t103 = 0.67183 + t101
+    t104 = -0.67183 + t103
+    t105 = t104*t41 - t102*t56
+    t106 = t102**2 + t104**2 + t88**2
+    t107 = t42*t86
+    t108 = -t107 + t41*t95 + t56*t97
+    t109 = t107 + t108
+    t110 = t109**2 + t98**2
+    t111 = 1e-24*t57
+    t112 = (t110 <= t111*t99)
+    t113 = casadi.if_else(t112, 1, 1/casadi.sqrt(t110))
+    t114 = casadi.if_else(t112, 1, t109*t113)
+    t115 = casadi.if_else(t112, 0, -t113*t98)
+    t116 = t114*t83 - t115*t91
+    t117 = t114*t91 + t115*t83
+    t118 = t116*t43 + t117*t60
+    t119 = t116*t60 - t117*t43
+    t120 = t116*t45 + t117*t62
+    t121 = t116*t62 - t117*t45
+    t122 = casadi.if_else(t112, 0, casadi.atan2(-t98, t109))
+    t123 = t122 - 6.283185307179586*casadi.floor(0.125 + 0.15915494309189535*t122)
+    t124 = 1 - t116
+    t125 = t124*t44
+    t126 = t125 + t116*t44
+    t127 = t124*t46
+    t128 = t127 + t116*t46
+    t129 = t119**2
+    t130 = -t129
+    t131 = 1 + t130
+    t132 = (1e-12 < t131)
+    t133 = casadi.if_else(t132, casadi.sqrt(t131), 0)
+    t134 = t129 + t118*t133
+    t135 = t130 + t134
+    t136 = t126**2
+    t137 = t129 + t136 + t118**2
+    t138 = t133**2
+    t139 = t135**2 + t136*t138
+    t140 = t129 + t138
+    t141 = 1e-24*t140
+    t142 = (t139 <= t137*t141)
+    t143 = casadi.if_else(t142, 1, 1/casadi.sqrt(t139))
+    t144 = casadi.if_else(t142, 1, t135*t143)
+    t145 = t121*(1 - t144)
+    t146 = t145 + t121*t144
+    t147 = t126*t133
+    t148 = casadi.if_else(t142, 0, t143*t147)
+    t149 = t120*t144 + t128*t148
+    t150 = t128*t144 - t120*t148
+    t151 = (t140 <= t141)
+    t152 = casadi.if_else(t151, 1, 1/casadi.sqrt(t140))
+    t153 = casadi.if_else(t151, 1, t119*t152)
+    t154 = casadi.if_else(t151, 0, -t133*t152)
+    t155 = t150*(1 - t153)
+    t156 = t146*t154 + t149*t153
+    t157 = t155 + t150*t153
+    t158 = t146*t153 - t149*t154
+    t159 = t156**2 + t157**2
+    t160 = t159
+    t161 = t159 + t158**2
+    t162 = t42*t88
+    t163 = -t162 + t102*t41 + t104*t56
+    t164 = t162 + t163
+    t165 = t105**2 + t164**2
+    t166 = (t165 <= t106*t111)
+    t167 = casadi.if_else(t166, 1, 1/casadi.sqrt(t165))
+    t168 = casadi.if_else(t166, 1, t164*t167)
+    t169 = casadi.if_else(t166, 0, -t105*t167)
+    t170 = t168*t84 - t169*t92
+    t171 = t168*t92 + t169*t84
+    t172 = t170*t43 + t171*t60
+    t173 = t170*t60 - t171*t43
+    t174 = t170*t45 + t171*t62
+    t175 = t170*t62 - t171*t45
+    t176 = casadi.if_else(t166, 0, casadi.atan2(-t105, t164))
+    t177 = t176 - 6.283185307179586*casadi.floor(0.125 + 0.15915494309189535*t176)
+    t178 = 1 - t170
+    t179 = t178*t44
+    t180 = t179 + t170*t44
+    t181 = t178*t46
+    t182 = t181 + t170*t46
+    t183 = t173**2
+    t184 = -t183
+    t185 = 1 + t184
+    t186 = (1e-12 < t185)
+    t187 = casadi.if_else(t186, casadi.sqrt(t185), 0)
+    t188 = t183 + t172*t187
+    t189 = t184 + t188
+    t190 = t180**2
+    t191 = t183 + t190 + t172**2
+    t192 = t187**2
+    t193 = t189**2 + t190*t192
+    t194 = t183 + t192
+    t195 = 1e-24*t194
+    t196 = (t193 <= t191*t195)
+    t197 = casadi.if_else(t196, 1, 1/casadi.sqrt(t193))
+    t198 = casadi.if_else(t196, 1, t189*t197)
+    t199 = t175*(1 - t198)
+    t200 = t199 + t175*t198
+    t201 = t180*t187
+    t202 = casadi.if_else(t196, 0, t197*t201)
+    t203 = t174*t198 + t182*t202
+    t204 = t182*t198 - t174*t202
+    t205 = (t194 <= t195)
+    t206 = casadi.if_else(t205, 1, 1/casadi.sqrt(t194))
+    t207 = casadi.if_else(t205, 1, t173*t206)
+    t208 = casadi.if_else(t205, 0, -t187*t206)
+    t209 = t204*(1 - t207)
+    t210 = t200*t208 + t203*t207
+    t211 = t209 + t204*t207
+    t212 = t200*t207 - t203*t208
+    t213 = t210**2 + t211**2
+    t214 = t213
+    t215 = t213 + t212**2
+    t216 = 1 - t36
+    t217 = t13*t216
+    t218 = t217 + t13*t36
+    t219 = -0.67183 + t218
+    t220 = t219**2 + t47**2 + t48**2
+    t221 = 0.19791478625 - 0.5*t220
+    t222 = T22*t216
+    t223 = t222 + T22*t36
+    t224 = T20*t216
+    t225 = t224 + T20*t36
+    t226 = t221**2
+    t227 = 1 - t226*t66
+    t228 = t221*t64
+    t229 = (1e-12 < t227)
+    t230 = casadi.if_else(t229, t228, casadi.if_else((t228 > 0), 1, -1))
+    t231 = casadi.if_else(t229, casadi.sqrt(t227), 0)
+    t232 = casadi.atan2(t231, t230)
+    t233 = casadi.if_else(t63, 0, t0 + t232)
+    t234 = t0 - t232
+    t235 = t233 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t233)
+    t236 = t235 - 6.283185307179586*casadi.floor(0.625 + 0.15915494309189535*t235)
+    t237 = t234 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t234)
+    t238 = t237 - 6.283185307179586*casadi.floor(0.625 + 0.15915494309189535*t237)
+    t239 = t230*t64
+    t240 = 0.00876554*t239
+    t241 = t231*t64
+    t242 = 0.18645124*t241
+    t243 = casadi.if_else(t63, 1, -t240 - t242)
+    t244 = t242 - t240
+    t245 = 0.15005 - 0.15005*t243
+    t246 = t245 + 0.15005*t243
+    t247 = 0.15005 - 0.15005*t244
+    t248 = t247 + 0.15005*t244
+    t249 = 0.18645124*t239
+    t250 = 0.00876554*t241
+    t251 = casadi.if_else(t63, 0, t249 - t250)
+    t252 = t249 + t250
+    t253 = 0.0203*t243 - 0.4318*t251
+    t254 = 0.0203*t251 + 0.4318*t243
+    t255 = 0.4318 + t253
+    t256 = 0.67183 + t254
+    t257 = -0.67183 + t256
+    t258 = t257*t47 - t219*t255
+    t259 = t246**2 + t255**2 + t257**2
+    t260 = 0.0203*t244 - 0.4318*t252
+    t261 = 0.0203*t252 + 0.4318*t244
+    t262 = 0.4318 + t260
+    t263 = 0.67183 + t261
+    t264 = -0.67183 + t263
+    t265 = t264*t47 - t219*t262
+    t266 = t248**2 + t262**2 + t264**2
+    t267 = t246*t48
+    t268 = -t267 + t219*t257 + t255*t47
+    t269 = t267 + t268
+    t270 = t258**2 + t269**2
+    t271 = 1e-24*t220
+    t272 = (t270 <= t259*t271)
+    t273 = casadi.if_else(t272, 1, 1/casadi.sqrt(t270))
+    t274 = casadi.if_else(t272, 1, t269*t273)
+    t275 = casadi.if_else(t272, 0, -t258*t273)
+    t276 = t243*t274 - t251*t275
+    t277 = t243*t275 + t251*t274
+    t278 = t223*t277 + t276*t49
+    t279 = t223*t276 - t277*t49
+    t280 = t225*t277 + t276*t51
+    t281 = t225*t276 - t277*t51
+    t282 = casadi.if_else(t272, 0, casadi.atan2(-t258, t269))
+    t283 = t282 - 6.283185307179586*casadi.floor(0.125 + 0.15915494309189535*t282)
+    t284 = 1 - t276
+    t285 = t284*t50
+    t286 = t285 + t276*t50
+    t287 = t284*t52
+    t288 = t287 + t276*t52
+    t289 = t279**2
+    t290 = -t289
+    t291 = 1 + t290
+    t292 = (1e-12 < t291)
+    t293 = casadi.if_else(t292, casadi.sqrt(t291), 0)
+    t294 = t289 + t278*t293
+    t295 = t290 + t294
+    t296 = t286**2
+    t297 = t289 + t296 + t278**2
+    t298 = t293**2
+    t299 = t295**2 + t296*t298
+    t300 = t289 + t298
+    t301 = 1e-24*t300
+    t302 = (t299 <= t297*t301)
+    t303 = casadi.if_else(t302, 1, 1/casadi.sqrt(t299))
+    t304 = casadi.if_else(t302, 1, t295*t303)
+    t305 = t281*(1 - t304)
+    t306 = t305 + t281*t304
+    t307 = t286*t293
+    t308 = casadi.if_else(t302, 0, t303*t307)
+    t309 = t280*t304 + t288*t308
+    t310 = t288*t304 - t280*t308
+    t311 = (t300 <= t301)
+    t312 = casadi.if_else(t311, 1, 1/casadi.sqrt(t300))
+    t313 = casadi.if_else(t311, 1, t279*t312)
+    t314 = casadi.if_else(t311, 0, -t293*t312)
+    t315 = t310*(1 - t313)
+    t316 = t306*t314 + t309*t313
+    t317 = t315 + t310*t313
+    t318 = t306*t313 - t309*t314
+    t319 = t316**2 + t317**2
+    t320 = t319
+    t321 = t319 + t318**2
+    t322 = t248*t48
+    t323 = -t322 + t219*t264 + t262*t47
+    t324 = t322 + t323
+    t325 = t265**2 + t324**2
+    t326 = (t325 <= t266*t271)
+    t327 = casadi.if_else(t326, 1, 1/casadi.sqrt(t325))
+    t328 = casadi.if_else(t326, 1, t324*t327)
+    t329 = casadi.if_else(t326, 0, -t265*t327)
+    t330 = t244*t328 - t252*t329
+    t331 = t244*t329 + t252*t328
+    t332 = t223*t331 + t330*t49
+    t333 = t223*t330 - t331*t49
+    t334 = t225*t331 + t330*t51
+    t335 = t225*t330 - t331*t51
+    t336 = casadi.if_else(t326, 0, casadi.atan2(-t265, t324))
+    t337 = t336 - 6.283185307179586*casadi.floor(0.125 + 0.15915494309189535*t336)
+    t338 = 1 - t330
+    t339 = t338*t50
+    t340 = t339 + t330*t50
+    t341 = t338*t52
+    t342 = t341 + t330*t52
+    t343 = t333**2
+    t344 = -t343
+    t345 = 1 + t344
+    t346 = (1e-12 < t345)
+    t347 = casadi.if_else(t346, casadi.sqrt(t345), 0)
+    t348 = t343 + t332*t347
+    t349 = t344 + t348
+    t350 = t340**2
+    t351 = t343 + t350 + t332**2
+    t352 = t347**2
+    t353 = t349**2 + t350*t352
+    t354 = t343 + t352
+    t355 = 1e-24*t354
+    t356 = (t353 <= t351*t355)
+    t357 = casadi.if_else(t356, 1, 1/casadi.sqrt(t353))
+    t358 = casadi.if_else(t356, 1, t349*t357)
+    t359 = t335*(1 - t358)
+    t360 = t359 + t335*t358
+    t361 = t340*t347
+    t362 = casadi.if_else(t356, 0, t357*t361)
+    t363 = t334*t358 + t342*t362
+    t364 = t342*t358 - t334*t362
+    t365 = (t354 <= t355)
+    t366 = casadi.if_else(t365, 1, 1/casadi.sqrt(t354))
+    t367 = casadi.if_else(t365, 1, t333*t366)
+    t368 = casadi.if_else(t365, 0, -t347*t366)
+    t369 = t364*(1 - t367)
+    t370 = t360*t368 + t363*t367
+    t371 = t369 + t364*t367
+    t372 = t360*t367 - t363*t368
+    t373 = t370**2 + t371**2
+    t374 = t373
+    t375 = t373 + t372**2
+    t376 = T00 + T01 + T02 + T03 + T10 + T11 + T12 + T13 + T20 + T21 + T22 + T23
+    t377 = t376
+    t378 = qn1 + qn2 + qn3 + qn4 + qn5 + qn6 + qw1 + qw2 + qw3 + qw4 + qw5 + qw6 + t376
+    t379 = casadi.if_else(t142, 0, casadi.atan2(t147, t135))
+    t380 = t379
+    t381 = t380 - 6.283185307179586*casadi.floor(0.3055555555555555 + 0.15915494309189535*t380)
+    t382 = 3.141592653589793 + t379 - 6.283185307179586*casadi.ceil(0.15915494309189535*t379)
+    t383 = t382 - 6.283185307179586*casadi.floor(0.3055555555555555 + 0.15915494309189535*t382)
+    t384 = casadi.if_else(t151, 0, casadi.atan2(-t133, t119))
+    t385 = t384
+    t386 = t385 - 6.283185307179586*casadi.floor(0.2777777777777778 + 0.15915494309189535*t385)
+    t387 = t384 + 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t384)
+    t388 = casadi.if_else((t160 <= 1e-24*t161), 0, casadi.atan2(t157, t156))
+    t389 = t388
+    t390 = t389 - 6.283185307179586*casadi.floor(0.7388888888888888 + 0.15915494309189535*t389)
+    t391 = 3.141592653589793 + t388 - 6.283185307179586*casadi.ceil(0.15915494309189535*t388)
+    t392 = t391 - 6.283185307179586*casadi.floor(0.7388888888888888 + 0.15915494309189535*t391)
+    t393 = -t387
+    t394 = t387 + 6.283185307179586*casadi.floor(0.2777777777777778 + 0.15915494309189535*t393)
+    t395 = casadi.if_else(t196, 0, casadi.atan2(t201, t189))
+    t396 = t395
+    t397 = t396 - 6.283185307179586*casadi.floor(0.3055555555555555 + 0.15915494309189535*t396)
+    t398 = 3.141592653589793 + t395 - 6.283185307179586*casadi.ceil(0.15915494309189535*t395)
+    t399 = t398 - 6.283185307179586*casadi.floor(0.3055555555555555 + 0.15915494309189535*t398)
+    t400 = casadi.if_else(t205, 0, casadi.atan2(-t187, t173))
+    t401 = t400
+    t402 = t401 - 6.283185307179586*casadi.floor(0.2777777777777778 + 0.15915494309189535*t401)
+    t403 = t400 + 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t400)
+    t404 = casadi.if_else((t214 <= 1e-24*t215), 0, casadi.atan2(t211, t210))
+    t405 = t404
+    t406 = t405 - 6.283185307179586*casadi.floor(0.7388888888888888 + 0.15915494309189535*t405)
+    t407 = 3.141592653589793 + t404 - 6.283185307179586*casadi.ceil(0.15915494309189535*t404)
+    t408 = t407 - 6.283185307179586*casadi.floor(0.7388888888888888 + 0.15915494309189535*t407)
+    t409 = -t403
+    t410 = t403 + 6.283185307179586*casadi.floor(0.2777777777777778 + 0.15915494309189535*t409)
+    t411 = casadi.if_else(t302, 0, casadi.atan2(t307, t295))
+    t412 = t411
+    t413 = t412 - 6.283185307179586*casadi.floor(0.3055555555555555 + 0.15915494309189535*t412)
+    t414 = 3.141592653589793 + t411 - 6.283185307179586*casadi.ceil(0.15915494309189535*t411)
+    t415 = t414 - 6.283185307179586*casadi.floor(0.3055555555555555 + 0.15915494309189535*t414)
+    t416 = casadi.if_else(t311, 0, casadi.atan2(-t293, t279))
+    t417 = t416
+    t418 = t417 - 6.283185307179586*casadi.floor(0.2777777777777778 + 0.15915494309189535*t417)
+    t419 = t416 + 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t416)
+    t420 = casadi.if_else((t320 <= 1e-24*t321), 0, casadi.atan2(t317, t316))
+    t421 = t420
+    t422 = t421 - 6.283185307179586*casadi.floor(0.7388888888888888 + 0.15915494309189535*t421)
+    t423 = 3.141592653589793 + t420 - 6.283185307179586*casadi.ceil(0.15915494309189535*t420)
+    t424 = t423 - 6.283185307179586*casadi.floor(0.7388888888888888 + 0.15915494309189535*t423)
+    t425 = -t419
+    t426 = t419 + 6.283185307179586*casadi.floor(0.2777777777777778 + 0.15915494309189535*t425)
+    t427 = casadi.if_else(t356, 0, casadi.atan2(t361, t349))
+    t428 = t427
+    t429 = t428 - 6.283185307179586*casadi.floor(0.3055555555555555 + 0.15915494309189535*t428)
+    t430 = 3.141592653589793 + t427 - 6.283185307179586*casadi.ceil(0.15915494309189535*t427)
+    t431 = t430 - 6.283185307179586*casadi.floor(0.3055555555555555 + 0.15915494309189535*t430)
+    t432 = casadi.if_else(t365, 0, casadi.atan2(-t347, t333))
+    t433 = t432
+    t434 = t433 - 6.283185307179586*casadi.floor(0.2777777777777778 + 0.15915494309189535*t433)
+    t435 = t432 + 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t432)
+    t436 = casadi.if_else((t374 <= 1e-24*t375), 0, casadi.atan2(t371, t370))
+    t437 = t436
+    t438 = t437 - 6.283185307179586*casadi.floor(0.7388888888888888 + 0.15915494309189535*t437)
+    t439 = 3.141592653589793 + t436 - 6.283185307179586*casadi.ceil(0.15915494309189535*t436)
+    t440 = t439 - 6.283185307179586*casadi.floor(0.7388888888888888 + 0.15915494309189535*t439)
+    t441 = -t435
+    t442 = t435 + 6.283185307179586*casadi.floor(0.2777777777777778 + 0.15915494309189535*t441)
+    t443 = (t28 <= 2.792526803190927)
+    t444 = casadi.logic_and((t27 >= -2.792526803190927), (t27 <= 2.792526803190927))
+    t445 = casadi.if_else(casadi.logic_and(t443, casadi.logic_not(t444)), t28, t27)
+    t446 = t445
+    t447 = t446 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn1 - 0.15915494309189535*t446)
+    t448 = casadi.if_else((qn1 > t447), 6.283185307179586, -6.283185307179586)
+    t449 = t447 + t448
+    t450 = t447 - t448
+    t451 = casadi.if_else(casadi.logic_and((t447 >= -2.792526803190927), (t447 <= 2.792526803190927)), t447, casadi.if_else(casadi.logic_and((t449 >= -2.792526803190927), (t449 <= 2.792526803190927)), t449, casadi.if_else(casadi.logic_and((t450 >= -2.792526803190927), (t450 <= 2.792526803190927)), t450, t445)))
+    t452 = (t123 <= 3.9269908169872414)
+    t453 = casadi.logic_and((t122 >= -0.7853981633974483), (t122 <= 3.9269908169872414))
+    t454 = casadi.if_else(casadi.logic_and(t452, casadi.logic_not(t453)), t123, t122)
+    t455 = t454
+    t456 = t455 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t455)
+    t457 = casadi.if_else((qn2 > t456), 6.283185307179586, -6.283185307179586)
+    t458 = t456 + t457
+    t459 = t456 - t457
+    t460 = casadi.if_else(casadi.logic_and((t456 >= -0.7853981633974483), (t456 <= 3.9269908169872414)), t456, casadi.if_else(casadi.logic_and((t458 >= -0.7853981633974483), (t458 <= 3.9269908169872414)), t458, casadi.if_else(casadi.logic_and((t459 >= -0.7853981633974483), (t459 <= 3.9269908169872414)), t459, t454)))
+    t461 = (t76 <= 0.7853981633974483)
+    t462 = casadi.logic_and((t75 >= -3.9269908169872414), (t75 <= 0.7853981633974483))
+    t463 = casadi.if_else(casadi.logic_and(t461, casadi.logic_not(t462)), t76, t75)
+    t464 = t463
+    t465 = t464 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn3 - 0.15915494309189535*t464)
+    t466 = casadi.if_else((qn3 > t465), 6.283185307179586, -6.283185307179586)
+    t467 = t465 + t466
+    t468 = t465 - t466
+    t469 = casadi.if_else(casadi.logic_and((t465 >= -3.9269908169872414), (t465 <= 0.7853981633974483)), t465, casadi.if_else(casadi.logic_and((t467 >= -3.9269908169872414), (t467 <= 0.7853981633974483)), t467, casadi.if_else(casadi.logic_and((t468 >= -3.9269908169872414), (t468 <= 0.7853981633974483)), t468, t463)))
+    t470 = (t381 <= 2.9670597283903604)
+    t471 = casadi.logic_and((t380 >= -1.9198621771937625), (t380 <= 2.9670597283903604))
+    t472 = casadi.if_else(casadi.logic_and(t470, casadi.logic_not(t471)), t381, t380)
+    t473 = t472
+    t474 = t473 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t473)
+    t475 = casadi.if_else((qn4 > t474), 6.283185307179586, -6.283185307179586)
+    t476 = t474 + t475
+    t477 = t474 - t475
+    t478 = casadi.if_else(casadi.logic_and((t474 >= -1.9198621771937625), (t474 <= 2.9670597283903604)), t474, casadi.if_else(casadi.logic_and((t476 >= -1.9198621771937625), (t476 <= 2.9670597283903604)), t476, casadi.if_else(casadi.logic_and((t477 >= -1.9198621771937625), (t477 <= 2.9670597283903604)), t477, t472)))
+    t479 = (t386 <= 1.7453292519943295)
+    t480 = casadi.logic_and((t385 >= -1.7453292519943295), (t385 <= 1.7453292519943295))
+    t481 = casadi.if_else(casadi.logic_and(t479, casadi.logic_not(t480)), t386, t385)
+    t482 = t481
+    t483 = t482 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn5 - 0.15915494309189535*t482)
+    t484 = casadi.if_else((qn5 > t483), 6.283185307179586, -6.283185307179586)
+    t485 = t483 + t484
+    t486 = t483 - t484
+    t487 = casadi.if_else(casadi.logic_and((t483 >= -1.7453292519943295), (t483 <= 1.7453292519943295)), t483, casadi.if_else(casadi.logic_and((t485 >= -1.7453292519943295), (t485 <= 1.7453292519943295)), t485, casadi.if_else(casadi.logic_and((t486 >= -1.7453292519943295), (t486 <= 1.7453292519943295)), t486, t481)))
+    t488 = (t390 <= 4.642575810304916)
+    t489 = casadi.logic_and((t389 >= -4.642575810304916), (t389 <= 4.642575810304916))
+    t490 = casadi.if_else(casadi.logic_and(t488, casadi.logic_not(t489)), t390, t389)
+    t491 = t490
+    t492 = t491 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn6 - 0.15915494309189535*t491)
+    t493 = casadi.if_else((qn6 > t492), 6.283185307179586, -6.283185307179586)
+    t494 = t492 + t493
+    t495 = t492 - t493
+    t496 = casadi.if_else(casadi.logic_and((t492 >= -4.642575810304916), (t492 <= 4.642575810304916)), t492, casadi.if_else(casadi.logic_and((t494 >= -4.642575810304916), (t494 <= 4.642575810304916)), t494, casadi.if_else(casadi.logic_and((t495 >= -4.642575810304916), (t495 <= 4.642575810304916)), t495, t490)))
+    t497 = -qn4
+    t498 = -qn5
+    t499 = -qn6
+    t500 = -qn1
+    t501 = qw1*(t451 + t500)**2
+    t502 = -qn2
+    t503 = -qn3
+    t504 = t501 + qw2*(t460 + t502)**2 + qw3*(t469 + t503)**2
+    t505 = t504 + qw4*(t478 + t497)**2 + qw5*(t487 + t498)**2 + qw6*(t496 + t499)**2
+    t506 = (casadi.fabs(t377) < casadi.inf)
+    t507 = casadi.logic_or(t443, t444)
+    t508 = casadi.logic_or(t452, t453)
+    t509 = casadi.logic_or(t461, t462)
+    t510 = True
+    t511 = casadi.logic_or(casadi.logic_and(t63, (1e-12 >= 25.615508834817042*t65)), casadi.logic_and(t510, (1e-12 >= -t67)))
+    t512 = (t15 > t17)
+    t513 = casadi.logic_or(casadi.logic_and(t18, (1e-12*t16 >= 0.0225150025)), casadi.logic_and(t512, (1e-12 >= -t20)))
+    t514 = casadi.if_else(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t506, t507), t508), t509), t511), t513), (t131 >= -1e-12)), casadi.logic_or(t470, t471)), casadi.logic_or(t479, t480)), casadi.logic_or(t488, t489)), 1, 0)
+    t515 = casadi.if_else((t514 > 0), 1, 0)
+    t516 = (t515 > 0)
+    t517 = casadi.if_else(t516, t451, qn1)
+    t518 = casadi.if_else(t516, t460, qn2)
+    t519 = casadi.if_else(t516, t469, qn3)
+    t520 = casadi.if_else(t516, t478, qn4)
+    t521 = casadi.if_else(t516, t487, qn5)
+    t522 = casadi.if_else(t516, t496, qn6)
+    t523 = casadi.if_else(t516, t505, 0)
+    t524 = (t383 <= 2.9670597283903604)
+    t525 = casadi.logic_and((t382 >= -1.9198621771937625), (t382 <= 2.9670597283903604))
+    t526 = casadi.if_else(casadi.logic_and(t524, casadi.logic_not(t525)), t383, t382)
+    t527 = t526
+    t528 = t527 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t527)
+    t529 = casadi.if_else((qn4 > t528), 6.283185307179586, -6.283185307179586)
+    t530 = t528 + t529
+    t531 = t528 - t529
+    t532 = casadi.if_else(casadi.logic_and((t528 >= -1.9198621771937625), (t528 <= 2.9670597283903604)), t528, casadi.if_else(casadi.logic_and((t530 >= -1.9198621771937625), (t530 <= 2.9670597283903604)), t530, casadi.if_else(casadi.logic_and((t531 >= -1.9198621771937625), (t531 <= 2.9670597283903604)), t531, t526)))
+    t533 = (t394 >= -1.7453292519943295)
+    t534 = casadi.logic_and((t387 >= -1.7453292519943295), (t387 <= 1.7453292519943295))
+    t535 = casadi.if_else(casadi.logic_and(t533, casadi.logic_not(t534)), -t394, t393)
+    t536 = t535
+    t537 = t536 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn5 - 0.15915494309189535*t536)
+    t538 = casadi.if_else((qn5 > t537), 6.283185307179586, -6.283185307179586)
+    t539 = t537 + t538
+    t540 = t537 - t538
+    t541 = casadi.if_else(casadi.logic_and((t537 >= -1.7453292519943295), (t537 <= 1.7453292519943295)), t537, casadi.if_else(casadi.logic_and((t539 >= -1.7453292519943295), (t539 <= 1.7453292519943295)), t539, casadi.if_else(casadi.logic_and((t540 >= -1.7453292519943295), (t540 <= 1.7453292519943295)), t540, t535)))
+    t542 = (t392 <= 4.642575810304916)
+    t543 = casadi.logic_and((t391 >= -4.642575810304916), (t391 <= 4.642575810304916))
+    t544 = casadi.if_else(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t132, t506), t507), t508), t509), t511), t513), casadi.logic_or(t524, t525)), casadi.logic_or(t533, t534)), casadi.logic_or(t542, t543)), 1, 0)
+    t545 = casadi.if_else(casadi.logic_and(t542, casadi.logic_not(t543)), t392, t391)
+    t546 = t545
+    t547 = t546 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn6 - 0.15915494309189535*t546)
+    t548 = casadi.if_else((qn6 > t547), 6.283185307179586, -6.283185307179586)
+    t549 = t547 + t548
+    t550 = t547 - t548
+    t551 = casadi.if_else(casadi.logic_and((t547 >= -4.642575810304916), (t547 <= 4.642575810304916)), t547, casadi.if_else(casadi.logic_and((t549 >= -4.642575810304916), (t549 <= 4.642575810304916)), t549, casadi.if_else(casadi.logic_and((t550 >= -4.642575810304916), (t550 <= 4.642575810304916)), t550, t545)))
+    t552 = t504 + qw4*(t497 + t532)**2 + qw5*(t498 + t541)**2 + qw6*(t499 + t551)**2
+    t553 = (t544 > 0)
+    t554 = casadi.if_else(casadi.logic_and(t553, casadi.logic_or((t523 > t552), (t515 < 1))), 1, 0)
+    t555 = casadi.if_else(t553, 1, t515)
+    t556 = (t554 > 0)
+    t557 = casadi.if_else(t556, t451, t517)
+    t558 = casadi.if_else(t556, t460, t518)
+    t559 = casadi.if_else(t556, t469, t519)
+    t560 = casadi.if_else(t556, t532, t520)
+    t561 = casadi.if_else(t556, t541, t521)
+    t562 = casadi.if_else(t556, t551, t522)
+    t563 = casadi.if_else(t556, t552, t523)
+    t564 = (t177 <= 3.9269908169872414)
+    t565 = casadi.logic_and((t176 >= -0.7853981633974483), (t176 <= 3.9269908169872414))
+    t566 = casadi.if_else(casadi.logic_and(t564, casadi.logic_not(t565)), t177, t176)
+    t567 = t566
+    t568 = t567 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t567)
+    t569 = casadi.if_else((qn2 > t568), 6.283185307179586, -6.283185307179586)
+    t570 = t568 + t569
+    t571 = t568 - t569
+    t572 = casadi.if_else(casadi.logic_and((t568 >= -0.7853981633974483), (t568 <= 3.9269908169872414)), t568, casadi.if_else(casadi.logic_and((t570 >= -0.7853981633974483), (t570 <= 3.9269908169872414)), t570, casadi.if_else(casadi.logic_and((t571 >= -0.7853981633974483), (t571 <= 3.9269908169872414)), t571, t566)))
+    t573 = (t78 <= 0.7853981633974483)
+    t574 = casadi.logic_and((t77 >= -3.9269908169872414), (t77 <= 0.7853981633974483))
+    t575 = casadi.if_else(casadi.logic_and(t573, casadi.logic_not(t574)), t78, t77)
+    t576 = t575
+    t577 = t576 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn3 - 0.15915494309189535*t576)
+    t578 = casadi.if_else((qn3 > t577), 6.283185307179586, -6.283185307179586)
+    t579 = t577 + t578
+    t580 = t577 - t578
+    t581 = casadi.if_else(casadi.logic_and((t577 >= -3.9269908169872414), (t577 <= 0.7853981633974483)), t577, casadi.if_else(casadi.logic_and((t579 >= -3.9269908169872414), (t579 <= 0.7853981633974483)), t579, casadi.if_else(casadi.logic_and((t580 >= -3.9269908169872414), (t580 <= 0.7853981633974483)), t580, t575)))
+    t582 = (t397 <= 2.9670597283903604)
+    t583 = casadi.logic_and((t396 >= -1.9198621771937625), (t396 <= 2.9670597283903604))
+    t584 = casadi.if_else(casadi.logic_and(t582, casadi.logic_not(t583)), t397, t396)
+    t585 = t584
+    t586 = t585 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t585)
+    t587 = casadi.if_else((qn4 > t586), 6.283185307179586, -6.283185307179586)
+    t588 = t586 + t587
+    t589 = t586 - t587
+    t590 = casadi.if_else(casadi.logic_and((t586 >= -1.9198621771937625), (t586 <= 2.9670597283903604)), t586, casadi.if_else(casadi.logic_and((t588 >= -1.9198621771937625), (t588 <= 2.9670597283903604)), t588, casadi.if_else(casadi.logic_and((t589 >= -1.9198621771937625), (t589 <= 2.9670597283903604)), t589, t584)))
+    t591 = (t402 <= 1.7453292519943295)
+    t592 = casadi.logic_and((t401 >= -1.7453292519943295), (t401 <= 1.7453292519943295))
+    t593 = casadi.if_else(casadi.logic_and(t591, casadi.logic_not(t592)), t402, t401)
+    t594 = t593
+    t595 = t594 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn5 - 0.15915494309189535*t594)
+    t596 = casadi.if_else((qn5 > t595), 6.283185307179586, -6.283185307179586)
+    t597 = t595 + t596
+    t598 = t595 - t596
+    t599 = casadi.if_else(casadi.logic_and((t595 >= -1.7453292519943295), (t595 <= 1.7453292519943295)), t595, casadi.if_else(casadi.logic_and((t597 >= -1.7453292519943295), (t597 <= 1.7453292519943295)), t597, casadi.if_else(casadi.logic_and((t598 >= -1.7453292519943295), (t598 <= 1.7453292519943295)), t598, t593)))
+    t600 = (t406 <= 4.642575810304916)
+    t601 = casadi.logic_and((t405 >= -4.642575810304916), (t405 <= 4.642575810304916))
+    t602 = casadi.if_else(casadi.logic_and(t600, casadi.logic_not(t601)), t406, t405)
+    t603 = t602
+    t604 = t603 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn6 - 0.15915494309189535*t603)
+    t605 = casadi.if_else((qn6 > t604), 6.283185307179586, -6.283185307179586)
+    t606 = t604 + t605
+    t607 = t604 - t605
+    t608 = casadi.if_else(casadi.logic_and((t604 >= -4.642575810304916), (t604 <= 4.642575810304916)), t604, casadi.if_else(casadi.logic_and((t606 >= -4.642575810304916), (t606 <= 4.642575810304916)), t606, casadi.if_else(casadi.logic_and((t607 >= -4.642575810304916), (t607 <= 4.642575810304916)), t607, t602)))
+    t609 = t501 + qw2*(t502 + t572)**2 + qw3*(t503 + t581)**2
+    t610 = t609 + qw4*(t497 + t590)**2 + qw5*(t498 + t599)**2 + qw6*(t499 + t608)**2
+    t611 = casadi.logic_or(t564, t565)
+    t612 = casadi.logic_or(t573, t574)
+    t613 = casadi.if_else(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t506, t507), t510), t513), t611), t612), t69), (t185 >= -1e-12)), casadi.logic_or(t582, t583)), casadi.logic_or(t591, t592)), casadi.logic_or(t600, t601)), 1, 0)
+    t614 = (t613 > 0)
+    t615 = casadi.if_else(casadi.logic_and(t614, casadi.logic_or((t563 > t610), (t555 < 1))), 1, 0)
+    t616 = casadi.if_else(t614, 1, t555)
+    t617 = (t615 > 0)
+    t618 = casadi.if_else(t617, t451, t557)
+    t619 = casadi.if_else(t617, t572, t558)
+    t620 = casadi.if_else(t617, t581, t559)
+    t621 = casadi.if_else(t617, t590, t560)
+    t622 = casadi.if_else(t617, t599, t561)
+    t623 = casadi.if_else(t617, t608, t562)
+    t624 = casadi.if_else(t617, t610, t563)
+    t625 = (t399 <= 2.9670597283903604)
+    t626 = casadi.logic_and((t398 >= -1.9198621771937625), (t398 <= 2.9670597283903604))
+    t627 = casadi.if_else(casadi.logic_and(t625, casadi.logic_not(t626)), t399, t398)
+    t628 = t627
+    t629 = t628 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t628)
+    t630 = casadi.if_else((qn4 > t629), 6.283185307179586, -6.283185307179586)
+    t631 = t629 + t630
+    t632 = t629 - t630
+    t633 = casadi.if_else(casadi.logic_and((t629 >= -1.9198621771937625), (t629 <= 2.9670597283903604)), t629, casadi.if_else(casadi.logic_and((t631 >= -1.9198621771937625), (t631 <= 2.9670597283903604)), t631, casadi.if_else(casadi.logic_and((t632 >= -1.9198621771937625), (t632 <= 2.9670597283903604)), t632, t627)))
+    t634 = (t410 >= -1.7453292519943295)
+    t635 = casadi.logic_and((t403 >= -1.7453292519943295), (t403 <= 1.7453292519943295))
+    t636 = casadi.if_else(casadi.logic_and(t634, casadi.logic_not(t635)), -t410, t409)
+    t637 = t636
+    t638 = t637 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn5 - 0.15915494309189535*t637)
+    t639 = casadi.if_else((qn5 > t638), 6.283185307179586, -6.283185307179586)
+    t640 = t638 + t639
+    t641 = t638 - t639
+    t642 = casadi.if_else(casadi.logic_and((t638 >= -1.7453292519943295), (t638 <= 1.7453292519943295)), t638, casadi.if_else(casadi.logic_and((t640 >= -1.7453292519943295), (t640 <= 1.7453292519943295)), t640, casadi.if_else(casadi.logic_and((t641 >= -1.7453292519943295), (t641 <= 1.7453292519943295)), t641, t636)))
+    t643 = (t408 <= 4.642575810304916)
+    t644 = casadi.logic_and((t407 >= -4.642575810304916), (t407 <= 4.642575810304916))
+    t645 = casadi.if_else(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t186, t506), t507), t510), t513), t611), t612), t69), casadi.logic_or(t625, t626)), casadi.logic_or(t634, t635)), casadi.logic_or(t643, t644)), 1, 0)
+    t646 = casadi.if_else(casadi.logic_and(t643, casadi.logic_not(t644)), t408, t407)
+    t647 = t646
+    t648 = t647 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn6 - 0.15915494309189535*t647)
+    t649 = casadi.if_else((qn6 > t648), 6.283185307179586, -6.283185307179586)
+    t650 = t648 + t649
+    t651 = t648 - t649
+    t652 = casadi.if_else(casadi.logic_and((t648 >= -4.642575810304916), (t648 <= 4.642575810304916)), t648, casadi.if_else(casadi.logic_and((t650 >= -4.642575810304916), (t650 <= 4.642575810304916)), t650, casadi.if_else(casadi.logic_and((t651 >= -4.642575810304916), (t651 <= 4.642575810304916)), t651, t646)))
+    t653 = t609 + qw4*(t497 + t633)**2 + qw5*(t498 + t642)**2 + qw6*(t499 + t652)**2
+    t654 = (t645 > 0)
+    t655 = casadi.if_else(casadi.logic_and(t654, casadi.logic_or((t624 > t653), (t616 < 1))), 1, 0)
+    t656 = casadi.if_else(t654, 1, t616)
+    t657 = (t655 > 0)
+    t658 = casadi.if_else(t657, t451, t618)
+    t659 = casadi.if_else(t657, t572, t619)
+    t660 = casadi.if_else(t657, t581, t620)
+    t661 = casadi.if_else(t657, t633, t621)
+    t662 = casadi.if_else(t657, t642, t622)
+    t663 = casadi.if_else(t657, t652, t623)
+    t664 = casadi.if_else(t657, t653, t624)
+    t665 = (t30 <= 2.792526803190927)
+    t666 = casadi.logic_and((t29 >= -2.792526803190927), (t29 <= 2.792526803190927))
+    t667 = casadi.if_else(casadi.logic_and(t665, casadi.logic_not(t666)), t30, t29)
+    t668 = t667
+    t669 = t668 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn1 - 0.15915494309189535*t668)
+    t670 = casadi.if_else((qn1 > t669), 6.283185307179586, -6.283185307179586)
+    t671 = t669 + t670
+    t672 = t669 - t670
+    t673 = casadi.if_else(casadi.logic_and((t669 >= -2.792526803190927), (t669 <= 2.792526803190927)), t669, casadi.if_else(casadi.logic_and((t671 >= -2.792526803190927), (t671 <= 2.792526803190927)), t671, casadi.if_else(casadi.logic_and((t672 >= -2.792526803190927), (t672 <= 2.792526803190927)), t672, t667)))
+    t674 = (t283 <= 3.9269908169872414)
+    t675 = casadi.logic_and((t282 >= -0.7853981633974483), (t282 <= 3.9269908169872414))
+    t676 = casadi.if_else(casadi.logic_and(t674, casadi.logic_not(t675)), t283, t282)
+    t677 = t676
+    t678 = t677 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t677)
+    t679 = casadi.if_else((qn2 > t678), 6.283185307179586, -6.283185307179586)
+    t680 = t678 + t679
+    t681 = t678 - t679
+    t682 = casadi.if_else(casadi.logic_and((t678 >= -0.7853981633974483), (t678 <= 3.9269908169872414)), t678, casadi.if_else(casadi.logic_and((t680 >= -0.7853981633974483), (t680 <= 3.9269908169872414)), t680, casadi.if_else(casadi.logic_and((t681 >= -0.7853981633974483), (t681 <= 3.9269908169872414)), t681, t676)))
+    t683 = (t236 <= 0.7853981633974483)
+    t684 = casadi.logic_and((t235 >= -3.9269908169872414), (t235 <= 0.7853981633974483))
+    t685 = casadi.if_else(casadi.logic_and(t683, casadi.logic_not(t684)), t236, t235)
+    t686 = t685
+    t687 = t686 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn3 - 0.15915494309189535*t686)
+    t688 = casadi.if_else((qn3 > t687), 6.283185307179586, -6.283185307179586)
+    t689 = t687 + t688
+    t690 = t687 - t688
+    t691 = casadi.if_else(casadi.logic_and((t687 >= -3.9269908169872414), (t687 <= 0.7853981633974483)), t687, casadi.if_else(casadi.logic_and((t689 >= -3.9269908169872414), (t689 <= 0.7853981633974483)), t689, casadi.if_else(casadi.logic_and((t690 >= -3.9269908169872414), (t690 <= 0.7853981633974483)), t690, t685)))
+    t692 = (t413 <= 2.9670597283903604)
+    t693 = casadi.logic_and((t412 >= -1.9198621771937625), (t412 <= 2.9670597283903604))
+    t694 = casadi.if_else(casadi.logic_and(t692, casadi.logic_not(t693)), t413, t412)
+    t695 = t694
+    t696 = t695 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t695)
+    t697 = casadi.if_else((qn4 > t696), 6.283185307179586, -6.283185307179586)
+    t698 = t696 + t697
+    t699 = t696 - t697
+    t700 = casadi.if_else(casadi.logic_and((t696 >= -1.9198621771937625), (t696 <= 2.9670597283903604)), t696, casadi.if_else(casadi.logic_and((t698 >= -1.9198621771937625), (t698 <= 2.9670597283903604)), t698, casadi.if_else(casadi.logic_and((t699 >= -1.9198621771937625), (t699 <= 2.9670597283903604)), t699, t694)))
+    t701 = (t418 <= 1.7453292519943295)
+    t702 = casadi.logic_and((t417 >= -1.7453292519943295), (t417 <= 1.7453292519943295))
+    t703 = casadi.if_else(casadi.logic_and(t701, casadi.logic_not(t702)), t418, t417)
+    t704 = t703
+    t705 = t704 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn5 - 0.15915494309189535*t704)
+    t706 = casadi.if_else((qn5 > t705), 6.283185307179586, -6.283185307179586)
+    t707 = t705 + t706
+    t708 = t705 - t706
+    t709 = casadi.if_else(casadi.logic_and((t705 >= -1.7453292519943295), (t705 <= 1.7453292519943295)), t705, casadi.if_else(casadi.logic_and((t707 >= -1.7453292519943295), (t707 <= 1.7453292519943295)), t707, casadi.if_else(casadi.logic_and((t708 >= -1.7453292519943295), (t708 <= 1.7453292519943295)), t708, t703)))
+    t710 = (t422 <= 4.642575810304916)
+    t711 = casadi.logic_and((t421 >= -4.642575810304916), (t421 <= 4.642575810304916))
+    t712 = casadi.if_else(casadi.logic_and(t710, casadi.logic_not(t711)), t422, t421)
+    t713 = t712
+    t714 = t713 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn6 - 0.15915494309189535*t713)
+    t715 = casadi.if_else((qn6 > t714), 6.283185307179586, -6.283185307179586)
+    t716 = t714 + t715
+    t717 = t714 - t715
+    t718 = casadi.if_else(casadi.logic_and((t714 >= -4.642575810304916), (t714 <= 4.642575810304916)), t714, casadi.if_else(casadi.logic_and((t716 >= -4.642575810304916), (t716 <= 4.642575810304916)), t716, casadi.if_else(casadi.logic_and((t717 >= -4.642575810304916), (t717 <= 4.642575810304916)), t717, t712)))
+    t719 = qw1*(t500 + t673)**2
+    t720 = t719 + qw2*(t502 + t682)**2 + qw3*(t503 + t691)**2
+    t721 = t720 + qw4*(t497 + t700)**2 + qw5*(t498 + t709)**2 + qw6*(t499 + t718)**2
+    t722 = casadi.logic_or(t665, t666)
+    t723 = casadi.logic_or(t674, t675)
+    t724 = casadi.logic_or(t683, t684)
+    t725 = casadi.logic_or(casadi.logic_and(t63, (1e-12 >= 25.615508834817042*t226)), casadi.logic_and(t510, (1e-12 >= -t227)))
+    t726 = casadi.if_else(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t21, t506), t512), t722), t723), t724), t725), (t291 >= -1e-12)), casadi.logic_or(t692, t693)), casadi.logic_or(t701, t702)), casadi.logic_or(t710, t711)), 1, 0)
+    t727 = (t726 > 0)
+    t728 = casadi.if_else(casadi.logic_and(t727, casadi.logic_or((t664 > t721), (t656 < 1))), 1, 0)
+    t729 = casadi.if_else(t727, 1, t656)
+    t730 = (t728 > 0)
+    t731 = casadi.if_else(t730, t673, t658)
+    t732 = casadi.if_else(t730, t682, t659)
+    t733 = casadi.if_else(t730, t691, t660)
+    t734 = casadi.if_else(t730, t700, t661)
+    t735 = casadi.if_else(t730, t709, t662)
+    t736 = casadi.if_else(t730, t718, t663)
+    t737 = casadi.if_else(t730, t721, t664)
+    t738 = (t415 <= 2.9670597283903604)
+    t739 = casadi.logic_and((t414 >= -1.9198621771937625), (t414 <= 2.9670597283903604))
+    t740 = casadi.if_else(casadi.logic_and(t738, casadi.logic_not(t739)), t415, t414)
+    t741 = t740
+    t742 = t741 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t741)
+    t743 = casadi.if_else((qn4 > t742), 6.283185307179586, -6.283185307179586)
+    t744 = t742 + t743
+    t745 = t742 - t743
+    t746 = casadi.if_else(casadi.logic_and((t742 >= -1.9198621771937625), (t742 <= 2.9670597283903604)), t742, casadi.if_else(casadi.logic_and((t744 >= -1.9198621771937625), (t744 <= 2.9670597283903604)), t744, casadi.if_else(casadi.logic_and((t745 >= -1.9198621771937625), (t745 <= 2.9670597283903604)), t745, t740)))
+    t747 = (t426 >= -1.7453292519943295)
+    t748 = casadi.logic_and((t419 >= -1.7453292519943295), (t419 <= 1.7453292519943295))
+    t749 = casadi.if_else(casadi.logic_and(t747, casadi.logic_not(t748)), -t426, t425)
+    t750 = t749
+    t751 = t750 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn5 - 0.15915494309189535*t750)
+    t752 = casadi.if_else((qn5 > t751), 6.283185307179586, -6.283185307179586)
+    t753 = t751 + t752
+    t754 = t751 - t752
+    t755 = casadi.if_else(casadi.logic_and((t751 >= -1.7453292519943295), (t751 <= 1.7453292519943295)), t751, casadi.if_else(casadi.logic_and((t753 >= -1.7453292519943295), (t753 <= 1.7453292519943295)), t753, casadi.if_else(casadi.logic_and((t754 >= -1.7453292519943295), (t754 <= 1.7453292519943295)), t754, t749)))
+    t756 = (t424 <= 4.642575810304916)
+    t757 = casadi.logic_and((t423 >= -4.642575810304916), (t423 <= 4.642575810304916))
+    t758 = casadi.if_else(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t21, t292), t506), t512), t722), t723), t724), t725), casadi.logic_or(t738, t739)), casadi.logic_or(t747, t748)), casadi.logic_or(t756, t757)), 1, 0)
+    t759 = casadi.if_else(casadi.logic_and(t756, casadi.logic_not(t757)), t424, t423)
+    t760 = t759
+    t761 = t760 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn6 - 0.15915494309189535*t760)
+    t762 = casadi.if_else((qn6 > t761), 6.283185307179586, -6.283185307179586)
+    t763 = t761 + t762
+    t764 = t761 - t762
+    t765 = casadi.if_else(casadi.logic_and((t761 >= -4.642575810304916), (t761 <= 4.642575810304916)), t761, casadi.if_else(casadi.logic_and((t763 >= -4.642575810304916), (t763 <= 4.642575810304916)), t763, casadi.if_else(casadi.logic_and((t764 >= -4.642575810304916), (t764 <= 4.642575810304916)), t764, t759)))
+    t766 = t720 + qw4*(t497 + t746)**2 + qw5*(t498 + t755)**2 + qw6*(t499 + t765)**2
+    t767 = (t758 > 0)
+    t768 = casadi.if_else(casadi.logic_and(t767, casadi.logic_or((t737 > t766), (t729 < 1))), 1, 0)
+    t769 = casadi.if_else(t767, 1, t729)
+    t770 = (t768 > 0)
+    t771 = casadi.if_else(t770, t673, t731)
+    t772 = casadi.if_else(t770, t682, t732)
+    t773 = casadi.if_else(t770, t691, t733)
+    t774 = casadi.if_else(t770, t746, t734)
+    t775 = casadi.if_else(t770, t755, t735)
+    t776 = casadi.if_else(t770, t765, t736)
+    t777 = casadi.if_else(t770, t766, t737)
+    t778 = (t337 <= 3.9269908169872414)
+    t779 = casadi.logic_and((t336 >= -0.7853981633974483), (t336 <= 3.9269908169872414))
+    t780 = casadi.if_else(casadi.logic_and(t778, casadi.logic_not(t779)), t337, t336)
+    t781 = t780
+    t782 = t781 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t781)
+    t783 = casadi.if_else((qn2 > t782), 6.283185307179586, -6.283185307179586)
+    t784 = t782 + t783
+    t785 = t782 - t783
+    t786 = casadi.if_else(casadi.logic_and((t782 >= -0.7853981633974483), (t782 <= 3.9269908169872414)), t782, casadi.if_else(casadi.logic_and((t784 >= -0.7853981633974483), (t784 <= 3.9269908169872414)), t784, casadi.if_else(casadi.logic_and((t785 >= -0.7853981633974483), (t785 <= 3.9269908169872414)), t785, t780)))
+    t787 = (t238 <= 0.7853981633974483)
+    t788 = casadi.logic_and((t237 >= -3.9269908169872414), (t237 <= 0.7853981633974483))
+    t789 = casadi.if_else(casadi.logic_and(t787, casadi.logic_not(t788)), t238, t237)
+    t790 = t789
+    t791 = t790 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn3 - 0.15915494309189535*t790)
+    t792 = casadi.if_else((qn3 > t791), 6.283185307179586, -6.283185307179586)
+    t793 = t791 + t792
+    t794 = t791 - t792
+    t795 = casadi.if_else(casadi.logic_and((t791 >= -3.9269908169872414), (t791 <= 0.7853981633974483)), t791, casadi.if_else(casadi.logic_and((t793 >= -3.9269908169872414), (t793 <= 0.7853981633974483)), t793, casadi.if_else(casadi.logic_and((t794 >= -3.9269908169872414), (t794 <= 0.7853981633974483)), t794, t789)))
+    t796 = (t429 <= 2.9670597283903604)
+    t797 = casadi.logic_and((t428 >= -1.9198621771937625), (t428 <= 2.9670597283903604))
+    t798 = casadi.if_else(casadi.logic_and(t796, casadi.logic_not(t797)), t429, t428)
+    t799 = t798
+    t800 = t799 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t799)
+    t801 = casadi.if_else((qn4 > t800), 6.283185307179586, -6.283185307179586)
+    t802 = t800 + t801
+    t803 = t800 - t801
+    t804 = casadi.if_else(casadi.logic_and((t800 >= -1.9198621771937625), (t800 <= 2.9670597283903604)), t800, casadi.if_else(casadi.logic_and((t802 >= -1.9198621771937625), (t802 <= 2.9670597283903604)), t802, casadi.if_else(casadi.logic_and((t803 >= -1.9198621771937625), (t803 <= 2.9670597283903604)), t803, t798)))
+    t805 = (t434 <= 1.7453292519943295)
+    t806 = casadi.logic_and((t433 >= -1.7453292519943295), (t433 <= 1.7453292519943295))
+    t807 = casadi.if_else(casadi.logic_and(t805, casadi.logic_not(t806)), t434, t433)
+    t808 = t807
+    t809 = t808 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn5 - 0.15915494309189535*t808)
+    t810 = casadi.if_else((qn5 > t809), 6.283185307179586, -6.283185307179586)
+    t811 = t809 + t810
+    t812 = t809 - t810
+    t813 = casadi.if_else(casadi.logic_and((t809 >= -1.7453292519943295), (t809 <= 1.7453292519943295)), t809, casadi.if_else(casadi.logic_and((t811 >= -1.7453292519943295), (t811 <= 1.7453292519943295)), t811, casadi.if_else(casadi.logic_and((t812 >= -1.7453292519943295), (t812 <= 1.7453292519943295)), t812, t807)))
+    t814 = (t438 <= 4.642575810304916)
+    t815 = casadi.logic_and((t437 >= -4.642575810304916), (t437 <= 4.642575810304916))
+    t816 = casadi.if_else(casadi.logic_and(t814, casadi.logic_not(t815)), t438, t437)
+    t817 = t816
+    t818 = t817 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn6 - 0.15915494309189535*t817)
+    t819 = casadi.if_else((qn6 > t818), 6.283185307179586, -6.283185307179586)
+    t820 = t818 + t819
+    t821 = t818 - t819
+    t822 = casadi.if_else(casadi.logic_and((t818 >= -4.642575810304916), (t818 <= 4.642575810304916)), t818, casadi.if_else(casadi.logic_and((t820 >= -4.642575810304916), (t820 <= 4.642575810304916)), t820, casadi.if_else(casadi.logic_and((t821 >= -4.642575810304916), (t821 <= 4.642575810304916)), t821, t816)))
+    t823 = t719 + qw2*(t502 + t786)**2 + qw3*(t503 + t795)**2
+    t824 = t823 + qw4*(t497 + t804)**2 + qw5*(t498 + t813)**2 + qw6*(t499 + t822)**2
+    t825 = casadi.logic_or(t778, t779)
+    t826 = casadi.logic_or(t787, t788)
+    t827 = casadi.if_else(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t21, t229), t506), t510), t512), t722), t825), t826), (t345 >= -1e-12)), casadi.logic_or(t796, t797)), casadi.logic_or(t805, t806)), casadi.logic_or(t814, t815)), 1, 0)
+    t828 = (t827 > 0)
+    t829 = casadi.if_else(casadi.logic_and(t828, casadi.logic_or((t777 > t824), (t769 < 1))), 1, 0)
+    t830 = casadi.if_else(t828, 1, t769)
+    t831 = (t829 > 0)
+    t832 = casadi.if_else(t831, t673, t771)
+    t833 = casadi.if_else(t831, t786, t772)
+    t834 = casadi.if_else(t831, t795, t773)
+    t835 = casadi.if_else(t831, t804, t774)
+    t836 = casadi.if_else(t831, t813, t775)
+    t837 = casadi.if_else(t831, t822, t776)
+    t838 = casadi.if_else(t831, t824, t777)
+    t839 = (t431 <= 2.9670597283903604)
+    t840 = casadi.logic_and((t430 >= -1.9198621771937625), (t430 <= 2.9670597283903604))
+    t841 = casadi.if_else(casadi.logic_and(t839, casadi.logic_not(t840)), t431, t430)
+    t842 = t841
+    t843 = t842 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t842)
+    t844 = casadi.if_else((qn4 > t843), 6.283185307179586, -6.283185307179586)
+    t845 = t843 + t844
+    t846 = t843 - t844
+    t847 = casadi.if_else(casadi.logic_and((t843 >= -1.9198621771937625), (t843 <= 2.9670597283903604)), t843, casadi.if_else(casadi.logic_and((t845 >= -1.9198621771937625), (t845 <= 2.9670597283903604)), t845, casadi.if_else(casadi.logic_and((t846 >= -1.9198621771937625), (t846 <= 2.9670597283903604)), t846, t841)))
+    t848 = (t442 >= -1.7453292519943295)
+    t849 = casadi.logic_and((t435 >= -1.7453292519943295), (t435 <= 1.7453292519943295))
+    t850 = casadi.if_else(casadi.logic_and(t848, casadi.logic_not(t849)), -t442, t441)
+    t851 = t850
+    t852 = t851 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn5 - 0.15915494309189535*t851)
+    t853 = casadi.if_else((qn5 > t852), 6.283185307179586, -6.283185307179586)
+    t854 = t852 + t853
+    t855 = t852 - t853
+    t856 = casadi.if_else(casadi.logic_and((t852 >= -1.7453292519943295), (t852 <= 1.7453292519943295)), t852, casadi.if_else(casadi.logic_and((t854 >= -1.7453292519943295), (t854 <= 1.7453292519943295)), t854, casadi.if_else(casadi.logic_and((t855 >= -1.7453292519943295), (t855 <= 1.7453292519943295)), t855, t850)))
+    t857 = (t440 <= 4.642575810304916)
+    t858 = casadi.logic_and((t439 >= -4.642575810304916), (t439 <= 4.642575810304916))
+    t859 = casadi.if_else(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t21, t229), t346), t506), t510), t512), t722), t825), t826), casadi.logic_or(t839, t840)), casadi.logic_or(t848, t849)), casadi.logic_or(t857, t858)), 1, 0)
+    t860 = casadi.if_else(casadi.logic_and(t857, casadi.logic_not(t858)), t440, t439)
+    t861 = t860
+    t862 = t861 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn6 - 0.15915494309189535*t861)
+    t863 = casadi.if_else((qn6 > t862), 6.283185307179586, -6.283185307179586)
+    t864 = t862 + t863
+    t865 = t862 - t863
+    t866 = casadi.if_else(casadi.logic_and((t862 >= -4.642575810304916), (t862 <= 4.642575810304916)), t862, casadi.if_else(casadi.logic_and((t864 >= -4.642575810304916), (t864 <= 4.642575810304916)), t864, casadi.if_else(casadi.logic_and((t865 >= -4.642575810304916), (t865 <= 4.642575810304916)), t865, t860)))
+    t867 = t823 + qw4*(t497 + t847)**2 + qw5*(t498 + t856)**2 + qw6*(t499 + t866)**2
+    t868 = (t859 > 0)
+    t869 = casadi.if_else(casadi.logic_and(t868, casadi.logic_or((t838 > t867), (t830 < 1))), 1, 0)
+    t870 = casadi.if_else(t868, 1, t830)
+    t871 = (t869 > 0)
+    t872 = casadi.if_else(t871, t673, t832)
+    t873 = casadi.if_else(t871, t786, t833)
+    t874 = casadi.if_else(t871, t795, t834)
+    t875 = casadi.if_else(t871, t847, t835)
+    t876 = casadi.if_else(t871, t856, t836)
+    t877 = casadi.if_else(t871, t866, t837)
+    t878 = (casadi.fabs(t378) < casadi.inf)
+    t879 = (t870 > 0)
+    t880 = casadi.logic_and(t878, t879)
+    q = casadi.SX(6, 1)
+    q[0, 0] = casadi.if_else(t880, t872, qn1)
+    q[1, 0] = casadi.if_else(t880, t873, qn2)
+    q[2, 0] = casadi.if_else(t880, t874, qn3)
+    q[3, 0] = casadi.if_else(t880, t875, qn4)
+    q[4, 0] = casadi.if_else(t880, t876, qn5)
+    q[5, 0] = casadi.if_else(t880, t877, qn6)
+    status = casadi.SX(1, 1)
+    status[0, 0] = casadi.if_else(casadi.logic_not(t878), 2, casadi.if_else(t879, 0, 1))
+    return [q, status]
 
 
 _q = casadi.SX.sym("q", 6, 1)
@@ -2399,6 +3474,8 @@ _mu_dot = casadi.SX.sym("mu_dot", 6, 1)
 _damping = casadi.SX.sym("damping", 1, 1)
 _target = casadi.SX.sym("target", 4, 4)
 _T = casadi.SX.sym("T", 4, 4)
+_q_seed = casadi.SX.sym("q_seed", 6, 1)
+_weights = casadi.SX.sym("weights", 6, 1)
 fk = casadi.Function("fk", [_q], _fk(_q), ["q"], ["T"])
 jacobian = casadi.Function("jacobian", [_q], _jacobian(_q), ["q"], ["J"])
 fk_jacobian = casadi.Function("fk_jacobian", [_q], _fk_jacobian(_q), ["q"], ["T", "J"])
@@ -2415,8 +3492,9 @@ manipulability = casadi.Function("manipulability", [_q], _manipulability(_q), ["
 jacobian_det = casadi.Function("jacobian_det", [_q], _jacobian_det(_q), ["q"], ["d"])
 velocity_ik = casadi.Function("velocity_ik", [_q, _mu_dot, _damping], _velocity_ik(_q, _mu_dot, _damping), ["q", "mu_dot", "damping"], ["q_dot", "status"])
 ik_numeric_step = casadi.Function("ik_numeric_step", [_target, _q, _damping], _ik_numeric_step(_target, _q, _damping), ["target", "q", "damping"], ["q_start", "q_next", "cost"])
-ik_branches = casadi.Function("ik_branches", [_T], _ik_branches(_T), ["T"], ["q", "valid"])
-ik = ik_branches  # CasADi functions have fixed-size outputs: every branch and its validity
+ik_branches = casadi.Function("ik_branches", [_T], _ik_branches(_T), ["T"], ["q", "valid", "in_limits"])
+ik_nearest = casadi.Function("ik_nearest", [_T, _q_seed, _weights], _ik_nearest(_T, _q_seed, _weights), ["T", "q_seed", "weights"], ["q", "status"])
+ik = ik_branches  # CasADi functions have fixed-size outputs: every branch, its validity and its limits
 
 IK_NUMERIC_CONVERGED = 0  # |error| <= tol
 IK_NUMERIC_ITERATION_LIMIT = 1  # IK_NUMERIC_ITERATIONS steps taken, |error| still above tol
@@ -2458,4 +3536,4 @@ ik_numeric = casadi.Function("ik_numeric", _inputs, _ik_numeric(*_inputs), ["tar
 
 def functions():
     """All functions by name."""
-    return {"fk": fk, "jacobian": jacobian, "fk_jacobian": fk_jacobian, "jacobian_tool": jacobian_tool, "task": task, "task_jacobian": task_jacobian, "fk_jacobian_dot": fk_jacobian_dot, "jacobian_dot": jacobian_dot, "bias_acceleration": bias_acceleration, "task_jacobian_dot": task_jacobian_dot, "hessian": hessian, "singularity_factors": singularity_factors, "manipulability": manipulability, "jacobian_det": jacobian_det, "velocity_ik": velocity_ik, "ik_numeric_step": ik_numeric_step, "ik_branches": ik_branches}
+    return {"fk": fk, "jacobian": jacobian, "fk_jacobian": fk_jacobian, "jacobian_tool": jacobian_tool, "task": task, "task_jacobian": task_jacobian, "fk_jacobian_dot": fk_jacobian_dot, "jacobian_dot": jacobian_dot, "bias_acceleration": bias_acceleration, "task_jacobian_dot": task_jacobian_dot, "hessian": hessian, "singularity_factors": singularity_factors, "manipulability": manipulability, "jacobian_det": jacobian_det, "velocity_ik": velocity_ik, "ik_numeric_step": ik_numeric_step, "ik_branches": ik_branches, "ik_nearest": ik_nearest}

@@ -96,9 +96,13 @@ int rexarm_velocity_ik(const rexarm_real q[REXARM_DOF], const rexarm_real mu_dot
  * Result: q_start[i], i < 4; q_next[i], i < 4; returned as a scalar. 403 operations. */
 rexarm_real rexarm_ik_numeric_step(const rexarm_real target[REXARM_TASK_DIM], const rexarm_real q[REXARM_DOF], rexarm_real damping, rexarm_real q_start[REXARM_DOF], rexarm_real q_next[REXARM_DOF]);
 
-/* Every branch of the closed-form ik and whether the target allows it.
- * Result: q: 8 x 4 row-major, element (r, c) at q[r * 4 + c]; valid[i], i < 8. 566 operations. */
-void rexarm_ik_branches(const rexarm_real mu[REXARM_TASK_DIM], rexarm_real q[REXARM_MAX_IK_SOLUTIONS * REXARM_DOF], int valid[REXARM_MAX_IK_SOLUTIONS]);
+/* Every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits.
+ * Result: q: 8 x 4 row-major, element (r, c) at q[r * 4 + c]; valid[i], i < 8; in_limits[i], i < 8. 928 operations. */
+void rexarm_ik_branches(const rexarm_real mu[REXARM_TASK_DIM], rexarm_real q[REXARM_MAX_IK_SOLUTIONS * REXARM_DOF], int valid[REXARM_MAX_IK_SOLUTIONS], int in_limits[REXARM_MAX_IK_SOLUTIONS]);
+
+/* The closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status.
+ * Result: q[i], i < 4; returned as a scalar. 1598 operations. */
+int rexarm_ik_nearest(const rexarm_real mu[REXARM_TASK_DIM], const rexarm_real q_seed[REXARM_DOF], const rexarm_real weights[REXARM_DOF], rexarm_real q[REXARM_DOF]);
 
 /* Statuses of rexarm_velocity_ik: OK, singular (a diagonal entry of the QR factor R of the
  * 4 x 4 system at most 1e-12 times its Frobenius norm: take damping > 0), or
@@ -108,12 +112,15 @@ void rexarm_ik_branches(const rexarm_real mu[REXARM_TASK_DIM], rexarm_real q[REX
 #define REXARM_VELOCITY_IK_SINGULAR 1
 #define REXARM_VELOCITY_IK_NOT_FINITE 2
 
-/* Closed-form inverse kinematics: every joint solution that reaches the target; returns
- * their count k and writes solution i to q[i * REXARM_DOF + j], i < k: the valid
- * rows of rexarm_ik_branches, in its order. No allocation, no recursion.
+/* Closed-form inverse kinematics: every joint solution inside the joint limits that reaches
+ * the target; returns their count k and writes solution i to q[i * REXARM_DOF + j],
+ * i < k: the rows of rexarm_ik_branches that are valid and in_limits, in its order
+ * (rexarm_ik_branches also gives those outside the limits). No allocation, no recursion.
  * target: the task vector (x, y, z, pitch), pitch in [-pi/2, pi/2].
- * Result: k <= REXARM_MAX_IK_SOLUTIONS solutions, revolute angles wrapped into (-pi, pi],
- * joint limits not applied; k = 0 when the target is out of reach or not finite.
+ * Result: k <= REXARM_MAX_IK_SOLUTIONS solutions inside the joint limits, revolute angles
+ * wrapped into (-pi, pi] or, where that is outside the limits, their lowest equivalent
+ * inside them; k = 0 when the target is out of reach or not finite. ik_branches also gives
+ * the solutions outside the limits (in_limits 0).
  * Solver: base yaw + three parallel pitch axes: the pitch fixes the sum of the pitch
  * angles (SP4), the base yaw puts the arm's plane through the target (SP4), the law of
  * cosines gives the elbow (SP3).
@@ -128,6 +135,12 @@ void rexarm_ik_branches(const rexarm_real mu[REXARM_TASK_DIM], rexarm_real q[REX
  * angle the target leaves free (a singular wrist or shoulder) is set to 0.
  */
 int rexarm_ik(const rexarm_real mu[REXARM_TASK_DIM], rexarm_real q[REXARM_MAX_IK_SOLUTIONS * REXARM_DOF]);
+
+/* Statuses of rexarm_ik_nearest: a solution found; no solution inside the limits (out of
+ * reach); the target (its first three rows), q_seed or weights not finite. q = q_seed unless OK. */
+#define REXARM_IK_NEAREST_OK 0
+#define REXARM_IK_NEAREST_NO_SOLUTION 1
+#define REXARM_IK_NEAREST_NOT_FINITE 2
 
 /* ik_numeric status codes. */
 #define REXARM_IK_NUMERIC_CONVERGED 0       /* |error| <= tol */

@@ -5,7 +5,8 @@
 Every function takes `q` (4 x 1: radians for revolute joints, m for
 prismatic ones) and returns a rows x cols result whose zeros are structural; ik_branches
 (also named ik) takes the target instead of q and returns every branch (MAX_IK_SOLUTIONS x
-DOF) and its validity (MAX_IK_SOLUTIONS x 1, 1 or 0).
+DOF), its validity and whether it is inside the joint limits (MAX_IK_SOLUTIONS x 1 each, 1
+or 0); ik_nearest takes the target and q_seed and returns the solution nearest q_seed.
 Task vector: (x, y, z, pitch).
 """
 
@@ -1214,7 +1215,7 @@ def _ik_numeric_step(target, q, damping):
 
 
 def _ik_branches(mu):
-    """Every branch of the closed-form ik and whether the target allows it: 566 operations."""
+    """Every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits: 928 operations."""
     mu0 = mu[0]
     mu1 = mu[1]
     mu2 = mu[2]
@@ -1245,235 +1246,969 @@ def _ik_branches(mu):
     t23 = casadi.atan2(t22, t21)
     t24 = casadi.if_else(t18, 0, t1 + t23)
     t25 = t1 - t23
-    t26 = t19*t21
-    t27 = mu1*t26
-    t28 = t19*t22
-    t29 = mu0*t28
-    t30 = casadi.if_else(t18, 1, -t27 - t29)
-    t31 = t29 - t27
-    t32 = mu2*(1 - t30)
-    t33 = t32 + mu2*t30
-    t34 = mu2*(1 - t31)
-    t35 = t34 + mu2*t31
-    t36 = mu0*t26
-    t37 = mu1*t28
-    t38 = casadi.if_else(t18, 0, t36 - t37)
-    t39 = t36 + t37
-    t40 = mu0*t30 + mu1*t38
-    t41 = mu1*t30 - mu0*t38
-    t42 = mu0*t31 + mu1*t39
-    t43 = mu1*t31 - mu0*t39
-    t44 = 0.1*t12
-    t45 = t40 + t44
-    t46 = t42 + t44
-    t47 = -0.1*t11
-    t48 = t33 + t47
-    t49 = -0.12 + t48
-    t50 = t35 + t47
-    t51 = -0.12 + t50
-    t52 = t41**2
-    t53 = t52 + t45**2 + t49**2
-    t54 = 0.01 - 0.5*t53
-    t55 = t54**2
-    t56 = t13**2
-    t57 = 1 - t55*t56
-    t58 = t13*t54
-    t59 = (1e-12 < t57)
-    t60 = casadi.if_else(t59, t58, casadi.if_else((t58 > 0), 1, -1))
-    t61 = casadi.if_else(t59, casadi.sqrt(t57), 0)
-    t62 = casadi.atan2(t61, t60)
-    t63 = casadi.if_else(t9, 0, 3.141592653589793 + t62)
-    t64 = 3.141592653589793 - t62
-    t65 = 0.01*t13
-    t66 = casadi.if_else(t9, 1, -t60*t65)
-    t67 = casadi.if_else(t9, 0, -t61*t65)
-    t68 = 0.22 + 0.1*t66
-    t69 = -0.12 + t68
-    t70 = t69**2 + 0.01*t67**2
-    t71 = 0.1*t67
-    t72 = t49*t69 - t45*t71
-    t73 = t45*t69 + t49*t71
-    t74 = t72**2 + t73**2
-    t75 = 0.001*t13
-    t76 = 0.22 - t60*t75
+    t26 = t24 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t24)
+    t27 = t26 - 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*t26)
+    t28 = t25 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t25)
+    t29 = t28 - 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*t28)
+    t30 = t19*t21
+    t31 = mu1*t30
+    t32 = t19*t22
+    t33 = mu0*t32
+    t34 = casadi.if_else(t18, 1, -t31 - t33)
+    t35 = t33 - t31
+    t36 = mu2*(1 - t34)
+    t37 = t36 + mu2*t34
+    t38 = mu2*(1 - t35)
+    t39 = t38 + mu2*t35
+    t40 = mu0*t30
+    t41 = mu1*t32
+    t42 = casadi.if_else(t18, 0, t40 - t41)
+    t43 = t40 + t41
+    t44 = mu0*t34 + mu1*t42
+    t45 = mu1*t34 - mu0*t42
+    t46 = mu0*t35 + mu1*t43
+    t47 = mu1*t35 - mu0*t43
+    t48 = 0.1*t12
+    t49 = t44 + t48
+    t50 = t46 + t48
+    t51 = -0.1*t11
+    t52 = t37 + t51
+    t53 = -0.12 + t52
+    t54 = t39 + t51
+    t55 = -0.12 + t54
+    t56 = t45**2
+    t57 = t56 + t49**2 + t53**2
+    t58 = 0.01 - 0.5*t57
+    t59 = t58**2
+    t60 = t13**2
+    t61 = 1 - t59*t60
+    t62 = t13*t58
+    t63 = (1e-12 < t61)
+    t64 = casadi.if_else(t63, t62, casadi.if_else((t62 > 0), 1, -1))
+    t65 = casadi.if_else(t63, casadi.sqrt(t61), 0)
+    t66 = casadi.atan2(t65, t64)
+    t67 = casadi.if_else(t9, 0, 3.141592653589793 + t66)
+    t68 = 3.141592653589793 - t66
+    t69 = t67 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t67)
+    t70 = t69 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t69)
+    t71 = t68 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t68)
+    t72 = t71 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t71)
+    t73 = 0.01*t13
+    t74 = casadi.if_else(t9, 1, -t64*t73)
+    t75 = casadi.if_else(t9, 0, -t65*t73)
+    t76 = 0.22 + 0.1*t74
     t77 = -0.12 + t76
-    t78 = t61*t75
-    t79 = t49*t77 - t45*t78
-    t80 = t45*t77 + t49*t78
-    t81 = t79**2 + t80**2
-    t82 = 1e-06*t56
-    t83 = t77**2 + t82*t61**2
-    t84 = -0.1*t7
-    t85 = t40 + t84
-    t86 = t42 + t84
-    t87 = -0.1*t6
-    t88 = t33 + t87
-    t89 = -0.12 + t88
-    t90 = t52 + t85**2 + t89**2
-    t91 = 0.01 - 0.5*t90
-    t92 = t35 + t87
-    t93 = -0.12 + t92
-    t94 = t91**2
-    t95 = 1 - t56*t94
-    t96 = t13*t91
-    t97 = (1e-12 < t95)
-    t98 = casadi.if_else(t97, t96, casadi.if_else((t96 > 0), 1, -1))
-    t99 = casadi.if_else(t97, casadi.sqrt(t95), 0)
-    t100 = casadi.atan2(t99, t98)
-    t101 = casadi.if_else(t9, 0, 3.141592653589793 + t100)
-    t102 = casadi.if_else(t9, 1, -t65*t98)
-    t103 = casadi.if_else(t9, 0, -t65*t99)
-    t104 = 3.141592653589793 - t100
-    t105 = 0.22 + 0.1*t102
-    t106 = -0.12 + t105
-    t107 = t106**2 + 0.01*t103**2
-    t108 = 0.22 - t75*t98
-    t109 = -0.12 + t108
-    t110 = t109**2 + t82*t99**2
-    t111 = 0.1*t103
-    t112 = t106*t89 - t111*t85
-    t113 = t106*t85 + t111*t89
-    t114 = t112**2 + t113**2
-    t115 = t75*t99
-    t116 = t109*t89 - t115*t85
-    t117 = t109*t85 + t115*t89
-    t118 = t116**2 + t117**2
-    t119 = t43**2
-    t120 = t119 + t46**2 + t51**2
-    t121 = 0.01 - 0.5*t120
-    t122 = t119 + t86**2 + t93**2
-    t123 = 0.01 - 0.5*t122
-    t124 = t121**2
-    t125 = 1 - t124*t56
-    t126 = t121*t13
-    t127 = (1e-12 < t125)
-    t128 = casadi.if_else(t127, t126, casadi.if_else((t126 > 0), 1, -1))
-    t129 = casadi.if_else(t127, casadi.sqrt(t125), 0)
-    t130 = casadi.atan2(t129, t128)
-    t131 = casadi.if_else(t9, 0, 3.141592653589793 + t130)
-    t132 = casadi.if_else(t9, 1, -t128*t65)
-    t133 = casadi.if_else(t9, 0, -t129*t65)
-    t134 = 3.141592653589793 - t130
-    t135 = 0.22 + 0.1*t132
-    t136 = -0.12 + t135
-    t137 = t136**2 + 0.01*t133**2
-    t138 = 0.22 - t128*t75
-    t139 = -0.12 + t138
-    t140 = t139**2 + t82*t129**2
-    t141 = 0.1*t133
-    t142 = t136*t51 - t141*t46
-    t143 = t136*t46 + t141*t51
-    t144 = t142**2 + t143**2
-    t145 = t129*t75
-    t146 = t139*t51 - t145*t46
-    t147 = t139*t46 + t145*t51
-    t148 = t146**2 + t147**2
-    t149 = t123**2
-    t150 = 1 - t149*t56
-    t151 = t123*t13
-    t152 = (1e-12 < t150)
-    t153 = casadi.if_else(t152, t151, casadi.if_else((t151 > 0), 1, -1))
-    t154 = casadi.if_else(t152, casadi.sqrt(t150), 0)
-    t155 = casadi.atan2(t154, t153)
-    t156 = casadi.if_else(t9, 0, 3.141592653589793 + t155)
-    t157 = casadi.if_else(t9, 1, -t153*t65)
-    t158 = casadi.if_else(t9, 0, -t154*t65)
-    t159 = 3.141592653589793 - t155
-    t160 = 0.22 + 0.1*t157
-    t161 = -0.12 + t160
-    t162 = t161**2 + 0.01*t158**2
-    t163 = 0.22 - t153*t75
-    t164 = -0.12 + t163
-    t165 = t164**2 + t82*t154**2
-    t166 = 0.1*t158
-    t167 = t161*t93 - t166*t86
-    t168 = t161*t86 + t166*t93
-    t169 = t167**2 + t168**2
-    t170 = t154*t75
-    t171 = t164*t93 - t170*t86
-    t172 = t164*t86 + t170*t93
-    t173 = t171**2 + t172**2
-    t174 = t24 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t24)
-    t175 = 1e-24*t53
-    t176 = casadi.if_else((t74 <= t175*t70), 0, casadi.atan2(-t73, t72))
-    t177 = -t10
-    t178 = 3.141592653589793 + t177
-    t179 = t176 + t63
-    t180 = casadi.if_else((t81 <= t175*t83), 0, casadi.atan2(-t80, t79))
-    t181 = t180 + t64
-    t182 = 1e-24*t90
-    t183 = casadi.if_else((t114 <= t107*t182), 0, casadi.atan2(-t113, t112))
-    t184 = 3.141592653589793 + t8
-    t185 = t101 + t183
-    t186 = casadi.if_else((t118 <= t110*t182), 0, casadi.atan2(-t117, t116))
-    t187 = t104 + t186
-    t188 = t25 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t25)
-    t189 = 1e-24*t120
-    t190 = casadi.if_else((t144 <= t137*t189), 0, casadi.atan2(-t143, t142))
-    t191 = t131 + t190
-    t192 = casadi.if_else((t148 <= t140*t189), 0, casadi.atan2(-t147, t146))
-    t193 = t134 + t192
-    t194 = 1e-24*t122
-    t195 = casadi.if_else((t169 <= t162*t194), 0, casadi.atan2(-t168, t167))
-    t196 = t156 + t195
-    t197 = casadi.if_else((t173 <= t165*t194), 0, casadi.atan2(-t172, t171))
-    t198 = t159 + t197
-    t199 = (casadi.fabs(t2) < casadi.inf)
-    t200 = (casadi.fabs(mu3) <= 1.5707963267948966)
-    t201 = (t15 > t17)
-    t202 = casadi.logic_or(t201, casadi.logic_and(t18, (0 <= 1e-12*t16)))
-    t203 = True
-    t204 = -1e-12
-    t205 = casadi.logic_and(t203, (t4 >= t204))
-    t206 = 1e-28
-    t207 = (0.0001 > t206)
-    t208 = (0.0001 <= t206)
-    t209 = 1e-16
-    t210 = (t4 > 1e-12)
-    t211 = True
+    t78 = t77**2 + 0.01*t75**2
+    t79 = 0.1*t75
+    t80 = t53*t77 - t49*t79
+    t81 = t49*t77 + t53*t79
+    t82 = t80**2 + t81**2
+    t83 = 0.001*t13
+    t84 = 0.22 - t64*t83
+    t85 = -0.12 + t84
+    t86 = t65*t83
+    t87 = t53*t85 - t49*t86
+    t88 = t49*t85 + t53*t86
+    t89 = t87**2 + t88**2
+    t90 = 1e-06*t60
+    t91 = t85**2 + t90*t65**2
+    t92 = -0.1*t7
+    t93 = t44 + t92
+    t94 = t46 + t92
+    t95 = -0.1*t6
+    t96 = t37 + t95
+    t97 = -0.12 + t96
+    t98 = t56 + t93**2 + t97**2
+    t99 = 0.01 - 0.5*t98
+    t100 = t39 + t95
+    t101 = -0.12 + t100
+    t102 = t99**2
+    t103 = 1 - t102*t60
+    t104 = t13*t99
+    t105 = (1e-12 < t103)
+    t106 = casadi.if_else(t105, t104, casadi.if_else((t104 > 0), 1, -1))
+    t107 = casadi.if_else(t105, casadi.sqrt(t103), 0)
+    t108 = casadi.atan2(t107, t106)
+    t109 = casadi.if_else(t9, 0, 3.141592653589793 + t108)
+    t110 = casadi.if_else(t9, 1, -t106*t73)
+    t111 = casadi.if_else(t9, 0, -t107*t73)
+    t112 = 3.141592653589793 - t108
+    t113 = 0.22 + 0.1*t110
+    t114 = -0.12 + t113
+    t115 = t114**2 + 0.01*t111**2
+    t116 = 0.22 - t106*t83
+    t117 = -0.12 + t116
+    t118 = t117**2 + t90*t107**2
+    t119 = t109 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t109)
+    t120 = t119 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t119)
+    t121 = t112 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t112)
+    t122 = t121 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t121)
+    t123 = 0.1*t111
+    t124 = t114*t97 - t123*t93
+    t125 = t114*t93 + t123*t97
+    t126 = t124**2 + t125**2
+    t127 = t107*t83
+    t128 = t117*t97 - t127*t93
+    t129 = t117*t93 + t127*t97
+    t130 = t128**2 + t129**2
+    t131 = t47**2
+    t132 = t131 + t50**2 + t55**2
+    t133 = 0.01 - 0.5*t132
+    t134 = t131 + t101**2 + t94**2
+    t135 = 0.01 - 0.5*t134
+    t136 = t133**2
+    t137 = 1 - t136*t60
+    t138 = t13*t133
+    t139 = (1e-12 < t137)
+    t140 = casadi.if_else(t139, t138, casadi.if_else((t138 > 0), 1, -1))
+    t141 = casadi.if_else(t139, casadi.sqrt(t137), 0)
+    t142 = casadi.atan2(t141, t140)
+    t143 = casadi.if_else(t9, 0, 3.141592653589793 + t142)
+    t144 = casadi.if_else(t9, 1, -t140*t73)
+    t145 = casadi.if_else(t9, 0, -t141*t73)
+    t146 = 3.141592653589793 - t142
+    t147 = 0.22 + 0.1*t144
+    t148 = -0.12 + t147
+    t149 = t148**2 + 0.01*t145**2
+    t150 = 0.22 - t140*t83
+    t151 = -0.12 + t150
+    t152 = t151**2 + t90*t141**2
+    t153 = t143 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t143)
+    t154 = t153 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t153)
+    t155 = t146 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t146)
+    t156 = t155 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t155)
+    t157 = 0.1*t145
+    t158 = t148*t55 - t157*t50
+    t159 = t148*t50 + t157*t55
+    t160 = t158**2 + t159**2
+    t161 = t141*t83
+    t162 = t151*t55 - t161*t50
+    t163 = t151*t50 + t161*t55
+    t164 = t162**2 + t163**2
+    t165 = t135**2
+    t166 = 1 - t165*t60
+    t167 = t13*t135
+    t168 = (1e-12 < t166)
+    t169 = casadi.if_else(t168, t167, casadi.if_else((t167 > 0), 1, -1))
+    t170 = casadi.if_else(t168, casadi.sqrt(t166), 0)
+    t171 = casadi.atan2(t170, t169)
+    t172 = casadi.if_else(t9, 0, 3.141592653589793 + t171)
+    t173 = casadi.if_else(t9, 1, -t169*t73)
+    t174 = casadi.if_else(t9, 0, -t170*t73)
+    t175 = 3.141592653589793 - t171
+    t176 = 0.22 + 0.1*t173
+    t177 = -0.12 + t176
+    t178 = t177**2 + 0.01*t174**2
+    t179 = 0.22 - t169*t83
+    t180 = -0.12 + t179
+    t181 = t180**2 + t90*t170**2
+    t182 = t172 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t172)
+    t183 = t182 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t182)
+    t184 = t175 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t175)
+    t185 = t184 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t184)
+    t186 = 0.1*t174
+    t187 = t101*t177 - t186*t94
+    t188 = t101*t186 + t177*t94
+    t189 = t187**2 + t188**2
+    t190 = t170*t83
+    t191 = t101*t180 - t190*t94
+    t192 = t101*t190 + t180*t94
+    t193 = t191**2 + t192**2
+    t194 = 1e-24*t57
+    t195 = casadi.if_else((t82 <= t194*t78), 0, casadi.atan2(-t81, t80))
+    t196 = t195
+    t197 = t196 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t196)
+    t198 = -t10
+    t199 = 3.141592653589793 + t198
+    t200 = t195 + t67
+    t201 = t198 + t200 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t199 - 0.15915494309189535*t200)
+    t202 = -t201
+    t203 = t201 + 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t202)
+    t204 = casadi.if_else((t89 <= t194*t91), 0, casadi.atan2(-t88, t87))
+    t205 = t204
+    t206 = t205 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t205)
+    t207 = t204 + t68
+    t208 = t198 + t207 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t199 - 0.15915494309189535*t207)
+    t209 = -t208
+    t210 = t208 + 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t209)
+    t211 = 1e-24*t98
+    t212 = casadi.if_else((t126 <= t115*t211), 0, casadi.atan2(-t125, t124))
+    t213 = t212
+    t214 = t213 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t213)
+    t215 = 3.141592653589793 + t8
+    t216 = t109 + t212
+    t217 = t216 + t8 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t215 - 0.15915494309189535*t216)
+    t218 = -t217
+    t219 = t217 + 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t218)
+    t220 = casadi.if_else((t130 <= t118*t211), 0, casadi.atan2(-t129, t128))
+    t221 = t220
+    t222 = t221 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t221)
+    t223 = t112 + t220
+    t224 = t223 + t8 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t215 - 0.15915494309189535*t223)
+    t225 = -t224
+    t226 = t224 + 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t225)
+    t227 = 1e-24*t132
+    t228 = casadi.if_else((t160 <= t149*t227), 0, casadi.atan2(-t159, t158))
+    t229 = t228
+    t230 = t229 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t229)
+    t231 = t143 + t228
+    t232 = t198 + t231 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t199 - 0.15915494309189535*t231)
+    t233 = -t232
+    t234 = t232 + 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t233)
+    t235 = casadi.if_else((t164 <= t152*t227), 0, casadi.atan2(-t163, t162))
+    t236 = t235
+    t237 = t236 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t236)
+    t238 = t146 + t235
+    t239 = t198 + t238 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t199 - 0.15915494309189535*t238)
+    t240 = -t239
+    t241 = t239 + 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t240)
+    t242 = 1e-24*t134
+    t243 = casadi.if_else((t189 <= t178*t242), 0, casadi.atan2(-t188, t187))
+    t244 = t243
+    t245 = t244 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t244)
+    t246 = t172 + t243
+    t247 = t246 + t8 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t215 - 0.15915494309189535*t246)
+    t248 = -t247
+    t249 = t247 + 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t248)
+    t250 = casadi.if_else((t193 <= t181*t242), 0, casadi.atan2(-t192, t191))
+    t251 = t250
+    t252 = t251 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t251)
+    t253 = t175 + t250
+    t254 = t253 + t8 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t215 - 0.15915494309189535*t253)
+    t255 = -t254
+    t256 = t254 + 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t255)
+    t257 = (t27 <= 3.141592653589793)
+    t258 = casadi.logic_and((t26 >= -3.141592653589793), (t26 <= 3.141592653589793))
+    t259 = casadi.if_else(casadi.logic_and(t257, casadi.logic_not(t258)), t27, t26)
+    t260 = (t197 <= 2.0943951023931953)
+    t261 = casadi.logic_and((t196 >= -2.0943951023931953), (t196 <= 2.0943951023931953))
+    t262 = (t70 <= 2.0943951023931953)
+    t263 = casadi.logic_and((t69 >= -2.0943951023931953), (t69 <= 2.0943951023931953))
+    t264 = -t203
+    t265 = (t206 <= 2.0943951023931953)
+    t266 = casadi.logic_and((t205 >= -2.0943951023931953), (t205 <= 2.0943951023931953))
+    t267 = (t72 <= 2.0943951023931953)
+    t268 = casadi.logic_and((t71 >= -2.0943951023931953), (t71 <= 2.0943951023931953))
+    t269 = -t210
+    t270 = (t214 <= 2.0943951023931953)
+    t271 = casadi.logic_and((t213 >= -2.0943951023931953), (t213 <= 2.0943951023931953))
+    t272 = (t120 <= 2.0943951023931953)
+    t273 = casadi.logic_and((t119 >= -2.0943951023931953), (t119 <= 2.0943951023931953))
+    t274 = -t219
+    t275 = (t222 <= 2.0943951023931953)
+    t276 = casadi.logic_and((t221 >= -2.0943951023931953), (t221 <= 2.0943951023931953))
+    t277 = (t122 <= 2.0943951023931953)
+    t278 = casadi.logic_and((t121 >= -2.0943951023931953), (t121 <= 2.0943951023931953))
+    t279 = -t226
+    t280 = (t29 <= 3.141592653589793)
+    t281 = casadi.logic_and((t28 >= -3.141592653589793), (t28 <= 3.141592653589793))
+    t282 = casadi.if_else(casadi.logic_and(t280, casadi.logic_not(t281)), t29, t28)
+    t283 = (t230 <= 2.0943951023931953)
+    t284 = casadi.logic_and((t229 >= -2.0943951023931953), (t229 <= 2.0943951023931953))
+    t285 = (t154 <= 2.0943951023931953)
+    t286 = casadi.logic_and((t153 >= -2.0943951023931953), (t153 <= 2.0943951023931953))
+    t287 = -t234
+    t288 = (t237 <= 2.0943951023931953)
+    t289 = casadi.logic_and((t236 >= -2.0943951023931953), (t236 <= 2.0943951023931953))
+    t290 = (t156 <= 2.0943951023931953)
+    t291 = casadi.logic_and((t155 >= -2.0943951023931953), (t155 <= 2.0943951023931953))
+    t292 = -t241
+    t293 = (t245 <= 2.0943951023931953)
+    t294 = casadi.logic_and((t244 >= -2.0943951023931953), (t244 <= 2.0943951023931953))
+    t295 = (t183 <= 2.0943951023931953)
+    t296 = casadi.logic_and((t182 >= -2.0943951023931953), (t182 <= 2.0943951023931953))
+    t297 = -t249
+    t298 = (t252 <= 2.0943951023931953)
+    t299 = casadi.logic_and((t251 >= -2.0943951023931953), (t251 <= 2.0943951023931953))
+    t300 = (t185 <= 2.0943951023931953)
+    t301 = casadi.logic_and((t184 >= -2.0943951023931953), (t184 <= 2.0943951023931953))
+    t302 = -t256
+    t303 = (casadi.fabs(t2) < casadi.inf)
+    t304 = (casadi.fabs(mu3) <= 1.5707963267948966)
+    t305 = (t15 > t17)
+    t306 = casadi.logic_or(t305, casadi.logic_and(t18, (0 <= 1e-12*t16)))
+    t307 = True
+    t308 = -1e-12
+    t309 = casadi.logic_and(t307, (t4 >= t308))
+    t310 = 1e-28
+    t311 = (0.0001 > t310)
+    t312 = (0.0001 <= t310)
+    t313 = 1e-16
+    t314 = (t4 > 1e-12)
+    t315 = True
+    t316 = casadi.logic_or(t257, t258)
+    t317 = casadi.logic_or(t280, t281)
     q = casadi.SX(8, 4)
-    q[0, 0] = t174
-    q[0, 1] = t176
-    q[0, 2] = t63 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t63)
-    q[0, 3] = -t177 - t179 - 6.283185307179586*casadi.ceil(-0.15915494309189535*t178 - 0.15915494309189535*t179)
-    q[1, 0] = t174
-    q[1, 1] = t180
-    q[1, 2] = t64 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t64)
-    q[1, 3] = -t177 - t181 - 6.283185307179586*casadi.ceil(-0.15915494309189535*t178 - 0.15915494309189535*t181)
-    q[2, 0] = t174
-    q[2, 1] = t183
-    q[2, 2] = t101 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t101)
-    q[2, 3] = -t185 - t8 - 6.283185307179586*casadi.ceil(-0.15915494309189535*t184 - 0.15915494309189535*t185)
-    q[3, 0] = t174
-    q[3, 1] = t186
-    q[3, 2] = t104 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t104)
-    q[3, 3] = -t187 - t8 - 6.283185307179586*casadi.ceil(-0.15915494309189535*t184 - 0.15915494309189535*t187)
-    q[4, 0] = t188
-    q[4, 1] = t190
-    q[4, 2] = t131 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t131)
-    q[4, 3] = -t177 - t191 - 6.283185307179586*casadi.ceil(-0.15915494309189535*t178 - 0.15915494309189535*t191)
-    q[5, 0] = t188
-    q[5, 1] = t192
-    q[5, 2] = t134 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t134)
-    q[5, 3] = -t177 - t193 - 6.283185307179586*casadi.ceil(-0.15915494309189535*t178 - 0.15915494309189535*t193)
-    q[6, 0] = t188
-    q[6, 1] = t195
-    q[6, 2] = t156 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t156)
-    q[6, 3] = -t196 - t8 - 6.283185307179586*casadi.ceil(-0.15915494309189535*t184 - 0.15915494309189535*t196)
-    q[7, 0] = t188
-    q[7, 1] = t197
-    q[7, 2] = t159 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t159)
-    q[7, 3] = -t198 - t8 - 6.283185307179586*casadi.ceil(-0.15915494309189535*t184 - 0.15915494309189535*t198)
+    q[0, 0] = t259
+    q[0, 1] = casadi.if_else(casadi.logic_and(t260, casadi.logic_not(t261)), t197, t196)
+    q[0, 2] = casadi.if_else(casadi.logic_and(t262, casadi.logic_not(t263)), t70, t69)
+    q[0, 3] = casadi.if_else(casadi.logic_and((t203 >= -2.0943951023931953), casadi.logic_not(casadi.logic_and((t201 >= -2.0943951023931953), (t201 <= 2.0943951023931953)))), t264, t202)
+    q[1, 0] = t259
+    q[1, 1] = casadi.if_else(casadi.logic_and(t265, casadi.logic_not(t266)), t206, t205)
+    q[1, 2] = casadi.if_else(casadi.logic_and(t267, casadi.logic_not(t268)), t72, t71)
+    q[1, 3] = casadi.if_else(casadi.logic_and((t210 >= -2.0943951023931953), casadi.logic_not(casadi.logic_and((t208 >= -2.0943951023931953), (t208 <= 2.0943951023931953)))), t269, t209)
+    q[2, 0] = t259
+    q[2, 1] = casadi.if_else(casadi.logic_and(t270, casadi.logic_not(t271)), t214, t213)
+    q[2, 2] = casadi.if_else(casadi.logic_and(t272, casadi.logic_not(t273)), t120, t119)
+    q[2, 3] = casadi.if_else(casadi.logic_and((t219 >= -2.0943951023931953), casadi.logic_not(casadi.logic_and((t217 >= -2.0943951023931953), (t217 <= 2.0943951023931953)))), t274, t218)
+    q[3, 0] = t259
+    q[3, 1] = casadi.if_else(casadi.logic_and(t275, casadi.logic_not(t276)), t222, t221)
+    q[3, 2] = casadi.if_else(casadi.logic_and(t277, casadi.logic_not(t278)), t122, t121)
+    q[3, 3] = casadi.if_else(casadi.logic_and((t226 >= -2.0943951023931953), casadi.logic_not(casadi.logic_and((t224 >= -2.0943951023931953), (t224 <= 2.0943951023931953)))), t279, t225)
+    q[4, 0] = t282
+    q[4, 1] = casadi.if_else(casadi.logic_and(t283, casadi.logic_not(t284)), t230, t229)
+    q[4, 2] = casadi.if_else(casadi.logic_and(t285, casadi.logic_not(t286)), t154, t153)
+    q[4, 3] = casadi.if_else(casadi.logic_and((t234 >= -2.0943951023931953), casadi.logic_not(casadi.logic_and((t232 >= -2.0943951023931953), (t232 <= 2.0943951023931953)))), t287, t233)
+    q[5, 0] = t282
+    q[5, 1] = casadi.if_else(casadi.logic_and(t288, casadi.logic_not(t289)), t237, t236)
+    q[5, 2] = casadi.if_else(casadi.logic_and(t290, casadi.logic_not(t291)), t156, t155)
+    q[5, 3] = casadi.if_else(casadi.logic_and((t241 >= -2.0943951023931953), casadi.logic_not(casadi.logic_and((t239 >= -2.0943951023931953), (t239 <= 2.0943951023931953)))), t292, t240)
+    q[6, 0] = t282
+    q[6, 1] = casadi.if_else(casadi.logic_and(t293, casadi.logic_not(t294)), t245, t244)
+    q[6, 2] = casadi.if_else(casadi.logic_and(t295, casadi.logic_not(t296)), t183, t182)
+    q[6, 3] = casadi.if_else(casadi.logic_and((t249 >= -2.0943951023931953), casadi.logic_not(casadi.logic_and((t247 >= -2.0943951023931953), (t247 <= 2.0943951023931953)))), t297, t248)
+    q[7, 0] = t282
+    q[7, 1] = casadi.if_else(casadi.logic_and(t298, casadi.logic_not(t299)), t252, t251)
+    q[7, 2] = casadi.if_else(casadi.logic_and(t300, casadi.logic_not(t301)), t185, t184)
+    q[7, 3] = casadi.if_else(casadi.logic_and((t256 >= -2.0943951023931953), casadi.logic_not(casadi.logic_and((t254 >= -2.0943951023931953), (t254 <= 2.0943951023931953)))), t302, t255)
     valid = casadi.SX(8, 1)
-    valid[0, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t199, t200), t202), t205), casadi.logic_or(casadi.logic_and(t207, (t57 >= t204)), casadi.logic_and(t208, (t55 <= t209))))
-    valid[1, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t199, t200), t202), t205), t207), (t57 > 1e-12))
-    valid[2, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t199, t200), t202), t203), t210), casadi.logic_or(casadi.logic_and(t207, (t95 >= t204)), casadi.logic_and(t208, (t94 <= t209))))
-    valid[3, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t199, t200), t202), t203), t207), t210), (t95 > 1e-12))
-    valid[4, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t199, t200), t201), t205), t211), casadi.logic_or(casadi.logic_and(t207, (t125 >= t204)), casadi.logic_and(t208, (t124 <= t209))))
-    valid[5, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t199, t200), t201), t205), t207), t211), (t125 > 1e-12))
-    valid[6, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t199, t200), t201), t203), t210), t211), casadi.logic_or(casadi.logic_and(t207, (t150 >= t204)), casadi.logic_and(t208, (t149 <= t209))))
-    valid[7, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t199, t200), t201), t203), t207), t210), t211), (t150 > 1e-12))
-    return [q, valid]
+    valid[0, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t303, t304), t306), t309), casadi.logic_or(casadi.logic_and(t311, (t61 >= t308)), casadi.logic_and(t312, (t59 <= t313))))
+    valid[1, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t303, t304), t306), t309), t311), (t61 > 1e-12))
+    valid[2, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t303, t304), t306), t307), t314), casadi.logic_or(casadi.logic_and(t311, (t103 >= t308)), casadi.logic_and(t312, (t102 <= t313))))
+    valid[3, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t303, t304), t306), t307), t311), t314), (t103 > 1e-12))
+    valid[4, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t303, t304), t305), t309), t315), casadi.logic_or(casadi.logic_and(t311, (t137 >= t308)), casadi.logic_and(t312, (t136 <= t313))))
+    valid[5, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t303, t304), t305), t309), t311), t315), (t137 > 1e-12))
+    valid[6, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t303, t304), t305), t307), t314), t315), casadi.logic_or(casadi.logic_and(t311, (t166 >= t308)), casadi.logic_and(t312, (t165 <= t313))))
+    valid[7, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t303, t304), t305), t307), t311), t314), t315), (t166 > 1e-12))
+    in_limits = casadi.SX(8, 1)
+    in_limits[0, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t316, casadi.logic_or(t260, t261)), casadi.logic_or(t262, t263)), casadi.logic_or((t264 <= 2.0943951023931953), casadi.logic_and((t202 >= -2.0943951023931953), (t202 <= 2.0943951023931953))))
+    in_limits[1, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t316, casadi.logic_or(t265, t266)), casadi.logic_or(t267, t268)), casadi.logic_or((t269 <= 2.0943951023931953), casadi.logic_and((t209 >= -2.0943951023931953), (t209 <= 2.0943951023931953))))
+    in_limits[2, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t316, casadi.logic_or(t270, t271)), casadi.logic_or(t272, t273)), casadi.logic_or((t274 <= 2.0943951023931953), casadi.logic_and((t218 >= -2.0943951023931953), (t218 <= 2.0943951023931953))))
+    in_limits[3, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t316, casadi.logic_or(t275, t276)), casadi.logic_or(t277, t278)), casadi.logic_or((t279 <= 2.0943951023931953), casadi.logic_and((t225 >= -2.0943951023931953), (t225 <= 2.0943951023931953))))
+    in_limits[4, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t317, casadi.logic_or(t283, t284)), casadi.logic_or(t285, t286)), casadi.logic_or((t287 <= 2.0943951023931953), casadi.logic_and((t233 >= -2.0943951023931953), (t233 <= 2.0943951023931953))))
+    in_limits[5, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t317, casadi.logic_or(t288, t289)), casadi.logic_or(t290, t291)), casadi.logic_or((t292 <= 2.0943951023931953), casadi.logic_and((t240 >= -2.0943951023931953), (t240 <= 2.0943951023931953))))
+    in_limits[6, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t317, casadi.logic_or(t293, t294)), casadi.logic_or(t295, t296)), casadi.logic_or((t297 <= 2.0943951023931953), casadi.logic_and((t248 >= -2.0943951023931953), (t248 <= 2.0943951023931953))))
+    in_limits[7, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t317, casadi.logic_or(t298, t299)), casadi.logic_or(t300, t301)), casadi.logic_or((t302 <= 2.0943951023931953), casadi.logic_and((t255 >= -2.0943951023931953), (t255 <= 2.0943951023931953))))
+    return [q, valid, in_limits]
+
+
+def _ik_nearest(mu, q_seed, weights):
+    """The closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status: 1598 operations."""
+    mu0 = mu[0]
+    mu1 = mu[1]
+    mu2 = mu[2]
+    mu3 = mu[3]
+    qn1 = q_seed[0]
+    qn2 = q_seed[1]
+    qn3 = q_seed[2]
+    qn4 = q_seed[3]
+    qw1 = weights[0]
+    qw2 = weights[1]
+    qw3 = weights[2]
+    qw4 = weights[3]
+    t0 = casadi.sin(mu3)
+    t1 = casadi.atan2(mu0, -mu1)
+    t2 = t0**2
+    t3 = 1 - t2
+    t4 = (1e-12 < t3)
+    t5 = casadi.if_else(t4, -t0, casadi.if_else((t0 < 0), 1, -1))
+    t6 = casadi.if_else(t4, casadi.sqrt(t3), 0)
+    t7 = casadi.atan2(t6, t5)
+    t8 = False
+    t9 = casadi.if_else(t8, 0, t7)
+    t10 = casadi.if_else(t8, 1, t5)
+    t11 = casadi.if_else(t8, 0, t6)
+    t12 = casadi.if_else(t8, 1, 100)
+    t13 = mu0**2 + mu1**2
+    t14 = t13
+    t15 = t13 + mu2**2
+    t16 = 1e-24*t15
+    t17 = (t14 <= t16)
+    t18 = casadi.if_else(t17, 1, 1/casadi.sqrt(t14))
+    t19 = True
+    t20 = casadi.if_else(t19, 0, -1)
+    t21 = casadi.if_else(t19, 1, 0)
+    t22 = casadi.atan2(t21, t20)
+    t23 = casadi.if_else(t17, 0, t1 + t22)
+    t24 = t1 - t22
+    t25 = t23 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t23)
+    t26 = t25 - 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*t25)
+    t27 = t24 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t24)
+    t28 = t27 - 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*t27)
+    t29 = t18*t20
+    t30 = mu1*t29
+    t31 = t18*t21
+    t32 = mu0*t31
+    t33 = casadi.if_else(t17, 1, -t30 - t32)
+    t34 = t32 - t30
+    t35 = mu2*(1 - t33)
+    t36 = t35 + mu2*t33
+    t37 = mu2*(1 - t34)
+    t38 = t37 + mu2*t34
+    t39 = mu0*t29
+    t40 = mu1*t31
+    t41 = casadi.if_else(t17, 0, t39 - t40)
+    t42 = t39 + t40
+    t43 = mu0*t33 + mu1*t41
+    t44 = mu1*t33 - mu0*t41
+    t45 = mu0*t34 + mu1*t42
+    t46 = mu1*t34 - mu0*t42
+    t47 = 0.1*t11
+    t48 = t43 + t47
+    t49 = t45 + t47
+    t50 = -0.1*t10
+    t51 = t36 + t50
+    t52 = -0.12 + t51
+    t53 = t38 + t50
+    t54 = -0.12 + t53
+    t55 = t44**2
+    t56 = t55 + t48**2 + t52**2
+    t57 = 0.01 - 0.5*t56
+    t58 = t57**2
+    t59 = t12**2
+    t60 = 1 - t58*t59
+    t61 = t12*t57
+    t62 = (1e-12 < t60)
+    t63 = casadi.if_else(t62, t61, casadi.if_else((t61 > 0), 1, -1))
+    t64 = casadi.if_else(t62, casadi.sqrt(t60), 0)
+    t65 = casadi.atan2(t64, t63)
+    t66 = casadi.if_else(t8, 0, 3.141592653589793 + t65)
+    t67 = 3.141592653589793 - t65
+    t68 = t66 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t66)
+    t69 = t68 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t68)
+    t70 = t67 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t67)
+    t71 = t70 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t70)
+    t72 = 0.01*t12
+    t73 = casadi.if_else(t8, 1, -t63*t72)
+    t74 = casadi.if_else(t8, 0, -t64*t72)
+    t75 = 0.22 + 0.1*t73
+    t76 = -0.12 + t75
+    t77 = t76**2 + 0.01*t74**2
+    t78 = 0.1*t74
+    t79 = t52*t76 - t48*t78
+    t80 = t48*t76 + t52*t78
+    t81 = t79**2 + t80**2
+    t82 = 0.001*t12
+    t83 = 0.22 - t63*t82
+    t84 = -0.12 + t83
+    t85 = t64*t82
+    t86 = t52*t84 - t48*t85
+    t87 = t48*t84 + t52*t85
+    t88 = t86**2 + t87**2
+    t89 = 1e-06*t59
+    t90 = t84**2 + t89*t64**2
+    t91 = -0.1*t6
+    t92 = t43 + t91
+    t93 = t45 + t91
+    t94 = -0.1*t5
+    t95 = t36 + t94
+    t96 = -0.12 + t95
+    t97 = t55 + t92**2 + t96**2
+    t98 = 0.01 - 0.5*t97
+    t99 = t38 + t94
+    t100 = -0.12 + t99
+    t101 = t98**2
+    t102 = 1 - t101*t59
+    t103 = t12*t98
+    t104 = (1e-12 < t102)
+    t105 = casadi.if_else(t104, t103, casadi.if_else((t103 > 0), 1, -1))
+    t106 = casadi.if_else(t104, casadi.sqrt(t102), 0)
+    t107 = casadi.atan2(t106, t105)
+    t108 = casadi.if_else(t8, 0, 3.141592653589793 + t107)
+    t109 = casadi.if_else(t8, 1, -t105*t72)
+    t110 = casadi.if_else(t8, 0, -t106*t72)
+    t111 = 3.141592653589793 - t107
+    t112 = 0.22 + 0.1*t109
+    t113 = -0.12 + t112
+    t114 = t113**2 + 0.01*t110**2
+    t115 = 0.22 - t105*t82
+    t116 = -0.12 + t115
+    t117 = t116**2 + t89*t106**2
+    t118 = t108 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t108)
+    t119 = t118 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t118)
+    t120 = t111 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t111)
+    t121 = t120 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t120)
+    t122 = 0.1*t110
+    t123 = t113*t96 - t122*t92
+    t124 = t113*t92 + t122*t96
+    t125 = t123**2 + t124**2
+    t126 = t106*t82
+    t127 = t116*t96 - t126*t92
+    t128 = t116*t92 + t126*t96
+    t129 = t127**2 + t128**2
+    t130 = t46**2
+    t131 = t130 + t49**2 + t54**2
+    t132 = 0.01 - 0.5*t131
+    t133 = t130 + t100**2 + t93**2
+    t134 = 0.01 - 0.5*t133
+    t135 = t132**2
+    t136 = 1 - t135*t59
+    t137 = t12*t132
+    t138 = (1e-12 < t136)
+    t139 = casadi.if_else(t138, t137, casadi.if_else((t137 > 0), 1, -1))
+    t140 = casadi.if_else(t138, casadi.sqrt(t136), 0)
+    t141 = casadi.atan2(t140, t139)
+    t142 = casadi.if_else(t8, 0, 3.141592653589793 + t141)
+    t143 = casadi.if_else(t8, 1, -t139*t72)
+    t144 = casadi.if_else(t8, 0, -t140*t72)
+    t145 = 3.141592653589793 - t141
+    t146 = 0.22 + 0.1*t143
+    t147 = -0.12 + t146
+    t148 = t147**2 + 0.01*t144**2
+    t149 = 0.22 - t139*t82
+    t150 = -0.12 + t149
+    t151 = t150**2 + t89*t140**2
+    t152 = t142 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t142)
+    t153 = t152 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t152)
+    t154 = t145 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t145)
+    t155 = t154 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t154)
+    t156 = 0.1*t144
+    t157 = t147*t54 - t156*t49
+    t158 = t147*t49 + t156*t54
+    t159 = t157**2 + t158**2
+    t160 = t140*t82
+    t161 = t150*t54 - t160*t49
+    t162 = t150*t49 + t160*t54
+    t163 = t161**2 + t162**2
+    t164 = t134**2
+    t165 = 1 - t164*t59
+    t166 = t12*t134
+    t167 = (1e-12 < t165)
+    t168 = casadi.if_else(t167, t166, casadi.if_else((t166 > 0), 1, -1))
+    t169 = casadi.if_else(t167, casadi.sqrt(t165), 0)
+    t170 = casadi.atan2(t169, t168)
+    t171 = casadi.if_else(t8, 0, 3.141592653589793 + t170)
+    t172 = casadi.if_else(t8, 1, -t168*t72)
+    t173 = casadi.if_else(t8, 0, -t169*t72)
+    t174 = 3.141592653589793 - t170
+    t175 = 0.22 + 0.1*t172
+    t176 = -0.12 + t175
+    t177 = t176**2 + 0.01*t173**2
+    t178 = 0.22 - t168*t82
+    t179 = -0.12 + t178
+    t180 = t179**2 + t89*t169**2
+    t181 = t171 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t171)
+    t182 = t181 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t181)
+    t183 = t174 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t174)
+    t184 = t183 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t183)
+    t185 = 0.1*t173
+    t186 = t100*t176 - t185*t93
+    t187 = t100*t185 + t176*t93
+    t188 = t186**2 + t187**2
+    t189 = t169*t82
+    t190 = t100*t179 - t189*t93
+    t191 = t100*t189 + t179*t93
+    t192 = t190**2 + t191**2
+    t193 = mu0 + mu1 + mu2 + mu3
+    t194 = t193
+    t195 = qn1 + qn2 + qn3 + qn4 + qw1 + qw2 + qw3 + qw4 + t193
+    t196 = 1e-24*t56
+    t197 = casadi.if_else((t81 <= t196*t77), 0, casadi.atan2(-t80, t79))
+    t198 = t197
+    t199 = t198 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t198)
+    t200 = -t9
+    t201 = 3.141592653589793 + t200
+    t202 = t197 + t66
+    t203 = t200 + t202 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t201 - 0.15915494309189535*t202)
+    t204 = -t203
+    t205 = t203 + 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t204)
+    t206 = casadi.if_else((t88 <= t196*t90), 0, casadi.atan2(-t87, t86))
+    t207 = t206
+    t208 = t207 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t207)
+    t209 = t206 + t67
+    t210 = t200 + t209 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t201 - 0.15915494309189535*t209)
+    t211 = -t210
+    t212 = t210 + 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t211)
+    t213 = 1e-24*t97
+    t214 = casadi.if_else((t125 <= t114*t213), 0, casadi.atan2(-t124, t123))
+    t215 = t214
+    t216 = t215 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t215)
+    t217 = 3.141592653589793 + t7
+    t218 = t108 + t214
+    t219 = t218 + t7 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t217 - 0.15915494309189535*t218)
+    t220 = -t219
+    t221 = t219 + 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t220)
+    t222 = casadi.if_else((t129 <= t117*t213), 0, casadi.atan2(-t128, t127))
+    t223 = t222
+    t224 = t223 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t223)
+    t225 = t111 + t222
+    t226 = t225 + t7 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t217 - 0.15915494309189535*t225)
+    t227 = -t226
+    t228 = t226 + 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t227)
+    t229 = 1e-24*t131
+    t230 = casadi.if_else((t159 <= t148*t229), 0, casadi.atan2(-t158, t157))
+    t231 = t230
+    t232 = t231 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t231)
+    t233 = t142 + t230
+    t234 = t200 + t233 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t201 - 0.15915494309189535*t233)
+    t235 = -t234
+    t236 = t234 + 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t235)
+    t237 = casadi.if_else((t163 <= t151*t229), 0, casadi.atan2(-t162, t161))
+    t238 = t237
+    t239 = t238 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t238)
+    t240 = t145 + t237
+    t241 = t200 + t240 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t201 - 0.15915494309189535*t240)
+    t242 = -t241
+    t243 = t241 + 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t242)
+    t244 = 1e-24*t133
+    t245 = casadi.if_else((t188 <= t177*t244), 0, casadi.atan2(-t187, t186))
+    t246 = t245
+    t247 = t246 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t246)
+    t248 = t171 + t245
+    t249 = t248 + t7 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t217 - 0.15915494309189535*t248)
+    t250 = -t249
+    t251 = t249 + 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t250)
+    t252 = casadi.if_else((t192 <= t180*t244), 0, casadi.atan2(-t191, t190))
+    t253 = t252
+    t254 = t253 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t253)
+    t255 = t174 + t252
+    t256 = t255 + t7 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t217 - 0.15915494309189535*t255)
+    t257 = -t256
+    t258 = t256 + 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t257)
+    t259 = (t26 <= 3.141592653589793)
+    t260 = casadi.logic_and((t25 >= -3.141592653589793), (t25 <= 3.141592653589793))
+    t261 = casadi.if_else(casadi.logic_and(t259, casadi.logic_not(t260)), t26, t25)
+    t262 = t261
+    t263 = t262 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn1 - 0.15915494309189535*t262)
+    t264 = casadi.if_else((qn1 > t263), 6.283185307179586, -6.283185307179586)
+    t265 = t263 + t264
+    t266 = t263 - t264
+    t267 = casadi.if_else(casadi.logic_and((t263 >= -3.141592653589793), (t263 <= 3.141592653589793)), t263, casadi.if_else(casadi.logic_and((t265 >= -3.141592653589793), (t265 <= 3.141592653589793)), t265, casadi.if_else(casadi.logic_and((t266 >= -3.141592653589793), (t266 <= 3.141592653589793)), t266, t261)))
+    t268 = (t199 <= 2.0943951023931953)
+    t269 = casadi.logic_and((t198 >= -2.0943951023931953), (t198 <= 2.0943951023931953))
+    t270 = casadi.if_else(casadi.logic_and(t268, casadi.logic_not(t269)), t199, t198)
+    t271 = t270
+    t272 = t271 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t271)
+    t273 = casadi.if_else((qn2 > t272), 6.283185307179586, -6.283185307179586)
+    t274 = t272 + t273
+    t275 = t272 - t273
+    t276 = casadi.if_else(casadi.logic_and((t272 >= -2.0943951023931953), (t272 <= 2.0943951023931953)), t272, casadi.if_else(casadi.logic_and((t274 >= -2.0943951023931953), (t274 <= 2.0943951023931953)), t274, casadi.if_else(casadi.logic_and((t275 >= -2.0943951023931953), (t275 <= 2.0943951023931953)), t275, t270)))
+    t277 = (t69 <= 2.0943951023931953)
+    t278 = casadi.logic_and((t68 >= -2.0943951023931953), (t68 <= 2.0943951023931953))
+    t279 = casadi.if_else(casadi.logic_and(t277, casadi.logic_not(t278)), t69, t68)
+    t280 = t279
+    t281 = t280 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn3 - 0.15915494309189535*t280)
+    t282 = casadi.if_else((qn3 > t281), 6.283185307179586, -6.283185307179586)
+    t283 = t281 + t282
+    t284 = t281 - t282
+    t285 = casadi.if_else(casadi.logic_and((t281 >= -2.0943951023931953), (t281 <= 2.0943951023931953)), t281, casadi.if_else(casadi.logic_and((t283 >= -2.0943951023931953), (t283 <= 2.0943951023931953)), t283, casadi.if_else(casadi.logic_and((t284 >= -2.0943951023931953), (t284 <= 2.0943951023931953)), t284, t279)))
+    t286 = (t205 >= -2.0943951023931953)
+    t287 = casadi.logic_and((t203 >= -2.0943951023931953), (t203 <= 2.0943951023931953))
+    t288 = casadi.if_else(casadi.logic_and(t286, casadi.logic_not(t287)), -t205, t204)
+    t289 = t288
+    t290 = t289 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t289)
+    t291 = casadi.if_else((qn4 > t290), 6.283185307179586, -6.283185307179586)
+    t292 = t290 + t291
+    t293 = t290 - t291
+    t294 = casadi.if_else(casadi.logic_and((t290 >= -2.0943951023931953), (t290 <= 2.0943951023931953)), t290, casadi.if_else(casadi.logic_and((t292 >= -2.0943951023931953), (t292 <= 2.0943951023931953)), t292, casadi.if_else(casadi.logic_and((t293 >= -2.0943951023931953), (t293 <= 2.0943951023931953)), t293, t288)))
+    t295 = -qn1
+    t296 = qw1*(t267 + t295)**2
+    t297 = -qn2
+    t298 = -qn3
+    t299 = -qn4
+    t300 = t296 + qw2*(t276 + t297)**2 + qw3*(t285 + t298)**2 + qw4*(t294 + t299)**2
+    t301 = (casadi.fabs(t194) < casadi.inf)
+    t302 = (casadi.fabs(mu3) <= 1.5707963267948966)
+    t303 = casadi.logic_or(t259, t260)
+    t304 = (t14 > t16)
+    t305 = casadi.logic_or(t304, casadi.logic_and(t17, (1e-12*t15 >= 0)))
+    t306 = True
+    t307 = casadi.logic_or(casadi.logic_and(t8, (1e-12 >= t2)), casadi.logic_and(t306, (1e-12 >= -t3)))
+    t308 = casadi.if_else(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t301, t302), t303), t305), t307), casadi.logic_or(t268, t269)), casadi.logic_or(t277, t278)), casadi.logic_or(t286, t287)), casadi.logic_or(casadi.logic_and(t306, (t60 >= -1e-12)), casadi.logic_and(t8, (t58 <= 1e-16)))), 1, 0)
+    t309 = casadi.if_else((t308 > 0), 1, 0)
+    t310 = (t309 > 0)
+    t311 = casadi.if_else(t310, t267, qn1)
+    t312 = casadi.if_else(t310, t276, qn2)
+    t313 = casadi.if_else(t310, t285, qn3)
+    t314 = casadi.if_else(t310, t294, qn4)
+    t315 = casadi.if_else(t310, t300, 0)
+    t316 = (t208 <= 2.0943951023931953)
+    t317 = casadi.logic_and((t207 >= -2.0943951023931953), (t207 <= 2.0943951023931953))
+    t318 = casadi.if_else(casadi.logic_and(t316, casadi.logic_not(t317)), t208, t207)
+    t319 = t318
+    t320 = t319 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t319)
+    t321 = casadi.if_else((qn2 > t320), 6.283185307179586, -6.283185307179586)
+    t322 = t320 + t321
+    t323 = t320 - t321
+    t324 = casadi.if_else(casadi.logic_and((t320 >= -2.0943951023931953), (t320 <= 2.0943951023931953)), t320, casadi.if_else(casadi.logic_and((t322 >= -2.0943951023931953), (t322 <= 2.0943951023931953)), t322, casadi.if_else(casadi.logic_and((t323 >= -2.0943951023931953), (t323 <= 2.0943951023931953)), t323, t318)))
+    t325 = (t71 <= 2.0943951023931953)
+    t326 = casadi.logic_and((t70 >= -2.0943951023931953), (t70 <= 2.0943951023931953))
+    t327 = casadi.if_else(casadi.logic_and(t325, casadi.logic_not(t326)), t71, t70)
+    t328 = t327
+    t329 = t328 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn3 - 0.15915494309189535*t328)
+    t330 = casadi.if_else((qn3 > t329), 6.283185307179586, -6.283185307179586)
+    t331 = t329 + t330
+    t332 = t329 - t330
+    t333 = casadi.if_else(casadi.logic_and((t329 >= -2.0943951023931953), (t329 <= 2.0943951023931953)), t329, casadi.if_else(casadi.logic_and((t331 >= -2.0943951023931953), (t331 <= 2.0943951023931953)), t331, casadi.if_else(casadi.logic_and((t332 >= -2.0943951023931953), (t332 <= 2.0943951023931953)), t332, t327)))
+    t334 = (t212 >= -2.0943951023931953)
+    t335 = casadi.logic_and((t210 >= -2.0943951023931953), (t210 <= 2.0943951023931953))
+    t336 = casadi.if_else(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t301, t302), t303), t305), t306), t307), t62), casadi.logic_or(t316, t317)), casadi.logic_or(t325, t326)), casadi.logic_or(t334, t335)), 1, 0)
+    t337 = casadi.if_else(casadi.logic_and(t334, casadi.logic_not(t335)), -t212, t211)
+    t338 = t337
+    t339 = t338 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t338)
+    t340 = casadi.if_else((qn4 > t339), 6.283185307179586, -6.283185307179586)
+    t341 = t339 + t340
+    t342 = t339 - t340
+    t343 = casadi.if_else(casadi.logic_and((t339 >= -2.0943951023931953), (t339 <= 2.0943951023931953)), t339, casadi.if_else(casadi.logic_and((t341 >= -2.0943951023931953), (t341 <= 2.0943951023931953)), t341, casadi.if_else(casadi.logic_and((t342 >= -2.0943951023931953), (t342 <= 2.0943951023931953)), t342, t337)))
+    t344 = t296 + qw2*(t297 + t324)**2 + qw3*(t298 + t333)**2 + qw4*(t299 + t343)**2
+    t345 = (t336 > 0)
+    t346 = casadi.if_else(casadi.logic_and(t345, casadi.logic_or((t315 > t344), (t309 < 1))), 1, 0)
+    t347 = casadi.if_else(t345, 1, t309)
+    t348 = (t346 > 0)
+    t349 = casadi.if_else(t348, t267, t311)
+    t350 = casadi.if_else(t348, t324, t312)
+    t351 = casadi.if_else(t348, t333, t313)
+    t352 = casadi.if_else(t348, t343, t314)
+    t353 = casadi.if_else(t348, t344, t315)
+    t354 = (t216 <= 2.0943951023931953)
+    t355 = casadi.logic_and((t215 >= -2.0943951023931953), (t215 <= 2.0943951023931953))
+    t356 = casadi.if_else(casadi.logic_and(t354, casadi.logic_not(t355)), t216, t215)
+    t357 = t356
+    t358 = t357 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t357)
+    t359 = casadi.if_else((qn2 > t358), 6.283185307179586, -6.283185307179586)
+    t360 = t358 + t359
+    t361 = t358 - t359
+    t362 = casadi.if_else(casadi.logic_and((t358 >= -2.0943951023931953), (t358 <= 2.0943951023931953)), t358, casadi.if_else(casadi.logic_and((t360 >= -2.0943951023931953), (t360 <= 2.0943951023931953)), t360, casadi.if_else(casadi.logic_and((t361 >= -2.0943951023931953), (t361 <= 2.0943951023931953)), t361, t356)))
+    t363 = (t119 <= 2.0943951023931953)
+    t364 = casadi.logic_and((t118 >= -2.0943951023931953), (t118 <= 2.0943951023931953))
+    t365 = casadi.if_else(casadi.logic_and(t363, casadi.logic_not(t364)), t119, t118)
+    t366 = t365
+    t367 = t366 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn3 - 0.15915494309189535*t366)
+    t368 = casadi.if_else((qn3 > t367), 6.283185307179586, -6.283185307179586)
+    t369 = t367 + t368
+    t370 = t367 - t368
+    t371 = casadi.if_else(casadi.logic_and((t367 >= -2.0943951023931953), (t367 <= 2.0943951023931953)), t367, casadi.if_else(casadi.logic_and((t369 >= -2.0943951023931953), (t369 <= 2.0943951023931953)), t369, casadi.if_else(casadi.logic_and((t370 >= -2.0943951023931953), (t370 <= 2.0943951023931953)), t370, t365)))
+    t372 = (t221 >= -2.0943951023931953)
+    t373 = casadi.logic_and((t219 >= -2.0943951023931953), (t219 <= 2.0943951023931953))
+    t374 = casadi.if_else(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t301, t302), t303), t305), t306), t4), casadi.logic_or(t354, t355)), casadi.logic_or(t363, t364)), casadi.logic_or(t372, t373)), casadi.logic_or(casadi.logic_and(t306, (t102 >= -1e-12)), casadi.logic_and(t8, (t101 <= 1e-16)))), 1, 0)
+    t375 = casadi.if_else(casadi.logic_and(t372, casadi.logic_not(t373)), -t221, t220)
+    t376 = t375
+    t377 = t376 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t376)
+    t378 = casadi.if_else((qn4 > t377), 6.283185307179586, -6.283185307179586)
+    t379 = t377 + t378
+    t380 = t377 - t378
+    t381 = casadi.if_else(casadi.logic_and((t377 >= -2.0943951023931953), (t377 <= 2.0943951023931953)), t377, casadi.if_else(casadi.logic_and((t379 >= -2.0943951023931953), (t379 <= 2.0943951023931953)), t379, casadi.if_else(casadi.logic_and((t380 >= -2.0943951023931953), (t380 <= 2.0943951023931953)), t380, t375)))
+    t382 = t296 + qw2*(t297 + t362)**2 + qw3*(t298 + t371)**2 + qw4*(t299 + t381)**2
+    t383 = (t374 > 0)
+    t384 = casadi.if_else(casadi.logic_and(t383, casadi.logic_or((t353 > t382), (t347 < 1))), 1, 0)
+    t385 = casadi.if_else(t383, 1, t347)
+    t386 = (t384 > 0)
+    t387 = casadi.if_else(t386, t267, t349)
+    t388 = casadi.if_else(t386, t362, t350)
+    t389 = casadi.if_else(t386, t371, t351)
+    t390 = casadi.if_else(t386, t381, t352)
+    t391 = casadi.if_else(t386, t382, t353)
+    t392 = (t224 <= 2.0943951023931953)
+    t393 = casadi.logic_and((t223 >= -2.0943951023931953), (t223 <= 2.0943951023931953))
+    t394 = casadi.if_else(casadi.logic_and(t392, casadi.logic_not(t393)), t224, t223)
+    t395 = t394
+    t396 = t395 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t395)
+    t397 = casadi.if_else((qn2 > t396), 6.283185307179586, -6.283185307179586)
+    t398 = t396 + t397
+    t399 = t396 - t397
+    t400 = casadi.if_else(casadi.logic_and((t396 >= -2.0943951023931953), (t396 <= 2.0943951023931953)), t396, casadi.if_else(casadi.logic_and((t398 >= -2.0943951023931953), (t398 <= 2.0943951023931953)), t398, casadi.if_else(casadi.logic_and((t399 >= -2.0943951023931953), (t399 <= 2.0943951023931953)), t399, t394)))
+    t401 = (t121 <= 2.0943951023931953)
+    t402 = casadi.logic_and((t120 >= -2.0943951023931953), (t120 <= 2.0943951023931953))
+    t403 = casadi.if_else(casadi.logic_and(t401, casadi.logic_not(t402)), t121, t120)
+    t404 = t403
+    t405 = t404 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn3 - 0.15915494309189535*t404)
+    t406 = casadi.if_else((qn3 > t405), 6.283185307179586, -6.283185307179586)
+    t407 = t405 + t406
+    t408 = t405 - t406
+    t409 = casadi.if_else(casadi.logic_and((t405 >= -2.0943951023931953), (t405 <= 2.0943951023931953)), t405, casadi.if_else(casadi.logic_and((t407 >= -2.0943951023931953), (t407 <= 2.0943951023931953)), t407, casadi.if_else(casadi.logic_and((t408 >= -2.0943951023931953), (t408 <= 2.0943951023931953)), t408, t403)))
+    t410 = (t228 >= -2.0943951023931953)
+    t411 = casadi.logic_and((t226 >= -2.0943951023931953), (t226 <= 2.0943951023931953))
+    t412 = casadi.if_else(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t104, t301), t302), t303), t305), t306), t4), casadi.logic_or(t392, t393)), casadi.logic_or(t401, t402)), casadi.logic_or(t410, t411)), 1, 0)
+    t413 = casadi.if_else(casadi.logic_and(t410, casadi.logic_not(t411)), -t228, t227)
+    t414 = t413
+    t415 = t414 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t414)
+    t416 = casadi.if_else((qn4 > t415), 6.283185307179586, -6.283185307179586)
+    t417 = t415 + t416
+    t418 = t415 - t416
+    t419 = casadi.if_else(casadi.logic_and((t415 >= -2.0943951023931953), (t415 <= 2.0943951023931953)), t415, casadi.if_else(casadi.logic_and((t417 >= -2.0943951023931953), (t417 <= 2.0943951023931953)), t417, casadi.if_else(casadi.logic_and((t418 >= -2.0943951023931953), (t418 <= 2.0943951023931953)), t418, t413)))
+    t420 = t296 + qw2*(t297 + t400)**2 + qw3*(t298 + t409)**2 + qw4*(t299 + t419)**2
+    t421 = (t412 > 0)
+    t422 = casadi.if_else(casadi.logic_and(t421, casadi.logic_or((t391 > t420), (t385 < 1))), 1, 0)
+    t423 = casadi.if_else(t421, 1, t385)
+    t424 = (t422 > 0)
+    t425 = casadi.if_else(t424, t267, t387)
+    t426 = casadi.if_else(t424, t400, t388)
+    t427 = casadi.if_else(t424, t409, t389)
+    t428 = casadi.if_else(t424, t419, t390)
+    t429 = casadi.if_else(t424, t420, t391)
+    t430 = (t28 <= 3.141592653589793)
+    t431 = casadi.logic_and((t27 >= -3.141592653589793), (t27 <= 3.141592653589793))
+    t432 = casadi.if_else(casadi.logic_and(t430, casadi.logic_not(t431)), t28, t27)
+    t433 = t432
+    t434 = t433 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn1 - 0.15915494309189535*t433)
+    t435 = casadi.if_else((qn1 > t434), 6.283185307179586, -6.283185307179586)
+    t436 = t434 + t435
+    t437 = t434 - t435
+    t438 = casadi.if_else(casadi.logic_and((t434 >= -3.141592653589793), (t434 <= 3.141592653589793)), t434, casadi.if_else(casadi.logic_and((t436 >= -3.141592653589793), (t436 <= 3.141592653589793)), t436, casadi.if_else(casadi.logic_and((t437 >= -3.141592653589793), (t437 <= 3.141592653589793)), t437, t432)))
+    t439 = (t232 <= 2.0943951023931953)
+    t440 = casadi.logic_and((t231 >= -2.0943951023931953), (t231 <= 2.0943951023931953))
+    t441 = casadi.if_else(casadi.logic_and(t439, casadi.logic_not(t440)), t232, t231)
+    t442 = t441
+    t443 = t442 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t442)
+    t444 = casadi.if_else((qn2 > t443), 6.283185307179586, -6.283185307179586)
+    t445 = t443 + t444
+    t446 = t443 - t444
+    t447 = casadi.if_else(casadi.logic_and((t443 >= -2.0943951023931953), (t443 <= 2.0943951023931953)), t443, casadi.if_else(casadi.logic_and((t445 >= -2.0943951023931953), (t445 <= 2.0943951023931953)), t445, casadi.if_else(casadi.logic_and((t446 >= -2.0943951023931953), (t446 <= 2.0943951023931953)), t446, t441)))
+    t448 = (t153 <= 2.0943951023931953)
+    t449 = casadi.logic_and((t152 >= -2.0943951023931953), (t152 <= 2.0943951023931953))
+    t450 = casadi.if_else(casadi.logic_and(t448, casadi.logic_not(t449)), t153, t152)
+    t451 = t450
+    t452 = t451 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn3 - 0.15915494309189535*t451)
+    t453 = casadi.if_else((qn3 > t452), 6.283185307179586, -6.283185307179586)
+    t454 = t452 + t453
+    t455 = t452 - t453
+    t456 = casadi.if_else(casadi.logic_and((t452 >= -2.0943951023931953), (t452 <= 2.0943951023931953)), t452, casadi.if_else(casadi.logic_and((t454 >= -2.0943951023931953), (t454 <= 2.0943951023931953)), t454, casadi.if_else(casadi.logic_and((t455 >= -2.0943951023931953), (t455 <= 2.0943951023931953)), t455, t450)))
+    t457 = (t236 >= -2.0943951023931953)
+    t458 = casadi.logic_and((t234 >= -2.0943951023931953), (t234 <= 2.0943951023931953))
+    t459 = casadi.if_else(casadi.logic_and(t457, casadi.logic_not(t458)), -t236, t235)
+    t460 = t459
+    t461 = t460 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t460)
+    t462 = casadi.if_else((qn4 > t461), 6.283185307179586, -6.283185307179586)
+    t463 = t461 + t462
+    t464 = t461 - t462
+    t465 = casadi.if_else(casadi.logic_and((t461 >= -2.0943951023931953), (t461 <= 2.0943951023931953)), t461, casadi.if_else(casadi.logic_and((t463 >= -2.0943951023931953), (t463 <= 2.0943951023931953)), t463, casadi.if_else(casadi.logic_and((t464 >= -2.0943951023931953), (t464 <= 2.0943951023931953)), t464, t459)))
+    t466 = qw1*(t295 + t438)**2
+    t467 = t466 + qw2*(t297 + t447)**2 + qw3*(t298 + t456)**2 + qw4*(t299 + t465)**2
+    t468 = casadi.logic_or(t430, t431)
+    t469 = casadi.if_else(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t19, t301), t302), t304), t307), t468), casadi.logic_or(t439, t440)), casadi.logic_or(t448, t449)), casadi.logic_or(t457, t458)), casadi.logic_or(casadi.logic_and(t306, (t136 >= -1e-12)), casadi.logic_and(t8, (t135 <= 1e-16)))), 1, 0)
+    t470 = (t469 > 0)
+    t471 = casadi.if_else(casadi.logic_and(t470, casadi.logic_or((t429 > t467), (t423 < 1))), 1, 0)
+    t472 = casadi.if_else(t470, 1, t423)
+    t473 = (t471 > 0)
+    t474 = casadi.if_else(t473, t438, t425)
+    t475 = casadi.if_else(t473, t447, t426)
+    t476 = casadi.if_else(t473, t456, t427)
+    t477 = casadi.if_else(t473, t465, t428)
+    t478 = casadi.if_else(t473, t467, t429)
+    t479 = (t239 <= 2.0943951023931953)
+    t480 = casadi.logic_and((t238 >= -2.0943951023931953), (t238 <= 2.0943951023931953))
+    t481 = casadi.if_else(casadi.logic_and(t479, casadi.logic_not(t480)), t239, t238)
+    t482 = t481
+    t483 = t482 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t482)
+    t484 = casadi.if_else((qn2 > t483), 6.283185307179586, -6.283185307179586)
+    t485 = t483 + t484
+    t486 = t483 - t484
+    t487 = casadi.if_else(casadi.logic_and((t483 >= -2.0943951023931953), (t483 <= 2.0943951023931953)), t483, casadi.if_else(casadi.logic_and((t485 >= -2.0943951023931953), (t485 <= 2.0943951023931953)), t485, casadi.if_else(casadi.logic_and((t486 >= -2.0943951023931953), (t486 <= 2.0943951023931953)), t486, t481)))
+    t488 = (t155 <= 2.0943951023931953)
+    t489 = casadi.logic_and((t154 >= -2.0943951023931953), (t154 <= 2.0943951023931953))
+    t490 = casadi.if_else(casadi.logic_and(t488, casadi.logic_not(t489)), t155, t154)
+    t491 = t490
+    t492 = t491 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn3 - 0.15915494309189535*t491)
+    t493 = casadi.if_else((qn3 > t492), 6.283185307179586, -6.283185307179586)
+    t494 = t492 + t493
+    t495 = t492 - t493
+    t496 = casadi.if_else(casadi.logic_and((t492 >= -2.0943951023931953), (t492 <= 2.0943951023931953)), t492, casadi.if_else(casadi.logic_and((t494 >= -2.0943951023931953), (t494 <= 2.0943951023931953)), t494, casadi.if_else(casadi.logic_and((t495 >= -2.0943951023931953), (t495 <= 2.0943951023931953)), t495, t490)))
+    t497 = (t243 >= -2.0943951023931953)
+    t498 = casadi.logic_and((t241 >= -2.0943951023931953), (t241 <= 2.0943951023931953))
+    t499 = casadi.if_else(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t138, t19), t301), t302), t304), t306), t307), t468), casadi.logic_or(t479, t480)), casadi.logic_or(t488, t489)), casadi.logic_or(t497, t498)), 1, 0)
+    t500 = casadi.if_else(casadi.logic_and(t497, casadi.logic_not(t498)), -t243, t242)
+    t501 = t500
+    t502 = t501 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t501)
+    t503 = casadi.if_else((qn4 > t502), 6.283185307179586, -6.283185307179586)
+    t504 = t502 + t503
+    t505 = t502 - t503
+    t506 = casadi.if_else(casadi.logic_and((t502 >= -2.0943951023931953), (t502 <= 2.0943951023931953)), t502, casadi.if_else(casadi.logic_and((t504 >= -2.0943951023931953), (t504 <= 2.0943951023931953)), t504, casadi.if_else(casadi.logic_and((t505 >= -2.0943951023931953), (t505 <= 2.0943951023931953)), t505, t500)))
+    t507 = t466 + qw2*(t297 + t487)**2 + qw3*(t298 + t496)**2 + qw4*(t299 + t506)**2
+    t508 = (t499 > 0)
+    t509 = casadi.if_else(casadi.logic_and(t508, casadi.logic_or((t478 > t507), (t472 < 1))), 1, 0)
+    t510 = casadi.if_else(t508, 1, t472)
+    t511 = (t509 > 0)
+    t512 = casadi.if_else(t511, t438, t474)
+    t513 = casadi.if_else(t511, t487, t475)
+    t514 = casadi.if_else(t511, t496, t476)
+    t515 = casadi.if_else(t511, t506, t477)
+    t516 = casadi.if_else(t511, t507, t478)
+    t517 = (t247 <= 2.0943951023931953)
+    t518 = casadi.logic_and((t246 >= -2.0943951023931953), (t246 <= 2.0943951023931953))
+    t519 = casadi.if_else(casadi.logic_and(t517, casadi.logic_not(t518)), t247, t246)
+    t520 = t519
+    t521 = t520 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t520)
+    t522 = casadi.if_else((qn2 > t521), 6.283185307179586, -6.283185307179586)
+    t523 = t521 + t522
+    t524 = t521 - t522
+    t525 = casadi.if_else(casadi.logic_and((t521 >= -2.0943951023931953), (t521 <= 2.0943951023931953)), t521, casadi.if_else(casadi.logic_and((t523 >= -2.0943951023931953), (t523 <= 2.0943951023931953)), t523, casadi.if_else(casadi.logic_and((t524 >= -2.0943951023931953), (t524 <= 2.0943951023931953)), t524, t519)))
+    t526 = (t182 <= 2.0943951023931953)
+    t527 = casadi.logic_and((t181 >= -2.0943951023931953), (t181 <= 2.0943951023931953))
+    t528 = casadi.if_else(casadi.logic_and(t526, casadi.logic_not(t527)), t182, t181)
+    t529 = t528
+    t530 = t529 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn3 - 0.15915494309189535*t529)
+    t531 = casadi.if_else((qn3 > t530), 6.283185307179586, -6.283185307179586)
+    t532 = t530 + t531
+    t533 = t530 - t531
+    t534 = casadi.if_else(casadi.logic_and((t530 >= -2.0943951023931953), (t530 <= 2.0943951023931953)), t530, casadi.if_else(casadi.logic_and((t532 >= -2.0943951023931953), (t532 <= 2.0943951023931953)), t532, casadi.if_else(casadi.logic_and((t533 >= -2.0943951023931953), (t533 <= 2.0943951023931953)), t533, t528)))
+    t535 = (t251 >= -2.0943951023931953)
+    t536 = casadi.logic_and((t249 >= -2.0943951023931953), (t249 <= 2.0943951023931953))
+    t537 = casadi.if_else(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t19, t301), t302), t304), t306), t4), t468), casadi.logic_or(t517, t518)), casadi.logic_or(t526, t527)), casadi.logic_or(t535, t536)), casadi.logic_or(casadi.logic_and(t306, (t165 >= -1e-12)), casadi.logic_and(t8, (t164 <= 1e-16)))), 1, 0)
+    t538 = casadi.if_else(casadi.logic_and(t535, casadi.logic_not(t536)), -t251, t250)
+    t539 = t538
+    t540 = t539 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t539)
+    t541 = casadi.if_else((qn4 > t540), 6.283185307179586, -6.283185307179586)
+    t542 = t540 + t541
+    t543 = t540 - t541
+    t544 = casadi.if_else(casadi.logic_and((t540 >= -2.0943951023931953), (t540 <= 2.0943951023931953)), t540, casadi.if_else(casadi.logic_and((t542 >= -2.0943951023931953), (t542 <= 2.0943951023931953)), t542, casadi.if_else(casadi.logic_and((t543 >= -2.0943951023931953), (t543 <= 2.0943951023931953)), t543, t538)))
+    t545 = t466 + qw2*(t297 + t525)**2 + qw3*(t298 + t534)**2 + qw4*(t299 + t544)**2
+    t546 = (t537 > 0)
+    t547 = casadi.if_else(casadi.logic_and(t546, casadi.logic_or((t516 > t545), (t510 < 1))), 1, 0)
+    t548 = casadi.if_else(t546, 1, t510)
+    t549 = (t547 > 0)
+    t550 = casadi.if_else(t549, t438, t512)
+    t551 = casadi.if_else(t549, t525, t513)
+    t552 = casadi.if_else(t549, t534, t514)
+    t553 = casadi.if_else(t549, t544, t515)
+    t554 = casadi.if_else(t549, t545, t516)
+    t555 = (t254 <= 2.0943951023931953)
+    t556 = casadi.logic_and((t253 >= -2.0943951023931953), (t253 <= 2.0943951023931953))
+    t557 = casadi.if_else(casadi.logic_and(t555, casadi.logic_not(t556)), t254, t253)
+    t558 = t557
+    t559 = t558 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t558)
+    t560 = casadi.if_else((qn2 > t559), 6.283185307179586, -6.283185307179586)
+    t561 = t559 + t560
+    t562 = t559 - t560
+    t563 = casadi.if_else(casadi.logic_and((t559 >= -2.0943951023931953), (t559 <= 2.0943951023931953)), t559, casadi.if_else(casadi.logic_and((t561 >= -2.0943951023931953), (t561 <= 2.0943951023931953)), t561, casadi.if_else(casadi.logic_and((t562 >= -2.0943951023931953), (t562 <= 2.0943951023931953)), t562, t557)))
+    t564 = (t184 <= 2.0943951023931953)
+    t565 = casadi.logic_and((t183 >= -2.0943951023931953), (t183 <= 2.0943951023931953))
+    t566 = casadi.if_else(casadi.logic_and(t564, casadi.logic_not(t565)), t184, t183)
+    t567 = t566
+    t568 = t567 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn3 - 0.15915494309189535*t567)
+    t569 = casadi.if_else((qn3 > t568), 6.283185307179586, -6.283185307179586)
+    t570 = t568 + t569
+    t571 = t568 - t569
+    t572 = casadi.if_else(casadi.logic_and((t568 >= -2.0943951023931953), (t568 <= 2.0943951023931953)), t568, casadi.if_else(casadi.logic_and((t570 >= -2.0943951023931953), (t570 <= 2.0943951023931953)), t570, casadi.if_else(casadi.logic_and((t571 >= -2.0943951023931953), (t571 <= 2.0943951023931953)), t571, t566)))
+    t573 = (t258 >= -2.0943951023931953)
+    t574 = casadi.logic_and((t256 >= -2.0943951023931953), (t256 <= 2.0943951023931953))
+    t575 = casadi.if_else(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t167, t19), t301), t302), t304), t306), t4), t468), casadi.logic_or(t555, t556)), casadi.logic_or(t564, t565)), casadi.logic_or(t573, t574)), 1, 0)
+    t576 = casadi.if_else(casadi.logic_and(t573, casadi.logic_not(t574)), -t258, t257)
+    t577 = t576
+    t578 = t577 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t577)
+    t579 = casadi.if_else((qn4 > t578), 6.283185307179586, -6.283185307179586)
+    t580 = t578 + t579
+    t581 = t578 - t579
+    t582 = casadi.if_else(casadi.logic_and((t578 >= -2.0943951023931953), (t578 <= 2.0943951023931953)), t578, casadi.if_else(casadi.logic_and((t580 >= -2.0943951023931953), (t580 <= 2.0943951023931953)), t580, casadi.if_else(casadi.logic_and((t581 >= -2.0943951023931953), (t581 <= 2.0943951023931953)), t581, t576)))
+    t583 = t466 + qw2*(t297 + t563)**2 + qw3*(t298 + t572)**2 + qw4*(t299 + t582)**2
+    t584 = (t575 > 0)
+    t585 = casadi.if_else(casadi.logic_and(t584, casadi.logic_or((t554 > t583), (t548 < 1))), 1, 0)
+    t586 = casadi.if_else(t584, 1, t548)
+    t587 = (t585 > 0)
+    t588 = casadi.if_else(t587, t438, t550)
+    t589 = casadi.if_else(t587, t563, t551)
+    t590 = casadi.if_else(t587, t572, t552)
+    t591 = casadi.if_else(t587, t582, t553)
+    t592 = (casadi.fabs(t195) < casadi.inf)
+    t593 = (t586 > 0)
+    t594 = casadi.logic_and(t592, t593)
+    q = casadi.SX(4, 1)
+    q[0, 0] = casadi.if_else(t594, t588, qn1)
+    q[1, 0] = casadi.if_else(t594, t589, qn2)
+    q[2, 0] = casadi.if_else(t594, t590, qn3)
+    q[3, 0] = casadi.if_else(t594, t591, qn4)
+    status = casadi.SX(1, 1)
+    status[0, 0] = casadi.if_else(casadi.logic_not(t592), 2, casadi.if_else(t593, 0, 1))
+    return [q, status]
 
 
 _q = casadi.SX.sym("q", 4, 1)
@@ -1482,6 +2217,8 @@ _mu_dot = casadi.SX.sym("mu_dot", 4, 1)
 _damping = casadi.SX.sym("damping", 1, 1)
 _target = casadi.SX.sym("target", 4, 1)
 _mu = casadi.SX.sym("mu", 4, 1)
+_q_seed = casadi.SX.sym("q_seed", 4, 1)
+_weights = casadi.SX.sym("weights", 4, 1)
 fk = casadi.Function("fk", [_q], _fk(_q), ["q"], ["T"])
 jacobian = casadi.Function("jacobian", [_q], _jacobian(_q), ["q"], ["J"])
 fk_jacobian = casadi.Function("fk_jacobian", [_q], _fk_jacobian(_q), ["q"], ["T", "J"])
@@ -1498,8 +2235,9 @@ manipulability = casadi.Function("manipulability", [_q], _manipulability(_q), ["
 jacobian_det = casadi.Function("jacobian_det", [_q], _jacobian_det(_q), ["q"], ["d"])
 velocity_ik = casadi.Function("velocity_ik", [_q, _mu_dot, _damping], _velocity_ik(_q, _mu_dot, _damping), ["q", "mu_dot", "damping"], ["q_dot", "status"])
 ik_numeric_step = casadi.Function("ik_numeric_step", [_target, _q, _damping], _ik_numeric_step(_target, _q, _damping), ["target", "q", "damping"], ["q_start", "q_next", "cost"])
-ik_branches = casadi.Function("ik_branches", [_mu], _ik_branches(_mu), ["mu"], ["q", "valid"])
-ik = ik_branches  # CasADi functions have fixed-size outputs: every branch and its validity
+ik_branches = casadi.Function("ik_branches", [_mu], _ik_branches(_mu), ["mu"], ["q", "valid", "in_limits"])
+ik_nearest = casadi.Function("ik_nearest", [_mu, _q_seed, _weights], _ik_nearest(_mu, _q_seed, _weights), ["mu", "q_seed", "weights"], ["q", "status"])
+ik = ik_branches  # CasADi functions have fixed-size outputs: every branch, its validity and its limits
 
 IK_NUMERIC_CONVERGED = 0  # |error| <= tol
 IK_NUMERIC_ITERATION_LIMIT = 1  # IK_NUMERIC_ITERATIONS steps taken, |error| still above tol
@@ -1541,4 +2279,4 @@ ik_numeric = casadi.Function("ik_numeric", _inputs, _ik_numeric(*_inputs), ["tar
 
 def functions():
     """All functions by name."""
-    return {"fk": fk, "jacobian": jacobian, "fk_jacobian": fk_jacobian, "jacobian_tool": jacobian_tool, "task": task, "task_jacobian": task_jacobian, "fk_jacobian_dot": fk_jacobian_dot, "jacobian_dot": jacobian_dot, "bias_acceleration": bias_acceleration, "task_jacobian_dot": task_jacobian_dot, "hessian": hessian, "singularity_factors": singularity_factors, "manipulability": manipulability, "jacobian_det": jacobian_det, "velocity_ik": velocity_ik, "ik_numeric_step": ik_numeric_step, "ik_branches": ik_branches}
+    return {"fk": fk, "jacobian": jacobian, "fk_jacobian": fk_jacobian, "jacobian_tool": jacobian_tool, "task": task, "task_jacobian": task_jacobian, "fk_jacobian_dot": fk_jacobian_dot, "jacobian_dot": jacobian_dot, "bias_acceleration": bias_acceleration, "task_jacobian_dot": task_jacobian_dot, "hessian": hessian, "singularity_factors": singularity_factors, "manipulability": manipulability, "jacobian_det": jacobian_det, "velocity_ik": velocity_ik, "ik_numeric_step": ik_numeric_step, "ik_branches": ik_branches, "ik_nearest": ik_nearest}

@@ -939,9 +939,9 @@ scara_real scara_ik_numeric_step(const scara_real target[SCARA_TASK_DIM], const 
     return (isfinite(t5) ? t19 : -1);
 }
 
-void scara_ik_branches(const scara_real mu[SCARA_TASK_DIM], scara_real q[SCARA_MAX_IK_SOLUTIONS * SCARA_DOF], int valid[SCARA_MAX_IK_SOLUTIONS])
+void scara_ik_branches(const scara_real mu[SCARA_TASK_DIM], scara_real q[SCARA_MAX_IK_SOLUTIONS * SCARA_DOF], int valid[SCARA_MAX_IK_SOLUTIONS], int in_limits[SCARA_MAX_IK_SOLUTIONS])
 {
-    /* 127 operations */
+    /* 213 operations */
 
     /* Inputs */
     const scara_real mu0 = mu[0];
@@ -965,56 +965,253 @@ void scara_ik_branches(const scara_real mu[SCARA_TASK_DIM], scara_real q[SCARA_M
     const scara_real t12 = atan2(t11, t10);
     const scara_real t13 = (t3 ? 0 : 3.141592653589793 + t12);
     const scara_real t14 = 3.141592653589793 - t12;
-    const scara_real t15 = 0.089375*t4;
-    const scara_real t16 = (t3 ? 1 : -t10*t15);
-    const scara_real t17 = (t3 ? 0 : -t11*t15);
-    const scara_real t18 = 0.325 + 0.275*t16;
-    const scara_real t19 = 0.149769 + 0.075625*(t17*t17) + (t18*t18);
-    const scara_real t20 = 0.275*t17;
-    const scara_real t21 = 0.149769 + mu0*t18 + mu1*t20;
-    const scara_real t22 = -0.149769 + t21;
-    const scara_real t23 = mu1*t18 - mu0*t20;
-    const scara_real t24 = (t22*t22) + (t23*t23);
-    const scara_real t25 = 0.024578125*t4;
-    const scara_real t26 = 0.325 - t10*t25;
-    const scara_real t27 = 0.149769 + 0.000604084228515625*t6*(t11*t11) + (t26*t26);
-    const scara_real t28 = t11*t25;
-    const scara_real t29 = 0.149769 + mu0*t26 + mu1*t28;
-    const scara_real t30 = -0.149769 + t29;
-    const scara_real t31 = mu1*t26 - mu0*t28;
-    const scara_real t32 = (t30*t30) + (t31*t31);
-    const scara_real t33 = 1e-24*t0;
-    const scara_real t34 = (t24 <= t19*t33 ? 0 : atan2(t23, t22));
-    const scara_real t35 = 0.387 - mu2;
-    const scara_real t36 = -mu3;
-    const scara_real t37 = -t13 - t34 - t36;
-    const scara_real t38 = (t32 <= t27*t33 ? 0 : atan2(t31, t30));
-    const scara_real t39 = -t14 - t36 - t38;
-    const int t40 = isfinite(t2);
-    const scara_real t41 = 1.9314171249999998e-26;
-    const int t42 = 0.007987890625 > t41;
+    const scara_real t15 = t13 - 6.283185307179586*ceil(-0.5 + 0.15915494309189535*t13);
+    const scara_real t16 = t15 - 6.283185307179586*floor(0.24444444444444444 + 0.15915494309189535*t15);
+    const scara_real t17 = t14 - 6.283185307179586*ceil(-0.5 + 0.15915494309189535*t14);
+    const scara_real t18 = t17 - 6.283185307179586*floor(0.24444444444444444 + 0.15915494309189535*t17);
+    const scara_real t19 = 0.089375*t4;
+    const scara_real t20 = (t3 ? 1 : -t10*t19);
+    const scara_real t21 = (t3 ? 0 : -t11*t19);
+    const scara_real t22 = 0.325 + 0.275*t20;
+    const scara_real t23 = 0.149769 + 0.075625*(t21*t21) + (t22*t22);
+    const scara_real t24 = 0.275*t21;
+    const scara_real t25 = 0.149769 + mu0*t22 + mu1*t24;
+    const scara_real t26 = -0.149769 + t25;
+    const scara_real t27 = mu1*t22 - mu0*t24;
+    const scara_real t28 = (t26*t26) + (t27*t27);
+    const scara_real t29 = 0.024578125*t4;
+    const scara_real t30 = 0.325 - t10*t29;
+    const scara_real t31 = 0.149769 + 0.000604084228515625*t6*(t11*t11) + (t30*t30);
+    const scara_real t32 = t11*t29;
+    const scara_real t33 = 0.149769 + mu0*t30 + mu1*t32;
+    const scara_real t34 = -0.149769 + t33;
+    const scara_real t35 = mu1*t30 - mu0*t32;
+    const scara_real t36 = (t34*t34) + (t35*t35);
+    const scara_real t37 = 1e-24*t0;
+    const scara_real t38 = (t28 <= t23*t37 ? 0 : atan2(t27, t26));
+    const scara_real t39 = t38;
+    const scara_real t40 = t39 - 6.283185307179586*floor(0.1388888888888889 + 0.15915494309189535*t39);
+    const scara_real t41 = -mu3;
+    const scara_real t42 = -t13 - t38 - t41;
+    const scara_real t43 = t42 + 6.283185307179586*ceil(-0.5 - 0.15915494309189535*t42);
+    const scara_real t44 = -t43;
+    const scara_real t45 = t43 + 6.283185307179586*floor(1.0 + 0.15915494309189535*t44);
+    const scara_real t46 = (t36 <= t31*t37 ? 0 : atan2(t35, t34));
+    const scara_real t47 = t46;
+    const scara_real t48 = t47 - 6.283185307179586*floor(0.1388888888888889 + 0.15915494309189535*t47);
+    const scara_real t49 = -t14 - t41 - t46;
+    const scara_real t50 = t49 + 6.283185307179586*ceil(-0.5 - 0.15915494309189535*t49);
+    const scara_real t51 = -t50;
+    const scara_real t52 = t50 + 6.283185307179586*floor(1.0 + 0.15915494309189535*t51);
+    const int t53 = t40 <= 0.8726646259971648;
+    const int t54 = t39 >= -0.8726646259971648 && t39 <= 0.8726646259971648;
+    const int t55 = t16 <= 1.53588974175501;
+    const int t56 = t15 >= -1.53588974175501 && t15 <= 1.53588974175501;
+    const scara_real t57 = 0.387 - mu2;
+    const scara_real t58 = -t45;
+    const int t59 = t48 <= 0.8726646259971648;
+    const int t60 = t47 >= -0.8726646259971648 && t47 <= 0.8726646259971648;
+    const int t61 = t18 <= 1.53588974175501;
+    const int t62 = t17 >= -1.53588974175501 && t17 <= 1.53588974175501;
+    const scara_real t63 = -t52;
+    const int t64 = isfinite(t2);
+    const scara_real t65 = 1.9314171249999998e-26;
+    const int t66 = 0.007987890625 > t65;
+    const int t67 = t57 >= 0.0;
+    const int t68 = t57 <= 0.21;
 
     /* Outputs */
-    q[0] = t34;
-    q[1] = t13 - 6.283185307179586*ceil(-0.5 + 0.15915494309189535*t13);
-    q[2] = t35;
-    q[3] = -t37 - 6.283185307179586*ceil(-0.5 - 0.15915494309189535*t37);
-    q[4] = t38;
-    q[5] = t14 - 6.283185307179586*ceil(-0.5 + 0.15915494309189535*t14);
-    q[6] = t35;
-    q[7] = -t39 - 6.283185307179586*ceil(-0.5 - 0.15915494309189535*t39);
-    valid[0] = t40 && ((t42 && t7 >= -1e-12) || (0.007987890625 <= t41 && t5 <= 1.931417125e-14));
-    valid[1] = t40 && t42 && t7 > 1e-12;
+    q[0] = (t53 && !t54 ? t40 : t39);
+    q[1] = (t55 && !t56 ? t16 : t15);
+    q[2] = t57;
+    q[3] = (t45 >= -6.283185307179586 && !(t43 >= -6.283185307179586 && t43 <= 6.283185307179586) ? t58 : t44);
+    q[4] = (t59 && !t60 ? t48 : t47);
+    q[5] = (t61 && !t62 ? t18 : t17);
+    q[6] = t57;
+    q[7] = (t52 >= -6.283185307179586 && !(t50 >= -6.283185307179586 && t50 <= 6.283185307179586) ? t63 : t51);
+    valid[0] = t64 && ((t66 && t7 >= -1e-12) || (0.007987890625 <= t65 && t5 <= 1.931417125e-14));
+    valid[1] = t64 && t66 && t7 > 1e-12;
+    in_limits[0] = t67 && t68 && (t53 || t54) && (t55 || t56) && ((t58 <= 6.283185307179586) || (t44 >= -6.283185307179586 && t44 <= 6.283185307179586));
+    in_limits[1] = t67 && t68 && (t59 || t60) && (t61 || t62) && ((t63 <= 6.283185307179586) || (t51 >= -6.283185307179586 && t51 <= 6.283185307179586));
+}
+
+int scara_ik_nearest(const scara_real mu[SCARA_TASK_DIM], const scara_real q_seed[SCARA_DOF], const scara_real weights[SCARA_DOF], scara_real q[SCARA_DOF])
+{
+    /* 379 operations */
+
+    /* Inputs */
+    const scara_real mu0 = mu[0];
+    const scara_real mu1 = mu[1];
+    const scara_real mu2 = mu[2];
+    const scara_real mu3 = mu[3];
+    const scara_real qn1 = q_seed[0];
+    const scara_real qn2 = q_seed[1];
+    const scara_real qn3 = q_seed[2];
+    const scara_real qn4 = q_seed[3];
+    const scara_real qw1 = weights[0];
+    const scara_real qw2 = weights[1];
+    const scara_real qw3 = weights[2];
+    const scara_real qw4 = weights[3];
+
+    /* Intermediate terms */
+    const scara_real t0 = 0.149769 + (mu0*mu0) + (mu1*mu1);
+    const scara_real t1 = 0.1655095 - 0.5*t0;
+    const scara_real t2 = -0.387 + mu2;
+    const int t3 = 0;
+    const scara_real t4 = (t3 ? 1 : 11.188811188811188);
+    const scara_real t5 = (t1*t1);
+    const scara_real t6 = (t4*t4);
+    const scara_real t7 = 1 - t5*t6;
+    const scara_real t8 = t1*t4;
+    const int t9 = 1e-12 < t7;
+    const scara_real t10 = (t9 ? t8 : (t8 > 0 ? 1 : -1));
+    const scara_real t11 = (t9 ? sqrt(t7) : 0);
+    const scara_real t12 = atan2(t11, t10);
+    const scara_real t13 = (t3 ? 0 : 3.141592653589793 + t12);
+    const scara_real t14 = 3.141592653589793 - t12;
+    const scara_real t15 = t13 - 6.283185307179586*ceil(-0.5 + 0.15915494309189535*t13);
+    const scara_real t16 = t15 - 6.283185307179586*floor(0.24444444444444444 + 0.15915494309189535*t15);
+    const scara_real t17 = t14 - 6.283185307179586*ceil(-0.5 + 0.15915494309189535*t14);
+    const scara_real t18 = t17 - 6.283185307179586*floor(0.24444444444444444 + 0.15915494309189535*t17);
+    const scara_real t19 = 0.089375*t4;
+    const scara_real t20 = (t3 ? 1 : -t10*t19);
+    const scara_real t21 = (t3 ? 0 : -t11*t19);
+    const scara_real t22 = 0.325 + 0.275*t20;
+    const scara_real t23 = 0.149769 + 0.075625*(t21*t21) + (t22*t22);
+    const scara_real t24 = 0.275*t21;
+    const scara_real t25 = 0.149769 + mu0*t22 + mu1*t24;
+    const scara_real t26 = -0.149769 + t25;
+    const scara_real t27 = mu1*t22 - mu0*t24;
+    const scara_real t28 = (t26*t26) + (t27*t27);
+    const scara_real t29 = 0.024578125*t4;
+    const scara_real t30 = 0.325 - t10*t29;
+    const scara_real t31 = 0.149769 + 0.000604084228515625*t6*(t11*t11) + (t30*t30);
+    const scara_real t32 = t11*t29;
+    const scara_real t33 = 0.149769 + mu0*t30 + mu1*t32;
+    const scara_real t34 = -0.149769 + t33;
+    const scara_real t35 = mu1*t30 - mu0*t32;
+    const scara_real t36 = (t34*t34) + (t35*t35);
+    const scara_real t37 = mu0 + mu1 + mu2 + mu3;
+    const scara_real t38 = t37;
+    const scara_real t39 = qn1 + qn2 + qn3 + qn4 + qw1 + qw2 + qw3 + qw4 + t37;
+    const scara_real t40 = 1e-24*t0;
+    const scara_real t41 = (t28 <= t23*t40 ? 0 : atan2(t27, t26));
+    const scara_real t42 = t41;
+    const scara_real t43 = t42 - 6.283185307179586*floor(0.1388888888888889 + 0.15915494309189535*t42);
+    const scara_real t44 = -mu3;
+    const scara_real t45 = -t13 - t41 - t44;
+    const scara_real t46 = t45 + 6.283185307179586*ceil(-0.5 - 0.15915494309189535*t45);
+    const scara_real t47 = -t46;
+    const scara_real t48 = t46 + 6.283185307179586*floor(1.0 + 0.15915494309189535*t47);
+    const scara_real t49 = (t36 <= t31*t40 ? 0 : atan2(t35, t34));
+    const scara_real t50 = t49;
+    const scara_real t51 = t50 - 6.283185307179586*floor(0.1388888888888889 + 0.15915494309189535*t50);
+    const scara_real t52 = -t14 - t44 - t49;
+    const scara_real t53 = t52 + 6.283185307179586*ceil(-0.5 - 0.15915494309189535*t52);
+    const scara_real t54 = -t53;
+    const scara_real t55 = t53 + 6.283185307179586*floor(1.0 + 0.15915494309189535*t54);
+    const int t56 = t43 <= 0.8726646259971648;
+    const int t57 = t42 >= -0.8726646259971648 && t42 <= 0.8726646259971648;
+    const scara_real t58 = (t56 && !t57 ? t43 : t42);
+    const scara_real t59 = t58;
+    const scara_real t60 = t59 + 6.283185307179586*floor(0.5 + 0.15915494309189535*qn1 - 0.15915494309189535*t59);
+    const scara_real t61 = (qn1 > t60 ? 6.283185307179586 : -6.283185307179586);
+    const scara_real t62 = t60 + t61;
+    const scara_real t63 = t60 - t61;
+    const scara_real t64 = (t60 >= -0.8726646259971648 && t60 <= 0.8726646259971648 ? t60 : (t62 >= -0.8726646259971648 && t62 <= 0.8726646259971648 ? t62 : (t63 >= -0.8726646259971648 && t63 <= 0.8726646259971648 ? t63 : t58)));
+    const int t65 = t16 <= 1.53588974175501;
+    const int t66 = t15 >= -1.53588974175501 && t15 <= 1.53588974175501;
+    const scara_real t67 = (t65 && !t66 ? t16 : t15);
+    const scara_real t68 = t67;
+    const scara_real t69 = t68 + 6.283185307179586*floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t68);
+    const scara_real t70 = (qn2 > t69 ? 6.283185307179586 : -6.283185307179586);
+    const scara_real t71 = t69 + t70;
+    const scara_real t72 = t69 - t70;
+    const scara_real t73 = (t69 >= -1.53588974175501 && t69 <= 1.53588974175501 ? t69 : (t71 >= -1.53588974175501 && t71 <= 1.53588974175501 ? t71 : (t72 >= -1.53588974175501 && t72 <= 1.53588974175501 ? t72 : t67)));
+    const int t74 = t48 >= -6.283185307179586;
+    const int t75 = t46 >= -6.283185307179586 && t46 <= 6.283185307179586;
+    const scara_real t76 = (t74 && !t75 ? -t48 : t47);
+    const scara_real t77 = t76;
+    const scara_real t78 = t77 + 6.283185307179586*floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t77);
+    const scara_real t79 = (qn4 > t78 ? 6.283185307179586 : -6.283185307179586);
+    const scara_real t80 = t78 + t79;
+    const scara_real t81 = t78 - t79;
+    const scara_real t82 = (t78 >= -6.283185307179586 && t78 <= 6.283185307179586 ? t78 : (t80 >= -6.283185307179586 && t80 <= 6.283185307179586 ? t80 : (t81 >= -6.283185307179586 && t81 <= 6.283185307179586 ? t81 : t76)));
+    const scara_real t83 = -qn1;
+    const scara_real t84 = -qn2;
+    const scara_real t85 = -qn4;
+    const scara_real t86 = qw3*((qn3 + t2)*(qn3 + t2));
+    const scara_real t87 = t86 + qw1*((t64 + t83)*(t64 + t83)) + qw2*((t73 + t84)*(t73 + t84)) + qw4*((t82 + t85)*(t82 + t85));
+    const int t88 = isfinite(t38);
+    const int t89 = mu2 >= 0.17700000000000002;
+    const int t90 = mu2 <= 0.387;
+    const int t91 = 1;
+    const scara_real t92 = (t88 && t89 && t90 && (t56 || t57) && (t65 || t66) && (t74 || t75) && ((t91 && t7 >= -1e-12) || (t3 && 51.775454771324966*t5 <= 1e-12)) ? 1 : 0);
+    const scara_real t93 = (t92 > 0 ? 1 : 0);
+    const int t94 = t93 > 0;
+    const scara_real t95 = (t94 ? t64 : qn1);
+    const scara_real t96 = (t94 ? t73 : qn2);
+    const scara_real t97 = (t94 ? t82 : qn4);
+    const scara_real t98 = (t94 ? t87 : 0);
+    const scara_real t99 = -t2;
+    const scara_real t100 = (t94 ? t99 : qn3);
+    const int t101 = t51 <= 0.8726646259971648;
+    const int t102 = t50 >= -0.8726646259971648 && t50 <= 0.8726646259971648;
+    const scara_real t103 = (t101 && !t102 ? t51 : t50);
+    const scara_real t104 = t103;
+    const scara_real t105 = t104 + 6.283185307179586*floor(0.5 + 0.15915494309189535*qn1 - 0.15915494309189535*t104);
+    const scara_real t106 = (qn1 > t105 ? 6.283185307179586 : -6.283185307179586);
+    const scara_real t107 = t105 + t106;
+    const scara_real t108 = t105 - t106;
+    const scara_real t109 = (t105 >= -0.8726646259971648 && t105 <= 0.8726646259971648 ? t105 : (t107 >= -0.8726646259971648 && t107 <= 0.8726646259971648 ? t107 : (t108 >= -0.8726646259971648 && t108 <= 0.8726646259971648 ? t108 : t103)));
+    const int t110 = t18 <= 1.53588974175501;
+    const int t111 = t17 >= -1.53588974175501 && t17 <= 1.53588974175501;
+    const scara_real t112 = (t110 && !t111 ? t18 : t17);
+    const scara_real t113 = t112;
+    const scara_real t114 = t113 + 6.283185307179586*floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t113);
+    const scara_real t115 = (qn2 > t114 ? 6.283185307179586 : -6.283185307179586);
+    const scara_real t116 = t114 + t115;
+    const scara_real t117 = t114 - t115;
+    const scara_real t118 = (t114 >= -1.53588974175501 && t114 <= 1.53588974175501 ? t114 : (t116 >= -1.53588974175501 && t116 <= 1.53588974175501 ? t116 : (t117 >= -1.53588974175501 && t117 <= 1.53588974175501 ? t117 : t112)));
+    const int t119 = t55 >= -6.283185307179586;
+    const int t120 = t53 >= -6.283185307179586 && t53 <= 6.283185307179586;
+    const scara_real t121 = (t88 && t89 && t9 && t90 && t91 && (t101 || t102) && (t110 || t111) && (t119 || t120) ? 1 : 0);
+    const scara_real t122 = (t119 && !t120 ? -t55 : t54);
+    const scara_real t123 = t122;
+    const scara_real t124 = t123 + 6.283185307179586*floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t123);
+    const scara_real t125 = (qn4 > t124 ? 6.283185307179586 : -6.283185307179586);
+    const scara_real t126 = t124 + t125;
+    const scara_real t127 = t124 - t125;
+    const scara_real t128 = (t124 >= -6.283185307179586 && t124 <= 6.283185307179586 ? t124 : (t126 >= -6.283185307179586 && t126 <= 6.283185307179586 ? t126 : (t127 >= -6.283185307179586 && t127 <= 6.283185307179586 ? t127 : t122)));
+    const scara_real t129 = t86 + qw1*((t109 + t83)*(t109 + t83)) + qw2*((t118 + t84)*(t118 + t84)) + qw4*((t128 + t85)*(t128 + t85));
+    const int t130 = t121 > 0;
+    const scara_real t131 = (t130 && ((t129 < t98) || (t93 < 1)) ? 1 : 0);
+    const scara_real t132 = (t130 ? 1 : t93);
+    const int t133 = t131 > 0;
+    const scara_real t134 = (t133 ? t109 : t95);
+    const scara_real t135 = (t133 ? t118 : t96);
+    const scara_real t136 = (t133 ? t99 : t100);
+    const scara_real t137 = (t133 ? t128 : t97);
+    const int t138 = isfinite(t39);
+    const int t139 = t132 > 0;
+    const int t140 = t138 && t139;
+
+    /* Outputs */
+    q[0] = (t140 ? t134 : qn1);
+    q[1] = (t140 ? t135 : qn2);
+    q[2] = (t140 ? t136 : qn3);
+    q[3] = (t140 ? t137 : qn4);
+    return (!t138 ? 2 : (t139 ? 0 : 1));
 }
 
 int scara_ik(const scara_real mu[SCARA_TASK_DIM], scara_real q[SCARA_MAX_IK_SOLUTIONS * SCARA_DOF])
 {
     scara_real branches[SCARA_MAX_IK_SOLUTIONS * SCARA_DOF];
-    int valid[SCARA_MAX_IK_SOLUTIONS];
+    int valid[SCARA_MAX_IK_SOLUTIONS], in_limits[SCARA_MAX_IK_SOLUTIONS];
     int count = 0, i, j;
-    scara_ik_branches(mu, branches, valid);
+    scara_ik_branches(mu, branches, valid, in_limits);
     for (i = 0; i < SCARA_MAX_IK_SOLUTIONS; ++i) {
-        if (valid[i]) {
+        if (valid[i] && in_limits[i]) {
             for (j = 0; j < SCARA_DOF; ++j) {
                 q[SCARA_DOF * count + j] = branches[SCARA_DOF * i + j];
             }

@@ -96,9 +96,13 @@ int scara_velocity_ik(const scara_real q[SCARA_DOF], const scara_real mu_dot[SCA
  * Result: q_start[i], i < 4; q_next[i], i < 4; returned as a scalar. 227 operations. */
 scara_real scara_ik_numeric_step(const scara_real target[SCARA_TASK_DIM], const scara_real q[SCARA_DOF], scara_real damping, scara_real q_start[SCARA_DOF], scara_real q_next[SCARA_DOF]);
 
-/* Every branch of the closed-form ik and whether the target allows it.
- * Result: q: 2 x 4 row-major, element (r, c) at q[r * 4 + c]; valid[i], i < 2. 127 operations. */
-void scara_ik_branches(const scara_real mu[SCARA_TASK_DIM], scara_real q[SCARA_MAX_IK_SOLUTIONS * SCARA_DOF], int valid[SCARA_MAX_IK_SOLUTIONS]);
+/* Every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits.
+ * Result: q: 2 x 4 row-major, element (r, c) at q[r * 4 + c]; valid[i], i < 2; in_limits[i], i < 2. 213 operations. */
+void scara_ik_branches(const scara_real mu[SCARA_TASK_DIM], scara_real q[SCARA_MAX_IK_SOLUTIONS * SCARA_DOF], int valid[SCARA_MAX_IK_SOLUTIONS], int in_limits[SCARA_MAX_IK_SOLUTIONS]);
+
+/* The closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status.
+ * Result: q[i], i < 4; returned as a scalar. 379 operations. */
+int scara_ik_nearest(const scara_real mu[SCARA_TASK_DIM], const scara_real q_seed[SCARA_DOF], const scara_real weights[SCARA_DOF], scara_real q[SCARA_DOF]);
 
 /* Statuses of scara_velocity_ik: OK, singular (a diagonal entry of the QR factor R of the
  * 4 x 4 system at most 1e-12 times its Frobenius norm: take damping > 0), or
@@ -108,12 +112,15 @@ void scara_ik_branches(const scara_real mu[SCARA_TASK_DIM], scara_real q[SCARA_M
 #define SCARA_VELOCITY_IK_SINGULAR 1
 #define SCARA_VELOCITY_IK_NOT_FINITE 2
 
-/* Closed-form inverse kinematics: every joint solution that reaches the target; returns
- * their count k and writes solution i to q[i * SCARA_DOF + j], i < k: the valid
- * rows of scara_ik_branches, in its order. No allocation, no recursion.
+/* Closed-form inverse kinematics: every joint solution inside the joint limits that reaches
+ * the target; returns their count k and writes solution i to q[i * SCARA_DOF + j],
+ * i < k: the rows of scara_ik_branches that are valid and in_limits, in its order
+ * (scara_ik_branches also gives those outside the limits). No allocation, no recursion.
  * target: the task vector (x, y, z, yaw).
- * Result: k <= SCARA_MAX_IK_SOLUTIONS solutions, revolute angles wrapped into (-pi, pi],
- * joint limits not applied; k = 0 when the target is out of reach or not finite.
+ * Result: k <= SCARA_MAX_IK_SOLUTIONS solutions inside the joint limits, revolute angles
+ * wrapped into (-pi, pi] or, where that is outside the limits, their lowest equivalent
+ * inside them; k = 0 when the target is out of reach or not finite. ik_branches also gives
+ * the solutions outside the limits (in_limits 0).
  * Solver: planar arm: revolute axes (and any prismatic axis) parallel to world z; the last
  * revolute joint sets the yaw, the first two place the wrist point (SP3, SP1).
  * Order: nested loops over the branches, outermost first; where a subproblem has two roots
@@ -125,6 +132,12 @@ void scara_ik_branches(const scara_real mu[SCARA_TASK_DIM], scara_real q[SCARA_M
  * angle the target leaves free (a singular wrist or shoulder) is set to 0.
  */
 int scara_ik(const scara_real mu[SCARA_TASK_DIM], scara_real q[SCARA_MAX_IK_SOLUTIONS * SCARA_DOF]);
+
+/* Statuses of scara_ik_nearest: a solution found; no solution inside the limits (out of
+ * reach); the target (its first three rows), q_seed or weights not finite. q = q_seed unless OK. */
+#define SCARA_IK_NEAREST_OK 0
+#define SCARA_IK_NEAREST_NO_SOLUTION 1
+#define SCARA_IK_NEAREST_NOT_FINITE 2
 
 /* ik_numeric status codes. */
 #define SCARA_IK_NUMERIC_CONVERGED 0       /* |error| <= tol */

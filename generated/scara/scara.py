@@ -914,7 +914,7 @@ def ik_numeric_step(target, q, damping=0.0):
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def ik_branches(mu):
-    """every branch of the closed-form ik and whether the target allows it: (2 x 4 and 2 x 1), 127 operations."""
+    """every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits: (2 x 4 and 2 x 1 and 2 x 1), 213 operations."""
     mu = _argument("mu", mu, (4,))
     mu0 = mu[..., 0]
     mu1 = mu[..., 1]
@@ -935,61 +935,267 @@ def ik_branches(mu):
     t12 = numpy.arctan2(t11, t10)
     t13 = numpy.where(t3, 0, 3.141592653589793 + t12)
     t14 = 3.141592653589793 - t12
-    t15 = 0.089375*t4
-    t16 = numpy.where(t3, 1, -t10*t15)
-    t17 = numpy.where(t3, 0, -t11*t15)
-    t18 = 0.325 + 0.275*t16
-    t19 = 0.149769 + t18**2 + 0.075625*t17**2
-    t20 = 0.275*t17
-    t21 = 0.149769 + mu0*t18 + mu1*t20
-    t22 = -0.149769 + t21
-    t23 = mu1*t18 - mu0*t20
-    t24 = t22**2 + t23**2
-    t25 = 0.024578125*t4
-    t26 = 0.325 - t10*t25
-    t27 = 0.149769 + t26**2 + 0.000604084228515625*t6*t11**2
-    t28 = t11*t25
-    t29 = 0.149769 + mu0*t26 + mu1*t28
-    t30 = -0.149769 + t29
-    t31 = mu1*t26 - mu0*t28
-    t32 = t30**2 + t31**2
-    t33 = 1e-24*t0
-    t34 = numpy.where(numpy.less_equal(t24, t19*t33), 0, numpy.arctan2(t23, t22))
-    t35 = -(-0.387 + mu2)
-    t36 = -mu3
-    t37 = -t13 - t34 - t36
-    t38 = numpy.where(numpy.less_equal(t32, t27*t33), 0, numpy.arctan2(t31, t30))
-    t39 = -t14 - t36 - t38
-    t40 = numpy.isfinite(t2)
-    t41 = 1.9314171249999998e-26
-    t42 = numpy.greater(0.007987890625, t41)
+    t15 = t13 - 6.283185307179586*numpy.ceil(-0.5 + 0.15915494309189535*t13)
+    t16 = t15 - 6.283185307179586*numpy.floor(0.24444444444444444 + 0.15915494309189535*t15)
+    t17 = t14 - 6.283185307179586*numpy.ceil(-0.5 + 0.15915494309189535*t14)
+    t18 = t17 - 6.283185307179586*numpy.floor(0.24444444444444444 + 0.15915494309189535*t17)
+    t19 = 0.089375*t4
+    t20 = numpy.where(t3, 1, -t10*t19)
+    t21 = numpy.where(t3, 0, -t11*t19)
+    t22 = 0.325 + 0.275*t20
+    t23 = 0.149769 + t22**2 + 0.075625*t21**2
+    t24 = 0.275*t21
+    t25 = 0.149769 + mu0*t22 + mu1*t24
+    t26 = -0.149769 + t25
+    t27 = mu1*t22 - mu0*t24
+    t28 = t26**2 + t27**2
+    t29 = 0.024578125*t4
+    t30 = 0.325 - t10*t29
+    t31 = 0.149769 + t30**2 + 0.000604084228515625*t6*t11**2
+    t32 = t11*t29
+    t33 = 0.149769 + mu0*t30 + mu1*t32
+    t34 = -0.149769 + t33
+    t35 = mu1*t30 - mu0*t32
+    t36 = t34**2 + t35**2
+    t37 = 1e-24*t0
+    t38 = numpy.where(numpy.less_equal(t28, t23*t37), 0, numpy.arctan2(t27, t26))
+    t39 = t38
+    t40 = t39 - 6.283185307179586*numpy.floor(0.1388888888888889 + 0.15915494309189535*t39)
+    t41 = -mu3
+    t42 = -t13 - t38 - t41
+    t43 = t42 + 6.283185307179586*numpy.ceil(-0.5 - 0.15915494309189535*t42)
+    t44 = -t43
+    t45 = t43 + 6.283185307179586*numpy.floor(1.0 + 0.15915494309189535*t44)
+    t46 = numpy.where(numpy.less_equal(t36, t31*t37), 0, numpy.arctan2(t35, t34))
+    t47 = t46
+    t48 = t47 - 6.283185307179586*numpy.floor(0.1388888888888889 + 0.15915494309189535*t47)
+    t49 = -t14 - t41 - t46
+    t50 = t49 + 6.283185307179586*numpy.ceil(-0.5 - 0.15915494309189535*t49)
+    t51 = -t50
+    t52 = t50 + 6.283185307179586*numpy.floor(1.0 + 0.15915494309189535*t51)
+    t53 = numpy.less_equal(t40, 0.8726646259971648)
+    t54 = (numpy.greater_equal(t39, -0.8726646259971648)) & (numpy.less_equal(t39, 0.8726646259971648))
+    t55 = numpy.less_equal(t16, 1.53588974175501)
+    t56 = (numpy.greater_equal(t15, -1.53588974175501)) & (numpy.less_equal(t15, 1.53588974175501))
+    t57 = -(-0.387 + mu2)
+    t58 = -t45
+    t59 = numpy.less_equal(t48, 0.8726646259971648)
+    t60 = (numpy.greater_equal(t47, -0.8726646259971648)) & (numpy.less_equal(t47, 0.8726646259971648))
+    t61 = numpy.less_equal(t18, 1.53588974175501)
+    t62 = (numpy.greater_equal(t17, -1.53588974175501)) & (numpy.less_equal(t17, 1.53588974175501))
+    t63 = -t52
+    t64 = numpy.isfinite(t2)
+    t65 = 1.9314171249999998e-26
+    t66 = numpy.greater(0.007987890625, t65)
+    t67 = numpy.greater_equal(t57, 0.0)
+    t68 = numpy.less_equal(t57, 0.21)
     q = numpy.empty(mu.shape[:-1] + (2, 4))
-    q[..., 0, 0] = t34
-    q[..., 0, 1] = t13 - 6.283185307179586*numpy.ceil(-0.5 + 0.15915494309189535*t13)
-    q[..., 0, 2] = t35
-    q[..., 0, 3] = -t37 - 6.283185307179586*numpy.ceil(-0.5 - 0.15915494309189535*t37)
-    q[..., 1, 0] = t38
-    q[..., 1, 1] = t14 - 6.283185307179586*numpy.ceil(-0.5 + 0.15915494309189535*t14)
-    q[..., 1, 2] = t35
-    q[..., 1, 3] = -t39 - 6.283185307179586*numpy.ceil(-0.5 - 0.15915494309189535*t39)
+    q[..., 0, 0] = numpy.where(t53 & numpy.logical_not(t54), t40, t39)
+    q[..., 0, 1] = numpy.where(t55 & numpy.logical_not(t56), t16, t15)
+    q[..., 0, 2] = t57
+    q[..., 0, 3] = numpy.where((numpy.greater_equal(t45, -6.283185307179586)) & numpy.logical_not((numpy.greater_equal(t43, -6.283185307179586)) & (numpy.less_equal(t43, 6.283185307179586))), t58, t44)
+    q[..., 1, 0] = numpy.where(t59 & numpy.logical_not(t60), t48, t47)
+    q[..., 1, 1] = numpy.where(t61 & numpy.logical_not(t62), t18, t17)
+    q[..., 1, 2] = t57
+    q[..., 1, 3] = numpy.where((numpy.greater_equal(t52, -6.283185307179586)) & numpy.logical_not((numpy.greater_equal(t50, -6.283185307179586)) & (numpy.less_equal(t50, 6.283185307179586))), t63, t51)
     valid = numpy.empty(mu.shape[:-1] + (2,), dtype=bool)
-    valid[..., 0] = t40 & ((t42 & (numpy.greater_equal(t7, -1e-12))) | ((numpy.less_equal(0.007987890625, t41)) & (numpy.less_equal(t5, 1.931417125e-14))))
-    valid[..., 1] = t40 & t42 & (numpy.greater(t7, 1e-12))
-    return q, valid
+    valid[..., 0] = t64 & ((t66 & (numpy.greater_equal(t7, -1e-12))) | ((numpy.less_equal(0.007987890625, t65)) & (numpy.less_equal(t5, 1.931417125e-14))))
+    valid[..., 1] = t64 & t66 & (numpy.greater(t7, 1e-12))
+    in_limits = numpy.empty(mu.shape[:-1] + (2,), dtype=bool)
+    in_limits[..., 0] = t67 & t68 & (t53 | t54) & (t55 | t56) & ((numpy.less_equal(t58, 6.283185307179586)) | ((numpy.greater_equal(t44, -6.283185307179586)) & (numpy.less_equal(t44, 6.283185307179586))))
+    in_limits[..., 1] = t67 & t68 & (t59 | t60) & (t61 | t62) & ((numpy.less_equal(t63, 6.283185307179586)) | ((numpy.greater_equal(t51, -6.283185307179586)) & (numpy.less_equal(t51, 6.283185307179586))))
+    return q, valid, in_limits
+
+
+@numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
+def ik_nearest(mu, q_seed, weights=(1.0,) * DOF):
+    """the closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status: (4 x 1 and 1 x 1), 379 operations."""
+    mu = _argument("mu", mu, (4,))
+    q_seed = _argument("q_seed", q_seed, (4,))
+    weights = _argument("weights", weights, (4,))
+    mu0 = mu[..., 0]
+    mu1 = mu[..., 1]
+    mu2 = mu[..., 2]
+    mu3 = mu[..., 3]
+    qn1 = q_seed[..., 0]
+    qn2 = q_seed[..., 1]
+    qn3 = q_seed[..., 2]
+    qn4 = q_seed[..., 3]
+    qw1 = weights[..., 0]
+    qw2 = weights[..., 1]
+    qw3 = weights[..., 2]
+    qw4 = weights[..., 3]
+    t0 = 0.149769 + mu0**2 + mu1**2
+    t1 = 0.1655095 - 0.5*t0
+    t2 = -0.387 + mu2
+    t3 = False
+    t4 = numpy.where(t3, 1, 11.188811188811188)
+    t5 = t1**2
+    t6 = t4**2
+    t7 = 1 - t5*t6
+    t8 = t1*t4
+    t9 = numpy.less(1e-12, t7)
+    t10 = numpy.where(t9, t8, numpy.where(numpy.greater(t8, 0), 1, -1))
+    t11 = numpy.where(t9, numpy.sqrt(t7), 0)
+    t12 = numpy.arctan2(t11, t10)
+    t13 = numpy.where(t3, 0, 3.141592653589793 + t12)
+    t14 = 3.141592653589793 - t12
+    t15 = t13 - 6.283185307179586*numpy.ceil(-0.5 + 0.15915494309189535*t13)
+    t16 = t15 - 6.283185307179586*numpy.floor(0.24444444444444444 + 0.15915494309189535*t15)
+    t17 = t14 - 6.283185307179586*numpy.ceil(-0.5 + 0.15915494309189535*t14)
+    t18 = t17 - 6.283185307179586*numpy.floor(0.24444444444444444 + 0.15915494309189535*t17)
+    t19 = 0.089375*t4
+    t20 = numpy.where(t3, 1, -t10*t19)
+    t21 = numpy.where(t3, 0, -t11*t19)
+    t22 = 0.325 + 0.275*t20
+    t23 = 0.149769 + t22**2 + 0.075625*t21**2
+    t24 = 0.275*t21
+    t25 = 0.149769 + mu0*t22 + mu1*t24
+    t26 = -0.149769 + t25
+    t27 = mu1*t22 - mu0*t24
+    t28 = t26**2 + t27**2
+    t29 = 0.024578125*t4
+    t30 = 0.325 - t10*t29
+    t31 = 0.149769 + t30**2 + 0.000604084228515625*t6*t11**2
+    t32 = t11*t29
+    t33 = 0.149769 + mu0*t30 + mu1*t32
+    t34 = -0.149769 + t33
+    t35 = mu1*t30 - mu0*t32
+    t36 = t34**2 + t35**2
+    t37 = mu0 + mu1 + mu2 + mu3
+    t38 = t37
+    t39 = qn1 + qn2 + qn3 + qn4 + qw1 + qw2 + qw3 + qw4 + t37
+    t40 = 1e-24*t0
+    t41 = numpy.where(numpy.less_equal(t28, t23*t40), 0, numpy.arctan2(t27, t26))
+    t42 = t41
+    t43 = t42 - 6.283185307179586*numpy.floor(0.1388888888888889 + 0.15915494309189535*t42)
+    t44 = -mu3
+    t45 = -t13 - t41 - t44
+    t46 = t45 + 6.283185307179586*numpy.ceil(-0.5 - 0.15915494309189535*t45)
+    t47 = -t46
+    t48 = t46 + 6.283185307179586*numpy.floor(1.0 + 0.15915494309189535*t47)
+    t49 = numpy.where(numpy.less_equal(t36, t31*t40), 0, numpy.arctan2(t35, t34))
+    t50 = t49
+    t51 = t50 - 6.283185307179586*numpy.floor(0.1388888888888889 + 0.15915494309189535*t50)
+    t52 = -t14 - t44 - t49
+    t53 = t52 + 6.283185307179586*numpy.ceil(-0.5 - 0.15915494309189535*t52)
+    t54 = -t53
+    t55 = t53 + 6.283185307179586*numpy.floor(1.0 + 0.15915494309189535*t54)
+    t56 = numpy.less_equal(t43, 0.8726646259971648)
+    t57 = (numpy.greater_equal(t42, -0.8726646259971648)) & (numpy.less_equal(t42, 0.8726646259971648))
+    t58 = numpy.where(t56 & numpy.logical_not(t57), t43, t42)
+    t59 = t58
+    t60 = t59 + 6.283185307179586*numpy.floor(0.5 + 0.15915494309189535*qn1 - 0.15915494309189535*t59)
+    t61 = numpy.where(numpy.greater(qn1, t60), 6.283185307179586, -6.283185307179586)
+    t62 = t60 + t61
+    t63 = t60 - t61
+    t64 = numpy.where((numpy.greater_equal(t60, -0.8726646259971648)) & (numpy.less_equal(t60, 0.8726646259971648)), t60, numpy.where((numpy.greater_equal(t62, -0.8726646259971648)) & (numpy.less_equal(t62, 0.8726646259971648)), t62, numpy.where((numpy.greater_equal(t63, -0.8726646259971648)) & (numpy.less_equal(t63, 0.8726646259971648)), t63, t58)))
+    t65 = numpy.less_equal(t16, 1.53588974175501)
+    t66 = (numpy.greater_equal(t15, -1.53588974175501)) & (numpy.less_equal(t15, 1.53588974175501))
+    t67 = numpy.where(t65 & numpy.logical_not(t66), t16, t15)
+    t68 = t67
+    t69 = t68 + 6.283185307179586*numpy.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t68)
+    t70 = numpy.where(numpy.greater(qn2, t69), 6.283185307179586, -6.283185307179586)
+    t71 = t69 + t70
+    t72 = t69 - t70
+    t73 = numpy.where((numpy.greater_equal(t69, -1.53588974175501)) & (numpy.less_equal(t69, 1.53588974175501)), t69, numpy.where((numpy.greater_equal(t71, -1.53588974175501)) & (numpy.less_equal(t71, 1.53588974175501)), t71, numpy.where((numpy.greater_equal(t72, -1.53588974175501)) & (numpy.less_equal(t72, 1.53588974175501)), t72, t67)))
+    t74 = numpy.greater_equal(t48, -6.283185307179586)
+    t75 = (numpy.greater_equal(t46, -6.283185307179586)) & (numpy.less_equal(t46, 6.283185307179586))
+    t76 = numpy.where(t74 & numpy.logical_not(t75), -t48, t47)
+    t77 = t76
+    t78 = t77 + 6.283185307179586*numpy.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t77)
+    t79 = numpy.where(numpy.greater(qn4, t78), 6.283185307179586, -6.283185307179586)
+    t80 = t78 + t79
+    t81 = t78 - t79
+    t82 = numpy.where((numpy.greater_equal(t78, -6.283185307179586)) & (numpy.less_equal(t78, 6.283185307179586)), t78, numpy.where((numpy.greater_equal(t80, -6.283185307179586)) & (numpy.less_equal(t80, 6.283185307179586)), t80, numpy.where((numpy.greater_equal(t81, -6.283185307179586)) & (numpy.less_equal(t81, 6.283185307179586)), t81, t76)))
+    t83 = -qn1
+    t84 = -qn2
+    t85 = -qn4
+    t86 = qw3*(qn3 + t2)**2
+    t87 = t86 + qw1*(t64 + t83)**2 + qw2*(t73 + t84)**2 + qw4*(t82 + t85)**2
+    t88 = numpy.isfinite(t38)
+    t89 = numpy.greater_equal(mu2, 0.17700000000000002)
+    t90 = numpy.less_equal(mu2, 0.387)
+    t91 = True
+    t92 = numpy.where(t88 & t89 & t90 & (t56 | t57) & (t65 | t66) & (t74 | t75) & ((t91 & (numpy.greater_equal(t7, -1e-12))) | (t3 & (numpy.less_equal(51.775454771324966*t5, 1e-12)))), 1, 0)
+    t93 = numpy.where(numpy.greater(t92, 0), 1, 0)
+    t94 = numpy.greater(t93, 0)
+    t95 = numpy.where(t94, t64, qn1)
+    t96 = numpy.where(t94, t73, qn2)
+    t97 = numpy.where(t94, t82, qn4)
+    t98 = numpy.where(t94, t87, 0)
+    t99 = -t2
+    t100 = numpy.where(t94, t99, qn3)
+    t101 = numpy.less_equal(t51, 0.8726646259971648)
+    t102 = (numpy.greater_equal(t50, -0.8726646259971648)) & (numpy.less_equal(t50, 0.8726646259971648))
+    t103 = numpy.where(t101 & numpy.logical_not(t102), t51, t50)
+    t104 = t103
+    t105 = t104 + 6.283185307179586*numpy.floor(0.5 + 0.15915494309189535*qn1 - 0.15915494309189535*t104)
+    t106 = numpy.where(numpy.greater(qn1, t105), 6.283185307179586, -6.283185307179586)
+    t107 = t105 + t106
+    t108 = t105 - t106
+    t109 = numpy.where((numpy.greater_equal(t105, -0.8726646259971648)) & (numpy.less_equal(t105, 0.8726646259971648)), t105, numpy.where((numpy.greater_equal(t107, -0.8726646259971648)) & (numpy.less_equal(t107, 0.8726646259971648)), t107, numpy.where((numpy.greater_equal(t108, -0.8726646259971648)) & (numpy.less_equal(t108, 0.8726646259971648)), t108, t103)))
+    t110 = numpy.less_equal(t18, 1.53588974175501)
+    t111 = (numpy.greater_equal(t17, -1.53588974175501)) & (numpy.less_equal(t17, 1.53588974175501))
+    t112 = numpy.where(t110 & numpy.logical_not(t111), t18, t17)
+    t113 = t112
+    t114 = t113 + 6.283185307179586*numpy.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t113)
+    t115 = numpy.where(numpy.greater(qn2, t114), 6.283185307179586, -6.283185307179586)
+    t116 = t114 + t115
+    t117 = t114 - t115
+    t118 = numpy.where((numpy.greater_equal(t114, -1.53588974175501)) & (numpy.less_equal(t114, 1.53588974175501)), t114, numpy.where((numpy.greater_equal(t116, -1.53588974175501)) & (numpy.less_equal(t116, 1.53588974175501)), t116, numpy.where((numpy.greater_equal(t117, -1.53588974175501)) & (numpy.less_equal(t117, 1.53588974175501)), t117, t112)))
+    t119 = numpy.greater_equal(t55, -6.283185307179586)
+    t120 = (numpy.greater_equal(t53, -6.283185307179586)) & (numpy.less_equal(t53, 6.283185307179586))
+    t121 = numpy.where(t88 & t89 & t9 & t90 & t91 & (t101 | t102) & (t110 | t111) & (t119 | t120), 1, 0)
+    t122 = numpy.where(t119 & numpy.logical_not(t120), -t55, t54)
+    t123 = t122
+    t124 = t123 + 6.283185307179586*numpy.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t123)
+    t125 = numpy.where(numpy.greater(qn4, t124), 6.283185307179586, -6.283185307179586)
+    t126 = t124 + t125
+    t127 = t124 - t125
+    t128 = numpy.where((numpy.greater_equal(t124, -6.283185307179586)) & (numpy.less_equal(t124, 6.283185307179586)), t124, numpy.where((numpy.greater_equal(t126, -6.283185307179586)) & (numpy.less_equal(t126, 6.283185307179586)), t126, numpy.where((numpy.greater_equal(t127, -6.283185307179586)) & (numpy.less_equal(t127, 6.283185307179586)), t127, t122)))
+    t129 = t86 + qw1*(t109 + t83)**2 + qw2*(t118 + t84)**2 + qw4*(t128 + t85)**2
+    t130 = numpy.greater(t121, 0)
+    t131 = numpy.where(t130 & ((numpy.less(t129, t98)) | (numpy.less(t93, 1))), 1, 0)
+    t132 = numpy.where(t130, 1, t93)
+    t133 = numpy.greater(t131, 0)
+    t134 = numpy.where(t133, t109, t95)
+    t135 = numpy.where(t133, t118, t96)
+    t136 = numpy.where(t133, t99, t100)
+    t137 = numpy.where(t133, t128, t97)
+    t138 = numpy.isfinite(t39)
+    t139 = numpy.greater(t132, 0)
+    t140 = t138 & t139
+    q = numpy.empty(numpy.broadcast_shapes(mu.shape[:-1], q_seed.shape[:-1], weights.shape[:-1]) + (4,))
+    q[..., 0] = numpy.where(t140, t134, qn1)
+    q[..., 1] = numpy.where(t140, t135, qn2)
+    q[..., 2] = numpy.where(t140, t136, qn3)
+    q[..., 3] = numpy.where(t140, t137, qn4)
+    status = numpy.empty(numpy.broadcast_shapes(mu.shape[:-1], q_seed.shape[:-1], weights.shape[:-1]) + (), dtype=int)
+    status[...] = numpy.where(numpy.logical_not(t138), 2, numpy.where(t139, 0, 1))
+    return q, status
 
 
 MAX_IK_SOLUTIONS = 2
+# Statuses of ik_nearest: a solution found; no solution inside the limits (out of reach); the
+# target (its first three rows), q_seed or weights not finite. q = q_seed unless OK.
+IK_NEAREST_OK = 0
+IK_NEAREST_NO_SOLUTION = 1
+IK_NEAREST_NOT_FINITE = 2
 
 
-def ik(mu):
-    """Closed-form inverse kinematics: every joint solution that reaches the target.
+def ik(mu, limits=True):
+    """Closed-form inverse kinematics: every joint solution that reaches the target, inside
+    the joint limits unless `limits` is False.
 
-    One target: the solutions as (k, DOF), the valid rows of ik_branches in its order.
-    A batch of targets: ik_branches' (q, valid), (..., MAX_IK_SOLUTIONS, DOF) and
-    (..., MAX_IK_SOLUTIONS).
+    One target: the solutions as (k, DOF), the rows of ik_branches that are valid (and
+    in_limits), in its order. A batch of targets: (q, keep), (..., MAX_IK_SOLUTIONS, DOF)
+    and (..., MAX_IK_SOLUTIONS).
     target: the task vector (x, y, z, yaw).
-    Result: k <= MAX_IK_SOLUTIONS solutions, revolute angles wrapped into (-pi, pi], joint
-    limits not applied; k = 0 when the target is out of reach or not finite.
+    Result: k <= MAX_IK_SOLUTIONS solutions inside the joint limits, revolute angles wrapped
+    into (-pi, pi] or, where that is outside the limits, their lowest equivalent inside
+    them; k = 0 when the target is out of reach or not finite. ik_branches also gives the
+    solutions outside the limits (in_limits 0).
     Solver: planar arm: revolute axes (and any prismatic axis) parallel to world z; the last
     revolute joint sets the yaw, the first two place the wrist point (SP3, SP1).
     Order: nested loops over the branches, outermost first; where a subproblem has two roots
@@ -1000,8 +1206,9 @@ def ik(mu):
     root (a target on a singularity or on the workspace boundary) is returned once, and an
     angle the target leaves free (a singular wrist or shoulder) is set to 0.
     """
-    q, valid = ik_branches(mu)
-    return q[valid] if valid.ndim == 1 else (q, valid)
+    q, valid, in_limits = ik_branches(mu)
+    keep = valid & in_limits if limits else valid
+    return q[keep] if keep.ndim == 1 else (q, keep)
 
 
 # -- Iterative inverse kinematics: the loop around ik_numeric_step --

@@ -98,9 +98,13 @@ int stanford_velocity_ik(const stanford_real q[STANFORD_DOF], const stanford_rea
  * Result: q_start[i], i < 6; q_next[i], i < 6; returned as a scalar. 876 operations. */
 stanford_real stanford_ik_numeric_step(const stanford_real target[16], const stanford_real q[STANFORD_DOF], stanford_real damping, stanford_real q_start[STANFORD_DOF], stanford_real q_next[STANFORD_DOF]);
 
-/* Every branch of the closed-form ik and whether the target allows it.
- * Result: q: 8 x 6 row-major, element (r, c) at q[r * 6 + c]; valid[i], i < 8. 646 operations. */
-void stanford_ik_branches(const stanford_real T[16], stanford_real q[STANFORD_MAX_IK_SOLUTIONS * STANFORD_DOF], int valid[STANFORD_MAX_IK_SOLUTIONS]);
+/* Every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits.
+ * Result: q: 8 x 6 row-major, element (r, c) at q[r * 6 + c]; valid[i], i < 8; in_limits[i], i < 8. 1056 operations. */
+void stanford_ik_branches(const stanford_real T[16], stanford_real q[STANFORD_MAX_IK_SOLUTIONS * STANFORD_DOF], int valid[STANFORD_MAX_IK_SOLUTIONS], int in_limits[STANFORD_MAX_IK_SOLUTIONS]);
+
+/* The closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status.
+ * Result: q[i], i < 6; returned as a scalar. 1859 operations. */
+int stanford_ik_nearest(const stanford_real T[16], const stanford_real q_seed[STANFORD_DOF], const stanford_real weights[STANFORD_DOF], stanford_real q[STANFORD_DOF]);
 
 /* Statuses of stanford_velocity_ik: OK, singular (a diagonal entry of the QR factor R of the
  * 6 x 6 system at most 1e-12 times its Frobenius norm: take damping > 0), or
@@ -110,12 +114,15 @@ void stanford_ik_branches(const stanford_real T[16], stanford_real q[STANFORD_MA
 #define STANFORD_VELOCITY_IK_SINGULAR 1
 #define STANFORD_VELOCITY_IK_NOT_FINITE 2
 
-/* Closed-form inverse kinematics: every joint solution that reaches the target; returns
- * their count k and writes solution i to q[i * STANFORD_DOF + j], i < k: the valid
- * rows of stanford_ik_branches, in its order. No allocation, no recursion.
+/* Closed-form inverse kinematics: every joint solution inside the joint limits that reaches
+ * the target; returns their count k and writes solution i to q[i * STANFORD_DOF + j],
+ * i < k: the rows of stanford_ik_branches that are valid and in_limits, in its order
+ * (stanford_ik_branches also gives those outside the limits). No allocation, no recursion.
  * target: the 4x4 tool pose in the world frame (rotation part orthonormal).
- * Result: k <= STANFORD_MAX_IK_SOLUTIONS solutions, revolute angles wrapped into (-pi,
- * pi], joint limits not applied; k = 0 when the target is out of reach or not finite.
+ * Result: k <= STANFORD_MAX_IK_SOLUTIONS solutions inside the joint limits, revolute
+ * angles wrapped into (-pi, pi] or, where that is outside the limits, their lowest
+ * equivalent inside them; k = 0 when the target is out of reach or not finite. ik_branches
+ * also gives the solutions outside the limits (in_limits 0).
  * Solver: RRP + spherical wrist (Stanford arm): wrist centre, the prismatic joint 3 from
  * the distance to the shoulder point (quadratic), base and shoulder (SP2), then the wrist
  * orientation (SP2, SP1).
@@ -129,6 +136,12 @@ void stanford_ik_branches(const stanford_real T[16], stanford_real q[STANFORD_MA
  * angle the target leaves free (a singular wrist or shoulder) is set to 0.
  */
 int stanford_ik(const stanford_real T[16], stanford_real q[STANFORD_MAX_IK_SOLUTIONS * STANFORD_DOF]);
+
+/* Statuses of stanford_ik_nearest: a solution found; no solution inside the limits (out of
+ * reach); the target (its first three rows), q_seed or weights not finite. q = q_seed unless OK. */
+#define STANFORD_IK_NEAREST_OK 0
+#define STANFORD_IK_NEAREST_NO_SOLUTION 1
+#define STANFORD_IK_NEAREST_NOT_FINITE 2
 
 /* ik_numeric status codes. */
 #define STANFORD_IK_NUMERIC_CONVERGED 0       /* |error| <= tol */

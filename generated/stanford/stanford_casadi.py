@@ -5,7 +5,8 @@ Stanford arm RRPRRR (rtb Stanford), standard DH
 Every function takes `q` (6 x 1: radians for revolute joints, m for
 prismatic ones) and returns a rows x cols result whose zeros are structural; ik_branches
 (also named ik) takes the target instead of q and returns every branch (MAX_IK_SOLUTIONS x
-DOF) and its validity (MAX_IK_SOLUTIONS x 1, 1 or 0).
+DOF), its validity and whether it is inside the joint limits (MAX_IK_SOLUTIONS x 1 each, 1
+or 0); ik_nearest takes the target and q_seed and returns the solution nearest q_seed.
 Task vector: (x, y, z, roll, pitch, yaw).
 """
 
@@ -1691,7 +1692,7 @@ def _ik_numeric_step(target, q, damping):
 
 
 def _ik_branches(T):
-    """Every branch of the closed-form ik and whether the target allows it: 646 operations."""
+    """Every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits: 1056 operations."""
     T00 = T[0, 0]
     T01 = T[0, 1]
     T02 = T[0, 2]
@@ -1759,293 +1760,1209 @@ def _ik_branches(T):
     t52 = T12*t49 - T02*t50
     t53 = T00*t49 + T10*t50
     t54 = T10*t49 - T00*t50
-    t55 = t13*t21
-    t56 = 0.01787569 + t55
-    t57 = -0.01787569 + t56
-    t58 = 0.01787569 - t55
+    t55 = casadi.if_else(t47, 0, casadi.atan2(-t39, t35))
+    t56 = t55 - 6.283185307179586*casadi.floor(0.4722222222222222 + 0.15915494309189535*t55)
+    t57 = t13*t21
+    t58 = 0.01787569 + t57
     t59 = -0.01787569 + t58
-    t60 = t22*t43
-    t61 = t60 + t57**2
-    t62 = t60 + t59**2
-    t63 = t23*t45
-    t64 = (t61 <= t63)
-    t65 = casadi.if_else(t64, 1, 1/casadi.sqrt(t61))
-    t66 = casadi.if_else(t64, 1, t57*t65)
-    t67 = t21*t29
-    t68 = t65*t67
-    t69 = casadi.if_else(t64, 0, -t68)
-    t70 = casadi.if_else(t64, 0, t68)
-    t71 = (t42 <= t46)
-    t72 = casadi.if_else(t71, 1, 1/casadi.sqrt(t42))
-    t73 = casadi.if_else(t71, 1, t36*t72)
-    t74 = casadi.if_else(t71, 0, t41*t72)
-    t75 = T02*t73 + T12*t74
-    t76 = T12*t73 - T02*t74
-    t77 = T00*t73 + T10*t74
-    t78 = T10*t73 - T00*t74
-    t79 = 1 - t49
-    t80 = T22*t79
-    t81 = t80 + T22*t49
-    t82 = T20*t79
-    t83 = t82 + T20*t49
-    t84 = t51*t66 - t69*t81
-    t85 = t51*t69 + t66*t81
-    t86 = t53*t66 - t69*t83
-    t87 = t53*t69 + t66*t83
-    t88 = 1 - t66
-    t89 = t52*t88
-    t90 = t89 + t52*t66
-    t91 = t54*t88
-    t92 = t91 + t54*t66
-    t93 = t76*t88
-    t94 = t93 + t66*t76
-    t95 = t78*t88
-    t96 = t95 + t66*t78
-    t97 = t85**2
-    t98 = -t97
-    t99 = 1 + t98
-    t100 = casadi.if_else((t99 > 1e-12), casadi.sqrt(t99), 0)
-    t101 = t97 + t100*t90
-    t102 = t101 + t98
-    t103 = t84**2
-    t104 = t103 + t97 + t90**2
-    t105 = t100**2
-    t106 = t102**2 + t103*t105
-    t107 = t105 + t97
-    t108 = 1e-24*t107
-    t109 = (t106 <= t104*t108)
-    t110 = casadi.if_else(t109, 1, 1/casadi.sqrt(t106))
-    t111 = casadi.if_else(t109, 1, t102*t110)
-    t112 = t87*(1 - t111)
-    t113 = t112 + t111*t87
-    t114 = t100*t84
-    t115 = casadi.if_else(t109, 0, -t110*t114)
-    t116 = t111*t86 + t115*t92
-    t117 = t111*t92 - t115*t86
-    t118 = (t107 <= t108)
-    t119 = casadi.if_else(t118, 1, 1/casadi.sqrt(t107))
-    t120 = casadi.if_else(t118, 1, t119*t85)
-    t121 = casadi.if_else(t118, 0, -t100*t119)
-    t122 = t116*(1 - t120)
-    t123 = t122 + t116*t120
-    t124 = t113*t121 + t117*t120
-    t125 = t113*t120 - t117*t121
-    t126 = t123**2 + t124**2
-    t127 = t126
-    t128 = t126 + t125**2
-    t129 = 1 - t73
-    t130 = T22*t129
-    t131 = t130 + T22*t73
-    t132 = T20*t129
-    t133 = t132 + T20*t73
-    t134 = t66*t75 - t131*t70
-    t135 = t131*t66 + t70*t75
-    t136 = t66*t77 - t133*t70
-    t137 = t133*t66 + t70*t77
-    t138 = t135**2
-    t139 = -t138
-    t140 = 1 + t139
-    t141 = casadi.if_else((t140 > 1e-12), casadi.sqrt(t140), 0)
-    t142 = t138 + t141*t94
-    t143 = t139 + t142
-    t144 = t134**2
-    t145 = t138 + t144 + t94**2
-    t146 = t141**2
-    t147 = t143**2 + t144*t146
-    t148 = t138 + t146
-    t149 = 1e-24*t148
-    t150 = (t147 <= t145*t149)
-    t151 = casadi.if_else(t150, 1, 1/casadi.sqrt(t147))
-    t152 = casadi.if_else(t150, 1, t143*t151)
-    t153 = t137*(1 - t152)
-    t154 = t153 + t137*t152
-    t155 = t134*t141
-    t156 = casadi.if_else(t150, 0, -t151*t155)
-    t157 = t136*t152 + t156*t96
-    t158 = t152*t96 - t136*t156
-    t159 = (t148 <= t149)
-    t160 = casadi.if_else(t159, 1, 1/casadi.sqrt(t148))
-    t161 = casadi.if_else(t159, 1, t135*t160)
-    t162 = casadi.if_else(t159, 0, -t141*t160)
-    t163 = t157*(1 - t161)
-    t164 = t163 + t157*t161
-    t165 = t154*t162 + t158*t161
-    t166 = t154*t161 - t158*t162
-    t167 = t164**2 + t165**2
-    t168 = t167
-    t169 = t167 + t166**2
-    t170 = (t62 <= t63)
-    t171 = casadi.if_else(t170, 1, 1/casadi.sqrt(t62))
-    t172 = casadi.if_else(t170, 1, t171*t59)
-    t173 = t171*t67
-    t174 = casadi.if_else(t170, 0, t173)
-    t175 = casadi.if_else(t170, 0, -t173)
-    t176 = t172*t51 - t174*t81
-    t177 = t172*t81 + t174*t51
-    t178 = t172*t53 - t174*t83
-    t179 = t172*t83 + t174*t53
-    t180 = t172*t75 - t131*t175
-    t181 = t131*t172 + t175*t75
-    t182 = t172*t77 - t133*t175
-    t183 = t133*t172 + t175*t77
-    t184 = 1 - t172
-    t185 = t184*t52
-    t186 = t185 + t172*t52
-    t187 = t184*t54
-    t188 = t187 + t172*t54
-    t189 = t184*t76
-    t190 = t189 + t172*t76
-    t191 = t184*t78
-    t192 = t191 + t172*t78
-    t193 = t177**2
-    t194 = -t193
-    t195 = 1 + t194
-    t196 = casadi.if_else((t195 > 1e-12), casadi.sqrt(t195), 0)
-    t197 = t193 + t186*t196
-    t198 = t194 + t197
-    t199 = t176**2
-    t200 = t193 + t199 + t186**2
-    t201 = t196**2
-    t202 = t198**2 + t199*t201
-    t203 = t193 + t201
-    t204 = 1e-24*t203
-    t205 = (t202 <= t200*t204)
-    t206 = casadi.if_else(t205, 1, 1/casadi.sqrt(t202))
-    t207 = casadi.if_else(t205, 1, t198*t206)
-    t208 = t179*(1 - t207)
-    t209 = t208 + t179*t207
-    t210 = t176*t196
-    t211 = casadi.if_else(t205, 0, -t206*t210)
-    t212 = t178*t207 + t188*t211
-    t213 = t188*t207 - t178*t211
-    t214 = (t203 <= t204)
-    t215 = casadi.if_else(t214, 1, 1/casadi.sqrt(t203))
-    t216 = casadi.if_else(t214, 1, t177*t215)
-    t217 = casadi.if_else(t214, 0, -t196*t215)
-    t218 = t212*(1 - t216)
-    t219 = t218 + t212*t216
-    t220 = t209*t217 + t213*t216
-    t221 = t209*t216 - t213*t217
-    t222 = t219**2 + t220**2
-    t223 = t222
-    t224 = t222 + t221**2
-    t225 = t181**2
-    t226 = -t225
-    t227 = 1 + t226
-    t228 = casadi.if_else((t227 > 1e-12), casadi.sqrt(t227), 0)
-    t229 = t225 + t190*t228
-    t230 = t226 + t229
-    t231 = t180**2
-    t232 = t225 + t231 + t190**2
-    t233 = t228**2
-    t234 = t230**2 + t231*t233
-    t235 = t225 + t233
-    t236 = 1e-24*t235
-    t237 = (t234 <= t232*t236)
-    t238 = casadi.if_else(t237, 1, 1/casadi.sqrt(t234))
-    t239 = casadi.if_else(t237, 1, t230*t238)
-    t240 = t183*(1 - t239)
-    t241 = t240 + t183*t239
-    t242 = t180*t228
-    t243 = casadi.if_else(t237, 0, -t238*t242)
-    t244 = t182*t239 + t192*t243
-    t245 = t192*t239 - t182*t243
-    t246 = (t235 <= t236)
-    t247 = casadi.if_else(t246, 1, 1/casadi.sqrt(t235))
-    t248 = casadi.if_else(t246, 1, t181*t247)
-    t249 = casadi.if_else(t246, 0, -t228*t247)
-    t250 = t244*(1 - t248)
-    t251 = t250 + t244*t248
-    t252 = t241*t249 + t245*t248
-    t253 = t241*t248 - t245*t249
-    t254 = t251**2 + t252**2
-    t255 = t254
-    t256 = t254 + t253**2
-    t257 = casadi.if_else(t47, 0, casadi.atan2(-t39, t35))
-    t258 = -t67
-    t259 = casadi.if_else(t64, 0, casadi.atan2(t258, t57))
-    t260 = casadi.if_else(t109, 0, casadi.atan2(-t114, t102))
-    t261 = casadi.if_else(t118, 0, casadi.atan2(-t100, t85))
-    t262 = casadi.if_else((t127 <= 1e-24*t128), 0, casadi.atan2(t123, -t124))
-    t263 = casadi.if_else(t71, 0, casadi.atan2(t41, t36))
-    t264 = casadi.if_else(t64, 0, casadi.atan2(t67, t57))
-    t265 = casadi.if_else(t150, 0, casadi.atan2(-t155, t143))
-    t266 = casadi.if_else(t159, 0, casadi.atan2(-t141, t135))
-    t267 = casadi.if_else((t168 <= 1e-24*t169), 0, casadi.atan2(t164, -t165))
-    t268 = casadi.if_else(t170, 0, casadi.atan2(t67, t59))
-    t269 = -t21
-    t270 = casadi.if_else(t205, 0, casadi.atan2(-t210, t198))
-    t271 = casadi.if_else(t214, 0, casadi.atan2(-t196, t177))
-    t272 = casadi.if_else((t223 <= 1e-24*t224), 0, casadi.atan2(t219, -t220))
-    t273 = casadi.if_else(t170, 0, casadi.atan2(t258, t59))
-    t274 = casadi.if_else(t237, 0, casadi.atan2(-t242, t230))
-    t275 = casadi.if_else(t246, 0, casadi.atan2(-t228, t181))
-    t276 = casadi.if_else((t255 <= 1e-24*t256), 0, casadi.atan2(t251, -t252))
-    t277 = (casadi.fabs(t0) < casadi.inf)
-    t278 = -1e-12
-    t279 = (t18 >= t20)
-    t280 = (t26 >= t28)
-    t281 = (t26 > t27)
-    t282 = (t18 > t19)
+    t60 = 0.01787569 - t57
+    t61 = -0.01787569 + t60
+    t62 = t22*t43
+    t63 = t62 + t59**2
+    t64 = t62 + t61**2
+    t65 = t23*t45
+    t66 = (t63 <= t65)
+    t67 = casadi.if_else(t66, 1, 1/casadi.sqrt(t63))
+    t68 = casadi.if_else(t66, 1, t59*t67)
+    t69 = t21*t29
+    t70 = casadi.if_else(t66, 0, casadi.atan2(t69, t59))
+    t71 = t70 - 6.283185307179586*casadi.floor(0.4722222222222222 + 0.15915494309189535*t70)
+    t72 = t67*t69
+    t73 = casadi.if_else(t66, 0, -t72)
+    t74 = casadi.if_else(t66, 0, t72)
+    t75 = (t42 <= t46)
+    t76 = casadi.if_else(t75, 1, 1/casadi.sqrt(t42))
+    t77 = casadi.if_else(t75, 1, t36*t76)
+    t78 = casadi.if_else(t75, 0, t41*t76)
+    t79 = T02*t77 + T12*t78
+    t80 = T12*t77 - T02*t78
+    t81 = T00*t77 + T10*t78
+    t82 = T10*t77 - T00*t78
+    t83 = casadi.if_else(t75, 0, casadi.atan2(t41, t36))
+    t84 = t83 - 6.283185307179586*casadi.floor(0.4722222222222222 + 0.15915494309189535*t83)
+    t85 = 1 - t49
+    t86 = T22*t85
+    t87 = t86 + T22*t49
+    t88 = T20*t85
+    t89 = t88 + T20*t49
+    t90 = t51*t68 - t73*t87
+    t91 = t51*t73 + t68*t87
+    t92 = t53*t68 - t73*t89
+    t93 = t53*t73 + t68*t89
+    t94 = 1 - t68
+    t95 = t52*t94
+    t96 = t95 + t52*t68
+    t97 = t54*t94
+    t98 = t97 + t54*t68
+    t99 = t80*t94
+    t100 = t99 + t68*t80
+    t101 = t82*t94
+    t102 = t101 + t68*t82
+    t103 = t91**2
+    t104 = -t103
+    t105 = 1 + t104
+    t106 = casadi.if_else((t105 > 1e-12), casadi.sqrt(t105), 0)
+    t107 = t103 + t106*t96
+    t108 = t104 + t107
+    t109 = t90**2
+    t110 = t103 + t109 + t96**2
+    t111 = t106**2
+    t112 = t108**2 + t109*t111
+    t113 = t103 + t111
+    t114 = 1e-24*t113
+    t115 = (t112 <= t110*t114)
+    t116 = casadi.if_else(t115, 1, 1/casadi.sqrt(t112))
+    t117 = casadi.if_else(t115, 1, t108*t116)
+    t118 = t93*(1 - t117)
+    t119 = t118 + t117*t93
+    t120 = t106*t90
+    t121 = casadi.if_else(t115, 0, -t116*t120)
+    t122 = t117*t92 + t121*t98
+    t123 = t117*t98 - t121*t92
+    t124 = (t113 <= t114)
+    t125 = casadi.if_else(t124, 1, 1/casadi.sqrt(t113))
+    t126 = casadi.if_else(t124, 1, t125*t91)
+    t127 = casadi.if_else(t124, 0, -t106*t125)
+    t128 = t122*(1 - t126)
+    t129 = t128 + t122*t126
+    t130 = t119*t127 + t123*t126
+    t131 = t119*t126 - t123*t127
+    t132 = t129**2 + t130**2
+    t133 = t132
+    t134 = t132 + t131**2
+    t135 = 1 - t77
+    t136 = T22*t135
+    t137 = t136 + T22*t77
+    t138 = T20*t135
+    t139 = t138 + T20*t77
+    t140 = t68*t79 - t137*t74
+    t141 = t137*t68 + t74*t79
+    t142 = t68*t81 - t139*t74
+    t143 = t139*t68 + t74*t81
+    t144 = t141**2
+    t145 = -t144
+    t146 = 1 + t145
+    t147 = casadi.if_else((t146 > 1e-12), casadi.sqrt(t146), 0)
+    t148 = t144 + t100*t147
+    t149 = t145 + t148
+    t150 = t140**2
+    t151 = t144 + t150 + t100**2
+    t152 = t147**2
+    t153 = t149**2 + t150*t152
+    t154 = t144 + t152
+    t155 = 1e-24*t154
+    t156 = (t153 <= t151*t155)
+    t157 = casadi.if_else(t156, 1, 1/casadi.sqrt(t153))
+    t158 = casadi.if_else(t156, 1, t149*t157)
+    t159 = t143*(1 - t158)
+    t160 = t159 + t143*t158
+    t161 = t140*t147
+    t162 = casadi.if_else(t156, 0, -t157*t161)
+    t163 = t102*t162 + t142*t158
+    t164 = t102*t158 - t142*t162
+    t165 = (t154 <= t155)
+    t166 = casadi.if_else(t165, 1, 1/casadi.sqrt(t154))
+    t167 = casadi.if_else(t165, 1, t141*t166)
+    t168 = casadi.if_else(t165, 0, -t147*t166)
+    t169 = t163*(1 - t167)
+    t170 = t169 + t163*t167
+    t171 = t160*t168 + t164*t167
+    t172 = t160*t167 - t164*t168
+    t173 = t170**2 + t171**2
+    t174 = t173
+    t175 = t173 + t172**2
+    t176 = (t64 <= t65)
+    t177 = casadi.if_else(t176, 1, 1/casadi.sqrt(t64))
+    t178 = casadi.if_else(t176, 1, t177*t61)
+    t179 = casadi.if_else(t176, 0, casadi.atan2(t69, t61))
+    t180 = t179 - 6.283185307179586*casadi.floor(0.4722222222222222 + 0.15915494309189535*t179)
+    t181 = t177*t69
+    t182 = casadi.if_else(t176, 0, t181)
+    t183 = casadi.if_else(t176, 0, -t181)
+    t184 = t178*t51 - t182*t87
+    t185 = t178*t87 + t182*t51
+    t186 = t178*t53 - t182*t89
+    t187 = t178*t89 + t182*t53
+    t188 = t178*t79 - t137*t183
+    t189 = t137*t178 + t183*t79
+    t190 = t178*t81 - t139*t183
+    t191 = t139*t178 + t183*t81
+    t192 = 1 - t178
+    t193 = t192*t52
+    t194 = t193 + t178*t52
+    t195 = t192*t54
+    t196 = t195 + t178*t54
+    t197 = t192*t80
+    t198 = t197 + t178*t80
+    t199 = t192*t82
+    t200 = t199 + t178*t82
+    t201 = t185**2
+    t202 = -t201
+    t203 = 1 + t202
+    t204 = casadi.if_else((t203 > 1e-12), casadi.sqrt(t203), 0)
+    t205 = t201 + t194*t204
+    t206 = t202 + t205
+    t207 = t184**2
+    t208 = t201 + t207 + t194**2
+    t209 = t204**2
+    t210 = t206**2 + t207*t209
+    t211 = t201 + t209
+    t212 = 1e-24*t211
+    t213 = (t210 <= t208*t212)
+    t214 = casadi.if_else(t213, 1, 1/casadi.sqrt(t210))
+    t215 = casadi.if_else(t213, 1, t206*t214)
+    t216 = t187*(1 - t215)
+    t217 = t216 + t187*t215
+    t218 = t184*t204
+    t219 = casadi.if_else(t213, 0, -t214*t218)
+    t220 = t186*t215 + t196*t219
+    t221 = t196*t215 - t186*t219
+    t222 = (t211 <= t212)
+    t223 = casadi.if_else(t222, 1, 1/casadi.sqrt(t211))
+    t224 = casadi.if_else(t222, 1, t185*t223)
+    t225 = casadi.if_else(t222, 0, -t204*t223)
+    t226 = t220*(1 - t224)
+    t227 = t226 + t220*t224
+    t228 = t217*t225 + t221*t224
+    t229 = t217*t224 - t221*t225
+    t230 = t227**2 + t228**2
+    t231 = t230
+    t232 = t230 + t229**2
+    t233 = t189**2
+    t234 = -t233
+    t235 = 1 + t234
+    t236 = casadi.if_else((t235 > 1e-12), casadi.sqrt(t235), 0)
+    t237 = t233 + t198*t236
+    t238 = t234 + t237
+    t239 = t188**2
+    t240 = t233 + t239 + t198**2
+    t241 = t236**2
+    t242 = t238**2 + t239*t241
+    t243 = t233 + t241
+    t244 = 1e-24*t243
+    t245 = (t242 <= t240*t244)
+    t246 = casadi.if_else(t245, 1, 1/casadi.sqrt(t242))
+    t247 = casadi.if_else(t245, 1, t238*t246)
+    t248 = t191*(1 - t247)
+    t249 = t248 + t191*t247
+    t250 = t188*t236
+    t251 = casadi.if_else(t245, 0, -t246*t250)
+    t252 = t190*t247 + t200*t251
+    t253 = t200*t247 - t190*t251
+    t254 = (t243 <= t244)
+    t255 = casadi.if_else(t254, 1, 1/casadi.sqrt(t243))
+    t256 = casadi.if_else(t254, 1, t189*t255)
+    t257 = casadi.if_else(t254, 0, -t236*t255)
+    t258 = t252*(1 - t256)
+    t259 = t258 + t252*t256
+    t260 = t249*t257 + t253*t256
+    t261 = t249*t256 - t253*t257
+    t262 = t259**2 + t260**2
+    t263 = t262
+    t264 = t262 + t261**2
+    t265 = -t69
+    t266 = casadi.if_else(t66, 0, casadi.atan2(t265, t59))
+    t267 = t266 - 6.283185307179586*casadi.floor(0.4722222222222222 + 0.15915494309189535*t266)
+    t268 = casadi.if_else(t176, 0, casadi.atan2(t265, t61))
+    t269 = t268 - 6.283185307179586*casadi.floor(0.4722222222222222 + 0.15915494309189535*t268)
+    t270 = casadi.if_else(t115, 0, casadi.atan2(-t120, t108))
+    t271 = t270
+    t272 = t271 - 6.283185307179586*casadi.floor(0.4722222222222222 + 0.15915494309189535*t271)
+    t273 = 3.141592653589793 + t270 - 6.283185307179586*casadi.ceil(0.15915494309189535*t270)
+    t274 = t273 - 6.283185307179586*casadi.floor(0.4722222222222222 + 0.15915494309189535*t273)
+    t275 = casadi.if_else(t124, 0, casadi.atan2(-t106, t91))
+    t276 = t275
+    t277 = t276 - 6.283185307179586*casadi.floor(0.25 + 0.15915494309189535*t276)
+    t278 = t275 + 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t275)
+    t279 = casadi.if_else((t133 <= 1e-24*t134), 0, casadi.atan2(t129, -t130))
+    t280 = t279
+    t281 = t280 - 6.283185307179586*casadi.floor(0.4722222222222222 + 0.15915494309189535*t280)
+    t282 = 3.141592653589793 + t279 - 6.283185307179586*casadi.ceil(0.15915494309189535*t279)
+    t283 = t282 - 6.283185307179586*casadi.floor(0.4722222222222222 + 0.15915494309189535*t282)
+    t284 = -t278
+    t285 = t278 + 6.283185307179586*casadi.floor(0.25 + 0.15915494309189535*t284)
+    t286 = casadi.if_else(t156, 0, casadi.atan2(-t161, t149))
+    t287 = t286
+    t288 = t287 - 6.283185307179586*casadi.floor(0.4722222222222222 + 0.15915494309189535*t287)
+    t289 = 3.141592653589793 + t286 - 6.283185307179586*casadi.ceil(0.15915494309189535*t286)
+    t290 = t289 - 6.283185307179586*casadi.floor(0.4722222222222222 + 0.15915494309189535*t289)
+    t291 = casadi.if_else(t165, 0, casadi.atan2(-t147, t141))
+    t292 = t291
+    t293 = t292 - 6.283185307179586*casadi.floor(0.25 + 0.15915494309189535*t292)
+    t294 = t291 + 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t291)
+    t295 = casadi.if_else((t174 <= 1e-24*t175), 0, casadi.atan2(t170, -t171))
+    t296 = t295
+    t297 = t296 - 6.283185307179586*casadi.floor(0.4722222222222222 + 0.15915494309189535*t296)
+    t298 = 3.141592653589793 + t295 - 6.283185307179586*casadi.ceil(0.15915494309189535*t295)
+    t299 = t298 - 6.283185307179586*casadi.floor(0.4722222222222222 + 0.15915494309189535*t298)
+    t300 = -t294
+    t301 = t294 + 6.283185307179586*casadi.floor(0.25 + 0.15915494309189535*t300)
+    t302 = casadi.if_else(t213, 0, casadi.atan2(-t218, t206))
+    t303 = t302
+    t304 = t303 - 6.283185307179586*casadi.floor(0.4722222222222222 + 0.15915494309189535*t303)
+    t305 = 3.141592653589793 + t302 - 6.283185307179586*casadi.ceil(0.15915494309189535*t302)
+    t306 = t305 - 6.283185307179586*casadi.floor(0.4722222222222222 + 0.15915494309189535*t305)
+    t307 = casadi.if_else(t222, 0, casadi.atan2(-t204, t185))
+    t308 = t307
+    t309 = t308 - 6.283185307179586*casadi.floor(0.25 + 0.15915494309189535*t308)
+    t310 = t307 + 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t307)
+    t311 = casadi.if_else((t231 <= 1e-24*t232), 0, casadi.atan2(t227, -t228))
+    t312 = t311
+    t313 = t312 - 6.283185307179586*casadi.floor(0.4722222222222222 + 0.15915494309189535*t312)
+    t314 = 3.141592653589793 + t311 - 6.283185307179586*casadi.ceil(0.15915494309189535*t311)
+    t315 = t314 - 6.283185307179586*casadi.floor(0.4722222222222222 + 0.15915494309189535*t314)
+    t316 = -t310
+    t317 = t310 + 6.283185307179586*casadi.floor(0.25 + 0.15915494309189535*t316)
+    t318 = casadi.if_else(t245, 0, casadi.atan2(-t250, t238))
+    t319 = t318
+    t320 = t319 - 6.283185307179586*casadi.floor(0.4722222222222222 + 0.15915494309189535*t319)
+    t321 = 3.141592653589793 + t318 - 6.283185307179586*casadi.ceil(0.15915494309189535*t318)
+    t322 = t321 - 6.283185307179586*casadi.floor(0.4722222222222222 + 0.15915494309189535*t321)
+    t323 = casadi.if_else(t254, 0, casadi.atan2(-t236, t189))
+    t324 = t323
+    t325 = t324 - 6.283185307179586*casadi.floor(0.25 + 0.15915494309189535*t324)
+    t326 = t323 + 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t323)
+    t327 = casadi.if_else((t263 <= 1e-24*t264), 0, casadi.atan2(t259, -t260))
+    t328 = t327
+    t329 = t328 - 6.283185307179586*casadi.floor(0.4722222222222222 + 0.15915494309189535*t328)
+    t330 = 3.141592653589793 + t327 - 6.283185307179586*casadi.ceil(0.15915494309189535*t327)
+    t331 = t330 - 6.283185307179586*casadi.floor(0.4722222222222222 + 0.15915494309189535*t330)
+    t332 = -t326
+    t333 = t326 + 6.283185307179586*casadi.floor(0.25 + 0.15915494309189535*t332)
+    t334 = (t56 <= 2.9670597283903604)
+    t335 = casadi.logic_and((t55 >= -2.9670597283903604), (t55 <= 2.9670597283903604))
+    t336 = casadi.if_else(casadi.logic_and(t334, casadi.logic_not(t335)), t56, t55)
+    t337 = (t267 <= 2.9670597283903604)
+    t338 = casadi.logic_and((t266 >= -2.9670597283903604), (t266 <= 2.9670597283903604))
+    t339 = casadi.if_else(casadi.logic_and(t337, casadi.logic_not(t338)), t267, t266)
+    t340 = (t272 <= 2.9670597283903604)
+    t341 = casadi.logic_and((t271 >= -2.9670597283903604), (t271 <= 2.9670597283903604))
+    t342 = (t277 <= 1.5707963267948966)
+    t343 = casadi.logic_and((t276 >= -1.5707963267948966), (t276 <= 1.5707963267948966))
+    t344 = (t281 <= 2.9670597283903604)
+    t345 = casadi.logic_and((t280 >= -2.9670597283903604), (t280 <= 2.9670597283903604))
+    t346 = (t274 <= 2.9670597283903604)
+    t347 = casadi.logic_and((t273 >= -2.9670597283903604), (t273 <= 2.9670597283903604))
+    t348 = -t285
+    t349 = (t283 <= 2.9670597283903604)
+    t350 = casadi.logic_and((t282 >= -2.9670597283903604), (t282 <= 2.9670597283903604))
+    t351 = (t84 <= 2.9670597283903604)
+    t352 = casadi.logic_and((t83 >= -2.9670597283903604), (t83 <= 2.9670597283903604))
+    t353 = casadi.if_else(casadi.logic_and(t351, casadi.logic_not(t352)), t84, t83)
+    t354 = (t71 <= 2.9670597283903604)
+    t355 = casadi.logic_and((t70 >= -2.9670597283903604), (t70 <= 2.9670597283903604))
+    t356 = casadi.if_else(casadi.logic_and(t354, casadi.logic_not(t355)), t71, t70)
+    t357 = (t288 <= 2.9670597283903604)
+    t358 = casadi.logic_and((t287 >= -2.9670597283903604), (t287 <= 2.9670597283903604))
+    t359 = (t293 <= 1.5707963267948966)
+    t360 = casadi.logic_and((t292 >= -1.5707963267948966), (t292 <= 1.5707963267948966))
+    t361 = (t297 <= 2.9670597283903604)
+    t362 = casadi.logic_and((t296 >= -2.9670597283903604), (t296 <= 2.9670597283903604))
+    t363 = (t290 <= 2.9670597283903604)
+    t364 = casadi.logic_and((t289 >= -2.9670597283903604), (t289 <= 2.9670597283903604))
+    t365 = -t301
+    t366 = (t299 <= 2.9670597283903604)
+    t367 = casadi.logic_and((t298 >= -2.9670597283903604), (t298 <= 2.9670597283903604))
+    t368 = (t180 <= 2.9670597283903604)
+    t369 = casadi.logic_and((t179 >= -2.9670597283903604), (t179 <= 2.9670597283903604))
+    t370 = casadi.if_else(casadi.logic_and(t368, casadi.logic_not(t369)), t180, t179)
+    t371 = -t21
+    t372 = (t304 <= 2.9670597283903604)
+    t373 = casadi.logic_and((t303 >= -2.9670597283903604), (t303 <= 2.9670597283903604))
+    t374 = (t309 <= 1.5707963267948966)
+    t375 = casadi.logic_and((t308 >= -1.5707963267948966), (t308 <= 1.5707963267948966))
+    t376 = (t313 <= 2.9670597283903604)
+    t377 = casadi.logic_and((t312 >= -2.9670597283903604), (t312 <= 2.9670597283903604))
+    t378 = (t306 <= 2.9670597283903604)
+    t379 = casadi.logic_and((t305 >= -2.9670597283903604), (t305 <= 2.9670597283903604))
+    t380 = -t317
+    t381 = (t315 <= 2.9670597283903604)
+    t382 = casadi.logic_and((t314 >= -2.9670597283903604), (t314 <= 2.9670597283903604))
+    t383 = (t269 <= 2.9670597283903604)
+    t384 = casadi.logic_and((t268 >= -2.9670597283903604), (t268 <= 2.9670597283903604))
+    t385 = casadi.if_else(casadi.logic_and(t383, casadi.logic_not(t384)), t269, t268)
+    t386 = (t320 <= 2.9670597283903604)
+    t387 = casadi.logic_and((t319 >= -2.9670597283903604), (t319 <= 2.9670597283903604))
+    t388 = (t325 <= 1.5707963267948966)
+    t389 = casadi.logic_and((t324 >= -1.5707963267948966), (t324 <= 1.5707963267948966))
+    t390 = (t329 <= 2.9670597283903604)
+    t391 = casadi.logic_and((t328 >= -2.9670597283903604), (t328 <= 2.9670597283903604))
+    t392 = (t322 <= 2.9670597283903604)
+    t393 = casadi.logic_and((t321 >= -2.9670597283903604), (t321 <= 2.9670597283903604))
+    t394 = -t333
+    t395 = (t331 <= 2.9670597283903604)
+    t396 = casadi.logic_and((t330 >= -2.9670597283903604), (t330 <= 2.9670597283903604))
+    t397 = (casadi.fabs(t0) < casadi.inf)
+    t398 = -1e-12
+    t399 = (t18 >= t20)
+    t400 = (t26 >= t28)
+    t401 = (t26 > t27)
+    t402 = (t18 > t19)
+    t403 = (t21 >= 0.30479999999999996)
+    t404 = (t21 <= 1.27)
+    t405 = casadi.logic_or(t334, t335)
+    t406 = casadi.logic_or(t337, t338)
+    t407 = casadi.logic_or(t351, t352)
+    t408 = casadi.logic_or(t354, t355)
+    t409 = (t371 >= 0.30479999999999996)
+    t410 = (t371 <= 1.27)
+    t411 = casadi.logic_or(t368, t369)
+    t412 = casadi.logic_or(t383, t384)
     q = casadi.SX(8, 6)
-    q[0, 0] = t257
-    q[0, 1] = t259
+    q[0, 0] = t336
+    q[0, 1] = t339
     q[0, 2] = t21
-    q[0, 3] = t260
-    q[0, 4] = t261
-    q[0, 5] = t262
-    q[1, 0] = t257
-    q[1, 1] = t259
+    q[0, 3] = casadi.if_else(casadi.logic_and(t340, casadi.logic_not(t341)), t272, t271)
+    q[0, 4] = casadi.if_else(casadi.logic_and(t342, casadi.logic_not(t343)), t277, t276)
+    q[0, 5] = casadi.if_else(casadi.logic_and(t344, casadi.logic_not(t345)), t281, t280)
+    q[1, 0] = t336
+    q[1, 1] = t339
     q[1, 2] = t21
-    q[1, 3] = 3.141592653589793 + t260 - 6.283185307179586*casadi.ceil(0.15915494309189535*t260)
-    q[1, 4] = -t261 - 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t261)
-    q[1, 5] = 3.141592653589793 + t262 - 6.283185307179586*casadi.ceil(0.15915494309189535*t262)
-    q[2, 0] = t263
-    q[2, 1] = t264
+    q[1, 3] = casadi.if_else(casadi.logic_and(t346, casadi.logic_not(t347)), t274, t273)
+    q[1, 4] = casadi.if_else(casadi.logic_and((t285 >= -1.5707963267948966), casadi.logic_not(casadi.logic_and((t278 >= -1.5707963267948966), (t278 <= 1.5707963267948966)))), t348, t284)
+    q[1, 5] = casadi.if_else(casadi.logic_and(t349, casadi.logic_not(t350)), t283, t282)
+    q[2, 0] = t353
+    q[2, 1] = t356
     q[2, 2] = t21
-    q[2, 3] = t265
-    q[2, 4] = t266
-    q[2, 5] = t267
-    q[3, 0] = t263
-    q[3, 1] = t264
+    q[2, 3] = casadi.if_else(casadi.logic_and(t357, casadi.logic_not(t358)), t288, t287)
+    q[2, 4] = casadi.if_else(casadi.logic_and(t359, casadi.logic_not(t360)), t293, t292)
+    q[2, 5] = casadi.if_else(casadi.logic_and(t361, casadi.logic_not(t362)), t297, t296)
+    q[3, 0] = t353
+    q[3, 1] = t356
     q[3, 2] = t21
-    q[3, 3] = 3.141592653589793 + t265 - 6.283185307179586*casadi.ceil(0.15915494309189535*t265)
-    q[3, 4] = -t266 - 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t266)
-    q[3, 5] = 3.141592653589793 + t267 - 6.283185307179586*casadi.ceil(0.15915494309189535*t267)
-    q[4, 0] = t257
-    q[4, 1] = t268
-    q[4, 2] = t269
-    q[4, 3] = t270
-    q[4, 4] = t271
-    q[4, 5] = t272
-    q[5, 0] = t257
-    q[5, 1] = t268
-    q[5, 2] = t269
-    q[5, 3] = 3.141592653589793 + t270 - 6.283185307179586*casadi.ceil(0.15915494309189535*t270)
-    q[5, 4] = -t271 - 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t271)
-    q[5, 5] = 3.141592653589793 + t272 - 6.283185307179586*casadi.ceil(0.15915494309189535*t272)
-    q[6, 0] = t263
-    q[6, 1] = t273
-    q[6, 2] = t269
-    q[6, 3] = t274
-    q[6, 4] = t275
-    q[6, 5] = t276
-    q[7, 0] = t263
-    q[7, 1] = t273
-    q[7, 2] = t269
-    q[7, 3] = 3.141592653589793 + t274 - 6.283185307179586*casadi.ceil(0.15915494309189535*t274)
-    q[7, 4] = -t275 - 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t275)
-    q[7, 5] = 3.141592653589793 + t276 - 6.283185307179586*casadi.ceil(0.15915494309189535*t276)
+    q[3, 3] = casadi.if_else(casadi.logic_and(t363, casadi.logic_not(t364)), t290, t289)
+    q[3, 4] = casadi.if_else(casadi.logic_and((t301 >= -1.5707963267948966), casadi.logic_not(casadi.logic_and((t294 >= -1.5707963267948966), (t294 <= 1.5707963267948966)))), t365, t300)
+    q[3, 5] = casadi.if_else(casadi.logic_and(t366, casadi.logic_not(t367)), t299, t298)
+    q[4, 0] = t336
+    q[4, 1] = t370
+    q[4, 2] = t371
+    q[4, 3] = casadi.if_else(casadi.logic_and(t372, casadi.logic_not(t373)), t304, t303)
+    q[4, 4] = casadi.if_else(casadi.logic_and(t374, casadi.logic_not(t375)), t309, t308)
+    q[4, 5] = casadi.if_else(casadi.logic_and(t376, casadi.logic_not(t377)), t313, t312)
+    q[5, 0] = t336
+    q[5, 1] = t370
+    q[5, 2] = t371
+    q[5, 3] = casadi.if_else(casadi.logic_and(t378, casadi.logic_not(t379)), t306, t305)
+    q[5, 4] = casadi.if_else(casadi.logic_and((t317 >= -1.5707963267948966), casadi.logic_not(casadi.logic_and((t310 >= -1.5707963267948966), (t310 <= 1.5707963267948966)))), t380, t316)
+    q[5, 5] = casadi.if_else(casadi.logic_and(t381, casadi.logic_not(t382)), t315, t314)
+    q[6, 0] = t353
+    q[6, 1] = t385
+    q[6, 2] = t371
+    q[6, 3] = casadi.if_else(casadi.logic_and(t386, casadi.logic_not(t387)), t320, t319)
+    q[6, 4] = casadi.if_else(casadi.logic_and(t388, casadi.logic_not(t389)), t325, t324)
+    q[6, 5] = casadi.if_else(casadi.logic_and(t390, casadi.logic_not(t391)), t329, t328)
+    q[7, 0] = t353
+    q[7, 1] = t385
+    q[7, 2] = t371
+    q[7, 3] = casadi.if_else(casadi.logic_and(t392, casadi.logic_not(t393)), t322, t321)
+    q[7, 4] = casadi.if_else(casadi.logic_and((t333 >= -1.5707963267948966), casadi.logic_not(casadi.logic_and((t326 >= -1.5707963267948966), (t326 <= 1.5707963267948966)))), t394, t332)
+    q[7, 5] = casadi.if_else(casadi.logic_and(t395, casadi.logic_not(t396)), t331, t330)
     valid = casadi.SX(8, 1)
-    valid[0, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t277, t279), t280), (t99 >= t278))
-    valid[1, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t277, t279), t280), (t99 > 1e-12))
-    valid[2, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t277, t279), t281), (t140 >= t278))
-    valid[3, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t277, t279), t281), (t140 > 1e-12))
-    valid[4, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t277, t280), t282), (t195 >= t278))
-    valid[5, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t277, t280), t282), (t195 > 1e-12))
-    valid[6, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t277, t281), t282), (t227 >= t278))
-    valid[7, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t277, t281), t282), (t227 > 1e-12))
-    return [q, valid]
+    valid[0, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t397, t399), t400), (t105 >= t398))
+    valid[1, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t397, t399), t400), (t105 > 1e-12))
+    valid[2, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t397, t399), t401), (t146 >= t398))
+    valid[3, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t397, t399), t401), (t146 > 1e-12))
+    valid[4, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t397, t400), t402), (t203 >= t398))
+    valid[5, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t397, t400), t402), (t203 > 1e-12))
+    valid[6, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t397, t401), t402), (t235 >= t398))
+    valid[7, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t397, t401), t402), (t235 > 1e-12))
+    in_limits = casadi.SX(8, 1)
+    in_limits[0, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t403, t404), t405), t406), casadi.logic_or(t340, t341)), casadi.logic_or(t342, t343)), casadi.logic_or(t344, t345))
+    in_limits[1, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t403, t404), t405), t406), casadi.logic_or(t346, t347)), casadi.logic_or(t349, t350)), casadi.logic_or((t348 <= 1.5707963267948966), casadi.logic_and((t284 >= -1.5707963267948966), (t284 <= 1.5707963267948966))))
+    in_limits[2, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t403, t404), t407), t408), casadi.logic_or(t357, t358)), casadi.logic_or(t359, t360)), casadi.logic_or(t361, t362))
+    in_limits[3, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t403, t404), t407), t408), casadi.logic_or(t363, t364)), casadi.logic_or(t366, t367)), casadi.logic_or((t365 <= 1.5707963267948966), casadi.logic_and((t300 >= -1.5707963267948966), (t300 <= 1.5707963267948966))))
+    in_limits[4, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t405, t409), t410), t411), casadi.logic_or(t372, t373)), casadi.logic_or(t374, t375)), casadi.logic_or(t376, t377))
+    in_limits[5, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t405, t409), t410), t411), casadi.logic_or(t378, t379)), casadi.logic_or(t381, t382)), casadi.logic_or((t380 <= 1.5707963267948966), casadi.logic_and((t316 >= -1.5707963267948966), (t316 <= 1.5707963267948966))))
+    in_limits[6, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t407, t409), t410), t412), casadi.logic_or(t386, t387)), casadi.logic_or(t388, t389)), casadi.logic_or(t390, t391))
+    in_limits[7, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t407, t409), t410), t412), casadi.logic_or(t392, t393)), casadi.logic_or(t395, t396)), casadi.logic_or((t394 <= 1.5707963267948966), casadi.logic_and((t332 >= -1.5707963267948966), (t332 <= 1.5707963267948966))))
+    return [q, valid, in_limits]
+
+
+def _ik_nearest(T, q_seed, weights):
+    """The closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status: 1859 operations."""
+    T00 = T[0, 0]
+    T01 = T[0, 1]
+    T02 = T[0, 2]
+    T03 = T[0, 3]
+    T10 = T[1, 0]
+    T11 = T[1, 1]
+    T12 = T[1, 2]
+    T13 = T[1, 3]
+    T20 = T[2, 0]
+    T21 = T[2, 1]
+    T22 = T[2, 2]
+    T23 = T[2, 3]
+    qn1 = q_seed[0]
+    qn2 = q_seed[1]
+    qn3 = q_seed[2]
+    qn4 = q_seed[3]
+    qn5 = q_seed[4]
+    qn6 = q_seed[5]
+    qw1 = weights[0]
+    qw2 = weights[1]
+    qw3 = weights[2]
+    qw4 = weights[3]
+    qw5 = weights[4]
+    qw6 = weights[5]
+    t0 = 0.412*T02 - 0.1337*T00
+    t1 = T03 - t0
+    t2 = t0
+    t3 = t1 + t2
+    t4 = 0.412*T12 - 0.1337*T10
+    t5 = T13 - t4
+    t6 = t4
+    t7 = t5 + t6
+    t8 = 0.412*T22 - 0.1337*T20
+    t9 = T23 - t8
+    t10 = t8
+    t11 = t10 + t9
+    t12 = -0.412 + t11
+    t13 = t12**2
+    t14 = t13 + t3**2 + t7**2
+    t15 = 0.01787569 - t14
+    t16 = 0.01787569 + t14
+    t17 = 1e-12*t16
+    t18 = (t15 < -t17)
+    t19 = casadi.if_else(t18, casadi.sqrt(-t15), 0)
+    t20 = t19**2
+    t21 = 0.01787569 + t20
+    t22 = 0.01787569 + t13
+    t23 = t22 - t21
+    t24 = 1e-12*t21
+    t25 = (t23 < -t24)
+    t26 = casadi.if_else(t25, casadi.sqrt(-t23), 0)
+    t27 = t26*t3
+    t28 = t13 + 0.1337*t7
+    t29 = t28 - t27
+    t30 = t27 + t28
+    t31 = -t13
+    t32 = t29 + t31
+    t33 = t30 + t31
+    t34 = 0.1337*t3
+    t35 = t26*t7
+    t36 = t34 + t35
+    t37 = t32**2 + t36**2
+    t38 = t35 - t34
+    t39 = t33**2 + t38**2
+    t40 = t26**2
+    t41 = t22 + t40
+    t42 = 1e-24*t41
+    t43 = t14*t42
+    t44 = (t37 <= t43)
+    t45 = casadi.if_else(t44, 1, 1/casadi.sqrt(t37))
+    t46 = casadi.if_else(t44, 1, t32*t45)
+    t47 = casadi.if_else(t44, 0, -t36*t45)
+    t48 = T02*t46 + T12*t47
+    t49 = T12*t46 - T02*t47
+    t50 = T00*t46 + T10*t47
+    t51 = T10*t46 - T00*t47
+    t52 = casadi.if_else(t44, 0, casadi.atan2(-t36, t32))
+    t53 = t52 - 6.283185307179586*casadi.floor(0.4722222222222222 + 0.15915494309189535*t52)
+    t54 = t12*t19
+    t55 = 0.01787569 + t54
+    t56 = -0.01787569 + t55
+    t57 = 0.01787569 - t54
+    t58 = -0.01787569 + t57
+    t59 = t20*t40
+    t60 = t59 + t56**2
+    t61 = t59 + t58**2
+    t62 = t21*t42
+    t63 = (t60 <= t62)
+    t64 = casadi.if_else(t63, 1, 1/casadi.sqrt(t60))
+    t65 = casadi.if_else(t63, 1, t56*t64)
+    t66 = t19*t26
+    t67 = casadi.if_else(t63, 0, casadi.atan2(t66, t56))
+    t68 = t67 - 6.283185307179586*casadi.floor(0.4722222222222222 + 0.15915494309189535*t67)
+    t69 = t64*t66
+    t70 = casadi.if_else(t63, 0, -t69)
+    t71 = casadi.if_else(t63, 0, t69)
+    t72 = (t39 <= t43)
+    t73 = casadi.if_else(t72, 1, 1/casadi.sqrt(t39))
+    t74 = casadi.if_else(t72, 1, t33*t73)
+    t75 = casadi.if_else(t72, 0, t38*t73)
+    t76 = T02*t74 + T12*t75
+    t77 = T12*t74 - T02*t75
+    t78 = T00*t74 + T10*t75
+    t79 = T10*t74 - T00*t75
+    t80 = casadi.if_else(t72, 0, casadi.atan2(t38, t33))
+    t81 = t80 - 6.283185307179586*casadi.floor(0.4722222222222222 + 0.15915494309189535*t80)
+    t82 = 1 - t46
+    t83 = T22*t82
+    t84 = t83 + T22*t46
+    t85 = T20*t82
+    t86 = t85 + T20*t46
+    t87 = t48*t65 - t70*t84
+    t88 = t48*t70 + t65*t84
+    t89 = t50*t65 - t70*t86
+    t90 = t50*t70 + t65*t86
+    t91 = 1 - t65
+    t92 = t49*t91
+    t93 = t92 + t49*t65
+    t94 = t51*t91
+    t95 = t94 + t51*t65
+    t96 = t77*t91
+    t97 = t96 + t65*t77
+    t98 = t79*t91
+    t99 = t98 + t65*t79
+    t100 = t88**2
+    t101 = -t100
+    t102 = 1 + t101
+    t103 = (1e-12 < t102)
+    t104 = casadi.if_else(t103, casadi.sqrt(t102), 0)
+    t105 = t100 + t104*t93
+    t106 = t101 + t105
+    t107 = t87**2
+    t108 = t100 + t107 + t93**2
+    t109 = t104**2
+    t110 = t106**2 + t107*t109
+    t111 = t100 + t109
+    t112 = 1e-24*t111
+    t113 = (t110 <= t108*t112)
+    t114 = casadi.if_else(t113, 1, 1/casadi.sqrt(t110))
+    t115 = casadi.if_else(t113, 1, t106*t114)
+    t116 = t90*(1 - t115)
+    t117 = t116 + t115*t90
+    t118 = t104*t87
+    t119 = casadi.if_else(t113, 0, -t114*t118)
+    t120 = t115*t89 + t119*t95
+    t121 = t115*t95 - t119*t89
+    t122 = (t111 <= t112)
+    t123 = casadi.if_else(t122, 1, 1/casadi.sqrt(t111))
+    t124 = casadi.if_else(t122, 1, t123*t88)
+    t125 = casadi.if_else(t122, 0, -t104*t123)
+    t126 = t120*(1 - t124)
+    t127 = t126 + t120*t124
+    t128 = t117*t125 + t121*t124
+    t129 = t117*t124 - t121*t125
+    t130 = t127**2 + t128**2
+    t131 = t130
+    t132 = t130 + t129**2
+    t133 = 1 - t74
+    t134 = T22*t133
+    t135 = t134 + T22*t74
+    t136 = T20*t133
+    t137 = t136 + T20*t74
+    t138 = t65*t76 - t135*t71
+    t139 = t135*t65 + t71*t76
+    t140 = t65*t78 - t137*t71
+    t141 = t137*t65 + t71*t78
+    t142 = t139**2
+    t143 = -t142
+    t144 = 1 + t143
+    t145 = (1e-12 < t144)
+    t146 = casadi.if_else(t145, casadi.sqrt(t144), 0)
+    t147 = t142 + t146*t97
+    t148 = t143 + t147
+    t149 = t138**2
+    t150 = t142 + t149 + t97**2
+    t151 = t146**2
+    t152 = t148**2 + t149*t151
+    t153 = t142 + t151
+    t154 = 1e-24*t153
+    t155 = (t152 <= t150*t154)
+    t156 = casadi.if_else(t155, 1, 1/casadi.sqrt(t152))
+    t157 = casadi.if_else(t155, 1, t148*t156)
+    t158 = t141*(1 - t157)
+    t159 = t158 + t141*t157
+    t160 = t138*t146
+    t161 = casadi.if_else(t155, 0, -t156*t160)
+    t162 = t140*t157 + t161*t99
+    t163 = t157*t99 - t140*t161
+    t164 = (t153 <= t154)
+    t165 = casadi.if_else(t164, 1, 1/casadi.sqrt(t153))
+    t166 = casadi.if_else(t164, 1, t139*t165)
+    t167 = casadi.if_else(t164, 0, -t146*t165)
+    t168 = t162*(1 - t166)
+    t169 = t168 + t162*t166
+    t170 = t159*t167 + t163*t166
+    t171 = t159*t166 - t163*t167
+    t172 = t169**2 + t170**2
+    t173 = t172
+    t174 = t172 + t171**2
+    t175 = (t61 <= t62)
+    t176 = casadi.if_else(t175, 1, 1/casadi.sqrt(t61))
+    t177 = casadi.if_else(t175, 1, t176*t58)
+    t178 = casadi.if_else(t175, 0, casadi.atan2(t66, t58))
+    t179 = t178 - 6.283185307179586*casadi.floor(0.4722222222222222 + 0.15915494309189535*t178)
+    t180 = t176*t66
+    t181 = casadi.if_else(t175, 0, t180)
+    t182 = casadi.if_else(t175, 0, -t180)
+    t183 = t177*t48 - t181*t84
+    t184 = t177*t84 + t181*t48
+    t185 = t177*t50 - t181*t86
+    t186 = t177*t86 + t181*t50
+    t187 = t177*t76 - t135*t182
+    t188 = t135*t177 + t182*t76
+    t189 = t177*t78 - t137*t182
+    t190 = t137*t177 + t182*t78
+    t191 = 1 - t177
+    t192 = t191*t49
+    t193 = t192 + t177*t49
+    t194 = t191*t51
+    t195 = t194 + t177*t51
+    t196 = t191*t77
+    t197 = t196 + t177*t77
+    t198 = t191*t79
+    t199 = t198 + t177*t79
+    t200 = t184**2
+    t201 = -t200
+    t202 = 1 + t201
+    t203 = (1e-12 < t202)
+    t204 = casadi.if_else(t203, casadi.sqrt(t202), 0)
+    t205 = t200 + t193*t204
+    t206 = t201 + t205
+    t207 = t183**2
+    t208 = t200 + t207 + t193**2
+    t209 = t204**2
+    t210 = t206**2 + t207*t209
+    t211 = t200 + t209
+    t212 = 1e-24*t211
+    t213 = (t210 <= t208*t212)
+    t214 = casadi.if_else(t213, 1, 1/casadi.sqrt(t210))
+    t215 = casadi.if_else(t213, 1, t206*t214)
+    t216 = t186*(1 - t215)
+    t217 = t216 + t186*t215
+    t218 = t183*t204
+    t219 = casadi.if_else(t213, 0, -t214*t218)
+    t220 = t185*t215 + t195*t219
+    t221 = t195*t215 - t185*t219
+    t222 = (t211 <= t212)
+    t223 = casadi.if_else(t222, 1, 1/casadi.sqrt(t211))
+    t224 = casadi.if_else(t222, 1, t184*t223)
+    t225 = casadi.if_else(t222, 0, -t204*t223)
+    t226 = t220*(1 - t224)
+    t227 = t226 + t220*t224
+    t228 = t217*t225 + t221*t224
+    t229 = t217*t224 - t221*t225
+    t230 = t227**2 + t228**2
+    t231 = t230
+    t232 = t230 + t229**2
+    t233 = t188**2
+    t234 = -t233
+    t235 = 1 + t234
+    t236 = (1e-12 < t235)
+    t237 = casadi.if_else(t236, casadi.sqrt(t235), 0)
+    t238 = t233 + t197*t237
+    t239 = t234 + t238
+    t240 = t187**2
+    t241 = t233 + t240 + t197**2
+    t242 = t237**2
+    t243 = t239**2 + t240*t242
+    t244 = t233 + t242
+    t245 = 1e-24*t244
+    t246 = (t243 <= t241*t245)
+    t247 = casadi.if_else(t246, 1, 1/casadi.sqrt(t243))
+    t248 = casadi.if_else(t246, 1, t239*t247)
+    t249 = t190*(1 - t248)
+    t250 = t249 + t190*t248
+    t251 = t187*t237
+    t252 = casadi.if_else(t246, 0, -t247*t251)
+    t253 = t189*t248 + t199*t252
+    t254 = t199*t248 - t189*t252
+    t255 = (t244 <= t245)
+    t256 = casadi.if_else(t255, 1, 1/casadi.sqrt(t244))
+    t257 = casadi.if_else(t255, 1, t188*t256)
+    t258 = casadi.if_else(t255, 0, -t237*t256)
+    t259 = t253*(1 - t257)
+    t260 = t259 + t253*t257
+    t261 = t250*t258 + t254*t257
+    t262 = t250*t257 - t254*t258
+    t263 = t260**2 + t261**2
+    t264 = t263
+    t265 = t263 + t262**2
+    t266 = T00 + T01 + T02 + T03 + T10 + T11 + T12 + T13 + T20 + T21 + T22 + T23
+    t267 = t266
+    t268 = qn1 + qn2 + qn3 + qn4 + qn5 + qn6 + qw1 + qw2 + qw3 + qw4 + qw5 + qw6 + t266
+    t269 = -t66
+    t270 = casadi.if_else(t63, 0, casadi.atan2(t269, t56))
+    t271 = t270 - 6.283185307179586*casadi.floor(0.4722222222222222 + 0.15915494309189535*t270)
+    t272 = casadi.if_else(t175, 0, casadi.atan2(t269, t58))
+    t273 = t272 - 6.283185307179586*casadi.floor(0.4722222222222222 + 0.15915494309189535*t272)
+    t274 = casadi.if_else(t113, 0, casadi.atan2(-t118, t106))
+    t275 = t274
+    t276 = t275 - 6.283185307179586*casadi.floor(0.4722222222222222 + 0.15915494309189535*t275)
+    t277 = 3.141592653589793 + t274 - 6.283185307179586*casadi.ceil(0.15915494309189535*t274)
+    t278 = t277 - 6.283185307179586*casadi.floor(0.4722222222222222 + 0.15915494309189535*t277)
+    t279 = casadi.if_else(t122, 0, casadi.atan2(-t104, t88))
+    t280 = t279
+    t281 = t280 - 6.283185307179586*casadi.floor(0.25 + 0.15915494309189535*t280)
+    t282 = t279 + 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t279)
+    t283 = casadi.if_else((t131 <= 1e-24*t132), 0, casadi.atan2(t127, -t128))
+    t284 = t283
+    t285 = t284 - 6.283185307179586*casadi.floor(0.4722222222222222 + 0.15915494309189535*t284)
+    t286 = 3.141592653589793 + t283 - 6.283185307179586*casadi.ceil(0.15915494309189535*t283)
+    t287 = t286 - 6.283185307179586*casadi.floor(0.4722222222222222 + 0.15915494309189535*t286)
+    t288 = -t282
+    t289 = t282 + 6.283185307179586*casadi.floor(0.25 + 0.15915494309189535*t288)
+    t290 = casadi.if_else(t155, 0, casadi.atan2(-t160, t148))
+    t291 = t290
+    t292 = t291 - 6.283185307179586*casadi.floor(0.4722222222222222 + 0.15915494309189535*t291)
+    t293 = 3.141592653589793 + t290 - 6.283185307179586*casadi.ceil(0.15915494309189535*t290)
+    t294 = t293 - 6.283185307179586*casadi.floor(0.4722222222222222 + 0.15915494309189535*t293)
+    t295 = casadi.if_else(t164, 0, casadi.atan2(-t146, t139))
+    t296 = t295
+    t297 = t296 - 6.283185307179586*casadi.floor(0.25 + 0.15915494309189535*t296)
+    t298 = t295 + 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t295)
+    t299 = casadi.if_else((t173 <= 1e-24*t174), 0, casadi.atan2(t169, -t170))
+    t300 = t299
+    t301 = t300 - 6.283185307179586*casadi.floor(0.4722222222222222 + 0.15915494309189535*t300)
+    t302 = 3.141592653589793 + t299 - 6.283185307179586*casadi.ceil(0.15915494309189535*t299)
+    t303 = t302 - 6.283185307179586*casadi.floor(0.4722222222222222 + 0.15915494309189535*t302)
+    t304 = -t298
+    t305 = t298 + 6.283185307179586*casadi.floor(0.25 + 0.15915494309189535*t304)
+    t306 = casadi.if_else(t213, 0, casadi.atan2(-t218, t206))
+    t307 = t306
+    t308 = t307 - 6.283185307179586*casadi.floor(0.4722222222222222 + 0.15915494309189535*t307)
+    t309 = 3.141592653589793 + t306 - 6.283185307179586*casadi.ceil(0.15915494309189535*t306)
+    t310 = t309 - 6.283185307179586*casadi.floor(0.4722222222222222 + 0.15915494309189535*t309)
+    t311 = casadi.if_else(t222, 0, casadi.atan2(-t204, t184))
+    t312 = t311
+    t313 = t312 - 6.283185307179586*casadi.floor(0.25 + 0.15915494309189535*t312)
+    t314 = t311 + 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t311)
+    t315 = casadi.if_else((t231 <= 1e-24*t232), 0, casadi.atan2(t227, -t228))
+    t316 = t315
+    t317 = t316 - 6.283185307179586*casadi.floor(0.4722222222222222 + 0.15915494309189535*t316)
+    t318 = 3.141592653589793 + t315 - 6.283185307179586*casadi.ceil(0.15915494309189535*t315)
+    t319 = t318 - 6.283185307179586*casadi.floor(0.4722222222222222 + 0.15915494309189535*t318)
+    t320 = -t314
+    t321 = t314 + 6.283185307179586*casadi.floor(0.25 + 0.15915494309189535*t320)
+    t322 = casadi.if_else(t246, 0, casadi.atan2(-t251, t239))
+    t323 = t322
+    t324 = t323 - 6.283185307179586*casadi.floor(0.4722222222222222 + 0.15915494309189535*t323)
+    t325 = 3.141592653589793 + t322 - 6.283185307179586*casadi.ceil(0.15915494309189535*t322)
+    t326 = t325 - 6.283185307179586*casadi.floor(0.4722222222222222 + 0.15915494309189535*t325)
+    t327 = casadi.if_else(t255, 0, casadi.atan2(-t237, t188))
+    t328 = t327
+    t329 = t328 - 6.283185307179586*casadi.floor(0.25 + 0.15915494309189535*t328)
+    t330 = t327 + 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t327)
+    t331 = casadi.if_else((t264 <= 1e-24*t265), 0, casadi.atan2(t260, -t261))
+    t332 = t331
+    t333 = t332 - 6.283185307179586*casadi.floor(0.4722222222222222 + 0.15915494309189535*t332)
+    t334 = 3.141592653589793 + t331 - 6.283185307179586*casadi.ceil(0.15915494309189535*t331)
+    t335 = t334 - 6.283185307179586*casadi.floor(0.4722222222222222 + 0.15915494309189535*t334)
+    t336 = -t330
+    t337 = t330 + 6.283185307179586*casadi.floor(0.25 + 0.15915494309189535*t336)
+    t338 = (t53 <= 2.9670597283903604)
+    t339 = casadi.logic_and((t52 >= -2.9670597283903604), (t52 <= 2.9670597283903604))
+    t340 = casadi.if_else(casadi.logic_and(t338, casadi.logic_not(t339)), t53, t52)
+    t341 = t340
+    t342 = t341 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn1 - 0.15915494309189535*t341)
+    t343 = casadi.if_else((qn1 > t342), 6.283185307179586, -6.283185307179586)
+    t344 = t342 + t343
+    t345 = t342 - t343
+    t346 = casadi.if_else(casadi.logic_and((t342 >= -2.9670597283903604), (t342 <= 2.9670597283903604)), t342, casadi.if_else(casadi.logic_and((t344 >= -2.9670597283903604), (t344 <= 2.9670597283903604)), t344, casadi.if_else(casadi.logic_and((t345 >= -2.9670597283903604), (t345 <= 2.9670597283903604)), t345, t340)))
+    t347 = (t271 <= 2.9670597283903604)
+    t348 = casadi.logic_and((t270 >= -2.9670597283903604), (t270 <= 2.9670597283903604))
+    t349 = casadi.if_else(casadi.logic_and(t347, casadi.logic_not(t348)), t271, t270)
+    t350 = t349
+    t351 = t350 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t350)
+    t352 = casadi.if_else((qn2 > t351), 6.283185307179586, -6.283185307179586)
+    t353 = t351 + t352
+    t354 = t351 - t352
+    t355 = casadi.if_else(casadi.logic_and((t351 >= -2.9670597283903604), (t351 <= 2.9670597283903604)), t351, casadi.if_else(casadi.logic_and((t353 >= -2.9670597283903604), (t353 <= 2.9670597283903604)), t353, casadi.if_else(casadi.logic_and((t354 >= -2.9670597283903604), (t354 <= 2.9670597283903604)), t354, t349)))
+    t356 = (t276 <= 2.9670597283903604)
+    t357 = casadi.logic_and((t275 >= -2.9670597283903604), (t275 <= 2.9670597283903604))
+    t358 = casadi.if_else(casadi.logic_and(t356, casadi.logic_not(t357)), t276, t275)
+    t359 = t358
+    t360 = t359 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t359)
+    t361 = casadi.if_else((qn4 > t360), 6.283185307179586, -6.283185307179586)
+    t362 = t360 + t361
+    t363 = t360 - t361
+    t364 = casadi.if_else(casadi.logic_and((t360 >= -2.9670597283903604), (t360 <= 2.9670597283903604)), t360, casadi.if_else(casadi.logic_and((t362 >= -2.9670597283903604), (t362 <= 2.9670597283903604)), t362, casadi.if_else(casadi.logic_and((t363 >= -2.9670597283903604), (t363 <= 2.9670597283903604)), t363, t358)))
+    t365 = (t281 <= 1.5707963267948966)
+    t366 = casadi.logic_and((t280 >= -1.5707963267948966), (t280 <= 1.5707963267948966))
+    t367 = casadi.if_else(casadi.logic_and(t365, casadi.logic_not(t366)), t281, t280)
+    t368 = t367
+    t369 = t368 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn5 - 0.15915494309189535*t368)
+    t370 = casadi.if_else((qn5 > t369), 6.283185307179586, -6.283185307179586)
+    t371 = t369 + t370
+    t372 = t369 - t370
+    t373 = casadi.if_else(casadi.logic_and((t369 >= -1.5707963267948966), (t369 <= 1.5707963267948966)), t369, casadi.if_else(casadi.logic_and((t371 >= -1.5707963267948966), (t371 <= 1.5707963267948966)), t371, casadi.if_else(casadi.logic_and((t372 >= -1.5707963267948966), (t372 <= 1.5707963267948966)), t372, t367)))
+    t374 = (t285 <= 2.9670597283903604)
+    t375 = casadi.logic_and((t284 >= -2.9670597283903604), (t284 <= 2.9670597283903604))
+    t376 = casadi.if_else(casadi.logic_and(t374, casadi.logic_not(t375)), t285, t284)
+    t377 = t376
+    t378 = t377 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn6 - 0.15915494309189535*t377)
+    t379 = casadi.if_else((qn6 > t378), 6.283185307179586, -6.283185307179586)
+    t380 = t378 + t379
+    t381 = t378 - t379
+    t382 = casadi.if_else(casadi.logic_and((t378 >= -2.9670597283903604), (t378 <= 2.9670597283903604)), t378, casadi.if_else(casadi.logic_and((t380 >= -2.9670597283903604), (t380 <= 2.9670597283903604)), t380, casadi.if_else(casadi.logic_and((t381 >= -2.9670597283903604), (t381 <= 2.9670597283903604)), t381, t376)))
+    t383 = -qn4
+    t384 = -qn5
+    t385 = -qn6
+    t386 = -qn1
+    t387 = qw1*(t346 + t386)**2
+    t388 = -qn2
+    t389 = qw3*(t19 - qn3)**2
+    t390 = t387 + t389 + qw2*(t355 + t388)**2
+    t391 = t390 + qw4*(t364 + t383)**2 + qw5*(t373 + t384)**2 + qw6*(t382 + t385)**2
+    t392 = (casadi.fabs(t267) < casadi.inf)
+    t393 = (t19 >= 0.30479999999999996)
+    t394 = (t19 <= 1.27)
+    t395 = (t15 <= t17)
+    t396 = (t23 <= t24)
+    t397 = casadi.logic_or(t338, t339)
+    t398 = casadi.logic_or(t347, t348)
+    t399 = casadi.if_else(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t392, t393), t394), t395), t396), t397), t398), (t102 >= -1e-12)), casadi.logic_or(t356, t357)), casadi.logic_or(t365, t366)), casadi.logic_or(t374, t375)), 1, 0)
+    t400 = casadi.if_else((t399 > 0), 1, 0)
+    t401 = (t400 > 0)
+    t402 = casadi.if_else(t401, t346, qn1)
+    t403 = casadi.if_else(t401, t355, qn2)
+    t404 = casadi.if_else(t401, t19, qn3)
+    t405 = casadi.if_else(t401, t364, qn4)
+    t406 = casadi.if_else(t401, t373, qn5)
+    t407 = casadi.if_else(t401, t382, qn6)
+    t408 = casadi.if_else(t401, t391, 0)
+    t409 = (t278 <= 2.9670597283903604)
+    t410 = casadi.logic_and((t277 >= -2.9670597283903604), (t277 <= 2.9670597283903604))
+    t411 = casadi.if_else(casadi.logic_and(t409, casadi.logic_not(t410)), t278, t277)
+    t412 = t411
+    t413 = t412 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t412)
+    t414 = casadi.if_else((qn4 > t413), 6.283185307179586, -6.283185307179586)
+    t415 = t413 + t414
+    t416 = t413 - t414
+    t417 = casadi.if_else(casadi.logic_and((t413 >= -2.9670597283903604), (t413 <= 2.9670597283903604)), t413, casadi.if_else(casadi.logic_and((t415 >= -2.9670597283903604), (t415 <= 2.9670597283903604)), t415, casadi.if_else(casadi.logic_and((t416 >= -2.9670597283903604), (t416 <= 2.9670597283903604)), t416, t411)))
+    t418 = (t289 >= -1.5707963267948966)
+    t419 = casadi.logic_and((t282 >= -1.5707963267948966), (t282 <= 1.5707963267948966))
+    t420 = casadi.if_else(casadi.logic_and(t418, casadi.logic_not(t419)), -t289, t288)
+    t421 = t420
+    t422 = t421 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn5 - 0.15915494309189535*t421)
+    t423 = casadi.if_else((qn5 > t422), 6.283185307179586, -6.283185307179586)
+    t424 = t422 + t423
+    t425 = t422 - t423
+    t426 = casadi.if_else(casadi.logic_and((t422 >= -1.5707963267948966), (t422 <= 1.5707963267948966)), t422, casadi.if_else(casadi.logic_and((t424 >= -1.5707963267948966), (t424 <= 1.5707963267948966)), t424, casadi.if_else(casadi.logic_and((t425 >= -1.5707963267948966), (t425 <= 1.5707963267948966)), t425, t420)))
+    t427 = (t287 <= 2.9670597283903604)
+    t428 = casadi.logic_and((t286 >= -2.9670597283903604), (t286 <= 2.9670597283903604))
+    t429 = casadi.if_else(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t103, t392), t393), t394), t395), t396), t397), t398), casadi.logic_or(t409, t410)), casadi.logic_or(t418, t419)), casadi.logic_or(t427, t428)), 1, 0)
+    t430 = casadi.if_else(casadi.logic_and(t427, casadi.logic_not(t428)), t287, t286)
+    t431 = t430
+    t432 = t431 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn6 - 0.15915494309189535*t431)
+    t433 = casadi.if_else((qn6 > t432), 6.283185307179586, -6.283185307179586)
+    t434 = t432 + t433
+    t435 = t432 - t433
+    t436 = casadi.if_else(casadi.logic_and((t432 >= -2.9670597283903604), (t432 <= 2.9670597283903604)), t432, casadi.if_else(casadi.logic_and((t434 >= -2.9670597283903604), (t434 <= 2.9670597283903604)), t434, casadi.if_else(casadi.logic_and((t435 >= -2.9670597283903604), (t435 <= 2.9670597283903604)), t435, t430)))
+    t437 = t390 + qw4*(t383 + t417)**2 + qw5*(t384 + t426)**2 + qw6*(t385 + t436)**2
+    t438 = (t429 > 0)
+    t439 = casadi.if_else(casadi.logic_and(t438, casadi.logic_or((t408 > t437), (t400 < 1))), 1, 0)
+    t440 = casadi.if_else(t438, 1, t400)
+    t441 = (t439 > 0)
+    t442 = casadi.if_else(t441, t346, t402)
+    t443 = casadi.if_else(t441, t355, t403)
+    t444 = casadi.if_else(t441, t19, t404)
+    t445 = casadi.if_else(t441, t417, t405)
+    t446 = casadi.if_else(t441, t426, t406)
+    t447 = casadi.if_else(t441, t436, t407)
+    t448 = casadi.if_else(t441, t437, t408)
+    t449 = (t81 <= 2.9670597283903604)
+    t450 = casadi.logic_and((t80 >= -2.9670597283903604), (t80 <= 2.9670597283903604))
+    t451 = casadi.if_else(casadi.logic_and(t449, casadi.logic_not(t450)), t81, t80)
+    t452 = t451
+    t453 = t452 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn1 - 0.15915494309189535*t452)
+    t454 = casadi.if_else((qn1 > t453), 6.283185307179586, -6.283185307179586)
+    t455 = t453 + t454
+    t456 = t453 - t454
+    t457 = casadi.if_else(casadi.logic_and((t453 >= -2.9670597283903604), (t453 <= 2.9670597283903604)), t453, casadi.if_else(casadi.logic_and((t455 >= -2.9670597283903604), (t455 <= 2.9670597283903604)), t455, casadi.if_else(casadi.logic_and((t456 >= -2.9670597283903604), (t456 <= 2.9670597283903604)), t456, t451)))
+    t458 = (t68 <= 2.9670597283903604)
+    t459 = casadi.logic_and((t67 >= -2.9670597283903604), (t67 <= 2.9670597283903604))
+    t460 = casadi.if_else(casadi.logic_and(t458, casadi.logic_not(t459)), t68, t67)
+    t461 = t460
+    t462 = t461 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t461)
+    t463 = casadi.if_else((qn2 > t462), 6.283185307179586, -6.283185307179586)
+    t464 = t462 + t463
+    t465 = t462 - t463
+    t466 = casadi.if_else(casadi.logic_and((t462 >= -2.9670597283903604), (t462 <= 2.9670597283903604)), t462, casadi.if_else(casadi.logic_and((t464 >= -2.9670597283903604), (t464 <= 2.9670597283903604)), t464, casadi.if_else(casadi.logic_and((t465 >= -2.9670597283903604), (t465 <= 2.9670597283903604)), t465, t460)))
+    t467 = (t292 <= 2.9670597283903604)
+    t468 = casadi.logic_and((t291 >= -2.9670597283903604), (t291 <= 2.9670597283903604))
+    t469 = casadi.if_else(casadi.logic_and(t467, casadi.logic_not(t468)), t292, t291)
+    t470 = t469
+    t471 = t470 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t470)
+    t472 = casadi.if_else((qn4 > t471), 6.283185307179586, -6.283185307179586)
+    t473 = t471 + t472
+    t474 = t471 - t472
+    t475 = casadi.if_else(casadi.logic_and((t471 >= -2.9670597283903604), (t471 <= 2.9670597283903604)), t471, casadi.if_else(casadi.logic_and((t473 >= -2.9670597283903604), (t473 <= 2.9670597283903604)), t473, casadi.if_else(casadi.logic_and((t474 >= -2.9670597283903604), (t474 <= 2.9670597283903604)), t474, t469)))
+    t476 = (t297 <= 1.5707963267948966)
+    t477 = casadi.logic_and((t296 >= -1.5707963267948966), (t296 <= 1.5707963267948966))
+    t478 = casadi.if_else(casadi.logic_and(t476, casadi.logic_not(t477)), t297, t296)
+    t479 = t478
+    t480 = t479 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn5 - 0.15915494309189535*t479)
+    t481 = casadi.if_else((qn5 > t480), 6.283185307179586, -6.283185307179586)
+    t482 = t480 + t481
+    t483 = t480 - t481
+    t484 = casadi.if_else(casadi.logic_and((t480 >= -1.5707963267948966), (t480 <= 1.5707963267948966)), t480, casadi.if_else(casadi.logic_and((t482 >= -1.5707963267948966), (t482 <= 1.5707963267948966)), t482, casadi.if_else(casadi.logic_and((t483 >= -1.5707963267948966), (t483 <= 1.5707963267948966)), t483, t478)))
+    t485 = (t301 <= 2.9670597283903604)
+    t486 = casadi.logic_and((t300 >= -2.9670597283903604), (t300 <= 2.9670597283903604))
+    t487 = casadi.if_else(casadi.logic_and(t485, casadi.logic_not(t486)), t301, t300)
+    t488 = t487
+    t489 = t488 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn6 - 0.15915494309189535*t488)
+    t490 = casadi.if_else((qn6 > t489), 6.283185307179586, -6.283185307179586)
+    t491 = t489 + t490
+    t492 = t489 - t490
+    t493 = casadi.if_else(casadi.logic_and((t489 >= -2.9670597283903604), (t489 <= 2.9670597283903604)), t489, casadi.if_else(casadi.logic_and((t491 >= -2.9670597283903604), (t491 <= 2.9670597283903604)), t491, casadi.if_else(casadi.logic_and((t492 >= -2.9670597283903604), (t492 <= 2.9670597283903604)), t492, t487)))
+    t494 = qw1*(t386 + t457)**2
+    t495 = t389 + t494 + qw2*(t388 + t466)**2
+    t496 = t495 + qw4*(t383 + t475)**2 + qw5*(t384 + t484)**2 + qw6*(t385 + t493)**2
+    t497 = casadi.logic_or(t449, t450)
+    t498 = casadi.logic_or(t458, t459)
+    t499 = casadi.if_else(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t25, t392), t393), t394), t395), t497), t498), (t144 >= -1e-12)), casadi.logic_or(t467, t468)), casadi.logic_or(t476, t477)), casadi.logic_or(t485, t486)), 1, 0)
+    t500 = (t499 > 0)
+    t501 = casadi.if_else(casadi.logic_and(t500, casadi.logic_or((t448 > t496), (t440 < 1))), 1, 0)
+    t502 = casadi.if_else(t500, 1, t440)
+    t503 = (t501 > 0)
+    t504 = casadi.if_else(t503, t457, t442)
+    t505 = casadi.if_else(t503, t466, t443)
+    t506 = casadi.if_else(t503, t19, t444)
+    t507 = casadi.if_else(t503, t475, t445)
+    t508 = casadi.if_else(t503, t484, t446)
+    t509 = casadi.if_else(t503, t493, t447)
+    t510 = casadi.if_else(t503, t496, t448)
+    t511 = (t294 <= 2.9670597283903604)
+    t512 = casadi.logic_and((t293 >= -2.9670597283903604), (t293 <= 2.9670597283903604))
+    t513 = casadi.if_else(casadi.logic_and(t511, casadi.logic_not(t512)), t294, t293)
+    t514 = t513
+    t515 = t514 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t514)
+    t516 = casadi.if_else((qn4 > t515), 6.283185307179586, -6.283185307179586)
+    t517 = t515 + t516
+    t518 = t515 - t516
+    t519 = casadi.if_else(casadi.logic_and((t515 >= -2.9670597283903604), (t515 <= 2.9670597283903604)), t515, casadi.if_else(casadi.logic_and((t517 >= -2.9670597283903604), (t517 <= 2.9670597283903604)), t517, casadi.if_else(casadi.logic_and((t518 >= -2.9670597283903604), (t518 <= 2.9670597283903604)), t518, t513)))
+    t520 = (t305 >= -1.5707963267948966)
+    t521 = casadi.logic_and((t298 >= -1.5707963267948966), (t298 <= 1.5707963267948966))
+    t522 = casadi.if_else(casadi.logic_and(t520, casadi.logic_not(t521)), -t305, t304)
+    t523 = t522
+    t524 = t523 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn5 - 0.15915494309189535*t523)
+    t525 = casadi.if_else((qn5 > t524), 6.283185307179586, -6.283185307179586)
+    t526 = t524 + t525
+    t527 = t524 - t525
+    t528 = casadi.if_else(casadi.logic_and((t524 >= -1.5707963267948966), (t524 <= 1.5707963267948966)), t524, casadi.if_else(casadi.logic_and((t526 >= -1.5707963267948966), (t526 <= 1.5707963267948966)), t526, casadi.if_else(casadi.logic_and((t527 >= -1.5707963267948966), (t527 <= 1.5707963267948966)), t527, t522)))
+    t529 = (t303 <= 2.9670597283903604)
+    t530 = casadi.logic_and((t302 >= -2.9670597283903604), (t302 <= 2.9670597283903604))
+    t531 = casadi.if_else(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t145, t25), t392), t393), t394), t395), t497), t498), casadi.logic_or(t511, t512)), casadi.logic_or(t520, t521)), casadi.logic_or(t529, t530)), 1, 0)
+    t532 = casadi.if_else(casadi.logic_and(t529, casadi.logic_not(t530)), t303, t302)
+    t533 = t532
+    t534 = t533 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn6 - 0.15915494309189535*t533)
+    t535 = casadi.if_else((qn6 > t534), 6.283185307179586, -6.283185307179586)
+    t536 = t534 + t535
+    t537 = t534 - t535
+    t538 = casadi.if_else(casadi.logic_and((t534 >= -2.9670597283903604), (t534 <= 2.9670597283903604)), t534, casadi.if_else(casadi.logic_and((t536 >= -2.9670597283903604), (t536 <= 2.9670597283903604)), t536, casadi.if_else(casadi.logic_and((t537 >= -2.9670597283903604), (t537 <= 2.9670597283903604)), t537, t532)))
+    t539 = t495 + qw4*(t383 + t519)**2 + qw5*(t384 + t528)**2 + qw6*(t385 + t538)**2
+    t540 = (t531 > 0)
+    t541 = casadi.if_else(casadi.logic_and(t540, casadi.logic_or((t510 > t539), (t502 < 1))), 1, 0)
+    t542 = casadi.if_else(t540, 1, t502)
+    t543 = (t541 > 0)
+    t544 = casadi.if_else(t543, t457, t504)
+    t545 = casadi.if_else(t543, t466, t505)
+    t546 = casadi.if_else(t543, t19, t506)
+    t547 = casadi.if_else(t543, t519, t507)
+    t548 = casadi.if_else(t543, t528, t508)
+    t549 = casadi.if_else(t543, t538, t509)
+    t550 = casadi.if_else(t543, t539, t510)
+    t551 = (t179 <= 2.9670597283903604)
+    t552 = casadi.logic_and((t178 >= -2.9670597283903604), (t178 <= 2.9670597283903604))
+    t553 = casadi.if_else(casadi.logic_and(t551, casadi.logic_not(t552)), t179, t178)
+    t554 = t553
+    t555 = t554 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t554)
+    t556 = casadi.if_else((qn2 > t555), 6.283185307179586, -6.283185307179586)
+    t557 = t555 + t556
+    t558 = t555 - t556
+    t559 = casadi.if_else(casadi.logic_and((t555 >= -2.9670597283903604), (t555 <= 2.9670597283903604)), t555, casadi.if_else(casadi.logic_and((t557 >= -2.9670597283903604), (t557 <= 2.9670597283903604)), t557, casadi.if_else(casadi.logic_and((t558 >= -2.9670597283903604), (t558 <= 2.9670597283903604)), t558, t553)))
+    t560 = (t308 <= 2.9670597283903604)
+    t561 = casadi.logic_and((t307 >= -2.9670597283903604), (t307 <= 2.9670597283903604))
+    t562 = casadi.if_else(casadi.logic_and(t560, casadi.logic_not(t561)), t308, t307)
+    t563 = t562
+    t564 = t563 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t563)
+    t565 = casadi.if_else((qn4 > t564), 6.283185307179586, -6.283185307179586)
+    t566 = t564 + t565
+    t567 = t564 - t565
+    t568 = casadi.if_else(casadi.logic_and((t564 >= -2.9670597283903604), (t564 <= 2.9670597283903604)), t564, casadi.if_else(casadi.logic_and((t566 >= -2.9670597283903604), (t566 <= 2.9670597283903604)), t566, casadi.if_else(casadi.logic_and((t567 >= -2.9670597283903604), (t567 <= 2.9670597283903604)), t567, t562)))
+    t569 = (t313 <= 1.5707963267948966)
+    t570 = casadi.logic_and((t312 >= -1.5707963267948966), (t312 <= 1.5707963267948966))
+    t571 = casadi.if_else(casadi.logic_and(t569, casadi.logic_not(t570)), t313, t312)
+    t572 = t571
+    t573 = t572 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn5 - 0.15915494309189535*t572)
+    t574 = casadi.if_else((qn5 > t573), 6.283185307179586, -6.283185307179586)
+    t575 = t573 + t574
+    t576 = t573 - t574
+    t577 = casadi.if_else(casadi.logic_and((t573 >= -1.5707963267948966), (t573 <= 1.5707963267948966)), t573, casadi.if_else(casadi.logic_and((t575 >= -1.5707963267948966), (t575 <= 1.5707963267948966)), t575, casadi.if_else(casadi.logic_and((t576 >= -1.5707963267948966), (t576 <= 1.5707963267948966)), t576, t571)))
+    t578 = (t317 <= 2.9670597283903604)
+    t579 = casadi.logic_and((t316 >= -2.9670597283903604), (t316 <= 2.9670597283903604))
+    t580 = casadi.if_else(casadi.logic_and(t578, casadi.logic_not(t579)), t317, t316)
+    t581 = t580
+    t582 = t581 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn6 - 0.15915494309189535*t581)
+    t583 = casadi.if_else((qn6 > t582), 6.283185307179586, -6.283185307179586)
+    t584 = t582 + t583
+    t585 = t582 - t583
+    t586 = casadi.if_else(casadi.logic_and((t582 >= -2.9670597283903604), (t582 <= 2.9670597283903604)), t582, casadi.if_else(casadi.logic_and((t584 >= -2.9670597283903604), (t584 <= 2.9670597283903604)), t584, casadi.if_else(casadi.logic_and((t585 >= -2.9670597283903604), (t585 <= 2.9670597283903604)), t585, t580)))
+    t587 = qw3*(qn3 + t19)**2
+    t588 = t387 + t587 + qw2*(t388 + t559)**2
+    t589 = t588 + qw4*(t383 + t568)**2 + qw5*(t384 + t577)**2 + qw6*(t385 + t586)**2
+    t590 = (t19 >= -1.27)
+    t591 = (t19 <= -0.30479999999999996)
+    t592 = casadi.logic_or(t551, t552)
+    t593 = casadi.if_else(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t18, t392), t396), t397), t590), t591), t592), (t202 >= -1e-12)), casadi.logic_or(t560, t561)), casadi.logic_or(t569, t570)), casadi.logic_or(t578, t579)), 1, 0)
+    t594 = (t593 > 0)
+    t595 = casadi.if_else(casadi.logic_and(t594, casadi.logic_or((t550 > t589), (t542 < 1))), 1, 0)
+    t596 = casadi.if_else(t594, 1, t542)
+    t597 = (t595 > 0)
+    t598 = casadi.if_else(t597, t346, t544)
+    t599 = casadi.if_else(t597, t559, t545)
+    t600 = casadi.if_else(t597, t568, t547)
+    t601 = casadi.if_else(t597, t577, t548)
+    t602 = casadi.if_else(t597, t586, t549)
+    t603 = casadi.if_else(t597, t589, t550)
+    t604 = -t19
+    t605 = casadi.if_else(t597, t604, t546)
+    t606 = (t310 <= 2.9670597283903604)
+    t607 = casadi.logic_and((t309 >= -2.9670597283903604), (t309 <= 2.9670597283903604))
+    t608 = casadi.if_else(casadi.logic_and(t606, casadi.logic_not(t607)), t310, t309)
+    t609 = t608
+    t610 = t609 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t609)
+    t611 = casadi.if_else((qn4 > t610), 6.283185307179586, -6.283185307179586)
+    t612 = t610 + t611
+    t613 = t610 - t611
+    t614 = casadi.if_else(casadi.logic_and((t610 >= -2.9670597283903604), (t610 <= 2.9670597283903604)), t610, casadi.if_else(casadi.logic_and((t612 >= -2.9670597283903604), (t612 <= 2.9670597283903604)), t612, casadi.if_else(casadi.logic_and((t613 >= -2.9670597283903604), (t613 <= 2.9670597283903604)), t613, t608)))
+    t615 = (t321 >= -1.5707963267948966)
+    t616 = casadi.logic_and((t314 >= -1.5707963267948966), (t314 <= 1.5707963267948966))
+    t617 = casadi.if_else(casadi.logic_and(t615, casadi.logic_not(t616)), -t321, t320)
+    t618 = t617
+    t619 = t618 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn5 - 0.15915494309189535*t618)
+    t620 = casadi.if_else((qn5 > t619), 6.283185307179586, -6.283185307179586)
+    t621 = t619 + t620
+    t622 = t619 - t620
+    t623 = casadi.if_else(casadi.logic_and((t619 >= -1.5707963267948966), (t619 <= 1.5707963267948966)), t619, casadi.if_else(casadi.logic_and((t621 >= -1.5707963267948966), (t621 <= 1.5707963267948966)), t621, casadi.if_else(casadi.logic_and((t622 >= -1.5707963267948966), (t622 <= 1.5707963267948966)), t622, t617)))
+    t624 = (t319 <= 2.9670597283903604)
+    t625 = casadi.logic_and((t318 >= -2.9670597283903604), (t318 <= 2.9670597283903604))
+    t626 = casadi.if_else(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t18, t203), t392), t396), t397), t590), t591), t592), casadi.logic_or(t606, t607)), casadi.logic_or(t615, t616)), casadi.logic_or(t624, t625)), 1, 0)
+    t627 = casadi.if_else(casadi.logic_and(t624, casadi.logic_not(t625)), t319, t318)
+    t628 = t627
+    t629 = t628 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn6 - 0.15915494309189535*t628)
+    t630 = casadi.if_else((qn6 > t629), 6.283185307179586, -6.283185307179586)
+    t631 = t629 + t630
+    t632 = t629 - t630
+    t633 = casadi.if_else(casadi.logic_and((t629 >= -2.9670597283903604), (t629 <= 2.9670597283903604)), t629, casadi.if_else(casadi.logic_and((t631 >= -2.9670597283903604), (t631 <= 2.9670597283903604)), t631, casadi.if_else(casadi.logic_and((t632 >= -2.9670597283903604), (t632 <= 2.9670597283903604)), t632, t627)))
+    t634 = t588 + qw4*(t383 + t614)**2 + qw5*(t384 + t623)**2 + qw6*(t385 + t633)**2
+    t635 = (t626 > 0)
+    t636 = casadi.if_else(casadi.logic_and(t635, casadi.logic_or((t603 > t634), (t596 < 1))), 1, 0)
+    t637 = casadi.if_else(t635, 1, t596)
+    t638 = (t636 > 0)
+    t639 = casadi.if_else(t638, t346, t598)
+    t640 = casadi.if_else(t638, t559, t599)
+    t641 = casadi.if_else(t638, t604, t605)
+    t642 = casadi.if_else(t638, t614, t600)
+    t643 = casadi.if_else(t638, t623, t601)
+    t644 = casadi.if_else(t638, t633, t602)
+    t645 = casadi.if_else(t638, t634, t603)
+    t646 = (t273 <= 2.9670597283903604)
+    t647 = casadi.logic_and((t272 >= -2.9670597283903604), (t272 <= 2.9670597283903604))
+    t648 = casadi.if_else(casadi.logic_and(t646, casadi.logic_not(t647)), t273, t272)
+    t649 = t648
+    t650 = t649 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t649)
+    t651 = casadi.if_else((qn2 > t650), 6.283185307179586, -6.283185307179586)
+    t652 = t650 + t651
+    t653 = t650 - t651
+    t654 = casadi.if_else(casadi.logic_and((t650 >= -2.9670597283903604), (t650 <= 2.9670597283903604)), t650, casadi.if_else(casadi.logic_and((t652 >= -2.9670597283903604), (t652 <= 2.9670597283903604)), t652, casadi.if_else(casadi.logic_and((t653 >= -2.9670597283903604), (t653 <= 2.9670597283903604)), t653, t648)))
+    t655 = (t324 <= 2.9670597283903604)
+    t656 = casadi.logic_and((t323 >= -2.9670597283903604), (t323 <= 2.9670597283903604))
+    t657 = casadi.if_else(casadi.logic_and(t655, casadi.logic_not(t656)), t324, t323)
+    t658 = t657
+    t659 = t658 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t658)
+    t660 = casadi.if_else((qn4 > t659), 6.283185307179586, -6.283185307179586)
+    t661 = t659 + t660
+    t662 = t659 - t660
+    t663 = casadi.if_else(casadi.logic_and((t659 >= -2.9670597283903604), (t659 <= 2.9670597283903604)), t659, casadi.if_else(casadi.logic_and((t661 >= -2.9670597283903604), (t661 <= 2.9670597283903604)), t661, casadi.if_else(casadi.logic_and((t662 >= -2.9670597283903604), (t662 <= 2.9670597283903604)), t662, t657)))
+    t664 = (t329 <= 1.5707963267948966)
+    t665 = casadi.logic_and((t328 >= -1.5707963267948966), (t328 <= 1.5707963267948966))
+    t666 = casadi.if_else(casadi.logic_and(t664, casadi.logic_not(t665)), t329, t328)
+    t667 = t666
+    t668 = t667 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn5 - 0.15915494309189535*t667)
+    t669 = casadi.if_else((qn5 > t668), 6.283185307179586, -6.283185307179586)
+    t670 = t668 + t669
+    t671 = t668 - t669
+    t672 = casadi.if_else(casadi.logic_and((t668 >= -1.5707963267948966), (t668 <= 1.5707963267948966)), t668, casadi.if_else(casadi.logic_and((t670 >= -1.5707963267948966), (t670 <= 1.5707963267948966)), t670, casadi.if_else(casadi.logic_and((t671 >= -1.5707963267948966), (t671 <= 1.5707963267948966)), t671, t666)))
+    t673 = (t333 <= 2.9670597283903604)
+    t674 = casadi.logic_and((t332 >= -2.9670597283903604), (t332 <= 2.9670597283903604))
+    t675 = casadi.if_else(casadi.logic_and(t673, casadi.logic_not(t674)), t333, t332)
+    t676 = t675
+    t677 = t676 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn6 - 0.15915494309189535*t676)
+    t678 = casadi.if_else((qn6 > t677), 6.283185307179586, -6.283185307179586)
+    t679 = t677 + t678
+    t680 = t677 - t678
+    t681 = casadi.if_else(casadi.logic_and((t677 >= -2.9670597283903604), (t677 <= 2.9670597283903604)), t677, casadi.if_else(casadi.logic_and((t679 >= -2.9670597283903604), (t679 <= 2.9670597283903604)), t679, casadi.if_else(casadi.logic_and((t680 >= -2.9670597283903604), (t680 <= 2.9670597283903604)), t680, t675)))
+    t682 = t494 + t587 + qw2*(t388 + t654)**2
+    t683 = t682 + qw4*(t383 + t663)**2 + qw5*(t384 + t672)**2 + qw6*(t385 + t681)**2
+    t684 = casadi.logic_or(t646, t647)
+    t685 = casadi.if_else(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t18, t25), t392), t497), t590), t591), t684), (t235 >= -1e-12)), casadi.logic_or(t655, t656)), casadi.logic_or(t664, t665)), casadi.logic_or(t673, t674)), 1, 0)
+    t686 = (t685 > 0)
+    t687 = casadi.if_else(casadi.logic_and(t686, casadi.logic_or((t645 > t683), (t637 < 1))), 1, 0)
+    t688 = casadi.if_else(t686, 1, t637)
+    t689 = (t687 > 0)
+    t690 = casadi.if_else(t689, t457, t639)
+    t691 = casadi.if_else(t689, t654, t640)
+    t692 = casadi.if_else(t689, t604, t641)
+    t693 = casadi.if_else(t689, t663, t642)
+    t694 = casadi.if_else(t689, t672, t643)
+    t695 = casadi.if_else(t689, t681, t644)
+    t696 = casadi.if_else(t689, t683, t645)
+    t697 = (t326 <= 2.9670597283903604)
+    t698 = casadi.logic_and((t325 >= -2.9670597283903604), (t325 <= 2.9670597283903604))
+    t699 = casadi.if_else(casadi.logic_and(t697, casadi.logic_not(t698)), t326, t325)
+    t700 = t699
+    t701 = t700 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t700)
+    t702 = casadi.if_else((qn4 > t701), 6.283185307179586, -6.283185307179586)
+    t703 = t701 + t702
+    t704 = t701 - t702
+    t705 = casadi.if_else(casadi.logic_and((t701 >= -2.9670597283903604), (t701 <= 2.9670597283903604)), t701, casadi.if_else(casadi.logic_and((t703 >= -2.9670597283903604), (t703 <= 2.9670597283903604)), t703, casadi.if_else(casadi.logic_and((t704 >= -2.9670597283903604), (t704 <= 2.9670597283903604)), t704, t699)))
+    t706 = (t337 >= -1.5707963267948966)
+    t707 = casadi.logic_and((t330 >= -1.5707963267948966), (t330 <= 1.5707963267948966))
+    t708 = casadi.if_else(casadi.logic_and(t706, casadi.logic_not(t707)), -t337, t336)
+    t709 = t708
+    t710 = t709 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn5 - 0.15915494309189535*t709)
+    t711 = casadi.if_else((qn5 > t710), 6.283185307179586, -6.283185307179586)
+    t712 = t710 + t711
+    t713 = t710 - t711
+    t714 = casadi.if_else(casadi.logic_and((t710 >= -1.5707963267948966), (t710 <= 1.5707963267948966)), t710, casadi.if_else(casadi.logic_and((t712 >= -1.5707963267948966), (t712 <= 1.5707963267948966)), t712, casadi.if_else(casadi.logic_and((t713 >= -1.5707963267948966), (t713 <= 1.5707963267948966)), t713, t708)))
+    t715 = (t335 <= 2.9670597283903604)
+    t716 = casadi.logic_and((t334 >= -2.9670597283903604), (t334 <= 2.9670597283903604))
+    t717 = casadi.if_else(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t18, t236), t25), t392), t497), t590), t591), t684), casadi.logic_or(t697, t698)), casadi.logic_or(t706, t707)), casadi.logic_or(t715, t716)), 1, 0)
+    t718 = casadi.if_else(casadi.logic_and(t715, casadi.logic_not(t716)), t335, t334)
+    t719 = t718
+    t720 = t719 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn6 - 0.15915494309189535*t719)
+    t721 = casadi.if_else((qn6 > t720), 6.283185307179586, -6.283185307179586)
+    t722 = t720 + t721
+    t723 = t720 - t721
+    t724 = casadi.if_else(casadi.logic_and((t720 >= -2.9670597283903604), (t720 <= 2.9670597283903604)), t720, casadi.if_else(casadi.logic_and((t722 >= -2.9670597283903604), (t722 <= 2.9670597283903604)), t722, casadi.if_else(casadi.logic_and((t723 >= -2.9670597283903604), (t723 <= 2.9670597283903604)), t723, t718)))
+    t725 = t682 + qw4*(t383 + t705)**2 + qw5*(t384 + t714)**2 + qw6*(t385 + t724)**2
+    t726 = (t717 > 0)
+    t727 = casadi.if_else(casadi.logic_and(t726, casadi.logic_or((t696 > t725), (t688 < 1))), 1, 0)
+    t728 = casadi.if_else(t726, 1, t688)
+    t729 = (t727 > 0)
+    t730 = casadi.if_else(t729, t457, t690)
+    t731 = casadi.if_else(t729, t654, t691)
+    t732 = casadi.if_else(t729, t604, t692)
+    t733 = casadi.if_else(t729, t705, t693)
+    t734 = casadi.if_else(t729, t714, t694)
+    t735 = casadi.if_else(t729, t724, t695)
+    t736 = (casadi.fabs(t268) < casadi.inf)
+    t737 = (t728 > 0)
+    t738 = casadi.logic_and(t736, t737)
+    q = casadi.SX(6, 1)
+    q[0, 0] = casadi.if_else(t738, t730, qn1)
+    q[1, 0] = casadi.if_else(t738, t731, qn2)
+    q[2, 0] = casadi.if_else(t738, t732, qn3)
+    q[3, 0] = casadi.if_else(t738, t733, qn4)
+    q[4, 0] = casadi.if_else(t738, t734, qn5)
+    q[5, 0] = casadi.if_else(t738, t735, qn6)
+    status = casadi.SX(1, 1)
+    status[0, 0] = casadi.if_else(casadi.logic_not(t736), 2, casadi.if_else(t737, 0, 1))
+    return [q, status]
 
 
 _q = casadi.SX.sym("q", 6, 1)
@@ -2054,6 +2971,8 @@ _mu_dot = casadi.SX.sym("mu_dot", 6, 1)
 _damping = casadi.SX.sym("damping", 1, 1)
 _target = casadi.SX.sym("target", 4, 4)
 _T = casadi.SX.sym("T", 4, 4)
+_q_seed = casadi.SX.sym("q_seed", 6, 1)
+_weights = casadi.SX.sym("weights", 6, 1)
 fk = casadi.Function("fk", [_q], _fk(_q), ["q"], ["T"])
 jacobian = casadi.Function("jacobian", [_q], _jacobian(_q), ["q"], ["J"])
 fk_jacobian = casadi.Function("fk_jacobian", [_q], _fk_jacobian(_q), ["q"], ["T", "J"])
@@ -2070,8 +2989,9 @@ manipulability = casadi.Function("manipulability", [_q], _manipulability(_q), ["
 jacobian_det = casadi.Function("jacobian_det", [_q], _jacobian_det(_q), ["q"], ["d"])
 velocity_ik = casadi.Function("velocity_ik", [_q, _mu_dot, _damping], _velocity_ik(_q, _mu_dot, _damping), ["q", "mu_dot", "damping"], ["q_dot", "status"])
 ik_numeric_step = casadi.Function("ik_numeric_step", [_target, _q, _damping], _ik_numeric_step(_target, _q, _damping), ["target", "q", "damping"], ["q_start", "q_next", "cost"])
-ik_branches = casadi.Function("ik_branches", [_T], _ik_branches(_T), ["T"], ["q", "valid"])
-ik = ik_branches  # CasADi functions have fixed-size outputs: every branch and its validity
+ik_branches = casadi.Function("ik_branches", [_T], _ik_branches(_T), ["T"], ["q", "valid", "in_limits"])
+ik_nearest = casadi.Function("ik_nearest", [_T, _q_seed, _weights], _ik_nearest(_T, _q_seed, _weights), ["T", "q_seed", "weights"], ["q", "status"])
+ik = ik_branches  # CasADi functions have fixed-size outputs: every branch, its validity and its limits
 
 IK_NUMERIC_CONVERGED = 0  # |error| <= tol
 IK_NUMERIC_ITERATION_LIMIT = 1  # IK_NUMERIC_ITERATIONS steps taken, |error| still above tol
@@ -2113,4 +3033,4 @@ ik_numeric = casadi.Function("ik_numeric", _inputs, _ik_numeric(*_inputs), ["tar
 
 def functions():
     """All functions by name."""
-    return {"fk": fk, "jacobian": jacobian, "fk_jacobian": fk_jacobian, "jacobian_tool": jacobian_tool, "task": task, "task_jacobian": task_jacobian, "fk_jacobian_dot": fk_jacobian_dot, "jacobian_dot": jacobian_dot, "bias_acceleration": bias_acceleration, "task_jacobian_dot": task_jacobian_dot, "hessian": hessian, "singularity_factors": singularity_factors, "manipulability": manipulability, "jacobian_det": jacobian_det, "velocity_ik": velocity_ik, "ik_numeric_step": ik_numeric_step, "ik_branches": ik_branches}
+    return {"fk": fk, "jacobian": jacobian, "fk_jacobian": fk_jacobian, "jacobian_tool": jacobian_tool, "task": task, "task_jacobian": task_jacobian, "fk_jacobian_dot": fk_jacobian_dot, "jacobian_dot": jacobian_dot, "bias_acceleration": bias_acceleration, "task_jacobian_dot": task_jacobian_dot, "hessian": hessian, "singularity_factors": singularity_factors, "manipulability": manipulability, "jacobian_det": jacobian_det, "velocity_ik": velocity_ik, "ik_numeric_step": ik_numeric_step, "ik_branches": ik_branches, "ik_nearest": ik_nearest}

@@ -98,9 +98,13 @@ int ur5_velocity_ik(const ur5_real q[UR5_DOF], const ur5_real mu_dot[UR5_TASK_DI
  * Result: q_start[i], i < 6; q_next[i], i < 6; returned as a scalar. 979 operations. */
 ur5_real ur5_ik_numeric_step(const ur5_real target[16], const ur5_real q[UR5_DOF], ur5_real damping, ur5_real q_start[UR5_DOF], ur5_real q_next[UR5_DOF]);
 
-/* Every branch of the closed-form ik and whether the target allows it.
- * Result: q: 8 x 6 row-major, element (r, c) at q[r * 6 + c]; valid[i], i < 8. 860 operations. */
-void ur5_ik_branches(const ur5_real T[16], ur5_real q[UR5_MAX_IK_SOLUTIONS * UR5_DOF], int valid[UR5_MAX_IK_SOLUTIONS]);
+/* Every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits.
+ * Result: q: 8 x 6 row-major, element (r, c) at q[r * 6 + c]; valid[i], i < 8; in_limits[i], i < 8. 1330 operations. */
+void ur5_ik_branches(const ur5_real T[16], ur5_real q[UR5_MAX_IK_SOLUTIONS * UR5_DOF], int valid[UR5_MAX_IK_SOLUTIONS], int in_limits[UR5_MAX_IK_SOLUTIONS]);
+
+/* The closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status.
+ * Result: q[i], i < 6; returned as a scalar. 2191 operations. */
+int ur5_ik_nearest(const ur5_real T[16], const ur5_real q_seed[UR5_DOF], const ur5_real weights[UR5_DOF], ur5_real q[UR5_DOF]);
 
 /* Statuses of ur5_velocity_ik: OK, singular (a diagonal entry of the QR factor R of the
  * 6 x 6 system at most 1e-12 times its Frobenius norm: take damping > 0), or
@@ -110,12 +114,15 @@ void ur5_ik_branches(const ur5_real T[16], ur5_real q[UR5_MAX_IK_SOLUTIONS * UR5
 #define UR5_VELOCITY_IK_SINGULAR 1
 #define UR5_VELOCITY_IK_NOT_FINITE 2
 
-/* Closed-form inverse kinematics: every joint solution that reaches the target; returns
- * their count k and writes solution i to q[i * UR5_DOF + j], i < k: the valid
- * rows of ur5_ik_branches, in its order. No allocation, no recursion.
+/* Closed-form inverse kinematics: every joint solution inside the joint limits that reaches
+ * the target; returns their count k and writes solution i to q[i * UR5_DOF + j],
+ * i < k: the rows of ur5_ik_branches that are valid and in_limits, in its order
+ * (ur5_ik_branches also gives those outside the limits). No allocation, no recursion.
  * target: the 4x4 tool pose in the world frame (rotation part orthonormal).
- * Result: k <= UR5_MAX_IK_SOLUTIONS solutions, revolute angles wrapped into (-pi, pi],
- * joint limits not applied; k = 0 when the target is out of reach or not finite.
+ * Result: k <= UR5_MAX_IK_SOLUTIONS solutions inside the joint limits, revolute angles
+ * wrapped into (-pi, pi] or, where that is outside the limits, their lowest equivalent
+ * inside them; k = 0 when the target is out of reach or not finite. ik_branches also gives
+ * the solutions outside the limits (in_limits 0).
  * Solver: 6R with axes 2, 3, 4 parallel and axes 5, 6 intersecting (Universal Robots):
  * base angle (SP4), wrist 2 (SP4), wrist 3 (SP1), the sum q2 + q3 + q4 (SP1), elbow (SP3),
  * shoulder (SP1).
@@ -129,6 +136,12 @@ void ur5_ik_branches(const ur5_real T[16], ur5_real q[UR5_MAX_IK_SOLUTIONS * UR5
  * angle the target leaves free (a singular wrist or shoulder) is set to 0.
  */
 int ur5_ik(const ur5_real T[16], ur5_real q[UR5_MAX_IK_SOLUTIONS * UR5_DOF]);
+
+/* Statuses of ur5_ik_nearest: a solution found; no solution inside the limits (out of
+ * reach); the target (its first three rows), q_seed or weights not finite. q = q_seed unless OK. */
+#define UR5_IK_NEAREST_OK 0
+#define UR5_IK_NEAREST_NO_SOLUTION 1
+#define UR5_IK_NEAREST_NOT_FINITE 2
 
 /* ik_numeric status codes. */
 #define UR5_IK_NUMERIC_CONVERGED 0       /* |error| <= tol */

@@ -5,7 +5,8 @@ Universal Robots UR5 (rtb UR5), standard DH
 Every function takes `q` (6 x 1: radians for revolute joints, m for
 prismatic ones) and returns a rows x cols result whose zeros are structural; ik_branches
 (also named ik) takes the target instead of q and returns every branch (MAX_IK_SOLUTIONS x
-DOF) and its validity (MAX_IK_SOLUTIONS x 1, 1 or 0).
+DOF), its validity and whether it is inside the joint limits (MAX_IK_SOLUTIONS x 1 each, 1
+or 0); ik_nearest takes the target and q_seed and returns the solution nearest q_seed.
 Task vector: (x, y, z, roll, pitch, yaw).
 """
 
@@ -2100,7 +2101,7 @@ def _ik_numeric_step(target, q, damping):
 
 
 def _ik_branches(T):
-    """Every branch of the closed-form ik and whether the target allows it: 860 operations."""
+    """Every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits: 1330 operations."""
     T00 = T[0, 0]
     T01 = T[0, 1]
     T02 = T[0, 2]
@@ -2140,373 +2141,1398 @@ def _ik_branches(T):
     t24 = casadi.atan2(t23, t22)
     t25 = casadi.if_else(t18, 0, t24 + t9)
     t26 = t9 - t24
-    t27 = t19*t4
-    t28 = t23*t27
-    t29 = t19*t8
-    t30 = t22*t29
-    t31 = casadi.if_else(t18, 1, -t28 - t30)
-    t32 = t28 - t30
-    t33 = t22*t27
-    t34 = t23*t29
-    t35 = casadi.if_else(t18, 0, t33 - t34)
-    t36 = t33 + t34
-    t37 = t31*t4 + t35*t8
-    t38 = t31*t8 - t35*t4
-    t39 = T00*t35 - T10*t31
-    t40 = T01*t35 - T11*t31
-    t41 = t32*t4 + t36*t8
-    t42 = t32*t8 - t36*t4
-    t43 = T00*t36 - T10*t32
-    t44 = T01*t36 - T11*t32
-    t45 = 1 - t31
-    t46 = t13*t45
-    t47 = t46 + t13*t31
-    t48 = T02*t35
-    t49 = T12*t31
-    t50 = t48 - t49
-    t51 = t49 - t48
-    t52 = t50**2
-    t53 = 1 - t52
-    t54 = (1e-12 < t53)
-    t55 = casadi.if_else(t54, t50, casadi.if_else((t50 > 0), 1, -1))
-    t56 = casadi.if_else(t54, casadi.sqrt(t53), 0)
-    t57 = casadi.atan2(t56, t55)
-    t58 = False
-    t59 = casadi.if_else(t58, 0, t57)
-    t60 = casadi.if_else(t58, 1, t55)
-    t61 = casadi.if_else(t58, 0, t56)
-    t62 = casadi.if_else(t58, 1, 5.99857533835714)
-    t63 = t51*t60
-    t64 = -t63 + t39*t61
-    t65 = t63 + t64
-    t66 = t61**2
-    t67 = t66 + t60**2
-    t68 = t40**2
-    t69 = t65**2 + t66*t68
-    t70 = t68 + t39**2 + t51**2
-    t71 = (t69 <= 1e-24*t67*t70)
-    t72 = casadi.if_else(t71, 1, 1/casadi.sqrt(t69))
-    t73 = casadi.if_else(t71, 1, t65*t72)
-    t74 = t61*(1 - t73)
-    t75 = t74 + t61*t73
-    t76 = t40*t61
-    t77 = casadi.if_else(t71, 0, -t72*t76)
-    t78 = t60*t77
-    t79 = t60*t73
-    t80 = T01*t78 + T02*t75 - T00*t79
-    t81 = T11*t78 + T12*t75 - T10*t79
-    t82 = T21*t78 + T22*t75 - T20*t79
-    t83 = t45*t82
-    t84 = t31*t80 + t35*t81
-    t85 = t35*t80 - t31*t81
-    t86 = t83 + t31*t82
-    t87 = t84**2 + t86**2
-    t88 = t87
-    t89 = t87 + t85**2
-    t90 = (t88 <= 1e-24*t89)
-    t91 = casadi.if_else(t90, 1, 1/casadi.sqrt(t88))
-    t92 = casadi.if_else(t90, 1, -t84*t91)
-    t93 = casadi.if_else(t90, 0, -t86*t91)
-    t94 = 0.10915 - 0.10915*t92
-    t95 = 0.10915 + 0.10915*t92
-    t96 = 0.10915*t92
-    t97 = t94 + t96
-    t98 = t38 + t97
-    t99 = t96 - t95
-    t100 = t38 - t99
-    t101 = 0.09465*t93
-    t102 = t37 - t101
-    t103 = t101 + t37
-    t104 = 0.09465*t92
-    t105 = t104 + t47
-    t106 = -0.089459 + t105
-    t107 = t102**2 + t106**2 + t98**2
-    t108 = 0.16724253125 - 0.5*t107
-    t109 = t47 - t104
-    t110 = -0.089459 + t109
-    t111 = t100**2 + t103**2 + t110**2
-    t112 = 0.16724253125 - 0.5*t111
-    t113 = t108**2
-    t114 = t62**2
-    t115 = 1 - t113*t114
-    t116 = t108*t62
-    t117 = (1e-12 < t115)
-    t118 = casadi.if_else(t117, t116, casadi.if_else((t116 > 0), 1, -1))
-    t119 = casadi.if_else(t117, casadi.sqrt(t115), 0)
-    t120 = casadi.atan2(t119, t118)
-    t121 = casadi.if_else(t58, 0, 3.141592653589793 + t120)
-    t122 = 3.141592653589793 - t120
-    t123 = 0.16670625*t62
-    t124 = casadi.if_else(t58, 1, -t118*t123)
-    t125 = casadi.if_else(t58, 0, -t119*t123)
-    t126 = 0.425 + 0.39225*t124
-    t127 = 0.089459 - 0.39225*t125
-    t128 = -0.089459 + t127
-    t129 = t106*t128 - t102*t126
-    t130 = t102*t128 + t106*t126
-    t131 = t129**2 + t130**2
-    t132 = t126**2 + t128**2
-    t133 = 0.0653905265625*t62
-    t134 = -0.425 + t118*t133
-    t135 = 0.089459 - t119*t133
-    t136 = -0.089459 + t135
-    t137 = t102*t134 + t106*t136
-    t138 = t102*t136 - t106*t134
-    t139 = t137**2 + t138**2
-    t140 = t134**2 + t136**2
-    t141 = t112**2
-    t142 = 1 - t114*t141
-    t143 = t112*t62
-    t144 = (1e-12 < t142)
-    t145 = casadi.if_else(t144, t143, casadi.if_else((t143 > 0), 1, -1))
-    t146 = casadi.if_else(t144, casadi.sqrt(t142), 0)
-    t147 = casadi.atan2(t146, t145)
-    t148 = casadi.if_else(t58, 0, 3.141592653589793 + t147)
-    t149 = casadi.if_else(t58, 1, -t123*t145)
-    t150 = casadi.if_else(t58, 0, -t123*t146)
-    t151 = 3.141592653589793 - t147
-    t152 = 0.425 + 0.39225*t149
-    t153 = 0.089459 - 0.39225*t150
-    t154 = -0.089459 + t153
-    t155 = t110*t154 - t103*t152
-    t156 = t103*t154 + t110*t152
-    t157 = t155**2 + t156**2
-    t158 = t152**2 + t154**2
-    t159 = -0.425 + t133*t145
-    t160 = 0.089459 - t133*t146
-    t161 = -0.089459 + t160
-    t162 = t103*t159 + t110*t161
-    t163 = t103*t161 - t110*t159
-    t164 = t162**2 + t163**2
-    t165 = t159**2 + t161**2
-    t166 = 1 - t32
-    t167 = t13*t166
-    t168 = t167 + t13*t32
-    t169 = T02*t36
-    t170 = T12*t32
-    t171 = t169 - t170
-    t172 = t170 - t169
-    t173 = t171**2
-    t174 = 1 - t173
-    t175 = (1e-12 < t174)
-    t176 = casadi.if_else(t175, t171, casadi.if_else((t171 > 0), 1, -1))
-    t177 = casadi.if_else(t175, casadi.sqrt(t174), 0)
-    t178 = casadi.atan2(t177, t176)
-    t179 = casadi.if_else(t58, 0, t178)
-    t180 = casadi.if_else(t58, 1, t176)
-    t181 = casadi.if_else(t58, 0, t177)
-    t182 = t172*t180
-    t183 = -t182 + t181*t43
-    t184 = t182 + t183
-    t185 = t181**2
-    t186 = t185 + t180**2
-    t187 = t44**2
-    t188 = t184**2 + t185*t187
-    t189 = t187 + t172**2 + t43**2
-    t190 = (t188 <= 1e-24*t186*t189)
-    t191 = casadi.if_else(t190, 1, 1/casadi.sqrt(t188))
-    t192 = casadi.if_else(t190, 1, t184*t191)
-    t193 = t181*(1 - t192)
-    t194 = t193 + t181*t192
-    t195 = t181*t44
-    t196 = casadi.if_else(t190, 0, -t191*t195)
-    t197 = t180*t196
-    t198 = t180*t192
-    t199 = T01*t197 + T02*t194 - T00*t198
-    t200 = T11*t197 + T12*t194 - T10*t198
-    t201 = T21*t197 + T22*t194 - T20*t198
-    t202 = t166*t201
-    t203 = t199*t32 + t200*t36
-    t204 = t199*t36 - t200*t32
-    t205 = t202 + t201*t32
-    t206 = t203**2 + t205**2
-    t207 = t206
-    t208 = t206 + t204**2
-    t209 = (t207 <= 1e-24*t208)
-    t210 = casadi.if_else(t209, 1, 1/casadi.sqrt(t207))
-    t211 = casadi.if_else(t209, 1, -t203*t210)
-    t212 = casadi.if_else(t209, 0, -t205*t210)
-    t213 = 0.10915 - 0.10915*t211
-    t214 = 0.10915 + 0.10915*t211
-    t215 = 0.10915*t211
-    t216 = t213 + t215
-    t217 = t216 + t42
-    t218 = t215 - t214
-    t219 = t42 - t218
-    t220 = 0.09465*t212
-    t221 = t41 - t220
-    t222 = t220 + t41
-    t223 = 0.09465*t211
-    t224 = t168 + t223
-    t225 = -0.089459 + t224
-    t226 = t217**2 + t221**2 + t225**2
-    t227 = 0.16724253125 - 0.5*t226
-    t228 = t168 - t223
-    t229 = -0.089459 + t228
-    t230 = t219**2 + t222**2 + t229**2
-    t231 = 0.16724253125 - 0.5*t230
-    t232 = t227**2
-    t233 = 1 - t114*t232
-    t234 = t227*t62
-    t235 = (1e-12 < t233)
-    t236 = casadi.if_else(t235, t234, casadi.if_else((t234 > 0), 1, -1))
-    t237 = casadi.if_else(t235, casadi.sqrt(t233), 0)
-    t238 = casadi.atan2(t237, t236)
-    t239 = casadi.if_else(t58, 0, 3.141592653589793 + t238)
-    t240 = casadi.if_else(t58, 1, -t123*t236)
-    t241 = casadi.if_else(t58, 0, -t123*t237)
-    t242 = 3.141592653589793 - t238
-    t243 = 0.425 + 0.39225*t240
-    t244 = 0.089459 - 0.39225*t241
-    t245 = -0.089459 + t244
-    t246 = t225*t245 - t221*t243
-    t247 = t221*t245 + t225*t243
-    t248 = t246**2 + t247**2
-    t249 = t243**2 + t245**2
-    t250 = -0.425 + t133*t236
-    t251 = 0.089459 - t133*t237
-    t252 = -0.089459 + t251
-    t253 = t221*t250 + t225*t252
-    t254 = t221*t252 - t225*t250
-    t255 = t253**2 + t254**2
-    t256 = t250**2 + t252**2
-    t257 = t231**2
-    t258 = 1 - t114*t257
-    t259 = t231*t62
-    t260 = (1e-12 < t258)
-    t261 = casadi.if_else(t260, t259, casadi.if_else((t259 > 0), 1, -1))
-    t262 = casadi.if_else(t260, casadi.sqrt(t258), 0)
-    t263 = casadi.atan2(t262, t261)
-    t264 = casadi.if_else(t58, 0, 3.141592653589793 + t263)
-    t265 = casadi.if_else(t58, 1, -t123*t261)
-    t266 = casadi.if_else(t58, 0, -t123*t262)
-    t267 = 3.141592653589793 - t263
-    t268 = 0.425 + 0.39225*t265
-    t269 = 0.089459 - 0.39225*t266
-    t270 = -0.089459 + t269
-    t271 = t229*t270 - t222*t268
-    t272 = t222*t270 + t229*t268
-    t273 = t271**2 + t272**2
-    t274 = t268**2 + t270**2
-    t275 = -0.425 + t133*t261
-    t276 = 0.089459 - t133*t262
-    t277 = -0.089459 + t276
-    t278 = t222*t275 + t229*t277
-    t279 = t222*t277 - t229*t275
-    t280 = t278**2 + t279**2
-    t281 = t275**2 + t277**2
-    t282 = t25 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t25)
-    t283 = 1e-24*t107
-    t284 = casadi.if_else((t131 <= t132*t283), 0, casadi.atan2(-t130, t129))
-    t285 = -casadi.if_else(t90, 0, casadi.atan2(-t86, -t84))
-    t286 = 3.141592653589793 + t285
-    t287 = t121 + t284
-    t288 = t59 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t59)
-    t289 = casadi.if_else(t71, 0, casadi.atan2(-t76, t65))
-    t290 = casadi.if_else((t139 <= t140*t283), 0, casadi.atan2(-t138, t137))
-    t291 = t122 + t290
-    t292 = 1e-24*t111
-    t293 = casadi.if_else((t157 <= t158*t292), 0, casadi.atan2(-t156, t155))
-    t294 = -3.141592653589793 + t148
-    t295 = t285 + t293
-    t296 = -t57 - 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t57)
-    t297 = 3.141592653589793 + t289 - 6.283185307179586*casadi.ceil(0.15915494309189535*t289)
-    t298 = casadi.if_else((t164 <= t165*t292), 0, casadi.atan2(-t163, t162))
-    t299 = -3.141592653589793 + t151
-    t300 = t285 + t298
-    t301 = t26 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t26)
-    t302 = 1e-24*t226
-    t303 = casadi.if_else((t248 <= t249*t302), 0, casadi.atan2(-t247, t246))
-    t304 = -casadi.if_else(t209, 0, casadi.atan2(-t205, -t203))
+    t27 = t25 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t25)
+    t28 = t27 - 6.283185307179586*casadi.floor(1.0 + 0.15915494309189535*t27)
+    t29 = t26 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t26)
+    t30 = t29 - 6.283185307179586*casadi.floor(1.0 + 0.15915494309189535*t29)
+    t31 = t19*t4
+    t32 = t23*t31
+    t33 = t19*t8
+    t34 = t22*t33
+    t35 = casadi.if_else(t18, 1, -t32 - t34)
+    t36 = t32 - t34
+    t37 = t22*t31
+    t38 = t23*t33
+    t39 = casadi.if_else(t18, 0, t37 - t38)
+    t40 = t37 + t38
+    t41 = t35*t4 + t39*t8
+    t42 = t35*t8 - t39*t4
+    t43 = T00*t39 - T10*t35
+    t44 = T01*t39 - T11*t35
+    t45 = t36*t4 + t40*t8
+    t46 = t36*t8 - t4*t40
+    t47 = T00*t40 - T10*t36
+    t48 = T01*t40 - T11*t36
+    t49 = 1 - t35
+    t50 = t13*t49
+    t51 = t50 + t13*t35
+    t52 = T02*t39
+    t53 = T12*t35
+    t54 = t52 - t53
+    t55 = t53 - t52
+    t56 = t54**2
+    t57 = 1 - t56
+    t58 = (1e-12 < t57)
+    t59 = casadi.if_else(t58, t54, casadi.if_else((t54 > 0), 1, -1))
+    t60 = casadi.if_else(t58, casadi.sqrt(t57), 0)
+    t61 = casadi.atan2(t60, t59)
+    t62 = t61 + 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t61)
+    t63 = False
+    t64 = casadi.if_else(t63, 0, t61)
+    t65 = casadi.if_else(t63, 1, t59)
+    t66 = casadi.if_else(t63, 0, t60)
+    t67 = casadi.if_else(t63, 1, 5.99857533835714)
+    t68 = t64 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t64)
+    t69 = t68 - 6.283185307179586*casadi.floor(1.0 + 0.15915494309189535*t68)
+    t70 = t55*t65
+    t71 = -t70 + t43*t66
+    t72 = t70 + t71
+    t73 = t66**2
+    t74 = t73 + t65**2
+    t75 = t44**2
+    t76 = t72**2 + t73*t75
+    t77 = t75 + t43**2 + t55**2
+    t78 = (t76 <= 1e-24*t74*t77)
+    t79 = casadi.if_else(t78, 1, 1/casadi.sqrt(t76))
+    t80 = casadi.if_else(t78, 1, t72*t79)
+    t81 = t66*(1 - t80)
+    t82 = t81 + t66*t80
+    t83 = t44*t66
+    t84 = casadi.if_else(t78, 0, -t79*t83)
+    t85 = t65*t84
+    t86 = t65*t80
+    t87 = T01*t85 + T02*t82 - T00*t86
+    t88 = T11*t85 + T12*t82 - T10*t86
+    t89 = T21*t85 + T22*t82 - T20*t86
+    t90 = t49*t89
+    t91 = t35*t87 + t39*t88
+    t92 = t39*t87 - t35*t88
+    t93 = t90 + t35*t89
+    t94 = t91**2 + t93**2
+    t95 = t94
+    t96 = t94 + t92**2
+    t97 = (t95 <= 1e-24*t96)
+    t98 = casadi.if_else(t97, 1, 1/casadi.sqrt(t95))
+    t99 = casadi.if_else(t97, 1, -t91*t98)
+    t100 = casadi.if_else(t97, 0, -t93*t98)
+    t101 = 0.10915 - 0.10915*t99
+    t102 = 0.10915 + 0.10915*t99
+    t103 = 0.10915*t99
+    t104 = t101 + t103
+    t105 = t104 + t42
+    t106 = t103 - t102
+    t107 = t42 - t106
+    t108 = 0.09465*t100
+    t109 = t41 - t108
+    t110 = t108 + t41
+    t111 = 0.09465*t99
+    t112 = t111 + t51
+    t113 = -0.089459 + t112
+    t114 = t105**2 + t109**2 + t113**2
+    t115 = 0.16724253125 - 0.5*t114
+    t116 = t51 - t111
+    t117 = -0.089459 + t116
+    t118 = t107**2 + t110**2 + t117**2
+    t119 = 0.16724253125 - 0.5*t118
+    t120 = t115**2
+    t121 = t67**2
+    t122 = 1 - t120*t121
+    t123 = t115*t67
+    t124 = (1e-12 < t122)
+    t125 = casadi.if_else(t124, t123, casadi.if_else((t123 > 0), 1, -1))
+    t126 = casadi.if_else(t124, casadi.sqrt(t122), 0)
+    t127 = casadi.atan2(t126, t125)
+    t128 = casadi.if_else(t63, 0, 3.141592653589793 + t127)
+    t129 = 3.141592653589793 - t127
+    t130 = t128 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t128)
+    t131 = t130 - 6.283185307179586*casadi.floor(1.0 + 0.15915494309189535*t130)
+    t132 = t129 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t129)
+    t133 = t132 - 6.283185307179586*casadi.floor(1.0 + 0.15915494309189535*t132)
+    t134 = 0.16670625*t67
+    t135 = casadi.if_else(t63, 1, -t125*t134)
+    t136 = casadi.if_else(t63, 0, -t126*t134)
+    t137 = 0.425 + 0.39225*t135
+    t138 = 0.089459 - 0.39225*t136
+    t139 = -0.089459 + t138
+    t140 = t113*t139 - t109*t137
+    t141 = t109*t139 + t113*t137
+    t142 = t140**2 + t141**2
+    t143 = t137**2 + t139**2
+    t144 = 0.0653905265625*t67
+    t145 = -0.425 + t125*t144
+    t146 = 0.089459 - t126*t144
+    t147 = -0.089459 + t146
+    t148 = t109*t145 + t113*t147
+    t149 = t109*t147 - t113*t145
+    t150 = t148**2 + t149**2
+    t151 = t145**2 + t147**2
+    t152 = t119**2
+    t153 = 1 - t121*t152
+    t154 = t119*t67
+    t155 = (1e-12 < t153)
+    t156 = casadi.if_else(t155, t154, casadi.if_else((t154 > 0), 1, -1))
+    t157 = casadi.if_else(t155, casadi.sqrt(t153), 0)
+    t158 = casadi.atan2(t157, t156)
+    t159 = casadi.if_else(t63, 0, 3.141592653589793 + t158)
+    t160 = casadi.if_else(t63, 1, -t134*t156)
+    t161 = casadi.if_else(t63, 0, -t134*t157)
+    t162 = 3.141592653589793 - t158
+    t163 = 0.425 + 0.39225*t160
+    t164 = 0.089459 - 0.39225*t161
+    t165 = -0.089459 + t164
+    t166 = t117*t165 - t110*t163
+    t167 = t110*t165 + t117*t163
+    t168 = t166**2 + t167**2
+    t169 = t163**2 + t165**2
+    t170 = -0.425 + t144*t156
+    t171 = 0.089459 - t144*t157
+    t172 = -0.089459 + t171
+    t173 = t110*t170 + t117*t172
+    t174 = t110*t172 - t117*t170
+    t175 = t173**2 + t174**2
+    t176 = t170**2 + t172**2
+    t177 = 1 - t36
+    t178 = t13*t177
+    t179 = t178 + t13*t36
+    t180 = T02*t40
+    t181 = T12*t36
+    t182 = t180 - t181
+    t183 = t181 - t180
+    t184 = t182**2
+    t185 = 1 - t184
+    t186 = (1e-12 < t185)
+    t187 = casadi.if_else(t186, t182, casadi.if_else((t182 > 0), 1, -1))
+    t188 = casadi.if_else(t186, casadi.sqrt(t185), 0)
+    t189 = casadi.atan2(t188, t187)
+    t190 = casadi.if_else(t63, 0, t189)
+    t191 = casadi.if_else(t63, 1, t187)
+    t192 = casadi.if_else(t63, 0, t188)
+    t193 = t190 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t190)
+    t194 = t193 - 6.283185307179586*casadi.floor(1.0 + 0.15915494309189535*t193)
+    t195 = t189 + 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t189)
+    t196 = t183*t191
+    t197 = -t196 + t192*t47
+    t198 = t196 + t197
+    t199 = t192**2
+    t200 = t199 + t191**2
+    t201 = t48**2
+    t202 = t198**2 + t199*t201
+    t203 = t201 + t183**2 + t47**2
+    t204 = (t202 <= 1e-24*t200*t203)
+    t205 = casadi.if_else(t204, 1, 1/casadi.sqrt(t202))
+    t206 = casadi.if_else(t204, 1, t198*t205)
+    t207 = t192*(1 - t206)
+    t208 = t207 + t192*t206
+    t209 = t192*t48
+    t210 = casadi.if_else(t204, 0, -t205*t209)
+    t211 = t191*t210
+    t212 = t191*t206
+    t213 = T01*t211 + T02*t208 - T00*t212
+    t214 = T11*t211 + T12*t208 - T10*t212
+    t215 = T21*t211 + T22*t208 - T20*t212
+    t216 = t177*t215
+    t217 = t213*t36 + t214*t40
+    t218 = t213*t40 - t214*t36
+    t219 = t216 + t215*t36
+    t220 = t217**2 + t219**2
+    t221 = t220
+    t222 = t220 + t218**2
+    t223 = (t221 <= 1e-24*t222)
+    t224 = casadi.if_else(t223, 1, 1/casadi.sqrt(t221))
+    t225 = casadi.if_else(t223, 1, -t217*t224)
+    t226 = casadi.if_else(t223, 0, -t219*t224)
+    t227 = 0.10915 - 0.10915*t225
+    t228 = 0.10915 + 0.10915*t225
+    t229 = 0.10915*t225
+    t230 = t227 + t229
+    t231 = t230 + t46
+    t232 = t229 - t228
+    t233 = t46 - t232
+    t234 = 0.09465*t226
+    t235 = t45 - t234
+    t236 = t234 + t45
+    t237 = 0.09465*t225
+    t238 = t179 + t237
+    t239 = -0.089459 + t238
+    t240 = t231**2 + t235**2 + t239**2
+    t241 = 0.16724253125 - 0.5*t240
+    t242 = t179 - t237
+    t243 = -0.089459 + t242
+    t244 = t233**2 + t236**2 + t243**2
+    t245 = 0.16724253125 - 0.5*t244
+    t246 = t241**2
+    t247 = 1 - t121*t246
+    t248 = t241*t67
+    t249 = (1e-12 < t247)
+    t250 = casadi.if_else(t249, t248, casadi.if_else((t248 > 0), 1, -1))
+    t251 = casadi.if_else(t249, casadi.sqrt(t247), 0)
+    t252 = casadi.atan2(t251, t250)
+    t253 = casadi.if_else(t63, 0, 3.141592653589793 + t252)
+    t254 = casadi.if_else(t63, 1, -t134*t250)
+    t255 = casadi.if_else(t63, 0, -t134*t251)
+    t256 = 3.141592653589793 - t252
+    t257 = 0.425 + 0.39225*t254
+    t258 = 0.089459 - 0.39225*t255
+    t259 = -0.089459 + t258
+    t260 = t239*t259 - t235*t257
+    t261 = t235*t259 + t239*t257
+    t262 = t260**2 + t261**2
+    t263 = t257**2 + t259**2
+    t264 = -0.425 + t144*t250
+    t265 = 0.089459 - t144*t251
+    t266 = -0.089459 + t265
+    t267 = t235*t264 + t239*t266
+    t268 = t235*t266 - t239*t264
+    t269 = t267**2 + t268**2
+    t270 = t264**2 + t266**2
+    t271 = t253 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t253)
+    t272 = t271 - 6.283185307179586*casadi.floor(1.0 + 0.15915494309189535*t271)
+    t273 = t256 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t256)
+    t274 = t273 - 6.283185307179586*casadi.floor(1.0 + 0.15915494309189535*t273)
+    t275 = t245**2
+    t276 = 1 - t121*t275
+    t277 = t245*t67
+    t278 = (1e-12 < t276)
+    t279 = casadi.if_else(t278, t277, casadi.if_else((t277 > 0), 1, -1))
+    t280 = casadi.if_else(t278, casadi.sqrt(t276), 0)
+    t281 = casadi.atan2(t280, t279)
+    t282 = casadi.if_else(t63, 0, 3.141592653589793 + t281)
+    t283 = casadi.if_else(t63, 1, -t134*t279)
+    t284 = casadi.if_else(t63, 0, -t134*t280)
+    t285 = 3.141592653589793 - t281
+    t286 = 0.425 + 0.39225*t283
+    t287 = 0.089459 - 0.39225*t284
+    t288 = -0.089459 + t287
+    t289 = t243*t288 - t236*t286
+    t290 = t236*t288 + t243*t286
+    t291 = t289**2 + t290**2
+    t292 = t286**2 + t288**2
+    t293 = -0.425 + t144*t279
+    t294 = 0.089459 - t144*t280
+    t295 = -0.089459 + t294
+    t296 = t236*t293 + t243*t295
+    t297 = t236*t295 - t243*t293
+    t298 = t296**2 + t297**2
+    t299 = t293**2 + t295**2
+    t300 = 1e-24*t114
+    t301 = casadi.if_else((t142 <= t143*t300), 0, casadi.atan2(-t141, t140))
+    t302 = t301
+    t303 = t302 - 6.283185307179586*casadi.floor(1.0 + 0.15915494309189535*t302)
+    t304 = -casadi.if_else(t97, 0, casadi.atan2(-t93, -t91))
     t305 = 3.141592653589793 + t304
-    t306 = t239 + t303
-    t307 = t179 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t179)
-    t308 = casadi.if_else(t190, 0, casadi.atan2(-t195, t184))
-    t309 = casadi.if_else((t255 <= t256*t302), 0, casadi.atan2(-t254, t253))
-    t310 = t242 + t309
-    t311 = 1e-24*t230
-    t312 = casadi.if_else((t273 <= t274*t311), 0, casadi.atan2(-t272, t271))
-    t313 = -3.141592653589793 + t264
-    t314 = t304 + t312
-    t315 = -t178 - 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t178)
-    t316 = 3.141592653589793 + t308 - 6.283185307179586*casadi.ceil(0.15915494309189535*t308)
-    t317 = casadi.if_else((t280 <= t281*t311), 0, casadi.atan2(-t279, t278))
-    t318 = -3.141592653589793 + t267
-    t319 = t304 + t317
-    t320 = (casadi.fabs(t0) < casadi.inf)
-    t321 = False
-    t322 = True
-    t323 = -1e-12
-    t324 = casadi.logic_or(casadi.logic_and(t321, (t52 <= 1e-12)), casadi.logic_and(t322, (t53 >= t323)))
-    t325 = (t15 > t17)
-    t326 = casadi.logic_or(casadi.logic_and(t325, (t20 >= t323)), casadi.logic_and(t18, (0.0119137225 <= 1e-12*t16)))
-    t327 = 2.77909737890625e-26
-    t328 = (0.0277909737890625 > t327)
-    t329 = (0.0277909737890625 <= t327)
-    t330 = 2.77909737890625e-14
-    t331 = (t53 > 1e-12)
-    t332 = (t20 > 1e-12)
-    t333 = casadi.logic_or(casadi.logic_and(t321, (t173 <= 1e-12)), casadi.logic_and(t322, (t174 >= t323)))
-    t334 = (t174 > 1e-12)
+    t306 = t128 + t301
+    t307 = t304 + t306 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t305 - 0.15915494309189535*t306)
+    t308 = -t307
+    t309 = t307 + 6.283185307179586*casadi.floor(1.0 + 0.15915494309189535*t308)
+    t310 = casadi.if_else(t78, 0, casadi.atan2(-t83, t72))
+    t311 = t310
+    t312 = t311 - 6.283185307179586*casadi.floor(1.0 + 0.15915494309189535*t311)
+    t313 = 3.141592653589793 + t310 - 6.283185307179586*casadi.ceil(0.15915494309189535*t310)
+    t314 = t313 - 6.283185307179586*casadi.floor(1.0 + 0.15915494309189535*t313)
+    t315 = casadi.if_else((t150 <= t151*t300), 0, casadi.atan2(-t149, t148))
+    t316 = t315
+    t317 = t316 - 6.283185307179586*casadi.floor(1.0 + 0.15915494309189535*t316)
+    t318 = t129 + t315
+    t319 = t304 + t318 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t305 - 0.15915494309189535*t318)
+    t320 = -t319
+    t321 = t319 + 6.283185307179586*casadi.floor(1.0 + 0.15915494309189535*t320)
+    t322 = 1e-24*t118
+    t323 = casadi.if_else((t168 <= t169*t322), 0, casadi.atan2(-t167, t166))
+    t324 = t323
+    t325 = t324 - 6.283185307179586*casadi.floor(1.0 + 0.15915494309189535*t324)
+    t326 = -3.141592653589793 + t159
+    t327 = t159 - 6.283185307179586*casadi.ceil(0.15915494309189535*t326)
+    t328 = t327 - 6.283185307179586*casadi.floor(1.0 + 0.15915494309189535*t327)
+    t329 = t304 + t323
+    t330 = t326 + t329 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t159 - 0.15915494309189535*t329)
+    t331 = -t330
+    t332 = t330 + 6.283185307179586*casadi.floor(1.0 + 0.15915494309189535*t331)
+    t333 = -t62
+    t334 = t62 + 6.283185307179586*casadi.floor(1.0 + 0.15915494309189535*t333)
+    t335 = casadi.if_else((t175 <= t176*t322), 0, casadi.atan2(-t174, t173))
+    t336 = t335
+    t337 = t336 - 6.283185307179586*casadi.floor(1.0 + 0.15915494309189535*t336)
+    t338 = -3.141592653589793 + t162
+    t339 = t162 - 6.283185307179586*casadi.ceil(0.15915494309189535*t338)
+    t340 = t339 - 6.283185307179586*casadi.floor(1.0 + 0.15915494309189535*t339)
+    t341 = t304 + t335
+    t342 = t338 + t341 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t162 - 0.15915494309189535*t341)
+    t343 = -t342
+    t344 = t342 + 6.283185307179586*casadi.floor(1.0 + 0.15915494309189535*t343)
+    t345 = 1e-24*t240
+    t346 = casadi.if_else((t262 <= t263*t345), 0, casadi.atan2(-t261, t260))
+    t347 = t346
+    t348 = t347 - 6.283185307179586*casadi.floor(1.0 + 0.15915494309189535*t347)
+    t349 = -casadi.if_else(t223, 0, casadi.atan2(-t219, -t217))
+    t350 = 3.141592653589793 + t349
+    t351 = t253 + t346
+    t352 = t349 + t351 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t350 - 0.15915494309189535*t351)
+    t353 = -t352
+    t354 = t352 + 6.283185307179586*casadi.floor(1.0 + 0.15915494309189535*t353)
+    t355 = casadi.if_else(t204, 0, casadi.atan2(-t209, t198))
+    t356 = t355
+    t357 = t356 - 6.283185307179586*casadi.floor(1.0 + 0.15915494309189535*t356)
+    t358 = 3.141592653589793 + t355 - 6.283185307179586*casadi.ceil(0.15915494309189535*t355)
+    t359 = t358 - 6.283185307179586*casadi.floor(1.0 + 0.15915494309189535*t358)
+    t360 = casadi.if_else((t269 <= t270*t345), 0, casadi.atan2(-t268, t267))
+    t361 = t360
+    t362 = t361 - 6.283185307179586*casadi.floor(1.0 + 0.15915494309189535*t361)
+    t363 = t256 + t360
+    t364 = t349 + t363 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t350 - 0.15915494309189535*t363)
+    t365 = -t364
+    t366 = t364 + 6.283185307179586*casadi.floor(1.0 + 0.15915494309189535*t365)
+    t367 = 1e-24*t244
+    t368 = casadi.if_else((t291 <= t292*t367), 0, casadi.atan2(-t290, t289))
+    t369 = t368
+    t370 = t369 - 6.283185307179586*casadi.floor(1.0 + 0.15915494309189535*t369)
+    t371 = -3.141592653589793 + t282
+    t372 = t282 - 6.283185307179586*casadi.ceil(0.15915494309189535*t371)
+    t373 = t372 - 6.283185307179586*casadi.floor(1.0 + 0.15915494309189535*t372)
+    t374 = t349 + t368
+    t375 = t371 + t374 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t282 - 0.15915494309189535*t374)
+    t376 = -t375
+    t377 = t375 + 6.283185307179586*casadi.floor(1.0 + 0.15915494309189535*t376)
+    t378 = -t195
+    t379 = t195 + 6.283185307179586*casadi.floor(1.0 + 0.15915494309189535*t378)
+    t380 = casadi.if_else((t298 <= t299*t367), 0, casadi.atan2(-t297, t296))
+    t381 = t380
+    t382 = t381 - 6.283185307179586*casadi.floor(1.0 + 0.15915494309189535*t381)
+    t383 = -3.141592653589793 + t285
+    t384 = t285 - 6.283185307179586*casadi.ceil(0.15915494309189535*t383)
+    t385 = t384 - 6.283185307179586*casadi.floor(1.0 + 0.15915494309189535*t384)
+    t386 = t349 + t380
+    t387 = t383 + t386 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t285 - 0.15915494309189535*t386)
+    t388 = -t387
+    t389 = t387 + 6.283185307179586*casadi.floor(1.0 + 0.15915494309189535*t388)
+    t390 = (t28 <= 6.283185307179586)
+    t391 = casadi.logic_and((t27 >= -6.283185307179586), (t27 <= 6.283185307179586))
+    t392 = casadi.if_else(casadi.logic_and(t390, casadi.logic_not(t391)), t28, t27)
+    t393 = (t303 <= 6.283185307179586)
+    t394 = casadi.logic_and((t302 >= -6.283185307179586), (t302 <= 6.283185307179586))
+    t395 = (t131 <= 6.283185307179586)
+    t396 = casadi.logic_and((t130 >= -6.283185307179586), (t130 <= 6.283185307179586))
+    t397 = -t309
+    t398 = (t69 <= 6.283185307179586)
+    t399 = casadi.logic_and((t68 >= -6.283185307179586), (t68 <= 6.283185307179586))
+    t400 = casadi.if_else(casadi.logic_and(t398, casadi.logic_not(t399)), t69, t68)
+    t401 = (t312 <= 6.283185307179586)
+    t402 = casadi.logic_and((t311 >= -6.283185307179586), (t311 <= 6.283185307179586))
+    t403 = casadi.if_else(casadi.logic_and(t401, casadi.logic_not(t402)), t312, t311)
+    t404 = (t317 <= 6.283185307179586)
+    t405 = casadi.logic_and((t316 >= -6.283185307179586), (t316 <= 6.283185307179586))
+    t406 = (t133 <= 6.283185307179586)
+    t407 = casadi.logic_and((t132 >= -6.283185307179586), (t132 <= 6.283185307179586))
+    t408 = -t321
+    t409 = (t325 <= 6.283185307179586)
+    t410 = casadi.logic_and((t324 >= -6.283185307179586), (t324 <= 6.283185307179586))
+    t411 = (t328 <= 6.283185307179586)
+    t412 = casadi.logic_and((t327 >= -6.283185307179586), (t327 <= 6.283185307179586))
+    t413 = -t332
+    t414 = -t334
+    t415 = casadi.if_else(casadi.logic_and((t334 >= -6.283185307179586), casadi.logic_not(casadi.logic_and((t62 >= -6.283185307179586), (t62 <= 6.283185307179586)))), t414, t333)
+    t416 = (t314 <= 6.283185307179586)
+    t417 = casadi.logic_and((t313 >= -6.283185307179586), (t313 <= 6.283185307179586))
+    t418 = casadi.if_else(casadi.logic_and(t416, casadi.logic_not(t417)), t314, t313)
+    t419 = (t337 <= 6.283185307179586)
+    t420 = casadi.logic_and((t336 >= -6.283185307179586), (t336 <= 6.283185307179586))
+    t421 = (t340 <= 6.283185307179586)
+    t422 = casadi.logic_and((t339 >= -6.283185307179586), (t339 <= 6.283185307179586))
+    t423 = -t344
+    t424 = (t30 <= 6.283185307179586)
+    t425 = casadi.logic_and((t29 >= -6.283185307179586), (t29 <= 6.283185307179586))
+    t426 = casadi.if_else(casadi.logic_and(t424, casadi.logic_not(t425)), t30, t29)
+    t427 = (t348 <= 6.283185307179586)
+    t428 = casadi.logic_and((t347 >= -6.283185307179586), (t347 <= 6.283185307179586))
+    t429 = (t272 <= 6.283185307179586)
+    t430 = casadi.logic_and((t271 >= -6.283185307179586), (t271 <= 6.283185307179586))
+    t431 = -t354
+    t432 = (t194 <= 6.283185307179586)
+    t433 = casadi.logic_and((t193 >= -6.283185307179586), (t193 <= 6.283185307179586))
+    t434 = casadi.if_else(casadi.logic_and(t432, casadi.logic_not(t433)), t194, t193)
+    t435 = (t357 <= 6.283185307179586)
+    t436 = casadi.logic_and((t356 >= -6.283185307179586), (t356 <= 6.283185307179586))
+    t437 = casadi.if_else(casadi.logic_and(t435, casadi.logic_not(t436)), t357, t356)
+    t438 = (t362 <= 6.283185307179586)
+    t439 = casadi.logic_and((t361 >= -6.283185307179586), (t361 <= 6.283185307179586))
+    t440 = (t274 <= 6.283185307179586)
+    t441 = casadi.logic_and((t273 >= -6.283185307179586), (t273 <= 6.283185307179586))
+    t442 = -t366
+    t443 = (t370 <= 6.283185307179586)
+    t444 = casadi.logic_and((t369 >= -6.283185307179586), (t369 <= 6.283185307179586))
+    t445 = (t373 <= 6.283185307179586)
+    t446 = casadi.logic_and((t372 >= -6.283185307179586), (t372 <= 6.283185307179586))
+    t447 = -t377
+    t448 = -t379
+    t449 = casadi.if_else(casadi.logic_and((t379 >= -6.283185307179586), casadi.logic_not(casadi.logic_and((t195 >= -6.283185307179586), (t195 <= 6.283185307179586)))), t448, t378)
+    t450 = (t359 <= 6.283185307179586)
+    t451 = casadi.logic_and((t358 >= -6.283185307179586), (t358 <= 6.283185307179586))
+    t452 = casadi.if_else(casadi.logic_and(t450, casadi.logic_not(t451)), t359, t358)
+    t453 = (t382 <= 6.283185307179586)
+    t454 = casadi.logic_and((t381 >= -6.283185307179586), (t381 <= 6.283185307179586))
+    t455 = (t385 <= 6.283185307179586)
+    t456 = casadi.logic_and((t384 >= -6.283185307179586), (t384 <= 6.283185307179586))
+    t457 = -t389
+    t458 = (casadi.fabs(t0) < casadi.inf)
+    t459 = False
+    t460 = True
+    t461 = -1e-12
+    t462 = casadi.logic_or(casadi.logic_and(t459, (t56 <= 1e-12)), casadi.logic_and(t460, (t57 >= t461)))
+    t463 = (t15 > t17)
+    t464 = casadi.logic_or(casadi.logic_and(t463, (t20 >= t461)), casadi.logic_and(t18, (0.0119137225 <= 1e-12*t16)))
+    t465 = 2.77909737890625e-26
+    t466 = (0.0277909737890625 > t465)
+    t467 = (0.0277909737890625 <= t465)
+    t468 = 2.77909737890625e-14
+    t469 = (t57 > 1e-12)
+    t470 = (t20 > 1e-12)
+    t471 = casadi.logic_or(casadi.logic_and(t459, (t184 <= 1e-12)), casadi.logic_and(t460, (t185 >= t461)))
+    t472 = (t185 > 1e-12)
+    t473 = casadi.logic_or(t390, t391)
+    t474 = casadi.logic_or(t398, t399)
+    t475 = casadi.logic_or(t401, t402)
+    t476 = casadi.logic_or(t416, t417)
+    t477 = casadi.logic_or((t414 <= 6.283185307179586), casadi.logic_and((t333 >= -6.283185307179586), (t333 <= 6.283185307179586)))
+    t478 = casadi.logic_or(t424, t425)
+    t479 = casadi.logic_or(t432, t433)
+    t480 = casadi.logic_or(t435, t436)
+    t481 = casadi.logic_or(t450, t451)
+    t482 = casadi.logic_or((t448 <= 6.283185307179586), casadi.logic_and((t378 >= -6.283185307179586), (t378 <= 6.283185307179586)))
     q = casadi.SX(8, 6)
-    q[0, 0] = t282
-    q[0, 1] = t284
-    q[0, 2] = t121 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t121)
-    q[0, 3] = -t285 - t287 - 6.283185307179586*casadi.ceil(-0.15915494309189535*t286 - 0.15915494309189535*t287)
-    q[0, 4] = t288
-    q[0, 5] = t289
-    q[1, 0] = t282
-    q[1, 1] = t290
-    q[1, 2] = t122 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t122)
-    q[1, 3] = -t285 - t291 - 6.283185307179586*casadi.ceil(-0.15915494309189535*t286 - 0.15915494309189535*t291)
-    q[1, 4] = t288
-    q[1, 5] = t289
-    q[2, 0] = t282
-    q[2, 1] = t293
-    q[2, 2] = t148 - 6.283185307179586*casadi.ceil(0.15915494309189535*t294)
-    q[2, 3] = -t294 - t295 - 6.283185307179586*casadi.ceil(-0.15915494309189535*t148 - 0.15915494309189535*t295)
-    q[2, 4] = t296
-    q[2, 5] = t297
-    q[3, 0] = t282
-    q[3, 1] = t298
-    q[3, 2] = t151 - 6.283185307179586*casadi.ceil(0.15915494309189535*t299)
-    q[3, 3] = -t299 - t300 - 6.283185307179586*casadi.ceil(-0.15915494309189535*t151 - 0.15915494309189535*t300)
-    q[3, 4] = t296
-    q[3, 5] = t297
-    q[4, 0] = t301
-    q[4, 1] = t303
-    q[4, 2] = t239 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t239)
-    q[4, 3] = -t304 - t306 - 6.283185307179586*casadi.ceil(-0.15915494309189535*t305 - 0.15915494309189535*t306)
-    q[4, 4] = t307
-    q[4, 5] = t308
-    q[5, 0] = t301
-    q[5, 1] = t309
-    q[5, 2] = t242 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t242)
-    q[5, 3] = -t304 - t310 - 6.283185307179586*casadi.ceil(-0.15915494309189535*t305 - 0.15915494309189535*t310)
-    q[5, 4] = t307
-    q[5, 5] = t308
-    q[6, 0] = t301
-    q[6, 1] = t312
-    q[6, 2] = t264 - 6.283185307179586*casadi.ceil(0.15915494309189535*t313)
-    q[6, 3] = -t313 - t314 - 6.283185307179586*casadi.ceil(-0.15915494309189535*t264 - 0.15915494309189535*t314)
-    q[6, 4] = t315
-    q[6, 5] = t316
-    q[7, 0] = t301
-    q[7, 1] = t317
-    q[7, 2] = t267 - 6.283185307179586*casadi.ceil(0.15915494309189535*t318)
-    q[7, 3] = -t318 - t319 - 6.283185307179586*casadi.ceil(-0.15915494309189535*t267 - 0.15915494309189535*t319)
-    q[7, 4] = t315
-    q[7, 5] = t316
+    q[0, 0] = t392
+    q[0, 1] = casadi.if_else(casadi.logic_and(t393, casadi.logic_not(t394)), t303, t302)
+    q[0, 2] = casadi.if_else(casadi.logic_and(t395, casadi.logic_not(t396)), t131, t130)
+    q[0, 3] = casadi.if_else(casadi.logic_and((t309 >= -6.283185307179586), casadi.logic_not(casadi.logic_and((t307 >= -6.283185307179586), (t307 <= 6.283185307179586)))), t397, t308)
+    q[0, 4] = t400
+    q[0, 5] = t403
+    q[1, 0] = t392
+    q[1, 1] = casadi.if_else(casadi.logic_and(t404, casadi.logic_not(t405)), t317, t316)
+    q[1, 2] = casadi.if_else(casadi.logic_and(t406, casadi.logic_not(t407)), t133, t132)
+    q[1, 3] = casadi.if_else(casadi.logic_and((t321 >= -6.283185307179586), casadi.logic_not(casadi.logic_and((t319 >= -6.283185307179586), (t319 <= 6.283185307179586)))), t408, t320)
+    q[1, 4] = t400
+    q[1, 5] = t403
+    q[2, 0] = t392
+    q[2, 1] = casadi.if_else(casadi.logic_and(t409, casadi.logic_not(t410)), t325, t324)
+    q[2, 2] = casadi.if_else(casadi.logic_and(t411, casadi.logic_not(t412)), t328, t327)
+    q[2, 3] = casadi.if_else(casadi.logic_and((t332 >= -6.283185307179586), casadi.logic_not(casadi.logic_and((t330 >= -6.283185307179586), (t330 <= 6.283185307179586)))), t413, t331)
+    q[2, 4] = t415
+    q[2, 5] = t418
+    q[3, 0] = t392
+    q[3, 1] = casadi.if_else(casadi.logic_and(t419, casadi.logic_not(t420)), t337, t336)
+    q[3, 2] = casadi.if_else(casadi.logic_and(t421, casadi.logic_not(t422)), t340, t339)
+    q[3, 3] = casadi.if_else(casadi.logic_and((t344 >= -6.283185307179586), casadi.logic_not(casadi.logic_and((t342 >= -6.283185307179586), (t342 <= 6.283185307179586)))), t423, t343)
+    q[3, 4] = t415
+    q[3, 5] = t418
+    q[4, 0] = t426
+    q[4, 1] = casadi.if_else(casadi.logic_and(t427, casadi.logic_not(t428)), t348, t347)
+    q[4, 2] = casadi.if_else(casadi.logic_and(t429, casadi.logic_not(t430)), t272, t271)
+    q[4, 3] = casadi.if_else(casadi.logic_and((t354 >= -6.283185307179586), casadi.logic_not(casadi.logic_and((t352 >= -6.283185307179586), (t352 <= 6.283185307179586)))), t431, t353)
+    q[4, 4] = t434
+    q[4, 5] = t437
+    q[5, 0] = t426
+    q[5, 1] = casadi.if_else(casadi.logic_and(t438, casadi.logic_not(t439)), t362, t361)
+    q[5, 2] = casadi.if_else(casadi.logic_and(t440, casadi.logic_not(t441)), t274, t273)
+    q[5, 3] = casadi.if_else(casadi.logic_and((t366 >= -6.283185307179586), casadi.logic_not(casadi.logic_and((t364 >= -6.283185307179586), (t364 <= 6.283185307179586)))), t442, t365)
+    q[5, 4] = t434
+    q[5, 5] = t437
+    q[6, 0] = t426
+    q[6, 1] = casadi.if_else(casadi.logic_and(t443, casadi.logic_not(t444)), t370, t369)
+    q[6, 2] = casadi.if_else(casadi.logic_and(t445, casadi.logic_not(t446)), t373, t372)
+    q[6, 3] = casadi.if_else(casadi.logic_and((t377 >= -6.283185307179586), casadi.logic_not(casadi.logic_and((t375 >= -6.283185307179586), (t375 <= 6.283185307179586)))), t447, t376)
+    q[6, 4] = t449
+    q[6, 5] = t452
+    q[7, 0] = t426
+    q[7, 1] = casadi.if_else(casadi.logic_and(t453, casadi.logic_not(t454)), t382, t381)
+    q[7, 2] = casadi.if_else(casadi.logic_and(t455, casadi.logic_not(t456)), t385, t384)
+    q[7, 3] = casadi.if_else(casadi.logic_and((t389 >= -6.283185307179586), casadi.logic_not(casadi.logic_and((t387 >= -6.283185307179586), (t387 <= 6.283185307179586)))), t457, t388)
+    q[7, 4] = t449
+    q[7, 5] = t452
     valid = casadi.SX(8, 1)
-    valid[0, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t320, t324), t326), casadi.logic_or(casadi.logic_and(t328, (t115 >= t323)), casadi.logic_and(t329, (t113 <= t330))))
-    valid[1, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t320, t324), t326), t328), (t115 > 1e-12))
-    valid[2, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t320, t322), t326), t331), casadi.logic_or(casadi.logic_and(t328, (t142 >= t323)), casadi.logic_and(t329, (t141 <= t330))))
-    valid[3, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t320, t322), t326), t328), t331), (t142 > 1e-12))
-    valid[4, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t320, t325), t332), t333), casadi.logic_or(casadi.logic_and(t328, (t233 >= t323)), casadi.logic_and(t329, (t232 <= t330))))
-    valid[5, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t320, t325), t328), t332), t333), (t233 > 1e-12))
-    valid[6, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t320, t322), t325), t332), t334), casadi.logic_or(casadi.logic_and(t328, (t258 >= t323)), casadi.logic_and(t329, (t257 <= t330))))
-    valid[7, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t320, t322), t325), t328), t332), t334), (t258 > 1e-12))
-    return [q, valid]
+    valid[0, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t458, t462), t464), casadi.logic_or(casadi.logic_and(t466, (t122 >= t461)), casadi.logic_and(t467, (t120 <= t468))))
+    valid[1, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t458, t462), t464), t466), (t122 > 1e-12))
+    valid[2, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t458, t460), t464), t469), casadi.logic_or(casadi.logic_and(t466, (t153 >= t461)), casadi.logic_and(t467, (t152 <= t468))))
+    valid[3, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t458, t460), t464), t466), t469), (t153 > 1e-12))
+    valid[4, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t458, t463), t470), t471), casadi.logic_or(casadi.logic_and(t466, (t247 >= t461)), casadi.logic_and(t467, (t246 <= t468))))
+    valid[5, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t458, t463), t466), t470), t471), (t247 > 1e-12))
+    valid[6, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t458, t460), t463), t470), t472), casadi.logic_or(casadi.logic_and(t466, (t276 >= t461)), casadi.logic_and(t467, (t275 <= t468))))
+    valid[7, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t458, t460), t463), t466), t470), t472), (t276 > 1e-12))
+    in_limits = casadi.SX(8, 1)
+    in_limits[0, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t473, t474), t475), casadi.logic_or(t393, t394)), casadi.logic_or(t395, t396)), casadi.logic_or((t397 <= 6.283185307179586), casadi.logic_and((t308 >= -6.283185307179586), (t308 <= 6.283185307179586))))
+    in_limits[1, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t473, t474), t475), casadi.logic_or(t404, t405)), casadi.logic_or(t406, t407)), casadi.logic_or((t408 <= 6.283185307179586), casadi.logic_and((t320 >= -6.283185307179586), (t320 <= 6.283185307179586))))
+    in_limits[2, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t473, t476), t477), casadi.logic_or(t409, t410)), casadi.logic_or(t411, t412)), casadi.logic_or((t413 <= 6.283185307179586), casadi.logic_and((t331 >= -6.283185307179586), (t331 <= 6.283185307179586))))
+    in_limits[3, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t473, t476), t477), casadi.logic_or(t419, t420)), casadi.logic_or(t421, t422)), casadi.logic_or((t423 <= 6.283185307179586), casadi.logic_and((t343 >= -6.283185307179586), (t343 <= 6.283185307179586))))
+    in_limits[4, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t478, t479), t480), casadi.logic_or(t427, t428)), casadi.logic_or(t429, t430)), casadi.logic_or((t431 <= 6.283185307179586), casadi.logic_and((t353 >= -6.283185307179586), (t353 <= 6.283185307179586))))
+    in_limits[5, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t478, t479), t480), casadi.logic_or(t438, t439)), casadi.logic_or(t440, t441)), casadi.logic_or((t442 <= 6.283185307179586), casadi.logic_and((t365 >= -6.283185307179586), (t365 <= 6.283185307179586))))
+    in_limits[6, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t478, t481), t482), casadi.logic_or(t443, t444)), casadi.logic_or(t445, t446)), casadi.logic_or((t447 <= 6.283185307179586), casadi.logic_and((t376 >= -6.283185307179586), (t376 <= 6.283185307179586))))
+    in_limits[7, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t478, t481), t482), casadi.logic_or(t453, t454)), casadi.logic_or(t455, t456)), casadi.logic_or((t457 <= 6.283185307179586), casadi.logic_and((t388 >= -6.283185307179586), (t388 <= 6.283185307179586))))
+    return [q, valid, in_limits]
+
+
+def _ik_nearest(T, q_seed, weights):
+    """The closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status: 2191 operations."""
+    T00 = T[0, 0]
+    T01 = T[0, 1]
+    T02 = T[0, 2]
+    T03 = T[0, 3]
+    T10 = T[1, 0]
+    T11 = T[1, 1]
+    T12 = T[1, 2]
+    T13 = T[1, 3]
+    T20 = T[2, 0]
+    T21 = T[2, 1]
+    T22 = T[2, 2]
+    T23 = T[2, 3]
+    qn1 = q_seed[0]
+    qn2 = q_seed[1]
+    qn3 = q_seed[2]
+    qn4 = q_seed[3]
+    qn5 = q_seed[4]
+    qn6 = q_seed[5]
+    qw1 = weights[0]
+    qw2 = weights[1]
+    qw3 = weights[2]
+    qw4 = weights[3]
+    qw5 = weights[4]
+    qw6 = weights[5]
+    t0 = 0.81725*T00 + 0.005191*T01
+    t1 = T03 + t0 - 0.19145*T02
+    t2 = t0 - 0.10915*T02
+    t3 = t1 - t2
+    t4 = 0.81725*T10 + 0.005191*T11
+    t5 = T13 + t4 - 0.19145*T12
+    t6 = t4 - 0.10915*T12
+    t7 = t5 - t6
+    t8 = casadi.atan2(t3, -t7)
+    t9 = 0.81725*T20 + 0.005191*T21
+    t10 = T23 + t9 - 0.19145*T22
+    t11 = t9 - 0.10915*T22
+    t12 = t10 - t11
+    t13 = t3**2 + t7**2
+    t14 = t13
+    t15 = t13 + t12**2
+    t16 = 1e-24*t15
+    t17 = (t14 <= t16)
+    t18 = casadi.if_else(t17, 1, 1/casadi.sqrt(t14))
+    t19 = 1 - 0.0119137225*t18**2
+    t20 = (1e-12 < t19)
+    t21 = casadi.if_else(t20, 0.10915*t18, casadi.if_else((t18 > 0), 1, -1))
+    t22 = casadi.if_else(t20, casadi.sqrt(t19), 0)
+    t23 = casadi.atan2(t22, t21)
+    t24 = casadi.if_else(t17, 0, t23 + t8)
+    t25 = t8 - t23
+    t26 = t24 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t24)
+    t27 = t26 - 6.283185307179586*casadi.floor(1.0 + 0.15915494309189535*t26)
+    t28 = t25 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t25)
+    t29 = t28 - 6.283185307179586*casadi.floor(1.0 + 0.15915494309189535*t28)
+    t30 = t18*t3
+    t31 = t22*t30
+    t32 = t18*t7
+    t33 = t21*t32
+    t34 = casadi.if_else(t17, 1, -t31 - t33)
+    t35 = t31 - t33
+    t36 = t21*t30
+    t37 = t22*t32
+    t38 = casadi.if_else(t17, 0, t36 - t37)
+    t39 = t36 + t37
+    t40 = t3*t34 + t38*t7
+    t41 = t34*t7 - t3*t38
+    t42 = T00*t38 - T10*t34
+    t43 = T01*t38 - T11*t34
+    t44 = t3*t35 + t39*t7
+    t45 = t35*t7 - t3*t39
+    t46 = T00*t39 - T10*t35
+    t47 = T01*t39 - T11*t35
+    t48 = 1 - t34
+    t49 = t12*t48
+    t50 = t49 + t12*t34
+    t51 = T02*t38
+    t52 = T12*t34
+    t53 = t51 - t52
+    t54 = t52 - t51
+    t55 = t53**2
+    t56 = 1 - t55
+    t57 = (1e-12 < t56)
+    t58 = casadi.if_else(t57, t53, casadi.if_else((t53 > 0), 1, -1))
+    t59 = casadi.if_else(t57, casadi.sqrt(t56), 0)
+    t60 = casadi.atan2(t59, t58)
+    t61 = t60 + 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t60)
+    t62 = False
+    t63 = casadi.if_else(t62, 0, t60)
+    t64 = casadi.if_else(t62, 1, t58)
+    t65 = casadi.if_else(t62, 0, t59)
+    t66 = casadi.if_else(t62, 1, 5.99857533835714)
+    t67 = t63 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t63)
+    t68 = t67 - 6.283185307179586*casadi.floor(1.0 + 0.15915494309189535*t67)
+    t69 = t54*t64
+    t70 = -t69 + t42*t65
+    t71 = t69 + t70
+    t72 = t65**2
+    t73 = t72 + t64**2
+    t74 = t43**2
+    t75 = t71**2 + t72*t74
+    t76 = t74 + t42**2 + t54**2
+    t77 = (t75 <= 1e-24*t73*t76)
+    t78 = casadi.if_else(t77, 1, 1/casadi.sqrt(t75))
+    t79 = casadi.if_else(t77, 1, t71*t78)
+    t80 = t65*(1 - t79)
+    t81 = t80 + t65*t79
+    t82 = t43*t65
+    t83 = casadi.if_else(t77, 0, -t78*t82)
+    t84 = t64*t83
+    t85 = t64*t79
+    t86 = T01*t84 + T02*t81 - T00*t85
+    t87 = T11*t84 + T12*t81 - T10*t85
+    t88 = T21*t84 + T22*t81 - T20*t85
+    t89 = t48*t88
+    t90 = t34*t86 + t38*t87
+    t91 = t38*t86 - t34*t87
+    t92 = t89 + t34*t88
+    t93 = t90**2 + t92**2
+    t94 = t93
+    t95 = t93 + t91**2
+    t96 = (t94 <= 1e-24*t95)
+    t97 = casadi.if_else(t96, 1, 1/casadi.sqrt(t94))
+    t98 = casadi.if_else(t96, 1, -t90*t97)
+    t99 = casadi.if_else(t96, 0, -t92*t97)
+    t100 = 0.10915 - 0.10915*t98
+    t101 = 0.10915 + 0.10915*t98
+    t102 = 0.10915*t98
+    t103 = t100 + t102
+    t104 = t103 + t41
+    t105 = t102 - t101
+    t106 = t41 - t105
+    t107 = 0.09465*t99
+    t108 = t40 - t107
+    t109 = t107 + t40
+    t110 = 0.09465*t98
+    t111 = t110 + t50
+    t112 = -0.089459 + t111
+    t113 = t104**2 + t108**2 + t112**2
+    t114 = 0.16724253125 - 0.5*t113
+    t115 = t50 - t110
+    t116 = -0.089459 + t115
+    t117 = t106**2 + t109**2 + t116**2
+    t118 = 0.16724253125 - 0.5*t117
+    t119 = t114**2
+    t120 = t66**2
+    t121 = 1 - t119*t120
+    t122 = t114*t66
+    t123 = (1e-12 < t121)
+    t124 = casadi.if_else(t123, t122, casadi.if_else((t122 > 0), 1, -1))
+    t125 = casadi.if_else(t123, casadi.sqrt(t121), 0)
+    t126 = casadi.atan2(t125, t124)
+    t127 = casadi.if_else(t62, 0, 3.141592653589793 + t126)
+    t128 = 3.141592653589793 - t126
+    t129 = t127 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t127)
+    t130 = t129 - 6.283185307179586*casadi.floor(1.0 + 0.15915494309189535*t129)
+    t131 = t128 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t128)
+    t132 = t131 - 6.283185307179586*casadi.floor(1.0 + 0.15915494309189535*t131)
+    t133 = 0.16670625*t66
+    t134 = casadi.if_else(t62, 1, -t124*t133)
+    t135 = casadi.if_else(t62, 0, -t125*t133)
+    t136 = 0.425 + 0.39225*t134
+    t137 = 0.089459 - 0.39225*t135
+    t138 = -0.089459 + t137
+    t139 = t112*t138 - t108*t136
+    t140 = t108*t138 + t112*t136
+    t141 = t139**2 + t140**2
+    t142 = t136**2 + t138**2
+    t143 = 0.0653905265625*t66
+    t144 = -0.425 + t124*t143
+    t145 = 0.089459 - t125*t143
+    t146 = -0.089459 + t145
+    t147 = t108*t144 + t112*t146
+    t148 = t108*t146 - t112*t144
+    t149 = t147**2 + t148**2
+    t150 = t144**2 + t146**2
+    t151 = t118**2
+    t152 = 1 - t120*t151
+    t153 = t118*t66
+    t154 = (1e-12 < t152)
+    t155 = casadi.if_else(t154, t153, casadi.if_else((t153 > 0), 1, -1))
+    t156 = casadi.if_else(t154, casadi.sqrt(t152), 0)
+    t157 = casadi.atan2(t156, t155)
+    t158 = casadi.if_else(t62, 0, 3.141592653589793 + t157)
+    t159 = casadi.if_else(t62, 1, -t133*t155)
+    t160 = casadi.if_else(t62, 0, -t133*t156)
+    t161 = 3.141592653589793 - t157
+    t162 = 0.425 + 0.39225*t159
+    t163 = 0.089459 - 0.39225*t160
+    t164 = -0.089459 + t163
+    t165 = t116*t164 - t109*t162
+    t166 = t109*t164 + t116*t162
+    t167 = t165**2 + t166**2
+    t168 = t162**2 + t164**2
+    t169 = -0.425 + t143*t155
+    t170 = 0.089459 - t143*t156
+    t171 = -0.089459 + t170
+    t172 = t109*t169 + t116*t171
+    t173 = t109*t171 - t116*t169
+    t174 = t172**2 + t173**2
+    t175 = t169**2 + t171**2
+    t176 = 1 - t35
+    t177 = t12*t176
+    t178 = t177 + t12*t35
+    t179 = T02*t39
+    t180 = T12*t35
+    t181 = t179 - t180
+    t182 = t180 - t179
+    t183 = t181**2
+    t184 = 1 - t183
+    t185 = (1e-12 < t184)
+    t186 = casadi.if_else(t185, t181, casadi.if_else((t181 > 0), 1, -1))
+    t187 = casadi.if_else(t185, casadi.sqrt(t184), 0)
+    t188 = casadi.atan2(t187, t186)
+    t189 = casadi.if_else(t62, 0, t188)
+    t190 = casadi.if_else(t62, 1, t186)
+    t191 = casadi.if_else(t62, 0, t187)
+    t192 = t189 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t189)
+    t193 = t192 - 6.283185307179586*casadi.floor(1.0 + 0.15915494309189535*t192)
+    t194 = t188 + 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t188)
+    t195 = t182*t190
+    t196 = -t195 + t191*t46
+    t197 = t195 + t196
+    t198 = t191**2
+    t199 = t198 + t190**2
+    t200 = t47**2
+    t201 = t197**2 + t198*t200
+    t202 = t200 + t182**2 + t46**2
+    t203 = (t201 <= 1e-24*t199*t202)
+    t204 = casadi.if_else(t203, 1, 1/casadi.sqrt(t201))
+    t205 = casadi.if_else(t203, 1, t197*t204)
+    t206 = t191*(1 - t205)
+    t207 = t206 + t191*t205
+    t208 = t191*t47
+    t209 = casadi.if_else(t203, 0, -t204*t208)
+    t210 = t190*t209
+    t211 = t190*t205
+    t212 = T01*t210 + T02*t207 - T00*t211
+    t213 = T11*t210 + T12*t207 - T10*t211
+    t214 = T21*t210 + T22*t207 - T20*t211
+    t215 = t176*t214
+    t216 = t212*t35 + t213*t39
+    t217 = t212*t39 - t213*t35
+    t218 = t215 + t214*t35
+    t219 = t216**2 + t218**2
+    t220 = t219
+    t221 = t219 + t217**2
+    t222 = (t220 <= 1e-24*t221)
+    t223 = casadi.if_else(t222, 1, 1/casadi.sqrt(t220))
+    t224 = casadi.if_else(t222, 1, -t216*t223)
+    t225 = casadi.if_else(t222, 0, -t218*t223)
+    t226 = 0.10915 - 0.10915*t224
+    t227 = 0.10915 + 0.10915*t224
+    t228 = 0.10915*t224
+    t229 = t226 + t228
+    t230 = t229 + t45
+    t231 = t228 - t227
+    t232 = t45 - t231
+    t233 = 0.09465*t225
+    t234 = t44 - t233
+    t235 = t233 + t44
+    t236 = 0.09465*t224
+    t237 = t178 + t236
+    t238 = -0.089459 + t237
+    t239 = t230**2 + t234**2 + t238**2
+    t240 = 0.16724253125 - 0.5*t239
+    t241 = t178 - t236
+    t242 = -0.089459 + t241
+    t243 = t232**2 + t235**2 + t242**2
+    t244 = 0.16724253125 - 0.5*t243
+    t245 = t240**2
+    t246 = 1 - t120*t245
+    t247 = t240*t66
+    t248 = (1e-12 < t246)
+    t249 = casadi.if_else(t248, t247, casadi.if_else((t247 > 0), 1, -1))
+    t250 = casadi.if_else(t248, casadi.sqrt(t246), 0)
+    t251 = casadi.atan2(t250, t249)
+    t252 = casadi.if_else(t62, 0, 3.141592653589793 + t251)
+    t253 = casadi.if_else(t62, 1, -t133*t249)
+    t254 = casadi.if_else(t62, 0, -t133*t250)
+    t255 = 3.141592653589793 - t251
+    t256 = 0.425 + 0.39225*t253
+    t257 = 0.089459 - 0.39225*t254
+    t258 = -0.089459 + t257
+    t259 = t238*t258 - t234*t256
+    t260 = t234*t258 + t238*t256
+    t261 = t259**2 + t260**2
+    t262 = t256**2 + t258**2
+    t263 = -0.425 + t143*t249
+    t264 = 0.089459 - t143*t250
+    t265 = -0.089459 + t264
+    t266 = t234*t263 + t238*t265
+    t267 = t234*t265 - t238*t263
+    t268 = t266**2 + t267**2
+    t269 = t263**2 + t265**2
+    t270 = t252 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t252)
+    t271 = t270 - 6.283185307179586*casadi.floor(1.0 + 0.15915494309189535*t270)
+    t272 = t255 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t255)
+    t273 = t272 - 6.283185307179586*casadi.floor(1.0 + 0.15915494309189535*t272)
+    t274 = t244**2
+    t275 = 1 - t120*t274
+    t276 = t244*t66
+    t277 = (1e-12 < t275)
+    t278 = casadi.if_else(t277, t276, casadi.if_else((t276 > 0), 1, -1))
+    t279 = casadi.if_else(t277, casadi.sqrt(t275), 0)
+    t280 = casadi.atan2(t279, t278)
+    t281 = casadi.if_else(t62, 0, 3.141592653589793 + t280)
+    t282 = casadi.if_else(t62, 1, -t133*t278)
+    t283 = casadi.if_else(t62, 0, -t133*t279)
+    t284 = 3.141592653589793 - t280
+    t285 = 0.425 + 0.39225*t282
+    t286 = 0.089459 - 0.39225*t283
+    t287 = -0.089459 + t286
+    t288 = t242*t287 - t235*t285
+    t289 = t235*t287 + t242*t285
+    t290 = t288**2 + t289**2
+    t291 = t285**2 + t287**2
+    t292 = -0.425 + t143*t278
+    t293 = 0.089459 - t143*t279
+    t294 = -0.089459 + t293
+    t295 = t235*t292 + t242*t294
+    t296 = t235*t294 - t242*t292
+    t297 = t295**2 + t296**2
+    t298 = t292**2 + t294**2
+    t299 = T00 + T01 + T02 + T03 + T10 + T11 + T12 + T13 + T20 + T21 + T22 + T23
+    t300 = t299
+    t301 = qn1 + qn2 + qn3 + qn4 + qn5 + qn6 + qw1 + qw2 + qw3 + qw4 + qw5 + qw6 + t299
+    t302 = 1e-24*t113
+    t303 = casadi.if_else((t141 <= t142*t302), 0, casadi.atan2(-t140, t139))
+    t304 = t303
+    t305 = t304 - 6.283185307179586*casadi.floor(1.0 + 0.15915494309189535*t304)
+    t306 = -casadi.if_else(t96, 0, casadi.atan2(-t92, -t90))
+    t307 = 3.141592653589793 + t306
+    t308 = t127 + t303
+    t309 = t306 + t308 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t307 - 0.15915494309189535*t308)
+    t310 = -t309
+    t311 = t309 + 6.283185307179586*casadi.floor(1.0 + 0.15915494309189535*t310)
+    t312 = casadi.if_else(t77, 0, casadi.atan2(-t82, t71))
+    t313 = t312
+    t314 = t313 - 6.283185307179586*casadi.floor(1.0 + 0.15915494309189535*t313)
+    t315 = 3.141592653589793 + t312 - 6.283185307179586*casadi.ceil(0.15915494309189535*t312)
+    t316 = t315 - 6.283185307179586*casadi.floor(1.0 + 0.15915494309189535*t315)
+    t317 = casadi.if_else((t149 <= t150*t302), 0, casadi.atan2(-t148, t147))
+    t318 = t317
+    t319 = t318 - 6.283185307179586*casadi.floor(1.0 + 0.15915494309189535*t318)
+    t320 = t128 + t317
+    t321 = t306 + t320 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t307 - 0.15915494309189535*t320)
+    t322 = -t321
+    t323 = t321 + 6.283185307179586*casadi.floor(1.0 + 0.15915494309189535*t322)
+    t324 = 1e-24*t117
+    t325 = casadi.if_else((t167 <= t168*t324), 0, casadi.atan2(-t166, t165))
+    t326 = t325
+    t327 = t326 - 6.283185307179586*casadi.floor(1.0 + 0.15915494309189535*t326)
+    t328 = -3.141592653589793 + t158
+    t329 = t158 - 6.283185307179586*casadi.ceil(0.15915494309189535*t328)
+    t330 = t329 - 6.283185307179586*casadi.floor(1.0 + 0.15915494309189535*t329)
+    t331 = t306 + t325
+    t332 = t328 + t331 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t158 - 0.15915494309189535*t331)
+    t333 = -t332
+    t334 = t332 + 6.283185307179586*casadi.floor(1.0 + 0.15915494309189535*t333)
+    t335 = -t61
+    t336 = t61 + 6.283185307179586*casadi.floor(1.0 + 0.15915494309189535*t335)
+    t337 = casadi.if_else((t174 <= t175*t324), 0, casadi.atan2(-t173, t172))
+    t338 = t337
+    t339 = t338 - 6.283185307179586*casadi.floor(1.0 + 0.15915494309189535*t338)
+    t340 = -3.141592653589793 + t161
+    t341 = t161 - 6.283185307179586*casadi.ceil(0.15915494309189535*t340)
+    t342 = t341 - 6.283185307179586*casadi.floor(1.0 + 0.15915494309189535*t341)
+    t343 = t306 + t337
+    t344 = t340 + t343 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t161 - 0.15915494309189535*t343)
+    t345 = -t344
+    t346 = t344 + 6.283185307179586*casadi.floor(1.0 + 0.15915494309189535*t345)
+    t347 = 1e-24*t239
+    t348 = casadi.if_else((t261 <= t262*t347), 0, casadi.atan2(-t260, t259))
+    t349 = t348
+    t350 = t349 - 6.283185307179586*casadi.floor(1.0 + 0.15915494309189535*t349)
+    t351 = -casadi.if_else(t222, 0, casadi.atan2(-t218, -t216))
+    t352 = 3.141592653589793 + t351
+    t353 = t252 + t348
+    t354 = t351 + t353 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t352 - 0.15915494309189535*t353)
+    t355 = -t354
+    t356 = t354 + 6.283185307179586*casadi.floor(1.0 + 0.15915494309189535*t355)
+    t357 = casadi.if_else(t203, 0, casadi.atan2(-t208, t197))
+    t358 = t357
+    t359 = t358 - 6.283185307179586*casadi.floor(1.0 + 0.15915494309189535*t358)
+    t360 = 3.141592653589793 + t357 - 6.283185307179586*casadi.ceil(0.15915494309189535*t357)
+    t361 = t360 - 6.283185307179586*casadi.floor(1.0 + 0.15915494309189535*t360)
+    t362 = casadi.if_else((t268 <= t269*t347), 0, casadi.atan2(-t267, t266))
+    t363 = t362
+    t364 = t363 - 6.283185307179586*casadi.floor(1.0 + 0.15915494309189535*t363)
+    t365 = t255 + t362
+    t366 = t351 + t365 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t352 - 0.15915494309189535*t365)
+    t367 = -t366
+    t368 = t366 + 6.283185307179586*casadi.floor(1.0 + 0.15915494309189535*t367)
+    t369 = 1e-24*t243
+    t370 = casadi.if_else((t290 <= t291*t369), 0, casadi.atan2(-t289, t288))
+    t371 = t370
+    t372 = t371 - 6.283185307179586*casadi.floor(1.0 + 0.15915494309189535*t371)
+    t373 = -3.141592653589793 + t281
+    t374 = t281 - 6.283185307179586*casadi.ceil(0.15915494309189535*t373)
+    t375 = t374 - 6.283185307179586*casadi.floor(1.0 + 0.15915494309189535*t374)
+    t376 = t351 + t370
+    t377 = t373 + t376 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t281 - 0.15915494309189535*t376)
+    t378 = -t377
+    t379 = t377 + 6.283185307179586*casadi.floor(1.0 + 0.15915494309189535*t378)
+    t380 = -t194
+    t381 = t194 + 6.283185307179586*casadi.floor(1.0 + 0.15915494309189535*t380)
+    t382 = casadi.if_else((t297 <= t298*t369), 0, casadi.atan2(-t296, t295))
+    t383 = t382
+    t384 = t383 - 6.283185307179586*casadi.floor(1.0 + 0.15915494309189535*t383)
+    t385 = -3.141592653589793 + t284
+    t386 = t284 - 6.283185307179586*casadi.ceil(0.15915494309189535*t385)
+    t387 = t386 - 6.283185307179586*casadi.floor(1.0 + 0.15915494309189535*t386)
+    t388 = t351 + t382
+    t389 = t385 + t388 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t284 - 0.15915494309189535*t388)
+    t390 = -t389
+    t391 = t389 + 6.283185307179586*casadi.floor(1.0 + 0.15915494309189535*t390)
+    t392 = (t27 <= 6.283185307179586)
+    t393 = casadi.logic_and((t26 >= -6.283185307179586), (t26 <= 6.283185307179586))
+    t394 = casadi.if_else(casadi.logic_and(t392, casadi.logic_not(t393)), t27, t26)
+    t395 = t394
+    t396 = t395 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn1 - 0.15915494309189535*t395)
+    t397 = casadi.if_else((qn1 > t396), 6.283185307179586, -6.283185307179586)
+    t398 = t396 + t397
+    t399 = t396 - t397
+    t400 = casadi.if_else(casadi.logic_and((t396 >= -6.283185307179586), (t396 <= 6.283185307179586)), t396, casadi.if_else(casadi.logic_and((t398 >= -6.283185307179586), (t398 <= 6.283185307179586)), t398, casadi.if_else(casadi.logic_and((t399 >= -6.283185307179586), (t399 <= 6.283185307179586)), t399, t394)))
+    t401 = (t305 <= 6.283185307179586)
+    t402 = casadi.logic_and((t304 >= -6.283185307179586), (t304 <= 6.283185307179586))
+    t403 = casadi.if_else(casadi.logic_and(t401, casadi.logic_not(t402)), t305, t304)
+    t404 = t403
+    t405 = t404 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t404)
+    t406 = casadi.if_else((qn2 > t405), 6.283185307179586, -6.283185307179586)
+    t407 = t405 + t406
+    t408 = t405 - t406
+    t409 = casadi.if_else(casadi.logic_and((t405 >= -6.283185307179586), (t405 <= 6.283185307179586)), t405, casadi.if_else(casadi.logic_and((t407 >= -6.283185307179586), (t407 <= 6.283185307179586)), t407, casadi.if_else(casadi.logic_and((t408 >= -6.283185307179586), (t408 <= 6.283185307179586)), t408, t403)))
+    t410 = (t130 <= 6.283185307179586)
+    t411 = casadi.logic_and((t129 >= -6.283185307179586), (t129 <= 6.283185307179586))
+    t412 = casadi.if_else(casadi.logic_and(t410, casadi.logic_not(t411)), t130, t129)
+    t413 = t412
+    t414 = t413 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn3 - 0.15915494309189535*t413)
+    t415 = casadi.if_else((qn3 > t414), 6.283185307179586, -6.283185307179586)
+    t416 = t414 + t415
+    t417 = t414 - t415
+    t418 = casadi.if_else(casadi.logic_and((t414 >= -6.283185307179586), (t414 <= 6.283185307179586)), t414, casadi.if_else(casadi.logic_and((t416 >= -6.283185307179586), (t416 <= 6.283185307179586)), t416, casadi.if_else(casadi.logic_and((t417 >= -6.283185307179586), (t417 <= 6.283185307179586)), t417, t412)))
+    t419 = (t311 >= -6.283185307179586)
+    t420 = casadi.logic_and((t309 >= -6.283185307179586), (t309 <= 6.283185307179586))
+    t421 = casadi.if_else(casadi.logic_and(t419, casadi.logic_not(t420)), -t311, t310)
+    t422 = t421
+    t423 = t422 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t422)
+    t424 = casadi.if_else((qn4 > t423), 6.283185307179586, -6.283185307179586)
+    t425 = t423 + t424
+    t426 = t423 - t424
+    t427 = casadi.if_else(casadi.logic_and((t423 >= -6.283185307179586), (t423 <= 6.283185307179586)), t423, casadi.if_else(casadi.logic_and((t425 >= -6.283185307179586), (t425 <= 6.283185307179586)), t425, casadi.if_else(casadi.logic_and((t426 >= -6.283185307179586), (t426 <= 6.283185307179586)), t426, t421)))
+    t428 = (t68 <= 6.283185307179586)
+    t429 = casadi.logic_and((t67 >= -6.283185307179586), (t67 <= 6.283185307179586))
+    t430 = casadi.if_else(casadi.logic_and(t428, casadi.logic_not(t429)), t68, t67)
+    t431 = t430
+    t432 = t431 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn5 - 0.15915494309189535*t431)
+    t433 = casadi.if_else((qn5 > t432), 6.283185307179586, -6.283185307179586)
+    t434 = t432 + t433
+    t435 = t432 - t433
+    t436 = casadi.if_else(casadi.logic_and((t432 >= -6.283185307179586), (t432 <= 6.283185307179586)), t432, casadi.if_else(casadi.logic_and((t434 >= -6.283185307179586), (t434 <= 6.283185307179586)), t434, casadi.if_else(casadi.logic_and((t435 >= -6.283185307179586), (t435 <= 6.283185307179586)), t435, t430)))
+    t437 = (t314 <= 6.283185307179586)
+    t438 = casadi.logic_and((t313 >= -6.283185307179586), (t313 <= 6.283185307179586))
+    t439 = casadi.if_else(casadi.logic_and(t437, casadi.logic_not(t438)), t314, t313)
+    t440 = t439
+    t441 = t440 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn6 - 0.15915494309189535*t440)
+    t442 = casadi.if_else((qn6 > t441), 6.283185307179586, -6.283185307179586)
+    t443 = t441 + t442
+    t444 = t441 - t442
+    t445 = casadi.if_else(casadi.logic_and((t441 >= -6.283185307179586), (t441 <= 6.283185307179586)), t441, casadi.if_else(casadi.logic_and((t443 >= -6.283185307179586), (t443 <= 6.283185307179586)), t443, casadi.if_else(casadi.logic_and((t444 >= -6.283185307179586), (t444 <= 6.283185307179586)), t444, t439)))
+    t446 = -qn2
+    t447 = -qn3
+    t448 = -qn4
+    t449 = -qn1
+    t450 = qw1*(t400 + t449)**2
+    t451 = -qn5
+    t452 = -qn6
+    t453 = t450 + qw5*(t436 + t451)**2 + qw6*(t445 + t452)**2
+    t454 = t453 + qw2*(t409 + t446)**2 + qw3*(t418 + t447)**2 + qw4*(t427 + t448)**2
+    t455 = (casadi.fabs(t300) < casadi.inf)
+    t456 = casadi.logic_or(t392, t393)
+    t457 = casadi.logic_or(t428, t429)
+    t458 = casadi.logic_or(t437, t438)
+    t459 = True
+    t460 = casadi.logic_or(casadi.logic_and(t62, (1e-12 >= t55)), casadi.logic_and(t459, (1e-12 >= -t56)))
+    t461 = (t14 > t16)
+    t462 = casadi.logic_or(casadi.logic_and(t17, (1e-12*t15 >= 0.0119137225)), casadi.logic_and(t461, (1e-12 >= -t19)))
+    t463 = casadi.if_else(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t455, t456), t457), t458), t460), t462), casadi.logic_or(t401, t402)), casadi.logic_or(t410, t411)), casadi.logic_or(t419, t420)), casadi.logic_or(casadi.logic_and(t459, (t121 >= -1e-12)), casadi.logic_and(t62, (35.98290608994648*t119 <= 1e-12)))), 1, 0)
+    t464 = casadi.if_else((t463 > 0), 1, 0)
+    t465 = (t464 > 0)
+    t466 = casadi.if_else(t465, t400, qn1)
+    t467 = casadi.if_else(t465, t409, qn2)
+    t468 = casadi.if_else(t465, t418, qn3)
+    t469 = casadi.if_else(t465, t427, qn4)
+    t470 = casadi.if_else(t465, t436, qn5)
+    t471 = casadi.if_else(t465, t445, qn6)
+    t472 = casadi.if_else(t465, t454, 0)
+    t473 = (t319 <= 6.283185307179586)
+    t474 = casadi.logic_and((t318 >= -6.283185307179586), (t318 <= 6.283185307179586))
+    t475 = casadi.if_else(casadi.logic_and(t473, casadi.logic_not(t474)), t319, t318)
+    t476 = t475
+    t477 = t476 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t476)
+    t478 = casadi.if_else((qn2 > t477), 6.283185307179586, -6.283185307179586)
+    t479 = t477 + t478
+    t480 = t477 - t478
+    t481 = casadi.if_else(casadi.logic_and((t477 >= -6.283185307179586), (t477 <= 6.283185307179586)), t477, casadi.if_else(casadi.logic_and((t479 >= -6.283185307179586), (t479 <= 6.283185307179586)), t479, casadi.if_else(casadi.logic_and((t480 >= -6.283185307179586), (t480 <= 6.283185307179586)), t480, t475)))
+    t482 = (t132 <= 6.283185307179586)
+    t483 = casadi.logic_and((t131 >= -6.283185307179586), (t131 <= 6.283185307179586))
+    t484 = casadi.if_else(casadi.logic_and(t482, casadi.logic_not(t483)), t132, t131)
+    t485 = t484
+    t486 = t485 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn3 - 0.15915494309189535*t485)
+    t487 = casadi.if_else((qn3 > t486), 6.283185307179586, -6.283185307179586)
+    t488 = t486 + t487
+    t489 = t486 - t487
+    t490 = casadi.if_else(casadi.logic_and((t486 >= -6.283185307179586), (t486 <= 6.283185307179586)), t486, casadi.if_else(casadi.logic_and((t488 >= -6.283185307179586), (t488 <= 6.283185307179586)), t488, casadi.if_else(casadi.logic_and((t489 >= -6.283185307179586), (t489 <= 6.283185307179586)), t489, t484)))
+    t491 = (t323 >= -6.283185307179586)
+    t492 = casadi.logic_and((t321 >= -6.283185307179586), (t321 <= 6.283185307179586))
+    t493 = casadi.if_else(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t123, t455), t456), t457), t458), t459), t460), t462), casadi.logic_or(t473, t474)), casadi.logic_or(t482, t483)), casadi.logic_or(t491, t492)), 1, 0)
+    t494 = casadi.if_else(casadi.logic_and(t491, casadi.logic_not(t492)), -t323, t322)
+    t495 = t494
+    t496 = t495 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t495)
+    t497 = casadi.if_else((qn4 > t496), 6.283185307179586, -6.283185307179586)
+    t498 = t496 + t497
+    t499 = t496 - t497
+    t500 = casadi.if_else(casadi.logic_and((t496 >= -6.283185307179586), (t496 <= 6.283185307179586)), t496, casadi.if_else(casadi.logic_and((t498 >= -6.283185307179586), (t498 <= 6.283185307179586)), t498, casadi.if_else(casadi.logic_and((t499 >= -6.283185307179586), (t499 <= 6.283185307179586)), t499, t494)))
+    t501 = t453 + qw2*(t446 + t481)**2 + qw3*(t447 + t490)**2 + qw4*(t448 + t500)**2
+    t502 = (t493 > 0)
+    t503 = casadi.if_else(casadi.logic_and(t502, casadi.logic_or((t472 > t501), (t464 < 1))), 1, 0)
+    t504 = casadi.if_else(t502, 1, t464)
+    t505 = (t503 > 0)
+    t506 = casadi.if_else(t505, t400, t466)
+    t507 = casadi.if_else(t505, t481, t467)
+    t508 = casadi.if_else(t505, t490, t468)
+    t509 = casadi.if_else(t505, t500, t469)
+    t510 = casadi.if_else(t505, t436, t470)
+    t511 = casadi.if_else(t505, t445, t471)
+    t512 = casadi.if_else(t505, t501, t472)
+    t513 = (t327 <= 6.283185307179586)
+    t514 = casadi.logic_and((t326 >= -6.283185307179586), (t326 <= 6.283185307179586))
+    t515 = casadi.if_else(casadi.logic_and(t513, casadi.logic_not(t514)), t327, t326)
+    t516 = t515
+    t517 = t516 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t516)
+    t518 = casadi.if_else((qn2 > t517), 6.283185307179586, -6.283185307179586)
+    t519 = t517 + t518
+    t520 = t517 - t518
+    t521 = casadi.if_else(casadi.logic_and((t517 >= -6.283185307179586), (t517 <= 6.283185307179586)), t517, casadi.if_else(casadi.logic_and((t519 >= -6.283185307179586), (t519 <= 6.283185307179586)), t519, casadi.if_else(casadi.logic_and((t520 >= -6.283185307179586), (t520 <= 6.283185307179586)), t520, t515)))
+    t522 = (t330 <= 6.283185307179586)
+    t523 = casadi.logic_and((t329 >= -6.283185307179586), (t329 <= 6.283185307179586))
+    t524 = casadi.if_else(casadi.logic_and(t522, casadi.logic_not(t523)), t330, t329)
+    t525 = t524
+    t526 = t525 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn3 - 0.15915494309189535*t525)
+    t527 = casadi.if_else((qn3 > t526), 6.283185307179586, -6.283185307179586)
+    t528 = t526 + t527
+    t529 = t526 - t527
+    t530 = casadi.if_else(casadi.logic_and((t526 >= -6.283185307179586), (t526 <= 6.283185307179586)), t526, casadi.if_else(casadi.logic_and((t528 >= -6.283185307179586), (t528 <= 6.283185307179586)), t528, casadi.if_else(casadi.logic_and((t529 >= -6.283185307179586), (t529 <= 6.283185307179586)), t529, t524)))
+    t531 = (t334 >= -6.283185307179586)
+    t532 = casadi.logic_and((t332 >= -6.283185307179586), (t332 <= 6.283185307179586))
+    t533 = casadi.if_else(casadi.logic_and(t531, casadi.logic_not(t532)), -t334, t333)
+    t534 = t533
+    t535 = t534 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t534)
+    t536 = casadi.if_else((qn4 > t535), 6.283185307179586, -6.283185307179586)
+    t537 = t535 + t536
+    t538 = t535 - t536
+    t539 = casadi.if_else(casadi.logic_and((t535 >= -6.283185307179586), (t535 <= 6.283185307179586)), t535, casadi.if_else(casadi.logic_and((t537 >= -6.283185307179586), (t537 <= 6.283185307179586)), t537, casadi.if_else(casadi.logic_and((t538 >= -6.283185307179586), (t538 <= 6.283185307179586)), t538, t533)))
+    t540 = (t336 >= -6.283185307179586)
+    t541 = casadi.logic_and((t61 >= -6.283185307179586), (t61 <= 6.283185307179586))
+    t542 = casadi.if_else(casadi.logic_and(t540, casadi.logic_not(t541)), -t336, t335)
+    t543 = t542
+    t544 = t543 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn5 - 0.15915494309189535*t543)
+    t545 = casadi.if_else((qn5 > t544), 6.283185307179586, -6.283185307179586)
+    t546 = t544 + t545
+    t547 = t544 - t545
+    t548 = casadi.if_else(casadi.logic_and((t544 >= -6.283185307179586), (t544 <= 6.283185307179586)), t544, casadi.if_else(casadi.logic_and((t546 >= -6.283185307179586), (t546 <= 6.283185307179586)), t546, casadi.if_else(casadi.logic_and((t547 >= -6.283185307179586), (t547 <= 6.283185307179586)), t547, t542)))
+    t549 = (t316 <= 6.283185307179586)
+    t550 = casadi.logic_and((t315 >= -6.283185307179586), (t315 <= 6.283185307179586))
+    t551 = casadi.if_else(casadi.logic_and(t549, casadi.logic_not(t550)), t316, t315)
+    t552 = t551
+    t553 = t552 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn6 - 0.15915494309189535*t552)
+    t554 = casadi.if_else((qn6 > t553), 6.283185307179586, -6.283185307179586)
+    t555 = t553 + t554
+    t556 = t553 - t554
+    t557 = casadi.if_else(casadi.logic_and((t553 >= -6.283185307179586), (t553 <= 6.283185307179586)), t553, casadi.if_else(casadi.logic_and((t555 >= -6.283185307179586), (t555 <= 6.283185307179586)), t555, casadi.if_else(casadi.logic_and((t556 >= -6.283185307179586), (t556 <= 6.283185307179586)), t556, t551)))
+    t558 = t450 + qw5*(t451 + t548)**2 + qw6*(t452 + t557)**2
+    t559 = t558 + qw2*(t446 + t521)**2 + qw3*(t447 + t530)**2 + qw4*(t448 + t539)**2
+    t560 = casadi.logic_or(t540, t541)
+    t561 = casadi.logic_or(t549, t550)
+    t562 = casadi.if_else(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t455, t456), t459), t462), t560), t561), t57), casadi.logic_or(t513, t514)), casadi.logic_or(t522, t523)), casadi.logic_or(t531, t532)), casadi.logic_or(casadi.logic_and(t459, (t152 >= -1e-12)), casadi.logic_and(t62, (35.98290608994648*t151 <= 1e-12)))), 1, 0)
+    t563 = (t562 > 0)
+    t564 = casadi.if_else(casadi.logic_and(t563, casadi.logic_or((t512 > t559), (t504 < 1))), 1, 0)
+    t565 = casadi.if_else(t563, 1, t504)
+    t566 = (t564 > 0)
+    t567 = casadi.if_else(t566, t400, t506)
+    t568 = casadi.if_else(t566, t521, t507)
+    t569 = casadi.if_else(t566, t530, t508)
+    t570 = casadi.if_else(t566, t539, t509)
+    t571 = casadi.if_else(t566, t548, t510)
+    t572 = casadi.if_else(t566, t557, t511)
+    t573 = casadi.if_else(t566, t559, t512)
+    t574 = (t339 <= 6.283185307179586)
+    t575 = casadi.logic_and((t338 >= -6.283185307179586), (t338 <= 6.283185307179586))
+    t576 = casadi.if_else(casadi.logic_and(t574, casadi.logic_not(t575)), t339, t338)
+    t577 = t576
+    t578 = t577 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t577)
+    t579 = casadi.if_else((qn2 > t578), 6.283185307179586, -6.283185307179586)
+    t580 = t578 + t579
+    t581 = t578 - t579
+    t582 = casadi.if_else(casadi.logic_and((t578 >= -6.283185307179586), (t578 <= 6.283185307179586)), t578, casadi.if_else(casadi.logic_and((t580 >= -6.283185307179586), (t580 <= 6.283185307179586)), t580, casadi.if_else(casadi.logic_and((t581 >= -6.283185307179586), (t581 <= 6.283185307179586)), t581, t576)))
+    t583 = (t342 <= 6.283185307179586)
+    t584 = casadi.logic_and((t341 >= -6.283185307179586), (t341 <= 6.283185307179586))
+    t585 = casadi.if_else(casadi.logic_and(t583, casadi.logic_not(t584)), t342, t341)
+    t586 = t585
+    t587 = t586 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn3 - 0.15915494309189535*t586)
+    t588 = casadi.if_else((qn3 > t587), 6.283185307179586, -6.283185307179586)
+    t589 = t587 + t588
+    t590 = t587 - t588
+    t591 = casadi.if_else(casadi.logic_and((t587 >= -6.283185307179586), (t587 <= 6.283185307179586)), t587, casadi.if_else(casadi.logic_and((t589 >= -6.283185307179586), (t589 <= 6.283185307179586)), t589, casadi.if_else(casadi.logic_and((t590 >= -6.283185307179586), (t590 <= 6.283185307179586)), t590, t585)))
+    t592 = (t346 >= -6.283185307179586)
+    t593 = casadi.logic_and((t344 >= -6.283185307179586), (t344 <= 6.283185307179586))
+    t594 = casadi.if_else(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t154, t455), t456), t459), t462), t560), t561), t57), casadi.logic_or(t574, t575)), casadi.logic_or(t583, t584)), casadi.logic_or(t592, t593)), 1, 0)
+    t595 = casadi.if_else(casadi.logic_and(t592, casadi.logic_not(t593)), -t346, t345)
+    t596 = t595
+    t597 = t596 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t596)
+    t598 = casadi.if_else((qn4 > t597), 6.283185307179586, -6.283185307179586)
+    t599 = t597 + t598
+    t600 = t597 - t598
+    t601 = casadi.if_else(casadi.logic_and((t597 >= -6.283185307179586), (t597 <= 6.283185307179586)), t597, casadi.if_else(casadi.logic_and((t599 >= -6.283185307179586), (t599 <= 6.283185307179586)), t599, casadi.if_else(casadi.logic_and((t600 >= -6.283185307179586), (t600 <= 6.283185307179586)), t600, t595)))
+    t602 = t558 + qw2*(t446 + t582)**2 + qw3*(t447 + t591)**2 + qw4*(t448 + t601)**2
+    t603 = (t594 > 0)
+    t604 = casadi.if_else(casadi.logic_and(t603, casadi.logic_or((t573 > t602), (t565 < 1))), 1, 0)
+    t605 = casadi.if_else(t603, 1, t565)
+    t606 = (t604 > 0)
+    t607 = casadi.if_else(t606, t400, t567)
+    t608 = casadi.if_else(t606, t582, t568)
+    t609 = casadi.if_else(t606, t591, t569)
+    t610 = casadi.if_else(t606, t601, t570)
+    t611 = casadi.if_else(t606, t548, t571)
+    t612 = casadi.if_else(t606, t557, t572)
+    t613 = casadi.if_else(t606, t602, t573)
+    t614 = (t29 <= 6.283185307179586)
+    t615 = casadi.logic_and((t28 >= -6.283185307179586), (t28 <= 6.283185307179586))
+    t616 = casadi.if_else(casadi.logic_and(t614, casadi.logic_not(t615)), t29, t28)
+    t617 = t616
+    t618 = t617 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn1 - 0.15915494309189535*t617)
+    t619 = casadi.if_else((qn1 > t618), 6.283185307179586, -6.283185307179586)
+    t620 = t618 + t619
+    t621 = t618 - t619
+    t622 = casadi.if_else(casadi.logic_and((t618 >= -6.283185307179586), (t618 <= 6.283185307179586)), t618, casadi.if_else(casadi.logic_and((t620 >= -6.283185307179586), (t620 <= 6.283185307179586)), t620, casadi.if_else(casadi.logic_and((t621 >= -6.283185307179586), (t621 <= 6.283185307179586)), t621, t616)))
+    t623 = (t350 <= 6.283185307179586)
+    t624 = casadi.logic_and((t349 >= -6.283185307179586), (t349 <= 6.283185307179586))
+    t625 = casadi.if_else(casadi.logic_and(t623, casadi.logic_not(t624)), t350, t349)
+    t626 = t625
+    t627 = t626 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t626)
+    t628 = casadi.if_else((qn2 > t627), 6.283185307179586, -6.283185307179586)
+    t629 = t627 + t628
+    t630 = t627 - t628
+    t631 = casadi.if_else(casadi.logic_and((t627 >= -6.283185307179586), (t627 <= 6.283185307179586)), t627, casadi.if_else(casadi.logic_and((t629 >= -6.283185307179586), (t629 <= 6.283185307179586)), t629, casadi.if_else(casadi.logic_and((t630 >= -6.283185307179586), (t630 <= 6.283185307179586)), t630, t625)))
+    t632 = (t271 <= 6.283185307179586)
+    t633 = casadi.logic_and((t270 >= -6.283185307179586), (t270 <= 6.283185307179586))
+    t634 = casadi.if_else(casadi.logic_and(t632, casadi.logic_not(t633)), t271, t270)
+    t635 = t634
+    t636 = t635 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn3 - 0.15915494309189535*t635)
+    t637 = casadi.if_else((qn3 > t636), 6.283185307179586, -6.283185307179586)
+    t638 = t636 + t637
+    t639 = t636 - t637
+    t640 = casadi.if_else(casadi.logic_and((t636 >= -6.283185307179586), (t636 <= 6.283185307179586)), t636, casadi.if_else(casadi.logic_and((t638 >= -6.283185307179586), (t638 <= 6.283185307179586)), t638, casadi.if_else(casadi.logic_and((t639 >= -6.283185307179586), (t639 <= 6.283185307179586)), t639, t634)))
+    t641 = (t356 >= -6.283185307179586)
+    t642 = casadi.logic_and((t354 >= -6.283185307179586), (t354 <= 6.283185307179586))
+    t643 = casadi.if_else(casadi.logic_and(t641, casadi.logic_not(t642)), -t356, t355)
+    t644 = t643
+    t645 = t644 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t644)
+    t646 = casadi.if_else((qn4 > t645), 6.283185307179586, -6.283185307179586)
+    t647 = t645 + t646
+    t648 = t645 - t646
+    t649 = casadi.if_else(casadi.logic_and((t645 >= -6.283185307179586), (t645 <= 6.283185307179586)), t645, casadi.if_else(casadi.logic_and((t647 >= -6.283185307179586), (t647 <= 6.283185307179586)), t647, casadi.if_else(casadi.logic_and((t648 >= -6.283185307179586), (t648 <= 6.283185307179586)), t648, t643)))
+    t650 = (t193 <= 6.283185307179586)
+    t651 = casadi.logic_and((t192 >= -6.283185307179586), (t192 <= 6.283185307179586))
+    t652 = casadi.if_else(casadi.logic_and(t650, casadi.logic_not(t651)), t193, t192)
+    t653 = t652
+    t654 = t653 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn5 - 0.15915494309189535*t653)
+    t655 = casadi.if_else((qn5 > t654), 6.283185307179586, -6.283185307179586)
+    t656 = t654 + t655
+    t657 = t654 - t655
+    t658 = casadi.if_else(casadi.logic_and((t654 >= -6.283185307179586), (t654 <= 6.283185307179586)), t654, casadi.if_else(casadi.logic_and((t656 >= -6.283185307179586), (t656 <= 6.283185307179586)), t656, casadi.if_else(casadi.logic_and((t657 >= -6.283185307179586), (t657 <= 6.283185307179586)), t657, t652)))
+    t659 = (t359 <= 6.283185307179586)
+    t660 = casadi.logic_and((t358 >= -6.283185307179586), (t358 <= 6.283185307179586))
+    t661 = casadi.if_else(casadi.logic_and(t659, casadi.logic_not(t660)), t359, t358)
+    t662 = t661
+    t663 = t662 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn6 - 0.15915494309189535*t662)
+    t664 = casadi.if_else((qn6 > t663), 6.283185307179586, -6.283185307179586)
+    t665 = t663 + t664
+    t666 = t663 - t664
+    t667 = casadi.if_else(casadi.logic_and((t663 >= -6.283185307179586), (t663 <= 6.283185307179586)), t663, casadi.if_else(casadi.logic_and((t665 >= -6.283185307179586), (t665 <= 6.283185307179586)), t665, casadi.if_else(casadi.logic_and((t666 >= -6.283185307179586), (t666 <= 6.283185307179586)), t666, t661)))
+    t668 = qw1*(t449 + t622)**2
+    t669 = t668 + qw5*(t451 + t658)**2 + qw6*(t452 + t667)**2
+    t670 = t669 + qw2*(t446 + t631)**2 + qw3*(t447 + t640)**2 + qw4*(t448 + t649)**2
+    t671 = casadi.logic_or(t614, t615)
+    t672 = casadi.logic_or(t650, t651)
+    t673 = casadi.logic_or(t659, t660)
+    t674 = casadi.logic_or(casadi.logic_and(t62, (1e-12 >= t183)), casadi.logic_and(t459, (1e-12 >= -t184)))
+    t675 = casadi.if_else(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t20, t455), t461), t671), t672), t673), t674), casadi.logic_or(t623, t624)), casadi.logic_or(t632, t633)), casadi.logic_or(t641, t642)), casadi.logic_or(casadi.logic_and(t459, (t246 >= -1e-12)), casadi.logic_and(t62, (35.98290608994648*t245 <= 1e-12)))), 1, 0)
+    t676 = (t675 > 0)
+    t677 = casadi.if_else(casadi.logic_and(t676, casadi.logic_or((t613 > t670), (t605 < 1))), 1, 0)
+    t678 = casadi.if_else(t676, 1, t605)
+    t679 = (t677 > 0)
+    t680 = casadi.if_else(t679, t622, t607)
+    t681 = casadi.if_else(t679, t631, t608)
+    t682 = casadi.if_else(t679, t640, t609)
+    t683 = casadi.if_else(t679, t649, t610)
+    t684 = casadi.if_else(t679, t658, t611)
+    t685 = casadi.if_else(t679, t667, t612)
+    t686 = casadi.if_else(t679, t670, t613)
+    t687 = (t364 <= 6.283185307179586)
+    t688 = casadi.logic_and((t363 >= -6.283185307179586), (t363 <= 6.283185307179586))
+    t689 = casadi.if_else(casadi.logic_and(t687, casadi.logic_not(t688)), t364, t363)
+    t690 = t689
+    t691 = t690 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t690)
+    t692 = casadi.if_else((qn2 > t691), 6.283185307179586, -6.283185307179586)
+    t693 = t691 + t692
+    t694 = t691 - t692
+    t695 = casadi.if_else(casadi.logic_and((t691 >= -6.283185307179586), (t691 <= 6.283185307179586)), t691, casadi.if_else(casadi.logic_and((t693 >= -6.283185307179586), (t693 <= 6.283185307179586)), t693, casadi.if_else(casadi.logic_and((t694 >= -6.283185307179586), (t694 <= 6.283185307179586)), t694, t689)))
+    t696 = (t273 <= 6.283185307179586)
+    t697 = casadi.logic_and((t272 >= -6.283185307179586), (t272 <= 6.283185307179586))
+    t698 = casadi.if_else(casadi.logic_and(t696, casadi.logic_not(t697)), t273, t272)
+    t699 = t698
+    t700 = t699 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn3 - 0.15915494309189535*t699)
+    t701 = casadi.if_else((qn3 > t700), 6.283185307179586, -6.283185307179586)
+    t702 = t700 + t701
+    t703 = t700 - t701
+    t704 = casadi.if_else(casadi.logic_and((t700 >= -6.283185307179586), (t700 <= 6.283185307179586)), t700, casadi.if_else(casadi.logic_and((t702 >= -6.283185307179586), (t702 <= 6.283185307179586)), t702, casadi.if_else(casadi.logic_and((t703 >= -6.283185307179586), (t703 <= 6.283185307179586)), t703, t698)))
+    t705 = (t368 >= -6.283185307179586)
+    t706 = casadi.logic_and((t366 >= -6.283185307179586), (t366 <= 6.283185307179586))
+    t707 = casadi.if_else(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t20, t248), t455), t459), t461), t671), t672), t673), t674), casadi.logic_or(t687, t688)), casadi.logic_or(t696, t697)), casadi.logic_or(t705, t706)), 1, 0)
+    t708 = casadi.if_else(casadi.logic_and(t705, casadi.logic_not(t706)), -t368, t367)
+    t709 = t708
+    t710 = t709 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t709)
+    t711 = casadi.if_else((qn4 > t710), 6.283185307179586, -6.283185307179586)
+    t712 = t710 + t711
+    t713 = t710 - t711
+    t714 = casadi.if_else(casadi.logic_and((t710 >= -6.283185307179586), (t710 <= 6.283185307179586)), t710, casadi.if_else(casadi.logic_and((t712 >= -6.283185307179586), (t712 <= 6.283185307179586)), t712, casadi.if_else(casadi.logic_and((t713 >= -6.283185307179586), (t713 <= 6.283185307179586)), t713, t708)))
+    t715 = t669 + qw2*(t446 + t695)**2 + qw3*(t447 + t704)**2 + qw4*(t448 + t714)**2
+    t716 = (t707 > 0)
+    t717 = casadi.if_else(casadi.logic_and(t716, casadi.logic_or((t686 > t715), (t678 < 1))), 1, 0)
+    t718 = casadi.if_else(t716, 1, t678)
+    t719 = (t717 > 0)
+    t720 = casadi.if_else(t719, t622, t680)
+    t721 = casadi.if_else(t719, t695, t681)
+    t722 = casadi.if_else(t719, t704, t682)
+    t723 = casadi.if_else(t719, t714, t683)
+    t724 = casadi.if_else(t719, t658, t684)
+    t725 = casadi.if_else(t719, t667, t685)
+    t726 = casadi.if_else(t719, t715, t686)
+    t727 = (t372 <= 6.283185307179586)
+    t728 = casadi.logic_and((t371 >= -6.283185307179586), (t371 <= 6.283185307179586))
+    t729 = casadi.if_else(casadi.logic_and(t727, casadi.logic_not(t728)), t372, t371)
+    t730 = t729
+    t731 = t730 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t730)
+    t732 = casadi.if_else((qn2 > t731), 6.283185307179586, -6.283185307179586)
+    t733 = t731 + t732
+    t734 = t731 - t732
+    t735 = casadi.if_else(casadi.logic_and((t731 >= -6.283185307179586), (t731 <= 6.283185307179586)), t731, casadi.if_else(casadi.logic_and((t733 >= -6.283185307179586), (t733 <= 6.283185307179586)), t733, casadi.if_else(casadi.logic_and((t734 >= -6.283185307179586), (t734 <= 6.283185307179586)), t734, t729)))
+    t736 = (t375 <= 6.283185307179586)
+    t737 = casadi.logic_and((t374 >= -6.283185307179586), (t374 <= 6.283185307179586))
+    t738 = casadi.if_else(casadi.logic_and(t736, casadi.logic_not(t737)), t375, t374)
+    t739 = t738
+    t740 = t739 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn3 - 0.15915494309189535*t739)
+    t741 = casadi.if_else((qn3 > t740), 6.283185307179586, -6.283185307179586)
+    t742 = t740 + t741
+    t743 = t740 - t741
+    t744 = casadi.if_else(casadi.logic_and((t740 >= -6.283185307179586), (t740 <= 6.283185307179586)), t740, casadi.if_else(casadi.logic_and((t742 >= -6.283185307179586), (t742 <= 6.283185307179586)), t742, casadi.if_else(casadi.logic_and((t743 >= -6.283185307179586), (t743 <= 6.283185307179586)), t743, t738)))
+    t745 = (t379 >= -6.283185307179586)
+    t746 = casadi.logic_and((t377 >= -6.283185307179586), (t377 <= 6.283185307179586))
+    t747 = casadi.if_else(casadi.logic_and(t745, casadi.logic_not(t746)), -t379, t378)
+    t748 = t747
+    t749 = t748 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t748)
+    t750 = casadi.if_else((qn4 > t749), 6.283185307179586, -6.283185307179586)
+    t751 = t749 + t750
+    t752 = t749 - t750
+    t753 = casadi.if_else(casadi.logic_and((t749 >= -6.283185307179586), (t749 <= 6.283185307179586)), t749, casadi.if_else(casadi.logic_and((t751 >= -6.283185307179586), (t751 <= 6.283185307179586)), t751, casadi.if_else(casadi.logic_and((t752 >= -6.283185307179586), (t752 <= 6.283185307179586)), t752, t747)))
+    t754 = (t381 >= -6.283185307179586)
+    t755 = casadi.logic_and((t194 >= -6.283185307179586), (t194 <= 6.283185307179586))
+    t756 = casadi.if_else(casadi.logic_and(t754, casadi.logic_not(t755)), -t381, t380)
+    t757 = t756
+    t758 = t757 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn5 - 0.15915494309189535*t757)
+    t759 = casadi.if_else((qn5 > t758), 6.283185307179586, -6.283185307179586)
+    t760 = t758 + t759
+    t761 = t758 - t759
+    t762 = casadi.if_else(casadi.logic_and((t758 >= -6.283185307179586), (t758 <= 6.283185307179586)), t758, casadi.if_else(casadi.logic_and((t760 >= -6.283185307179586), (t760 <= 6.283185307179586)), t760, casadi.if_else(casadi.logic_and((t761 >= -6.283185307179586), (t761 <= 6.283185307179586)), t761, t756)))
+    t763 = (t361 <= 6.283185307179586)
+    t764 = casadi.logic_and((t360 >= -6.283185307179586), (t360 <= 6.283185307179586))
+    t765 = casadi.if_else(casadi.logic_and(t763, casadi.logic_not(t764)), t361, t360)
+    t766 = t765
+    t767 = t766 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn6 - 0.15915494309189535*t766)
+    t768 = casadi.if_else((qn6 > t767), 6.283185307179586, -6.283185307179586)
+    t769 = t767 + t768
+    t770 = t767 - t768
+    t771 = casadi.if_else(casadi.logic_and((t767 >= -6.283185307179586), (t767 <= 6.283185307179586)), t767, casadi.if_else(casadi.logic_and((t769 >= -6.283185307179586), (t769 <= 6.283185307179586)), t769, casadi.if_else(casadi.logic_and((t770 >= -6.283185307179586), (t770 <= 6.283185307179586)), t770, t765)))
+    t772 = t668 + qw5*(t451 + t762)**2 + qw6*(t452 + t771)**2
+    t773 = t772 + qw2*(t446 + t735)**2 + qw3*(t447 + t744)**2 + qw4*(t448 + t753)**2
+    t774 = casadi.logic_or(t754, t755)
+    t775 = casadi.logic_or(t763, t764)
+    t776 = casadi.if_else(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t185, t20), t455), t459), t461), t671), t774), t775), casadi.logic_or(t727, t728)), casadi.logic_or(t736, t737)), casadi.logic_or(t745, t746)), casadi.logic_or(casadi.logic_and(t459, (t275 >= -1e-12)), casadi.logic_and(t62, (35.98290608994648*t274 <= 1e-12)))), 1, 0)
+    t777 = (t776 > 0)
+    t778 = casadi.if_else(casadi.logic_and(t777, casadi.logic_or((t726 > t773), (t718 < 1))), 1, 0)
+    t779 = casadi.if_else(t777, 1, t718)
+    t780 = (t778 > 0)
+    t781 = casadi.if_else(t780, t622, t720)
+    t782 = casadi.if_else(t780, t735, t721)
+    t783 = casadi.if_else(t780, t744, t722)
+    t784 = casadi.if_else(t780, t753, t723)
+    t785 = casadi.if_else(t780, t762, t724)
+    t786 = casadi.if_else(t780, t771, t725)
+    t787 = casadi.if_else(t780, t773, t726)
+    t788 = (t384 <= 6.283185307179586)
+    t789 = casadi.logic_and((t383 >= -6.283185307179586), (t383 <= 6.283185307179586))
+    t790 = casadi.if_else(casadi.logic_and(t788, casadi.logic_not(t789)), t384, t383)
+    t791 = t790
+    t792 = t791 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t791)
+    t793 = casadi.if_else((qn2 > t792), 6.283185307179586, -6.283185307179586)
+    t794 = t792 + t793
+    t795 = t792 - t793
+    t796 = casadi.if_else(casadi.logic_and((t792 >= -6.283185307179586), (t792 <= 6.283185307179586)), t792, casadi.if_else(casadi.logic_and((t794 >= -6.283185307179586), (t794 <= 6.283185307179586)), t794, casadi.if_else(casadi.logic_and((t795 >= -6.283185307179586), (t795 <= 6.283185307179586)), t795, t790)))
+    t797 = (t387 <= 6.283185307179586)
+    t798 = casadi.logic_and((t386 >= -6.283185307179586), (t386 <= 6.283185307179586))
+    t799 = casadi.if_else(casadi.logic_and(t797, casadi.logic_not(t798)), t387, t386)
+    t800 = t799
+    t801 = t800 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn3 - 0.15915494309189535*t800)
+    t802 = casadi.if_else((qn3 > t801), 6.283185307179586, -6.283185307179586)
+    t803 = t801 + t802
+    t804 = t801 - t802
+    t805 = casadi.if_else(casadi.logic_and((t801 >= -6.283185307179586), (t801 <= 6.283185307179586)), t801, casadi.if_else(casadi.logic_and((t803 >= -6.283185307179586), (t803 <= 6.283185307179586)), t803, casadi.if_else(casadi.logic_and((t804 >= -6.283185307179586), (t804 <= 6.283185307179586)), t804, t799)))
+    t806 = (t391 >= -6.283185307179586)
+    t807 = casadi.logic_and((t389 >= -6.283185307179586), (t389 <= 6.283185307179586))
+    t808 = casadi.if_else(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t185, t20), t277), t455), t459), t461), t671), t774), t775), casadi.logic_or(t788, t789)), casadi.logic_or(t797, t798)), casadi.logic_or(t806, t807)), 1, 0)
+    t809 = casadi.if_else(casadi.logic_and(t806, casadi.logic_not(t807)), -t391, t390)
+    t810 = t809
+    t811 = t810 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t810)
+    t812 = casadi.if_else((qn4 > t811), 6.283185307179586, -6.283185307179586)
+    t813 = t811 + t812
+    t814 = t811 - t812
+    t815 = casadi.if_else(casadi.logic_and((t811 >= -6.283185307179586), (t811 <= 6.283185307179586)), t811, casadi.if_else(casadi.logic_and((t813 >= -6.283185307179586), (t813 <= 6.283185307179586)), t813, casadi.if_else(casadi.logic_and((t814 >= -6.283185307179586), (t814 <= 6.283185307179586)), t814, t809)))
+    t816 = t772 + qw2*(t446 + t796)**2 + qw3*(t447 + t805)**2 + qw4*(t448 + t815)**2
+    t817 = (t808 > 0)
+    t818 = casadi.if_else(casadi.logic_and(t817, casadi.logic_or((t787 > t816), (t779 < 1))), 1, 0)
+    t819 = casadi.if_else(t817, 1, t779)
+    t820 = (t818 > 0)
+    t821 = casadi.if_else(t820, t622, t781)
+    t822 = casadi.if_else(t820, t796, t782)
+    t823 = casadi.if_else(t820, t805, t783)
+    t824 = casadi.if_else(t820, t815, t784)
+    t825 = casadi.if_else(t820, t762, t785)
+    t826 = casadi.if_else(t820, t771, t786)
+    t827 = (casadi.fabs(t301) < casadi.inf)
+    t828 = (t819 > 0)
+    t829 = casadi.logic_and(t827, t828)
+    q = casadi.SX(6, 1)
+    q[0, 0] = casadi.if_else(t829, t821, qn1)
+    q[1, 0] = casadi.if_else(t829, t822, qn2)
+    q[2, 0] = casadi.if_else(t829, t823, qn3)
+    q[3, 0] = casadi.if_else(t829, t824, qn4)
+    q[4, 0] = casadi.if_else(t829, t825, qn5)
+    q[5, 0] = casadi.if_else(t829, t826, qn6)
+    status = casadi.SX(1, 1)
+    status[0, 0] = casadi.if_else(casadi.logic_not(t827), 2, casadi.if_else(t828, 0, 1))
+    return [q, status]
 
 
 _q = casadi.SX.sym("q", 6, 1)
@@ -2515,6 +3541,8 @@ _mu_dot = casadi.SX.sym("mu_dot", 6, 1)
 _damping = casadi.SX.sym("damping", 1, 1)
 _target = casadi.SX.sym("target", 4, 4)
 _T = casadi.SX.sym("T", 4, 4)
+_q_seed = casadi.SX.sym("q_seed", 6, 1)
+_weights = casadi.SX.sym("weights", 6, 1)
 fk = casadi.Function("fk", [_q], _fk(_q), ["q"], ["T"])
 jacobian = casadi.Function("jacobian", [_q], _jacobian(_q), ["q"], ["J"])
 fk_jacobian = casadi.Function("fk_jacobian", [_q], _fk_jacobian(_q), ["q"], ["T", "J"])
@@ -2531,8 +3559,9 @@ manipulability = casadi.Function("manipulability", [_q], _manipulability(_q), ["
 jacobian_det = casadi.Function("jacobian_det", [_q], _jacobian_det(_q), ["q"], ["d"])
 velocity_ik = casadi.Function("velocity_ik", [_q, _mu_dot, _damping], _velocity_ik(_q, _mu_dot, _damping), ["q", "mu_dot", "damping"], ["q_dot", "status"])
 ik_numeric_step = casadi.Function("ik_numeric_step", [_target, _q, _damping], _ik_numeric_step(_target, _q, _damping), ["target", "q", "damping"], ["q_start", "q_next", "cost"])
-ik_branches = casadi.Function("ik_branches", [_T], _ik_branches(_T), ["T"], ["q", "valid"])
-ik = ik_branches  # CasADi functions have fixed-size outputs: every branch and its validity
+ik_branches = casadi.Function("ik_branches", [_T], _ik_branches(_T), ["T"], ["q", "valid", "in_limits"])
+ik_nearest = casadi.Function("ik_nearest", [_T, _q_seed, _weights], _ik_nearest(_T, _q_seed, _weights), ["T", "q_seed", "weights"], ["q", "status"])
+ik = ik_branches  # CasADi functions have fixed-size outputs: every branch, its validity and its limits
 
 IK_NUMERIC_CONVERGED = 0  # |error| <= tol
 IK_NUMERIC_ITERATION_LIMIT = 1  # IK_NUMERIC_ITERATIONS steps taken, |error| still above tol
@@ -2574,4 +3603,4 @@ ik_numeric = casadi.Function("ik_numeric", _inputs, _ik_numeric(*_inputs), ["tar
 
 def functions():
     """All functions by name."""
-    return {"fk": fk, "jacobian": jacobian, "fk_jacobian": fk_jacobian, "jacobian_tool": jacobian_tool, "task": task, "task_jacobian": task_jacobian, "fk_jacobian_dot": fk_jacobian_dot, "jacobian_dot": jacobian_dot, "bias_acceleration": bias_acceleration, "task_jacobian_dot": task_jacobian_dot, "hessian": hessian, "singularity_factors": singularity_factors, "manipulability": manipulability, "jacobian_det": jacobian_det, "velocity_ik": velocity_ik, "ik_numeric_step": ik_numeric_step, "ik_branches": ik_branches}
+    return {"fk": fk, "jacobian": jacobian, "fk_jacobian": fk_jacobian, "jacobian_tool": jacobian_tool, "task": task, "task_jacobian": task_jacobian, "fk_jacobian_dot": fk_jacobian_dot, "jacobian_dot": jacobian_dot, "bias_acceleration": bias_acceleration, "task_jacobian_dot": task_jacobian_dot, "hessian": hessian, "singularity_factors": singularity_factors, "manipulability": manipulability, "jacobian_det": jacobian_det, "velocity_ik": velocity_ik, "ik_numeric_step": ik_numeric_step, "ik_branches": ik_branches, "ik_nearest": ik_nearest}
