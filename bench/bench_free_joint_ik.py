@@ -9,7 +9,8 @@ robot is built. The Panda has no hand here: frankik's ik takes the flange pose.
 
 - "C native": the generated `NAME_ik(T, q_free, q)` (double) in a native loop (the
   harness of bench_ik.py);
-- "C via ctypes": the same library called from Python, one call per pose;
+- "C via ctypes": the same library called from Python, one call per pose, the pose copied
+  into a buffer whose address is taken once (`T.ctypes.data` per call would cost 2 us);
 - "numpy batch": the generated Python `ik(T, q_free)` on all poses at once (time per pose);
 - "frankik" (Panda): `frankik.ik_full(T, q, q7)`, He & Liu's solver (up to 4 solutions);
 - "EAIK": `eaik.IK_HP.HPRobot(H, P, fixed_axes=[(k, value)]).IK(T)`, real solutions only;
@@ -107,10 +108,13 @@ def run(robot, count: int, rounds: int, folder: Path) -> list[tuple[str, float, 
     micros, _ = native(robot, source, targets, rounds, folder, frees)
     function = library._library[f"{robot.name}_ik"]
     function.argtypes = [ctypes.c_void_p, ctypes.c_double, ctypes.c_void_p]
-    out = np.zeros(8 * robot.dof)
-    contiguous = [np.ascontiguousarray(T) for T in targets]
-    ctypes_micros = timed(lambda T, angle: function(T.ctypes.data, angle, out.ctypes.data),
-                          list(zip(contiguous, frees)), rounds)
+    pose, out = np.zeros((4, 4)), np.zeros(8 * robot.dof)  # buffers a caller reuses: their addresses once
+    pose_address, out_address = pose.ctypes.data, out.ctypes.data
+
+    def call(T, angle):
+        pose[...] = T
+        return function(pose_address, angle, out_address)
+    ctypes_micros = timed(call, list(zip(targets, frees)), rounds)
     ours = [library.ik(T, 8, None, angle) for T, angle in zip(targets, frees)]
     measured = quality(robot, q, targets, ours)
     rows += [("C native", micros, measured), ("C via ctypes", ctypes_micros, measured)]

@@ -3,7 +3,8 @@
     PYTHONPATH=. python bench/bench_ik.py [--targets 2000] [--rounds 7]
 
 For the UR5 and the Puma 560, the same random reachable poses (fk of random joint vectors
-inside the limits) are solved by:
+inside the limits) are solved by (every branch: the arms are generated without their joint
+limits, which EAIK and ik-geo do not apply):
 
 - "C native": the generated `NAME_ik` (double) called in a native loop by a C harness
   compiled with -O2 (the generated file in its own translation unit);
@@ -41,6 +42,7 @@ from jacgen.compile import WARNING_FLAGS, compile_shared  # noqa: E402
 from jacgen.ik import closed_form  # noqa: E402
 from jacgen.render import render_robot, write_files  # noqa: E402
 from jacgen.robot import load_robot  # noqa: E402
+from conftest import without_limits  # noqa: E402
 from test_ik import kinematic_chain  # noqa: E402
 
 ROBOTS = {"ur5": IkGeoRobot.three_parallel_two_intersecting, "puma560": IkGeoRobot.spherical_two_parallel}
@@ -164,12 +166,13 @@ def main():
     with tempfile.TemporaryDirectory() as temporary:
         folder = Path(temporary)
         for name, ik_geo_factory in ROBOTS.items():
-            robot = load_robot(ROOT / "robots" / f"{name}.yaml")
+            shipped = load_robot(ROOT / "robots" / f"{name}.yaml")
+            robot = without_limits(shipped)  # every branch, as EAIK and ik-geo return them
             write_files(render_robot(robot, ("c",)), folder)
             source = folder / name / f"{name}.c"
             library = ctypes.CDLL(str(compile_shared([source], folder / f"lib{name}.so")))
             rng = np.random.default_rng(1)
-            limits = np.array([joint.limits for joint in robot.joints])
+            limits = np.array([joint.limits for joint in shipped.joints])
             q = rng.uniform(limits[:, 0], limits[:, 1], (arguments.targets, robot.dof))
             targets = np.array([reference.fk(robot, row) for row in q])
             results = {"C native": native(robot, source, targets, arguments.rounds, folder)}

@@ -1,12 +1,14 @@
 """Shared fixtures: the shipped robots and the generated modules under test."""
 
 import importlib.util
+import re
 from pathlib import Path
 
 import numpy as np
 import pytest
 
 from jacgen import load_robot
+from jacgen.robot import parse_robot
 
 ROOT = Path(__file__).resolve().parent.parent
 ROBOT_FILES = sorted((ROOT / "robots").glob("*.yaml"))
@@ -20,6 +22,13 @@ def pytest_addoption(parser):
 
 def robot(name: str):
     return load_robot(ROOT / "robots" / f"{name}.yaml")
+
+
+def without_limits(arm):
+    """The arm read from its file with every `limits: [...]` removed (for the ik's branches
+    alone: every solution, none dropped by the limits)."""
+    text = re.sub(r",\s*limits: \[[^]]*\]", "", open(arm.source).read())
+    return parse_robot(text.encode(), arm.source)
 
 
 def import_file(path: Path, module_name: str | None = None):

@@ -8,7 +8,6 @@ velocity_ik a function `(q, mu_dot, damping) -> (q_dot, status)`.
 """
 
 import functools
-import re
 
 import numpy as np
 import pytest
@@ -16,20 +15,12 @@ import pytest
 from jacgen import reference
 from jacgen.compile import CLibrary, compile_shared
 from jacgen.render import render_robot, write_files
-from jacgen.robot import parse_robot
 
-from conftest import import_file, random_configurations, robot
+from conftest import import_file, random_configurations, robot, without_limits
 
 ROBOTS = ["puma560", "ur5", "stanford", "rexarm", "planar_3r", "scara"]
 BACKENDS = ["c", "numpy", "numpy_batch", "casadi"]
 TOLERANCE = 1e-9
-
-
-def _without_limits(arm):
-    """The arm with its joint limits removed: these cases are about the branches of the
-    solver (the limits are tested in test_ik_limits)."""
-    text = re.sub(r", limits: \[[^]]*\]", "", open(arm.source).read())
-    return parse_robot(text.encode(), arm.source)
 
 
 @pytest.fixture(scope="module")
@@ -39,7 +30,7 @@ def backends(tmp_path_factory):
 
     @functools.cache
     def load(name):
-        arm = _without_limits(robot(name))
+        arm = without_limits(robot(name))  # these cases are about the branches (limits: test_ik_limits)
         write_files(render_robot(arm, ("c", "python", "casadi")), folder)
         numpy_module = import_file(folder / name / f"{name}.py", f"contract_{name}")
         casadi_module = import_file(folder / name / f"{name}_casadi.py", f"contract_{name}_casadi")
