@@ -135,8 +135,13 @@ def ik_lines(structure: Structure) -> list[str]:
     if structure.solver is None:
         return [f"no closed form ({structure.reason}); ik_numeric only"]
     info = SOLVERS[structure.solver]
+    chain = structure.chain
+    joints = ""
+    if chain.joints != tuple(range(len(chain.joints))):
+        turned = ", each turned the other way" if chain.signs[0] < 0 else ""
+        joints = f" (the solver's q1..q6 are joints {', '.join(str(j + 1) for j in chain.joints)}{turned})"
     return [f"{info.title} ({structure.reason}), at most {info.max_solutions} solutions, branches "
-            f"(outermost first): {'; '.join(info.branches)}"]
+            f"(outermost first){joints}: {'; '.join(info.branches)}"]
 
 
 def describe(model: Model) -> str:
