@@ -25,7 +25,7 @@ from jacgen.robot import load_robot
 from conftest import ROBOT_FILES, ROOT, random_configurations
 
 ARM_FLAGS = ("-mcpu=cortex-m4", "-mthumb", "-mfloat-abi=hard", "-mfpu=fpv4-sp-d16", "-Os")
-LIBM = {name + suffix for name in "sin cos sincos tan asin acos atan atan2 sqrt fabs hypot ceil".split()
+LIBM = {name + suffix for name in "sin cos sincos tan asin acos atan atan2 sqrt fabs hypot ceil floor".split()
         for suffix in ("", "f")}
 # GCC may emit calls to these for array copies even in freestanding code, which must provide
 # them ("Standards", GCC manual); the sources call none of them.

@@ -17,6 +17,7 @@ from ik_geo import Robot as IkGeoRobot
 
 from jacgen import reference
 from jacgen.compile import CLibrary, compile_shared
+from jacgen.functions import Generator
 from jacgen.render import render_robot
 from jacgen.robot import parse_robot
 
@@ -28,9 +29,10 @@ SAMPLES = 1000  # random configurations per shipped robot (Python); the C takes 
 TOLERANCE = 1e-9
 
 
-def _generate(arm, folder, languages=("python",), real="double"):
-    """Render `arm` into `folder`; the Python module (imported) or the C source path."""
-    files = render_robot(arm, languages, real)
+def _generate(arm, folder, languages=("python",), real="double", generator=None):
+    """Render `arm` into `folder` (with its `generator` when given, to share the symbolic
+    work); the Python module (imported) or the C source path."""
+    files = render_robot(arm, languages, real, generator)
     for relative, text in files.items():
         path = folder / relative
         path.parent.mkdir(parents=True, exist_ok=True)
@@ -247,10 +249,10 @@ RANDOM_CLASSES = ["planar_2r", "planar_3r", "scara", "yaw_pitch", "spherical_wri
                   "spherical_wrist_intersecting", "spherical_wrist_prismatic", "three_parallel"]
 
 
-def _c_ik(arm, folder, real):
+def _c_ik(arm, folder, real, generator=None):
     """A function target -> solutions (k, n) calling the C NAME_ik of `arm` (compiled with the
     contract's warning flags)."""
-    source = _generate(arm, folder / real, ("c",), real)
+    source = _generate(arm, folder / real, ("c",), real, generator)
     library = CLibrary(compile_shared([source], folder / real / f"lib{arm.name}.so"), arm, [], real)
     return functools.partial(library.ik, max_solutions=8)
 
@@ -273,18 +275,19 @@ def test_random_robots_of_each_class(kind, tmp_path):
     jacgen.reference, the revolute 6R classes also against EAIK."""
     for seed in range(2):
         arm = _random_robot(kind, seed)
-        module = _generate(arm, tmp_path)
+        generator = Generator(arm)
+        module = _generate(arm, tmp_path, generator=generator)
         q = np.random.default_rng(seed).uniform(-np.pi, np.pi, (100, arm.dof))
         q[:, [not joint.revolute for joint in arm.joints]] *= 0.1
         counts = _check_round_trip(arm, _batched(module), _reference_targets(arm), q, _regular(arm, q))
         assert counts.max() == module.MAX_IK_SOLUTIONS
         if seed == 0:  # the C: the Python's solutions in the Python's order; float compiles cleanly
-            solve = _c_ik(arm, tmp_path, "double")
+            solve = _c_ik(arm, tmp_path, "double", generator)
             targets = _reference_targets(arm)(q[:50])
             for target, python in zip(targets, _batched(module, limits=True)(targets)):
                 ours = solve(target)
                 assert len(ours) == len(python) and (not len(ours) or _joint_distance(arm, ours, python).max() < 1e-6)
-            _c_ik(arm, tmp_path, "float")
+            _c_ik(arm, tmp_path, "float", generator)
         if kind in EAIK_CLASSES:
             _compare_with_eaik(module, arm, q[:50], _reference_targets(arm))
 

@@ -25,7 +25,7 @@ DATA = ROOT / "tests" / "data" / "urdf"
 URDFS = {
     "ur5": ("ur5_robot.urdf", "base", "tool0", "three_parallel"),
     "ur10": ("ur10_robot.urdf", "base_link", "ee_link", "three_parallel"),
-    "panda": ("panda.urdf", None, "panda_hand_tcp", None),
+    "panda": ("panda.urdf", None, "panda_hand_tcp", "spherical_wrist_intersecting"),  # joint 7 free
     "kinova_jaco2": ("kinova.urdf", None, "j2s6s200_end_effector", "spherical_wrist_parallel"),
     "xarm7": ("xarm7.urdf", None, None, None),
     "z1": ("z1.urdf", None, "link06", "three_parallel"),
