@@ -375,7 +375,7 @@ IK_NEAREST_OK, IK_NEAREST_NO_SOLUTION, IK_NEAREST_NOT_FINITE = 0, 1, 2
 TURN = 2 * sympy.pi
 
 
-def _inside(value, limits) -> sympy.Basic:
+def _inside(value, limits: tuple[float, float]) -> sympy.Basic:
     return sympy.And(value >= limits[0], value <= limits[1])
 
 
@@ -386,9 +386,9 @@ def _in_limits(sp: Subproblems, value, joint) -> tuple[sympy.Expr, sympy.Basic]:
     lowest equivalent above the lower limit, lower + (angle - lower) mod 2 pi, is inside them
     (the Panda's joint 6, -0.0175 to 3.7525 rad, needs it); a joint without limits is always
     inside."""
-    if joint.limits is None:
+    limits = joint.limits
+    if limits is None:
         return value, sympy.true
-    limits = tuple(sympy.Float(limit) for limit in joint.limits)
     if not joint.revolute:
         return value, _inside(value, limits)
     value = sp.name(value)
@@ -431,9 +431,9 @@ def _nearest_equivalent(sp: Subproblems, value, given, seed, joint):
     if not joint.revolute:
         return value
     nearest = sp.name(value + TURN * sympy.floor((seed - value) / TURN + sympy.Rational(1, 2)))
-    if joint.limits is None:
+    limits = joint.limits
+    if limits is None:
         return nearest
-    limits = tuple(sympy.Float(limit) for limit in joint.limits)
     below = nearest < seed
     second, third = sp.name(nearest + select(below, TURN, -TURN)), sp.name(nearest - select(below, TURN, -TURN))
     return select(_inside(nearest, limits), nearest,

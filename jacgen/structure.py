@@ -15,9 +15,8 @@ axes after it depend on them, and a relation is decided for every angle of the f
 meet in a point (a spherical shoulder) is solved backwards: `Geometry.reversed`.
 """
 
-import re
-
 import copy
+import re
 from dataclasses import dataclass, field, replace
 
 import sympy
