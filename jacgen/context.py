@@ -59,15 +59,25 @@ def _common(robot: Robot) -> dict:
 def _python_function(function: Function, printer: PythonPrinter, parameters: list[dict]) -> dict:
     body = function.body
     shapes = [() if a.scalar else a.symbols.shape[:1] if a.vector else a.symbols.shape for a in function.arguments]
-    batches = [f"{a.name}.shape[:-{len(shape)}]" if shape else f"{a.name}.shape"
-               for a, shape in zip(function.arguments, shapes)]
+    batched = sum(not a.scalar for a in function.arguments)
     results = []
     for output, values in function.parts(body.outputs):
-        indices = [", ".join(["..."] + [str(i) for i in numpy.unravel_index(k, output.shape)])
-                   for k in range(output.size)]
-        dtype = "bool" if output.boolean else "int" if output.integer else "float"
-        results.append({"name": output.name, "shape": repr(output.shape), "dtype": dtype,
-                        "values": [(index, printer.doprint(e)) for index, e in zip(indices, values)]})
+        dtype = ", dtype=xp.bool" if output.boolean else ", dtype=dtype"
+        codes = []
+        for k, value in enumerate(values):
+            code = printer.doprint(value)
+            if not value.free_symbols:  # a number or truth value: an array of the batch shape, like the others
+                code = f"xp.full(batch, {code}{dtype}, device=device)"
+            elif batched > 1 or output.scalar:  # it may read only some of the batched arguments
+                code = f"xp.broadcast_to({code}, batch)"
+            if output.integer:  # a status, computed as a real number
+                code = f"xp.astype({code}, xp.int32)"
+            codes.append((", ".join(map(str, numpy.unravel_index(k, output.shape))), code))
+        results.append({"name": output.name, "shape": repr(output.shape), "scalar": not output.shape,
+                        "values": codes})
+    trig, offsets = _joint_trig(function)
+    read = set().union(*(e.free_symbols for s, e in body.definitions if s not in trig),
+                       *(e.free_symbols for e in body.outputs))
     return {
         "name": function.name,
         "summary": function.summary,
@@ -76,13 +86,30 @@ def _python_function(function: Function, printer: PythonPrinter, parameters: lis
         "arguments": [(a.name, repr(shape)) for a, shape in zip(function.arguments, shapes)],
         "signature": ", ".join([f"{a.name}={a.default}" if a.default else a.name for a in function.arguments] + ["*"] * bool(parameters)
                                + [f"{p['name']}={p['value']}" for p in parameters]),
-        "batch": batches[0] if len(batches) == 1 else f"numpy.broadcast_shapes({', '.join(batches)})",
         "selects": any(e.has(sympy.Piecewise) for e in [v for _, v in body.definitions] + list(body.outputs)),
         "inputs": [(str(symbol), f"{argument.name}[..., {row}]" if argument.vector else f"{argument.name}[..., {row}, {col}]")
-                   for symbol, argument, row, col in function.inputs],
-        "definitions": [(str(symbol), printer.doprint(e)) for symbol, e in body.definitions],
+                   for symbol, argument, row, col in function.inputs if symbol in read],
+        "trig": repr(tuple(offsets)) if trig else None,
+        "definitions": [(str(symbol), trig.get(symbol) or printer.doprint(e)) for symbol, e in body.definitions],
         "results": results,
     }
+
+
+def _joint_trig(function: Function) -> tuple[dict, list]:
+    """The definitions cos(q_j + offset) and sin(q_j + offset) of the argument q, as entries of
+    `_cos_sin`'s array, and the offsets: ({symbol: code}, offset per joint)."""
+    joints = {symbol: row for symbol, argument, row, _ in function.inputs if argument.name == "q"}
+    if not joints:
+        return {}, []
+    offsets, trig = [0.0] * function.arguments[0].size, {}
+    for symbol, value in function.body.definitions:
+        if isinstance(value, (sympy.cos, sympy.sin)):
+            offset, angle = value.args[0].as_independent(*joints, as_Add=True)
+            if angle in joints and offset.is_number:
+                row = joints[angle]
+                offsets[row] = float(offset)
+                trig[symbol] = f"trig[..., {2 * row + isinstance(value, sympy.sin)}]"
+    return trig, offsets
 
 
 def _dimensions(output: Output) -> str:
@@ -267,9 +294,9 @@ def _ik_numeric_context(robot: Robot, language: str, real: str) -> dict:
         "damping": {key: number(sympy.Float(value)) for key, value in IK_NUMERIC_DAMPING.items()},
         "tenth": number(sympy.Float(0.1)),
         "iterations": IK_NUMERIC_ITERATIONS,
-        "numpy": {"where": "numpy.where", "logical_and": "numpy.logical_and", "maximum": "numpy.maximum",
-                  "finite": "(cost >= 0.0) & (max_iter >= 0)", "iterations": "max(max_iter, 0)",
-                  "widen": "[..., None]", "q0": "numpy.asarray(q0, dtype=float)", "fixed": False},
+        "python": {"where": "xp.where", "logical_and": "xp.logical_and", "maximum": "xp.maximum",
+                   "finite": "(cost >= 0.0) & (max_iter >= 0)", "iterations": "max(max_iter, 0)",
+                   "widen": "[..., None]", "q0": "xp.asarray(q0, dtype=q.dtype)", "fixed": False},
         "casadi": {"where": "casadi.if_else", "logical_and": "casadi.logic_and", "maximum": "casadi.fmax",
                    "finite": "cost >= 0.0", "iterations": "IK_NUMERIC_ITERATIONS",
                    "widen": "", "q0": "q0", "fixed": True},

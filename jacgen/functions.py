@@ -17,7 +17,7 @@ from sympy.logic.boolalg import Boolean
 
 from . import analysis, differential, ik, kinematics, subproblems
 from .model import Model
-from .subproblems import Subproblems
+from .subproblems import TOLERANCES, Subproblems
 from .printers import fold_constants
 from .robot import Robot
 
@@ -404,6 +404,7 @@ class Generator:
                                               symbols=sympy.numbered_symbols("_r", real=True), order="canonical")
         bound = [(s, fold(v)) for s, v in bindings.items() if s in needed]
         definitions = _in_dependency_order(bound + trig + list(zip((s for s, _ in named), reduced)) + replacements)
+        definitions, reduced = _without_constants(definitions, reduced)
         temporaries = sympy.numbered_symbols("t", real=True)
         rename = {symbol: next(temporaries) for symbol, _ in definitions if symbol.name.startswith("_")}
         definitions = tuple((rename.get(s, s), v.xreplace(rename)) for s, v in definitions)
@@ -438,6 +439,25 @@ class Generator:
             self.ik_numeric_step_function(task_jacobian),
             *self.ik_functions(),
         )
+
+
+def _without_constants(definitions: list[tuple[sympy.Symbol, sympy.Expr]], outputs: list[sympy.Basic]):
+    """The definitions that are constants (numbers, truth values, the IK's tolerances) put
+    into their readers, which sympy then folds: a select on a condition that is always false
+    is its other side. A comparison of tolerances and numbers is decided when it holds, or
+    fails, in every real type."""
+    constants, kept = {}, []
+    for symbol, value in definitions:
+        if not constants.keys().isdisjoint(value.free_symbols):
+            value = value.xreplace(constants)
+        if is_boolean(value) and value.free_symbols and value.free_symbols <= TOLERANCES["double"].keys():
+            truths = {value.xreplace(numbers) for numbers in TOLERANCES.values()}
+            value = truths.pop() if len(truths) == 1 else value
+        if value.free_symbols <= TOLERANCES["double"].keys():
+            constants[symbol] = value
+        else:
+            kept.append((symbol, value))
+    return kept, [e.xreplace(constants) if not constants.keys().isdisjoint(e.free_symbols) else e for e in outputs]
 
 
 def _in_dependency_order(definitions: list[tuple[sympy.Symbol, sympy.Expr]]) -> list[tuple[sympy.Symbol, sympy.Expr]]:

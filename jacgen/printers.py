@@ -42,19 +42,37 @@ def float_literal(value: sympy.Expr) -> str:
     return repr(float(value))
 
 
-def _selects(printer, expr, select: str) -> str:
-    """`select(condition, value, otherwise)` nested for each pair of a Piecewise."""
+def _selects(printer, expr, select: str, real_array: str = "{}") -> str:
+    """`select(condition, value, otherwise)` nested for each pair of a Piecewise; when both
+    sides are numbers, the value as `real_array`."""
     (value, condition), *rest = expr.args
     otherwise = rest[0][0] if len(rest) == 1 and rest[0][1] == sympy.true else sympy.Piecewise(*rest)
-    return f"{select}({printer._print(condition)}, {printer._print(value)}, {printer._print(otherwise)})"
+    first = printer._print(value)
+    if value.is_number and otherwise.is_number:
+        first = real_array.format(first)
+    return f"{select}({printer._print(condition)}, {first}, {printer._print(otherwise)})"
 
 
 class PythonPrinter(NumPyPrinter):
-    """numpy code over batched inputs; a select is `numpy.where` (both sides computed, the
-    generated function ignores the floating-point warnings of the side not taken)."""
+    """Python over the array API namespace `xp` of the inputs (numpy, JAX, PyTorch), batched.
+
+    Functions take their standard names (`xp.atan2`, not numpy's `arctan2`). A select is
+    `xp.where`, both sides computed (the generated function ignores numpy's floating-point
+    warnings of the side not taken). A select of two numbers makes the first an array of the
+    function's `dtype`: otherwise PyTorch makes it float32, and numpy an integer array that
+    turns float32 arithmetic into float64 (the context makes statuses integers again).
+    """
+
+    _module = "xp"
+    _kf = {name: f"xp.{function}" for name, function in {
+        "sin": "sin", "cos": "cos", "tan": "tan", "asin": "asin", "acos": "acos", "atan": "atan",
+        "atan2": "atan2", "exp": "exp", "log": "log", "sqrt": "sqrt", "Abs": "abs", "sign": "sign",
+        "floor": "floor", "ceiling": "ceil",
+    }.items()}
 
     def __init__(self):
         super().__init__({"fully_qualified_modules": True, "allow_unknown_functions": False, "order": "none"})
+        self._kf = dict(type(self)._kf)  # NumPyPrinter merges in Python's math names
 
     def doprint(self, expr, assign_to=None):
         return super().doprint(expr.xreplace(TOLERANCES["double"]), assign_to)
@@ -63,7 +81,7 @@ class PythonPrinter(NumPyPrinter):
         return float_literal(expr)
 
     def _print_Piecewise(self, expr):
-        return _selects(self, expr, "numpy.where")
+        return _selects(self, expr, "xp.where", "xp.asarray({}, dtype=dtype)")
 
     def _print_And(self, expr):
         return " & ".join(self.parenthesize(a, PRECEDENCE["BitwiseAnd"] + 1) for a in expr.args)
@@ -71,11 +89,8 @@ class PythonPrinter(NumPyPrinter):
     def _print_Or(self, expr):
         return " | ".join(self.parenthesize(a, PRECEDENCE["BitwiseOr"] + 1) for a in expr.args)
 
-    def _print_Not(self, expr):
-        return f"numpy.logical_not({self._print(expr.args[0])})"
-
     def _print_IsFinite(self, expr):
-        return f"numpy.isfinite({self._print(expr.args[0])})"
+        return f"xp.isfinite({self._print(expr.args[0])})"
 
 
 C_REAL_TYPES = {"double": ast.float64, "float": ast.float32}

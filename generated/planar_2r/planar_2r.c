@@ -609,7 +609,7 @@ planar_2r_real planar_2r_ik_numeric_step(const planar_2r_real target[PLANAR_2R_T
 
 void planar_2r_ik_branches(const planar_2r_real mu[PLANAR_2R_TASK_DIM], planar_2r_real q[PLANAR_2R_MAX_IK_SOLUTIONS * PLANAR_2R_DOF], int valid[PLANAR_2R_MAX_IK_SOLUTIONS], int in_limits[PLANAR_2R_MAX_IK_SOLUTIONS])
 {
-    /* 79 operations */
+    /* 73 operations */
 
     /* Inputs */
     const planar_2r_real mu0 = mu[0];
@@ -626,39 +626,37 @@ void planar_2r_ik_branches(const planar_2r_real mu[PLANAR_2R_TASK_DIM], planar_2
     const planar_2r_real t7 = (t5 ? sqrt(t4) : 0);
     const planar_2r_real t8 = atan2(t7, t6);
     const planar_2r_real t9 = 3.141592653589793 - t8;
-    const int t10 = 0;
-    const planar_2r_real t11 = (t10 ? 0 : 3.141592653589793 + t8);
-    const planar_2r_real t12 = (t10 ? 0 : -t7);
-    const planar_2r_real t13 = -t6;
-    const planar_2r_real t14 = (t10 ? 1 : t13);
-    const planar_2r_real t15 = 1 + t14;
-    const planar_2r_real t16 = mu0*t15 + mu1*t12;
-    const planar_2r_real t17 = mu1*t15 - mu0*t12;
-    const planar_2r_real t18 = (t16*t16) + (t17*t17);
-    const planar_2r_real t19 = (t12*t12) + (t15*t15);
-    const planar_2r_real t20 = 1 + t13;
-    const planar_2r_real t21 = mu0*t20 + mu1*t7;
-    const planar_2r_real t22 = mu1*t20 - mu0*t7;
-    const planar_2r_real t23 = (t21*t21) + (t22*t22);
-    const planar_2r_real t24 = (t20*t20) + (t7*t7);
-    const planar_2r_real t25 = 1e-24*t0;
-    const int t26 = isfinite(t2);
-    const int t27 = 1;
+    const planar_2r_real t10 = 3.141592653589793 + t8;
+    const planar_2r_real t11 = -t7;
+    const planar_2r_real t12 = -t6;
+    const planar_2r_real t13 = t12;
+    const planar_2r_real t14 = 1 + t13;
+    const planar_2r_real t15 = mu0*t14 + mu1*t11;
+    const planar_2r_real t16 = mu1*t14 - mu0*t11;
+    const planar_2r_real t17 = (t15*t15) + (t16*t16);
+    const planar_2r_real t18 = (t11*t11) + (t14*t14);
+    const planar_2r_real t19 = 1 + t12;
+    const planar_2r_real t20 = mu0*t19 + mu1*t7;
+    const planar_2r_real t21 = mu1*t19 - mu0*t7;
+    const planar_2r_real t22 = (t20*t20) + (t21*t21);
+    const planar_2r_real t23 = (t19*t19) + (t7*t7);
+    const planar_2r_real t24 = 1e-24*t0;
+    const int t25 = isfinite(t2);
 
     /* Outputs */
-    q[0] = (t18 <= t19*t25 ? 0 : atan2(t17, t16));
-    q[1] = t11 - 6.283185307179586*ceil(-0.5 + 0.15915494309189535*t11);
-    q[2] = (t23 <= t24*t25 ? 0 : atan2(t22, t21));
+    q[0] = (t17 <= t18*t24 ? 0 : atan2(t16, t15));
+    q[1] = t10 - 6.283185307179586*ceil(-0.5 + 0.15915494309189535*t10);
+    q[2] = (t22 <= t23*t24 ? 0 : atan2(t21, t20));
     q[3] = t9 - 6.283185307179586*ceil(-0.5 + 0.15915494309189535*t9);
-    valid[0] = t26 && t27 && t4 >= -1e-12;
-    valid[1] = t26 && t27 && t4 > 1e-12;
+    valid[0] = t25 && t4 >= -1e-12;
+    valid[1] = t25 && t4 > 1e-12;
     in_limits[0] = 1;
     in_limits[1] = 1;
 }
 
 int planar_2r_ik_nearest(const planar_2r_real mu[PLANAR_2R_TASK_DIM], const planar_2r_real q_seed[PLANAR_2R_DOF], const planar_2r_real weights[PLANAR_2R_DOF], planar_2r_real q[PLANAR_2R_DOF])
 {
-    /* 147 operations */
+    /* 138 operations */
 
     /* Inputs */
     const planar_2r_real mu0 = mu[0];
@@ -680,58 +678,56 @@ int planar_2r_ik_nearest(const planar_2r_real mu[PLANAR_2R_TASK_DIM], const plan
     const planar_2r_real t8 = 3.141592653589793 - t7;
     const planar_2r_real t9 = t8 - 6.283185307179586*ceil(-0.5 + 0.15915494309189535*t8);
     const planar_2r_real t10 = t9 + 6.283185307179586*floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t9);
-    const int t11 = 0;
-    const planar_2r_real t12 = (t11 ? 0 : 3.141592653589793 + t7);
-    const planar_2r_real t13 = (t11 ? 0 : -t6);
-    const planar_2r_real t14 = t12 - 6.283185307179586*ceil(-0.5 + 0.15915494309189535*t12);
-    const planar_2r_real t15 = t14 + 6.283185307179586*floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t14);
-    const planar_2r_real t16 = -t5;
-    const planar_2r_real t17 = (t11 ? 1 : t16);
-    const planar_2r_real t18 = 1 + t17;
-    const planar_2r_real t19 = mu0*t18 + mu1*t13;
-    const planar_2r_real t20 = mu1*t18 - mu0*t13;
-    const planar_2r_real t21 = (t19*t19) + (t20*t20);
-    const planar_2r_real t22 = (t13*t13) + (t18*t18);
-    const planar_2r_real t23 = 1 + t16;
-    const planar_2r_real t24 = mu0*t23 + mu1*t6;
-    const planar_2r_real t25 = mu1*t23 - mu0*t6;
-    const planar_2r_real t26 = (t24*t24) + (t25*t25);
-    const planar_2r_real t27 = (t23*t23) + (t6*t6);
-    const planar_2r_real t28 = mu0 + mu1;
-    const planar_2r_real t29 = t28;
-    const planar_2r_real t30 = qn1 + qn2 + qw1 + qw2 + t28;
-    const planar_2r_real t31 = 1e-24*t0;
-    const planar_2r_real t32 = (t21 <= t22*t31 ? 0 : atan2(t20, t19));
-    const planar_2r_real t33 = t32 + 6.283185307179586*floor(0.5 + 0.15915494309189535*qn1 - 0.15915494309189535*t32);
-    const planar_2r_real t34 = (t26 <= t27*t31 ? 0 : atan2(t25, t24));
-    const planar_2r_real t35 = t34 + 6.283185307179586*floor(0.5 + 0.15915494309189535*qn1 - 0.15915494309189535*t34);
-    const planar_2r_real t36 = -qn1;
-    const planar_2r_real t37 = -qn2;
-    const planar_2r_real t38 = qw1*((t33 + t36)*(t33 + t36)) + qw2*((t15 + t37)*(t15 + t37));
-    const planar_2r_real t39 = qw1*((t35 + t36)*(t35 + t36)) + qw2*((t10 + t37)*(t10 + t37));
-    const int t40 = isfinite(t29);
-    const int t41 = 1;
-    const planar_2r_real t42 = (t40 && ((t11 && t2 <= 1e-12) || (t41 && t3 >= -1e-12)) ? 1 : 0);
-    const planar_2r_real t43 = (t42 > 0 ? 1 : 0);
-    const planar_2r_real t44 = (t4 && t40 && t41 ? 1 : 0);
-    const int t45 = t43 > 0;
-    const planar_2r_real t46 = (t45 ? t33 : qn1);
-    const planar_2r_real t47 = (t45 ? t15 : qn2);
-    const planar_2r_real t48 = (t45 ? t38 : 0);
-    const int t49 = t44 > 0;
-    const planar_2r_real t50 = (t49 && ((t39 < t48) || (t43 < 1)) ? 1 : 0);
-    const planar_2r_real t51 = (t49 ? 1 : t43);
-    const int t52 = t50 > 0;
-    const planar_2r_real t53 = (t52 ? t35 : t46);
-    const planar_2r_real t54 = (t52 ? t10 : t47);
-    const int t55 = isfinite(t30);
-    const int t56 = t51 > 0;
-    const int t57 = t55 && t56;
+    const planar_2r_real t11 = 3.141592653589793 + t7;
+    const planar_2r_real t12 = -t6;
+    const planar_2r_real t13 = t11 - 6.283185307179586*ceil(-0.5 + 0.15915494309189535*t11);
+    const planar_2r_real t14 = t13 + 6.283185307179586*floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t13);
+    const planar_2r_real t15 = -t5;
+    const planar_2r_real t16 = t15;
+    const planar_2r_real t17 = 1 + t16;
+    const planar_2r_real t18 = mu0*t17 + mu1*t12;
+    const planar_2r_real t19 = mu1*t17 - mu0*t12;
+    const planar_2r_real t20 = (t18*t18) + (t19*t19);
+    const planar_2r_real t21 = (t12*t12) + (t17*t17);
+    const planar_2r_real t22 = 1 + t15;
+    const planar_2r_real t23 = mu0*t22 + mu1*t6;
+    const planar_2r_real t24 = mu1*t22 - mu0*t6;
+    const planar_2r_real t25 = (t23*t23) + (t24*t24);
+    const planar_2r_real t26 = (t22*t22) + (t6*t6);
+    const planar_2r_real t27 = mu0 + mu1;
+    const planar_2r_real t28 = t27;
+    const planar_2r_real t29 = qn1 + qn2 + qw1 + qw2 + t27;
+    const planar_2r_real t30 = 1e-24*t0;
+    const planar_2r_real t31 = (t20 <= t21*t30 ? 0 : atan2(t19, t18));
+    const planar_2r_real t32 = t31 + 6.283185307179586*floor(0.5 + 0.15915494309189535*qn1 - 0.15915494309189535*t31);
+    const planar_2r_real t33 = (t25 <= t26*t30 ? 0 : atan2(t24, t23));
+    const planar_2r_real t34 = t33 + 6.283185307179586*floor(0.5 + 0.15915494309189535*qn1 - 0.15915494309189535*t33);
+    const planar_2r_real t35 = -qn1;
+    const planar_2r_real t36 = -qn2;
+    const planar_2r_real t37 = qw1*((t32 + t35)*(t32 + t35)) + qw2*((t14 + t36)*(t14 + t36));
+    const planar_2r_real t38 = qw1*((t34 + t35)*(t34 + t35)) + qw2*((t10 + t36)*(t10 + t36));
+    const int t39 = isfinite(t28);
+    const planar_2r_real t40 = (t39 && t3 >= -1e-12 ? 1 : 0);
+    const planar_2r_real t41 = (t40 > 0 ? 1 : 0);
+    const planar_2r_real t42 = (t39 && t4 ? 1 : 0);
+    const int t43 = t41 > 0;
+    const planar_2r_real t44 = (t43 ? t32 : qn1);
+    const planar_2r_real t45 = (t43 ? t14 : qn2);
+    const planar_2r_real t46 = (t43 ? t37 : 0);
+    const int t47 = t42 > 0;
+    const planar_2r_real t48 = (t47 && ((t38 < t46) || (t41 < 1)) ? 1 : 0);
+    const planar_2r_real t49 = (t47 ? 1 : t41);
+    const int t50 = t48 > 0;
+    const planar_2r_real t51 = (t50 ? t34 : t44);
+    const planar_2r_real t52 = (t50 ? t10 : t45);
+    const int t53 = isfinite(t29);
+    const int t54 = t49 > 0;
+    const int t55 = t53 && t54;
 
     /* Outputs */
-    q[0] = (t57 ? t53 : qn1);
-    q[1] = (t57 ? t54 : qn2);
-    return (!t55 ? 2 : (t56 ? 0 : 1));
+    q[0] = (t55 ? t51 : qn1);
+    q[1] = (t55 ? t52 : qn2);
+    return (!t53 ? 2 : (t54 ? 0 : 1));
 }
 
 int planar_2r_ik(const planar_2r_real mu[PLANAR_2R_TASK_DIM], planar_2r_real q[PLANAR_2R_MAX_IK_SOLUTIONS * PLANAR_2R_DOF])

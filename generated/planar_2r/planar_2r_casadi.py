@@ -465,7 +465,7 @@ def _ik_numeric_step(target, q, damping):
 
 
 def _ik_branches(mu):
-    """Every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits: 79 operations."""
+    """Every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits: 73 operations."""
     mu0 = mu[0]
     mu1 = mu[1]
     t0 = mu0**2 + mu1**2
@@ -478,32 +478,30 @@ def _ik_branches(mu):
     t7 = casadi.if_else(t5, casadi.sqrt(t4), 0)
     t8 = casadi.atan2(t7, t6)
     t9 = 3.141592653589793 - t8
-    t10 = False
-    t11 = casadi.if_else(t10, 0, 3.141592653589793 + t8)
-    t12 = casadi.if_else(t10, 0, -t7)
-    t13 = -t6
-    t14 = casadi.if_else(t10, 1, t13)
-    t15 = 1 + t14
-    t16 = mu0*t15 + mu1*t12
-    t17 = mu1*t15 - mu0*t12
-    t18 = t16**2 + t17**2
-    t19 = t12**2 + t15**2
-    t20 = 1 + t13
-    t21 = mu0*t20 + mu1*t7
-    t22 = mu1*t20 - mu0*t7
-    t23 = t21**2 + t22**2
-    t24 = t20**2 + t7**2
-    t25 = 1e-24*t0
-    t26 = (casadi.fabs(t2) < casadi.inf)
-    t27 = True
+    t10 = 3.141592653589793 + t8
+    t11 = -t7
+    t12 = -t6
+    t13 = t12
+    t14 = 1 + t13
+    t15 = mu0*t14 + mu1*t11
+    t16 = mu1*t14 - mu0*t11
+    t17 = t15**2 + t16**2
+    t18 = t11**2 + t14**2
+    t19 = 1 + t12
+    t20 = mu0*t19 + mu1*t7
+    t21 = mu1*t19 - mu0*t7
+    t22 = t20**2 + t21**2
+    t23 = t19**2 + t7**2
+    t24 = 1e-24*t0
+    t25 = (casadi.fabs(t2) < casadi.inf)
     q = casadi.SX(2, 2)
-    q[0, 0] = casadi.if_else((t18 <= t19*t25), 0, casadi.atan2(t17, t16))
-    q[0, 1] = t11 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t11)
-    q[1, 0] = casadi.if_else((t23 <= t24*t25), 0, casadi.atan2(t22, t21))
+    q[0, 0] = casadi.if_else((t17 <= t18*t24), 0, casadi.atan2(t16, t15))
+    q[0, 1] = t10 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t10)
+    q[1, 0] = casadi.if_else((t22 <= t23*t24), 0, casadi.atan2(t21, t20))
     q[1, 1] = t9 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t9)
     valid = casadi.SX(2, 1)
-    valid[0, 0] = casadi.logic_and(casadi.logic_and(t26, t27), (t4 >= -1e-12))
-    valid[1, 0] = casadi.logic_and(casadi.logic_and(t26, t27), (t4 > 1e-12))
+    valid[0, 0] = casadi.logic_and(t25, (t4 >= -1e-12))
+    valid[1, 0] = casadi.logic_and(t25, (t4 > 1e-12))
     in_limits = casadi.SX(2, 1)
     in_limits[0, 0] = True
     in_limits[1, 0] = True
@@ -511,7 +509,7 @@ def _ik_branches(mu):
 
 
 def _ik_nearest(mu, q_seed, weights):
-    """The closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status: 147 operations."""
+    """The closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status: 138 operations."""
     mu0 = mu[0]
     mu1 = mu[1]
     qn1 = q_seed[0]
@@ -529,58 +527,56 @@ def _ik_nearest(mu, q_seed, weights):
     t8 = 3.141592653589793 - t7
     t9 = t8 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t8)
     t10 = t9 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t9)
-    t11 = False
-    t12 = casadi.if_else(t11, 0, 3.141592653589793 + t7)
-    t13 = casadi.if_else(t11, 0, -t6)
-    t14 = t12 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t12)
-    t15 = t14 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t14)
-    t16 = -t5
-    t17 = casadi.if_else(t11, 1, t16)
-    t18 = 1 + t17
-    t19 = mu0*t18 + mu1*t13
-    t20 = mu1*t18 - mu0*t13
-    t21 = t19**2 + t20**2
-    t22 = t13**2 + t18**2
-    t23 = 1 + t16
-    t24 = mu0*t23 + mu1*t6
-    t25 = mu1*t23 - mu0*t6
-    t26 = t24**2 + t25**2
-    t27 = t23**2 + t6**2
-    t28 = mu0 + mu1
-    t29 = t28
-    t30 = qn1 + qn2 + qw1 + qw2 + t28
-    t31 = 1e-24*t0
-    t32 = casadi.if_else((t21 <= t22*t31), 0, casadi.atan2(t20, t19))
-    t33 = t32 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn1 - 0.15915494309189535*t32)
-    t34 = casadi.if_else((t26 <= t27*t31), 0, casadi.atan2(t25, t24))
-    t35 = t34 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn1 - 0.15915494309189535*t34)
-    t36 = -qn1
-    t37 = -qn2
-    t38 = qw1*(t33 + t36)**2 + qw2*(t15 + t37)**2
-    t39 = qw1*(t35 + t36)**2 + qw2*(t10 + t37)**2
-    t40 = (casadi.fabs(t29) < casadi.inf)
-    t41 = True
-    t42 = casadi.if_else(casadi.logic_and(t40, casadi.logic_or(casadi.logic_and(t11, (t2 <= 1e-12)), casadi.logic_and(t41, (t3 >= -1e-12)))), 1, 0)
-    t43 = casadi.if_else((t42 > 0), 1, 0)
-    t44 = casadi.if_else(casadi.logic_and(casadi.logic_and(t4, t40), t41), 1, 0)
-    t45 = (t43 > 0)
-    t46 = casadi.if_else(t45, t33, qn1)
-    t47 = casadi.if_else(t45, t15, qn2)
-    t48 = casadi.if_else(t45, t38, 0)
-    t49 = (t44 > 0)
-    t50 = casadi.if_else(casadi.logic_and(t49, casadi.logic_or((t39 < t48), (t43 < 1))), 1, 0)
-    t51 = casadi.if_else(t49, 1, t43)
-    t52 = (t50 > 0)
-    t53 = casadi.if_else(t52, t35, t46)
-    t54 = casadi.if_else(t52, t10, t47)
-    t55 = (casadi.fabs(t30) < casadi.inf)
-    t56 = (t51 > 0)
-    t57 = casadi.logic_and(t55, t56)
+    t11 = 3.141592653589793 + t7
+    t12 = -t6
+    t13 = t11 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t11)
+    t14 = t13 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t13)
+    t15 = -t5
+    t16 = t15
+    t17 = 1 + t16
+    t18 = mu0*t17 + mu1*t12
+    t19 = mu1*t17 - mu0*t12
+    t20 = t18**2 + t19**2
+    t21 = t12**2 + t17**2
+    t22 = 1 + t15
+    t23 = mu0*t22 + mu1*t6
+    t24 = mu1*t22 - mu0*t6
+    t25 = t23**2 + t24**2
+    t26 = t22**2 + t6**2
+    t27 = mu0 + mu1
+    t28 = t27
+    t29 = qn1 + qn2 + qw1 + qw2 + t27
+    t30 = 1e-24*t0
+    t31 = casadi.if_else((t20 <= t21*t30), 0, casadi.atan2(t19, t18))
+    t32 = t31 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn1 - 0.15915494309189535*t31)
+    t33 = casadi.if_else((t25 <= t26*t30), 0, casadi.atan2(t24, t23))
+    t34 = t33 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn1 - 0.15915494309189535*t33)
+    t35 = -qn1
+    t36 = -qn2
+    t37 = qw1*(t32 + t35)**2 + qw2*(t14 + t36)**2
+    t38 = qw1*(t34 + t35)**2 + qw2*(t10 + t36)**2
+    t39 = (casadi.fabs(t28) < casadi.inf)
+    t40 = casadi.if_else(casadi.logic_and(t39, (t3 >= -1e-12)), 1, 0)
+    t41 = casadi.if_else((t40 > 0), 1, 0)
+    t42 = casadi.if_else(casadi.logic_and(t39, t4), 1, 0)
+    t43 = (t41 > 0)
+    t44 = casadi.if_else(t43, t32, qn1)
+    t45 = casadi.if_else(t43, t14, qn2)
+    t46 = casadi.if_else(t43, t37, 0)
+    t47 = (t42 > 0)
+    t48 = casadi.if_else(casadi.logic_and(t47, casadi.logic_or((t38 < t46), (t41 < 1))), 1, 0)
+    t49 = casadi.if_else(t47, 1, t41)
+    t50 = (t48 > 0)
+    t51 = casadi.if_else(t50, t34, t44)
+    t52 = casadi.if_else(t50, t10, t45)
+    t53 = (casadi.fabs(t29) < casadi.inf)
+    t54 = (t49 > 0)
+    t55 = casadi.logic_and(t53, t54)
     q = casadi.SX(2, 1)
-    q[0, 0] = casadi.if_else(t57, t53, qn1)
-    q[1, 0] = casadi.if_else(t57, t54, qn2)
+    q[0, 0] = casadi.if_else(t55, t51, qn1)
+    q[1, 0] = casadi.if_else(t55, t52, qn2)
     status = casadi.SX(1, 1)
-    status[0, 0] = casadi.if_else(casadi.logic_not(t55), 2, casadi.if_else(t56, 0, 1))
+    status[0, 0] = casadi.if_else(casadi.logic_not(t53), 2, casadi.if_else(t54, 0, 1))
     return [q, status]
 
 

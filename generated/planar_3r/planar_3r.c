@@ -883,7 +883,7 @@ planar_3r_real planar_3r_ik_numeric_step(const planar_3r_real target[PLANAR_3R_T
 
 void planar_3r_ik_branches(const planar_3r_real mu[PLANAR_3R_TASK_DIM], planar_3r_real q[PLANAR_3R_MAX_IK_SOLUTIONS * PLANAR_3R_DOF], int valid[PLANAR_3R_MAX_IK_SOLUTIONS], int in_limits[PLANAR_3R_MAX_IK_SOLUTIONS])
 {
-    /* 106 operations */
+    /* 100 operations */
 
     /* Inputs */
     const planar_3r_real mu0 = mu[0];
@@ -905,47 +905,45 @@ void planar_3r_ik_branches(const planar_3r_real mu[PLANAR_3R_TASK_DIM], planar_3
     const planar_3r_real t11 = (t9 ? sqrt(t8) : 0);
     const planar_3r_real t12 = atan2(t11, t10);
     const planar_3r_real t13 = 3.141592653589793 - t12;
-    const int t14 = 0;
-    const planar_3r_real t15 = (t14 ? 0 : 3.141592653589793 + t12);
-    const planar_3r_real t16 = (t14 ? 0 : -t11);
-    const planar_3r_real t17 = -t10;
-    const planar_3r_real t18 = (t14 ? 1 : t17);
-    const planar_3r_real t19 = 1 + t18;
-    const planar_3r_real t20 = t16*t3 + t19*t2;
-    const planar_3r_real t21 = t19*t3 - t16*t2;
-    const planar_3r_real t22 = (t20*t20) + (t21*t21);
-    const planar_3r_real t23 = (t16*t16) + (t19*t19);
-    const planar_3r_real t24 = 1 + t17;
-    const planar_3r_real t25 = t11*t3 + t2*t24;
-    const planar_3r_real t26 = t24*t3 - t11*t2;
-    const planar_3r_real t27 = (t25*t25) + (t26*t26);
-    const planar_3r_real t28 = (t11*t11) + (t24*t24);
-    const planar_3r_real t29 = 1e-24*t4;
-    const planar_3r_real t30 = (t22 <= t23*t29 ? 0 : atan2(t21, t20));
-    const planar_3r_real t31 = -mu2;
-    const planar_3r_real t32 = 3.141592653589793 + t31;
-    const planar_3r_real t33 = t15 + t30;
-    const planar_3r_real t34 = (t27 <= t28*t29 ? 0 : atan2(t26, t25));
-    const planar_3r_real t35 = t13 + t34;
-    const int t36 = isfinite(t6);
-    const int t37 = 1;
+    const planar_3r_real t14 = 3.141592653589793 + t12;
+    const planar_3r_real t15 = -t11;
+    const planar_3r_real t16 = -t10;
+    const planar_3r_real t17 = t16;
+    const planar_3r_real t18 = 1 + t17;
+    const planar_3r_real t19 = t15*t3 + t18*t2;
+    const planar_3r_real t20 = t18*t3 - t15*t2;
+    const planar_3r_real t21 = (t19*t19) + (t20*t20);
+    const planar_3r_real t22 = (t15*t15) + (t18*t18);
+    const planar_3r_real t23 = 1 + t16;
+    const planar_3r_real t24 = t11*t3 + t2*t23;
+    const planar_3r_real t25 = t23*t3 - t11*t2;
+    const planar_3r_real t26 = (t24*t24) + (t25*t25);
+    const planar_3r_real t27 = (t11*t11) + (t23*t23);
+    const planar_3r_real t28 = 1e-24*t4;
+    const planar_3r_real t29 = (t21 <= t22*t28 ? 0 : atan2(t20, t19));
+    const planar_3r_real t30 = -mu2;
+    const planar_3r_real t31 = 3.141592653589793 + t30;
+    const planar_3r_real t32 = t14 + t29;
+    const planar_3r_real t33 = (t26 <= t27*t28 ? 0 : atan2(t25, t24));
+    const planar_3r_real t34 = t13 + t33;
+    const int t35 = isfinite(t6);
 
     /* Outputs */
-    q[0] = t30;
-    q[1] = t15 - 6.283185307179586*ceil(-0.5 + 0.15915494309189535*t15);
-    q[2] = -t31 - t33 - 6.283185307179586*ceil(-0.15915494309189535*t32 - 0.15915494309189535*t33);
-    q[3] = t34;
+    q[0] = t29;
+    q[1] = t14 - 6.283185307179586*ceil(-0.5 + 0.15915494309189535*t14);
+    q[2] = -t30 - t32 - 6.283185307179586*ceil(-0.15915494309189535*t31 - 0.15915494309189535*t32);
+    q[3] = t33;
     q[4] = t13 - 6.283185307179586*ceil(-0.5 + 0.15915494309189535*t13);
-    q[5] = -t31 - t35 - 6.283185307179586*ceil(-0.15915494309189535*t32 - 0.15915494309189535*t35);
-    valid[0] = t36 && t37 && t8 >= -1e-12;
-    valid[1] = t36 && t37 && t8 > 1e-12;
+    q[5] = -t30 - t34 - 6.283185307179586*ceil(-0.15915494309189535*t31 - 0.15915494309189535*t34);
+    valid[0] = t35 && t8 >= -1e-12;
+    valid[1] = t35 && t8 > 1e-12;
     in_limits[0] = 1;
     in_limits[1] = 1;
 }
 
 int planar_3r_ik_nearest(const planar_3r_real mu[PLANAR_3R_TASK_DIM], const planar_3r_real q_seed[PLANAR_3R_DOF], const planar_3r_real weights[PLANAR_3R_DOF], planar_3r_real q[PLANAR_3R_DOF])
 {
-    /* 200 operations */
+    /* 191 operations */
 
     /* Inputs */
     const planar_3r_real mu0 = mu[0];
@@ -974,72 +972,70 @@ int planar_3r_ik_nearest(const planar_3r_real mu[PLANAR_3R_TASK_DIM], const plan
     const planar_3r_real t12 = 3.141592653589793 - t11;
     const planar_3r_real t13 = t12 - 6.283185307179586*ceil(-0.5 + 0.15915494309189535*t12);
     const planar_3r_real t14 = t13 + 6.283185307179586*floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t13);
-    const int t15 = 0;
-    const planar_3r_real t16 = (t15 ? 0 : 3.141592653589793 + t11);
-    const planar_3r_real t17 = (t15 ? 0 : -t10);
-    const planar_3r_real t18 = t16 - 6.283185307179586*ceil(-0.5 + 0.15915494309189535*t16);
-    const planar_3r_real t19 = t18 + 6.283185307179586*floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t18);
-    const planar_3r_real t20 = -t9;
-    const planar_3r_real t21 = (t15 ? 1 : t20);
-    const planar_3r_real t22 = 1 + t21;
-    const planar_3r_real t23 = t17*t3 + t2*t22;
-    const planar_3r_real t24 = t22*t3 - t17*t2;
-    const planar_3r_real t25 = (t23*t23) + (t24*t24);
-    const planar_3r_real t26 = (t17*t17) + (t22*t22);
-    const planar_3r_real t27 = 1 + t20;
-    const planar_3r_real t28 = t10*t3 + t2*t27;
-    const planar_3r_real t29 = t27*t3 - t10*t2;
-    const planar_3r_real t30 = (t28*t28) + (t29*t29);
-    const planar_3r_real t31 = (t10*t10) + (t27*t27);
-    const planar_3r_real t32 = mu0 + mu1 + mu2;
-    const planar_3r_real t33 = t32;
-    const planar_3r_real t34 = qn1 + qn2 + qn3 + qw1 + qw2 + qw3 + t32;
-    const planar_3r_real t35 = 1e-24*t4;
-    const planar_3r_real t36 = (t25 <= t26*t35 ? 0 : atan2(t24, t23));
-    const planar_3r_real t37 = t36;
-    const planar_3r_real t38 = t37 + 6.283185307179586*floor(0.5 + 0.15915494309189535*qn1 - 0.15915494309189535*t37);
-    const planar_3r_real t39 = -mu2;
-    const planar_3r_real t40 = 3.141592653589793 + t39;
-    const planar_3r_real t41 = t16 + t36;
-    const planar_3r_real t42 = t39 + t41 + 6.283185307179586*ceil(-0.15915494309189535*t40 - 0.15915494309189535*t41);
-    const planar_3r_real t43 = -t42 + 6.283185307179586*floor(0.5 + 0.15915494309189535*qn3 + 0.15915494309189535*t42);
-    const planar_3r_real t44 = -qn1;
-    const planar_3r_real t45 = -qn2;
-    const planar_3r_real t46 = -qn3;
-    const planar_3r_real t47 = qw1*((t38 + t44)*(t38 + t44)) + qw2*((t19 + t45)*(t19 + t45)) + qw3*((t43 + t46)*(t43 + t46));
-    const int t48 = isfinite(t33);
-    const int t49 = 1;
-    const planar_3r_real t50 = (t48 && ((t15 && t6 <= 1e-12) || (t49 && t7 >= -1e-12)) ? 1 : 0);
-    const planar_3r_real t51 = (t50 > 0 ? 1 : 0);
-    const planar_3r_real t52 = (t48 && t49 && t8 ? 1 : 0);
-    const int t53 = t51 > 0;
-    const planar_3r_real t54 = (t53 ? t38 : qn1);
-    const planar_3r_real t55 = (t53 ? t19 : qn2);
-    const planar_3r_real t56 = (t53 ? t43 : qn3);
-    const planar_3r_real t57 = (t53 ? t47 : 0);
-    const planar_3r_real t58 = (t30 <= t31*t35 ? 0 : atan2(t29, t28));
-    const planar_3r_real t59 = t58;
-    const planar_3r_real t60 = t59 + 6.283185307179586*floor(0.5 + 0.15915494309189535*qn1 - 0.15915494309189535*t59);
-    const planar_3r_real t61 = t12 + t58;
-    const planar_3r_real t62 = t39 + t61 + 6.283185307179586*ceil(-0.15915494309189535*t40 - 0.15915494309189535*t61);
-    const planar_3r_real t63 = -t62 + 6.283185307179586*floor(0.5 + 0.15915494309189535*qn3 + 0.15915494309189535*t62);
-    const planar_3r_real t64 = qw1*((t44 + t60)*(t44 + t60)) + qw2*((t14 + t45)*(t14 + t45)) + qw3*((t46 + t63)*(t46 + t63));
-    const int t65 = t52 > 0;
-    const planar_3r_real t66 = (t65 && ((t57 > t64) || (t51 < 1)) ? 1 : 0);
-    const planar_3r_real t67 = (t65 ? 1 : t51);
-    const int t68 = t66 > 0;
-    const planar_3r_real t69 = (t68 ? t60 : t54);
-    const planar_3r_real t70 = (t68 ? t14 : t55);
-    const planar_3r_real t71 = (t68 ? t63 : t56);
-    const int t72 = isfinite(t34);
-    const int t73 = t67 > 0;
-    const int t74 = t72 && t73;
+    const planar_3r_real t15 = 3.141592653589793 + t11;
+    const planar_3r_real t16 = -t10;
+    const planar_3r_real t17 = t15 - 6.283185307179586*ceil(-0.5 + 0.15915494309189535*t15);
+    const planar_3r_real t18 = t17 + 6.283185307179586*floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t17);
+    const planar_3r_real t19 = -t9;
+    const planar_3r_real t20 = t19;
+    const planar_3r_real t21 = 1 + t20;
+    const planar_3r_real t22 = t16*t3 + t2*t21;
+    const planar_3r_real t23 = t21*t3 - t16*t2;
+    const planar_3r_real t24 = (t22*t22) + (t23*t23);
+    const planar_3r_real t25 = (t16*t16) + (t21*t21);
+    const planar_3r_real t26 = 1 + t19;
+    const planar_3r_real t27 = t10*t3 + t2*t26;
+    const planar_3r_real t28 = t26*t3 - t10*t2;
+    const planar_3r_real t29 = (t27*t27) + (t28*t28);
+    const planar_3r_real t30 = (t10*t10) + (t26*t26);
+    const planar_3r_real t31 = mu0 + mu1 + mu2;
+    const planar_3r_real t32 = t31;
+    const planar_3r_real t33 = qn1 + qn2 + qn3 + qw1 + qw2 + qw3 + t31;
+    const planar_3r_real t34 = 1e-24*t4;
+    const planar_3r_real t35 = (t24 <= t25*t34 ? 0 : atan2(t23, t22));
+    const planar_3r_real t36 = t35;
+    const planar_3r_real t37 = t36 + 6.283185307179586*floor(0.5 + 0.15915494309189535*qn1 - 0.15915494309189535*t36);
+    const planar_3r_real t38 = -mu2;
+    const planar_3r_real t39 = 3.141592653589793 + t38;
+    const planar_3r_real t40 = t15 + t35;
+    const planar_3r_real t41 = t38 + t40 + 6.283185307179586*ceil(-0.15915494309189535*t39 - 0.15915494309189535*t40);
+    const planar_3r_real t42 = -t41 + 6.283185307179586*floor(0.5 + 0.15915494309189535*qn3 + 0.15915494309189535*t41);
+    const planar_3r_real t43 = -qn1;
+    const planar_3r_real t44 = -qn2;
+    const planar_3r_real t45 = -qn3;
+    const planar_3r_real t46 = qw1*((t37 + t43)*(t37 + t43)) + qw2*((t18 + t44)*(t18 + t44)) + qw3*((t42 + t45)*(t42 + t45));
+    const int t47 = isfinite(t32);
+    const planar_3r_real t48 = (t47 && t7 >= -1e-12 ? 1 : 0);
+    const planar_3r_real t49 = (t48 > 0 ? 1 : 0);
+    const planar_3r_real t50 = (t47 && t8 ? 1 : 0);
+    const int t51 = t49 > 0;
+    const planar_3r_real t52 = (t51 ? t37 : qn1);
+    const planar_3r_real t53 = (t51 ? t18 : qn2);
+    const planar_3r_real t54 = (t51 ? t42 : qn3);
+    const planar_3r_real t55 = (t51 ? t46 : 0);
+    const planar_3r_real t56 = (t29 <= t30*t34 ? 0 : atan2(t28, t27));
+    const planar_3r_real t57 = t56;
+    const planar_3r_real t58 = t57 + 6.283185307179586*floor(0.5 + 0.15915494309189535*qn1 - 0.15915494309189535*t57);
+    const planar_3r_real t59 = t12 + t56;
+    const planar_3r_real t60 = t38 + t59 + 6.283185307179586*ceil(-0.15915494309189535*t39 - 0.15915494309189535*t59);
+    const planar_3r_real t61 = -t60 + 6.283185307179586*floor(0.5 + 0.15915494309189535*qn3 + 0.15915494309189535*t60);
+    const planar_3r_real t62 = qw1*((t43 + t58)*(t43 + t58)) + qw2*((t14 + t44)*(t14 + t44)) + qw3*((t45 + t61)*(t45 + t61));
+    const int t63 = t50 > 0;
+    const planar_3r_real t64 = (t63 && ((t55 > t62) || (t49 < 1)) ? 1 : 0);
+    const planar_3r_real t65 = (t63 ? 1 : t49);
+    const int t66 = t64 > 0;
+    const planar_3r_real t67 = (t66 ? t58 : t52);
+    const planar_3r_real t68 = (t66 ? t14 : t53);
+    const planar_3r_real t69 = (t66 ? t61 : t54);
+    const int t70 = isfinite(t33);
+    const int t71 = t65 > 0;
+    const int t72 = t70 && t71;
 
     /* Outputs */
-    q[0] = (t74 ? t69 : qn1);
-    q[1] = (t74 ? t70 : qn2);
-    q[2] = (t74 ? t71 : qn3);
-    return (!t72 ? 2 : (t73 ? 0 : 1));
+    q[0] = (t72 ? t67 : qn1);
+    q[1] = (t72 ? t68 : qn2);
+    q[2] = (t72 ? t69 : qn3);
+    return (!t70 ? 2 : (t71 ? 0 : 1));
 }
 
 int planar_3r_ik(const planar_3r_real mu[PLANAR_3R_TASK_DIM], planar_3r_real q[PLANAR_3R_MAX_IK_SOLUTIONS * PLANAR_3R_DOF])

@@ -700,7 +700,7 @@ def _ik_numeric_step(target, q, damping):
 
 
 def _ik_branches(mu):
-    """Every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits: 106 operations."""
+    """Every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits: 100 operations."""
     mu0 = mu[0]
     mu1 = mu[1]
     mu2 = mu[2]
@@ -718,40 +718,38 @@ def _ik_branches(mu):
     t11 = casadi.if_else(t9, casadi.sqrt(t8), 0)
     t12 = casadi.atan2(t11, t10)
     t13 = 3.141592653589793 - t12
-    t14 = False
-    t15 = casadi.if_else(t14, 0, 3.141592653589793 + t12)
-    t16 = casadi.if_else(t14, 0, -t11)
-    t17 = -t10
-    t18 = casadi.if_else(t14, 1, t17)
-    t19 = 1 + t18
-    t20 = t16*t3 + t19*t2
-    t21 = t19*t3 - t16*t2
-    t22 = t20**2 + t21**2
-    t23 = t16**2 + t19**2
-    t24 = 1 + t17
-    t25 = t11*t3 + t2*t24
-    t26 = t24*t3 - t11*t2
-    t27 = t25**2 + t26**2
-    t28 = t11**2 + t24**2
-    t29 = 1e-24*t4
-    t30 = casadi.if_else((t22 <= t23*t29), 0, casadi.atan2(t21, t20))
-    t31 = -mu2
-    t32 = 3.141592653589793 + t31
-    t33 = t15 + t30
-    t34 = casadi.if_else((t27 <= t28*t29), 0, casadi.atan2(t26, t25))
-    t35 = t13 + t34
-    t36 = (casadi.fabs(t6) < casadi.inf)
-    t37 = True
+    t14 = 3.141592653589793 + t12
+    t15 = -t11
+    t16 = -t10
+    t17 = t16
+    t18 = 1 + t17
+    t19 = t15*t3 + t18*t2
+    t20 = t18*t3 - t15*t2
+    t21 = t19**2 + t20**2
+    t22 = t15**2 + t18**2
+    t23 = 1 + t16
+    t24 = t11*t3 + t2*t23
+    t25 = t23*t3 - t11*t2
+    t26 = t24**2 + t25**2
+    t27 = t11**2 + t23**2
+    t28 = 1e-24*t4
+    t29 = casadi.if_else((t21 <= t22*t28), 0, casadi.atan2(t20, t19))
+    t30 = -mu2
+    t31 = 3.141592653589793 + t30
+    t32 = t14 + t29
+    t33 = casadi.if_else((t26 <= t27*t28), 0, casadi.atan2(t25, t24))
+    t34 = t13 + t33
+    t35 = (casadi.fabs(t6) < casadi.inf)
     q = casadi.SX(2, 3)
-    q[0, 0] = t30
-    q[0, 1] = t15 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t15)
-    q[0, 2] = -t31 - t33 - 6.283185307179586*casadi.ceil(-0.15915494309189535*t32 - 0.15915494309189535*t33)
-    q[1, 0] = t34
+    q[0, 0] = t29
+    q[0, 1] = t14 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t14)
+    q[0, 2] = -t30 - t32 - 6.283185307179586*casadi.ceil(-0.15915494309189535*t31 - 0.15915494309189535*t32)
+    q[1, 0] = t33
     q[1, 1] = t13 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t13)
-    q[1, 2] = -t31 - t35 - 6.283185307179586*casadi.ceil(-0.15915494309189535*t32 - 0.15915494309189535*t35)
+    q[1, 2] = -t30 - t34 - 6.283185307179586*casadi.ceil(-0.15915494309189535*t31 - 0.15915494309189535*t34)
     valid = casadi.SX(2, 1)
-    valid[0, 0] = casadi.logic_and(casadi.logic_and(t36, t37), (t8 >= -1e-12))
-    valid[1, 0] = casadi.logic_and(casadi.logic_and(t36, t37), (t8 > 1e-12))
+    valid[0, 0] = casadi.logic_and(t35, (t8 >= -1e-12))
+    valid[1, 0] = casadi.logic_and(t35, (t8 > 1e-12))
     in_limits = casadi.SX(2, 1)
     in_limits[0, 0] = True
     in_limits[1, 0] = True
@@ -759,7 +757,7 @@ def _ik_branches(mu):
 
 
 def _ik_nearest(mu, q_seed, weights):
-    """The closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status: 200 operations."""
+    """The closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status: 191 operations."""
     mu0 = mu[0]
     mu1 = mu[1]
     mu2 = mu[2]
@@ -784,72 +782,70 @@ def _ik_nearest(mu, q_seed, weights):
     t12 = 3.141592653589793 - t11
     t13 = t12 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t12)
     t14 = t13 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t13)
-    t15 = False
-    t16 = casadi.if_else(t15, 0, 3.141592653589793 + t11)
-    t17 = casadi.if_else(t15, 0, -t10)
-    t18 = t16 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t16)
-    t19 = t18 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t18)
-    t20 = -t9
-    t21 = casadi.if_else(t15, 1, t20)
-    t22 = 1 + t21
-    t23 = t17*t3 + t2*t22
-    t24 = t22*t3 - t17*t2
-    t25 = t23**2 + t24**2
-    t26 = t17**2 + t22**2
-    t27 = 1 + t20
-    t28 = t10*t3 + t2*t27
-    t29 = t27*t3 - t10*t2
-    t30 = t28**2 + t29**2
-    t31 = t10**2 + t27**2
-    t32 = mu0 + mu1 + mu2
-    t33 = t32
-    t34 = qn1 + qn2 + qn3 + qw1 + qw2 + qw3 + t32
-    t35 = 1e-24*t4
-    t36 = casadi.if_else((t25 <= t26*t35), 0, casadi.atan2(t24, t23))
-    t37 = t36
-    t38 = t37 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn1 - 0.15915494309189535*t37)
-    t39 = -mu2
-    t40 = 3.141592653589793 + t39
-    t41 = t16 + t36
-    t42 = t39 + t41 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t40 - 0.15915494309189535*t41)
-    t43 = -t42 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn3 + 0.15915494309189535*t42)
-    t44 = -qn1
-    t45 = -qn2
-    t46 = -qn3
-    t47 = qw1*(t38 + t44)**2 + qw2*(t19 + t45)**2 + qw3*(t43 + t46)**2
-    t48 = (casadi.fabs(t33) < casadi.inf)
-    t49 = True
-    t50 = casadi.if_else(casadi.logic_and(t48, casadi.logic_or(casadi.logic_and(t15, (t6 <= 1e-12)), casadi.logic_and(t49, (t7 >= -1e-12)))), 1, 0)
-    t51 = casadi.if_else((t50 > 0), 1, 0)
-    t52 = casadi.if_else(casadi.logic_and(casadi.logic_and(t48, t49), t8), 1, 0)
-    t53 = (t51 > 0)
-    t54 = casadi.if_else(t53, t38, qn1)
-    t55 = casadi.if_else(t53, t19, qn2)
-    t56 = casadi.if_else(t53, t43, qn3)
-    t57 = casadi.if_else(t53, t47, 0)
-    t58 = casadi.if_else((t30 <= t31*t35), 0, casadi.atan2(t29, t28))
-    t59 = t58
-    t60 = t59 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn1 - 0.15915494309189535*t59)
-    t61 = t12 + t58
-    t62 = t39 + t61 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t40 - 0.15915494309189535*t61)
-    t63 = -t62 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn3 + 0.15915494309189535*t62)
-    t64 = qw1*(t44 + t60)**2 + qw2*(t14 + t45)**2 + qw3*(t46 + t63)**2
-    t65 = (t52 > 0)
-    t66 = casadi.if_else(casadi.logic_and(t65, casadi.logic_or((t57 > t64), (t51 < 1))), 1, 0)
-    t67 = casadi.if_else(t65, 1, t51)
-    t68 = (t66 > 0)
-    t69 = casadi.if_else(t68, t60, t54)
-    t70 = casadi.if_else(t68, t14, t55)
-    t71 = casadi.if_else(t68, t63, t56)
-    t72 = (casadi.fabs(t34) < casadi.inf)
-    t73 = (t67 > 0)
-    t74 = casadi.logic_and(t72, t73)
+    t15 = 3.141592653589793 + t11
+    t16 = -t10
+    t17 = t15 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t15)
+    t18 = t17 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t17)
+    t19 = -t9
+    t20 = t19
+    t21 = 1 + t20
+    t22 = t16*t3 + t2*t21
+    t23 = t21*t3 - t16*t2
+    t24 = t22**2 + t23**2
+    t25 = t16**2 + t21**2
+    t26 = 1 + t19
+    t27 = t10*t3 + t2*t26
+    t28 = t26*t3 - t10*t2
+    t29 = t27**2 + t28**2
+    t30 = t10**2 + t26**2
+    t31 = mu0 + mu1 + mu2
+    t32 = t31
+    t33 = qn1 + qn2 + qn3 + qw1 + qw2 + qw3 + t31
+    t34 = 1e-24*t4
+    t35 = casadi.if_else((t24 <= t25*t34), 0, casadi.atan2(t23, t22))
+    t36 = t35
+    t37 = t36 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn1 - 0.15915494309189535*t36)
+    t38 = -mu2
+    t39 = 3.141592653589793 + t38
+    t40 = t15 + t35
+    t41 = t38 + t40 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t39 - 0.15915494309189535*t40)
+    t42 = -t41 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn3 + 0.15915494309189535*t41)
+    t43 = -qn1
+    t44 = -qn2
+    t45 = -qn3
+    t46 = qw1*(t37 + t43)**2 + qw2*(t18 + t44)**2 + qw3*(t42 + t45)**2
+    t47 = (casadi.fabs(t32) < casadi.inf)
+    t48 = casadi.if_else(casadi.logic_and(t47, (t7 >= -1e-12)), 1, 0)
+    t49 = casadi.if_else((t48 > 0), 1, 0)
+    t50 = casadi.if_else(casadi.logic_and(t47, t8), 1, 0)
+    t51 = (t49 > 0)
+    t52 = casadi.if_else(t51, t37, qn1)
+    t53 = casadi.if_else(t51, t18, qn2)
+    t54 = casadi.if_else(t51, t42, qn3)
+    t55 = casadi.if_else(t51, t46, 0)
+    t56 = casadi.if_else((t29 <= t30*t34), 0, casadi.atan2(t28, t27))
+    t57 = t56
+    t58 = t57 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn1 - 0.15915494309189535*t57)
+    t59 = t12 + t56
+    t60 = t38 + t59 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t39 - 0.15915494309189535*t59)
+    t61 = -t60 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn3 + 0.15915494309189535*t60)
+    t62 = qw1*(t43 + t58)**2 + qw2*(t14 + t44)**2 + qw3*(t45 + t61)**2
+    t63 = (t50 > 0)
+    t64 = casadi.if_else(casadi.logic_and(t63, casadi.logic_or((t55 > t62), (t49 < 1))), 1, 0)
+    t65 = casadi.if_else(t63, 1, t49)
+    t66 = (t64 > 0)
+    t67 = casadi.if_else(t66, t58, t52)
+    t68 = casadi.if_else(t66, t14, t53)
+    t69 = casadi.if_else(t66, t61, t54)
+    t70 = (casadi.fabs(t33) < casadi.inf)
+    t71 = (t65 > 0)
+    t72 = casadi.logic_and(t70, t71)
     q = casadi.SX(3, 1)
-    q[0, 0] = casadi.if_else(t74, t69, qn1)
-    q[1, 0] = casadi.if_else(t74, t70, qn2)
-    q[2, 0] = casadi.if_else(t74, t71, qn3)
+    q[0, 0] = casadi.if_else(t72, t67, qn1)
+    q[1, 0] = casadi.if_else(t72, t68, qn2)
+    q[2, 0] = casadi.if_else(t72, t69, qn3)
     status = casadi.SX(1, 1)
-    status[0, 0] = casadi.if_else(casadi.logic_not(t72), 2, casadi.if_else(t73, 0, 1))
+    status[0, 0] = casadi.if_else(casadi.logic_not(t70), 2, casadi.if_else(t71, 0, 1))
     return [q, status]
 
 

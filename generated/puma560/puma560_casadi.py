@@ -1932,7 +1932,7 @@ def _ik_numeric_step(target, q, damping):
 
 
 def _ik_branches(T):
-    """Every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits: 1372 operations."""
+    """Every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits: 1357 operations."""
     T00 = T[0, 0]
     T01 = T[0, 1]
     T02 = T[0, 2]
@@ -1945,637 +1945,7 @@ def _ik_branches(T):
     T21 = T[2, 1]
     T22 = T[2, 2]
     T23 = T[2, 3]
-    t0 = 1.6177742431429796
-    t1 = T00 + T01 + T02 + T03 + T10 + T11 + T12 + T13 + T20 + T21 + T22 + T23
-    t2 = 0.4521*T00 + 1.10363*T02 - 0.15005*T01
-    t3 = T03 - t2
-    t4 = t2
-    t5 = t3 + t4
-    t6 = 0.4521*T10 + 1.10363*T12 - 0.15005*T11
-    t7 = T13 - t6
-    t8 = t6
-    t9 = t7 + t8
-    t10 = casadi.atan2(t5, -t9)
-    t11 = 0.4521*T20 + 1.10363*T22 - 0.15005*T21
-    t12 = T23 - t11
-    t13 = t11
-    t14 = t12 + t13
-    t15 = t5**2 + t9**2
-    t16 = t15
-    t17 = t15 + t14**2
-    t18 = 1e-24*t17
-    t19 = (t16 <= t18)
-    t20 = casadi.if_else(t19, 1, 1/casadi.sqrt(t16))
-    t21 = 1 - 0.0225150025*t20**2
-    t22 = (1e-12 < t21)
-    t23 = casadi.if_else(t22, 0.15005*t20, casadi.if_else((t20 > 0), 1, -1))
-    t24 = casadi.if_else(t22, casadi.sqrt(t21), 0)
-    t25 = casadi.atan2(t24, t23)
-    t26 = casadi.if_else(t19, 0, t10 + t25)
-    t27 = t10 - t25
-    t28 = t26 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t26)
-    t29 = t28 - 6.283185307179586*casadi.floor(0.4444444444444444 + 0.15915494309189535*t28)
-    t30 = t27 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t27)
-    t31 = t30 - 6.283185307179586*casadi.floor(0.4444444444444444 + 0.15915494309189535*t30)
-    t32 = t20*t5
-    t33 = t24*t32
-    t34 = t20*t9
-    t35 = t23*t34
-    t36 = casadi.if_else(t19, 1, -t33 - t35)
-    t37 = t33 - t35
-    t38 = t23*t32
-    t39 = t24*t34
-    t40 = casadi.if_else(t19, 0, t38 - t39)
-    t41 = t38 + t39
-    t42 = t36*t5 + t40*t9
-    t43 = t36*t9 - t40*t5
-    t44 = T02*t36 + T12*t40
-    t45 = T12*t36 - T02*t40
-    t46 = T00*t36 + T10*t40
-    t47 = T10*t36 - T00*t40
-    t48 = t37*t5 + t41*t9
-    t49 = t37*t9 - t41*t5
-    t50 = T02*t37 + T12*t41
-    t51 = T12*t37 - T02*t41
-    t52 = T00*t37 + T10*t41
-    t53 = T10*t37 - T00*t41
-    t54 = 1 - t36
-    t55 = t14*t54
-    t56 = t55 + t14*t36
-    t57 = -0.67183 + t56
-    t58 = t42**2 + t43**2 + t57**2
-    t59 = 0.19791478625 - 0.5*t58
-    t60 = T22*t54
-    t61 = t60 + T22*t36
-    t62 = T20*t54
-    t63 = t62 + T20*t36
-    t64 = False
-    t65 = casadi.if_else(t64, 1, 5.357415379007653)
-    t66 = t59**2
-    t67 = t65**2
-    t68 = 1 - t66*t67
-    t69 = t59*t65
-    t70 = (1e-12 < t68)
-    t71 = casadi.if_else(t70, t69, casadi.if_else((t69 > 0), 1, -1))
-    t72 = casadi.if_else(t70, casadi.sqrt(t68), 0)
-    t73 = casadi.atan2(t72, t71)
-    t74 = casadi.if_else(t64, 0, t0 + t73)
-    t75 = t0 - t73
-    t76 = t74 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t74)
-    t77 = t76 - 6.283185307179586*casadi.floor(0.625 + 0.15915494309189535*t76)
-    t78 = t75 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t75)
-    t79 = t78 - 6.283185307179586*casadi.floor(0.625 + 0.15915494309189535*t78)
-    t80 = t65*t71
-    t81 = 0.00876554*t80
-    t82 = t65*t72
-    t83 = 0.18645124*t82
-    t84 = casadi.if_else(t64, 1, -t81 - t83)
-    t85 = t83 - t81
-    t86 = 0.15005 - 0.15005*t84
-    t87 = t86 + 0.15005*t84
-    t88 = 0.15005 - 0.15005*t85
-    t89 = t88 + 0.15005*t85
-    t90 = 0.18645124*t80
-    t91 = 0.00876554*t82
-    t92 = casadi.if_else(t64, 0, t90 - t91)
-    t93 = t90 + t91
-    t94 = 0.0203*t84 - 0.4318*t92
-    t95 = 0.0203*t92 + 0.4318*t84
-    t96 = 0.4318 + t94
-    t97 = 0.67183 + t95
-    t98 = -0.67183 + t97
-    t99 = t42*t98 - t57*t96
-    t100 = t87**2 + t96**2 + t98**2
-    t101 = 0.0203*t85 - 0.4318*t93
-    t102 = 0.0203*t93 + 0.4318*t85
-    t103 = 0.4318 + t101
-    t104 = 0.67183 + t102
-    t105 = -0.67183 + t104
-    t106 = t105*t42 - t103*t57
-    t107 = t103**2 + t105**2 + t89**2
-    t108 = t43*t87
-    t109 = -t108 + t42*t96 + t57*t98
-    t110 = t108 + t109
-    t111 = t110**2 + t99**2
-    t112 = 1e-24*t58
-    t113 = (t111 <= t100*t112)
-    t114 = casadi.if_else(t113, 1, 1/casadi.sqrt(t111))
-    t115 = casadi.if_else(t113, 1, t110*t114)
-    t116 = casadi.if_else(t113, 0, -t114*t99)
-    t117 = t115*t84 - t116*t92
-    t118 = t115*t92 + t116*t84
-    t119 = t117*t44 + t118*t61
-    t120 = t117*t61 - t118*t44
-    t121 = t117*t46 + t118*t63
-    t122 = t117*t63 - t118*t46
-    t123 = casadi.if_else(t113, 0, casadi.atan2(-t99, t110))
-    t124 = t123 - 6.283185307179586*casadi.floor(0.125 + 0.15915494309189535*t123)
-    t125 = 1 - t117
-    t126 = t125*t45
-    t127 = t126 + t117*t45
-    t128 = t125*t47
-    t129 = t128 + t117*t47
-    t130 = t120**2
-    t131 = -t130
-    t132 = 1 + t131
-    t133 = casadi.if_else((t132 > 1e-12), casadi.sqrt(t132), 0)
-    t134 = t130 + t119*t133
-    t135 = t131 + t134
-    t136 = t127**2
-    t137 = t130 + t136 + t119**2
-    t138 = t133**2
-    t139 = t135**2 + t136*t138
-    t140 = t130 + t138
-    t141 = 1e-24*t140
-    t142 = (t139 <= t137*t141)
-    t143 = casadi.if_else(t142, 1, 1/casadi.sqrt(t139))
-    t144 = casadi.if_else(t142, 1, t135*t143)
-    t145 = t122*(1 - t144)
-    t146 = t145 + t122*t144
-    t147 = t127*t133
-    t148 = casadi.if_else(t142, 0, t143*t147)
-    t149 = t121*t144 + t129*t148
-    t150 = t129*t144 - t121*t148
-    t151 = (t140 <= t141)
-    t152 = casadi.if_else(t151, 1, 1/casadi.sqrt(t140))
-    t153 = casadi.if_else(t151, 1, t120*t152)
-    t154 = casadi.if_else(t151, 0, -t133*t152)
-    t155 = t150*(1 - t153)
-    t156 = t146*t154 + t149*t153
-    t157 = t155 + t150*t153
-    t158 = t146*t153 - t149*t154
-    t159 = t156**2 + t157**2
-    t160 = t159
-    t161 = t159 + t158**2
-    t162 = t43*t89
-    t163 = -t162 + t103*t42 + t105*t57
-    t164 = t162 + t163
-    t165 = t106**2 + t164**2
-    t166 = (t165 <= t107*t112)
-    t167 = casadi.if_else(t166, 1, 1/casadi.sqrt(t165))
-    t168 = casadi.if_else(t166, 1, t164*t167)
-    t169 = casadi.if_else(t166, 0, -t106*t167)
-    t170 = t168*t85 - t169*t93
-    t171 = t168*t93 + t169*t85
-    t172 = t170*t44 + t171*t61
-    t173 = t170*t61 - t171*t44
-    t174 = t170*t46 + t171*t63
-    t175 = t170*t63 - t171*t46
-    t176 = casadi.if_else(t166, 0, casadi.atan2(-t106, t164))
-    t177 = t176 - 6.283185307179586*casadi.floor(0.125 + 0.15915494309189535*t176)
-    t178 = 1 - t170
-    t179 = t178*t45
-    t180 = t179 + t170*t45
-    t181 = t178*t47
-    t182 = t181 + t170*t47
-    t183 = t173**2
-    t184 = -t183
-    t185 = 1 + t184
-    t186 = casadi.if_else((t185 > 1e-12), casadi.sqrt(t185), 0)
-    t187 = t183 + t172*t186
-    t188 = t184 + t187
-    t189 = t180**2
-    t190 = t183 + t189 + t172**2
-    t191 = t186**2
-    t192 = t188**2 + t189*t191
-    t193 = t183 + t191
-    t194 = 1e-24*t193
-    t195 = (t192 <= t190*t194)
-    t196 = casadi.if_else(t195, 1, 1/casadi.sqrt(t192))
-    t197 = casadi.if_else(t195, 1, t188*t196)
-    t198 = t175*(1 - t197)
-    t199 = t198 + t175*t197
-    t200 = t180*t186
-    t201 = casadi.if_else(t195, 0, t196*t200)
-    t202 = t174*t197 + t182*t201
-    t203 = t182*t197 - t174*t201
-    t204 = (t193 <= t194)
-    t205 = casadi.if_else(t204, 1, 1/casadi.sqrt(t193))
-    t206 = casadi.if_else(t204, 1, t173*t205)
-    t207 = casadi.if_else(t204, 0, -t186*t205)
-    t208 = t203*(1 - t206)
-    t209 = t199*t207 + t202*t206
-    t210 = t208 + t203*t206
-    t211 = t199*t206 - t202*t207
-    t212 = t209**2 + t210**2
-    t213 = t212
-    t214 = t212 + t211**2
-    t215 = 1 - t37
-    t216 = t14*t215
-    t217 = t216 + t14*t37
-    t218 = -0.67183 + t217
-    t219 = t218**2 + t48**2 + t49**2
-    t220 = 0.19791478625 - 0.5*t219
-    t221 = T22*t215
-    t222 = t221 + T22*t37
-    t223 = T20*t215
-    t224 = t223 + T20*t37
-    t225 = t220**2
-    t226 = 1 - t225*t67
-    t227 = t220*t65
-    t228 = (1e-12 < t226)
-    t229 = casadi.if_else(t228, t227, casadi.if_else((t227 > 0), 1, -1))
-    t230 = casadi.if_else(t228, casadi.sqrt(t226), 0)
-    t231 = casadi.atan2(t230, t229)
-    t232 = casadi.if_else(t64, 0, t0 + t231)
-    t233 = t0 - t231
-    t234 = t232 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t232)
-    t235 = t234 - 6.283185307179586*casadi.floor(0.625 + 0.15915494309189535*t234)
-    t236 = t233 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t233)
-    t237 = t236 - 6.283185307179586*casadi.floor(0.625 + 0.15915494309189535*t236)
-    t238 = t229*t65
-    t239 = 0.00876554*t238
-    t240 = t230*t65
-    t241 = 0.18645124*t240
-    t242 = casadi.if_else(t64, 1, -t239 - t241)
-    t243 = t241 - t239
-    t244 = 0.15005 - 0.15005*t242
-    t245 = t244 + 0.15005*t242
-    t246 = 0.15005 - 0.15005*t243
-    t247 = t246 + 0.15005*t243
-    t248 = 0.18645124*t238
-    t249 = 0.00876554*t240
-    t250 = casadi.if_else(t64, 0, t248 - t249)
-    t251 = t248 + t249
-    t252 = 0.0203*t242 - 0.4318*t250
-    t253 = 0.0203*t250 + 0.4318*t242
-    t254 = 0.4318 + t252
-    t255 = 0.67183 + t253
-    t256 = -0.67183 + t255
-    t257 = t256*t48 - t218*t254
-    t258 = t245**2 + t254**2 + t256**2
-    t259 = 0.0203*t243 - 0.4318*t251
-    t260 = 0.0203*t251 + 0.4318*t243
-    t261 = 0.4318 + t259
-    t262 = 0.67183 + t260
-    t263 = -0.67183 + t262
-    t264 = t263*t48 - t218*t261
-    t265 = t247**2 + t261**2 + t263**2
-    t266 = t245*t49
-    t267 = -t266 + t218*t256 + t254*t48
-    t268 = t266 + t267
-    t269 = t257**2 + t268**2
-    t270 = 1e-24*t219
-    t271 = (t269 <= t258*t270)
-    t272 = casadi.if_else(t271, 1, 1/casadi.sqrt(t269))
-    t273 = casadi.if_else(t271, 1, t268*t272)
-    t274 = casadi.if_else(t271, 0, -t257*t272)
-    t275 = t242*t273 - t250*t274
-    t276 = t242*t274 + t250*t273
-    t277 = t222*t276 + t275*t50
-    t278 = t222*t275 - t276*t50
-    t279 = t224*t276 + t275*t52
-    t280 = t224*t275 - t276*t52
-    t281 = casadi.if_else(t271, 0, casadi.atan2(-t257, t268))
-    t282 = t281 - 6.283185307179586*casadi.floor(0.125 + 0.15915494309189535*t281)
-    t283 = 1 - t275
-    t284 = t283*t51
-    t285 = t284 + t275*t51
-    t286 = t283*t53
-    t287 = t286 + t275*t53
-    t288 = t278**2
-    t289 = -t288
-    t290 = 1 + t289
-    t291 = casadi.if_else((t290 > 1e-12), casadi.sqrt(t290), 0)
-    t292 = t288 + t277*t291
-    t293 = t289 + t292
-    t294 = t285**2
-    t295 = t288 + t294 + t277**2
-    t296 = t291**2
-    t297 = t293**2 + t294*t296
-    t298 = t288 + t296
-    t299 = 1e-24*t298
-    t300 = (t297 <= t295*t299)
-    t301 = casadi.if_else(t300, 1, 1/casadi.sqrt(t297))
-    t302 = casadi.if_else(t300, 1, t293*t301)
-    t303 = t280*(1 - t302)
-    t304 = t303 + t280*t302
-    t305 = t285*t291
-    t306 = casadi.if_else(t300, 0, t301*t305)
-    t307 = t279*t302 + t287*t306
-    t308 = t287*t302 - t279*t306
-    t309 = (t298 <= t299)
-    t310 = casadi.if_else(t309, 1, 1/casadi.sqrt(t298))
-    t311 = casadi.if_else(t309, 1, t278*t310)
-    t312 = casadi.if_else(t309, 0, -t291*t310)
-    t313 = t308*(1 - t311)
-    t314 = t304*t312 + t307*t311
-    t315 = t313 + t308*t311
-    t316 = t304*t311 - t307*t312
-    t317 = t314**2 + t315**2
-    t318 = t317
-    t319 = t317 + t316**2
-    t320 = t247*t49
-    t321 = -t320 + t218*t263 + t261*t48
-    t322 = t320 + t321
-    t323 = t264**2 + t322**2
-    t324 = (t323 <= t265*t270)
-    t325 = casadi.if_else(t324, 1, 1/casadi.sqrt(t323))
-    t326 = casadi.if_else(t324, 1, t322*t325)
-    t327 = casadi.if_else(t324, 0, -t264*t325)
-    t328 = t243*t326 - t251*t327
-    t329 = t243*t327 + t251*t326
-    t330 = t222*t329 + t328*t50
-    t331 = t222*t328 - t329*t50
-    t332 = t224*t329 + t328*t52
-    t333 = t224*t328 - t329*t52
-    t334 = casadi.if_else(t324, 0, casadi.atan2(-t264, t322))
-    t335 = t334 - 6.283185307179586*casadi.floor(0.125 + 0.15915494309189535*t334)
-    t336 = 1 - t328
-    t337 = t336*t51
-    t338 = t337 + t328*t51
-    t339 = t336*t53
-    t340 = t339 + t328*t53
-    t341 = t331**2
-    t342 = -t341
-    t343 = 1 + t342
-    t344 = casadi.if_else((t343 > 1e-12), casadi.sqrt(t343), 0)
-    t345 = t341 + t330*t344
-    t346 = t342 + t345
-    t347 = t338**2
-    t348 = t341 + t347 + t330**2
-    t349 = t344**2
-    t350 = t346**2 + t347*t349
-    t351 = t341 + t349
-    t352 = 1e-24*t351
-    t353 = (t350 <= t348*t352)
-    t354 = casadi.if_else(t353, 1, 1/casadi.sqrt(t350))
-    t355 = casadi.if_else(t353, 1, t346*t354)
-    t356 = t333*(1 - t355)
-    t357 = t356 + t333*t355
-    t358 = t338*t344
-    t359 = casadi.if_else(t353, 0, t354*t358)
-    t360 = t332*t355 + t340*t359
-    t361 = t340*t355 - t332*t359
-    t362 = (t351 <= t352)
-    t363 = casadi.if_else(t362, 1, 1/casadi.sqrt(t351))
-    t364 = casadi.if_else(t362, 1, t331*t363)
-    t365 = casadi.if_else(t362, 0, -t344*t363)
-    t366 = t361*(1 - t364)
-    t367 = t357*t365 + t360*t364
-    t368 = t366 + t361*t364
-    t369 = t357*t364 - t360*t365
-    t370 = t367**2 + t368**2
-    t371 = t370
-    t372 = t370 + t369**2
-    t373 = casadi.if_else(t142, 0, casadi.atan2(t147, t135))
-    t374 = t373
-    t375 = t374 - 6.283185307179586*casadi.floor(0.3055555555555555 + 0.15915494309189535*t374)
-    t376 = 3.141592653589793 + t373 - 6.283185307179586*casadi.ceil(0.15915494309189535*t373)
-    t377 = t376 - 6.283185307179586*casadi.floor(0.3055555555555555 + 0.15915494309189535*t376)
-    t378 = casadi.if_else(t151, 0, casadi.atan2(-t133, t120))
-    t379 = t378
-    t380 = t379 - 6.283185307179586*casadi.floor(0.2777777777777778 + 0.15915494309189535*t379)
-    t381 = t378 + 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t378)
-    t382 = casadi.if_else((t160 <= 1e-24*t161), 0, casadi.atan2(t157, t156))
-    t383 = t382
-    t384 = t383 - 6.283185307179586*casadi.floor(0.7388888888888888 + 0.15915494309189535*t383)
-    t385 = 3.141592653589793 + t382 - 6.283185307179586*casadi.ceil(0.15915494309189535*t382)
-    t386 = t385 - 6.283185307179586*casadi.floor(0.7388888888888888 + 0.15915494309189535*t385)
-    t387 = -t381
-    t388 = t381 + 6.283185307179586*casadi.floor(0.2777777777777778 + 0.15915494309189535*t387)
-    t389 = casadi.if_else(t195, 0, casadi.atan2(t200, t188))
-    t390 = t389
-    t391 = t390 - 6.283185307179586*casadi.floor(0.3055555555555555 + 0.15915494309189535*t390)
-    t392 = 3.141592653589793 + t389 - 6.283185307179586*casadi.ceil(0.15915494309189535*t389)
-    t393 = t392 - 6.283185307179586*casadi.floor(0.3055555555555555 + 0.15915494309189535*t392)
-    t394 = casadi.if_else(t204, 0, casadi.atan2(-t186, t173))
-    t395 = t394
-    t396 = t395 - 6.283185307179586*casadi.floor(0.2777777777777778 + 0.15915494309189535*t395)
-    t397 = t394 + 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t394)
-    t398 = casadi.if_else((t213 <= 1e-24*t214), 0, casadi.atan2(t210, t209))
-    t399 = t398
-    t400 = t399 - 6.283185307179586*casadi.floor(0.7388888888888888 + 0.15915494309189535*t399)
-    t401 = 3.141592653589793 + t398 - 6.283185307179586*casadi.ceil(0.15915494309189535*t398)
-    t402 = t401 - 6.283185307179586*casadi.floor(0.7388888888888888 + 0.15915494309189535*t401)
-    t403 = -t397
-    t404 = t397 + 6.283185307179586*casadi.floor(0.2777777777777778 + 0.15915494309189535*t403)
-    t405 = casadi.if_else(t300, 0, casadi.atan2(t305, t293))
-    t406 = t405
-    t407 = t406 - 6.283185307179586*casadi.floor(0.3055555555555555 + 0.15915494309189535*t406)
-    t408 = 3.141592653589793 + t405 - 6.283185307179586*casadi.ceil(0.15915494309189535*t405)
-    t409 = t408 - 6.283185307179586*casadi.floor(0.3055555555555555 + 0.15915494309189535*t408)
-    t410 = casadi.if_else(t309, 0, casadi.atan2(-t291, t278))
-    t411 = t410
-    t412 = t411 - 6.283185307179586*casadi.floor(0.2777777777777778 + 0.15915494309189535*t411)
-    t413 = t410 + 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t410)
-    t414 = casadi.if_else((t318 <= 1e-24*t319), 0, casadi.atan2(t315, t314))
-    t415 = t414
-    t416 = t415 - 6.283185307179586*casadi.floor(0.7388888888888888 + 0.15915494309189535*t415)
-    t417 = 3.141592653589793 + t414 - 6.283185307179586*casadi.ceil(0.15915494309189535*t414)
-    t418 = t417 - 6.283185307179586*casadi.floor(0.7388888888888888 + 0.15915494309189535*t417)
-    t419 = -t413
-    t420 = t413 + 6.283185307179586*casadi.floor(0.2777777777777778 + 0.15915494309189535*t419)
-    t421 = casadi.if_else(t353, 0, casadi.atan2(t358, t346))
-    t422 = t421
-    t423 = t422 - 6.283185307179586*casadi.floor(0.3055555555555555 + 0.15915494309189535*t422)
-    t424 = 3.141592653589793 + t421 - 6.283185307179586*casadi.ceil(0.15915494309189535*t421)
-    t425 = t424 - 6.283185307179586*casadi.floor(0.3055555555555555 + 0.15915494309189535*t424)
-    t426 = casadi.if_else(t362, 0, casadi.atan2(-t344, t331))
-    t427 = t426
-    t428 = t427 - 6.283185307179586*casadi.floor(0.2777777777777778 + 0.15915494309189535*t427)
-    t429 = t426 + 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t426)
-    t430 = casadi.if_else((t371 <= 1e-24*t372), 0, casadi.atan2(t368, t367))
-    t431 = t430
-    t432 = t431 - 6.283185307179586*casadi.floor(0.7388888888888888 + 0.15915494309189535*t431)
-    t433 = 3.141592653589793 + t430 - 6.283185307179586*casadi.ceil(0.15915494309189535*t430)
-    t434 = t433 - 6.283185307179586*casadi.floor(0.7388888888888888 + 0.15915494309189535*t433)
-    t435 = -t429
-    t436 = t429 + 6.283185307179586*casadi.floor(0.2777777777777778 + 0.15915494309189535*t435)
-    t437 = (t29 <= 2.792526803190927)
-    t438 = casadi.logic_and((t28 >= -2.792526803190927), (t28 <= 2.792526803190927))
-    t439 = casadi.if_else(casadi.logic_and(t437, casadi.logic_not(t438)), t29, t28)
-    t440 = (t124 <= 3.9269908169872414)
-    t441 = casadi.logic_and((t123 >= -0.7853981633974483), (t123 <= 3.9269908169872414))
-    t442 = casadi.if_else(casadi.logic_and(t440, casadi.logic_not(t441)), t124, t123)
-    t443 = (t77 <= 0.7853981633974483)
-    t444 = casadi.logic_and((t76 >= -3.9269908169872414), (t76 <= 0.7853981633974483))
-    t445 = casadi.if_else(casadi.logic_and(t443, casadi.logic_not(t444)), t77, t76)
-    t446 = (t375 <= 2.9670597283903604)
-    t447 = casadi.logic_and((t374 >= -1.9198621771937625), (t374 <= 2.9670597283903604))
-    t448 = (t380 <= 1.7453292519943295)
-    t449 = casadi.logic_and((t379 >= -1.7453292519943295), (t379 <= 1.7453292519943295))
-    t450 = (t384 <= 4.642575810304916)
-    t451 = casadi.logic_and((t383 >= -4.642575810304916), (t383 <= 4.642575810304916))
-    t452 = (t377 <= 2.9670597283903604)
-    t453 = casadi.logic_and((t376 >= -1.9198621771937625), (t376 <= 2.9670597283903604))
-    t454 = -t388
-    t455 = (t386 <= 4.642575810304916)
-    t456 = casadi.logic_and((t385 >= -4.642575810304916), (t385 <= 4.642575810304916))
-    t457 = (t177 <= 3.9269908169872414)
-    t458 = casadi.logic_and((t176 >= -0.7853981633974483), (t176 <= 3.9269908169872414))
-    t459 = casadi.if_else(casadi.logic_and(t457, casadi.logic_not(t458)), t177, t176)
-    t460 = (t79 <= 0.7853981633974483)
-    t461 = casadi.logic_and((t78 >= -3.9269908169872414), (t78 <= 0.7853981633974483))
-    t462 = casadi.if_else(casadi.logic_and(t460, casadi.logic_not(t461)), t79, t78)
-    t463 = (t391 <= 2.9670597283903604)
-    t464 = casadi.logic_and((t390 >= -1.9198621771937625), (t390 <= 2.9670597283903604))
-    t465 = (t396 <= 1.7453292519943295)
-    t466 = casadi.logic_and((t395 >= -1.7453292519943295), (t395 <= 1.7453292519943295))
-    t467 = (t400 <= 4.642575810304916)
-    t468 = casadi.logic_and((t399 >= -4.642575810304916), (t399 <= 4.642575810304916))
-    t469 = (t393 <= 2.9670597283903604)
-    t470 = casadi.logic_and((t392 >= -1.9198621771937625), (t392 <= 2.9670597283903604))
-    t471 = -t404
-    t472 = (t402 <= 4.642575810304916)
-    t473 = casadi.logic_and((t401 >= -4.642575810304916), (t401 <= 4.642575810304916))
-    t474 = (t31 <= 2.792526803190927)
-    t475 = casadi.logic_and((t30 >= -2.792526803190927), (t30 <= 2.792526803190927))
-    t476 = casadi.if_else(casadi.logic_and(t474, casadi.logic_not(t475)), t31, t30)
-    t477 = (t282 <= 3.9269908169872414)
-    t478 = casadi.logic_and((t281 >= -0.7853981633974483), (t281 <= 3.9269908169872414))
-    t479 = casadi.if_else(casadi.logic_and(t477, casadi.logic_not(t478)), t282, t281)
-    t480 = (t235 <= 0.7853981633974483)
-    t481 = casadi.logic_and((t234 >= -3.9269908169872414), (t234 <= 0.7853981633974483))
-    t482 = casadi.if_else(casadi.logic_and(t480, casadi.logic_not(t481)), t235, t234)
-    t483 = (t407 <= 2.9670597283903604)
-    t484 = casadi.logic_and((t406 >= -1.9198621771937625), (t406 <= 2.9670597283903604))
-    t485 = (t412 <= 1.7453292519943295)
-    t486 = casadi.logic_and((t411 >= -1.7453292519943295), (t411 <= 1.7453292519943295))
-    t487 = (t416 <= 4.642575810304916)
-    t488 = casadi.logic_and((t415 >= -4.642575810304916), (t415 <= 4.642575810304916))
-    t489 = (t409 <= 2.9670597283903604)
-    t490 = casadi.logic_and((t408 >= -1.9198621771937625), (t408 <= 2.9670597283903604))
-    t491 = -t420
-    t492 = (t418 <= 4.642575810304916)
-    t493 = casadi.logic_and((t417 >= -4.642575810304916), (t417 <= 4.642575810304916))
-    t494 = (t335 <= 3.9269908169872414)
-    t495 = casadi.logic_and((t334 >= -0.7853981633974483), (t334 <= 3.9269908169872414))
-    t496 = casadi.if_else(casadi.logic_and(t494, casadi.logic_not(t495)), t335, t334)
-    t497 = (t237 <= 0.7853981633974483)
-    t498 = casadi.logic_and((t236 >= -3.9269908169872414), (t236 <= 0.7853981633974483))
-    t499 = casadi.if_else(casadi.logic_and(t497, casadi.logic_not(t498)), t237, t236)
-    t500 = (t423 <= 2.9670597283903604)
-    t501 = casadi.logic_and((t422 >= -1.9198621771937625), (t422 <= 2.9670597283903604))
-    t502 = (t428 <= 1.7453292519943295)
-    t503 = casadi.logic_and((t427 >= -1.7453292519943295), (t427 <= 1.7453292519943295))
-    t504 = (t432 <= 4.642575810304916)
-    t505 = casadi.logic_and((t431 >= -4.642575810304916), (t431 <= 4.642575810304916))
-    t506 = (t425 <= 2.9670597283903604)
-    t507 = casadi.logic_and((t424 >= -1.9198621771937625), (t424 <= 2.9670597283903604))
-    t508 = -t436
-    t509 = (t434 <= 4.642575810304916)
-    t510 = casadi.logic_and((t433 >= -4.642575810304916), (t433 <= 4.642575810304916))
-    t511 = (casadi.fabs(t1) < casadi.inf)
-    t512 = -1e-12
-    t513 = (t16 > t18)
-    t514 = casadi.logic_or(casadi.logic_and(t513, (t21 >= t512)), casadi.logic_and(t19, (0.0225150025 <= 1e-12*t17)))
-    t515 = 3.9038849723757295e-26
-    t516 = (0.0348408995890292 > t515)
-    t517 = (0.0348408995890292 <= t515)
-    t518 = 3.9038849723757296e-14
-    t519 = casadi.logic_or(casadi.logic_and(t516, (t68 >= t512)), casadi.logic_and(t517, (t66 <= t518)))
-    t520 = (t68 > 1e-12)
-    t521 = (t21 > 1e-12)
-    t522 = casadi.logic_or(casadi.logic_and(t516, (t226 >= t512)), casadi.logic_and(t517, (t225 <= t518)))
-    t523 = (t226 > 1e-12)
-    t524 = casadi.logic_or(t437, t438)
-    t525 = casadi.logic_or(t440, t441)
-    t526 = casadi.logic_or(t443, t444)
-    t527 = casadi.logic_or(t457, t458)
-    t528 = casadi.logic_or(t460, t461)
-    t529 = casadi.logic_or(t474, t475)
-    t530 = casadi.logic_or(t477, t478)
-    t531 = casadi.logic_or(t480, t481)
-    t532 = casadi.logic_or(t494, t495)
-    t533 = casadi.logic_or(t497, t498)
-    q = casadi.SX(8, 6)
-    q[0, 0] = t439
-    q[0, 1] = t442
-    q[0, 2] = t445
-    q[0, 3] = casadi.if_else(casadi.logic_and(t446, casadi.logic_not(t447)), t375, t374)
-    q[0, 4] = casadi.if_else(casadi.logic_and(t448, casadi.logic_not(t449)), t380, t379)
-    q[0, 5] = casadi.if_else(casadi.logic_and(t450, casadi.logic_not(t451)), t384, t383)
-    q[1, 0] = t439
-    q[1, 1] = t442
-    q[1, 2] = t445
-    q[1, 3] = casadi.if_else(casadi.logic_and(t452, casadi.logic_not(t453)), t377, t376)
-    q[1, 4] = casadi.if_else(casadi.logic_and((t388 >= -1.7453292519943295), casadi.logic_not(casadi.logic_and((t381 >= -1.7453292519943295), (t381 <= 1.7453292519943295)))), t454, t387)
-    q[1, 5] = casadi.if_else(casadi.logic_and(t455, casadi.logic_not(t456)), t386, t385)
-    q[2, 0] = t439
-    q[2, 1] = t459
-    q[2, 2] = t462
-    q[2, 3] = casadi.if_else(casadi.logic_and(t463, casadi.logic_not(t464)), t391, t390)
-    q[2, 4] = casadi.if_else(casadi.logic_and(t465, casadi.logic_not(t466)), t396, t395)
-    q[2, 5] = casadi.if_else(casadi.logic_and(t467, casadi.logic_not(t468)), t400, t399)
-    q[3, 0] = t439
-    q[3, 1] = t459
-    q[3, 2] = t462
-    q[3, 3] = casadi.if_else(casadi.logic_and(t469, casadi.logic_not(t470)), t393, t392)
-    q[3, 4] = casadi.if_else(casadi.logic_and((t404 >= -1.7453292519943295), casadi.logic_not(casadi.logic_and((t397 >= -1.7453292519943295), (t397 <= 1.7453292519943295)))), t471, t403)
-    q[3, 5] = casadi.if_else(casadi.logic_and(t472, casadi.logic_not(t473)), t402, t401)
-    q[4, 0] = t476
-    q[4, 1] = t479
-    q[4, 2] = t482
-    q[4, 3] = casadi.if_else(casadi.logic_and(t483, casadi.logic_not(t484)), t407, t406)
-    q[4, 4] = casadi.if_else(casadi.logic_and(t485, casadi.logic_not(t486)), t412, t411)
-    q[4, 5] = casadi.if_else(casadi.logic_and(t487, casadi.logic_not(t488)), t416, t415)
-    q[5, 0] = t476
-    q[5, 1] = t479
-    q[5, 2] = t482
-    q[5, 3] = casadi.if_else(casadi.logic_and(t489, casadi.logic_not(t490)), t409, t408)
-    q[5, 4] = casadi.if_else(casadi.logic_and((t420 >= -1.7453292519943295), casadi.logic_not(casadi.logic_and((t413 >= -1.7453292519943295), (t413 <= 1.7453292519943295)))), t491, t419)
-    q[5, 5] = casadi.if_else(casadi.logic_and(t492, casadi.logic_not(t493)), t418, t417)
-    q[6, 0] = t476
-    q[6, 1] = t496
-    q[6, 2] = t499
-    q[6, 3] = casadi.if_else(casadi.logic_and(t500, casadi.logic_not(t501)), t423, t422)
-    q[6, 4] = casadi.if_else(casadi.logic_and(t502, casadi.logic_not(t503)), t428, t427)
-    q[6, 5] = casadi.if_else(casadi.logic_and(t504, casadi.logic_not(t505)), t432, t431)
-    q[7, 0] = t476
-    q[7, 1] = t496
-    q[7, 2] = t499
-    q[7, 3] = casadi.if_else(casadi.logic_and(t506, casadi.logic_not(t507)), t425, t424)
-    q[7, 4] = casadi.if_else(casadi.logic_and((t436 >= -1.7453292519943295), casadi.logic_not(casadi.logic_and((t429 >= -1.7453292519943295), (t429 <= 1.7453292519943295)))), t508, t435)
-    q[7, 5] = casadi.if_else(casadi.logic_and(t509, casadi.logic_not(t510)), t434, t433)
-    valid = casadi.SX(8, 1)
-    valid[0, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t511, t514), t519), (t132 >= t512))
-    valid[1, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t511, t514), t519), (t132 > 1e-12))
-    valid[2, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t511, t514), t516), t520), (t185 >= t512))
-    valid[3, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t511, t514), t516), t520), (t185 > 1e-12))
-    valid[4, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t511, t513), t521), t522), (t290 >= t512))
-    valid[5, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t511, t513), t521), t522), (t290 > 1e-12))
-    valid[6, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t511, t513), t516), t521), t523), (t343 >= t512))
-    valid[7, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t511, t513), t516), t521), t523), (t343 > 1e-12))
-    in_limits = casadi.SX(8, 1)
-    in_limits[0, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t524, t525), t526), casadi.logic_or(t446, t447)), casadi.logic_or(t448, t449)), casadi.logic_or(t450, t451))
-    in_limits[1, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t524, t525), t526), casadi.logic_or(t452, t453)), casadi.logic_or(t455, t456)), casadi.logic_or((t454 <= 1.7453292519943295), casadi.logic_and((t387 >= -1.7453292519943295), (t387 <= 1.7453292519943295))))
-    in_limits[2, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t524, t527), t528), casadi.logic_or(t463, t464)), casadi.logic_or(t465, t466)), casadi.logic_or(t467, t468))
-    in_limits[3, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t524, t527), t528), casadi.logic_or(t469, t470)), casadi.logic_or(t472, t473)), casadi.logic_or((t471 <= 1.7453292519943295), casadi.logic_and((t403 >= -1.7453292519943295), (t403 <= 1.7453292519943295))))
-    in_limits[4, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t529, t530), t531), casadi.logic_or(t483, t484)), casadi.logic_or(t485, t486)), casadi.logic_or(t487, t488))
-    in_limits[5, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t529, t530), t531), casadi.logic_or(t489, t490)), casadi.logic_or(t492, t493)), casadi.logic_or((t491 <= 1.7453292519943295), casadi.logic_and((t419 >= -1.7453292519943295), (t419 <= 1.7453292519943295))))
-    in_limits[6, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t529, t532), t533), casadi.logic_or(t500, t501)), casadi.logic_or(t502, t503)), casadi.logic_or(t504, t505))
-    in_limits[7, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t529, t532), t533), casadi.logic_or(t506, t507)), casadi.logic_or(t509, t510)), casadi.logic_or((t508 <= 1.7453292519943295), casadi.logic_and((t435 >= -1.7453292519943295), (t435 <= 1.7453292519943295))))
-    return [q, valid, in_limits]
-
-
-def _ik_nearest(T, q_seed, weights):
-    """The closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status: 2245 operations."""
-    T00 = T[0, 0]
-    T01 = T[0, 1]
-    T02 = T[0, 2]
-    T03 = T[0, 3]
-    T10 = T[1, 0]
-    T11 = T[1, 1]
-    T12 = T[1, 2]
-    T13 = T[1, 3]
-    T20 = T[2, 0]
-    T21 = T[2, 1]
-    T22 = T[2, 2]
-    T23 = T[2, 3]
-    qn1 = q_seed[0]
-    qn2 = q_seed[1]
-    qn3 = q_seed[2]
-    qn4 = q_seed[3]
-    qn5 = q_seed[4]
-    qn6 = q_seed[5]
-    qw1 = weights[0]
-    qw2 = weights[1]
-    qw3 = weights[2]
-    qw4 = weights[3]
-    qw5 = weights[4]
-    qw6 = weights[5]
-    t0 = 1.6177742431429796
+    t0 = T00 + T01 + T02 + T03 + T10 + T11 + T12 + T13 + T20 + T21 + T22 + T23
     t1 = 0.4521*T00 + 1.10363*T02 - 0.15005*T01
     t2 = T03 - t1
     t3 = t1
@@ -2638,833 +2008,1449 @@ def _ik_nearest(T, q_seed, weights):
     t60 = t59 + T22*t35
     t61 = T20*t53
     t62 = t61 + T20*t35
-    t63 = False
-    t64 = casadi.if_else(t63, 1, 5.357415379007653)
-    t65 = t58**2
-    t66 = t64**2
-    t67 = 1 - t65*t66
-    t68 = t58*t64
-    t69 = (1e-12 < t67)
-    t70 = casadi.if_else(t69, t68, casadi.if_else((t68 > 0), 1, -1))
-    t71 = casadi.if_else(t69, casadi.sqrt(t67), 0)
-    t72 = casadi.atan2(t71, t70)
-    t73 = casadi.if_else(t63, 0, t0 + t72)
-    t74 = t0 - t72
-    t75 = t73 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t73)
-    t76 = t75 - 6.283185307179586*casadi.floor(0.625 + 0.15915494309189535*t75)
-    t77 = t74 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t74)
-    t78 = t77 - 6.283185307179586*casadi.floor(0.625 + 0.15915494309189535*t77)
-    t79 = t64*t70
-    t80 = 0.00876554*t79
-    t81 = t64*t71
-    t82 = 0.18645124*t81
-    t83 = casadi.if_else(t63, 1, -t80 - t82)
-    t84 = t82 - t80
-    t85 = 0.15005 - 0.15005*t83
-    t86 = t85 + 0.15005*t83
-    t87 = 0.15005 - 0.15005*t84
-    t88 = t87 + 0.15005*t84
-    t89 = 0.18645124*t79
-    t90 = 0.00876554*t81
-    t91 = casadi.if_else(t63, 0, t89 - t90)
-    t92 = t89 + t90
-    t93 = 0.0203*t83 - 0.4318*t91
-    t94 = 0.0203*t91 + 0.4318*t83
-    t95 = 0.4318 + t93
-    t96 = 0.67183 + t94
-    t97 = -0.67183 + t96
-    t98 = t41*t97 - t56*t95
-    t99 = t86**2 + t95**2 + t97**2
-    t100 = 0.0203*t84 - 0.4318*t92
-    t101 = 0.0203*t92 + 0.4318*t84
-    t102 = 0.4318 + t100
-    t103 = 0.67183 + t101
-    t104 = -0.67183 + t103
-    t105 = t104*t41 - t102*t56
-    t106 = t102**2 + t104**2 + t88**2
-    t107 = t42*t86
-    t108 = -t107 + t41*t95 + t56*t97
-    t109 = t107 + t108
-    t110 = t109**2 + t98**2
-    t111 = 1e-24*t57
-    t112 = (t110 <= t111*t99)
-    t113 = casadi.if_else(t112, 1, 1/casadi.sqrt(t110))
-    t114 = casadi.if_else(t112, 1, t109*t113)
-    t115 = casadi.if_else(t112, 0, -t113*t98)
-    t116 = t114*t83 - t115*t91
-    t117 = t114*t91 + t115*t83
-    t118 = t116*t43 + t117*t60
-    t119 = t116*t60 - t117*t43
-    t120 = t116*t45 + t117*t62
-    t121 = t116*t62 - t117*t45
-    t122 = casadi.if_else(t112, 0, casadi.atan2(-t98, t109))
-    t123 = t122 - 6.283185307179586*casadi.floor(0.125 + 0.15915494309189535*t122)
-    t124 = 1 - t116
-    t125 = t124*t44
-    t126 = t125 + t116*t44
-    t127 = t124*t46
-    t128 = t127 + t116*t46
-    t129 = t119**2
-    t130 = -t129
-    t131 = 1 + t130
-    t132 = (1e-12 < t131)
-    t133 = casadi.if_else(t132, casadi.sqrt(t131), 0)
-    t134 = t129 + t118*t133
-    t135 = t130 + t134
-    t136 = t126**2
-    t137 = t129 + t136 + t118**2
-    t138 = t133**2
-    t139 = t135**2 + t136*t138
-    t140 = t129 + t138
-    t141 = 1e-24*t140
-    t142 = (t139 <= t137*t141)
-    t143 = casadi.if_else(t142, 1, 1/casadi.sqrt(t139))
-    t144 = casadi.if_else(t142, 1, t135*t143)
-    t145 = t121*(1 - t144)
-    t146 = t145 + t121*t144
-    t147 = t126*t133
-    t148 = casadi.if_else(t142, 0, t143*t147)
-    t149 = t120*t144 + t128*t148
-    t150 = t128*t144 - t120*t148
-    t151 = (t140 <= t141)
-    t152 = casadi.if_else(t151, 1, 1/casadi.sqrt(t140))
-    t153 = casadi.if_else(t151, 1, t119*t152)
-    t154 = casadi.if_else(t151, 0, -t133*t152)
-    t155 = t150*(1 - t153)
-    t156 = t146*t154 + t149*t153
-    t157 = t155 + t150*t153
-    t158 = t146*t153 - t149*t154
-    t159 = t156**2 + t157**2
-    t160 = t159
-    t161 = t159 + t158**2
-    t162 = t42*t88
-    t163 = -t162 + t102*t41 + t104*t56
-    t164 = t162 + t163
-    t165 = t105**2 + t164**2
-    t166 = (t165 <= t106*t111)
-    t167 = casadi.if_else(t166, 1, 1/casadi.sqrt(t165))
-    t168 = casadi.if_else(t166, 1, t164*t167)
-    t169 = casadi.if_else(t166, 0, -t105*t167)
-    t170 = t168*t84 - t169*t92
-    t171 = t168*t92 + t169*t84
-    t172 = t170*t43 + t171*t60
-    t173 = t170*t60 - t171*t43
-    t174 = t170*t45 + t171*t62
-    t175 = t170*t62 - t171*t45
-    t176 = casadi.if_else(t166, 0, casadi.atan2(-t105, t164))
-    t177 = t176 - 6.283185307179586*casadi.floor(0.125 + 0.15915494309189535*t176)
-    t178 = 1 - t170
-    t179 = t178*t44
-    t180 = t179 + t170*t44
-    t181 = t178*t46
-    t182 = t181 + t170*t46
-    t183 = t173**2
-    t184 = -t183
-    t185 = 1 + t184
-    t186 = (1e-12 < t185)
-    t187 = casadi.if_else(t186, casadi.sqrt(t185), 0)
-    t188 = t183 + t172*t187
-    t189 = t184 + t188
-    t190 = t180**2
-    t191 = t183 + t190 + t172**2
-    t192 = t187**2
-    t193 = t189**2 + t190*t192
-    t194 = t183 + t192
-    t195 = 1e-24*t194
-    t196 = (t193 <= t191*t195)
-    t197 = casadi.if_else(t196, 1, 1/casadi.sqrt(t193))
-    t198 = casadi.if_else(t196, 1, t189*t197)
-    t199 = t175*(1 - t198)
-    t200 = t199 + t175*t198
-    t201 = t180*t187
-    t202 = casadi.if_else(t196, 0, t197*t201)
-    t203 = t174*t198 + t182*t202
-    t204 = t182*t198 - t174*t202
-    t205 = (t194 <= t195)
-    t206 = casadi.if_else(t205, 1, 1/casadi.sqrt(t194))
-    t207 = casadi.if_else(t205, 1, t173*t206)
-    t208 = casadi.if_else(t205, 0, -t187*t206)
-    t209 = t204*(1 - t207)
-    t210 = t200*t208 + t203*t207
-    t211 = t209 + t204*t207
-    t212 = t200*t207 - t203*t208
-    t213 = t210**2 + t211**2
-    t214 = t213
-    t215 = t213 + t212**2
-    t216 = 1 - t36
-    t217 = t13*t216
-    t218 = t217 + t13*t36
-    t219 = -0.67183 + t218
-    t220 = t219**2 + t47**2 + t48**2
-    t221 = 0.19791478625 - 0.5*t220
-    t222 = T22*t216
-    t223 = t222 + T22*t36
-    t224 = T20*t216
-    t225 = t224 + T20*t36
-    t226 = t221**2
-    t227 = 1 - t226*t66
-    t228 = t221*t64
-    t229 = (1e-12 < t227)
-    t230 = casadi.if_else(t229, t228, casadi.if_else((t228 > 0), 1, -1))
-    t231 = casadi.if_else(t229, casadi.sqrt(t227), 0)
-    t232 = casadi.atan2(t231, t230)
-    t233 = casadi.if_else(t63, 0, t0 + t232)
-    t234 = t0 - t232
-    t235 = t233 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t233)
-    t236 = t235 - 6.283185307179586*casadi.floor(0.625 + 0.15915494309189535*t235)
-    t237 = t234 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t234)
-    t238 = t237 - 6.283185307179586*casadi.floor(0.625 + 0.15915494309189535*t237)
-    t239 = t230*t64
-    t240 = 0.00876554*t239
-    t241 = t231*t64
-    t242 = 0.18645124*t241
-    t243 = casadi.if_else(t63, 1, -t240 - t242)
-    t244 = t242 - t240
-    t245 = 0.15005 - 0.15005*t243
-    t246 = t245 + 0.15005*t243
-    t247 = 0.15005 - 0.15005*t244
-    t248 = t247 + 0.15005*t244
-    t249 = 0.18645124*t239
-    t250 = 0.00876554*t241
-    t251 = casadi.if_else(t63, 0, t249 - t250)
-    t252 = t249 + t250
-    t253 = 0.0203*t243 - 0.4318*t251
-    t254 = 0.0203*t251 + 0.4318*t243
-    t255 = 0.4318 + t253
-    t256 = 0.67183 + t254
-    t257 = -0.67183 + t256
-    t258 = t257*t47 - t219*t255
-    t259 = t246**2 + t255**2 + t257**2
-    t260 = 0.0203*t244 - 0.4318*t252
-    t261 = 0.0203*t252 + 0.4318*t244
-    t262 = 0.4318 + t260
-    t263 = 0.67183 + t261
-    t264 = -0.67183 + t263
-    t265 = t264*t47 - t219*t262
-    t266 = t248**2 + t262**2 + t264**2
-    t267 = t246*t48
-    t268 = -t267 + t219*t257 + t255*t47
-    t269 = t267 + t268
-    t270 = t258**2 + t269**2
-    t271 = 1e-24*t220
-    t272 = (t270 <= t259*t271)
-    t273 = casadi.if_else(t272, 1, 1/casadi.sqrt(t270))
-    t274 = casadi.if_else(t272, 1, t269*t273)
-    t275 = casadi.if_else(t272, 0, -t258*t273)
-    t276 = t243*t274 - t251*t275
-    t277 = t243*t275 + t251*t274
-    t278 = t223*t277 + t276*t49
-    t279 = t223*t276 - t277*t49
-    t280 = t225*t277 + t276*t51
-    t281 = t225*t276 - t277*t51
-    t282 = casadi.if_else(t272, 0, casadi.atan2(-t258, t269))
-    t283 = t282 - 6.283185307179586*casadi.floor(0.125 + 0.15915494309189535*t282)
-    t284 = 1 - t276
-    t285 = t284*t50
-    t286 = t285 + t276*t50
-    t287 = t284*t52
-    t288 = t287 + t276*t52
-    t289 = t279**2
-    t290 = -t289
-    t291 = 1 + t290
-    t292 = (1e-12 < t291)
-    t293 = casadi.if_else(t292, casadi.sqrt(t291), 0)
-    t294 = t289 + t278*t293
-    t295 = t290 + t294
-    t296 = t286**2
-    t297 = t289 + t296 + t278**2
-    t298 = t293**2
-    t299 = t295**2 + t296*t298
-    t300 = t289 + t298
-    t301 = 1e-24*t300
-    t302 = (t299 <= t297*t301)
-    t303 = casadi.if_else(t302, 1, 1/casadi.sqrt(t299))
-    t304 = casadi.if_else(t302, 1, t295*t303)
-    t305 = t281*(1 - t304)
-    t306 = t305 + t281*t304
-    t307 = t286*t293
-    t308 = casadi.if_else(t302, 0, t303*t307)
-    t309 = t280*t304 + t288*t308
-    t310 = t288*t304 - t280*t308
-    t311 = (t300 <= t301)
-    t312 = casadi.if_else(t311, 1, 1/casadi.sqrt(t300))
-    t313 = casadi.if_else(t311, 1, t279*t312)
-    t314 = casadi.if_else(t311, 0, -t293*t312)
-    t315 = t310*(1 - t313)
-    t316 = t306*t314 + t309*t313
-    t317 = t315 + t310*t313
-    t318 = t306*t313 - t309*t314
-    t319 = t316**2 + t317**2
-    t320 = t319
-    t321 = t319 + t318**2
-    t322 = t248*t48
-    t323 = -t322 + t219*t264 + t262*t47
-    t324 = t322 + t323
-    t325 = t265**2 + t324**2
-    t326 = (t325 <= t266*t271)
-    t327 = casadi.if_else(t326, 1, 1/casadi.sqrt(t325))
-    t328 = casadi.if_else(t326, 1, t324*t327)
-    t329 = casadi.if_else(t326, 0, -t265*t327)
-    t330 = t244*t328 - t252*t329
-    t331 = t244*t329 + t252*t328
-    t332 = t223*t331 + t330*t49
-    t333 = t223*t330 - t331*t49
-    t334 = t225*t331 + t330*t51
-    t335 = t225*t330 - t331*t51
-    t336 = casadi.if_else(t326, 0, casadi.atan2(-t265, t324))
-    t337 = t336 - 6.283185307179586*casadi.floor(0.125 + 0.15915494309189535*t336)
-    t338 = 1 - t330
-    t339 = t338*t50
-    t340 = t339 + t330*t50
-    t341 = t338*t52
-    t342 = t341 + t330*t52
-    t343 = t333**2
-    t344 = -t343
-    t345 = 1 + t344
-    t346 = (1e-12 < t345)
-    t347 = casadi.if_else(t346, casadi.sqrt(t345), 0)
-    t348 = t343 + t332*t347
-    t349 = t344 + t348
-    t350 = t340**2
-    t351 = t343 + t350 + t332**2
-    t352 = t347**2
-    t353 = t349**2 + t350*t352
-    t354 = t343 + t352
-    t355 = 1e-24*t354
-    t356 = (t353 <= t351*t355)
-    t357 = casadi.if_else(t356, 1, 1/casadi.sqrt(t353))
-    t358 = casadi.if_else(t356, 1, t349*t357)
-    t359 = t335*(1 - t358)
-    t360 = t359 + t335*t358
-    t361 = t340*t347
-    t362 = casadi.if_else(t356, 0, t357*t361)
-    t363 = t334*t358 + t342*t362
-    t364 = t342*t358 - t334*t362
-    t365 = (t354 <= t355)
-    t366 = casadi.if_else(t365, 1, 1/casadi.sqrt(t354))
-    t367 = casadi.if_else(t365, 1, t333*t366)
-    t368 = casadi.if_else(t365, 0, -t347*t366)
-    t369 = t364*(1 - t367)
-    t370 = t360*t368 + t363*t367
-    t371 = t369 + t364*t367
-    t372 = t360*t367 - t363*t368
-    t373 = t370**2 + t371**2
-    t374 = t373
-    t375 = t373 + t372**2
-    t376 = T00 + T01 + T02 + T03 + T10 + T11 + T12 + T13 + T20 + T21 + T22 + T23
-    t377 = t376
-    t378 = qn1 + qn2 + qn3 + qn4 + qn5 + qn6 + qw1 + qw2 + qw3 + qw4 + qw5 + qw6 + t376
-    t379 = casadi.if_else(t142, 0, casadi.atan2(t147, t135))
-    t380 = t379
-    t381 = t380 - 6.283185307179586*casadi.floor(0.3055555555555555 + 0.15915494309189535*t380)
-    t382 = 3.141592653589793 + t379 - 6.283185307179586*casadi.ceil(0.15915494309189535*t379)
-    t383 = t382 - 6.283185307179586*casadi.floor(0.3055555555555555 + 0.15915494309189535*t382)
-    t384 = casadi.if_else(t151, 0, casadi.atan2(-t133, t119))
+    t63 = t58**2
+    t64 = 1 - 28.701899543227718*t63
+    t65 = 5.357415379007653*t58
+    t66 = (1e-12 < t64)
+    t67 = casadi.if_else(t66, t65, casadi.if_else((t65 > 0), 1, -1))
+    t68 = casadi.if_else(t66, casadi.sqrt(t64), 0)
+    t69 = casadi.atan2(t68, t67)
+    t70 = 1.6177742431429796 + t69
+    t71 = 1.6177742431429796 - t69
+    t72 = t70 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t70)
+    t73 = t72 - 6.283185307179586*casadi.floor(0.625 + 0.15915494309189535*t72)
+    t74 = t71 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t71)
+    t75 = t74 - 6.283185307179586*casadi.floor(0.625 + 0.15915494309189535*t74)
+    t76 = 5.357415379007653*t67
+    t77 = 0.00876554*t76
+    t78 = 5.357415379007653*t68
+    t79 = 0.18645124*t78
+    t80 = -t77 - t79
+    t81 = t79 - t77
+    t82 = 0.15005 - 0.15005*t80
+    t83 = t82 + 0.15005*t80
+    t84 = 0.15005 - 0.15005*t81
+    t85 = t84 + 0.15005*t81
+    t86 = 0.18645124*t76
+    t87 = 0.00876554*t78
+    t88 = t86 - t87
+    t89 = t86 + t87
+    t90 = 0.0203*t80 - 0.4318*t88
+    t91 = 0.0203*t88 + 0.4318*t80
+    t92 = 0.4318 + t90
+    t93 = 0.67183 + t91
+    t94 = -0.67183 + t93
+    t95 = t41*t94 - t56*t92
+    t96 = t83**2 + t92**2 + t94**2
+    t97 = 0.0203*t81 - 0.4318*t89
+    t98 = 0.0203*t89 + 0.4318*t81
+    t99 = 0.4318 + t97
+    t100 = 0.67183 + t98
+    t101 = -0.67183 + t100
+    t102 = t101*t41 - t56*t99
+    t103 = t101**2 + t85**2 + t99**2
+    t104 = t42*t83
+    t105 = -t104 + t41*t92 + t56*t94
+    t106 = t104 + t105
+    t107 = t106**2 + t95**2
+    t108 = 1e-24*t57
+    t109 = (t107 <= t108*t96)
+    t110 = casadi.if_else(t109, 1, 1/casadi.sqrt(t107))
+    t111 = casadi.if_else(t109, 1, t106*t110)
+    t112 = casadi.if_else(t109, 0, -t110*t95)
+    t113 = t111*t80 - t112*t88
+    t114 = t111*t88 + t112*t80
+    t115 = t113*t43 + t114*t60
+    t116 = t113*t60 - t114*t43
+    t117 = t113*t45 + t114*t62
+    t118 = t113*t62 - t114*t45
+    t119 = casadi.if_else(t109, 0, casadi.atan2(-t95, t106))
+    t120 = t119 - 6.283185307179586*casadi.floor(0.125 + 0.15915494309189535*t119)
+    t121 = 1 - t113
+    t122 = t121*t44
+    t123 = t122 + t113*t44
+    t124 = t121*t46
+    t125 = t124 + t113*t46
+    t126 = t116**2
+    t127 = -t126
+    t128 = 1 + t127
+    t129 = casadi.if_else((t128 > 1e-12), casadi.sqrt(t128), 0)
+    t130 = t126 + t115*t129
+    t131 = t127 + t130
+    t132 = t123**2
+    t133 = t126 + t132 + t115**2
+    t134 = t129**2
+    t135 = t131**2 + t132*t134
+    t136 = t126 + t134
+    t137 = 1e-24*t136
+    t138 = (t135 <= t133*t137)
+    t139 = casadi.if_else(t138, 1, 1/casadi.sqrt(t135))
+    t140 = casadi.if_else(t138, 1, t131*t139)
+    t141 = t118*(1 - t140)
+    t142 = t141 + t118*t140
+    t143 = t123*t129
+    t144 = casadi.if_else(t138, 0, t139*t143)
+    t145 = t117*t140 + t125*t144
+    t146 = t125*t140 - t117*t144
+    t147 = (t136 <= t137)
+    t148 = casadi.if_else(t147, 1, 1/casadi.sqrt(t136))
+    t149 = casadi.if_else(t147, 1, t116*t148)
+    t150 = casadi.if_else(t147, 0, -t129*t148)
+    t151 = t146*(1 - t149)
+    t152 = t142*t150 + t145*t149
+    t153 = t151 + t146*t149
+    t154 = t142*t149 - t145*t150
+    t155 = t152**2 + t153**2
+    t156 = t155
+    t157 = t155 + t154**2
+    t158 = t42*t85
+    t159 = -t158 + t101*t56 + t41*t99
+    t160 = t158 + t159
+    t161 = t102**2 + t160**2
+    t162 = (t161 <= t103*t108)
+    t163 = casadi.if_else(t162, 1, 1/casadi.sqrt(t161))
+    t164 = casadi.if_else(t162, 1, t160*t163)
+    t165 = casadi.if_else(t162, 0, -t102*t163)
+    t166 = t164*t81 - t165*t89
+    t167 = t164*t89 + t165*t81
+    t168 = t166*t43 + t167*t60
+    t169 = t166*t60 - t167*t43
+    t170 = t166*t45 + t167*t62
+    t171 = t166*t62 - t167*t45
+    t172 = casadi.if_else(t162, 0, casadi.atan2(-t102, t160))
+    t173 = t172 - 6.283185307179586*casadi.floor(0.125 + 0.15915494309189535*t172)
+    t174 = 1 - t166
+    t175 = t174*t44
+    t176 = t175 + t166*t44
+    t177 = t174*t46
+    t178 = t177 + t166*t46
+    t179 = t169**2
+    t180 = -t179
+    t181 = 1 + t180
+    t182 = casadi.if_else((t181 > 1e-12), casadi.sqrt(t181), 0)
+    t183 = t179 + t168*t182
+    t184 = t180 + t183
+    t185 = t176**2
+    t186 = t179 + t185 + t168**2
+    t187 = t182**2
+    t188 = t184**2 + t185*t187
+    t189 = t179 + t187
+    t190 = 1e-24*t189
+    t191 = (t188 <= t186*t190)
+    t192 = casadi.if_else(t191, 1, 1/casadi.sqrt(t188))
+    t193 = casadi.if_else(t191, 1, t184*t192)
+    t194 = t171*(1 - t193)
+    t195 = t194 + t171*t193
+    t196 = t176*t182
+    t197 = casadi.if_else(t191, 0, t192*t196)
+    t198 = t170*t193 + t178*t197
+    t199 = t178*t193 - t170*t197
+    t200 = (t189 <= t190)
+    t201 = casadi.if_else(t200, 1, 1/casadi.sqrt(t189))
+    t202 = casadi.if_else(t200, 1, t169*t201)
+    t203 = casadi.if_else(t200, 0, -t182*t201)
+    t204 = t199*(1 - t202)
+    t205 = t195*t203 + t198*t202
+    t206 = t204 + t199*t202
+    t207 = t195*t202 - t198*t203
+    t208 = t205**2 + t206**2
+    t209 = t208
+    t210 = t208 + t207**2
+    t211 = 1 - t36
+    t212 = t13*t211
+    t213 = t212 + t13*t36
+    t214 = -0.67183 + t213
+    t215 = t214**2 + t47**2 + t48**2
+    t216 = 0.19791478625 - 0.5*t215
+    t217 = T22*t211
+    t218 = t217 + T22*t36
+    t219 = T20*t211
+    t220 = t219 + T20*t36
+    t221 = t216**2
+    t222 = 1 - 28.701899543227718*t221
+    t223 = 5.357415379007653*t216
+    t224 = (1e-12 < t222)
+    t225 = casadi.if_else(t224, t223, casadi.if_else((t223 > 0), 1, -1))
+    t226 = casadi.if_else(t224, casadi.sqrt(t222), 0)
+    t227 = casadi.atan2(t226, t225)
+    t228 = 1.6177742431429796 + t227
+    t229 = 1.6177742431429796 - t227
+    t230 = t228 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t228)
+    t231 = t230 - 6.283185307179586*casadi.floor(0.625 + 0.15915494309189535*t230)
+    t232 = t229 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t229)
+    t233 = t232 - 6.283185307179586*casadi.floor(0.625 + 0.15915494309189535*t232)
+    t234 = 5.357415379007653*t225
+    t235 = 0.00876554*t234
+    t236 = 5.357415379007653*t226
+    t237 = 0.18645124*t236
+    t238 = -t235 - t237
+    t239 = t237 - t235
+    t240 = 0.15005 - 0.15005*t238
+    t241 = t240 + 0.15005*t238
+    t242 = 0.15005 - 0.15005*t239
+    t243 = t242 + 0.15005*t239
+    t244 = 0.18645124*t234
+    t245 = 0.00876554*t236
+    t246 = t244 - t245
+    t247 = t244 + t245
+    t248 = 0.0203*t238 - 0.4318*t246
+    t249 = 0.0203*t246 + 0.4318*t238
+    t250 = 0.4318 + t248
+    t251 = 0.67183 + t249
+    t252 = -0.67183 + t251
+    t253 = t252*t47 - t214*t250
+    t254 = t241**2 + t250**2 + t252**2
+    t255 = 0.0203*t239 - 0.4318*t247
+    t256 = 0.0203*t247 + 0.4318*t239
+    t257 = 0.4318 + t255
+    t258 = 0.67183 + t256
+    t259 = -0.67183 + t258
+    t260 = t259*t47 - t214*t257
+    t261 = t243**2 + t257**2 + t259**2
+    t262 = t241*t48
+    t263 = -t262 + t214*t252 + t250*t47
+    t264 = t262 + t263
+    t265 = t253**2 + t264**2
+    t266 = 1e-24*t215
+    t267 = (t265 <= t254*t266)
+    t268 = casadi.if_else(t267, 1, 1/casadi.sqrt(t265))
+    t269 = casadi.if_else(t267, 1, t264*t268)
+    t270 = casadi.if_else(t267, 0, -t253*t268)
+    t271 = t238*t269 - t246*t270
+    t272 = t238*t270 + t246*t269
+    t273 = t218*t272 + t271*t49
+    t274 = t218*t271 - t272*t49
+    t275 = t220*t272 + t271*t51
+    t276 = t220*t271 - t272*t51
+    t277 = casadi.if_else(t267, 0, casadi.atan2(-t253, t264))
+    t278 = t277 - 6.283185307179586*casadi.floor(0.125 + 0.15915494309189535*t277)
+    t279 = 1 - t271
+    t280 = t279*t50
+    t281 = t280 + t271*t50
+    t282 = t279*t52
+    t283 = t282 + t271*t52
+    t284 = t274**2
+    t285 = -t284
+    t286 = 1 + t285
+    t287 = casadi.if_else((t286 > 1e-12), casadi.sqrt(t286), 0)
+    t288 = t284 + t273*t287
+    t289 = t285 + t288
+    t290 = t281**2
+    t291 = t284 + t290 + t273**2
+    t292 = t287**2
+    t293 = t289**2 + t290*t292
+    t294 = t284 + t292
+    t295 = 1e-24*t294
+    t296 = (t293 <= t291*t295)
+    t297 = casadi.if_else(t296, 1, 1/casadi.sqrt(t293))
+    t298 = casadi.if_else(t296, 1, t289*t297)
+    t299 = t276*(1 - t298)
+    t300 = t299 + t276*t298
+    t301 = t281*t287
+    t302 = casadi.if_else(t296, 0, t297*t301)
+    t303 = t275*t298 + t283*t302
+    t304 = t283*t298 - t275*t302
+    t305 = (t294 <= t295)
+    t306 = casadi.if_else(t305, 1, 1/casadi.sqrt(t294))
+    t307 = casadi.if_else(t305, 1, t274*t306)
+    t308 = casadi.if_else(t305, 0, -t287*t306)
+    t309 = t304*(1 - t307)
+    t310 = t300*t308 + t303*t307
+    t311 = t309 + t304*t307
+    t312 = t300*t307 - t303*t308
+    t313 = t310**2 + t311**2
+    t314 = t313
+    t315 = t313 + t312**2
+    t316 = t243*t48
+    t317 = -t316 + t214*t259 + t257*t47
+    t318 = t316 + t317
+    t319 = t260**2 + t318**2
+    t320 = (t319 <= t261*t266)
+    t321 = casadi.if_else(t320, 1, 1/casadi.sqrt(t319))
+    t322 = casadi.if_else(t320, 1, t318*t321)
+    t323 = casadi.if_else(t320, 0, -t260*t321)
+    t324 = t239*t322 - t247*t323
+    t325 = t239*t323 + t247*t322
+    t326 = t218*t325 + t324*t49
+    t327 = t218*t324 - t325*t49
+    t328 = t220*t325 + t324*t51
+    t329 = t220*t324 - t325*t51
+    t330 = casadi.if_else(t320, 0, casadi.atan2(-t260, t318))
+    t331 = t330 - 6.283185307179586*casadi.floor(0.125 + 0.15915494309189535*t330)
+    t332 = 1 - t324
+    t333 = t332*t50
+    t334 = t333 + t324*t50
+    t335 = t332*t52
+    t336 = t335 + t324*t52
+    t337 = t327**2
+    t338 = -t337
+    t339 = 1 + t338
+    t340 = casadi.if_else((t339 > 1e-12), casadi.sqrt(t339), 0)
+    t341 = t337 + t326*t340
+    t342 = t338 + t341
+    t343 = t334**2
+    t344 = t337 + t343 + t326**2
+    t345 = t340**2
+    t346 = t342**2 + t343*t345
+    t347 = t337 + t345
+    t348 = 1e-24*t347
+    t349 = (t346 <= t344*t348)
+    t350 = casadi.if_else(t349, 1, 1/casadi.sqrt(t346))
+    t351 = casadi.if_else(t349, 1, t342*t350)
+    t352 = t329*(1 - t351)
+    t353 = t352 + t329*t351
+    t354 = t334*t340
+    t355 = casadi.if_else(t349, 0, t350*t354)
+    t356 = t328*t351 + t336*t355
+    t357 = t336*t351 - t328*t355
+    t358 = (t347 <= t348)
+    t359 = casadi.if_else(t358, 1, 1/casadi.sqrt(t347))
+    t360 = casadi.if_else(t358, 1, t327*t359)
+    t361 = casadi.if_else(t358, 0, -t340*t359)
+    t362 = t357*(1 - t360)
+    t363 = t353*t361 + t356*t360
+    t364 = t362 + t357*t360
+    t365 = t353*t360 - t356*t361
+    t366 = t363**2 + t364**2
+    t367 = t366
+    t368 = t366 + t365**2
+    t369 = casadi.if_else(t138, 0, casadi.atan2(t143, t131))
+    t370 = t369
+    t371 = t370 - 6.283185307179586*casadi.floor(0.3055555555555555 + 0.15915494309189535*t370)
+    t372 = 3.141592653589793 + t369 - 6.283185307179586*casadi.ceil(0.15915494309189535*t369)
+    t373 = t372 - 6.283185307179586*casadi.floor(0.3055555555555555 + 0.15915494309189535*t372)
+    t374 = casadi.if_else(t147, 0, casadi.atan2(-t129, t116))
+    t375 = t374
+    t376 = t375 - 6.283185307179586*casadi.floor(0.2777777777777778 + 0.15915494309189535*t375)
+    t377 = t374 + 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t374)
+    t378 = casadi.if_else((t156 <= 1e-24*t157), 0, casadi.atan2(t153, t152))
+    t379 = t378
+    t380 = t379 - 6.283185307179586*casadi.floor(0.7388888888888888 + 0.15915494309189535*t379)
+    t381 = 3.141592653589793 + t378 - 6.283185307179586*casadi.ceil(0.15915494309189535*t378)
+    t382 = t381 - 6.283185307179586*casadi.floor(0.7388888888888888 + 0.15915494309189535*t381)
+    t383 = -t377
+    t384 = t377 + 6.283185307179586*casadi.floor(0.2777777777777778 + 0.15915494309189535*t383)
+    t385 = casadi.if_else(t191, 0, casadi.atan2(t196, t184))
+    t386 = t385
+    t387 = t386 - 6.283185307179586*casadi.floor(0.3055555555555555 + 0.15915494309189535*t386)
+    t388 = 3.141592653589793 + t385 - 6.283185307179586*casadi.ceil(0.15915494309189535*t385)
+    t389 = t388 - 6.283185307179586*casadi.floor(0.3055555555555555 + 0.15915494309189535*t388)
+    t390 = casadi.if_else(t200, 0, casadi.atan2(-t182, t169))
+    t391 = t390
+    t392 = t391 - 6.283185307179586*casadi.floor(0.2777777777777778 + 0.15915494309189535*t391)
+    t393 = t390 + 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t390)
+    t394 = casadi.if_else((t209 <= 1e-24*t210), 0, casadi.atan2(t206, t205))
+    t395 = t394
+    t396 = t395 - 6.283185307179586*casadi.floor(0.7388888888888888 + 0.15915494309189535*t395)
+    t397 = 3.141592653589793 + t394 - 6.283185307179586*casadi.ceil(0.15915494309189535*t394)
+    t398 = t397 - 6.283185307179586*casadi.floor(0.7388888888888888 + 0.15915494309189535*t397)
+    t399 = -t393
+    t400 = t393 + 6.283185307179586*casadi.floor(0.2777777777777778 + 0.15915494309189535*t399)
+    t401 = casadi.if_else(t296, 0, casadi.atan2(t301, t289))
+    t402 = t401
+    t403 = t402 - 6.283185307179586*casadi.floor(0.3055555555555555 + 0.15915494309189535*t402)
+    t404 = 3.141592653589793 + t401 - 6.283185307179586*casadi.ceil(0.15915494309189535*t401)
+    t405 = t404 - 6.283185307179586*casadi.floor(0.3055555555555555 + 0.15915494309189535*t404)
+    t406 = casadi.if_else(t305, 0, casadi.atan2(-t287, t274))
+    t407 = t406
+    t408 = t407 - 6.283185307179586*casadi.floor(0.2777777777777778 + 0.15915494309189535*t407)
+    t409 = t406 + 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t406)
+    t410 = casadi.if_else((t314 <= 1e-24*t315), 0, casadi.atan2(t311, t310))
+    t411 = t410
+    t412 = t411 - 6.283185307179586*casadi.floor(0.7388888888888888 + 0.15915494309189535*t411)
+    t413 = 3.141592653589793 + t410 - 6.283185307179586*casadi.ceil(0.15915494309189535*t410)
+    t414 = t413 - 6.283185307179586*casadi.floor(0.7388888888888888 + 0.15915494309189535*t413)
+    t415 = -t409
+    t416 = t409 + 6.283185307179586*casadi.floor(0.2777777777777778 + 0.15915494309189535*t415)
+    t417 = casadi.if_else(t349, 0, casadi.atan2(t354, t342))
+    t418 = t417
+    t419 = t418 - 6.283185307179586*casadi.floor(0.3055555555555555 + 0.15915494309189535*t418)
+    t420 = 3.141592653589793 + t417 - 6.283185307179586*casadi.ceil(0.15915494309189535*t417)
+    t421 = t420 - 6.283185307179586*casadi.floor(0.3055555555555555 + 0.15915494309189535*t420)
+    t422 = casadi.if_else(t358, 0, casadi.atan2(-t340, t327))
+    t423 = t422
+    t424 = t423 - 6.283185307179586*casadi.floor(0.2777777777777778 + 0.15915494309189535*t423)
+    t425 = t422 + 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t422)
+    t426 = casadi.if_else((t367 <= 1e-24*t368), 0, casadi.atan2(t364, t363))
+    t427 = t426
+    t428 = t427 - 6.283185307179586*casadi.floor(0.7388888888888888 + 0.15915494309189535*t427)
+    t429 = 3.141592653589793 + t426 - 6.283185307179586*casadi.ceil(0.15915494309189535*t426)
+    t430 = t429 - 6.283185307179586*casadi.floor(0.7388888888888888 + 0.15915494309189535*t429)
+    t431 = -t425
+    t432 = t425 + 6.283185307179586*casadi.floor(0.2777777777777778 + 0.15915494309189535*t431)
+    t433 = (t28 <= 2.792526803190927)
+    t434 = casadi.logic_and((t27 >= -2.792526803190927), (t27 <= 2.792526803190927))
+    t435 = casadi.if_else(casadi.logic_and(t433, casadi.logic_not(t434)), t28, t27)
+    t436 = (t120 <= 3.9269908169872414)
+    t437 = casadi.logic_and((t119 >= -0.7853981633974483), (t119 <= 3.9269908169872414))
+    t438 = casadi.if_else(casadi.logic_and(t436, casadi.logic_not(t437)), t120, t119)
+    t439 = (t73 <= 0.7853981633974483)
+    t440 = casadi.logic_and((t72 >= -3.9269908169872414), (t72 <= 0.7853981633974483))
+    t441 = casadi.if_else(casadi.logic_and(t439, casadi.logic_not(t440)), t73, t72)
+    t442 = (t371 <= 2.9670597283903604)
+    t443 = casadi.logic_and((t370 >= -1.9198621771937625), (t370 <= 2.9670597283903604))
+    t444 = (t376 <= 1.7453292519943295)
+    t445 = casadi.logic_and((t375 >= -1.7453292519943295), (t375 <= 1.7453292519943295))
+    t446 = (t380 <= 4.642575810304916)
+    t447 = casadi.logic_and((t379 >= -4.642575810304916), (t379 <= 4.642575810304916))
+    t448 = (t373 <= 2.9670597283903604)
+    t449 = casadi.logic_and((t372 >= -1.9198621771937625), (t372 <= 2.9670597283903604))
+    t450 = -t384
+    t451 = (t382 <= 4.642575810304916)
+    t452 = casadi.logic_and((t381 >= -4.642575810304916), (t381 <= 4.642575810304916))
+    t453 = (t173 <= 3.9269908169872414)
+    t454 = casadi.logic_and((t172 >= -0.7853981633974483), (t172 <= 3.9269908169872414))
+    t455 = casadi.if_else(casadi.logic_and(t453, casadi.logic_not(t454)), t173, t172)
+    t456 = (t75 <= 0.7853981633974483)
+    t457 = casadi.logic_and((t74 >= -3.9269908169872414), (t74 <= 0.7853981633974483))
+    t458 = casadi.if_else(casadi.logic_and(t456, casadi.logic_not(t457)), t75, t74)
+    t459 = (t387 <= 2.9670597283903604)
+    t460 = casadi.logic_and((t386 >= -1.9198621771937625), (t386 <= 2.9670597283903604))
+    t461 = (t392 <= 1.7453292519943295)
+    t462 = casadi.logic_and((t391 >= -1.7453292519943295), (t391 <= 1.7453292519943295))
+    t463 = (t396 <= 4.642575810304916)
+    t464 = casadi.logic_and((t395 >= -4.642575810304916), (t395 <= 4.642575810304916))
+    t465 = (t389 <= 2.9670597283903604)
+    t466 = casadi.logic_and((t388 >= -1.9198621771937625), (t388 <= 2.9670597283903604))
+    t467 = -t400
+    t468 = (t398 <= 4.642575810304916)
+    t469 = casadi.logic_and((t397 >= -4.642575810304916), (t397 <= 4.642575810304916))
+    t470 = (t30 <= 2.792526803190927)
+    t471 = casadi.logic_and((t29 >= -2.792526803190927), (t29 <= 2.792526803190927))
+    t472 = casadi.if_else(casadi.logic_and(t470, casadi.logic_not(t471)), t30, t29)
+    t473 = (t278 <= 3.9269908169872414)
+    t474 = casadi.logic_and((t277 >= -0.7853981633974483), (t277 <= 3.9269908169872414))
+    t475 = casadi.if_else(casadi.logic_and(t473, casadi.logic_not(t474)), t278, t277)
+    t476 = (t231 <= 0.7853981633974483)
+    t477 = casadi.logic_and((t230 >= -3.9269908169872414), (t230 <= 0.7853981633974483))
+    t478 = casadi.if_else(casadi.logic_and(t476, casadi.logic_not(t477)), t231, t230)
+    t479 = (t403 <= 2.9670597283903604)
+    t480 = casadi.logic_and((t402 >= -1.9198621771937625), (t402 <= 2.9670597283903604))
+    t481 = (t408 <= 1.7453292519943295)
+    t482 = casadi.logic_and((t407 >= -1.7453292519943295), (t407 <= 1.7453292519943295))
+    t483 = (t412 <= 4.642575810304916)
+    t484 = casadi.logic_and((t411 >= -4.642575810304916), (t411 <= 4.642575810304916))
+    t485 = (t405 <= 2.9670597283903604)
+    t486 = casadi.logic_and((t404 >= -1.9198621771937625), (t404 <= 2.9670597283903604))
+    t487 = -t416
+    t488 = (t414 <= 4.642575810304916)
+    t489 = casadi.logic_and((t413 >= -4.642575810304916), (t413 <= 4.642575810304916))
+    t490 = (t331 <= 3.9269908169872414)
+    t491 = casadi.logic_and((t330 >= -0.7853981633974483), (t330 <= 3.9269908169872414))
+    t492 = casadi.if_else(casadi.logic_and(t490, casadi.logic_not(t491)), t331, t330)
+    t493 = (t233 <= 0.7853981633974483)
+    t494 = casadi.logic_and((t232 >= -3.9269908169872414), (t232 <= 0.7853981633974483))
+    t495 = casadi.if_else(casadi.logic_and(t493, casadi.logic_not(t494)), t233, t232)
+    t496 = (t419 <= 2.9670597283903604)
+    t497 = casadi.logic_and((t418 >= -1.9198621771937625), (t418 <= 2.9670597283903604))
+    t498 = (t424 <= 1.7453292519943295)
+    t499 = casadi.logic_and((t423 >= -1.7453292519943295), (t423 <= 1.7453292519943295))
+    t500 = (t428 <= 4.642575810304916)
+    t501 = casadi.logic_and((t427 >= -4.642575810304916), (t427 <= 4.642575810304916))
+    t502 = (t421 <= 2.9670597283903604)
+    t503 = casadi.logic_and((t420 >= -1.9198621771937625), (t420 <= 2.9670597283903604))
+    t504 = -t432
+    t505 = (t430 <= 4.642575810304916)
+    t506 = casadi.logic_and((t429 >= -4.642575810304916), (t429 <= 4.642575810304916))
+    t507 = (casadi.fabs(t0) < casadi.inf)
+    t508 = (t15 > t17)
+    t509 = casadi.logic_or(casadi.logic_and(t508, (t20 >= -1e-12)), casadi.logic_and(t18, (0.0225150025 <= 1e-12*t16)))
+    t510 = (t64 >= -1e-12)
+    t511 = (t64 > 1e-12)
+    t512 = (t20 > 1e-12)
+    t513 = (t222 >= -1e-12)
+    t514 = (t222 > 1e-12)
+    t515 = casadi.logic_or(t433, t434)
+    t516 = casadi.logic_or(t436, t437)
+    t517 = casadi.logic_or(t439, t440)
+    t518 = casadi.logic_or(t453, t454)
+    t519 = casadi.logic_or(t456, t457)
+    t520 = casadi.logic_or(t470, t471)
+    t521 = casadi.logic_or(t473, t474)
+    t522 = casadi.logic_or(t476, t477)
+    t523 = casadi.logic_or(t490, t491)
+    t524 = casadi.logic_or(t493, t494)
+    q = casadi.SX(8, 6)
+    q[0, 0] = t435
+    q[0, 1] = t438
+    q[0, 2] = t441
+    q[0, 3] = casadi.if_else(casadi.logic_and(t442, casadi.logic_not(t443)), t371, t370)
+    q[0, 4] = casadi.if_else(casadi.logic_and(t444, casadi.logic_not(t445)), t376, t375)
+    q[0, 5] = casadi.if_else(casadi.logic_and(t446, casadi.logic_not(t447)), t380, t379)
+    q[1, 0] = t435
+    q[1, 1] = t438
+    q[1, 2] = t441
+    q[1, 3] = casadi.if_else(casadi.logic_and(t448, casadi.logic_not(t449)), t373, t372)
+    q[1, 4] = casadi.if_else(casadi.logic_and((t384 >= -1.7453292519943295), casadi.logic_not(casadi.logic_and((t377 >= -1.7453292519943295), (t377 <= 1.7453292519943295)))), t450, t383)
+    q[1, 5] = casadi.if_else(casadi.logic_and(t451, casadi.logic_not(t452)), t382, t381)
+    q[2, 0] = t435
+    q[2, 1] = t455
+    q[2, 2] = t458
+    q[2, 3] = casadi.if_else(casadi.logic_and(t459, casadi.logic_not(t460)), t387, t386)
+    q[2, 4] = casadi.if_else(casadi.logic_and(t461, casadi.logic_not(t462)), t392, t391)
+    q[2, 5] = casadi.if_else(casadi.logic_and(t463, casadi.logic_not(t464)), t396, t395)
+    q[3, 0] = t435
+    q[3, 1] = t455
+    q[3, 2] = t458
+    q[3, 3] = casadi.if_else(casadi.logic_and(t465, casadi.logic_not(t466)), t389, t388)
+    q[3, 4] = casadi.if_else(casadi.logic_and((t400 >= -1.7453292519943295), casadi.logic_not(casadi.logic_and((t393 >= -1.7453292519943295), (t393 <= 1.7453292519943295)))), t467, t399)
+    q[3, 5] = casadi.if_else(casadi.logic_and(t468, casadi.logic_not(t469)), t398, t397)
+    q[4, 0] = t472
+    q[4, 1] = t475
+    q[4, 2] = t478
+    q[4, 3] = casadi.if_else(casadi.logic_and(t479, casadi.logic_not(t480)), t403, t402)
+    q[4, 4] = casadi.if_else(casadi.logic_and(t481, casadi.logic_not(t482)), t408, t407)
+    q[4, 5] = casadi.if_else(casadi.logic_and(t483, casadi.logic_not(t484)), t412, t411)
+    q[5, 0] = t472
+    q[5, 1] = t475
+    q[5, 2] = t478
+    q[5, 3] = casadi.if_else(casadi.logic_and(t485, casadi.logic_not(t486)), t405, t404)
+    q[5, 4] = casadi.if_else(casadi.logic_and((t416 >= -1.7453292519943295), casadi.logic_not(casadi.logic_and((t409 >= -1.7453292519943295), (t409 <= 1.7453292519943295)))), t487, t415)
+    q[5, 5] = casadi.if_else(casadi.logic_and(t488, casadi.logic_not(t489)), t414, t413)
+    q[6, 0] = t472
+    q[6, 1] = t492
+    q[6, 2] = t495
+    q[6, 3] = casadi.if_else(casadi.logic_and(t496, casadi.logic_not(t497)), t419, t418)
+    q[6, 4] = casadi.if_else(casadi.logic_and(t498, casadi.logic_not(t499)), t424, t423)
+    q[6, 5] = casadi.if_else(casadi.logic_and(t500, casadi.logic_not(t501)), t428, t427)
+    q[7, 0] = t472
+    q[7, 1] = t492
+    q[7, 2] = t495
+    q[7, 3] = casadi.if_else(casadi.logic_and(t502, casadi.logic_not(t503)), t421, t420)
+    q[7, 4] = casadi.if_else(casadi.logic_and((t432 >= -1.7453292519943295), casadi.logic_not(casadi.logic_and((t425 >= -1.7453292519943295), (t425 <= 1.7453292519943295)))), t504, t431)
+    q[7, 5] = casadi.if_else(casadi.logic_and(t505, casadi.logic_not(t506)), t430, t429)
+    valid = casadi.SX(8, 1)
+    valid[0, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t507, t509), t510), (t128 >= -1e-12))
+    valid[1, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t507, t509), t510), (t128 > 1e-12))
+    valid[2, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t507, t509), t511), (t181 >= -1e-12))
+    valid[3, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t507, t509), t511), (t181 > 1e-12))
+    valid[4, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t507, t508), t512), t513), (t286 >= -1e-12))
+    valid[5, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t507, t508), t512), t513), (t286 > 1e-12))
+    valid[6, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t507, t508), t512), t514), (t339 >= -1e-12))
+    valid[7, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t507, t508), t512), t514), (t339 > 1e-12))
+    in_limits = casadi.SX(8, 1)
+    in_limits[0, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t515, t516), t517), casadi.logic_or(t442, t443)), casadi.logic_or(t444, t445)), casadi.logic_or(t446, t447))
+    in_limits[1, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t515, t516), t517), casadi.logic_or(t448, t449)), casadi.logic_or(t451, t452)), casadi.logic_or((t450 <= 1.7453292519943295), casadi.logic_and((t383 >= -1.7453292519943295), (t383 <= 1.7453292519943295))))
+    in_limits[2, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t515, t518), t519), casadi.logic_or(t459, t460)), casadi.logic_or(t461, t462)), casadi.logic_or(t463, t464))
+    in_limits[3, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t515, t518), t519), casadi.logic_or(t465, t466)), casadi.logic_or(t468, t469)), casadi.logic_or((t467 <= 1.7453292519943295), casadi.logic_and((t399 >= -1.7453292519943295), (t399 <= 1.7453292519943295))))
+    in_limits[4, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t520, t521), t522), casadi.logic_or(t479, t480)), casadi.logic_or(t481, t482)), casadi.logic_or(t483, t484))
+    in_limits[5, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t520, t521), t522), casadi.logic_or(t485, t486)), casadi.logic_or(t488, t489)), casadi.logic_or((t487 <= 1.7453292519943295), casadi.logic_and((t415 >= -1.7453292519943295), (t415 <= 1.7453292519943295))))
+    in_limits[6, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t520, t523), t524), casadi.logic_or(t496, t497)), casadi.logic_or(t498, t499)), casadi.logic_or(t500, t501))
+    in_limits[7, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t520, t523), t524), casadi.logic_or(t502, t503)), casadi.logic_or(t505, t506)), casadi.logic_or((t504 <= 1.7453292519943295), casadi.logic_and((t431 >= -1.7453292519943295), (t431 <= 1.7453292519943295))))
+    return [q, valid, in_limits]
+
+
+def _ik_nearest(T, q_seed, weights):
+    """The closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status: 2221 operations."""
+    T00 = T[0, 0]
+    T01 = T[0, 1]
+    T02 = T[0, 2]
+    T03 = T[0, 3]
+    T10 = T[1, 0]
+    T11 = T[1, 1]
+    T12 = T[1, 2]
+    T13 = T[1, 3]
+    T20 = T[2, 0]
+    T21 = T[2, 1]
+    T22 = T[2, 2]
+    T23 = T[2, 3]
+    qn1 = q_seed[0]
+    qn2 = q_seed[1]
+    qn3 = q_seed[2]
+    qn4 = q_seed[3]
+    qn5 = q_seed[4]
+    qn6 = q_seed[5]
+    qw1 = weights[0]
+    qw2 = weights[1]
+    qw3 = weights[2]
+    qw4 = weights[3]
+    qw5 = weights[4]
+    qw6 = weights[5]
+    t0 = 0.4521*T00 + 1.10363*T02 - 0.15005*T01
+    t1 = T03 - t0
+    t2 = t0
+    t3 = t1 + t2
+    t4 = 0.4521*T10 + 1.10363*T12 - 0.15005*T11
+    t5 = T13 - t4
+    t6 = t4
+    t7 = t5 + t6
+    t8 = casadi.atan2(t3, -t7)
+    t9 = 0.4521*T20 + 1.10363*T22 - 0.15005*T21
+    t10 = T23 - t9
+    t11 = t9
+    t12 = t10 + t11
+    t13 = t3**2 + t7**2
+    t14 = t13
+    t15 = t13 + t12**2
+    t16 = 1e-24*t15
+    t17 = (t14 <= t16)
+    t18 = casadi.if_else(t17, 1, 1/casadi.sqrt(t14))
+    t19 = 1 - 0.0225150025*t18**2
+    t20 = (1e-12 < t19)
+    t21 = casadi.if_else(t20, 0.15005*t18, casadi.if_else((t18 > 0), 1, -1))
+    t22 = casadi.if_else(t20, casadi.sqrt(t19), 0)
+    t23 = casadi.atan2(t22, t21)
+    t24 = casadi.if_else(t17, 0, t23 + t8)
+    t25 = t8 - t23
+    t26 = t24 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t24)
+    t27 = t26 - 6.283185307179586*casadi.floor(0.4444444444444444 + 0.15915494309189535*t26)
+    t28 = t25 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t25)
+    t29 = t28 - 6.283185307179586*casadi.floor(0.4444444444444444 + 0.15915494309189535*t28)
+    t30 = t18*t3
+    t31 = t22*t30
+    t32 = t18*t7
+    t33 = t21*t32
+    t34 = casadi.if_else(t17, 1, -t31 - t33)
+    t35 = t31 - t33
+    t36 = t21*t30
+    t37 = t22*t32
+    t38 = casadi.if_else(t17, 0, t36 - t37)
+    t39 = t36 + t37
+    t40 = t3*t34 + t38*t7
+    t41 = t34*t7 - t3*t38
+    t42 = T02*t34 + T12*t38
+    t43 = T12*t34 - T02*t38
+    t44 = T00*t34 + T10*t38
+    t45 = T10*t34 - T00*t38
+    t46 = t3*t35 + t39*t7
+    t47 = t35*t7 - t3*t39
+    t48 = T02*t35 + T12*t39
+    t49 = T12*t35 - T02*t39
+    t50 = T00*t35 + T10*t39
+    t51 = T10*t35 - T00*t39
+    t52 = 1 - t34
+    t53 = t12*t52
+    t54 = t53 + t12*t34
+    t55 = -0.67183 + t54
+    t56 = t40**2 + t41**2 + t55**2
+    t57 = 0.19791478625 - 0.5*t56
+    t58 = T22*t52
+    t59 = t58 + T22*t34
+    t60 = T20*t52
+    t61 = t60 + T20*t34
+    t62 = t57**2
+    t63 = 1 - 28.701899543227718*t62
+    t64 = 5.357415379007653*t57
+    t65 = (1e-12 < t63)
+    t66 = casadi.if_else(t65, t64, casadi.if_else((t64 > 0), 1, -1))
+    t67 = casadi.if_else(t65, casadi.sqrt(t63), 0)
+    t68 = casadi.atan2(t67, t66)
+    t69 = 1.6177742431429796 + t68
+    t70 = 1.6177742431429796 - t68
+    t71 = t69 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t69)
+    t72 = t71 - 6.283185307179586*casadi.floor(0.625 + 0.15915494309189535*t71)
+    t73 = t70 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t70)
+    t74 = t73 - 6.283185307179586*casadi.floor(0.625 + 0.15915494309189535*t73)
+    t75 = 5.357415379007653*t66
+    t76 = 0.00876554*t75
+    t77 = 5.357415379007653*t67
+    t78 = 0.18645124*t77
+    t79 = -t76 - t78
+    t80 = t78 - t76
+    t81 = 0.15005 - 0.15005*t79
+    t82 = t81 + 0.15005*t79
+    t83 = 0.15005 - 0.15005*t80
+    t84 = t83 + 0.15005*t80
+    t85 = 0.18645124*t75
+    t86 = 0.00876554*t77
+    t87 = t85 - t86
+    t88 = t85 + t86
+    t89 = 0.0203*t79 - 0.4318*t87
+    t90 = 0.0203*t87 + 0.4318*t79
+    t91 = 0.4318 + t89
+    t92 = 0.67183 + t90
+    t93 = -0.67183 + t92
+    t94 = t40*t93 - t55*t91
+    t95 = t82**2 + t91**2 + t93**2
+    t96 = 0.0203*t80 - 0.4318*t88
+    t97 = 0.0203*t88 + 0.4318*t80
+    t98 = 0.4318 + t96
+    t99 = 0.67183 + t97
+    t100 = -0.67183 + t99
+    t101 = t100*t40 - t55*t98
+    t102 = t100**2 + t84**2 + t98**2
+    t103 = t41*t82
+    t104 = -t103 + t40*t91 + t55*t93
+    t105 = t103 + t104
+    t106 = t105**2 + t94**2
+    t107 = 1e-24*t56
+    t108 = (t106 <= t107*t95)
+    t109 = casadi.if_else(t108, 1, 1/casadi.sqrt(t106))
+    t110 = casadi.if_else(t108, 1, t105*t109)
+    t111 = casadi.if_else(t108, 0, -t109*t94)
+    t112 = t110*t79 - t111*t87
+    t113 = t110*t87 + t111*t79
+    t114 = t112*t42 + t113*t59
+    t115 = t112*t59 - t113*t42
+    t116 = t112*t44 + t113*t61
+    t117 = t112*t61 - t113*t44
+    t118 = casadi.if_else(t108, 0, casadi.atan2(-t94, t105))
+    t119 = t118 - 6.283185307179586*casadi.floor(0.125 + 0.15915494309189535*t118)
+    t120 = 1 - t112
+    t121 = t120*t43
+    t122 = t121 + t112*t43
+    t123 = t120*t45
+    t124 = t123 + t112*t45
+    t125 = t115**2
+    t126 = -t125
+    t127 = 1 + t126
+    t128 = (1e-12 < t127)
+    t129 = casadi.if_else(t128, casadi.sqrt(t127), 0)
+    t130 = t125 + t114*t129
+    t131 = t126 + t130
+    t132 = t122**2
+    t133 = t125 + t132 + t114**2
+    t134 = t129**2
+    t135 = t131**2 + t132*t134
+    t136 = t125 + t134
+    t137 = 1e-24*t136
+    t138 = (t135 <= t133*t137)
+    t139 = casadi.if_else(t138, 1, 1/casadi.sqrt(t135))
+    t140 = casadi.if_else(t138, 1, t131*t139)
+    t141 = t117*(1 - t140)
+    t142 = t141 + t117*t140
+    t143 = t122*t129
+    t144 = casadi.if_else(t138, 0, t139*t143)
+    t145 = t116*t140 + t124*t144
+    t146 = t124*t140 - t116*t144
+    t147 = (t136 <= t137)
+    t148 = casadi.if_else(t147, 1, 1/casadi.sqrt(t136))
+    t149 = casadi.if_else(t147, 1, t115*t148)
+    t150 = casadi.if_else(t147, 0, -t129*t148)
+    t151 = t146*(1 - t149)
+    t152 = t142*t150 + t145*t149
+    t153 = t151 + t146*t149
+    t154 = t142*t149 - t145*t150
+    t155 = t152**2 + t153**2
+    t156 = t155
+    t157 = t155 + t154**2
+    t158 = t41*t84
+    t159 = -t158 + t100*t55 + t40*t98
+    t160 = t158 + t159
+    t161 = t101**2 + t160**2
+    t162 = (t161 <= t102*t107)
+    t163 = casadi.if_else(t162, 1, 1/casadi.sqrt(t161))
+    t164 = casadi.if_else(t162, 1, t160*t163)
+    t165 = casadi.if_else(t162, 0, -t101*t163)
+    t166 = t164*t80 - t165*t88
+    t167 = t164*t88 + t165*t80
+    t168 = t166*t42 + t167*t59
+    t169 = t166*t59 - t167*t42
+    t170 = t166*t44 + t167*t61
+    t171 = t166*t61 - t167*t44
+    t172 = casadi.if_else(t162, 0, casadi.atan2(-t101, t160))
+    t173 = t172 - 6.283185307179586*casadi.floor(0.125 + 0.15915494309189535*t172)
+    t174 = 1 - t166
+    t175 = t174*t43
+    t176 = t175 + t166*t43
+    t177 = t174*t45
+    t178 = t177 + t166*t45
+    t179 = t169**2
+    t180 = -t179
+    t181 = 1 + t180
+    t182 = (1e-12 < t181)
+    t183 = casadi.if_else(t182, casadi.sqrt(t181), 0)
+    t184 = t179 + t168*t183
+    t185 = t180 + t184
+    t186 = t176**2
+    t187 = t179 + t186 + t168**2
+    t188 = t183**2
+    t189 = t185**2 + t186*t188
+    t190 = t179 + t188
+    t191 = 1e-24*t190
+    t192 = (t189 <= t187*t191)
+    t193 = casadi.if_else(t192, 1, 1/casadi.sqrt(t189))
+    t194 = casadi.if_else(t192, 1, t185*t193)
+    t195 = t171*(1 - t194)
+    t196 = t195 + t171*t194
+    t197 = t176*t183
+    t198 = casadi.if_else(t192, 0, t193*t197)
+    t199 = t170*t194 + t178*t198
+    t200 = t178*t194 - t170*t198
+    t201 = (t190 <= t191)
+    t202 = casadi.if_else(t201, 1, 1/casadi.sqrt(t190))
+    t203 = casadi.if_else(t201, 1, t169*t202)
+    t204 = casadi.if_else(t201, 0, -t183*t202)
+    t205 = t200*(1 - t203)
+    t206 = t196*t204 + t199*t203
+    t207 = t205 + t200*t203
+    t208 = t196*t203 - t199*t204
+    t209 = t206**2 + t207**2
+    t210 = t209
+    t211 = t209 + t208**2
+    t212 = 1 - t35
+    t213 = t12*t212
+    t214 = t213 + t12*t35
+    t215 = -0.67183 + t214
+    t216 = t215**2 + t46**2 + t47**2
+    t217 = 0.19791478625 - 0.5*t216
+    t218 = T22*t212
+    t219 = t218 + T22*t35
+    t220 = T20*t212
+    t221 = t220 + T20*t35
+    t222 = t217**2
+    t223 = 1 - 28.701899543227718*t222
+    t224 = 5.357415379007653*t217
+    t225 = (1e-12 < t223)
+    t226 = casadi.if_else(t225, t224, casadi.if_else((t224 > 0), 1, -1))
+    t227 = casadi.if_else(t225, casadi.sqrt(t223), 0)
+    t228 = casadi.atan2(t227, t226)
+    t229 = 1.6177742431429796 + t228
+    t230 = 1.6177742431429796 - t228
+    t231 = t229 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t229)
+    t232 = t231 - 6.283185307179586*casadi.floor(0.625 + 0.15915494309189535*t231)
+    t233 = t230 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t230)
+    t234 = t233 - 6.283185307179586*casadi.floor(0.625 + 0.15915494309189535*t233)
+    t235 = 5.357415379007653*t226
+    t236 = 0.00876554*t235
+    t237 = 5.357415379007653*t227
+    t238 = 0.18645124*t237
+    t239 = -t236 - t238
+    t240 = t238 - t236
+    t241 = 0.15005 - 0.15005*t239
+    t242 = t241 + 0.15005*t239
+    t243 = 0.15005 - 0.15005*t240
+    t244 = t243 + 0.15005*t240
+    t245 = 0.18645124*t235
+    t246 = 0.00876554*t237
+    t247 = t245 - t246
+    t248 = t245 + t246
+    t249 = 0.0203*t239 - 0.4318*t247
+    t250 = 0.0203*t247 + 0.4318*t239
+    t251 = 0.4318 + t249
+    t252 = 0.67183 + t250
+    t253 = -0.67183 + t252
+    t254 = t253*t46 - t215*t251
+    t255 = t242**2 + t251**2 + t253**2
+    t256 = 0.0203*t240 - 0.4318*t248
+    t257 = 0.0203*t248 + 0.4318*t240
+    t258 = 0.4318 + t256
+    t259 = 0.67183 + t257
+    t260 = -0.67183 + t259
+    t261 = t260*t46 - t215*t258
+    t262 = t244**2 + t258**2 + t260**2
+    t263 = t242*t47
+    t264 = -t263 + t215*t253 + t251*t46
+    t265 = t263 + t264
+    t266 = t254**2 + t265**2
+    t267 = 1e-24*t216
+    t268 = (t266 <= t255*t267)
+    t269 = casadi.if_else(t268, 1, 1/casadi.sqrt(t266))
+    t270 = casadi.if_else(t268, 1, t265*t269)
+    t271 = casadi.if_else(t268, 0, -t254*t269)
+    t272 = t239*t270 - t247*t271
+    t273 = t239*t271 + t247*t270
+    t274 = t219*t273 + t272*t48
+    t275 = t219*t272 - t273*t48
+    t276 = t221*t273 + t272*t50
+    t277 = t221*t272 - t273*t50
+    t278 = casadi.if_else(t268, 0, casadi.atan2(-t254, t265))
+    t279 = t278 - 6.283185307179586*casadi.floor(0.125 + 0.15915494309189535*t278)
+    t280 = 1 - t272
+    t281 = t280*t49
+    t282 = t281 + t272*t49
+    t283 = t280*t51
+    t284 = t283 + t272*t51
+    t285 = t275**2
+    t286 = -t285
+    t287 = 1 + t286
+    t288 = (1e-12 < t287)
+    t289 = casadi.if_else(t288, casadi.sqrt(t287), 0)
+    t290 = t285 + t274*t289
+    t291 = t286 + t290
+    t292 = t282**2
+    t293 = t285 + t292 + t274**2
+    t294 = t289**2
+    t295 = t291**2 + t292*t294
+    t296 = t285 + t294
+    t297 = 1e-24*t296
+    t298 = (t295 <= t293*t297)
+    t299 = casadi.if_else(t298, 1, 1/casadi.sqrt(t295))
+    t300 = casadi.if_else(t298, 1, t291*t299)
+    t301 = t277*(1 - t300)
+    t302 = t301 + t277*t300
+    t303 = t282*t289
+    t304 = casadi.if_else(t298, 0, t299*t303)
+    t305 = t276*t300 + t284*t304
+    t306 = t284*t300 - t276*t304
+    t307 = (t296 <= t297)
+    t308 = casadi.if_else(t307, 1, 1/casadi.sqrt(t296))
+    t309 = casadi.if_else(t307, 1, t275*t308)
+    t310 = casadi.if_else(t307, 0, -t289*t308)
+    t311 = t306*(1 - t309)
+    t312 = t302*t310 + t305*t309
+    t313 = t311 + t306*t309
+    t314 = t302*t309 - t305*t310
+    t315 = t312**2 + t313**2
+    t316 = t315
+    t317 = t315 + t314**2
+    t318 = t244*t47
+    t319 = -t318 + t215*t260 + t258*t46
+    t320 = t318 + t319
+    t321 = t261**2 + t320**2
+    t322 = (t321 <= t262*t267)
+    t323 = casadi.if_else(t322, 1, 1/casadi.sqrt(t321))
+    t324 = casadi.if_else(t322, 1, t320*t323)
+    t325 = casadi.if_else(t322, 0, -t261*t323)
+    t326 = t240*t324 - t248*t325
+    t327 = t240*t325 + t248*t324
+    t328 = t219*t327 + t326*t48
+    t329 = t219*t326 - t327*t48
+    t330 = t221*t327 + t326*t50
+    t331 = t221*t326 - t327*t50
+    t332 = casadi.if_else(t322, 0, casadi.atan2(-t261, t320))
+    t333 = t332 - 6.283185307179586*casadi.floor(0.125 + 0.15915494309189535*t332)
+    t334 = 1 - t326
+    t335 = t334*t49
+    t336 = t335 + t326*t49
+    t337 = t334*t51
+    t338 = t337 + t326*t51
+    t339 = t329**2
+    t340 = -t339
+    t341 = 1 + t340
+    t342 = (1e-12 < t341)
+    t343 = casadi.if_else(t342, casadi.sqrt(t341), 0)
+    t344 = t339 + t328*t343
+    t345 = t340 + t344
+    t346 = t336**2
+    t347 = t339 + t346 + t328**2
+    t348 = t343**2
+    t349 = t345**2 + t346*t348
+    t350 = t339 + t348
+    t351 = 1e-24*t350
+    t352 = (t349 <= t347*t351)
+    t353 = casadi.if_else(t352, 1, 1/casadi.sqrt(t349))
+    t354 = casadi.if_else(t352, 1, t345*t353)
+    t355 = t331*(1 - t354)
+    t356 = t355 + t331*t354
+    t357 = t336*t343
+    t358 = casadi.if_else(t352, 0, t353*t357)
+    t359 = t330*t354 + t338*t358
+    t360 = t338*t354 - t330*t358
+    t361 = (t350 <= t351)
+    t362 = casadi.if_else(t361, 1, 1/casadi.sqrt(t350))
+    t363 = casadi.if_else(t361, 1, t329*t362)
+    t364 = casadi.if_else(t361, 0, -t343*t362)
+    t365 = t360*(1 - t363)
+    t366 = t356*t364 + t359*t363
+    t367 = t365 + t360*t363
+    t368 = t356*t363 - t359*t364
+    t369 = t366**2 + t367**2
+    t370 = t369
+    t371 = t369 + t368**2
+    t372 = T00 + T01 + T02 + T03 + T10 + T11 + T12 + T13 + T20 + T21 + T22 + T23
+    t373 = t372
+    t374 = qn1 + qn2 + qn3 + qn4 + qn5 + qn6 + qw1 + qw2 + qw3 + qw4 + qw5 + qw6 + t372
+    t375 = casadi.if_else(t138, 0, casadi.atan2(t143, t131))
+    t376 = t375
+    t377 = t376 - 6.283185307179586*casadi.floor(0.3055555555555555 + 0.15915494309189535*t376)
+    t378 = 3.141592653589793 + t375 - 6.283185307179586*casadi.ceil(0.15915494309189535*t375)
+    t379 = t378 - 6.283185307179586*casadi.floor(0.3055555555555555 + 0.15915494309189535*t378)
+    t380 = casadi.if_else(t147, 0, casadi.atan2(-t129, t115))
+    t381 = t380
+    t382 = t381 - 6.283185307179586*casadi.floor(0.2777777777777778 + 0.15915494309189535*t381)
+    t383 = t380 + 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t380)
+    t384 = casadi.if_else((t156 <= 1e-24*t157), 0, casadi.atan2(t153, t152))
     t385 = t384
-    t386 = t385 - 6.283185307179586*casadi.floor(0.2777777777777778 + 0.15915494309189535*t385)
-    t387 = t384 + 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t384)
-    t388 = casadi.if_else((t160 <= 1e-24*t161), 0, casadi.atan2(t157, t156))
-    t389 = t388
-    t390 = t389 - 6.283185307179586*casadi.floor(0.7388888888888888 + 0.15915494309189535*t389)
-    t391 = 3.141592653589793 + t388 - 6.283185307179586*casadi.ceil(0.15915494309189535*t388)
-    t392 = t391 - 6.283185307179586*casadi.floor(0.7388888888888888 + 0.15915494309189535*t391)
-    t393 = -t387
-    t394 = t387 + 6.283185307179586*casadi.floor(0.2777777777777778 + 0.15915494309189535*t393)
-    t395 = casadi.if_else(t196, 0, casadi.atan2(t201, t189))
-    t396 = t395
-    t397 = t396 - 6.283185307179586*casadi.floor(0.3055555555555555 + 0.15915494309189535*t396)
-    t398 = 3.141592653589793 + t395 - 6.283185307179586*casadi.ceil(0.15915494309189535*t395)
-    t399 = t398 - 6.283185307179586*casadi.floor(0.3055555555555555 + 0.15915494309189535*t398)
-    t400 = casadi.if_else(t205, 0, casadi.atan2(-t187, t173))
+    t386 = t385 - 6.283185307179586*casadi.floor(0.7388888888888888 + 0.15915494309189535*t385)
+    t387 = 3.141592653589793 + t384 - 6.283185307179586*casadi.ceil(0.15915494309189535*t384)
+    t388 = t387 - 6.283185307179586*casadi.floor(0.7388888888888888 + 0.15915494309189535*t387)
+    t389 = -t383
+    t390 = t383 + 6.283185307179586*casadi.floor(0.2777777777777778 + 0.15915494309189535*t389)
+    t391 = casadi.if_else(t192, 0, casadi.atan2(t197, t185))
+    t392 = t391
+    t393 = t392 - 6.283185307179586*casadi.floor(0.3055555555555555 + 0.15915494309189535*t392)
+    t394 = 3.141592653589793 + t391 - 6.283185307179586*casadi.ceil(0.15915494309189535*t391)
+    t395 = t394 - 6.283185307179586*casadi.floor(0.3055555555555555 + 0.15915494309189535*t394)
+    t396 = casadi.if_else(t201, 0, casadi.atan2(-t183, t169))
+    t397 = t396
+    t398 = t397 - 6.283185307179586*casadi.floor(0.2777777777777778 + 0.15915494309189535*t397)
+    t399 = t396 + 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t396)
+    t400 = casadi.if_else((t210 <= 1e-24*t211), 0, casadi.atan2(t207, t206))
     t401 = t400
-    t402 = t401 - 6.283185307179586*casadi.floor(0.2777777777777778 + 0.15915494309189535*t401)
-    t403 = t400 + 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t400)
-    t404 = casadi.if_else((t214 <= 1e-24*t215), 0, casadi.atan2(t211, t210))
-    t405 = t404
-    t406 = t405 - 6.283185307179586*casadi.floor(0.7388888888888888 + 0.15915494309189535*t405)
-    t407 = 3.141592653589793 + t404 - 6.283185307179586*casadi.ceil(0.15915494309189535*t404)
-    t408 = t407 - 6.283185307179586*casadi.floor(0.7388888888888888 + 0.15915494309189535*t407)
-    t409 = -t403
-    t410 = t403 + 6.283185307179586*casadi.floor(0.2777777777777778 + 0.15915494309189535*t409)
-    t411 = casadi.if_else(t302, 0, casadi.atan2(t307, t295))
-    t412 = t411
-    t413 = t412 - 6.283185307179586*casadi.floor(0.3055555555555555 + 0.15915494309189535*t412)
-    t414 = 3.141592653589793 + t411 - 6.283185307179586*casadi.ceil(0.15915494309189535*t411)
-    t415 = t414 - 6.283185307179586*casadi.floor(0.3055555555555555 + 0.15915494309189535*t414)
-    t416 = casadi.if_else(t311, 0, casadi.atan2(-t293, t279))
+    t402 = t401 - 6.283185307179586*casadi.floor(0.7388888888888888 + 0.15915494309189535*t401)
+    t403 = 3.141592653589793 + t400 - 6.283185307179586*casadi.ceil(0.15915494309189535*t400)
+    t404 = t403 - 6.283185307179586*casadi.floor(0.7388888888888888 + 0.15915494309189535*t403)
+    t405 = -t399
+    t406 = t399 + 6.283185307179586*casadi.floor(0.2777777777777778 + 0.15915494309189535*t405)
+    t407 = casadi.if_else(t298, 0, casadi.atan2(t303, t291))
+    t408 = t407
+    t409 = t408 - 6.283185307179586*casadi.floor(0.3055555555555555 + 0.15915494309189535*t408)
+    t410 = 3.141592653589793 + t407 - 6.283185307179586*casadi.ceil(0.15915494309189535*t407)
+    t411 = t410 - 6.283185307179586*casadi.floor(0.3055555555555555 + 0.15915494309189535*t410)
+    t412 = casadi.if_else(t307, 0, casadi.atan2(-t289, t275))
+    t413 = t412
+    t414 = t413 - 6.283185307179586*casadi.floor(0.2777777777777778 + 0.15915494309189535*t413)
+    t415 = t412 + 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t412)
+    t416 = casadi.if_else((t316 <= 1e-24*t317), 0, casadi.atan2(t313, t312))
     t417 = t416
-    t418 = t417 - 6.283185307179586*casadi.floor(0.2777777777777778 + 0.15915494309189535*t417)
-    t419 = t416 + 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t416)
-    t420 = casadi.if_else((t320 <= 1e-24*t321), 0, casadi.atan2(t317, t316))
-    t421 = t420
-    t422 = t421 - 6.283185307179586*casadi.floor(0.7388888888888888 + 0.15915494309189535*t421)
-    t423 = 3.141592653589793 + t420 - 6.283185307179586*casadi.ceil(0.15915494309189535*t420)
-    t424 = t423 - 6.283185307179586*casadi.floor(0.7388888888888888 + 0.15915494309189535*t423)
-    t425 = -t419
-    t426 = t419 + 6.283185307179586*casadi.floor(0.2777777777777778 + 0.15915494309189535*t425)
-    t427 = casadi.if_else(t356, 0, casadi.atan2(t361, t349))
-    t428 = t427
-    t429 = t428 - 6.283185307179586*casadi.floor(0.3055555555555555 + 0.15915494309189535*t428)
-    t430 = 3.141592653589793 + t427 - 6.283185307179586*casadi.ceil(0.15915494309189535*t427)
-    t431 = t430 - 6.283185307179586*casadi.floor(0.3055555555555555 + 0.15915494309189535*t430)
-    t432 = casadi.if_else(t365, 0, casadi.atan2(-t347, t333))
+    t418 = t417 - 6.283185307179586*casadi.floor(0.7388888888888888 + 0.15915494309189535*t417)
+    t419 = 3.141592653589793 + t416 - 6.283185307179586*casadi.ceil(0.15915494309189535*t416)
+    t420 = t419 - 6.283185307179586*casadi.floor(0.7388888888888888 + 0.15915494309189535*t419)
+    t421 = -t415
+    t422 = t415 + 6.283185307179586*casadi.floor(0.2777777777777778 + 0.15915494309189535*t421)
+    t423 = casadi.if_else(t352, 0, casadi.atan2(t357, t345))
+    t424 = t423
+    t425 = t424 - 6.283185307179586*casadi.floor(0.3055555555555555 + 0.15915494309189535*t424)
+    t426 = 3.141592653589793 + t423 - 6.283185307179586*casadi.ceil(0.15915494309189535*t423)
+    t427 = t426 - 6.283185307179586*casadi.floor(0.3055555555555555 + 0.15915494309189535*t426)
+    t428 = casadi.if_else(t361, 0, casadi.atan2(-t343, t329))
+    t429 = t428
+    t430 = t429 - 6.283185307179586*casadi.floor(0.2777777777777778 + 0.15915494309189535*t429)
+    t431 = t428 + 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t428)
+    t432 = casadi.if_else((t370 <= 1e-24*t371), 0, casadi.atan2(t367, t366))
     t433 = t432
-    t434 = t433 - 6.283185307179586*casadi.floor(0.2777777777777778 + 0.15915494309189535*t433)
-    t435 = t432 + 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t432)
-    t436 = casadi.if_else((t374 <= 1e-24*t375), 0, casadi.atan2(t371, t370))
-    t437 = t436
-    t438 = t437 - 6.283185307179586*casadi.floor(0.7388888888888888 + 0.15915494309189535*t437)
-    t439 = 3.141592653589793 + t436 - 6.283185307179586*casadi.ceil(0.15915494309189535*t436)
-    t440 = t439 - 6.283185307179586*casadi.floor(0.7388888888888888 + 0.15915494309189535*t439)
-    t441 = -t435
-    t442 = t435 + 6.283185307179586*casadi.floor(0.2777777777777778 + 0.15915494309189535*t441)
-    t443 = (t28 <= 2.792526803190927)
-    t444 = casadi.logic_and((t27 >= -2.792526803190927), (t27 <= 2.792526803190927))
-    t445 = casadi.if_else(casadi.logic_and(t443, casadi.logic_not(t444)), t28, t27)
-    t446 = t445
-    t447 = t446 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn1 - 0.15915494309189535*t446)
-    t448 = casadi.if_else((qn1 > t447), 6.283185307179586, -6.283185307179586)
-    t449 = t447 + t448
-    t450 = t447 - t448
-    t451 = casadi.if_else(casadi.logic_and((t447 >= -2.792526803190927), (t447 <= 2.792526803190927)), t447, casadi.if_else(casadi.logic_and((t449 >= -2.792526803190927), (t449 <= 2.792526803190927)), t449, casadi.if_else(casadi.logic_and((t450 >= -2.792526803190927), (t450 <= 2.792526803190927)), t450, t445)))
-    t452 = (t123 <= 3.9269908169872414)
-    t453 = casadi.logic_and((t122 >= -0.7853981633974483), (t122 <= 3.9269908169872414))
-    t454 = casadi.if_else(casadi.logic_and(t452, casadi.logic_not(t453)), t123, t122)
-    t455 = t454
-    t456 = t455 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t455)
-    t457 = casadi.if_else((qn2 > t456), 6.283185307179586, -6.283185307179586)
-    t458 = t456 + t457
-    t459 = t456 - t457
-    t460 = casadi.if_else(casadi.logic_and((t456 >= -0.7853981633974483), (t456 <= 3.9269908169872414)), t456, casadi.if_else(casadi.logic_and((t458 >= -0.7853981633974483), (t458 <= 3.9269908169872414)), t458, casadi.if_else(casadi.logic_and((t459 >= -0.7853981633974483), (t459 <= 3.9269908169872414)), t459, t454)))
-    t461 = (t76 <= 0.7853981633974483)
-    t462 = casadi.logic_and((t75 >= -3.9269908169872414), (t75 <= 0.7853981633974483))
-    t463 = casadi.if_else(casadi.logic_and(t461, casadi.logic_not(t462)), t76, t75)
-    t464 = t463
-    t465 = t464 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn3 - 0.15915494309189535*t464)
-    t466 = casadi.if_else((qn3 > t465), 6.283185307179586, -6.283185307179586)
-    t467 = t465 + t466
-    t468 = t465 - t466
-    t469 = casadi.if_else(casadi.logic_and((t465 >= -3.9269908169872414), (t465 <= 0.7853981633974483)), t465, casadi.if_else(casadi.logic_and((t467 >= -3.9269908169872414), (t467 <= 0.7853981633974483)), t467, casadi.if_else(casadi.logic_and((t468 >= -3.9269908169872414), (t468 <= 0.7853981633974483)), t468, t463)))
-    t470 = (t381 <= 2.9670597283903604)
-    t471 = casadi.logic_and((t380 >= -1.9198621771937625), (t380 <= 2.9670597283903604))
-    t472 = casadi.if_else(casadi.logic_and(t470, casadi.logic_not(t471)), t381, t380)
-    t473 = t472
-    t474 = t473 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t473)
-    t475 = casadi.if_else((qn4 > t474), 6.283185307179586, -6.283185307179586)
-    t476 = t474 + t475
-    t477 = t474 - t475
-    t478 = casadi.if_else(casadi.logic_and((t474 >= -1.9198621771937625), (t474 <= 2.9670597283903604)), t474, casadi.if_else(casadi.logic_and((t476 >= -1.9198621771937625), (t476 <= 2.9670597283903604)), t476, casadi.if_else(casadi.logic_and((t477 >= -1.9198621771937625), (t477 <= 2.9670597283903604)), t477, t472)))
-    t479 = (t386 <= 1.7453292519943295)
-    t480 = casadi.logic_and((t385 >= -1.7453292519943295), (t385 <= 1.7453292519943295))
-    t481 = casadi.if_else(casadi.logic_and(t479, casadi.logic_not(t480)), t386, t385)
-    t482 = t481
-    t483 = t482 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn5 - 0.15915494309189535*t482)
-    t484 = casadi.if_else((qn5 > t483), 6.283185307179586, -6.283185307179586)
-    t485 = t483 + t484
-    t486 = t483 - t484
-    t487 = casadi.if_else(casadi.logic_and((t483 >= -1.7453292519943295), (t483 <= 1.7453292519943295)), t483, casadi.if_else(casadi.logic_and((t485 >= -1.7453292519943295), (t485 <= 1.7453292519943295)), t485, casadi.if_else(casadi.logic_and((t486 >= -1.7453292519943295), (t486 <= 1.7453292519943295)), t486, t481)))
-    t488 = (t390 <= 4.642575810304916)
-    t489 = casadi.logic_and((t389 >= -4.642575810304916), (t389 <= 4.642575810304916))
-    t490 = casadi.if_else(casadi.logic_and(t488, casadi.logic_not(t489)), t390, t389)
-    t491 = t490
-    t492 = t491 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn6 - 0.15915494309189535*t491)
-    t493 = casadi.if_else((qn6 > t492), 6.283185307179586, -6.283185307179586)
-    t494 = t492 + t493
-    t495 = t492 - t493
-    t496 = casadi.if_else(casadi.logic_and((t492 >= -4.642575810304916), (t492 <= 4.642575810304916)), t492, casadi.if_else(casadi.logic_and((t494 >= -4.642575810304916), (t494 <= 4.642575810304916)), t494, casadi.if_else(casadi.logic_and((t495 >= -4.642575810304916), (t495 <= 4.642575810304916)), t495, t490)))
-    t497 = -qn4
-    t498 = -qn5
-    t499 = -qn6
-    t500 = -qn1
-    t501 = qw1*(t451 + t500)**2
-    t502 = -qn2
-    t503 = -qn3
-    t504 = t501 + qw2*(t460 + t502)**2 + qw3*(t469 + t503)**2
-    t505 = t504 + qw4*(t478 + t497)**2 + qw5*(t487 + t498)**2 + qw6*(t496 + t499)**2
-    t506 = (casadi.fabs(t377) < casadi.inf)
-    t507 = casadi.logic_or(t443, t444)
-    t508 = casadi.logic_or(t452, t453)
-    t509 = casadi.logic_or(t461, t462)
-    t510 = True
-    t511 = casadi.logic_or(casadi.logic_and(t63, (1e-12 >= 25.615508834817042*t65)), casadi.logic_and(t510, (1e-12 >= -t67)))
-    t512 = (t15 > t17)
-    t513 = casadi.logic_or(casadi.logic_and(t18, (1e-12*t16 >= 0.0225150025)), casadi.logic_and(t512, (1e-12 >= -t20)))
-    t514 = casadi.if_else(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t506, t507), t508), t509), t511), t513), (t131 >= -1e-12)), casadi.logic_or(t470, t471)), casadi.logic_or(t479, t480)), casadi.logic_or(t488, t489)), 1, 0)
-    t515 = casadi.if_else((t514 > 0), 1, 0)
-    t516 = (t515 > 0)
-    t517 = casadi.if_else(t516, t451, qn1)
-    t518 = casadi.if_else(t516, t460, qn2)
-    t519 = casadi.if_else(t516, t469, qn3)
-    t520 = casadi.if_else(t516, t478, qn4)
-    t521 = casadi.if_else(t516, t487, qn5)
-    t522 = casadi.if_else(t516, t496, qn6)
-    t523 = casadi.if_else(t516, t505, 0)
-    t524 = (t383 <= 2.9670597283903604)
-    t525 = casadi.logic_and((t382 >= -1.9198621771937625), (t382 <= 2.9670597283903604))
-    t526 = casadi.if_else(casadi.logic_and(t524, casadi.logic_not(t525)), t383, t382)
-    t527 = t526
-    t528 = t527 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t527)
-    t529 = casadi.if_else((qn4 > t528), 6.283185307179586, -6.283185307179586)
-    t530 = t528 + t529
-    t531 = t528 - t529
-    t532 = casadi.if_else(casadi.logic_and((t528 >= -1.9198621771937625), (t528 <= 2.9670597283903604)), t528, casadi.if_else(casadi.logic_and((t530 >= -1.9198621771937625), (t530 <= 2.9670597283903604)), t530, casadi.if_else(casadi.logic_and((t531 >= -1.9198621771937625), (t531 <= 2.9670597283903604)), t531, t526)))
-    t533 = (t394 >= -1.7453292519943295)
-    t534 = casadi.logic_and((t387 >= -1.7453292519943295), (t387 <= 1.7453292519943295))
-    t535 = casadi.if_else(casadi.logic_and(t533, casadi.logic_not(t534)), -t394, t393)
-    t536 = t535
-    t537 = t536 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn5 - 0.15915494309189535*t536)
-    t538 = casadi.if_else((qn5 > t537), 6.283185307179586, -6.283185307179586)
-    t539 = t537 + t538
-    t540 = t537 - t538
-    t541 = casadi.if_else(casadi.logic_and((t537 >= -1.7453292519943295), (t537 <= 1.7453292519943295)), t537, casadi.if_else(casadi.logic_and((t539 >= -1.7453292519943295), (t539 <= 1.7453292519943295)), t539, casadi.if_else(casadi.logic_and((t540 >= -1.7453292519943295), (t540 <= 1.7453292519943295)), t540, t535)))
-    t542 = (t392 <= 4.642575810304916)
-    t543 = casadi.logic_and((t391 >= -4.642575810304916), (t391 <= 4.642575810304916))
-    t544 = casadi.if_else(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t132, t506), t507), t508), t509), t511), t513), casadi.logic_or(t524, t525)), casadi.logic_or(t533, t534)), casadi.logic_or(t542, t543)), 1, 0)
-    t545 = casadi.if_else(casadi.logic_and(t542, casadi.logic_not(t543)), t392, t391)
-    t546 = t545
-    t547 = t546 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn6 - 0.15915494309189535*t546)
-    t548 = casadi.if_else((qn6 > t547), 6.283185307179586, -6.283185307179586)
-    t549 = t547 + t548
-    t550 = t547 - t548
-    t551 = casadi.if_else(casadi.logic_and((t547 >= -4.642575810304916), (t547 <= 4.642575810304916)), t547, casadi.if_else(casadi.logic_and((t549 >= -4.642575810304916), (t549 <= 4.642575810304916)), t549, casadi.if_else(casadi.logic_and((t550 >= -4.642575810304916), (t550 <= 4.642575810304916)), t550, t545)))
-    t552 = t504 + qw4*(t497 + t532)**2 + qw5*(t498 + t541)**2 + qw6*(t499 + t551)**2
-    t553 = (t544 > 0)
-    t554 = casadi.if_else(casadi.logic_and(t553, casadi.logic_or((t523 > t552), (t515 < 1))), 1, 0)
-    t555 = casadi.if_else(t553, 1, t515)
-    t556 = (t554 > 0)
-    t557 = casadi.if_else(t556, t451, t517)
-    t558 = casadi.if_else(t556, t460, t518)
-    t559 = casadi.if_else(t556, t469, t519)
-    t560 = casadi.if_else(t556, t532, t520)
-    t561 = casadi.if_else(t556, t541, t521)
-    t562 = casadi.if_else(t556, t551, t522)
-    t563 = casadi.if_else(t556, t552, t523)
-    t564 = (t177 <= 3.9269908169872414)
-    t565 = casadi.logic_and((t176 >= -0.7853981633974483), (t176 <= 3.9269908169872414))
-    t566 = casadi.if_else(casadi.logic_and(t564, casadi.logic_not(t565)), t177, t176)
-    t567 = t566
-    t568 = t567 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t567)
-    t569 = casadi.if_else((qn2 > t568), 6.283185307179586, -6.283185307179586)
-    t570 = t568 + t569
-    t571 = t568 - t569
-    t572 = casadi.if_else(casadi.logic_and((t568 >= -0.7853981633974483), (t568 <= 3.9269908169872414)), t568, casadi.if_else(casadi.logic_and((t570 >= -0.7853981633974483), (t570 <= 3.9269908169872414)), t570, casadi.if_else(casadi.logic_and((t571 >= -0.7853981633974483), (t571 <= 3.9269908169872414)), t571, t566)))
-    t573 = (t78 <= 0.7853981633974483)
-    t574 = casadi.logic_and((t77 >= -3.9269908169872414), (t77 <= 0.7853981633974483))
-    t575 = casadi.if_else(casadi.logic_and(t573, casadi.logic_not(t574)), t78, t77)
-    t576 = t575
-    t577 = t576 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn3 - 0.15915494309189535*t576)
-    t578 = casadi.if_else((qn3 > t577), 6.283185307179586, -6.283185307179586)
-    t579 = t577 + t578
-    t580 = t577 - t578
-    t581 = casadi.if_else(casadi.logic_and((t577 >= -3.9269908169872414), (t577 <= 0.7853981633974483)), t577, casadi.if_else(casadi.logic_and((t579 >= -3.9269908169872414), (t579 <= 0.7853981633974483)), t579, casadi.if_else(casadi.logic_and((t580 >= -3.9269908169872414), (t580 <= 0.7853981633974483)), t580, t575)))
-    t582 = (t397 <= 2.9670597283903604)
-    t583 = casadi.logic_and((t396 >= -1.9198621771937625), (t396 <= 2.9670597283903604))
-    t584 = casadi.if_else(casadi.logic_and(t582, casadi.logic_not(t583)), t397, t396)
-    t585 = t584
-    t586 = t585 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t585)
-    t587 = casadi.if_else((qn4 > t586), 6.283185307179586, -6.283185307179586)
-    t588 = t586 + t587
-    t589 = t586 - t587
-    t590 = casadi.if_else(casadi.logic_and((t586 >= -1.9198621771937625), (t586 <= 2.9670597283903604)), t586, casadi.if_else(casadi.logic_and((t588 >= -1.9198621771937625), (t588 <= 2.9670597283903604)), t588, casadi.if_else(casadi.logic_and((t589 >= -1.9198621771937625), (t589 <= 2.9670597283903604)), t589, t584)))
-    t591 = (t402 <= 1.7453292519943295)
-    t592 = casadi.logic_and((t401 >= -1.7453292519943295), (t401 <= 1.7453292519943295))
-    t593 = casadi.if_else(casadi.logic_and(t591, casadi.logic_not(t592)), t402, t401)
-    t594 = t593
-    t595 = t594 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn5 - 0.15915494309189535*t594)
-    t596 = casadi.if_else((qn5 > t595), 6.283185307179586, -6.283185307179586)
-    t597 = t595 + t596
-    t598 = t595 - t596
-    t599 = casadi.if_else(casadi.logic_and((t595 >= -1.7453292519943295), (t595 <= 1.7453292519943295)), t595, casadi.if_else(casadi.logic_and((t597 >= -1.7453292519943295), (t597 <= 1.7453292519943295)), t597, casadi.if_else(casadi.logic_and((t598 >= -1.7453292519943295), (t598 <= 1.7453292519943295)), t598, t593)))
-    t600 = (t406 <= 4.642575810304916)
-    t601 = casadi.logic_and((t405 >= -4.642575810304916), (t405 <= 4.642575810304916))
-    t602 = casadi.if_else(casadi.logic_and(t600, casadi.logic_not(t601)), t406, t405)
-    t603 = t602
-    t604 = t603 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn6 - 0.15915494309189535*t603)
-    t605 = casadi.if_else((qn6 > t604), 6.283185307179586, -6.283185307179586)
-    t606 = t604 + t605
-    t607 = t604 - t605
-    t608 = casadi.if_else(casadi.logic_and((t604 >= -4.642575810304916), (t604 <= 4.642575810304916)), t604, casadi.if_else(casadi.logic_and((t606 >= -4.642575810304916), (t606 <= 4.642575810304916)), t606, casadi.if_else(casadi.logic_and((t607 >= -4.642575810304916), (t607 <= 4.642575810304916)), t607, t602)))
-    t609 = t501 + qw2*(t502 + t572)**2 + qw3*(t503 + t581)**2
-    t610 = t609 + qw4*(t497 + t590)**2 + qw5*(t498 + t599)**2 + qw6*(t499 + t608)**2
-    t611 = casadi.logic_or(t564, t565)
-    t612 = casadi.logic_or(t573, t574)
-    t613 = casadi.if_else(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t506, t507), t510), t513), t611), t612), t69), (t185 >= -1e-12)), casadi.logic_or(t582, t583)), casadi.logic_or(t591, t592)), casadi.logic_or(t600, t601)), 1, 0)
-    t614 = (t613 > 0)
-    t615 = casadi.if_else(casadi.logic_and(t614, casadi.logic_or((t563 > t610), (t555 < 1))), 1, 0)
-    t616 = casadi.if_else(t614, 1, t555)
-    t617 = (t615 > 0)
-    t618 = casadi.if_else(t617, t451, t557)
-    t619 = casadi.if_else(t617, t572, t558)
-    t620 = casadi.if_else(t617, t581, t559)
-    t621 = casadi.if_else(t617, t590, t560)
-    t622 = casadi.if_else(t617, t599, t561)
-    t623 = casadi.if_else(t617, t608, t562)
-    t624 = casadi.if_else(t617, t610, t563)
-    t625 = (t399 <= 2.9670597283903604)
-    t626 = casadi.logic_and((t398 >= -1.9198621771937625), (t398 <= 2.9670597283903604))
-    t627 = casadi.if_else(casadi.logic_and(t625, casadi.logic_not(t626)), t399, t398)
-    t628 = t627
-    t629 = t628 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t628)
-    t630 = casadi.if_else((qn4 > t629), 6.283185307179586, -6.283185307179586)
-    t631 = t629 + t630
-    t632 = t629 - t630
-    t633 = casadi.if_else(casadi.logic_and((t629 >= -1.9198621771937625), (t629 <= 2.9670597283903604)), t629, casadi.if_else(casadi.logic_and((t631 >= -1.9198621771937625), (t631 <= 2.9670597283903604)), t631, casadi.if_else(casadi.logic_and((t632 >= -1.9198621771937625), (t632 <= 2.9670597283903604)), t632, t627)))
-    t634 = (t410 >= -1.7453292519943295)
-    t635 = casadi.logic_and((t403 >= -1.7453292519943295), (t403 <= 1.7453292519943295))
-    t636 = casadi.if_else(casadi.logic_and(t634, casadi.logic_not(t635)), -t410, t409)
-    t637 = t636
-    t638 = t637 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn5 - 0.15915494309189535*t637)
-    t639 = casadi.if_else((qn5 > t638), 6.283185307179586, -6.283185307179586)
-    t640 = t638 + t639
-    t641 = t638 - t639
-    t642 = casadi.if_else(casadi.logic_and((t638 >= -1.7453292519943295), (t638 <= 1.7453292519943295)), t638, casadi.if_else(casadi.logic_and((t640 >= -1.7453292519943295), (t640 <= 1.7453292519943295)), t640, casadi.if_else(casadi.logic_and((t641 >= -1.7453292519943295), (t641 <= 1.7453292519943295)), t641, t636)))
-    t643 = (t408 <= 4.642575810304916)
-    t644 = casadi.logic_and((t407 >= -4.642575810304916), (t407 <= 4.642575810304916))
-    t645 = casadi.if_else(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t186, t506), t507), t510), t513), t611), t612), t69), casadi.logic_or(t625, t626)), casadi.logic_or(t634, t635)), casadi.logic_or(t643, t644)), 1, 0)
-    t646 = casadi.if_else(casadi.logic_and(t643, casadi.logic_not(t644)), t408, t407)
-    t647 = t646
-    t648 = t647 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn6 - 0.15915494309189535*t647)
-    t649 = casadi.if_else((qn6 > t648), 6.283185307179586, -6.283185307179586)
-    t650 = t648 + t649
-    t651 = t648 - t649
-    t652 = casadi.if_else(casadi.logic_and((t648 >= -4.642575810304916), (t648 <= 4.642575810304916)), t648, casadi.if_else(casadi.logic_and((t650 >= -4.642575810304916), (t650 <= 4.642575810304916)), t650, casadi.if_else(casadi.logic_and((t651 >= -4.642575810304916), (t651 <= 4.642575810304916)), t651, t646)))
-    t653 = t609 + qw4*(t497 + t633)**2 + qw5*(t498 + t642)**2 + qw6*(t499 + t652)**2
-    t654 = (t645 > 0)
-    t655 = casadi.if_else(casadi.logic_and(t654, casadi.logic_or((t624 > t653), (t616 < 1))), 1, 0)
-    t656 = casadi.if_else(t654, 1, t616)
-    t657 = (t655 > 0)
-    t658 = casadi.if_else(t657, t451, t618)
-    t659 = casadi.if_else(t657, t572, t619)
-    t660 = casadi.if_else(t657, t581, t620)
-    t661 = casadi.if_else(t657, t633, t621)
-    t662 = casadi.if_else(t657, t642, t622)
-    t663 = casadi.if_else(t657, t652, t623)
-    t664 = casadi.if_else(t657, t653, t624)
-    t665 = (t30 <= 2.792526803190927)
-    t666 = casadi.logic_and((t29 >= -2.792526803190927), (t29 <= 2.792526803190927))
-    t667 = casadi.if_else(casadi.logic_and(t665, casadi.logic_not(t666)), t30, t29)
-    t668 = t667
-    t669 = t668 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn1 - 0.15915494309189535*t668)
-    t670 = casadi.if_else((qn1 > t669), 6.283185307179586, -6.283185307179586)
-    t671 = t669 + t670
-    t672 = t669 - t670
-    t673 = casadi.if_else(casadi.logic_and((t669 >= -2.792526803190927), (t669 <= 2.792526803190927)), t669, casadi.if_else(casadi.logic_and((t671 >= -2.792526803190927), (t671 <= 2.792526803190927)), t671, casadi.if_else(casadi.logic_and((t672 >= -2.792526803190927), (t672 <= 2.792526803190927)), t672, t667)))
-    t674 = (t283 <= 3.9269908169872414)
-    t675 = casadi.logic_and((t282 >= -0.7853981633974483), (t282 <= 3.9269908169872414))
-    t676 = casadi.if_else(casadi.logic_and(t674, casadi.logic_not(t675)), t283, t282)
-    t677 = t676
-    t678 = t677 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t677)
-    t679 = casadi.if_else((qn2 > t678), 6.283185307179586, -6.283185307179586)
-    t680 = t678 + t679
-    t681 = t678 - t679
-    t682 = casadi.if_else(casadi.logic_and((t678 >= -0.7853981633974483), (t678 <= 3.9269908169872414)), t678, casadi.if_else(casadi.logic_and((t680 >= -0.7853981633974483), (t680 <= 3.9269908169872414)), t680, casadi.if_else(casadi.logic_and((t681 >= -0.7853981633974483), (t681 <= 3.9269908169872414)), t681, t676)))
-    t683 = (t236 <= 0.7853981633974483)
-    t684 = casadi.logic_and((t235 >= -3.9269908169872414), (t235 <= 0.7853981633974483))
-    t685 = casadi.if_else(casadi.logic_and(t683, casadi.logic_not(t684)), t236, t235)
-    t686 = t685
-    t687 = t686 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn3 - 0.15915494309189535*t686)
-    t688 = casadi.if_else((qn3 > t687), 6.283185307179586, -6.283185307179586)
-    t689 = t687 + t688
-    t690 = t687 - t688
-    t691 = casadi.if_else(casadi.logic_and((t687 >= -3.9269908169872414), (t687 <= 0.7853981633974483)), t687, casadi.if_else(casadi.logic_and((t689 >= -3.9269908169872414), (t689 <= 0.7853981633974483)), t689, casadi.if_else(casadi.logic_and((t690 >= -3.9269908169872414), (t690 <= 0.7853981633974483)), t690, t685)))
-    t692 = (t413 <= 2.9670597283903604)
-    t693 = casadi.logic_and((t412 >= -1.9198621771937625), (t412 <= 2.9670597283903604))
-    t694 = casadi.if_else(casadi.logic_and(t692, casadi.logic_not(t693)), t413, t412)
-    t695 = t694
-    t696 = t695 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t695)
-    t697 = casadi.if_else((qn4 > t696), 6.283185307179586, -6.283185307179586)
-    t698 = t696 + t697
-    t699 = t696 - t697
-    t700 = casadi.if_else(casadi.logic_and((t696 >= -1.9198621771937625), (t696 <= 2.9670597283903604)), t696, casadi.if_else(casadi.logic_and((t698 >= -1.9198621771937625), (t698 <= 2.9670597283903604)), t698, casadi.if_else(casadi.logic_and((t699 >= -1.9198621771937625), (t699 <= 2.9670597283903604)), t699, t694)))
-    t701 = (t418 <= 1.7453292519943295)
-    t702 = casadi.logic_and((t417 >= -1.7453292519943295), (t417 <= 1.7453292519943295))
-    t703 = casadi.if_else(casadi.logic_and(t701, casadi.logic_not(t702)), t418, t417)
-    t704 = t703
-    t705 = t704 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn5 - 0.15915494309189535*t704)
-    t706 = casadi.if_else((qn5 > t705), 6.283185307179586, -6.283185307179586)
-    t707 = t705 + t706
-    t708 = t705 - t706
-    t709 = casadi.if_else(casadi.logic_and((t705 >= -1.7453292519943295), (t705 <= 1.7453292519943295)), t705, casadi.if_else(casadi.logic_and((t707 >= -1.7453292519943295), (t707 <= 1.7453292519943295)), t707, casadi.if_else(casadi.logic_and((t708 >= -1.7453292519943295), (t708 <= 1.7453292519943295)), t708, t703)))
-    t710 = (t422 <= 4.642575810304916)
-    t711 = casadi.logic_and((t421 >= -4.642575810304916), (t421 <= 4.642575810304916))
-    t712 = casadi.if_else(casadi.logic_and(t710, casadi.logic_not(t711)), t422, t421)
-    t713 = t712
-    t714 = t713 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn6 - 0.15915494309189535*t713)
-    t715 = casadi.if_else((qn6 > t714), 6.283185307179586, -6.283185307179586)
-    t716 = t714 + t715
-    t717 = t714 - t715
-    t718 = casadi.if_else(casadi.logic_and((t714 >= -4.642575810304916), (t714 <= 4.642575810304916)), t714, casadi.if_else(casadi.logic_and((t716 >= -4.642575810304916), (t716 <= 4.642575810304916)), t716, casadi.if_else(casadi.logic_and((t717 >= -4.642575810304916), (t717 <= 4.642575810304916)), t717, t712)))
-    t719 = qw1*(t500 + t673)**2
-    t720 = t719 + qw2*(t502 + t682)**2 + qw3*(t503 + t691)**2
-    t721 = t720 + qw4*(t497 + t700)**2 + qw5*(t498 + t709)**2 + qw6*(t499 + t718)**2
-    t722 = casadi.logic_or(t665, t666)
-    t723 = casadi.logic_or(t674, t675)
-    t724 = casadi.logic_or(t683, t684)
-    t725 = casadi.logic_or(casadi.logic_and(t63, (1e-12 >= 25.615508834817042*t226)), casadi.logic_and(t510, (1e-12 >= -t227)))
-    t726 = casadi.if_else(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t21, t506), t512), t722), t723), t724), t725), (t291 >= -1e-12)), casadi.logic_or(t692, t693)), casadi.logic_or(t701, t702)), casadi.logic_or(t710, t711)), 1, 0)
-    t727 = (t726 > 0)
-    t728 = casadi.if_else(casadi.logic_and(t727, casadi.logic_or((t664 > t721), (t656 < 1))), 1, 0)
-    t729 = casadi.if_else(t727, 1, t656)
-    t730 = (t728 > 0)
-    t731 = casadi.if_else(t730, t673, t658)
-    t732 = casadi.if_else(t730, t682, t659)
-    t733 = casadi.if_else(t730, t691, t660)
-    t734 = casadi.if_else(t730, t700, t661)
-    t735 = casadi.if_else(t730, t709, t662)
-    t736 = casadi.if_else(t730, t718, t663)
-    t737 = casadi.if_else(t730, t721, t664)
-    t738 = (t415 <= 2.9670597283903604)
-    t739 = casadi.logic_and((t414 >= -1.9198621771937625), (t414 <= 2.9670597283903604))
-    t740 = casadi.if_else(casadi.logic_and(t738, casadi.logic_not(t739)), t415, t414)
-    t741 = t740
-    t742 = t741 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t741)
-    t743 = casadi.if_else((qn4 > t742), 6.283185307179586, -6.283185307179586)
-    t744 = t742 + t743
-    t745 = t742 - t743
-    t746 = casadi.if_else(casadi.logic_and((t742 >= -1.9198621771937625), (t742 <= 2.9670597283903604)), t742, casadi.if_else(casadi.logic_and((t744 >= -1.9198621771937625), (t744 <= 2.9670597283903604)), t744, casadi.if_else(casadi.logic_and((t745 >= -1.9198621771937625), (t745 <= 2.9670597283903604)), t745, t740)))
-    t747 = (t426 >= -1.7453292519943295)
-    t748 = casadi.logic_and((t419 >= -1.7453292519943295), (t419 <= 1.7453292519943295))
-    t749 = casadi.if_else(casadi.logic_and(t747, casadi.logic_not(t748)), -t426, t425)
-    t750 = t749
-    t751 = t750 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn5 - 0.15915494309189535*t750)
-    t752 = casadi.if_else((qn5 > t751), 6.283185307179586, -6.283185307179586)
-    t753 = t751 + t752
-    t754 = t751 - t752
-    t755 = casadi.if_else(casadi.logic_and((t751 >= -1.7453292519943295), (t751 <= 1.7453292519943295)), t751, casadi.if_else(casadi.logic_and((t753 >= -1.7453292519943295), (t753 <= 1.7453292519943295)), t753, casadi.if_else(casadi.logic_and((t754 >= -1.7453292519943295), (t754 <= 1.7453292519943295)), t754, t749)))
-    t756 = (t424 <= 4.642575810304916)
-    t757 = casadi.logic_and((t423 >= -4.642575810304916), (t423 <= 4.642575810304916))
-    t758 = casadi.if_else(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t21, t292), t506), t512), t722), t723), t724), t725), casadi.logic_or(t738, t739)), casadi.logic_or(t747, t748)), casadi.logic_or(t756, t757)), 1, 0)
-    t759 = casadi.if_else(casadi.logic_and(t756, casadi.logic_not(t757)), t424, t423)
-    t760 = t759
-    t761 = t760 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn6 - 0.15915494309189535*t760)
-    t762 = casadi.if_else((qn6 > t761), 6.283185307179586, -6.283185307179586)
-    t763 = t761 + t762
-    t764 = t761 - t762
-    t765 = casadi.if_else(casadi.logic_and((t761 >= -4.642575810304916), (t761 <= 4.642575810304916)), t761, casadi.if_else(casadi.logic_and((t763 >= -4.642575810304916), (t763 <= 4.642575810304916)), t763, casadi.if_else(casadi.logic_and((t764 >= -4.642575810304916), (t764 <= 4.642575810304916)), t764, t759)))
-    t766 = t720 + qw4*(t497 + t746)**2 + qw5*(t498 + t755)**2 + qw6*(t499 + t765)**2
-    t767 = (t758 > 0)
-    t768 = casadi.if_else(casadi.logic_and(t767, casadi.logic_or((t737 > t766), (t729 < 1))), 1, 0)
-    t769 = casadi.if_else(t767, 1, t729)
-    t770 = (t768 > 0)
-    t771 = casadi.if_else(t770, t673, t731)
-    t772 = casadi.if_else(t770, t682, t732)
-    t773 = casadi.if_else(t770, t691, t733)
-    t774 = casadi.if_else(t770, t746, t734)
-    t775 = casadi.if_else(t770, t755, t735)
-    t776 = casadi.if_else(t770, t765, t736)
-    t777 = casadi.if_else(t770, t766, t737)
-    t778 = (t337 <= 3.9269908169872414)
-    t779 = casadi.logic_and((t336 >= -0.7853981633974483), (t336 <= 3.9269908169872414))
-    t780 = casadi.if_else(casadi.logic_and(t778, casadi.logic_not(t779)), t337, t336)
-    t781 = t780
-    t782 = t781 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t781)
-    t783 = casadi.if_else((qn2 > t782), 6.283185307179586, -6.283185307179586)
-    t784 = t782 + t783
-    t785 = t782 - t783
-    t786 = casadi.if_else(casadi.logic_and((t782 >= -0.7853981633974483), (t782 <= 3.9269908169872414)), t782, casadi.if_else(casadi.logic_and((t784 >= -0.7853981633974483), (t784 <= 3.9269908169872414)), t784, casadi.if_else(casadi.logic_and((t785 >= -0.7853981633974483), (t785 <= 3.9269908169872414)), t785, t780)))
-    t787 = (t238 <= 0.7853981633974483)
-    t788 = casadi.logic_and((t237 >= -3.9269908169872414), (t237 <= 0.7853981633974483))
-    t789 = casadi.if_else(casadi.logic_and(t787, casadi.logic_not(t788)), t238, t237)
-    t790 = t789
-    t791 = t790 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn3 - 0.15915494309189535*t790)
-    t792 = casadi.if_else((qn3 > t791), 6.283185307179586, -6.283185307179586)
-    t793 = t791 + t792
-    t794 = t791 - t792
-    t795 = casadi.if_else(casadi.logic_and((t791 >= -3.9269908169872414), (t791 <= 0.7853981633974483)), t791, casadi.if_else(casadi.logic_and((t793 >= -3.9269908169872414), (t793 <= 0.7853981633974483)), t793, casadi.if_else(casadi.logic_and((t794 >= -3.9269908169872414), (t794 <= 0.7853981633974483)), t794, t789)))
-    t796 = (t429 <= 2.9670597283903604)
-    t797 = casadi.logic_and((t428 >= -1.9198621771937625), (t428 <= 2.9670597283903604))
-    t798 = casadi.if_else(casadi.logic_and(t796, casadi.logic_not(t797)), t429, t428)
-    t799 = t798
-    t800 = t799 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t799)
-    t801 = casadi.if_else((qn4 > t800), 6.283185307179586, -6.283185307179586)
-    t802 = t800 + t801
-    t803 = t800 - t801
-    t804 = casadi.if_else(casadi.logic_and((t800 >= -1.9198621771937625), (t800 <= 2.9670597283903604)), t800, casadi.if_else(casadi.logic_and((t802 >= -1.9198621771937625), (t802 <= 2.9670597283903604)), t802, casadi.if_else(casadi.logic_and((t803 >= -1.9198621771937625), (t803 <= 2.9670597283903604)), t803, t798)))
-    t805 = (t434 <= 1.7453292519943295)
-    t806 = casadi.logic_and((t433 >= -1.7453292519943295), (t433 <= 1.7453292519943295))
-    t807 = casadi.if_else(casadi.logic_and(t805, casadi.logic_not(t806)), t434, t433)
-    t808 = t807
-    t809 = t808 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn5 - 0.15915494309189535*t808)
-    t810 = casadi.if_else((qn5 > t809), 6.283185307179586, -6.283185307179586)
-    t811 = t809 + t810
-    t812 = t809 - t810
-    t813 = casadi.if_else(casadi.logic_and((t809 >= -1.7453292519943295), (t809 <= 1.7453292519943295)), t809, casadi.if_else(casadi.logic_and((t811 >= -1.7453292519943295), (t811 <= 1.7453292519943295)), t811, casadi.if_else(casadi.logic_and((t812 >= -1.7453292519943295), (t812 <= 1.7453292519943295)), t812, t807)))
-    t814 = (t438 <= 4.642575810304916)
-    t815 = casadi.logic_and((t437 >= -4.642575810304916), (t437 <= 4.642575810304916))
-    t816 = casadi.if_else(casadi.logic_and(t814, casadi.logic_not(t815)), t438, t437)
-    t817 = t816
-    t818 = t817 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn6 - 0.15915494309189535*t817)
-    t819 = casadi.if_else((qn6 > t818), 6.283185307179586, -6.283185307179586)
-    t820 = t818 + t819
-    t821 = t818 - t819
-    t822 = casadi.if_else(casadi.logic_and((t818 >= -4.642575810304916), (t818 <= 4.642575810304916)), t818, casadi.if_else(casadi.logic_and((t820 >= -4.642575810304916), (t820 <= 4.642575810304916)), t820, casadi.if_else(casadi.logic_and((t821 >= -4.642575810304916), (t821 <= 4.642575810304916)), t821, t816)))
-    t823 = t719 + qw2*(t502 + t786)**2 + qw3*(t503 + t795)**2
-    t824 = t823 + qw4*(t497 + t804)**2 + qw5*(t498 + t813)**2 + qw6*(t499 + t822)**2
-    t825 = casadi.logic_or(t778, t779)
-    t826 = casadi.logic_or(t787, t788)
-    t827 = casadi.if_else(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t21, t229), t506), t510), t512), t722), t825), t826), (t345 >= -1e-12)), casadi.logic_or(t796, t797)), casadi.logic_or(t805, t806)), casadi.logic_or(t814, t815)), 1, 0)
-    t828 = (t827 > 0)
-    t829 = casadi.if_else(casadi.logic_and(t828, casadi.logic_or((t777 > t824), (t769 < 1))), 1, 0)
-    t830 = casadi.if_else(t828, 1, t769)
-    t831 = (t829 > 0)
-    t832 = casadi.if_else(t831, t673, t771)
-    t833 = casadi.if_else(t831, t786, t772)
-    t834 = casadi.if_else(t831, t795, t773)
-    t835 = casadi.if_else(t831, t804, t774)
-    t836 = casadi.if_else(t831, t813, t775)
-    t837 = casadi.if_else(t831, t822, t776)
-    t838 = casadi.if_else(t831, t824, t777)
-    t839 = (t431 <= 2.9670597283903604)
-    t840 = casadi.logic_and((t430 >= -1.9198621771937625), (t430 <= 2.9670597283903604))
-    t841 = casadi.if_else(casadi.logic_and(t839, casadi.logic_not(t840)), t431, t430)
-    t842 = t841
-    t843 = t842 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t842)
-    t844 = casadi.if_else((qn4 > t843), 6.283185307179586, -6.283185307179586)
-    t845 = t843 + t844
-    t846 = t843 - t844
-    t847 = casadi.if_else(casadi.logic_and((t843 >= -1.9198621771937625), (t843 <= 2.9670597283903604)), t843, casadi.if_else(casadi.logic_and((t845 >= -1.9198621771937625), (t845 <= 2.9670597283903604)), t845, casadi.if_else(casadi.logic_and((t846 >= -1.9198621771937625), (t846 <= 2.9670597283903604)), t846, t841)))
-    t848 = (t442 >= -1.7453292519943295)
-    t849 = casadi.logic_and((t435 >= -1.7453292519943295), (t435 <= 1.7453292519943295))
-    t850 = casadi.if_else(casadi.logic_and(t848, casadi.logic_not(t849)), -t442, t441)
-    t851 = t850
-    t852 = t851 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn5 - 0.15915494309189535*t851)
-    t853 = casadi.if_else((qn5 > t852), 6.283185307179586, -6.283185307179586)
-    t854 = t852 + t853
-    t855 = t852 - t853
-    t856 = casadi.if_else(casadi.logic_and((t852 >= -1.7453292519943295), (t852 <= 1.7453292519943295)), t852, casadi.if_else(casadi.logic_and((t854 >= -1.7453292519943295), (t854 <= 1.7453292519943295)), t854, casadi.if_else(casadi.logic_and((t855 >= -1.7453292519943295), (t855 <= 1.7453292519943295)), t855, t850)))
-    t857 = (t440 <= 4.642575810304916)
-    t858 = casadi.logic_and((t439 >= -4.642575810304916), (t439 <= 4.642575810304916))
-    t859 = casadi.if_else(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t21, t229), t346), t506), t510), t512), t722), t825), t826), casadi.logic_or(t839, t840)), casadi.logic_or(t848, t849)), casadi.logic_or(t857, t858)), 1, 0)
-    t860 = casadi.if_else(casadi.logic_and(t857, casadi.logic_not(t858)), t440, t439)
-    t861 = t860
-    t862 = t861 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn6 - 0.15915494309189535*t861)
-    t863 = casadi.if_else((qn6 > t862), 6.283185307179586, -6.283185307179586)
-    t864 = t862 + t863
-    t865 = t862 - t863
-    t866 = casadi.if_else(casadi.logic_and((t862 >= -4.642575810304916), (t862 <= 4.642575810304916)), t862, casadi.if_else(casadi.logic_and((t864 >= -4.642575810304916), (t864 <= 4.642575810304916)), t864, casadi.if_else(casadi.logic_and((t865 >= -4.642575810304916), (t865 <= 4.642575810304916)), t865, t860)))
-    t867 = t823 + qw4*(t497 + t847)**2 + qw5*(t498 + t856)**2 + qw6*(t499 + t866)**2
-    t868 = (t859 > 0)
-    t869 = casadi.if_else(casadi.logic_and(t868, casadi.logic_or((t838 > t867), (t830 < 1))), 1, 0)
-    t870 = casadi.if_else(t868, 1, t830)
-    t871 = (t869 > 0)
-    t872 = casadi.if_else(t871, t673, t832)
-    t873 = casadi.if_else(t871, t786, t833)
-    t874 = casadi.if_else(t871, t795, t834)
-    t875 = casadi.if_else(t871, t847, t835)
-    t876 = casadi.if_else(t871, t856, t836)
-    t877 = casadi.if_else(t871, t866, t837)
-    t878 = (casadi.fabs(t378) < casadi.inf)
-    t879 = (t870 > 0)
-    t880 = casadi.logic_and(t878, t879)
+    t434 = t433 - 6.283185307179586*casadi.floor(0.7388888888888888 + 0.15915494309189535*t433)
+    t435 = 3.141592653589793 + t432 - 6.283185307179586*casadi.ceil(0.15915494309189535*t432)
+    t436 = t435 - 6.283185307179586*casadi.floor(0.7388888888888888 + 0.15915494309189535*t435)
+    t437 = -t431
+    t438 = t431 + 6.283185307179586*casadi.floor(0.2777777777777778 + 0.15915494309189535*t437)
+    t439 = (t27 <= 2.792526803190927)
+    t440 = casadi.logic_and((t26 >= -2.792526803190927), (t26 <= 2.792526803190927))
+    t441 = casadi.if_else(casadi.logic_and(t439, casadi.logic_not(t440)), t27, t26)
+    t442 = t441
+    t443 = t442 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn1 - 0.15915494309189535*t442)
+    t444 = casadi.if_else((qn1 > t443), 6.283185307179586, -6.283185307179586)
+    t445 = t443 + t444
+    t446 = t443 - t444
+    t447 = casadi.if_else(casadi.logic_and((t443 >= -2.792526803190927), (t443 <= 2.792526803190927)), t443, casadi.if_else(casadi.logic_and((t445 >= -2.792526803190927), (t445 <= 2.792526803190927)), t445, casadi.if_else(casadi.logic_and((t446 >= -2.792526803190927), (t446 <= 2.792526803190927)), t446, t441)))
+    t448 = (t119 <= 3.9269908169872414)
+    t449 = casadi.logic_and((t118 >= -0.7853981633974483), (t118 <= 3.9269908169872414))
+    t450 = casadi.if_else(casadi.logic_and(t448, casadi.logic_not(t449)), t119, t118)
+    t451 = t450
+    t452 = t451 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t451)
+    t453 = casadi.if_else((qn2 > t452), 6.283185307179586, -6.283185307179586)
+    t454 = t452 + t453
+    t455 = t452 - t453
+    t456 = casadi.if_else(casadi.logic_and((t452 >= -0.7853981633974483), (t452 <= 3.9269908169872414)), t452, casadi.if_else(casadi.logic_and((t454 >= -0.7853981633974483), (t454 <= 3.9269908169872414)), t454, casadi.if_else(casadi.logic_and((t455 >= -0.7853981633974483), (t455 <= 3.9269908169872414)), t455, t450)))
+    t457 = (t72 <= 0.7853981633974483)
+    t458 = casadi.logic_and((t71 >= -3.9269908169872414), (t71 <= 0.7853981633974483))
+    t459 = casadi.if_else(casadi.logic_and(t457, casadi.logic_not(t458)), t72, t71)
+    t460 = t459
+    t461 = t460 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn3 - 0.15915494309189535*t460)
+    t462 = casadi.if_else((qn3 > t461), 6.283185307179586, -6.283185307179586)
+    t463 = t461 + t462
+    t464 = t461 - t462
+    t465 = casadi.if_else(casadi.logic_and((t461 >= -3.9269908169872414), (t461 <= 0.7853981633974483)), t461, casadi.if_else(casadi.logic_and((t463 >= -3.9269908169872414), (t463 <= 0.7853981633974483)), t463, casadi.if_else(casadi.logic_and((t464 >= -3.9269908169872414), (t464 <= 0.7853981633974483)), t464, t459)))
+    t466 = (t377 <= 2.9670597283903604)
+    t467 = casadi.logic_and((t376 >= -1.9198621771937625), (t376 <= 2.9670597283903604))
+    t468 = casadi.if_else(casadi.logic_and(t466, casadi.logic_not(t467)), t377, t376)
+    t469 = t468
+    t470 = t469 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t469)
+    t471 = casadi.if_else((qn4 > t470), 6.283185307179586, -6.283185307179586)
+    t472 = t470 + t471
+    t473 = t470 - t471
+    t474 = casadi.if_else(casadi.logic_and((t470 >= -1.9198621771937625), (t470 <= 2.9670597283903604)), t470, casadi.if_else(casadi.logic_and((t472 >= -1.9198621771937625), (t472 <= 2.9670597283903604)), t472, casadi.if_else(casadi.logic_and((t473 >= -1.9198621771937625), (t473 <= 2.9670597283903604)), t473, t468)))
+    t475 = (t382 <= 1.7453292519943295)
+    t476 = casadi.logic_and((t381 >= -1.7453292519943295), (t381 <= 1.7453292519943295))
+    t477 = casadi.if_else(casadi.logic_and(t475, casadi.logic_not(t476)), t382, t381)
+    t478 = t477
+    t479 = t478 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn5 - 0.15915494309189535*t478)
+    t480 = casadi.if_else((qn5 > t479), 6.283185307179586, -6.283185307179586)
+    t481 = t479 + t480
+    t482 = t479 - t480
+    t483 = casadi.if_else(casadi.logic_and((t479 >= -1.7453292519943295), (t479 <= 1.7453292519943295)), t479, casadi.if_else(casadi.logic_and((t481 >= -1.7453292519943295), (t481 <= 1.7453292519943295)), t481, casadi.if_else(casadi.logic_and((t482 >= -1.7453292519943295), (t482 <= 1.7453292519943295)), t482, t477)))
+    t484 = (t386 <= 4.642575810304916)
+    t485 = casadi.logic_and((t385 >= -4.642575810304916), (t385 <= 4.642575810304916))
+    t486 = casadi.if_else(casadi.logic_and(t484, casadi.logic_not(t485)), t386, t385)
+    t487 = t486
+    t488 = t487 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn6 - 0.15915494309189535*t487)
+    t489 = casadi.if_else((qn6 > t488), 6.283185307179586, -6.283185307179586)
+    t490 = t488 + t489
+    t491 = t488 - t489
+    t492 = casadi.if_else(casadi.logic_and((t488 >= -4.642575810304916), (t488 <= 4.642575810304916)), t488, casadi.if_else(casadi.logic_and((t490 >= -4.642575810304916), (t490 <= 4.642575810304916)), t490, casadi.if_else(casadi.logic_and((t491 >= -4.642575810304916), (t491 <= 4.642575810304916)), t491, t486)))
+    t493 = -qn4
+    t494 = -qn5
+    t495 = -qn6
+    t496 = -qn1
+    t497 = qw1*(t447 + t496)**2
+    t498 = -qn2
+    t499 = -qn3
+    t500 = t497 + qw2*(t456 + t498)**2 + qw3*(t465 + t499)**2
+    t501 = t500 + qw4*(t474 + t493)**2 + qw5*(t483 + t494)**2 + qw6*(t492 + t495)**2
+    t502 = (casadi.fabs(t373) < casadi.inf)
+    t503 = casadi.logic_or(t439, t440)
+    t504 = casadi.logic_or(t448, t449)
+    t505 = casadi.logic_or(t457, t458)
+    t506 = (1e-12 >= -t63)
+    t507 = (t14 > t16)
+    t508 = casadi.logic_or(casadi.logic_and(t17, (1e-12*t15 >= 0.0225150025)), casadi.logic_and(t507, (1e-12 >= -t19)))
+    t509 = casadi.if_else(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t502, t503), t504), t505), t506), t508), (t127 >= -1e-12)), casadi.logic_or(t466, t467)), casadi.logic_or(t475, t476)), casadi.logic_or(t484, t485)), 1, 0)
+    t510 = casadi.if_else((t509 > 0), 1, 0)
+    t511 = (t510 > 0)
+    t512 = casadi.if_else(t511, t447, qn1)
+    t513 = casadi.if_else(t511, t456, qn2)
+    t514 = casadi.if_else(t511, t465, qn3)
+    t515 = casadi.if_else(t511, t474, qn4)
+    t516 = casadi.if_else(t511, t483, qn5)
+    t517 = casadi.if_else(t511, t492, qn6)
+    t518 = casadi.if_else(t511, t501, 0)
+    t519 = (t379 <= 2.9670597283903604)
+    t520 = casadi.logic_and((t378 >= -1.9198621771937625), (t378 <= 2.9670597283903604))
+    t521 = casadi.if_else(casadi.logic_and(t519, casadi.logic_not(t520)), t379, t378)
+    t522 = t521
+    t523 = t522 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t522)
+    t524 = casadi.if_else((qn4 > t523), 6.283185307179586, -6.283185307179586)
+    t525 = t523 + t524
+    t526 = t523 - t524
+    t527 = casadi.if_else(casadi.logic_and((t523 >= -1.9198621771937625), (t523 <= 2.9670597283903604)), t523, casadi.if_else(casadi.logic_and((t525 >= -1.9198621771937625), (t525 <= 2.9670597283903604)), t525, casadi.if_else(casadi.logic_and((t526 >= -1.9198621771937625), (t526 <= 2.9670597283903604)), t526, t521)))
+    t528 = (t390 >= -1.7453292519943295)
+    t529 = casadi.logic_and((t383 >= -1.7453292519943295), (t383 <= 1.7453292519943295))
+    t530 = casadi.if_else(casadi.logic_and(t528, casadi.logic_not(t529)), -t390, t389)
+    t531 = t530
+    t532 = t531 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn5 - 0.15915494309189535*t531)
+    t533 = casadi.if_else((qn5 > t532), 6.283185307179586, -6.283185307179586)
+    t534 = t532 + t533
+    t535 = t532 - t533
+    t536 = casadi.if_else(casadi.logic_and((t532 >= -1.7453292519943295), (t532 <= 1.7453292519943295)), t532, casadi.if_else(casadi.logic_and((t534 >= -1.7453292519943295), (t534 <= 1.7453292519943295)), t534, casadi.if_else(casadi.logic_and((t535 >= -1.7453292519943295), (t535 <= 1.7453292519943295)), t535, t530)))
+    t537 = (t388 <= 4.642575810304916)
+    t538 = casadi.logic_and((t387 >= -4.642575810304916), (t387 <= 4.642575810304916))
+    t539 = casadi.if_else(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t128, t502), t503), t504), t505), t506), t508), casadi.logic_or(t519, t520)), casadi.logic_or(t528, t529)), casadi.logic_or(t537, t538)), 1, 0)
+    t540 = casadi.if_else(casadi.logic_and(t537, casadi.logic_not(t538)), t388, t387)
+    t541 = t540
+    t542 = t541 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn6 - 0.15915494309189535*t541)
+    t543 = casadi.if_else((qn6 > t542), 6.283185307179586, -6.283185307179586)
+    t544 = t542 + t543
+    t545 = t542 - t543
+    t546 = casadi.if_else(casadi.logic_and((t542 >= -4.642575810304916), (t542 <= 4.642575810304916)), t542, casadi.if_else(casadi.logic_and((t544 >= -4.642575810304916), (t544 <= 4.642575810304916)), t544, casadi.if_else(casadi.logic_and((t545 >= -4.642575810304916), (t545 <= 4.642575810304916)), t545, t540)))
+    t547 = t500 + qw4*(t493 + t527)**2 + qw5*(t494 + t536)**2 + qw6*(t495 + t546)**2
+    t548 = (t539 > 0)
+    t549 = casadi.if_else(casadi.logic_and(t548, casadi.logic_or((t518 > t547), (t510 < 1))), 1, 0)
+    t550 = casadi.if_else(t548, 1, t510)
+    t551 = (t549 > 0)
+    t552 = casadi.if_else(t551, t447, t512)
+    t553 = casadi.if_else(t551, t456, t513)
+    t554 = casadi.if_else(t551, t465, t514)
+    t555 = casadi.if_else(t551, t527, t515)
+    t556 = casadi.if_else(t551, t536, t516)
+    t557 = casadi.if_else(t551, t546, t517)
+    t558 = casadi.if_else(t551, t547, t518)
+    t559 = (t173 <= 3.9269908169872414)
+    t560 = casadi.logic_and((t172 >= -0.7853981633974483), (t172 <= 3.9269908169872414))
+    t561 = casadi.if_else(casadi.logic_and(t559, casadi.logic_not(t560)), t173, t172)
+    t562 = t561
+    t563 = t562 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t562)
+    t564 = casadi.if_else((qn2 > t563), 6.283185307179586, -6.283185307179586)
+    t565 = t563 + t564
+    t566 = t563 - t564
+    t567 = casadi.if_else(casadi.logic_and((t563 >= -0.7853981633974483), (t563 <= 3.9269908169872414)), t563, casadi.if_else(casadi.logic_and((t565 >= -0.7853981633974483), (t565 <= 3.9269908169872414)), t565, casadi.if_else(casadi.logic_and((t566 >= -0.7853981633974483), (t566 <= 3.9269908169872414)), t566, t561)))
+    t568 = (t74 <= 0.7853981633974483)
+    t569 = casadi.logic_and((t73 >= -3.9269908169872414), (t73 <= 0.7853981633974483))
+    t570 = casadi.if_else(casadi.logic_and(t568, casadi.logic_not(t569)), t74, t73)
+    t571 = t570
+    t572 = t571 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn3 - 0.15915494309189535*t571)
+    t573 = casadi.if_else((qn3 > t572), 6.283185307179586, -6.283185307179586)
+    t574 = t572 + t573
+    t575 = t572 - t573
+    t576 = casadi.if_else(casadi.logic_and((t572 >= -3.9269908169872414), (t572 <= 0.7853981633974483)), t572, casadi.if_else(casadi.logic_and((t574 >= -3.9269908169872414), (t574 <= 0.7853981633974483)), t574, casadi.if_else(casadi.logic_and((t575 >= -3.9269908169872414), (t575 <= 0.7853981633974483)), t575, t570)))
+    t577 = (t393 <= 2.9670597283903604)
+    t578 = casadi.logic_and((t392 >= -1.9198621771937625), (t392 <= 2.9670597283903604))
+    t579 = casadi.if_else(casadi.logic_and(t577, casadi.logic_not(t578)), t393, t392)
+    t580 = t579
+    t581 = t580 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t580)
+    t582 = casadi.if_else((qn4 > t581), 6.283185307179586, -6.283185307179586)
+    t583 = t581 + t582
+    t584 = t581 - t582
+    t585 = casadi.if_else(casadi.logic_and((t581 >= -1.9198621771937625), (t581 <= 2.9670597283903604)), t581, casadi.if_else(casadi.logic_and((t583 >= -1.9198621771937625), (t583 <= 2.9670597283903604)), t583, casadi.if_else(casadi.logic_and((t584 >= -1.9198621771937625), (t584 <= 2.9670597283903604)), t584, t579)))
+    t586 = (t398 <= 1.7453292519943295)
+    t587 = casadi.logic_and((t397 >= -1.7453292519943295), (t397 <= 1.7453292519943295))
+    t588 = casadi.if_else(casadi.logic_and(t586, casadi.logic_not(t587)), t398, t397)
+    t589 = t588
+    t590 = t589 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn5 - 0.15915494309189535*t589)
+    t591 = casadi.if_else((qn5 > t590), 6.283185307179586, -6.283185307179586)
+    t592 = t590 + t591
+    t593 = t590 - t591
+    t594 = casadi.if_else(casadi.logic_and((t590 >= -1.7453292519943295), (t590 <= 1.7453292519943295)), t590, casadi.if_else(casadi.logic_and((t592 >= -1.7453292519943295), (t592 <= 1.7453292519943295)), t592, casadi.if_else(casadi.logic_and((t593 >= -1.7453292519943295), (t593 <= 1.7453292519943295)), t593, t588)))
+    t595 = (t402 <= 4.642575810304916)
+    t596 = casadi.logic_and((t401 >= -4.642575810304916), (t401 <= 4.642575810304916))
+    t597 = casadi.if_else(casadi.logic_and(t595, casadi.logic_not(t596)), t402, t401)
+    t598 = t597
+    t599 = t598 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn6 - 0.15915494309189535*t598)
+    t600 = casadi.if_else((qn6 > t599), 6.283185307179586, -6.283185307179586)
+    t601 = t599 + t600
+    t602 = t599 - t600
+    t603 = casadi.if_else(casadi.logic_and((t599 >= -4.642575810304916), (t599 <= 4.642575810304916)), t599, casadi.if_else(casadi.logic_and((t601 >= -4.642575810304916), (t601 <= 4.642575810304916)), t601, casadi.if_else(casadi.logic_and((t602 >= -4.642575810304916), (t602 <= 4.642575810304916)), t602, t597)))
+    t604 = t497 + qw2*(t498 + t567)**2 + qw3*(t499 + t576)**2
+    t605 = t604 + qw4*(t493 + t585)**2 + qw5*(t494 + t594)**2 + qw6*(t495 + t603)**2
+    t606 = casadi.logic_or(t559, t560)
+    t607 = casadi.logic_or(t568, t569)
+    t608 = casadi.if_else(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t502, t503), t508), t606), t607), t65), (t181 >= -1e-12)), casadi.logic_or(t577, t578)), casadi.logic_or(t586, t587)), casadi.logic_or(t595, t596)), 1, 0)
+    t609 = (t608 > 0)
+    t610 = casadi.if_else(casadi.logic_and(t609, casadi.logic_or((t558 > t605), (t550 < 1))), 1, 0)
+    t611 = casadi.if_else(t609, 1, t550)
+    t612 = (t610 > 0)
+    t613 = casadi.if_else(t612, t447, t552)
+    t614 = casadi.if_else(t612, t567, t553)
+    t615 = casadi.if_else(t612, t576, t554)
+    t616 = casadi.if_else(t612, t585, t555)
+    t617 = casadi.if_else(t612, t594, t556)
+    t618 = casadi.if_else(t612, t603, t557)
+    t619 = casadi.if_else(t612, t605, t558)
+    t620 = (t395 <= 2.9670597283903604)
+    t621 = casadi.logic_and((t394 >= -1.9198621771937625), (t394 <= 2.9670597283903604))
+    t622 = casadi.if_else(casadi.logic_and(t620, casadi.logic_not(t621)), t395, t394)
+    t623 = t622
+    t624 = t623 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t623)
+    t625 = casadi.if_else((qn4 > t624), 6.283185307179586, -6.283185307179586)
+    t626 = t624 + t625
+    t627 = t624 - t625
+    t628 = casadi.if_else(casadi.logic_and((t624 >= -1.9198621771937625), (t624 <= 2.9670597283903604)), t624, casadi.if_else(casadi.logic_and((t626 >= -1.9198621771937625), (t626 <= 2.9670597283903604)), t626, casadi.if_else(casadi.logic_and((t627 >= -1.9198621771937625), (t627 <= 2.9670597283903604)), t627, t622)))
+    t629 = (t406 >= -1.7453292519943295)
+    t630 = casadi.logic_and((t399 >= -1.7453292519943295), (t399 <= 1.7453292519943295))
+    t631 = casadi.if_else(casadi.logic_and(t629, casadi.logic_not(t630)), -t406, t405)
+    t632 = t631
+    t633 = t632 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn5 - 0.15915494309189535*t632)
+    t634 = casadi.if_else((qn5 > t633), 6.283185307179586, -6.283185307179586)
+    t635 = t633 + t634
+    t636 = t633 - t634
+    t637 = casadi.if_else(casadi.logic_and((t633 >= -1.7453292519943295), (t633 <= 1.7453292519943295)), t633, casadi.if_else(casadi.logic_and((t635 >= -1.7453292519943295), (t635 <= 1.7453292519943295)), t635, casadi.if_else(casadi.logic_and((t636 >= -1.7453292519943295), (t636 <= 1.7453292519943295)), t636, t631)))
+    t638 = (t404 <= 4.642575810304916)
+    t639 = casadi.logic_and((t403 >= -4.642575810304916), (t403 <= 4.642575810304916))
+    t640 = casadi.if_else(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t182, t502), t503), t508), t606), t607), t65), casadi.logic_or(t620, t621)), casadi.logic_or(t629, t630)), casadi.logic_or(t638, t639)), 1, 0)
+    t641 = casadi.if_else(casadi.logic_and(t638, casadi.logic_not(t639)), t404, t403)
+    t642 = t641
+    t643 = t642 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn6 - 0.15915494309189535*t642)
+    t644 = casadi.if_else((qn6 > t643), 6.283185307179586, -6.283185307179586)
+    t645 = t643 + t644
+    t646 = t643 - t644
+    t647 = casadi.if_else(casadi.logic_and((t643 >= -4.642575810304916), (t643 <= 4.642575810304916)), t643, casadi.if_else(casadi.logic_and((t645 >= -4.642575810304916), (t645 <= 4.642575810304916)), t645, casadi.if_else(casadi.logic_and((t646 >= -4.642575810304916), (t646 <= 4.642575810304916)), t646, t641)))
+    t648 = t604 + qw4*(t493 + t628)**2 + qw5*(t494 + t637)**2 + qw6*(t495 + t647)**2
+    t649 = (t640 > 0)
+    t650 = casadi.if_else(casadi.logic_and(t649, casadi.logic_or((t619 > t648), (t611 < 1))), 1, 0)
+    t651 = casadi.if_else(t649, 1, t611)
+    t652 = (t650 > 0)
+    t653 = casadi.if_else(t652, t447, t613)
+    t654 = casadi.if_else(t652, t567, t614)
+    t655 = casadi.if_else(t652, t576, t615)
+    t656 = casadi.if_else(t652, t628, t616)
+    t657 = casadi.if_else(t652, t637, t617)
+    t658 = casadi.if_else(t652, t647, t618)
+    t659 = casadi.if_else(t652, t648, t619)
+    t660 = (t29 <= 2.792526803190927)
+    t661 = casadi.logic_and((t28 >= -2.792526803190927), (t28 <= 2.792526803190927))
+    t662 = casadi.if_else(casadi.logic_and(t660, casadi.logic_not(t661)), t29, t28)
+    t663 = t662
+    t664 = t663 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn1 - 0.15915494309189535*t663)
+    t665 = casadi.if_else((qn1 > t664), 6.283185307179586, -6.283185307179586)
+    t666 = t664 + t665
+    t667 = t664 - t665
+    t668 = casadi.if_else(casadi.logic_and((t664 >= -2.792526803190927), (t664 <= 2.792526803190927)), t664, casadi.if_else(casadi.logic_and((t666 >= -2.792526803190927), (t666 <= 2.792526803190927)), t666, casadi.if_else(casadi.logic_and((t667 >= -2.792526803190927), (t667 <= 2.792526803190927)), t667, t662)))
+    t669 = (t279 <= 3.9269908169872414)
+    t670 = casadi.logic_and((t278 >= -0.7853981633974483), (t278 <= 3.9269908169872414))
+    t671 = casadi.if_else(casadi.logic_and(t669, casadi.logic_not(t670)), t279, t278)
+    t672 = t671
+    t673 = t672 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t672)
+    t674 = casadi.if_else((qn2 > t673), 6.283185307179586, -6.283185307179586)
+    t675 = t673 + t674
+    t676 = t673 - t674
+    t677 = casadi.if_else(casadi.logic_and((t673 >= -0.7853981633974483), (t673 <= 3.9269908169872414)), t673, casadi.if_else(casadi.logic_and((t675 >= -0.7853981633974483), (t675 <= 3.9269908169872414)), t675, casadi.if_else(casadi.logic_and((t676 >= -0.7853981633974483), (t676 <= 3.9269908169872414)), t676, t671)))
+    t678 = (t232 <= 0.7853981633974483)
+    t679 = casadi.logic_and((t231 >= -3.9269908169872414), (t231 <= 0.7853981633974483))
+    t680 = casadi.if_else(casadi.logic_and(t678, casadi.logic_not(t679)), t232, t231)
+    t681 = t680
+    t682 = t681 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn3 - 0.15915494309189535*t681)
+    t683 = casadi.if_else((qn3 > t682), 6.283185307179586, -6.283185307179586)
+    t684 = t682 + t683
+    t685 = t682 - t683
+    t686 = casadi.if_else(casadi.logic_and((t682 >= -3.9269908169872414), (t682 <= 0.7853981633974483)), t682, casadi.if_else(casadi.logic_and((t684 >= -3.9269908169872414), (t684 <= 0.7853981633974483)), t684, casadi.if_else(casadi.logic_and((t685 >= -3.9269908169872414), (t685 <= 0.7853981633974483)), t685, t680)))
+    t687 = (t409 <= 2.9670597283903604)
+    t688 = casadi.logic_and((t408 >= -1.9198621771937625), (t408 <= 2.9670597283903604))
+    t689 = casadi.if_else(casadi.logic_and(t687, casadi.logic_not(t688)), t409, t408)
+    t690 = t689
+    t691 = t690 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t690)
+    t692 = casadi.if_else((qn4 > t691), 6.283185307179586, -6.283185307179586)
+    t693 = t691 + t692
+    t694 = t691 - t692
+    t695 = casadi.if_else(casadi.logic_and((t691 >= -1.9198621771937625), (t691 <= 2.9670597283903604)), t691, casadi.if_else(casadi.logic_and((t693 >= -1.9198621771937625), (t693 <= 2.9670597283903604)), t693, casadi.if_else(casadi.logic_and((t694 >= -1.9198621771937625), (t694 <= 2.9670597283903604)), t694, t689)))
+    t696 = (t414 <= 1.7453292519943295)
+    t697 = casadi.logic_and((t413 >= -1.7453292519943295), (t413 <= 1.7453292519943295))
+    t698 = casadi.if_else(casadi.logic_and(t696, casadi.logic_not(t697)), t414, t413)
+    t699 = t698
+    t700 = t699 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn5 - 0.15915494309189535*t699)
+    t701 = casadi.if_else((qn5 > t700), 6.283185307179586, -6.283185307179586)
+    t702 = t700 + t701
+    t703 = t700 - t701
+    t704 = casadi.if_else(casadi.logic_and((t700 >= -1.7453292519943295), (t700 <= 1.7453292519943295)), t700, casadi.if_else(casadi.logic_and((t702 >= -1.7453292519943295), (t702 <= 1.7453292519943295)), t702, casadi.if_else(casadi.logic_and((t703 >= -1.7453292519943295), (t703 <= 1.7453292519943295)), t703, t698)))
+    t705 = (t418 <= 4.642575810304916)
+    t706 = casadi.logic_and((t417 >= -4.642575810304916), (t417 <= 4.642575810304916))
+    t707 = casadi.if_else(casadi.logic_and(t705, casadi.logic_not(t706)), t418, t417)
+    t708 = t707
+    t709 = t708 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn6 - 0.15915494309189535*t708)
+    t710 = casadi.if_else((qn6 > t709), 6.283185307179586, -6.283185307179586)
+    t711 = t709 + t710
+    t712 = t709 - t710
+    t713 = casadi.if_else(casadi.logic_and((t709 >= -4.642575810304916), (t709 <= 4.642575810304916)), t709, casadi.if_else(casadi.logic_and((t711 >= -4.642575810304916), (t711 <= 4.642575810304916)), t711, casadi.if_else(casadi.logic_and((t712 >= -4.642575810304916), (t712 <= 4.642575810304916)), t712, t707)))
+    t714 = qw1*(t496 + t668)**2
+    t715 = t714 + qw2*(t498 + t677)**2 + qw3*(t499 + t686)**2
+    t716 = t715 + qw4*(t493 + t695)**2 + qw5*(t494 + t704)**2 + qw6*(t495 + t713)**2
+    t717 = casadi.logic_or(t660, t661)
+    t718 = casadi.logic_or(t669, t670)
+    t719 = casadi.logic_or(t678, t679)
+    t720 = (1e-12 >= -t223)
+    t721 = casadi.if_else(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t20, t502), t507), t717), t718), t719), t720), (t287 >= -1e-12)), casadi.logic_or(t687, t688)), casadi.logic_or(t696, t697)), casadi.logic_or(t705, t706)), 1, 0)
+    t722 = (t721 > 0)
+    t723 = casadi.if_else(casadi.logic_and(t722, casadi.logic_or((t659 > t716), (t651 < 1))), 1, 0)
+    t724 = casadi.if_else(t722, 1, t651)
+    t725 = (t723 > 0)
+    t726 = casadi.if_else(t725, t668, t653)
+    t727 = casadi.if_else(t725, t677, t654)
+    t728 = casadi.if_else(t725, t686, t655)
+    t729 = casadi.if_else(t725, t695, t656)
+    t730 = casadi.if_else(t725, t704, t657)
+    t731 = casadi.if_else(t725, t713, t658)
+    t732 = casadi.if_else(t725, t716, t659)
+    t733 = (t411 <= 2.9670597283903604)
+    t734 = casadi.logic_and((t410 >= -1.9198621771937625), (t410 <= 2.9670597283903604))
+    t735 = casadi.if_else(casadi.logic_and(t733, casadi.logic_not(t734)), t411, t410)
+    t736 = t735
+    t737 = t736 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t736)
+    t738 = casadi.if_else((qn4 > t737), 6.283185307179586, -6.283185307179586)
+    t739 = t737 + t738
+    t740 = t737 - t738
+    t741 = casadi.if_else(casadi.logic_and((t737 >= -1.9198621771937625), (t737 <= 2.9670597283903604)), t737, casadi.if_else(casadi.logic_and((t739 >= -1.9198621771937625), (t739 <= 2.9670597283903604)), t739, casadi.if_else(casadi.logic_and((t740 >= -1.9198621771937625), (t740 <= 2.9670597283903604)), t740, t735)))
+    t742 = (t422 >= -1.7453292519943295)
+    t743 = casadi.logic_and((t415 >= -1.7453292519943295), (t415 <= 1.7453292519943295))
+    t744 = casadi.if_else(casadi.logic_and(t742, casadi.logic_not(t743)), -t422, t421)
+    t745 = t744
+    t746 = t745 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn5 - 0.15915494309189535*t745)
+    t747 = casadi.if_else((qn5 > t746), 6.283185307179586, -6.283185307179586)
+    t748 = t746 + t747
+    t749 = t746 - t747
+    t750 = casadi.if_else(casadi.logic_and((t746 >= -1.7453292519943295), (t746 <= 1.7453292519943295)), t746, casadi.if_else(casadi.logic_and((t748 >= -1.7453292519943295), (t748 <= 1.7453292519943295)), t748, casadi.if_else(casadi.logic_and((t749 >= -1.7453292519943295), (t749 <= 1.7453292519943295)), t749, t744)))
+    t751 = (t420 <= 4.642575810304916)
+    t752 = casadi.logic_and((t419 >= -4.642575810304916), (t419 <= 4.642575810304916))
+    t753 = casadi.if_else(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t20, t288), t502), t507), t717), t718), t719), t720), casadi.logic_or(t733, t734)), casadi.logic_or(t742, t743)), casadi.logic_or(t751, t752)), 1, 0)
+    t754 = casadi.if_else(casadi.logic_and(t751, casadi.logic_not(t752)), t420, t419)
+    t755 = t754
+    t756 = t755 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn6 - 0.15915494309189535*t755)
+    t757 = casadi.if_else((qn6 > t756), 6.283185307179586, -6.283185307179586)
+    t758 = t756 + t757
+    t759 = t756 - t757
+    t760 = casadi.if_else(casadi.logic_and((t756 >= -4.642575810304916), (t756 <= 4.642575810304916)), t756, casadi.if_else(casadi.logic_and((t758 >= -4.642575810304916), (t758 <= 4.642575810304916)), t758, casadi.if_else(casadi.logic_and((t759 >= -4.642575810304916), (t759 <= 4.642575810304916)), t759, t754)))
+    t761 = t715 + qw4*(t493 + t741)**2 + qw5*(t494 + t750)**2 + qw6*(t495 + t760)**2
+    t762 = (t753 > 0)
+    t763 = casadi.if_else(casadi.logic_and(t762, casadi.logic_or((t732 > t761), (t724 < 1))), 1, 0)
+    t764 = casadi.if_else(t762, 1, t724)
+    t765 = (t763 > 0)
+    t766 = casadi.if_else(t765, t668, t726)
+    t767 = casadi.if_else(t765, t677, t727)
+    t768 = casadi.if_else(t765, t686, t728)
+    t769 = casadi.if_else(t765, t741, t729)
+    t770 = casadi.if_else(t765, t750, t730)
+    t771 = casadi.if_else(t765, t760, t731)
+    t772 = casadi.if_else(t765, t761, t732)
+    t773 = (t333 <= 3.9269908169872414)
+    t774 = casadi.logic_and((t332 >= -0.7853981633974483), (t332 <= 3.9269908169872414))
+    t775 = casadi.if_else(casadi.logic_and(t773, casadi.logic_not(t774)), t333, t332)
+    t776 = t775
+    t777 = t776 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t776)
+    t778 = casadi.if_else((qn2 > t777), 6.283185307179586, -6.283185307179586)
+    t779 = t777 + t778
+    t780 = t777 - t778
+    t781 = casadi.if_else(casadi.logic_and((t777 >= -0.7853981633974483), (t777 <= 3.9269908169872414)), t777, casadi.if_else(casadi.logic_and((t779 >= -0.7853981633974483), (t779 <= 3.9269908169872414)), t779, casadi.if_else(casadi.logic_and((t780 >= -0.7853981633974483), (t780 <= 3.9269908169872414)), t780, t775)))
+    t782 = (t234 <= 0.7853981633974483)
+    t783 = casadi.logic_and((t233 >= -3.9269908169872414), (t233 <= 0.7853981633974483))
+    t784 = casadi.if_else(casadi.logic_and(t782, casadi.logic_not(t783)), t234, t233)
+    t785 = t784
+    t786 = t785 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn3 - 0.15915494309189535*t785)
+    t787 = casadi.if_else((qn3 > t786), 6.283185307179586, -6.283185307179586)
+    t788 = t786 + t787
+    t789 = t786 - t787
+    t790 = casadi.if_else(casadi.logic_and((t786 >= -3.9269908169872414), (t786 <= 0.7853981633974483)), t786, casadi.if_else(casadi.logic_and((t788 >= -3.9269908169872414), (t788 <= 0.7853981633974483)), t788, casadi.if_else(casadi.logic_and((t789 >= -3.9269908169872414), (t789 <= 0.7853981633974483)), t789, t784)))
+    t791 = (t425 <= 2.9670597283903604)
+    t792 = casadi.logic_and((t424 >= -1.9198621771937625), (t424 <= 2.9670597283903604))
+    t793 = casadi.if_else(casadi.logic_and(t791, casadi.logic_not(t792)), t425, t424)
+    t794 = t793
+    t795 = t794 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t794)
+    t796 = casadi.if_else((qn4 > t795), 6.283185307179586, -6.283185307179586)
+    t797 = t795 + t796
+    t798 = t795 - t796
+    t799 = casadi.if_else(casadi.logic_and((t795 >= -1.9198621771937625), (t795 <= 2.9670597283903604)), t795, casadi.if_else(casadi.logic_and((t797 >= -1.9198621771937625), (t797 <= 2.9670597283903604)), t797, casadi.if_else(casadi.logic_and((t798 >= -1.9198621771937625), (t798 <= 2.9670597283903604)), t798, t793)))
+    t800 = (t430 <= 1.7453292519943295)
+    t801 = casadi.logic_and((t429 >= -1.7453292519943295), (t429 <= 1.7453292519943295))
+    t802 = casadi.if_else(casadi.logic_and(t800, casadi.logic_not(t801)), t430, t429)
+    t803 = t802
+    t804 = t803 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn5 - 0.15915494309189535*t803)
+    t805 = casadi.if_else((qn5 > t804), 6.283185307179586, -6.283185307179586)
+    t806 = t804 + t805
+    t807 = t804 - t805
+    t808 = casadi.if_else(casadi.logic_and((t804 >= -1.7453292519943295), (t804 <= 1.7453292519943295)), t804, casadi.if_else(casadi.logic_and((t806 >= -1.7453292519943295), (t806 <= 1.7453292519943295)), t806, casadi.if_else(casadi.logic_and((t807 >= -1.7453292519943295), (t807 <= 1.7453292519943295)), t807, t802)))
+    t809 = (t434 <= 4.642575810304916)
+    t810 = casadi.logic_and((t433 >= -4.642575810304916), (t433 <= 4.642575810304916))
+    t811 = casadi.if_else(casadi.logic_and(t809, casadi.logic_not(t810)), t434, t433)
+    t812 = t811
+    t813 = t812 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn6 - 0.15915494309189535*t812)
+    t814 = casadi.if_else((qn6 > t813), 6.283185307179586, -6.283185307179586)
+    t815 = t813 + t814
+    t816 = t813 - t814
+    t817 = casadi.if_else(casadi.logic_and((t813 >= -4.642575810304916), (t813 <= 4.642575810304916)), t813, casadi.if_else(casadi.logic_and((t815 >= -4.642575810304916), (t815 <= 4.642575810304916)), t815, casadi.if_else(casadi.logic_and((t816 >= -4.642575810304916), (t816 <= 4.642575810304916)), t816, t811)))
+    t818 = t714 + qw2*(t498 + t781)**2 + qw3*(t499 + t790)**2
+    t819 = t818 + qw4*(t493 + t799)**2 + qw5*(t494 + t808)**2 + qw6*(t495 + t817)**2
+    t820 = casadi.logic_or(t773, t774)
+    t821 = casadi.logic_or(t782, t783)
+    t822 = casadi.if_else(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t20, t225), t502), t507), t717), t820), t821), (t341 >= -1e-12)), casadi.logic_or(t791, t792)), casadi.logic_or(t800, t801)), casadi.logic_or(t809, t810)), 1, 0)
+    t823 = (t822 > 0)
+    t824 = casadi.if_else(casadi.logic_and(t823, casadi.logic_or((t772 > t819), (t764 < 1))), 1, 0)
+    t825 = casadi.if_else(t823, 1, t764)
+    t826 = (t824 > 0)
+    t827 = casadi.if_else(t826, t668, t766)
+    t828 = casadi.if_else(t826, t781, t767)
+    t829 = casadi.if_else(t826, t790, t768)
+    t830 = casadi.if_else(t826, t799, t769)
+    t831 = casadi.if_else(t826, t808, t770)
+    t832 = casadi.if_else(t826, t817, t771)
+    t833 = casadi.if_else(t826, t819, t772)
+    t834 = (t427 <= 2.9670597283903604)
+    t835 = casadi.logic_and((t426 >= -1.9198621771937625), (t426 <= 2.9670597283903604))
+    t836 = casadi.if_else(casadi.logic_and(t834, casadi.logic_not(t835)), t427, t426)
+    t837 = t836
+    t838 = t837 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t837)
+    t839 = casadi.if_else((qn4 > t838), 6.283185307179586, -6.283185307179586)
+    t840 = t838 + t839
+    t841 = t838 - t839
+    t842 = casadi.if_else(casadi.logic_and((t838 >= -1.9198621771937625), (t838 <= 2.9670597283903604)), t838, casadi.if_else(casadi.logic_and((t840 >= -1.9198621771937625), (t840 <= 2.9670597283903604)), t840, casadi.if_else(casadi.logic_and((t841 >= -1.9198621771937625), (t841 <= 2.9670597283903604)), t841, t836)))
+    t843 = (t438 >= -1.7453292519943295)
+    t844 = casadi.logic_and((t431 >= -1.7453292519943295), (t431 <= 1.7453292519943295))
+    t845 = casadi.if_else(casadi.logic_and(t843, casadi.logic_not(t844)), -t438, t437)
+    t846 = t845
+    t847 = t846 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn5 - 0.15915494309189535*t846)
+    t848 = casadi.if_else((qn5 > t847), 6.283185307179586, -6.283185307179586)
+    t849 = t847 + t848
+    t850 = t847 - t848
+    t851 = casadi.if_else(casadi.logic_and((t847 >= -1.7453292519943295), (t847 <= 1.7453292519943295)), t847, casadi.if_else(casadi.logic_and((t849 >= -1.7453292519943295), (t849 <= 1.7453292519943295)), t849, casadi.if_else(casadi.logic_and((t850 >= -1.7453292519943295), (t850 <= 1.7453292519943295)), t850, t845)))
+    t852 = (t436 <= 4.642575810304916)
+    t853 = casadi.logic_and((t435 >= -4.642575810304916), (t435 <= 4.642575810304916))
+    t854 = casadi.if_else(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t20, t225), t342), t502), t507), t717), t820), t821), casadi.logic_or(t834, t835)), casadi.logic_or(t843, t844)), casadi.logic_or(t852, t853)), 1, 0)
+    t855 = casadi.if_else(casadi.logic_and(t852, casadi.logic_not(t853)), t436, t435)
+    t856 = t855
+    t857 = t856 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn6 - 0.15915494309189535*t856)
+    t858 = casadi.if_else((qn6 > t857), 6.283185307179586, -6.283185307179586)
+    t859 = t857 + t858
+    t860 = t857 - t858
+    t861 = casadi.if_else(casadi.logic_and((t857 >= -4.642575810304916), (t857 <= 4.642575810304916)), t857, casadi.if_else(casadi.logic_and((t859 >= -4.642575810304916), (t859 <= 4.642575810304916)), t859, casadi.if_else(casadi.logic_and((t860 >= -4.642575810304916), (t860 <= 4.642575810304916)), t860, t855)))
+    t862 = t818 + qw4*(t493 + t842)**2 + qw5*(t494 + t851)**2 + qw6*(t495 + t861)**2
+    t863 = (t854 > 0)
+    t864 = casadi.if_else(casadi.logic_and(t863, casadi.logic_or((t833 > t862), (t825 < 1))), 1, 0)
+    t865 = casadi.if_else(t863, 1, t825)
+    t866 = (t864 > 0)
+    t867 = casadi.if_else(t866, t668, t827)
+    t868 = casadi.if_else(t866, t781, t828)
+    t869 = casadi.if_else(t866, t790, t829)
+    t870 = casadi.if_else(t866, t842, t830)
+    t871 = casadi.if_else(t866, t851, t831)
+    t872 = casadi.if_else(t866, t861, t832)
+    t873 = (casadi.fabs(t374) < casadi.inf)
+    t874 = (t865 > 0)
+    t875 = casadi.logic_and(t873, t874)
     q = casadi.SX(6, 1)
-    q[0, 0] = casadi.if_else(t880, t872, qn1)
-    q[1, 0] = casadi.if_else(t880, t873, qn2)
-    q[2, 0] = casadi.if_else(t880, t874, qn3)
-    q[3, 0] = casadi.if_else(t880, t875, qn4)
-    q[4, 0] = casadi.if_else(t880, t876, qn5)
-    q[5, 0] = casadi.if_else(t880, t877, qn6)
+    q[0, 0] = casadi.if_else(t875, t867, qn1)
+    q[1, 0] = casadi.if_else(t875, t868, qn2)
+    q[2, 0] = casadi.if_else(t875, t869, qn3)
+    q[3, 0] = casadi.if_else(t875, t870, qn4)
+    q[4, 0] = casadi.if_else(t875, t871, qn5)
+    q[5, 0] = casadi.if_else(t875, t872, qn6)
     status = casadi.SX(1, 1)
-    status[0, 0] = casadi.if_else(casadi.logic_not(t878), 2, casadi.if_else(t879, 0, 1))
+    status[0, 0] = casadi.if_else(casadi.logic_not(t873), 2, casadi.if_else(t874, 0, 1))
     return [q, status]
 
 

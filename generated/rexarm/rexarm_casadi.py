@@ -1215,7 +1215,7 @@ def _ik_numeric_step(target, q, damping):
 
 
 def _ik_branches(mu):
-    """Every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits: 928 operations."""
+    """Every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits: 878 operations."""
     mu0 = mu[0]
     mu1 = mu[1]
     mu2 = mu[2]
@@ -1229,371 +1229,351 @@ def _ik_branches(mu):
     t6 = casadi.if_else(t5, -t0, casadi.if_else((t0 < 0), 1, -1))
     t7 = casadi.if_else(t5, casadi.sqrt(t4), 0)
     t8 = casadi.atan2(t7, t6)
-    t9 = False
-    t10 = casadi.if_else(t9, 0, t8)
-    t11 = casadi.if_else(t9, 1, t6)
-    t12 = casadi.if_else(t9, 0, t7)
-    t13 = casadi.if_else(t9, 1, 100)
-    t14 = mu0**2 + mu1**2
-    t15 = t14
-    t16 = t14 + mu2**2
-    t17 = 1e-24*t16
-    t18 = (t15 <= t17)
-    t19 = casadi.if_else(t18, 1, 1/casadi.sqrt(t15))
-    t20 = True
-    t21 = casadi.if_else(t20, 0, -1)
-    t22 = casadi.if_else(t20, 1, 0)
-    t23 = casadi.atan2(t22, t21)
-    t24 = casadi.if_else(t18, 0, t1 + t23)
-    t25 = t1 - t23
-    t26 = t24 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t24)
-    t27 = t26 - 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*t26)
-    t28 = t25 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t25)
-    t29 = t28 - 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*t28)
-    t30 = t19*t21
-    t31 = mu1*t30
-    t32 = t19*t22
-    t33 = mu0*t32
-    t34 = casadi.if_else(t18, 1, -t31 - t33)
-    t35 = t33 - t31
-    t36 = mu2*(1 - t34)
-    t37 = t36 + mu2*t34
-    t38 = mu2*(1 - t35)
-    t39 = t38 + mu2*t35
-    t40 = mu0*t30
-    t41 = mu1*t32
-    t42 = casadi.if_else(t18, 0, t40 - t41)
-    t43 = t40 + t41
-    t44 = mu0*t34 + mu1*t42
-    t45 = mu1*t34 - mu0*t42
-    t46 = mu0*t35 + mu1*t43
-    t47 = mu1*t35 - mu0*t43
-    t48 = 0.1*t12
-    t49 = t44 + t48
-    t50 = t46 + t48
-    t51 = -0.1*t11
-    t52 = t37 + t51
-    t53 = -0.12 + t52
-    t54 = t39 + t51
-    t55 = -0.12 + t54
-    t56 = t45**2
-    t57 = t56 + t49**2 + t53**2
-    t58 = 0.01 - 0.5*t57
-    t59 = t58**2
-    t60 = t13**2
-    t61 = 1 - t59*t60
-    t62 = t13*t58
-    t63 = (1e-12 < t61)
-    t64 = casadi.if_else(t63, t62, casadi.if_else((t62 > 0), 1, -1))
-    t65 = casadi.if_else(t63, casadi.sqrt(t61), 0)
-    t66 = casadi.atan2(t65, t64)
-    t67 = casadi.if_else(t9, 0, 3.141592653589793 + t66)
-    t68 = 3.141592653589793 - t66
-    t69 = t67 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t67)
-    t70 = t69 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t69)
-    t71 = t68 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t68)
-    t72 = t71 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t71)
-    t73 = 0.01*t13
-    t74 = casadi.if_else(t9, 1, -t64*t73)
-    t75 = casadi.if_else(t9, 0, -t65*t73)
-    t76 = 0.22 + 0.1*t74
-    t77 = -0.12 + t76
-    t78 = t77**2 + 0.01*t75**2
-    t79 = 0.1*t75
-    t80 = t53*t77 - t49*t79
-    t81 = t49*t77 + t53*t79
-    t82 = t80**2 + t81**2
-    t83 = 0.001*t13
-    t84 = 0.22 - t64*t83
-    t85 = -0.12 + t84
-    t86 = t65*t83
-    t87 = t53*t85 - t49*t86
-    t88 = t49*t85 + t53*t86
-    t89 = t87**2 + t88**2
-    t90 = 1e-06*t60
-    t91 = t85**2 + t90*t65**2
-    t92 = -0.1*t7
-    t93 = t44 + t92
-    t94 = t46 + t92
-    t95 = -0.1*t6
-    t96 = t37 + t95
-    t97 = -0.12 + t96
-    t98 = t56 + t93**2 + t97**2
-    t99 = 0.01 - 0.5*t98
-    t100 = t39 + t95
+    t9 = t8
+    t10 = t6
+    t11 = t7
+    t12 = mu0**2 + mu1**2
+    t13 = t12
+    t14 = t12 + mu2**2
+    t15 = 1e-24*t14
+    t16 = (t13 <= t15)
+    t17 = casadi.if_else(t16, 1, 1/casadi.sqrt(t13))
+    t18 = casadi.if_else(t16, 0, t1 + (1/2)*casadi.pi)
+    t19 = t1 - 1/2*casadi.pi
+    t20 = t18 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t18)
+    t21 = t20 - 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*t20)
+    t22 = t19 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t19)
+    t23 = t22 - 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*t22)
+    t24 = t17
+    t25 = mu0*t24
+    t26 = casadi.if_else(t16, 1, -t25)
+    t27 = t25
+    t28 = mu2*(1 - t26)
+    t29 = t28 + mu2*t26
+    t30 = mu2*(1 - t27)
+    t31 = t30 + mu2*t27
+    t32 = mu1*t24
+    t33 = casadi.if_else(t16, 0, -t32)
+    t34 = t32
+    t35 = mu0*t26 + mu1*t33
+    t36 = mu1*t26 - mu0*t33
+    t37 = mu0*t27 + mu1*t34
+    t38 = mu1*t27 - mu0*t34
+    t39 = 0.1*t11
+    t40 = t35 + t39
+    t41 = t37 + t39
+    t42 = -0.1*t10
+    t43 = t29 + t42
+    t44 = -0.12 + t43
+    t45 = t31 + t42
+    t46 = -0.12 + t45
+    t47 = t36**2
+    t48 = t47 + t40**2 + t44**2
+    t49 = 0.01 - 0.5*t48
+    t50 = t49**2
+    t51 = 1 - 10000*t50
+    t52 = 100*t49
+    t53 = (1e-12 < t51)
+    t54 = casadi.if_else(t53, t52, casadi.if_else((t52 > 0), 1, -1))
+    t55 = casadi.if_else(t53, casadi.sqrt(t51), 0)
+    t56 = casadi.atan2(t55, t54)
+    t57 = 3.141592653589793 + t56
+    t58 = 3.141592653589793 - t56
+    t59 = t57 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t57)
+    t60 = t59 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t59)
+    t61 = t58 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t58)
+    t62 = t61 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t61)
+    t63 = -1.0*t54
+    t64 = -1.0*t55
+    t65 = 0.22 + 0.1*t63
+    t66 = -0.12 + t65
+    t67 = t66**2 + 0.01*t64**2
+    t68 = 0.1*t64
+    t69 = t44*t66 - t40*t68
+    t70 = t40*t66 + t44*t68
+    t71 = t69**2 + t70**2
+    t72 = 0.22 - 0.1*t54
+    t73 = -0.12 + t72
+    t74 = 0.1*t55
+    t75 = t44*t73 - t40*t74
+    t76 = t40*t73 + t44*t74
+    t77 = t75**2 + t76**2
+    t78 = t73**2 + 0.01*t55**2
+    t79 = -0.1*t7
+    t80 = t35 + t79
+    t81 = t37 + t79
+    t82 = -0.1*t6
+    t83 = t29 + t82
+    t84 = -0.12 + t83
+    t85 = t47 + t80**2 + t84**2
+    t86 = 0.01 - 0.5*t85
+    t87 = t31 + t82
+    t88 = -0.12 + t87
+    t89 = t86**2
+    t90 = 1 - 10000*t89
+    t91 = 100*t86
+    t92 = (1e-12 < t90)
+    t93 = casadi.if_else(t92, t91, casadi.if_else((t91 > 0), 1, -1))
+    t94 = casadi.if_else(t92, casadi.sqrt(t90), 0)
+    t95 = casadi.atan2(t94, t93)
+    t96 = 3.141592653589793 + t95
+    t97 = -1.0*t93
+    t98 = -1.0*t94
+    t99 = 3.141592653589793 - t95
+    t100 = 0.22 + 0.1*t97
     t101 = -0.12 + t100
-    t102 = t99**2
-    t103 = 1 - t102*t60
-    t104 = t13*t99
-    t105 = (1e-12 < t103)
-    t106 = casadi.if_else(t105, t104, casadi.if_else((t104 > 0), 1, -1))
-    t107 = casadi.if_else(t105, casadi.sqrt(t103), 0)
-    t108 = casadi.atan2(t107, t106)
-    t109 = casadi.if_else(t9, 0, 3.141592653589793 + t108)
-    t110 = casadi.if_else(t9, 1, -t106*t73)
-    t111 = casadi.if_else(t9, 0, -t107*t73)
-    t112 = 3.141592653589793 - t108
-    t113 = 0.22 + 0.1*t110
-    t114 = -0.12 + t113
-    t115 = t114**2 + 0.01*t111**2
-    t116 = 0.22 - t106*t83
-    t117 = -0.12 + t116
-    t118 = t117**2 + t90*t107**2
-    t119 = t109 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t109)
-    t120 = t119 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t119)
-    t121 = t112 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t112)
-    t122 = t121 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t121)
-    t123 = 0.1*t111
-    t124 = t114*t97 - t123*t93
-    t125 = t114*t93 + t123*t97
-    t126 = t124**2 + t125**2
-    t127 = t107*t83
-    t128 = t117*t97 - t127*t93
-    t129 = t117*t93 + t127*t97
-    t130 = t128**2 + t129**2
-    t131 = t47**2
-    t132 = t131 + t50**2 + t55**2
-    t133 = 0.01 - 0.5*t132
-    t134 = t131 + t101**2 + t94**2
-    t135 = 0.01 - 0.5*t134
-    t136 = t133**2
-    t137 = 1 - t136*t60
-    t138 = t13*t133
-    t139 = (1e-12 < t137)
-    t140 = casadi.if_else(t139, t138, casadi.if_else((t138 > 0), 1, -1))
-    t141 = casadi.if_else(t139, casadi.sqrt(t137), 0)
-    t142 = casadi.atan2(t141, t140)
-    t143 = casadi.if_else(t9, 0, 3.141592653589793 + t142)
-    t144 = casadi.if_else(t9, 1, -t140*t73)
-    t145 = casadi.if_else(t9, 0, -t141*t73)
-    t146 = 3.141592653589793 - t142
-    t147 = 0.22 + 0.1*t144
-    t148 = -0.12 + t147
-    t149 = t148**2 + 0.01*t145**2
-    t150 = 0.22 - t140*t83
-    t151 = -0.12 + t150
-    t152 = t151**2 + t90*t141**2
-    t153 = t143 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t143)
-    t154 = t153 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t153)
-    t155 = t146 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t146)
-    t156 = t155 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t155)
-    t157 = 0.1*t145
-    t158 = t148*t55 - t157*t50
-    t159 = t148*t50 + t157*t55
-    t160 = t158**2 + t159**2
-    t161 = t141*t83
-    t162 = t151*t55 - t161*t50
-    t163 = t151*t50 + t161*t55
-    t164 = t162**2 + t163**2
-    t165 = t135**2
-    t166 = 1 - t165*t60
-    t167 = t13*t135
-    t168 = (1e-12 < t166)
-    t169 = casadi.if_else(t168, t167, casadi.if_else((t167 > 0), 1, -1))
-    t170 = casadi.if_else(t168, casadi.sqrt(t166), 0)
-    t171 = casadi.atan2(t170, t169)
-    t172 = casadi.if_else(t9, 0, 3.141592653589793 + t171)
-    t173 = casadi.if_else(t9, 1, -t169*t73)
-    t174 = casadi.if_else(t9, 0, -t170*t73)
-    t175 = 3.141592653589793 - t171
-    t176 = 0.22 + 0.1*t173
-    t177 = -0.12 + t176
-    t178 = t177**2 + 0.01*t174**2
-    t179 = 0.22 - t169*t83
-    t180 = -0.12 + t179
-    t181 = t180**2 + t90*t170**2
-    t182 = t172 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t172)
-    t183 = t182 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t182)
-    t184 = t175 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t175)
-    t185 = t184 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t184)
-    t186 = 0.1*t174
-    t187 = t101*t177 - t186*t94
-    t188 = t101*t186 + t177*t94
-    t189 = t187**2 + t188**2
-    t190 = t170*t83
-    t191 = t101*t180 - t190*t94
-    t192 = t101*t190 + t180*t94
-    t193 = t191**2 + t192**2
-    t194 = 1e-24*t57
-    t195 = casadi.if_else((t82 <= t194*t78), 0, casadi.atan2(-t81, t80))
-    t196 = t195
-    t197 = t196 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t196)
-    t198 = -t10
-    t199 = 3.141592653589793 + t198
-    t200 = t195 + t67
-    t201 = t198 + t200 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t199 - 0.15915494309189535*t200)
-    t202 = -t201
-    t203 = t201 + 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t202)
-    t204 = casadi.if_else((t89 <= t194*t91), 0, casadi.atan2(-t88, t87))
-    t205 = t204
-    t206 = t205 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t205)
-    t207 = t204 + t68
-    t208 = t198 + t207 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t199 - 0.15915494309189535*t207)
-    t209 = -t208
-    t210 = t208 + 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t209)
-    t211 = 1e-24*t98
-    t212 = casadi.if_else((t126 <= t115*t211), 0, casadi.atan2(-t125, t124))
-    t213 = t212
-    t214 = t213 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t213)
-    t215 = 3.141592653589793 + t8
-    t216 = t109 + t212
-    t217 = t216 + t8 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t215 - 0.15915494309189535*t216)
-    t218 = -t217
-    t219 = t217 + 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t218)
-    t220 = casadi.if_else((t130 <= t118*t211), 0, casadi.atan2(-t129, t128))
-    t221 = t220
-    t222 = t221 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t221)
-    t223 = t112 + t220
-    t224 = t223 + t8 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t215 - 0.15915494309189535*t223)
-    t225 = -t224
-    t226 = t224 + 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t225)
-    t227 = 1e-24*t132
-    t228 = casadi.if_else((t160 <= t149*t227), 0, casadi.atan2(-t159, t158))
-    t229 = t228
-    t230 = t229 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t229)
-    t231 = t143 + t228
-    t232 = t198 + t231 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t199 - 0.15915494309189535*t231)
-    t233 = -t232
-    t234 = t232 + 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t233)
-    t235 = casadi.if_else((t164 <= t152*t227), 0, casadi.atan2(-t163, t162))
-    t236 = t235
-    t237 = t236 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t236)
-    t238 = t146 + t235
-    t239 = t198 + t238 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t199 - 0.15915494309189535*t238)
-    t240 = -t239
-    t241 = t239 + 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t240)
-    t242 = 1e-24*t134
-    t243 = casadi.if_else((t189 <= t178*t242), 0, casadi.atan2(-t188, t187))
-    t244 = t243
-    t245 = t244 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t244)
-    t246 = t172 + t243
-    t247 = t246 + t8 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t215 - 0.15915494309189535*t246)
-    t248 = -t247
-    t249 = t247 + 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t248)
-    t250 = casadi.if_else((t193 <= t181*t242), 0, casadi.atan2(-t192, t191))
-    t251 = t250
-    t252 = t251 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t251)
-    t253 = t175 + t250
-    t254 = t253 + t8 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t215 - 0.15915494309189535*t253)
-    t255 = -t254
-    t256 = t254 + 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t255)
-    t257 = (t27 <= 3.141592653589793)
-    t258 = casadi.logic_and((t26 >= -3.141592653589793), (t26 <= 3.141592653589793))
-    t259 = casadi.if_else(casadi.logic_and(t257, casadi.logic_not(t258)), t27, t26)
-    t260 = (t197 <= 2.0943951023931953)
-    t261 = casadi.logic_and((t196 >= -2.0943951023931953), (t196 <= 2.0943951023931953))
-    t262 = (t70 <= 2.0943951023931953)
-    t263 = casadi.logic_and((t69 >= -2.0943951023931953), (t69 <= 2.0943951023931953))
-    t264 = -t203
-    t265 = (t206 <= 2.0943951023931953)
-    t266 = casadi.logic_and((t205 >= -2.0943951023931953), (t205 <= 2.0943951023931953))
-    t267 = (t72 <= 2.0943951023931953)
-    t268 = casadi.logic_and((t71 >= -2.0943951023931953), (t71 <= 2.0943951023931953))
-    t269 = -t210
-    t270 = (t214 <= 2.0943951023931953)
-    t271 = casadi.logic_and((t213 >= -2.0943951023931953), (t213 <= 2.0943951023931953))
-    t272 = (t120 <= 2.0943951023931953)
-    t273 = casadi.logic_and((t119 >= -2.0943951023931953), (t119 <= 2.0943951023931953))
-    t274 = -t219
-    t275 = (t222 <= 2.0943951023931953)
-    t276 = casadi.logic_and((t221 >= -2.0943951023931953), (t221 <= 2.0943951023931953))
-    t277 = (t122 <= 2.0943951023931953)
-    t278 = casadi.logic_and((t121 >= -2.0943951023931953), (t121 <= 2.0943951023931953))
-    t279 = -t226
-    t280 = (t29 <= 3.141592653589793)
-    t281 = casadi.logic_and((t28 >= -3.141592653589793), (t28 <= 3.141592653589793))
-    t282 = casadi.if_else(casadi.logic_and(t280, casadi.logic_not(t281)), t29, t28)
-    t283 = (t230 <= 2.0943951023931953)
-    t284 = casadi.logic_and((t229 >= -2.0943951023931953), (t229 <= 2.0943951023931953))
-    t285 = (t154 <= 2.0943951023931953)
-    t286 = casadi.logic_and((t153 >= -2.0943951023931953), (t153 <= 2.0943951023931953))
-    t287 = -t234
-    t288 = (t237 <= 2.0943951023931953)
-    t289 = casadi.logic_and((t236 >= -2.0943951023931953), (t236 <= 2.0943951023931953))
-    t290 = (t156 <= 2.0943951023931953)
-    t291 = casadi.logic_and((t155 >= -2.0943951023931953), (t155 <= 2.0943951023931953))
-    t292 = -t241
-    t293 = (t245 <= 2.0943951023931953)
-    t294 = casadi.logic_and((t244 >= -2.0943951023931953), (t244 <= 2.0943951023931953))
-    t295 = (t183 <= 2.0943951023931953)
-    t296 = casadi.logic_and((t182 >= -2.0943951023931953), (t182 <= 2.0943951023931953))
-    t297 = -t249
-    t298 = (t252 <= 2.0943951023931953)
-    t299 = casadi.logic_and((t251 >= -2.0943951023931953), (t251 <= 2.0943951023931953))
-    t300 = (t185 <= 2.0943951023931953)
-    t301 = casadi.logic_and((t184 >= -2.0943951023931953), (t184 <= 2.0943951023931953))
-    t302 = -t256
-    t303 = (casadi.fabs(t2) < casadi.inf)
-    t304 = (casadi.fabs(mu3) <= 1.5707963267948966)
-    t305 = (t15 > t17)
-    t306 = casadi.logic_or(t305, casadi.logic_and(t18, (0 <= 1e-12*t16)))
-    t307 = True
-    t308 = -1e-12
-    t309 = casadi.logic_and(t307, (t4 >= t308))
-    t310 = 1e-28
-    t311 = (0.0001 > t310)
-    t312 = (0.0001 <= t310)
-    t313 = 1e-16
-    t314 = (t4 > 1e-12)
-    t315 = True
-    t316 = casadi.logic_or(t257, t258)
-    t317 = casadi.logic_or(t280, t281)
+    t102 = t101**2 + 0.01*t98**2
+    t103 = 0.22 - 0.1*t93
+    t104 = -0.12 + t103
+    t105 = t104**2 + 0.01*t94**2
+    t106 = t96 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t96)
+    t107 = t106 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t106)
+    t108 = t99 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t99)
+    t109 = t108 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t108)
+    t110 = 0.1*t98
+    t111 = t101*t84 - t110*t80
+    t112 = t101*t80 + t110*t84
+    t113 = t111**2 + t112**2
+    t114 = 0.1*t94
+    t115 = t104*t84 - t114*t80
+    t116 = t104*t80 + t114*t84
+    t117 = t115**2 + t116**2
+    t118 = t38**2
+    t119 = t118 + t41**2 + t46**2
+    t120 = 0.01 - 0.5*t119
+    t121 = t118 + t81**2 + t88**2
+    t122 = 0.01 - 0.5*t121
+    t123 = t120**2
+    t124 = 1 - 10000*t123
+    t125 = 100*t120
+    t126 = (1e-12 < t124)
+    t127 = casadi.if_else(t126, t125, casadi.if_else((t125 > 0), 1, -1))
+    t128 = casadi.if_else(t126, casadi.sqrt(t124), 0)
+    t129 = casadi.atan2(t128, t127)
+    t130 = 3.141592653589793 + t129
+    t131 = -1.0*t127
+    t132 = -1.0*t128
+    t133 = 3.141592653589793 - t129
+    t134 = 0.22 + 0.1*t131
+    t135 = -0.12 + t134
+    t136 = t135**2 + 0.01*t132**2
+    t137 = 0.22 - 0.1*t127
+    t138 = -0.12 + t137
+    t139 = t138**2 + 0.01*t128**2
+    t140 = t130 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t130)
+    t141 = t140 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t140)
+    t142 = t133 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t133)
+    t143 = t142 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t142)
+    t144 = 0.1*t132
+    t145 = t135*t46 - t144*t41
+    t146 = t135*t41 + t144*t46
+    t147 = t145**2 + t146**2
+    t148 = 0.1*t128
+    t149 = t138*t46 - t148*t41
+    t150 = t138*t41 + t148*t46
+    t151 = t149**2 + t150**2
+    t152 = t122**2
+    t153 = 1 - 10000*t152
+    t154 = 100*t122
+    t155 = (1e-12 < t153)
+    t156 = casadi.if_else(t155, t154, casadi.if_else((t154 > 0), 1, -1))
+    t157 = casadi.if_else(t155, casadi.sqrt(t153), 0)
+    t158 = casadi.atan2(t157, t156)
+    t159 = 3.141592653589793 + t158
+    t160 = -1.0*t156
+    t161 = -1.0*t157
+    t162 = 3.141592653589793 - t158
+    t163 = 0.22 + 0.1*t160
+    t164 = -0.12 + t163
+    t165 = t164**2 + 0.01*t161**2
+    t166 = 0.22 - 0.1*t156
+    t167 = -0.12 + t166
+    t168 = t167**2 + 0.01*t157**2
+    t169 = t159 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t159)
+    t170 = t169 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t169)
+    t171 = t162 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t162)
+    t172 = t171 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t171)
+    t173 = 0.1*t161
+    t174 = t164*t88 - t173*t81
+    t175 = t164*t81 + t173*t88
+    t176 = t174**2 + t175**2
+    t177 = 0.1*t157
+    t178 = t167*t88 - t177*t81
+    t179 = t167*t81 + t177*t88
+    t180 = t178**2 + t179**2
+    t181 = 1e-24*t48
+    t182 = casadi.if_else((t71 <= t181*t67), 0, casadi.atan2(-t70, t69))
+    t183 = t182
+    t184 = t183 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t183)
+    t185 = -t9
+    t186 = 3.141592653589793 + t185
+    t187 = t182 + t57
+    t188 = t185 + t187 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t186 - 0.15915494309189535*t187)
+    t189 = -t188
+    t190 = t188 + 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t189)
+    t191 = casadi.if_else((t77 <= t181*t78), 0, casadi.atan2(-t76, t75))
+    t192 = t191
+    t193 = t192 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t192)
+    t194 = t191 + t58
+    t195 = t185 + t194 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t186 - 0.15915494309189535*t194)
+    t196 = -t195
+    t197 = t195 + 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t196)
+    t198 = 1e-24*t85
+    t199 = casadi.if_else((t113 <= t102*t198), 0, casadi.atan2(-t112, t111))
+    t200 = t199
+    t201 = t200 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t200)
+    t202 = 3.141592653589793 + t8
+    t203 = t199 + t96
+    t204 = t203 + t8 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t202 - 0.15915494309189535*t203)
+    t205 = -t204
+    t206 = t204 + 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t205)
+    t207 = casadi.if_else((t117 <= t105*t198), 0, casadi.atan2(-t116, t115))
+    t208 = t207
+    t209 = t208 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t208)
+    t210 = t207 + t99
+    t211 = t210 + t8 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t202 - 0.15915494309189535*t210)
+    t212 = -t211
+    t213 = t211 + 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t212)
+    t214 = 1e-24*t119
+    t215 = casadi.if_else((t147 <= t136*t214), 0, casadi.atan2(-t146, t145))
+    t216 = t215
+    t217 = t216 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t216)
+    t218 = t130 + t215
+    t219 = t185 + t218 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t186 - 0.15915494309189535*t218)
+    t220 = -t219
+    t221 = t219 + 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t220)
+    t222 = casadi.if_else((t151 <= t139*t214), 0, casadi.atan2(-t150, t149))
+    t223 = t222
+    t224 = t223 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t223)
+    t225 = t133 + t222
+    t226 = t185 + t225 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t186 - 0.15915494309189535*t225)
+    t227 = -t226
+    t228 = t226 + 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t227)
+    t229 = 1e-24*t121
+    t230 = casadi.if_else((t176 <= t165*t229), 0, casadi.atan2(-t175, t174))
+    t231 = t230
+    t232 = t231 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t231)
+    t233 = t159 + t230
+    t234 = t233 + t8 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t202 - 0.15915494309189535*t233)
+    t235 = -t234
+    t236 = t234 + 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t235)
+    t237 = casadi.if_else((t180 <= t168*t229), 0, casadi.atan2(-t179, t178))
+    t238 = t237
+    t239 = t238 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t238)
+    t240 = t162 + t237
+    t241 = t240 + t8 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t202 - 0.15915494309189535*t240)
+    t242 = -t241
+    t243 = t241 + 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t242)
+    t244 = (t21 <= 3.141592653589793)
+    t245 = casadi.logic_and((t20 >= -3.141592653589793), (t20 <= 3.141592653589793))
+    t246 = casadi.if_else(casadi.logic_and(t244, casadi.logic_not(t245)), t21, t20)
+    t247 = (t184 <= 2.0943951023931953)
+    t248 = casadi.logic_and((t183 >= -2.0943951023931953), (t183 <= 2.0943951023931953))
+    t249 = (t60 <= 2.0943951023931953)
+    t250 = casadi.logic_and((t59 >= -2.0943951023931953), (t59 <= 2.0943951023931953))
+    t251 = -t190
+    t252 = (t193 <= 2.0943951023931953)
+    t253 = casadi.logic_and((t192 >= -2.0943951023931953), (t192 <= 2.0943951023931953))
+    t254 = (t62 <= 2.0943951023931953)
+    t255 = casadi.logic_and((t61 >= -2.0943951023931953), (t61 <= 2.0943951023931953))
+    t256 = -t197
+    t257 = (t201 <= 2.0943951023931953)
+    t258 = casadi.logic_and((t200 >= -2.0943951023931953), (t200 <= 2.0943951023931953))
+    t259 = (t107 <= 2.0943951023931953)
+    t260 = casadi.logic_and((t106 >= -2.0943951023931953), (t106 <= 2.0943951023931953))
+    t261 = -t206
+    t262 = (t209 <= 2.0943951023931953)
+    t263 = casadi.logic_and((t208 >= -2.0943951023931953), (t208 <= 2.0943951023931953))
+    t264 = (t109 <= 2.0943951023931953)
+    t265 = casadi.logic_and((t108 >= -2.0943951023931953), (t108 <= 2.0943951023931953))
+    t266 = -t213
+    t267 = (t23 <= 3.141592653589793)
+    t268 = casadi.logic_and((t22 >= -3.141592653589793), (t22 <= 3.141592653589793))
+    t269 = casadi.if_else(casadi.logic_and(t267, casadi.logic_not(t268)), t23, t22)
+    t270 = (t217 <= 2.0943951023931953)
+    t271 = casadi.logic_and((t216 >= -2.0943951023931953), (t216 <= 2.0943951023931953))
+    t272 = (t141 <= 2.0943951023931953)
+    t273 = casadi.logic_and((t140 >= -2.0943951023931953), (t140 <= 2.0943951023931953))
+    t274 = -t221
+    t275 = (t224 <= 2.0943951023931953)
+    t276 = casadi.logic_and((t223 >= -2.0943951023931953), (t223 <= 2.0943951023931953))
+    t277 = (t143 <= 2.0943951023931953)
+    t278 = casadi.logic_and((t142 >= -2.0943951023931953), (t142 <= 2.0943951023931953))
+    t279 = -t228
+    t280 = (t232 <= 2.0943951023931953)
+    t281 = casadi.logic_and((t231 >= -2.0943951023931953), (t231 <= 2.0943951023931953))
+    t282 = (t170 <= 2.0943951023931953)
+    t283 = casadi.logic_and((t169 >= -2.0943951023931953), (t169 <= 2.0943951023931953))
+    t284 = -t236
+    t285 = (t239 <= 2.0943951023931953)
+    t286 = casadi.logic_and((t238 >= -2.0943951023931953), (t238 <= 2.0943951023931953))
+    t287 = (t172 <= 2.0943951023931953)
+    t288 = casadi.logic_and((t171 >= -2.0943951023931953), (t171 <= 2.0943951023931953))
+    t289 = -t243
+    t290 = (casadi.fabs(t2) < casadi.inf)
+    t291 = (casadi.fabs(mu3) <= 1.5707963267948966)
+    t292 = (t13 > t15)
+    t293 = casadi.logic_or(t292, casadi.logic_and(t16, (0 <= 1e-12*t14)))
+    t294 = (t4 >= -1e-12)
+    t295 = (t4 > 1e-12)
+    t296 = casadi.logic_or(t244, t245)
+    t297 = casadi.logic_or(t267, t268)
     q = casadi.SX(8, 4)
-    q[0, 0] = t259
-    q[0, 1] = casadi.if_else(casadi.logic_and(t260, casadi.logic_not(t261)), t197, t196)
-    q[0, 2] = casadi.if_else(casadi.logic_and(t262, casadi.logic_not(t263)), t70, t69)
-    q[0, 3] = casadi.if_else(casadi.logic_and((t203 >= -2.0943951023931953), casadi.logic_not(casadi.logic_and((t201 >= -2.0943951023931953), (t201 <= 2.0943951023931953)))), t264, t202)
-    q[1, 0] = t259
-    q[1, 1] = casadi.if_else(casadi.logic_and(t265, casadi.logic_not(t266)), t206, t205)
-    q[1, 2] = casadi.if_else(casadi.logic_and(t267, casadi.logic_not(t268)), t72, t71)
-    q[1, 3] = casadi.if_else(casadi.logic_and((t210 >= -2.0943951023931953), casadi.logic_not(casadi.logic_and((t208 >= -2.0943951023931953), (t208 <= 2.0943951023931953)))), t269, t209)
-    q[2, 0] = t259
-    q[2, 1] = casadi.if_else(casadi.logic_and(t270, casadi.logic_not(t271)), t214, t213)
-    q[2, 2] = casadi.if_else(casadi.logic_and(t272, casadi.logic_not(t273)), t120, t119)
-    q[2, 3] = casadi.if_else(casadi.logic_and((t219 >= -2.0943951023931953), casadi.logic_not(casadi.logic_and((t217 >= -2.0943951023931953), (t217 <= 2.0943951023931953)))), t274, t218)
-    q[3, 0] = t259
-    q[3, 1] = casadi.if_else(casadi.logic_and(t275, casadi.logic_not(t276)), t222, t221)
-    q[3, 2] = casadi.if_else(casadi.logic_and(t277, casadi.logic_not(t278)), t122, t121)
-    q[3, 3] = casadi.if_else(casadi.logic_and((t226 >= -2.0943951023931953), casadi.logic_not(casadi.logic_and((t224 >= -2.0943951023931953), (t224 <= 2.0943951023931953)))), t279, t225)
-    q[4, 0] = t282
-    q[4, 1] = casadi.if_else(casadi.logic_and(t283, casadi.logic_not(t284)), t230, t229)
-    q[4, 2] = casadi.if_else(casadi.logic_and(t285, casadi.logic_not(t286)), t154, t153)
-    q[4, 3] = casadi.if_else(casadi.logic_and((t234 >= -2.0943951023931953), casadi.logic_not(casadi.logic_and((t232 >= -2.0943951023931953), (t232 <= 2.0943951023931953)))), t287, t233)
-    q[5, 0] = t282
-    q[5, 1] = casadi.if_else(casadi.logic_and(t288, casadi.logic_not(t289)), t237, t236)
-    q[5, 2] = casadi.if_else(casadi.logic_and(t290, casadi.logic_not(t291)), t156, t155)
-    q[5, 3] = casadi.if_else(casadi.logic_and((t241 >= -2.0943951023931953), casadi.logic_not(casadi.logic_and((t239 >= -2.0943951023931953), (t239 <= 2.0943951023931953)))), t292, t240)
-    q[6, 0] = t282
-    q[6, 1] = casadi.if_else(casadi.logic_and(t293, casadi.logic_not(t294)), t245, t244)
-    q[6, 2] = casadi.if_else(casadi.logic_and(t295, casadi.logic_not(t296)), t183, t182)
-    q[6, 3] = casadi.if_else(casadi.logic_and((t249 >= -2.0943951023931953), casadi.logic_not(casadi.logic_and((t247 >= -2.0943951023931953), (t247 <= 2.0943951023931953)))), t297, t248)
-    q[7, 0] = t282
-    q[7, 1] = casadi.if_else(casadi.logic_and(t298, casadi.logic_not(t299)), t252, t251)
-    q[7, 2] = casadi.if_else(casadi.logic_and(t300, casadi.logic_not(t301)), t185, t184)
-    q[7, 3] = casadi.if_else(casadi.logic_and((t256 >= -2.0943951023931953), casadi.logic_not(casadi.logic_and((t254 >= -2.0943951023931953), (t254 <= 2.0943951023931953)))), t302, t255)
+    q[0, 0] = t246
+    q[0, 1] = casadi.if_else(casadi.logic_and(t247, casadi.logic_not(t248)), t184, t183)
+    q[0, 2] = casadi.if_else(casadi.logic_and(t249, casadi.logic_not(t250)), t60, t59)
+    q[0, 3] = casadi.if_else(casadi.logic_and((t190 >= -2.0943951023931953), casadi.logic_not(casadi.logic_and((t188 >= -2.0943951023931953), (t188 <= 2.0943951023931953)))), t251, t189)
+    q[1, 0] = t246
+    q[1, 1] = casadi.if_else(casadi.logic_and(t252, casadi.logic_not(t253)), t193, t192)
+    q[1, 2] = casadi.if_else(casadi.logic_and(t254, casadi.logic_not(t255)), t62, t61)
+    q[1, 3] = casadi.if_else(casadi.logic_and((t197 >= -2.0943951023931953), casadi.logic_not(casadi.logic_and((t195 >= -2.0943951023931953), (t195 <= 2.0943951023931953)))), t256, t196)
+    q[2, 0] = t246
+    q[2, 1] = casadi.if_else(casadi.logic_and(t257, casadi.logic_not(t258)), t201, t200)
+    q[2, 2] = casadi.if_else(casadi.logic_and(t259, casadi.logic_not(t260)), t107, t106)
+    q[2, 3] = casadi.if_else(casadi.logic_and((t206 >= -2.0943951023931953), casadi.logic_not(casadi.logic_and((t204 >= -2.0943951023931953), (t204 <= 2.0943951023931953)))), t261, t205)
+    q[3, 0] = t246
+    q[3, 1] = casadi.if_else(casadi.logic_and(t262, casadi.logic_not(t263)), t209, t208)
+    q[3, 2] = casadi.if_else(casadi.logic_and(t264, casadi.logic_not(t265)), t109, t108)
+    q[3, 3] = casadi.if_else(casadi.logic_and((t213 >= -2.0943951023931953), casadi.logic_not(casadi.logic_and((t211 >= -2.0943951023931953), (t211 <= 2.0943951023931953)))), t266, t212)
+    q[4, 0] = t269
+    q[4, 1] = casadi.if_else(casadi.logic_and(t270, casadi.logic_not(t271)), t217, t216)
+    q[4, 2] = casadi.if_else(casadi.logic_and(t272, casadi.logic_not(t273)), t141, t140)
+    q[4, 3] = casadi.if_else(casadi.logic_and((t221 >= -2.0943951023931953), casadi.logic_not(casadi.logic_and((t219 >= -2.0943951023931953), (t219 <= 2.0943951023931953)))), t274, t220)
+    q[5, 0] = t269
+    q[5, 1] = casadi.if_else(casadi.logic_and(t275, casadi.logic_not(t276)), t224, t223)
+    q[5, 2] = casadi.if_else(casadi.logic_and(t277, casadi.logic_not(t278)), t143, t142)
+    q[5, 3] = casadi.if_else(casadi.logic_and((t228 >= -2.0943951023931953), casadi.logic_not(casadi.logic_and((t226 >= -2.0943951023931953), (t226 <= 2.0943951023931953)))), t279, t227)
+    q[6, 0] = t269
+    q[6, 1] = casadi.if_else(casadi.logic_and(t280, casadi.logic_not(t281)), t232, t231)
+    q[6, 2] = casadi.if_else(casadi.logic_and(t282, casadi.logic_not(t283)), t170, t169)
+    q[6, 3] = casadi.if_else(casadi.logic_and((t236 >= -2.0943951023931953), casadi.logic_not(casadi.logic_and((t234 >= -2.0943951023931953), (t234 <= 2.0943951023931953)))), t284, t235)
+    q[7, 0] = t269
+    q[7, 1] = casadi.if_else(casadi.logic_and(t285, casadi.logic_not(t286)), t239, t238)
+    q[7, 2] = casadi.if_else(casadi.logic_and(t287, casadi.logic_not(t288)), t172, t171)
+    q[7, 3] = casadi.if_else(casadi.logic_and((t243 >= -2.0943951023931953), casadi.logic_not(casadi.logic_and((t241 >= -2.0943951023931953), (t241 <= 2.0943951023931953)))), t289, t242)
     valid = casadi.SX(8, 1)
-    valid[0, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t303, t304), t306), t309), casadi.logic_or(casadi.logic_and(t311, (t61 >= t308)), casadi.logic_and(t312, (t59 <= t313))))
-    valid[1, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t303, t304), t306), t309), t311), (t61 > 1e-12))
-    valid[2, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t303, t304), t306), t307), t314), casadi.logic_or(casadi.logic_and(t311, (t103 >= t308)), casadi.logic_and(t312, (t102 <= t313))))
-    valid[3, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t303, t304), t306), t307), t311), t314), (t103 > 1e-12))
-    valid[4, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t303, t304), t305), t309), t315), casadi.logic_or(casadi.logic_and(t311, (t137 >= t308)), casadi.logic_and(t312, (t136 <= t313))))
-    valid[5, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t303, t304), t305), t309), t311), t315), (t137 > 1e-12))
-    valid[6, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t303, t304), t305), t307), t314), t315), casadi.logic_or(casadi.logic_and(t311, (t166 >= t308)), casadi.logic_and(t312, (t165 <= t313))))
-    valid[7, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t303, t304), t305), t307), t311), t314), t315), (t166 > 1e-12))
+    valid[0, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t290, t291), t293), t294), (t51 >= -1e-12))
+    valid[1, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t290, t291), t293), t294), (t51 > 1e-12))
+    valid[2, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t290, t291), t293), t295), (t90 >= -1e-12))
+    valid[3, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t290, t291), t293), t295), (t90 > 1e-12))
+    valid[4, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t290, t291), t292), t294), (t124 >= -1e-12))
+    valid[5, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t290, t291), t292), t294), (t124 > 1e-12))
+    valid[6, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t290, t291), t292), t295), (t153 >= -1e-12))
+    valid[7, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t290, t291), t292), t295), (t153 > 1e-12))
     in_limits = casadi.SX(8, 1)
-    in_limits[0, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t316, casadi.logic_or(t260, t261)), casadi.logic_or(t262, t263)), casadi.logic_or((t264 <= 2.0943951023931953), casadi.logic_and((t202 >= -2.0943951023931953), (t202 <= 2.0943951023931953))))
-    in_limits[1, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t316, casadi.logic_or(t265, t266)), casadi.logic_or(t267, t268)), casadi.logic_or((t269 <= 2.0943951023931953), casadi.logic_and((t209 >= -2.0943951023931953), (t209 <= 2.0943951023931953))))
-    in_limits[2, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t316, casadi.logic_or(t270, t271)), casadi.logic_or(t272, t273)), casadi.logic_or((t274 <= 2.0943951023931953), casadi.logic_and((t218 >= -2.0943951023931953), (t218 <= 2.0943951023931953))))
-    in_limits[3, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t316, casadi.logic_or(t275, t276)), casadi.logic_or(t277, t278)), casadi.logic_or((t279 <= 2.0943951023931953), casadi.logic_and((t225 >= -2.0943951023931953), (t225 <= 2.0943951023931953))))
-    in_limits[4, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t317, casadi.logic_or(t283, t284)), casadi.logic_or(t285, t286)), casadi.logic_or((t287 <= 2.0943951023931953), casadi.logic_and((t233 >= -2.0943951023931953), (t233 <= 2.0943951023931953))))
-    in_limits[5, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t317, casadi.logic_or(t288, t289)), casadi.logic_or(t290, t291)), casadi.logic_or((t292 <= 2.0943951023931953), casadi.logic_and((t240 >= -2.0943951023931953), (t240 <= 2.0943951023931953))))
-    in_limits[6, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t317, casadi.logic_or(t293, t294)), casadi.logic_or(t295, t296)), casadi.logic_or((t297 <= 2.0943951023931953), casadi.logic_and((t248 >= -2.0943951023931953), (t248 <= 2.0943951023931953))))
-    in_limits[7, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t317, casadi.logic_or(t298, t299)), casadi.logic_or(t300, t301)), casadi.logic_or((t302 <= 2.0943951023931953), casadi.logic_and((t255 >= -2.0943951023931953), (t255 <= 2.0943951023931953))))
+    in_limits[0, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t296, casadi.logic_or(t247, t248)), casadi.logic_or(t249, t250)), casadi.logic_or((t251 <= 2.0943951023931953), casadi.logic_and((t189 >= -2.0943951023931953), (t189 <= 2.0943951023931953))))
+    in_limits[1, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t296, casadi.logic_or(t252, t253)), casadi.logic_or(t254, t255)), casadi.logic_or((t256 <= 2.0943951023931953), casadi.logic_and((t196 >= -2.0943951023931953), (t196 <= 2.0943951023931953))))
+    in_limits[2, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t296, casadi.logic_or(t257, t258)), casadi.logic_or(t259, t260)), casadi.logic_or((t261 <= 2.0943951023931953), casadi.logic_and((t205 >= -2.0943951023931953), (t205 <= 2.0943951023931953))))
+    in_limits[3, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t296, casadi.logic_or(t262, t263)), casadi.logic_or(t264, t265)), casadi.logic_or((t266 <= 2.0943951023931953), casadi.logic_and((t212 >= -2.0943951023931953), (t212 <= 2.0943951023931953))))
+    in_limits[4, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t297, casadi.logic_or(t270, t271)), casadi.logic_or(t272, t273)), casadi.logic_or((t274 <= 2.0943951023931953), casadi.logic_and((t220 >= -2.0943951023931953), (t220 <= 2.0943951023931953))))
+    in_limits[5, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t297, casadi.logic_or(t275, t276)), casadi.logic_or(t277, t278)), casadi.logic_or((t279 <= 2.0943951023931953), casadi.logic_and((t227 >= -2.0943951023931953), (t227 <= 2.0943951023931953))))
+    in_limits[6, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t297, casadi.logic_or(t280, t281)), casadi.logic_or(t282, t283)), casadi.logic_or((t284 <= 2.0943951023931953), casadi.logic_and((t235 >= -2.0943951023931953), (t235 <= 2.0943951023931953))))
+    in_limits[7, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t297, casadi.logic_or(t285, t286)), casadi.logic_or(t287, t288)), casadi.logic_or((t289 <= 2.0943951023931953), casadi.logic_and((t242 >= -2.0943951023931953), (t242 <= 2.0943951023931953))))
     return [q, valid, in_limits]
 
 
 def _ik_nearest(mu, q_seed, weights):
-    """The closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status: 1598 operations."""
+    """The closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status: 1536 operations."""
     mu0 = mu[0]
     mu1 = mu[1]
     mu2 = mu[2]
@@ -1614,600 +1594,586 @@ def _ik_nearest(mu, q_seed, weights):
     t5 = casadi.if_else(t4, -t0, casadi.if_else((t0 < 0), 1, -1))
     t6 = casadi.if_else(t4, casadi.sqrt(t3), 0)
     t7 = casadi.atan2(t6, t5)
-    t8 = False
-    t9 = casadi.if_else(t8, 0, t7)
-    t10 = casadi.if_else(t8, 1, t5)
-    t11 = casadi.if_else(t8, 0, t6)
-    t12 = casadi.if_else(t8, 1, 100)
-    t13 = mu0**2 + mu1**2
-    t14 = t13
-    t15 = t13 + mu2**2
-    t16 = 1e-24*t15
-    t17 = (t14 <= t16)
-    t18 = casadi.if_else(t17, 1, 1/casadi.sqrt(t14))
-    t19 = True
-    t20 = casadi.if_else(t19, 0, -1)
-    t21 = casadi.if_else(t19, 1, 0)
-    t22 = casadi.atan2(t21, t20)
-    t23 = casadi.if_else(t17, 0, t1 + t22)
-    t24 = t1 - t22
-    t25 = t23 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t23)
-    t26 = t25 - 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*t25)
-    t27 = t24 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t24)
-    t28 = t27 - 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*t27)
-    t29 = t18*t20
-    t30 = mu1*t29
-    t31 = t18*t21
-    t32 = mu0*t31
-    t33 = casadi.if_else(t17, 1, -t30 - t32)
-    t34 = t32 - t30
-    t35 = mu2*(1 - t33)
-    t36 = t35 + mu2*t33
-    t37 = mu2*(1 - t34)
-    t38 = t37 + mu2*t34
-    t39 = mu0*t29
-    t40 = mu1*t31
-    t41 = casadi.if_else(t17, 0, t39 - t40)
-    t42 = t39 + t40
-    t43 = mu0*t33 + mu1*t41
-    t44 = mu1*t33 - mu0*t41
-    t45 = mu0*t34 + mu1*t42
-    t46 = mu1*t34 - mu0*t42
-    t47 = 0.1*t11
-    t48 = t43 + t47
-    t49 = t45 + t47
-    t50 = -0.1*t10
-    t51 = t36 + t50
-    t52 = -0.12 + t51
-    t53 = t38 + t50
-    t54 = -0.12 + t53
-    t55 = t44**2
-    t56 = t55 + t48**2 + t52**2
-    t57 = 0.01 - 0.5*t56
-    t58 = t57**2
-    t59 = t12**2
-    t60 = 1 - t58*t59
-    t61 = t12*t57
-    t62 = (1e-12 < t60)
-    t63 = casadi.if_else(t62, t61, casadi.if_else((t61 > 0), 1, -1))
-    t64 = casadi.if_else(t62, casadi.sqrt(t60), 0)
-    t65 = casadi.atan2(t64, t63)
-    t66 = casadi.if_else(t8, 0, 3.141592653589793 + t65)
-    t67 = 3.141592653589793 - t65
-    t68 = t66 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t66)
-    t69 = t68 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t68)
-    t70 = t67 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t67)
-    t71 = t70 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t70)
-    t72 = 0.01*t12
-    t73 = casadi.if_else(t8, 1, -t63*t72)
-    t74 = casadi.if_else(t8, 0, -t64*t72)
-    t75 = 0.22 + 0.1*t73
-    t76 = -0.12 + t75
-    t77 = t76**2 + 0.01*t74**2
-    t78 = 0.1*t74
-    t79 = t52*t76 - t48*t78
-    t80 = t48*t76 + t52*t78
-    t81 = t79**2 + t80**2
-    t82 = 0.001*t12
-    t83 = 0.22 - t63*t82
-    t84 = -0.12 + t83
-    t85 = t64*t82
-    t86 = t52*t84 - t48*t85
-    t87 = t48*t84 + t52*t85
-    t88 = t86**2 + t87**2
-    t89 = 1e-06*t59
-    t90 = t84**2 + t89*t64**2
-    t91 = -0.1*t6
-    t92 = t43 + t91
-    t93 = t45 + t91
-    t94 = -0.1*t5
-    t95 = t36 + t94
-    t96 = -0.12 + t95
-    t97 = t55 + t92**2 + t96**2
-    t98 = 0.01 - 0.5*t97
-    t99 = t38 + t94
+    t8 = t7
+    t9 = t5
+    t10 = t6
+    t11 = mu0**2 + mu1**2
+    t12 = t11
+    t13 = t11 + mu2**2
+    t14 = 1e-24*t13
+    t15 = (t12 <= t14)
+    t16 = casadi.if_else(t15, 1, 1/casadi.sqrt(t12))
+    t17 = casadi.if_else(t15, 0, t1 + (1/2)*casadi.pi)
+    t18 = t1 - 1/2*casadi.pi
+    t19 = t17 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t17)
+    t20 = t19 - 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*t19)
+    t21 = t18 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t18)
+    t22 = t21 - 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*t21)
+    t23 = t16
+    t24 = mu0*t23
+    t25 = casadi.if_else(t15, 1, -t24)
+    t26 = t24
+    t27 = mu2*(1 - t25)
+    t28 = t27 + mu2*t25
+    t29 = mu2*(1 - t26)
+    t30 = t29 + mu2*t26
+    t31 = mu1*t23
+    t32 = casadi.if_else(t15, 0, -t31)
+    t33 = t31
+    t34 = mu0*t25 + mu1*t32
+    t35 = mu1*t25 - mu0*t32
+    t36 = mu0*t26 + mu1*t33
+    t37 = mu1*t26 - mu0*t33
+    t38 = 0.1*t10
+    t39 = t34 + t38
+    t40 = t36 + t38
+    t41 = -0.1*t9
+    t42 = t28 + t41
+    t43 = -0.12 + t42
+    t44 = t30 + t41
+    t45 = -0.12 + t44
+    t46 = t35**2
+    t47 = t46 + t39**2 + t43**2
+    t48 = 0.01 - 0.5*t47
+    t49 = t48**2
+    t50 = 1 - 10000*t49
+    t51 = 100*t48
+    t52 = (1e-12 < t50)
+    t53 = casadi.if_else(t52, t51, casadi.if_else((t51 > 0), 1, -1))
+    t54 = casadi.if_else(t52, casadi.sqrt(t50), 0)
+    t55 = casadi.atan2(t54, t53)
+    t56 = 3.141592653589793 + t55
+    t57 = 3.141592653589793 - t55
+    t58 = t56 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t56)
+    t59 = t58 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t58)
+    t60 = t57 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t57)
+    t61 = t60 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t60)
+    t62 = -1.0*t53
+    t63 = -1.0*t54
+    t64 = 0.22 + 0.1*t62
+    t65 = -0.12 + t64
+    t66 = t65**2 + 0.01*t63**2
+    t67 = 0.1*t63
+    t68 = t43*t65 - t39*t67
+    t69 = t39*t65 + t43*t67
+    t70 = t68**2 + t69**2
+    t71 = 0.22 - 0.1*t53
+    t72 = -0.12 + t71
+    t73 = 0.1*t54
+    t74 = t43*t72 - t39*t73
+    t75 = t39*t72 + t43*t73
+    t76 = t74**2 + t75**2
+    t77 = t72**2 + 0.01*t54**2
+    t78 = -0.1*t6
+    t79 = t34 + t78
+    t80 = t36 + t78
+    t81 = -0.1*t5
+    t82 = t28 + t81
+    t83 = -0.12 + t82
+    t84 = t46 + t79**2 + t83**2
+    t85 = 0.01 - 0.5*t84
+    t86 = t30 + t81
+    t87 = -0.12 + t86
+    t88 = t85**2
+    t89 = 1 - 10000*t88
+    t90 = 100*t85
+    t91 = (1e-12 < t89)
+    t92 = casadi.if_else(t91, t90, casadi.if_else((t90 > 0), 1, -1))
+    t93 = casadi.if_else(t91, casadi.sqrt(t89), 0)
+    t94 = casadi.atan2(t93, t92)
+    t95 = 3.141592653589793 + t94
+    t96 = -1.0*t92
+    t97 = -1.0*t93
+    t98 = 3.141592653589793 - t94
+    t99 = 0.22 + 0.1*t96
     t100 = -0.12 + t99
-    t101 = t98**2
-    t102 = 1 - t101*t59
-    t103 = t12*t98
-    t104 = (1e-12 < t102)
-    t105 = casadi.if_else(t104, t103, casadi.if_else((t103 > 0), 1, -1))
-    t106 = casadi.if_else(t104, casadi.sqrt(t102), 0)
-    t107 = casadi.atan2(t106, t105)
-    t108 = casadi.if_else(t8, 0, 3.141592653589793 + t107)
-    t109 = casadi.if_else(t8, 1, -t105*t72)
-    t110 = casadi.if_else(t8, 0, -t106*t72)
-    t111 = 3.141592653589793 - t107
-    t112 = 0.22 + 0.1*t109
-    t113 = -0.12 + t112
-    t114 = t113**2 + 0.01*t110**2
-    t115 = 0.22 - t105*t82
-    t116 = -0.12 + t115
-    t117 = t116**2 + t89*t106**2
-    t118 = t108 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t108)
-    t119 = t118 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t118)
-    t120 = t111 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t111)
-    t121 = t120 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t120)
-    t122 = 0.1*t110
-    t123 = t113*t96 - t122*t92
-    t124 = t113*t92 + t122*t96
-    t125 = t123**2 + t124**2
-    t126 = t106*t82
-    t127 = t116*t96 - t126*t92
-    t128 = t116*t92 + t126*t96
-    t129 = t127**2 + t128**2
-    t130 = t46**2
-    t131 = t130 + t49**2 + t54**2
-    t132 = 0.01 - 0.5*t131
-    t133 = t130 + t100**2 + t93**2
-    t134 = 0.01 - 0.5*t133
-    t135 = t132**2
-    t136 = 1 - t135*t59
-    t137 = t12*t132
-    t138 = (1e-12 < t136)
-    t139 = casadi.if_else(t138, t137, casadi.if_else((t137 > 0), 1, -1))
-    t140 = casadi.if_else(t138, casadi.sqrt(t136), 0)
-    t141 = casadi.atan2(t140, t139)
-    t142 = casadi.if_else(t8, 0, 3.141592653589793 + t141)
-    t143 = casadi.if_else(t8, 1, -t139*t72)
-    t144 = casadi.if_else(t8, 0, -t140*t72)
-    t145 = 3.141592653589793 - t141
-    t146 = 0.22 + 0.1*t143
-    t147 = -0.12 + t146
-    t148 = t147**2 + 0.01*t144**2
-    t149 = 0.22 - t139*t82
-    t150 = -0.12 + t149
-    t151 = t150**2 + t89*t140**2
-    t152 = t142 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t142)
-    t153 = t152 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t152)
-    t154 = t145 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t145)
-    t155 = t154 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t154)
-    t156 = 0.1*t144
-    t157 = t147*t54 - t156*t49
-    t158 = t147*t49 + t156*t54
-    t159 = t157**2 + t158**2
-    t160 = t140*t82
-    t161 = t150*t54 - t160*t49
-    t162 = t150*t49 + t160*t54
-    t163 = t161**2 + t162**2
-    t164 = t134**2
-    t165 = 1 - t164*t59
-    t166 = t12*t134
-    t167 = (1e-12 < t165)
-    t168 = casadi.if_else(t167, t166, casadi.if_else((t166 > 0), 1, -1))
-    t169 = casadi.if_else(t167, casadi.sqrt(t165), 0)
-    t170 = casadi.atan2(t169, t168)
-    t171 = casadi.if_else(t8, 0, 3.141592653589793 + t170)
-    t172 = casadi.if_else(t8, 1, -t168*t72)
-    t173 = casadi.if_else(t8, 0, -t169*t72)
-    t174 = 3.141592653589793 - t170
-    t175 = 0.22 + 0.1*t172
-    t176 = -0.12 + t175
-    t177 = t176**2 + 0.01*t173**2
-    t178 = 0.22 - t168*t82
-    t179 = -0.12 + t178
-    t180 = t179**2 + t89*t169**2
-    t181 = t171 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t171)
-    t182 = t181 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t181)
-    t183 = t174 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t174)
-    t184 = t183 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t183)
-    t185 = 0.1*t173
-    t186 = t100*t176 - t185*t93
-    t187 = t100*t185 + t176*t93
-    t188 = t186**2 + t187**2
-    t189 = t169*t82
-    t190 = t100*t179 - t189*t93
-    t191 = t100*t189 + t179*t93
-    t192 = t190**2 + t191**2
-    t193 = mu0 + mu1 + mu2 + mu3
+    t101 = t100**2 + 0.01*t97**2
+    t102 = 0.22 - 0.1*t92
+    t103 = -0.12 + t102
+    t104 = t103**2 + 0.01*t93**2
+    t105 = t95 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t95)
+    t106 = t105 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t105)
+    t107 = t98 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t98)
+    t108 = t107 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t107)
+    t109 = 0.1*t97
+    t110 = t100*t83 - t109*t79
+    t111 = t100*t79 + t109*t83
+    t112 = t110**2 + t111**2
+    t113 = 0.1*t93
+    t114 = t103*t83 - t113*t79
+    t115 = t103*t79 + t113*t83
+    t116 = t114**2 + t115**2
+    t117 = t37**2
+    t118 = t117 + t40**2 + t45**2
+    t119 = 0.01 - 0.5*t118
+    t120 = t117 + t80**2 + t87**2
+    t121 = 0.01 - 0.5*t120
+    t122 = t119**2
+    t123 = 1 - 10000*t122
+    t124 = 100*t119
+    t125 = (1e-12 < t123)
+    t126 = casadi.if_else(t125, t124, casadi.if_else((t124 > 0), 1, -1))
+    t127 = casadi.if_else(t125, casadi.sqrt(t123), 0)
+    t128 = casadi.atan2(t127, t126)
+    t129 = 3.141592653589793 + t128
+    t130 = -1.0*t126
+    t131 = -1.0*t127
+    t132 = 3.141592653589793 - t128
+    t133 = 0.22 + 0.1*t130
+    t134 = -0.12 + t133
+    t135 = t134**2 + 0.01*t131**2
+    t136 = 0.22 - 0.1*t126
+    t137 = -0.12 + t136
+    t138 = t137**2 + 0.01*t127**2
+    t139 = t129 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t129)
+    t140 = t139 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t139)
+    t141 = t132 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t132)
+    t142 = t141 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t141)
+    t143 = 0.1*t131
+    t144 = t134*t45 - t143*t40
+    t145 = t134*t40 + t143*t45
+    t146 = t144**2 + t145**2
+    t147 = 0.1*t127
+    t148 = t137*t45 - t147*t40
+    t149 = t137*t40 + t147*t45
+    t150 = t148**2 + t149**2
+    t151 = t121**2
+    t152 = 1 - 10000*t151
+    t153 = 100*t121
+    t154 = (1e-12 < t152)
+    t155 = casadi.if_else(t154, t153, casadi.if_else((t153 > 0), 1, -1))
+    t156 = casadi.if_else(t154, casadi.sqrt(t152), 0)
+    t157 = casadi.atan2(t156, t155)
+    t158 = 3.141592653589793 + t157
+    t159 = -1.0*t155
+    t160 = -1.0*t156
+    t161 = 3.141592653589793 - t157
+    t162 = 0.22 + 0.1*t159
+    t163 = -0.12 + t162
+    t164 = t163**2 + 0.01*t160**2
+    t165 = 0.22 - 0.1*t155
+    t166 = -0.12 + t165
+    t167 = t166**2 + 0.01*t156**2
+    t168 = t158 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t158)
+    t169 = t168 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t168)
+    t170 = t161 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t161)
+    t171 = t170 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t170)
+    t172 = 0.1*t160
+    t173 = t163*t87 - t172*t80
+    t174 = t163*t80 + t172*t87
+    t175 = t173**2 + t174**2
+    t176 = 0.1*t156
+    t177 = t166*t87 - t176*t80
+    t178 = t166*t80 + t176*t87
+    t179 = t177**2 + t178**2
+    t180 = mu0 + mu1 + mu2 + mu3
+    t181 = t180
+    t182 = qn1 + qn2 + qn3 + qn4 + qw1 + qw2 + qw3 + qw4 + t180
+    t183 = 1e-24*t47
+    t184 = casadi.if_else((t70 <= t183*t66), 0, casadi.atan2(-t69, t68))
+    t185 = t184
+    t186 = t185 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t185)
+    t187 = -t8
+    t188 = 3.141592653589793 + t187
+    t189 = t184 + t56
+    t190 = t187 + t189 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t188 - 0.15915494309189535*t189)
+    t191 = -t190
+    t192 = t190 + 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t191)
+    t193 = casadi.if_else((t76 <= t183*t77), 0, casadi.atan2(-t75, t74))
     t194 = t193
-    t195 = qn1 + qn2 + qn3 + qn4 + qw1 + qw2 + qw3 + qw4 + t193
-    t196 = 1e-24*t56
-    t197 = casadi.if_else((t81 <= t196*t77), 0, casadi.atan2(-t80, t79))
-    t198 = t197
-    t199 = t198 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t198)
-    t200 = -t9
-    t201 = 3.141592653589793 + t200
-    t202 = t197 + t66
-    t203 = t200 + t202 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t201 - 0.15915494309189535*t202)
-    t204 = -t203
-    t205 = t203 + 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t204)
-    t206 = casadi.if_else((t88 <= t196*t90), 0, casadi.atan2(-t87, t86))
-    t207 = t206
-    t208 = t207 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t207)
-    t209 = t206 + t67
-    t210 = t200 + t209 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t201 - 0.15915494309189535*t209)
-    t211 = -t210
-    t212 = t210 + 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t211)
-    t213 = 1e-24*t97
-    t214 = casadi.if_else((t125 <= t114*t213), 0, casadi.atan2(-t124, t123))
-    t215 = t214
-    t216 = t215 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t215)
-    t217 = 3.141592653589793 + t7
-    t218 = t108 + t214
-    t219 = t218 + t7 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t217 - 0.15915494309189535*t218)
-    t220 = -t219
-    t221 = t219 + 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t220)
-    t222 = casadi.if_else((t129 <= t117*t213), 0, casadi.atan2(-t128, t127))
-    t223 = t222
-    t224 = t223 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t223)
-    t225 = t111 + t222
-    t226 = t225 + t7 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t217 - 0.15915494309189535*t225)
-    t227 = -t226
-    t228 = t226 + 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t227)
-    t229 = 1e-24*t131
-    t230 = casadi.if_else((t159 <= t148*t229), 0, casadi.atan2(-t158, t157))
-    t231 = t230
-    t232 = t231 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t231)
-    t233 = t142 + t230
-    t234 = t200 + t233 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t201 - 0.15915494309189535*t233)
-    t235 = -t234
-    t236 = t234 + 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t235)
-    t237 = casadi.if_else((t163 <= t151*t229), 0, casadi.atan2(-t162, t161))
-    t238 = t237
-    t239 = t238 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t238)
-    t240 = t145 + t237
-    t241 = t200 + t240 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t201 - 0.15915494309189535*t240)
-    t242 = -t241
-    t243 = t241 + 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t242)
-    t244 = 1e-24*t133
-    t245 = casadi.if_else((t188 <= t177*t244), 0, casadi.atan2(-t187, t186))
-    t246 = t245
-    t247 = t246 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t246)
-    t248 = t171 + t245
-    t249 = t248 + t7 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t217 - 0.15915494309189535*t248)
-    t250 = -t249
-    t251 = t249 + 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t250)
-    t252 = casadi.if_else((t192 <= t180*t244), 0, casadi.atan2(-t191, t190))
-    t253 = t252
-    t254 = t253 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t253)
-    t255 = t174 + t252
-    t256 = t255 + t7 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t217 - 0.15915494309189535*t255)
-    t257 = -t256
-    t258 = t256 + 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t257)
-    t259 = (t26 <= 3.141592653589793)
-    t260 = casadi.logic_and((t25 >= -3.141592653589793), (t25 <= 3.141592653589793))
-    t261 = casadi.if_else(casadi.logic_and(t259, casadi.logic_not(t260)), t26, t25)
-    t262 = t261
-    t263 = t262 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn1 - 0.15915494309189535*t262)
-    t264 = casadi.if_else((qn1 > t263), 6.283185307179586, -6.283185307179586)
-    t265 = t263 + t264
-    t266 = t263 - t264
-    t267 = casadi.if_else(casadi.logic_and((t263 >= -3.141592653589793), (t263 <= 3.141592653589793)), t263, casadi.if_else(casadi.logic_and((t265 >= -3.141592653589793), (t265 <= 3.141592653589793)), t265, casadi.if_else(casadi.logic_and((t266 >= -3.141592653589793), (t266 <= 3.141592653589793)), t266, t261)))
-    t268 = (t199 <= 2.0943951023931953)
-    t269 = casadi.logic_and((t198 >= -2.0943951023931953), (t198 <= 2.0943951023931953))
-    t270 = casadi.if_else(casadi.logic_and(t268, casadi.logic_not(t269)), t199, t198)
-    t271 = t270
-    t272 = t271 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t271)
-    t273 = casadi.if_else((qn2 > t272), 6.283185307179586, -6.283185307179586)
-    t274 = t272 + t273
-    t275 = t272 - t273
-    t276 = casadi.if_else(casadi.logic_and((t272 >= -2.0943951023931953), (t272 <= 2.0943951023931953)), t272, casadi.if_else(casadi.logic_and((t274 >= -2.0943951023931953), (t274 <= 2.0943951023931953)), t274, casadi.if_else(casadi.logic_and((t275 >= -2.0943951023931953), (t275 <= 2.0943951023931953)), t275, t270)))
-    t277 = (t69 <= 2.0943951023931953)
-    t278 = casadi.logic_and((t68 >= -2.0943951023931953), (t68 <= 2.0943951023931953))
-    t279 = casadi.if_else(casadi.logic_and(t277, casadi.logic_not(t278)), t69, t68)
-    t280 = t279
-    t281 = t280 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn3 - 0.15915494309189535*t280)
-    t282 = casadi.if_else((qn3 > t281), 6.283185307179586, -6.283185307179586)
-    t283 = t281 + t282
-    t284 = t281 - t282
-    t285 = casadi.if_else(casadi.logic_and((t281 >= -2.0943951023931953), (t281 <= 2.0943951023931953)), t281, casadi.if_else(casadi.logic_and((t283 >= -2.0943951023931953), (t283 <= 2.0943951023931953)), t283, casadi.if_else(casadi.logic_and((t284 >= -2.0943951023931953), (t284 <= 2.0943951023931953)), t284, t279)))
-    t286 = (t205 >= -2.0943951023931953)
-    t287 = casadi.logic_and((t203 >= -2.0943951023931953), (t203 <= 2.0943951023931953))
-    t288 = casadi.if_else(casadi.logic_and(t286, casadi.logic_not(t287)), -t205, t204)
-    t289 = t288
-    t290 = t289 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t289)
-    t291 = casadi.if_else((qn4 > t290), 6.283185307179586, -6.283185307179586)
-    t292 = t290 + t291
-    t293 = t290 - t291
-    t294 = casadi.if_else(casadi.logic_and((t290 >= -2.0943951023931953), (t290 <= 2.0943951023931953)), t290, casadi.if_else(casadi.logic_and((t292 >= -2.0943951023931953), (t292 <= 2.0943951023931953)), t292, casadi.if_else(casadi.logic_and((t293 >= -2.0943951023931953), (t293 <= 2.0943951023931953)), t293, t288)))
-    t295 = -qn1
-    t296 = qw1*(t267 + t295)**2
-    t297 = -qn2
-    t298 = -qn3
-    t299 = -qn4
-    t300 = t296 + qw2*(t276 + t297)**2 + qw3*(t285 + t298)**2 + qw4*(t294 + t299)**2
-    t301 = (casadi.fabs(t194) < casadi.inf)
-    t302 = (casadi.fabs(mu3) <= 1.5707963267948966)
-    t303 = casadi.logic_or(t259, t260)
-    t304 = (t14 > t16)
-    t305 = casadi.logic_or(t304, casadi.logic_and(t17, (1e-12*t15 >= 0)))
-    t306 = True
-    t307 = casadi.logic_or(casadi.logic_and(t8, (1e-12 >= t2)), casadi.logic_and(t306, (1e-12 >= -t3)))
-    t308 = casadi.if_else(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t301, t302), t303), t305), t307), casadi.logic_or(t268, t269)), casadi.logic_or(t277, t278)), casadi.logic_or(t286, t287)), casadi.logic_or(casadi.logic_and(t306, (t60 >= -1e-12)), casadi.logic_and(t8, (t58 <= 1e-16)))), 1, 0)
-    t309 = casadi.if_else((t308 > 0), 1, 0)
-    t310 = (t309 > 0)
-    t311 = casadi.if_else(t310, t267, qn1)
-    t312 = casadi.if_else(t310, t276, qn2)
-    t313 = casadi.if_else(t310, t285, qn3)
-    t314 = casadi.if_else(t310, t294, qn4)
-    t315 = casadi.if_else(t310, t300, 0)
-    t316 = (t208 <= 2.0943951023931953)
-    t317 = casadi.logic_and((t207 >= -2.0943951023931953), (t207 <= 2.0943951023931953))
-    t318 = casadi.if_else(casadi.logic_and(t316, casadi.logic_not(t317)), t208, t207)
-    t319 = t318
-    t320 = t319 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t319)
-    t321 = casadi.if_else((qn2 > t320), 6.283185307179586, -6.283185307179586)
-    t322 = t320 + t321
-    t323 = t320 - t321
-    t324 = casadi.if_else(casadi.logic_and((t320 >= -2.0943951023931953), (t320 <= 2.0943951023931953)), t320, casadi.if_else(casadi.logic_and((t322 >= -2.0943951023931953), (t322 <= 2.0943951023931953)), t322, casadi.if_else(casadi.logic_and((t323 >= -2.0943951023931953), (t323 <= 2.0943951023931953)), t323, t318)))
-    t325 = (t71 <= 2.0943951023931953)
-    t326 = casadi.logic_and((t70 >= -2.0943951023931953), (t70 <= 2.0943951023931953))
-    t327 = casadi.if_else(casadi.logic_and(t325, casadi.logic_not(t326)), t71, t70)
-    t328 = t327
-    t329 = t328 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn3 - 0.15915494309189535*t328)
-    t330 = casadi.if_else((qn3 > t329), 6.283185307179586, -6.283185307179586)
-    t331 = t329 + t330
-    t332 = t329 - t330
-    t333 = casadi.if_else(casadi.logic_and((t329 >= -2.0943951023931953), (t329 <= 2.0943951023931953)), t329, casadi.if_else(casadi.logic_and((t331 >= -2.0943951023931953), (t331 <= 2.0943951023931953)), t331, casadi.if_else(casadi.logic_and((t332 >= -2.0943951023931953), (t332 <= 2.0943951023931953)), t332, t327)))
-    t334 = (t212 >= -2.0943951023931953)
-    t335 = casadi.logic_and((t210 >= -2.0943951023931953), (t210 <= 2.0943951023931953))
-    t336 = casadi.if_else(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t301, t302), t303), t305), t306), t307), t62), casadi.logic_or(t316, t317)), casadi.logic_or(t325, t326)), casadi.logic_or(t334, t335)), 1, 0)
-    t337 = casadi.if_else(casadi.logic_and(t334, casadi.logic_not(t335)), -t212, t211)
-    t338 = t337
-    t339 = t338 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t338)
-    t340 = casadi.if_else((qn4 > t339), 6.283185307179586, -6.283185307179586)
-    t341 = t339 + t340
-    t342 = t339 - t340
-    t343 = casadi.if_else(casadi.logic_and((t339 >= -2.0943951023931953), (t339 <= 2.0943951023931953)), t339, casadi.if_else(casadi.logic_and((t341 >= -2.0943951023931953), (t341 <= 2.0943951023931953)), t341, casadi.if_else(casadi.logic_and((t342 >= -2.0943951023931953), (t342 <= 2.0943951023931953)), t342, t337)))
-    t344 = t296 + qw2*(t297 + t324)**2 + qw3*(t298 + t333)**2 + qw4*(t299 + t343)**2
-    t345 = (t336 > 0)
-    t346 = casadi.if_else(casadi.logic_and(t345, casadi.logic_or((t315 > t344), (t309 < 1))), 1, 0)
-    t347 = casadi.if_else(t345, 1, t309)
-    t348 = (t346 > 0)
-    t349 = casadi.if_else(t348, t267, t311)
-    t350 = casadi.if_else(t348, t324, t312)
-    t351 = casadi.if_else(t348, t333, t313)
-    t352 = casadi.if_else(t348, t343, t314)
-    t353 = casadi.if_else(t348, t344, t315)
-    t354 = (t216 <= 2.0943951023931953)
-    t355 = casadi.logic_and((t215 >= -2.0943951023931953), (t215 <= 2.0943951023931953))
-    t356 = casadi.if_else(casadi.logic_and(t354, casadi.logic_not(t355)), t216, t215)
-    t357 = t356
-    t358 = t357 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t357)
-    t359 = casadi.if_else((qn2 > t358), 6.283185307179586, -6.283185307179586)
-    t360 = t358 + t359
-    t361 = t358 - t359
-    t362 = casadi.if_else(casadi.logic_and((t358 >= -2.0943951023931953), (t358 <= 2.0943951023931953)), t358, casadi.if_else(casadi.logic_and((t360 >= -2.0943951023931953), (t360 <= 2.0943951023931953)), t360, casadi.if_else(casadi.logic_and((t361 >= -2.0943951023931953), (t361 <= 2.0943951023931953)), t361, t356)))
-    t363 = (t119 <= 2.0943951023931953)
-    t364 = casadi.logic_and((t118 >= -2.0943951023931953), (t118 <= 2.0943951023931953))
-    t365 = casadi.if_else(casadi.logic_and(t363, casadi.logic_not(t364)), t119, t118)
-    t366 = t365
-    t367 = t366 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn3 - 0.15915494309189535*t366)
-    t368 = casadi.if_else((qn3 > t367), 6.283185307179586, -6.283185307179586)
-    t369 = t367 + t368
-    t370 = t367 - t368
-    t371 = casadi.if_else(casadi.logic_and((t367 >= -2.0943951023931953), (t367 <= 2.0943951023931953)), t367, casadi.if_else(casadi.logic_and((t369 >= -2.0943951023931953), (t369 <= 2.0943951023931953)), t369, casadi.if_else(casadi.logic_and((t370 >= -2.0943951023931953), (t370 <= 2.0943951023931953)), t370, t365)))
-    t372 = (t221 >= -2.0943951023931953)
-    t373 = casadi.logic_and((t219 >= -2.0943951023931953), (t219 <= 2.0943951023931953))
-    t374 = casadi.if_else(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t301, t302), t303), t305), t306), t4), casadi.logic_or(t354, t355)), casadi.logic_or(t363, t364)), casadi.logic_or(t372, t373)), casadi.logic_or(casadi.logic_and(t306, (t102 >= -1e-12)), casadi.logic_and(t8, (t101 <= 1e-16)))), 1, 0)
-    t375 = casadi.if_else(casadi.logic_and(t372, casadi.logic_not(t373)), -t221, t220)
-    t376 = t375
-    t377 = t376 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t376)
-    t378 = casadi.if_else((qn4 > t377), 6.283185307179586, -6.283185307179586)
-    t379 = t377 + t378
-    t380 = t377 - t378
-    t381 = casadi.if_else(casadi.logic_and((t377 >= -2.0943951023931953), (t377 <= 2.0943951023931953)), t377, casadi.if_else(casadi.logic_and((t379 >= -2.0943951023931953), (t379 <= 2.0943951023931953)), t379, casadi.if_else(casadi.logic_and((t380 >= -2.0943951023931953), (t380 <= 2.0943951023931953)), t380, t375)))
-    t382 = t296 + qw2*(t297 + t362)**2 + qw3*(t298 + t371)**2 + qw4*(t299 + t381)**2
-    t383 = (t374 > 0)
-    t384 = casadi.if_else(casadi.logic_and(t383, casadi.logic_or((t353 > t382), (t347 < 1))), 1, 0)
-    t385 = casadi.if_else(t383, 1, t347)
-    t386 = (t384 > 0)
-    t387 = casadi.if_else(t386, t267, t349)
-    t388 = casadi.if_else(t386, t362, t350)
-    t389 = casadi.if_else(t386, t371, t351)
-    t390 = casadi.if_else(t386, t381, t352)
-    t391 = casadi.if_else(t386, t382, t353)
-    t392 = (t224 <= 2.0943951023931953)
-    t393 = casadi.logic_and((t223 >= -2.0943951023931953), (t223 <= 2.0943951023931953))
-    t394 = casadi.if_else(casadi.logic_and(t392, casadi.logic_not(t393)), t224, t223)
-    t395 = t394
-    t396 = t395 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t395)
-    t397 = casadi.if_else((qn2 > t396), 6.283185307179586, -6.283185307179586)
-    t398 = t396 + t397
-    t399 = t396 - t397
-    t400 = casadi.if_else(casadi.logic_and((t396 >= -2.0943951023931953), (t396 <= 2.0943951023931953)), t396, casadi.if_else(casadi.logic_and((t398 >= -2.0943951023931953), (t398 <= 2.0943951023931953)), t398, casadi.if_else(casadi.logic_and((t399 >= -2.0943951023931953), (t399 <= 2.0943951023931953)), t399, t394)))
-    t401 = (t121 <= 2.0943951023931953)
-    t402 = casadi.logic_and((t120 >= -2.0943951023931953), (t120 <= 2.0943951023931953))
-    t403 = casadi.if_else(casadi.logic_and(t401, casadi.logic_not(t402)), t121, t120)
-    t404 = t403
-    t405 = t404 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn3 - 0.15915494309189535*t404)
-    t406 = casadi.if_else((qn3 > t405), 6.283185307179586, -6.283185307179586)
-    t407 = t405 + t406
-    t408 = t405 - t406
-    t409 = casadi.if_else(casadi.logic_and((t405 >= -2.0943951023931953), (t405 <= 2.0943951023931953)), t405, casadi.if_else(casadi.logic_and((t407 >= -2.0943951023931953), (t407 <= 2.0943951023931953)), t407, casadi.if_else(casadi.logic_and((t408 >= -2.0943951023931953), (t408 <= 2.0943951023931953)), t408, t403)))
-    t410 = (t228 >= -2.0943951023931953)
-    t411 = casadi.logic_and((t226 >= -2.0943951023931953), (t226 <= 2.0943951023931953))
-    t412 = casadi.if_else(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t104, t301), t302), t303), t305), t306), t4), casadi.logic_or(t392, t393)), casadi.logic_or(t401, t402)), casadi.logic_or(t410, t411)), 1, 0)
-    t413 = casadi.if_else(casadi.logic_and(t410, casadi.logic_not(t411)), -t228, t227)
-    t414 = t413
-    t415 = t414 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t414)
-    t416 = casadi.if_else((qn4 > t415), 6.283185307179586, -6.283185307179586)
-    t417 = t415 + t416
-    t418 = t415 - t416
-    t419 = casadi.if_else(casadi.logic_and((t415 >= -2.0943951023931953), (t415 <= 2.0943951023931953)), t415, casadi.if_else(casadi.logic_and((t417 >= -2.0943951023931953), (t417 <= 2.0943951023931953)), t417, casadi.if_else(casadi.logic_and((t418 >= -2.0943951023931953), (t418 <= 2.0943951023931953)), t418, t413)))
-    t420 = t296 + qw2*(t297 + t400)**2 + qw3*(t298 + t409)**2 + qw4*(t299 + t419)**2
-    t421 = (t412 > 0)
-    t422 = casadi.if_else(casadi.logic_and(t421, casadi.logic_or((t391 > t420), (t385 < 1))), 1, 0)
-    t423 = casadi.if_else(t421, 1, t385)
-    t424 = (t422 > 0)
-    t425 = casadi.if_else(t424, t267, t387)
-    t426 = casadi.if_else(t424, t400, t388)
-    t427 = casadi.if_else(t424, t409, t389)
-    t428 = casadi.if_else(t424, t419, t390)
-    t429 = casadi.if_else(t424, t420, t391)
-    t430 = (t28 <= 3.141592653589793)
-    t431 = casadi.logic_and((t27 >= -3.141592653589793), (t27 <= 3.141592653589793))
-    t432 = casadi.if_else(casadi.logic_and(t430, casadi.logic_not(t431)), t28, t27)
-    t433 = t432
-    t434 = t433 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn1 - 0.15915494309189535*t433)
-    t435 = casadi.if_else((qn1 > t434), 6.283185307179586, -6.283185307179586)
-    t436 = t434 + t435
-    t437 = t434 - t435
-    t438 = casadi.if_else(casadi.logic_and((t434 >= -3.141592653589793), (t434 <= 3.141592653589793)), t434, casadi.if_else(casadi.logic_and((t436 >= -3.141592653589793), (t436 <= 3.141592653589793)), t436, casadi.if_else(casadi.logic_and((t437 >= -3.141592653589793), (t437 <= 3.141592653589793)), t437, t432)))
-    t439 = (t232 <= 2.0943951023931953)
-    t440 = casadi.logic_and((t231 >= -2.0943951023931953), (t231 <= 2.0943951023931953))
-    t441 = casadi.if_else(casadi.logic_and(t439, casadi.logic_not(t440)), t232, t231)
-    t442 = t441
-    t443 = t442 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t442)
-    t444 = casadi.if_else((qn2 > t443), 6.283185307179586, -6.283185307179586)
-    t445 = t443 + t444
-    t446 = t443 - t444
-    t447 = casadi.if_else(casadi.logic_and((t443 >= -2.0943951023931953), (t443 <= 2.0943951023931953)), t443, casadi.if_else(casadi.logic_and((t445 >= -2.0943951023931953), (t445 <= 2.0943951023931953)), t445, casadi.if_else(casadi.logic_and((t446 >= -2.0943951023931953), (t446 <= 2.0943951023931953)), t446, t441)))
-    t448 = (t153 <= 2.0943951023931953)
-    t449 = casadi.logic_and((t152 >= -2.0943951023931953), (t152 <= 2.0943951023931953))
-    t450 = casadi.if_else(casadi.logic_and(t448, casadi.logic_not(t449)), t153, t152)
-    t451 = t450
-    t452 = t451 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn3 - 0.15915494309189535*t451)
-    t453 = casadi.if_else((qn3 > t452), 6.283185307179586, -6.283185307179586)
-    t454 = t452 + t453
-    t455 = t452 - t453
-    t456 = casadi.if_else(casadi.logic_and((t452 >= -2.0943951023931953), (t452 <= 2.0943951023931953)), t452, casadi.if_else(casadi.logic_and((t454 >= -2.0943951023931953), (t454 <= 2.0943951023931953)), t454, casadi.if_else(casadi.logic_and((t455 >= -2.0943951023931953), (t455 <= 2.0943951023931953)), t455, t450)))
-    t457 = (t236 >= -2.0943951023931953)
-    t458 = casadi.logic_and((t234 >= -2.0943951023931953), (t234 <= 2.0943951023931953))
-    t459 = casadi.if_else(casadi.logic_and(t457, casadi.logic_not(t458)), -t236, t235)
-    t460 = t459
-    t461 = t460 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t460)
-    t462 = casadi.if_else((qn4 > t461), 6.283185307179586, -6.283185307179586)
-    t463 = t461 + t462
-    t464 = t461 - t462
-    t465 = casadi.if_else(casadi.logic_and((t461 >= -2.0943951023931953), (t461 <= 2.0943951023931953)), t461, casadi.if_else(casadi.logic_and((t463 >= -2.0943951023931953), (t463 <= 2.0943951023931953)), t463, casadi.if_else(casadi.logic_and((t464 >= -2.0943951023931953), (t464 <= 2.0943951023931953)), t464, t459)))
-    t466 = qw1*(t295 + t438)**2
-    t467 = t466 + qw2*(t297 + t447)**2 + qw3*(t298 + t456)**2 + qw4*(t299 + t465)**2
-    t468 = casadi.logic_or(t430, t431)
-    t469 = casadi.if_else(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t19, t301), t302), t304), t307), t468), casadi.logic_or(t439, t440)), casadi.logic_or(t448, t449)), casadi.logic_or(t457, t458)), casadi.logic_or(casadi.logic_and(t306, (t136 >= -1e-12)), casadi.logic_and(t8, (t135 <= 1e-16)))), 1, 0)
-    t470 = (t469 > 0)
-    t471 = casadi.if_else(casadi.logic_and(t470, casadi.logic_or((t429 > t467), (t423 < 1))), 1, 0)
-    t472 = casadi.if_else(t470, 1, t423)
-    t473 = (t471 > 0)
-    t474 = casadi.if_else(t473, t438, t425)
-    t475 = casadi.if_else(t473, t447, t426)
-    t476 = casadi.if_else(t473, t456, t427)
-    t477 = casadi.if_else(t473, t465, t428)
-    t478 = casadi.if_else(t473, t467, t429)
-    t479 = (t239 <= 2.0943951023931953)
-    t480 = casadi.logic_and((t238 >= -2.0943951023931953), (t238 <= 2.0943951023931953))
-    t481 = casadi.if_else(casadi.logic_and(t479, casadi.logic_not(t480)), t239, t238)
-    t482 = t481
-    t483 = t482 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t482)
-    t484 = casadi.if_else((qn2 > t483), 6.283185307179586, -6.283185307179586)
-    t485 = t483 + t484
-    t486 = t483 - t484
-    t487 = casadi.if_else(casadi.logic_and((t483 >= -2.0943951023931953), (t483 <= 2.0943951023931953)), t483, casadi.if_else(casadi.logic_and((t485 >= -2.0943951023931953), (t485 <= 2.0943951023931953)), t485, casadi.if_else(casadi.logic_and((t486 >= -2.0943951023931953), (t486 <= 2.0943951023931953)), t486, t481)))
-    t488 = (t155 <= 2.0943951023931953)
-    t489 = casadi.logic_and((t154 >= -2.0943951023931953), (t154 <= 2.0943951023931953))
-    t490 = casadi.if_else(casadi.logic_and(t488, casadi.logic_not(t489)), t155, t154)
-    t491 = t490
-    t492 = t491 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn3 - 0.15915494309189535*t491)
-    t493 = casadi.if_else((qn3 > t492), 6.283185307179586, -6.283185307179586)
-    t494 = t492 + t493
-    t495 = t492 - t493
-    t496 = casadi.if_else(casadi.logic_and((t492 >= -2.0943951023931953), (t492 <= 2.0943951023931953)), t492, casadi.if_else(casadi.logic_and((t494 >= -2.0943951023931953), (t494 <= 2.0943951023931953)), t494, casadi.if_else(casadi.logic_and((t495 >= -2.0943951023931953), (t495 <= 2.0943951023931953)), t495, t490)))
-    t497 = (t243 >= -2.0943951023931953)
-    t498 = casadi.logic_and((t241 >= -2.0943951023931953), (t241 <= 2.0943951023931953))
-    t499 = casadi.if_else(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t138, t19), t301), t302), t304), t306), t307), t468), casadi.logic_or(t479, t480)), casadi.logic_or(t488, t489)), casadi.logic_or(t497, t498)), 1, 0)
-    t500 = casadi.if_else(casadi.logic_and(t497, casadi.logic_not(t498)), -t243, t242)
-    t501 = t500
-    t502 = t501 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t501)
-    t503 = casadi.if_else((qn4 > t502), 6.283185307179586, -6.283185307179586)
-    t504 = t502 + t503
-    t505 = t502 - t503
-    t506 = casadi.if_else(casadi.logic_and((t502 >= -2.0943951023931953), (t502 <= 2.0943951023931953)), t502, casadi.if_else(casadi.logic_and((t504 >= -2.0943951023931953), (t504 <= 2.0943951023931953)), t504, casadi.if_else(casadi.logic_and((t505 >= -2.0943951023931953), (t505 <= 2.0943951023931953)), t505, t500)))
-    t507 = t466 + qw2*(t297 + t487)**2 + qw3*(t298 + t496)**2 + qw4*(t299 + t506)**2
-    t508 = (t499 > 0)
-    t509 = casadi.if_else(casadi.logic_and(t508, casadi.logic_or((t478 > t507), (t472 < 1))), 1, 0)
-    t510 = casadi.if_else(t508, 1, t472)
-    t511 = (t509 > 0)
-    t512 = casadi.if_else(t511, t438, t474)
-    t513 = casadi.if_else(t511, t487, t475)
-    t514 = casadi.if_else(t511, t496, t476)
-    t515 = casadi.if_else(t511, t506, t477)
-    t516 = casadi.if_else(t511, t507, t478)
-    t517 = (t247 <= 2.0943951023931953)
-    t518 = casadi.logic_and((t246 >= -2.0943951023931953), (t246 <= 2.0943951023931953))
-    t519 = casadi.if_else(casadi.logic_and(t517, casadi.logic_not(t518)), t247, t246)
-    t520 = t519
-    t521 = t520 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t520)
-    t522 = casadi.if_else((qn2 > t521), 6.283185307179586, -6.283185307179586)
-    t523 = t521 + t522
-    t524 = t521 - t522
-    t525 = casadi.if_else(casadi.logic_and((t521 >= -2.0943951023931953), (t521 <= 2.0943951023931953)), t521, casadi.if_else(casadi.logic_and((t523 >= -2.0943951023931953), (t523 <= 2.0943951023931953)), t523, casadi.if_else(casadi.logic_and((t524 >= -2.0943951023931953), (t524 <= 2.0943951023931953)), t524, t519)))
-    t526 = (t182 <= 2.0943951023931953)
-    t527 = casadi.logic_and((t181 >= -2.0943951023931953), (t181 <= 2.0943951023931953))
-    t528 = casadi.if_else(casadi.logic_and(t526, casadi.logic_not(t527)), t182, t181)
-    t529 = t528
-    t530 = t529 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn3 - 0.15915494309189535*t529)
-    t531 = casadi.if_else((qn3 > t530), 6.283185307179586, -6.283185307179586)
-    t532 = t530 + t531
-    t533 = t530 - t531
-    t534 = casadi.if_else(casadi.logic_and((t530 >= -2.0943951023931953), (t530 <= 2.0943951023931953)), t530, casadi.if_else(casadi.logic_and((t532 >= -2.0943951023931953), (t532 <= 2.0943951023931953)), t532, casadi.if_else(casadi.logic_and((t533 >= -2.0943951023931953), (t533 <= 2.0943951023931953)), t533, t528)))
-    t535 = (t251 >= -2.0943951023931953)
-    t536 = casadi.logic_and((t249 >= -2.0943951023931953), (t249 <= 2.0943951023931953))
-    t537 = casadi.if_else(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t19, t301), t302), t304), t306), t4), t468), casadi.logic_or(t517, t518)), casadi.logic_or(t526, t527)), casadi.logic_or(t535, t536)), casadi.logic_or(casadi.logic_and(t306, (t165 >= -1e-12)), casadi.logic_and(t8, (t164 <= 1e-16)))), 1, 0)
-    t538 = casadi.if_else(casadi.logic_and(t535, casadi.logic_not(t536)), -t251, t250)
-    t539 = t538
-    t540 = t539 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t539)
-    t541 = casadi.if_else((qn4 > t540), 6.283185307179586, -6.283185307179586)
-    t542 = t540 + t541
-    t543 = t540 - t541
-    t544 = casadi.if_else(casadi.logic_and((t540 >= -2.0943951023931953), (t540 <= 2.0943951023931953)), t540, casadi.if_else(casadi.logic_and((t542 >= -2.0943951023931953), (t542 <= 2.0943951023931953)), t542, casadi.if_else(casadi.logic_and((t543 >= -2.0943951023931953), (t543 <= 2.0943951023931953)), t543, t538)))
-    t545 = t466 + qw2*(t297 + t525)**2 + qw3*(t298 + t534)**2 + qw4*(t299 + t544)**2
-    t546 = (t537 > 0)
-    t547 = casadi.if_else(casadi.logic_and(t546, casadi.logic_or((t516 > t545), (t510 < 1))), 1, 0)
-    t548 = casadi.if_else(t546, 1, t510)
-    t549 = (t547 > 0)
-    t550 = casadi.if_else(t549, t438, t512)
-    t551 = casadi.if_else(t549, t525, t513)
-    t552 = casadi.if_else(t549, t534, t514)
-    t553 = casadi.if_else(t549, t544, t515)
-    t554 = casadi.if_else(t549, t545, t516)
-    t555 = (t254 <= 2.0943951023931953)
-    t556 = casadi.logic_and((t253 >= -2.0943951023931953), (t253 <= 2.0943951023931953))
-    t557 = casadi.if_else(casadi.logic_and(t555, casadi.logic_not(t556)), t254, t253)
-    t558 = t557
-    t559 = t558 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t558)
-    t560 = casadi.if_else((qn2 > t559), 6.283185307179586, -6.283185307179586)
-    t561 = t559 + t560
-    t562 = t559 - t560
-    t563 = casadi.if_else(casadi.logic_and((t559 >= -2.0943951023931953), (t559 <= 2.0943951023931953)), t559, casadi.if_else(casadi.logic_and((t561 >= -2.0943951023931953), (t561 <= 2.0943951023931953)), t561, casadi.if_else(casadi.logic_and((t562 >= -2.0943951023931953), (t562 <= 2.0943951023931953)), t562, t557)))
-    t564 = (t184 <= 2.0943951023931953)
-    t565 = casadi.logic_and((t183 >= -2.0943951023931953), (t183 <= 2.0943951023931953))
-    t566 = casadi.if_else(casadi.logic_and(t564, casadi.logic_not(t565)), t184, t183)
-    t567 = t566
-    t568 = t567 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn3 - 0.15915494309189535*t567)
-    t569 = casadi.if_else((qn3 > t568), 6.283185307179586, -6.283185307179586)
-    t570 = t568 + t569
-    t571 = t568 - t569
-    t572 = casadi.if_else(casadi.logic_and((t568 >= -2.0943951023931953), (t568 <= 2.0943951023931953)), t568, casadi.if_else(casadi.logic_and((t570 >= -2.0943951023931953), (t570 <= 2.0943951023931953)), t570, casadi.if_else(casadi.logic_and((t571 >= -2.0943951023931953), (t571 <= 2.0943951023931953)), t571, t566)))
-    t573 = (t258 >= -2.0943951023931953)
-    t574 = casadi.logic_and((t256 >= -2.0943951023931953), (t256 <= 2.0943951023931953))
-    t575 = casadi.if_else(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t167, t19), t301), t302), t304), t306), t4), t468), casadi.logic_or(t555, t556)), casadi.logic_or(t564, t565)), casadi.logic_or(t573, t574)), 1, 0)
-    t576 = casadi.if_else(casadi.logic_and(t573, casadi.logic_not(t574)), -t258, t257)
-    t577 = t576
-    t578 = t577 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t577)
-    t579 = casadi.if_else((qn4 > t578), 6.283185307179586, -6.283185307179586)
-    t580 = t578 + t579
-    t581 = t578 - t579
-    t582 = casadi.if_else(casadi.logic_and((t578 >= -2.0943951023931953), (t578 <= 2.0943951023931953)), t578, casadi.if_else(casadi.logic_and((t580 >= -2.0943951023931953), (t580 <= 2.0943951023931953)), t580, casadi.if_else(casadi.logic_and((t581 >= -2.0943951023931953), (t581 <= 2.0943951023931953)), t581, t576)))
-    t583 = t466 + qw2*(t297 + t563)**2 + qw3*(t298 + t572)**2 + qw4*(t299 + t582)**2
-    t584 = (t575 > 0)
-    t585 = casadi.if_else(casadi.logic_and(t584, casadi.logic_or((t554 > t583), (t548 < 1))), 1, 0)
-    t586 = casadi.if_else(t584, 1, t548)
-    t587 = (t585 > 0)
-    t588 = casadi.if_else(t587, t438, t550)
-    t589 = casadi.if_else(t587, t563, t551)
-    t590 = casadi.if_else(t587, t572, t552)
-    t591 = casadi.if_else(t587, t582, t553)
-    t592 = (casadi.fabs(t195) < casadi.inf)
-    t593 = (t586 > 0)
-    t594 = casadi.logic_and(t592, t593)
+    t195 = t194 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t194)
+    t196 = t193 + t57
+    t197 = t187 + t196 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t188 - 0.15915494309189535*t196)
+    t198 = -t197
+    t199 = t197 + 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t198)
+    t200 = 1e-24*t84
+    t201 = casadi.if_else((t112 <= t101*t200), 0, casadi.atan2(-t111, t110))
+    t202 = t201
+    t203 = t202 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t202)
+    t204 = 3.141592653589793 + t7
+    t205 = t201 + t95
+    t206 = t205 + t7 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t204 - 0.15915494309189535*t205)
+    t207 = -t206
+    t208 = t206 + 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t207)
+    t209 = casadi.if_else((t116 <= t104*t200), 0, casadi.atan2(-t115, t114))
+    t210 = t209
+    t211 = t210 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t210)
+    t212 = t209 + t98
+    t213 = t212 + t7 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t204 - 0.15915494309189535*t212)
+    t214 = -t213
+    t215 = t213 + 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t214)
+    t216 = 1e-24*t118
+    t217 = casadi.if_else((t146 <= t135*t216), 0, casadi.atan2(-t145, t144))
+    t218 = t217
+    t219 = t218 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t218)
+    t220 = t129 + t217
+    t221 = t187 + t220 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t188 - 0.15915494309189535*t220)
+    t222 = -t221
+    t223 = t221 + 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t222)
+    t224 = casadi.if_else((t150 <= t138*t216), 0, casadi.atan2(-t149, t148))
+    t225 = t224
+    t226 = t225 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t225)
+    t227 = t132 + t224
+    t228 = t187 + t227 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t188 - 0.15915494309189535*t227)
+    t229 = -t228
+    t230 = t228 + 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t229)
+    t231 = 1e-24*t120
+    t232 = casadi.if_else((t175 <= t164*t231), 0, casadi.atan2(-t174, t173))
+    t233 = t232
+    t234 = t233 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t233)
+    t235 = t158 + t232
+    t236 = t235 + t7 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t204 - 0.15915494309189535*t235)
+    t237 = -t236
+    t238 = t236 + 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t237)
+    t239 = casadi.if_else((t179 <= t167*t231), 0, casadi.atan2(-t178, t177))
+    t240 = t239
+    t241 = t240 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t240)
+    t242 = t161 + t239
+    t243 = t242 + t7 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t204 - 0.15915494309189535*t242)
+    t244 = -t243
+    t245 = t243 + 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t244)
+    t246 = (t20 <= 3.141592653589793)
+    t247 = casadi.logic_and((t19 >= -3.141592653589793), (t19 <= 3.141592653589793))
+    t248 = casadi.if_else(casadi.logic_and(t246, casadi.logic_not(t247)), t20, t19)
+    t249 = t248
+    t250 = t249 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn1 - 0.15915494309189535*t249)
+    t251 = casadi.if_else((qn1 > t250), 6.283185307179586, -6.283185307179586)
+    t252 = t250 + t251
+    t253 = t250 - t251
+    t254 = casadi.if_else(casadi.logic_and((t250 >= -3.141592653589793), (t250 <= 3.141592653589793)), t250, casadi.if_else(casadi.logic_and((t252 >= -3.141592653589793), (t252 <= 3.141592653589793)), t252, casadi.if_else(casadi.logic_and((t253 >= -3.141592653589793), (t253 <= 3.141592653589793)), t253, t248)))
+    t255 = (t186 <= 2.0943951023931953)
+    t256 = casadi.logic_and((t185 >= -2.0943951023931953), (t185 <= 2.0943951023931953))
+    t257 = casadi.if_else(casadi.logic_and(t255, casadi.logic_not(t256)), t186, t185)
+    t258 = t257
+    t259 = t258 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t258)
+    t260 = casadi.if_else((qn2 > t259), 6.283185307179586, -6.283185307179586)
+    t261 = t259 + t260
+    t262 = t259 - t260
+    t263 = casadi.if_else(casadi.logic_and((t259 >= -2.0943951023931953), (t259 <= 2.0943951023931953)), t259, casadi.if_else(casadi.logic_and((t261 >= -2.0943951023931953), (t261 <= 2.0943951023931953)), t261, casadi.if_else(casadi.logic_and((t262 >= -2.0943951023931953), (t262 <= 2.0943951023931953)), t262, t257)))
+    t264 = (t59 <= 2.0943951023931953)
+    t265 = casadi.logic_and((t58 >= -2.0943951023931953), (t58 <= 2.0943951023931953))
+    t266 = casadi.if_else(casadi.logic_and(t264, casadi.logic_not(t265)), t59, t58)
+    t267 = t266
+    t268 = t267 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn3 - 0.15915494309189535*t267)
+    t269 = casadi.if_else((qn3 > t268), 6.283185307179586, -6.283185307179586)
+    t270 = t268 + t269
+    t271 = t268 - t269
+    t272 = casadi.if_else(casadi.logic_and((t268 >= -2.0943951023931953), (t268 <= 2.0943951023931953)), t268, casadi.if_else(casadi.logic_and((t270 >= -2.0943951023931953), (t270 <= 2.0943951023931953)), t270, casadi.if_else(casadi.logic_and((t271 >= -2.0943951023931953), (t271 <= 2.0943951023931953)), t271, t266)))
+    t273 = (t192 >= -2.0943951023931953)
+    t274 = casadi.logic_and((t190 >= -2.0943951023931953), (t190 <= 2.0943951023931953))
+    t275 = casadi.if_else(casadi.logic_and(t273, casadi.logic_not(t274)), -t192, t191)
+    t276 = t275
+    t277 = t276 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t276)
+    t278 = casadi.if_else((qn4 > t277), 6.283185307179586, -6.283185307179586)
+    t279 = t277 + t278
+    t280 = t277 - t278
+    t281 = casadi.if_else(casadi.logic_and((t277 >= -2.0943951023931953), (t277 <= 2.0943951023931953)), t277, casadi.if_else(casadi.logic_and((t279 >= -2.0943951023931953), (t279 <= 2.0943951023931953)), t279, casadi.if_else(casadi.logic_and((t280 >= -2.0943951023931953), (t280 <= 2.0943951023931953)), t280, t275)))
+    t282 = -qn1
+    t283 = qw1*(t254 + t282)**2
+    t284 = -qn2
+    t285 = -qn3
+    t286 = -qn4
+    t287 = t283 + qw2*(t263 + t284)**2 + qw3*(t272 + t285)**2 + qw4*(t281 + t286)**2
+    t288 = (casadi.fabs(t181) < casadi.inf)
+    t289 = (casadi.fabs(mu3) <= 1.5707963267948966)
+    t290 = casadi.logic_or(t246, t247)
+    t291 = (t12 > t14)
+    t292 = casadi.logic_or(t291, casadi.logic_and(t15, (1e-12*t13 >= 0)))
+    t293 = (1e-12 >= -t3)
+    t294 = casadi.if_else(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t288, t289), t290), t292), t293), (t50 >= -1e-12)), casadi.logic_or(t255, t256)), casadi.logic_or(t264, t265)), casadi.logic_or(t273, t274)), 1, 0)
+    t295 = casadi.if_else((t294 > 0), 1, 0)
+    t296 = (t295 > 0)
+    t297 = casadi.if_else(t296, t254, qn1)
+    t298 = casadi.if_else(t296, t263, qn2)
+    t299 = casadi.if_else(t296, t272, qn3)
+    t300 = casadi.if_else(t296, t281, qn4)
+    t301 = casadi.if_else(t296, t287, 0)
+    t302 = (t195 <= 2.0943951023931953)
+    t303 = casadi.logic_and((t194 >= -2.0943951023931953), (t194 <= 2.0943951023931953))
+    t304 = casadi.if_else(casadi.logic_and(t302, casadi.logic_not(t303)), t195, t194)
+    t305 = t304
+    t306 = t305 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t305)
+    t307 = casadi.if_else((qn2 > t306), 6.283185307179586, -6.283185307179586)
+    t308 = t306 + t307
+    t309 = t306 - t307
+    t310 = casadi.if_else(casadi.logic_and((t306 >= -2.0943951023931953), (t306 <= 2.0943951023931953)), t306, casadi.if_else(casadi.logic_and((t308 >= -2.0943951023931953), (t308 <= 2.0943951023931953)), t308, casadi.if_else(casadi.logic_and((t309 >= -2.0943951023931953), (t309 <= 2.0943951023931953)), t309, t304)))
+    t311 = (t61 <= 2.0943951023931953)
+    t312 = casadi.logic_and((t60 >= -2.0943951023931953), (t60 <= 2.0943951023931953))
+    t313 = casadi.if_else(casadi.logic_and(t311, casadi.logic_not(t312)), t61, t60)
+    t314 = t313
+    t315 = t314 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn3 - 0.15915494309189535*t314)
+    t316 = casadi.if_else((qn3 > t315), 6.283185307179586, -6.283185307179586)
+    t317 = t315 + t316
+    t318 = t315 - t316
+    t319 = casadi.if_else(casadi.logic_and((t315 >= -2.0943951023931953), (t315 <= 2.0943951023931953)), t315, casadi.if_else(casadi.logic_and((t317 >= -2.0943951023931953), (t317 <= 2.0943951023931953)), t317, casadi.if_else(casadi.logic_and((t318 >= -2.0943951023931953), (t318 <= 2.0943951023931953)), t318, t313)))
+    t320 = (t199 >= -2.0943951023931953)
+    t321 = casadi.logic_and((t197 >= -2.0943951023931953), (t197 <= 2.0943951023931953))
+    t322 = casadi.if_else(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t288, t289), t290), t292), t293), t52), casadi.logic_or(t302, t303)), casadi.logic_or(t311, t312)), casadi.logic_or(t320, t321)), 1, 0)
+    t323 = casadi.if_else(casadi.logic_and(t320, casadi.logic_not(t321)), -t199, t198)
+    t324 = t323
+    t325 = t324 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t324)
+    t326 = casadi.if_else((qn4 > t325), 6.283185307179586, -6.283185307179586)
+    t327 = t325 + t326
+    t328 = t325 - t326
+    t329 = casadi.if_else(casadi.logic_and((t325 >= -2.0943951023931953), (t325 <= 2.0943951023931953)), t325, casadi.if_else(casadi.logic_and((t327 >= -2.0943951023931953), (t327 <= 2.0943951023931953)), t327, casadi.if_else(casadi.logic_and((t328 >= -2.0943951023931953), (t328 <= 2.0943951023931953)), t328, t323)))
+    t330 = t283 + qw2*(t284 + t310)**2 + qw3*(t285 + t319)**2 + qw4*(t286 + t329)**2
+    t331 = (t322 > 0)
+    t332 = casadi.if_else(casadi.logic_and(t331, casadi.logic_or((t301 > t330), (t295 < 1))), 1, 0)
+    t333 = casadi.if_else(t331, 1, t295)
+    t334 = (t332 > 0)
+    t335 = casadi.if_else(t334, t254, t297)
+    t336 = casadi.if_else(t334, t310, t298)
+    t337 = casadi.if_else(t334, t319, t299)
+    t338 = casadi.if_else(t334, t329, t300)
+    t339 = casadi.if_else(t334, t330, t301)
+    t340 = (t203 <= 2.0943951023931953)
+    t341 = casadi.logic_and((t202 >= -2.0943951023931953), (t202 <= 2.0943951023931953))
+    t342 = casadi.if_else(casadi.logic_and(t340, casadi.logic_not(t341)), t203, t202)
+    t343 = t342
+    t344 = t343 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t343)
+    t345 = casadi.if_else((qn2 > t344), 6.283185307179586, -6.283185307179586)
+    t346 = t344 + t345
+    t347 = t344 - t345
+    t348 = casadi.if_else(casadi.logic_and((t344 >= -2.0943951023931953), (t344 <= 2.0943951023931953)), t344, casadi.if_else(casadi.logic_and((t346 >= -2.0943951023931953), (t346 <= 2.0943951023931953)), t346, casadi.if_else(casadi.logic_and((t347 >= -2.0943951023931953), (t347 <= 2.0943951023931953)), t347, t342)))
+    t349 = (t106 <= 2.0943951023931953)
+    t350 = casadi.logic_and((t105 >= -2.0943951023931953), (t105 <= 2.0943951023931953))
+    t351 = casadi.if_else(casadi.logic_and(t349, casadi.logic_not(t350)), t106, t105)
+    t352 = t351
+    t353 = t352 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn3 - 0.15915494309189535*t352)
+    t354 = casadi.if_else((qn3 > t353), 6.283185307179586, -6.283185307179586)
+    t355 = t353 + t354
+    t356 = t353 - t354
+    t357 = casadi.if_else(casadi.logic_and((t353 >= -2.0943951023931953), (t353 <= 2.0943951023931953)), t353, casadi.if_else(casadi.logic_and((t355 >= -2.0943951023931953), (t355 <= 2.0943951023931953)), t355, casadi.if_else(casadi.logic_and((t356 >= -2.0943951023931953), (t356 <= 2.0943951023931953)), t356, t351)))
+    t358 = (t208 >= -2.0943951023931953)
+    t359 = casadi.logic_and((t206 >= -2.0943951023931953), (t206 <= 2.0943951023931953))
+    t360 = casadi.if_else(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t288, t289), t290), t292), t4), (t89 >= -1e-12)), casadi.logic_or(t340, t341)), casadi.logic_or(t349, t350)), casadi.logic_or(t358, t359)), 1, 0)
+    t361 = casadi.if_else(casadi.logic_and(t358, casadi.logic_not(t359)), -t208, t207)
+    t362 = t361
+    t363 = t362 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t362)
+    t364 = casadi.if_else((qn4 > t363), 6.283185307179586, -6.283185307179586)
+    t365 = t363 + t364
+    t366 = t363 - t364
+    t367 = casadi.if_else(casadi.logic_and((t363 >= -2.0943951023931953), (t363 <= 2.0943951023931953)), t363, casadi.if_else(casadi.logic_and((t365 >= -2.0943951023931953), (t365 <= 2.0943951023931953)), t365, casadi.if_else(casadi.logic_and((t366 >= -2.0943951023931953), (t366 <= 2.0943951023931953)), t366, t361)))
+    t368 = t283 + qw2*(t284 + t348)**2 + qw3*(t285 + t357)**2 + qw4*(t286 + t367)**2
+    t369 = (t360 > 0)
+    t370 = casadi.if_else(casadi.logic_and(t369, casadi.logic_or((t339 > t368), (t333 < 1))), 1, 0)
+    t371 = casadi.if_else(t369, 1, t333)
+    t372 = (t370 > 0)
+    t373 = casadi.if_else(t372, t254, t335)
+    t374 = casadi.if_else(t372, t348, t336)
+    t375 = casadi.if_else(t372, t357, t337)
+    t376 = casadi.if_else(t372, t367, t338)
+    t377 = casadi.if_else(t372, t368, t339)
+    t378 = (t211 <= 2.0943951023931953)
+    t379 = casadi.logic_and((t210 >= -2.0943951023931953), (t210 <= 2.0943951023931953))
+    t380 = casadi.if_else(casadi.logic_and(t378, casadi.logic_not(t379)), t211, t210)
+    t381 = t380
+    t382 = t381 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t381)
+    t383 = casadi.if_else((qn2 > t382), 6.283185307179586, -6.283185307179586)
+    t384 = t382 + t383
+    t385 = t382 - t383
+    t386 = casadi.if_else(casadi.logic_and((t382 >= -2.0943951023931953), (t382 <= 2.0943951023931953)), t382, casadi.if_else(casadi.logic_and((t384 >= -2.0943951023931953), (t384 <= 2.0943951023931953)), t384, casadi.if_else(casadi.logic_and((t385 >= -2.0943951023931953), (t385 <= 2.0943951023931953)), t385, t380)))
+    t387 = (t108 <= 2.0943951023931953)
+    t388 = casadi.logic_and((t107 >= -2.0943951023931953), (t107 <= 2.0943951023931953))
+    t389 = casadi.if_else(casadi.logic_and(t387, casadi.logic_not(t388)), t108, t107)
+    t390 = t389
+    t391 = t390 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn3 - 0.15915494309189535*t390)
+    t392 = casadi.if_else((qn3 > t391), 6.283185307179586, -6.283185307179586)
+    t393 = t391 + t392
+    t394 = t391 - t392
+    t395 = casadi.if_else(casadi.logic_and((t391 >= -2.0943951023931953), (t391 <= 2.0943951023931953)), t391, casadi.if_else(casadi.logic_and((t393 >= -2.0943951023931953), (t393 <= 2.0943951023931953)), t393, casadi.if_else(casadi.logic_and((t394 >= -2.0943951023931953), (t394 <= 2.0943951023931953)), t394, t389)))
+    t396 = (t215 >= -2.0943951023931953)
+    t397 = casadi.logic_and((t213 >= -2.0943951023931953), (t213 <= 2.0943951023931953))
+    t398 = casadi.if_else(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t288, t289), t290), t292), t4), t91), casadi.logic_or(t378, t379)), casadi.logic_or(t387, t388)), casadi.logic_or(t396, t397)), 1, 0)
+    t399 = casadi.if_else(casadi.logic_and(t396, casadi.logic_not(t397)), -t215, t214)
+    t400 = t399
+    t401 = t400 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t400)
+    t402 = casadi.if_else((qn4 > t401), 6.283185307179586, -6.283185307179586)
+    t403 = t401 + t402
+    t404 = t401 - t402
+    t405 = casadi.if_else(casadi.logic_and((t401 >= -2.0943951023931953), (t401 <= 2.0943951023931953)), t401, casadi.if_else(casadi.logic_and((t403 >= -2.0943951023931953), (t403 <= 2.0943951023931953)), t403, casadi.if_else(casadi.logic_and((t404 >= -2.0943951023931953), (t404 <= 2.0943951023931953)), t404, t399)))
+    t406 = t283 + qw2*(t284 + t386)**2 + qw3*(t285 + t395)**2 + qw4*(t286 + t405)**2
+    t407 = (t398 > 0)
+    t408 = casadi.if_else(casadi.logic_and(t407, casadi.logic_or((t377 > t406), (t371 < 1))), 1, 0)
+    t409 = casadi.if_else(t407, 1, t371)
+    t410 = (t408 > 0)
+    t411 = casadi.if_else(t410, t254, t373)
+    t412 = casadi.if_else(t410, t386, t374)
+    t413 = casadi.if_else(t410, t395, t375)
+    t414 = casadi.if_else(t410, t405, t376)
+    t415 = casadi.if_else(t410, t406, t377)
+    t416 = (t22 <= 3.141592653589793)
+    t417 = casadi.logic_and((t21 >= -3.141592653589793), (t21 <= 3.141592653589793))
+    t418 = casadi.if_else(casadi.logic_and(t416, casadi.logic_not(t417)), t22, t21)
+    t419 = t418
+    t420 = t419 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn1 - 0.15915494309189535*t419)
+    t421 = casadi.if_else((qn1 > t420), 6.283185307179586, -6.283185307179586)
+    t422 = t420 + t421
+    t423 = t420 - t421
+    t424 = casadi.if_else(casadi.logic_and((t420 >= -3.141592653589793), (t420 <= 3.141592653589793)), t420, casadi.if_else(casadi.logic_and((t422 >= -3.141592653589793), (t422 <= 3.141592653589793)), t422, casadi.if_else(casadi.logic_and((t423 >= -3.141592653589793), (t423 <= 3.141592653589793)), t423, t418)))
+    t425 = (t219 <= 2.0943951023931953)
+    t426 = casadi.logic_and((t218 >= -2.0943951023931953), (t218 <= 2.0943951023931953))
+    t427 = casadi.if_else(casadi.logic_and(t425, casadi.logic_not(t426)), t219, t218)
+    t428 = t427
+    t429 = t428 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t428)
+    t430 = casadi.if_else((qn2 > t429), 6.283185307179586, -6.283185307179586)
+    t431 = t429 + t430
+    t432 = t429 - t430
+    t433 = casadi.if_else(casadi.logic_and((t429 >= -2.0943951023931953), (t429 <= 2.0943951023931953)), t429, casadi.if_else(casadi.logic_and((t431 >= -2.0943951023931953), (t431 <= 2.0943951023931953)), t431, casadi.if_else(casadi.logic_and((t432 >= -2.0943951023931953), (t432 <= 2.0943951023931953)), t432, t427)))
+    t434 = (t140 <= 2.0943951023931953)
+    t435 = casadi.logic_and((t139 >= -2.0943951023931953), (t139 <= 2.0943951023931953))
+    t436 = casadi.if_else(casadi.logic_and(t434, casadi.logic_not(t435)), t140, t139)
+    t437 = t436
+    t438 = t437 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn3 - 0.15915494309189535*t437)
+    t439 = casadi.if_else((qn3 > t438), 6.283185307179586, -6.283185307179586)
+    t440 = t438 + t439
+    t441 = t438 - t439
+    t442 = casadi.if_else(casadi.logic_and((t438 >= -2.0943951023931953), (t438 <= 2.0943951023931953)), t438, casadi.if_else(casadi.logic_and((t440 >= -2.0943951023931953), (t440 <= 2.0943951023931953)), t440, casadi.if_else(casadi.logic_and((t441 >= -2.0943951023931953), (t441 <= 2.0943951023931953)), t441, t436)))
+    t443 = (t223 >= -2.0943951023931953)
+    t444 = casadi.logic_and((t221 >= -2.0943951023931953), (t221 <= 2.0943951023931953))
+    t445 = casadi.if_else(casadi.logic_and(t443, casadi.logic_not(t444)), -t223, t222)
+    t446 = t445
+    t447 = t446 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t446)
+    t448 = casadi.if_else((qn4 > t447), 6.283185307179586, -6.283185307179586)
+    t449 = t447 + t448
+    t450 = t447 - t448
+    t451 = casadi.if_else(casadi.logic_and((t447 >= -2.0943951023931953), (t447 <= 2.0943951023931953)), t447, casadi.if_else(casadi.logic_and((t449 >= -2.0943951023931953), (t449 <= 2.0943951023931953)), t449, casadi.if_else(casadi.logic_and((t450 >= -2.0943951023931953), (t450 <= 2.0943951023931953)), t450, t445)))
+    t452 = qw1*(t282 + t424)**2
+    t453 = t452 + qw2*(t284 + t433)**2 + qw3*(t285 + t442)**2 + qw4*(t286 + t451)**2
+    t454 = casadi.logic_or(t416, t417)
+    t455 = casadi.if_else(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t288, t289), t291), t293), t454), (t123 >= -1e-12)), casadi.logic_or(t425, t426)), casadi.logic_or(t434, t435)), casadi.logic_or(t443, t444)), 1, 0)
+    t456 = (t455 > 0)
+    t457 = casadi.if_else(casadi.logic_and(t456, casadi.logic_or((t415 > t453), (t409 < 1))), 1, 0)
+    t458 = casadi.if_else(t456, 1, t409)
+    t459 = (t457 > 0)
+    t460 = casadi.if_else(t459, t424, t411)
+    t461 = casadi.if_else(t459, t433, t412)
+    t462 = casadi.if_else(t459, t442, t413)
+    t463 = casadi.if_else(t459, t451, t414)
+    t464 = casadi.if_else(t459, t453, t415)
+    t465 = (t226 <= 2.0943951023931953)
+    t466 = casadi.logic_and((t225 >= -2.0943951023931953), (t225 <= 2.0943951023931953))
+    t467 = casadi.if_else(casadi.logic_and(t465, casadi.logic_not(t466)), t226, t225)
+    t468 = t467
+    t469 = t468 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t468)
+    t470 = casadi.if_else((qn2 > t469), 6.283185307179586, -6.283185307179586)
+    t471 = t469 + t470
+    t472 = t469 - t470
+    t473 = casadi.if_else(casadi.logic_and((t469 >= -2.0943951023931953), (t469 <= 2.0943951023931953)), t469, casadi.if_else(casadi.logic_and((t471 >= -2.0943951023931953), (t471 <= 2.0943951023931953)), t471, casadi.if_else(casadi.logic_and((t472 >= -2.0943951023931953), (t472 <= 2.0943951023931953)), t472, t467)))
+    t474 = (t142 <= 2.0943951023931953)
+    t475 = casadi.logic_and((t141 >= -2.0943951023931953), (t141 <= 2.0943951023931953))
+    t476 = casadi.if_else(casadi.logic_and(t474, casadi.logic_not(t475)), t142, t141)
+    t477 = t476
+    t478 = t477 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn3 - 0.15915494309189535*t477)
+    t479 = casadi.if_else((qn3 > t478), 6.283185307179586, -6.283185307179586)
+    t480 = t478 + t479
+    t481 = t478 - t479
+    t482 = casadi.if_else(casadi.logic_and((t478 >= -2.0943951023931953), (t478 <= 2.0943951023931953)), t478, casadi.if_else(casadi.logic_and((t480 >= -2.0943951023931953), (t480 <= 2.0943951023931953)), t480, casadi.if_else(casadi.logic_and((t481 >= -2.0943951023931953), (t481 <= 2.0943951023931953)), t481, t476)))
+    t483 = (t230 >= -2.0943951023931953)
+    t484 = casadi.logic_and((t228 >= -2.0943951023931953), (t228 <= 2.0943951023931953))
+    t485 = casadi.if_else(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t125, t288), t289), t291), t293), t454), casadi.logic_or(t465, t466)), casadi.logic_or(t474, t475)), casadi.logic_or(t483, t484)), 1, 0)
+    t486 = casadi.if_else(casadi.logic_and(t483, casadi.logic_not(t484)), -t230, t229)
+    t487 = t486
+    t488 = t487 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t487)
+    t489 = casadi.if_else((qn4 > t488), 6.283185307179586, -6.283185307179586)
+    t490 = t488 + t489
+    t491 = t488 - t489
+    t492 = casadi.if_else(casadi.logic_and((t488 >= -2.0943951023931953), (t488 <= 2.0943951023931953)), t488, casadi.if_else(casadi.logic_and((t490 >= -2.0943951023931953), (t490 <= 2.0943951023931953)), t490, casadi.if_else(casadi.logic_and((t491 >= -2.0943951023931953), (t491 <= 2.0943951023931953)), t491, t486)))
+    t493 = t452 + qw2*(t284 + t473)**2 + qw3*(t285 + t482)**2 + qw4*(t286 + t492)**2
+    t494 = (t485 > 0)
+    t495 = casadi.if_else(casadi.logic_and(t494, casadi.logic_or((t464 > t493), (t458 < 1))), 1, 0)
+    t496 = casadi.if_else(t494, 1, t458)
+    t497 = (t495 > 0)
+    t498 = casadi.if_else(t497, t424, t460)
+    t499 = casadi.if_else(t497, t473, t461)
+    t500 = casadi.if_else(t497, t482, t462)
+    t501 = casadi.if_else(t497, t492, t463)
+    t502 = casadi.if_else(t497, t493, t464)
+    t503 = (t234 <= 2.0943951023931953)
+    t504 = casadi.logic_and((t233 >= -2.0943951023931953), (t233 <= 2.0943951023931953))
+    t505 = casadi.if_else(casadi.logic_and(t503, casadi.logic_not(t504)), t234, t233)
+    t506 = t505
+    t507 = t506 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t506)
+    t508 = casadi.if_else((qn2 > t507), 6.283185307179586, -6.283185307179586)
+    t509 = t507 + t508
+    t510 = t507 - t508
+    t511 = casadi.if_else(casadi.logic_and((t507 >= -2.0943951023931953), (t507 <= 2.0943951023931953)), t507, casadi.if_else(casadi.logic_and((t509 >= -2.0943951023931953), (t509 <= 2.0943951023931953)), t509, casadi.if_else(casadi.logic_and((t510 >= -2.0943951023931953), (t510 <= 2.0943951023931953)), t510, t505)))
+    t512 = (t169 <= 2.0943951023931953)
+    t513 = casadi.logic_and((t168 >= -2.0943951023931953), (t168 <= 2.0943951023931953))
+    t514 = casadi.if_else(casadi.logic_and(t512, casadi.logic_not(t513)), t169, t168)
+    t515 = t514
+    t516 = t515 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn3 - 0.15915494309189535*t515)
+    t517 = casadi.if_else((qn3 > t516), 6.283185307179586, -6.283185307179586)
+    t518 = t516 + t517
+    t519 = t516 - t517
+    t520 = casadi.if_else(casadi.logic_and((t516 >= -2.0943951023931953), (t516 <= 2.0943951023931953)), t516, casadi.if_else(casadi.logic_and((t518 >= -2.0943951023931953), (t518 <= 2.0943951023931953)), t518, casadi.if_else(casadi.logic_and((t519 >= -2.0943951023931953), (t519 <= 2.0943951023931953)), t519, t514)))
+    t521 = (t238 >= -2.0943951023931953)
+    t522 = casadi.logic_and((t236 >= -2.0943951023931953), (t236 <= 2.0943951023931953))
+    t523 = casadi.if_else(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t288, t289), t291), t4), t454), (t152 >= -1e-12)), casadi.logic_or(t503, t504)), casadi.logic_or(t512, t513)), casadi.logic_or(t521, t522)), 1, 0)
+    t524 = casadi.if_else(casadi.logic_and(t521, casadi.logic_not(t522)), -t238, t237)
+    t525 = t524
+    t526 = t525 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t525)
+    t527 = casadi.if_else((qn4 > t526), 6.283185307179586, -6.283185307179586)
+    t528 = t526 + t527
+    t529 = t526 - t527
+    t530 = casadi.if_else(casadi.logic_and((t526 >= -2.0943951023931953), (t526 <= 2.0943951023931953)), t526, casadi.if_else(casadi.logic_and((t528 >= -2.0943951023931953), (t528 <= 2.0943951023931953)), t528, casadi.if_else(casadi.logic_and((t529 >= -2.0943951023931953), (t529 <= 2.0943951023931953)), t529, t524)))
+    t531 = t452 + qw2*(t284 + t511)**2 + qw3*(t285 + t520)**2 + qw4*(t286 + t530)**2
+    t532 = (t523 > 0)
+    t533 = casadi.if_else(casadi.logic_and(t532, casadi.logic_or((t502 > t531), (t496 < 1))), 1, 0)
+    t534 = casadi.if_else(t532, 1, t496)
+    t535 = (t533 > 0)
+    t536 = casadi.if_else(t535, t424, t498)
+    t537 = casadi.if_else(t535, t511, t499)
+    t538 = casadi.if_else(t535, t520, t500)
+    t539 = casadi.if_else(t535, t530, t501)
+    t540 = casadi.if_else(t535, t531, t502)
+    t541 = (t241 <= 2.0943951023931953)
+    t542 = casadi.logic_and((t240 >= -2.0943951023931953), (t240 <= 2.0943951023931953))
+    t543 = casadi.if_else(casadi.logic_and(t541, casadi.logic_not(t542)), t241, t240)
+    t544 = t543
+    t545 = t544 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t544)
+    t546 = casadi.if_else((qn2 > t545), 6.283185307179586, -6.283185307179586)
+    t547 = t545 + t546
+    t548 = t545 - t546
+    t549 = casadi.if_else(casadi.logic_and((t545 >= -2.0943951023931953), (t545 <= 2.0943951023931953)), t545, casadi.if_else(casadi.logic_and((t547 >= -2.0943951023931953), (t547 <= 2.0943951023931953)), t547, casadi.if_else(casadi.logic_and((t548 >= -2.0943951023931953), (t548 <= 2.0943951023931953)), t548, t543)))
+    t550 = (t171 <= 2.0943951023931953)
+    t551 = casadi.logic_and((t170 >= -2.0943951023931953), (t170 <= 2.0943951023931953))
+    t552 = casadi.if_else(casadi.logic_and(t550, casadi.logic_not(t551)), t171, t170)
+    t553 = t552
+    t554 = t553 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn3 - 0.15915494309189535*t553)
+    t555 = casadi.if_else((qn3 > t554), 6.283185307179586, -6.283185307179586)
+    t556 = t554 + t555
+    t557 = t554 - t555
+    t558 = casadi.if_else(casadi.logic_and((t554 >= -2.0943951023931953), (t554 <= 2.0943951023931953)), t554, casadi.if_else(casadi.logic_and((t556 >= -2.0943951023931953), (t556 <= 2.0943951023931953)), t556, casadi.if_else(casadi.logic_and((t557 >= -2.0943951023931953), (t557 <= 2.0943951023931953)), t557, t552)))
+    t559 = (t245 >= -2.0943951023931953)
+    t560 = casadi.logic_and((t243 >= -2.0943951023931953), (t243 <= 2.0943951023931953))
+    t561 = casadi.if_else(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t154, t288), t289), t291), t4), t454), casadi.logic_or(t541, t542)), casadi.logic_or(t550, t551)), casadi.logic_or(t559, t560)), 1, 0)
+    t562 = casadi.if_else(casadi.logic_and(t559, casadi.logic_not(t560)), -t245, t244)
+    t563 = t562
+    t564 = t563 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t563)
+    t565 = casadi.if_else((qn4 > t564), 6.283185307179586, -6.283185307179586)
+    t566 = t564 + t565
+    t567 = t564 - t565
+    t568 = casadi.if_else(casadi.logic_and((t564 >= -2.0943951023931953), (t564 <= 2.0943951023931953)), t564, casadi.if_else(casadi.logic_and((t566 >= -2.0943951023931953), (t566 <= 2.0943951023931953)), t566, casadi.if_else(casadi.logic_and((t567 >= -2.0943951023931953), (t567 <= 2.0943951023931953)), t567, t562)))
+    t569 = t452 + qw2*(t284 + t549)**2 + qw3*(t285 + t558)**2 + qw4*(t286 + t568)**2
+    t570 = (t561 > 0)
+    t571 = casadi.if_else(casadi.logic_and(t570, casadi.logic_or((t540 > t569), (t534 < 1))), 1, 0)
+    t572 = casadi.if_else(t570, 1, t534)
+    t573 = (t571 > 0)
+    t574 = casadi.if_else(t573, t424, t536)
+    t575 = casadi.if_else(t573, t549, t537)
+    t576 = casadi.if_else(t573, t558, t538)
+    t577 = casadi.if_else(t573, t568, t539)
+    t578 = (casadi.fabs(t182) < casadi.inf)
+    t579 = (t572 > 0)
+    t580 = casadi.logic_and(t578, t579)
     q = casadi.SX(4, 1)
-    q[0, 0] = casadi.if_else(t594, t588, qn1)
-    q[1, 0] = casadi.if_else(t594, t589, qn2)
-    q[2, 0] = casadi.if_else(t594, t590, qn3)
-    q[3, 0] = casadi.if_else(t594, t591, qn4)
+    q[0, 0] = casadi.if_else(t580, t574, qn1)
+    q[1, 0] = casadi.if_else(t580, t575, qn2)
+    q[2, 0] = casadi.if_else(t580, t576, qn3)
+    q[3, 0] = casadi.if_else(t580, t577, qn4)
     status = casadi.SX(1, 1)
-    status[0, 0] = casadi.if_else(casadi.logic_not(t592), 2, casadi.if_else(t593, 0, 1))
+    status[0, 0] = casadi.if_else(casadi.logic_not(t578), 2, casadi.if_else(t579, 0, 1))
     return [q, status]
 
 

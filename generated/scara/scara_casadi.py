@@ -657,7 +657,7 @@ def _ik_numeric_step(target, q, damping):
 
 
 def _ik_branches(mu):
-    """Every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits: 213 operations."""
+    """Every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits: 202 operations."""
     mu0 = mu[0]
     mu1 = mu[1]
     mu2 = mu[2]
@@ -665,92 +665,85 @@ def _ik_branches(mu):
     t0 = 0.149769 + mu0**2 + mu1**2
     t1 = 0.1655095 - 0.5*t0
     t2 = mu0 + mu1 + mu2 + mu3
-    t3 = False
-    t4 = casadi.if_else(t3, 1, 11.188811188811188)
-    t5 = t1**2
-    t6 = t4**2
-    t7 = 1 - t5*t6
-    t8 = t1*t4
-    t9 = (1e-12 < t7)
-    t10 = casadi.if_else(t9, t8, casadi.if_else((t8 > 0), 1, -1))
-    t11 = casadi.if_else(t9, casadi.sqrt(t7), 0)
-    t12 = casadi.atan2(t11, t10)
-    t13 = casadi.if_else(t3, 0, 3.141592653589793 + t12)
-    t14 = 3.141592653589793 - t12
-    t15 = t13 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t13)
-    t16 = t15 - 6.283185307179586*casadi.floor(0.24444444444444444 + 0.15915494309189535*t15)
-    t17 = t14 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t14)
-    t18 = t17 - 6.283185307179586*casadi.floor(0.24444444444444444 + 0.15915494309189535*t17)
-    t19 = 0.089375*t4
-    t20 = casadi.if_else(t3, 1, -t10*t19)
-    t21 = casadi.if_else(t3, 0, -t11*t19)
-    t22 = 0.325 + 0.275*t20
-    t23 = 0.149769 + t22**2 + 0.075625*t21**2
-    t24 = 0.275*t21
-    t25 = 0.149769 + mu0*t22 + mu1*t24
-    t26 = -0.149769 + t25
-    t27 = mu1*t22 - mu0*t24
-    t28 = t26**2 + t27**2
-    t29 = 0.024578125*t4
-    t30 = 0.325 - t10*t29
-    t31 = 0.149769 + t30**2 + 0.000604084228515625*t6*t11**2
-    t32 = t11*t29
-    t33 = 0.149769 + mu0*t30 + mu1*t32
-    t34 = -0.149769 + t33
-    t35 = mu1*t30 - mu0*t32
-    t36 = t34**2 + t35**2
-    t37 = 1e-24*t0
-    t38 = casadi.if_else((t28 <= t23*t37), 0, casadi.atan2(t27, t26))
-    t39 = t38
-    t40 = t39 - 6.283185307179586*casadi.floor(0.1388888888888889 + 0.15915494309189535*t39)
-    t41 = -mu3
-    t42 = -t13 - t38 - t41
-    t43 = t42 + 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t42)
-    t44 = -t43
-    t45 = t43 + 6.283185307179586*casadi.floor(1.0 + 0.15915494309189535*t44)
-    t46 = casadi.if_else((t36 <= t31*t37), 0, casadi.atan2(t35, t34))
-    t47 = t46
-    t48 = t47 - 6.283185307179586*casadi.floor(0.1388888888888889 + 0.15915494309189535*t47)
-    t49 = -t14 - t41 - t46
-    t50 = t49 + 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t49)
-    t51 = -t50
-    t52 = t50 + 6.283185307179586*casadi.floor(1.0 + 0.15915494309189535*t51)
-    t53 = (t40 <= 0.8726646259971648)
-    t54 = casadi.logic_and((t39 >= -0.8726646259971648), (t39 <= 0.8726646259971648))
-    t55 = (t16 <= 1.53588974175501)
-    t56 = casadi.logic_and((t15 >= -1.53588974175501), (t15 <= 1.53588974175501))
-    t57 = -(-0.387 + mu2)
-    t58 = -t45
-    t59 = (t48 <= 0.8726646259971648)
-    t60 = casadi.logic_and((t47 >= -0.8726646259971648), (t47 <= 0.8726646259971648))
-    t61 = (t18 <= 1.53588974175501)
-    t62 = casadi.logic_and((t17 >= -1.53588974175501), (t17 <= 1.53588974175501))
-    t63 = -t52
-    t64 = (casadi.fabs(t2) < casadi.inf)
-    t65 = 1.9314171249999998e-26
-    t66 = (0.007987890625 > t65)
-    t67 = (t57 >= 0.0)
-    t68 = (t57 <= 0.21)
+    t3 = t1**2
+    t4 = 1 - 125.18949581886645*t3
+    t5 = 11.188811188811188*t1
+    t6 = (1e-12 < t4)
+    t7 = casadi.if_else(t6, t5, casadi.if_else((t5 > 0), 1, -1))
+    t8 = casadi.if_else(t6, casadi.sqrt(t4), 0)
+    t9 = casadi.atan2(t8, t7)
+    t10 = 3.141592653589793 + t9
+    t11 = 3.141592653589793 - t9
+    t12 = t10 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t10)
+    t13 = t12 - 6.283185307179586*casadi.floor(0.24444444444444444 + 0.15915494309189535*t12)
+    t14 = t11 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t11)
+    t15 = t14 - 6.283185307179586*casadi.floor(0.24444444444444444 + 0.15915494309189535*t14)
+    t16 = -1.0*t7
+    t17 = -1.0*t8
+    t18 = 0.325 + 0.275*t16
+    t19 = 0.149769 + t18**2 + 0.075625*t17**2
+    t20 = 0.275*t17
+    t21 = 0.149769 + mu0*t18 + mu1*t20
+    t22 = -0.149769 + t21
+    t23 = mu1*t18 - mu0*t20
+    t24 = t22**2 + t23**2
+    t25 = 0.325 - 0.275*t7
+    t26 = 0.149769 + t25**2 + 0.075625*t8**2
+    t27 = 0.275*t8
+    t28 = 0.149769 + mu0*t25 + mu1*t27
+    t29 = -0.149769 + t28
+    t30 = mu1*t25 - mu0*t27
+    t31 = t29**2 + t30**2
+    t32 = 1e-24*t0
+    t33 = casadi.if_else((t24 <= t19*t32), 0, casadi.atan2(t23, t22))
+    t34 = t33
+    t35 = t34 - 6.283185307179586*casadi.floor(0.1388888888888889 + 0.15915494309189535*t34)
+    t36 = -mu3
+    t37 = -t10 - t33 - t36
+    t38 = t37 + 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t37)
+    t39 = -t38
+    t40 = t38 + 6.283185307179586*casadi.floor(1.0 + 0.15915494309189535*t39)
+    t41 = casadi.if_else((t31 <= t26*t32), 0, casadi.atan2(t30, t29))
+    t42 = t41
+    t43 = t42 - 6.283185307179586*casadi.floor(0.1388888888888889 + 0.15915494309189535*t42)
+    t44 = -t11 - t36 - t41
+    t45 = t44 + 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t44)
+    t46 = -t45
+    t47 = t45 + 6.283185307179586*casadi.floor(1.0 + 0.15915494309189535*t46)
+    t48 = (t35 <= 0.8726646259971648)
+    t49 = casadi.logic_and((t34 >= -0.8726646259971648), (t34 <= 0.8726646259971648))
+    t50 = (t13 <= 1.53588974175501)
+    t51 = casadi.logic_and((t12 >= -1.53588974175501), (t12 <= 1.53588974175501))
+    t52 = -(-0.387 + mu2)
+    t53 = -t40
+    t54 = (t43 <= 0.8726646259971648)
+    t55 = casadi.logic_and((t42 >= -0.8726646259971648), (t42 <= 0.8726646259971648))
+    t56 = (t15 <= 1.53588974175501)
+    t57 = casadi.logic_and((t14 >= -1.53588974175501), (t14 <= 1.53588974175501))
+    t58 = -t47
+    t59 = (casadi.fabs(t2) < casadi.inf)
+    t60 = (t52 >= 0.0)
+    t61 = (t52 <= 0.21)
     q = casadi.SX(2, 4)
-    q[0, 0] = casadi.if_else(casadi.logic_and(t53, casadi.logic_not(t54)), t40, t39)
-    q[0, 1] = casadi.if_else(casadi.logic_and(t55, casadi.logic_not(t56)), t16, t15)
-    q[0, 2] = t57
-    q[0, 3] = casadi.if_else(casadi.logic_and((t45 >= -6.283185307179586), casadi.logic_not(casadi.logic_and((t43 >= -6.283185307179586), (t43 <= 6.283185307179586)))), t58, t44)
-    q[1, 0] = casadi.if_else(casadi.logic_and(t59, casadi.logic_not(t60)), t48, t47)
-    q[1, 1] = casadi.if_else(casadi.logic_and(t61, casadi.logic_not(t62)), t18, t17)
-    q[1, 2] = t57
-    q[1, 3] = casadi.if_else(casadi.logic_and((t52 >= -6.283185307179586), casadi.logic_not(casadi.logic_and((t50 >= -6.283185307179586), (t50 <= 6.283185307179586)))), t63, t51)
+    q[0, 0] = casadi.if_else(casadi.logic_and(t48, casadi.logic_not(t49)), t35, t34)
+    q[0, 1] = casadi.if_else(casadi.logic_and(t50, casadi.logic_not(t51)), t13, t12)
+    q[0, 2] = t52
+    q[0, 3] = casadi.if_else(casadi.logic_and((t40 >= -6.283185307179586), casadi.logic_not(casadi.logic_and((t38 >= -6.283185307179586), (t38 <= 6.283185307179586)))), t53, t39)
+    q[1, 0] = casadi.if_else(casadi.logic_and(t54, casadi.logic_not(t55)), t43, t42)
+    q[1, 1] = casadi.if_else(casadi.logic_and(t56, casadi.logic_not(t57)), t15, t14)
+    q[1, 2] = t52
+    q[1, 3] = casadi.if_else(casadi.logic_and((t47 >= -6.283185307179586), casadi.logic_not(casadi.logic_and((t45 >= -6.283185307179586), (t45 <= 6.283185307179586)))), t58, t46)
     valid = casadi.SX(2, 1)
-    valid[0, 0] = casadi.logic_and(t64, casadi.logic_or(casadi.logic_and(t66, (t7 >= -1e-12)), casadi.logic_and((0.007987890625 <= t65), (t5 <= 1.931417125e-14))))
-    valid[1, 0] = casadi.logic_and(casadi.logic_and(t64, t66), (t7 > 1e-12))
+    valid[0, 0] = casadi.logic_and(t59, (t4 >= -1e-12))
+    valid[1, 0] = casadi.logic_and(t59, (t4 > 1e-12))
     in_limits = casadi.SX(2, 1)
-    in_limits[0, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t67, t68), casadi.logic_or(t53, t54)), casadi.logic_or(t55, t56)), casadi.logic_or((t58 <= 6.283185307179586), casadi.logic_and((t44 >= -6.283185307179586), (t44 <= 6.283185307179586))))
-    in_limits[1, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t67, t68), casadi.logic_or(t59, t60)), casadi.logic_or(t61, t62)), casadi.logic_or((t63 <= 6.283185307179586), casadi.logic_and((t51 >= -6.283185307179586), (t51 <= 6.283185307179586))))
+    in_limits[0, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t60, t61), casadi.logic_or(t48, t49)), casadi.logic_or(t50, t51)), casadi.logic_or((t53 <= 6.283185307179586), casadi.logic_and((t39 >= -6.283185307179586), (t39 <= 6.283185307179586))))
+    in_limits[1, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t60, t61), casadi.logic_or(t54, t55)), casadi.logic_or(t56, t57)), casadi.logic_or((t58 <= 6.283185307179586), casadi.logic_and((t46 >= -6.283185307179586), (t46 <= 6.283185307179586))))
     return [q, valid, in_limits]
 
 
 def _ik_nearest(mu, q_seed, weights):
-    """The closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status: 379 operations."""
+    """The closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status: 364 operations."""
     mu0 = mu[0]
     mu1 = mu[1]
     mu2 = mu[2]
@@ -766,151 +759,145 @@ def _ik_nearest(mu, q_seed, weights):
     t0 = 0.149769 + mu0**2 + mu1**2
     t1 = 0.1655095 - 0.5*t0
     t2 = -0.387 + mu2
-    t3 = False
-    t4 = casadi.if_else(t3, 1, 11.188811188811188)
-    t5 = t1**2
-    t6 = t4**2
-    t7 = 1 - t5*t6
-    t8 = t1*t4
-    t9 = (1e-12 < t7)
-    t10 = casadi.if_else(t9, t8, casadi.if_else((t8 > 0), 1, -1))
-    t11 = casadi.if_else(t9, casadi.sqrt(t7), 0)
-    t12 = casadi.atan2(t11, t10)
-    t13 = casadi.if_else(t3, 0, 3.141592653589793 + t12)
-    t14 = 3.141592653589793 - t12
-    t15 = t13 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t13)
-    t16 = t15 - 6.283185307179586*casadi.floor(0.24444444444444444 + 0.15915494309189535*t15)
-    t17 = t14 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t14)
-    t18 = t17 - 6.283185307179586*casadi.floor(0.24444444444444444 + 0.15915494309189535*t17)
-    t19 = 0.089375*t4
-    t20 = casadi.if_else(t3, 1, -t10*t19)
-    t21 = casadi.if_else(t3, 0, -t11*t19)
-    t22 = 0.325 + 0.275*t20
-    t23 = 0.149769 + t22**2 + 0.075625*t21**2
-    t24 = 0.275*t21
-    t25 = 0.149769 + mu0*t22 + mu1*t24
-    t26 = -0.149769 + t25
-    t27 = mu1*t22 - mu0*t24
-    t28 = t26**2 + t27**2
-    t29 = 0.024578125*t4
-    t30 = 0.325 - t10*t29
-    t31 = 0.149769 + t30**2 + 0.000604084228515625*t6*t11**2
-    t32 = t11*t29
-    t33 = 0.149769 + mu0*t30 + mu1*t32
-    t34 = -0.149769 + t33
-    t35 = mu1*t30 - mu0*t32
-    t36 = t34**2 + t35**2
-    t37 = mu0 + mu1 + mu2 + mu3
-    t38 = t37
-    t39 = qn1 + qn2 + qn3 + qn4 + qw1 + qw2 + qw3 + qw4 + t37
-    t40 = 1e-24*t0
-    t41 = casadi.if_else((t28 <= t23*t40), 0, casadi.atan2(t27, t26))
-    t42 = t41
-    t43 = t42 - 6.283185307179586*casadi.floor(0.1388888888888889 + 0.15915494309189535*t42)
-    t44 = -mu3
-    t45 = -t13 - t41 - t44
-    t46 = t45 + 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t45)
-    t47 = -t46
-    t48 = t46 + 6.283185307179586*casadi.floor(1.0 + 0.15915494309189535*t47)
-    t49 = casadi.if_else((t36 <= t31*t40), 0, casadi.atan2(t35, t34))
-    t50 = t49
-    t51 = t50 - 6.283185307179586*casadi.floor(0.1388888888888889 + 0.15915494309189535*t50)
-    t52 = -t14 - t44 - t49
-    t53 = t52 + 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t52)
-    t54 = -t53
-    t55 = t53 + 6.283185307179586*casadi.floor(1.0 + 0.15915494309189535*t54)
-    t56 = (t43 <= 0.8726646259971648)
-    t57 = casadi.logic_and((t42 >= -0.8726646259971648), (t42 <= 0.8726646259971648))
-    t58 = casadi.if_else(casadi.logic_and(t56, casadi.logic_not(t57)), t43, t42)
-    t59 = t58
-    t60 = t59 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn1 - 0.15915494309189535*t59)
-    t61 = casadi.if_else((qn1 > t60), 6.283185307179586, -6.283185307179586)
-    t62 = t60 + t61
-    t63 = t60 - t61
-    t64 = casadi.if_else(casadi.logic_and((t60 >= -0.8726646259971648), (t60 <= 0.8726646259971648)), t60, casadi.if_else(casadi.logic_and((t62 >= -0.8726646259971648), (t62 <= 0.8726646259971648)), t62, casadi.if_else(casadi.logic_and((t63 >= -0.8726646259971648), (t63 <= 0.8726646259971648)), t63, t58)))
-    t65 = (t16 <= 1.53588974175501)
-    t66 = casadi.logic_and((t15 >= -1.53588974175501), (t15 <= 1.53588974175501))
-    t67 = casadi.if_else(casadi.logic_and(t65, casadi.logic_not(t66)), t16, t15)
-    t68 = t67
-    t69 = t68 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t68)
-    t70 = casadi.if_else((qn2 > t69), 6.283185307179586, -6.283185307179586)
-    t71 = t69 + t70
-    t72 = t69 - t70
-    t73 = casadi.if_else(casadi.logic_and((t69 >= -1.53588974175501), (t69 <= 1.53588974175501)), t69, casadi.if_else(casadi.logic_and((t71 >= -1.53588974175501), (t71 <= 1.53588974175501)), t71, casadi.if_else(casadi.logic_and((t72 >= -1.53588974175501), (t72 <= 1.53588974175501)), t72, t67)))
-    t74 = (t48 >= -6.283185307179586)
-    t75 = casadi.logic_and((t46 >= -6.283185307179586), (t46 <= 6.283185307179586))
-    t76 = casadi.if_else(casadi.logic_and(t74, casadi.logic_not(t75)), -t48, t47)
-    t77 = t76
-    t78 = t77 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t77)
-    t79 = casadi.if_else((qn4 > t78), 6.283185307179586, -6.283185307179586)
-    t80 = t78 + t79
-    t81 = t78 - t79
-    t82 = casadi.if_else(casadi.logic_and((t78 >= -6.283185307179586), (t78 <= 6.283185307179586)), t78, casadi.if_else(casadi.logic_and((t80 >= -6.283185307179586), (t80 <= 6.283185307179586)), t80, casadi.if_else(casadi.logic_and((t81 >= -6.283185307179586), (t81 <= 6.283185307179586)), t81, t76)))
-    t83 = -qn1
-    t84 = -qn2
-    t85 = -qn4
-    t86 = qw3*(qn3 + t2)**2
-    t87 = t86 + qw1*(t64 + t83)**2 + qw2*(t73 + t84)**2 + qw4*(t82 + t85)**2
-    t88 = (casadi.fabs(t38) < casadi.inf)
-    t89 = (mu2 >= 0.17700000000000002)
-    t90 = (mu2 <= 0.387)
-    t91 = True
-    t92 = casadi.if_else(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t88, t89), t90), casadi.logic_or(t56, t57)), casadi.logic_or(t65, t66)), casadi.logic_or(t74, t75)), casadi.logic_or(casadi.logic_and(t91, (t7 >= -1e-12)), casadi.logic_and(t3, (51.775454771324966*t5 <= 1e-12)))), 1, 0)
-    t93 = casadi.if_else((t92 > 0), 1, 0)
-    t94 = (t93 > 0)
-    t95 = casadi.if_else(t94, t64, qn1)
-    t96 = casadi.if_else(t94, t73, qn2)
-    t97 = casadi.if_else(t94, t82, qn4)
-    t98 = casadi.if_else(t94, t87, 0)
-    t99 = -t2
-    t100 = casadi.if_else(t94, t99, qn3)
-    t101 = (t51 <= 0.8726646259971648)
-    t102 = casadi.logic_and((t50 >= -0.8726646259971648), (t50 <= 0.8726646259971648))
-    t103 = casadi.if_else(casadi.logic_and(t101, casadi.logic_not(t102)), t51, t50)
-    t104 = t103
-    t105 = t104 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn1 - 0.15915494309189535*t104)
-    t106 = casadi.if_else((qn1 > t105), 6.283185307179586, -6.283185307179586)
-    t107 = t105 + t106
-    t108 = t105 - t106
-    t109 = casadi.if_else(casadi.logic_and((t105 >= -0.8726646259971648), (t105 <= 0.8726646259971648)), t105, casadi.if_else(casadi.logic_and((t107 >= -0.8726646259971648), (t107 <= 0.8726646259971648)), t107, casadi.if_else(casadi.logic_and((t108 >= -0.8726646259971648), (t108 <= 0.8726646259971648)), t108, t103)))
-    t110 = (t18 <= 1.53588974175501)
-    t111 = casadi.logic_and((t17 >= -1.53588974175501), (t17 <= 1.53588974175501))
-    t112 = casadi.if_else(casadi.logic_and(t110, casadi.logic_not(t111)), t18, t17)
-    t113 = t112
-    t114 = t113 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t113)
-    t115 = casadi.if_else((qn2 > t114), 6.283185307179586, -6.283185307179586)
-    t116 = t114 + t115
-    t117 = t114 - t115
-    t118 = casadi.if_else(casadi.logic_and((t114 >= -1.53588974175501), (t114 <= 1.53588974175501)), t114, casadi.if_else(casadi.logic_and((t116 >= -1.53588974175501), (t116 <= 1.53588974175501)), t116, casadi.if_else(casadi.logic_and((t117 >= -1.53588974175501), (t117 <= 1.53588974175501)), t117, t112)))
-    t119 = (t55 >= -6.283185307179586)
-    t120 = casadi.logic_and((t53 >= -6.283185307179586), (t53 <= 6.283185307179586))
-    t121 = casadi.if_else(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t88, t89), t9), t90), t91), casadi.logic_or(t101, t102)), casadi.logic_or(t110, t111)), casadi.logic_or(t119, t120)), 1, 0)
-    t122 = casadi.if_else(casadi.logic_and(t119, casadi.logic_not(t120)), -t55, t54)
-    t123 = t122
-    t124 = t123 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t123)
-    t125 = casadi.if_else((qn4 > t124), 6.283185307179586, -6.283185307179586)
-    t126 = t124 + t125
-    t127 = t124 - t125
-    t128 = casadi.if_else(casadi.logic_and((t124 >= -6.283185307179586), (t124 <= 6.283185307179586)), t124, casadi.if_else(casadi.logic_and((t126 >= -6.283185307179586), (t126 <= 6.283185307179586)), t126, casadi.if_else(casadi.logic_and((t127 >= -6.283185307179586), (t127 <= 6.283185307179586)), t127, t122)))
-    t129 = t86 + qw1*(t109 + t83)**2 + qw2*(t118 + t84)**2 + qw4*(t128 + t85)**2
-    t130 = (t121 > 0)
-    t131 = casadi.if_else(casadi.logic_and(t130, casadi.logic_or((t129 < t98), (t93 < 1))), 1, 0)
-    t132 = casadi.if_else(t130, 1, t93)
-    t133 = (t131 > 0)
-    t134 = casadi.if_else(t133, t109, t95)
-    t135 = casadi.if_else(t133, t118, t96)
-    t136 = casadi.if_else(t133, t99, t100)
-    t137 = casadi.if_else(t133, t128, t97)
-    t138 = (casadi.fabs(t39) < casadi.inf)
-    t139 = (t132 > 0)
-    t140 = casadi.logic_and(t138, t139)
+    t3 = t1**2
+    t4 = 1 - 125.18949581886645*t3
+    t5 = 11.188811188811188*t1
+    t6 = (1e-12 < t4)
+    t7 = casadi.if_else(t6, t5, casadi.if_else((t5 > 0), 1, -1))
+    t8 = casadi.if_else(t6, casadi.sqrt(t4), 0)
+    t9 = casadi.atan2(t8, t7)
+    t10 = 3.141592653589793 + t9
+    t11 = 3.141592653589793 - t9
+    t12 = t10 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t10)
+    t13 = t12 - 6.283185307179586*casadi.floor(0.24444444444444444 + 0.15915494309189535*t12)
+    t14 = t11 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t11)
+    t15 = t14 - 6.283185307179586*casadi.floor(0.24444444444444444 + 0.15915494309189535*t14)
+    t16 = -1.0*t7
+    t17 = -1.0*t8
+    t18 = 0.325 + 0.275*t16
+    t19 = 0.149769 + t18**2 + 0.075625*t17**2
+    t20 = 0.275*t17
+    t21 = 0.149769 + mu0*t18 + mu1*t20
+    t22 = -0.149769 + t21
+    t23 = mu1*t18 - mu0*t20
+    t24 = t22**2 + t23**2
+    t25 = 0.325 - 0.275*t7
+    t26 = 0.149769 + t25**2 + 0.075625*t8**2
+    t27 = 0.275*t8
+    t28 = 0.149769 + mu0*t25 + mu1*t27
+    t29 = -0.149769 + t28
+    t30 = mu1*t25 - mu0*t27
+    t31 = t29**2 + t30**2
+    t32 = mu0 + mu1 + mu2 + mu3
+    t33 = t32
+    t34 = qn1 + qn2 + qn3 + qn4 + qw1 + qw2 + qw3 + qw4 + t32
+    t35 = 1e-24*t0
+    t36 = casadi.if_else((t24 <= t19*t35), 0, casadi.atan2(t23, t22))
+    t37 = t36
+    t38 = t37 - 6.283185307179586*casadi.floor(0.1388888888888889 + 0.15915494309189535*t37)
+    t39 = -mu3
+    t40 = -t10 - t36 - t39
+    t41 = t40 + 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t40)
+    t42 = -t41
+    t43 = t41 + 6.283185307179586*casadi.floor(1.0 + 0.15915494309189535*t42)
+    t44 = casadi.if_else((t31 <= t26*t35), 0, casadi.atan2(t30, t29))
+    t45 = t44
+    t46 = t45 - 6.283185307179586*casadi.floor(0.1388888888888889 + 0.15915494309189535*t45)
+    t47 = -t11 - t39 - t44
+    t48 = t47 + 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t47)
+    t49 = -t48
+    t50 = t48 + 6.283185307179586*casadi.floor(1.0 + 0.15915494309189535*t49)
+    t51 = (t38 <= 0.8726646259971648)
+    t52 = casadi.logic_and((t37 >= -0.8726646259971648), (t37 <= 0.8726646259971648))
+    t53 = casadi.if_else(casadi.logic_and(t51, casadi.logic_not(t52)), t38, t37)
+    t54 = t53
+    t55 = t54 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn1 - 0.15915494309189535*t54)
+    t56 = casadi.if_else((qn1 > t55), 6.283185307179586, -6.283185307179586)
+    t57 = t55 + t56
+    t58 = t55 - t56
+    t59 = casadi.if_else(casadi.logic_and((t55 >= -0.8726646259971648), (t55 <= 0.8726646259971648)), t55, casadi.if_else(casadi.logic_and((t57 >= -0.8726646259971648), (t57 <= 0.8726646259971648)), t57, casadi.if_else(casadi.logic_and((t58 >= -0.8726646259971648), (t58 <= 0.8726646259971648)), t58, t53)))
+    t60 = (t13 <= 1.53588974175501)
+    t61 = casadi.logic_and((t12 >= -1.53588974175501), (t12 <= 1.53588974175501))
+    t62 = casadi.if_else(casadi.logic_and(t60, casadi.logic_not(t61)), t13, t12)
+    t63 = t62
+    t64 = t63 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t63)
+    t65 = casadi.if_else((qn2 > t64), 6.283185307179586, -6.283185307179586)
+    t66 = t64 + t65
+    t67 = t64 - t65
+    t68 = casadi.if_else(casadi.logic_and((t64 >= -1.53588974175501), (t64 <= 1.53588974175501)), t64, casadi.if_else(casadi.logic_and((t66 >= -1.53588974175501), (t66 <= 1.53588974175501)), t66, casadi.if_else(casadi.logic_and((t67 >= -1.53588974175501), (t67 <= 1.53588974175501)), t67, t62)))
+    t69 = (t43 >= -6.283185307179586)
+    t70 = casadi.logic_and((t41 >= -6.283185307179586), (t41 <= 6.283185307179586))
+    t71 = casadi.if_else(casadi.logic_and(t69, casadi.logic_not(t70)), -t43, t42)
+    t72 = t71
+    t73 = t72 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t72)
+    t74 = casadi.if_else((qn4 > t73), 6.283185307179586, -6.283185307179586)
+    t75 = t73 + t74
+    t76 = t73 - t74
+    t77 = casadi.if_else(casadi.logic_and((t73 >= -6.283185307179586), (t73 <= 6.283185307179586)), t73, casadi.if_else(casadi.logic_and((t75 >= -6.283185307179586), (t75 <= 6.283185307179586)), t75, casadi.if_else(casadi.logic_and((t76 >= -6.283185307179586), (t76 <= 6.283185307179586)), t76, t71)))
+    t78 = -qn1
+    t79 = -qn2
+    t80 = -qn4
+    t81 = qw3*(qn3 + t2)**2
+    t82 = t81 + qw1*(t59 + t78)**2 + qw2*(t68 + t79)**2 + qw4*(t77 + t80)**2
+    t83 = (casadi.fabs(t33) < casadi.inf)
+    t84 = (mu2 >= 0.17700000000000002)
+    t85 = (mu2 <= 0.387)
+    t86 = casadi.if_else(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t83, t84), t85), (t4 >= -1e-12)), casadi.logic_or(t51, t52)), casadi.logic_or(t60, t61)), casadi.logic_or(t69, t70)), 1, 0)
+    t87 = casadi.if_else((t86 > 0), 1, 0)
+    t88 = (t87 > 0)
+    t89 = casadi.if_else(t88, t59, qn1)
+    t90 = casadi.if_else(t88, t68, qn2)
+    t91 = casadi.if_else(t88, t77, qn4)
+    t92 = casadi.if_else(t88, t82, 0)
+    t93 = -t2
+    t94 = casadi.if_else(t88, t93, qn3)
+    t95 = (t46 <= 0.8726646259971648)
+    t96 = casadi.logic_and((t45 >= -0.8726646259971648), (t45 <= 0.8726646259971648))
+    t97 = casadi.if_else(casadi.logic_and(t95, casadi.logic_not(t96)), t46, t45)
+    t98 = t97
+    t99 = t98 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn1 - 0.15915494309189535*t98)
+    t100 = casadi.if_else((qn1 > t99), 6.283185307179586, -6.283185307179586)
+    t101 = t100 + t99
+    t102 = t99 - t100
+    t103 = casadi.if_else(casadi.logic_and((t99 >= -0.8726646259971648), (t99 <= 0.8726646259971648)), t99, casadi.if_else(casadi.logic_and((t101 >= -0.8726646259971648), (t101 <= 0.8726646259971648)), t101, casadi.if_else(casadi.logic_and((t102 >= -0.8726646259971648), (t102 <= 0.8726646259971648)), t102, t97)))
+    t104 = (t15 <= 1.53588974175501)
+    t105 = casadi.logic_and((t14 >= -1.53588974175501), (t14 <= 1.53588974175501))
+    t106 = casadi.if_else(casadi.logic_and(t104, casadi.logic_not(t105)), t15, t14)
+    t107 = t106
+    t108 = t107 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t107)
+    t109 = casadi.if_else((qn2 > t108), 6.283185307179586, -6.283185307179586)
+    t110 = t108 + t109
+    t111 = t108 - t109
+    t112 = casadi.if_else(casadi.logic_and((t108 >= -1.53588974175501), (t108 <= 1.53588974175501)), t108, casadi.if_else(casadi.logic_and((t110 >= -1.53588974175501), (t110 <= 1.53588974175501)), t110, casadi.if_else(casadi.logic_and((t111 >= -1.53588974175501), (t111 <= 1.53588974175501)), t111, t106)))
+    t113 = (t50 >= -6.283185307179586)
+    t114 = casadi.logic_and((t48 >= -6.283185307179586), (t48 <= 6.283185307179586))
+    t115 = casadi.if_else(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t6, t83), t84), t85), casadi.logic_or(t104, t105)), casadi.logic_or(t113, t114)), casadi.logic_or(t95, t96)), 1, 0)
+    t116 = casadi.if_else(casadi.logic_and(t113, casadi.logic_not(t114)), -t50, t49)
+    t117 = t116
+    t118 = t117 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t117)
+    t119 = casadi.if_else((qn4 > t118), 6.283185307179586, -6.283185307179586)
+    t120 = t118 + t119
+    t121 = t118 - t119
+    t122 = casadi.if_else(casadi.logic_and((t118 >= -6.283185307179586), (t118 <= 6.283185307179586)), t118, casadi.if_else(casadi.logic_and((t120 >= -6.283185307179586), (t120 <= 6.283185307179586)), t120, casadi.if_else(casadi.logic_and((t121 >= -6.283185307179586), (t121 <= 6.283185307179586)), t121, t116)))
+    t123 = t81 + qw1*(t103 + t78)**2 + qw2*(t112 + t79)**2 + qw4*(t122 + t80)**2
+    t124 = (t115 > 0)
+    t125 = casadi.if_else(casadi.logic_and(t124, casadi.logic_or((t123 < t92), (t87 < 1))), 1, 0)
+    t126 = casadi.if_else(t124, 1, t87)
+    t127 = (t125 > 0)
+    t128 = casadi.if_else(t127, t103, t89)
+    t129 = casadi.if_else(t127, t112, t90)
+    t130 = casadi.if_else(t127, t93, t94)
+    t131 = casadi.if_else(t127, t122, t91)
+    t132 = (casadi.fabs(t34) < casadi.inf)
+    t133 = (t126 > 0)
+    t134 = casadi.logic_and(t132, t133)
     q = casadi.SX(4, 1)
-    q[0, 0] = casadi.if_else(t140, t134, qn1)
-    q[1, 0] = casadi.if_else(t140, t135, qn2)
-    q[2, 0] = casadi.if_else(t140, t136, qn3)
-    q[3, 0] = casadi.if_else(t140, t137, qn4)
+    q[0, 0] = casadi.if_else(t134, t128, qn1)
+    q[1, 0] = casadi.if_else(t134, t129, qn2)
+    q[2, 0] = casadi.if_else(t134, t130, qn3)
+    q[3, 0] = casadi.if_else(t134, t131, qn4)
     status = casadi.SX(1, 1)
-    status[0, 0] = casadi.if_else(casadi.logic_not(t138), 2, casadi.if_else(t139, 0, 1))
+    status[0, 0] = casadi.if_else(casadi.logic_not(t132), 2, casadi.if_else(t133, 0, 1))
     return [q, status]
 
 

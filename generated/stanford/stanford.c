@@ -2043,7 +2043,7 @@ stanford_real stanford_ik_numeric_step(const stanford_real target[16], const sta
 
 void stanford_ik_branches(const stanford_real T[16], stanford_real q[STANFORD_MAX_IK_SOLUTIONS * STANFORD_DOF], int valid[STANFORD_MAX_IK_SOLUTIONS], int in_limits[STANFORD_MAX_IK_SOLUTIONS])
 {
-    /* 1056 operations */
+    /* 1059 operations */
 
     /* Inputs */
     const stanford_real T00 = T[0];
@@ -2458,21 +2458,20 @@ void stanford_ik_branches(const stanford_real T[16], stanford_real q[STANFORD_MA
     const int t395 = t331 <= 2.9670597283903604;
     const int t396 = t330 >= -2.9670597283903604 && t330 <= 2.9670597283903604;
     const int t397 = isfinite(t0);
-    const stanford_real t398 = -1e-12;
-    const int t399 = t18 >= t20;
-    const int t400 = t26 >= t28;
-    const int t401 = t26 > t27;
-    const int t402 = t18 > t19;
-    const int t403 = t21 >= 0.30479999999999996;
-    const int t404 = t21 <= 1.27;
-    const int t405 = t334 || t335;
-    const int t406 = t337 || t338;
-    const int t407 = t351 || t352;
-    const int t408 = t354 || t355;
-    const int t409 = t371 >= 0.30479999999999996;
-    const int t410 = t371 <= 1.27;
-    const int t411 = t368 || t369;
-    const int t412 = t383 || t384;
+    const int t398 = t18 >= t20;
+    const int t399 = t26 >= t28;
+    const int t400 = t26 > t27;
+    const int t401 = t18 > t19;
+    const int t402 = t21 >= 0.30479999999999996;
+    const int t403 = t21 <= 1.27;
+    const int t404 = t334 || t335;
+    const int t405 = t337 || t338;
+    const int t406 = t351 || t352;
+    const int t407 = t354 || t355;
+    const int t408 = t371 >= 0.30479999999999996;
+    const int t409 = t371 <= 1.27;
+    const int t410 = t368 || t369;
+    const int t411 = t383 || t384;
 
     /* Outputs */
     q[0] = t336;
@@ -2523,22 +2522,22 @@ void stanford_ik_branches(const stanford_real T[16], stanford_real q[STANFORD_MA
     q[45] = (t392 && !t393 ? t322 : t321);
     q[46] = (t333 >= -1.5707963267948966 && !(t326 >= -1.5707963267948966 && t326 <= 1.5707963267948966) ? t394 : t332);
     q[47] = (t395 && !t396 ? t331 : t330);
-    valid[0] = t397 && t399 && t400 && t105 >= t398;
-    valid[1] = t397 && t399 && t400 && t105 > 1e-12;
-    valid[2] = t397 && t399 && t401 && t146 >= t398;
-    valid[3] = t397 && t399 && t401 && t146 > 1e-12;
-    valid[4] = t397 && t400 && t402 && t203 >= t398;
-    valid[5] = t397 && t400 && t402 && t203 > 1e-12;
-    valid[6] = t397 && t401 && t402 && t235 >= t398;
-    valid[7] = t397 && t401 && t402 && t235 > 1e-12;
-    in_limits[0] = t403 && t404 && t405 && t406 && (t340 || t341) && (t342 || t343) && (t344 || t345);
-    in_limits[1] = t403 && t404 && t405 && t406 && (t346 || t347) && (t349 || t350) && ((t348 <= 1.5707963267948966) || (t284 >= -1.5707963267948966 && t284 <= 1.5707963267948966));
-    in_limits[2] = t403 && t404 && t407 && t408 && (t357 || t358) && (t359 || t360) && (t361 || t362);
-    in_limits[3] = t403 && t404 && t407 && t408 && (t363 || t364) && (t366 || t367) && ((t365 <= 1.5707963267948966) || (t300 >= -1.5707963267948966 && t300 <= 1.5707963267948966));
-    in_limits[4] = t405 && t409 && t410 && t411 && (t372 || t373) && (t374 || t375) && (t376 || t377);
-    in_limits[5] = t405 && t409 && t410 && t411 && (t378 || t379) && (t381 || t382) && ((t380 <= 1.5707963267948966) || (t316 >= -1.5707963267948966 && t316 <= 1.5707963267948966));
-    in_limits[6] = t407 && t409 && t410 && t412 && (t386 || t387) && (t388 || t389) && (t390 || t391);
-    in_limits[7] = t407 && t409 && t410 && t412 && (t392 || t393) && (t395 || t396) && ((t394 <= 1.5707963267948966) || (t332 >= -1.5707963267948966 && t332 <= 1.5707963267948966));
+    valid[0] = t397 && t398 && t399 && t105 >= -1e-12;
+    valid[1] = t397 && t398 && t399 && t105 > 1e-12;
+    valid[2] = t397 && t398 && t400 && t146 >= -1e-12;
+    valid[3] = t397 && t398 && t400 && t146 > 1e-12;
+    valid[4] = t397 && t399 && t401 && t203 >= -1e-12;
+    valid[5] = t397 && t399 && t401 && t203 > 1e-12;
+    valid[6] = t397 && t400 && t401 && t235 >= -1e-12;
+    valid[7] = t397 && t400 && t401 && t235 > 1e-12;
+    in_limits[0] = t402 && t403 && t404 && t405 && (t340 || t341) && (t342 || t343) && (t344 || t345);
+    in_limits[1] = t402 && t403 && t404 && t405 && (t346 || t347) && (t349 || t350) && ((t348 <= 1.5707963267948966) || (t284 >= -1.5707963267948966 && t284 <= 1.5707963267948966));
+    in_limits[2] = t402 && t403 && t406 && t407 && (t357 || t358) && (t359 || t360) && (t361 || t362);
+    in_limits[3] = t402 && t403 && t406 && t407 && (t363 || t364) && (t366 || t367) && ((t365 <= 1.5707963267948966) || (t300 >= -1.5707963267948966 && t300 <= 1.5707963267948966));
+    in_limits[4] = t404 && t408 && t409 && t410 && (t372 || t373) && (t374 || t375) && (t376 || t377);
+    in_limits[5] = t404 && t408 && t409 && t410 && (t378 || t379) && (t381 || t382) && ((t380 <= 1.5707963267948966) || (t316 >= -1.5707963267948966 && t316 <= 1.5707963267948966));
+    in_limits[6] = t406 && t408 && t409 && t411 && (t386 || t387) && (t388 || t389) && (t390 || t391);
+    in_limits[7] = t406 && t408 && t409 && t411 && (t392 || t393) && (t395 || t396) && ((t394 <= 1.5707963267948966) || (t332 >= -1.5707963267948966 && t332 <= 1.5707963267948966));
 }
 
 int stanford_ik_nearest(const stanford_real T[16], const stanford_real q_seed[STANFORD_DOF], const stanford_real weights[STANFORD_DOF], stanford_real q[STANFORD_DOF])

@@ -1692,7 +1692,7 @@ def _ik_numeric_step(target, q, damping):
 
 
 def _ik_branches(T):
-    """Every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits: 1056 operations."""
+    """Every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits: 1059 operations."""
     T00 = T[0, 0]
     T01 = T[0, 1]
     T02 = T[0, 2]
@@ -2103,21 +2103,20 @@ def _ik_branches(T):
     t395 = (t331 <= 2.9670597283903604)
     t396 = casadi.logic_and((t330 >= -2.9670597283903604), (t330 <= 2.9670597283903604))
     t397 = (casadi.fabs(t0) < casadi.inf)
-    t398 = -1e-12
-    t399 = (t18 >= t20)
-    t400 = (t26 >= t28)
-    t401 = (t26 > t27)
-    t402 = (t18 > t19)
-    t403 = (t21 >= 0.30479999999999996)
-    t404 = (t21 <= 1.27)
-    t405 = casadi.logic_or(t334, t335)
-    t406 = casadi.logic_or(t337, t338)
-    t407 = casadi.logic_or(t351, t352)
-    t408 = casadi.logic_or(t354, t355)
-    t409 = (t371 >= 0.30479999999999996)
-    t410 = (t371 <= 1.27)
-    t411 = casadi.logic_or(t368, t369)
-    t412 = casadi.logic_or(t383, t384)
+    t398 = (t18 >= t20)
+    t399 = (t26 >= t28)
+    t400 = (t26 > t27)
+    t401 = (t18 > t19)
+    t402 = (t21 >= 0.30479999999999996)
+    t403 = (t21 <= 1.27)
+    t404 = casadi.logic_or(t334, t335)
+    t405 = casadi.logic_or(t337, t338)
+    t406 = casadi.logic_or(t351, t352)
+    t407 = casadi.logic_or(t354, t355)
+    t408 = (t371 >= 0.30479999999999996)
+    t409 = (t371 <= 1.27)
+    t410 = casadi.logic_or(t368, t369)
+    t411 = casadi.logic_or(t383, t384)
     q = casadi.SX(8, 6)
     q[0, 0] = t336
     q[0, 1] = t339
@@ -2168,23 +2167,23 @@ def _ik_branches(T):
     q[7, 4] = casadi.if_else(casadi.logic_and((t333 >= -1.5707963267948966), casadi.logic_not(casadi.logic_and((t326 >= -1.5707963267948966), (t326 <= 1.5707963267948966)))), t394, t332)
     q[7, 5] = casadi.if_else(casadi.logic_and(t395, casadi.logic_not(t396)), t331, t330)
     valid = casadi.SX(8, 1)
-    valid[0, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t397, t399), t400), (t105 >= t398))
-    valid[1, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t397, t399), t400), (t105 > 1e-12))
-    valid[2, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t397, t399), t401), (t146 >= t398))
-    valid[3, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t397, t399), t401), (t146 > 1e-12))
-    valid[4, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t397, t400), t402), (t203 >= t398))
-    valid[5, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t397, t400), t402), (t203 > 1e-12))
-    valid[6, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t397, t401), t402), (t235 >= t398))
-    valid[7, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t397, t401), t402), (t235 > 1e-12))
+    valid[0, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t397, t398), t399), (t105 >= -1e-12))
+    valid[1, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t397, t398), t399), (t105 > 1e-12))
+    valid[2, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t397, t398), t400), (t146 >= -1e-12))
+    valid[3, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t397, t398), t400), (t146 > 1e-12))
+    valid[4, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t397, t399), t401), (t203 >= -1e-12))
+    valid[5, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t397, t399), t401), (t203 > 1e-12))
+    valid[6, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t397, t400), t401), (t235 >= -1e-12))
+    valid[7, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t397, t400), t401), (t235 > 1e-12))
     in_limits = casadi.SX(8, 1)
-    in_limits[0, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t403, t404), t405), t406), casadi.logic_or(t340, t341)), casadi.logic_or(t342, t343)), casadi.logic_or(t344, t345))
-    in_limits[1, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t403, t404), t405), t406), casadi.logic_or(t346, t347)), casadi.logic_or(t349, t350)), casadi.logic_or((t348 <= 1.5707963267948966), casadi.logic_and((t284 >= -1.5707963267948966), (t284 <= 1.5707963267948966))))
-    in_limits[2, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t403, t404), t407), t408), casadi.logic_or(t357, t358)), casadi.logic_or(t359, t360)), casadi.logic_or(t361, t362))
-    in_limits[3, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t403, t404), t407), t408), casadi.logic_or(t363, t364)), casadi.logic_or(t366, t367)), casadi.logic_or((t365 <= 1.5707963267948966), casadi.logic_and((t300 >= -1.5707963267948966), (t300 <= 1.5707963267948966))))
-    in_limits[4, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t405, t409), t410), t411), casadi.logic_or(t372, t373)), casadi.logic_or(t374, t375)), casadi.logic_or(t376, t377))
-    in_limits[5, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t405, t409), t410), t411), casadi.logic_or(t378, t379)), casadi.logic_or(t381, t382)), casadi.logic_or((t380 <= 1.5707963267948966), casadi.logic_and((t316 >= -1.5707963267948966), (t316 <= 1.5707963267948966))))
-    in_limits[6, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t407, t409), t410), t412), casadi.logic_or(t386, t387)), casadi.logic_or(t388, t389)), casadi.logic_or(t390, t391))
-    in_limits[7, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t407, t409), t410), t412), casadi.logic_or(t392, t393)), casadi.logic_or(t395, t396)), casadi.logic_or((t394 <= 1.5707963267948966), casadi.logic_and((t332 >= -1.5707963267948966), (t332 <= 1.5707963267948966))))
+    in_limits[0, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t402, t403), t404), t405), casadi.logic_or(t340, t341)), casadi.logic_or(t342, t343)), casadi.logic_or(t344, t345))
+    in_limits[1, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t402, t403), t404), t405), casadi.logic_or(t346, t347)), casadi.logic_or(t349, t350)), casadi.logic_or((t348 <= 1.5707963267948966), casadi.logic_and((t284 >= -1.5707963267948966), (t284 <= 1.5707963267948966))))
+    in_limits[2, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t402, t403), t406), t407), casadi.logic_or(t357, t358)), casadi.logic_or(t359, t360)), casadi.logic_or(t361, t362))
+    in_limits[3, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t402, t403), t406), t407), casadi.logic_or(t363, t364)), casadi.logic_or(t366, t367)), casadi.logic_or((t365 <= 1.5707963267948966), casadi.logic_and((t300 >= -1.5707963267948966), (t300 <= 1.5707963267948966))))
+    in_limits[4, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t404, t408), t409), t410), casadi.logic_or(t372, t373)), casadi.logic_or(t374, t375)), casadi.logic_or(t376, t377))
+    in_limits[5, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t404, t408), t409), t410), casadi.logic_or(t378, t379)), casadi.logic_or(t381, t382)), casadi.logic_or((t380 <= 1.5707963267948966), casadi.logic_and((t316 >= -1.5707963267948966), (t316 <= 1.5707963267948966))))
+    in_limits[6, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t406, t408), t409), t411), casadi.logic_or(t386, t387)), casadi.logic_or(t388, t389)), casadi.logic_or(t390, t391))
+    in_limits[7, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t406, t408), t409), t411), casadi.logic_or(t392, t393)), casadi.logic_or(t395, t396)), casadi.logic_or((t394 <= 1.5707963267948966), casadi.logic_and((t332 >= -1.5707963267948966), (t332 <= 1.5707963267948966))))
     return [q, valid, in_limits]
 
 
