@@ -6,7 +6,7 @@ import numpy
 import sympy
 
 from . import analysis, differential, ik, report
-from .functions import Function, Generator, Output, is_boolean
+from .functions import Call, Function, Generator, Output, is_boolean
 from .printers import CasadiPrinter, CPrinter, PythonPrinter
 from .robot import Robot
 from .subproblems import RANK, TOLERANCES
@@ -87,6 +87,8 @@ def _python_function(function: Function, printer: PythonPrinter, parameters: lis
         "signature": ", ".join([f"{a.name}={a.default}" if a.default else a.name for a in function.arguments] + ["*"] * bool(parameters)
                                + [f"{p['name']}={p['value']}" for p in parameters]),
         "selects": any(e.has(sympy.Piecewise) for e in [v for _, v in body.definitions] + list(body.outputs)),
+        "calls": [(", ".join(r.name for r in call.results), f"{call.function}({', '.join(call.passes)}"
+                   + "".join(f", {p['name']}={p['name']}" for p in parameters) + ")") for call in function.calls],
         "inputs": [(str(symbol), f"{argument.name}[..., {row}]" if argument.vector else f"{argument.name}[..., {row}, {col}]")
                    for symbol, argument, row, col in function.inputs if symbol in read],
         "trig": repr(tuple(offsets)) if trig else None,
@@ -167,7 +169,8 @@ def _c_type(output: Output, real: str) -> str:
     return "int" if output.boolean or output.integer else real
 
 
-def _c_function(function: Function, robot: Robot, printer: CPrinter, macros: dict[str, int]) -> dict:
+def _c_function(function: Function, robot: Robot, printer: CPrinter, macros: dict[str, int],
+                functions: dict[str, Function]) -> dict:
     body, prefix, real = function.body, robot.name.upper(), f"{robot.name}_real"
     arguments = [f"{real} {a.name}" if a.scalar else f"const {real} {a.name}[{_c_extent(a.name, a.size, macros, prefix)}]"
                  for a in function.arguments]
@@ -179,10 +182,13 @@ def _c_function(function: Function, robot: Robot, printer: CPrinter, macros: dic
     if robot.symbolic_parameters:
         arguments.append(f"const {robot.name}_params *p")
     inputs = list(function.inputs)
-    unused = [a.name for a in function.arguments
-              if not any(argument is a for _, argument, _, _ in inputs) and not (a.scalar and a.symbols[0] in body.read)]
+    passed = {name for call in function.calls for name in call.passes}
+    unused = [a.name for a in function.arguments if a.name not in passed
+              and not any(argument is a for _, argument, _, _ in inputs) and not (a.scalar and a.symbols[0] in body.read)]
     unused += ["p"] * bool(robot.symbolic_parameters and not parameters)
     values = dict(function.parts(body.outputs))
+    types = {result.name: _c_type(output, real) for call in function.calls
+             for result, output in zip(call.results, functions[call.function].outputs)}
     return {
         "name": function.name,
         "summary": _sentence(function.summary),
@@ -190,13 +196,23 @@ def _c_function(function: Function, robot: Robot, printer: CPrinter, macros: dic
         "operations": body.operation_count,
         "prototype": f"{_c_type(returned, real) if returned else 'void'} {robot.name}_{function.name}({', '.join(arguments)})",
         "unused": unused,
-        "inputs": [(str(symbol), f"{argument.name}[{row * argument.symbols.cols + col}]")
-                   for symbol, argument, row, col in inputs] + [(name, f"p->{name}") for name in parameters],
+        "calls": [_c_call(call, functions[call.function], robot, macros) for call in function.calls],
+        "inputs": [(types.get(argument.name, real), str(symbol), f"{argument.name}[{row * argument.symbols.cols + col}]")
+                   for symbol, argument, row, col in inputs] + [(real, name, f"p->{name}") for name in parameters],
         "definitions": [("int" if is_boolean(e) else real, str(symbol), printer.doprint(e)) for symbol, e in body.definitions],
         "outputs": [(f"{output.name}[{k}]", printer.doprint(e)) for output in arrays
                     for k, e in enumerate(values[output])],
         "result": printer.doprint(values[returned][0]) if returned else None,
     }
+
+
+def _c_call(call: Call, callee: Function, robot: Robot, macros: dict[str, int]) -> dict:
+    """The local arrays that receive a call's results, and the call."""
+    prefix, real = robot.name.upper(), f"{robot.name}_real"
+    arrays = [f"{_c_type(output, real)} {result.name}[{_c_extent(_c_output_key(callee, output), output.size, macros, prefix)}]"
+              for result, output in zip(call.results, callee.outputs)]
+    arguments = [*call.passes, *(result.name for result in call.results)] + ["p"] * bool(robot.symbolic_parameters)
+    return {"arrays": arrays, "call": f"{robot.name}_{callee.name}({', '.join(arguments)})"}
 
 
 def _joint_lines(robot: Robot) -> list[str]:
@@ -235,6 +251,8 @@ def _casadi_function(function: Function, robot: Robot, printer: CasadiPrinter) -
         "summary": _sentence(function.summary),
         "operations": body.operation_count,
         "arguments": [(a.name, a.symbols.rows, a.symbols.cols) for a in function.arguments],
+        "calls": [(", ".join(r.name for r in call.results), f"_{call.function}({', '.join(call.passes)}"
+                   + ", p" * bool(robot.symbolic_parameters) + ")") for call in function.calls],
         "inputs": [(str(symbol), f"{argument.name}[{row}]" if argument.vector else f"{argument.name}[{row}, {col}]")
                    for symbol, argument, row, col in function.inputs]
         + [(name, f"p[{[q.name for q in robot.symbolic_parameters].index(name)}]")
@@ -365,7 +383,7 @@ def c_context(robot: Robot, generator: Generator, printer: CPrinter, real: str) 
         "macros": list(macros.items()),
         "joint_lines": _joint_lines(robot),
         "task_lines": _task_lines(robot),
-        "functions": [_c_function(f, robot, printer, macros) for f in functions],
+        "functions": [_c_function(f, robot, printer, macros, {g.name: g for g in functions}) for f in functions],
         "ik": _ik_context(robot, generator, "c", real),
         "ik_numeric": _ik_numeric_context(robot, "c", real),
         "velocity_ik": _velocity_ik_context(robot, real),

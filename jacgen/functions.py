@@ -87,6 +87,17 @@ class Output:
 
 
 @dataclass(frozen=True)
+class Call:
+    """Another generated function that a function calls before its body, passing some of its
+    arguments; the body reads the callee's results, held as `results` (arguments named as
+    the local arrays, with their symbols)."""
+
+    function: str
+    passes: tuple[str, ...]
+    results: tuple[Argument, ...]
+
+
+@dataclass(frozen=True)
 class Function:
     """One generated function; its body's outputs are those of `outputs`, concatenated."""
 
@@ -95,11 +106,13 @@ class Function:
     outputs: tuple[Output, ...]
     body: Body
     arguments: tuple[Argument, ...]
+    calls: tuple[Call, ...] = ()
 
     @property
     def inputs(self):
-        """(symbol, argument, row, col) of every input the body reads, in argument order."""
-        for argument in self.arguments:
+        """(symbol, argument, row, col) of every input the body reads, in argument order, then
+        the results of its calls."""
+        for argument in (*self.arguments, *(result for call in self.calls for result in call.results)):
             for k, symbol in enumerate(argument.symbols):
                 if symbol in self.body.read and not argument.scalar:
                     yield (symbol, argument, *divmod(k, argument.symbols.cols))
@@ -181,18 +194,26 @@ class Generator:
         sp = Subproblems(self.name)
         with distribute(False):
             q, valid, inside = ik.branches(self.robot, form, sp, target.symbols, free_angle)
+        branches = self.function("ik_branches", "every branch of the closed-form ik, whether the target allows it "
+                                 "and whether it is inside the joint limits", ("q", q), ("valid", valid),
+                                 ("in_limits", inside), arguments=(target, *free), bindings=bindings)
+        # ik_nearest reads ik_branches' results rather than lowering the solver a second time.
+        rows = range(q.rows)
+        table = Call("ik_branches", tuple(a.name for a in branches.arguments), (
+            Argument("branches_q", sympy.Matrix(q.rows, n, lambda r, c: sympy.Symbol(f"qb{r}_{c}", real=True)),
+                     vector=False),
+            Argument("branches_valid", sympy.Matrix([sympy.Symbol(f"vb{r}") for r in rows])),
+            Argument("branches_in_limits", sympy.Matrix([sympy.Symbol(f"lb{r}") for r in rows]))))
+        table_q, table_valid, table_inside = (result.symbols for result in table.results)
+        with distribute(False):
             read = target.symbols[:3, :] if form.target == "pose" else target.symbols
-            closest, status = ik.nearest(self.robot, sp, q, valid, inside, list(seed.symbols), list(weights.symbols),
-                                         form.free, list(read))
-        return [
-            self.function("ik_branches", "every branch of the closed-form ik, whether the target allows it and "
-                          "whether it is inside the joint limits", ("q", q), ("valid", valid), ("in_limits", inside),
-                          arguments=(target, *free), bindings=bindings),
-            self.function("ik_nearest", "the closed-form ik solution inside the joint limits nearest q_seed "
-                          "(sum of weights_j (q_j - q_seed_j)^2), and the status", ("q", sympy.Matrix(closest)),
-                          ("status", sympy.Matrix([status])), vector=True, integers=("status",),
-                          arguments=(target, seed, *free, weights), bindings=bindings),
-        ]
+            closest, status = ik.nearest(self.robot, sp, table_q, list(table_valid), list(table_inside),
+                                         list(seed.symbols), list(weights.symbols), form.free, list(read))
+        nearest = self.function("ik_nearest", "the closed-form ik solution inside the joint limits nearest q_seed "
+                                "(sum of weights_j (q_j - q_seed_j)^2), and the status", ("q", sympy.Matrix(closest)),
+                                ("status", sympy.Matrix([status])), vector=True, integers=("status",),
+                                arguments=(target, seed, *free, weights), calls=(table,))
+        return [branches, nearest]
 
     def velocity_ik_function(self, js: sympy.Matrix) -> Function:
         """velocity_ik: q_dot solving Js q_dot = mu_dot, and the status (`differential`)."""
@@ -340,12 +361,13 @@ class Generator:
                  vector: bool = False, equals: tuple[str, ...] = (),
                  arguments: tuple[Argument, ...] | None = None, scalars: tuple[str, ...] = (),
                  integers: tuple[str, ...] = (), bindings: dict | None = None, layers: int = 1,
-                 vectors: tuple[str, ...] = ()) -> Function:
+                 vectors: tuple[str, ...] = (), calls: tuple[Call, ...] = ()) -> Function:
         """A function of one or more named results (matrices, or lists of truth values as
         columns), lowered together so they share their terms; its arguments are q unless
         given. The results named in `scalars` are scalars, those in `integers` integer
         scalars (statuses), those in `vectors` (or all, with `vector`) column vectors; `bindings` define symbols (the joints) from the arguments for
-        this function alone; `layers` > 1 makes the results stacks of that many matrices."""
+        this function alone; `layers` > 1 makes the results stacks of that many matrices; `calls`
+        are the generated functions whose results the body reads."""
         outputs, values = [], []
         for (output, result), equal in zip(results, equals or ("",) * len(results)):
             rows, cols = result.shape if isinstance(result, sympy.Matrix) else (len(result), 1)
@@ -355,7 +377,7 @@ class Generator:
                                   vector or boolean or output in vectors, equal, boolean, integer, layers))
             values += list(result)
         return Function(name, summary, tuple(outputs), self.lower(values, bindings or {}),
-                        arguments or (Argument("q", sympy.Matrix(self.q)),))
+                        arguments or (Argument("q", sympy.Matrix(self.q)),), calls)
 
     def name(self, value: sympy.Expr) -> sympy.Expr:
         """`value` as a symbol of its own (an atom, a number or a product of atoms stays as it

@@ -75,11 +75,12 @@ GENERATED_NAMES = frozenset("""
     ik_numeric_step IK_NUMERIC_INVALID IK_NUMERIC_ITERATIONS active after better lighter retry
     worse fk_jacobian_dot jacobian_dot bias_acceleration task_jacobian_dot hessian Jd H a
     ik_nearest q_seed q_free weights in_limits IK_FREE_JOINT IK_NEAREST_OK IK_NEAREST_NO_SOLUTION
-    IK_NEAREST_NOT_FINITE limits keep
+    IK_NEAREST_NOT_FINITE limits keep xp dtype device trig branches_q branches_valid
+    branches_in_limits
 """.split())
 # Temporaries t0.., trig terms c1.. s1.., joint variables q1.., rates qd1.., seeds qn1.. and weights qw1.., the entries of an ik target
-# T00.. and mu0..; names starting with '_'; <math.h>'s M_PI, FP_NAN...
-_GENERATED_PATTERN = re.compile(r"^(?:[tcsqT]\d+(?:_\d+)*|mu(?:_dot)?\d+|q[sdnw]\d+|_.*|M_\w+|FP_\w+)$")
+# T00.. and mu0.., the ik_branches table read by ik_nearest (qb0_0.., vb0.., lb0..); names starting with '_'; <math.h>'s M_PI, FP_NAN...
+_GENERATED_PATTERN = re.compile(r"^(?:[tcsqT]\d+(?:_\d+)*|mu(?:_dot)?\d+|q[sdnw]\d+|qb\d+_\d+|[vl]b\d+|_.*|M_\w+|FP_\w+)$")
 
 ROBOT_NAME_RULE = ("a robot name may not be a C or Python keyword, a C standard header or a "
                    "Python module name, since it names the generated files and modules")

@@ -3363,7 +3363,8 @@ def _ik_branches(T, q_free):
 
 
 def _ik_nearest(T, q_seed, q_free, weights):
-    """The closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status: 2523 operations."""
+    """The closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status: 1104 operations."""
+    branches_q, branches_valid, branches_in_limits = _ik_branches(T, q_free)
     T00 = T[0, 0]
     T01 = T[0, 1]
     T02 = T[0, 2]
@@ -3390,996 +3391,448 @@ def _ik_nearest(T, q_seed, q_free, weights):
     qw5 = weights[4]
     qw6 = weights[5]
     qw7 = weights[6]
-    q3 = q_free
-    c3 = casadi.cos(q3)
-    s3 = casadi.sin(q3)
-    t0 = T00*c3 - T01*s3
-    t1 = T00*s3 + T01*c3
-    t2 = T10*c3 - T11*s3
-    t3 = T10*s3 + T11*c3
-    t4 = T20*c3 - T21*s3
-    t5 = T20*s3 + T21*c3
-    t6 = T03 - 1.306*T02
-    t7 = T13 - 1.306*T12
-    t8 = T23 - 1.306*T22
-    t9 = t6 + 1.18*T02
-    t10 = t7 + 1.18*T12
-    t11 = t8 + 1.18*T22
-    t12 = -0.36 + t11
-    t13 = c3*t0 + s3*t1
-    t14 = c3*t2 + s3*t3
-    t15 = c3*t4 + s3*t5
-    t16 = t12**2
-    t17 = t16 + t10**2 + t9**2
-    t18 = 0.1682 - 0.5*t17
-    t19 = t18**2
-    t20 = 1 - 35.430839002267575*t19
-    t21 = 5.9523809523809526*t18
-    t22 = (1e-12 < t20)
-    t23 = casadi.if_else(t22, t21, casadi.if_else((t21 > 0), 1, -1))
-    t24 = casadi.if_else(t22, casadi.sqrt(t20), 0)
-    t25 = casadi.atan2(t24, t23)
-    t26 = 3.141592653589793 + t25
-    t27 = 3.141592653589793 - t25
-    t28 = t26 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t26)
-    t29 = t28 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t28)
-    t30 = t27 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t27)
-    t31 = t30 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t30)
-    t32 = 1.0*t23
-    t33 = -t32
-    t34 = 0.78 + 0.4*t33
-    t35 = -0.36 + t34
-    t36 = 1.0*t24
-    t37 = -t36
-    t38 = c3**2
-    t39 = 0.16*t37**2
-    t40 = s3**2
-    t41 = t38 + t40
-    t42 = t39*t40
-    t43 = t42 + t35**2 + t38*t39
-    t44 = t16 + t42
-    t45 = t44 - t43
-    t46 = 1e-12*t43
-    t47 = (t45 < -t46)
-    t48 = casadi.if_else(t47, casadi.sqrt(-t45), 0)
-    t49 = t44 + t48**2
-    t50 = t48*t9
-    t51 = 0.4*t37
-    t52 = s3*t10
-    t53 = t51*t52
-    t54 = t16 + t50 - t53
-    t55 = -t16
-    t56 = t50 + t53 + t55
-    t57 = t16 + t56
-    t58 = t54 + t55
-    t59 = t10*t48
-    t60 = s3*t9
-    t61 = t51*t60
-    t62 = t61 - t59
-    t63 = t57**2 + t62**2
-    t64 = t59 + t61
-    t65 = t58**2 + t64**2
-    t66 = 1e-24*t49
-    t67 = t17*t66
-    t68 = (t63 <= t67)
-    t69 = casadi.if_else(t68, 1, 1/casadi.sqrt(t63))
-    t70 = casadi.if_else(t68, 1, -t57*t69)
-    t71 = casadi.if_else(t68, 0, t62*t69)
-    t72 = T02*t70 + T12*t71
-    t73 = T12*t70 - T02*t71
-    t74 = t13*t70 + t14*t71
-    t75 = t14*t70 - t13*t71
-    t76 = casadi.if_else(t68, 0, casadi.atan2(t62, -t57))
-    t77 = t76 - 6.283185307179586*casadi.floor(0.4722222222222222 + 0.15915494309189535*t76)
-    t78 = c3*t51
-    t79 = t48*t78
-    t80 = t42 + t12*t35
-    t81 = t79 + t80
-    t82 = t80 - t79
-    t83 = -t42
-    t84 = t81 + t83
-    t85 = t82 + t83
-    t86 = t35*t48
-    t87 = t12*t78
-    t88 = t87 - t86
-    t89 = t84**2 + t88**2
-    t90 = t86 + t87
-    t91 = t85**2 + t90**2
-    t92 = t43*t66
-    t93 = (t89 <= t92)
-    t94 = casadi.if_else(t93, 1, 1/casadi.sqrt(t89))
-    t95 = casadi.if_else(t93, 1, t84*t94)
-    t96 = casadi.if_else(t93, 0, t88*t94)
-    t97 = casadi.if_else(t93, 0, casadi.atan2(t88, t84))
-    t98 = t97 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t97)
-    t99 = (t65 <= t67)
-    t100 = casadi.if_else(t99, 1, 1/casadi.sqrt(t65))
-    t101 = casadi.if_else(t99, 1, t100*t58)
-    t102 = casadi.if_else(t99, 0, t100*t64)
-    t103 = T02*t101 + T12*t102
-    t104 = T12*t101 - T02*t102
-    t105 = t101*t13 + t102*t14
-    t106 = t101*t14 - t102*t13
-    t107 = casadi.if_else(t99, 0, casadi.atan2(t64, t58))
-    t108 = t107 - 6.283185307179586*casadi.floor(0.4722222222222222 + 0.15915494309189535*t107)
-    t109 = (t91 <= t92)
-    t110 = casadi.if_else(t109, 1, 1/casadi.sqrt(t91))
-    t111 = casadi.if_else(t109, 1, t110*t85)
-    t112 = casadi.if_else(t109, 0, t110*t90)
-    t113 = casadi.if_else(t109, 0, casadi.atan2(t90, t85))
-    t114 = t113 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t113)
-    t115 = 1 - t70
-    t116 = T22*t115
-    t117 = t116 + T22*t70
-    t118 = t115*t15
-    t119 = t118 + t15*t70
-    t120 = t72*t95 - t117*t96
-    t121 = t117*t95 + t72*t96
-    t122 = t74*t95 - t119*t96
-    t123 = t119*t95 + t74*t96
-    t124 = 1 - t95
-    t125 = t124*t73
-    t126 = t125 + t73*t95
-    t127 = t124*t75
-    t128 = t127 + t75*t95
-    t129 = c3*t120 + s3*t126
-    t130 = s3*t120 - c3*t126
-    t131 = t121*t33 - t129*t37
-    t132 = c3*t122 + s3*t128
-    t133 = s3*t122 - c3*t128
-    t134 = t123*t33 - t132*t37
-    t135 = 1 - t33
-    t136 = t130*t135
-    t137 = t133*t135
-    t138 = t121*t37
-    t139 = c3*t138 + s3*t136 + t120*t33
-    t140 = s3*t138 + t126*t33 - c3*t136
-    t141 = t123*t37
-    t142 = c3*t141 + s3*t137 + t122*t33
-    t143 = s3*t141 + t128*t33 - c3*t137
-    t144 = t131**2
-    t145 = t144 + t139**2 + t140**2
-    t146 = -t144
-    t147 = 1 + t146
-    t148 = (1e-12 < t147)
-    t149 = casadi.if_else(t148, casadi.sqrt(t147), 0)
-    t150 = t149*t38 + t149*t40
-    t151 = t144 + t150**2
-    t152 = t139*t149
-    t153 = t140*t149
-    t154 = t146 + c3*t152 + s3*t153
-    t155 = t144 + t154
-    t156 = s3*t152 - c3*t153
-    t157 = t155**2 + t156**2
-    t158 = t149**2
-    t159 = t144 + t158*t38 + t158*t40
-    t160 = 1e-24*t159
-    t161 = (t157 <= t145*t160)
-    t162 = casadi.if_else(t161, 1, 1/casadi.sqrt(t157))
-    t163 = casadi.if_else(t161, 1, -t155*t162)
-    t164 = casadi.if_else(t161, 0, t156*t162)
-    t165 = t134*(1 - t163)
-    t166 = t142*t163 + t143*t164
-    t167 = t143*t163 - t142*t164
-    t168 = t165 + t134*t163
-    t169 = c3*t166 + s3*t167
-    t170 = c3*t167 - s3*t166
-    t171 = (t151 <= t160)
-    t172 = casadi.if_else(t171, 1, 1/casadi.sqrt(t151))
-    t173 = casadi.if_else(t171, 1, t131*t172)
-    t174 = casadi.if_else(t171, 0, -t150*t172)
-    t175 = t170*(1 - t173)
-    t176 = t168*t173 + t169*t174
-    t177 = t168*t174
-    t178 = c3*t177 + s3*t175 - t166*t173
-    t179 = c3*t175 + t167*t173 - s3*t177
-    t180 = s3*t179 - c3*t178
-    t181 = c3*t179 + s3*t178
-    t182 = t180**2 + t181**2
-    t183 = t176**2 + t178**2 + t179**2
-    t184 = 1 - t101
-    t185 = T22*t184
-    t186 = t185 + T22*t101
-    t187 = t15*t184
-    t188 = t187 + t101*t15
-    t189 = t103*t111 - t112*t186
-    t190 = t103*t112 + t111*t186
-    t191 = t105*t111 - t112*t188
-    t192 = t105*t112 + t111*t188
-    t193 = 1 - t111
-    t194 = t104*t193
-    t195 = t194 + t104*t111
-    t196 = t106*t193
-    t197 = t196 + t106*t111
-    t198 = c3*t189 + s3*t195
-    t199 = s3*t189 - c3*t195
-    t200 = t135*t199
-    t201 = t190*t33 - t198*t37
-    t202 = c3*t191 + s3*t197
-    t203 = s3*t191 - c3*t197
-    t204 = t135*t203
-    t205 = t192*t33 - t202*t37
-    t206 = t190*t37
-    t207 = c3*t206 + s3*t200 + t189*t33
-    t208 = s3*t206 + t195*t33 - c3*t200
-    t209 = t192*t37
-    t210 = c3*t209 + s3*t204 + t191*t33
-    t211 = s3*t209 + t197*t33 - c3*t204
-    t212 = t201**2
-    t213 = t212 + t207**2 + t208**2
-    t214 = -t212
-    t215 = 1 + t214
-    t216 = (1e-12 < t215)
-    t217 = casadi.if_else(t216, casadi.sqrt(t215), 0)
-    t218 = t217*t38 + t217*t40
-    t219 = t212 + t218**2
-    t220 = t207*t217
-    t221 = t208*t217
-    t222 = t214 + c3*t220 + s3*t221
-    t223 = t212 + t222
-    t224 = s3*t220 - c3*t221
-    t225 = t223**2 + t224**2
-    t226 = t217**2
-    t227 = t212 + t226*t38 + t226*t40
-    t228 = 1e-24*t227
-    t229 = (t225 <= t213*t228)
-    t230 = casadi.if_else(t229, 1, 1/casadi.sqrt(t225))
-    t231 = casadi.if_else(t229, 1, -t223*t230)
-    t232 = casadi.if_else(t229, 0, t224*t230)
-    t233 = t205*(1 - t231)
-    t234 = t210*t231 + t211*t232
-    t235 = t211*t231 - t210*t232
-    t236 = t233 + t205*t231
-    t237 = c3*t234 + s3*t235
-    t238 = c3*t235 - s3*t234
-    t239 = (t219 <= t228)
-    t240 = casadi.if_else(t239, 1, 1/casadi.sqrt(t219))
-    t241 = casadi.if_else(t239, 1, t201*t240)
-    t242 = casadi.if_else(t239, 0, -t218*t240)
-    t243 = t238*(1 - t241)
-    t244 = t236*t241 + t237*t242
-    t245 = t236*t242
-    t246 = c3*t245 + s3*t243 - t234*t241
-    t247 = c3*t243 + t235*t241 - s3*t245
-    t248 = s3*t247 - c3*t246
-    t249 = c3*t247 + s3*t246
-    t250 = t248**2 + t249**2
-    t251 = t244**2 + t246**2 + t247**2
-    t252 = 0.78 - 0.4*t23
-    t253 = -0.36 + t252
-    t254 = 0.16*t24**2
-    t255 = t254*t40
-    t256 = t255 + t253**2 + t254*t38
-    t257 = t16 + t255
-    t258 = t257 - t256
-    t259 = 1e-12*t256
-    t260 = (t258 < -t259)
-    t261 = casadi.if_else(t260, casadi.sqrt(-t258), 0)
-    t262 = t257 + t261**2
-    t263 = t261*t9
-    t264 = 0.4*t24
-    t265 = t264*t52
-    t266 = t263 + t265 + t55
-    t267 = t16 + t266
-    t268 = t16 + t263 - t265
-    t269 = t268 + t55
-    t270 = t10*t261
-    t271 = t264*t60
-    t272 = t271 - t270
-    t273 = t267**2 + t272**2
-    t274 = t270 + t271
-    t275 = t269**2 + t274**2
-    t276 = 1e-24*t262
-    t277 = t17*t276
-    t278 = (t273 <= t277)
-    t279 = casadi.if_else(t278, 1, 1/casadi.sqrt(t273))
-    t280 = casadi.if_else(t278, 1, -t267*t279)
-    t281 = casadi.if_else(t278, 0, t272*t279)
-    t282 = T02*t280 + T12*t281
-    t283 = T12*t280 - T02*t281
-    t284 = t13*t280 + t14*t281
-    t285 = t14*t280 - t13*t281
-    t286 = casadi.if_else(t278, 0, casadi.atan2(t272, -t267))
-    t287 = t286 - 6.283185307179586*casadi.floor(0.4722222222222222 + 0.15915494309189535*t286)
-    t288 = c3*t264
-    t289 = t261*t288
-    t290 = t255 + t12*t253
-    t291 = t289 + t290
-    t292 = t290 - t289
-    t293 = -t255
-    t294 = t291 + t293
-    t295 = t292 + t293
-    t296 = t253*t261
-    t297 = t12*t288
-    t298 = t297 - t296
-    t299 = t294**2 + t298**2
-    t300 = t296 + t297
-    t301 = t295**2 + t300**2
-    t302 = t256*t276
-    t303 = (t299 <= t302)
-    t304 = casadi.if_else(t303, 1, 1/casadi.sqrt(t299))
-    t305 = casadi.if_else(t303, 1, t294*t304)
-    t306 = casadi.if_else(t303, 0, t298*t304)
-    t307 = casadi.if_else(t303, 0, casadi.atan2(t298, t294))
-    t308 = t307 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t307)
-    t309 = (t275 <= t277)
-    t310 = casadi.if_else(t309, 1, 1/casadi.sqrt(t275))
-    t311 = casadi.if_else(t309, 1, t269*t310)
-    t312 = casadi.if_else(t309, 0, t274*t310)
-    t313 = T02*t311 + T12*t312
-    t314 = T12*t311 - T02*t312
-    t315 = t13*t311 + t14*t312
-    t316 = t14*t311 - t13*t312
-    t317 = casadi.if_else(t309, 0, casadi.atan2(t274, t269))
-    t318 = t317 - 6.283185307179586*casadi.floor(0.4722222222222222 + 0.15915494309189535*t317)
-    t319 = (t301 <= t302)
-    t320 = casadi.if_else(t319, 1, 1/casadi.sqrt(t301))
-    t321 = casadi.if_else(t319, 1, t295*t320)
-    t322 = casadi.if_else(t319, 0, t300*t320)
-    t323 = casadi.if_else(t319, 0, casadi.atan2(t300, t295))
-    t324 = t323 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t323)
-    t325 = 1 - t280
-    t326 = T22*t325
-    t327 = t326 + T22*t280
-    t328 = t15*t325
-    t329 = t328 + t15*t280
-    t330 = t282*t305 - t306*t327
-    t331 = t282*t306 + t305*t327
-    t332 = t284*t305 - t306*t329
-    t333 = t284*t306 + t305*t329
-    t334 = 1 - t305
-    t335 = t283*t334
-    t336 = t335 + t283*t305
-    t337 = t285*t334
-    t338 = t337 + t285*t305
-    t339 = c3*t330 + s3*t336
-    t340 = s3*t330 - c3*t336
-    t341 = t32*t331 + t339*t36
-    t342 = c3*t332 + s3*t338
-    t343 = s3*t332 - c3*t338
-    t344 = t32*t333 + t342*t36
-    t345 = 1 + t32
-    t346 = t340*t345
-    t347 = t343*t345
-    t348 = t331*t36
-    t349 = c3*t348 + s3*t346 - t32*t330
-    t350 = c3*t346 + t32*t336 - s3*t348
-    t351 = t333*t36
-    t352 = c3*t351 + s3*t347 - t32*t332
-    t353 = c3*t347 + t32*t338 - s3*t351
-    t354 = t341**2
-    t355 = t354 + t349**2 + t350**2
-    t356 = -t354
-    t357 = 1 + t356
-    t358 = (1e-12 < t357)
-    t359 = casadi.if_else(t358, casadi.sqrt(t357), 0)
-    t360 = t359*t38 + t359*t40
-    t361 = t354 + t360**2
-    t362 = s3*t359
-    t363 = c3*t359
-    t364 = t354 + t350*t362 - t349*t363
-    t365 = t356 + t364
-    t366 = t349*t362 + t350*t363
-    t367 = t365**2 + t366**2
-    t368 = t359**2
-    t369 = t354 + t368*t38 + t368*t40
-    t370 = 1e-24*t369
-    t371 = (t367 <= t355*t370)
-    t372 = casadi.if_else(t371, 1, 1/casadi.sqrt(t367))
-    t373 = casadi.if_else(t371, 1, t365*t372)
-    t374 = casadi.if_else(t371, 0, t366*t372)
-    t375 = t344*(1 - t373)
-    t376 = t352*t373 - t353*t374
-    t377 = t352*t374 + t353*t373
-    t378 = t375 + t344*t373
-    t379 = s3*t377 - c3*t376
-    t380 = c3*t377 + s3*t376
-    t381 = (t361 <= t370)
-    t382 = casadi.if_else(t381, 1, 1/casadi.sqrt(t361))
-    t383 = casadi.if_else(t381, 1, -t341*t382)
-    t384 = casadi.if_else(t381, 0, -t360*t382)
-    t385 = t380*(1 - t383)
-    t386 = t378*t383 + t379*t384
-    t387 = t378*t384
-    t388 = c3*t387 + s3*t385 + t376*t383
-    t389 = c3*t385 + t377*t383 - s3*t387
-    t390 = c3*t388 - s3*t389
-    t391 = c3*t389 + s3*t388
-    t392 = t390**2 + t391**2
-    t393 = t386**2 + t388**2 + t389**2
-    t394 = 1 - t311
-    t395 = T22*t394
-    t396 = t395 + T22*t311
-    t397 = t15*t394
-    t398 = t397 + t15*t311
-    t399 = t313*t321 - t322*t396
-    t400 = t313*t322 + t321*t396
-    t401 = t315*t321 - t322*t398
-    t402 = t315*t322 + t321*t398
-    t403 = 1 - t321
-    t404 = t314*t403
-    t405 = t404 + t314*t321
-    t406 = t316*t403
-    t407 = t406 + t316*t321
-    t408 = c3*t399 + s3*t405
-    t409 = s3*t399 - c3*t405
-    t410 = t345*t409
-    t411 = t32*t400 + t36*t408
-    t412 = c3*t401 + s3*t407
-    t413 = s3*t401 - c3*t407
-    t414 = t345*t413
-    t415 = t32*t402 + t36*t412
-    t416 = t36*t400
-    t417 = c3*t416 + s3*t410 - t32*t399
-    t418 = c3*t410 + t32*t405 - s3*t416
-    t419 = t36*t402
-    t420 = c3*t419 + s3*t414 - t32*t401
-    t421 = c3*t414 + t32*t407 - s3*t419
-    t422 = t411**2
-    t423 = t422 + t417**2 + t418**2
-    t424 = -t422
-    t425 = 1 + t424
-    t426 = (1e-12 < t425)
-    t427 = casadi.if_else(t426, casadi.sqrt(t425), 0)
-    t428 = t38*t427 + t40*t427
-    t429 = t422 + t428**2
-    t430 = s3*t427
-    t431 = c3*t427
-    t432 = t422 + t418*t430 - t417*t431
-    t433 = t424 + t432
-    t434 = t417*t430 + t418*t431
-    t435 = t433**2 + t434**2
-    t436 = t427**2
-    t437 = t422 + t38*t436 + t40*t436
-    t438 = 1e-24*t437
-    t439 = (t435 <= t423*t438)
-    t440 = casadi.if_else(t439, 1, 1/casadi.sqrt(t435))
-    t441 = casadi.if_else(t439, 1, t433*t440)
-    t442 = casadi.if_else(t439, 0, t434*t440)
-    t443 = t415*(1 - t441)
-    t444 = t420*t441 - t421*t442
-    t445 = t420*t442 + t421*t441
-    t446 = t443 + t415*t441
-    t447 = s3*t445 - c3*t444
-    t448 = c3*t445 + s3*t444
-    t449 = (t429 <= t438)
-    t450 = casadi.if_else(t449, 1, 1/casadi.sqrt(t429))
-    t451 = casadi.if_else(t449, 1, -t411*t450)
-    t452 = casadi.if_else(t449, 0, -t428*t450)
-    t453 = t448*(1 - t451)
-    t454 = t446*t451 + t447*t452
-    t455 = t446*t452
-    t456 = c3*t455 + s3*t453 + t444*t451
-    t457 = c3*t453 + t445*t451 - s3*t455
-    t458 = c3*t456 - s3*t457
-    t459 = c3*t457 + s3*t456
-    t460 = t458**2 + t459**2
-    t461 = t454**2 + t456**2 + t457**2
-    t462 = T00 + T01 + T02 + T03 + T10 + T11 + T12 + T13 + T20 + T21 + T22 + T23
-    t463 = t462
-    t464 = qn1 + qn2 + qn3 + qn4 + qn5 + qn6 + qn7 + qw1 + qw2 + qw3 + qw4 + qw5 + qw6 + qw7 + t462
-    t465 = casadi.if_else(t161, 0, casadi.atan2(t156, -t155))
-    t466 = t465
-    t467 = t466 - 6.283185307179586*casadi.floor(0.4722222222222222 + 0.15915494309189535*t466)
-    t468 = 3.141592653589793 + t465 - 6.283185307179586*casadi.ceil(0.15915494309189535*t465)
-    t469 = t468 - 6.283185307179586*casadi.floor(0.4722222222222222 + 0.15915494309189535*t468)
-    t470 = casadi.if_else(t171, 0, casadi.atan2(-t150, t131))
-    t471 = t470
-    t472 = t471 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t471)
-    t473 = t470 + 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t470)
-    t474 = 1e-24*t41
-    t475 = casadi.if_else((t182 <= t183*t474), 0, casadi.atan2(t181, t180))
-    t476 = t475
-    t477 = t476 - 6.283185307179586*casadi.floor(0.4861111111111111 + 0.15915494309189535*t476)
-    t478 = 3.141592653589793 + t475 - 6.283185307179586*casadi.ceil(0.15915494309189535*t475)
-    t479 = t478 - 6.283185307179586*casadi.floor(0.4861111111111111 + 0.15915494309189535*t478)
-    t480 = -t473
-    t481 = t473 + 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t480)
-    t482 = casadi.if_else(t229, 0, casadi.atan2(t224, -t223))
-    t483 = t482
-    t484 = t483 - 6.283185307179586*casadi.floor(0.4722222222222222 + 0.15915494309189535*t483)
-    t485 = 3.141592653589793 + t482 - 6.283185307179586*casadi.ceil(0.15915494309189535*t482)
-    t486 = t485 - 6.283185307179586*casadi.floor(0.4722222222222222 + 0.15915494309189535*t485)
-    t487 = casadi.if_else(t239, 0, casadi.atan2(-t218, t201))
-    t488 = t487
-    t489 = t488 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t488)
-    t490 = t487 + 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t487)
-    t491 = casadi.if_else((t250 <= t251*t474), 0, casadi.atan2(t249, t248))
-    t492 = t491
-    t493 = t492 - 6.283185307179586*casadi.floor(0.4861111111111111 + 0.15915494309189535*t492)
-    t494 = 3.141592653589793 + t491 - 6.283185307179586*casadi.ceil(0.15915494309189535*t491)
-    t495 = t494 - 6.283185307179586*casadi.floor(0.4861111111111111 + 0.15915494309189535*t494)
-    t496 = -t490
-    t497 = t490 + 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t496)
-    t498 = casadi.if_else(t371, 0, casadi.atan2(t366, t365))
-    t499 = t498
-    t500 = t499 - 6.283185307179586*casadi.floor(0.4722222222222222 + 0.15915494309189535*t499)
-    t501 = 3.141592653589793 + t498 - 6.283185307179586*casadi.ceil(0.15915494309189535*t498)
-    t502 = t501 - 6.283185307179586*casadi.floor(0.4722222222222222 + 0.15915494309189535*t501)
-    t503 = casadi.if_else(t381, 0, casadi.atan2(-t360, -t341))
-    t504 = t503
-    t505 = t504 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t504)
-    t506 = t503 + 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t503)
-    t507 = casadi.if_else((t392 <= t393*t474), 0, casadi.atan2(-t391, t390))
-    t508 = t507
-    t509 = t508 - 6.283185307179586*casadi.floor(0.4861111111111111 + 0.15915494309189535*t508)
-    t510 = 3.141592653589793 + t507 - 6.283185307179586*casadi.ceil(0.15915494309189535*t507)
-    t511 = t510 - 6.283185307179586*casadi.floor(0.4861111111111111 + 0.15915494309189535*t510)
-    t512 = -t506
-    t513 = t506 + 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t512)
-    t514 = casadi.if_else(t439, 0, casadi.atan2(t434, t433))
-    t515 = t514
-    t516 = t515 - 6.283185307179586*casadi.floor(0.4722222222222222 + 0.15915494309189535*t515)
-    t517 = 3.141592653589793 + t514 - 6.283185307179586*casadi.ceil(0.15915494309189535*t514)
-    t518 = t517 - 6.283185307179586*casadi.floor(0.4722222222222222 + 0.15915494309189535*t517)
-    t519 = casadi.if_else(t449, 0, casadi.atan2(-t428, -t411))
-    t520 = t519
-    t521 = t520 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t520)
-    t522 = t519 + 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t519)
-    t523 = casadi.if_else((t460 <= t461*t474), 0, casadi.atan2(-t459, t458))
-    t524 = t523
-    t525 = t524 - 6.283185307179586*casadi.floor(0.4861111111111111 + 0.15915494309189535*t524)
-    t526 = 3.141592653589793 + t523 - 6.283185307179586*casadi.ceil(0.15915494309189535*t523)
-    t527 = t526 - 6.283185307179586*casadi.floor(0.4861111111111111 + 0.15915494309189535*t526)
-    t528 = -t522
-    t529 = t522 + 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t528)
-    t530 = (t77 <= 2.9670597283903604)
-    t531 = casadi.logic_and((t76 >= -2.9670597283903604), (t76 <= 2.9670597283903604))
-    t532 = casadi.if_else(casadi.logic_and(t530, casadi.logic_not(t531)), t77, t76)
-    t533 = t532
-    t534 = t533 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn1 - 0.15915494309189535*t533)
-    t535 = casadi.if_else((qn1 > t534), 6.283185307179586, -6.283185307179586)
-    t536 = t534 + t535
-    t537 = t534 - t535
-    t538 = casadi.if_else(casadi.logic_and((t534 >= -2.9670597283903604), (t534 <= 2.9670597283903604)), t534, casadi.if_else(casadi.logic_and((t536 >= -2.9670597283903604), (t536 <= 2.9670597283903604)), t536, casadi.if_else(casadi.logic_and((t537 >= -2.9670597283903604), (t537 <= 2.9670597283903604)), t537, t532)))
-    t539 = (t98 <= 2.0943951023931953)
-    t540 = casadi.logic_and((t97 >= -2.0943951023931953), (t97 <= 2.0943951023931953))
-    t541 = casadi.if_else(casadi.logic_and(t539, casadi.logic_not(t540)), t98, t97)
-    t542 = t541
-    t543 = t542 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t542)
-    t544 = casadi.if_else((qn2 > t543), 6.283185307179586, -6.283185307179586)
-    t545 = t543 + t544
-    t546 = t543 - t544
-    t547 = casadi.if_else(casadi.logic_and((t543 >= -2.0943951023931953), (t543 <= 2.0943951023931953)), t543, casadi.if_else(casadi.logic_and((t545 >= -2.0943951023931953), (t545 <= 2.0943951023931953)), t545, casadi.if_else(casadi.logic_and((t546 >= -2.0943951023931953), (t546 <= 2.0943951023931953)), t546, t541)))
-    t548 = (t29 <= 2.0943951023931953)
-    t549 = casadi.logic_and((t28 >= -2.0943951023931953), (t28 <= 2.0943951023931953))
-    t550 = casadi.if_else(casadi.logic_and(t548, casadi.logic_not(t549)), t29, t28)
-    t551 = t550
-    t552 = t551 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t551)
-    t553 = casadi.if_else((qn4 > t552), 6.283185307179586, -6.283185307179586)
-    t554 = t552 + t553
-    t555 = t552 - t553
-    t556 = casadi.if_else(casadi.logic_and((t552 >= -2.0943951023931953), (t552 <= 2.0943951023931953)), t552, casadi.if_else(casadi.logic_and((t554 >= -2.0943951023931953), (t554 <= 2.0943951023931953)), t554, casadi.if_else(casadi.logic_and((t555 >= -2.0943951023931953), (t555 <= 2.0943951023931953)), t555, t550)))
-    t557 = (t467 <= 2.9670597283903604)
-    t558 = casadi.logic_and((t466 >= -2.9670597283903604), (t466 <= 2.9670597283903604))
-    t559 = casadi.if_else(casadi.logic_and(t557, casadi.logic_not(t558)), t467, t466)
-    t560 = t559
-    t561 = t560 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn5 - 0.15915494309189535*t560)
-    t562 = casadi.if_else((qn5 > t561), 6.283185307179586, -6.283185307179586)
-    t563 = t561 + t562
-    t564 = t561 - t562
-    t565 = casadi.if_else(casadi.logic_and((t561 >= -2.9670597283903604), (t561 <= 2.9670597283903604)), t561, casadi.if_else(casadi.logic_and((t563 >= -2.9670597283903604), (t563 <= 2.9670597283903604)), t563, casadi.if_else(casadi.logic_and((t564 >= -2.9670597283903604), (t564 <= 2.9670597283903604)), t564, t559)))
-    t566 = (t472 <= 2.0943951023931953)
-    t567 = casadi.logic_and((t471 >= -2.0943951023931953), (t471 <= 2.0943951023931953))
-    t568 = casadi.if_else(casadi.logic_and(t566, casadi.logic_not(t567)), t472, t471)
-    t569 = t568
-    t570 = t569 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn6 - 0.15915494309189535*t569)
-    t571 = casadi.if_else((qn6 > t570), 6.283185307179586, -6.283185307179586)
-    t572 = t570 + t571
-    t573 = t570 - t571
-    t574 = casadi.if_else(casadi.logic_and((t570 >= -2.0943951023931953), (t570 <= 2.0943951023931953)), t570, casadi.if_else(casadi.logic_and((t572 >= -2.0943951023931953), (t572 <= 2.0943951023931953)), t572, casadi.if_else(casadi.logic_and((t573 >= -2.0943951023931953), (t573 <= 2.0943951023931953)), t573, t568)))
-    t575 = (t477 <= 3.0543261909900767)
-    t576 = casadi.logic_and((t476 >= -3.0543261909900767), (t476 <= 3.0543261909900767))
-    t577 = casadi.if_else(casadi.logic_and(t575, casadi.logic_not(t576)), t477, t476)
-    t578 = t577
-    t579 = t578 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn7 - 0.15915494309189535*t578)
-    t580 = casadi.if_else((qn7 > t579), 6.283185307179586, -6.283185307179586)
-    t581 = t579 + t580
-    t582 = t579 - t580
-    t583 = casadi.if_else(casadi.logic_and((t579 >= -3.0543261909900767), (t579 <= 3.0543261909900767)), t579, casadi.if_else(casadi.logic_and((t581 >= -3.0543261909900767), (t581 <= 3.0543261909900767)), t581, casadi.if_else(casadi.logic_and((t582 >= -3.0543261909900767), (t582 <= 3.0543261909900767)), t582, t577)))
-    t584 = -qn5
-    t585 = -qn6
-    t586 = -qn7
-    t587 = -qn1
-    t588 = -qn2
-    t589 = qw3*(q3 - qn3)**2
-    t590 = -qn4
-    t591 = t589 + qw4*(t556 + t590)**2
-    t592 = t591 + qw1*(t538 + t587)**2 + qw2*(t547 + t588)**2
-    t593 = t592 + qw5*(t565 + t584)**2 + qw6*(t574 + t585)**2 + qw7*(t583 + t586)**2
-    t594 = (casadi.fabs(t463) < casadi.inf)
-    t595 = (q3 >= -2.9670597283903604)
-    t596 = (q3 <= 2.9670597283903604)
-    t597 = (t45 <= t46)
-    t598 = casadi.logic_or(t530, t531)
-    t599 = casadi.logic_or(t539, t540)
-    t600 = casadi.logic_or(t548, t549)
-    t601 = (1e-12 >= -t20)
-    t602 = casadi.if_else(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t594, t595), t596), t597), t598), t599), t600), t601), (t147 >= -1e-12)), casadi.logic_or(t557, t558)), casadi.logic_or(t566, t567)), casadi.logic_or(t575, t576)), 1, 0)
-    t603 = casadi.if_else((t602 > 0), 1, 0)
-    t604 = (t603 > 0)
-    t605 = casadi.if_else(t604, t538, qn1)
-    t606 = casadi.if_else(t604, t547, qn2)
-    t607 = casadi.if_else(t604, q3, qn3)
-    t608 = casadi.if_else(t604, t556, qn4)
-    t609 = casadi.if_else(t604, t565, qn5)
-    t610 = casadi.if_else(t604, t574, qn6)
-    t611 = casadi.if_else(t604, t583, qn7)
-    t612 = casadi.if_else(t604, t593, 0)
-    t613 = (t469 <= 2.9670597283903604)
-    t614 = casadi.logic_and((t468 >= -2.9670597283903604), (t468 <= 2.9670597283903604))
-    t615 = casadi.if_else(casadi.logic_and(t613, casadi.logic_not(t614)), t469, t468)
-    t616 = t615
-    t617 = t616 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn5 - 0.15915494309189535*t616)
-    t618 = casadi.if_else((qn5 > t617), 6.283185307179586, -6.283185307179586)
-    t619 = t617 + t618
-    t620 = t617 - t618
-    t621 = casadi.if_else(casadi.logic_and((t617 >= -2.9670597283903604), (t617 <= 2.9670597283903604)), t617, casadi.if_else(casadi.logic_and((t619 >= -2.9670597283903604), (t619 <= 2.9670597283903604)), t619, casadi.if_else(casadi.logic_and((t620 >= -2.9670597283903604), (t620 <= 2.9670597283903604)), t620, t615)))
-    t622 = (t481 >= -2.0943951023931953)
-    t623 = casadi.logic_and((t473 >= -2.0943951023931953), (t473 <= 2.0943951023931953))
-    t624 = casadi.if_else(casadi.logic_and(t622, casadi.logic_not(t623)), -t481, t480)
-    t625 = t624
-    t626 = t625 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn6 - 0.15915494309189535*t625)
-    t627 = casadi.if_else((qn6 > t626), 6.283185307179586, -6.283185307179586)
-    t628 = t626 + t627
-    t629 = t626 - t627
-    t630 = casadi.if_else(casadi.logic_and((t626 >= -2.0943951023931953), (t626 <= 2.0943951023931953)), t626, casadi.if_else(casadi.logic_and((t628 >= -2.0943951023931953), (t628 <= 2.0943951023931953)), t628, casadi.if_else(casadi.logic_and((t629 >= -2.0943951023931953), (t629 <= 2.0943951023931953)), t629, t624)))
-    t631 = (t479 <= 3.0543261909900767)
-    t632 = casadi.logic_and((t478 >= -3.0543261909900767), (t478 <= 3.0543261909900767))
-    t633 = casadi.if_else(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t148, t594), t595), t596), t597), t598), t599), t600), t601), casadi.logic_or(t613, t614)), casadi.logic_or(t622, t623)), casadi.logic_or(t631, t632)), 1, 0)
-    t634 = casadi.if_else(casadi.logic_and(t631, casadi.logic_not(t632)), t479, t478)
-    t635 = t634
-    t636 = t635 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn7 - 0.15915494309189535*t635)
-    t637 = casadi.if_else((qn7 > t636), 6.283185307179586, -6.283185307179586)
-    t638 = t636 + t637
-    t639 = t636 - t637
-    t640 = casadi.if_else(casadi.logic_and((t636 >= -3.0543261909900767), (t636 <= 3.0543261909900767)), t636, casadi.if_else(casadi.logic_and((t638 >= -3.0543261909900767), (t638 <= 3.0543261909900767)), t638, casadi.if_else(casadi.logic_and((t639 >= -3.0543261909900767), (t639 <= 3.0543261909900767)), t639, t634)))
-    t641 = t592 + qw5*(t584 + t621)**2 + qw6*(t585 + t630)**2 + qw7*(t586 + t640)**2
-    t642 = (t633 > 0)
-    t643 = casadi.if_else(casadi.logic_and(t642, casadi.logic_or((t612 > t641), (t603 < 1))), 1, 0)
-    t644 = casadi.if_else(t642, 1, t603)
-    t645 = (t643 > 0)
-    t646 = casadi.if_else(t645, t538, t605)
-    t647 = casadi.if_else(t645, t547, t606)
-    t648 = casadi.if_else(t645, q3, t607)
-    t649 = casadi.if_else(t645, t556, t608)
-    t650 = casadi.if_else(t645, t621, t609)
-    t651 = casadi.if_else(t645, t630, t610)
-    t652 = casadi.if_else(t645, t640, t611)
-    t653 = casadi.if_else(t645, t641, t612)
-    t654 = (t108 <= 2.9670597283903604)
-    t655 = casadi.logic_and((t107 >= -2.9670597283903604), (t107 <= 2.9670597283903604))
-    t656 = casadi.if_else(casadi.logic_and(t654, casadi.logic_not(t655)), t108, t107)
-    t657 = t656
-    t658 = t657 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn1 - 0.15915494309189535*t657)
-    t659 = casadi.if_else((qn1 > t658), 6.283185307179586, -6.283185307179586)
-    t660 = t658 + t659
-    t661 = t658 - t659
-    t662 = casadi.if_else(casadi.logic_and((t658 >= -2.9670597283903604), (t658 <= 2.9670597283903604)), t658, casadi.if_else(casadi.logic_and((t660 >= -2.9670597283903604), (t660 <= 2.9670597283903604)), t660, casadi.if_else(casadi.logic_and((t661 >= -2.9670597283903604), (t661 <= 2.9670597283903604)), t661, t656)))
-    t663 = (t114 <= 2.0943951023931953)
-    t664 = casadi.logic_and((t113 >= -2.0943951023931953), (t113 <= 2.0943951023931953))
-    t665 = casadi.if_else(casadi.logic_and(t663, casadi.logic_not(t664)), t114, t113)
-    t666 = t665
-    t667 = t666 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t666)
-    t668 = casadi.if_else((qn2 > t667), 6.283185307179586, -6.283185307179586)
-    t669 = t667 + t668
-    t670 = t667 - t668
-    t671 = casadi.if_else(casadi.logic_and((t667 >= -2.0943951023931953), (t667 <= 2.0943951023931953)), t667, casadi.if_else(casadi.logic_and((t669 >= -2.0943951023931953), (t669 <= 2.0943951023931953)), t669, casadi.if_else(casadi.logic_and((t670 >= -2.0943951023931953), (t670 <= 2.0943951023931953)), t670, t665)))
-    t672 = (t484 <= 2.9670597283903604)
-    t673 = casadi.logic_and((t483 >= -2.9670597283903604), (t483 <= 2.9670597283903604))
-    t674 = casadi.if_else(casadi.logic_and(t672, casadi.logic_not(t673)), t484, t483)
-    t675 = t674
-    t676 = t675 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn5 - 0.15915494309189535*t675)
-    t677 = casadi.if_else((qn5 > t676), 6.283185307179586, -6.283185307179586)
-    t678 = t676 + t677
-    t679 = t676 - t677
-    t680 = casadi.if_else(casadi.logic_and((t676 >= -2.9670597283903604), (t676 <= 2.9670597283903604)), t676, casadi.if_else(casadi.logic_and((t678 >= -2.9670597283903604), (t678 <= 2.9670597283903604)), t678, casadi.if_else(casadi.logic_and((t679 >= -2.9670597283903604), (t679 <= 2.9670597283903604)), t679, t674)))
-    t681 = (t489 <= 2.0943951023931953)
-    t682 = casadi.logic_and((t488 >= -2.0943951023931953), (t488 <= 2.0943951023931953))
-    t683 = casadi.if_else(casadi.logic_and(t681, casadi.logic_not(t682)), t489, t488)
-    t684 = t683
-    t685 = t684 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn6 - 0.15915494309189535*t684)
-    t686 = casadi.if_else((qn6 > t685), 6.283185307179586, -6.283185307179586)
-    t687 = t685 + t686
-    t688 = t685 - t686
-    t689 = casadi.if_else(casadi.logic_and((t685 >= -2.0943951023931953), (t685 <= 2.0943951023931953)), t685, casadi.if_else(casadi.logic_and((t687 >= -2.0943951023931953), (t687 <= 2.0943951023931953)), t687, casadi.if_else(casadi.logic_and((t688 >= -2.0943951023931953), (t688 <= 2.0943951023931953)), t688, t683)))
-    t690 = (t493 <= 3.0543261909900767)
-    t691 = casadi.logic_and((t492 >= -3.0543261909900767), (t492 <= 3.0543261909900767))
-    t692 = casadi.if_else(casadi.logic_and(t690, casadi.logic_not(t691)), t493, t492)
-    t693 = t692
-    t694 = t693 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn7 - 0.15915494309189535*t693)
-    t695 = casadi.if_else((qn7 > t694), 6.283185307179586, -6.283185307179586)
-    t696 = t694 + t695
-    t697 = t694 - t695
-    t698 = casadi.if_else(casadi.logic_and((t694 >= -3.0543261909900767), (t694 <= 3.0543261909900767)), t694, casadi.if_else(casadi.logic_and((t696 >= -3.0543261909900767), (t696 <= 3.0543261909900767)), t696, casadi.if_else(casadi.logic_and((t697 >= -3.0543261909900767), (t697 <= 3.0543261909900767)), t697, t692)))
-    t699 = t591 + qw1*(t587 + t662)**2 + qw2*(t588 + t671)**2
-    t700 = t699 + qw5*(t584 + t680)**2 + qw6*(t585 + t689)**2 + qw7*(t586 + t698)**2
-    t701 = casadi.logic_or(t654, t655)
-    t702 = casadi.logic_or(t663, t664)
-    t703 = casadi.if_else(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t47, t594), t595), t596), t600), t601), t701), t702), (t215 >= -1e-12)), casadi.logic_or(t672, t673)), casadi.logic_or(t681, t682)), casadi.logic_or(t690, t691)), 1, 0)
-    t704 = (t703 > 0)
-    t705 = casadi.if_else(casadi.logic_and(t704, casadi.logic_or((t653 > t700), (t644 < 1))), 1, 0)
-    t706 = casadi.if_else(t704, 1, t644)
-    t707 = (t705 > 0)
-    t708 = casadi.if_else(t707, t662, t646)
-    t709 = casadi.if_else(t707, t671, t647)
-    t710 = casadi.if_else(t707, q3, t648)
-    t711 = casadi.if_else(t707, t556, t649)
-    t712 = casadi.if_else(t707, t680, t650)
-    t713 = casadi.if_else(t707, t689, t651)
-    t714 = casadi.if_else(t707, t698, t652)
-    t715 = casadi.if_else(t707, t700, t653)
-    t716 = (t486 <= 2.9670597283903604)
-    t717 = casadi.logic_and((t485 >= -2.9670597283903604), (t485 <= 2.9670597283903604))
-    t718 = casadi.if_else(casadi.logic_and(t716, casadi.logic_not(t717)), t486, t485)
-    t719 = t718
-    t720 = t719 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn5 - 0.15915494309189535*t719)
-    t721 = casadi.if_else((qn5 > t720), 6.283185307179586, -6.283185307179586)
-    t722 = t720 + t721
-    t723 = t720 - t721
-    t724 = casadi.if_else(casadi.logic_and((t720 >= -2.9670597283903604), (t720 <= 2.9670597283903604)), t720, casadi.if_else(casadi.logic_and((t722 >= -2.9670597283903604), (t722 <= 2.9670597283903604)), t722, casadi.if_else(casadi.logic_and((t723 >= -2.9670597283903604), (t723 <= 2.9670597283903604)), t723, t718)))
-    t725 = (t497 >= -2.0943951023931953)
-    t726 = casadi.logic_and((t490 >= -2.0943951023931953), (t490 <= 2.0943951023931953))
-    t727 = casadi.if_else(casadi.logic_and(t725, casadi.logic_not(t726)), -t497, t496)
-    t728 = t727
-    t729 = t728 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn6 - 0.15915494309189535*t728)
-    t730 = casadi.if_else((qn6 > t729), 6.283185307179586, -6.283185307179586)
-    t731 = t729 + t730
-    t732 = t729 - t730
-    t733 = casadi.if_else(casadi.logic_and((t729 >= -2.0943951023931953), (t729 <= 2.0943951023931953)), t729, casadi.if_else(casadi.logic_and((t731 >= -2.0943951023931953), (t731 <= 2.0943951023931953)), t731, casadi.if_else(casadi.logic_and((t732 >= -2.0943951023931953), (t732 <= 2.0943951023931953)), t732, t727)))
-    t734 = (t495 <= 3.0543261909900767)
-    t735 = casadi.logic_and((t494 >= -3.0543261909900767), (t494 <= 3.0543261909900767))
-    t736 = casadi.if_else(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t216, t47), t594), t595), t596), t600), t601), t701), t702), casadi.logic_or(t716, t717)), casadi.logic_or(t725, t726)), casadi.logic_or(t734, t735)), 1, 0)
-    t737 = casadi.if_else(casadi.logic_and(t734, casadi.logic_not(t735)), t495, t494)
-    t738 = t737
-    t739 = t738 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn7 - 0.15915494309189535*t738)
-    t740 = casadi.if_else((qn7 > t739), 6.283185307179586, -6.283185307179586)
-    t741 = t739 + t740
-    t742 = t739 - t740
-    t743 = casadi.if_else(casadi.logic_and((t739 >= -3.0543261909900767), (t739 <= 3.0543261909900767)), t739, casadi.if_else(casadi.logic_and((t741 >= -3.0543261909900767), (t741 <= 3.0543261909900767)), t741, casadi.if_else(casadi.logic_and((t742 >= -3.0543261909900767), (t742 <= 3.0543261909900767)), t742, t737)))
-    t744 = t699 + qw5*(t584 + t724)**2 + qw6*(t585 + t733)**2 + qw7*(t586 + t743)**2
-    t745 = (t736 > 0)
-    t746 = casadi.if_else(casadi.logic_and(t745, casadi.logic_or((t715 > t744), (t706 < 1))), 1, 0)
-    t747 = casadi.if_else(t745, 1, t706)
-    t748 = (t746 > 0)
-    t749 = casadi.if_else(t748, t662, t708)
-    t750 = casadi.if_else(t748, t671, t709)
-    t751 = casadi.if_else(t748, q3, t710)
-    t752 = casadi.if_else(t748, t556, t711)
-    t753 = casadi.if_else(t748, t724, t712)
-    t754 = casadi.if_else(t748, t733, t713)
-    t755 = casadi.if_else(t748, t743, t714)
-    t756 = casadi.if_else(t748, t744, t715)
-    t757 = (t287 <= 2.9670597283903604)
-    t758 = casadi.logic_and((t286 >= -2.9670597283903604), (t286 <= 2.9670597283903604))
-    t759 = casadi.if_else(casadi.logic_and(t757, casadi.logic_not(t758)), t287, t286)
-    t760 = t759
-    t761 = t760 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn1 - 0.15915494309189535*t760)
-    t762 = casadi.if_else((qn1 > t761), 6.283185307179586, -6.283185307179586)
-    t763 = t761 + t762
-    t764 = t761 - t762
-    t765 = casadi.if_else(casadi.logic_and((t761 >= -2.9670597283903604), (t761 <= 2.9670597283903604)), t761, casadi.if_else(casadi.logic_and((t763 >= -2.9670597283903604), (t763 <= 2.9670597283903604)), t763, casadi.if_else(casadi.logic_and((t764 >= -2.9670597283903604), (t764 <= 2.9670597283903604)), t764, t759)))
-    t766 = (t308 <= 2.0943951023931953)
-    t767 = casadi.logic_and((t307 >= -2.0943951023931953), (t307 <= 2.0943951023931953))
-    t768 = casadi.if_else(casadi.logic_and(t766, casadi.logic_not(t767)), t308, t307)
-    t769 = t768
-    t770 = t769 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t769)
-    t771 = casadi.if_else((qn2 > t770), 6.283185307179586, -6.283185307179586)
-    t772 = t770 + t771
-    t773 = t770 - t771
-    t774 = casadi.if_else(casadi.logic_and((t770 >= -2.0943951023931953), (t770 <= 2.0943951023931953)), t770, casadi.if_else(casadi.logic_and((t772 >= -2.0943951023931953), (t772 <= 2.0943951023931953)), t772, casadi.if_else(casadi.logic_and((t773 >= -2.0943951023931953), (t773 <= 2.0943951023931953)), t773, t768)))
-    t775 = (t31 <= 2.0943951023931953)
-    t776 = casadi.logic_and((t30 >= -2.0943951023931953), (t30 <= 2.0943951023931953))
-    t777 = casadi.if_else(casadi.logic_and(t775, casadi.logic_not(t776)), t31, t30)
-    t778 = t777
-    t779 = t778 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t778)
-    t780 = casadi.if_else((qn4 > t779), 6.283185307179586, -6.283185307179586)
-    t781 = t779 + t780
-    t782 = t779 - t780
-    t783 = casadi.if_else(casadi.logic_and((t779 >= -2.0943951023931953), (t779 <= 2.0943951023931953)), t779, casadi.if_else(casadi.logic_and((t781 >= -2.0943951023931953), (t781 <= 2.0943951023931953)), t781, casadi.if_else(casadi.logic_and((t782 >= -2.0943951023931953), (t782 <= 2.0943951023931953)), t782, t777)))
-    t784 = (t500 <= 2.9670597283903604)
-    t785 = casadi.logic_and((t499 >= -2.9670597283903604), (t499 <= 2.9670597283903604))
-    t786 = casadi.if_else(casadi.logic_and(t784, casadi.logic_not(t785)), t500, t499)
-    t787 = t786
-    t788 = t787 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn5 - 0.15915494309189535*t787)
-    t789 = casadi.if_else((qn5 > t788), 6.283185307179586, -6.283185307179586)
-    t790 = t788 + t789
-    t791 = t788 - t789
-    t792 = casadi.if_else(casadi.logic_and((t788 >= -2.9670597283903604), (t788 <= 2.9670597283903604)), t788, casadi.if_else(casadi.logic_and((t790 >= -2.9670597283903604), (t790 <= 2.9670597283903604)), t790, casadi.if_else(casadi.logic_and((t791 >= -2.9670597283903604), (t791 <= 2.9670597283903604)), t791, t786)))
-    t793 = (t505 <= 2.0943951023931953)
-    t794 = casadi.logic_and((t504 >= -2.0943951023931953), (t504 <= 2.0943951023931953))
-    t795 = casadi.if_else(casadi.logic_and(t793, casadi.logic_not(t794)), t505, t504)
-    t796 = t795
-    t797 = t796 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn6 - 0.15915494309189535*t796)
-    t798 = casadi.if_else((qn6 > t797), 6.283185307179586, -6.283185307179586)
-    t799 = t797 + t798
-    t800 = t797 - t798
-    t801 = casadi.if_else(casadi.logic_and((t797 >= -2.0943951023931953), (t797 <= 2.0943951023931953)), t797, casadi.if_else(casadi.logic_and((t799 >= -2.0943951023931953), (t799 <= 2.0943951023931953)), t799, casadi.if_else(casadi.logic_and((t800 >= -2.0943951023931953), (t800 <= 2.0943951023931953)), t800, t795)))
-    t802 = (t509 <= 3.0543261909900767)
-    t803 = casadi.logic_and((t508 >= -3.0543261909900767), (t508 <= 3.0543261909900767))
-    t804 = casadi.if_else(casadi.logic_and(t802, casadi.logic_not(t803)), t509, t508)
-    t805 = t804
-    t806 = t805 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn7 - 0.15915494309189535*t805)
-    t807 = casadi.if_else((qn7 > t806), 6.283185307179586, -6.283185307179586)
-    t808 = t806 + t807
-    t809 = t806 - t807
-    t810 = casadi.if_else(casadi.logic_and((t806 >= -3.0543261909900767), (t806 <= 3.0543261909900767)), t806, casadi.if_else(casadi.logic_and((t808 >= -3.0543261909900767), (t808 <= 3.0543261909900767)), t808, casadi.if_else(casadi.logic_and((t809 >= -3.0543261909900767), (t809 <= 3.0543261909900767)), t809, t804)))
-    t811 = t589 + qw4*(t590 + t783)**2
-    t812 = t811 + qw1*(t587 + t765)**2 + qw2*(t588 + t774)**2
-    t813 = t812 + qw5*(t584 + t792)**2 + qw6*(t585 + t801)**2 + qw7*(t586 + t810)**2
-    t814 = (t258 <= t259)
-    t815 = casadi.logic_or(t757, t758)
-    t816 = casadi.logic_or(t766, t767)
-    t817 = casadi.logic_or(t775, t776)
-    t818 = casadi.if_else(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t22, t594), t595), t596), t814), t815), t816), t817), (t357 >= -1e-12)), casadi.logic_or(t784, t785)), casadi.logic_or(t793, t794)), casadi.logic_or(t802, t803)), 1, 0)
-    t819 = (t818 > 0)
-    t820 = casadi.if_else(casadi.logic_and(t819, casadi.logic_or((t756 > t813), (t747 < 1))), 1, 0)
-    t821 = casadi.if_else(t819, 1, t747)
-    t822 = (t820 > 0)
-    t823 = casadi.if_else(t822, t765, t749)
-    t824 = casadi.if_else(t822, t774, t750)
-    t825 = casadi.if_else(t822, q3, t751)
-    t826 = casadi.if_else(t822, t783, t752)
-    t827 = casadi.if_else(t822, t792, t753)
-    t828 = casadi.if_else(t822, t801, t754)
-    t829 = casadi.if_else(t822, t810, t755)
-    t830 = casadi.if_else(t822, t813, t756)
-    t831 = (t502 <= 2.9670597283903604)
-    t832 = casadi.logic_and((t501 >= -2.9670597283903604), (t501 <= 2.9670597283903604))
-    t833 = casadi.if_else(casadi.logic_and(t831, casadi.logic_not(t832)), t502, t501)
-    t834 = t833
-    t835 = t834 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn5 - 0.15915494309189535*t834)
-    t836 = casadi.if_else((qn5 > t835), 6.283185307179586, -6.283185307179586)
-    t837 = t835 + t836
-    t838 = t835 - t836
-    t839 = casadi.if_else(casadi.logic_and((t835 >= -2.9670597283903604), (t835 <= 2.9670597283903604)), t835, casadi.if_else(casadi.logic_and((t837 >= -2.9670597283903604), (t837 <= 2.9670597283903604)), t837, casadi.if_else(casadi.logic_and((t838 >= -2.9670597283903604), (t838 <= 2.9670597283903604)), t838, t833)))
-    t840 = (t513 >= -2.0943951023931953)
-    t841 = casadi.logic_and((t506 >= -2.0943951023931953), (t506 <= 2.0943951023931953))
-    t842 = casadi.if_else(casadi.logic_and(t840, casadi.logic_not(t841)), -t513, t512)
-    t843 = t842
-    t844 = t843 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn6 - 0.15915494309189535*t843)
-    t845 = casadi.if_else((qn6 > t844), 6.283185307179586, -6.283185307179586)
-    t846 = t844 + t845
-    t847 = t844 - t845
-    t848 = casadi.if_else(casadi.logic_and((t844 >= -2.0943951023931953), (t844 <= 2.0943951023931953)), t844, casadi.if_else(casadi.logic_and((t846 >= -2.0943951023931953), (t846 <= 2.0943951023931953)), t846, casadi.if_else(casadi.logic_and((t847 >= -2.0943951023931953), (t847 <= 2.0943951023931953)), t847, t842)))
-    t849 = (t511 <= 3.0543261909900767)
-    t850 = casadi.logic_and((t510 >= -3.0543261909900767), (t510 <= 3.0543261909900767))
-    t851 = casadi.if_else(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t22, t358), t594), t595), t596), t814), t815), t816), t817), casadi.logic_or(t831, t832)), casadi.logic_or(t840, t841)), casadi.logic_or(t849, t850)), 1, 0)
-    t852 = casadi.if_else(casadi.logic_and(t849, casadi.logic_not(t850)), t511, t510)
-    t853 = t852
-    t854 = t853 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn7 - 0.15915494309189535*t853)
-    t855 = casadi.if_else((qn7 > t854), 6.283185307179586, -6.283185307179586)
-    t856 = t854 + t855
-    t857 = t854 - t855
-    t858 = casadi.if_else(casadi.logic_and((t854 >= -3.0543261909900767), (t854 <= 3.0543261909900767)), t854, casadi.if_else(casadi.logic_and((t856 >= -3.0543261909900767), (t856 <= 3.0543261909900767)), t856, casadi.if_else(casadi.logic_and((t857 >= -3.0543261909900767), (t857 <= 3.0543261909900767)), t857, t852)))
-    t859 = t812 + qw5*(t584 + t839)**2 + qw6*(t585 + t848)**2 + qw7*(t586 + t858)**2
-    t860 = (t851 > 0)
-    t861 = casadi.if_else(casadi.logic_and(t860, casadi.logic_or((t830 > t859), (t821 < 1))), 1, 0)
-    t862 = casadi.if_else(t860, 1, t821)
-    t863 = (t861 > 0)
-    t864 = casadi.if_else(t863, t765, t823)
-    t865 = casadi.if_else(t863, t774, t824)
-    t866 = casadi.if_else(t863, q3, t825)
-    t867 = casadi.if_else(t863, t783, t826)
-    t868 = casadi.if_else(t863, t839, t827)
-    t869 = casadi.if_else(t863, t848, t828)
-    t870 = casadi.if_else(t863, t858, t829)
-    t871 = casadi.if_else(t863, t859, t830)
-    t872 = (t318 <= 2.9670597283903604)
-    t873 = casadi.logic_and((t317 >= -2.9670597283903604), (t317 <= 2.9670597283903604))
-    t874 = casadi.if_else(casadi.logic_and(t872, casadi.logic_not(t873)), t318, t317)
-    t875 = t874
-    t876 = t875 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn1 - 0.15915494309189535*t875)
-    t877 = casadi.if_else((qn1 > t876), 6.283185307179586, -6.283185307179586)
-    t878 = t876 + t877
-    t879 = t876 - t877
-    t880 = casadi.if_else(casadi.logic_and((t876 >= -2.9670597283903604), (t876 <= 2.9670597283903604)), t876, casadi.if_else(casadi.logic_and((t878 >= -2.9670597283903604), (t878 <= 2.9670597283903604)), t878, casadi.if_else(casadi.logic_and((t879 >= -2.9670597283903604), (t879 <= 2.9670597283903604)), t879, t874)))
-    t881 = (t324 <= 2.0943951023931953)
-    t882 = casadi.logic_and((t323 >= -2.0943951023931953), (t323 <= 2.0943951023931953))
-    t883 = casadi.if_else(casadi.logic_and(t881, casadi.logic_not(t882)), t324, t323)
-    t884 = t883
-    t885 = t884 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t884)
-    t886 = casadi.if_else((qn2 > t885), 6.283185307179586, -6.283185307179586)
-    t887 = t885 + t886
-    t888 = t885 - t886
-    t889 = casadi.if_else(casadi.logic_and((t885 >= -2.0943951023931953), (t885 <= 2.0943951023931953)), t885, casadi.if_else(casadi.logic_and((t887 >= -2.0943951023931953), (t887 <= 2.0943951023931953)), t887, casadi.if_else(casadi.logic_and((t888 >= -2.0943951023931953), (t888 <= 2.0943951023931953)), t888, t883)))
-    t890 = (t516 <= 2.9670597283903604)
-    t891 = casadi.logic_and((t515 >= -2.9670597283903604), (t515 <= 2.9670597283903604))
-    t892 = casadi.if_else(casadi.logic_and(t890, casadi.logic_not(t891)), t516, t515)
-    t893 = t892
-    t894 = t893 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn5 - 0.15915494309189535*t893)
-    t895 = casadi.if_else((qn5 > t894), 6.283185307179586, -6.283185307179586)
-    t896 = t894 + t895
-    t897 = t894 - t895
-    t898 = casadi.if_else(casadi.logic_and((t894 >= -2.9670597283903604), (t894 <= 2.9670597283903604)), t894, casadi.if_else(casadi.logic_and((t896 >= -2.9670597283903604), (t896 <= 2.9670597283903604)), t896, casadi.if_else(casadi.logic_and((t897 >= -2.9670597283903604), (t897 <= 2.9670597283903604)), t897, t892)))
-    t899 = (t521 <= 2.0943951023931953)
-    t900 = casadi.logic_and((t520 >= -2.0943951023931953), (t520 <= 2.0943951023931953))
-    t901 = casadi.if_else(casadi.logic_and(t899, casadi.logic_not(t900)), t521, t520)
-    t902 = t901
-    t903 = t902 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn6 - 0.15915494309189535*t902)
-    t904 = casadi.if_else((qn6 > t903), 6.283185307179586, -6.283185307179586)
-    t905 = t903 + t904
-    t906 = t903 - t904
-    t907 = casadi.if_else(casadi.logic_and((t903 >= -2.0943951023931953), (t903 <= 2.0943951023931953)), t903, casadi.if_else(casadi.logic_and((t905 >= -2.0943951023931953), (t905 <= 2.0943951023931953)), t905, casadi.if_else(casadi.logic_and((t906 >= -2.0943951023931953), (t906 <= 2.0943951023931953)), t906, t901)))
-    t908 = (t525 <= 3.0543261909900767)
-    t909 = casadi.logic_and((t524 >= -3.0543261909900767), (t524 <= 3.0543261909900767))
-    t910 = casadi.if_else(casadi.logic_and(t908, casadi.logic_not(t909)), t525, t524)
-    t911 = t910
-    t912 = t911 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn7 - 0.15915494309189535*t911)
-    t913 = casadi.if_else((qn7 > t912), 6.283185307179586, -6.283185307179586)
-    t914 = t912 + t913
-    t915 = t912 - t913
-    t916 = casadi.if_else(casadi.logic_and((t912 >= -3.0543261909900767), (t912 <= 3.0543261909900767)), t912, casadi.if_else(casadi.logic_and((t914 >= -3.0543261909900767), (t914 <= 3.0543261909900767)), t914, casadi.if_else(casadi.logic_and((t915 >= -3.0543261909900767), (t915 <= 3.0543261909900767)), t915, t910)))
-    t917 = t811 + qw1*(t587 + t880)**2 + qw2*(t588 + t889)**2
-    t918 = t917 + qw5*(t584 + t898)**2 + qw6*(t585 + t907)**2 + qw7*(t586 + t916)**2
-    t919 = casadi.logic_or(t872, t873)
-    t920 = casadi.logic_or(t881, t882)
-    t921 = casadi.if_else(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t22, t260), t594), t595), t596), t817), t919), t920), (t425 >= -1e-12)), casadi.logic_or(t890, t891)), casadi.logic_or(t899, t900)), casadi.logic_or(t908, t909)), 1, 0)
-    t922 = (t921 > 0)
-    t923 = casadi.if_else(casadi.logic_and(t922, casadi.logic_or((t871 > t918), (t862 < 1))), 1, 0)
-    t924 = casadi.if_else(t922, 1, t862)
-    t925 = (t923 > 0)
-    t926 = casadi.if_else(t925, t880, t864)
-    t927 = casadi.if_else(t925, t889, t865)
-    t928 = casadi.if_else(t925, q3, t866)
-    t929 = casadi.if_else(t925, t783, t867)
-    t930 = casadi.if_else(t925, t898, t868)
-    t931 = casadi.if_else(t925, t907, t869)
-    t932 = casadi.if_else(t925, t916, t870)
-    t933 = casadi.if_else(t925, t918, t871)
-    t934 = (t518 <= 2.9670597283903604)
-    t935 = casadi.logic_and((t517 >= -2.9670597283903604), (t517 <= 2.9670597283903604))
-    t936 = casadi.if_else(casadi.logic_and(t934, casadi.logic_not(t935)), t518, t517)
-    t937 = t936
-    t938 = t937 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn5 - 0.15915494309189535*t937)
-    t939 = casadi.if_else((qn5 > t938), 6.283185307179586, -6.283185307179586)
-    t940 = t938 + t939
-    t941 = t938 - t939
-    t942 = casadi.if_else(casadi.logic_and((t938 >= -2.9670597283903604), (t938 <= 2.9670597283903604)), t938, casadi.if_else(casadi.logic_and((t940 >= -2.9670597283903604), (t940 <= 2.9670597283903604)), t940, casadi.if_else(casadi.logic_and((t941 >= -2.9670597283903604), (t941 <= 2.9670597283903604)), t941, t936)))
-    t943 = (t529 >= -2.0943951023931953)
-    t944 = casadi.logic_and((t522 >= -2.0943951023931953), (t522 <= 2.0943951023931953))
-    t945 = casadi.if_else(casadi.logic_and(t943, casadi.logic_not(t944)), -t529, t528)
-    t946 = t945
-    t947 = t946 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn6 - 0.15915494309189535*t946)
-    t948 = casadi.if_else((qn6 > t947), 6.283185307179586, -6.283185307179586)
-    t949 = t947 + t948
-    t950 = t947 - t948
-    t951 = casadi.if_else(casadi.logic_and((t947 >= -2.0943951023931953), (t947 <= 2.0943951023931953)), t947, casadi.if_else(casadi.logic_and((t949 >= -2.0943951023931953), (t949 <= 2.0943951023931953)), t949, casadi.if_else(casadi.logic_and((t950 >= -2.0943951023931953), (t950 <= 2.0943951023931953)), t950, t945)))
-    t952 = (t527 <= 3.0543261909900767)
-    t953 = casadi.logic_and((t526 >= -3.0543261909900767), (t526 <= 3.0543261909900767))
-    t954 = casadi.if_else(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t22, t260), t426), t594), t595), t596), t817), t919), t920), casadi.logic_or(t934, t935)), casadi.logic_or(t943, t944)), casadi.logic_or(t952, t953)), 1, 0)
-    t955 = casadi.if_else(casadi.logic_and(t952, casadi.logic_not(t953)), t527, t526)
-    t956 = t955
-    t957 = t956 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn7 - 0.15915494309189535*t956)
-    t958 = casadi.if_else((qn7 > t957), 6.283185307179586, -6.283185307179586)
-    t959 = t957 + t958
-    t960 = t957 - t958
-    t961 = casadi.if_else(casadi.logic_and((t957 >= -3.0543261909900767), (t957 <= 3.0543261909900767)), t957, casadi.if_else(casadi.logic_and((t959 >= -3.0543261909900767), (t959 <= 3.0543261909900767)), t959, casadi.if_else(casadi.logic_and((t960 >= -3.0543261909900767), (t960 <= 3.0543261909900767)), t960, t955)))
-    t962 = t917 + qw5*(t584 + t942)**2 + qw6*(t585 + t951)**2 + qw7*(t586 + t961)**2
-    t963 = (t954 > 0)
-    t964 = casadi.if_else(casadi.logic_and(t963, casadi.logic_or((t933 > t962), (t924 < 1))), 1, 0)
-    t965 = casadi.if_else(t963, 1, t924)
-    t966 = (t964 > 0)
-    t967 = casadi.if_else(t966, t880, t926)
-    t968 = casadi.if_else(t966, t889, t927)
-    t969 = casadi.if_else(t966, q3, t928)
-    t970 = casadi.if_else(t966, t783, t929)
-    t971 = casadi.if_else(t966, t942, t930)
-    t972 = casadi.if_else(t966, t951, t931)
-    t973 = casadi.if_else(t966, t961, t932)
-    t974 = (casadi.fabs(t464) < casadi.inf)
-    t975 = (t965 > 0)
-    t976 = casadi.logic_and(t974, t975)
+    qb0_0 = branches_q[0, 0]
+    qb0_1 = branches_q[0, 1]
+    qb0_2 = branches_q[0, 2]
+    qb0_3 = branches_q[0, 3]
+    qb0_4 = branches_q[0, 4]
+    qb0_5 = branches_q[0, 5]
+    qb0_6 = branches_q[0, 6]
+    qb1_0 = branches_q[1, 0]
+    qb1_1 = branches_q[1, 1]
+    qb1_2 = branches_q[1, 2]
+    qb1_3 = branches_q[1, 3]
+    qb1_4 = branches_q[1, 4]
+    qb1_5 = branches_q[1, 5]
+    qb1_6 = branches_q[1, 6]
+    qb2_0 = branches_q[2, 0]
+    qb2_1 = branches_q[2, 1]
+    qb2_2 = branches_q[2, 2]
+    qb2_3 = branches_q[2, 3]
+    qb2_4 = branches_q[2, 4]
+    qb2_5 = branches_q[2, 5]
+    qb2_6 = branches_q[2, 6]
+    qb3_0 = branches_q[3, 0]
+    qb3_1 = branches_q[3, 1]
+    qb3_2 = branches_q[3, 2]
+    qb3_3 = branches_q[3, 3]
+    qb3_4 = branches_q[3, 4]
+    qb3_5 = branches_q[3, 5]
+    qb3_6 = branches_q[3, 6]
+    qb4_0 = branches_q[4, 0]
+    qb4_1 = branches_q[4, 1]
+    qb4_2 = branches_q[4, 2]
+    qb4_3 = branches_q[4, 3]
+    qb4_4 = branches_q[4, 4]
+    qb4_5 = branches_q[4, 5]
+    qb4_6 = branches_q[4, 6]
+    qb5_0 = branches_q[5, 0]
+    qb5_1 = branches_q[5, 1]
+    qb5_2 = branches_q[5, 2]
+    qb5_3 = branches_q[5, 3]
+    qb5_4 = branches_q[5, 4]
+    qb5_5 = branches_q[5, 5]
+    qb5_6 = branches_q[5, 6]
+    qb6_0 = branches_q[6, 0]
+    qb6_1 = branches_q[6, 1]
+    qb6_2 = branches_q[6, 2]
+    qb6_3 = branches_q[6, 3]
+    qb6_4 = branches_q[6, 4]
+    qb6_5 = branches_q[6, 5]
+    qb6_6 = branches_q[6, 6]
+    qb7_0 = branches_q[7, 0]
+    qb7_1 = branches_q[7, 1]
+    qb7_2 = branches_q[7, 2]
+    qb7_3 = branches_q[7, 3]
+    qb7_4 = branches_q[7, 4]
+    qb7_5 = branches_q[7, 5]
+    qb7_6 = branches_q[7, 6]
+    vb0 = branches_valid[0]
+    vb1 = branches_valid[1]
+    vb2 = branches_valid[2]
+    vb3 = branches_valid[3]
+    vb4 = branches_valid[4]
+    vb5 = branches_valid[5]
+    vb6 = branches_valid[6]
+    vb7 = branches_valid[7]
+    lb0 = branches_in_limits[0]
+    lb1 = branches_in_limits[1]
+    lb2 = branches_in_limits[2]
+    lb3 = branches_in_limits[3]
+    lb4 = branches_in_limits[4]
+    lb5 = branches_in_limits[5]
+    lb6 = branches_in_limits[6]
+    lb7 = branches_in_limits[7]
+    t0 = qb0_0 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn1 - qb0_0))
+    t1 = qb0_1 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn2 - qb0_1))
+    t2 = qb0_3 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn4 - qb0_3))
+    t3 = qb0_4 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn5 - qb0_4))
+    t4 = qb0_5 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn6 - qb0_5))
+    t5 = qb0_6 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn7 - qb0_6))
+    t6 = casadi.if_else(casadi.logic_and(lb0, vb0), 1, 0)
+    t7 = casadi.if_else((t6 > 0), 1, 0)
+    t8 = qb1_0 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn1 - qb1_0))
+    t9 = qb1_1 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn2 - qb1_1))
+    t10 = qb1_3 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn4 - qb1_3))
+    t11 = qb1_4 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn5 - qb1_4))
+    t12 = qb1_5 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn6 - qb1_5))
+    t13 = qb1_6 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn7 - qb1_6))
+    t14 = casadi.if_else(casadi.logic_and(lb1, vb1), 1, 0)
+    t15 = qb2_0 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn1 - qb2_0))
+    t16 = qb2_1 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn2 - qb2_1))
+    t17 = qb2_3 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn4 - qb2_3))
+    t18 = qb2_4 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn5 - qb2_4))
+    t19 = qb2_5 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn6 - qb2_5))
+    t20 = qb2_6 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn7 - qb2_6))
+    t21 = casadi.if_else(casadi.logic_and(lb2, vb2), 1, 0)
+    t22 = qb3_0 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn1 - qb3_0))
+    t23 = qb3_1 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn2 - qb3_1))
+    t24 = qb3_3 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn4 - qb3_3))
+    t25 = qb3_4 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn5 - qb3_4))
+    t26 = qb3_5 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn6 - qb3_5))
+    t27 = qb3_6 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn7 - qb3_6))
+    t28 = casadi.if_else(casadi.logic_and(lb3, vb3), 1, 0)
+    t29 = qb4_0 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn1 - qb4_0))
+    t30 = qb4_1 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn2 - qb4_1))
+    t31 = qb4_3 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn4 - qb4_3))
+    t32 = qb4_4 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn5 - qb4_4))
+    t33 = qb4_5 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn6 - qb4_5))
+    t34 = qb4_6 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn7 - qb4_6))
+    t35 = casadi.if_else(casadi.logic_and(lb4, vb4), 1, 0)
+    t36 = qb5_0 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn1 - qb5_0))
+    t37 = qb5_1 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn2 - qb5_1))
+    t38 = qb5_3 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn4 - qb5_3))
+    t39 = qb5_4 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn5 - qb5_4))
+    t40 = qb5_5 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn6 - qb5_5))
+    t41 = qb5_6 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn7 - qb5_6))
+    t42 = casadi.if_else(casadi.logic_and(lb5, vb5), 1, 0)
+    t43 = qb6_0 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn1 - qb6_0))
+    t44 = qb6_1 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn2 - qb6_1))
+    t45 = qb6_3 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn4 - qb6_3))
+    t46 = qb6_4 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn5 - qb6_4))
+    t47 = qb6_5 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn6 - qb6_5))
+    t48 = qb6_6 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn7 - qb6_6))
+    t49 = casadi.if_else(casadi.logic_and(lb6, vb6), 1, 0)
+    t50 = qb7_0 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn1 - qb7_0))
+    t51 = qb7_1 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn2 - qb7_1))
+    t52 = qb7_3 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn4 - qb7_3))
+    t53 = qb7_4 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn5 - qb7_4))
+    t54 = qb7_5 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn6 - qb7_5))
+    t55 = qb7_6 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn7 - qb7_6))
+    t56 = casadi.if_else(casadi.logic_and(lb7, vb7), 1, 0)
+    t57 = T00 + T01 + T02 + T03 + T10 + T11 + T12 + T13 + T20 + T21 + T22 + T23 + qn1 + qn2 + qn3 + qn4 + qn5 + qn6 + qn7 + qw1 + qw2 + qw3 + qw4 + qw5 + qw6 + qw7
+    t58 = casadi.if_else((qn1 > t0), 6.283185307179586, -6.283185307179586)
+    t59 = t0 + t58
+    t60 = t0 - t58
+    t61 = casadi.if_else(casadi.logic_and((t0 >= -2.9670597283903604), (t0 <= 2.9670597283903604)), t0, casadi.if_else(casadi.logic_and((t59 >= -2.9670597283903604), (t59 <= 2.9670597283903604)), t59, casadi.if_else(casadi.logic_and((t60 >= -2.9670597283903604), (t60 <= 2.9670597283903604)), t60, qb0_0)))
+    t62 = casadi.if_else((qn2 > t1), 6.283185307179586, -6.283185307179586)
+    t63 = t1 + t62
+    t64 = t1 - t62
+    t65 = casadi.if_else(casadi.logic_and((t1 >= -2.0943951023931953), (t1 <= 2.0943951023931953)), t1, casadi.if_else(casadi.logic_and((t63 >= -2.0943951023931953), (t63 <= 2.0943951023931953)), t63, casadi.if_else(casadi.logic_and((t64 >= -2.0943951023931953), (t64 <= 2.0943951023931953)), t64, qb0_1)))
+    t66 = casadi.if_else((qn4 > t2), 6.283185307179586, -6.283185307179586)
+    t67 = t2 + t66
+    t68 = t2 - t66
+    t69 = casadi.if_else(casadi.logic_and((t2 >= -2.0943951023931953), (t2 <= 2.0943951023931953)), t2, casadi.if_else(casadi.logic_and((t67 >= -2.0943951023931953), (t67 <= 2.0943951023931953)), t67, casadi.if_else(casadi.logic_and((t68 >= -2.0943951023931953), (t68 <= 2.0943951023931953)), t68, qb0_3)))
+    t70 = casadi.if_else((qn5 > t3), 6.283185307179586, -6.283185307179586)
+    t71 = t3 + t70
+    t72 = t3 - t70
+    t73 = casadi.if_else(casadi.logic_and((t3 >= -2.9670597283903604), (t3 <= 2.9670597283903604)), t3, casadi.if_else(casadi.logic_and((t71 >= -2.9670597283903604), (t71 <= 2.9670597283903604)), t71, casadi.if_else(casadi.logic_and((t72 >= -2.9670597283903604), (t72 <= 2.9670597283903604)), t72, qb0_4)))
+    t74 = casadi.if_else((qn6 > t4), 6.283185307179586, -6.283185307179586)
+    t75 = t4 + t74
+    t76 = t4 - t74
+    t77 = casadi.if_else(casadi.logic_and((t4 >= -2.0943951023931953), (t4 <= 2.0943951023931953)), t4, casadi.if_else(casadi.logic_and((t75 >= -2.0943951023931953), (t75 <= 2.0943951023931953)), t75, casadi.if_else(casadi.logic_and((t76 >= -2.0943951023931953), (t76 <= 2.0943951023931953)), t76, qb0_5)))
+    t78 = casadi.if_else((qn7 > t5), 6.283185307179586, -6.283185307179586)
+    t79 = t5 + t78
+    t80 = t5 - t78
+    t81 = casadi.if_else(casadi.logic_and((t5 >= -3.0543261909900767), (t5 <= 3.0543261909900767)), t5, casadi.if_else(casadi.logic_and((t79 >= -3.0543261909900767), (t79 <= 3.0543261909900767)), t79, casadi.if_else(casadi.logic_and((t80 >= -3.0543261909900767), (t80 <= 3.0543261909900767)), t80, qb0_6)))
+    t82 = -qn1
+    t83 = -qn2
+    t84 = -qn3
+    t85 = -qn4
+    t86 = -qn5
+    t87 = -qn6
+    t88 = -qn7
+    t89 = qw1*(t61 + t82)**2 + qw2*(t65 + t83)**2 + qw3*(qb0_2 + t84)**2 + qw4*(t69 + t85)**2 + qw5*(t73 + t86)**2 + qw6*(t77 + t87)**2 + qw7*(t81 + t88)**2
+    t90 = (t7 > 0)
+    t91 = casadi.if_else(t90, t61, qn1)
+    t92 = casadi.if_else(t90, t65, qn2)
+    t93 = casadi.if_else(t90, qb0_2, qn3)
+    t94 = casadi.if_else(t90, t69, qn4)
+    t95 = casadi.if_else(t90, t73, qn5)
+    t96 = casadi.if_else(t90, t77, qn6)
+    t97 = casadi.if_else(t90, t81, qn7)
+    t98 = casadi.if_else(t90, t89, 0)
+    t99 = casadi.if_else((qn1 > t8), 6.283185307179586, -6.283185307179586)
+    t100 = t8 + t99
+    t101 = t8 - t99
+    t102 = casadi.if_else(casadi.logic_and((t8 >= -2.9670597283903604), (t8 <= 2.9670597283903604)), t8, casadi.if_else(casadi.logic_and((t100 >= -2.9670597283903604), (t100 <= 2.9670597283903604)), t100, casadi.if_else(casadi.logic_and((t101 >= -2.9670597283903604), (t101 <= 2.9670597283903604)), t101, qb1_0)))
+    t103 = casadi.if_else((qn2 > t9), 6.283185307179586, -6.283185307179586)
+    t104 = t103 + t9
+    t105 = t9 - t103
+    t106 = casadi.if_else(casadi.logic_and((t9 >= -2.0943951023931953), (t9 <= 2.0943951023931953)), t9, casadi.if_else(casadi.logic_and((t104 >= -2.0943951023931953), (t104 <= 2.0943951023931953)), t104, casadi.if_else(casadi.logic_and((t105 >= -2.0943951023931953), (t105 <= 2.0943951023931953)), t105, qb1_1)))
+    t107 = casadi.if_else((qn4 > t10), 6.283185307179586, -6.283185307179586)
+    t108 = t10 + t107
+    t109 = t10 - t107
+    t110 = casadi.if_else(casadi.logic_and((t10 >= -2.0943951023931953), (t10 <= 2.0943951023931953)), t10, casadi.if_else(casadi.logic_and((t108 >= -2.0943951023931953), (t108 <= 2.0943951023931953)), t108, casadi.if_else(casadi.logic_and((t109 >= -2.0943951023931953), (t109 <= 2.0943951023931953)), t109, qb1_3)))
+    t111 = casadi.if_else((qn5 > t11), 6.283185307179586, -6.283185307179586)
+    t112 = t11 + t111
+    t113 = t11 - t111
+    t114 = casadi.if_else(casadi.logic_and((t11 >= -2.9670597283903604), (t11 <= 2.9670597283903604)), t11, casadi.if_else(casadi.logic_and((t112 >= -2.9670597283903604), (t112 <= 2.9670597283903604)), t112, casadi.if_else(casadi.logic_and((t113 >= -2.9670597283903604), (t113 <= 2.9670597283903604)), t113, qb1_4)))
+    t115 = casadi.if_else((qn6 > t12), 6.283185307179586, -6.283185307179586)
+    t116 = t115 + t12
+    t117 = t12 - t115
+    t118 = casadi.if_else(casadi.logic_and((t12 >= -2.0943951023931953), (t12 <= 2.0943951023931953)), t12, casadi.if_else(casadi.logic_and((t116 >= -2.0943951023931953), (t116 <= 2.0943951023931953)), t116, casadi.if_else(casadi.logic_and((t117 >= -2.0943951023931953), (t117 <= 2.0943951023931953)), t117, qb1_5)))
+    t119 = casadi.if_else((qn7 > t13), 6.283185307179586, -6.283185307179586)
+    t120 = t119 + t13
+    t121 = t13 - t119
+    t122 = casadi.if_else(casadi.logic_and((t13 >= -3.0543261909900767), (t13 <= 3.0543261909900767)), t13, casadi.if_else(casadi.logic_and((t120 >= -3.0543261909900767), (t120 <= 3.0543261909900767)), t120, casadi.if_else(casadi.logic_and((t121 >= -3.0543261909900767), (t121 <= 3.0543261909900767)), t121, qb1_6)))
+    t123 = qw1*(t102 + t82)**2 + qw2*(t106 + t83)**2 + qw3*(qb1_2 + t84)**2 + qw4*(t110 + t85)**2 + qw5*(t114 + t86)**2 + qw6*(t118 + t87)**2 + qw7*(t122 + t88)**2
+    t124 = (t14 > 0)
+    t125 = casadi.if_else(casadi.logic_and(t124, casadi.logic_or((t123 < t98), (t7 < 1))), 1, 0)
+    t126 = casadi.if_else(t124, 1, t7)
+    t127 = (t125 > 0)
+    t128 = casadi.if_else(t127, t102, t91)
+    t129 = casadi.if_else(t127, t106, t92)
+    t130 = casadi.if_else(t127, qb1_2, t93)
+    t131 = casadi.if_else(t127, t110, t94)
+    t132 = casadi.if_else(t127, t114, t95)
+    t133 = casadi.if_else(t127, t118, t96)
+    t134 = casadi.if_else(t127, t122, t97)
+    t135 = casadi.if_else(t127, t123, t98)
+    t136 = casadi.if_else((qn1 > t15), 6.283185307179586, -6.283185307179586)
+    t137 = t136 + t15
+    t138 = t15 - t136
+    t139 = casadi.if_else(casadi.logic_and((t15 >= -2.9670597283903604), (t15 <= 2.9670597283903604)), t15, casadi.if_else(casadi.logic_and((t137 >= -2.9670597283903604), (t137 <= 2.9670597283903604)), t137, casadi.if_else(casadi.logic_and((t138 >= -2.9670597283903604), (t138 <= 2.9670597283903604)), t138, qb2_0)))
+    t140 = casadi.if_else((qn2 > t16), 6.283185307179586, -6.283185307179586)
+    t141 = t140 + t16
+    t142 = t16 - t140
+    t143 = casadi.if_else(casadi.logic_and((t16 >= -2.0943951023931953), (t16 <= 2.0943951023931953)), t16, casadi.if_else(casadi.logic_and((t141 >= -2.0943951023931953), (t141 <= 2.0943951023931953)), t141, casadi.if_else(casadi.logic_and((t142 >= -2.0943951023931953), (t142 <= 2.0943951023931953)), t142, qb2_1)))
+    t144 = casadi.if_else((qn4 > t17), 6.283185307179586, -6.283185307179586)
+    t145 = t144 + t17
+    t146 = t17 - t144
+    t147 = casadi.if_else(casadi.logic_and((t17 >= -2.0943951023931953), (t17 <= 2.0943951023931953)), t17, casadi.if_else(casadi.logic_and((t145 >= -2.0943951023931953), (t145 <= 2.0943951023931953)), t145, casadi.if_else(casadi.logic_and((t146 >= -2.0943951023931953), (t146 <= 2.0943951023931953)), t146, qb2_3)))
+    t148 = casadi.if_else((qn5 > t18), 6.283185307179586, -6.283185307179586)
+    t149 = t148 + t18
+    t150 = t18 - t148
+    t151 = casadi.if_else(casadi.logic_and((t18 >= -2.9670597283903604), (t18 <= 2.9670597283903604)), t18, casadi.if_else(casadi.logic_and((t149 >= -2.9670597283903604), (t149 <= 2.9670597283903604)), t149, casadi.if_else(casadi.logic_and((t150 >= -2.9670597283903604), (t150 <= 2.9670597283903604)), t150, qb2_4)))
+    t152 = casadi.if_else((qn6 > t19), 6.283185307179586, -6.283185307179586)
+    t153 = t152 + t19
+    t154 = t19 - t152
+    t155 = casadi.if_else(casadi.logic_and((t19 >= -2.0943951023931953), (t19 <= 2.0943951023931953)), t19, casadi.if_else(casadi.logic_and((t153 >= -2.0943951023931953), (t153 <= 2.0943951023931953)), t153, casadi.if_else(casadi.logic_and((t154 >= -2.0943951023931953), (t154 <= 2.0943951023931953)), t154, qb2_5)))
+    t156 = casadi.if_else((qn7 > t20), 6.283185307179586, -6.283185307179586)
+    t157 = t156 + t20
+    t158 = t20 - t156
+    t159 = casadi.if_else(casadi.logic_and((t20 >= -3.0543261909900767), (t20 <= 3.0543261909900767)), t20, casadi.if_else(casadi.logic_and((t157 >= -3.0543261909900767), (t157 <= 3.0543261909900767)), t157, casadi.if_else(casadi.logic_and((t158 >= -3.0543261909900767), (t158 <= 3.0543261909900767)), t158, qb2_6)))
+    t160 = qw1*(t139 + t82)**2 + qw2*(t143 + t83)**2 + qw3*(qb2_2 + t84)**2 + qw4*(t147 + t85)**2 + qw5*(t151 + t86)**2 + qw6*(t155 + t87)**2 + qw7*(t159 + t88)**2
+    t161 = (t21 > 0)
+    t162 = casadi.if_else(casadi.logic_and(t161, casadi.logic_or((t135 > t160), (t126 < 1))), 1, 0)
+    t163 = casadi.if_else(t161, 1, t126)
+    t164 = (t162 > 0)
+    t165 = casadi.if_else(t164, t139, t128)
+    t166 = casadi.if_else(t164, t143, t129)
+    t167 = casadi.if_else(t164, qb2_2, t130)
+    t168 = casadi.if_else(t164, t147, t131)
+    t169 = casadi.if_else(t164, t151, t132)
+    t170 = casadi.if_else(t164, t155, t133)
+    t171 = casadi.if_else(t164, t159, t134)
+    t172 = casadi.if_else(t164, t160, t135)
+    t173 = casadi.if_else((qn1 > t22), 6.283185307179586, -6.283185307179586)
+    t174 = t173 + t22
+    t175 = t22 - t173
+    t176 = casadi.if_else(casadi.logic_and((t22 >= -2.9670597283903604), (t22 <= 2.9670597283903604)), t22, casadi.if_else(casadi.logic_and((t174 >= -2.9670597283903604), (t174 <= 2.9670597283903604)), t174, casadi.if_else(casadi.logic_and((t175 >= -2.9670597283903604), (t175 <= 2.9670597283903604)), t175, qb3_0)))
+    t177 = casadi.if_else((qn2 > t23), 6.283185307179586, -6.283185307179586)
+    t178 = t177 + t23
+    t179 = t23 - t177
+    t180 = casadi.if_else(casadi.logic_and((t23 >= -2.0943951023931953), (t23 <= 2.0943951023931953)), t23, casadi.if_else(casadi.logic_and((t178 >= -2.0943951023931953), (t178 <= 2.0943951023931953)), t178, casadi.if_else(casadi.logic_and((t179 >= -2.0943951023931953), (t179 <= 2.0943951023931953)), t179, qb3_1)))
+    t181 = casadi.if_else((qn4 > t24), 6.283185307179586, -6.283185307179586)
+    t182 = t181 + t24
+    t183 = t24 - t181
+    t184 = casadi.if_else(casadi.logic_and((t24 >= -2.0943951023931953), (t24 <= 2.0943951023931953)), t24, casadi.if_else(casadi.logic_and((t182 >= -2.0943951023931953), (t182 <= 2.0943951023931953)), t182, casadi.if_else(casadi.logic_and((t183 >= -2.0943951023931953), (t183 <= 2.0943951023931953)), t183, qb3_3)))
+    t185 = casadi.if_else((qn5 > t25), 6.283185307179586, -6.283185307179586)
+    t186 = t185 + t25
+    t187 = t25 - t185
+    t188 = casadi.if_else(casadi.logic_and((t25 >= -2.9670597283903604), (t25 <= 2.9670597283903604)), t25, casadi.if_else(casadi.logic_and((t186 >= -2.9670597283903604), (t186 <= 2.9670597283903604)), t186, casadi.if_else(casadi.logic_and((t187 >= -2.9670597283903604), (t187 <= 2.9670597283903604)), t187, qb3_4)))
+    t189 = casadi.if_else((qn6 > t26), 6.283185307179586, -6.283185307179586)
+    t190 = t189 + t26
+    t191 = t26 - t189
+    t192 = casadi.if_else(casadi.logic_and((t26 >= -2.0943951023931953), (t26 <= 2.0943951023931953)), t26, casadi.if_else(casadi.logic_and((t190 >= -2.0943951023931953), (t190 <= 2.0943951023931953)), t190, casadi.if_else(casadi.logic_and((t191 >= -2.0943951023931953), (t191 <= 2.0943951023931953)), t191, qb3_5)))
+    t193 = casadi.if_else((qn7 > t27), 6.283185307179586, -6.283185307179586)
+    t194 = t193 + t27
+    t195 = t27 - t193
+    t196 = casadi.if_else(casadi.logic_and((t27 >= -3.0543261909900767), (t27 <= 3.0543261909900767)), t27, casadi.if_else(casadi.logic_and((t194 >= -3.0543261909900767), (t194 <= 3.0543261909900767)), t194, casadi.if_else(casadi.logic_and((t195 >= -3.0543261909900767), (t195 <= 3.0543261909900767)), t195, qb3_6)))
+    t197 = qw1*(t176 + t82)**2 + qw2*(t180 + t83)**2 + qw3*(qb3_2 + t84)**2 + qw4*(t184 + t85)**2 + qw5*(t188 + t86)**2 + qw6*(t192 + t87)**2 + qw7*(t196 + t88)**2
+    t198 = (t28 > 0)
+    t199 = casadi.if_else(casadi.logic_and(t198, casadi.logic_or((t172 > t197), (t163 < 1))), 1, 0)
+    t200 = casadi.if_else(t198, 1, t163)
+    t201 = (t199 > 0)
+    t202 = casadi.if_else(t201, t176, t165)
+    t203 = casadi.if_else(t201, t180, t166)
+    t204 = casadi.if_else(t201, qb3_2, t167)
+    t205 = casadi.if_else(t201, t184, t168)
+    t206 = casadi.if_else(t201, t188, t169)
+    t207 = casadi.if_else(t201, t192, t170)
+    t208 = casadi.if_else(t201, t196, t171)
+    t209 = casadi.if_else(t201, t197, t172)
+    t210 = casadi.if_else((qn1 > t29), 6.283185307179586, -6.283185307179586)
+    t211 = t210 + t29
+    t212 = t29 - t210
+    t213 = casadi.if_else(casadi.logic_and((t29 >= -2.9670597283903604), (t29 <= 2.9670597283903604)), t29, casadi.if_else(casadi.logic_and((t211 >= -2.9670597283903604), (t211 <= 2.9670597283903604)), t211, casadi.if_else(casadi.logic_and((t212 >= -2.9670597283903604), (t212 <= 2.9670597283903604)), t212, qb4_0)))
+    t214 = casadi.if_else((qn2 > t30), 6.283185307179586, -6.283185307179586)
+    t215 = t214 + t30
+    t216 = t30 - t214
+    t217 = casadi.if_else(casadi.logic_and((t30 >= -2.0943951023931953), (t30 <= 2.0943951023931953)), t30, casadi.if_else(casadi.logic_and((t215 >= -2.0943951023931953), (t215 <= 2.0943951023931953)), t215, casadi.if_else(casadi.logic_and((t216 >= -2.0943951023931953), (t216 <= 2.0943951023931953)), t216, qb4_1)))
+    t218 = casadi.if_else((qn4 > t31), 6.283185307179586, -6.283185307179586)
+    t219 = t218 + t31
+    t220 = t31 - t218
+    t221 = casadi.if_else(casadi.logic_and((t31 >= -2.0943951023931953), (t31 <= 2.0943951023931953)), t31, casadi.if_else(casadi.logic_and((t219 >= -2.0943951023931953), (t219 <= 2.0943951023931953)), t219, casadi.if_else(casadi.logic_and((t220 >= -2.0943951023931953), (t220 <= 2.0943951023931953)), t220, qb4_3)))
+    t222 = casadi.if_else((qn5 > t32), 6.283185307179586, -6.283185307179586)
+    t223 = t222 + t32
+    t224 = t32 - t222
+    t225 = casadi.if_else(casadi.logic_and((t32 >= -2.9670597283903604), (t32 <= 2.9670597283903604)), t32, casadi.if_else(casadi.logic_and((t223 >= -2.9670597283903604), (t223 <= 2.9670597283903604)), t223, casadi.if_else(casadi.logic_and((t224 >= -2.9670597283903604), (t224 <= 2.9670597283903604)), t224, qb4_4)))
+    t226 = casadi.if_else((qn6 > t33), 6.283185307179586, -6.283185307179586)
+    t227 = t226 + t33
+    t228 = t33 - t226
+    t229 = casadi.if_else(casadi.logic_and((t33 >= -2.0943951023931953), (t33 <= 2.0943951023931953)), t33, casadi.if_else(casadi.logic_and((t227 >= -2.0943951023931953), (t227 <= 2.0943951023931953)), t227, casadi.if_else(casadi.logic_and((t228 >= -2.0943951023931953), (t228 <= 2.0943951023931953)), t228, qb4_5)))
+    t230 = casadi.if_else((qn7 > t34), 6.283185307179586, -6.283185307179586)
+    t231 = t230 + t34
+    t232 = t34 - t230
+    t233 = casadi.if_else(casadi.logic_and((t34 >= -3.0543261909900767), (t34 <= 3.0543261909900767)), t34, casadi.if_else(casadi.logic_and((t231 >= -3.0543261909900767), (t231 <= 3.0543261909900767)), t231, casadi.if_else(casadi.logic_and((t232 >= -3.0543261909900767), (t232 <= 3.0543261909900767)), t232, qb4_6)))
+    t234 = qw1*(t213 + t82)**2 + qw2*(t217 + t83)**2 + qw3*(qb4_2 + t84)**2 + qw4*(t221 + t85)**2 + qw5*(t225 + t86)**2 + qw6*(t229 + t87)**2 + qw7*(t233 + t88)**2
+    t235 = (t35 > 0)
+    t236 = casadi.if_else(casadi.logic_and(t235, casadi.logic_or((t209 > t234), (t200 < 1))), 1, 0)
+    t237 = casadi.if_else(t235, 1, t200)
+    t238 = (t236 > 0)
+    t239 = casadi.if_else(t238, t213, t202)
+    t240 = casadi.if_else(t238, t217, t203)
+    t241 = casadi.if_else(t238, qb4_2, t204)
+    t242 = casadi.if_else(t238, t221, t205)
+    t243 = casadi.if_else(t238, t225, t206)
+    t244 = casadi.if_else(t238, t229, t207)
+    t245 = casadi.if_else(t238, t233, t208)
+    t246 = casadi.if_else(t238, t234, t209)
+    t247 = casadi.if_else((qn1 > t36), 6.283185307179586, -6.283185307179586)
+    t248 = t247 + t36
+    t249 = t36 - t247
+    t250 = casadi.if_else(casadi.logic_and((t36 >= -2.9670597283903604), (t36 <= 2.9670597283903604)), t36, casadi.if_else(casadi.logic_and((t248 >= -2.9670597283903604), (t248 <= 2.9670597283903604)), t248, casadi.if_else(casadi.logic_and((t249 >= -2.9670597283903604), (t249 <= 2.9670597283903604)), t249, qb5_0)))
+    t251 = casadi.if_else((qn2 > t37), 6.283185307179586, -6.283185307179586)
+    t252 = t251 + t37
+    t253 = t37 - t251
+    t254 = casadi.if_else(casadi.logic_and((t37 >= -2.0943951023931953), (t37 <= 2.0943951023931953)), t37, casadi.if_else(casadi.logic_and((t252 >= -2.0943951023931953), (t252 <= 2.0943951023931953)), t252, casadi.if_else(casadi.logic_and((t253 >= -2.0943951023931953), (t253 <= 2.0943951023931953)), t253, qb5_1)))
+    t255 = casadi.if_else((qn4 > t38), 6.283185307179586, -6.283185307179586)
+    t256 = t255 + t38
+    t257 = t38 - t255
+    t258 = casadi.if_else(casadi.logic_and((t38 >= -2.0943951023931953), (t38 <= 2.0943951023931953)), t38, casadi.if_else(casadi.logic_and((t256 >= -2.0943951023931953), (t256 <= 2.0943951023931953)), t256, casadi.if_else(casadi.logic_and((t257 >= -2.0943951023931953), (t257 <= 2.0943951023931953)), t257, qb5_3)))
+    t259 = casadi.if_else((qn5 > t39), 6.283185307179586, -6.283185307179586)
+    t260 = t259 + t39
+    t261 = t39 - t259
+    t262 = casadi.if_else(casadi.logic_and((t39 >= -2.9670597283903604), (t39 <= 2.9670597283903604)), t39, casadi.if_else(casadi.logic_and((t260 >= -2.9670597283903604), (t260 <= 2.9670597283903604)), t260, casadi.if_else(casadi.logic_and((t261 >= -2.9670597283903604), (t261 <= 2.9670597283903604)), t261, qb5_4)))
+    t263 = casadi.if_else((qn6 > t40), 6.283185307179586, -6.283185307179586)
+    t264 = t263 + t40
+    t265 = t40 - t263
+    t266 = casadi.if_else(casadi.logic_and((t40 >= -2.0943951023931953), (t40 <= 2.0943951023931953)), t40, casadi.if_else(casadi.logic_and((t264 >= -2.0943951023931953), (t264 <= 2.0943951023931953)), t264, casadi.if_else(casadi.logic_and((t265 >= -2.0943951023931953), (t265 <= 2.0943951023931953)), t265, qb5_5)))
+    t267 = casadi.if_else((qn7 > t41), 6.283185307179586, -6.283185307179586)
+    t268 = t267 + t41
+    t269 = t41 - t267
+    t270 = casadi.if_else(casadi.logic_and((t41 >= -3.0543261909900767), (t41 <= 3.0543261909900767)), t41, casadi.if_else(casadi.logic_and((t268 >= -3.0543261909900767), (t268 <= 3.0543261909900767)), t268, casadi.if_else(casadi.logic_and((t269 >= -3.0543261909900767), (t269 <= 3.0543261909900767)), t269, qb5_6)))
+    t271 = qw1*(t250 + t82)**2 + qw2*(t254 + t83)**2 + qw3*(qb5_2 + t84)**2 + qw4*(t258 + t85)**2 + qw5*(t262 + t86)**2 + qw6*(t266 + t87)**2 + qw7*(t270 + t88)**2
+    t272 = (t42 > 0)
+    t273 = casadi.if_else(casadi.logic_and(t272, casadi.logic_or((t246 > t271), (t237 < 1))), 1, 0)
+    t274 = casadi.if_else(t272, 1, t237)
+    t275 = (t273 > 0)
+    t276 = casadi.if_else(t275, t250, t239)
+    t277 = casadi.if_else(t275, t254, t240)
+    t278 = casadi.if_else(t275, qb5_2, t241)
+    t279 = casadi.if_else(t275, t258, t242)
+    t280 = casadi.if_else(t275, t262, t243)
+    t281 = casadi.if_else(t275, t266, t244)
+    t282 = casadi.if_else(t275, t270, t245)
+    t283 = casadi.if_else(t275, t271, t246)
+    t284 = casadi.if_else((qn1 > t43), 6.283185307179586, -6.283185307179586)
+    t285 = t284 + t43
+    t286 = t43 - t284
+    t287 = casadi.if_else(casadi.logic_and((t43 >= -2.9670597283903604), (t43 <= 2.9670597283903604)), t43, casadi.if_else(casadi.logic_and((t285 >= -2.9670597283903604), (t285 <= 2.9670597283903604)), t285, casadi.if_else(casadi.logic_and((t286 >= -2.9670597283903604), (t286 <= 2.9670597283903604)), t286, qb6_0)))
+    t288 = casadi.if_else((qn2 > t44), 6.283185307179586, -6.283185307179586)
+    t289 = t288 + t44
+    t290 = t44 - t288
+    t291 = casadi.if_else(casadi.logic_and((t44 >= -2.0943951023931953), (t44 <= 2.0943951023931953)), t44, casadi.if_else(casadi.logic_and((t289 >= -2.0943951023931953), (t289 <= 2.0943951023931953)), t289, casadi.if_else(casadi.logic_and((t290 >= -2.0943951023931953), (t290 <= 2.0943951023931953)), t290, qb6_1)))
+    t292 = casadi.if_else((qn4 > t45), 6.283185307179586, -6.283185307179586)
+    t293 = t292 + t45
+    t294 = t45 - t292
+    t295 = casadi.if_else(casadi.logic_and((t45 >= -2.0943951023931953), (t45 <= 2.0943951023931953)), t45, casadi.if_else(casadi.logic_and((t293 >= -2.0943951023931953), (t293 <= 2.0943951023931953)), t293, casadi.if_else(casadi.logic_and((t294 >= -2.0943951023931953), (t294 <= 2.0943951023931953)), t294, qb6_3)))
+    t296 = casadi.if_else((qn5 > t46), 6.283185307179586, -6.283185307179586)
+    t297 = t296 + t46
+    t298 = t46 - t296
+    t299 = casadi.if_else(casadi.logic_and((t46 >= -2.9670597283903604), (t46 <= 2.9670597283903604)), t46, casadi.if_else(casadi.logic_and((t297 >= -2.9670597283903604), (t297 <= 2.9670597283903604)), t297, casadi.if_else(casadi.logic_and((t298 >= -2.9670597283903604), (t298 <= 2.9670597283903604)), t298, qb6_4)))
+    t300 = casadi.if_else((qn6 > t47), 6.283185307179586, -6.283185307179586)
+    t301 = t300 + t47
+    t302 = t47 - t300
+    t303 = casadi.if_else(casadi.logic_and((t47 >= -2.0943951023931953), (t47 <= 2.0943951023931953)), t47, casadi.if_else(casadi.logic_and((t301 >= -2.0943951023931953), (t301 <= 2.0943951023931953)), t301, casadi.if_else(casadi.logic_and((t302 >= -2.0943951023931953), (t302 <= 2.0943951023931953)), t302, qb6_5)))
+    t304 = casadi.if_else((qn7 > t48), 6.283185307179586, -6.283185307179586)
+    t305 = t304 + t48
+    t306 = t48 - t304
+    t307 = casadi.if_else(casadi.logic_and((t48 >= -3.0543261909900767), (t48 <= 3.0543261909900767)), t48, casadi.if_else(casadi.logic_and((t305 >= -3.0543261909900767), (t305 <= 3.0543261909900767)), t305, casadi.if_else(casadi.logic_and((t306 >= -3.0543261909900767), (t306 <= 3.0543261909900767)), t306, qb6_6)))
+    t308 = qw1*(t287 + t82)**2 + qw2*(t291 + t83)**2 + qw3*(qb6_2 + t84)**2 + qw4*(t295 + t85)**2 + qw5*(t299 + t86)**2 + qw6*(t303 + t87)**2 + qw7*(t307 + t88)**2
+    t309 = (t49 > 0)
+    t310 = casadi.if_else(casadi.logic_and(t309, casadi.logic_or((t283 > t308), (t274 < 1))), 1, 0)
+    t311 = casadi.if_else(t309, 1, t274)
+    t312 = (t310 > 0)
+    t313 = casadi.if_else(t312, t287, t276)
+    t314 = casadi.if_else(t312, t291, t277)
+    t315 = casadi.if_else(t312, qb6_2, t278)
+    t316 = casadi.if_else(t312, t295, t279)
+    t317 = casadi.if_else(t312, t299, t280)
+    t318 = casadi.if_else(t312, t303, t281)
+    t319 = casadi.if_else(t312, t307, t282)
+    t320 = casadi.if_else(t312, t308, t283)
+    t321 = casadi.if_else((qn1 > t50), 6.283185307179586, -6.283185307179586)
+    t322 = t321 + t50
+    t323 = t50 - t321
+    t324 = casadi.if_else(casadi.logic_and((t50 >= -2.9670597283903604), (t50 <= 2.9670597283903604)), t50, casadi.if_else(casadi.logic_and((t322 >= -2.9670597283903604), (t322 <= 2.9670597283903604)), t322, casadi.if_else(casadi.logic_and((t323 >= -2.9670597283903604), (t323 <= 2.9670597283903604)), t323, qb7_0)))
+    t325 = casadi.if_else((qn2 > t51), 6.283185307179586, -6.283185307179586)
+    t326 = t325 + t51
+    t327 = t51 - t325
+    t328 = casadi.if_else(casadi.logic_and((t51 >= -2.0943951023931953), (t51 <= 2.0943951023931953)), t51, casadi.if_else(casadi.logic_and((t326 >= -2.0943951023931953), (t326 <= 2.0943951023931953)), t326, casadi.if_else(casadi.logic_and((t327 >= -2.0943951023931953), (t327 <= 2.0943951023931953)), t327, qb7_1)))
+    t329 = casadi.if_else((qn4 > t52), 6.283185307179586, -6.283185307179586)
+    t330 = t329 + t52
+    t331 = t52 - t329
+    t332 = casadi.if_else(casadi.logic_and((t52 >= -2.0943951023931953), (t52 <= 2.0943951023931953)), t52, casadi.if_else(casadi.logic_and((t330 >= -2.0943951023931953), (t330 <= 2.0943951023931953)), t330, casadi.if_else(casadi.logic_and((t331 >= -2.0943951023931953), (t331 <= 2.0943951023931953)), t331, qb7_3)))
+    t333 = casadi.if_else((qn5 > t53), 6.283185307179586, -6.283185307179586)
+    t334 = t333 + t53
+    t335 = t53 - t333
+    t336 = casadi.if_else(casadi.logic_and((t53 >= -2.9670597283903604), (t53 <= 2.9670597283903604)), t53, casadi.if_else(casadi.logic_and((t334 >= -2.9670597283903604), (t334 <= 2.9670597283903604)), t334, casadi.if_else(casadi.logic_and((t335 >= -2.9670597283903604), (t335 <= 2.9670597283903604)), t335, qb7_4)))
+    t337 = casadi.if_else((qn6 > t54), 6.283185307179586, -6.283185307179586)
+    t338 = t337 + t54
+    t339 = t54 - t337
+    t340 = casadi.if_else(casadi.logic_and((t54 >= -2.0943951023931953), (t54 <= 2.0943951023931953)), t54, casadi.if_else(casadi.logic_and((t338 >= -2.0943951023931953), (t338 <= 2.0943951023931953)), t338, casadi.if_else(casadi.logic_and((t339 >= -2.0943951023931953), (t339 <= 2.0943951023931953)), t339, qb7_5)))
+    t341 = casadi.if_else((qn7 > t55), 6.283185307179586, -6.283185307179586)
+    t342 = t341 + t55
+    t343 = t55 - t341
+    t344 = casadi.if_else(casadi.logic_and((t55 >= -3.0543261909900767), (t55 <= 3.0543261909900767)), t55, casadi.if_else(casadi.logic_and((t342 >= -3.0543261909900767), (t342 <= 3.0543261909900767)), t342, casadi.if_else(casadi.logic_and((t343 >= -3.0543261909900767), (t343 <= 3.0543261909900767)), t343, qb7_6)))
+    t345 = qw1*(t324 + t82)**2 + qw2*(t328 + t83)**2 + qw3*(qb7_2 + t84)**2 + qw4*(t332 + t85)**2 + qw5*(t336 + t86)**2 + qw6*(t340 + t87)**2 + qw7*(t344 + t88)**2
+    t346 = (t56 > 0)
+    t347 = casadi.if_else(casadi.logic_and(t346, casadi.logic_or((t320 > t345), (t311 < 1))), 1, 0)
+    t348 = casadi.if_else(t346, 1, t311)
+    t349 = (t347 > 0)
+    t350 = casadi.if_else(t349, t324, t313)
+    t351 = casadi.if_else(t349, t328, t314)
+    t352 = casadi.if_else(t349, qb7_2, t315)
+    t353 = casadi.if_else(t349, t332, t316)
+    t354 = casadi.if_else(t349, t336, t317)
+    t355 = casadi.if_else(t349, t340, t318)
+    t356 = casadi.if_else(t349, t344, t319)
+    t357 = (casadi.fabs(t57) < casadi.inf)
+    t358 = (t348 > 0)
+    t359 = casadi.logic_and(t357, t358)
     q = casadi.SX(7, 1)
-    q[0, 0] = casadi.if_else(t976, t967, qn1)
-    q[1, 0] = casadi.if_else(t976, t968, qn2)
-    q[2, 0] = casadi.if_else(t976, t969, qn3)
-    q[3, 0] = casadi.if_else(t976, t970, qn4)
-    q[4, 0] = casadi.if_else(t976, t971, qn5)
-    q[5, 0] = casadi.if_else(t976, t972, qn6)
-    q[6, 0] = casadi.if_else(t976, t973, qn7)
+    q[0, 0] = casadi.if_else(t359, t350, qn1)
+    q[1, 0] = casadi.if_else(t359, t351, qn2)
+    q[2, 0] = casadi.if_else(t359, t352, qn3)
+    q[3, 0] = casadi.if_else(t359, t353, qn4)
+    q[4, 0] = casadi.if_else(t359, t354, qn5)
+    q[5, 0] = casadi.if_else(t359, t355, qn6)
+    q[6, 0] = casadi.if_else(t359, t356, qn7)
     status = casadi.SX(1, 1)
-    status[0, 0] = casadi.if_else(casadi.logic_not(t974), 2, casadi.if_else(t975, 0, 1))
+    status[0, 0] = casadi.if_else(casadi.logic_not(t357), 2, casadi.if_else(t358, 0, 1))
     return [q, status]
 
 

@@ -103,7 +103,7 @@ kr5_real kr5_ik_numeric_step(const kr5_real target[16], const kr5_real q[KR5_DOF
 void kr5_ik_branches(const kr5_real T[16], kr5_real q[KR5_MAX_IK_SOLUTIONS * KR5_DOF], int valid[KR5_MAX_IK_SOLUTIONS], int in_limits[KR5_MAX_IK_SOLUTIONS]);
 
 /* The closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status.
- * Result: q[i], i < 6; returned as a scalar. 2162 operations. */
+ * Result: q[i], i < 6; returned as a scalar. 1060 operations. */
 int kr5_ik_nearest(const kr5_real T[16], const kr5_real q_seed[KR5_DOF], const kr5_real weights[KR5_DOF], kr5_real q[KR5_DOF]);
 
 /* Statuses of kr5_velocity_ik: OK, singular (a diagonal entry of the QR factor R of the

@@ -101,7 +101,7 @@ panda_real panda_ik_numeric_step(const panda_real target[16], const panda_real q
 void panda_ik_branches(const panda_real T[16], panda_real q_free, panda_real q[PANDA_MAX_IK_SOLUTIONS * PANDA_DOF], int valid[PANDA_MAX_IK_SOLUTIONS], int in_limits[PANDA_MAX_IK_SOLUTIONS]);
 
 /* The closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status.
- * Result: q[i], i < 7; returned as a scalar. 2446 operations. */
+ * Result: q[i], i < 7; returned as a scalar. 1104 operations. */
 int panda_ik_nearest(const panda_real T[16], const panda_real q_seed[PANDA_DOF], panda_real q_free, const panda_real weights[PANDA_DOF], panda_real q[PANDA_DOF]);
 
 /* Statuses of panda_velocity_ik: OK, singular (a diagonal entry of the QR factor R of the

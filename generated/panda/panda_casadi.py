@@ -3535,7 +3535,8 @@ def _ik_branches(T, q_free):
 
 
 def _ik_nearest(T, q_seed, q_free, weights):
-    """The closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status: 2446 operations."""
+    """The closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status: 1104 operations."""
+    branches_q, branches_valid, branches_in_limits = _ik_branches(T, q_free)
     T00 = T[0, 0]
     T01 = T[0, 1]
     T02 = T[0, 2]
@@ -3562,984 +3563,448 @@ def _ik_nearest(T, q_seed, q_free, weights):
     qw5 = weights[4]
     qw6 = weights[5]
     qw7 = weights[6]
-    q7 = q_free
-    c7 = casadi.cos(q7)
-    s7 = casadi.sin(q7)
-    t0 = 0.823 + T02*T03 + T12*T13 + T22*T23
-    t1 = t0 - 0.333*T22
-    t2 = -1.033 + t1
-    t3 = 0.7071067811865476*c7
-    t4 = 0.7071067811865476*s7
-    t5 = t3 + t4
-    t6 = t3 - t4
-    t7 = T00*t5 + T01*t6
-    t8 = T10*t5 + T11*t6
-    t9 = T20*t5 + T21*t6
-    t10 = 0.088 - T03*t7 - T13*t8 - T23*t9
-    t11 = t10 + 0.333*t9
-    t12 = -t5
-    t13 = T00*t6 + T01*t12
-    t14 = T10*t6 + T11*t12
-    t15 = T20*t6 + T21*t12
-    t16 = T03*t13 + T13*t14 + T23*t15
-    t17 = -t16 + 0.333*t15
-    t18 = t17**2
-    t19 = t18 + t11**2 + t2**2
-    t20 = 0.13046225 - 0.5*t19
-    t21 = t20**2
-    t22 = 1 - 60.77564796097323*t21
-    t23 = 7.795873777901566*t20
-    t24 = (1e-12 < t22)
-    t25 = casadi.if_else(t24, t23, casadi.if_else((t23 > 0), 1, -1))
-    t26 = casadi.if_else(t24, casadi.sqrt(t22), 0)
-    t27 = casadi.atan2(t26, t25)
-    t28 = -2.6745902299367814 + t27
-    t29 = -2.6745902299367814 - t27
-    t30 = t28 + 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t28)
-    t31 = t29 + 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t29)
-    t32 = 7.795873777901566*t25
-    t33 = 0.11453775*t32
-    t34 = 7.795873777901566*t26
-    t35 = 0.05775*t34
-    t36 = t35 - t33
-    t37 = t33 + t35
-    t38 = 0.05775*t32
-    t39 = 0.11453775*t34
-    t40 = -t38 - t39
-    t41 = t39 - t38
-    t42 = 0.316*t40 - 0.0825*t36
-    t43 = 0.316*t36 + 0.0825*t40
-    t44 = 0.0825 + t42
-    t45 = 0.649 - t43
-    t46 = -1.033 + t45
-    t47 = 0.316*t41 + 0.0825*t37
-    t48 = 0.316*t37 - 0.0825*t41
-    t49 = 0.0825 + t47
-    t50 = 0.649 + t48
-    t51 = -1.033 + t50
-    t52 = t44**2
-    t53 = t46**2
-    t54 = t52 + t53
-    t55 = t18 + t53
-    t56 = t55 - t54
-    t57 = 1e-12*t54
-    t58 = (t56 < -t57)
-    t59 = casadi.if_else(t58, casadi.sqrt(-t56), 0)
-    t60 = t55 + t59**2
-    t61 = t11*t59
-    t62 = t18 + t2*t46
-    t63 = t62 - t61
-    t64 = t61 + t62
-    t65 = -t18
-    t66 = t63 + t65
-    t67 = t64 + t65
-    t68 = t11*t46
-    t69 = t2*t59
-    t70 = t68 + t69
-    t71 = t66**2 + t70**2
-    t72 = t68 - t69
-    t73 = t67**2 + t72**2
-    t74 = 1e-24*t60
-    t75 = t19*t74
-    t76 = (t71 <= t75)
-    t77 = casadi.if_else(t76, 1, 1/casadi.sqrt(t71))
-    t78 = casadi.if_else(t76, 1, t66*t77)
-    t79 = casadi.if_else(t76, 0, -t70*t77)
-    t80 = t78*t9 - T22*t79
-    t81 = T22*t78 + t79*t9
-    t82 = t7*t78 - T02*t79
-    t83 = T02*t78 + t7*t79
-    t84 = t44*t59
-    t85 = t53 - t84
-    t86 = t53 + t84
-    t87 = -t53
-    t88 = t85 + t87
-    t89 = t86 + t87
-    t90 = t18*t52
-    t91 = t90 + t88**2
-    t92 = t90 + t89**2
-    t93 = t54*t74
-    t94 = (t91 <= t93)
-    t95 = casadi.if_else(t94, 1, 1/casadi.sqrt(t91))
-    t96 = casadi.if_else(t94, 1, t88*t95)
-    t97 = t17*t44
-    t98 = casadi.if_else(t94, 0, t95*t97)
-    t99 = (t73 <= t75)
-    t100 = casadi.if_else(t99, 1, 1/casadi.sqrt(t73))
-    t101 = casadi.if_else(t99, 1, t100*t67)
-    t102 = casadi.if_else(t99, 0, -t100*t72)
-    t103 = t101*t9 - T22*t102
-    t104 = T22*t101 + t102*t9
-    t105 = t101*t7 - T02*t102
-    t106 = T02*t101 + t102*t7
-    t107 = (t92 <= t93)
-    t108 = casadi.if_else(t107, 1, 1/casadi.sqrt(t92))
-    t109 = casadi.if_else(t107, 1, t108*t89)
-    t110 = casadi.if_else(t107, 0, t108*t97)
-    t111 = 1 - t78
-    t112 = t111*t15
-    t113 = t112 + t15*t78
-    t114 = t111*t13
-    t115 = t114 + t13*t78
-    t116 = t113*t98 + t80*t96
-    t117 = t113*t96 - t80*t98
-    t118 = t115*t98 + t82*t96
-    t119 = t115*t96 - t82*t98
-    t120 = 1 - t96
-    t121 = t120*t81
-    t122 = t121 + t81*t96
-    t123 = t120*t83
-    t124 = t123 + t83*t96
-    t125 = t116*t36 - t122*t40
-    t126 = t116*t40 + t122*t36
-    t127 = t118*t36 - t124*t40
-    t128 = t118*t40 + t124*t36
-    t129 = 1 - t36
-    t130 = t117*t129
-    t131 = t130 + t117*t36
-    t132 = t119*t129
-    t133 = t132 + t119*t36
-    t134 = t126**2
-    t135 = -t134
-    t136 = 1 + t135
-    t137 = (1e-12 < t136)
-    t138 = casadi.if_else(t137, casadi.sqrt(t136), 0)
-    t139 = t134 - t125*t138
-    t140 = t135 + t139
-    t141 = t131**2
-    t142 = t134 + t141 + t125**2
-    t143 = t138**2
-    t144 = t140**2 + t141*t143
-    t145 = t134 + t143
-    t146 = 1e-24*t145
-    t147 = (t144 <= t142*t146)
-    t148 = casadi.if_else(t147, 1, 1/casadi.sqrt(t144))
-    t149 = casadi.if_else(t147, 1, t140*t148)
-    t150 = t128*(1 - t149)
-    t151 = t150 + t128*t149
-    t152 = t131*t138
-    t153 = casadi.if_else(t147, 0, -t148*t152)
-    t154 = t127*t149 + t133*t153
-    t155 = t133*t149 - t127*t153
-    t156 = (t145 <= t146)
-    t157 = casadi.if_else(t156, 1, 1/casadi.sqrt(t145))
-    t158 = casadi.if_else(t156, 1, -t126*t157)
-    t159 = casadi.if_else(t156, 0, -t138*t157)
-    t160 = t155*(1 - t158)
-    t161 = t151*t159 + t154*t158
-    t162 = t160 + t155*t158
-    t163 = t154*t159 - t151*t158
-    t164 = t161**2 + t162**2
-    t165 = t164
-    t166 = t164 + t163**2
-    t167 = 1 - t101
-    t168 = t15*t167
-    t169 = t168 + t101*t15
-    t170 = t13*t167
-    t171 = t170 + t101*t13
-    t172 = t103*t109 + t110*t169
-    t173 = t109*t169 - t103*t110
-    t174 = t105*t109 + t110*t171
-    t175 = t109*t171 - t105*t110
-    t176 = t129*t173
-    t177 = t176 + t173*t36
-    t178 = t129*t175
-    t179 = t178 + t175*t36
-    t180 = 1 - t109
-    t181 = t104*t180
-    t182 = t181 + t104*t109
-    t183 = t106*t180
-    t184 = t183 + t106*t109
-    t185 = t172*t36 - t182*t40
-    t186 = t172*t40 + t182*t36
-    t187 = t174*t36 - t184*t40
-    t188 = t174*t40 + t184*t36
-    t189 = t186**2
-    t190 = -t189
-    t191 = 1 + t190
-    t192 = (1e-12 < t191)
-    t193 = casadi.if_else(t192, casadi.sqrt(t191), 0)
-    t194 = t189 - t185*t193
-    t195 = t190 + t194
-    t196 = t177**2
-    t197 = t189 + t196 + t185**2
-    t198 = t193**2
-    t199 = t195**2 + t196*t198
-    t200 = t189 + t198
-    t201 = 1e-24*t200
-    t202 = (t199 <= t197*t201)
-    t203 = casadi.if_else(t202, 1, 1/casadi.sqrt(t199))
-    t204 = casadi.if_else(t202, 1, t195*t203)
-    t205 = t188*(1 - t204)
-    t206 = t205 + t188*t204
-    t207 = t177*t193
-    t208 = casadi.if_else(t202, 0, -t203*t207)
-    t209 = t179*t208 + t187*t204
-    t210 = t179*t204 - t187*t208
-    t211 = (t200 <= t201)
-    t212 = casadi.if_else(t211, 1, 1/casadi.sqrt(t200))
-    t213 = casadi.if_else(t211, 1, -t186*t212)
-    t214 = casadi.if_else(t211, 0, -t193*t212)
-    t215 = t210*(1 - t213)
-    t216 = t206*t214 + t209*t213
-    t217 = t215 + t210*t213
-    t218 = t209*t214 - t206*t213
-    t219 = t216**2 + t217**2
-    t220 = t219
-    t221 = t219 + t218**2
-    t222 = t49**2
-    t223 = t51**2
-    t224 = t222 + t223
-    t225 = t18 + t223
-    t226 = t225 - t224
-    t227 = 1e-12*t224
-    t228 = (t226 < -t227)
-    t229 = casadi.if_else(t228, casadi.sqrt(-t226), 0)
-    t230 = t225 + t229**2
-    t231 = t11*t229
-    t232 = t18 + t2*t51
-    t233 = t232 - t231
-    t234 = t233 + t65
-    t235 = t231 + t232
-    t236 = t235 + t65
-    t237 = t11*t51
-    t238 = t2*t229
-    t239 = t237 + t238
-    t240 = t234**2 + t239**2
-    t241 = t237 - t238
-    t242 = t236**2 + t241**2
-    t243 = 1e-24*t230
-    t244 = t19*t243
-    t245 = (t240 <= t244)
-    t246 = casadi.if_else(t245, 1, 1/casadi.sqrt(t240))
-    t247 = casadi.if_else(t245, 1, t234*t246)
-    t248 = casadi.if_else(t245, 0, -t239*t246)
-    t249 = t247*t9 - T22*t248
-    t250 = T22*t247 + t248*t9
-    t251 = t247*t7 - T02*t248
-    t252 = T02*t247 + t248*t7
-    t253 = t229*t49
-    t254 = t223 - t253
-    t255 = t223 + t253
-    t256 = -t223
-    t257 = t254 + t256
-    t258 = t255 + t256
-    t259 = t18*t222
-    t260 = t259 + t257**2
-    t261 = t259 + t258**2
-    t262 = t224*t243
-    t263 = (t260 <= t262)
-    t264 = casadi.if_else(t263, 1, 1/casadi.sqrt(t260))
-    t265 = casadi.if_else(t263, 1, t257*t264)
-    t266 = t17*t49
-    t267 = casadi.if_else(t263, 0, t264*t266)
-    t268 = (t242 <= t244)
-    t269 = casadi.if_else(t268, 1, 1/casadi.sqrt(t242))
-    t270 = casadi.if_else(t268, 1, t236*t269)
-    t271 = casadi.if_else(t268, 0, -t241*t269)
-    t272 = t270*t9 - T22*t271
-    t273 = T22*t270 + t271*t9
-    t274 = t270*t7 - T02*t271
-    t275 = T02*t270 + t271*t7
-    t276 = (t261 <= t262)
-    t277 = casadi.if_else(t276, 1, 1/casadi.sqrt(t261))
-    t278 = casadi.if_else(t276, 1, t258*t277)
-    t279 = casadi.if_else(t276, 0, t266*t277)
-    t280 = 1 - t247
-    t281 = t15*t280
-    t282 = t281 + t15*t247
-    t283 = t13*t280
-    t284 = t283 + t13*t247
-    t285 = t249*t265 + t267*t282
-    t286 = t265*t282 - t249*t267
-    t287 = t251*t265 + t267*t284
-    t288 = t265*t284 - t251*t267
-    t289 = 1 - t265
-    t290 = t250*t289
-    t291 = t290 + t250*t265
-    t292 = t252*t289
-    t293 = t292 + t252*t265
-    t294 = t285*t37 + t291*t41
-    t295 = t291*t37 - t285*t41
-    t296 = t287*t37 + t293*t41
-    t297 = t293*t37 - t287*t41
-    t298 = 1 + t37
-    t299 = t286*t298
-    t300 = t299 - t286*t37
-    t301 = t288*t298
-    t302 = t301 - t288*t37
-    t303 = t295**2
-    t304 = -t303
-    t305 = 1 + t304
-    t306 = (1e-12 < t305)
-    t307 = casadi.if_else(t306, casadi.sqrt(t305), 0)
-    t308 = t303 + t294*t307
-    t309 = t304 + t308
-    t310 = t300**2
-    t311 = t303 + t310 + t294**2
-    t312 = t307**2
-    t313 = t309**2 + t310*t312
-    t314 = t303 + t312
-    t315 = 1e-24*t314
-    t316 = (t313 <= t311*t315)
-    t317 = casadi.if_else(t316, 1, 1/casadi.sqrt(t313))
-    t318 = casadi.if_else(t316, 1, t309*t317)
-    t319 = t297*(1 - t318)
-    t320 = t319 + t297*t318
-    t321 = t300*t307
-    t322 = casadi.if_else(t316, 0, -t317*t321)
-    t323 = t302*t322 - t296*t318
-    t324 = t296*t322 + t302*t318
-    t325 = (t314 <= t315)
-    t326 = casadi.if_else(t325, 1, 1/casadi.sqrt(t314))
-    t327 = casadi.if_else(t325, 1, t295*t326)
-    t328 = casadi.if_else(t325, 0, -t307*t326)
-    t329 = t324*(1 - t327)
-    t330 = t323*t327 - t320*t328
-    t331 = t329 + t324*t327
-    t332 = t320*t327 + t323*t328
-    t333 = t330**2 + t331**2
-    t334 = t333
-    t335 = t333 + t332**2
-    t336 = 1 - t270
-    t337 = t15*t336
-    t338 = t337 + t15*t270
-    t339 = t13*t336
-    t340 = t339 + t13*t270
-    t341 = t272*t278 + t279*t338
-    t342 = t278*t338 - t272*t279
-    t343 = t274*t278 + t279*t340
-    t344 = t278*t340 - t274*t279
-    t345 = t298*t342
-    t346 = t345 - t342*t37
-    t347 = t298*t344
-    t348 = t347 - t344*t37
-    t349 = 1 - t278
-    t350 = t273*t349
-    t351 = t350 + t273*t278
-    t352 = t275*t349
-    t353 = t352 + t275*t278
-    t354 = t341*t37 + t351*t41
-    t355 = t351*t37 - t341*t41
-    t356 = t343*t37 + t353*t41
-    t357 = t353*t37 - t343*t41
-    t358 = t355**2
-    t359 = -t358
-    t360 = 1 + t359
-    t361 = (1e-12 < t360)
-    t362 = casadi.if_else(t361, casadi.sqrt(t360), 0)
-    t363 = t358 + t354*t362
-    t364 = t359 + t363
-    t365 = t346**2
-    t366 = t358 + t365 + t354**2
-    t367 = t362**2
-    t368 = t364**2 + t365*t367
-    t369 = t358 + t367
-    t370 = 1e-24*t369
-    t371 = (t368 <= t366*t370)
-    t372 = casadi.if_else(t371, 1, 1/casadi.sqrt(t368))
-    t373 = casadi.if_else(t371, 1, t364*t372)
-    t374 = t357*(1 - t373)
-    t375 = t374 + t357*t373
-    t376 = t346*t362
-    t377 = casadi.if_else(t371, 0, -t372*t376)
-    t378 = t348*t377 - t356*t373
-    t379 = t348*t373 + t356*t377
-    t380 = (t369 <= t370)
-    t381 = casadi.if_else(t380, 1, 1/casadi.sqrt(t369))
-    t382 = casadi.if_else(t380, 1, t355*t381)
-    t383 = casadi.if_else(t380, 0, -t362*t381)
-    t384 = t379*(1 - t382)
-    t385 = t378*t382 - t375*t383
-    t386 = t384 + t379*t382
-    t387 = t375*t382 + t378*t383
-    t388 = t385**2 + t386**2
-    t389 = t388
-    t390 = t388 + t387**2
-    t391 = T00 + T01 + T02 + T03 + T10 + T11 + T12 + T13 + T20 + T21 + T22 + T23
-    t392 = t391
-    t393 = qn1 + qn2 + qn3 + qn4 + qn5 + qn6 + qn7 + qw1 + qw2 + qw3 + qw4 + qw5 + qw6 + qw7 + t391
-    t394 = casadi.if_else(t76, 0, casadi.atan2(-t70, t66))
-    t395 = t394 + 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t394)
-    t396 = -t395
-    t397 = t395 + 6.283185307179586*casadi.floor(0.0027852115041081685 + 0.15915494309189535*t396)
-    t398 = casadi.if_else(t94, 0, casadi.atan2(t97, t88))
-    t399 = t398 + 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t398)
-    t400 = -t399
-    t401 = t399 + 6.283185307179586*casadi.floor(0.46111961662014833 + 0.15915494309189535*t400)
-    t402 = -t30
-    t403 = t30 + 6.283185307179586*casadi.floor(0.4888921541896841 + 0.15915494309189535*t402)
-    t404 = casadi.if_else(t147, 0, casadi.atan2(-t152, t140))
-    t405 = 3.141592653589793 + t404
-    t406 = t404 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t405)
-    t407 = -6.283185307179586 + t405 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t404)
-    t408 = -t406
-    t409 = t406 + 6.283185307179586*casadi.floor(0.46111961662014833 + 0.15915494309189535*t408)
-    t410 = casadi.if_else(t156, 0, casadi.atan2(-t138, -t126))
-    t411 = t410 + 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t410)
-    t412 = t410
-    t413 = t412 - 6.283185307179586*casadi.floor(0.280558333682393 + 0.15915494309189535*t412)
-    t414 = -t411
-    t415 = t411 + 6.283185307179586*casadi.floor(0.280558333682393 + 0.15915494309189535*t414)
-    t416 = casadi.if_else((t165 <= 1e-24*t166), 0, casadi.atan2(t162, t161))
-    t417 = 3.141592653589793 + t416
-    t418 = t416 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t417)
-    t419 = -6.283185307179586 + t417 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t416)
-    t420 = -t418
-    t421 = t418 + 6.283185307179586*casadi.floor(0.46111961662014833 + 0.15915494309189535*t420)
-    t422 = -t407
-    t423 = t407 + 6.283185307179586*casadi.floor(0.46111961662014833 + 0.15915494309189535*t422)
-    t424 = -t419
-    t425 = t419 + 6.283185307179586*casadi.floor(0.46111961662014833 + 0.15915494309189535*t424)
-    t426 = casadi.if_else(t99, 0, casadi.atan2(-t72, t67))
-    t427 = t426 + 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t426)
-    t428 = -t427
-    t429 = t427 + 6.283185307179586*casadi.floor(0.0027852115041081685 + 0.15915494309189535*t428)
-    t430 = casadi.if_else(t107, 0, casadi.atan2(t97, t89))
-    t431 = t430 + 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t430)
-    t432 = -t431
-    t433 = t431 + 6.283185307179586*casadi.floor(0.46111961662014833 + 0.15915494309189535*t432)
-    t434 = casadi.if_else(t202, 0, casadi.atan2(-t207, t195))
-    t435 = 3.141592653589793 + t434
-    t436 = t434 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t435)
-    t437 = -6.283185307179586 + t435 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t434)
-    t438 = -t436
-    t439 = t436 + 6.283185307179586*casadi.floor(0.46111961662014833 + 0.15915494309189535*t438)
-    t440 = casadi.if_else(t211, 0, casadi.atan2(-t193, -t186))
-    t441 = t440 + 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t440)
-    t442 = t440
-    t443 = t442 - 6.283185307179586*casadi.floor(0.280558333682393 + 0.15915494309189535*t442)
-    t444 = -t441
-    t445 = t441 + 6.283185307179586*casadi.floor(0.280558333682393 + 0.15915494309189535*t444)
-    t446 = casadi.if_else((t220 <= 1e-24*t221), 0, casadi.atan2(t217, t216))
-    t447 = 3.141592653589793 + t446
-    t448 = t446 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t447)
-    t449 = -6.283185307179586 + t447 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t446)
-    t450 = -t448
-    t451 = t448 + 6.283185307179586*casadi.floor(0.46111961662014833 + 0.15915494309189535*t450)
-    t452 = -t437
-    t453 = t437 + 6.283185307179586*casadi.floor(0.46111961662014833 + 0.15915494309189535*t452)
-    t454 = -t449
-    t455 = t449 + 6.283185307179586*casadi.floor(0.46111961662014833 + 0.15915494309189535*t454)
-    t456 = casadi.if_else(t245, 0, casadi.atan2(-t239, t234))
-    t457 = t456 + 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t456)
-    t458 = -t457
-    t459 = t457 + 6.283185307179586*casadi.floor(0.0027852115041081685 + 0.15915494309189535*t458)
-    t460 = casadi.if_else(t263, 0, casadi.atan2(t266, t257))
-    t461 = t460 + 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t460)
-    t462 = -t461
-    t463 = t461 + 6.283185307179586*casadi.floor(0.46111961662014833 + 0.15915494309189535*t462)
-    t464 = -t31
-    t465 = t31 + 6.283185307179586*casadi.floor(0.4888921541896841 + 0.15915494309189535*t464)
-    t466 = casadi.if_else(t316, 0, casadi.atan2(-t321, t309))
-    t467 = 3.141592653589793 + t466
-    t468 = t466 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t467)
-    t469 = -6.283185307179586 + t467 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t466)
-    t470 = -t468
-    t471 = t468 + 6.283185307179586*casadi.floor(0.46111961662014833 + 0.15915494309189535*t470)
-    t472 = casadi.if_else(t325, 0, casadi.atan2(-t307, t295))
-    t473 = t472 + 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t472)
-    t474 = t472
-    t475 = t474 - 6.283185307179586*casadi.floor(0.280558333682393 + 0.15915494309189535*t474)
-    t476 = -t473
-    t477 = t473 + 6.283185307179586*casadi.floor(0.280558333682393 + 0.15915494309189535*t476)
-    t478 = casadi.if_else((t334 <= 1e-24*t335), 0, casadi.atan2(t331, t330))
-    t479 = 3.141592653589793 + t478
-    t480 = t478 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t479)
-    t481 = -6.283185307179586 + t479 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t478)
-    t482 = -t480
-    t483 = t480 + 6.283185307179586*casadi.floor(0.46111961662014833 + 0.15915494309189535*t482)
-    t484 = -t469
-    t485 = t469 + 6.283185307179586*casadi.floor(0.46111961662014833 + 0.15915494309189535*t484)
-    t486 = -t481
-    t487 = t481 + 6.283185307179586*casadi.floor(0.46111961662014833 + 0.15915494309189535*t486)
-    t488 = casadi.if_else(t268, 0, casadi.atan2(-t241, t236))
-    t489 = t488 + 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t488)
-    t490 = -t489
-    t491 = t489 + 6.283185307179586*casadi.floor(0.0027852115041081685 + 0.15915494309189535*t490)
-    t492 = casadi.if_else(t276, 0, casadi.atan2(t266, t258))
-    t493 = t492 + 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t492)
-    t494 = -t493
-    t495 = t493 + 6.283185307179586*casadi.floor(0.46111961662014833 + 0.15915494309189535*t494)
-    t496 = casadi.if_else(t371, 0, casadi.atan2(-t376, t364))
-    t497 = 3.141592653589793 + t496
-    t498 = t496 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t497)
-    t499 = -6.283185307179586 + t497 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t496)
-    t500 = -t498
-    t501 = t498 + 6.283185307179586*casadi.floor(0.46111961662014833 + 0.15915494309189535*t500)
-    t502 = casadi.if_else(t380, 0, casadi.atan2(-t362, t355))
-    t503 = t502 + 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t502)
-    t504 = t502
-    t505 = t504 - 6.283185307179586*casadi.floor(0.280558333682393 + 0.15915494309189535*t504)
-    t506 = -t503
-    t507 = t503 + 6.283185307179586*casadi.floor(0.280558333682393 + 0.15915494309189535*t506)
-    t508 = casadi.if_else((t389 <= 1e-24*t390), 0, casadi.atan2(t386, t385))
-    t509 = 3.141592653589793 + t508
-    t510 = t508 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t509)
-    t511 = -6.283185307179586 + t509 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t508)
-    t512 = -t510
-    t513 = t510 + 6.283185307179586*casadi.floor(0.46111961662014833 + 0.15915494309189535*t512)
-    t514 = -t499
-    t515 = t499 + 6.283185307179586*casadi.floor(0.46111961662014833 + 0.15915494309189535*t514)
-    t516 = -t511
-    t517 = t511 + 6.283185307179586*casadi.floor(0.46111961662014833 + 0.15915494309189535*t516)
-    t518 = (t421 >= -2.8973)
-    t519 = casadi.logic_and((t418 >= -2.8973), (t418 <= 2.8973))
-    t520 = casadi.if_else(casadi.logic_and(t518, casadi.logic_not(t519)), -t421, t420)
-    t521 = t520
-    t522 = t521 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn1 - 0.15915494309189535*t521)
-    t523 = casadi.if_else((qn1 > t522), 6.283185307179586, -6.283185307179586)
-    t524 = t522 + t523
-    t525 = t522 - t523
-    t526 = casadi.if_else(casadi.logic_and((t522 >= -2.8973), (t522 <= 2.8973)), t522, casadi.if_else(casadi.logic_and((t524 >= -2.8973), (t524 <= 2.8973)), t524, casadi.if_else(casadi.logic_and((t525 >= -2.8973), (t525 <= 2.8973)), t525, t520)))
-    t527 = (t415 >= -1.7627999999999997)
-    t528 = casadi.logic_and((t411 >= -1.7627999999999997), (t411 <= 1.7627999999999997))
-    t529 = casadi.if_else(casadi.logic_and(t527, casadi.logic_not(t528)), -t415, t414)
-    t530 = t529
-    t531 = t530 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t530)
-    t532 = casadi.if_else((qn2 > t531), 6.283185307179586, -6.283185307179586)
-    t533 = t531 + t532
-    t534 = t531 - t532
-    t535 = casadi.if_else(casadi.logic_and((t531 >= -1.7627999999999997), (t531 <= 1.7627999999999997)), t531, casadi.if_else(casadi.logic_and((t533 >= -1.7627999999999997), (t533 <= 1.7627999999999997)), t533, casadi.if_else(casadi.logic_and((t534 >= -1.7627999999999997), (t534 <= 1.7627999999999997)), t534, t529)))
-    t536 = (t409 >= -2.8973)
-    t537 = casadi.logic_and((t406 >= -2.8973), (t406 <= 2.8973))
-    t538 = casadi.if_else(casadi.logic_and(t536, casadi.logic_not(t537)), -t409, t408)
-    t539 = t538
-    t540 = t539 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn3 - 0.15915494309189535*t539)
-    t541 = casadi.if_else((qn3 > t540), 6.283185307179586, -6.283185307179586)
-    t542 = t540 + t541
-    t543 = t540 - t541
-    t544 = casadi.if_else(casadi.logic_and((t540 >= -2.8973), (t540 <= 2.8973)), t540, casadi.if_else(casadi.logic_and((t542 >= -2.8973), (t542 <= 2.8973)), t542, casadi.if_else(casadi.logic_and((t543 >= -2.8973), (t543 <= 2.8973)), t543, t538)))
-    t545 = (t403 >= 0.0698)
-    t546 = casadi.logic_and((t30 >= 0.0698), (t30 <= 3.0718))
-    t547 = casadi.if_else(casadi.logic_and(t545, casadi.logic_not(t546)), -t403, t402)
-    t548 = t547
-    t549 = t548 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t548)
-    t550 = casadi.if_else((qn4 > t549), 6.283185307179586, -6.283185307179586)
-    t551 = t549 + t550
-    t552 = t549 - t550
-    t553 = casadi.if_else(casadi.logic_and((t549 >= -3.0718), (t549 <= -0.0698)), t549, casadi.if_else(casadi.logic_and((t551 >= -3.0718), (t551 <= -0.0698)), t551, casadi.if_else(casadi.logic_and((t552 >= -3.0718), (t552 <= -0.0698)), t552, t547)))
-    t554 = (t401 >= -2.8973)
-    t555 = casadi.logic_and((t399 >= -2.8973), (t399 <= 2.8973))
-    t556 = casadi.if_else(casadi.logic_and(t554, casadi.logic_not(t555)), -t401, t400)
-    t557 = t556
-    t558 = t557 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn5 - 0.15915494309189535*t557)
-    t559 = casadi.if_else((qn5 > t558), 6.283185307179586, -6.283185307179586)
-    t560 = t558 + t559
-    t561 = t558 - t559
-    t562 = casadi.if_else(casadi.logic_and((t558 >= -2.8973), (t558 <= 2.8973)), t558, casadi.if_else(casadi.logic_and((t560 >= -2.8973), (t560 <= 2.8973)), t560, casadi.if_else(casadi.logic_and((t561 >= -2.8973), (t561 <= 2.8973)), t561, t556)))
-    t563 = (t397 >= -3.7525000000000004)
-    t564 = casadi.logic_and((t395 >= -3.7525000000000004), (t395 <= 0.0175))
-    t565 = casadi.if_else(casadi.logic_and(t563, casadi.logic_not(t564)), -t397, t396)
-    t566 = t565
-    t567 = t566 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn6 - 0.15915494309189535*t566)
-    t568 = casadi.if_else((qn6 > t567), 6.283185307179586, -6.283185307179586)
-    t569 = t567 + t568
-    t570 = t567 - t568
-    t571 = casadi.if_else(casadi.logic_and((t567 >= -0.0175), (t567 <= 3.7525000000000004)), t567, casadi.if_else(casadi.logic_and((t569 >= -0.0175), (t569 <= 3.7525000000000004)), t569, casadi.if_else(casadi.logic_and((t570 >= -0.0175), (t570 <= 3.7525000000000004)), t570, t565)))
-    t572 = -qn1
-    t573 = -qn2
-    t574 = -qn3
-    t575 = -qn5
-    t576 = -qn6
-    t577 = -qn4
-    t578 = qw7*(q7 - qn7)**2
-    t579 = t578 + qw4*(t553 + t577)**2
-    t580 = t579 + qw5*(t562 + t575)**2 + qw6*(t571 + t576)**2
-    t581 = t580 + qw1*(t526 + t572)**2 + qw2*(t535 + t573)**2 + qw3*(t544 + t574)**2
-    t582 = (casadi.fabs(t392) < casadi.inf)
-    t583 = (q7 >= -2.8973)
-    t584 = (q7 <= 2.8973)
-    t585 = (t56 <= t57)
-    t586 = casadi.logic_or(t563, t564)
-    t587 = casadi.logic_or(t554, t555)
-    t588 = casadi.logic_or(t545, t546)
-    t589 = (1e-12 >= -t22)
-    t590 = casadi.if_else(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t582, t583), t584), t585), t586), t587), t588), t589), (t136 >= -1e-12)), casadi.logic_or(t518, t519)), casadi.logic_or(t527, t528)), casadi.logic_or(t536, t537)), 1, 0)
-    t591 = casadi.if_else((t590 > 0), 1, 0)
-    t592 = (t591 > 0)
-    t593 = casadi.if_else(t592, t526, qn1)
-    t594 = casadi.if_else(t592, t535, qn2)
-    t595 = casadi.if_else(t592, t544, qn3)
-    t596 = casadi.if_else(t592, t553, qn4)
-    t597 = casadi.if_else(t592, t562, qn5)
-    t598 = casadi.if_else(t592, t571, qn6)
-    t599 = casadi.if_else(t592, q7, qn7)
-    t600 = casadi.if_else(t592, t581, 0)
-    t601 = (t425 >= -2.8973)
-    t602 = casadi.logic_and((t419 >= -2.8973), (t419 <= 2.8973))
-    t603 = casadi.if_else(casadi.logic_and(t601, casadi.logic_not(t602)), -t425, t424)
-    t604 = t603
-    t605 = t604 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn1 - 0.15915494309189535*t604)
-    t606 = casadi.if_else((qn1 > t605), 6.283185307179586, -6.283185307179586)
-    t607 = t605 + t606
-    t608 = t605 - t606
-    t609 = casadi.if_else(casadi.logic_and((t605 >= -2.8973), (t605 <= 2.8973)), t605, casadi.if_else(casadi.logic_and((t607 >= -2.8973), (t607 <= 2.8973)), t607, casadi.if_else(casadi.logic_and((t608 >= -2.8973), (t608 <= 2.8973)), t608, t603)))
-    t610 = (t413 <= 1.7627999999999997)
-    t611 = casadi.logic_and((t412 >= -1.7627999999999997), (t412 <= 1.7627999999999997))
-    t612 = casadi.if_else(casadi.logic_and(t610, casadi.logic_not(t611)), t413, t412)
-    t613 = t612
-    t614 = t613 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t613)
-    t615 = casadi.if_else((qn2 > t614), 6.283185307179586, -6.283185307179586)
-    t616 = t614 + t615
-    t617 = t614 - t615
-    t618 = casadi.if_else(casadi.logic_and((t614 >= -1.7627999999999997), (t614 <= 1.7627999999999997)), t614, casadi.if_else(casadi.logic_and((t616 >= -1.7627999999999997), (t616 <= 1.7627999999999997)), t616, casadi.if_else(casadi.logic_and((t617 >= -1.7627999999999997), (t617 <= 1.7627999999999997)), t617, t612)))
-    t619 = (t423 >= -2.8973)
-    t620 = casadi.logic_and((t407 >= -2.8973), (t407 <= 2.8973))
-    t621 = casadi.if_else(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t137, t582), t583), t584), t585), t586), t587), t588), t589), casadi.logic_or(t601, t602)), casadi.logic_or(t610, t611)), casadi.logic_or(t619, t620)), 1, 0)
-    t622 = casadi.if_else(casadi.logic_and(t619, casadi.logic_not(t620)), -t423, t422)
-    t623 = t622
-    t624 = t623 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn3 - 0.15915494309189535*t623)
-    t625 = casadi.if_else((qn3 > t624), 6.283185307179586, -6.283185307179586)
-    t626 = t624 + t625
-    t627 = t624 - t625
-    t628 = casadi.if_else(casadi.logic_and((t624 >= -2.8973), (t624 <= 2.8973)), t624, casadi.if_else(casadi.logic_and((t626 >= -2.8973), (t626 <= 2.8973)), t626, casadi.if_else(casadi.logic_and((t627 >= -2.8973), (t627 <= 2.8973)), t627, t622)))
-    t629 = t580 + qw1*(t572 + t609)**2 + qw2*(t573 + t618)**2 + qw3*(t574 + t628)**2
-    t630 = (t621 > 0)
-    t631 = casadi.if_else(casadi.logic_and(t630, casadi.logic_or((t600 > t629), (t591 < 1))), 1, 0)
-    t632 = casadi.if_else(t630, 1, t591)
-    t633 = (t631 > 0)
-    t634 = casadi.if_else(t633, t609, t593)
-    t635 = casadi.if_else(t633, t618, t594)
-    t636 = casadi.if_else(t633, t628, t595)
-    t637 = casadi.if_else(t633, t553, t596)
-    t638 = casadi.if_else(t633, t562, t597)
-    t639 = casadi.if_else(t633, t571, t598)
-    t640 = casadi.if_else(t633, q7, t599)
-    t641 = casadi.if_else(t633, t629, t600)
-    t642 = (t451 >= -2.8973)
-    t643 = casadi.logic_and((t448 >= -2.8973), (t448 <= 2.8973))
-    t644 = casadi.if_else(casadi.logic_and(t642, casadi.logic_not(t643)), -t451, t450)
-    t645 = t644
-    t646 = t645 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn1 - 0.15915494309189535*t645)
-    t647 = casadi.if_else((qn1 > t646), 6.283185307179586, -6.283185307179586)
-    t648 = t646 + t647
-    t649 = t646 - t647
-    t650 = casadi.if_else(casadi.logic_and((t646 >= -2.8973), (t646 <= 2.8973)), t646, casadi.if_else(casadi.logic_and((t648 >= -2.8973), (t648 <= 2.8973)), t648, casadi.if_else(casadi.logic_and((t649 >= -2.8973), (t649 <= 2.8973)), t649, t644)))
-    t651 = (t445 >= -1.7627999999999997)
-    t652 = casadi.logic_and((t441 >= -1.7627999999999997), (t441 <= 1.7627999999999997))
-    t653 = casadi.if_else(casadi.logic_and(t651, casadi.logic_not(t652)), -t445, t444)
-    t654 = t653
-    t655 = t654 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t654)
-    t656 = casadi.if_else((qn2 > t655), 6.283185307179586, -6.283185307179586)
-    t657 = t655 + t656
-    t658 = t655 - t656
-    t659 = casadi.if_else(casadi.logic_and((t655 >= -1.7627999999999997), (t655 <= 1.7627999999999997)), t655, casadi.if_else(casadi.logic_and((t657 >= -1.7627999999999997), (t657 <= 1.7627999999999997)), t657, casadi.if_else(casadi.logic_and((t658 >= -1.7627999999999997), (t658 <= 1.7627999999999997)), t658, t653)))
-    t660 = (t439 >= -2.8973)
-    t661 = casadi.logic_and((t436 >= -2.8973), (t436 <= 2.8973))
-    t662 = casadi.if_else(casadi.logic_and(t660, casadi.logic_not(t661)), -t439, t438)
-    t663 = t662
-    t664 = t663 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn3 - 0.15915494309189535*t663)
-    t665 = casadi.if_else((qn3 > t664), 6.283185307179586, -6.283185307179586)
-    t666 = t664 + t665
-    t667 = t664 - t665
-    t668 = casadi.if_else(casadi.logic_and((t664 >= -2.8973), (t664 <= 2.8973)), t664, casadi.if_else(casadi.logic_and((t666 >= -2.8973), (t666 <= 2.8973)), t666, casadi.if_else(casadi.logic_and((t667 >= -2.8973), (t667 <= 2.8973)), t667, t662)))
-    t669 = (t433 >= -2.8973)
-    t670 = casadi.logic_and((t431 >= -2.8973), (t431 <= 2.8973))
-    t671 = casadi.if_else(casadi.logic_and(t669, casadi.logic_not(t670)), -t433, t432)
-    t672 = t671
-    t673 = t672 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn5 - 0.15915494309189535*t672)
-    t674 = casadi.if_else((qn5 > t673), 6.283185307179586, -6.283185307179586)
-    t675 = t673 + t674
-    t676 = t673 - t674
-    t677 = casadi.if_else(casadi.logic_and((t673 >= -2.8973), (t673 <= 2.8973)), t673, casadi.if_else(casadi.logic_and((t675 >= -2.8973), (t675 <= 2.8973)), t675, casadi.if_else(casadi.logic_and((t676 >= -2.8973), (t676 <= 2.8973)), t676, t671)))
-    t678 = (t429 >= -3.7525000000000004)
-    t679 = casadi.logic_and((t427 >= -3.7525000000000004), (t427 <= 0.0175))
-    t680 = casadi.if_else(casadi.logic_and(t678, casadi.logic_not(t679)), -t429, t428)
-    t681 = t680
-    t682 = t681 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn6 - 0.15915494309189535*t681)
-    t683 = casadi.if_else((qn6 > t682), 6.283185307179586, -6.283185307179586)
-    t684 = t682 + t683
-    t685 = t682 - t683
-    t686 = casadi.if_else(casadi.logic_and((t682 >= -0.0175), (t682 <= 3.7525000000000004)), t682, casadi.if_else(casadi.logic_and((t684 >= -0.0175), (t684 <= 3.7525000000000004)), t684, casadi.if_else(casadi.logic_and((t685 >= -0.0175), (t685 <= 3.7525000000000004)), t685, t680)))
-    t687 = t579 + qw5*(t575 + t677)**2 + qw6*(t576 + t686)**2
-    t688 = t687 + qw1*(t572 + t650)**2 + qw2*(t573 + t659)**2 + qw3*(t574 + t668)**2
-    t689 = casadi.logic_or(t678, t679)
-    t690 = casadi.logic_or(t669, t670)
-    t691 = casadi.if_else(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t58, t582), t583), t584), t588), t589), t689), t690), (t191 >= -1e-12)), casadi.logic_or(t642, t643)), casadi.logic_or(t651, t652)), casadi.logic_or(t660, t661)), 1, 0)
-    t692 = (t691 > 0)
-    t693 = casadi.if_else(casadi.logic_and(t692, casadi.logic_or((t641 > t688), (t632 < 1))), 1, 0)
-    t694 = casadi.if_else(t692, 1, t632)
-    t695 = (t693 > 0)
-    t696 = casadi.if_else(t695, t650, t634)
-    t697 = casadi.if_else(t695, t659, t635)
-    t698 = casadi.if_else(t695, t668, t636)
-    t699 = casadi.if_else(t695, t553, t637)
-    t700 = casadi.if_else(t695, t677, t638)
-    t701 = casadi.if_else(t695, t686, t639)
-    t702 = casadi.if_else(t695, q7, t640)
-    t703 = casadi.if_else(t695, t688, t641)
-    t704 = (t455 >= -2.8973)
-    t705 = casadi.logic_and((t449 >= -2.8973), (t449 <= 2.8973))
-    t706 = casadi.if_else(casadi.logic_and(t704, casadi.logic_not(t705)), -t455, t454)
-    t707 = t706
-    t708 = t707 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn1 - 0.15915494309189535*t707)
-    t709 = casadi.if_else((qn1 > t708), 6.283185307179586, -6.283185307179586)
-    t710 = t708 + t709
-    t711 = t708 - t709
-    t712 = casadi.if_else(casadi.logic_and((t708 >= -2.8973), (t708 <= 2.8973)), t708, casadi.if_else(casadi.logic_and((t710 >= -2.8973), (t710 <= 2.8973)), t710, casadi.if_else(casadi.logic_and((t711 >= -2.8973), (t711 <= 2.8973)), t711, t706)))
-    t713 = (t443 <= 1.7627999999999997)
-    t714 = casadi.logic_and((t442 >= -1.7627999999999997), (t442 <= 1.7627999999999997))
-    t715 = casadi.if_else(casadi.logic_and(t713, casadi.logic_not(t714)), t443, t442)
-    t716 = t715
-    t717 = t716 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t716)
-    t718 = casadi.if_else((qn2 > t717), 6.283185307179586, -6.283185307179586)
-    t719 = t717 + t718
-    t720 = t717 - t718
-    t721 = casadi.if_else(casadi.logic_and((t717 >= -1.7627999999999997), (t717 <= 1.7627999999999997)), t717, casadi.if_else(casadi.logic_and((t719 >= -1.7627999999999997), (t719 <= 1.7627999999999997)), t719, casadi.if_else(casadi.logic_and((t720 >= -1.7627999999999997), (t720 <= 1.7627999999999997)), t720, t715)))
-    t722 = (t453 >= -2.8973)
-    t723 = casadi.logic_and((t437 >= -2.8973), (t437 <= 2.8973))
-    t724 = casadi.if_else(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t192, t58), t582), t583), t584), t588), t589), t689), t690), casadi.logic_or(t704, t705)), casadi.logic_or(t713, t714)), casadi.logic_or(t722, t723)), 1, 0)
-    t725 = casadi.if_else(casadi.logic_and(t722, casadi.logic_not(t723)), -t453, t452)
-    t726 = t725
-    t727 = t726 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn3 - 0.15915494309189535*t726)
-    t728 = casadi.if_else((qn3 > t727), 6.283185307179586, -6.283185307179586)
-    t729 = t727 + t728
-    t730 = t727 - t728
-    t731 = casadi.if_else(casadi.logic_and((t727 >= -2.8973), (t727 <= 2.8973)), t727, casadi.if_else(casadi.logic_and((t729 >= -2.8973), (t729 <= 2.8973)), t729, casadi.if_else(casadi.logic_and((t730 >= -2.8973), (t730 <= 2.8973)), t730, t725)))
-    t732 = t687 + qw1*(t572 + t712)**2 + qw2*(t573 + t721)**2 + qw3*(t574 + t731)**2
-    t733 = (t724 > 0)
-    t734 = casadi.if_else(casadi.logic_and(t733, casadi.logic_or((t703 > t732), (t694 < 1))), 1, 0)
-    t735 = casadi.if_else(t733, 1, t694)
-    t736 = (t734 > 0)
-    t737 = casadi.if_else(t736, t712, t696)
-    t738 = casadi.if_else(t736, t721, t697)
-    t739 = casadi.if_else(t736, t731, t698)
-    t740 = casadi.if_else(t736, t553, t699)
-    t741 = casadi.if_else(t736, t677, t700)
-    t742 = casadi.if_else(t736, t686, t701)
-    t743 = casadi.if_else(t736, q7, t702)
-    t744 = casadi.if_else(t736, t732, t703)
-    t745 = (t483 >= -2.8973)
-    t746 = casadi.logic_and((t480 >= -2.8973), (t480 <= 2.8973))
-    t747 = casadi.if_else(casadi.logic_and(t745, casadi.logic_not(t746)), -t483, t482)
-    t748 = t747
-    t749 = t748 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn1 - 0.15915494309189535*t748)
-    t750 = casadi.if_else((qn1 > t749), 6.283185307179586, -6.283185307179586)
-    t751 = t749 + t750
-    t752 = t749 - t750
-    t753 = casadi.if_else(casadi.logic_and((t749 >= -2.8973), (t749 <= 2.8973)), t749, casadi.if_else(casadi.logic_and((t751 >= -2.8973), (t751 <= 2.8973)), t751, casadi.if_else(casadi.logic_and((t752 >= -2.8973), (t752 <= 2.8973)), t752, t747)))
-    t754 = (t477 >= -1.7627999999999997)
-    t755 = casadi.logic_and((t473 >= -1.7627999999999997), (t473 <= 1.7627999999999997))
-    t756 = casadi.if_else(casadi.logic_and(t754, casadi.logic_not(t755)), -t477, t476)
-    t757 = t756
-    t758 = t757 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t757)
-    t759 = casadi.if_else((qn2 > t758), 6.283185307179586, -6.283185307179586)
-    t760 = t758 + t759
-    t761 = t758 - t759
-    t762 = casadi.if_else(casadi.logic_and((t758 >= -1.7627999999999997), (t758 <= 1.7627999999999997)), t758, casadi.if_else(casadi.logic_and((t760 >= -1.7627999999999997), (t760 <= 1.7627999999999997)), t760, casadi.if_else(casadi.logic_and((t761 >= -1.7627999999999997), (t761 <= 1.7627999999999997)), t761, t756)))
-    t763 = (t471 >= -2.8973)
-    t764 = casadi.logic_and((t468 >= -2.8973), (t468 <= 2.8973))
-    t765 = casadi.if_else(casadi.logic_and(t763, casadi.logic_not(t764)), -t471, t470)
-    t766 = t765
-    t767 = t766 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn3 - 0.15915494309189535*t766)
-    t768 = casadi.if_else((qn3 > t767), 6.283185307179586, -6.283185307179586)
-    t769 = t767 + t768
-    t770 = t767 - t768
-    t771 = casadi.if_else(casadi.logic_and((t767 >= -2.8973), (t767 <= 2.8973)), t767, casadi.if_else(casadi.logic_and((t769 >= -2.8973), (t769 <= 2.8973)), t769, casadi.if_else(casadi.logic_and((t770 >= -2.8973), (t770 <= 2.8973)), t770, t765)))
-    t772 = (t465 >= 0.0698)
-    t773 = casadi.logic_and((t31 >= 0.0698), (t31 <= 3.0718))
-    t774 = casadi.if_else(casadi.logic_and(t772, casadi.logic_not(t773)), -t465, t464)
-    t775 = t774
-    t776 = t775 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t775)
-    t777 = casadi.if_else((qn4 > t776), 6.283185307179586, -6.283185307179586)
-    t778 = t776 + t777
-    t779 = t776 - t777
-    t780 = casadi.if_else(casadi.logic_and((t776 >= -3.0718), (t776 <= -0.0698)), t776, casadi.if_else(casadi.logic_and((t778 >= -3.0718), (t778 <= -0.0698)), t778, casadi.if_else(casadi.logic_and((t779 >= -3.0718), (t779 <= -0.0698)), t779, t774)))
-    t781 = (t463 >= -2.8973)
-    t782 = casadi.logic_and((t461 >= -2.8973), (t461 <= 2.8973))
-    t783 = casadi.if_else(casadi.logic_and(t781, casadi.logic_not(t782)), -t463, t462)
-    t784 = t783
-    t785 = t784 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn5 - 0.15915494309189535*t784)
-    t786 = casadi.if_else((qn5 > t785), 6.283185307179586, -6.283185307179586)
-    t787 = t785 + t786
-    t788 = t785 - t786
-    t789 = casadi.if_else(casadi.logic_and((t785 >= -2.8973), (t785 <= 2.8973)), t785, casadi.if_else(casadi.logic_and((t787 >= -2.8973), (t787 <= 2.8973)), t787, casadi.if_else(casadi.logic_and((t788 >= -2.8973), (t788 <= 2.8973)), t788, t783)))
-    t790 = (t459 >= -3.7525000000000004)
-    t791 = casadi.logic_and((t457 >= -3.7525000000000004), (t457 <= 0.0175))
-    t792 = casadi.if_else(casadi.logic_and(t790, casadi.logic_not(t791)), -t459, t458)
-    t793 = t792
-    t794 = t793 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn6 - 0.15915494309189535*t793)
-    t795 = casadi.if_else((qn6 > t794), 6.283185307179586, -6.283185307179586)
-    t796 = t794 + t795
-    t797 = t794 - t795
-    t798 = casadi.if_else(casadi.logic_and((t794 >= -0.0175), (t794 <= 3.7525000000000004)), t794, casadi.if_else(casadi.logic_and((t796 >= -0.0175), (t796 <= 3.7525000000000004)), t796, casadi.if_else(casadi.logic_and((t797 >= -0.0175), (t797 <= 3.7525000000000004)), t797, t792)))
-    t799 = t578 + qw4*(t577 + t780)**2
-    t800 = t799 + qw5*(t575 + t789)**2 + qw6*(t576 + t798)**2
-    t801 = t800 + qw1*(t572 + t753)**2 + qw2*(t573 + t762)**2 + qw3*(t574 + t771)**2
-    t802 = (t226 <= t227)
-    t803 = casadi.logic_or(t790, t791)
-    t804 = casadi.logic_or(t781, t782)
-    t805 = casadi.logic_or(t772, t773)
-    t806 = casadi.if_else(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t24, t582), t583), t584), t802), t803), t804), t805), (t305 >= -1e-12)), casadi.logic_or(t745, t746)), casadi.logic_or(t754, t755)), casadi.logic_or(t763, t764)), 1, 0)
-    t807 = (t806 > 0)
-    t808 = casadi.if_else(casadi.logic_and(t807, casadi.logic_or((t744 > t801), (t735 < 1))), 1, 0)
-    t809 = casadi.if_else(t807, 1, t735)
-    t810 = (t808 > 0)
-    t811 = casadi.if_else(t810, t753, t737)
-    t812 = casadi.if_else(t810, t762, t738)
-    t813 = casadi.if_else(t810, t771, t739)
-    t814 = casadi.if_else(t810, t780, t740)
-    t815 = casadi.if_else(t810, t789, t741)
-    t816 = casadi.if_else(t810, t798, t742)
-    t817 = casadi.if_else(t810, q7, t743)
-    t818 = casadi.if_else(t810, t801, t744)
-    t819 = (t487 >= -2.8973)
-    t820 = casadi.logic_and((t481 >= -2.8973), (t481 <= 2.8973))
-    t821 = casadi.if_else(casadi.logic_and(t819, casadi.logic_not(t820)), -t487, t486)
-    t822 = t821
-    t823 = t822 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn1 - 0.15915494309189535*t822)
-    t824 = casadi.if_else((qn1 > t823), 6.283185307179586, -6.283185307179586)
-    t825 = t823 + t824
-    t826 = t823 - t824
-    t827 = casadi.if_else(casadi.logic_and((t823 >= -2.8973), (t823 <= 2.8973)), t823, casadi.if_else(casadi.logic_and((t825 >= -2.8973), (t825 <= 2.8973)), t825, casadi.if_else(casadi.logic_and((t826 >= -2.8973), (t826 <= 2.8973)), t826, t821)))
-    t828 = (t475 <= 1.7627999999999997)
-    t829 = casadi.logic_and((t474 >= -1.7627999999999997), (t474 <= 1.7627999999999997))
-    t830 = casadi.if_else(casadi.logic_and(t828, casadi.logic_not(t829)), t475, t474)
-    t831 = t830
-    t832 = t831 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t831)
-    t833 = casadi.if_else((qn2 > t832), 6.283185307179586, -6.283185307179586)
-    t834 = t832 + t833
-    t835 = t832 - t833
-    t836 = casadi.if_else(casadi.logic_and((t832 >= -1.7627999999999997), (t832 <= 1.7627999999999997)), t832, casadi.if_else(casadi.logic_and((t834 >= -1.7627999999999997), (t834 <= 1.7627999999999997)), t834, casadi.if_else(casadi.logic_and((t835 >= -1.7627999999999997), (t835 <= 1.7627999999999997)), t835, t830)))
-    t837 = (t485 >= -2.8973)
-    t838 = casadi.logic_and((t469 >= -2.8973), (t469 <= 2.8973))
-    t839 = casadi.if_else(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t24, t306), t582), t583), t584), t802), t803), t804), t805), casadi.logic_or(t819, t820)), casadi.logic_or(t828, t829)), casadi.logic_or(t837, t838)), 1, 0)
-    t840 = casadi.if_else(casadi.logic_and(t837, casadi.logic_not(t838)), -t485, t484)
-    t841 = t840
-    t842 = t841 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn3 - 0.15915494309189535*t841)
-    t843 = casadi.if_else((qn3 > t842), 6.283185307179586, -6.283185307179586)
-    t844 = t842 + t843
-    t845 = t842 - t843
-    t846 = casadi.if_else(casadi.logic_and((t842 >= -2.8973), (t842 <= 2.8973)), t842, casadi.if_else(casadi.logic_and((t844 >= -2.8973), (t844 <= 2.8973)), t844, casadi.if_else(casadi.logic_and((t845 >= -2.8973), (t845 <= 2.8973)), t845, t840)))
-    t847 = t800 + qw1*(t572 + t827)**2 + qw2*(t573 + t836)**2 + qw3*(t574 + t846)**2
-    t848 = (t839 > 0)
-    t849 = casadi.if_else(casadi.logic_and(t848, casadi.logic_or((t818 > t847), (t809 < 1))), 1, 0)
-    t850 = casadi.if_else(t848, 1, t809)
-    t851 = (t849 > 0)
-    t852 = casadi.if_else(t851, t827, t811)
-    t853 = casadi.if_else(t851, t836, t812)
-    t854 = casadi.if_else(t851, t846, t813)
-    t855 = casadi.if_else(t851, t780, t814)
-    t856 = casadi.if_else(t851, t789, t815)
-    t857 = casadi.if_else(t851, t798, t816)
-    t858 = casadi.if_else(t851, q7, t817)
-    t859 = casadi.if_else(t851, t847, t818)
-    t860 = (t513 >= -2.8973)
-    t861 = casadi.logic_and((t510 >= -2.8973), (t510 <= 2.8973))
-    t862 = casadi.if_else(casadi.logic_and(t860, casadi.logic_not(t861)), -t513, t512)
-    t863 = t862
-    t864 = t863 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn1 - 0.15915494309189535*t863)
-    t865 = casadi.if_else((qn1 > t864), 6.283185307179586, -6.283185307179586)
-    t866 = t864 + t865
-    t867 = t864 - t865
-    t868 = casadi.if_else(casadi.logic_and((t864 >= -2.8973), (t864 <= 2.8973)), t864, casadi.if_else(casadi.logic_and((t866 >= -2.8973), (t866 <= 2.8973)), t866, casadi.if_else(casadi.logic_and((t867 >= -2.8973), (t867 <= 2.8973)), t867, t862)))
-    t869 = (t507 >= -1.7627999999999997)
-    t870 = casadi.logic_and((t503 >= -1.7627999999999997), (t503 <= 1.7627999999999997))
-    t871 = casadi.if_else(casadi.logic_and(t869, casadi.logic_not(t870)), -t507, t506)
-    t872 = t871
-    t873 = t872 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t872)
-    t874 = casadi.if_else((qn2 > t873), 6.283185307179586, -6.283185307179586)
-    t875 = t873 + t874
-    t876 = t873 - t874
-    t877 = casadi.if_else(casadi.logic_and((t873 >= -1.7627999999999997), (t873 <= 1.7627999999999997)), t873, casadi.if_else(casadi.logic_and((t875 >= -1.7627999999999997), (t875 <= 1.7627999999999997)), t875, casadi.if_else(casadi.logic_and((t876 >= -1.7627999999999997), (t876 <= 1.7627999999999997)), t876, t871)))
-    t878 = (t501 >= -2.8973)
-    t879 = casadi.logic_and((t498 >= -2.8973), (t498 <= 2.8973))
-    t880 = casadi.if_else(casadi.logic_and(t878, casadi.logic_not(t879)), -t501, t500)
-    t881 = t880
-    t882 = t881 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn3 - 0.15915494309189535*t881)
-    t883 = casadi.if_else((qn3 > t882), 6.283185307179586, -6.283185307179586)
-    t884 = t882 + t883
-    t885 = t882 - t883
-    t886 = casadi.if_else(casadi.logic_and((t882 >= -2.8973), (t882 <= 2.8973)), t882, casadi.if_else(casadi.logic_and((t884 >= -2.8973), (t884 <= 2.8973)), t884, casadi.if_else(casadi.logic_and((t885 >= -2.8973), (t885 <= 2.8973)), t885, t880)))
-    t887 = (t495 >= -2.8973)
-    t888 = casadi.logic_and((t493 >= -2.8973), (t493 <= 2.8973))
-    t889 = casadi.if_else(casadi.logic_and(t887, casadi.logic_not(t888)), -t495, t494)
-    t890 = t889
-    t891 = t890 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn5 - 0.15915494309189535*t890)
-    t892 = casadi.if_else((qn5 > t891), 6.283185307179586, -6.283185307179586)
-    t893 = t891 + t892
-    t894 = t891 - t892
-    t895 = casadi.if_else(casadi.logic_and((t891 >= -2.8973), (t891 <= 2.8973)), t891, casadi.if_else(casadi.logic_and((t893 >= -2.8973), (t893 <= 2.8973)), t893, casadi.if_else(casadi.logic_and((t894 >= -2.8973), (t894 <= 2.8973)), t894, t889)))
-    t896 = (t491 >= -3.7525000000000004)
-    t897 = casadi.logic_and((t489 >= -3.7525000000000004), (t489 <= 0.0175))
-    t898 = casadi.if_else(casadi.logic_and(t896, casadi.logic_not(t897)), -t491, t490)
-    t899 = t898
-    t900 = t899 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn6 - 0.15915494309189535*t899)
-    t901 = casadi.if_else((qn6 > t900), 6.283185307179586, -6.283185307179586)
-    t902 = t900 + t901
-    t903 = t900 - t901
-    t904 = casadi.if_else(casadi.logic_and((t900 >= -0.0175), (t900 <= 3.7525000000000004)), t900, casadi.if_else(casadi.logic_and((t902 >= -0.0175), (t902 <= 3.7525000000000004)), t902, casadi.if_else(casadi.logic_and((t903 >= -0.0175), (t903 <= 3.7525000000000004)), t903, t898)))
-    t905 = t799 + qw5*(t575 + t895)**2 + qw6*(t576 + t904)**2
-    t906 = t905 + qw1*(t572 + t868)**2 + qw2*(t573 + t877)**2 + qw3*(t574 + t886)**2
-    t907 = casadi.logic_or(t896, t897)
-    t908 = casadi.logic_or(t887, t888)
-    t909 = casadi.if_else(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t228, t24), t582), t583), t584), t805), t907), t908), (t360 >= -1e-12)), casadi.logic_or(t860, t861)), casadi.logic_or(t869, t870)), casadi.logic_or(t878, t879)), 1, 0)
-    t910 = (t909 > 0)
-    t911 = casadi.if_else(casadi.logic_and(t910, casadi.logic_or((t859 > t906), (t850 < 1))), 1, 0)
-    t912 = casadi.if_else(t910, 1, t850)
-    t913 = (t911 > 0)
-    t914 = casadi.if_else(t913, t868, t852)
-    t915 = casadi.if_else(t913, t877, t853)
-    t916 = casadi.if_else(t913, t886, t854)
-    t917 = casadi.if_else(t913, t780, t855)
-    t918 = casadi.if_else(t913, t895, t856)
-    t919 = casadi.if_else(t913, t904, t857)
-    t920 = casadi.if_else(t913, q7, t858)
-    t921 = casadi.if_else(t913, t906, t859)
-    t922 = (t517 >= -2.8973)
-    t923 = casadi.logic_and((t511 >= -2.8973), (t511 <= 2.8973))
-    t924 = casadi.if_else(casadi.logic_and(t922, casadi.logic_not(t923)), -t517, t516)
-    t925 = t924
-    t926 = t925 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn1 - 0.15915494309189535*t925)
-    t927 = casadi.if_else((qn1 > t926), 6.283185307179586, -6.283185307179586)
-    t928 = t926 + t927
-    t929 = t926 - t927
-    t930 = casadi.if_else(casadi.logic_and((t926 >= -2.8973), (t926 <= 2.8973)), t926, casadi.if_else(casadi.logic_and((t928 >= -2.8973), (t928 <= 2.8973)), t928, casadi.if_else(casadi.logic_and((t929 >= -2.8973), (t929 <= 2.8973)), t929, t924)))
-    t931 = (t505 <= 1.7627999999999997)
-    t932 = casadi.logic_and((t504 >= -1.7627999999999997), (t504 <= 1.7627999999999997))
-    t933 = casadi.if_else(casadi.logic_and(t931, casadi.logic_not(t932)), t505, t504)
-    t934 = t933
-    t935 = t934 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t934)
-    t936 = casadi.if_else((qn2 > t935), 6.283185307179586, -6.283185307179586)
-    t937 = t935 + t936
-    t938 = t935 - t936
-    t939 = casadi.if_else(casadi.logic_and((t935 >= -1.7627999999999997), (t935 <= 1.7627999999999997)), t935, casadi.if_else(casadi.logic_and((t937 >= -1.7627999999999997), (t937 <= 1.7627999999999997)), t937, casadi.if_else(casadi.logic_and((t938 >= -1.7627999999999997), (t938 <= 1.7627999999999997)), t938, t933)))
-    t940 = (t515 >= -2.8973)
-    t941 = casadi.logic_and((t499 >= -2.8973), (t499 <= 2.8973))
-    t942 = casadi.if_else(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t228, t24), t361), t582), t583), t584), t805), t907), t908), casadi.logic_or(t922, t923)), casadi.logic_or(t931, t932)), casadi.logic_or(t940, t941)), 1, 0)
-    t943 = casadi.if_else(casadi.logic_and(t940, casadi.logic_not(t941)), -t515, t514)
-    t944 = t943
-    t945 = t944 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn3 - 0.15915494309189535*t944)
-    t946 = casadi.if_else((qn3 > t945), 6.283185307179586, -6.283185307179586)
-    t947 = t945 + t946
-    t948 = t945 - t946
-    t949 = casadi.if_else(casadi.logic_and((t945 >= -2.8973), (t945 <= 2.8973)), t945, casadi.if_else(casadi.logic_and((t947 >= -2.8973), (t947 <= 2.8973)), t947, casadi.if_else(casadi.logic_and((t948 >= -2.8973), (t948 <= 2.8973)), t948, t943)))
-    t950 = t905 + qw1*(t572 + t930)**2 + qw2*(t573 + t939)**2 + qw3*(t574 + t949)**2
-    t951 = (t942 > 0)
-    t952 = casadi.if_else(casadi.logic_and(t951, casadi.logic_or((t921 > t950), (t912 < 1))), 1, 0)
-    t953 = casadi.if_else(t951, 1, t912)
-    t954 = (t952 > 0)
-    t955 = casadi.if_else(t954, t930, t914)
-    t956 = casadi.if_else(t954, t939, t915)
-    t957 = casadi.if_else(t954, t949, t916)
-    t958 = casadi.if_else(t954, t780, t917)
-    t959 = casadi.if_else(t954, t895, t918)
-    t960 = casadi.if_else(t954, t904, t919)
-    t961 = casadi.if_else(t954, q7, t920)
-    t962 = (casadi.fabs(t393) < casadi.inf)
-    t963 = (t953 > 0)
-    t964 = casadi.logic_and(t962, t963)
+    qb0_0 = branches_q[0, 0]
+    qb0_1 = branches_q[0, 1]
+    qb0_2 = branches_q[0, 2]
+    qb0_3 = branches_q[0, 3]
+    qb0_4 = branches_q[0, 4]
+    qb0_5 = branches_q[0, 5]
+    qb0_6 = branches_q[0, 6]
+    qb1_0 = branches_q[1, 0]
+    qb1_1 = branches_q[1, 1]
+    qb1_2 = branches_q[1, 2]
+    qb1_3 = branches_q[1, 3]
+    qb1_4 = branches_q[1, 4]
+    qb1_5 = branches_q[1, 5]
+    qb1_6 = branches_q[1, 6]
+    qb2_0 = branches_q[2, 0]
+    qb2_1 = branches_q[2, 1]
+    qb2_2 = branches_q[2, 2]
+    qb2_3 = branches_q[2, 3]
+    qb2_4 = branches_q[2, 4]
+    qb2_5 = branches_q[2, 5]
+    qb2_6 = branches_q[2, 6]
+    qb3_0 = branches_q[3, 0]
+    qb3_1 = branches_q[3, 1]
+    qb3_2 = branches_q[3, 2]
+    qb3_3 = branches_q[3, 3]
+    qb3_4 = branches_q[3, 4]
+    qb3_5 = branches_q[3, 5]
+    qb3_6 = branches_q[3, 6]
+    qb4_0 = branches_q[4, 0]
+    qb4_1 = branches_q[4, 1]
+    qb4_2 = branches_q[4, 2]
+    qb4_3 = branches_q[4, 3]
+    qb4_4 = branches_q[4, 4]
+    qb4_5 = branches_q[4, 5]
+    qb4_6 = branches_q[4, 6]
+    qb5_0 = branches_q[5, 0]
+    qb5_1 = branches_q[5, 1]
+    qb5_2 = branches_q[5, 2]
+    qb5_3 = branches_q[5, 3]
+    qb5_4 = branches_q[5, 4]
+    qb5_5 = branches_q[5, 5]
+    qb5_6 = branches_q[5, 6]
+    qb6_0 = branches_q[6, 0]
+    qb6_1 = branches_q[6, 1]
+    qb6_2 = branches_q[6, 2]
+    qb6_3 = branches_q[6, 3]
+    qb6_4 = branches_q[6, 4]
+    qb6_5 = branches_q[6, 5]
+    qb6_6 = branches_q[6, 6]
+    qb7_0 = branches_q[7, 0]
+    qb7_1 = branches_q[7, 1]
+    qb7_2 = branches_q[7, 2]
+    qb7_3 = branches_q[7, 3]
+    qb7_4 = branches_q[7, 4]
+    qb7_5 = branches_q[7, 5]
+    qb7_6 = branches_q[7, 6]
+    vb0 = branches_valid[0]
+    vb1 = branches_valid[1]
+    vb2 = branches_valid[2]
+    vb3 = branches_valid[3]
+    vb4 = branches_valid[4]
+    vb5 = branches_valid[5]
+    vb6 = branches_valid[6]
+    vb7 = branches_valid[7]
+    lb0 = branches_in_limits[0]
+    lb1 = branches_in_limits[1]
+    lb2 = branches_in_limits[2]
+    lb3 = branches_in_limits[3]
+    lb4 = branches_in_limits[4]
+    lb5 = branches_in_limits[5]
+    lb6 = branches_in_limits[6]
+    lb7 = branches_in_limits[7]
+    t0 = qb0_0 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn1 - qb0_0))
+    t1 = qb0_1 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn2 - qb0_1))
+    t2 = qb0_2 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn3 - qb0_2))
+    t3 = qb0_3 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn4 - qb0_3))
+    t4 = qb0_4 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn5 - qb0_4))
+    t5 = qb0_5 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn6 - qb0_5))
+    t6 = casadi.if_else(casadi.logic_and(lb0, vb0), 1, 0)
+    t7 = casadi.if_else((t6 > 0), 1, 0)
+    t8 = qb1_0 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn1 - qb1_0))
+    t9 = qb1_1 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn2 - qb1_1))
+    t10 = qb1_2 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn3 - qb1_2))
+    t11 = qb1_3 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn4 - qb1_3))
+    t12 = qb1_4 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn5 - qb1_4))
+    t13 = qb1_5 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn6 - qb1_5))
+    t14 = casadi.if_else(casadi.logic_and(lb1, vb1), 1, 0)
+    t15 = qb2_0 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn1 - qb2_0))
+    t16 = qb2_1 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn2 - qb2_1))
+    t17 = qb2_2 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn3 - qb2_2))
+    t18 = qb2_3 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn4 - qb2_3))
+    t19 = qb2_4 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn5 - qb2_4))
+    t20 = qb2_5 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn6 - qb2_5))
+    t21 = casadi.if_else(casadi.logic_and(lb2, vb2), 1, 0)
+    t22 = qb3_0 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn1 - qb3_0))
+    t23 = qb3_1 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn2 - qb3_1))
+    t24 = qb3_2 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn3 - qb3_2))
+    t25 = qb3_3 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn4 - qb3_3))
+    t26 = qb3_4 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn5 - qb3_4))
+    t27 = qb3_5 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn6 - qb3_5))
+    t28 = casadi.if_else(casadi.logic_and(lb3, vb3), 1, 0)
+    t29 = qb4_0 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn1 - qb4_0))
+    t30 = qb4_1 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn2 - qb4_1))
+    t31 = qb4_2 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn3 - qb4_2))
+    t32 = qb4_3 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn4 - qb4_3))
+    t33 = qb4_4 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn5 - qb4_4))
+    t34 = qb4_5 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn6 - qb4_5))
+    t35 = casadi.if_else(casadi.logic_and(lb4, vb4), 1, 0)
+    t36 = qb5_0 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn1 - qb5_0))
+    t37 = qb5_1 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn2 - qb5_1))
+    t38 = qb5_2 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn3 - qb5_2))
+    t39 = qb5_3 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn4 - qb5_3))
+    t40 = qb5_4 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn5 - qb5_4))
+    t41 = qb5_5 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn6 - qb5_5))
+    t42 = casadi.if_else(casadi.logic_and(lb5, vb5), 1, 0)
+    t43 = qb6_0 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn1 - qb6_0))
+    t44 = qb6_1 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn2 - qb6_1))
+    t45 = qb6_2 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn3 - qb6_2))
+    t46 = qb6_3 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn4 - qb6_3))
+    t47 = qb6_4 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn5 - qb6_4))
+    t48 = qb6_5 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn6 - qb6_5))
+    t49 = casadi.if_else(casadi.logic_and(lb6, vb6), 1, 0)
+    t50 = qb7_0 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn1 - qb7_0))
+    t51 = qb7_1 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn2 - qb7_1))
+    t52 = qb7_2 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn3 - qb7_2))
+    t53 = qb7_3 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn4 - qb7_3))
+    t54 = qb7_4 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn5 - qb7_4))
+    t55 = qb7_5 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn6 - qb7_5))
+    t56 = casadi.if_else(casadi.logic_and(lb7, vb7), 1, 0)
+    t57 = T00 + T01 + T02 + T03 + T10 + T11 + T12 + T13 + T20 + T21 + T22 + T23 + qn1 + qn2 + qn3 + qn4 + qn5 + qn6 + qn7 + qw1 + qw2 + qw3 + qw4 + qw5 + qw6 + qw7
+    t58 = casadi.if_else((qn1 > t0), 6.283185307179586, -6.283185307179586)
+    t59 = t0 + t58
+    t60 = t0 - t58
+    t61 = casadi.if_else(casadi.logic_and((t0 >= -2.8973), (t0 <= 2.8973)), t0, casadi.if_else(casadi.logic_and((t59 >= -2.8973), (t59 <= 2.8973)), t59, casadi.if_else(casadi.logic_and((t60 >= -2.8973), (t60 <= 2.8973)), t60, qb0_0)))
+    t62 = casadi.if_else((qn2 > t1), 6.283185307179586, -6.283185307179586)
+    t63 = t1 + t62
+    t64 = t1 - t62
+    t65 = casadi.if_else(casadi.logic_and((t1 >= -1.7627999999999997), (t1 <= 1.7627999999999997)), t1, casadi.if_else(casadi.logic_and((t63 >= -1.7627999999999997), (t63 <= 1.7627999999999997)), t63, casadi.if_else(casadi.logic_and((t64 >= -1.7627999999999997), (t64 <= 1.7627999999999997)), t64, qb0_1)))
+    t66 = casadi.if_else((qn3 > t2), 6.283185307179586, -6.283185307179586)
+    t67 = t2 + t66
+    t68 = t2 - t66
+    t69 = casadi.if_else(casadi.logic_and((t2 >= -2.8973), (t2 <= 2.8973)), t2, casadi.if_else(casadi.logic_and((t67 >= -2.8973), (t67 <= 2.8973)), t67, casadi.if_else(casadi.logic_and((t68 >= -2.8973), (t68 <= 2.8973)), t68, qb0_2)))
+    t70 = casadi.if_else((qn4 > t3), 6.283185307179586, -6.283185307179586)
+    t71 = t3 + t70
+    t72 = t3 - t70
+    t73 = casadi.if_else(casadi.logic_and((t3 >= -3.0718), (t3 <= -0.0698)), t3, casadi.if_else(casadi.logic_and((t71 >= -3.0718), (t71 <= -0.0698)), t71, casadi.if_else(casadi.logic_and((t72 >= -3.0718), (t72 <= -0.0698)), t72, qb0_3)))
+    t74 = casadi.if_else((qn5 > t4), 6.283185307179586, -6.283185307179586)
+    t75 = t4 + t74
+    t76 = t4 - t74
+    t77 = casadi.if_else(casadi.logic_and((t4 >= -2.8973), (t4 <= 2.8973)), t4, casadi.if_else(casadi.logic_and((t75 >= -2.8973), (t75 <= 2.8973)), t75, casadi.if_else(casadi.logic_and((t76 >= -2.8973), (t76 <= 2.8973)), t76, qb0_4)))
+    t78 = casadi.if_else((qn6 > t5), 6.283185307179586, -6.283185307179586)
+    t79 = t5 + t78
+    t80 = t5 - t78
+    t81 = casadi.if_else(casadi.logic_and((t5 >= -0.0175), (t5 <= 3.7525000000000004)), t5, casadi.if_else(casadi.logic_and((t79 >= -0.0175), (t79 <= 3.7525000000000004)), t79, casadi.if_else(casadi.logic_and((t80 >= -0.0175), (t80 <= 3.7525000000000004)), t80, qb0_5)))
+    t82 = -qn1
+    t83 = -qn2
+    t84 = -qn3
+    t85 = -qn4
+    t86 = -qn5
+    t87 = -qn6
+    t88 = -qn7
+    t89 = qw1*(t61 + t82)**2 + qw2*(t65 + t83)**2 + qw3*(t69 + t84)**2 + qw4*(t73 + t85)**2 + qw5*(t77 + t86)**2 + qw6*(t81 + t87)**2 + qw7*(qb0_6 + t88)**2
+    t90 = (t7 > 0)
+    t91 = casadi.if_else(t90, t61, qn1)
+    t92 = casadi.if_else(t90, t65, qn2)
+    t93 = casadi.if_else(t90, t69, qn3)
+    t94 = casadi.if_else(t90, t73, qn4)
+    t95 = casadi.if_else(t90, t77, qn5)
+    t96 = casadi.if_else(t90, t81, qn6)
+    t97 = casadi.if_else(t90, qb0_6, qn7)
+    t98 = casadi.if_else(t90, t89, 0)
+    t99 = casadi.if_else((qn1 > t8), 6.283185307179586, -6.283185307179586)
+    t100 = t8 + t99
+    t101 = t8 - t99
+    t102 = casadi.if_else(casadi.logic_and((t8 >= -2.8973), (t8 <= 2.8973)), t8, casadi.if_else(casadi.logic_and((t100 >= -2.8973), (t100 <= 2.8973)), t100, casadi.if_else(casadi.logic_and((t101 >= -2.8973), (t101 <= 2.8973)), t101, qb1_0)))
+    t103 = casadi.if_else((qn2 > t9), 6.283185307179586, -6.283185307179586)
+    t104 = t103 + t9
+    t105 = t9 - t103
+    t106 = casadi.if_else(casadi.logic_and((t9 >= -1.7627999999999997), (t9 <= 1.7627999999999997)), t9, casadi.if_else(casadi.logic_and((t104 >= -1.7627999999999997), (t104 <= 1.7627999999999997)), t104, casadi.if_else(casadi.logic_and((t105 >= -1.7627999999999997), (t105 <= 1.7627999999999997)), t105, qb1_1)))
+    t107 = casadi.if_else((qn3 > t10), 6.283185307179586, -6.283185307179586)
+    t108 = t10 + t107
+    t109 = t10 - t107
+    t110 = casadi.if_else(casadi.logic_and((t10 >= -2.8973), (t10 <= 2.8973)), t10, casadi.if_else(casadi.logic_and((t108 >= -2.8973), (t108 <= 2.8973)), t108, casadi.if_else(casadi.logic_and((t109 >= -2.8973), (t109 <= 2.8973)), t109, qb1_2)))
+    t111 = casadi.if_else((qn4 > t11), 6.283185307179586, -6.283185307179586)
+    t112 = t11 + t111
+    t113 = t11 - t111
+    t114 = casadi.if_else(casadi.logic_and((t11 >= -3.0718), (t11 <= -0.0698)), t11, casadi.if_else(casadi.logic_and((t112 >= -3.0718), (t112 <= -0.0698)), t112, casadi.if_else(casadi.logic_and((t113 >= -3.0718), (t113 <= -0.0698)), t113, qb1_3)))
+    t115 = casadi.if_else((qn5 > t12), 6.283185307179586, -6.283185307179586)
+    t116 = t115 + t12
+    t117 = t12 - t115
+    t118 = casadi.if_else(casadi.logic_and((t12 >= -2.8973), (t12 <= 2.8973)), t12, casadi.if_else(casadi.logic_and((t116 >= -2.8973), (t116 <= 2.8973)), t116, casadi.if_else(casadi.logic_and((t117 >= -2.8973), (t117 <= 2.8973)), t117, qb1_4)))
+    t119 = casadi.if_else((qn6 > t13), 6.283185307179586, -6.283185307179586)
+    t120 = t119 + t13
+    t121 = t13 - t119
+    t122 = casadi.if_else(casadi.logic_and((t13 >= -0.0175), (t13 <= 3.7525000000000004)), t13, casadi.if_else(casadi.logic_and((t120 >= -0.0175), (t120 <= 3.7525000000000004)), t120, casadi.if_else(casadi.logic_and((t121 >= -0.0175), (t121 <= 3.7525000000000004)), t121, qb1_5)))
+    t123 = qw1*(t102 + t82)**2 + qw2*(t106 + t83)**2 + qw3*(t110 + t84)**2 + qw4*(t114 + t85)**2 + qw5*(t118 + t86)**2 + qw6*(t122 + t87)**2 + qw7*(qb1_6 + t88)**2
+    t124 = (t14 > 0)
+    t125 = casadi.if_else(casadi.logic_and(t124, casadi.logic_or((t123 < t98), (t7 < 1))), 1, 0)
+    t126 = casadi.if_else(t124, 1, t7)
+    t127 = (t125 > 0)
+    t128 = casadi.if_else(t127, t102, t91)
+    t129 = casadi.if_else(t127, t106, t92)
+    t130 = casadi.if_else(t127, t110, t93)
+    t131 = casadi.if_else(t127, t114, t94)
+    t132 = casadi.if_else(t127, t118, t95)
+    t133 = casadi.if_else(t127, t122, t96)
+    t134 = casadi.if_else(t127, qb1_6, t97)
+    t135 = casadi.if_else(t127, t123, t98)
+    t136 = casadi.if_else((qn1 > t15), 6.283185307179586, -6.283185307179586)
+    t137 = t136 + t15
+    t138 = t15 - t136
+    t139 = casadi.if_else(casadi.logic_and((t15 >= -2.8973), (t15 <= 2.8973)), t15, casadi.if_else(casadi.logic_and((t137 >= -2.8973), (t137 <= 2.8973)), t137, casadi.if_else(casadi.logic_and((t138 >= -2.8973), (t138 <= 2.8973)), t138, qb2_0)))
+    t140 = casadi.if_else((qn2 > t16), 6.283185307179586, -6.283185307179586)
+    t141 = t140 + t16
+    t142 = t16 - t140
+    t143 = casadi.if_else(casadi.logic_and((t16 >= -1.7627999999999997), (t16 <= 1.7627999999999997)), t16, casadi.if_else(casadi.logic_and((t141 >= -1.7627999999999997), (t141 <= 1.7627999999999997)), t141, casadi.if_else(casadi.logic_and((t142 >= -1.7627999999999997), (t142 <= 1.7627999999999997)), t142, qb2_1)))
+    t144 = casadi.if_else((qn3 > t17), 6.283185307179586, -6.283185307179586)
+    t145 = t144 + t17
+    t146 = t17 - t144
+    t147 = casadi.if_else(casadi.logic_and((t17 >= -2.8973), (t17 <= 2.8973)), t17, casadi.if_else(casadi.logic_and((t145 >= -2.8973), (t145 <= 2.8973)), t145, casadi.if_else(casadi.logic_and((t146 >= -2.8973), (t146 <= 2.8973)), t146, qb2_2)))
+    t148 = casadi.if_else((qn4 > t18), 6.283185307179586, -6.283185307179586)
+    t149 = t148 + t18
+    t150 = t18 - t148
+    t151 = casadi.if_else(casadi.logic_and((t18 >= -3.0718), (t18 <= -0.0698)), t18, casadi.if_else(casadi.logic_and((t149 >= -3.0718), (t149 <= -0.0698)), t149, casadi.if_else(casadi.logic_and((t150 >= -3.0718), (t150 <= -0.0698)), t150, qb2_3)))
+    t152 = casadi.if_else((qn5 > t19), 6.283185307179586, -6.283185307179586)
+    t153 = t152 + t19
+    t154 = t19 - t152
+    t155 = casadi.if_else(casadi.logic_and((t19 >= -2.8973), (t19 <= 2.8973)), t19, casadi.if_else(casadi.logic_and((t153 >= -2.8973), (t153 <= 2.8973)), t153, casadi.if_else(casadi.logic_and((t154 >= -2.8973), (t154 <= 2.8973)), t154, qb2_4)))
+    t156 = casadi.if_else((qn6 > t20), 6.283185307179586, -6.283185307179586)
+    t157 = t156 + t20
+    t158 = t20 - t156
+    t159 = casadi.if_else(casadi.logic_and((t20 >= -0.0175), (t20 <= 3.7525000000000004)), t20, casadi.if_else(casadi.logic_and((t157 >= -0.0175), (t157 <= 3.7525000000000004)), t157, casadi.if_else(casadi.logic_and((t158 >= -0.0175), (t158 <= 3.7525000000000004)), t158, qb2_5)))
+    t160 = qw1*(t139 + t82)**2 + qw2*(t143 + t83)**2 + qw3*(t147 + t84)**2 + qw4*(t151 + t85)**2 + qw5*(t155 + t86)**2 + qw6*(t159 + t87)**2 + qw7*(qb2_6 + t88)**2
+    t161 = (t21 > 0)
+    t162 = casadi.if_else(casadi.logic_and(t161, casadi.logic_or((t135 > t160), (t126 < 1))), 1, 0)
+    t163 = casadi.if_else(t161, 1, t126)
+    t164 = (t162 > 0)
+    t165 = casadi.if_else(t164, t139, t128)
+    t166 = casadi.if_else(t164, t143, t129)
+    t167 = casadi.if_else(t164, t147, t130)
+    t168 = casadi.if_else(t164, t151, t131)
+    t169 = casadi.if_else(t164, t155, t132)
+    t170 = casadi.if_else(t164, t159, t133)
+    t171 = casadi.if_else(t164, qb2_6, t134)
+    t172 = casadi.if_else(t164, t160, t135)
+    t173 = casadi.if_else((qn1 > t22), 6.283185307179586, -6.283185307179586)
+    t174 = t173 + t22
+    t175 = t22 - t173
+    t176 = casadi.if_else(casadi.logic_and((t22 >= -2.8973), (t22 <= 2.8973)), t22, casadi.if_else(casadi.logic_and((t174 >= -2.8973), (t174 <= 2.8973)), t174, casadi.if_else(casadi.logic_and((t175 >= -2.8973), (t175 <= 2.8973)), t175, qb3_0)))
+    t177 = casadi.if_else((qn2 > t23), 6.283185307179586, -6.283185307179586)
+    t178 = t177 + t23
+    t179 = t23 - t177
+    t180 = casadi.if_else(casadi.logic_and((t23 >= -1.7627999999999997), (t23 <= 1.7627999999999997)), t23, casadi.if_else(casadi.logic_and((t178 >= -1.7627999999999997), (t178 <= 1.7627999999999997)), t178, casadi.if_else(casadi.logic_and((t179 >= -1.7627999999999997), (t179 <= 1.7627999999999997)), t179, qb3_1)))
+    t181 = casadi.if_else((qn3 > t24), 6.283185307179586, -6.283185307179586)
+    t182 = t181 + t24
+    t183 = t24 - t181
+    t184 = casadi.if_else(casadi.logic_and((t24 >= -2.8973), (t24 <= 2.8973)), t24, casadi.if_else(casadi.logic_and((t182 >= -2.8973), (t182 <= 2.8973)), t182, casadi.if_else(casadi.logic_and((t183 >= -2.8973), (t183 <= 2.8973)), t183, qb3_2)))
+    t185 = casadi.if_else((qn4 > t25), 6.283185307179586, -6.283185307179586)
+    t186 = t185 + t25
+    t187 = t25 - t185
+    t188 = casadi.if_else(casadi.logic_and((t25 >= -3.0718), (t25 <= -0.0698)), t25, casadi.if_else(casadi.logic_and((t186 >= -3.0718), (t186 <= -0.0698)), t186, casadi.if_else(casadi.logic_and((t187 >= -3.0718), (t187 <= -0.0698)), t187, qb3_3)))
+    t189 = casadi.if_else((qn5 > t26), 6.283185307179586, -6.283185307179586)
+    t190 = t189 + t26
+    t191 = t26 - t189
+    t192 = casadi.if_else(casadi.logic_and((t26 >= -2.8973), (t26 <= 2.8973)), t26, casadi.if_else(casadi.logic_and((t190 >= -2.8973), (t190 <= 2.8973)), t190, casadi.if_else(casadi.logic_and((t191 >= -2.8973), (t191 <= 2.8973)), t191, qb3_4)))
+    t193 = casadi.if_else((qn6 > t27), 6.283185307179586, -6.283185307179586)
+    t194 = t193 + t27
+    t195 = t27 - t193
+    t196 = casadi.if_else(casadi.logic_and((t27 >= -0.0175), (t27 <= 3.7525000000000004)), t27, casadi.if_else(casadi.logic_and((t194 >= -0.0175), (t194 <= 3.7525000000000004)), t194, casadi.if_else(casadi.logic_and((t195 >= -0.0175), (t195 <= 3.7525000000000004)), t195, qb3_5)))
+    t197 = qw1*(t176 + t82)**2 + qw2*(t180 + t83)**2 + qw3*(t184 + t84)**2 + qw4*(t188 + t85)**2 + qw5*(t192 + t86)**2 + qw6*(t196 + t87)**2 + qw7*(qb3_6 + t88)**2
+    t198 = (t28 > 0)
+    t199 = casadi.if_else(casadi.logic_and(t198, casadi.logic_or((t172 > t197), (t163 < 1))), 1, 0)
+    t200 = casadi.if_else(t198, 1, t163)
+    t201 = (t199 > 0)
+    t202 = casadi.if_else(t201, t176, t165)
+    t203 = casadi.if_else(t201, t180, t166)
+    t204 = casadi.if_else(t201, t184, t167)
+    t205 = casadi.if_else(t201, t188, t168)
+    t206 = casadi.if_else(t201, t192, t169)
+    t207 = casadi.if_else(t201, t196, t170)
+    t208 = casadi.if_else(t201, qb3_6, t171)
+    t209 = casadi.if_else(t201, t197, t172)
+    t210 = casadi.if_else((qn1 > t29), 6.283185307179586, -6.283185307179586)
+    t211 = t210 + t29
+    t212 = t29 - t210
+    t213 = casadi.if_else(casadi.logic_and((t29 >= -2.8973), (t29 <= 2.8973)), t29, casadi.if_else(casadi.logic_and((t211 >= -2.8973), (t211 <= 2.8973)), t211, casadi.if_else(casadi.logic_and((t212 >= -2.8973), (t212 <= 2.8973)), t212, qb4_0)))
+    t214 = casadi.if_else((qn2 > t30), 6.283185307179586, -6.283185307179586)
+    t215 = t214 + t30
+    t216 = t30 - t214
+    t217 = casadi.if_else(casadi.logic_and((t30 >= -1.7627999999999997), (t30 <= 1.7627999999999997)), t30, casadi.if_else(casadi.logic_and((t215 >= -1.7627999999999997), (t215 <= 1.7627999999999997)), t215, casadi.if_else(casadi.logic_and((t216 >= -1.7627999999999997), (t216 <= 1.7627999999999997)), t216, qb4_1)))
+    t218 = casadi.if_else((qn3 > t31), 6.283185307179586, -6.283185307179586)
+    t219 = t218 + t31
+    t220 = t31 - t218
+    t221 = casadi.if_else(casadi.logic_and((t31 >= -2.8973), (t31 <= 2.8973)), t31, casadi.if_else(casadi.logic_and((t219 >= -2.8973), (t219 <= 2.8973)), t219, casadi.if_else(casadi.logic_and((t220 >= -2.8973), (t220 <= 2.8973)), t220, qb4_2)))
+    t222 = casadi.if_else((qn4 > t32), 6.283185307179586, -6.283185307179586)
+    t223 = t222 + t32
+    t224 = t32 - t222
+    t225 = casadi.if_else(casadi.logic_and((t32 >= -3.0718), (t32 <= -0.0698)), t32, casadi.if_else(casadi.logic_and((t223 >= -3.0718), (t223 <= -0.0698)), t223, casadi.if_else(casadi.logic_and((t224 >= -3.0718), (t224 <= -0.0698)), t224, qb4_3)))
+    t226 = casadi.if_else((qn5 > t33), 6.283185307179586, -6.283185307179586)
+    t227 = t226 + t33
+    t228 = t33 - t226
+    t229 = casadi.if_else(casadi.logic_and((t33 >= -2.8973), (t33 <= 2.8973)), t33, casadi.if_else(casadi.logic_and((t227 >= -2.8973), (t227 <= 2.8973)), t227, casadi.if_else(casadi.logic_and((t228 >= -2.8973), (t228 <= 2.8973)), t228, qb4_4)))
+    t230 = casadi.if_else((qn6 > t34), 6.283185307179586, -6.283185307179586)
+    t231 = t230 + t34
+    t232 = t34 - t230
+    t233 = casadi.if_else(casadi.logic_and((t34 >= -0.0175), (t34 <= 3.7525000000000004)), t34, casadi.if_else(casadi.logic_and((t231 >= -0.0175), (t231 <= 3.7525000000000004)), t231, casadi.if_else(casadi.logic_and((t232 >= -0.0175), (t232 <= 3.7525000000000004)), t232, qb4_5)))
+    t234 = qw1*(t213 + t82)**2 + qw2*(t217 + t83)**2 + qw3*(t221 + t84)**2 + qw4*(t225 + t85)**2 + qw5*(t229 + t86)**2 + qw6*(t233 + t87)**2 + qw7*(qb4_6 + t88)**2
+    t235 = (t35 > 0)
+    t236 = casadi.if_else(casadi.logic_and(t235, casadi.logic_or((t209 > t234), (t200 < 1))), 1, 0)
+    t237 = casadi.if_else(t235, 1, t200)
+    t238 = (t236 > 0)
+    t239 = casadi.if_else(t238, t213, t202)
+    t240 = casadi.if_else(t238, t217, t203)
+    t241 = casadi.if_else(t238, t221, t204)
+    t242 = casadi.if_else(t238, t225, t205)
+    t243 = casadi.if_else(t238, t229, t206)
+    t244 = casadi.if_else(t238, t233, t207)
+    t245 = casadi.if_else(t238, qb4_6, t208)
+    t246 = casadi.if_else(t238, t234, t209)
+    t247 = casadi.if_else((qn1 > t36), 6.283185307179586, -6.283185307179586)
+    t248 = t247 + t36
+    t249 = t36 - t247
+    t250 = casadi.if_else(casadi.logic_and((t36 >= -2.8973), (t36 <= 2.8973)), t36, casadi.if_else(casadi.logic_and((t248 >= -2.8973), (t248 <= 2.8973)), t248, casadi.if_else(casadi.logic_and((t249 >= -2.8973), (t249 <= 2.8973)), t249, qb5_0)))
+    t251 = casadi.if_else((qn2 > t37), 6.283185307179586, -6.283185307179586)
+    t252 = t251 + t37
+    t253 = t37 - t251
+    t254 = casadi.if_else(casadi.logic_and((t37 >= -1.7627999999999997), (t37 <= 1.7627999999999997)), t37, casadi.if_else(casadi.logic_and((t252 >= -1.7627999999999997), (t252 <= 1.7627999999999997)), t252, casadi.if_else(casadi.logic_and((t253 >= -1.7627999999999997), (t253 <= 1.7627999999999997)), t253, qb5_1)))
+    t255 = casadi.if_else((qn3 > t38), 6.283185307179586, -6.283185307179586)
+    t256 = t255 + t38
+    t257 = t38 - t255
+    t258 = casadi.if_else(casadi.logic_and((t38 >= -2.8973), (t38 <= 2.8973)), t38, casadi.if_else(casadi.logic_and((t256 >= -2.8973), (t256 <= 2.8973)), t256, casadi.if_else(casadi.logic_and((t257 >= -2.8973), (t257 <= 2.8973)), t257, qb5_2)))
+    t259 = casadi.if_else((qn4 > t39), 6.283185307179586, -6.283185307179586)
+    t260 = t259 + t39
+    t261 = t39 - t259
+    t262 = casadi.if_else(casadi.logic_and((t39 >= -3.0718), (t39 <= -0.0698)), t39, casadi.if_else(casadi.logic_and((t260 >= -3.0718), (t260 <= -0.0698)), t260, casadi.if_else(casadi.logic_and((t261 >= -3.0718), (t261 <= -0.0698)), t261, qb5_3)))
+    t263 = casadi.if_else((qn5 > t40), 6.283185307179586, -6.283185307179586)
+    t264 = t263 + t40
+    t265 = t40 - t263
+    t266 = casadi.if_else(casadi.logic_and((t40 >= -2.8973), (t40 <= 2.8973)), t40, casadi.if_else(casadi.logic_and((t264 >= -2.8973), (t264 <= 2.8973)), t264, casadi.if_else(casadi.logic_and((t265 >= -2.8973), (t265 <= 2.8973)), t265, qb5_4)))
+    t267 = casadi.if_else((qn6 > t41), 6.283185307179586, -6.283185307179586)
+    t268 = t267 + t41
+    t269 = t41 - t267
+    t270 = casadi.if_else(casadi.logic_and((t41 >= -0.0175), (t41 <= 3.7525000000000004)), t41, casadi.if_else(casadi.logic_and((t268 >= -0.0175), (t268 <= 3.7525000000000004)), t268, casadi.if_else(casadi.logic_and((t269 >= -0.0175), (t269 <= 3.7525000000000004)), t269, qb5_5)))
+    t271 = qw1*(t250 + t82)**2 + qw2*(t254 + t83)**2 + qw3*(t258 + t84)**2 + qw4*(t262 + t85)**2 + qw5*(t266 + t86)**2 + qw6*(t270 + t87)**2 + qw7*(qb5_6 + t88)**2
+    t272 = (t42 > 0)
+    t273 = casadi.if_else(casadi.logic_and(t272, casadi.logic_or((t246 > t271), (t237 < 1))), 1, 0)
+    t274 = casadi.if_else(t272, 1, t237)
+    t275 = (t273 > 0)
+    t276 = casadi.if_else(t275, t250, t239)
+    t277 = casadi.if_else(t275, t254, t240)
+    t278 = casadi.if_else(t275, t258, t241)
+    t279 = casadi.if_else(t275, t262, t242)
+    t280 = casadi.if_else(t275, t266, t243)
+    t281 = casadi.if_else(t275, t270, t244)
+    t282 = casadi.if_else(t275, qb5_6, t245)
+    t283 = casadi.if_else(t275, t271, t246)
+    t284 = casadi.if_else((qn1 > t43), 6.283185307179586, -6.283185307179586)
+    t285 = t284 + t43
+    t286 = t43 - t284
+    t287 = casadi.if_else(casadi.logic_and((t43 >= -2.8973), (t43 <= 2.8973)), t43, casadi.if_else(casadi.logic_and((t285 >= -2.8973), (t285 <= 2.8973)), t285, casadi.if_else(casadi.logic_and((t286 >= -2.8973), (t286 <= 2.8973)), t286, qb6_0)))
+    t288 = casadi.if_else((qn2 > t44), 6.283185307179586, -6.283185307179586)
+    t289 = t288 + t44
+    t290 = t44 - t288
+    t291 = casadi.if_else(casadi.logic_and((t44 >= -1.7627999999999997), (t44 <= 1.7627999999999997)), t44, casadi.if_else(casadi.logic_and((t289 >= -1.7627999999999997), (t289 <= 1.7627999999999997)), t289, casadi.if_else(casadi.logic_and((t290 >= -1.7627999999999997), (t290 <= 1.7627999999999997)), t290, qb6_1)))
+    t292 = casadi.if_else((qn3 > t45), 6.283185307179586, -6.283185307179586)
+    t293 = t292 + t45
+    t294 = t45 - t292
+    t295 = casadi.if_else(casadi.logic_and((t45 >= -2.8973), (t45 <= 2.8973)), t45, casadi.if_else(casadi.logic_and((t293 >= -2.8973), (t293 <= 2.8973)), t293, casadi.if_else(casadi.logic_and((t294 >= -2.8973), (t294 <= 2.8973)), t294, qb6_2)))
+    t296 = casadi.if_else((qn4 > t46), 6.283185307179586, -6.283185307179586)
+    t297 = t296 + t46
+    t298 = t46 - t296
+    t299 = casadi.if_else(casadi.logic_and((t46 >= -3.0718), (t46 <= -0.0698)), t46, casadi.if_else(casadi.logic_and((t297 >= -3.0718), (t297 <= -0.0698)), t297, casadi.if_else(casadi.logic_and((t298 >= -3.0718), (t298 <= -0.0698)), t298, qb6_3)))
+    t300 = casadi.if_else((qn5 > t47), 6.283185307179586, -6.283185307179586)
+    t301 = t300 + t47
+    t302 = t47 - t300
+    t303 = casadi.if_else(casadi.logic_and((t47 >= -2.8973), (t47 <= 2.8973)), t47, casadi.if_else(casadi.logic_and((t301 >= -2.8973), (t301 <= 2.8973)), t301, casadi.if_else(casadi.logic_and((t302 >= -2.8973), (t302 <= 2.8973)), t302, qb6_4)))
+    t304 = casadi.if_else((qn6 > t48), 6.283185307179586, -6.283185307179586)
+    t305 = t304 + t48
+    t306 = t48 - t304
+    t307 = casadi.if_else(casadi.logic_and((t48 >= -0.0175), (t48 <= 3.7525000000000004)), t48, casadi.if_else(casadi.logic_and((t305 >= -0.0175), (t305 <= 3.7525000000000004)), t305, casadi.if_else(casadi.logic_and((t306 >= -0.0175), (t306 <= 3.7525000000000004)), t306, qb6_5)))
+    t308 = qw1*(t287 + t82)**2 + qw2*(t291 + t83)**2 + qw3*(t295 + t84)**2 + qw4*(t299 + t85)**2 + qw5*(t303 + t86)**2 + qw6*(t307 + t87)**2 + qw7*(qb6_6 + t88)**2
+    t309 = (t49 > 0)
+    t310 = casadi.if_else(casadi.logic_and(t309, casadi.logic_or((t283 > t308), (t274 < 1))), 1, 0)
+    t311 = casadi.if_else(t309, 1, t274)
+    t312 = (t310 > 0)
+    t313 = casadi.if_else(t312, t287, t276)
+    t314 = casadi.if_else(t312, t291, t277)
+    t315 = casadi.if_else(t312, t295, t278)
+    t316 = casadi.if_else(t312, t299, t279)
+    t317 = casadi.if_else(t312, t303, t280)
+    t318 = casadi.if_else(t312, t307, t281)
+    t319 = casadi.if_else(t312, qb6_6, t282)
+    t320 = casadi.if_else(t312, t308, t283)
+    t321 = casadi.if_else((qn1 > t50), 6.283185307179586, -6.283185307179586)
+    t322 = t321 + t50
+    t323 = t50 - t321
+    t324 = casadi.if_else(casadi.logic_and((t50 >= -2.8973), (t50 <= 2.8973)), t50, casadi.if_else(casadi.logic_and((t322 >= -2.8973), (t322 <= 2.8973)), t322, casadi.if_else(casadi.logic_and((t323 >= -2.8973), (t323 <= 2.8973)), t323, qb7_0)))
+    t325 = casadi.if_else((qn2 > t51), 6.283185307179586, -6.283185307179586)
+    t326 = t325 + t51
+    t327 = t51 - t325
+    t328 = casadi.if_else(casadi.logic_and((t51 >= -1.7627999999999997), (t51 <= 1.7627999999999997)), t51, casadi.if_else(casadi.logic_and((t326 >= -1.7627999999999997), (t326 <= 1.7627999999999997)), t326, casadi.if_else(casadi.logic_and((t327 >= -1.7627999999999997), (t327 <= 1.7627999999999997)), t327, qb7_1)))
+    t329 = casadi.if_else((qn3 > t52), 6.283185307179586, -6.283185307179586)
+    t330 = t329 + t52
+    t331 = t52 - t329
+    t332 = casadi.if_else(casadi.logic_and((t52 >= -2.8973), (t52 <= 2.8973)), t52, casadi.if_else(casadi.logic_and((t330 >= -2.8973), (t330 <= 2.8973)), t330, casadi.if_else(casadi.logic_and((t331 >= -2.8973), (t331 <= 2.8973)), t331, qb7_2)))
+    t333 = casadi.if_else((qn4 > t53), 6.283185307179586, -6.283185307179586)
+    t334 = t333 + t53
+    t335 = t53 - t333
+    t336 = casadi.if_else(casadi.logic_and((t53 >= -3.0718), (t53 <= -0.0698)), t53, casadi.if_else(casadi.logic_and((t334 >= -3.0718), (t334 <= -0.0698)), t334, casadi.if_else(casadi.logic_and((t335 >= -3.0718), (t335 <= -0.0698)), t335, qb7_3)))
+    t337 = casadi.if_else((qn5 > t54), 6.283185307179586, -6.283185307179586)
+    t338 = t337 + t54
+    t339 = t54 - t337
+    t340 = casadi.if_else(casadi.logic_and((t54 >= -2.8973), (t54 <= 2.8973)), t54, casadi.if_else(casadi.logic_and((t338 >= -2.8973), (t338 <= 2.8973)), t338, casadi.if_else(casadi.logic_and((t339 >= -2.8973), (t339 <= 2.8973)), t339, qb7_4)))
+    t341 = casadi.if_else((qn6 > t55), 6.283185307179586, -6.283185307179586)
+    t342 = t341 + t55
+    t343 = t55 - t341
+    t344 = casadi.if_else(casadi.logic_and((t55 >= -0.0175), (t55 <= 3.7525000000000004)), t55, casadi.if_else(casadi.logic_and((t342 >= -0.0175), (t342 <= 3.7525000000000004)), t342, casadi.if_else(casadi.logic_and((t343 >= -0.0175), (t343 <= 3.7525000000000004)), t343, qb7_5)))
+    t345 = qw1*(t324 + t82)**2 + qw2*(t328 + t83)**2 + qw3*(t332 + t84)**2 + qw4*(t336 + t85)**2 + qw5*(t340 + t86)**2 + qw6*(t344 + t87)**2 + qw7*(qb7_6 + t88)**2
+    t346 = (t56 > 0)
+    t347 = casadi.if_else(casadi.logic_and(t346, casadi.logic_or((t320 > t345), (t311 < 1))), 1, 0)
+    t348 = casadi.if_else(t346, 1, t311)
+    t349 = (t347 > 0)
+    t350 = casadi.if_else(t349, t324, t313)
+    t351 = casadi.if_else(t349, t328, t314)
+    t352 = casadi.if_else(t349, t332, t315)
+    t353 = casadi.if_else(t349, t336, t316)
+    t354 = casadi.if_else(t349, t340, t317)
+    t355 = casadi.if_else(t349, t344, t318)
+    t356 = casadi.if_else(t349, qb7_6, t319)
+    t357 = (casadi.fabs(t57) < casadi.inf)
+    t358 = (t348 > 0)
+    t359 = casadi.logic_and(t357, t358)
     q = casadi.SX(7, 1)
-    q[0, 0] = casadi.if_else(t964, t955, qn1)
-    q[1, 0] = casadi.if_else(t964, t956, qn2)
-    q[2, 0] = casadi.if_else(t964, t957, qn3)
-    q[3, 0] = casadi.if_else(t964, t958, qn4)
-    q[4, 0] = casadi.if_else(t964, t959, qn5)
-    q[5, 0] = casadi.if_else(t964, t960, qn6)
-    q[6, 0] = casadi.if_else(t964, t961, qn7)
+    q[0, 0] = casadi.if_else(t359, t350, qn1)
+    q[1, 0] = casadi.if_else(t359, t351, qn2)
+    q[2, 0] = casadi.if_else(t359, t352, qn3)
+    q[3, 0] = casadi.if_else(t359, t353, qn4)
+    q[4, 0] = casadi.if_else(t359, t354, qn5)
+    q[5, 0] = casadi.if_else(t359, t355, qn6)
+    q[6, 0] = casadi.if_else(t359, t356, qn7)
     status = casadi.SX(1, 1)
-    status[0, 0] = casadi.if_else(casadi.logic_not(t962), 2, casadi.if_else(t963, 0, 1))
+    status[0, 0] = casadi.if_else(casadi.logic_not(t357), 2, casadi.if_else(t358, 0, 1))
     return [q, status]
 
 

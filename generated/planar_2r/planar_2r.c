@@ -656,7 +656,11 @@ void planar_2r_ik_branches(const planar_2r_real mu[PLANAR_2R_TASK_DIM], planar_2
 
 int planar_2r_ik_nearest(const planar_2r_real mu[PLANAR_2R_TASK_DIM], const planar_2r_real q_seed[PLANAR_2R_DOF], const planar_2r_real weights[PLANAR_2R_DOF], planar_2r_real q[PLANAR_2R_DOF])
 {
-    /* 138 operations */
+    /* 70 operations */
+    planar_2r_real branches_q[PLANAR_2R_MAX_IK_SOLUTIONS * PLANAR_2R_DOF];
+    int branches_valid[PLANAR_2R_MAX_IK_SOLUTIONS];
+    int branches_in_limits[PLANAR_2R_MAX_IK_SOLUTIONS];
+    planar_2r_ik_branches(mu, branches_q, branches_valid, branches_in_limits);
 
     /* Inputs */
     const planar_2r_real mu0 = mu[0];
@@ -665,69 +669,46 @@ int planar_2r_ik_nearest(const planar_2r_real mu[PLANAR_2R_TASK_DIM], const plan
     const planar_2r_real qn2 = q_seed[1];
     const planar_2r_real qw1 = weights[0];
     const planar_2r_real qw2 = weights[1];
+    const planar_2r_real qb0_0 = branches_q[0];
+    const planar_2r_real qb0_1 = branches_q[1];
+    const planar_2r_real qb1_0 = branches_q[2];
+    const planar_2r_real qb1_1 = branches_q[3];
+    const int vb0 = branches_valid[0];
+    const int vb1 = branches_valid[1];
+    const int lb0 = branches_in_limits[0];
+    const int lb1 = branches_in_limits[1];
 
     /* Intermediate terms */
-    const planar_2r_real t0 = (mu0*mu0) + (mu1*mu1);
-    const planar_2r_real t1 = 1.0 - 0.5*t0;
-    const planar_2r_real t2 = (t1*t1);
-    const planar_2r_real t3 = 1 - t2;
-    const int t4 = 1e-12 < t3;
-    const planar_2r_real t5 = (t4 ? t1 : (t1 > 0 ? 1 : -1));
-    const planar_2r_real t6 = (t4 ? sqrt(t3) : 0);
-    const planar_2r_real t7 = atan2(t6, t5);
-    const planar_2r_real t8 = 3.141592653589793 - t7;
-    const planar_2r_real t9 = t8 - 6.283185307179586*ceil(-0.5 + 0.15915494309189535*t8);
-    const planar_2r_real t10 = t9 + 6.283185307179586*floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t9);
-    const planar_2r_real t11 = 3.141592653589793 + t7;
-    const planar_2r_real t12 = -t6;
-    const planar_2r_real t13 = t11 - 6.283185307179586*ceil(-0.5 + 0.15915494309189535*t11);
-    const planar_2r_real t14 = t13 + 6.283185307179586*floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t13);
-    const planar_2r_real t15 = -t5;
-    const planar_2r_real t16 = t15;
-    const planar_2r_real t17 = 1 + t16;
-    const planar_2r_real t18 = mu0*t17 + mu1*t12;
-    const planar_2r_real t19 = mu1*t17 - mu0*t12;
-    const planar_2r_real t20 = (t18*t18) + (t19*t19);
-    const planar_2r_real t21 = (t12*t12) + (t17*t17);
-    const planar_2r_real t22 = 1 + t15;
-    const planar_2r_real t23 = mu0*t22 + mu1*t6;
-    const planar_2r_real t24 = mu1*t22 - mu0*t6;
-    const planar_2r_real t25 = (t23*t23) + (t24*t24);
-    const planar_2r_real t26 = (t22*t22) + (t6*t6);
-    const planar_2r_real t27 = mu0 + mu1;
-    const planar_2r_real t28 = t27;
-    const planar_2r_real t29 = qn1 + qn2 + qw1 + qw2 + t27;
-    const planar_2r_real t30 = 1e-24*t0;
-    const planar_2r_real t31 = (t20 <= t21*t30 ? 0 : atan2(t19, t18));
-    const planar_2r_real t32 = t31 + 6.283185307179586*floor(0.5 + 0.15915494309189535*qn1 - 0.15915494309189535*t31);
-    const planar_2r_real t33 = (t25 <= t26*t30 ? 0 : atan2(t24, t23));
-    const planar_2r_real t34 = t33 + 6.283185307179586*floor(0.5 + 0.15915494309189535*qn1 - 0.15915494309189535*t33);
-    const planar_2r_real t35 = -qn1;
-    const planar_2r_real t36 = -qn2;
-    const planar_2r_real t37 = qw1*((t32 + t35)*(t32 + t35)) + qw2*((t14 + t36)*(t14 + t36));
-    const planar_2r_real t38 = qw1*((t34 + t35)*(t34 + t35)) + qw2*((t10 + t36)*(t10 + t36));
-    const int t39 = isfinite(t28);
-    const planar_2r_real t40 = (t39 && t3 >= -1e-12 ? 1 : 0);
-    const planar_2r_real t41 = (t40 > 0 ? 1 : 0);
-    const planar_2r_real t42 = (t39 && t4 ? 1 : 0);
-    const int t43 = t41 > 0;
-    const planar_2r_real t44 = (t43 ? t32 : qn1);
-    const planar_2r_real t45 = (t43 ? t14 : qn2);
-    const planar_2r_real t46 = (t43 ? t37 : 0);
-    const int t47 = t42 > 0;
-    const planar_2r_real t48 = (t47 && ((t38 < t46) || (t41 < 1)) ? 1 : 0);
-    const planar_2r_real t49 = (t47 ? 1 : t41);
-    const int t50 = t48 > 0;
-    const planar_2r_real t51 = (t50 ? t34 : t44);
-    const planar_2r_real t52 = (t50 ? t10 : t45);
-    const int t53 = isfinite(t29);
-    const int t54 = t49 > 0;
-    const int t55 = t53 && t54;
+    const planar_2r_real t0 = qb0_0 + 6.283185307179586*floor(0.5 + 0.15915494309189535*qn1 - 0.15915494309189535*qb0_0);
+    const planar_2r_real t1 = qb0_1 + 6.283185307179586*floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*qb0_1);
+    const planar_2r_real t2 = (lb0 && vb0 ? 1 : 0);
+    const planar_2r_real t3 = (t2 > 0 ? 1 : 0);
+    const planar_2r_real t4 = qb1_0 + 6.283185307179586*floor(0.5 + 0.15915494309189535*qn1 - 0.15915494309189535*qb1_0);
+    const planar_2r_real t5 = qb1_1 + 6.283185307179586*floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*qb1_1);
+    const planar_2r_real t6 = (lb1 && vb1 ? 1 : 0);
+    const planar_2r_real t7 = mu0 + mu1 + qn1 + qn2 + qw1 + qw2;
+    const planar_2r_real t8 = -qn1;
+    const planar_2r_real t9 = -qn2;
+    const planar_2r_real t10 = qw1*((t0 + t8)*(t0 + t8)) + qw2*((t1 + t9)*(t1 + t9));
+    const planar_2r_real t11 = qw1*((t4 + t8)*(t4 + t8)) + qw2*((t5 + t9)*(t5 + t9));
+    const int t12 = t3 > 0;
+    const planar_2r_real t13 = (t12 ? t0 : qn1);
+    const planar_2r_real t14 = (t12 ? t1 : qn2);
+    const planar_2r_real t15 = (t12 ? t10 : 0);
+    const int t16 = t6 > 0;
+    const planar_2r_real t17 = (t16 && ((t11 < t15) || (t3 < 1)) ? 1 : 0);
+    const planar_2r_real t18 = (t16 ? 1 : t3);
+    const int t19 = t17 > 0;
+    const planar_2r_real t20 = (t19 ? t4 : t13);
+    const planar_2r_real t21 = (t19 ? t5 : t14);
+    const int t22 = isfinite(t7);
+    const int t23 = t18 > 0;
+    const int t24 = t22 && t23;
 
     /* Outputs */
-    q[0] = (t55 ? t51 : qn1);
-    q[1] = (t55 ? t52 : qn2);
-    return (!t53 ? 2 : (t54 ? 0 : 1));
+    q[0] = (t24 ? t20 : qn1);
+    q[1] = (t24 ? t21 : qn2);
+    return (!t22 ? 2 : (t23 ? 0 : 1));
 }
 
 int planar_2r_ik(const planar_2r_real mu[PLANAR_2R_TASK_DIM], planar_2r_real q[PLANAR_2R_MAX_IK_SOLUTIONS * PLANAR_2R_DOF])

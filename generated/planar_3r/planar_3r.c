@@ -943,7 +943,11 @@ void planar_3r_ik_branches(const planar_3r_real mu[PLANAR_3R_TASK_DIM], planar_3
 
 int planar_3r_ik_nearest(const planar_3r_real mu[PLANAR_3R_TASK_DIM], const planar_3r_real q_seed[PLANAR_3R_DOF], const planar_3r_real weights[PLANAR_3R_DOF], planar_3r_real q[PLANAR_3R_DOF])
 {
-    /* 191 operations */
+    /* 97 operations */
+    planar_3r_real branches_q[PLANAR_3R_MAX_IK_SOLUTIONS * PLANAR_3R_DOF];
+    int branches_valid[PLANAR_3R_MAX_IK_SOLUTIONS];
+    int branches_in_limits[PLANAR_3R_MAX_IK_SOLUTIONS];
+    planar_3r_ik_branches(mu, branches_q, branches_valid, branches_in_limits);
 
     /* Inputs */
     const planar_3r_real mu0 = mu[0];
@@ -955,87 +959,54 @@ int planar_3r_ik_nearest(const planar_3r_real mu[PLANAR_3R_TASK_DIM], const plan
     const planar_3r_real qw1 = weights[0];
     const planar_3r_real qw2 = weights[1];
     const planar_3r_real qw3 = weights[2];
+    const planar_3r_real qb0_0 = branches_q[0];
+    const planar_3r_real qb0_1 = branches_q[1];
+    const planar_3r_real qb0_2 = branches_q[2];
+    const planar_3r_real qb1_0 = branches_q[3];
+    const planar_3r_real qb1_1 = branches_q[4];
+    const planar_3r_real qb1_2 = branches_q[5];
+    const int vb0 = branches_valid[0];
+    const int vb1 = branches_valid[1];
+    const int lb0 = branches_in_limits[0];
+    const int lb1 = branches_in_limits[1];
 
     /* Intermediate terms */
-    const planar_3r_real t0 = cos(mu2);
-    const planar_3r_real t1 = sin(mu2);
-    const planar_3r_real t2 = mu0 - t0;
-    const planar_3r_real t3 = mu1 - t1;
-    const planar_3r_real t4 = (t2*t2) + (t3*t3);
-    const planar_3r_real t5 = 1.0 - 0.5*t4;
-    const planar_3r_real t6 = (t5*t5);
-    const planar_3r_real t7 = 1 - t6;
-    const int t8 = 1e-12 < t7;
-    const planar_3r_real t9 = (t8 ? t5 : (t5 > 0 ? 1 : -1));
-    const planar_3r_real t10 = (t8 ? sqrt(t7) : 0);
-    const planar_3r_real t11 = atan2(t10, t9);
-    const planar_3r_real t12 = 3.141592653589793 - t11;
-    const planar_3r_real t13 = t12 - 6.283185307179586*ceil(-0.5 + 0.15915494309189535*t12);
-    const planar_3r_real t14 = t13 + 6.283185307179586*floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t13);
-    const planar_3r_real t15 = 3.141592653589793 + t11;
-    const planar_3r_real t16 = -t10;
-    const planar_3r_real t17 = t15 - 6.283185307179586*ceil(-0.5 + 0.15915494309189535*t15);
-    const planar_3r_real t18 = t17 + 6.283185307179586*floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t17);
-    const planar_3r_real t19 = -t9;
-    const planar_3r_real t20 = t19;
-    const planar_3r_real t21 = 1 + t20;
-    const planar_3r_real t22 = t16*t3 + t2*t21;
-    const planar_3r_real t23 = t21*t3 - t16*t2;
-    const planar_3r_real t24 = (t22*t22) + (t23*t23);
-    const planar_3r_real t25 = (t16*t16) + (t21*t21);
-    const planar_3r_real t26 = 1 + t19;
-    const planar_3r_real t27 = t10*t3 + t2*t26;
-    const planar_3r_real t28 = t26*t3 - t10*t2;
-    const planar_3r_real t29 = (t27*t27) + (t28*t28);
-    const planar_3r_real t30 = (t10*t10) + (t26*t26);
-    const planar_3r_real t31 = mu0 + mu1 + mu2;
-    const planar_3r_real t32 = t31;
-    const planar_3r_real t33 = qn1 + qn2 + qn3 + qw1 + qw2 + qw3 + t31;
-    const planar_3r_real t34 = 1e-24*t4;
-    const planar_3r_real t35 = (t24 <= t25*t34 ? 0 : atan2(t23, t22));
-    const planar_3r_real t36 = t35;
-    const planar_3r_real t37 = t36 + 6.283185307179586*floor(0.5 + 0.15915494309189535*qn1 - 0.15915494309189535*t36);
-    const planar_3r_real t38 = -mu2;
-    const planar_3r_real t39 = 3.141592653589793 + t38;
-    const planar_3r_real t40 = t15 + t35;
-    const planar_3r_real t41 = t38 + t40 + 6.283185307179586*ceil(-0.15915494309189535*t39 - 0.15915494309189535*t40);
-    const planar_3r_real t42 = -t41 + 6.283185307179586*floor(0.5 + 0.15915494309189535*qn3 + 0.15915494309189535*t41);
-    const planar_3r_real t43 = -qn1;
-    const planar_3r_real t44 = -qn2;
-    const planar_3r_real t45 = -qn3;
-    const planar_3r_real t46 = qw1*((t37 + t43)*(t37 + t43)) + qw2*((t18 + t44)*(t18 + t44)) + qw3*((t42 + t45)*(t42 + t45));
-    const int t47 = isfinite(t32);
-    const planar_3r_real t48 = (t47 && t7 >= -1e-12 ? 1 : 0);
-    const planar_3r_real t49 = (t48 > 0 ? 1 : 0);
-    const planar_3r_real t50 = (t47 && t8 ? 1 : 0);
-    const int t51 = t49 > 0;
-    const planar_3r_real t52 = (t51 ? t37 : qn1);
-    const planar_3r_real t53 = (t51 ? t18 : qn2);
-    const planar_3r_real t54 = (t51 ? t42 : qn3);
-    const planar_3r_real t55 = (t51 ? t46 : 0);
-    const planar_3r_real t56 = (t29 <= t30*t34 ? 0 : atan2(t28, t27));
-    const planar_3r_real t57 = t56;
-    const planar_3r_real t58 = t57 + 6.283185307179586*floor(0.5 + 0.15915494309189535*qn1 - 0.15915494309189535*t57);
-    const planar_3r_real t59 = t12 + t56;
-    const planar_3r_real t60 = t38 + t59 + 6.283185307179586*ceil(-0.15915494309189535*t39 - 0.15915494309189535*t59);
-    const planar_3r_real t61 = -t60 + 6.283185307179586*floor(0.5 + 0.15915494309189535*qn3 + 0.15915494309189535*t60);
-    const planar_3r_real t62 = qw1*((t43 + t58)*(t43 + t58)) + qw2*((t14 + t44)*(t14 + t44)) + qw3*((t45 + t61)*(t45 + t61));
-    const int t63 = t50 > 0;
-    const planar_3r_real t64 = (t63 && ((t55 > t62) || (t49 < 1)) ? 1 : 0);
-    const planar_3r_real t65 = (t63 ? 1 : t49);
-    const int t66 = t64 > 0;
-    const planar_3r_real t67 = (t66 ? t58 : t52);
-    const planar_3r_real t68 = (t66 ? t14 : t53);
-    const planar_3r_real t69 = (t66 ? t61 : t54);
-    const int t70 = isfinite(t33);
-    const int t71 = t65 > 0;
-    const int t72 = t70 && t71;
+    const planar_3r_real t0 = qb0_0 + 6.283185307179586*floor(0.5 + 0.15915494309189535*qn1 - 0.15915494309189535*qb0_0);
+    const planar_3r_real t1 = qb0_1 + 6.283185307179586*floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*qb0_1);
+    const planar_3r_real t2 = qb0_2 + 6.283185307179586*floor(0.5 + 0.15915494309189535*qn3 - 0.15915494309189535*qb0_2);
+    const planar_3r_real t3 = (lb0 && vb0 ? 1 : 0);
+    const planar_3r_real t4 = (t3 > 0 ? 1 : 0);
+    const planar_3r_real t5 = qb1_0 + 6.283185307179586*floor(0.5 + 0.15915494309189535*qn1 - 0.15915494309189535*qb1_0);
+    const planar_3r_real t6 = qb1_1 + 6.283185307179586*floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*qb1_1);
+    const planar_3r_real t7 = qb1_2 + 6.283185307179586*floor(0.5 + 0.15915494309189535*qn3 - 0.15915494309189535*qb1_2);
+    const planar_3r_real t8 = (lb1 && vb1 ? 1 : 0);
+    const planar_3r_real t9 = mu0 + mu1 + mu2 + qn1 + qn2 + qn3 + qw1 + qw2 + qw3;
+    const planar_3r_real t10 = -qn1;
+    const planar_3r_real t11 = -qn2;
+    const planar_3r_real t12 = -qn3;
+    const planar_3r_real t13 = qw1*((t0 + t10)*(t0 + t10)) + qw2*((t1 + t11)*(t1 + t11)) + qw3*((t12 + t2)*(t12 + t2));
+    const planar_3r_real t14 = qw1*((t10 + t5)*(t10 + t5)) + qw2*((t11 + t6)*(t11 + t6)) + qw3*((t12 + t7)*(t12 + t7));
+    const int t15 = t4 > 0;
+    const planar_3r_real t16 = (t15 ? t0 : qn1);
+    const planar_3r_real t17 = (t15 ? t1 : qn2);
+    const planar_3r_real t18 = (t15 ? t2 : qn3);
+    const planar_3r_real t19 = (t15 ? t13 : 0);
+    const int t20 = t8 > 0;
+    const planar_3r_real t21 = (t20 && ((t14 < t19) || (t4 < 1)) ? 1 : 0);
+    const planar_3r_real t22 = (t20 ? 1 : t4);
+    const int t23 = t21 > 0;
+    const planar_3r_real t24 = (t23 ? t5 : t16);
+    const planar_3r_real t25 = (t23 ? t6 : t17);
+    const planar_3r_real t26 = (t23 ? t7 : t18);
+    const int t27 = isfinite(t9);
+    const int t28 = t22 > 0;
+    const int t29 = t27 && t28;
 
     /* Outputs */
-    q[0] = (t72 ? t67 : qn1);
-    q[1] = (t72 ? t68 : qn2);
-    q[2] = (t72 ? t69 : qn3);
-    return (!t70 ? 2 : (t71 ? 0 : 1));
+    q[0] = (t29 ? t24 : qn1);
+    q[1] = (t29 ? t25 : qn2);
+    q[2] = (t29 ? t26 : qn3);
+    return (!t27 ? 2 : (t28 ? 0 : 1));
 }
 
 int planar_3r_ik(const planar_3r_real mu[PLANAR_3R_TASK_DIM], planar_3r_real q[PLANAR_3R_MAX_IK_SOLUTIONS * PLANAR_3R_DOF])

@@ -100,7 +100,7 @@ planar_3r_real planar_3r_ik_numeric_step(const planar_3r_real target[PLANAR_3R_T
 void planar_3r_ik_branches(const planar_3r_real mu[PLANAR_3R_TASK_DIM], planar_3r_real q[PLANAR_3R_MAX_IK_SOLUTIONS * PLANAR_3R_DOF], int valid[PLANAR_3R_MAX_IK_SOLUTIONS], int in_limits[PLANAR_3R_MAX_IK_SOLUTIONS]);
 
 /* The closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status.
- * Result: q[i], i < 3; returned as a scalar. 191 operations. */
+ * Result: q[i], i < 3; returned as a scalar. 97 operations. */
 int planar_3r_ik_nearest(const planar_3r_real mu[PLANAR_3R_TASK_DIM], const planar_3r_real q_seed[PLANAR_3R_DOF], const planar_3r_real weights[PLANAR_3R_DOF], planar_3r_real q[PLANAR_3R_DOF]);
 
 /* Statuses of planar_3r_velocity_ik: OK, singular (a diagonal entry of the QR factor R of the

@@ -61,7 +61,7 @@ def _cos_sin(xp, q, offsets, device):
     return xp.take(both, xp.asarray(_INTERLEAVED, device=device), axis=-1)
 
 
-_INTERLEAVED = [k // 2 + k % 2 * DOF for k in range(2 * DOF)]
+_INTERLEAVED = [_k // 2 + _k % 2 * DOF for _k in range(2 * DOF)]  # c1, s1, c2, s2, ...
 
 
 def _stack(xp, values, shape):
@@ -943,8 +943,9 @@ def ik_branches(mu):
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def ik_nearest(mu, q_seed, weights=(1.0,) * DOF):
-    """the closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status: (3 x 1 and 1 x 1), 191 operations."""
+    """the closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status: (3 x 1 and 1 x 1), 97 operations."""
     xp, dtype, device, batch, (mu, q_seed, weights,) = _arguments(("mu", mu, (3,)), ("q_seed", q_seed, (3,)), ("weights", weights, (3,)))
+    branches_q, branches_valid, branches_in_limits = ik_branches(mu)
     mu0 = mu[..., 0]
     mu1 = mu[..., 1]
     mu2 = mu[..., 2]
@@ -954,85 +955,52 @@ def ik_nearest(mu, q_seed, weights=(1.0,) * DOF):
     qw1 = weights[..., 0]
     qw2 = weights[..., 1]
     qw3 = weights[..., 2]
-    t0 = xp.cos(mu2)
-    t1 = xp.sin(mu2)
-    t2 = mu0 - t0
-    t3 = mu1 - t1
-    t4 = t2**2 + t3**2
-    t5 = 1.0 - 0.5*t4
-    t6 = t5**2
-    t7 = 1 - t6
-    t8 = xp.less(1e-12, t7)
-    t9 = xp.where(t8, t5, xp.where(xp.greater(t5, 0), xp.asarray(1, dtype=dtype), -1))
-    t10 = xp.where(t8, xp.sqrt(t7), 0)
-    t11 = xp.atan2(t10, t9)
-    t12 = 3.141592653589793 - t11
-    t13 = t12 - 6.283185307179586*xp.ceil(-0.5 + 0.15915494309189535*t12)
-    t14 = t13 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t13)
-    t15 = 3.141592653589793 + t11
-    t16 = -t10
-    t17 = t15 - 6.283185307179586*xp.ceil(-0.5 + 0.15915494309189535*t15)
-    t18 = t17 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t17)
-    t19 = -t9
-    t20 = t19
-    t21 = 1 + t20
-    t22 = t16*t3 + t2*t21
-    t23 = t21*t3 - t16*t2
-    t24 = t22**2 + t23**2
-    t25 = t16**2 + t21**2
-    t26 = 1 + t19
-    t27 = t10*t3 + t2*t26
-    t28 = t26*t3 - t10*t2
-    t29 = t27**2 + t28**2
-    t30 = t10**2 + t26**2
-    t31 = mu0 + mu1 + mu2
-    t32 = t31
-    t33 = qn1 + qn2 + qn3 + qw1 + qw2 + qw3 + t31
-    t34 = 1e-24*t4
-    t35 = xp.where(xp.less_equal(t24, t25*t34), 0, xp.atan2(t23, t22))
-    t36 = t35
-    t37 = t36 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*qn1 - 0.15915494309189535*t36)
-    t38 = -mu2
-    t39 = 3.141592653589793 + t38
-    t40 = t15 + t35
-    t41 = t38 + t40 + 6.283185307179586*xp.ceil(-0.15915494309189535*t39 - 0.15915494309189535*t40)
-    t42 = -t41 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*qn3 + 0.15915494309189535*t41)
-    t43 = -qn1
-    t44 = -qn2
-    t45 = -qn3
-    t46 = qw1*(t37 + t43)**2 + qw2*(t18 + t44)**2 + qw3*(t42 + t45)**2
-    t47 = xp.isfinite(t32)
-    t48 = xp.where(t47 & (xp.greater_equal(t7, -1e-12)), xp.asarray(1, dtype=dtype), 0)
-    t49 = xp.where(xp.greater(t48, 0), xp.asarray(1, dtype=dtype), 0)
-    t50 = xp.where(t47 & t8, xp.asarray(1, dtype=dtype), 0)
-    t51 = xp.greater(t49, 0)
-    t52 = xp.where(t51, t37, qn1)
-    t53 = xp.where(t51, t18, qn2)
-    t54 = xp.where(t51, t42, qn3)
-    t55 = xp.where(t51, t46, 0)
-    t56 = xp.where(xp.less_equal(t29, t30*t34), 0, xp.atan2(t28, t27))
-    t57 = t56
-    t58 = t57 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*qn1 - 0.15915494309189535*t57)
-    t59 = t12 + t56
-    t60 = t38 + t59 + 6.283185307179586*xp.ceil(-0.15915494309189535*t39 - 0.15915494309189535*t59)
-    t61 = -t60 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*qn3 + 0.15915494309189535*t60)
-    t62 = qw1*(t43 + t58)**2 + qw2*(t14 + t44)**2 + qw3*(t45 + t61)**2
-    t63 = xp.greater(t50, 0)
-    t64 = xp.where(t63 & ((xp.greater(t55, t62)) | (xp.less(t49, 1))), xp.asarray(1, dtype=dtype), 0)
-    t65 = xp.where(t63, 1, t49)
-    t66 = xp.greater(t64, 0)
-    t67 = xp.where(t66, t58, t52)
-    t68 = xp.where(t66, t14, t53)
-    t69 = xp.where(t66, t61, t54)
-    t70 = xp.isfinite(t33)
-    t71 = xp.greater(t65, 0)
-    t72 = t70 & t71
+    qb0_0 = branches_q[..., 0, 0]
+    qb0_1 = branches_q[..., 0, 1]
+    qb0_2 = branches_q[..., 0, 2]
+    qb1_0 = branches_q[..., 1, 0]
+    qb1_1 = branches_q[..., 1, 1]
+    qb1_2 = branches_q[..., 1, 2]
+    vb0 = branches_valid[..., 0]
+    vb1 = branches_valid[..., 1]
+    lb0 = branches_in_limits[..., 0]
+    lb1 = branches_in_limits[..., 1]
+    t0 = qb0_0 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn1 - qb0_0))
+    t1 = qb0_1 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn2 - qb0_1))
+    t2 = qb0_2 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn3 - qb0_2))
+    t3 = xp.where(lb0 & vb0, xp.asarray(1, dtype=dtype), 0)
+    t4 = xp.where(xp.greater(t3, 0), xp.asarray(1, dtype=dtype), 0)
+    t5 = qb1_0 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn1 - qb1_0))
+    t6 = qb1_1 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn2 - qb1_1))
+    t7 = qb1_2 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn3 - qb1_2))
+    t8 = xp.where(lb1 & vb1, xp.asarray(1, dtype=dtype), 0)
+    t9 = mu0 + mu1 + mu2 + qn1 + qn2 + qn3 + qw1 + qw2 + qw3
+    t10 = -qn1
+    t11 = -qn2
+    t12 = -qn3
+    t13 = qw1*(t0 + t10)**2 + qw2*(t1 + t11)**2 + qw3*(t12 + t2)**2
+    t14 = qw1*(t10 + t5)**2 + qw2*(t11 + t6)**2 + qw3*(t12 + t7)**2
+    t15 = xp.greater(t4, 0)
+    t16 = xp.where(t15, t0, qn1)
+    t17 = xp.where(t15, t1, qn2)
+    t18 = xp.where(t15, t2, qn3)
+    t19 = xp.where(t15, t13, 0)
+    t20 = xp.greater(t8, 0)
+    t21 = xp.where(t20 & ((xp.less(t14, t19)) | (xp.less(t4, 1))), xp.asarray(1, dtype=dtype), 0)
+    t22 = xp.where(t20, 1, t4)
+    t23 = xp.greater(t21, 0)
+    t24 = xp.where(t23, t5, t16)
+    t25 = xp.where(t23, t6, t17)
+    t26 = xp.where(t23, t7, t18)
+    t27 = xp.isfinite(t9)
+    t28 = xp.greater(t22, 0)
+    t29 = t27 & t28
     q = _stack(xp, [
-        xp.broadcast_to(xp.where(t72, t67, qn1), batch),  # 0
-        xp.broadcast_to(xp.where(t72, t68, qn2), batch),  # 1
-        xp.broadcast_to(xp.where(t72, t69, qn3), batch),  # 2
+        xp.broadcast_to(xp.where(t29, t24, qn1), batch),  # 0
+        xp.broadcast_to(xp.where(t29, t25, qn2), batch),  # 1
+        xp.broadcast_to(xp.where(t29, t26, qn3), batch),  # 2
     ], (3,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t70), 2, xp.where(t71, xp.asarray(0, dtype=dtype), 1)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t27), 2, xp.where(t28, xp.asarray(0, dtype=dtype), 1)), batch), xp.int32)
     return q, status
 
 

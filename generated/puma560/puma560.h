@@ -103,7 +103,7 @@ puma560_real puma560_ik_numeric_step(const puma560_real target[16], const puma56
 void puma560_ik_branches(const puma560_real T[16], puma560_real q[PUMA560_MAX_IK_SOLUTIONS * PUMA560_DOF], int valid[PUMA560_MAX_IK_SOLUTIONS], int in_limits[PUMA560_MAX_IK_SOLUTIONS]);
 
 /* The closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status.
- * Result: q[i], i < 6; returned as a scalar. 2221 operations. */
+ * Result: q[i], i < 6; returned as a scalar. 1060 operations. */
 int puma560_ik_nearest(const puma560_real T[16], const puma560_real q_seed[PUMA560_DOF], const puma560_real weights[PUMA560_DOF], puma560_real q[PUMA560_DOF]);
 
 /* Statuses of puma560_velocity_ik: OK, singular (a diagonal entry of the QR factor R of the

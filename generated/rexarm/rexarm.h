@@ -101,7 +101,7 @@ rexarm_real rexarm_ik_numeric_step(const rexarm_real target[REXARM_TASK_DIM], co
 void rexarm_ik_branches(const rexarm_real mu[REXARM_TASK_DIM], rexarm_real q[REXARM_MAX_IK_SOLUTIONS * REXARM_DOF], int valid[REXARM_MAX_IK_SOLUTIONS], int in_limits[REXARM_MAX_IK_SOLUTIONS]);
 
 /* The closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status.
- * Result: q[i], i < 4; returned as a scalar. 1536 operations. */
+ * Result: q[i], i < 4; returned as a scalar. 724 operations. */
 int rexarm_ik_nearest(const rexarm_real mu[REXARM_TASK_DIM], const rexarm_real q_seed[REXARM_DOF], const rexarm_real weights[REXARM_DOF], rexarm_real q[REXARM_DOF]);
 
 /* Statuses of rexarm_velocity_ik: OK, singular (a diagonal entry of the QR factor R of the

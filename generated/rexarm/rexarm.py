@@ -61,7 +61,7 @@ def _cos_sin(xp, q, offsets, device):
     return xp.take(both, xp.asarray(_INTERLEAVED, device=device), axis=-1)
 
 
-_INTERLEAVED = [k // 2 + k % 2 * DOF for k in range(2 * DOF)]
+_INTERLEAVED = [_k // 2 + _k % 2 * DOF for _k in range(2 * DOF)]  # c1, s1, c2, s2, ...
 
 
 def _stack(xp, values, shape):
@@ -1737,8 +1737,9 @@ def ik_branches(mu):
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def ik_nearest(mu, q_seed, weights=(1.0,) * DOF):
-    """the closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status: (4 x 1 and 1 x 1), 1536 operations."""
+    """the closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status: (4 x 1 and 1 x 1), 724 operations."""
     xp, dtype, device, batch, (mu, q_seed, weights,) = _arguments(("mu", mu, (4,)), ("q_seed", q_seed, (4,)), ("weights", weights, (4,)))
+    branches_q, branches_valid, branches_in_limits = ik_branches(mu)
     mu0 = mu[..., 0]
     mu1 = mu[..., 1]
     mu2 = mu[..., 2]
@@ -1751,594 +1752,314 @@ def ik_nearest(mu, q_seed, weights=(1.0,) * DOF):
     qw2 = weights[..., 1]
     qw3 = weights[..., 2]
     qw4 = weights[..., 3]
-    t0 = xp.sin(mu3)
-    t1 = xp.atan2(mu0, -mu1)
-    t2 = t0**2
-    t3 = 1 - t2
-    t4 = xp.less(1e-12, t3)
-    t5 = xp.where(t4, -t0, xp.where(xp.less(t0, 0), xp.asarray(1, dtype=dtype), -1))
-    t6 = xp.where(t4, xp.sqrt(t3), 0)
-    t7 = xp.atan2(t6, t5)
-    t8 = t7
-    t9 = t5
-    t10 = t6
-    t11 = mu0**2 + mu1**2
-    t12 = t11
-    t13 = t11 + mu2**2
-    t14 = 1e-24*t13
-    t15 = xp.less_equal(t12, t14)
-    t16 = xp.where(t15, 1, 1/xp.sqrt(t12))
-    t17 = xp.where(t15, 0, t1 + (1/2)*numpy.pi)
-    t18 = t1 - 1/2*numpy.pi
-    t19 = t17 - 6.283185307179586*xp.ceil(-0.5 + 0.15915494309189535*t17)
-    t20 = t19 - 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*t19)
-    t21 = t18 - 6.283185307179586*xp.ceil(-0.5 + 0.15915494309189535*t18)
-    t22 = t21 - 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*t21)
-    t23 = t16
-    t24 = mu0*t23
-    t25 = xp.where(t15, 1, -t24)
-    t26 = t24
-    t27 = mu2*(1 - t25)
-    t28 = t27 + mu2*t25
-    t29 = mu2*(1 - t26)
-    t30 = t29 + mu2*t26
-    t31 = mu1*t23
-    t32 = xp.where(t15, 0, -t31)
-    t33 = t31
-    t34 = mu0*t25 + mu1*t32
-    t35 = mu1*t25 - mu0*t32
-    t36 = mu0*t26 + mu1*t33
-    t37 = mu1*t26 - mu0*t33
-    t38 = 0.1*t10
-    t39 = t34 + t38
-    t40 = t36 + t38
-    t41 = -0.1*t9
-    t42 = t28 + t41
-    t43 = -0.12 + t42
-    t44 = t30 + t41
-    t45 = -0.12 + t44
-    t46 = t35**2
-    t47 = t46 + t39**2 + t43**2
-    t48 = 0.01 - 0.5*t47
-    t49 = t48**2
-    t50 = 1 - 10000*t49
-    t51 = 100*t48
-    t52 = xp.less(1e-12, t50)
-    t53 = xp.where(t52, t51, xp.where(xp.greater(t51, 0), xp.asarray(1, dtype=dtype), -1))
-    t54 = xp.where(t52, xp.sqrt(t50), 0)
-    t55 = xp.atan2(t54, t53)
-    t56 = 3.141592653589793 + t55
-    t57 = 3.141592653589793 - t55
-    t58 = t56 - 6.283185307179586*xp.ceil(-0.5 + 0.15915494309189535*t56)
-    t59 = t58 - 6.283185307179586*xp.floor(0.3333333333333333 + 0.15915494309189535*t58)
-    t60 = t57 - 6.283185307179586*xp.ceil(-0.5 + 0.15915494309189535*t57)
-    t61 = t60 - 6.283185307179586*xp.floor(0.3333333333333333 + 0.15915494309189535*t60)
-    t62 = -1.0*t53
-    t63 = -1.0*t54
-    t64 = 0.22 + 0.1*t62
-    t65 = -0.12 + t64
-    t66 = t65**2 + 0.01*t63**2
-    t67 = 0.1*t63
-    t68 = t43*t65 - t39*t67
-    t69 = t39*t65 + t43*t67
-    t70 = t68**2 + t69**2
-    t71 = 0.22 - 0.1*t53
-    t72 = -0.12 + t71
-    t73 = 0.1*t54
-    t74 = t43*t72 - t39*t73
-    t75 = t39*t72 + t43*t73
-    t76 = t74**2 + t75**2
-    t77 = t72**2 + 0.01*t54**2
-    t78 = -0.1*t6
-    t79 = t34 + t78
-    t80 = t36 + t78
-    t81 = -0.1*t5
-    t82 = t28 + t81
-    t83 = -0.12 + t82
-    t84 = t46 + t79**2 + t83**2
-    t85 = 0.01 - 0.5*t84
-    t86 = t30 + t81
-    t87 = -0.12 + t86
-    t88 = t85**2
-    t89 = 1 - 10000*t88
-    t90 = 100*t85
-    t91 = xp.less(1e-12, t89)
-    t92 = xp.where(t91, t90, xp.where(xp.greater(t90, 0), xp.asarray(1, dtype=dtype), -1))
-    t93 = xp.where(t91, xp.sqrt(t89), 0)
-    t94 = xp.atan2(t93, t92)
-    t95 = 3.141592653589793 + t94
-    t96 = -1.0*t92
-    t97 = -1.0*t93
-    t98 = 3.141592653589793 - t94
-    t99 = 0.22 + 0.1*t96
-    t100 = -0.12 + t99
-    t101 = t100**2 + 0.01*t97**2
-    t102 = 0.22 - 0.1*t92
-    t103 = -0.12 + t102
-    t104 = t103**2 + 0.01*t93**2
-    t105 = t95 - 6.283185307179586*xp.ceil(-0.5 + 0.15915494309189535*t95)
-    t106 = t105 - 6.283185307179586*xp.floor(0.3333333333333333 + 0.15915494309189535*t105)
-    t107 = t98 - 6.283185307179586*xp.ceil(-0.5 + 0.15915494309189535*t98)
-    t108 = t107 - 6.283185307179586*xp.floor(0.3333333333333333 + 0.15915494309189535*t107)
-    t109 = 0.1*t97
-    t110 = t100*t83 - t109*t79
-    t111 = t100*t79 + t109*t83
-    t112 = t110**2 + t111**2
-    t113 = 0.1*t93
-    t114 = t103*t83 - t113*t79
-    t115 = t103*t79 + t113*t83
-    t116 = t114**2 + t115**2
-    t117 = t37**2
-    t118 = t117 + t40**2 + t45**2
-    t119 = 0.01 - 0.5*t118
-    t120 = t117 + t80**2 + t87**2
-    t121 = 0.01 - 0.5*t120
-    t122 = t119**2
-    t123 = 1 - 10000*t122
-    t124 = 100*t119
-    t125 = xp.less(1e-12, t123)
-    t126 = xp.where(t125, t124, xp.where(xp.greater(t124, 0), xp.asarray(1, dtype=dtype), -1))
-    t127 = xp.where(t125, xp.sqrt(t123), 0)
-    t128 = xp.atan2(t127, t126)
-    t129 = 3.141592653589793 + t128
-    t130 = -1.0*t126
-    t131 = -1.0*t127
-    t132 = 3.141592653589793 - t128
-    t133 = 0.22 + 0.1*t130
-    t134 = -0.12 + t133
-    t135 = t134**2 + 0.01*t131**2
-    t136 = 0.22 - 0.1*t126
-    t137 = -0.12 + t136
-    t138 = t137**2 + 0.01*t127**2
-    t139 = t129 - 6.283185307179586*xp.ceil(-0.5 + 0.15915494309189535*t129)
-    t140 = t139 - 6.283185307179586*xp.floor(0.3333333333333333 + 0.15915494309189535*t139)
-    t141 = t132 - 6.283185307179586*xp.ceil(-0.5 + 0.15915494309189535*t132)
-    t142 = t141 - 6.283185307179586*xp.floor(0.3333333333333333 + 0.15915494309189535*t141)
-    t143 = 0.1*t131
-    t144 = t134*t45 - t143*t40
-    t145 = t134*t40 + t143*t45
-    t146 = t144**2 + t145**2
-    t147 = 0.1*t127
-    t148 = t137*t45 - t147*t40
-    t149 = t137*t40 + t147*t45
-    t150 = t148**2 + t149**2
-    t151 = t121**2
-    t152 = 1 - 10000*t151
-    t153 = 100*t121
-    t154 = xp.less(1e-12, t152)
-    t155 = xp.where(t154, t153, xp.where(xp.greater(t153, 0), xp.asarray(1, dtype=dtype), -1))
-    t156 = xp.where(t154, xp.sqrt(t152), 0)
-    t157 = xp.atan2(t156, t155)
-    t158 = 3.141592653589793 + t157
-    t159 = -1.0*t155
-    t160 = -1.0*t156
-    t161 = 3.141592653589793 - t157
-    t162 = 0.22 + 0.1*t159
-    t163 = -0.12 + t162
-    t164 = t163**2 + 0.01*t160**2
-    t165 = 0.22 - 0.1*t155
-    t166 = -0.12 + t165
-    t167 = t166**2 + 0.01*t156**2
-    t168 = t158 - 6.283185307179586*xp.ceil(-0.5 + 0.15915494309189535*t158)
-    t169 = t168 - 6.283185307179586*xp.floor(0.3333333333333333 + 0.15915494309189535*t168)
-    t170 = t161 - 6.283185307179586*xp.ceil(-0.5 + 0.15915494309189535*t161)
-    t171 = t170 - 6.283185307179586*xp.floor(0.3333333333333333 + 0.15915494309189535*t170)
-    t172 = 0.1*t160
-    t173 = t163*t87 - t172*t80
-    t174 = t163*t80 + t172*t87
-    t175 = t173**2 + t174**2
-    t176 = 0.1*t156
-    t177 = t166*t87 - t176*t80
-    t178 = t166*t80 + t176*t87
-    t179 = t177**2 + t178**2
-    t180 = mu0 + mu1 + mu2 + mu3
-    t181 = t180
-    t182 = qn1 + qn2 + qn3 + qn4 + qw1 + qw2 + qw3 + qw4 + t180
-    t183 = 1e-24*t47
-    t184 = xp.where(xp.less_equal(t70, t183*t66), 0, xp.atan2(-t69, t68))
-    t185 = t184
-    t186 = t185 - 6.283185307179586*xp.floor(0.3333333333333333 + 0.15915494309189535*t185)
-    t187 = -t8
-    t188 = 3.141592653589793 + t187
-    t189 = t184 + t56
-    t190 = t187 + t189 + 6.283185307179586*xp.ceil(-0.15915494309189535*t188 - 0.15915494309189535*t189)
-    t191 = -t190
-    t192 = t190 + 6.283185307179586*xp.floor(0.3333333333333333 + 0.15915494309189535*t191)
-    t193 = xp.where(xp.less_equal(t76, t183*t77), 0, xp.atan2(-t75, t74))
-    t194 = t193
-    t195 = t194 - 6.283185307179586*xp.floor(0.3333333333333333 + 0.15915494309189535*t194)
-    t196 = t193 + t57
-    t197 = t187 + t196 + 6.283185307179586*xp.ceil(-0.15915494309189535*t188 - 0.15915494309189535*t196)
-    t198 = -t197
-    t199 = t197 + 6.283185307179586*xp.floor(0.3333333333333333 + 0.15915494309189535*t198)
-    t200 = 1e-24*t84
-    t201 = xp.where(xp.less_equal(t112, t101*t200), 0, xp.atan2(-t111, t110))
-    t202 = t201
-    t203 = t202 - 6.283185307179586*xp.floor(0.3333333333333333 + 0.15915494309189535*t202)
-    t204 = 3.141592653589793 + t7
-    t205 = t201 + t95
-    t206 = t205 + t7 + 6.283185307179586*xp.ceil(-0.15915494309189535*t204 - 0.15915494309189535*t205)
-    t207 = -t206
-    t208 = t206 + 6.283185307179586*xp.floor(0.3333333333333333 + 0.15915494309189535*t207)
-    t209 = xp.where(xp.less_equal(t116, t104*t200), 0, xp.atan2(-t115, t114))
-    t210 = t209
-    t211 = t210 - 6.283185307179586*xp.floor(0.3333333333333333 + 0.15915494309189535*t210)
-    t212 = t209 + t98
-    t213 = t212 + t7 + 6.283185307179586*xp.ceil(-0.15915494309189535*t204 - 0.15915494309189535*t212)
-    t214 = -t213
-    t215 = t213 + 6.283185307179586*xp.floor(0.3333333333333333 + 0.15915494309189535*t214)
-    t216 = 1e-24*t118
-    t217 = xp.where(xp.less_equal(t146, t135*t216), 0, xp.atan2(-t145, t144))
-    t218 = t217
-    t219 = t218 - 6.283185307179586*xp.floor(0.3333333333333333 + 0.15915494309189535*t218)
-    t220 = t129 + t217
-    t221 = t187 + t220 + 6.283185307179586*xp.ceil(-0.15915494309189535*t188 - 0.15915494309189535*t220)
-    t222 = -t221
-    t223 = t221 + 6.283185307179586*xp.floor(0.3333333333333333 + 0.15915494309189535*t222)
-    t224 = xp.where(xp.less_equal(t150, t138*t216), 0, xp.atan2(-t149, t148))
-    t225 = t224
-    t226 = t225 - 6.283185307179586*xp.floor(0.3333333333333333 + 0.15915494309189535*t225)
-    t227 = t132 + t224
-    t228 = t187 + t227 + 6.283185307179586*xp.ceil(-0.15915494309189535*t188 - 0.15915494309189535*t227)
-    t229 = -t228
-    t230 = t228 + 6.283185307179586*xp.floor(0.3333333333333333 + 0.15915494309189535*t229)
-    t231 = 1e-24*t120
-    t232 = xp.where(xp.less_equal(t175, t164*t231), 0, xp.atan2(-t174, t173))
-    t233 = t232
-    t234 = t233 - 6.283185307179586*xp.floor(0.3333333333333333 + 0.15915494309189535*t233)
-    t235 = t158 + t232
-    t236 = t235 + t7 + 6.283185307179586*xp.ceil(-0.15915494309189535*t204 - 0.15915494309189535*t235)
-    t237 = -t236
-    t238 = t236 + 6.283185307179586*xp.floor(0.3333333333333333 + 0.15915494309189535*t237)
-    t239 = xp.where(xp.less_equal(t179, t167*t231), 0, xp.atan2(-t178, t177))
-    t240 = t239
-    t241 = t240 - 6.283185307179586*xp.floor(0.3333333333333333 + 0.15915494309189535*t240)
-    t242 = t161 + t239
-    t243 = t242 + t7 + 6.283185307179586*xp.ceil(-0.15915494309189535*t204 - 0.15915494309189535*t242)
-    t244 = -t243
-    t245 = t243 + 6.283185307179586*xp.floor(0.3333333333333333 + 0.15915494309189535*t244)
-    t246 = xp.less_equal(t20, 3.141592653589793)
-    t247 = (xp.greater_equal(t19, -3.141592653589793)) & (xp.less_equal(t19, 3.141592653589793))
-    t248 = xp.where(t246 & xp.logical_not(t247), t20, t19)
-    t249 = t248
-    t250 = t249 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*qn1 - 0.15915494309189535*t249)
-    t251 = xp.where(xp.greater(qn1, t250), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t252 = t250 + t251
-    t253 = t250 - t251
-    t254 = xp.where((xp.greater_equal(t250, -3.141592653589793)) & (xp.less_equal(t250, 3.141592653589793)), t250, xp.where((xp.greater_equal(t252, -3.141592653589793)) & (xp.less_equal(t252, 3.141592653589793)), t252, xp.where((xp.greater_equal(t253, -3.141592653589793)) & (xp.less_equal(t253, 3.141592653589793)), t253, t248)))
-    t255 = xp.less_equal(t186, 2.0943951023931953)
-    t256 = (xp.greater_equal(t185, -2.0943951023931953)) & (xp.less_equal(t185, 2.0943951023931953))
-    t257 = xp.where(t255 & xp.logical_not(t256), t186, t185)
-    t258 = t257
-    t259 = t258 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t258)
-    t260 = xp.where(xp.greater(qn2, t259), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t261 = t259 + t260
-    t262 = t259 - t260
-    t263 = xp.where((xp.greater_equal(t259, -2.0943951023931953)) & (xp.less_equal(t259, 2.0943951023931953)), t259, xp.where((xp.greater_equal(t261, -2.0943951023931953)) & (xp.less_equal(t261, 2.0943951023931953)), t261, xp.where((xp.greater_equal(t262, -2.0943951023931953)) & (xp.less_equal(t262, 2.0943951023931953)), t262, t257)))
-    t264 = xp.less_equal(t59, 2.0943951023931953)
-    t265 = (xp.greater_equal(t58, -2.0943951023931953)) & (xp.less_equal(t58, 2.0943951023931953))
-    t266 = xp.where(t264 & xp.logical_not(t265), t59, t58)
-    t267 = t266
-    t268 = t267 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*qn3 - 0.15915494309189535*t267)
-    t269 = xp.where(xp.greater(qn3, t268), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t270 = t268 + t269
-    t271 = t268 - t269
-    t272 = xp.where((xp.greater_equal(t268, -2.0943951023931953)) & (xp.less_equal(t268, 2.0943951023931953)), t268, xp.where((xp.greater_equal(t270, -2.0943951023931953)) & (xp.less_equal(t270, 2.0943951023931953)), t270, xp.where((xp.greater_equal(t271, -2.0943951023931953)) & (xp.less_equal(t271, 2.0943951023931953)), t271, t266)))
-    t273 = xp.greater_equal(t192, -2.0943951023931953)
-    t274 = (xp.greater_equal(t190, -2.0943951023931953)) & (xp.less_equal(t190, 2.0943951023931953))
-    t275 = xp.where(t273 & xp.logical_not(t274), -t192, t191)
-    t276 = t275
-    t277 = t276 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t276)
-    t278 = xp.where(xp.greater(qn4, t277), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t279 = t277 + t278
-    t280 = t277 - t278
-    t281 = xp.where((xp.greater_equal(t277, -2.0943951023931953)) & (xp.less_equal(t277, 2.0943951023931953)), t277, xp.where((xp.greater_equal(t279, -2.0943951023931953)) & (xp.less_equal(t279, 2.0943951023931953)), t279, xp.where((xp.greater_equal(t280, -2.0943951023931953)) & (xp.less_equal(t280, 2.0943951023931953)), t280, t275)))
-    t282 = -qn1
-    t283 = qw1*(t254 + t282)**2
-    t284 = -qn2
-    t285 = -qn3
-    t286 = -qn4
-    t287 = t283 + qw2*(t263 + t284)**2 + qw3*(t272 + t285)**2 + qw4*(t281 + t286)**2
-    t288 = xp.isfinite(t181)
-    t289 = xp.less_equal(xp.abs(mu3), 1.5707963267948966)
-    t290 = t246 | t247
-    t291 = xp.greater(t12, t14)
-    t292 = t291 | (t15 & (xp.greater_equal(1e-12*t13, 0)))
-    t293 = xp.greater_equal(1e-12, -t3)
-    t294 = xp.where(t288 & t289 & t290 & t292 & t293 & (xp.greater_equal(t50, -1e-12)) & (t255 | t256) & (t264 | t265) & (t273 | t274), xp.asarray(1, dtype=dtype), 0)
-    t295 = xp.where(xp.greater(t294, 0), xp.asarray(1, dtype=dtype), 0)
-    t296 = xp.greater(t295, 0)
-    t297 = xp.where(t296, t254, qn1)
-    t298 = xp.where(t296, t263, qn2)
-    t299 = xp.where(t296, t272, qn3)
-    t300 = xp.where(t296, t281, qn4)
-    t301 = xp.where(t296, t287, 0)
-    t302 = xp.less_equal(t195, 2.0943951023931953)
-    t303 = (xp.greater_equal(t194, -2.0943951023931953)) & (xp.less_equal(t194, 2.0943951023931953))
-    t304 = xp.where(t302 & xp.logical_not(t303), t195, t194)
-    t305 = t304
-    t306 = t305 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t305)
-    t307 = xp.where(xp.greater(qn2, t306), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t308 = t306 + t307
-    t309 = t306 - t307
-    t310 = xp.where((xp.greater_equal(t306, -2.0943951023931953)) & (xp.less_equal(t306, 2.0943951023931953)), t306, xp.where((xp.greater_equal(t308, -2.0943951023931953)) & (xp.less_equal(t308, 2.0943951023931953)), t308, xp.where((xp.greater_equal(t309, -2.0943951023931953)) & (xp.less_equal(t309, 2.0943951023931953)), t309, t304)))
-    t311 = xp.less_equal(t61, 2.0943951023931953)
-    t312 = (xp.greater_equal(t60, -2.0943951023931953)) & (xp.less_equal(t60, 2.0943951023931953))
-    t313 = xp.where(t311 & xp.logical_not(t312), t61, t60)
-    t314 = t313
-    t315 = t314 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*qn3 - 0.15915494309189535*t314)
-    t316 = xp.where(xp.greater(qn3, t315), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t317 = t315 + t316
-    t318 = t315 - t316
-    t319 = xp.where((xp.greater_equal(t315, -2.0943951023931953)) & (xp.less_equal(t315, 2.0943951023931953)), t315, xp.where((xp.greater_equal(t317, -2.0943951023931953)) & (xp.less_equal(t317, 2.0943951023931953)), t317, xp.where((xp.greater_equal(t318, -2.0943951023931953)) & (xp.less_equal(t318, 2.0943951023931953)), t318, t313)))
-    t320 = xp.greater_equal(t199, -2.0943951023931953)
-    t321 = (xp.greater_equal(t197, -2.0943951023931953)) & (xp.less_equal(t197, 2.0943951023931953))
-    t322 = xp.where(t288 & t289 & t290 & t292 & t293 & t52 & (t302 | t303) & (t311 | t312) & (t320 | t321), xp.asarray(1, dtype=dtype), 0)
-    t323 = xp.where(t320 & xp.logical_not(t321), -t199, t198)
-    t324 = t323
-    t325 = t324 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t324)
-    t326 = xp.where(xp.greater(qn4, t325), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t327 = t325 + t326
-    t328 = t325 - t326
-    t329 = xp.where((xp.greater_equal(t325, -2.0943951023931953)) & (xp.less_equal(t325, 2.0943951023931953)), t325, xp.where((xp.greater_equal(t327, -2.0943951023931953)) & (xp.less_equal(t327, 2.0943951023931953)), t327, xp.where((xp.greater_equal(t328, -2.0943951023931953)) & (xp.less_equal(t328, 2.0943951023931953)), t328, t323)))
-    t330 = t283 + qw2*(t284 + t310)**2 + qw3*(t285 + t319)**2 + qw4*(t286 + t329)**2
-    t331 = xp.greater(t322, 0)
-    t332 = xp.where(t331 & ((xp.greater(t301, t330)) | (xp.less(t295, 1))), xp.asarray(1, dtype=dtype), 0)
-    t333 = xp.where(t331, 1, t295)
-    t334 = xp.greater(t332, 0)
-    t335 = xp.where(t334, t254, t297)
-    t336 = xp.where(t334, t310, t298)
-    t337 = xp.where(t334, t319, t299)
-    t338 = xp.where(t334, t329, t300)
-    t339 = xp.where(t334, t330, t301)
-    t340 = xp.less_equal(t203, 2.0943951023931953)
-    t341 = (xp.greater_equal(t202, -2.0943951023931953)) & (xp.less_equal(t202, 2.0943951023931953))
-    t342 = xp.where(t340 & xp.logical_not(t341), t203, t202)
-    t343 = t342
-    t344 = t343 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t343)
-    t345 = xp.where(xp.greater(qn2, t344), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t346 = t344 + t345
-    t347 = t344 - t345
-    t348 = xp.where((xp.greater_equal(t344, -2.0943951023931953)) & (xp.less_equal(t344, 2.0943951023931953)), t344, xp.where((xp.greater_equal(t346, -2.0943951023931953)) & (xp.less_equal(t346, 2.0943951023931953)), t346, xp.where((xp.greater_equal(t347, -2.0943951023931953)) & (xp.less_equal(t347, 2.0943951023931953)), t347, t342)))
-    t349 = xp.less_equal(t106, 2.0943951023931953)
-    t350 = (xp.greater_equal(t105, -2.0943951023931953)) & (xp.less_equal(t105, 2.0943951023931953))
-    t351 = xp.where(t349 & xp.logical_not(t350), t106, t105)
-    t352 = t351
-    t353 = t352 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*qn3 - 0.15915494309189535*t352)
-    t354 = xp.where(xp.greater(qn3, t353), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t355 = t353 + t354
-    t356 = t353 - t354
-    t357 = xp.where((xp.greater_equal(t353, -2.0943951023931953)) & (xp.less_equal(t353, 2.0943951023931953)), t353, xp.where((xp.greater_equal(t355, -2.0943951023931953)) & (xp.less_equal(t355, 2.0943951023931953)), t355, xp.where((xp.greater_equal(t356, -2.0943951023931953)) & (xp.less_equal(t356, 2.0943951023931953)), t356, t351)))
-    t358 = xp.greater_equal(t208, -2.0943951023931953)
-    t359 = (xp.greater_equal(t206, -2.0943951023931953)) & (xp.less_equal(t206, 2.0943951023931953))
-    t360 = xp.where(t288 & t289 & t290 & t292 & t4 & (xp.greater_equal(t89, -1e-12)) & (t340 | t341) & (t349 | t350) & (t358 | t359), xp.asarray(1, dtype=dtype), 0)
-    t361 = xp.where(t358 & xp.logical_not(t359), -t208, t207)
-    t362 = t361
-    t363 = t362 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t362)
-    t364 = xp.where(xp.greater(qn4, t363), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t365 = t363 + t364
-    t366 = t363 - t364
-    t367 = xp.where((xp.greater_equal(t363, -2.0943951023931953)) & (xp.less_equal(t363, 2.0943951023931953)), t363, xp.where((xp.greater_equal(t365, -2.0943951023931953)) & (xp.less_equal(t365, 2.0943951023931953)), t365, xp.where((xp.greater_equal(t366, -2.0943951023931953)) & (xp.less_equal(t366, 2.0943951023931953)), t366, t361)))
-    t368 = t283 + qw2*(t284 + t348)**2 + qw3*(t285 + t357)**2 + qw4*(t286 + t367)**2
-    t369 = xp.greater(t360, 0)
-    t370 = xp.where(t369 & ((xp.greater(t339, t368)) | (xp.less(t333, 1))), xp.asarray(1, dtype=dtype), 0)
-    t371 = xp.where(t369, 1, t333)
-    t372 = xp.greater(t370, 0)
-    t373 = xp.where(t372, t254, t335)
-    t374 = xp.where(t372, t348, t336)
-    t375 = xp.where(t372, t357, t337)
-    t376 = xp.where(t372, t367, t338)
-    t377 = xp.where(t372, t368, t339)
-    t378 = xp.less_equal(t211, 2.0943951023931953)
-    t379 = (xp.greater_equal(t210, -2.0943951023931953)) & (xp.less_equal(t210, 2.0943951023931953))
-    t380 = xp.where(t378 & xp.logical_not(t379), t211, t210)
-    t381 = t380
-    t382 = t381 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t381)
-    t383 = xp.where(xp.greater(qn2, t382), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t384 = t382 + t383
-    t385 = t382 - t383
-    t386 = xp.where((xp.greater_equal(t382, -2.0943951023931953)) & (xp.less_equal(t382, 2.0943951023931953)), t382, xp.where((xp.greater_equal(t384, -2.0943951023931953)) & (xp.less_equal(t384, 2.0943951023931953)), t384, xp.where((xp.greater_equal(t385, -2.0943951023931953)) & (xp.less_equal(t385, 2.0943951023931953)), t385, t380)))
-    t387 = xp.less_equal(t108, 2.0943951023931953)
-    t388 = (xp.greater_equal(t107, -2.0943951023931953)) & (xp.less_equal(t107, 2.0943951023931953))
-    t389 = xp.where(t387 & xp.logical_not(t388), t108, t107)
-    t390 = t389
-    t391 = t390 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*qn3 - 0.15915494309189535*t390)
-    t392 = xp.where(xp.greater(qn3, t391), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t393 = t391 + t392
-    t394 = t391 - t392
-    t395 = xp.where((xp.greater_equal(t391, -2.0943951023931953)) & (xp.less_equal(t391, 2.0943951023931953)), t391, xp.where((xp.greater_equal(t393, -2.0943951023931953)) & (xp.less_equal(t393, 2.0943951023931953)), t393, xp.where((xp.greater_equal(t394, -2.0943951023931953)) & (xp.less_equal(t394, 2.0943951023931953)), t394, t389)))
-    t396 = xp.greater_equal(t215, -2.0943951023931953)
-    t397 = (xp.greater_equal(t213, -2.0943951023931953)) & (xp.less_equal(t213, 2.0943951023931953))
-    t398 = xp.where(t288 & t289 & t290 & t292 & t4 & t91 & (t378 | t379) & (t387 | t388) & (t396 | t397), xp.asarray(1, dtype=dtype), 0)
-    t399 = xp.where(t396 & xp.logical_not(t397), -t215, t214)
-    t400 = t399
-    t401 = t400 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t400)
-    t402 = xp.where(xp.greater(qn4, t401), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t403 = t401 + t402
-    t404 = t401 - t402
-    t405 = xp.where((xp.greater_equal(t401, -2.0943951023931953)) & (xp.less_equal(t401, 2.0943951023931953)), t401, xp.where((xp.greater_equal(t403, -2.0943951023931953)) & (xp.less_equal(t403, 2.0943951023931953)), t403, xp.where((xp.greater_equal(t404, -2.0943951023931953)) & (xp.less_equal(t404, 2.0943951023931953)), t404, t399)))
-    t406 = t283 + qw2*(t284 + t386)**2 + qw3*(t285 + t395)**2 + qw4*(t286 + t405)**2
-    t407 = xp.greater(t398, 0)
-    t408 = xp.where(t407 & ((xp.greater(t377, t406)) | (xp.less(t371, 1))), xp.asarray(1, dtype=dtype), 0)
-    t409 = xp.where(t407, 1, t371)
-    t410 = xp.greater(t408, 0)
-    t411 = xp.where(t410, t254, t373)
-    t412 = xp.where(t410, t386, t374)
-    t413 = xp.where(t410, t395, t375)
-    t414 = xp.where(t410, t405, t376)
-    t415 = xp.where(t410, t406, t377)
-    t416 = xp.less_equal(t22, 3.141592653589793)
-    t417 = (xp.greater_equal(t21, -3.141592653589793)) & (xp.less_equal(t21, 3.141592653589793))
-    t418 = xp.where(t416 & xp.logical_not(t417), t22, t21)
-    t419 = t418
-    t420 = t419 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*qn1 - 0.15915494309189535*t419)
-    t421 = xp.where(xp.greater(qn1, t420), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t422 = t420 + t421
-    t423 = t420 - t421
-    t424 = xp.where((xp.greater_equal(t420, -3.141592653589793)) & (xp.less_equal(t420, 3.141592653589793)), t420, xp.where((xp.greater_equal(t422, -3.141592653589793)) & (xp.less_equal(t422, 3.141592653589793)), t422, xp.where((xp.greater_equal(t423, -3.141592653589793)) & (xp.less_equal(t423, 3.141592653589793)), t423, t418)))
-    t425 = xp.less_equal(t219, 2.0943951023931953)
-    t426 = (xp.greater_equal(t218, -2.0943951023931953)) & (xp.less_equal(t218, 2.0943951023931953))
-    t427 = xp.where(t425 & xp.logical_not(t426), t219, t218)
-    t428 = t427
-    t429 = t428 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t428)
-    t430 = xp.where(xp.greater(qn2, t429), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t431 = t429 + t430
-    t432 = t429 - t430
-    t433 = xp.where((xp.greater_equal(t429, -2.0943951023931953)) & (xp.less_equal(t429, 2.0943951023931953)), t429, xp.where((xp.greater_equal(t431, -2.0943951023931953)) & (xp.less_equal(t431, 2.0943951023931953)), t431, xp.where((xp.greater_equal(t432, -2.0943951023931953)) & (xp.less_equal(t432, 2.0943951023931953)), t432, t427)))
-    t434 = xp.less_equal(t140, 2.0943951023931953)
-    t435 = (xp.greater_equal(t139, -2.0943951023931953)) & (xp.less_equal(t139, 2.0943951023931953))
-    t436 = xp.where(t434 & xp.logical_not(t435), t140, t139)
-    t437 = t436
-    t438 = t437 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*qn3 - 0.15915494309189535*t437)
-    t439 = xp.where(xp.greater(qn3, t438), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t440 = t438 + t439
-    t441 = t438 - t439
-    t442 = xp.where((xp.greater_equal(t438, -2.0943951023931953)) & (xp.less_equal(t438, 2.0943951023931953)), t438, xp.where((xp.greater_equal(t440, -2.0943951023931953)) & (xp.less_equal(t440, 2.0943951023931953)), t440, xp.where((xp.greater_equal(t441, -2.0943951023931953)) & (xp.less_equal(t441, 2.0943951023931953)), t441, t436)))
-    t443 = xp.greater_equal(t223, -2.0943951023931953)
-    t444 = (xp.greater_equal(t221, -2.0943951023931953)) & (xp.less_equal(t221, 2.0943951023931953))
-    t445 = xp.where(t443 & xp.logical_not(t444), -t223, t222)
-    t446 = t445
-    t447 = t446 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t446)
-    t448 = xp.where(xp.greater(qn4, t447), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t449 = t447 + t448
-    t450 = t447 - t448
-    t451 = xp.where((xp.greater_equal(t447, -2.0943951023931953)) & (xp.less_equal(t447, 2.0943951023931953)), t447, xp.where((xp.greater_equal(t449, -2.0943951023931953)) & (xp.less_equal(t449, 2.0943951023931953)), t449, xp.where((xp.greater_equal(t450, -2.0943951023931953)) & (xp.less_equal(t450, 2.0943951023931953)), t450, t445)))
-    t452 = qw1*(t282 + t424)**2
-    t453 = t452 + qw2*(t284 + t433)**2 + qw3*(t285 + t442)**2 + qw4*(t286 + t451)**2
-    t454 = t416 | t417
-    t455 = xp.where(t288 & t289 & t291 & t293 & t454 & (xp.greater_equal(t123, -1e-12)) & (t425 | t426) & (t434 | t435) & (t443 | t444), xp.asarray(1, dtype=dtype), 0)
-    t456 = xp.greater(t455, 0)
-    t457 = xp.where(t456 & ((xp.greater(t415, t453)) | (xp.less(t409, 1))), xp.asarray(1, dtype=dtype), 0)
-    t458 = xp.where(t456, 1, t409)
-    t459 = xp.greater(t457, 0)
-    t460 = xp.where(t459, t424, t411)
-    t461 = xp.where(t459, t433, t412)
-    t462 = xp.where(t459, t442, t413)
-    t463 = xp.where(t459, t451, t414)
-    t464 = xp.where(t459, t453, t415)
-    t465 = xp.less_equal(t226, 2.0943951023931953)
-    t466 = (xp.greater_equal(t225, -2.0943951023931953)) & (xp.less_equal(t225, 2.0943951023931953))
-    t467 = xp.where(t465 & xp.logical_not(t466), t226, t225)
-    t468 = t467
-    t469 = t468 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t468)
-    t470 = xp.where(xp.greater(qn2, t469), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t471 = t469 + t470
-    t472 = t469 - t470
-    t473 = xp.where((xp.greater_equal(t469, -2.0943951023931953)) & (xp.less_equal(t469, 2.0943951023931953)), t469, xp.where((xp.greater_equal(t471, -2.0943951023931953)) & (xp.less_equal(t471, 2.0943951023931953)), t471, xp.where((xp.greater_equal(t472, -2.0943951023931953)) & (xp.less_equal(t472, 2.0943951023931953)), t472, t467)))
-    t474 = xp.less_equal(t142, 2.0943951023931953)
-    t475 = (xp.greater_equal(t141, -2.0943951023931953)) & (xp.less_equal(t141, 2.0943951023931953))
-    t476 = xp.where(t474 & xp.logical_not(t475), t142, t141)
-    t477 = t476
-    t478 = t477 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*qn3 - 0.15915494309189535*t477)
-    t479 = xp.where(xp.greater(qn3, t478), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t480 = t478 + t479
-    t481 = t478 - t479
-    t482 = xp.where((xp.greater_equal(t478, -2.0943951023931953)) & (xp.less_equal(t478, 2.0943951023931953)), t478, xp.where((xp.greater_equal(t480, -2.0943951023931953)) & (xp.less_equal(t480, 2.0943951023931953)), t480, xp.where((xp.greater_equal(t481, -2.0943951023931953)) & (xp.less_equal(t481, 2.0943951023931953)), t481, t476)))
-    t483 = xp.greater_equal(t230, -2.0943951023931953)
-    t484 = (xp.greater_equal(t228, -2.0943951023931953)) & (xp.less_equal(t228, 2.0943951023931953))
-    t485 = xp.where(t125 & t288 & t289 & t291 & t293 & t454 & (t465 | t466) & (t474 | t475) & (t483 | t484), xp.asarray(1, dtype=dtype), 0)
-    t486 = xp.where(t483 & xp.logical_not(t484), -t230, t229)
-    t487 = t486
-    t488 = t487 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t487)
-    t489 = xp.where(xp.greater(qn4, t488), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t490 = t488 + t489
-    t491 = t488 - t489
-    t492 = xp.where((xp.greater_equal(t488, -2.0943951023931953)) & (xp.less_equal(t488, 2.0943951023931953)), t488, xp.where((xp.greater_equal(t490, -2.0943951023931953)) & (xp.less_equal(t490, 2.0943951023931953)), t490, xp.where((xp.greater_equal(t491, -2.0943951023931953)) & (xp.less_equal(t491, 2.0943951023931953)), t491, t486)))
-    t493 = t452 + qw2*(t284 + t473)**2 + qw3*(t285 + t482)**2 + qw4*(t286 + t492)**2
-    t494 = xp.greater(t485, 0)
-    t495 = xp.where(t494 & ((xp.greater(t464, t493)) | (xp.less(t458, 1))), xp.asarray(1, dtype=dtype), 0)
-    t496 = xp.where(t494, 1, t458)
-    t497 = xp.greater(t495, 0)
-    t498 = xp.where(t497, t424, t460)
-    t499 = xp.where(t497, t473, t461)
-    t500 = xp.where(t497, t482, t462)
-    t501 = xp.where(t497, t492, t463)
-    t502 = xp.where(t497, t493, t464)
-    t503 = xp.less_equal(t234, 2.0943951023931953)
-    t504 = (xp.greater_equal(t233, -2.0943951023931953)) & (xp.less_equal(t233, 2.0943951023931953))
-    t505 = xp.where(t503 & xp.logical_not(t504), t234, t233)
-    t506 = t505
-    t507 = t506 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t506)
-    t508 = xp.where(xp.greater(qn2, t507), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t509 = t507 + t508
-    t510 = t507 - t508
-    t511 = xp.where((xp.greater_equal(t507, -2.0943951023931953)) & (xp.less_equal(t507, 2.0943951023931953)), t507, xp.where((xp.greater_equal(t509, -2.0943951023931953)) & (xp.less_equal(t509, 2.0943951023931953)), t509, xp.where((xp.greater_equal(t510, -2.0943951023931953)) & (xp.less_equal(t510, 2.0943951023931953)), t510, t505)))
-    t512 = xp.less_equal(t169, 2.0943951023931953)
-    t513 = (xp.greater_equal(t168, -2.0943951023931953)) & (xp.less_equal(t168, 2.0943951023931953))
-    t514 = xp.where(t512 & xp.logical_not(t513), t169, t168)
-    t515 = t514
-    t516 = t515 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*qn3 - 0.15915494309189535*t515)
-    t517 = xp.where(xp.greater(qn3, t516), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t518 = t516 + t517
-    t519 = t516 - t517
-    t520 = xp.where((xp.greater_equal(t516, -2.0943951023931953)) & (xp.less_equal(t516, 2.0943951023931953)), t516, xp.where((xp.greater_equal(t518, -2.0943951023931953)) & (xp.less_equal(t518, 2.0943951023931953)), t518, xp.where((xp.greater_equal(t519, -2.0943951023931953)) & (xp.less_equal(t519, 2.0943951023931953)), t519, t514)))
-    t521 = xp.greater_equal(t238, -2.0943951023931953)
-    t522 = (xp.greater_equal(t236, -2.0943951023931953)) & (xp.less_equal(t236, 2.0943951023931953))
-    t523 = xp.where(t288 & t289 & t291 & t4 & t454 & (xp.greater_equal(t152, -1e-12)) & (t503 | t504) & (t512 | t513) & (t521 | t522), xp.asarray(1, dtype=dtype), 0)
-    t524 = xp.where(t521 & xp.logical_not(t522), -t238, t237)
-    t525 = t524
-    t526 = t525 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t525)
-    t527 = xp.where(xp.greater(qn4, t526), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t528 = t526 + t527
-    t529 = t526 - t527
-    t530 = xp.where((xp.greater_equal(t526, -2.0943951023931953)) & (xp.less_equal(t526, 2.0943951023931953)), t526, xp.where((xp.greater_equal(t528, -2.0943951023931953)) & (xp.less_equal(t528, 2.0943951023931953)), t528, xp.where((xp.greater_equal(t529, -2.0943951023931953)) & (xp.less_equal(t529, 2.0943951023931953)), t529, t524)))
-    t531 = t452 + qw2*(t284 + t511)**2 + qw3*(t285 + t520)**2 + qw4*(t286 + t530)**2
-    t532 = xp.greater(t523, 0)
-    t533 = xp.where(t532 & ((xp.greater(t502, t531)) | (xp.less(t496, 1))), xp.asarray(1, dtype=dtype), 0)
-    t534 = xp.where(t532, 1, t496)
-    t535 = xp.greater(t533, 0)
-    t536 = xp.where(t535, t424, t498)
-    t537 = xp.where(t535, t511, t499)
-    t538 = xp.where(t535, t520, t500)
-    t539 = xp.where(t535, t530, t501)
-    t540 = xp.where(t535, t531, t502)
-    t541 = xp.less_equal(t241, 2.0943951023931953)
-    t542 = (xp.greater_equal(t240, -2.0943951023931953)) & (xp.less_equal(t240, 2.0943951023931953))
-    t543 = xp.where(t541 & xp.logical_not(t542), t241, t240)
-    t544 = t543
-    t545 = t544 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t544)
-    t546 = xp.where(xp.greater(qn2, t545), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t547 = t545 + t546
-    t548 = t545 - t546
-    t549 = xp.where((xp.greater_equal(t545, -2.0943951023931953)) & (xp.less_equal(t545, 2.0943951023931953)), t545, xp.where((xp.greater_equal(t547, -2.0943951023931953)) & (xp.less_equal(t547, 2.0943951023931953)), t547, xp.where((xp.greater_equal(t548, -2.0943951023931953)) & (xp.less_equal(t548, 2.0943951023931953)), t548, t543)))
-    t550 = xp.less_equal(t171, 2.0943951023931953)
-    t551 = (xp.greater_equal(t170, -2.0943951023931953)) & (xp.less_equal(t170, 2.0943951023931953))
-    t552 = xp.where(t550 & xp.logical_not(t551), t171, t170)
-    t553 = t552
-    t554 = t553 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*qn3 - 0.15915494309189535*t553)
-    t555 = xp.where(xp.greater(qn3, t554), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t556 = t554 + t555
-    t557 = t554 - t555
-    t558 = xp.where((xp.greater_equal(t554, -2.0943951023931953)) & (xp.less_equal(t554, 2.0943951023931953)), t554, xp.where((xp.greater_equal(t556, -2.0943951023931953)) & (xp.less_equal(t556, 2.0943951023931953)), t556, xp.where((xp.greater_equal(t557, -2.0943951023931953)) & (xp.less_equal(t557, 2.0943951023931953)), t557, t552)))
-    t559 = xp.greater_equal(t245, -2.0943951023931953)
-    t560 = (xp.greater_equal(t243, -2.0943951023931953)) & (xp.less_equal(t243, 2.0943951023931953))
-    t561 = xp.where(t154 & t288 & t289 & t291 & t4 & t454 & (t541 | t542) & (t550 | t551) & (t559 | t560), xp.asarray(1, dtype=dtype), 0)
-    t562 = xp.where(t559 & xp.logical_not(t560), -t245, t244)
-    t563 = t562
-    t564 = t563 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t563)
-    t565 = xp.where(xp.greater(qn4, t564), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t566 = t564 + t565
-    t567 = t564 - t565
-    t568 = xp.where((xp.greater_equal(t564, -2.0943951023931953)) & (xp.less_equal(t564, 2.0943951023931953)), t564, xp.where((xp.greater_equal(t566, -2.0943951023931953)) & (xp.less_equal(t566, 2.0943951023931953)), t566, xp.where((xp.greater_equal(t567, -2.0943951023931953)) & (xp.less_equal(t567, 2.0943951023931953)), t567, t562)))
-    t569 = t452 + qw2*(t284 + t549)**2 + qw3*(t285 + t558)**2 + qw4*(t286 + t568)**2
-    t570 = xp.greater(t561, 0)
-    t571 = xp.where(t570 & ((xp.greater(t540, t569)) | (xp.less(t534, 1))), xp.asarray(1, dtype=dtype), 0)
-    t572 = xp.where(t570, 1, t534)
-    t573 = xp.greater(t571, 0)
-    t574 = xp.where(t573, t424, t536)
-    t575 = xp.where(t573, t549, t537)
-    t576 = xp.where(t573, t558, t538)
-    t577 = xp.where(t573, t568, t539)
-    t578 = xp.isfinite(t182)
-    t579 = xp.greater(t572, 0)
-    t580 = t578 & t579
+    qb0_0 = branches_q[..., 0, 0]
+    qb0_1 = branches_q[..., 0, 1]
+    qb0_2 = branches_q[..., 0, 2]
+    qb0_3 = branches_q[..., 0, 3]
+    qb1_0 = branches_q[..., 1, 0]
+    qb1_1 = branches_q[..., 1, 1]
+    qb1_2 = branches_q[..., 1, 2]
+    qb1_3 = branches_q[..., 1, 3]
+    qb2_0 = branches_q[..., 2, 0]
+    qb2_1 = branches_q[..., 2, 1]
+    qb2_2 = branches_q[..., 2, 2]
+    qb2_3 = branches_q[..., 2, 3]
+    qb3_0 = branches_q[..., 3, 0]
+    qb3_1 = branches_q[..., 3, 1]
+    qb3_2 = branches_q[..., 3, 2]
+    qb3_3 = branches_q[..., 3, 3]
+    qb4_0 = branches_q[..., 4, 0]
+    qb4_1 = branches_q[..., 4, 1]
+    qb4_2 = branches_q[..., 4, 2]
+    qb4_3 = branches_q[..., 4, 3]
+    qb5_0 = branches_q[..., 5, 0]
+    qb5_1 = branches_q[..., 5, 1]
+    qb5_2 = branches_q[..., 5, 2]
+    qb5_3 = branches_q[..., 5, 3]
+    qb6_0 = branches_q[..., 6, 0]
+    qb6_1 = branches_q[..., 6, 1]
+    qb6_2 = branches_q[..., 6, 2]
+    qb6_3 = branches_q[..., 6, 3]
+    qb7_0 = branches_q[..., 7, 0]
+    qb7_1 = branches_q[..., 7, 1]
+    qb7_2 = branches_q[..., 7, 2]
+    qb7_3 = branches_q[..., 7, 3]
+    vb0 = branches_valid[..., 0]
+    vb1 = branches_valid[..., 1]
+    vb2 = branches_valid[..., 2]
+    vb3 = branches_valid[..., 3]
+    vb4 = branches_valid[..., 4]
+    vb5 = branches_valid[..., 5]
+    vb6 = branches_valid[..., 6]
+    vb7 = branches_valid[..., 7]
+    lb0 = branches_in_limits[..., 0]
+    lb1 = branches_in_limits[..., 1]
+    lb2 = branches_in_limits[..., 2]
+    lb3 = branches_in_limits[..., 3]
+    lb4 = branches_in_limits[..., 4]
+    lb5 = branches_in_limits[..., 5]
+    lb6 = branches_in_limits[..., 6]
+    lb7 = branches_in_limits[..., 7]
+    t0 = qb0_0 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn1 - qb0_0))
+    t1 = qb0_1 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn2 - qb0_1))
+    t2 = qb0_2 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn3 - qb0_2))
+    t3 = qb0_3 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn4 - qb0_3))
+    t4 = xp.where(lb0 & vb0, xp.asarray(1, dtype=dtype), 0)
+    t5 = xp.where(xp.greater(t4, 0), xp.asarray(1, dtype=dtype), 0)
+    t6 = qb1_0 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn1 - qb1_0))
+    t7 = qb1_1 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn2 - qb1_1))
+    t8 = qb1_2 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn3 - qb1_2))
+    t9 = qb1_3 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn4 - qb1_3))
+    t10 = xp.where(lb1 & vb1, xp.asarray(1, dtype=dtype), 0)
+    t11 = qb2_0 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn1 - qb2_0))
+    t12 = qb2_1 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn2 - qb2_1))
+    t13 = qb2_2 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn3 - qb2_2))
+    t14 = qb2_3 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn4 - qb2_3))
+    t15 = xp.where(lb2 & vb2, xp.asarray(1, dtype=dtype), 0)
+    t16 = qb3_0 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn1 - qb3_0))
+    t17 = qb3_1 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn2 - qb3_1))
+    t18 = qb3_2 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn3 - qb3_2))
+    t19 = qb3_3 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn4 - qb3_3))
+    t20 = xp.where(lb3 & vb3, xp.asarray(1, dtype=dtype), 0)
+    t21 = qb4_0 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn1 - qb4_0))
+    t22 = qb4_1 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn2 - qb4_1))
+    t23 = qb4_2 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn3 - qb4_2))
+    t24 = qb4_3 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn4 - qb4_3))
+    t25 = xp.where(lb4 & vb4, xp.asarray(1, dtype=dtype), 0)
+    t26 = qb5_0 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn1 - qb5_0))
+    t27 = qb5_1 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn2 - qb5_1))
+    t28 = qb5_2 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn3 - qb5_2))
+    t29 = qb5_3 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn4 - qb5_3))
+    t30 = xp.where(lb5 & vb5, xp.asarray(1, dtype=dtype), 0)
+    t31 = qb6_0 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn1 - qb6_0))
+    t32 = qb6_1 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn2 - qb6_1))
+    t33 = qb6_2 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn3 - qb6_2))
+    t34 = qb6_3 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn4 - qb6_3))
+    t35 = xp.where(lb6 & vb6, xp.asarray(1, dtype=dtype), 0)
+    t36 = qb7_0 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn1 - qb7_0))
+    t37 = qb7_1 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn2 - qb7_1))
+    t38 = qb7_2 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn3 - qb7_2))
+    t39 = qb7_3 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn4 - qb7_3))
+    t40 = xp.where(lb7 & vb7, xp.asarray(1, dtype=dtype), 0)
+    t41 = mu0 + mu1 + mu2 + mu3 + qn1 + qn2 + qn3 + qn4 + qw1 + qw2 + qw3 + qw4
+    t42 = xp.where(xp.greater(qn1, t0), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t43 = t0 + t42
+    t44 = t0 - t42
+    t45 = xp.where((xp.greater_equal(t0, -3.141592653589793)) & (xp.less_equal(t0, 3.141592653589793)), t0, xp.where((xp.greater_equal(t43, -3.141592653589793)) & (xp.less_equal(t43, 3.141592653589793)), t43, xp.where((xp.greater_equal(t44, -3.141592653589793)) & (xp.less_equal(t44, 3.141592653589793)), t44, qb0_0)))
+    t46 = xp.where(xp.greater(qn2, t1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t47 = t1 + t46
+    t48 = t1 - t46
+    t49 = xp.where((xp.greater_equal(t1, -2.0943951023931953)) & (xp.less_equal(t1, 2.0943951023931953)), t1, xp.where((xp.greater_equal(t47, -2.0943951023931953)) & (xp.less_equal(t47, 2.0943951023931953)), t47, xp.where((xp.greater_equal(t48, -2.0943951023931953)) & (xp.less_equal(t48, 2.0943951023931953)), t48, qb0_1)))
+    t50 = xp.where(xp.greater(qn3, t2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t51 = t2 + t50
+    t52 = t2 - t50
+    t53 = xp.where((xp.greater_equal(t2, -2.0943951023931953)) & (xp.less_equal(t2, 2.0943951023931953)), t2, xp.where((xp.greater_equal(t51, -2.0943951023931953)) & (xp.less_equal(t51, 2.0943951023931953)), t51, xp.where((xp.greater_equal(t52, -2.0943951023931953)) & (xp.less_equal(t52, 2.0943951023931953)), t52, qb0_2)))
+    t54 = xp.where(xp.greater(qn4, t3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t55 = t3 + t54
+    t56 = t3 - t54
+    t57 = xp.where((xp.greater_equal(t3, -2.0943951023931953)) & (xp.less_equal(t3, 2.0943951023931953)), t3, xp.where((xp.greater_equal(t55, -2.0943951023931953)) & (xp.less_equal(t55, 2.0943951023931953)), t55, xp.where((xp.greater_equal(t56, -2.0943951023931953)) & (xp.less_equal(t56, 2.0943951023931953)), t56, qb0_3)))
+    t58 = -qn1
+    t59 = -qn2
+    t60 = -qn3
+    t61 = -qn4
+    t62 = qw1*(t45 + t58)**2 + qw2*(t49 + t59)**2 + qw3*(t53 + t60)**2 + qw4*(t57 + t61)**2
+    t63 = xp.greater(t5, 0)
+    t64 = xp.where(t63, t45, qn1)
+    t65 = xp.where(t63, t49, qn2)
+    t66 = xp.where(t63, t53, qn3)
+    t67 = xp.where(t63, t57, qn4)
+    t68 = xp.where(t63, t62, 0)
+    t69 = xp.where(xp.greater(qn1, t6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t70 = t6 + t69
+    t71 = t6 - t69
+    t72 = xp.where((xp.greater_equal(t6, -3.141592653589793)) & (xp.less_equal(t6, 3.141592653589793)), t6, xp.where((xp.greater_equal(t70, -3.141592653589793)) & (xp.less_equal(t70, 3.141592653589793)), t70, xp.where((xp.greater_equal(t71, -3.141592653589793)) & (xp.less_equal(t71, 3.141592653589793)), t71, qb1_0)))
+    t73 = xp.where(xp.greater(qn2, t7), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t74 = t7 + t73
+    t75 = t7 - t73
+    t76 = xp.where((xp.greater_equal(t7, -2.0943951023931953)) & (xp.less_equal(t7, 2.0943951023931953)), t7, xp.where((xp.greater_equal(t74, -2.0943951023931953)) & (xp.less_equal(t74, 2.0943951023931953)), t74, xp.where((xp.greater_equal(t75, -2.0943951023931953)) & (xp.less_equal(t75, 2.0943951023931953)), t75, qb1_1)))
+    t77 = xp.where(xp.greater(qn3, t8), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t78 = t77 + t8
+    t79 = t8 - t77
+    t80 = xp.where((xp.greater_equal(t8, -2.0943951023931953)) & (xp.less_equal(t8, 2.0943951023931953)), t8, xp.where((xp.greater_equal(t78, -2.0943951023931953)) & (xp.less_equal(t78, 2.0943951023931953)), t78, xp.where((xp.greater_equal(t79, -2.0943951023931953)) & (xp.less_equal(t79, 2.0943951023931953)), t79, qb1_2)))
+    t81 = xp.where(xp.greater(qn4, t9), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t82 = t81 + t9
+    t83 = t9 - t81
+    t84 = xp.where((xp.greater_equal(t9, -2.0943951023931953)) & (xp.less_equal(t9, 2.0943951023931953)), t9, xp.where((xp.greater_equal(t82, -2.0943951023931953)) & (xp.less_equal(t82, 2.0943951023931953)), t82, xp.where((xp.greater_equal(t83, -2.0943951023931953)) & (xp.less_equal(t83, 2.0943951023931953)), t83, qb1_3)))
+    t85 = qw1*(t58 + t72)**2 + qw2*(t59 + t76)**2 + qw3*(t60 + t80)**2 + qw4*(t61 + t84)**2
+    t86 = xp.greater(t10, 0)
+    t87 = xp.where(t86 & ((xp.greater(t68, t85)) | (xp.less(t5, 1))), xp.asarray(1, dtype=dtype), 0)
+    t88 = xp.where(t86, 1, t5)
+    t89 = xp.greater(t87, 0)
+    t90 = xp.where(t89, t72, t64)
+    t91 = xp.where(t89, t76, t65)
+    t92 = xp.where(t89, t80, t66)
+    t93 = xp.where(t89, t84, t67)
+    t94 = xp.where(t89, t85, t68)
+    t95 = xp.where(xp.greater(qn1, t11), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t96 = t11 + t95
+    t97 = t11 - t95
+    t98 = xp.where((xp.greater_equal(t11, -3.141592653589793)) & (xp.less_equal(t11, 3.141592653589793)), t11, xp.where((xp.greater_equal(t96, -3.141592653589793)) & (xp.less_equal(t96, 3.141592653589793)), t96, xp.where((xp.greater_equal(t97, -3.141592653589793)) & (xp.less_equal(t97, 3.141592653589793)), t97, qb2_0)))
+    t99 = xp.where(xp.greater(qn2, t12), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t100 = t12 + t99
+    t101 = t12 - t99
+    t102 = xp.where((xp.greater_equal(t12, -2.0943951023931953)) & (xp.less_equal(t12, 2.0943951023931953)), t12, xp.where((xp.greater_equal(t100, -2.0943951023931953)) & (xp.less_equal(t100, 2.0943951023931953)), t100, xp.where((xp.greater_equal(t101, -2.0943951023931953)) & (xp.less_equal(t101, 2.0943951023931953)), t101, qb2_1)))
+    t103 = xp.where(xp.greater(qn3, t13), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t104 = t103 + t13
+    t105 = t13 - t103
+    t106 = xp.where((xp.greater_equal(t13, -2.0943951023931953)) & (xp.less_equal(t13, 2.0943951023931953)), t13, xp.where((xp.greater_equal(t104, -2.0943951023931953)) & (xp.less_equal(t104, 2.0943951023931953)), t104, xp.where((xp.greater_equal(t105, -2.0943951023931953)) & (xp.less_equal(t105, 2.0943951023931953)), t105, qb2_2)))
+    t107 = xp.where(xp.greater(qn4, t14), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t108 = t107 + t14
+    t109 = t14 - t107
+    t110 = xp.where((xp.greater_equal(t14, -2.0943951023931953)) & (xp.less_equal(t14, 2.0943951023931953)), t14, xp.where((xp.greater_equal(t108, -2.0943951023931953)) & (xp.less_equal(t108, 2.0943951023931953)), t108, xp.where((xp.greater_equal(t109, -2.0943951023931953)) & (xp.less_equal(t109, 2.0943951023931953)), t109, qb2_3)))
+    t111 = qw1*(t58 + t98)**2 + qw2*(t102 + t59)**2 + qw3*(t106 + t60)**2 + qw4*(t110 + t61)**2
+    t112 = xp.greater(t15, 0)
+    t113 = xp.where(t112 & ((xp.less(t111, t94)) | (xp.less(t88, 1))), xp.asarray(1, dtype=dtype), 0)
+    t114 = xp.where(t112, 1, t88)
+    t115 = xp.greater(t113, 0)
+    t116 = xp.where(t115, t98, t90)
+    t117 = xp.where(t115, t102, t91)
+    t118 = xp.where(t115, t106, t92)
+    t119 = xp.where(t115, t110, t93)
+    t120 = xp.where(t115, t111, t94)
+    t121 = xp.where(xp.greater(qn1, t16), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t122 = t121 + t16
+    t123 = t16 - t121
+    t124 = xp.where((xp.greater_equal(t16, -3.141592653589793)) & (xp.less_equal(t16, 3.141592653589793)), t16, xp.where((xp.greater_equal(t122, -3.141592653589793)) & (xp.less_equal(t122, 3.141592653589793)), t122, xp.where((xp.greater_equal(t123, -3.141592653589793)) & (xp.less_equal(t123, 3.141592653589793)), t123, qb3_0)))
+    t125 = xp.where(xp.greater(qn2, t17), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t126 = t125 + t17
+    t127 = t17 - t125
+    t128 = xp.where((xp.greater_equal(t17, -2.0943951023931953)) & (xp.less_equal(t17, 2.0943951023931953)), t17, xp.where((xp.greater_equal(t126, -2.0943951023931953)) & (xp.less_equal(t126, 2.0943951023931953)), t126, xp.where((xp.greater_equal(t127, -2.0943951023931953)) & (xp.less_equal(t127, 2.0943951023931953)), t127, qb3_1)))
+    t129 = xp.where(xp.greater(qn3, t18), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t130 = t129 + t18
+    t131 = t18 - t129
+    t132 = xp.where((xp.greater_equal(t18, -2.0943951023931953)) & (xp.less_equal(t18, 2.0943951023931953)), t18, xp.where((xp.greater_equal(t130, -2.0943951023931953)) & (xp.less_equal(t130, 2.0943951023931953)), t130, xp.where((xp.greater_equal(t131, -2.0943951023931953)) & (xp.less_equal(t131, 2.0943951023931953)), t131, qb3_2)))
+    t133 = xp.where(xp.greater(qn4, t19), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t134 = t133 + t19
+    t135 = t19 - t133
+    t136 = xp.where((xp.greater_equal(t19, -2.0943951023931953)) & (xp.less_equal(t19, 2.0943951023931953)), t19, xp.where((xp.greater_equal(t134, -2.0943951023931953)) & (xp.less_equal(t134, 2.0943951023931953)), t134, xp.where((xp.greater_equal(t135, -2.0943951023931953)) & (xp.less_equal(t135, 2.0943951023931953)), t135, qb3_3)))
+    t137 = qw1*(t124 + t58)**2 + qw2*(t128 + t59)**2 + qw3*(t132 + t60)**2 + qw4*(t136 + t61)**2
+    t138 = xp.greater(t20, 0)
+    t139 = xp.where(t138 & ((xp.greater(t120, t137)) | (xp.less(t114, 1))), xp.asarray(1, dtype=dtype), 0)
+    t140 = xp.where(t138, 1, t114)
+    t141 = xp.greater(t139, 0)
+    t142 = xp.where(t141, t124, t116)
+    t143 = xp.where(t141, t128, t117)
+    t144 = xp.where(t141, t132, t118)
+    t145 = xp.where(t141, t136, t119)
+    t146 = xp.where(t141, t137, t120)
+    t147 = xp.where(xp.greater(qn1, t21), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t148 = t147 + t21
+    t149 = t21 - t147
+    t150 = xp.where((xp.greater_equal(t21, -3.141592653589793)) & (xp.less_equal(t21, 3.141592653589793)), t21, xp.where((xp.greater_equal(t148, -3.141592653589793)) & (xp.less_equal(t148, 3.141592653589793)), t148, xp.where((xp.greater_equal(t149, -3.141592653589793)) & (xp.less_equal(t149, 3.141592653589793)), t149, qb4_0)))
+    t151 = xp.where(xp.greater(qn2, t22), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t152 = t151 + t22
+    t153 = t22 - t151
+    t154 = xp.where((xp.greater_equal(t22, -2.0943951023931953)) & (xp.less_equal(t22, 2.0943951023931953)), t22, xp.where((xp.greater_equal(t152, -2.0943951023931953)) & (xp.less_equal(t152, 2.0943951023931953)), t152, xp.where((xp.greater_equal(t153, -2.0943951023931953)) & (xp.less_equal(t153, 2.0943951023931953)), t153, qb4_1)))
+    t155 = xp.where(xp.greater(qn3, t23), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t156 = t155 + t23
+    t157 = t23 - t155
+    t158 = xp.where((xp.greater_equal(t23, -2.0943951023931953)) & (xp.less_equal(t23, 2.0943951023931953)), t23, xp.where((xp.greater_equal(t156, -2.0943951023931953)) & (xp.less_equal(t156, 2.0943951023931953)), t156, xp.where((xp.greater_equal(t157, -2.0943951023931953)) & (xp.less_equal(t157, 2.0943951023931953)), t157, qb4_2)))
+    t159 = xp.where(xp.greater(qn4, t24), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t160 = t159 + t24
+    t161 = t24 - t159
+    t162 = xp.where((xp.greater_equal(t24, -2.0943951023931953)) & (xp.less_equal(t24, 2.0943951023931953)), t24, xp.where((xp.greater_equal(t160, -2.0943951023931953)) & (xp.less_equal(t160, 2.0943951023931953)), t160, xp.where((xp.greater_equal(t161, -2.0943951023931953)) & (xp.less_equal(t161, 2.0943951023931953)), t161, qb4_3)))
+    t163 = qw1*(t150 + t58)**2 + qw2*(t154 + t59)**2 + qw3*(t158 + t60)**2 + qw4*(t162 + t61)**2
+    t164 = xp.greater(t25, 0)
+    t165 = xp.where(t164 & ((xp.greater(t146, t163)) | (xp.less(t140, 1))), xp.asarray(1, dtype=dtype), 0)
+    t166 = xp.where(t164, 1, t140)
+    t167 = xp.greater(t165, 0)
+    t168 = xp.where(t167, t150, t142)
+    t169 = xp.where(t167, t154, t143)
+    t170 = xp.where(t167, t158, t144)
+    t171 = xp.where(t167, t162, t145)
+    t172 = xp.where(t167, t163, t146)
+    t173 = xp.where(xp.greater(qn1, t26), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t174 = t173 + t26
+    t175 = t26 - t173
+    t176 = xp.where((xp.greater_equal(t26, -3.141592653589793)) & (xp.less_equal(t26, 3.141592653589793)), t26, xp.where((xp.greater_equal(t174, -3.141592653589793)) & (xp.less_equal(t174, 3.141592653589793)), t174, xp.where((xp.greater_equal(t175, -3.141592653589793)) & (xp.less_equal(t175, 3.141592653589793)), t175, qb5_0)))
+    t177 = xp.where(xp.greater(qn2, t27), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t178 = t177 + t27
+    t179 = t27 - t177
+    t180 = xp.where((xp.greater_equal(t27, -2.0943951023931953)) & (xp.less_equal(t27, 2.0943951023931953)), t27, xp.where((xp.greater_equal(t178, -2.0943951023931953)) & (xp.less_equal(t178, 2.0943951023931953)), t178, xp.where((xp.greater_equal(t179, -2.0943951023931953)) & (xp.less_equal(t179, 2.0943951023931953)), t179, qb5_1)))
+    t181 = xp.where(xp.greater(qn3, t28), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t182 = t181 + t28
+    t183 = t28 - t181
+    t184 = xp.where((xp.greater_equal(t28, -2.0943951023931953)) & (xp.less_equal(t28, 2.0943951023931953)), t28, xp.where((xp.greater_equal(t182, -2.0943951023931953)) & (xp.less_equal(t182, 2.0943951023931953)), t182, xp.where((xp.greater_equal(t183, -2.0943951023931953)) & (xp.less_equal(t183, 2.0943951023931953)), t183, qb5_2)))
+    t185 = xp.where(xp.greater(qn4, t29), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t186 = t185 + t29
+    t187 = t29 - t185
+    t188 = xp.where((xp.greater_equal(t29, -2.0943951023931953)) & (xp.less_equal(t29, 2.0943951023931953)), t29, xp.where((xp.greater_equal(t186, -2.0943951023931953)) & (xp.less_equal(t186, 2.0943951023931953)), t186, xp.where((xp.greater_equal(t187, -2.0943951023931953)) & (xp.less_equal(t187, 2.0943951023931953)), t187, qb5_3)))
+    t189 = qw1*(t176 + t58)**2 + qw2*(t180 + t59)**2 + qw3*(t184 + t60)**2 + qw4*(t188 + t61)**2
+    t190 = xp.greater(t30, 0)
+    t191 = xp.where(t190 & ((xp.greater(t172, t189)) | (xp.less(t166, 1))), xp.asarray(1, dtype=dtype), 0)
+    t192 = xp.where(t190, 1, t166)
+    t193 = xp.greater(t191, 0)
+    t194 = xp.where(t193, t176, t168)
+    t195 = xp.where(t193, t180, t169)
+    t196 = xp.where(t193, t184, t170)
+    t197 = xp.where(t193, t188, t171)
+    t198 = xp.where(t193, t189, t172)
+    t199 = xp.where(xp.greater(qn1, t31), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t200 = t199 + t31
+    t201 = t31 - t199
+    t202 = xp.where((xp.greater_equal(t31, -3.141592653589793)) & (xp.less_equal(t31, 3.141592653589793)), t31, xp.where((xp.greater_equal(t200, -3.141592653589793)) & (xp.less_equal(t200, 3.141592653589793)), t200, xp.where((xp.greater_equal(t201, -3.141592653589793)) & (xp.less_equal(t201, 3.141592653589793)), t201, qb6_0)))
+    t203 = xp.where(xp.greater(qn2, t32), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t204 = t203 + t32
+    t205 = t32 - t203
+    t206 = xp.where((xp.greater_equal(t32, -2.0943951023931953)) & (xp.less_equal(t32, 2.0943951023931953)), t32, xp.where((xp.greater_equal(t204, -2.0943951023931953)) & (xp.less_equal(t204, 2.0943951023931953)), t204, xp.where((xp.greater_equal(t205, -2.0943951023931953)) & (xp.less_equal(t205, 2.0943951023931953)), t205, qb6_1)))
+    t207 = xp.where(xp.greater(qn3, t33), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t208 = t207 + t33
+    t209 = t33 - t207
+    t210 = xp.where((xp.greater_equal(t33, -2.0943951023931953)) & (xp.less_equal(t33, 2.0943951023931953)), t33, xp.where((xp.greater_equal(t208, -2.0943951023931953)) & (xp.less_equal(t208, 2.0943951023931953)), t208, xp.where((xp.greater_equal(t209, -2.0943951023931953)) & (xp.less_equal(t209, 2.0943951023931953)), t209, qb6_2)))
+    t211 = xp.where(xp.greater(qn4, t34), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t212 = t211 + t34
+    t213 = t34 - t211
+    t214 = xp.where((xp.greater_equal(t34, -2.0943951023931953)) & (xp.less_equal(t34, 2.0943951023931953)), t34, xp.where((xp.greater_equal(t212, -2.0943951023931953)) & (xp.less_equal(t212, 2.0943951023931953)), t212, xp.where((xp.greater_equal(t213, -2.0943951023931953)) & (xp.less_equal(t213, 2.0943951023931953)), t213, qb6_3)))
+    t215 = qw1*(t202 + t58)**2 + qw2*(t206 + t59)**2 + qw3*(t210 + t60)**2 + qw4*(t214 + t61)**2
+    t216 = xp.greater(t35, 0)
+    t217 = xp.where(t216 & ((xp.greater(t198, t215)) | (xp.less(t192, 1))), xp.asarray(1, dtype=dtype), 0)
+    t218 = xp.where(t216, 1, t192)
+    t219 = xp.greater(t217, 0)
+    t220 = xp.where(t219, t202, t194)
+    t221 = xp.where(t219, t206, t195)
+    t222 = xp.where(t219, t210, t196)
+    t223 = xp.where(t219, t214, t197)
+    t224 = xp.where(t219, t215, t198)
+    t225 = xp.where(xp.greater(qn1, t36), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t226 = t225 + t36
+    t227 = t36 - t225
+    t228 = xp.where((xp.greater_equal(t36, -3.141592653589793)) & (xp.less_equal(t36, 3.141592653589793)), t36, xp.where((xp.greater_equal(t226, -3.141592653589793)) & (xp.less_equal(t226, 3.141592653589793)), t226, xp.where((xp.greater_equal(t227, -3.141592653589793)) & (xp.less_equal(t227, 3.141592653589793)), t227, qb7_0)))
+    t229 = xp.where(xp.greater(qn2, t37), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t230 = t229 + t37
+    t231 = t37 - t229
+    t232 = xp.where((xp.greater_equal(t37, -2.0943951023931953)) & (xp.less_equal(t37, 2.0943951023931953)), t37, xp.where((xp.greater_equal(t230, -2.0943951023931953)) & (xp.less_equal(t230, 2.0943951023931953)), t230, xp.where((xp.greater_equal(t231, -2.0943951023931953)) & (xp.less_equal(t231, 2.0943951023931953)), t231, qb7_1)))
+    t233 = xp.where(xp.greater(qn3, t38), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t234 = t233 + t38
+    t235 = t38 - t233
+    t236 = xp.where((xp.greater_equal(t38, -2.0943951023931953)) & (xp.less_equal(t38, 2.0943951023931953)), t38, xp.where((xp.greater_equal(t234, -2.0943951023931953)) & (xp.less_equal(t234, 2.0943951023931953)), t234, xp.where((xp.greater_equal(t235, -2.0943951023931953)) & (xp.less_equal(t235, 2.0943951023931953)), t235, qb7_2)))
+    t237 = xp.where(xp.greater(qn4, t39), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t238 = t237 + t39
+    t239 = t39 - t237
+    t240 = xp.where((xp.greater_equal(t39, -2.0943951023931953)) & (xp.less_equal(t39, 2.0943951023931953)), t39, xp.where((xp.greater_equal(t238, -2.0943951023931953)) & (xp.less_equal(t238, 2.0943951023931953)), t238, xp.where((xp.greater_equal(t239, -2.0943951023931953)) & (xp.less_equal(t239, 2.0943951023931953)), t239, qb7_3)))
+    t241 = qw1*(t228 + t58)**2 + qw2*(t232 + t59)**2 + qw3*(t236 + t60)**2 + qw4*(t240 + t61)**2
+    t242 = xp.greater(t40, 0)
+    t243 = xp.where(t242 & ((xp.greater(t224, t241)) | (xp.less(t218, 1))), xp.asarray(1, dtype=dtype), 0)
+    t244 = xp.where(t242, 1, t218)
+    t245 = xp.greater(t243, 0)
+    t246 = xp.where(t245, t228, t220)
+    t247 = xp.where(t245, t232, t221)
+    t248 = xp.where(t245, t236, t222)
+    t249 = xp.where(t245, t240, t223)
+    t250 = xp.isfinite(t41)
+    t251 = xp.greater(t244, 0)
+    t252 = t250 & t251
     q = _stack(xp, [
-        xp.broadcast_to(xp.where(t580, t574, qn1), batch),  # 0
-        xp.broadcast_to(xp.where(t580, t575, qn2), batch),  # 1
-        xp.broadcast_to(xp.where(t580, t576, qn3), batch),  # 2
-        xp.broadcast_to(xp.where(t580, t577, qn4), batch),  # 3
+        xp.broadcast_to(xp.where(t252, t246, qn1), batch),  # 0
+        xp.broadcast_to(xp.where(t252, t247, qn2), batch),  # 1
+        xp.broadcast_to(xp.where(t252, t248, qn3), batch),  # 2
+        xp.broadcast_to(xp.where(t252, t249, qn4), batch),  # 3
     ], (4,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t578), 2, xp.where(t579, xp.asarray(0, dtype=dtype), 1)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t250), 2, xp.where(t251, xp.asarray(0, dtype=dtype), 1)), batch), xp.int32)
     return q, status
 
 

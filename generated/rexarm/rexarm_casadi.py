@@ -1573,7 +1573,8 @@ def _ik_branches(mu):
 
 
 def _ik_nearest(mu, q_seed, weights):
-    """The closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status: 1536 operations."""
+    """The closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status: 724 operations."""
+    branches_q, branches_valid, branches_in_limits = _ik_branches(mu)
     mu0 = mu[0]
     mu1 = mu[1]
     mu2 = mu[2]
@@ -1586,594 +1587,314 @@ def _ik_nearest(mu, q_seed, weights):
     qw2 = weights[1]
     qw3 = weights[2]
     qw4 = weights[3]
-    t0 = casadi.sin(mu3)
-    t1 = casadi.atan2(mu0, -mu1)
-    t2 = t0**2
-    t3 = 1 - t2
-    t4 = (1e-12 < t3)
-    t5 = casadi.if_else(t4, -t0, casadi.if_else((t0 < 0), 1, -1))
-    t6 = casadi.if_else(t4, casadi.sqrt(t3), 0)
-    t7 = casadi.atan2(t6, t5)
-    t8 = t7
-    t9 = t5
-    t10 = t6
-    t11 = mu0**2 + mu1**2
-    t12 = t11
-    t13 = t11 + mu2**2
-    t14 = 1e-24*t13
-    t15 = (t12 <= t14)
-    t16 = casadi.if_else(t15, 1, 1/casadi.sqrt(t12))
-    t17 = casadi.if_else(t15, 0, t1 + (1/2)*casadi.pi)
-    t18 = t1 - 1/2*casadi.pi
-    t19 = t17 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t17)
-    t20 = t19 - 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*t19)
-    t21 = t18 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t18)
-    t22 = t21 - 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*t21)
-    t23 = t16
-    t24 = mu0*t23
-    t25 = casadi.if_else(t15, 1, -t24)
-    t26 = t24
-    t27 = mu2*(1 - t25)
-    t28 = t27 + mu2*t25
-    t29 = mu2*(1 - t26)
-    t30 = t29 + mu2*t26
-    t31 = mu1*t23
-    t32 = casadi.if_else(t15, 0, -t31)
-    t33 = t31
-    t34 = mu0*t25 + mu1*t32
-    t35 = mu1*t25 - mu0*t32
-    t36 = mu0*t26 + mu1*t33
-    t37 = mu1*t26 - mu0*t33
-    t38 = 0.1*t10
-    t39 = t34 + t38
-    t40 = t36 + t38
-    t41 = -0.1*t9
-    t42 = t28 + t41
-    t43 = -0.12 + t42
-    t44 = t30 + t41
-    t45 = -0.12 + t44
-    t46 = t35**2
-    t47 = t46 + t39**2 + t43**2
-    t48 = 0.01 - 0.5*t47
-    t49 = t48**2
-    t50 = 1 - 10000*t49
-    t51 = 100*t48
-    t52 = (1e-12 < t50)
-    t53 = casadi.if_else(t52, t51, casadi.if_else((t51 > 0), 1, -1))
-    t54 = casadi.if_else(t52, casadi.sqrt(t50), 0)
-    t55 = casadi.atan2(t54, t53)
-    t56 = 3.141592653589793 + t55
-    t57 = 3.141592653589793 - t55
-    t58 = t56 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t56)
-    t59 = t58 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t58)
-    t60 = t57 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t57)
-    t61 = t60 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t60)
-    t62 = -1.0*t53
-    t63 = -1.0*t54
-    t64 = 0.22 + 0.1*t62
-    t65 = -0.12 + t64
-    t66 = t65**2 + 0.01*t63**2
-    t67 = 0.1*t63
-    t68 = t43*t65 - t39*t67
-    t69 = t39*t65 + t43*t67
-    t70 = t68**2 + t69**2
-    t71 = 0.22 - 0.1*t53
-    t72 = -0.12 + t71
-    t73 = 0.1*t54
-    t74 = t43*t72 - t39*t73
-    t75 = t39*t72 + t43*t73
-    t76 = t74**2 + t75**2
-    t77 = t72**2 + 0.01*t54**2
-    t78 = -0.1*t6
-    t79 = t34 + t78
-    t80 = t36 + t78
-    t81 = -0.1*t5
-    t82 = t28 + t81
-    t83 = -0.12 + t82
-    t84 = t46 + t79**2 + t83**2
-    t85 = 0.01 - 0.5*t84
-    t86 = t30 + t81
-    t87 = -0.12 + t86
-    t88 = t85**2
-    t89 = 1 - 10000*t88
-    t90 = 100*t85
-    t91 = (1e-12 < t89)
-    t92 = casadi.if_else(t91, t90, casadi.if_else((t90 > 0), 1, -1))
-    t93 = casadi.if_else(t91, casadi.sqrt(t89), 0)
-    t94 = casadi.atan2(t93, t92)
-    t95 = 3.141592653589793 + t94
-    t96 = -1.0*t92
-    t97 = -1.0*t93
-    t98 = 3.141592653589793 - t94
-    t99 = 0.22 + 0.1*t96
-    t100 = -0.12 + t99
-    t101 = t100**2 + 0.01*t97**2
-    t102 = 0.22 - 0.1*t92
-    t103 = -0.12 + t102
-    t104 = t103**2 + 0.01*t93**2
-    t105 = t95 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t95)
-    t106 = t105 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t105)
-    t107 = t98 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t98)
-    t108 = t107 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t107)
-    t109 = 0.1*t97
-    t110 = t100*t83 - t109*t79
-    t111 = t100*t79 + t109*t83
-    t112 = t110**2 + t111**2
-    t113 = 0.1*t93
-    t114 = t103*t83 - t113*t79
-    t115 = t103*t79 + t113*t83
-    t116 = t114**2 + t115**2
-    t117 = t37**2
-    t118 = t117 + t40**2 + t45**2
-    t119 = 0.01 - 0.5*t118
-    t120 = t117 + t80**2 + t87**2
-    t121 = 0.01 - 0.5*t120
-    t122 = t119**2
-    t123 = 1 - 10000*t122
-    t124 = 100*t119
-    t125 = (1e-12 < t123)
-    t126 = casadi.if_else(t125, t124, casadi.if_else((t124 > 0), 1, -1))
-    t127 = casadi.if_else(t125, casadi.sqrt(t123), 0)
-    t128 = casadi.atan2(t127, t126)
-    t129 = 3.141592653589793 + t128
-    t130 = -1.0*t126
-    t131 = -1.0*t127
-    t132 = 3.141592653589793 - t128
-    t133 = 0.22 + 0.1*t130
-    t134 = -0.12 + t133
-    t135 = t134**2 + 0.01*t131**2
-    t136 = 0.22 - 0.1*t126
-    t137 = -0.12 + t136
-    t138 = t137**2 + 0.01*t127**2
-    t139 = t129 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t129)
-    t140 = t139 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t139)
-    t141 = t132 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t132)
-    t142 = t141 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t141)
-    t143 = 0.1*t131
-    t144 = t134*t45 - t143*t40
-    t145 = t134*t40 + t143*t45
-    t146 = t144**2 + t145**2
-    t147 = 0.1*t127
-    t148 = t137*t45 - t147*t40
-    t149 = t137*t40 + t147*t45
-    t150 = t148**2 + t149**2
-    t151 = t121**2
-    t152 = 1 - 10000*t151
-    t153 = 100*t121
-    t154 = (1e-12 < t152)
-    t155 = casadi.if_else(t154, t153, casadi.if_else((t153 > 0), 1, -1))
-    t156 = casadi.if_else(t154, casadi.sqrt(t152), 0)
-    t157 = casadi.atan2(t156, t155)
-    t158 = 3.141592653589793 + t157
-    t159 = -1.0*t155
-    t160 = -1.0*t156
-    t161 = 3.141592653589793 - t157
-    t162 = 0.22 + 0.1*t159
-    t163 = -0.12 + t162
-    t164 = t163**2 + 0.01*t160**2
-    t165 = 0.22 - 0.1*t155
-    t166 = -0.12 + t165
-    t167 = t166**2 + 0.01*t156**2
-    t168 = t158 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t158)
-    t169 = t168 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t168)
-    t170 = t161 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t161)
-    t171 = t170 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t170)
-    t172 = 0.1*t160
-    t173 = t163*t87 - t172*t80
-    t174 = t163*t80 + t172*t87
-    t175 = t173**2 + t174**2
-    t176 = 0.1*t156
-    t177 = t166*t87 - t176*t80
-    t178 = t166*t80 + t176*t87
-    t179 = t177**2 + t178**2
-    t180 = mu0 + mu1 + mu2 + mu3
-    t181 = t180
-    t182 = qn1 + qn2 + qn3 + qn4 + qw1 + qw2 + qw3 + qw4 + t180
-    t183 = 1e-24*t47
-    t184 = casadi.if_else((t70 <= t183*t66), 0, casadi.atan2(-t69, t68))
-    t185 = t184
-    t186 = t185 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t185)
-    t187 = -t8
-    t188 = 3.141592653589793 + t187
-    t189 = t184 + t56
-    t190 = t187 + t189 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t188 - 0.15915494309189535*t189)
-    t191 = -t190
-    t192 = t190 + 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t191)
-    t193 = casadi.if_else((t76 <= t183*t77), 0, casadi.atan2(-t75, t74))
-    t194 = t193
-    t195 = t194 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t194)
-    t196 = t193 + t57
-    t197 = t187 + t196 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t188 - 0.15915494309189535*t196)
-    t198 = -t197
-    t199 = t197 + 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t198)
-    t200 = 1e-24*t84
-    t201 = casadi.if_else((t112 <= t101*t200), 0, casadi.atan2(-t111, t110))
-    t202 = t201
-    t203 = t202 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t202)
-    t204 = 3.141592653589793 + t7
-    t205 = t201 + t95
-    t206 = t205 + t7 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t204 - 0.15915494309189535*t205)
-    t207 = -t206
-    t208 = t206 + 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t207)
-    t209 = casadi.if_else((t116 <= t104*t200), 0, casadi.atan2(-t115, t114))
-    t210 = t209
-    t211 = t210 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t210)
-    t212 = t209 + t98
-    t213 = t212 + t7 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t204 - 0.15915494309189535*t212)
-    t214 = -t213
-    t215 = t213 + 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t214)
-    t216 = 1e-24*t118
-    t217 = casadi.if_else((t146 <= t135*t216), 0, casadi.atan2(-t145, t144))
-    t218 = t217
-    t219 = t218 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t218)
-    t220 = t129 + t217
-    t221 = t187 + t220 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t188 - 0.15915494309189535*t220)
-    t222 = -t221
-    t223 = t221 + 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t222)
-    t224 = casadi.if_else((t150 <= t138*t216), 0, casadi.atan2(-t149, t148))
-    t225 = t224
-    t226 = t225 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t225)
-    t227 = t132 + t224
-    t228 = t187 + t227 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t188 - 0.15915494309189535*t227)
-    t229 = -t228
-    t230 = t228 + 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t229)
-    t231 = 1e-24*t120
-    t232 = casadi.if_else((t175 <= t164*t231), 0, casadi.atan2(-t174, t173))
-    t233 = t232
-    t234 = t233 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t233)
-    t235 = t158 + t232
-    t236 = t235 + t7 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t204 - 0.15915494309189535*t235)
-    t237 = -t236
-    t238 = t236 + 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t237)
-    t239 = casadi.if_else((t179 <= t167*t231), 0, casadi.atan2(-t178, t177))
-    t240 = t239
-    t241 = t240 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t240)
-    t242 = t161 + t239
-    t243 = t242 + t7 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t204 - 0.15915494309189535*t242)
-    t244 = -t243
-    t245 = t243 + 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t244)
-    t246 = (t20 <= 3.141592653589793)
-    t247 = casadi.logic_and((t19 >= -3.141592653589793), (t19 <= 3.141592653589793))
-    t248 = casadi.if_else(casadi.logic_and(t246, casadi.logic_not(t247)), t20, t19)
-    t249 = t248
-    t250 = t249 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn1 - 0.15915494309189535*t249)
-    t251 = casadi.if_else((qn1 > t250), 6.283185307179586, -6.283185307179586)
-    t252 = t250 + t251
-    t253 = t250 - t251
-    t254 = casadi.if_else(casadi.logic_and((t250 >= -3.141592653589793), (t250 <= 3.141592653589793)), t250, casadi.if_else(casadi.logic_and((t252 >= -3.141592653589793), (t252 <= 3.141592653589793)), t252, casadi.if_else(casadi.logic_and((t253 >= -3.141592653589793), (t253 <= 3.141592653589793)), t253, t248)))
-    t255 = (t186 <= 2.0943951023931953)
-    t256 = casadi.logic_and((t185 >= -2.0943951023931953), (t185 <= 2.0943951023931953))
-    t257 = casadi.if_else(casadi.logic_and(t255, casadi.logic_not(t256)), t186, t185)
-    t258 = t257
-    t259 = t258 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t258)
-    t260 = casadi.if_else((qn2 > t259), 6.283185307179586, -6.283185307179586)
-    t261 = t259 + t260
-    t262 = t259 - t260
-    t263 = casadi.if_else(casadi.logic_and((t259 >= -2.0943951023931953), (t259 <= 2.0943951023931953)), t259, casadi.if_else(casadi.logic_and((t261 >= -2.0943951023931953), (t261 <= 2.0943951023931953)), t261, casadi.if_else(casadi.logic_and((t262 >= -2.0943951023931953), (t262 <= 2.0943951023931953)), t262, t257)))
-    t264 = (t59 <= 2.0943951023931953)
-    t265 = casadi.logic_and((t58 >= -2.0943951023931953), (t58 <= 2.0943951023931953))
-    t266 = casadi.if_else(casadi.logic_and(t264, casadi.logic_not(t265)), t59, t58)
-    t267 = t266
-    t268 = t267 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn3 - 0.15915494309189535*t267)
-    t269 = casadi.if_else((qn3 > t268), 6.283185307179586, -6.283185307179586)
-    t270 = t268 + t269
-    t271 = t268 - t269
-    t272 = casadi.if_else(casadi.logic_and((t268 >= -2.0943951023931953), (t268 <= 2.0943951023931953)), t268, casadi.if_else(casadi.logic_and((t270 >= -2.0943951023931953), (t270 <= 2.0943951023931953)), t270, casadi.if_else(casadi.logic_and((t271 >= -2.0943951023931953), (t271 <= 2.0943951023931953)), t271, t266)))
-    t273 = (t192 >= -2.0943951023931953)
-    t274 = casadi.logic_and((t190 >= -2.0943951023931953), (t190 <= 2.0943951023931953))
-    t275 = casadi.if_else(casadi.logic_and(t273, casadi.logic_not(t274)), -t192, t191)
-    t276 = t275
-    t277 = t276 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t276)
-    t278 = casadi.if_else((qn4 > t277), 6.283185307179586, -6.283185307179586)
-    t279 = t277 + t278
-    t280 = t277 - t278
-    t281 = casadi.if_else(casadi.logic_and((t277 >= -2.0943951023931953), (t277 <= 2.0943951023931953)), t277, casadi.if_else(casadi.logic_and((t279 >= -2.0943951023931953), (t279 <= 2.0943951023931953)), t279, casadi.if_else(casadi.logic_and((t280 >= -2.0943951023931953), (t280 <= 2.0943951023931953)), t280, t275)))
-    t282 = -qn1
-    t283 = qw1*(t254 + t282)**2
-    t284 = -qn2
-    t285 = -qn3
-    t286 = -qn4
-    t287 = t283 + qw2*(t263 + t284)**2 + qw3*(t272 + t285)**2 + qw4*(t281 + t286)**2
-    t288 = (casadi.fabs(t181) < casadi.inf)
-    t289 = (casadi.fabs(mu3) <= 1.5707963267948966)
-    t290 = casadi.logic_or(t246, t247)
-    t291 = (t12 > t14)
-    t292 = casadi.logic_or(t291, casadi.logic_and(t15, (1e-12*t13 >= 0)))
-    t293 = (1e-12 >= -t3)
-    t294 = casadi.if_else(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t288, t289), t290), t292), t293), (t50 >= -1e-12)), casadi.logic_or(t255, t256)), casadi.logic_or(t264, t265)), casadi.logic_or(t273, t274)), 1, 0)
-    t295 = casadi.if_else((t294 > 0), 1, 0)
-    t296 = (t295 > 0)
-    t297 = casadi.if_else(t296, t254, qn1)
-    t298 = casadi.if_else(t296, t263, qn2)
-    t299 = casadi.if_else(t296, t272, qn3)
-    t300 = casadi.if_else(t296, t281, qn4)
-    t301 = casadi.if_else(t296, t287, 0)
-    t302 = (t195 <= 2.0943951023931953)
-    t303 = casadi.logic_and((t194 >= -2.0943951023931953), (t194 <= 2.0943951023931953))
-    t304 = casadi.if_else(casadi.logic_and(t302, casadi.logic_not(t303)), t195, t194)
-    t305 = t304
-    t306 = t305 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t305)
-    t307 = casadi.if_else((qn2 > t306), 6.283185307179586, -6.283185307179586)
-    t308 = t306 + t307
-    t309 = t306 - t307
-    t310 = casadi.if_else(casadi.logic_and((t306 >= -2.0943951023931953), (t306 <= 2.0943951023931953)), t306, casadi.if_else(casadi.logic_and((t308 >= -2.0943951023931953), (t308 <= 2.0943951023931953)), t308, casadi.if_else(casadi.logic_and((t309 >= -2.0943951023931953), (t309 <= 2.0943951023931953)), t309, t304)))
-    t311 = (t61 <= 2.0943951023931953)
-    t312 = casadi.logic_and((t60 >= -2.0943951023931953), (t60 <= 2.0943951023931953))
-    t313 = casadi.if_else(casadi.logic_and(t311, casadi.logic_not(t312)), t61, t60)
-    t314 = t313
-    t315 = t314 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn3 - 0.15915494309189535*t314)
-    t316 = casadi.if_else((qn3 > t315), 6.283185307179586, -6.283185307179586)
-    t317 = t315 + t316
-    t318 = t315 - t316
-    t319 = casadi.if_else(casadi.logic_and((t315 >= -2.0943951023931953), (t315 <= 2.0943951023931953)), t315, casadi.if_else(casadi.logic_and((t317 >= -2.0943951023931953), (t317 <= 2.0943951023931953)), t317, casadi.if_else(casadi.logic_and((t318 >= -2.0943951023931953), (t318 <= 2.0943951023931953)), t318, t313)))
-    t320 = (t199 >= -2.0943951023931953)
-    t321 = casadi.logic_and((t197 >= -2.0943951023931953), (t197 <= 2.0943951023931953))
-    t322 = casadi.if_else(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t288, t289), t290), t292), t293), t52), casadi.logic_or(t302, t303)), casadi.logic_or(t311, t312)), casadi.logic_or(t320, t321)), 1, 0)
-    t323 = casadi.if_else(casadi.logic_and(t320, casadi.logic_not(t321)), -t199, t198)
-    t324 = t323
-    t325 = t324 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t324)
-    t326 = casadi.if_else((qn4 > t325), 6.283185307179586, -6.283185307179586)
-    t327 = t325 + t326
-    t328 = t325 - t326
-    t329 = casadi.if_else(casadi.logic_and((t325 >= -2.0943951023931953), (t325 <= 2.0943951023931953)), t325, casadi.if_else(casadi.logic_and((t327 >= -2.0943951023931953), (t327 <= 2.0943951023931953)), t327, casadi.if_else(casadi.logic_and((t328 >= -2.0943951023931953), (t328 <= 2.0943951023931953)), t328, t323)))
-    t330 = t283 + qw2*(t284 + t310)**2 + qw3*(t285 + t319)**2 + qw4*(t286 + t329)**2
-    t331 = (t322 > 0)
-    t332 = casadi.if_else(casadi.logic_and(t331, casadi.logic_or((t301 > t330), (t295 < 1))), 1, 0)
-    t333 = casadi.if_else(t331, 1, t295)
-    t334 = (t332 > 0)
-    t335 = casadi.if_else(t334, t254, t297)
-    t336 = casadi.if_else(t334, t310, t298)
-    t337 = casadi.if_else(t334, t319, t299)
-    t338 = casadi.if_else(t334, t329, t300)
-    t339 = casadi.if_else(t334, t330, t301)
-    t340 = (t203 <= 2.0943951023931953)
-    t341 = casadi.logic_and((t202 >= -2.0943951023931953), (t202 <= 2.0943951023931953))
-    t342 = casadi.if_else(casadi.logic_and(t340, casadi.logic_not(t341)), t203, t202)
-    t343 = t342
-    t344 = t343 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t343)
-    t345 = casadi.if_else((qn2 > t344), 6.283185307179586, -6.283185307179586)
-    t346 = t344 + t345
-    t347 = t344 - t345
-    t348 = casadi.if_else(casadi.logic_and((t344 >= -2.0943951023931953), (t344 <= 2.0943951023931953)), t344, casadi.if_else(casadi.logic_and((t346 >= -2.0943951023931953), (t346 <= 2.0943951023931953)), t346, casadi.if_else(casadi.logic_and((t347 >= -2.0943951023931953), (t347 <= 2.0943951023931953)), t347, t342)))
-    t349 = (t106 <= 2.0943951023931953)
-    t350 = casadi.logic_and((t105 >= -2.0943951023931953), (t105 <= 2.0943951023931953))
-    t351 = casadi.if_else(casadi.logic_and(t349, casadi.logic_not(t350)), t106, t105)
-    t352 = t351
-    t353 = t352 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn3 - 0.15915494309189535*t352)
-    t354 = casadi.if_else((qn3 > t353), 6.283185307179586, -6.283185307179586)
-    t355 = t353 + t354
-    t356 = t353 - t354
-    t357 = casadi.if_else(casadi.logic_and((t353 >= -2.0943951023931953), (t353 <= 2.0943951023931953)), t353, casadi.if_else(casadi.logic_and((t355 >= -2.0943951023931953), (t355 <= 2.0943951023931953)), t355, casadi.if_else(casadi.logic_and((t356 >= -2.0943951023931953), (t356 <= 2.0943951023931953)), t356, t351)))
-    t358 = (t208 >= -2.0943951023931953)
-    t359 = casadi.logic_and((t206 >= -2.0943951023931953), (t206 <= 2.0943951023931953))
-    t360 = casadi.if_else(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t288, t289), t290), t292), t4), (t89 >= -1e-12)), casadi.logic_or(t340, t341)), casadi.logic_or(t349, t350)), casadi.logic_or(t358, t359)), 1, 0)
-    t361 = casadi.if_else(casadi.logic_and(t358, casadi.logic_not(t359)), -t208, t207)
-    t362 = t361
-    t363 = t362 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t362)
-    t364 = casadi.if_else((qn4 > t363), 6.283185307179586, -6.283185307179586)
-    t365 = t363 + t364
-    t366 = t363 - t364
-    t367 = casadi.if_else(casadi.logic_and((t363 >= -2.0943951023931953), (t363 <= 2.0943951023931953)), t363, casadi.if_else(casadi.logic_and((t365 >= -2.0943951023931953), (t365 <= 2.0943951023931953)), t365, casadi.if_else(casadi.logic_and((t366 >= -2.0943951023931953), (t366 <= 2.0943951023931953)), t366, t361)))
-    t368 = t283 + qw2*(t284 + t348)**2 + qw3*(t285 + t357)**2 + qw4*(t286 + t367)**2
-    t369 = (t360 > 0)
-    t370 = casadi.if_else(casadi.logic_and(t369, casadi.logic_or((t339 > t368), (t333 < 1))), 1, 0)
-    t371 = casadi.if_else(t369, 1, t333)
-    t372 = (t370 > 0)
-    t373 = casadi.if_else(t372, t254, t335)
-    t374 = casadi.if_else(t372, t348, t336)
-    t375 = casadi.if_else(t372, t357, t337)
-    t376 = casadi.if_else(t372, t367, t338)
-    t377 = casadi.if_else(t372, t368, t339)
-    t378 = (t211 <= 2.0943951023931953)
-    t379 = casadi.logic_and((t210 >= -2.0943951023931953), (t210 <= 2.0943951023931953))
-    t380 = casadi.if_else(casadi.logic_and(t378, casadi.logic_not(t379)), t211, t210)
-    t381 = t380
-    t382 = t381 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t381)
-    t383 = casadi.if_else((qn2 > t382), 6.283185307179586, -6.283185307179586)
-    t384 = t382 + t383
-    t385 = t382 - t383
-    t386 = casadi.if_else(casadi.logic_and((t382 >= -2.0943951023931953), (t382 <= 2.0943951023931953)), t382, casadi.if_else(casadi.logic_and((t384 >= -2.0943951023931953), (t384 <= 2.0943951023931953)), t384, casadi.if_else(casadi.logic_and((t385 >= -2.0943951023931953), (t385 <= 2.0943951023931953)), t385, t380)))
-    t387 = (t108 <= 2.0943951023931953)
-    t388 = casadi.logic_and((t107 >= -2.0943951023931953), (t107 <= 2.0943951023931953))
-    t389 = casadi.if_else(casadi.logic_and(t387, casadi.logic_not(t388)), t108, t107)
-    t390 = t389
-    t391 = t390 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn3 - 0.15915494309189535*t390)
-    t392 = casadi.if_else((qn3 > t391), 6.283185307179586, -6.283185307179586)
-    t393 = t391 + t392
-    t394 = t391 - t392
-    t395 = casadi.if_else(casadi.logic_and((t391 >= -2.0943951023931953), (t391 <= 2.0943951023931953)), t391, casadi.if_else(casadi.logic_and((t393 >= -2.0943951023931953), (t393 <= 2.0943951023931953)), t393, casadi.if_else(casadi.logic_and((t394 >= -2.0943951023931953), (t394 <= 2.0943951023931953)), t394, t389)))
-    t396 = (t215 >= -2.0943951023931953)
-    t397 = casadi.logic_and((t213 >= -2.0943951023931953), (t213 <= 2.0943951023931953))
-    t398 = casadi.if_else(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t288, t289), t290), t292), t4), t91), casadi.logic_or(t378, t379)), casadi.logic_or(t387, t388)), casadi.logic_or(t396, t397)), 1, 0)
-    t399 = casadi.if_else(casadi.logic_and(t396, casadi.logic_not(t397)), -t215, t214)
-    t400 = t399
-    t401 = t400 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t400)
-    t402 = casadi.if_else((qn4 > t401), 6.283185307179586, -6.283185307179586)
-    t403 = t401 + t402
-    t404 = t401 - t402
-    t405 = casadi.if_else(casadi.logic_and((t401 >= -2.0943951023931953), (t401 <= 2.0943951023931953)), t401, casadi.if_else(casadi.logic_and((t403 >= -2.0943951023931953), (t403 <= 2.0943951023931953)), t403, casadi.if_else(casadi.logic_and((t404 >= -2.0943951023931953), (t404 <= 2.0943951023931953)), t404, t399)))
-    t406 = t283 + qw2*(t284 + t386)**2 + qw3*(t285 + t395)**2 + qw4*(t286 + t405)**2
-    t407 = (t398 > 0)
-    t408 = casadi.if_else(casadi.logic_and(t407, casadi.logic_or((t377 > t406), (t371 < 1))), 1, 0)
-    t409 = casadi.if_else(t407, 1, t371)
-    t410 = (t408 > 0)
-    t411 = casadi.if_else(t410, t254, t373)
-    t412 = casadi.if_else(t410, t386, t374)
-    t413 = casadi.if_else(t410, t395, t375)
-    t414 = casadi.if_else(t410, t405, t376)
-    t415 = casadi.if_else(t410, t406, t377)
-    t416 = (t22 <= 3.141592653589793)
-    t417 = casadi.logic_and((t21 >= -3.141592653589793), (t21 <= 3.141592653589793))
-    t418 = casadi.if_else(casadi.logic_and(t416, casadi.logic_not(t417)), t22, t21)
-    t419 = t418
-    t420 = t419 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn1 - 0.15915494309189535*t419)
-    t421 = casadi.if_else((qn1 > t420), 6.283185307179586, -6.283185307179586)
-    t422 = t420 + t421
-    t423 = t420 - t421
-    t424 = casadi.if_else(casadi.logic_and((t420 >= -3.141592653589793), (t420 <= 3.141592653589793)), t420, casadi.if_else(casadi.logic_and((t422 >= -3.141592653589793), (t422 <= 3.141592653589793)), t422, casadi.if_else(casadi.logic_and((t423 >= -3.141592653589793), (t423 <= 3.141592653589793)), t423, t418)))
-    t425 = (t219 <= 2.0943951023931953)
-    t426 = casadi.logic_and((t218 >= -2.0943951023931953), (t218 <= 2.0943951023931953))
-    t427 = casadi.if_else(casadi.logic_and(t425, casadi.logic_not(t426)), t219, t218)
-    t428 = t427
-    t429 = t428 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t428)
-    t430 = casadi.if_else((qn2 > t429), 6.283185307179586, -6.283185307179586)
-    t431 = t429 + t430
-    t432 = t429 - t430
-    t433 = casadi.if_else(casadi.logic_and((t429 >= -2.0943951023931953), (t429 <= 2.0943951023931953)), t429, casadi.if_else(casadi.logic_and((t431 >= -2.0943951023931953), (t431 <= 2.0943951023931953)), t431, casadi.if_else(casadi.logic_and((t432 >= -2.0943951023931953), (t432 <= 2.0943951023931953)), t432, t427)))
-    t434 = (t140 <= 2.0943951023931953)
-    t435 = casadi.logic_and((t139 >= -2.0943951023931953), (t139 <= 2.0943951023931953))
-    t436 = casadi.if_else(casadi.logic_and(t434, casadi.logic_not(t435)), t140, t139)
-    t437 = t436
-    t438 = t437 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn3 - 0.15915494309189535*t437)
-    t439 = casadi.if_else((qn3 > t438), 6.283185307179586, -6.283185307179586)
-    t440 = t438 + t439
-    t441 = t438 - t439
-    t442 = casadi.if_else(casadi.logic_and((t438 >= -2.0943951023931953), (t438 <= 2.0943951023931953)), t438, casadi.if_else(casadi.logic_and((t440 >= -2.0943951023931953), (t440 <= 2.0943951023931953)), t440, casadi.if_else(casadi.logic_and((t441 >= -2.0943951023931953), (t441 <= 2.0943951023931953)), t441, t436)))
-    t443 = (t223 >= -2.0943951023931953)
-    t444 = casadi.logic_and((t221 >= -2.0943951023931953), (t221 <= 2.0943951023931953))
-    t445 = casadi.if_else(casadi.logic_and(t443, casadi.logic_not(t444)), -t223, t222)
-    t446 = t445
-    t447 = t446 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t446)
-    t448 = casadi.if_else((qn4 > t447), 6.283185307179586, -6.283185307179586)
-    t449 = t447 + t448
-    t450 = t447 - t448
-    t451 = casadi.if_else(casadi.logic_and((t447 >= -2.0943951023931953), (t447 <= 2.0943951023931953)), t447, casadi.if_else(casadi.logic_and((t449 >= -2.0943951023931953), (t449 <= 2.0943951023931953)), t449, casadi.if_else(casadi.logic_and((t450 >= -2.0943951023931953), (t450 <= 2.0943951023931953)), t450, t445)))
-    t452 = qw1*(t282 + t424)**2
-    t453 = t452 + qw2*(t284 + t433)**2 + qw3*(t285 + t442)**2 + qw4*(t286 + t451)**2
-    t454 = casadi.logic_or(t416, t417)
-    t455 = casadi.if_else(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t288, t289), t291), t293), t454), (t123 >= -1e-12)), casadi.logic_or(t425, t426)), casadi.logic_or(t434, t435)), casadi.logic_or(t443, t444)), 1, 0)
-    t456 = (t455 > 0)
-    t457 = casadi.if_else(casadi.logic_and(t456, casadi.logic_or((t415 > t453), (t409 < 1))), 1, 0)
-    t458 = casadi.if_else(t456, 1, t409)
-    t459 = (t457 > 0)
-    t460 = casadi.if_else(t459, t424, t411)
-    t461 = casadi.if_else(t459, t433, t412)
-    t462 = casadi.if_else(t459, t442, t413)
-    t463 = casadi.if_else(t459, t451, t414)
-    t464 = casadi.if_else(t459, t453, t415)
-    t465 = (t226 <= 2.0943951023931953)
-    t466 = casadi.logic_and((t225 >= -2.0943951023931953), (t225 <= 2.0943951023931953))
-    t467 = casadi.if_else(casadi.logic_and(t465, casadi.logic_not(t466)), t226, t225)
-    t468 = t467
-    t469 = t468 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t468)
-    t470 = casadi.if_else((qn2 > t469), 6.283185307179586, -6.283185307179586)
-    t471 = t469 + t470
-    t472 = t469 - t470
-    t473 = casadi.if_else(casadi.logic_and((t469 >= -2.0943951023931953), (t469 <= 2.0943951023931953)), t469, casadi.if_else(casadi.logic_and((t471 >= -2.0943951023931953), (t471 <= 2.0943951023931953)), t471, casadi.if_else(casadi.logic_and((t472 >= -2.0943951023931953), (t472 <= 2.0943951023931953)), t472, t467)))
-    t474 = (t142 <= 2.0943951023931953)
-    t475 = casadi.logic_and((t141 >= -2.0943951023931953), (t141 <= 2.0943951023931953))
-    t476 = casadi.if_else(casadi.logic_and(t474, casadi.logic_not(t475)), t142, t141)
-    t477 = t476
-    t478 = t477 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn3 - 0.15915494309189535*t477)
-    t479 = casadi.if_else((qn3 > t478), 6.283185307179586, -6.283185307179586)
-    t480 = t478 + t479
-    t481 = t478 - t479
-    t482 = casadi.if_else(casadi.logic_and((t478 >= -2.0943951023931953), (t478 <= 2.0943951023931953)), t478, casadi.if_else(casadi.logic_and((t480 >= -2.0943951023931953), (t480 <= 2.0943951023931953)), t480, casadi.if_else(casadi.logic_and((t481 >= -2.0943951023931953), (t481 <= 2.0943951023931953)), t481, t476)))
-    t483 = (t230 >= -2.0943951023931953)
-    t484 = casadi.logic_and((t228 >= -2.0943951023931953), (t228 <= 2.0943951023931953))
-    t485 = casadi.if_else(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t125, t288), t289), t291), t293), t454), casadi.logic_or(t465, t466)), casadi.logic_or(t474, t475)), casadi.logic_or(t483, t484)), 1, 0)
-    t486 = casadi.if_else(casadi.logic_and(t483, casadi.logic_not(t484)), -t230, t229)
-    t487 = t486
-    t488 = t487 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t487)
-    t489 = casadi.if_else((qn4 > t488), 6.283185307179586, -6.283185307179586)
-    t490 = t488 + t489
-    t491 = t488 - t489
-    t492 = casadi.if_else(casadi.logic_and((t488 >= -2.0943951023931953), (t488 <= 2.0943951023931953)), t488, casadi.if_else(casadi.logic_and((t490 >= -2.0943951023931953), (t490 <= 2.0943951023931953)), t490, casadi.if_else(casadi.logic_and((t491 >= -2.0943951023931953), (t491 <= 2.0943951023931953)), t491, t486)))
-    t493 = t452 + qw2*(t284 + t473)**2 + qw3*(t285 + t482)**2 + qw4*(t286 + t492)**2
-    t494 = (t485 > 0)
-    t495 = casadi.if_else(casadi.logic_and(t494, casadi.logic_or((t464 > t493), (t458 < 1))), 1, 0)
-    t496 = casadi.if_else(t494, 1, t458)
-    t497 = (t495 > 0)
-    t498 = casadi.if_else(t497, t424, t460)
-    t499 = casadi.if_else(t497, t473, t461)
-    t500 = casadi.if_else(t497, t482, t462)
-    t501 = casadi.if_else(t497, t492, t463)
-    t502 = casadi.if_else(t497, t493, t464)
-    t503 = (t234 <= 2.0943951023931953)
-    t504 = casadi.logic_and((t233 >= -2.0943951023931953), (t233 <= 2.0943951023931953))
-    t505 = casadi.if_else(casadi.logic_and(t503, casadi.logic_not(t504)), t234, t233)
-    t506 = t505
-    t507 = t506 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t506)
-    t508 = casadi.if_else((qn2 > t507), 6.283185307179586, -6.283185307179586)
-    t509 = t507 + t508
-    t510 = t507 - t508
-    t511 = casadi.if_else(casadi.logic_and((t507 >= -2.0943951023931953), (t507 <= 2.0943951023931953)), t507, casadi.if_else(casadi.logic_and((t509 >= -2.0943951023931953), (t509 <= 2.0943951023931953)), t509, casadi.if_else(casadi.logic_and((t510 >= -2.0943951023931953), (t510 <= 2.0943951023931953)), t510, t505)))
-    t512 = (t169 <= 2.0943951023931953)
-    t513 = casadi.logic_and((t168 >= -2.0943951023931953), (t168 <= 2.0943951023931953))
-    t514 = casadi.if_else(casadi.logic_and(t512, casadi.logic_not(t513)), t169, t168)
-    t515 = t514
-    t516 = t515 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn3 - 0.15915494309189535*t515)
-    t517 = casadi.if_else((qn3 > t516), 6.283185307179586, -6.283185307179586)
-    t518 = t516 + t517
-    t519 = t516 - t517
-    t520 = casadi.if_else(casadi.logic_and((t516 >= -2.0943951023931953), (t516 <= 2.0943951023931953)), t516, casadi.if_else(casadi.logic_and((t518 >= -2.0943951023931953), (t518 <= 2.0943951023931953)), t518, casadi.if_else(casadi.logic_and((t519 >= -2.0943951023931953), (t519 <= 2.0943951023931953)), t519, t514)))
-    t521 = (t238 >= -2.0943951023931953)
-    t522 = casadi.logic_and((t236 >= -2.0943951023931953), (t236 <= 2.0943951023931953))
-    t523 = casadi.if_else(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t288, t289), t291), t4), t454), (t152 >= -1e-12)), casadi.logic_or(t503, t504)), casadi.logic_or(t512, t513)), casadi.logic_or(t521, t522)), 1, 0)
-    t524 = casadi.if_else(casadi.logic_and(t521, casadi.logic_not(t522)), -t238, t237)
-    t525 = t524
-    t526 = t525 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t525)
-    t527 = casadi.if_else((qn4 > t526), 6.283185307179586, -6.283185307179586)
-    t528 = t526 + t527
-    t529 = t526 - t527
-    t530 = casadi.if_else(casadi.logic_and((t526 >= -2.0943951023931953), (t526 <= 2.0943951023931953)), t526, casadi.if_else(casadi.logic_and((t528 >= -2.0943951023931953), (t528 <= 2.0943951023931953)), t528, casadi.if_else(casadi.logic_and((t529 >= -2.0943951023931953), (t529 <= 2.0943951023931953)), t529, t524)))
-    t531 = t452 + qw2*(t284 + t511)**2 + qw3*(t285 + t520)**2 + qw4*(t286 + t530)**2
-    t532 = (t523 > 0)
-    t533 = casadi.if_else(casadi.logic_and(t532, casadi.logic_or((t502 > t531), (t496 < 1))), 1, 0)
-    t534 = casadi.if_else(t532, 1, t496)
-    t535 = (t533 > 0)
-    t536 = casadi.if_else(t535, t424, t498)
-    t537 = casadi.if_else(t535, t511, t499)
-    t538 = casadi.if_else(t535, t520, t500)
-    t539 = casadi.if_else(t535, t530, t501)
-    t540 = casadi.if_else(t535, t531, t502)
-    t541 = (t241 <= 2.0943951023931953)
-    t542 = casadi.logic_and((t240 >= -2.0943951023931953), (t240 <= 2.0943951023931953))
-    t543 = casadi.if_else(casadi.logic_and(t541, casadi.logic_not(t542)), t241, t240)
-    t544 = t543
-    t545 = t544 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t544)
-    t546 = casadi.if_else((qn2 > t545), 6.283185307179586, -6.283185307179586)
-    t547 = t545 + t546
-    t548 = t545 - t546
-    t549 = casadi.if_else(casadi.logic_and((t545 >= -2.0943951023931953), (t545 <= 2.0943951023931953)), t545, casadi.if_else(casadi.logic_and((t547 >= -2.0943951023931953), (t547 <= 2.0943951023931953)), t547, casadi.if_else(casadi.logic_and((t548 >= -2.0943951023931953), (t548 <= 2.0943951023931953)), t548, t543)))
-    t550 = (t171 <= 2.0943951023931953)
-    t551 = casadi.logic_and((t170 >= -2.0943951023931953), (t170 <= 2.0943951023931953))
-    t552 = casadi.if_else(casadi.logic_and(t550, casadi.logic_not(t551)), t171, t170)
-    t553 = t552
-    t554 = t553 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn3 - 0.15915494309189535*t553)
-    t555 = casadi.if_else((qn3 > t554), 6.283185307179586, -6.283185307179586)
-    t556 = t554 + t555
-    t557 = t554 - t555
-    t558 = casadi.if_else(casadi.logic_and((t554 >= -2.0943951023931953), (t554 <= 2.0943951023931953)), t554, casadi.if_else(casadi.logic_and((t556 >= -2.0943951023931953), (t556 <= 2.0943951023931953)), t556, casadi.if_else(casadi.logic_and((t557 >= -2.0943951023931953), (t557 <= 2.0943951023931953)), t557, t552)))
-    t559 = (t245 >= -2.0943951023931953)
-    t560 = casadi.logic_and((t243 >= -2.0943951023931953), (t243 <= 2.0943951023931953))
-    t561 = casadi.if_else(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t154, t288), t289), t291), t4), t454), casadi.logic_or(t541, t542)), casadi.logic_or(t550, t551)), casadi.logic_or(t559, t560)), 1, 0)
-    t562 = casadi.if_else(casadi.logic_and(t559, casadi.logic_not(t560)), -t245, t244)
-    t563 = t562
-    t564 = t563 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t563)
-    t565 = casadi.if_else((qn4 > t564), 6.283185307179586, -6.283185307179586)
-    t566 = t564 + t565
-    t567 = t564 - t565
-    t568 = casadi.if_else(casadi.logic_and((t564 >= -2.0943951023931953), (t564 <= 2.0943951023931953)), t564, casadi.if_else(casadi.logic_and((t566 >= -2.0943951023931953), (t566 <= 2.0943951023931953)), t566, casadi.if_else(casadi.logic_and((t567 >= -2.0943951023931953), (t567 <= 2.0943951023931953)), t567, t562)))
-    t569 = t452 + qw2*(t284 + t549)**2 + qw3*(t285 + t558)**2 + qw4*(t286 + t568)**2
-    t570 = (t561 > 0)
-    t571 = casadi.if_else(casadi.logic_and(t570, casadi.logic_or((t540 > t569), (t534 < 1))), 1, 0)
-    t572 = casadi.if_else(t570, 1, t534)
-    t573 = (t571 > 0)
-    t574 = casadi.if_else(t573, t424, t536)
-    t575 = casadi.if_else(t573, t549, t537)
-    t576 = casadi.if_else(t573, t558, t538)
-    t577 = casadi.if_else(t573, t568, t539)
-    t578 = (casadi.fabs(t182) < casadi.inf)
-    t579 = (t572 > 0)
-    t580 = casadi.logic_and(t578, t579)
+    qb0_0 = branches_q[0, 0]
+    qb0_1 = branches_q[0, 1]
+    qb0_2 = branches_q[0, 2]
+    qb0_3 = branches_q[0, 3]
+    qb1_0 = branches_q[1, 0]
+    qb1_1 = branches_q[1, 1]
+    qb1_2 = branches_q[1, 2]
+    qb1_3 = branches_q[1, 3]
+    qb2_0 = branches_q[2, 0]
+    qb2_1 = branches_q[2, 1]
+    qb2_2 = branches_q[2, 2]
+    qb2_3 = branches_q[2, 3]
+    qb3_0 = branches_q[3, 0]
+    qb3_1 = branches_q[3, 1]
+    qb3_2 = branches_q[3, 2]
+    qb3_3 = branches_q[3, 3]
+    qb4_0 = branches_q[4, 0]
+    qb4_1 = branches_q[4, 1]
+    qb4_2 = branches_q[4, 2]
+    qb4_3 = branches_q[4, 3]
+    qb5_0 = branches_q[5, 0]
+    qb5_1 = branches_q[5, 1]
+    qb5_2 = branches_q[5, 2]
+    qb5_3 = branches_q[5, 3]
+    qb6_0 = branches_q[6, 0]
+    qb6_1 = branches_q[6, 1]
+    qb6_2 = branches_q[6, 2]
+    qb6_3 = branches_q[6, 3]
+    qb7_0 = branches_q[7, 0]
+    qb7_1 = branches_q[7, 1]
+    qb7_2 = branches_q[7, 2]
+    qb7_3 = branches_q[7, 3]
+    vb0 = branches_valid[0]
+    vb1 = branches_valid[1]
+    vb2 = branches_valid[2]
+    vb3 = branches_valid[3]
+    vb4 = branches_valid[4]
+    vb5 = branches_valid[5]
+    vb6 = branches_valid[6]
+    vb7 = branches_valid[7]
+    lb0 = branches_in_limits[0]
+    lb1 = branches_in_limits[1]
+    lb2 = branches_in_limits[2]
+    lb3 = branches_in_limits[3]
+    lb4 = branches_in_limits[4]
+    lb5 = branches_in_limits[5]
+    lb6 = branches_in_limits[6]
+    lb7 = branches_in_limits[7]
+    t0 = qb0_0 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn1 - qb0_0))
+    t1 = qb0_1 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn2 - qb0_1))
+    t2 = qb0_2 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn3 - qb0_2))
+    t3 = qb0_3 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn4 - qb0_3))
+    t4 = casadi.if_else(casadi.logic_and(lb0, vb0), 1, 0)
+    t5 = casadi.if_else((t4 > 0), 1, 0)
+    t6 = qb1_0 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn1 - qb1_0))
+    t7 = qb1_1 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn2 - qb1_1))
+    t8 = qb1_2 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn3 - qb1_2))
+    t9 = qb1_3 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn4 - qb1_3))
+    t10 = casadi.if_else(casadi.logic_and(lb1, vb1), 1, 0)
+    t11 = qb2_0 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn1 - qb2_0))
+    t12 = qb2_1 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn2 - qb2_1))
+    t13 = qb2_2 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn3 - qb2_2))
+    t14 = qb2_3 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn4 - qb2_3))
+    t15 = casadi.if_else(casadi.logic_and(lb2, vb2), 1, 0)
+    t16 = qb3_0 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn1 - qb3_0))
+    t17 = qb3_1 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn2 - qb3_1))
+    t18 = qb3_2 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn3 - qb3_2))
+    t19 = qb3_3 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn4 - qb3_3))
+    t20 = casadi.if_else(casadi.logic_and(lb3, vb3), 1, 0)
+    t21 = qb4_0 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn1 - qb4_0))
+    t22 = qb4_1 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn2 - qb4_1))
+    t23 = qb4_2 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn3 - qb4_2))
+    t24 = qb4_3 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn4 - qb4_3))
+    t25 = casadi.if_else(casadi.logic_and(lb4, vb4), 1, 0)
+    t26 = qb5_0 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn1 - qb5_0))
+    t27 = qb5_1 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn2 - qb5_1))
+    t28 = qb5_2 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn3 - qb5_2))
+    t29 = qb5_3 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn4 - qb5_3))
+    t30 = casadi.if_else(casadi.logic_and(lb5, vb5), 1, 0)
+    t31 = qb6_0 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn1 - qb6_0))
+    t32 = qb6_1 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn2 - qb6_1))
+    t33 = qb6_2 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn3 - qb6_2))
+    t34 = qb6_3 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn4 - qb6_3))
+    t35 = casadi.if_else(casadi.logic_and(lb6, vb6), 1, 0)
+    t36 = qb7_0 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn1 - qb7_0))
+    t37 = qb7_1 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn2 - qb7_1))
+    t38 = qb7_2 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn3 - qb7_2))
+    t39 = qb7_3 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn4 - qb7_3))
+    t40 = casadi.if_else(casadi.logic_and(lb7, vb7), 1, 0)
+    t41 = mu0 + mu1 + mu2 + mu3 + qn1 + qn2 + qn3 + qn4 + qw1 + qw2 + qw3 + qw4
+    t42 = casadi.if_else((qn1 > t0), 6.283185307179586, -6.283185307179586)
+    t43 = t0 + t42
+    t44 = t0 - t42
+    t45 = casadi.if_else(casadi.logic_and((t0 >= -3.141592653589793), (t0 <= 3.141592653589793)), t0, casadi.if_else(casadi.logic_and((t43 >= -3.141592653589793), (t43 <= 3.141592653589793)), t43, casadi.if_else(casadi.logic_and((t44 >= -3.141592653589793), (t44 <= 3.141592653589793)), t44, qb0_0)))
+    t46 = casadi.if_else((qn2 > t1), 6.283185307179586, -6.283185307179586)
+    t47 = t1 + t46
+    t48 = t1 - t46
+    t49 = casadi.if_else(casadi.logic_and((t1 >= -2.0943951023931953), (t1 <= 2.0943951023931953)), t1, casadi.if_else(casadi.logic_and((t47 >= -2.0943951023931953), (t47 <= 2.0943951023931953)), t47, casadi.if_else(casadi.logic_and((t48 >= -2.0943951023931953), (t48 <= 2.0943951023931953)), t48, qb0_1)))
+    t50 = casadi.if_else((qn3 > t2), 6.283185307179586, -6.283185307179586)
+    t51 = t2 + t50
+    t52 = t2 - t50
+    t53 = casadi.if_else(casadi.logic_and((t2 >= -2.0943951023931953), (t2 <= 2.0943951023931953)), t2, casadi.if_else(casadi.logic_and((t51 >= -2.0943951023931953), (t51 <= 2.0943951023931953)), t51, casadi.if_else(casadi.logic_and((t52 >= -2.0943951023931953), (t52 <= 2.0943951023931953)), t52, qb0_2)))
+    t54 = casadi.if_else((qn4 > t3), 6.283185307179586, -6.283185307179586)
+    t55 = t3 + t54
+    t56 = t3 - t54
+    t57 = casadi.if_else(casadi.logic_and((t3 >= -2.0943951023931953), (t3 <= 2.0943951023931953)), t3, casadi.if_else(casadi.logic_and((t55 >= -2.0943951023931953), (t55 <= 2.0943951023931953)), t55, casadi.if_else(casadi.logic_and((t56 >= -2.0943951023931953), (t56 <= 2.0943951023931953)), t56, qb0_3)))
+    t58 = -qn1
+    t59 = -qn2
+    t60 = -qn3
+    t61 = -qn4
+    t62 = qw1*(t45 + t58)**2 + qw2*(t49 + t59)**2 + qw3*(t53 + t60)**2 + qw4*(t57 + t61)**2
+    t63 = (t5 > 0)
+    t64 = casadi.if_else(t63, t45, qn1)
+    t65 = casadi.if_else(t63, t49, qn2)
+    t66 = casadi.if_else(t63, t53, qn3)
+    t67 = casadi.if_else(t63, t57, qn4)
+    t68 = casadi.if_else(t63, t62, 0)
+    t69 = casadi.if_else((qn1 > t6), 6.283185307179586, -6.283185307179586)
+    t70 = t6 + t69
+    t71 = t6 - t69
+    t72 = casadi.if_else(casadi.logic_and((t6 >= -3.141592653589793), (t6 <= 3.141592653589793)), t6, casadi.if_else(casadi.logic_and((t70 >= -3.141592653589793), (t70 <= 3.141592653589793)), t70, casadi.if_else(casadi.logic_and((t71 >= -3.141592653589793), (t71 <= 3.141592653589793)), t71, qb1_0)))
+    t73 = casadi.if_else((qn2 > t7), 6.283185307179586, -6.283185307179586)
+    t74 = t7 + t73
+    t75 = t7 - t73
+    t76 = casadi.if_else(casadi.logic_and((t7 >= -2.0943951023931953), (t7 <= 2.0943951023931953)), t7, casadi.if_else(casadi.logic_and((t74 >= -2.0943951023931953), (t74 <= 2.0943951023931953)), t74, casadi.if_else(casadi.logic_and((t75 >= -2.0943951023931953), (t75 <= 2.0943951023931953)), t75, qb1_1)))
+    t77 = casadi.if_else((qn3 > t8), 6.283185307179586, -6.283185307179586)
+    t78 = t77 + t8
+    t79 = t8 - t77
+    t80 = casadi.if_else(casadi.logic_and((t8 >= -2.0943951023931953), (t8 <= 2.0943951023931953)), t8, casadi.if_else(casadi.logic_and((t78 >= -2.0943951023931953), (t78 <= 2.0943951023931953)), t78, casadi.if_else(casadi.logic_and((t79 >= -2.0943951023931953), (t79 <= 2.0943951023931953)), t79, qb1_2)))
+    t81 = casadi.if_else((qn4 > t9), 6.283185307179586, -6.283185307179586)
+    t82 = t81 + t9
+    t83 = t9 - t81
+    t84 = casadi.if_else(casadi.logic_and((t9 >= -2.0943951023931953), (t9 <= 2.0943951023931953)), t9, casadi.if_else(casadi.logic_and((t82 >= -2.0943951023931953), (t82 <= 2.0943951023931953)), t82, casadi.if_else(casadi.logic_and((t83 >= -2.0943951023931953), (t83 <= 2.0943951023931953)), t83, qb1_3)))
+    t85 = qw1*(t58 + t72)**2 + qw2*(t59 + t76)**2 + qw3*(t60 + t80)**2 + qw4*(t61 + t84)**2
+    t86 = (t10 > 0)
+    t87 = casadi.if_else(casadi.logic_and(t86, casadi.logic_or((t68 > t85), (t5 < 1))), 1, 0)
+    t88 = casadi.if_else(t86, 1, t5)
+    t89 = (t87 > 0)
+    t90 = casadi.if_else(t89, t72, t64)
+    t91 = casadi.if_else(t89, t76, t65)
+    t92 = casadi.if_else(t89, t80, t66)
+    t93 = casadi.if_else(t89, t84, t67)
+    t94 = casadi.if_else(t89, t85, t68)
+    t95 = casadi.if_else((qn1 > t11), 6.283185307179586, -6.283185307179586)
+    t96 = t11 + t95
+    t97 = t11 - t95
+    t98 = casadi.if_else(casadi.logic_and((t11 >= -3.141592653589793), (t11 <= 3.141592653589793)), t11, casadi.if_else(casadi.logic_and((t96 >= -3.141592653589793), (t96 <= 3.141592653589793)), t96, casadi.if_else(casadi.logic_and((t97 >= -3.141592653589793), (t97 <= 3.141592653589793)), t97, qb2_0)))
+    t99 = casadi.if_else((qn2 > t12), 6.283185307179586, -6.283185307179586)
+    t100 = t12 + t99
+    t101 = t12 - t99
+    t102 = casadi.if_else(casadi.logic_and((t12 >= -2.0943951023931953), (t12 <= 2.0943951023931953)), t12, casadi.if_else(casadi.logic_and((t100 >= -2.0943951023931953), (t100 <= 2.0943951023931953)), t100, casadi.if_else(casadi.logic_and((t101 >= -2.0943951023931953), (t101 <= 2.0943951023931953)), t101, qb2_1)))
+    t103 = casadi.if_else((qn3 > t13), 6.283185307179586, -6.283185307179586)
+    t104 = t103 + t13
+    t105 = t13 - t103
+    t106 = casadi.if_else(casadi.logic_and((t13 >= -2.0943951023931953), (t13 <= 2.0943951023931953)), t13, casadi.if_else(casadi.logic_and((t104 >= -2.0943951023931953), (t104 <= 2.0943951023931953)), t104, casadi.if_else(casadi.logic_and((t105 >= -2.0943951023931953), (t105 <= 2.0943951023931953)), t105, qb2_2)))
+    t107 = casadi.if_else((qn4 > t14), 6.283185307179586, -6.283185307179586)
+    t108 = t107 + t14
+    t109 = t14 - t107
+    t110 = casadi.if_else(casadi.logic_and((t14 >= -2.0943951023931953), (t14 <= 2.0943951023931953)), t14, casadi.if_else(casadi.logic_and((t108 >= -2.0943951023931953), (t108 <= 2.0943951023931953)), t108, casadi.if_else(casadi.logic_and((t109 >= -2.0943951023931953), (t109 <= 2.0943951023931953)), t109, qb2_3)))
+    t111 = qw1*(t58 + t98)**2 + qw2*(t102 + t59)**2 + qw3*(t106 + t60)**2 + qw4*(t110 + t61)**2
+    t112 = (t15 > 0)
+    t113 = casadi.if_else(casadi.logic_and(t112, casadi.logic_or((t111 < t94), (t88 < 1))), 1, 0)
+    t114 = casadi.if_else(t112, 1, t88)
+    t115 = (t113 > 0)
+    t116 = casadi.if_else(t115, t98, t90)
+    t117 = casadi.if_else(t115, t102, t91)
+    t118 = casadi.if_else(t115, t106, t92)
+    t119 = casadi.if_else(t115, t110, t93)
+    t120 = casadi.if_else(t115, t111, t94)
+    t121 = casadi.if_else((qn1 > t16), 6.283185307179586, -6.283185307179586)
+    t122 = t121 + t16
+    t123 = t16 - t121
+    t124 = casadi.if_else(casadi.logic_and((t16 >= -3.141592653589793), (t16 <= 3.141592653589793)), t16, casadi.if_else(casadi.logic_and((t122 >= -3.141592653589793), (t122 <= 3.141592653589793)), t122, casadi.if_else(casadi.logic_and((t123 >= -3.141592653589793), (t123 <= 3.141592653589793)), t123, qb3_0)))
+    t125 = casadi.if_else((qn2 > t17), 6.283185307179586, -6.283185307179586)
+    t126 = t125 + t17
+    t127 = t17 - t125
+    t128 = casadi.if_else(casadi.logic_and((t17 >= -2.0943951023931953), (t17 <= 2.0943951023931953)), t17, casadi.if_else(casadi.logic_and((t126 >= -2.0943951023931953), (t126 <= 2.0943951023931953)), t126, casadi.if_else(casadi.logic_and((t127 >= -2.0943951023931953), (t127 <= 2.0943951023931953)), t127, qb3_1)))
+    t129 = casadi.if_else((qn3 > t18), 6.283185307179586, -6.283185307179586)
+    t130 = t129 + t18
+    t131 = t18 - t129
+    t132 = casadi.if_else(casadi.logic_and((t18 >= -2.0943951023931953), (t18 <= 2.0943951023931953)), t18, casadi.if_else(casadi.logic_and((t130 >= -2.0943951023931953), (t130 <= 2.0943951023931953)), t130, casadi.if_else(casadi.logic_and((t131 >= -2.0943951023931953), (t131 <= 2.0943951023931953)), t131, qb3_2)))
+    t133 = casadi.if_else((qn4 > t19), 6.283185307179586, -6.283185307179586)
+    t134 = t133 + t19
+    t135 = t19 - t133
+    t136 = casadi.if_else(casadi.logic_and((t19 >= -2.0943951023931953), (t19 <= 2.0943951023931953)), t19, casadi.if_else(casadi.logic_and((t134 >= -2.0943951023931953), (t134 <= 2.0943951023931953)), t134, casadi.if_else(casadi.logic_and((t135 >= -2.0943951023931953), (t135 <= 2.0943951023931953)), t135, qb3_3)))
+    t137 = qw1*(t124 + t58)**2 + qw2*(t128 + t59)**2 + qw3*(t132 + t60)**2 + qw4*(t136 + t61)**2
+    t138 = (t20 > 0)
+    t139 = casadi.if_else(casadi.logic_and(t138, casadi.logic_or((t120 > t137), (t114 < 1))), 1, 0)
+    t140 = casadi.if_else(t138, 1, t114)
+    t141 = (t139 > 0)
+    t142 = casadi.if_else(t141, t124, t116)
+    t143 = casadi.if_else(t141, t128, t117)
+    t144 = casadi.if_else(t141, t132, t118)
+    t145 = casadi.if_else(t141, t136, t119)
+    t146 = casadi.if_else(t141, t137, t120)
+    t147 = casadi.if_else((qn1 > t21), 6.283185307179586, -6.283185307179586)
+    t148 = t147 + t21
+    t149 = t21 - t147
+    t150 = casadi.if_else(casadi.logic_and((t21 >= -3.141592653589793), (t21 <= 3.141592653589793)), t21, casadi.if_else(casadi.logic_and((t148 >= -3.141592653589793), (t148 <= 3.141592653589793)), t148, casadi.if_else(casadi.logic_and((t149 >= -3.141592653589793), (t149 <= 3.141592653589793)), t149, qb4_0)))
+    t151 = casadi.if_else((qn2 > t22), 6.283185307179586, -6.283185307179586)
+    t152 = t151 + t22
+    t153 = t22 - t151
+    t154 = casadi.if_else(casadi.logic_and((t22 >= -2.0943951023931953), (t22 <= 2.0943951023931953)), t22, casadi.if_else(casadi.logic_and((t152 >= -2.0943951023931953), (t152 <= 2.0943951023931953)), t152, casadi.if_else(casadi.logic_and((t153 >= -2.0943951023931953), (t153 <= 2.0943951023931953)), t153, qb4_1)))
+    t155 = casadi.if_else((qn3 > t23), 6.283185307179586, -6.283185307179586)
+    t156 = t155 + t23
+    t157 = t23 - t155
+    t158 = casadi.if_else(casadi.logic_and((t23 >= -2.0943951023931953), (t23 <= 2.0943951023931953)), t23, casadi.if_else(casadi.logic_and((t156 >= -2.0943951023931953), (t156 <= 2.0943951023931953)), t156, casadi.if_else(casadi.logic_and((t157 >= -2.0943951023931953), (t157 <= 2.0943951023931953)), t157, qb4_2)))
+    t159 = casadi.if_else((qn4 > t24), 6.283185307179586, -6.283185307179586)
+    t160 = t159 + t24
+    t161 = t24 - t159
+    t162 = casadi.if_else(casadi.logic_and((t24 >= -2.0943951023931953), (t24 <= 2.0943951023931953)), t24, casadi.if_else(casadi.logic_and((t160 >= -2.0943951023931953), (t160 <= 2.0943951023931953)), t160, casadi.if_else(casadi.logic_and((t161 >= -2.0943951023931953), (t161 <= 2.0943951023931953)), t161, qb4_3)))
+    t163 = qw1*(t150 + t58)**2 + qw2*(t154 + t59)**2 + qw3*(t158 + t60)**2 + qw4*(t162 + t61)**2
+    t164 = (t25 > 0)
+    t165 = casadi.if_else(casadi.logic_and(t164, casadi.logic_or((t146 > t163), (t140 < 1))), 1, 0)
+    t166 = casadi.if_else(t164, 1, t140)
+    t167 = (t165 > 0)
+    t168 = casadi.if_else(t167, t150, t142)
+    t169 = casadi.if_else(t167, t154, t143)
+    t170 = casadi.if_else(t167, t158, t144)
+    t171 = casadi.if_else(t167, t162, t145)
+    t172 = casadi.if_else(t167, t163, t146)
+    t173 = casadi.if_else((qn1 > t26), 6.283185307179586, -6.283185307179586)
+    t174 = t173 + t26
+    t175 = t26 - t173
+    t176 = casadi.if_else(casadi.logic_and((t26 >= -3.141592653589793), (t26 <= 3.141592653589793)), t26, casadi.if_else(casadi.logic_and((t174 >= -3.141592653589793), (t174 <= 3.141592653589793)), t174, casadi.if_else(casadi.logic_and((t175 >= -3.141592653589793), (t175 <= 3.141592653589793)), t175, qb5_0)))
+    t177 = casadi.if_else((qn2 > t27), 6.283185307179586, -6.283185307179586)
+    t178 = t177 + t27
+    t179 = t27 - t177
+    t180 = casadi.if_else(casadi.logic_and((t27 >= -2.0943951023931953), (t27 <= 2.0943951023931953)), t27, casadi.if_else(casadi.logic_and((t178 >= -2.0943951023931953), (t178 <= 2.0943951023931953)), t178, casadi.if_else(casadi.logic_and((t179 >= -2.0943951023931953), (t179 <= 2.0943951023931953)), t179, qb5_1)))
+    t181 = casadi.if_else((qn3 > t28), 6.283185307179586, -6.283185307179586)
+    t182 = t181 + t28
+    t183 = t28 - t181
+    t184 = casadi.if_else(casadi.logic_and((t28 >= -2.0943951023931953), (t28 <= 2.0943951023931953)), t28, casadi.if_else(casadi.logic_and((t182 >= -2.0943951023931953), (t182 <= 2.0943951023931953)), t182, casadi.if_else(casadi.logic_and((t183 >= -2.0943951023931953), (t183 <= 2.0943951023931953)), t183, qb5_2)))
+    t185 = casadi.if_else((qn4 > t29), 6.283185307179586, -6.283185307179586)
+    t186 = t185 + t29
+    t187 = t29 - t185
+    t188 = casadi.if_else(casadi.logic_and((t29 >= -2.0943951023931953), (t29 <= 2.0943951023931953)), t29, casadi.if_else(casadi.logic_and((t186 >= -2.0943951023931953), (t186 <= 2.0943951023931953)), t186, casadi.if_else(casadi.logic_and((t187 >= -2.0943951023931953), (t187 <= 2.0943951023931953)), t187, qb5_3)))
+    t189 = qw1*(t176 + t58)**2 + qw2*(t180 + t59)**2 + qw3*(t184 + t60)**2 + qw4*(t188 + t61)**2
+    t190 = (t30 > 0)
+    t191 = casadi.if_else(casadi.logic_and(t190, casadi.logic_or((t172 > t189), (t166 < 1))), 1, 0)
+    t192 = casadi.if_else(t190, 1, t166)
+    t193 = (t191 > 0)
+    t194 = casadi.if_else(t193, t176, t168)
+    t195 = casadi.if_else(t193, t180, t169)
+    t196 = casadi.if_else(t193, t184, t170)
+    t197 = casadi.if_else(t193, t188, t171)
+    t198 = casadi.if_else(t193, t189, t172)
+    t199 = casadi.if_else((qn1 > t31), 6.283185307179586, -6.283185307179586)
+    t200 = t199 + t31
+    t201 = t31 - t199
+    t202 = casadi.if_else(casadi.logic_and((t31 >= -3.141592653589793), (t31 <= 3.141592653589793)), t31, casadi.if_else(casadi.logic_and((t200 >= -3.141592653589793), (t200 <= 3.141592653589793)), t200, casadi.if_else(casadi.logic_and((t201 >= -3.141592653589793), (t201 <= 3.141592653589793)), t201, qb6_0)))
+    t203 = casadi.if_else((qn2 > t32), 6.283185307179586, -6.283185307179586)
+    t204 = t203 + t32
+    t205 = t32 - t203
+    t206 = casadi.if_else(casadi.logic_and((t32 >= -2.0943951023931953), (t32 <= 2.0943951023931953)), t32, casadi.if_else(casadi.logic_and((t204 >= -2.0943951023931953), (t204 <= 2.0943951023931953)), t204, casadi.if_else(casadi.logic_and((t205 >= -2.0943951023931953), (t205 <= 2.0943951023931953)), t205, qb6_1)))
+    t207 = casadi.if_else((qn3 > t33), 6.283185307179586, -6.283185307179586)
+    t208 = t207 + t33
+    t209 = t33 - t207
+    t210 = casadi.if_else(casadi.logic_and((t33 >= -2.0943951023931953), (t33 <= 2.0943951023931953)), t33, casadi.if_else(casadi.logic_and((t208 >= -2.0943951023931953), (t208 <= 2.0943951023931953)), t208, casadi.if_else(casadi.logic_and((t209 >= -2.0943951023931953), (t209 <= 2.0943951023931953)), t209, qb6_2)))
+    t211 = casadi.if_else((qn4 > t34), 6.283185307179586, -6.283185307179586)
+    t212 = t211 + t34
+    t213 = t34 - t211
+    t214 = casadi.if_else(casadi.logic_and((t34 >= -2.0943951023931953), (t34 <= 2.0943951023931953)), t34, casadi.if_else(casadi.logic_and((t212 >= -2.0943951023931953), (t212 <= 2.0943951023931953)), t212, casadi.if_else(casadi.logic_and((t213 >= -2.0943951023931953), (t213 <= 2.0943951023931953)), t213, qb6_3)))
+    t215 = qw1*(t202 + t58)**2 + qw2*(t206 + t59)**2 + qw3*(t210 + t60)**2 + qw4*(t214 + t61)**2
+    t216 = (t35 > 0)
+    t217 = casadi.if_else(casadi.logic_and(t216, casadi.logic_or((t198 > t215), (t192 < 1))), 1, 0)
+    t218 = casadi.if_else(t216, 1, t192)
+    t219 = (t217 > 0)
+    t220 = casadi.if_else(t219, t202, t194)
+    t221 = casadi.if_else(t219, t206, t195)
+    t222 = casadi.if_else(t219, t210, t196)
+    t223 = casadi.if_else(t219, t214, t197)
+    t224 = casadi.if_else(t219, t215, t198)
+    t225 = casadi.if_else((qn1 > t36), 6.283185307179586, -6.283185307179586)
+    t226 = t225 + t36
+    t227 = t36 - t225
+    t228 = casadi.if_else(casadi.logic_and((t36 >= -3.141592653589793), (t36 <= 3.141592653589793)), t36, casadi.if_else(casadi.logic_and((t226 >= -3.141592653589793), (t226 <= 3.141592653589793)), t226, casadi.if_else(casadi.logic_and((t227 >= -3.141592653589793), (t227 <= 3.141592653589793)), t227, qb7_0)))
+    t229 = casadi.if_else((qn2 > t37), 6.283185307179586, -6.283185307179586)
+    t230 = t229 + t37
+    t231 = t37 - t229
+    t232 = casadi.if_else(casadi.logic_and((t37 >= -2.0943951023931953), (t37 <= 2.0943951023931953)), t37, casadi.if_else(casadi.logic_and((t230 >= -2.0943951023931953), (t230 <= 2.0943951023931953)), t230, casadi.if_else(casadi.logic_and((t231 >= -2.0943951023931953), (t231 <= 2.0943951023931953)), t231, qb7_1)))
+    t233 = casadi.if_else((qn3 > t38), 6.283185307179586, -6.283185307179586)
+    t234 = t233 + t38
+    t235 = t38 - t233
+    t236 = casadi.if_else(casadi.logic_and((t38 >= -2.0943951023931953), (t38 <= 2.0943951023931953)), t38, casadi.if_else(casadi.logic_and((t234 >= -2.0943951023931953), (t234 <= 2.0943951023931953)), t234, casadi.if_else(casadi.logic_and((t235 >= -2.0943951023931953), (t235 <= 2.0943951023931953)), t235, qb7_2)))
+    t237 = casadi.if_else((qn4 > t39), 6.283185307179586, -6.283185307179586)
+    t238 = t237 + t39
+    t239 = t39 - t237
+    t240 = casadi.if_else(casadi.logic_and((t39 >= -2.0943951023931953), (t39 <= 2.0943951023931953)), t39, casadi.if_else(casadi.logic_and((t238 >= -2.0943951023931953), (t238 <= 2.0943951023931953)), t238, casadi.if_else(casadi.logic_and((t239 >= -2.0943951023931953), (t239 <= 2.0943951023931953)), t239, qb7_3)))
+    t241 = qw1*(t228 + t58)**2 + qw2*(t232 + t59)**2 + qw3*(t236 + t60)**2 + qw4*(t240 + t61)**2
+    t242 = (t40 > 0)
+    t243 = casadi.if_else(casadi.logic_and(t242, casadi.logic_or((t224 > t241), (t218 < 1))), 1, 0)
+    t244 = casadi.if_else(t242, 1, t218)
+    t245 = (t243 > 0)
+    t246 = casadi.if_else(t245, t228, t220)
+    t247 = casadi.if_else(t245, t232, t221)
+    t248 = casadi.if_else(t245, t236, t222)
+    t249 = casadi.if_else(t245, t240, t223)
+    t250 = (casadi.fabs(t41) < casadi.inf)
+    t251 = (t244 > 0)
+    t252 = casadi.logic_and(t250, t251)
     q = casadi.SX(4, 1)
-    q[0, 0] = casadi.if_else(t580, t574, qn1)
-    q[1, 0] = casadi.if_else(t580, t575, qn2)
-    q[2, 0] = casadi.if_else(t580, t576, qn3)
-    q[3, 0] = casadi.if_else(t580, t577, qn4)
+    q[0, 0] = casadi.if_else(t252, t246, qn1)
+    q[1, 0] = casadi.if_else(t252, t247, qn2)
+    q[2, 0] = casadi.if_else(t252, t248, qn3)
+    q[3, 0] = casadi.if_else(t252, t249, qn4)
     status = casadi.SX(1, 1)
-    status[0, 0] = casadi.if_else(casadi.logic_not(t578), 2, casadi.if_else(t579, 0, 1))
+    status[0, 0] = casadi.if_else(casadi.logic_not(t250), 2, casadi.if_else(t251, 0, 1))
     return [q, status]
 
 

@@ -101,7 +101,7 @@ scara_real scara_ik_numeric_step(const scara_real target[SCARA_TASK_DIM], const 
 void scara_ik_branches(const scara_real mu[SCARA_TASK_DIM], scara_real q[SCARA_MAX_IK_SOLUTIONS * SCARA_DOF], int valid[SCARA_MAX_IK_SOLUTIONS], int in_limits[SCARA_MAX_IK_SOLUTIONS]);
 
 /* The closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status.
- * Result: q[i], i < 4; returned as a scalar. 364 operations. */
+ * Result: q[i], i < 4; returned as a scalar. 166 operations. */
 int scara_ik_nearest(const scara_real mu[SCARA_TASK_DIM], const scara_real q_seed[SCARA_DOF], const scara_real weights[SCARA_DOF], scara_real q[SCARA_DOF]);
 
 /* Statuses of scara_velocity_ik: OK, singular (a diagonal entry of the QR factor R of the

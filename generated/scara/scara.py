@@ -61,7 +61,7 @@ def _cos_sin(xp, q, offsets, device):
     return xp.take(both, xp.asarray(_INTERLEAVED, device=device), axis=-1)
 
 
-_INTERLEAVED = [k // 2 + k % 2 * DOF for k in range(2 * DOF)]
+_INTERLEAVED = [_k // 2 + _k % 2 * DOF for _k in range(2 * DOF)]  # c1, s1, c2, s2, ...
 
 
 def _stack(xp, values, shape):
@@ -1038,8 +1038,9 @@ def ik_branches(mu):
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def ik_nearest(mu, q_seed, weights=(1.0,) * DOF):
-    """the closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status: (4 x 1 and 1 x 1), 364 operations."""
+    """the closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status: (4 x 1 and 1 x 1), 166 operations."""
     xp, dtype, device, batch, (mu, q_seed, weights,) = _arguments(("mu", mu, (4,)), ("q_seed", q_seed, (4,)), ("weights", weights, (4,)))
+    branches_q, branches_valid, branches_in_limits = ik_branches(mu)
     mu0 = mu[..., 0]
     mu1 = mu[..., 1]
     mu2 = mu[..., 2]
@@ -1052,148 +1053,82 @@ def ik_nearest(mu, q_seed, weights=(1.0,) * DOF):
     qw2 = weights[..., 1]
     qw3 = weights[..., 2]
     qw4 = weights[..., 3]
-    t0 = 0.149769 + mu0**2 + mu1**2
-    t1 = 0.1655095 - 0.5*t0
-    t2 = -0.387 + mu2
-    t3 = t1**2
-    t4 = 1 - 125.18949581886645*t3
-    t5 = 11.188811188811188*t1
-    t6 = xp.less(1e-12, t4)
-    t7 = xp.where(t6, t5, xp.where(xp.greater(t5, 0), xp.asarray(1, dtype=dtype), -1))
-    t8 = xp.where(t6, xp.sqrt(t4), 0)
-    t9 = xp.atan2(t8, t7)
-    t10 = 3.141592653589793 + t9
-    t11 = 3.141592653589793 - t9
-    t12 = t10 - 6.283185307179586*xp.ceil(-0.5 + 0.15915494309189535*t10)
-    t13 = t12 - 6.283185307179586*xp.floor(0.24444444444444444 + 0.15915494309189535*t12)
-    t14 = t11 - 6.283185307179586*xp.ceil(-0.5 + 0.15915494309189535*t11)
-    t15 = t14 - 6.283185307179586*xp.floor(0.24444444444444444 + 0.15915494309189535*t14)
-    t16 = -1.0*t7
-    t17 = -1.0*t8
-    t18 = 0.325 + 0.275*t16
-    t19 = 0.149769 + t18**2 + 0.075625*t17**2
-    t20 = 0.275*t17
-    t21 = 0.149769 + mu0*t18 + mu1*t20
-    t22 = -0.149769 + t21
-    t23 = mu1*t18 - mu0*t20
-    t24 = t22**2 + t23**2
-    t25 = 0.325 - 0.275*t7
-    t26 = 0.149769 + t25**2 + 0.075625*t8**2
-    t27 = 0.275*t8
-    t28 = 0.149769 + mu0*t25 + mu1*t27
-    t29 = -0.149769 + t28
-    t30 = mu1*t25 - mu0*t27
-    t31 = t29**2 + t30**2
-    t32 = mu0 + mu1 + mu2 + mu3
-    t33 = t32
-    t34 = qn1 + qn2 + qn3 + qn4 + qw1 + qw2 + qw3 + qw4 + t32
-    t35 = 1e-24*t0
-    t36 = xp.where(xp.less_equal(t24, t19*t35), 0, xp.atan2(t23, t22))
-    t37 = t36
-    t38 = t37 - 6.283185307179586*xp.floor(0.1388888888888889 + 0.15915494309189535*t37)
-    t39 = -mu3
-    t40 = -t10 - t36 - t39
-    t41 = t40 + 6.283185307179586*xp.ceil(-0.5 - 0.15915494309189535*t40)
-    t42 = -t41
-    t43 = t41 + 6.283185307179586*xp.floor(1.0 + 0.15915494309189535*t42)
-    t44 = xp.where(xp.less_equal(t31, t26*t35), 0, xp.atan2(t30, t29))
-    t45 = t44
-    t46 = t45 - 6.283185307179586*xp.floor(0.1388888888888889 + 0.15915494309189535*t45)
-    t47 = -t11 - t39 - t44
-    t48 = t47 + 6.283185307179586*xp.ceil(-0.5 - 0.15915494309189535*t47)
-    t49 = -t48
-    t50 = t48 + 6.283185307179586*xp.floor(1.0 + 0.15915494309189535*t49)
-    t51 = xp.less_equal(t38, 0.8726646259971648)
-    t52 = (xp.greater_equal(t37, -0.8726646259971648)) & (xp.less_equal(t37, 0.8726646259971648))
-    t53 = xp.where(t51 & xp.logical_not(t52), t38, t37)
-    t54 = t53
-    t55 = t54 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*qn1 - 0.15915494309189535*t54)
-    t56 = xp.where(xp.greater(qn1, t55), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t57 = t55 + t56
-    t58 = t55 - t56
-    t59 = xp.where((xp.greater_equal(t55, -0.8726646259971648)) & (xp.less_equal(t55, 0.8726646259971648)), t55, xp.where((xp.greater_equal(t57, -0.8726646259971648)) & (xp.less_equal(t57, 0.8726646259971648)), t57, xp.where((xp.greater_equal(t58, -0.8726646259971648)) & (xp.less_equal(t58, 0.8726646259971648)), t58, t53)))
-    t60 = xp.less_equal(t13, 1.53588974175501)
-    t61 = (xp.greater_equal(t12, -1.53588974175501)) & (xp.less_equal(t12, 1.53588974175501))
-    t62 = xp.where(t60 & xp.logical_not(t61), t13, t12)
-    t63 = t62
-    t64 = t63 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t63)
-    t65 = xp.where(xp.greater(qn2, t64), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t66 = t64 + t65
-    t67 = t64 - t65
-    t68 = xp.where((xp.greater_equal(t64, -1.53588974175501)) & (xp.less_equal(t64, 1.53588974175501)), t64, xp.where((xp.greater_equal(t66, -1.53588974175501)) & (xp.less_equal(t66, 1.53588974175501)), t66, xp.where((xp.greater_equal(t67, -1.53588974175501)) & (xp.less_equal(t67, 1.53588974175501)), t67, t62)))
-    t69 = xp.greater_equal(t43, -6.283185307179586)
-    t70 = (xp.greater_equal(t41, -6.283185307179586)) & (xp.less_equal(t41, 6.283185307179586))
-    t71 = xp.where(t69 & xp.logical_not(t70), -t43, t42)
-    t72 = t71
-    t73 = t72 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t72)
-    t74 = xp.where(xp.greater(qn4, t73), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t75 = t73 + t74
-    t76 = t73 - t74
-    t77 = xp.where((xp.greater_equal(t73, -6.283185307179586)) & (xp.less_equal(t73, 6.283185307179586)), t73, xp.where((xp.greater_equal(t75, -6.283185307179586)) & (xp.less_equal(t75, 6.283185307179586)), t75, xp.where((xp.greater_equal(t76, -6.283185307179586)) & (xp.less_equal(t76, 6.283185307179586)), t76, t71)))
-    t78 = -qn1
-    t79 = -qn2
-    t80 = -qn4
-    t81 = qw3*(qn3 + t2)**2
-    t82 = t81 + qw1*(t59 + t78)**2 + qw2*(t68 + t79)**2 + qw4*(t77 + t80)**2
-    t83 = xp.isfinite(t33)
-    t84 = xp.greater_equal(mu2, 0.17700000000000002)
-    t85 = xp.less_equal(mu2, 0.387)
-    t86 = xp.where(t83 & t84 & t85 & (xp.greater_equal(t4, -1e-12)) & (t51 | t52) & (t60 | t61) & (t69 | t70), xp.asarray(1, dtype=dtype), 0)
-    t87 = xp.where(xp.greater(t86, 0), xp.asarray(1, dtype=dtype), 0)
-    t88 = xp.greater(t87, 0)
-    t89 = xp.where(t88, t59, qn1)
-    t90 = xp.where(t88, t68, qn2)
-    t91 = xp.where(t88, t77, qn4)
-    t92 = xp.where(t88, t82, 0)
-    t93 = -t2
-    t94 = xp.where(t88, t93, qn3)
-    t95 = xp.less_equal(t46, 0.8726646259971648)
-    t96 = (xp.greater_equal(t45, -0.8726646259971648)) & (xp.less_equal(t45, 0.8726646259971648))
-    t97 = xp.where(t95 & xp.logical_not(t96), t46, t45)
-    t98 = t97
-    t99 = t98 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*qn1 - 0.15915494309189535*t98)
-    t100 = xp.where(xp.greater(qn1, t99), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t101 = t100 + t99
-    t102 = t99 - t100
-    t103 = xp.where((xp.greater_equal(t99, -0.8726646259971648)) & (xp.less_equal(t99, 0.8726646259971648)), t99, xp.where((xp.greater_equal(t101, -0.8726646259971648)) & (xp.less_equal(t101, 0.8726646259971648)), t101, xp.where((xp.greater_equal(t102, -0.8726646259971648)) & (xp.less_equal(t102, 0.8726646259971648)), t102, t97)))
-    t104 = xp.less_equal(t15, 1.53588974175501)
-    t105 = (xp.greater_equal(t14, -1.53588974175501)) & (xp.less_equal(t14, 1.53588974175501))
-    t106 = xp.where(t104 & xp.logical_not(t105), t15, t14)
-    t107 = t106
-    t108 = t107 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t107)
-    t109 = xp.where(xp.greater(qn2, t108), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t110 = t108 + t109
-    t111 = t108 - t109
-    t112 = xp.where((xp.greater_equal(t108, -1.53588974175501)) & (xp.less_equal(t108, 1.53588974175501)), t108, xp.where((xp.greater_equal(t110, -1.53588974175501)) & (xp.less_equal(t110, 1.53588974175501)), t110, xp.where((xp.greater_equal(t111, -1.53588974175501)) & (xp.less_equal(t111, 1.53588974175501)), t111, t106)))
-    t113 = xp.greater_equal(t50, -6.283185307179586)
-    t114 = (xp.greater_equal(t48, -6.283185307179586)) & (xp.less_equal(t48, 6.283185307179586))
-    t115 = xp.where(t6 & t83 & t84 & t85 & (t104 | t105) & (t113 | t114) & (t95 | t96), xp.asarray(1, dtype=dtype), 0)
-    t116 = xp.where(t113 & xp.logical_not(t114), -t50, t49)
-    t117 = t116
-    t118 = t117 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t117)
-    t119 = xp.where(xp.greater(qn4, t118), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t120 = t118 + t119
-    t121 = t118 - t119
-    t122 = xp.where((xp.greater_equal(t118, -6.283185307179586)) & (xp.less_equal(t118, 6.283185307179586)), t118, xp.where((xp.greater_equal(t120, -6.283185307179586)) & (xp.less_equal(t120, 6.283185307179586)), t120, xp.where((xp.greater_equal(t121, -6.283185307179586)) & (xp.less_equal(t121, 6.283185307179586)), t121, t116)))
-    t123 = t81 + qw1*(t103 + t78)**2 + qw2*(t112 + t79)**2 + qw4*(t122 + t80)**2
-    t124 = xp.greater(t115, 0)
-    t125 = xp.where(t124 & ((xp.less(t123, t92)) | (xp.less(t87, 1))), xp.asarray(1, dtype=dtype), 0)
-    t126 = xp.where(t124, 1, t87)
-    t127 = xp.greater(t125, 0)
-    t128 = xp.where(t127, t103, t89)
-    t129 = xp.where(t127, t112, t90)
-    t130 = xp.where(t127, t93, t94)
-    t131 = xp.where(t127, t122, t91)
-    t132 = xp.isfinite(t34)
-    t133 = xp.greater(t126, 0)
-    t134 = t132 & t133
+    qb0_0 = branches_q[..., 0, 0]
+    qb0_1 = branches_q[..., 0, 1]
+    qb0_2 = branches_q[..., 0, 2]
+    qb0_3 = branches_q[..., 0, 3]
+    qb1_0 = branches_q[..., 1, 0]
+    qb1_1 = branches_q[..., 1, 1]
+    qb1_2 = branches_q[..., 1, 2]
+    qb1_3 = branches_q[..., 1, 3]
+    vb0 = branches_valid[..., 0]
+    vb1 = branches_valid[..., 1]
+    lb0 = branches_in_limits[..., 0]
+    lb1 = branches_in_limits[..., 1]
+    t0 = qb0_0 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn1 - qb0_0))
+    t1 = qb0_1 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn2 - qb0_1))
+    t2 = qb0_3 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn4 - qb0_3))
+    t3 = xp.where(lb0 & vb0, xp.asarray(1, dtype=dtype), 0)
+    t4 = xp.where(xp.greater(t3, 0), xp.asarray(1, dtype=dtype), 0)
+    t5 = qb1_0 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn1 - qb1_0))
+    t6 = qb1_1 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn2 - qb1_1))
+    t7 = qb1_3 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn4 - qb1_3))
+    t8 = xp.where(lb1 & vb1, xp.asarray(1, dtype=dtype), 0)
+    t9 = mu0 + mu1 + mu2 + mu3 + qn1 + qn2 + qn3 + qn4 + qw1 + qw2 + qw3 + qw4
+    t10 = xp.where(xp.greater(qn1, t0), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t11 = t0 + t10
+    t12 = t0 - t10
+    t13 = xp.where((xp.greater_equal(t0, -0.8726646259971648)) & (xp.less_equal(t0, 0.8726646259971648)), t0, xp.where((xp.greater_equal(t11, -0.8726646259971648)) & (xp.less_equal(t11, 0.8726646259971648)), t11, xp.where((xp.greater_equal(t12, -0.8726646259971648)) & (xp.less_equal(t12, 0.8726646259971648)), t12, qb0_0)))
+    t14 = xp.where(xp.greater(qn2, t1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t15 = t1 + t14
+    t16 = t1 - t14
+    t17 = xp.where((xp.greater_equal(t1, -1.53588974175501)) & (xp.less_equal(t1, 1.53588974175501)), t1, xp.where((xp.greater_equal(t15, -1.53588974175501)) & (xp.less_equal(t15, 1.53588974175501)), t15, xp.where((xp.greater_equal(t16, -1.53588974175501)) & (xp.less_equal(t16, 1.53588974175501)), t16, qb0_1)))
+    t18 = xp.where(xp.greater(qn4, t2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t19 = t18 + t2
+    t20 = t2 - t18
+    t21 = xp.where((xp.greater_equal(t2, -6.283185307179586)) & (xp.less_equal(t2, 6.283185307179586)), t2, xp.where((xp.greater_equal(t19, -6.283185307179586)) & (xp.less_equal(t19, 6.283185307179586)), t19, xp.where((xp.greater_equal(t20, -6.283185307179586)) & (xp.less_equal(t20, 6.283185307179586)), t20, qb0_3)))
+    t22 = -qn1
+    t23 = -qn2
+    t24 = -qn3
+    t25 = -qn4
+    t26 = qw1*(t13 + t22)**2 + qw2*(t17 + t23)**2 + qw3*(qb0_2 + t24)**2 + qw4*(t21 + t25)**2
+    t27 = xp.greater(t4, 0)
+    t28 = xp.where(t27, t13, qn1)
+    t29 = xp.where(t27, t17, qn2)
+    t30 = xp.where(t27, qb0_2, qn3)
+    t31 = xp.where(t27, t21, qn4)
+    t32 = xp.where(t27, t26, 0)
+    t33 = xp.where(xp.greater(qn1, t5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t34 = t33 + t5
+    t35 = t5 - t33
+    t36 = xp.where((xp.greater_equal(t5, -0.8726646259971648)) & (xp.less_equal(t5, 0.8726646259971648)), t5, xp.where((xp.greater_equal(t34, -0.8726646259971648)) & (xp.less_equal(t34, 0.8726646259971648)), t34, xp.where((xp.greater_equal(t35, -0.8726646259971648)) & (xp.less_equal(t35, 0.8726646259971648)), t35, qb1_0)))
+    t37 = xp.where(xp.greater(qn2, t6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t38 = t37 + t6
+    t39 = t6 - t37
+    t40 = xp.where((xp.greater_equal(t6, -1.53588974175501)) & (xp.less_equal(t6, 1.53588974175501)), t6, xp.where((xp.greater_equal(t38, -1.53588974175501)) & (xp.less_equal(t38, 1.53588974175501)), t38, xp.where((xp.greater_equal(t39, -1.53588974175501)) & (xp.less_equal(t39, 1.53588974175501)), t39, qb1_1)))
+    t41 = xp.where(xp.greater(qn4, t7), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t42 = t41 + t7
+    t43 = t7 - t41
+    t44 = xp.where((xp.greater_equal(t7, -6.283185307179586)) & (xp.less_equal(t7, 6.283185307179586)), t7, xp.where((xp.greater_equal(t42, -6.283185307179586)) & (xp.less_equal(t42, 6.283185307179586)), t42, xp.where((xp.greater_equal(t43, -6.283185307179586)) & (xp.less_equal(t43, 6.283185307179586)), t43, qb1_3)))
+    t45 = qw1*(t22 + t36)**2 + qw2*(t23 + t40)**2 + qw3*(qb1_2 + t24)**2 + qw4*(t25 + t44)**2
+    t46 = xp.greater(t8, 0)
+    t47 = xp.where(t46 & ((xp.greater(t32, t45)) | (xp.less(t4, 1))), xp.asarray(1, dtype=dtype), 0)
+    t48 = xp.where(t46, 1, t4)
+    t49 = xp.greater(t47, 0)
+    t50 = xp.where(t49, t36, t28)
+    t51 = xp.where(t49, t40, t29)
+    t52 = xp.where(t49, qb1_2, t30)
+    t53 = xp.where(t49, t44, t31)
+    t54 = xp.isfinite(t9)
+    t55 = xp.greater(t48, 0)
+    t56 = t54 & t55
     q = _stack(xp, [
-        xp.broadcast_to(xp.where(t134, t128, qn1), batch),  # 0
-        xp.broadcast_to(xp.where(t134, t129, qn2), batch),  # 1
-        xp.broadcast_to(xp.where(t134, t130, qn3), batch),  # 2
-        xp.broadcast_to(xp.where(t134, t131, qn4), batch),  # 3
+        xp.broadcast_to(xp.where(t56, t50, qn1), batch),  # 0
+        xp.broadcast_to(xp.where(t56, t51, qn2), batch),  # 1
+        xp.broadcast_to(xp.where(t56, t52, qn3), batch),  # 2
+        xp.broadcast_to(xp.where(t56, t53, qn4), batch),  # 3
     ], (4,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t132), 2, xp.where(t133, xp.asarray(0, dtype=dtype), 1)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t54), 2, xp.where(t55, xp.asarray(0, dtype=dtype), 1)), batch), xp.int32)
     return q, status
 
 

@@ -743,7 +743,8 @@ def _ik_branches(mu):
 
 
 def _ik_nearest(mu, q_seed, weights):
-    """The closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status: 364 operations."""
+    """The closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status: 166 operations."""
+    branches_q, branches_valid, branches_in_limits = _ik_branches(mu)
     mu0 = mu[0]
     mu1 = mu[1]
     mu2 = mu[2]
@@ -756,148 +757,82 @@ def _ik_nearest(mu, q_seed, weights):
     qw2 = weights[1]
     qw3 = weights[2]
     qw4 = weights[3]
-    t0 = 0.149769 + mu0**2 + mu1**2
-    t1 = 0.1655095 - 0.5*t0
-    t2 = -0.387 + mu2
-    t3 = t1**2
-    t4 = 1 - 125.18949581886645*t3
-    t5 = 11.188811188811188*t1
-    t6 = (1e-12 < t4)
-    t7 = casadi.if_else(t6, t5, casadi.if_else((t5 > 0), 1, -1))
-    t8 = casadi.if_else(t6, casadi.sqrt(t4), 0)
-    t9 = casadi.atan2(t8, t7)
-    t10 = 3.141592653589793 + t9
-    t11 = 3.141592653589793 - t9
-    t12 = t10 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t10)
-    t13 = t12 - 6.283185307179586*casadi.floor(0.24444444444444444 + 0.15915494309189535*t12)
-    t14 = t11 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t11)
-    t15 = t14 - 6.283185307179586*casadi.floor(0.24444444444444444 + 0.15915494309189535*t14)
-    t16 = -1.0*t7
-    t17 = -1.0*t8
-    t18 = 0.325 + 0.275*t16
-    t19 = 0.149769 + t18**2 + 0.075625*t17**2
-    t20 = 0.275*t17
-    t21 = 0.149769 + mu0*t18 + mu1*t20
-    t22 = -0.149769 + t21
-    t23 = mu1*t18 - mu0*t20
-    t24 = t22**2 + t23**2
-    t25 = 0.325 - 0.275*t7
-    t26 = 0.149769 + t25**2 + 0.075625*t8**2
-    t27 = 0.275*t8
-    t28 = 0.149769 + mu0*t25 + mu1*t27
-    t29 = -0.149769 + t28
-    t30 = mu1*t25 - mu0*t27
-    t31 = t29**2 + t30**2
-    t32 = mu0 + mu1 + mu2 + mu3
-    t33 = t32
-    t34 = qn1 + qn2 + qn3 + qn4 + qw1 + qw2 + qw3 + qw4 + t32
-    t35 = 1e-24*t0
-    t36 = casadi.if_else((t24 <= t19*t35), 0, casadi.atan2(t23, t22))
-    t37 = t36
-    t38 = t37 - 6.283185307179586*casadi.floor(0.1388888888888889 + 0.15915494309189535*t37)
-    t39 = -mu3
-    t40 = -t10 - t36 - t39
-    t41 = t40 + 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t40)
-    t42 = -t41
-    t43 = t41 + 6.283185307179586*casadi.floor(1.0 + 0.15915494309189535*t42)
-    t44 = casadi.if_else((t31 <= t26*t35), 0, casadi.atan2(t30, t29))
-    t45 = t44
-    t46 = t45 - 6.283185307179586*casadi.floor(0.1388888888888889 + 0.15915494309189535*t45)
-    t47 = -t11 - t39 - t44
-    t48 = t47 + 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t47)
-    t49 = -t48
-    t50 = t48 + 6.283185307179586*casadi.floor(1.0 + 0.15915494309189535*t49)
-    t51 = (t38 <= 0.8726646259971648)
-    t52 = casadi.logic_and((t37 >= -0.8726646259971648), (t37 <= 0.8726646259971648))
-    t53 = casadi.if_else(casadi.logic_and(t51, casadi.logic_not(t52)), t38, t37)
-    t54 = t53
-    t55 = t54 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn1 - 0.15915494309189535*t54)
-    t56 = casadi.if_else((qn1 > t55), 6.283185307179586, -6.283185307179586)
-    t57 = t55 + t56
-    t58 = t55 - t56
-    t59 = casadi.if_else(casadi.logic_and((t55 >= -0.8726646259971648), (t55 <= 0.8726646259971648)), t55, casadi.if_else(casadi.logic_and((t57 >= -0.8726646259971648), (t57 <= 0.8726646259971648)), t57, casadi.if_else(casadi.logic_and((t58 >= -0.8726646259971648), (t58 <= 0.8726646259971648)), t58, t53)))
-    t60 = (t13 <= 1.53588974175501)
-    t61 = casadi.logic_and((t12 >= -1.53588974175501), (t12 <= 1.53588974175501))
-    t62 = casadi.if_else(casadi.logic_and(t60, casadi.logic_not(t61)), t13, t12)
-    t63 = t62
-    t64 = t63 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t63)
-    t65 = casadi.if_else((qn2 > t64), 6.283185307179586, -6.283185307179586)
-    t66 = t64 + t65
-    t67 = t64 - t65
-    t68 = casadi.if_else(casadi.logic_and((t64 >= -1.53588974175501), (t64 <= 1.53588974175501)), t64, casadi.if_else(casadi.logic_and((t66 >= -1.53588974175501), (t66 <= 1.53588974175501)), t66, casadi.if_else(casadi.logic_and((t67 >= -1.53588974175501), (t67 <= 1.53588974175501)), t67, t62)))
-    t69 = (t43 >= -6.283185307179586)
-    t70 = casadi.logic_and((t41 >= -6.283185307179586), (t41 <= 6.283185307179586))
-    t71 = casadi.if_else(casadi.logic_and(t69, casadi.logic_not(t70)), -t43, t42)
-    t72 = t71
-    t73 = t72 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t72)
-    t74 = casadi.if_else((qn4 > t73), 6.283185307179586, -6.283185307179586)
-    t75 = t73 + t74
-    t76 = t73 - t74
-    t77 = casadi.if_else(casadi.logic_and((t73 >= -6.283185307179586), (t73 <= 6.283185307179586)), t73, casadi.if_else(casadi.logic_and((t75 >= -6.283185307179586), (t75 <= 6.283185307179586)), t75, casadi.if_else(casadi.logic_and((t76 >= -6.283185307179586), (t76 <= 6.283185307179586)), t76, t71)))
-    t78 = -qn1
-    t79 = -qn2
-    t80 = -qn4
-    t81 = qw3*(qn3 + t2)**2
-    t82 = t81 + qw1*(t59 + t78)**2 + qw2*(t68 + t79)**2 + qw4*(t77 + t80)**2
-    t83 = (casadi.fabs(t33) < casadi.inf)
-    t84 = (mu2 >= 0.17700000000000002)
-    t85 = (mu2 <= 0.387)
-    t86 = casadi.if_else(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t83, t84), t85), (t4 >= -1e-12)), casadi.logic_or(t51, t52)), casadi.logic_or(t60, t61)), casadi.logic_or(t69, t70)), 1, 0)
-    t87 = casadi.if_else((t86 > 0), 1, 0)
-    t88 = (t87 > 0)
-    t89 = casadi.if_else(t88, t59, qn1)
-    t90 = casadi.if_else(t88, t68, qn2)
-    t91 = casadi.if_else(t88, t77, qn4)
-    t92 = casadi.if_else(t88, t82, 0)
-    t93 = -t2
-    t94 = casadi.if_else(t88, t93, qn3)
-    t95 = (t46 <= 0.8726646259971648)
-    t96 = casadi.logic_and((t45 >= -0.8726646259971648), (t45 <= 0.8726646259971648))
-    t97 = casadi.if_else(casadi.logic_and(t95, casadi.logic_not(t96)), t46, t45)
-    t98 = t97
-    t99 = t98 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn1 - 0.15915494309189535*t98)
-    t100 = casadi.if_else((qn1 > t99), 6.283185307179586, -6.283185307179586)
-    t101 = t100 + t99
-    t102 = t99 - t100
-    t103 = casadi.if_else(casadi.logic_and((t99 >= -0.8726646259971648), (t99 <= 0.8726646259971648)), t99, casadi.if_else(casadi.logic_and((t101 >= -0.8726646259971648), (t101 <= 0.8726646259971648)), t101, casadi.if_else(casadi.logic_and((t102 >= -0.8726646259971648), (t102 <= 0.8726646259971648)), t102, t97)))
-    t104 = (t15 <= 1.53588974175501)
-    t105 = casadi.logic_and((t14 >= -1.53588974175501), (t14 <= 1.53588974175501))
-    t106 = casadi.if_else(casadi.logic_and(t104, casadi.logic_not(t105)), t15, t14)
-    t107 = t106
-    t108 = t107 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t107)
-    t109 = casadi.if_else((qn2 > t108), 6.283185307179586, -6.283185307179586)
-    t110 = t108 + t109
-    t111 = t108 - t109
-    t112 = casadi.if_else(casadi.logic_and((t108 >= -1.53588974175501), (t108 <= 1.53588974175501)), t108, casadi.if_else(casadi.logic_and((t110 >= -1.53588974175501), (t110 <= 1.53588974175501)), t110, casadi.if_else(casadi.logic_and((t111 >= -1.53588974175501), (t111 <= 1.53588974175501)), t111, t106)))
-    t113 = (t50 >= -6.283185307179586)
-    t114 = casadi.logic_and((t48 >= -6.283185307179586), (t48 <= 6.283185307179586))
-    t115 = casadi.if_else(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t6, t83), t84), t85), casadi.logic_or(t104, t105)), casadi.logic_or(t113, t114)), casadi.logic_or(t95, t96)), 1, 0)
-    t116 = casadi.if_else(casadi.logic_and(t113, casadi.logic_not(t114)), -t50, t49)
-    t117 = t116
-    t118 = t117 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t117)
-    t119 = casadi.if_else((qn4 > t118), 6.283185307179586, -6.283185307179586)
-    t120 = t118 + t119
-    t121 = t118 - t119
-    t122 = casadi.if_else(casadi.logic_and((t118 >= -6.283185307179586), (t118 <= 6.283185307179586)), t118, casadi.if_else(casadi.logic_and((t120 >= -6.283185307179586), (t120 <= 6.283185307179586)), t120, casadi.if_else(casadi.logic_and((t121 >= -6.283185307179586), (t121 <= 6.283185307179586)), t121, t116)))
-    t123 = t81 + qw1*(t103 + t78)**2 + qw2*(t112 + t79)**2 + qw4*(t122 + t80)**2
-    t124 = (t115 > 0)
-    t125 = casadi.if_else(casadi.logic_and(t124, casadi.logic_or((t123 < t92), (t87 < 1))), 1, 0)
-    t126 = casadi.if_else(t124, 1, t87)
-    t127 = (t125 > 0)
-    t128 = casadi.if_else(t127, t103, t89)
-    t129 = casadi.if_else(t127, t112, t90)
-    t130 = casadi.if_else(t127, t93, t94)
-    t131 = casadi.if_else(t127, t122, t91)
-    t132 = (casadi.fabs(t34) < casadi.inf)
-    t133 = (t126 > 0)
-    t134 = casadi.logic_and(t132, t133)
+    qb0_0 = branches_q[0, 0]
+    qb0_1 = branches_q[0, 1]
+    qb0_2 = branches_q[0, 2]
+    qb0_3 = branches_q[0, 3]
+    qb1_0 = branches_q[1, 0]
+    qb1_1 = branches_q[1, 1]
+    qb1_2 = branches_q[1, 2]
+    qb1_3 = branches_q[1, 3]
+    vb0 = branches_valid[0]
+    vb1 = branches_valid[1]
+    lb0 = branches_in_limits[0]
+    lb1 = branches_in_limits[1]
+    t0 = qb0_0 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn1 - qb0_0))
+    t1 = qb0_1 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn2 - qb0_1))
+    t2 = qb0_3 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn4 - qb0_3))
+    t3 = casadi.if_else(casadi.logic_and(lb0, vb0), 1, 0)
+    t4 = casadi.if_else((t3 > 0), 1, 0)
+    t5 = qb1_0 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn1 - qb1_0))
+    t6 = qb1_1 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn2 - qb1_1))
+    t7 = qb1_3 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn4 - qb1_3))
+    t8 = casadi.if_else(casadi.logic_and(lb1, vb1), 1, 0)
+    t9 = mu0 + mu1 + mu2 + mu3 + qn1 + qn2 + qn3 + qn4 + qw1 + qw2 + qw3 + qw4
+    t10 = casadi.if_else((qn1 > t0), 6.283185307179586, -6.283185307179586)
+    t11 = t0 + t10
+    t12 = t0 - t10
+    t13 = casadi.if_else(casadi.logic_and((t0 >= -0.8726646259971648), (t0 <= 0.8726646259971648)), t0, casadi.if_else(casadi.logic_and((t11 >= -0.8726646259971648), (t11 <= 0.8726646259971648)), t11, casadi.if_else(casadi.logic_and((t12 >= -0.8726646259971648), (t12 <= 0.8726646259971648)), t12, qb0_0)))
+    t14 = casadi.if_else((qn2 > t1), 6.283185307179586, -6.283185307179586)
+    t15 = t1 + t14
+    t16 = t1 - t14
+    t17 = casadi.if_else(casadi.logic_and((t1 >= -1.53588974175501), (t1 <= 1.53588974175501)), t1, casadi.if_else(casadi.logic_and((t15 >= -1.53588974175501), (t15 <= 1.53588974175501)), t15, casadi.if_else(casadi.logic_and((t16 >= -1.53588974175501), (t16 <= 1.53588974175501)), t16, qb0_1)))
+    t18 = casadi.if_else((qn4 > t2), 6.283185307179586, -6.283185307179586)
+    t19 = t18 + t2
+    t20 = t2 - t18
+    t21 = casadi.if_else(casadi.logic_and((t2 >= -6.283185307179586), (t2 <= 6.283185307179586)), t2, casadi.if_else(casadi.logic_and((t19 >= -6.283185307179586), (t19 <= 6.283185307179586)), t19, casadi.if_else(casadi.logic_and((t20 >= -6.283185307179586), (t20 <= 6.283185307179586)), t20, qb0_3)))
+    t22 = -qn1
+    t23 = -qn2
+    t24 = -qn3
+    t25 = -qn4
+    t26 = qw1*(t13 + t22)**2 + qw2*(t17 + t23)**2 + qw3*(qb0_2 + t24)**2 + qw4*(t21 + t25)**2
+    t27 = (t4 > 0)
+    t28 = casadi.if_else(t27, t13, qn1)
+    t29 = casadi.if_else(t27, t17, qn2)
+    t30 = casadi.if_else(t27, qb0_2, qn3)
+    t31 = casadi.if_else(t27, t21, qn4)
+    t32 = casadi.if_else(t27, t26, 0)
+    t33 = casadi.if_else((qn1 > t5), 6.283185307179586, -6.283185307179586)
+    t34 = t33 + t5
+    t35 = t5 - t33
+    t36 = casadi.if_else(casadi.logic_and((t5 >= -0.8726646259971648), (t5 <= 0.8726646259971648)), t5, casadi.if_else(casadi.logic_and((t34 >= -0.8726646259971648), (t34 <= 0.8726646259971648)), t34, casadi.if_else(casadi.logic_and((t35 >= -0.8726646259971648), (t35 <= 0.8726646259971648)), t35, qb1_0)))
+    t37 = casadi.if_else((qn2 > t6), 6.283185307179586, -6.283185307179586)
+    t38 = t37 + t6
+    t39 = t6 - t37
+    t40 = casadi.if_else(casadi.logic_and((t6 >= -1.53588974175501), (t6 <= 1.53588974175501)), t6, casadi.if_else(casadi.logic_and((t38 >= -1.53588974175501), (t38 <= 1.53588974175501)), t38, casadi.if_else(casadi.logic_and((t39 >= -1.53588974175501), (t39 <= 1.53588974175501)), t39, qb1_1)))
+    t41 = casadi.if_else((qn4 > t7), 6.283185307179586, -6.283185307179586)
+    t42 = t41 + t7
+    t43 = t7 - t41
+    t44 = casadi.if_else(casadi.logic_and((t7 >= -6.283185307179586), (t7 <= 6.283185307179586)), t7, casadi.if_else(casadi.logic_and((t42 >= -6.283185307179586), (t42 <= 6.283185307179586)), t42, casadi.if_else(casadi.logic_and((t43 >= -6.283185307179586), (t43 <= 6.283185307179586)), t43, qb1_3)))
+    t45 = qw1*(t22 + t36)**2 + qw2*(t23 + t40)**2 + qw3*(qb1_2 + t24)**2 + qw4*(t25 + t44)**2
+    t46 = (t8 > 0)
+    t47 = casadi.if_else(casadi.logic_and(t46, casadi.logic_or((t32 > t45), (t4 < 1))), 1, 0)
+    t48 = casadi.if_else(t46, 1, t4)
+    t49 = (t47 > 0)
+    t50 = casadi.if_else(t49, t36, t28)
+    t51 = casadi.if_else(t49, t40, t29)
+    t52 = casadi.if_else(t49, qb1_2, t30)
+    t53 = casadi.if_else(t49, t44, t31)
+    t54 = (casadi.fabs(t9) < casadi.inf)
+    t55 = (t48 > 0)
+    t56 = casadi.logic_and(t54, t55)
     q = casadi.SX(4, 1)
-    q[0, 0] = casadi.if_else(t134, t128, qn1)
-    q[1, 0] = casadi.if_else(t134, t129, qn2)
-    q[2, 0] = casadi.if_else(t134, t130, qn3)
-    q[3, 0] = casadi.if_else(t134, t131, qn4)
+    q[0, 0] = casadi.if_else(t56, t50, qn1)
+    q[1, 0] = casadi.if_else(t56, t51, qn2)
+    q[2, 0] = casadi.if_else(t56, t52, qn3)
+    q[3, 0] = casadi.if_else(t56, t53, qn4)
     status = casadi.SX(1, 1)
-    status[0, 0] = casadi.if_else(casadi.logic_not(t132), 2, casadi.if_else(t133, 0, 1))
+    status[0, 0] = casadi.if_else(casadi.logic_not(t54), 2, casadi.if_else(t55, 0, 1))
     return [q, status]
 
 

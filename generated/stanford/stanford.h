@@ -103,7 +103,7 @@ stanford_real stanford_ik_numeric_step(const stanford_real target[16], const sta
 void stanford_ik_branches(const stanford_real T[16], stanford_real q[STANFORD_MAX_IK_SOLUTIONS * STANFORD_DOF], int valid[STANFORD_MAX_IK_SOLUTIONS], int in_limits[STANFORD_MAX_IK_SOLUTIONS]);
 
 /* The closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status.
- * Result: q[i], i < 6; returned as a scalar. 1859 operations. */
+ * Result: q[i], i < 6; returned as a scalar. 940 operations. */
 int stanford_ik_nearest(const stanford_real T[16], const stanford_real q_seed[STANFORD_DOF], const stanford_real weights[STANFORD_DOF], stanford_real q[STANFORD_DOF]);
 
 /* Statuses of stanford_velocity_ik: OK, singular (a diagonal entry of the QR factor R of the

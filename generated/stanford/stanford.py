@@ -61,7 +61,7 @@ def _cos_sin(xp, q, offsets, device):
     return xp.take(both, xp.asarray(_INTERLEAVED, device=device), axis=-1)
 
 
-_INTERLEAVED = [k // 2 + k % 2 * DOF for k in range(2 * DOF)]
+_INTERLEAVED = [_k // 2 + _k % 2 * DOF for _k in range(2 * DOF)]  # c1, s1, c2, s2, ...
 
 
 def _stack(xp, values, shape):
@@ -2525,8 +2525,9 @@ def ik_branches(T):
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
-    """the closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status: (6 x 1 and 1 x 1), 1859 operations."""
+    """the closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status: (6 x 1 and 1 x 1), 940 operations."""
     xp, dtype, device, batch, (T, q_seed, weights,) = _arguments(("T", T, (4, 4)), ("q_seed", q_seed, (6,)), ("weights", weights, (6,)))
+    branches_q, branches_valid, branches_in_limits = ik_branches(T)
     T00 = T[..., 0, 0]
     T01 = T[..., 0, 1]
     T02 = T[..., 0, 2]
@@ -2551,754 +2552,390 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     qw4 = weights[..., 3]
     qw5 = weights[..., 4]
     qw6 = weights[..., 5]
-    t0 = 0.412*T02 - 0.1337*T00
-    t1 = T03 - t0
-    t2 = t0
-    t3 = t1 + t2
-    t4 = 0.412*T12 - 0.1337*T10
-    t5 = T13 - t4
-    t6 = t4
-    t7 = t5 + t6
-    t8 = 0.412*T22 - 0.1337*T20
-    t9 = T23 - t8
-    t10 = t8
-    t11 = t10 + t9
-    t12 = -0.412 + t11
-    t13 = t12**2
-    t14 = t13 + t3**2 + t7**2
-    t15 = 0.01787569 - t14
-    t16 = 0.01787569 + t14
-    t17 = 1e-12*t16
-    t18 = xp.less(t15, -t17)
-    t19 = xp.where(t18, xp.sqrt(-t15), 0)
-    t20 = t19**2
-    t21 = 0.01787569 + t20
-    t22 = 0.01787569 + t13
-    t23 = t22 - t21
-    t24 = 1e-12*t21
-    t25 = xp.less(t23, -t24)
-    t26 = xp.where(t25, xp.sqrt(-t23), 0)
-    t27 = t26*t3
-    t28 = t13 + 0.1337*t7
-    t29 = t28 - t27
-    t30 = t27 + t28
-    t31 = -t13
-    t32 = t29 + t31
-    t33 = t30 + t31
-    t34 = 0.1337*t3
-    t35 = t26*t7
-    t36 = t34 + t35
-    t37 = t32**2 + t36**2
-    t38 = t35 - t34
-    t39 = t33**2 + t38**2
-    t40 = t26**2
-    t41 = t22 + t40
-    t42 = 1e-24*t41
-    t43 = t14*t42
-    t44 = xp.less_equal(t37, t43)
-    t45 = xp.where(t44, 1, 1/xp.sqrt(t37))
-    t46 = xp.where(t44, 1, t32*t45)
-    t47 = xp.where(t44, 0, -t36*t45)
-    t48 = T02*t46 + T12*t47
-    t49 = T12*t46 - T02*t47
-    t50 = T00*t46 + T10*t47
-    t51 = T10*t46 - T00*t47
-    t52 = xp.where(t44, 0, xp.atan2(-t36, t32))
-    t53 = t52 - 6.283185307179586*xp.floor(0.4722222222222222 + 0.15915494309189535*t52)
-    t54 = t12*t19
-    t55 = 0.01787569 + t54
-    t56 = -0.01787569 + t55
-    t57 = 0.01787569 - t54
-    t58 = -0.01787569 + t57
-    t59 = t20*t40
-    t60 = t59 + t56**2
-    t61 = t59 + t58**2
-    t62 = t21*t42
-    t63 = xp.less_equal(t60, t62)
-    t64 = xp.where(t63, 1, 1/xp.sqrt(t60))
-    t65 = xp.where(t63, 1, t56*t64)
-    t66 = t19*t26
-    t67 = xp.where(t63, 0, xp.atan2(t66, t56))
-    t68 = t67 - 6.283185307179586*xp.floor(0.4722222222222222 + 0.15915494309189535*t67)
-    t69 = t64*t66
-    t70 = xp.where(t63, 0, -t69)
-    t71 = xp.where(t63, 0, t69)
-    t72 = xp.less_equal(t39, t43)
-    t73 = xp.where(t72, 1, 1/xp.sqrt(t39))
-    t74 = xp.where(t72, 1, t33*t73)
-    t75 = xp.where(t72, 0, t38*t73)
-    t76 = T02*t74 + T12*t75
-    t77 = T12*t74 - T02*t75
-    t78 = T00*t74 + T10*t75
-    t79 = T10*t74 - T00*t75
-    t80 = xp.where(t72, 0, xp.atan2(t38, t33))
-    t81 = t80 - 6.283185307179586*xp.floor(0.4722222222222222 + 0.15915494309189535*t80)
-    t82 = 1 - t46
-    t83 = T22*t82
-    t84 = t83 + T22*t46
-    t85 = T20*t82
-    t86 = t85 + T20*t46
-    t87 = t48*t65 - t70*t84
-    t88 = t48*t70 + t65*t84
-    t89 = t50*t65 - t70*t86
-    t90 = t50*t70 + t65*t86
-    t91 = 1 - t65
-    t92 = t49*t91
-    t93 = t92 + t49*t65
-    t94 = t51*t91
-    t95 = t94 + t51*t65
-    t96 = t77*t91
-    t97 = t96 + t65*t77
-    t98 = t79*t91
-    t99 = t98 + t65*t79
-    t100 = t88**2
-    t101 = -t100
-    t102 = 1 + t101
-    t103 = xp.less(1e-12, t102)
-    t104 = xp.where(t103, xp.sqrt(t102), 0)
-    t105 = t100 + t104*t93
-    t106 = t101 + t105
-    t107 = t87**2
-    t108 = t100 + t107 + t93**2
-    t109 = t104**2
-    t110 = t106**2 + t107*t109
-    t111 = t100 + t109
-    t112 = 1e-24*t111
-    t113 = xp.less_equal(t110, t108*t112)
-    t114 = xp.where(t113, 1, 1/xp.sqrt(t110))
-    t115 = xp.where(t113, 1, t106*t114)
-    t116 = t90*(1 - t115)
-    t117 = t116 + t115*t90
-    t118 = t104*t87
-    t119 = xp.where(t113, 0, -t114*t118)
-    t120 = t115*t89 + t119*t95
-    t121 = t115*t95 - t119*t89
-    t122 = xp.less_equal(t111, t112)
-    t123 = xp.where(t122, 1, 1/xp.sqrt(t111))
-    t124 = xp.where(t122, 1, t123*t88)
-    t125 = xp.where(t122, 0, -t104*t123)
-    t126 = t120*(1 - t124)
-    t127 = t126 + t120*t124
-    t128 = t117*t125 + t121*t124
-    t129 = t117*t124 - t121*t125
-    t130 = t127**2 + t128**2
-    t131 = t130
-    t132 = t130 + t129**2
-    t133 = 1 - t74
-    t134 = T22*t133
-    t135 = t134 + T22*t74
-    t136 = T20*t133
-    t137 = t136 + T20*t74
-    t138 = t65*t76 - t135*t71
-    t139 = t135*t65 + t71*t76
-    t140 = t65*t78 - t137*t71
-    t141 = t137*t65 + t71*t78
-    t142 = t139**2
-    t143 = -t142
-    t144 = 1 + t143
-    t145 = xp.less(1e-12, t144)
-    t146 = xp.where(t145, xp.sqrt(t144), 0)
-    t147 = t142 + t146*t97
-    t148 = t143 + t147
-    t149 = t138**2
-    t150 = t142 + t149 + t97**2
-    t151 = t146**2
-    t152 = t148**2 + t149*t151
-    t153 = t142 + t151
-    t154 = 1e-24*t153
-    t155 = xp.less_equal(t152, t150*t154)
-    t156 = xp.where(t155, 1, 1/xp.sqrt(t152))
-    t157 = xp.where(t155, 1, t148*t156)
-    t158 = t141*(1 - t157)
-    t159 = t158 + t141*t157
-    t160 = t138*t146
-    t161 = xp.where(t155, 0, -t156*t160)
-    t162 = t140*t157 + t161*t99
-    t163 = t157*t99 - t140*t161
-    t164 = xp.less_equal(t153, t154)
-    t165 = xp.where(t164, 1, 1/xp.sqrt(t153))
-    t166 = xp.where(t164, 1, t139*t165)
-    t167 = xp.where(t164, 0, -t146*t165)
-    t168 = t162*(1 - t166)
-    t169 = t168 + t162*t166
-    t170 = t159*t167 + t163*t166
-    t171 = t159*t166 - t163*t167
-    t172 = t169**2 + t170**2
-    t173 = t172
-    t174 = t172 + t171**2
-    t175 = xp.less_equal(t61, t62)
-    t176 = xp.where(t175, 1, 1/xp.sqrt(t61))
-    t177 = xp.where(t175, 1, t176*t58)
-    t178 = xp.where(t175, 0, xp.atan2(t66, t58))
-    t179 = t178 - 6.283185307179586*xp.floor(0.4722222222222222 + 0.15915494309189535*t178)
-    t180 = t176*t66
-    t181 = xp.where(t175, 0, t180)
-    t182 = xp.where(t175, 0, -t180)
-    t183 = t177*t48 - t181*t84
-    t184 = t177*t84 + t181*t48
-    t185 = t177*t50 - t181*t86
-    t186 = t177*t86 + t181*t50
-    t187 = t177*t76 - t135*t182
-    t188 = t135*t177 + t182*t76
-    t189 = t177*t78 - t137*t182
-    t190 = t137*t177 + t182*t78
-    t191 = 1 - t177
-    t192 = t191*t49
-    t193 = t192 + t177*t49
-    t194 = t191*t51
-    t195 = t194 + t177*t51
-    t196 = t191*t77
-    t197 = t196 + t177*t77
-    t198 = t191*t79
-    t199 = t198 + t177*t79
-    t200 = t184**2
-    t201 = -t200
-    t202 = 1 + t201
-    t203 = xp.less(1e-12, t202)
-    t204 = xp.where(t203, xp.sqrt(t202), 0)
-    t205 = t200 + t193*t204
-    t206 = t201 + t205
-    t207 = t183**2
-    t208 = t200 + t207 + t193**2
-    t209 = t204**2
-    t210 = t206**2 + t207*t209
-    t211 = t200 + t209
-    t212 = 1e-24*t211
-    t213 = xp.less_equal(t210, t208*t212)
-    t214 = xp.where(t213, 1, 1/xp.sqrt(t210))
-    t215 = xp.where(t213, 1, t206*t214)
-    t216 = t186*(1 - t215)
-    t217 = t216 + t186*t215
-    t218 = t183*t204
-    t219 = xp.where(t213, 0, -t214*t218)
-    t220 = t185*t215 + t195*t219
-    t221 = t195*t215 - t185*t219
-    t222 = xp.less_equal(t211, t212)
-    t223 = xp.where(t222, 1, 1/xp.sqrt(t211))
-    t224 = xp.where(t222, 1, t184*t223)
-    t225 = xp.where(t222, 0, -t204*t223)
-    t226 = t220*(1 - t224)
-    t227 = t226 + t220*t224
-    t228 = t217*t225 + t221*t224
-    t229 = t217*t224 - t221*t225
-    t230 = t227**2 + t228**2
-    t231 = t230
-    t232 = t230 + t229**2
-    t233 = t188**2
-    t234 = -t233
-    t235 = 1 + t234
-    t236 = xp.less(1e-12, t235)
-    t237 = xp.where(t236, xp.sqrt(t235), 0)
-    t238 = t233 + t197*t237
-    t239 = t234 + t238
-    t240 = t187**2
-    t241 = t233 + t240 + t197**2
-    t242 = t237**2
-    t243 = t239**2 + t240*t242
-    t244 = t233 + t242
-    t245 = 1e-24*t244
-    t246 = xp.less_equal(t243, t241*t245)
-    t247 = xp.where(t246, 1, 1/xp.sqrt(t243))
-    t248 = xp.where(t246, 1, t239*t247)
-    t249 = t190*(1 - t248)
-    t250 = t249 + t190*t248
-    t251 = t187*t237
-    t252 = xp.where(t246, 0, -t247*t251)
-    t253 = t189*t248 + t199*t252
-    t254 = t199*t248 - t189*t252
-    t255 = xp.less_equal(t244, t245)
-    t256 = xp.where(t255, 1, 1/xp.sqrt(t244))
-    t257 = xp.where(t255, 1, t188*t256)
-    t258 = xp.where(t255, 0, -t237*t256)
-    t259 = t253*(1 - t257)
-    t260 = t259 + t253*t257
-    t261 = t250*t258 + t254*t257
-    t262 = t250*t257 - t254*t258
-    t263 = t260**2 + t261**2
-    t264 = t263
-    t265 = t263 + t262**2
-    t266 = T00 + T01 + T02 + T03 + T10 + T11 + T12 + T13 + T20 + T21 + T22 + T23
-    t267 = t266
-    t268 = qn1 + qn2 + qn3 + qn4 + qn5 + qn6 + qw1 + qw2 + qw3 + qw4 + qw5 + qw6 + t266
-    t269 = -t66
-    t270 = xp.where(t63, 0, xp.atan2(t269, t56))
-    t271 = t270 - 6.283185307179586*xp.floor(0.4722222222222222 + 0.15915494309189535*t270)
-    t272 = xp.where(t175, 0, xp.atan2(t269, t58))
-    t273 = t272 - 6.283185307179586*xp.floor(0.4722222222222222 + 0.15915494309189535*t272)
-    t274 = xp.where(t113, 0, xp.atan2(-t118, t106))
-    t275 = t274
-    t276 = t275 - 6.283185307179586*xp.floor(0.4722222222222222 + 0.15915494309189535*t275)
-    t277 = 3.141592653589793 + t274 - 6.283185307179586*xp.ceil(0.15915494309189535*t274)
-    t278 = t277 - 6.283185307179586*xp.floor(0.4722222222222222 + 0.15915494309189535*t277)
-    t279 = xp.where(t122, 0, xp.atan2(-t104, t88))
-    t280 = t279
-    t281 = t280 - 6.283185307179586*xp.floor(0.25 + 0.15915494309189535*t280)
-    t282 = t279 + 6.283185307179586*xp.ceil(-0.5 - 0.15915494309189535*t279)
-    t283 = xp.where(xp.less_equal(t131, 1e-24*t132), 0, xp.atan2(t127, -t128))
-    t284 = t283
-    t285 = t284 - 6.283185307179586*xp.floor(0.4722222222222222 + 0.15915494309189535*t284)
-    t286 = 3.141592653589793 + t283 - 6.283185307179586*xp.ceil(0.15915494309189535*t283)
-    t287 = t286 - 6.283185307179586*xp.floor(0.4722222222222222 + 0.15915494309189535*t286)
-    t288 = -t282
-    t289 = t282 + 6.283185307179586*xp.floor(0.25 + 0.15915494309189535*t288)
-    t290 = xp.where(t155, 0, xp.atan2(-t160, t148))
-    t291 = t290
-    t292 = t291 - 6.283185307179586*xp.floor(0.4722222222222222 + 0.15915494309189535*t291)
-    t293 = 3.141592653589793 + t290 - 6.283185307179586*xp.ceil(0.15915494309189535*t290)
-    t294 = t293 - 6.283185307179586*xp.floor(0.4722222222222222 + 0.15915494309189535*t293)
-    t295 = xp.where(t164, 0, xp.atan2(-t146, t139))
-    t296 = t295
-    t297 = t296 - 6.283185307179586*xp.floor(0.25 + 0.15915494309189535*t296)
-    t298 = t295 + 6.283185307179586*xp.ceil(-0.5 - 0.15915494309189535*t295)
-    t299 = xp.where(xp.less_equal(t173, 1e-24*t174), 0, xp.atan2(t169, -t170))
-    t300 = t299
-    t301 = t300 - 6.283185307179586*xp.floor(0.4722222222222222 + 0.15915494309189535*t300)
-    t302 = 3.141592653589793 + t299 - 6.283185307179586*xp.ceil(0.15915494309189535*t299)
-    t303 = t302 - 6.283185307179586*xp.floor(0.4722222222222222 + 0.15915494309189535*t302)
-    t304 = -t298
-    t305 = t298 + 6.283185307179586*xp.floor(0.25 + 0.15915494309189535*t304)
-    t306 = xp.where(t213, 0, xp.atan2(-t218, t206))
-    t307 = t306
-    t308 = t307 - 6.283185307179586*xp.floor(0.4722222222222222 + 0.15915494309189535*t307)
-    t309 = 3.141592653589793 + t306 - 6.283185307179586*xp.ceil(0.15915494309189535*t306)
-    t310 = t309 - 6.283185307179586*xp.floor(0.4722222222222222 + 0.15915494309189535*t309)
-    t311 = xp.where(t222, 0, xp.atan2(-t204, t184))
-    t312 = t311
-    t313 = t312 - 6.283185307179586*xp.floor(0.25 + 0.15915494309189535*t312)
-    t314 = t311 + 6.283185307179586*xp.ceil(-0.5 - 0.15915494309189535*t311)
-    t315 = xp.where(xp.less_equal(t231, 1e-24*t232), 0, xp.atan2(t227, -t228))
-    t316 = t315
-    t317 = t316 - 6.283185307179586*xp.floor(0.4722222222222222 + 0.15915494309189535*t316)
-    t318 = 3.141592653589793 + t315 - 6.283185307179586*xp.ceil(0.15915494309189535*t315)
-    t319 = t318 - 6.283185307179586*xp.floor(0.4722222222222222 + 0.15915494309189535*t318)
-    t320 = -t314
-    t321 = t314 + 6.283185307179586*xp.floor(0.25 + 0.15915494309189535*t320)
-    t322 = xp.where(t246, 0, xp.atan2(-t251, t239))
-    t323 = t322
-    t324 = t323 - 6.283185307179586*xp.floor(0.4722222222222222 + 0.15915494309189535*t323)
-    t325 = 3.141592653589793 + t322 - 6.283185307179586*xp.ceil(0.15915494309189535*t322)
-    t326 = t325 - 6.283185307179586*xp.floor(0.4722222222222222 + 0.15915494309189535*t325)
-    t327 = xp.where(t255, 0, xp.atan2(-t237, t188))
-    t328 = t327
-    t329 = t328 - 6.283185307179586*xp.floor(0.25 + 0.15915494309189535*t328)
-    t330 = t327 + 6.283185307179586*xp.ceil(-0.5 - 0.15915494309189535*t327)
-    t331 = xp.where(xp.less_equal(t264, 1e-24*t265), 0, xp.atan2(t260, -t261))
-    t332 = t331
-    t333 = t332 - 6.283185307179586*xp.floor(0.4722222222222222 + 0.15915494309189535*t332)
-    t334 = 3.141592653589793 + t331 - 6.283185307179586*xp.ceil(0.15915494309189535*t331)
-    t335 = t334 - 6.283185307179586*xp.floor(0.4722222222222222 + 0.15915494309189535*t334)
-    t336 = -t330
-    t337 = t330 + 6.283185307179586*xp.floor(0.25 + 0.15915494309189535*t336)
-    t338 = xp.less_equal(t53, 2.9670597283903604)
-    t339 = (xp.greater_equal(t52, -2.9670597283903604)) & (xp.less_equal(t52, 2.9670597283903604))
-    t340 = xp.where(t338 & xp.logical_not(t339), t53, t52)
-    t341 = t340
-    t342 = t341 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*qn1 - 0.15915494309189535*t341)
-    t343 = xp.where(xp.greater(qn1, t342), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t344 = t342 + t343
-    t345 = t342 - t343
-    t346 = xp.where((xp.greater_equal(t342, -2.9670597283903604)) & (xp.less_equal(t342, 2.9670597283903604)), t342, xp.where((xp.greater_equal(t344, -2.9670597283903604)) & (xp.less_equal(t344, 2.9670597283903604)), t344, xp.where((xp.greater_equal(t345, -2.9670597283903604)) & (xp.less_equal(t345, 2.9670597283903604)), t345, t340)))
-    t347 = xp.less_equal(t271, 2.9670597283903604)
-    t348 = (xp.greater_equal(t270, -2.9670597283903604)) & (xp.less_equal(t270, 2.9670597283903604))
-    t349 = xp.where(t347 & xp.logical_not(t348), t271, t270)
-    t350 = t349
-    t351 = t350 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t350)
-    t352 = xp.where(xp.greater(qn2, t351), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t353 = t351 + t352
-    t354 = t351 - t352
-    t355 = xp.where((xp.greater_equal(t351, -2.9670597283903604)) & (xp.less_equal(t351, 2.9670597283903604)), t351, xp.where((xp.greater_equal(t353, -2.9670597283903604)) & (xp.less_equal(t353, 2.9670597283903604)), t353, xp.where((xp.greater_equal(t354, -2.9670597283903604)) & (xp.less_equal(t354, 2.9670597283903604)), t354, t349)))
-    t356 = xp.less_equal(t276, 2.9670597283903604)
-    t357 = (xp.greater_equal(t275, -2.9670597283903604)) & (xp.less_equal(t275, 2.9670597283903604))
-    t358 = xp.where(t356 & xp.logical_not(t357), t276, t275)
-    t359 = t358
-    t360 = t359 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t359)
-    t361 = xp.where(xp.greater(qn4, t360), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t362 = t360 + t361
-    t363 = t360 - t361
-    t364 = xp.where((xp.greater_equal(t360, -2.9670597283903604)) & (xp.less_equal(t360, 2.9670597283903604)), t360, xp.where((xp.greater_equal(t362, -2.9670597283903604)) & (xp.less_equal(t362, 2.9670597283903604)), t362, xp.where((xp.greater_equal(t363, -2.9670597283903604)) & (xp.less_equal(t363, 2.9670597283903604)), t363, t358)))
-    t365 = xp.less_equal(t281, 1.5707963267948966)
-    t366 = (xp.greater_equal(t280, -1.5707963267948966)) & (xp.less_equal(t280, 1.5707963267948966))
-    t367 = xp.where(t365 & xp.logical_not(t366), t281, t280)
-    t368 = t367
-    t369 = t368 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*qn5 - 0.15915494309189535*t368)
-    t370 = xp.where(xp.greater(qn5, t369), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t371 = t369 + t370
-    t372 = t369 - t370
-    t373 = xp.where((xp.greater_equal(t369, -1.5707963267948966)) & (xp.less_equal(t369, 1.5707963267948966)), t369, xp.where((xp.greater_equal(t371, -1.5707963267948966)) & (xp.less_equal(t371, 1.5707963267948966)), t371, xp.where((xp.greater_equal(t372, -1.5707963267948966)) & (xp.less_equal(t372, 1.5707963267948966)), t372, t367)))
-    t374 = xp.less_equal(t285, 2.9670597283903604)
-    t375 = (xp.greater_equal(t284, -2.9670597283903604)) & (xp.less_equal(t284, 2.9670597283903604))
-    t376 = xp.where(t374 & xp.logical_not(t375), t285, t284)
-    t377 = t376
-    t378 = t377 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*qn6 - 0.15915494309189535*t377)
-    t379 = xp.where(xp.greater(qn6, t378), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t380 = t378 + t379
-    t381 = t378 - t379
-    t382 = xp.where((xp.greater_equal(t378, -2.9670597283903604)) & (xp.less_equal(t378, 2.9670597283903604)), t378, xp.where((xp.greater_equal(t380, -2.9670597283903604)) & (xp.less_equal(t380, 2.9670597283903604)), t380, xp.where((xp.greater_equal(t381, -2.9670597283903604)) & (xp.less_equal(t381, 2.9670597283903604)), t381, t376)))
-    t383 = -qn4
-    t384 = -qn5
-    t385 = -qn6
-    t386 = -qn1
-    t387 = qw1*(t346 + t386)**2
-    t388 = -qn2
-    t389 = qw3*(t19 - qn3)**2
-    t390 = t387 + t389 + qw2*(t355 + t388)**2
-    t391 = t390 + qw4*(t364 + t383)**2 + qw5*(t373 + t384)**2 + qw6*(t382 + t385)**2
-    t392 = xp.isfinite(t267)
-    t393 = xp.greater_equal(t19, 0.30479999999999996)
-    t394 = xp.less_equal(t19, 1.27)
-    t395 = xp.less_equal(t15, t17)
-    t396 = xp.less_equal(t23, t24)
-    t397 = t338 | t339
-    t398 = t347 | t348
-    t399 = xp.where(t392 & t393 & t394 & t395 & t396 & t397 & t398 & (xp.greater_equal(t102, -1e-12)) & (t356 | t357) & (t365 | t366) & (t374 | t375), xp.asarray(1, dtype=dtype), 0)
-    t400 = xp.where(xp.greater(t399, 0), xp.asarray(1, dtype=dtype), 0)
-    t401 = xp.greater(t400, 0)
-    t402 = xp.where(t401, t346, qn1)
-    t403 = xp.where(t401, t355, qn2)
-    t404 = xp.where(t401, t19, qn3)
-    t405 = xp.where(t401, t364, qn4)
-    t406 = xp.where(t401, t373, qn5)
-    t407 = xp.where(t401, t382, qn6)
-    t408 = xp.where(t401, t391, 0)
-    t409 = xp.less_equal(t278, 2.9670597283903604)
-    t410 = (xp.greater_equal(t277, -2.9670597283903604)) & (xp.less_equal(t277, 2.9670597283903604))
-    t411 = xp.where(t409 & xp.logical_not(t410), t278, t277)
-    t412 = t411
-    t413 = t412 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t412)
-    t414 = xp.where(xp.greater(qn4, t413), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t415 = t413 + t414
-    t416 = t413 - t414
-    t417 = xp.where((xp.greater_equal(t413, -2.9670597283903604)) & (xp.less_equal(t413, 2.9670597283903604)), t413, xp.where((xp.greater_equal(t415, -2.9670597283903604)) & (xp.less_equal(t415, 2.9670597283903604)), t415, xp.where((xp.greater_equal(t416, -2.9670597283903604)) & (xp.less_equal(t416, 2.9670597283903604)), t416, t411)))
-    t418 = xp.greater_equal(t289, -1.5707963267948966)
-    t419 = (xp.greater_equal(t282, -1.5707963267948966)) & (xp.less_equal(t282, 1.5707963267948966))
-    t420 = xp.where(t418 & xp.logical_not(t419), -t289, t288)
-    t421 = t420
-    t422 = t421 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*qn5 - 0.15915494309189535*t421)
-    t423 = xp.where(xp.greater(qn5, t422), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t424 = t422 + t423
-    t425 = t422 - t423
-    t426 = xp.where((xp.greater_equal(t422, -1.5707963267948966)) & (xp.less_equal(t422, 1.5707963267948966)), t422, xp.where((xp.greater_equal(t424, -1.5707963267948966)) & (xp.less_equal(t424, 1.5707963267948966)), t424, xp.where((xp.greater_equal(t425, -1.5707963267948966)) & (xp.less_equal(t425, 1.5707963267948966)), t425, t420)))
-    t427 = xp.less_equal(t287, 2.9670597283903604)
-    t428 = (xp.greater_equal(t286, -2.9670597283903604)) & (xp.less_equal(t286, 2.9670597283903604))
-    t429 = xp.where(t103 & t392 & t393 & t394 & t395 & t396 & t397 & t398 & (t409 | t410) & (t418 | t419) & (t427 | t428), xp.asarray(1, dtype=dtype), 0)
-    t430 = xp.where(t427 & xp.logical_not(t428), t287, t286)
-    t431 = t430
-    t432 = t431 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*qn6 - 0.15915494309189535*t431)
-    t433 = xp.where(xp.greater(qn6, t432), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t434 = t432 + t433
-    t435 = t432 - t433
-    t436 = xp.where((xp.greater_equal(t432, -2.9670597283903604)) & (xp.less_equal(t432, 2.9670597283903604)), t432, xp.where((xp.greater_equal(t434, -2.9670597283903604)) & (xp.less_equal(t434, 2.9670597283903604)), t434, xp.where((xp.greater_equal(t435, -2.9670597283903604)) & (xp.less_equal(t435, 2.9670597283903604)), t435, t430)))
-    t437 = t390 + qw4*(t383 + t417)**2 + qw5*(t384 + t426)**2 + qw6*(t385 + t436)**2
-    t438 = xp.greater(t429, 0)
-    t439 = xp.where(t438 & ((xp.greater(t408, t437)) | (xp.less(t400, 1))), xp.asarray(1, dtype=dtype), 0)
-    t440 = xp.where(t438, 1, t400)
-    t441 = xp.greater(t439, 0)
-    t442 = xp.where(t441, t346, t402)
-    t443 = xp.where(t441, t355, t403)
-    t444 = xp.where(t441, t19, t404)
-    t445 = xp.where(t441, t417, t405)
-    t446 = xp.where(t441, t426, t406)
-    t447 = xp.where(t441, t436, t407)
-    t448 = xp.where(t441, t437, t408)
-    t449 = xp.less_equal(t81, 2.9670597283903604)
-    t450 = (xp.greater_equal(t80, -2.9670597283903604)) & (xp.less_equal(t80, 2.9670597283903604))
-    t451 = xp.where(t449 & xp.logical_not(t450), t81, t80)
-    t452 = t451
-    t453 = t452 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*qn1 - 0.15915494309189535*t452)
-    t454 = xp.where(xp.greater(qn1, t453), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t455 = t453 + t454
-    t456 = t453 - t454
-    t457 = xp.where((xp.greater_equal(t453, -2.9670597283903604)) & (xp.less_equal(t453, 2.9670597283903604)), t453, xp.where((xp.greater_equal(t455, -2.9670597283903604)) & (xp.less_equal(t455, 2.9670597283903604)), t455, xp.where((xp.greater_equal(t456, -2.9670597283903604)) & (xp.less_equal(t456, 2.9670597283903604)), t456, t451)))
-    t458 = xp.less_equal(t68, 2.9670597283903604)
-    t459 = (xp.greater_equal(t67, -2.9670597283903604)) & (xp.less_equal(t67, 2.9670597283903604))
-    t460 = xp.where(t458 & xp.logical_not(t459), t68, t67)
-    t461 = t460
-    t462 = t461 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t461)
-    t463 = xp.where(xp.greater(qn2, t462), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t464 = t462 + t463
-    t465 = t462 - t463
-    t466 = xp.where((xp.greater_equal(t462, -2.9670597283903604)) & (xp.less_equal(t462, 2.9670597283903604)), t462, xp.where((xp.greater_equal(t464, -2.9670597283903604)) & (xp.less_equal(t464, 2.9670597283903604)), t464, xp.where((xp.greater_equal(t465, -2.9670597283903604)) & (xp.less_equal(t465, 2.9670597283903604)), t465, t460)))
-    t467 = xp.less_equal(t292, 2.9670597283903604)
-    t468 = (xp.greater_equal(t291, -2.9670597283903604)) & (xp.less_equal(t291, 2.9670597283903604))
-    t469 = xp.where(t467 & xp.logical_not(t468), t292, t291)
-    t470 = t469
-    t471 = t470 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t470)
-    t472 = xp.where(xp.greater(qn4, t471), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t473 = t471 + t472
-    t474 = t471 - t472
-    t475 = xp.where((xp.greater_equal(t471, -2.9670597283903604)) & (xp.less_equal(t471, 2.9670597283903604)), t471, xp.where((xp.greater_equal(t473, -2.9670597283903604)) & (xp.less_equal(t473, 2.9670597283903604)), t473, xp.where((xp.greater_equal(t474, -2.9670597283903604)) & (xp.less_equal(t474, 2.9670597283903604)), t474, t469)))
-    t476 = xp.less_equal(t297, 1.5707963267948966)
-    t477 = (xp.greater_equal(t296, -1.5707963267948966)) & (xp.less_equal(t296, 1.5707963267948966))
-    t478 = xp.where(t476 & xp.logical_not(t477), t297, t296)
-    t479 = t478
-    t480 = t479 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*qn5 - 0.15915494309189535*t479)
-    t481 = xp.where(xp.greater(qn5, t480), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t482 = t480 + t481
-    t483 = t480 - t481
-    t484 = xp.where((xp.greater_equal(t480, -1.5707963267948966)) & (xp.less_equal(t480, 1.5707963267948966)), t480, xp.where((xp.greater_equal(t482, -1.5707963267948966)) & (xp.less_equal(t482, 1.5707963267948966)), t482, xp.where((xp.greater_equal(t483, -1.5707963267948966)) & (xp.less_equal(t483, 1.5707963267948966)), t483, t478)))
-    t485 = xp.less_equal(t301, 2.9670597283903604)
-    t486 = (xp.greater_equal(t300, -2.9670597283903604)) & (xp.less_equal(t300, 2.9670597283903604))
-    t487 = xp.where(t485 & xp.logical_not(t486), t301, t300)
-    t488 = t487
-    t489 = t488 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*qn6 - 0.15915494309189535*t488)
-    t490 = xp.where(xp.greater(qn6, t489), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t491 = t489 + t490
-    t492 = t489 - t490
-    t493 = xp.where((xp.greater_equal(t489, -2.9670597283903604)) & (xp.less_equal(t489, 2.9670597283903604)), t489, xp.where((xp.greater_equal(t491, -2.9670597283903604)) & (xp.less_equal(t491, 2.9670597283903604)), t491, xp.where((xp.greater_equal(t492, -2.9670597283903604)) & (xp.less_equal(t492, 2.9670597283903604)), t492, t487)))
-    t494 = qw1*(t386 + t457)**2
-    t495 = t389 + t494 + qw2*(t388 + t466)**2
-    t496 = t495 + qw4*(t383 + t475)**2 + qw5*(t384 + t484)**2 + qw6*(t385 + t493)**2
-    t497 = t449 | t450
-    t498 = t458 | t459
-    t499 = xp.where(t25 & t392 & t393 & t394 & t395 & t497 & t498 & (xp.greater_equal(t144, -1e-12)) & (t467 | t468) & (t476 | t477) & (t485 | t486), xp.asarray(1, dtype=dtype), 0)
-    t500 = xp.greater(t499, 0)
-    t501 = xp.where(t500 & ((xp.greater(t448, t496)) | (xp.less(t440, 1))), xp.asarray(1, dtype=dtype), 0)
-    t502 = xp.where(t500, 1, t440)
-    t503 = xp.greater(t501, 0)
-    t504 = xp.where(t503, t457, t442)
-    t505 = xp.where(t503, t466, t443)
-    t506 = xp.where(t503, t19, t444)
-    t507 = xp.where(t503, t475, t445)
-    t508 = xp.where(t503, t484, t446)
-    t509 = xp.where(t503, t493, t447)
-    t510 = xp.where(t503, t496, t448)
-    t511 = xp.less_equal(t294, 2.9670597283903604)
-    t512 = (xp.greater_equal(t293, -2.9670597283903604)) & (xp.less_equal(t293, 2.9670597283903604))
-    t513 = xp.where(t511 & xp.logical_not(t512), t294, t293)
-    t514 = t513
-    t515 = t514 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t514)
-    t516 = xp.where(xp.greater(qn4, t515), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t517 = t515 + t516
-    t518 = t515 - t516
-    t519 = xp.where((xp.greater_equal(t515, -2.9670597283903604)) & (xp.less_equal(t515, 2.9670597283903604)), t515, xp.where((xp.greater_equal(t517, -2.9670597283903604)) & (xp.less_equal(t517, 2.9670597283903604)), t517, xp.where((xp.greater_equal(t518, -2.9670597283903604)) & (xp.less_equal(t518, 2.9670597283903604)), t518, t513)))
-    t520 = xp.greater_equal(t305, -1.5707963267948966)
-    t521 = (xp.greater_equal(t298, -1.5707963267948966)) & (xp.less_equal(t298, 1.5707963267948966))
-    t522 = xp.where(t520 & xp.logical_not(t521), -t305, t304)
-    t523 = t522
-    t524 = t523 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*qn5 - 0.15915494309189535*t523)
-    t525 = xp.where(xp.greater(qn5, t524), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t526 = t524 + t525
-    t527 = t524 - t525
-    t528 = xp.where((xp.greater_equal(t524, -1.5707963267948966)) & (xp.less_equal(t524, 1.5707963267948966)), t524, xp.where((xp.greater_equal(t526, -1.5707963267948966)) & (xp.less_equal(t526, 1.5707963267948966)), t526, xp.where((xp.greater_equal(t527, -1.5707963267948966)) & (xp.less_equal(t527, 1.5707963267948966)), t527, t522)))
-    t529 = xp.less_equal(t303, 2.9670597283903604)
-    t530 = (xp.greater_equal(t302, -2.9670597283903604)) & (xp.less_equal(t302, 2.9670597283903604))
-    t531 = xp.where(t145 & t25 & t392 & t393 & t394 & t395 & t497 & t498 & (t511 | t512) & (t520 | t521) & (t529 | t530), xp.asarray(1, dtype=dtype), 0)
-    t532 = xp.where(t529 & xp.logical_not(t530), t303, t302)
-    t533 = t532
-    t534 = t533 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*qn6 - 0.15915494309189535*t533)
-    t535 = xp.where(xp.greater(qn6, t534), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t536 = t534 + t535
-    t537 = t534 - t535
-    t538 = xp.where((xp.greater_equal(t534, -2.9670597283903604)) & (xp.less_equal(t534, 2.9670597283903604)), t534, xp.where((xp.greater_equal(t536, -2.9670597283903604)) & (xp.less_equal(t536, 2.9670597283903604)), t536, xp.where((xp.greater_equal(t537, -2.9670597283903604)) & (xp.less_equal(t537, 2.9670597283903604)), t537, t532)))
-    t539 = t495 + qw4*(t383 + t519)**2 + qw5*(t384 + t528)**2 + qw6*(t385 + t538)**2
-    t540 = xp.greater(t531, 0)
-    t541 = xp.where(t540 & ((xp.greater(t510, t539)) | (xp.less(t502, 1))), xp.asarray(1, dtype=dtype), 0)
-    t542 = xp.where(t540, 1, t502)
-    t543 = xp.greater(t541, 0)
-    t544 = xp.where(t543, t457, t504)
-    t545 = xp.where(t543, t466, t505)
-    t546 = xp.where(t543, t19, t506)
-    t547 = xp.where(t543, t519, t507)
-    t548 = xp.where(t543, t528, t508)
-    t549 = xp.where(t543, t538, t509)
-    t550 = xp.where(t543, t539, t510)
-    t551 = xp.less_equal(t179, 2.9670597283903604)
-    t552 = (xp.greater_equal(t178, -2.9670597283903604)) & (xp.less_equal(t178, 2.9670597283903604))
-    t553 = xp.where(t551 & xp.logical_not(t552), t179, t178)
-    t554 = t553
-    t555 = t554 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t554)
-    t556 = xp.where(xp.greater(qn2, t555), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t557 = t555 + t556
-    t558 = t555 - t556
-    t559 = xp.where((xp.greater_equal(t555, -2.9670597283903604)) & (xp.less_equal(t555, 2.9670597283903604)), t555, xp.where((xp.greater_equal(t557, -2.9670597283903604)) & (xp.less_equal(t557, 2.9670597283903604)), t557, xp.where((xp.greater_equal(t558, -2.9670597283903604)) & (xp.less_equal(t558, 2.9670597283903604)), t558, t553)))
-    t560 = xp.less_equal(t308, 2.9670597283903604)
-    t561 = (xp.greater_equal(t307, -2.9670597283903604)) & (xp.less_equal(t307, 2.9670597283903604))
-    t562 = xp.where(t560 & xp.logical_not(t561), t308, t307)
-    t563 = t562
-    t564 = t563 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t563)
-    t565 = xp.where(xp.greater(qn4, t564), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t566 = t564 + t565
-    t567 = t564 - t565
-    t568 = xp.where((xp.greater_equal(t564, -2.9670597283903604)) & (xp.less_equal(t564, 2.9670597283903604)), t564, xp.where((xp.greater_equal(t566, -2.9670597283903604)) & (xp.less_equal(t566, 2.9670597283903604)), t566, xp.where((xp.greater_equal(t567, -2.9670597283903604)) & (xp.less_equal(t567, 2.9670597283903604)), t567, t562)))
-    t569 = xp.less_equal(t313, 1.5707963267948966)
-    t570 = (xp.greater_equal(t312, -1.5707963267948966)) & (xp.less_equal(t312, 1.5707963267948966))
-    t571 = xp.where(t569 & xp.logical_not(t570), t313, t312)
-    t572 = t571
-    t573 = t572 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*qn5 - 0.15915494309189535*t572)
-    t574 = xp.where(xp.greater(qn5, t573), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t575 = t573 + t574
-    t576 = t573 - t574
-    t577 = xp.where((xp.greater_equal(t573, -1.5707963267948966)) & (xp.less_equal(t573, 1.5707963267948966)), t573, xp.where((xp.greater_equal(t575, -1.5707963267948966)) & (xp.less_equal(t575, 1.5707963267948966)), t575, xp.where((xp.greater_equal(t576, -1.5707963267948966)) & (xp.less_equal(t576, 1.5707963267948966)), t576, t571)))
-    t578 = xp.less_equal(t317, 2.9670597283903604)
-    t579 = (xp.greater_equal(t316, -2.9670597283903604)) & (xp.less_equal(t316, 2.9670597283903604))
-    t580 = xp.where(t578 & xp.logical_not(t579), t317, t316)
-    t581 = t580
-    t582 = t581 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*qn6 - 0.15915494309189535*t581)
-    t583 = xp.where(xp.greater(qn6, t582), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t584 = t582 + t583
-    t585 = t582 - t583
-    t586 = xp.where((xp.greater_equal(t582, -2.9670597283903604)) & (xp.less_equal(t582, 2.9670597283903604)), t582, xp.where((xp.greater_equal(t584, -2.9670597283903604)) & (xp.less_equal(t584, 2.9670597283903604)), t584, xp.where((xp.greater_equal(t585, -2.9670597283903604)) & (xp.less_equal(t585, 2.9670597283903604)), t585, t580)))
-    t587 = qw3*(qn3 + t19)**2
-    t588 = t387 + t587 + qw2*(t388 + t559)**2
-    t589 = t588 + qw4*(t383 + t568)**2 + qw5*(t384 + t577)**2 + qw6*(t385 + t586)**2
-    t590 = xp.greater_equal(t19, -1.27)
-    t591 = xp.less_equal(t19, -0.30479999999999996)
-    t592 = t551 | t552
-    t593 = xp.where(t18 & t392 & t396 & t397 & t590 & t591 & t592 & (xp.greater_equal(t202, -1e-12)) & (t560 | t561) & (t569 | t570) & (t578 | t579), xp.asarray(1, dtype=dtype), 0)
-    t594 = xp.greater(t593, 0)
-    t595 = xp.where(t594 & ((xp.greater(t550, t589)) | (xp.less(t542, 1))), xp.asarray(1, dtype=dtype), 0)
-    t596 = xp.where(t594, 1, t542)
-    t597 = xp.greater(t595, 0)
-    t598 = xp.where(t597, t346, t544)
-    t599 = xp.where(t597, t559, t545)
-    t600 = xp.where(t597, t568, t547)
-    t601 = xp.where(t597, t577, t548)
-    t602 = xp.where(t597, t586, t549)
-    t603 = xp.where(t597, t589, t550)
-    t604 = -t19
-    t605 = xp.where(t597, t604, t546)
-    t606 = xp.less_equal(t310, 2.9670597283903604)
-    t607 = (xp.greater_equal(t309, -2.9670597283903604)) & (xp.less_equal(t309, 2.9670597283903604))
-    t608 = xp.where(t606 & xp.logical_not(t607), t310, t309)
-    t609 = t608
-    t610 = t609 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t609)
-    t611 = xp.where(xp.greater(qn4, t610), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t612 = t610 + t611
-    t613 = t610 - t611
-    t614 = xp.where((xp.greater_equal(t610, -2.9670597283903604)) & (xp.less_equal(t610, 2.9670597283903604)), t610, xp.where((xp.greater_equal(t612, -2.9670597283903604)) & (xp.less_equal(t612, 2.9670597283903604)), t612, xp.where((xp.greater_equal(t613, -2.9670597283903604)) & (xp.less_equal(t613, 2.9670597283903604)), t613, t608)))
-    t615 = xp.greater_equal(t321, -1.5707963267948966)
-    t616 = (xp.greater_equal(t314, -1.5707963267948966)) & (xp.less_equal(t314, 1.5707963267948966))
-    t617 = xp.where(t615 & xp.logical_not(t616), -t321, t320)
-    t618 = t617
-    t619 = t618 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*qn5 - 0.15915494309189535*t618)
-    t620 = xp.where(xp.greater(qn5, t619), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t621 = t619 + t620
-    t622 = t619 - t620
-    t623 = xp.where((xp.greater_equal(t619, -1.5707963267948966)) & (xp.less_equal(t619, 1.5707963267948966)), t619, xp.where((xp.greater_equal(t621, -1.5707963267948966)) & (xp.less_equal(t621, 1.5707963267948966)), t621, xp.where((xp.greater_equal(t622, -1.5707963267948966)) & (xp.less_equal(t622, 1.5707963267948966)), t622, t617)))
-    t624 = xp.less_equal(t319, 2.9670597283903604)
-    t625 = (xp.greater_equal(t318, -2.9670597283903604)) & (xp.less_equal(t318, 2.9670597283903604))
-    t626 = xp.where(t18 & t203 & t392 & t396 & t397 & t590 & t591 & t592 & (t606 | t607) & (t615 | t616) & (t624 | t625), xp.asarray(1, dtype=dtype), 0)
-    t627 = xp.where(t624 & xp.logical_not(t625), t319, t318)
-    t628 = t627
-    t629 = t628 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*qn6 - 0.15915494309189535*t628)
-    t630 = xp.where(xp.greater(qn6, t629), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t631 = t629 + t630
-    t632 = t629 - t630
-    t633 = xp.where((xp.greater_equal(t629, -2.9670597283903604)) & (xp.less_equal(t629, 2.9670597283903604)), t629, xp.where((xp.greater_equal(t631, -2.9670597283903604)) & (xp.less_equal(t631, 2.9670597283903604)), t631, xp.where((xp.greater_equal(t632, -2.9670597283903604)) & (xp.less_equal(t632, 2.9670597283903604)), t632, t627)))
-    t634 = t588 + qw4*(t383 + t614)**2 + qw5*(t384 + t623)**2 + qw6*(t385 + t633)**2
-    t635 = xp.greater(t626, 0)
-    t636 = xp.where(t635 & ((xp.greater(t603, t634)) | (xp.less(t596, 1))), xp.asarray(1, dtype=dtype), 0)
-    t637 = xp.where(t635, 1, t596)
-    t638 = xp.greater(t636, 0)
-    t639 = xp.where(t638, t346, t598)
-    t640 = xp.where(t638, t559, t599)
-    t641 = xp.where(t638, t604, t605)
-    t642 = xp.where(t638, t614, t600)
-    t643 = xp.where(t638, t623, t601)
-    t644 = xp.where(t638, t633, t602)
-    t645 = xp.where(t638, t634, t603)
-    t646 = xp.less_equal(t273, 2.9670597283903604)
-    t647 = (xp.greater_equal(t272, -2.9670597283903604)) & (xp.less_equal(t272, 2.9670597283903604))
-    t648 = xp.where(t646 & xp.logical_not(t647), t273, t272)
-    t649 = t648
-    t650 = t649 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t649)
-    t651 = xp.where(xp.greater(qn2, t650), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t652 = t650 + t651
-    t653 = t650 - t651
-    t654 = xp.where((xp.greater_equal(t650, -2.9670597283903604)) & (xp.less_equal(t650, 2.9670597283903604)), t650, xp.where((xp.greater_equal(t652, -2.9670597283903604)) & (xp.less_equal(t652, 2.9670597283903604)), t652, xp.where((xp.greater_equal(t653, -2.9670597283903604)) & (xp.less_equal(t653, 2.9670597283903604)), t653, t648)))
-    t655 = xp.less_equal(t324, 2.9670597283903604)
-    t656 = (xp.greater_equal(t323, -2.9670597283903604)) & (xp.less_equal(t323, 2.9670597283903604))
-    t657 = xp.where(t655 & xp.logical_not(t656), t324, t323)
-    t658 = t657
-    t659 = t658 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t658)
-    t660 = xp.where(xp.greater(qn4, t659), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t661 = t659 + t660
-    t662 = t659 - t660
-    t663 = xp.where((xp.greater_equal(t659, -2.9670597283903604)) & (xp.less_equal(t659, 2.9670597283903604)), t659, xp.where((xp.greater_equal(t661, -2.9670597283903604)) & (xp.less_equal(t661, 2.9670597283903604)), t661, xp.where((xp.greater_equal(t662, -2.9670597283903604)) & (xp.less_equal(t662, 2.9670597283903604)), t662, t657)))
-    t664 = xp.less_equal(t329, 1.5707963267948966)
-    t665 = (xp.greater_equal(t328, -1.5707963267948966)) & (xp.less_equal(t328, 1.5707963267948966))
-    t666 = xp.where(t664 & xp.logical_not(t665), t329, t328)
-    t667 = t666
-    t668 = t667 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*qn5 - 0.15915494309189535*t667)
-    t669 = xp.where(xp.greater(qn5, t668), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t670 = t668 + t669
-    t671 = t668 - t669
-    t672 = xp.where((xp.greater_equal(t668, -1.5707963267948966)) & (xp.less_equal(t668, 1.5707963267948966)), t668, xp.where((xp.greater_equal(t670, -1.5707963267948966)) & (xp.less_equal(t670, 1.5707963267948966)), t670, xp.where((xp.greater_equal(t671, -1.5707963267948966)) & (xp.less_equal(t671, 1.5707963267948966)), t671, t666)))
-    t673 = xp.less_equal(t333, 2.9670597283903604)
-    t674 = (xp.greater_equal(t332, -2.9670597283903604)) & (xp.less_equal(t332, 2.9670597283903604))
-    t675 = xp.where(t673 & xp.logical_not(t674), t333, t332)
-    t676 = t675
-    t677 = t676 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*qn6 - 0.15915494309189535*t676)
-    t678 = xp.where(xp.greater(qn6, t677), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t679 = t677 + t678
-    t680 = t677 - t678
-    t681 = xp.where((xp.greater_equal(t677, -2.9670597283903604)) & (xp.less_equal(t677, 2.9670597283903604)), t677, xp.where((xp.greater_equal(t679, -2.9670597283903604)) & (xp.less_equal(t679, 2.9670597283903604)), t679, xp.where((xp.greater_equal(t680, -2.9670597283903604)) & (xp.less_equal(t680, 2.9670597283903604)), t680, t675)))
-    t682 = t494 + t587 + qw2*(t388 + t654)**2
-    t683 = t682 + qw4*(t383 + t663)**2 + qw5*(t384 + t672)**2 + qw6*(t385 + t681)**2
-    t684 = t646 | t647
-    t685 = xp.where(t18 & t25 & t392 & t497 & t590 & t591 & t684 & (xp.greater_equal(t235, -1e-12)) & (t655 | t656) & (t664 | t665) & (t673 | t674), xp.asarray(1, dtype=dtype), 0)
-    t686 = xp.greater(t685, 0)
-    t687 = xp.where(t686 & ((xp.greater(t645, t683)) | (xp.less(t637, 1))), xp.asarray(1, dtype=dtype), 0)
-    t688 = xp.where(t686, 1, t637)
-    t689 = xp.greater(t687, 0)
-    t690 = xp.where(t689, t457, t639)
-    t691 = xp.where(t689, t654, t640)
-    t692 = xp.where(t689, t604, t641)
-    t693 = xp.where(t689, t663, t642)
-    t694 = xp.where(t689, t672, t643)
-    t695 = xp.where(t689, t681, t644)
-    t696 = xp.where(t689, t683, t645)
-    t697 = xp.less_equal(t326, 2.9670597283903604)
-    t698 = (xp.greater_equal(t325, -2.9670597283903604)) & (xp.less_equal(t325, 2.9670597283903604))
-    t699 = xp.where(t697 & xp.logical_not(t698), t326, t325)
-    t700 = t699
-    t701 = t700 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t700)
-    t702 = xp.where(xp.greater(qn4, t701), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t703 = t701 + t702
-    t704 = t701 - t702
-    t705 = xp.where((xp.greater_equal(t701, -2.9670597283903604)) & (xp.less_equal(t701, 2.9670597283903604)), t701, xp.where((xp.greater_equal(t703, -2.9670597283903604)) & (xp.less_equal(t703, 2.9670597283903604)), t703, xp.where((xp.greater_equal(t704, -2.9670597283903604)) & (xp.less_equal(t704, 2.9670597283903604)), t704, t699)))
-    t706 = xp.greater_equal(t337, -1.5707963267948966)
-    t707 = (xp.greater_equal(t330, -1.5707963267948966)) & (xp.less_equal(t330, 1.5707963267948966))
-    t708 = xp.where(t706 & xp.logical_not(t707), -t337, t336)
-    t709 = t708
-    t710 = t709 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*qn5 - 0.15915494309189535*t709)
-    t711 = xp.where(xp.greater(qn5, t710), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t712 = t710 + t711
-    t713 = t710 - t711
-    t714 = xp.where((xp.greater_equal(t710, -1.5707963267948966)) & (xp.less_equal(t710, 1.5707963267948966)), t710, xp.where((xp.greater_equal(t712, -1.5707963267948966)) & (xp.less_equal(t712, 1.5707963267948966)), t712, xp.where((xp.greater_equal(t713, -1.5707963267948966)) & (xp.less_equal(t713, 1.5707963267948966)), t713, t708)))
-    t715 = xp.less_equal(t335, 2.9670597283903604)
-    t716 = (xp.greater_equal(t334, -2.9670597283903604)) & (xp.less_equal(t334, 2.9670597283903604))
-    t717 = xp.where(t18 & t236 & t25 & t392 & t497 & t590 & t591 & t684 & (t697 | t698) & (t706 | t707) & (t715 | t716), xp.asarray(1, dtype=dtype), 0)
-    t718 = xp.where(t715 & xp.logical_not(t716), t335, t334)
-    t719 = t718
-    t720 = t719 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*qn6 - 0.15915494309189535*t719)
-    t721 = xp.where(xp.greater(qn6, t720), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t722 = t720 + t721
-    t723 = t720 - t721
-    t724 = xp.where((xp.greater_equal(t720, -2.9670597283903604)) & (xp.less_equal(t720, 2.9670597283903604)), t720, xp.where((xp.greater_equal(t722, -2.9670597283903604)) & (xp.less_equal(t722, 2.9670597283903604)), t722, xp.where((xp.greater_equal(t723, -2.9670597283903604)) & (xp.less_equal(t723, 2.9670597283903604)), t723, t718)))
-    t725 = t682 + qw4*(t383 + t705)**2 + qw5*(t384 + t714)**2 + qw6*(t385 + t724)**2
-    t726 = xp.greater(t717, 0)
-    t727 = xp.where(t726 & ((xp.greater(t696, t725)) | (xp.less(t688, 1))), xp.asarray(1, dtype=dtype), 0)
-    t728 = xp.where(t726, 1, t688)
-    t729 = xp.greater(t727, 0)
-    t730 = xp.where(t729, t457, t690)
-    t731 = xp.where(t729, t654, t691)
-    t732 = xp.where(t729, t604, t692)
-    t733 = xp.where(t729, t705, t693)
-    t734 = xp.where(t729, t714, t694)
-    t735 = xp.where(t729, t724, t695)
-    t736 = xp.isfinite(t268)
-    t737 = xp.greater(t728, 0)
-    t738 = t736 & t737
+    qb0_0 = branches_q[..., 0, 0]
+    qb0_1 = branches_q[..., 0, 1]
+    qb0_2 = branches_q[..., 0, 2]
+    qb0_3 = branches_q[..., 0, 3]
+    qb0_4 = branches_q[..., 0, 4]
+    qb0_5 = branches_q[..., 0, 5]
+    qb1_0 = branches_q[..., 1, 0]
+    qb1_1 = branches_q[..., 1, 1]
+    qb1_2 = branches_q[..., 1, 2]
+    qb1_3 = branches_q[..., 1, 3]
+    qb1_4 = branches_q[..., 1, 4]
+    qb1_5 = branches_q[..., 1, 5]
+    qb2_0 = branches_q[..., 2, 0]
+    qb2_1 = branches_q[..., 2, 1]
+    qb2_2 = branches_q[..., 2, 2]
+    qb2_3 = branches_q[..., 2, 3]
+    qb2_4 = branches_q[..., 2, 4]
+    qb2_5 = branches_q[..., 2, 5]
+    qb3_0 = branches_q[..., 3, 0]
+    qb3_1 = branches_q[..., 3, 1]
+    qb3_2 = branches_q[..., 3, 2]
+    qb3_3 = branches_q[..., 3, 3]
+    qb3_4 = branches_q[..., 3, 4]
+    qb3_5 = branches_q[..., 3, 5]
+    qb4_0 = branches_q[..., 4, 0]
+    qb4_1 = branches_q[..., 4, 1]
+    qb4_2 = branches_q[..., 4, 2]
+    qb4_3 = branches_q[..., 4, 3]
+    qb4_4 = branches_q[..., 4, 4]
+    qb4_5 = branches_q[..., 4, 5]
+    qb5_0 = branches_q[..., 5, 0]
+    qb5_1 = branches_q[..., 5, 1]
+    qb5_2 = branches_q[..., 5, 2]
+    qb5_3 = branches_q[..., 5, 3]
+    qb5_4 = branches_q[..., 5, 4]
+    qb5_5 = branches_q[..., 5, 5]
+    qb6_0 = branches_q[..., 6, 0]
+    qb6_1 = branches_q[..., 6, 1]
+    qb6_2 = branches_q[..., 6, 2]
+    qb6_3 = branches_q[..., 6, 3]
+    qb6_4 = branches_q[..., 6, 4]
+    qb6_5 = branches_q[..., 6, 5]
+    qb7_0 = branches_q[..., 7, 0]
+    qb7_1 = branches_q[..., 7, 1]
+    qb7_2 = branches_q[..., 7, 2]
+    qb7_3 = branches_q[..., 7, 3]
+    qb7_4 = branches_q[..., 7, 4]
+    qb7_5 = branches_q[..., 7, 5]
+    vb0 = branches_valid[..., 0]
+    vb1 = branches_valid[..., 1]
+    vb2 = branches_valid[..., 2]
+    vb3 = branches_valid[..., 3]
+    vb4 = branches_valid[..., 4]
+    vb5 = branches_valid[..., 5]
+    vb6 = branches_valid[..., 6]
+    vb7 = branches_valid[..., 7]
+    lb0 = branches_in_limits[..., 0]
+    lb1 = branches_in_limits[..., 1]
+    lb2 = branches_in_limits[..., 2]
+    lb3 = branches_in_limits[..., 3]
+    lb4 = branches_in_limits[..., 4]
+    lb5 = branches_in_limits[..., 5]
+    lb6 = branches_in_limits[..., 6]
+    lb7 = branches_in_limits[..., 7]
+    t0 = qb0_0 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn1 - qb0_0))
+    t1 = qb0_1 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn2 - qb0_1))
+    t2 = qb0_3 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn4 - qb0_3))
+    t3 = qb0_4 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn5 - qb0_4))
+    t4 = qb0_5 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn6 - qb0_5))
+    t5 = xp.where(lb0 & vb0, xp.asarray(1, dtype=dtype), 0)
+    t6 = xp.where(xp.greater(t5, 0), xp.asarray(1, dtype=dtype), 0)
+    t7 = qb1_0 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn1 - qb1_0))
+    t8 = qb1_1 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn2 - qb1_1))
+    t9 = qb1_3 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn4 - qb1_3))
+    t10 = qb1_4 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn5 - qb1_4))
+    t11 = qb1_5 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn6 - qb1_5))
+    t12 = xp.where(lb1 & vb1, xp.asarray(1, dtype=dtype), 0)
+    t13 = qb2_0 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn1 - qb2_0))
+    t14 = qb2_1 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn2 - qb2_1))
+    t15 = qb2_3 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn4 - qb2_3))
+    t16 = qb2_4 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn5 - qb2_4))
+    t17 = qb2_5 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn6 - qb2_5))
+    t18 = xp.where(lb2 & vb2, xp.asarray(1, dtype=dtype), 0)
+    t19 = qb3_0 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn1 - qb3_0))
+    t20 = qb3_1 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn2 - qb3_1))
+    t21 = qb3_3 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn4 - qb3_3))
+    t22 = qb3_4 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn5 - qb3_4))
+    t23 = qb3_5 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn6 - qb3_5))
+    t24 = xp.where(lb3 & vb3, xp.asarray(1, dtype=dtype), 0)
+    t25 = qb4_0 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn1 - qb4_0))
+    t26 = qb4_1 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn2 - qb4_1))
+    t27 = qb4_3 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn4 - qb4_3))
+    t28 = qb4_4 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn5 - qb4_4))
+    t29 = qb4_5 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn6 - qb4_5))
+    t30 = xp.where(lb4 & vb4, xp.asarray(1, dtype=dtype), 0)
+    t31 = qb5_0 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn1 - qb5_0))
+    t32 = qb5_1 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn2 - qb5_1))
+    t33 = qb5_3 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn4 - qb5_3))
+    t34 = qb5_4 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn5 - qb5_4))
+    t35 = qb5_5 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn6 - qb5_5))
+    t36 = xp.where(lb5 & vb5, xp.asarray(1, dtype=dtype), 0)
+    t37 = qb6_0 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn1 - qb6_0))
+    t38 = qb6_1 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn2 - qb6_1))
+    t39 = qb6_3 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn4 - qb6_3))
+    t40 = qb6_4 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn5 - qb6_4))
+    t41 = qb6_5 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn6 - qb6_5))
+    t42 = xp.where(lb6 & vb6, xp.asarray(1, dtype=dtype), 0)
+    t43 = qb7_0 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn1 - qb7_0))
+    t44 = qb7_1 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn2 - qb7_1))
+    t45 = qb7_3 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn4 - qb7_3))
+    t46 = qb7_4 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn5 - qb7_4))
+    t47 = qb7_5 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn6 - qb7_5))
+    t48 = xp.where(lb7 & vb7, xp.asarray(1, dtype=dtype), 0)
+    t49 = T00 + T01 + T02 + T03 + T10 + T11 + T12 + T13 + T20 + T21 + T22 + T23 + qn1 + qn2 + qn3 + qn4 + qn5 + qn6 + qw1 + qw2 + qw3 + qw4 + qw5 + qw6
+    t50 = xp.where(xp.greater(qn1, t0), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t51 = t0 + t50
+    t52 = t0 - t50
+    t53 = xp.where((xp.greater_equal(t0, -2.9670597283903604)) & (xp.less_equal(t0, 2.9670597283903604)), t0, xp.where((xp.greater_equal(t51, -2.9670597283903604)) & (xp.less_equal(t51, 2.9670597283903604)), t51, xp.where((xp.greater_equal(t52, -2.9670597283903604)) & (xp.less_equal(t52, 2.9670597283903604)), t52, qb0_0)))
+    t54 = xp.where(xp.greater(qn2, t1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t55 = t1 + t54
+    t56 = t1 - t54
+    t57 = xp.where((xp.greater_equal(t1, -2.9670597283903604)) & (xp.less_equal(t1, 2.9670597283903604)), t1, xp.where((xp.greater_equal(t55, -2.9670597283903604)) & (xp.less_equal(t55, 2.9670597283903604)), t55, xp.where((xp.greater_equal(t56, -2.9670597283903604)) & (xp.less_equal(t56, 2.9670597283903604)), t56, qb0_1)))
+    t58 = xp.where(xp.greater(qn4, t2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t59 = t2 + t58
+    t60 = t2 - t58
+    t61 = xp.where((xp.greater_equal(t2, -2.9670597283903604)) & (xp.less_equal(t2, 2.9670597283903604)), t2, xp.where((xp.greater_equal(t59, -2.9670597283903604)) & (xp.less_equal(t59, 2.9670597283903604)), t59, xp.where((xp.greater_equal(t60, -2.9670597283903604)) & (xp.less_equal(t60, 2.9670597283903604)), t60, qb0_3)))
+    t62 = xp.where(xp.greater(qn5, t3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t63 = t3 + t62
+    t64 = t3 - t62
+    t65 = xp.where((xp.greater_equal(t3, -1.5707963267948966)) & (xp.less_equal(t3, 1.5707963267948966)), t3, xp.where((xp.greater_equal(t63, -1.5707963267948966)) & (xp.less_equal(t63, 1.5707963267948966)), t63, xp.where((xp.greater_equal(t64, -1.5707963267948966)) & (xp.less_equal(t64, 1.5707963267948966)), t64, qb0_4)))
+    t66 = xp.where(xp.greater(qn6, t4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t67 = t4 + t66
+    t68 = t4 - t66
+    t69 = xp.where((xp.greater_equal(t4, -2.9670597283903604)) & (xp.less_equal(t4, 2.9670597283903604)), t4, xp.where((xp.greater_equal(t67, -2.9670597283903604)) & (xp.less_equal(t67, 2.9670597283903604)), t67, xp.where((xp.greater_equal(t68, -2.9670597283903604)) & (xp.less_equal(t68, 2.9670597283903604)), t68, qb0_5)))
+    t70 = -qn1
+    t71 = -qn2
+    t72 = -qn3
+    t73 = -qn4
+    t74 = -qn5
+    t75 = -qn6
+    t76 = qw1*(t53 + t70)**2 + qw2*(t57 + t71)**2 + qw3*(qb0_2 + t72)**2 + qw4*(t61 + t73)**2 + qw5*(t65 + t74)**2 + qw6*(t69 + t75)**2
+    t77 = xp.greater(t6, 0)
+    t78 = xp.where(t77, t53, qn1)
+    t79 = xp.where(t77, t57, qn2)
+    t80 = xp.where(t77, qb0_2, qn3)
+    t81 = xp.where(t77, t61, qn4)
+    t82 = xp.where(t77, t65, qn5)
+    t83 = xp.where(t77, t69, qn6)
+    t84 = xp.where(t77, t76, 0)
+    t85 = xp.where(xp.greater(qn1, t7), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t86 = t7 + t85
+    t87 = t7 - t85
+    t88 = xp.where((xp.greater_equal(t7, -2.9670597283903604)) & (xp.less_equal(t7, 2.9670597283903604)), t7, xp.where((xp.greater_equal(t86, -2.9670597283903604)) & (xp.less_equal(t86, 2.9670597283903604)), t86, xp.where((xp.greater_equal(t87, -2.9670597283903604)) & (xp.less_equal(t87, 2.9670597283903604)), t87, qb1_0)))
+    t89 = xp.where(xp.greater(qn2, t8), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t90 = t8 + t89
+    t91 = t8 - t89
+    t92 = xp.where((xp.greater_equal(t8, -2.9670597283903604)) & (xp.less_equal(t8, 2.9670597283903604)), t8, xp.where((xp.greater_equal(t90, -2.9670597283903604)) & (xp.less_equal(t90, 2.9670597283903604)), t90, xp.where((xp.greater_equal(t91, -2.9670597283903604)) & (xp.less_equal(t91, 2.9670597283903604)), t91, qb1_1)))
+    t93 = xp.where(xp.greater(qn4, t9), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t94 = t9 + t93
+    t95 = t9 - t93
+    t96 = xp.where((xp.greater_equal(t9, -2.9670597283903604)) & (xp.less_equal(t9, 2.9670597283903604)), t9, xp.where((xp.greater_equal(t94, -2.9670597283903604)) & (xp.less_equal(t94, 2.9670597283903604)), t94, xp.where((xp.greater_equal(t95, -2.9670597283903604)) & (xp.less_equal(t95, 2.9670597283903604)), t95, qb1_3)))
+    t97 = xp.where(xp.greater(qn5, t10), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t98 = t10 + t97
+    t99 = t10 - t97
+    t100 = xp.where((xp.greater_equal(t10, -1.5707963267948966)) & (xp.less_equal(t10, 1.5707963267948966)), t10, xp.where((xp.greater_equal(t98, -1.5707963267948966)) & (xp.less_equal(t98, 1.5707963267948966)), t98, xp.where((xp.greater_equal(t99, -1.5707963267948966)) & (xp.less_equal(t99, 1.5707963267948966)), t99, qb1_4)))
+    t101 = xp.where(xp.greater(qn6, t11), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t102 = t101 + t11
+    t103 = t11 - t101
+    t104 = xp.where((xp.greater_equal(t11, -2.9670597283903604)) & (xp.less_equal(t11, 2.9670597283903604)), t11, xp.where((xp.greater_equal(t102, -2.9670597283903604)) & (xp.less_equal(t102, 2.9670597283903604)), t102, xp.where((xp.greater_equal(t103, -2.9670597283903604)) & (xp.less_equal(t103, 2.9670597283903604)), t103, qb1_5)))
+    t105 = qw1*(t70 + t88)**2 + qw2*(t71 + t92)**2 + qw3*(qb1_2 + t72)**2 + qw4*(t73 + t96)**2 + qw5*(t100 + t74)**2 + qw6*(t104 + t75)**2
+    t106 = xp.greater(t12, 0)
+    t107 = xp.where(t106 & ((xp.less(t105, t84)) | (xp.less(t6, 1))), xp.asarray(1, dtype=dtype), 0)
+    t108 = xp.where(t106, 1, t6)
+    t109 = xp.greater(t107, 0)
+    t110 = xp.where(t109, t88, t78)
+    t111 = xp.where(t109, t92, t79)
+    t112 = xp.where(t109, qb1_2, t80)
+    t113 = xp.where(t109, t96, t81)
+    t114 = xp.where(t109, t100, t82)
+    t115 = xp.where(t109, t104, t83)
+    t116 = xp.where(t109, t105, t84)
+    t117 = xp.where(xp.greater(qn1, t13), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t118 = t117 + t13
+    t119 = t13 - t117
+    t120 = xp.where((xp.greater_equal(t13, -2.9670597283903604)) & (xp.less_equal(t13, 2.9670597283903604)), t13, xp.where((xp.greater_equal(t118, -2.9670597283903604)) & (xp.less_equal(t118, 2.9670597283903604)), t118, xp.where((xp.greater_equal(t119, -2.9670597283903604)) & (xp.less_equal(t119, 2.9670597283903604)), t119, qb2_0)))
+    t121 = xp.where(xp.greater(qn2, t14), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t122 = t121 + t14
+    t123 = t14 - t121
+    t124 = xp.where((xp.greater_equal(t14, -2.9670597283903604)) & (xp.less_equal(t14, 2.9670597283903604)), t14, xp.where((xp.greater_equal(t122, -2.9670597283903604)) & (xp.less_equal(t122, 2.9670597283903604)), t122, xp.where((xp.greater_equal(t123, -2.9670597283903604)) & (xp.less_equal(t123, 2.9670597283903604)), t123, qb2_1)))
+    t125 = xp.where(xp.greater(qn4, t15), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t126 = t125 + t15
+    t127 = t15 - t125
+    t128 = xp.where((xp.greater_equal(t15, -2.9670597283903604)) & (xp.less_equal(t15, 2.9670597283903604)), t15, xp.where((xp.greater_equal(t126, -2.9670597283903604)) & (xp.less_equal(t126, 2.9670597283903604)), t126, xp.where((xp.greater_equal(t127, -2.9670597283903604)) & (xp.less_equal(t127, 2.9670597283903604)), t127, qb2_3)))
+    t129 = xp.where(xp.greater(qn5, t16), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t130 = t129 + t16
+    t131 = t16 - t129
+    t132 = xp.where((xp.greater_equal(t16, -1.5707963267948966)) & (xp.less_equal(t16, 1.5707963267948966)), t16, xp.where((xp.greater_equal(t130, -1.5707963267948966)) & (xp.less_equal(t130, 1.5707963267948966)), t130, xp.where((xp.greater_equal(t131, -1.5707963267948966)) & (xp.less_equal(t131, 1.5707963267948966)), t131, qb2_4)))
+    t133 = xp.where(xp.greater(qn6, t17), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t134 = t133 + t17
+    t135 = t17 - t133
+    t136 = xp.where((xp.greater_equal(t17, -2.9670597283903604)) & (xp.less_equal(t17, 2.9670597283903604)), t17, xp.where((xp.greater_equal(t134, -2.9670597283903604)) & (xp.less_equal(t134, 2.9670597283903604)), t134, xp.where((xp.greater_equal(t135, -2.9670597283903604)) & (xp.less_equal(t135, 2.9670597283903604)), t135, qb2_5)))
+    t137 = qw1*(t120 + t70)**2 + qw2*(t124 + t71)**2 + qw3*(qb2_2 + t72)**2 + qw4*(t128 + t73)**2 + qw5*(t132 + t74)**2 + qw6*(t136 + t75)**2
+    t138 = xp.greater(t18, 0)
+    t139 = xp.where(t138 & ((xp.greater(t116, t137)) | (xp.less(t108, 1))), xp.asarray(1, dtype=dtype), 0)
+    t140 = xp.where(t138, 1, t108)
+    t141 = xp.greater(t139, 0)
+    t142 = xp.where(t141, t120, t110)
+    t143 = xp.where(t141, t124, t111)
+    t144 = xp.where(t141, qb2_2, t112)
+    t145 = xp.where(t141, t128, t113)
+    t146 = xp.where(t141, t132, t114)
+    t147 = xp.where(t141, t136, t115)
+    t148 = xp.where(t141, t137, t116)
+    t149 = xp.where(xp.greater(qn1, t19), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t150 = t149 + t19
+    t151 = t19 - t149
+    t152 = xp.where((xp.greater_equal(t19, -2.9670597283903604)) & (xp.less_equal(t19, 2.9670597283903604)), t19, xp.where((xp.greater_equal(t150, -2.9670597283903604)) & (xp.less_equal(t150, 2.9670597283903604)), t150, xp.where((xp.greater_equal(t151, -2.9670597283903604)) & (xp.less_equal(t151, 2.9670597283903604)), t151, qb3_0)))
+    t153 = xp.where(xp.greater(qn2, t20), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t154 = t153 + t20
+    t155 = t20 - t153
+    t156 = xp.where((xp.greater_equal(t20, -2.9670597283903604)) & (xp.less_equal(t20, 2.9670597283903604)), t20, xp.where((xp.greater_equal(t154, -2.9670597283903604)) & (xp.less_equal(t154, 2.9670597283903604)), t154, xp.where((xp.greater_equal(t155, -2.9670597283903604)) & (xp.less_equal(t155, 2.9670597283903604)), t155, qb3_1)))
+    t157 = xp.where(xp.greater(qn4, t21), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t158 = t157 + t21
+    t159 = t21 - t157
+    t160 = xp.where((xp.greater_equal(t21, -2.9670597283903604)) & (xp.less_equal(t21, 2.9670597283903604)), t21, xp.where((xp.greater_equal(t158, -2.9670597283903604)) & (xp.less_equal(t158, 2.9670597283903604)), t158, xp.where((xp.greater_equal(t159, -2.9670597283903604)) & (xp.less_equal(t159, 2.9670597283903604)), t159, qb3_3)))
+    t161 = xp.where(xp.greater(qn5, t22), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t162 = t161 + t22
+    t163 = t22 - t161
+    t164 = xp.where((xp.greater_equal(t22, -1.5707963267948966)) & (xp.less_equal(t22, 1.5707963267948966)), t22, xp.where((xp.greater_equal(t162, -1.5707963267948966)) & (xp.less_equal(t162, 1.5707963267948966)), t162, xp.where((xp.greater_equal(t163, -1.5707963267948966)) & (xp.less_equal(t163, 1.5707963267948966)), t163, qb3_4)))
+    t165 = xp.where(xp.greater(qn6, t23), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t166 = t165 + t23
+    t167 = t23 - t165
+    t168 = xp.where((xp.greater_equal(t23, -2.9670597283903604)) & (xp.less_equal(t23, 2.9670597283903604)), t23, xp.where((xp.greater_equal(t166, -2.9670597283903604)) & (xp.less_equal(t166, 2.9670597283903604)), t166, xp.where((xp.greater_equal(t167, -2.9670597283903604)) & (xp.less_equal(t167, 2.9670597283903604)), t167, qb3_5)))
+    t169 = qw1*(t152 + t70)**2 + qw2*(t156 + t71)**2 + qw3*(qb3_2 + t72)**2 + qw4*(t160 + t73)**2 + qw5*(t164 + t74)**2 + qw6*(t168 + t75)**2
+    t170 = xp.greater(t24, 0)
+    t171 = xp.where(t170 & ((xp.greater(t148, t169)) | (xp.less(t140, 1))), xp.asarray(1, dtype=dtype), 0)
+    t172 = xp.where(t170, 1, t140)
+    t173 = xp.greater(t171, 0)
+    t174 = xp.where(t173, t152, t142)
+    t175 = xp.where(t173, t156, t143)
+    t176 = xp.where(t173, qb3_2, t144)
+    t177 = xp.where(t173, t160, t145)
+    t178 = xp.where(t173, t164, t146)
+    t179 = xp.where(t173, t168, t147)
+    t180 = xp.where(t173, t169, t148)
+    t181 = xp.where(xp.greater(qn1, t25), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t182 = t181 + t25
+    t183 = t25 - t181
+    t184 = xp.where((xp.greater_equal(t25, -2.9670597283903604)) & (xp.less_equal(t25, 2.9670597283903604)), t25, xp.where((xp.greater_equal(t182, -2.9670597283903604)) & (xp.less_equal(t182, 2.9670597283903604)), t182, xp.where((xp.greater_equal(t183, -2.9670597283903604)) & (xp.less_equal(t183, 2.9670597283903604)), t183, qb4_0)))
+    t185 = xp.where(xp.greater(qn2, t26), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t186 = t185 + t26
+    t187 = t26 - t185
+    t188 = xp.where((xp.greater_equal(t26, -2.9670597283903604)) & (xp.less_equal(t26, 2.9670597283903604)), t26, xp.where((xp.greater_equal(t186, -2.9670597283903604)) & (xp.less_equal(t186, 2.9670597283903604)), t186, xp.where((xp.greater_equal(t187, -2.9670597283903604)) & (xp.less_equal(t187, 2.9670597283903604)), t187, qb4_1)))
+    t189 = xp.where(xp.greater(qn4, t27), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t190 = t189 + t27
+    t191 = t27 - t189
+    t192 = xp.where((xp.greater_equal(t27, -2.9670597283903604)) & (xp.less_equal(t27, 2.9670597283903604)), t27, xp.where((xp.greater_equal(t190, -2.9670597283903604)) & (xp.less_equal(t190, 2.9670597283903604)), t190, xp.where((xp.greater_equal(t191, -2.9670597283903604)) & (xp.less_equal(t191, 2.9670597283903604)), t191, qb4_3)))
+    t193 = xp.where(xp.greater(qn5, t28), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t194 = t193 + t28
+    t195 = t28 - t193
+    t196 = xp.where((xp.greater_equal(t28, -1.5707963267948966)) & (xp.less_equal(t28, 1.5707963267948966)), t28, xp.where((xp.greater_equal(t194, -1.5707963267948966)) & (xp.less_equal(t194, 1.5707963267948966)), t194, xp.where((xp.greater_equal(t195, -1.5707963267948966)) & (xp.less_equal(t195, 1.5707963267948966)), t195, qb4_4)))
+    t197 = xp.where(xp.greater(qn6, t29), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t198 = t197 + t29
+    t199 = t29 - t197
+    t200 = xp.where((xp.greater_equal(t29, -2.9670597283903604)) & (xp.less_equal(t29, 2.9670597283903604)), t29, xp.where((xp.greater_equal(t198, -2.9670597283903604)) & (xp.less_equal(t198, 2.9670597283903604)), t198, xp.where((xp.greater_equal(t199, -2.9670597283903604)) & (xp.less_equal(t199, 2.9670597283903604)), t199, qb4_5)))
+    t201 = qw1*(t184 + t70)**2 + qw2*(t188 + t71)**2 + qw3*(qb4_2 + t72)**2 + qw4*(t192 + t73)**2 + qw5*(t196 + t74)**2 + qw6*(t200 + t75)**2
+    t202 = xp.greater(t30, 0)
+    t203 = xp.where(t202 & ((xp.greater(t180, t201)) | (xp.less(t172, 1))), xp.asarray(1, dtype=dtype), 0)
+    t204 = xp.where(t202, 1, t172)
+    t205 = xp.greater(t203, 0)
+    t206 = xp.where(t205, t184, t174)
+    t207 = xp.where(t205, t188, t175)
+    t208 = xp.where(t205, qb4_2, t176)
+    t209 = xp.where(t205, t192, t177)
+    t210 = xp.where(t205, t196, t178)
+    t211 = xp.where(t205, t200, t179)
+    t212 = xp.where(t205, t201, t180)
+    t213 = xp.where(xp.greater(qn1, t31), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t214 = t213 + t31
+    t215 = t31 - t213
+    t216 = xp.where((xp.greater_equal(t31, -2.9670597283903604)) & (xp.less_equal(t31, 2.9670597283903604)), t31, xp.where((xp.greater_equal(t214, -2.9670597283903604)) & (xp.less_equal(t214, 2.9670597283903604)), t214, xp.where((xp.greater_equal(t215, -2.9670597283903604)) & (xp.less_equal(t215, 2.9670597283903604)), t215, qb5_0)))
+    t217 = xp.where(xp.greater(qn2, t32), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t218 = t217 + t32
+    t219 = t32 - t217
+    t220 = xp.where((xp.greater_equal(t32, -2.9670597283903604)) & (xp.less_equal(t32, 2.9670597283903604)), t32, xp.where((xp.greater_equal(t218, -2.9670597283903604)) & (xp.less_equal(t218, 2.9670597283903604)), t218, xp.where((xp.greater_equal(t219, -2.9670597283903604)) & (xp.less_equal(t219, 2.9670597283903604)), t219, qb5_1)))
+    t221 = xp.where(xp.greater(qn4, t33), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t222 = t221 + t33
+    t223 = t33 - t221
+    t224 = xp.where((xp.greater_equal(t33, -2.9670597283903604)) & (xp.less_equal(t33, 2.9670597283903604)), t33, xp.where((xp.greater_equal(t222, -2.9670597283903604)) & (xp.less_equal(t222, 2.9670597283903604)), t222, xp.where((xp.greater_equal(t223, -2.9670597283903604)) & (xp.less_equal(t223, 2.9670597283903604)), t223, qb5_3)))
+    t225 = xp.where(xp.greater(qn5, t34), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t226 = t225 + t34
+    t227 = t34 - t225
+    t228 = xp.where((xp.greater_equal(t34, -1.5707963267948966)) & (xp.less_equal(t34, 1.5707963267948966)), t34, xp.where((xp.greater_equal(t226, -1.5707963267948966)) & (xp.less_equal(t226, 1.5707963267948966)), t226, xp.where((xp.greater_equal(t227, -1.5707963267948966)) & (xp.less_equal(t227, 1.5707963267948966)), t227, qb5_4)))
+    t229 = xp.where(xp.greater(qn6, t35), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t230 = t229 + t35
+    t231 = t35 - t229
+    t232 = xp.where((xp.greater_equal(t35, -2.9670597283903604)) & (xp.less_equal(t35, 2.9670597283903604)), t35, xp.where((xp.greater_equal(t230, -2.9670597283903604)) & (xp.less_equal(t230, 2.9670597283903604)), t230, xp.where((xp.greater_equal(t231, -2.9670597283903604)) & (xp.less_equal(t231, 2.9670597283903604)), t231, qb5_5)))
+    t233 = qw1*(t216 + t70)**2 + qw2*(t220 + t71)**2 + qw3*(qb5_2 + t72)**2 + qw4*(t224 + t73)**2 + qw5*(t228 + t74)**2 + qw6*(t232 + t75)**2
+    t234 = xp.greater(t36, 0)
+    t235 = xp.where(t234 & ((xp.greater(t212, t233)) | (xp.less(t204, 1))), xp.asarray(1, dtype=dtype), 0)
+    t236 = xp.where(t234, 1, t204)
+    t237 = xp.greater(t235, 0)
+    t238 = xp.where(t237, t216, t206)
+    t239 = xp.where(t237, t220, t207)
+    t240 = xp.where(t237, qb5_2, t208)
+    t241 = xp.where(t237, t224, t209)
+    t242 = xp.where(t237, t228, t210)
+    t243 = xp.where(t237, t232, t211)
+    t244 = xp.where(t237, t233, t212)
+    t245 = xp.where(xp.greater(qn1, t37), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t246 = t245 + t37
+    t247 = t37 - t245
+    t248 = xp.where((xp.greater_equal(t37, -2.9670597283903604)) & (xp.less_equal(t37, 2.9670597283903604)), t37, xp.where((xp.greater_equal(t246, -2.9670597283903604)) & (xp.less_equal(t246, 2.9670597283903604)), t246, xp.where((xp.greater_equal(t247, -2.9670597283903604)) & (xp.less_equal(t247, 2.9670597283903604)), t247, qb6_0)))
+    t249 = xp.where(xp.greater(qn2, t38), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t250 = t249 + t38
+    t251 = t38 - t249
+    t252 = xp.where((xp.greater_equal(t38, -2.9670597283903604)) & (xp.less_equal(t38, 2.9670597283903604)), t38, xp.where((xp.greater_equal(t250, -2.9670597283903604)) & (xp.less_equal(t250, 2.9670597283903604)), t250, xp.where((xp.greater_equal(t251, -2.9670597283903604)) & (xp.less_equal(t251, 2.9670597283903604)), t251, qb6_1)))
+    t253 = xp.where(xp.greater(qn4, t39), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t254 = t253 + t39
+    t255 = t39 - t253
+    t256 = xp.where((xp.greater_equal(t39, -2.9670597283903604)) & (xp.less_equal(t39, 2.9670597283903604)), t39, xp.where((xp.greater_equal(t254, -2.9670597283903604)) & (xp.less_equal(t254, 2.9670597283903604)), t254, xp.where((xp.greater_equal(t255, -2.9670597283903604)) & (xp.less_equal(t255, 2.9670597283903604)), t255, qb6_3)))
+    t257 = xp.where(xp.greater(qn5, t40), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t258 = t257 + t40
+    t259 = t40 - t257
+    t260 = xp.where((xp.greater_equal(t40, -1.5707963267948966)) & (xp.less_equal(t40, 1.5707963267948966)), t40, xp.where((xp.greater_equal(t258, -1.5707963267948966)) & (xp.less_equal(t258, 1.5707963267948966)), t258, xp.where((xp.greater_equal(t259, -1.5707963267948966)) & (xp.less_equal(t259, 1.5707963267948966)), t259, qb6_4)))
+    t261 = xp.where(xp.greater(qn6, t41), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t262 = t261 + t41
+    t263 = t41 - t261
+    t264 = xp.where((xp.greater_equal(t41, -2.9670597283903604)) & (xp.less_equal(t41, 2.9670597283903604)), t41, xp.where((xp.greater_equal(t262, -2.9670597283903604)) & (xp.less_equal(t262, 2.9670597283903604)), t262, xp.where((xp.greater_equal(t263, -2.9670597283903604)) & (xp.less_equal(t263, 2.9670597283903604)), t263, qb6_5)))
+    t265 = qw1*(t248 + t70)**2 + qw2*(t252 + t71)**2 + qw3*(qb6_2 + t72)**2 + qw4*(t256 + t73)**2 + qw5*(t260 + t74)**2 + qw6*(t264 + t75)**2
+    t266 = xp.greater(t42, 0)
+    t267 = xp.where(t266 & ((xp.greater(t244, t265)) | (xp.less(t236, 1))), xp.asarray(1, dtype=dtype), 0)
+    t268 = xp.where(t266, 1, t236)
+    t269 = xp.greater(t267, 0)
+    t270 = xp.where(t269, t248, t238)
+    t271 = xp.where(t269, t252, t239)
+    t272 = xp.where(t269, qb6_2, t240)
+    t273 = xp.where(t269, t256, t241)
+    t274 = xp.where(t269, t260, t242)
+    t275 = xp.where(t269, t264, t243)
+    t276 = xp.where(t269, t265, t244)
+    t277 = xp.where(xp.greater(qn1, t43), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t278 = t277 + t43
+    t279 = t43 - t277
+    t280 = xp.where((xp.greater_equal(t43, -2.9670597283903604)) & (xp.less_equal(t43, 2.9670597283903604)), t43, xp.where((xp.greater_equal(t278, -2.9670597283903604)) & (xp.less_equal(t278, 2.9670597283903604)), t278, xp.where((xp.greater_equal(t279, -2.9670597283903604)) & (xp.less_equal(t279, 2.9670597283903604)), t279, qb7_0)))
+    t281 = xp.where(xp.greater(qn2, t44), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t282 = t281 + t44
+    t283 = t44 - t281
+    t284 = xp.where((xp.greater_equal(t44, -2.9670597283903604)) & (xp.less_equal(t44, 2.9670597283903604)), t44, xp.where((xp.greater_equal(t282, -2.9670597283903604)) & (xp.less_equal(t282, 2.9670597283903604)), t282, xp.where((xp.greater_equal(t283, -2.9670597283903604)) & (xp.less_equal(t283, 2.9670597283903604)), t283, qb7_1)))
+    t285 = xp.where(xp.greater(qn4, t45), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t286 = t285 + t45
+    t287 = t45 - t285
+    t288 = xp.where((xp.greater_equal(t45, -2.9670597283903604)) & (xp.less_equal(t45, 2.9670597283903604)), t45, xp.where((xp.greater_equal(t286, -2.9670597283903604)) & (xp.less_equal(t286, 2.9670597283903604)), t286, xp.where((xp.greater_equal(t287, -2.9670597283903604)) & (xp.less_equal(t287, 2.9670597283903604)), t287, qb7_3)))
+    t289 = xp.where(xp.greater(qn5, t46), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t290 = t289 + t46
+    t291 = t46 - t289
+    t292 = xp.where((xp.greater_equal(t46, -1.5707963267948966)) & (xp.less_equal(t46, 1.5707963267948966)), t46, xp.where((xp.greater_equal(t290, -1.5707963267948966)) & (xp.less_equal(t290, 1.5707963267948966)), t290, xp.where((xp.greater_equal(t291, -1.5707963267948966)) & (xp.less_equal(t291, 1.5707963267948966)), t291, qb7_4)))
+    t293 = xp.where(xp.greater(qn6, t47), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t294 = t293 + t47
+    t295 = t47 - t293
+    t296 = xp.where((xp.greater_equal(t47, -2.9670597283903604)) & (xp.less_equal(t47, 2.9670597283903604)), t47, xp.where((xp.greater_equal(t294, -2.9670597283903604)) & (xp.less_equal(t294, 2.9670597283903604)), t294, xp.where((xp.greater_equal(t295, -2.9670597283903604)) & (xp.less_equal(t295, 2.9670597283903604)), t295, qb7_5)))
+    t297 = qw1*(t280 + t70)**2 + qw2*(t284 + t71)**2 + qw3*(qb7_2 + t72)**2 + qw4*(t288 + t73)**2 + qw5*(t292 + t74)**2 + qw6*(t296 + t75)**2
+    t298 = xp.greater(t48, 0)
+    t299 = xp.where(t298 & ((xp.greater(t276, t297)) | (xp.less(t268, 1))), xp.asarray(1, dtype=dtype), 0)
+    t300 = xp.where(t298, 1, t268)
+    t301 = xp.greater(t299, 0)
+    t302 = xp.where(t301, t280, t270)
+    t303 = xp.where(t301, t284, t271)
+    t304 = xp.where(t301, qb7_2, t272)
+    t305 = xp.where(t301, t288, t273)
+    t306 = xp.where(t301, t292, t274)
+    t307 = xp.where(t301, t296, t275)
+    t308 = xp.isfinite(t49)
+    t309 = xp.greater(t300, 0)
+    t310 = t308 & t309
     q = _stack(xp, [
-        xp.broadcast_to(xp.where(t738, t730, qn1), batch),  # 0
-        xp.broadcast_to(xp.where(t738, t731, qn2), batch),  # 1
-        xp.broadcast_to(xp.where(t738, t732, qn3), batch),  # 2
-        xp.broadcast_to(xp.where(t738, t733, qn4), batch),  # 3
-        xp.broadcast_to(xp.where(t738, t734, qn5), batch),  # 4
-        xp.broadcast_to(xp.where(t738, t735, qn6), batch),  # 5
+        xp.broadcast_to(xp.where(t310, t302, qn1), batch),  # 0
+        xp.broadcast_to(xp.where(t310, t303, qn2), batch),  # 1
+        xp.broadcast_to(xp.where(t310, t304, qn3), batch),  # 2
+        xp.broadcast_to(xp.where(t310, t305, qn4), batch),  # 3
+        xp.broadcast_to(xp.where(t310, t306, qn5), batch),  # 4
+        xp.broadcast_to(xp.where(t310, t307, qn6), batch),  # 5
     ], (6,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t736), 2, xp.where(t737, xp.asarray(0, dtype=dtype), 1)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t308), 2, xp.where(t309, xp.asarray(0, dtype=dtype), 1)), batch), xp.int32)
     return q, status
 
 

@@ -2188,7 +2188,8 @@ def _ik_branches(T):
 
 
 def _ik_nearest(T, q_seed, weights):
-    """The closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status: 1859 operations."""
+    """The closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status: 940 operations."""
+    branches_q, branches_valid, branches_in_limits = _ik_branches(T)
     T00 = T[0, 0]
     T01 = T[0, 1]
     T02 = T[0, 2]
@@ -2213,754 +2214,390 @@ def _ik_nearest(T, q_seed, weights):
     qw4 = weights[3]
     qw5 = weights[4]
     qw6 = weights[5]
-    t0 = 0.412*T02 - 0.1337*T00
-    t1 = T03 - t0
-    t2 = t0
-    t3 = t1 + t2
-    t4 = 0.412*T12 - 0.1337*T10
-    t5 = T13 - t4
-    t6 = t4
-    t7 = t5 + t6
-    t8 = 0.412*T22 - 0.1337*T20
-    t9 = T23 - t8
-    t10 = t8
-    t11 = t10 + t9
-    t12 = -0.412 + t11
-    t13 = t12**2
-    t14 = t13 + t3**2 + t7**2
-    t15 = 0.01787569 - t14
-    t16 = 0.01787569 + t14
-    t17 = 1e-12*t16
-    t18 = (t15 < -t17)
-    t19 = casadi.if_else(t18, casadi.sqrt(-t15), 0)
-    t20 = t19**2
-    t21 = 0.01787569 + t20
-    t22 = 0.01787569 + t13
-    t23 = t22 - t21
-    t24 = 1e-12*t21
-    t25 = (t23 < -t24)
-    t26 = casadi.if_else(t25, casadi.sqrt(-t23), 0)
-    t27 = t26*t3
-    t28 = t13 + 0.1337*t7
-    t29 = t28 - t27
-    t30 = t27 + t28
-    t31 = -t13
-    t32 = t29 + t31
-    t33 = t30 + t31
-    t34 = 0.1337*t3
-    t35 = t26*t7
-    t36 = t34 + t35
-    t37 = t32**2 + t36**2
-    t38 = t35 - t34
-    t39 = t33**2 + t38**2
-    t40 = t26**2
-    t41 = t22 + t40
-    t42 = 1e-24*t41
-    t43 = t14*t42
-    t44 = (t37 <= t43)
-    t45 = casadi.if_else(t44, 1, 1/casadi.sqrt(t37))
-    t46 = casadi.if_else(t44, 1, t32*t45)
-    t47 = casadi.if_else(t44, 0, -t36*t45)
-    t48 = T02*t46 + T12*t47
-    t49 = T12*t46 - T02*t47
-    t50 = T00*t46 + T10*t47
-    t51 = T10*t46 - T00*t47
-    t52 = casadi.if_else(t44, 0, casadi.atan2(-t36, t32))
-    t53 = t52 - 6.283185307179586*casadi.floor(0.4722222222222222 + 0.15915494309189535*t52)
-    t54 = t12*t19
-    t55 = 0.01787569 + t54
-    t56 = -0.01787569 + t55
-    t57 = 0.01787569 - t54
-    t58 = -0.01787569 + t57
-    t59 = t20*t40
-    t60 = t59 + t56**2
-    t61 = t59 + t58**2
-    t62 = t21*t42
-    t63 = (t60 <= t62)
-    t64 = casadi.if_else(t63, 1, 1/casadi.sqrt(t60))
-    t65 = casadi.if_else(t63, 1, t56*t64)
-    t66 = t19*t26
-    t67 = casadi.if_else(t63, 0, casadi.atan2(t66, t56))
-    t68 = t67 - 6.283185307179586*casadi.floor(0.4722222222222222 + 0.15915494309189535*t67)
-    t69 = t64*t66
-    t70 = casadi.if_else(t63, 0, -t69)
-    t71 = casadi.if_else(t63, 0, t69)
-    t72 = (t39 <= t43)
-    t73 = casadi.if_else(t72, 1, 1/casadi.sqrt(t39))
-    t74 = casadi.if_else(t72, 1, t33*t73)
-    t75 = casadi.if_else(t72, 0, t38*t73)
-    t76 = T02*t74 + T12*t75
-    t77 = T12*t74 - T02*t75
-    t78 = T00*t74 + T10*t75
-    t79 = T10*t74 - T00*t75
-    t80 = casadi.if_else(t72, 0, casadi.atan2(t38, t33))
-    t81 = t80 - 6.283185307179586*casadi.floor(0.4722222222222222 + 0.15915494309189535*t80)
-    t82 = 1 - t46
-    t83 = T22*t82
-    t84 = t83 + T22*t46
-    t85 = T20*t82
-    t86 = t85 + T20*t46
-    t87 = t48*t65 - t70*t84
-    t88 = t48*t70 + t65*t84
-    t89 = t50*t65 - t70*t86
-    t90 = t50*t70 + t65*t86
-    t91 = 1 - t65
-    t92 = t49*t91
-    t93 = t92 + t49*t65
-    t94 = t51*t91
-    t95 = t94 + t51*t65
-    t96 = t77*t91
-    t97 = t96 + t65*t77
-    t98 = t79*t91
-    t99 = t98 + t65*t79
-    t100 = t88**2
-    t101 = -t100
-    t102 = 1 + t101
-    t103 = (1e-12 < t102)
-    t104 = casadi.if_else(t103, casadi.sqrt(t102), 0)
-    t105 = t100 + t104*t93
-    t106 = t101 + t105
-    t107 = t87**2
-    t108 = t100 + t107 + t93**2
-    t109 = t104**2
-    t110 = t106**2 + t107*t109
-    t111 = t100 + t109
-    t112 = 1e-24*t111
-    t113 = (t110 <= t108*t112)
-    t114 = casadi.if_else(t113, 1, 1/casadi.sqrt(t110))
-    t115 = casadi.if_else(t113, 1, t106*t114)
-    t116 = t90*(1 - t115)
-    t117 = t116 + t115*t90
-    t118 = t104*t87
-    t119 = casadi.if_else(t113, 0, -t114*t118)
-    t120 = t115*t89 + t119*t95
-    t121 = t115*t95 - t119*t89
-    t122 = (t111 <= t112)
-    t123 = casadi.if_else(t122, 1, 1/casadi.sqrt(t111))
-    t124 = casadi.if_else(t122, 1, t123*t88)
-    t125 = casadi.if_else(t122, 0, -t104*t123)
-    t126 = t120*(1 - t124)
-    t127 = t126 + t120*t124
-    t128 = t117*t125 + t121*t124
-    t129 = t117*t124 - t121*t125
-    t130 = t127**2 + t128**2
-    t131 = t130
-    t132 = t130 + t129**2
-    t133 = 1 - t74
-    t134 = T22*t133
-    t135 = t134 + T22*t74
-    t136 = T20*t133
-    t137 = t136 + T20*t74
-    t138 = t65*t76 - t135*t71
-    t139 = t135*t65 + t71*t76
-    t140 = t65*t78 - t137*t71
-    t141 = t137*t65 + t71*t78
-    t142 = t139**2
-    t143 = -t142
-    t144 = 1 + t143
-    t145 = (1e-12 < t144)
-    t146 = casadi.if_else(t145, casadi.sqrt(t144), 0)
-    t147 = t142 + t146*t97
-    t148 = t143 + t147
-    t149 = t138**2
-    t150 = t142 + t149 + t97**2
-    t151 = t146**2
-    t152 = t148**2 + t149*t151
-    t153 = t142 + t151
-    t154 = 1e-24*t153
-    t155 = (t152 <= t150*t154)
-    t156 = casadi.if_else(t155, 1, 1/casadi.sqrt(t152))
-    t157 = casadi.if_else(t155, 1, t148*t156)
-    t158 = t141*(1 - t157)
-    t159 = t158 + t141*t157
-    t160 = t138*t146
-    t161 = casadi.if_else(t155, 0, -t156*t160)
-    t162 = t140*t157 + t161*t99
-    t163 = t157*t99 - t140*t161
-    t164 = (t153 <= t154)
-    t165 = casadi.if_else(t164, 1, 1/casadi.sqrt(t153))
-    t166 = casadi.if_else(t164, 1, t139*t165)
-    t167 = casadi.if_else(t164, 0, -t146*t165)
-    t168 = t162*(1 - t166)
-    t169 = t168 + t162*t166
-    t170 = t159*t167 + t163*t166
-    t171 = t159*t166 - t163*t167
-    t172 = t169**2 + t170**2
-    t173 = t172
-    t174 = t172 + t171**2
-    t175 = (t61 <= t62)
-    t176 = casadi.if_else(t175, 1, 1/casadi.sqrt(t61))
-    t177 = casadi.if_else(t175, 1, t176*t58)
-    t178 = casadi.if_else(t175, 0, casadi.atan2(t66, t58))
-    t179 = t178 - 6.283185307179586*casadi.floor(0.4722222222222222 + 0.15915494309189535*t178)
-    t180 = t176*t66
-    t181 = casadi.if_else(t175, 0, t180)
-    t182 = casadi.if_else(t175, 0, -t180)
-    t183 = t177*t48 - t181*t84
-    t184 = t177*t84 + t181*t48
-    t185 = t177*t50 - t181*t86
-    t186 = t177*t86 + t181*t50
-    t187 = t177*t76 - t135*t182
-    t188 = t135*t177 + t182*t76
-    t189 = t177*t78 - t137*t182
-    t190 = t137*t177 + t182*t78
-    t191 = 1 - t177
-    t192 = t191*t49
-    t193 = t192 + t177*t49
-    t194 = t191*t51
-    t195 = t194 + t177*t51
-    t196 = t191*t77
-    t197 = t196 + t177*t77
-    t198 = t191*t79
-    t199 = t198 + t177*t79
-    t200 = t184**2
-    t201 = -t200
-    t202 = 1 + t201
-    t203 = (1e-12 < t202)
-    t204 = casadi.if_else(t203, casadi.sqrt(t202), 0)
-    t205 = t200 + t193*t204
-    t206 = t201 + t205
-    t207 = t183**2
-    t208 = t200 + t207 + t193**2
-    t209 = t204**2
-    t210 = t206**2 + t207*t209
-    t211 = t200 + t209
-    t212 = 1e-24*t211
-    t213 = (t210 <= t208*t212)
-    t214 = casadi.if_else(t213, 1, 1/casadi.sqrt(t210))
-    t215 = casadi.if_else(t213, 1, t206*t214)
-    t216 = t186*(1 - t215)
-    t217 = t216 + t186*t215
-    t218 = t183*t204
-    t219 = casadi.if_else(t213, 0, -t214*t218)
-    t220 = t185*t215 + t195*t219
-    t221 = t195*t215 - t185*t219
-    t222 = (t211 <= t212)
-    t223 = casadi.if_else(t222, 1, 1/casadi.sqrt(t211))
-    t224 = casadi.if_else(t222, 1, t184*t223)
-    t225 = casadi.if_else(t222, 0, -t204*t223)
-    t226 = t220*(1 - t224)
-    t227 = t226 + t220*t224
-    t228 = t217*t225 + t221*t224
-    t229 = t217*t224 - t221*t225
-    t230 = t227**2 + t228**2
-    t231 = t230
-    t232 = t230 + t229**2
-    t233 = t188**2
-    t234 = -t233
-    t235 = 1 + t234
-    t236 = (1e-12 < t235)
-    t237 = casadi.if_else(t236, casadi.sqrt(t235), 0)
-    t238 = t233 + t197*t237
-    t239 = t234 + t238
-    t240 = t187**2
-    t241 = t233 + t240 + t197**2
-    t242 = t237**2
-    t243 = t239**2 + t240*t242
-    t244 = t233 + t242
-    t245 = 1e-24*t244
-    t246 = (t243 <= t241*t245)
-    t247 = casadi.if_else(t246, 1, 1/casadi.sqrt(t243))
-    t248 = casadi.if_else(t246, 1, t239*t247)
-    t249 = t190*(1 - t248)
-    t250 = t249 + t190*t248
-    t251 = t187*t237
-    t252 = casadi.if_else(t246, 0, -t247*t251)
-    t253 = t189*t248 + t199*t252
-    t254 = t199*t248 - t189*t252
-    t255 = (t244 <= t245)
-    t256 = casadi.if_else(t255, 1, 1/casadi.sqrt(t244))
-    t257 = casadi.if_else(t255, 1, t188*t256)
-    t258 = casadi.if_else(t255, 0, -t237*t256)
-    t259 = t253*(1 - t257)
-    t260 = t259 + t253*t257
-    t261 = t250*t258 + t254*t257
-    t262 = t250*t257 - t254*t258
-    t263 = t260**2 + t261**2
-    t264 = t263
-    t265 = t263 + t262**2
-    t266 = T00 + T01 + T02 + T03 + T10 + T11 + T12 + T13 + T20 + T21 + T22 + T23
-    t267 = t266
-    t268 = qn1 + qn2 + qn3 + qn4 + qn5 + qn6 + qw1 + qw2 + qw3 + qw4 + qw5 + qw6 + t266
-    t269 = -t66
-    t270 = casadi.if_else(t63, 0, casadi.atan2(t269, t56))
-    t271 = t270 - 6.283185307179586*casadi.floor(0.4722222222222222 + 0.15915494309189535*t270)
-    t272 = casadi.if_else(t175, 0, casadi.atan2(t269, t58))
-    t273 = t272 - 6.283185307179586*casadi.floor(0.4722222222222222 + 0.15915494309189535*t272)
-    t274 = casadi.if_else(t113, 0, casadi.atan2(-t118, t106))
-    t275 = t274
-    t276 = t275 - 6.283185307179586*casadi.floor(0.4722222222222222 + 0.15915494309189535*t275)
-    t277 = 3.141592653589793 + t274 - 6.283185307179586*casadi.ceil(0.15915494309189535*t274)
-    t278 = t277 - 6.283185307179586*casadi.floor(0.4722222222222222 + 0.15915494309189535*t277)
-    t279 = casadi.if_else(t122, 0, casadi.atan2(-t104, t88))
-    t280 = t279
-    t281 = t280 - 6.283185307179586*casadi.floor(0.25 + 0.15915494309189535*t280)
-    t282 = t279 + 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t279)
-    t283 = casadi.if_else((t131 <= 1e-24*t132), 0, casadi.atan2(t127, -t128))
-    t284 = t283
-    t285 = t284 - 6.283185307179586*casadi.floor(0.4722222222222222 + 0.15915494309189535*t284)
-    t286 = 3.141592653589793 + t283 - 6.283185307179586*casadi.ceil(0.15915494309189535*t283)
-    t287 = t286 - 6.283185307179586*casadi.floor(0.4722222222222222 + 0.15915494309189535*t286)
-    t288 = -t282
-    t289 = t282 + 6.283185307179586*casadi.floor(0.25 + 0.15915494309189535*t288)
-    t290 = casadi.if_else(t155, 0, casadi.atan2(-t160, t148))
-    t291 = t290
-    t292 = t291 - 6.283185307179586*casadi.floor(0.4722222222222222 + 0.15915494309189535*t291)
-    t293 = 3.141592653589793 + t290 - 6.283185307179586*casadi.ceil(0.15915494309189535*t290)
-    t294 = t293 - 6.283185307179586*casadi.floor(0.4722222222222222 + 0.15915494309189535*t293)
-    t295 = casadi.if_else(t164, 0, casadi.atan2(-t146, t139))
-    t296 = t295
-    t297 = t296 - 6.283185307179586*casadi.floor(0.25 + 0.15915494309189535*t296)
-    t298 = t295 + 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t295)
-    t299 = casadi.if_else((t173 <= 1e-24*t174), 0, casadi.atan2(t169, -t170))
-    t300 = t299
-    t301 = t300 - 6.283185307179586*casadi.floor(0.4722222222222222 + 0.15915494309189535*t300)
-    t302 = 3.141592653589793 + t299 - 6.283185307179586*casadi.ceil(0.15915494309189535*t299)
-    t303 = t302 - 6.283185307179586*casadi.floor(0.4722222222222222 + 0.15915494309189535*t302)
-    t304 = -t298
-    t305 = t298 + 6.283185307179586*casadi.floor(0.25 + 0.15915494309189535*t304)
-    t306 = casadi.if_else(t213, 0, casadi.atan2(-t218, t206))
-    t307 = t306
-    t308 = t307 - 6.283185307179586*casadi.floor(0.4722222222222222 + 0.15915494309189535*t307)
-    t309 = 3.141592653589793 + t306 - 6.283185307179586*casadi.ceil(0.15915494309189535*t306)
-    t310 = t309 - 6.283185307179586*casadi.floor(0.4722222222222222 + 0.15915494309189535*t309)
-    t311 = casadi.if_else(t222, 0, casadi.atan2(-t204, t184))
-    t312 = t311
-    t313 = t312 - 6.283185307179586*casadi.floor(0.25 + 0.15915494309189535*t312)
-    t314 = t311 + 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t311)
-    t315 = casadi.if_else((t231 <= 1e-24*t232), 0, casadi.atan2(t227, -t228))
-    t316 = t315
-    t317 = t316 - 6.283185307179586*casadi.floor(0.4722222222222222 + 0.15915494309189535*t316)
-    t318 = 3.141592653589793 + t315 - 6.283185307179586*casadi.ceil(0.15915494309189535*t315)
-    t319 = t318 - 6.283185307179586*casadi.floor(0.4722222222222222 + 0.15915494309189535*t318)
-    t320 = -t314
-    t321 = t314 + 6.283185307179586*casadi.floor(0.25 + 0.15915494309189535*t320)
-    t322 = casadi.if_else(t246, 0, casadi.atan2(-t251, t239))
-    t323 = t322
-    t324 = t323 - 6.283185307179586*casadi.floor(0.4722222222222222 + 0.15915494309189535*t323)
-    t325 = 3.141592653589793 + t322 - 6.283185307179586*casadi.ceil(0.15915494309189535*t322)
-    t326 = t325 - 6.283185307179586*casadi.floor(0.4722222222222222 + 0.15915494309189535*t325)
-    t327 = casadi.if_else(t255, 0, casadi.atan2(-t237, t188))
-    t328 = t327
-    t329 = t328 - 6.283185307179586*casadi.floor(0.25 + 0.15915494309189535*t328)
-    t330 = t327 + 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t327)
-    t331 = casadi.if_else((t264 <= 1e-24*t265), 0, casadi.atan2(t260, -t261))
-    t332 = t331
-    t333 = t332 - 6.283185307179586*casadi.floor(0.4722222222222222 + 0.15915494309189535*t332)
-    t334 = 3.141592653589793 + t331 - 6.283185307179586*casadi.ceil(0.15915494309189535*t331)
-    t335 = t334 - 6.283185307179586*casadi.floor(0.4722222222222222 + 0.15915494309189535*t334)
-    t336 = -t330
-    t337 = t330 + 6.283185307179586*casadi.floor(0.25 + 0.15915494309189535*t336)
-    t338 = (t53 <= 2.9670597283903604)
-    t339 = casadi.logic_and((t52 >= -2.9670597283903604), (t52 <= 2.9670597283903604))
-    t340 = casadi.if_else(casadi.logic_and(t338, casadi.logic_not(t339)), t53, t52)
-    t341 = t340
-    t342 = t341 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn1 - 0.15915494309189535*t341)
-    t343 = casadi.if_else((qn1 > t342), 6.283185307179586, -6.283185307179586)
-    t344 = t342 + t343
-    t345 = t342 - t343
-    t346 = casadi.if_else(casadi.logic_and((t342 >= -2.9670597283903604), (t342 <= 2.9670597283903604)), t342, casadi.if_else(casadi.logic_and((t344 >= -2.9670597283903604), (t344 <= 2.9670597283903604)), t344, casadi.if_else(casadi.logic_and((t345 >= -2.9670597283903604), (t345 <= 2.9670597283903604)), t345, t340)))
-    t347 = (t271 <= 2.9670597283903604)
-    t348 = casadi.logic_and((t270 >= -2.9670597283903604), (t270 <= 2.9670597283903604))
-    t349 = casadi.if_else(casadi.logic_and(t347, casadi.logic_not(t348)), t271, t270)
-    t350 = t349
-    t351 = t350 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t350)
-    t352 = casadi.if_else((qn2 > t351), 6.283185307179586, -6.283185307179586)
-    t353 = t351 + t352
-    t354 = t351 - t352
-    t355 = casadi.if_else(casadi.logic_and((t351 >= -2.9670597283903604), (t351 <= 2.9670597283903604)), t351, casadi.if_else(casadi.logic_and((t353 >= -2.9670597283903604), (t353 <= 2.9670597283903604)), t353, casadi.if_else(casadi.logic_and((t354 >= -2.9670597283903604), (t354 <= 2.9670597283903604)), t354, t349)))
-    t356 = (t276 <= 2.9670597283903604)
-    t357 = casadi.logic_and((t275 >= -2.9670597283903604), (t275 <= 2.9670597283903604))
-    t358 = casadi.if_else(casadi.logic_and(t356, casadi.logic_not(t357)), t276, t275)
-    t359 = t358
-    t360 = t359 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t359)
-    t361 = casadi.if_else((qn4 > t360), 6.283185307179586, -6.283185307179586)
-    t362 = t360 + t361
-    t363 = t360 - t361
-    t364 = casadi.if_else(casadi.logic_and((t360 >= -2.9670597283903604), (t360 <= 2.9670597283903604)), t360, casadi.if_else(casadi.logic_and((t362 >= -2.9670597283903604), (t362 <= 2.9670597283903604)), t362, casadi.if_else(casadi.logic_and((t363 >= -2.9670597283903604), (t363 <= 2.9670597283903604)), t363, t358)))
-    t365 = (t281 <= 1.5707963267948966)
-    t366 = casadi.logic_and((t280 >= -1.5707963267948966), (t280 <= 1.5707963267948966))
-    t367 = casadi.if_else(casadi.logic_and(t365, casadi.logic_not(t366)), t281, t280)
-    t368 = t367
-    t369 = t368 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn5 - 0.15915494309189535*t368)
-    t370 = casadi.if_else((qn5 > t369), 6.283185307179586, -6.283185307179586)
-    t371 = t369 + t370
-    t372 = t369 - t370
-    t373 = casadi.if_else(casadi.logic_and((t369 >= -1.5707963267948966), (t369 <= 1.5707963267948966)), t369, casadi.if_else(casadi.logic_and((t371 >= -1.5707963267948966), (t371 <= 1.5707963267948966)), t371, casadi.if_else(casadi.logic_and((t372 >= -1.5707963267948966), (t372 <= 1.5707963267948966)), t372, t367)))
-    t374 = (t285 <= 2.9670597283903604)
-    t375 = casadi.logic_and((t284 >= -2.9670597283903604), (t284 <= 2.9670597283903604))
-    t376 = casadi.if_else(casadi.logic_and(t374, casadi.logic_not(t375)), t285, t284)
-    t377 = t376
-    t378 = t377 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn6 - 0.15915494309189535*t377)
-    t379 = casadi.if_else((qn6 > t378), 6.283185307179586, -6.283185307179586)
-    t380 = t378 + t379
-    t381 = t378 - t379
-    t382 = casadi.if_else(casadi.logic_and((t378 >= -2.9670597283903604), (t378 <= 2.9670597283903604)), t378, casadi.if_else(casadi.logic_and((t380 >= -2.9670597283903604), (t380 <= 2.9670597283903604)), t380, casadi.if_else(casadi.logic_and((t381 >= -2.9670597283903604), (t381 <= 2.9670597283903604)), t381, t376)))
-    t383 = -qn4
-    t384 = -qn5
-    t385 = -qn6
-    t386 = -qn1
-    t387 = qw1*(t346 + t386)**2
-    t388 = -qn2
-    t389 = qw3*(t19 - qn3)**2
-    t390 = t387 + t389 + qw2*(t355 + t388)**2
-    t391 = t390 + qw4*(t364 + t383)**2 + qw5*(t373 + t384)**2 + qw6*(t382 + t385)**2
-    t392 = (casadi.fabs(t267) < casadi.inf)
-    t393 = (t19 >= 0.30479999999999996)
-    t394 = (t19 <= 1.27)
-    t395 = (t15 <= t17)
-    t396 = (t23 <= t24)
-    t397 = casadi.logic_or(t338, t339)
-    t398 = casadi.logic_or(t347, t348)
-    t399 = casadi.if_else(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t392, t393), t394), t395), t396), t397), t398), (t102 >= -1e-12)), casadi.logic_or(t356, t357)), casadi.logic_or(t365, t366)), casadi.logic_or(t374, t375)), 1, 0)
-    t400 = casadi.if_else((t399 > 0), 1, 0)
-    t401 = (t400 > 0)
-    t402 = casadi.if_else(t401, t346, qn1)
-    t403 = casadi.if_else(t401, t355, qn2)
-    t404 = casadi.if_else(t401, t19, qn3)
-    t405 = casadi.if_else(t401, t364, qn4)
-    t406 = casadi.if_else(t401, t373, qn5)
-    t407 = casadi.if_else(t401, t382, qn6)
-    t408 = casadi.if_else(t401, t391, 0)
-    t409 = (t278 <= 2.9670597283903604)
-    t410 = casadi.logic_and((t277 >= -2.9670597283903604), (t277 <= 2.9670597283903604))
-    t411 = casadi.if_else(casadi.logic_and(t409, casadi.logic_not(t410)), t278, t277)
-    t412 = t411
-    t413 = t412 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t412)
-    t414 = casadi.if_else((qn4 > t413), 6.283185307179586, -6.283185307179586)
-    t415 = t413 + t414
-    t416 = t413 - t414
-    t417 = casadi.if_else(casadi.logic_and((t413 >= -2.9670597283903604), (t413 <= 2.9670597283903604)), t413, casadi.if_else(casadi.logic_and((t415 >= -2.9670597283903604), (t415 <= 2.9670597283903604)), t415, casadi.if_else(casadi.logic_and((t416 >= -2.9670597283903604), (t416 <= 2.9670597283903604)), t416, t411)))
-    t418 = (t289 >= -1.5707963267948966)
-    t419 = casadi.logic_and((t282 >= -1.5707963267948966), (t282 <= 1.5707963267948966))
-    t420 = casadi.if_else(casadi.logic_and(t418, casadi.logic_not(t419)), -t289, t288)
-    t421 = t420
-    t422 = t421 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn5 - 0.15915494309189535*t421)
-    t423 = casadi.if_else((qn5 > t422), 6.283185307179586, -6.283185307179586)
-    t424 = t422 + t423
-    t425 = t422 - t423
-    t426 = casadi.if_else(casadi.logic_and((t422 >= -1.5707963267948966), (t422 <= 1.5707963267948966)), t422, casadi.if_else(casadi.logic_and((t424 >= -1.5707963267948966), (t424 <= 1.5707963267948966)), t424, casadi.if_else(casadi.logic_and((t425 >= -1.5707963267948966), (t425 <= 1.5707963267948966)), t425, t420)))
-    t427 = (t287 <= 2.9670597283903604)
-    t428 = casadi.logic_and((t286 >= -2.9670597283903604), (t286 <= 2.9670597283903604))
-    t429 = casadi.if_else(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t103, t392), t393), t394), t395), t396), t397), t398), casadi.logic_or(t409, t410)), casadi.logic_or(t418, t419)), casadi.logic_or(t427, t428)), 1, 0)
-    t430 = casadi.if_else(casadi.logic_and(t427, casadi.logic_not(t428)), t287, t286)
-    t431 = t430
-    t432 = t431 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn6 - 0.15915494309189535*t431)
-    t433 = casadi.if_else((qn6 > t432), 6.283185307179586, -6.283185307179586)
-    t434 = t432 + t433
-    t435 = t432 - t433
-    t436 = casadi.if_else(casadi.logic_and((t432 >= -2.9670597283903604), (t432 <= 2.9670597283903604)), t432, casadi.if_else(casadi.logic_and((t434 >= -2.9670597283903604), (t434 <= 2.9670597283903604)), t434, casadi.if_else(casadi.logic_and((t435 >= -2.9670597283903604), (t435 <= 2.9670597283903604)), t435, t430)))
-    t437 = t390 + qw4*(t383 + t417)**2 + qw5*(t384 + t426)**2 + qw6*(t385 + t436)**2
-    t438 = (t429 > 0)
-    t439 = casadi.if_else(casadi.logic_and(t438, casadi.logic_or((t408 > t437), (t400 < 1))), 1, 0)
-    t440 = casadi.if_else(t438, 1, t400)
-    t441 = (t439 > 0)
-    t442 = casadi.if_else(t441, t346, t402)
-    t443 = casadi.if_else(t441, t355, t403)
-    t444 = casadi.if_else(t441, t19, t404)
-    t445 = casadi.if_else(t441, t417, t405)
-    t446 = casadi.if_else(t441, t426, t406)
-    t447 = casadi.if_else(t441, t436, t407)
-    t448 = casadi.if_else(t441, t437, t408)
-    t449 = (t81 <= 2.9670597283903604)
-    t450 = casadi.logic_and((t80 >= -2.9670597283903604), (t80 <= 2.9670597283903604))
-    t451 = casadi.if_else(casadi.logic_and(t449, casadi.logic_not(t450)), t81, t80)
-    t452 = t451
-    t453 = t452 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn1 - 0.15915494309189535*t452)
-    t454 = casadi.if_else((qn1 > t453), 6.283185307179586, -6.283185307179586)
-    t455 = t453 + t454
-    t456 = t453 - t454
-    t457 = casadi.if_else(casadi.logic_and((t453 >= -2.9670597283903604), (t453 <= 2.9670597283903604)), t453, casadi.if_else(casadi.logic_and((t455 >= -2.9670597283903604), (t455 <= 2.9670597283903604)), t455, casadi.if_else(casadi.logic_and((t456 >= -2.9670597283903604), (t456 <= 2.9670597283903604)), t456, t451)))
-    t458 = (t68 <= 2.9670597283903604)
-    t459 = casadi.logic_and((t67 >= -2.9670597283903604), (t67 <= 2.9670597283903604))
-    t460 = casadi.if_else(casadi.logic_and(t458, casadi.logic_not(t459)), t68, t67)
-    t461 = t460
-    t462 = t461 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t461)
-    t463 = casadi.if_else((qn2 > t462), 6.283185307179586, -6.283185307179586)
-    t464 = t462 + t463
-    t465 = t462 - t463
-    t466 = casadi.if_else(casadi.logic_and((t462 >= -2.9670597283903604), (t462 <= 2.9670597283903604)), t462, casadi.if_else(casadi.logic_and((t464 >= -2.9670597283903604), (t464 <= 2.9670597283903604)), t464, casadi.if_else(casadi.logic_and((t465 >= -2.9670597283903604), (t465 <= 2.9670597283903604)), t465, t460)))
-    t467 = (t292 <= 2.9670597283903604)
-    t468 = casadi.logic_and((t291 >= -2.9670597283903604), (t291 <= 2.9670597283903604))
-    t469 = casadi.if_else(casadi.logic_and(t467, casadi.logic_not(t468)), t292, t291)
-    t470 = t469
-    t471 = t470 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t470)
-    t472 = casadi.if_else((qn4 > t471), 6.283185307179586, -6.283185307179586)
-    t473 = t471 + t472
-    t474 = t471 - t472
-    t475 = casadi.if_else(casadi.logic_and((t471 >= -2.9670597283903604), (t471 <= 2.9670597283903604)), t471, casadi.if_else(casadi.logic_and((t473 >= -2.9670597283903604), (t473 <= 2.9670597283903604)), t473, casadi.if_else(casadi.logic_and((t474 >= -2.9670597283903604), (t474 <= 2.9670597283903604)), t474, t469)))
-    t476 = (t297 <= 1.5707963267948966)
-    t477 = casadi.logic_and((t296 >= -1.5707963267948966), (t296 <= 1.5707963267948966))
-    t478 = casadi.if_else(casadi.logic_and(t476, casadi.logic_not(t477)), t297, t296)
-    t479 = t478
-    t480 = t479 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn5 - 0.15915494309189535*t479)
-    t481 = casadi.if_else((qn5 > t480), 6.283185307179586, -6.283185307179586)
-    t482 = t480 + t481
-    t483 = t480 - t481
-    t484 = casadi.if_else(casadi.logic_and((t480 >= -1.5707963267948966), (t480 <= 1.5707963267948966)), t480, casadi.if_else(casadi.logic_and((t482 >= -1.5707963267948966), (t482 <= 1.5707963267948966)), t482, casadi.if_else(casadi.logic_and((t483 >= -1.5707963267948966), (t483 <= 1.5707963267948966)), t483, t478)))
-    t485 = (t301 <= 2.9670597283903604)
-    t486 = casadi.logic_and((t300 >= -2.9670597283903604), (t300 <= 2.9670597283903604))
-    t487 = casadi.if_else(casadi.logic_and(t485, casadi.logic_not(t486)), t301, t300)
-    t488 = t487
-    t489 = t488 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn6 - 0.15915494309189535*t488)
-    t490 = casadi.if_else((qn6 > t489), 6.283185307179586, -6.283185307179586)
-    t491 = t489 + t490
-    t492 = t489 - t490
-    t493 = casadi.if_else(casadi.logic_and((t489 >= -2.9670597283903604), (t489 <= 2.9670597283903604)), t489, casadi.if_else(casadi.logic_and((t491 >= -2.9670597283903604), (t491 <= 2.9670597283903604)), t491, casadi.if_else(casadi.logic_and((t492 >= -2.9670597283903604), (t492 <= 2.9670597283903604)), t492, t487)))
-    t494 = qw1*(t386 + t457)**2
-    t495 = t389 + t494 + qw2*(t388 + t466)**2
-    t496 = t495 + qw4*(t383 + t475)**2 + qw5*(t384 + t484)**2 + qw6*(t385 + t493)**2
-    t497 = casadi.logic_or(t449, t450)
-    t498 = casadi.logic_or(t458, t459)
-    t499 = casadi.if_else(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t25, t392), t393), t394), t395), t497), t498), (t144 >= -1e-12)), casadi.logic_or(t467, t468)), casadi.logic_or(t476, t477)), casadi.logic_or(t485, t486)), 1, 0)
-    t500 = (t499 > 0)
-    t501 = casadi.if_else(casadi.logic_and(t500, casadi.logic_or((t448 > t496), (t440 < 1))), 1, 0)
-    t502 = casadi.if_else(t500, 1, t440)
-    t503 = (t501 > 0)
-    t504 = casadi.if_else(t503, t457, t442)
-    t505 = casadi.if_else(t503, t466, t443)
-    t506 = casadi.if_else(t503, t19, t444)
-    t507 = casadi.if_else(t503, t475, t445)
-    t508 = casadi.if_else(t503, t484, t446)
-    t509 = casadi.if_else(t503, t493, t447)
-    t510 = casadi.if_else(t503, t496, t448)
-    t511 = (t294 <= 2.9670597283903604)
-    t512 = casadi.logic_and((t293 >= -2.9670597283903604), (t293 <= 2.9670597283903604))
-    t513 = casadi.if_else(casadi.logic_and(t511, casadi.logic_not(t512)), t294, t293)
-    t514 = t513
-    t515 = t514 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t514)
-    t516 = casadi.if_else((qn4 > t515), 6.283185307179586, -6.283185307179586)
-    t517 = t515 + t516
-    t518 = t515 - t516
-    t519 = casadi.if_else(casadi.logic_and((t515 >= -2.9670597283903604), (t515 <= 2.9670597283903604)), t515, casadi.if_else(casadi.logic_and((t517 >= -2.9670597283903604), (t517 <= 2.9670597283903604)), t517, casadi.if_else(casadi.logic_and((t518 >= -2.9670597283903604), (t518 <= 2.9670597283903604)), t518, t513)))
-    t520 = (t305 >= -1.5707963267948966)
-    t521 = casadi.logic_and((t298 >= -1.5707963267948966), (t298 <= 1.5707963267948966))
-    t522 = casadi.if_else(casadi.logic_and(t520, casadi.logic_not(t521)), -t305, t304)
-    t523 = t522
-    t524 = t523 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn5 - 0.15915494309189535*t523)
-    t525 = casadi.if_else((qn5 > t524), 6.283185307179586, -6.283185307179586)
-    t526 = t524 + t525
-    t527 = t524 - t525
-    t528 = casadi.if_else(casadi.logic_and((t524 >= -1.5707963267948966), (t524 <= 1.5707963267948966)), t524, casadi.if_else(casadi.logic_and((t526 >= -1.5707963267948966), (t526 <= 1.5707963267948966)), t526, casadi.if_else(casadi.logic_and((t527 >= -1.5707963267948966), (t527 <= 1.5707963267948966)), t527, t522)))
-    t529 = (t303 <= 2.9670597283903604)
-    t530 = casadi.logic_and((t302 >= -2.9670597283903604), (t302 <= 2.9670597283903604))
-    t531 = casadi.if_else(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t145, t25), t392), t393), t394), t395), t497), t498), casadi.logic_or(t511, t512)), casadi.logic_or(t520, t521)), casadi.logic_or(t529, t530)), 1, 0)
-    t532 = casadi.if_else(casadi.logic_and(t529, casadi.logic_not(t530)), t303, t302)
-    t533 = t532
-    t534 = t533 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn6 - 0.15915494309189535*t533)
-    t535 = casadi.if_else((qn6 > t534), 6.283185307179586, -6.283185307179586)
-    t536 = t534 + t535
-    t537 = t534 - t535
-    t538 = casadi.if_else(casadi.logic_and((t534 >= -2.9670597283903604), (t534 <= 2.9670597283903604)), t534, casadi.if_else(casadi.logic_and((t536 >= -2.9670597283903604), (t536 <= 2.9670597283903604)), t536, casadi.if_else(casadi.logic_and((t537 >= -2.9670597283903604), (t537 <= 2.9670597283903604)), t537, t532)))
-    t539 = t495 + qw4*(t383 + t519)**2 + qw5*(t384 + t528)**2 + qw6*(t385 + t538)**2
-    t540 = (t531 > 0)
-    t541 = casadi.if_else(casadi.logic_and(t540, casadi.logic_or((t510 > t539), (t502 < 1))), 1, 0)
-    t542 = casadi.if_else(t540, 1, t502)
-    t543 = (t541 > 0)
-    t544 = casadi.if_else(t543, t457, t504)
-    t545 = casadi.if_else(t543, t466, t505)
-    t546 = casadi.if_else(t543, t19, t506)
-    t547 = casadi.if_else(t543, t519, t507)
-    t548 = casadi.if_else(t543, t528, t508)
-    t549 = casadi.if_else(t543, t538, t509)
-    t550 = casadi.if_else(t543, t539, t510)
-    t551 = (t179 <= 2.9670597283903604)
-    t552 = casadi.logic_and((t178 >= -2.9670597283903604), (t178 <= 2.9670597283903604))
-    t553 = casadi.if_else(casadi.logic_and(t551, casadi.logic_not(t552)), t179, t178)
-    t554 = t553
-    t555 = t554 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t554)
-    t556 = casadi.if_else((qn2 > t555), 6.283185307179586, -6.283185307179586)
-    t557 = t555 + t556
-    t558 = t555 - t556
-    t559 = casadi.if_else(casadi.logic_and((t555 >= -2.9670597283903604), (t555 <= 2.9670597283903604)), t555, casadi.if_else(casadi.logic_and((t557 >= -2.9670597283903604), (t557 <= 2.9670597283903604)), t557, casadi.if_else(casadi.logic_and((t558 >= -2.9670597283903604), (t558 <= 2.9670597283903604)), t558, t553)))
-    t560 = (t308 <= 2.9670597283903604)
-    t561 = casadi.logic_and((t307 >= -2.9670597283903604), (t307 <= 2.9670597283903604))
-    t562 = casadi.if_else(casadi.logic_and(t560, casadi.logic_not(t561)), t308, t307)
-    t563 = t562
-    t564 = t563 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t563)
-    t565 = casadi.if_else((qn4 > t564), 6.283185307179586, -6.283185307179586)
-    t566 = t564 + t565
-    t567 = t564 - t565
-    t568 = casadi.if_else(casadi.logic_and((t564 >= -2.9670597283903604), (t564 <= 2.9670597283903604)), t564, casadi.if_else(casadi.logic_and((t566 >= -2.9670597283903604), (t566 <= 2.9670597283903604)), t566, casadi.if_else(casadi.logic_and((t567 >= -2.9670597283903604), (t567 <= 2.9670597283903604)), t567, t562)))
-    t569 = (t313 <= 1.5707963267948966)
-    t570 = casadi.logic_and((t312 >= -1.5707963267948966), (t312 <= 1.5707963267948966))
-    t571 = casadi.if_else(casadi.logic_and(t569, casadi.logic_not(t570)), t313, t312)
-    t572 = t571
-    t573 = t572 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn5 - 0.15915494309189535*t572)
-    t574 = casadi.if_else((qn5 > t573), 6.283185307179586, -6.283185307179586)
-    t575 = t573 + t574
-    t576 = t573 - t574
-    t577 = casadi.if_else(casadi.logic_and((t573 >= -1.5707963267948966), (t573 <= 1.5707963267948966)), t573, casadi.if_else(casadi.logic_and((t575 >= -1.5707963267948966), (t575 <= 1.5707963267948966)), t575, casadi.if_else(casadi.logic_and((t576 >= -1.5707963267948966), (t576 <= 1.5707963267948966)), t576, t571)))
-    t578 = (t317 <= 2.9670597283903604)
-    t579 = casadi.logic_and((t316 >= -2.9670597283903604), (t316 <= 2.9670597283903604))
-    t580 = casadi.if_else(casadi.logic_and(t578, casadi.logic_not(t579)), t317, t316)
-    t581 = t580
-    t582 = t581 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn6 - 0.15915494309189535*t581)
-    t583 = casadi.if_else((qn6 > t582), 6.283185307179586, -6.283185307179586)
-    t584 = t582 + t583
-    t585 = t582 - t583
-    t586 = casadi.if_else(casadi.logic_and((t582 >= -2.9670597283903604), (t582 <= 2.9670597283903604)), t582, casadi.if_else(casadi.logic_and((t584 >= -2.9670597283903604), (t584 <= 2.9670597283903604)), t584, casadi.if_else(casadi.logic_and((t585 >= -2.9670597283903604), (t585 <= 2.9670597283903604)), t585, t580)))
-    t587 = qw3*(qn3 + t19)**2
-    t588 = t387 + t587 + qw2*(t388 + t559)**2
-    t589 = t588 + qw4*(t383 + t568)**2 + qw5*(t384 + t577)**2 + qw6*(t385 + t586)**2
-    t590 = (t19 >= -1.27)
-    t591 = (t19 <= -0.30479999999999996)
-    t592 = casadi.logic_or(t551, t552)
-    t593 = casadi.if_else(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t18, t392), t396), t397), t590), t591), t592), (t202 >= -1e-12)), casadi.logic_or(t560, t561)), casadi.logic_or(t569, t570)), casadi.logic_or(t578, t579)), 1, 0)
-    t594 = (t593 > 0)
-    t595 = casadi.if_else(casadi.logic_and(t594, casadi.logic_or((t550 > t589), (t542 < 1))), 1, 0)
-    t596 = casadi.if_else(t594, 1, t542)
-    t597 = (t595 > 0)
-    t598 = casadi.if_else(t597, t346, t544)
-    t599 = casadi.if_else(t597, t559, t545)
-    t600 = casadi.if_else(t597, t568, t547)
-    t601 = casadi.if_else(t597, t577, t548)
-    t602 = casadi.if_else(t597, t586, t549)
-    t603 = casadi.if_else(t597, t589, t550)
-    t604 = -t19
-    t605 = casadi.if_else(t597, t604, t546)
-    t606 = (t310 <= 2.9670597283903604)
-    t607 = casadi.logic_and((t309 >= -2.9670597283903604), (t309 <= 2.9670597283903604))
-    t608 = casadi.if_else(casadi.logic_and(t606, casadi.logic_not(t607)), t310, t309)
-    t609 = t608
-    t610 = t609 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t609)
-    t611 = casadi.if_else((qn4 > t610), 6.283185307179586, -6.283185307179586)
-    t612 = t610 + t611
-    t613 = t610 - t611
-    t614 = casadi.if_else(casadi.logic_and((t610 >= -2.9670597283903604), (t610 <= 2.9670597283903604)), t610, casadi.if_else(casadi.logic_and((t612 >= -2.9670597283903604), (t612 <= 2.9670597283903604)), t612, casadi.if_else(casadi.logic_and((t613 >= -2.9670597283903604), (t613 <= 2.9670597283903604)), t613, t608)))
-    t615 = (t321 >= -1.5707963267948966)
-    t616 = casadi.logic_and((t314 >= -1.5707963267948966), (t314 <= 1.5707963267948966))
-    t617 = casadi.if_else(casadi.logic_and(t615, casadi.logic_not(t616)), -t321, t320)
-    t618 = t617
-    t619 = t618 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn5 - 0.15915494309189535*t618)
-    t620 = casadi.if_else((qn5 > t619), 6.283185307179586, -6.283185307179586)
-    t621 = t619 + t620
-    t622 = t619 - t620
-    t623 = casadi.if_else(casadi.logic_and((t619 >= -1.5707963267948966), (t619 <= 1.5707963267948966)), t619, casadi.if_else(casadi.logic_and((t621 >= -1.5707963267948966), (t621 <= 1.5707963267948966)), t621, casadi.if_else(casadi.logic_and((t622 >= -1.5707963267948966), (t622 <= 1.5707963267948966)), t622, t617)))
-    t624 = (t319 <= 2.9670597283903604)
-    t625 = casadi.logic_and((t318 >= -2.9670597283903604), (t318 <= 2.9670597283903604))
-    t626 = casadi.if_else(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t18, t203), t392), t396), t397), t590), t591), t592), casadi.logic_or(t606, t607)), casadi.logic_or(t615, t616)), casadi.logic_or(t624, t625)), 1, 0)
-    t627 = casadi.if_else(casadi.logic_and(t624, casadi.logic_not(t625)), t319, t318)
-    t628 = t627
-    t629 = t628 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn6 - 0.15915494309189535*t628)
-    t630 = casadi.if_else((qn6 > t629), 6.283185307179586, -6.283185307179586)
-    t631 = t629 + t630
-    t632 = t629 - t630
-    t633 = casadi.if_else(casadi.logic_and((t629 >= -2.9670597283903604), (t629 <= 2.9670597283903604)), t629, casadi.if_else(casadi.logic_and((t631 >= -2.9670597283903604), (t631 <= 2.9670597283903604)), t631, casadi.if_else(casadi.logic_and((t632 >= -2.9670597283903604), (t632 <= 2.9670597283903604)), t632, t627)))
-    t634 = t588 + qw4*(t383 + t614)**2 + qw5*(t384 + t623)**2 + qw6*(t385 + t633)**2
-    t635 = (t626 > 0)
-    t636 = casadi.if_else(casadi.logic_and(t635, casadi.logic_or((t603 > t634), (t596 < 1))), 1, 0)
-    t637 = casadi.if_else(t635, 1, t596)
-    t638 = (t636 > 0)
-    t639 = casadi.if_else(t638, t346, t598)
-    t640 = casadi.if_else(t638, t559, t599)
-    t641 = casadi.if_else(t638, t604, t605)
-    t642 = casadi.if_else(t638, t614, t600)
-    t643 = casadi.if_else(t638, t623, t601)
-    t644 = casadi.if_else(t638, t633, t602)
-    t645 = casadi.if_else(t638, t634, t603)
-    t646 = (t273 <= 2.9670597283903604)
-    t647 = casadi.logic_and((t272 >= -2.9670597283903604), (t272 <= 2.9670597283903604))
-    t648 = casadi.if_else(casadi.logic_and(t646, casadi.logic_not(t647)), t273, t272)
-    t649 = t648
-    t650 = t649 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*t649)
-    t651 = casadi.if_else((qn2 > t650), 6.283185307179586, -6.283185307179586)
-    t652 = t650 + t651
-    t653 = t650 - t651
-    t654 = casadi.if_else(casadi.logic_and((t650 >= -2.9670597283903604), (t650 <= 2.9670597283903604)), t650, casadi.if_else(casadi.logic_and((t652 >= -2.9670597283903604), (t652 <= 2.9670597283903604)), t652, casadi.if_else(casadi.logic_and((t653 >= -2.9670597283903604), (t653 <= 2.9670597283903604)), t653, t648)))
-    t655 = (t324 <= 2.9670597283903604)
-    t656 = casadi.logic_and((t323 >= -2.9670597283903604), (t323 <= 2.9670597283903604))
-    t657 = casadi.if_else(casadi.logic_and(t655, casadi.logic_not(t656)), t324, t323)
-    t658 = t657
-    t659 = t658 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t658)
-    t660 = casadi.if_else((qn4 > t659), 6.283185307179586, -6.283185307179586)
-    t661 = t659 + t660
-    t662 = t659 - t660
-    t663 = casadi.if_else(casadi.logic_and((t659 >= -2.9670597283903604), (t659 <= 2.9670597283903604)), t659, casadi.if_else(casadi.logic_and((t661 >= -2.9670597283903604), (t661 <= 2.9670597283903604)), t661, casadi.if_else(casadi.logic_and((t662 >= -2.9670597283903604), (t662 <= 2.9670597283903604)), t662, t657)))
-    t664 = (t329 <= 1.5707963267948966)
-    t665 = casadi.logic_and((t328 >= -1.5707963267948966), (t328 <= 1.5707963267948966))
-    t666 = casadi.if_else(casadi.logic_and(t664, casadi.logic_not(t665)), t329, t328)
-    t667 = t666
-    t668 = t667 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn5 - 0.15915494309189535*t667)
-    t669 = casadi.if_else((qn5 > t668), 6.283185307179586, -6.283185307179586)
-    t670 = t668 + t669
-    t671 = t668 - t669
-    t672 = casadi.if_else(casadi.logic_and((t668 >= -1.5707963267948966), (t668 <= 1.5707963267948966)), t668, casadi.if_else(casadi.logic_and((t670 >= -1.5707963267948966), (t670 <= 1.5707963267948966)), t670, casadi.if_else(casadi.logic_and((t671 >= -1.5707963267948966), (t671 <= 1.5707963267948966)), t671, t666)))
-    t673 = (t333 <= 2.9670597283903604)
-    t674 = casadi.logic_and((t332 >= -2.9670597283903604), (t332 <= 2.9670597283903604))
-    t675 = casadi.if_else(casadi.logic_and(t673, casadi.logic_not(t674)), t333, t332)
-    t676 = t675
-    t677 = t676 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn6 - 0.15915494309189535*t676)
-    t678 = casadi.if_else((qn6 > t677), 6.283185307179586, -6.283185307179586)
-    t679 = t677 + t678
-    t680 = t677 - t678
-    t681 = casadi.if_else(casadi.logic_and((t677 >= -2.9670597283903604), (t677 <= 2.9670597283903604)), t677, casadi.if_else(casadi.logic_and((t679 >= -2.9670597283903604), (t679 <= 2.9670597283903604)), t679, casadi.if_else(casadi.logic_and((t680 >= -2.9670597283903604), (t680 <= 2.9670597283903604)), t680, t675)))
-    t682 = t494 + t587 + qw2*(t388 + t654)**2
-    t683 = t682 + qw4*(t383 + t663)**2 + qw5*(t384 + t672)**2 + qw6*(t385 + t681)**2
-    t684 = casadi.logic_or(t646, t647)
-    t685 = casadi.if_else(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t18, t25), t392), t497), t590), t591), t684), (t235 >= -1e-12)), casadi.logic_or(t655, t656)), casadi.logic_or(t664, t665)), casadi.logic_or(t673, t674)), 1, 0)
-    t686 = (t685 > 0)
-    t687 = casadi.if_else(casadi.logic_and(t686, casadi.logic_or((t645 > t683), (t637 < 1))), 1, 0)
-    t688 = casadi.if_else(t686, 1, t637)
-    t689 = (t687 > 0)
-    t690 = casadi.if_else(t689, t457, t639)
-    t691 = casadi.if_else(t689, t654, t640)
-    t692 = casadi.if_else(t689, t604, t641)
-    t693 = casadi.if_else(t689, t663, t642)
-    t694 = casadi.if_else(t689, t672, t643)
-    t695 = casadi.if_else(t689, t681, t644)
-    t696 = casadi.if_else(t689, t683, t645)
-    t697 = (t326 <= 2.9670597283903604)
-    t698 = casadi.logic_and((t325 >= -2.9670597283903604), (t325 <= 2.9670597283903604))
-    t699 = casadi.if_else(casadi.logic_and(t697, casadi.logic_not(t698)), t326, t325)
-    t700 = t699
-    t701 = t700 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*t700)
-    t702 = casadi.if_else((qn4 > t701), 6.283185307179586, -6.283185307179586)
-    t703 = t701 + t702
-    t704 = t701 - t702
-    t705 = casadi.if_else(casadi.logic_and((t701 >= -2.9670597283903604), (t701 <= 2.9670597283903604)), t701, casadi.if_else(casadi.logic_and((t703 >= -2.9670597283903604), (t703 <= 2.9670597283903604)), t703, casadi.if_else(casadi.logic_and((t704 >= -2.9670597283903604), (t704 <= 2.9670597283903604)), t704, t699)))
-    t706 = (t337 >= -1.5707963267948966)
-    t707 = casadi.logic_and((t330 >= -1.5707963267948966), (t330 <= 1.5707963267948966))
-    t708 = casadi.if_else(casadi.logic_and(t706, casadi.logic_not(t707)), -t337, t336)
-    t709 = t708
-    t710 = t709 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn5 - 0.15915494309189535*t709)
-    t711 = casadi.if_else((qn5 > t710), 6.283185307179586, -6.283185307179586)
-    t712 = t710 + t711
-    t713 = t710 - t711
-    t714 = casadi.if_else(casadi.logic_and((t710 >= -1.5707963267948966), (t710 <= 1.5707963267948966)), t710, casadi.if_else(casadi.logic_and((t712 >= -1.5707963267948966), (t712 <= 1.5707963267948966)), t712, casadi.if_else(casadi.logic_and((t713 >= -1.5707963267948966), (t713 <= 1.5707963267948966)), t713, t708)))
-    t715 = (t335 <= 2.9670597283903604)
-    t716 = casadi.logic_and((t334 >= -2.9670597283903604), (t334 <= 2.9670597283903604))
-    t717 = casadi.if_else(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t18, t236), t25), t392), t497), t590), t591), t684), casadi.logic_or(t697, t698)), casadi.logic_or(t706, t707)), casadi.logic_or(t715, t716)), 1, 0)
-    t718 = casadi.if_else(casadi.logic_and(t715, casadi.logic_not(t716)), t335, t334)
-    t719 = t718
-    t720 = t719 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*qn6 - 0.15915494309189535*t719)
-    t721 = casadi.if_else((qn6 > t720), 6.283185307179586, -6.283185307179586)
-    t722 = t720 + t721
-    t723 = t720 - t721
-    t724 = casadi.if_else(casadi.logic_and((t720 >= -2.9670597283903604), (t720 <= 2.9670597283903604)), t720, casadi.if_else(casadi.logic_and((t722 >= -2.9670597283903604), (t722 <= 2.9670597283903604)), t722, casadi.if_else(casadi.logic_and((t723 >= -2.9670597283903604), (t723 <= 2.9670597283903604)), t723, t718)))
-    t725 = t682 + qw4*(t383 + t705)**2 + qw5*(t384 + t714)**2 + qw6*(t385 + t724)**2
-    t726 = (t717 > 0)
-    t727 = casadi.if_else(casadi.logic_and(t726, casadi.logic_or((t696 > t725), (t688 < 1))), 1, 0)
-    t728 = casadi.if_else(t726, 1, t688)
-    t729 = (t727 > 0)
-    t730 = casadi.if_else(t729, t457, t690)
-    t731 = casadi.if_else(t729, t654, t691)
-    t732 = casadi.if_else(t729, t604, t692)
-    t733 = casadi.if_else(t729, t705, t693)
-    t734 = casadi.if_else(t729, t714, t694)
-    t735 = casadi.if_else(t729, t724, t695)
-    t736 = (casadi.fabs(t268) < casadi.inf)
-    t737 = (t728 > 0)
-    t738 = casadi.logic_and(t736, t737)
+    qb0_0 = branches_q[0, 0]
+    qb0_1 = branches_q[0, 1]
+    qb0_2 = branches_q[0, 2]
+    qb0_3 = branches_q[0, 3]
+    qb0_4 = branches_q[0, 4]
+    qb0_5 = branches_q[0, 5]
+    qb1_0 = branches_q[1, 0]
+    qb1_1 = branches_q[1, 1]
+    qb1_2 = branches_q[1, 2]
+    qb1_3 = branches_q[1, 3]
+    qb1_4 = branches_q[1, 4]
+    qb1_5 = branches_q[1, 5]
+    qb2_0 = branches_q[2, 0]
+    qb2_1 = branches_q[2, 1]
+    qb2_2 = branches_q[2, 2]
+    qb2_3 = branches_q[2, 3]
+    qb2_4 = branches_q[2, 4]
+    qb2_5 = branches_q[2, 5]
+    qb3_0 = branches_q[3, 0]
+    qb3_1 = branches_q[3, 1]
+    qb3_2 = branches_q[3, 2]
+    qb3_3 = branches_q[3, 3]
+    qb3_4 = branches_q[3, 4]
+    qb3_5 = branches_q[3, 5]
+    qb4_0 = branches_q[4, 0]
+    qb4_1 = branches_q[4, 1]
+    qb4_2 = branches_q[4, 2]
+    qb4_3 = branches_q[4, 3]
+    qb4_4 = branches_q[4, 4]
+    qb4_5 = branches_q[4, 5]
+    qb5_0 = branches_q[5, 0]
+    qb5_1 = branches_q[5, 1]
+    qb5_2 = branches_q[5, 2]
+    qb5_3 = branches_q[5, 3]
+    qb5_4 = branches_q[5, 4]
+    qb5_5 = branches_q[5, 5]
+    qb6_0 = branches_q[6, 0]
+    qb6_1 = branches_q[6, 1]
+    qb6_2 = branches_q[6, 2]
+    qb6_3 = branches_q[6, 3]
+    qb6_4 = branches_q[6, 4]
+    qb6_5 = branches_q[6, 5]
+    qb7_0 = branches_q[7, 0]
+    qb7_1 = branches_q[7, 1]
+    qb7_2 = branches_q[7, 2]
+    qb7_3 = branches_q[7, 3]
+    qb7_4 = branches_q[7, 4]
+    qb7_5 = branches_q[7, 5]
+    vb0 = branches_valid[0]
+    vb1 = branches_valid[1]
+    vb2 = branches_valid[2]
+    vb3 = branches_valid[3]
+    vb4 = branches_valid[4]
+    vb5 = branches_valid[5]
+    vb6 = branches_valid[6]
+    vb7 = branches_valid[7]
+    lb0 = branches_in_limits[0]
+    lb1 = branches_in_limits[1]
+    lb2 = branches_in_limits[2]
+    lb3 = branches_in_limits[3]
+    lb4 = branches_in_limits[4]
+    lb5 = branches_in_limits[5]
+    lb6 = branches_in_limits[6]
+    lb7 = branches_in_limits[7]
+    t0 = qb0_0 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn1 - qb0_0))
+    t1 = qb0_1 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn2 - qb0_1))
+    t2 = qb0_3 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn4 - qb0_3))
+    t3 = qb0_4 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn5 - qb0_4))
+    t4 = qb0_5 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn6 - qb0_5))
+    t5 = casadi.if_else(casadi.logic_and(lb0, vb0), 1, 0)
+    t6 = casadi.if_else((t5 > 0), 1, 0)
+    t7 = qb1_0 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn1 - qb1_0))
+    t8 = qb1_1 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn2 - qb1_1))
+    t9 = qb1_3 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn4 - qb1_3))
+    t10 = qb1_4 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn5 - qb1_4))
+    t11 = qb1_5 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn6 - qb1_5))
+    t12 = casadi.if_else(casadi.logic_and(lb1, vb1), 1, 0)
+    t13 = qb2_0 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn1 - qb2_0))
+    t14 = qb2_1 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn2 - qb2_1))
+    t15 = qb2_3 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn4 - qb2_3))
+    t16 = qb2_4 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn5 - qb2_4))
+    t17 = qb2_5 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn6 - qb2_5))
+    t18 = casadi.if_else(casadi.logic_and(lb2, vb2), 1, 0)
+    t19 = qb3_0 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn1 - qb3_0))
+    t20 = qb3_1 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn2 - qb3_1))
+    t21 = qb3_3 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn4 - qb3_3))
+    t22 = qb3_4 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn5 - qb3_4))
+    t23 = qb3_5 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn6 - qb3_5))
+    t24 = casadi.if_else(casadi.logic_and(lb3, vb3), 1, 0)
+    t25 = qb4_0 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn1 - qb4_0))
+    t26 = qb4_1 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn2 - qb4_1))
+    t27 = qb4_3 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn4 - qb4_3))
+    t28 = qb4_4 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn5 - qb4_4))
+    t29 = qb4_5 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn6 - qb4_5))
+    t30 = casadi.if_else(casadi.logic_and(lb4, vb4), 1, 0)
+    t31 = qb5_0 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn1 - qb5_0))
+    t32 = qb5_1 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn2 - qb5_1))
+    t33 = qb5_3 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn4 - qb5_3))
+    t34 = qb5_4 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn5 - qb5_4))
+    t35 = qb5_5 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn6 - qb5_5))
+    t36 = casadi.if_else(casadi.logic_and(lb5, vb5), 1, 0)
+    t37 = qb6_0 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn1 - qb6_0))
+    t38 = qb6_1 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn2 - qb6_1))
+    t39 = qb6_3 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn4 - qb6_3))
+    t40 = qb6_4 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn5 - qb6_4))
+    t41 = qb6_5 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn6 - qb6_5))
+    t42 = casadi.if_else(casadi.logic_and(lb6, vb6), 1, 0)
+    t43 = qb7_0 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn1 - qb7_0))
+    t44 = qb7_1 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn2 - qb7_1))
+    t45 = qb7_3 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn4 - qb7_3))
+    t46 = qb7_4 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn5 - qb7_4))
+    t47 = qb7_5 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn6 - qb7_5))
+    t48 = casadi.if_else(casadi.logic_and(lb7, vb7), 1, 0)
+    t49 = T00 + T01 + T02 + T03 + T10 + T11 + T12 + T13 + T20 + T21 + T22 + T23 + qn1 + qn2 + qn3 + qn4 + qn5 + qn6 + qw1 + qw2 + qw3 + qw4 + qw5 + qw6
+    t50 = casadi.if_else((qn1 > t0), 6.283185307179586, -6.283185307179586)
+    t51 = t0 + t50
+    t52 = t0 - t50
+    t53 = casadi.if_else(casadi.logic_and((t0 >= -2.9670597283903604), (t0 <= 2.9670597283903604)), t0, casadi.if_else(casadi.logic_and((t51 >= -2.9670597283903604), (t51 <= 2.9670597283903604)), t51, casadi.if_else(casadi.logic_and((t52 >= -2.9670597283903604), (t52 <= 2.9670597283903604)), t52, qb0_0)))
+    t54 = casadi.if_else((qn2 > t1), 6.283185307179586, -6.283185307179586)
+    t55 = t1 + t54
+    t56 = t1 - t54
+    t57 = casadi.if_else(casadi.logic_and((t1 >= -2.9670597283903604), (t1 <= 2.9670597283903604)), t1, casadi.if_else(casadi.logic_and((t55 >= -2.9670597283903604), (t55 <= 2.9670597283903604)), t55, casadi.if_else(casadi.logic_and((t56 >= -2.9670597283903604), (t56 <= 2.9670597283903604)), t56, qb0_1)))
+    t58 = casadi.if_else((qn4 > t2), 6.283185307179586, -6.283185307179586)
+    t59 = t2 + t58
+    t60 = t2 - t58
+    t61 = casadi.if_else(casadi.logic_and((t2 >= -2.9670597283903604), (t2 <= 2.9670597283903604)), t2, casadi.if_else(casadi.logic_and((t59 >= -2.9670597283903604), (t59 <= 2.9670597283903604)), t59, casadi.if_else(casadi.logic_and((t60 >= -2.9670597283903604), (t60 <= 2.9670597283903604)), t60, qb0_3)))
+    t62 = casadi.if_else((qn5 > t3), 6.283185307179586, -6.283185307179586)
+    t63 = t3 + t62
+    t64 = t3 - t62
+    t65 = casadi.if_else(casadi.logic_and((t3 >= -1.5707963267948966), (t3 <= 1.5707963267948966)), t3, casadi.if_else(casadi.logic_and((t63 >= -1.5707963267948966), (t63 <= 1.5707963267948966)), t63, casadi.if_else(casadi.logic_and((t64 >= -1.5707963267948966), (t64 <= 1.5707963267948966)), t64, qb0_4)))
+    t66 = casadi.if_else((qn6 > t4), 6.283185307179586, -6.283185307179586)
+    t67 = t4 + t66
+    t68 = t4 - t66
+    t69 = casadi.if_else(casadi.logic_and((t4 >= -2.9670597283903604), (t4 <= 2.9670597283903604)), t4, casadi.if_else(casadi.logic_and((t67 >= -2.9670597283903604), (t67 <= 2.9670597283903604)), t67, casadi.if_else(casadi.logic_and((t68 >= -2.9670597283903604), (t68 <= 2.9670597283903604)), t68, qb0_5)))
+    t70 = -qn1
+    t71 = -qn2
+    t72 = -qn3
+    t73 = -qn4
+    t74 = -qn5
+    t75 = -qn6
+    t76 = qw1*(t53 + t70)**2 + qw2*(t57 + t71)**2 + qw3*(qb0_2 + t72)**2 + qw4*(t61 + t73)**2 + qw5*(t65 + t74)**2 + qw6*(t69 + t75)**2
+    t77 = (t6 > 0)
+    t78 = casadi.if_else(t77, t53, qn1)
+    t79 = casadi.if_else(t77, t57, qn2)
+    t80 = casadi.if_else(t77, qb0_2, qn3)
+    t81 = casadi.if_else(t77, t61, qn4)
+    t82 = casadi.if_else(t77, t65, qn5)
+    t83 = casadi.if_else(t77, t69, qn6)
+    t84 = casadi.if_else(t77, t76, 0)
+    t85 = casadi.if_else((qn1 > t7), 6.283185307179586, -6.283185307179586)
+    t86 = t7 + t85
+    t87 = t7 - t85
+    t88 = casadi.if_else(casadi.logic_and((t7 >= -2.9670597283903604), (t7 <= 2.9670597283903604)), t7, casadi.if_else(casadi.logic_and((t86 >= -2.9670597283903604), (t86 <= 2.9670597283903604)), t86, casadi.if_else(casadi.logic_and((t87 >= -2.9670597283903604), (t87 <= 2.9670597283903604)), t87, qb1_0)))
+    t89 = casadi.if_else((qn2 > t8), 6.283185307179586, -6.283185307179586)
+    t90 = t8 + t89
+    t91 = t8 - t89
+    t92 = casadi.if_else(casadi.logic_and((t8 >= -2.9670597283903604), (t8 <= 2.9670597283903604)), t8, casadi.if_else(casadi.logic_and((t90 >= -2.9670597283903604), (t90 <= 2.9670597283903604)), t90, casadi.if_else(casadi.logic_and((t91 >= -2.9670597283903604), (t91 <= 2.9670597283903604)), t91, qb1_1)))
+    t93 = casadi.if_else((qn4 > t9), 6.283185307179586, -6.283185307179586)
+    t94 = t9 + t93
+    t95 = t9 - t93
+    t96 = casadi.if_else(casadi.logic_and((t9 >= -2.9670597283903604), (t9 <= 2.9670597283903604)), t9, casadi.if_else(casadi.logic_and((t94 >= -2.9670597283903604), (t94 <= 2.9670597283903604)), t94, casadi.if_else(casadi.logic_and((t95 >= -2.9670597283903604), (t95 <= 2.9670597283903604)), t95, qb1_3)))
+    t97 = casadi.if_else((qn5 > t10), 6.283185307179586, -6.283185307179586)
+    t98 = t10 + t97
+    t99 = t10 - t97
+    t100 = casadi.if_else(casadi.logic_and((t10 >= -1.5707963267948966), (t10 <= 1.5707963267948966)), t10, casadi.if_else(casadi.logic_and((t98 >= -1.5707963267948966), (t98 <= 1.5707963267948966)), t98, casadi.if_else(casadi.logic_and((t99 >= -1.5707963267948966), (t99 <= 1.5707963267948966)), t99, qb1_4)))
+    t101 = casadi.if_else((qn6 > t11), 6.283185307179586, -6.283185307179586)
+    t102 = t101 + t11
+    t103 = t11 - t101
+    t104 = casadi.if_else(casadi.logic_and((t11 >= -2.9670597283903604), (t11 <= 2.9670597283903604)), t11, casadi.if_else(casadi.logic_and((t102 >= -2.9670597283903604), (t102 <= 2.9670597283903604)), t102, casadi.if_else(casadi.logic_and((t103 >= -2.9670597283903604), (t103 <= 2.9670597283903604)), t103, qb1_5)))
+    t105 = qw1*(t70 + t88)**2 + qw2*(t71 + t92)**2 + qw3*(qb1_2 + t72)**2 + qw4*(t73 + t96)**2 + qw5*(t100 + t74)**2 + qw6*(t104 + t75)**2
+    t106 = (t12 > 0)
+    t107 = casadi.if_else(casadi.logic_and(t106, casadi.logic_or((t105 < t84), (t6 < 1))), 1, 0)
+    t108 = casadi.if_else(t106, 1, t6)
+    t109 = (t107 > 0)
+    t110 = casadi.if_else(t109, t88, t78)
+    t111 = casadi.if_else(t109, t92, t79)
+    t112 = casadi.if_else(t109, qb1_2, t80)
+    t113 = casadi.if_else(t109, t96, t81)
+    t114 = casadi.if_else(t109, t100, t82)
+    t115 = casadi.if_else(t109, t104, t83)
+    t116 = casadi.if_else(t109, t105, t84)
+    t117 = casadi.if_else((qn1 > t13), 6.283185307179586, -6.283185307179586)
+    t118 = t117 + t13
+    t119 = t13 - t117
+    t120 = casadi.if_else(casadi.logic_and((t13 >= -2.9670597283903604), (t13 <= 2.9670597283903604)), t13, casadi.if_else(casadi.logic_and((t118 >= -2.9670597283903604), (t118 <= 2.9670597283903604)), t118, casadi.if_else(casadi.logic_and((t119 >= -2.9670597283903604), (t119 <= 2.9670597283903604)), t119, qb2_0)))
+    t121 = casadi.if_else((qn2 > t14), 6.283185307179586, -6.283185307179586)
+    t122 = t121 + t14
+    t123 = t14 - t121
+    t124 = casadi.if_else(casadi.logic_and((t14 >= -2.9670597283903604), (t14 <= 2.9670597283903604)), t14, casadi.if_else(casadi.logic_and((t122 >= -2.9670597283903604), (t122 <= 2.9670597283903604)), t122, casadi.if_else(casadi.logic_and((t123 >= -2.9670597283903604), (t123 <= 2.9670597283903604)), t123, qb2_1)))
+    t125 = casadi.if_else((qn4 > t15), 6.283185307179586, -6.283185307179586)
+    t126 = t125 + t15
+    t127 = t15 - t125
+    t128 = casadi.if_else(casadi.logic_and((t15 >= -2.9670597283903604), (t15 <= 2.9670597283903604)), t15, casadi.if_else(casadi.logic_and((t126 >= -2.9670597283903604), (t126 <= 2.9670597283903604)), t126, casadi.if_else(casadi.logic_and((t127 >= -2.9670597283903604), (t127 <= 2.9670597283903604)), t127, qb2_3)))
+    t129 = casadi.if_else((qn5 > t16), 6.283185307179586, -6.283185307179586)
+    t130 = t129 + t16
+    t131 = t16 - t129
+    t132 = casadi.if_else(casadi.logic_and((t16 >= -1.5707963267948966), (t16 <= 1.5707963267948966)), t16, casadi.if_else(casadi.logic_and((t130 >= -1.5707963267948966), (t130 <= 1.5707963267948966)), t130, casadi.if_else(casadi.logic_and((t131 >= -1.5707963267948966), (t131 <= 1.5707963267948966)), t131, qb2_4)))
+    t133 = casadi.if_else((qn6 > t17), 6.283185307179586, -6.283185307179586)
+    t134 = t133 + t17
+    t135 = t17 - t133
+    t136 = casadi.if_else(casadi.logic_and((t17 >= -2.9670597283903604), (t17 <= 2.9670597283903604)), t17, casadi.if_else(casadi.logic_and((t134 >= -2.9670597283903604), (t134 <= 2.9670597283903604)), t134, casadi.if_else(casadi.logic_and((t135 >= -2.9670597283903604), (t135 <= 2.9670597283903604)), t135, qb2_5)))
+    t137 = qw1*(t120 + t70)**2 + qw2*(t124 + t71)**2 + qw3*(qb2_2 + t72)**2 + qw4*(t128 + t73)**2 + qw5*(t132 + t74)**2 + qw6*(t136 + t75)**2
+    t138 = (t18 > 0)
+    t139 = casadi.if_else(casadi.logic_and(t138, casadi.logic_or((t116 > t137), (t108 < 1))), 1, 0)
+    t140 = casadi.if_else(t138, 1, t108)
+    t141 = (t139 > 0)
+    t142 = casadi.if_else(t141, t120, t110)
+    t143 = casadi.if_else(t141, t124, t111)
+    t144 = casadi.if_else(t141, qb2_2, t112)
+    t145 = casadi.if_else(t141, t128, t113)
+    t146 = casadi.if_else(t141, t132, t114)
+    t147 = casadi.if_else(t141, t136, t115)
+    t148 = casadi.if_else(t141, t137, t116)
+    t149 = casadi.if_else((qn1 > t19), 6.283185307179586, -6.283185307179586)
+    t150 = t149 + t19
+    t151 = t19 - t149
+    t152 = casadi.if_else(casadi.logic_and((t19 >= -2.9670597283903604), (t19 <= 2.9670597283903604)), t19, casadi.if_else(casadi.logic_and((t150 >= -2.9670597283903604), (t150 <= 2.9670597283903604)), t150, casadi.if_else(casadi.logic_and((t151 >= -2.9670597283903604), (t151 <= 2.9670597283903604)), t151, qb3_0)))
+    t153 = casadi.if_else((qn2 > t20), 6.283185307179586, -6.283185307179586)
+    t154 = t153 + t20
+    t155 = t20 - t153
+    t156 = casadi.if_else(casadi.logic_and((t20 >= -2.9670597283903604), (t20 <= 2.9670597283903604)), t20, casadi.if_else(casadi.logic_and((t154 >= -2.9670597283903604), (t154 <= 2.9670597283903604)), t154, casadi.if_else(casadi.logic_and((t155 >= -2.9670597283903604), (t155 <= 2.9670597283903604)), t155, qb3_1)))
+    t157 = casadi.if_else((qn4 > t21), 6.283185307179586, -6.283185307179586)
+    t158 = t157 + t21
+    t159 = t21 - t157
+    t160 = casadi.if_else(casadi.logic_and((t21 >= -2.9670597283903604), (t21 <= 2.9670597283903604)), t21, casadi.if_else(casadi.logic_and((t158 >= -2.9670597283903604), (t158 <= 2.9670597283903604)), t158, casadi.if_else(casadi.logic_and((t159 >= -2.9670597283903604), (t159 <= 2.9670597283903604)), t159, qb3_3)))
+    t161 = casadi.if_else((qn5 > t22), 6.283185307179586, -6.283185307179586)
+    t162 = t161 + t22
+    t163 = t22 - t161
+    t164 = casadi.if_else(casadi.logic_and((t22 >= -1.5707963267948966), (t22 <= 1.5707963267948966)), t22, casadi.if_else(casadi.logic_and((t162 >= -1.5707963267948966), (t162 <= 1.5707963267948966)), t162, casadi.if_else(casadi.logic_and((t163 >= -1.5707963267948966), (t163 <= 1.5707963267948966)), t163, qb3_4)))
+    t165 = casadi.if_else((qn6 > t23), 6.283185307179586, -6.283185307179586)
+    t166 = t165 + t23
+    t167 = t23 - t165
+    t168 = casadi.if_else(casadi.logic_and((t23 >= -2.9670597283903604), (t23 <= 2.9670597283903604)), t23, casadi.if_else(casadi.logic_and((t166 >= -2.9670597283903604), (t166 <= 2.9670597283903604)), t166, casadi.if_else(casadi.logic_and((t167 >= -2.9670597283903604), (t167 <= 2.9670597283903604)), t167, qb3_5)))
+    t169 = qw1*(t152 + t70)**2 + qw2*(t156 + t71)**2 + qw3*(qb3_2 + t72)**2 + qw4*(t160 + t73)**2 + qw5*(t164 + t74)**2 + qw6*(t168 + t75)**2
+    t170 = (t24 > 0)
+    t171 = casadi.if_else(casadi.logic_and(t170, casadi.logic_or((t148 > t169), (t140 < 1))), 1, 0)
+    t172 = casadi.if_else(t170, 1, t140)
+    t173 = (t171 > 0)
+    t174 = casadi.if_else(t173, t152, t142)
+    t175 = casadi.if_else(t173, t156, t143)
+    t176 = casadi.if_else(t173, qb3_2, t144)
+    t177 = casadi.if_else(t173, t160, t145)
+    t178 = casadi.if_else(t173, t164, t146)
+    t179 = casadi.if_else(t173, t168, t147)
+    t180 = casadi.if_else(t173, t169, t148)
+    t181 = casadi.if_else((qn1 > t25), 6.283185307179586, -6.283185307179586)
+    t182 = t181 + t25
+    t183 = t25 - t181
+    t184 = casadi.if_else(casadi.logic_and((t25 >= -2.9670597283903604), (t25 <= 2.9670597283903604)), t25, casadi.if_else(casadi.logic_and((t182 >= -2.9670597283903604), (t182 <= 2.9670597283903604)), t182, casadi.if_else(casadi.logic_and((t183 >= -2.9670597283903604), (t183 <= 2.9670597283903604)), t183, qb4_0)))
+    t185 = casadi.if_else((qn2 > t26), 6.283185307179586, -6.283185307179586)
+    t186 = t185 + t26
+    t187 = t26 - t185
+    t188 = casadi.if_else(casadi.logic_and((t26 >= -2.9670597283903604), (t26 <= 2.9670597283903604)), t26, casadi.if_else(casadi.logic_and((t186 >= -2.9670597283903604), (t186 <= 2.9670597283903604)), t186, casadi.if_else(casadi.logic_and((t187 >= -2.9670597283903604), (t187 <= 2.9670597283903604)), t187, qb4_1)))
+    t189 = casadi.if_else((qn4 > t27), 6.283185307179586, -6.283185307179586)
+    t190 = t189 + t27
+    t191 = t27 - t189
+    t192 = casadi.if_else(casadi.logic_and((t27 >= -2.9670597283903604), (t27 <= 2.9670597283903604)), t27, casadi.if_else(casadi.logic_and((t190 >= -2.9670597283903604), (t190 <= 2.9670597283903604)), t190, casadi.if_else(casadi.logic_and((t191 >= -2.9670597283903604), (t191 <= 2.9670597283903604)), t191, qb4_3)))
+    t193 = casadi.if_else((qn5 > t28), 6.283185307179586, -6.283185307179586)
+    t194 = t193 + t28
+    t195 = t28 - t193
+    t196 = casadi.if_else(casadi.logic_and((t28 >= -1.5707963267948966), (t28 <= 1.5707963267948966)), t28, casadi.if_else(casadi.logic_and((t194 >= -1.5707963267948966), (t194 <= 1.5707963267948966)), t194, casadi.if_else(casadi.logic_and((t195 >= -1.5707963267948966), (t195 <= 1.5707963267948966)), t195, qb4_4)))
+    t197 = casadi.if_else((qn6 > t29), 6.283185307179586, -6.283185307179586)
+    t198 = t197 + t29
+    t199 = t29 - t197
+    t200 = casadi.if_else(casadi.logic_and((t29 >= -2.9670597283903604), (t29 <= 2.9670597283903604)), t29, casadi.if_else(casadi.logic_and((t198 >= -2.9670597283903604), (t198 <= 2.9670597283903604)), t198, casadi.if_else(casadi.logic_and((t199 >= -2.9670597283903604), (t199 <= 2.9670597283903604)), t199, qb4_5)))
+    t201 = qw1*(t184 + t70)**2 + qw2*(t188 + t71)**2 + qw3*(qb4_2 + t72)**2 + qw4*(t192 + t73)**2 + qw5*(t196 + t74)**2 + qw6*(t200 + t75)**2
+    t202 = (t30 > 0)
+    t203 = casadi.if_else(casadi.logic_and(t202, casadi.logic_or((t180 > t201), (t172 < 1))), 1, 0)
+    t204 = casadi.if_else(t202, 1, t172)
+    t205 = (t203 > 0)
+    t206 = casadi.if_else(t205, t184, t174)
+    t207 = casadi.if_else(t205, t188, t175)
+    t208 = casadi.if_else(t205, qb4_2, t176)
+    t209 = casadi.if_else(t205, t192, t177)
+    t210 = casadi.if_else(t205, t196, t178)
+    t211 = casadi.if_else(t205, t200, t179)
+    t212 = casadi.if_else(t205, t201, t180)
+    t213 = casadi.if_else((qn1 > t31), 6.283185307179586, -6.283185307179586)
+    t214 = t213 + t31
+    t215 = t31 - t213
+    t216 = casadi.if_else(casadi.logic_and((t31 >= -2.9670597283903604), (t31 <= 2.9670597283903604)), t31, casadi.if_else(casadi.logic_and((t214 >= -2.9670597283903604), (t214 <= 2.9670597283903604)), t214, casadi.if_else(casadi.logic_and((t215 >= -2.9670597283903604), (t215 <= 2.9670597283903604)), t215, qb5_0)))
+    t217 = casadi.if_else((qn2 > t32), 6.283185307179586, -6.283185307179586)
+    t218 = t217 + t32
+    t219 = t32 - t217
+    t220 = casadi.if_else(casadi.logic_and((t32 >= -2.9670597283903604), (t32 <= 2.9670597283903604)), t32, casadi.if_else(casadi.logic_and((t218 >= -2.9670597283903604), (t218 <= 2.9670597283903604)), t218, casadi.if_else(casadi.logic_and((t219 >= -2.9670597283903604), (t219 <= 2.9670597283903604)), t219, qb5_1)))
+    t221 = casadi.if_else((qn4 > t33), 6.283185307179586, -6.283185307179586)
+    t222 = t221 + t33
+    t223 = t33 - t221
+    t224 = casadi.if_else(casadi.logic_and((t33 >= -2.9670597283903604), (t33 <= 2.9670597283903604)), t33, casadi.if_else(casadi.logic_and((t222 >= -2.9670597283903604), (t222 <= 2.9670597283903604)), t222, casadi.if_else(casadi.logic_and((t223 >= -2.9670597283903604), (t223 <= 2.9670597283903604)), t223, qb5_3)))
+    t225 = casadi.if_else((qn5 > t34), 6.283185307179586, -6.283185307179586)
+    t226 = t225 + t34
+    t227 = t34 - t225
+    t228 = casadi.if_else(casadi.logic_and((t34 >= -1.5707963267948966), (t34 <= 1.5707963267948966)), t34, casadi.if_else(casadi.logic_and((t226 >= -1.5707963267948966), (t226 <= 1.5707963267948966)), t226, casadi.if_else(casadi.logic_and((t227 >= -1.5707963267948966), (t227 <= 1.5707963267948966)), t227, qb5_4)))
+    t229 = casadi.if_else((qn6 > t35), 6.283185307179586, -6.283185307179586)
+    t230 = t229 + t35
+    t231 = t35 - t229
+    t232 = casadi.if_else(casadi.logic_and((t35 >= -2.9670597283903604), (t35 <= 2.9670597283903604)), t35, casadi.if_else(casadi.logic_and((t230 >= -2.9670597283903604), (t230 <= 2.9670597283903604)), t230, casadi.if_else(casadi.logic_and((t231 >= -2.9670597283903604), (t231 <= 2.9670597283903604)), t231, qb5_5)))
+    t233 = qw1*(t216 + t70)**2 + qw2*(t220 + t71)**2 + qw3*(qb5_2 + t72)**2 + qw4*(t224 + t73)**2 + qw5*(t228 + t74)**2 + qw6*(t232 + t75)**2
+    t234 = (t36 > 0)
+    t235 = casadi.if_else(casadi.logic_and(t234, casadi.logic_or((t212 > t233), (t204 < 1))), 1, 0)
+    t236 = casadi.if_else(t234, 1, t204)
+    t237 = (t235 > 0)
+    t238 = casadi.if_else(t237, t216, t206)
+    t239 = casadi.if_else(t237, t220, t207)
+    t240 = casadi.if_else(t237, qb5_2, t208)
+    t241 = casadi.if_else(t237, t224, t209)
+    t242 = casadi.if_else(t237, t228, t210)
+    t243 = casadi.if_else(t237, t232, t211)
+    t244 = casadi.if_else(t237, t233, t212)
+    t245 = casadi.if_else((qn1 > t37), 6.283185307179586, -6.283185307179586)
+    t246 = t245 + t37
+    t247 = t37 - t245
+    t248 = casadi.if_else(casadi.logic_and((t37 >= -2.9670597283903604), (t37 <= 2.9670597283903604)), t37, casadi.if_else(casadi.logic_and((t246 >= -2.9670597283903604), (t246 <= 2.9670597283903604)), t246, casadi.if_else(casadi.logic_and((t247 >= -2.9670597283903604), (t247 <= 2.9670597283903604)), t247, qb6_0)))
+    t249 = casadi.if_else((qn2 > t38), 6.283185307179586, -6.283185307179586)
+    t250 = t249 + t38
+    t251 = t38 - t249
+    t252 = casadi.if_else(casadi.logic_and((t38 >= -2.9670597283903604), (t38 <= 2.9670597283903604)), t38, casadi.if_else(casadi.logic_and((t250 >= -2.9670597283903604), (t250 <= 2.9670597283903604)), t250, casadi.if_else(casadi.logic_and((t251 >= -2.9670597283903604), (t251 <= 2.9670597283903604)), t251, qb6_1)))
+    t253 = casadi.if_else((qn4 > t39), 6.283185307179586, -6.283185307179586)
+    t254 = t253 + t39
+    t255 = t39 - t253
+    t256 = casadi.if_else(casadi.logic_and((t39 >= -2.9670597283903604), (t39 <= 2.9670597283903604)), t39, casadi.if_else(casadi.logic_and((t254 >= -2.9670597283903604), (t254 <= 2.9670597283903604)), t254, casadi.if_else(casadi.logic_and((t255 >= -2.9670597283903604), (t255 <= 2.9670597283903604)), t255, qb6_3)))
+    t257 = casadi.if_else((qn5 > t40), 6.283185307179586, -6.283185307179586)
+    t258 = t257 + t40
+    t259 = t40 - t257
+    t260 = casadi.if_else(casadi.logic_and((t40 >= -1.5707963267948966), (t40 <= 1.5707963267948966)), t40, casadi.if_else(casadi.logic_and((t258 >= -1.5707963267948966), (t258 <= 1.5707963267948966)), t258, casadi.if_else(casadi.logic_and((t259 >= -1.5707963267948966), (t259 <= 1.5707963267948966)), t259, qb6_4)))
+    t261 = casadi.if_else((qn6 > t41), 6.283185307179586, -6.283185307179586)
+    t262 = t261 + t41
+    t263 = t41 - t261
+    t264 = casadi.if_else(casadi.logic_and((t41 >= -2.9670597283903604), (t41 <= 2.9670597283903604)), t41, casadi.if_else(casadi.logic_and((t262 >= -2.9670597283903604), (t262 <= 2.9670597283903604)), t262, casadi.if_else(casadi.logic_and((t263 >= -2.9670597283903604), (t263 <= 2.9670597283903604)), t263, qb6_5)))
+    t265 = qw1*(t248 + t70)**2 + qw2*(t252 + t71)**2 + qw3*(qb6_2 + t72)**2 + qw4*(t256 + t73)**2 + qw5*(t260 + t74)**2 + qw6*(t264 + t75)**2
+    t266 = (t42 > 0)
+    t267 = casadi.if_else(casadi.logic_and(t266, casadi.logic_or((t244 > t265), (t236 < 1))), 1, 0)
+    t268 = casadi.if_else(t266, 1, t236)
+    t269 = (t267 > 0)
+    t270 = casadi.if_else(t269, t248, t238)
+    t271 = casadi.if_else(t269, t252, t239)
+    t272 = casadi.if_else(t269, qb6_2, t240)
+    t273 = casadi.if_else(t269, t256, t241)
+    t274 = casadi.if_else(t269, t260, t242)
+    t275 = casadi.if_else(t269, t264, t243)
+    t276 = casadi.if_else(t269, t265, t244)
+    t277 = casadi.if_else((qn1 > t43), 6.283185307179586, -6.283185307179586)
+    t278 = t277 + t43
+    t279 = t43 - t277
+    t280 = casadi.if_else(casadi.logic_and((t43 >= -2.9670597283903604), (t43 <= 2.9670597283903604)), t43, casadi.if_else(casadi.logic_and((t278 >= -2.9670597283903604), (t278 <= 2.9670597283903604)), t278, casadi.if_else(casadi.logic_and((t279 >= -2.9670597283903604), (t279 <= 2.9670597283903604)), t279, qb7_0)))
+    t281 = casadi.if_else((qn2 > t44), 6.283185307179586, -6.283185307179586)
+    t282 = t281 + t44
+    t283 = t44 - t281
+    t284 = casadi.if_else(casadi.logic_and((t44 >= -2.9670597283903604), (t44 <= 2.9670597283903604)), t44, casadi.if_else(casadi.logic_and((t282 >= -2.9670597283903604), (t282 <= 2.9670597283903604)), t282, casadi.if_else(casadi.logic_and((t283 >= -2.9670597283903604), (t283 <= 2.9670597283903604)), t283, qb7_1)))
+    t285 = casadi.if_else((qn4 > t45), 6.283185307179586, -6.283185307179586)
+    t286 = t285 + t45
+    t287 = t45 - t285
+    t288 = casadi.if_else(casadi.logic_and((t45 >= -2.9670597283903604), (t45 <= 2.9670597283903604)), t45, casadi.if_else(casadi.logic_and((t286 >= -2.9670597283903604), (t286 <= 2.9670597283903604)), t286, casadi.if_else(casadi.logic_and((t287 >= -2.9670597283903604), (t287 <= 2.9670597283903604)), t287, qb7_3)))
+    t289 = casadi.if_else((qn5 > t46), 6.283185307179586, -6.283185307179586)
+    t290 = t289 + t46
+    t291 = t46 - t289
+    t292 = casadi.if_else(casadi.logic_and((t46 >= -1.5707963267948966), (t46 <= 1.5707963267948966)), t46, casadi.if_else(casadi.logic_and((t290 >= -1.5707963267948966), (t290 <= 1.5707963267948966)), t290, casadi.if_else(casadi.logic_and((t291 >= -1.5707963267948966), (t291 <= 1.5707963267948966)), t291, qb7_4)))
+    t293 = casadi.if_else((qn6 > t47), 6.283185307179586, -6.283185307179586)
+    t294 = t293 + t47
+    t295 = t47 - t293
+    t296 = casadi.if_else(casadi.logic_and((t47 >= -2.9670597283903604), (t47 <= 2.9670597283903604)), t47, casadi.if_else(casadi.logic_and((t294 >= -2.9670597283903604), (t294 <= 2.9670597283903604)), t294, casadi.if_else(casadi.logic_and((t295 >= -2.9670597283903604), (t295 <= 2.9670597283903604)), t295, qb7_5)))
+    t297 = qw1*(t280 + t70)**2 + qw2*(t284 + t71)**2 + qw3*(qb7_2 + t72)**2 + qw4*(t288 + t73)**2 + qw5*(t292 + t74)**2 + qw6*(t296 + t75)**2
+    t298 = (t48 > 0)
+    t299 = casadi.if_else(casadi.logic_and(t298, casadi.logic_or((t276 > t297), (t268 < 1))), 1, 0)
+    t300 = casadi.if_else(t298, 1, t268)
+    t301 = (t299 > 0)
+    t302 = casadi.if_else(t301, t280, t270)
+    t303 = casadi.if_else(t301, t284, t271)
+    t304 = casadi.if_else(t301, qb7_2, t272)
+    t305 = casadi.if_else(t301, t288, t273)
+    t306 = casadi.if_else(t301, t292, t274)
+    t307 = casadi.if_else(t301, t296, t275)
+    t308 = (casadi.fabs(t49) < casadi.inf)
+    t309 = (t300 > 0)
+    t310 = casadi.logic_and(t308, t309)
     q = casadi.SX(6, 1)
-    q[0, 0] = casadi.if_else(t738, t730, qn1)
-    q[1, 0] = casadi.if_else(t738, t731, qn2)
-    q[2, 0] = casadi.if_else(t738, t732, qn3)
-    q[3, 0] = casadi.if_else(t738, t733, qn4)
-    q[4, 0] = casadi.if_else(t738, t734, qn5)
-    q[5, 0] = casadi.if_else(t738, t735, qn6)
+    q[0, 0] = casadi.if_else(t310, t302, qn1)
+    q[1, 0] = casadi.if_else(t310, t303, qn2)
+    q[2, 0] = casadi.if_else(t310, t304, qn3)
+    q[3, 0] = casadi.if_else(t310, t305, qn4)
+    q[4, 0] = casadi.if_else(t310, t306, qn5)
+    q[5, 0] = casadi.if_else(t310, t307, qn6)
     status = casadi.SX(1, 1)
-    status[0, 0] = casadi.if_else(casadi.logic_not(t736), 2, casadi.if_else(t737, 0, 1))
+    status[0, 0] = casadi.if_else(casadi.logic_not(t308), 2, casadi.if_else(t309, 0, 1))
     return [q, status]
 
 

@@ -103,7 +103,7 @@ ur5_real ur5_ik_numeric_step(const ur5_real target[16], const ur5_real q[UR5_DOF
 void ur5_ik_branches(const ur5_real T[16], ur5_real q[UR5_MAX_IK_SOLUTIONS * UR5_DOF], int valid[UR5_MAX_IK_SOLUTIONS], int in_limits[UR5_MAX_IK_SOLUTIONS]);
 
 /* The closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status.
- * Result: q[i], i < 6; returned as a scalar. 2137 operations. */
+ * Result: q[i], i < 6; returned as a scalar. 1060 operations. */
 int ur5_ik_nearest(const ur5_real T[16], const ur5_real q_seed[UR5_DOF], const ur5_real weights[UR5_DOF], ur5_real q[UR5_DOF]);
 
 /* Statuses of ur5_velocity_ik: OK, singular (a diagonal entry of the QR factor R of the
