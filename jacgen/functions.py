@@ -426,11 +426,11 @@ class Generator:
                                               symbols=sympy.numbered_symbols("_r", real=True), order="canonical")
         bound = [(s, fold(v)) for s, v in bindings.items() if s in needed]
         definitions = _in_dependency_order(bound + trig + list(zip((s for s, _ in named), reduced)) + replacements)
-        definitions, reduced = _without_constants(definitions, reduced)
+        definitions, reduced = _without_constants(definitions, reduced[len(named):])
         temporaries = sympy.numbered_symbols("t", real=True)
         rename = {symbol: next(temporaries) for symbol, _ in definitions if symbol.name.startswith("_")}
         definitions = tuple((rename.get(s, s), v.xreplace(rename)) for s, v in definitions)
-        reduced = [e.xreplace(rename) for e in reduced[len(named):]]
+        reduced = [e.xreplace(rename) for e in reduced]
         read = set().union(*(e.free_symbols for _, e in definitions), *(e.free_symbols for e in reduced))
         return Body(frozenset(read - {symbol for symbol, _ in definitions}), definitions, tuple(reduced))
 
@@ -466,8 +466,8 @@ class Generator:
 def _without_constants(definitions: list[tuple[sympy.Symbol, sympy.Expr]], outputs: list[sympy.Basic]):
     """The definitions that are constants (numbers, truth values, the IK's tolerances) put
     into their readers, which sympy then folds: a select on a condition that is always false
-    is its other side. A comparison of tolerances and numbers is decided when it holds, or
-    fails, in every real type."""
+    is its other side, and the definitions no longer read are dropped. A comparison of
+    tolerances and numbers is decided when it holds, or fails, in every real type."""
     constants, kept = {}, []
     for symbol, value in definitions:
         if not constants.keys().isdisjoint(value.free_symbols):
@@ -479,7 +479,13 @@ def _without_constants(definitions: list[tuple[sympy.Symbol, sympy.Expr]], outpu
             constants[symbol] = value
         else:
             kept.append((symbol, value))
-    return kept, [e.xreplace(constants) if not constants.keys().isdisjoint(e.free_symbols) else e for e in outputs]
+    outputs = [e.xreplace(constants) if not constants.keys().isdisjoint(e.free_symbols) else e for e in outputs]
+    # A folded select may leave the terms of its other side unread: those go too.
+    read = set().union(*(e.free_symbols for e in outputs))
+    for symbol, value in reversed(kept):
+        if symbol in read:
+            read |= value.free_symbols
+    return [(symbol, value) for symbol, value in kept if symbol in read], outputs
 
 
 def _in_dependency_order(definitions: list[tuple[sympy.Symbol, sympy.Expr]]) -> list[tuple[sympy.Symbol, sympy.Expr]]:

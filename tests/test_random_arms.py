@@ -15,7 +15,7 @@ from click.testing import CliRunner
 from jacgen.cli import main
 from random_arms import random_arm_text
 
-STRESS_SEEDS = int(os.environ.get("JACGEN_STRESS_SEEDS", "18"))
+STRESS_SEEDS = int(os.environ.get("JACGEN_STRESS_SEEDS", "8"))
 
 
 @pytest.mark.parametrize("seed", range(STRESS_SEEDS))

@@ -7,9 +7,8 @@ import numpy as np
 import pytest
 
 from jacgen.compile import compile_shared
-from jacgen.render import render_robot, write_files
 
-from conftest import ROBOT_NAMES, import_file, random_configurations, robot
+from conftest import GENERATED, ROBOT_NAMES, generated_module, random_configurations, robot
 from test_analysis import reference_js
 
 DAMPING = 0.1
@@ -17,15 +16,14 @@ DAMPING = 0.1
 
 @pytest.fixture(scope="module")
 def generated(tmp_path_factory):
-    """Python module and C shared library of a robot, generated into a temporary folder."""
+    """The committed Python module of a robot and its C, compiled into a shared library."""
     folder = tmp_path_factory.mktemp("velocity_ik")
     cache = {}
 
     def build(name):
         if name not in cache:
-            write_files(render_robot(robot(name), ("python", "c")), folder)
-            library = compile_shared([folder / name / f"{name}.c"], folder / name / f"lib{name}.so")
-            cache[name] = (import_file(folder / name / f"{name}.py", f"velocity_{name}"), ctypes.CDLL(str(library)))
+            library = compile_shared([GENERATED / name / f"{name}.c"], folder / f"lib{name}.so")
+            cache[name] = (generated_module(name), ctypes.CDLL(str(library)))
         return cache[name]
     return build
 
