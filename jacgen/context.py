@@ -374,6 +374,7 @@ def c_context(robot: Robot, generator: Generator, printer: CPrinter, real: str) 
     """The C header and source: functions with prototypes and size macros, in `real`."""
     context = _common(robot)
     functions = generator.functions()
+    by_name = {f.name: f for f in functions}  # the callees of functions that call another
     macros = _c_macros(robot, functions)
     if generator.closed_form and generator.closed_form.free is not None:
         macros["IK_FREE_JOINT"] = generator.closed_form.free  # 0-based index into q of ik's q_free
@@ -383,7 +384,7 @@ def c_context(robot: Robot, generator: Generator, printer: CPrinter, real: str) 
         "macros": list(macros.items()),
         "joint_lines": _joint_lines(robot),
         "task_lines": _task_lines(robot),
-        "functions": [_c_function(f, robot, printer, macros, {g.name: g for g in functions}) for f in functions],
+        "functions": [_c_function(f, robot, printer, macros, by_name) for f in functions],
         "ik": _ik_context(robot, generator, "c", real),
         "ik_numeric": _ik_numeric_context(robot, "c", real),
         "velocity_ik": _velocity_ik_context(robot, real),
