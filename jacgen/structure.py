@@ -27,7 +27,9 @@ from .robot import TASK_COMPONENTS, Pose, Robot
 
 Matrix = sympy.Matrix
 E_Z = Matrix([0, 0, 1])
-PRECISION = 60  # digits of the irrational numbers of the geometry; zero means below 1e-40
+PRECISION = 60  # digits of the irrational numbers of the geometry
+TOLERANCE = 1e-40  # a relation holds when its measure (a squared distance or sine) is below this
+GENERIC_POINTS = 3  # values of the symbolic parameters (and the free joint) a relation must hold at
 
 
 @dataclass(frozen=True)
@@ -87,7 +89,6 @@ class Structure:
     """The class of a robot: its closed-form solver (None when none applies) and why."""
 
     solver: str | None
-    features: tuple[str, ...]  # what was found, in words
     reason: str  # why the solver applies, or why no solver does
     chain: "Geometry | None" = field(default=None, compare=False)  # what the solver solves (see Geometry)
 
@@ -103,7 +104,7 @@ def _circle(expr: sympy.Expr) -> tuple[sympy.Symbol, sympy.Symbol] | None:
 
 def _on_circle(polynomial: sympy.Expr, cos: sympy.Symbol, sin: sympy.Symbol) -> sympy.Expr:
     """The polynomial with sin^2 = 1 - cos^2: a(cos) + sin b(cos), one form per function on the
-    circle; numeric coefficients below 1e-40 (the rounding of 60-digit numbers) dropped."""
+    circle; numeric coefficients below TOLERANCE (the rounding of 60-digit numbers) dropped."""
     terms = sympy.Poly(sympy.expand(polynomial), sin).terms()
     reduced = sympy.Poly(sympy.Add(*(c * sin ** (k % 2) * (1 - cos**2) ** (k // 2) for (k,), c in terms)), cos, sin)
     return sympy.Add(*(c * cos**i * sin**j for (i, j), c in reduced.terms() if c.free_symbols or not is_zero(c)))
@@ -115,22 +116,41 @@ def _rational(expr: sympy.Expr, circle: tuple[sympy.Symbol, sympy.Symbol]) -> bo
                if not (isinstance(atom, sympy.Pow) and atom.exp.is_Integer))
 
 
+def _generic_points(symbols: set[sympy.Symbol]) -> list[dict[sympy.Symbol, sympy.Float]]:
+    """GENERIC_POINTS fixed values of the symbols, none special: each symbolic parameter in
+    [0.5, 1.5), each free joint at an angle whose cos and sin replace its c_k and s_k. An
+    expression of the geometry that vanishes at all of them vanishes for every value (up to a
+    set of measure zero that fixed irrational fractions do not hit)."""
+    def fraction(k: int, j: int) -> sympy.Float:
+        return sympy.Float((0.3819660112501051 * k + 0.7548776662466927 * j) % 1, PRECISION)
+
+    points = []
+    for k in range(1, GENERIC_POINTS + 1):
+        point = {}
+        for j, symbol in enumerate(sorted(symbols, key=lambda x: x.name), 1):
+            if joint := _FREE_TRIG.fullmatch(symbol.name):
+                angle = 2 * sympy.pi * fraction(k, int(joint[1]))  # one angle for c_k and s_k
+                value = (sympy.cos if symbol.name[0] == "c" else sympy.sin)(angle)
+            else:
+                value = 0.5 + fraction(k, j)
+            point[symbol] = sympy.Float(sympy.N(value, PRECISION), PRECISION)
+        points.append(point)
+    return points
+
+
 def is_zero(expr) -> bool:
-    """Zero: simplified when symbolic, else evaluated (exact or 60-digit inputs) below 1e-40;
-    a function of the free joint is zero when it is for every angle of it."""
+    """Below TOLERANCE, evaluated with 60-digit numbers: the geometry's entries are numbers
+    (see `_precise`), so each test costs a fixed number of operations. An expression of
+    symbolic parameters or of the free joint's angle is zero when it is at GENERIC_POINTS
+    fixed generic values of them (for every value of them, then)."""
     expr = sympy.sympify(expr)
-    circle = _circle(expr)
-    if circle and _rational(expr, circle):
-        return _on_circle(sympy.fraction(sympy.together(expr))[0], *circle) == 0
-    if expr.free_symbols:
-        return sympy.simplify(expr) == 0
-    return abs(complex(sympy.N(expr, PRECISION))) < 1e-40
+    points = _generic_points(expr.free_symbols) if expr.free_symbols else [{}]
+    return all(abs(complex(sympy.N(expr.xreplace(point), PRECISION))) < TOLERANCE for point in points)
 
 
 def tidy(expr: sympy.Expr) -> sympy.Expr:
     """Simplified when symbolic (for readable reports), reduced on the circle when a function of
-    the free joint; numbers stay as they are, since simplifying exact trigonometric numbers
-    is slow and their value is all that is used."""
+    the free joint; numbers stay as they are, since their value is all that is used."""
     circle = _circle(expr)
     if circle and _rational(expr, circle):
         numerator, denominator = sympy.fraction(sympy.together(expr))
@@ -138,25 +158,37 @@ def tidy(expr: sympy.Expr) -> sympy.Expr:
     return sympy.simplify(expr) if expr.free_symbols else expr
 
 
-def _precise(value: Value) -> Value:
-    """A value whose cosine and sine stay exact and small: rationals (lengths), multiples of
-    pi/2 and symbolic expressions as they are, other numbers as 60-digit floats. The exact
-    cosine of an angle such as 73.1234 deg does not simplify, and products of such terms
-    grow without bound while only their value matters."""
+def _precise_length(value: Value) -> Value:
+    """A length: exact when rational or symbolic, else a 60-digit float."""
     e = value.exact
-    if e.free_symbols or e.is_Rational or (2 * e / sympy.pi).is_Integer:
+    if e.free_symbols or e.is_Rational:
+        return value
+    return Value(sympy.Float(sympy.N(e, PRECISION), PRECISION), value.approx)
+
+
+def _precise_angle(value: Value) -> Value:
+    """An angle: exact when a multiple of pi/2 (its cos and sin are 0 and +-1) or symbolic, else
+    a 60-digit float, so that its cos and sin are 60-digit floats too. Kept exact, an angle such
+    as 1.2001 rad stays cos(12001/10000) and the chain's products of such terms grow with every
+    joint, while only their value is used."""
+    e = value.exact
+    if e.free_symbols or (2 * e / sympy.pi).is_Integer:
         return value
     return Value(sympy.Float(sympy.N(e, PRECISION), PRECISION), value.approx)
 
 
 def _precise_robot(robot: Robot) -> Robot:
-    """The robot with every value made `_precise`."""
+    """The robot with its angles and lengths made precise: every entry of its geometry is then a
+    number (a rational or a 60-digit float) or, with symbolic parameters, a function of them."""
     def pose(p: Pose) -> Pose:
-        return Pose(tuple(map(_precise, p.xyz)), tuple(map(_precise, p.rpy)))
+        return Pose(tuple(map(_precise_length, p.xyz)), tuple(map(_precise_angle, p.rpy)))
 
-    joints = tuple(replace(j, a=_precise(j.a), alpha=_precise(j.alpha), offset=_precise(j.offset),
-                           d=None if j.d is None else _precise(j.d),
-                           theta=None if j.theta is None else _precise(j.theta))
+    def offset(joint):
+        return _precise_angle(joint.offset) if joint.revolute else _precise_length(joint.offset)
+
+    joints = tuple(replace(j, a=_precise_length(j.a), alpha=_precise_angle(j.alpha), offset=offset(j),
+                           d=None if j.d is None else _precise_length(j.d),
+                           theta=None if j.theta is None else _precise_angle(j.theta))
                    for j in robot.joints)
     return replace(robot, joints=joints, base=pose(robot.base), tool=pose(robot.tool))
 
@@ -236,38 +268,10 @@ class Geometry:
         return point
 
 
-def point_text(point: Matrix) -> str:
+def _point_text(point: Matrix) -> str:
     if any(e.free_symbols for e in point):
         return "(" + ", ".join(str(tidy(e)) for e in point) + ")"
     return "(" + ", ".join(f"{float(e):.6g}" for e in point) + ")"
-
-
-def _features(g: Geometry) -> list[str]:
-    """Relations of consecutive axes, spherical wrists, runs of parallel axes, prismatic joints."""
-    n, lines = len(g.axes), []
-    pairs = []
-    for i in range(n - 1):
-        if g.same_line(i, i + 1):
-            pairs.append(f"{i + 1}-{i + 2} coincide")
-        elif g.parallel(i, i + 1):
-            pairs.append(f"{i + 1}-{i + 2} parallel")
-        elif (point := g.intersection(i, i + 1)) is not None:
-            pairs.append(f"{i + 1}-{i + 2} intersect at {point_text(point)}")
-        else:
-            pairs.append(f"{i + 1}-{i + 2} skew")
-    if pairs:
-        lines.append("consecutive axes: " + "; ".join(pairs))
-    for i in range(n - 2):
-        if g.parallel(i, i + 1) and g.parallel(i + 1, i + 2):
-            lines.append(f"axes {i + 1}, {i + 2}, {i + 3} parallel")
-        elif (centre := g.wrist_centre(i)) is not None:
-            lines.append(f"axes {i + 1}, {i + 2}, {i + 3} meet at {point_text(centre)} (spherical joint)")
-    prismatic = [str(i + 1) for i, revolute in enumerate(g.revolute) if not revolute]
-    if prismatic:
-        lines.append("prismatic joint" + ("s " if len(prismatic) > 1 else " ") + ", ".join(prismatic))
-    if all(is_zero(squared_norm(h.cross(E_Z))) for h in g.axes):
-        lines.append("planar: every axis parallel to world z")
-    return lines
 
 
 def _spherical_wrist(g: Geometry) -> tuple[str | None, str]:
@@ -275,7 +279,7 @@ def _spherical_wrist(g: Geometry) -> tuple[str | None, str]:
     centre = g.wrist_centre(3)
     if centre is None:
         return None, "no spherical wrist (axes 4, 5, 6 do not meet in one point)"
-    wrist = f"spherical wrist: axes 4, 5, 6 meet at {point_text(centre)}"
+    wrist = f"spherical wrist: axes 4, 5, 6 meet at {_point_text(centre)}"
     rev = g.revolute
     if all(rev[:3]) and g.parallel(1, 2) and not g.parallel(0, 1):
         if g.same_line(1, 2) or g.on_axis(centre, 2):
@@ -284,7 +288,7 @@ def _spherical_wrist(g: Geometry) -> tuple[str | None, str]:
     x12 = g.intersection(0, 1) if rev[0] and rev[1] else None
     if x12 is None:
         return None, f"{wrist}, but neither axes 2, 3 parallel nor axes 1, 2 intersecting"
-    shoulder = f"axes 1 and 2 intersect at {point_text(x12)}"
+    shoulder = f"axes 1 and 2 intersect at {_point_text(x12)}"
     if not rev[2]:
         return "spherical_wrist_prismatic", f"{wrist}; {shoulder}; joint 3 prismatic"
     if g.on_axis(x12, 2) or g.on_axis(centre, 2):
@@ -303,7 +307,7 @@ def _three_parallel(g: Geometry) -> tuple[str | None, str]:
         return None, "axes 2, 3, 4 parallel, but axis 1 or axis 5 is parallel to them too"
     if g.same_line(1, 2) or g.same_line(2, 3):
         return None, "axes 2, 3, 4 parallel, but two of them coincide"
-    return "three_parallel", f"axes 2, 3, 4 parallel; axes 5 and 6 intersect at {point_text(point)}"
+    return "three_parallel", f"axes 2, 3, 4 parallel; axes 5 and 6 intersect at {_point_text(point)}"
 
 
 def _six_dof(g: Geometry) -> tuple[str | None, str, Geometry | None]:
@@ -378,7 +382,6 @@ def classify(robot: Robot, geometry: Geometry | None = None) -> Structure:
     """The structure of `robot` and the closed-form solver that applies to it, if any."""
     g = geometry or Geometry(robot)
     n, task = robot.dof, robot.task
-    features = tuple(_features(g))
     if task == TASK_COMPONENTS:
         if n == 6:
             solver, reason, chain = _six_dof(g)
@@ -388,25 +391,11 @@ def classify(robot: Robot, geometry: Geometry | None = None) -> Structure:
             solver, reason, chain = None, f"{n} joints for a 6-component task: redundant, infinitely many solutions", None
         else:
             solver, reason, chain = None, f"{n} joints cannot reach every pose of a 6-component task", None
-        return Structure(solver, features, reason, chain)
+        return Structure(solver, reason, chain)
     for candidate in (_planar, _yaw_pitch):
         found = candidate(g, task)
         if found is not None:
-            return Structure(found[0], features, found[1], g)
-    return Structure(None, features, (
+            return Structure(found[0], found[1], g)
+    return Structure(None, (
         f"{n} joints with task ({', '.join(task)}): closed forms exist for planar arms (axes parallel "
         f"to world z, task x, y[, z][, yaw]) and base yaw + three parallel pitch axes (task x, y, z, pitch)"))
-
-
-def describe_structure(robot: Robot) -> list[str]:
-    """Lines for the report and `jacgen show`: the structure found and which ik solver applies."""
-    structure = classify(robot)
-    lines = [f"structure: {feature}" for feature in structure.features]
-    if structure.solver is None:
-        lines.append(f"closed-form ik: none ({structure.reason}); ik_numeric is generated")
-        return lines
-    info = SOLVERS[structure.solver]
-    lines.append(f"closed-form ik: {structure.reason}")
-    lines.append(f"solver: {info.title}; up to {info.max_solutions} solutions, in the order:")
-    lines += [f"  {branch}" for branch in info.branches]
-    return lines
