@@ -7,6 +7,7 @@ import click
 
 from . import __version__, budget
 from .errors import JacgenError
+from .functions import with_callees
 from .model import Model
 from .backends import BACKENDS, DEFAULT_LANGUAGES
 from .render import render_robot, stale_files, write_files
@@ -22,6 +23,17 @@ def _languages(ctx, param, value: str) -> tuple[str, ...]:
     if unknown or not names:
         what = f"unknown language {unknown[0]!r}; " if unknown else ""
         raise click.BadParameter(f"{what}expected a comma-separated list of {', '.join(BACKENDS)}")
+    return names
+
+
+def _functions(ctx, param, value: str | None) -> tuple[str, ...] | None:
+    if value is None:
+        return None
+    names = tuple(dict.fromkeys(part.strip() for part in value.split(",") if part.strip()))
+    try:
+        with_callees(names or ("",))
+    except ValueError as error:
+        raise click.BadParameter(str(error)) from None
     return names
 
 
@@ -82,12 +94,15 @@ def main(debug):
 @click.option("--real", type=click.Choice(["double", "float"]), default="double", show_default=True,
               help="Floating-point type of the generated C.")
 @click.option("--check", is_flag=True, help="Write nothing; exit 1 with a diff if a file would change.")
+@click.option("--functions", "functions", default=None, callback=_functions, metavar="NAMES",
+              help="Comma-separated functions to generate (with those they call), e.g. fk_jacobian,ik; "
+                   "default: all.")
 @click.option("--budget", "budget_seconds", default=budget.DEFAULT_SECONDS, show_default=True,
               type=click.FloatRange(min=0), metavar="SECONDS",
               help="Safety net on the exact singularity analysis of each robot, whose work is "
                    "bounded by size limits anyway: past it the numeric rank determinant stands as the "
                    "condition, with a warning (0: no limit).")
-def generate(robot_files, output, languages, real, check, budget_seconds):
+def generate(robot_files, output, languages, real, check, functions, budget_seconds):
     """Generate code for each ROBOT_FILE."""
     budget.set_seconds(budget_seconds)
     robots = [load_robot(path) for path in dict.fromkeys(robot_files)]  # validate all before writing any
@@ -95,7 +110,7 @@ def generate(robot_files, output, languages, real, check, budget_seconds):
     files = {}
     for robot in robots:
         _progress(f"generating {robot.name}")
-        files.update(render_robot(robot, languages, real))
+        files.update(render_robot(robot, languages, real, functions=functions))
     folder = Path(output)
     if check:
         diffs = stale_files(files, folder)

@@ -269,9 +269,10 @@ IK_NUMERIC_DAMPING = {"start": 1e-6, "min": 1e-12, "max": 1e8}
 
 
 def _ik_context(robot: Robot, generator: Generator, language: str, real: str) -> dict | None:
-    """What the ik wrapper around ik_branches documents and declares, None without a closed form."""
+    """What the ik wrapper around ik_branches (`wrapper`) and ik_nearest's statuses (`nearest`)
+    document and declare, None without ik_branches."""
     form = generator.closed_form
-    if form is None:
+    if form is None or not generator.generates("ik_branches"):
         return None
     prefix, real_type = robot.name.upper(), f"{robot.name}_real"
     pose = form.target == "pose"
@@ -289,6 +290,8 @@ def _ik_context(robot: Robot, generator: Generator, language: str, real: str) ->
         "nearest_statuses": [("OK", ik.IK_NEAREST_OK), ("NO_SOLUTION", ik.IK_NEAREST_NO_SOLUTION),
                              ("NOT_FINITE", ik.IK_NEAREST_NOT_FINITE)],
         "signature": ", ".join(arguments),
+        "wrapper": generator.generates("ik"),
+        "nearest": generator.generates("ik_nearest"),
     }
 
 
@@ -365,8 +368,8 @@ def python_context(robot: Robot, generator: Generator, printer: PythonPrinter, r
     context = _common(robot)
     context["functions"] = [_python_function(f, printer, context["parameters"]) for f in generator.functions()]
     context["ik"] = _ik_context(robot, generator, "python", "double")
-    context["ik_numeric"] = _ik_numeric_context(robot, "python", "double")
-    context["velocity_ik"] = _velocity_ik_context(robot, "double")
+    context["ik_numeric"] = generator.generates("ik_numeric") and _ik_numeric_context(robot, "python", "double")
+    context["velocity_ik"] = generator.generates("velocity_ik") and _velocity_ik_context(robot, "double")
     return dict(sorted(context.items()))
 
 
@@ -386,8 +389,8 @@ def c_context(robot: Robot, generator: Generator, printer: CPrinter, real: str) 
         "task_lines": _task_lines(robot),
         "functions": [_c_function(f, robot, printer, macros, by_name) for f in functions],
         "ik": _ik_context(robot, generator, "c", real),
-        "ik_numeric": _ik_numeric_context(robot, "c", real),
-        "velocity_ik": _velocity_ik_context(robot, real),
+        "ik_numeric": generator.generates("ik_numeric") and _ik_numeric_context(robot, "c", real),
+        "velocity_ik": generator.generates("velocity_ik") and _velocity_ik_context(robot, real),
     })
     return dict(sorted(context.items()))
 
@@ -399,8 +402,8 @@ def casadi_context(robot: Robot, generator: Generator, printer: CasadiPrinter, r
     context["functions"] = [_casadi_function(f, robot, printer) for f in functions]
     context["arguments"] = sorted({(a.name, a.symbols.rows, a.symbols.cols) for f in functions for a in f.arguments},
                                   key=lambda a: ("q", "q_dot", "mu_dot", "damping", "target", "T", "mu", "q_seed", "q_free", "weights").index(a[0]))
-    context["ik"] = generator.closed_form is not None
-    context["ik_numeric"] = _ik_numeric_context(robot, "python", "double")
+    context["ik"] = generator.closed_form is not None and generator.generates("ik")
+    context["ik_numeric"] = generator.generates("ik_numeric") and _ik_numeric_context(robot, "python", "double")
     return dict(sorted(context.items()))
 
 

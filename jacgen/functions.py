@@ -22,6 +22,24 @@ from .printers import fold_constants
 from .robot import Robot
 
 ANGLES = ("roll", "pitch", "yaw")
+SECOND_ORDER = ("fk_jacobian_dot", "jacobian_dot", "bias_acceleration", "task_jacobian_dot", "hessian")
+
+# Every function a robot can get, in the order the backends emit them (`ik` and `ik_numeric`
+# are loops the templates write around ik_branches and ik_numeric_step), and the functions each
+# one calls: `--functions` generates the named ones and their callees.
+FUNCTION_NAMES = ("fk", "jacobian", "fk_jacobian", "jacobian_tool", "task", "task_jacobian", "fk_jacobian_dot",
+                  "jacobian_dot", "bias_acceleration", "task_jacobian_dot", "hessian", "singularity_factors",
+                  "manipulability", "jacobian_det", "velocity_ik", "ik_numeric_step", "ik_numeric", "ik_branches",
+                  "ik_nearest", "ik")
+CALLEES = {"ik": ("ik_branches",), "ik_nearest": ("ik_branches",), "ik_numeric": ("ik_numeric_step",)}
+
+
+def with_callees(names) -> frozenset[str]:
+    """The functions named and those they call (ValueError for a name no robot has)."""
+    unknown = [name for name in names if name not in FUNCTION_NAMES]
+    if unknown:
+        raise ValueError(f"unknown function {unknown[0]!r}; expected some of {', '.join(FUNCTION_NAMES)}")
+    return frozenset(names).union(*(CALLEES.get(name, ()) for name in names))
 
 
 @dataclass(frozen=True)
@@ -136,11 +154,14 @@ class Function:
 
 
 class Generator:
-    """Builds the emitted functions of one robot, sharing the symbolic chain between them."""
+    """Builds the emitted functions of one robot, sharing the symbolic chain between them:
+    every function, or those of `selection` (names of FUNCTION_NAMES, callees included), whose
+    derivation alone is done."""
 
-    def __init__(self, robot: Robot, model: Model | None = None):
+    def __init__(self, robot: Robot, model: Model | None = None, selection=None):
         self.robot = robot
         self.model = model or Model(robot)
+        self.selection = None if selection is None else with_callees(selection)
         self.q = kinematics.joint_symbols(robot)
         # Trig symbols, each defined once, in an order that defines before use.
         self.definitions: list[tuple[sympy.Symbol, sympy.Expr]] = []
@@ -166,6 +187,10 @@ class Generator:
             self._trig[joints] = (cos, sin)
         return self._trig[joints]
 
+    def generates(self, name: str) -> bool:
+        """Whether `name` is among the functions to generate (when the robot has it)."""
+        return self.selection is None or name in self.selection
+
     @property
     def closed_form(self) -> "ik.ClosedForm | None":
         return self.model.closed_form
@@ -175,7 +200,7 @@ class Generator:
         whether it is inside the joint limits) and ik_nearest (the solution nearest a seed), from
         the target's symbols (none without a closed form)."""
         form = self.closed_form
-        if form is None:
+        if form is None or not (self.generates("ik_branches") or self.generates("ik_nearest")):
             return []
         if form.target == "pose":
             target = Argument("T", sympy.Matrix(4, 4, lambda r, c: sympy.Symbol(f"T{r}{c}", real=True)), vector=False)
@@ -197,6 +222,8 @@ class Generator:
         branches = self.function("ik_branches", "every branch of the closed-form ik, whether the target allows it "
                                  "and whether it is inside the joint limits", ("q", q), ("valid", valid),
                                  ("in_limits", inside), arguments=(target, *free), bindings=bindings)
+        if not self.generates("ik_nearest"):
+            return [branches]
         # ik_nearest reads ik_branches' results rather than lowering the solver a second time.
         rows = range(q.rows)
         table = Call("ik_branches", tuple(a.name for a in branches.arguments), (
@@ -269,6 +296,8 @@ class Generator:
     def second_order_functions(self) -> list[Function]:
         """fk_jacobian_dot, jacobian_dot, bias_acceleration, task_jacobian_dot and hessian, from
         the chain and the named columns of J (`kinematics`): O(1) per entry on top of J."""
+        if not any(map(self.generates, SECOND_ORDER)):
+            return []
         robot, n, m = self.robot, self.robot.dof, len(self.robot.task)
         q_dot = Argument("q_dot", sympy.Matrix([sympy.Symbol(f"qd{i + 1}", real=True) for i in range(n)]))
         arguments = (Argument("q", sympy.Matrix(self.q)), q_dot)
@@ -328,6 +357,8 @@ class Generator:
         The exact factors come first; where they are not the whole condition, the numeric
         rank determinant follows them. jacobian_det is the product of the exact factors
         when they are complete and cheaper to compute than the expansion of det(Js)."""
+        if not any(map(self.generates, ("singularity_factors", "manipulability", "jacobian_det"))):
+            return []
         singular, (m, n) = self.singularities, js.shape
         atoms = {}
         for i, symbols in enumerate(analysis.joint_atoms(self.robot)):
@@ -361,13 +392,16 @@ class Generator:
                  vector: bool = False, equals: tuple[str, ...] = (),
                  arguments: tuple[Argument, ...] | None = None, scalars: tuple[str, ...] = (),
                  integers: tuple[str, ...] = (), bindings: dict | None = None, layers: int = 1,
-                 vectors: tuple[str, ...] = (), calls: tuple[Call, ...] = ()) -> Function:
+                 vectors: tuple[str, ...] = (), calls: tuple[Call, ...] = ()) -> Function | None:
         """A function of one or more named results (matrices, or lists of truth values as
         columns), lowered together so they share their terms; its arguments are q unless
         given. The results named in `scalars` are scalars, those in `integers` integer
         scalars (statuses), those in `vectors` (or all, with `vector`) column vectors; `bindings` define symbols (the joints) from the arguments for
         this function alone; `layers` > 1 makes the results stacks of that many matrices; `calls`
-        are the generated functions whose results the body reads."""
+        are the generated functions whose results the body reads. None when `name` is not to be
+        generated (nothing is lowered then)."""
+        if not self.generates(name):
+            return None
         outputs, values = [], []
         for (output, result), equal in zip(results, equals or ("",) * len(results)):
             rows, cols = result.shape if isinstance(result, sympy.Matrix) else (len(result), 1)
@@ -438,13 +472,25 @@ class Generator:
         """Every straight-line function, in the order the backends emit them."""
         return list(self._functions)
 
+    def unavailable(self) -> list[str]:
+        """The selected functions this robot does not have, each with why."""
+        made = {f.name for f in self._functions}
+        made |= {name for name, callees in CALLEES.items() if made.issuperset(callees)}
+        if self.closed_form is None:
+            made.discard("ik")
+        why = {"ik": f"no closed form ({self.model.structure.reason})",
+               "jacobian_det": f"Js is {len(self.robot.task)} x {self.robot.dof}, not square"}
+        why["ik_branches"] = why["ik_nearest"] = why["ik"]
+        return [f"{name}: {why.get(name, 'not generated for this robot')}"
+                for name in FUNCTION_NAMES if name in (self.selection or ()) and name not in made]
+
     @cached_property
     def _functions(self) -> tuple[Function, ...]:
         robot, m = self.robot, len(self.robot.task)
         pose = self.chain.tool
         task_jacobian = kinematics.task_jacobian(robot, pose, self.jacobian)
         js = analysis.singularity_jacobian(robot, self.jacobian, task_jacobian)
-        return (
+        functions = (
             self.function("fk", "pose of the tool frame in the world frame (4x4 homogeneous)", ("T", pose)),
             self.function("jacobian", "geometric Jacobian in the world frame (6 x DOF, rows vx vy vz wx wy wz)",
                           ("J", self.jacobian)),
@@ -457,10 +503,11 @@ class Generator:
             self.function("task_jacobian", f"analytic Jacobian d mu / d q ({m} x DOF)", ("J", task_jacobian)),
             *self.second_order_functions(),
             *self.singularity_functions(js),
-            self.velocity_ik_function(js),
-            self.ik_numeric_step_function(task_jacobian),
+            self.velocity_ik_function(js) if self.generates("velocity_ik") else None,
+            self.ik_numeric_step_function(task_jacobian) if self.generates("ik_numeric_step") else None,
             *self.ik_functions(),
         )
+        return tuple(function for function in functions if function is not None)
 
 
 def _without_constants(definitions: list[tuple[sympy.Symbol, sympy.Expr]], outputs: list[sympy.Basic]):

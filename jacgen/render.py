@@ -14,6 +14,7 @@ import jinja2
 
 from . import __version__
 from .backends import BACKENDS, DEFAULT_LANGUAGES
+from .errors import JacgenError
 from .functions import Generator
 from .robot import Robot
 
@@ -42,13 +43,17 @@ def header(robot: Robot) -> str:
 
 
 def render_robot(robot: Robot, languages=DEFAULT_LANGUAGES, real: str = "double",
-                 generator: Generator | None = None) -> dict[str, str]:
-    """All files of one robot as {path relative to the output folder: text}.
+                 generator: Generator | None = None, functions=None) -> dict[str, str]:
+    """All files of one robot as {path relative to the output folder: text}: every function, or
+    the `functions` named and those they call (JacgenError for one the robot does not have).
 
     Pass the robot's `generator` to share its symbolic work between renderings.
     """
     environment = _environment()
-    generator = generator or Generator(robot)
+    generator = generator or Generator(robot, selection=functions)
+    unavailable = generator.unavailable()
+    if unavailable:
+        raise JacgenError(f"{robot.source}: robot {robot.name} has no {unavailable[0]}")
     files = {}
     for name in languages:
         backend = BACKENDS[name]

@@ -1,12 +1,17 @@
 """The command line (SPEC §4): version, generate and its idempotence, --check with a diff,
 usage mistakes as one line. (Byte-identical output under any PYTHONHASHSEED: test_golden.)"""
 
+import re
+
+import numpy as np
 from click.testing import CliRunner
 
-from jacgen import __version__
+from jacgen import __version__, load_robot, reference
 from jacgen.cli import main
+from jacgen.compile import CLibrary, compile_shared
+from jacgen.functions import Generator
 
-from conftest import ROOT
+from conftest import ROOT, import_file, random_configurations
 
 
 def run(*arguments):
@@ -99,3 +104,36 @@ def test_internal_error_is_one_line_and_debug_shows_the_traceback(tmp_path, monk
     assert existing.read_text() == "earlier output\n"
     debug = CliRunner().invoke(main, ["--debug"] + arguments)
     assert isinstance(debug.exception, ZeroDivisionError)
+
+
+def test_functions_option_emits_only_the_named_functions_and_their_callees(tmp_path):
+    """`--functions fk_jacobian,ik_nearest`: the C declares those and ik_branches (which
+    ik_nearest calls), nothing else; it compiles on its own, and fk_jacobian equals the numpy
+    reference fk and Jacobian."""
+    result = run("generate", ROOT / "robots" / "ur5.yaml", "-o", tmp_path, "--functions", "fk_jacobian,ik_nearest")
+    assert result.exit_code == 0, result.output
+    header = (tmp_path / "ur5" / "ur5.h").read_text()
+    declared = re.findall(r"^\w+ (ur5_\w+)\(", header, re.MULTILINE)
+    assert declared == ["ur5_fk_jacobian", "ur5_ik_branches", "ur5_ik_nearest"]
+    assert "UR5_VELOCITY_IK_OK" not in header and "UR5_IK_NUMERIC" not in header and "UR5_IK_NEAREST_OK" in header
+    robot = load_robot(ROOT / "robots" / "ur5.yaml")
+    generator = Generator(robot, selection=("fk_jacobian",))
+    library = CLibrary(compile_shared([tmp_path / "ur5" / "ur5.c"], tmp_path / "ur5.so"), robot,
+                       generator.functions(), "double")
+    q = random_configurations(robot, 20)
+    values = library.evaluate("fk_jacobian", q)
+    expected = np.array([np.concatenate([reference.fk(robot, x).ravel(), reference.jacobian(robot, x).ravel()])
+                         for x in q])
+    np.testing.assert_allclose(values, expected, atol=1e-13)
+    module = import_file(tmp_path / "ur5" / "ur5.py", "ur5_selected")
+    assert not hasattr(module, "jacobian") and not hasattr(module, "ik_numeric") and hasattr(module, "ik_nearest")
+
+
+def test_functions_option_rejects_what_cannot_be_made(tmp_path):
+    unknown = run("generate", ROOT / "robots" / "ur5.yaml", "-o", tmp_path, "--functions", "fk,fkk")
+    assert unknown.exit_code == 2
+    assert unknown.stderr.startswith("jacgen: error: Invalid value for '--functions': unknown function 'fkk'")
+    missing = run("generate", ROOT / "robots" / "iiwa.yaml", "-o", tmp_path, "--functions", "fk,jacobian_det")
+    assert missing.exit_code == 2
+    assert missing.stderr.endswith("iiwa.yaml: robot iiwa has no jacobian_det: Js is 6 x 7, not square\n")
+    assert len(missing.stderr.splitlines()) == 1 and not list(tmp_path.iterdir())
