@@ -31,9 +31,12 @@ def fold_constants(expr: sympy.Expr, _folded: dict | None = None) -> sympy.Expr:
         elif expr.is_Atom:
             folded[expr] = expr
         elif expr.is_Pow:
-            folded[expr] = sympy.Pow(fold_constants(expr.base, folded), expr.exp)
-        else:
-            folded[expr] = expr.func(*(fold_constants(arg, folded) for arg in expr.args))
+            base = fold_constants(expr.base, folded)
+            folded[expr] = expr if base is expr.base else sympy.Pow(base, expr.exp)
+        else:  # rebuilt only when an argument changed: a rebuild evaluates (Piecewise, floor, relations)
+            args = tuple(fold_constants(arg, folded) for arg in expr.args)
+            changed = any(new is not old and new != old for new, old in zip(args, expr.args))
+            folded[expr] = expr.func(*args) if changed else expr
     return folded[expr]
 
 

@@ -679,12 +679,12 @@ int planar_2r_ik_nearest(const planar_2r_real mu[PLANAR_2R_TASK_DIM], const plan
     const int lb1 = branches_in_limits[1];
 
     /* Intermediate terms */
-    const planar_2r_real t0 = qb0_0 + 6.283185307179586*floor(0.5 + 0.15915494309189535*qn1 - 0.15915494309189535*qb0_0);
-    const planar_2r_real t1 = qb0_1 + 6.283185307179586*floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*qb0_1);
+    const planar_2r_real t0 = qb0_0 + 6.283185307179586*floor(0.5 + 0.15915494309189535*(qn1 - qb0_0));
+    const planar_2r_real t1 = qb0_1 + 6.283185307179586*floor(0.5 + 0.15915494309189535*(qn2 - qb0_1));
     const planar_2r_real t2 = (lb0 && vb0 ? 1 : 0);
     const planar_2r_real t3 = (t2 > 0 ? 1 : 0);
-    const planar_2r_real t4 = qb1_0 + 6.283185307179586*floor(0.5 + 0.15915494309189535*qn1 - 0.15915494309189535*qb1_0);
-    const planar_2r_real t5 = qb1_1 + 6.283185307179586*floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*qb1_1);
+    const planar_2r_real t4 = qb1_0 + 6.283185307179586*floor(0.5 + 0.15915494309189535*(qn1 - qb1_0));
+    const planar_2r_real t5 = qb1_1 + 6.283185307179586*floor(0.5 + 0.15915494309189535*(qn2 - qb1_1));
     const planar_2r_real t6 = (lb1 && vb1 ? 1 : 0);
     const planar_2r_real t7 = mu0 + mu1 + qn1 + qn2 + qw1 + qw2;
     const planar_2r_real t8 = -qn1;

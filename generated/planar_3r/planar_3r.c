@@ -971,14 +971,14 @@ int planar_3r_ik_nearest(const planar_3r_real mu[PLANAR_3R_TASK_DIM], const plan
     const int lb1 = branches_in_limits[1];
 
     /* Intermediate terms */
-    const planar_3r_real t0 = qb0_0 + 6.283185307179586*floor(0.5 + 0.15915494309189535*qn1 - 0.15915494309189535*qb0_0);
-    const planar_3r_real t1 = qb0_1 + 6.283185307179586*floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*qb0_1);
-    const planar_3r_real t2 = qb0_2 + 6.283185307179586*floor(0.5 + 0.15915494309189535*qn3 - 0.15915494309189535*qb0_2);
+    const planar_3r_real t0 = qb0_0 + 6.283185307179586*floor(0.5 + 0.15915494309189535*(qn1 - qb0_0));
+    const planar_3r_real t1 = qb0_1 + 6.283185307179586*floor(0.5 + 0.15915494309189535*(qn2 - qb0_1));
+    const planar_3r_real t2 = qb0_2 + 6.283185307179586*floor(0.5 + 0.15915494309189535*(qn3 - qb0_2));
     const planar_3r_real t3 = (lb0 && vb0 ? 1 : 0);
     const planar_3r_real t4 = (t3 > 0 ? 1 : 0);
-    const planar_3r_real t5 = qb1_0 + 6.283185307179586*floor(0.5 + 0.15915494309189535*qn1 - 0.15915494309189535*qb1_0);
-    const planar_3r_real t6 = qb1_1 + 6.283185307179586*floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*qb1_1);
-    const planar_3r_real t7 = qb1_2 + 6.283185307179586*floor(0.5 + 0.15915494309189535*qn3 - 0.15915494309189535*qb1_2);
+    const planar_3r_real t5 = qb1_0 + 6.283185307179586*floor(0.5 + 0.15915494309189535*(qn1 - qb1_0));
+    const planar_3r_real t6 = qb1_1 + 6.283185307179586*floor(0.5 + 0.15915494309189535*(qn2 - qb1_1));
+    const planar_3r_real t7 = qb1_2 + 6.283185307179586*floor(0.5 + 0.15915494309189535*(qn3 - qb1_2));
     const planar_3r_real t8 = (lb1 && vb1 ? 1 : 0);
     const planar_3r_real t9 = mu0 + mu1 + mu2 + qn1 + qn2 + qn3 + qw1 + qw2 + qw3;
     const planar_3r_real t10 = -qn1;

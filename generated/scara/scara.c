@@ -1002,7 +1002,7 @@ void scara_ik_branches(const scara_real mu[SCARA_TASK_DIM], scara_real q[SCARA_M
     const int t49 = t34 >= -0.8726646259971648 && t34 <= 0.8726646259971648;
     const int t50 = t13 <= 1.53588974175501;
     const int t51 = t12 >= -1.53588974175501 && t12 <= 1.53588974175501;
-    const scara_real t52 = 0.387 - mu2;
+    const scara_real t52 = -(-0.387 + mu2);
     const scara_real t53 = -t40;
     const int t54 = t43 <= 0.8726646259971648;
     const int t55 = t42 >= -0.8726646259971648 && t42 <= 0.8726646259971648;
@@ -1063,14 +1063,14 @@ int scara_ik_nearest(const scara_real mu[SCARA_TASK_DIM], const scara_real q_see
     const int lb1 = branches_in_limits[1];
 
     /* Intermediate terms */
-    const scara_real t0 = qb0_0 + 6.283185307179586*floor(0.5 + 0.15915494309189535*qn1 - 0.15915494309189535*qb0_0);
-    const scara_real t1 = qb0_1 + 6.283185307179586*floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*qb0_1);
-    const scara_real t2 = qb0_3 + 6.283185307179586*floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*qb0_3);
+    const scara_real t0 = qb0_0 + 6.283185307179586*floor(0.5 + 0.15915494309189535*(qn1 - qb0_0));
+    const scara_real t1 = qb0_1 + 6.283185307179586*floor(0.5 + 0.15915494309189535*(qn2 - qb0_1));
+    const scara_real t2 = qb0_3 + 6.283185307179586*floor(0.5 + 0.15915494309189535*(qn4 - qb0_3));
     const scara_real t3 = (lb0 && vb0 ? 1 : 0);
     const scara_real t4 = (t3 > 0 ? 1 : 0);
-    const scara_real t5 = qb1_0 + 6.283185307179586*floor(0.5 + 0.15915494309189535*qn1 - 0.15915494309189535*qb1_0);
-    const scara_real t6 = qb1_1 + 6.283185307179586*floor(0.5 + 0.15915494309189535*qn2 - 0.15915494309189535*qb1_1);
-    const scara_real t7 = qb1_3 + 6.283185307179586*floor(0.5 + 0.15915494309189535*qn4 - 0.15915494309189535*qb1_3);
+    const scara_real t5 = qb1_0 + 6.283185307179586*floor(0.5 + 0.15915494309189535*(qn1 - qb1_0));
+    const scara_real t6 = qb1_1 + 6.283185307179586*floor(0.5 + 0.15915494309189535*(qn2 - qb1_1));
+    const scara_real t7 = qb1_3 + 6.283185307179586*floor(0.5 + 0.15915494309189535*(qn4 - qb1_3));
     const scara_real t8 = (lb1 && vb1 ? 1 : 0);
     const scara_real t9 = mu0 + mu1 + mu2 + mu3 + qn1 + qn2 + qn3 + qn4 + qw1 + qw2 + qw3 + qw4;
     const scara_real t10 = (qn1 > t0 ? 6.283185307179586 : -6.283185307179586);
