@@ -5,10 +5,15 @@ bench/bench_scaling.py).
 convention, revolute and prismatic joints mixed, each alpha one of 0, ±90, 180 degrees or
 an arbitrary angle, arbitrary offsets and lengths, base and tool transforms with arbitrary
 rotations, a task of any shape (fewer, as many or more components than joints; with or
-without Euler angles) and some lengths kept as symbolic runtime parameters.
+without Euler angles) and some lengths kept as symbolic runtime parameters. With
+`radians`, the same arm is written in radians: 0, pi/2, -pi/2, pi, and arbitrary angles as
+4-decimal numbers such as 1.2001 (exact rationals whose cosines have no closed form, the
+arms whose structure detection once took minutes).
 """
 
+import math
 import random
+import re
 
 from jacgen.robot import TASK_COMPONENTS
 
@@ -41,8 +46,26 @@ def _task(rng: random.Random, dof: int) -> list[str]:
                   key=TASK_COMPONENTS.index)
 
 
-def random_arm_text(seed: int, dof: int | None = None, revolute_only: bool = False) -> str:
-    """Robot file text of the random arm `seed` (angles in degrees, lengths in metres)."""
+SPECIAL_RADIANS = {"0": "0", "0.0": "0", "90.0": "pi/2", "-90.0": "-pi/2", "180.0": "pi"}
+
+
+def _in_radians(degrees: str) -> str:
+    """A drawn angle (degrees, as text) in radians: exact for the special ones."""
+    return SPECIAL_RADIANS.get(degrees) or f"{math.radians(float(degrees)):.4f}"
+
+
+def random_arm_text(seed: int, dof: int | None = None, revolute_only: bool = False, radians: bool = False) -> str:
+    """Robot file text of the random arm `seed` (angles in degrees, or radians; lengths in metres)."""
+    text = _random_arm_text(seed, dof, revolute_only)
+    if not radians:
+        return text
+    text = re.sub(r"(type: revolute.*?)(offset: )([-\d.]+)", lambda m: m[1] + m[2] + _in_radians(m[3]), text)
+    text = re.sub(r"((?:alpha|theta): )([-\d.]+)", lambda m: m[1] + _in_radians(m[2]), text)
+    text = re.sub(r"rpy: \[([^\]]*)\]", lambda m: "rpy: [" + ", ".join(map(_in_radians, m[1].split(", "))) + "]", text)
+    return text.replace("angle_unit: deg", "angle_unit: rad")
+
+
+def _random_arm_text(seed: int, dof: int | None, revolute_only: bool) -> str:
     rng = random.Random(seed)
     dof = dof or rng.randint(1, 12)
     lines = [f"name: arm{seed}", f"description: random arm, seed {seed}",

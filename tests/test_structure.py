@@ -126,7 +126,7 @@ def test_irrational_twists_are_decided_in_bounded_time():
     text = f"name: twisty\nconvention: modified\nangle_unit: rad\njoints:\n{joints}\n"
     start = time.perf_counter()
     structure = classify(parse_robot(text.encode()))
-    assert time.perf_counter() - start < 2.0
+    assert time.perf_counter() - start < 5.0  # 0.02 s here
     assert structure.solver is None and "redundant" in structure.reason
 
 
