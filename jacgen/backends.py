@@ -3,7 +3,7 @@
 A backend is an expression printer (for a real type; it holds the literal policy), the
 templates it renders with the file each becomes, its comment syntax, the builder of what
 its templates receive (types included), and the words it reserves.
-Every algorithm reaches every backend as straight-line `Body`s (`functions.py`); a backend
+Every algorithm reaches every backend as straight-line `Body`s (`lowering.py`); a backend
 only prints and lays out. A new language is a printer in `printers.py` (for selects,
 comparisons and `isfinite` too), a context builder in `context.py`, templates under
 `templates/`, its reserved words (`names.py`), and one entry here.

@@ -6,7 +6,8 @@ import numpy
 import sympy
 
 from . import analysis, differential, ik, report
-from .functions import Call, Function, Generator, Output, is_boolean
+from .functions import Call, Function, Generator, Output
+from .lowering import is_boolean
 from .printers import CasadiPrinter, CPrinter, PythonPrinter
 from .robot import Robot
 from .subproblems import RANK, TOLERANCES

@@ -35,11 +35,11 @@ def test_column_formula_agrees_with_velocity_propagation(name):
     generator = Generator(arm)
     by_columns = kinematics.tool_frame(generator.jacobian, generator.chain.tool)
     by_propagation = kinematics.propagated_jacobian_tool(arm, lambda i: generator.cos_sin((i,)), generator.q)
-    symbols = [s for s, _ in generator.definitions] + list(generator.q)
+    symbols = [s for s, _ in generator.lowering.definitions] + list(generator.q)
     by_columns, by_propagation = numeric(by_columns, symbols), numeric(by_propagation, symbols)
     for q in random_configurations(arm, 10, seed=2):
         known = dict(zip(generator.q, q))
-        for symbol, value in generator.definitions:  # in order: sums after their terms
+        for symbol, value in generator.lowering.definitions:  # in order: sums after their terms
             known[symbol] = float(value.subs(known))
         values = [known[s] for s in symbols]
         np.testing.assert_allclose(by_columns(values), by_propagation(values), atol=1e-12, rtol=0)
@@ -75,5 +75,5 @@ def test_planar_2r_closed_form():
 def test_parallel_axes_share_one_rotation():
     """UR5's three parallel pitch joints: the emitted fk computes cos(q2+q3+q4) once, from products."""
     generator = Generator(robot("ur5"))
-    names = {str(symbol) for symbol, _ in generator.definitions}
+    names = {str(symbol) for symbol, _ in generator.lowering.definitions}
     assert {"c23", "s23", "c234", "s234"} <= names

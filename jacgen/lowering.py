@@ -1,0 +1,156 @@
+"""The lowering core: named values and straight-line code over named temporaries.
+
+The algorithms (`kinematics`, `subproblems`, `ik`, `differential`) name every intermediate
+value with `Lowering.name`, so that no expression they build grows with the chain; a
+function's outputs are then lowered to a `Body`: the named values and trig symbols they read,
+common-subexpression elimination, constants folded, temporaries numbered in a fixed order
+(the output does not depend on hashing). Every printer turns a Body into its language.
+"""
+
+import heapq
+from dataclasses import dataclass
+from functools import cached_property
+
+import sympy
+from sympy.core.parameters import distribute
+from sympy.logic.boolalg import Boolean
+
+from .printers import fold_constants
+from .subproblems import TOLERANCES
+
+
+@dataclass(frozen=True)
+class Body:
+    """Straight-line code: definitions in order, then the outputs (selects, no branches)."""
+
+    read: frozenset  # the input symbols the body reads
+    definitions: tuple[tuple[sympy.Symbol, sympy.Expr], ...]
+    outputs: tuple[sympy.Expr, ...]  # row-major
+
+    @cached_property
+    def operation_count(self) -> int:
+        return int(sympy.count_ops([e for _, e in self.definitions] + list(self.outputs)))
+
+
+def is_boolean(value: sympy.Basic) -> bool:
+    """A truth value (a comparison, And, Or, ...): an `int` in C, a bool array in numpy."""
+    return isinstance(value, Boolean) and not isinstance(value, sympy.Expr)
+
+
+class Lowering:
+    """The named values of one robot (trig symbols defined first, by `define`) and the Bodies
+    lowered from them, each once per outputs and bindings."""
+
+    def __init__(self):
+        self.definitions: list[tuple[sympy.Symbol, sympy.Expr]] = []  # in an order that defines before use
+        self._names: dict[sympy.Expr, sympy.Symbol] = {}  # named values (see `name`)
+        self._folded: dict[sympy.Expr, sympy.Expr] = {}  # fold_constants' results, shared by every lowering
+        self._lowered: dict[tuple, Body] = {}
+
+    def define(self, symbol: sympy.Symbol, value: sympy.Expr):
+        """A symbol of the generated code (a joint's cos) and its value."""
+        self.definitions.append((symbol, value))
+
+    def name(self, value: sympy.Expr) -> sympy.Expr:
+        """`value` as a symbol of its own (an atom, a number or a product of atoms stays as it
+        is; -x is named as x). The chain names its rotations, steps and levers, so that every
+        expression CSE sees has a bounded size: written out, sympy flattens the nested sums
+        and each lever would repeat the rest of the chain."""
+        if value.is_Atom or (value.is_Mul and all(arg.is_Atom for arg in value.args)):
+            return value
+        negated = sympy.Add(*(-term for term in value.args)) if value.is_Add else -value
+        if value.could_extract_minus_sign() and not negated.could_extract_minus_sign():
+            return -self.name(negated)
+        if value in self._names:
+            return self._names[value]
+        symbol = sympy.Symbol(f"_n{len(self.definitions)}", real=True)
+        self.definitions.append((symbol, value))
+        self._names[value] = symbol
+        return symbol
+
+    def lower(self, outputs: list[sympy.Basic], bindings: dict | None = None) -> Body:
+        """`_lower`, once per outputs and bindings (jacobian_det's determinant is lowered to
+        compare its two forms, then again as a function)."""
+        key = (tuple(outputs), tuple((bindings or {}).items()))
+        if key not in self._lowered:
+            self._lowered[key] = self._lower(outputs, bindings)
+        return self._lowered[key]
+
+    def _lower(self, outputs: list[sympy.Basic], bindings: dict | None = None) -> Body:
+        """The outputs as straight-line code: the trig symbols and named values they need,
+        then temporaries (t0, t1, ...) after common-subexpression elimination, in an order
+        that defines before use."""
+        bindings = bindings or {}
+        values = dict(self.definitions) | bindings
+        needed, frontier = set(), set().union(*(e.free_symbols for e in outputs))
+        while frontier:
+            symbol = frontier.pop()
+            if symbol in values and symbol not in needed:
+                needed.add(symbol)
+                frontier |= values[symbol].free_symbols
+        named_symbols = set(self._names.values())
+        fold = lambda value: fold_constants(value, self._folded)  # noqa: E731
+        trig = [(s, fold(v)) for s, v in self.definitions
+                if s in needed and s not in named_symbols and s not in bindings]
+        named = [(s, v) for s, v in self.definitions if s in needed and s in named_symbols]
+        with distribute(False):
+            replacements, reduced = sympy.cse([fold(v) for _, v in named] + [fold(e) for e in outputs],
+                                              symbols=sympy.numbered_symbols("_r", real=True), order="canonical")
+        bound = [(s, fold(v)) for s, v in bindings.items() if s in needed]
+        definitions = _in_dependency_order(bound + trig + list(zip((s for s, _ in named), reduced)) + replacements)
+        definitions, reduced = _without_constants(definitions, reduced[len(named):])
+        temporaries = sympy.numbered_symbols("t", real=True)
+        rename = {symbol: next(temporaries) for symbol, _ in definitions if symbol.name.startswith("_")}
+        definitions = tuple((rename.get(s, s), v.xreplace(rename)) for s, v in definitions)
+        reduced = [e.xreplace(rename) for e in reduced]
+        read = set().union(*(e.free_symbols for _, e in definitions), *(e.free_symbols for e in reduced))
+        return Body(frozenset(read - {symbol for symbol, _ in definitions}), definitions, tuple(reduced))
+
+
+def _without_constants(definitions: list[tuple[sympy.Symbol, sympy.Expr]], outputs: list[sympy.Basic]):
+    """The definitions that are constants (numbers, truth values, the IK's tolerances) put
+    into their readers, which sympy then folds: a select on a condition that is always false
+    is its other side, and the definitions no longer read are dropped. A comparison of
+    tolerances and numbers is decided when it holds, or fails, in every real type."""
+    constants, kept = {}, []
+    for symbol, value in definitions:
+        if not constants.keys().isdisjoint(value.free_symbols):
+            value = value.xreplace(constants)
+        if is_boolean(value) and value.free_symbols and value.free_symbols <= TOLERANCES["double"].keys():
+            truths = {value.xreplace(numbers) for numbers in TOLERANCES.values()}
+            value = truths.pop() if len(truths) == 1 else value
+        if value.free_symbols <= TOLERANCES["double"].keys():
+            constants[symbol] = value
+        else:
+            kept.append((symbol, value))
+    outputs = [e.xreplace(constants) if not constants.keys().isdisjoint(e.free_symbols) else e for e in outputs]
+    # A folded select may leave the terms of its other side unread: those go too.
+    read = set().union(*(e.free_symbols for e in outputs))
+    for symbol, value in reversed(kept):
+        if symbol in read:
+            read |= value.free_symbols
+    return [(symbol, value) for symbol, value in kept if symbol in read], outputs
+
+
+def _in_dependency_order(definitions: list[tuple[sympy.Symbol, sympy.Expr]]) -> list[tuple[sympy.Symbol, sympy.Expr]]:
+    """Each definition after those it reads; among the ready ones, the earliest listed first
+    (so the order is fixed, whatever the hashing)."""
+    index = {symbol: k for k, (symbol, _) in enumerate(definitions)}
+    readers: dict[int, list[int]] = {k: [] for k in range(len(definitions))}
+    waiting = []
+    for k, (_, value) in enumerate(definitions):
+        reads = {index[s] for s in value.free_symbols if s in index}
+        waiting.append(len(reads))
+        for j in reads:
+            readers[j].append(k)
+    ready = [k for k, count in enumerate(waiting) if count == 0]
+    heapq.heapify(ready)
+    ordered = []
+    while ready:
+        k = heapq.heappop(ready)
+        ordered.append(definitions[k])
+        for reader in readers[k]:
+            waiting[reader] -= 1
+            if waiting[reader] == 0:
+                heapq.heappush(ready, reader)
+    return ordered
