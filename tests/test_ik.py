@@ -356,7 +356,8 @@ def c_solvers(request, tmp_path_factory):
     solvers = {}
     for name in WITH_IK + FREE_JOINT:
         arm = robot(name)
-        source = GENERATED / name / f"{name}.c" if real == "double" else _generate(arm, folder, ("c",), real)
+        float_ik = Generator(arm, selection=("ik", "ik_numeric"))  # the functions this fixture calls
+        source = GENERATED / name / f"{name}.c" if real == "double" else _generate(arm, folder, ("c",), real, float_ik)
         library = CLibrary(compile_shared([source], folder / f"lib{name}.so"), arm, [], real)
         closed = functools.partial(library.ik, max_solutions=8) if name in WITH_IK else None  # see test_free_joint
         solvers[name] = (closed, library.ik_numeric)
