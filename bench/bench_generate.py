@@ -40,7 +40,8 @@ render_robot(robot, generator=generator)
 seconds = time.perf_counter() - start
 operations = {f.name: f.body.operation_count for f in generator.functions()}
 peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
-print(json.dumps({"seconds": seconds, "peak_mb": peak, "operations": operations}))
+print(json.dumps({"seconds": seconds, "peak_mb": peak, "operations": operations,
+                  "complete": generator.singularities.complete}))
 """
 
 

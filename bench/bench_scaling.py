@@ -11,45 +11,28 @@ time (Python start-up excluded), the process's peak memory, and the operation co
 """
 
 import argparse
-import json
 import math
-import subprocess
 import sys
+import tempfile
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
+sys.path[:0] = [str(ROOT / "bench"), str(ROOT / "tests")]
+import bench_generate  # noqa: E402 (one worker renders a robot in a fresh process for both benches)
+from random_arms import random_arm_text  # noqa: E402
 COLUMNS = ("seconds", "peak_mb", "fk_jacobian", "singularity_factors", "manipulability")
 
 
-def worker(dof: int, seed: int) -> None:
-    """Render one random arm in this process; print its measurements as JSON."""
-    import resource
-    import time
-
-    sys.path[:0] = [str(ROOT), str(ROOT / "tests")]
-    from jacgen.functions import Generator
-    from jacgen.render import render_robot
-    from jacgen.robot import parse_robot
-    from random_arms import random_arm_text
-
-    robot = parse_robot(random_arm_text(seed, dof=dof).encode(), f"arm{seed}.yaml")
-    start = time.perf_counter()
-    generator = Generator(robot)
-    render_robot(robot, generator=generator)
-    seconds = time.perf_counter() - start
-    operations = {f.name: f.body.operation_count for f in generator.functions()}
-    peak_mb = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
-    print(json.dumps({"seconds": seconds, "peak_mb": peak_mb, "complete": generator.singularities.complete,
-                      **{name: operations[name] for name in COLUMNS[2:]}}))
-
-
-def measure(dof: int, repeats: int) -> dict:
+def measure(dof: int, repeats: int, folder: Path) -> dict:
+    """The means over `repeats` random arms of `dof` joints, each rendered in a fresh process."""
     rows = []
     for repeat in range(repeats):
         seed = 1000 * dof + repeat
-        output = subprocess.run([sys.executable, __file__, "--worker", str(dof), str(seed)], check=True,
-                                capture_output=True, text=True).stdout
-        rows.append(json.loads(output))
+        path = folder / f"arm{seed}.yaml"
+        path.write_text(random_arm_text(seed, dof=dof))
+        result = bench_generate.measure(ROOT, path, timeout=3600)
+        rows.append({"seconds": result["seconds"], "peak_mb": result["peak_mb"], "complete": result["complete"],
+                     **{name: result["operations"][name] for name in COLUMNS[2:]}})
     mean = {key: sum(row[key] for row in rows) / len(rows) for key in COLUMNS}
     return {"n": dof, **mean, "peak_mb": max(row["peak_mb"] for row in rows),
             "max_seconds": max(row["seconds"] for row in rows), "exact": sum(row["complete"] for row in rows)}
@@ -63,9 +46,6 @@ def slope(xs, ys) -> float:
 
 
 def main() -> None:
-    if sys.argv[1:2] == ["--worker"]:
-        worker(int(sys.argv[2]), int(sys.argv[3]))
-        return
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--sizes", default="1,2,4,6,8,12,16,24,32", help="comma-separated joint counts")
     parser.add_argument("--repeats", type=int, default=3, help="random arms per size")
@@ -75,7 +55,8 @@ def main() -> None:
     print(f"{'n':>3} {'time s':>7} {'max s':>7} {'peak MB':>8} {'fk_jacobian':>12} {'sing. factors':>14} "
           f"{'manipulab.':>11} {'exact':>6}")
     for n in (int(size) for size in arguments.sizes.split(",")):
-        row = measure(n, arguments.repeats)
+        with tempfile.TemporaryDirectory() as folder:
+            row = measure(n, arguments.repeats, Path(folder))
         rows.append(row)
         print(f"{n:>3} {row['seconds']:>7.2f} {row['max_seconds']:>7.2f} {row['peak_mb']:>8.0f} "
               f"{row['fk_jacobian']:>12.0f} {row['singularity_factors']:>14.0f} {row['manipulability']:>11.0f} "
@@ -83,7 +64,8 @@ def main() -> None:
     for label, chosen in (("all sizes", rows), ("n >= 6", [row for row in rows if row["n"] >= 6])):
         if len(chosen) >= 2:
             sizes = [row["n"] for row in chosen]
-            slopes = ", ".join(f"{key} n^{slope(sizes, [row[key] for row in chosen]):.2f}" for key in COLUMNS)
+            slopes = ", ".join(f"{key} n^{slope(sizes, [row[key] for row in chosen]):.2f}" for key in COLUMNS
+                               if all(row[key] > 0 for row in chosen))  # a log needs positive values
             print(f"log-log slopes ({label}): {slopes}")
 
 
