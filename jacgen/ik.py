@@ -15,7 +15,7 @@ from dataclasses import dataclass
 import sympy
 
 from .structure import E_Z, SOLVERS, Geometry, SolverInfo, Structure, classify, is_zero, tidy
-from .subproblems import EPS, Angle, IsFinite, Subproblems, relative, select, times, times_transposed, wrapped
+from .subproblems import EPS, Angle, Floor, IsFinite, Subproblems, relative, select, times, times_transposed, wrapped
 
 Matrix = sympy.Matrix
 
@@ -392,7 +392,7 @@ def _in_limits(sp: Subproblems, value, joint) -> tuple[sympy.Expr, sympy.Basic]:
     if not joint.revolute:
         return value, _inside(value, limits)
     value = sp.name(value)
-    shifted = sp.name(value - TURN * sympy.floor((value - limits[0]) / TURN))
+    shifted = sp.name(value - TURN * Floor((value - limits[0]) / TURN))
     wrapped_inside, shifted_inside = _inside(value, limits), shifted <= limits[1]
     return select(sympy.And(sympy.Not(wrapped_inside), shifted_inside), shifted, value), \
         sympy.Or(wrapped_inside, shifted_inside)
@@ -430,7 +430,7 @@ def _nearest_equivalent(sp: Subproblems, value, given, seed, joint):
     lowest inside, `_in_limits`). A prismatic joint's value as it is."""
     if not joint.revolute:
         return value
-    nearest = sp.name(value + TURN * sympy.floor((seed - value) / TURN + sympy.Rational(1, 2)))
+    nearest = sp.name(value + TURN * Floor((seed - value) / TURN + sympy.Rational(1, 2)))
     limits = joint.limits
     if limits is None:
         return nearest

@@ -70,7 +70,7 @@ class PythonPrinter(NumPyPrinter):
     _kf = {name: f"xp.{function}" for name, function in {
         "sin": "sin", "cos": "cos", "tan": "tan", "asin": "asin", "acos": "acos", "atan": "atan",
         "atan2": "atan2", "exp": "exp", "log": "log", "sqrt": "sqrt", "Abs": "abs", "sign": "sign",
-        "floor": "floor", "ceiling": "ceil",
+        "floor": "floor", "ceiling": "ceil", "Floor": "floor",
     }.items()}
 
     def __init__(self):
@@ -94,6 +94,8 @@ class PythonPrinter(NumPyPrinter):
 
     def _print_IsFinite(self, expr):
         return f"xp.isfinite({self._print(expr.args[0])})"
+
+    _print_Floor = _print_known_func
 
 
 C_REAL_TYPES = {"double": ast.float64, "float": ast.float32}
@@ -134,7 +136,9 @@ class CPrinter(C99CodePrinter):
         self.real = real
         self._folded = {}  # one fold per shared subtree across everything this printer prints
         super().__init__({"type_aliases": {ast.real: C_REAL_TYPES[real]}, "strict": True, "math_macros": {},
-                          "order": "none"})
+                          "order": "none", "user_functions": {"Floor": "floor"}})
+
+    _print_Floor = C99CodePrinter._print_math_func
 
     def doprint(self, expr, assign_to=None):
         folded = fold_constants(expr.xreplace(TOLERANCES[self.real]), self._folded)
@@ -192,7 +196,7 @@ class CasadiPrinter(AbstractPythonCodePrinter):
         "sin": "sin", "cos": "cos", "tan": "tan", "asin": "asin", "acos": "acos", "atan": "atan",
         "atan2": "atan2", "sinh": "sinh", "cosh": "cosh", "tanh": "tanh", "asinh": "asinh",
         "acosh": "acosh", "atanh": "atanh", "exp": "exp", "log": "log", "Abs": "fabs",
-        "sign": "sign", "floor": "floor", "ceiling": "ceil", "erf": "erf",
+        "sign": "sign", "floor": "floor", "ceiling": "ceil", "erf": "erf", "Floor": "floor",
     }.items()}
     _kc = {"Pi": "casadi.pi"}
 

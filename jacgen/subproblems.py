@@ -38,6 +38,18 @@ class IsFinite(BooleanFunction):
     nargs = 1
 
 
+class Floor(sympy.Function):
+    """floor(x), decided only for a number: sympy's own floor asks its assumption system
+    whether x is an integer, real, ... each time CSE or a substitution rebuilds it (seconds
+    per robot for the IK's angle wrapping)."""
+
+    nargs = 1
+
+    @classmethod
+    def eval(cls, x):
+        return sympy.floor(x) if x.is_Number else None
+
+
 def select(condition, if_true, if_false) -> sympy.Expr:
     """`if_true` where `condition` holds, else `if_false`; both are computed."""
     return sympy.Piecewise((if_true, condition), (if_false, True))
