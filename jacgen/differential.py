@@ -12,7 +12,7 @@ from typing import Callable
 
 import sympy
 
-from .subproblems import RANK, IsFinite, select
+from .subproblems import RANK, Above, AtLeast, AtMost, Below, IsFinite, Unequal, select
 
 # Statuses of velocity_ik, the same in every backend.
 VELOCITY_IK_OK, VELOCITY_IK_SINGULAR, VELOCITY_IK_NOT_FINITE = 0, 1, 2
@@ -27,9 +27,9 @@ def householder_solve(A: list[list[sympy.Expr]], b: list[sympy.Expr], name: Call
     for j in range(k):
         column = [A[i][j] for i in range(j, k)]
         norm = name(sympy.sqrt(sympy.Add(*(c**2 for c in column))))
-        alpha = name(-select(column[0] >= 0, 1, -1) * norm)  # R[j][j]; the sign avoids cancellation
+        alpha = name(-select(AtLeast(column[0], 0), 1, -1) * norm)  # R[j][j]; the sign avoids cancellation
         v = [name(column[0] - alpha)] + column[1:]
-        beta = name(select(norm > 0, 1 / (norm * (norm + sympy.Abs(column[0]))), 0))  # 2 / |v|^2
+        beta = name(select(Above(norm, 0), 1 / (norm * (norm + sympy.Abs(column[0]))), 0))  # 2 / |v|^2
         for c in range(j + 1, k):
             s = name(beta * sympy.Add(*(v[i - j] * A[i][c] for i in range(j, k))))
             for i in range(j, k):
@@ -41,8 +41,8 @@ def householder_solve(A: list[list[sympy.Expr]], b: list[sympy.Expr], name: Call
         norms.append(norm)
     x = [sympy.Integer(0)] * k
     for j in reversed(range(k)):
-        x[j] = name(select(sympy.Ne(A[j][j], 0), (b[j] - sympy.Add(*(A[j][c] * x[c] for c in range(j + 1, k)))) / A[j][j], 0))
-    return x, sympy.Or(*(norm <= RANK * scale for norm in norms))
+        x[j] = name(select(Unequal(A[j][j], 0), (b[j] - sympy.Add(*(A[j][c] * x[c] for c in range(j + 1, k)))) / A[j][j], 0))
+    return x, sympy.Or(*(AtMost(norm, RANK * scale) for norm in norms))
 
 
 def velocity_ik(js: sympy.Matrix, q: list, mu_dot: list, damping: sympy.Symbol,
@@ -61,11 +61,11 @@ def velocity_ik(js: sympy.Matrix, q: list, mu_dot: list, damping: sympy.Symbol,
     q_dot = [name(e) for e in js.T * sympy.Matrix(x)] if m <= n else x
     if m == n:
         direct, direct_singular = householder_solve(js.tolist(), list(mu_dot), name)
-        damped = damping > 0
+        damped = Above(damping, 0)
         q_dot = [select(damped, a, b) for a, b in zip(q_dot, direct)]
         singular = sympy.Or(sympy.And(damped, singular), sympy.And(sympy.Not(damped), direct_singular))
     inputs = [*q, *mu_dot, damping, *(e for e in js)]
-    finite = sympy.And(IsFinite(name(sympy.Add(*inputs))), damping >= 0)
+    finite = sympy.And(IsFinite(name(sympy.Add(*inputs))), AtLeast(damping, 0))
     status = select(sympy.Not(finite), VELOCITY_IK_NOT_FINITE, select(singular, VELOCITY_IK_SINGULAR, VELOCITY_IK_OK))
     ok = sympy.And(finite, sympy.Not(singular))
     return [select(ok, e, 0) for e in q_dot], status
@@ -82,13 +82,13 @@ def rotation_vector(E: sympy.Matrix, name: Callable) -> list[sympy.Expr]:
     cos = name((E[0, 0] + E[1, 1] + E[2, 2] - 1) / 2)
     sin = name(sympy.sqrt(v[0]**2 + v[1]**2 + v[2]**2))
     angle = name(sympy.atan2(sin, cos))
-    regular = sympy.Or(sin > sympy.Float(1e-6), cos > 0)
-    scale = name(select(sin > 0, angle / sin, 1))
-    first = [sympy.And(E[0, 0] >= E[1, 1], E[0, 0] >= E[2, 2]), E[1, 1] >= E[2, 2]]
+    regular = sympy.Or(Above(sin, sympy.Float(1e-6)), Above(cos, 0))
+    scale = name(select(Above(sin, 0), angle / sin, 1))
+    first = [sympy.And(AtLeast(E[0, 0], E[1, 1]), AtLeast(E[0, 0], E[2, 2])), AtLeast(E[1, 1], E[2, 2])]
     column = [name(select(first[0], (E[i, 0] + int(i == 0)) / 2, select(first[1], (E[i, 1] + int(i == 1)) / 2,
                                                                        (E[i, 2] + int(i == 2)) / 2))) for i in range(3)]
     length = name(sympy.sqrt(column[0]**2 + column[1]**2 + column[2]**2))
-    sign = name(select(column[0] * v[0] + column[1] * v[1] + column[2] * v[2] >= 0, 1, -1))
+    sign = name(select(AtLeast(column[0] * v[0] + column[1] * v[1] + column[2] * v[2], 0), 1, -1))
     return [name(select(regular, scale * v[i], sign * angle * column[i] / length)) for i in range(3)]
 
 
@@ -122,4 +122,4 @@ def clamp(value: sympy.Expr, bounds) -> sympy.Expr:
     if bounds is None:
         return value
     low, high = (sympy.Float(b) for b in bounds)
-    return select(value < low, low, select(value > high, high, value))
+    return select(Below(value, low), low, select(Above(value, high), high, value))

@@ -15,7 +15,8 @@ from dataclasses import dataclass
 import sympy
 
 from .structure import E_Z, SOLVERS, Geometry, SolverInfo, Structure, classify, is_zero, tidy
-from .subproblems import EPS, Angle, Floor, IsFinite, Subproblems, relative, select, times, times_transposed, wrapped
+from .subproblems import (EPS, Above, Angle, AtLeast, AtMost, Below, Floor, IsFinite, Subproblems, relative, select,
+                          times, times_transposed, wrapped)
 
 Matrix = sympy.Matrix
 
@@ -228,7 +229,7 @@ def _yaw_pitch_branches(sp: Subproblems, k: dict, target, form: ClosedForm, dof:
     yaw puts the target in the arm's plane (SP4), and the wrist point is reached by SP3
     (elbow) and SP1 (shoulder). A pitch beyond +-pi/2 has no solution."""
     point = tuple(target[:3])
-    pitch_valid = sympy.Abs(target[3]) <= sympy.pi / 2
+    pitch_valid = AtMost(sympy.Abs(target[3]), sympy.pi / 2)
     approaches = sp.sp4((0, 0, 1), k["tool_x"], k["h2"], sp.name(-sympy.sin(target[3])))
     branches = []
     for base in sp.sp4(sp.sub(point, k["p1"]), k["h2"], k["h1"], k["reach"]):
@@ -305,10 +306,10 @@ def _spherical_wrist_prismatic_branches(sp: Subproblems, k: dict, target, form: 
     half, rest = sp.dot(k["h3"], e), sp.name(sp.dot(e, e) - sp.dot(d, d))
     disc = sp.name(half**2 - rest)
     scale = sp.name(sp.dot(e, e) + sp.dot(d, d))
-    two = disc > EPS * scale
+    two = Above(disc, EPS * scale)
     root = sp.name(select(two, sympy.sqrt(disc), 0))
     branches = []
-    for t3, valid in ((sp.name(-half + root), disc >= -EPS * scale), (sp.name(-half - root), two)):
+    for t3, valid in ((sp.name(-half + root), AtLeast(disc, -EPS * scale)), (sp.name(-half - root), two)):
         reached = sp.add(e, sp.scaled(k["h3"], t3))
         for t1, t2, shoulder_valid in sp.sp2(reached, d, k["h1"], k["h2"]):
             branches += _wrist_branches(sp, k, R, ((k["h1"], t1), (k["h2"], t2)), (t1.theta, t2.theta, t3),
@@ -376,7 +377,7 @@ TURN = 2 * sympy.pi
 
 
 def _inside(value, limits: tuple[float, float]) -> sympy.Basic:
-    return sympy.And(value >= limits[0], value <= limits[1])
+    return sympy.And(AtLeast(value, limits[0]), AtMost(value, limits[1]))
 
 
 def _in_limits(sp: Subproblems, value, joint) -> tuple[sympy.Expr, sympy.Basic]:
@@ -393,7 +394,7 @@ def _in_limits(sp: Subproblems, value, joint) -> tuple[sympy.Expr, sympy.Basic]:
         return value, _inside(value, limits)
     value = sp.name(value)
     shifted = sp.name(value - TURN * Floor((value - limits[0]) / TURN))
-    wrapped_inside, shifted_inside = _inside(value, limits), shifted <= limits[1]
+    wrapped_inside, shifted_inside = _inside(value, limits), AtMost(shifted, limits[1])
     return select(sympy.And(sympy.Not(wrapped_inside), shifted_inside), shifted, value), \
         sympy.Or(wrapped_inside, shifted_inside)
 
@@ -434,7 +435,7 @@ def _nearest_equivalent(sp: Subproblems, value, given, seed, joint):
     limits = joint.limits
     if limits is None:
         return nearest
-    below = nearest < seed
+    below = Below(nearest, seed)
     second, third = sp.name(nearest + select(below, TURN, -TURN)), sp.name(nearest - select(below, TURN, -TURN))
     return select(_inside(nearest, limits), nearest,
                   select(_inside(second, limits), second, select(_inside(third, limits), third, given)))
@@ -453,12 +454,12 @@ def nearest(robot, sp: Subproblems, q: sympy.Matrix, valid: list, inside: list, 
         candidate = [sp.name(value if j == free else _nearest_equivalent(sp, sp.name(value), value, seed[j], joint))
                      for j, (value, joint) in enumerate(zip(row, robot.joints))]
         cost = sp.name(sympy.Add(*(w * (x - s) ** 2 for w, x, s in zip(weights, candidate, seed))))
-        allowed = sp.name(select(sympy.And(row_valid, row_inside), 1, 0)) > 0
-        take = sp.name(select(sympy.And(allowed, sympy.Or(found < 1, cost < distance)), 1, 0)) > 0
+        allowed = Above(sp.name(select(sympy.And(row_valid, row_inside), 1, 0)), 0)
+        take = Above(sp.name(select(sympy.And(allowed, sympy.Or(Below(found, 1), Below(cost, distance))), 1, 0)), 0)
         best = [sp.name(select(take, x, b)) for x, b in zip(candidate, best)]
         distance = sp.name(select(take, cost, distance))
         found = sp.name(select(allowed, 1, found))
     inputs_finite = IsFinite(sp.name(sympy.Add(*read, *seed, *weights)))
     status = select(sympy.Not(inputs_finite), IK_NEAREST_NOT_FINITE,
-                    select(found > 0, IK_NEAREST_OK, IK_NEAREST_NO_SOLUTION))
-    return [select(sympy.And(found > 0, inputs_finite), x, s) for x, s in zip(best, seed)], status
+                    select(Above(found, 0), IK_NEAREST_OK, IK_NEAREST_NO_SOLUTION))
+    return [select(sympy.And(Above(found, 0), inputs_finite), x, s) for x, s in zip(best, seed)], status

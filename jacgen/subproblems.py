@@ -28,6 +28,8 @@ RANK = sympy.Symbol("RANK", positive=True)  # velocity_ik's singularity threshol
 TOLERANCES = {"double": {EPS: sympy.Float(1e-12), TINY: sympy.Float(1e-24), RANK: sympy.Float(1e-12)},
               "float": {EPS: sympy.Float(1e-6), TINY: sympy.Float(1e-12), RANK: sympy.Float(1e-5)}}
 
+TOLERANCE_SYMBOLS = frozenset(TOLERANCES["double"])
+
 Vector = tuple[sympy.Expr, sympy.Expr, sympy.Expr]
 
 
@@ -48,6 +50,68 @@ class Floor(sympy.Function):
     @classmethod
     def eval(cls, x):
         return sympy.floor(x) if x.is_Number else None
+
+
+class _Plain:
+    """A comparison decided only between numbers and the positive tolerances (or of a value with
+    itself). sympy's own asks
+    its assumption system whether the difference of its sides is nonnegative each time it is
+    built, and CSE and every substitution build each comparison again (a fifth of a robot's
+    generation time). It sorts and prints as sympy's comparison of the same kind; its negation
+    and its reversals (which sympy's And and Not form) are comparisons of this family."""
+
+    @classmethod
+    def _eval_relation(cls, lhs, rhs, **options):
+        if lhs == rhs or (lhs.free_symbols | rhs.free_symbols) <= TOLERANCE_SYMBOLS:  # 1 >= -EPS: true
+            return super()._eval_relation(lhs, rhs, **options)
+        return cls(lhs, rhs, evaluate=False)
+
+    @classmethod
+    def class_key(cls):
+        return 5, 0, cls.kind.__name__
+
+    @property
+    def negated(self):
+        return PLAIN[NEGATED[self.kind]](*self.args)
+
+    @property
+    def reversed(self):
+        return PLAIN[REVERSED[self.kind]](*self.args[::-1])
+
+    @property
+    def reversedsign(self):
+        return PLAIN[REVERSED[self.kind]](-self.lhs, -self.rhs)
+
+
+class AtLeast(_Plain, sympy.GreaterThan):
+    kind = sympy.GreaterThan
+
+
+class Above(_Plain, sympy.StrictGreaterThan):
+    kind = sympy.StrictGreaterThan
+
+
+class AtMost(_Plain, sympy.LessThan):
+    kind = sympy.LessThan
+
+
+class Below(_Plain, sympy.StrictLessThan):
+    kind = sympy.StrictLessThan
+
+
+class Equal(_Plain, sympy.Equality):
+    kind = sympy.Equality
+
+
+class Unequal(_Plain, sympy.Unequality):
+    kind = sympy.Unequality
+
+
+PLAIN = {cls.kind: cls for cls in (AtLeast, Above, AtMost, Below, Equal, Unequal)}
+NEGATED = {sympy.Ge: sympy.Lt, sympy.Gt: sympy.Le, sympy.Le: sympy.Gt, sympy.Lt: sympy.Ge, sympy.Eq: sympy.Ne,
+           sympy.Ne: sympy.Eq}
+REVERSED = {sympy.Ge: sympy.Le, sympy.Gt: sympy.Lt, sympy.Le: sympy.Ge, sympy.Lt: sympy.Gt, sympy.Eq: sympy.Eq,
+            sympy.Ne: sympy.Ne}
 
 
 def select(condition, if_true, if_false) -> sympy.Expr:
@@ -123,7 +187,7 @@ class Subproblems:
         x = self.name(self.dot(p, q) - self.dot(k, p) * self.dot(k, q))
         y = self.dot(k, self.cross(p, q))
         rr = self.name(x * x + y * y)
-        free = rr <= TINY * self.dot(p, p) * self.dot(q, q)
+        free = AtMost(rr, TINY * self.dot(p, p) * self.dot(q, q))
         scale = self.name(select(free, 1, 1 / sympy.sqrt(rr)))  # never 1/0, even for constant vectors
         return Angle(select(free, 0, sympy.atan2(y, x)), self.name(select(free, 1, x * scale)),
                      self.name(select(free, 0, y * scale)))
@@ -140,14 +204,14 @@ class Subproblems:
         rhs = self.name(d - hk * kp)
         r2 = self.name(a * a + b * b)
         scale = self.name(self.dot(h, h) * self.dot(p, p))
-        constant = r2 <= TINY * scale
+        constant = AtMost(r2, TINY * scale)
         inverse_r = self.name(select(constant, 1, 1 / sympy.sqrt(r2)))
         cos_phi, sin_phi = self.name(a * inverse_r), self.name(b * inverse_r)
         cos_alpha = self.name(rhs * inverse_r)
         disc = self.name(1 - cos_alpha**2)
-        two = disc > EPS
+        two = Above(disc, EPS)
         # a double root: cos(alpha) = +-1, sin(alpha) = 0
-        cos_alpha = self.name(select(two, cos_alpha, select(cos_alpha > 0, 1, -1)))
+        cos_alpha = self.name(select(two, cos_alpha, select(Above(cos_alpha, 0), 1, -1)))
         sin_alpha = self.name(select(two, sympy.sqrt(disc), 0))
         phi, alpha = self.name(sympy.atan2(b, a)), self.name(sympy.atan2(sin_alpha, cos_alpha))
         plus = Angle(self.name(select(constant, 0, phi + alpha)),
@@ -155,7 +219,7 @@ class Subproblems:
                      self.name(select(constant, 0, sin_phi * cos_alpha + cos_phi * sin_alpha)))
         minus = Angle(self.name(phi - alpha), self.name(cos_phi * cos_alpha + sin_phi * sin_alpha),
                       self.name(sin_phi * cos_alpha - cos_phi * sin_alpha))
-        plus_valid = sympy.Or(sympy.And(constant, rhs**2 <= EPS * scale), sympy.And(sympy.Not(constant), disc >= -EPS))
+        plus_valid = sympy.Or(sympy.And(constant, AtMost(rhs**2, EPS * scale)), sympy.And(sympy.Not(constant), AtLeast(disc, -EPS)))
         return Root(plus, plus_valid), Root(minus, sympy.And(sympy.Not(constant), two))
 
     def sp3(self, p: Vector, q: Vector, k: Vector, dd: sympy.Expr) -> tuple[Root, Root]:
@@ -172,11 +236,11 @@ class Subproblems:
         alpha, beta = self.name((u - k12 * v) / nn), self.name((v - k12 * u) / nn)
         pp = self.dot(p, p)
         gg = self.name((pp - alpha**2 - beta**2 - 2 * alpha * beta * k12) / nn)
-        two = gg > EPS * pp
+        two = Above(gg, EPS * pp)
         gamma = self.name(select(two, sympy.sqrt(gg), 0))
         normal = self.cross(k1, k2)
         pairs = []
-        for sign, valid in ((1, gg >= -EPS * pp), (-1, two)):
+        for sign, valid in ((1, AtLeast(gg, -EPS * pp)), (-1, two)):
             c = self.vector(alpha * k1[i] + beta * k2[i] + sign * gamma * normal[i] for i in range(3))
             pairs.append((self.sp1(c, q, k1), self.sp1(p, c, k2), valid))
         return tuple(pairs)
