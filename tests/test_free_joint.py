@@ -89,7 +89,7 @@ def test_panda_contains_frankik_solutions(tmp_path):
     text = open(robot("panda").source).read().replace("name: panda", "name: panda_flange")
     tcp = parse_robot(text.replace("tool: {xyz: [0, 0, 0.103]", "tool: {xyz: [0, 0, 0.1034]").encode())
     flange = parse_robot(text.replace("tool: {xyz: [0, 0, 0.103], rpy: [0, 0, -45]}", "").encode())
-    write_files(render_robot(flange, ("python",)), tmp_path)
+    write_files(render_robot(flange, ("python",), functions=("ik",)), tmp_path)
     module = import_file(tmp_path / flange.name / f"{flange.name}.py", "free_joint_panda_flange")
     q = random_configurations(flange, 1000, seed=33)
     compared = 0
@@ -143,7 +143,7 @@ def test_random_arms_round_trip(kind, seed, free, tmp_path):
     (None: joint 7, the first it tries, works for both kinds)."""
     text = (_srs if kind == "srs" else _offset_elbow)(seed) + (f"ik: {{free_joint: {free}}}\n" if free else "")
     arm = parse_robot(text.encode())
-    write_files(render_robot(arm, ("python",)), tmp_path)
+    write_files(render_robot(arm, ("python",), functions=("ik",)), tmp_path)
     module = import_file(tmp_path / arm.name / f"{arm.name}.py", f"free_joint_{arm.name}")
     assert module.IK_FREE_JOINT == (free or 7) - 1
     q = np.random.default_rng(seed).uniform(-np.pi, np.pi, (300, 7))
