@@ -107,10 +107,10 @@ def main() -> None:
                 now, then = best(now), best(then)
                 ratio = then["seconds"] / now["seconds"] if now and then else None
                 operations = [f"{text(counts(now).get(name))}/{text(counts(then).get(name))}" for name in COUNTED]
-                print(f"{robot.stem:<14} {text(now and now['seconds'], '{:.2f}'):>7} "
-                      f"{text(then and then['seconds'], '{:.2f}') if then else '>' + str(int(options.timeout)):>7} "
-                      f"{text(ratio, '{:.1f}x'):>6} {text(now and now['peak_mb'], '{:.0f}'):>7} "
-                      f"{text(then and then['peak_mb'], '{:.0f}'):>7}  " + "  ".join(operations), flush=True)
+                seconds = [f"{r['seconds']:.2f}" if r else f">{options.timeout:.0f}" for r in (now, then)]
+                memory = [f"{r['peak_mb']:.0f}" if r else "-" for r in (now, then)]
+                print(f"{robot.stem:<14} {seconds[0]:>7} {seconds[1]:>7} {text(ratio, '{:.1f}x'):>6} {memory[0]:>7} "
+                      f"{memory[1]:>7}  " + "  ".join(operations), flush=True)
         finally:
             subprocess.run(["git", "-C", str(ROOT), "worktree", "remove", "--force", str(baseline)], check=True)
 

@@ -30,8 +30,10 @@ def _functions(ctx, param, value: str | None) -> tuple[str, ...] | None:
     if value is None:
         return None
     names = tuple(dict.fromkeys(part.strip() for part in value.split(",") if part.strip()))
+    if not names:
+        raise click.BadParameter("expected a comma-separated list of function names")
     try:
-        with_callees(names or ("",))
+        with_callees(names)
     except ValueError as error:
         raise click.BadParameter(str(error)) from None
     return names

@@ -398,8 +398,6 @@ class Generator:
         """The selected functions this robot does not have, each with why."""
         made = {f.name for f in self._functions}
         made |= {name for name, callees in CALLEES.items() if made.issuperset(callees)}
-        if self.closed_form is None:
-            made.discard("ik")
         why = {"ik": f"no closed form ({self.model.structure.reason})",
                "jacobian_det": f"Js is {len(self.robot.task)} x {self.robot.dof}, not square"}
         why["ik_branches"] = why["ik_nearest"] = why["ik"]

@@ -54,11 +54,11 @@ class Floor(sympy.Function):
 
 class _Plain:
     """A comparison decided only between numbers and the positive tolerances (or of a value with
-    itself). sympy's own asks
-    its assumption system whether the difference of its sides is nonnegative each time it is
-    built, and CSE and every substitution build each comparison again (a fifth of a robot's
-    generation time). It sorts and prints as sympy's comparison of the same kind; its negation
-    and its reversals (which sympy's And and Not form) are comparisons of this family."""
+    itself). sympy's own asks its assumption system whether the difference of its sides is
+    nonnegative each time it is built, and CSE and every substitution build each comparison
+    again (a fifth of a robot's generation time). It sorts and prints as sympy's comparison of
+    the same kind; its negation and its reversals (which sympy's And and Not form) are
+    comparisons of this family."""
 
     @classmethod
     def _eval_relation(cls, lhs, rhs, **options):
@@ -83,30 +83,14 @@ class _Plain:
         return PLAIN[REVERSED[self.kind]](-self.lhs, -self.rhs)
 
 
-class AtLeast(_Plain, sympy.GreaterThan):
-    kind = sympy.GreaterThan
+def _plain(name: str, kind: type) -> type:
+    """The plain comparison of sympy's `kind`."""
+    return type(name, (_Plain, kind), {"kind": kind, "__module__": __name__})
 
 
-class Above(_Plain, sympy.StrictGreaterThan):
-    kind = sympy.StrictGreaterThan
-
-
-class AtMost(_Plain, sympy.LessThan):
-    kind = sympy.LessThan
-
-
-class Below(_Plain, sympy.StrictLessThan):
-    kind = sympy.StrictLessThan
-
-
-class Equal(_Plain, sympy.Equality):
-    kind = sympy.Equality
-
-
-class Unequal(_Plain, sympy.Unequality):
-    kind = sympy.Unequality
-
-
+AtLeast, Above = _plain("AtLeast", sympy.GreaterThan), _plain("Above", sympy.StrictGreaterThan)
+AtMost, Below = _plain("AtMost", sympy.LessThan), _plain("Below", sympy.StrictLessThan)
+Equal, Unequal = _plain("Equal", sympy.Equality), _plain("Unequal", sympy.Unequality)
 PLAIN = {cls.kind: cls for cls in (AtLeast, Above, AtMost, Below, Equal, Unequal)}
 NEGATED = {sympy.Ge: sympy.Lt, sympy.Gt: sympy.Le, sympy.Le: sympy.Gt, sympy.Lt: sympy.Ge, sympy.Eq: sympy.Ne,
            sympy.Ne: sympy.Eq}
