@@ -59,14 +59,14 @@ def _common(robot: Robot) -> dict:
 
 def _python_function(function: Function, printer: PythonPrinter, parameters: list[dict]) -> dict:
     body = function.body
+    definitions, outputs = printer.body(body)
     shapes = [() if a.scalar else a.symbols.shape[:1] if a.vector else a.symbols.shape for a in function.arguments]
     batched = sum(not a.scalar for a in function.arguments)
     results = []
-    for output, values in function.parts(body.outputs):
+    for (output, values), (_, texts) in zip(function.parts(body.outputs), function.parts(outputs)):
         dtype = ", dtype=xp.bool" if output.boolean else ", dtype=dtype"
         codes = []
-        for k, value in enumerate(values):
-            code = printer.doprint(value)
+        for k, (value, code) in enumerate(zip(values, texts)):
             if not value.free_symbols:  # a number or truth value: an array of the batch shape, like the others
                 code = f"xp.full(batch, {code}{dtype}, device=device)"
             elif batched > 1 or output.scalar:  # it may read only some of the batched arguments
@@ -93,7 +93,7 @@ def _python_function(function: Function, printer: PythonPrinter, parameters: lis
         "inputs": [(str(symbol), f"{argument.name}[..., {row}]" if argument.vector else f"{argument.name}[..., {row}, {col}]")
                    for symbol, argument, row, col in function.inputs if symbol in read],
         "trig": repr(tuple(offsets)) if trig else None,
-        "definitions": [(str(symbol), trig.get(symbol) or printer.doprint(e)) for symbol, e in body.definitions],
+        "definitions": [(body.name(symbol), trig.get(symbol) or text) for (symbol, _), text in zip(body.definitions, definitions)],
         "results": results,
     }
 
@@ -187,7 +187,8 @@ def _c_function(function: Function, robot: Robot, printer: CPrinter, macros: dic
     unused = [a.name for a in function.arguments if a.name not in passed
               and not any(argument is a for _, argument, _, _ in inputs) and not (a.scalar and a.symbols[0] in body.read)]
     unused += ["p"] * bool(robot.symbolic_parameters and not parameters)
-    values = dict(function.parts(body.outputs))
+    definitions, outputs = printer.body(body)
+    values = dict(function.parts(outputs))
     types = {result.name: _c_type(output, real) for call in function.calls
              for result, output in zip(call.results, functions[call.function].outputs)}
     return {
@@ -200,10 +201,10 @@ def _c_function(function: Function, robot: Robot, printer: CPrinter, macros: dic
         "calls": [_c_call(call, functions[call.function], robot, macros) for call in function.calls],
         "inputs": [(types.get(argument.name, real), str(symbol), f"{argument.name}[{row * argument.symbols.cols + col}]")
                    for symbol, argument, row, col in inputs] + [(real, name, f"p->{name}") for name in parameters],
-        "definitions": [("int" if is_boolean(e) else real, str(symbol), printer.doprint(e)) for symbol, e in body.definitions],
-        "outputs": [(f"{output.name}[{k}]", printer.doprint(e)) for output in arrays
-                    for k, e in enumerate(values[output])],
-        "result": printer.doprint(values[returned][0]) if returned else None,
+        "definitions": [("int" if is_boolean(e) else real, body.name(symbol), text)
+                        for (symbol, e), text in zip(body.definitions, definitions)],
+        "outputs": [(f"{output.name}[{k}]", text) for output in arrays for k, text in enumerate(values[output])],
+        "result": values[returned][0] if returned else None,
     }
 
 
@@ -240,12 +241,13 @@ def _task_lines(robot: Robot) -> list[str]:
 
 def _casadi_function(function: Function, robot: Robot, printer: CasadiPrinter) -> dict:
     body = function.body
+    definitions, outputs = printer.body(body)
     results = []
-    for output, values in function.parts(body.outputs):
+    for (output, values), (_, texts) in zip(function.parts(body.outputs), function.parts(outputs)):
         positions = [divmod(k, output.cols) for k in range(output.size)]
         # Zeros stay structural zeros of the sparse SX result.
         results.append({"name": output.name, "rows": output.rows, "cols": output.cols,
-                        "values": [(row, col, printer.doprint(e)) for (row, col), e in zip(positions, values)
+                        "values": [(row, col, text) for (row, col), e, text in zip(positions, values, texts)
                                    if e != sympy.S.Zero]})
     return {
         "name": function.name,
@@ -258,7 +260,7 @@ def _casadi_function(function: Function, robot: Robot, printer: CasadiPrinter) -
                    for symbol, argument, row, col in function.inputs]
         + [(name, f"p[{[q.name for q in robot.symbolic_parameters].index(name)}]")
            for name in _parameters_read(body, robot)],
-        "definitions": [(str(symbol), printer.doprint(e)) for symbol, e in body.definitions],
+        "definitions": [(body.name(symbol), text) for (symbol, _), text in zip(body.definitions, definitions)],
         "results": results,
     }
 

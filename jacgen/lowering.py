@@ -15,7 +15,6 @@ import sympy
 from sympy.core.parameters import distribute
 from sympy.logic.boolalg import Boolean
 
-from .printers import fold_constants
 from .subproblems import TOLERANCES
 
 
@@ -26,10 +25,37 @@ class Body:
     read: frozenset  # the input symbols the body reads
     definitions: tuple[tuple[sympy.Symbol, sympy.Expr], ...]
     outputs: tuple[sympy.Expr, ...]  # row-major
+    names: dict[sympy.Symbol, str]  # the temporaries' printed names (t0, t1, ...), in definition order
+
+    def name(self, symbol: sympy.Symbol) -> str:
+        """The printed name of a defined symbol."""
+        return self.names.get(symbol, symbol.name)
 
     @cached_property
     def operation_count(self) -> int:
         return int(sympy.count_ops([e for _, e in self.definitions] + list(self.outputs)))
+
+
+def fold_constants(expr: sympy.Expr, _folded: dict | None = None) -> sympy.Expr:
+    """Replace constant subexpressions (2159/5000, sqrt(2)/2, pi/4) by one Float each.
+
+    Integers stay integers and exponents stay exact, so x**(1/2) still prints as sqrt(x).
+    Shared subtrees are folded once (the DH chain is a DAG far smaller than its tree).
+    """
+    folded = {} if _folded is None else _folded
+    if expr not in folded:
+        if expr.is_number:
+            folded[expr] = expr if expr.is_Integer else sympy.Float(expr.evalf(30), 30)
+        elif expr.is_Atom:
+            folded[expr] = expr
+        elif expr.is_Pow:
+            base = fold_constants(expr.base, folded)
+            folded[expr] = expr if base is expr.base else sympy.Pow(base, expr.exp)
+        else:  # rebuilt only when an argument changed: a rebuild evaluates (Piecewise, floor, relations)
+            args = tuple(fold_constants(arg, folded) for arg in expr.args)
+            changed = any(new is not old and new != old for new, old in zip(args, expr.args))
+            folded[expr] = expr.func(*args) if changed else expr
+    return folded[expr]
 
 
 def is_boolean(value: sympy.Basic) -> bool:
@@ -58,11 +84,13 @@ class Lowering:
         and each lever would repeat the rest of the chain."""
         if value.is_Atom or (value.is_Mul and all(arg.is_Atom for arg in value.args)):
             return value
-        negated = sympy.Add(*(-term for term in value.args)) if value.is_Add else -value
-        if value.could_extract_minus_sign() and not negated.could_extract_minus_sign():
-            return -self.name(negated)
         if value in self._names:
             return self._names[value]
+        negated = sympy.Add(*(-term for term in value.args)) if value.is_Add else -value
+        if negated in self._names:
+            return -self._names[negated]
+        if _mostly_negative(value):
+            return -self.name(negated)
         symbol = sympy.Symbol(f"_n{len(self.definitions)}", real=True)
         self.definitions.append((symbol, value))
         self._names[value] = symbol
@@ -99,12 +127,20 @@ class Lowering:
         bound = [(s, fold(v)) for s, v in bindings.items() if s in needed]
         definitions = _in_dependency_order(bound + trig + list(zip((s for s, _ in named), reduced)) + replacements)
         definitions, reduced = _without_constants(definitions, reduced[len(named):])
-        temporaries = sympy.numbered_symbols("t", real=True)
-        rename = {symbol: next(temporaries) for symbol, _ in definitions if symbol.name.startswith("_")}
-        definitions = tuple((rename.get(s, s), v.xreplace(rename)) for s, v in definitions)
-        reduced = [e.xreplace(rename) for e in reduced]
+        # The temporaries are named when printed: renaming them here would rebuild every expression.
+        temporaries = [symbol for symbol, _ in definitions if symbol.name.startswith("_")]
         read = set().union(*(e.free_symbols for _, e in definitions), *(e.free_symbols for e in reduced))
-        return Body(frozenset(read - {symbol for symbol, _ in definitions}), definitions, tuple(reduced))
+        return Body(frozenset(read - {symbol for symbol, _ in definitions}), tuple(definitions), tuple(reduced),
+                    {symbol: f"t{k}" for k, symbol in enumerate(temporaries)})
+
+
+def _mostly_negative(value: sympy.Expr) -> bool:
+    """A product with a negative coefficient, or a sum with more such terms than others (sympy's
+    `could_extract_minus_sign` decides ties by sorting, which costs more than naming saves)."""
+    terms = value.args if value.is_Add else (value,)
+    negative = sum(bool((term.args[0] if term.is_Mul else term).is_extended_negative) for term in terms
+                   if term.is_Number or term.is_Mul and term.args[0].is_Number)
+    return 2 * negative > len(terms)
 
 
 def _without_constants(definitions: list[tuple[sympy.Symbol, sympy.Expr]], outputs: list[sympy.Basic]):

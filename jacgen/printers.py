@@ -1,249 +1,308 @@
-"""Expression printers: sympy's own (numpy, C99, and a small CasADi one), each override documented.
+"""Expression printers: one walk over a lowered Body's nodes, with the rules of each language.
 
-Constants are folded first (`fold_constants`), so every number that is not an integer
-is a single Float, printed as the shortest decimal that reads back as the same double
-(the same float, in float C builds). The IK's tolerances EPS and TINY are replaced by the
-numbers of the build's real type.
+A Body holds few kinds of node: sums, products, powers, the math functions, selects
+(Piecewise), comparisons, and/or/not, `isfinite`. `Printer` walks them once each (the
+text of a node is kept for every later reader of it) and prints the arguments of sums and
+products in the order sympy stores them, which it sorts by structure, never by hash: the
+text is deterministic and nothing is re-sorted or rebuilt while printing. Each language
+is a subclass that says how a function, a literal, a power, a select and the logic read.
+
+Every number that is not an integer, and every subexpression of the IK's tolerances alone
+(EPS, TINY, RANK, replaced by the numbers of the build's real type), prints as one literal:
+the shortest decimal that reads back as the same value of that type.
 """
 
 import numpy
 import sympy
-from sympy.codegen import ast
-from sympy.printing.c import C99CodePrinter
-from sympy.printing.codeprinter import CodePrinter
-from sympy.printing.numpy import NumPyPrinter
-from sympy.printing.precedence import PRECEDENCE
-from sympy.printing.pycode import AbstractPythonCodePrinter, _print_known_const, _print_known_func
 
-from .subproblems import TOLERANCES
+from .lowering import Body, is_boolean
+from .subproblems import TOLERANCE_SYMBOLS, TOLERANCES
 
-
-def fold_constants(expr: sympy.Expr, _folded: dict | None = None) -> sympy.Expr:
-    """Replace constant subexpressions (2159/5000, sqrt(2)/2, pi/4) by one Float each.
-
-    Integers stay integers and exponents stay exact, so x**(1/2) still prints as sqrt(x).
-    Shared subtrees are folded once (the DH chain is a DAG far smaller than its tree).
-    """
-    folded = {} if _folded is None else _folded
-    if expr not in folded:
-        if expr.is_number:
-            folded[expr] = expr if expr.is_Integer else sympy.Float(expr.evalf(30), 30)
-        elif expr.is_Atom:
-            folded[expr] = expr
-        elif expr.is_Pow:
-            base = fold_constants(expr.base, folded)
-            folded[expr] = expr if base is expr.base else sympy.Pow(base, expr.exp)
-        else:  # rebuilt only when an argument changed: a rebuild evaluates (Piecewise, floor, relations)
-            args = tuple(fold_constants(arg, folded) for arg in expr.args)
-            changed = any(new is not old and new != old for new, old in zip(args, expr.args))
-            folded[expr] = expr.func(*args) if changed else expr
-    return folded[expr]
+# Binding strength of what a node prints as: an operand binding more loosely than its
+# operator is parenthesised.
+ATOM, POWER, PRODUCT, SUM, RELATION, AND, OR = 1000, 60, 50, 40, 35, 30, 20
 
 
-def float_literal(value: sympy.Expr) -> str:
-    """Shortest decimal that reads back as the nearest double to `value`."""
-    return repr(float(value))
+class Printer:
+    """The rules every language shares: numbers, sums, products, function calls."""
+
+    functions: dict[str, str]  # sympy's class name -> the function printed
+    one = "1"  # the numerator of a reciprocal
+
+    def __init__(self, real: str = "double"):
+        self.tolerances = TOLERANCES[real]
+        self._printed: dict[sympy.Basic, tuple[str, int]] = {}
+        self._constants: dict[sympy.Basic, bool] = {}
+        self._names: dict[sympy.Symbol, str] = {}  # the temporaries of the Body being printed
+
+    def doprint(self, expr: sympy.Basic) -> str:
+        return self._print(expr)[0]
+
+    def body(self, body: Body) -> tuple[list[str], list[str]]:
+        """The texts of a Body's definitions and outputs, its temporaries by their names."""
+        self._names, self._printed = body.names, {}
+        try:
+            return [self.doprint(value) for _, value in body.definitions], [self.doprint(e) for e in body.outputs]
+        finally:
+            self._names, self._printed = {}, {}
+
+    def _print(self, expr: sympy.Basic) -> tuple[str, int]:
+        """(text, binding strength), once per node."""
+        printed = self._printed.get(expr)
+        if printed is None:
+            printed = self._printed[expr] = self._node(expr)
+        return printed
+
+    def _operand(self, expr: sympy.Basic, strength: int) -> str:
+        """The text of `expr`, in parentheses when it binds more loosely than `strength`."""
+        text, binding = self._print(expr)
+        return f"({text})" if binding < strength else text
+
+    def _node(self, expr: sympy.Basic) -> tuple[str, int]:
+        if expr.is_Symbol and expr not in TOLERANCE_SYMBOLS:
+            return self._names.get(expr, expr.name), ATOM
+        if expr.is_Integer:
+            return str(expr), SUM if expr < 0 else ATOM
+        constant = self._constant(expr)
+        if is_boolean(expr):
+            if constant:
+                expr = expr.xreplace(self.tolerances)
+                return self.truth(bool(expr)), ATOM
+            return self._boolean(expr)
+        if constant:
+            text = self.literal(float(expr.xreplace(self.tolerances)))
+            return text, SUM if text.startswith("-") else ATOM
+        if expr.is_Add:
+            return self._sum(expr.args), SUM
+        if expr.is_Mul:
+            return self._product(expr.args)
+        if expr.is_Pow:
+            return self._power(expr.base, expr.exp)
+        if isinstance(expr, sympy.Piecewise):
+            return self._piecewise(expr.args), ATOM
+        name = type(expr).__name__
+        if name not in self.functions:
+            raise ValueError(f"unsupported in {type(self).__name__}: {name} ({expr})")
+        return f"{self.functions[name]}({', '.join(self._print(arg)[0] for arg in expr.args)})", ATOM
+
+    def _constant(self, expr: sympy.Basic) -> bool:
+        """Whether `expr` reads nothing but numbers and tolerances, once per node."""
+        constant = self._constants.get(expr)
+        if constant is None:
+            if expr.is_Symbol:
+                constant = expr in TOLERANCE_SYMBOLS
+            else:
+                constant = expr.is_Atom or all(self._constant(arg) for arg in expr.args)
+            self._constants[expr] = constant
+        return constant
+
+    def _sum(self, terms) -> str:
+        text = []
+        for term in terms:
+            term_text = self._operand(term, SUM)
+            if term_text.startswith("-"):
+                text += ["-", term_text[1:]]
+            else:
+                text += ["+", term_text]
+        return " ".join(text[1:]) if text[0] == "+" else "-" + " ".join(text[1:])
+
+    def _product(self, factors) -> tuple[str, int]:
+        """`-a*b/(c*d)`: a leading negative coefficient as the sign, powers with a negative
+        exponent as the denominator."""
+        sign, numerator, denominator = "", [], []
+        for factor in sorted(factors, key=lambda factor: not self._constant(factor)):  # numbers first
+            if factor.is_Pow and factor.exp.is_Rational and factor.exp < 0 and not self._constant(factor):
+                denominator.append(self._power(factor.base, -factor.exp))
+                continue
+            number = self._constant(factor)
+            text = self._print(factor)[0] if number else self._operand(factor, PRODUCT)
+            if number and text.startswith("-"):
+                sign, text = "-", text[1:]
+            if text != "1":
+                numerator.append(text)
+        text = "*".join(numerator) or "1"
+        if len(denominator) == 1:
+            base, binding = denominator[0]
+            text += "/" + (f"({base})" if binding <= PRODUCT else base)
+        elif denominator:
+            text += "/(" + "*".join(f"({t})" if b < PRODUCT else t for t, b in denominator) + ")"
+        return sign + text, SUM if sign else PRODUCT
+
+    def _power(self, base: sympy.Expr, exponent: sympy.Rational) -> tuple[str, int]:
+        if exponent == 1:
+            return self._print(base)
+        if exponent == sympy.S.Half:
+            return f"{self.functions['sqrt']}({self.doprint(base)})", ATOM
+        if exponent < 0:
+            text, binding = self._power(base, -exponent)
+            return f"{self.one}/" + (f"({text})" if binding <= PRODUCT else text), PRODUCT
+        return self.power(base, exponent)
+
+    def _piecewise(self, pairs) -> str:
+        """Nested selects, one per condition: the last pair's condition is `True`."""
+        (value, condition), *rest = pairs
+        if not rest:
+            if condition is not sympy.true:
+                raise ValueError("a Piecewise without an otherwise value")
+            return self.doprint(value)
+        otherwise = rest[0][0] if len(rest) == 1 else None
+        numbers = value.is_number and otherwise is not None and otherwise.is_number
+        return self.select(self.doprint(condition), self.doprint(value), self._piecewise(rest), numbers)
+
+    def _boolean(self, expr) -> tuple[str, int]:
+        name = type(expr).__name__
+        if name in ("And", "Or"):
+            return self.logic(name, expr.args), AND if name == "And" else OR
+        if name == "Not":
+            return self.negation(expr.args[0]), ATOM
+        if name == "IsFinite":
+            return self.finite(self.doprint(expr.args[0])), ATOM
+        if isinstance(expr, sympy.core.relational.Relational):
+            return self.relation(self.doprint(expr.lhs), expr.rel_op, self.doprint(expr.rhs))
+        raise ValueError(f"unsupported in {type(self).__name__}: {name} ({expr})")
+
+    # What each language says.
+    def literal(self, value: float) -> str:
+        return repr(value)
+
+    def truth(self, value: bool) -> str:
+        return repr(value)
+
+    def power(self, base: sympy.Expr, exponent: sympy.Rational) -> tuple[str, int]:
+        power = str(exponent) if exponent.is_Integer else repr(float(exponent))
+        return f"{self._operand(base, POWER + 1)}**{power}", POWER
+
+    def relation(self, lhs: str, operator: str, rhs: str) -> tuple[str, int]:
+        return f"({lhs} {operator} {rhs})", ATOM
+
+    def select(self, condition: str, value: str, otherwise: str, numbers: bool) -> str:
+        raise NotImplementedError
+
+    def logic(self, name: str, operands) -> str:
+        raise NotImplementedError
+
+    def negation(self, operand) -> str:
+        raise NotImplementedError
+
+    def finite(self, text: str) -> str:
+        raise NotImplementedError
 
 
-def _selects(printer, expr, select: str, real_array: str = "{}") -> str:
-    """`select(condition, value, otherwise)` nested for each pair of a Piecewise; when both
-    sides are numbers, the value as `real_array`."""
-    (value, condition), *rest = expr.args
-    otherwise = rest[0][0] if len(rest) == 1 and rest[0][1] == sympy.true else sympy.Piecewise(*rest)
-    first = printer._print(value)
-    if value.is_number and otherwise.is_number:
-        first = real_array.format(first)
-    return f"{select}({printer._print(condition)}, {first}, {printer._print(otherwise)})"
-
-
-class PythonPrinter(NumPyPrinter):
-    """Python over the array API namespace `xp` of the inputs (numpy, JAX, PyTorch), batched.
-
-    Functions take their standard names (`xp.atan2`, not numpy's `arctan2`). A select is
-    `xp.where`, both sides computed (the generated function ignores numpy's floating-point
-    warnings of the side not taken). A select of two numbers makes the first an array of the
-    function's `dtype`: otherwise PyTorch makes it float32, and numpy an integer array that
-    turns float32 arithmetic into float64 (the context makes statuses integers again).
-    """
-
-    _module = "xp"
-    _kf = {name: f"xp.{function}" for name, function in {
-        "sin": "sin", "cos": "cos", "tan": "tan", "asin": "asin", "acos": "acos", "atan": "atan",
-        "atan2": "atan2", "exp": "exp", "log": "log", "sqrt": "sqrt", "Abs": "abs", "sign": "sign",
-        "floor": "floor", "ceiling": "ceil", "Floor": "floor",
-    }.items()}
-
-    def __init__(self):
-        super().__init__({"fully_qualified_modules": True, "allow_unknown_functions": False, "order": "none"})
-        self._kf = dict(type(self)._kf)  # NumPyPrinter merges in Python's math names
-
-    def doprint(self, expr, assign_to=None):
-        return super().doprint(expr.xreplace(TOLERANCES["double"]), assign_to)
-
-    def _print_Float(self, expr):
-        return float_literal(expr)
-
-    def _print_Piecewise(self, expr):
-        return _selects(self, expr, "xp.where", "xp.asarray({}, dtype=dtype)")
-
-    def _print_And(self, expr):
-        return " & ".join(self.parenthesize(a, PRECEDENCE["BitwiseAnd"] + 1) for a in expr.args)
-
-    def _print_Or(self, expr):
-        return " | ".join(self.parenthesize(a, PRECEDENCE["BitwiseOr"] + 1) for a in expr.args)
-
-    def _print_IsFinite(self, expr):
-        return f"xp.isfinite({self._print(expr.args[0])})"
-
-    _print_Floor = _print_known_func
-
-
-C_REAL_TYPES = {"double": ast.float64, "float": ast.float32}
 _FLOAT_MAX = float(numpy.finfo(numpy.float32).max)
 
 
-class _Power(sympy.Function):
-    """`base**n` for a small n >= 3/2, integer or half-integer, printed in C as
-    `(base*base*...)`, with `sqrt(base)*` in front for a half, rather than `pow()`.
+class CPrinter(Printer):
+    """C99 for `double` or `float` builds: the type's functions (`sinf`, `atan2f`) and literals
+    (`0.5F`), so a float build has no double promotion; small integer and half-integer powers
+    as products (`(x*x)`, `(sqrt(x)*x)`), never `pow()`; selects as `(c ? a : b)`. No math
+    macro: `M_PI` and `M_SQRT2` are POSIX, not C99."""
 
-    sympy's `create_expand_pow_optimization` does the same with an `UnevaluatedExpr`, which
-    is not commutative, so its reciprocals print as `y*1.0/(x*x)` instead of `y/(x*x)`.
-    """
-
-
-def expand_integer_powers(expr: sympy.Expr, limit: int = 8) -> sympy.Expr:
-    """x**2 -> _Power(x, 2), x**-3 -> 1/_Power(x, 3), x**(-3/2) -> 1/_Power(x, 3/2) (up to
-    `limit`); other powers unchanged."""
-    return expr.replace(lambda e: e.is_Pow and e.exp.is_Rational and e.exp.q in (1, 2)
-                        and sympy.Rational(3, 2) <= abs(e.exp) <= limit,
-                        lambda e: _Power(e.base, abs(e.exp)) ** sympy.sign(e.exp))
-
-
-class CPrinter(C99CodePrinter):
-    """C99 for `double` or `float` builds.
-
-    sympy's printer with `real` aliased to the build's type prints the type's functions
-    (`sinf`, `atan2f`) and literal suffix (`F`), so a float build has no double promotion;
-    unsupported nodes raise (`strict`). Overrides: literals, integer powers (`x*x`, never
-    `pow()`), and `x**(-1/2)`. Constants are folded again at printing (sympy recreates
-    `sqrt(2)` from `sqrt(2*x**2)` after CSE), and no math macro is printed: `M_SQRT2` and
-    `M_PI` are POSIX, not C99.
-    """
+    MATH = {"sin": "sin", "cos": "cos", "tan": "tan", "asin": "asin", "acos": "acos", "atan": "atan",
+            "atan2": "atan2", "exp": "exp", "log": "log", "sqrt": "sqrt", "Abs": "fabs", "Floor": "floor",
+            "floor": "floor", "ceiling": "ceil"}
+    LARGEST_EXPANDED_POWER = 8
 
     def __init__(self, real: str):
-        if real not in C_REAL_TYPES:
-            raise ValueError(f"real must be one of {', '.join(C_REAL_TYPES)}, got {real!r}")
+        if real not in TOLERANCES:
+            raise ValueError(f"real must be one of {', '.join(TOLERANCES)}, got {real!r}")
+        super().__init__(real)
         self.real = real
-        self._folded = {}  # one fold per shared subtree across everything this printer prints
-        super().__init__({"type_aliases": {ast.real: C_REAL_TYPES[real]}, "strict": True, "math_macros": {},
-                          "order": "none", "user_functions": {"Floor": "floor"}})
+        suffix = "f" if real == "float" else ""
+        self.functions = {name: function + suffix for name, function in self.MATH.items()}
+        self.one = self.literal(1.0)
 
-    _print_Floor = C99CodePrinter._print_math_func
-
-    def doprint(self, expr, assign_to=None):
-        folded = fold_constants(expr.xreplace(TOLERANCES[self.real]), self._folded)
-        return super().doprint(expand_integer_powers(folded), assign_to)
-
-    def _print_BooleanTrue(self, expr):
-        return "1"
-
-    def _print_BooleanFalse(self, expr):
-        return "0"
-
-    def _print_Or(self, expr):
-        """Every operand that is not an atom in parentheses (gcc's -Wparentheses)."""
-        return " || ".join(self._print(a) if a.is_Atom else f"({self._print(a)})" for a in expr.args)
-
-    def _print_Piecewise(self, expr):
-        """`(condition ? value : otherwise)` on one line."""
-        (value, condition), *rest = expr.args
-        otherwise = rest[0][0] if len(rest) == 1 and rest[0][1] == sympy.true else sympy.Piecewise(*rest)
-        return f"({self._print(condition)} ? {self._print(value)} : {self._print(otherwise)})"
-
-    def _print_IsFinite(self, expr):
-        return f"isfinite({self._print(expr.args[0])})"
-
-    def _print_Float(self, expr):
+    def literal(self, value: float) -> str:
         """Shortest literal that reads back as the nearest value of the build's type."""
-        if self.real == "float":
-            if not abs(float(expr)) <= _FLOAT_MAX:
-                raise ValueError(f"constant {float(expr)!r} is out of the range of float")
-            return str(numpy.float32(float(expr))) + "F"
-        return float_literal(expr)
+        if self.real == "double":
+            return repr(value)
+        if not abs(value) <= _FLOAT_MAX:
+            raise ValueError(f"constant {value!r} is out of the range of float")
+        return str(numpy.float32(value)) + "F"
 
-    def _print__Power(self, expr):
-        base, exponent = expr.args
-        factor = self.parenthesize(base, PRECEDENCE["Mul"], strict=True)
-        root = [self._print(sympy.sqrt(base))] if not exponent.is_Integer else []
-        return "(" + "*".join(root + [factor] * int(exponent)) + ")"
+    def truth(self, value: bool) -> str:
+        return str(int(value))
 
-    def _print_Pow(self, expr):
-        """`1.0/sqrt(x)` rather than sympy's `pow(x, -1.0/2.0)`."""
-        if expr.exp == -sympy.S.Half:
-            return f"{self._print(sympy.Float(1))}/{self._print(sympy.sqrt(expr.base))}"
-        return super()._print_Pow(expr)
+    def power(self, base, exponent):
+        if exponent.q not in (1, 2) or exponent > self.LARGEST_EXPANDED_POWER:
+            return f"pow{'f' * (self.real == 'float')}({self.doprint(base)}, {self.literal(float(exponent))})", ATOM
+        factor = self._operand(base, PRODUCT + 1)
+        root = [f"{self.functions['sqrt']}({self.doprint(base)})"] * (exponent.q == 2)
+        return "(" + "*".join(root + [factor] * int(exponent)) + ")", ATOM
+
+    def relation(self, lhs, operator, rhs):
+        return f"{lhs} {operator} {rhs}", RELATION
+
+    def select(self, condition, value, otherwise, numbers):
+        return f"({condition} ? {value} : {otherwise})"
+
+    def logic(self, name, operands):
+        """`a && b`, and every operand of `||` that is not an atom in parentheses (gcc's
+        -Wparentheses)."""
+        if name == "And":
+            return " && ".join(self._operand(operand, AND + 1) for operand in operands)
+        return " || ".join(self._operand(operand, ATOM) for operand in operands)
+
+    def negation(self, operand):
+        return "!" + self._operand(operand, ATOM)
+
+    def finite(self, text):
+        return f"isfinite({text})"
 
 
-class CasadiPrinter(AbstractPythonCodePrinter):
-    """Python building CasADi SX expressions: `casadi.cos(q1)`, `casadi.sqrt(t3)`.
+class PythonPrinter(Printer):
+    """Python over the array API namespace `xp` of the inputs (numpy, JAX, PyTorch), batched.
 
-    Only the functions CasADi has are known; anything else (Piecewise, Min, relations...)
-    raises instead of printing Python that would not build an expression graph.
+    A select is `xp.where`, both sides computed (the generated function ignores numpy's
+    floating-point warnings of the side not taken). A select of two numbers makes the first an
+    array of the function's `dtype`: otherwise PyTorch makes it float32, and numpy an integer
+    array that turns float32 arithmetic into float64 (the context makes statuses integers again).
     """
 
-    _module = "casadi"
-    _kf = {name: f"casadi.{function}" for name, function in {
+    functions = {name: f"xp.{function}" for name, function in {
         "sin": "sin", "cos": "cos", "tan": "tan", "asin": "asin", "acos": "acos", "atan": "atan",
-        "atan2": "atan2", "sinh": "sinh", "cosh": "cosh", "tanh": "tanh", "asinh": "asinh",
-        "acosh": "acosh", "atanh": "atanh", "exp": "exp", "log": "log", "Abs": "fabs",
-        "sign": "sign", "floor": "floor", "ceiling": "ceil", "erf": "erf", "Floor": "floor",
-    }.items()}
-    _kc = {"Pi": "casadi.pi"}
+        "atan2": "atan2", "exp": "exp", "log": "log", "sqrt": "sqrt", "Abs": "abs", "Floor": "floor",
+        "floor": "floor", "ceiling": "ceil"}.items()}
+    COMPARISONS = {">=": "greater_equal", ">": "greater", "<=": "less_equal", "<": "less", "==": "equal",
+                   "!=": "not_equal"}
 
-    def __init__(self):
-        super().__init__({"fully_qualified_modules": True, "allow_unknown_functions": False, "strict": True,
-                          "order": "none"})
+    def relation(self, lhs, operator, rhs):
+        return f"xp.{self.COMPARISONS[operator]}({lhs}, {rhs})", ATOM
 
-    def _print_Float(self, expr):
-        return float_literal(expr)
+    def select(self, condition, value, otherwise, numbers):
+        value = f"xp.asarray({value}, dtype=dtype)" if numbers else value
+        return f"xp.where({condition}, {value}, {otherwise})"
 
-    def doprint(self, expr, assign_to=None):
-        return super().doprint(expr.xreplace(TOLERANCES["double"]), assign_to)
+    def logic(self, name, operands):
+        return (" & " if name == "And" else " | ").join(self._operand(operand, RELATION) for operand in operands)
 
-    def _print_Pow(self, expr, rational=False):
-        return self._hprint_Pow(expr, rational=rational, sqrt="casadi.sqrt")
+    def negation(self, operand):
+        return f"xp.logical_not({self.doprint(operand)})"
 
-    def _print_Piecewise(self, expr):
-        return _selects(self, expr, "casadi.if_else")
+    def finite(self, text):
+        return f"xp.isfinite({text})"
 
-    def _print_Relational(self, expr):
-        return f"({self._print(expr.lhs)} {expr.rel_op} {self._print(expr.rhs)})"
 
-    def _print_And(self, expr):
-        return self._logic("casadi.logic_and", expr.args)
+class CasadiPrinter(Printer):
+    """Python building CasADi SX expressions: `casadi.cos(q1)`, `casadi.if_else(c, a, b)`."""
 
-    def _print_Or(self, expr):
-        return self._logic("casadi.logic_or", expr.args)
+    functions = {name: f"casadi.{function}" for name, function in {
+        "sin": "sin", "cos": "cos", "tan": "tan", "asin": "asin", "acos": "acos", "atan": "atan",
+        "atan2": "atan2", "exp": "exp", "log": "log", "sqrt": "sqrt", "Abs": "fabs", "Floor": "floor",
+        "floor": "floor", "ceiling": "ceil"}.items()}
 
-    def _logic(self, function: str, args) -> str:
-        text = self._print(args[0])
-        for arg in args[1:]:
-            text = f"{function}({text}, {self._print(arg)})"
+    def select(self, condition, value, otherwise, numbers):
+        return f"casadi.if_else({condition}, {value}, {otherwise})"
+
+    def logic(self, name, operands):
+        function = "casadi.logic_and" if name == "And" else "casadi.logic_or"
+        text = self.doprint(operands[0])
+        for operand in operands[1:]:
+            text = f"{function}({text}, {self.doprint(operand)})"
         return text
 
-    def _print_Not(self, expr):
-        return f"casadi.logic_not({self._print(expr.args[0])})"
+    def negation(self, operand):
+        return f"casadi.logic_not({self.doprint(operand)})"
 
-    def _print_IsFinite(self, expr):
+    def finite(self, text):
         """NaN < inf is false, as is inf < inf."""
-        return f"(casadi.fabs({self._print(expr.args[0])}) < casadi.inf)"
-
-    _print_ITE = CodePrinter._print_not_supported
-    _print_Mod = CodePrinter._print_not_supported
-    _print_Sum = CodePrinter._print_not_supported
-
-
-for _name in CasadiPrinter._kf:
-    setattr(CasadiPrinter, f"_print_{_name}", _print_known_func)
-for _name in CasadiPrinter._kc:
-    setattr(CasadiPrinter, f"_print_{_name}", _print_known_const)
+        return f"(casadi.fabs({text}) < casadi.inf)"

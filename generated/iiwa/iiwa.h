@@ -41,15 +41,15 @@ typedef double iiwa_real;
 void iiwa_fk(const iiwa_real q[IIWA_DOF], iiwa_real T[16]);
 
 /* Geometric Jacobian in the world frame (6 x DOF, rows vx vy vz wx wy wz).
- * Result: J: 6 x 7 row-major, element (r, c) at J[r * 7 + c]. 137 operations. */
+ * Result: J: 6 x 7 row-major, element (r, c) at J[r * 7 + c]. 134 operations. */
 void iiwa_jacobian(const iiwa_real q[IIWA_DOF], iiwa_real J[6 * IIWA_DOF]);
 
 /* Fk and jacobian in one pass, sharing their terms.
- * Result: T: 4 x 4 row-major, element (r, c) at T[r * 4 + c]; J: 6 x 7 row-major, element (r, c) at J[r * 7 + c]. 168 operations. */
+ * Result: T: 4 x 4 row-major, element (r, c) at T[r * 4 + c]; J: 6 x 7 row-major, element (r, c) at J[r * 7 + c]. 165 operations. */
 void iiwa_fk_jacobian(const iiwa_real q[IIWA_DOF], iiwa_real T[16], iiwa_real J[6 * IIWA_DOF]);
 
 /* Geometric Jacobian in the tool frame (6 x DOF, rows vx vy vz wx wy wz).
- * Result: J: 6 x 7 row-major, element (r, c) at J[r * 7 + c]. 330 operations. */
+ * Result: J: 6 x 7 row-major, element (r, c) at J[r * 7 + c]. 325 operations. */
 void iiwa_jacobian_tool(const iiwa_real q[IIWA_DOF], iiwa_real J[6 * IIWA_DOF]);
 
 /* Task vector mu = (x, y, z, roll, pitch, yaw).
@@ -57,7 +57,7 @@ void iiwa_jacobian_tool(const iiwa_real q[IIWA_DOF], iiwa_real J[6 * IIWA_DOF]);
 void iiwa_task(const iiwa_real q[IIWA_DOF], iiwa_real mu[IIWA_TASK_DIM]);
 
 /* Analytic Jacobian d mu / d q (6 x DOF).
- * Result: J: 6 x 7 row-major, element (r, c) at J[r * 7 + c]. 222 operations. */
+ * Result: J: 6 x 7 row-major, element (r, c) at J[r * 7 + c]. 218 operations. */
 void iiwa_task_jacobian(const iiwa_real q[IIWA_DOF], iiwa_real J[IIWA_TASK_DIM * IIWA_DOF]);
 
 /* Fk, jacobian and bias_acceleration in one pass, sharing their terms.
@@ -65,7 +65,7 @@ void iiwa_task_jacobian(const iiwa_real q[IIWA_DOF], iiwa_real J[IIWA_TASK_DIM *
 void iiwa_fk_jacobian_dot(const iiwa_real q[IIWA_DOF], const iiwa_real q_dot[IIWA_DOF], iiwa_real T[16], iiwa_real J[6 * IIWA_DOF], iiwa_real a[6]);
 
 /* Time derivative dJ/dt of the world geometric Jacobian along q_dot (6 x DOF).
- * Result: Jd: 6 x 7 row-major, element (r, c) at Jd[r * 7 + c]. 336 operations. */
+ * Result: Jd: 6 x 7 row-major, element (r, c) at Jd[r * 7 + c]. 326 operations. */
 void iiwa_jacobian_dot(const iiwa_real q[IIWA_DOF], const iiwa_real q_dot[IIWA_DOF], iiwa_real Jd[6 * IIWA_DOF]);
 
 /* J' q_dot: the tool's classical linear and angular acceleration at zero joint acceleration, world frame (6).
@@ -73,19 +73,19 @@ void iiwa_jacobian_dot(const iiwa_real q[IIWA_DOF], const iiwa_real q_dot[IIWA_D
 void iiwa_bias_acceleration(const iiwa_real q[IIWA_DOF], const iiwa_real q_dot[IIWA_DOF], iiwa_real a[6]);
 
 /* Time derivative of the analytic Jacobian along q_dot (6 x DOF): mu'' = J_a q'' + J_a' q'.
- * Result: Jd: 6 x 7 row-major, element (r, c) at Jd[r * 7 + c]. 699 operations. */
+ * Result: Jd: 6 x 7 row-major, element (r, c) at Jd[r * 7 + c]. 695 operations. */
 void iiwa_task_jacobian_dot(const iiwa_real q[IIWA_DOF], const iiwa_real q_dot[IIWA_DOF], iiwa_real Jd[IIWA_TASK_DIM * IIWA_DOF]);
 
 /* Partial derivatives dJ/dq_k of the world geometric Jacobian (DOF x 6 x DOF, indexed [k, r, c]).
- * Result: H: 7 x 6 x 7 row-major, element (k, r, c) at H[k * 42 + r * 7 + c]. 402 operations. */
+ * Result: H: 7 x 6 x 7 row-major, element (k, r, c) at H[k * 42 + r * 7 + c]. 381 operations. */
 void iiwa_hessian(const iiwa_real q[IIWA_DOF], iiwa_real H[IIWA_DOF * 6 * IIWA_DOF]);
 
 /* Factors of det(Js Js^T): the robot is singular where one is 0.
- * Result: f[i], i < 2. 735 operations. */
+ * Result: f[i], i < 2. 707 operations. */
 void iiwa_singularity_factors(const iiwa_real q[IIWA_DOF], iiwa_real f[IIWA_NUM_SINGULARITY_FACTORS]);
 
 /* Manipulability sqrt(det(Js Js^T)).
- * Result: returned as a scalar. 738 operations. */
+ * Result: returned as a scalar. 710 operations. */
 iiwa_real iiwa_manipulability(const iiwa_real q[IIWA_DOF]);
 
 /* Joint rates q_dot solving Js q_dot = mu_dot: Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status.
@@ -93,7 +93,7 @@ iiwa_real iiwa_manipulability(const iiwa_real q[IIWA_DOF]);
 int iiwa_velocity_ik(const iiwa_real q[IIWA_DOF], const iiwa_real mu_dot[IIWA_TASK_DIM], iiwa_real damping, iiwa_real q_dot[IIWA_DOF]);
 
 /* One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite).
- * Result: q_start[i], i < 7; q_next[i], i < 7; returned as a scalar. 1131 operations. */
+ * Result: q_start[i], i < 7; q_next[i], i < 7; returned as a scalar. 1126 operations. */
 iiwa_real iiwa_ik_numeric_step(const iiwa_real target[16], const iiwa_real q[IIWA_DOF], iiwa_real damping, iiwa_real q_start[IIWA_DOF], iiwa_real q_next[IIWA_DOF]);
 
 /* Every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits.

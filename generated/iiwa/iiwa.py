@@ -89,44 +89,44 @@ def fk(q):
     s7 = trig[..., 13]
     t0 = s1*s3
     t1 = c1*c3
-    t2 = -t0 + c2*t1
-    t3 = t1 - c2*t0
+    t2 = -t0 + t1*c2
+    t3 = t1 - t0*c2
     t4 = c3*s1
     t5 = c1*s3
-    t6 = t4 + c2*t5
-    t7 = t5 + c2*t4
+    t6 = t4 + t5*c2
+    t7 = t5 + t4*c2
     t8 = c1*s2
-    t9 = c4*t2 + s4*t8
-    t10 = c4*t8 - s4*t2
-    t11 = c5*t9 - s5*t6
-    t12 = c5*t6 + s5*t9
-    t13 = c6*t11 - s6*t10
-    t14 = c6*t10 + s6*t11
-    t15 = c7*t13 - s7*t12
-    t16 = c7*t12 + s7*t13
+    t9 = t2*c4 + t8*s4
+    t10 = t8*c4 - t2*s4
+    t11 = t9*c5 - t6*s5
+    t12 = t9*s5 + t6*c5
+    t13 = t11*c6 - t10*s6
+    t14 = t10*c6 + t11*s6
+    t15 = t13*c7 - t12*s7
+    t16 = t12*c7 + t13*s7
     t17 = 0.126*t14 + 0.4*t10
     t18 = t17 + 0.42*t8
     t19 = s1*s2
-    t20 = c4*t7 + s4*t19
-    t21 = c4*t19 - s4*t7
-    t22 = c5*t20 + s5*t3
-    t23 = c5*t3 - s5*t20
-    t24 = c6*t22 - s6*t21
-    t25 = c6*t21 + s6*t22
-    t26 = c7*t24 + s7*t23
-    t27 = c7*t23 - s7*t24
+    t20 = t7*c4 + t19*s4
+    t21 = t19*c4 - t7*s4
+    t22 = t20*c5 + t3*s5
+    t23 = t3*c5 - t20*s5
+    t24 = t22*c6 - t21*s6
+    t25 = t21*c6 + t22*s6
+    t26 = t23*s7 + t24*c7
+    t27 = t23*c7 - t24*s7
     t28 = 0.126*t25 + 0.4*t21
     t29 = t28 + 0.42*t19
     t30 = c3*s2
-    t31 = c2*s4 - c4*t30
-    t32 = c2*c4 + s4*t30
+    t31 = c2*s4 - t30*c4
+    t32 = t30*s4 + c2*c4
     t33 = s2*s3
-    t34 = c5*t31 + s5*t33
-    t35 = c5*t33 - s5*t31
-    t36 = c6*t34 - s6*t32
-    t37 = c6*t32 + s6*t34
-    t38 = c7*t36 + s7*t35
-    t39 = c7*t35 - s7*t36
+    t34 = t31*c5 + t33*s5
+    t35 = t33*c5 - t31*s5
+    t36 = t34*c6 - t32*s6
+    t37 = t32*c6 + t34*s6
+    t38 = t35*s7 + t36*c7
+    t39 = t35*c7 - t36*s7
     t40 = 0.126*t37 + 0.4*t32
     t41 = t40 + 0.42*c2
     t42 = 0.36 + t41
@@ -152,7 +152,7 @@ def fk(q):
 
 
 def jacobian(q):
-    """geometric Jacobian in the world frame (6 x DOF, rows vx vy vz wx wy wz): (6 x 7), 137 operations."""
+    """geometric Jacobian in the world frame (6 x DOF, rows vx vy vz wx wy wz): (6 x 7), 134 operations."""
     xp, dtype, device, batch, (q,) = _arguments(("q", q, (7,)))
     trig = _cos_sin(xp, q, (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0), device)
     c1 = trig[..., 0]
@@ -169,31 +169,31 @@ def jacobian(q):
     s6 = trig[..., 11]
     t0 = s1*s3
     t1 = c1*c3
-    t2 = -t0 + c2*t1
-    t3 = t1 - c2*t0
+    t2 = -t0 + t1*c2
+    t3 = t1 - t0*c2
     t4 = c3*s1
     t5 = c1*s3
-    t6 = t4 + c2*t5
-    t7 = t5 + c2*t4
+    t6 = t4 + t5*c2
+    t7 = t5 + t4*c2
     t8 = c1*s2
-    t9 = c4*t2 + s4*t8
-    t10 = c4*t8 - s4*t2
-    t11 = c5*t9 - s5*t6
-    t12 = c5*t6 + s5*t9
-    t13 = c6*t10 + s6*t11
+    t9 = t2*c4 + t8*s4
+    t10 = t8*c4 - t2*s4
+    t11 = t9*c5 - t6*s5
+    t12 = t9*s5 + t6*c5
+    t13 = t10*c6 + t11*s6
     t14 = s1*s2
-    t15 = c4*t7 + s4*t14
-    t16 = c4*t14 - s4*t7
-    t17 = c5*t15 + s5*t3
-    t18 = c5*t3 - s5*t15
-    t19 = c6*t16 + s6*t17
+    t15 = t7*c4 + t14*s4
+    t16 = t14*c4 - t7*s4
+    t17 = t15*c5 + t3*s5
+    t18 = t3*c5 - t15*s5
+    t19 = t16*c6 + t17*s6
     t20 = c3*s2
-    t21 = c2*s4 - c4*t20
-    t22 = c2*c4 + s4*t20
+    t21 = c2*s4 - t20*c4
+    t22 = t20*s4 + c2*c4
     t23 = s2*s3
-    t24 = c5*t21 + s5*t23
-    t25 = c5*t23 - s5*t21
-    t26 = c6*t22 + s6*t24
+    t24 = t21*c5 + t23*s5
+    t25 = t23*c5 - t21*s5
+    t26 = t22*c6 + t24*s6
     t27 = 0.126*t13
     t28 = t27 + 0.4*t10
     t29 = t28 + 0.42*t8
@@ -203,29 +203,29 @@ def jacobian(q):
     t33 = 0.126*t26
     t34 = t33 + 0.4*t22
     t35 = t34 + 0.42*c2
-    t36 = c1*t35
-    t37 = s1*t35
+    t36 = t35*c1
+    t37 = t35*s1
     J = _stack(xp, [
         -t32,  # 0, 0
         t36,  # 0, 1
-        s2*t37 - c2*t32,  # 0, 2
-        t23*t31 - t3*t34,  # 0, 3
+        t37*s2 - t32*c2,  # 0, 2
+        t31*t23 - t34*t3,  # 0, 3
         t16*t34 - t22*t31,  # 0, 4
         t18*t33 - t25*t30,  # 0, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 6
         t29,  # 1, 0
         t37,  # 1, 1
-        c2*t29 - s2*t36,  # 1, 2
-        -t23*t28 - t34*t6,  # 1, 3
+        t29*c2 - t36*s2,  # 1, 2
+        -(t28*t23 + t34*t6),  # 1, 3
         t22*t28 - t10*t34,  # 1, 4
         t12*t33 + t25*t27,  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
-        -c1*t29 - s1*t32,  # 2, 1
-        t32*t8 - t14*t29,  # 2, 2
+        -(t29*c1 + t32*s1),  # 2, 1
+        t32*t8 - t29*t14,  # 2, 2
         t28*t3 + t31*t6,  # 2, 3
         t10*t31 - t16*t28,  # 2, 4
-        -t12*t30 - t18*t27,  # 2, 5
+        -(t12*t30 + t18*t27),  # 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
         -s1,  # 3, 1
@@ -253,7 +253,7 @@ def jacobian(q):
 
 
 def fk_jacobian(q):
-    """fk and jacobian in one pass, sharing their terms: (4 x 4 and 6 x 7), 168 operations."""
+    """fk and jacobian in one pass, sharing their terms: (4 x 4 and 6 x 7), 165 operations."""
     xp, dtype, device, batch, (q,) = _arguments(("q", q, (7,)))
     trig = _cos_sin(xp, q, (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0), device)
     c1 = trig[..., 0]
@@ -272,40 +272,40 @@ def fk_jacobian(q):
     s7 = trig[..., 13]
     t0 = s1*s3
     t1 = c1*c3
-    t2 = -t0 + c2*t1
-    t3 = t1 - c2*t0
+    t2 = -t0 + t1*c2
+    t3 = t1 - t0*c2
     t4 = c3*s1
     t5 = c1*s3
-    t6 = t4 + c2*t5
-    t7 = t5 + c2*t4
+    t6 = t4 + t5*c2
+    t7 = t5 + t4*c2
     t8 = c1*s2
-    t9 = c4*t2 + s4*t8
-    t10 = c4*t8 - s4*t2
-    t11 = c5*t9 - s5*t6
-    t12 = c5*t6 + s5*t9
-    t13 = c6*t11 - s6*t10
-    t14 = c6*t10 + s6*t11
-    t15 = c7*t13 - s7*t12
-    t16 = c7*t12 + s7*t13
+    t9 = t2*c4 + t8*s4
+    t10 = t8*c4 - t2*s4
+    t11 = t9*c5 - t6*s5
+    t12 = t9*s5 + t6*c5
+    t13 = t11*c6 - t10*s6
+    t14 = t10*c6 + t11*s6
+    t15 = t13*c7 - t12*s7
+    t16 = t12*c7 + t13*s7
     t17 = s1*s2
-    t18 = c4*t7 + s4*t17
-    t19 = c4*t17 - s4*t7
-    t20 = c5*t18 + s5*t3
-    t21 = c5*t3 - s5*t18
-    t22 = c6*t20 - s6*t19
-    t23 = c6*t19 + s6*t20
-    t24 = c7*t22 + s7*t21
-    t25 = c7*t21 - s7*t22
+    t18 = t7*c4 + t17*s4
+    t19 = t17*c4 - t7*s4
+    t20 = t18*c5 + t3*s5
+    t21 = t3*c5 - t18*s5
+    t22 = t20*c6 - t19*s6
+    t23 = t19*c6 + t20*s6
+    t24 = t21*s7 + t22*c7
+    t25 = t21*c7 - t22*s7
     t26 = c3*s2
-    t27 = c2*s4 - c4*t26
-    t28 = c2*c4 + s4*t26
+    t27 = c2*s4 - t26*c4
+    t28 = t26*s4 + c2*c4
     t29 = s2*s3
-    t30 = c5*t27 + s5*t29
-    t31 = c5*t29 - s5*t27
-    t32 = c6*t30 - s6*t28
-    t33 = c6*t28 + s6*t30
-    t34 = c7*t32 + s7*t31
-    t35 = c7*t31 - s7*t32
+    t30 = t27*c5 + t29*s5
+    t31 = t29*c5 - t27*s5
+    t32 = t30*c6 - t28*s6
+    t33 = t28*c6 + t30*s6
+    t34 = t31*s7 + t32*c7
+    t35 = t31*c7 - t32*s7
     t36 = 0.126*t14
     t37 = t36 + 0.4*t10
     t38 = t37 + 0.42*t8
@@ -316,8 +316,8 @@ def fk_jacobian(q):
     t43 = t42 + 0.4*t28
     t44 = t43 + 0.42*c2
     t45 = 0.36 + t44
-    t46 = c1*t44
-    t47 = s1*t44
+    t46 = t44*c1
+    t47 = t44*s1
     T = _stack(xp, [
         t15,  # 0, 0
         -t16,  # 0, 1
@@ -339,24 +339,24 @@ def fk_jacobian(q):
     J = _stack(xp, [
         -t41,  # 0, 0
         t46,  # 0, 1
-        s2*t47 - c2*t41,  # 0, 2
-        t29*t40 - t3*t43,  # 0, 3
+        t47*s2 - t41*c2,  # 0, 2
+        t40*t29 - t43*t3,  # 0, 3
         t19*t43 - t28*t40,  # 0, 4
         t21*t42 - t31*t39,  # 0, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 6
         t38,  # 1, 0
         t47,  # 1, 1
-        c2*t38 - s2*t46,  # 1, 2
-        -t29*t37 - t43*t6,  # 1, 3
+        t38*c2 - t46*s2,  # 1, 2
+        -(t37*t29 + t43*t6),  # 1, 3
         t28*t37 - t10*t43,  # 1, 4
         t12*t42 + t31*t36,  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
-        -c1*t38 - s1*t41,  # 2, 1
-        t41*t8 - t17*t38,  # 2, 2
-        t3*t37 + t40*t6,  # 2, 3
+        -(t38*c1 + t41*s1),  # 2, 1
+        t41*t8 - t38*t17,  # 2, 2
+        t37*t3 + t40*t6,  # 2, 3
         t10*t40 - t19*t37,  # 2, 4
-        -t12*t39 - t21*t36,  # 2, 5
+        -(t12*t39 + t21*t36),  # 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
         -s1,  # 3, 1
@@ -384,7 +384,7 @@ def fk_jacobian(q):
 
 
 def jacobian_tool(q):
-    """geometric Jacobian in the tool frame (6 x DOF, rows vx vy vz wx wy wz): (6 x 7), 330 operations."""
+    """geometric Jacobian in the tool frame (6 x DOF, rows vx vy vz wx wy wz): (6 x 7), 325 operations."""
     xp, dtype, device, batch, (q,) = _arguments(("q", q, (7,)))
     trig = _cos_sin(xp, q, (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0), device)
     c1 = trig[..., 0]
@@ -403,40 +403,40 @@ def jacobian_tool(q):
     s7 = trig[..., 13]
     t0 = s1*s3
     t1 = c1*c3
-    t2 = -t0 + c2*t1
-    t3 = t1 - c2*t0
+    t2 = -t0 + t1*c2
+    t3 = t1 - t0*c2
     t4 = c3*s1
     t5 = c1*s3
-    t6 = t4 + c2*t5
-    t7 = t5 + c2*t4
+    t6 = t4 + t5*c2
+    t7 = t5 + t4*c2
     t8 = c1*s2
-    t9 = c4*t2 + s4*t8
-    t10 = c4*t8 - s4*t2
-    t11 = c5*t9 - s5*t6
-    t12 = c5*t6 + s5*t9
-    t13 = c6*t11 - s6*t10
-    t14 = c6*t10 + s6*t11
-    t15 = c7*t13 - s7*t12
-    t16 = c7*t12 + s7*t13
+    t9 = t2*c4 + t8*s4
+    t10 = t8*c4 - t2*s4
+    t11 = t9*c5 - t6*s5
+    t12 = t9*s5 + t6*c5
+    t13 = t11*c6 - t10*s6
+    t14 = t10*c6 + t11*s6
+    t15 = t13*c7 - t12*s7
+    t16 = t12*c7 + t13*s7
     t17 = s1*s2
-    t18 = c4*t7 + s4*t17
-    t19 = c4*t17 - s4*t7
-    t20 = c5*t18 + s5*t3
-    t21 = c5*t3 - s5*t18
-    t22 = c6*t20 - s6*t19
-    t23 = c6*t19 + s6*t20
-    t24 = c7*t22 + s7*t21
-    t25 = c7*t21 - s7*t22
+    t18 = t7*c4 + t17*s4
+    t19 = t17*c4 - t7*s4
+    t20 = t18*c5 + t3*s5
+    t21 = t3*c5 - t18*s5
+    t22 = t20*c6 - t19*s6
+    t23 = t19*c6 + t20*s6
+    t24 = t21*s7 + t22*c7
+    t25 = t21*c7 - t22*s7
     t26 = c3*s2
-    t27 = c2*s4 - c4*t26
-    t28 = c2*c4 + s4*t26
+    t27 = c2*s4 - t26*c4
+    t28 = t26*s4 + c2*c4
     t29 = s2*s3
-    t30 = c5*t27 + s5*t29
-    t31 = c5*t29 - s5*t27
-    t32 = c6*t30 - s6*t28
-    t33 = c6*t28 + s6*t30
-    t34 = c7*t32 + s7*t31
-    t35 = c7*t31 - s7*t32
+    t30 = t27*c5 + t29*s5
+    t31 = t29*c5 - t27*s5
+    t32 = t30*c6 - t28*s6
+    t33 = t28*c6 + t30*s6
+    t34 = t31*s7 + t32*c7
+    t35 = t31*c7 - t32*s7
     t36 = 0.126*t14
     t37 = t36 + 0.4*t10
     t38 = t37 + 0.42*t8
@@ -446,21 +446,21 @@ def jacobian_tool(q):
     t42 = 0.126*t33
     t43 = t42 + 0.4*t28
     t44 = t43 + 0.42*c2
-    t45 = c1*t44
-    t46 = s1*t44
-    t47 = -c1*t38 - s1*t41
-    t48 = t17*t44 - c2*t41
-    t49 = c2*t38 - t44*t8
-    t50 = t41*t8 - t17*t38
-    t51 = t3*t37 + t40*t6
-    t52 = t29*t40 - t3*t43
-    t53 = -t29*t37 - t43*t6
+    t45 = t44*c1
+    t46 = t44*s1
+    t47 = -(t38*c1 + t41*s1)
+    t48 = t44*t17 - t41*c2
+    t49 = t38*c2 - t44*t8
+    t50 = t41*t8 - t38*t17
+    t51 = t37*t3 + t40*t6
+    t52 = t40*t29 - t43*t3
+    t53 = -(t37*t29 + t43*t6)
     t54 = t19*t43 - t28*t40
     t55 = t28*t37 - t10*t43
     t56 = t10*t40 - t19*t37
     t57 = t21*t42 - t31*t39
     t58 = t12*t42 + t31*t36
-    t59 = -t12*t39 - t21*t36
+    t59 = -(t12*t39 + t21*t36)
     J = _stack(xp, [
         t24*t38 - t15*t41,  # 0, 0
         t15*t45 + t24*t46 + t34*t47,  # 0, 1
@@ -484,23 +484,23 @@ def jacobian_tool(q):
         t14*t57 + t23*t58 + t33*t59,  # 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 6
         t34,  # 3, 0
-        c1*t24 - s1*t15,  # 3, 1
-        c2*t34 + t15*t8 + t17*t24,  # 3, 2
-        t15*t6 - t24*t3 - t29*t34,  # 3, 3
+        t24*c1 - t15*s1,  # 3, 1
+        t15*t8 + t24*t17 + t34*c2,  # 3, 2
+        -(t24*t3 + t34*t29 - t15*t6),  # 3, 3
         t10*t15 + t19*t24 + t28*t34,  # 3, 4
         t21*t24 + t31*t34 - t12*t15,  # 3, 5
         t14*t15 + t23*t24 + t33*t34,  # 3, 6
         t35,  # 4, 0
-        c1*t25 + s1*t16,  # 4, 1
-        c2*t35 + t17*t25 - t16*t8,  # 4, 2
-        -t16*t6 - t25*t3 - t29*t35,  # 4, 3
+        t16*s1 + t25*c1,  # 4, 1
+        t25*t17 + t35*c2 - t16*t8,  # 4, 2
+        -(t16*t6 + t25*t3 + t35*t29),  # 4, 3
         t19*t25 + t28*t35 - t10*t16,  # 4, 4
         t12*t16 + t21*t25 + t31*t35,  # 4, 5
         t23*t25 + t33*t35 - t14*t16,  # 4, 6
         t33,  # 5, 0
-        c1*t23 - s1*t14,  # 5, 1
-        c2*t33 + t14*t8 + t17*t23,  # 5, 2
-        t14*t6 - t23*t3 - t29*t33,  # 5, 3
+        t23*c1 - t14*s1,  # 5, 1
+        t14*t8 + t23*t17 + t33*c2,  # 5, 2
+        -(t23*t3 + t33*t29 - t14*t6),  # 5, 3
         t10*t14 + t19*t23 + t28*t33,  # 5, 4
         t21*t23 + t31*t33 - t12*t14,  # 5, 5
         t14**2 + t23**2 + t33**2,  # 5, 6
@@ -528,42 +528,42 @@ def task(q):
     s7 = trig[..., 13]
     t0 = s1*s3
     t1 = c1*c3
-    t2 = -t0 + c2*t1
-    t3 = t1 - c2*t0
+    t2 = -t0 + t1*c2
+    t3 = t1 - t0*c2
     t4 = c3*s1
     t5 = c1*s3
-    t6 = t4 + c2*t5
-    t7 = t5 + c2*t4
+    t6 = t4 + t5*c2
+    t7 = t5 + t4*c2
     t8 = c1*s2
-    t9 = c4*t2 + s4*t8
-    t10 = c4*t8 - s4*t2
-    t11 = c5*t9 - s5*t6
-    t12 = c5*t6 + s5*t9
-    t13 = c6*t11 - s6*t10
-    t14 = c6*t10 + s6*t11
-    t15 = c7*t13 - s7*t12
+    t9 = t2*c4 + t8*s4
+    t10 = t8*c4 - t2*s4
+    t11 = t9*c5 - t6*s5
+    t12 = t9*s5 + t6*c5
+    t13 = t11*c6 - t10*s6
+    t14 = t10*c6 + t11*s6
+    t15 = t13*c7 - t12*s7
     t16 = 0.126*t14 + 0.4*t10
     t17 = t16 + 0.42*t8
     t18 = s1*s2
-    t19 = c4*t7 + s4*t18
-    t20 = c4*t18 - s4*t7
-    t21 = c5*t19 + s5*t3
-    t22 = c5*t3 - s5*t19
-    t23 = c6*t21 - s6*t20
-    t24 = c6*t20 + s6*t21
-    t25 = c7*t23 + s7*t22
+    t19 = t7*c4 + t18*s4
+    t20 = t18*c4 - t7*s4
+    t21 = t19*c5 + t3*s5
+    t22 = t3*c5 - t19*s5
+    t23 = t21*c6 - t20*s6
+    t24 = t20*c6 + t21*s6
+    t25 = t22*s7 + t23*c7
     t26 = 0.126*t24 + 0.4*t20
     t27 = t26 + 0.42*t18
     t28 = c3*s2
-    t29 = c2*s4 - c4*t28
-    t30 = c2*c4 + s4*t28
+    t29 = c2*s4 - t28*c4
+    t30 = t28*s4 + c2*c4
     t31 = s2*s3
-    t32 = c5*t29 + s5*t31
-    t33 = c5*t31 - s5*t29
-    t34 = c6*t32 - s6*t30
-    t35 = c6*t30 + s6*t32
-    t36 = c7*t34 + s7*t33
-    t37 = c7*t33 - s7*t34
+    t32 = t29*c5 + t31*s5
+    t33 = t31*c5 - t29*s5
+    t34 = t32*c6 - t30*s6
+    t35 = t30*c6 + t32*s6
+    t36 = t33*s7 + t34*c7
+    t37 = t33*c7 - t34*s7
     t38 = 0.126*t35 + 0.4*t30
     t39 = t38 + 0.42*c2
     t40 = 0.36 + t39
@@ -579,7 +579,7 @@ def task(q):
 
 
 def task_jacobian(q):
-    """analytic Jacobian d mu / d q (6 x DOF): (6 x 7), 222 operations."""
+    """analytic Jacobian d mu / d q (6 x DOF): (6 x 7), 218 operations."""
     xp, dtype, device, batch, (q,) = _arguments(("q", q, (7,)))
     trig = _cos_sin(xp, q, (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0), device)
     c1 = trig[..., 0]
@@ -598,37 +598,37 @@ def task_jacobian(q):
     s7 = trig[..., 13]
     t0 = s1*s3
     t1 = c1*c3
-    t2 = -t0 + c2*t1
-    t3 = t1 - c2*t0
+    t2 = -t0 + t1*c2
+    t3 = t1 - t0*c2
     t4 = c3*s1
     t5 = c1*s3
-    t6 = t4 + c2*t5
-    t7 = t5 + c2*t4
+    t6 = t4 + t5*c2
+    t7 = t5 + t4*c2
     t8 = c1*s2
-    t9 = c4*t2 + s4*t8
-    t10 = c4*t8 - s4*t2
-    t11 = c5*t9 - s5*t6
-    t12 = c5*t6 + s5*t9
-    t13 = c6*t11 - s6*t10
-    t14 = c6*t10 + s6*t11
-    t15 = c7*t13 - s7*t12
+    t9 = t2*c4 + t8*s4
+    t10 = t8*c4 - t2*s4
+    t11 = t9*c5 - t6*s5
+    t12 = t9*s5 + t6*c5
+    t13 = t11*c6 - t10*s6
+    t14 = t10*c6 + t11*s6
+    t15 = t13*c7 - t12*s7
     t16 = s1*s2
-    t17 = c4*t7 + s4*t16
-    t18 = c4*t16 - s4*t7
-    t19 = c5*t17 + s5*t3
-    t20 = c5*t3 - s5*t17
-    t21 = c6*t19 - s6*t18
-    t22 = c6*t18 + s6*t19
-    t23 = c7*t21 + s7*t20
+    t17 = t7*c4 + t16*s4
+    t18 = t16*c4 - t7*s4
+    t19 = t17*c5 + t3*s5
+    t20 = t3*c5 - t17*s5
+    t21 = t19*c6 - t18*s6
+    t22 = t18*c6 + t19*s6
+    t23 = t20*s7 + t21*c7
     t24 = c3*s2
-    t25 = c2*s4 - c4*t24
-    t26 = c2*c4 + s4*t24
+    t25 = c2*s4 - t24*c4
+    t26 = t24*s4 + c2*c4
     t27 = s2*s3
-    t28 = c5*t25 + s5*t27
-    t29 = c5*t27 - s5*t25
-    t30 = c6*t28 - s6*t26
-    t31 = c6*t26 + s6*t28
-    t32 = c7*t30 + s7*t29
+    t28 = t25*c5 + t27*s5
+    t29 = t27*c5 - t25*s5
+    t30 = t28*c6 - t26*s6
+    t31 = t26*c6 + t28*s6
+    t32 = t29*s7 + t30*c7
     t33 = 0.126*t14
     t34 = t33 + 0.4*t10
     t35 = t34 + 0.42*t8
@@ -638,16 +638,16 @@ def task_jacobian(q):
     t39 = 0.126*t31
     t40 = t39 + 0.4*t26
     t41 = t40 + 0.42*c2
-    t42 = c1*t41
-    t43 = s1*t41
-    t44 = c1*t23
-    t45 = s1*t15
+    t42 = t41*c1
+    t43 = t41*s1
+    t44 = t23*c1
+    t45 = t15*s1
     t46 = t15**2 + t23**2
-    t47 = t46**(-1.0)
+    t47 = 1/t46
     t48 = t47*(t44 - t45)
-    t49 = c1*t15
-    t50 = s1*t23
-    t51 = t47*(s2*t49 + s2*t50)
+    t49 = t15*c1
+    t50 = t23*s1
+    t51 = t47*(t49*s2 + t50*s2)
     t52 = t47*(t15*t6 - t23*t3)
     t53 = t47*(t10*t15 + t18*t23)
     t54 = t47*(t20*t23 - t12*t15)
@@ -656,24 +656,24 @@ def task_jacobian(q):
     J = _stack(xp, [
         -t38,  # 0, 0
         t42,  # 0, 1
-        s2*t43 - c2*t38,  # 0, 2
-        t27*t37 - t3*t40,  # 0, 3
+        t43*s2 - t38*c2,  # 0, 2
+        t37*t27 - t40*t3,  # 0, 3
         t18*t40 - t26*t37,  # 0, 4
         t20*t39 - t29*t36,  # 0, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 6
         t35,  # 1, 0
         t43,  # 1, 1
-        c2*t35 - s2*t42,  # 1, 2
-        -t27*t34 - t40*t6,  # 1, 3
+        t35*c2 - t42*s2,  # 1, 2
+        -(t34*t27 + t40*t6),  # 1, 3
         t26*t34 - t10*t40,  # 1, 4
         t12*t39 + t29*t33,  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
-        -c1*t35 - s1*t38,  # 2, 1
-        t38*t8 - t16*t35,  # 2, 2
-        t3*t34 + t37*t6,  # 2, 3
+        -(t35*c1 + t38*s1),  # 2, 1
+        t38*t8 - t35*t16,  # 2, 2
+        t34*t3 + t37*t6,  # 2, 3
         t10*t37 - t18*t34,  # 2, 4
-        -t12*t36 - t20*t33,  # 2, 5
+        -(t12*t36 + t20*t33),  # 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
         t48,  # 3, 1
@@ -684,15 +684,15 @@ def task_jacobian(q):
         t55,  # 3, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
         t56*(t49 + t50),  # 4, 1
-        t56*(s2*t45 - s2*t44),  # 4, 2
+        t56*(t45*s2 - t44*s2),  # 4, 2
         -t56*(t15*t3 + t23*t6),  # 4, 3
-        t56*(t15*t18 - t10*t23),  # 4, 4
-        t56*(t12*t23 + t15*t20),  # 4, 5
-        t56*(t15*t22 - t14*t23),  # 4, 6
+        t56*(t18*t15 - t10*t23),  # 4, 4
+        t56*(t12*t23 + t20*t15),  # 4, 5
+        t56*(t22*t15 - t14*t23),  # 4, 6
         xp.full(batch, 1, dtype=dtype, device=device),  # 5, 0
         -t32*t48,  # 5, 1
         c2 - t32*t51,  # 5, 2
-        -t27 - t32*t52,  # 5, 3
+        -(t27 + t32*t52),  # 5, 3
         t26 - t32*t53,  # 5, 4
         t29 - t32*t54,  # 5, 5
         t31 - t32*t55,  # 5, 6
@@ -728,42 +728,42 @@ def fk_jacobian_dot(q, q_dot):
     t0 = qd1 + c2*qd3
     t1 = s1*s3
     t2 = c1*c3
-    t3 = -t1 + c2*t2
-    t4 = t2 - c2*t1
+    t3 = -t1 + t2*c2
+    t4 = t2 - t1*c2
     t5 = c3*s1
     t6 = c1*s3
-    t7 = t5 + c2*t6
-    t8 = t6 + c2*t5
+    t7 = t5 + t6*c2
+    t8 = t6 + t5*c2
     t9 = c1*s2
-    t10 = c4*t3 + s4*t9
-    t11 = c4*t9 - s4*t3
-    t12 = c5*t10 - s5*t7
-    t13 = c5*t7 + s5*t10
-    t14 = c6*t12 - s6*t11
-    t15 = c6*t11 + s6*t12
-    t16 = c7*t14 - s7*t13
-    t17 = c7*t13 + s7*t14
+    t10 = t3*c4 + t9*s4
+    t11 = t9*c4 - t3*s4
+    t12 = t10*c5 - t7*s5
+    t13 = t10*s5 + t7*c5
+    t14 = t12*c6 - t11*s6
+    t15 = t11*c6 + t12*s6
+    t16 = t14*c7 - t13*s7
+    t17 = t13*c7 + t14*s7
     t18 = s1*s2
-    t19 = c4*t8 + s4*t18
-    t20 = c4*t18 - s4*t8
-    t21 = c5*t19 + s5*t4
-    t22 = c5*t4 - s5*t19
-    t23 = c6*t21 - s6*t20
-    t24 = c6*t20 + s6*t21
-    t25 = c7*t23 + s7*t22
-    t26 = c7*t22 - s7*t23
+    t19 = t8*c4 + t18*s4
+    t20 = t18*c4 - t8*s4
+    t21 = t19*c5 + t4*s5
+    t22 = t4*c5 - t19*s5
+    t23 = t21*c6 - t20*s6
+    t24 = t20*c6 + t21*s6
+    t25 = t22*s7 + t23*c7
+    t26 = t22*c7 - t23*s7
     t27 = c3*s2
-    t28 = c2*s4 - c4*t27
-    t29 = c2*c4 + s4*t27
+    t28 = c2*s4 - t27*c4
+    t29 = t27*s4 + c2*c4
     t30 = s2*s3
-    t31 = c5*t28 + s5*t30
-    t32 = c5*t30 - s5*t28
-    t33 = c6*t31 - s6*t29
-    t34 = c6*t29 + s6*t31
-    t35 = c7*t33 + s7*t32
-    t36 = c7*t32 - s7*t33
-    t37 = t0 - qd4*t30
-    t38 = t37 + qd5*t29
+    t31 = t28*c5 + t30*s5
+    t32 = t30*c5 - t28*s5
+    t33 = t31*c6 - t29*s6
+    t34 = t29*c6 + t31*s6
+    t35 = t32*s7 + t33*c7
+    t36 = t32*c7 - t33*s7
+    t37 = t0 - t30*qd4
+    t38 = t37 + t29*qd5
     t39 = 0.126*t15
     t40 = t39 + 0.4*t11
     t41 = t40 + 0.42*t9
@@ -774,62 +774,62 @@ def fk_jacobian_dot(q, q_dot):
     t46 = t45 + 0.4*t29
     t47 = t46 + 0.42*c2
     t48 = 0.36 + t47
-    t49 = s1*t47
-    t50 = s2*t49 - c2*t44
+    t49 = t47*s1
+    t50 = t49*s2 - t44*c2
     t51 = t50
-    t52 = t30*t43 - t4*t46
+    t52 = t43*t30 - t46*t4
     t53 = t52
     t54 = t20*t46 - t29*t43
     t55 = t54
     t56 = t22*t45 - t32*t42
     t57 = t56
-    t58 = qd5*t55 + qd6*t57
-    t59 = t58 + qd4*t53
-    t60 = t59 + qd3*t51
-    t61 = c1*t47
-    t62 = c2*t41 - s2*t61
+    t58 = t55*qd5 + t57*qd6
+    t59 = t58 + t53*qd4
+    t60 = t59 + t51*qd3
+    t61 = t47*c1
+    t62 = t41*c2 - t61*s2
     t63 = t62
-    t64 = t30*t40 + t46*t7
+    t64 = t40*t30 + t46*t7
     t65 = t64
     t66 = t29*t40 - t11*t46
     t67 = t66
     t68 = t13*t45 + t32*t39
     t69 = t68
-    t70 = qd5*t67 + qd6*t69
-    t71 = t70 - qd4*t65
-    t72 = t71 + qd3*t63
-    t73 = c1*t41 + s1*t44
+    t70 = t67*qd5 + t69*qd6
+    t71 = t70 - t65*qd4
+    t72 = t71 + t63*qd3
+    t73 = t41*c1 + t44*s1
     t74 = t73
-    t75 = t44*t9 - t18*t41
+    t75 = t44*t9 - t41*t18
     t76 = t75
-    t77 = t4*t40 + t43*t7
+    t77 = t40*t4 + t43*t7
     t78 = t77
     t79 = t11*t43 - t20*t40
     t80 = t79
     t81 = t13*t42 + t22*t39
     t82 = t81
-    t83 = qd5*t80 - qd6*t82
-    t84 = t83 + qd4*t78
-    t85 = t84 + qd3*t76
-    t86 = t85 - qd2*t74
+    t83 = t80*qd5 - t82*qd6
+    t84 = t83 + t78*qd4
+    t85 = t84 + t76*qd3
+    t86 = t85 - t74*qd2
     t87 = qd2*s1
-    t88 = -t87 + qd3*t9
-    t89 = t88 + qd4*t7
-    t90 = t89 + qd5*t11
+    t88 = -t87 + t9*qd3
+    t89 = t88 + t7*qd4
+    t90 = t89 + t11*qd5
     t91 = t72 + t47*t87
-    t92 = t91 + qd1*t41
+    t92 = t91 + t41*qd1
     t93 = c1*qd2
-    t94 = t93 + qd3*t18
-    t95 = t94 - qd4*t4
-    t96 = t95 + qd5*t20
+    t94 = t93 + t18*qd3
+    t95 = t94 - t4*qd4
+    t96 = t95 + t20*qd5
     t97 = t60 + t47*t93
-    t98 = t97 - qd1*t44
-    t99 = qd6*t13
+    t98 = t97 - t44*qd1
+    t99 = t13*qd6
     t100 = t90 - t99
-    t101 = qd6*t22
-    t102 = t101 + t96
-    t103 = qd6*t32
-    t104 = t103 + t38
+    t101 = t22*qd6
+    t102 = t96 + t101
+    t103 = t32*qd6
+    t104 = t38 + t103
     t105 = qd2*s2
     T = _stack(xp, [
         xp.broadcast_to(t16, batch),  # 0, 0
@@ -894,18 +894,18 @@ def fk_jacobian_dot(q, q_dot):
         xp.broadcast_to(t34, batch),  # 5, 6
     ], (6, 7))
     a = _stack(xp, [
-        xp.broadcast_to(qd2*(c1*t86 - qd1*t49) + qd3*(t18*t85 + t76*t93 - c2*t72 - qd1*t63) + qd4*(t0*t65 + t30*t71 + t78*t94 - t4*t84) + qd5*(t20*t83 + t80*t95 - t29*t70 - t37*t67) - qd1*t92 - qd6*(t101*t82 + t103*t69 + t38*t69 + t82*t96), batch),  # 0
-        xp.broadcast_to(qd1*t98 + qd2*(qd1*t61 + s1*t86) + qd3*(c2*t60 + qd1*t51 + t76*t87 - t85*t9) + qd5*(t29*t58 + t37*t55 - t11*t83 - t80*t89) + qd6*(t103*t57 + t38*t57 + t82*t90 - t82*t99) - qd4*(t30*t59 + t7*t84 + t78*t88 - t0*t53), batch),  # 1
-        xp.broadcast_to(qd4*(t4*t59 + t7*t71 - t53*t94 - t65*t88) + qd5*(t11*t70 + t67*t89 - t20*t58 - t55*t95) - qd2*(c1*t97 + s1*t91) - qd3*(t18*t60 + t51*t93 + t63*t87 - c1*s2*t72) - qd6*(t101*t57 + t57*t96 + t69*t99 - t69*t90), batch),  # 2
-        xp.broadcast_to(qd3*(c2*t93 - qd1*t18) + qd4*(t0*t4 - t30*t94) + qd5*(t29*t95 - t20*t37) + qd6*(t32*t96 - t22*t38) + qd7*(t102*t34 - t104*t24) - qd1*t93, batch),  # 3
-        xp.broadcast_to(qd3*(c2*t87 + qd1*t9) + qd4*(t0*t7 + t30*t88) + qd5*(t11*t37 - t29*t89) + qd7*(t104*t15 - t100*t34) - qd1*t87 - qd6*(t13*t38 + t32*t90), batch),  # 4
-        xp.broadcast_to(qd5*(t20*t89 - t11*t95) + qd6*(t13*t96 + t22*t90) + qd7*(t100*t24 - t102*t15) - qd3*(t105*c1**2 + t105*s1**2) - qd4*(t4*t88 + t7*t94), batch),  # 5
+        xp.broadcast_to(qd2*(t86*c1 - t49*qd1) + qd3*(t76*t93 + t85*t18 - t63*qd1 - t72*c2) + qd4*(t65*t0 + t78*t94 + t71*t30 - t84*t4) + qd5*(t20*t83 + t80*t95 - t29*t70 - t67*t37) - t92*qd1 - qd6*(t69*t38 + t69*t103 + t82*t96 + t82*t101), batch),  # 0
+        xp.broadcast_to(t98*qd1 + qd2*(t86*s1 + t61*qd1) + qd3*(t51*qd1 + t76*t87 + t60*c2 - t85*t9) + qd5*(t29*t58 + t55*t37 - t11*t83 - t80*t89) + qd6*(t57*t38 + t57*t103 + t82*t90 - t82*t99) - qd4*(t78*t88 + t7*t84 + t59*t30 - t53*t0), batch),  # 1
+        xp.broadcast_to(qd4*(t7*t71 + t59*t4 - t53*t94 - t65*t88) + qd5*(t11*t70 + t67*t89 - t20*t58 - t55*t95) - qd2*(t97*c1 + t91*s1) - qd3*(t51*t93 + t63*t87 + t60*t18 - t72*c1*s2) - qd6*(t57*t96 + t57*t101 + t69*t99 - t69*t90), batch),  # 2
+        xp.broadcast_to(qd3*(t93*c2 - t18*qd1) + qd4*(t0*t4 - t94*t30) + qd5*(t29*t95 - t20*t37) + qd6*(t32*t96 - t22*t38) + qd7*(t34*t102 - t24*t104) - t93*qd1, batch),  # 3
+        xp.broadcast_to(qd3*(t87*c2 + t9*qd1) + qd4*(t88*t30 + t7*t0) + qd5*(t11*t37 - t29*t89) + qd7*(t15*t104 - t34*t100) - t87*qd1 - qd6*(t13*t38 + t32*t90), batch),  # 4
+        xp.broadcast_to(qd5*(t20*t89 - t11*t95) + qd6*(t13*t96 + t22*t90) + qd7*(t24*t100 - t15*t102) - qd3*(t105*c1**2 + t105*s1**2) - qd4*(t88*t4 + t7*t94), batch),  # 5
     ], (6,))
     return T, J, a
 
 
 def jacobian_dot(q, q_dot):
-    """time derivative dJ/dt of the world geometric Jacobian along q_dot (6 x DOF): (6 x 7), 336 operations."""
+    """time derivative dJ/dt of the world geometric Jacobian along q_dot (6 x DOF): (6 x 7), 326 operations."""
     xp, dtype, device, batch, (q, q_dot,) = _arguments(("q", q, (7,)), ("q_dot", q_dot, (7,)))
     qd1 = q_dot[..., 0]
     qd2 = q_dot[..., 1]
@@ -929,126 +929,126 @@ def jacobian_dot(q, q_dot):
     t0 = qd1 + c2*qd3
     t1 = s1*s3
     t2 = c1*c3
-    t3 = -t1 + c2*t2
-    t4 = t2 - c2*t1
+    t3 = -t1 + t2*c2
+    t4 = t2 - t1*c2
     t5 = c3*s1
     t6 = c1*s3
-    t7 = t5 + c2*t6
-    t8 = t6 + c2*t5
+    t7 = t5 + t6*c2
+    t8 = t6 + t5*c2
     t9 = c1*s2
-    t10 = c4*t3 + s4*t9
-    t11 = c4*t9 - s4*t3
-    t12 = c5*t10 - s5*t7
-    t13 = c5*t7 + s5*t10
-    t14 = c6*t11 + s6*t12
+    t10 = t3*c4 + t9*s4
+    t11 = t9*c4 - t3*s4
+    t12 = t10*c5 - t7*s5
+    t13 = t10*s5 + t7*c5
+    t14 = t11*c6 + t12*s6
     t15 = s1*s2
-    t16 = c4*t8 + s4*t15
-    t17 = c4*t15 - s4*t8
-    t18 = c5*t16 + s5*t4
-    t19 = c5*t4 - s5*t16
-    t20 = c6*t17 + s6*t18
+    t16 = t8*c4 + t15*s4
+    t17 = t15*c4 - t8*s4
+    t18 = t16*c5 + t4*s5
+    t19 = t4*c5 - t16*s5
+    t20 = t17*c6 + t18*s6
     t21 = c3*s2
-    t22 = c2*s4 - c4*t21
-    t23 = c2*c4 + s4*t21
+    t22 = c2*s4 - t21*c4
+    t23 = t21*s4 + c2*c4
     t24 = s2*s3
-    t25 = c5*t22 + s5*t24
-    t26 = c5*t24 - s5*t22
-    t27 = c6*t23 + s6*t25
-    t28 = t0 - qd4*t24
-    t29 = t28 + qd5*t23
+    t25 = t22*c5 + t24*s5
+    t26 = t24*c5 - t22*s5
+    t27 = t23*c6 + t25*s6
+    t28 = t0 - t24*qd4
+    t29 = t28 + t23*qd5
     t30 = 0.126*t14
     t31 = t30 + 0.4*t11
     t32 = t31 + 0.42*t9
     t33 = 0.126*t20
     t34 = t33 + 0.4*t17
     t35 = t34 + 0.42*t15
-    t36 = c1*t32 + s1*t35
-    t37 = t35*t9 - t15*t32
+    t36 = t32*c1 + t35*s1
+    t37 = t35*t9 - t32*t15
     t38 = t31*t4 + t34*t7
     t39 = t11*t34 - t17*t31
     t40 = t13*t33 + t19*t30
-    t41 = qd5*t39 - qd6*t40
-    t42 = t41 + qd4*t38
-    t43 = t42 + qd3*t37
-    t44 = t43 - qd2*t36
+    t41 = t39*qd5 - t40*qd6
+    t42 = t41 + t38*qd4
+    t43 = t42 + t37*qd3
+    t44 = t43 - t36*qd2
     t45 = 0.126*t27
     t46 = t45 + 0.4*t23
     t47 = t46 + 0.42*c2
-    t48 = t15*t47 - c2*t35
-    t49 = t24*t34 - t4*t46
+    t48 = t47*t15 - t35*c2
+    t49 = t34*t24 - t46*t4
     t50 = t17*t46 - t23*t34
     t51 = t19*t45 - t26*t33
-    t52 = c2*t32 - t47*t9
-    t53 = t24*t31 + t46*t7
+    t52 = t32*c2 - t47*t9
+    t53 = t31*t24 + t46*t7
     t54 = t23*t31 - t11*t46
     t55 = t13*t45 + t26*t30
-    t56 = qd5*t50 + qd6*t51
-    t57 = qd5*t54 + qd6*t55
-    t58 = t56 + qd4*t49
-    t59 = t57 - qd4*t53
-    t60 = t58 + qd3*t48
-    t61 = t59 + qd3*t52
+    t56 = t50*qd5 + t51*qd6
+    t57 = t54*qd5 + t55*qd6
+    t58 = t56 + t49*qd4
+    t59 = t57 - t53*qd4
+    t60 = t58 + t48*qd3
+    t61 = t59 + t52*qd3
     t62 = qd2*s1
-    t63 = -t62 + qd3*t9
-    t64 = t63 + qd4*t7
-    t65 = t64 + qd5*t11
+    t63 = -t62 + t9*qd3
+    t64 = t63 + t7*qd4
+    t65 = t64 + t11*qd5
     t66 = t61 + t47*t62
-    t67 = t66 + qd1*t32
+    t67 = t66 + t32*qd1
     t68 = c1*qd2
-    t69 = t68 + qd3*t15
-    t70 = t69 - qd4*t4
-    t71 = t70 + qd5*t17
+    t69 = t68 + t15*qd3
+    t70 = t69 - t4*qd4
+    t71 = t70 + t17*qd5
     t72 = t60 + t47*t68
-    t73 = t72 - qd1*t35
-    t74 = qd6*t13
+    t73 = t72 - t35*qd1
+    t74 = t13*qd6
     t75 = t65 - t74
-    t76 = qd6*t19
+    t76 = t19*qd6
     t77 = t71 + t76
-    t78 = qd6*t26
+    t78 = t26*qd6
     t79 = t29 + t78
     t80 = qd1*s1
     t81 = c1*qd1
     t82 = qd2*s2
     Jd = _stack(xp, [
         xp.broadcast_to(-t67, batch),  # 0, 0
-        xp.broadcast_to(c1*t44 - t47*t80, batch),  # 0, 1
-        xp.broadcast_to(t15*t43 + t37*t68 - c2*t61 - qd1*t52, batch),  # 0, 2
-        xp.broadcast_to(t0*t53 + t24*t59 + t38*t69 - t4*t42, batch),  # 0, 3
-        xp.broadcast_to(t17*t41 + t39*t70 - t23*t57 - t28*t54, batch),  # 0, 4
-        xp.broadcast_to(-t29*t55 - t40*t71 - t40*t76 - t55*t78, batch),  # 0, 5
+        xp.broadcast_to(t44*c1 - t47*t80, batch),  # 0, 1
+        xp.broadcast_to(t37*t68 + t43*t15 - t52*qd1 - t61*c2, batch),  # 0, 2
+        xp.broadcast_to(t53*t0 + t38*t69 + t59*t24 - t42*t4, batch),  # 0, 3
+        xp.broadcast_to(t17*t41 + t39*t70 - t23*t57 - t54*t28, batch),  # 0, 4
+        xp.broadcast_to(-(t55*t29 + t55*t78 + t40*t71 + t40*t76), batch),  # 0, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 6
         xp.broadcast_to(t73, batch),  # 1, 0
-        xp.broadcast_to(s1*t44 + t47*t81, batch),  # 1, 1
-        xp.broadcast_to(c2*t60 + qd1*t48 + t37*t62 - t43*t9, batch),  # 1, 2
-        xp.broadcast_to(t0*t49 - t24*t58 - t38*t63 - t42*t7, batch),  # 1, 3
-        xp.broadcast_to(t23*t56 + t28*t50 - t11*t41 - t39*t64, batch),  # 1, 4
-        xp.broadcast_to(t29*t51 + t40*t65 + t51*t78 - t40*t74, batch),  # 1, 5
+        xp.broadcast_to(t47*t81 + t44*s1, batch),  # 1, 1
+        xp.broadcast_to(t48*qd1 + t37*t62 + t60*c2 - t43*t9, batch),  # 1, 2
+        xp.broadcast_to(-(t38*t63 + t7*t42 + t58*t24 - t49*t0), batch),  # 1, 3
+        xp.broadcast_to(t23*t56 + t50*t28 - t11*t41 - t39*t64, batch),  # 1, 4
+        xp.broadcast_to(t51*t29 + t51*t78 + t40*t65 - t40*t74, batch),  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
-        xp.broadcast_to(-c1*t72 - s1*t66, batch),  # 2, 1
-        xp.broadcast_to(-t15*t60 - t48*t68 - t52*t62 + c1*s2*t61, batch),  # 2, 2
-        xp.broadcast_to(t4*t58 + t59*t7 - t49*t69 - t53*t63, batch),  # 2, 3
+        xp.broadcast_to(-(t72*c1 + t66*s1), batch),  # 2, 1
+        xp.broadcast_to(-(t48*t68 + t52*t62 + t60*t15 - t61*c1*s2), batch),  # 2, 2
+        xp.broadcast_to(t7*t59 + t58*t4 - t49*t69 - t53*t63, batch),  # 2, 3
         xp.broadcast_to(t11*t57 + t54*t64 - t17*t56 - t50*t70, batch),  # 2, 4
-        xp.broadcast_to(t55*t65 - t51*t71 - t51*t76 - t55*t74, batch),  # 2, 5
+        xp.broadcast_to(-(t51*t71 + t51*t76 + t55*t74 - t55*t65), batch),  # 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
         xp.broadcast_to(-t81, batch),  # 3, 1
-        xp.broadcast_to(c2*t68 - s2*t80, batch),  # 3, 2
-        xp.broadcast_to(t0*t4 - t24*t69, batch),  # 3, 3
+        xp.broadcast_to(t68*c2 - t80*s2, batch),  # 3, 2
+        xp.broadcast_to(t0*t4 - t69*t24, batch),  # 3, 3
         xp.broadcast_to(t23*t70 - t17*t28, batch),  # 3, 4
         xp.broadcast_to(t26*t71 - t19*t29, batch),  # 3, 5
         xp.broadcast_to(t27*t77 - t20*t79, batch),  # 3, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
         xp.broadcast_to(-t80, batch),  # 4, 1
-        xp.broadcast_to(c2*t62 + s2*t81, batch),  # 4, 2
-        xp.broadcast_to(t0*t7 + t24*t63, batch),  # 4, 3
+        xp.broadcast_to(t62*c2 + t81*s2, batch),  # 4, 2
+        xp.broadcast_to(t63*t24 + t7*t0, batch),  # 4, 3
         xp.broadcast_to(t11*t28 - t23*t64, batch),  # 4, 4
-        xp.broadcast_to(-t13*t29 - t26*t65, batch),  # 4, 5
+        xp.broadcast_to(-(t13*t29 + t26*t65), batch),  # 4, 5
         xp.broadcast_to(t14*t79 - t27*t75, batch),  # 4, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 1
-        xp.broadcast_to(-t82*c1**2 - t82*s1**2, batch),  # 5, 2
-        xp.broadcast_to(-t4*t63 - t69*t7, batch),  # 5, 3
+        xp.broadcast_to(-(t82*c1**2 + t82*s1**2), batch),  # 5, 2
+        xp.broadcast_to(-(t63*t4 + t7*t69), batch),  # 5, 3
         xp.broadcast_to(t17*t64 - t11*t70, batch),  # 5, 4
         xp.broadcast_to(t13*t71 + t19*t65, batch),  # 5, 5
         xp.broadcast_to(t20*t75 - t14*t77, batch),  # 5, 6
@@ -1082,98 +1082,98 @@ def bias_acceleration(q, q_dot):
     t0 = qd1 + c2*qd3
     t1 = s1*s3
     t2 = c1*c3
-    t3 = -t1 + c2*t2
-    t4 = t2 - c2*t1
+    t3 = -t1 + t2*c2
+    t4 = t2 - t1*c2
     t5 = c3*s1
     t6 = c1*s3
-    t7 = t5 + c2*t6
-    t8 = t6 + c2*t5
+    t7 = t5 + t6*c2
+    t8 = t6 + t5*c2
     t9 = c1*s2
-    t10 = c4*t3 + s4*t9
-    t11 = c4*t9 - s4*t3
-    t12 = c5*t10 - s5*t7
-    t13 = c5*t7 + s5*t10
-    t14 = c6*t11 + s6*t12
+    t10 = t3*c4 + t9*s4
+    t11 = t9*c4 - t3*s4
+    t12 = t10*c5 - t7*s5
+    t13 = t10*s5 + t7*c5
+    t14 = t11*c6 + t12*s6
     t15 = s1*s2
-    t16 = c4*t8 + s4*t15
-    t17 = c4*t15 - s4*t8
-    t18 = c5*t16 + s5*t4
-    t19 = c5*t4 - s5*t16
-    t20 = c6*t17 + s6*t18
+    t16 = t8*c4 + t15*s4
+    t17 = t15*c4 - t8*s4
+    t18 = t16*c5 + t4*s5
+    t19 = t4*c5 - t16*s5
+    t20 = t17*c6 + t18*s6
     t21 = c3*s2
-    t22 = c2*s4 - c4*t21
-    t23 = c2*c4 + s4*t21
+    t22 = c2*s4 - t21*c4
+    t23 = t21*s4 + c2*c4
     t24 = s2*s3
-    t25 = c5*t22 + s5*t24
-    t26 = c5*t24 - s5*t22
-    t27 = c6*t23 + s6*t25
-    t28 = t0 - qd4*t24
-    t29 = t28 + qd5*t23
+    t25 = t22*c5 + t24*s5
+    t26 = t24*c5 - t22*s5
+    t27 = t23*c6 + t25*s6
+    t28 = t0 - t24*qd4
+    t29 = t28 + t23*qd5
     t30 = 0.126*t14
     t31 = t30 + 0.4*t11
     t32 = t31 + 0.42*t9
     t33 = 0.126*t20
     t34 = t33 + 0.4*t17
     t35 = t34 + 0.42*t15
-    t36 = c1*t32 + s1*t35
-    t37 = t35*t9 - t15*t32
+    t36 = t32*c1 + t35*s1
+    t37 = t35*t9 - t32*t15
     t38 = t31*t4 + t34*t7
     t39 = t11*t34 - t17*t31
     t40 = t13*t33 + t19*t30
-    t41 = qd5*t39 - qd6*t40
-    t42 = t41 + qd4*t38
-    t43 = t42 + qd3*t37
-    t44 = t43 - qd2*t36
+    t41 = t39*qd5 - t40*qd6
+    t42 = t41 + t38*qd4
+    t43 = t42 + t37*qd3
+    t44 = t43 - t36*qd2
     t45 = 0.126*t27
     t46 = t45 + 0.4*t23
     t47 = t46 + 0.42*c2
-    t48 = t15*t47 - c2*t35
-    t49 = t24*t34 - t4*t46
+    t48 = t47*t15 - t35*c2
+    t49 = t34*t24 - t46*t4
     t50 = t17*t46 - t23*t34
     t51 = t19*t45 - t26*t33
-    t52 = c2*t32 - t47*t9
-    t53 = t24*t31 + t46*t7
+    t52 = t32*c2 - t47*t9
+    t53 = t31*t24 + t46*t7
     t54 = t23*t31 - t11*t46
     t55 = t13*t45 + t26*t30
-    t56 = qd5*t50 + qd6*t51
-    t57 = qd5*t54 + qd6*t55
-    t58 = t56 + qd4*t49
-    t59 = t57 - qd4*t53
-    t60 = t58 + qd3*t48
-    t61 = t59 + qd3*t52
+    t56 = t50*qd5 + t51*qd6
+    t57 = t54*qd5 + t55*qd6
+    t58 = t56 + t49*qd4
+    t59 = t57 - t53*qd4
+    t60 = t58 + t48*qd3
+    t61 = t59 + t52*qd3
     t62 = qd2*s1
-    t63 = -t62 + qd3*t9
-    t64 = t63 + qd4*t7
-    t65 = t64 + qd5*t11
+    t63 = -t62 + t9*qd3
+    t64 = t63 + t7*qd4
+    t65 = t64 + t11*qd5
     t66 = t61 + t47*t62
-    t67 = t66 + qd1*t32
+    t67 = t66 + t32*qd1
     t68 = c1*qd2
-    t69 = t68 + qd3*t15
-    t70 = t69 - qd4*t4
-    t71 = t70 + qd5*t17
+    t69 = t68 + t15*qd3
+    t70 = t69 - t4*qd4
+    t71 = t70 + t17*qd5
     t72 = t60 + t47*t68
-    t73 = t72 - qd1*t35
-    t74 = qd6*t13
+    t73 = t72 - t35*qd1
+    t74 = t13*qd6
     t75 = t65 - t74
-    t76 = qd6*t19
+    t76 = t19*qd6
     t77 = t71 + t76
-    t78 = qd6*t26
+    t78 = t26*qd6
     t79 = t29 + t78
-    t80 = qd1*t47
+    t80 = t47*qd1
     t81 = qd2*s2
     a = _stack(xp, [
-        xp.broadcast_to(qd2*(c1*t44 - s1*t80) + qd3*(t15*t43 + t37*t68 - c2*t61 - qd1*t52) + qd4*(t0*t53 + t24*t59 + t38*t69 - t4*t42) + qd5*(t17*t41 + t39*t70 - t23*t57 - t28*t54) - qd1*t67 - qd6*(t29*t55 + t40*t71 + t40*t76 + t55*t78), batch),  # 0
-        xp.broadcast_to(qd1*t73 + qd2*(c1*t80 + s1*t44) + qd3*(c2*t60 + qd1*t48 + t37*t62 - t43*t9) + qd5*(t23*t56 + t28*t50 - t11*t41 - t39*t64) + qd6*(t29*t51 + t40*t65 + t51*t78 - t40*t74) - qd4*(t24*t58 + t38*t63 + t42*t7 - t0*t49), batch),  # 1
-        xp.broadcast_to(qd4*(t4*t58 + t59*t7 - t49*t69 - t53*t63) + qd5*(t11*t57 + t54*t64 - t17*t56 - t50*t70) - qd2*(c1*t72 + s1*t66) - qd3*(t15*t60 + t48*t68 + t52*t62 - c1*s2*t61) - qd6*(t51*t71 + t51*t76 + t55*t74 - t55*t65), batch),  # 2
-        xp.broadcast_to(qd3*(c2*t68 - qd1*t15) + qd4*(t0*t4 - t24*t69) + qd5*(t23*t70 - t17*t28) + qd6*(t26*t71 - t19*t29) + qd7*(t27*t77 - t20*t79) - qd1*t68, batch),  # 3
-        xp.broadcast_to(qd3*(c2*t62 + qd1*t9) + qd4*(t0*t7 + t24*t63) + qd5*(t11*t28 - t23*t64) + qd7*(t14*t79 - t27*t75) - qd1*t62 - qd6*(t13*t29 + t26*t65), batch),  # 4
-        xp.broadcast_to(qd5*(t17*t64 - t11*t70) + qd6*(t13*t71 + t19*t65) + qd7*(t20*t75 - t14*t77) - qd3*(t81*c1**2 + t81*s1**2) - qd4*(t4*t63 + t69*t7), batch),  # 5
+        xp.broadcast_to(qd2*(t44*c1 - t80*s1) + qd3*(t37*t68 + t43*t15 - t52*qd1 - t61*c2) + qd4*(t53*t0 + t38*t69 + t59*t24 - t42*t4) + qd5*(t17*t41 + t39*t70 - t23*t57 - t54*t28) - t67*qd1 - qd6*(t55*t29 + t55*t78 + t40*t71 + t40*t76), batch),  # 0
+        xp.broadcast_to(t73*qd1 + qd2*(t44*s1 + t80*c1) + qd3*(t48*qd1 + t37*t62 + t60*c2 - t43*t9) + qd5*(t23*t56 + t50*t28 - t11*t41 - t39*t64) + qd6*(t51*t29 + t51*t78 + t40*t65 - t40*t74) - qd4*(t38*t63 + t7*t42 + t58*t24 - t49*t0), batch),  # 1
+        xp.broadcast_to(qd4*(t7*t59 + t58*t4 - t49*t69 - t53*t63) + qd5*(t11*t57 + t54*t64 - t17*t56 - t50*t70) - qd2*(t72*c1 + t66*s1) - qd3*(t48*t68 + t52*t62 + t60*t15 - t61*c1*s2) - qd6*(t51*t71 + t51*t76 + t55*t74 - t55*t65), batch),  # 2
+        xp.broadcast_to(qd3*(t68*c2 - t15*qd1) + qd4*(t0*t4 - t69*t24) + qd5*(t23*t70 - t17*t28) + qd6*(t26*t71 - t19*t29) + qd7*(t27*t77 - t20*t79) - t68*qd1, batch),  # 3
+        xp.broadcast_to(qd3*(t62*c2 + t9*qd1) + qd4*(t63*t24 + t7*t0) + qd5*(t11*t28 - t23*t64) + qd7*(t14*t79 - t27*t75) - t62*qd1 - qd6*(t13*t29 + t26*t65), batch),  # 4
+        xp.broadcast_to(qd5*(t17*t64 - t11*t70) + qd6*(t13*t71 + t19*t65) + qd7*(t20*t75 - t14*t77) - qd3*(t81*c1**2 + t81*s1**2) - qd4*(t63*t4 + t7*t69), batch),  # 5
     ], (6,))
     return a
 
 
 def task_jacobian_dot(q, q_dot):
-    """time derivative of the analytic Jacobian along q_dot (6 x DOF): mu'' = J_a q'' + J_a' q': (6 x 7), 699 operations."""
+    """time derivative of the analytic Jacobian along q_dot (6 x DOF): mu'' = J_a q'' + J_a' q': (6 x 7), 695 operations."""
     xp, dtype, device, batch, (q, q_dot,) = _arguments(("q", q, (7,)), ("q_dot", q_dot, (7,)))
     qd1 = q_dot[..., 0]
     qd2 = q_dot[..., 1]
@@ -1199,210 +1199,210 @@ def task_jacobian_dot(q, q_dot):
     s7 = trig[..., 13]
     t0 = s1*s3
     t1 = c1*c3
-    t2 = -t0 + c2*t1
-    t3 = t1 - c2*t0
+    t2 = -t0 + t1*c2
+    t3 = t1 - t0*c2
     t4 = c3*s1
     t5 = c1*s3
-    t6 = t4 + c2*t5
-    t7 = t5 + c2*t4
+    t6 = t4 + t5*c2
+    t7 = t5 + t4*c2
     t8 = c1*s2
-    t9 = c4*t2 + s4*t8
-    t10 = c4*t8 - s4*t2
-    t11 = c5*t9 - s5*t6
-    t12 = c5*t6 + s5*t9
-    t13 = c6*t11 - s6*t10
-    t14 = c6*t10 + s6*t11
-    t15 = c7*t13 - s7*t12
+    t9 = t2*c4 + t8*s4
+    t10 = t8*c4 - t2*s4
+    t11 = t9*c5 - t6*s5
+    t12 = t9*s5 + t6*c5
+    t13 = t11*c6 - t10*s6
+    t14 = t10*c6 + t11*s6
+    t15 = t13*c7 - t12*s7
     t16 = s1*s2
-    t17 = c4*t7 + s4*t16
-    t18 = c4*t16 - s4*t7
-    t19 = c5*t17 + s5*t3
-    t20 = c5*t3 - s5*t17
-    t21 = c6*t19 - s6*t18
-    t22 = c6*t18 + s6*t19
-    t23 = c7*t21 + s7*t20
+    t17 = t7*c4 + t16*s4
+    t18 = t16*c4 - t7*s4
+    t19 = t17*c5 + t3*s5
+    t20 = t3*c5 - t17*s5
+    t21 = t19*c6 - t18*s6
+    t22 = t18*c6 + t19*s6
+    t23 = t20*s7 + t21*c7
     t24 = c3*s2
-    t25 = c2*s4 - c4*t24
-    t26 = c2*c4 + s4*t24
+    t25 = c2*s4 - t24*c4
+    t26 = t24*s4 + c2*c4
     t27 = s2*s3
-    t28 = c5*t25 + s5*t27
-    t29 = c5*t27 - s5*t25
-    t30 = c6*t28 - s6*t26
-    t31 = c6*t26 + s6*t28
-    t32 = c7*t30 + s7*t29
+    t28 = t25*c5 + t27*s5
+    t29 = t27*c5 - t25*s5
+    t30 = t28*c6 - t26*s6
+    t31 = t26*c6 + t28*s6
+    t32 = t29*s7 + t30*c7
     t33 = 0.126*t14
     t34 = t33 + 0.4*t10
     t35 = t34 + 0.42*t8
     t36 = 0.126*t22
     t37 = t36 + 0.4*t18
     t38 = t37 + 0.42*t16
-    t39 = c1*t35 + s1*t38
-    t40 = t38*t8 - t16*t35
-    t41 = t3*t34 + t37*t6
+    t39 = t35*c1 + t38*s1
+    t40 = t38*t8 - t35*t16
+    t41 = t34*t3 + t37*t6
     t42 = t10*t37 - t18*t34
     t43 = t12*t36 + t20*t33
-    t44 = qd5*t42 - qd6*t43
-    t45 = t44 + qd4*t41
-    t46 = t45 + qd3*t40
-    t47 = t46 - qd2*t39
+    t44 = t42*qd5 - t43*qd6
+    t45 = t44 + t41*qd4
+    t46 = t45 + t40*qd3
+    t47 = t46 - t39*qd2
     t48 = 0.126*t31
     t49 = t48 + 0.4*t26
     t50 = t49 + 0.42*c2
-    t51 = t16*t50 - c2*t38
-    t52 = t27*t37 - t3*t49
+    t51 = t50*t16 - t38*c2
+    t52 = t37*t27 - t49*t3
     t53 = t18*t49 - t26*t37
     t54 = t20*t48 - t29*t36
-    t55 = c2*t35 - t50*t8
-    t56 = t27*t34 + t49*t6
+    t55 = t35*c2 - t50*t8
+    t56 = t34*t27 + t49*t6
     t57 = t26*t34 - t10*t49
     t58 = t12*t48 + t29*t33
-    t59 = qd5*t53 + qd6*t54
-    t60 = qd5*t57 + qd6*t58
-    t61 = t59 + qd4*t52
-    t62 = t60 - qd4*t56
-    t63 = t61 + qd3*t51
-    t64 = t62 + qd3*t55
+    t59 = t53*qd5 + t54*qd6
+    t60 = t57*qd5 + t58*qd6
+    t61 = t59 + t52*qd4
+    t62 = t60 - t56*qd4
+    t63 = t61 + t51*qd3
+    t64 = t62 + t55*qd3
     t65 = qd2*s1
     t66 = t64 + t50*t65
-    t67 = t66 + qd1*t35
-    t68 = c2*t63 + qd1*t51 + t40*t65 - t46*t8
-    t69 = c2*t65 + qd1*t8
-    t70 = -t65 + qd3*t8
+    t67 = t66 + t35*qd1
+    t68 = t51*qd1 + t40*t65 + t63*c2 - t46*t8
+    t69 = t65*c2 + t8*qd1
+    t70 = -t65 + t8*qd3
     t71 = t70
     t72 = c1*qd2
     t73 = t63 + t50*t72
-    t74 = t73 - qd1*t38
-    t75 = t16*t46 + t40*t72 - c2*t64 - qd1*t55
-    t76 = c1*t73 + s1*t66
-    t77 = t16*t63 + t51*t72 + t55*t65 - t64*t8
-    t78 = c2*t72 - qd1*t16
-    t79 = t72 + qd3*t16
+    t74 = t73 - t38*qd1
+    t75 = t40*t72 + t46*t16 - t55*qd1 - t64*c2
+    t76 = t73*c1 + t66*s1
+    t77 = t51*t72 + t55*t65 + t63*t16 - t64*t8
+    t78 = t72*c2 - t16*qd1
+    t79 = t72 + t16*qd3
     t80 = t79
-    t81 = t3*t61 + t6*t62 - t52*t80 - t56*t71
-    t82 = t3*t71 + t6*t80
+    t81 = t6*t62 + t61*t3 - t52*t80 - t56*t71
+    t82 = t71*t3 + t6*t80
     t83 = qd1 + c2*qd3
     t84 = t83
-    t85 = t27*t62 + t41*t80 + t56*t84 - t3*t45
-    t86 = t27*t61 + t41*t71 + t45*t6 - t52*t84
-    t87 = t3*t84 - t27*t80
-    t88 = t27*t71 + t6*t84
-    t89 = qd4*t6
+    t85 = t56*t84 + t41*t80 + t62*t27 - t45*t3
+    t86 = t41*t71 + t6*t45 + t61*t27 - t52*t84
+    t87 = t84*t3 - t80*t27
+    t88 = t71*t27 + t6*t84
+    t89 = t6*qd4
     t90 = t71 + t89
-    t91 = -qd4*t3
+    t91 = -t3*qd4
     t92 = t80 + t91
     t93 = t10*t60 + t57*t90 - t18*t59 - t53*t92
     t94 = t18*t90 - t10*t92
-    t95 = -qd4*t27
+    t95 = -t27*qd4
     t96 = t84 + t95
     t97 = t18*t44 + t42*t92 - t26*t60 - t57*t96
     t98 = t26*t59 + t53*t96 - t10*t44 - t42*t90
     t99 = t26*t92 - t18*t96
     t100 = t10*t96 - t26*t90
-    t101 = qd5*t10
-    t102 = t101 + t90
-    t103 = qd5*t18
-    t104 = t103 + t92
-    t105 = t102*t20 + t104*t12
-    t106 = qd5*t26
-    t107 = t106 + t96
-    t108 = t104*t29 - t107*t20
-    t109 = t102*t29 + t107*t12
-    t110 = qd6*t12
+    t101 = t10*qd5
+    t102 = t90 + t101
+    t103 = t18*qd5
+    t104 = t92 + t103
+    t105 = t12*t104 + t20*t102
+    t106 = t26*qd5
+    t107 = t96 + t106
+    t108 = t29*t104 - t20*t107
+    t109 = t12*t107 + t29*t102
+    t110 = t12*qd6
     t111 = -t110
     t112 = t102 + t111
-    t113 = t101 + t111 + t70 + t89 + qd7*t14
-    t114 = qd6*t20
+    t113 = t70 + t89 + t101 + t111 + t14*qd7
+    t114 = t20*qd6
     t115 = t104 + t114
-    t116 = t104*t54 + t110*t58 + t114*t54 - t102*t58
-    t117 = t112*t22 - t115*t14
-    t118 = t103 + t114 + t79 + t91 + qd7*t22
+    t116 = t54*t104 + t54*t114 + t58*t110 - t58*t102
+    t117 = t22*t112 - t14*t115
+    t118 = t79 + t91 + t103 + t114 + t22*qd7
     t119 = t113*t23 - t118*t15
-    t120 = qd6*t29
+    t120 = t29*qd6
     t121 = t107 + t120
-    t122 = t104*t43 + t107*t58 + t114*t43 + t120*t58
-    t123 = t102*t43 + t107*t54 + t120*t54 - t110*t43
-    t124 = t115*t31 - t121*t22
-    t125 = t121*t14 - t112*t31
-    t126 = t106 + t120 + t83 + t95 + qd7*t31
+    t122 = t58*t107 + t58*t120 + t43*t104 + t43*t114
+    t123 = t54*t107 + t54*t120 + t43*t102 - t43*t110
+    t124 = t31*t115 - t22*t121
+    t125 = t14*t121 - t31*t112
+    t126 = t83 + t95 + t106 + t120 + t31*qd7
     t127 = t118*t32 - t126*t23
     t128 = t126*t15 - t113*t32
-    t129 = qd1*t50
-    t130 = c1*t47 - s1*t129
-    t131 = c1*t129 + s1*t47
+    t129 = t50*qd1
+    t130 = t47*c1 - t129*s1
+    t131 = t47*s1 + t129*c1
     t132 = qd2*s2
     t133 = t132*c1**2 + t132*s1**2
     t134 = t15**2 + t23**2
-    t135 = t134**(-1.0)
-    t136 = c1*t135
-    t137 = qd1*t15
-    t138 = s1*t135
-    t139 = qd1*t23
-    t140 = c1*t23
-    t141 = s1*t15
+    t135 = 1/t134
+    t136 = t135*c1
+    t137 = t15*qd1
+    t138 = t135*s1
+    t139 = t23*qd1
+    t140 = t23*c1
+    t141 = t15*s1
     t142 = t140 - t141
     t143 = 2/t134**2
     t144 = t142*t143
-    t145 = t144*t23
-    t146 = t144*t15
-    t147 = t135*t15
-    t148 = t147*t78
-    t149 = t135*t23
-    t150 = t149*t69
-    t151 = s2*t136
-    t152 = c1*t15
-    t153 = s1*t23
-    t154 = s2*t152 + s2*t153
+    t145 = t23*t144
+    t146 = t15*t144
+    t147 = t15*t135
+    t148 = t78*t147
+    t149 = t23*t135
+    t150 = t69*t149
+    t151 = t136*s2
+    t152 = t15*c1
+    t153 = t23*s1
+    t154 = t152*s2 + t153*s2
     t155 = t143*t154
     t156 = t15*t155
-    t157 = s2*t138
-    t158 = t155*t23
-    t159 = t147*t87
-    t160 = t149*t88
-    t161 = t135*t6
+    t157 = t138*s2
+    t158 = t23*t155
+    t159 = t87*t147
+    t160 = t88*t149
+    t161 = t6*t135
     t162 = t15*t6 - t23*t3
     t163 = t143*t162
     t164 = t15*t163
-    t165 = t135*t3
-    t166 = t163*t23
-    t167 = t147*t99
+    t165 = t3*t135
+    t166 = t23*t163
+    t167 = t99*t147
     t168 = t100*t149
     t169 = t10*t135
     t170 = t10*t15 + t18*t23
     t171 = t143*t170
     t172 = t15*t171
-    t173 = t135*t18
-    t174 = t171*t23
+    t173 = t18*t135
+    t174 = t23*t171
     t175 = t108*t147
     t176 = t109*t149
-    t177 = t135*t20
+    t177 = t20*t135
     t178 = t20*t23 - t12*t15
     t179 = t143*t178
-    t180 = t179*t23
+    t180 = t23*t179
     t181 = t12*t135
     t182 = t15*t179
     t183 = t124*t147
     t184 = t125*t149
-    t185 = t135*t14
+    t185 = t14*t135
     t186 = t14*t15 + t22*t23
     t187 = t143*t186
     t188 = t15*t187
-    t189 = t135*t22
-    t190 = t187*t23
+    t189 = t22*t135
+    t190 = t23*t187
     t191 = 1/xp.sqrt(t134)
-    t192 = qd1*t191
-    t193 = c1*t191
-    t194 = t134**(-3/2)
+    t192 = t191*qd1
+    t193 = t191*c1
+    t194 = 1/t134**1.5
     t195 = t194*(t152 + t153)
-    t196 = s1*t191
+    t196 = t191*s1
     t197 = t15*t191
-    t198 = t191*t23
-    t199 = t194*(s2*t141 - s2*t140)
+    t198 = t23*t191
+    t199 = t194*(t141*s2 - t140*s2)
     t200 = -t194*(t15*t3 + t23*t6)
-    t201 = t194*(t15*t18 - t10*t23)
-    t202 = t194*(t12*t23 + t15*t20)
-    t203 = t194*(t15*t22 - t14*t23)
-    t204 = t136*t32
-    t205 = t138*t32
+    t201 = t194*(t18*t15 - t10*t23)
+    t202 = t194*(t12*t23 + t20*t15)
+    t203 = t194*(t22*t15 - t14*t23)
+    t204 = t32*t136
+    t205 = t32*t138
     t206 = t119*t135
     Jd = _stack(xp, [
         xp.broadcast_to(-t67, batch),  # 0, 0
@@ -1434,25 +1434,25 @@ def task_jacobian_dot(q, q_dot):
         xp.broadcast_to(t175 - t176 + t128*(t177 - t180) - t127*(t181 + t182), batch),  # 3, 5
         xp.broadcast_to(t183 + t184 + t127*(t185 - t188) + t128*(t189 - t190), batch),  # 3, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
-        xp.broadcast_to(t127*(t193 - t15*t195) + t128*(t196 - t195*t23) + t140*t192 - t141*t192, batch),  # 4, 1
-        xp.broadcast_to(t127*(s2*t196 - t15*t199) + t197*t69 - t128*(s2*t193 + t199*t23) - t198*t78, batch),  # 4, 2
-        xp.broadcast_to(t197*t88 - t127*(t15*t200 + t191*t3) - t128*(t191*t6 + t200*t23) - t198*t87, batch),  # 4, 3
-        xp.broadcast_to(t100*t197 + t127*(t18*t191 - t15*t201) - t128*(t10*t191 + t201*t23) - t198*t99, batch),  # 4, 4
-        xp.broadcast_to(t127*(t191*t20 - t15*t202) + t128*(t12*t191 - t202*t23) - t108*t198 - t109*t197, batch),  # 4, 5
-        xp.broadcast_to(t125*t197 + t127*(t191*t22 - t15*t203) - t124*t198 - t128*(t14*t191 + t203*t23), batch),  # 4, 6
+        xp.broadcast_to(t127*(t193 - t15*t195) + t128*(t196 - t23*t195) + t140*t192 - t141*t192, batch),  # 4, 1
+        xp.broadcast_to(t69*t197 + t127*(t196*s2 - t15*t199) - t78*t198 - t128*(t23*t199 + t193*s2), batch),  # 4, 2
+        xp.broadcast_to(t88*t197 - t87*t198 - t127*(t15*t200 + t3*t191) - t128*(t23*t200 + t6*t191), batch),  # 4, 3
+        xp.broadcast_to(t100*t197 + t127*(t18*t191 - t15*t201) - t99*t198 - t128*(t10*t191 + t23*t201), batch),  # 4, 4
+        xp.broadcast_to(t127*(t20*t191 - t15*t202) + t128*(t12*t191 - t23*t202) - t108*t198 - t109*t197, batch),  # 4, 5
+        xp.broadcast_to(t125*t197 + t127*(t22*t191 - t15*t203) - t124*t198 - t128*(t14*t191 + t23*t203), batch),  # 4, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 0
-        xp.broadcast_to(t127*(t205 + t146*t32) + t128*(-t204 + t145*t32) + t137*t204 + t139*t205 - t142*t206, batch),  # 5, 1
-        xp.broadcast_to(-t133 + t127*(t156*t32 - t151*t32) + t128*(t158*t32 - t157*t32) - t148*t32 - t150*t32 - t154*t206, batch),  # 5, 2
-        xp.broadcast_to(-t82 + t127*(t164*t32 - t161*t32) + t128*(t165*t32 + t166*t32) - t159*t32 - t160*t32 - t162*t206, batch),  # 5, 3
-        xp.broadcast_to(t94 + t127*(t172*t32 - t169*t32) + t128*(t174*t32 - t173*t32) - t167*t32 - t168*t32 - t170*t206, batch),  # 5, 4
-        xp.broadcast_to(t105 + t127*(t181*t32 + t182*t32) + t128*(t180*t32 - t177*t32) + t176*t32 - t175*t32 - t178*t206, batch),  # 5, 5
-        xp.broadcast_to(t117 + t127*(t188*t32 - t185*t32) + t128*(t190*t32 - t189*t32) - t183*t32 - t184*t32 - t186*t206, batch),  # 5, 6
+        xp.broadcast_to(t127*(t205 + t32*t146) + t128*(-t204 + t32*t145) + t137*t204 + t139*t205 - t206*t142, batch),  # 5, 1
+        xp.broadcast_to(-(t133 + t32*t148 + t32*t150 + t206*t154 - t127*(t32*t156 - t32*t151) - t128*(t32*t158 - t32*t157)), batch),  # 5, 2
+        xp.broadcast_to(-(t82 + t32*t159 + t32*t160 + t206*t162 - t127*(t32*t164 - t32*t161) - t128*(t32*t165 + t32*t166)), batch),  # 5, 3
+        xp.broadcast_to(t94 + t127*(t32*t172 - t32*t169) + t128*(t32*t174 - t32*t173) - t32*t167 - t32*t168 - t206*t170, batch),  # 5, 4
+        xp.broadcast_to(t105 + t127*(t32*t181 + t32*t182) + t128*(t32*t180 - t32*t177) + t32*t176 - t32*t175 - t206*t178, batch),  # 5, 5
+        xp.broadcast_to(t117 + t127*(t32*t188 - t32*t185) + t128*(t32*t190 - t32*t189) - t32*t183 - t32*t184 - t206*t186, batch),  # 5, 6
     ], (6, 7))
     return Jd
 
 
 def hessian(q):
-    """partial derivatives dJ/dq_k of the world geometric Jacobian (DOF x 6 x DOF, indexed [k, r, c]): (7 x 6 x 7), 402 operations."""
+    """partial derivatives dJ/dq_k of the world geometric Jacobian (DOF x 6 x DOF, indexed [k, r, c]): (7 x 6 x 7), 381 operations."""
     xp, dtype, device, batch, (q,) = _arguments(("q", q, (7,)))
     trig = _cos_sin(xp, q, (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0), device)
     c1 = trig[..., 0]
@@ -1469,90 +1469,90 @@ def hessian(q):
     s6 = trig[..., 11]
     t0 = s1*s3
     t1 = c1*c3
-    t2 = -t0 + c2*t1
-    t3 = t1 - c2*t0
+    t2 = -t0 + t1*c2
+    t3 = t1 - t0*c2
     t4 = c3*s1
     t5 = c1*s3
-    t6 = t4 + c2*t5
-    t7 = t5 + c2*t4
+    t6 = t4 + t5*c2
+    t7 = t5 + t4*c2
     t8 = c1*s2
-    t9 = c4*t2 + s4*t8
-    t10 = c4*t8 - s4*t2
-    t11 = c5*t9 - s5*t6
-    t12 = c5*t6 + s5*t9
-    t13 = c6*t10 + s6*t11
+    t9 = t2*c4 + t8*s4
+    t10 = t8*c4 - t2*s4
+    t11 = t9*c5 - t6*s5
+    t12 = t9*s5 + t6*c5
+    t13 = t10*c6 + t11*s6
     t14 = s1*s2
-    t15 = c4*t7 + s4*t14
-    t16 = c4*t14 - s4*t7
-    t17 = c5*t15 + s5*t3
-    t18 = c5*t3 - s5*t15
-    t19 = c6*t16 + s6*t17
+    t15 = t7*c4 + t14*s4
+    t16 = t14*c4 - t7*s4
+    t17 = t15*c5 + t3*s5
+    t18 = t3*c5 - t15*s5
+    t19 = t16*c6 + t17*s6
     t20 = c3*s2
-    t21 = c2*s4 - c4*t20
-    t22 = c2*c4 + s4*t20
+    t21 = c2*s4 - t20*c4
+    t22 = t20*s4 + c2*c4
     t23 = s2*s3
-    t24 = c5*t21 + s5*t23
-    t25 = c5*t23 - s5*t21
-    t26 = c6*t22 + s6*t24
+    t24 = t21*c5 + t23*s5
+    t25 = t23*c5 - t21*s5
+    t26 = t22*c6 + t24*s6
     t27 = 0.126*t13
     t28 = t27 + 0.4*t10
     t29 = t28 + 0.42*t8
     t30 = 0.126*t19
     t31 = t30 + 0.4*t16
     t32 = t31 + 0.42*t14
-    t33 = c1*t29 + s1*t32
-    t34 = t32*t8 - t14*t29
+    t33 = t29*c1 + t32*s1
+    t34 = t32*t8 - t29*t14
     t35 = t28*t3 + t31*t6
     t36 = t10*t31 - t16*t28
     t37 = t12*t30 + t18*t27
     t38 = 0.126*t26
     t39 = t38 + 0.4*t22
     t40 = t39 + 0.42*c2
-    t41 = t23*t31 - t3*t39
+    t41 = t31*t23 - t39*t3
     t42 = t16*t39 - t22*t31
     t43 = t18*t38 - t25*t30
-    t44 = t23*t28 + t39*t6
+    t44 = t28*t23 + t39*t6
     t45 = t22*t28 - t10*t39
     t46 = t12*t38 + t25*t27
-    t47 = s1*t40
-    t48 = s2*t47 - c2*t32
-    t49 = c1*t40
-    t50 = c2*t29 - s2*t49
+    t47 = t40*s1
+    t48 = t47*s2 - t32*c2
+    t49 = t40*c1
+    t50 = t29*c2 - t49*s2
     t51 = -t47
     t52 = -t50
     t53 = -t45
     t54 = -t46
-    t55 = c1*t34
-    t56 = c1*t35
-    t57 = c1*t36
-    t58 = -c1*t37
-    t59 = s1*t34
-    t60 = s1*t35
-    t61 = s1*t36
-    t62 = -s1*t37
+    t55 = t34*c1
+    t56 = t35*c1
+    t57 = t36*c1
+    t58 = -t37*c1
+    t59 = t34*s1
+    t60 = t35*s1
+    t61 = t36*s1
+    t62 = -t37*s1
     t63 = c1**2
     t64 = s1**2
-    t65 = -c1*t48 - s1*t50
-    t66 = s1*t44 - c1*t41
-    t67 = -c1*t42 - s1*t45
-    t68 = -c1*t43 - s1*t46
-    t69 = c2*t44 + t14*t35
-    t70 = t14*t36 - c2*t45
-    t71 = -c2*t46 - t14*t37
-    t72 = c2*t41 - t35*t8
-    t73 = c2*t42 - t36*t8
-    t74 = c2*t43 + t37*t8
-    t75 = -t14*t41 - t44*t8
-    t76 = t45*t8 - t14*t42
-    t77 = t46*t8 - t14*t43
+    t65 = -(t48*c1 + t50*s1)
+    t66 = t44*s1 - t41*c1
+    t67 = -(t42*c1 + t45*s1)
+    t68 = -(t43*c1 + t46*s1)
+    t69 = t44*c2 + t35*t14
+    t70 = t36*t14 - t45*c2
+    t71 = -(t46*c2 + t37*t14)
+    t72 = t41*c2 - t35*t8
+    t73 = t42*c2 - t36*t8
+    t74 = t43*c2 + t37*t8
+    t75 = -(t41*t14 + t44*t8)
+    t76 = t45*t8 - t42*t14
+    t77 = t46*t8 - t43*t14
     t78 = s2**2
-    t79 = t23*t45 - t3*t36
-    t80 = t23*t46 + t3*t37
-    t81 = -t23*t42 - t36*t6
-    t82 = t37*t6 - t23*t43
-    t83 = t3*t42 + t45*t6
-    t84 = t3*t43 + t46*t6
-    t85 = -t16*t37 - t22*t46
+    t79 = t45*t23 - t36*t3
+    t80 = t46*t23 + t37*t3
+    t81 = -(t42*t23 + t36*t6)
+    t82 = t37*t6 - t43*t23
+    t83 = t42*t3 + t45*t6
+    t84 = t43*t3 + t46*t6
+    t85 = -(t16*t37 + t22*t46)
     t86 = t10*t37 + t22*t43
     t87 = t10*t46 - t16*t43
     H = _stack(xp, [
@@ -1599,21 +1599,21 @@ def hessian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5, 6
         t51,  # 1, 0, 0
-        -c1*t33,  # 1, 0, 1
+        -t33*c1,  # 1, 0, 1
         t55,  # 1, 0, 2
         t56,  # 1, 0, 3
         t57,  # 1, 0, 4
         t58,  # 1, 0, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 0, 6
         t49,  # 1, 1, 0
-        -s1*t33,  # 1, 1, 1
+        -t33*s1,  # 1, 1, 1
         t59,  # 1, 1, 2
         t60,  # 1, 1, 3
         t61,  # 1, 1, 4
         t62,  # 1, 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 1, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 2, 0
-        -t40*t63 - t40*t64,  # 1, 2, 1
+        -(t40*t63 + t40*t64),  # 1, 2, 1
         t65,  # 1, 2, 2
         t66,  # 1, 2, 3
         t67,  # 1, 2, 4
@@ -1622,41 +1622,41 @@ def hessian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 3, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 3, 1
         c1*c2,  # 1, 3, 2
-        -s2*t5,  # 1, 3, 3
-        c1*t22,  # 1, 3, 4
-        c1*t25,  # 1, 3, 5
-        c1*t26,  # 1, 3, 6
+        -t5*s2,  # 1, 3, 3
+        t22*c1,  # 1, 3, 4
+        t25*c1,  # 1, 3, 5
+        t26*c1,  # 1, 3, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 4, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 4, 1
         c2*s1,  # 1, 4, 2
-        -s2*t0,  # 1, 4, 3
-        s1*t22,  # 1, 4, 4
-        s1*t25,  # 1, 4, 5
-        s1*t26,  # 1, 4, 6
+        -t0*s2,  # 1, 4, 3
+        t22*s1,  # 1, 4, 4
+        t25*s1,  # 1, 4, 5
+        t26*s1,  # 1, 4, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5, 1
-        -s2*t63 - s2*t64,  # 1, 5, 2
-        s1*t3 - c1*t6,  # 1, 5, 3
-        -c1*t10 - s1*t16,  # 1, 5, 4
-        c1*t12 - s1*t18,  # 1, 5, 5
-        -c1*t13 - s1*t19,  # 1, 5, 6
+        -(t63*s2 + t64*s2),  # 1, 5, 2
+        t3*s1 - t6*c1,  # 1, 5, 3
+        -(t10*c1 + t16*s1),  # 1, 5, 4
+        t12*c1 - t18*s1,  # 1, 5, 5
+        -(t13*c1 + t19*s1),  # 1, 5, 6
         t52,  # 2, 0, 0
         t55,  # 2, 0, 1
-        t14*t34 - c2*t50,  # 2, 0, 2
+        t34*t14 - t50*c2,  # 2, 0, 2
         t69,  # 2, 0, 3
         t70,  # 2, 0, 4
         t71,  # 2, 0, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0, 6
         t48,  # 2, 1, 0
         t59,  # 2, 1, 1
-        c2*t48 - t34*t8,  # 2, 1, 2
+        t48*c2 - t34*t8,  # 2, 1, 2
         t72,  # 2, 1, 3
         t73,  # 2, 1, 4
         t74,  # 2, 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 1, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 2, 0
         t65,  # 2, 2, 1
-        t50*t8 - t14*t48,  # 2, 2, 2
+        t50*t8 - t48*t14,  # 2, 2, 2
         t75,  # 2, 2, 3
         t76,  # 2, 2, 4
         t77,  # 2, 2, 5
@@ -1664,42 +1664,42 @@ def hessian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 3, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 3, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 3, 2
-        c2*t3 - t0*t78,  # 2, 3, 3
-        t14*t22 - c2*t16,  # 2, 3, 4
-        t14*t25 - c2*t18,  # 2, 3, 5
-        t14*t26 - c2*t19,  # 2, 3, 6
+        t3*c2 - t0*t78,  # 2, 3, 3
+        t22*t14 - t16*c2,  # 2, 3, 4
+        t25*t14 - t18*c2,  # 2, 3, 5
+        t26*t14 - t19*c2,  # 2, 3, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 4, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 4, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 4, 2
-        c2*t6 + t5*t78,  # 2, 4, 3
-        c2*t10 - t22*t8,  # 2, 4, 4
-        -c2*t12 - t25*t8,  # 2, 4, 5
-        c2*t13 - t26*t8,  # 2, 4, 6
+        t6*c2 + t5*t78,  # 2, 4, 3
+        t10*c2 - t22*t8,  # 2, 4, 4
+        -(t12*c2 + t25*t8),  # 2, 4, 5
+        t13*c2 - t26*t8,  # 2, 4, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 5, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 5, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 5, 2
-        -t14*t6 - t3*t8,  # 2, 5, 3
+        -(t6*t14 + t3*t8),  # 2, 5, 3
         t16*t8 - t10*t14,  # 2, 5, 4
         t12*t14 + t18*t8,  # 2, 5, 5
         t19*t8 - t13*t14,  # 2, 5, 6
         t44,  # 3, 0, 0
         t56,  # 3, 0, 1
         t69,  # 3, 0, 2
-        -t23*t44 - t3*t35,  # 3, 0, 3
+        -(t44*t23 + t35*t3),  # 3, 0, 3
         t79,  # 3, 0, 4
         t80,  # 3, 0, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0, 6
         t41,  # 3, 1, 0
         t60,  # 3, 1, 1
         t72,  # 3, 1, 2
-        -t23*t41 - t35*t6,  # 3, 1, 3
+        -(t41*t23 + t35*t6),  # 3, 1, 3
         t81,  # 3, 1, 4
         t82,  # 3, 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 1, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 2, 0
         t66,  # 3, 2, 1
         t75,  # 3, 2, 2
-        t3*t41 - t44*t6,  # 3, 2, 3
+        t41*t3 - t44*t6,  # 3, 2, 3
         t83,  # 3, 2, 4
         t84,  # 3, 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 2, 6
@@ -1714,9 +1714,9 @@ def hessian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 4, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 4, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 4, 3
-        -t10*t23 - t22*t6,  # 3, 4, 4
+        -(t10*t23 + t22*t6),  # 3, 4, 4
         t12*t23 - t25*t6,  # 3, 4, 5
-        -t13*t23 - t26*t6,  # 3, 4, 6
+        -(t13*t23 + t26*t6),  # 3, 4, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 5, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 5, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 5, 2
@@ -1750,28 +1750,28 @@ def hessian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 3, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 3, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 3, 4
-        t16*t25 - t18*t22,  # 4, 3, 5
-        t16*t26 - t19*t22,  # 4, 3, 6
+        t16*t25 - t22*t18,  # 4, 3, 5
+        t16*t26 - t22*t19,  # 4, 3, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 4, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 4, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 4, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 4, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 4, 4
-        -t10*t25 - t12*t22,  # 4, 4, 5
-        t13*t22 - t10*t26,  # 4, 4, 6
+        -(t10*t25 + t22*t12),  # 4, 4, 5
+        t22*t13 - t10*t26,  # 4, 4, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 5, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 5, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 5, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 5, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 5, 4
-        t10*t18 + t12*t16,  # 4, 5, 5
-        t10*t19 - t13*t16,  # 4, 5, 6
+        t10*t18 + t16*t12,  # 4, 5, 5
+        t10*t19 - t16*t13,  # 4, 5, 6
         t54,  # 5, 0, 0
         t58,  # 5, 0, 1
         t71,  # 5, 0, 2
         t80,  # 5, 0, 3
         t85,  # 5, 0, 4
-        -t18*t37 - t25*t46,  # 5, 0, 5
+        -(t18*t37 + t25*t46),  # 5, 0, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 0, 6
         t43,  # 5, 1, 0
         t62,  # 5, 1, 1
@@ -1785,7 +1785,7 @@ def hessian(q):
         t77,  # 5, 2, 2
         t84,  # 5, 2, 3
         t87,  # 5, 2, 4
-        -t12*t46 - t18*t43,  # 5, 2, 5
+        -(t12*t46 + t18*t43),  # 5, 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 2, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 3, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 3, 1
@@ -1793,21 +1793,21 @@ def hessian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 3, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 3, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 3, 5
-        t18*t26 - t19*t25,  # 5, 3, 6
+        t18*t26 - t25*t19,  # 5, 3, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 4, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 4, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 4, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 4, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 4, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 4, 5
-        t12*t26 + t13*t25,  # 5, 4, 6
+        t12*t26 + t25*t13,  # 5, 4, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 5, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 5, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 5, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 5, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 5, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 5, 5
-        -t12*t19 - t13*t18,  # 5, 5, 6
+        -(t12*t19 + t18*t13),  # 5, 5, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 6, 0, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 6, 0, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 6, 0, 2
@@ -1855,7 +1855,7 @@ def hessian(q):
 
 
 def singularity_factors(q):
-    """factors of det(Js Js^T): the robot is singular where one is 0: (2 x 1), 735 operations."""
+    """factors of det(Js Js^T): the robot is singular where one is 0: (2 x 1), 707 operations."""
     xp, dtype, device, batch, (q,) = _arguments(("q", q, (7,)))
     trig = _cos_sin(xp, q, (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0), device)
     c1 = trig[..., 0]
@@ -1872,174 +1872,174 @@ def singularity_factors(q):
     s6 = trig[..., 11]
     t0 = s1*s3
     t1 = c1*c3
-    t2 = -t0 + c2*t1
-    t3 = t1 - c2*t0
+    t2 = -t0 + t1*c2
+    t3 = t1 - t0*c2
     t4 = c3*s1
     t5 = c1*s3
-    t6 = t4 + c2*t5
-    t7 = t5 + c2*t4
+    t6 = t4 + t5*c2
+    t7 = t5 + t4*c2
     t8 = c1*s2
-    t9 = c4*t2 + s4*t8
-    t10 = c4*t8 - s4*t2
-    t11 = c5*t9 - s5*t6
-    t12 = c5*t6 + s5*t9
-    t13 = c6*t10 + s6*t11
+    t9 = t2*c4 + t8*s4
+    t10 = t8*c4 - t2*s4
+    t11 = t9*c5 - t6*s5
+    t12 = t9*s5 + t6*c5
+    t13 = t10*c6 + t11*s6
     t14 = s1*s2
-    t15 = c4*t7 + s4*t14
-    t16 = c4*t14 - s4*t7
-    t17 = c5*t15 + s5*t3
-    t18 = c5*t3 - s5*t15
-    t19 = c6*t16 + s6*t17
+    t15 = t7*c4 + t14*s4
+    t16 = t14*c4 - t7*s4
+    t17 = t15*c5 + t3*s5
+    t18 = t3*c5 - t15*s5
+    t19 = t16*c6 + t17*s6
     t20 = c3*s2
-    t21 = c2*s4 - c4*t20
-    t22 = c2*c4 + s4*t20
+    t21 = c2*s4 - t20*c4
+    t22 = t20*s4 + c2*c4
     t23 = s2*s3
-    t24 = c5*t21 + s5*t23
-    t25 = c5*t23 - s5*t21
-    t26 = c6*t22 + s6*t24
+    t24 = t21*c5 + t23*s5
+    t25 = t23*c5 - t21*s5
+    t26 = t22*c6 + t24*s6
     t27 = 0.126*t13
     t28 = t27 + 0.4*t10
     t29 = t28 + 0.42*t8
     t30 = 0.126*t19
     t31 = t30 + 0.4*t16
     t32 = t31 + 0.42*t14
-    t33 = c1*t29 + s1*t32
-    t34 = t28*t3 + t31*t6
-    t35 = t10*t31 - t16*t28
-    t36 = t12*t30 + t18*t27
-    t37 = t14*t29 - t32*t8
+    t33 = t29*c1 + t32*s1
+    t34 = t32*t8 - t29*t14
+    t35 = t28*t3 + t31*t6
+    t36 = t10*t31 - t16*t28
+    t37 = t12*t30 + t18*t27
     t38 = 0.126*t26
     t39 = t38 + 0.4*t22
     t40 = t39 + 0.42*c2
-    t41 = t23*t31 - t3*t39
-    t42 = t16*t39 - t22*t31
-    t43 = t18*t38 - t25*t30
-    t44 = c2*t29 - t40*t8
-    t45 = t23*t28 + t39*t6
-    t46 = t12*t38 + t25*t27
-    t47 = c2*t32 - t14*t40
-    t48 = t10*t39 - t22*t28
-    t49 = t18*t6 - t12*t3
-    t50 = c1*t12
-    t51 = t50 - s1*t18
-    t52 = c1*t6
-    t53 = -t52 + s1*t3
-    t54 = t33*t49 + t34*t51 + t36*t53
-    t55 = t10*t18 + t12*t16
-    t56 = c1*t10
-    t57 = -t56 - s1*t16
-    t58 = t33*t55 + t35*t51 + t36*t57
+    t41 = t40*t14 - t32*c2
+    t42 = t31*t23 - t39*t3
+    t43 = t16*t39 - t22*t31
+    t44 = t18*t38 - t25*t30
+    t45 = t29*c2 - t40*t8
+    t46 = t28*t23 + t39*t6
+    t47 = t22*t28 - t10*t39
+    t48 = t12*t38 + t25*t27
+    t49 = t10*t18 + t16*t12
+    t50 = t12*c1
+    t51 = t50 - t18*s1
+    t52 = t10*c1
+    t53 = -(t52 + t16*s1)
+    t54 = t33*t49 + t36*t51 + t37*t53
+    t55 = t18*t6 - t12*t3
+    t56 = t6*c1
+    t57 = -t56 + t3*s1
+    t58 = t33*t55 + t35*t51 + t37*t57
     t59 = t10*t3 + t16*t6
-    t60 = t33*t59 + t34*t57 - t35*t53
-    t61 = t35*t49 + t36*t59 - t34*t55
-    t62 = s1*t40
-    t63 = t16*t25 - t18*t22
-    t64 = -s1*t63 - t22*t50 - t25*t56
+    t60 = t36*t55 + t37*t59 - t35*t49
+    t61 = t40*s1
+    t62 = t33*t59 + t35*t53 - t36*t57
+    t63 = t16*t25 - t22*t18
+    t64 = -(t22*t50 + t25*t52 + t63*s1)
     t65 = t18*t23 - t25*t3
-    t66 = -s1*t65 - t25*t52 + c1*s2*s3*t12
-    t67 = s2*t5
+    t66 = -(t25*t56 + t65*s1 - t12*c1*s2*s3)
+    t67 = t5*s2
     t68 = t16*t23 - t22*t3
-    t69 = -s1*t68 - t10*t67 - t22*t52
-    t70 = t6*t63 - t10*t65 - t12*t68
-    t71 = t35*t66 + t36*t69 - t33*t70 - t34*t64
+    t69 = -(t10*t67 + t22*t56 + t68*s1)
+    t70 = -(t10*t65 + t12*t68 - t6*t63)
+    t71 = t36*t66 + t37*t69 - t33*t70 - t35*t64
     t72 = t12*t14 + t18*t8
     t73 = t16*t8 - t10*t14
-    t74 = t35*t72 + t36*t73 + t37*t55
+    t74 = t36*t72 + t37*t73 - t34*t49
     t75 = c1**2
-    t76 = s2*t75
-    t77 = -t76 - s2*s1**2
-    t78 = t33*t72 + t36*t77 - t37*t51
-    t79 = t33*t73 - t35*t77 - t37*t57
-    t80 = t14*t22 - c2*t16
-    t81 = -s1*t80 - t22*t76 + c1*c2*t10
-    t82 = t14*t25 - c2*t18
-    t83 = -c2*t50 - s1*t82 - t25*t76
-    t84 = -t10*t82 - t12*t80 + c1*s2*t63
-    t85 = t35*t83 + t36*t81 + t37*t64 - t33*t84
-    t86 = -t14*t6 - t3*t8
-    t87 = t34*t72 + t36*t86 + t37*t49
-    t88 = t33*t86 - t34*t77 - t37*t53
+    t76 = t75*s2
+    t77 = -(t76 + s2*s1**2)
+    t78 = t33*t72 + t34*t51 + t37*t77
+    t79 = t33*t73 + t34*t53 - t36*t77
+    t80 = t22*t14 - t16*c2
+    t81 = -(t22*t76 + t80*s1 - t10*c1*c2)
+    t82 = t25*t14 - t18*c2
+    t83 = -(t25*t76 + t50*c2 + t82*s1)
+    t84 = -(t10*t82 + t12*t80 - t63*c1*s2)
+    t85 = t36*t83 + t37*t81 - t33*t84 - t34*t64
+    t86 = -(t6*t14 + t3*t8)
+    t87 = t35*t72 + t37*t86 - t34*t55
+    t88 = t33*t86 + t34*t57 - t35*t77
     t89 = s2**2
-    t90 = c2*t3 - t0*t89
-    t91 = c2*t52 - s1*t90 + s3*t75*t89
-    t92 = -t12*t90 - t6*t82 + c1*s2*t65
-    t93 = t34*t83 + t36*t91 + t37*t66 - t33*t92
-    t94 = t34*t73 + t37*t59 - t35*t86
+    t90 = t3*c2 - t0*t89
+    t91 = t56*c2 - t90*s1 + t75*t89*s3
+    t92 = -(t12*t90 + t6*t82 - t65*c1*s2)
+    t93 = t35*t83 + t37*t91 - t33*t92 - t34*t66
+    t94 = -(t34*t59 + t36*t86 - t35*t73)
     t95 = t10*t90 + t68*t8 - t6*t80
-    t96 = t34*t81 + t37*t69 - t33*t95 - t35*t91
-    t97 = t35*t92 + t36*t95 - t34*t84 - t37*t70
-    t98 = c1*t40
-    t99 = t32*(t46*t96 + t48*t93 + t62*t97 - t44*t71 - t45*t85) + t41*(t29*t85 + t44*t58 + t46*t79 + t48*t78 - t62*t74) + t43*(t29*t96 + t44*t60 + t45*t79 - t48*t88 - t62*t94) + t47*(t29*t71 + t46*t60 + t48*t54 - t45*t58 - t61*t62) + t98*(t29*t97 + t46*t94 + t48*t87 - t44*t61 - t45*t74) - t42*(t29*t93 + t44*t54 + t45*t78 + t46*t88 - t62*t87)
+    t96 = -(t33*t95 + t34*t69 + t36*t91 - t35*t81)
+    t97 = t34*t70 + t36*t92 + t37*t95 - t35*t84
+    t98 = t40*c1
+    t99 = t41*(t46*t54 + t47*t58 + t60*t61 - t29*t71 - t48*t62) + t42*(t29*t85 + t45*t54 + t48*t79 - t47*t78 - t61*t74) + t44*(t29*t96 + t45*t62 + t46*t79 + t47*t88 - t61*t94) - t32*(t45*t71 + t46*t85 + t47*t93 - t48*t96 - t40*t97*s1) - t43*(t29*t93 + t45*t58 + t46*t78 + t48*t88 - t61*t87) - t98*(t45*t60 + t46*t74 + t47*t87 - t29*t97 - t48*t94)
     t100 = t13*t3 + t19*t6
-    t101 = c1*t13
-    t102 = -t101 - s1*t19
-    t103 = t100*t33 + t102*t34
-    t104 = t10*t19 - t13*t16
-    t105 = t102*t35 + t104*t33
-    t106 = t100*t35 - t104*t34
-    t107 = t16*t26 - t19*t22
-    t108 = -s1*t107 - t26*t56 + c1*t13*t22
+    t101 = t13*c1
+    t102 = -(t101 + t19*s1)
+    t103 = t33*t100 + t35*t102
+    t104 = t10*t19 - t16*t13
+    t105 = t33*t104 + t36*t102
+    t106 = t36*t100 - t35*t104
+    t107 = t16*t26 - t22*t19
+    t108 = -(t26*t52 + t107*s1 - t22*t13*c1)
     t109 = t19*t23 - t26*t3
-    t110 = -s1*t109 - t13*t67 - t26*t52
-    t111 = t107*t6 + t13*t68 - t10*t109
-    t112 = t110*t35 - t108*t34 - t111*t33
-    t113 = t103*t48 + t112*t29 - t105*t45 - t106*t62
+    t110 = -(t13*t67 + t26*t56 + t109*s1)
+    t111 = t13*t68 + t6*t107 - t10*t109
+    t112 = -(t33*t111 + t35*t108 - t36*t110)
+    t113 = -(t46*t105 + t47*t103 + t61*t106 - t29*t112)
     t114 = t19*t8 - t13*t14
-    t115 = t114*t33 - t102*t37
-    t116 = t104*t37 + t114*t35
-    t117 = t14*t26 - c2*t19
-    t118 = -s1*t117 - t26*t76 + c1*c2*t13
-    t119 = t107*t8 + t13*t80 - t10*t117
-    t120 = t108*t37 + t118*t35 - t119*t33
-    t121 = t105*t44 + t115*t48 + t120*t29 - t116*t62
-    t122 = t100*t37 + t114*t34
-    t123 = t109*t8 + t13*t90 - t117*t6
-    t124 = t110*t37 + t118*t34 - t123*t33
-    t125 = t103*t44 + t115*t45 + t124*t29 - t122*t62
-    t126 = t123*t35 - t111*t37 - t119*t34
-    t127 = t122*t48 + t126*t29 - t106*t44 - t116*t45
-    t128 = t124*t48 + t126*t62 - t112*t44 - t120*t45
-    t129 = t113*t47 + t121*t41 + t127*t98 + t128*t32 - t125*t42
-    t130 = -t12*t19 - t13*t18
-    t131 = t130*t33 - t102*t36
-    t132 = -t100*t36 - t130*t34
-    t133 = t18*t26 - t19*t25
-    t134 = t101*t25 + t26*t50 - s1*t133
-    t135 = t109*t12 + t13*t65 + t133*t6
-    t136 = -t110*t36 - t134*t34 - t135*t33
-    t137 = t136*t29 - t103*t46 - t131*t45 - t132*t62
-    t138 = t130*t37 - t114*t36
-    t139 = t117*t12 + t13*t82 + t133*t8
-    t140 = t134*t37 - t118*t36 - t139*t33
-    t141 = t131*t44 + t140*t29 - t115*t46 - t138*t62
-    t142 = -t123*t36 - t135*t37 - t139*t34
-    t143 = t142*t29 - t122*t46 - t132*t44 - t138*t45
-    t144 = -t124*t46 - t136*t44 - t140*t45 + s1*t142*t40
-    t145 = t137*t47 + t141*t41 + t143*t98 + t144*t32 - t125*t43
-    t146 = -t104*t36 - t130*t35
-    t147 = t10*t133 + t107*t12 + t13*t63
-    t148 = -t108*t36 - t134*t35 - t147*t33
-    t149 = t148*t29 - t105*t46 - t131*t48 - t146*t62
-    t150 = -t119*t36 - t139*t35 - t147*t37
-    t151 = t150*t29 - t116*t46 - t138*t48 - t146*t44
-    t152 = -t120*t46 - t140*t48 - t148*t44 + s1*t150*t40
-    t153 = t141*t42 + t149*t47 + t151*t98 + t152*t32 - t121*t43
-    t154 = t147*t34 - t111*t36 - t135*t35
-    t155 = t146*t45 + t154*t29 - t106*t46 - t132*t48
-    t156 = t148*t45 + t154*t62 - t112*t46 - t136*t48
-    t157 = t137*t42 + t155*t98 + t156*t32 - t113*t43 - t149*t41
-    t158 = t150*t45 + t154*t44 - t126*t46 - t142*t48
-    t159 = t127*t43 + t151*t41 + t155*t47 - t143*t42 - t158*t32
-    t160 = t128*t43 + t152*t41 + t156*t47 + t158*t98 - t144*t42
+    t115 = t33*t114 + t34*t102
+    t116 = t36*t114 - t34*t104
+    t117 = t26*t14 - t19*c2
+    t118 = -(t26*t76 + t117*s1 - t13*c1*c2)
+    t119 = t13*t80 + t8*t107 - t10*t117
+    t120 = -(t33*t119 + t34*t108 - t36*t118)
+    t121 = t29*t120 + t45*t105 - t47*t115 - t61*t116
+    t122 = t35*t114 - t34*t100
+    t123 = t13*t90 + t8*t109 - t6*t117
+    t124 = -(t33*t123 + t34*t110 - t35*t118)
+    t125 = t29*t124 + t45*t103 + t46*t115 - t61*t122
+    t126 = t34*t111 + t36*t123 - t35*t119
+    t127 = -(t45*t106 + t46*t116 + t47*t122 - t29*t126)
+    t128 = -(t45*t112 + t46*t120 + t47*t124 - t40*t126*s1)
+    t129 = t32*t128 + t42*t121 + t98*t127 - t41*t113 - t43*t125
+    t130 = -(t12*t19 + t18*t13)
+    t131 = t33*t130 - t37*t102
+    t132 = -(t35*t130 + t37*t100)
+    t133 = t18*t26 - t25*t19
+    t134 = t25*t101 + t26*t50 - t133*s1
+    t135 = t12*t109 + t13*t65 + t6*t133
+    t136 = -(t33*t135 + t35*t134 + t37*t110)
+    t137 = -(t46*t131 + t48*t103 + t61*t132 - t29*t136)
+    t138 = -(t34*t130 + t37*t114)
+    t139 = t12*t117 + t13*t82 + t8*t133
+    t140 = -(t33*t139 + t34*t134 + t37*t118)
+    t141 = t29*t140 + t45*t131 - t48*t115 - t61*t138
+    t142 = -(t35*t139 + t37*t123 - t34*t135)
+    t143 = -(t45*t132 + t46*t138 + t48*t122 - t29*t142)
+    t144 = -(t45*t136 + t46*t140 + t48*t124 - t40*t142*s1)
+    t145 = t32*t144 + t42*t141 + t143*t98 - t41*t137 - t44*t125
+    t146 = -(t36*t130 + t37*t104)
+    t147 = t10*t133 + t12*t107 + t13*t63
+    t148 = -(t33*t147 + t36*t134 + t37*t108)
+    t149 = t29*t148 + t47*t131 - t48*t105 - t146*t61
+    t150 = -(t36*t139 + t37*t119 - t34*t147)
+    t151 = t29*t150 + t47*t138 - t45*t146 - t48*t116
+    t152 = t47*t140 + t150*t61 - t45*t148 - t48*t120
+    t153 = t32*t152 + t43*t141 + t151*t98 - t41*t149 - t44*t121
+    t154 = -(t36*t135 + t37*t111 - t35*t147)
+    t155 = t29*t154 + t46*t146 + t47*t132 - t48*t106
+    t156 = t46*t148 + t47*t136 + t154*t61 - t48*t112
+    t157 = t32*t156 + t43*t137 + t155*t98 - t42*t149 - t44*t113
+    t158 = t45*t154 + t46*t150 + t47*t142 - t48*t126
+    t159 = t32*t158 + t41*t155 + t43*t143 - t42*t151 - t44*t127
+    t160 = t42*t152 + t44*t128 + t158*t98 - t41*t156 - t43*t144
     f = _stack(xp, [
         s4,  # 0
-        t129**2 + t145**2 + t153**2 + t157**2 + t159**2 + t160**2 + t99**2,  # 1
+        t99**2 + t129**2 + t145**2 + t153**2 + t157**2 + t159**2 + t160**2,  # 1
     ], (2,))
     return f
 
 
 def manipulability(q):
-    """manipulability sqrt(det(Js Js^T)): (1 x 1), 738 operations."""
+    """manipulability sqrt(det(Js Js^T)): (1 x 1), 710 operations."""
     xp, dtype, device, batch, (q,) = _arguments(("q", q, (7,)))
     trig = _cos_sin(xp, q, (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0), device)
     c1 = trig[..., 0]
@@ -2056,166 +2056,166 @@ def manipulability(q):
     s6 = trig[..., 11]
     t0 = s1*s3
     t1 = c1*c3
-    t2 = -t0 + c2*t1
-    t3 = t1 - c2*t0
+    t2 = -t0 + t1*c2
+    t3 = t1 - t0*c2
     t4 = c3*s1
     t5 = c1*s3
-    t6 = t4 + c2*t5
-    t7 = t5 + c2*t4
+    t6 = t4 + t5*c2
+    t7 = t5 + t4*c2
     t8 = c1*s2
-    t9 = c4*t2 + s4*t8
-    t10 = c4*t8 - s4*t2
-    t11 = c5*t9 - s5*t6
-    t12 = c5*t6 + s5*t9
-    t13 = c6*t10 + s6*t11
+    t9 = t2*c4 + t8*s4
+    t10 = t8*c4 - t2*s4
+    t11 = t9*c5 - t6*s5
+    t12 = t9*s5 + t6*c5
+    t13 = t10*c6 + t11*s6
     t14 = s1*s2
-    t15 = c4*t7 + s4*t14
-    t16 = c4*t14 - s4*t7
-    t17 = c5*t15 + s5*t3
-    t18 = c5*t3 - s5*t15
-    t19 = c6*t16 + s6*t17
+    t15 = t7*c4 + t14*s4
+    t16 = t14*c4 - t7*s4
+    t17 = t15*c5 + t3*s5
+    t18 = t3*c5 - t15*s5
+    t19 = t16*c6 + t17*s6
     t20 = c3*s2
-    t21 = c2*s4 - c4*t20
-    t22 = c2*c4 + s4*t20
+    t21 = c2*s4 - t20*c4
+    t22 = t20*s4 + c2*c4
     t23 = s2*s3
-    t24 = c5*t21 + s5*t23
-    t25 = c5*t23 - s5*t21
-    t26 = c6*t22 + s6*t24
+    t24 = t21*c5 + t23*s5
+    t25 = t23*c5 - t21*s5
+    t26 = t22*c6 + t24*s6
     t27 = 0.126*t13
     t28 = t27 + 0.4*t10
     t29 = t28 + 0.42*t8
     t30 = 0.126*t19
     t31 = t30 + 0.4*t16
     t32 = t31 + 0.42*t14
-    t33 = c1*t29 + s1*t32
-    t34 = t28*t3 + t31*t6
-    t35 = t10*t31 - t16*t28
-    t36 = t12*t30 + t18*t27
-    t37 = t14*t29 - t32*t8
+    t33 = t29*c1 + t32*s1
+    t34 = t32*t8 - t29*t14
+    t35 = t28*t3 + t31*t6
+    t36 = t10*t31 - t16*t28
+    t37 = t12*t30 + t18*t27
     t38 = 0.126*t26
     t39 = t38 + 0.4*t22
     t40 = t39 + 0.42*c2
-    t41 = t23*t31 - t3*t39
-    t42 = t16*t39 - t22*t31
-    t43 = t18*t38 - t25*t30
-    t44 = c2*t29 - t40*t8
-    t45 = t23*t28 + t39*t6
-    t46 = t12*t38 + t25*t27
-    t47 = c2*t32 - t14*t40
-    t48 = t10*t39 - t22*t28
-    t49 = t18*t6 - t12*t3
-    t50 = c1*t12
-    t51 = t50 - s1*t18
-    t52 = c1*t6
-    t53 = -t52 + s1*t3
-    t54 = t33*t49 + t34*t51 + t36*t53
-    t55 = t10*t18 + t12*t16
-    t56 = c1*t10
-    t57 = -t56 - s1*t16
-    t58 = t33*t55 + t35*t51 + t36*t57
+    t41 = t40*t14 - t32*c2
+    t42 = t31*t23 - t39*t3
+    t43 = t16*t39 - t22*t31
+    t44 = t18*t38 - t25*t30
+    t45 = t29*c2 - t40*t8
+    t46 = t28*t23 + t39*t6
+    t47 = t22*t28 - t10*t39
+    t48 = t12*t38 + t25*t27
+    t49 = t10*t18 + t16*t12
+    t50 = t12*c1
+    t51 = t50 - t18*s1
+    t52 = t10*c1
+    t53 = -(t52 + t16*s1)
+    t54 = t33*t49 + t36*t51 + t37*t53
+    t55 = t18*t6 - t12*t3
+    t56 = t6*c1
+    t57 = -t56 + t3*s1
+    t58 = t33*t55 + t35*t51 + t37*t57
     t59 = t10*t3 + t16*t6
-    t60 = t33*t59 + t34*t57 - t35*t53
-    t61 = t35*t49 + t36*t59 - t34*t55
-    t62 = s1*t40
-    t63 = t16*t25 - t18*t22
-    t64 = -s1*t63 - t22*t50 - t25*t56
+    t60 = t36*t55 + t37*t59 - t35*t49
+    t61 = t40*s1
+    t62 = t33*t59 + t35*t53 - t36*t57
+    t63 = t16*t25 - t22*t18
+    t64 = -(t22*t50 + t25*t52 + t63*s1)
     t65 = t18*t23 - t25*t3
-    t66 = -s1*t65 - t25*t52 + c1*s2*s3*t12
-    t67 = s2*t5
+    t66 = -(t25*t56 + t65*s1 - t12*c1*s2*s3)
+    t67 = t5*s2
     t68 = t16*t23 - t22*t3
-    t69 = -s1*t68 - t10*t67 - t22*t52
-    t70 = t6*t63 - t10*t65 - t12*t68
-    t71 = t35*t66 + t36*t69 - t33*t70 - t34*t64
+    t69 = -(t10*t67 + t22*t56 + t68*s1)
+    t70 = -(t10*t65 + t12*t68 - t6*t63)
+    t71 = t36*t66 + t37*t69 - t33*t70 - t35*t64
     t72 = t12*t14 + t18*t8
     t73 = t16*t8 - t10*t14
-    t74 = t35*t72 + t36*t73 + t37*t55
+    t74 = t36*t72 + t37*t73 - t34*t49
     t75 = c1**2
-    t76 = s2*t75
-    t77 = -t76 - s2*s1**2
-    t78 = t33*t72 + t36*t77 - t37*t51
-    t79 = t33*t73 - t35*t77 - t37*t57
-    t80 = t14*t22 - c2*t16
-    t81 = -s1*t80 - t22*t76 + c1*c2*t10
-    t82 = t14*t25 - c2*t18
-    t83 = -c2*t50 - s1*t82 - t25*t76
-    t84 = -t10*t82 - t12*t80 + c1*s2*t63
-    t85 = t35*t83 + t36*t81 + t37*t64 - t33*t84
-    t86 = -t14*t6 - t3*t8
-    t87 = t34*t72 + t36*t86 + t37*t49
-    t88 = t33*t86 - t34*t77 - t37*t53
+    t76 = t75*s2
+    t77 = -(t76 + s2*s1**2)
+    t78 = t33*t72 + t34*t51 + t37*t77
+    t79 = t33*t73 + t34*t53 - t36*t77
+    t80 = t22*t14 - t16*c2
+    t81 = -(t22*t76 + t80*s1 - t10*c1*c2)
+    t82 = t25*t14 - t18*c2
+    t83 = -(t25*t76 + t50*c2 + t82*s1)
+    t84 = -(t10*t82 + t12*t80 - t63*c1*s2)
+    t85 = t36*t83 + t37*t81 - t33*t84 - t34*t64
+    t86 = -(t6*t14 + t3*t8)
+    t87 = t35*t72 + t37*t86 - t34*t55
+    t88 = t33*t86 + t34*t57 - t35*t77
     t89 = s2**2
-    t90 = c2*t3 - t0*t89
-    t91 = c2*t52 - s1*t90 + s3*t75*t89
-    t92 = -t12*t90 - t6*t82 + c1*s2*t65
-    t93 = t34*t83 + t36*t91 + t37*t66 - t33*t92
-    t94 = t34*t73 + t37*t59 - t35*t86
+    t90 = t3*c2 - t0*t89
+    t91 = t56*c2 - t90*s1 + t75*t89*s3
+    t92 = -(t12*t90 + t6*t82 - t65*c1*s2)
+    t93 = t35*t83 + t37*t91 - t33*t92 - t34*t66
+    t94 = -(t34*t59 + t36*t86 - t35*t73)
     t95 = t10*t90 + t68*t8 - t6*t80
-    t96 = t34*t81 + t37*t69 - t33*t95 - t35*t91
-    t97 = t35*t92 + t36*t95 - t34*t84 - t37*t70
-    t98 = c1*t40
-    t99 = t32*(t46*t96 + t48*t93 + t62*t97 - t44*t71 - t45*t85) + t41*(t29*t85 + t44*t58 + t46*t79 + t48*t78 - t62*t74) + t43*(t29*t96 + t44*t60 + t45*t79 - t48*t88 - t62*t94) + t47*(t29*t71 + t46*t60 + t48*t54 - t45*t58 - t61*t62) + t98*(t29*t97 + t46*t94 + t48*t87 - t44*t61 - t45*t74) - t42*(t29*t93 + t44*t54 + t45*t78 + t46*t88 - t62*t87)
+    t96 = -(t33*t95 + t34*t69 + t36*t91 - t35*t81)
+    t97 = t34*t70 + t36*t92 + t37*t95 - t35*t84
+    t98 = t40*c1
+    t99 = t41*(t46*t54 + t47*t58 + t60*t61 - t29*t71 - t48*t62) + t42*(t29*t85 + t45*t54 + t48*t79 - t47*t78 - t61*t74) + t44*(t29*t96 + t45*t62 + t46*t79 + t47*t88 - t61*t94) - t32*(t45*t71 + t46*t85 + t47*t93 - t48*t96 - t40*t97*s1) - t43*(t29*t93 + t45*t58 + t46*t78 + t48*t88 - t61*t87) - t98*(t45*t60 + t46*t74 + t47*t87 - t29*t97 - t48*t94)
     t100 = t13*t3 + t19*t6
-    t101 = c1*t13
-    t102 = -t101 - s1*t19
-    t103 = t100*t33 + t102*t34
-    t104 = t10*t19 - t13*t16
-    t105 = t102*t35 + t104*t33
-    t106 = t100*t35 - t104*t34
-    t107 = t16*t26 - t19*t22
-    t108 = -s1*t107 - t26*t56 + c1*t13*t22
+    t101 = t13*c1
+    t102 = -(t101 + t19*s1)
+    t103 = t33*t100 + t35*t102
+    t104 = t10*t19 - t16*t13
+    t105 = t33*t104 + t36*t102
+    t106 = t36*t100 - t35*t104
+    t107 = t16*t26 - t22*t19
+    t108 = -(t26*t52 + t107*s1 - t22*t13*c1)
     t109 = t19*t23 - t26*t3
-    t110 = -s1*t109 - t13*t67 - t26*t52
-    t111 = t107*t6 + t13*t68 - t10*t109
-    t112 = t110*t35 - t108*t34 - t111*t33
-    t113 = t103*t48 + t112*t29 - t105*t45 - t106*t62
+    t110 = -(t13*t67 + t26*t56 + t109*s1)
+    t111 = t13*t68 + t6*t107 - t10*t109
+    t112 = -(t33*t111 + t35*t108 - t36*t110)
+    t113 = -(t46*t105 + t47*t103 + t61*t106 - t29*t112)
     t114 = t19*t8 - t13*t14
-    t115 = t114*t33 - t102*t37
-    t116 = t104*t37 + t114*t35
-    t117 = t14*t26 - c2*t19
-    t118 = -s1*t117 - t26*t76 + c1*c2*t13
-    t119 = t107*t8 + t13*t80 - t10*t117
-    t120 = t108*t37 + t118*t35 - t119*t33
-    t121 = t105*t44 + t115*t48 + t120*t29 - t116*t62
-    t122 = t100*t37 + t114*t34
-    t123 = t109*t8 + t13*t90 - t117*t6
-    t124 = t110*t37 + t118*t34 - t123*t33
-    t125 = t103*t44 + t115*t45 + t124*t29 - t122*t62
-    t126 = t123*t35 - t111*t37 - t119*t34
-    t127 = t122*t48 + t126*t29 - t106*t44 - t116*t45
-    t128 = t124*t48 + t126*t62 - t112*t44 - t120*t45
-    t129 = t113*t47 + t121*t41 + t127*t98 + t128*t32 - t125*t42
-    t130 = -t12*t19 - t13*t18
-    t131 = t130*t33 - t102*t36
-    t132 = -t100*t36 - t130*t34
-    t133 = t18*t26 - t19*t25
-    t134 = t101*t25 + t26*t50 - s1*t133
-    t135 = t109*t12 + t13*t65 + t133*t6
-    t136 = -t110*t36 - t134*t34 - t135*t33
-    t137 = t136*t29 - t103*t46 - t131*t45 - t132*t62
-    t138 = t130*t37 - t114*t36
-    t139 = t117*t12 + t13*t82 + t133*t8
-    t140 = t134*t37 - t118*t36 - t139*t33
-    t141 = t131*t44 + t140*t29 - t115*t46 - t138*t62
-    t142 = -t123*t36 - t135*t37 - t139*t34
-    t143 = t142*t29 - t122*t46 - t132*t44 - t138*t45
-    t144 = -t124*t46 - t136*t44 - t140*t45 + s1*t142*t40
-    t145 = t137*t47 + t141*t41 + t143*t98 + t144*t32 - t125*t43
-    t146 = -t104*t36 - t130*t35
-    t147 = t10*t133 + t107*t12 + t13*t63
-    t148 = -t108*t36 - t134*t35 - t147*t33
-    t149 = t148*t29 - t105*t46 - t131*t48 - t146*t62
-    t150 = -t119*t36 - t139*t35 - t147*t37
-    t151 = t150*t29 - t116*t46 - t138*t48 - t146*t44
-    t152 = -t120*t46 - t140*t48 - t148*t44 + s1*t150*t40
-    t153 = t141*t42 + t149*t47 + t151*t98 + t152*t32 - t121*t43
-    t154 = t147*t34 - t111*t36 - t135*t35
-    t155 = t146*t45 + t154*t29 - t106*t46 - t132*t48
-    t156 = t148*t45 + t154*t62 - t112*t46 - t136*t48
-    t157 = t137*t42 + t155*t98 + t156*t32 - t113*t43 - t149*t41
-    t158 = t150*t45 + t154*t44 - t126*t46 - t142*t48
-    t159 = t127*t43 + t151*t41 + t155*t47 - t143*t42 - t158*t32
-    t160 = t128*t43 + t152*t41 + t156*t47 + t158*t98 - t144*t42
-    t161 = t129**2 + t145**2 + t153**2 + t157**2 + t159**2 + t160**2 + t99**2
+    t115 = t33*t114 + t34*t102
+    t116 = t36*t114 - t34*t104
+    t117 = t26*t14 - t19*c2
+    t118 = -(t26*t76 + t117*s1 - t13*c1*c2)
+    t119 = t13*t80 + t8*t107 - t10*t117
+    t120 = -(t33*t119 + t34*t108 - t36*t118)
+    t121 = t29*t120 + t45*t105 - t47*t115 - t61*t116
+    t122 = t35*t114 - t34*t100
+    t123 = t13*t90 + t8*t109 - t6*t117
+    t124 = -(t33*t123 + t34*t110 - t35*t118)
+    t125 = t29*t124 + t45*t103 + t46*t115 - t61*t122
+    t126 = t34*t111 + t36*t123 - t35*t119
+    t127 = -(t45*t106 + t46*t116 + t47*t122 - t29*t126)
+    t128 = -(t45*t112 + t46*t120 + t47*t124 - t40*t126*s1)
+    t129 = t32*t128 + t42*t121 + t98*t127 - t41*t113 - t43*t125
+    t130 = -(t12*t19 + t18*t13)
+    t131 = t33*t130 - t37*t102
+    t132 = -(t35*t130 + t37*t100)
+    t133 = t18*t26 - t25*t19
+    t134 = t25*t101 + t26*t50 - t133*s1
+    t135 = t12*t109 + t13*t65 + t6*t133
+    t136 = -(t33*t135 + t35*t134 + t37*t110)
+    t137 = -(t46*t131 + t48*t103 + t61*t132 - t29*t136)
+    t138 = -(t34*t130 + t37*t114)
+    t139 = t12*t117 + t13*t82 + t8*t133
+    t140 = -(t33*t139 + t34*t134 + t37*t118)
+    t141 = t29*t140 + t45*t131 - t48*t115 - t61*t138
+    t142 = -(t35*t139 + t37*t123 - t34*t135)
+    t143 = -(t45*t132 + t46*t138 + t48*t122 - t29*t142)
+    t144 = -(t45*t136 + t46*t140 + t48*t124 - t40*t142*s1)
+    t145 = t32*t144 + t42*t141 + t143*t98 - t41*t137 - t44*t125
+    t146 = -(t36*t130 + t37*t104)
+    t147 = t10*t133 + t12*t107 + t13*t63
+    t148 = -(t33*t147 + t36*t134 + t37*t108)
+    t149 = t29*t148 + t47*t131 - t48*t105 - t146*t61
+    t150 = -(t36*t139 + t37*t119 - t34*t147)
+    t151 = t29*t150 + t47*t138 - t45*t146 - t48*t116
+    t152 = t47*t140 + t150*t61 - t45*t148 - t48*t120
+    t153 = t32*t152 + t43*t141 + t151*t98 - t41*t149 - t44*t121
+    t154 = -(t36*t135 + t37*t111 - t35*t147)
+    t155 = t29*t154 + t46*t146 + t47*t132 - t48*t106
+    t156 = t46*t148 + t47*t136 + t154*t61 - t48*t112
+    t157 = t32*t156 + t43*t137 + t155*t98 - t42*t149 - t44*t113
+    t158 = t45*t154 + t46*t150 + t47*t142 - t48*t126
+    t159 = t32*t158 + t41*t155 + t43*t143 - t42*t151 - t44*t127
+    t160 = t42*t152 + t44*t128 + t158*t98 - t41*t156 - t43*t144
+    t161 = t99**2 + t129**2 + t145**2 + t153**2 + t157**2 + t159**2 + t160**2
     w = xp.broadcast_to(xp.sqrt(xp.abs(t161)), batch)
     return w
 
@@ -2252,86 +2252,86 @@ def velocity_ik(q, mu_dot, damping=0.0):
     s6 = trig[..., 11]
     t0 = s1*s3
     t1 = c1*c3
-    t2 = -t0 + c2*t1
-    t3 = t1 - c2*t0
+    t2 = -t0 + t1*c2
+    t3 = t1 - t0*c2
     t4 = c3*s1
     t5 = c1*s3
-    t6 = t4 + c2*t5
-    t7 = t5 + c2*t4
+    t6 = t4 + t5*c2
+    t7 = t5 + t4*c2
     t8 = c1*s2
-    t9 = c4*t2 + s4*t8
-    t10 = c4*t8 - s4*t2
-    t11 = c5*t9 - s5*t6
-    t12 = c5*t6 + s5*t9
-    t13 = c6*t10 + s6*t11
+    t9 = t2*c4 + t8*s4
+    t10 = t8*c4 - t2*s4
+    t11 = t9*c5 - t6*s5
+    t12 = t9*s5 + t6*c5
+    t13 = t10*c6 + t11*s6
     t14 = s1*s2
-    t15 = c4*t7 + s4*t14
-    t16 = c4*t14 - s4*t7
-    t17 = c5*t15 + s5*t3
-    t18 = c5*t3 - s5*t15
-    t19 = c6*t16 + s6*t17
+    t15 = t7*c4 + t14*s4
+    t16 = t14*c4 - t7*s4
+    t17 = t15*c5 + t3*s5
+    t18 = t3*c5 - t15*s5
+    t19 = t16*c6 + t17*s6
     t20 = c3*s2
-    t21 = c2*s4 - c4*t20
-    t22 = c2*c4 + s4*t20
+    t21 = c2*s4 - t20*c4
+    t22 = t20*s4 + c2*c4
     t23 = s2*s3
-    t24 = c5*t21 + s5*t23
-    t25 = c5*t23 - s5*t21
-    t26 = c6*t22 + s6*t24
-    t27 = c2*t8 + t10*t22 + t13*t26 - t12*t25 - t23*t6
-    t28 = c2*t14 + t16*t22 + t18*t25 + t19*t26 + t23*t3
+    t24 = t21*c5 + t23*s5
+    t25 = t23*c5 - t21*s5
+    t26 = t22*c6 + t24*s6
+    t27 = t10*t22 + t13*t26 + t8*c2 - t12*t25 - t6*t23
+    t28 = t16*t22 + t18*t25 + t19*t26 + t3*t23 + t14*c2
     t29 = 0.126*t13
     t30 = t29 + 0.4*t10
     t31 = t30 + 0.42*t8
     t32 = 0.126*t19
     t33 = t32 + 0.4*t16
     t34 = t33 + 0.42*t14
-    t35 = c1*t31 + s1*t34
-    t36 = t34*t8 - t14*t31
-    t37 = t3*t30 + t33*t6
+    t35 = t31*c1 + t34*s1
+    t36 = t34*t8 - t31*t14
+    t37 = t30*t3 + t33*t6
     t38 = t10*t33 - t16*t30
     t39 = t12*t32 + t18*t29
     t40 = t35**2 + t36**2 + t37**2 + t38**2 + t39**2
-    t41 = c2*t36 + t22*t38 - t23*t37 - t25*t39
+    t41 = t22*t38 + t36*c2 - t25*t39 - t37*t23
     t42 = 0.126*t26
     t43 = t42 + 0.4*t22
     t44 = t43 + 0.42*c2
-    t45 = t23*t33 - t3*t43
+    t45 = t33*t23 - t43*t3
     t46 = t16*t43 - t22*t33
     t47 = t18*t42 - t25*t32
-    t48 = t23*t30 + t43*t6
+    t48 = t30*t23 + t43*t6
     t49 = t22*t30 - t10*t43
     t50 = t12*t42 + t25*t29
-    t51 = s1*t44
-    t52 = s2*t51 - c2*t34
-    t53 = c1*t44
-    t54 = c2*t31 - s2*t53
-    t55 = t31 + c2*t54 + t22*t49 + t23*t48 + t25*t50
+    t51 = t44*s1
+    t52 = t51*s2 - t34*c2
+    t53 = t44*c1
+    t54 = t31*c2 - t53*s2
+    t55 = t31 + t22*t49 + t25*t50 + t54*c2 + t48*t23
     t56 = t44**2
     t57 = c1**2
-    t58 = t34**2 + t45**2 + t46**2 + t47**2 + t52**2 + t56*t57
-    t59 = t14*t52 + t16*t46 + t18*t47 + t44*t57 - t3*t45
+    t58 = t34**2 + t52**2 + t45**2 + t46**2 + t47**2 + t56*t57
+    t59 = t16*t46 + t18*t47 + t44*t57 + t52*t14 - t45*t3
     t60 = c1*s1
-    t61 = t46*t49 + t47*t50 + t52*t54 + t56*t60 - t31*t34 - t45*t48
+    t61 = t52*t54 + t46*t49 + t47*t50 + t56*t60 - t31*t34 - t45*t48
     t62 = -t34
-    t63 = t62 + c2*t52 + t22*t46 + t25*t47 - t23*t45
-    t64 = 1 + c1 + c2 + damping + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + q1 + q2 + q3 + q4 + q5 + q6 + q7 + t10 + t13 + t14 + t16 + t18 + t19 + t22 + t25 + t26 + t31 + t36 + t37 + t38 + t45 + t46 + t47 + t49 + t50 + t51 + t52 + t53 + t54 + t6 + t62 + t8 - s1 - t12 - t23 - t3 - t35 - t39 - t48
-    t65 = c1*t35
-    t66 = t36*t52 + t37*t45 + t38*t46 - t39*t47 - t44*t65
-    t67 = t65 + t18*t39 + t3*t37 - t14*t36 - t16*t38
+    t63 = t62 + t22*t46 + t25*t47 + t52*c2 - t45*t23
+    t64 = 1 + t10 + t16 + t22 + t18 + t25 + t13 + t19 + t26 + t31 + t52 + t45 + t46 + t47 + t54 + t49 + t50 + t36 + t37 + t38 + t6 + t51 + t53 + t62 + t8 + t14 + c1 + c2 + damping + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + q1 + q2 + q3 + q4 + q5 + q6 + q7 - t12 - t48 - t35 - t39 - t3 - t23 - s1
+    t65 = t35*c1
+    t66 = t52*t36 + t45*t37 + t46*t38 - t44*t65 - t47*t39
+    t67 = t65 + t18*t39 + t37*t3 - t16*t38 - t36*t14
     t68 = t44*t60
-    t69 = -t68 + t10*t46 + t45*t6 + t52*t8 - t12*t47
-    t70 = t68 + t14*t54 + t16*t49 + t18*t50 + t3*t48
+    t69 = -t68 + t10*t46 + t52*t8 + t45*t6 - t12*t47
+    t70 = t68 + t16*t49 + t18*t50 + t54*t14 + t48*t3
     t71 = s1**2
-    t72 = t31**2 + t48**2 + t49**2 + t50**2 + t54**2 + t56*t71
+    t72 = t31**2 + t54**2 + t48**2 + t49**2 + t50**2 + t56*t71
     t73 = t12*t50 + t44*t71 + t48*t6 - t10*t49 - t54*t8
-    t74 = s1*t35
-    t75 = t37*t48 + t39*t50 + t44*t74 - t36*t54 - t38*t49
+    t74 = t35*s1
+    t75 = t44*t74 + t48*t37 + t50*t39 - t54*t36 - t49*t38
     t76 = t74 + t10*t38 + t12*t39 + t36*t8 + t37*t6
     t77 = s2**2
     t78 = t71 + t10**2 + t12**2 + t13**2 + t6**2 + t57*t77
-    t79 = -t60 + t10*t16 + t13*t19 + t60*t77 - t12*t18 - t3*t6
+    t79 = -t60 + t10*t16 + t13*t19 + t60*t77 - t12*t18 - t6*t3
     t80 = t57 + t16**2 + t18**2 + t19**2 + t3**2 + t71*t77
-    t81 = 1 + c2**2 + t22**2 + t25**2 + t26**2 + t77*s3**2
+    t81 = 1 + t22**2 + t25**2 + t26**2 + c2**2 + t77*s3**2
     t82 = t61**2
     t83 = t63**2
     t84 = t66**2
@@ -2342,9 +2342,9 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t89 = t88**2
     t90 = xp.sqrt(t82 + t83 + t84 + t85 + t86 + t89)
     t91 = t90*xp.where(xp.greater_equal(t88, 0), xp.asarray(1, dtype=dtype), -1)
-    t92 = t88 + t91
+    t92 = t91 + t88
     t93 = xp.where(xp.greater(t90, 0), 1/(t90*(t90 + xp.abs(t88))), 0)
-    t94 = t93*(mu_dot0*t92 + mu_dot1*t61 + mu_dot2*t66 + mu_dot3*t69 + mu_dot4*t59 + mu_dot5*t63)
+    t94 = t93*(t61*mu_dot1 + t63*mu_dot5 + t66*mu_dot2 + t69*mu_dot3 + t59*mu_dot4 + t92*mu_dot0)
     t95 = mu_dot0 - t92*t94
     t96 = mu_dot1 - t61*t94
     t97 = mu_dot2 - t66*t94
@@ -2352,32 +2352,32 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t99 = mu_dot4 - t59*t94
     t100 = mu_dot5 - t63*t94
     t101 = t72 + t87
-    t102 = t93*(t101*t61 + t55*t63 + t59*t70 + t61*t92 - t66*t75 - t69*t73)
-    t103 = t61 - t102*t92
-    t104 = t101 - t102*t61
-    t105 = t75 + t102*t66
-    t106 = t73 + t102*t69
-    t107 = t70 - t102*t59
-    t108 = t55 - t102*t63
+    t102 = t93*(t61*t92 + t61*t101 + t63*t55 + t59*t70 - t66*t75 - t69*t73)
+    t103 = t61 - t92*t102
+    t104 = t101 - t61*t102
+    t105 = t75 + t66*t102
+    t106 = t73 + t69*t102
+    t107 = t70 - t59*t102
+    t108 = t55 - t63*t102
     t109 = xp.sqrt(t104**2 + t105**2 + t106**2 + t107**2 + t108**2)
     t110 = t109*xp.where(xp.greater_equal(t104, 0), xp.asarray(1, dtype=dtype), -1)
     t111 = t104 + t110
     t112 = xp.where(xp.greater(t109, 0), 1/(t109*(t109 + xp.abs(t104))), 0)
-    t113 = t112*(t100*t108 + t107*t99 + t111*t96 - t105*t97 - t106*t98)
+    t113 = t112*(t107*t99 + t108*t100 + t96*t111 - t105*t97 - t106*t98)
     t114 = t96 - t111*t113
     t115 = t97 + t105*t113
     t116 = t98 + t106*t113
     t117 = t99 - t107*t113
     t118 = t100 - t108*t113
     t119 = t40 + t87
-    t120 = t93*(t119*t66 + t41*t63 + t66*t92 + t69*t76 - t59*t67 - t61*t75)
-    t121 = t66 - t120*t92
-    t122 = t75 + t120*t61
-    t123 = t119 - t120*t66
-    t124 = t76 - t120*t69
-    t125 = t67 + t120*t59
-    t126 = t41 - t120*t63
-    t127 = -t112*(t105*t123 + t106*t124 + t107*t125 + t111*t122 - t108*t126)
+    t120 = t93*(t63*t41 + t66*t92 + t66*t119 + t69*t76 - t61*t75 - t59*t67)
+    t121 = t66 - t92*t120
+    t122 = t75 + t61*t120
+    t123 = t119 - t66*t120
+    t124 = t76 - t69*t120
+    t125 = t67 + t59*t120
+    t126 = t41 - t63*t120
+    t127 = -t112*(t105*t123 + t106*t124 + t107*t125 + t122*t111 - t108*t126)
     t128 = t122 + t111*t127
     t129 = t123 + t105*t127
     t130 = t124 + t106*t127
@@ -2387,26 +2387,26 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t134 = t133*xp.where(xp.greater_equal(t129, 0), xp.asarray(1, dtype=dtype), -1)
     t135 = t129 + t134
     t136 = xp.where(xp.greater(t133, 0), 1/(t133*(t133 + xp.abs(t129))), 0)
-    t137 = t136*(t115*t135 + t116*t130 + t118*t132 - t117*t131)
+    t137 = t136*(t130*t116 + t132*t118 + t115*t135 - t131*t117)
     t138 = t115 - t135*t137
     t139 = t116 - t130*t137
     t140 = t117 + t131*t137
     t141 = t118 - t132*t137
     t142 = t78 + t87
-    t143 = t93*(t142*t69 + t27*t63 + t59*t79 + t66*t76 + t69*t92 - t61*t73)
-    t144 = t69 - t143*t92
-    t145 = t73 + t143*t61
-    t146 = t76 - t143*t66
-    t147 = t142 - t143*t69
-    t148 = t79 - t143*t59
-    t149 = t27 - t143*t63
-    t150 = -t112*(t105*t146 + t106*t147 + t111*t145 - t107*t148 - t108*t149)
+    t143 = t93*(t63*t27 + t66*t76 + t69*t92 + t69*t142 + t59*t79 - t61*t73)
+    t144 = t69 - t92*t143
+    t145 = t73 + t61*t143
+    t146 = t76 - t66*t143
+    t147 = t142 - t69*t143
+    t148 = t79 - t59*t143
+    t149 = t27 - t63*t143
+    t150 = -t112*(t105*t146 + t106*t147 + t145*t111 - t107*t148 - t108*t149)
     t151 = t145 + t111*t150
     t152 = t146 + t105*t150
     t153 = t147 + t106*t150
     t154 = t148 - t107*t150
     t155 = t149 - t108*t150
-    t156 = t136*(t130*t153 + t132*t155 + t135*t152 - t131*t154)
+    t156 = t136*(t130*t153 + t132*t155 + t152*t135 - t131*t154)
     t157 = t152 - t135*t156
     t158 = t153 - t130*t156
     t159 = t154 + t131*t156
@@ -2415,30 +2415,30 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t162 = t161*xp.where(xp.greater_equal(t158, 0), xp.asarray(1, dtype=dtype), -1)
     t163 = t158 + t162
     t164 = xp.where(xp.greater(t161, 0), 1/(t161*(t161 + xp.abs(t158))), 0)
-    t165 = t164*(t139*t163 + t140*t159 + t141*t160)
+    t165 = t164*(t159*t140 + t160*t141 + t139*t163)
     t166 = t139 - t163*t165
     t167 = t140 - t159*t165
     t168 = t141 - t160*t165
     t169 = t80 + t87
-    t170 = t93*(t169*t59 + t28*t63 + t59*t92 + t61*t70 + t69*t79 - t66*t67)
-    t171 = t59 - t170*t92
-    t172 = t70 - t170*t61
-    t173 = t67 + t170*t66
-    t174 = t79 - t170*t69
-    t175 = t169 - t170*t59
-    t176 = t28 - t170*t63
-    t177 = t112*(t105*t173 + t107*t175 + t108*t176 + t111*t172 - t106*t174)
+    t170 = t93*(t61*t70 + t63*t28 + t69*t79 + t59*t92 + t59*t169 - t66*t67)
+    t171 = t59 - t92*t170
+    t172 = t70 - t61*t170
+    t173 = t67 + t66*t170
+    t174 = t79 - t69*t170
+    t175 = t169 - t59*t170
+    t176 = t28 - t63*t170
+    t177 = t112*(t105*t173 + t107*t175 + t108*t176 + t172*t111 - t106*t174)
     t178 = t172 - t111*t177
     t179 = -t173 + t105*t177
     t180 = t174 + t106*t177
     t181 = t175 - t107*t177
     t182 = t176 - t108*t177
-    t183 = t136*(t130*t180 + t132*t182 + t135*t179 - t131*t181)
+    t183 = t136*(t130*t180 + t132*t182 + t179*t135 - t131*t181)
     t184 = t179 - t135*t183
     t185 = t180 - t130*t183
     t186 = t181 + t131*t183
     t187 = t182 - t132*t183
-    t188 = t164*(t159*t186 + t160*t187 + t163*t185)
+    t188 = t164*(t159*t186 + t160*t187 + t185*t163)
     t189 = t185 - t163*t188
     t190 = t186 - t159*t188
     t191 = t187 - t160*t188
@@ -2446,59 +2446,59 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t193 = t192*xp.where(xp.greater_equal(t190, 0), xp.asarray(1, dtype=dtype), -1)
     t194 = t190 + t193
     t195 = xp.where(xp.greater(t192, 0), 1/(t192*(t192 + xp.abs(t190))), 0)
-    t196 = t195*(t167*t194 + t168*t191)
+    t196 = t195*(t191*t168 + t167*t194)
     t197 = t167 - t194*t196
     t198 = t168 - t191*t196
     t199 = t81 + t87
-    t200 = xp.sqrt(t89 + t101**2 + t119**2 + t142**2 + t169**2 + t199**2 + 2*t82 + 2*t83 + 2*t84 + 2*t85 + 2*t86 + 2*t27**2 + 2*t28**2 + 2*t41**2 + 2*t55**2 + 2*t67**2 + 2*t70**2 + 2*t73**2 + 2*t75**2 + 2*t76**2 + 2*t79**2)
-    t201 = t93*(t199*t63 + t27*t69 + t28*t59 + t41*t66 + t55*t61 + t63*t92)
-    t202 = t63 - t201*t92
-    t203 = t55 - t201*t61
-    t204 = t41 - t201*t66
-    t205 = t27 - t201*t69
-    t206 = t28 - t201*t59
-    t207 = t199 - t201*t63
-    t208 = t112*(t107*t206 + t108*t207 + t111*t203 - t105*t204 - t106*t205)
+    t200 = xp.sqrt(t89 + t101**2 + t119**2 + t142**2 + t169**2 + t199**2 + 2*t82 + 2*t83 + 2*t84 + 2*t85 + 2*t86 + 2*t55**2 + 2*t75**2 + 2*t73**2 + 2*t70**2 + 2*t76**2 + 2*t67**2 + 2*t41**2 + 2*t79**2 + 2*t27**2 + 2*t28**2)
+    t201 = t93*(t61*t55 + t63*t92 + t63*t199 + t66*t41 + t69*t27 + t59*t28)
+    t202 = t63 - t92*t201
+    t203 = t55 - t61*t201
+    t204 = t41 - t66*t201
+    t205 = t27 - t69*t201
+    t206 = t28 - t59*t201
+    t207 = t199 - t63*t201
+    t208 = t112*(t107*t206 + t108*t207 + t203*t111 - t105*t204 - t106*t205)
     t209 = t203 - t111*t208
     t210 = t204 + t105*t208
     t211 = t205 + t106*t208
     t212 = t206 - t107*t208
     t213 = t207 - t108*t208
-    t214 = t136*(t130*t211 + t132*t213 + t135*t210 - t131*t212)
+    t214 = t136*(t130*t211 + t132*t213 + t210*t135 - t131*t212)
     t215 = t210 - t135*t214
     t216 = t211 - t130*t214
     t217 = t212 + t131*t214
     t218 = t213 - t132*t214
-    t219 = t164*(t159*t217 + t160*t218 + t163*t216)
+    t219 = t164*(t159*t217 + t160*t218 + t216*t163)
     t220 = t216 - t163*t219
     t221 = t217 - t159*t219
     t222 = t218 - t160*t219
-    t223 = t195*(t191*t222 + t194*t221)
+    t223 = t195*(t191*t222 + t221*t194)
     t224 = t221 - t194*t223
     t225 = t222 - t191*t223
     t226 = xp.abs(t225)
     t227 = t226
     t228 = t227*xp.where(xp.greater_equal(t225, 0), xp.asarray(1, dtype=dtype), -1)
     t229 = t225 + t228
-    t230 = xp.where(xp.greater(t227, 0), 1/(t227*(t226 + t227)), 0)
+    t230 = xp.where(xp.greater(t227, 0), 1/(t227*(t227 + t226)), 0)
     t231 = t198 - t198*t230*t229**2
     t232 = xp.where(xp.not_equal(t228, 0), -t231/t228, 0)
     t233 = xp.where(xp.not_equal(t193, 0), -(t197 - t224*t232)/t193, 0)
-    t234 = xp.where(xp.not_equal(t162, 0), -(t166 - t189*t233 - t220*t232)/t162, 0)
-    t235 = xp.where(xp.not_equal(t134, 0), -(t138 - t157*t234 - t184*t233 - t215*t232)/t134, 0)
-    t236 = xp.where(xp.not_equal(t110, 0), -(t114 + t128*t235 + t151*t234 - t178*t233 - t209*t232)/t110, 0)
-    t237 = xp.where(xp.not_equal(t91, 0), -(t95 - t103*t236 - t121*t235 - t144*t234 - t171*t233 - t202*t232)/t91, 0)
+    t234 = xp.where(xp.not_equal(t162, 0), -(t166 - (t189*t233 + t220*t232))/t162, 0)
+    t235 = xp.where(xp.not_equal(t134, 0), -(t138 - (t157*t234 + t184*t233 + t215*t232))/t134, 0)
+    t236 = xp.where(xp.not_equal(t110, 0), -(t114 - (t178*t233 + t209*t232 - t128*t235 - t151*t234))/t110, 0)
+    t237 = xp.where(xp.not_equal(t91, 0), -(t95 - (t103*t236 + t121*t235 + t144*t234 + t171*t233 + t202*t232))/t91, 0)
     t238 = t232 + t236*t31 - t237*t34
-    t239 = c1*t233 + t236*t51 + t237*t53 - s1*t234 - t235*t35
-    t240 = c2*t232 + t14*t233 + t234*t8 + t235*t36 + t236*t54 + t237*t52
-    t241 = t234*t6 + t235*t37 + t237*t45 - t23*t232 - t233*t3 - t236*t48
+    t239 = t233*c1 + t236*t51 + t237*t53 - t234*s1 - t235*t35
+    t240 = t232*c2 + t233*t14 + t234*t8 + t235*t36 + t236*t54 + t237*t52
+    t241 = t234*t6 + t235*t37 + t237*t45 - t232*t23 - t233*t3 - t236*t48
     t242 = t10*t234 + t16*t233 + t22*t232 + t235*t38 + t236*t49 + t237*t46
-    t243 = t18*t233 + t232*t25 + t236*t50 + t237*t47 - t12*t234 - t235*t39
-    t244 = t13*t234 + t19*t233 + t232*t26
+    t243 = t18*t233 + t25*t232 + t236*t50 + t237*t47 - t12*t234 - t235*t39
+    t244 = t232*t26 + t233*t19 + t234*t13
     t245 = xp.isfinite(t64)
     t246 = xp.greater_equal(damping, 0)
     t247 = 1e-12*t200
-    t248 = (xp.less_equal(t109, t247)) | (xp.less_equal(t133, t247)) | (xp.less_equal(t161, t247)) | (xp.less_equal(t192, t247)) | (xp.less_equal(t227, t247)) | (xp.less_equal(t90, t247))
+    t248 = xp.less_equal(t90, t247) | xp.less_equal(t109, t247) | xp.less_equal(t133, t247) | xp.less_equal(t161, t247) | xp.less_equal(t192, t247) | xp.less_equal(t227, t247)
     t249 = t245 & t246 & xp.logical_not(t248)
     q_dot = _stack(xp, [
         xp.broadcast_to(xp.where(t249, t238, 0), batch),  # 0
@@ -2515,7 +2515,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def ik_numeric_step(target, q, damping=0.0):
-    """one step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite): (7 x 1 and 7 x 1 and 1 x 1), 1131 operations."""
+    """one step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite): (7 x 1 and 7 x 1 and 1 x 1), 1126 operations."""
     xp, dtype, device, batch, (target, q, damping,) = _arguments(("target", target, (4, 4)), ("q", q, (7,)), ("damping", damping, ()))
     T00 = target[..., 0, 0]
     T01 = target[..., 0, 1]
@@ -2560,56 +2560,56 @@ def ik_numeric_step(target, q, damping=0.0):
     t0 = T00 + T01 + T02 + T03 + T10 + T11 + T12 + T13 + T20 + T21 + T22 + T23 + qs1 + qs2 + qs3 + qs4 + qs5 + qs6 + qs7
     t1 = s1*s3
     t2 = c1*c3
-    t3 = -t1 + c2*t2
-    t4 = t2 - c2*t1
+    t3 = -t1 + t2*c2
+    t4 = t2 - t1*c2
     t5 = c3*s1
     t6 = c1*s3
-    t7 = t5 + c2*t6
-    t8 = t6 + c2*t5
+    t7 = t5 + t6*c2
+    t8 = t6 + t5*c2
     t9 = c1*s2
-    t10 = c4*t3 + s4*t9
-    t11 = c4*t9 - s4*t3
-    t12 = c5*t10 - s5*t7
-    t13 = c5*t7 + s5*t10
-    t14 = c6*t12 - s6*t11
-    t15 = c6*t11 + s6*t12
-    t16 = c7*t14 - s7*t13
-    t17 = c7*t13 + s7*t14
+    t10 = t3*c4 + t9*s4
+    t11 = t9*c4 - t3*s4
+    t12 = t10*c5 - t7*s5
+    t13 = t10*s5 + t7*c5
+    t14 = t12*c6 - t11*s6
+    t15 = t11*c6 + t12*s6
+    t16 = t14*c7 - t13*s7
+    t17 = t13*c7 + t14*s7
     t18 = T00*t16 + T02*t15 - T01*t17
     t19 = T10*t16 + T12*t15 - T11*t17
     t20 = T20*t16 + T22*t15 - T21*t17
     t21 = s1*s2
-    t22 = c4*t8 + s4*t21
-    t23 = c4*t21 - s4*t8
-    t24 = c5*t22 + s5*t4
-    t25 = c5*t4 - s5*t22
-    t26 = c6*t24 - s6*t23
-    t27 = c6*t23 + s6*t24
-    t28 = c7*t26 + s7*t25
-    t29 = c7*t25 - s7*t26
+    t22 = t8*c4 + t21*s4
+    t23 = t21*c4 - t8*s4
+    t24 = t22*c5 + t4*s5
+    t25 = t4*c5 - t22*s5
+    t26 = t24*c6 - t23*s6
+    t27 = t23*c6 + t24*s6
+    t28 = t25*s7 + t26*c7
+    t29 = t25*c7 - t26*s7
     t30 = T00*t28 + T01*t29 + T02*t27
     t31 = T10*t28 + T11*t29 + T12*t27
     t32 = T20*t28 + T21*t29 + T22*t27
-    t33 = 0.5*t19 - 0.5*t30
+    t33 = 0.5*(t19 - t30)
     t34 = c3*s2
-    t35 = c2*s4 - c4*t34
-    t36 = c2*c4 + s4*t34
+    t35 = c2*s4 - t34*c4
+    t36 = t34*s4 + c2*c4
     t37 = s2*s3
-    t38 = c5*t35 + s5*t37
-    t39 = c5*t37 - s5*t35
-    t40 = c6*t38 - s6*t36
-    t41 = c6*t36 + s6*t38
-    t42 = c7*t40 + s7*t39
-    t43 = c7*t39 - s7*t40
-    t44 = c2*t9 + t11*t36 + t15*t41 - t13*t39 - t37*t7
-    t45 = c2*t21 + t23*t36 + t25*t39 + t27*t41 + t37*t4
+    t38 = t35*c5 + t37*s5
+    t39 = t37*c5 - t35*s5
+    t40 = t38*c6 - t36*s6
+    t41 = t36*c6 + t38*s6
+    t42 = t39*s7 + t40*c7
+    t43 = t39*c7 - t40*s7
+    t44 = t11*t36 + t15*t41 + t9*c2 - t13*t39 - t7*t37
+    t45 = t23*t36 + t25*t39 + t27*t41 + t4*t37 + t21*c2
     t46 = T00*t42 + T01*t43 + T02*t41
     t47 = T10*t42 + T11*t43 + T12*t41
     t48 = T20*t42 + T21*t43 + T22*t41
-    t49 = 0.5*t32 - 0.5*t47
-    t50 = 0.5*t46 - 0.5*t20
-    t51 = -0.5 + 0.5*t18 + 0.5*t31 + 0.5*t48
-    t52 = xp.sqrt(t33**2 + t49**2 + t50**2)
+    t49 = 0.5*(t32 - t47)
+    t50 = 0.5*(t46 - t20)
+    t51 = 0.5*(-1 + t18 + t31 + t48)
+    t52 = xp.sqrt(t49**2 + t50**2 + t33**2)
     t53 = xp.atan2(t52, t51)
     t54 = xp.where(xp.greater(t52, 0), t53/t52, 1)
     t55 = 0.126*t15
@@ -2619,105 +2619,105 @@ def ik_numeric_step(target, q, damping=0.0):
     t59 = 0.126*t27
     t60 = t59 + 0.4*t23
     t61 = t60 + 0.42*t21
-    t62 = c1*t57 + s1*t61
-    t63 = t61*t9 - t21*t57
-    t64 = t4*t56 + t60*t7
+    t62 = t57*c1 + t61*s1
+    t63 = t61*t9 - t57*t21
+    t64 = t56*t4 + t60*t7
     t65 = t11*t60 - t23*t56
     t66 = t13*t59 + t25*t55
     t67 = t62**2 + t63**2 + t64**2 + t65**2 + t66**2
-    t68 = c2*t63 + t36*t65 - t37*t64 - t39*t66
+    t68 = t36*t65 + t63*c2 - t39*t66 - t64*t37
     t69 = 0.126*t41
     t70 = t69 + 0.4*t36
     t71 = t70 + 0.42*c2
     t72 = 0.36 + t71
-    t73 = t21*t71 - c2*t61
-    t74 = t37*t60 - t4*t70
+    t73 = t71*t21 - t61*c2
+    t74 = t60*t37 - t70*t4
     t75 = t23*t70 - t36*t60
     t76 = t25*t69 - t39*t59
-    t77 = c2*t57 - t71*t9
-    t78 = t37*t56 + t7*t70
+    t77 = t57*c2 - t71*t9
+    t78 = t56*t37 + t70*t7
     t79 = t36*t56 - t11*t70
     t80 = t13*t69 + t39*t55
-    t81 = t57 + c2*t77 + t36*t79 + t37*t78 + t39*t80
+    t81 = t57 + t36*t79 + t39*t80 + t77*c2 + t78*t37
     t82 = T23 - t72
     t83 = t71**2
     t84 = c1**2
     t85 = t61**2 + t73**2 + t74**2 + t75**2 + t76**2 + t83*t84
-    t86 = t21*t73 + t23*t75 + t25*t76 + t71*t84 - t4*t74
+    t86 = t23*t75 + t25*t76 + t71*t84 + t73*t21 - t74*t4
     t87 = c1*s1
     t88 = t73*t77 + t75*t79 + t76*t80 + t83*t87 - t57*t61 - t74*t78
     t89 = -t61
-    t90 = t89 + c2*t73 + t36*t75 + t39*t76 - t37*t74
+    t90 = t89 + t36*t75 + t39*t76 + t73*c2 - t74*t37
     t91 = T13 + t89
-    t92 = c1*t62
-    t93 = t63*t73 + t64*t74 + t65*t75 - t66*t76 - t71*t92
-    t94 = t92 + t25*t66 + t4*t64 - t21*t63 - t23*t65
+    t92 = t62*c1
+    t93 = t73*t63 + t74*t64 + t75*t65 - t71*t92 - t76*t66
+    t94 = t92 + t25*t66 + t64*t4 - t23*t65 - t63*t21
     t95 = t71*t87
-    t96 = -t95 + t11*t75 + t7*t74 + t73*t9 - t13*t76
-    t97 = t95 + t21*t77 + t23*t79 + t25*t80 + t4*t78
+    t96 = -t95 + t11*t75 + t73*t9 + t74*t7 - t13*t76
+    t97 = t95 + t23*t79 + t25*t80 + t77*t21 + t78*t4
     t98 = s1**2
     t99 = t57**2 + t77**2 + t78**2 + t79**2 + t80**2 + t83*t98
-    t100 = t13*t80 + t7*t78 + t71*t98 - t11*t79 - t77*t9
-    t101 = s1*t62
-    t102 = t101*t71 + t64*t78 + t66*t80 - t63*t77 - t65*t79
+    t100 = t13*t80 + t71*t98 + t78*t7 - t11*t79 - t77*t9
+    t101 = t62*s1
+    t102 = t71*t101 + t78*t64 + t80*t66 - t77*t63 - t79*t65
     t103 = t101 + t11*t65 + t13*t66 + t63*t9 + t64*t7
     t104 = s2**2
-    t105 = t98 + t11**2 + t13**2 + t15**2 + t7**2 + t104*t84
-    t106 = -t87 + t104*t87 + t11*t23 + t15*t27 - t13*t25 - t4*t7
-    t107 = t84 + t23**2 + t25**2 + t27**2 + t4**2 + t104*t98
-    t108 = 1 + c2**2 + t36**2 + t39**2 + t41**2 + t104*s3**2
-    t109 = (xp.greater_equal(t18, t31)) & (xp.greater_equal(t18, t48))
+    t105 = t98 + t11**2 + t13**2 + t15**2 + t7**2 + t84*t104
+    t106 = -t87 + t11*t23 + t15*t27 + t87*t104 - t13*t25 - t7*t4
+    t107 = t84 + t23**2 + t25**2 + t27**2 + t4**2 + t98*t104
+    t108 = 1 + t36**2 + t39**2 + t41**2 + c2**2 + t104*s3**2
+    t109 = xp.greater_equal(t18, t31) & xp.greater_equal(t18, t48)
     t110 = xp.greater_equal(t31, t48)
-    t111 = xp.where(t109, 0.5 + 0.5*t18, xp.where(t110, 0.5*t30, 0.5*t46))
-    t112 = xp.where(t109, 0.5*t19, xp.where(t110, 0.5 + 0.5*t31, 0.5*t47))
-    t113 = xp.where(t109, 0.5*t20, xp.where(t110, 0.5*t32, 0.5 + 0.5*t48))
+    t111 = xp.where(t109, 0.5*(1 + t18), xp.where(t110, 0.5*t30, 0.5*t46))
+    t112 = xp.where(t109, 0.5*t19, xp.where(t110, 0.5*(1 + t31), 0.5*t47))
+    t113 = xp.where(t109, 0.5*t20, xp.where(t110, 0.5*t32, 0.5*(1 + t48)))
     t114 = xp.sqrt(t111**2 + t112**2 + t113**2)
-    t115 = xp.where(xp.greater_equal(t111*t49 + t112*t50 + t113*t33, 0), xp.asarray(1, dtype=dtype), -1)
-    t116 = (xp.greater(t52, 1e-06)) | (xp.greater(t51, 0))
-    t117 = t115*t53/t114
+    t115 = xp.where(xp.greater_equal(t49*t111 + t50*t112 + t33*t113, 0), xp.asarray(1, dtype=dtype), -1)
+    t116 = xp.greater(t52, 1e-06) | xp.greater(t51, 0)
+    t117 = t53*t115/t114
     t118 = xp.where(t116, t49*t54, t111*t117)
     t119 = xp.where(t116, t50*t54, t112*t117)
     t120 = xp.where(t116, t33*t54, t113*t117)
-    t121 = t118**2 + t119**2 + t120**2 + t58**2 + t82**2 + t91**2
-    t122 = damping + t85
-    t123 = xp.sqrt(t122**2 + t86**2 + t88**2 + t90**2 + t93**2 + t96**2)
+    t121 = t118**2 + t119**2 + t120**2 + t58**2 + t91**2 + t82**2
+    t122 = t85 + damping
+    t123 = xp.sqrt(t88**2 + t90**2 + t93**2 + t96**2 + t86**2 + t122**2)
     t124 = t123*xp.where(xp.greater_equal(t122, 0), xp.asarray(1, dtype=dtype), -1)
-    t125 = t122 + t124
+    t125 = t124 + t122
     t126 = xp.where(xp.greater(t123, 0), 1/(t123*(t123 + xp.abs(t122))), 0)
-    t127 = t126*(t118*t96 + t119*t86 + t120*t90 + t125*t58 + t82*t93 + t88*t91)
+    t127 = t126*(t88*t91 + t90*t120 + t93*t82 + t96*t118 + t86*t119 + t58*t125)
     t128 = t58 - t125*t127
-    t129 = t91 - t127*t88
-    t130 = t82 - t127*t93
-    t131 = t118 - t127*t96
-    t132 = t119 - t127*t86
-    t133 = t120 - t127*t90
-    t134 = damping + t99
-    t135 = t126*(t125*t88 + t134*t88 + t81*t90 + t86*t97 - t100*t96 - t102*t93)
+    t129 = t91 - t88*t127
+    t130 = t82 - t93*t127
+    t131 = t118 - t96*t127
+    t132 = t119 - t86*t127
+    t133 = t120 - t90*t127
+    t134 = t99 + damping
+    t135 = t126*(t88*t125 + t88*t134 + t90*t81 + t86*t97 - t93*t102 - t96*t100)
     t136 = t88 - t125*t135
-    t137 = t134 - t135*t88
-    t138 = t102 + t135*t93
-    t139 = t100 + t135*t96
-    t140 = t97 - t135*t86
-    t141 = t81 - t135*t90
+    t137 = t134 - t88*t135
+    t138 = t102 + t93*t135
+    t139 = t100 + t96*t135
+    t140 = t97 - t86*t135
+    t141 = t81 - t90*t135
     t142 = xp.sqrt(t137**2 + t138**2 + t139**2 + t140**2 + t141**2)
     t143 = t142*xp.where(xp.greater_equal(t137, 0), xp.asarray(1, dtype=dtype), -1)
     t144 = t137 + t143
     t145 = xp.where(xp.greater(t142, 0), 1/(t142*(t142 + xp.abs(t137))), 0)
-    t146 = t145*(t129*t144 + t132*t140 + t133*t141 - t130*t138 - t131*t139)
+    t146 = t145*(t140*t132 + t141*t133 + t129*t144 - t138*t130 - t139*t131)
     t147 = t129 - t144*t146
     t148 = t130 + t138*t146
     t149 = t131 + t139*t146
     t150 = t132 - t140*t146
     t151 = t133 - t141*t146
-    t152 = damping + t67
-    t153 = t126*(t103*t96 + t125*t93 + t152*t93 + t68*t90 - t102*t88 - t86*t94)
+    t152 = t67 + damping
+    t153 = t126*(t90*t68 + t93*t125 + t93*t152 + t96*t103 - t88*t102 - t86*t94)
     t154 = t93 - t125*t153
-    t155 = t102 + t153*t88
-    t156 = t152 - t153*t93
-    t157 = t103 - t153*t96
-    t158 = t94 + t153*t86
-    t159 = t68 - t153*t90
-    t160 = -t145*(t138*t156 + t139*t157 + t140*t158 + t144*t155 - t141*t159)
+    t155 = t102 + t88*t153
+    t156 = t152 - t93*t153
+    t157 = t103 - t96*t153
+    t158 = t94 + t86*t153
+    t159 = t68 - t90*t153
+    t160 = -t145*(t138*t156 + t139*t157 + t140*t158 + t155*t144 - t141*t159)
     t161 = t155 + t144*t160
     t162 = t156 + t138*t160
     t163 = t157 + t139*t160
@@ -2727,26 +2727,26 @@ def ik_numeric_step(target, q, damping=0.0):
     t167 = t166*xp.where(xp.greater_equal(t162, 0), xp.asarray(1, dtype=dtype), -1)
     t168 = t162 + t167
     t169 = xp.where(xp.greater(t166, 0), 1/(t166*(t166 + xp.abs(t162))), 0)
-    t170 = t169*(t148*t168 + t149*t163 + t151*t165 - t150*t164)
+    t170 = t169*(t163*t149 + t165*t151 + t148*t168 - t164*t150)
     t171 = t148 - t168*t170
     t172 = t149 - t163*t170
     t173 = t150 + t164*t170
     t174 = t151 - t165*t170
-    t175 = damping + t105
-    t176 = t126*(t103*t93 + t106*t86 + t125*t96 + t175*t96 + t44*t90 - t100*t88)
+    t175 = t105 + damping
+    t176 = t126*(t90*t44 + t93*t103 + t96*t125 + t96*t175 + t86*t106 - t88*t100)
     t177 = t96 - t125*t176
-    t178 = t100 + t176*t88
-    t179 = t103 - t176*t93
-    t180 = t175 - t176*t96
-    t181 = t106 - t176*t86
-    t182 = t44 - t176*t90
-    t183 = -t145*(t138*t179 + t139*t180 + t144*t178 - t140*t181 - t141*t182)
+    t178 = t100 + t88*t176
+    t179 = t103 - t93*t176
+    t180 = t175 - t96*t176
+    t181 = t106 - t86*t176
+    t182 = t44 - t90*t176
+    t183 = -t145*(t138*t179 + t139*t180 + t178*t144 - t140*t181 - t141*t182)
     t184 = t178 + t144*t183
     t185 = t179 + t138*t183
     t186 = t180 + t139*t183
     t187 = t181 - t140*t183
     t188 = t182 - t141*t183
-    t189 = t169*(t163*t186 + t165*t188 + t168*t185 - t164*t187)
+    t189 = t169*(t163*t186 + t165*t188 + t185*t168 - t164*t187)
     t190 = t185 - t168*t189
     t191 = t186 - t163*t189
     t192 = t187 + t164*t189
@@ -2755,30 +2755,30 @@ def ik_numeric_step(target, q, damping=0.0):
     t195 = t194*xp.where(xp.greater_equal(t191, 0), xp.asarray(1, dtype=dtype), -1)
     t196 = t191 + t195
     t197 = xp.where(xp.greater(t194, 0), 1/(t194*(t194 + xp.abs(t191))), 0)
-    t198 = t197*(t172*t196 + t173*t192 + t174*t193)
+    t198 = t197*(t192*t173 + t193*t174 + t172*t196)
     t199 = t172 - t196*t198
     t200 = t173 - t192*t198
     t201 = t174 - t193*t198
-    t202 = damping + t107
-    t203 = t126*(t106*t96 + t125*t86 + t202*t86 + t45*t90 + t88*t97 - t93*t94)
+    t202 = t107 + damping
+    t203 = t126*(t88*t97 + t90*t45 + t96*t106 + t86*t125 + t86*t202 - t93*t94)
     t204 = t86 - t125*t203
-    t205 = t97 - t203*t88
-    t206 = t94 + t203*t93
-    t207 = t106 - t203*t96
-    t208 = t202 - t203*t86
-    t209 = t45 - t203*t90
-    t210 = t145*(t138*t206 + t140*t208 + t141*t209 + t144*t205 - t139*t207)
+    t205 = t97 - t88*t203
+    t206 = t94 + t93*t203
+    t207 = t106 - t96*t203
+    t208 = t202 - t86*t203
+    t209 = t45 - t90*t203
+    t210 = t145*(t138*t206 + t140*t208 + t141*t209 + t205*t144 - t139*t207)
     t211 = t205 - t144*t210
     t212 = -t206 + t138*t210
     t213 = t207 + t139*t210
     t214 = t208 - t140*t210
     t215 = t209 - t141*t210
-    t216 = t169*(t163*t213 + t165*t215 + t168*t212 - t164*t214)
+    t216 = t169*(t163*t213 + t165*t215 + t212*t168 - t164*t214)
     t217 = t212 - t168*t216
     t218 = t213 - t163*t216
     t219 = t214 + t164*t216
     t220 = t215 - t165*t216
-    t221 = t197*(t192*t219 + t193*t220 + t196*t218)
+    t221 = t197*(t192*t219 + t193*t220 + t218*t196)
     t222 = t218 - t196*t221
     t223 = t219 - t192*t221
     t224 = t220 - t193*t221
@@ -2786,54 +2786,54 @@ def ik_numeric_step(target, q, damping=0.0):
     t226 = t225*xp.where(xp.greater_equal(t223, 0), xp.asarray(1, dtype=dtype), -1)
     t227 = t223 + t226
     t228 = xp.where(xp.greater(t225, 0), 1/(t225*(t225 + xp.abs(t223))), 0)
-    t229 = t228*(t200*t227 + t201*t224)
+    t229 = t228*(t224*t201 + t200*t227)
     t230 = t200 - t227*t229
     t231 = t201 - t224*t229
-    t232 = damping + t108
-    t233 = t126*(t125*t90 + t232*t90 + t44*t96 + t45*t86 + t68*t93 + t81*t88)
+    t232 = t108 + damping
+    t233 = t126*(t88*t81 + t90*t125 + t90*t232 + t93*t68 + t96*t44 + t86*t45)
     t234 = t90 - t125*t233
-    t235 = t81 - t233*t88
-    t236 = t68 - t233*t93
-    t237 = t44 - t233*t96
-    t238 = t45 - t233*t86
-    t239 = t232 - t233*t90
-    t240 = t145*(t140*t238 + t141*t239 + t144*t235 - t138*t236 - t139*t237)
+    t235 = t81 - t88*t233
+    t236 = t68 - t93*t233
+    t237 = t44 - t96*t233
+    t238 = t45 - t86*t233
+    t239 = t232 - t90*t233
+    t240 = t145*(t140*t238 + t141*t239 + t235*t144 - t138*t236 - t139*t237)
     t241 = t235 - t144*t240
     t242 = t236 + t138*t240
     t243 = t237 + t139*t240
     t244 = t238 - t140*t240
     t245 = t239 - t141*t240
-    t246 = t169*(t163*t243 + t165*t245 + t168*t242 - t164*t244)
+    t246 = t169*(t163*t243 + t165*t245 + t242*t168 - t164*t244)
     t247 = t242 - t168*t246
     t248 = t243 - t163*t246
     t249 = t244 + t164*t246
     t250 = t245 - t165*t246
-    t251 = t197*(t192*t249 + t193*t250 + t196*t248)
+    t251 = t197*(t192*t249 + t193*t250 + t248*t196)
     t252 = t248 - t196*t251
     t253 = t249 - t192*t251
     t254 = t250 - t193*t251
-    t255 = t228*(t224*t254 + t227*t253)
+    t255 = t228*(t224*t254 + t253*t227)
     t256 = t253 - t227*t255
     t257 = t254 - t224*t255
     t258 = xp.abs(t257)
     t259 = t258
     t260 = t259*xp.where(xp.greater_equal(t257, 0), xp.asarray(1, dtype=dtype), -1)
     t261 = t257 + t260
-    t262 = xp.where(xp.greater(t259, 0), 1/(t259*(t258 + t259)), 0)
+    t262 = xp.where(xp.greater(t259, 0), 1/(t259*(t259 + t258)), 0)
     t263 = t231 - t231*t262*t261**2
     t264 = xp.where(xp.not_equal(t260, 0), -t263/t260, 0)
     t265 = xp.where(xp.not_equal(t226, 0), -(t230 - t256*t264)/t226, 0)
-    t266 = xp.where(xp.not_equal(t195, 0), -(t199 - t222*t265 - t252*t264)/t195, 0)
-    t267 = xp.where(xp.not_equal(t167, 0), -(t171 - t190*t266 - t217*t265 - t247*t264)/t167, 0)
-    t268 = xp.where(xp.not_equal(t143, 0), -(t147 + t161*t267 + t184*t266 - t211*t265 - t241*t264)/t143, 0)
-    t269 = xp.where(xp.not_equal(t124, 0), -(t128 - t136*t268 - t154*t267 - t177*t266 - t204*t265 - t234*t264)/t124, 0)
-    t270 = q1 + t264 + t268*t57 - t269*t61
-    t271 = q2 + c1*t265 - s1*t266 - t267*t62 + c1*t269*t71 + s1*t268*t71
-    t272 = q3 + c2*t264 + t21*t265 + t266*t9 + t267*t63 + t268*t77 + t269*t73
+    t266 = xp.where(xp.not_equal(t195, 0), -(t199 - (t222*t265 + t252*t264))/t195, 0)
+    t267 = xp.where(xp.not_equal(t167, 0), -(t171 - (t190*t266 + t217*t265 + t247*t264))/t167, 0)
+    t268 = xp.where(xp.not_equal(t143, 0), -(t147 - (t211*t265 + t241*t264 - t161*t267 - t184*t266))/t143, 0)
+    t269 = xp.where(xp.not_equal(t124, 0), -(t128 - (t136*t268 + t154*t267 + t177*t266 + t204*t265 + t234*t264))/t124, 0)
+    t270 = t264 + q1 + t268*t57 - t269*t61
+    t271 = q2 + t265*c1 - t266*s1 - t267*t62 + t268*t71*s1 + t269*t71*c1
+    t272 = q3 + t264*c2 + t265*t21 + t266*t9 + t267*t63 + t268*t77 + t269*t73
     t273 = q4 + t266*t7 + t267*t64 + t269*t74 - t264*t37 - t265*t4 - t268*t78
-    t274 = q5 + t11*t266 + t23*t265 + t264*t36 + t267*t65 + t268*t79 + t269*t75
-    t275 = q6 + t25*t265 + t264*t39 + t268*t80 + t269*t76 - t13*t266 - t267*t66
-    t276 = q7 + t15*t266 + t264*t41 + t265*t27
+    t274 = q5 + t11*t266 + t23*t265 + t36*t264 + t267*t65 + t268*t79 + t269*t75
+    t275 = q6 + t25*t265 + t39*t264 + t268*t80 + t269*t76 - t13*t266 - t267*t66
+    t276 = q7 + t15*t266 + t27*t265 + t41*t264
     q_start = _stack(xp, [
         xp.broadcast_to(q1, batch),  # 0
         xp.broadcast_to(q2, batch),  # 1
@@ -2888,13 +2888,13 @@ def ik_branches(T, q_free):
     t10 = t7 + 1.18*T12
     t11 = t8 + 1.18*T22
     t12 = -0.36 + t11
-    t13 = c3*t0 + s3*t1
-    t14 = c3*t2 + s3*t3
-    t15 = c3*t4 + s3*t5
+    t13 = t0*c3 + t1*s3
+    t14 = t2*c3 + t3*s3
+    t15 = t4*c3 + t5*s3
     t16 = T00 + T01 + T02 + T03 + T10 + T11 + T12 + T13 + T20 + T21 + T22 + T23
     t17 = t12**2
-    t18 = t17 + t10**2 + t9**2
-    t19 = 0.1682 - 0.5*t18
+    t18 = t17 + t9**2 + t10**2
+    t19 = 0.5*(0.3364 - t18)
     t20 = t19**2
     t21 = 1 - 35.430839002267575*t20
     t22 = 5.9523809523809526*t19
@@ -2904,10 +2904,10 @@ def ik_branches(T, q_free):
     t26 = xp.atan2(t25, t24)
     t27 = 3.141592653589793 + t26
     t28 = 3.141592653589793 - t26
-    t29 = t27 - 6.283185307179586*xp.ceil(-0.5 + 0.15915494309189535*t27)
-    t30 = t29 - 6.283185307179586*xp.floor(0.3333333333333333 + 0.15915494309189535*t29)
-    t31 = t28 - 6.283185307179586*xp.ceil(-0.5 + 0.15915494309189535*t28)
-    t32 = t31 - 6.283185307179586*xp.floor(0.3333333333333333 + 0.15915494309189535*t31)
+    t29 = t27 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t27))
+    t30 = t29 - 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t29))
+    t31 = t28 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t28))
+    t32 = t31 - 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t31))
     t33 = 1.0*t24
     t34 = -t33
     t35 = 0.78 + 0.4*t34
@@ -2917,9 +2917,9 @@ def ik_branches(T, q_free):
     t39 = c3**2
     t40 = 0.16*t38**2
     t41 = s3**2
-    t42 = t39 + t41
+    t42 = t41 + t39
     t43 = t40*t41
-    t44 = t43 + t36**2 + t39*t40
+    t44 = t43 + t36**2 + t40*t39
     t45 = t17 + t43
     t46 = t45 - t44
     t47 = -t46
@@ -2927,17 +2927,17 @@ def ik_branches(T, q_free):
     t49 = -t48
     t50 = xp.where(xp.less(t46, t49), xp.sqrt(t47), 0)
     t51 = t45 + t50**2
-    t52 = t50*t9
+    t52 = t9*t50
     t53 = 0.4*t38
-    t54 = s3*t10
+    t54 = t10*s3
     t55 = t53*t54
     t56 = t17 + t52 - t55
     t57 = -t17
     t58 = t52 + t55 + t57
-    t59 = t17 + t58
+    t59 = t58 + t17
     t60 = t56 + t57
     t61 = t10*t50
-    t62 = s3*t9
+    t62 = t9*s3
     t63 = t53*t62
     t64 = t63 - t61
     t65 = t59**2 + t64**2
@@ -2951,11 +2951,11 @@ def ik_branches(T, q_free):
     t73 = xp.where(t70, 0, t64*t71)
     t74 = T02*t72 + T12*t73
     t75 = T12*t72 - T02*t73
-    t76 = t13*t72 + t14*t73
-    t77 = t14*t72 - t13*t73
+    t76 = t72*t13 + t73*t14
+    t77 = t72*t14 - t73*t13
     t78 = xp.where(t70, 0, xp.atan2(t64, -t59))
-    t79 = t78 - 6.283185307179586*xp.floor(0.4722222222222222 + 0.15915494309189535*t78)
-    t80 = c3*t53
+    t79 = t78 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t78))
+    t80 = t53*c3
     t81 = t50*t80
     t82 = t43 + t12*t36
     t83 = t81 + t82
@@ -2975,67 +2975,67 @@ def ik_branches(T, q_free):
     t97 = xp.where(t95, 1, t86*t96)
     t98 = xp.where(t95, 0, t90*t96)
     t99 = xp.where(t95, 0, xp.atan2(t90, t86))
-    t100 = t99 - 6.283185307179586*xp.floor(0.3333333333333333 + 0.15915494309189535*t99)
+    t100 = t99 - 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t99))
     t101 = xp.less_equal(t67, t69)
     t102 = xp.where(t101, 1, 1/xp.sqrt(t67))
-    t103 = xp.where(t101, 1, t102*t60)
-    t104 = xp.where(t101, 0, t102*t66)
+    t103 = xp.where(t101, 1, t60*t102)
+    t104 = xp.where(t101, 0, t66*t102)
     t105 = T02*t103 + T12*t104
     t106 = T12*t103 - T02*t104
     t107 = t103*t13 + t104*t14
     t108 = t103*t14 - t104*t13
     t109 = xp.where(t101, 0, xp.atan2(t66, t60))
-    t110 = t109 - 6.283185307179586*xp.floor(0.4722222222222222 + 0.15915494309189535*t109)
+    t110 = t109 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t109))
     t111 = xp.less_equal(t93, t94)
     t112 = xp.where(t111, 1, 1/xp.sqrt(t93))
-    t113 = xp.where(t111, 1, t112*t87)
-    t114 = xp.where(t111, 0, t112*t92)
+    t113 = xp.where(t111, 1, t87*t112)
+    t114 = xp.where(t111, 0, t92*t112)
     t115 = xp.where(t111, 0, xp.atan2(t92, t87))
-    t116 = t115 - 6.283185307179586*xp.floor(0.3333333333333333 + 0.15915494309189535*t115)
+    t116 = t115 - 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t115))
     t117 = 1 - t72
     t118 = T22*t117
     t119 = t118 + T22*t72
-    t120 = t117*t15
-    t121 = t120 + t15*t72
-    t122 = t74*t97 - t119*t98
-    t123 = t119*t97 + t74*t98
-    t124 = t76*t97 - t121*t98
-    t125 = t121*t97 + t76*t98
+    t120 = t15*t117
+    t121 = t120 + t72*t15
+    t122 = t97*t74 - t98*t119
+    t123 = t97*t119 + t98*t74
+    t124 = t97*t76 - t98*t121
+    t125 = t97*t121 + t98*t76
     t126 = 1 - t97
-    t127 = t126*t75
-    t128 = t127 + t75*t97
-    t129 = t126*t77
-    t130 = t129 + t77*t97
-    t131 = c3*t122 + s3*t128
-    t132 = s3*t122 - c3*t128
-    t133 = t123*t34 - t131*t38
-    t134 = c3*t124 + s3*t130
-    t135 = s3*t124 - c3*t130
-    t136 = t125*t34 - t134*t38
+    t127 = t75*t126
+    t128 = t127 + t97*t75
+    t129 = t77*t126
+    t130 = t129 + t97*t77
+    t131 = t122*c3 + t128*s3
+    t132 = t122*s3 - t128*c3
+    t133 = t34*t123 - t38*t131
+    t134 = t124*c3 + t130*s3
+    t135 = t124*s3 - t130*c3
+    t136 = t34*t125 - t38*t134
     t137 = 1 - t34
     t138 = t132*t137
     t139 = t135*t137
-    t140 = t123*t38
-    t141 = c3*t140 + s3*t138 + t122*t34
-    t142 = s3*t140 + t128*t34 - c3*t138
-    t143 = t125*t38
-    t144 = c3*t143 + s3*t139 + t124*t34
-    t145 = s3*t143 + t130*t34 - c3*t139
+    t140 = t38*t123
+    t141 = t34*t122 + t138*s3 + t140*c3
+    t142 = t34*t128 + t140*s3 - t138*c3
+    t143 = t38*t125
+    t144 = t34*t124 + t139*s3 + t143*c3
+    t145 = t34*t130 + t143*s3 - t139*c3
     t146 = t133**2
     t147 = t146 + t141**2 + t142**2
     t148 = -t146
     t149 = 1 + t148
-    t150 = xp.where(xp.greater(t149, 1e-12), xp.sqrt(t149), 0)
-    t151 = t150*t39 + t150*t41
+    t150 = xp.where(xp.less(1e-12, t149), xp.sqrt(t149), 0)
+    t151 = t150*t41 + t150*t39
     t152 = t146 + t151**2
     t153 = t141*t150
     t154 = t142*t150
-    t155 = t148 + c3*t153 + s3*t154
-    t156 = t146 + t155
-    t157 = s3*t153 - c3*t154
+    t155 = t148 + t153*c3 + t154*s3
+    t156 = t155 + t146
+    t157 = t153*s3 - t154*c3
     t158 = t156**2 + t157**2
     t159 = t150**2
-    t160 = t146 + t159*t39 + t159*t41
+    t160 = t146 + t41*t159 + t159*t39
     t161 = 1e-24*t160
     t162 = xp.less_equal(t158, t147*t161)
     t163 = xp.where(t162, 1, 1/xp.sqrt(t158))
@@ -3045,64 +3045,64 @@ def ik_branches(T, q_free):
     t167 = t144*t164 + t145*t165
     t168 = t145*t164 - t144*t165
     t169 = t166 + t136*t164
-    t170 = c3*t167 + s3*t168
-    t171 = c3*t168 - s3*t167
+    t170 = t167*c3 + t168*s3
+    t171 = t168*c3 - t167*s3
     t172 = xp.less_equal(t152, t161)
     t173 = xp.where(t172, 1, 1/xp.sqrt(t152))
     t174 = xp.where(t172, 1, t133*t173)
     t175 = xp.where(t172, 0, -t151*t173)
     t176 = t171*(1 - t174)
-    t177 = t169*t174 + t170*t175
-    t178 = t169*t175
-    t179 = c3*t178 + s3*t176 - t167*t174
-    t180 = c3*t176 + t168*t174 - s3*t178
-    t181 = s3*t180 - c3*t179
-    t182 = c3*t180 + s3*t179
+    t177 = t174*t169 + t175*t170
+    t178 = t175*t169
+    t179 = t176*s3 + t178*c3 - t174*t167
+    t180 = t174*t168 + t176*c3 - t178*s3
+    t181 = t180*s3 - t179*c3
+    t182 = t179*s3 + t180*c3
     t183 = t181**2 + t182**2
-    t184 = t177**2 + t179**2 + t180**2
+    t184 = t179**2 + t180**2 + t177**2
     t185 = 1 - t103
     t186 = T22*t185
     t187 = t186 + T22*t103
     t188 = t15*t185
     t189 = t188 + t103*t15
-    t190 = t105*t113 - t114*t187
-    t191 = t105*t114 + t113*t187
-    t192 = t107*t113 - t114*t189
-    t193 = t107*t114 + t113*t189
+    t190 = t113*t105 - t114*t187
+    t191 = t113*t187 + t114*t105
+    t192 = t113*t107 - t114*t189
+    t193 = t113*t189 + t114*t107
     t194 = 1 - t113
     t195 = t106*t194
-    t196 = t195 + t106*t113
+    t196 = t195 + t113*t106
     t197 = t108*t194
-    t198 = t197 + t108*t113
-    t199 = c3*t190 + s3*t196
-    t200 = s3*t190 - c3*t196
-    t201 = t137*t200
-    t202 = t191*t34 - t199*t38
-    t203 = c3*t192 + s3*t198
-    t204 = s3*t192 - c3*t198
-    t205 = t137*t204
-    t206 = t193*t34 - t203*t38
-    t207 = t191*t38
-    t208 = c3*t207 + s3*t201 + t190*t34
-    t209 = s3*t207 + t196*t34 - c3*t201
-    t210 = t193*t38
-    t211 = c3*t210 + s3*t205 + t192*t34
-    t212 = s3*t210 + t198*t34 - c3*t205
+    t198 = t197 + t113*t108
+    t199 = t190*c3 + t196*s3
+    t200 = t190*s3 - t196*c3
+    t201 = t200*t137
+    t202 = t34*t191 - t38*t199
+    t203 = t192*c3 + t198*s3
+    t204 = t192*s3 - t198*c3
+    t205 = t204*t137
+    t206 = t34*t193 - t38*t203
+    t207 = t38*t191
+    t208 = t34*t190 + t201*s3 + t207*c3
+    t209 = t34*t196 + t207*s3 - t201*c3
+    t210 = t38*t193
+    t211 = t34*t192 + t205*s3 + t210*c3
+    t212 = t34*t198 + t210*s3 - t205*c3
     t213 = t202**2
     t214 = t213 + t208**2 + t209**2
     t215 = -t213
     t216 = 1 + t215
-    t217 = xp.where(xp.greater(t216, 1e-12), xp.sqrt(t216), 0)
-    t218 = t217*t39 + t217*t41
+    t217 = xp.where(xp.less(1e-12, t216), xp.sqrt(t216), 0)
+    t218 = t217*t41 + t217*t39
     t219 = t213 + t218**2
     t220 = t208*t217
     t221 = t209*t217
-    t222 = t215 + c3*t220 + s3*t221
-    t223 = t213 + t222
-    t224 = s3*t220 - c3*t221
+    t222 = t215 + t220*c3 + t221*s3
+    t223 = t222 + t213
+    t224 = t220*s3 - t221*c3
     t225 = t223**2 + t224**2
     t226 = t217**2
-    t227 = t213 + t226*t39 + t226*t41
+    t227 = t213 + t41*t226 + t226*t39
     t228 = 1e-24*t227
     t229 = xp.less_equal(t225, t214*t228)
     t230 = xp.where(t229, 1, 1/xp.sqrt(t225))
@@ -3112,25 +3112,25 @@ def ik_branches(T, q_free):
     t234 = t211*t231 + t212*t232
     t235 = t212*t231 - t211*t232
     t236 = t233 + t206*t231
-    t237 = c3*t234 + s3*t235
-    t238 = c3*t235 - s3*t234
+    t237 = t234*c3 + t235*s3
+    t238 = t235*c3 - t234*s3
     t239 = xp.less_equal(t219, t228)
     t240 = xp.where(t239, 1, 1/xp.sqrt(t219))
     t241 = xp.where(t239, 1, t202*t240)
     t242 = xp.where(t239, 0, -t218*t240)
     t243 = t238*(1 - t241)
-    t244 = t236*t241 + t237*t242
-    t245 = t236*t242
-    t246 = c3*t245 + s3*t243 - t234*t241
-    t247 = c3*t243 + t235*t241 - s3*t245
-    t248 = s3*t247 - c3*t246
-    t249 = c3*t247 + s3*t246
+    t244 = t241*t236 + t242*t237
+    t245 = t242*t236
+    t246 = t243*s3 + t245*c3 - t241*t234
+    t247 = t241*t235 + t243*c3 - t245*s3
+    t248 = t247*s3 - t246*c3
+    t249 = t246*s3 + t247*c3
     t250 = t248**2 + t249**2
-    t251 = t244**2 + t246**2 + t247**2
+    t251 = t246**2 + t247**2 + t244**2
     t252 = 0.78 - 0.4*t24
     t253 = -0.36 + t252
     t254 = 0.16*t25**2
-    t255 = t254*t41
+    t255 = t41*t254
     t256 = t255 + t253**2 + t254*t39
     t257 = t17 + t255
     t258 = t257 - t256
@@ -3139,15 +3139,15 @@ def ik_branches(T, q_free):
     t261 = -t260
     t262 = xp.where(xp.less(t258, t261), xp.sqrt(t259), 0)
     t263 = t257 + t262**2
-    t264 = t262*t9
+    t264 = t9*t262
     t265 = 0.4*t25
-    t266 = t265*t54
-    t267 = t264 + t266 + t57
-    t268 = t17 + t267
+    t266 = t54*t265
+    t267 = t57 + t264 + t266
+    t268 = t267 + t17
     t269 = t17 + t264 - t266
     t270 = t269 + t57
     t271 = t10*t262
-    t272 = t265*t62
+    t272 = t62*t265
     t273 = t272 - t271
     t274 = t268**2 + t273**2
     t275 = t271 + t272
@@ -3163,8 +3163,8 @@ def ik_branches(T, q_free):
     t285 = t13*t281 + t14*t282
     t286 = t14*t281 - t13*t282
     t287 = xp.where(t279, 0, xp.atan2(t273, -t268))
-    t288 = t287 - 6.283185307179586*xp.floor(0.4722222222222222 + 0.15915494309189535*t287)
-    t289 = c3*t265
+    t288 = t287 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t287))
+    t289 = t265*c3
     t290 = t262*t289
     t291 = t255 + t12*t253
     t292 = t290 + t291
@@ -3184,7 +3184,7 @@ def ik_branches(T, q_free):
     t306 = xp.where(t304, 1, t295*t305)
     t307 = xp.where(t304, 0, t299*t305)
     t308 = xp.where(t304, 0, xp.atan2(t299, t295))
-    t309 = t308 - 6.283185307179586*xp.floor(0.3333333333333333 + 0.15915494309189535*t308)
+    t309 = t308 - 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t308))
     t310 = xp.less_equal(t276, t278)
     t311 = xp.where(t310, 1, 1/xp.sqrt(t276))
     t312 = xp.where(t310, 1, t270*t311)
@@ -3194,57 +3194,57 @@ def ik_branches(T, q_free):
     t316 = t13*t312 + t14*t313
     t317 = t14*t312 - t13*t313
     t318 = xp.where(t310, 0, xp.atan2(t275, t270))
-    t319 = t318 - 6.283185307179586*xp.floor(0.4722222222222222 + 0.15915494309189535*t318)
+    t319 = t318 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t318))
     t320 = xp.less_equal(t302, t303)
     t321 = xp.where(t320, 1, 1/xp.sqrt(t302))
     t322 = xp.where(t320, 1, t296*t321)
     t323 = xp.where(t320, 0, t301*t321)
     t324 = xp.where(t320, 0, xp.atan2(t301, t296))
-    t325 = t324 - 6.283185307179586*xp.floor(0.3333333333333333 + 0.15915494309189535*t324)
+    t325 = t324 - 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t324))
     t326 = 1 - t281
     t327 = T22*t326
     t328 = t327 + T22*t281
     t329 = t15*t326
     t330 = t329 + t15*t281
-    t331 = t283*t306 - t307*t328
-    t332 = t283*t307 + t306*t328
-    t333 = t285*t306 - t307*t330
-    t334 = t285*t307 + t306*t330
+    t331 = t306*t283 - t307*t328
+    t332 = t306*t328 + t307*t283
+    t333 = t306*t285 - t307*t330
+    t334 = t306*t330 + t307*t285
     t335 = 1 - t306
     t336 = t284*t335
-    t337 = t336 + t284*t306
+    t337 = t336 + t306*t284
     t338 = t286*t335
-    t339 = t338 + t286*t306
-    t340 = c3*t331 + s3*t337
-    t341 = s3*t331 - c3*t337
-    t342 = t33*t332 + t340*t37
-    t343 = c3*t333 + s3*t339
-    t344 = s3*t333 - c3*t339
-    t345 = t33*t334 + t343*t37
+    t339 = t338 + t306*t286
+    t340 = t331*c3 + t337*s3
+    t341 = t331*s3 - t337*c3
+    t342 = t332*t33 + t340*t37
+    t343 = t333*c3 + t339*s3
+    t344 = t333*s3 - t339*c3
+    t345 = t334*t33 + t343*t37
     t346 = 1 + t33
     t347 = t341*t346
     t348 = t344*t346
     t349 = t332*t37
-    t350 = c3*t349 + s3*t347 - t33*t331
-    t351 = c3*t347 + t33*t337 - s3*t349
+    t350 = t347*s3 + t349*c3 - t331*t33
+    t351 = t337*t33 + t347*c3 - t349*s3
     t352 = t334*t37
-    t353 = c3*t352 + s3*t348 - t33*t333
-    t354 = c3*t348 + t33*t339 - s3*t352
+    t353 = t348*s3 + t352*c3 - t333*t33
+    t354 = t339*t33 + t348*c3 - t352*s3
     t355 = t342**2
     t356 = t355 + t350**2 + t351**2
     t357 = -t355
     t358 = 1 + t357
-    t359 = xp.where(xp.greater(t358, 1e-12), xp.sqrt(t358), 0)
-    t360 = t359*t39 + t359*t41
+    t359 = xp.where(xp.less(1e-12, t358), xp.sqrt(t358), 0)
+    t360 = t359*t41 + t359*t39
     t361 = t355 + t360**2
-    t362 = s3*t359
-    t363 = c3*t359
+    t362 = t359*s3
+    t363 = t359*c3
     t364 = t355 + t351*t362 - t350*t363
-    t365 = t357 + t364
+    t365 = t364 + t357
     t366 = t350*t362 + t351*t363
     t367 = t365**2 + t366**2
     t368 = t359**2
-    t369 = t355 + t368*t39 + t368*t41
+    t369 = t355 + t41*t368 + t39*t368
     t370 = 1e-24*t369
     t371 = xp.less_equal(t367, t356*t370)
     t372 = xp.where(t371, 1, 1/xp.sqrt(t367))
@@ -3254,64 +3254,64 @@ def ik_branches(T, q_free):
     t376 = t353*t373 - t354*t374
     t377 = t353*t374 + t354*t373
     t378 = t375 + t345*t373
-    t379 = s3*t377 - c3*t376
-    t380 = c3*t377 + s3*t376
+    t379 = t377*s3 - t376*c3
+    t380 = t376*s3 + t377*c3
     t381 = xp.less_equal(t361, t370)
     t382 = xp.where(t381, 1, 1/xp.sqrt(t361))
     t383 = xp.where(t381, 1, -t342*t382)
     t384 = xp.where(t381, 0, -t360*t382)
     t385 = t380*(1 - t383)
-    t386 = t378*t383 + t379*t384
-    t387 = t378*t384
-    t388 = c3*t387 + s3*t385 + t376*t383
-    t389 = c3*t385 + t377*t383 - s3*t387
-    t390 = c3*t388 - s3*t389
-    t391 = c3*t389 + s3*t388
+    t386 = t383*t378 + t384*t379
+    t387 = t384*t378
+    t388 = t383*t376 + t385*s3 + t387*c3
+    t389 = t383*t377 + t385*c3 - t387*s3
+    t390 = t388*c3 - t389*s3
+    t391 = t388*s3 + t389*c3
     t392 = t390**2 + t391**2
-    t393 = t386**2 + t388**2 + t389**2
+    t393 = t388**2 + t389**2 + t386**2
     t394 = 1 - t312
     t395 = T22*t394
     t396 = t395 + T22*t312
     t397 = t15*t394
     t398 = t397 + t15*t312
-    t399 = t314*t322 - t323*t396
-    t400 = t314*t323 + t322*t396
-    t401 = t316*t322 - t323*t398
-    t402 = t316*t323 + t322*t398
+    t399 = t322*t314 - t323*t396
+    t400 = t322*t396 + t323*t314
+    t401 = t322*t316 - t323*t398
+    t402 = t322*t398 + t323*t316
     t403 = 1 - t322
     t404 = t315*t403
-    t405 = t404 + t315*t322
+    t405 = t404 + t322*t315
     t406 = t317*t403
-    t407 = t406 + t317*t322
-    t408 = c3*t399 + s3*t405
-    t409 = s3*t399 - c3*t405
-    t410 = t346*t409
-    t411 = t33*t400 + t37*t408
-    t412 = c3*t401 + s3*t407
-    t413 = s3*t401 - c3*t407
-    t414 = t346*t413
-    t415 = t33*t402 + t37*t412
-    t416 = t37*t400
-    t417 = c3*t416 + s3*t410 - t33*t399
-    t418 = c3*t410 + t33*t405 - s3*t416
-    t419 = t37*t402
-    t420 = c3*t419 + s3*t414 - t33*t401
-    t421 = c3*t414 + t33*t407 - s3*t419
+    t407 = t406 + t322*t317
+    t408 = t399*c3 + t405*s3
+    t409 = t399*s3 - t405*c3
+    t410 = t409*t346
+    t411 = t400*t33 + t408*t37
+    t412 = t401*c3 + t407*s3
+    t413 = t401*s3 - t407*c3
+    t414 = t413*t346
+    t415 = t402*t33 + t412*t37
+    t416 = t400*t37
+    t417 = t410*s3 + t416*c3 - t399*t33
+    t418 = t405*t33 + t410*c3 - t416*s3
+    t419 = t402*t37
+    t420 = t414*s3 + t419*c3 - t401*t33
+    t421 = t407*t33 + t414*c3 - t419*s3
     t422 = t411**2
     t423 = t422 + t417**2 + t418**2
     t424 = -t422
     t425 = 1 + t424
-    t426 = xp.where(xp.greater(t425, 1e-12), xp.sqrt(t425), 0)
-    t427 = t39*t426 + t41*t426
+    t426 = xp.where(xp.less(1e-12, t425), xp.sqrt(t425), 0)
+    t427 = t426*t41 + t426*t39
     t428 = t422 + t427**2
-    t429 = s3*t426
-    t430 = c3*t426
+    t429 = t426*s3
+    t430 = t426*c3
     t431 = t422 + t418*t429 - t417*t430
-    t432 = t424 + t431
+    t432 = t431 + t424
     t433 = t417*t429 + t418*t430
     t434 = t432**2 + t433**2
     t435 = t426**2
-    t436 = t422 + t39*t435 + t41*t435
+    t436 = t422 + t41*t435 + t435*t39
     t437 = 1e-24*t436
     t438 = xp.less_equal(t434, t423*t437)
     t439 = xp.where(t438, 1, 1/xp.sqrt(t434))
@@ -3321,163 +3321,163 @@ def ik_branches(T, q_free):
     t443 = t420*t440 - t421*t441
     t444 = t420*t441 + t421*t440
     t445 = t442 + t415*t440
-    t446 = s3*t444 - c3*t443
-    t447 = c3*t444 + s3*t443
+    t446 = t444*s3 - t443*c3
+    t447 = t443*s3 + t444*c3
     t448 = xp.less_equal(t428, t437)
     t449 = xp.where(t448, 1, 1/xp.sqrt(t428))
     t450 = xp.where(t448, 1, -t411*t449)
     t451 = xp.where(t448, 0, -t427*t449)
     t452 = t447*(1 - t450)
-    t453 = t445*t450 + t446*t451
-    t454 = t445*t451
-    t455 = c3*t454 + s3*t452 + t443*t450
-    t456 = c3*t452 + t444*t450 - s3*t454
-    t457 = c3*t455 - s3*t456
-    t458 = c3*t456 + s3*t455
+    t453 = t450*t445 + t451*t446
+    t454 = t451*t445
+    t455 = t450*t443 + t452*s3 + t454*c3
+    t456 = t450*t444 + t452*c3 - t454*s3
+    t457 = t455*c3 - t456*s3
+    t458 = t455*s3 + t456*c3
     t459 = t457**2 + t458**2
-    t460 = t453**2 + t455**2 + t456**2
+    t460 = t455**2 + t456**2 + t453**2
     t461 = xp.where(t162, 0, xp.atan2(t157, -t156))
     t462 = t461
-    t463 = t462 - 6.283185307179586*xp.floor(0.4722222222222222 + 0.15915494309189535*t462)
+    t463 = t462 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t462))
     t464 = 3.141592653589793 + t461 - 6.283185307179586*xp.ceil(0.15915494309189535*t461)
-    t465 = t464 - 6.283185307179586*xp.floor(0.4722222222222222 + 0.15915494309189535*t464)
+    t465 = t464 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t464))
     t466 = xp.where(t172, 0, xp.atan2(-t151, t133))
     t467 = t466
-    t468 = t467 - 6.283185307179586*xp.floor(0.3333333333333333 + 0.15915494309189535*t467)
-    t469 = t466 + 6.283185307179586*xp.ceil(-0.5 - 0.15915494309189535*t466)
+    t468 = t467 - 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t467))
+    t469 = t466 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t466))
     t470 = 1e-24*t42
     t471 = xp.where(xp.less_equal(t183, t184*t470), 0, xp.atan2(t182, t181))
     t472 = t471
-    t473 = t472 - 6.283185307179586*xp.floor(0.4861111111111111 + 0.15915494309189535*t472)
+    t473 = t472 - 6.283185307179586*xp.floor(0.15915494309189535*(3.0543261909900767 + t472))
     t474 = 3.141592653589793 + t471 - 6.283185307179586*xp.ceil(0.15915494309189535*t471)
-    t475 = t474 - 6.283185307179586*xp.floor(0.4861111111111111 + 0.15915494309189535*t474)
+    t475 = t474 - 6.283185307179586*xp.floor(0.15915494309189535*(3.0543261909900767 + t474))
     t476 = -t469
-    t477 = t469 + 6.283185307179586*xp.floor(0.3333333333333333 + 0.15915494309189535*t476)
+    t477 = t469 + 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t476))
     t478 = xp.where(t229, 0, xp.atan2(t224, -t223))
     t479 = t478
-    t480 = t479 - 6.283185307179586*xp.floor(0.4722222222222222 + 0.15915494309189535*t479)
+    t480 = t479 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t479))
     t481 = 3.141592653589793 + t478 - 6.283185307179586*xp.ceil(0.15915494309189535*t478)
-    t482 = t481 - 6.283185307179586*xp.floor(0.4722222222222222 + 0.15915494309189535*t481)
+    t482 = t481 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t481))
     t483 = xp.where(t239, 0, xp.atan2(-t218, t202))
     t484 = t483
-    t485 = t484 - 6.283185307179586*xp.floor(0.3333333333333333 + 0.15915494309189535*t484)
-    t486 = t483 + 6.283185307179586*xp.ceil(-0.5 - 0.15915494309189535*t483)
+    t485 = t484 - 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t484))
+    t486 = t483 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t483))
     t487 = xp.where(xp.less_equal(t250, t251*t470), 0, xp.atan2(t249, t248))
     t488 = t487
-    t489 = t488 - 6.283185307179586*xp.floor(0.4861111111111111 + 0.15915494309189535*t488)
+    t489 = t488 - 6.283185307179586*xp.floor(0.15915494309189535*(3.0543261909900767 + t488))
     t490 = 3.141592653589793 + t487 - 6.283185307179586*xp.ceil(0.15915494309189535*t487)
-    t491 = t490 - 6.283185307179586*xp.floor(0.4861111111111111 + 0.15915494309189535*t490)
+    t491 = t490 - 6.283185307179586*xp.floor(0.15915494309189535*(3.0543261909900767 + t490))
     t492 = -t486
-    t493 = t486 + 6.283185307179586*xp.floor(0.3333333333333333 + 0.15915494309189535*t492)
+    t493 = t486 + 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t492))
     t494 = xp.where(t371, 0, xp.atan2(t366, t365))
     t495 = t494
-    t496 = t495 - 6.283185307179586*xp.floor(0.4722222222222222 + 0.15915494309189535*t495)
+    t496 = t495 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t495))
     t497 = 3.141592653589793 + t494 - 6.283185307179586*xp.ceil(0.15915494309189535*t494)
-    t498 = t497 - 6.283185307179586*xp.floor(0.4722222222222222 + 0.15915494309189535*t497)
+    t498 = t497 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t497))
     t499 = xp.where(t381, 0, xp.atan2(-t360, -t342))
     t500 = t499
-    t501 = t500 - 6.283185307179586*xp.floor(0.3333333333333333 + 0.15915494309189535*t500)
-    t502 = t499 + 6.283185307179586*xp.ceil(-0.5 - 0.15915494309189535*t499)
+    t501 = t500 - 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t500))
+    t502 = t499 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t499))
     t503 = xp.where(xp.less_equal(t392, t393*t470), 0, xp.atan2(-t391, t390))
     t504 = t503
-    t505 = t504 - 6.283185307179586*xp.floor(0.4861111111111111 + 0.15915494309189535*t504)
+    t505 = t504 - 6.283185307179586*xp.floor(0.15915494309189535*(3.0543261909900767 + t504))
     t506 = 3.141592653589793 + t503 - 6.283185307179586*xp.ceil(0.15915494309189535*t503)
-    t507 = t506 - 6.283185307179586*xp.floor(0.4861111111111111 + 0.15915494309189535*t506)
+    t507 = t506 - 6.283185307179586*xp.floor(0.15915494309189535*(3.0543261909900767 + t506))
     t508 = -t502
-    t509 = t502 + 6.283185307179586*xp.floor(0.3333333333333333 + 0.15915494309189535*t508)
+    t509 = t502 + 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t508))
     t510 = xp.where(t438, 0, xp.atan2(t433, t432))
     t511 = t510
-    t512 = t511 - 6.283185307179586*xp.floor(0.4722222222222222 + 0.15915494309189535*t511)
+    t512 = t511 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t511))
     t513 = 3.141592653589793 + t510 - 6.283185307179586*xp.ceil(0.15915494309189535*t510)
-    t514 = t513 - 6.283185307179586*xp.floor(0.4722222222222222 + 0.15915494309189535*t513)
+    t514 = t513 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t513))
     t515 = xp.where(t448, 0, xp.atan2(-t427, -t411))
     t516 = t515
-    t517 = t516 - 6.283185307179586*xp.floor(0.3333333333333333 + 0.15915494309189535*t516)
-    t518 = t515 + 6.283185307179586*xp.ceil(-0.5 - 0.15915494309189535*t515)
+    t517 = t516 - 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t516))
+    t518 = t515 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t515))
     t519 = xp.where(xp.less_equal(t459, t460*t470), 0, xp.atan2(-t458, t457))
     t520 = t519
-    t521 = t520 - 6.283185307179586*xp.floor(0.4861111111111111 + 0.15915494309189535*t520)
+    t521 = t520 - 6.283185307179586*xp.floor(0.15915494309189535*(3.0543261909900767 + t520))
     t522 = 3.141592653589793 + t519 - 6.283185307179586*xp.ceil(0.15915494309189535*t519)
-    t523 = t522 - 6.283185307179586*xp.floor(0.4861111111111111 + 0.15915494309189535*t522)
+    t523 = t522 - 6.283185307179586*xp.floor(0.15915494309189535*(3.0543261909900767 + t522))
     t524 = -t518
-    t525 = t518 + 6.283185307179586*xp.floor(0.3333333333333333 + 0.15915494309189535*t524)
+    t525 = t518 + 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t524))
     t526 = xp.less_equal(t79, 2.9670597283903604)
-    t527 = (xp.greater_equal(t78, -2.9670597283903604)) & (xp.less_equal(t78, 2.9670597283903604))
+    t527 = xp.greater_equal(t78, -2.9670597283903604) & xp.less_equal(t78, 2.9670597283903604)
     t528 = xp.where(t526 & xp.logical_not(t527), t79, t78)
     t529 = xp.less_equal(t100, 2.0943951023931953)
-    t530 = (xp.greater_equal(t99, -2.0943951023931953)) & (xp.less_equal(t99, 2.0943951023931953))
+    t530 = xp.greater_equal(t99, -2.0943951023931953) & xp.less_equal(t99, 2.0943951023931953)
     t531 = xp.where(t529 & xp.logical_not(t530), t100, t99)
     t532 = xp.less_equal(t30, 2.0943951023931953)
-    t533 = (xp.greater_equal(t29, -2.0943951023931953)) & (xp.less_equal(t29, 2.0943951023931953))
+    t533 = xp.greater_equal(t29, -2.0943951023931953) & xp.less_equal(t29, 2.0943951023931953)
     t534 = xp.where(t532 & xp.logical_not(t533), t30, t29)
     t535 = xp.less_equal(t463, 2.9670597283903604)
-    t536 = (xp.greater_equal(t462, -2.9670597283903604)) & (xp.less_equal(t462, 2.9670597283903604))
+    t536 = xp.greater_equal(t462, -2.9670597283903604) & xp.less_equal(t462, 2.9670597283903604)
     t537 = xp.less_equal(t468, 2.0943951023931953)
-    t538 = (xp.greater_equal(t467, -2.0943951023931953)) & (xp.less_equal(t467, 2.0943951023931953))
+    t538 = xp.greater_equal(t467, -2.0943951023931953) & xp.less_equal(t467, 2.0943951023931953)
     t539 = xp.less_equal(t473, 3.0543261909900767)
-    t540 = (xp.greater_equal(t472, -3.0543261909900767)) & (xp.less_equal(t472, 3.0543261909900767))
+    t540 = xp.greater_equal(t472, -3.0543261909900767) & xp.less_equal(t472, 3.0543261909900767)
     t541 = xp.less_equal(t465, 2.9670597283903604)
-    t542 = (xp.greater_equal(t464, -2.9670597283903604)) & (xp.less_equal(t464, 2.9670597283903604))
+    t542 = xp.greater_equal(t464, -2.9670597283903604) & xp.less_equal(t464, 2.9670597283903604)
     t543 = -t477
     t544 = xp.less_equal(t475, 3.0543261909900767)
-    t545 = (xp.greater_equal(t474, -3.0543261909900767)) & (xp.less_equal(t474, 3.0543261909900767))
+    t545 = xp.greater_equal(t474, -3.0543261909900767) & xp.less_equal(t474, 3.0543261909900767)
     t546 = xp.less_equal(t110, 2.9670597283903604)
-    t547 = (xp.greater_equal(t109, -2.9670597283903604)) & (xp.less_equal(t109, 2.9670597283903604))
+    t547 = xp.greater_equal(t109, -2.9670597283903604) & xp.less_equal(t109, 2.9670597283903604)
     t548 = xp.where(t546 & xp.logical_not(t547), t110, t109)
     t549 = xp.less_equal(t116, 2.0943951023931953)
-    t550 = (xp.greater_equal(t115, -2.0943951023931953)) & (xp.less_equal(t115, 2.0943951023931953))
+    t550 = xp.greater_equal(t115, -2.0943951023931953) & xp.less_equal(t115, 2.0943951023931953)
     t551 = xp.where(t549 & xp.logical_not(t550), t116, t115)
     t552 = xp.less_equal(t480, 2.9670597283903604)
-    t553 = (xp.greater_equal(t479, -2.9670597283903604)) & (xp.less_equal(t479, 2.9670597283903604))
+    t553 = xp.greater_equal(t479, -2.9670597283903604) & xp.less_equal(t479, 2.9670597283903604)
     t554 = xp.less_equal(t485, 2.0943951023931953)
-    t555 = (xp.greater_equal(t484, -2.0943951023931953)) & (xp.less_equal(t484, 2.0943951023931953))
+    t555 = xp.greater_equal(t484, -2.0943951023931953) & xp.less_equal(t484, 2.0943951023931953)
     t556 = xp.less_equal(t489, 3.0543261909900767)
-    t557 = (xp.greater_equal(t488, -3.0543261909900767)) & (xp.less_equal(t488, 3.0543261909900767))
+    t557 = xp.greater_equal(t488, -3.0543261909900767) & xp.less_equal(t488, 3.0543261909900767)
     t558 = xp.less_equal(t482, 2.9670597283903604)
-    t559 = (xp.greater_equal(t481, -2.9670597283903604)) & (xp.less_equal(t481, 2.9670597283903604))
+    t559 = xp.greater_equal(t481, -2.9670597283903604) & xp.less_equal(t481, 2.9670597283903604)
     t560 = -t493
     t561 = xp.less_equal(t491, 3.0543261909900767)
-    t562 = (xp.greater_equal(t490, -3.0543261909900767)) & (xp.less_equal(t490, 3.0543261909900767))
+    t562 = xp.greater_equal(t490, -3.0543261909900767) & xp.less_equal(t490, 3.0543261909900767)
     t563 = xp.less_equal(t288, 2.9670597283903604)
-    t564 = (xp.greater_equal(t287, -2.9670597283903604)) & (xp.less_equal(t287, 2.9670597283903604))
+    t564 = xp.greater_equal(t287, -2.9670597283903604) & xp.less_equal(t287, 2.9670597283903604)
     t565 = xp.where(t563 & xp.logical_not(t564), t288, t287)
     t566 = xp.less_equal(t309, 2.0943951023931953)
-    t567 = (xp.greater_equal(t308, -2.0943951023931953)) & (xp.less_equal(t308, 2.0943951023931953))
+    t567 = xp.greater_equal(t308, -2.0943951023931953) & xp.less_equal(t308, 2.0943951023931953)
     t568 = xp.where(t566 & xp.logical_not(t567), t309, t308)
     t569 = xp.less_equal(t32, 2.0943951023931953)
-    t570 = (xp.greater_equal(t31, -2.0943951023931953)) & (xp.less_equal(t31, 2.0943951023931953))
+    t570 = xp.greater_equal(t31, -2.0943951023931953) & xp.less_equal(t31, 2.0943951023931953)
     t571 = xp.where(t569 & xp.logical_not(t570), t32, t31)
     t572 = xp.less_equal(t496, 2.9670597283903604)
-    t573 = (xp.greater_equal(t495, -2.9670597283903604)) & (xp.less_equal(t495, 2.9670597283903604))
+    t573 = xp.greater_equal(t495, -2.9670597283903604) & xp.less_equal(t495, 2.9670597283903604)
     t574 = xp.less_equal(t501, 2.0943951023931953)
-    t575 = (xp.greater_equal(t500, -2.0943951023931953)) & (xp.less_equal(t500, 2.0943951023931953))
+    t575 = xp.greater_equal(t500, -2.0943951023931953) & xp.less_equal(t500, 2.0943951023931953)
     t576 = xp.less_equal(t505, 3.0543261909900767)
-    t577 = (xp.greater_equal(t504, -3.0543261909900767)) & (xp.less_equal(t504, 3.0543261909900767))
+    t577 = xp.greater_equal(t504, -3.0543261909900767) & xp.less_equal(t504, 3.0543261909900767)
     t578 = xp.less_equal(t498, 2.9670597283903604)
-    t579 = (xp.greater_equal(t497, -2.9670597283903604)) & (xp.less_equal(t497, 2.9670597283903604))
+    t579 = xp.greater_equal(t497, -2.9670597283903604) & xp.less_equal(t497, 2.9670597283903604)
     t580 = -t509
     t581 = xp.less_equal(t507, 3.0543261909900767)
-    t582 = (xp.greater_equal(t506, -3.0543261909900767)) & (xp.less_equal(t506, 3.0543261909900767))
+    t582 = xp.greater_equal(t506, -3.0543261909900767) & xp.less_equal(t506, 3.0543261909900767)
     t583 = xp.less_equal(t319, 2.9670597283903604)
-    t584 = (xp.greater_equal(t318, -2.9670597283903604)) & (xp.less_equal(t318, 2.9670597283903604))
+    t584 = xp.greater_equal(t318, -2.9670597283903604) & xp.less_equal(t318, 2.9670597283903604)
     t585 = xp.where(t583 & xp.logical_not(t584), t319, t318)
     t586 = xp.less_equal(t325, 2.0943951023931953)
-    t587 = (xp.greater_equal(t324, -2.0943951023931953)) & (xp.less_equal(t324, 2.0943951023931953))
+    t587 = xp.greater_equal(t324, -2.0943951023931953) & xp.less_equal(t324, 2.0943951023931953)
     t588 = xp.where(t586 & xp.logical_not(t587), t325, t324)
     t589 = xp.less_equal(t512, 2.9670597283903604)
-    t590 = (xp.greater_equal(t511, -2.9670597283903604)) & (xp.less_equal(t511, 2.9670597283903604))
+    t590 = xp.greater_equal(t511, -2.9670597283903604) & xp.less_equal(t511, 2.9670597283903604)
     t591 = xp.less_equal(t517, 2.0943951023931953)
-    t592 = (xp.greater_equal(t516, -2.0943951023931953)) & (xp.less_equal(t516, 2.0943951023931953))
+    t592 = xp.greater_equal(t516, -2.0943951023931953) & xp.less_equal(t516, 2.0943951023931953)
     t593 = xp.less_equal(t521, 3.0543261909900767)
-    t594 = (xp.greater_equal(t520, -3.0543261909900767)) & (xp.less_equal(t520, 3.0543261909900767))
+    t594 = xp.greater_equal(t520, -3.0543261909900767) & xp.less_equal(t520, 3.0543261909900767)
     t595 = xp.less_equal(t514, 2.9670597283903604)
-    t596 = (xp.greater_equal(t513, -2.9670597283903604)) & (xp.less_equal(t513, 2.9670597283903604))
+    t596 = xp.greater_equal(t513, -2.9670597283903604) & xp.less_equal(t513, 2.9670597283903604)
     t597 = -t525
     t598 = xp.less_equal(t523, 3.0543261909900767)
-    t599 = (xp.greater_equal(t522, -3.0543261909900767)) & (xp.less_equal(t522, 3.0543261909900767))
+    t599 = xp.greater_equal(t522, -3.0543261909900767) & xp.less_equal(t522, 3.0543261909900767)
     t600 = xp.isfinite(t16)
     t601 = xp.greater_equal(t47, t49)
-    t602 = xp.greater_equal(t21, -1e-12)
+    t602 = xp.greater_equal(t21, -1e-12) | (False & xp.less_equal(t20, 2.8223999999999998e-14))
     t603 = xp.greater(t47, t48)
     t604 = xp.greater(t21, 1e-12)
     t605 = xp.greater_equal(t259, t261)
@@ -3507,7 +3507,7 @@ def ik_branches(T, q_free):
         q3,  # 1, 2
         t534,  # 1, 3
         xp.where(t541 & xp.logical_not(t542), t465, t464),  # 1, 4
-        xp.where((xp.greater_equal(t477, -2.0943951023931953)) & xp.logical_not((xp.greater_equal(t469, -2.0943951023931953)) & (xp.less_equal(t469, 2.0943951023931953))), t543, t476),  # 1, 5
+        xp.where(xp.greater_equal(t477, -2.0943951023931953) & xp.logical_not(xp.greater_equal(t469, -2.0943951023931953) & xp.less_equal(t469, 2.0943951023931953)), t543, t476),  # 1, 5
         xp.where(t544 & xp.logical_not(t545), t475, t474),  # 1, 6
         t548,  # 2, 0
         t551,  # 2, 1
@@ -3521,7 +3521,7 @@ def ik_branches(T, q_free):
         q3,  # 3, 2
         t534,  # 3, 3
         xp.where(t558 & xp.logical_not(t559), t482, t481),  # 3, 4
-        xp.where((xp.greater_equal(t493, -2.0943951023931953)) & xp.logical_not((xp.greater_equal(t486, -2.0943951023931953)) & (xp.less_equal(t486, 2.0943951023931953))), t560, t492),  # 3, 5
+        xp.where(xp.greater_equal(t493, -2.0943951023931953) & xp.logical_not(xp.greater_equal(t486, -2.0943951023931953) & xp.less_equal(t486, 2.0943951023931953)), t560, t492),  # 3, 5
         xp.where(t561 & xp.logical_not(t562), t491, t490),  # 3, 6
         t565,  # 4, 0
         t568,  # 4, 1
@@ -3535,7 +3535,7 @@ def ik_branches(T, q_free):
         q3,  # 5, 2
         t571,  # 5, 3
         xp.where(t578 & xp.logical_not(t579), t498, t497),  # 5, 4
-        xp.where((xp.greater_equal(t509, -2.0943951023931953)) & xp.logical_not((xp.greater_equal(t502, -2.0943951023931953)) & (xp.less_equal(t502, 2.0943951023931953))), t580, t508),  # 5, 5
+        xp.where(xp.greater_equal(t509, -2.0943951023931953) & xp.logical_not(xp.greater_equal(t502, -2.0943951023931953) & xp.less_equal(t502, 2.0943951023931953)), t580, t508),  # 5, 5
         xp.where(t581 & xp.logical_not(t582), t507, t506),  # 5, 6
         t585,  # 6, 0
         t588,  # 6, 1
@@ -3549,28 +3549,28 @@ def ik_branches(T, q_free):
         q3,  # 7, 2
         t571,  # 7, 3
         xp.where(t595 & xp.logical_not(t596), t514, t513),  # 7, 4
-        xp.where((xp.greater_equal(t525, -2.0943951023931953)) & xp.logical_not((xp.greater_equal(t518, -2.0943951023931953)) & (xp.less_equal(t518, 2.0943951023931953))), t597, t524),  # 7, 5
+        xp.where(xp.greater_equal(t525, -2.0943951023931953) & xp.logical_not(xp.greater_equal(t518, -2.0943951023931953) & xp.less_equal(t518, 2.0943951023931953)), t597, t524),  # 7, 5
         xp.where(t598 & xp.logical_not(t599), t523, t522),  # 7, 6
     ], (8, 7))
     valid = _stack(xp, [
-        t600 & t601 & t602 & (xp.greater_equal(t149, -1e-12)),  # 0
-        t600 & t601 & t602 & (xp.greater(t149, 1e-12)),  # 1
-        t600 & t602 & t603 & (xp.greater_equal(t216, -1e-12)),  # 2
-        t600 & t602 & t603 & (xp.greater(t216, 1e-12)),  # 3
-        t600 & t604 & t605 & (xp.greater_equal(t358, -1e-12)),  # 4
-        t600 & t604 & t605 & (xp.greater(t358, 1e-12)),  # 5
-        t600 & t604 & t606 & (xp.greater_equal(t425, -1e-12)),  # 6
-        t600 & t604 & t606 & (xp.greater(t425, 1e-12)),  # 7
+        t600 & t601 & t602 & xp.greater_equal(t149, -1e-12),  # 0
+        t600 & t601 & t602 & xp.greater(t149, 1e-12),  # 1
+        t600 & t602 & t603 & xp.greater_equal(t216, -1e-12),  # 2
+        t600 & t602 & t603 & xp.greater(t216, 1e-12),  # 3
+        t600 & t604 & t605 & xp.greater_equal(t358, -1e-12),  # 4
+        t600 & t604 & t605 & xp.greater(t358, 1e-12),  # 5
+        t600 & t604 & t606 & xp.greater_equal(t425, -1e-12),  # 6
+        t600 & t604 & t606 & xp.greater(t425, 1e-12),  # 7
     ], (8,))
     in_limits = _stack(xp, [
         t607 & t608 & t609 & t610 & t611 & (t535 | t536) & (t537 | t538) & (t539 | t540),  # 0
-        t607 & t608 & t609 & t610 & t611 & (t541 | t542) & (t544 | t545) & ((xp.less_equal(t543, 2.0943951023931953)) | ((xp.greater_equal(t476, -2.0943951023931953)) & (xp.less_equal(t476, 2.0943951023931953)))),  # 1
+        t607 & t608 & t609 & t610 & t611 & (t541 | t542) & (t544 | t545) & (xp.less_equal(t543, 2.0943951023931953) | (xp.greater_equal(t476, -2.0943951023931953) & xp.less_equal(t476, 2.0943951023931953))),  # 1
         t607 & t608 & t611 & t612 & t613 & (t552 | t553) & (t554 | t555) & (t556 | t557),  # 2
-        t607 & t608 & t611 & t612 & t613 & (t558 | t559) & (t561 | t562) & ((xp.less_equal(t560, 2.0943951023931953)) | ((xp.greater_equal(t492, -2.0943951023931953)) & (xp.less_equal(t492, 2.0943951023931953)))),  # 3
+        t607 & t608 & t611 & t612 & t613 & (t558 | t559) & (t561 | t562) & (xp.less_equal(t560, 2.0943951023931953) | (xp.greater_equal(t492, -2.0943951023931953) & xp.less_equal(t492, 2.0943951023931953))),  # 3
         t607 & t608 & t614 & t615 & t616 & (t572 | t573) & (t574 | t575) & (t576 | t577),  # 4
-        t607 & t608 & t614 & t615 & t616 & (t578 | t579) & (t581 | t582) & ((xp.less_equal(t580, 2.0943951023931953)) | ((xp.greater_equal(t508, -2.0943951023931953)) & (xp.less_equal(t508, 2.0943951023931953)))),  # 5
+        t607 & t608 & t614 & t615 & t616 & (t578 | t579) & (t581 | t582) & (xp.less_equal(t580, 2.0943951023931953) | (xp.greater_equal(t508, -2.0943951023931953) & xp.less_equal(t508, 2.0943951023931953))),  # 5
         t607 & t608 & t616 & t617 & t618 & (t589 | t590) & (t591 | t592) & (t593 | t594),  # 6
-        t607 & t608 & t616 & t617 & t618 & (t595 | t596) & (t598 | t599) & ((xp.less_equal(t597, 2.0943951023931953)) | ((xp.greater_equal(t524, -2.0943951023931953)) & (xp.less_equal(t524, 2.0943951023931953)))),  # 7
+        t607 & t608 & t616 & t617 & t618 & (t595 | t596) & (t598 | t599) & (xp.less_equal(t597, 2.0943951023931953) | (xp.greater_equal(t524, -2.0943951023931953) & xp.less_equal(t524, 2.0943951023931953))),  # 7
     ], (8,))
     return q, valid, in_limits
 
@@ -3736,30 +3736,30 @@ def ik_nearest(T, q_seed, q_free, weights=(1.0,) * DOF):
     t55 = qb7_6 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn7 - qb7_6))
     t56 = xp.where(lb7 & vb7, xp.asarray(1, dtype=dtype), 0)
     t57 = T00 + T01 + T02 + T03 + T10 + T11 + T12 + T13 + T20 + T21 + T22 + T23 + qn1 + qn2 + qn3 + qn4 + qn5 + qn6 + qn7 + qw1 + qw2 + qw3 + qw4 + qw5 + qw6 + qw7
-    t58 = xp.where(xp.greater(qn1, t0), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t58 = xp.where(xp.less(t0, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t59 = t0 + t58
     t60 = t0 - t58
-    t61 = xp.where((xp.greater_equal(t0, -2.9670597283903604)) & (xp.less_equal(t0, 2.9670597283903604)), t0, xp.where((xp.greater_equal(t59, -2.9670597283903604)) & (xp.less_equal(t59, 2.9670597283903604)), t59, xp.where((xp.greater_equal(t60, -2.9670597283903604)) & (xp.less_equal(t60, 2.9670597283903604)), t60, qb0_0)))
-    t62 = xp.where(xp.greater(qn2, t1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t61 = xp.where(xp.greater_equal(t0, -2.9670597283903604) & xp.less_equal(t0, 2.9670597283903604), t0, xp.where(xp.greater_equal(t59, -2.9670597283903604) & xp.less_equal(t59, 2.9670597283903604), t59, xp.where(xp.greater_equal(t60, -2.9670597283903604) & xp.less_equal(t60, 2.9670597283903604), t60, qb0_0)))
+    t62 = xp.where(xp.less(t1, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t63 = t1 + t62
     t64 = t1 - t62
-    t65 = xp.where((xp.greater_equal(t1, -2.0943951023931953)) & (xp.less_equal(t1, 2.0943951023931953)), t1, xp.where((xp.greater_equal(t63, -2.0943951023931953)) & (xp.less_equal(t63, 2.0943951023931953)), t63, xp.where((xp.greater_equal(t64, -2.0943951023931953)) & (xp.less_equal(t64, 2.0943951023931953)), t64, qb0_1)))
-    t66 = xp.where(xp.greater(qn4, t2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t65 = xp.where(xp.greater_equal(t1, -2.0943951023931953) & xp.less_equal(t1, 2.0943951023931953), t1, xp.where(xp.greater_equal(t63, -2.0943951023931953) & xp.less_equal(t63, 2.0943951023931953), t63, xp.where(xp.greater_equal(t64, -2.0943951023931953) & xp.less_equal(t64, 2.0943951023931953), t64, qb0_1)))
+    t66 = xp.where(xp.less(t2, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t67 = t2 + t66
     t68 = t2 - t66
-    t69 = xp.where((xp.greater_equal(t2, -2.0943951023931953)) & (xp.less_equal(t2, 2.0943951023931953)), t2, xp.where((xp.greater_equal(t67, -2.0943951023931953)) & (xp.less_equal(t67, 2.0943951023931953)), t67, xp.where((xp.greater_equal(t68, -2.0943951023931953)) & (xp.less_equal(t68, 2.0943951023931953)), t68, qb0_3)))
-    t70 = xp.where(xp.greater(qn5, t3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t69 = xp.where(xp.greater_equal(t2, -2.0943951023931953) & xp.less_equal(t2, 2.0943951023931953), t2, xp.where(xp.greater_equal(t67, -2.0943951023931953) & xp.less_equal(t67, 2.0943951023931953), t67, xp.where(xp.greater_equal(t68, -2.0943951023931953) & xp.less_equal(t68, 2.0943951023931953), t68, qb0_3)))
+    t70 = xp.where(xp.less(t3, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t71 = t3 + t70
     t72 = t3 - t70
-    t73 = xp.where((xp.greater_equal(t3, -2.9670597283903604)) & (xp.less_equal(t3, 2.9670597283903604)), t3, xp.where((xp.greater_equal(t71, -2.9670597283903604)) & (xp.less_equal(t71, 2.9670597283903604)), t71, xp.where((xp.greater_equal(t72, -2.9670597283903604)) & (xp.less_equal(t72, 2.9670597283903604)), t72, qb0_4)))
-    t74 = xp.where(xp.greater(qn6, t4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t73 = xp.where(xp.greater_equal(t3, -2.9670597283903604) & xp.less_equal(t3, 2.9670597283903604), t3, xp.where(xp.greater_equal(t71, -2.9670597283903604) & xp.less_equal(t71, 2.9670597283903604), t71, xp.where(xp.greater_equal(t72, -2.9670597283903604) & xp.less_equal(t72, 2.9670597283903604), t72, qb0_4)))
+    t74 = xp.where(xp.less(t4, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t75 = t4 + t74
     t76 = t4 - t74
-    t77 = xp.where((xp.greater_equal(t4, -2.0943951023931953)) & (xp.less_equal(t4, 2.0943951023931953)), t4, xp.where((xp.greater_equal(t75, -2.0943951023931953)) & (xp.less_equal(t75, 2.0943951023931953)), t75, xp.where((xp.greater_equal(t76, -2.0943951023931953)) & (xp.less_equal(t76, 2.0943951023931953)), t76, qb0_5)))
-    t78 = xp.where(xp.greater(qn7, t5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t77 = xp.where(xp.greater_equal(t4, -2.0943951023931953) & xp.less_equal(t4, 2.0943951023931953), t4, xp.where(xp.greater_equal(t75, -2.0943951023931953) & xp.less_equal(t75, 2.0943951023931953), t75, xp.where(xp.greater_equal(t76, -2.0943951023931953) & xp.less_equal(t76, 2.0943951023931953), t76, qb0_5)))
+    t78 = xp.where(xp.less(t5, qn7), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t79 = t5 + t78
     t80 = t5 - t78
-    t81 = xp.where((xp.greater_equal(t5, -3.0543261909900767)) & (xp.less_equal(t5, 3.0543261909900767)), t5, xp.where((xp.greater_equal(t79, -3.0543261909900767)) & (xp.less_equal(t79, 3.0543261909900767)), t79, xp.where((xp.greater_equal(t80, -3.0543261909900767)) & (xp.less_equal(t80, 3.0543261909900767)), t80, qb0_6)))
+    t81 = xp.where(xp.greater_equal(t5, -3.0543261909900767) & xp.less_equal(t5, 3.0543261909900767), t5, xp.where(xp.greater_equal(t79, -3.0543261909900767) & xp.less_equal(t79, 3.0543261909900767), t79, xp.where(xp.greater_equal(t80, -3.0543261909900767) & xp.less_equal(t80, 3.0543261909900767), t80, qb0_6)))
     t82 = -qn1
     t83 = -qn2
     t84 = -qn3
@@ -3767,7 +3767,7 @@ def ik_nearest(T, q_seed, q_free, weights=(1.0,) * DOF):
     t86 = -qn5
     t87 = -qn6
     t88 = -qn7
-    t89 = qw1*(t61 + t82)**2 + qw2*(t65 + t83)**2 + qw3*(qb0_2 + t84)**2 + qw4*(t69 + t85)**2 + qw5*(t73 + t86)**2 + qw6*(t77 + t87)**2 + qw7*(t81 + t88)**2
+    t89 = qw1*(t61 + t82)**2 + qw2*(t65 + t83)**2 + qw3*(t84 + qb0_2)**2 + qw4*(t69 + t85)**2 + qw5*(t73 + t86)**2 + qw6*(t77 + t87)**2 + qw7*(t81 + t88)**2
     t90 = xp.greater(t7, 0)
     t91 = xp.where(t90, t61, qn1)
     t92 = xp.where(t90, t65, qn2)
@@ -3777,33 +3777,33 @@ def ik_nearest(T, q_seed, q_free, weights=(1.0,) * DOF):
     t96 = xp.where(t90, t77, qn6)
     t97 = xp.where(t90, t81, qn7)
     t98 = xp.where(t90, t89, 0)
-    t99 = xp.where(xp.greater(qn1, t8), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t99 = xp.where(xp.less(t8, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t100 = t8 + t99
     t101 = t8 - t99
-    t102 = xp.where((xp.greater_equal(t8, -2.9670597283903604)) & (xp.less_equal(t8, 2.9670597283903604)), t8, xp.where((xp.greater_equal(t100, -2.9670597283903604)) & (xp.less_equal(t100, 2.9670597283903604)), t100, xp.where((xp.greater_equal(t101, -2.9670597283903604)) & (xp.less_equal(t101, 2.9670597283903604)), t101, qb1_0)))
-    t103 = xp.where(xp.greater(qn2, t9), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t104 = t103 + t9
+    t102 = xp.where(xp.greater_equal(t8, -2.9670597283903604) & xp.less_equal(t8, 2.9670597283903604), t8, xp.where(xp.greater_equal(t100, -2.9670597283903604) & xp.less_equal(t100, 2.9670597283903604), t100, xp.where(xp.greater_equal(t101, -2.9670597283903604) & xp.less_equal(t101, 2.9670597283903604), t101, qb1_0)))
+    t103 = xp.where(xp.less(t9, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t104 = t9 + t103
     t105 = t9 - t103
-    t106 = xp.where((xp.greater_equal(t9, -2.0943951023931953)) & (xp.less_equal(t9, 2.0943951023931953)), t9, xp.where((xp.greater_equal(t104, -2.0943951023931953)) & (xp.less_equal(t104, 2.0943951023931953)), t104, xp.where((xp.greater_equal(t105, -2.0943951023931953)) & (xp.less_equal(t105, 2.0943951023931953)), t105, qb1_1)))
-    t107 = xp.where(xp.greater(qn4, t10), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t106 = xp.where(xp.greater_equal(t9, -2.0943951023931953) & xp.less_equal(t9, 2.0943951023931953), t9, xp.where(xp.greater_equal(t104, -2.0943951023931953) & xp.less_equal(t104, 2.0943951023931953), t104, xp.where(xp.greater_equal(t105, -2.0943951023931953) & xp.less_equal(t105, 2.0943951023931953), t105, qb1_1)))
+    t107 = xp.where(xp.less(t10, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t108 = t10 + t107
     t109 = t10 - t107
-    t110 = xp.where((xp.greater_equal(t10, -2.0943951023931953)) & (xp.less_equal(t10, 2.0943951023931953)), t10, xp.where((xp.greater_equal(t108, -2.0943951023931953)) & (xp.less_equal(t108, 2.0943951023931953)), t108, xp.where((xp.greater_equal(t109, -2.0943951023931953)) & (xp.less_equal(t109, 2.0943951023931953)), t109, qb1_3)))
-    t111 = xp.where(xp.greater(qn5, t11), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t110 = xp.where(xp.greater_equal(t10, -2.0943951023931953) & xp.less_equal(t10, 2.0943951023931953), t10, xp.where(xp.greater_equal(t108, -2.0943951023931953) & xp.less_equal(t108, 2.0943951023931953), t108, xp.where(xp.greater_equal(t109, -2.0943951023931953) & xp.less_equal(t109, 2.0943951023931953), t109, qb1_3)))
+    t111 = xp.where(xp.less(t11, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t112 = t11 + t111
     t113 = t11 - t111
-    t114 = xp.where((xp.greater_equal(t11, -2.9670597283903604)) & (xp.less_equal(t11, 2.9670597283903604)), t11, xp.where((xp.greater_equal(t112, -2.9670597283903604)) & (xp.less_equal(t112, 2.9670597283903604)), t112, xp.where((xp.greater_equal(t113, -2.9670597283903604)) & (xp.less_equal(t113, 2.9670597283903604)), t113, qb1_4)))
-    t115 = xp.where(xp.greater(qn6, t12), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t116 = t115 + t12
+    t114 = xp.where(xp.greater_equal(t11, -2.9670597283903604) & xp.less_equal(t11, 2.9670597283903604), t11, xp.where(xp.greater_equal(t112, -2.9670597283903604) & xp.less_equal(t112, 2.9670597283903604), t112, xp.where(xp.greater_equal(t113, -2.9670597283903604) & xp.less_equal(t113, 2.9670597283903604), t113, qb1_4)))
+    t115 = xp.where(xp.less(t12, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t116 = t12 + t115
     t117 = t12 - t115
-    t118 = xp.where((xp.greater_equal(t12, -2.0943951023931953)) & (xp.less_equal(t12, 2.0943951023931953)), t12, xp.where((xp.greater_equal(t116, -2.0943951023931953)) & (xp.less_equal(t116, 2.0943951023931953)), t116, xp.where((xp.greater_equal(t117, -2.0943951023931953)) & (xp.less_equal(t117, 2.0943951023931953)), t117, qb1_5)))
-    t119 = xp.where(xp.greater(qn7, t13), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t120 = t119 + t13
+    t118 = xp.where(xp.greater_equal(t12, -2.0943951023931953) & xp.less_equal(t12, 2.0943951023931953), t12, xp.where(xp.greater_equal(t116, -2.0943951023931953) & xp.less_equal(t116, 2.0943951023931953), t116, xp.where(xp.greater_equal(t117, -2.0943951023931953) & xp.less_equal(t117, 2.0943951023931953), t117, qb1_5)))
+    t119 = xp.where(xp.less(t13, qn7), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t120 = t13 + t119
     t121 = t13 - t119
-    t122 = xp.where((xp.greater_equal(t13, -3.0543261909900767)) & (xp.less_equal(t13, 3.0543261909900767)), t13, xp.where((xp.greater_equal(t120, -3.0543261909900767)) & (xp.less_equal(t120, 3.0543261909900767)), t120, xp.where((xp.greater_equal(t121, -3.0543261909900767)) & (xp.less_equal(t121, 3.0543261909900767)), t121, qb1_6)))
-    t123 = qw1*(t102 + t82)**2 + qw2*(t106 + t83)**2 + qw3*(qb1_2 + t84)**2 + qw4*(t110 + t85)**2 + qw5*(t114 + t86)**2 + qw6*(t118 + t87)**2 + qw7*(t122 + t88)**2
+    t122 = xp.where(xp.greater_equal(t13, -3.0543261909900767) & xp.less_equal(t13, 3.0543261909900767), t13, xp.where(xp.greater_equal(t120, -3.0543261909900767) & xp.less_equal(t120, 3.0543261909900767), t120, xp.where(xp.greater_equal(t121, -3.0543261909900767) & xp.less_equal(t121, 3.0543261909900767), t121, qb1_6)))
+    t123 = qw1*(t102 + t82)**2 + qw2*(t106 + t83)**2 + qw3*(t84 + qb1_2)**2 + qw4*(t110 + t85)**2 + qw5*(t114 + t86)**2 + qw6*(t118 + t87)**2 + qw7*(t122 + t88)**2
     t124 = xp.greater(t14, 0)
-    t125 = xp.where(t124 & ((xp.less(t123, t98)) | (xp.less(t7, 1))), xp.asarray(1, dtype=dtype), 0)
+    t125 = xp.where(t124 & (xp.less(t123, t98) | xp.less(t7, 1)), xp.asarray(1, dtype=dtype), 0)
     t126 = xp.where(t124, 1, t7)
     t127 = xp.greater(t125, 0)
     t128 = xp.where(t127, t102, t91)
@@ -3814,33 +3814,33 @@ def ik_nearest(T, q_seed, q_free, weights=(1.0,) * DOF):
     t133 = xp.where(t127, t118, t96)
     t134 = xp.where(t127, t122, t97)
     t135 = xp.where(t127, t123, t98)
-    t136 = xp.where(xp.greater(qn1, t15), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t137 = t136 + t15
+    t136 = xp.where(xp.less(t15, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t137 = t15 + t136
     t138 = t15 - t136
-    t139 = xp.where((xp.greater_equal(t15, -2.9670597283903604)) & (xp.less_equal(t15, 2.9670597283903604)), t15, xp.where((xp.greater_equal(t137, -2.9670597283903604)) & (xp.less_equal(t137, 2.9670597283903604)), t137, xp.where((xp.greater_equal(t138, -2.9670597283903604)) & (xp.less_equal(t138, 2.9670597283903604)), t138, qb2_0)))
-    t140 = xp.where(xp.greater(qn2, t16), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t141 = t140 + t16
+    t139 = xp.where(xp.greater_equal(t15, -2.9670597283903604) & xp.less_equal(t15, 2.9670597283903604), t15, xp.where(xp.greater_equal(t137, -2.9670597283903604) & xp.less_equal(t137, 2.9670597283903604), t137, xp.where(xp.greater_equal(t138, -2.9670597283903604) & xp.less_equal(t138, 2.9670597283903604), t138, qb2_0)))
+    t140 = xp.where(xp.less(t16, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t141 = t16 + t140
     t142 = t16 - t140
-    t143 = xp.where((xp.greater_equal(t16, -2.0943951023931953)) & (xp.less_equal(t16, 2.0943951023931953)), t16, xp.where((xp.greater_equal(t141, -2.0943951023931953)) & (xp.less_equal(t141, 2.0943951023931953)), t141, xp.where((xp.greater_equal(t142, -2.0943951023931953)) & (xp.less_equal(t142, 2.0943951023931953)), t142, qb2_1)))
-    t144 = xp.where(xp.greater(qn4, t17), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t145 = t144 + t17
+    t143 = xp.where(xp.greater_equal(t16, -2.0943951023931953) & xp.less_equal(t16, 2.0943951023931953), t16, xp.where(xp.greater_equal(t141, -2.0943951023931953) & xp.less_equal(t141, 2.0943951023931953), t141, xp.where(xp.greater_equal(t142, -2.0943951023931953) & xp.less_equal(t142, 2.0943951023931953), t142, qb2_1)))
+    t144 = xp.where(xp.less(t17, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t145 = t17 + t144
     t146 = t17 - t144
-    t147 = xp.where((xp.greater_equal(t17, -2.0943951023931953)) & (xp.less_equal(t17, 2.0943951023931953)), t17, xp.where((xp.greater_equal(t145, -2.0943951023931953)) & (xp.less_equal(t145, 2.0943951023931953)), t145, xp.where((xp.greater_equal(t146, -2.0943951023931953)) & (xp.less_equal(t146, 2.0943951023931953)), t146, qb2_3)))
-    t148 = xp.where(xp.greater(qn5, t18), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t149 = t148 + t18
+    t147 = xp.where(xp.greater_equal(t17, -2.0943951023931953) & xp.less_equal(t17, 2.0943951023931953), t17, xp.where(xp.greater_equal(t145, -2.0943951023931953) & xp.less_equal(t145, 2.0943951023931953), t145, xp.where(xp.greater_equal(t146, -2.0943951023931953) & xp.less_equal(t146, 2.0943951023931953), t146, qb2_3)))
+    t148 = xp.where(xp.less(t18, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t149 = t18 + t148
     t150 = t18 - t148
-    t151 = xp.where((xp.greater_equal(t18, -2.9670597283903604)) & (xp.less_equal(t18, 2.9670597283903604)), t18, xp.where((xp.greater_equal(t149, -2.9670597283903604)) & (xp.less_equal(t149, 2.9670597283903604)), t149, xp.where((xp.greater_equal(t150, -2.9670597283903604)) & (xp.less_equal(t150, 2.9670597283903604)), t150, qb2_4)))
-    t152 = xp.where(xp.greater(qn6, t19), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t153 = t152 + t19
+    t151 = xp.where(xp.greater_equal(t18, -2.9670597283903604) & xp.less_equal(t18, 2.9670597283903604), t18, xp.where(xp.greater_equal(t149, -2.9670597283903604) & xp.less_equal(t149, 2.9670597283903604), t149, xp.where(xp.greater_equal(t150, -2.9670597283903604) & xp.less_equal(t150, 2.9670597283903604), t150, qb2_4)))
+    t152 = xp.where(xp.less(t19, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t153 = t19 + t152
     t154 = t19 - t152
-    t155 = xp.where((xp.greater_equal(t19, -2.0943951023931953)) & (xp.less_equal(t19, 2.0943951023931953)), t19, xp.where((xp.greater_equal(t153, -2.0943951023931953)) & (xp.less_equal(t153, 2.0943951023931953)), t153, xp.where((xp.greater_equal(t154, -2.0943951023931953)) & (xp.less_equal(t154, 2.0943951023931953)), t154, qb2_5)))
-    t156 = xp.where(xp.greater(qn7, t20), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t157 = t156 + t20
+    t155 = xp.where(xp.greater_equal(t19, -2.0943951023931953) & xp.less_equal(t19, 2.0943951023931953), t19, xp.where(xp.greater_equal(t153, -2.0943951023931953) & xp.less_equal(t153, 2.0943951023931953), t153, xp.where(xp.greater_equal(t154, -2.0943951023931953) & xp.less_equal(t154, 2.0943951023931953), t154, qb2_5)))
+    t156 = xp.where(xp.less(t20, qn7), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t157 = t20 + t156
     t158 = t20 - t156
-    t159 = xp.where((xp.greater_equal(t20, -3.0543261909900767)) & (xp.less_equal(t20, 3.0543261909900767)), t20, xp.where((xp.greater_equal(t157, -3.0543261909900767)) & (xp.less_equal(t157, 3.0543261909900767)), t157, xp.where((xp.greater_equal(t158, -3.0543261909900767)) & (xp.less_equal(t158, 3.0543261909900767)), t158, qb2_6)))
-    t160 = qw1*(t139 + t82)**2 + qw2*(t143 + t83)**2 + qw3*(qb2_2 + t84)**2 + qw4*(t147 + t85)**2 + qw5*(t151 + t86)**2 + qw6*(t155 + t87)**2 + qw7*(t159 + t88)**2
+    t159 = xp.where(xp.greater_equal(t20, -3.0543261909900767) & xp.less_equal(t20, 3.0543261909900767), t20, xp.where(xp.greater_equal(t157, -3.0543261909900767) & xp.less_equal(t157, 3.0543261909900767), t157, xp.where(xp.greater_equal(t158, -3.0543261909900767) & xp.less_equal(t158, 3.0543261909900767), t158, qb2_6)))
+    t160 = qw1*(t139 + t82)**2 + qw2*(t143 + t83)**2 + qw3*(t84 + qb2_2)**2 + qw4*(t147 + t85)**2 + qw5*(t151 + t86)**2 + qw6*(t155 + t87)**2 + qw7*(t159 + t88)**2
     t161 = xp.greater(t21, 0)
-    t162 = xp.where(t161 & ((xp.greater(t135, t160)) | (xp.less(t126, 1))), xp.asarray(1, dtype=dtype), 0)
+    t162 = xp.where(t161 & (xp.greater(t135, t160) | xp.less(t126, 1)), xp.asarray(1, dtype=dtype), 0)
     t163 = xp.where(t161, 1, t126)
     t164 = xp.greater(t162, 0)
     t165 = xp.where(t164, t139, t128)
@@ -3851,33 +3851,33 @@ def ik_nearest(T, q_seed, q_free, weights=(1.0,) * DOF):
     t170 = xp.where(t164, t155, t133)
     t171 = xp.where(t164, t159, t134)
     t172 = xp.where(t164, t160, t135)
-    t173 = xp.where(xp.greater(qn1, t22), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t174 = t173 + t22
+    t173 = xp.where(xp.less(t22, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t174 = t22 + t173
     t175 = t22 - t173
-    t176 = xp.where((xp.greater_equal(t22, -2.9670597283903604)) & (xp.less_equal(t22, 2.9670597283903604)), t22, xp.where((xp.greater_equal(t174, -2.9670597283903604)) & (xp.less_equal(t174, 2.9670597283903604)), t174, xp.where((xp.greater_equal(t175, -2.9670597283903604)) & (xp.less_equal(t175, 2.9670597283903604)), t175, qb3_0)))
-    t177 = xp.where(xp.greater(qn2, t23), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t178 = t177 + t23
+    t176 = xp.where(xp.greater_equal(t22, -2.9670597283903604) & xp.less_equal(t22, 2.9670597283903604), t22, xp.where(xp.greater_equal(t174, -2.9670597283903604) & xp.less_equal(t174, 2.9670597283903604), t174, xp.where(xp.greater_equal(t175, -2.9670597283903604) & xp.less_equal(t175, 2.9670597283903604), t175, qb3_0)))
+    t177 = xp.where(xp.less(t23, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t178 = t23 + t177
     t179 = t23 - t177
-    t180 = xp.where((xp.greater_equal(t23, -2.0943951023931953)) & (xp.less_equal(t23, 2.0943951023931953)), t23, xp.where((xp.greater_equal(t178, -2.0943951023931953)) & (xp.less_equal(t178, 2.0943951023931953)), t178, xp.where((xp.greater_equal(t179, -2.0943951023931953)) & (xp.less_equal(t179, 2.0943951023931953)), t179, qb3_1)))
-    t181 = xp.where(xp.greater(qn4, t24), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t182 = t181 + t24
+    t180 = xp.where(xp.greater_equal(t23, -2.0943951023931953) & xp.less_equal(t23, 2.0943951023931953), t23, xp.where(xp.greater_equal(t178, -2.0943951023931953) & xp.less_equal(t178, 2.0943951023931953), t178, xp.where(xp.greater_equal(t179, -2.0943951023931953) & xp.less_equal(t179, 2.0943951023931953), t179, qb3_1)))
+    t181 = xp.where(xp.less(t24, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t182 = t24 + t181
     t183 = t24 - t181
-    t184 = xp.where((xp.greater_equal(t24, -2.0943951023931953)) & (xp.less_equal(t24, 2.0943951023931953)), t24, xp.where((xp.greater_equal(t182, -2.0943951023931953)) & (xp.less_equal(t182, 2.0943951023931953)), t182, xp.where((xp.greater_equal(t183, -2.0943951023931953)) & (xp.less_equal(t183, 2.0943951023931953)), t183, qb3_3)))
-    t185 = xp.where(xp.greater(qn5, t25), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t186 = t185 + t25
+    t184 = xp.where(xp.greater_equal(t24, -2.0943951023931953) & xp.less_equal(t24, 2.0943951023931953), t24, xp.where(xp.greater_equal(t182, -2.0943951023931953) & xp.less_equal(t182, 2.0943951023931953), t182, xp.where(xp.greater_equal(t183, -2.0943951023931953) & xp.less_equal(t183, 2.0943951023931953), t183, qb3_3)))
+    t185 = xp.where(xp.less(t25, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t186 = t25 + t185
     t187 = t25 - t185
-    t188 = xp.where((xp.greater_equal(t25, -2.9670597283903604)) & (xp.less_equal(t25, 2.9670597283903604)), t25, xp.where((xp.greater_equal(t186, -2.9670597283903604)) & (xp.less_equal(t186, 2.9670597283903604)), t186, xp.where((xp.greater_equal(t187, -2.9670597283903604)) & (xp.less_equal(t187, 2.9670597283903604)), t187, qb3_4)))
-    t189 = xp.where(xp.greater(qn6, t26), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t190 = t189 + t26
+    t188 = xp.where(xp.greater_equal(t25, -2.9670597283903604) & xp.less_equal(t25, 2.9670597283903604), t25, xp.where(xp.greater_equal(t186, -2.9670597283903604) & xp.less_equal(t186, 2.9670597283903604), t186, xp.where(xp.greater_equal(t187, -2.9670597283903604) & xp.less_equal(t187, 2.9670597283903604), t187, qb3_4)))
+    t189 = xp.where(xp.less(t26, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t190 = t26 + t189
     t191 = t26 - t189
-    t192 = xp.where((xp.greater_equal(t26, -2.0943951023931953)) & (xp.less_equal(t26, 2.0943951023931953)), t26, xp.where((xp.greater_equal(t190, -2.0943951023931953)) & (xp.less_equal(t190, 2.0943951023931953)), t190, xp.where((xp.greater_equal(t191, -2.0943951023931953)) & (xp.less_equal(t191, 2.0943951023931953)), t191, qb3_5)))
-    t193 = xp.where(xp.greater(qn7, t27), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t194 = t193 + t27
+    t192 = xp.where(xp.greater_equal(t26, -2.0943951023931953) & xp.less_equal(t26, 2.0943951023931953), t26, xp.where(xp.greater_equal(t190, -2.0943951023931953) & xp.less_equal(t190, 2.0943951023931953), t190, xp.where(xp.greater_equal(t191, -2.0943951023931953) & xp.less_equal(t191, 2.0943951023931953), t191, qb3_5)))
+    t193 = xp.where(xp.less(t27, qn7), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t194 = t27 + t193
     t195 = t27 - t193
-    t196 = xp.where((xp.greater_equal(t27, -3.0543261909900767)) & (xp.less_equal(t27, 3.0543261909900767)), t27, xp.where((xp.greater_equal(t194, -3.0543261909900767)) & (xp.less_equal(t194, 3.0543261909900767)), t194, xp.where((xp.greater_equal(t195, -3.0543261909900767)) & (xp.less_equal(t195, 3.0543261909900767)), t195, qb3_6)))
-    t197 = qw1*(t176 + t82)**2 + qw2*(t180 + t83)**2 + qw3*(qb3_2 + t84)**2 + qw4*(t184 + t85)**2 + qw5*(t188 + t86)**2 + qw6*(t192 + t87)**2 + qw7*(t196 + t88)**2
+    t196 = xp.where(xp.greater_equal(t27, -3.0543261909900767) & xp.less_equal(t27, 3.0543261909900767), t27, xp.where(xp.greater_equal(t194, -3.0543261909900767) & xp.less_equal(t194, 3.0543261909900767), t194, xp.where(xp.greater_equal(t195, -3.0543261909900767) & xp.less_equal(t195, 3.0543261909900767), t195, qb3_6)))
+    t197 = qw1*(t176 + t82)**2 + qw2*(t180 + t83)**2 + qw3*(t84 + qb3_2)**2 + qw4*(t184 + t85)**2 + qw5*(t188 + t86)**2 + qw6*(t192 + t87)**2 + qw7*(t196 + t88)**2
     t198 = xp.greater(t28, 0)
-    t199 = xp.where(t198 & ((xp.greater(t172, t197)) | (xp.less(t163, 1))), xp.asarray(1, dtype=dtype), 0)
+    t199 = xp.where(t198 & (xp.greater(t172, t197) | xp.less(t163, 1)), xp.asarray(1, dtype=dtype), 0)
     t200 = xp.where(t198, 1, t163)
     t201 = xp.greater(t199, 0)
     t202 = xp.where(t201, t176, t165)
@@ -3888,33 +3888,33 @@ def ik_nearest(T, q_seed, q_free, weights=(1.0,) * DOF):
     t207 = xp.where(t201, t192, t170)
     t208 = xp.where(t201, t196, t171)
     t209 = xp.where(t201, t197, t172)
-    t210 = xp.where(xp.greater(qn1, t29), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t211 = t210 + t29
+    t210 = xp.where(xp.less(t29, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t211 = t29 + t210
     t212 = t29 - t210
-    t213 = xp.where((xp.greater_equal(t29, -2.9670597283903604)) & (xp.less_equal(t29, 2.9670597283903604)), t29, xp.where((xp.greater_equal(t211, -2.9670597283903604)) & (xp.less_equal(t211, 2.9670597283903604)), t211, xp.where((xp.greater_equal(t212, -2.9670597283903604)) & (xp.less_equal(t212, 2.9670597283903604)), t212, qb4_0)))
-    t214 = xp.where(xp.greater(qn2, t30), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t215 = t214 + t30
+    t213 = xp.where(xp.greater_equal(t29, -2.9670597283903604) & xp.less_equal(t29, 2.9670597283903604), t29, xp.where(xp.greater_equal(t211, -2.9670597283903604) & xp.less_equal(t211, 2.9670597283903604), t211, xp.where(xp.greater_equal(t212, -2.9670597283903604) & xp.less_equal(t212, 2.9670597283903604), t212, qb4_0)))
+    t214 = xp.where(xp.less(t30, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t215 = t30 + t214
     t216 = t30 - t214
-    t217 = xp.where((xp.greater_equal(t30, -2.0943951023931953)) & (xp.less_equal(t30, 2.0943951023931953)), t30, xp.where((xp.greater_equal(t215, -2.0943951023931953)) & (xp.less_equal(t215, 2.0943951023931953)), t215, xp.where((xp.greater_equal(t216, -2.0943951023931953)) & (xp.less_equal(t216, 2.0943951023931953)), t216, qb4_1)))
-    t218 = xp.where(xp.greater(qn4, t31), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t219 = t218 + t31
+    t217 = xp.where(xp.greater_equal(t30, -2.0943951023931953) & xp.less_equal(t30, 2.0943951023931953), t30, xp.where(xp.greater_equal(t215, -2.0943951023931953) & xp.less_equal(t215, 2.0943951023931953), t215, xp.where(xp.greater_equal(t216, -2.0943951023931953) & xp.less_equal(t216, 2.0943951023931953), t216, qb4_1)))
+    t218 = xp.where(xp.less(t31, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t219 = t31 + t218
     t220 = t31 - t218
-    t221 = xp.where((xp.greater_equal(t31, -2.0943951023931953)) & (xp.less_equal(t31, 2.0943951023931953)), t31, xp.where((xp.greater_equal(t219, -2.0943951023931953)) & (xp.less_equal(t219, 2.0943951023931953)), t219, xp.where((xp.greater_equal(t220, -2.0943951023931953)) & (xp.less_equal(t220, 2.0943951023931953)), t220, qb4_3)))
-    t222 = xp.where(xp.greater(qn5, t32), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t223 = t222 + t32
+    t221 = xp.where(xp.greater_equal(t31, -2.0943951023931953) & xp.less_equal(t31, 2.0943951023931953), t31, xp.where(xp.greater_equal(t219, -2.0943951023931953) & xp.less_equal(t219, 2.0943951023931953), t219, xp.where(xp.greater_equal(t220, -2.0943951023931953) & xp.less_equal(t220, 2.0943951023931953), t220, qb4_3)))
+    t222 = xp.where(xp.less(t32, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t223 = t32 + t222
     t224 = t32 - t222
-    t225 = xp.where((xp.greater_equal(t32, -2.9670597283903604)) & (xp.less_equal(t32, 2.9670597283903604)), t32, xp.where((xp.greater_equal(t223, -2.9670597283903604)) & (xp.less_equal(t223, 2.9670597283903604)), t223, xp.where((xp.greater_equal(t224, -2.9670597283903604)) & (xp.less_equal(t224, 2.9670597283903604)), t224, qb4_4)))
-    t226 = xp.where(xp.greater(qn6, t33), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t227 = t226 + t33
+    t225 = xp.where(xp.greater_equal(t32, -2.9670597283903604) & xp.less_equal(t32, 2.9670597283903604), t32, xp.where(xp.greater_equal(t223, -2.9670597283903604) & xp.less_equal(t223, 2.9670597283903604), t223, xp.where(xp.greater_equal(t224, -2.9670597283903604) & xp.less_equal(t224, 2.9670597283903604), t224, qb4_4)))
+    t226 = xp.where(xp.less(t33, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t227 = t33 + t226
     t228 = t33 - t226
-    t229 = xp.where((xp.greater_equal(t33, -2.0943951023931953)) & (xp.less_equal(t33, 2.0943951023931953)), t33, xp.where((xp.greater_equal(t227, -2.0943951023931953)) & (xp.less_equal(t227, 2.0943951023931953)), t227, xp.where((xp.greater_equal(t228, -2.0943951023931953)) & (xp.less_equal(t228, 2.0943951023931953)), t228, qb4_5)))
-    t230 = xp.where(xp.greater(qn7, t34), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t231 = t230 + t34
+    t229 = xp.where(xp.greater_equal(t33, -2.0943951023931953) & xp.less_equal(t33, 2.0943951023931953), t33, xp.where(xp.greater_equal(t227, -2.0943951023931953) & xp.less_equal(t227, 2.0943951023931953), t227, xp.where(xp.greater_equal(t228, -2.0943951023931953) & xp.less_equal(t228, 2.0943951023931953), t228, qb4_5)))
+    t230 = xp.where(xp.less(t34, qn7), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t231 = t34 + t230
     t232 = t34 - t230
-    t233 = xp.where((xp.greater_equal(t34, -3.0543261909900767)) & (xp.less_equal(t34, 3.0543261909900767)), t34, xp.where((xp.greater_equal(t231, -3.0543261909900767)) & (xp.less_equal(t231, 3.0543261909900767)), t231, xp.where((xp.greater_equal(t232, -3.0543261909900767)) & (xp.less_equal(t232, 3.0543261909900767)), t232, qb4_6)))
-    t234 = qw1*(t213 + t82)**2 + qw2*(t217 + t83)**2 + qw3*(qb4_2 + t84)**2 + qw4*(t221 + t85)**2 + qw5*(t225 + t86)**2 + qw6*(t229 + t87)**2 + qw7*(t233 + t88)**2
+    t233 = xp.where(xp.greater_equal(t34, -3.0543261909900767) & xp.less_equal(t34, 3.0543261909900767), t34, xp.where(xp.greater_equal(t231, -3.0543261909900767) & xp.less_equal(t231, 3.0543261909900767), t231, xp.where(xp.greater_equal(t232, -3.0543261909900767) & xp.less_equal(t232, 3.0543261909900767), t232, qb4_6)))
+    t234 = qw1*(t213 + t82)**2 + qw2*(t217 + t83)**2 + qw3*(t84 + qb4_2)**2 + qw4*(t221 + t85)**2 + qw5*(t225 + t86)**2 + qw6*(t229 + t87)**2 + qw7*(t233 + t88)**2
     t235 = xp.greater(t35, 0)
-    t236 = xp.where(t235 & ((xp.greater(t209, t234)) | (xp.less(t200, 1))), xp.asarray(1, dtype=dtype), 0)
+    t236 = xp.where(t235 & (xp.greater(t209, t234) | xp.less(t200, 1)), xp.asarray(1, dtype=dtype), 0)
     t237 = xp.where(t235, 1, t200)
     t238 = xp.greater(t236, 0)
     t239 = xp.where(t238, t213, t202)
@@ -3925,33 +3925,33 @@ def ik_nearest(T, q_seed, q_free, weights=(1.0,) * DOF):
     t244 = xp.where(t238, t229, t207)
     t245 = xp.where(t238, t233, t208)
     t246 = xp.where(t238, t234, t209)
-    t247 = xp.where(xp.greater(qn1, t36), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t248 = t247 + t36
+    t247 = xp.where(xp.less(t36, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t248 = t36 + t247
     t249 = t36 - t247
-    t250 = xp.where((xp.greater_equal(t36, -2.9670597283903604)) & (xp.less_equal(t36, 2.9670597283903604)), t36, xp.where((xp.greater_equal(t248, -2.9670597283903604)) & (xp.less_equal(t248, 2.9670597283903604)), t248, xp.where((xp.greater_equal(t249, -2.9670597283903604)) & (xp.less_equal(t249, 2.9670597283903604)), t249, qb5_0)))
-    t251 = xp.where(xp.greater(qn2, t37), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t252 = t251 + t37
+    t250 = xp.where(xp.greater_equal(t36, -2.9670597283903604) & xp.less_equal(t36, 2.9670597283903604), t36, xp.where(xp.greater_equal(t248, -2.9670597283903604) & xp.less_equal(t248, 2.9670597283903604), t248, xp.where(xp.greater_equal(t249, -2.9670597283903604) & xp.less_equal(t249, 2.9670597283903604), t249, qb5_0)))
+    t251 = xp.where(xp.less(t37, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t252 = t37 + t251
     t253 = t37 - t251
-    t254 = xp.where((xp.greater_equal(t37, -2.0943951023931953)) & (xp.less_equal(t37, 2.0943951023931953)), t37, xp.where((xp.greater_equal(t252, -2.0943951023931953)) & (xp.less_equal(t252, 2.0943951023931953)), t252, xp.where((xp.greater_equal(t253, -2.0943951023931953)) & (xp.less_equal(t253, 2.0943951023931953)), t253, qb5_1)))
-    t255 = xp.where(xp.greater(qn4, t38), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t256 = t255 + t38
+    t254 = xp.where(xp.greater_equal(t37, -2.0943951023931953) & xp.less_equal(t37, 2.0943951023931953), t37, xp.where(xp.greater_equal(t252, -2.0943951023931953) & xp.less_equal(t252, 2.0943951023931953), t252, xp.where(xp.greater_equal(t253, -2.0943951023931953) & xp.less_equal(t253, 2.0943951023931953), t253, qb5_1)))
+    t255 = xp.where(xp.less(t38, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t256 = t38 + t255
     t257 = t38 - t255
-    t258 = xp.where((xp.greater_equal(t38, -2.0943951023931953)) & (xp.less_equal(t38, 2.0943951023931953)), t38, xp.where((xp.greater_equal(t256, -2.0943951023931953)) & (xp.less_equal(t256, 2.0943951023931953)), t256, xp.where((xp.greater_equal(t257, -2.0943951023931953)) & (xp.less_equal(t257, 2.0943951023931953)), t257, qb5_3)))
-    t259 = xp.where(xp.greater(qn5, t39), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t260 = t259 + t39
+    t258 = xp.where(xp.greater_equal(t38, -2.0943951023931953) & xp.less_equal(t38, 2.0943951023931953), t38, xp.where(xp.greater_equal(t256, -2.0943951023931953) & xp.less_equal(t256, 2.0943951023931953), t256, xp.where(xp.greater_equal(t257, -2.0943951023931953) & xp.less_equal(t257, 2.0943951023931953), t257, qb5_3)))
+    t259 = xp.where(xp.less(t39, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t260 = t39 + t259
     t261 = t39 - t259
-    t262 = xp.where((xp.greater_equal(t39, -2.9670597283903604)) & (xp.less_equal(t39, 2.9670597283903604)), t39, xp.where((xp.greater_equal(t260, -2.9670597283903604)) & (xp.less_equal(t260, 2.9670597283903604)), t260, xp.where((xp.greater_equal(t261, -2.9670597283903604)) & (xp.less_equal(t261, 2.9670597283903604)), t261, qb5_4)))
-    t263 = xp.where(xp.greater(qn6, t40), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t264 = t263 + t40
+    t262 = xp.where(xp.greater_equal(t39, -2.9670597283903604) & xp.less_equal(t39, 2.9670597283903604), t39, xp.where(xp.greater_equal(t260, -2.9670597283903604) & xp.less_equal(t260, 2.9670597283903604), t260, xp.where(xp.greater_equal(t261, -2.9670597283903604) & xp.less_equal(t261, 2.9670597283903604), t261, qb5_4)))
+    t263 = xp.where(xp.less(t40, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t264 = t40 + t263
     t265 = t40 - t263
-    t266 = xp.where((xp.greater_equal(t40, -2.0943951023931953)) & (xp.less_equal(t40, 2.0943951023931953)), t40, xp.where((xp.greater_equal(t264, -2.0943951023931953)) & (xp.less_equal(t264, 2.0943951023931953)), t264, xp.where((xp.greater_equal(t265, -2.0943951023931953)) & (xp.less_equal(t265, 2.0943951023931953)), t265, qb5_5)))
-    t267 = xp.where(xp.greater(qn7, t41), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t268 = t267 + t41
+    t266 = xp.where(xp.greater_equal(t40, -2.0943951023931953) & xp.less_equal(t40, 2.0943951023931953), t40, xp.where(xp.greater_equal(t264, -2.0943951023931953) & xp.less_equal(t264, 2.0943951023931953), t264, xp.where(xp.greater_equal(t265, -2.0943951023931953) & xp.less_equal(t265, 2.0943951023931953), t265, qb5_5)))
+    t267 = xp.where(xp.less(t41, qn7), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t268 = t41 + t267
     t269 = t41 - t267
-    t270 = xp.where((xp.greater_equal(t41, -3.0543261909900767)) & (xp.less_equal(t41, 3.0543261909900767)), t41, xp.where((xp.greater_equal(t268, -3.0543261909900767)) & (xp.less_equal(t268, 3.0543261909900767)), t268, xp.where((xp.greater_equal(t269, -3.0543261909900767)) & (xp.less_equal(t269, 3.0543261909900767)), t269, qb5_6)))
-    t271 = qw1*(t250 + t82)**2 + qw2*(t254 + t83)**2 + qw3*(qb5_2 + t84)**2 + qw4*(t258 + t85)**2 + qw5*(t262 + t86)**2 + qw6*(t266 + t87)**2 + qw7*(t270 + t88)**2
+    t270 = xp.where(xp.greater_equal(t41, -3.0543261909900767) & xp.less_equal(t41, 3.0543261909900767), t41, xp.where(xp.greater_equal(t268, -3.0543261909900767) & xp.less_equal(t268, 3.0543261909900767), t268, xp.where(xp.greater_equal(t269, -3.0543261909900767) & xp.less_equal(t269, 3.0543261909900767), t269, qb5_6)))
+    t271 = qw1*(t250 + t82)**2 + qw2*(t254 + t83)**2 + qw3*(t84 + qb5_2)**2 + qw4*(t258 + t85)**2 + qw5*(t262 + t86)**2 + qw6*(t266 + t87)**2 + qw7*(t270 + t88)**2
     t272 = xp.greater(t42, 0)
-    t273 = xp.where(t272 & ((xp.greater(t246, t271)) | (xp.less(t237, 1))), xp.asarray(1, dtype=dtype), 0)
+    t273 = xp.where(t272 & (xp.greater(t246, t271) | xp.less(t237, 1)), xp.asarray(1, dtype=dtype), 0)
     t274 = xp.where(t272, 1, t237)
     t275 = xp.greater(t273, 0)
     t276 = xp.where(t275, t250, t239)
@@ -3962,33 +3962,33 @@ def ik_nearest(T, q_seed, q_free, weights=(1.0,) * DOF):
     t281 = xp.where(t275, t266, t244)
     t282 = xp.where(t275, t270, t245)
     t283 = xp.where(t275, t271, t246)
-    t284 = xp.where(xp.greater(qn1, t43), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t285 = t284 + t43
+    t284 = xp.where(xp.less(t43, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t285 = t43 + t284
     t286 = t43 - t284
-    t287 = xp.where((xp.greater_equal(t43, -2.9670597283903604)) & (xp.less_equal(t43, 2.9670597283903604)), t43, xp.where((xp.greater_equal(t285, -2.9670597283903604)) & (xp.less_equal(t285, 2.9670597283903604)), t285, xp.where((xp.greater_equal(t286, -2.9670597283903604)) & (xp.less_equal(t286, 2.9670597283903604)), t286, qb6_0)))
-    t288 = xp.where(xp.greater(qn2, t44), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t289 = t288 + t44
+    t287 = xp.where(xp.greater_equal(t43, -2.9670597283903604) & xp.less_equal(t43, 2.9670597283903604), t43, xp.where(xp.greater_equal(t285, -2.9670597283903604) & xp.less_equal(t285, 2.9670597283903604), t285, xp.where(xp.greater_equal(t286, -2.9670597283903604) & xp.less_equal(t286, 2.9670597283903604), t286, qb6_0)))
+    t288 = xp.where(xp.less(t44, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t289 = t44 + t288
     t290 = t44 - t288
-    t291 = xp.where((xp.greater_equal(t44, -2.0943951023931953)) & (xp.less_equal(t44, 2.0943951023931953)), t44, xp.where((xp.greater_equal(t289, -2.0943951023931953)) & (xp.less_equal(t289, 2.0943951023931953)), t289, xp.where((xp.greater_equal(t290, -2.0943951023931953)) & (xp.less_equal(t290, 2.0943951023931953)), t290, qb6_1)))
-    t292 = xp.where(xp.greater(qn4, t45), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t293 = t292 + t45
+    t291 = xp.where(xp.greater_equal(t44, -2.0943951023931953) & xp.less_equal(t44, 2.0943951023931953), t44, xp.where(xp.greater_equal(t289, -2.0943951023931953) & xp.less_equal(t289, 2.0943951023931953), t289, xp.where(xp.greater_equal(t290, -2.0943951023931953) & xp.less_equal(t290, 2.0943951023931953), t290, qb6_1)))
+    t292 = xp.where(xp.less(t45, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t293 = t45 + t292
     t294 = t45 - t292
-    t295 = xp.where((xp.greater_equal(t45, -2.0943951023931953)) & (xp.less_equal(t45, 2.0943951023931953)), t45, xp.where((xp.greater_equal(t293, -2.0943951023931953)) & (xp.less_equal(t293, 2.0943951023931953)), t293, xp.where((xp.greater_equal(t294, -2.0943951023931953)) & (xp.less_equal(t294, 2.0943951023931953)), t294, qb6_3)))
-    t296 = xp.where(xp.greater(qn5, t46), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t297 = t296 + t46
+    t295 = xp.where(xp.greater_equal(t45, -2.0943951023931953) & xp.less_equal(t45, 2.0943951023931953), t45, xp.where(xp.greater_equal(t293, -2.0943951023931953) & xp.less_equal(t293, 2.0943951023931953), t293, xp.where(xp.greater_equal(t294, -2.0943951023931953) & xp.less_equal(t294, 2.0943951023931953), t294, qb6_3)))
+    t296 = xp.where(xp.less(t46, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t297 = t46 + t296
     t298 = t46 - t296
-    t299 = xp.where((xp.greater_equal(t46, -2.9670597283903604)) & (xp.less_equal(t46, 2.9670597283903604)), t46, xp.where((xp.greater_equal(t297, -2.9670597283903604)) & (xp.less_equal(t297, 2.9670597283903604)), t297, xp.where((xp.greater_equal(t298, -2.9670597283903604)) & (xp.less_equal(t298, 2.9670597283903604)), t298, qb6_4)))
-    t300 = xp.where(xp.greater(qn6, t47), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t301 = t300 + t47
+    t299 = xp.where(xp.greater_equal(t46, -2.9670597283903604) & xp.less_equal(t46, 2.9670597283903604), t46, xp.where(xp.greater_equal(t297, -2.9670597283903604) & xp.less_equal(t297, 2.9670597283903604), t297, xp.where(xp.greater_equal(t298, -2.9670597283903604) & xp.less_equal(t298, 2.9670597283903604), t298, qb6_4)))
+    t300 = xp.where(xp.less(t47, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t301 = t47 + t300
     t302 = t47 - t300
-    t303 = xp.where((xp.greater_equal(t47, -2.0943951023931953)) & (xp.less_equal(t47, 2.0943951023931953)), t47, xp.where((xp.greater_equal(t301, -2.0943951023931953)) & (xp.less_equal(t301, 2.0943951023931953)), t301, xp.where((xp.greater_equal(t302, -2.0943951023931953)) & (xp.less_equal(t302, 2.0943951023931953)), t302, qb6_5)))
-    t304 = xp.where(xp.greater(qn7, t48), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t305 = t304 + t48
+    t303 = xp.where(xp.greater_equal(t47, -2.0943951023931953) & xp.less_equal(t47, 2.0943951023931953), t47, xp.where(xp.greater_equal(t301, -2.0943951023931953) & xp.less_equal(t301, 2.0943951023931953), t301, xp.where(xp.greater_equal(t302, -2.0943951023931953) & xp.less_equal(t302, 2.0943951023931953), t302, qb6_5)))
+    t304 = xp.where(xp.less(t48, qn7), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t305 = t48 + t304
     t306 = t48 - t304
-    t307 = xp.where((xp.greater_equal(t48, -3.0543261909900767)) & (xp.less_equal(t48, 3.0543261909900767)), t48, xp.where((xp.greater_equal(t305, -3.0543261909900767)) & (xp.less_equal(t305, 3.0543261909900767)), t305, xp.where((xp.greater_equal(t306, -3.0543261909900767)) & (xp.less_equal(t306, 3.0543261909900767)), t306, qb6_6)))
-    t308 = qw1*(t287 + t82)**2 + qw2*(t291 + t83)**2 + qw3*(qb6_2 + t84)**2 + qw4*(t295 + t85)**2 + qw5*(t299 + t86)**2 + qw6*(t303 + t87)**2 + qw7*(t307 + t88)**2
+    t307 = xp.where(xp.greater_equal(t48, -3.0543261909900767) & xp.less_equal(t48, 3.0543261909900767), t48, xp.where(xp.greater_equal(t305, -3.0543261909900767) & xp.less_equal(t305, 3.0543261909900767), t305, xp.where(xp.greater_equal(t306, -3.0543261909900767) & xp.less_equal(t306, 3.0543261909900767), t306, qb6_6)))
+    t308 = qw1*(t287 + t82)**2 + qw2*(t291 + t83)**2 + qw3*(t84 + qb6_2)**2 + qw4*(t295 + t85)**2 + qw5*(t299 + t86)**2 + qw6*(t303 + t87)**2 + qw7*(t307 + t88)**2
     t309 = xp.greater(t49, 0)
-    t310 = xp.where(t309 & ((xp.greater(t283, t308)) | (xp.less(t274, 1))), xp.asarray(1, dtype=dtype), 0)
+    t310 = xp.where(t309 & (xp.greater(t283, t308) | xp.less(t274, 1)), xp.asarray(1, dtype=dtype), 0)
     t311 = xp.where(t309, 1, t274)
     t312 = xp.greater(t310, 0)
     t313 = xp.where(t312, t287, t276)
@@ -3999,33 +3999,33 @@ def ik_nearest(T, q_seed, q_free, weights=(1.0,) * DOF):
     t318 = xp.where(t312, t303, t281)
     t319 = xp.where(t312, t307, t282)
     t320 = xp.where(t312, t308, t283)
-    t321 = xp.where(xp.greater(qn1, t50), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t322 = t321 + t50
+    t321 = xp.where(xp.less(t50, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t322 = t50 + t321
     t323 = t50 - t321
-    t324 = xp.where((xp.greater_equal(t50, -2.9670597283903604)) & (xp.less_equal(t50, 2.9670597283903604)), t50, xp.where((xp.greater_equal(t322, -2.9670597283903604)) & (xp.less_equal(t322, 2.9670597283903604)), t322, xp.where((xp.greater_equal(t323, -2.9670597283903604)) & (xp.less_equal(t323, 2.9670597283903604)), t323, qb7_0)))
-    t325 = xp.where(xp.greater(qn2, t51), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t326 = t325 + t51
+    t324 = xp.where(xp.greater_equal(t50, -2.9670597283903604) & xp.less_equal(t50, 2.9670597283903604), t50, xp.where(xp.greater_equal(t322, -2.9670597283903604) & xp.less_equal(t322, 2.9670597283903604), t322, xp.where(xp.greater_equal(t323, -2.9670597283903604) & xp.less_equal(t323, 2.9670597283903604), t323, qb7_0)))
+    t325 = xp.where(xp.less(t51, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t326 = t51 + t325
     t327 = t51 - t325
-    t328 = xp.where((xp.greater_equal(t51, -2.0943951023931953)) & (xp.less_equal(t51, 2.0943951023931953)), t51, xp.where((xp.greater_equal(t326, -2.0943951023931953)) & (xp.less_equal(t326, 2.0943951023931953)), t326, xp.where((xp.greater_equal(t327, -2.0943951023931953)) & (xp.less_equal(t327, 2.0943951023931953)), t327, qb7_1)))
-    t329 = xp.where(xp.greater(qn4, t52), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t330 = t329 + t52
+    t328 = xp.where(xp.greater_equal(t51, -2.0943951023931953) & xp.less_equal(t51, 2.0943951023931953), t51, xp.where(xp.greater_equal(t326, -2.0943951023931953) & xp.less_equal(t326, 2.0943951023931953), t326, xp.where(xp.greater_equal(t327, -2.0943951023931953) & xp.less_equal(t327, 2.0943951023931953), t327, qb7_1)))
+    t329 = xp.where(xp.less(t52, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t330 = t52 + t329
     t331 = t52 - t329
-    t332 = xp.where((xp.greater_equal(t52, -2.0943951023931953)) & (xp.less_equal(t52, 2.0943951023931953)), t52, xp.where((xp.greater_equal(t330, -2.0943951023931953)) & (xp.less_equal(t330, 2.0943951023931953)), t330, xp.where((xp.greater_equal(t331, -2.0943951023931953)) & (xp.less_equal(t331, 2.0943951023931953)), t331, qb7_3)))
-    t333 = xp.where(xp.greater(qn5, t53), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t334 = t333 + t53
+    t332 = xp.where(xp.greater_equal(t52, -2.0943951023931953) & xp.less_equal(t52, 2.0943951023931953), t52, xp.where(xp.greater_equal(t330, -2.0943951023931953) & xp.less_equal(t330, 2.0943951023931953), t330, xp.where(xp.greater_equal(t331, -2.0943951023931953) & xp.less_equal(t331, 2.0943951023931953), t331, qb7_3)))
+    t333 = xp.where(xp.less(t53, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t334 = t53 + t333
     t335 = t53 - t333
-    t336 = xp.where((xp.greater_equal(t53, -2.9670597283903604)) & (xp.less_equal(t53, 2.9670597283903604)), t53, xp.where((xp.greater_equal(t334, -2.9670597283903604)) & (xp.less_equal(t334, 2.9670597283903604)), t334, xp.where((xp.greater_equal(t335, -2.9670597283903604)) & (xp.less_equal(t335, 2.9670597283903604)), t335, qb7_4)))
-    t337 = xp.where(xp.greater(qn6, t54), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t338 = t337 + t54
+    t336 = xp.where(xp.greater_equal(t53, -2.9670597283903604) & xp.less_equal(t53, 2.9670597283903604), t53, xp.where(xp.greater_equal(t334, -2.9670597283903604) & xp.less_equal(t334, 2.9670597283903604), t334, xp.where(xp.greater_equal(t335, -2.9670597283903604) & xp.less_equal(t335, 2.9670597283903604), t335, qb7_4)))
+    t337 = xp.where(xp.less(t54, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t338 = t54 + t337
     t339 = t54 - t337
-    t340 = xp.where((xp.greater_equal(t54, -2.0943951023931953)) & (xp.less_equal(t54, 2.0943951023931953)), t54, xp.where((xp.greater_equal(t338, -2.0943951023931953)) & (xp.less_equal(t338, 2.0943951023931953)), t338, xp.where((xp.greater_equal(t339, -2.0943951023931953)) & (xp.less_equal(t339, 2.0943951023931953)), t339, qb7_5)))
-    t341 = xp.where(xp.greater(qn7, t55), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t342 = t341 + t55
+    t340 = xp.where(xp.greater_equal(t54, -2.0943951023931953) & xp.less_equal(t54, 2.0943951023931953), t54, xp.where(xp.greater_equal(t338, -2.0943951023931953) & xp.less_equal(t338, 2.0943951023931953), t338, xp.where(xp.greater_equal(t339, -2.0943951023931953) & xp.less_equal(t339, 2.0943951023931953), t339, qb7_5)))
+    t341 = xp.where(xp.less(t55, qn7), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t342 = t55 + t341
     t343 = t55 - t341
-    t344 = xp.where((xp.greater_equal(t55, -3.0543261909900767)) & (xp.less_equal(t55, 3.0543261909900767)), t55, xp.where((xp.greater_equal(t342, -3.0543261909900767)) & (xp.less_equal(t342, 3.0543261909900767)), t342, xp.where((xp.greater_equal(t343, -3.0543261909900767)) & (xp.less_equal(t343, 3.0543261909900767)), t343, qb7_6)))
-    t345 = qw1*(t324 + t82)**2 + qw2*(t328 + t83)**2 + qw3*(qb7_2 + t84)**2 + qw4*(t332 + t85)**2 + qw5*(t336 + t86)**2 + qw6*(t340 + t87)**2 + qw7*(t344 + t88)**2
+    t344 = xp.where(xp.greater_equal(t55, -3.0543261909900767) & xp.less_equal(t55, 3.0543261909900767), t55, xp.where(xp.greater_equal(t342, -3.0543261909900767) & xp.less_equal(t342, 3.0543261909900767), t342, xp.where(xp.greater_equal(t343, -3.0543261909900767) & xp.less_equal(t343, 3.0543261909900767), t343, qb7_6)))
+    t345 = qw1*(t324 + t82)**2 + qw2*(t328 + t83)**2 + qw3*(t84 + qb7_2)**2 + qw4*(t332 + t85)**2 + qw5*(t336 + t86)**2 + qw6*(t340 + t87)**2 + qw7*(t344 + t88)**2
     t346 = xp.greater(t56, 0)
-    t347 = xp.where(t346 & ((xp.greater(t320, t345)) | (xp.less(t311, 1))), xp.asarray(1, dtype=dtype), 0)
+    t347 = xp.where(t346 & (xp.greater(t320, t345) | xp.less(t311, 1)), xp.asarray(1, dtype=dtype), 0)
     t348 = xp.where(t346, 1, t311)
     t349 = xp.greater(t347, 0)
     t350 = xp.where(t349, t324, t313)

@@ -39,15 +39,15 @@ typedef double kr5_real;
 void kr5_fk(const kr5_real q[KR5_DOF], kr5_real T[16]);
 
 /* Geometric Jacobian in the world frame (6 x DOF, rows vx vy vz wx wy wz).
- * Result: J: 6 x 6 row-major, element (r, c) at J[r * 6 + c]. 103 operations. */
+ * Result: J: 6 x 6 row-major, element (r, c) at J[r * 6 + c]. 100 operations. */
 void kr5_jacobian(const kr5_real q[KR5_DOF], kr5_real J[6 * KR5_DOF]);
 
 /* Fk and jacobian in one pass, sharing their terms.
- * Result: T: 4 x 4 row-major, element (r, c) at T[r * 4 + c]; J: 6 x 6 row-major, element (r, c) at J[r * 6 + c]. 137 operations. */
+ * Result: T: 4 x 4 row-major, element (r, c) at T[r * 4 + c]; J: 6 x 6 row-major, element (r, c) at J[r * 6 + c]. 134 operations. */
 void kr5_fk_jacobian(const kr5_real q[KR5_DOF], kr5_real T[16], kr5_real J[6 * KR5_DOF]);
 
 /* Geometric Jacobian in the tool frame (6 x DOF, rows vx vy vz wx wy wz).
- * Result: J: 6 x 6 row-major, element (r, c) at J[r * 6 + c]. 260 operations. */
+ * Result: J: 6 x 6 row-major, element (r, c) at J[r * 6 + c]. 251 operations. */
 void kr5_jacobian_tool(const kr5_real q[KR5_DOF], kr5_real J[6 * KR5_DOF]);
 
 /* Task vector mu = (x, y, z, roll, pitch, yaw).
@@ -55,7 +55,7 @@ void kr5_jacobian_tool(const kr5_real q[KR5_DOF], kr5_real J[6 * KR5_DOF]);
 void kr5_task(const kr5_real q[KR5_DOF], kr5_real mu[KR5_TASK_DIM]);
 
 /* Analytic Jacobian d mu / d q (6 x DOF).
- * Result: J: 6 x 6 row-major, element (r, c) at J[r * 6 + c]. 168 operations. */
+ * Result: J: 6 x 6 row-major, element (r, c) at J[r * 6 + c]. 164 operations. */
 void kr5_task_jacobian(const kr5_real q[KR5_DOF], kr5_real J[KR5_TASK_DIM * KR5_DOF]);
 
 /* Fk, jacobian and bias_acceleration in one pass, sharing their terms.
@@ -63,7 +63,7 @@ void kr5_task_jacobian(const kr5_real q[KR5_DOF], kr5_real J[KR5_TASK_DIM * KR5_
 void kr5_fk_jacobian_dot(const kr5_real q[KR5_DOF], const kr5_real q_dot[KR5_DOF], kr5_real T[16], kr5_real J[6 * KR5_DOF], kr5_real a[6]);
 
 /* Time derivative dJ/dt of the world geometric Jacobian along q_dot (6 x DOF).
- * Result: Jd: 6 x 6 row-major, element (r, c) at Jd[r * 6 + c]. 246 operations. */
+ * Result: Jd: 6 x 6 row-major, element (r, c) at Jd[r * 6 + c]. 238 operations. */
 void kr5_jacobian_dot(const kr5_real q[KR5_DOF], const kr5_real q_dot[KR5_DOF], kr5_real Jd[6 * KR5_DOF]);
 
 /* J' q_dot: the tool's classical linear and angular acceleration at zero joint acceleration, world frame (6).
@@ -75,7 +75,7 @@ void kr5_bias_acceleration(const kr5_real q[KR5_DOF], const kr5_real q_dot[KR5_D
 void kr5_task_jacobian_dot(const kr5_real q[KR5_DOF], const kr5_real q_dot[KR5_DOF], kr5_real Jd[KR5_TASK_DIM * KR5_DOF]);
 
 /* Partial derivatives dJ/dq_k of the world geometric Jacobian (DOF x 6 x DOF, indexed [k, r, c]).
- * Result: H: 6 x 6 x 6 row-major, element (k, r, c) at H[k * 36 + r * 6 + c]. 215 operations. */
+ * Result: H: 6 x 6 x 6 row-major, element (k, r, c) at H[k * 36 + r * 6 + c]. 204 operations. */
 void kr5_hessian(const kr5_real q[KR5_DOF], kr5_real H[KR5_DOF * 6 * KR5_DOF]);
 
 /* Factors of det(Js): the robot is singular where one is 0.
@@ -95,11 +95,11 @@ kr5_real kr5_jacobian_det(const kr5_real q[KR5_DOF]);
 int kr5_velocity_ik(const kr5_real q[KR5_DOF], const kr5_real mu_dot[KR5_TASK_DIM], kr5_real damping, kr5_real q_dot[KR5_DOF]);
 
 /* One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite).
- * Result: q_start[i], i < 6; q_next[i], i < 6; returned as a scalar. 1021 operations. */
+ * Result: q_start[i], i < 6; q_next[i], i < 6; returned as a scalar. 1016 operations. */
 kr5_real kr5_ik_numeric_step(const kr5_real target[16], const kr5_real q[KR5_DOF], kr5_real damping, kr5_real q_start[KR5_DOF], kr5_real q_next[KR5_DOF]);
 
 /* Every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits.
- * Result: q: 8 x 6 row-major, element (r, c) at q[r * 6 + c]; valid[i], i < 8; in_limits[i], i < 8. 1301 operations. */
+ * Result: q: 8 x 6 row-major, element (r, c) at q[r * 6 + c]; valid[i], i < 8; in_limits[i], i < 8. 1299 operations. */
 void kr5_ik_branches(const kr5_real T[16], kr5_real q[KR5_MAX_IK_SOLUTIONS * KR5_DOF], int valid[KR5_MAX_IK_SOLUTIONS], int in_limits[KR5_MAX_IK_SOLUTIONS]);
 
 /* The closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status.

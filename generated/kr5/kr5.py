@@ -89,40 +89,40 @@ def fk(q):
     s6 = trig[..., 11]
     t0 = s1*s4
     t1 = c1*c4
-    t2 = -t0 + c23*t1
-    t3 = t1 - c23*t0
+    t2 = -t0 + t1*c23
+    t3 = t1 - t0*c23
     t4 = c4*s1
     t5 = c1*s4
-    t6 = t4 + c23*t5
-    t7 = t5 + c23*t4
+    t6 = t4 + t5*c23
+    t7 = t5 + t4*c23
     t8 = c1*s23
-    t9 = c5*t2 - s5*t8
-    t10 = c5*t8 + s5*t2
-    t11 = c6*t9 - s6*t6
-    t12 = c6*t6 + s6*t9
+    t9 = t2*c5 - t8*s5
+    t10 = t2*s5 + t8*c5
+    t11 = t9*c6 - t6*s6
+    t12 = t6*c6 + t9*s6
     t13 = 0.62*t8 + 0.115*t10
     t14 = s1*s23
-    t15 = c5*t7 - s5*t14
-    t16 = c5*t14 + s5*t7
-    t17 = c6*t15 + s6*t3
-    t18 = c6*t3 - s6*t15
+    t15 = t7*c5 - t14*s5
+    t16 = t7*s5 + t14*c5
+    t17 = t3*s6 + t15*c6
+    t18 = t3*c6 - t15*s6
     t19 = 0.62*t14 + 0.115*t16
     t20 = c4*s23
-    t21 = c23*s5 + c5*t20
-    t22 = s5*t20 - c23*c5
+    t21 = t20*c5 + c23*s5
+    t22 = t20*s5 - c23*c5
     t23 = 0.115*t22 - 0.62*c23
     t24 = t23 - 0.12*s23
     t25 = t24 - 0.6*s2
     t26 = 0.4 + t25
     t27 = s23*s4
-    t28 = s6*t27 - c6*t21
-    t29 = c6*t27 + s6*t21
+    t28 = t27*s6 - t21*c6
+    t29 = t21*s6 + t27*c6
     t30 = 0.12*c23
-    t31 = -t13 + c1*t30
-    t32 = -t19 + s1*t30
+    t31 = -t13 + t30*c1
+    t32 = -t19 + t30*s1
     t33 = 0.6*c2
-    t34 = t31 + c1*t33
-    t35 = t32 + s1*t33
+    t34 = t31 + t33*c1
+    t35 = t32 + t33*s1
     t36 = t34 + 0.18*c1
     t37 = t35 + 0.18*s1
     T = _stack(xp, [
@@ -147,7 +147,7 @@ def fk(q):
 
 
 def jacobian(q):
-    """geometric Jacobian in the world frame (6 x DOF, rows vx vy vz wx wy wz): (6 x 6), 103 operations."""
+    """geometric Jacobian in the world frame (6 x DOF, rows vx vy vz wx wy wz): (6 x 6), 100 operations."""
     xp, dtype, device, batch, (q,) = _arguments(("q", q, (6,)))
     trig = _cos_sin(xp, q, (0.0, 0.0, 0.0, 0.0, 0.0, 0.0), device)
     c1 = trig[..., 0]
@@ -165,16 +165,16 @@ def jacobian(q):
     t0 = -c23*c5 + c4*s23*s5
     t1 = s1*s4
     t2 = c1*c4
-    t3 = -t1 + c23*t2
-    t4 = t2 - c23*t1
+    t3 = -t1 + t2*c23
+    t4 = t2 - t1*c23
     t5 = c4*s1
     t6 = c1*s4
-    t7 = t5 + c23*t6
-    t8 = t6 + c23*t5
+    t7 = t5 + t6*c23
+    t8 = t6 + t5*c23
     t9 = c1*s23
-    t10 = c5*t9 + s5*t3
+    t10 = t3*s5 + t9*c5
     t11 = s1*s23
-    t12 = c5*t11 + s5*t8
+    t12 = t8*s5 + t11*c5
     t13 = 0.115*t10
     t14 = t13 + 0.62*t9
     t15 = 0.115*t12
@@ -184,33 +184,33 @@ def jacobian(q):
     t19 = t18 - 0.12*s23
     t20 = t19 - 0.6*s2
     t21 = 0.12*c23
-    t22 = -t14 + c1*t21
-    t23 = -t16 + s1*t21
+    t22 = -t14 + t21*c1
+    t23 = -t16 + t21*s1
     t24 = 0.6*c2
-    t25 = t22 + c1*t24
-    t26 = t23 + s1*t24
+    t25 = t22 + t24*c1
+    t26 = t23 + t24*s1
     t27 = t25 + 0.18*c1
     t28 = t26 + 0.18*s1
     t29 = s23*s4
     t30 = -s1
     J = _stack(xp, [
         -t28,  # 0, 0
-        c1*t20,  # 0, 1
-        c1*t19,  # 0, 2
-        c23*t16 + t11*t18,  # 0, 3
-        t15*t29 + t17*t4,  # 0, 4
+        t20*c1,  # 0, 1
+        t19*c1,  # 0, 2
+        t16*c23 + t18*t11,  # 0, 3
+        t4*t17 + t29*t15,  # 0, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5
         t27,  # 1, 0
-        s1*t20,  # 1, 1
-        s1*t19,  # 1, 2
-        -c23*t14 - t18*t9,  # 1, 3
-        t17*t7 - t13*t29,  # 1, 4
+        t20*s1,  # 1, 1
+        t19*s1,  # 1, 2
+        -(t14*c23 + t18*t9),  # 1, 3
+        t7*t17 - t29*t13,  # 1, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
-        -c1*t25 - s1*t26,  # 2, 1
-        -c1*t22 - s1*t23,  # 2, 2
-        t11*t14 - t16*t9,  # 2, 3
-        t13*t4 + t15*t7,  # 2, 4
+        -(t25*c1 + t26*s1),  # 2, 1
+        -(t22*c1 + t23*s1),  # 2, 2
+        t14*t11 - t16*t9,  # 2, 3
+        t7*t15 + t4*t13,  # 2, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
         t30,  # 3, 1
@@ -235,7 +235,7 @@ def jacobian(q):
 
 
 def fk_jacobian(q):
-    """fk and jacobian in one pass, sharing their terms: (4 x 4 and 6 x 6), 137 operations."""
+    """fk and jacobian in one pass, sharing their terms: (4 x 4 and 6 x 6), 134 operations."""
     xp, dtype, device, batch, (q,) = _arguments(("q", q, (6,)))
     trig = _cos_sin(xp, q, (0.0, 0.0, 0.0, 0.0, 0.0, 0.0), device)
     c1 = trig[..., 0]
@@ -254,28 +254,28 @@ def fk_jacobian(q):
     s6 = trig[..., 11]
     t0 = s1*s4
     t1 = c1*c4
-    t2 = -t0 + c23*t1
-    t3 = t1 - c23*t0
+    t2 = -t0 + t1*c23
+    t3 = t1 - t0*c23
     t4 = c4*s1
     t5 = c1*s4
-    t6 = t4 + c23*t5
-    t7 = t5 + c23*t4
+    t6 = t4 + t5*c23
+    t7 = t5 + t4*c23
     t8 = c1*s23
-    t9 = c5*t2 - s5*t8
-    t10 = c5*t8 + s5*t2
-    t11 = c6*t9 - s6*t6
-    t12 = c6*t6 + s6*t9
+    t9 = t2*c5 - t8*s5
+    t10 = t2*s5 + t8*c5
+    t11 = t9*c6 - t6*s6
+    t12 = t6*c6 + t9*s6
     t13 = s1*s23
-    t14 = c5*t7 - s5*t13
-    t15 = c5*t13 + s5*t7
-    t16 = c6*t14 + s6*t3
-    t17 = c6*t3 - s6*t14
+    t14 = t7*c5 - t13*s5
+    t15 = t7*s5 + t13*c5
+    t16 = t3*s6 + t14*c6
+    t17 = t3*c6 - t14*s6
     t18 = c4*s23
-    t19 = c23*s5 + c5*t18
-    t20 = s5*t18 - c23*c5
+    t19 = t18*c5 + c23*s5
+    t20 = t18*s5 - c23*c5
     t21 = s23*s4
-    t22 = s6*t21 - c6*t19
-    t23 = c6*t21 + s6*t19
+    t22 = t21*s6 - t19*c6
+    t23 = t19*s6 + t21*c6
     t24 = 0.115*t10
     t25 = t24 + 0.62*t8
     t26 = 0.115*t15
@@ -286,11 +286,11 @@ def fk_jacobian(q):
     t31 = t30 - 0.6*s2
     t32 = 0.4 + t31
     t33 = 0.12*c23
-    t34 = -t25 + c1*t33
-    t35 = -t27 + s1*t33
+    t34 = -t25 + t33*c1
+    t35 = -t27 + t33*s1
     t36 = 0.6*c2
-    t37 = t34 + c1*t36
-    t38 = t35 + s1*t36
+    t37 = t34 + t36*c1
+    t38 = t35 + t36*s1
     t39 = t37 + 0.18*c1
     t40 = t38 + 0.18*s1
     t41 = -s1
@@ -314,22 +314,22 @@ def fk_jacobian(q):
     ], (4, 4))
     J = _stack(xp, [
         -t40,  # 0, 0
-        c1*t31,  # 0, 1
-        c1*t30,  # 0, 2
-        c23*t27 + t13*t29,  # 0, 3
-        t21*t26 + t28*t3,  # 0, 4
+        t31*c1,  # 0, 1
+        t30*c1,  # 0, 2
+        t27*c23 + t29*t13,  # 0, 3
+        t3*t28 + t21*t26,  # 0, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5
         t39,  # 1, 0
-        s1*t31,  # 1, 1
-        s1*t30,  # 1, 2
-        -c23*t25 - t29*t8,  # 1, 3
-        t28*t6 - t21*t24,  # 1, 4
+        t31*s1,  # 1, 1
+        t30*s1,  # 1, 2
+        -(t25*c23 + t29*t8),  # 1, 3
+        t6*t28 - t21*t24,  # 1, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
-        -c1*t37 - s1*t38,  # 2, 1
-        -c1*t34 - s1*t35,  # 2, 2
-        t13*t25 - t27*t8,  # 2, 3
-        t24*t3 + t26*t6,  # 2, 4
+        -(t37*c1 + t38*s1),  # 2, 1
+        -(t34*c1 + t35*s1),  # 2, 2
+        t25*t13 - t27*t8,  # 2, 3
+        t6*t26 + t3*t24,  # 2, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
         t41,  # 3, 1
@@ -354,7 +354,7 @@ def fk_jacobian(q):
 
 
 def jacobian_tool(q):
-    """geometric Jacobian in the tool frame (6 x DOF, rows vx vy vz wx wy wz): (6 x 6), 260 operations."""
+    """geometric Jacobian in the tool frame (6 x DOF, rows vx vy vz wx wy wz): (6 x 6), 251 operations."""
     xp, dtype, device, batch, (q,) = _arguments(("q", q, (6,)))
     trig = _cos_sin(xp, q, (0.0, 0.0, 0.0, 0.0, 0.0, 0.0), device)
     c1 = trig[..., 0]
@@ -373,28 +373,28 @@ def jacobian_tool(q):
     s6 = trig[..., 11]
     t0 = s1*s4
     t1 = c1*c4
-    t2 = -t0 + c23*t1
-    t3 = t1 - c23*t0
+    t2 = -t0 + t1*c23
+    t3 = t1 - t0*c23
     t4 = c4*s1
     t5 = c1*s4
-    t6 = t4 + c23*t5
-    t7 = t5 + c23*t4
+    t6 = t4 + t5*c23
+    t7 = t5 + t4*c23
     t8 = c1*s23
-    t9 = c5*t2 - s5*t8
-    t10 = c5*t8 + s5*t2
-    t11 = c6*t9 - s6*t6
-    t12 = c6*t6 + s6*t9
+    t9 = t2*c5 - t8*s5
+    t10 = t2*s5 + t8*c5
+    t11 = t9*c6 - t6*s6
+    t12 = t6*c6 + t9*s6
     t13 = s1*s23
-    t14 = c5*t7 - s5*t13
-    t15 = c5*t13 + s5*t7
-    t16 = c6*t14 + s6*t3
-    t17 = c6*t3 - s6*t14
+    t14 = t7*c5 - t13*s5
+    t15 = t7*s5 + t13*c5
+    t16 = t3*s6 + t14*c6
+    t17 = t3*c6 - t14*s6
     t18 = c4*s23
-    t19 = c23*s5 + c5*t18
-    t20 = s5*t18 - c23*c5
+    t19 = t18*c5 + c23*s5
+    t20 = t18*s5 - c23*c5
     t21 = s23*s4
-    t22 = s6*t21 - c6*t19
-    t23 = c6*t21 + s6*t19
+    t22 = t21*s6 - t19*c6
+    t23 = t19*s6 + t21*c6
     t24 = 0.115*t10
     t25 = t24 + 0.62*t8
     t26 = 0.115*t15
@@ -404,29 +404,29 @@ def jacobian_tool(q):
     t30 = t29 - 0.12*s23
     t31 = t30 - 0.6*s2
     t32 = 0.12*c23
-    t33 = -t25 + c1*t32
-    t34 = -t27 + s1*t32
+    t33 = -t25 + t32*c1
+    t34 = -t27 + t32*s1
     t35 = 0.6*c2
-    t36 = t33 + c1*t35
-    t37 = t34 + s1*t35
+    t36 = t33 + t35*c1
+    t37 = t34 + t35*s1
     t38 = t36 + 0.18*c1
     t39 = t37 + 0.18*s1
-    t40 = c1*t11
-    t41 = s1*t16
-    t42 = -c1*t36 - s1*t37
-    t43 = -c1*t33 - s1*t34
-    t44 = c23*t27 + t13*t29
-    t45 = -c23*t25 - t29*t8
-    t46 = t13*t25 - t27*t8
-    t47 = t24*t3 + t26*t6
-    t48 = t21*t26 + t28*t3
-    t49 = t28*t6 - t21*t24
-    t50 = s1*t17
-    t51 = c1*t10
-    t52 = s1*t15
-    t53 = c1*t16 - s1*t11
-    t54 = -c1*t17 - s1*t12
-    t55 = s1*t10 - c1*t15
+    t40 = t11*c1
+    t41 = t16*s1
+    t42 = -(t36*c1 + t37*s1)
+    t43 = -(t33*c1 + t34*s1)
+    t44 = t27*c23 + t29*t13
+    t45 = -(t25*c23 + t29*t8)
+    t46 = t25*t13 - t27*t8
+    t47 = t6*t26 + t3*t24
+    t48 = t3*t28 + t21*t26
+    t49 = t6*t28 - t21*t24
+    t50 = t17*s1
+    t51 = t10*c1
+    t52 = t15*s1
+    t53 = t16*c1 - t11*s1
+    t54 = -(t12*s1 + t17*c1)
+    t55 = t10*s1 - t15*c1
     J = _stack(xp, [
         t16*t38 - t11*t39,  # 0, 0
         t22*t42 + t31*t40 + t31*t41,  # 0, 1
@@ -434,36 +434,36 @@ def jacobian_tool(q):
         t11*t44 + t16*t45 + t22*t46,  # 0, 3
         t11*t48 + t16*t49 + t22*t47,  # 0, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5
-        -t12*t39 - t17*t38,  # 1, 0
-        -t23*t42 - t31*t50 + c1*t12*t31,  # 1, 1
-        -t23*t43 - t30*t50 + c1*t12*t30,  # 1, 2
-        t12*t44 - t17*t45 - t23*t46,  # 1, 3
-        t12*t48 - t17*t49 - t23*t47,  # 1, 4
+        -(t12*t39 + t17*t38),  # 1, 0
+        -(t23*t42 + t31*t50 - t12*t31*c1),  # 1, 1
+        -(t23*t43 + t30*t50 - t12*t30*c1),  # 1, 2
+        -(t17*t45 + t23*t46 - t12*t44),  # 1, 3
+        -(t17*t49 + t23*t47 - t12*t48),  # 1, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5
         t10*t39 - t15*t38,  # 2, 0
-        t20*t42 - t31*t51 - t31*t52,  # 2, 1
-        t20*t43 - t30*t51 - t30*t52,  # 2, 2
-        t20*t46 - t10*t44 - t15*t45,  # 2, 3
-        t20*t47 - t10*t48 - t15*t49,  # 2, 4
+        -(t31*t51 + t31*t52 - t20*t42),  # 2, 1
+        -(t30*t51 + t30*t52 - t20*t43),  # 2, 2
+        -(t10*t44 + t15*t45 - t20*t46),  # 2, 3
+        -(t10*t48 + t15*t49 - t20*t47),  # 2, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 5
         t22,  # 3, 0
         t53,  # 3, 1
         t53,  # 3, 2
-        c23*t22 + t11*t8 + t13*t16,  # 3, 3
-        t16*t3 + t21*t22 - t11*t6,  # 3, 4
+        t11*t8 + t16*t13 + t22*c23,  # 3, 3
+        t3*t16 + t22*t21 - t6*t11,  # 3, 4
         t10*t11 + t15*t16 - t20*t22,  # 3, 5
         -t23,  # 4, 0
         t54,  # 4, 1
         t54,  # 4, 2
-        -c23*t23 - t13*t17 + c1*s23*t12,  # 4, 3
-        -t12*t6 - t17*t3 - t21*t23,  # 4, 4
+        -(t17*t13 + t23*c23 - t12*c1*s23),  # 4, 3
+        -(t6*t12 + t3*t17 + t23*t21),  # 4, 4
         t10*t12 + t20*t23 - t15*t17,  # 4, 5
         t20,  # 5, 0
         t55,  # 5, 1
         t55,  # 5, 2
-        c23*t20 - t10*t8 - t13*t15,  # 5, 3
-        t10*t6 + t20*t21 - t15*t3,  # 5, 4
-        -t10**2 - t15**2 - t20**2,  # 5, 5
+        -(t10*t8 + t15*t13 - t20*c23),  # 5, 3
+        t6*t10 + t20*t21 - t3*t15,  # 5, 4
+        -(t10**2 + t15**2 + t20**2),  # 5, 5
     ], (6, 6))
     return J
 
@@ -488,38 +488,38 @@ def task(q):
     s6 = trig[..., 11]
     t0 = s1*s4
     t1 = c1*c4
-    t2 = -t0 + c23*t1
-    t3 = t1 - c23*t0
+    t2 = -t0 + t1*c23
+    t3 = t1 - t0*c23
     t4 = c4*s1
     t5 = c1*s4
-    t6 = t4 + c23*t5
-    t7 = t5 + c23*t4
+    t6 = t4 + t5*c23
+    t7 = t5 + t4*c23
     t8 = c1*s23
-    t9 = c5*t2 - s5*t8
-    t10 = c5*t8 + s5*t2
-    t11 = c6*t9 - s6*t6
+    t9 = t2*c5 - t8*s5
+    t10 = t2*s5 + t8*c5
+    t11 = t9*c6 - t6*s6
     t12 = 0.62*t8 + 0.115*t10
     t13 = s1*s23
-    t14 = c5*t7 - s5*t13
-    t15 = c5*t13 + s5*t7
-    t16 = c6*t14 + s6*t3
+    t14 = t7*c5 - t13*s5
+    t15 = t7*s5 + t13*c5
+    t16 = t3*s6 + t14*c6
     t17 = 0.62*t13 + 0.115*t15
     t18 = c4*s23
-    t19 = c23*s5 + c5*t18
-    t20 = s5*t18 - c23*c5
+    t19 = t18*c5 + c23*s5
+    t20 = t18*s5 - c23*c5
     t21 = 0.115*t20 - 0.62*c23
     t22 = t21 - 0.12*s23
     t23 = t22 - 0.6*s2
     t24 = 0.4 + t23
     t25 = s23*s4
-    t26 = s6*t25 - c6*t19
-    t27 = c6*t25 + s6*t19
+    t26 = t25*s6 - t19*c6
+    t27 = t19*s6 + t25*c6
     t28 = 0.12*c23
-    t29 = -t12 + c1*t28
-    t30 = -t17 + s1*t28
+    t29 = -t12 + t28*c1
+    t30 = -t17 + t28*s1
     t31 = 0.6*c2
-    t32 = t29 + c1*t31
-    t33 = t30 + s1*t31
+    t32 = t29 + t31*c1
+    t33 = t30 + t31*s1
     t34 = t32 + 0.18*c1
     t35 = t33 + 0.18*s1
     mu = _stack(xp, [
@@ -534,7 +534,7 @@ def task(q):
 
 
 def task_jacobian(q):
-    """analytic Jacobian d mu / d q (6 x DOF): (6 x 6), 168 operations."""
+    """analytic Jacobian d mu / d q (6 x DOF): (6 x 6), 164 operations."""
     xp, dtype, device, batch, (q,) = _arguments(("q", q, (6,)))
     trig = _cos_sin(xp, q, (0.0, 0.0, 0.0, 0.0, 0.0, 0.0), device)
     c1 = trig[..., 0]
@@ -553,25 +553,25 @@ def task_jacobian(q):
     s6 = trig[..., 11]
     t0 = s1*s4
     t1 = c1*c4
-    t2 = -t0 + c23*t1
-    t3 = t1 - c23*t0
+    t2 = -t0 + t1*c23
+    t3 = t1 - t0*c23
     t4 = c4*s1
     t5 = c1*s4
-    t6 = t4 + c23*t5
-    t7 = t5 + c23*t4
+    t6 = t4 + t5*c23
+    t7 = t5 + t4*c23
     t8 = c1*s23
-    t9 = c5*t2 - s5*t8
-    t10 = c5*t8 + s5*t2
-    t11 = c6*t9 - s6*t6
+    t9 = t2*c5 - t8*s5
+    t10 = t2*s5 + t8*c5
+    t11 = t9*c6 - t6*s6
     t12 = s1*s23
-    t13 = c5*t7 - s5*t12
-    t14 = c5*t12 + s5*t7
-    t15 = c6*t13 + s6*t3
+    t13 = t7*c5 - t12*s5
+    t14 = t7*s5 + t12*c5
+    t15 = t3*s6 + t13*c6
     t16 = c4*s23
-    t17 = c23*s5 + c5*t16
-    t18 = s5*t16 - c23*c5
+    t17 = t16*c5 + c23*s5
+    t18 = t16*s5 - c23*c5
     t19 = s23*s4
-    t20 = s6*t19 - c6*t17
+    t20 = t19*s6 - t17*c6
     t21 = 0.115*t10
     t22 = t21 + 0.62*t8
     t23 = 0.115*t14
@@ -581,44 +581,44 @@ def task_jacobian(q):
     t27 = t26 - 0.12*s23
     t28 = t27 - 0.6*s2
     t29 = 0.12*c23
-    t30 = -t22 + c1*t29
-    t31 = -t24 + s1*t29
+    t30 = -t22 + t29*c1
+    t31 = -t24 + t29*s1
     t32 = 0.6*c2
-    t33 = t30 + c1*t32
-    t34 = t31 + s1*t32
+    t33 = t30 + t32*c1
+    t34 = t31 + t32*s1
     t35 = t33 + 0.18*c1
     t36 = t34 + 0.18*s1
-    t37 = c1*t15
-    t38 = s1*t11
+    t37 = t15*c1
+    t38 = t11*s1
     t39 = t11**2 + t15**2
-    t40 = t39**(-1.0)
+    t40 = 1/t39
     t41 = t40*(t37 - t38)
-    t42 = c1*t11
-    t43 = s1*t15
-    t44 = t40*(s23*t42 + s23*t43)
-    t45 = t40*(t15*t3 - t11*t6)
+    t42 = t11*c1
+    t43 = t15*s1
+    t44 = t40*(t42*s23 + t43*s23)
+    t45 = t40*(t3*t15 - t6*t11)
     t46 = t40*(t10*t11 + t14*t15)
     t47 = 1/xp.sqrt(t39)
     t48 = t47*(t42 + t43)
     t49 = -t20*t41
     J = _stack(xp, [
         -t36,  # 0, 0
-        c1*t28,  # 0, 1
-        c1*t27,  # 0, 2
-        c23*t24 + t12*t26,  # 0, 3
-        t19*t23 + t25*t3,  # 0, 4
+        t28*c1,  # 0, 1
+        t27*c1,  # 0, 2
+        t24*c23 + t26*t12,  # 0, 3
+        t3*t25 + t19*t23,  # 0, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5
         t35,  # 1, 0
-        s1*t28,  # 1, 1
-        s1*t27,  # 1, 2
-        -c23*t22 - t26*t8,  # 1, 3
-        t25*t6 - t19*t21,  # 1, 4
+        t28*s1,  # 1, 1
+        t27*s1,  # 1, 2
+        -(t22*c23 + t26*t8),  # 1, 3
+        t6*t25 - t19*t21,  # 1, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
-        -c1*t33 - s1*t34,  # 2, 1
-        -c1*t30 - s1*t31,  # 2, 2
-        t12*t22 - t24*t8,  # 2, 3
-        t21*t3 + t23*t6,  # 2, 4
+        -(t33*c1 + t34*s1),  # 2, 1
+        -(t30*c1 + t31*s1),  # 2, 2
+        t22*t12 - t24*t8,  # 2, 3
+        t6*t23 + t3*t21,  # 2, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
         t41,  # 3, 1
@@ -629,15 +629,15 @@ def task_jacobian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
         t48,  # 4, 1
         t48,  # 4, 2
-        t47*(s23*t38 - s23*t37),  # 4, 3
-        t47*(t11*t3 + t15*t6),  # 4, 4
-        t47*(t11*t14 - t10*t15),  # 4, 5
+        t47*(t38*s23 - t37*s23),  # 4, 3
+        t47*(t6*t15 + t3*t11),  # 4, 4
+        t47*(t14*t11 - t10*t15),  # 4, 5
         xp.full(batch, 1, dtype=dtype, device=device),  # 5, 0
         t49,  # 5, 1
         t49,  # 5, 2
         c23 - t20*t44,  # 5, 3
         t19 - t20*t45,  # 5, 4
-        -t18 - t20*t46,  # 5, 5
+        -(t18 + t20*t46),  # 5, 5
     ], (6, 6))
     return J
 
@@ -669,29 +669,29 @@ def fk_jacobian_dot(q, q_dot):
     t0 = qd1 + c23*qd4
     t1 = s1*s4
     t2 = c1*c4
-    t3 = -t1 + c23*t2
-    t4 = t2 - c23*t1
+    t3 = -t1 + t2*c23
+    t4 = t2 - t1*c23
     t5 = c4*s1
     t6 = c1*s4
-    t7 = t5 + c23*t6
-    t8 = t6 + c23*t5
+    t7 = t5 + t6*c23
+    t8 = t6 + t5*c23
     t9 = c1*s23
-    t10 = c5*t3 - s5*t9
-    t11 = c5*t9 + s5*t3
-    t12 = c6*t10 - s6*t7
-    t13 = c6*t7 + s6*t10
+    t10 = t3*c5 - t9*s5
+    t11 = t3*s5 + t9*c5
+    t12 = t10*c6 - t7*s6
+    t13 = t7*c6 + t10*s6
     t14 = s1*s23
-    t15 = c5*t8 - s5*t14
-    t16 = c5*t14 + s5*t8
-    t17 = c6*t15 + s6*t4
-    t18 = c6*t4 - s6*t15
+    t15 = t8*c5 - t14*s5
+    t16 = t8*s5 + t14*c5
+    t17 = t4*s6 + t15*c6
+    t18 = t4*c6 - t15*s6
     t19 = c4*s23
-    t20 = c23*s5 + c5*t19
-    t21 = s5*t19 - c23*c5
+    t20 = t19*c5 + c23*s5
+    t21 = t19*s5 - c23*c5
     t22 = s23*s4
-    t23 = s6*t22 - c6*t20
-    t24 = c6*t22 + s6*t20
-    t25 = t0 + qd5*t22
+    t23 = t22*s6 - t20*c6
+    t24 = t20*s6 + t22*c6
+    t25 = t0 + t22*qd5
     t26 = 0.115*t11
     t27 = t26 + 0.62*t9
     t28 = 0.115*t16
@@ -702,60 +702,60 @@ def fk_jacobian_dot(q, q_dot):
     t33 = t32 - 0.6*s2
     t34 = 0.4 + t33
     t35 = 0.12*c23
-    t36 = -t27 + c1*t35
-    t37 = -t29 + s1*t35
+    t36 = -t27 + t35*c1
+    t37 = -t29 + t35*s1
     t38 = 0.6*c2
-    t39 = t36 + c1*t38
-    t40 = t37 + s1*t38
+    t39 = t36 + t38*c1
+    t40 = t37 + t38*s1
     t41 = t39 + 0.18*c1
     t42 = t40 + 0.18*s1
-    t43 = c23*t29 + t14*t31
+    t43 = t29*c23 + t31*t14
     t44 = t43
-    t45 = t22*t28 + t30*t4
+    t45 = t4*t30 + t22*t28
     t46 = t45
-    t47 = c23*t27 + t31*t9
+    t47 = t27*c23 + t31*t9
     t48 = t47
-    t49 = t30*t7 - t22*t26
+    t49 = t7*t30 - t22*t26
     t50 = t49
-    t51 = c1*t39 + s1*t40
+    t51 = t39*c1 + t40*s1
     t52 = t51
-    t53 = c1*t36 + s1*t37
+    t53 = t36*c1 + t37*s1
     t54 = t53
-    t55 = t14*t27 - t29*t9
+    t55 = t27*t14 - t29*t9
     t56 = t55
-    t57 = t26*t4 + t28*t7
+    t57 = t7*t28 + t4*t26
     t58 = t57
-    t59 = qd4*t56 + qd5*t58
-    t60 = t59 - qd3*t54
-    t61 = t60 - qd2*t52
+    t59 = t56*qd4 + t58*qd5
+    t60 = t59 - t54*qd3
+    t61 = t60 - t52*qd2
     t62 = qd2*s1
     t63 = qd3*s1
     t64 = t62 + t63
-    t65 = -t64 + qd4*t9
+    t65 = -t64 + t9*qd4
     t66 = c1*qd2
     t67 = c1*qd3
     t68 = t66 + t67
-    t69 = t68 + qd4*t14
-    t70 = qd5*t7
+    t69 = t68 + t14*qd4
+    t70 = t7*qd5
     t71 = t65 - t70
-    t72 = qd5*t4
+    t72 = t4*qd5
     t73 = t69 + t72
-    t74 = qd5*t46
-    t75 = t74 + qd4*t44
+    t74 = t46*qd5
+    t75 = t74 + t44*qd4
     t76 = t75 + t32*t67
     t77 = t76 + t33*t66
-    t78 = t77 - qd1*t42
-    t79 = qd5*t50
-    t80 = t79 - qd4*t48
+    t78 = t77 - t42*qd1
+    t79 = t50*qd5
+    t80 = t79 - t48*qd4
     t81 = t80 + t32*t63
     t82 = t81 + t33*t62
-    t83 = t82 + qd1*t41
-    t84 = c1*t33
-    t85 = c1*t32
-    t86 = s1*t33
-    t87 = s1*t32
+    t83 = t82 + t41*qd1
+    t84 = t33*c1
+    t85 = t32*c1
+    t86 = t33*s1
+    t87 = t32*s1
     t88 = -s1
-    t89 = qd2*t32
+    t89 = t32*qd2
     T = _stack(xp, [
         xp.broadcast_to(t12, batch),  # 0, 0
         xp.broadcast_to(t13, batch),  # 0, 1
@@ -813,18 +813,18 @@ def fk_jacobian_dot(q, q_dot):
         xp.broadcast_to(-t21, batch),  # 5, 5
     ], (6, 6))
     a = _stack(xp, [
-        xp.broadcast_to(qd2*(c1*t61 - qd1*t86) + qd4*(qd1*t48 + t14*t59 + t56*t68 - c23*t80) + qd5*(t58*t69 + t58*t72 - t0*t50 - t22*t79) - qd1*t83 - qd3*(qd1*t87 + t54*t66 - c1*t60), batch),  # 0
-        xp.broadcast_to(qd1*t78 + qd2*(qd1*t84 + s1*t61) + qd3*(qd1*t85 + s1*t60 - t54*t62) + qd4*(c23*t75 + qd1*t44 + t56*t64 - t59*t9) + qd5*(t0*t46 + t22*t74 + t58*t70 - t58*t65), batch),  # 1
-        xp.broadcast_to(qd4*(t48*t64 + t80*t9 - t14*t75 - t44*t68) - qd2*(c1*t77 + s1*t82) - qd3*(c1*t76 + s1*t81 + t89*c1**2 + t89*s1**2) - qd5*(t46*t69 + t46*t72 + t50*t70 - t50*t65), batch),  # 2
-        xp.broadcast_to(qd4*(c23*t68 - qd1*t14) + qd5*(t22*t69 - t0*t4) - qd1*t66 - qd1*t67 - qd6*(t16*t25 + t21*t73), batch),  # 3
-        xp.broadcast_to(qd4*(c23*t64 + qd1*t9) + qd6*(t11*t25 + t21*t71) - qd1*t62 - qd1*t63 - qd5*(t0*t7 + t22*t65), batch),  # 4
-        xp.broadcast_to(qd5*(t4*t65 + t69*t7) + qd6*(t16*t71 - t11*t73) - qd4*(t14*t64 + t68*t9), batch),  # 5
+        xp.broadcast_to(qd2*(t61*c1 - t86*qd1) + qd4*(t48*qd1 + t56*t68 + t59*t14 - t80*c23) + qd5*(t58*t69 + t58*t72 - t50*t0 - t79*t22) - t83*qd1 - qd3*(t54*t66 + t87*qd1 - t60*c1), batch),  # 0
+        xp.broadcast_to(t78*qd1 + qd2*(t61*s1 + t84*qd1) + qd3*(t60*s1 + t85*qd1 - t54*t62) + qd4*(t44*qd1 + t56*t64 + t75*c23 - t59*t9) + qd5*(t46*t0 + t58*t70 + t74*t22 - t58*t65), batch),  # 1
+        xp.broadcast_to(qd4*(t48*t64 + t80*t9 - t44*t68 - t75*t14) - qd2*(t77*c1 + t82*s1) - qd3*(t76*c1 + t81*s1 + t89*c1**2 + t89*s1**2) - qd5*(t46*t69 + t46*t72 + t50*t70 - t50*t65), batch),  # 2
+        xp.broadcast_to(qd4*(t68*c23 - t14*qd1) + qd5*(t69*t22 - t4*t0) - t66*qd1 - t67*qd1 - qd6*(t16*t25 + t21*t73), batch),  # 3
+        xp.broadcast_to(qd4*(t64*c23 + t9*qd1) + qd6*(t11*t25 + t21*t71) - t62*qd1 - t63*qd1 - qd5*(t7*t0 + t65*t22), batch),  # 4
+        xp.broadcast_to(qd5*(t7*t69 + t4*t65) + qd6*(t16*t71 - t11*t73) - qd4*(t64*t14 + t68*t9), batch),  # 5
     ], (6,))
     return T, J, a
 
 
 def jacobian_dot(q, q_dot):
-    """time derivative dJ/dt of the world geometric Jacobian along q_dot (6 x DOF): (6 x 6), 246 operations."""
+    """time derivative dJ/dt of the world geometric Jacobian along q_dot (6 x DOF): (6 x 6), 238 operations."""
     xp, dtype, device, batch, (q, q_dot,) = _arguments(("q", q, (6,)), ("q_dot", q_dot, (6,)))
     qd1 = q_dot[..., 0]
     qd2 = q_dot[..., 1]
@@ -848,111 +848,111 @@ def jacobian_dot(q, q_dot):
     t1 = qd1 + c23*qd4
     t2 = s1*s4
     t3 = c1*c4
-    t4 = -t2 + c23*t3
-    t5 = t3 - c23*t2
+    t4 = -t2 + t3*c23
+    t5 = t3 - t2*c23
     t6 = c4*s1
     t7 = c1*s4
-    t8 = t6 + c23*t7
-    t9 = t7 + c23*t6
+    t8 = t6 + t7*c23
+    t9 = t7 + t6*c23
     t10 = c5*s23
-    t11 = c1*t10 + s5*t4
-    t12 = s1*t10 + s5*t9
+    t11 = t4*s5 + t10*c1
+    t12 = t9*s5 + t10*s1
     t13 = 0.115*t11
     t14 = 0.62*s23
-    t15 = t13 + c1*t14
+    t15 = t13 + t14*c1
     t16 = 0.115*t12
-    t17 = t16 + s1*t14
-    t18 = t13*t5 + t16*t8
+    t17 = t16 + t14*s1
+    t18 = t8*t16 + t5*t13
     t19 = 0.115*t0
     t20 = t19 - 0.62*c23
     t21 = t20 - 0.12*s23
     t22 = t21 - 0.6*s2
     t23 = 0.12*c23
-    t24 = -t15 + c1*t23
-    t25 = -t17 + s1*t23
-    t26 = c1*t24 + s1*t25
+    t24 = -t15 + t23*c1
+    t25 = -t17 + t23*s1
+    t26 = t24*c1 + t25*s1
     t27 = 0.6*c2
-    t28 = t24 + c1*t27
-    t29 = t25 + s1*t27
+    t28 = t24 + t27*c1
+    t29 = t25 + t27*s1
     t30 = t28 + 0.18*c1
     t31 = t29 + 0.18*s1
-    t32 = c1*t28 + s1*t29
-    t33 = s23*t20
-    t34 = c23*t17 + s1*t33
-    t35 = c1*t33 + c23*t15
+    t32 = t28*c1 + t29*s1
+    t33 = t20*s23
+    t34 = t17*c23 + t33*s1
+    t35 = t15*c23 + t33*c1
     t36 = s23*s4
-    t37 = t16*t36 + t19*t5
-    t38 = t19*t8 - t13*t36
-    t39 = t1 + qd5*t36
+    t37 = t5*t19 + t36*t16
+    t38 = t8*t19 - t36*t13
+    t39 = t1 + t36*qd5
     t40 = s1*s23
     t41 = c1*s23
     t42 = t15*t40 - t17*t41
-    t43 = qd4*t42 + qd5*t18
-    t44 = t43 - qd3*t26
-    t45 = t44 - qd2*t32
+    t43 = t42*qd4 + t18*qd5
+    t44 = t43 - t26*qd3
+    t45 = t44 - t32*qd2
     t46 = qd2*s1
     t47 = qd3*s1
     t48 = t46 + t47
-    t49 = -t48 + qd4*t41
+    t49 = -t48 + t41*qd4
     t50 = c1*qd2
     t51 = c1*qd3
     t52 = t50 + t51
-    t53 = t52 + qd4*t40
-    t54 = qd5*t8
+    t53 = t52 + t40*qd4
+    t54 = t8*qd5
     t55 = t49 - t54
-    t56 = qd5*t5
+    t56 = t5*qd5
     t57 = t53 + t56
-    t58 = qd5*t37
-    t59 = t58 + qd4*t34
+    t58 = t37*qd5
+    t59 = t58 + t34*qd4
     t60 = t59 + t21*t51
     t61 = t60 + t22*t50
-    t62 = t61 - qd1*t31
-    t63 = qd5*t38
-    t64 = t63 - qd4*t35
+    t62 = t61 - t31*qd1
+    t63 = t38*qd5
+    t64 = t63 - t35*qd4
     t65 = t64 + t21*t47
     t66 = t65 + t22*t46
-    t67 = t66 + qd1*t30
+    t67 = t66 + t30*qd1
     t68 = qd1*s1
     t69 = c1*qd1
-    t70 = qd2*t21
+    t70 = t21*qd2
     t71 = -t69
     t72 = -t68
     Jd = _stack(xp, [
         xp.broadcast_to(-t67, batch),  # 0, 0
-        xp.broadcast_to(c1*t45 - t22*t68, batch),  # 0, 1
-        xp.broadcast_to(c1*t44 - t21*t68 - t26*t50, batch),  # 0, 2
-        xp.broadcast_to(qd1*t35 + t40*t43 + t42*t52 - c23*t64, batch),  # 0, 3
-        xp.broadcast_to(t18*t53 + t18*t56 - t1*t38 - t36*t63, batch),  # 0, 4
+        xp.broadcast_to(t45*c1 - t22*t68, batch),  # 0, 1
+        xp.broadcast_to(-(t21*t68 + t26*t50 - t44*c1), batch),  # 0, 2
+        xp.broadcast_to(t35*qd1 + t42*t52 + t43*t40 - t64*c23, batch),  # 0, 3
+        xp.broadcast_to(t18*t53 + t18*t56 - t38*t1 - t36*t63, batch),  # 0, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5
         xp.broadcast_to(t62, batch),  # 1, 0
-        xp.broadcast_to(s1*t45 + t22*t69, batch),  # 1, 1
-        xp.broadcast_to(s1*t44 + t21*t69 - t26*t46, batch),  # 1, 2
-        xp.broadcast_to(c23*t59 + qd1*t34 + t42*t48 - t41*t43, batch),  # 1, 3
-        xp.broadcast_to(t1*t37 + t18*t54 + t36*t58 - t18*t49, batch),  # 1, 4
+        xp.broadcast_to(t22*t69 + t45*s1, batch),  # 1, 1
+        xp.broadcast_to(t21*t69 + t44*s1 - t26*t46, batch),  # 1, 2
+        xp.broadcast_to(t34*qd1 + t42*t48 + t59*c23 - t43*t41, batch),  # 1, 3
+        xp.broadcast_to(t37*t1 + t18*t54 + t36*t58 - t18*t49, batch),  # 1, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
-        xp.broadcast_to(-c1*t61 - s1*t66, batch),  # 2, 1
-        xp.broadcast_to(-c1*t60 - s1*t65 - t70*c1**2 - t70*s1**2, batch),  # 2, 2
-        xp.broadcast_to(t35*t48 + t41*t64 - t34*t52 - t40*t59, batch),  # 2, 3
-        xp.broadcast_to(t38*t49 - t37*t53 - t37*t56 - t38*t54, batch),  # 2, 4
+        xp.broadcast_to(-(t61*c1 + t66*s1), batch),  # 2, 1
+        xp.broadcast_to(-(t60*c1 + t65*s1 + t70*c1**2 + t70*s1**2), batch),  # 2, 2
+        xp.broadcast_to(t35*t48 + t64*t41 - t34*t52 - t59*t40, batch),  # 2, 3
+        xp.broadcast_to(-(t37*t53 + t37*t56 + t38*t54 - t38*t49), batch),  # 2, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
         xp.broadcast_to(t71, batch),  # 3, 1
         xp.broadcast_to(t71, batch),  # 3, 2
-        xp.broadcast_to(c23*t52 - s23*t68, batch),  # 3, 3
-        xp.broadcast_to(t36*t53 - t1*t5, batch),  # 3, 4
-        xp.broadcast_to(-t0*t57 - t12*t39, batch),  # 3, 5
+        xp.broadcast_to(t52*c23 - t68*s23, batch),  # 3, 3
+        xp.broadcast_to(t53*t36 - t5*t1, batch),  # 3, 4
+        xp.broadcast_to(-(t12*t39 + t0*t57), batch),  # 3, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
         xp.broadcast_to(t72, batch),  # 4, 1
         xp.broadcast_to(t72, batch),  # 4, 2
-        xp.broadcast_to(c23*t48 + s23*t69, batch),  # 4, 3
-        xp.broadcast_to(-t1*t8 - t36*t49, batch),  # 4, 4
-        xp.broadcast_to(t0*t55 + t11*t39, batch),  # 4, 5
+        xp.broadcast_to(t48*c23 + t69*s23, batch),  # 4, 3
+        xp.broadcast_to(-(t8*t1 + t49*t36), batch),  # 4, 4
+        xp.broadcast_to(t11*t39 + t0*t55, batch),  # 4, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 2
-        xp.broadcast_to(-t40*t48 - t41*t52, batch),  # 5, 3
-        xp.broadcast_to(t49*t5 + t53*t8, batch),  # 5, 4
+        xp.broadcast_to(-(t48*t40 + t52*t41), batch),  # 5, 3
+        xp.broadcast_to(t8*t53 + t5*t49, batch),  # 5, 4
         xp.broadcast_to(t12*t55 - t11*t57, batch),  # 5, 5
     ], (6, 6))
     return Jd
@@ -984,80 +984,80 @@ def bias_acceleration(q, q_dot):
     t1 = qd1 + c23*qd4
     t2 = s1*s4
     t3 = c1*c4
-    t4 = -t2 + c23*t3
-    t5 = t3 - c23*t2
+    t4 = -t2 + t3*c23
+    t5 = t3 - t2*c23
     t6 = c4*s1
     t7 = c1*s4
-    t8 = t6 + c23*t7
-    t9 = t7 + c23*t6
+    t8 = t6 + t7*c23
+    t9 = t7 + t6*c23
     t10 = c5*s23
-    t11 = c1*t10 + s5*t4
-    t12 = s1*t10 + s5*t9
+    t11 = t4*s5 + t10*c1
+    t12 = t9*s5 + t10*s1
     t13 = 0.115*t11
     t14 = 0.62*s23
-    t15 = t13 + c1*t14
+    t15 = t13 + t14*c1
     t16 = 0.115*t12
-    t17 = t16 + s1*t14
-    t18 = t13*t5 + t16*t8
+    t17 = t16 + t14*s1
+    t18 = t8*t16 + t5*t13
     t19 = 0.115*t0
     t20 = t19 - 0.62*c23
     t21 = t20 - 0.12*s23
     t22 = t21 - 0.6*s2
     t23 = 0.12*c23
-    t24 = -t15 + c1*t23
-    t25 = -t17 + s1*t23
-    t26 = c1*t24 + s1*t25
+    t24 = -t15 + t23*c1
+    t25 = -t17 + t23*s1
+    t26 = t24*c1 + t25*s1
     t27 = 0.6*c2
-    t28 = t24 + c1*t27
-    t29 = t25 + s1*t27
+    t28 = t24 + t27*c1
+    t29 = t25 + t27*s1
     t30 = t28 + 0.18*c1
     t31 = t29 + 0.18*s1
-    t32 = c1*t28 + s1*t29
-    t33 = s23*t20
-    t34 = c23*t17 + s1*t33
-    t35 = c1*t33 + c23*t15
+    t32 = t28*c1 + t29*s1
+    t33 = t20*s23
+    t34 = t17*c23 + t33*s1
+    t35 = t15*c23 + t33*c1
     t36 = s23*s4
-    t37 = t16*t36 + t19*t5
-    t38 = t19*t8 - t13*t36
-    t39 = t1 + qd5*t36
+    t37 = t5*t19 + t36*t16
+    t38 = t8*t19 - t36*t13
+    t39 = t1 + t36*qd5
     t40 = s1*s23
     t41 = c1*s23
     t42 = t15*t40 - t17*t41
-    t43 = qd4*t42 + qd5*t18
-    t44 = t43 - qd3*t26
-    t45 = t44 - qd2*t32
+    t43 = t42*qd4 + t18*qd5
+    t44 = t43 - t26*qd3
+    t45 = t44 - t32*qd2
     t46 = qd2*s1
     t47 = qd3*s1
     t48 = t46 + t47
-    t49 = -t48 + qd4*t41
+    t49 = -t48 + t41*qd4
     t50 = c1*qd2
     t51 = c1*qd3
     t52 = t50 + t51
-    t53 = t52 + qd4*t40
-    t54 = qd5*t8
+    t53 = t52 + t40*qd4
+    t54 = t8*qd5
     t55 = t49 - t54
-    t56 = qd5*t5
+    t56 = t5*qd5
     t57 = t53 + t56
-    t58 = qd5*t37
-    t59 = t58 + qd4*t34
+    t58 = t37*qd5
+    t59 = t58 + t34*qd4
     t60 = t59 + t21*t51
     t61 = t60 + t22*t50
-    t62 = t61 - qd1*t31
-    t63 = qd5*t38
-    t64 = t63 - qd4*t35
+    t62 = t61 - t31*qd1
+    t63 = t38*qd5
+    t64 = t63 - t35*qd4
     t65 = t64 + t21*t47
     t66 = t65 + t22*t46
-    t67 = t66 + qd1*t30
+    t67 = t66 + t30*qd1
     t68 = qd1*s1
     t69 = c1*qd1
-    t70 = qd2*t21
+    t70 = t21*qd2
     a = _stack(xp, [
-        xp.broadcast_to(qd2*(c1*t45 - t22*t68) + qd4*(qd1*t35 + t40*t43 + t42*t52 - c23*t64) + qd5*(t18*t53 + t18*t56 - t1*t38 - t36*t63) - qd1*t67 - qd3*(t21*t68 + t26*t50 - c1*t44), batch),  # 0
-        xp.broadcast_to(qd1*t62 + qd2*(s1*t45 + t22*t69) + qd3*(s1*t44 + t21*t69 - t26*t46) + qd4*(c23*t59 + qd1*t34 + t42*t48 - t41*t43) + qd5*(t1*t37 + t18*t54 + t36*t58 - t18*t49), batch),  # 1
-        xp.broadcast_to(qd4*(t35*t48 + t41*t64 - t34*t52 - t40*t59) - qd2*(c1*t61 + s1*t66) - qd3*(c1*t60 + s1*t65 + t70*c1**2 + t70*s1**2) - qd5*(t37*t53 + t37*t56 + t38*t54 - t38*t49), batch),  # 2
-        xp.broadcast_to(qd4*(c23*t52 - qd1*t40) + qd5*(t36*t53 - t1*t5) - qd1*t50 - qd1*t51 - qd6*(t0*t57 + t12*t39), batch),  # 3
-        xp.broadcast_to(qd4*(c23*t48 + qd1*t41) + qd6*(t0*t55 + t11*t39) - qd1*t46 - qd1*t47 - qd5*(t1*t8 + t36*t49), batch),  # 4
-        xp.broadcast_to(qd5*(t49*t5 + t53*t8) + qd6*(t12*t55 - t11*t57) - qd4*(t40*t48 + t41*t52), batch),  # 5
+        xp.broadcast_to(qd2*(t45*c1 - t22*t68) + qd4*(t35*qd1 + t42*t52 + t43*t40 - t64*c23) + qd5*(t18*t53 + t18*t56 - t38*t1 - t36*t63) - t67*qd1 - qd3*(t21*t68 + t26*t50 - t44*c1), batch),  # 0
+        xp.broadcast_to(t62*qd1 + qd2*(t22*t69 + t45*s1) + qd3*(t21*t69 + t44*s1 - t26*t46) + qd4*(t34*qd1 + t42*t48 + t59*c23 - t43*t41) + qd5*(t37*t1 + t18*t54 + t36*t58 - t18*t49), batch),  # 1
+        xp.broadcast_to(qd4*(t35*t48 + t64*t41 - t34*t52 - t59*t40) - qd2*(t61*c1 + t66*s1) - qd3*(t60*c1 + t65*s1 + t70*c1**2 + t70*s1**2) - qd5*(t37*t53 + t37*t56 + t38*t54 - t38*t49), batch),  # 2
+        xp.broadcast_to(qd4*(t52*c23 - t40*qd1) + qd5*(t53*t36 - t5*t1) - t50*qd1 - t51*qd1 - qd6*(t12*t39 + t0*t57), batch),  # 3
+        xp.broadcast_to(qd4*(t48*c23 + t41*qd1) + qd6*(t11*t39 + t0*t55) - t46*qd1 - t47*qd1 - qd5*(t8*t1 + t49*t36), batch),  # 4
+        xp.broadcast_to(qd5*(t8*t53 + t5*t49) + qd6*(t12*t55 - t11*t57) - qd4*(t48*t40 + t52*t41), batch),  # 5
     ], (6,))
     return a
 
@@ -1088,170 +1088,170 @@ def task_jacobian_dot(q, q_dot):
     s6 = trig[..., 11]
     t0 = s1*s4
     t1 = c1*c4
-    t2 = -t0 + c23*t1
-    t3 = t1 - c23*t0
+    t2 = -t0 + t1*c23
+    t3 = t1 - t0*c23
     t4 = c4*s1
     t5 = c1*s4
-    t6 = t4 + c23*t5
-    t7 = t5 + c23*t4
+    t6 = t4 + t5*c23
+    t7 = t5 + t4*c23
     t8 = c1*s23
-    t9 = c5*t2 - s5*t8
-    t10 = c5*t8 + s5*t2
-    t11 = c6*t9 - s6*t6
+    t9 = t2*c5 - t8*s5
+    t10 = t2*s5 + t8*c5
+    t11 = t9*c6 - t6*s6
     t12 = s1*s23
-    t13 = c5*t7 - s5*t12
-    t14 = c5*t12 + s5*t7
-    t15 = c6*t13 + s6*t3
+    t13 = t7*c5 - t12*s5
+    t14 = t7*s5 + t12*c5
+    t15 = t3*s6 + t13*c6
     t16 = c4*s23
-    t17 = c23*s5 + c5*t16
-    t18 = s5*t16 - c23*c5
+    t17 = t16*c5 + c23*s5
+    t18 = t16*s5 - c23*c5
     t19 = s23*s4
-    t20 = s6*t19 - c6*t17
+    t20 = t19*s6 - t17*c6
     t21 = 0.115*t10
     t22 = t21 + 0.62*t8
     t23 = 0.115*t14
     t24 = t23 + 0.62*t12
-    t25 = t12*t22 - t24*t8
-    t26 = t21*t3 + t23*t6
-    t27 = qd4*t25 + qd5*t26
+    t25 = t22*t12 - t24*t8
+    t26 = t6*t23 + t3*t21
+    t27 = t25*qd4 + t26*qd5
     t28 = 0.115*t18
     t29 = t28 - 0.62*c23
     t30 = t29 - 0.12*s23
     t31 = t30 - 0.6*s2
-    t32 = c23*t24 + t12*t29
-    t33 = t19*t23 + t28*t3
-    t34 = c23*t22 + t29*t8
-    t35 = t28*t6 - t19*t21
+    t32 = t24*c23 + t29*t12
+    t33 = t3*t28 + t19*t23
+    t34 = t22*c23 + t29*t8
+    t35 = t6*t28 - t19*t21
     t36 = 0.12*c23
-    t37 = -t22 + c1*t36
-    t38 = -t24 + s1*t36
-    t39 = c1*t37 + s1*t38
-    t40 = t27 - qd3*t39
+    t37 = -t22 + t36*c1
+    t38 = -t24 + t36*s1
+    t39 = t37*c1 + t38*s1
+    t40 = t27 - t39*qd3
     t41 = 0.6*c2
-    t42 = t37 + c1*t41
-    t43 = t38 + s1*t41
+    t42 = t37 + t41*c1
+    t43 = t38 + t41*s1
     t44 = t42 + 0.18*c1
     t45 = t43 + 0.18*s1
-    t46 = c1*t42 + s1*t43
-    t47 = t40 - qd2*t46
+    t46 = t42*c1 + t43*s1
+    t47 = t40 - t46*qd2
     t48 = qd2*s1
     t49 = qd3*s1
     t50 = t48 + t49
     t51 = t50
-    t52 = c23*t51 + qd1*t8
+    t52 = t51*c23 + t8*qd1
     t53 = c1*qd2
     t54 = c1*qd3
     t55 = t53 + t54
     t56 = t55
-    t57 = c23*t56 - qd1*t12
-    t58 = t12*t51 + t56*t8
-    t59 = qd4*t8
+    t57 = t56*c23 - t12*qd1
+    t58 = t51*t12 + t56*t8
+    t59 = t8*qd4
     t60 = t59 - t51
-    t61 = qd4*t12
+    t61 = t12*qd4
     t62 = t56 + t61
-    t63 = t3*t60 + t6*t62
+    t63 = t6*t62 + t3*t60
     t64 = qd1 + c23*qd4
     t65 = t64
-    t66 = t19*t62 - t3*t65
-    t67 = t19*t60 + t6*t65
-    t68 = qd5*t6
+    t66 = t62*t19 - t3*t65
+    t67 = t6*t65 + t60*t19
+    t68 = t6*qd5
     t69 = t60 - t68
-    t70 = t50 + t68 - t59 - qd6*t10
-    t71 = qd5*t3
+    t70 = t50 + t68 - t59 - t10*qd6
+    t71 = t3*qd5
     t72 = t62 + t71
     t73 = t33*t62 + t33*t71 + t35*t68 - t35*t60
     t74 = t14*t69 - t10*t72
-    t75 = t55 + t61 + t71 + qd6*t14
-    t76 = t11*t75 + t15*t70
-    t77 = qd5*t19
+    t75 = t55 + t61 + t71 + t14*qd6
+    t76 = t70*t15 + t75*t11
+    t77 = t19*qd5
     t78 = t65 + t77
     t79 = t14*t78 + t18*t72
     t80 = t10*t78 + t18*t69
-    t81 = t64 + t77 - qd6*t18
-    t82 = t20*t75 - t15*t81
-    t83 = t11*t81 + t20*t70
-    t84 = qd5*t33
-    t85 = t84 + qd4*t32
+    t81 = t64 + t77 - t18*qd6
+    t82 = t75*t20 - t81*t15
+    t83 = t70*t20 + t81*t11
+    t84 = t33*qd5
+    t85 = t84 + t32*qd4
     t86 = t85 + t30*t54
     t87 = t86 + t31*t53
-    t88 = t87 - qd1*t45
-    t89 = c23*t85 + qd1*t32 + t25*t51 - t27*t8
-    t90 = t19*t84 + t26*t68 + t33*t65 - t26*t60
-    t91 = qd5*t35
-    t92 = t91 - qd4*t34
+    t88 = t87 - t45*qd1
+    t89 = t32*qd1 + t25*t51 + t85*c23 - t27*t8
+    t90 = t33*t65 + t26*t68 + t84*t19 - t26*t60
+    t91 = t35*qd5
+    t92 = t91 - t34*qd4
     t93 = t92 + t30*t49
     t94 = t93 + t31*t48
-    t95 = t94 + qd1*t44
-    t96 = qd1*t34 + t12*t27 + t25*t56 - c23*t92
-    t97 = t26*t62 + t26*t71 - t19*t91 - t35*t65
-    t98 = c1*t87 + s1*t94
-    t99 = t34*t51 + t8*t92 - t12*t85 - t32*t56
+    t95 = t94 + t44*qd1
+    t96 = t34*qd1 + t25*t56 + t27*t12 - t92*c23
+    t97 = t26*t62 + t26*t71 - t35*t65 - t91*t19
+    t98 = t87*c1 + t94*s1
+    t99 = t34*t51 + t92*t8 - t32*t56 - t85*t12
     t100 = qd1*s1
-    t101 = c1*t47 - t100*t31
-    t102 = t100*t30 + t39*t53 - c1*t40
+    t101 = t47*c1 - t31*t100
+    t102 = t30*t100 + t39*t53 - t40*c1
     t103 = c1*qd1
-    t104 = s1*t47 + t103*t31
-    t105 = s1*t40 + t103*t30 - t39*t48
-    t106 = qd2*t30
-    t107 = c1*t86 + s1*t93 + t106*c1**2 + t106*s1**2
+    t104 = t31*t103 + t47*s1
+    t105 = t30*t103 + t40*s1 - t39*t48
+    t106 = t30*qd2
+    t107 = t86*c1 + t93*s1 + t106*c1**2 + t106*s1**2
     t108 = t11**2 + t15**2
-    t109 = t108**(-1.0)
-    t110 = c1*t109
-    t111 = qd1*t11
-    t112 = s1*t109
-    t113 = qd1*t15
-    t114 = c1*t15
-    t115 = s1*t11
+    t109 = 1/t108
+    t110 = t109*c1
+    t111 = t11*qd1
+    t112 = t109*s1
+    t113 = t15*qd1
+    t114 = t15*c1
+    t115 = t11*s1
     t116 = t114 - t115
     t117 = 2/t108**2
     t118 = t116*t117
-    t119 = t118*t15
+    t119 = t15*t118
     t120 = t11*t118
-    t121 = t83*(t110 - t119) - t110*t111 - t112*t113 - t82*(t112 + t120)
-    t122 = t109*t11
-    t123 = t122*t57
-    t124 = t109*t15
-    t125 = t124*t52
-    t126 = s23*t110
-    t127 = c1*t11
-    t128 = s1*t15
-    t129 = s23*t127 + s23*t128
+    t121 = t83*(t110 - t119) - t82*(t112 + t120) - t110*t111 - t112*t113
+    t122 = t11*t109
+    t123 = t57*t122
+    t124 = t15*t109
+    t125 = t52*t124
+    t126 = t110*s23
+    t127 = t11*c1
+    t128 = t15*s1
+    t129 = t127*s23 + t128*s23
     t130 = t117*t129
     t131 = t11*t130
-    t132 = s23*t112
-    t133 = t130*t15
-    t134 = t122*t66
-    t135 = t124*t67
-    t136 = t109*t3
-    t137 = t15*t3 - t11*t6
+    t132 = t112*s23
+    t133 = t15*t130
+    t134 = t66*t122
+    t135 = t67*t124
+    t136 = t3*t109
+    t137 = t3*t15 - t6*t11
     t138 = t117*t137
-    t139 = t138*t15
-    t140 = t109*t6
+    t139 = t15*t138
+    t140 = t6*t109
     t141 = t11*t138
-    t142 = t124*t80
-    t143 = t122*t79
+    t142 = t80*t124
+    t143 = t79*t122
     t144 = t10*t109
     t145 = t10*t11 + t14*t15
     t146 = t117*t145
     t147 = t11*t146
-    t148 = t109*t14
-    t149 = t146*t15
+    t148 = t14*t109
+    t149 = t15*t146
     t150 = 1/xp.sqrt(t108)
-    t151 = qd1*t150
-    t152 = c1*t150
-    t153 = t108**(-3/2)
+    t151 = t150*qd1
+    t152 = t150*c1
+    t153 = 1/t108**1.5
     t154 = t153*(t127 + t128)
-    t155 = s1*t150
-    t156 = t114*t151 + t82*(t152 - t11*t154) + t83*(t155 - t15*t154) - t115*t151
+    t155 = t150*s1
+    t156 = t82*(t152 - t11*t154) + t83*(t155 - t15*t154) + t114*t151 - t115*t151
     t157 = t11*t150
     t158 = t15*t150
-    t159 = t153*(s23*t115 - s23*t114)
-    t160 = t153*(t11*t3 + t15*t6)
-    t161 = t153*(t11*t14 - t10*t15)
-    t162 = t110*t20
-    t163 = t112*t20
-    t164 = t109*t76
-    t165 = t111*t162 + t113*t163 + t116*t164 + t82*(t163 + t120*t20) + t83*(-t162 + t119*t20)
+    t159 = t153*(t115*s23 - t114*s23)
+    t160 = t153*(t6*t15 + t3*t11)
+    t161 = t153*(t14*t11 - t10*t15)
+    t162 = t20*t110
+    t163 = t20*t112
+    t164 = t76*t109
+    t165 = t82*(t163 + t20*t120) + t83*(-t162 + t20*t119) + t111*t162 + t113*t163 + t116*t164
     Jd = _stack(xp, [
         xp.broadcast_to(-t95, batch),  # 0, 0
         xp.broadcast_to(t101, batch),  # 0, 1
@@ -1280,21 +1280,21 @@ def task_jacobian_dot(q, q_dot):
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
         xp.broadcast_to(t156, batch),  # 4, 1
         xp.broadcast_to(t156, batch),  # 4, 2
-        xp.broadcast_to(t157*t52 + t82*(s23*t155 - t11*t159) - t158*t57 - t83*(s23*t152 + t15*t159), batch),  # 4, 3
-        xp.broadcast_to(t82*(t150*t3 - t11*t160) + t83*(t150*t6 - t15*t160) - t157*t67 - t158*t66, batch),  # 4, 4
-        xp.broadcast_to(t157*t80 + t158*t79 + t82*(t14*t150 - t11*t161) - t83*(t10*t150 + t15*t161), batch),  # 4, 5
+        xp.broadcast_to(t82*(t155*s23 - t11*t159) + t52*t157 - t83*(t15*t159 + t152*s23) - t57*t158, batch),  # 4, 3
+        xp.broadcast_to(t82*(t3*t150 - t11*t160) + t83*(t6*t150 - t15*t160) - t67*t157 - t66*t158, batch),  # 4, 4
+        xp.broadcast_to(t80*t157 + t82*(t14*t150 - t11*t161) + t79*t158 - t83*(t10*t150 + t15*t161), batch),  # 4, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 0
         xp.broadcast_to(t165, batch),  # 5, 1
         xp.broadcast_to(t165, batch),  # 5, 2
-        xp.broadcast_to(-t58 + t129*t164 + t82*(t131*t20 - t126*t20) + t83*(t133*t20 - t132*t20) - t123*t20 - t125*t20, batch),  # 5, 3
-        xp.broadcast_to(t63 + t135*t20 + t137*t164 + t82*(t140*t20 + t141*t20) + t83*(t139*t20 - t136*t20) - t134*t20, batch),  # 5, 4
-        xp.broadcast_to(t74 + t143*t20 + t145*t164 + t82*(t147*t20 - t144*t20) + t83*(t149*t20 - t148*t20) - t142*t20, batch),  # 5, 5
+        xp.broadcast_to(-t58 + t82*(t20*t131 - t20*t126) + t83*(t20*t133 - t20*t132) + t129*t164 - t20*t123 - t20*t125, batch),  # 5, 3
+        xp.broadcast_to(t63 + t82*(t20*t140 + t20*t141) + t83*(t20*t139 - t20*t136) + t20*t135 + t137*t164 - t20*t134, batch),  # 5, 4
+        xp.broadcast_to(t74 + t82*(t20*t147 - t20*t144) + t83*(t20*t149 - t20*t148) + t20*t143 + t145*t164 - t20*t142, batch),  # 5, 5
     ], (6, 6))
     return Jd
 
 
 def hessian(q):
-    """partial derivatives dJ/dq_k of the world geometric Jacobian (DOF x 6 x DOF, indexed [k, r, c]): (6 x 6 x 6), 215 operations."""
+    """partial derivatives dJ/dq_k of the world geometric Jacobian (DOF x 6 x DOF, indexed [k, r, c]): (6 x 6 x 6), 204 operations."""
     xp, dtype, device, batch, (q,) = _arguments(("q", q, (6,)))
     trig = _cos_sin(xp, q, (0.0, 0.0, 0.0, 0.0, 0.0, 0.0), device)
     c1 = trig[..., 0]
@@ -1312,70 +1312,70 @@ def hessian(q):
     t0 = -c23*c5 + c4*s23*s5
     t1 = s1*s4
     t2 = c1*c4
-    t3 = -t1 + c23*t2
-    t4 = t2 - c23*t1
+    t3 = -t1 + t2*c23
+    t4 = t2 - t1*c23
     t5 = c4*s1
     t6 = c1*s4
-    t7 = t5 + c23*t6
-    t8 = t6 + c23*t5
+    t7 = t5 + t6*c23
+    t8 = t6 + t5*c23
     t9 = c1*s23
-    t10 = c5*t9 + s5*t3
+    t10 = t3*s5 + t9*c5
     t11 = s1*s23
-    t12 = c5*t11 + s5*t8
+    t12 = t8*s5 + t11*c5
     t13 = 0.115*t10
     t14 = t13 + 0.62*t9
     t15 = 0.115*t12
     t16 = t15 + 0.62*t11
-    t17 = t11*t14 - t16*t9
-    t18 = t13*t4 + t15*t7
+    t17 = t14*t11 - t16*t9
+    t18 = t7*t15 + t4*t13
     t19 = 0.115*t0
     t20 = t19 - 0.62*c23
     t21 = t20 - 0.12*s23
     t22 = t21 - 0.6*s2
-    t23 = c23*t16 + t11*t20
-    t24 = c23*t14 + t20*t9
+    t23 = t16*c23 + t20*t11
+    t24 = t14*c23 + t20*t9
     t25 = c1*c23
     t26 = -t14 + 0.12*t25
     t27 = c23*s1
     t28 = -t16 + 0.12*t27
-    t29 = c1*t26 + s1*t28
+    t29 = t26*c1 + t28*s1
     t30 = 0.6*c2
-    t31 = t26 + c1*t30
-    t32 = t28 + s1*t30
+    t31 = t26 + t30*c1
+    t32 = t28 + t30*s1
     t33 = t31 + 0.18*c1
     t34 = t32 + 0.18*s1
-    t35 = c1*t31 + s1*t32
+    t35 = t31*c1 + t32*s1
     t36 = s23*s4
-    t37 = t15*t36 + t19*t4
-    t38 = t19*t7 - t13*t36
-    t39 = -s1*t22
-    t40 = -s1*t21
+    t37 = t4*t19 + t36*t15
+    t38 = t7*t19 - t36*t13
+    t39 = -t22*s1
+    t40 = -t21*s1
     t41 = -t38
-    t42 = c1*t22
-    t43 = c1*t21
+    t42 = t22*c1
+    t43 = t21*c1
     t44 = -c1
     t45 = -s1
-    t46 = -c1*t29
-    t47 = c1*t17
-    t48 = c1*t18
-    t49 = -s1*t29
-    t50 = s1*t17
-    t51 = s1*t18
+    t46 = -t29*c1
+    t47 = t17*c1
+    t48 = t18*c1
+    t49 = -t29*s1
+    t50 = t17*s1
+    t51 = t18*s1
     t52 = c1**2
     t53 = s1**2
-    t54 = -t21*t52 - t21*t53
-    t55 = s1*t24 - c1*t23
-    t56 = -c1*t37 - s1*t38
-    t57 = s23*t6
-    t58 = -c1*t0
-    t59 = s23*t1
-    t60 = -s1*t0
-    t61 = -s23*t52 - s23*t53
-    t62 = c1*t7 - s1*t4
-    t63 = -c1*t10 - s1*t12
-    t64 = t11*t18 - c23*t38
-    t65 = c23*t37 - t18*t9
-    t66 = t38*t9 - t11*t37
+    t54 = -(t21*t52 + t21*t53)
+    t55 = t24*s1 - t23*c1
+    t56 = -(t37*c1 + t38*s1)
+    t57 = t6*s23
+    t58 = -t0*c1
+    t59 = t1*s23
+    t60 = -t0*s1
+    t61 = -(t52*s23 + t53*s23)
+    t62 = t7*c1 - t4*s1
+    t63 = -(t10*c1 + t12*s1)
+    t64 = t18*t11 - t38*c23
+    t65 = t37*c23 - t18*t9
+    t66 = t38*t9 - t37*t11
     t67 = s23**2
     H = _stack(xp, [
         -t33,  # 0, 0, 0
@@ -1415,19 +1415,19 @@ def hessian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5, 5
         t39,  # 1, 0, 0
-        -c1*t35,  # 1, 0, 1
+        -t35*c1,  # 1, 0, 1
         t46,  # 1, 0, 2
         t47,  # 1, 0, 3
         t48,  # 1, 0, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 0, 5
         t42,  # 1, 1, 0
-        -s1*t35,  # 1, 1, 1
+        -t35*s1,  # 1, 1, 1
         t49,  # 1, 1, 2
         t50,  # 1, 1, 3
         t51,  # 1, 1, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 2, 0
-        -t22*t52 - t22*t53,  # 1, 2, 1
+        -(t22*t52 + t22*t53),  # 1, 2, 1
         t54,  # 1, 2, 2
         t55,  # 1, 2, 3
         t56,  # 1, 2, 4
@@ -1489,75 +1489,75 @@ def hessian(q):
         t24,  # 3, 0, 0
         t47,  # 3, 0, 1
         t47,  # 3, 0, 2
-        c23*t24 + t11*t17,  # 3, 0, 3
+        t24*c23 + t17*t11,  # 3, 0, 3
         t64,  # 3, 0, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0, 5
         t23,  # 3, 1, 0
         t50,  # 3, 1, 1
         t50,  # 3, 1, 2
-        c23*t23 - t17*t9,  # 3, 1, 3
+        t23*c23 - t17*t9,  # 3, 1, 3
         t65,  # 3, 1, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 2, 0
         t55,  # 3, 2, 1
         t55,  # 3, 2, 2
-        -t11*t23 - t24*t9,  # 3, 2, 3
+        -(t23*t11 + t24*t9),  # 3, 2, 3
         t66,  # 3, 2, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 3, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 3, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 3, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 3, 3
-        t1*t67 - c23*t4,  # 3, 3, 4
-        -c23*t12 - t0*t11,  # 3, 3, 5
+        t1*t67 - t4*c23,  # 3, 3, 4
+        -(t12*c23 + t0*t11),  # 3, 3, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 4, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 4, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 4, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 4, 3
-        -c23*t7 - t6*t67,  # 3, 4, 4
-        c23*t10 + t0*t9,  # 3, 4, 5
+        -(t7*c23 + t6*t67),  # 3, 4, 4
+        t10*c23 + t0*t9,  # 3, 4, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 5, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 5, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 5, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 5, 3
-        t11*t7 + t4*t9,  # 3, 5, 4
+        t7*t11 + t4*t9,  # 3, 5, 4
         t12*t9 - t10*t11,  # 3, 5, 5
         t41,  # 4, 0, 0
         t48,  # 4, 0, 1
         t48,  # 4, 0, 2
         t64,  # 4, 0, 3
-        t18*t4 - t36*t38,  # 4, 0, 4
+        t4*t18 - t38*t36,  # 4, 0, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0, 5
         t37,  # 4, 1, 0
         t51,  # 4, 1, 1
         t51,  # 4, 1, 2
         t65,  # 4, 1, 3
-        t18*t7 + t36*t37,  # 4, 1, 4
+        t7*t18 + t37*t36,  # 4, 1, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 2, 0
         t56,  # 4, 2, 1
         t56,  # 4, 2, 2
         t66,  # 4, 2, 3
-        -t37*t4 - t38*t7,  # 4, 2, 4
+        -(t7*t38 + t4*t37),  # 4, 2, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 3, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 3, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 3, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 3, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 3, 4
-        -t0*t4 - t12*t36,  # 4, 3, 5
+        -(t4*t0 + t12*t36),  # 4, 3, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 4, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 4, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 4, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 4, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 4, 4
-        t10*t36 - t0*t7,  # 4, 4, 5
+        t10*t36 - t7*t0,  # 4, 4, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 5, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 5, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 5, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 5, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 5, 4
-        -t10*t4 - t12*t7,  # 4, 5, 5
+        -(t7*t12 + t4*t10),  # 4, 5, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 0, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 0, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 0, 2
@@ -1609,9 +1609,9 @@ def singularity_factors(q):
     s5 = trig[..., 9]
     t0 = 0.1935483870967742*s3
     f = _stack(xp, [
-        c3 + t0,  # 0
+        t0 + c3,  # 0
         s5,  # 1
-        0.2903225806451613 + 0.967741935483871*c2 - c2*s3 - c3*s2 - s2*t0 + 0.1935483870967742*c2*c3,  # 2
+        0.2903225806451613 + 0.967741935483871*c2 - t0*s2 - c2*s3 - c3*s2 + 0.1935483870967742*c2*c3,  # 2
     ], (3,))
     return f
 
@@ -1626,7 +1626,7 @@ def manipulability(q):
     s3 = trig[..., 5]
     s5 = trig[..., 9]
     t0 = 0.1935483870967742*s3
-    t1 = 0.23064*s5*(c3 + t0)*(0.2903225806451613 + 0.967741935483871*c2 - c2*s3 - c3*s2 - s2*t0 + 0.1935483870967742*c2*c3)
+    t1 = 0.23064*s5*(t0 + c3)*(0.2903225806451613 + 0.967741935483871*c2 - t0*s2 - c2*s3 - c3*s2 + 0.1935483870967742*c2*c3)
     w = xp.broadcast_to(xp.abs(t1), batch)
     return w
 
@@ -1641,7 +1641,7 @@ def jacobian_det(q):
     s3 = trig[..., 5]
     s5 = trig[..., 9]
     t0 = 0.1935483870967742*s3
-    d = xp.broadcast_to(-0.23064*s5*(c3 + t0)*(0.2903225806451613 + 0.967741935483871*c2 - c2*s3 - c3*s2 - s2*t0 + 0.1935483870967742*c2*c3), batch)
+    d = xp.broadcast_to(-0.23064*s5*(t0 + c3)*(0.2903225806451613 + 0.967741935483871*c2 - t0*s2 - c2*s3 - c3*s2 + 0.1935483870967742*c2*c3), batch)
     return d
 
 
@@ -1677,85 +1677,85 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t0 = -c23*c5 + c4*s23*s5
     t1 = s1*s4
     t2 = c1*c4
-    t3 = -t1 + c23*t2
-    t4 = t2 - c23*t1
+    t3 = -t1 + t2*c23
+    t4 = t2 - t1*c23
     t5 = c4*s1
     t6 = c1*s4
-    t7 = t5 + c23*t6
-    t8 = t6 + c23*t5
+    t7 = t5 + t6*c23
+    t8 = t6 + t5*c23
     t9 = c1*s23
-    t10 = c5*t9 + s5*t3
+    t10 = t3*s5 + t9*c5
     t11 = s1*s23
-    t12 = c5*t11 + s5*t8
+    t12 = t8*s5 + t11*c5
     t13 = 0.115*t10
     t14 = t13 + 0.62*t9
     t15 = 0.115*t12
     t16 = t15 + 0.62*t11
-    t17 = t11*t14 - t16*t9
-    t18 = t13*t4 + t15*t7
+    t17 = t14*t11 - t16*t9
+    t18 = t7*t15 + t4*t13
     t19 = 0.115*t0
     t20 = t19 - 0.62*c23
     t21 = t20 - 0.12*s23
     t22 = t21 - 0.6*s2
-    t23 = c23*t16 + t11*t20
-    t24 = c23*t14 + t20*t9
+    t23 = t16*c23 + t20*t11
+    t24 = t14*c23 + t20*t9
     t25 = 0.12*c23
-    t26 = -t14 + c1*t25
-    t27 = -t16 + s1*t25
-    t28 = c1*t26 + s1*t27
+    t26 = -t14 + t25*c1
+    t27 = -t16 + t25*s1
+    t28 = t26*c1 + t27*s1
     t29 = 0.6*c2
-    t30 = t26 + c1*t29
-    t31 = t27 + s1*t29
+    t30 = t26 + t29*c1
+    t31 = t27 + t29*s1
     t32 = t30 + 0.18*c1
     t33 = t31 + 0.18*s1
-    t34 = c1*t30 + s1*t31
+    t34 = t30*c1 + t31*s1
     t35 = s23*s4
-    t36 = t15*t35 + t19*t4
-    t37 = t19*t7 - t13*t35
-    t38 = t32 + t35*t37 - c23*t24
-    t39 = c23*t17 + t18*t35
-    t40 = t0*t10 + t35*t7 - c23*t9
-    t41 = c23*t11 + t35*t4 - t0*t12
+    t36 = t4*t19 + t35*t15
+    t37 = t7*t19 - t35*t13
+    t38 = t32 + t37*t35 - t24*c23
+    t39 = t17*c23 + t18*t35
+    t40 = t7*t35 + t10*t0 - t9*c23
+    t41 = t4*t35 + t11*c23 - t12*t0
     t42 = t33**2
     t43 = t21**2
     t44 = c1**2
-    t45 = t11*t23 + t21*t44 + t22*t44 + t36*t4
+    t45 = t4*t36 + t21*t44 + t22*t44 + t23*t11
     t46 = t22**2
     t47 = t23**2 + t36**2 + t43*t44 + t44*t46
     t48 = t42 + t47
     t49 = c1*s1
-    t50 = t36*t37 + t43*t49 + t46*t49 - t23*t24 - t32*t33
+    t50 = t36*t37 + t43*t49 + t46*t49 - t32*t33 - t23*t24
     t51 = -t33
-    t52 = t51 + c23*t23 + t35*t36
-    t53 = c1*t28
-    t54 = c1*t34
-    t55 = t17*t23 + t18*t36 - t21*t53 - t22*t54
-    t56 = -t53 - t54 + t11*t17 + t18*t4
-    t57 = c1*t21
-    t58 = c1*t22
-    t59 = s1*t57 + s1*t58
-    t60 = t59 + t36*t7 - t23*t9
-    t61 = t59 + t37*t4 - t11*t24
+    t52 = t51 + t23*c23 + t36*t35
+    t53 = t28*c1
+    t54 = t34*c1
+    t55 = t23*t17 + t36*t18 - t21*t53 - t22*t54
+    t56 = -t53 - t54 + t4*t18 + t17*t11
+    t57 = t21*c1
+    t58 = t22*c1
+    t59 = t57*s1 + t58*s1
+    t60 = t59 + t7*t36 - t23*t9
+    t61 = t59 + t4*t37 - t24*t11
     t62 = t32**2
     t63 = s1**2
-    t64 = t21*t63 + t22*t63 + t24*t9 + t37*t7
+    t64 = t7*t37 + t21*t63 + t22*t63 + t24*t9
     t65 = t24**2 + t37**2 + t43*t63 + t46*t63
     t66 = t62 + t65
-    t67 = s1*t28
-    t68 = s1*t34
-    t69 = t17*t24 + t21*t67 + t22*t68 - t18*t37
-    t70 = t67 + t68 + t17*t9 - t18*t7
+    t67 = t28*s1
+    t68 = t34*s1
+    t69 = t21*t67 + t22*t68 + t24*t17 - t37*t18
+    t70 = t67 + t68 + t17*t9 - t7*t18
     t71 = t34**2
-    t72 = t71 + t17**2 + t18**2 + t28**2
+    t72 = t71 + t28**2 + t17**2 + t18**2
     t73 = t72
     t74 = s23**2
-    t75 = t10**2 + t7**2 + 2*t63 + t44*t74
+    t75 = t7**2 + t10**2 + 2*t63 + t44*t74
     t76 = t75
     t77 = 2*s1
-    t78 = t10*t12 + t49*t74 - c1*t77 - t4*t7
-    t79 = t12**2 + t4**2 + 2*t44 + t63*t74
+    t78 = t10*t12 + t49*t74 - t7*t4 - t77*c1
+    t79 = t4**2 + t12**2 + 2*t44 + t63*t74
     t80 = t79
-    t81 = c23**2 + t0**2 + t74*s4**2
+    t81 = t0**2 + c23**2 + t74*s4**2
     t82 = 1 + t81
     t83 = t50**2
     t84 = t52**2
@@ -1767,9 +1767,9 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t90 = t89**2
     t91 = xp.sqrt(t83 + t84 + t85 + t86 + t87 + t90)
     t92 = t91*xp.where(xp.greater_equal(t89, 0), xp.asarray(1, dtype=dtype), -1)
-    t93 = t89 + t92
+    t93 = t92 + t89
     t94 = xp.where(xp.greater(t91, 0), 1/(t91*(t91 + xp.abs(t89))), 0)
-    t95 = t94*(mu_dot0*t93 + mu_dot1*t50 + mu_dot2*t55 + mu_dot4*t45 + mu_dot5*t52 - mu_dot3*t60)
+    t95 = t94*(t50*mu_dot1 + t52*mu_dot5 + t55*mu_dot2 + t45*mu_dot4 + t93*mu_dot0 - t60*mu_dot3)
     t96 = mu_dot0 - t93*t95
     t97 = mu_dot1 - t50*t95
     t98 = mu_dot2 - t55*t95
@@ -1777,32 +1777,32 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t100 = mu_dot4 - t45*t95
     t101 = mu_dot5 - t52*t95
     t102 = t66 + t88
-    t103 = t94*(t102*t50 + t38*t52 + t45*t61 + t50*t93 + t60*t64 - t55*t69)
-    t104 = t50 - t103*t93
-    t105 = t102 - t103*t50
-    t106 = t69 + t103*t55
-    t107 = -t64 + t103*t60
-    t108 = t61 - t103*t45
-    t109 = t38 - t103*t52
+    t103 = t94*(t50*t93 + t50*t102 + t52*t38 + t60*t64 + t45*t61 - t55*t69)
+    t104 = t50 - t93*t103
+    t105 = t102 - t50*t103
+    t106 = t69 + t55*t103
+    t107 = -t64 + t60*t103
+    t108 = t61 - t45*t103
+    t109 = t38 - t52*t103
     t110 = xp.sqrt(t105**2 + t106**2 + t107**2 + t108**2 + t109**2)
     t111 = t110*xp.where(xp.greater_equal(t105, 0), xp.asarray(1, dtype=dtype), -1)
     t112 = t105 + t111
     t113 = xp.where(xp.greater(t110, 0), 1/(t110*(t110 + xp.abs(t105))), 0)
-    t114 = t113*(t100*t108 + t101*t109 + t107*t99 + t112*t97 - t106*t98)
+    t114 = t113*(t107*t99 + t108*t100 + t109*t101 + t97*t112 - t106*t98)
     t115 = t97 - t112*t114
     t116 = t98 + t106*t114
     t117 = t99 - t107*t114
     t118 = t100 - t108*t114
     t119 = t101 - t109*t114
     t120 = t73 + t88
-    t121 = t94*(t120*t55 + t39*t52 + t45*t56 + t55*t93 - t50*t69 - t60*t70)
-    t122 = t55 - t121*t93
-    t123 = t69 + t121*t50
-    t124 = t120 - t121*t55
-    t125 = t70 + t121*t60
-    t126 = t56 - t121*t45
-    t127 = t39 - t121*t52
-    t128 = t113*(t107*t125 + t108*t126 + t109*t127 - t106*t124 - t112*t123)
+    t121 = t94*(t52*t39 + t55*t93 + t55*t120 + t45*t56 - t50*t69 - t60*t70)
+    t122 = t55 - t93*t121
+    t123 = t69 + t50*t121
+    t124 = t120 - t55*t121
+    t125 = t70 + t60*t121
+    t126 = t56 - t45*t121
+    t127 = t39 - t52*t121
+    t128 = t113*(t107*t125 + t108*t126 + t109*t127 - t106*t124 - t123*t112)
     t129 = t123 + t112*t128
     t130 = t124 + t106*t128
     t131 = t125 - t107*t128
@@ -1812,26 +1812,26 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t135 = t134*xp.where(xp.greater_equal(t130, 0), xp.asarray(1, dtype=dtype), -1)
     t136 = t130 + t135
     t137 = xp.where(xp.greater(t134, 0), 1/(t134*(t134 + xp.abs(t130))), 0)
-    t138 = t137*(t116*t136 + t117*t131 + t118*t132 + t119*t133)
+    t138 = t137*(t131*t117 + t132*t118 + t133*t119 + t116*t136)
     t139 = t116 - t136*t138
     t140 = t117 - t131*t138
     t141 = t118 - t132*t138
     t142 = t119 - t133*t138
     t143 = t76 + t88
-    t144 = -t94*(t143*t60 + t40*t52 + t50*t64 + t60*t93 - t45*t78 - t55*t70)
-    t145 = t60 + t144*t93
-    t146 = t64 + t144*t50
-    t147 = t70 - t144*t55
-    t148 = t143 + t144*t60
-    t149 = t78 - t144*t45
-    t150 = t40 + t144*t52
-    t151 = -t113*(t106*t147 + t109*t150 + t112*t146 - t107*t148 - t108*t149)
+    t144 = -t94*(t50*t64 + t52*t40 + t60*t93 + t60*t143 - t55*t70 - t45*t78)
+    t145 = t60 + t93*t144
+    t146 = t64 + t50*t144
+    t147 = t70 - t55*t144
+    t148 = t143 + t60*t144
+    t149 = t78 - t45*t144
+    t150 = t40 + t52*t144
+    t151 = -t113*(t106*t147 + t109*t150 + t146*t112 - t107*t148 - t108*t149)
     t152 = t146 + t112*t151
     t153 = t147 + t106*t151
     t154 = t148 - t107*t151
     t155 = t149 - t108*t151
     t156 = t150 + t109*t151
-    t157 = t137*(t131*t154 + t132*t155 + t136*t153 - t133*t156)
+    t157 = t137*(t131*t154 + t132*t155 + t153*t136 - t133*t156)
     t158 = t153 - t136*t157
     t159 = t154 - t131*t157
     t160 = t155 - t132*t157
@@ -1840,30 +1840,30 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t163 = t162*xp.where(xp.greater_equal(t159, 0), xp.asarray(1, dtype=dtype), -1)
     t164 = t159 + t163
     t165 = xp.where(xp.greater(t162, 0), 1/(t162*(t162 + xp.abs(t159))), 0)
-    t166 = t165*(t140*t164 + t141*t160 - t142*t161)
+    t166 = t165*(t160*t141 + t140*t164 - t161*t142)
     t167 = t140 - t164*t166
     t168 = t141 - t160*t166
     t169 = t142 + t161*t166
     t170 = t80 + t88
-    t171 = t94*(t170*t45 + t41*t52 + t45*t93 + t50*t61 + t55*t56 - t60*t78)
-    t172 = t45 - t171*t93
-    t173 = t61 - t171*t50
-    t174 = t56 - t171*t55
-    t175 = t78 + t171*t60
-    t176 = t170 - t171*t45
-    t177 = t41 - t171*t52
-    t178 = t113*(t107*t175 + t108*t176 + t109*t177 + t112*t173 - t106*t174)
+    t171 = t94*(t50*t61 + t52*t41 + t55*t56 + t45*t93 + t45*t170 - t60*t78)
+    t172 = t45 - t93*t171
+    t173 = t61 - t50*t171
+    t174 = t56 - t55*t171
+    t175 = t78 + t60*t171
+    t176 = t170 - t45*t171
+    t177 = t41 - t52*t171
+    t178 = t113*(t107*t175 + t108*t176 + t109*t177 + t173*t112 - t106*t174)
     t179 = t173 - t112*t178
     t180 = t174 + t106*t178
     t181 = t175 - t107*t178
     t182 = t176 - t108*t178
     t183 = t177 - t109*t178
-    t184 = t137*(t131*t181 + t132*t182 + t133*t183 + t136*t180)
+    t184 = t137*(t131*t181 + t132*t182 + t133*t183 + t180*t136)
     t185 = t180 - t136*t184
     t186 = t181 - t131*t184
     t187 = t182 - t132*t184
     t188 = t183 - t133*t184
-    t189 = t165*(t160*t187 + t164*t186 - t161*t188)
+    t189 = t165*(t160*t187 + t186*t164 - t161*t188)
     t190 = t186 - t164*t189
     t191 = t187 - t160*t189
     t192 = t188 + t161*t189
@@ -1871,70 +1871,70 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t194 = t193*xp.where(xp.greater_equal(t191, 0), xp.asarray(1, dtype=dtype), -1)
     t195 = t191 + t194
     t196 = xp.where(xp.greater(t193, 0), 1/(t193*(t193 + xp.abs(t191))), 0)
-    t197 = t196*(t168*t195 + t169*t192)
+    t197 = t196*(t192*t169 + t168*t195)
     t198 = t168 - t195*t197
     t199 = t169 - t192*t197
     t200 = t82 + t88
-    t201 = xp.sqrt(t90 + t102**2 + t120**2 + t143**2 + t170**2 + t200**2 + 2*t83 + 2*t84 + 2*t85 + 2*t86 + 2*t87 + 2*t38**2 + 2*t39**2 + 2*t40**2 + 2*t41**2 + 2*t56**2 + 2*t61**2 + 2*t64**2 + 2*t69**2 + 2*t70**2 + 2*t78**2)
-    t202 = t94*(t200*t52 + t38*t50 + t39*t55 + t40*t60 + t41*t45 + t52*t93)
-    t203 = t52 - t202*t93
-    t204 = t38 - t202*t50
-    t205 = t39 - t202*t55
-    t206 = -t40 + t202*t60
-    t207 = t41 - t202*t45
-    t208 = t200 - t202*t52
-    t209 = t113*(t107*t206 + t108*t207 + t109*t208 + t112*t204 - t106*t205)
+    t201 = xp.sqrt(t90 + t102**2 + t120**2 + t143**2 + t170**2 + t200**2 + 2*t83 + 2*t84 + 2*t85 + 2*t86 + 2*t87 + 2*t38**2 + 2*t69**2 + 2*t64**2 + 2*t61**2 + 2*t70**2 + 2*t56**2 + 2*t39**2 + 2*t78**2 + 2*t40**2 + 2*t41**2)
+    t202 = t94*(t50*t38 + t52*t93 + t52*t200 + t55*t39 + t60*t40 + t45*t41)
+    t203 = t52 - t93*t202
+    t204 = t38 - t50*t202
+    t205 = t39 - t55*t202
+    t206 = -t40 + t60*t202
+    t207 = t41 - t45*t202
+    t208 = t200 - t52*t202
+    t209 = t113*(t107*t206 + t108*t207 + t109*t208 + t204*t112 - t106*t205)
     t210 = t204 - t112*t209
     t211 = t205 + t106*t209
     t212 = t206 - t107*t209
     t213 = t207 - t108*t209
     t214 = t208 - t109*t209
-    t215 = t137*(t131*t212 + t132*t213 + t133*t214 + t136*t211)
+    t215 = t137*(t131*t212 + t132*t213 + t133*t214 + t211*t136)
     t216 = t211 - t136*t215
     t217 = t212 - t131*t215
     t218 = t213 - t132*t215
     t219 = t214 - t133*t215
-    t220 = t165*(t160*t218 + t164*t217 - t161*t219)
+    t220 = t165*(t160*t218 + t217*t164 - t161*t219)
     t221 = t217 - t164*t220
     t222 = t218 - t160*t220
     t223 = t219 + t161*t220
-    t224 = t196*(t192*t223 + t195*t222)
+    t224 = t196*(t192*t223 + t222*t195)
     t225 = t222 - t195*t224
     t226 = t223 - t192*t224
     t227 = xp.abs(t226)
     t228 = t227
     t229 = t228*xp.where(xp.greater_equal(t226, 0), xp.asarray(1, dtype=dtype), -1)
     t230 = t226 + t229
-    t231 = xp.where(xp.greater(t228, 0), 1/(t228*(t227 + t228)), 0)
+    t231 = xp.where(xp.greater(t228, 0), 1/(t228*(t228 + t227)), 0)
     t232 = t199 - t199*t231*t230**2
     t233 = xp.where(xp.not_equal(t229, 0), -t232/t229, 0)
     t234 = xp.where(xp.not_equal(t194, 0), -(t198 - t225*t233)/t194, 0)
-    t235 = xp.where(xp.not_equal(t163, 0), -(t167 - t190*t234 - t221*t233)/t163, 0)
-    t236 = xp.where(xp.not_equal(t135, 0), -(t139 - t158*t235 - t185*t234 - t216*t233)/t135, 0)
-    t237 = xp.where(xp.not_equal(t111, 0), -(t115 + t129*t236 + t152*t235 - t179*t234 - t210*t233)/t111, 0)
-    t238 = xp.where(xp.not_equal(t92, 0), -(t96 + t145*t235 - t104*t237 - t122*t236 - t172*t234 - t203*t233)/t92, 0)
+    t235 = xp.where(xp.not_equal(t163, 0), -(t167 - (t190*t234 + t221*t233))/t163, 0)
+    t236 = xp.where(xp.not_equal(t135, 0), -(t139 - (t158*t235 + t185*t234 + t216*t233))/t135, 0)
+    t237 = xp.where(xp.not_equal(t111, 0), -(t115 - (t179*t234 + t210*t233 - t129*t236 - t152*t235))/t111, 0)
+    t238 = xp.where(xp.not_equal(t92, 0), -(t96 - (t104*t237 + t122*t236 + t172*t234 + t203*t233 - t145*t235))/t92, 0)
     t239 = t233 + t237*t32 - t238*t33
-    t240 = c23*t233 + t11*t234 + t17*t236 + t23*t238 + t235*t9 - t237*t24
-    t241 = t18*t236 + t233*t35 + t234*t4 + t237*t37 + t238*t36 - t235*t7
-    t242 = t10*t235 + t12*t234 - t0*t233
-    t243 = s1*t22
-    t244 = c1*t234 - s1*t235
+    t240 = t233*c23 + t234*t11 + t235*t9 + t236*t17 + t238*t23 - t237*t24
+    t241 = t4*t234 + t233*t35 + t236*t18 + t237*t37 + t238*t36 - t7*t235
+    t242 = t10*t235 + t234*t12 - t233*t0
+    t243 = t22*s1
+    t244 = t234*c1 - t235*s1
     t245 = t244 + t237*t243 + t238*t58 - t236*t34
-    t246 = s1*t21
+    t246 = t21*s1
     t247 = t244 + t237*t246 + t238*t57 - t236*t28
     t248 = 1 + t42 + t62
-    t249 = xp.sqrt(t248 + t47 + t65 + t72 + t75 + t79 + t81)
+    t249 = xp.sqrt(t47 + t65 + t72 + t75 + t79 + t81 + t248)
     t250 = xp.sqrt(t248)
     t251 = t250*xp.where(xp.less_equal(t33, 0), xp.asarray(1, dtype=dtype), -1)
     t252 = t251 + t51
     t253 = xp.where(xp.greater(t250, 0), 1/(t250*(t250 + xp.abs(t33))), 0)
-    t254 = t253*(t243*t32 + t252*t58)
+    t254 = t253*(t252*t58 + t32*t243)
     t255 = t58 - t252*t254
     t256 = t243 - t254*t32
-    t257 = t253*(t246*t32 + t252*t57)
+    t257 = t253*(t252*t57 + t32*t246)
     t258 = t57 - t252*t257
     t259 = t246 - t257*t32
-    t260 = t253*(c23 + t23*t252 - t24*t32)
+    t260 = t253*(c23 + t252*t23 - t32*t24)
     t261 = t23 - t252*t260
     t262 = t24 + t260*t32
     t263 = c23 - t260
@@ -1942,43 +1942,43 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t265 = t36 - t252*t264
     t266 = t37 - t264*t32
     t267 = t35 - t264
-    t268 = t253*(mu_dot5 + mu_dot0*t252 + mu_dot1*t32)
+    t268 = t253*(mu_dot5 + t252*mu_dot0 + t32*mu_dot1)
     t269 = mu_dot0 - t252*t268
     t270 = mu_dot1 - t268*t32
     t271 = mu_dot5 - t268
     t272 = -t0
-    t273 = t0*t253
+    t273 = t253*t0
     t274 = t272 + t273
     t275 = t44 + t63
-    t276 = xp.sqrt(t275 + t71 + t254**2 + t256**2)
+    t276 = xp.sqrt(t71 + t275 + t254**2 + t256**2)
     t277 = t276*xp.where(xp.greater_equal(t256, 0), xp.asarray(1, dtype=dtype), -1)
     t278 = t256 + t277
     t279 = xp.where(xp.greater(t276, 0), 1/(t276*(t276 + xp.abs(t256))), 0)
-    t280 = t279*(t275 + t254*t257 + t259*t278 + t28*t34)
+    t280 = t279*(t275 + t254*t257 + t259*t278 + t34*t28)
     t281 = t259 - t278*t280
-    t282 = -s1 + s1*t280
-    t283 = c1 - c1*t280
+    t282 = -s1 + t280*s1
+    t283 = c1 - t280*c1
     t284 = -t257 + t254*t280
-    t285 = -t279*(t17*t34 + t254*t263 + t262*t278)
+    t285 = -t279*(t254*t263 + t262*t278 + t34*t17)
     t286 = t262 + t278*t285
     t287 = t17 + t285*t34
-    t288 = t9 + s1*t285
-    t289 = t11 - c1*t285
+    t288 = t9 + t285*s1
+    t289 = t11 - t285*c1
     t290 = t263 + t254*t285
-    t291 = t279*(c1*t4 + s1*t7 + t266*t278 - t18*t34 - t254*t267)
+    t291 = t279*(t7*s1 + t4*c1 + t266*t278 - t254*t267 - t34*t18)
     t292 = t266 - t278*t291
     t293 = t18 + t291*t34
-    t294 = t4 - c1*t291
+    t294 = t4 - t291*c1
     t295 = t267 + t254*t291
-    t296 = -t279*(mu_dot2*t34 + mu_dot3*s1 + t254*t271 - c1*mu_dot4 - t270*t278)
+    t296 = -t279*(t254*t271 + t34*mu_dot2 + mu_dot3*s1 - t270*t278 - c1*mu_dot4)
     t297 = t270 - t278*t296
     t298 = mu_dot2 + t296*t34
-    t299 = mu_dot3 + s1*t296
-    t300 = mu_dot4 - c1*t296
+    t299 = mu_dot3 + t296*s1
+    t300 = mu_dot4 - t296*c1
     t301 = t271 + t254*t296
     t302 = -t28
     t303 = t302 + t280*t34
-    t304 = xp.sqrt(t282**2 + t283**2 + t284**2 + t303**2)
+    t304 = xp.sqrt(t303**2 + t282**2 + t283**2 + t284**2)
     t305 = t304*xp.where(xp.greater_equal(t303, 0), xp.asarray(1, dtype=dtype), -1)
     t306 = t303 + t305
     t307 = xp.where(xp.greater(t304, 0), 1/(t304*(t304 + xp.abs(t303))), 0)
@@ -2001,13 +2001,13 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t324 = t316 - t311*t322
     t325 = t317 - t312*t322
     t326 = -t7
-    t327 = t326 + s1*t291
+    t327 = t326 + t291*s1
     t328 = t307*(t282*t327 + t283*t294 + t284*t295 + t293*t306)
     t329 = t293 - t306*t328
     t330 = t327 - t282*t328
     t331 = t294 - t283*t328
     t332 = t295 - t284*t328
-    t333 = t321*(t311*t331 + t312*t332 + t320*t330)
+    t333 = t321*(t311*t331 + t312*t332 + t330*t320)
     t334 = t330 - t320*t333
     t335 = t331 - t311*t333
     t336 = t332 - t312*t333
@@ -2015,47 +2015,47 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t338 = t337*xp.where(xp.greater_equal(t335, 0), xp.asarray(1, dtype=dtype), -1)
     t339 = t335 + t338
     t340 = xp.where(xp.greater(t337, 0), 1/(t337*(t337 + xp.abs(t335))), 0)
-    t341 = t340*(t324*t339 + t325*t336)
+    t341 = t340*(t336*t325 + t324*t339)
     t342 = t324 - t339*t341
     t343 = t325 - t336*t341
-    t344 = 1 + c23 + damping + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + q1 + q2 + q3 + q4 + q5 + q6 + t10 + t11 + t12 + t17 + t18 + t23 + t243 + t246 + t272 + t302 + t32 + t326 + t35 + t36 + t37 + t4 + t51 + t57 + t58 + t9 - t24 - t34 - t77 + 2*c1
-    t345 = t273*t32
-    t346 = t279*(c1*t12 + t278*t345 - s1*t10 - t254*t274)
+    t344 = 1 + t4 + t10 + t12 + t32 + t23 + t36 + t37 + t17 + t18 + t35 + t51 + t57 + t58 + t9 + t11 + t243 + t246 + t272 + t302 + t326 + c23 + damping + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + q1 + q2 + q3 + q4 + q5 + q6 - t24 - t34 - t77 + 2*c1
+    t345 = t32*t273
+    t346 = t279*(t12*c1 + t278*t345 - t10*s1 - t254*t274)
     t347 = t345 - t278*t346
-    t348 = t10 + s1*t346
-    t349 = t12 - c1*t346
+    t348 = t10 + t346*s1
+    t349 = t12 - t346*c1
     t350 = t274 + t254*t346
-    t351 = t34*t346
+    t351 = t346*t34
     t352 = t307*(t282*t348 + t283*t349 + t284*t350 + t306*t351)
     t353 = t351 - t306*t352
     t354 = t348 - t282*t352
     t355 = t349 - t283*t352
     t356 = t350 - t284*t352
-    t357 = t321*(t311*t355 + t312*t356 + t320*t354)
+    t357 = t321*(t311*t355 + t312*t356 + t354*t320)
     t358 = t354 - t320*t357
     t359 = t355 - t311*t357
     t360 = t356 - t312*t357
-    t361 = t340*(t336*t360 + t339*t359)
+    t361 = t340*(t336*t360 + t359*t339)
     t362 = t359 - t339*t361
     t363 = t360 - t336*t361
     t364 = xp.abs(t363)
     t365 = t364
     t366 = t365*xp.where(xp.greater_equal(t363, 0), xp.asarray(1, dtype=dtype), -1)
     t367 = t363 + t366
-    t368 = xp.where(xp.greater(t365, 0), 1/(t365*(t364 + t365)), 0)
+    t368 = xp.where(xp.greater(t365, 0), 1/(t365*(t365 + t364)), 0)
     t369 = t343 - t343*t368*t367**2
     t370 = xp.where(xp.not_equal(t366, 0), -t369/t366, 0)
     t371 = xp.where(xp.not_equal(t338, 0), -(t342 - t362*t370)/t338, 0)
-    t372 = xp.where(xp.not_equal(t319, 0), -(t323 - t334*t371 - t358*t370)/t319, 0)
-    t373 = xp.where(xp.not_equal(t305, 0), -(t314 - t309*t372 - t329*t371 - t353*t370)/t305, 0)
-    t374 = xp.where(xp.not_equal(t277, 0), -(t297 + t286*t372 - t281*t373 - t292*t371 - t347*t370)/t277, 0)
-    t375 = xp.where(xp.not_equal(t251, 0), -(t269 - t255*t374 - t258*t373 - t261*t372 - t265*t371 - t252*t273*t370)/t251, 0)
+    t372 = xp.where(xp.not_equal(t319, 0), -(t323 - (t334*t371 + t358*t370))/t319, 0)
+    t373 = xp.where(xp.not_equal(t305, 0), -(t314 - (t309*t372 + t329*t371 + t353*t370))/t305, 0)
+    t374 = xp.where(xp.not_equal(t277, 0), -(t297 - (t281*t373 + t292*t371 + t347*t370 - t286*t372))/t277, 0)
+    t375 = xp.where(xp.not_equal(t251, 0), -(t269 - (t255*t374 + t258*t373 + t261*t372 + t265*t371 + t252*t370*t273))/t251, 0)
     t376 = xp.greater(damping, 0)
     t377 = xp.isfinite(t344)
     t378 = xp.greater_equal(damping, 0)
     t379 = 1e-12*t249
     t380 = 1e-12*t201
-    t381 = (t376 & ((xp.less_equal(t110, t380)) | (xp.less_equal(t134, t380)) | (xp.less_equal(t162, t380)) | (xp.less_equal(t193, t380)) | (xp.less_equal(t228, t380)) | (xp.less_equal(t91, t380)))) | ((xp.less_equal(damping, 0)) & ((xp.less_equal(t250, t379)) | (xp.less_equal(t276, t379)) | (xp.less_equal(t304, t379)) | (xp.less_equal(t318, t379)) | (xp.less_equal(t337, t379)) | (xp.less_equal(t365, t379))))
+    t381 = (t376 & (xp.less_equal(t91, t380) | xp.less_equal(t110, t380) | xp.less_equal(t134, t380) | xp.less_equal(t162, t380) | xp.less_equal(t193, t380) | xp.less_equal(t228, t380))) | (xp.less_equal(damping, 0) & (xp.less_equal(t250, t379) | xp.less_equal(t276, t379) | xp.less_equal(t304, t379) | xp.less_equal(t318, t379) | xp.less_equal(t337, t379) | xp.less_equal(t365, t379)))
     t382 = t377 & t378 & xp.logical_not(t381)
     q_dot = _stack(xp, [
         xp.broadcast_to(xp.where(t382, xp.where(t376, t239, t375), 0), batch),  # 0
@@ -2071,7 +2071,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def ik_numeric_step(target, q, damping=0.0):
-    """one step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite): (6 x 1 and 6 x 1 and 1 x 1), 1021 operations."""
+    """one step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite): (6 x 1 and 6 x 1 and 1 x 1), 1016 operations."""
     xp, dtype, device, batch, (target, q, damping,) = _arguments(("target", target, (4, 4)), ("q", q, (6,)), ("damping", damping, ()))
     T00 = target[..., 0, 0]
     T01 = target[..., 0, 1]
@@ -2114,158 +2114,158 @@ def ik_numeric_step(target, q, damping=0.0):
     t0 = T00 + T01 + T02 + T03 + T10 + T11 + T12 + T13 + T20 + T21 + T22 + T23 + qs1 + qs2 + qs3 + qs4 + qs5 + qs6
     t1 = s1*s4
     t2 = c1*c4
-    t3 = -t1 + c23*t2
-    t4 = t2 - c23*t1
+    t3 = -t1 + t2*c23
+    t4 = t2 - t1*c23
     t5 = c4*s1
     t6 = c1*s4
-    t7 = t5 + c23*t6
-    t8 = t6 + c23*t5
+    t7 = t5 + t6*c23
+    t8 = t6 + t5*c23
     t9 = c1*s23
-    t10 = c5*t3 - s5*t9
-    t11 = c5*t9 + s5*t3
-    t12 = c6*t10 - s6*t7
-    t13 = c6*t7 + s6*t10
+    t10 = t3*c5 - t9*s5
+    t11 = t3*s5 + t9*c5
+    t12 = t10*c6 - t7*s6
+    t13 = t7*c6 + t10*s6
     t14 = T00*t12 + T01*t13 - T02*t11
     t15 = T10*t12 + T11*t13 - T12*t11
     t16 = T20*t12 + T21*t13 - T22*t11
     t17 = s1*s23
-    t18 = c5*t8 - s5*t17
-    t19 = c5*t17 + s5*t8
-    t20 = c6*t18 + s6*t4
-    t21 = c6*t4 - s6*t18
+    t18 = t8*c5 - t17*s5
+    t19 = t8*s5 + t17*c5
+    t20 = t4*s6 + t18*c6
+    t21 = t4*c6 - t18*s6
     t22 = T01*t21 + T02*t19 - T00*t20
     t23 = T11*t21 + T12*t19 - T10*t20
     t24 = T21*t21 + T22*t19 - T20*t20
-    t25 = 0.5*t15 + 0.5*t22
+    t25 = 0.5*(t22 + t15)
     t26 = c4*s23
-    t27 = c23*s5 + c5*t26
-    t28 = s5*t26 - c23*c5
+    t27 = t26*c5 + c23*s5
+    t28 = t26*s5 - c23*c5
     t29 = s23*s4
-    t30 = s6*t29 - c6*t27
-    t31 = c6*t29 + s6*t27
-    t32 = t11*t28 + t29*t7 - c23*t9
-    t33 = c23*t17 + t29*t4 - t19*t28
+    t30 = t29*s6 - t27*c6
+    t31 = t27*s6 + t29*c6
+    t32 = t7*t29 + t11*t28 - t9*c23
+    t33 = t4*t29 + t17*c23 - t19*t28
     t34 = T00*t30 + T02*t28 - T01*t31
     t35 = T10*t30 + T12*t28 - T11*t31
     t36 = T20*t30 + T22*t28 - T21*t31
-    t37 = -0.5*t24 - 0.5*t35
-    t38 = 0.5*t34 - 0.5*t16
-    t39 = xp.sqrt(t25**2 + t37**2 + t38**2)
+    t37 = -0.5*(t35 + t24)
+    t38 = 0.5*(t34 - t16)
+    t39 = xp.sqrt(t37**2 + t38**2 + t25**2)
     t40 = 0.115*t11
     t41 = t40 + 0.62*t9
     t42 = 0.115*t19
     t43 = t42 + 0.62*t17
-    t44 = t17*t41 - t43*t9
-    t45 = t4*t40 + t42*t7
-    t46 = c23*t44 + t29*t45
+    t44 = t41*t17 - t43*t9
+    t45 = t7*t42 + t4*t40
+    t46 = t44*c23 + t45*t29
     t47 = 0.115*t28
     t48 = t47 - 0.62*c23
     t49 = t48 - 0.12*s23
     t50 = t49 - 0.6*s2
     t51 = 0.4 + t50
-    t52 = c23*t43 + t17*t48
-    t53 = t29*t42 + t4*t47
-    t54 = c23*t41 + t48*t9
-    t55 = t47*t7 - t29*t40
+    t52 = t43*c23 + t48*t17
+    t53 = t4*t47 + t29*t42
+    t54 = t41*c23 + t48*t9
+    t55 = t7*t47 - t29*t40
     t56 = T23 - t51
     t57 = 0.12*c23
-    t58 = -t41 + c1*t57
-    t59 = -t43 + s1*t57
-    t60 = c1*t58 + s1*t59
+    t58 = -t41 + t57*c1
+    t59 = -t43 + t57*s1
+    t60 = t58*c1 + t59*s1
     t61 = 0.6*c2
-    t62 = t58 + c1*t61
-    t63 = t59 + s1*t61
+    t62 = t58 + t61*c1
+    t63 = t59 + t61*s1
     t64 = t62 + 0.18*c1
     t65 = t63 + 0.18*s1
-    t66 = c1*t62 + s1*t63
-    t67 = t64 + t29*t55 - c23*t54
-    t68 = t44**2 + t45**2 + t60**2 + t66**2
+    t66 = t62*c1 + t63*s1
+    t67 = t64 + t55*t29 - t54*c23
+    t68 = t66**2 + t60**2 + t44**2 + t45**2
     t69 = T03 - t64
     t70 = t49**2
     t71 = c1**2
-    t72 = t17*t52 + t4*t53 + t49*t71 + t50*t71
+    t72 = t4*t53 + t49*t71 + t50*t71 + t52*t17
     t73 = t50**2
-    t74 = t52**2 + t53**2 + t65**2 + t70*t71 + t71*t73
+    t74 = t65**2 + t52**2 + t53**2 + t70*t71 + t71*t73
     t75 = c1*s1
-    t76 = t53*t55 + t70*t75 + t73*t75 - t52*t54 - t64*t65
+    t76 = t53*t55 + t70*t75 + t73*t75 - t64*t65 - t52*t54
     t77 = -t65
-    t78 = t77 + c23*t52 + t29*t53
+    t78 = t77 + t52*c23 + t53*t29
     t79 = T13 + t77
-    t80 = c1*t60
-    t81 = c1*t66
-    t82 = t44*t52 + t45*t53 - t49*t80 - t50*t81
-    t83 = -t80 - t81 + t17*t44 + t4*t45
+    t80 = t60*c1
+    t81 = t66*c1
+    t82 = t52*t44 + t53*t45 - t49*t80 - t50*t81
+    t83 = -t80 - t81 + t4*t45 + t44*t17
     t84 = t49*t75 + t50*t75
-    t85 = t84 + t53*t7 - t52*t9
-    t86 = t84 + t4*t55 - t17*t54
+    t85 = t84 + t7*t53 - t52*t9
+    t86 = t84 + t4*t55 - t54*t17
     t87 = s1**2
-    t88 = t54**2 + t55**2 + t64**2 + t70*t87 + t73*t87
-    t89 = t49*t87 + t50*t87 + t54*t9 + t55*t7
-    t90 = s1*t60
-    t91 = s1*t66
-    t92 = t44*t54 + t49*t90 + t50*t91 - t45*t55
-    t93 = t90 + t91 + t44*t9 - t45*t7
+    t88 = t64**2 + t54**2 + t55**2 + t70*t87 + t73*t87
+    t89 = t7*t55 + t49*t87 + t50*t87 + t54*t9
+    t90 = t60*s1
+    t91 = t66*s1
+    t92 = t49*t90 + t50*t91 + t54*t44 - t55*t45
+    t93 = t90 + t91 + t44*t9 - t7*t45
     t94 = s23**2
-    t95 = t11**2 + t7**2 + 2*t87 + t71*t94
-    t96 = -2*t75 + t11*t19 + t75*t94 - t4*t7
-    t97 = t19**2 + t4**2 + 2*t71 + t87*t94
-    t98 = 1 + c23**2 + t28**2 + t94*s4**2
+    t95 = t7**2 + t11**2 + 2*t87 + t71*t94
+    t96 = -2*t75 + t11*t19 + t75*t94 - t7*t4
+    t97 = t4**2 + t19**2 + 2*t71 + t87*t94
+    t98 = 1 + t28**2 + c23**2 + t94*s4**2
     t99 = -t23
-    t100 = -0.5 + 0.5*t14 + 0.5*t36 + 0.5*t99
+    t100 = 0.5*(-1 + t14 + t36 + t99)
     t101 = xp.atan2(t39, t100)
     t102 = xp.where(xp.greater(t39, 0), t101/t39, 1)
-    t103 = (xp.greater_equal(t14, t36)) & (xp.greater_equal(t14, t99))
+    t103 = xp.greater_equal(t14, t36) & xp.greater_equal(t14, t99)
     t104 = xp.less_equal(t23, -t36)
-    t105 = xp.where(t103, 0.5 + 0.5*t14, xp.where(t104, -0.5*t22, 0.5*t34))
-    t106 = xp.where(t103, 0.5*t15, xp.where(t104, 0.5 + 0.5*t99, 0.5*t35))
-    t107 = xp.where(t103, 0.5*t16, xp.where(t104, -0.5*t24, 0.5 + 0.5*t36))
+    t105 = xp.where(t103, 0.5*(1 + t14), xp.where(t104, -0.5*t22, 0.5*t34))
+    t106 = xp.where(t103, 0.5*t15, xp.where(t104, 0.5*(1 + t99), 0.5*t35))
+    t107 = xp.where(t103, 0.5*t16, xp.where(t104, -0.5*t24, 0.5*(1 + t36)))
     t108 = xp.sqrt(t105**2 + t106**2 + t107**2)
-    t109 = xp.where(xp.greater_equal(t105*t37 + t106*t38 + t107*t25, 0), xp.asarray(1, dtype=dtype), -1)
-    t110 = (xp.greater(t39, 1e-06)) | (xp.greater(t100, 0))
+    t109 = xp.where(xp.greater_equal(t37*t105 + t38*t106 + t25*t107, 0), xp.asarray(1, dtype=dtype), -1)
+    t110 = xp.greater(t39, 1e-06) | xp.greater(t100, 0)
     t111 = t101*t109/t108
-    t112 = xp.where(t110, t102*t37, t105*t111)
-    t113 = xp.where(t110, t102*t38, t106*t111)
-    t114 = xp.where(t110, t102*t25, t107*t111)
-    t115 = t112**2 + t113**2 + t114**2 + t56**2 + t69**2 + t79**2
-    t116 = damping + t74
-    t117 = xp.sqrt(t116**2 + t72**2 + t76**2 + t78**2 + t82**2 + t85**2)
+    t112 = xp.where(t110, t37*t102, t105*t111)
+    t113 = xp.where(t110, t38*t102, t106*t111)
+    t114 = xp.where(t110, t25*t102, t107*t111)
+    t115 = t112**2 + t113**2 + t114**2 + t69**2 + t79**2 + t56**2
+    t116 = t74 + damping
+    t117 = xp.sqrt(t76**2 + t78**2 + t82**2 + t85**2 + t72**2 + t116**2)
     t118 = t117*xp.where(xp.greater_equal(t116, 0), xp.asarray(1, dtype=dtype), -1)
-    t119 = t116 + t118
+    t119 = t118 + t116
     t120 = xp.where(xp.greater(t117, 0), 1/(t117*(t117 + xp.abs(t116))), 0)
-    t121 = t120*(t113*t72 + t114*t78 + t119*t69 + t56*t82 + t76*t79 - t112*t85)
+    t121 = t120*(t76*t79 + t78*t114 + t82*t56 + t72*t113 + t69*t119 - t85*t112)
     t122 = t69 - t119*t121
-    t123 = t79 - t121*t76
-    t124 = t56 - t121*t82
-    t125 = t112 + t121*t85
-    t126 = t113 - t121*t72
-    t127 = t114 - t121*t78
-    t128 = damping + t88
-    t129 = t120*(t119*t76 + t128*t76 + t67*t78 + t72*t86 + t85*t89 - t82*t92)
+    t123 = t79 - t76*t121
+    t124 = t56 - t82*t121
+    t125 = t112 + t85*t121
+    t126 = t113 - t72*t121
+    t127 = t114 - t78*t121
+    t128 = t88 + damping
+    t129 = t120*(t76*t119 + t76*t128 + t78*t67 + t85*t89 + t72*t86 - t82*t92)
     t130 = t76 - t119*t129
-    t131 = t128 - t129*t76
-    t132 = t92 + t129*t82
-    t133 = -t89 + t129*t85
-    t134 = t86 - t129*t72
-    t135 = t67 - t129*t78
+    t131 = t128 - t76*t129
+    t132 = t92 + t82*t129
+    t133 = -t89 + t85*t129
+    t134 = t86 - t72*t129
+    t135 = t67 - t78*t129
     t136 = xp.sqrt(t131**2 + t132**2 + t133**2 + t134**2 + t135**2)
     t137 = t136*xp.where(xp.greater_equal(t131, 0), xp.asarray(1, dtype=dtype), -1)
     t138 = t131 + t137
     t139 = xp.where(xp.greater(t136, 0), 1/(t136*(t136 + xp.abs(t131))), 0)
-    t140 = t139*(t123*t138 + t125*t133 + t126*t134 + t127*t135 - t124*t132)
+    t140 = t139*(t133*t125 + t134*t126 + t135*t127 + t123*t138 - t132*t124)
     t141 = t123 - t138*t140
     t142 = t124 + t132*t140
     t143 = t125 - t133*t140
     t144 = t126 - t134*t140
     t145 = t127 - t135*t140
-    t146 = damping + t68
-    t147 = t120*(t119*t82 + t146*t82 + t46*t78 + t72*t83 - t76*t92 - t85*t93)
+    t146 = t68 + damping
+    t147 = t120*(t78*t46 + t82*t119 + t82*t146 + t72*t83 - t76*t92 - t85*t93)
     t148 = t82 - t119*t147
-    t149 = t92 + t147*t76
-    t150 = t146 - t147*t82
-    t151 = t93 + t147*t85
-    t152 = t83 - t147*t72
-    t153 = t46 - t147*t78
-    t154 = t139*(t133*t151 + t134*t152 + t135*t153 - t132*t150 - t138*t149)
+    t149 = t92 + t76*t147
+    t150 = t146 - t82*t147
+    t151 = t93 + t85*t147
+    t152 = t83 - t72*t147
+    t153 = t46 - t78*t147
+    t154 = t139*(t133*t151 + t134*t152 + t135*t153 - t132*t150 - t149*t138)
     t155 = t149 + t138*t154
     t156 = t150 + t132*t154
     t157 = t151 - t133*t154
@@ -2275,26 +2275,26 @@ def ik_numeric_step(target, q, damping=0.0):
     t161 = t160*xp.where(xp.greater_equal(t156, 0), xp.asarray(1, dtype=dtype), -1)
     t162 = t156 + t161
     t163 = xp.where(xp.greater(t160, 0), 1/(t160*(t160 + xp.abs(t156))), 0)
-    t164 = t163*(t142*t162 + t143*t157 + t144*t158 + t145*t159)
+    t164 = t163*(t157*t143 + t158*t144 + t159*t145 + t142*t162)
     t165 = t142 - t162*t164
     t166 = t143 - t157*t164
     t167 = t144 - t158*t164
     t168 = t145 - t159*t164
-    t169 = damping + t95
-    t170 = -t120*(t119*t85 + t169*t85 + t32*t78 + t76*t89 - t72*t96 - t82*t93)
+    t169 = t95 + damping
+    t170 = -t120*(t76*t89 + t78*t32 + t85*t119 + t85*t169 - t82*t93 - t72*t96)
     t171 = t85 + t119*t170
-    t172 = t89 + t170*t76
-    t173 = t93 - t170*t82
-    t174 = t169 + t170*t85
-    t175 = t96 - t170*t72
-    t176 = t32 + t170*t78
-    t177 = -t139*(t132*t173 + t135*t176 + t138*t172 - t133*t174 - t134*t175)
+    t172 = t89 + t76*t170
+    t173 = t93 - t82*t170
+    t174 = t169 + t85*t170
+    t175 = t96 - t72*t170
+    t176 = t32 + t78*t170
+    t177 = -t139*(t132*t173 + t135*t176 + t172*t138 - t133*t174 - t134*t175)
     t178 = t172 + t138*t177
     t179 = t173 + t132*t177
     t180 = t174 - t133*t177
     t181 = t175 - t134*t177
     t182 = t176 + t135*t177
-    t183 = t163*(t157*t180 + t158*t181 + t162*t179 - t159*t182)
+    t183 = t163*(t157*t180 + t158*t181 + t179*t162 - t159*t182)
     t184 = t179 - t162*t183
     t185 = t180 - t157*t183
     t186 = t181 - t158*t183
@@ -2303,30 +2303,30 @@ def ik_numeric_step(target, q, damping=0.0):
     t189 = t188*xp.where(xp.greater_equal(t185, 0), xp.asarray(1, dtype=dtype), -1)
     t190 = t185 + t189
     t191 = xp.where(xp.greater(t188, 0), 1/(t188*(t188 + xp.abs(t185))), 0)
-    t192 = t191*(t166*t190 + t167*t186 - t168*t187)
+    t192 = t191*(t186*t167 + t166*t190 - t187*t168)
     t193 = t166 - t190*t192
     t194 = t167 - t186*t192
     t195 = t168 + t187*t192
-    t196 = damping + t97
-    t197 = t120*(t119*t72 + t196*t72 + t33*t78 + t76*t86 + t82*t83 - t85*t96)
+    t196 = t97 + damping
+    t197 = t120*(t76*t86 + t78*t33 + t82*t83 + t72*t119 + t72*t196 - t85*t96)
     t198 = t72 - t119*t197
-    t199 = t86 - t197*t76
-    t200 = t83 - t197*t82
-    t201 = t96 + t197*t85
-    t202 = t196 - t197*t72
-    t203 = t33 - t197*t78
-    t204 = t139*(t133*t201 + t134*t202 + t135*t203 + t138*t199 - t132*t200)
+    t199 = t86 - t76*t197
+    t200 = t83 - t82*t197
+    t201 = t96 + t85*t197
+    t202 = t196 - t72*t197
+    t203 = t33 - t78*t197
+    t204 = t139*(t133*t201 + t134*t202 + t135*t203 + t199*t138 - t132*t200)
     t205 = t199 - t138*t204
     t206 = t200 + t132*t204
     t207 = t201 - t133*t204
     t208 = t202 - t134*t204
     t209 = t203 - t135*t204
-    t210 = t163*(t157*t207 + t158*t208 + t159*t209 + t162*t206)
+    t210 = t163*(t157*t207 + t158*t208 + t159*t209 + t206*t162)
     t211 = t206 - t162*t210
     t212 = t207 - t157*t210
     t213 = t208 - t158*t210
     t214 = t209 - t159*t210
-    t215 = t191*(t186*t213 + t190*t212 - t187*t214)
+    t215 = t191*(t186*t213 + t212*t190 - t187*t214)
     t216 = t212 - t190*t215
     t217 = t213 - t186*t215
     t218 = t214 + t187*t215
@@ -2334,56 +2334,56 @@ def ik_numeric_step(target, q, damping=0.0):
     t220 = t219*xp.where(xp.greater_equal(t217, 0), xp.asarray(1, dtype=dtype), -1)
     t221 = t217 + t220
     t222 = xp.where(xp.greater(t219, 0), 1/(t219*(t219 + xp.abs(t217))), 0)
-    t223 = t222*(t194*t221 + t195*t218)
+    t223 = t222*(t218*t195 + t194*t221)
     t224 = t194 - t221*t223
     t225 = t195 - t218*t223
-    t226 = damping + t98
-    t227 = t120*(t119*t78 + t226*t78 + t32*t85 + t33*t72 + t46*t82 + t67*t76)
+    t226 = t98 + damping
+    t227 = t120*(t76*t67 + t78*t119 + t78*t226 + t82*t46 + t85*t32 + t72*t33)
     t228 = t78 - t119*t227
-    t229 = t67 - t227*t76
-    t230 = t46 - t227*t82
-    t231 = -t32 + t227*t85
-    t232 = t33 - t227*t72
-    t233 = t226 - t227*t78
-    t234 = t139*(t133*t231 + t134*t232 + t135*t233 + t138*t229 - t132*t230)
+    t229 = t67 - t76*t227
+    t230 = t46 - t82*t227
+    t231 = -t32 + t85*t227
+    t232 = t33 - t72*t227
+    t233 = t226 - t78*t227
+    t234 = t139*(t133*t231 + t134*t232 + t135*t233 + t229*t138 - t132*t230)
     t235 = t229 - t138*t234
     t236 = t230 + t132*t234
     t237 = t231 - t133*t234
     t238 = t232 - t134*t234
     t239 = t233 - t135*t234
-    t240 = t163*(t157*t237 + t158*t238 + t159*t239 + t162*t236)
+    t240 = t163*(t157*t237 + t158*t238 + t159*t239 + t236*t162)
     t241 = t236 - t162*t240
     t242 = t237 - t157*t240
     t243 = t238 - t158*t240
     t244 = t239 - t159*t240
-    t245 = t191*(t186*t243 + t190*t242 - t187*t244)
+    t245 = t191*(t186*t243 + t242*t190 - t187*t244)
     t246 = t242 - t190*t245
     t247 = t243 - t186*t245
     t248 = t244 + t187*t245
-    t249 = t222*(t218*t248 + t221*t247)
+    t249 = t222*(t218*t248 + t247*t221)
     t250 = t247 - t221*t249
     t251 = t248 - t218*t249
     t252 = xp.abs(t251)
     t253 = t252
     t254 = t253*xp.where(xp.greater_equal(t251, 0), xp.asarray(1, dtype=dtype), -1)
     t255 = t251 + t254
-    t256 = xp.where(xp.greater(t253, 0), 1/(t253*(t252 + t253)), 0)
+    t256 = xp.where(xp.greater(t253, 0), 1/(t253*(t253 + t252)), 0)
     t257 = t225 - t225*t256*t255**2
     t258 = xp.where(xp.not_equal(t254, 0), -t257/t254, 0)
     t259 = xp.where(xp.not_equal(t220, 0), -(t224 - t250*t258)/t220, 0)
-    t260 = xp.where(xp.not_equal(t189, 0), -(t193 - t216*t259 - t246*t258)/t189, 0)
-    t261 = xp.where(xp.not_equal(t161, 0), -(t165 - t184*t260 - t211*t259 - t241*t258)/t161, 0)
-    t262 = xp.where(xp.not_equal(t137, 0), -(t141 + t155*t261 + t178*t260 - t205*t259 - t235*t258)/t137, 0)
-    t263 = xp.where(xp.not_equal(t118, 0), -(t122 + t171*t260 - t130*t262 - t148*t261 - t198*t259 - t228*t258)/t118, 0)
-    t264 = q1 + t258 + t262*t64 - t263*t65
-    t265 = q4 + c23*t258 + t17*t259 + t260*t9 + t261*t44 + t263*t52 - t262*t54
-    t266 = q5 + t258*t29 + t259*t4 + t261*t45 + t262*t55 + t263*t53 - t260*t7
-    t267 = q6 + t11*t260 + t19*t259 - t258*t28
-    t268 = s1*t262
-    t269 = c1*t263
-    t270 = c1*t259 - s1*t260
-    t271 = q2 + t270 + t268*t50 + t269*t50 - t261*t66
-    t272 = q3 + t270 + t268*t49 + t269*t49 - t261*t60
+    t260 = xp.where(xp.not_equal(t189, 0), -(t193 - (t216*t259 + t246*t258))/t189, 0)
+    t261 = xp.where(xp.not_equal(t161, 0), -(t165 - (t184*t260 + t211*t259 + t241*t258))/t161, 0)
+    t262 = xp.where(xp.not_equal(t137, 0), -(t141 - (t205*t259 + t235*t258 - t155*t261 - t178*t260))/t137, 0)
+    t263 = xp.where(xp.not_equal(t118, 0), -(t122 - (t130*t262 + t148*t261 + t198*t259 + t228*t258 - t171*t260))/t118, 0)
+    t264 = t258 + q1 + t64*t262 - t65*t263
+    t265 = q4 + t52*t263 + t258*c23 + t259*t17 + t260*t9 + t261*t44 - t54*t262
+    t266 = q5 + t4*t259 + t53*t263 + t258*t29 + t261*t45 + t262*t55 - t7*t260
+    t267 = q6 + t11*t260 + t19*t259 - t28*t258
+    t268 = t262*s1
+    t269 = t263*c1
+    t270 = t259*c1 - t260*s1
+    t271 = t270 + q2 + t50*t268 + t50*t269 - t261*t66
+    t272 = t270 + q3 + t49*t268 + t49*t269 - t261*t60
     q_start = _stack(xp, [
         xp.broadcast_to(q1, batch),  # 0
         xp.broadcast_to(q2, batch),  # 1
@@ -2406,7 +2406,7 @@ def ik_numeric_step(target, q, damping=0.0):
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def ik_branches(T):
-    """every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits: (8 x 6 and 8 x 1 and 8 x 1), 1301 operations."""
+    """every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits: (8 x 6 and 8 x 1 and 8 x 1), 1299 operations."""
     xp, dtype, device, batch, (T,) = _arguments(("T", T, (4, 4)))
     T00 = T[..., 0, 0]
     T01 = T[..., 0, 1]
@@ -2422,16 +2422,16 @@ def ik_branches(T):
     T23 = T[..., 2, 3]
     t0 = T00 + T01 + T02 + T03 + T10 + T11 + T12 + T13 + T20 + T21 + T22 + T23
     t1 = 0.9*T00
-    t2 = T03 - t1 - 0.335*T02
+    t2 = T03 - (t1 + 0.335*T02)
     t3 = t1 + 0.22*T02
     t4 = t2 + t3
     t5 = 0.9*T10
-    t6 = T13 - t5 - 0.335*T12
+    t6 = T13 - (t5 + 0.335*T12)
     t7 = t5 + 0.22*T12
     t8 = t6 + t7
     t9 = xp.atan2(-t4, t8)
     t10 = 0.9*T20
-    t11 = T23 - t10 - 0.335*T22
+    t11 = T23 - (t10 + 0.335*T22)
     t12 = t10 + 0.22*T22
     t13 = t11 + t12
     t14 = t4**2 + t8**2
@@ -2440,28 +2440,28 @@ def ik_branches(T):
     t17 = 1e-24*t16
     t18 = xp.less_equal(t15, t17)
     t19 = xp.where(t18, 1, 1/xp.sqrt(t15))
-    t20 = xp.where(t18, 0, t9 + (1/2)*numpy.pi)
-    t21 = t9 - 1/2*numpy.pi
-    t22 = t20 - 6.283185307179586*xp.ceil(-0.5 + 0.15915494309189535*t20)
-    t23 = t22 - 6.283185307179586*xp.floor(0.4305555555555555 + 0.15915494309189535*t22)
-    t24 = t21 - 6.283185307179586*xp.ceil(-0.5 + 0.15915494309189535*t21)
-    t25 = t24 - 6.283185307179586*xp.floor(0.4305555555555555 + 0.15915494309189535*t24)
+    t20 = xp.where(t18, 0, t9 + 1.5707963267948966)
+    t21 = t9 - 1.5707963267948966
+    t22 = t20 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t20))
+    t23 = t22 - 6.283185307179586*xp.floor(0.15915494309189535*(2.705260340591211 + t22))
+    t24 = t21 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t21))
+    t25 = t24 - 6.283185307179586*xp.floor(0.15915494309189535*(2.705260340591211 + t24))
     t26 = t19
-    t27 = t26*t4
+    t27 = t4*t26
     t28 = xp.where(t18, 1, t27)
     t29 = -t27
-    t30 = t26*t8
+    t30 = t8*t26
     t31 = xp.where(t18, 0, t30)
     t32 = t30
-    t33 = t28*t4 + t31*t8
-    t34 = t28*t8 - t31*t4
+    t33 = t4*t28 + t8*t31
+    t34 = t8*t28 - t4*t31
     t35 = -0.18 + t33
     t36 = T02*t28 + T12*t31
     t37 = T02*t31 - T12*t28
     t38 = T00*t28 + T10*t31
     t39 = T10*t28 - T00*t31
-    t40 = t29*t4 - t32*t8
-    t41 = t29*t8 + t32*t4
+    t40 = t4*t29 - t8*t32
+    t41 = t4*t32 + t8*t29
     t42 = -0.18 + t40
     t43 = T12*t32 - T02*t29
     t44 = T02*t32 + T12*t29
@@ -2472,7 +2472,7 @@ def ik_branches(T):
     t49 = t48 + t13*t28
     t50 = -0.4 + t49
     t51 = t34**2 + t35**2 + t50**2
-    t52 = 0.3794 - 0.5*t51
+    t52 = 0.5*(0.7588 - t51)
     t53 = T22*t47
     t54 = t53 + T22*t28
     t55 = T20*t47
@@ -2486,13 +2486,13 @@ def ik_branches(T):
     t63 = xp.atan2(t62, t61)
     t64 = 1.761980786391911 + t63
     t65 = 1.761980786391911 - t63
-    t66 = t64 - 6.283185307179586*xp.ceil(-0.5 + 0.15915494309189535*t64)
-    t67 = t66 - 6.283185307179586*xp.floor(0.041666666666666664 + 0.15915494309189535*t66)
-    t68 = t65 - 6.283185307179586*xp.ceil(-0.5 + 0.15915494309189535*t65)
-    t69 = t68 - 6.283185307179586*xp.floor(0.041666666666666664 + 0.15915494309189535*t68)
+    t66 = t64 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t64))
+    t67 = t66 - 6.283185307179586*xp.floor(0.15915494309189535*(0.2617993877991494 + t66))
+    t68 = t65 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t65))
+    t69 = t68 - 6.283185307179586*xp.floor(0.15915494309189535*(0.2617993877991494 + t68))
     t70 = 0.1900219065658609*t61
     t71 = 0.9817798505902814*t62
-    t72 = -t70 - t71
+    t72 = -(t70 + t71)
     t73 = t71 - t70
     t74 = 0.9817798505902814*t61
     t75 = 0.1900219065658609*t62
@@ -2521,27 +2521,27 @@ def ik_branches(T):
     t98 = 1e-24*t51
     t99 = xp.less_equal(t86, t87*t98)
     t100 = xp.where(t99, 1, 1/xp.sqrt(t86))
-    t101 = xp.where(t99, 1, t100*t84)
-    t102 = xp.where(t99, 0, t100*t85)
-    t103 = t101*t72 - t102*t76
-    t104 = t101*t76 + t102*t72
+    t101 = xp.where(t99, 1, t84*t100)
+    t102 = xp.where(t99, 0, t85*t100)
+    t103 = t72*t101 - t76*t102
+    t104 = t72*t102 + t76*t101
     t105 = t104*t54 - t103*t36
     t106 = t103*t54 + t104*t36
     t107 = t103*t38 - t104*t56
     t108 = t103*t56 + t104*t38
     t109 = xp.where(t99, 0, xp.atan2(t85, t84))
-    t110 = t109 - 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*t109)
+    t110 = t109 - 6.283185307179586*xp.floor(0.15915494309189535*(3.141592653589793 + t109))
     t111 = 1 - t103
-    t112 = t111*t37
+    t112 = t37*t111
     t113 = t112 + t103*t37
-    t114 = t111*t39
+    t114 = t39*t111
     t115 = t114 + t103*t39
     t116 = t106**2
     t117 = -t116
     t118 = 1 + t117
-    t119 = xp.where(xp.greater(t118, 1e-12), xp.sqrt(t118), 0)
+    t119 = xp.where(xp.less(1e-12, t118), xp.sqrt(t118), 0)
     t120 = t116 - t105*t119
-    t121 = t117 + t120
+    t121 = t120 + t117
     t122 = t113**2
     t123 = t116 + t122 + t105**2
     t124 = t119**2
@@ -2562,35 +2562,35 @@ def ik_branches(T):
     t139 = xp.where(t137, 1, -t106*t138)
     t140 = xp.where(t137, 0, -t119*t138)
     t141 = t136*(1 - t139)
-    t142 = t135*t139 - t132*t140
-    t143 = t141 + t136*t139
-    t144 = t132*t139 + t135*t140
+    t142 = t139*t135 - t140*t132
+    t143 = t141 + t139*t136
+    t144 = t139*t132 + t140*t135
     t145 = t142**2 + t143**2
     t146 = t145
     t147 = t145 + t144**2
     t148 = xp.less_equal(t96, t97*t98)
     t149 = xp.where(t148, 1, 1/xp.sqrt(t96))
-    t150 = xp.where(t148, 1, t149*t94)
-    t151 = xp.where(t148, 0, t149*t95)
-    t152 = t150*t73 - t151*t77
-    t153 = t150*t77 + t151*t73
-    t154 = t153*t54 - t152*t36
-    t155 = t152*t54 + t153*t36
-    t156 = t152*t38 - t153*t56
-    t157 = t152*t56 + t153*t38
+    t150 = xp.where(t148, 1, t94*t149)
+    t151 = xp.where(t148, 0, t95*t149)
+    t152 = t73*t150 - t77*t151
+    t153 = t73*t151 + t77*t150
+    t154 = t54*t153 - t36*t152
+    t155 = t36*t153 + t54*t152
+    t156 = t38*t152 - t56*t153
+    t157 = t38*t153 + t56*t152
     t158 = xp.where(t148, 0, xp.atan2(t95, t94))
-    t159 = t158 - 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*t158)
+    t159 = t158 - 6.283185307179586*xp.floor(0.15915494309189535*(3.141592653589793 + t158))
     t160 = 1 - t152
-    t161 = t160*t37
-    t162 = t161 + t152*t37
-    t163 = t160*t39
-    t164 = t163 + t152*t39
+    t161 = t37*t160
+    t162 = t161 + t37*t152
+    t163 = t39*t160
+    t164 = t163 + t39*t152
     t165 = t155**2
     t166 = -t165
     t167 = 1 + t166
-    t168 = xp.where(xp.greater(t167, 1e-12), xp.sqrt(t167), 0)
+    t168 = xp.where(xp.less(1e-12, t167), xp.sqrt(t167), 0)
     t169 = t165 - t154*t168
-    t170 = t166 + t169
+    t170 = t169 + t166
     t171 = t162**2
     t172 = t165 + t171 + t154**2
     t173 = t168**2
@@ -2611,9 +2611,9 @@ def ik_branches(T):
     t188 = xp.where(t186, 1, -t155*t187)
     t189 = xp.where(t186, 0, -t168*t187)
     t190 = t185*(1 - t188)
-    t191 = t184*t188 - t181*t189
-    t192 = t190 + t185*t188
-    t193 = t181*t188 + t184*t189
+    t191 = t188*t184 - t189*t181
+    t192 = t190 + t188*t185
+    t193 = t188*t181 + t189*t184
     t194 = t191**2 + t192**2
     t195 = t194
     t196 = t194 + t193**2
@@ -2621,8 +2621,8 @@ def ik_branches(T):
     t198 = t13*t197
     t199 = t198 + t13*t29
     t200 = -0.4 + t199
-    t201 = t200**2 + t41**2 + t42**2
-    t202 = 0.3794 - 0.5*t201
+    t201 = t41**2 + t42**2 + t200**2
+    t202 = 0.5*(0.7588 - t201)
     t203 = T22*t197
     t204 = t203 + T22*t29
     t205 = T20*t197
@@ -2636,13 +2636,13 @@ def ik_branches(T):
     t213 = xp.atan2(t212, t211)
     t214 = 1.761980786391911 + t213
     t215 = 1.761980786391911 - t213
-    t216 = t214 - 6.283185307179586*xp.ceil(-0.5 + 0.15915494309189535*t214)
-    t217 = t216 - 6.283185307179586*xp.floor(0.041666666666666664 + 0.15915494309189535*t216)
-    t218 = t215 - 6.283185307179586*xp.ceil(-0.5 + 0.15915494309189535*t215)
-    t219 = t218 - 6.283185307179586*xp.floor(0.041666666666666664 + 0.15915494309189535*t218)
+    t216 = t214 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t214))
+    t217 = t216 - 6.283185307179586*xp.floor(0.15915494309189535*(0.2617993877991494 + t216))
+    t218 = t215 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t215))
+    t219 = t218 - 6.283185307179586*xp.floor(0.15915494309189535*(0.2617993877991494 + t218))
     t220 = 0.1900219065658609*t211
     t221 = 0.9817798505902814*t212
-    t222 = -t220 - t221
+    t222 = -(t220 + t221)
     t223 = t221 - t220
     t224 = 0.9817798505902814*t211
     t225 = 0.1900219065658609*t212
@@ -2654,8 +2654,8 @@ def ik_branches(T):
     t231 = 0.4 - t229
     t232 = -0.18 + t230
     t233 = -0.4 + t231
-    t234 = t200*t233 + t232*t42
-    t235 = t233*t42 - t200*t232
+    t234 = t42*t232 + t200*t233
+    t235 = t42*t233 - t200*t232
     t236 = t234**2 + t235**2
     t237 = t232**2 + t233**2
     t238 = 0.12*t223 - 0.62*t227
@@ -2664,8 +2664,8 @@ def ik_branches(T):
     t241 = 0.4 - t239
     t242 = -0.18 + t240
     t243 = -0.4 + t241
-    t244 = t200*t243 + t242*t42
-    t245 = t243*t42 - t200*t242
+    t244 = t42*t242 + t200*t243
+    t245 = t42*t243 - t200*t242
     t246 = t244**2 + t245**2
     t247 = t242**2 + t243**2
     t248 = 1e-24*t201
@@ -2675,23 +2675,23 @@ def ik_branches(T):
     t252 = xp.where(t249, 0, t235*t250)
     t253 = t222*t251 - t226*t252
     t254 = t222*t252 + t226*t251
-    t255 = t204*t254 + t253*t43
-    t256 = t254*t43 - t204*t253
-    t257 = t253*t45 - t206*t254
-    t258 = t206*t253 + t254*t45
+    t255 = t253*t43 + t254*t204
+    t256 = t254*t43 - t253*t204
+    t257 = t253*t45 - t254*t206
+    t258 = t253*t206 + t254*t45
     t259 = xp.where(t249, 0, xp.atan2(t235, t234))
-    t260 = t259 - 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*t259)
+    t260 = t259 - 6.283185307179586*xp.floor(0.15915494309189535*(3.141592653589793 + t259))
     t261 = 1 - t253
-    t262 = t261*t44
+    t262 = t44*t261
     t263 = t262 + t253*t44
-    t264 = t261*t46
+    t264 = t46*t261
     t265 = t264 + t253*t46
     t266 = t256**2
     t267 = -t266
     t268 = 1 + t267
-    t269 = xp.where(xp.greater(t268, 1e-12), xp.sqrt(t268), 0)
+    t269 = xp.where(xp.less(1e-12, t268), xp.sqrt(t268), 0)
     t270 = t266 - t255*t269
-    t271 = t267 + t270
+    t271 = t270 + t267
     t272 = t263**2
     t273 = t266 + t272 + t255**2
     t274 = t269**2
@@ -2712,9 +2712,9 @@ def ik_branches(T):
     t289 = xp.where(t287, 1, t256*t288)
     t290 = xp.where(t287, 0, -t269*t288)
     t291 = t286*(1 - t289)
-    t292 = t285*t289 - t282*t290
-    t293 = t291 + t286*t289
-    t294 = t282*t289 + t285*t290
+    t292 = t289*t285 - t290*t282
+    t293 = t291 + t289*t286
+    t294 = t289*t282 + t290*t285
     t295 = t292**2 + t293**2
     t296 = t295
     t297 = t295 + t294**2
@@ -2724,23 +2724,23 @@ def ik_branches(T):
     t301 = xp.where(t298, 0, t245*t299)
     t302 = t223*t300 - t227*t301
     t303 = t223*t301 + t227*t300
-    t304 = t204*t303 + t302*t43
-    t305 = t303*t43 - t204*t302
-    t306 = t302*t45 - t206*t303
-    t307 = t206*t302 + t303*t45
+    t304 = t43*t302 + t204*t303
+    t305 = t43*t303 - t204*t302
+    t306 = t45*t302 - t206*t303
+    t307 = t45*t303 + t206*t302
     t308 = xp.where(t298, 0, xp.atan2(t245, t244))
-    t309 = t308 - 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*t308)
+    t309 = t308 - 6.283185307179586*xp.floor(0.15915494309189535*(3.141592653589793 + t308))
     t310 = 1 - t302
-    t311 = t310*t44
-    t312 = t311 + t302*t44
-    t313 = t310*t46
-    t314 = t313 + t302*t46
+    t311 = t44*t310
+    t312 = t311 + t44*t302
+    t313 = t46*t310
+    t314 = t313 + t46*t302
     t315 = t305**2
     t316 = -t315
     t317 = 1 + t316
-    t318 = xp.where(xp.greater(t317, 1e-12), xp.sqrt(t317), 0)
+    t318 = xp.where(xp.less(1e-12, t317), xp.sqrt(t317), 0)
     t319 = t315 - t304*t318
-    t320 = t316 + t319
+    t320 = t319 + t316
     t321 = t312**2
     t322 = t315 + t321 + t304**2
     t323 = t318**2
@@ -2761,153 +2761,153 @@ def ik_branches(T):
     t338 = xp.where(t336, 1, t305*t337)
     t339 = xp.where(t336, 0, -t318*t337)
     t340 = t335*(1 - t338)
-    t341 = t334*t338 - t331*t339
-    t342 = t340 + t335*t338
-    t343 = t331*t338 + t334*t339
+    t341 = t338*t334 - t339*t331
+    t342 = t340 + t338*t335
+    t343 = t338*t331 + t339*t334
     t344 = t341**2 + t342**2
     t345 = t344
     t346 = t344 + t343**2
     t347 = xp.where(t128, 0, xp.atan2(-t133, t121))
     t348 = t347
-    t349 = t348 - 6.283185307179586*xp.floor(0.9722222222222222 + 0.15915494309189535*t348)
+    t349 = t348 - 6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t348))
     t350 = 3.141592653589793 + t347 - 6.283185307179586*xp.ceil(0.15915494309189535*t347)
-    t351 = t350 - 6.283185307179586*xp.floor(0.9722222222222222 + 0.15915494309189535*t350)
+    t351 = t350 - 6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t350))
     t352 = xp.where(t137, 0, xp.atan2(-t119, -t106))
     t353 = t352
-    t354 = t353 - 6.283185307179586*xp.floor(0.3611111111111111 + 0.15915494309189535*t353)
-    t355 = t352 + 6.283185307179586*xp.ceil(-0.5 - 0.15915494309189535*t352)
+    t354 = t353 - 6.283185307179586*xp.floor(0.15915494309189535*(2.2689280275926285 + t353))
+    t355 = t352 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t352))
     t356 = xp.where(xp.less_equal(t146, 1e-24*t147), 0, xp.atan2(t143, t142))
     t357 = t356
-    t358 = t357 - 6.283185307179586*xp.floor(0.9722222222222222 + 0.15915494309189535*t357)
+    t358 = t357 - 6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t357))
     t359 = 3.141592653589793 + t356 - 6.283185307179586*xp.ceil(0.15915494309189535*t356)
-    t360 = t359 - 6.283185307179586*xp.floor(0.9722222222222222 + 0.15915494309189535*t359)
+    t360 = t359 - 6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t359))
     t361 = -t355
-    t362 = t355 + 6.283185307179586*xp.floor(0.3611111111111111 + 0.15915494309189535*t361)
+    t362 = t355 + 6.283185307179586*xp.floor(0.15915494309189535*(2.2689280275926285 + t361))
     t363 = xp.where(t177, 0, xp.atan2(-t182, t170))
     t364 = t363
-    t365 = t364 - 6.283185307179586*xp.floor(0.9722222222222222 + 0.15915494309189535*t364)
+    t365 = t364 - 6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t364))
     t366 = 3.141592653589793 + t363 - 6.283185307179586*xp.ceil(0.15915494309189535*t363)
-    t367 = t366 - 6.283185307179586*xp.floor(0.9722222222222222 + 0.15915494309189535*t366)
+    t367 = t366 - 6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t366))
     t368 = xp.where(t186, 0, xp.atan2(-t168, -t155))
     t369 = t368
-    t370 = t369 - 6.283185307179586*xp.floor(0.3611111111111111 + 0.15915494309189535*t369)
-    t371 = t368 + 6.283185307179586*xp.ceil(-0.5 - 0.15915494309189535*t368)
+    t370 = t369 - 6.283185307179586*xp.floor(0.15915494309189535*(2.2689280275926285 + t369))
+    t371 = t368 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t368))
     t372 = xp.where(xp.less_equal(t195, 1e-24*t196), 0, xp.atan2(t192, t191))
     t373 = t372
-    t374 = t373 - 6.283185307179586*xp.floor(0.9722222222222222 + 0.15915494309189535*t373)
+    t374 = t373 - 6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t373))
     t375 = 3.141592653589793 + t372 - 6.283185307179586*xp.ceil(0.15915494309189535*t372)
-    t376 = t375 - 6.283185307179586*xp.floor(0.9722222222222222 + 0.15915494309189535*t375)
+    t376 = t375 - 6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t375))
     t377 = -t371
-    t378 = t371 + 6.283185307179586*xp.floor(0.3611111111111111 + 0.15915494309189535*t377)
+    t378 = t371 + 6.283185307179586*xp.floor(0.15915494309189535*(2.2689280275926285 + t377))
     t379 = xp.where(t278, 0, xp.atan2(t283, t271))
     t380 = t379
-    t381 = t380 - 6.283185307179586*xp.floor(0.9722222222222222 + 0.15915494309189535*t380)
+    t381 = t380 - 6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t380))
     t382 = 3.141592653589793 + t379 - 6.283185307179586*xp.ceil(0.15915494309189535*t379)
-    t383 = t382 - 6.283185307179586*xp.floor(0.9722222222222222 + 0.15915494309189535*t382)
+    t383 = t382 - 6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t382))
     t384 = xp.where(t287, 0, xp.atan2(-t269, t256))
     t385 = t384
-    t386 = t385 - 6.283185307179586*xp.floor(0.3611111111111111 + 0.15915494309189535*t385)
-    t387 = t384 + 6.283185307179586*xp.ceil(-0.5 - 0.15915494309189535*t384)
+    t386 = t385 - 6.283185307179586*xp.floor(0.15915494309189535*(2.2689280275926285 + t385))
+    t387 = t384 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t384))
     t388 = xp.where(xp.less_equal(t296, 1e-24*t297), 0, xp.atan2(t293, t292))
     t389 = t388
-    t390 = t389 - 6.283185307179586*xp.floor(0.9722222222222222 + 0.15915494309189535*t389)
+    t390 = t389 - 6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t389))
     t391 = 3.141592653589793 + t388 - 6.283185307179586*xp.ceil(0.15915494309189535*t388)
-    t392 = t391 - 6.283185307179586*xp.floor(0.9722222222222222 + 0.15915494309189535*t391)
+    t392 = t391 - 6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t391))
     t393 = -t387
-    t394 = t387 + 6.283185307179586*xp.floor(0.3611111111111111 + 0.15915494309189535*t393)
+    t394 = t387 + 6.283185307179586*xp.floor(0.15915494309189535*(2.2689280275926285 + t393))
     t395 = xp.where(t327, 0, xp.atan2(t332, t320))
     t396 = t395
-    t397 = t396 - 6.283185307179586*xp.floor(0.9722222222222222 + 0.15915494309189535*t396)
+    t397 = t396 - 6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t396))
     t398 = 3.141592653589793 + t395 - 6.283185307179586*xp.ceil(0.15915494309189535*t395)
-    t399 = t398 - 6.283185307179586*xp.floor(0.9722222222222222 + 0.15915494309189535*t398)
+    t399 = t398 - 6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t398))
     t400 = xp.where(t336, 0, xp.atan2(-t318, t305))
     t401 = t400
-    t402 = t401 - 6.283185307179586*xp.floor(0.3611111111111111 + 0.15915494309189535*t401)
-    t403 = t400 + 6.283185307179586*xp.ceil(-0.5 - 0.15915494309189535*t400)
+    t402 = t401 - 6.283185307179586*xp.floor(0.15915494309189535*(2.2689280275926285 + t401))
+    t403 = t400 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t400))
     t404 = xp.where(xp.less_equal(t345, 1e-24*t346), 0, xp.atan2(t342, t341))
     t405 = t404
-    t406 = t405 - 6.283185307179586*xp.floor(0.9722222222222222 + 0.15915494309189535*t405)
+    t406 = t405 - 6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t405))
     t407 = 3.141592653589793 + t404 - 6.283185307179586*xp.ceil(0.15915494309189535*t404)
-    t408 = t407 - 6.283185307179586*xp.floor(0.9722222222222222 + 0.15915494309189535*t407)
+    t408 = t407 - 6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t407))
     t409 = -t403
-    t410 = t403 + 6.283185307179586*xp.floor(0.3611111111111111 + 0.15915494309189535*t409)
+    t410 = t403 + 6.283185307179586*xp.floor(0.15915494309189535*(2.2689280275926285 + t409))
     t411 = xp.less_equal(t23, 2.705260340591211)
-    t412 = (xp.greater_equal(t22, -2.705260340591211)) & (xp.less_equal(t22, 2.705260340591211))
+    t412 = xp.greater_equal(t22, -2.705260340591211) & xp.less_equal(t22, 2.705260340591211)
     t413 = xp.where(t411 & xp.logical_not(t412), t23, t22)
     t414 = xp.less_equal(t110, 1.1344640137963142)
-    t415 = (xp.greater_equal(t109, -3.141592653589793)) & (xp.less_equal(t109, 1.1344640137963142))
+    t415 = xp.greater_equal(t109, -3.141592653589793) & xp.less_equal(t109, 1.1344640137963142)
     t416 = xp.where(t414 & xp.logical_not(t415), t110, t109)
     t417 = xp.less_equal(t67, 2.7576202181510405)
-    t418 = (xp.greater_equal(t66, -0.2617993877991494)) & (xp.less_equal(t66, 2.7576202181510405))
+    t418 = xp.greater_equal(t66, -0.2617993877991494) & xp.less_equal(t66, 2.7576202181510405)
     t419 = xp.where(t417 & xp.logical_not(t418), t67, t66)
     t420 = xp.less_equal(t349, 6.1086523819801535)
-    t421 = (xp.greater_equal(t348, -6.1086523819801535)) & (xp.less_equal(t348, 6.1086523819801535))
+    t421 = xp.greater_equal(t348, -6.1086523819801535) & xp.less_equal(t348, 6.1086523819801535)
     t422 = xp.less_equal(t354, 2.2689280275926285)
-    t423 = (xp.greater_equal(t353, -2.2689280275926285)) & (xp.less_equal(t353, 2.2689280275926285))
+    t423 = xp.greater_equal(t353, -2.2689280275926285) & xp.less_equal(t353, 2.2689280275926285)
     t424 = xp.less_equal(t358, 6.1086523819801535)
-    t425 = (xp.greater_equal(t357, -6.1086523819801535)) & (xp.less_equal(t357, 6.1086523819801535))
+    t425 = xp.greater_equal(t357, -6.1086523819801535) & xp.less_equal(t357, 6.1086523819801535)
     t426 = xp.less_equal(t351, 6.1086523819801535)
-    t427 = (xp.greater_equal(t350, -6.1086523819801535)) & (xp.less_equal(t350, 6.1086523819801535))
+    t427 = xp.greater_equal(t350, -6.1086523819801535) & xp.less_equal(t350, 6.1086523819801535)
     t428 = -t362
     t429 = xp.less_equal(t360, 6.1086523819801535)
-    t430 = (xp.greater_equal(t359, -6.1086523819801535)) & (xp.less_equal(t359, 6.1086523819801535))
+    t430 = xp.greater_equal(t359, -6.1086523819801535) & xp.less_equal(t359, 6.1086523819801535)
     t431 = xp.less_equal(t159, 1.1344640137963142)
-    t432 = (xp.greater_equal(t158, -3.141592653589793)) & (xp.less_equal(t158, 1.1344640137963142))
+    t432 = xp.greater_equal(t158, -3.141592653589793) & xp.less_equal(t158, 1.1344640137963142)
     t433 = xp.where(t431 & xp.logical_not(t432), t159, t158)
     t434 = xp.less_equal(t69, 2.7576202181510405)
-    t435 = (xp.greater_equal(t68, -0.2617993877991494)) & (xp.less_equal(t68, 2.7576202181510405))
+    t435 = xp.greater_equal(t68, -0.2617993877991494) & xp.less_equal(t68, 2.7576202181510405)
     t436 = xp.where(t434 & xp.logical_not(t435), t69, t68)
     t437 = xp.less_equal(t365, 6.1086523819801535)
-    t438 = (xp.greater_equal(t364, -6.1086523819801535)) & (xp.less_equal(t364, 6.1086523819801535))
+    t438 = xp.greater_equal(t364, -6.1086523819801535) & xp.less_equal(t364, 6.1086523819801535)
     t439 = xp.less_equal(t370, 2.2689280275926285)
-    t440 = (xp.greater_equal(t369, -2.2689280275926285)) & (xp.less_equal(t369, 2.2689280275926285))
+    t440 = xp.greater_equal(t369, -2.2689280275926285) & xp.less_equal(t369, 2.2689280275926285)
     t441 = xp.less_equal(t374, 6.1086523819801535)
-    t442 = (xp.greater_equal(t373, -6.1086523819801535)) & (xp.less_equal(t373, 6.1086523819801535))
+    t442 = xp.greater_equal(t373, -6.1086523819801535) & xp.less_equal(t373, 6.1086523819801535)
     t443 = xp.less_equal(t367, 6.1086523819801535)
-    t444 = (xp.greater_equal(t366, -6.1086523819801535)) & (xp.less_equal(t366, 6.1086523819801535))
+    t444 = xp.greater_equal(t366, -6.1086523819801535) & xp.less_equal(t366, 6.1086523819801535)
     t445 = -t378
     t446 = xp.less_equal(t376, 6.1086523819801535)
-    t447 = (xp.greater_equal(t375, -6.1086523819801535)) & (xp.less_equal(t375, 6.1086523819801535))
+    t447 = xp.greater_equal(t375, -6.1086523819801535) & xp.less_equal(t375, 6.1086523819801535)
     t448 = xp.less_equal(t25, 2.705260340591211)
-    t449 = (xp.greater_equal(t24, -2.705260340591211)) & (xp.less_equal(t24, 2.705260340591211))
+    t449 = xp.greater_equal(t24, -2.705260340591211) & xp.less_equal(t24, 2.705260340591211)
     t450 = xp.where(t448 & xp.logical_not(t449), t25, t24)
     t451 = xp.less_equal(t260, 1.1344640137963142)
-    t452 = (xp.greater_equal(t259, -3.141592653589793)) & (xp.less_equal(t259, 1.1344640137963142))
+    t452 = xp.greater_equal(t259, -3.141592653589793) & xp.less_equal(t259, 1.1344640137963142)
     t453 = xp.where(t451 & xp.logical_not(t452), t260, t259)
     t454 = xp.less_equal(t217, 2.7576202181510405)
-    t455 = (xp.greater_equal(t216, -0.2617993877991494)) & (xp.less_equal(t216, 2.7576202181510405))
+    t455 = xp.greater_equal(t216, -0.2617993877991494) & xp.less_equal(t216, 2.7576202181510405)
     t456 = xp.where(t454 & xp.logical_not(t455), t217, t216)
     t457 = xp.less_equal(t381, 6.1086523819801535)
-    t458 = (xp.greater_equal(t380, -6.1086523819801535)) & (xp.less_equal(t380, 6.1086523819801535))
+    t458 = xp.greater_equal(t380, -6.1086523819801535) & xp.less_equal(t380, 6.1086523819801535)
     t459 = xp.less_equal(t386, 2.2689280275926285)
-    t460 = (xp.greater_equal(t385, -2.2689280275926285)) & (xp.less_equal(t385, 2.2689280275926285))
+    t460 = xp.greater_equal(t385, -2.2689280275926285) & xp.less_equal(t385, 2.2689280275926285)
     t461 = xp.less_equal(t390, 6.1086523819801535)
-    t462 = (xp.greater_equal(t389, -6.1086523819801535)) & (xp.less_equal(t389, 6.1086523819801535))
+    t462 = xp.greater_equal(t389, -6.1086523819801535) & xp.less_equal(t389, 6.1086523819801535)
     t463 = xp.less_equal(t383, 6.1086523819801535)
-    t464 = (xp.greater_equal(t382, -6.1086523819801535)) & (xp.less_equal(t382, 6.1086523819801535))
+    t464 = xp.greater_equal(t382, -6.1086523819801535) & xp.less_equal(t382, 6.1086523819801535)
     t465 = -t394
     t466 = xp.less_equal(t392, 6.1086523819801535)
-    t467 = (xp.greater_equal(t391, -6.1086523819801535)) & (xp.less_equal(t391, 6.1086523819801535))
+    t467 = xp.greater_equal(t391, -6.1086523819801535) & xp.less_equal(t391, 6.1086523819801535)
     t468 = xp.less_equal(t309, 1.1344640137963142)
-    t469 = (xp.greater_equal(t308, -3.141592653589793)) & (xp.less_equal(t308, 1.1344640137963142))
+    t469 = xp.greater_equal(t308, -3.141592653589793) & xp.less_equal(t308, 1.1344640137963142)
     t470 = xp.where(t468 & xp.logical_not(t469), t309, t308)
     t471 = xp.less_equal(t219, 2.7576202181510405)
-    t472 = (xp.greater_equal(t218, -0.2617993877991494)) & (xp.less_equal(t218, 2.7576202181510405))
+    t472 = xp.greater_equal(t218, -0.2617993877991494) & xp.less_equal(t218, 2.7576202181510405)
     t473 = xp.where(t471 & xp.logical_not(t472), t219, t218)
     t474 = xp.less_equal(t397, 6.1086523819801535)
-    t475 = (xp.greater_equal(t396, -6.1086523819801535)) & (xp.less_equal(t396, 6.1086523819801535))
+    t475 = xp.greater_equal(t396, -6.1086523819801535) & xp.less_equal(t396, 6.1086523819801535)
     t476 = xp.less_equal(t402, 2.2689280275926285)
-    t477 = (xp.greater_equal(t401, -2.2689280275926285)) & (xp.less_equal(t401, 2.2689280275926285))
+    t477 = xp.greater_equal(t401, -2.2689280275926285) & xp.less_equal(t401, 2.2689280275926285)
     t478 = xp.less_equal(t406, 6.1086523819801535)
-    t479 = (xp.greater_equal(t405, -6.1086523819801535)) & (xp.less_equal(t405, 6.1086523819801535))
+    t479 = xp.greater_equal(t405, -6.1086523819801535) & xp.less_equal(t405, 6.1086523819801535)
     t480 = xp.less_equal(t399, 6.1086523819801535)
-    t481 = (xp.greater_equal(t398, -6.1086523819801535)) & (xp.less_equal(t398, 6.1086523819801535))
+    t481 = xp.greater_equal(t398, -6.1086523819801535) & xp.less_equal(t398, 6.1086523819801535)
     t482 = -t410
     t483 = xp.less_equal(t408, 6.1086523819801535)
-    t484 = (xp.greater_equal(t407, -6.1086523819801535)) & (xp.less_equal(t407, 6.1086523819801535))
+    t484 = xp.greater_equal(t407, -6.1086523819801535) & xp.less_equal(t407, 6.1086523819801535)
     t485 = xp.isfinite(t0)
     t486 = xp.greater(t15, t17)
-    t487 = t486 | (t18 & (xp.less_equal(0, 1e-12*t16)))
+    t487 = t486 | (t18 & xp.less_equal(0, 1e-12*t16))
     t488 = xp.greater_equal(t58, -1e-12)
     t489 = xp.greater(t58, 1e-12)
     t490 = xp.greater_equal(t208, -1e-12)
@@ -2933,7 +2933,7 @@ def ik_branches(T):
         t416,  # 1, 1
         t419,  # 1, 2
         xp.where(t426 & xp.logical_not(t427), t351, t350),  # 1, 3
-        xp.where((xp.greater_equal(t362, -2.2689280275926285)) & xp.logical_not((xp.greater_equal(t355, -2.2689280275926285)) & (xp.less_equal(t355, 2.2689280275926285))), t428, t361),  # 1, 4
+        xp.where(xp.greater_equal(t362, -2.2689280275926285) & xp.logical_not(xp.greater_equal(t355, -2.2689280275926285) & xp.less_equal(t355, 2.2689280275926285)), t428, t361),  # 1, 4
         xp.where(t429 & xp.logical_not(t430), t360, t359),  # 1, 5
         t413,  # 2, 0
         t433,  # 2, 1
@@ -2945,7 +2945,7 @@ def ik_branches(T):
         t433,  # 3, 1
         t436,  # 3, 2
         xp.where(t443 & xp.logical_not(t444), t367, t366),  # 3, 3
-        xp.where((xp.greater_equal(t378, -2.2689280275926285)) & xp.logical_not((xp.greater_equal(t371, -2.2689280275926285)) & (xp.less_equal(t371, 2.2689280275926285))), t445, t377),  # 3, 4
+        xp.where(xp.greater_equal(t378, -2.2689280275926285) & xp.logical_not(xp.greater_equal(t371, -2.2689280275926285) & xp.less_equal(t371, 2.2689280275926285)), t445, t377),  # 3, 4
         xp.where(t446 & xp.logical_not(t447), t376, t375),  # 3, 5
         t450,  # 4, 0
         t453,  # 4, 1
@@ -2957,7 +2957,7 @@ def ik_branches(T):
         t453,  # 5, 1
         t456,  # 5, 2
         xp.where(t463 & xp.logical_not(t464), t383, t382),  # 5, 3
-        xp.where((xp.greater_equal(t394, -2.2689280275926285)) & xp.logical_not((xp.greater_equal(t387, -2.2689280275926285)) & (xp.less_equal(t387, 2.2689280275926285))), t465, t393),  # 5, 4
+        xp.where(xp.greater_equal(t394, -2.2689280275926285) & xp.logical_not(xp.greater_equal(t387, -2.2689280275926285) & xp.less_equal(t387, 2.2689280275926285)), t465, t393),  # 5, 4
         xp.where(t466 & xp.logical_not(t467), t392, t391),  # 5, 5
         t450,  # 6, 0
         t470,  # 6, 1
@@ -2969,28 +2969,28 @@ def ik_branches(T):
         t470,  # 7, 1
         t473,  # 7, 2
         xp.where(t480 & xp.logical_not(t481), t399, t398),  # 7, 3
-        xp.where((xp.greater_equal(t410, -2.2689280275926285)) & xp.logical_not((xp.greater_equal(t403, -2.2689280275926285)) & (xp.less_equal(t403, 2.2689280275926285))), t482, t409),  # 7, 4
+        xp.where(xp.greater_equal(t410, -2.2689280275926285) & xp.logical_not(xp.greater_equal(t403, -2.2689280275926285) & xp.less_equal(t403, 2.2689280275926285)), t482, t409),  # 7, 4
         xp.where(t483 & xp.logical_not(t484), t408, t407),  # 7, 5
     ], (8, 6))
     valid = _stack(xp, [
-        t485 & t487 & t488 & (xp.greater_equal(t118, -1e-12)),  # 0
-        t485 & t487 & t488 & (xp.greater(t118, 1e-12)),  # 1
-        t485 & t487 & t489 & (xp.greater_equal(t167, -1e-12)),  # 2
-        t485 & t487 & t489 & (xp.greater(t167, 1e-12)),  # 3
-        t485 & t486 & t490 & (xp.greater_equal(t268, -1e-12)),  # 4
-        t485 & t486 & t490 & (xp.greater(t268, 1e-12)),  # 5
-        t485 & t486 & t491 & (xp.greater_equal(t317, -1e-12)),  # 6
-        t485 & t486 & t491 & (xp.greater(t317, 1e-12)),  # 7
+        t485 & t487 & t488 & xp.greater_equal(t118, -1e-12),  # 0
+        t485 & t487 & t488 & xp.greater(t118, 1e-12),  # 1
+        t485 & t487 & t489 & xp.greater_equal(t167, -1e-12),  # 2
+        t485 & t487 & t489 & xp.greater(t167, 1e-12),  # 3
+        t485 & t486 & t490 & xp.greater_equal(t268, -1e-12),  # 4
+        t485 & t486 & t490 & xp.greater(t268, 1e-12),  # 5
+        t485 & t486 & t491 & xp.greater_equal(t317, -1e-12),  # 6
+        t485 & t486 & t491 & xp.greater(t317, 1e-12),  # 7
     ], (8,))
     in_limits = _stack(xp, [
         t492 & t493 & t494 & (t420 | t421) & (t422 | t423) & (t424 | t425),  # 0
-        t492 & t493 & t494 & (t426 | t427) & (t429 | t430) & ((xp.less_equal(t428, 2.2689280275926285)) | ((xp.greater_equal(t361, -2.2689280275926285)) & (xp.less_equal(t361, 2.2689280275926285)))),  # 1
+        t492 & t493 & t494 & (t426 | t427) & (t429 | t430) & (xp.less_equal(t428, 2.2689280275926285) | (xp.greater_equal(t361, -2.2689280275926285) & xp.less_equal(t361, 2.2689280275926285))),  # 1
         t492 & t495 & t496 & (t437 | t438) & (t439 | t440) & (t441 | t442),  # 2
-        t492 & t495 & t496 & (t443 | t444) & (t446 | t447) & ((xp.less_equal(t445, 2.2689280275926285)) | ((xp.greater_equal(t377, -2.2689280275926285)) & (xp.less_equal(t377, 2.2689280275926285)))),  # 3
+        t492 & t495 & t496 & (t443 | t444) & (t446 | t447) & (xp.less_equal(t445, 2.2689280275926285) | (xp.greater_equal(t377, -2.2689280275926285) & xp.less_equal(t377, 2.2689280275926285))),  # 3
         t497 & t498 & t499 & (t457 | t458) & (t459 | t460) & (t461 | t462),  # 4
-        t497 & t498 & t499 & (t463 | t464) & (t466 | t467) & ((xp.less_equal(t465, 2.2689280275926285)) | ((xp.greater_equal(t393, -2.2689280275926285)) & (xp.less_equal(t393, 2.2689280275926285)))),  # 5
+        t497 & t498 & t499 & (t463 | t464) & (t466 | t467) & (xp.less_equal(t465, 2.2689280275926285) | (xp.greater_equal(t393, -2.2689280275926285) & xp.less_equal(t393, 2.2689280275926285))),  # 5
         t497 & t500 & t501 & (t474 | t475) & (t476 | t477) & (t478 | t479),  # 6
-        t497 & t500 & t501 & (t480 | t481) & (t483 | t484) & ((xp.less_equal(t482, 2.2689280275926285)) | ((xp.greater_equal(t409, -2.2689280275926285)) & (xp.less_equal(t409, 2.2689280275926285)))),  # 7
+        t497 & t500 & t501 & (t480 | t481) & (t483 | t484) & (xp.less_equal(t482, 2.2689280275926285) | (xp.greater_equal(t409, -2.2689280275926285) & xp.less_equal(t409, 2.2689280275926285))),  # 7
     ], (8,))
     return q, valid, in_limits
 
@@ -3146,30 +3146,30 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     t55 = qb7_5 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn6 - qb7_5))
     t56 = xp.where(lb7 & vb7, xp.asarray(1, dtype=dtype), 0)
     t57 = T00 + T01 + T02 + T03 + T10 + T11 + T12 + T13 + T20 + T21 + T22 + T23 + qn1 + qn2 + qn3 + qn4 + qn5 + qn6 + qw1 + qw2 + qw3 + qw4 + qw5 + qw6
-    t58 = xp.where(xp.greater(qn1, t0), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t58 = xp.where(xp.less(t0, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t59 = t0 + t58
     t60 = t0 - t58
-    t61 = xp.where((xp.greater_equal(t0, -2.705260340591211)) & (xp.less_equal(t0, 2.705260340591211)), t0, xp.where((xp.greater_equal(t59, -2.705260340591211)) & (xp.less_equal(t59, 2.705260340591211)), t59, xp.where((xp.greater_equal(t60, -2.705260340591211)) & (xp.less_equal(t60, 2.705260340591211)), t60, qb0_0)))
-    t62 = xp.where(xp.greater(qn2, t1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t61 = xp.where(xp.greater_equal(t0, -2.705260340591211) & xp.less_equal(t0, 2.705260340591211), t0, xp.where(xp.greater_equal(t59, -2.705260340591211) & xp.less_equal(t59, 2.705260340591211), t59, xp.where(xp.greater_equal(t60, -2.705260340591211) & xp.less_equal(t60, 2.705260340591211), t60, qb0_0)))
+    t62 = xp.where(xp.less(t1, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t63 = t1 + t62
     t64 = t1 - t62
-    t65 = xp.where((xp.greater_equal(t1, -3.141592653589793)) & (xp.less_equal(t1, 1.1344640137963142)), t1, xp.where((xp.greater_equal(t63, -3.141592653589793)) & (xp.less_equal(t63, 1.1344640137963142)), t63, xp.where((xp.greater_equal(t64, -3.141592653589793)) & (xp.less_equal(t64, 1.1344640137963142)), t64, qb0_1)))
-    t66 = xp.where(xp.greater(qn3, t2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t65 = xp.where(xp.greater_equal(t1, -3.141592653589793) & xp.less_equal(t1, 1.1344640137963142), t1, xp.where(xp.greater_equal(t63, -3.141592653589793) & xp.less_equal(t63, 1.1344640137963142), t63, xp.where(xp.greater_equal(t64, -3.141592653589793) & xp.less_equal(t64, 1.1344640137963142), t64, qb0_1)))
+    t66 = xp.where(xp.less(t2, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t67 = t2 + t66
     t68 = t2 - t66
-    t69 = xp.where((xp.greater_equal(t2, -0.2617993877991494)) & (xp.less_equal(t2, 2.7576202181510405)), t2, xp.where((xp.greater_equal(t67, -0.2617993877991494)) & (xp.less_equal(t67, 2.7576202181510405)), t67, xp.where((xp.greater_equal(t68, -0.2617993877991494)) & (xp.less_equal(t68, 2.7576202181510405)), t68, qb0_2)))
-    t70 = xp.where(xp.greater(qn4, t3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t69 = xp.where(xp.greater_equal(t2, -0.2617993877991494) & xp.less_equal(t2, 2.7576202181510405), t2, xp.where(xp.greater_equal(t67, -0.2617993877991494) & xp.less_equal(t67, 2.7576202181510405), t67, xp.where(xp.greater_equal(t68, -0.2617993877991494) & xp.less_equal(t68, 2.7576202181510405), t68, qb0_2)))
+    t70 = xp.where(xp.less(t3, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t71 = t3 + t70
     t72 = t3 - t70
-    t73 = xp.where((xp.greater_equal(t3, -6.1086523819801535)) & (xp.less_equal(t3, 6.1086523819801535)), t3, xp.where((xp.greater_equal(t71, -6.1086523819801535)) & (xp.less_equal(t71, 6.1086523819801535)), t71, xp.where((xp.greater_equal(t72, -6.1086523819801535)) & (xp.less_equal(t72, 6.1086523819801535)), t72, qb0_3)))
-    t74 = xp.where(xp.greater(qn5, t4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t73 = xp.where(xp.greater_equal(t3, -6.1086523819801535) & xp.less_equal(t3, 6.1086523819801535), t3, xp.where(xp.greater_equal(t71, -6.1086523819801535) & xp.less_equal(t71, 6.1086523819801535), t71, xp.where(xp.greater_equal(t72, -6.1086523819801535) & xp.less_equal(t72, 6.1086523819801535), t72, qb0_3)))
+    t74 = xp.where(xp.less(t4, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t75 = t4 + t74
     t76 = t4 - t74
-    t77 = xp.where((xp.greater_equal(t4, -2.2689280275926285)) & (xp.less_equal(t4, 2.2689280275926285)), t4, xp.where((xp.greater_equal(t75, -2.2689280275926285)) & (xp.less_equal(t75, 2.2689280275926285)), t75, xp.where((xp.greater_equal(t76, -2.2689280275926285)) & (xp.less_equal(t76, 2.2689280275926285)), t76, qb0_4)))
-    t78 = xp.where(xp.greater(qn6, t5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t77 = xp.where(xp.greater_equal(t4, -2.2689280275926285) & xp.less_equal(t4, 2.2689280275926285), t4, xp.where(xp.greater_equal(t75, -2.2689280275926285) & xp.less_equal(t75, 2.2689280275926285), t75, xp.where(xp.greater_equal(t76, -2.2689280275926285) & xp.less_equal(t76, 2.2689280275926285), t76, qb0_4)))
+    t78 = xp.where(xp.less(t5, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t79 = t5 + t78
     t80 = t5 - t78
-    t81 = xp.where((xp.greater_equal(t5, -6.1086523819801535)) & (xp.less_equal(t5, 6.1086523819801535)), t5, xp.where((xp.greater_equal(t79, -6.1086523819801535)) & (xp.less_equal(t79, 6.1086523819801535)), t79, xp.where((xp.greater_equal(t80, -6.1086523819801535)) & (xp.less_equal(t80, 6.1086523819801535)), t80, qb0_5)))
+    t81 = xp.where(xp.greater_equal(t5, -6.1086523819801535) & xp.less_equal(t5, 6.1086523819801535), t5, xp.where(xp.greater_equal(t79, -6.1086523819801535) & xp.less_equal(t79, 6.1086523819801535), t79, xp.where(xp.greater_equal(t80, -6.1086523819801535) & xp.less_equal(t80, 6.1086523819801535), t80, qb0_5)))
     t82 = -qn1
     t83 = -qn2
     t84 = -qn3
@@ -3185,33 +3185,33 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     t94 = xp.where(t89, t77, qn5)
     t95 = xp.where(t89, t81, qn6)
     t96 = xp.where(t89, t88, 0)
-    t97 = xp.where(xp.greater(qn1, t8), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t97 = xp.where(xp.less(t8, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t98 = t8 + t97
     t99 = t8 - t97
-    t100 = xp.where((xp.greater_equal(t8, -2.705260340591211)) & (xp.less_equal(t8, 2.705260340591211)), t8, xp.where((xp.greater_equal(t98, -2.705260340591211)) & (xp.less_equal(t98, 2.705260340591211)), t98, xp.where((xp.greater_equal(t99, -2.705260340591211)) & (xp.less_equal(t99, 2.705260340591211)), t99, qb1_0)))
-    t101 = xp.where(xp.greater(qn2, t9), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t102 = t101 + t9
+    t100 = xp.where(xp.greater_equal(t8, -2.705260340591211) & xp.less_equal(t8, 2.705260340591211), t8, xp.where(xp.greater_equal(t98, -2.705260340591211) & xp.less_equal(t98, 2.705260340591211), t98, xp.where(xp.greater_equal(t99, -2.705260340591211) & xp.less_equal(t99, 2.705260340591211), t99, qb1_0)))
+    t101 = xp.where(xp.less(t9, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t102 = t9 + t101
     t103 = t9 - t101
-    t104 = xp.where((xp.greater_equal(t9, -3.141592653589793)) & (xp.less_equal(t9, 1.1344640137963142)), t9, xp.where((xp.greater_equal(t102, -3.141592653589793)) & (xp.less_equal(t102, 1.1344640137963142)), t102, xp.where((xp.greater_equal(t103, -3.141592653589793)) & (xp.less_equal(t103, 1.1344640137963142)), t103, qb1_1)))
-    t105 = xp.where(xp.greater(qn3, t10), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t104 = xp.where(xp.greater_equal(t9, -3.141592653589793) & xp.less_equal(t9, 1.1344640137963142), t9, xp.where(xp.greater_equal(t102, -3.141592653589793) & xp.less_equal(t102, 1.1344640137963142), t102, xp.where(xp.greater_equal(t103, -3.141592653589793) & xp.less_equal(t103, 1.1344640137963142), t103, qb1_1)))
+    t105 = xp.where(xp.less(t10, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t106 = t10 + t105
     t107 = t10 - t105
-    t108 = xp.where((xp.greater_equal(t10, -0.2617993877991494)) & (xp.less_equal(t10, 2.7576202181510405)), t10, xp.where((xp.greater_equal(t106, -0.2617993877991494)) & (xp.less_equal(t106, 2.7576202181510405)), t106, xp.where((xp.greater_equal(t107, -0.2617993877991494)) & (xp.less_equal(t107, 2.7576202181510405)), t107, qb1_2)))
-    t109 = xp.where(xp.greater(qn4, t11), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t110 = t109 + t11
+    t108 = xp.where(xp.greater_equal(t10, -0.2617993877991494) & xp.less_equal(t10, 2.7576202181510405), t10, xp.where(xp.greater_equal(t106, -0.2617993877991494) & xp.less_equal(t106, 2.7576202181510405), t106, xp.where(xp.greater_equal(t107, -0.2617993877991494) & xp.less_equal(t107, 2.7576202181510405), t107, qb1_2)))
+    t109 = xp.where(xp.less(t11, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t110 = t11 + t109
     t111 = t11 - t109
-    t112 = xp.where((xp.greater_equal(t11, -6.1086523819801535)) & (xp.less_equal(t11, 6.1086523819801535)), t11, xp.where((xp.greater_equal(t110, -6.1086523819801535)) & (xp.less_equal(t110, 6.1086523819801535)), t110, xp.where((xp.greater_equal(t111, -6.1086523819801535)) & (xp.less_equal(t111, 6.1086523819801535)), t111, qb1_3)))
-    t113 = xp.where(xp.greater(qn5, t12), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t114 = t113 + t12
+    t112 = xp.where(xp.greater_equal(t11, -6.1086523819801535) & xp.less_equal(t11, 6.1086523819801535), t11, xp.where(xp.greater_equal(t110, -6.1086523819801535) & xp.less_equal(t110, 6.1086523819801535), t110, xp.where(xp.greater_equal(t111, -6.1086523819801535) & xp.less_equal(t111, 6.1086523819801535), t111, qb1_3)))
+    t113 = xp.where(xp.less(t12, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t114 = t12 + t113
     t115 = t12 - t113
-    t116 = xp.where((xp.greater_equal(t12, -2.2689280275926285)) & (xp.less_equal(t12, 2.2689280275926285)), t12, xp.where((xp.greater_equal(t114, -2.2689280275926285)) & (xp.less_equal(t114, 2.2689280275926285)), t114, xp.where((xp.greater_equal(t115, -2.2689280275926285)) & (xp.less_equal(t115, 2.2689280275926285)), t115, qb1_4)))
-    t117 = xp.where(xp.greater(qn6, t13), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t118 = t117 + t13
+    t116 = xp.where(xp.greater_equal(t12, -2.2689280275926285) & xp.less_equal(t12, 2.2689280275926285), t12, xp.where(xp.greater_equal(t114, -2.2689280275926285) & xp.less_equal(t114, 2.2689280275926285), t114, xp.where(xp.greater_equal(t115, -2.2689280275926285) & xp.less_equal(t115, 2.2689280275926285), t115, qb1_4)))
+    t117 = xp.where(xp.less(t13, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t118 = t13 + t117
     t119 = t13 - t117
-    t120 = xp.where((xp.greater_equal(t13, -6.1086523819801535)) & (xp.less_equal(t13, 6.1086523819801535)), t13, xp.where((xp.greater_equal(t118, -6.1086523819801535)) & (xp.less_equal(t118, 6.1086523819801535)), t118, xp.where((xp.greater_equal(t119, -6.1086523819801535)) & (xp.less_equal(t119, 6.1086523819801535)), t119, qb1_5)))
+    t120 = xp.where(xp.greater_equal(t13, -6.1086523819801535) & xp.less_equal(t13, 6.1086523819801535), t13, xp.where(xp.greater_equal(t118, -6.1086523819801535) & xp.less_equal(t118, 6.1086523819801535), t118, xp.where(xp.greater_equal(t119, -6.1086523819801535) & xp.less_equal(t119, 6.1086523819801535), t119, qb1_5)))
     t121 = qw1*(t100 + t82)**2 + qw2*(t104 + t83)**2 + qw3*(t108 + t84)**2 + qw4*(t112 + t85)**2 + qw5*(t116 + t86)**2 + qw6*(t120 + t87)**2
     t122 = xp.greater(t14, 0)
-    t123 = xp.where(t122 & ((xp.less(t121, t96)) | (xp.less(t7, 1))), xp.asarray(1, dtype=dtype), 0)
+    t123 = xp.where(t122 & (xp.less(t121, t96) | xp.less(t7, 1)), xp.asarray(1, dtype=dtype), 0)
     t124 = xp.where(t122, 1, t7)
     t125 = xp.greater(t123, 0)
     t126 = xp.where(t125, t100, t90)
@@ -3221,33 +3221,33 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     t130 = xp.where(t125, t116, t94)
     t131 = xp.where(t125, t120, t95)
     t132 = xp.where(t125, t121, t96)
-    t133 = xp.where(xp.greater(qn1, t15), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t134 = t133 + t15
+    t133 = xp.where(xp.less(t15, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t134 = t15 + t133
     t135 = t15 - t133
-    t136 = xp.where((xp.greater_equal(t15, -2.705260340591211)) & (xp.less_equal(t15, 2.705260340591211)), t15, xp.where((xp.greater_equal(t134, -2.705260340591211)) & (xp.less_equal(t134, 2.705260340591211)), t134, xp.where((xp.greater_equal(t135, -2.705260340591211)) & (xp.less_equal(t135, 2.705260340591211)), t135, qb2_0)))
-    t137 = xp.where(xp.greater(qn2, t16), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t138 = t137 + t16
+    t136 = xp.where(xp.greater_equal(t15, -2.705260340591211) & xp.less_equal(t15, 2.705260340591211), t15, xp.where(xp.greater_equal(t134, -2.705260340591211) & xp.less_equal(t134, 2.705260340591211), t134, xp.where(xp.greater_equal(t135, -2.705260340591211) & xp.less_equal(t135, 2.705260340591211), t135, qb2_0)))
+    t137 = xp.where(xp.less(t16, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t138 = t16 + t137
     t139 = t16 - t137
-    t140 = xp.where((xp.greater_equal(t16, -3.141592653589793)) & (xp.less_equal(t16, 1.1344640137963142)), t16, xp.where((xp.greater_equal(t138, -3.141592653589793)) & (xp.less_equal(t138, 1.1344640137963142)), t138, xp.where((xp.greater_equal(t139, -3.141592653589793)) & (xp.less_equal(t139, 1.1344640137963142)), t139, qb2_1)))
-    t141 = xp.where(xp.greater(qn3, t17), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t142 = t141 + t17
+    t140 = xp.where(xp.greater_equal(t16, -3.141592653589793) & xp.less_equal(t16, 1.1344640137963142), t16, xp.where(xp.greater_equal(t138, -3.141592653589793) & xp.less_equal(t138, 1.1344640137963142), t138, xp.where(xp.greater_equal(t139, -3.141592653589793) & xp.less_equal(t139, 1.1344640137963142), t139, qb2_1)))
+    t141 = xp.where(xp.less(t17, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t142 = t17 + t141
     t143 = t17 - t141
-    t144 = xp.where((xp.greater_equal(t17, -0.2617993877991494)) & (xp.less_equal(t17, 2.7576202181510405)), t17, xp.where((xp.greater_equal(t142, -0.2617993877991494)) & (xp.less_equal(t142, 2.7576202181510405)), t142, xp.where((xp.greater_equal(t143, -0.2617993877991494)) & (xp.less_equal(t143, 2.7576202181510405)), t143, qb2_2)))
-    t145 = xp.where(xp.greater(qn4, t18), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t146 = t145 + t18
+    t144 = xp.where(xp.greater_equal(t17, -0.2617993877991494) & xp.less_equal(t17, 2.7576202181510405), t17, xp.where(xp.greater_equal(t142, -0.2617993877991494) & xp.less_equal(t142, 2.7576202181510405), t142, xp.where(xp.greater_equal(t143, -0.2617993877991494) & xp.less_equal(t143, 2.7576202181510405), t143, qb2_2)))
+    t145 = xp.where(xp.less(t18, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t146 = t18 + t145
     t147 = t18 - t145
-    t148 = xp.where((xp.greater_equal(t18, -6.1086523819801535)) & (xp.less_equal(t18, 6.1086523819801535)), t18, xp.where((xp.greater_equal(t146, -6.1086523819801535)) & (xp.less_equal(t146, 6.1086523819801535)), t146, xp.where((xp.greater_equal(t147, -6.1086523819801535)) & (xp.less_equal(t147, 6.1086523819801535)), t147, qb2_3)))
-    t149 = xp.where(xp.greater(qn5, t19), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t150 = t149 + t19
+    t148 = xp.where(xp.greater_equal(t18, -6.1086523819801535) & xp.less_equal(t18, 6.1086523819801535), t18, xp.where(xp.greater_equal(t146, -6.1086523819801535) & xp.less_equal(t146, 6.1086523819801535), t146, xp.where(xp.greater_equal(t147, -6.1086523819801535) & xp.less_equal(t147, 6.1086523819801535), t147, qb2_3)))
+    t149 = xp.where(xp.less(t19, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t150 = t19 + t149
     t151 = t19 - t149
-    t152 = xp.where((xp.greater_equal(t19, -2.2689280275926285)) & (xp.less_equal(t19, 2.2689280275926285)), t19, xp.where((xp.greater_equal(t150, -2.2689280275926285)) & (xp.less_equal(t150, 2.2689280275926285)), t150, xp.where((xp.greater_equal(t151, -2.2689280275926285)) & (xp.less_equal(t151, 2.2689280275926285)), t151, qb2_4)))
-    t153 = xp.where(xp.greater(qn6, t20), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t154 = t153 + t20
+    t152 = xp.where(xp.greater_equal(t19, -2.2689280275926285) & xp.less_equal(t19, 2.2689280275926285), t19, xp.where(xp.greater_equal(t150, -2.2689280275926285) & xp.less_equal(t150, 2.2689280275926285), t150, xp.where(xp.greater_equal(t151, -2.2689280275926285) & xp.less_equal(t151, 2.2689280275926285), t151, qb2_4)))
+    t153 = xp.where(xp.less(t20, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t154 = t20 + t153
     t155 = t20 - t153
-    t156 = xp.where((xp.greater_equal(t20, -6.1086523819801535)) & (xp.less_equal(t20, 6.1086523819801535)), t20, xp.where((xp.greater_equal(t154, -6.1086523819801535)) & (xp.less_equal(t154, 6.1086523819801535)), t154, xp.where((xp.greater_equal(t155, -6.1086523819801535)) & (xp.less_equal(t155, 6.1086523819801535)), t155, qb2_5)))
+    t156 = xp.where(xp.greater_equal(t20, -6.1086523819801535) & xp.less_equal(t20, 6.1086523819801535), t20, xp.where(xp.greater_equal(t154, -6.1086523819801535) & xp.less_equal(t154, 6.1086523819801535), t154, xp.where(xp.greater_equal(t155, -6.1086523819801535) & xp.less_equal(t155, 6.1086523819801535), t155, qb2_5)))
     t157 = qw1*(t136 + t82)**2 + qw2*(t140 + t83)**2 + qw3*(t144 + t84)**2 + qw4*(t148 + t85)**2 + qw5*(t152 + t86)**2 + qw6*(t156 + t87)**2
     t158 = xp.greater(t21, 0)
-    t159 = xp.where(t158 & ((xp.greater(t132, t157)) | (xp.less(t124, 1))), xp.asarray(1, dtype=dtype), 0)
+    t159 = xp.where(t158 & (xp.greater(t132, t157) | xp.less(t124, 1)), xp.asarray(1, dtype=dtype), 0)
     t160 = xp.where(t158, 1, t124)
     t161 = xp.greater(t159, 0)
     t162 = xp.where(t161, t136, t126)
@@ -3257,33 +3257,33 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     t166 = xp.where(t161, t152, t130)
     t167 = xp.where(t161, t156, t131)
     t168 = xp.where(t161, t157, t132)
-    t169 = xp.where(xp.greater(qn1, t22), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t170 = t169 + t22
+    t169 = xp.where(xp.less(t22, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t170 = t22 + t169
     t171 = t22 - t169
-    t172 = xp.where((xp.greater_equal(t22, -2.705260340591211)) & (xp.less_equal(t22, 2.705260340591211)), t22, xp.where((xp.greater_equal(t170, -2.705260340591211)) & (xp.less_equal(t170, 2.705260340591211)), t170, xp.where((xp.greater_equal(t171, -2.705260340591211)) & (xp.less_equal(t171, 2.705260340591211)), t171, qb3_0)))
-    t173 = xp.where(xp.greater(qn2, t23), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t174 = t173 + t23
+    t172 = xp.where(xp.greater_equal(t22, -2.705260340591211) & xp.less_equal(t22, 2.705260340591211), t22, xp.where(xp.greater_equal(t170, -2.705260340591211) & xp.less_equal(t170, 2.705260340591211), t170, xp.where(xp.greater_equal(t171, -2.705260340591211) & xp.less_equal(t171, 2.705260340591211), t171, qb3_0)))
+    t173 = xp.where(xp.less(t23, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t174 = t23 + t173
     t175 = t23 - t173
-    t176 = xp.where((xp.greater_equal(t23, -3.141592653589793)) & (xp.less_equal(t23, 1.1344640137963142)), t23, xp.where((xp.greater_equal(t174, -3.141592653589793)) & (xp.less_equal(t174, 1.1344640137963142)), t174, xp.where((xp.greater_equal(t175, -3.141592653589793)) & (xp.less_equal(t175, 1.1344640137963142)), t175, qb3_1)))
-    t177 = xp.where(xp.greater(qn3, t24), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t178 = t177 + t24
+    t176 = xp.where(xp.greater_equal(t23, -3.141592653589793) & xp.less_equal(t23, 1.1344640137963142), t23, xp.where(xp.greater_equal(t174, -3.141592653589793) & xp.less_equal(t174, 1.1344640137963142), t174, xp.where(xp.greater_equal(t175, -3.141592653589793) & xp.less_equal(t175, 1.1344640137963142), t175, qb3_1)))
+    t177 = xp.where(xp.less(t24, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t178 = t24 + t177
     t179 = t24 - t177
-    t180 = xp.where((xp.greater_equal(t24, -0.2617993877991494)) & (xp.less_equal(t24, 2.7576202181510405)), t24, xp.where((xp.greater_equal(t178, -0.2617993877991494)) & (xp.less_equal(t178, 2.7576202181510405)), t178, xp.where((xp.greater_equal(t179, -0.2617993877991494)) & (xp.less_equal(t179, 2.7576202181510405)), t179, qb3_2)))
-    t181 = xp.where(xp.greater(qn4, t25), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t182 = t181 + t25
+    t180 = xp.where(xp.greater_equal(t24, -0.2617993877991494) & xp.less_equal(t24, 2.7576202181510405), t24, xp.where(xp.greater_equal(t178, -0.2617993877991494) & xp.less_equal(t178, 2.7576202181510405), t178, xp.where(xp.greater_equal(t179, -0.2617993877991494) & xp.less_equal(t179, 2.7576202181510405), t179, qb3_2)))
+    t181 = xp.where(xp.less(t25, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t182 = t25 + t181
     t183 = t25 - t181
-    t184 = xp.where((xp.greater_equal(t25, -6.1086523819801535)) & (xp.less_equal(t25, 6.1086523819801535)), t25, xp.where((xp.greater_equal(t182, -6.1086523819801535)) & (xp.less_equal(t182, 6.1086523819801535)), t182, xp.where((xp.greater_equal(t183, -6.1086523819801535)) & (xp.less_equal(t183, 6.1086523819801535)), t183, qb3_3)))
-    t185 = xp.where(xp.greater(qn5, t26), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t186 = t185 + t26
+    t184 = xp.where(xp.greater_equal(t25, -6.1086523819801535) & xp.less_equal(t25, 6.1086523819801535), t25, xp.where(xp.greater_equal(t182, -6.1086523819801535) & xp.less_equal(t182, 6.1086523819801535), t182, xp.where(xp.greater_equal(t183, -6.1086523819801535) & xp.less_equal(t183, 6.1086523819801535), t183, qb3_3)))
+    t185 = xp.where(xp.less(t26, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t186 = t26 + t185
     t187 = t26 - t185
-    t188 = xp.where((xp.greater_equal(t26, -2.2689280275926285)) & (xp.less_equal(t26, 2.2689280275926285)), t26, xp.where((xp.greater_equal(t186, -2.2689280275926285)) & (xp.less_equal(t186, 2.2689280275926285)), t186, xp.where((xp.greater_equal(t187, -2.2689280275926285)) & (xp.less_equal(t187, 2.2689280275926285)), t187, qb3_4)))
-    t189 = xp.where(xp.greater(qn6, t27), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t190 = t189 + t27
+    t188 = xp.where(xp.greater_equal(t26, -2.2689280275926285) & xp.less_equal(t26, 2.2689280275926285), t26, xp.where(xp.greater_equal(t186, -2.2689280275926285) & xp.less_equal(t186, 2.2689280275926285), t186, xp.where(xp.greater_equal(t187, -2.2689280275926285) & xp.less_equal(t187, 2.2689280275926285), t187, qb3_4)))
+    t189 = xp.where(xp.less(t27, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t190 = t27 + t189
     t191 = t27 - t189
-    t192 = xp.where((xp.greater_equal(t27, -6.1086523819801535)) & (xp.less_equal(t27, 6.1086523819801535)), t27, xp.where((xp.greater_equal(t190, -6.1086523819801535)) & (xp.less_equal(t190, 6.1086523819801535)), t190, xp.where((xp.greater_equal(t191, -6.1086523819801535)) & (xp.less_equal(t191, 6.1086523819801535)), t191, qb3_5)))
+    t192 = xp.where(xp.greater_equal(t27, -6.1086523819801535) & xp.less_equal(t27, 6.1086523819801535), t27, xp.where(xp.greater_equal(t190, -6.1086523819801535) & xp.less_equal(t190, 6.1086523819801535), t190, xp.where(xp.greater_equal(t191, -6.1086523819801535) & xp.less_equal(t191, 6.1086523819801535), t191, qb3_5)))
     t193 = qw1*(t172 + t82)**2 + qw2*(t176 + t83)**2 + qw3*(t180 + t84)**2 + qw4*(t184 + t85)**2 + qw5*(t188 + t86)**2 + qw6*(t192 + t87)**2
     t194 = xp.greater(t28, 0)
-    t195 = xp.where(t194 & ((xp.greater(t168, t193)) | (xp.less(t160, 1))), xp.asarray(1, dtype=dtype), 0)
+    t195 = xp.where(t194 & (xp.greater(t168, t193) | xp.less(t160, 1)), xp.asarray(1, dtype=dtype), 0)
     t196 = xp.where(t194, 1, t160)
     t197 = xp.greater(t195, 0)
     t198 = xp.where(t197, t172, t162)
@@ -3293,33 +3293,33 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     t202 = xp.where(t197, t188, t166)
     t203 = xp.where(t197, t192, t167)
     t204 = xp.where(t197, t193, t168)
-    t205 = xp.where(xp.greater(qn1, t29), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t206 = t205 + t29
+    t205 = xp.where(xp.less(t29, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t206 = t29 + t205
     t207 = t29 - t205
-    t208 = xp.where((xp.greater_equal(t29, -2.705260340591211)) & (xp.less_equal(t29, 2.705260340591211)), t29, xp.where((xp.greater_equal(t206, -2.705260340591211)) & (xp.less_equal(t206, 2.705260340591211)), t206, xp.where((xp.greater_equal(t207, -2.705260340591211)) & (xp.less_equal(t207, 2.705260340591211)), t207, qb4_0)))
-    t209 = xp.where(xp.greater(qn2, t30), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t210 = t209 + t30
+    t208 = xp.where(xp.greater_equal(t29, -2.705260340591211) & xp.less_equal(t29, 2.705260340591211), t29, xp.where(xp.greater_equal(t206, -2.705260340591211) & xp.less_equal(t206, 2.705260340591211), t206, xp.where(xp.greater_equal(t207, -2.705260340591211) & xp.less_equal(t207, 2.705260340591211), t207, qb4_0)))
+    t209 = xp.where(xp.less(t30, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t210 = t30 + t209
     t211 = t30 - t209
-    t212 = xp.where((xp.greater_equal(t30, -3.141592653589793)) & (xp.less_equal(t30, 1.1344640137963142)), t30, xp.where((xp.greater_equal(t210, -3.141592653589793)) & (xp.less_equal(t210, 1.1344640137963142)), t210, xp.where((xp.greater_equal(t211, -3.141592653589793)) & (xp.less_equal(t211, 1.1344640137963142)), t211, qb4_1)))
-    t213 = xp.where(xp.greater(qn3, t31), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t214 = t213 + t31
+    t212 = xp.where(xp.greater_equal(t30, -3.141592653589793) & xp.less_equal(t30, 1.1344640137963142), t30, xp.where(xp.greater_equal(t210, -3.141592653589793) & xp.less_equal(t210, 1.1344640137963142), t210, xp.where(xp.greater_equal(t211, -3.141592653589793) & xp.less_equal(t211, 1.1344640137963142), t211, qb4_1)))
+    t213 = xp.where(xp.less(t31, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t214 = t31 + t213
     t215 = t31 - t213
-    t216 = xp.where((xp.greater_equal(t31, -0.2617993877991494)) & (xp.less_equal(t31, 2.7576202181510405)), t31, xp.where((xp.greater_equal(t214, -0.2617993877991494)) & (xp.less_equal(t214, 2.7576202181510405)), t214, xp.where((xp.greater_equal(t215, -0.2617993877991494)) & (xp.less_equal(t215, 2.7576202181510405)), t215, qb4_2)))
-    t217 = xp.where(xp.greater(qn4, t32), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t218 = t217 + t32
+    t216 = xp.where(xp.greater_equal(t31, -0.2617993877991494) & xp.less_equal(t31, 2.7576202181510405), t31, xp.where(xp.greater_equal(t214, -0.2617993877991494) & xp.less_equal(t214, 2.7576202181510405), t214, xp.where(xp.greater_equal(t215, -0.2617993877991494) & xp.less_equal(t215, 2.7576202181510405), t215, qb4_2)))
+    t217 = xp.where(xp.less(t32, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t218 = t32 + t217
     t219 = t32 - t217
-    t220 = xp.where((xp.greater_equal(t32, -6.1086523819801535)) & (xp.less_equal(t32, 6.1086523819801535)), t32, xp.where((xp.greater_equal(t218, -6.1086523819801535)) & (xp.less_equal(t218, 6.1086523819801535)), t218, xp.where((xp.greater_equal(t219, -6.1086523819801535)) & (xp.less_equal(t219, 6.1086523819801535)), t219, qb4_3)))
-    t221 = xp.where(xp.greater(qn5, t33), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t222 = t221 + t33
+    t220 = xp.where(xp.greater_equal(t32, -6.1086523819801535) & xp.less_equal(t32, 6.1086523819801535), t32, xp.where(xp.greater_equal(t218, -6.1086523819801535) & xp.less_equal(t218, 6.1086523819801535), t218, xp.where(xp.greater_equal(t219, -6.1086523819801535) & xp.less_equal(t219, 6.1086523819801535), t219, qb4_3)))
+    t221 = xp.where(xp.less(t33, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t222 = t33 + t221
     t223 = t33 - t221
-    t224 = xp.where((xp.greater_equal(t33, -2.2689280275926285)) & (xp.less_equal(t33, 2.2689280275926285)), t33, xp.where((xp.greater_equal(t222, -2.2689280275926285)) & (xp.less_equal(t222, 2.2689280275926285)), t222, xp.where((xp.greater_equal(t223, -2.2689280275926285)) & (xp.less_equal(t223, 2.2689280275926285)), t223, qb4_4)))
-    t225 = xp.where(xp.greater(qn6, t34), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t226 = t225 + t34
+    t224 = xp.where(xp.greater_equal(t33, -2.2689280275926285) & xp.less_equal(t33, 2.2689280275926285), t33, xp.where(xp.greater_equal(t222, -2.2689280275926285) & xp.less_equal(t222, 2.2689280275926285), t222, xp.where(xp.greater_equal(t223, -2.2689280275926285) & xp.less_equal(t223, 2.2689280275926285), t223, qb4_4)))
+    t225 = xp.where(xp.less(t34, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t226 = t34 + t225
     t227 = t34 - t225
-    t228 = xp.where((xp.greater_equal(t34, -6.1086523819801535)) & (xp.less_equal(t34, 6.1086523819801535)), t34, xp.where((xp.greater_equal(t226, -6.1086523819801535)) & (xp.less_equal(t226, 6.1086523819801535)), t226, xp.where((xp.greater_equal(t227, -6.1086523819801535)) & (xp.less_equal(t227, 6.1086523819801535)), t227, qb4_5)))
+    t228 = xp.where(xp.greater_equal(t34, -6.1086523819801535) & xp.less_equal(t34, 6.1086523819801535), t34, xp.where(xp.greater_equal(t226, -6.1086523819801535) & xp.less_equal(t226, 6.1086523819801535), t226, xp.where(xp.greater_equal(t227, -6.1086523819801535) & xp.less_equal(t227, 6.1086523819801535), t227, qb4_5)))
     t229 = qw1*(t208 + t82)**2 + qw2*(t212 + t83)**2 + qw3*(t216 + t84)**2 + qw4*(t220 + t85)**2 + qw5*(t224 + t86)**2 + qw6*(t228 + t87)**2
     t230 = xp.greater(t35, 0)
-    t231 = xp.where(t230 & ((xp.greater(t204, t229)) | (xp.less(t196, 1))), xp.asarray(1, dtype=dtype), 0)
+    t231 = xp.where(t230 & (xp.greater(t204, t229) | xp.less(t196, 1)), xp.asarray(1, dtype=dtype), 0)
     t232 = xp.where(t230, 1, t196)
     t233 = xp.greater(t231, 0)
     t234 = xp.where(t233, t208, t198)
@@ -3329,33 +3329,33 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     t238 = xp.where(t233, t224, t202)
     t239 = xp.where(t233, t228, t203)
     t240 = xp.where(t233, t229, t204)
-    t241 = xp.where(xp.greater(qn1, t36), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t242 = t241 + t36
+    t241 = xp.where(xp.less(t36, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t242 = t36 + t241
     t243 = t36 - t241
-    t244 = xp.where((xp.greater_equal(t36, -2.705260340591211)) & (xp.less_equal(t36, 2.705260340591211)), t36, xp.where((xp.greater_equal(t242, -2.705260340591211)) & (xp.less_equal(t242, 2.705260340591211)), t242, xp.where((xp.greater_equal(t243, -2.705260340591211)) & (xp.less_equal(t243, 2.705260340591211)), t243, qb5_0)))
-    t245 = xp.where(xp.greater(qn2, t37), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t246 = t245 + t37
+    t244 = xp.where(xp.greater_equal(t36, -2.705260340591211) & xp.less_equal(t36, 2.705260340591211), t36, xp.where(xp.greater_equal(t242, -2.705260340591211) & xp.less_equal(t242, 2.705260340591211), t242, xp.where(xp.greater_equal(t243, -2.705260340591211) & xp.less_equal(t243, 2.705260340591211), t243, qb5_0)))
+    t245 = xp.where(xp.less(t37, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t246 = t37 + t245
     t247 = t37 - t245
-    t248 = xp.where((xp.greater_equal(t37, -3.141592653589793)) & (xp.less_equal(t37, 1.1344640137963142)), t37, xp.where((xp.greater_equal(t246, -3.141592653589793)) & (xp.less_equal(t246, 1.1344640137963142)), t246, xp.where((xp.greater_equal(t247, -3.141592653589793)) & (xp.less_equal(t247, 1.1344640137963142)), t247, qb5_1)))
-    t249 = xp.where(xp.greater(qn3, t38), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t250 = t249 + t38
+    t248 = xp.where(xp.greater_equal(t37, -3.141592653589793) & xp.less_equal(t37, 1.1344640137963142), t37, xp.where(xp.greater_equal(t246, -3.141592653589793) & xp.less_equal(t246, 1.1344640137963142), t246, xp.where(xp.greater_equal(t247, -3.141592653589793) & xp.less_equal(t247, 1.1344640137963142), t247, qb5_1)))
+    t249 = xp.where(xp.less(t38, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t250 = t38 + t249
     t251 = t38 - t249
-    t252 = xp.where((xp.greater_equal(t38, -0.2617993877991494)) & (xp.less_equal(t38, 2.7576202181510405)), t38, xp.where((xp.greater_equal(t250, -0.2617993877991494)) & (xp.less_equal(t250, 2.7576202181510405)), t250, xp.where((xp.greater_equal(t251, -0.2617993877991494)) & (xp.less_equal(t251, 2.7576202181510405)), t251, qb5_2)))
-    t253 = xp.where(xp.greater(qn4, t39), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t254 = t253 + t39
+    t252 = xp.where(xp.greater_equal(t38, -0.2617993877991494) & xp.less_equal(t38, 2.7576202181510405), t38, xp.where(xp.greater_equal(t250, -0.2617993877991494) & xp.less_equal(t250, 2.7576202181510405), t250, xp.where(xp.greater_equal(t251, -0.2617993877991494) & xp.less_equal(t251, 2.7576202181510405), t251, qb5_2)))
+    t253 = xp.where(xp.less(t39, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t254 = t39 + t253
     t255 = t39 - t253
-    t256 = xp.where((xp.greater_equal(t39, -6.1086523819801535)) & (xp.less_equal(t39, 6.1086523819801535)), t39, xp.where((xp.greater_equal(t254, -6.1086523819801535)) & (xp.less_equal(t254, 6.1086523819801535)), t254, xp.where((xp.greater_equal(t255, -6.1086523819801535)) & (xp.less_equal(t255, 6.1086523819801535)), t255, qb5_3)))
-    t257 = xp.where(xp.greater(qn5, t40), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t258 = t257 + t40
+    t256 = xp.where(xp.greater_equal(t39, -6.1086523819801535) & xp.less_equal(t39, 6.1086523819801535), t39, xp.where(xp.greater_equal(t254, -6.1086523819801535) & xp.less_equal(t254, 6.1086523819801535), t254, xp.where(xp.greater_equal(t255, -6.1086523819801535) & xp.less_equal(t255, 6.1086523819801535), t255, qb5_3)))
+    t257 = xp.where(xp.less(t40, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t258 = t40 + t257
     t259 = t40 - t257
-    t260 = xp.where((xp.greater_equal(t40, -2.2689280275926285)) & (xp.less_equal(t40, 2.2689280275926285)), t40, xp.where((xp.greater_equal(t258, -2.2689280275926285)) & (xp.less_equal(t258, 2.2689280275926285)), t258, xp.where((xp.greater_equal(t259, -2.2689280275926285)) & (xp.less_equal(t259, 2.2689280275926285)), t259, qb5_4)))
-    t261 = xp.where(xp.greater(qn6, t41), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t262 = t261 + t41
+    t260 = xp.where(xp.greater_equal(t40, -2.2689280275926285) & xp.less_equal(t40, 2.2689280275926285), t40, xp.where(xp.greater_equal(t258, -2.2689280275926285) & xp.less_equal(t258, 2.2689280275926285), t258, xp.where(xp.greater_equal(t259, -2.2689280275926285) & xp.less_equal(t259, 2.2689280275926285), t259, qb5_4)))
+    t261 = xp.where(xp.less(t41, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t262 = t41 + t261
     t263 = t41 - t261
-    t264 = xp.where((xp.greater_equal(t41, -6.1086523819801535)) & (xp.less_equal(t41, 6.1086523819801535)), t41, xp.where((xp.greater_equal(t262, -6.1086523819801535)) & (xp.less_equal(t262, 6.1086523819801535)), t262, xp.where((xp.greater_equal(t263, -6.1086523819801535)) & (xp.less_equal(t263, 6.1086523819801535)), t263, qb5_5)))
+    t264 = xp.where(xp.greater_equal(t41, -6.1086523819801535) & xp.less_equal(t41, 6.1086523819801535), t41, xp.where(xp.greater_equal(t262, -6.1086523819801535) & xp.less_equal(t262, 6.1086523819801535), t262, xp.where(xp.greater_equal(t263, -6.1086523819801535) & xp.less_equal(t263, 6.1086523819801535), t263, qb5_5)))
     t265 = qw1*(t244 + t82)**2 + qw2*(t248 + t83)**2 + qw3*(t252 + t84)**2 + qw4*(t256 + t85)**2 + qw5*(t260 + t86)**2 + qw6*(t264 + t87)**2
     t266 = xp.greater(t42, 0)
-    t267 = xp.where(t266 & ((xp.greater(t240, t265)) | (xp.less(t232, 1))), xp.asarray(1, dtype=dtype), 0)
+    t267 = xp.where(t266 & (xp.greater(t240, t265) | xp.less(t232, 1)), xp.asarray(1, dtype=dtype), 0)
     t268 = xp.where(t266, 1, t232)
     t269 = xp.greater(t267, 0)
     t270 = xp.where(t269, t244, t234)
@@ -3365,33 +3365,33 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     t274 = xp.where(t269, t260, t238)
     t275 = xp.where(t269, t264, t239)
     t276 = xp.where(t269, t265, t240)
-    t277 = xp.where(xp.greater(qn1, t43), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t278 = t277 + t43
+    t277 = xp.where(xp.less(t43, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t278 = t43 + t277
     t279 = t43 - t277
-    t280 = xp.where((xp.greater_equal(t43, -2.705260340591211)) & (xp.less_equal(t43, 2.705260340591211)), t43, xp.where((xp.greater_equal(t278, -2.705260340591211)) & (xp.less_equal(t278, 2.705260340591211)), t278, xp.where((xp.greater_equal(t279, -2.705260340591211)) & (xp.less_equal(t279, 2.705260340591211)), t279, qb6_0)))
-    t281 = xp.where(xp.greater(qn2, t44), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t282 = t281 + t44
+    t280 = xp.where(xp.greater_equal(t43, -2.705260340591211) & xp.less_equal(t43, 2.705260340591211), t43, xp.where(xp.greater_equal(t278, -2.705260340591211) & xp.less_equal(t278, 2.705260340591211), t278, xp.where(xp.greater_equal(t279, -2.705260340591211) & xp.less_equal(t279, 2.705260340591211), t279, qb6_0)))
+    t281 = xp.where(xp.less(t44, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t282 = t44 + t281
     t283 = t44 - t281
-    t284 = xp.where((xp.greater_equal(t44, -3.141592653589793)) & (xp.less_equal(t44, 1.1344640137963142)), t44, xp.where((xp.greater_equal(t282, -3.141592653589793)) & (xp.less_equal(t282, 1.1344640137963142)), t282, xp.where((xp.greater_equal(t283, -3.141592653589793)) & (xp.less_equal(t283, 1.1344640137963142)), t283, qb6_1)))
-    t285 = xp.where(xp.greater(qn3, t45), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t286 = t285 + t45
+    t284 = xp.where(xp.greater_equal(t44, -3.141592653589793) & xp.less_equal(t44, 1.1344640137963142), t44, xp.where(xp.greater_equal(t282, -3.141592653589793) & xp.less_equal(t282, 1.1344640137963142), t282, xp.where(xp.greater_equal(t283, -3.141592653589793) & xp.less_equal(t283, 1.1344640137963142), t283, qb6_1)))
+    t285 = xp.where(xp.less(t45, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t286 = t45 + t285
     t287 = t45 - t285
-    t288 = xp.where((xp.greater_equal(t45, -0.2617993877991494)) & (xp.less_equal(t45, 2.7576202181510405)), t45, xp.where((xp.greater_equal(t286, -0.2617993877991494)) & (xp.less_equal(t286, 2.7576202181510405)), t286, xp.where((xp.greater_equal(t287, -0.2617993877991494)) & (xp.less_equal(t287, 2.7576202181510405)), t287, qb6_2)))
-    t289 = xp.where(xp.greater(qn4, t46), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t290 = t289 + t46
+    t288 = xp.where(xp.greater_equal(t45, -0.2617993877991494) & xp.less_equal(t45, 2.7576202181510405), t45, xp.where(xp.greater_equal(t286, -0.2617993877991494) & xp.less_equal(t286, 2.7576202181510405), t286, xp.where(xp.greater_equal(t287, -0.2617993877991494) & xp.less_equal(t287, 2.7576202181510405), t287, qb6_2)))
+    t289 = xp.where(xp.less(t46, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t290 = t46 + t289
     t291 = t46 - t289
-    t292 = xp.where((xp.greater_equal(t46, -6.1086523819801535)) & (xp.less_equal(t46, 6.1086523819801535)), t46, xp.where((xp.greater_equal(t290, -6.1086523819801535)) & (xp.less_equal(t290, 6.1086523819801535)), t290, xp.where((xp.greater_equal(t291, -6.1086523819801535)) & (xp.less_equal(t291, 6.1086523819801535)), t291, qb6_3)))
-    t293 = xp.where(xp.greater(qn5, t47), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t294 = t293 + t47
+    t292 = xp.where(xp.greater_equal(t46, -6.1086523819801535) & xp.less_equal(t46, 6.1086523819801535), t46, xp.where(xp.greater_equal(t290, -6.1086523819801535) & xp.less_equal(t290, 6.1086523819801535), t290, xp.where(xp.greater_equal(t291, -6.1086523819801535) & xp.less_equal(t291, 6.1086523819801535), t291, qb6_3)))
+    t293 = xp.where(xp.less(t47, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t294 = t47 + t293
     t295 = t47 - t293
-    t296 = xp.where((xp.greater_equal(t47, -2.2689280275926285)) & (xp.less_equal(t47, 2.2689280275926285)), t47, xp.where((xp.greater_equal(t294, -2.2689280275926285)) & (xp.less_equal(t294, 2.2689280275926285)), t294, xp.where((xp.greater_equal(t295, -2.2689280275926285)) & (xp.less_equal(t295, 2.2689280275926285)), t295, qb6_4)))
-    t297 = xp.where(xp.greater(qn6, t48), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t298 = t297 + t48
+    t296 = xp.where(xp.greater_equal(t47, -2.2689280275926285) & xp.less_equal(t47, 2.2689280275926285), t47, xp.where(xp.greater_equal(t294, -2.2689280275926285) & xp.less_equal(t294, 2.2689280275926285), t294, xp.where(xp.greater_equal(t295, -2.2689280275926285) & xp.less_equal(t295, 2.2689280275926285), t295, qb6_4)))
+    t297 = xp.where(xp.less(t48, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t298 = t48 + t297
     t299 = t48 - t297
-    t300 = xp.where((xp.greater_equal(t48, -6.1086523819801535)) & (xp.less_equal(t48, 6.1086523819801535)), t48, xp.where((xp.greater_equal(t298, -6.1086523819801535)) & (xp.less_equal(t298, 6.1086523819801535)), t298, xp.where((xp.greater_equal(t299, -6.1086523819801535)) & (xp.less_equal(t299, 6.1086523819801535)), t299, qb6_5)))
+    t300 = xp.where(xp.greater_equal(t48, -6.1086523819801535) & xp.less_equal(t48, 6.1086523819801535), t48, xp.where(xp.greater_equal(t298, -6.1086523819801535) & xp.less_equal(t298, 6.1086523819801535), t298, xp.where(xp.greater_equal(t299, -6.1086523819801535) & xp.less_equal(t299, 6.1086523819801535), t299, qb6_5)))
     t301 = qw1*(t280 + t82)**2 + qw2*(t284 + t83)**2 + qw3*(t288 + t84)**2 + qw4*(t292 + t85)**2 + qw5*(t296 + t86)**2 + qw6*(t300 + t87)**2
     t302 = xp.greater(t49, 0)
-    t303 = xp.where(t302 & ((xp.greater(t276, t301)) | (xp.less(t268, 1))), xp.asarray(1, dtype=dtype), 0)
+    t303 = xp.where(t302 & (xp.greater(t276, t301) | xp.less(t268, 1)), xp.asarray(1, dtype=dtype), 0)
     t304 = xp.where(t302, 1, t268)
     t305 = xp.greater(t303, 0)
     t306 = xp.where(t305, t280, t270)
@@ -3401,33 +3401,33 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     t310 = xp.where(t305, t296, t274)
     t311 = xp.where(t305, t300, t275)
     t312 = xp.where(t305, t301, t276)
-    t313 = xp.where(xp.greater(qn1, t50), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t314 = t313 + t50
+    t313 = xp.where(xp.less(t50, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t314 = t50 + t313
     t315 = t50 - t313
-    t316 = xp.where((xp.greater_equal(t50, -2.705260340591211)) & (xp.less_equal(t50, 2.705260340591211)), t50, xp.where((xp.greater_equal(t314, -2.705260340591211)) & (xp.less_equal(t314, 2.705260340591211)), t314, xp.where((xp.greater_equal(t315, -2.705260340591211)) & (xp.less_equal(t315, 2.705260340591211)), t315, qb7_0)))
-    t317 = xp.where(xp.greater(qn2, t51), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t318 = t317 + t51
+    t316 = xp.where(xp.greater_equal(t50, -2.705260340591211) & xp.less_equal(t50, 2.705260340591211), t50, xp.where(xp.greater_equal(t314, -2.705260340591211) & xp.less_equal(t314, 2.705260340591211), t314, xp.where(xp.greater_equal(t315, -2.705260340591211) & xp.less_equal(t315, 2.705260340591211), t315, qb7_0)))
+    t317 = xp.where(xp.less(t51, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t318 = t51 + t317
     t319 = t51 - t317
-    t320 = xp.where((xp.greater_equal(t51, -3.141592653589793)) & (xp.less_equal(t51, 1.1344640137963142)), t51, xp.where((xp.greater_equal(t318, -3.141592653589793)) & (xp.less_equal(t318, 1.1344640137963142)), t318, xp.where((xp.greater_equal(t319, -3.141592653589793)) & (xp.less_equal(t319, 1.1344640137963142)), t319, qb7_1)))
-    t321 = xp.where(xp.greater(qn3, t52), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t322 = t321 + t52
+    t320 = xp.where(xp.greater_equal(t51, -3.141592653589793) & xp.less_equal(t51, 1.1344640137963142), t51, xp.where(xp.greater_equal(t318, -3.141592653589793) & xp.less_equal(t318, 1.1344640137963142), t318, xp.where(xp.greater_equal(t319, -3.141592653589793) & xp.less_equal(t319, 1.1344640137963142), t319, qb7_1)))
+    t321 = xp.where(xp.less(t52, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t322 = t52 + t321
     t323 = t52 - t321
-    t324 = xp.where((xp.greater_equal(t52, -0.2617993877991494)) & (xp.less_equal(t52, 2.7576202181510405)), t52, xp.where((xp.greater_equal(t322, -0.2617993877991494)) & (xp.less_equal(t322, 2.7576202181510405)), t322, xp.where((xp.greater_equal(t323, -0.2617993877991494)) & (xp.less_equal(t323, 2.7576202181510405)), t323, qb7_2)))
-    t325 = xp.where(xp.greater(qn4, t53), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t326 = t325 + t53
+    t324 = xp.where(xp.greater_equal(t52, -0.2617993877991494) & xp.less_equal(t52, 2.7576202181510405), t52, xp.where(xp.greater_equal(t322, -0.2617993877991494) & xp.less_equal(t322, 2.7576202181510405), t322, xp.where(xp.greater_equal(t323, -0.2617993877991494) & xp.less_equal(t323, 2.7576202181510405), t323, qb7_2)))
+    t325 = xp.where(xp.less(t53, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t326 = t53 + t325
     t327 = t53 - t325
-    t328 = xp.where((xp.greater_equal(t53, -6.1086523819801535)) & (xp.less_equal(t53, 6.1086523819801535)), t53, xp.where((xp.greater_equal(t326, -6.1086523819801535)) & (xp.less_equal(t326, 6.1086523819801535)), t326, xp.where((xp.greater_equal(t327, -6.1086523819801535)) & (xp.less_equal(t327, 6.1086523819801535)), t327, qb7_3)))
-    t329 = xp.where(xp.greater(qn5, t54), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t330 = t329 + t54
+    t328 = xp.where(xp.greater_equal(t53, -6.1086523819801535) & xp.less_equal(t53, 6.1086523819801535), t53, xp.where(xp.greater_equal(t326, -6.1086523819801535) & xp.less_equal(t326, 6.1086523819801535), t326, xp.where(xp.greater_equal(t327, -6.1086523819801535) & xp.less_equal(t327, 6.1086523819801535), t327, qb7_3)))
+    t329 = xp.where(xp.less(t54, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t330 = t54 + t329
     t331 = t54 - t329
-    t332 = xp.where((xp.greater_equal(t54, -2.2689280275926285)) & (xp.less_equal(t54, 2.2689280275926285)), t54, xp.where((xp.greater_equal(t330, -2.2689280275926285)) & (xp.less_equal(t330, 2.2689280275926285)), t330, xp.where((xp.greater_equal(t331, -2.2689280275926285)) & (xp.less_equal(t331, 2.2689280275926285)), t331, qb7_4)))
-    t333 = xp.where(xp.greater(qn6, t55), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t334 = t333 + t55
+    t332 = xp.where(xp.greater_equal(t54, -2.2689280275926285) & xp.less_equal(t54, 2.2689280275926285), t54, xp.where(xp.greater_equal(t330, -2.2689280275926285) & xp.less_equal(t330, 2.2689280275926285), t330, xp.where(xp.greater_equal(t331, -2.2689280275926285) & xp.less_equal(t331, 2.2689280275926285), t331, qb7_4)))
+    t333 = xp.where(xp.less(t55, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t334 = t55 + t333
     t335 = t55 - t333
-    t336 = xp.where((xp.greater_equal(t55, -6.1086523819801535)) & (xp.less_equal(t55, 6.1086523819801535)), t55, xp.where((xp.greater_equal(t334, -6.1086523819801535)) & (xp.less_equal(t334, 6.1086523819801535)), t334, xp.where((xp.greater_equal(t335, -6.1086523819801535)) & (xp.less_equal(t335, 6.1086523819801535)), t335, qb7_5)))
+    t336 = xp.where(xp.greater_equal(t55, -6.1086523819801535) & xp.less_equal(t55, 6.1086523819801535), t55, xp.where(xp.greater_equal(t334, -6.1086523819801535) & xp.less_equal(t334, 6.1086523819801535), t334, xp.where(xp.greater_equal(t335, -6.1086523819801535) & xp.less_equal(t335, 6.1086523819801535), t335, qb7_5)))
     t337 = qw1*(t316 + t82)**2 + qw2*(t320 + t83)**2 + qw3*(t324 + t84)**2 + qw4*(t328 + t85)**2 + qw5*(t332 + t86)**2 + qw6*(t336 + t87)**2
     t338 = xp.greater(t56, 0)
-    t339 = xp.where(t338 & ((xp.greater(t312, t337)) | (xp.less(t304, 1))), xp.asarray(1, dtype=dtype), 0)
+    t339 = xp.where(t338 & (xp.greater(t312, t337) | xp.less(t304, 1)), xp.asarray(1, dtype=dtype), 0)
     t340 = xp.where(t338, 1, t304)
     t341 = xp.greater(t339, 0)
     t342 = xp.where(t341, t316, t306)

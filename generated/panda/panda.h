@@ -41,15 +41,15 @@ typedef double panda_real;
 void panda_fk(const panda_real q[PANDA_DOF], panda_real T[16]);
 
 /* Geometric Jacobian in the world frame (6 x DOF, rows vx vy vz wx wy wz).
- * Result: J: 6 x 7 row-major, element (r, c) at J[r * 7 + c]. 168 operations. */
+ * Result: J: 6 x 7 row-major, element (r, c) at J[r * 7 + c]. 165 operations. */
 void panda_jacobian(const panda_real q[PANDA_DOF], panda_real J[6 * PANDA_DOF]);
 
 /* Fk and jacobian in one pass, sharing their terms.
- * Result: T: 4 x 4 row-major, element (r, c) at T[r * 4 + c]; J: 6 x 7 row-major, element (r, c) at J[r * 7 + c]. 201 operations. */
+ * Result: T: 4 x 4 row-major, element (r, c) at T[r * 4 + c]; J: 6 x 7 row-major, element (r, c) at J[r * 7 + c]. 198 operations. */
 void panda_fk_jacobian(const panda_real q[PANDA_DOF], panda_real T[16], panda_real J[6 * PANDA_DOF]);
 
 /* Geometric Jacobian in the tool frame (6 x DOF, rows vx vy vz wx wy wz).
- * Result: J: 6 x 7 row-major, element (r, c) at J[r * 7 + c]. 370 operations. */
+ * Result: J: 6 x 7 row-major, element (r, c) at J[r * 7 + c]. 349 operations. */
 void panda_jacobian_tool(const panda_real q[PANDA_DOF], panda_real J[6 * PANDA_DOF]);
 
 /* Task vector mu = (x, y, z, roll, pitch, yaw).
@@ -57,7 +57,7 @@ void panda_jacobian_tool(const panda_real q[PANDA_DOF], panda_real J[6 * PANDA_D
 void panda_task(const panda_real q[PANDA_DOF], panda_real mu[PANDA_TASK_DIM]);
 
 /* Analytic Jacobian d mu / d q (6 x DOF).
- * Result: J: 6 x 7 row-major, element (r, c) at J[r * 7 + c]. 263 operations. */
+ * Result: J: 6 x 7 row-major, element (r, c) at J[r * 7 + c]. 257 operations. */
 void panda_task_jacobian(const panda_real q[PANDA_DOF], panda_real J[PANDA_TASK_DIM * PANDA_DOF]);
 
 /* Fk, jacobian and bias_acceleration in one pass, sharing their terms.
@@ -65,7 +65,7 @@ void panda_task_jacobian(const panda_real q[PANDA_DOF], panda_real J[PANDA_TASK_
 void panda_fk_jacobian_dot(const panda_real q[PANDA_DOF], const panda_real q_dot[PANDA_DOF], panda_real T[16], panda_real J[6 * PANDA_DOF], panda_real a[6]);
 
 /* Time derivative dJ/dt of the world geometric Jacobian along q_dot (6 x DOF).
- * Result: Jd: 6 x 7 row-major, element (r, c) at Jd[r * 7 + c]. 364 operations. */
+ * Result: Jd: 6 x 7 row-major, element (r, c) at Jd[r * 7 + c]. 356 operations. */
 void panda_jacobian_dot(const panda_real q[PANDA_DOF], const panda_real q_dot[PANDA_DOF], panda_real Jd[6 * PANDA_DOF]);
 
 /* J' q_dot: the tool's classical linear and angular acceleration at zero joint acceleration, world frame (6).
@@ -73,19 +73,19 @@ void panda_jacobian_dot(const panda_real q[PANDA_DOF], const panda_real q_dot[PA
 void panda_bias_acceleration(const panda_real q[PANDA_DOF], const panda_real q_dot[PANDA_DOF], panda_real a[6]);
 
 /* Time derivative of the analytic Jacobian along q_dot (6 x DOF): mu'' = J_a q'' + J_a' q'.
- * Result: Jd: 6 x 7 row-major, element (r, c) at Jd[r * 7 + c]. 739 operations. */
+ * Result: Jd: 6 x 7 row-major, element (r, c) at Jd[r * 7 + c]. 732 operations. */
 void panda_task_jacobian_dot(const panda_real q[PANDA_DOF], const panda_real q_dot[PANDA_DOF], panda_real Jd[PANDA_TASK_DIM * PANDA_DOF]);
 
 /* Partial derivatives dJ/dq_k of the world geometric Jacobian (DOF x 6 x DOF, indexed [k, r, c]).
- * Result: H: 7 x 6 x 7 row-major, element (k, r, c) at H[k * 42 + r * 7 + c]. 428 operations. */
+ * Result: H: 7 x 6 x 7 row-major, element (k, r, c) at H[k * 42 + r * 7 + c]. 407 operations. */
 void panda_hessian(const panda_real q[PANDA_DOF], panda_real H[PANDA_DOF * 6 * PANDA_DOF]);
 
 /* Factors of det(Js Js^T): the robot is singular where one is 0.
- * Result: f[i], i < 1. 755 operations. */
+ * Result: f[i], i < 1. 740 operations. */
 void panda_singularity_factors(const panda_real q[PANDA_DOF], panda_real f[PANDA_NUM_SINGULARITY_FACTORS]);
 
 /* Manipulability sqrt(det(Js Js^T)).
- * Result: returned as a scalar. 758 operations. */
+ * Result: returned as a scalar. 743 operations. */
 panda_real panda_manipulability(const panda_real q[PANDA_DOF]);
 
 /* Joint rates q_dot solving Js q_dot = mu_dot: Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status.
@@ -93,11 +93,11 @@ panda_real panda_manipulability(const panda_real q[PANDA_DOF]);
 int panda_velocity_ik(const panda_real q[PANDA_DOF], const panda_real mu_dot[PANDA_TASK_DIM], panda_real damping, panda_real q_dot[PANDA_DOF]);
 
 /* One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite).
- * Result: q_start[i], i < 7; q_next[i], i < 7; returned as a scalar. 1162 operations. */
+ * Result: q_start[i], i < 7; q_next[i], i < 7; returned as a scalar. 1157 operations. */
 panda_real panda_ik_numeric_step(const panda_real target[16], const panda_real q[PANDA_DOF], panda_real damping, panda_real q_start[PANDA_DOF], panda_real q_next[PANDA_DOF]);
 
 /* Every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits.
- * Result: q: 8 x 7 row-major, element (r, c) at q[r * 7 + c]; valid[i], i < 8; in_limits[i], i < 8. 1584 operations. */
+ * Result: q: 8 x 7 row-major, element (r, c) at q[r * 7 + c]; valid[i], i < 8; in_limits[i], i < 8. 1583 operations. */
 void panda_ik_branches(const panda_real T[16], panda_real q_free, panda_real q[PANDA_MAX_IK_SOLUTIONS * PANDA_DOF], int valid[PANDA_MAX_IK_SOLUTIONS], int in_limits[PANDA_MAX_IK_SOLUTIONS]);
 
 /* The closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status.

@@ -89,52 +89,52 @@ def fk(q):
     s7 = trig[..., 13]
     t0 = s1*s3
     t1 = c1*c3
-    t2 = -t0 + c2*t1
-    t3 = t1 - c2*t0
+    t2 = -t0 + t1*c2
+    t3 = t1 - t0*c2
     t4 = c3*s1
     t5 = c1*s3
-    t6 = t4 + c2*t5
-    t7 = t5 + c2*t4
+    t6 = t4 + t5*c2
+    t7 = t5 + t4*c2
     t8 = 0.316*s2
-    t9 = 0.0825*t2 + c1*t8
-    t10 = 0.0825*t7 + s1*t8
+    t9 = 0.0825*t2 + t8*c1
+    t10 = 0.0825*t7 + t8*s1
     t11 = c3*s2
     t12 = 0.316*c2 - 0.0825*t11
-    t13 = c2*s4 - c4*t11
-    t14 = c2*c4 + s4*t11
+    t13 = c2*s4 - t11*c4
+    t14 = t11*s4 + c2*c4
     t15 = c1*s2
-    t16 = c4*t2 + s4*t15
-    t17 = c4*t15 - s4*t2
-    t18 = c5*t16 - s5*t6
-    t19 = c5*t6 + s5*t16
-    t20 = c6*t18 + s6*t17
-    t21 = c6*t17 - s6*t18
-    t22 = c7*t20 + s7*t19
-    t23 = c7*t19 - s7*t20
+    t16 = t2*c4 + t15*s4
+    t17 = t15*c4 - t2*s4
+    t18 = t16*c5 - t6*s5
+    t19 = t16*s5 + t6*c5
+    t20 = t17*s6 + t18*c6
+    t21 = t17*c6 - t18*s6
+    t22 = t19*s7 + t20*c7
+    t23 = t19*c7 - t20*s7
     t24 = 0.088*t20 - 0.21*t21
     t25 = t24 + 0.384*t17
     t26 = t25 - 0.0825*t16
-    t27 = t26 + t9
+    t27 = t9 + t26
     t28 = s1*s2
-    t29 = c4*t7 + s4*t28
-    t30 = c4*t28 - s4*t7
-    t31 = c5*t29 + s5*t3
-    t32 = c5*t3 - s5*t29
-    t33 = c6*t31 + s6*t30
-    t34 = c6*t30 - s6*t31
-    t35 = c7*t33 - s7*t32
-    t36 = c7*t32 + s7*t33
+    t29 = t7*c4 + t28*s4
+    t30 = t28*c4 - t7*s4
+    t31 = t29*c5 + t3*s5
+    t32 = t3*c5 - t29*s5
+    t33 = t30*s6 + t31*c6
+    t34 = t30*c6 - t31*s6
+    t35 = t33*c7 - t32*s7
+    t36 = t32*c7 + t33*s7
     t37 = 0.088*t33 - 0.21*t34
     t38 = t37 + 0.384*t30
     t39 = t38 - 0.0825*t29
     t40 = t10 + t39
     t41 = s2*s3
-    t42 = c5*t13 + s5*t41
-    t43 = c5*t41 - s5*t13
-    t44 = c6*t42 + s6*t14
-    t45 = c6*t14 - s6*t42
-    t46 = c7*t44 - s7*t43
-    t47 = c7*t43 + s7*t44
+    t42 = t13*c5 + t41*s5
+    t43 = t41*c5 - t13*s5
+    t44 = t14*s6 + t42*c6
+    t45 = t14*c6 - t42*s6
+    t46 = t44*c7 - t43*s7
+    t47 = t43*c7 + t44*s7
     t48 = 0.088*t44 - 0.21*t45
     t49 = t48 + 0.384*t14
     t50 = t49 - 0.0825*t13
@@ -143,7 +143,7 @@ def fk(q):
     t53 = 0.7071067811865476*t22
     t54 = 0.7071067811865476*t23
     t55 = t53 - t54
-    t56 = t53 + t54
+    t56 = t54 + t53
     t57 = 0.7071067811865476*t35
     t58 = 0.7071067811865476*t36
     t59 = t57 + t58
@@ -174,7 +174,7 @@ def fk(q):
 
 
 def jacobian(q):
-    """geometric Jacobian in the world frame (6 x DOF, rows vx vy vz wx wy wz): (6 x 7), 168 operations."""
+    """geometric Jacobian in the world frame (6 x DOF, rows vx vy vz wx wy wz): (6 x 7), 165 operations."""
     xp, dtype, device, batch, (q,) = _arguments(("q", q, (7,)))
     trig = _cos_sin(xp, q, (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0), device)
     c1 = trig[..., 0]
@@ -191,72 +191,72 @@ def jacobian(q):
     s6 = trig[..., 11]
     t0 = s1*s3
     t1 = c1*c3
-    t2 = -t0 + c2*t1
-    t3 = t1 - c2*t0
+    t2 = -t0 + t1*c2
+    t3 = t1 - t0*c2
     t4 = c3*s1
     t5 = c1*s3
-    t6 = t4 + c2*t5
-    t7 = t5 + c2*t4
+    t6 = t4 + t5*c2
+    t7 = t5 + t4*c2
     t8 = c1*s2
     t9 = 0.316*t8 + 0.0825*t2
-    t10 = c4*t2 + s4*t8
-    t11 = c4*t8 - s4*t2
-    t12 = c5*t10 - s5*t6
-    t13 = c5*t6 + s5*t10
-    t14 = c6*t12 + s6*t11
-    t15 = c6*t11 - s6*t12
+    t10 = t2*c4 + t8*s4
+    t11 = t8*c4 - t2*s4
+    t12 = t10*c5 - t6*s5
+    t13 = t10*s5 + t6*c5
+    t14 = t11*s6 + t12*c6
+    t15 = t11*c6 - t12*s6
     t16 = 0.088*t14 - 0.21*t15
     t17 = t16 + 0.384*t11
     t18 = t17 - 0.0825*t10
-    t19 = t18 + t9
+    t19 = t9 + t18
     t20 = s1*s2
     t21 = 0.316*t20 + 0.0825*t7
-    t22 = c4*t7 + s4*t20
-    t23 = c4*t20 - s4*t7
-    t24 = c5*t22 + s5*t3
-    t25 = c5*t3 - s5*t22
-    t26 = c6*t24 + s6*t23
-    t27 = c6*t23 - s6*t24
+    t22 = t7*c4 + t20*s4
+    t23 = t20*c4 - t7*s4
+    t24 = t22*c5 + t3*s5
+    t25 = t3*c5 - t22*s5
+    t26 = t23*s6 + t24*c6
+    t27 = t23*c6 - t24*s6
     t28 = 0.088*t26 - 0.21*t27
     t29 = t28 + 0.384*t23
     t30 = t29 - 0.0825*t22
     t31 = t21 + t30
     t32 = c3*s2
     t33 = 0.316*c2 - 0.0825*t32
-    t34 = c2*s4 - c4*t32
-    t35 = c2*c4 + s4*t32
+    t34 = c2*s4 - t32*c4
+    t35 = t32*s4 + c2*c4
     t36 = s2*s3
-    t37 = c5*t34 + s5*t36
-    t38 = c5*t36 - s5*t34
-    t39 = c6*t37 + s6*t35
-    t40 = c6*t35 - s6*t37
+    t37 = t34*c5 + t36*s5
+    t38 = t36*c5 - t34*s5
+    t39 = t35*s6 + t37*c6
+    t40 = t35*c6 - t37*s6
     t41 = 0.088*t39 - 0.21*t40
     t42 = t41 + 0.384*t35
     t43 = t42 - 0.0825*t34
     t44 = t33 + t43
-    t45 = c1*t44
-    t46 = s1*t44
+    t45 = t44*c1
+    t46 = t44*s1
     J = _stack(xp, [
         -t31,  # 0, 0
         t45,  # 0, 1
-        s2*t46 - c2*t31,  # 0, 2
-        t30*t36 - t3*t43,  # 0, 3
-        t23*t42 - t29*t35,  # 0, 4
-        t28*t38 - t25*t41,  # 0, 5
+        t46*s2 - t31*c2,  # 0, 2
+        t30*t36 - t43*t3,  # 0, 3
+        t23*t42 - t35*t29,  # 0, 4
+        t38*t28 - t25*t41,  # 0, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 6
         t19,  # 1, 0
         t46,  # 1, 1
-        c2*t19 - s2*t45,  # 1, 2
-        -t18*t36 - t43*t6,  # 1, 3
-        t17*t35 - t11*t42,  # 1, 4
-        -t13*t41 - t16*t38,  # 1, 5
+        t19*c2 - t45*s2,  # 1, 2
+        -(t18*t36 + t43*t6),  # 1, 3
+        t35*t17 - t11*t42,  # 1, 4
+        -(t13*t41 + t38*t16),  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
-        -c1*t19 - s1*t31,  # 2, 1
+        -(t19*c1 + t31*s1),  # 2, 1
         t31*t8 - t19*t20,  # 2, 2
         t18*t3 + t30*t6,  # 2, 3
-        t11*t29 - t17*t23,  # 2, 4
-        t13*t28 + t16*t25,  # 2, 5
+        t11*t29 - t23*t17,  # 2, 4
+        t13*t28 + t25*t16,  # 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
         -s1,  # 3, 1
@@ -284,7 +284,7 @@ def jacobian(q):
 
 
 def fk_jacobian(q):
-    """fk and jacobian in one pass, sharing their terms: (4 x 4 and 6 x 7), 201 operations."""
+    """fk and jacobian in one pass, sharing their terms: (4 x 4 and 6 x 7), 198 operations."""
     xp, dtype, device, batch, (q,) = _arguments(("q", q, (7,)))
     trig = _cos_sin(xp, q, (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0), device)
     c1 = trig[..., 0]
@@ -303,51 +303,51 @@ def fk_jacobian(q):
     s7 = trig[..., 13]
     t0 = s1*s3
     t1 = c1*c3
-    t2 = -t0 + c2*t1
-    t3 = t1 - c2*t0
+    t2 = -t0 + t1*c2
+    t3 = t1 - t0*c2
     t4 = c3*s1
     t5 = c1*s3
-    t6 = t4 + c2*t5
-    t7 = t5 + c2*t4
+    t6 = t4 + t5*c2
+    t7 = t5 + t4*c2
     t8 = c1*s2
     t9 = 0.316*t8 + 0.0825*t2
-    t10 = c4*t2 + s4*t8
-    t11 = c4*t8 - s4*t2
-    t12 = c5*t10 - s5*t6
-    t13 = c5*t6 + s5*t10
-    t14 = c6*t12 + s6*t11
-    t15 = c6*t11 - s6*t12
-    t16 = c7*t14 + s7*t13
-    t17 = c7*t13 - s7*t14
+    t10 = t2*c4 + t8*s4
+    t11 = t8*c4 - t2*s4
+    t12 = t10*c5 - t6*s5
+    t13 = t10*s5 + t6*c5
+    t14 = t11*s6 + t12*c6
+    t15 = t11*c6 - t12*s6
+    t16 = t13*s7 + t14*c7
+    t17 = t13*c7 - t14*s7
     t18 = 0.088*t14 - 0.21*t15
     t19 = t18 + 0.384*t11
     t20 = t19 - 0.0825*t10
-    t21 = t20 + t9
+    t21 = t9 + t20
     t22 = s1*s2
     t23 = 0.316*t22 + 0.0825*t7
-    t24 = c4*t7 + s4*t22
-    t25 = c4*t22 - s4*t7
-    t26 = c5*t24 + s5*t3
-    t27 = c5*t3 - s5*t24
-    t28 = c6*t26 + s6*t25
-    t29 = c6*t25 - s6*t26
-    t30 = c7*t28 - s7*t27
-    t31 = c7*t27 + s7*t28
+    t24 = t7*c4 + t22*s4
+    t25 = t22*c4 - t7*s4
+    t26 = t24*c5 + t3*s5
+    t27 = t3*c5 - t24*s5
+    t28 = t25*s6 + t26*c6
+    t29 = t25*c6 - t26*s6
+    t30 = t28*c7 - t27*s7
+    t31 = t27*c7 + t28*s7
     t32 = 0.088*t28 - 0.21*t29
     t33 = t32 + 0.384*t25
     t34 = t33 - 0.0825*t24
     t35 = t23 + t34
     t36 = c3*s2
     t37 = 0.316*c2 - 0.0825*t36
-    t38 = c2*s4 - c4*t36
-    t39 = c2*c4 + s4*t36
+    t38 = c2*s4 - t36*c4
+    t39 = t36*s4 + c2*c4
     t40 = s2*s3
-    t41 = c5*t38 + s5*t40
-    t42 = c5*t40 - s5*t38
-    t43 = c6*t41 + s6*t39
-    t44 = c6*t39 - s6*t41
-    t45 = c7*t43 - s7*t42
-    t46 = c7*t42 + s7*t43
+    t41 = t38*c5 + t40*s5
+    t42 = t40*c5 - t38*s5
+    t43 = t39*s6 + t41*c6
+    t44 = t39*c6 - t41*s6
+    t45 = t43*c7 - t42*s7
+    t46 = t42*c7 + t43*s7
     t47 = 0.088*t43 - 0.21*t44
     t48 = t47 + 0.384*t39
     t49 = t48 - 0.0825*t38
@@ -368,8 +368,8 @@ def fk_jacobian(q):
     t64 = -t15
     t65 = -t29
     t66 = -t44
-    t67 = c1*t50
-    t68 = s1*t50
+    t67 = t50*c1
+    t68 = t50*s1
     T = _stack(xp, [
         t54,  # 0, 0
         t55,  # 0, 1
@@ -391,24 +391,24 @@ def fk_jacobian(q):
     J = _stack(xp, [
         -t35,  # 0, 0
         t67,  # 0, 1
-        s2*t68 - c2*t35,  # 0, 2
-        t34*t40 - t3*t49,  # 0, 3
-        t25*t48 - t33*t39,  # 0, 4
-        t32*t42 - t27*t47,  # 0, 5
+        t68*s2 - t35*c2,  # 0, 2
+        t34*t40 - t49*t3,  # 0, 3
+        t25*t48 - t39*t33,  # 0, 4
+        t42*t32 - t27*t47,  # 0, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 6
         t21,  # 1, 0
         t68,  # 1, 1
-        c2*t21 - s2*t67,  # 1, 2
-        -t20*t40 - t49*t6,  # 1, 3
-        t19*t39 - t11*t48,  # 1, 4
-        -t13*t47 - t18*t42,  # 1, 5
+        t21*c2 - t67*s2,  # 1, 2
+        -(t20*t40 + t49*t6),  # 1, 3
+        t39*t19 - t11*t48,  # 1, 4
+        -(t13*t47 + t42*t18),  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
-        -c1*t21 - s1*t35,  # 2, 1
+        -(t21*c1 + t35*s1),  # 2, 1
         t35*t8 - t21*t22,  # 2, 2
         t20*t3 + t34*t6,  # 2, 3
-        t11*t33 - t19*t25,  # 2, 4
-        t13*t32 + t18*t27,  # 2, 5
+        t11*t33 - t25*t19,  # 2, 4
+        t13*t32 + t27*t18,  # 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
         -s1,  # 3, 1
@@ -436,7 +436,7 @@ def fk_jacobian(q):
 
 
 def jacobian_tool(q):
-    """geometric Jacobian in the tool frame (6 x DOF, rows vx vy vz wx wy wz): (6 x 7), 370 operations."""
+    """geometric Jacobian in the tool frame (6 x DOF, rows vx vy vz wx wy wz): (6 x 7), 349 operations."""
     xp, dtype, device, batch, (q,) = _arguments(("q", q, (7,)))
     trig = _cos_sin(xp, q, (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0), device)
     c1 = trig[..., 0]
@@ -455,52 +455,52 @@ def jacobian_tool(q):
     s7 = trig[..., 13]
     t0 = s1*s3
     t1 = c1*c3
-    t2 = -t0 + c2*t1
-    t3 = t1 - c2*t0
+    t2 = -t0 + t1*c2
+    t3 = t1 - t0*c2
     t4 = c3*s1
     t5 = c1*s3
-    t6 = t4 + c2*t5
-    t7 = t5 + c2*t4
+    t6 = t4 + t5*c2
+    t7 = t5 + t4*c2
     t8 = 0.316*s2
-    t9 = 0.0825*t2 + c1*t8
-    t10 = 0.0825*t7 + s1*t8
+    t9 = 0.0825*t2 + t8*c1
+    t10 = 0.0825*t7 + t8*s1
     t11 = c3*s2
     t12 = 0.316*c2 - 0.0825*t11
-    t13 = c2*s4 - c4*t11
-    t14 = c2*c4 + s4*t11
+    t13 = c2*s4 - t11*c4
+    t14 = t11*s4 + c2*c4
     t15 = c1*s2
-    t16 = c4*t2 + s4*t15
-    t17 = c4*t15 - s4*t2
-    t18 = c5*t16 - s5*t6
-    t19 = c5*t6 + s5*t16
-    t20 = c6*t18 + s6*t17
-    t21 = c6*t17 - s6*t18
-    t22 = c7*t20 + s7*t19
-    t23 = c7*t19 - s7*t20
+    t16 = t2*c4 + t15*s4
+    t17 = t15*c4 - t2*s4
+    t18 = t16*c5 - t6*s5
+    t19 = t16*s5 + t6*c5
+    t20 = t17*s6 + t18*c6
+    t21 = t17*c6 - t18*s6
+    t22 = t19*s7 + t20*c7
+    t23 = t19*c7 - t20*s7
     t24 = 0.088*t20 - 0.21*t21
     t25 = t24 + 0.384*t17
     t26 = t25 - 0.0825*t16
-    t27 = t26 + t9
+    t27 = t9 + t26
     t28 = s1*s2
-    t29 = c4*t7 + s4*t28
-    t30 = c4*t28 - s4*t7
-    t31 = c5*t29 + s5*t3
-    t32 = c5*t3 - s5*t29
-    t33 = c6*t31 + s6*t30
-    t34 = c6*t30 - s6*t31
-    t35 = c7*t33 - s7*t32
-    t36 = c7*t32 + s7*t33
+    t29 = t7*c4 + t28*s4
+    t30 = t28*c4 - t7*s4
+    t31 = t29*c5 + t3*s5
+    t32 = t3*c5 - t29*s5
+    t33 = t30*s6 + t31*c6
+    t34 = t30*c6 - t31*s6
+    t35 = t33*c7 - t32*s7
+    t36 = t32*c7 + t33*s7
     t37 = 0.088*t33 - 0.21*t34
     t38 = t37 + 0.384*t30
     t39 = t38 - 0.0825*t29
     t40 = t10 + t39
     t41 = s2*s3
-    t42 = c5*t13 + s5*t41
-    t43 = c5*t41 - s5*t13
-    t44 = c6*t42 + s6*t14
-    t45 = c6*t14 - s6*t42
-    t46 = c7*t44 - s7*t43
-    t47 = c7*t43 + s7*t44
+    t42 = t13*c5 + t41*s5
+    t43 = t41*c5 - t13*s5
+    t44 = t14*s6 + t42*c6
+    t45 = t14*c6 - t42*s6
+    t46 = t44*c7 - t43*s7
+    t47 = t43*c7 + t44*s7
     t48 = 0.088*t44 - 0.21*t45
     t49 = t48 + 0.384*t14
     t50 = t49 - 0.0825*t13
@@ -508,7 +508,7 @@ def jacobian_tool(q):
     t52 = 0.7071067811865476*t22
     t53 = 0.7071067811865476*t23
     t54 = t52 - t53
-    t55 = t52 + t53
+    t55 = t53 + t52
     t56 = 0.7071067811865476*t35
     t57 = 0.7071067811865476*t36
     t58 = t56 + t57
@@ -517,21 +517,21 @@ def jacobian_tool(q):
     t61 = 0.7071067811865476*t47
     t62 = t60 + t61
     t63 = t60 - t61
-    t64 = c1*t51
-    t65 = s1*t51
-    t66 = -c1*t27 - s1*t40
-    t67 = t28*t51 - c2*t40
-    t68 = c2*t27 - t15*t51
-    t69 = t15*t40 - t27*t28
+    t64 = t51*c1
+    t65 = t51*s1
+    t66 = -(t27*c1 + t40*s1)
+    t67 = t51*t28 - t40*c2
+    t68 = t27*c2 - t51*t15
+    t69 = t40*t15 - t27*t28
     t70 = t26*t3 + t39*t6
-    t71 = t39*t41 - t3*t50
-    t72 = -t26*t41 - t50*t6
+    t71 = t39*t41 - t50*t3
+    t72 = -(t26*t41 + t50*t6)
     t73 = t30*t49 - t14*t38
     t74 = t14*t25 - t17*t49
-    t75 = t17*t38 - t25*t30
-    t76 = t19*t37 + t24*t32
-    t77 = t37*t43 - t32*t48
-    t78 = -t19*t48 - t24*t43
+    t75 = t17*t38 - t30*t25
+    t76 = t19*t37 + t32*t24
+    t77 = t43*t37 - t32*t48
+    t78 = -(t19*t48 + t43*t24)
     J = _stack(xp, [
         t27*t58 - t40*t54,  # 0, 0
         t54*t64 + t58*t65 + t62*t66,  # 0, 1
@@ -547,32 +547,32 @@ def jacobian_tool(q):
         t55*t73 + t59*t74 + t63*t75,  # 1, 4
         t55*t77 + t59*t78 + t63*t76,  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 6
-        t21*t40 - t27*t34,  # 2, 0
-        -t21*t64 - t34*t65 - t45*t66,  # 2, 1
-        -t21*t67 - t34*t68 - t45*t69,  # 2, 2
-        -t21*t71 - t34*t72 - t45*t70,  # 2, 3
-        -t21*t73 - t34*t74 - t45*t75,  # 2, 4
-        -t21*t77 - t34*t78 - t45*t76,  # 2, 5
+        t21*t40 - t34*t27,  # 2, 0
+        -(t21*t64 + t34*t65 + t45*t66),  # 2, 1
+        -(t21*t67 + t34*t68 + t45*t69),  # 2, 2
+        -(t21*t71 + t34*t72 + t45*t70),  # 2, 3
+        -(t21*t73 + t34*t74 + t45*t75),  # 2, 4
+        -(t21*t77 + t34*t78 + t45*t76),  # 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 6
         t62,  # 3, 0
-        c1*t58 - s1*t54,  # 3, 1
-        c2*t62 + t15*t54 + t28*t58,  # 3, 2
-        t54*t6 - t3*t58 - t41*t62,  # 3, 3
-        t14*t62 + t17*t54 + t30*t58,  # 3, 4
-        t19*t54 - t32*t58 - t43*t62,  # 3, 5
-        -t21*t54 - t34*t58 - t45*t62,  # 3, 6
+        t58*c1 - t54*s1,  # 3, 1
+        t54*t15 + t58*t28 + t62*c2,  # 3, 2
+        -(t58*t3 + t62*t41 - t6*t54),  # 3, 3
+        t17*t54 + t30*t58 + t14*t62,  # 3, 4
+        -(t32*t58 + t43*t62 - t19*t54),  # 3, 5
+        -(t21*t54 + t34*t58 + t45*t62),  # 3, 6
         t63,  # 4, 0
-        c1*t59 - s1*t55,  # 4, 1
-        c2*t63 + t15*t55 + t28*t59,  # 4, 2
-        t55*t6 - t3*t59 - t41*t63,  # 4, 3
-        t14*t63 + t17*t55 + t30*t59,  # 4, 4
-        t19*t55 - t32*t59 - t43*t63,  # 4, 5
-        -t21*t55 - t34*t59 - t45*t63,  # 4, 6
+        t59*c1 - t55*s1,  # 4, 1
+        t55*t15 + t59*t28 + t63*c2,  # 4, 2
+        -(t59*t3 + t63*t41 - t6*t55),  # 4, 3
+        t17*t55 + t30*t59 + t14*t63,  # 4, 4
+        -(t32*t59 + t43*t63 - t19*t55),  # 4, 5
+        -(t21*t55 + t34*t59 + t45*t63),  # 4, 6
         -t45,  # 5, 0
-        s1*t21 - c1*t34,  # 5, 1
-        -c2*t45 - t15*t21 - t28*t34,  # 5, 2
-        t3*t34 + t41*t45 - t21*t6,  # 5, 3
-        -t14*t45 - t17*t21 - t30*t34,  # 5, 4
+        t21*s1 - t34*c1,  # 5, 1
+        -(t21*t15 + t34*t28 + t45*c2),  # 5, 2
+        t34*t3 + t45*t41 - t21*t6,  # 5, 3
+        -(t17*t21 + t30*t34 + t14*t45),  # 5, 4
         t32*t34 + t43*t45 - t19*t21,  # 5, 5
         t21**2 + t34**2 + t45**2,  # 5, 6
     ], (6, 7))
@@ -599,54 +599,54 @@ def task(q):
     s7 = trig[..., 13]
     t0 = s1*s3
     t1 = c1*c3
-    t2 = -t0 + c2*t1
-    t3 = t1 - c2*t0
+    t2 = -t0 + t1*c2
+    t3 = t1 - t0*c2
     t4 = c3*s1
     t5 = c1*s3
-    t6 = t4 + c2*t5
-    t7 = t5 + c2*t4
+    t6 = t4 + t5*c2
+    t7 = t5 + t4*c2
     t8 = 0.316*s2
-    t9 = 0.0825*t2 + c1*t8
-    t10 = 0.0825*t7 + s1*t8
+    t9 = 0.0825*t2 + t8*c1
+    t10 = 0.0825*t7 + t8*s1
     t11 = c3*s2
     t12 = 0.316*c2 - 0.0825*t11
-    t13 = c2*s4 - c4*t11
-    t14 = c2*c4 + s4*t11
+    t13 = c2*s4 - t11*c4
+    t14 = t11*s4 + c2*c4
     t15 = c1*s2
-    t16 = c4*t2 + s4*t15
-    t17 = c4*t15 - s4*t2
-    t18 = c5*t16 - s5*t6
-    t19 = c5*t6 + s5*t16
-    t20 = c6*t18 + s6*t17
-    t21 = c6*t17 - s6*t18
-    t22 = c7*t20 + s7*t19
-    t23 = c7*t19 - s7*t20
+    t16 = t2*c4 + t15*s4
+    t17 = t15*c4 - t2*s4
+    t18 = t16*c5 - t6*s5
+    t19 = t16*s5 + t6*c5
+    t20 = t17*s6 + t18*c6
+    t21 = t17*c6 - t18*s6
+    t22 = t19*s7 + t20*c7
+    t23 = t19*c7 - t20*s7
     t24 = 0.088*t20 - 0.21*t21
     t25 = t24 + 0.384*t17
     t26 = t25 - 0.0825*t16
-    t27 = t26 + t9
+    t27 = t9 + t26
     t28 = 0.7071067811865476*t22 - 0.7071067811865476*t23
     t29 = s1*s2
-    t30 = c4*t7 + s4*t29
-    t31 = c4*t29 - s4*t7
-    t32 = c5*t30 + s5*t3
-    t33 = c5*t3 - s5*t30
-    t34 = c6*t32 + s6*t31
-    t35 = c6*t31 - s6*t32
-    t36 = c7*t34 - s7*t33
-    t37 = c7*t33 + s7*t34
+    t30 = t7*c4 + t29*s4
+    t31 = t29*c4 - t7*s4
+    t32 = t30*c5 + t3*s5
+    t33 = t3*c5 - t30*s5
+    t34 = t31*s6 + t32*c6
+    t35 = t31*c6 - t32*s6
+    t36 = t34*c7 - t33*s7
+    t37 = t33*c7 + t34*s7
     t38 = 0.088*t34 - 0.21*t35
     t39 = t38 + 0.384*t31
     t40 = t39 - 0.0825*t30
     t41 = t10 + t40
     t42 = 0.7071067811865476*t36 + 0.7071067811865476*t37
     t43 = s2*s3
-    t44 = c5*t13 + s5*t43
-    t45 = c5*t43 - s5*t13
-    t46 = c6*t44 + s6*t14
-    t47 = c6*t14 - s6*t44
-    t48 = c7*t46 - s7*t45
-    t49 = c7*t45 + s7*t46
+    t44 = t13*c5 + t43*s5
+    t45 = t43*c5 - t13*s5
+    t46 = t14*s6 + t44*c6
+    t47 = t14*c6 - t44*s6
+    t48 = t46*c7 - t45*s7
+    t49 = t45*c7 + t46*s7
     t50 = 0.088*t46 - 0.21*t47
     t51 = t50 + 0.384*t14
     t52 = t51 - 0.0825*t13
@@ -654,7 +654,7 @@ def task(q):
     t54 = 0.333 + t53
     t55 = 0.7071067811865476*t48
     t56 = 0.7071067811865476*t49
-    t57 = t55 + t56
+    t57 = t56 + t55
     t58 = t55 - t56
     mu = _stack(xp, [
         t27,  # 0
@@ -668,7 +668,7 @@ def task(q):
 
 
 def task_jacobian(q):
-    """analytic Jacobian d mu / d q (6 x DOF): (6 x 7), 263 operations."""
+    """analytic Jacobian d mu / d q (6 x DOF): (6 x 7), 257 operations."""
     xp, dtype, device, batch, (q,) = _arguments(("q", q, (7,)))
     trig = _cos_sin(xp, q, (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0), device)
     c1 = trig[..., 0]
@@ -687,70 +687,70 @@ def task_jacobian(q):
     s7 = trig[..., 13]
     t0 = s1*s3
     t1 = c1*c3
-    t2 = -t0 + c2*t1
-    t3 = t1 - c2*t0
+    t2 = -t0 + t1*c2
+    t3 = t1 - t0*c2
     t4 = c3*s1
     t5 = c1*s3
-    t6 = t4 + c2*t5
-    t7 = t5 + c2*t4
+    t6 = t4 + t5*c2
+    t7 = t5 + t4*c2
     t8 = 0.316*s2
-    t9 = 0.0825*t2 + c1*t8
-    t10 = 0.0825*t7 + s1*t8
+    t9 = 0.0825*t2 + t8*c1
+    t10 = 0.0825*t7 + t8*s1
     t11 = c3*s2
     t12 = 0.316*c2 - 0.0825*t11
-    t13 = c2*s4 - c4*t11
-    t14 = c2*c4 + s4*t11
+    t13 = c2*s4 - t11*c4
+    t14 = t11*s4 + c2*c4
     t15 = c1*s2
-    t16 = c4*t2 + s4*t15
-    t17 = c4*t15 - s4*t2
-    t18 = c5*t16 - s5*t6
-    t19 = c5*t6 + s5*t16
-    t20 = c6*t18 + s6*t17
-    t21 = c6*t17 - s6*t18
-    t22 = c7*t20 + s7*t19
-    t23 = c7*t19 - s7*t20
+    t16 = t2*c4 + t15*s4
+    t17 = t15*c4 - t2*s4
+    t18 = t16*c5 - t6*s5
+    t19 = t16*s5 + t6*c5
+    t20 = t17*s6 + t18*c6
+    t21 = t17*c6 - t18*s6
+    t22 = t19*s7 + t20*c7
+    t23 = t19*c7 - t20*s7
     t24 = 0.088*t20 - 0.21*t21
     t25 = t24 + 0.384*t17
     t26 = t25 - 0.0825*t16
-    t27 = t26 + t9
+    t27 = t9 + t26
     t28 = 0.7071067811865476*t22 - 0.7071067811865476*t23
     t29 = s1*s2
-    t30 = c4*t7 + s4*t29
-    t31 = c4*t29 - s4*t7
-    t32 = c5*t30 + s5*t3
-    t33 = c5*t3 - s5*t30
-    t34 = c6*t32 + s6*t31
-    t35 = c6*t31 - s6*t32
-    t36 = c7*t34 - s7*t33
-    t37 = c7*t33 + s7*t34
+    t30 = t7*c4 + t29*s4
+    t31 = t29*c4 - t7*s4
+    t32 = t30*c5 + t3*s5
+    t33 = t3*c5 - t30*s5
+    t34 = t31*s6 + t32*c6
+    t35 = t31*c6 - t32*s6
+    t36 = t34*c7 - t33*s7
+    t37 = t33*c7 + t34*s7
     t38 = 0.088*t34 - 0.21*t35
     t39 = t38 + 0.384*t31
     t40 = t39 - 0.0825*t30
     t41 = t10 + t40
     t42 = 0.7071067811865476*t36 + 0.7071067811865476*t37
     t43 = s2*s3
-    t44 = c5*t13 + s5*t43
-    t45 = c5*t43 - s5*t13
-    t46 = c6*t44 + s6*t14
-    t47 = c6*t14 - s6*t44
-    t48 = c7*t46 - s7*t45
-    t49 = c7*t45 + s7*t46
+    t44 = t13*c5 + t43*s5
+    t45 = t43*c5 - t13*s5
+    t46 = t14*s6 + t44*c6
+    t47 = t14*c6 - t44*s6
+    t48 = t46*c7 - t45*s7
+    t49 = t45*c7 + t46*s7
     t50 = 0.088*t46 - 0.21*t47
     t51 = t50 + 0.384*t14
     t52 = t51 - 0.0825*t13
     t53 = t12 + t52
     t54 = 0.7071067811865476*t48 + 0.7071067811865476*t49
-    t55 = c1*t53
-    t56 = s1*t53
-    t57 = c1*t42
-    t58 = s1*t28
+    t55 = t53*c1
+    t56 = t53*s1
+    t57 = t42*c1
+    t58 = t28*s1
     t59 = t28**2 + t42**2
-    t60 = t59**(-1.0)
+    t60 = 1/t59
     t61 = t60*(t57 - t58)
-    t62 = c1*t28
-    t63 = s1*t42
-    t64 = t60*(s2*t62 + s2*t63)
-    t65 = t60*(t28*t6 - t3*t42)
+    t62 = t28*c1
+    t63 = t42*s1
+    t64 = t60*(t62*s2 + t63*s2)
+    t65 = t60*(t6*t28 - t42*t3)
     t66 = t60*(t17*t28 + t31*t42)
     t67 = t60*(t19*t28 - t33*t42)
     t68 = -t60*(t21*t28 + t35*t42)
@@ -758,24 +758,24 @@ def task_jacobian(q):
     J = _stack(xp, [
         -t41,  # 0, 0
         t55,  # 0, 1
-        s2*t56 - c2*t41,  # 0, 2
-        t40*t43 - t3*t52,  # 0, 3
+        t56*s2 - t41*c2,  # 0, 2
+        t40*t43 - t52*t3,  # 0, 3
         t31*t51 - t14*t39,  # 0, 4
-        t38*t45 - t33*t50,  # 0, 5
+        t45*t38 - t33*t50,  # 0, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 6
         t27,  # 1, 0
         t56,  # 1, 1
-        c2*t27 - s2*t55,  # 1, 2
-        -t26*t43 - t52*t6,  # 1, 3
+        t27*c2 - t55*s2,  # 1, 2
+        -(t26*t43 + t52*t6),  # 1, 3
         t14*t25 - t17*t51,  # 1, 4
-        -t19*t50 - t24*t45,  # 1, 5
+        -(t19*t50 + t45*t24),  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
-        -c1*t27 - s1*t41,  # 2, 1
-        t15*t41 - t27*t29,  # 2, 2
+        -(t27*c1 + t41*s1),  # 2, 1
+        t41*t15 - t27*t29,  # 2, 2
         t26*t3 + t40*t6,  # 2, 3
-        t17*t39 - t25*t31,  # 2, 4
-        t19*t38 + t24*t33,  # 2, 5
+        t17*t39 - t31*t25,  # 2, 4
+        t19*t38 + t33*t24,  # 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
         t61,  # 3, 1
@@ -786,18 +786,18 @@ def task_jacobian(q):
         t68,  # 3, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
         t69*(t62 + t63),  # 4, 1
-        t69*(s2*t58 - s2*t57),  # 4, 2
-        -t69*(t28*t3 + t42*t6),  # 4, 3
-        t69*(t28*t31 - t17*t42),  # 4, 4
-        -t69*(t19*t42 + t28*t33),  # 4, 5
-        t69*(t21*t42 - t28*t35),  # 4, 6
+        t69*(t58*s2 - t57*s2),  # 4, 2
+        -t69*(t6*t42 + t28*t3),  # 4, 3
+        t69*(t31*t28 - t17*t42),  # 4, 4
+        -t69*(t19*t42 + t33*t28),  # 4, 5
+        t69*(t21*t42 - t35*t28),  # 4, 6
         xp.full(batch, 1, dtype=dtype, device=device),  # 5, 0
         -t54*t61,  # 5, 1
         c2 - t54*t64,  # 5, 2
-        -t43 - t54*t65,  # 5, 3
+        -(t43 + t54*t65),  # 5, 3
         t14 - t54*t66,  # 5, 4
-        -t45 - t54*t67,  # 5, 5
-        -t47 - t54*t68,  # 5, 6
+        -(t45 + t54*t67),  # 5, 5
+        -(t47 + t54*t68),  # 5, 6
     ], (6, 7))
     return J
 
@@ -830,58 +830,58 @@ def fk_jacobian_dot(q, q_dot):
     t0 = qd1 + c2*qd3
     t1 = s1*s3
     t2 = c1*c3
-    t3 = -t1 + c2*t2
-    t4 = t2 - c2*t1
+    t3 = -t1 + t2*c2
+    t4 = t2 - t1*c2
     t5 = c3*s1
     t6 = c1*s3
-    t7 = t5 + c2*t6
-    t8 = t6 + c2*t5
+    t7 = t5 + t6*c2
+    t8 = t6 + t5*c2
     t9 = c1*s2
     t10 = 0.316*t9 + 0.0825*t3
-    t11 = c4*t3 + s4*t9
-    t12 = c4*t9 - s4*t3
-    t13 = c5*t11 - s5*t7
-    t14 = c5*t7 + s5*t11
-    t15 = c6*t13 + s6*t12
-    t16 = c6*t12 - s6*t13
-    t17 = c7*t15 + s7*t14
-    t18 = c7*t14 - s7*t15
+    t11 = t3*c4 + t9*s4
+    t12 = t9*c4 - t3*s4
+    t13 = t11*c5 - t7*s5
+    t14 = t11*s5 + t7*c5
+    t15 = t12*s6 + t13*c6
+    t16 = t12*c6 - t13*s6
+    t17 = t14*s7 + t15*c7
+    t18 = t14*c7 - t15*s7
     t19 = 0.088*t15 - 0.21*t16
     t20 = t19 + 0.384*t12
     t21 = t20 - 0.0825*t11
     t22 = t10 + t21
     t23 = s1*s2
     t24 = 0.316*t23 + 0.0825*t8
-    t25 = c4*t8 + s4*t23
-    t26 = c4*t23 - s4*t8
-    t27 = c5*t25 + s5*t4
-    t28 = c5*t4 - s5*t25
-    t29 = c6*t27 + s6*t26
-    t30 = c6*t26 - s6*t27
-    t31 = c7*t29 - s7*t28
-    t32 = c7*t28 + s7*t29
+    t25 = t8*c4 + t23*s4
+    t26 = t23*c4 - t8*s4
+    t27 = t25*c5 + t4*s5
+    t28 = t4*c5 - t25*s5
+    t29 = t26*s6 + t27*c6
+    t30 = t26*c6 - t27*s6
+    t31 = t29*c7 - t28*s7
+    t32 = t28*c7 + t29*s7
     t33 = 0.088*t29 - 0.21*t30
     t34 = t33 + 0.384*t26
     t35 = t34 - 0.0825*t25
     t36 = t24 + t35
     t37 = c3*s2
     t38 = 0.316*c2 - 0.0825*t37
-    t39 = c2*s4 - c4*t37
-    t40 = c2*c4 + s4*t37
+    t39 = c2*s4 - t37*c4
+    t40 = t37*s4 + c2*c4
     t41 = s2*s3
-    t42 = c5*t39 + s5*t41
-    t43 = c5*t41 - s5*t39
-    t44 = c6*t42 + s6*t40
-    t45 = c6*t40 - s6*t42
-    t46 = c7*t44 - s7*t43
-    t47 = c7*t43 + s7*t44
+    t42 = t39*c5 + t41*s5
+    t43 = t41*c5 - t39*s5
+    t44 = t40*s6 + t42*c6
+    t45 = t40*c6 - t42*s6
+    t46 = t44*c7 - t43*s7
+    t47 = t43*c7 + t44*s7
     t48 = 0.088*t44 - 0.21*t45
     t49 = t48 + 0.384*t40
     t50 = t49 - 0.0825*t39
     t51 = t38 + t50
     t52 = 0.333 + t51
-    t53 = t0 - qd4*t41
-    t54 = t53 + qd5*t40
+    t53 = t0 - t41*qd4
+    t54 = t53 + t40*qd5
     t55 = 0.7071067811865476*t17
     t56 = 0.7071067811865476*t18
     t57 = t55 - t56
@@ -894,61 +894,61 @@ def fk_jacobian_dot(q, q_dot):
     t64 = 0.7071067811865476*t47
     t65 = t63 + t64
     t66 = t63 - t64
-    t67 = s1*t51
-    t68 = s2*t67 - c2*t36
+    t67 = t51*s1
+    t68 = t67*s2 - t36*c2
     t69 = t68
-    t70 = t35*t41 - t4*t50
+    t70 = t35*t41 - t50*t4
     t71 = t70
-    t72 = t26*t49 - t34*t40
+    t72 = t26*t49 - t40*t34
     t73 = t72
-    t74 = t33*t43 - t28*t48
+    t74 = t43*t33 - t28*t48
     t75 = t74
-    t76 = qd5*t73 + qd6*t75
-    t77 = t76 + qd4*t71
-    t78 = t77 + qd3*t69
-    t79 = c1*t51
-    t80 = c2*t22 - s2*t79
+    t76 = t73*qd5 + t75*qd6
+    t77 = t76 + t71*qd4
+    t78 = t77 + t69*qd3
+    t79 = t51*c1
+    t80 = t22*c2 - t79*s2
     t81 = t80
     t82 = t21*t41 + t50*t7
     t83 = t82
-    t84 = t20*t40 - t12*t49
+    t84 = t40*t20 - t12*t49
     t85 = t84
-    t86 = t14*t48 + t19*t43
+    t86 = t14*t48 + t43*t19
     t87 = t86
-    t88 = qd5*t85 - qd6*t87
-    t89 = t88 - qd4*t83
-    t90 = t89 + qd3*t81
-    t91 = c1*t22 + s1*t36
+    t88 = t85*qd5 - t87*qd6
+    t89 = t88 - t83*qd4
+    t90 = t89 + t81*qd3
+    t91 = t22*c1 + t36*s1
     t92 = t91
     t93 = t36*t9 - t22*t23
     t94 = t93
     t95 = t21*t4 + t35*t7
     t96 = t95
-    t97 = t12*t34 - t20*t26
+    t97 = t12*t34 - t26*t20
     t98 = t97
-    t99 = t14*t33 + t19*t28
+    t99 = t14*t33 + t28*t19
     t100 = t99
-    t101 = qd5*t98 + qd6*t100
-    t102 = t101 + qd4*t96
-    t103 = t102 + qd3*t94
-    t104 = t103 - qd2*t92
+    t101 = t98*qd5 + t100*qd6
+    t102 = t101 + t96*qd4
+    t103 = t102 + t94*qd3
+    t104 = t103 - t92*qd2
     t105 = qd2*s1
-    t106 = -t105 + qd3*t9
-    t107 = t106 + qd4*t7
-    t108 = t107 + qd5*t12
-    t109 = t90 + t105*t51
-    t110 = t109 + qd1*t22
+    t106 = -t105 + t9*qd3
+    t107 = t106 + t7*qd4
+    t108 = t107 + t12*qd5
+    t109 = t90 + t51*t105
+    t110 = t109 + t22*qd1
     t111 = c1*qd2
-    t112 = t111 + qd3*t23
-    t113 = t112 - qd4*t4
-    t114 = t113 + qd5*t26
-    t115 = t78 + t111*t51
-    t116 = t115 - qd1*t36
-    t117 = qd6*t14
+    t112 = t111 + t23*qd3
+    t113 = t112 - t4*qd4
+    t114 = t113 + t26*qd5
+    t115 = t78 + t51*t111
+    t116 = t115 - t36*qd1
+    t117 = t14*qd6
     t118 = t108 + t117
-    t119 = qd6*t28
+    t119 = t28*qd6
     t120 = t114 - t119
-    t121 = qd6*t43
+    t121 = t43*qd6
     t122 = t54 - t121
     t123 = -t16
     t124 = -t30
@@ -1017,18 +1017,18 @@ def fk_jacobian_dot(q, q_dot):
         xp.broadcast_to(t125, batch),  # 5, 6
     ], (6, 7))
     a = _stack(xp, [
-        xp.broadcast_to(qd2*(c1*t104 - qd1*t67) + qd3*(t103*t23 + t111*t94 - c2*t90 - qd1*t81) + qd4*(t0*t83 + t112*t96 + t41*t89 - t102*t4) + qd5*(t101*t26 + t113*t98 - t40*t88 - t53*t85) + qd6*(t100*t114 + t54*t87 - t100*t119 - t121*t87) - qd1*t110, batch),  # 0
-        xp.broadcast_to(qd1*t116 + qd2*(qd1*t79 + s1*t104) + qd3*(c2*t78 + qd1*t69 + t105*t94 - t103*t9) + qd5*(t40*t76 + t53*t73 - t101*t12 - t107*t98) - qd4*(t102*t7 + t106*t96 + t41*t77 - t0*t71) - qd6*(t100*t108 + t100*t117 + t121*t75 - t54*t75), batch),  # 1
-        xp.broadcast_to(qd4*(t4*t77 + t7*t89 - t106*t83 - t112*t71) + qd5*(t107*t85 + t12*t88 - t113*t73 - t26*t76) - qd2*(c1*t115 + s1*t109) - qd3*(t105*t81 + t111*t69 + t23*t78 - c1*s2*t90) - qd6*(t108*t87 + t114*t75 + t117*t87 - qd6*t28*t75), batch),  # 2
-        xp.broadcast_to(qd3*(c2*t111 - qd1*t23) + qd4*(t0*t4 - t112*t41) + qd5*(t113*t40 - t26*t53) + qd6*(t28*t54 - t114*t43) + qd7*(t122*t30 - t120*t45) - qd1*t111, batch),  # 3
-        xp.broadcast_to(qd3*(c2*t105 + qd1*t9) + qd4*(t0*t7 + t106*t41) + qd5*(t12*t53 - t107*t40) + qd6*(t108*t43 + t14*t54) + qd7*(t118*t45 - t122*t16) - qd1*t105, batch),  # 4
-        xp.broadcast_to(qd5*(t107*t26 - t113*t12) + qd7*(t120*t16 - t118*t30) - qd3*(t126*c1**2 + t126*s1**2) - qd4*(t106*t4 + t112*t7) - qd6*(t108*t28 + t114*t14), batch),  # 5
+        xp.broadcast_to(qd2*(t104*c1 - t67*qd1) + qd3*(t103*t23 + t94*t111 - t90*c2 - t81*qd1) + qd4*(t89*t41 + t83*t0 + t96*t112 - t102*t4) + qd5*(t101*t26 + t98*t113 - t88*t40 - t85*t53) + qd6*(t87*t54 + t100*t114 - t87*t121 - t100*t119) - t110*qd1, batch),  # 0
+        xp.broadcast_to(t116*qd1 + qd2*(t104*s1 + t79*qd1) + qd3*(t78*c2 + t69*qd1 + t94*t105 - t103*t9) + qd5*(t76*t40 + t73*t53 - t101*t12 - t98*t107) - qd4*(t77*t41 + t102*t7 + t96*t106 - t71*t0) - qd6*(t75*t121 + t100*t108 + t100*t117 - t75*t54), batch),  # 1
+        xp.broadcast_to(qd4*(t77*t4 + t89*t7 - t71*t112 - t83*t106) + qd5*(t88*t12 + t85*t107 - t76*t26 - t73*t113) - qd2*(t115*c1 + t109*s1) - qd3*(t78*t23 + t69*t111 + t81*t105 - t90*c1*s2) - qd6*(t75*t114 + t87*t108 + t87*t117 - t28*t75*qd6), batch),  # 2
+        xp.broadcast_to(qd3*(t111*c2 - t23*qd1) + qd4*(t4*t0 - t112*t41) + qd5*(t40*t113 - t26*t53) + qd6*(t28*t54 - t43*t114) + qd7*(t122*t30 - t120*t45) - t111*qd1, batch),  # 3
+        xp.broadcast_to(qd3*(t105*c2 + t9*qd1) + qd4*(t7*t0 + t106*t41) + qd5*(t12*t53 - t40*t107) + qd6*(t14*t54 + t43*t108) + qd7*(t45*t118 - t122*t16) - t105*qd1, batch),  # 4
+        xp.broadcast_to(qd5*(t26*t107 - t12*t113) + qd7*(t120*t16 - t30*t118) - qd3*(t126*c1**2 + t126*s1**2) - qd4*(t7*t112 + t4*t106) - qd6*(t14*t114 + t28*t108), batch),  # 5
     ], (6,))
     return T, J, a
 
 
 def jacobian_dot(q, q_dot):
-    """time derivative dJ/dt of the world geometric Jacobian along q_dot (6 x DOF): (6 x 7), 364 operations."""
+    """time derivative dJ/dt of the world geometric Jacobian along q_dot (6 x DOF): (6 x 7), 356 operations."""
     xp, dtype, device, batch, (q, q_dot,) = _arguments(("q", q, (7,)), ("q_dot", q_dot, (7,)))
     qd1 = q_dot[..., 0]
     qd2 = q_dot[..., 1]
@@ -1052,139 +1052,139 @@ def jacobian_dot(q, q_dot):
     t0 = qd1 + c2*qd3
     t1 = s1*s3
     t2 = c1*c3
-    t3 = -t1 + c2*t2
-    t4 = t2 - c2*t1
+    t3 = -t1 + t2*c2
+    t4 = t2 - t1*c2
     t5 = c3*s1
     t6 = c1*s3
-    t7 = t5 + c2*t6
-    t8 = t6 + c2*t5
+    t7 = t5 + t6*c2
+    t8 = t6 + t5*c2
     t9 = 0.316*s2
-    t10 = 0.0825*t3 + c1*t9
-    t11 = 0.0825*t8 + s1*t9
+    t10 = 0.0825*t3 + t9*c1
+    t11 = 0.0825*t8 + t9*s1
     t12 = c3*s2
     t13 = 0.316*c2 - 0.0825*t12
-    t14 = c2*s4 - c4*t12
-    t15 = c2*c4 + s4*t12
+    t14 = c2*s4 - t12*c4
+    t15 = t12*s4 + c2*c4
     t16 = c1*s2
-    t17 = c4*t3 + s4*t16
-    t18 = c4*t16 - s4*t3
-    t19 = c5*t17 - s5*t7
-    t20 = c5*t7 + s5*t17
-    t21 = c6*t19 + s6*t18
-    t22 = c6*t18 - s6*t19
+    t17 = t3*c4 + t16*s4
+    t18 = t16*c4 - t3*s4
+    t19 = t17*c5 - t7*s5
+    t20 = t17*s5 + t7*c5
+    t21 = t18*s6 + t19*c6
+    t22 = t18*c6 - t19*s6
     t23 = 0.088*t21 - 0.21*t22
     t24 = t23 + 0.384*t18
     t25 = t24 - 0.0825*t17
     t26 = t10 + t25
     t27 = s1*s2
-    t28 = c4*t8 + s4*t27
-    t29 = c4*t27 - s4*t8
-    t30 = c5*t28 + s5*t4
-    t31 = c5*t4 - s5*t28
-    t32 = c6*t30 + s6*t29
-    t33 = c6*t29 - s6*t30
+    t28 = t8*c4 + t27*s4
+    t29 = t27*c4 - t8*s4
+    t30 = t28*c5 + t4*s5
+    t31 = t4*c5 - t28*s5
+    t32 = t29*s6 + t30*c6
+    t33 = t29*c6 - t30*s6
     t34 = 0.088*t32 - 0.21*t33
     t35 = t34 + 0.384*t29
     t36 = t35 - 0.0825*t28
     t37 = t11 + t36
-    t38 = c1*t26 + s1*t37
-    t39 = t16*t37 - t26*t27
+    t38 = t26*c1 + t37*s1
+    t39 = t37*t16 - t26*t27
     t40 = t25*t4 + t36*t7
-    t41 = t18*t35 - t24*t29
-    t42 = t20*t34 + t23*t31
-    t43 = qd5*t41 + qd6*t42
-    t44 = t43 + qd4*t40
-    t45 = t44 + qd3*t39
-    t46 = t45 - qd2*t38
+    t41 = t18*t35 - t29*t24
+    t42 = t20*t34 + t31*t23
+    t43 = t41*qd5 + t42*qd6
+    t44 = t43 + t40*qd4
+    t45 = t44 + t39*qd3
+    t46 = t45 - t38*qd2
     t47 = s2*s3
-    t48 = c5*t14 + s5*t47
-    t49 = c5*t47 - s5*t14
-    t50 = c6*t48 + s6*t15
-    t51 = c6*t15 - s6*t48
+    t48 = t14*c5 + t47*s5
+    t49 = t47*c5 - t14*s5
+    t50 = t15*s6 + t48*c6
+    t51 = t15*c6 - t48*s6
     t52 = 0.088*t50 - 0.21*t51
     t53 = t52 + 0.384*t15
     t54 = t53 - 0.0825*t14
     t55 = t13 + t54
-    t56 = t27*t55 - c2*t37
-    t57 = t36*t47 - t4*t54
+    t56 = t55*t27 - t37*c2
+    t57 = t36*t47 - t54*t4
     t58 = t29*t53 - t15*t35
-    t59 = t34*t49 - t31*t52
-    t60 = c2*t26 - t16*t55
+    t59 = t49*t34 - t31*t52
+    t60 = t26*c2 - t55*t16
     t61 = t25*t47 + t54*t7
     t62 = t15*t24 - t18*t53
-    t63 = t20*t52 + t23*t49
-    t64 = t0 - qd4*t47
-    t65 = t64 + qd5*t15
-    t66 = qd5*t58 + qd6*t59
-    t67 = qd5*t62 - qd6*t63
-    t68 = t66 + qd4*t57
-    t69 = t67 - qd4*t61
-    t70 = t68 + qd3*t56
-    t71 = t69 + qd3*t60
+    t63 = t20*t52 + t49*t23
+    t64 = t0 - t47*qd4
+    t65 = t64 + t15*qd5
+    t66 = t58*qd5 + t59*qd6
+    t67 = t62*qd5 - t63*qd6
+    t68 = t66 + t57*qd4
+    t69 = t67 - t61*qd4
+    t70 = t68 + t56*qd3
+    t71 = t69 + t60*qd3
     t72 = qd2*s1
-    t73 = -t72 + qd3*t16
-    t74 = t73 + qd4*t7
-    t75 = t74 + qd5*t18
+    t73 = -t72 + t16*qd3
+    t74 = t73 + t7*qd4
+    t75 = t74 + t18*qd5
     t76 = t71 + t55*t72
-    t77 = t76 + qd1*t26
+    t77 = t76 + t26*qd1
     t78 = c1*qd2
-    t79 = t78 + qd3*t27
-    t80 = t79 - qd4*t4
-    t81 = t80 + qd5*t29
+    t79 = t78 + t27*qd3
+    t80 = t79 - t4*qd4
+    t81 = t80 + t29*qd5
     t82 = t70 + t55*t78
-    t83 = t82 - qd1*t37
-    t84 = qd6*t20
+    t83 = t82 - t37*qd1
+    t84 = t20*qd6
     t85 = t75 + t84
-    t86 = qd6*t31
+    t86 = t31*qd6
     t87 = t81 - t86
-    t88 = qd6*t49
+    t88 = t49*qd6
     t89 = t65 - t88
     t90 = qd1*s1
     t91 = c1*qd1
     t92 = qd2*s2
     Jd = _stack(xp, [
         xp.broadcast_to(-t77, batch),  # 0, 0
-        xp.broadcast_to(c1*t46 - t55*t90, batch),  # 0, 1
-        xp.broadcast_to(t27*t45 + t39*t78 - c2*t71 - qd1*t60, batch),  # 0, 2
-        xp.broadcast_to(t0*t61 + t40*t79 + t47*t69 - t4*t44, batch),  # 0, 3
-        xp.broadcast_to(t29*t43 + t41*t80 - t15*t67 - t62*t64, batch),  # 0, 4
-        xp.broadcast_to(t42*t81 + t63*t65 - t42*t86 - t63*t88, batch),  # 0, 5
+        xp.broadcast_to(t46*c1 - t55*t90, batch),  # 0, 1
+        xp.broadcast_to(t45*t27 + t39*t78 - t71*c2 - t60*qd1, batch),  # 0, 2
+        xp.broadcast_to(t69*t47 + t61*t0 + t40*t79 - t44*t4, batch),  # 0, 3
+        xp.broadcast_to(t43*t29 + t41*t80 - t67*t15 - t62*t64, batch),  # 0, 4
+        xp.broadcast_to(t63*t65 + t42*t81 - t63*t88 - t42*t86, batch),  # 0, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 6
         xp.broadcast_to(t83, batch),  # 1, 0
-        xp.broadcast_to(s1*t46 + t55*t91, batch),  # 1, 1
-        xp.broadcast_to(c2*t70 + qd1*t56 + t39*t72 - t16*t45, batch),  # 1, 2
-        xp.broadcast_to(t0*t57 - t40*t73 - t44*t7 - t47*t68, batch),  # 1, 3
-        xp.broadcast_to(t15*t66 + t58*t64 - t18*t43 - t41*t74, batch),  # 1, 4
-        xp.broadcast_to(t59*t65 - t42*t75 - t42*t84 - t59*t88, batch),  # 1, 5
+        xp.broadcast_to(t46*s1 + t55*t91, batch),  # 1, 1
+        xp.broadcast_to(t70*c2 + t56*qd1 + t39*t72 - t45*t16, batch),  # 1, 2
+        xp.broadcast_to(-(t68*t47 + t44*t7 + t40*t73 - t57*t0), batch),  # 1, 3
+        xp.broadcast_to(t66*t15 + t58*t64 - t43*t18 - t41*t74, batch),  # 1, 4
+        xp.broadcast_to(-(t59*t88 + t42*t75 + t42*t84 - t59*t65), batch),  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
-        xp.broadcast_to(-c1*t82 - s1*t76, batch),  # 2, 1
-        xp.broadcast_to(-t27*t70 - t56*t78 - t60*t72 + c1*s2*t71, batch),  # 2, 2
-        xp.broadcast_to(t4*t68 + t69*t7 - t57*t79 - t61*t73, batch),  # 2, 3
-        xp.broadcast_to(t18*t67 + t62*t74 - t29*t66 - t58*t80, batch),  # 2, 4
-        xp.broadcast_to(-t59*t81 - t63*t75 - t63*t84 + qd6*t31*t59, batch),  # 2, 5
+        xp.broadcast_to(-(t82*c1 + t76*s1), batch),  # 2, 1
+        xp.broadcast_to(-(t70*t27 + t56*t78 + t60*t72 - t71*c1*s2), batch),  # 2, 2
+        xp.broadcast_to(t68*t4 + t69*t7 - t57*t79 - t61*t73, batch),  # 2, 3
+        xp.broadcast_to(t67*t18 + t62*t74 - t66*t29 - t58*t80, batch),  # 2, 4
+        xp.broadcast_to(-(t59*t81 + t63*t75 + t63*t84 - t31*t59*qd6), batch),  # 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
         xp.broadcast_to(-t91, batch),  # 3, 1
-        xp.broadcast_to(c2*t78 - s2*t90, batch),  # 3, 2
-        xp.broadcast_to(t0*t4 - t47*t79, batch),  # 3, 3
+        xp.broadcast_to(t78*c2 - t90*s2, batch),  # 3, 2
+        xp.broadcast_to(t4*t0 - t79*t47, batch),  # 3, 3
         xp.broadcast_to(t15*t80 - t29*t64, batch),  # 3, 4
         xp.broadcast_to(t31*t65 - t49*t81, batch),  # 3, 5
-        xp.broadcast_to(t33*t89 - t51*t87, batch),  # 3, 6
+        xp.broadcast_to(t89*t33 - t87*t51, batch),  # 3, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
         xp.broadcast_to(-t90, batch),  # 4, 1
-        xp.broadcast_to(c2*t72 + s2*t91, batch),  # 4, 2
-        xp.broadcast_to(t0*t7 + t47*t73, batch),  # 4, 3
+        xp.broadcast_to(t91*s2 + t72*c2, batch),  # 4, 2
+        xp.broadcast_to(t7*t0 + t73*t47, batch),  # 4, 3
         xp.broadcast_to(t18*t64 - t15*t74, batch),  # 4, 4
         xp.broadcast_to(t20*t65 + t49*t75, batch),  # 4, 5
-        xp.broadcast_to(t51*t85 - t22*t89, batch),  # 4, 6
+        xp.broadcast_to(t51*t85 - t89*t22, batch),  # 4, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 1
-        xp.broadcast_to(-t92*c1**2 - t92*s1**2, batch),  # 5, 2
-        xp.broadcast_to(-t4*t73 - t7*t79, batch),  # 5, 3
+        xp.broadcast_to(-(t92*c1**2 + t92*s1**2), batch),  # 5, 2
+        xp.broadcast_to(-(t7*t79 + t4*t73), batch),  # 5, 3
         xp.broadcast_to(t29*t74 - t18*t80, batch),  # 5, 4
-        xp.broadcast_to(-t20*t81 - t31*t75, batch),  # 5, 5
-        xp.broadcast_to(t22*t87 - t33*t85, batch),  # 5, 6
+        xp.broadcast_to(-(t20*t81 + t31*t75), batch),  # 5, 5
+        xp.broadcast_to(t87*t22 - t33*t85, batch),  # 5, 6
     ], (6, 7))
     return Jd
 
@@ -1215,108 +1215,108 @@ def bias_acceleration(q, q_dot):
     t0 = qd1 + c2*qd3
     t1 = s1*s3
     t2 = c1*c3
-    t3 = -t1 + c2*t2
-    t4 = t2 - c2*t1
+    t3 = -t1 + t2*c2
+    t4 = t2 - t1*c2
     t5 = c3*s1
     t6 = c1*s3
-    t7 = t5 + c2*t6
-    t8 = t6 + c2*t5
+    t7 = t5 + t6*c2
+    t8 = t6 + t5*c2
     t9 = 0.316*s2
-    t10 = 0.0825*t3 + c1*t9
-    t11 = 0.0825*t8 + s1*t9
+    t10 = 0.0825*t3 + t9*c1
+    t11 = 0.0825*t8 + t9*s1
     t12 = c3*s2
     t13 = 0.316*c2 - 0.0825*t12
-    t14 = c2*s4 - c4*t12
-    t15 = c2*c4 + s4*t12
+    t14 = c2*s4 - t12*c4
+    t15 = t12*s4 + c2*c4
     t16 = c1*s2
-    t17 = c4*t3 + s4*t16
-    t18 = c4*t16 - s4*t3
-    t19 = c5*t17 - s5*t7
-    t20 = c5*t7 + s5*t17
-    t21 = c6*t19 + s6*t18
-    t22 = c6*t18 - s6*t19
+    t17 = t3*c4 + t16*s4
+    t18 = t16*c4 - t3*s4
+    t19 = t17*c5 - t7*s5
+    t20 = t17*s5 + t7*c5
+    t21 = t18*s6 + t19*c6
+    t22 = t18*c6 - t19*s6
     t23 = 0.088*t21 - 0.21*t22
     t24 = t23 + 0.384*t18
     t25 = t24 - 0.0825*t17
     t26 = t10 + t25
     t27 = s1*s2
-    t28 = c4*t8 + s4*t27
-    t29 = c4*t27 - s4*t8
-    t30 = c5*t28 + s5*t4
-    t31 = c5*t4 - s5*t28
-    t32 = c6*t30 + s6*t29
-    t33 = c6*t29 - s6*t30
+    t28 = t8*c4 + t27*s4
+    t29 = t27*c4 - t8*s4
+    t30 = t28*c5 + t4*s5
+    t31 = t4*c5 - t28*s5
+    t32 = t29*s6 + t30*c6
+    t33 = t29*c6 - t30*s6
     t34 = 0.088*t32 - 0.21*t33
     t35 = t34 + 0.384*t29
     t36 = t35 - 0.0825*t28
     t37 = t11 + t36
-    t38 = c1*t26 + s1*t37
-    t39 = t16*t37 - t26*t27
+    t38 = t26*c1 + t37*s1
+    t39 = t37*t16 - t26*t27
     t40 = t25*t4 + t36*t7
-    t41 = t18*t35 - t24*t29
-    t42 = t20*t34 + t23*t31
-    t43 = qd5*t41 + qd6*t42
-    t44 = t43 + qd4*t40
-    t45 = t44 + qd3*t39
-    t46 = t45 - qd2*t38
+    t41 = t18*t35 - t29*t24
+    t42 = t20*t34 + t31*t23
+    t43 = t41*qd5 + t42*qd6
+    t44 = t43 + t40*qd4
+    t45 = t44 + t39*qd3
+    t46 = t45 - t38*qd2
     t47 = s2*s3
-    t48 = c5*t14 + s5*t47
-    t49 = c5*t47 - s5*t14
-    t50 = c6*t48 + s6*t15
-    t51 = c6*t15 - s6*t48
+    t48 = t14*c5 + t47*s5
+    t49 = t47*c5 - t14*s5
+    t50 = t15*s6 + t48*c6
+    t51 = t15*c6 - t48*s6
     t52 = 0.088*t50 - 0.21*t51
     t53 = t52 + 0.384*t15
     t54 = t53 - 0.0825*t14
     t55 = t13 + t54
-    t56 = t27*t55 - c2*t37
-    t57 = t36*t47 - t4*t54
+    t56 = t55*t27 - t37*c2
+    t57 = t36*t47 - t54*t4
     t58 = t29*t53 - t15*t35
-    t59 = t34*t49 - t31*t52
-    t60 = c2*t26 - t16*t55
+    t59 = t49*t34 - t31*t52
+    t60 = t26*c2 - t55*t16
     t61 = t25*t47 + t54*t7
     t62 = t15*t24 - t18*t53
-    t63 = t20*t52 + t23*t49
-    t64 = t0 - qd4*t47
-    t65 = t64 + qd5*t15
-    t66 = qd5*t58 + qd6*t59
-    t67 = qd5*t62 - qd6*t63
-    t68 = t66 + qd4*t57
-    t69 = t67 - qd4*t61
-    t70 = t68 + qd3*t56
-    t71 = t69 + qd3*t60
+    t63 = t20*t52 + t49*t23
+    t64 = t0 - t47*qd4
+    t65 = t64 + t15*qd5
+    t66 = t58*qd5 + t59*qd6
+    t67 = t62*qd5 - t63*qd6
+    t68 = t66 + t57*qd4
+    t69 = t67 - t61*qd4
+    t70 = t68 + t56*qd3
+    t71 = t69 + t60*qd3
     t72 = qd2*s1
-    t73 = -t72 + qd3*t16
-    t74 = t73 + qd4*t7
-    t75 = t74 + qd5*t18
+    t73 = -t72 + t16*qd3
+    t74 = t73 + t7*qd4
+    t75 = t74 + t18*qd5
     t76 = t71 + t55*t72
-    t77 = t76 + qd1*t26
+    t77 = t76 + t26*qd1
     t78 = c1*qd2
-    t79 = t78 + qd3*t27
-    t80 = t79 - qd4*t4
-    t81 = t80 + qd5*t29
+    t79 = t78 + t27*qd3
+    t80 = t79 - t4*qd4
+    t81 = t80 + t29*qd5
     t82 = t70 + t55*t78
-    t83 = t82 - qd1*t37
-    t84 = qd6*t20
+    t83 = t82 - t37*qd1
+    t84 = t20*qd6
     t85 = t75 + t84
-    t86 = qd6*t31
+    t86 = t31*qd6
     t87 = t81 - t86
-    t88 = qd6*t49
+    t88 = t49*qd6
     t89 = t65 - t88
-    t90 = qd1*t55
+    t90 = t55*qd1
     t91 = qd2*s2
     a = _stack(xp, [
-        xp.broadcast_to(qd2*(c1*t46 - s1*t90) + qd3*(t27*t45 + t39*t78 - c2*t71 - qd1*t60) + qd4*(t0*t61 + t40*t79 + t47*t69 - t4*t44) + qd5*(t29*t43 + t41*t80 - t15*t67 - t62*t64) + qd6*(t42*t81 + t63*t65 - t42*t86 - t63*t88) - qd1*t77, batch),  # 0
-        xp.broadcast_to(qd1*t83 + qd2*(c1*t90 + s1*t46) + qd3*(c2*t70 + qd1*t56 + t39*t72 - t16*t45) + qd5*(t15*t66 + t58*t64 - t18*t43 - t41*t74) - qd4*(t40*t73 + t44*t7 + t47*t68 - t0*t57) - qd6*(t42*t75 + t42*t84 + t59*t88 - t59*t65), batch),  # 1
-        xp.broadcast_to(qd4*(t4*t68 + t69*t7 - t57*t79 - t61*t73) + qd5*(t18*t67 + t62*t74 - t29*t66 - t58*t80) - qd2*(c1*t82 + s1*t76) - qd3*(t27*t70 + t56*t78 + t60*t72 - c1*s2*t71) - qd6*(t59*t81 + t63*t75 + t63*t84 - qd6*t31*t59), batch),  # 2
-        xp.broadcast_to(qd3*(c2*t78 - qd1*t27) + qd4*(t0*t4 - t47*t79) + qd5*(t15*t80 - t29*t64) + qd6*(t31*t65 - t49*t81) + qd7*(t33*t89 - t51*t87) - qd1*t78, batch),  # 3
-        xp.broadcast_to(qd3*(c2*t72 + qd1*t16) + qd4*(t0*t7 + t47*t73) + qd5*(t18*t64 - t15*t74) + qd6*(t20*t65 + t49*t75) + qd7*(t51*t85 - t22*t89) - qd1*t72, batch),  # 4
-        xp.broadcast_to(qd5*(t29*t74 - t18*t80) + qd7*(t22*t87 - t33*t85) - qd3*(t91*c1**2 + t91*s1**2) - qd4*(t4*t73 + t7*t79) - qd6*(t20*t81 + t31*t75), batch),  # 5
+        xp.broadcast_to(qd2*(t46*c1 - t90*s1) + qd3*(t45*t27 + t39*t78 - t71*c2 - t60*qd1) + qd4*(t69*t47 + t61*t0 + t40*t79 - t44*t4) + qd5*(t43*t29 + t41*t80 - t67*t15 - t62*t64) + qd6*(t63*t65 + t42*t81 - t63*t88 - t42*t86) - t77*qd1, batch),  # 0
+        xp.broadcast_to(t83*qd1 + qd2*(t46*s1 + t90*c1) + qd3*(t70*c2 + t56*qd1 + t39*t72 - t45*t16) + qd5*(t66*t15 + t58*t64 - t43*t18 - t41*t74) - qd4*(t68*t47 + t44*t7 + t40*t73 - t57*t0) - qd6*(t59*t88 + t42*t75 + t42*t84 - t59*t65), batch),  # 1
+        xp.broadcast_to(qd4*(t68*t4 + t69*t7 - t57*t79 - t61*t73) + qd5*(t67*t18 + t62*t74 - t66*t29 - t58*t80) - qd2*(t82*c1 + t76*s1) - qd3*(t70*t27 + t56*t78 + t60*t72 - t71*c1*s2) - qd6*(t59*t81 + t63*t75 + t63*t84 - t31*t59*qd6), batch),  # 2
+        xp.broadcast_to(qd3*(t78*c2 - t27*qd1) + qd4*(t4*t0 - t79*t47) + qd5*(t15*t80 - t29*t64) + qd6*(t31*t65 - t49*t81) + qd7*(t89*t33 - t87*t51) - t78*qd1, batch),  # 3
+        xp.broadcast_to(qd3*(t16*qd1 + t72*c2) + qd4*(t7*t0 + t73*t47) + qd5*(t18*t64 - t15*t74) + qd6*(t20*t65 + t49*t75) + qd7*(t51*t85 - t89*t22) - t72*qd1, batch),  # 4
+        xp.broadcast_to(qd5*(t29*t74 - t18*t80) + qd7*(t87*t22 - t33*t85) - qd3*(t91*c1**2 + t91*s1**2) - qd4*(t7*t79 + t4*t73) - qd6*(t20*t81 + t31*t75), batch),  # 5
     ], (6,))
     return a
 
 
 def task_jacobian_dot(q, q_dot):
-    """time derivative of the analytic Jacobian along q_dot (6 x DOF): mu'' = J_a q'' + J_a' q': (6 x 7), 739 operations."""
+    """time derivative of the analytic Jacobian along q_dot (6 x DOF): mu'' = J_a q'' + J_a' q': (6 x 7), 732 operations."""
     xp, dtype, device, batch, (q, q_dot,) = _arguments(("q", q, (7,)), ("q_dot", q_dot, (7,)))
     qd1 = q_dot[..., 0]
     qd2 = q_dot[..., 1]
@@ -1342,224 +1342,224 @@ def task_jacobian_dot(q, q_dot):
     s7 = trig[..., 13]
     t0 = s1*s3
     t1 = c1*c3
-    t2 = -t0 + c2*t1
-    t3 = t1 - c2*t0
+    t2 = -t0 + t1*c2
+    t3 = t1 - t0*c2
     t4 = c3*s1
     t5 = c1*s3
-    t6 = t4 + c2*t5
-    t7 = t5 + c2*t4
+    t6 = t4 + t5*c2
+    t7 = t5 + t4*c2
     t8 = 0.316*s2
-    t9 = 0.0825*t2 + c1*t8
-    t10 = 0.0825*t7 + s1*t8
+    t9 = 0.0825*t2 + t8*c1
+    t10 = 0.0825*t7 + t8*s1
     t11 = c3*s2
     t12 = 0.316*c2 - 0.0825*t11
-    t13 = c2*s4 - c4*t11
-    t14 = c2*c4 + s4*t11
+    t13 = c2*s4 - t11*c4
+    t14 = t11*s4 + c2*c4
     t15 = c1*s2
-    t16 = c4*t2 + s4*t15
-    t17 = c4*t15 - s4*t2
-    t18 = c5*t16 - s5*t6
-    t19 = c5*t6 + s5*t16
-    t20 = c6*t18 + s6*t17
-    t21 = c6*t17 - s6*t18
-    t22 = c7*t20 + s7*t19
-    t23 = c7*t19 - s7*t20
+    t16 = t2*c4 + t15*s4
+    t17 = t15*c4 - t2*s4
+    t18 = t16*c5 - t6*s5
+    t19 = t16*s5 + t6*c5
+    t20 = t17*s6 + t18*c6
+    t21 = t17*c6 - t18*s6
+    t22 = t19*s7 + t20*c7
+    t23 = t19*c7 - t20*s7
     t24 = 0.088*t20 - 0.21*t21
     t25 = t24 + 0.384*t17
     t26 = t25 - 0.0825*t16
-    t27 = t26 + t9
+    t27 = t9 + t26
     t28 = 0.7071067811865476*t22 - 0.7071067811865476*t23
     t29 = s1*s2
-    t30 = c4*t7 + s4*t29
-    t31 = c4*t29 - s4*t7
-    t32 = c5*t30 + s5*t3
-    t33 = c5*t3 - s5*t30
-    t34 = c6*t32 + s6*t31
-    t35 = c6*t31 - s6*t32
-    t36 = c7*t34 - s7*t33
-    t37 = c7*t33 + s7*t34
+    t30 = t7*c4 + t29*s4
+    t31 = t29*c4 - t7*s4
+    t32 = t30*c5 + t3*s5
+    t33 = t3*c5 - t30*s5
+    t34 = t31*s6 + t32*c6
+    t35 = t31*c6 - t32*s6
+    t36 = t34*c7 - t33*s7
+    t37 = t33*c7 + t34*s7
     t38 = 0.088*t34 - 0.21*t35
     t39 = t38 + 0.384*t31
     t40 = t39 - 0.0825*t30
     t41 = t10 + t40
     t42 = 0.7071067811865476*t36 + 0.7071067811865476*t37
-    t43 = c1*t27 + s1*t41
-    t44 = t15*t41 - t27*t29
+    t43 = t27*c1 + t41*s1
+    t44 = t41*t15 - t27*t29
     t45 = t26*t3 + t40*t6
-    t46 = t17*t39 - t25*t31
-    t47 = t19*t38 + t24*t33
-    t48 = qd5*t46 + qd6*t47
-    t49 = t48 + qd4*t45
-    t50 = t49 + qd3*t44
-    t51 = t50 - qd2*t43
+    t46 = t17*t39 - t31*t25
+    t47 = t19*t38 + t33*t24
+    t48 = t46*qd5 + t47*qd6
+    t49 = t48 + t45*qd4
+    t50 = t49 + t44*qd3
+    t51 = t50 - t43*qd2
     t52 = s2*s3
-    t53 = c5*t13 + s5*t52
-    t54 = c5*t52 - s5*t13
-    t55 = c6*t53 + s6*t14
-    t56 = c6*t14 - s6*t53
-    t57 = c7*t55 - s7*t54
-    t58 = c7*t54 + s7*t55
+    t53 = t13*c5 + t52*s5
+    t54 = t52*c5 - t13*s5
+    t55 = t14*s6 + t53*c6
+    t56 = t14*c6 - t53*s6
+    t57 = t55*c7 - t54*s7
+    t58 = t54*c7 + t55*s7
     t59 = 0.088*t55 - 0.21*t56
     t60 = t59 + 0.384*t14
     t61 = t60 - 0.0825*t13
     t62 = t12 + t61
     t63 = 0.7071067811865476*t57 + 0.7071067811865476*t58
-    t64 = t29*t62 - c2*t41
-    t65 = t40*t52 - t3*t61
+    t64 = t62*t29 - t41*c2
+    t65 = t40*t52 - t61*t3
     t66 = t31*t60 - t14*t39
-    t67 = t38*t54 - t33*t59
-    t68 = c2*t27 - t15*t62
-    t69 = t26*t52 + t6*t61
+    t67 = t54*t38 - t33*t59
+    t68 = t27*c2 - t62*t15
+    t69 = t26*t52 + t61*t6
     t70 = t14*t25 - t17*t60
-    t71 = t19*t59 + t24*t54
-    t72 = qd5*t66 + qd6*t67
-    t73 = qd5*t70 - qd6*t71
-    t74 = t72 + qd4*t65
-    t75 = t73 - qd4*t69
-    t76 = t74 + qd3*t64
-    t77 = t75 + qd3*t68
+    t71 = t19*t59 + t54*t24
+    t72 = t66*qd5 + t67*qd6
+    t73 = t70*qd5 - t71*qd6
+    t74 = t72 + t65*qd4
+    t75 = t73 - t69*qd4
+    t76 = t74 + t64*qd3
+    t77 = t75 + t68*qd3
     t78 = qd2*s1
     t79 = t77 + t62*t78
-    t80 = t79 + qd1*t27
-    t81 = c2*t76 + qd1*t64 + t44*t78 - t15*t50
-    t82 = c2*t78 + qd1*t15
-    t83 = -t78 + qd3*t15
+    t80 = t79 + t27*qd1
+    t81 = t76*c2 + t64*qd1 + t44*t78 - t50*t15
+    t82 = t15*qd1 + t78*c2
+    t83 = -t78 + t15*qd3
     t84 = t83
     t85 = c1*qd2
     t86 = t76 + t62*t85
-    t87 = t86 - qd1*t41
-    t88 = t29*t50 + t44*t85 - c2*t77 - qd1*t68
-    t89 = c1*t86 + s1*t79
-    t90 = t29*t76 + t64*t85 + t68*t78 - t15*t77
-    t91 = c2*t85 - qd1*t29
-    t92 = t85 + qd3*t29
+    t87 = t86 - t41*qd1
+    t88 = t50*t29 + t44*t85 - t77*c2 - t68*qd1
+    t89 = t86*c1 + t79*s1
+    t90 = t76*t29 + t64*t85 + t68*t78 - t77*t15
+    t91 = t85*c2 - t29*qd1
+    t92 = t85 + t29*qd3
     t93 = t92
-    t94 = t3*t74 + t6*t75 - t65*t93 - t69*t84
-    t95 = t3*t84 + t6*t93
+    t94 = t74*t3 + t75*t6 - t65*t93 - t69*t84
+    t95 = t6*t93 + t3*t84
     t96 = qd1 + c2*qd3
     t97 = t96
-    t98 = t45*t93 + t52*t75 + t69*t97 - t3*t49
-    t99 = t45*t84 + t49*t6 + t52*t74 - t65*t97
-    t100 = t3*t97 - t52*t93
-    t101 = t52*t84 + t6*t97
-    t102 = qd4*t6
-    t103 = t102 + t84
-    t104 = -qd4*t3
-    t105 = t104 + t93
-    t106 = t103*t70 + t17*t73 - t105*t66 - t31*t72
-    t107 = t103*t31 - t105*t17
-    t108 = -qd4*t52
-    t109 = t108 + t97
-    t110 = t105*t46 + t31*t48 - t109*t70 - t14*t73
-    t111 = t109*t66 + t14*t72 - t103*t46 - t17*t48
-    t112 = t105*t14 - t109*t31
-    t113 = t109*t17 - t103*t14
-    t114 = qd5*t17
+    t98 = t75*t52 + t69*t97 + t45*t93 - t49*t3
+    t99 = t74*t52 + t49*t6 + t45*t84 - t65*t97
+    t100 = t3*t97 - t93*t52
+    t101 = t6*t97 + t84*t52
+    t102 = t6*qd4
+    t103 = t84 + t102
+    t104 = -t3*qd4
+    t105 = t93 + t104
+    t106 = t73*t17 + t70*t103 - t72*t31 - t66*t105
+    t107 = t31*t103 - t17*t105
+    t108 = -t52*qd4
+    t109 = t97 + t108
+    t110 = t48*t31 + t46*t105 - t73*t14 - t70*t109
+    t111 = t72*t14 + t66*t109 - t48*t17 - t46*t103
+    t112 = t14*t105 - t31*t109
+    t113 = t17*t109 - t14*t103
+    t114 = t17*qd5
     t115 = t103 + t114
-    t116 = qd5*t31
+    t116 = t31*qd5
     t117 = t105 + t116
-    t118 = t115*t33 + t117*t19
-    t119 = qd5*t14
+    t118 = t19*t117 + t33*t115
+    t119 = t14*qd5
     t120 = t109 + t119
-    t121 = t120*t33 - t117*t54
-    t122 = t115*t54 + t120*t19
-    t123 = qd6*t19
+    t121 = t33*t120 - t54*t117
+    t122 = t19*t120 + t54*t115
+    t123 = t19*qd6
     t124 = t115 + t123
-    t125 = t102 + t114 + t123 + t83 - qd7*t21
-    t126 = qd6*t33
-    t127 = t115*t71 + t117*t67 + t123*t71 - t126*t67
+    t125 = t83 + t102 + t114 + t123 - t21*qd7
+    t126 = t33*qd6
+    t127 = t67*t117 + t71*t115 + t71*t123 - t67*t126
     t128 = -t126
     t129 = t117 + t128
-    t130 = t129*t21 - t124*t35
-    t131 = t104 + t116 + t128 + t92 - qd7*t35
+    t130 = t129*t21 - t35*t124
+    t131 = t92 + t104 + t116 + t128 - t35*qd7
     t132 = t125*t42 - t131*t28
-    t133 = qd6*t54
-    t134 = t117*t47 + t120*t71 - t126*t47 - t133*t71
-    t135 = t115*t47 + t123*t47 + t133*t67 - t120*t67
+    t133 = t54*qd6
+    t134 = t71*t120 + t47*t117 - t71*t133 - t47*t126
+    t135 = t67*t133 + t47*t115 + t47*t123 - t67*t120
     t136 = -t133
     t137 = t120 + t136
     t138 = t137*t35 - t129*t56
-    t139 = t124*t56 - t137*t21
-    t140 = t108 + t119 + t136 + t96 - qd7*t56
+    t139 = t56*t124 - t137*t21
+    t140 = t96 + t108 + t119 + t136 - t56*qd7
     t141 = t131*t63 - t140*t42
     t142 = t140*t28 - t125*t63
-    t143 = qd1*t62
-    t144 = c1*t51 - s1*t143
-    t145 = c1*t143 + s1*t51
+    t143 = t62*qd1
+    t144 = t51*c1 - t143*s1
+    t145 = t51*s1 + t143*c1
     t146 = qd2*s2
     t147 = t146*c1**2 + t146*s1**2
     t148 = t28**2 + t42**2
-    t149 = t148**(-1.0)
-    t150 = c1*t149
-    t151 = qd1*t28
-    t152 = s1*t149
-    t153 = qd1*t42
-    t154 = c1*t42
-    t155 = s1*t28
+    t149 = 1/t148
+    t150 = t149*c1
+    t151 = t28*qd1
+    t152 = t149*s1
+    t153 = t42*qd1
+    t154 = t42*c1
+    t155 = t28*s1
     t156 = t154 - t155
     t157 = 2/t148**2
     t158 = t156*t157
-    t159 = t158*t42
-    t160 = t158*t28
-    t161 = t149*t28
-    t162 = t161*t91
-    t163 = t149*t42
-    t164 = t163*t82
-    t165 = s2*t150
-    t166 = c1*t28
-    t167 = s1*t42
-    t168 = s2*t166 + s2*t167
+    t159 = t42*t158
+    t160 = t28*t158
+    t161 = t28*t149
+    t162 = t91*t161
+    t163 = t42*t149
+    t164 = t82*t163
+    t165 = t150*s2
+    t166 = t28*c1
+    t167 = t42*s1
+    t168 = t166*s2 + t167*s2
     t169 = t157*t168
-    t170 = t169*t28
-    t171 = s2*t152
-    t172 = t169*t42
+    t170 = t28*t169
+    t171 = t152*s2
+    t172 = t42*t169
     t173 = t100*t161
     t174 = t101*t163
-    t175 = t149*t6
-    t176 = t28*t6 - t3*t42
+    t175 = t6*t149
+    t176 = t6*t28 - t42*t3
     t177 = t157*t176
-    t178 = t177*t28
-    t179 = t149*t3
-    t180 = t177*t42
+    t178 = t28*t177
+    t179 = t3*t149
+    t180 = t42*t177
     t181 = t112*t161
     t182 = t113*t163
-    t183 = t149*t17
+    t183 = t17*t149
     t184 = t17*t28 + t31*t42
     t185 = t157*t184
-    t186 = t185*t28
-    t187 = t149*t31
-    t188 = t185*t42
+    t186 = t28*t185
+    t187 = t31*t149
+    t188 = t42*t185
     t189 = t121*t161
     t190 = t122*t163
-    t191 = t149*t19
+    t191 = t19*t149
     t192 = t19*t28 - t33*t42
     t193 = t157*t192
-    t194 = t193*t28
-    t195 = t149*t33
-    t196 = t193*t42
+    t194 = t28*t193
+    t195 = t33*t149
+    t196 = t42*t193
     t197 = t138*t161
     t198 = t139*t163
-    t199 = t149*t21
-    t200 = -t21*t28 - t35*t42
+    t199 = t21*t149
+    t200 = -(t21*t28 + t35*t42)
     t201 = t157*t200
-    t202 = t201*t28
-    t203 = t149*t35
-    t204 = t201*t42
+    t202 = t28*t201
+    t203 = t35*t149
+    t204 = t42*t201
     t205 = 1/xp.sqrt(t148)
-    t206 = qd1*t205
-    t207 = c1*t205
-    t208 = t148**(-3/2)
+    t206 = t205*qd1
+    t207 = t205*c1
+    t208 = 1/t148**1.5
     t209 = t208*(t166 + t167)
-    t210 = s1*t205
-    t211 = t205*t28
-    t212 = t205*t42
-    t213 = t208*(s2*t155 - s2*t154)
-    t214 = -t208*(t28*t3 + t42*t6)
-    t215 = t208*(t28*t31 - t17*t42)
-    t216 = -t208*(t19*t42 + t28*t33)
-    t217 = t208*(t21*t42 - t28*t35)
-    t218 = t150*t63
-    t219 = t152*t63
+    t210 = t205*s1
+    t211 = t28*t205
+    t212 = t42*t205
+    t213 = t208*(t155*s2 - t154*s2)
+    t214 = -t208*(t6*t42 + t28*t3)
+    t215 = t208*(t31*t28 - t17*t42)
+    t216 = -t208*(t19*t42 + t33*t28)
+    t217 = t208*(t21*t42 - t35*t28)
+    t218 = t63*t150
+    t219 = t63*t152
     t220 = t132*t149
     Jd = _stack(xp, [
         xp.broadcast_to(-t80, batch),  # 0, 0
@@ -1591,25 +1591,25 @@ def task_jacobian_dot(q, q_dot):
         xp.broadcast_to(t189 + t190 + t141*(t191 - t194) - t142*(t195 + t196), batch),  # 3, 5
         xp.broadcast_to(t197 + t198 - t141*(t199 + t202) - t142*(t203 + t204), batch),  # 3, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
-        xp.broadcast_to(t141*(t207 - t209*t28) + t142*(t210 - t209*t42) + t154*t206 - t155*t206, batch),  # 4, 1
-        xp.broadcast_to(t141*(s2*t210 - t213*t28) + t211*t82 - t142*(s2*t207 + t213*t42) - t212*t91, batch),  # 4, 2
-        xp.broadcast_to(t101*t211 - t100*t212 - t141*(t205*t3 + t214*t28) - t142*(t205*t6 + t214*t42), batch),  # 4, 3
-        xp.broadcast_to(t113*t211 + t141*(t205*t31 - t215*t28) - t112*t212 - t142*(t17*t205 + t215*t42), batch),  # 4, 4
-        xp.broadcast_to(t122*t211 - t121*t212 - t141*(t205*t33 + t216*t28) - t142*(t19*t205 + t216*t42), batch),  # 4, 5
-        xp.broadcast_to(t139*t211 + t142*(t205*t21 - t217*t42) - t138*t212 - t141*(t205*t35 + t217*t28), batch),  # 4, 6
+        xp.broadcast_to(t141*(t207 - t28*t209) + t142*(t210 - t42*t209) + t154*t206 - t155*t206, batch),  # 4, 1
+        xp.broadcast_to(t82*t211 + t141*(t210*s2 - t28*t213) - t91*t212 - t142*(t42*t213 + t207*s2), batch),  # 4, 2
+        xp.broadcast_to(t101*t211 - t100*t212 - t141*(t28*t214 + t3*t205) - t142*(t6*t205 + t42*t214), batch),  # 4, 3
+        xp.broadcast_to(t113*t211 + t141*(t31*t205 - t28*t215) - t112*t212 - t142*(t17*t205 + t42*t215), batch),  # 4, 4
+        xp.broadcast_to(t122*t211 - t121*t212 - t141*(t33*t205 + t28*t216) - t142*(t19*t205 + t42*t216), batch),  # 4, 5
+        xp.broadcast_to(t139*t211 + t142*(t21*t205 - t42*t217) - t138*t212 - t141*(t35*t205 + t28*t217), batch),  # 4, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 0
-        xp.broadcast_to(t141*(t219 + t160*t63) + t142*(-t218 + t159*t63) + t151*t218 + t153*t219 - t156*t220, batch),  # 5, 1
-        xp.broadcast_to(-t147 + t141*(t170*t63 - t165*t63) + t142*(t172*t63 - t171*t63) - t162*t63 - t164*t63 - t168*t220, batch),  # 5, 2
-        xp.broadcast_to(-t95 + t141*(t178*t63 - t175*t63) + t142*(t179*t63 + t180*t63) - t173*t63 - t174*t63 - t176*t220, batch),  # 5, 3
-        xp.broadcast_to(t107 + t141*(t186*t63 - t183*t63) + t142*(t188*t63 - t187*t63) - t181*t63 - t182*t63 - t184*t220, batch),  # 5, 4
-        xp.broadcast_to(-t118 + t141*(t194*t63 - t191*t63) + t142*(t195*t63 + t196*t63) - t189*t63 - t190*t63 - t192*t220, batch),  # 5, 5
-        xp.broadcast_to(t130 + t141*(t199*t63 + t202*t63) + t142*(t203*t63 + t204*t63) - t197*t63 - t198*t63 - t200*t220, batch),  # 5, 6
+        xp.broadcast_to(t141*(t219 + t63*t160) + t142*(-t218 + t63*t159) + t151*t218 + t153*t219 - t156*t220, batch),  # 5, 1
+        xp.broadcast_to(-(t147 + t63*t162 + t63*t164 + t168*t220 - t141*(t63*t170 - t63*t165) - t142*(t63*t172 - t63*t171)), batch),  # 5, 2
+        xp.broadcast_to(-(t95 + t63*t173 + t63*t174 + t176*t220 - t141*(t63*t178 - t63*t175) - t142*(t63*t179 + t63*t180)), batch),  # 5, 3
+        xp.broadcast_to(t107 + t141*(t63*t186 - t63*t183) + t142*(t63*t188 - t63*t187) - t63*t181 - t63*t182 - t184*t220, batch),  # 5, 4
+        xp.broadcast_to(-(t118 + t63*t189 + t63*t190 + t192*t220 - t141*(t63*t194 - t63*t191) - t142*(t63*t195 + t63*t196)), batch),  # 5, 5
+        xp.broadcast_to(t130 + t141*(t63*t199 + t63*t202) + t142*(t63*t203 + t63*t204) - t63*t197 - t63*t198 - t200*t220, batch),  # 5, 6
     ], (6, 7))
     return Jd
 
 
 def hessian(q):
-    """partial derivatives dJ/dq_k of the world geometric Jacobian (DOF x 6 x DOF, indexed [k, r, c]): (7 x 6 x 7), 428 operations."""
+    """partial derivatives dJ/dq_k of the world geometric Jacobian (DOF x 6 x DOF, indexed [k, r, c]): (7 x 6 x 7), 407 operations."""
     xp, dtype, device, batch, (q,) = _arguments(("q", q, (7,)))
     trig = _cos_sin(xp, q, (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0), device)
     c1 = trig[..., 0]
@@ -1626,100 +1626,100 @@ def hessian(q):
     s6 = trig[..., 11]
     t0 = s1*s3
     t1 = c1*c3
-    t2 = -t0 + c2*t1
-    t3 = t1 - c2*t0
+    t2 = -t0 + t1*c2
+    t3 = t1 - t0*c2
     t4 = c3*s1
     t5 = c1*s3
-    t6 = t4 + c2*t5
-    t7 = t5 + c2*t4
+    t6 = t4 + t5*c2
+    t7 = t5 + t4*c2
     t8 = c1*s2
     t9 = 0.316*t8 + 0.0825*t2
-    t10 = c4*t2 + s4*t8
-    t11 = c4*t8 - s4*t2
-    t12 = c5*t10 - s5*t6
-    t13 = c5*t6 + s5*t10
-    t14 = c6*t12 + s6*t11
-    t15 = c6*t11 - s6*t12
+    t10 = t2*c4 + t8*s4
+    t11 = t8*c4 - t2*s4
+    t12 = t10*c5 - t6*s5
+    t13 = t10*s5 + t6*c5
+    t14 = t11*s6 + t12*c6
+    t15 = t11*c6 - t12*s6
     t16 = 0.088*t14 - 0.21*t15
     t17 = t16 + 0.384*t11
     t18 = t17 - 0.0825*t10
-    t19 = t18 + t9
+    t19 = t9 + t18
     t20 = s1*s2
     t21 = 0.316*t20 + 0.0825*t7
-    t22 = c4*t7 + s4*t20
-    t23 = c4*t20 - s4*t7
-    t24 = c5*t22 + s5*t3
-    t25 = c5*t3 - s5*t22
-    t26 = c6*t24 + s6*t23
-    t27 = c6*t23 - s6*t24
+    t22 = t7*c4 + t20*s4
+    t23 = t20*c4 - t7*s4
+    t24 = t22*c5 + t3*s5
+    t25 = t3*c5 - t22*s5
+    t26 = t23*s6 + t24*c6
+    t27 = t23*c6 - t24*s6
     t28 = 0.088*t26 - 0.21*t27
     t29 = t28 + 0.384*t23
     t30 = t29 - 0.0825*t22
     t31 = t21 + t30
-    t32 = c1*t19 + s1*t31
+    t32 = t19*c1 + t31*s1
     t33 = t31*t8 - t19*t20
     t34 = t18*t3 + t30*t6
-    t35 = t11*t29 - t17*t23
-    t36 = t13*t28 + t16*t25
+    t35 = t11*t29 - t23*t17
+    t36 = t13*t28 + t25*t16
     t37 = c3*s2
     t38 = 0.316*c2 - 0.0825*t37
-    t39 = c2*s4 - c4*t37
-    t40 = c2*c4 + s4*t37
+    t39 = c2*s4 - t37*c4
+    t40 = t37*s4 + c2*c4
     t41 = s2*s3
-    t42 = c5*t39 + s5*t41
-    t43 = c5*t41 - s5*t39
-    t44 = c6*t42 + s6*t40
-    t45 = c6*t40 - s6*t42
+    t42 = t39*c5 + t41*s5
+    t43 = t41*c5 - t39*s5
+    t44 = t40*s6 + t42*c6
+    t45 = t40*c6 - t42*s6
     t46 = 0.088*t44 - 0.21*t45
     t47 = t46 + 0.384*t40
     t48 = t47 - 0.0825*t39
     t49 = t38 + t48
-    t50 = t30*t41 - t3*t48
-    t51 = t23*t47 - t29*t40
-    t52 = t28*t43 - t25*t46
+    t50 = t30*t41 - t48*t3
+    t51 = t23*t47 - t40*t29
+    t52 = t43*t28 - t25*t46
     t53 = t18*t41 + t48*t6
-    t54 = t17*t40 - t11*t47
-    t55 = t13*t46 + t16*t43
-    t56 = s1*t49
-    t57 = s2*t56 - c2*t31
-    t58 = c1*t49
-    t59 = c2*t19 - s2*t58
+    t54 = t40*t17 - t11*t47
+    t55 = t13*t46 + t43*t16
+    t56 = t49*s1
+    t57 = t56*s2 - t31*c2
+    t58 = t49*c1
+    t59 = t19*c2 - t58*s2
     t60 = -t56
     t61 = -t59
     t62 = -t54
-    t63 = c1*t33
-    t64 = c1*t34
-    t65 = c1*t35
-    t66 = c1*t36
-    t67 = s1*t33
-    t68 = s1*t34
-    t69 = s1*t35
-    t70 = s1*t36
+    t63 = t33*c1
+    t64 = t34*c1
+    t65 = t35*c1
+    t66 = t36*c1
+    t67 = t33*s1
+    t68 = t34*s1
+    t69 = t35*s1
+    t70 = t36*s1
     t71 = c1**2
     t72 = s1**2
-    t73 = -c1*t57 - s1*t59
-    t74 = s1*t53 - c1*t50
-    t75 = -c1*t51 - s1*t54
-    t76 = s1*t55 - c1*t52
-    t77 = c2*t53 + t20*t34
-    t78 = t20*t35 - c2*t54
-    t79 = c2*t55 + t20*t36
-    t80 = c2*t50 - t34*t8
-    t81 = c2*t51 - t35*t8
-    t82 = c2*t52 - t36*t8
-    t83 = -t20*t50 - t53*t8
-    t84 = t54*t8 - t20*t51
-    t85 = -t20*t52 - t55*t8
+    t73 = -(t57*c1 + t59*s1)
+    t74 = t53*s1 - t50*c1
+    t75 = -(t51*c1 + t54*s1)
+    t76 = t55*s1 - t52*c1
+    t77 = t53*c2 + t34*t20
+    t78 = t35*t20 - t54*c2
+    t79 = t55*c2 + t36*t20
+    t80 = t50*c2 - t34*t8
+    t81 = t51*c2 - t35*t8
+    t82 = t52*c2 - t36*t8
+    t83 = -(t50*t20 + t53*t8)
+    t84 = t54*t8 - t51*t20
+    t85 = -(t52*t20 + t55*t8)
     t86 = s2**2
-    t87 = t41*t54 - t3*t35
-    t88 = -t3*t36 - t41*t55
-    t89 = -t35*t6 - t41*t51
-    t90 = -t36*t6 - t41*t52
-    t91 = t3*t51 + t54*t6
-    t92 = t3*t52 - t55*t6
+    t87 = t54*t41 - t35*t3
+    t88 = -(t55*t41 + t36*t3)
+    t89 = -(t6*t35 + t51*t41)
+    t90 = -(t6*t36 + t52*t41)
+    t91 = t6*t54 + t51*t3
+    t92 = t52*t3 - t6*t55
     t93 = t23*t36 + t40*t55
     t94 = t40*t52 - t11*t36
-    t95 = -t11*t55 - t23*t52
+    t95 = -(t11*t55 + t23*t52)
     H = _stack(xp, [
         -t19,  # 0, 0, 0
         t60,  # 0, 0, 1
@@ -1764,21 +1764,21 @@ def hessian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5, 6
         t60,  # 1, 0, 0
-        -c1*t32,  # 1, 0, 1
+        -t32*c1,  # 1, 0, 1
         t63,  # 1, 0, 2
         t64,  # 1, 0, 3
         t65,  # 1, 0, 4
         t66,  # 1, 0, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 0, 6
         t58,  # 1, 1, 0
-        -s1*t32,  # 1, 1, 1
+        -t32*s1,  # 1, 1, 1
         t67,  # 1, 1, 2
         t68,  # 1, 1, 3
         t69,  # 1, 1, 4
         t70,  # 1, 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 1, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 2, 0
-        -t49*t71 - t49*t72,  # 1, 2, 1
+        -(t49*t71 + t49*t72),  # 1, 2, 1
         t73,  # 1, 2, 2
         t74,  # 1, 2, 3
         t75,  # 1, 2, 4
@@ -1787,41 +1787,41 @@ def hessian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 3, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 3, 1
         c1*c2,  # 1, 3, 2
-        -s2*t5,  # 1, 3, 3
-        c1*t40,  # 1, 3, 4
-        -c1*t43,  # 1, 3, 5
-        -c1*t45,  # 1, 3, 6
+        -t5*s2,  # 1, 3, 3
+        t40*c1,  # 1, 3, 4
+        -t43*c1,  # 1, 3, 5
+        -t45*c1,  # 1, 3, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 4, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 4, 1
         c2*s1,  # 1, 4, 2
-        -s2*t0,  # 1, 4, 3
-        s1*t40,  # 1, 4, 4
-        -s1*t43,  # 1, 4, 5
-        -s1*t45,  # 1, 4, 6
+        -t0*s2,  # 1, 4, 3
+        t40*s1,  # 1, 4, 4
+        -t43*s1,  # 1, 4, 5
+        -t45*s1,  # 1, 4, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5, 1
-        -s2*t71 - s2*t72,  # 1, 5, 2
-        s1*t3 - c1*t6,  # 1, 5, 3
-        -c1*t11 - s1*t23,  # 1, 5, 4
-        s1*t25 - c1*t13,  # 1, 5, 5
-        c1*t15 + s1*t27,  # 1, 5, 6
+        -(t71*s2 + t72*s2),  # 1, 5, 2
+        t3*s1 - t6*c1,  # 1, 5, 3
+        -(t11*c1 + t23*s1),  # 1, 5, 4
+        t25*s1 - t13*c1,  # 1, 5, 5
+        t15*c1 + t27*s1,  # 1, 5, 6
         t61,  # 2, 0, 0
         t63,  # 2, 0, 1
-        t20*t33 - c2*t59,  # 2, 0, 2
+        t33*t20 - t59*c2,  # 2, 0, 2
         t77,  # 2, 0, 3
         t78,  # 2, 0, 4
         t79,  # 2, 0, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0, 6
         t57,  # 2, 1, 0
         t67,  # 2, 1, 1
-        c2*t57 - t33*t8,  # 2, 1, 2
+        t57*c2 - t33*t8,  # 2, 1, 2
         t80,  # 2, 1, 3
         t81,  # 2, 1, 4
         t82,  # 2, 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 1, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 2, 0
         t73,  # 2, 2, 1
-        t59*t8 - t20*t57,  # 2, 2, 2
+        t59*t8 - t57*t20,  # 2, 2, 2
         t83,  # 2, 2, 3
         t84,  # 2, 2, 4
         t85,  # 2, 2, 5
@@ -1829,42 +1829,42 @@ def hessian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 3, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 3, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 3, 2
-        c2*t3 - t0*t86,  # 2, 3, 3
-        t20*t40 - c2*t23,  # 2, 3, 4
-        c2*t25 - t20*t43,  # 2, 3, 5
-        c2*t27 - t20*t45,  # 2, 3, 6
+        t3*c2 - t0*t86,  # 2, 3, 3
+        t40*t20 - t23*c2,  # 2, 3, 4
+        t25*c2 - t43*t20,  # 2, 3, 5
+        t27*c2 - t45*t20,  # 2, 3, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 4, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 4, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 4, 2
-        c2*t6 + t5*t86,  # 2, 4, 3
-        c2*t11 - t40*t8,  # 2, 4, 4
-        c2*t13 + t43*t8,  # 2, 4, 5
-        t45*t8 - c2*t15,  # 2, 4, 6
+        t6*c2 + t5*t86,  # 2, 4, 3
+        t11*c2 - t40*t8,  # 2, 4, 4
+        t13*c2 + t43*t8,  # 2, 4, 5
+        t45*t8 - t15*c2,  # 2, 4, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 5, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 5, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 5, 2
-        -t20*t6 - t3*t8,  # 2, 5, 3
+        -(t6*t20 + t3*t8),  # 2, 5, 3
         t23*t8 - t11*t20,  # 2, 5, 4
-        -t13*t20 - t25*t8,  # 2, 5, 5
+        -(t13*t20 + t25*t8),  # 2, 5, 5
         t15*t20 - t27*t8,  # 2, 5, 6
         t53,  # 3, 0, 0
         t64,  # 3, 0, 1
         t77,  # 3, 0, 2
-        -t3*t34 - t41*t53,  # 3, 0, 3
+        -(t53*t41 + t34*t3),  # 3, 0, 3
         t87,  # 3, 0, 4
         t88,  # 3, 0, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0, 6
         t50,  # 3, 1, 0
         t68,  # 3, 1, 1
         t80,  # 3, 1, 2
-        -t34*t6 - t41*t50,  # 3, 1, 3
+        -(t6*t34 + t50*t41),  # 3, 1, 3
         t89,  # 3, 1, 4
         t90,  # 3, 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 1, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 2, 0
         t74,  # 3, 2, 1
         t83,  # 3, 2, 2
-        t3*t50 - t53*t6,  # 3, 2, 3
+        t50*t3 - t6*t53,  # 3, 2, 3
         t91,  # 3, 2, 4
         t92,  # 3, 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 2, 6
@@ -1872,14 +1872,14 @@ def hessian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 3, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 3, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 3, 3
-        t23*t41 - t3*t40,  # 3, 3, 4
-        t3*t43 - t25*t41,  # 3, 3, 5
-        t3*t45 - t27*t41,  # 3, 3, 6
+        t23*t41 - t40*t3,  # 3, 3, 4
+        t43*t3 - t25*t41,  # 3, 3, 5
+        t45*t3 - t27*t41,  # 3, 3, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 4, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 4, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 4, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 4, 3
-        -t11*t41 - t40*t6,  # 3, 4, 4
+        -(t11*t41 + t40*t6),  # 3, 4, 4
         t43*t6 - t13*t41,  # 3, 4, 5
         t15*t41 + t45*t6,  # 3, 4, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 5, 0
@@ -1888,7 +1888,7 @@ def hessian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 5, 3
         t11*t3 + t23*t6,  # 3, 5, 4
         t13*t3 - t25*t6,  # 3, 5, 5
-        -t15*t3 - t27*t6,  # 3, 5, 6
+        -(t15*t3 + t27*t6),  # 3, 5, 6
         t62,  # 4, 0, 0
         t65,  # 4, 0, 1
         t78,  # 4, 0, 2
@@ -1915,35 +1915,35 @@ def hessian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 3, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 3, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 3, 4
-        t25*t40 - t23*t43,  # 4, 3, 5
-        t27*t40 - t23*t45,  # 4, 3, 6
+        t40*t25 - t23*t43,  # 4, 3, 5
+        t40*t27 - t23*t45,  # 4, 3, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 4, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 4, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 4, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 4, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 4, 4
-        t11*t43 + t13*t40,  # 4, 4, 5
-        t11*t45 - t15*t40,  # 4, 4, 6
+        t11*t43 + t40*t13,  # 4, 4, 5
+        t11*t45 - t40*t15,  # 4, 4, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 5, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 5, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 5, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 5, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 5, 4
-        -t11*t25 - t13*t23,  # 4, 5, 5
-        t15*t23 - t11*t27,  # 4, 5, 6
+        -(t11*t25 + t23*t13),  # 4, 5, 5
+        t23*t15 - t11*t27,  # 4, 5, 6
         t55,  # 5, 0, 0
         t66,  # 5, 0, 1
         t79,  # 5, 0, 2
         t88,  # 5, 0, 3
         t93,  # 5, 0, 4
-        -t25*t36 - t43*t55,  # 5, 0, 5
+        -(t25*t36 + t43*t55),  # 5, 0, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 0, 6
         t52,  # 5, 1, 0
         t70,  # 5, 1, 1
         t82,  # 5, 1, 2
         t90,  # 5, 1, 3
         t94,  # 5, 1, 4
-        -t13*t36 - t43*t52,  # 5, 1, 5
+        -(t13*t36 + t43*t52),  # 5, 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 1, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 2, 0
         t76,  # 5, 2, 1
@@ -1958,21 +1958,21 @@ def hessian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 3, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 3, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 3, 5
-        t25*t45 - t27*t43,  # 5, 3, 6
+        t25*t45 - t43*t27,  # 5, 3, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 4, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 4, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 4, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 4, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 4, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 4, 5
-        t13*t45 + t15*t43,  # 5, 4, 6
+        t13*t45 + t43*t15,  # 5, 4, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 5, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 5, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 5, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 5, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 5, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 5, 5
-        -t13*t27 - t15*t25,  # 5, 5, 6
+        -(t13*t27 + t25*t15),  # 5, 5, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 6, 0, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 6, 0, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 6, 0, 2
@@ -2020,7 +2020,7 @@ def hessian(q):
 
 
 def singularity_factors(q):
-    """factors of det(Js Js^T): the robot is singular where one is 0: (1 x 1), 755 operations."""
+    """factors of det(Js Js^T): the robot is singular where one is 0: (1 x 1), 740 operations."""
     xp, dtype, device, batch, (q,) = _arguments(("q", q, (7,)))
     trig = _cos_sin(xp, q, (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0), device)
     c1 = trig[..., 0]
@@ -2037,175 +2037,175 @@ def singularity_factors(q):
     s6 = trig[..., 11]
     t0 = s1*s3
     t1 = c1*c3
-    t2 = -t0 + c2*t1
-    t3 = t1 - c2*t0
+    t2 = -t0 + t1*c2
+    t3 = t1 - t0*c2
     t4 = c3*s1
     t5 = c1*s3
-    t6 = t4 + c2*t5
-    t7 = t5 + c2*t4
+    t6 = t4 + t5*c2
+    t7 = t5 + t4*c2
     t8 = 0.316*s2
-    t9 = 0.0825*t2 + c1*t8
-    t10 = 0.0825*t7 + s1*t8
+    t9 = 0.0825*t2 + t8*c1
+    t10 = 0.0825*t7 + t8*s1
     t11 = c3*s2
     t12 = 0.316*c2 - 0.0825*t11
-    t13 = c2*s4 - c4*t11
-    t14 = c2*c4 + s4*t11
+    t13 = c2*s4 - t11*c4
+    t14 = t11*s4 + c2*c4
     t15 = c1*s2
-    t16 = c4*t2 + s4*t15
-    t17 = c4*t15 - s4*t2
-    t18 = c5*t16 - s5*t6
-    t19 = c5*t6 + s5*t16
-    t20 = c6*t18 + s6*t17
-    t21 = c6*t17 - s6*t18
+    t16 = t2*c4 + t15*s4
+    t17 = t15*c4 - t2*s4
+    t18 = t16*c5 - t6*s5
+    t19 = t16*s5 + t6*c5
+    t20 = t17*s6 + t18*c6
+    t21 = t17*c6 - t18*s6
     t22 = 0.088*t20 - 0.21*t21
     t23 = t22 + 0.384*t17
     t24 = t23 - 0.0825*t16
-    t25 = t24 + t9
+    t25 = t9 + t24
     t26 = s1*s2
-    t27 = c4*t7 + s4*t26
-    t28 = c4*t26 - s4*t7
-    t29 = c5*t27 + s5*t3
-    t30 = c5*t3 - s5*t27
-    t31 = c6*t29 + s6*t28
-    t32 = c6*t28 - s6*t29
+    t27 = t7*c4 + t26*s4
+    t28 = t26*c4 - t7*s4
+    t29 = t27*c5 + t3*s5
+    t30 = t3*c5 - t27*s5
+    t31 = t28*s6 + t29*c6
+    t32 = t28*c6 - t29*s6
     t33 = 0.088*t31 - 0.21*t32
     t34 = t33 + 0.384*t28
     t35 = t34 - 0.0825*t27
     t36 = t10 + t35
-    t37 = c1*t25 + s1*t36
-    t38 = t24*t3 + t35*t6
-    t39 = t17*t34 - t23*t28
-    t40 = t19*t33 + t22*t30
-    t41 = t25*t26 - t15*t36
+    t37 = t25*c1 + t36*s1
+    t38 = t36*t15 - t25*t26
+    t39 = t24*t3 + t35*t6
+    t40 = t17*t34 - t28*t23
+    t41 = t19*t33 + t30*t22
     t42 = s2*s3
-    t43 = c5*t13 + s5*t42
-    t44 = c5*t42 - s5*t13
-    t45 = c6*t43 + s6*t14
-    t46 = c6*t14 - s6*t43
+    t43 = t13*c5 + t42*s5
+    t44 = t42*c5 - t13*s5
+    t45 = t14*s6 + t43*c6
+    t46 = t14*c6 - t43*s6
     t47 = 0.088*t45 - 0.21*t46
     t48 = t47 + 0.384*t14
     t49 = t48 - 0.0825*t13
     t50 = t12 + t49
-    t51 = t35*t42 - t3*t49
-    t52 = t28*t48 - t14*t34
-    t53 = c2*t25 - t15*t50
-    t54 = t24*t42 + t49*t6
-    t55 = t19*t47 + t22*t44
-    t56 = c2*t36 - t26*t50
-    t57 = t30*t47 - t33*t44
-    t58 = t17*t48 - t14*t23
-    t59 = t17*t3 + t28*t6
-    t60 = c1*t17
-    t61 = -t60 - s1*t28
-    t62 = c1*t6
-    t63 = -t62 + s1*t3
-    t64 = t37*t59 + t38*t61 - t39*t63
-    t65 = t19*t3 - t30*t6
-    t66 = c1*t19
-    t67 = -t66 + s1*t30
-    t68 = t37*t65 + t38*t67 - t40*t63
-    t69 = -t17*t30 - t19*t28
-    t70 = t37*t69 + t39*t67 - t40*t61
-    t71 = t39*t65 - t38*t69 - t40*t59
-    t72 = s1*t50
+    t51 = t50*t26 - t36*c2
+    t52 = t35*t42 - t49*t3
+    t53 = t28*t48 - t14*t34
+    t54 = t44*t33 - t30*t47
+    t55 = t25*c2 - t50*t15
+    t56 = t24*t42 + t49*t6
+    t57 = t14*t23 - t17*t48
+    t58 = t19*t47 + t44*t22
+    t59 = t19*t3 - t30*t6
+    t60 = t19*c1
+    t61 = -t60 + t30*s1
+    t62 = t6*c1
+    t63 = -t62 + t3*s1
+    t64 = t37*t59 + t39*t61 - t41*t63
+    t65 = t17*t3 + t28*t6
+    t66 = t17*c1
+    t67 = -(t66 + t28*s1)
+    t68 = t37*t65 + t39*t67 - t40*t63
+    t69 = -(t17*t30 + t28*t19)
+    t70 = t37*t69 + t40*t61 - t41*t67
+    t71 = -(t39*t69 + t41*t65 - t40*t59)
+    t72 = t50*s1
     t73 = t14*t30 - t28*t44
-    t74 = t14*t66 + t44*t60 - s1*t73
-    t75 = s2*t5
-    t76 = t3*t44 - t30*t42
-    t77 = -s1*t76 - t19*t75 + c1*t44*t6
+    t74 = t14*t60 + t44*t66 - t73*s1
+    t75 = t5*s2
+    t76 = t44*t3 - t30*t42
+    t77 = -(t19*t75 + t76*s1 - t44*t6*c1)
     t78 = t28*t42 - t14*t3
-    t79 = -s1*t78 - t14*t62 - t17*t75
+    t79 = -(t17*t75 + t14*t62 + t78*s1)
     t80 = t19*t78 + t6*t73 - t17*t76
-    t81 = t39*t77 - t37*t80 - t38*t74 - t40*t79
-    t82 = -t15*t30 - t19*t26
-    t83 = t15*t28 - t17*t26
-    t84 = t39*t82 + t41*t69 - t40*t83
-    t85 = c1**2
-    t86 = s2*t85
-    t87 = -t86 - s2*s1**2
-    t88 = t37*t82 - t40*t87 - t41*t67
-    t89 = t37*t83 - t39*t87 - t41*t61
-    t90 = c2*t30 - t26*t44
-    t91 = c2*t66 + t44*t86 - s1*t90
-    t92 = t14*t26 - c2*t28
-    t93 = -s1*t92 - t14*t86 + c1*c2*t17
-    t94 = t15*t73 + t19*t92 - t17*t90
-    t95 = t39*t91 + t41*t74 - t37*t94 - t40*t93
-    t96 = -t15*t3 - t26*t6
-    t97 = t38*t83 + t41*t59 - t39*t96
-    t98 = t37*t96 - t38*t87 - t41*t63
+    t81 = -(t37*t80 + t39*t74 + t41*t79 - t40*t77)
+    t82 = -(t19*t26 + t30*t15)
+    t83 = c1**2
+    t84 = t83*s2
+    t85 = -(t84 + s2*s1**2)
+    t86 = t37*t82 + t38*t61 - t41*t85
+    t87 = t28*t15 - t17*t26
+    t88 = t37*t87 + t38*t67 - t40*t85
+    t89 = -(t38*t69 + t41*t87 - t40*t82)
+    t90 = t30*c2 - t44*t26
+    t91 = t44*t84 + t60*c2 - t90*s1
+    t92 = t14*t26 - t28*c2
+    t93 = -(t14*t84 + t92*s1 - t17*c1*c2)
+    t94 = t19*t92 + t73*t15 - t17*t90
+    t95 = -(t37*t94 + t38*t74 + t41*t93 - t40*t91)
+    t96 = -(t6*t26 + t3*t15)
+    t97 = -(t38*t65 + t40*t96 - t39*t87)
+    t98 = t37*t96 + t38*t63 - t39*t85
     t99 = s2**2
-    t100 = c2*t3 - t0*t99
-    t101 = c2*t62 - s1*t100 + s3*t85*t99
-    t102 = t100*t17 + t15*t78 - t6*t92
-    t103 = t38*t93 + t41*t79 - t101*t39 - t102*t37
-    t104 = t38*t82 + t41*t65 - t40*t96
-    t105 = t100*t19 + t15*t76 - t6*t90
-    t106 = t38*t91 + t41*t77 - t101*t40 - t105*t37
-    t107 = t105*t39 - t102*t40 - t38*t94 - t41*t80
-    t108 = c1*t50
-    t109 = t51*(t25*t95 + t53*t70 + t58*t88 - t55*t89 - t72*t84) - t108*(t53*t71 + t54*t84 + t55*t97 - t104*t58 - t107*t25) - t36*(t103*t55 + t53*t81 + t54*t95 - t106*t58 - s1*t107*t50) - t52*(t106*t25 + t53*t68 + t54*t88 - t104*t72 - t55*t98) - t56*(t54*t70 + t55*t64 + t71*t72 - t25*t81 - t58*t68) - t57*(t103*t25 + t53*t64 + t54*t89 - t58*t98 - t72*t97)
-    t110 = c1*t21
-    t111 = t110 + s1*t32
-    t112 = -t21*t3 - t32*t6
-    t113 = t111*t38 + t112*t37
-    t114 = t21*t28 - t17*t32
-    t115 = t111*t39 + t114*t37
-    t116 = t112*t39 - t114*t38
+    t100 = t3*c2 - t0*t99
+    t101 = t62*c2 - t100*s1 + t83*t99*s3
+    t102 = t17*t100 + t78*t15 - t6*t92
+    t103 = -(t37*t102 + t38*t79 + t40*t101 - t39*t93)
+    t104 = -(t38*t59 + t41*t96 - t39*t82)
+    t105 = t19*t100 + t76*t15 - t6*t90
+    t106 = -(t37*t105 + t38*t77 + t41*t101 - t39*t91)
+    t107 = t38*t80 + t40*t105 - t39*t94 - t41*t102
+    t108 = t50*c1
+    t109 = t51*(t56*t70 + t57*t64 + t58*t68 + t71*t72 - t25*t81) + t54*(t25*t103 + t55*t68 + t56*t88 + t57*t98 - t72*t97) - t36*(t55*t81 + t56*t95 + t57*t106 + t58*t103 - t50*t107*s1) - t52*(t57*t86 + t58*t88 + t72*t89 - t25*t95 - t55*t70) - t53*(t25*t106 + t55*t64 + t56*t86 - t58*t98 - t72*t104) - t108*(t55*t71 + t56*t89 + t57*t104 + t58*t97 - t25*t107)
+    t110 = t21*c1
+    t111 = t110 + t32*s1
+    t112 = t28*t21 - t17*t32
+    t113 = t37*t112 + t40*t111
+    t114 = -(t21*t3 + t32*t6)
+    t115 = t37*t114 + t39*t111
+    t116 = t40*t114 - t39*t112
     t117 = t14*t32 - t28*t46
-    t118 = -s1*t117 - t110*t14 + c1*t17*t46
-    t119 = t3*t46 - t32*t42
-    t120 = t21*t75 + t46*t62 - s1*t119
-    t121 = t117*t6 - t119*t17 - t21*t78
-    t122 = t120*t39 - t118*t38 - t121*t37
-    t123 = t113*t58 + t122*t25 - t115*t54 - t116*t72
-    t124 = t21*t26 - t15*t32
-    t125 = t124*t37 - t111*t41
-    t126 = t114*t41 + t124*t39
-    t127 = c2*t32 - t26*t46
-    t128 = -c2*t110 - s1*t127 + s2*t46*t85
-    t129 = -t127*t17 - t21*t92 + c1*s2*t117
-    t130 = t118*t41 + t128*t39 - t129*t37
-    t131 = t115*t53 + t125*t58 + t130*t25 - t126*t72
-    t132 = t112*t41 + t124*t38
-    t133 = -t100*t21 - t127*t6 + c1*s2*t119
-    t134 = t120*t41 + t128*t38 - t133*t37
-    t135 = t113*t53 + t125*t54 + t134*t25 - t132*t72
-    t136 = t133*t39 - t121*t41 - t129*t38
-    t137 = t132*t58 + t136*t25 - t116*t53 - t126*t54
-    t138 = t134*t58 + t136*t72 - t122*t53 - t130*t54
-    t139 = t108*t137 + t123*t56 + t131*t51 + t138*t36 - t135*t52
-    t140 = -t19*t32 - t21*t30
-    t141 = t111*t40 + t140*t37
-    t142 = t112*t40 - t140*t38
-    t143 = t30*t46 - t32*t44
-    t144 = t110*t44 + t46*t66 - s1*t143
-    t145 = t143*t6 - t119*t19 - t21*t76
-    t146 = t120*t40 - t144*t38 - t145*t37
-    t147 = t113*t55 + t146*t25 - t141*t54 - t142*t72
-    t148 = t124*t40 + t140*t41
-    t149 = -t127*t19 - t21*t90 + c1*s2*t143
-    t150 = t128*t40 + t144*t41 - t149*t37
-    t151 = t125*t55 + t141*t53 + t150*t25 - t148*t72
-    t152 = t133*t40 - t145*t41 - t149*t38
-    t153 = t132*t55 + t152*t25 - t142*t53 - t148*t54
-    t154 = t134*t55 + t152*t72 - t146*t53 - t150*t54
-    t155 = t108*t153 + t135*t57 + t147*t56 + t151*t51 + t154*t36
-    t156 = t114*t40 - t140*t39
-    t157 = t143*t17 - t117*t19 - t21*t73
-    t158 = t118*t40 - t144*t39 - t157*t37
-    t159 = t115*t55 + t158*t25 - t141*t58 - t156*t72
-    t160 = t129*t40 - t149*t39 - t157*t41
-    t161 = t126*t55 + t160*t25 - t148*t58 - t156*t53
-    t162 = t130*t55 + t160*t72 - t150*t58 - t158*t53
-    t163 = t108*t161 + t131*t57 + t151*t52 + t159*t56 + t162*t36
-    t164 = t121*t40 + t157*t38 - t145*t39
-    t165 = t116*t55 + t156*t54 + t164*t25 - t142*t58
-    t166 = t122*t55 + t158*t54 + t164*t72 - t146*t58
-    t167 = t108*t165 + t123*t57 + t147*t52 + t166*t36 - t159*t51
-    t168 = t136*t55 + t160*t54 + t164*t53 - t152*t58
-    t169 = t137*t57 + t153*t52 + t168*t36 - t161*t51 - t165*t56
-    t170 = t108*t168 + t162*t51 + t166*t56 - t138*t57 - t154*t52
+    t118 = -(t14*t110 + t117*s1 - t17*t46*c1)
+    t119 = t46*t3 - t32*t42
+    t120 = t21*t75 + t46*t62 - t119*s1
+    t121 = -(t17*t119 + t21*t78 - t6*t117)
+    t122 = -(t37*t121 + t39*t118 - t40*t120)
+    t123 = -(t56*t113 + t57*t115 + t72*t116 - t25*t122)
+    t124 = t21*t26 - t32*t15
+    t125 = t37*t124 + t38*t111
+    t126 = t40*t124 - t38*t112
+    t127 = t32*c2 - t46*t26
+    t128 = -(t110*c2 + t127*s1 - t46*t83*s2)
+    t129 = -(t17*t127 + t21*t92 - t117*c1*s2)
+    t130 = -(t37*t129 + t38*t118 - t40*t128)
+    t131 = t25*t130 + t55*t113 - t57*t125 - t72*t126
+    t132 = t39*t124 - t38*t114
+    t133 = -(t21*t100 + t6*t127 - t119*c1*s2)
+    t134 = -(t37*t133 + t38*t120 - t39*t128)
+    t135 = t25*t134 + t55*t115 + t56*t125 - t72*t132
+    t136 = t38*t121 + t40*t133 - t39*t129
+    t137 = -(t55*t116 + t56*t126 + t57*t132 - t25*t136)
+    t138 = -(t55*t122 + t56*t130 + t57*t134 - t50*t136*s1)
+    t139 = t36*t138 + t52*t131 + t108*t137 - t51*t123 - t53*t135
+    t140 = -(t19*t32 + t30*t21)
+    t141 = t37*t140 + t41*t111
+    t142 = t41*t114 - t39*t140
+    t143 = t30*t46 - t44*t32
+    t144 = t44*t110 + t46*t60 - t143*s1
+    t145 = -(t19*t119 + t21*t76 - t6*t143)
+    t146 = -(t37*t145 + t39*t144 - t41*t120)
+    t147 = t25*t146 + t58*t115 - t56*t141 - t72*t142
+    t148 = t41*t124 - t38*t140
+    t149 = -(t19*t127 + t21*t90 - t143*c1*s2)
+    t150 = -(t37*t149 + t38*t144 - t41*t128)
+    t151 = t25*t150 + t55*t141 + t58*t125 - t72*t148
+    t152 = t38*t145 + t41*t133 - t39*t149
+    t153 = t25*t152 + t58*t132 - t55*t142 - t56*t148
+    t154 = t58*t134 + t152*t72 - t55*t146 - t56*t150
+    t155 = t36*t154 + t52*t151 + t153*t108 - t51*t147 - t54*t135
+    t156 = t41*t112 - t40*t140
+    t157 = -(t19*t117 + t21*t73 - t17*t143)
+    t158 = -(t37*t157 + t40*t144 - t41*t118)
+    t159 = t25*t158 + t57*t141 + t58*t113 - t156*t72
+    t160 = t38*t157 + t41*t129 - t40*t149
+    t161 = t25*t160 + t57*t148 + t58*t126 - t55*t156
+    t162 = t57*t150 + t58*t130 + t160*t72 - t55*t158
+    t163 = t36*t162 + t53*t151 + t161*t108 - t51*t159 - t54*t131
+    t164 = t39*t157 + t41*t121 - t40*t145
+    t165 = t25*t164 + t56*t156 + t57*t142 + t58*t116
+    t166 = t56*t158 + t57*t146 + t58*t122 + t164*t72
+    t167 = t36*t166 + t53*t147 + t165*t108 - t52*t159 - t54*t123
+    t168 = t55*t164 + t56*t160 + t57*t152 + t58*t136
+    t169 = t36*t168 + t51*t165 + t53*t153 - t52*t161 - t54*t137
+    t170 = t52*t162 + t54*t138 + t168*t108 - t51*t166 - t53*t154
     f = _stack(xp, [
         t109**2 + t139**2 + t155**2 + t163**2 + t167**2 + t169**2 + t170**2,  # 0
     ], (1,))
@@ -2213,7 +2213,7 @@ def singularity_factors(q):
 
 
 def manipulability(q):
-    """manipulability sqrt(det(Js Js^T)): (1 x 1), 758 operations."""
+    """manipulability sqrt(det(Js Js^T)): (1 x 1), 743 operations."""
     xp, dtype, device, batch, (q,) = _arguments(("q", q, (7,)))
     trig = _cos_sin(xp, q, (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0), device)
     c1 = trig[..., 0]
@@ -2230,175 +2230,175 @@ def manipulability(q):
     s6 = trig[..., 11]
     t0 = s1*s3
     t1 = c1*c3
-    t2 = -t0 + c2*t1
-    t3 = t1 - c2*t0
+    t2 = -t0 + t1*c2
+    t3 = t1 - t0*c2
     t4 = c3*s1
     t5 = c1*s3
-    t6 = t4 + c2*t5
-    t7 = t5 + c2*t4
+    t6 = t4 + t5*c2
+    t7 = t5 + t4*c2
     t8 = 0.316*s2
-    t9 = 0.0825*t2 + c1*t8
-    t10 = 0.0825*t7 + s1*t8
+    t9 = 0.0825*t2 + t8*c1
+    t10 = 0.0825*t7 + t8*s1
     t11 = c3*s2
     t12 = 0.316*c2 - 0.0825*t11
-    t13 = c2*s4 - c4*t11
-    t14 = c2*c4 + s4*t11
+    t13 = c2*s4 - t11*c4
+    t14 = t11*s4 + c2*c4
     t15 = c1*s2
-    t16 = c4*t2 + s4*t15
-    t17 = c4*t15 - s4*t2
-    t18 = c5*t16 - s5*t6
-    t19 = c5*t6 + s5*t16
-    t20 = c6*t18 + s6*t17
-    t21 = c6*t17 - s6*t18
+    t16 = t2*c4 + t15*s4
+    t17 = t15*c4 - t2*s4
+    t18 = t16*c5 - t6*s5
+    t19 = t16*s5 + t6*c5
+    t20 = t17*s6 + t18*c6
+    t21 = t17*c6 - t18*s6
     t22 = 0.088*t20 - 0.21*t21
     t23 = t22 + 0.384*t17
     t24 = t23 - 0.0825*t16
-    t25 = t24 + t9
+    t25 = t9 + t24
     t26 = s1*s2
-    t27 = c4*t7 + s4*t26
-    t28 = c4*t26 - s4*t7
-    t29 = c5*t27 + s5*t3
-    t30 = c5*t3 - s5*t27
-    t31 = c6*t29 + s6*t28
-    t32 = c6*t28 - s6*t29
+    t27 = t7*c4 + t26*s4
+    t28 = t26*c4 - t7*s4
+    t29 = t27*c5 + t3*s5
+    t30 = t3*c5 - t27*s5
+    t31 = t28*s6 + t29*c6
+    t32 = t28*c6 - t29*s6
     t33 = 0.088*t31 - 0.21*t32
     t34 = t33 + 0.384*t28
     t35 = t34 - 0.0825*t27
     t36 = t10 + t35
-    t37 = c1*t25 + s1*t36
-    t38 = t24*t3 + t35*t6
-    t39 = t17*t34 - t23*t28
-    t40 = t19*t33 + t22*t30
-    t41 = t25*t26 - t15*t36
+    t37 = t25*c1 + t36*s1
+    t38 = t36*t15 - t25*t26
+    t39 = t24*t3 + t35*t6
+    t40 = t17*t34 - t28*t23
+    t41 = t19*t33 + t30*t22
     t42 = s2*s3
-    t43 = c5*t13 + s5*t42
-    t44 = c5*t42 - s5*t13
-    t45 = c6*t43 + s6*t14
-    t46 = c6*t14 - s6*t43
+    t43 = t13*c5 + t42*s5
+    t44 = t42*c5 - t13*s5
+    t45 = t14*s6 + t43*c6
+    t46 = t14*c6 - t43*s6
     t47 = 0.088*t45 - 0.21*t46
     t48 = t47 + 0.384*t14
     t49 = t48 - 0.0825*t13
     t50 = t12 + t49
-    t51 = t35*t42 - t3*t49
-    t52 = t28*t48 - t14*t34
-    t53 = c2*t25 - t15*t50
-    t54 = t24*t42 + t49*t6
-    t55 = t19*t47 + t22*t44
-    t56 = c2*t36 - t26*t50
-    t57 = t30*t47 - t33*t44
-    t58 = t17*t48 - t14*t23
-    t59 = t17*t3 + t28*t6
-    t60 = c1*t17
-    t61 = -t60 - s1*t28
-    t62 = c1*t6
-    t63 = -t62 + s1*t3
-    t64 = t37*t59 + t38*t61 - t39*t63
-    t65 = t19*t3 - t30*t6
-    t66 = c1*t19
-    t67 = -t66 + s1*t30
-    t68 = t37*t65 + t38*t67 - t40*t63
-    t69 = -t17*t30 - t19*t28
-    t70 = t37*t69 + t39*t67 - t40*t61
-    t71 = t39*t65 - t38*t69 - t40*t59
-    t72 = s1*t50
+    t51 = t50*t26 - t36*c2
+    t52 = t35*t42 - t49*t3
+    t53 = t28*t48 - t14*t34
+    t54 = t44*t33 - t30*t47
+    t55 = t25*c2 - t50*t15
+    t56 = t24*t42 + t49*t6
+    t57 = t14*t23 - t17*t48
+    t58 = t19*t47 + t44*t22
+    t59 = t19*t3 - t30*t6
+    t60 = t19*c1
+    t61 = -t60 + t30*s1
+    t62 = t6*c1
+    t63 = -t62 + t3*s1
+    t64 = t37*t59 + t39*t61 - t41*t63
+    t65 = t17*t3 + t28*t6
+    t66 = t17*c1
+    t67 = -(t66 + t28*s1)
+    t68 = t37*t65 + t39*t67 - t40*t63
+    t69 = -(t17*t30 + t28*t19)
+    t70 = t37*t69 + t40*t61 - t41*t67
+    t71 = -(t39*t69 + t41*t65 - t40*t59)
+    t72 = t50*s1
     t73 = t14*t30 - t28*t44
-    t74 = t14*t66 + t44*t60 - s1*t73
-    t75 = s2*t5
-    t76 = t3*t44 - t30*t42
-    t77 = -s1*t76 - t19*t75 + c1*t44*t6
+    t74 = t14*t60 + t44*t66 - t73*s1
+    t75 = t5*s2
+    t76 = t44*t3 - t30*t42
+    t77 = -(t19*t75 + t76*s1 - t44*t6*c1)
     t78 = t28*t42 - t14*t3
-    t79 = -s1*t78 - t14*t62 - t17*t75
+    t79 = -(t17*t75 + t14*t62 + t78*s1)
     t80 = t19*t78 + t6*t73 - t17*t76
-    t81 = t39*t77 - t37*t80 - t38*t74 - t40*t79
-    t82 = -t15*t30 - t19*t26
-    t83 = t15*t28 - t17*t26
-    t84 = t39*t82 + t41*t69 - t40*t83
-    t85 = c1**2
-    t86 = s2*t85
-    t87 = -t86 - s2*s1**2
-    t88 = t37*t82 - t40*t87 - t41*t67
-    t89 = t37*t83 - t39*t87 - t41*t61
-    t90 = c2*t30 - t26*t44
-    t91 = c2*t66 + t44*t86 - s1*t90
-    t92 = t14*t26 - c2*t28
-    t93 = -s1*t92 - t14*t86 + c1*c2*t17
-    t94 = t15*t73 + t19*t92 - t17*t90
-    t95 = t39*t91 + t41*t74 - t37*t94 - t40*t93
-    t96 = -t15*t3 - t26*t6
-    t97 = t38*t83 + t41*t59 - t39*t96
-    t98 = t37*t96 - t38*t87 - t41*t63
+    t81 = -(t37*t80 + t39*t74 + t41*t79 - t40*t77)
+    t82 = -(t19*t26 + t30*t15)
+    t83 = c1**2
+    t84 = t83*s2
+    t85 = -(t84 + s2*s1**2)
+    t86 = t37*t82 + t38*t61 - t41*t85
+    t87 = t28*t15 - t17*t26
+    t88 = t37*t87 + t38*t67 - t40*t85
+    t89 = -(t38*t69 + t41*t87 - t40*t82)
+    t90 = t30*c2 - t44*t26
+    t91 = t44*t84 + t60*c2 - t90*s1
+    t92 = t14*t26 - t28*c2
+    t93 = -(t14*t84 + t92*s1 - t17*c1*c2)
+    t94 = t19*t92 + t73*t15 - t17*t90
+    t95 = -(t37*t94 + t38*t74 + t41*t93 - t40*t91)
+    t96 = -(t6*t26 + t3*t15)
+    t97 = -(t38*t65 + t40*t96 - t39*t87)
+    t98 = t37*t96 + t38*t63 - t39*t85
     t99 = s2**2
-    t100 = c2*t3 - t0*t99
-    t101 = c2*t62 - s1*t100 + s3*t85*t99
-    t102 = t100*t17 + t15*t78 - t6*t92
-    t103 = t38*t93 + t41*t79 - t101*t39 - t102*t37
-    t104 = t38*t82 + t41*t65 - t40*t96
-    t105 = t100*t19 + t15*t76 - t6*t90
-    t106 = t38*t91 + t41*t77 - t101*t40 - t105*t37
-    t107 = t105*t39 - t102*t40 - t38*t94 - t41*t80
-    t108 = c1*t50
-    t109 = t51*(t25*t95 + t53*t70 + t58*t88 - t55*t89 - t72*t84) - t108*(t53*t71 + t54*t84 + t55*t97 - t104*t58 - t107*t25) - t36*(t103*t55 + t53*t81 + t54*t95 - t106*t58 - s1*t107*t50) - t52*(t106*t25 + t53*t68 + t54*t88 - t104*t72 - t55*t98) - t56*(t54*t70 + t55*t64 + t71*t72 - t25*t81 - t58*t68) - t57*(t103*t25 + t53*t64 + t54*t89 - t58*t98 - t72*t97)
-    t110 = c1*t21
-    t111 = t110 + s1*t32
-    t112 = -t21*t3 - t32*t6
-    t113 = t111*t38 + t112*t37
-    t114 = t21*t28 - t17*t32
-    t115 = t111*t39 + t114*t37
-    t116 = t112*t39 - t114*t38
+    t100 = t3*c2 - t0*t99
+    t101 = t62*c2 - t100*s1 + t83*t99*s3
+    t102 = t17*t100 + t78*t15 - t6*t92
+    t103 = -(t37*t102 + t38*t79 + t40*t101 - t39*t93)
+    t104 = -(t38*t59 + t41*t96 - t39*t82)
+    t105 = t19*t100 + t76*t15 - t6*t90
+    t106 = -(t37*t105 + t38*t77 + t41*t101 - t39*t91)
+    t107 = t38*t80 + t40*t105 - t39*t94 - t41*t102
+    t108 = t50*c1
+    t109 = t51*(t56*t70 + t57*t64 + t58*t68 + t71*t72 - t25*t81) + t54*(t25*t103 + t55*t68 + t56*t88 + t57*t98 - t72*t97) - t36*(t55*t81 + t56*t95 + t57*t106 + t58*t103 - t50*t107*s1) - t52*(t57*t86 + t58*t88 + t72*t89 - t25*t95 - t55*t70) - t53*(t25*t106 + t55*t64 + t56*t86 - t58*t98 - t72*t104) - t108*(t55*t71 + t56*t89 + t57*t104 + t58*t97 - t25*t107)
+    t110 = t21*c1
+    t111 = t110 + t32*s1
+    t112 = t28*t21 - t17*t32
+    t113 = t37*t112 + t40*t111
+    t114 = -(t21*t3 + t32*t6)
+    t115 = t37*t114 + t39*t111
+    t116 = t40*t114 - t39*t112
     t117 = t14*t32 - t28*t46
-    t118 = -s1*t117 - t110*t14 + c1*t17*t46
-    t119 = t3*t46 - t32*t42
-    t120 = t21*t75 + t46*t62 - s1*t119
-    t121 = t117*t6 - t119*t17 - t21*t78
-    t122 = t120*t39 - t118*t38 - t121*t37
-    t123 = t113*t58 + t122*t25 - t115*t54 - t116*t72
-    t124 = t21*t26 - t15*t32
-    t125 = t124*t37 - t111*t41
-    t126 = t114*t41 + t124*t39
-    t127 = c2*t32 - t26*t46
-    t128 = -c2*t110 - s1*t127 + s2*t46*t85
-    t129 = -t127*t17 - t21*t92 + c1*s2*t117
-    t130 = t118*t41 + t128*t39 - t129*t37
-    t131 = t115*t53 + t125*t58 + t130*t25 - t126*t72
-    t132 = t112*t41 + t124*t38
-    t133 = -t100*t21 - t127*t6 + c1*s2*t119
-    t134 = t120*t41 + t128*t38 - t133*t37
-    t135 = t113*t53 + t125*t54 + t134*t25 - t132*t72
-    t136 = t133*t39 - t121*t41 - t129*t38
-    t137 = t132*t58 + t136*t25 - t116*t53 - t126*t54
-    t138 = t134*t58 + t136*t72 - t122*t53 - t130*t54
-    t139 = t108*t137 + t123*t56 + t131*t51 + t138*t36 - t135*t52
-    t140 = -t19*t32 - t21*t30
-    t141 = t111*t40 + t140*t37
-    t142 = t112*t40 - t140*t38
-    t143 = t30*t46 - t32*t44
-    t144 = t110*t44 + t46*t66 - s1*t143
-    t145 = t143*t6 - t119*t19 - t21*t76
-    t146 = t120*t40 - t144*t38 - t145*t37
-    t147 = t113*t55 + t146*t25 - t141*t54 - t142*t72
-    t148 = t124*t40 + t140*t41
-    t149 = -t127*t19 - t21*t90 + c1*s2*t143
-    t150 = t128*t40 + t144*t41 - t149*t37
-    t151 = t125*t55 + t141*t53 + t150*t25 - t148*t72
-    t152 = t133*t40 - t145*t41 - t149*t38
-    t153 = t132*t55 + t152*t25 - t142*t53 - t148*t54
-    t154 = t134*t55 + t152*t72 - t146*t53 - t150*t54
-    t155 = t108*t153 + t135*t57 + t147*t56 + t151*t51 + t154*t36
-    t156 = t114*t40 - t140*t39
-    t157 = t143*t17 - t117*t19 - t21*t73
-    t158 = t118*t40 - t144*t39 - t157*t37
-    t159 = t115*t55 + t158*t25 - t141*t58 - t156*t72
-    t160 = t129*t40 - t149*t39 - t157*t41
-    t161 = t126*t55 + t160*t25 - t148*t58 - t156*t53
-    t162 = t130*t55 + t160*t72 - t150*t58 - t158*t53
-    t163 = t108*t161 + t131*t57 + t151*t52 + t159*t56 + t162*t36
-    t164 = t121*t40 + t157*t38 - t145*t39
-    t165 = t116*t55 + t156*t54 + t164*t25 - t142*t58
-    t166 = t122*t55 + t158*t54 + t164*t72 - t146*t58
-    t167 = t108*t165 + t123*t57 + t147*t52 + t166*t36 - t159*t51
-    t168 = t136*t55 + t160*t54 + t164*t53 - t152*t58
-    t169 = t137*t57 + t153*t52 + t168*t36 - t161*t51 - t165*t56
-    t170 = t108*t168 + t162*t51 + t166*t56 - t138*t57 - t154*t52
+    t118 = -(t14*t110 + t117*s1 - t17*t46*c1)
+    t119 = t46*t3 - t32*t42
+    t120 = t21*t75 + t46*t62 - t119*s1
+    t121 = -(t17*t119 + t21*t78 - t6*t117)
+    t122 = -(t37*t121 + t39*t118 - t40*t120)
+    t123 = -(t56*t113 + t57*t115 + t72*t116 - t25*t122)
+    t124 = t21*t26 - t32*t15
+    t125 = t37*t124 + t38*t111
+    t126 = t40*t124 - t38*t112
+    t127 = t32*c2 - t46*t26
+    t128 = -(t110*c2 + t127*s1 - t46*t83*s2)
+    t129 = -(t17*t127 + t21*t92 - t117*c1*s2)
+    t130 = -(t37*t129 + t38*t118 - t40*t128)
+    t131 = t25*t130 + t55*t113 - t57*t125 - t72*t126
+    t132 = t39*t124 - t38*t114
+    t133 = -(t21*t100 + t6*t127 - t119*c1*s2)
+    t134 = -(t37*t133 + t38*t120 - t39*t128)
+    t135 = t25*t134 + t55*t115 + t56*t125 - t72*t132
+    t136 = t38*t121 + t40*t133 - t39*t129
+    t137 = -(t55*t116 + t56*t126 + t57*t132 - t25*t136)
+    t138 = -(t55*t122 + t56*t130 + t57*t134 - t50*t136*s1)
+    t139 = t36*t138 + t52*t131 + t108*t137 - t51*t123 - t53*t135
+    t140 = -(t19*t32 + t30*t21)
+    t141 = t37*t140 + t41*t111
+    t142 = t41*t114 - t39*t140
+    t143 = t30*t46 - t44*t32
+    t144 = t44*t110 + t46*t60 - t143*s1
+    t145 = -(t19*t119 + t21*t76 - t6*t143)
+    t146 = -(t37*t145 + t39*t144 - t41*t120)
+    t147 = t25*t146 + t58*t115 - t56*t141 - t72*t142
+    t148 = t41*t124 - t38*t140
+    t149 = -(t19*t127 + t21*t90 - t143*c1*s2)
+    t150 = -(t37*t149 + t38*t144 - t41*t128)
+    t151 = t25*t150 + t55*t141 + t58*t125 - t72*t148
+    t152 = t38*t145 + t41*t133 - t39*t149
+    t153 = t25*t152 + t58*t132 - t55*t142 - t56*t148
+    t154 = t58*t134 + t152*t72 - t55*t146 - t56*t150
+    t155 = t36*t154 + t52*t151 + t153*t108 - t51*t147 - t54*t135
+    t156 = t41*t112 - t40*t140
+    t157 = -(t19*t117 + t21*t73 - t17*t143)
+    t158 = -(t37*t157 + t40*t144 - t41*t118)
+    t159 = t25*t158 + t57*t141 + t58*t113 - t156*t72
+    t160 = t38*t157 + t41*t129 - t40*t149
+    t161 = t25*t160 + t57*t148 + t58*t126 - t55*t156
+    t162 = t57*t150 + t58*t130 + t160*t72 - t55*t158
+    t163 = t36*t162 + t53*t151 + t161*t108 - t51*t159 - t54*t131
+    t164 = t39*t157 + t41*t121 - t40*t145
+    t165 = t25*t164 + t56*t156 + t57*t142 + t58*t116
+    t166 = t56*t158 + t57*t146 + t58*t122 + t164*t72
+    t167 = t36*t166 + t53*t147 + t165*t108 - t52*t159 - t54*t123
+    t168 = t55*t164 + t56*t160 + t57*t152 + t58*t136
+    t169 = t36*t168 + t51*t165 + t53*t153 - t52*t161 - t54*t137
+    t170 = t52*t162 + t54*t138 + t168*t108 - t51*t166 - t53*t154
     t171 = t109**2 + t139**2 + t155**2 + t163**2 + t167**2 + t169**2 + t170**2
     w = xp.broadcast_to(xp.sqrt(xp.abs(t171)), batch)
     return w
@@ -2436,94 +2436,94 @@ def velocity_ik(q, mu_dot, damping=0.0):
     s6 = trig[..., 11]
     t0 = s1*s3
     t1 = c1*c3
-    t2 = -t0 + c2*t1
-    t3 = t1 - c2*t0
+    t2 = -t0 + t1*c2
+    t3 = t1 - t0*c2
     t4 = c3*s1
     t5 = c1*s3
-    t6 = t4 + c2*t5
-    t7 = t5 + c2*t4
+    t6 = t4 + t5*c2
+    t7 = t5 + t4*c2
     t8 = c1*s2
     t9 = 0.316*t8 + 0.0825*t2
-    t10 = c4*t2 + s4*t8
-    t11 = c4*t8 - s4*t2
-    t12 = c5*t10 - s5*t6
-    t13 = c5*t6 + s5*t10
-    t14 = c6*t12 + s6*t11
-    t15 = c6*t11 - s6*t12
+    t10 = t2*c4 + t8*s4
+    t11 = t8*c4 - t2*s4
+    t12 = t10*c5 - t6*s5
+    t13 = t10*s5 + t6*c5
+    t14 = t11*s6 + t12*c6
+    t15 = t11*c6 - t12*s6
     t16 = 0.088*t14 - 0.21*t15
     t17 = t16 + 0.384*t11
     t18 = t17 - 0.0825*t10
-    t19 = t18 + t9
+    t19 = t9 + t18
     t20 = s1*s2
     t21 = 0.316*t20 + 0.0825*t7
-    t22 = c4*t7 + s4*t20
-    t23 = c4*t20 - s4*t7
-    t24 = c5*t22 + s5*t3
-    t25 = c5*t3 - s5*t22
-    t26 = c6*t24 + s6*t23
-    t27 = c6*t23 - s6*t24
+    t22 = t7*c4 + t20*s4
+    t23 = t20*c4 - t7*s4
+    t24 = t22*c5 + t3*s5
+    t25 = t3*c5 - t22*s5
+    t26 = t23*s6 + t24*c6
+    t27 = t23*c6 - t24*s6
     t28 = 0.088*t26 - 0.21*t27
     t29 = t28 + 0.384*t23
     t30 = t29 - 0.0825*t22
     t31 = t21 + t30
-    t32 = c1*t19 + s1*t31
+    t32 = t19*c1 + t31*s1
     t33 = t31*t8 - t19*t20
     t34 = t18*t3 + t30*t6
-    t35 = t11*t29 - t17*t23
-    t36 = t13*t28 + t16*t25
+    t35 = t11*t29 - t23*t17
+    t36 = t13*t28 + t25*t16
     t37 = t32**2 + t33**2 + t34**2 + t35**2 + t36**2
     t38 = c3*s2
     t39 = 0.316*c2 - 0.0825*t38
-    t40 = c2*s4 - c4*t38
-    t41 = c2*c4 + s4*t38
+    t40 = c2*s4 - t38*c4
+    t41 = t38*s4 + c2*c4
     t42 = s2*s3
-    t43 = c5*t40 + s5*t42
-    t44 = c5*t42 - s5*t40
-    t45 = c6*t43 + s6*t41
-    t46 = c6*t41 - s6*t43
+    t43 = t40*c5 + t42*s5
+    t44 = t42*c5 - t40*s5
+    t45 = t41*s6 + t43*c6
+    t46 = t41*c6 - t43*s6
     t47 = 0.088*t45 - 0.21*t46
     t48 = t47 + 0.384*t41
     t49 = t48 - 0.0825*t40
     t50 = t39 + t49
-    t51 = t30*t42 - t3*t49
-    t52 = t23*t48 - t29*t41
-    t53 = t28*t44 - t25*t47
+    t51 = t30*t42 - t49*t3
+    t52 = t23*t48 - t41*t29
+    t53 = t44*t28 - t25*t47
     t54 = t18*t42 + t49*t6
-    t55 = t17*t41 - t11*t48
-    t56 = t13*t47 + t16*t44
-    t57 = c2*t33 + t35*t41 - t34*t42 - t36*t44
-    t58 = c2*t8 + t11*t41 + t15*t46 - t13*t44 - t42*t6
-    t59 = c2*t20 + t23*t41 + t25*t44 + t27*t46 + t3*t42
-    t60 = s1*t50
-    t61 = s2*t60 - c2*t31
-    t62 = t31 + t42*t51 + t44*t53 - c2*t61 - t41*t52
-    t63 = c1*t50
-    t64 = c2*t19 - s2*t63
-    t65 = t19 + c2*t64 + t41*t55 + t42*t54 + t44*t56
-    t66 = 1 + c1 + c2 + damping + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + q1 + q2 + q3 + q4 + q5 + q6 + q7 + t11 + t13 + t19 + t20 + t23 + t33 + t34 + t35 + t36 + t41 + t51 + t52 + t53 + t55 + t6 + t60 + t61 + t63 + t64 + t8 - s1 - t15 - t25 - t27 - t3 - t31 - t32 - t42 - t44 - t46 - t54 - t56
+    t55 = t41*t17 - t11*t48
+    t56 = t13*t47 + t44*t16
+    t57 = t41*t35 + t33*c2 - t44*t36 - t34*t42
+    t58 = t11*t41 + t15*t46 + t8*c2 - t13*t44 - t6*t42
+    t59 = t23*t41 + t25*t44 + t27*t46 + t3*t42 + t20*c2
+    t60 = t50*s1
+    t61 = t60*s2 - t31*c2
+    t62 = t31 + t44*t53 + t51*t42 - t41*t52 - t61*c2
+    t63 = t50*c1
+    t64 = t19*c2 - t63*s2
+    t65 = t19 + t41*t55 + t44*t56 + t64*c2 + t54*t42
+    t66 = 1 + t11 + t23 + t41 + t13 + t19 + t6 + t61 + t51 + t52 + t53 + t64 + t55 + t33 + t34 + t35 + t36 + t8 + t20 + t60 + t63 + c1 + c2 + damping + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + q1 + q2 + q3 + q4 + q5 + q6 + q7 - t25 - t44 - t15 - t27 - t46 - t31 - t54 - t56 - t32 - t3 - t42 - s1
     t67 = t50**2
     t68 = c1**2
-    t69 = t31**2 + t51**2 + t52**2 + t53**2 + t61**2 + t67*t68
-    t70 = t20*t61 + t23*t52 + t50*t68 - t25*t53 - t3*t51
+    t69 = t31**2 + t61**2 + t51**2 + t52**2 + t53**2 + t67*t68
+    t70 = t23*t52 + t50*t68 + t61*t20 - t25*t53 - t51*t3
     t71 = c1*s1
-    t72 = t52*t55 + t61*t64 + t67*t71 - t19*t31 - t51*t54 - t53*t56
-    t73 = c1*t32
-    t74 = t33*t61 + t34*t51 + t35*t52 + t36*t53 - t50*t73
-    t75 = t73 + t25*t36 + t3*t34 - t20*t33 - t23*t35
+    t72 = t61*t64 + t52*t55 + t67*t71 - t19*t31 - t51*t54 - t53*t56
+    t73 = t32*c1
+    t74 = t61*t33 + t51*t34 + t52*t35 + t53*t36 - t50*t73
+    t75 = t73 + t25*t36 + t34*t3 - t23*t35 - t33*t20
     t76 = t50*t71
-    t77 = -t76 + t11*t52 + t13*t53 + t51*t6 + t61*t8
-    t78 = t76 + t20*t64 + t23*t55 + t25*t56 + t3*t54
+    t77 = -t76 + t11*t52 + t13*t53 + t6*t51 + t61*t8
+    t78 = t76 + t23*t55 + t25*t56 + t64*t20 + t54*t3
     t79 = s1**2
-    t80 = t19**2 + t54**2 + t55**2 + t56**2 + t64**2 + t67*t79
-    t81 = t13*t56 + t50*t79 + t54*t6 - t11*t55 - t64*t8
-    t82 = s1*t32
-    t83 = t34*t54 + t36*t56 + t50*t82 - t33*t64 - t35*t55
-    t84 = t82 + t11*t35 + t13*t36 + t33*t8 + t34*t6
+    t80 = t19**2 + t64**2 + t54**2 + t55**2 + t56**2 + t67*t79
+    t81 = t13*t56 + t50*t79 + t6*t54 - t11*t55 - t64*t8
+    t82 = t32*s1
+    t83 = t50*t82 + t54*t34 + t56*t36 - t64*t33 - t55*t35
+    t84 = t82 + t11*t35 + t13*t36 + t6*t34 + t33*t8
     t85 = s2**2
     t86 = t79 + t11**2 + t13**2 + t15**2 + t6**2 + t68*t85
-    t87 = -t71 + t11*t23 + t15*t27 + t71*t85 - t13*t25 - t3*t6
+    t87 = -t71 + t11*t23 + t15*t27 + t71*t85 - t13*t25 - t6*t3
     t88 = t68 + t23**2 + t25**2 + t27**2 + t3**2 + t79*t85
-    t89 = 1 + c2**2 + t41**2 + t44**2 + t46**2 + t85*s3**2
+    t89 = 1 + t41**2 + t44**2 + t46**2 + c2**2 + t85*s3**2
     t90 = t72**2
     t91 = t62**2
     t92 = t74**2
@@ -2534,42 +2534,42 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t97 = t96**2
     t98 = xp.sqrt(t90 + t91 + t92 + t93 + t94 + t97)
     t99 = t98*xp.where(xp.greater_equal(t96, 0), xp.asarray(1, dtype=dtype), -1)
-    t100 = t96 + t99
+    t100 = t99 + t96
     t101 = xp.where(xp.greater(t98, 0), 1/(t98*(t98 + xp.abs(t96))), 0)
-    t102 = t101*(mu_dot0*t100 + mu_dot1*t72 + mu_dot2*t74 + mu_dot3*t77 + mu_dot4*t70 - mu_dot5*t62)
+    t102 = t101*(t72*mu_dot1 + t74*mu_dot2 + t77*mu_dot3 + t70*mu_dot4 + t100*mu_dot0 - t62*mu_dot5)
     t103 = mu_dot0 - t100*t102
-    t104 = mu_dot1 - t102*t72
-    t105 = mu_dot2 - t102*t74
-    t106 = mu_dot3 - t102*t77
-    t107 = mu_dot4 - t102*t70
-    t108 = mu_dot5 + t102*t62
+    t104 = mu_dot1 - t72*t102
+    t105 = mu_dot2 - t74*t102
+    t106 = mu_dot3 - t77*t102
+    t107 = mu_dot4 - t70*t102
+    t108 = mu_dot5 + t62*t102
     t109 = t80 + t95
-    t110 = t101*(t100*t72 + t109*t72 + t70*t78 - t62*t65 - t74*t83 - t77*t81)
+    t110 = t101*(t72*t100 + t72*t109 + t70*t78 - t62*t65 - t74*t83 - t77*t81)
     t111 = t72 - t100*t110
-    t112 = t109 - t110*t72
-    t113 = t83 + t110*t74
-    t114 = t81 + t110*t77
-    t115 = t78 - t110*t70
-    t116 = t65 + t110*t62
+    t112 = t109 - t72*t110
+    t113 = t83 + t74*t110
+    t114 = t81 + t77*t110
+    t115 = t78 - t70*t110
+    t116 = t65 + t62*t110
     t117 = xp.sqrt(t112**2 + t113**2 + t114**2 + t115**2 + t116**2)
     t118 = t117*xp.where(xp.greater_equal(t112, 0), xp.asarray(1, dtype=dtype), -1)
     t119 = t112 + t118
     t120 = xp.where(xp.greater(t117, 0), 1/(t117*(t117 + xp.abs(t112))), 0)
-    t121 = t120*(t104*t119 + t107*t115 + t108*t116 - t105*t113 - t106*t114)
+    t121 = t120*(t115*t107 + t116*t108 + t104*t119 - t113*t105 - t114*t106)
     t122 = t104 - t119*t121
     t123 = t105 + t113*t121
     t124 = t106 + t114*t121
     t125 = t107 - t115*t121
     t126 = t108 - t116*t121
     t127 = t37 + t95
-    t128 = t101*(t100*t74 + t127*t74 + t77*t84 - t57*t62 - t70*t75 - t72*t83)
+    t128 = t101*(t74*t100 + t74*t127 + t77*t84 - t72*t83 - t62*t57 - t70*t75)
     t129 = t74 - t100*t128
-    t130 = t83 + t128*t72
-    t131 = t127 - t128*t74
-    t132 = t84 - t128*t77
-    t133 = t75 + t128*t70
-    t134 = t57 + t128*t62
-    t135 = -t120*(t113*t131 + t114*t132 + t115*t133 + t119*t130 - t116*t134)
+    t130 = t83 + t72*t128
+    t131 = t127 - t74*t128
+    t132 = t84 - t77*t128
+    t133 = t75 + t70*t128
+    t134 = t57 + t62*t128
+    t135 = -t120*(t113*t131 + t114*t132 + t115*t133 + t130*t119 - t116*t134)
     t136 = t130 + t119*t135
     t137 = t131 + t113*t135
     t138 = t132 + t114*t135
@@ -2579,26 +2579,26 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t142 = t141*xp.where(xp.greater_equal(t137, 0), xp.asarray(1, dtype=dtype), -1)
     t143 = t137 + t142
     t144 = xp.where(xp.greater(t141, 0), 1/(t141*(t141 + xp.abs(t137))), 0)
-    t145 = t144*(t123*t143 + t124*t138 + t126*t140 - t125*t139)
+    t145 = t144*(t138*t124 + t140*t126 + t123*t143 - t139*t125)
     t146 = t123 - t143*t145
     t147 = t124 - t138*t145
     t148 = t125 + t139*t145
     t149 = t126 - t140*t145
     t150 = t86 + t95
-    t151 = t101*(t100*t77 + t150*t77 + t70*t87 + t74*t84 - t58*t62 - t72*t81)
+    t151 = t101*(t74*t84 + t77*t100 + t77*t150 + t70*t87 - t72*t81 - t62*t58)
     t152 = t77 - t100*t151
-    t153 = t81 + t151*t72
-    t154 = t84 - t151*t74
-    t155 = t150 - t151*t77
-    t156 = t87 - t151*t70
-    t157 = t58 + t151*t62
-    t158 = -t120*(t113*t154 + t114*t155 + t119*t153 - t115*t156 - t116*t157)
+    t153 = t81 + t72*t151
+    t154 = t84 - t74*t151
+    t155 = t150 - t77*t151
+    t156 = t87 - t70*t151
+    t157 = t58 + t62*t151
+    t158 = -t120*(t113*t154 + t114*t155 + t153*t119 - t115*t156 - t116*t157)
     t159 = t153 + t119*t158
     t160 = t154 + t113*t158
     t161 = t155 + t114*t158
     t162 = t156 - t115*t158
     t163 = t157 - t116*t158
-    t164 = t144*(t138*t161 + t140*t163 + t143*t160 - t139*t162)
+    t164 = t144*(t138*t161 + t140*t163 + t160*t143 - t139*t162)
     t165 = t160 - t143*t164
     t166 = t161 - t138*t164
     t167 = t162 + t139*t164
@@ -2607,30 +2607,30 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t170 = t169*xp.where(xp.greater_equal(t166, 0), xp.asarray(1, dtype=dtype), -1)
     t171 = t166 + t170
     t172 = xp.where(xp.greater(t169, 0), 1/(t169*(t169 + xp.abs(t166))), 0)
-    t173 = t172*(t147*t171 + t148*t167 + t149*t168)
+    t173 = t172*(t167*t148 + t168*t149 + t147*t171)
     t174 = t147 - t171*t173
     t175 = t148 - t167*t173
     t176 = t149 - t168*t173
     t177 = t88 + t95
-    t178 = t101*(t100*t70 + t177*t70 + t72*t78 + t77*t87 - t59*t62 - t74*t75)
+    t178 = t101*(t72*t78 + t77*t87 + t70*t100 + t70*t177 - t62*t59 - t74*t75)
     t179 = t70 - t100*t178
-    t180 = t78 - t178*t72
-    t181 = t75 + t178*t74
-    t182 = t87 - t178*t77
-    t183 = t177 - t178*t70
-    t184 = t59 + t178*t62
-    t185 = t120*(t113*t181 + t115*t183 + t116*t184 + t119*t180 - t114*t182)
+    t180 = t78 - t72*t178
+    t181 = t75 + t74*t178
+    t182 = t87 - t77*t178
+    t183 = t177 - t70*t178
+    t184 = t59 + t62*t178
+    t185 = t120*(t113*t181 + t115*t183 + t116*t184 + t180*t119 - t114*t182)
     t186 = t180 - t119*t185
     t187 = -t181 + t113*t185
     t188 = t182 + t114*t185
     t189 = t183 - t115*t185
     t190 = t184 - t116*t185
-    t191 = t144*(t138*t188 + t140*t190 + t143*t187 - t139*t189)
+    t191 = t144*(t138*t188 + t140*t190 + t187*t143 - t139*t189)
     t192 = t187 - t143*t191
     t193 = t188 - t138*t191
     t194 = t189 + t139*t191
     t195 = t190 - t140*t191
-    t196 = t172*(t167*t194 + t168*t195 + t171*t193)
+    t196 = t172*(t167*t194 + t168*t195 + t193*t171)
     t197 = t193 - t171*t196
     t198 = t194 - t167*t196
     t199 = t195 - t168*t196
@@ -2638,59 +2638,59 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t201 = t200*xp.where(xp.greater_equal(t198, 0), xp.asarray(1, dtype=dtype), -1)
     t202 = t198 + t201
     t203 = xp.where(xp.greater(t200, 0), 1/(t200*(t200 + xp.abs(t198))), 0)
-    t204 = t203*(t175*t202 + t176*t199)
+    t204 = t203*(t199*t176 + t175*t202)
     t205 = t175 - t202*t204
     t206 = t176 - t199*t204
     t207 = t89 + t95
-    t208 = xp.sqrt(t97 + t109**2 + t127**2 + t150**2 + t177**2 + t207**2 + 2*t90 + 2*t91 + 2*t92 + 2*t93 + 2*t94 + 2*t57**2 + 2*t58**2 + 2*t59**2 + 2*t65**2 + 2*t75**2 + 2*t78**2 + 2*t81**2 + 2*t83**2 + 2*t84**2 + 2*t87**2)
-    t209 = t101*(t57*t74 + t58*t77 + t59*t70 + t65*t72 - t100*t62 - t207*t62)
+    t208 = xp.sqrt(t97 + t109**2 + t127**2 + t150**2 + t177**2 + t207**2 + 2*t90 + 2*t91 + 2*t92 + 2*t93 + 2*t94 + 2*t65**2 + 2*t83**2 + 2*t81**2 + 2*t78**2 + 2*t84**2 + 2*t75**2 + 2*t57**2 + 2*t87**2 + 2*t58**2 + 2*t59**2)
+    t209 = t101*(t72*t65 + t74*t57 + t77*t58 + t70*t59 - t62*t100 - t62*t207)
     t210 = t62 + t100*t209
-    t211 = t65 - t209*t72
-    t212 = t57 - t209*t74
-    t213 = t58 - t209*t77
-    t214 = t59 - t209*t70
-    t215 = t207 + t209*t62
-    t216 = t120*(t115*t214 + t116*t215 + t119*t211 - t113*t212 - t114*t213)
+    t211 = t65 - t72*t209
+    t212 = t57 - t74*t209
+    t213 = t58 - t77*t209
+    t214 = t59 - t70*t209
+    t215 = t207 + t62*t209
+    t216 = t120*(t115*t214 + t116*t215 + t211*t119 - t113*t212 - t114*t213)
     t217 = t211 - t119*t216
     t218 = t212 + t113*t216
     t219 = t213 + t114*t216
     t220 = t214 - t115*t216
     t221 = t215 - t116*t216
-    t222 = t144*(t138*t219 + t140*t221 + t143*t218 - t139*t220)
+    t222 = t144*(t138*t219 + t140*t221 + t218*t143 - t139*t220)
     t223 = t218 - t143*t222
     t224 = t219 - t138*t222
     t225 = t220 + t139*t222
     t226 = t221 - t140*t222
-    t227 = t172*(t167*t225 + t168*t226 + t171*t224)
+    t227 = t172*(t167*t225 + t168*t226 + t224*t171)
     t228 = t224 - t171*t227
     t229 = t225 - t167*t227
     t230 = t226 - t168*t227
-    t231 = t203*(t199*t230 + t202*t229)
+    t231 = t203*(t199*t230 + t229*t202)
     t232 = t229 - t202*t231
     t233 = t230 - t199*t231
     t234 = xp.abs(t233)
     t235 = t234
     t236 = t235*xp.where(xp.greater_equal(t233, 0), xp.asarray(1, dtype=dtype), -1)
     t237 = t233 + t236
-    t238 = xp.where(xp.greater(t235, 0), 1/(t235*(t234 + t235)), 0)
+    t238 = xp.where(xp.greater(t235, 0), 1/(t235*(t235 + t234)), 0)
     t239 = t206 - t206*t238*t237**2
     t240 = xp.where(xp.not_equal(t236, 0), -t239/t236, 0)
     t241 = xp.where(xp.not_equal(t201, 0), -(t205 - t232*t240)/t201, 0)
-    t242 = xp.where(xp.not_equal(t170, 0), -(t174 - t197*t241 - t228*t240)/t170, 0)
-    t243 = xp.where(xp.not_equal(t142, 0), -(t146 - t165*t242 - t192*t241 - t223*t240)/t142, 0)
-    t244 = xp.where(xp.not_equal(t118, 0), -(t122 + t136*t243 + t159*t242 - t186*t241 - t217*t240)/t118, 0)
-    t245 = xp.where(xp.not_equal(t99, 0), -(t103 + t210*t240 - t111*t244 - t129*t243 - t152*t242 - t179*t241)/t99, 0)
-    t246 = t240 + t19*t244 - t245*t31
-    t247 = c1*t241 + t244*t60 + t245*t63 - s1*t242 - t243*t32
-    t248 = c2*t240 + t20*t241 + t242*t8 + t243*t33 + t244*t64 + t245*t61
+    t242 = xp.where(xp.not_equal(t170, 0), -(t174 - (t197*t241 + t228*t240))/t170, 0)
+    t243 = xp.where(xp.not_equal(t142, 0), -(t146 - (t165*t242 + t192*t241 + t223*t240))/t142, 0)
+    t244 = xp.where(xp.not_equal(t118, 0), -(t122 - (t186*t241 + t217*t240 - t136*t243 - t159*t242))/t118, 0)
+    t245 = xp.where(xp.not_equal(t99, 0), -(t103 - (t111*t244 + t129*t243 + t152*t242 + t179*t241 - t210*t240))/t99, 0)
+    t246 = t240 + t244*t19 - t245*t31
+    t247 = t241*c1 + t244*t60 + t245*t63 - t242*s1 - t243*t32
+    t248 = t240*c2 + t241*t20 + t242*t8 + t243*t33 + t244*t64 + t245*t61
     t249 = t242*t6 + t243*t34 + t245*t51 - t240*t42 - t241*t3 - t244*t54
-    t250 = t11*t242 + t23*t241 + t240*t41 + t243*t35 + t244*t55 + t245*t52
-    t251 = t13*t242 + t243*t36 + t245*t53 - t240*t44 - t241*t25 - t244*t56
-    t252 = t15*t242 + t240*t46 + t241*t27
+    t250 = t11*t242 + t23*t241 + t41*t240 + t243*t35 + t244*t55 + t245*t52
+    t251 = t13*t242 + t243*t36 + t245*t53 - t25*t241 - t44*t240 - t244*t56
+    t252 = t240*t46 + t241*t27 + t242*t15
     t253 = xp.isfinite(t66)
     t254 = xp.greater_equal(damping, 0)
     t255 = 1e-12*t208
-    t256 = (xp.less_equal(t117, t255)) | (xp.less_equal(t141, t255)) | (xp.less_equal(t169, t255)) | (xp.less_equal(t200, t255)) | (xp.less_equal(t235, t255)) | (xp.less_equal(t98, t255))
+    t256 = xp.less_equal(t98, t255) | xp.less_equal(t117, t255) | xp.less_equal(t141, t255) | xp.less_equal(t169, t255) | xp.less_equal(t200, t255) | xp.less_equal(t235, t255)
     t257 = t253 & t254 & xp.logical_not(t256)
     q_dot = _stack(xp, [
         xp.broadcast_to(xp.where(t257, t246, 0), batch),  # 0
@@ -2707,7 +2707,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def ik_numeric_step(target, q, damping=0.0):
-    """one step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite): (7 x 1 and 7 x 1 and 1 x 1), 1162 operations."""
+    """one step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite): (7 x 1 and 7 x 1 and 1 x 1), 1157 operations."""
     xp, dtype, device, batch, (target, q, damping,) = _arguments(("target", target, (4, 4)), ("q", q, (7,)), ("damping", damping, ()))
     T00 = target[..., 0, 0]
     T01 = target[..., 0, 1]
@@ -2752,83 +2752,83 @@ def ik_numeric_step(target, q, damping=0.0):
     t0 = T00 + T01 + T02 + T03 + T10 + T11 + T12 + T13 + T20 + T21 + T22 + T23 + qs1 + qs2 + qs3 + qs4 + qs5 + qs6 + qs7
     t1 = s1*s3
     t2 = c1*c3
-    t3 = -t1 + c2*t2
-    t4 = t2 - c2*t1
+    t3 = -t1 + t2*c2
+    t4 = t2 - t1*c2
     t5 = c3*s1
     t6 = c1*s3
-    t7 = t5 + c2*t6
-    t8 = t6 + c2*t5
+    t7 = t5 + t6*c2
+    t8 = t6 + t5*c2
     t9 = 0.316*s2
-    t10 = 0.0825*t3 + c1*t9
-    t11 = 0.0825*t8 + s1*t9
+    t10 = 0.0825*t3 + t9*c1
+    t11 = 0.0825*t8 + t9*s1
     t12 = c3*s2
     t13 = 0.316*c2 - 0.0825*t12
-    t14 = c2*s4 - c4*t12
-    t15 = c2*c4 + s4*t12
+    t14 = c2*s4 - t12*c4
+    t15 = t12*s4 + c2*c4
     t16 = c1*s2
-    t17 = c4*t3 + s4*t16
-    t18 = c4*t16 - s4*t3
-    t19 = c5*t17 - s5*t7
-    t20 = c5*t7 + s5*t17
-    t21 = c6*t19 + s6*t18
-    t22 = c6*t18 - s6*t19
-    t23 = c7*t21 + s7*t20
-    t24 = c7*t20 - s7*t21
+    t17 = t3*c4 + t16*s4
+    t18 = t16*c4 - t3*s4
+    t19 = t17*c5 - t7*s5
+    t20 = t17*s5 + t7*c5
+    t21 = t18*s6 + t19*c6
+    t22 = t18*c6 - t19*s6
+    t23 = t20*s7 + t21*c7
+    t24 = t20*c7 - t21*s7
     t25 = 0.088*t21 - 0.21*t22
     t26 = t25 + 0.384*t18
     t27 = t26 - 0.0825*t17
     t28 = t10 + t27
     t29 = T03 - t28
     t30 = s1*s2
-    t31 = c4*t8 + s4*t30
-    t32 = c4*t30 - s4*t8
-    t33 = c5*t31 + s5*t4
-    t34 = c5*t4 - s5*t31
-    t35 = c6*t33 + s6*t32
-    t36 = c6*t32 - s6*t33
-    t37 = c7*t35 - s7*t34
-    t38 = c7*t34 + s7*t35
+    t31 = t8*c4 + t30*s4
+    t32 = t30*c4 - t8*s4
+    t33 = t31*c5 + t4*s5
+    t34 = t4*c5 - t31*s5
+    t35 = t32*s6 + t33*c6
+    t36 = t32*c6 - t33*s6
+    t37 = t35*c7 - t34*s7
+    t38 = t34*c7 + t35*s7
     t39 = 0.088*t35 - 0.21*t36
     t40 = t39 + 0.384*t32
     t41 = t40 - 0.0825*t31
     t42 = t11 + t41
-    t43 = c1*t28 + s1*t42
-    t44 = t16*t42 - t28*t30
+    t43 = t28*c1 + t42*s1
+    t44 = t42*t16 - t28*t30
     t45 = t27*t4 + t41*t7
-    t46 = t18*t40 - t26*t32
-    t47 = t20*t39 + t25*t34
+    t46 = t18*t40 - t32*t26
+    t47 = t20*t39 + t34*t25
     t48 = t43**2 + t44**2 + t45**2 + t46**2 + t47**2
     t49 = T13 - t42
     t50 = s2*s3
-    t51 = c5*t14 + s5*t50
-    t52 = c5*t50 - s5*t14
-    t53 = c6*t51 + s6*t15
-    t54 = c6*t15 - s6*t51
-    t55 = c7*t53 - s7*t52
-    t56 = c7*t52 + s7*t53
+    t51 = t14*c5 + t50*s5
+    t52 = t50*c5 - t14*s5
+    t53 = t15*s6 + t51*c6
+    t54 = t15*c6 - t51*s6
+    t55 = t53*c7 - t52*s7
+    t56 = t52*c7 + t53*s7
     t57 = 0.088*t53 - 0.21*t54
     t58 = t57 + 0.384*t15
     t59 = t58 - 0.0825*t14
     t60 = t13 + t59
     t61 = 0.333 + t60
-    t62 = t30*t60 - c2*t42
-    t63 = t41*t50 - t4*t59
+    t62 = t60*t30 - t42*c2
+    t63 = t41*t50 - t59*t4
     t64 = t32*t58 - t15*t40
-    t65 = t39*t52 - t34*t57
-    t66 = c2*t28 - t16*t60
+    t65 = t52*t39 - t34*t57
+    t66 = t28*c2 - t60*t16
     t67 = t27*t50 + t59*t7
     t68 = t15*t26 - t18*t58
-    t69 = t20*t57 + t25*t52
-    t70 = t42 + t50*t63 + t52*t65 - c2*t62 - t15*t64
-    t71 = t28 + c2*t66 + t15*t68 + t50*t67 + t52*t69
-    t72 = c2*t44 + t15*t46 - t45*t50 - t47*t52
-    t73 = c2*t16 + t15*t18 + t22*t54 - t20*t52 - t50*t7
-    t74 = c2*t30 + t15*t32 + t34*t52 + t36*t54 + t4*t50
+    t69 = t20*t57 + t52*t25
+    t70 = t42 + t52*t65 + t63*t50 - t15*t64 - t62*c2
+    t71 = t28 + t15*t68 + t52*t69 + t66*c2 + t67*t50
+    t72 = t15*t46 + t44*c2 - t52*t47 - t45*t50
+    t73 = t18*t15 + t22*t54 + t16*c2 - t20*t52 - t7*t50
+    t74 = t32*t15 + t34*t52 + t36*t54 + t4*t50 + t30*c2
     t75 = T23 - t61
     t76 = 0.7071067811865476*t23
     t77 = 0.7071067811865476*t24
     t78 = t76 - t77
-    t79 = t76 + t77
+    t79 = t77 + t76
     t80 = T00*t78 + T01*t79 - T02*t22
     t81 = T10*t78 + T11*t79 - T12*t22
     t82 = T20*t78 + T21*t79 - T22*t22
@@ -2839,7 +2839,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t87 = T00*t85 + T01*t86 - T02*t36
     t88 = T10*t85 + T11*t86 - T12*t36
     t89 = T20*t85 + T21*t86 - T22*t36
-    t90 = 0.5*t81 - 0.5*t87
+    t90 = 0.5*(t81 - t87)
     t91 = 0.7071067811865476*t55
     t92 = 0.7071067811865476*t56
     t93 = t91 + t92
@@ -2847,87 +2847,87 @@ def ik_numeric_step(target, q, damping=0.0):
     t95 = T00*t93 + T01*t94 - T02*t54
     t96 = T10*t93 + T11*t94 - T12*t54
     t97 = T20*t93 + T21*t94 - T22*t54
-    t98 = 0.5*t89 - 0.5*t96
-    t99 = 0.5*t95 - 0.5*t82
-    t100 = -0.5 + 0.5*t80 + 0.5*t88 + 0.5*t97
-    t101 = xp.sqrt(t90**2 + t98**2 + t99**2)
+    t98 = 0.5*(t89 - t96)
+    t99 = 0.5*(t95 - t82)
+    t100 = 0.5*(-1 + t80 + t88 + t97)
+    t101 = xp.sqrt(t98**2 + t99**2 + t90**2)
     t102 = xp.atan2(t101, t100)
     t103 = xp.where(xp.greater(t101, 0), t102/t101, 1)
     t104 = t60**2
     t105 = c1**2
     t106 = t42**2 + t62**2 + t63**2 + t64**2 + t65**2 + t104*t105
-    t107 = t105*t60 + t30*t62 + t32*t64 - t34*t65 - t4*t63
+    t107 = t32*t64 + t60*t105 + t62*t30 - t34*t65 - t63*t4
     t108 = c1*s1
-    t109 = t104*t108 + t62*t66 + t64*t68 - t28*t42 - t63*t67 - t65*t69
-    t110 = c1*t43
-    t111 = t44*t62 + t45*t63 + t46*t64 + t47*t65 - t110*t60
-    t112 = t110 + t34*t47 + t4*t45 - t30*t44 - t32*t46
-    t113 = t108*t60
-    t114 = -t113 + t16*t62 + t18*t64 + t20*t65 + t63*t7
-    t115 = t113 + t30*t66 + t32*t68 + t34*t69 + t4*t67
+    t109 = t62*t66 + t64*t68 + t104*t108 - t28*t42 - t63*t67 - t65*t69
+    t110 = t43*c1
+    t111 = t62*t44 + t63*t45 + t64*t46 + t65*t47 - t60*t110
+    t112 = t110 + t34*t47 + t45*t4 - t32*t46 - t44*t30
+    t113 = t60*t108
+    t114 = -t113 + t18*t64 + t20*t65 + t7*t63 + t62*t16
+    t115 = t113 + t32*t68 + t34*t69 + t66*t30 + t67*t4
     t116 = s1**2
     t117 = t28**2 + t66**2 + t67**2 + t68**2 + t69**2 + t104*t116
-    t118 = t116*t60 + t20*t69 + t67*t7 - t16*t66 - t18*t68
-    t119 = s1*t43
-    t120 = t119*t60 + t45*t67 + t47*t69 - t44*t66 - t46*t68
-    t121 = t119 + t16*t44 + t18*t46 + t20*t47 + t45*t7
+    t118 = t20*t69 + t60*t116 + t7*t67 - t18*t68 - t66*t16
+    t119 = t43*s1
+    t120 = t60*t119 + t67*t45 + t69*t47 - t66*t44 - t68*t46
+    t121 = t119 + t18*t46 + t20*t47 + t7*t45 + t44*t16
     t122 = s2**2
     t123 = t116 + t18**2 + t20**2 + t22**2 + t7**2 + t105*t122
-    t124 = -t108 + t108*t122 + t18*t32 + t22*t36 - t20*t34 - t4*t7
+    t124 = -t108 + t18*t32 + t22*t36 + t108*t122 - t20*t34 - t7*t4
     t125 = t105 + t32**2 + t34**2 + t36**2 + t4**2 + t116*t122
-    t126 = 1 + c2**2 + t15**2 + t52**2 + t54**2 + t122*s3**2
-    t127 = (xp.greater_equal(t80, t88)) & (xp.greater_equal(t80, t97))
+    t126 = 1 + t15**2 + t52**2 + t54**2 + c2**2 + t122*s3**2
+    t127 = xp.greater_equal(t80, t88) & xp.greater_equal(t80, t97)
     t128 = xp.greater_equal(t88, t97)
-    t129 = xp.where(t127, 0.5 + 0.5*t80, xp.where(t128, 0.5*t87, 0.5*t95))
-    t130 = xp.where(t127, 0.5*t81, xp.where(t128, 0.5 + 0.5*t88, 0.5*t96))
-    t131 = xp.where(t127, 0.5*t82, xp.where(t128, 0.5*t89, 0.5 + 0.5*t97))
+    t129 = xp.where(t127, 0.5*(1 + t80), xp.where(t128, 0.5*t87, 0.5*t95))
+    t130 = xp.where(t127, 0.5*t81, xp.where(t128, 0.5*(1 + t88), 0.5*t96))
+    t131 = xp.where(t127, 0.5*t82, xp.where(t128, 0.5*t89, 0.5*(1 + t97)))
     t132 = xp.sqrt(t129**2 + t130**2 + t131**2)
-    t133 = xp.where(xp.greater_equal(t129*t98 + t130*t99 + t131*t90, 0), xp.asarray(1, dtype=dtype), -1)
-    t134 = (xp.greater(t101, 1e-06)) | (xp.greater(t100, 0))
+    t133 = xp.where(xp.greater_equal(t98*t129 + t99*t130 + t90*t131, 0), xp.asarray(1, dtype=dtype), -1)
+    t134 = xp.greater(t101, 1e-06) | xp.greater(t100, 0)
     t135 = t102*t133/t132
-    t136 = xp.where(t134, t103*t98, t129*t135)
-    t137 = xp.where(t134, t103*t99, t130*t135)
-    t138 = xp.where(t134, t103*t90, t131*t135)
+    t136 = xp.where(t134, t98*t103, t129*t135)
+    t137 = xp.where(t134, t99*t103, t130*t135)
+    t138 = xp.where(t134, t90*t103, t131*t135)
     t139 = t136**2 + t137**2 + t138**2 + t29**2 + t49**2 + t75**2
-    t140 = damping + t106
-    t141 = xp.sqrt(t107**2 + t109**2 + t111**2 + t114**2 + t140**2 + t70**2)
+    t140 = t106 + damping
+    t141 = xp.sqrt(t109**2 + t70**2 + t111**2 + t114**2 + t107**2 + t140**2)
     t142 = t141*xp.where(xp.greater_equal(t140, 0), xp.asarray(1, dtype=dtype), -1)
-    t143 = t140 + t142
+    t143 = t142 + t140
     t144 = xp.where(xp.greater(t141, 0), 1/(t141*(t141 + xp.abs(t140))), 0)
-    t145 = t144*(t107*t137 + t109*t49 + t111*t75 + t114*t136 + t143*t29 - t138*t70)
+    t145 = t144*(t109*t49 + t111*t75 + t114*t136 + t107*t137 + t29*t143 - t70*t138)
     t146 = t29 - t143*t145
     t147 = t49 - t109*t145
     t148 = t75 - t111*t145
     t149 = t136 - t114*t145
     t150 = t137 - t107*t145
-    t151 = t138 + t145*t70
-    t152 = damping + t117
-    t153 = t144*(t107*t115 + t109*t143 + t109*t152 - t111*t120 - t114*t118 - t70*t71)
+    t151 = t138 + t70*t145
+    t152 = t117 + damping
+    t153 = t144*(t109*t143 + t109*t152 + t107*t115 - t70*t71 - t111*t120 - t114*t118)
     t154 = t109 - t143*t153
     t155 = t152 - t109*t153
     t156 = t120 + t111*t153
     t157 = t118 + t114*t153
     t158 = t115 - t107*t153
-    t159 = t71 + t153*t70
+    t159 = t71 + t70*t153
     t160 = xp.sqrt(t155**2 + t156**2 + t157**2 + t158**2 + t159**2)
     t161 = t160*xp.where(xp.greater_equal(t155, 0), xp.asarray(1, dtype=dtype), -1)
     t162 = t155 + t161
     t163 = xp.where(xp.greater(t160, 0), 1/(t160*(t160 + xp.abs(t155))), 0)
-    t164 = t163*(t147*t162 + t150*t158 + t151*t159 - t148*t156 - t149*t157)
+    t164 = t163*(t158*t150 + t159*t151 + t147*t162 - t156*t148 - t157*t149)
     t165 = t147 - t162*t164
     t166 = t148 + t156*t164
     t167 = t149 + t157*t164
     t168 = t150 - t158*t164
     t169 = t151 - t159*t164
-    t170 = damping + t48
-    t171 = t144*(t111*t143 + t111*t170 + t114*t121 - t107*t112 - t109*t120 - t70*t72)
+    t170 = t48 + damping
+    t171 = t144*(t111*t143 + t111*t170 + t114*t121 - t109*t120 - t70*t72 - t107*t112)
     t172 = t111 - t143*t171
     t173 = t120 + t109*t171
     t174 = t170 - t111*t171
     t175 = t121 - t114*t171
     t176 = t112 + t107*t171
-    t177 = t72 + t171*t70
-    t178 = -t163*(t156*t174 + t157*t175 + t158*t176 + t162*t173 - t159*t177)
+    t177 = t72 + t70*t171
+    t178 = -t163*(t156*t174 + t157*t175 + t158*t176 + t173*t162 - t159*t177)
     t179 = t173 + t162*t178
     t180 = t174 + t156*t178
     t181 = t175 + t157*t178
@@ -2937,26 +2937,26 @@ def ik_numeric_step(target, q, damping=0.0):
     t185 = t184*xp.where(xp.greater_equal(t180, 0), xp.asarray(1, dtype=dtype), -1)
     t186 = t180 + t185
     t187 = xp.where(xp.greater(t184, 0), 1/(t184*(t184 + xp.abs(t180))), 0)
-    t188 = t187*(t166*t186 + t167*t181 + t169*t183 - t168*t182)
+    t188 = t187*(t181*t167 + t183*t169 + t166*t186 - t182*t168)
     t189 = t166 - t186*t188
     t190 = t167 - t181*t188
     t191 = t168 + t182*t188
     t192 = t169 - t183*t188
-    t193 = damping + t123
-    t194 = t144*(t107*t124 + t111*t121 + t114*t143 + t114*t193 - t109*t118 - t70*t73)
+    t193 = t123 + damping
+    t194 = t144*(t111*t121 + t114*t143 + t114*t193 + t107*t124 - t109*t118 - t70*t73)
     t195 = t114 - t143*t194
     t196 = t118 + t109*t194
     t197 = t121 - t111*t194
     t198 = t193 - t114*t194
     t199 = t124 - t107*t194
-    t200 = t73 + t194*t70
-    t201 = -t163*(t156*t197 + t157*t198 + t162*t196 - t158*t199 - t159*t200)
+    t200 = t73 + t70*t194
+    t201 = -t163*(t156*t197 + t157*t198 + t196*t162 - t158*t199 - t159*t200)
     t202 = t196 + t162*t201
     t203 = t197 + t156*t201
     t204 = t198 + t157*t201
     t205 = t199 - t158*t201
     t206 = t200 - t159*t201
-    t207 = t187*(t181*t204 + t183*t206 + t186*t203 - t182*t205)
+    t207 = t187*(t181*t204 + t183*t206 + t203*t186 - t182*t205)
     t208 = t203 - t186*t207
     t209 = t204 - t181*t207
     t210 = t205 + t182*t207
@@ -2965,30 +2965,30 @@ def ik_numeric_step(target, q, damping=0.0):
     t213 = t212*xp.where(xp.greater_equal(t209, 0), xp.asarray(1, dtype=dtype), -1)
     t214 = t209 + t213
     t215 = xp.where(xp.greater(t212, 0), 1/(t212*(t212 + xp.abs(t209))), 0)
-    t216 = t215*(t190*t214 + t191*t210 + t192*t211)
+    t216 = t215*(t210*t191 + t211*t192 + t190*t214)
     t217 = t190 - t214*t216
     t218 = t191 - t210*t216
     t219 = t192 - t211*t216
-    t220 = damping + t125
-    t221 = t144*(t107*t143 + t107*t220 + t109*t115 + t114*t124 - t111*t112 - t70*t74)
+    t220 = t125 + damping
+    t221 = t144*(t109*t115 + t114*t124 + t107*t143 + t107*t220 - t70*t74 - t111*t112)
     t222 = t107 - t143*t221
     t223 = t115 - t109*t221
     t224 = t112 + t111*t221
     t225 = t124 - t114*t221
     t226 = t220 - t107*t221
-    t227 = t74 + t221*t70
-    t228 = t163*(t156*t224 + t158*t226 + t159*t227 + t162*t223 - t157*t225)
+    t227 = t74 + t70*t221
+    t228 = t163*(t156*t224 + t158*t226 + t159*t227 + t223*t162 - t157*t225)
     t229 = t223 - t162*t228
     t230 = -t224 + t156*t228
     t231 = t225 + t157*t228
     t232 = t226 - t158*t228
     t233 = t227 - t159*t228
-    t234 = t187*(t181*t231 + t183*t233 + t186*t230 - t182*t232)
+    t234 = t187*(t181*t231 + t183*t233 + t230*t186 - t182*t232)
     t235 = t230 - t186*t234
     t236 = t231 - t181*t234
     t237 = t232 + t182*t234
     t238 = t233 - t183*t234
-    t239 = t215*(t210*t237 + t211*t238 + t214*t236)
+    t239 = t215*(t210*t237 + t211*t238 + t236*t214)
     t240 = t236 - t214*t239
     t241 = t237 - t210*t239
     t242 = t238 - t211*t239
@@ -2996,54 +2996,54 @@ def ik_numeric_step(target, q, damping=0.0):
     t244 = t243*xp.where(xp.greater_equal(t241, 0), xp.asarray(1, dtype=dtype), -1)
     t245 = t241 + t244
     t246 = xp.where(xp.greater(t243, 0), 1/(t243*(t243 + xp.abs(t241))), 0)
-    t247 = t246*(t218*t245 + t219*t242)
+    t247 = t246*(t242*t219 + t218*t245)
     t248 = t218 - t245*t247
     t249 = t219 - t242*t247
-    t250 = damping + t126
-    t251 = t144*(t107*t74 + t109*t71 + t111*t72 + t114*t73 - t143*t70 - t250*t70)
+    t250 = t126 + damping
+    t251 = t144*(t109*t71 + t111*t72 + t114*t73 + t107*t74 - t70*t143 - t70*t250)
     t252 = t70 + t143*t251
     t253 = t71 - t109*t251
     t254 = t72 - t111*t251
     t255 = t73 - t114*t251
     t256 = t74 - t107*t251
-    t257 = t250 + t251*t70
-    t258 = t163*(t158*t256 + t159*t257 + t162*t253 - t156*t254 - t157*t255)
+    t257 = t250 + t70*t251
+    t258 = t163*(t158*t256 + t159*t257 + t253*t162 - t156*t254 - t157*t255)
     t259 = t253 - t162*t258
     t260 = t254 + t156*t258
     t261 = t255 + t157*t258
     t262 = t256 - t158*t258
     t263 = t257 - t159*t258
-    t264 = t187*(t181*t261 + t183*t263 + t186*t260 - t182*t262)
+    t264 = t187*(t181*t261 + t183*t263 + t260*t186 - t182*t262)
     t265 = t260 - t186*t264
     t266 = t261 - t181*t264
     t267 = t262 + t182*t264
     t268 = t263 - t183*t264
-    t269 = t215*(t210*t267 + t211*t268 + t214*t266)
+    t269 = t215*(t210*t267 + t211*t268 + t266*t214)
     t270 = t266 - t214*t269
     t271 = t267 - t210*t269
     t272 = t268 - t211*t269
-    t273 = t246*(t242*t272 + t245*t271)
+    t273 = t246*(t242*t272 + t271*t245)
     t274 = t271 - t245*t273
     t275 = t272 - t242*t273
     t276 = xp.abs(t275)
     t277 = t276
     t278 = t277*xp.where(xp.greater_equal(t275, 0), xp.asarray(1, dtype=dtype), -1)
     t279 = t275 + t278
-    t280 = xp.where(xp.greater(t277, 0), 1/(t277*(t276 + t277)), 0)
+    t280 = xp.where(xp.greater(t277, 0), 1/(t277*(t277 + t276)), 0)
     t281 = t249 - t249*t280*t279**2
     t282 = xp.where(xp.not_equal(t278, 0), -t281/t278, 0)
     t283 = xp.where(xp.not_equal(t244, 0), -(t248 - t274*t282)/t244, 0)
-    t284 = xp.where(xp.not_equal(t213, 0), -(t217 - t240*t283 - t270*t282)/t213, 0)
-    t285 = xp.where(xp.not_equal(t185, 0), -(t189 - t208*t284 - t235*t283 - t265*t282)/t185, 0)
-    t286 = xp.where(xp.not_equal(t161, 0), -(t165 + t179*t285 + t202*t284 - t229*t283 - t259*t282)/t161, 0)
-    t287 = xp.where(xp.not_equal(t142, 0), -(t146 + t252*t282 - t154*t286 - t172*t285 - t195*t284 - t222*t283)/t142, 0)
-    t288 = q1 + t282 + t28*t286 - t287*t42
-    t289 = q2 + c1*t283 - s1*t284 - t285*t43 + c1*t287*t60 + s1*t286*t60
-    t290 = q3 + c2*t282 + t16*t284 + t283*t30 + t285*t44 + t286*t66 + t287*t62
+    t284 = xp.where(xp.not_equal(t213, 0), -(t217 - (t240*t283 + t270*t282))/t213, 0)
+    t285 = xp.where(xp.not_equal(t185, 0), -(t189 - (t208*t284 + t235*t283 + t265*t282))/t185, 0)
+    t286 = xp.where(xp.not_equal(t161, 0), -(t165 - (t229*t283 + t259*t282 - t179*t285 - t202*t284))/t161, 0)
+    t287 = xp.where(xp.not_equal(t142, 0), -(t146 - (t154*t286 + t172*t285 + t195*t284 + t222*t283 - t252*t282))/t142, 0)
+    t288 = t282 + q1 + t286*t28 - t287*t42
+    t289 = q2 + t283*c1 - t284*s1 - t285*t43 + t286*t60*s1 + t287*t60*c1
+    t290 = q3 + t282*c2 + t283*t30 + t284*t16 + t285*t44 + t286*t66 + t287*t62
     t291 = q4 + t284*t7 + t285*t45 + t287*t63 - t282*t50 - t283*t4 - t286*t67
-    t292 = q5 + t15*t282 + t18*t284 + t283*t32 + t285*t46 + t286*t68 + t287*t64
-    t293 = q6 + t20*t284 + t285*t47 + t287*t65 - t282*t52 - t283*t34 - t286*t69
-    t294 = -q7 + t22*t284 + t282*t54 + t283*t36
+    t292 = q5 + t18*t284 + t32*t283 + t15*t282 + t285*t46 + t286*t68 + t287*t64
+    t293 = q6 + t20*t284 + t285*t47 + t287*t65 - t34*t283 - t52*t282 - t286*t69
+    t294 = -q7 + t22*t284 + t36*t283 + t54*t282
     q_start = _stack(xp, [
         xp.broadcast_to(q1, batch),  # 0
         xp.broadcast_to(q2, batch),  # 1
@@ -3068,7 +3068,7 @@ def ik_numeric_step(target, q, damping=0.0):
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def ik_branches(T, q_free):
-    """every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits: (8 x 7 and 8 x 1 and 8 x 1), 1584 operations."""
+    """every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits: (8 x 7 and 8 x 1 and 8 x 1), 1583 operations."""
     xp, dtype, device, batch, (T, q_free,) = _arguments(("T", T, (4, 4)), ("q_free", q_free, ()))
     T00 = T[..., 0, 0]
     T01 = T[..., 0, 1]
@@ -3096,7 +3096,7 @@ def ik_branches(T, q_free):
     t8 = T00*t6 + T01*t7
     t9 = T10*t6 + T11*t7
     t10 = T20*t6 + T21*t7
-    t11 = 0.088 - T03*t8 - T13*t9 - T23*t10
+    t11 = 0.088 - (T03*t8 + T13*t9 + T23*t10)
     t12 = t11 + 0.333*t10
     t13 = -t6
     t14 = T00*t7 + T01*t13
@@ -3106,7 +3106,7 @@ def ik_branches(T, q_free):
     t18 = -t17 + 0.333*t16
     t19 = t18**2
     t20 = t19 + t12**2 + t2**2
-    t21 = 0.13046225 - 0.5*t20
+    t21 = 0.5*(0.2609245 - t20)
     t22 = t21**2
     t23 = 1 - 60.77564796097323*t22
     t24 = 7.795873777901566*t21
@@ -3116,8 +3116,8 @@ def ik_branches(T, q_free):
     t28 = xp.atan2(t27, t26)
     t29 = -2.6745902299367814 + t28
     t30 = -2.6745902299367814 - t28
-    t31 = t29 + 6.283185307179586*xp.ceil(-0.5 - 0.15915494309189535*t29)
-    t32 = t30 + 6.283185307179586*xp.ceil(-0.5 - 0.15915494309189535*t30)
+    t31 = t29 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t29))
+    t32 = t30 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t30))
     t33 = 7.795873777901566*t26
     t34 = 0.11453775*t33
     t35 = 7.795873777901566*t27
@@ -3126,7 +3126,7 @@ def ik_branches(T, q_free):
     t38 = t34 + t36
     t39 = 0.05775*t33
     t40 = 0.11453775*t35
-    t41 = -t39 - t40
+    t41 = -(t39 + t40)
     t42 = t40 - t39
     t43 = 0.316*t41 - 0.0825*t37
     t44 = 0.316*t37 + 0.0825*t41
@@ -3141,7 +3141,7 @@ def ik_branches(T, q_free):
     t53 = t45**2
     t54 = t47**2
     t55 = t53 + t54
-    t56 = t19 + t54
+    t56 = t54 + t19
     t57 = t56 - t55
     t58 = -t57
     t59 = 1e-12*t55
@@ -3177,7 +3177,7 @@ def ik_branches(T, q_free):
     t89 = -t54
     t90 = t87 + t89
     t91 = t88 + t89
-    t92 = t19*t53
+    t92 = t53*t19
     t93 = t92 + t90**2
     t94 = t92 + t91**2
     t95 = t55*t76
@@ -3188,45 +3188,45 @@ def ik_branches(T, q_free):
     t100 = xp.where(t96, 0, t97*t99)
     t101 = xp.less_equal(t75, t77)
     t102 = xp.where(t101, 1, 1/xp.sqrt(t75))
-    t103 = xp.where(t101, 1, t102*t69)
-    t104 = xp.where(t101, 0, -t102*t74)
+    t103 = xp.where(t101, 1, t69*t102)
+    t104 = xp.where(t101, 0, -t74*t102)
     t105 = t10*t103 - T22*t104
     t106 = T22*t103 + t10*t104
-    t107 = t103*t8 - T02*t104
-    t108 = T02*t103 + t104*t8
+    t107 = t8*t103 - T02*t104
+    t108 = T02*t103 + t8*t104
     t109 = xp.less_equal(t94, t95)
     t110 = xp.where(t109, 1, 1/xp.sqrt(t94))
-    t111 = xp.where(t109, 1, t110*t91)
+    t111 = xp.where(t109, 1, t91*t110)
     t112 = xp.where(t109, 0, t110*t99)
     t113 = 1 - t80
-    t114 = t113*t16
+    t114 = t16*t113
     t115 = t114 + t16*t80
-    t116 = t113*t14
+    t116 = t14*t113
     t117 = t116 + t14*t80
-    t118 = t100*t115 + t82*t98
-    t119 = t115*t98 - t100*t82
-    t120 = t100*t117 + t84*t98
-    t121 = t117*t98 - t100*t84
+    t118 = t98*t82 + t100*t115
+    t119 = t98*t115 - t100*t82
+    t120 = t98*t84 + t100*t117
+    t121 = t98*t117 - t100*t84
     t122 = 1 - t98
-    t123 = t122*t83
-    t124 = t123 + t83*t98
-    t125 = t122*t85
-    t126 = t125 + t85*t98
-    t127 = t118*t37 - t124*t41
-    t128 = t118*t41 + t124*t37
-    t129 = t120*t37 - t126*t41
-    t130 = t120*t41 + t126*t37
+    t123 = t83*t122
+    t124 = t123 + t98*t83
+    t125 = t85*t122
+    t126 = t125 + t98*t85
+    t127 = t37*t118 - t41*t124
+    t128 = t37*t124 + t41*t118
+    t129 = t37*t120 - t41*t126
+    t130 = t37*t126 + t41*t120
     t131 = 1 - t37
     t132 = t119*t131
-    t133 = t132 + t119*t37
+    t133 = t132 + t37*t119
     t134 = t121*t131
-    t135 = t134 + t121*t37
+    t135 = t134 + t37*t121
     t136 = t128**2
     t137 = -t136
     t138 = 1 + t137
-    t139 = xp.where(xp.greater(t138, 1e-12), xp.sqrt(t138), 0)
+    t139 = xp.where(xp.less(1e-12, t138), xp.sqrt(t138), 0)
     t140 = t136 - t127*t139
-    t141 = t137 + t140
+    t141 = t140 + t137
     t142 = t133**2
     t143 = t136 + t142 + t127**2
     t144 = t139**2
@@ -3247,40 +3247,40 @@ def ik_branches(T, q_free):
     t159 = xp.where(t157, 1, -t128*t158)
     t160 = xp.where(t157, 0, -t139*t158)
     t161 = t156*(1 - t159)
-    t162 = t152*t160 + t155*t159
-    t163 = t161 + t156*t159
-    t164 = t155*t160 - t152*t159
+    t162 = t159*t155 + t160*t152
+    t163 = t161 + t159*t156
+    t164 = t160*t155 - t159*t152
     t165 = t162**2 + t163**2
     t166 = t165
     t167 = t165 + t164**2
     t168 = 1 - t103
     t169 = t16*t168
-    t170 = t169 + t103*t16
+    t170 = t169 + t16*t103
     t171 = t14*t168
-    t172 = t171 + t103*t14
-    t173 = t105*t111 + t112*t170
-    t174 = t111*t170 - t105*t112
-    t175 = t107*t111 + t112*t172
-    t176 = t111*t172 - t107*t112
-    t177 = t131*t174
-    t178 = t177 + t174*t37
-    t179 = t131*t176
-    t180 = t179 + t176*t37
+    t172 = t171 + t14*t103
+    t173 = t111*t105 + t112*t170
+    t174 = t111*t170 - t112*t105
+    t175 = t111*t107 + t112*t172
+    t176 = t111*t172 - t112*t107
+    t177 = t174*t131
+    t178 = t177 + t37*t174
+    t179 = t176*t131
+    t180 = t179 + t37*t176
     t181 = 1 - t111
     t182 = t106*t181
-    t183 = t182 + t106*t111
+    t183 = t182 + t111*t106
     t184 = t108*t181
-    t185 = t184 + t108*t111
-    t186 = t173*t37 - t183*t41
-    t187 = t173*t41 + t183*t37
-    t188 = t175*t37 - t185*t41
-    t189 = t175*t41 + t185*t37
+    t185 = t184 + t111*t108
+    t186 = t37*t173 - t41*t183
+    t187 = t37*t183 + t41*t173
+    t188 = t37*t175 - t41*t185
+    t189 = t37*t185 + t41*t175
     t190 = t187**2
     t191 = -t190
     t192 = 1 + t191
-    t193 = xp.where(xp.greater(t192, 1e-12), xp.sqrt(t192), 0)
+    t193 = xp.where(xp.less(1e-12, t192), xp.sqrt(t192), 0)
     t194 = t190 - t186*t193
-    t195 = t191 + t194
+    t195 = t194 + t191
     t196 = t178**2
     t197 = t190 + t196 + t186**2
     t198 = t193**2
@@ -3294,16 +3294,16 @@ def ik_branches(T, q_free):
     t206 = t205 + t189*t204
     t207 = t178*t193
     t208 = xp.where(t202, 0, -t203*t207)
-    t209 = t180*t208 + t188*t204
+    t209 = t188*t204 + t180*t208
     t210 = t180*t204 - t188*t208
     t211 = xp.less_equal(t200, t201)
     t212 = xp.where(t211, 1, 1/xp.sqrt(t200))
     t213 = xp.where(t211, 1, -t187*t212)
     t214 = xp.where(t211, 0, -t193*t212)
     t215 = t210*(1 - t213)
-    t216 = t206*t214 + t209*t213
-    t217 = t215 + t210*t213
-    t218 = t209*t214 - t206*t213
+    t216 = t213*t209 + t214*t206
+    t217 = t215 + t213*t210
+    t218 = t214*t209 - t213*t206
     t219 = t216**2 + t217**2
     t220 = t219
     t221 = t219 + t218**2
@@ -3337,9 +3337,9 @@ def ik_branches(T, q_free):
     t249 = xp.where(t246, 0, -t240*t247)
     t250 = t10*t248 - T22*t249
     t251 = T22*t248 + t10*t249
-    t252 = t248*t8 - T02*t249
-    t253 = T02*t248 + t249*t8
-    t254 = t230*t50
+    t252 = t8*t248 - T02*t249
+    t253 = T02*t248 + t8*t249
+    t254 = t50*t230
     t255 = t223 - t254
     t256 = t223 + t254
     t257 = -t223
@@ -3360,41 +3360,41 @@ def ik_branches(T, q_free):
     t272 = xp.where(t269, 0, -t242*t270)
     t273 = t10*t271 - T22*t272
     t274 = T22*t271 + t10*t272
-    t275 = t271*t8 - T02*t272
-    t276 = T02*t271 + t272*t8
+    t275 = t8*t271 - T02*t272
+    t276 = T02*t271 + t8*t272
     t277 = xp.less_equal(t262, t263)
     t278 = xp.where(t277, 1, 1/xp.sqrt(t262))
     t279 = xp.where(t277, 1, t259*t278)
-    t280 = xp.where(t277, 0, t267*t278)
+    t280 = xp.where(t277, 0, t278*t267)
     t281 = 1 - t248
     t282 = t16*t281
     t283 = t282 + t16*t248
     t284 = t14*t281
     t285 = t284 + t14*t248
-    t286 = t250*t266 + t268*t283
-    t287 = t266*t283 - t250*t268
-    t288 = t252*t266 + t268*t285
-    t289 = t266*t285 - t252*t268
+    t286 = t266*t250 + t268*t283
+    t287 = t266*t283 - t268*t250
+    t288 = t266*t252 + t268*t285
+    t289 = t266*t285 - t268*t252
     t290 = 1 - t266
     t291 = t251*t290
-    t292 = t291 + t251*t266
+    t292 = t291 + t266*t251
     t293 = t253*t290
-    t294 = t293 + t253*t266
-    t295 = t286*t38 + t292*t42
-    t296 = t292*t38 - t286*t42
-    t297 = t288*t38 + t294*t42
-    t298 = t294*t38 - t288*t42
+    t294 = t293 + t266*t253
+    t295 = t38*t286 + t42*t292
+    t296 = t38*t292 - t42*t286
+    t297 = t38*t288 + t42*t294
+    t298 = t38*t294 - t42*t288
     t299 = 1 + t38
     t300 = t287*t299
-    t301 = t300 - t287*t38
+    t301 = t300 - t38*t287
     t302 = t289*t299
-    t303 = t302 - t289*t38
+    t303 = t302 - t38*t289
     t304 = t296**2
     t305 = -t304
     t306 = 1 + t305
-    t307 = xp.where(xp.greater(t306, 1e-12), xp.sqrt(t306), 0)
+    t307 = xp.where(xp.less(1e-12, t306), xp.sqrt(t306), 0)
     t308 = t304 + t295*t307
-    t309 = t305 + t308
+    t309 = t308 + t305
     t310 = t301**2
     t311 = t304 + t310 + t295**2
     t312 = t307**2
@@ -3415,9 +3415,9 @@ def ik_branches(T, q_free):
     t327 = xp.where(t325, 1, t296*t326)
     t328 = xp.where(t325, 0, -t307*t326)
     t329 = t324*(1 - t327)
-    t330 = t323*t327 - t320*t328
-    t331 = t329 + t324*t327
-    t332 = t320*t327 + t323*t328
+    t330 = t327*t323 - t328*t320
+    t331 = t329 + t327*t324
+    t332 = t327*t320 + t328*t323
     t333 = t330**2 + t331**2
     t334 = t333
     t335 = t333 + t332**2
@@ -3426,29 +3426,29 @@ def ik_branches(T, q_free):
     t338 = t337 + t16*t271
     t339 = t14*t336
     t340 = t339 + t14*t271
-    t341 = t273*t279 + t280*t338
-    t342 = t279*t338 - t273*t280
-    t343 = t275*t279 + t280*t340
-    t344 = t279*t340 - t275*t280
-    t345 = t299*t342
-    t346 = t345 - t342*t38
-    t347 = t299*t344
-    t348 = t347 - t344*t38
+    t341 = t279*t273 + t280*t338
+    t342 = t279*t338 - t280*t273
+    t343 = t279*t275 + t280*t340
+    t344 = t279*t340 - t280*t275
+    t345 = t342*t299
+    t346 = t345 - t38*t342
+    t347 = t344*t299
+    t348 = t347 - t38*t344
     t349 = 1 - t279
     t350 = t274*t349
-    t351 = t350 + t274*t279
+    t351 = t350 + t279*t274
     t352 = t276*t349
-    t353 = t352 + t276*t279
-    t354 = t341*t38 + t351*t42
-    t355 = t351*t38 - t341*t42
-    t356 = t343*t38 + t353*t42
-    t357 = t353*t38 - t343*t42
+    t353 = t352 + t279*t276
+    t354 = t38*t341 + t42*t351
+    t355 = t38*t351 - t42*t341
+    t356 = t38*t343 + t42*t353
+    t357 = t38*t353 - t42*t343
     t358 = t355**2
     t359 = -t358
     t360 = 1 + t359
-    t361 = xp.where(xp.greater(t360, 1e-12), xp.sqrt(t360), 0)
+    t361 = xp.where(xp.less(1e-12, t360), xp.sqrt(t360), 0)
     t362 = t358 + t354*t361
-    t363 = t359 + t362
+    t363 = t362 + t359
     t364 = t346**2
     t365 = t358 + t364 + t354**2
     t366 = t361**2
@@ -3463,286 +3463,286 @@ def ik_branches(T, q_free):
     t375 = t346*t361
     t376 = xp.where(t370, 0, -t371*t375)
     t377 = t348*t376 - t356*t372
-    t378 = t348*t372 + t356*t376
+    t378 = t356*t376 + t348*t372
     t379 = xp.less_equal(t368, t369)
     t380 = xp.where(t379, 1, 1/xp.sqrt(t368))
     t381 = xp.where(t379, 1, t355*t380)
     t382 = xp.where(t379, 0, -t361*t380)
     t383 = t378*(1 - t381)
-    t384 = t377*t381 - t374*t382
-    t385 = t383 + t378*t381
-    t386 = t374*t381 + t377*t382
+    t384 = t381*t377 - t382*t374
+    t385 = t383 + t381*t378
+    t386 = t381*t374 + t382*t377
     t387 = t384**2 + t385**2
     t388 = t387
     t389 = t387 + t386**2
     t390 = xp.where(t78, 0, xp.atan2(-t72, t68))
-    t391 = t390 + 6.283185307179586*xp.ceil(-0.5 - 0.15915494309189535*t390)
+    t391 = t390 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t390))
     t392 = -t391
-    t393 = t391 + 6.283185307179586*xp.floor(0.0027852115041081685 + 0.15915494309189535*t392)
+    t393 = t391 + 6.283185307179586*xp.floor(0.15915494309189535*(0.0175 + t392))
     t394 = xp.where(t96, 0, xp.atan2(t99, t90))
-    t395 = t394 + 6.283185307179586*xp.ceil(-0.5 - 0.15915494309189535*t394)
+    t395 = t394 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t394))
     t396 = -t395
-    t397 = t395 + 6.283185307179586*xp.floor(0.46111961662014833 + 0.15915494309189535*t396)
+    t397 = t395 + 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t396))
     t398 = -t31
-    t399 = t31 + 6.283185307179586*xp.floor(0.4888921541896841 + 0.15915494309189535*t398)
+    t399 = t31 + 6.283185307179586*xp.floor(0.15915494309189535*(3.0718 + t398))
     t400 = xp.where(t148, 0, xp.atan2(-t153, t141))
     t401 = 3.141592653589793 + t400
     t402 = t400 + 6.283185307179586*xp.ceil(-0.15915494309189535*t401)
-    t403 = -6.283185307179586 + t401 + 6.283185307179586*xp.ceil(-0.15915494309189535*t400)
+    t403 = t401 + 6.283185307179586*xp.ceil(-0.15915494309189535*(6.283185307179586 + t400))
     t404 = -t402
-    t405 = t402 + 6.283185307179586*xp.floor(0.46111961662014833 + 0.15915494309189535*t404)
+    t405 = t402 + 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t404))
     t406 = xp.where(t157, 0, xp.atan2(-t139, -t128))
-    t407 = t406 + 6.283185307179586*xp.ceil(-0.5 - 0.15915494309189535*t406)
+    t407 = t406 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t406))
     t408 = t406
-    t409 = t408 - 6.283185307179586*xp.floor(0.280558333682393 + 0.15915494309189535*t408)
+    t409 = t408 - 6.283185307179586*xp.floor(0.15915494309189535*(1.7627999999999997 + t408))
     t410 = -t407
-    t411 = t407 + 6.283185307179586*xp.floor(0.280558333682393 + 0.15915494309189535*t410)
+    t411 = t407 + 6.283185307179586*xp.floor(0.15915494309189535*(1.7627999999999997 + t410))
     t412 = xp.where(xp.less_equal(t166, 1e-24*t167), 0, xp.atan2(t163, t162))
     t413 = 3.141592653589793 + t412
     t414 = t412 + 6.283185307179586*xp.ceil(-0.15915494309189535*t413)
-    t415 = -6.283185307179586 + t413 + 6.283185307179586*xp.ceil(-0.15915494309189535*t412)
+    t415 = t413 + 6.283185307179586*xp.ceil(-0.15915494309189535*(6.283185307179586 + t412))
     t416 = -t414
-    t417 = t414 + 6.283185307179586*xp.floor(0.46111961662014833 + 0.15915494309189535*t416)
+    t417 = t414 + 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t416))
     t418 = -t403
-    t419 = t403 + 6.283185307179586*xp.floor(0.46111961662014833 + 0.15915494309189535*t418)
+    t419 = t403 + 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t418))
     t420 = -t415
-    t421 = t415 + 6.283185307179586*xp.floor(0.46111961662014833 + 0.15915494309189535*t420)
+    t421 = t415 + 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t420))
     t422 = xp.where(t101, 0, xp.atan2(-t74, t69))
-    t423 = t422 + 6.283185307179586*xp.ceil(-0.5 - 0.15915494309189535*t422)
+    t423 = t422 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t422))
     t424 = -t423
-    t425 = t423 + 6.283185307179586*xp.floor(0.0027852115041081685 + 0.15915494309189535*t424)
+    t425 = t423 + 6.283185307179586*xp.floor(0.15915494309189535*(0.0175 + t424))
     t426 = xp.where(t109, 0, xp.atan2(t99, t91))
-    t427 = t426 + 6.283185307179586*xp.ceil(-0.5 - 0.15915494309189535*t426)
+    t427 = t426 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t426))
     t428 = -t427
-    t429 = t427 + 6.283185307179586*xp.floor(0.46111961662014833 + 0.15915494309189535*t428)
+    t429 = t427 + 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t428))
     t430 = xp.where(t202, 0, xp.atan2(-t207, t195))
     t431 = 3.141592653589793 + t430
     t432 = t430 + 6.283185307179586*xp.ceil(-0.15915494309189535*t431)
-    t433 = -6.283185307179586 + t431 + 6.283185307179586*xp.ceil(-0.15915494309189535*t430)
+    t433 = t431 + 6.283185307179586*xp.ceil(-0.15915494309189535*(6.283185307179586 + t430))
     t434 = -t432
-    t435 = t432 + 6.283185307179586*xp.floor(0.46111961662014833 + 0.15915494309189535*t434)
+    t435 = t432 + 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t434))
     t436 = xp.where(t211, 0, xp.atan2(-t193, -t187))
-    t437 = t436 + 6.283185307179586*xp.ceil(-0.5 - 0.15915494309189535*t436)
+    t437 = t436 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t436))
     t438 = t436
-    t439 = t438 - 6.283185307179586*xp.floor(0.280558333682393 + 0.15915494309189535*t438)
+    t439 = t438 - 6.283185307179586*xp.floor(0.15915494309189535*(1.7627999999999997 + t438))
     t440 = -t437
-    t441 = t437 + 6.283185307179586*xp.floor(0.280558333682393 + 0.15915494309189535*t440)
+    t441 = t437 + 6.283185307179586*xp.floor(0.15915494309189535*(1.7627999999999997 + t440))
     t442 = xp.where(xp.less_equal(t220, 1e-24*t221), 0, xp.atan2(t217, t216))
     t443 = 3.141592653589793 + t442
     t444 = t442 + 6.283185307179586*xp.ceil(-0.15915494309189535*t443)
-    t445 = -6.283185307179586 + t443 + 6.283185307179586*xp.ceil(-0.15915494309189535*t442)
+    t445 = t443 + 6.283185307179586*xp.ceil(-0.15915494309189535*(6.283185307179586 + t442))
     t446 = -t444
-    t447 = t444 + 6.283185307179586*xp.floor(0.46111961662014833 + 0.15915494309189535*t446)
+    t447 = t444 + 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t446))
     t448 = -t433
-    t449 = t433 + 6.283185307179586*xp.floor(0.46111961662014833 + 0.15915494309189535*t448)
+    t449 = t433 + 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t448))
     t450 = -t445
-    t451 = t445 + 6.283185307179586*xp.floor(0.46111961662014833 + 0.15915494309189535*t450)
+    t451 = t445 + 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t450))
     t452 = xp.where(t246, 0, xp.atan2(-t240, t235))
-    t453 = t452 + 6.283185307179586*xp.ceil(-0.5 - 0.15915494309189535*t452)
+    t453 = t452 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t452))
     t454 = -t453
-    t455 = t453 + 6.283185307179586*xp.floor(0.0027852115041081685 + 0.15915494309189535*t454)
+    t455 = t453 + 6.283185307179586*xp.floor(0.15915494309189535*(0.0175 + t454))
     t456 = xp.where(t264, 0, xp.atan2(t267, t258))
-    t457 = t456 + 6.283185307179586*xp.ceil(-0.5 - 0.15915494309189535*t456)
+    t457 = t456 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t456))
     t458 = -t457
-    t459 = t457 + 6.283185307179586*xp.floor(0.46111961662014833 + 0.15915494309189535*t458)
+    t459 = t457 + 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t458))
     t460 = -t32
-    t461 = t32 + 6.283185307179586*xp.floor(0.4888921541896841 + 0.15915494309189535*t460)
+    t461 = t32 + 6.283185307179586*xp.floor(0.15915494309189535*(3.0718 + t460))
     t462 = xp.where(t316, 0, xp.atan2(-t321, t309))
     t463 = 3.141592653589793 + t462
     t464 = t462 + 6.283185307179586*xp.ceil(-0.15915494309189535*t463)
-    t465 = -6.283185307179586 + t463 + 6.283185307179586*xp.ceil(-0.15915494309189535*t462)
+    t465 = t463 + 6.283185307179586*xp.ceil(-0.15915494309189535*(6.283185307179586 + t462))
     t466 = -t464
-    t467 = t464 + 6.283185307179586*xp.floor(0.46111961662014833 + 0.15915494309189535*t466)
+    t467 = t464 + 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t466))
     t468 = xp.where(t325, 0, xp.atan2(-t307, t296))
-    t469 = t468 + 6.283185307179586*xp.ceil(-0.5 - 0.15915494309189535*t468)
+    t469 = t468 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t468))
     t470 = t468
-    t471 = t470 - 6.283185307179586*xp.floor(0.280558333682393 + 0.15915494309189535*t470)
+    t471 = t470 - 6.283185307179586*xp.floor(0.15915494309189535*(1.7627999999999997 + t470))
     t472 = -t469
-    t473 = t469 + 6.283185307179586*xp.floor(0.280558333682393 + 0.15915494309189535*t472)
+    t473 = t469 + 6.283185307179586*xp.floor(0.15915494309189535*(1.7627999999999997 + t472))
     t474 = xp.where(xp.less_equal(t334, 1e-24*t335), 0, xp.atan2(t331, t330))
     t475 = 3.141592653589793 + t474
     t476 = t474 + 6.283185307179586*xp.ceil(-0.15915494309189535*t475)
-    t477 = -6.283185307179586 + t475 + 6.283185307179586*xp.ceil(-0.15915494309189535*t474)
+    t477 = t475 + 6.283185307179586*xp.ceil(-0.15915494309189535*(6.283185307179586 + t474))
     t478 = -t476
-    t479 = t476 + 6.283185307179586*xp.floor(0.46111961662014833 + 0.15915494309189535*t478)
+    t479 = t476 + 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t478))
     t480 = -t465
-    t481 = t465 + 6.283185307179586*xp.floor(0.46111961662014833 + 0.15915494309189535*t480)
+    t481 = t465 + 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t480))
     t482 = -t477
-    t483 = t477 + 6.283185307179586*xp.floor(0.46111961662014833 + 0.15915494309189535*t482)
+    t483 = t477 + 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t482))
     t484 = xp.where(t269, 0, xp.atan2(-t242, t237))
-    t485 = t484 + 6.283185307179586*xp.ceil(-0.5 - 0.15915494309189535*t484)
+    t485 = t484 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t484))
     t486 = -t485
-    t487 = t485 + 6.283185307179586*xp.floor(0.0027852115041081685 + 0.15915494309189535*t486)
+    t487 = t485 + 6.283185307179586*xp.floor(0.15915494309189535*(0.0175 + t486))
     t488 = xp.where(t277, 0, xp.atan2(t267, t259))
-    t489 = t488 + 6.283185307179586*xp.ceil(-0.5 - 0.15915494309189535*t488)
+    t489 = t488 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t488))
     t490 = -t489
-    t491 = t489 + 6.283185307179586*xp.floor(0.46111961662014833 + 0.15915494309189535*t490)
+    t491 = t489 + 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t490))
     t492 = xp.where(t370, 0, xp.atan2(-t375, t363))
     t493 = 3.141592653589793 + t492
     t494 = t492 + 6.283185307179586*xp.ceil(-0.15915494309189535*t493)
-    t495 = -6.283185307179586 + t493 + 6.283185307179586*xp.ceil(-0.15915494309189535*t492)
+    t495 = t493 + 6.283185307179586*xp.ceil(-0.15915494309189535*(6.283185307179586 + t492))
     t496 = -t494
-    t497 = t494 + 6.283185307179586*xp.floor(0.46111961662014833 + 0.15915494309189535*t496)
+    t497 = t494 + 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t496))
     t498 = xp.where(t379, 0, xp.atan2(-t361, t355))
-    t499 = t498 + 6.283185307179586*xp.ceil(-0.5 - 0.15915494309189535*t498)
+    t499 = t498 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t498))
     t500 = t498
-    t501 = t500 - 6.283185307179586*xp.floor(0.280558333682393 + 0.15915494309189535*t500)
+    t501 = t500 - 6.283185307179586*xp.floor(0.15915494309189535*(1.7627999999999997 + t500))
     t502 = -t499
-    t503 = t499 + 6.283185307179586*xp.floor(0.280558333682393 + 0.15915494309189535*t502)
+    t503 = t499 + 6.283185307179586*xp.floor(0.15915494309189535*(1.7627999999999997 + t502))
     t504 = xp.where(xp.less_equal(t388, 1e-24*t389), 0, xp.atan2(t385, t384))
     t505 = 3.141592653589793 + t504
     t506 = t504 + 6.283185307179586*xp.ceil(-0.15915494309189535*t505)
-    t507 = -6.283185307179586 + t505 + 6.283185307179586*xp.ceil(-0.15915494309189535*t504)
+    t507 = t505 + 6.283185307179586*xp.ceil(-0.15915494309189535*(6.283185307179586 + t504))
     t508 = -t506
-    t509 = t506 + 6.283185307179586*xp.floor(0.46111961662014833 + 0.15915494309189535*t508)
+    t509 = t506 + 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t508))
     t510 = -t495
-    t511 = t495 + 6.283185307179586*xp.floor(0.46111961662014833 + 0.15915494309189535*t510)
+    t511 = t495 + 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t510))
     t512 = -t507
-    t513 = t507 + 6.283185307179586*xp.floor(0.46111961662014833 + 0.15915494309189535*t512)
+    t513 = t507 + 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t512))
     t514 = -t417
     t515 = -t411
     t516 = -t405
     t517 = -t399
-    t518 = xp.where((xp.greater_equal(t399, 0.0698)) & xp.logical_not((xp.greater_equal(t31, 0.0698)) & (xp.less_equal(t31, 3.0718))), t517, t398)
+    t518 = xp.where(xp.greater_equal(t399, 0.0698) & xp.logical_not(xp.greater_equal(t31, 0.0698) & xp.less_equal(t31, 3.0718)), t517, t398)
     t519 = -t397
-    t520 = xp.where((xp.greater_equal(t397, -2.8973)) & xp.logical_not((xp.greater_equal(t395, -2.8973)) & (xp.less_equal(t395, 2.8973))), t519, t396)
+    t520 = xp.where(xp.greater_equal(t397, -2.8973) & xp.logical_not(xp.greater_equal(t395, -2.8973) & xp.less_equal(t395, 2.8973)), t519, t396)
     t521 = -t393
-    t522 = xp.where((xp.greater_equal(t393, -3.7525000000000004)) & xp.logical_not((xp.greater_equal(t391, -3.7525000000000004)) & (xp.less_equal(t391, 0.0175))), t521, t392)
+    t522 = xp.where(xp.greater_equal(t393, -3.7525000000000004) & xp.logical_not(xp.greater_equal(t391, -3.7525000000000004) & xp.less_equal(t391, 0.0175)), t521, t392)
     t523 = -t421
     t524 = xp.less_equal(t409, 1.7627999999999997)
-    t525 = (xp.greater_equal(t408, -1.7627999999999997)) & (xp.less_equal(t408, 1.7627999999999997))
+    t525 = xp.greater_equal(t408, -1.7627999999999997) & xp.less_equal(t408, 1.7627999999999997)
     t526 = -t419
     t527 = -t447
     t528 = -t441
     t529 = -t435
     t530 = -t429
-    t531 = xp.where((xp.greater_equal(t429, -2.8973)) & xp.logical_not((xp.greater_equal(t427, -2.8973)) & (xp.less_equal(t427, 2.8973))), t530, t428)
+    t531 = xp.where(xp.greater_equal(t429, -2.8973) & xp.logical_not(xp.greater_equal(t427, -2.8973) & xp.less_equal(t427, 2.8973)), t530, t428)
     t532 = -t425
-    t533 = xp.where((xp.greater_equal(t425, -3.7525000000000004)) & xp.logical_not((xp.greater_equal(t423, -3.7525000000000004)) & (xp.less_equal(t423, 0.0175))), t532, t424)
+    t533 = xp.where(xp.greater_equal(t425, -3.7525000000000004) & xp.logical_not(xp.greater_equal(t423, -3.7525000000000004) & xp.less_equal(t423, 0.0175)), t532, t424)
     t534 = -t451
     t535 = xp.less_equal(t439, 1.7627999999999997)
-    t536 = (xp.greater_equal(t438, -1.7627999999999997)) & (xp.less_equal(t438, 1.7627999999999997))
+    t536 = xp.greater_equal(t438, -1.7627999999999997) & xp.less_equal(t438, 1.7627999999999997)
     t537 = -t449
     t538 = -t479
     t539 = -t473
     t540 = -t467
     t541 = -t461
-    t542 = xp.where((xp.greater_equal(t461, 0.0698)) & xp.logical_not((xp.greater_equal(t32, 0.0698)) & (xp.less_equal(t32, 3.0718))), t541, t460)
+    t542 = xp.where(xp.greater_equal(t461, 0.0698) & xp.logical_not(xp.greater_equal(t32, 0.0698) & xp.less_equal(t32, 3.0718)), t541, t460)
     t543 = -t459
-    t544 = xp.where((xp.greater_equal(t459, -2.8973)) & xp.logical_not((xp.greater_equal(t457, -2.8973)) & (xp.less_equal(t457, 2.8973))), t543, t458)
+    t544 = xp.where(xp.greater_equal(t459, -2.8973) & xp.logical_not(xp.greater_equal(t457, -2.8973) & xp.less_equal(t457, 2.8973)), t543, t458)
     t545 = -t455
-    t546 = xp.where((xp.greater_equal(t455, -3.7525000000000004)) & xp.logical_not((xp.greater_equal(t453, -3.7525000000000004)) & (xp.less_equal(t453, 0.0175))), t545, t454)
+    t546 = xp.where(xp.greater_equal(t455, -3.7525000000000004) & xp.logical_not(xp.greater_equal(t453, -3.7525000000000004) & xp.less_equal(t453, 0.0175)), t545, t454)
     t547 = -t483
     t548 = xp.less_equal(t471, 1.7627999999999997)
-    t549 = (xp.greater_equal(t470, -1.7627999999999997)) & (xp.less_equal(t470, 1.7627999999999997))
+    t549 = xp.greater_equal(t470, -1.7627999999999997) & xp.less_equal(t470, 1.7627999999999997)
     t550 = -t481
     t551 = -t509
     t552 = -t503
     t553 = -t497
     t554 = -t491
-    t555 = xp.where((xp.greater_equal(t491, -2.8973)) & xp.logical_not((xp.greater_equal(t489, -2.8973)) & (xp.less_equal(t489, 2.8973))), t554, t490)
+    t555 = xp.where(xp.greater_equal(t491, -2.8973) & xp.logical_not(xp.greater_equal(t489, -2.8973) & xp.less_equal(t489, 2.8973)), t554, t490)
     t556 = -t487
-    t557 = xp.where((xp.greater_equal(t487, -3.7525000000000004)) & xp.logical_not((xp.greater_equal(t485, -3.7525000000000004)) & (xp.less_equal(t485, 0.0175))), t556, t486)
+    t557 = xp.where(xp.greater_equal(t487, -3.7525000000000004) & xp.logical_not(xp.greater_equal(t485, -3.7525000000000004) & xp.less_equal(t485, 0.0175)), t556, t486)
     t558 = -t513
     t559 = xp.less_equal(t501, 1.7627999999999997)
-    t560 = (xp.greater_equal(t500, -1.7627999999999997)) & (xp.less_equal(t500, 1.7627999999999997))
+    t560 = xp.greater_equal(t500, -1.7627999999999997) & xp.less_equal(t500, 1.7627999999999997)
     t561 = -t511
     t562 = xp.isfinite(t3)
     t563 = xp.greater_equal(t58, t60)
-    t564 = xp.greater_equal(t23, -1e-12)
+    t564 = xp.greater_equal(t23, -1e-12) | (False & xp.less_equal(t22, 1.64539586750625e-14))
     t565 = xp.greater(t58, t59)
     t566 = xp.greater(t23, 1e-12)
     t567 = xp.greater_equal(t227, t229)
     t568 = xp.greater(t227, t228)
     t569 = xp.greater_equal(q7, -2.8973)
     t570 = xp.less_equal(q7, 2.8973)
-    t571 = (xp.less_equal(t521, 3.7525000000000004)) | ((xp.greater_equal(t392, -0.0175)) & (xp.less_equal(t392, 3.7525000000000004)))
-    t572 = (xp.less_equal(t519, 2.8973)) | ((xp.greater_equal(t396, -2.8973)) & (xp.less_equal(t396, 2.8973)))
-    t573 = (xp.less_equal(t517, -0.0698)) | ((xp.greater_equal(t398, -3.0718)) & (xp.less_equal(t398, -0.0698)))
-    t574 = (xp.less_equal(t532, 3.7525000000000004)) | ((xp.greater_equal(t424, -0.0175)) & (xp.less_equal(t424, 3.7525000000000004)))
-    t575 = (xp.less_equal(t530, 2.8973)) | ((xp.greater_equal(t428, -2.8973)) & (xp.less_equal(t428, 2.8973)))
-    t576 = (xp.less_equal(t545, 3.7525000000000004)) | ((xp.greater_equal(t454, -0.0175)) & (xp.less_equal(t454, 3.7525000000000004)))
-    t577 = (xp.less_equal(t543, 2.8973)) | ((xp.greater_equal(t458, -2.8973)) & (xp.less_equal(t458, 2.8973)))
-    t578 = (xp.less_equal(t541, -0.0698)) | ((xp.greater_equal(t460, -3.0718)) & (xp.less_equal(t460, -0.0698)))
-    t579 = (xp.less_equal(t556, 3.7525000000000004)) | ((xp.greater_equal(t486, -0.0175)) & (xp.less_equal(t486, 3.7525000000000004)))
-    t580 = (xp.less_equal(t554, 2.8973)) | ((xp.greater_equal(t490, -2.8973)) & (xp.less_equal(t490, 2.8973)))
+    t571 = xp.less_equal(t521, 3.7525000000000004) | (xp.greater_equal(t392, -0.0175) & xp.less_equal(t392, 3.7525000000000004))
+    t572 = xp.less_equal(t519, 2.8973) | (xp.greater_equal(t396, -2.8973) & xp.less_equal(t396, 2.8973))
+    t573 = xp.less_equal(t517, -0.0698) | (xp.greater_equal(t398, -3.0718) & xp.less_equal(t398, -0.0698))
+    t574 = xp.less_equal(t532, 3.7525000000000004) | (xp.greater_equal(t424, -0.0175) & xp.less_equal(t424, 3.7525000000000004))
+    t575 = xp.less_equal(t530, 2.8973) | (xp.greater_equal(t428, -2.8973) & xp.less_equal(t428, 2.8973))
+    t576 = xp.less_equal(t545, 3.7525000000000004) | (xp.greater_equal(t454, -0.0175) & xp.less_equal(t454, 3.7525000000000004))
+    t577 = xp.less_equal(t543, 2.8973) | (xp.greater_equal(t458, -2.8973) & xp.less_equal(t458, 2.8973))
+    t578 = xp.less_equal(t541, -0.0698) | (xp.greater_equal(t460, -3.0718) & xp.less_equal(t460, -0.0698))
+    t579 = xp.less_equal(t556, 3.7525000000000004) | (xp.greater_equal(t486, -0.0175) & xp.less_equal(t486, 3.7525000000000004))
+    t580 = xp.less_equal(t554, 2.8973) | (xp.greater_equal(t490, -2.8973) & xp.less_equal(t490, 2.8973))
     q = _stack(xp, [
-        xp.where((xp.greater_equal(t417, -2.8973)) & xp.logical_not((xp.greater_equal(t414, -2.8973)) & (xp.less_equal(t414, 2.8973))), t514, t416),  # 0, 0
-        xp.where((xp.greater_equal(t411, -1.7627999999999997)) & xp.logical_not((xp.greater_equal(t407, -1.7627999999999997)) & (xp.less_equal(t407, 1.7627999999999997))), t515, t410),  # 0, 1
-        xp.where((xp.greater_equal(t405, -2.8973)) & xp.logical_not((xp.greater_equal(t402, -2.8973)) & (xp.less_equal(t402, 2.8973))), t516, t404),  # 0, 2
+        xp.where(xp.greater_equal(t417, -2.8973) & xp.logical_not(xp.greater_equal(t414, -2.8973) & xp.less_equal(t414, 2.8973)), t514, t416),  # 0, 0
+        xp.where(xp.greater_equal(t411, -1.7627999999999997) & xp.logical_not(xp.greater_equal(t407, -1.7627999999999997) & xp.less_equal(t407, 1.7627999999999997)), t515, t410),  # 0, 1
+        xp.where(xp.greater_equal(t405, -2.8973) & xp.logical_not(xp.greater_equal(t402, -2.8973) & xp.less_equal(t402, 2.8973)), t516, t404),  # 0, 2
         t518,  # 0, 3
         t520,  # 0, 4
         t522,  # 0, 5
         q7,  # 0, 6
-        xp.where((xp.greater_equal(t421, -2.8973)) & xp.logical_not((xp.greater_equal(t415, -2.8973)) & (xp.less_equal(t415, 2.8973))), t523, t420),  # 1, 0
+        xp.where(xp.greater_equal(t421, -2.8973) & xp.logical_not(xp.greater_equal(t415, -2.8973) & xp.less_equal(t415, 2.8973)), t523, t420),  # 1, 0
         xp.where(t524 & xp.logical_not(t525), t409, t408),  # 1, 1
-        xp.where((xp.greater_equal(t419, -2.8973)) & xp.logical_not((xp.greater_equal(t403, -2.8973)) & (xp.less_equal(t403, 2.8973))), t526, t418),  # 1, 2
+        xp.where(xp.greater_equal(t419, -2.8973) & xp.logical_not(xp.greater_equal(t403, -2.8973) & xp.less_equal(t403, 2.8973)), t526, t418),  # 1, 2
         t518,  # 1, 3
         t520,  # 1, 4
         t522,  # 1, 5
         q7,  # 1, 6
-        xp.where((xp.greater_equal(t447, -2.8973)) & xp.logical_not((xp.greater_equal(t444, -2.8973)) & (xp.less_equal(t444, 2.8973))), t527, t446),  # 2, 0
-        xp.where((xp.greater_equal(t441, -1.7627999999999997)) & xp.logical_not((xp.greater_equal(t437, -1.7627999999999997)) & (xp.less_equal(t437, 1.7627999999999997))), t528, t440),  # 2, 1
-        xp.where((xp.greater_equal(t435, -2.8973)) & xp.logical_not((xp.greater_equal(t432, -2.8973)) & (xp.less_equal(t432, 2.8973))), t529, t434),  # 2, 2
+        xp.where(xp.greater_equal(t447, -2.8973) & xp.logical_not(xp.greater_equal(t444, -2.8973) & xp.less_equal(t444, 2.8973)), t527, t446),  # 2, 0
+        xp.where(xp.greater_equal(t441, -1.7627999999999997) & xp.logical_not(xp.greater_equal(t437, -1.7627999999999997) & xp.less_equal(t437, 1.7627999999999997)), t528, t440),  # 2, 1
+        xp.where(xp.greater_equal(t435, -2.8973) & xp.logical_not(xp.greater_equal(t432, -2.8973) & xp.less_equal(t432, 2.8973)), t529, t434),  # 2, 2
         t518,  # 2, 3
         t531,  # 2, 4
         t533,  # 2, 5
         q7,  # 2, 6
-        xp.where((xp.greater_equal(t451, -2.8973)) & xp.logical_not((xp.greater_equal(t445, -2.8973)) & (xp.less_equal(t445, 2.8973))), t534, t450),  # 3, 0
+        xp.where(xp.greater_equal(t451, -2.8973) & xp.logical_not(xp.greater_equal(t445, -2.8973) & xp.less_equal(t445, 2.8973)), t534, t450),  # 3, 0
         xp.where(t535 & xp.logical_not(t536), t439, t438),  # 3, 1
-        xp.where((xp.greater_equal(t449, -2.8973)) & xp.logical_not((xp.greater_equal(t433, -2.8973)) & (xp.less_equal(t433, 2.8973))), t537, t448),  # 3, 2
+        xp.where(xp.greater_equal(t449, -2.8973) & xp.logical_not(xp.greater_equal(t433, -2.8973) & xp.less_equal(t433, 2.8973)), t537, t448),  # 3, 2
         t518,  # 3, 3
         t531,  # 3, 4
         t533,  # 3, 5
         q7,  # 3, 6
-        xp.where((xp.greater_equal(t479, -2.8973)) & xp.logical_not((xp.greater_equal(t476, -2.8973)) & (xp.less_equal(t476, 2.8973))), t538, t478),  # 4, 0
-        xp.where((xp.greater_equal(t473, -1.7627999999999997)) & xp.logical_not((xp.greater_equal(t469, -1.7627999999999997)) & (xp.less_equal(t469, 1.7627999999999997))), t539, t472),  # 4, 1
-        xp.where((xp.greater_equal(t467, -2.8973)) & xp.logical_not((xp.greater_equal(t464, -2.8973)) & (xp.less_equal(t464, 2.8973))), t540, t466),  # 4, 2
+        xp.where(xp.greater_equal(t479, -2.8973) & xp.logical_not(xp.greater_equal(t476, -2.8973) & xp.less_equal(t476, 2.8973)), t538, t478),  # 4, 0
+        xp.where(xp.greater_equal(t473, -1.7627999999999997) & xp.logical_not(xp.greater_equal(t469, -1.7627999999999997) & xp.less_equal(t469, 1.7627999999999997)), t539, t472),  # 4, 1
+        xp.where(xp.greater_equal(t467, -2.8973) & xp.logical_not(xp.greater_equal(t464, -2.8973) & xp.less_equal(t464, 2.8973)), t540, t466),  # 4, 2
         t542,  # 4, 3
         t544,  # 4, 4
         t546,  # 4, 5
         q7,  # 4, 6
-        xp.where((xp.greater_equal(t483, -2.8973)) & xp.logical_not((xp.greater_equal(t477, -2.8973)) & (xp.less_equal(t477, 2.8973))), t547, t482),  # 5, 0
+        xp.where(xp.greater_equal(t483, -2.8973) & xp.logical_not(xp.greater_equal(t477, -2.8973) & xp.less_equal(t477, 2.8973)), t547, t482),  # 5, 0
         xp.where(t548 & xp.logical_not(t549), t471, t470),  # 5, 1
-        xp.where((xp.greater_equal(t481, -2.8973)) & xp.logical_not((xp.greater_equal(t465, -2.8973)) & (xp.less_equal(t465, 2.8973))), t550, t480),  # 5, 2
+        xp.where(xp.greater_equal(t481, -2.8973) & xp.logical_not(xp.greater_equal(t465, -2.8973) & xp.less_equal(t465, 2.8973)), t550, t480),  # 5, 2
         t542,  # 5, 3
         t544,  # 5, 4
         t546,  # 5, 5
         q7,  # 5, 6
-        xp.where((xp.greater_equal(t509, -2.8973)) & xp.logical_not((xp.greater_equal(t506, -2.8973)) & (xp.less_equal(t506, 2.8973))), t551, t508),  # 6, 0
-        xp.where((xp.greater_equal(t503, -1.7627999999999997)) & xp.logical_not((xp.greater_equal(t499, -1.7627999999999997)) & (xp.less_equal(t499, 1.7627999999999997))), t552, t502),  # 6, 1
-        xp.where((xp.greater_equal(t497, -2.8973)) & xp.logical_not((xp.greater_equal(t494, -2.8973)) & (xp.less_equal(t494, 2.8973))), t553, t496),  # 6, 2
+        xp.where(xp.greater_equal(t509, -2.8973) & xp.logical_not(xp.greater_equal(t506, -2.8973) & xp.less_equal(t506, 2.8973)), t551, t508),  # 6, 0
+        xp.where(xp.greater_equal(t503, -1.7627999999999997) & xp.logical_not(xp.greater_equal(t499, -1.7627999999999997) & xp.less_equal(t499, 1.7627999999999997)), t552, t502),  # 6, 1
+        xp.where(xp.greater_equal(t497, -2.8973) & xp.logical_not(xp.greater_equal(t494, -2.8973) & xp.less_equal(t494, 2.8973)), t553, t496),  # 6, 2
         t542,  # 6, 3
         t555,  # 6, 4
         t557,  # 6, 5
         q7,  # 6, 6
-        xp.where((xp.greater_equal(t513, -2.8973)) & xp.logical_not((xp.greater_equal(t507, -2.8973)) & (xp.less_equal(t507, 2.8973))), t558, t512),  # 7, 0
+        xp.where(xp.greater_equal(t513, -2.8973) & xp.logical_not(xp.greater_equal(t507, -2.8973) & xp.less_equal(t507, 2.8973)), t558, t512),  # 7, 0
         xp.where(t559 & xp.logical_not(t560), t501, t500),  # 7, 1
-        xp.where((xp.greater_equal(t511, -2.8973)) & xp.logical_not((xp.greater_equal(t495, -2.8973)) & (xp.less_equal(t495, 2.8973))), t561, t510),  # 7, 2
+        xp.where(xp.greater_equal(t511, -2.8973) & xp.logical_not(xp.greater_equal(t495, -2.8973) & xp.less_equal(t495, 2.8973)), t561, t510),  # 7, 2
         t542,  # 7, 3
         t555,  # 7, 4
         t557,  # 7, 5
         q7,  # 7, 6
     ], (8, 7))
     valid = _stack(xp, [
-        t562 & t563 & t564 & (xp.greater_equal(t138, -1e-12)),  # 0
-        t562 & t563 & t564 & (xp.greater(t138, 1e-12)),  # 1
-        t562 & t564 & t565 & (xp.greater_equal(t192, -1e-12)),  # 2
-        t562 & t564 & t565 & (xp.greater(t192, 1e-12)),  # 3
-        t562 & t566 & t567 & (xp.greater_equal(t306, -1e-12)),  # 4
-        t562 & t566 & t567 & (xp.greater(t306, 1e-12)),  # 5
-        t562 & t566 & t568 & (xp.greater_equal(t360, -1e-12)),  # 6
-        t562 & t566 & t568 & (xp.greater(t360, 1e-12)),  # 7
+        t562 & t563 & t564 & xp.greater_equal(t138, -1e-12),  # 0
+        t562 & t563 & t564 & xp.greater(t138, 1e-12),  # 1
+        t562 & t564 & t565 & xp.greater_equal(t192, -1e-12),  # 2
+        t562 & t564 & t565 & xp.greater(t192, 1e-12),  # 3
+        t562 & t566 & t567 & xp.greater_equal(t306, -1e-12),  # 4
+        t562 & t566 & t567 & xp.greater(t306, 1e-12),  # 5
+        t562 & t566 & t568 & xp.greater_equal(t360, -1e-12),  # 6
+        t562 & t566 & t568 & xp.greater(t360, 1e-12),  # 7
     ], (8,))
     in_limits = _stack(xp, [
-        t569 & t570 & t571 & t572 & t573 & ((xp.less_equal(t514, 2.8973)) | ((xp.greater_equal(t416, -2.8973)) & (xp.less_equal(t416, 2.8973)))) & ((xp.less_equal(t515, 1.7627999999999997)) | ((xp.greater_equal(t410, -1.7627999999999997)) & (xp.less_equal(t410, 1.7627999999999997)))) & ((xp.less_equal(t516, 2.8973)) | ((xp.greater_equal(t404, -2.8973)) & (xp.less_equal(t404, 2.8973)))),  # 0
-        t569 & t570 & t571 & t572 & t573 & (t524 | t525) & ((xp.less_equal(t523, 2.8973)) | ((xp.greater_equal(t420, -2.8973)) & (xp.less_equal(t420, 2.8973)))) & ((xp.less_equal(t526, 2.8973)) | ((xp.greater_equal(t418, -2.8973)) & (xp.less_equal(t418, 2.8973)))),  # 1
-        t569 & t570 & t573 & t574 & t575 & ((xp.less_equal(t527, 2.8973)) | ((xp.greater_equal(t446, -2.8973)) & (xp.less_equal(t446, 2.8973)))) & ((xp.less_equal(t528, 1.7627999999999997)) | ((xp.greater_equal(t440, -1.7627999999999997)) & (xp.less_equal(t440, 1.7627999999999997)))) & ((xp.less_equal(t529, 2.8973)) | ((xp.greater_equal(t434, -2.8973)) & (xp.less_equal(t434, 2.8973)))),  # 2
-        t569 & t570 & t573 & t574 & t575 & (t535 | t536) & ((xp.less_equal(t534, 2.8973)) | ((xp.greater_equal(t450, -2.8973)) & (xp.less_equal(t450, 2.8973)))) & ((xp.less_equal(t537, 2.8973)) | ((xp.greater_equal(t448, -2.8973)) & (xp.less_equal(t448, 2.8973)))),  # 3
-        t569 & t570 & t576 & t577 & t578 & ((xp.less_equal(t538, 2.8973)) | ((xp.greater_equal(t478, -2.8973)) & (xp.less_equal(t478, 2.8973)))) & ((xp.less_equal(t539, 1.7627999999999997)) | ((xp.greater_equal(t472, -1.7627999999999997)) & (xp.less_equal(t472, 1.7627999999999997)))) & ((xp.less_equal(t540, 2.8973)) | ((xp.greater_equal(t466, -2.8973)) & (xp.less_equal(t466, 2.8973)))),  # 4
-        t569 & t570 & t576 & t577 & t578 & (t548 | t549) & ((xp.less_equal(t547, 2.8973)) | ((xp.greater_equal(t482, -2.8973)) & (xp.less_equal(t482, 2.8973)))) & ((xp.less_equal(t550, 2.8973)) | ((xp.greater_equal(t480, -2.8973)) & (xp.less_equal(t480, 2.8973)))),  # 5
-        t569 & t570 & t578 & t579 & t580 & ((xp.less_equal(t551, 2.8973)) | ((xp.greater_equal(t508, -2.8973)) & (xp.less_equal(t508, 2.8973)))) & ((xp.less_equal(t552, 1.7627999999999997)) | ((xp.greater_equal(t502, -1.7627999999999997)) & (xp.less_equal(t502, 1.7627999999999997)))) & ((xp.less_equal(t553, 2.8973)) | ((xp.greater_equal(t496, -2.8973)) & (xp.less_equal(t496, 2.8973)))),  # 6
-        t569 & t570 & t578 & t579 & t580 & (t559 | t560) & ((xp.less_equal(t558, 2.8973)) | ((xp.greater_equal(t512, -2.8973)) & (xp.less_equal(t512, 2.8973)))) & ((xp.less_equal(t561, 2.8973)) | ((xp.greater_equal(t510, -2.8973)) & (xp.less_equal(t510, 2.8973)))),  # 7
+        t569 & t570 & t571 & t572 & t573 & (xp.less_equal(t514, 2.8973) | (xp.greater_equal(t416, -2.8973) & xp.less_equal(t416, 2.8973))) & (xp.less_equal(t515, 1.7627999999999997) | (xp.greater_equal(t410, -1.7627999999999997) & xp.less_equal(t410, 1.7627999999999997))) & (xp.less_equal(t516, 2.8973) | (xp.greater_equal(t404, -2.8973) & xp.less_equal(t404, 2.8973))),  # 0
+        t569 & t570 & t571 & t572 & t573 & (t524 | t525) & (xp.less_equal(t523, 2.8973) | (xp.greater_equal(t420, -2.8973) & xp.less_equal(t420, 2.8973))) & (xp.less_equal(t526, 2.8973) | (xp.greater_equal(t418, -2.8973) & xp.less_equal(t418, 2.8973))),  # 1
+        t569 & t570 & t573 & t574 & t575 & (xp.less_equal(t527, 2.8973) | (xp.greater_equal(t446, -2.8973) & xp.less_equal(t446, 2.8973))) & (xp.less_equal(t528, 1.7627999999999997) | (xp.greater_equal(t440, -1.7627999999999997) & xp.less_equal(t440, 1.7627999999999997))) & (xp.less_equal(t529, 2.8973) | (xp.greater_equal(t434, -2.8973) & xp.less_equal(t434, 2.8973))),  # 2
+        t569 & t570 & t573 & t574 & t575 & (t535 | t536) & (xp.less_equal(t534, 2.8973) | (xp.greater_equal(t450, -2.8973) & xp.less_equal(t450, 2.8973))) & (xp.less_equal(t537, 2.8973) | (xp.greater_equal(t448, -2.8973) & xp.less_equal(t448, 2.8973))),  # 3
+        t569 & t570 & t576 & t577 & t578 & (xp.less_equal(t538, 2.8973) | (xp.greater_equal(t478, -2.8973) & xp.less_equal(t478, 2.8973))) & (xp.less_equal(t539, 1.7627999999999997) | (xp.greater_equal(t472, -1.7627999999999997) & xp.less_equal(t472, 1.7627999999999997))) & (xp.less_equal(t540, 2.8973) | (xp.greater_equal(t466, -2.8973) & xp.less_equal(t466, 2.8973))),  # 4
+        t569 & t570 & t576 & t577 & t578 & (t548 | t549) & (xp.less_equal(t547, 2.8973) | (xp.greater_equal(t482, -2.8973) & xp.less_equal(t482, 2.8973))) & (xp.less_equal(t550, 2.8973) | (xp.greater_equal(t480, -2.8973) & xp.less_equal(t480, 2.8973))),  # 5
+        t569 & t570 & t578 & t579 & t580 & (xp.less_equal(t551, 2.8973) | (xp.greater_equal(t508, -2.8973) & xp.less_equal(t508, 2.8973))) & (xp.less_equal(t552, 1.7627999999999997) | (xp.greater_equal(t502, -1.7627999999999997) & xp.less_equal(t502, 1.7627999999999997))) & (xp.less_equal(t553, 2.8973) | (xp.greater_equal(t496, -2.8973) & xp.less_equal(t496, 2.8973))),  # 6
+        t569 & t570 & t578 & t579 & t580 & (t559 | t560) & (xp.less_equal(t558, 2.8973) | (xp.greater_equal(t512, -2.8973) & xp.less_equal(t512, 2.8973))) & (xp.less_equal(t561, 2.8973) | (xp.greater_equal(t510, -2.8973) & xp.less_equal(t510, 2.8973))),  # 7
     ], (8,))
     return q, valid, in_limits
 
@@ -3908,30 +3908,30 @@ def ik_nearest(T, q_seed, q_free, weights=(1.0,) * DOF):
     t55 = qb7_5 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn6 - qb7_5))
     t56 = xp.where(lb7 & vb7, xp.asarray(1, dtype=dtype), 0)
     t57 = T00 + T01 + T02 + T03 + T10 + T11 + T12 + T13 + T20 + T21 + T22 + T23 + qn1 + qn2 + qn3 + qn4 + qn5 + qn6 + qn7 + qw1 + qw2 + qw3 + qw4 + qw5 + qw6 + qw7
-    t58 = xp.where(xp.greater(qn1, t0), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t58 = xp.where(xp.less(t0, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t59 = t0 + t58
     t60 = t0 - t58
-    t61 = xp.where((xp.greater_equal(t0, -2.8973)) & (xp.less_equal(t0, 2.8973)), t0, xp.where((xp.greater_equal(t59, -2.8973)) & (xp.less_equal(t59, 2.8973)), t59, xp.where((xp.greater_equal(t60, -2.8973)) & (xp.less_equal(t60, 2.8973)), t60, qb0_0)))
-    t62 = xp.where(xp.greater(qn2, t1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t61 = xp.where(xp.greater_equal(t0, -2.8973) & xp.less_equal(t0, 2.8973), t0, xp.where(xp.greater_equal(t59, -2.8973) & xp.less_equal(t59, 2.8973), t59, xp.where(xp.greater_equal(t60, -2.8973) & xp.less_equal(t60, 2.8973), t60, qb0_0)))
+    t62 = xp.where(xp.less(t1, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t63 = t1 + t62
     t64 = t1 - t62
-    t65 = xp.where((xp.greater_equal(t1, -1.7627999999999997)) & (xp.less_equal(t1, 1.7627999999999997)), t1, xp.where((xp.greater_equal(t63, -1.7627999999999997)) & (xp.less_equal(t63, 1.7627999999999997)), t63, xp.where((xp.greater_equal(t64, -1.7627999999999997)) & (xp.less_equal(t64, 1.7627999999999997)), t64, qb0_1)))
-    t66 = xp.where(xp.greater(qn3, t2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t65 = xp.where(xp.greater_equal(t1, -1.7627999999999997) & xp.less_equal(t1, 1.7627999999999997), t1, xp.where(xp.greater_equal(t63, -1.7627999999999997) & xp.less_equal(t63, 1.7627999999999997), t63, xp.where(xp.greater_equal(t64, -1.7627999999999997) & xp.less_equal(t64, 1.7627999999999997), t64, qb0_1)))
+    t66 = xp.where(xp.less(t2, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t67 = t2 + t66
     t68 = t2 - t66
-    t69 = xp.where((xp.greater_equal(t2, -2.8973)) & (xp.less_equal(t2, 2.8973)), t2, xp.where((xp.greater_equal(t67, -2.8973)) & (xp.less_equal(t67, 2.8973)), t67, xp.where((xp.greater_equal(t68, -2.8973)) & (xp.less_equal(t68, 2.8973)), t68, qb0_2)))
-    t70 = xp.where(xp.greater(qn4, t3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t69 = xp.where(xp.greater_equal(t2, -2.8973) & xp.less_equal(t2, 2.8973), t2, xp.where(xp.greater_equal(t67, -2.8973) & xp.less_equal(t67, 2.8973), t67, xp.where(xp.greater_equal(t68, -2.8973) & xp.less_equal(t68, 2.8973), t68, qb0_2)))
+    t70 = xp.where(xp.less(t3, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t71 = t3 + t70
     t72 = t3 - t70
-    t73 = xp.where((xp.greater_equal(t3, -3.0718)) & (xp.less_equal(t3, -0.0698)), t3, xp.where((xp.greater_equal(t71, -3.0718)) & (xp.less_equal(t71, -0.0698)), t71, xp.where((xp.greater_equal(t72, -3.0718)) & (xp.less_equal(t72, -0.0698)), t72, qb0_3)))
-    t74 = xp.where(xp.greater(qn5, t4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t73 = xp.where(xp.greater_equal(t3, -3.0718) & xp.less_equal(t3, -0.0698), t3, xp.where(xp.greater_equal(t71, -3.0718) & xp.less_equal(t71, -0.0698), t71, xp.where(xp.greater_equal(t72, -3.0718) & xp.less_equal(t72, -0.0698), t72, qb0_3)))
+    t74 = xp.where(xp.less(t4, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t75 = t4 + t74
     t76 = t4 - t74
-    t77 = xp.where((xp.greater_equal(t4, -2.8973)) & (xp.less_equal(t4, 2.8973)), t4, xp.where((xp.greater_equal(t75, -2.8973)) & (xp.less_equal(t75, 2.8973)), t75, xp.where((xp.greater_equal(t76, -2.8973)) & (xp.less_equal(t76, 2.8973)), t76, qb0_4)))
-    t78 = xp.where(xp.greater(qn6, t5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t77 = xp.where(xp.greater_equal(t4, -2.8973) & xp.less_equal(t4, 2.8973), t4, xp.where(xp.greater_equal(t75, -2.8973) & xp.less_equal(t75, 2.8973), t75, xp.where(xp.greater_equal(t76, -2.8973) & xp.less_equal(t76, 2.8973), t76, qb0_4)))
+    t78 = xp.where(xp.less(t5, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t79 = t5 + t78
     t80 = t5 - t78
-    t81 = xp.where((xp.greater_equal(t5, -0.0175)) & (xp.less_equal(t5, 3.7525000000000004)), t5, xp.where((xp.greater_equal(t79, -0.0175)) & (xp.less_equal(t79, 3.7525000000000004)), t79, xp.where((xp.greater_equal(t80, -0.0175)) & (xp.less_equal(t80, 3.7525000000000004)), t80, qb0_5)))
+    t81 = xp.where(xp.greater_equal(t5, -0.0175) & xp.less_equal(t5, 3.7525000000000004), t5, xp.where(xp.greater_equal(t79, -0.0175) & xp.less_equal(t79, 3.7525000000000004), t79, xp.where(xp.greater_equal(t80, -0.0175) & xp.less_equal(t80, 3.7525000000000004), t80, qb0_5)))
     t82 = -qn1
     t83 = -qn2
     t84 = -qn3
@@ -3939,7 +3939,7 @@ def ik_nearest(T, q_seed, q_free, weights=(1.0,) * DOF):
     t86 = -qn5
     t87 = -qn6
     t88 = -qn7
-    t89 = qw1*(t61 + t82)**2 + qw2*(t65 + t83)**2 + qw3*(t69 + t84)**2 + qw4*(t73 + t85)**2 + qw5*(t77 + t86)**2 + qw6*(t81 + t87)**2 + qw7*(qb0_6 + t88)**2
+    t89 = qw1*(t61 + t82)**2 + qw2*(t65 + t83)**2 + qw3*(t69 + t84)**2 + qw4*(t73 + t85)**2 + qw5*(t77 + t86)**2 + qw6*(t81 + t87)**2 + qw7*(t88 + qb0_6)**2
     t90 = xp.greater(t7, 0)
     t91 = xp.where(t90, t61, qn1)
     t92 = xp.where(t90, t65, qn2)
@@ -3949,33 +3949,33 @@ def ik_nearest(T, q_seed, q_free, weights=(1.0,) * DOF):
     t96 = xp.where(t90, t81, qn6)
     t97 = xp.where(t90, qb0_6, qn7)
     t98 = xp.where(t90, t89, 0)
-    t99 = xp.where(xp.greater(qn1, t8), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t99 = xp.where(xp.less(t8, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t100 = t8 + t99
     t101 = t8 - t99
-    t102 = xp.where((xp.greater_equal(t8, -2.8973)) & (xp.less_equal(t8, 2.8973)), t8, xp.where((xp.greater_equal(t100, -2.8973)) & (xp.less_equal(t100, 2.8973)), t100, xp.where((xp.greater_equal(t101, -2.8973)) & (xp.less_equal(t101, 2.8973)), t101, qb1_0)))
-    t103 = xp.where(xp.greater(qn2, t9), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t104 = t103 + t9
+    t102 = xp.where(xp.greater_equal(t8, -2.8973) & xp.less_equal(t8, 2.8973), t8, xp.where(xp.greater_equal(t100, -2.8973) & xp.less_equal(t100, 2.8973), t100, xp.where(xp.greater_equal(t101, -2.8973) & xp.less_equal(t101, 2.8973), t101, qb1_0)))
+    t103 = xp.where(xp.less(t9, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t104 = t9 + t103
     t105 = t9 - t103
-    t106 = xp.where((xp.greater_equal(t9, -1.7627999999999997)) & (xp.less_equal(t9, 1.7627999999999997)), t9, xp.where((xp.greater_equal(t104, -1.7627999999999997)) & (xp.less_equal(t104, 1.7627999999999997)), t104, xp.where((xp.greater_equal(t105, -1.7627999999999997)) & (xp.less_equal(t105, 1.7627999999999997)), t105, qb1_1)))
-    t107 = xp.where(xp.greater(qn3, t10), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t106 = xp.where(xp.greater_equal(t9, -1.7627999999999997) & xp.less_equal(t9, 1.7627999999999997), t9, xp.where(xp.greater_equal(t104, -1.7627999999999997) & xp.less_equal(t104, 1.7627999999999997), t104, xp.where(xp.greater_equal(t105, -1.7627999999999997) & xp.less_equal(t105, 1.7627999999999997), t105, qb1_1)))
+    t107 = xp.where(xp.less(t10, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t108 = t10 + t107
     t109 = t10 - t107
-    t110 = xp.where((xp.greater_equal(t10, -2.8973)) & (xp.less_equal(t10, 2.8973)), t10, xp.where((xp.greater_equal(t108, -2.8973)) & (xp.less_equal(t108, 2.8973)), t108, xp.where((xp.greater_equal(t109, -2.8973)) & (xp.less_equal(t109, 2.8973)), t109, qb1_2)))
-    t111 = xp.where(xp.greater(qn4, t11), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t110 = xp.where(xp.greater_equal(t10, -2.8973) & xp.less_equal(t10, 2.8973), t10, xp.where(xp.greater_equal(t108, -2.8973) & xp.less_equal(t108, 2.8973), t108, xp.where(xp.greater_equal(t109, -2.8973) & xp.less_equal(t109, 2.8973), t109, qb1_2)))
+    t111 = xp.where(xp.less(t11, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t112 = t11 + t111
     t113 = t11 - t111
-    t114 = xp.where((xp.greater_equal(t11, -3.0718)) & (xp.less_equal(t11, -0.0698)), t11, xp.where((xp.greater_equal(t112, -3.0718)) & (xp.less_equal(t112, -0.0698)), t112, xp.where((xp.greater_equal(t113, -3.0718)) & (xp.less_equal(t113, -0.0698)), t113, qb1_3)))
-    t115 = xp.where(xp.greater(qn5, t12), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t116 = t115 + t12
+    t114 = xp.where(xp.greater_equal(t11, -3.0718) & xp.less_equal(t11, -0.0698), t11, xp.where(xp.greater_equal(t112, -3.0718) & xp.less_equal(t112, -0.0698), t112, xp.where(xp.greater_equal(t113, -3.0718) & xp.less_equal(t113, -0.0698), t113, qb1_3)))
+    t115 = xp.where(xp.less(t12, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t116 = t12 + t115
     t117 = t12 - t115
-    t118 = xp.where((xp.greater_equal(t12, -2.8973)) & (xp.less_equal(t12, 2.8973)), t12, xp.where((xp.greater_equal(t116, -2.8973)) & (xp.less_equal(t116, 2.8973)), t116, xp.where((xp.greater_equal(t117, -2.8973)) & (xp.less_equal(t117, 2.8973)), t117, qb1_4)))
-    t119 = xp.where(xp.greater(qn6, t13), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t120 = t119 + t13
+    t118 = xp.where(xp.greater_equal(t12, -2.8973) & xp.less_equal(t12, 2.8973), t12, xp.where(xp.greater_equal(t116, -2.8973) & xp.less_equal(t116, 2.8973), t116, xp.where(xp.greater_equal(t117, -2.8973) & xp.less_equal(t117, 2.8973), t117, qb1_4)))
+    t119 = xp.where(xp.less(t13, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t120 = t13 + t119
     t121 = t13 - t119
-    t122 = xp.where((xp.greater_equal(t13, -0.0175)) & (xp.less_equal(t13, 3.7525000000000004)), t13, xp.where((xp.greater_equal(t120, -0.0175)) & (xp.less_equal(t120, 3.7525000000000004)), t120, xp.where((xp.greater_equal(t121, -0.0175)) & (xp.less_equal(t121, 3.7525000000000004)), t121, qb1_5)))
-    t123 = qw1*(t102 + t82)**2 + qw2*(t106 + t83)**2 + qw3*(t110 + t84)**2 + qw4*(t114 + t85)**2 + qw5*(t118 + t86)**2 + qw6*(t122 + t87)**2 + qw7*(qb1_6 + t88)**2
+    t122 = xp.where(xp.greater_equal(t13, -0.0175) & xp.less_equal(t13, 3.7525000000000004), t13, xp.where(xp.greater_equal(t120, -0.0175) & xp.less_equal(t120, 3.7525000000000004), t120, xp.where(xp.greater_equal(t121, -0.0175) & xp.less_equal(t121, 3.7525000000000004), t121, qb1_5)))
+    t123 = qw1*(t102 + t82)**2 + qw2*(t106 + t83)**2 + qw3*(t110 + t84)**2 + qw4*(t114 + t85)**2 + qw5*(t118 + t86)**2 + qw6*(t122 + t87)**2 + qw7*(t88 + qb1_6)**2
     t124 = xp.greater(t14, 0)
-    t125 = xp.where(t124 & ((xp.less(t123, t98)) | (xp.less(t7, 1))), xp.asarray(1, dtype=dtype), 0)
+    t125 = xp.where(t124 & (xp.greater(t98, t123) | xp.less(t7, 1)), xp.asarray(1, dtype=dtype), 0)
     t126 = xp.where(t124, 1, t7)
     t127 = xp.greater(t125, 0)
     t128 = xp.where(t127, t102, t91)
@@ -3986,33 +3986,33 @@ def ik_nearest(T, q_seed, q_free, weights=(1.0,) * DOF):
     t133 = xp.where(t127, t122, t96)
     t134 = xp.where(t127, qb1_6, t97)
     t135 = xp.where(t127, t123, t98)
-    t136 = xp.where(xp.greater(qn1, t15), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t137 = t136 + t15
+    t136 = xp.where(xp.less(t15, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t137 = t15 + t136
     t138 = t15 - t136
-    t139 = xp.where((xp.greater_equal(t15, -2.8973)) & (xp.less_equal(t15, 2.8973)), t15, xp.where((xp.greater_equal(t137, -2.8973)) & (xp.less_equal(t137, 2.8973)), t137, xp.where((xp.greater_equal(t138, -2.8973)) & (xp.less_equal(t138, 2.8973)), t138, qb2_0)))
-    t140 = xp.where(xp.greater(qn2, t16), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t141 = t140 + t16
+    t139 = xp.where(xp.greater_equal(t15, -2.8973) & xp.less_equal(t15, 2.8973), t15, xp.where(xp.greater_equal(t137, -2.8973) & xp.less_equal(t137, 2.8973), t137, xp.where(xp.greater_equal(t138, -2.8973) & xp.less_equal(t138, 2.8973), t138, qb2_0)))
+    t140 = xp.where(xp.less(t16, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t141 = t16 + t140
     t142 = t16 - t140
-    t143 = xp.where((xp.greater_equal(t16, -1.7627999999999997)) & (xp.less_equal(t16, 1.7627999999999997)), t16, xp.where((xp.greater_equal(t141, -1.7627999999999997)) & (xp.less_equal(t141, 1.7627999999999997)), t141, xp.where((xp.greater_equal(t142, -1.7627999999999997)) & (xp.less_equal(t142, 1.7627999999999997)), t142, qb2_1)))
-    t144 = xp.where(xp.greater(qn3, t17), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t145 = t144 + t17
+    t143 = xp.where(xp.greater_equal(t16, -1.7627999999999997) & xp.less_equal(t16, 1.7627999999999997), t16, xp.where(xp.greater_equal(t141, -1.7627999999999997) & xp.less_equal(t141, 1.7627999999999997), t141, xp.where(xp.greater_equal(t142, -1.7627999999999997) & xp.less_equal(t142, 1.7627999999999997), t142, qb2_1)))
+    t144 = xp.where(xp.less(t17, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t145 = t17 + t144
     t146 = t17 - t144
-    t147 = xp.where((xp.greater_equal(t17, -2.8973)) & (xp.less_equal(t17, 2.8973)), t17, xp.where((xp.greater_equal(t145, -2.8973)) & (xp.less_equal(t145, 2.8973)), t145, xp.where((xp.greater_equal(t146, -2.8973)) & (xp.less_equal(t146, 2.8973)), t146, qb2_2)))
-    t148 = xp.where(xp.greater(qn4, t18), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t149 = t148 + t18
+    t147 = xp.where(xp.greater_equal(t17, -2.8973) & xp.less_equal(t17, 2.8973), t17, xp.where(xp.greater_equal(t145, -2.8973) & xp.less_equal(t145, 2.8973), t145, xp.where(xp.greater_equal(t146, -2.8973) & xp.less_equal(t146, 2.8973), t146, qb2_2)))
+    t148 = xp.where(xp.less(t18, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t149 = t18 + t148
     t150 = t18 - t148
-    t151 = xp.where((xp.greater_equal(t18, -3.0718)) & (xp.less_equal(t18, -0.0698)), t18, xp.where((xp.greater_equal(t149, -3.0718)) & (xp.less_equal(t149, -0.0698)), t149, xp.where((xp.greater_equal(t150, -3.0718)) & (xp.less_equal(t150, -0.0698)), t150, qb2_3)))
-    t152 = xp.where(xp.greater(qn5, t19), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t153 = t152 + t19
+    t151 = xp.where(xp.greater_equal(t18, -3.0718) & xp.less_equal(t18, -0.0698), t18, xp.where(xp.greater_equal(t149, -3.0718) & xp.less_equal(t149, -0.0698), t149, xp.where(xp.greater_equal(t150, -3.0718) & xp.less_equal(t150, -0.0698), t150, qb2_3)))
+    t152 = xp.where(xp.less(t19, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t153 = t19 + t152
     t154 = t19 - t152
-    t155 = xp.where((xp.greater_equal(t19, -2.8973)) & (xp.less_equal(t19, 2.8973)), t19, xp.where((xp.greater_equal(t153, -2.8973)) & (xp.less_equal(t153, 2.8973)), t153, xp.where((xp.greater_equal(t154, -2.8973)) & (xp.less_equal(t154, 2.8973)), t154, qb2_4)))
-    t156 = xp.where(xp.greater(qn6, t20), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t157 = t156 + t20
+    t155 = xp.where(xp.greater_equal(t19, -2.8973) & xp.less_equal(t19, 2.8973), t19, xp.where(xp.greater_equal(t153, -2.8973) & xp.less_equal(t153, 2.8973), t153, xp.where(xp.greater_equal(t154, -2.8973) & xp.less_equal(t154, 2.8973), t154, qb2_4)))
+    t156 = xp.where(xp.less(t20, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t157 = t20 + t156
     t158 = t20 - t156
-    t159 = xp.where((xp.greater_equal(t20, -0.0175)) & (xp.less_equal(t20, 3.7525000000000004)), t20, xp.where((xp.greater_equal(t157, -0.0175)) & (xp.less_equal(t157, 3.7525000000000004)), t157, xp.where((xp.greater_equal(t158, -0.0175)) & (xp.less_equal(t158, 3.7525000000000004)), t158, qb2_5)))
-    t160 = qw1*(t139 + t82)**2 + qw2*(t143 + t83)**2 + qw3*(t147 + t84)**2 + qw4*(t151 + t85)**2 + qw5*(t155 + t86)**2 + qw6*(t159 + t87)**2 + qw7*(qb2_6 + t88)**2
+    t159 = xp.where(xp.greater_equal(t20, -0.0175) & xp.less_equal(t20, 3.7525000000000004), t20, xp.where(xp.greater_equal(t157, -0.0175) & xp.less_equal(t157, 3.7525000000000004), t157, xp.where(xp.greater_equal(t158, -0.0175) & xp.less_equal(t158, 3.7525000000000004), t158, qb2_5)))
+    t160 = qw1*(t139 + t82)**2 + qw2*(t143 + t83)**2 + qw3*(t147 + t84)**2 + qw4*(t151 + t85)**2 + qw5*(t155 + t86)**2 + qw6*(t159 + t87)**2 + qw7*(t88 + qb2_6)**2
     t161 = xp.greater(t21, 0)
-    t162 = xp.where(t161 & ((xp.greater(t135, t160)) | (xp.less(t126, 1))), xp.asarray(1, dtype=dtype), 0)
+    t162 = xp.where(t161 & (xp.less(t160, t135) | xp.less(t126, 1)), xp.asarray(1, dtype=dtype), 0)
     t163 = xp.where(t161, 1, t126)
     t164 = xp.greater(t162, 0)
     t165 = xp.where(t164, t139, t128)
@@ -4023,33 +4023,33 @@ def ik_nearest(T, q_seed, q_free, weights=(1.0,) * DOF):
     t170 = xp.where(t164, t159, t133)
     t171 = xp.where(t164, qb2_6, t134)
     t172 = xp.where(t164, t160, t135)
-    t173 = xp.where(xp.greater(qn1, t22), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t174 = t173 + t22
+    t173 = xp.where(xp.less(t22, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t174 = t22 + t173
     t175 = t22 - t173
-    t176 = xp.where((xp.greater_equal(t22, -2.8973)) & (xp.less_equal(t22, 2.8973)), t22, xp.where((xp.greater_equal(t174, -2.8973)) & (xp.less_equal(t174, 2.8973)), t174, xp.where((xp.greater_equal(t175, -2.8973)) & (xp.less_equal(t175, 2.8973)), t175, qb3_0)))
-    t177 = xp.where(xp.greater(qn2, t23), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t178 = t177 + t23
+    t176 = xp.where(xp.greater_equal(t22, -2.8973) & xp.less_equal(t22, 2.8973), t22, xp.where(xp.greater_equal(t174, -2.8973) & xp.less_equal(t174, 2.8973), t174, xp.where(xp.greater_equal(t175, -2.8973) & xp.less_equal(t175, 2.8973), t175, qb3_0)))
+    t177 = xp.where(xp.less(t23, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t178 = t23 + t177
     t179 = t23 - t177
-    t180 = xp.where((xp.greater_equal(t23, -1.7627999999999997)) & (xp.less_equal(t23, 1.7627999999999997)), t23, xp.where((xp.greater_equal(t178, -1.7627999999999997)) & (xp.less_equal(t178, 1.7627999999999997)), t178, xp.where((xp.greater_equal(t179, -1.7627999999999997)) & (xp.less_equal(t179, 1.7627999999999997)), t179, qb3_1)))
-    t181 = xp.where(xp.greater(qn3, t24), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t182 = t181 + t24
+    t180 = xp.where(xp.greater_equal(t23, -1.7627999999999997) & xp.less_equal(t23, 1.7627999999999997), t23, xp.where(xp.greater_equal(t178, -1.7627999999999997) & xp.less_equal(t178, 1.7627999999999997), t178, xp.where(xp.greater_equal(t179, -1.7627999999999997) & xp.less_equal(t179, 1.7627999999999997), t179, qb3_1)))
+    t181 = xp.where(xp.less(t24, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t182 = t24 + t181
     t183 = t24 - t181
-    t184 = xp.where((xp.greater_equal(t24, -2.8973)) & (xp.less_equal(t24, 2.8973)), t24, xp.where((xp.greater_equal(t182, -2.8973)) & (xp.less_equal(t182, 2.8973)), t182, xp.where((xp.greater_equal(t183, -2.8973)) & (xp.less_equal(t183, 2.8973)), t183, qb3_2)))
-    t185 = xp.where(xp.greater(qn4, t25), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t186 = t185 + t25
+    t184 = xp.where(xp.greater_equal(t24, -2.8973) & xp.less_equal(t24, 2.8973), t24, xp.where(xp.greater_equal(t182, -2.8973) & xp.less_equal(t182, 2.8973), t182, xp.where(xp.greater_equal(t183, -2.8973) & xp.less_equal(t183, 2.8973), t183, qb3_2)))
+    t185 = xp.where(xp.less(t25, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t186 = t25 + t185
     t187 = t25 - t185
-    t188 = xp.where((xp.greater_equal(t25, -3.0718)) & (xp.less_equal(t25, -0.0698)), t25, xp.where((xp.greater_equal(t186, -3.0718)) & (xp.less_equal(t186, -0.0698)), t186, xp.where((xp.greater_equal(t187, -3.0718)) & (xp.less_equal(t187, -0.0698)), t187, qb3_3)))
-    t189 = xp.where(xp.greater(qn5, t26), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t190 = t189 + t26
+    t188 = xp.where(xp.greater_equal(t25, -3.0718) & xp.less_equal(t25, -0.0698), t25, xp.where(xp.greater_equal(t186, -3.0718) & xp.less_equal(t186, -0.0698), t186, xp.where(xp.greater_equal(t187, -3.0718) & xp.less_equal(t187, -0.0698), t187, qb3_3)))
+    t189 = xp.where(xp.less(t26, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t190 = t26 + t189
     t191 = t26 - t189
-    t192 = xp.where((xp.greater_equal(t26, -2.8973)) & (xp.less_equal(t26, 2.8973)), t26, xp.where((xp.greater_equal(t190, -2.8973)) & (xp.less_equal(t190, 2.8973)), t190, xp.where((xp.greater_equal(t191, -2.8973)) & (xp.less_equal(t191, 2.8973)), t191, qb3_4)))
-    t193 = xp.where(xp.greater(qn6, t27), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t194 = t193 + t27
+    t192 = xp.where(xp.greater_equal(t26, -2.8973) & xp.less_equal(t26, 2.8973), t26, xp.where(xp.greater_equal(t190, -2.8973) & xp.less_equal(t190, 2.8973), t190, xp.where(xp.greater_equal(t191, -2.8973) & xp.less_equal(t191, 2.8973), t191, qb3_4)))
+    t193 = xp.where(xp.less(t27, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t194 = t27 + t193
     t195 = t27 - t193
-    t196 = xp.where((xp.greater_equal(t27, -0.0175)) & (xp.less_equal(t27, 3.7525000000000004)), t27, xp.where((xp.greater_equal(t194, -0.0175)) & (xp.less_equal(t194, 3.7525000000000004)), t194, xp.where((xp.greater_equal(t195, -0.0175)) & (xp.less_equal(t195, 3.7525000000000004)), t195, qb3_5)))
-    t197 = qw1*(t176 + t82)**2 + qw2*(t180 + t83)**2 + qw3*(t184 + t84)**2 + qw4*(t188 + t85)**2 + qw5*(t192 + t86)**2 + qw6*(t196 + t87)**2 + qw7*(qb3_6 + t88)**2
+    t196 = xp.where(xp.greater_equal(t27, -0.0175) & xp.less_equal(t27, 3.7525000000000004), t27, xp.where(xp.greater_equal(t194, -0.0175) & xp.less_equal(t194, 3.7525000000000004), t194, xp.where(xp.greater_equal(t195, -0.0175) & xp.less_equal(t195, 3.7525000000000004), t195, qb3_5)))
+    t197 = qw1*(t176 + t82)**2 + qw2*(t180 + t83)**2 + qw3*(t184 + t84)**2 + qw4*(t188 + t85)**2 + qw5*(t192 + t86)**2 + qw6*(t196 + t87)**2 + qw7*(t88 + qb3_6)**2
     t198 = xp.greater(t28, 0)
-    t199 = xp.where(t198 & ((xp.greater(t172, t197)) | (xp.less(t163, 1))), xp.asarray(1, dtype=dtype), 0)
+    t199 = xp.where(t198 & (xp.greater(t172, t197) | xp.less(t163, 1)), xp.asarray(1, dtype=dtype), 0)
     t200 = xp.where(t198, 1, t163)
     t201 = xp.greater(t199, 0)
     t202 = xp.where(t201, t176, t165)
@@ -4060,33 +4060,33 @@ def ik_nearest(T, q_seed, q_free, weights=(1.0,) * DOF):
     t207 = xp.where(t201, t196, t170)
     t208 = xp.where(t201, qb3_6, t171)
     t209 = xp.where(t201, t197, t172)
-    t210 = xp.where(xp.greater(qn1, t29), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t211 = t210 + t29
+    t210 = xp.where(xp.less(t29, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t211 = t29 + t210
     t212 = t29 - t210
-    t213 = xp.where((xp.greater_equal(t29, -2.8973)) & (xp.less_equal(t29, 2.8973)), t29, xp.where((xp.greater_equal(t211, -2.8973)) & (xp.less_equal(t211, 2.8973)), t211, xp.where((xp.greater_equal(t212, -2.8973)) & (xp.less_equal(t212, 2.8973)), t212, qb4_0)))
-    t214 = xp.where(xp.greater(qn2, t30), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t215 = t214 + t30
+    t213 = xp.where(xp.greater_equal(t29, -2.8973) & xp.less_equal(t29, 2.8973), t29, xp.where(xp.greater_equal(t211, -2.8973) & xp.less_equal(t211, 2.8973), t211, xp.where(xp.greater_equal(t212, -2.8973) & xp.less_equal(t212, 2.8973), t212, qb4_0)))
+    t214 = xp.where(xp.less(t30, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t215 = t30 + t214
     t216 = t30 - t214
-    t217 = xp.where((xp.greater_equal(t30, -1.7627999999999997)) & (xp.less_equal(t30, 1.7627999999999997)), t30, xp.where((xp.greater_equal(t215, -1.7627999999999997)) & (xp.less_equal(t215, 1.7627999999999997)), t215, xp.where((xp.greater_equal(t216, -1.7627999999999997)) & (xp.less_equal(t216, 1.7627999999999997)), t216, qb4_1)))
-    t218 = xp.where(xp.greater(qn3, t31), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t219 = t218 + t31
+    t217 = xp.where(xp.greater_equal(t30, -1.7627999999999997) & xp.less_equal(t30, 1.7627999999999997), t30, xp.where(xp.greater_equal(t215, -1.7627999999999997) & xp.less_equal(t215, 1.7627999999999997), t215, xp.where(xp.greater_equal(t216, -1.7627999999999997) & xp.less_equal(t216, 1.7627999999999997), t216, qb4_1)))
+    t218 = xp.where(xp.less(t31, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t219 = t31 + t218
     t220 = t31 - t218
-    t221 = xp.where((xp.greater_equal(t31, -2.8973)) & (xp.less_equal(t31, 2.8973)), t31, xp.where((xp.greater_equal(t219, -2.8973)) & (xp.less_equal(t219, 2.8973)), t219, xp.where((xp.greater_equal(t220, -2.8973)) & (xp.less_equal(t220, 2.8973)), t220, qb4_2)))
-    t222 = xp.where(xp.greater(qn4, t32), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t223 = t222 + t32
+    t221 = xp.where(xp.greater_equal(t31, -2.8973) & xp.less_equal(t31, 2.8973), t31, xp.where(xp.greater_equal(t219, -2.8973) & xp.less_equal(t219, 2.8973), t219, xp.where(xp.greater_equal(t220, -2.8973) & xp.less_equal(t220, 2.8973), t220, qb4_2)))
+    t222 = xp.where(xp.less(t32, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t223 = t32 + t222
     t224 = t32 - t222
-    t225 = xp.where((xp.greater_equal(t32, -3.0718)) & (xp.less_equal(t32, -0.0698)), t32, xp.where((xp.greater_equal(t223, -3.0718)) & (xp.less_equal(t223, -0.0698)), t223, xp.where((xp.greater_equal(t224, -3.0718)) & (xp.less_equal(t224, -0.0698)), t224, qb4_3)))
-    t226 = xp.where(xp.greater(qn5, t33), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t227 = t226 + t33
+    t225 = xp.where(xp.greater_equal(t32, -3.0718) & xp.less_equal(t32, -0.0698), t32, xp.where(xp.greater_equal(t223, -3.0718) & xp.less_equal(t223, -0.0698), t223, xp.where(xp.greater_equal(t224, -3.0718) & xp.less_equal(t224, -0.0698), t224, qb4_3)))
+    t226 = xp.where(xp.less(t33, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t227 = t33 + t226
     t228 = t33 - t226
-    t229 = xp.where((xp.greater_equal(t33, -2.8973)) & (xp.less_equal(t33, 2.8973)), t33, xp.where((xp.greater_equal(t227, -2.8973)) & (xp.less_equal(t227, 2.8973)), t227, xp.where((xp.greater_equal(t228, -2.8973)) & (xp.less_equal(t228, 2.8973)), t228, qb4_4)))
-    t230 = xp.where(xp.greater(qn6, t34), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t231 = t230 + t34
+    t229 = xp.where(xp.greater_equal(t33, -2.8973) & xp.less_equal(t33, 2.8973), t33, xp.where(xp.greater_equal(t227, -2.8973) & xp.less_equal(t227, 2.8973), t227, xp.where(xp.greater_equal(t228, -2.8973) & xp.less_equal(t228, 2.8973), t228, qb4_4)))
+    t230 = xp.where(xp.less(t34, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t231 = t34 + t230
     t232 = t34 - t230
-    t233 = xp.where((xp.greater_equal(t34, -0.0175)) & (xp.less_equal(t34, 3.7525000000000004)), t34, xp.where((xp.greater_equal(t231, -0.0175)) & (xp.less_equal(t231, 3.7525000000000004)), t231, xp.where((xp.greater_equal(t232, -0.0175)) & (xp.less_equal(t232, 3.7525000000000004)), t232, qb4_5)))
-    t234 = qw1*(t213 + t82)**2 + qw2*(t217 + t83)**2 + qw3*(t221 + t84)**2 + qw4*(t225 + t85)**2 + qw5*(t229 + t86)**2 + qw6*(t233 + t87)**2 + qw7*(qb4_6 + t88)**2
+    t233 = xp.where(xp.greater_equal(t34, -0.0175) & xp.less_equal(t34, 3.7525000000000004), t34, xp.where(xp.greater_equal(t231, -0.0175) & xp.less_equal(t231, 3.7525000000000004), t231, xp.where(xp.greater_equal(t232, -0.0175) & xp.less_equal(t232, 3.7525000000000004), t232, qb4_5)))
+    t234 = qw1*(t213 + t82)**2 + qw2*(t217 + t83)**2 + qw3*(t221 + t84)**2 + qw4*(t225 + t85)**2 + qw5*(t229 + t86)**2 + qw6*(t233 + t87)**2 + qw7*(t88 + qb4_6)**2
     t235 = xp.greater(t35, 0)
-    t236 = xp.where(t235 & ((xp.greater(t209, t234)) | (xp.less(t200, 1))), xp.asarray(1, dtype=dtype), 0)
+    t236 = xp.where(t235 & (xp.greater(t209, t234) | xp.less(t200, 1)), xp.asarray(1, dtype=dtype), 0)
     t237 = xp.where(t235, 1, t200)
     t238 = xp.greater(t236, 0)
     t239 = xp.where(t238, t213, t202)
@@ -4097,33 +4097,33 @@ def ik_nearest(T, q_seed, q_free, weights=(1.0,) * DOF):
     t244 = xp.where(t238, t233, t207)
     t245 = xp.where(t238, qb4_6, t208)
     t246 = xp.where(t238, t234, t209)
-    t247 = xp.where(xp.greater(qn1, t36), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t248 = t247 + t36
+    t247 = xp.where(xp.less(t36, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t248 = t36 + t247
     t249 = t36 - t247
-    t250 = xp.where((xp.greater_equal(t36, -2.8973)) & (xp.less_equal(t36, 2.8973)), t36, xp.where((xp.greater_equal(t248, -2.8973)) & (xp.less_equal(t248, 2.8973)), t248, xp.where((xp.greater_equal(t249, -2.8973)) & (xp.less_equal(t249, 2.8973)), t249, qb5_0)))
-    t251 = xp.where(xp.greater(qn2, t37), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t252 = t251 + t37
+    t250 = xp.where(xp.greater_equal(t36, -2.8973) & xp.less_equal(t36, 2.8973), t36, xp.where(xp.greater_equal(t248, -2.8973) & xp.less_equal(t248, 2.8973), t248, xp.where(xp.greater_equal(t249, -2.8973) & xp.less_equal(t249, 2.8973), t249, qb5_0)))
+    t251 = xp.where(xp.less(t37, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t252 = t37 + t251
     t253 = t37 - t251
-    t254 = xp.where((xp.greater_equal(t37, -1.7627999999999997)) & (xp.less_equal(t37, 1.7627999999999997)), t37, xp.where((xp.greater_equal(t252, -1.7627999999999997)) & (xp.less_equal(t252, 1.7627999999999997)), t252, xp.where((xp.greater_equal(t253, -1.7627999999999997)) & (xp.less_equal(t253, 1.7627999999999997)), t253, qb5_1)))
-    t255 = xp.where(xp.greater(qn3, t38), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t256 = t255 + t38
+    t254 = xp.where(xp.greater_equal(t37, -1.7627999999999997) & xp.less_equal(t37, 1.7627999999999997), t37, xp.where(xp.greater_equal(t252, -1.7627999999999997) & xp.less_equal(t252, 1.7627999999999997), t252, xp.where(xp.greater_equal(t253, -1.7627999999999997) & xp.less_equal(t253, 1.7627999999999997), t253, qb5_1)))
+    t255 = xp.where(xp.less(t38, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t256 = t38 + t255
     t257 = t38 - t255
-    t258 = xp.where((xp.greater_equal(t38, -2.8973)) & (xp.less_equal(t38, 2.8973)), t38, xp.where((xp.greater_equal(t256, -2.8973)) & (xp.less_equal(t256, 2.8973)), t256, xp.where((xp.greater_equal(t257, -2.8973)) & (xp.less_equal(t257, 2.8973)), t257, qb5_2)))
-    t259 = xp.where(xp.greater(qn4, t39), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t260 = t259 + t39
+    t258 = xp.where(xp.greater_equal(t38, -2.8973) & xp.less_equal(t38, 2.8973), t38, xp.where(xp.greater_equal(t256, -2.8973) & xp.less_equal(t256, 2.8973), t256, xp.where(xp.greater_equal(t257, -2.8973) & xp.less_equal(t257, 2.8973), t257, qb5_2)))
+    t259 = xp.where(xp.less(t39, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t260 = t39 + t259
     t261 = t39 - t259
-    t262 = xp.where((xp.greater_equal(t39, -3.0718)) & (xp.less_equal(t39, -0.0698)), t39, xp.where((xp.greater_equal(t260, -3.0718)) & (xp.less_equal(t260, -0.0698)), t260, xp.where((xp.greater_equal(t261, -3.0718)) & (xp.less_equal(t261, -0.0698)), t261, qb5_3)))
-    t263 = xp.where(xp.greater(qn5, t40), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t264 = t263 + t40
+    t262 = xp.where(xp.greater_equal(t39, -3.0718) & xp.less_equal(t39, -0.0698), t39, xp.where(xp.greater_equal(t260, -3.0718) & xp.less_equal(t260, -0.0698), t260, xp.where(xp.greater_equal(t261, -3.0718) & xp.less_equal(t261, -0.0698), t261, qb5_3)))
+    t263 = xp.where(xp.less(t40, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t264 = t40 + t263
     t265 = t40 - t263
-    t266 = xp.where((xp.greater_equal(t40, -2.8973)) & (xp.less_equal(t40, 2.8973)), t40, xp.where((xp.greater_equal(t264, -2.8973)) & (xp.less_equal(t264, 2.8973)), t264, xp.where((xp.greater_equal(t265, -2.8973)) & (xp.less_equal(t265, 2.8973)), t265, qb5_4)))
-    t267 = xp.where(xp.greater(qn6, t41), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t268 = t267 + t41
+    t266 = xp.where(xp.greater_equal(t40, -2.8973) & xp.less_equal(t40, 2.8973), t40, xp.where(xp.greater_equal(t264, -2.8973) & xp.less_equal(t264, 2.8973), t264, xp.where(xp.greater_equal(t265, -2.8973) & xp.less_equal(t265, 2.8973), t265, qb5_4)))
+    t267 = xp.where(xp.less(t41, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t268 = t41 + t267
     t269 = t41 - t267
-    t270 = xp.where((xp.greater_equal(t41, -0.0175)) & (xp.less_equal(t41, 3.7525000000000004)), t41, xp.where((xp.greater_equal(t268, -0.0175)) & (xp.less_equal(t268, 3.7525000000000004)), t268, xp.where((xp.greater_equal(t269, -0.0175)) & (xp.less_equal(t269, 3.7525000000000004)), t269, qb5_5)))
-    t271 = qw1*(t250 + t82)**2 + qw2*(t254 + t83)**2 + qw3*(t258 + t84)**2 + qw4*(t262 + t85)**2 + qw5*(t266 + t86)**2 + qw6*(t270 + t87)**2 + qw7*(qb5_6 + t88)**2
+    t270 = xp.where(xp.greater_equal(t41, -0.0175) & xp.less_equal(t41, 3.7525000000000004), t41, xp.where(xp.greater_equal(t268, -0.0175) & xp.less_equal(t268, 3.7525000000000004), t268, xp.where(xp.greater_equal(t269, -0.0175) & xp.less_equal(t269, 3.7525000000000004), t269, qb5_5)))
+    t271 = qw1*(t250 + t82)**2 + qw2*(t254 + t83)**2 + qw3*(t258 + t84)**2 + qw4*(t262 + t85)**2 + qw5*(t266 + t86)**2 + qw6*(t270 + t87)**2 + qw7*(t88 + qb5_6)**2
     t272 = xp.greater(t42, 0)
-    t273 = xp.where(t272 & ((xp.greater(t246, t271)) | (xp.less(t237, 1))), xp.asarray(1, dtype=dtype), 0)
+    t273 = xp.where(t272 & (xp.greater(t246, t271) | xp.less(t237, 1)), xp.asarray(1, dtype=dtype), 0)
     t274 = xp.where(t272, 1, t237)
     t275 = xp.greater(t273, 0)
     t276 = xp.where(t275, t250, t239)
@@ -4134,33 +4134,33 @@ def ik_nearest(T, q_seed, q_free, weights=(1.0,) * DOF):
     t281 = xp.where(t275, t270, t244)
     t282 = xp.where(t275, qb5_6, t245)
     t283 = xp.where(t275, t271, t246)
-    t284 = xp.where(xp.greater(qn1, t43), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t285 = t284 + t43
+    t284 = xp.where(xp.less(t43, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t285 = t43 + t284
     t286 = t43 - t284
-    t287 = xp.where((xp.greater_equal(t43, -2.8973)) & (xp.less_equal(t43, 2.8973)), t43, xp.where((xp.greater_equal(t285, -2.8973)) & (xp.less_equal(t285, 2.8973)), t285, xp.where((xp.greater_equal(t286, -2.8973)) & (xp.less_equal(t286, 2.8973)), t286, qb6_0)))
-    t288 = xp.where(xp.greater(qn2, t44), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t289 = t288 + t44
+    t287 = xp.where(xp.greater_equal(t43, -2.8973) & xp.less_equal(t43, 2.8973), t43, xp.where(xp.greater_equal(t285, -2.8973) & xp.less_equal(t285, 2.8973), t285, xp.where(xp.greater_equal(t286, -2.8973) & xp.less_equal(t286, 2.8973), t286, qb6_0)))
+    t288 = xp.where(xp.less(t44, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t289 = t44 + t288
     t290 = t44 - t288
-    t291 = xp.where((xp.greater_equal(t44, -1.7627999999999997)) & (xp.less_equal(t44, 1.7627999999999997)), t44, xp.where((xp.greater_equal(t289, -1.7627999999999997)) & (xp.less_equal(t289, 1.7627999999999997)), t289, xp.where((xp.greater_equal(t290, -1.7627999999999997)) & (xp.less_equal(t290, 1.7627999999999997)), t290, qb6_1)))
-    t292 = xp.where(xp.greater(qn3, t45), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t293 = t292 + t45
+    t291 = xp.where(xp.greater_equal(t44, -1.7627999999999997) & xp.less_equal(t44, 1.7627999999999997), t44, xp.where(xp.greater_equal(t289, -1.7627999999999997) & xp.less_equal(t289, 1.7627999999999997), t289, xp.where(xp.greater_equal(t290, -1.7627999999999997) & xp.less_equal(t290, 1.7627999999999997), t290, qb6_1)))
+    t292 = xp.where(xp.less(t45, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t293 = t45 + t292
     t294 = t45 - t292
-    t295 = xp.where((xp.greater_equal(t45, -2.8973)) & (xp.less_equal(t45, 2.8973)), t45, xp.where((xp.greater_equal(t293, -2.8973)) & (xp.less_equal(t293, 2.8973)), t293, xp.where((xp.greater_equal(t294, -2.8973)) & (xp.less_equal(t294, 2.8973)), t294, qb6_2)))
-    t296 = xp.where(xp.greater(qn4, t46), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t297 = t296 + t46
+    t295 = xp.where(xp.greater_equal(t45, -2.8973) & xp.less_equal(t45, 2.8973), t45, xp.where(xp.greater_equal(t293, -2.8973) & xp.less_equal(t293, 2.8973), t293, xp.where(xp.greater_equal(t294, -2.8973) & xp.less_equal(t294, 2.8973), t294, qb6_2)))
+    t296 = xp.where(xp.less(t46, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t297 = t46 + t296
     t298 = t46 - t296
-    t299 = xp.where((xp.greater_equal(t46, -3.0718)) & (xp.less_equal(t46, -0.0698)), t46, xp.where((xp.greater_equal(t297, -3.0718)) & (xp.less_equal(t297, -0.0698)), t297, xp.where((xp.greater_equal(t298, -3.0718)) & (xp.less_equal(t298, -0.0698)), t298, qb6_3)))
-    t300 = xp.where(xp.greater(qn5, t47), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t301 = t300 + t47
+    t299 = xp.where(xp.greater_equal(t46, -3.0718) & xp.less_equal(t46, -0.0698), t46, xp.where(xp.greater_equal(t297, -3.0718) & xp.less_equal(t297, -0.0698), t297, xp.where(xp.greater_equal(t298, -3.0718) & xp.less_equal(t298, -0.0698), t298, qb6_3)))
+    t300 = xp.where(xp.less(t47, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t301 = t47 + t300
     t302 = t47 - t300
-    t303 = xp.where((xp.greater_equal(t47, -2.8973)) & (xp.less_equal(t47, 2.8973)), t47, xp.where((xp.greater_equal(t301, -2.8973)) & (xp.less_equal(t301, 2.8973)), t301, xp.where((xp.greater_equal(t302, -2.8973)) & (xp.less_equal(t302, 2.8973)), t302, qb6_4)))
-    t304 = xp.where(xp.greater(qn6, t48), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t305 = t304 + t48
+    t303 = xp.where(xp.greater_equal(t47, -2.8973) & xp.less_equal(t47, 2.8973), t47, xp.where(xp.greater_equal(t301, -2.8973) & xp.less_equal(t301, 2.8973), t301, xp.where(xp.greater_equal(t302, -2.8973) & xp.less_equal(t302, 2.8973), t302, qb6_4)))
+    t304 = xp.where(xp.less(t48, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t305 = t48 + t304
     t306 = t48 - t304
-    t307 = xp.where((xp.greater_equal(t48, -0.0175)) & (xp.less_equal(t48, 3.7525000000000004)), t48, xp.where((xp.greater_equal(t305, -0.0175)) & (xp.less_equal(t305, 3.7525000000000004)), t305, xp.where((xp.greater_equal(t306, -0.0175)) & (xp.less_equal(t306, 3.7525000000000004)), t306, qb6_5)))
-    t308 = qw1*(t287 + t82)**2 + qw2*(t291 + t83)**2 + qw3*(t295 + t84)**2 + qw4*(t299 + t85)**2 + qw5*(t303 + t86)**2 + qw6*(t307 + t87)**2 + qw7*(qb6_6 + t88)**2
+    t307 = xp.where(xp.greater_equal(t48, -0.0175) & xp.less_equal(t48, 3.7525000000000004), t48, xp.where(xp.greater_equal(t305, -0.0175) & xp.less_equal(t305, 3.7525000000000004), t305, xp.where(xp.greater_equal(t306, -0.0175) & xp.less_equal(t306, 3.7525000000000004), t306, qb6_5)))
+    t308 = qw1*(t287 + t82)**2 + qw2*(t291 + t83)**2 + qw3*(t295 + t84)**2 + qw4*(t299 + t85)**2 + qw5*(t303 + t86)**2 + qw6*(t307 + t87)**2 + qw7*(t88 + qb6_6)**2
     t309 = xp.greater(t49, 0)
-    t310 = xp.where(t309 & ((xp.greater(t283, t308)) | (xp.less(t274, 1))), xp.asarray(1, dtype=dtype), 0)
+    t310 = xp.where(t309 & (xp.greater(t283, t308) | xp.less(t274, 1)), xp.asarray(1, dtype=dtype), 0)
     t311 = xp.where(t309, 1, t274)
     t312 = xp.greater(t310, 0)
     t313 = xp.where(t312, t287, t276)
@@ -4171,33 +4171,33 @@ def ik_nearest(T, q_seed, q_free, weights=(1.0,) * DOF):
     t318 = xp.where(t312, t307, t281)
     t319 = xp.where(t312, qb6_6, t282)
     t320 = xp.where(t312, t308, t283)
-    t321 = xp.where(xp.greater(qn1, t50), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t322 = t321 + t50
+    t321 = xp.where(xp.less(t50, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t322 = t50 + t321
     t323 = t50 - t321
-    t324 = xp.where((xp.greater_equal(t50, -2.8973)) & (xp.less_equal(t50, 2.8973)), t50, xp.where((xp.greater_equal(t322, -2.8973)) & (xp.less_equal(t322, 2.8973)), t322, xp.where((xp.greater_equal(t323, -2.8973)) & (xp.less_equal(t323, 2.8973)), t323, qb7_0)))
-    t325 = xp.where(xp.greater(qn2, t51), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t326 = t325 + t51
+    t324 = xp.where(xp.greater_equal(t50, -2.8973) & xp.less_equal(t50, 2.8973), t50, xp.where(xp.greater_equal(t322, -2.8973) & xp.less_equal(t322, 2.8973), t322, xp.where(xp.greater_equal(t323, -2.8973) & xp.less_equal(t323, 2.8973), t323, qb7_0)))
+    t325 = xp.where(xp.less(t51, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t326 = t51 + t325
     t327 = t51 - t325
-    t328 = xp.where((xp.greater_equal(t51, -1.7627999999999997)) & (xp.less_equal(t51, 1.7627999999999997)), t51, xp.where((xp.greater_equal(t326, -1.7627999999999997)) & (xp.less_equal(t326, 1.7627999999999997)), t326, xp.where((xp.greater_equal(t327, -1.7627999999999997)) & (xp.less_equal(t327, 1.7627999999999997)), t327, qb7_1)))
-    t329 = xp.where(xp.greater(qn3, t52), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t330 = t329 + t52
+    t328 = xp.where(xp.greater_equal(t51, -1.7627999999999997) & xp.less_equal(t51, 1.7627999999999997), t51, xp.where(xp.greater_equal(t326, -1.7627999999999997) & xp.less_equal(t326, 1.7627999999999997), t326, xp.where(xp.greater_equal(t327, -1.7627999999999997) & xp.less_equal(t327, 1.7627999999999997), t327, qb7_1)))
+    t329 = xp.where(xp.less(t52, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t330 = t52 + t329
     t331 = t52 - t329
-    t332 = xp.where((xp.greater_equal(t52, -2.8973)) & (xp.less_equal(t52, 2.8973)), t52, xp.where((xp.greater_equal(t330, -2.8973)) & (xp.less_equal(t330, 2.8973)), t330, xp.where((xp.greater_equal(t331, -2.8973)) & (xp.less_equal(t331, 2.8973)), t331, qb7_2)))
-    t333 = xp.where(xp.greater(qn4, t53), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t334 = t333 + t53
+    t332 = xp.where(xp.greater_equal(t52, -2.8973) & xp.less_equal(t52, 2.8973), t52, xp.where(xp.greater_equal(t330, -2.8973) & xp.less_equal(t330, 2.8973), t330, xp.where(xp.greater_equal(t331, -2.8973) & xp.less_equal(t331, 2.8973), t331, qb7_2)))
+    t333 = xp.where(xp.less(t53, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t334 = t53 + t333
     t335 = t53 - t333
-    t336 = xp.where((xp.greater_equal(t53, -3.0718)) & (xp.less_equal(t53, -0.0698)), t53, xp.where((xp.greater_equal(t334, -3.0718)) & (xp.less_equal(t334, -0.0698)), t334, xp.where((xp.greater_equal(t335, -3.0718)) & (xp.less_equal(t335, -0.0698)), t335, qb7_3)))
-    t337 = xp.where(xp.greater(qn5, t54), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t338 = t337 + t54
+    t336 = xp.where(xp.greater_equal(t53, -3.0718) & xp.less_equal(t53, -0.0698), t53, xp.where(xp.greater_equal(t334, -3.0718) & xp.less_equal(t334, -0.0698), t334, xp.where(xp.greater_equal(t335, -3.0718) & xp.less_equal(t335, -0.0698), t335, qb7_3)))
+    t337 = xp.where(xp.less(t54, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t338 = t54 + t337
     t339 = t54 - t337
-    t340 = xp.where((xp.greater_equal(t54, -2.8973)) & (xp.less_equal(t54, 2.8973)), t54, xp.where((xp.greater_equal(t338, -2.8973)) & (xp.less_equal(t338, 2.8973)), t338, xp.where((xp.greater_equal(t339, -2.8973)) & (xp.less_equal(t339, 2.8973)), t339, qb7_4)))
-    t341 = xp.where(xp.greater(qn6, t55), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t342 = t341 + t55
+    t340 = xp.where(xp.greater_equal(t54, -2.8973) & xp.less_equal(t54, 2.8973), t54, xp.where(xp.greater_equal(t338, -2.8973) & xp.less_equal(t338, 2.8973), t338, xp.where(xp.greater_equal(t339, -2.8973) & xp.less_equal(t339, 2.8973), t339, qb7_4)))
+    t341 = xp.where(xp.less(t55, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t342 = t55 + t341
     t343 = t55 - t341
-    t344 = xp.where((xp.greater_equal(t55, -0.0175)) & (xp.less_equal(t55, 3.7525000000000004)), t55, xp.where((xp.greater_equal(t342, -0.0175)) & (xp.less_equal(t342, 3.7525000000000004)), t342, xp.where((xp.greater_equal(t343, -0.0175)) & (xp.less_equal(t343, 3.7525000000000004)), t343, qb7_5)))
-    t345 = qw1*(t324 + t82)**2 + qw2*(t328 + t83)**2 + qw3*(t332 + t84)**2 + qw4*(t336 + t85)**2 + qw5*(t340 + t86)**2 + qw6*(t344 + t87)**2 + qw7*(qb7_6 + t88)**2
+    t344 = xp.where(xp.greater_equal(t55, -0.0175) & xp.less_equal(t55, 3.7525000000000004), t55, xp.where(xp.greater_equal(t342, -0.0175) & xp.less_equal(t342, 3.7525000000000004), t342, xp.where(xp.greater_equal(t343, -0.0175) & xp.less_equal(t343, 3.7525000000000004), t343, qb7_5)))
+    t345 = qw1*(t324 + t82)**2 + qw2*(t328 + t83)**2 + qw3*(t332 + t84)**2 + qw4*(t336 + t85)**2 + qw5*(t340 + t86)**2 + qw6*(t344 + t87)**2 + qw7*(t88 + qb7_6)**2
     t346 = xp.greater(t56, 0)
-    t347 = xp.where(t346 & ((xp.greater(t320, t345)) | (xp.less(t311, 1))), xp.asarray(1, dtype=dtype), 0)
+    t347 = xp.where(t346 & (xp.greater(t320, t345) | xp.less(t311, 1)), xp.asarray(1, dtype=dtype), 0)
     t348 = xp.where(t346, 1, t311)
     t349 = xp.greater(t347, 0)
     t350 = xp.where(t349, t324, t313)

@@ -143,9 +143,9 @@ void planar_2r_jacobian_tool(const planar_2r_real q[PLANAR_2R_DOF], planar_2r_re
     const planar_2r_real t1 = s1 + s12;
 
     /* Outputs */
-    J[0] = s12*t0 - c12*t1;
+    J[0] = t0*s12 - t1*c12;
     J[1] = 0;
-    J[2] = c12*t0 + s12*t1;
+    J[2] = t0*c12 + t1*s12;
     J[3] = (c12*c12) + (s12*s12);
     J[4] = 0;
     J[5] = 0;
@@ -225,9 +225,9 @@ void planar_2r_fk_jacobian_dot(const planar_2r_real q[PLANAR_2R_DOF], const plan
     const planar_2r_real t0 = c1 + c12;
     const planar_2r_real t1 = s1 + s12;
     const planar_2r_real t2 = qd2*s12;
-    const planar_2r_real t3 = t2 + qd1*t1;
+    const planar_2r_real t3 = t2 + t1*qd1;
     const planar_2r_real t4 = c12*qd2;
-    const planar_2r_real t5 = t4 + qd1*t0;
+    const planar_2r_real t5 = t4 + t0*qd1;
     const planar_2r_real t6 = -s12;
 
     /* Outputs */
@@ -259,8 +259,8 @@ void planar_2r_fk_jacobian_dot(const planar_2r_real q[PLANAR_2R_DOF], const plan
     J[9] = 0;
     J[10] = 1;
     J[11] = 1;
-    a[0] = -qd1*t5 - qd2*(t4 + c12*qd1);
-    a[1] = -qd1*t3 - qd2*(t2 + qd1*s12);
+    a[0] = -t5*qd1 - qd2*(t4 + c12*qd1);
+    a[1] = -t3*qd1 - qd2*(t2 + qd1*s12);
     a[2] = 0;
     a[3] = 0;
     a[4] = 0;
@@ -269,7 +269,7 @@ void planar_2r_fk_jacobian_dot(const planar_2r_real q[PLANAR_2R_DOF], const plan
 
 void planar_2r_jacobian_dot(const planar_2r_real q[PLANAR_2R_DOF], const planar_2r_real q_dot[PLANAR_2R_DOF], planar_2r_real Jd[6 * PLANAR_2R_DOF])
 {
-    /* 26 operations */
+    /* 24 operations */
 
     /* Inputs */
     const planar_2r_real q1 = q[0];
@@ -287,15 +287,15 @@ void planar_2r_jacobian_dot(const planar_2r_real q[PLANAR_2R_DOF], const planar_
     const planar_2r_real t0 = c1 + c12;
     const planar_2r_real t1 = s1 + s12;
     const planar_2r_real t2 = qd2*s12;
-    const planar_2r_real t3 = t2 + qd1*t1;
+    const planar_2r_real t3 = t2 + t1*qd1;
     const planar_2r_real t4 = c12*qd2;
-    const planar_2r_real t5 = t4 + qd1*t0;
+    const planar_2r_real t5 = t4 + t0*qd1;
 
     /* Outputs */
     Jd[0] = -t5;
-    Jd[1] = -t4 - c12*qd1;
+    Jd[1] = -(t4 + c12*qd1);
     Jd[2] = -t3;
-    Jd[3] = -t2 - qd1*s12;
+    Jd[3] = -(t2 + qd1*s12);
     Jd[4] = 0;
     Jd[5] = 0;
     Jd[6] = 0;
@@ -326,13 +326,13 @@ void planar_2r_bias_acceleration(const planar_2r_real q[PLANAR_2R_DOF], const pl
     const planar_2r_real t0 = c1 + c12;
     const planar_2r_real t1 = s1 + s12;
     const planar_2r_real t2 = qd2*s12;
-    const planar_2r_real t3 = t2 + qd1*t1;
+    const planar_2r_real t3 = t2 + t1*qd1;
     const planar_2r_real t4 = c12*qd2;
-    const planar_2r_real t5 = t4 + qd1*t0;
+    const planar_2r_real t5 = t4 + t0*qd1;
 
     /* Outputs */
-    a[0] = -qd1*t5 - qd2*(t4 + c12*qd1);
-    a[1] = -qd1*t3 - qd2*(t2 + qd1*s12);
+    a[0] = -t5*qd1 - qd2*(t4 + c12*qd1);
+    a[1] = -t3*qd1 - qd2*(t2 + qd1*s12);
     a[2] = 0;
     a[3] = 0;
     a[4] = 0;
@@ -359,10 +359,10 @@ void planar_2r_task_jacobian_dot(const planar_2r_real q[PLANAR_2R_DOF], const pl
     const planar_2r_real t0 = c1 + c12;
     const planar_2r_real t1 = s1 + s12;
     const planar_2r_real t2 = qd2*s12;
-    const planar_2r_real t3 = t2 + qd1*t1;
+    const planar_2r_real t3 = t2 + t1*qd1;
     const planar_2r_real t4 = t2 + qd1*s12;
     const planar_2r_real t5 = c12*qd2;
-    const planar_2r_real t6 = t5 + qd1*t0;
+    const planar_2r_real t6 = t5 + t0*qd1;
     const planar_2r_real t7 = t5 + c12*qd1;
 
     /* Outputs */
@@ -480,7 +480,7 @@ int planar_2r_velocity_ik(const planar_2r_real q[PLANAR_2R_DOF], const planar_2r
     const planar_2r_real s12 = c1*s2 + c2*s1;
     const planar_2r_real t0 = c1 + c12;
     const planar_2r_real t1 = s1 + s12;
-    const planar_2r_real t2 = c12*s12 + t0*t1;
+    const planar_2r_real t2 = t0*t1 + c12*s12;
     const planar_2r_real t3 = (t1*t1);
     const planar_2r_real t4 = t3 + (s12*s12);
     const planar_2r_real t5 = t4;
@@ -490,47 +490,47 @@ int planar_2r_velocity_ik(const planar_2r_real q[PLANAR_2R_DOF], const planar_2r
     const planar_2r_real t9 = (t7 > 0 ? 1/(t7*(t7 + fabs(t1))) : 0);
     const planar_2r_real t10 = t6 + (c12*c12);
     const planar_2r_real t11 = t10;
-    const planar_2r_real t12 = sqrt(t10 + t4);
+    const planar_2r_real t12 = sqrt(t4 + t10);
     const planar_2r_real t13 = (t2*t2);
     const planar_2r_real t14 = (damping*damping);
-    const planar_2r_real t15 = t14 + t5;
+    const planar_2r_real t15 = t5 + t14;
     const planar_2r_real t16 = (t15*t15);
     const planar_2r_real t17 = sqrt(t13 + t16);
     const planar_2r_real t18 = t17*(t15 >= 0 ? 1 : -1);
-    const planar_2r_real t19 = t15 + t18;
+    const planar_2r_real t19 = t18 + t15;
     const planar_2r_real t20 = (t17 > 0 ? 1/(t17*(t17 + fabs(t15))) : 0);
-    const planar_2r_real t21 = t20*(mu_dot0*t19 - mu_dot1*t2);
+    const planar_2r_real t21 = t20*(t19*mu_dot0 - t2*mu_dot1);
     const planar_2r_real t22 = mu_dot0 - t19*t21;
     const planar_2r_real t23 = mu_dot1 + t2*t21;
     const planar_2r_real t24 = t11 + t14;
-    const planar_2r_real t25 = sqrt(t16 + 2*t13 + (t24*t24));
-    const planar_2r_real t26 = -t20*(t19*t2 + t2*t24);
+    const planar_2r_real t25 = sqrt(t16 + (t24*t24) + 2*t13);
+    const planar_2r_real t26 = -t20*(t2*t19 + t2*t24);
     const planar_2r_real t27 = t2 + t19*t26;
     const planar_2r_real t28 = t24 + t2*t26;
     const planar_2r_real t29 = fabs(t28);
     const planar_2r_real t30 = t29;
     const planar_2r_real t31 = t30*(t28 >= 0 ? 1 : -1);
     const planar_2r_real t32 = t28 + t31;
-    const planar_2r_real t33 = (t30 > 0 ? 1/(t30*(t29 + t30)) : 0);
+    const planar_2r_real t33 = (t30 > 0 ? 1/(t30*(t30 + t29)) : 0);
     const planar_2r_real t34 = t23 - t23*t33*(t32*t32);
     const planar_2r_real t35 = (t31 != 0 ? -t34/t31 : 0);
     const planar_2r_real t36 = (t18 != 0 ? -(t22 + t27*t35)/t18 : 0);
-    const planar_2r_real t37 = t0*t35 - t1*t36;
-    const planar_2r_real t38 = c12*t35 - s12*t36;
+    const planar_2r_real t37 = t35*t0 - t36*t1;
+    const planar_2r_real t38 = t35*c12 - t36*s12;
     const planar_2r_real t39 = -t1;
-    const planar_2r_real t40 = t39 + t8;
-    const planar_2r_real t41 = t9*(c12*t0 - s12*t40);
+    const planar_2r_real t40 = t8 + t39;
+    const planar_2r_real t41 = t9*(t0*c12 - t40*s12);
     const planar_2r_real t42 = s12 + t40*t41;
-    const planar_2r_real t43 = c12 - t0*t41;
-    const planar_2r_real t44 = t9*(mu_dot0*t40 + mu_dot1*t0);
+    const planar_2r_real t43 = c12 - t41*t0;
+    const planar_2r_real t44 = t9*(t40*mu_dot0 + t0*mu_dot1);
     const planar_2r_real t45 = mu_dot0 - t40*t44;
-    const planar_2r_real t46 = mu_dot1 - t0*t44;
-    const planar_2r_real t47 = c12 + damping + mu_dot0 + mu_dot1 + q1 + q2 + t0 + t39 - s12;
+    const planar_2r_real t46 = mu_dot1 - t44*t0;
+    const planar_2r_real t47 = t0 + t39 + c12 + damping + mu_dot0 + mu_dot1 + q1 + q2 - s12;
     const planar_2r_real t48 = fabs(t43);
     const planar_2r_real t49 = t48;
     const planar_2r_real t50 = t49*(t43 >= 0 ? 1 : -1);
     const planar_2r_real t51 = t43 + t50;
-    const planar_2r_real t52 = (t49 > 0 ? 1/(t49*(t48 + t49)) : 0);
+    const planar_2r_real t52 = (t49 > 0 ? 1/(t49*(t49 + t48)) : 0);
     const planar_2r_real t53 = t46 - t46*t52*(t51*t51);
     const planar_2r_real t54 = (t50 != 0 ? -t53/t50 : 0);
     const planar_2r_real t55 = (t8 != 0 ? -(t45 + t42*t54)/t8 : 0);
@@ -539,7 +539,7 @@ int planar_2r_velocity_ik(const planar_2r_real q[PLANAR_2R_DOF], const planar_2r
     const int t58 = damping >= 0;
     const planar_2r_real t59 = 1e-12*t12;
     const planar_2r_real t60 = 1e-12*t25;
-    const int t61 = (t56 && ((t17 <= t60) || (t30 <= t60))) || (damping <= 0 && ((t49 <= t59) || (t7 <= t59)));
+    const int t61 = (t56 && ((t17 <= t60) || (t30 <= t60))) || (damping <= 0 && ((t7 <= t59) || (t49 <= t59)));
     const int t62 = t57 && t58 && !t61;
 
     /* Outputs */
@@ -569,35 +569,35 @@ planar_2r_real planar_2r_ik_numeric_step(const planar_2r_real target[PLANAR_2R_T
     const planar_2r_real s12 = c1*s2 + c2*s1;
     const planar_2r_real t0 = c1 + c12;
     const planar_2r_real t1 = s1 + s12;
-    const planar_2r_real t2 = (s12*s12) + (t1*t1);
-    const planar_2r_real t3 = c12*s12 + t0*t1;
-    const planar_2r_real t4 = (c12*c12) + (t0*t0);
+    const planar_2r_real t2 = (t1*t1) + (s12*s12);
+    const planar_2r_real t3 = t0*t1 + c12*s12;
+    const planar_2r_real t4 = (t0*t0) + (c12*c12);
     const planar_2r_real t5 = mu0 - t0;
     const planar_2r_real t6 = mu1 - t1;
     const planar_2r_real t7 = (t5*t5) + (t6*t6);
     const planar_2r_real t8 = mu0 + mu1 + qs1 + qs2;
-    const planar_2r_real t9 = damping + t2;
+    const planar_2r_real t9 = t2 + damping;
     const planar_2r_real t10 = sqrt((t3*t3) + (t9*t9));
     const planar_2r_real t11 = t10*(t9 >= 0 ? 1 : -1);
     const planar_2r_real t12 = t11 + t9;
     const planar_2r_real t13 = (t10 > 0 ? 1/(t10*(t10 + fabs(t9))) : 0);
-    const planar_2r_real t14 = t13*(t12*t5 - t3*t6);
+    const planar_2r_real t14 = t13*(t5*t12 - t3*t6);
     const planar_2r_real t15 = t5 - t12*t14;
-    const planar_2r_real t16 = t6 + t14*t3;
-    const planar_2r_real t17 = damping + t4;
-    const planar_2r_real t18 = -t13*(t12*t3 + t17*t3);
+    const planar_2r_real t16 = t6 + t3*t14;
+    const planar_2r_real t17 = t4 + damping;
+    const planar_2r_real t18 = -t13*(t3*t12 + t3*t17);
     const planar_2r_real t19 = t3 + t12*t18;
-    const planar_2r_real t20 = t17 + t18*t3;
+    const planar_2r_real t20 = t17 + t3*t18;
     const planar_2r_real t21 = fabs(t20);
     const planar_2r_real t22 = t21;
     const planar_2r_real t23 = t22*(t20 >= 0 ? 1 : -1);
     const planar_2r_real t24 = t20 + t23;
-    const planar_2r_real t25 = (t22 > 0 ? 1/(t22*(t21 + t22)) : 0);
+    const planar_2r_real t25 = (t22 > 0 ? 1/(t22*(t22 + t21)) : 0);
     const planar_2r_real t26 = t16 - t16*t25*(t24*t24);
     const planar_2r_real t27 = (t23 != 0 ? -t26/t23 : 0);
     const planar_2r_real t28 = (t11 != 0 ? -(t15 + t19*t27)/t11 : 0);
     const planar_2r_real t29 = q1 + t0*t27 - t1*t28;
-    const planar_2r_real t30 = q2 + c12*t27 - s12*t28;
+    const planar_2r_real t30 = q2 + t27*c12 - t28*s12;
 
     /* Outputs */
     q_start[0] = q1;
@@ -617,7 +617,7 @@ void planar_2r_ik_branches(const planar_2r_real mu[PLANAR_2R_TASK_DIM], planar_2
 
     /* Intermediate terms */
     const planar_2r_real t0 = (mu0*mu0) + (mu1*mu1);
-    const planar_2r_real t1 = 1.0 - 0.5*t0;
+    const planar_2r_real t1 = 0.5*(2 - t0);
     const planar_2r_real t2 = mu0 + mu1;
     const planar_2r_real t3 = (t1*t1);
     const planar_2r_real t4 = 1 - t3;
@@ -631,24 +631,24 @@ void planar_2r_ik_branches(const planar_2r_real mu[PLANAR_2R_TASK_DIM], planar_2
     const planar_2r_real t12 = -t6;
     const planar_2r_real t13 = t12;
     const planar_2r_real t14 = 1 + t13;
-    const planar_2r_real t15 = mu0*t14 + mu1*t11;
-    const planar_2r_real t16 = mu1*t14 - mu0*t11;
+    const planar_2r_real t15 = t11*mu1 + t14*mu0;
+    const planar_2r_real t16 = t14*mu1 - t11*mu0;
     const planar_2r_real t17 = (t15*t15) + (t16*t16);
     const planar_2r_real t18 = (t11*t11) + (t14*t14);
     const planar_2r_real t19 = 1 + t12;
-    const planar_2r_real t20 = mu0*t19 + mu1*t7;
-    const planar_2r_real t21 = mu1*t19 - mu0*t7;
+    const planar_2r_real t20 = t7*mu1 + t19*mu0;
+    const planar_2r_real t21 = t19*mu1 - t7*mu0;
     const planar_2r_real t22 = (t20*t20) + (t21*t21);
-    const planar_2r_real t23 = (t19*t19) + (t7*t7);
+    const planar_2r_real t23 = (t7*t7) + (t19*t19);
     const planar_2r_real t24 = 1e-24*t0;
     const int t25 = isfinite(t2);
 
     /* Outputs */
     q[0] = (t17 <= t18*t24 ? 0 : atan2(t16, t15));
-    q[1] = t10 - 6.283185307179586*ceil(-0.5 + 0.15915494309189535*t10);
+    q[1] = t10 - 6.283185307179586*ceil(0.15915494309189535*(-3.141592653589793 + t10));
     q[2] = (t22 <= t23*t24 ? 0 : atan2(t21, t20));
-    q[3] = t9 - 6.283185307179586*ceil(-0.5 + 0.15915494309189535*t9);
-    valid[0] = t25 && t4 >= -1e-12;
+    q[3] = t9 - 6.283185307179586*ceil(0.15915494309189535*(-3.141592653589793 + t9));
+    valid[0] = t25 && ((t4 >= -1e-12) || (0 && t3 <= 1e-12));
     valid[1] = t25 && t4 > 1e-12;
     in_limits[0] = 1;
     in_limits[1] = 1;
@@ -696,7 +696,7 @@ int planar_2r_ik_nearest(const planar_2r_real mu[PLANAR_2R_TASK_DIM], const plan
     const planar_2r_real t14 = (t12 ? t1 : qn2);
     const planar_2r_real t15 = (t12 ? t10 : 0);
     const int t16 = t6 > 0;
-    const planar_2r_real t17 = (t16 && ((t11 < t15) || (t3 < 1)) ? 1 : 0);
+    const planar_2r_real t17 = (t16 && ((t15 > t11) || (t3 < 1)) ? 1 : 0);
     const planar_2r_real t18 = (t16 ? 1 : t3);
     const int t19 = t17 > 0;
     const planar_2r_real t20 = (t19 ? t4 : t13);

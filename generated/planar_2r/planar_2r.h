@@ -58,7 +58,7 @@ void planar_2r_task_jacobian(const planar_2r_real q[PLANAR_2R_DOF], planar_2r_re
 void planar_2r_fk_jacobian_dot(const planar_2r_real q[PLANAR_2R_DOF], const planar_2r_real q_dot[PLANAR_2R_DOF], planar_2r_real T[16], planar_2r_real J[6 * PLANAR_2R_DOF], planar_2r_real a[6]);
 
 /* Time derivative dJ/dt of the world geometric Jacobian along q_dot (6 x DOF).
- * Result: Jd: 6 x 2 row-major, element (r, c) at Jd[r * 2 + c]. 26 operations. */
+ * Result: Jd: 6 x 2 row-major, element (r, c) at Jd[r * 2 + c]. 24 operations. */
 void planar_2r_jacobian_dot(const planar_2r_real q[PLANAR_2R_DOF], const planar_2r_real q_dot[PLANAR_2R_DOF], planar_2r_real Jd[6 * PLANAR_2R_DOF]);
 
 /* J' q_dot: the tool's classical linear and angular acceleration at zero joint acceleration, world frame (6).

@@ -192,9 +192,9 @@ def jacobian_tool(q):
     t0 = c1 + c12
     t1 = s1 + s12
     J = _stack(xp, [
-        s12*t0 - c12*t1,  # 0, 0
+        t0*s12 - t1*c12,  # 0, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 1
-        c12*t0 + s12*t1,  # 1, 0
+        t0*c12 + t1*s12,  # 1, 0
         c12**2 + s12**2,  # 1, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 1
@@ -263,9 +263,9 @@ def fk_jacobian_dot(q, q_dot):
     t0 = c1 + c12
     t1 = s1 + s12
     t2 = qd2*s12
-    t3 = t2 + qd1*t1
+    t3 = t2 + t1*qd1
     t4 = c12*qd2
-    t5 = t4 + qd1*t0
+    t5 = t4 + t0*qd1
     t6 = -s12
     T = _stack(xp, [
         xp.broadcast_to(c12, batch),  # 0, 0
@@ -300,8 +300,8 @@ def fk_jacobian_dot(q, q_dot):
         xp.full(batch, 1, dtype=dtype, device=device),  # 5, 1
     ], (6, 2))
     a = _stack(xp, [
-        xp.broadcast_to(-qd1*t5 - qd2*(t4 + c12*qd1), batch),  # 0
-        xp.broadcast_to(-qd1*t3 - qd2*(t2 + qd1*s12), batch),  # 1
+        xp.broadcast_to(-t5*qd1 - qd2*(t4 + c12*qd1), batch),  # 0
+        xp.broadcast_to(-t3*qd1 - qd2*(t2 + qd1*s12), batch),  # 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 4
@@ -311,7 +311,7 @@ def fk_jacobian_dot(q, q_dot):
 
 
 def jacobian_dot(q, q_dot):
-    """time derivative dJ/dt of the world geometric Jacobian along q_dot (6 x DOF): (6 x 2), 26 operations."""
+    """time derivative dJ/dt of the world geometric Jacobian along q_dot (6 x DOF): (6 x 2), 24 operations."""
     xp, dtype, device, batch, (q, q_dot,) = _arguments(("q", q, (2,)), ("q_dot", q_dot, (2,)))
     qd1 = q_dot[..., 0]
     qd2 = q_dot[..., 1]
@@ -325,14 +325,14 @@ def jacobian_dot(q, q_dot):
     t0 = c1 + c12
     t1 = s1 + s12
     t2 = qd2*s12
-    t3 = t2 + qd1*t1
+    t3 = t2 + t1*qd1
     t4 = c12*qd2
-    t5 = t4 + qd1*t0
+    t5 = t4 + t0*qd1
     Jd = _stack(xp, [
         xp.broadcast_to(-t5, batch),  # 0, 0
-        xp.broadcast_to(-t4 - c12*qd1, batch),  # 0, 1
+        xp.broadcast_to(-(t4 + c12*qd1), batch),  # 0, 1
         xp.broadcast_to(-t3, batch),  # 1, 0
-        xp.broadcast_to(-t2 - qd1*s12, batch),  # 1, 1
+        xp.broadcast_to(-(t2 + qd1*s12), batch),  # 1, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
@@ -360,12 +360,12 @@ def bias_acceleration(q, q_dot):
     t0 = c1 + c12
     t1 = s1 + s12
     t2 = qd2*s12
-    t3 = t2 + qd1*t1
+    t3 = t2 + t1*qd1
     t4 = c12*qd2
-    t5 = t4 + qd1*t0
+    t5 = t4 + t0*qd1
     a = _stack(xp, [
-        xp.broadcast_to(-qd1*t5 - qd2*(t4 + c12*qd1), batch),  # 0
-        xp.broadcast_to(-qd1*t3 - qd2*(t2 + qd1*s12), batch),  # 1
+        xp.broadcast_to(-t5*qd1 - qd2*(t4 + c12*qd1), batch),  # 0
+        xp.broadcast_to(-t3*qd1 - qd2*(t2 + qd1*s12), batch),  # 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 4
@@ -389,10 +389,10 @@ def task_jacobian_dot(q, q_dot):
     t0 = c1 + c12
     t1 = s1 + s12
     t2 = qd2*s12
-    t3 = t2 + qd1*t1
+    t3 = t2 + t1*qd1
     t4 = t2 + qd1*s12
     t5 = c12*qd2
-    t6 = t5 + qd1*t0
+    t6 = t5 + t0*qd1
     t7 = t5 + c12*qd1
     Jd = _stack(xp, [
         xp.broadcast_to(-t6, batch),  # 0, 0
@@ -492,7 +492,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
     s12 = c1*s2 + c2*s1
     t0 = c1 + c12
     t1 = s1 + s12
-    t2 = c12*s12 + t0*t1
+    t2 = t0*t1 + c12*s12
     t3 = t1**2
     t4 = t3 + s12**2
     t5 = t4
@@ -502,47 +502,47 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t9 = xp.where(xp.greater(t7, 0), 1/(t7*(t7 + xp.abs(t1))), 0)
     t10 = t6 + c12**2
     t11 = t10
-    t12 = xp.sqrt(t10 + t4)
+    t12 = xp.sqrt(t4 + t10)
     t13 = t2**2
     t14 = damping**2
-    t15 = t14 + t5
+    t15 = t5 + t14
     t16 = t15**2
     t17 = xp.sqrt(t13 + t16)
     t18 = t17*xp.where(xp.greater_equal(t15, 0), xp.asarray(1, dtype=dtype), -1)
-    t19 = t15 + t18
+    t19 = t18 + t15
     t20 = xp.where(xp.greater(t17, 0), 1/(t17*(t17 + xp.abs(t15))), 0)
-    t21 = t20*(mu_dot0*t19 - mu_dot1*t2)
+    t21 = t20*(t19*mu_dot0 - t2*mu_dot1)
     t22 = mu_dot0 - t19*t21
     t23 = mu_dot1 + t2*t21
     t24 = t11 + t14
     t25 = xp.sqrt(t16 + t24**2 + 2*t13)
-    t26 = -t20*(t19*t2 + t2*t24)
+    t26 = -t20*(t2*t19 + t2*t24)
     t27 = t2 + t19*t26
     t28 = t24 + t2*t26
     t29 = xp.abs(t28)
     t30 = t29
     t31 = t30*xp.where(xp.greater_equal(t28, 0), xp.asarray(1, dtype=dtype), -1)
     t32 = t28 + t31
-    t33 = xp.where(xp.greater(t30, 0), 1/(t30*(t29 + t30)), 0)
+    t33 = xp.where(xp.greater(t30, 0), 1/(t30*(t30 + t29)), 0)
     t34 = t23 - t23*t33*t32**2
     t35 = xp.where(xp.not_equal(t31, 0), -t34/t31, 0)
     t36 = xp.where(xp.not_equal(t18, 0), -(t22 + t27*t35)/t18, 0)
-    t37 = t0*t35 - t1*t36
-    t38 = c12*t35 - s12*t36
+    t37 = t35*t0 - t36*t1
+    t38 = t35*c12 - t36*s12
     t39 = -t1
-    t40 = t39 + t8
-    t41 = t9*(c12*t0 - s12*t40)
+    t40 = t8 + t39
+    t41 = t9*(t0*c12 - t40*s12)
     t42 = s12 + t40*t41
-    t43 = c12 - t0*t41
-    t44 = t9*(mu_dot0*t40 + mu_dot1*t0)
+    t43 = c12 - t41*t0
+    t44 = t9*(t40*mu_dot0 + t0*mu_dot1)
     t45 = mu_dot0 - t40*t44
-    t46 = mu_dot1 - t0*t44
-    t47 = c12 + damping + mu_dot0 + mu_dot1 + q1 + q2 + t0 + t39 - s12
+    t46 = mu_dot1 - t44*t0
+    t47 = t0 + t39 + c12 + damping + mu_dot0 + mu_dot1 + q1 + q2 - s12
     t48 = xp.abs(t43)
     t49 = t48
     t50 = t49*xp.where(xp.greater_equal(t43, 0), xp.asarray(1, dtype=dtype), -1)
     t51 = t43 + t50
-    t52 = xp.where(xp.greater(t49, 0), 1/(t49*(t48 + t49)), 0)
+    t52 = xp.where(xp.greater(t49, 0), 1/(t49*(t49 + t48)), 0)
     t53 = t46 - t46*t52*t51**2
     t54 = xp.where(xp.not_equal(t50, 0), -t53/t50, 0)
     t55 = xp.where(xp.not_equal(t8, 0), -(t45 + t42*t54)/t8, 0)
@@ -551,7 +551,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t58 = xp.greater_equal(damping, 0)
     t59 = 1e-12*t12
     t60 = 1e-12*t25
-    t61 = (t56 & ((xp.less_equal(t17, t60)) | (xp.less_equal(t30, t60)))) | ((xp.less_equal(damping, 0)) & ((xp.less_equal(t49, t59)) | (xp.less_equal(t7, t59))))
+    t61 = (t56 & (xp.less_equal(t17, t60) | xp.less_equal(t30, t60))) | (xp.less_equal(damping, 0) & (xp.less_equal(t7, t59) | xp.less_equal(t49, t59)))
     t62 = t57 & t58 & xp.logical_not(t61)
     q_dot = _stack(xp, [
         xp.broadcast_to(xp.where(t62, xp.where(t56, t37, t55), 0), batch),  # 0
@@ -579,35 +579,35 @@ def ik_numeric_step(target, q, damping=0.0):
     s12 = c1*s2 + c2*s1
     t0 = c1 + c12
     t1 = s1 + s12
-    t2 = s12**2 + t1**2
-    t3 = c12*s12 + t0*t1
-    t4 = c12**2 + t0**2
+    t2 = t1**2 + s12**2
+    t3 = t0*t1 + c12*s12
+    t4 = t0**2 + c12**2
     t5 = mu0 - t0
     t6 = mu1 - t1
     t7 = t5**2 + t6**2
     t8 = mu0 + mu1 + qs1 + qs2
-    t9 = damping + t2
+    t9 = t2 + damping
     t10 = xp.sqrt(t3**2 + t9**2)
     t11 = t10*xp.where(xp.greater_equal(t9, 0), xp.asarray(1, dtype=dtype), -1)
     t12 = t11 + t9
     t13 = xp.where(xp.greater(t10, 0), 1/(t10*(t10 + xp.abs(t9))), 0)
-    t14 = t13*(t12*t5 - t3*t6)
+    t14 = t13*(t5*t12 - t3*t6)
     t15 = t5 - t12*t14
-    t16 = t6 + t14*t3
-    t17 = damping + t4
-    t18 = -t13*(t12*t3 + t17*t3)
+    t16 = t6 + t3*t14
+    t17 = t4 + damping
+    t18 = -t13*(t3*t12 + t3*t17)
     t19 = t3 + t12*t18
-    t20 = t17 + t18*t3
+    t20 = t17 + t3*t18
     t21 = xp.abs(t20)
     t22 = t21
     t23 = t22*xp.where(xp.greater_equal(t20, 0), xp.asarray(1, dtype=dtype), -1)
     t24 = t20 + t23
-    t25 = xp.where(xp.greater(t22, 0), 1/(t22*(t21 + t22)), 0)
+    t25 = xp.where(xp.greater(t22, 0), 1/(t22*(t22 + t21)), 0)
     t26 = t16 - t16*t25*t24**2
     t27 = xp.where(xp.not_equal(t23, 0), -t26/t23, 0)
     t28 = xp.where(xp.not_equal(t11, 0), -(t15 + t19*t27)/t11, 0)
     t29 = q1 + t0*t27 - t1*t28
-    t30 = q2 + c12*t27 - s12*t28
+    t30 = q2 + t27*c12 - t28*s12
     q_start = _stack(xp, [
         xp.broadcast_to(q1, batch),  # 0
         xp.broadcast_to(q2, batch),  # 1
@@ -627,7 +627,7 @@ def ik_branches(mu):
     mu0 = mu[..., 0]
     mu1 = mu[..., 1]
     t0 = mu0**2 + mu1**2
-    t1 = 1.0 - 0.5*t0
+    t1 = 0.5*(2 - t0)
     t2 = mu0 + mu1
     t3 = t1**2
     t4 = 1 - t3
@@ -641,26 +641,26 @@ def ik_branches(mu):
     t12 = -t6
     t13 = t12
     t14 = 1 + t13
-    t15 = mu0*t14 + mu1*t11
-    t16 = mu1*t14 - mu0*t11
+    t15 = t11*mu1 + t14*mu0
+    t16 = t14*mu1 - t11*mu0
     t17 = t15**2 + t16**2
     t18 = t11**2 + t14**2
     t19 = 1 + t12
-    t20 = mu0*t19 + mu1*t7
-    t21 = mu1*t19 - mu0*t7
+    t20 = t7*mu1 + t19*mu0
+    t21 = t19*mu1 - t7*mu0
     t22 = t20**2 + t21**2
-    t23 = t19**2 + t7**2
+    t23 = t7**2 + t19**2
     t24 = 1e-24*t0
     t25 = xp.isfinite(t2)
     q = _stack(xp, [
         xp.where(xp.less_equal(t17, t18*t24), 0, xp.atan2(t16, t15)),  # 0, 0
-        t10 - 6.283185307179586*xp.ceil(-0.5 + 0.15915494309189535*t10),  # 0, 1
+        t10 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t10)),  # 0, 1
         xp.where(xp.less_equal(t22, t23*t24), 0, xp.atan2(t21, t20)),  # 1, 0
-        t9 - 6.283185307179586*xp.ceil(-0.5 + 0.15915494309189535*t9),  # 1, 1
+        t9 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t9)),  # 1, 1
     ], (2, 2))
     valid = _stack(xp, [
-        t25 & (xp.greater_equal(t4, -1e-12)),  # 0
-        t25 & (xp.greater(t4, 1e-12)),  # 1
+        t25 & (xp.greater_equal(t4, -1e-12) | (False & xp.less_equal(t3, 1e-12))),  # 0
+        t25 & xp.greater(t4, 1e-12),  # 1
     ], (2,))
     in_limits = _stack(xp, [
         xp.full(batch, True, dtype=xp.bool, device=device),  # 0
@@ -705,7 +705,7 @@ def ik_nearest(mu, q_seed, weights=(1.0,) * DOF):
     t14 = xp.where(t12, t1, qn2)
     t15 = xp.where(t12, t10, 0)
     t16 = xp.greater(t6, 0)
-    t17 = xp.where(t16 & ((xp.less(t11, t15)) | (xp.less(t3, 1))), xp.asarray(1, dtype=dtype), 0)
+    t17 = xp.where(t16 & (xp.greater(t15, t11) | xp.less(t3, 1)), xp.asarray(1, dtype=dtype), 0)
     t18 = xp.where(t16, 1, t3)
     t19 = xp.greater(t17, 0)
     t20 = xp.where(t19, t4, t13)

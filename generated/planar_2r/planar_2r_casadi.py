@@ -107,8 +107,8 @@ def _jacobian_tool(q):
     t0 = c1 + c12
     t1 = s1 + s12
     J = casadi.SX(6, 2)
-    J[0, 0] = s12*t0 - c12*t1
-    J[1, 0] = c12*t0 + s12*t1
+    J[0, 0] = t0*s12 - t1*c12
+    J[1, 0] = t0*c12 + t1*s12
     J[1, 1] = c12**2 + s12**2
     J[5, 0] = 1
     J[5, 1] = 1
@@ -168,9 +168,9 @@ def _fk_jacobian_dot(q, q_dot):
     t0 = c1 + c12
     t1 = s1 + s12
     t2 = qd2*s12
-    t3 = t2 + qd1*t1
+    t3 = t2 + t1*qd1
     t4 = c12*qd2
-    t5 = t4 + qd1*t0
+    t5 = t4 + t0*qd1
     t6 = -s12
     T = casadi.SX(4, 4)
     T[0, 0] = c12
@@ -189,13 +189,13 @@ def _fk_jacobian_dot(q, q_dot):
     J[5, 0] = 1
     J[5, 1] = 1
     a = casadi.SX(6, 1)
-    a[0, 0] = -qd1*t5 - qd2*(t4 + c12*qd1)
-    a[1, 0] = -qd1*t3 - qd2*(t2 + qd1*s12)
+    a[0, 0] = -t5*qd1 - qd2*(t4 + c12*qd1)
+    a[1, 0] = -t3*qd1 - qd2*(t2 + qd1*s12)
     return [T, J, a]
 
 
 def _jacobian_dot(q, q_dot):
-    """Time derivative dJ/dt of the world geometric Jacobian along q_dot (6 x DOF): 26 operations."""
+    """Time derivative dJ/dt of the world geometric Jacobian along q_dot (6 x DOF): 24 operations."""
     q1 = q[0]
     q2 = q[1]
     qd1 = q_dot[0]
@@ -209,14 +209,14 @@ def _jacobian_dot(q, q_dot):
     t0 = c1 + c12
     t1 = s1 + s12
     t2 = qd2*s12
-    t3 = t2 + qd1*t1
+    t3 = t2 + t1*qd1
     t4 = c12*qd2
-    t5 = t4 + qd1*t0
+    t5 = t4 + t0*qd1
     Jd = casadi.SX(6, 2)
     Jd[0, 0] = -t5
-    Jd[0, 1] = -t4 - c12*qd1
+    Jd[0, 1] = -(t4 + c12*qd1)
     Jd[1, 0] = -t3
-    Jd[1, 1] = -t2 - qd1*s12
+    Jd[1, 1] = -(t2 + qd1*s12)
     return [Jd]
 
 
@@ -235,12 +235,12 @@ def _bias_acceleration(q, q_dot):
     t0 = c1 + c12
     t1 = s1 + s12
     t2 = qd2*s12
-    t3 = t2 + qd1*t1
+    t3 = t2 + t1*qd1
     t4 = c12*qd2
-    t5 = t4 + qd1*t0
+    t5 = t4 + t0*qd1
     a = casadi.SX(6, 1)
-    a[0, 0] = -qd1*t5 - qd2*(t4 + c12*qd1)
-    a[1, 0] = -qd1*t3 - qd2*(t2 + qd1*s12)
+    a[0, 0] = -t5*qd1 - qd2*(t4 + c12*qd1)
+    a[1, 0] = -t3*qd1 - qd2*(t2 + qd1*s12)
     return [a]
 
 
@@ -259,10 +259,10 @@ def _task_jacobian_dot(q, q_dot):
     t0 = c1 + c12
     t1 = s1 + s12
     t2 = qd2*s12
-    t3 = t2 + qd1*t1
+    t3 = t2 + t1*qd1
     t4 = t2 + qd1*s12
     t5 = c12*qd2
-    t6 = t5 + qd1*t0
+    t6 = t5 + t0*qd1
     t7 = t5 + c12*qd1
     Jd = casadi.SX(2, 2)
     Jd[0, 0] = -t6
@@ -339,7 +339,7 @@ def _velocity_ik(q, mu_dot, damping):
     s12 = c1*s2 + c2*s1
     t0 = c1 + c12
     t1 = s1 + s12
-    t2 = c12*s12 + t0*t1
+    t2 = t0*t1 + c12*s12
     t3 = t1**2
     t4 = t3 + s12**2
     t5 = t4
@@ -349,47 +349,47 @@ def _velocity_ik(q, mu_dot, damping):
     t9 = casadi.if_else((t7 > 0), 1/(t7*(t7 + casadi.fabs(t1))), 0)
     t10 = t6 + c12**2
     t11 = t10
-    t12 = casadi.sqrt(t10 + t4)
+    t12 = casadi.sqrt(t4 + t10)
     t13 = t2**2
     t14 = damping**2
-    t15 = t14 + t5
+    t15 = t5 + t14
     t16 = t15**2
     t17 = casadi.sqrt(t13 + t16)
     t18 = t17*casadi.if_else((t15 >= 0), 1, -1)
-    t19 = t15 + t18
+    t19 = t18 + t15
     t20 = casadi.if_else((t17 > 0), 1/(t17*(t17 + casadi.fabs(t15))), 0)
-    t21 = t20*(mu_dot0*t19 - mu_dot1*t2)
+    t21 = t20*(t19*mu_dot0 - t2*mu_dot1)
     t22 = mu_dot0 - t19*t21
     t23 = mu_dot1 + t2*t21
     t24 = t11 + t14
     t25 = casadi.sqrt(t16 + t24**2 + 2*t13)
-    t26 = -t20*(t19*t2 + t2*t24)
+    t26 = -t20*(t2*t19 + t2*t24)
     t27 = t2 + t19*t26
     t28 = t24 + t2*t26
     t29 = casadi.fabs(t28)
     t30 = t29
     t31 = t30*casadi.if_else((t28 >= 0), 1, -1)
     t32 = t28 + t31
-    t33 = casadi.if_else((t30 > 0), 1/(t30*(t29 + t30)), 0)
+    t33 = casadi.if_else((t30 > 0), 1/(t30*(t30 + t29)), 0)
     t34 = t23 - t23*t33*t32**2
     t35 = casadi.if_else((t31 != 0), -t34/t31, 0)
     t36 = casadi.if_else((t18 != 0), -(t22 + t27*t35)/t18, 0)
-    t37 = t0*t35 - t1*t36
-    t38 = c12*t35 - s12*t36
+    t37 = t35*t0 - t36*t1
+    t38 = t35*c12 - t36*s12
     t39 = -t1
-    t40 = t39 + t8
-    t41 = t9*(c12*t0 - s12*t40)
+    t40 = t8 + t39
+    t41 = t9*(t0*c12 - t40*s12)
     t42 = s12 + t40*t41
-    t43 = c12 - t0*t41
-    t44 = t9*(mu_dot0*t40 + mu_dot1*t0)
+    t43 = c12 - t41*t0
+    t44 = t9*(t40*mu_dot0 + t0*mu_dot1)
     t45 = mu_dot0 - t40*t44
-    t46 = mu_dot1 - t0*t44
-    t47 = c12 + damping + mu_dot0 + mu_dot1 + q1 + q2 + t0 + t39 - s12
+    t46 = mu_dot1 - t44*t0
+    t47 = t0 + t39 + c12 + damping + mu_dot0 + mu_dot1 + q1 + q2 - s12
     t48 = casadi.fabs(t43)
     t49 = t48
     t50 = t49*casadi.if_else((t43 >= 0), 1, -1)
     t51 = t43 + t50
-    t52 = casadi.if_else((t49 > 0), 1/(t49*(t48 + t49)), 0)
+    t52 = casadi.if_else((t49 > 0), 1/(t49*(t49 + t48)), 0)
     t53 = t46 - t46*t52*t51**2
     t54 = casadi.if_else((t50 != 0), -t53/t50, 0)
     t55 = casadi.if_else((t8 != 0), -(t45 + t42*t54)/t8, 0)
@@ -398,7 +398,7 @@ def _velocity_ik(q, mu_dot, damping):
     t58 = (damping >= 0)
     t59 = 1e-12*t12
     t60 = 1e-12*t25
-    t61 = casadi.logic_or(casadi.logic_and(t56, casadi.logic_or((t17 <= t60), (t30 <= t60))), casadi.logic_and((damping <= 0), casadi.logic_or((t49 <= t59), (t7 <= t59))))
+    t61 = casadi.logic_or(casadi.logic_and(t56, casadi.logic_or((t17 <= t60), (t30 <= t60))), casadi.logic_and((damping <= 0), casadi.logic_or((t7 <= t59), (t49 <= t59))))
     t62 = casadi.logic_and(casadi.logic_and(t57, t58), casadi.logic_not(t61))
     q_dot = casadi.SX(2, 1)
     q_dot[0, 0] = casadi.if_else(t62, casadi.if_else(t56, t37, t55), 0)
@@ -424,35 +424,35 @@ def _ik_numeric_step(target, q, damping):
     s12 = c1*s2 + c2*s1
     t0 = c1 + c12
     t1 = s1 + s12
-    t2 = s12**2 + t1**2
-    t3 = c12*s12 + t0*t1
-    t4 = c12**2 + t0**2
+    t2 = t1**2 + s12**2
+    t3 = t0*t1 + c12*s12
+    t4 = t0**2 + c12**2
     t5 = mu0 - t0
     t6 = mu1 - t1
     t7 = t5**2 + t6**2
     t8 = mu0 + mu1 + qs1 + qs2
-    t9 = damping + t2
+    t9 = t2 + damping
     t10 = casadi.sqrt(t3**2 + t9**2)
     t11 = t10*casadi.if_else((t9 >= 0), 1, -1)
     t12 = t11 + t9
     t13 = casadi.if_else((t10 > 0), 1/(t10*(t10 + casadi.fabs(t9))), 0)
-    t14 = t13*(t12*t5 - t3*t6)
+    t14 = t13*(t5*t12 - t3*t6)
     t15 = t5 - t12*t14
-    t16 = t6 + t14*t3
-    t17 = damping + t4
-    t18 = -t13*(t12*t3 + t17*t3)
+    t16 = t6 + t3*t14
+    t17 = t4 + damping
+    t18 = -t13*(t3*t12 + t3*t17)
     t19 = t3 + t12*t18
-    t20 = t17 + t18*t3
+    t20 = t17 + t3*t18
     t21 = casadi.fabs(t20)
     t22 = t21
     t23 = t22*casadi.if_else((t20 >= 0), 1, -1)
     t24 = t20 + t23
-    t25 = casadi.if_else((t22 > 0), 1/(t22*(t21 + t22)), 0)
+    t25 = casadi.if_else((t22 > 0), 1/(t22*(t22 + t21)), 0)
     t26 = t16 - t16*t25*t24**2
     t27 = casadi.if_else((t23 != 0), -t26/t23, 0)
     t28 = casadi.if_else((t11 != 0), -(t15 + t19*t27)/t11, 0)
     t29 = q1 + t0*t27 - t1*t28
-    t30 = q2 + c12*t27 - s12*t28
+    t30 = q2 + t27*c12 - t28*s12
     q_start = casadi.SX(2, 1)
     q_start[0, 0] = q1
     q_start[1, 0] = q2
@@ -469,7 +469,7 @@ def _ik_branches(mu):
     mu0 = mu[0]
     mu1 = mu[1]
     t0 = mu0**2 + mu1**2
-    t1 = 1.0 - 0.5*t0
+    t1 = 0.5*(2 - t0)
     t2 = mu0 + mu1
     t3 = t1**2
     t4 = 1 - t3
@@ -483,24 +483,24 @@ def _ik_branches(mu):
     t12 = -t6
     t13 = t12
     t14 = 1 + t13
-    t15 = mu0*t14 + mu1*t11
-    t16 = mu1*t14 - mu0*t11
+    t15 = t11*mu1 + t14*mu0
+    t16 = t14*mu1 - t11*mu0
     t17 = t15**2 + t16**2
     t18 = t11**2 + t14**2
     t19 = 1 + t12
-    t20 = mu0*t19 + mu1*t7
-    t21 = mu1*t19 - mu0*t7
+    t20 = t7*mu1 + t19*mu0
+    t21 = t19*mu1 - t7*mu0
     t22 = t20**2 + t21**2
-    t23 = t19**2 + t7**2
+    t23 = t7**2 + t19**2
     t24 = 1e-24*t0
     t25 = (casadi.fabs(t2) < casadi.inf)
     q = casadi.SX(2, 2)
     q[0, 0] = casadi.if_else((t17 <= t18*t24), 0, casadi.atan2(t16, t15))
-    q[0, 1] = t10 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t10)
+    q[0, 1] = t10 - 6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t10))
     q[1, 0] = casadi.if_else((t22 <= t23*t24), 0, casadi.atan2(t21, t20))
-    q[1, 1] = t9 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t9)
+    q[1, 1] = t9 - 6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t9))
     valid = casadi.SX(2, 1)
-    valid[0, 0] = casadi.logic_and(t25, (t4 >= -1e-12))
+    valid[0, 0] = casadi.logic_and(t25, casadi.logic_or((t4 >= -1e-12), casadi.logic_and(False, (t3 <= 1e-12))))
     valid[1, 0] = casadi.logic_and(t25, (t4 > 1e-12))
     in_limits = casadi.SX(2, 1)
     in_limits[0, 0] = True
@@ -542,7 +542,7 @@ def _ik_nearest(mu, q_seed, weights):
     t14 = casadi.if_else(t12, t1, qn2)
     t15 = casadi.if_else(t12, t10, 0)
     t16 = (t6 > 0)
-    t17 = casadi.if_else(casadi.logic_and(t16, casadi.logic_or((t11 < t15), (t3 < 1))), 1, 0)
+    t17 = casadi.if_else(casadi.logic_and(t16, casadi.logic_or((t15 > t11), (t3 < 1))), 1, 0)
     t18 = casadi.if_else(t16, 1, t3)
     t19 = (t17 > 0)
     t20 = casadi.if_else(t19, t4, t13)

@@ -26,8 +26,8 @@ void planar_3r_fk(const planar_3r_real q[PLANAR_3R_DOF], planar_3r_real T[16])
     const planar_3r_real s123 = c12*s3 + c3*s12;
     const planar_3r_real t0 = c12 + c123;
     const planar_3r_real t1 = s12 + s123;
-    const planar_3r_real t2 = c1 + t0;
-    const planar_3r_real t3 = s1 + t1;
+    const planar_3r_real t2 = t0 + c1;
+    const planar_3r_real t3 = t1 + s1;
 
     /* Outputs */
     T[0] = c123;
@@ -70,8 +70,8 @@ void planar_3r_jacobian(const planar_3r_real q[PLANAR_3R_DOF], planar_3r_real J[
     const planar_3r_real s123 = c12*s3 + c3*s12;
     const planar_3r_real t0 = c12 + c123;
     const planar_3r_real t1 = s12 + s123;
-    const planar_3r_real t2 = c1 + t0;
-    const planar_3r_real t3 = s1 + t1;
+    const planar_3r_real t2 = t0 + c1;
+    const planar_3r_real t3 = t1 + s1;
 
     /* Outputs */
     J[0] = -t3;
@@ -116,8 +116,8 @@ void planar_3r_fk_jacobian(const planar_3r_real q[PLANAR_3R_DOF], planar_3r_real
     const planar_3r_real s123 = c12*s3 + c3*s12;
     const planar_3r_real t0 = c12 + c123;
     const planar_3r_real t1 = s12 + s123;
-    const planar_3r_real t2 = c1 + t0;
-    const planar_3r_real t3 = s1 + t1;
+    const planar_3r_real t2 = t0 + c1;
+    const planar_3r_real t3 = t1 + s1;
     const planar_3r_real t4 = -s123;
 
     /* Outputs */
@@ -179,15 +179,15 @@ void planar_3r_jacobian_tool(const planar_3r_real q[PLANAR_3R_DOF], planar_3r_re
     const planar_3r_real s123 = c12*s3 + c3*s12;
     const planar_3r_real t0 = c12 + c123;
     const planar_3r_real t1 = s12 + s123;
-    const planar_3r_real t2 = c1 + t0;
-    const planar_3r_real t3 = s1 + t1;
+    const planar_3r_real t2 = t0 + c1;
+    const planar_3r_real t3 = t1 + s1;
 
     /* Outputs */
-    J[0] = s123*t2 - c123*t3;
-    J[1] = s123*t0 - c123*t1;
+    J[0] = t2*s123 - t3*c123;
+    J[1] = t0*s123 - t1*c123;
     J[2] = 0;
-    J[3] = c123*t2 + s123*t3;
-    J[4] = c123*t0 + s123*t1;
+    J[3] = t2*c123 + t3*s123;
+    J[4] = t0*c123 + t1*s123;
     J[5] = (c123*c123) + (s123*s123);
     J[6] = 0;
     J[7] = 0;
@@ -225,8 +225,8 @@ void planar_3r_task(const planar_3r_real q[PLANAR_3R_DOF], planar_3r_real mu[PLA
     const planar_3r_real s123 = c12*s3 + c3*s12;
     const planar_3r_real t0 = c12 + c123;
     const planar_3r_real t1 = s12 + s123;
-    const planar_3r_real t2 = c1 + t0;
-    const planar_3r_real t3 = s1 + t1;
+    const planar_3r_real t2 = t0 + c1;
+    const planar_3r_real t3 = t1 + s1;
 
     /* Outputs */
     mu[0] = t2;
@@ -256,8 +256,8 @@ void planar_3r_task_jacobian(const planar_3r_real q[PLANAR_3R_DOF], planar_3r_re
     const planar_3r_real s123 = c12*s3 + c3*s12;
     const planar_3r_real t0 = c12 + c123;
     const planar_3r_real t1 = s12 + s123;
-    const planar_3r_real t2 = c1 + t0;
-    const planar_3r_real t3 = s1 + t1;
+    const planar_3r_real t2 = t0 + c1;
+    const planar_3r_real t3 = t1 + s1;
 
     /* Outputs */
     J[0] = -t3;
@@ -296,15 +296,15 @@ void planar_3r_fk_jacobian_dot(const planar_3r_real q[PLANAR_3R_DOF], const plan
     const planar_3r_real s123 = c12*s3 + c3*s12;
     const planar_3r_real t0 = c12 + c123;
     const planar_3r_real t1 = s12 + s123;
-    const planar_3r_real t2 = c1 + t0;
-    const planar_3r_real t3 = s1 + t1;
+    const planar_3r_real t2 = t0 + c1;
+    const planar_3r_real t3 = t1 + s1;
     const planar_3r_real t4 = qd1 + qd2;
     const planar_3r_real t5 = qd3*s123;
-    const planar_3r_real t6 = t5 + qd2*t1;
-    const planar_3r_real t7 = t6 + qd1*t3;
+    const planar_3r_real t6 = t5 + t1*qd2;
+    const planar_3r_real t7 = t6 + t3*qd1;
     const planar_3r_real t8 = c123*qd3;
-    const planar_3r_real t9 = t8 + qd2*t0;
-    const planar_3r_real t10 = t9 + qd1*t2;
+    const planar_3r_real t9 = t8 + t0*qd2;
+    const planar_3r_real t10 = t9 + t2*qd1;
     const planar_3r_real t11 = -s123;
 
     /* Outputs */
@@ -342,8 +342,8 @@ void planar_3r_fk_jacobian_dot(const planar_3r_real q[PLANAR_3R_DOF], const plan
     J[15] = 1;
     J[16] = 1;
     J[17] = 1;
-    a[0] = -qd1*t10 - qd2*(t9 + qd1*t0) - qd3*(t8 + c123*t4);
-    a[1] = -qd1*t7 - qd2*(t6 + qd1*t1) - qd3*(t5 + s123*t4);
+    a[0] = -t10*qd1 - qd2*(t9 + t0*qd1) - qd3*(t8 + t4*c123);
+    a[1] = -t7*qd1 - qd2*(t6 + t1*qd1) - qd3*(t5 + t4*s123);
     a[2] = 0;
     a[3] = 0;
     a[4] = 0;
@@ -352,7 +352,7 @@ void planar_3r_fk_jacobian_dot(const planar_3r_real q[PLANAR_3R_DOF], const plan
 
 void planar_3r_jacobian_dot(const planar_3r_real q[PLANAR_3R_DOF], const planar_3r_real q_dot[PLANAR_3R_DOF], planar_3r_real Jd[6 * PLANAR_3R_DOF])
 {
-    /* 47 operations */
+    /* 43 operations */
 
     /* Inputs */
     const planar_3r_real q1 = q[0];
@@ -375,23 +375,23 @@ void planar_3r_jacobian_dot(const planar_3r_real q[PLANAR_3R_DOF], const planar_
     const planar_3r_real s123 = c12*s3 + c3*s12;
     const planar_3r_real t0 = c12 + c123;
     const planar_3r_real t1 = s12 + s123;
-    const planar_3r_real t2 = c1 + t0;
-    const planar_3r_real t3 = s1 + t1;
+    const planar_3r_real t2 = t0 + c1;
+    const planar_3r_real t3 = t1 + s1;
     const planar_3r_real t4 = qd1 + qd2;
     const planar_3r_real t5 = qd3*s123;
-    const planar_3r_real t6 = t5 + qd2*t1;
-    const planar_3r_real t7 = t6 + qd1*t3;
+    const planar_3r_real t6 = t5 + t1*qd2;
+    const planar_3r_real t7 = t6 + t3*qd1;
     const planar_3r_real t8 = c123*qd3;
-    const planar_3r_real t9 = t8 + qd2*t0;
-    const planar_3r_real t10 = t9 + qd1*t2;
+    const planar_3r_real t9 = t8 + t0*qd2;
+    const planar_3r_real t10 = t9 + t2*qd1;
 
     /* Outputs */
     Jd[0] = -t10;
-    Jd[1] = -t9 - qd1*t0;
-    Jd[2] = -t8 - c123*t4;
+    Jd[1] = -(t9 + t0*qd1);
+    Jd[2] = -(t8 + t4*c123);
     Jd[3] = -t7;
-    Jd[4] = -t6 - qd1*t1;
-    Jd[5] = -t5 - s123*t4;
+    Jd[4] = -(t6 + t1*qd1);
+    Jd[5] = -(t5 + t4*s123);
     Jd[6] = 0;
     Jd[7] = 0;
     Jd[8] = 0;
@@ -431,19 +431,19 @@ void planar_3r_bias_acceleration(const planar_3r_real q[PLANAR_3R_DOF], const pl
     const planar_3r_real s123 = c12*s3 + c3*s12;
     const planar_3r_real t0 = c12 + c123;
     const planar_3r_real t1 = s12 + s123;
-    const planar_3r_real t2 = c1 + t0;
-    const planar_3r_real t3 = s1 + t1;
+    const planar_3r_real t2 = t0 + c1;
+    const planar_3r_real t3 = t1 + s1;
     const planar_3r_real t4 = qd1 + qd2;
     const planar_3r_real t5 = qd3*s123;
-    const planar_3r_real t6 = t5 + qd2*t1;
-    const planar_3r_real t7 = t6 + qd1*t3;
+    const planar_3r_real t6 = t5 + t1*qd2;
+    const planar_3r_real t7 = t6 + t3*qd1;
     const planar_3r_real t8 = c123*qd3;
-    const planar_3r_real t9 = t8 + qd2*t0;
-    const planar_3r_real t10 = t9 + qd1*t2;
+    const planar_3r_real t9 = t8 + t0*qd2;
+    const planar_3r_real t10 = t9 + t2*qd1;
 
     /* Outputs */
-    a[0] = -qd1*t10 - qd2*(t9 + qd1*t0) - qd3*(t8 + c123*t4);
-    a[1] = -qd1*t7 - qd2*(t6 + qd1*t1) - qd3*(t5 + s123*t4);
+    a[0] = -t10*qd1 - qd2*(t9 + t0*qd1) - qd3*(t8 + t4*c123);
+    a[1] = -t7*qd1 - qd2*(t6 + t1*qd1) - qd3*(t5 + t4*s123);
     a[2] = 0;
     a[3] = 0;
     a[4] = 0;
@@ -475,19 +475,19 @@ void planar_3r_task_jacobian_dot(const planar_3r_real q[PLANAR_3R_DOF], const pl
     const planar_3r_real s123 = c12*s3 + c3*s12;
     const planar_3r_real t0 = c12 + c123;
     const planar_3r_real t1 = s12 + s123;
-    const planar_3r_real t2 = c1 + t0;
-    const planar_3r_real t3 = s1 + t1;
+    const planar_3r_real t2 = t0 + c1;
+    const planar_3r_real t3 = t1 + s1;
     const planar_3r_real t4 = qd1 + qd2;
     const planar_3r_real t5 = qd3*s123;
-    const planar_3r_real t6 = t5 + qd2*t1;
-    const planar_3r_real t7 = t6 + qd1*t3;
-    const planar_3r_real t8 = t6 + qd1*t1;
-    const planar_3r_real t9 = t5 + s123*t4;
+    const planar_3r_real t6 = t5 + t1*qd2;
+    const planar_3r_real t7 = t6 + t3*qd1;
+    const planar_3r_real t8 = t6 + t1*qd1;
+    const planar_3r_real t9 = t5 + t4*s123;
     const planar_3r_real t10 = c123*qd3;
-    const planar_3r_real t11 = t10 + qd2*t0;
-    const planar_3r_real t12 = t11 + qd1*t2;
-    const planar_3r_real t13 = t11 + qd1*t0;
-    const planar_3r_real t14 = t10 + c123*t4;
+    const planar_3r_real t11 = t10 + t0*qd2;
+    const planar_3r_real t12 = t11 + t2*qd1;
+    const planar_3r_real t13 = t11 + t0*qd1;
+    const planar_3r_real t14 = t10 + t4*c123;
 
     /* Outputs */
     Jd[0] = -t12;
@@ -523,8 +523,8 @@ void planar_3r_hessian(const planar_3r_real q[PLANAR_3R_DOF], planar_3r_real H[P
     const planar_3r_real s123 = c12*s3 + c3*s12;
     const planar_3r_real t0 = c12 + c123;
     const planar_3r_real t1 = s12 + s123;
-    const planar_3r_real t2 = c1 + t0;
-    const planar_3r_real t3 = s1 + t1;
+    const planar_3r_real t2 = t0 + c1;
+    const planar_3r_real t3 = t1 + s1;
     const planar_3r_real t4 = -t0;
     const planar_3r_real t5 = -c123;
     const planar_3r_real t6 = -t1;
@@ -677,79 +677,79 @@ int planar_3r_velocity_ik(const planar_3r_real q[PLANAR_3R_DOF], const planar_3r
     const planar_3r_real s123 = c12*s3 + c3*s12;
     const planar_3r_real t0 = c12 + c123;
     const planar_3r_real t1 = s12 + s123;
-    const planar_3r_real t2 = c1 + t0;
-    const planar_3r_real t3 = s1 + t1;
-    const planar_3r_real t4 = c123*s123 + t0*t1 + t2*t3;
-    const planar_3r_real t5 = s123 + t1 + t3;
+    const planar_3r_real t2 = t0 + c1;
+    const planar_3r_real t3 = t1 + s1;
+    const planar_3r_real t4 = t0*t1 + t2*t3 + c123*s123;
+    const planar_3r_real t5 = t1 + t3 + s123;
     const planar_3r_real t6 = (t3*t3);
-    const planar_3r_real t7 = t6 + (s123*s123) + (t1*t1);
+    const planar_3r_real t7 = t6 + (t1*t1) + (s123*s123);
     const planar_3r_real t8 = t7;
     const planar_3r_real t9 = (t2*t2);
     const planar_3r_real t10 = sqrt(1 + t6 + t9);
     const planar_3r_real t11 = t10*(t3 <= 0 ? 1 : -1);
     const planar_3r_real t12 = (t10 > 0 ? 1/(t10*(t10 + fabs(t3))) : 0);
-    const planar_3r_real t13 = t9 + (c123*c123) + (t0*t0);
+    const planar_3r_real t13 = t9 + (t0*t0) + (c123*c123);
     const planar_3r_real t14 = t13;
-    const planar_3r_real t15 = sqrt(3 + t13 + t7);
-    const planar_3r_real t16 = c123 + t0 + t2;
+    const planar_3r_real t15 = sqrt(3 + t7 + t13);
+    const planar_3r_real t16 = t0 + t2 + c123;
     const planar_3r_real t17 = t16;
     const planar_3r_real t18 = (t4*t4);
     const planar_3r_real t19 = (t5*t5);
     const planar_3r_real t20 = (damping*damping);
-    const planar_3r_real t21 = t20 + t8;
+    const planar_3r_real t21 = t8 + t20;
     const planar_3r_real t22 = (t21*t21);
     const planar_3r_real t23 = sqrt(t18 + t19 + t22);
     const planar_3r_real t24 = t23*(t21 >= 0 ? 1 : -1);
-    const planar_3r_real t25 = t21 + t24;
+    const planar_3r_real t25 = t24 + t21;
     const planar_3r_real t26 = (t23 > 0 ? 1/(t23*(t23 + fabs(t21))) : 0);
-    const planar_3r_real t27 = -t26*(mu_dot1*t4 + mu_dot2*t5 - mu_dot0*t25);
+    const planar_3r_real t27 = -t26*(t4*mu_dot1 + t5*mu_dot2 - t25*mu_dot0);
     const planar_3r_real t28 = mu_dot0 - t25*t27;
-    const planar_3r_real t29 = mu_dot1 + t27*t4;
-    const planar_3r_real t30 = mu_dot2 + t27*t5;
+    const planar_3r_real t29 = mu_dot1 + t4*t27;
+    const planar_3r_real t30 = mu_dot2 + t5*t27;
     const planar_3r_real t31 = t14 + t20;
-    const planar_3r_real t32 = -t26*(t17*t5 + t25*t4 + t31*t4);
+    const planar_3r_real t32 = -t26*(t4*t25 + t4*t31 + t5*t17);
     const planar_3r_real t33 = t4 + t25*t32;
-    const planar_3r_real t34 = t31 + t32*t4;
-    const planar_3r_real t35 = t17 + t32*t5;
+    const planar_3r_real t34 = t31 + t4*t32;
+    const planar_3r_real t35 = t17 + t5*t32;
     const planar_3r_real t36 = sqrt((t34*t34) + (t35*t35));
     const planar_3r_real t37 = t36*(t34 >= 0 ? 1 : -1);
     const planar_3r_real t38 = t34 + t37;
     const planar_3r_real t39 = (t36 > 0 ? 1/(t36*(t36 + fabs(t34))) : 0);
-    const planar_3r_real t40 = t39*(t29*t38 + t30*t35);
+    const planar_3r_real t40 = t39*(t35*t30 + t29*t38);
     const planar_3r_real t41 = t29 - t38*t40;
     const planar_3r_real t42 = t30 - t35*t40;
     const planar_3r_real t43 = 3 + t20;
-    const planar_3r_real t44 = sqrt(t22 + 2*t18 + 2*t19 + 2*(t17*t17) + (t31*t31) + (t43*t43));
-    const planar_3r_real t45 = -t26*(t17*t4 + t25*t5 + t43*t5);
+    const planar_3r_real t44 = sqrt(t22 + (t31*t31) + (t43*t43) + 2*t18 + 2*t19 + 2*(t17*t17));
+    const planar_3r_real t45 = -t26*(t4*t17 + t5*t25 + t5*t43);
     const planar_3r_real t46 = t5 + t25*t45;
     const planar_3r_real t47 = t17 + t4*t45;
-    const planar_3r_real t48 = t43 + t45*t5;
-    const planar_3r_real t49 = t39*(t35*t48 + t38*t47);
+    const planar_3r_real t48 = t43 + t5*t45;
+    const planar_3r_real t49 = t39*(t35*t48 + t47*t38);
     const planar_3r_real t50 = t47 - t38*t49;
     const planar_3r_real t51 = t48 - t35*t49;
     const planar_3r_real t52 = fabs(t51);
     const planar_3r_real t53 = t52;
     const planar_3r_real t54 = t53*(t51 >= 0 ? 1 : -1);
     const planar_3r_real t55 = t51 + t54;
-    const planar_3r_real t56 = (t53 > 0 ? 1/(t53*(t52 + t53)) : 0);
+    const planar_3r_real t56 = (t53 > 0 ? 1/(t53*(t53 + t52)) : 0);
     const planar_3r_real t57 = t42 - t42*t56*(t55*t55);
     const planar_3r_real t58 = (t54 != 0 ? -t57/t54 : 0);
     const planar_3r_real t59 = (t37 != 0 ? -(t41 - t50*t58)/t37 : 0);
     const planar_3r_real t60 = (t24 != 0 ? -(t28 + t33*t59 + t46*t58)/t24 : 0);
     const planar_3r_real t61 = t58 + t2*t59 - t3*t60;
     const planar_3r_real t62 = t58 + t0*t59 - t1*t60;
-    const planar_3r_real t63 = t58 + c123*t59 - s123*t60;
+    const planar_3r_real t63 = t58 + t59*c123 - t60*s123;
     const planar_3r_real t64 = -t3;
     const planar_3r_real t65 = t11 + t64;
     const planar_3r_real t66 = t12*(1 + t0*t2 - t1*t65);
     const planar_3r_real t67 = t1 + t65*t66;
     const planar_3r_real t68 = t0 - t2*t66;
     const planar_3r_real t69 = 1 - t66;
-    const planar_3r_real t70 = t12*(1 + c123*t2 - s123*t65);
+    const planar_3r_real t70 = t12*(1 + t2*c123 - t65*s123);
     const planar_3r_real t71 = s123 + t65*t70;
     const planar_3r_real t72 = c123 - t2*t70;
     const planar_3r_real t73 = 1 - t70;
-    const planar_3r_real t74 = t12*(mu_dot2 + mu_dot0*t65 + mu_dot1*t2);
+    const planar_3r_real t74 = t12*(mu_dot2 + t2*mu_dot1 + t65*mu_dot0);
     const planar_3r_real t75 = mu_dot0 - t65*t74;
     const planar_3r_real t76 = mu_dot1 - t2*t74;
     const planar_3r_real t77 = mu_dot2 - t74;
@@ -763,29 +763,29 @@ int planar_3r_velocity_ik(const planar_3r_real q[PLANAR_3R_DOF], const planar_3r
     const planar_3r_real t85 = t81*(t69*t77 + t76*t80);
     const planar_3r_real t86 = t76 - t80*t85;
     const planar_3r_real t87 = t77 - t69*t85;
-    const planar_3r_real t88 = 3 + damping + mu_dot0 + mu_dot1 + mu_dot2 + q1 + q2 + q3 + t16 + t64 - s123 - t1;
+    const planar_3r_real t88 = 3 + t64 + t16 + damping + mu_dot0 + mu_dot1 + mu_dot2 + q1 + q2 + q3 - t1 - s123;
     const planar_3r_real t89 = fabs(t84);
     const planar_3r_real t90 = t89;
     const planar_3r_real t91 = t90*(t84 >= 0 ? 1 : -1);
-    const planar_3r_real t92 = t84 + t91;
-    const planar_3r_real t93 = (t90 > 0 ? 1/(t90*(t89 + t90)) : 0);
-    const planar_3r_real t94 = t87 - t87*t93*(t92*t92);
+    const planar_3r_real t92 = t91 + t84;
+    const planar_3r_real t93 = (t90 > 0 ? 1/(t90*(t90 + t89)) : 0);
+    const planar_3r_real t94 = t87 - t93*t87*(t92*t92);
     const planar_3r_real t95 = (t91 != 0 ? -t94/t91 : 0);
-    const planar_3r_real t96 = (t79 != 0 ? -(t86 - t83*t95)/t79 : 0);
-    const planar_3r_real t97 = (t11 != 0 ? -(t75 + t67*t96 + t71*t95)/t11 : 0);
+    const planar_3r_real t96 = (t79 != 0 ? -(t86 - t95*t83)/t79 : 0);
+    const planar_3r_real t97 = (t11 != 0 ? -(t75 + t95*t71 + t96*t67)/t11 : 0);
     const int t98 = damping > 0;
     const int t99 = isfinite(t88);
     const int t100 = damping >= 0;
     const planar_3r_real t101 = 1e-12*t15;
     const planar_3r_real t102 = 1e-12*t44;
-    const int t103 = (t98 && ((t23 <= t102) || (t36 <= t102) || (t53 <= t102))) || (damping <= 0 && ((t10 <= t101) || (t78 <= t101) || (t90 <= t101)));
-    const int t104 = t100 && t99 && !t103;
+    const int t103 = (t98 && ((t23 <= t102) || (t36 <= t102) || (t53 <= t102))) || (damping <= 0 && ((t90 <= t101) || (t10 <= t101) || (t78 <= t101)));
+    const int t104 = t99 && t100 && !t103;
 
     /* Outputs */
     q_dot[0] = (t104 ? (t98 ? t61 : t97) : 0);
     q_dot[1] = (t104 ? (t98 ? t62 : t96) : 0);
     q_dot[2] = (t104 ? (t98 ? t63 : t95) : 0);
-    return (!(t100 && t99) ? 2 : (t103 ? 1 : 0));
+    return (!(t99 && t100) ? 2 : (t103 ? 1 : 0));
 }
 
 planar_3r_real planar_3r_ik_numeric_step(const planar_3r_real target[PLANAR_3R_TASK_DIM], const planar_3r_real q[PLANAR_3R_DOF], planar_3r_real damping, planar_3r_real q_start[PLANAR_3R_DOF], planar_3r_real q_next[PLANAR_3R_DOF])
@@ -816,30 +816,30 @@ planar_3r_real planar_3r_ik_numeric_step(const planar_3r_real target[PLANAR_3R_T
     const planar_3r_real s123 = c12*s3 + c3*s12;
     const planar_3r_real t0 = c12 + c123;
     const planar_3r_real t1 = s12 + s123;
-    const planar_3r_real t2 = c1 + t0;
-    const planar_3r_real t3 = s1 + t1;
-    const planar_3r_real t4 = (s123*s123) + (t1*t1) + (t3*t3);
-    const planar_3r_real t5 = c123*s123 + t0*t1 + t2*t3;
-    const planar_3r_real t6 = s123 + t1 + t3;
-    const planar_3r_real t7 = (c123*c123) + (t0*t0) + (t2*t2);
-    const planar_3r_real t8 = c123 + t0 + t2;
+    const planar_3r_real t2 = t0 + c1;
+    const planar_3r_real t3 = t1 + s1;
+    const planar_3r_real t4 = (t1*t1) + (t3*t3) + (s123*s123);
+    const planar_3r_real t5 = t0*t1 + t2*t3 + c123*s123;
+    const planar_3r_real t6 = t1 + t3 + s123;
+    const planar_3r_real t7 = (t0*t0) + (t2*t2) + (c123*c123);
+    const planar_3r_real t8 = t0 + t2 + c123;
     const planar_3r_real t9 = mu0 - t2;
     const planar_3r_real t10 = mu1 - t3;
     const planar_3r_real t11 = mu0 + mu1 + mu2 + qs1 + qs2 + qs3;
     const planar_3r_real t12 = -mu2 + atan2(s123, c123);
-    const planar_3r_real t13 = t12 + 6.283185307179586*ceil(-0.5 - 0.15915494309189535*t12);
-    const planar_3r_real t14 = (t10*t10) + (t13*t13) + (t9*t9);
-    const planar_3r_real t15 = damping + t4;
-    const planar_3r_real t16 = sqrt((t15*t15) + (t5*t5) + (t6*t6));
+    const planar_3r_real t13 = t12 + 6.283185307179586*ceil(-0.15915494309189535*(3.141592653589793 + t12));
+    const planar_3r_real t14 = (t9*t9) + (t10*t10) + (t13*t13);
+    const planar_3r_real t15 = t4 + damping;
+    const planar_3r_real t16 = sqrt((t5*t5) + (t6*t6) + (t15*t15));
     const planar_3r_real t17 = t16*(t15 >= 0 ? 1 : -1);
-    const planar_3r_real t18 = t15 + t17;
+    const planar_3r_real t18 = t17 + t15;
     const planar_3r_real t19 = (t16 > 0 ? 1/(t16*(t16 + fabs(t15))) : 0);
-    const planar_3r_real t20 = t19*(t13*t6 + t18*t9 - t10*t5);
+    const planar_3r_real t20 = t19*(t9*t18 + t13*t6 - t10*t5);
     const planar_3r_real t21 = t9 - t18*t20;
     const planar_3r_real t22 = t10 + t20*t5;
     const planar_3r_real t23 = -t13 + t20*t6;
-    const planar_3r_real t24 = damping + t7;
-    const planar_3r_real t25 = -t19*(t18*t5 + t24*t5 + t6*t8);
+    const planar_3r_real t24 = t7 + damping;
+    const planar_3r_real t25 = -t19*(t18*t5 + t5*t24 + t6*t8);
     const planar_3r_real t26 = t5 + t18*t25;
     const planar_3r_real t27 = t24 + t25*t5;
     const planar_3r_real t28 = t8 + t25*t6;
@@ -847,29 +847,29 @@ planar_3r_real planar_3r_ik_numeric_step(const planar_3r_real target[PLANAR_3R_T
     const planar_3r_real t30 = t29*(t27 >= 0 ? 1 : -1);
     const planar_3r_real t31 = t27 + t30;
     const planar_3r_real t32 = (t29 > 0 ? 1/(t29*(t29 + fabs(t27))) : 0);
-    const planar_3r_real t33 = t32*(t22*t31 + t23*t28);
+    const planar_3r_real t33 = t32*(t28*t23 + t22*t31);
     const planar_3r_real t34 = t22 - t31*t33;
     const planar_3r_real t35 = t23 - t28*t33;
     const planar_3r_real t36 = 3 + damping;
-    const planar_3r_real t37 = -t19*(t18*t6 + t36*t6 + t5*t8);
+    const planar_3r_real t37 = -t19*(t18*t6 + t5*t8 + t6*t36);
     const planar_3r_real t38 = t6 + t18*t37;
     const planar_3r_real t39 = t8 + t37*t5;
     const planar_3r_real t40 = t36 + t37*t6;
-    const planar_3r_real t41 = t32*(t28*t40 + t31*t39);
+    const planar_3r_real t41 = t32*(t28*t40 + t39*t31);
     const planar_3r_real t42 = t39 - t31*t41;
     const planar_3r_real t43 = t40 - t28*t41;
     const planar_3r_real t44 = fabs(t43);
     const planar_3r_real t45 = t44;
     const planar_3r_real t46 = t45*(t43 >= 0 ? 1 : -1);
     const planar_3r_real t47 = t43 + t46;
-    const planar_3r_real t48 = (t45 > 0 ? 1/(t45*(t44 + t45)) : 0);
+    const planar_3r_real t48 = (t45 > 0 ? 1/(t45*(t45 + t44)) : 0);
     const planar_3r_real t49 = t35 - t35*t48*(t47*t47);
     const planar_3r_real t50 = (t46 != 0 ? -t49/t46 : 0);
     const planar_3r_real t51 = (t30 != 0 ? -(t34 - t42*t50)/t30 : 0);
     const planar_3r_real t52 = (t17 != 0 ? -(t21 + t26*t51 + t38*t50)/t17 : 0);
-    const planar_3r_real t53 = q1 + t50 + t2*t51 - t3*t52;
-    const planar_3r_real t54 = q2 + t50 + t0*t51 - t1*t52;
-    const planar_3r_real t55 = q3 + t50 + c123*t51 - s123*t52;
+    const planar_3r_real t53 = t50 + q1 + t51*t2 - t52*t3;
+    const planar_3r_real t54 = t50 + q2 + t0*t51 - t52*t1;
+    const planar_3r_real t55 = t50 + q3 + t51*c123 - t52*s123;
 
     /* Outputs */
     q_start[0] = q1;
@@ -883,7 +883,7 @@ planar_3r_real planar_3r_ik_numeric_step(const planar_3r_real target[PLANAR_3R_T
 
 void planar_3r_ik_branches(const planar_3r_real mu[PLANAR_3R_TASK_DIM], planar_3r_real q[PLANAR_3R_MAX_IK_SOLUTIONS * PLANAR_3R_DOF], int valid[PLANAR_3R_MAX_IK_SOLUTIONS], int in_limits[PLANAR_3R_MAX_IK_SOLUTIONS])
 {
-    /* 100 operations */
+    /* 94 operations */
 
     /* Inputs */
     const planar_3r_real mu0 = mu[0];
@@ -896,7 +896,7 @@ void planar_3r_ik_branches(const planar_3r_real mu[PLANAR_3R_TASK_DIM], planar_3
     const planar_3r_real t2 = mu0 - t0;
     const planar_3r_real t3 = mu1 - t1;
     const planar_3r_real t4 = (t2*t2) + (t3*t3);
-    const planar_3r_real t5 = 1.0 - 0.5*t4;
+    const planar_3r_real t5 = 0.5*(2 - t4);
     const planar_3r_real t6 = mu0 + mu1 + mu2;
     const planar_3r_real t7 = (t5*t5);
     const planar_3r_real t8 = 1 - t7;
@@ -910,13 +910,13 @@ void planar_3r_ik_branches(const planar_3r_real mu[PLANAR_3R_TASK_DIM], planar_3
     const planar_3r_real t16 = -t10;
     const planar_3r_real t17 = t16;
     const planar_3r_real t18 = 1 + t17;
-    const planar_3r_real t19 = t15*t3 + t18*t2;
-    const planar_3r_real t20 = t18*t3 - t15*t2;
+    const planar_3r_real t19 = t2*t18 + t3*t15;
+    const planar_3r_real t20 = t3*t18 - t2*t15;
     const planar_3r_real t21 = (t19*t19) + (t20*t20);
     const planar_3r_real t22 = (t15*t15) + (t18*t18);
     const planar_3r_real t23 = 1 + t16;
-    const planar_3r_real t24 = t11*t3 + t2*t23;
-    const planar_3r_real t25 = t23*t3 - t11*t2;
+    const planar_3r_real t24 = t2*t23 + t3*t11;
+    const planar_3r_real t25 = t3*t23 - t2*t11;
     const planar_3r_real t26 = (t24*t24) + (t25*t25);
     const planar_3r_real t27 = (t11*t11) + (t23*t23);
     const planar_3r_real t28 = 1e-24*t4;
@@ -930,12 +930,12 @@ void planar_3r_ik_branches(const planar_3r_real mu[PLANAR_3R_TASK_DIM], planar_3
 
     /* Outputs */
     q[0] = t29;
-    q[1] = t14 - 6.283185307179586*ceil(-0.5 + 0.15915494309189535*t14);
-    q[2] = -t30 - t32 - 6.283185307179586*ceil(-0.15915494309189535*t31 - 0.15915494309189535*t32);
+    q[1] = t14 - 6.283185307179586*ceil(0.15915494309189535*(-3.141592653589793 + t14));
+    q[2] = -(t30 + t32 + 6.283185307179586*ceil(-0.15915494309189535*(t31 + t32)));
     q[3] = t33;
-    q[4] = t13 - 6.283185307179586*ceil(-0.5 + 0.15915494309189535*t13);
-    q[5] = -t30 - t34 - 6.283185307179586*ceil(-0.15915494309189535*t31 - 0.15915494309189535*t34);
-    valid[0] = t35 && t8 >= -1e-12;
+    q[4] = t13 - 6.283185307179586*ceil(0.15915494309189535*(-3.141592653589793 + t13));
+    q[5] = -(t34 + t30 + 6.283185307179586*ceil(-0.15915494309189535*(t34 + t31)));
+    valid[0] = t35 && ((t8 >= -1e-12) || (0 && t7 <= 1e-12));
     valid[1] = t35 && t8 > 1e-12;
     in_limits[0] = 1;
     in_limits[1] = 1;
@@ -984,15 +984,15 @@ int planar_3r_ik_nearest(const planar_3r_real mu[PLANAR_3R_TASK_DIM], const plan
     const planar_3r_real t10 = -qn1;
     const planar_3r_real t11 = -qn2;
     const planar_3r_real t12 = -qn3;
-    const planar_3r_real t13 = qw1*((t0 + t10)*(t0 + t10)) + qw2*((t1 + t11)*(t1 + t11)) + qw3*((t12 + t2)*(t12 + t2));
-    const planar_3r_real t14 = qw1*((t10 + t5)*(t10 + t5)) + qw2*((t11 + t6)*(t11 + t6)) + qw3*((t12 + t7)*(t12 + t7));
+    const planar_3r_real t13 = qw1*((t0 + t10)*(t0 + t10)) + qw2*((t1 + t11)*(t1 + t11)) + qw3*((t2 + t12)*(t2 + t12));
+    const planar_3r_real t14 = qw1*((t5 + t10)*(t5 + t10)) + qw2*((t6 + t11)*(t6 + t11)) + qw3*((t7 + t12)*(t7 + t12));
     const int t15 = t4 > 0;
     const planar_3r_real t16 = (t15 ? t0 : qn1);
     const planar_3r_real t17 = (t15 ? t1 : qn2);
     const planar_3r_real t18 = (t15 ? t2 : qn3);
     const planar_3r_real t19 = (t15 ? t13 : 0);
     const int t20 = t8 > 0;
-    const planar_3r_real t21 = (t20 && ((t14 < t19) || (t4 < 1)) ? 1 : 0);
+    const planar_3r_real t21 = (t20 && ((t19 > t14) || (t4 < 1)) ? 1 : 0);
     const planar_3r_real t22 = (t20 ? 1 : t4);
     const int t23 = t21 > 0;
     const planar_3r_real t24 = (t23 ? t5 : t16);

@@ -85,8 +85,8 @@ def fk(q):
     s123 = c12*s3 + c3*s12
     t0 = c12 + c123
     t1 = s12 + s123
-    t2 = c1 + t0
-    t3 = s1 + t1
+    t2 = t0 + c1
+    t3 = t1 + s1
     T = _stack(xp, [
         c123,  # 0, 0
         -s123,  # 0, 1
@@ -124,8 +124,8 @@ def jacobian(q):
     s123 = c12*s3 + c3*s12
     t0 = c12 + c123
     t1 = s12 + s123
-    t2 = c1 + t0
-    t3 = s1 + t1
+    t2 = t0 + c1
+    t3 = t1 + s1
     J = _stack(xp, [
         -t3,  # 0, 0
         -t1,  # 0, 1
@@ -165,8 +165,8 @@ def fk_jacobian(q):
     s123 = c12*s3 + c3*s12
     t0 = c12 + c123
     t1 = s12 + s123
-    t2 = c1 + t0
-    t3 = s1 + t1
+    t2 = t0 + c1
+    t3 = t1 + s1
     t4 = -s123
     T = _stack(xp, [
         c123,  # 0, 0
@@ -225,14 +225,14 @@ def jacobian_tool(q):
     s123 = c12*s3 + c3*s12
     t0 = c12 + c123
     t1 = s12 + s123
-    t2 = c1 + t0
-    t3 = s1 + t1
+    t2 = t0 + c1
+    t3 = t1 + s1
     J = _stack(xp, [
-        s123*t2 - c123*t3,  # 0, 0
-        s123*t0 - c123*t1,  # 0, 1
+        t2*s123 - t3*c123,  # 0, 0
+        t0*s123 - t1*c123,  # 0, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 2
-        c123*t2 + s123*t3,  # 1, 0
-        c123*t0 + s123*t1,  # 1, 1
+        t2*c123 + t3*s123,  # 1, 0
+        t0*c123 + t1*s123,  # 1, 1
         c123**2 + s123**2,  # 1, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 1
@@ -266,8 +266,8 @@ def task(q):
     s123 = c12*s3 + c3*s12
     t0 = c12 + c123
     t1 = s12 + s123
-    t2 = c1 + t0
-    t3 = s1 + t1
+    t2 = t0 + c1
+    t3 = t1 + s1
     mu = _stack(xp, [
         t2,  # 0
         t3,  # 1
@@ -292,8 +292,8 @@ def task_jacobian(q):
     s123 = c12*s3 + c3*s12
     t0 = c12 + c123
     t1 = s12 + s123
-    t2 = c1 + t0
-    t3 = s1 + t1
+    t2 = t0 + c1
+    t3 = t1 + s1
     J = _stack(xp, [
         -t3,  # 0, 0
         -t1,  # 0, 1
@@ -327,15 +327,15 @@ def fk_jacobian_dot(q, q_dot):
     s123 = c12*s3 + c3*s12
     t0 = c12 + c123
     t1 = s12 + s123
-    t2 = c1 + t0
-    t3 = s1 + t1
+    t2 = t0 + c1
+    t3 = t1 + s1
     t4 = qd1 + qd2
     t5 = qd3*s123
-    t6 = t5 + qd2*t1
-    t7 = t6 + qd1*t3
+    t6 = t5 + t1*qd2
+    t7 = t6 + t3*qd1
     t8 = c123*qd3
-    t9 = t8 + qd2*t0
-    t10 = t9 + qd1*t2
+    t9 = t8 + t0*qd2
+    t10 = t9 + t2*qd1
     t11 = -s123
     T = _stack(xp, [
         xp.broadcast_to(c123, batch),  # 0, 0
@@ -376,8 +376,8 @@ def fk_jacobian_dot(q, q_dot):
         xp.full(batch, 1, dtype=dtype, device=device),  # 5, 2
     ], (6, 3))
     a = _stack(xp, [
-        xp.broadcast_to(-qd1*t10 - qd2*(t9 + qd1*t0) - qd3*(t8 + c123*t4), batch),  # 0
-        xp.broadcast_to(-qd1*t7 - qd2*(t6 + qd1*t1) - qd3*(t5 + s123*t4), batch),  # 1
+        xp.broadcast_to(-t10*qd1 - qd2*(t9 + t0*qd1) - qd3*(t8 + t4*c123), batch),  # 0
+        xp.broadcast_to(-t7*qd1 - qd2*(t6 + t1*qd1) - qd3*(t5 + t4*s123), batch),  # 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 4
@@ -387,7 +387,7 @@ def fk_jacobian_dot(q, q_dot):
 
 
 def jacobian_dot(q, q_dot):
-    """time derivative dJ/dt of the world geometric Jacobian along q_dot (6 x DOF): (6 x 3), 47 operations."""
+    """time derivative dJ/dt of the world geometric Jacobian along q_dot (6 x DOF): (6 x 3), 43 operations."""
     xp, dtype, device, batch, (q, q_dot,) = _arguments(("q", q, (3,)), ("q_dot", q_dot, (3,)))
     qd1 = q_dot[..., 0]
     qd2 = q_dot[..., 1]
@@ -405,22 +405,22 @@ def jacobian_dot(q, q_dot):
     s123 = c12*s3 + c3*s12
     t0 = c12 + c123
     t1 = s12 + s123
-    t2 = c1 + t0
-    t3 = s1 + t1
+    t2 = t0 + c1
+    t3 = t1 + s1
     t4 = qd1 + qd2
     t5 = qd3*s123
-    t6 = t5 + qd2*t1
-    t7 = t6 + qd1*t3
+    t6 = t5 + t1*qd2
+    t7 = t6 + t3*qd1
     t8 = c123*qd3
-    t9 = t8 + qd2*t0
-    t10 = t9 + qd1*t2
+    t9 = t8 + t0*qd2
+    t10 = t9 + t2*qd1
     Jd = _stack(xp, [
         xp.broadcast_to(-t10, batch),  # 0, 0
-        xp.broadcast_to(-t9 - qd1*t0, batch),  # 0, 1
-        xp.broadcast_to(-t8 - c123*t4, batch),  # 0, 2
+        xp.broadcast_to(-(t9 + t0*qd1), batch),  # 0, 1
+        xp.broadcast_to(-(t8 + t4*c123), batch),  # 0, 2
         xp.broadcast_to(-t7, batch),  # 1, 0
-        xp.broadcast_to(-t6 - qd1*t1, batch),  # 1, 1
-        xp.broadcast_to(-t5 - s123*t4, batch),  # 1, 2
+        xp.broadcast_to(-(t6 + t1*qd1), batch),  # 1, 1
+        xp.broadcast_to(-(t5 + t4*s123), batch),  # 1, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 2
@@ -456,18 +456,18 @@ def bias_acceleration(q, q_dot):
     s123 = c12*s3 + c3*s12
     t0 = c12 + c123
     t1 = s12 + s123
-    t2 = c1 + t0
-    t3 = s1 + t1
+    t2 = t0 + c1
+    t3 = t1 + s1
     t4 = qd1 + qd2
     t5 = qd3*s123
-    t6 = t5 + qd2*t1
-    t7 = t6 + qd1*t3
+    t6 = t5 + t1*qd2
+    t7 = t6 + t3*qd1
     t8 = c123*qd3
-    t9 = t8 + qd2*t0
-    t10 = t9 + qd1*t2
+    t9 = t8 + t0*qd2
+    t10 = t9 + t2*qd1
     a = _stack(xp, [
-        xp.broadcast_to(-qd1*t10 - qd2*(t9 + qd1*t0) - qd3*(t8 + c123*t4), batch),  # 0
-        xp.broadcast_to(-qd1*t7 - qd2*(t6 + qd1*t1) - qd3*(t5 + s123*t4), batch),  # 1
+        xp.broadcast_to(-t10*qd1 - qd2*(t9 + t0*qd1) - qd3*(t8 + t4*c123), batch),  # 0
+        xp.broadcast_to(-t7*qd1 - qd2*(t6 + t1*qd1) - qd3*(t5 + t4*s123), batch),  # 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 4
@@ -495,19 +495,19 @@ def task_jacobian_dot(q, q_dot):
     s123 = c12*s3 + c3*s12
     t0 = c12 + c123
     t1 = s12 + s123
-    t2 = c1 + t0
-    t3 = s1 + t1
+    t2 = t0 + c1
+    t3 = t1 + s1
     t4 = qd1 + qd2
     t5 = qd3*s123
-    t6 = t5 + qd2*t1
-    t7 = t6 + qd1*t3
-    t8 = t6 + qd1*t1
-    t9 = t5 + s123*t4
+    t6 = t5 + t1*qd2
+    t7 = t6 + t3*qd1
+    t8 = t6 + t1*qd1
+    t9 = t5 + t4*s123
     t10 = c123*qd3
-    t11 = t10 + qd2*t0
-    t12 = t11 + qd1*t2
-    t13 = t11 + qd1*t0
-    t14 = t10 + c123*t4
+    t11 = t10 + t0*qd2
+    t12 = t11 + t2*qd1
+    t13 = t11 + t0*qd1
+    t14 = t10 + t4*c123
     Jd = _stack(xp, [
         xp.broadcast_to(-t12, batch),  # 0, 0
         xp.broadcast_to(-t13, batch),  # 0, 1
@@ -538,8 +538,8 @@ def hessian(q):
     s123 = c12*s3 + c3*s12
     t0 = c12 + c123
     t1 = s12 + s123
-    t2 = c1 + t0
-    t3 = s1 + t1
+    t2 = t0 + c1
+    t3 = t1 + s1
     t4 = -t0
     t5 = -c123
     t6 = -t1
@@ -674,79 +674,79 @@ def velocity_ik(q, mu_dot, damping=0.0):
     s123 = c12*s3 + c3*s12
     t0 = c12 + c123
     t1 = s12 + s123
-    t2 = c1 + t0
-    t3 = s1 + t1
-    t4 = c123*s123 + t0*t1 + t2*t3
-    t5 = s123 + t1 + t3
+    t2 = t0 + c1
+    t3 = t1 + s1
+    t4 = t0*t1 + t2*t3 + c123*s123
+    t5 = t1 + t3 + s123
     t6 = t3**2
-    t7 = t6 + s123**2 + t1**2
+    t7 = t6 + t1**2 + s123**2
     t8 = t7
     t9 = t2**2
     t10 = xp.sqrt(1 + t6 + t9)
     t11 = t10*xp.where(xp.less_equal(t3, 0), xp.asarray(1, dtype=dtype), -1)
     t12 = xp.where(xp.greater(t10, 0), 1/(t10*(t10 + xp.abs(t3))), 0)
-    t13 = t9 + c123**2 + t0**2
+    t13 = t9 + t0**2 + c123**2
     t14 = t13
-    t15 = xp.sqrt(3 + t13 + t7)
-    t16 = c123 + t0 + t2
+    t15 = xp.sqrt(3 + t7 + t13)
+    t16 = t0 + t2 + c123
     t17 = t16
     t18 = t4**2
     t19 = t5**2
     t20 = damping**2
-    t21 = t20 + t8
+    t21 = t8 + t20
     t22 = t21**2
     t23 = xp.sqrt(t18 + t19 + t22)
     t24 = t23*xp.where(xp.greater_equal(t21, 0), xp.asarray(1, dtype=dtype), -1)
-    t25 = t21 + t24
+    t25 = t24 + t21
     t26 = xp.where(xp.greater(t23, 0), 1/(t23*(t23 + xp.abs(t21))), 0)
-    t27 = -t26*(mu_dot1*t4 + mu_dot2*t5 - mu_dot0*t25)
+    t27 = -t26*(t4*mu_dot1 + t5*mu_dot2 - t25*mu_dot0)
     t28 = mu_dot0 - t25*t27
-    t29 = mu_dot1 + t27*t4
-    t30 = mu_dot2 + t27*t5
+    t29 = mu_dot1 + t4*t27
+    t30 = mu_dot2 + t5*t27
     t31 = t14 + t20
-    t32 = -t26*(t17*t5 + t25*t4 + t31*t4)
+    t32 = -t26*(t4*t25 + t4*t31 + t5*t17)
     t33 = t4 + t25*t32
-    t34 = t31 + t32*t4
-    t35 = t17 + t32*t5
+    t34 = t31 + t4*t32
+    t35 = t17 + t5*t32
     t36 = xp.sqrt(t34**2 + t35**2)
     t37 = t36*xp.where(xp.greater_equal(t34, 0), xp.asarray(1, dtype=dtype), -1)
     t38 = t34 + t37
     t39 = xp.where(xp.greater(t36, 0), 1/(t36*(t36 + xp.abs(t34))), 0)
-    t40 = t39*(t29*t38 + t30*t35)
+    t40 = t39*(t35*t30 + t29*t38)
     t41 = t29 - t38*t40
     t42 = t30 - t35*t40
     t43 = 3 + t20
     t44 = xp.sqrt(t22 + t31**2 + t43**2 + 2*t18 + 2*t19 + 2*t17**2)
-    t45 = -t26*(t17*t4 + t25*t5 + t43*t5)
+    t45 = -t26*(t4*t17 + t5*t25 + t5*t43)
     t46 = t5 + t25*t45
     t47 = t17 + t4*t45
-    t48 = t43 + t45*t5
-    t49 = t39*(t35*t48 + t38*t47)
+    t48 = t43 + t5*t45
+    t49 = t39*(t35*t48 + t47*t38)
     t50 = t47 - t38*t49
     t51 = t48 - t35*t49
     t52 = xp.abs(t51)
     t53 = t52
     t54 = t53*xp.where(xp.greater_equal(t51, 0), xp.asarray(1, dtype=dtype), -1)
     t55 = t51 + t54
-    t56 = xp.where(xp.greater(t53, 0), 1/(t53*(t52 + t53)), 0)
+    t56 = xp.where(xp.greater(t53, 0), 1/(t53*(t53 + t52)), 0)
     t57 = t42 - t42*t56*t55**2
     t58 = xp.where(xp.not_equal(t54, 0), -t57/t54, 0)
     t59 = xp.where(xp.not_equal(t37, 0), -(t41 - t50*t58)/t37, 0)
     t60 = xp.where(xp.not_equal(t24, 0), -(t28 + t33*t59 + t46*t58)/t24, 0)
     t61 = t58 + t2*t59 - t3*t60
     t62 = t58 + t0*t59 - t1*t60
-    t63 = t58 + c123*t59 - s123*t60
+    t63 = t58 + t59*c123 - t60*s123
     t64 = -t3
     t65 = t11 + t64
     t66 = t12*(1 + t0*t2 - t1*t65)
     t67 = t1 + t65*t66
     t68 = t0 - t2*t66
     t69 = 1 - t66
-    t70 = t12*(1 + c123*t2 - s123*t65)
+    t70 = t12*(1 + t2*c123 - t65*s123)
     t71 = s123 + t65*t70
     t72 = c123 - t2*t70
     t73 = 1 - t70
-    t74 = t12*(mu_dot2 + mu_dot0*t65 + mu_dot1*t2)
+    t74 = t12*(mu_dot2 + t2*mu_dot1 + t65*mu_dot0)
     t75 = mu_dot0 - t65*t74
     t76 = mu_dot1 - t2*t74
     t77 = mu_dot2 - t74
@@ -760,29 +760,29 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t85 = t81*(t69*t77 + t76*t80)
     t86 = t76 - t80*t85
     t87 = t77 - t69*t85
-    t88 = 3 + damping + mu_dot0 + mu_dot1 + mu_dot2 + q1 + q2 + q3 + t16 + t64 - s123 - t1
+    t88 = 3 + t64 + t16 + damping + mu_dot0 + mu_dot1 + mu_dot2 + q1 + q2 + q3 - t1 - s123
     t89 = xp.abs(t84)
     t90 = t89
     t91 = t90*xp.where(xp.greater_equal(t84, 0), xp.asarray(1, dtype=dtype), -1)
-    t92 = t84 + t91
-    t93 = xp.where(xp.greater(t90, 0), 1/(t90*(t89 + t90)), 0)
-    t94 = t87 - t87*t93*t92**2
+    t92 = t91 + t84
+    t93 = xp.where(xp.greater(t90, 0), 1/(t90*(t90 + t89)), 0)
+    t94 = t87 - t93*t87*t92**2
     t95 = xp.where(xp.not_equal(t91, 0), -t94/t91, 0)
-    t96 = xp.where(xp.not_equal(t79, 0), -(t86 - t83*t95)/t79, 0)
-    t97 = xp.where(xp.not_equal(t11, 0), -(t75 + t67*t96 + t71*t95)/t11, 0)
+    t96 = xp.where(xp.not_equal(t79, 0), -(t86 - t95*t83)/t79, 0)
+    t97 = xp.where(xp.not_equal(t11, 0), -(t75 + t95*t71 + t96*t67)/t11, 0)
     t98 = xp.greater(damping, 0)
     t99 = xp.isfinite(t88)
     t100 = xp.greater_equal(damping, 0)
     t101 = 1e-12*t15
     t102 = 1e-12*t44
-    t103 = (t98 & ((xp.less_equal(t23, t102)) | (xp.less_equal(t36, t102)) | (xp.less_equal(t53, t102)))) | ((xp.less_equal(damping, 0)) & ((xp.less_equal(t10, t101)) | (xp.less_equal(t78, t101)) | (xp.less_equal(t90, t101))))
-    t104 = t100 & t99 & xp.logical_not(t103)
+    t103 = (t98 & (xp.less_equal(t23, t102) | xp.less_equal(t36, t102) | xp.less_equal(t53, t102))) | (xp.less_equal(damping, 0) & (xp.less_equal(t90, t101) | xp.less_equal(t10, t101) | xp.less_equal(t78, t101)))
+    t104 = t99 & t100 & xp.logical_not(t103)
     q_dot = _stack(xp, [
         xp.broadcast_to(xp.where(t104, xp.where(t98, t61, t97), 0), batch),  # 0
         xp.broadcast_to(xp.where(t104, xp.where(t98, t62, t96), 0), batch),  # 1
         xp.broadcast_to(xp.where(t104, xp.where(t98, t63, t95), 0), batch),  # 2
     ], (3,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t100 & t99), 2, xp.where(t103, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t99 & t100), 2, xp.where(t103, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
     return q_dot, status
 
 
@@ -811,30 +811,30 @@ def ik_numeric_step(target, q, damping=0.0):
     s123 = c12*s3 + c3*s12
     t0 = c12 + c123
     t1 = s12 + s123
-    t2 = c1 + t0
-    t3 = s1 + t1
-    t4 = s123**2 + t1**2 + t3**2
-    t5 = c123*s123 + t0*t1 + t2*t3
-    t6 = s123 + t1 + t3
-    t7 = c123**2 + t0**2 + t2**2
-    t8 = c123 + t0 + t2
+    t2 = t0 + c1
+    t3 = t1 + s1
+    t4 = t1**2 + t3**2 + s123**2
+    t5 = t0*t1 + t2*t3 + c123*s123
+    t6 = t1 + t3 + s123
+    t7 = t0**2 + t2**2 + c123**2
+    t8 = t0 + t2 + c123
     t9 = mu0 - t2
     t10 = mu1 - t3
     t11 = mu0 + mu1 + mu2 + qs1 + qs2 + qs3
     t12 = -mu2 + xp.atan2(s123, c123)
-    t13 = t12 + 6.283185307179586*xp.ceil(-0.5 - 0.15915494309189535*t12)
-    t14 = t10**2 + t13**2 + t9**2
-    t15 = damping + t4
-    t16 = xp.sqrt(t15**2 + t5**2 + t6**2)
+    t13 = t12 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t12))
+    t14 = t9**2 + t10**2 + t13**2
+    t15 = t4 + damping
+    t16 = xp.sqrt(t5**2 + t6**2 + t15**2)
     t17 = t16*xp.where(xp.greater_equal(t15, 0), xp.asarray(1, dtype=dtype), -1)
-    t18 = t15 + t17
+    t18 = t17 + t15
     t19 = xp.where(xp.greater(t16, 0), 1/(t16*(t16 + xp.abs(t15))), 0)
-    t20 = t19*(t13*t6 + t18*t9 - t10*t5)
+    t20 = t19*(t9*t18 + t13*t6 - t10*t5)
     t21 = t9 - t18*t20
     t22 = t10 + t20*t5
     t23 = -t13 + t20*t6
-    t24 = damping + t7
-    t25 = -t19*(t18*t5 + t24*t5 + t6*t8)
+    t24 = t7 + damping
+    t25 = -t19*(t18*t5 + t5*t24 + t6*t8)
     t26 = t5 + t18*t25
     t27 = t24 + t25*t5
     t28 = t8 + t25*t6
@@ -842,29 +842,29 @@ def ik_numeric_step(target, q, damping=0.0):
     t30 = t29*xp.where(xp.greater_equal(t27, 0), xp.asarray(1, dtype=dtype), -1)
     t31 = t27 + t30
     t32 = xp.where(xp.greater(t29, 0), 1/(t29*(t29 + xp.abs(t27))), 0)
-    t33 = t32*(t22*t31 + t23*t28)
+    t33 = t32*(t28*t23 + t22*t31)
     t34 = t22 - t31*t33
     t35 = t23 - t28*t33
     t36 = 3 + damping
-    t37 = -t19*(t18*t6 + t36*t6 + t5*t8)
+    t37 = -t19*(t18*t6 + t5*t8 + t6*t36)
     t38 = t6 + t18*t37
     t39 = t8 + t37*t5
     t40 = t36 + t37*t6
-    t41 = t32*(t28*t40 + t31*t39)
+    t41 = t32*(t28*t40 + t39*t31)
     t42 = t39 - t31*t41
     t43 = t40 - t28*t41
     t44 = xp.abs(t43)
     t45 = t44
     t46 = t45*xp.where(xp.greater_equal(t43, 0), xp.asarray(1, dtype=dtype), -1)
     t47 = t43 + t46
-    t48 = xp.where(xp.greater(t45, 0), 1/(t45*(t44 + t45)), 0)
+    t48 = xp.where(xp.greater(t45, 0), 1/(t45*(t45 + t44)), 0)
     t49 = t35 - t35*t48*t47**2
     t50 = xp.where(xp.not_equal(t46, 0), -t49/t46, 0)
     t51 = xp.where(xp.not_equal(t30, 0), -(t34 - t42*t50)/t30, 0)
     t52 = xp.where(xp.not_equal(t17, 0), -(t21 + t26*t51 + t38*t50)/t17, 0)
-    t53 = q1 + t50 + t2*t51 - t3*t52
-    t54 = q2 + t50 + t0*t51 - t1*t52
-    t55 = q3 + t50 + c123*t51 - s123*t52
+    t53 = t50 + q1 + t51*t2 - t52*t3
+    t54 = t50 + q2 + t0*t51 - t52*t1
+    t55 = t50 + q3 + t51*c123 - t52*s123
     q_start = _stack(xp, [
         xp.broadcast_to(q1, batch),  # 0
         xp.broadcast_to(q2, batch),  # 1
@@ -881,7 +881,7 @@ def ik_numeric_step(target, q, damping=0.0):
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def ik_branches(mu):
-    """every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits: (2 x 3 and 2 x 1 and 2 x 1), 100 operations."""
+    """every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits: (2 x 3 and 2 x 1 and 2 x 1), 94 operations."""
     xp, dtype, device, batch, (mu,) = _arguments(("mu", mu, (3,)))
     mu0 = mu[..., 0]
     mu1 = mu[..., 1]
@@ -891,7 +891,7 @@ def ik_branches(mu):
     t2 = mu0 - t0
     t3 = mu1 - t1
     t4 = t2**2 + t3**2
-    t5 = 1.0 - 0.5*t4
+    t5 = 0.5*(2 - t4)
     t6 = mu0 + mu1 + mu2
     t7 = t5**2
     t8 = 1 - t7
@@ -905,13 +905,13 @@ def ik_branches(mu):
     t16 = -t10
     t17 = t16
     t18 = 1 + t17
-    t19 = t15*t3 + t18*t2
-    t20 = t18*t3 - t15*t2
+    t19 = t2*t18 + t3*t15
+    t20 = t3*t18 - t2*t15
     t21 = t19**2 + t20**2
     t22 = t15**2 + t18**2
     t23 = 1 + t16
-    t24 = t11*t3 + t2*t23
-    t25 = t23*t3 - t11*t2
+    t24 = t2*t23 + t3*t11
+    t25 = t3*t23 - t2*t11
     t26 = t24**2 + t25**2
     t27 = t11**2 + t23**2
     t28 = 1e-24*t4
@@ -924,15 +924,15 @@ def ik_branches(mu):
     t35 = xp.isfinite(t6)
     q = _stack(xp, [
         t29,  # 0, 0
-        t14 - 6.283185307179586*xp.ceil(-0.5 + 0.15915494309189535*t14),  # 0, 1
-        -t30 - t32 - 6.283185307179586*xp.ceil(-0.15915494309189535*t31 - 0.15915494309189535*t32),  # 0, 2
+        t14 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t14)),  # 0, 1
+        -(t30 + t32 + 6.283185307179586*xp.ceil(-0.15915494309189535*(t31 + t32))),  # 0, 2
         t33,  # 1, 0
-        t13 - 6.283185307179586*xp.ceil(-0.5 + 0.15915494309189535*t13),  # 1, 1
-        -t30 - t34 - 6.283185307179586*xp.ceil(-0.15915494309189535*t31 - 0.15915494309189535*t34),  # 1, 2
+        t13 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t13)),  # 1, 1
+        -(t34 + t30 + 6.283185307179586*xp.ceil(-0.15915494309189535*(t34 + t31))),  # 1, 2
     ], (2, 3))
     valid = _stack(xp, [
-        t35 & (xp.greater_equal(t8, -1e-12)),  # 0
-        t35 & (xp.greater(t8, 1e-12)),  # 1
+        t35 & (xp.greater_equal(t8, -1e-12) | (False & xp.less_equal(t7, 1e-12))),  # 0
+        t35 & xp.greater(t8, 1e-12),  # 1
     ], (2,))
     in_limits = _stack(xp, [
         xp.full(batch, True, dtype=xp.bool, device=device),  # 0
@@ -978,15 +978,15 @@ def ik_nearest(mu, q_seed, weights=(1.0,) * DOF):
     t10 = -qn1
     t11 = -qn2
     t12 = -qn3
-    t13 = qw1*(t0 + t10)**2 + qw2*(t1 + t11)**2 + qw3*(t12 + t2)**2
-    t14 = qw1*(t10 + t5)**2 + qw2*(t11 + t6)**2 + qw3*(t12 + t7)**2
+    t13 = qw1*(t0 + t10)**2 + qw2*(t1 + t11)**2 + qw3*(t2 + t12)**2
+    t14 = qw1*(t5 + t10)**2 + qw2*(t6 + t11)**2 + qw3*(t7 + t12)**2
     t15 = xp.greater(t4, 0)
     t16 = xp.where(t15, t0, qn1)
     t17 = xp.where(t15, t1, qn2)
     t18 = xp.where(t15, t2, qn3)
     t19 = xp.where(t15, t13, 0)
     t20 = xp.greater(t8, 0)
-    t21 = xp.where(t20 & ((xp.less(t14, t19)) | (xp.less(t4, 1))), xp.asarray(1, dtype=dtype), 0)
+    t21 = xp.where(t20 & (xp.greater(t19, t14) | xp.less(t4, 1)), xp.asarray(1, dtype=dtype), 0)
     t22 = xp.where(t20, 1, t4)
     t23 = xp.greater(t21, 0)
     t24 = xp.where(t23, t5, t16)

@@ -47,7 +47,7 @@ void puma560_jacobian(const puma560_real q[PUMA560_DOF], puma560_real J[6 * PUMA
 void puma560_fk_jacobian(const puma560_real q[PUMA560_DOF], puma560_real T[16], puma560_real J[6 * PUMA560_DOF]);
 
 /* Geometric Jacobian in the tool frame (6 x DOF, rows vx vy vz wx wy wz).
- * Result: J: 6 x 6 row-major, element (r, c) at J[r * 6 + c]. 201 operations. */
+ * Result: J: 6 x 6 row-major, element (r, c) at J[r * 6 + c]. 198 operations. */
 void puma560_jacobian_tool(const puma560_real q[PUMA560_DOF], puma560_real J[6 * PUMA560_DOF]);
 
 /* Task vector mu = (x, y, z, roll, pitch, yaw).
@@ -63,7 +63,7 @@ void puma560_task_jacobian(const puma560_real q[PUMA560_DOF], puma560_real J[PUM
 void puma560_fk_jacobian_dot(const puma560_real q[PUMA560_DOF], const puma560_real q_dot[PUMA560_DOF], puma560_real T[16], puma560_real J[6 * PUMA560_DOF], puma560_real a[6]);
 
 /* Time derivative dJ/dt of the world geometric Jacobian along q_dot (6 x DOF).
- * Result: Jd: 6 x 6 row-major, element (r, c) at Jd[r * 6 + c]. 172 operations. */
+ * Result: Jd: 6 x 6 row-major, element (r, c) at Jd[r * 6 + c]. 161 operations. */
 void puma560_jacobian_dot(const puma560_real q[PUMA560_DOF], const puma560_real q_dot[PUMA560_DOF], puma560_real Jd[6 * PUMA560_DOF]);
 
 /* J' q_dot: the tool's classical linear and angular acceleration at zero joint acceleration, world frame (6).
@@ -71,15 +71,15 @@ void puma560_jacobian_dot(const puma560_real q[PUMA560_DOF], const puma560_real 
 void puma560_bias_acceleration(const puma560_real q[PUMA560_DOF], const puma560_real q_dot[PUMA560_DOF], puma560_real a[6]);
 
 /* Time derivative of the analytic Jacobian along q_dot (6 x DOF): mu'' = J_a q'' + J_a' q'.
- * Result: Jd: 6 x 6 row-major, element (r, c) at Jd[r * 6 + c]. 433 operations. */
+ * Result: Jd: 6 x 6 row-major, element (r, c) at Jd[r * 6 + c]. 423 operations. */
 void puma560_task_jacobian_dot(const puma560_real q[PUMA560_DOF], const puma560_real q_dot[PUMA560_DOF], puma560_real Jd[PUMA560_TASK_DIM * PUMA560_DOF]);
 
 /* Partial derivatives dJ/dq_k of the world geometric Jacobian (DOF x 6 x DOF, indexed [k, r, c]).
- * Result: H: 6 x 6 x 6 row-major, element (k, r, c) at H[k * 36 + r * 6 + c]. 148 operations. */
+ * Result: H: 6 x 6 x 6 row-major, element (k, r, c) at H[k * 36 + r * 6 + c]. 142 operations. */
 void puma560_hessian(const puma560_real q[PUMA560_DOF], puma560_real H[PUMA560_DOF * 6 * PUMA560_DOF]);
 
 /* Factors of det(Js): the robot is singular where one is 0.
- * Result: f[i], i < 3. 16 operations. */
+ * Result: f[i], i < 3. 15 operations. */
 void puma560_singularity_factors(const puma560_real q[PUMA560_DOF], puma560_real f[PUMA560_NUM_SINGULARITY_FACTORS]);
 
 /* Manipulability |det(Js)|.
@@ -95,11 +95,11 @@ puma560_real puma560_jacobian_det(const puma560_real q[PUMA560_DOF]);
 int puma560_velocity_ik(const puma560_real q[PUMA560_DOF], const puma560_real mu_dot[PUMA560_TASK_DIM], puma560_real damping, puma560_real q_dot[PUMA560_DOF]);
 
 /* One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite).
- * Result: q_start[i], i < 6; q_next[i], i < 6; returned as a scalar. 921 operations. */
+ * Result: q_start[i], i < 6; q_next[i], i < 6; returned as a scalar. 916 operations. */
 puma560_real puma560_ik_numeric_step(const puma560_real target[16], const puma560_real q[PUMA560_DOF], puma560_real damping, puma560_real q_start[PUMA560_DOF], puma560_real q_next[PUMA560_DOF]);
 
 /* Every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits.
- * Result: q: 8 x 6 row-major, element (r, c) at q[r * 6 + c]; valid[i], i < 8; in_limits[i], i < 8. 1357 operations. */
+ * Result: q: 8 x 6 row-major, element (r, c) at q[r * 6 + c]; valid[i], i < 8; in_limits[i], i < 8. 1354 operations. */
 void puma560_ik_branches(const puma560_real T[16], puma560_real q[PUMA560_MAX_IK_SOLUTIONS * PUMA560_DOF], int valid[PUMA560_MAX_IK_SOLUTIONS], int in_limits[PUMA560_MAX_IK_SOLUTIONS]);
 
 /* The closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status.

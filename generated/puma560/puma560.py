@@ -91,37 +91,37 @@ def fk(q):
     t1 = t0 + 0.4318*s2
     t2 = 0.67183 + t1
     t3 = 0.0203*c23
-    t4 = 0.15005*s1 + c1*t3
-    t5 = -0.15005*c1 + s1*t3
+    t4 = 0.15005*s1 + t3*c1
+    t5 = -0.15005*c1 + t3*s1
     t6 = s1*s4
     t7 = c1*c4
-    t8 = -t6 + c23*t7
-    t9 = t7 - c23*t6
+    t8 = -t6 + t7*c23
+    t9 = t7 - t6*c23
     t10 = c4*s1
     t11 = c1*s4
-    t12 = t10 + c23*t11
-    t13 = t11 + c23*t10
+    t12 = t10 + t11*c23
+    t13 = t11 + t10*c23
     t14 = c1*s23
-    t15 = c5*t8 - s5*t14
-    t16 = c5*t14 + s5*t8
-    t17 = c6*t15 - s6*t12
-    t18 = c6*t12 + s6*t15
+    t15 = t8*c5 - t14*s5
+    t16 = t8*s5 + t14*c5
+    t17 = t15*c6 - t12*s6
+    t18 = t12*c6 + t15*s6
     t19 = t4 - 0.4318*t14
     t20 = s1*s23
-    t21 = c5*t13 - s5*t20
-    t22 = c5*t20 + s5*t13
-    t23 = c6*t21 + s6*t9
-    t24 = c6*t9 - s6*t21
+    t21 = t13*c5 - t20*s5
+    t22 = t13*s5 + t20*c5
+    t23 = t9*s6 + t21*c6
+    t24 = t9*c6 - t21*s6
     t25 = t5 - 0.4318*t20
     t26 = c4*s23
-    t27 = c23*s5 + c5*t26
-    t28 = c23*c5 - s5*t26
+    t27 = t26*c5 + c23*s5
+    t28 = c23*c5 - t26*s5
     t29 = s23*s4
-    t30 = c6*t27 - s6*t29
-    t31 = c6*t29 + s6*t27
+    t30 = t27*c6 - t29*s6
+    t31 = t27*s6 + t29*c6
     t32 = 0.4318*c2
-    t33 = t19 + c1*t32
-    t34 = t25 + s1*t32
+    t33 = t19 + t32*c1
+    t34 = t25 + t32*s1
     T = _stack(xp, [
         t17,  # 0, 0
         -t18,  # 0, 1
@@ -163,42 +163,42 @@ def jacobian(q):
     t1 = 0.0203*s23 + 0.4318*c23
     t2 = t1 + 0.4318*s2
     t3 = 0.0203*c23
-    t4 = 0.15005*s1 + c1*t3
-    t5 = -0.15005*c1 + s1*t3
+    t4 = 0.15005*s1 + t3*c1
+    t5 = -0.15005*c1 + t3*s1
     t6 = s1*s4
     t7 = c1*c4
-    t8 = -t6 + c23*t7
-    t9 = t7 - c23*t6
+    t8 = -t6 + t7*c23
+    t9 = t7 - t6*c23
     t10 = c4*s1
     t11 = c1*s4
-    t12 = t10 + c23*t11
-    t13 = t11 + c23*t10
+    t12 = t10 + t11*c23
+    t13 = t11 + t10*c23
     t14 = c1*s23
-    t15 = c5*t14 + s5*t8
+    t15 = t8*s5 + t14*c5
     t16 = t4 - 0.4318*t14
     t17 = s1*s23
-    t18 = c5*t17 + s5*t13
+    t18 = t13*s5 + t17*c5
     t19 = t5 - 0.4318*t17
     t20 = 0.4318*c2
-    t21 = t16 + c1*t20
-    t22 = t19 + s1*t20
+    t21 = t16 + t20*c1
+    t22 = t19 + t20*s1
     t23 = -c1
     J = _stack(xp, [
         -t22,  # 0, 0
-        -c1*t2,  # 0, 1
-        -c1*t1,  # 0, 2
+        -t2*c1,  # 0, 1
+        -t1*c1,  # 0, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5
         t21,  # 1, 0
-        -s1*t2,  # 1, 1
-        -s1*t1,  # 1, 2
+        -t2*s1,  # 1, 1
+        -t1*s1,  # 1, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
-        c1*t21 + s1*t22,  # 2, 1
-        c1*t16 + s1*t19,  # 2, 2
+        t21*c1 + t22*s1,  # 2, 1
+        t16*c1 + t19*s1,  # 2, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 5
@@ -246,37 +246,37 @@ def fk_jacobian(q):
     t1 = t0 + 0.4318*s2
     t2 = 0.67183 + t1
     t3 = 0.0203*c23
-    t4 = 0.15005*s1 + c1*t3
-    t5 = -0.15005*c1 + s1*t3
+    t4 = 0.15005*s1 + t3*c1
+    t5 = -0.15005*c1 + t3*s1
     t6 = s1*s4
     t7 = c1*c4
-    t8 = -t6 + c23*t7
-    t9 = t7 - c23*t6
+    t8 = -t6 + t7*c23
+    t9 = t7 - t6*c23
     t10 = c4*s1
     t11 = c1*s4
-    t12 = t10 + c23*t11
-    t13 = t11 + c23*t10
+    t12 = t10 + t11*c23
+    t13 = t11 + t10*c23
     t14 = c1*s23
-    t15 = c5*t8 - s5*t14
-    t16 = c5*t14 + s5*t8
-    t17 = c6*t15 - s6*t12
-    t18 = c6*t12 + s6*t15
+    t15 = t8*c5 - t14*s5
+    t16 = t8*s5 + t14*c5
+    t17 = t15*c6 - t12*s6
+    t18 = t12*c6 + t15*s6
     t19 = t4 - 0.4318*t14
     t20 = s1*s23
-    t21 = c5*t13 - s5*t20
-    t22 = c5*t20 + s5*t13
-    t23 = c6*t21 + s6*t9
-    t24 = c6*t9 - s6*t21
+    t21 = t13*c5 - t20*s5
+    t22 = t13*s5 + t20*c5
+    t23 = t9*s6 + t21*c6
+    t24 = t9*c6 - t21*s6
     t25 = t5 - 0.4318*t20
     t26 = c4*s23
-    t27 = c23*s5 + c5*t26
-    t28 = c23*c5 - s5*t26
+    t27 = t26*c5 + c23*s5
+    t28 = c23*c5 - t26*s5
     t29 = s23*s4
-    t30 = c6*t27 - s6*t29
-    t31 = c6*t29 + s6*t27
+    t30 = t27*c6 - t29*s6
+    t31 = t27*s6 + t29*c6
     t32 = 0.4318*c2
-    t33 = t19 + c1*t32
-    t34 = t25 + s1*t32
+    t33 = t19 + t32*c1
+    t34 = t25 + t32*s1
     t35 = -t16
     t36 = -t22
     t37 = -c1
@@ -300,20 +300,20 @@ def fk_jacobian(q):
     ], (4, 4))
     J = _stack(xp, [
         -t34,  # 0, 0
-        -c1*t1,  # 0, 1
-        -c1*t0,  # 0, 2
+        -t1*c1,  # 0, 1
+        -t0*c1,  # 0, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5
         t33,  # 1, 0
-        -s1*t1,  # 1, 1
-        -s1*t0,  # 1, 2
+        -t1*s1,  # 1, 1
+        -t0*s1,  # 1, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
-        c1*t33 + s1*t34,  # 2, 1
-        c1*t19 + s1*t25,  # 2, 2
+        t33*c1 + t34*s1,  # 2, 1
+        t19*c1 + t25*s1,  # 2, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 5
@@ -340,7 +340,7 @@ def fk_jacobian(q):
 
 
 def jacobian_tool(q):
-    """geometric Jacobian in the tool frame (6 x DOF, rows vx vy vz wx wy wz): (6 x 6), 201 operations."""
+    """geometric Jacobian in the tool frame (6 x DOF, rows vx vy vz wx wy wz): (6 x 6), 198 operations."""
     xp, dtype, device, batch, (q,) = _arguments(("q", q, (6,)))
     trig = _cos_sin(xp, q, (0.0, 0.0, 0.0, 0.0, 0.0, 0.0), device)
     c1 = trig[..., 0]
@@ -360,83 +360,83 @@ def jacobian_tool(q):
     t0 = 0.0203*s23 + 0.4318*c23
     t1 = t0 + 0.4318*s2
     t2 = 0.0203*c23
-    t3 = 0.15005*s1 + c1*t2
-    t4 = -0.15005*c1 + s1*t2
+    t3 = 0.15005*s1 + t2*c1
+    t4 = -0.15005*c1 + t2*s1
     t5 = s1*s4
     t6 = c1*c4
-    t7 = -t5 + c23*t6
-    t8 = t6 - c23*t5
+    t7 = -t5 + t6*c23
+    t8 = t6 - t5*c23
     t9 = c4*s1
     t10 = c1*s4
-    t11 = t9 + c23*t10
-    t12 = t10 + c23*t9
+    t11 = t9 + t10*c23
+    t12 = t10 + t9*c23
     t13 = c1*s23
-    t14 = c5*t7 - s5*t13
-    t15 = c5*t13 + s5*t7
-    t16 = c6*t14 - s6*t11
-    t17 = c6*t11 + s6*t14
+    t14 = t7*c5 - t13*s5
+    t15 = t7*s5 + t13*c5
+    t16 = t14*c6 - t11*s6
+    t17 = t11*c6 + t14*s6
     t18 = t3 - 0.4318*t13
     t19 = s1*s23
-    t20 = c5*t12 - s5*t19
-    t21 = c5*t19 + s5*t12
-    t22 = c6*t20 + s6*t8
-    t23 = c6*t8 - s6*t20
+    t20 = t12*c5 - t19*s5
+    t21 = t12*s5 + t19*c5
+    t22 = t8*s6 + t20*c6
+    t23 = t8*c6 - t20*s6
     t24 = t4 - 0.4318*t19
     t25 = c4*s23
-    t26 = c23*s5 + c5*t25
-    t27 = c23*c5 - s5*t25
+    t26 = t25*c5 + c23*s5
+    t27 = c23*c5 - t25*s5
     t28 = s23*s4
-    t29 = c6*t26 - s6*t28
-    t30 = c6*t28 + s6*t26
+    t29 = t26*c6 - t28*s6
+    t30 = t26*s6 + t28*c6
     t31 = 0.4318*c2
-    t32 = t18 + c1*t31
-    t33 = t24 + s1*t31
-    t34 = c1*t16
-    t35 = s1*t22
-    t36 = c1*t32 + s1*t33
-    t37 = c1*t18 + s1*t24
-    t38 = s1*t23
-    t39 = c1*t15
-    t40 = s1*t21
-    t41 = s1*t16 - c1*t22
-    t42 = -c1*t23 - s1*t17
-    t43 = c1*t21 - s1*t15
+    t32 = t18 + t31*c1
+    t33 = t24 + t31*s1
+    t34 = t16*c1
+    t35 = t22*s1
+    t36 = t32*c1 + t33*s1
+    t37 = t18*c1 + t24*s1
+    t38 = t23*s1
+    t39 = t15*c1
+    t40 = t21*s1
+    t41 = t16*s1 - t22*c1
+    t42 = -(t17*s1 + t23*c1)
+    t43 = t21*c1 - t15*s1
     J = _stack(xp, [
         t22*t32 - t16*t33,  # 0, 0
-        t29*t36 - t1*t34 - t1*t35,  # 0, 1
-        t29*t37 - t0*t34 - t0*t35,  # 0, 2
+        -(t1*t34 + t1*t35 - t29*t36),  # 0, 1
+        -(t0*t34 + t0*t35 - t29*t37),  # 0, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5
         t17*t33 + t23*t32,  # 1, 0
-        -t1*t38 - t30*t36 + c1*t1*t17,  # 1, 1
-        -t0*t38 - t30*t37 + c1*t0*t17,  # 1, 2
+        -(t30*t36 + t1*t38 - t17*t1*c1),  # 1, 1
+        -(t30*t37 + t0*t38 - t17*t0*c1),  # 1, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5
         t15*t33 - t21*t32,  # 2, 0
-        t1*t39 + t1*t40 + t27*t36,  # 2, 1
-        t0*t39 + t0*t40 + t27*t37,  # 2, 2
+        t27*t36 + t1*t39 + t1*t40,  # 2, 1
+        t27*t37 + t0*t39 + t0*t40,  # 2, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 5
         t29,  # 3, 0
         t41,  # 3, 1
         t41,  # 3, 2
-        c23*t29 - t13*t16 - t19*t22,  # 3, 3
-        t11*t16 + t28*t29 - t22*t8,  # 3, 4
-        t27*t29 - t15*t16 - t21*t22,  # 3, 5
+        -(t16*t13 + t22*t19 - t29*c23),  # 3, 3
+        t11*t16 + t29*t28 - t8*t22,  # 3, 4
+        -(t15*t16 + t21*t22 - t27*t29),  # 3, 5
         -t30,  # 4, 0
         t42,  # 4, 1
         t42,  # 4, 2
-        -c23*t30 - t19*t23 + c1*s23*t17,  # 4, 3
-        -t11*t17 - t23*t8 - t28*t30,  # 4, 4
-        t15*t17 - t21*t23 - t27*t30,  # 4, 5
+        -(t23*t19 + t30*c23 - t17*c1*s23),  # 4, 3
+        -(t11*t17 + t8*t23 + t30*t28),  # 4, 4
+        -(t21*t23 + t27*t30 - t15*t17),  # 4, 5
         t27,  # 5, 0
         t43,  # 5, 1
         t43,  # 5, 2
-        c23*t27 + t13*t15 + t19*t21,  # 5, 3
-        t21*t8 + t27*t28 - t11*t15,  # 5, 4
+        t15*t13 + t21*t19 + t27*c23,  # 5, 3
+        t8*t21 + t27*t28 - t11*t15,  # 5, 4
         t15**2 + t21**2 + t27**2,  # 5, 5
     ], (6, 6))
     return J
@@ -465,31 +465,31 @@ def task(q):
     t2 = t1 + 0.4318*s2
     t3 = 0.67183 + t2
     t4 = 0.0203*c23
-    t5 = 0.15005*s1 + c1*t4
-    t6 = -0.15005*c1 + s1*t4
+    t5 = 0.15005*s1 + t4*c1
+    t6 = -0.15005*c1 + t4*s1
     t7 = s1*s4
     t8 = c1*c4
-    t9 = -t7 + c23*t8
-    t10 = t8 - c23*t7
+    t9 = -t7 + t8*c23
+    t10 = t8 - t7*c23
     t11 = c4*s1
     t12 = c1*s4
-    t13 = t11 + c23*t12
-    t14 = t12 + c23*t11
+    t13 = t11 + t12*c23
+    t14 = t12 + t11*c23
     t15 = s23*s5
-    t16 = c5*t9 - c1*t15
-    t17 = c5*t14 - s1*t15
-    t18 = c23*c5 - c4*t15
-    t19 = c6*t16 - s6*t13
-    t20 = c6*t17 + s6*t10
+    t16 = t9*c5 - t15*c1
+    t17 = t14*c5 - t15*s1
+    t18 = c23*c5 - t15*c4
+    t19 = t16*c6 - t13*s6
+    t20 = t10*s6 + t17*c6
     t21 = s23*s4
-    t22 = c6*t0 - s6*t21
-    t23 = c6*t21 + s6*t0
+    t22 = t0*c6 - t21*s6
+    t23 = t0*s6 + t21*c6
     t24 = 0.4318*s23
-    t25 = t5 - c1*t24
-    t26 = t6 - s1*t24
+    t25 = t5 - t24*c1
+    t26 = t6 - t24*s1
     t27 = 0.4318*c2
-    t28 = t25 + c1*t27
-    t29 = t26 + s1*t27
+    t28 = t25 + t27*c1
+    t29 = t26 + t27*s1
     mu = _stack(xp, [
         t28,  # 0
         t29,  # 1
@@ -522,63 +522,63 @@ def task_jacobian(q):
     t0 = 0.0203*s23 + 0.4318*c23
     t1 = t0 + 0.4318*s2
     t2 = 0.0203*c23
-    t3 = 0.15005*s1 + c1*t2
-    t4 = -0.15005*c1 + s1*t2
+    t3 = 0.15005*s1 + t2*c1
+    t4 = -0.15005*c1 + t2*s1
     t5 = s1*s4
     t6 = c1*c4
-    t7 = -t5 + c23*t6
-    t8 = t6 - c23*t5
+    t7 = -t5 + t6*c23
+    t8 = t6 - t5*c23
     t9 = c4*s1
     t10 = c1*s4
-    t11 = t9 + c23*t10
-    t12 = t10 + c23*t9
+    t11 = t9 + t10*c23
+    t12 = t10 + t9*c23
     t13 = c1*s23
-    t14 = c5*t7 - s5*t13
-    t15 = c5*t13 + s5*t7
-    t16 = c6*t14 - s6*t11
+    t14 = t7*c5 - t13*s5
+    t15 = t7*s5 + t13*c5
+    t16 = t14*c6 - t11*s6
     t17 = t3 - 0.4318*t13
     t18 = s1*s23
-    t19 = c5*t12 - s5*t18
-    t20 = c5*t18 + s5*t12
-    t21 = c6*t19 + s6*t8
+    t19 = t12*c5 - t18*s5
+    t20 = t12*s5 + t18*c5
+    t21 = t8*s6 + t19*c6
     t22 = t4 - 0.4318*t18
     t23 = c4*s23
-    t24 = c23*s5 + c5*t23
-    t25 = c23*c5 - s5*t23
+    t24 = t23*c5 + c23*s5
+    t25 = c23*c5 - t23*s5
     t26 = s23*s4
-    t27 = c6*t24 - s6*t26
+    t27 = t24*c6 - t26*s6
     t28 = 0.4318*c2
-    t29 = t17 + c1*t28
-    t30 = t22 + s1*t28
-    t31 = s1*t16
-    t32 = c1*t21
+    t29 = t17 + t28*c1
+    t30 = t22 + t28*s1
+    t31 = t16*s1
+    t32 = t21*c1
     t33 = t16**2 + t21**2
-    t34 = t33**(-1.0)
+    t34 = 1/t33
     t35 = t34*(t31 - t32)
-    t36 = c1*t16
-    t37 = s1*t21
-    t38 = -t34*(s23*t36 + s23*t37)
-    t39 = t34*(t11*t16 - t21*t8)
+    t36 = t16*c1
+    t37 = t21*s1
+    t38 = -t34*(t36*s23 + t37*s23)
+    t39 = t34*(t11*t16 - t8*t21)
     t40 = -t34*(t15*t16 + t20*t21)
     t41 = 1/xp.sqrt(t33)
     t42 = -t41*(t36 + t37)
     t43 = -t27*t35
     J = _stack(xp, [
         -t30,  # 0, 0
-        -c1*t1,  # 0, 1
-        -c1*t0,  # 0, 2
+        -t1*c1,  # 0, 1
+        -t0*c1,  # 0, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5
         t29,  # 1, 0
-        -s1*t1,  # 1, 1
-        -s1*t0,  # 1, 2
+        -t1*s1,  # 1, 1
+        -t0*s1,  # 1, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
-        c1*t29 + s1*t30,  # 2, 1
-        c1*t17 + s1*t22,  # 2, 2
+        t29*c1 + t30*s1,  # 2, 1
+        t17*c1 + t22*s1,  # 2, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 5
@@ -591,9 +591,9 @@ def task_jacobian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
         t42,  # 4, 1
         t42,  # 4, 2
-        t41*(s23*t32 - s23*t31),  # 4, 3
-        -t41*(t11*t21 + t16*t8),  # 4, 4
-        t41*(t15*t21 - t16*t20),  # 4, 5
+        t41*(t32*s23 - t31*s23),  # 4, 3
+        -t41*(t11*t21 + t8*t16),  # 4, 4
+        t41*(t15*t21 - t20*t16),  # 4, 5
         xp.full(batch, 1, dtype=dtype, device=device),  # 5, 0
         t43,  # 5, 1
         t43,  # 5, 2
@@ -633,66 +633,66 @@ def fk_jacobian_dot(q, q_dot):
     t2 = 0.67183 + t1
     t3 = qd1 + c23*qd4
     t4 = 0.0203*c23
-    t5 = 0.15005*s1 + c1*t4
-    t6 = -0.15005*c1 + s1*t4
+    t5 = 0.15005*s1 + t4*c1
+    t6 = -0.15005*c1 + t4*s1
     t7 = s1*s4
     t8 = c1*c4
-    t9 = -t7 + c23*t8
-    t10 = t8 - c23*t7
+    t9 = -t7 + t8*c23
+    t10 = t8 - t7*c23
     t11 = c4*s1
     t12 = c1*s4
-    t13 = t11 + c23*t12
-    t14 = t12 + c23*t11
+    t13 = t11 + t12*c23
+    t14 = t12 + t11*c23
     t15 = c1*s23
-    t16 = c5*t9 - s5*t15
-    t17 = c5*t15 + s5*t9
-    t18 = c6*t16 - s6*t13
-    t19 = c6*t13 + s6*t16
+    t16 = t9*c5 - t15*s5
+    t17 = t9*s5 + t15*c5
+    t18 = t16*c6 - t13*s6
+    t19 = t13*c6 + t16*s6
     t20 = t5 - 0.4318*t15
     t21 = s1*s23
-    t22 = c5*t14 - s5*t21
-    t23 = c5*t21 + s5*t14
-    t24 = c6*t22 + s6*t10
-    t25 = c6*t10 - s6*t22
+    t22 = t14*c5 - t21*s5
+    t23 = t14*s5 + t21*c5
+    t24 = t10*s6 + t22*c6
+    t25 = t10*c6 - t22*s6
     t26 = t6 - 0.4318*t21
     t27 = c4*s23
-    t28 = c23*s5 + c5*t27
-    t29 = c23*c5 - s5*t27
+    t28 = t27*c5 + c23*s5
+    t29 = c23*c5 - t27*s5
     t30 = s23*s4
-    t31 = c6*t28 - s6*t30
-    t32 = c6*t30 + s6*t28
-    t33 = t3 + qd5*t30
+    t31 = t28*c6 - t30*s6
+    t32 = t28*s6 + t30*c6
+    t33 = t3 + t30*qd5
     t34 = 0.4318*c2
-    t35 = t20 + c1*t34
-    t36 = t26 + s1*t34
-    t37 = c1*t35 + s1*t36
+    t35 = t20 + t34*c1
+    t36 = t26 + t34*s1
+    t37 = t35*c1 + t36*s1
     t38 = t37
-    t39 = c1*t20 + s1*t26
+    t39 = t20*c1 + t26*s1
     t40 = t39
-    t41 = qd2*t38 + qd3*t40
+    t41 = t38*qd2 + t40*qd3
     t42 = qd2*s1
     t43 = qd3*s1
     t44 = t42 + t43
-    t45 = t44 - qd4*t15
-    t46 = t45 + qd5*t13
+    t45 = t44 - t15*qd4
+    t46 = t45 + t13*qd5
     t47 = t0*t43 + t1*t42
-    t48 = -t47 + qd1*t35
+    t48 = -t47 + t35*qd1
     t49 = c1*qd2
     t50 = c1*qd3
     t51 = t49 + t50
-    t52 = t51 + qd4*t21
-    t53 = t52 + qd5*t10
+    t52 = t51 + t21*qd4
+    t53 = t52 + t10*qd5
     t54 = t0*t50 + t1*t49
-    t55 = t54 + qd1*t36
+    t55 = t54 + t36*qd1
     t56 = -t17
     t57 = -t23
-    t58 = c1*t1
-    t59 = c1*t0
-    t60 = s1*t1
+    t58 = t1*c1
+    t59 = t0*c1
+    t60 = t1*s1
     t61 = -c1
     t62 = c1**2
-    t63 = qd2*t0
-    t64 = qd3*t0
+    t63 = t0*qd2
+    t64 = t0*qd3
     t65 = s1**2
     T = _stack(xp, [
         xp.broadcast_to(t18, batch),  # 0, 0
@@ -721,7 +721,7 @@ def fk_jacobian_dot(q, q_dot):
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5
         xp.broadcast_to(t35, batch),  # 1, 0
         xp.broadcast_to(-t60, batch),  # 1, 1
-        xp.broadcast_to(-s1*t0, batch),  # 1, 2
+        xp.broadcast_to(-t0*s1, batch),  # 1, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5
@@ -751,18 +751,18 @@ def fk_jacobian_dot(q, q_dot):
         xp.broadcast_to(t29, batch),  # 5, 5
     ], (6, 6))
     a = _stack(xp, [
-        xp.broadcast_to(qd2*(qd1*t60 - c1*t41) - qd1*t48 - qd3*(t40*t49 + t40*t50 - qd1*s1*t0), batch),  # 0
-        xp.broadcast_to(-qd1*t55 - qd2*(qd1*t58 + s1*t41) - qd3*(qd1*t59 + t40*t42 + t40*t43), batch),  # 1
-        xp.broadcast_to(-qd2*(c1*t54 + s1*t47) - qd3*(t62*t63 + t62*t64 + t63*t65 + t64*t65), batch),  # 2
-        xp.broadcast_to(qd1*t49 + qd1*t50 + qd4*(qd1*t21 - c23*t51) + qd5*(t10*t3 - t30*t52) + qd6*(t23*t33 - t29*t53), batch),  # 3
-        xp.broadcast_to(qd1*t42 + qd1*t43 + qd5*(t13*t3 - t30*t45) - qd4*(c23*t44 + qd1*t15) - qd6*(t17*t33 + t29*t46), batch),  # 4
-        xp.broadcast_to(qd5*(t13*t52 - t10*t45) - qd4*(t15*t51 + t21*t44) - qd6*(t17*t53 + t23*t46), batch),  # 5
+        xp.broadcast_to(qd2*(t60*qd1 - t41*c1) - t48*qd1 - qd3*(t40*t49 + t40*t50 - t0*qd1*s1), batch),  # 0
+        xp.broadcast_to(-t55*qd1 - qd2*(t41*s1 + t58*qd1) - qd3*(t40*t42 + t40*t43 + t59*qd1), batch),  # 1
+        xp.broadcast_to(-qd2*(t54*c1 + t47*s1) - qd3*(t62*t63 + t62*t64 + t63*t65 + t64*t65), batch),  # 2
+        xp.broadcast_to(t49*qd1 + t50*qd1 + qd4*(t21*qd1 - t51*c23) + qd5*(t10*t3 - t52*t30) + qd6*(t23*t33 - t29*t53), batch),  # 3
+        xp.broadcast_to(t42*qd1 + t43*qd1 + qd5*(t13*t3 - t45*t30) - qd4*(t44*c23 + t15*qd1) - qd6*(t17*t33 + t29*t46), batch),  # 4
+        xp.broadcast_to(qd5*(t13*t52 - t10*t45) - qd4*(t44*t21 + t51*t15) - qd6*(t17*t53 + t23*t46), batch),  # 5
     ], (6,))
     return T, J, a
 
 
 def jacobian_dot(q, q_dot):
-    """time derivative dJ/dt of the world geometric Jacobian along q_dot (6 x DOF): (6 x 6), 172 operations."""
+    """time derivative dJ/dt of the world geometric Jacobian along q_dot (6 x DOF): (6 x 6), 161 operations."""
     xp, dtype, device, batch, (q, q_dot,) = _arguments(("q", q, (6,)), ("q_dot", q_dot, (6,)))
     qd1 = q_dot[..., 0]
     qd2 = q_dot[..., 1]
@@ -787,88 +787,88 @@ def jacobian_dot(q, q_dot):
     t2 = t1 + 0.4318*s2
     t3 = qd1 + c23*qd4
     t4 = 0.0203*c23
-    t5 = 0.15005*s1 + c1*t4
-    t6 = -0.15005*c1 + s1*t4
+    t5 = 0.15005*s1 + t4*c1
+    t6 = -0.15005*c1 + t4*s1
     t7 = s1*s4
     t8 = c1*c4
-    t9 = -t7 + c23*t8
-    t10 = t8 - c23*t7
+    t9 = -t7 + t8*c23
+    t10 = t8 - t7*c23
     t11 = c4*s1
     t12 = c1*s4
-    t13 = t11 + c23*t12
-    t14 = t12 + c23*t11
+    t13 = t11 + t12*c23
+    t14 = t12 + t11*c23
     t15 = c5*s23
-    t16 = c1*t15 + s5*t9
-    t17 = s1*t15 + s5*t14
+    t16 = t9*s5 + t15*c1
+    t17 = t14*s5 + t15*s1
     t18 = 0.4318*s23
-    t19 = t5 - c1*t18
-    t20 = t6 - s1*t18
-    t21 = c1*t19 + s1*t20
+    t19 = t5 - t18*c1
+    t20 = t6 - t18*s1
+    t21 = t19*c1 + t20*s1
     t22 = 0.4318*c2
-    t23 = t19 + c1*t22
-    t24 = t20 + s1*t22
-    t25 = c1*t23 + s1*t24
-    t26 = qd2*t25 + qd3*t21
+    t23 = t19 + t22*c1
+    t24 = t20 + t22*s1
+    t25 = t23*c1 + t24*s1
+    t26 = t25*qd2 + t21*qd3
     t27 = qd2*s1
     t28 = qd3*s1
     t29 = t27 + t28
     t30 = t1*t28 + t2*t27
-    t31 = -t30 + qd1*t23
+    t31 = -t30 + t23*qd1
     t32 = c1*qd2
     t33 = c1*qd3
     t34 = t32 + t33
     t35 = t1*t33 + t2*t32
-    t36 = t35 + qd1*t24
+    t36 = t35 + t24*qd1
     t37 = qd4*s23
-    t38 = t29 - c1*t37
-    t39 = t34 + s1*t37
-    t40 = t38 + qd5*t13
-    t41 = t39 + qd5*t10
+    t38 = t29 - t37*c1
+    t39 = t34 + t37*s1
+    t40 = t38 + t13*qd5
+    t41 = t39 + t10*qd5
     t42 = s23*s4
-    t43 = t3 + qd5*t42
+    t43 = t3 + t42*qd5
     t44 = qd1*s1
     t45 = c1*qd1
     t46 = c1**2
-    t47 = qd2*t1
-    t48 = qd3*t1
+    t47 = t1*qd2
+    t48 = t1*qd3
     t49 = s1**2
     Jd = _stack(xp, [
         xp.broadcast_to(-t31, batch),  # 0, 0
-        xp.broadcast_to(t2*t44 - c1*t26, batch),  # 0, 1
-        xp.broadcast_to(-t21*t32 - t21*t33 + qd1*s1*t1, batch),  # 0, 2
+        xp.broadcast_to(t2*t44 - t26*c1, batch),  # 0, 1
+        xp.broadcast_to(-(t21*t32 + t21*t33 - t1*qd1*s1), batch),  # 0, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5
         xp.broadcast_to(-t36, batch),  # 1, 0
-        xp.broadcast_to(-s1*t26 - t2*t45, batch),  # 1, 1
-        xp.broadcast_to(-t1*t45 - t21*t27 - t21*t28, batch),  # 1, 2
+        xp.broadcast_to(-(t2*t45 + t26*s1), batch),  # 1, 1
+        xp.broadcast_to(-(t1*t45 + t21*t27 + t21*t28), batch),  # 1, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
-        xp.broadcast_to(-c1*t35 - s1*t30, batch),  # 2, 1
-        xp.broadcast_to(-t46*t47 - t46*t48 - t47*t49 - t48*t49, batch),  # 2, 2
+        xp.broadcast_to(-(t35*c1 + t30*s1), batch),  # 2, 1
+        xp.broadcast_to(-(t46*t47 + t46*t48 + t47*t49 + t48*t49), batch),  # 2, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
         xp.broadcast_to(t45, batch),  # 3, 1
         xp.broadcast_to(t45, batch),  # 3, 2
-        xp.broadcast_to(s23*t44 - c23*t34, batch),  # 3, 3
+        xp.broadcast_to(t44*s23 - t34*c23, batch),  # 3, 3
         xp.broadcast_to(t10*t3 - t39*t42, batch),  # 3, 4
         xp.broadcast_to(t17*t43 - t0*t41, batch),  # 3, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
         xp.broadcast_to(t44, batch),  # 4, 1
         xp.broadcast_to(t44, batch),  # 4, 2
-        xp.broadcast_to(-c23*t29 - s23*t45, batch),  # 4, 3
+        xp.broadcast_to(-(t29*c23 + t45*s23), batch),  # 4, 3
         xp.broadcast_to(t13*t3 - t38*t42, batch),  # 4, 4
-        xp.broadcast_to(-t0*t40 - t16*t43, batch),  # 4, 5
+        xp.broadcast_to(-(t16*t43 + t0*t40), batch),  # 4, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 2
-        xp.broadcast_to(-c1*s23*t34 - s1*s23*t29, batch),  # 5, 3
+        xp.broadcast_to(-(t29*s1*s23 + t34*c1*s23), batch),  # 5, 3
         xp.broadcast_to(t13*t39 - t10*t38, batch),  # 5, 4
-        xp.broadcast_to(-t16*t41 - t17*t40, batch),  # 5, 5
+        xp.broadcast_to(-(t16*t41 + t17*t40), batch),  # 5, 5
     ], (6, 6))
     return Jd
 
@@ -900,64 +900,64 @@ def bias_acceleration(q, q_dot):
     t2 = t1 + 0.4318*s2
     t3 = qd1 + c23*qd4
     t4 = 0.0203*c23
-    t5 = 0.15005*s1 + c1*t4
-    t6 = -0.15005*c1 + s1*t4
+    t5 = 0.15005*s1 + t4*c1
+    t6 = -0.15005*c1 + t4*s1
     t7 = s1*s4
     t8 = c1*c4
-    t9 = -t7 + c23*t8
-    t10 = t8 - c23*t7
+    t9 = -t7 + t8*c23
+    t10 = t8 - t7*c23
     t11 = c4*s1
     t12 = c1*s4
-    t13 = t11 + c23*t12
-    t14 = t12 + c23*t11
+    t13 = t11 + t12*c23
+    t14 = t12 + t11*c23
     t15 = c5*s23
-    t16 = c1*t15 + s5*t9
-    t17 = s1*t15 + s5*t14
+    t16 = t9*s5 + t15*c1
+    t17 = t14*s5 + t15*s1
     t18 = 0.4318*s23
-    t19 = t5 - c1*t18
-    t20 = t6 - s1*t18
-    t21 = c1*t19 + s1*t20
+    t19 = t5 - t18*c1
+    t20 = t6 - t18*s1
+    t21 = t19*c1 + t20*s1
     t22 = 0.4318*c2
-    t23 = t19 + c1*t22
-    t24 = t20 + s1*t22
-    t25 = c1*t23 + s1*t24
-    t26 = qd2*t25 + qd3*t21
+    t23 = t19 + t22*c1
+    t24 = t20 + t22*s1
+    t25 = t23*c1 + t24*s1
+    t26 = t25*qd2 + t21*qd3
     t27 = qd2*s1
     t28 = qd3*s1
     t29 = t27 + t28
     t30 = t1*t28 + t2*t27
-    t31 = -t30 + qd1*t23
+    t31 = -t30 + t23*qd1
     t32 = c1*qd2
     t33 = c1*qd3
     t34 = t32 + t33
     t35 = t1*t33 + t2*t32
-    t36 = t35 + qd1*t24
+    t36 = t35 + t24*qd1
     t37 = qd4*s23
-    t38 = t29 - c1*t37
-    t39 = t34 + s1*t37
-    t40 = t38 + qd5*t13
-    t41 = t39 + qd5*t10
+    t38 = t29 - t37*c1
+    t39 = t34 + t37*s1
+    t40 = t38 + t13*qd5
+    t41 = t39 + t10*qd5
     t42 = s23*s4
-    t43 = t3 + qd5*t42
+    t43 = t3 + t42*qd5
     t44 = qd1*s1
     t45 = c1*qd1
     t46 = c1**2
-    t47 = qd2*t1
-    t48 = qd3*t1
+    t47 = t1*qd2
+    t48 = t1*qd3
     t49 = s1**2
     a = _stack(xp, [
-        xp.broadcast_to(qd2*(t2*t44 - c1*t26) - qd1*t31 - qd3*(t21*t32 + t21*t33 - qd1*s1*t1), batch),  # 0
-        xp.broadcast_to(-qd1*t36 - qd2*(s1*t26 + t2*t45) - qd3*(t1*t45 + t21*t27 + t21*t28), batch),  # 1
-        xp.broadcast_to(-qd2*(c1*t35 + s1*t30) - qd3*(t46*t47 + t46*t48 + t47*t49 + t48*t49), batch),  # 2
-        xp.broadcast_to(qd1*t32 + qd1*t33 + qd4*(s23*t44 - c23*t34) + qd5*(t10*t3 - t39*t42) + qd6*(t17*t43 - t0*t41), batch),  # 3
-        xp.broadcast_to(qd1*t27 + qd1*t28 + qd5*(t13*t3 - t38*t42) - qd4*(c23*t29 + s23*t45) - qd6*(t0*t40 + t16*t43), batch),  # 4
-        xp.broadcast_to(qd5*(t13*t39 - t10*t38) - qd4*(c1*s23*t34 + s1*s23*t29) - qd6*(t16*t41 + t17*t40), batch),  # 5
+        xp.broadcast_to(qd2*(t2*t44 - t26*c1) - t31*qd1 - qd3*(t21*t32 + t21*t33 - t1*qd1*s1), batch),  # 0
+        xp.broadcast_to(-t36*qd1 - qd2*(t2*t45 + t26*s1) - qd3*(t1*t45 + t21*t27 + t21*t28), batch),  # 1
+        xp.broadcast_to(-qd2*(t35*c1 + t30*s1) - qd3*(t46*t47 + t46*t48 + t47*t49 + t48*t49), batch),  # 2
+        xp.broadcast_to(t32*qd1 + t33*qd1 + qd4*(t44*s23 - t34*c23) + qd5*(t10*t3 - t39*t42) + qd6*(t17*t43 - t0*t41), batch),  # 3
+        xp.broadcast_to(t27*qd1 + t28*qd1 + qd5*(t13*t3 - t38*t42) - qd4*(t29*c23 + t45*s23) - qd6*(t16*t43 + t0*t40), batch),  # 4
+        xp.broadcast_to(qd5*(t13*t39 - t10*t38) - qd4*(t29*s1*s23 + t34*c1*s23) - qd6*(t16*t41 + t17*t40), batch),  # 5
     ], (6,))
     return a
 
 
 def task_jacobian_dot(q, q_dot):
-    """time derivative of the analytic Jacobian along q_dot (6 x DOF): mu'' = J_a q'' + J_a' q': (6 x 6), 433 operations."""
+    """time derivative of the analytic Jacobian along q_dot (6 x DOF): mu'' = J_a q'' + J_a' q': (6 x 6), 423 operations."""
     xp, dtype, device, batch, (q, q_dot,) = _arguments(("q", q, (6,)), ("q_dot", q_dot, (6,)))
     qd1 = q_dot[..., 0]
     qd2 = q_dot[..., 1]
@@ -983,96 +983,96 @@ def task_jacobian_dot(q, q_dot):
     t0 = 0.0203*s23 + 0.4318*c23
     t1 = t0 + 0.4318*s2
     t2 = 0.0203*c23
-    t3 = 0.15005*s1 + c1*t2
-    t4 = -0.15005*c1 + s1*t2
+    t3 = 0.15005*s1 + t2*c1
+    t4 = -0.15005*c1 + t2*s1
     t5 = s1*s4
     t6 = c1*c4
-    t7 = -t5 + c23*t6
-    t8 = t6 - c23*t5
+    t7 = -t5 + t6*c23
+    t8 = t6 - t5*c23
     t9 = c4*s1
     t10 = c1*s4
-    t11 = t9 + c23*t10
-    t12 = t10 + c23*t9
+    t11 = t9 + t10*c23
+    t12 = t10 + t9*c23
     t13 = c1*s23
-    t14 = c5*t7 - s5*t13
-    t15 = c5*t13 + s5*t7
-    t16 = c6*t14 - s6*t11
+    t14 = t7*c5 - t13*s5
+    t15 = t7*s5 + t13*c5
+    t16 = t14*c6 - t11*s6
     t17 = t3 - 0.4318*t13
     t18 = s1*s23
-    t19 = c5*t12 - s5*t18
-    t20 = c5*t18 + s5*t12
-    t21 = c6*t19 + s6*t8
+    t19 = t12*c5 - t18*s5
+    t20 = t12*s5 + t18*c5
+    t21 = t8*s6 + t19*c6
     t22 = t4 - 0.4318*t18
-    t23 = c1*t17 + s1*t22
+    t23 = t17*c1 + t22*s1
     t24 = c4*s23
-    t25 = c23*s5 + c5*t24
-    t26 = c23*c5 - s5*t24
+    t25 = t24*c5 + c23*s5
+    t26 = c23*c5 - t24*s5
     t27 = s23*s4
-    t28 = c6*t25 - s6*t27
+    t28 = t25*c6 - t27*s6
     t29 = 0.4318*c2
-    t30 = t17 + c1*t29
-    t31 = t22 + s1*t29
-    t32 = c1*t30 + s1*t31
-    t33 = qd2*t32 + qd3*t23
+    t30 = t17 + t29*c1
+    t31 = t22 + t29*s1
+    t32 = t30*c1 + t31*s1
+    t33 = t32*qd2 + t23*qd3
     t34 = qd2*s1
     t35 = qd3*s1
     t36 = t0*t35 + t1*t34
-    t37 = -t36 + qd1*t30
+    t37 = -t36 + t30*qd1
     t38 = t34 + t35
     t39 = t38
-    t40 = c23*t39 + qd1*t13
+    t40 = t39*c23 + t13*qd1
     t41 = c1*qd2
     t42 = c1*qd3
     t43 = t0*t42 + t1*t41
-    t44 = t43 + qd1*t31
-    t45 = c1*t43 + s1*t36
+    t44 = t43 + t31*qd1
+    t45 = t43*c1 + t36*s1
     t46 = t41 + t42
     t47 = t46
-    t48 = qd1*t18 - c23*t47
-    t49 = t13*t47 + t18*t39
-    t50 = -qd4*t13
+    t48 = t18*qd1 - t47*c23
+    t49 = t39*t18 + t47*t13
+    t50 = -t13*qd4
     t51 = t39 + t50
-    t52 = qd4*t18
+    t52 = t18*qd4
     t53 = t47 + t52
-    t54 = t11*t53 - t51*t8
+    t54 = t11*t53 - t8*t51
     t55 = qd1 + c23*qd4
     t56 = t55
-    t57 = t56*t8 - t27*t53
-    t58 = t11*t56 - t27*t51
-    t59 = qd5*t11
+    t57 = t8*t56 - t53*t27
+    t58 = t11*t56 - t51*t27
+    t59 = t11*qd5
     t60 = t51 + t59
-    t61 = t38 + t50 + t59 - qd6*t15
-    t62 = qd5*t8
+    t61 = t38 + t50 + t59 - t15*qd6
+    t62 = t8*qd5
     t63 = t53 + t62
     t64 = t15*t63 + t20*t60
-    t65 = t46 + t52 + t62 + qd6*t20
+    t65 = t46 + t52 + t62 + t20*qd6
     t66 = t16*t65 + t21*t61
-    t67 = qd5*t27
+    t67 = t27*qd5
     t68 = t56 + t67
     t69 = t20*t68 - t26*t63
     t70 = t15*t68 + t26*t60
-    t71 = t55 + t67 + qd6*t26
+    t71 = t55 + t67 + t26*qd6
     t72 = t21*t71 + t28*t65
     t73 = t16*t71 - t28*t61
     t74 = qd1*s1
-    t75 = t1*t74 - c1*t33
+    t75 = t1*t74 - t33*c1
     t76 = t23*t41 + t23*t42 - t0*t74
     t77 = c1*qd1
-    t78 = s1*t33 + t1*t77
+    t78 = t1*t77 + t33*s1
     t79 = t0*t77 + t23*t34 + t23*t35
     t80 = c1**2
-    t81 = qd2*t0
-    t82 = qd3*t0
+    t81 = t0*qd2
+    t82 = t0*qd3
     t83 = s1**2
     t84 = t80*t81 + t80*t82 + t81*t83 + t82*t83
     t85 = t16**2 + t21**2
-    t86 = t85**(-1.0)
-    t87 = c1*t86
-    t88 = qd1*t16
-    t89 = s1*t86
-    t90 = qd1*t21
-    t91 = s1*t16
-    t92 = c1*t21
+    t86 = 1/t85
+    t87 = t86*c1
+    t88 = t16*qd1
+    t89 = t86*s1
+    t90 = t21*qd1
+    t91 = t16*s1
+    t92 = t21*c1
     t93 = t91 - t92
     t94 = 2/t85**2
     t95 = t93*t94
@@ -1082,45 +1082,45 @@ def task_jacobian_dot(q, q_dot):
     t99 = t16*t86
     t100 = t48*t99
     t101 = t21*t86
-    t102 = s23*t89
-    t103 = c1*t16
-    t104 = s1*t21
-    t105 = -s23*t103 - s23*t104
-    t106 = t105*t94
-    t107 = t106*t21
-    t108 = s23*t87
-    t109 = t106*t16
+    t102 = t89*s23
+    t103 = t16*c1
+    t104 = t21*s1
+    t105 = -(t103*s23 + t104*s23)
+    t106 = t94*t105
+    t107 = t21*t106
+    t108 = t87*s23
+    t109 = t16*t106
     t110 = t57*t99
-    t111 = t101*t58
+    t111 = t58*t101
     t112 = t11*t86
-    t113 = t11*t16 - t21*t8
-    t114 = t113*t94
-    t115 = t114*t16
+    t113 = t11*t16 - t8*t21
+    t114 = t94*t113
+    t115 = t16*t114
     t116 = t8*t86
-    t117 = t114*t21
+    t117 = t21*t114
     t118 = t69*t99
     t119 = t20*t86
-    t120 = -t15*t16 - t20*t21
-    t121 = t120*t94
-    t122 = t121*t21
+    t120 = -(t15*t16 + t20*t21)
+    t121 = t94*t120
+    t122 = t21*t121
     t123 = t15*t86
-    t124 = t121*t16
+    t124 = t16*t121
     t125 = 1/xp.sqrt(t85)
-    t126 = qd1*t125
-    t127 = s1*t125
-    t128 = t85**(-3/2)
+    t126 = t125*qd1
+    t127 = t125*s1
+    t128 = 1/t85**1.5
     t129 = -t128*(t103 + t104)
-    t130 = c1*t125
-    t131 = t126*t91 + t72*(t130 + t129*t16) - t126*t92 - t73*(t127 + t129*t21)
-    t132 = t125*t16
-    t133 = t125*t21
-    t134 = t128*(s23*t92 - s23*t91)
-    t135 = -t128*(t11*t21 + t16*t8)
-    t136 = t128*(t15*t21 - t16*t20)
+    t130 = t125*c1
+    t131 = t72*(t130 + t16*t129) + t91*t126 - t73*(t127 + t21*t129) - t92*t126
+    t132 = t16*t125
+    t133 = t21*t125
+    t134 = t128*(t92*s23 - t91*s23)
+    t135 = -t128*(t11*t21 + t8*t16)
+    t136 = t128*(t15*t21 - t20*t16)
     t137 = t28*t87
     t138 = t28*t89
     t139 = t66*t86
-    t140 = t73*(t137 + t28*t97) - t137*t88 - t138*t90 - t139*t93 - t72*(-t138 + t28*t96)
+    t140 = -(t72*(-t138 + t28*t96) + t88*t137 + t90*t138 + t93*t139 - t73*(t137 + t28*t97))
     Jd = _stack(xp, [
         xp.broadcast_to(-t37, batch),  # 0, 0
         xp.broadcast_to(t75, batch),  # 0, 1
@@ -1143,27 +1143,27 @@ def task_jacobian_dot(q, q_dot):
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
         xp.broadcast_to(t98, batch),  # 3, 1
         xp.broadcast_to(t98, batch),  # 3, 2
-        xp.broadcast_to(t100 + t72*(t108 + t109) - t101*t40 - t73*(t102 + t107), batch),  # 3, 3
+        xp.broadcast_to(t100 + t72*(t108 + t109) - t40*t101 - t73*(t102 + t107), batch),  # 3, 3
         xp.broadcast_to(t110 + t111 - t72*(t112 - t115) - t73*(t116 + t117), batch),  # 3, 4
-        xp.broadcast_to(t118 + t72*(t123 + t124) - t101*t70 - t73*(t119 + t122), batch),  # 3, 5
+        xp.broadcast_to(t118 + t72*(t123 + t124) - t70*t101 - t73*(t119 + t122), batch),  # 3, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
         xp.broadcast_to(t131, batch),  # 4, 1
         xp.broadcast_to(t131, batch),  # 4, 2
-        xp.broadcast_to(t72*(s23*t127 + t134*t16) + t73*(s23*t130 - t134*t21) - t132*t40 - t133*t48, batch),  # 4, 3
-        xp.broadcast_to(t132*t58 + t72*(t125*t8 + t135*t16) - t133*t57 - t73*(t11*t125 + t135*t21), batch),  # 4, 4
-        xp.broadcast_to(t72*(t125*t20 + t136*t16) + t73*(t125*t15 - t136*t21) - t132*t70 - t133*t69, batch),  # 4, 5
+        xp.broadcast_to(-(t48*t133 + t40*t132 - t72*(t16*t134 + t127*s23) - t73*(t130*s23 - t21*t134)), batch),  # 4, 3
+        xp.broadcast_to(t58*t132 + t72*(t8*t125 + t16*t135) - t57*t133 - t73*(t11*t125 + t21*t135), batch),  # 4, 4
+        xp.broadcast_to(-(t69*t133 + t70*t132 - t72*(t20*t125 + t16*t136) - t73*(t15*t125 - t21*t136)), batch),  # 4, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 0
         xp.broadcast_to(t140, batch),  # 5, 1
         xp.broadcast_to(t140, batch),  # 5, 2
-        xp.broadcast_to(-t49 + t73*(t102*t28 + t107*t28) - t100*t28 - t105*t139 - t72*(t108*t28 + t109*t28) + t21*t28*t40*t86, batch),  # 5, 3
-        xp.broadcast_to(t54 + t73*(t116*t28 + t117*t28) - t110*t28 - t111*t28 - t113*t139 - t72*(t115*t28 - t112*t28), batch),  # 5, 4
-        xp.broadcast_to(-t64 + t73*(t119*t28 + t122*t28) - t118*t28 - t120*t139 - t72*(t123*t28 + t124*t28) + t21*t28*t70*t86, batch),  # 5, 5
+        xp.broadcast_to(-(t49 + t28*t100 + t72*(t28*t108 + t28*t109) + t105*t139 - t73*(t28*t102 + t28*t107) - t21*t28*t40*t86), batch),  # 5, 3
+        xp.broadcast_to(-(-t54 + t28*t110 + t28*t111 + t72*(t28*t115 - t28*t112) + t113*t139 - t73*(t28*t116 + t28*t117)), batch),  # 5, 4
+        xp.broadcast_to(-(t64 + t28*t118 + t72*(t28*t123 + t28*t124) + t120*t139 - t73*(t28*t119 + t28*t122) - t21*t28*t70*t86), batch),  # 5, 5
     ], (6, 6))
     return Jd
 
 
 def hessian(q):
-    """partial derivatives dJ/dq_k of the world geometric Jacobian (DOF x 6 x DOF, indexed [k, r, c]): (6 x 6 x 6), 148 operations."""
+    """partial derivatives dJ/dq_k of the world geometric Jacobian (DOF x 6 x DOF, indexed [k, r, c]): (6 x 6 x 6), 142 operations."""
     xp, dtype, device, batch, (q,) = _arguments(("q", q, (6,)))
     trig = _cos_sin(xp, q, (0.0, 0.0, 0.0, 0.0, 0.0, 0.0), device)
     c1 = trig[..., 0]
@@ -1187,41 +1187,41 @@ def hessian(q):
     t6 = 0.0203*t5 - 0.15005*c1
     t7 = s1*s4
     t8 = c1*c4
-    t9 = -t7 + c23*t8
-    t10 = t8 - c23*t7
+    t9 = -t7 + t8*c23
+    t10 = t8 - t7*c23
     t11 = c4*s1
     t12 = c1*s4
-    t13 = t11 + c23*t12
-    t14 = t12 + c23*t11
+    t13 = t11 + t12*c23
+    t14 = t12 + t11*c23
     t15 = c1*s23
-    t16 = c5*t15 + s5*t9
+    t16 = t9*s5 + t15*c5
     t17 = t4 - 0.4318*t15
     t18 = s1*s23
-    t19 = c5*t18 + s5*t14
+    t19 = t14*s5 + t18*c5
     t20 = t6 - 0.4318*t18
-    t21 = c1*t17 + s1*t20
+    t21 = t17*c1 + t20*s1
     t22 = 0.4318*c2
-    t23 = t17 + c1*t22
-    t24 = t20 + s1*t22
-    t25 = c1*t23 + s1*t24
-    t26 = s1*t2
-    t27 = s1*t1
-    t28 = -c1*t2
-    t29 = -c1*t1
-    t30 = -c1*t21
-    t31 = -s1*t21
+    t23 = t17 + t22*c1
+    t24 = t20 + t22*s1
+    t25 = t23*c1 + t24*s1
+    t26 = t2*s1
+    t27 = t1*s1
+    t28 = -t2*c1
+    t29 = -t1*c1
+    t30 = -t21*c1
+    t31 = -t21*s1
     t32 = c1**2
     t33 = s1**2
-    t34 = -t1*t32 - t1*t33
+    t34 = -(t1*t32 + t1*t33)
     t35 = -t3
-    t36 = -s23*t12
-    t37 = -c1*t0
+    t36 = -t12*s23
+    t37 = -t0*c1
     t38 = -t5
-    t39 = -s23*t7
-    t40 = -s1*t0
-    t41 = -s23*t32 - s23*t33
-    t42 = c1*t13 - s1*t10
-    t43 = -c1*t16 - s1*t19
+    t39 = -t7*s23
+    t40 = -t0*s1
+    t41 = -(t32*s23 + t33*s23)
+    t42 = t13*c1 - t10*s1
+    t43 = -(t16*c1 + t19*s1)
     t44 = s23**2
     t45 = s23*s4
     H = _stack(xp, [
@@ -1262,19 +1262,19 @@ def hessian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5, 5
         t26,  # 1, 0, 0
-        -c1*t25,  # 1, 0, 1
+        -t25*c1,  # 1, 0, 1
         t30,  # 1, 0, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 0, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 0, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 0, 5
         t28,  # 1, 1, 0
-        -s1*t25,  # 1, 1, 1
+        -t25*s1,  # 1, 1, 1
         t31,  # 1, 1, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 1, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 1, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 2, 0
-        -t2*t32 - t2*t33,  # 1, 2, 1
+        -(t2*t32 + t2*t33),  # 1, 2, 1
         t34,  # 1, 2, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 2, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 2, 4
@@ -1355,20 +1355,20 @@ def hessian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 3, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 3, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 3, 3
-        c23*t10 - t44*t7,  # 3, 3, 4
-        c23*t19 - t0*t18,  # 3, 3, 5
+        t10*c23 - t7*t44,  # 3, 3, 4
+        t19*c23 - t0*t18,  # 3, 3, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 4, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 4, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 4, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 4, 3
-        c23*t13 + t12*t44,  # 3, 4, 4
-        t0*t15 - c23*t16,  # 3, 4, 5
+        t13*c23 + t44*t12,  # 3, 4, 4
+        t0*t15 - t16*c23,  # 3, 4, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 5, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 5, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 5, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 5, 3
-        t10*t15 + t13*t18,  # 3, 5, 4
-        t15*t19 - t16*t18,  # 3, 5, 5
+        t13*t18 + t10*t15,  # 3, 5, 4
+        t19*t15 - t16*t18,  # 3, 5, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0, 2
@@ -1392,19 +1392,19 @@ def hessian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 3, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 3, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 3, 4
-        t19*t45 - t0*t10,  # 4, 3, 5
+        t19*t45 - t10*t0,  # 4, 3, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 4, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 4, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 4, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 4, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 4, 4
-        -t0*t13 - t16*t45,  # 4, 4, 5
+        -(t13*t0 + t16*t45),  # 4, 4, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 5, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 5, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 5, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 5, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 5, 4
-        -t10*t16 - t13*t19,  # 4, 5, 5
+        -(t13*t19 + t10*t16),  # 4, 5, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 0, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 0, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 0, 2
@@ -1446,7 +1446,7 @@ def hessian(q):
 
 
 def singularity_factors(q):
-    """factors of det(Js): the robot is singular where one is 0: (3 x 1), 16 operations."""
+    """factors of det(Js): the robot is singular where one is 0: (3 x 1), 15 operations."""
     xp, dtype, device, batch, (q,) = _arguments(("q", q, (6,)))
     trig = _cos_sin(xp, q, (0.0, 0.0, 0.0, 0.0, 0.0, 0.0), device)
     c2 = trig[..., 2]
@@ -1456,9 +1456,9 @@ def singularity_factors(q):
     s5 = trig[..., 9]
     t0 = 0.04701250578971746*s3
     f = _stack(xp, [
-        c3 + t0,  # 0
+        t0 + c3,  # 0
         s5,  # 1
-        c2 - c2*s3 - c3*s2 - s2*t0 + 0.04701250578971746*c2*c3,  # 2
+        -(-c2 + t0*s2 + c2*s3 + c3*s2 - 0.04701250578971746*c2*c3),  # 2
     ], (3,))
     return f
 
@@ -1473,7 +1473,7 @@ def manipulability(q):
     s3 = trig[..., 5]
     s5 = trig[..., 9]
     t0 = 0.04701250578971746*s3
-    t1 = -0.080509645432*s5*(c3 + t0)*(-c2 + c2*s3 + c3*s2 + s2*t0 - 0.04701250578971746*c2*c3)
+    t1 = -0.080509645432*s5*(t0 + c3)*(-c2 + t0*s2 + c2*s3 + c3*s2 - 0.04701250578971746*c2*c3)
     w = xp.broadcast_to(xp.abs(t1), batch)
     return w
 
@@ -1488,7 +1488,7 @@ def jacobian_det(q):
     s3 = trig[..., 5]
     s5 = trig[..., 9]
     t0 = 0.04701250578971746*s3
-    d = xp.broadcast_to(-0.080509645432*s5*(c3 + t0)*(-c2 + c2*s3 + c3*s2 + s2*t0 - 0.04701250578971746*c2*c3), batch)
+    d = xp.broadcast_to(-0.080509645432*s5*(t0 + c3)*(-c2 + t0*s2 + c2*s3 + c3*s2 - 0.04701250578971746*c2*c3), batch)
     return d
 
 
@@ -1525,54 +1525,54 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t1 = 0.0203*s23 + 0.4318*c23
     t2 = t1 + 0.4318*s2
     t3 = 0.0203*c23
-    t4 = 0.15005*s1 + c1*t3
-    t5 = -0.15005*c1 + s1*t3
+    t4 = 0.15005*s1 + t3*c1
+    t5 = -0.15005*c1 + t3*s1
     t6 = s1*s4
     t7 = c1*c4
-    t8 = -t6 + c23*t7
-    t9 = t7 - c23*t6
+    t8 = -t6 + t7*c23
+    t9 = t7 - t6*c23
     t10 = c4*s1
     t11 = c1*s4
-    t12 = t10 + c23*t11
-    t13 = t11 + c23*t10
+    t12 = t10 + t11*c23
+    t13 = t11 + t10*c23
     t14 = c1*s23
-    t15 = c5*t14 + s5*t8
+    t15 = t8*s5 + t14*c5
     t16 = t4 - 0.4318*t14
     t17 = s1*s23
-    t18 = c5*t17 + s5*t13
+    t18 = t13*s5 + t17*c5
     t19 = t5 - 0.4318*t17
-    t20 = c1*t16 + s1*t19
+    t20 = t16*c1 + t19*s1
     t21 = 0.4318*c2
-    t22 = t16 + c1*t21
-    t23 = t19 + s1*t21
-    t24 = c1*t22 + s1*t23
+    t22 = t16 + t21*c1
+    t23 = t19 + t21*s1
+    t24 = t22*c1 + t23*s1
     t25 = t23**2
     t26 = t1**2
     t27 = c1**2
     t28 = t1*t27 + t2*t27
     t29 = t2**2
-    t30 = t25 + t26*t27 + t27*t29
+    t30 = t25 + t27*t29 + t27*t26
     t31 = t30
     t32 = -t22*t23
     t33 = c1*s1
-    t34 = t32 + t26*t33 + t29*t33
-    t35 = c1*t20
-    t36 = c1*t24
+    t34 = t32 + t29*t33 + t33*t26
+    t35 = t20*c1
+    t36 = t24*c1
     t37 = t1*t35 + t2*t36
     t38 = t35 + t36
-    t39 = c1*t1
-    t40 = c1*t2
-    t41 = s1*t39 + s1*t40
+    t39 = t1*c1
+    t40 = t2*c1
+    t41 = t39*s1 + t40*s1
     t42 = t22**2
-    t43 = xp.sqrt(1 + t25 + t42)
+    t43 = xp.sqrt(1 + t42 + t25)
     t44 = t43*xp.where(xp.less_equal(t23, 0), xp.asarray(1, dtype=dtype), -1)
     t45 = xp.where(xp.greater(t43, 0), 1/(t43*(t43 + xp.abs(t23))), 0)
     t46 = s1**2
     t47 = t1*t46 + t2*t46
-    t48 = t42 + t26*t46 + t29*t46
+    t48 = t42 + t29*t46 + t46*t26
     t49 = t48
-    t50 = s1*t20
-    t51 = s1*t24
+    t50 = t20*s1
+    t51 = t24*s1
     t52 = t1*t50 + t2*t51
     t53 = t50 + t51
     t54 = t24**2
@@ -1582,13 +1582,13 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t58 = t12**2 + t15**2 + 2*t46 + t27*t57
     t59 = t58
     t60 = 2*c1
-    t61 = t15*t18 + t33*t57 - s1*t60 - t12*t9
+    t61 = t15*t18 + t33*t57 - t12*t9 - t60*s1
     t62 = s23*s4
-    t63 = c23*t14 + t0*t15 - t12*t62
-    t64 = c23*t17 + t0*t18 + t62*t9
-    t65 = t18**2 + t9**2 + 2*t27 + t46*t57
+    t63 = t15*t0 + t14*c23 - t12*t62
+    t64 = t9*t62 + t18*t0 + t17*c23
+    t65 = t9**2 + t18**2 + 2*t27 + t46*t57
     t66 = t65
-    t67 = 1 + c23**2 + t0**2 + t57*s4**2
+    t67 = 1 + t0**2 + c23**2 + t57*s4**2
     t68 = t67
     t69 = xp.sqrt(t30 + t48 + t55 + t58 + t65 + t67)
     t70 = t34**2
@@ -1600,32 +1600,32 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t76 = t68 + t74
     t77 = t31 + t74
     t78 = t77**2
-    t79 = xp.sqrt(t25 + t70 + t71 + t72 + t73 + t78)
+    t79 = xp.sqrt(t70 + t71 + t72 + t73 + t78 + t25)
     t80 = t79*xp.where(xp.greater_equal(t77, 0), xp.asarray(1, dtype=dtype), -1)
-    t81 = t77 + t80
+    t81 = t80 + t77
     t82 = xp.where(xp.greater(t79, 0), 1/(t79*(t79 + xp.abs(t77))), 0)
-    t83 = t82*(t23*t64 + t28*t75 + t28*t81 + t34*t41 + t37*t38 - t41*t61)
+    t83 = t82*(t64*t23 + t81*t28 + t34*t41 + t37*t38 + t28*t75 - t41*t61)
     t84 = t28 - t81*t83
-    t85 = t41 - t34*t83
-    t86 = -t38 + t37*t83
-    t87 = t61 + t41*t83
-    t88 = t75 - t28*t83
-    t89 = -t64 + t23*t83
-    t90 = -t82*(t23*t76 + t23*t81 + t28*t64 - t22*t34 - t41*t63)
+    t85 = t41 - t83*t34
+    t86 = -t38 + t83*t37
+    t87 = t61 + t83*t41
+    t88 = t75 - t83*t28
+    t89 = -t64 + t83*t23
+    t90 = -t82*(t64*t28 + t81*t23 + t23*t76 - t22*t34 - t41*t63)
     t91 = t23 + t81*t90
-    t92 = t22 - t34*t90
-    t93 = t64 + t28*t90
-    t94 = t76 + t23*t90
-    t95 = t82*(mu_dot0*t81 + mu_dot1*t34 + mu_dot4*t28 - mu_dot2*t37 - mu_dot3*t41 - mu_dot5*t23)
+    t92 = t22 - t90*t34
+    t93 = t64 + t90*t28
+    t94 = t76 + t90*t23
+    t95 = t82*(t81*mu_dot0 + t34*mu_dot1 + t28*mu_dot4 - t23*mu_dot5 - t37*mu_dot2 - t41*mu_dot3)
     t96 = mu_dot0 - t81*t95
-    t97 = mu_dot1 - t34*t95
-    t98 = mu_dot2 + t37*t95
-    t99 = mu_dot3 + t41*t95
-    t100 = mu_dot4 - t28*t95
-    t101 = mu_dot5 + t23*t95
+    t97 = mu_dot1 - t95*t34
+    t98 = mu_dot2 + t95*t37
+    t99 = mu_dot3 + t95*t41
+    t100 = mu_dot4 - t95*t28
+    t101 = mu_dot5 + t95*t23
     t102 = t49 + t74
-    t103 = t82*(t32 + t102*t34 + t28*t41 + t34*t81 + t37*t52 + t41*t47)
-    t104 = t34 - t103*t81
+    t103 = t82*(t32 + t81*t34 + t34*t102 + t37*t52 + t41*t28 + t41*t47)
+    t104 = t34 - t81*t103
     t105 = t102 - t103*t34
     t106 = -t52 + t103*t37
     t107 = -t47 + t103*t41
@@ -1635,44 +1635,44 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t111 = t110*xp.where(xp.greater_equal(t105, 0), xp.asarray(1, dtype=dtype), -1)
     t112 = t105 + t111
     t113 = xp.where(xp.greater(t110, 0), 1/(t110*(t110 + xp.abs(t105))), 0)
-    t114 = t113*(t106*t86 + t107*t87 + t108*t88 + t109*t89 + t112*t85)
+    t114 = t113*(t106*t86 + t107*t87 + t108*t88 + t109*t89 + t85*t112)
     t115 = t85 - t112*t114
     t116 = t86 - t106*t114
     t117 = t87 - t107*t114
     t118 = t88 - t108*t114
     t119 = t89 - t109*t114
-    t120 = t113*(t100*t108 + t101*t109 + t106*t98 + t107*t99 + t112*t97)
+    t120 = t113*(t106*t98 + t107*t99 + t108*t100 + t109*t101 + t97*t112)
     t121 = t97 - t112*t120
     t122 = t98 - t106*t120
     t123 = t99 - t107*t120
     t124 = t100 - t108*t120
     t125 = t101 - t109*t120
     t126 = t56 + t74
-    t127 = -t82*(t126*t37 + t28*t38 + t34*t52 + t37*t81 + t41*t53)
-    t128 = t37 + t127*t81
+    t127 = -t82*(t81*t37 + t34*t52 + t37*t126 + t41*t53 + t28*t38)
+    t128 = t37 + t81*t127
     t129 = t52 + t127*t34
     t130 = t126 + t127*t37
     t131 = t53 + t127*t41
     t132 = t38 + t127*t28
     t133 = t59 + t74
-    t134 = xp.sqrt(t78 + t102**2 + t126**2 + t133**2 + t75**2 + t76**2 + 2*t25 + 2*t42 + 2*t70 + 2*t71 + 2*t73 + 2*t38**2 + 2*t47**2 + 2*t52**2 + 2*t53**2 + 2*t61**2 + 2*t63**2 + 2*t64**2 + 4*t72)
-    t135 = -t82*(t133*t41 + t34*t47 + t37*t53 + t41*t81 - t23*t63 - t28*t61)
-    t136 = t41 + t135*t81
+    t134 = xp.sqrt(t78 + t75**2 + t76**2 + t102**2 + t126**2 + t133**2 + 2*t42 + 2*t70 + 2*t71 + 2*t73 + 2*t25 + 2*t64**2 + 2*t52**2 + 2*t47**2 + 2*t53**2 + 2*t38**2 + 2*t61**2 + 2*t63**2 + 4*t72)
+    t135 = -t82*(t81*t41 + t34*t47 + t37*t53 + t41*t133 - t23*t63 - t28*t61)
+    t136 = t41 + t81*t135
     t137 = t47 + t135*t34
     t138 = t53 + t135*t37
     t139 = t133 + t135*t41
     t140 = t61 - t135*t28
     t141 = -t63
     t142 = t141 + t135*t23
-    t143 = t141 + t41*t90
-    t144 = t113*(t106*t138 + t107*t139 + t108*t140 + t109*t142 - t112*t137)
+    t143 = t141 + t90*t41
+    t144 = t113*(t106*t138 + t107*t139 + t108*t140 + t109*t142 - t137*t112)
     t145 = t137 + t112*t144
     t146 = t138 - t106*t144
     t147 = t139 - t107*t144
     t148 = t140 - t108*t144
     t149 = t142 - t109*t144
     t150 = t127*t23
-    t151 = t113*(t106*t130 + t107*t131 + t109*t150 - t108*t132 - t112*t129)
+    t151 = t113*(t106*t130 + t107*t131 + t109*t150 - t108*t132 - t129*t112)
     t152 = t129 + t112*t151
     t153 = t130 - t106*t151
     t154 = t131 - t107*t151
@@ -1682,17 +1682,17 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t158 = t157*xp.where(xp.greater_equal(t153, 0), xp.asarray(1, dtype=dtype), -1)
     t159 = t153 + t158
     t160 = xp.where(xp.greater(t157, 0), 1/(t157*(t157 + xp.abs(t153))), 0)
-    t161 = t160*(t146*t159 + t147*t154 + t149*t156 - t148*t155)
+    t161 = t160*(t154*t147 + t156*t149 + t146*t159 - t155*t148)
     t162 = t146 - t159*t161
     t163 = t147 - t154*t161
     t164 = t148 + t155*t161
     t165 = t149 - t156*t161
-    t166 = t160*(t116*t159 + t117*t154 + t119*t156 - t118*t155)
+    t166 = t160*(t154*t117 + t156*t119 + t116*t159 - t155*t118)
     t167 = t116 - t159*t166
     t168 = t117 - t154*t166
     t169 = t118 + t155*t166
     t170 = t119 - t156*t166
-    t171 = t160*(t122*t159 + t123*t154 + t125*t156 - t124*t155)
+    t171 = t160*(t154*t123 + t156*t125 + t122*t159 - t155*t124)
     t172 = t122 - t159*t171
     t173 = t123 - t154*t171
     t174 = t124 + t155*t171
@@ -1716,80 +1716,80 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t192 = t191*(t183*t187 + t186*t190)
     t193 = t186 - t190*t192
     t194 = t187 - t183*t192
-    t195 = t37*t90
-    t196 = t113*(t106*t195 + t107*t143 + t109*t94 + t112*t92 - t108*t93)
+    t195 = t90*t37
+    t196 = t113*(t106*t195 + t107*t143 + t109*t94 + t92*t112 - t108*t93)
     t197 = t92 - t112*t196
     t198 = t195 - t106*t196
     t199 = t143 - t107*t196
     t200 = t93 + t108*t196
     t201 = t94 - t109*t196
-    t202 = t160*(t154*t199 + t155*t200 + t156*t201 + t159*t198)
+    t202 = t160*(t154*t199 + t155*t200 + t156*t201 + t198*t159)
     t203 = t198 - t159*t202
     t204 = t199 - t154*t202
     t205 = -t200 + t155*t202
     t206 = t201 - t156*t202
-    t207 = t179*(t164*t205 + t165*t206 + t178*t204)
+    t207 = t179*(t164*t205 + t165*t206 + t204*t178)
     t208 = t204 - t178*t207
     t209 = t205 - t164*t207
     t210 = t206 - t165*t207
-    t211 = t191*(t183*t210 + t190*t209)
+    t211 = t191*(t183*t210 + t209*t190)
     t212 = t209 - t190*t211
     t213 = t210 - t183*t211
     t214 = xp.abs(t213)
     t215 = t214
     t216 = t215*xp.where(xp.greater_equal(t213, 0), xp.asarray(1, dtype=dtype), -1)
     t217 = t213 + t216
-    t218 = xp.where(xp.greater(t215, 0), 1/(t215*(t214 + t215)), 0)
+    t218 = xp.where(xp.greater(t215, 0), 1/(t215*(t215 + t214)), 0)
     t219 = t194 - t194*t218*t217**2
     t220 = xp.where(xp.not_equal(t216, 0), -t219/t216, 0)
     t221 = xp.where(xp.not_equal(t189, 0), -(t193 - t212*t220)/t189, 0)
-    t222 = xp.where(xp.not_equal(t177, 0), -(t185 - t181*t221 - t208*t220)/t177, 0)
-    t223 = xp.where(xp.not_equal(t158, 0), -(t172 - t162*t222 - t167*t221 - t203*t220)/t158, 0)
-    t224 = xp.where(xp.not_equal(t111, 0), -(t121 + t145*t222 + t152*t223 - t115*t221 - t197*t220)/t111, 0)
-    t225 = xp.where(xp.not_equal(t80, 0), -(t96 + t128*t223 + t136*t222 + t220*t91 - t104*t224 - t221*t84)/t80, 0)
-    t226 = t220 + t22*t224 - t225*t23
-    t227 = t14*t222 + t17*t221 - c23*t220
-    t228 = t12*t222 + t220*t62 - t221*t9
-    t229 = t15*t222 + t18*t221 - t0*t220
-    t230 = s1*t2
-    t231 = c1*t221 - s1*t222
+    t222 = xp.where(xp.not_equal(t177, 0), -(t185 - (t181*t221 + t208*t220))/t177, 0)
+    t223 = xp.where(xp.not_equal(t158, 0), -(t172 - (t162*t222 + t167*t221 + t203*t220))/t158, 0)
+    t224 = xp.where(xp.not_equal(t111, 0), -(t121 - (t115*t221 + t197*t220 - t152*t223 - t145*t222))/t111, 0)
+    t225 = xp.where(xp.not_equal(t80, 0), -(t96 + t128*t223 + t136*t222 + t91*t220 - t104*t224 - t84*t221)/t80, 0)
+    t226 = t220 + t224*t22 - t225*t23
+    t227 = t221*t17 + t222*t14 - t220*c23
+    t228 = t12*t222 + t220*t62 - t9*t221
+    t229 = t221*t18 + t222*t15 - t220*t0
+    t230 = t2*s1
+    t231 = t221*c1 - t222*s1
     t232 = t231 + t224*t230 + t225*t40 - t223*t24
-    t233 = s1*t1
-    t234 = t231 + t224*t233 + t225*t39 - t20*t223
+    t233 = t1*s1
+    t234 = t231 + t224*t233 + t225*t39 - t223*t20
     t235 = -t23
-    t236 = t235 + t44
-    t237 = -t45*(t22*t230 + t236*t40)
+    t236 = t44 + t235
+    t237 = -t45*(t236*t40 + t22*t230)
     t238 = t40 + t236*t237
-    t239 = t230 + t22*t237
-    t240 = -t45*(t22*t233 + t236*t39)
+    t239 = t230 + t237*t22
+    t240 = -t45*(t236*t39 + t22*t233)
     t241 = t39 + t236*t240
-    t242 = t233 + t22*t240
-    t243 = t45*(mu_dot5 + mu_dot0*t236 + mu_dot1*t22)
+    t242 = t233 + t240*t22
+    t243 = t45*(mu_dot5 + t236*mu_dot0 + t22*mu_dot1)
     t244 = mu_dot0 - t236*t243
-    t245 = mu_dot1 - t22*t243
+    t245 = mu_dot1 - t243*t22
     t246 = mu_dot5 - t243
-    t247 = c23*t45
+    t247 = t45*c23
     t248 = c23 - t247
     t249 = t45*t62
     t250 = t62 - t249
-    t251 = t0*t45
+    t251 = t45*t0
     t252 = t0 - t251
     t253 = t27 + t46
-    t254 = xp.sqrt(t253 + t54 + t237**2 + t239**2)
+    t254 = xp.sqrt(t54 + t253 + t237**2 + t239**2)
     t255 = t254*xp.where(xp.less_equal(t239, 0), xp.asarray(1, dtype=dtype), -1)
     t256 = t255 - t239
     t257 = xp.where(xp.greater(t254, 0), 1/(t254*(t254 + xp.abs(t239))), 0)
-    t258 = t257*(t253 + t20*t24 + t237*t240 - t242*t256)
+    t258 = t257*(t253 + t237*t240 + t24*t20 - t242*t256)
     t259 = t242 + t256*t258
-    t260 = t20 - t24*t258
-    t261 = s1 - s1*t258
-    t262 = -c1 + c1*t258
+    t260 = t20 - t258*t24
+    t261 = s1 - t258*s1
+    t262 = -c1 + t258*c1
     t263 = -t240 + t237*t258
-    t264 = t257*(mu_dot2*t24 + mu_dot3*s1 + t245*t256 - c1*mu_dot4 - t237*t246)
+    t264 = t257*(t245*t256 + t24*mu_dot2 + mu_dot3*s1 - t237*t246 - c1*mu_dot4)
     t265 = t245 - t256*t264
-    t266 = mu_dot2 - t24*t264
-    t267 = mu_dot3 - s1*t264
-    t268 = mu_dot4 + c1*t264
+    t266 = mu_dot2 - t264*t24
+    t267 = mu_dot3 - t264*s1
+    t268 = mu_dot4 + t264*c1
     t269 = t246 + t237*t264
     t270 = xp.sqrt(t260**2 + t261**2 + t262**2 + t263**2)
     t271 = t270*xp.where(xp.greater_equal(t260, 0), xp.asarray(1, dtype=dtype), -1)
@@ -1803,26 +1803,26 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t279 = t22*t247
     t280 = -t257*(t237*t248 + t256*t279)
     t281 = t279 + t256*t280
-    t282 = t14 + s1*t280
+    t282 = t14 + t280*s1
     t283 = t248 + t237*t280
     t284 = -t17
-    t285 = t284 + c1*t280
+    t285 = t284 + t280*c1
     t286 = t22*t249
-    t287 = t257*(c1*t9 + s1*t12 - t237*t250 - t256*t286)
+    t287 = t257*(t12*s1 + t9*c1 - t237*t250 - t256*t286)
     t288 = t286 + t256*t287
-    t289 = t12 - s1*t287
+    t289 = t12 - t287*s1
     t290 = t250 + t237*t287
     t291 = -t9
-    t292 = t291 + c1*t287
+    t292 = t291 + t287*c1
     t293 = t22*t251
-    t294 = -t257*(s1*t15 + t237*t252 + t256*t293 - c1*t18)
+    t294 = -t257*(t237*t252 + t15*s1 + t256*t293 - t18*c1)
     t295 = t293 + t256*t294
-    t296 = t15 + s1*t294
+    t296 = t15 + t294*s1
     t297 = t252 + t237*t294
     t298 = -t18
-    t299 = t298 + c1*t294
-    t300 = 1 + c23 + damping + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + q1 + q2 + q3 + q4 + q5 + q6 + t0 + t12 + t20 + t22 + t235 + t24 + t284 + t291 + t298 + t62 - t14 - t15 - t230 - t233 - t39 - t40 - t60 + 2*s1
-    t301 = t24*t280
+    t299 = t298 + t294*c1
+    t300 = 1 + t12 + t0 + t22 + t24 + t20 + t62 + t235 + t284 + t291 + t298 + c23 + damping + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + q1 + q2 + q3 + q4 + q5 + q6 - t15 - t39 - t40 - t60 - t230 - t14 - t233 + 2*s1
+    t301 = t280*t24
     t302 = t273*(t262*t285 + t263*t283 - t261*t282 - t272*t301)
     t303 = t301 + t272*t302
     t304 = t282 + t261*t302
@@ -1832,17 +1832,17 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t308 = t307*xp.where(xp.less_equal(t304, 0), xp.asarray(1, dtype=dtype), -1)
     t309 = t308 - t304
     t310 = xp.where(xp.greater(t307, 0), 1/(t307*(t307 + xp.abs(t304))), 0)
-    t311 = t310*(t276*t309 + t277*t305 + t278*t306)
+    t311 = t310*(t305*t277 + t306*t278 + t276*t309)
     t312 = t276 - t309*t311
     t313 = t277 - t305*t311
     t314 = t278 - t306*t311
-    t315 = t24*t287
+    t315 = t287*t24
     t316 = t273*(t261*t289 + t262*t292 + t263*t290 - t272*t315)
     t317 = t315 + t272*t316
     t318 = t289 - t261*t316
     t319 = t292 - t262*t316
     t320 = t290 - t263*t316
-    t321 = t310*(t305*t319 + t306*t320 + t309*t318)
+    t321 = t310*(t305*t319 + t306*t320 + t318*t309)
     t322 = t318 - t309*t321
     t323 = t319 - t305*t321
     t324 = t320 - t306*t321
@@ -1850,40 +1850,40 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t326 = t325*xp.where(xp.greater_equal(t323, 0), xp.asarray(1, dtype=dtype), -1)
     t327 = t323 + t326
     t328 = xp.where(xp.greater(t325, 0), 1/(t325*(t325 + xp.abs(t323))), 0)
-    t329 = t328*(t313*t327 + t314*t324)
+    t329 = t328*(t324*t314 + t313*t327)
     t330 = t313 - t327*t329
     t331 = t314 - t324*t329
-    t332 = t24*t294
+    t332 = t294*t24
     t333 = t273*(t262*t299 + t263*t297 - t261*t296 - t272*t332)
     t334 = t332 + t272*t333
     t335 = t296 + t261*t333
     t336 = t299 - t262*t333
     t337 = t297 - t263*t333
-    t338 = t310*(t305*t336 + t306*t337 - t309*t335)
+    t338 = t310*(t305*t336 + t306*t337 - t335*t309)
     t339 = t335 + t309*t338
     t340 = t336 - t305*t338
     t341 = t337 - t306*t338
-    t342 = t328*(t324*t341 + t327*t340)
+    t342 = t328*(t324*t341 + t340*t327)
     t343 = t340 - t327*t342
     t344 = t341 - t324*t342
     t345 = xp.abs(t344)
     t346 = t345
     t347 = t346*xp.where(xp.greater_equal(t344, 0), xp.asarray(1, dtype=dtype), -1)
     t348 = t344 + t347
-    t349 = xp.where(xp.greater(t346, 0), 1/(t346*(t345 + t346)), 0)
+    t349 = xp.where(xp.greater(t346, 0), 1/(t346*(t346 + t345)), 0)
     t350 = t331 - t331*t349*t348**2
     t351 = xp.where(xp.not_equal(t347, 0), -t350/t347, 0)
     t352 = xp.where(xp.not_equal(t326, 0), -(t330 - t343*t351)/t326, 0)
-    t353 = xp.where(xp.not_equal(t308, 0), -(t312 + t339*t351 - t322*t352)/t308, 0)
+    t353 = xp.where(xp.not_equal(t308, 0), -(t312 - (t322*t352 - t339*t351))/t308, 0)
     t354 = xp.where(xp.not_equal(t271, 0), -(t275 + t303*t353 + t317*t352 + t334*t351)/t271, 0)
     t355 = xp.where(xp.not_equal(t255, 0), -(t265 + t259*t354 + t281*t353 + t288*t352 + t295*t351)/t255, 0)
-    t356 = xp.where(xp.not_equal(t44, 0), -(t244 + t238*t355 + t241*t354 + t236*t247*t353 + t236*t249*t352 + t236*t251*t351)/t44, 0)
+    t356 = xp.where(xp.not_equal(t44, 0), -(t244 + t238*t355 + t241*t354 + t236*t351*t251 + t236*t352*t249 + t236*t353*t247)/t44, 0)
     t357 = xp.greater(damping, 0)
     t358 = xp.isfinite(t300)
     t359 = xp.greater_equal(damping, 0)
     t360 = 1e-12*t69
     t361 = 1e-12*t134
-    t362 = (t357 & ((xp.less_equal(t110, t361)) | (xp.less_equal(t157, t361)) | (xp.less_equal(t176, t361)) | (xp.less_equal(t188, t361)) | (xp.less_equal(t215, t361)) | (xp.less_equal(t79, t361)))) | ((xp.less_equal(damping, 0)) & ((xp.less_equal(t254, t360)) | (xp.less_equal(t270, t360)) | (xp.less_equal(t307, t360)) | (xp.less_equal(t325, t360)) | (xp.less_equal(t346, t360)) | (xp.less_equal(t43, t360))))
+    t362 = (t357 & (xp.less_equal(t79, t361) | xp.less_equal(t110, t361) | xp.less_equal(t157, t361) | xp.less_equal(t176, t361) | xp.less_equal(t188, t361) | xp.less_equal(t215, t361))) | (xp.less_equal(damping, 0) & (xp.less_equal(t43, t360) | xp.less_equal(t254, t360) | xp.less_equal(t270, t360) | xp.less_equal(t307, t360) | xp.less_equal(t325, t360) | xp.less_equal(t346, t360)))
     t363 = t358 & t359 & xp.logical_not(t362)
     q_dot = _stack(xp, [
         xp.broadcast_to(xp.where(t363, xp.where(t357, t226, t356), 0), batch),  # 0
@@ -1899,7 +1899,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def ik_numeric_step(target, q, damping=0.0):
-    """one step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite): (6 x 1 and 6 x 1 and 1 x 1), 921 operations."""
+    """one step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite): (6 x 1 and 6 x 1 and 1 x 1), 916 operations."""
     xp, dtype, device, batch, (target, q, damping,) = _arguments(("target", target, (4, 4)), ("q", q, (6,)), ("damping", damping, ()))
     T00 = target[..., 0, 0]
     T01 = target[..., 0, 1]
@@ -1945,55 +1945,55 @@ def ik_numeric_step(target, q, damping=0.0):
     t3 = T23 - t2
     t4 = T00 + T01 + T02 + T03 + T10 + T11 + T12 + T13 + T20 + T21 + T22 + T23 + qs1 + qs2 + qs3 + qs4 + qs5 + qs6
     t5 = 0.0203*c23
-    t6 = 0.15005*s1 + c1*t5
-    t7 = -0.15005*c1 + s1*t5
+    t6 = 0.15005*s1 + t5*c1
+    t7 = -0.15005*c1 + t5*s1
     t8 = s1*s4
     t9 = c1*c4
-    t10 = -t8 + c23*t9
-    t11 = t9 - c23*t8
+    t10 = -t8 + t9*c23
+    t11 = t9 - t8*c23
     t12 = c4*s1
     t13 = c1*s4
-    t14 = t12 + c23*t13
-    t15 = t13 + c23*t12
+    t14 = t12 + t13*c23
+    t15 = t13 + t12*c23
     t16 = c1*s23
-    t17 = c5*t10 - s5*t16
-    t18 = c5*t16 + s5*t10
-    t19 = c6*t17 - s6*t14
-    t20 = c6*t14 + s6*t17
+    t17 = t10*c5 - t16*s5
+    t18 = t10*s5 + t16*c5
+    t19 = t17*c6 - t14*s6
+    t20 = t14*c6 + t17*s6
     t21 = t6 - 0.4318*t16
     t22 = T01*t20 + T02*t18 - T00*t19
     t23 = T11*t20 + T12*t18 - T10*t19
     t24 = T21*t20 + T22*t18 - T20*t19
     t25 = s1*s23
-    t26 = c5*t15 - s5*t25
-    t27 = c5*t25 + s5*t15
-    t28 = c6*t26 + s6*t11
-    t29 = c6*t11 - s6*t26
+    t26 = t15*c5 - t25*s5
+    t27 = t15*s5 + t25*c5
+    t28 = t11*s6 + t26*c6
+    t29 = t11*c6 - t26*s6
     t30 = t7 - 0.4318*t25
-    t31 = c1*t21 + s1*t30
+    t31 = t21*c1 + t30*s1
     t32 = T00*t28 + T01*t29 - T02*t27
     t33 = T10*t28 + T11*t29 - T12*t27
     t34 = T20*t28 + T21*t29 - T22*t27
-    t35 = -0.5*t23 - 0.5*t32
+    t35 = -0.5*(t32 + t23)
     t36 = c4*s23
-    t37 = c23*s5 + c5*t36
-    t38 = c23*c5 - s5*t36
+    t37 = t36*c5 + c23*s5
+    t38 = c23*c5 - t36*s5
     t39 = s23*s4
-    t40 = c6*t37 - s6*t39
-    t41 = c6*t39 + s6*t37
-    t42 = c23*t16 + t18*t38 - t14*t39
-    t43 = c23*t25 + t11*t39 + t27*t38
+    t40 = t37*c6 - t39*s6
+    t41 = t37*s6 + t39*c6
+    t42 = t18*t38 + t16*c23 - t14*t39
+    t43 = t11*t39 + t27*t38 + t25*c23
     t44 = T00*t40 + T02*t38 - T01*t41
     t45 = T10*t40 + T12*t38 - T11*t41
     t46 = T20*t40 + T22*t38 - T21*t41
-    t47 = 0.5*t34 - 0.5*t45
-    t48 = 0.5*t24 + 0.5*t44
-    t49 = xp.sqrt(t35**2 + t47**2 + t48**2)
+    t47 = 0.5*(t34 - t45)
+    t48 = 0.5*(t44 + t24)
+    t49 = xp.sqrt(t47**2 + t48**2 + t35**2)
     t50 = 0.4318*c2
-    t51 = t21 + c1*t50
-    t52 = t30 + s1*t50
-    t53 = c1*t51 + s1*t52
-    t54 = t31**2 + t53**2
+    t51 = t21 + t50*c1
+    t52 = t30 + t50*s1
+    t53 = t51*c1 + t52*s1
+    t54 = t53**2 + t31**2
     t55 = T03 - t51
     t56 = T13 - t52
     t57 = t52**2
@@ -2006,53 +2006,53 @@ def ik_numeric_step(target, q, damping=0.0):
     t64 = c1*s1
     t65 = t63 + t58*t64 + t61*t64
     t66 = t0*t64 + t1*t64
-    t67 = c1*t31
-    t68 = c1*t53
+    t67 = t31*c1
+    t68 = t53*c1
     t69 = t0*t67 + t1*t68
     t70 = t67 + t68
     t71 = s1**2
     t72 = t51**2 + t58*t71 + t61*t71
     t73 = t0*t71 + t1*t71
-    t74 = s1*t31
-    t75 = s1*t53
+    t74 = t31*s1
+    t75 = t53*s1
     t76 = t0*t74 + t1*t75
     t77 = t74 + t75
     t78 = s23**2
     t79 = t14**2 + t18**2 + 2*t71 + t59*t78
-    t80 = -2*t64 + t18*t27 + t64*t78 - t11*t14
+    t80 = -2*t64 + t18*t27 + t64*t78 - t14*t11
     t81 = t11**2 + t27**2 + 2*t59 + t71*t78
-    t82 = 1 + c23**2 + t38**2 + t78*s4**2
+    t82 = 1 + t38**2 + c23**2 + t78*s4**2
     t83 = -t22
-    t84 = -0.5 + 0.5*t33 + 0.5*t46 + 0.5*t83
+    t84 = 0.5*(-1 + t33 + t46 + t83)
     t85 = xp.atan2(t49, t84)
     t86 = xp.where(xp.greater(t49, 0), t85/t49, 1)
-    t87 = (xp.less_equal(t22, -t33)) & (xp.less_equal(t22, -t46))
+    t87 = xp.less_equal(t22, -t33) & xp.less_equal(t22, -t46)
     t88 = xp.greater_equal(t33, t46)
-    t89 = xp.where(t87, 0.5 + 0.5*t83, xp.where(t88, 0.5*t32, 0.5*t44))
-    t90 = xp.where(t87, -0.5*t23, xp.where(t88, 0.5 + 0.5*t33, 0.5*t45))
-    t91 = xp.where(t87, -0.5*t24, xp.where(t88, 0.5*t34, 0.5 + 0.5*t46))
+    t89 = xp.where(t87, 0.5*(1 + t83), xp.where(t88, 0.5*t32, 0.5*t44))
+    t90 = xp.where(t87, -0.5*t23, xp.where(t88, 0.5*(1 + t33), 0.5*t45))
+    t91 = xp.where(t87, -0.5*t24, xp.where(t88, 0.5*t34, 0.5*(1 + t46)))
     t92 = xp.sqrt(t89**2 + t90**2 + t91**2)
-    t93 = xp.where(xp.greater_equal(t35*t91 + t47*t89 + t48*t90, 0), xp.asarray(1, dtype=dtype), -1)
-    t94 = (xp.greater(t49, 1e-06)) | (xp.greater(t84, 0))
+    t93 = xp.where(xp.greater_equal(t47*t89 + t48*t90 + t35*t91, 0), xp.asarray(1, dtype=dtype), -1)
+    t94 = xp.greater(t49, 1e-06) | xp.greater(t84, 0)
     t95 = t85*t93/t92
     t96 = xp.where(t94, t47*t86, t89*t95)
     t97 = xp.where(t94, t48*t86, t90*t95)
     t98 = xp.where(t94, t35*t86, t91*t95)
-    t99 = t3**2 + t55**2 + t56**2 + t96**2 + t97**2 + t98**2
-    t100 = damping + t62
-    t101 = xp.sqrt(t57 + t100**2 + t60**2 + t65**2 + t66**2 + t69**2)
+    t99 = t96**2 + t97**2 + t98**2 + t55**2 + t56**2 + t3**2
+    t100 = t62 + damping
+    t101 = xp.sqrt(t57 + t65**2 + t69**2 + t66**2 + t60**2 + t100**2)
     t102 = t101*xp.where(xp.greater_equal(t100, 0), xp.asarray(1, dtype=dtype), -1)
-    t103 = t100 + t102
+    t103 = t102 + t100
     t104 = xp.where(xp.greater(t101, 0), 1/(t101*(t101 + xp.abs(t100))), 0)
-    t105 = t104*(t103*t55 + t56*t65 + t60*t97 - t3*t69 - t52*t98 - t66*t96)
+    t105 = t104*(t97*t60 + t55*t103 + t56*t65 - t96*t66 - t98*t52 - t3*t69)
     t106 = t55 - t103*t105
     t107 = t56 - t105*t65
     t108 = t3 + t105*t69
     t109 = t96 + t105*t66
     t110 = t97 - t105*t60
     t111 = t98 + t105*t52
-    t112 = damping + t72
-    t113 = t104*(t63 + t103*t65 + t112*t65 + t60*t66 + t66*t73 + t69*t76)
+    t112 = t72 + damping
+    t113 = t104*(t63 + t103*t65 + t65*t112 + t69*t76 + t66*t60 + t66*t73)
     t114 = t65 - t103*t113
     t115 = t112 - t113*t65
     t116 = -t76 + t113*t69
@@ -2063,21 +2063,21 @@ def ik_numeric_step(target, q, damping=0.0):
     t121 = t120*xp.where(xp.greater_equal(t115, 0), xp.asarray(1, dtype=dtype), -1)
     t122 = t115 + t121
     t123 = xp.where(xp.greater(t120, 0), 1/(t120*(t120 + xp.abs(t115))), 0)
-    t124 = t123*(t107*t122 + t108*t116 + t109*t117 + t110*t118 + t111*t119)
+    t124 = t123*(t116*t108 + t117*t109 + t118*t110 + t119*t111 + t107*t122)
     t125 = t107 - t122*t124
     t126 = t108 - t116*t124
     t127 = t109 - t117*t124
     t128 = t110 - t118*t124
     t129 = t111 - t119*t124
-    t130 = damping + t54
-    t131 = -t104*(t103*t69 + t130*t69 + t60*t70 + t65*t76 + t66*t77)
+    t130 = t54 + damping
+    t131 = -t104*(t103*t69 + t65*t76 + t69*t130 + t66*t77 + t60*t70)
     t132 = t69 + t103*t131
     t133 = t76 + t131*t65
     t134 = t130 + t131*t69
     t135 = t77 + t131*t66
     t136 = t70 + t131*t60
-    t137 = damping + t79
-    t138 = -t104*(t103*t66 + t137*t66 + t65*t73 + t69*t77 - t42*t52 - t60*t80)
+    t137 = t79 + damping
+    t138 = -t104*(t103*t66 + t65*t73 + t69*t77 + t66*t137 - t52*t42 - t60*t80)
     t139 = t66 + t103*t138
     t140 = t73 + t138*t65
     t141 = t77 + t138*t69
@@ -2085,35 +2085,35 @@ def ik_numeric_step(target, q, damping=0.0):
     t143 = t80 - t138*t60
     t144 = -t42
     t145 = t144 + t138*t52
-    t146 = t123*(t116*t141 + t117*t142 + t118*t143 + t119*t145 - t122*t140)
+    t146 = t123*(t116*t141 + t117*t142 + t118*t143 + t119*t145 - t140*t122)
     t147 = t140 + t122*t146
     t148 = t141 - t116*t146
     t149 = t142 - t117*t146
     t150 = t143 - t118*t146
     t151 = t145 - t119*t146
-    t152 = damping + t81
-    t153 = t104*(t103*t60 + t152*t60 + t43*t52 + t65*t66 + t69*t70 - t66*t80)
+    t152 = t81 + damping
+    t153 = t104*(t43*t52 + t103*t60 + t65*t66 + t69*t70 + t60*t152 - t66*t80)
     t154 = t60 - t103*t153
     t155 = t66 - t153*t65
     t156 = -t70 + t153*t69
     t157 = t80 + t153*t66
     t158 = t152 - t153*t60
     t159 = -t43 + t153*t52
-    t160 = t123*(t116*t156 + t117*t157 + t118*t158 + t119*t159 + t122*t155)
+    t160 = t123*(t116*t156 + t117*t157 + t118*t158 + t119*t159 + t155*t122)
     t161 = t155 - t122*t160
     t162 = t156 - t116*t160
     t163 = t157 - t117*t160
     t164 = t158 - t118*t160
     t165 = t159 - t119*t160
-    t166 = damping + t82
-    t167 = -t104*(t103*t52 + t166*t52 + t43*t60 - t42*t66 - t51*t65)
+    t166 = t82 + damping
+    t167 = -t104*(t43*t60 + t103*t52 + t52*t166 - t51*t65 - t66*t42)
     t168 = t52 + t103*t167
     t169 = t51 - t167*t65
     t170 = t144 + t167*t66
     t171 = t43 + t167*t60
     t172 = t166 + t167*t52
     t173 = t131*t52
-    t174 = t123*(t116*t134 + t117*t135 + t119*t173 - t118*t136 - t122*t133)
+    t174 = t123*(t116*t134 + t117*t135 + t119*t173 - t118*t136 - t133*t122)
     t175 = t133 + t122*t174
     t176 = t134 - t116*t174
     t177 = t135 - t117*t174
@@ -2123,17 +2123,17 @@ def ik_numeric_step(target, q, damping=0.0):
     t181 = t180*xp.where(xp.greater_equal(t176, 0), xp.asarray(1, dtype=dtype), -1)
     t182 = t176 + t181
     t183 = xp.where(xp.greater(t180, 0), 1/(t180*(t180 + xp.abs(t176))), 0)
-    t184 = t183*(t148*t182 + t149*t177 + t151*t179 - t150*t178)
+    t184 = t183*(t177*t149 + t179*t151 + t148*t182 - t178*t150)
     t185 = t148 - t182*t184
     t186 = t149 - t177*t184
     t187 = t150 + t178*t184
     t188 = t151 - t179*t184
-    t189 = t183*(t162*t182 + t163*t177 + t165*t179 - t164*t178)
+    t189 = t183*(t177*t163 + t179*t165 + t162*t182 - t178*t164)
     t190 = t162 - t182*t189
     t191 = t163 - t177*t189
     t192 = t164 + t178*t189
     t193 = t165 - t179*t189
-    t194 = t183*(t126*t182 + t127*t177 + t129*t179 - t128*t178)
+    t194 = t183*(t177*t127 + t179*t129 + t126*t182 - t178*t128)
     t195 = t126 - t182*t194
     t196 = t127 - t177*t194
     t197 = t128 + t178*t194
@@ -2158,45 +2158,45 @@ def ik_numeric_step(target, q, damping=0.0):
     t216 = t209 - t213*t215
     t217 = t210 - t206*t215
     t218 = t167*t69
-    t219 = t123*(t116*t218 + t117*t170 + t119*t172 + t122*t169 - t118*t171)
+    t219 = t123*(t116*t218 + t117*t170 + t119*t172 + t169*t122 - t118*t171)
     t220 = t169 - t122*t219
     t221 = t218 - t116*t219
     t222 = t170 - t117*t219
     t223 = t171 + t118*t219
     t224 = t172 - t119*t219
-    t225 = t183*(t177*t222 + t178*t223 + t179*t224 + t182*t221)
+    t225 = t183*(t177*t222 + t178*t223 + t179*t224 + t221*t182)
     t226 = t221 - t182*t225
     t227 = t222 - t177*t225
     t228 = -t223 + t178*t225
     t229 = t224 - t179*t225
-    t230 = t202*(t187*t228 + t188*t229 + t201*t227)
+    t230 = t202*(t187*t228 + t188*t229 + t227*t201)
     t231 = t227 - t201*t230
     t232 = t228 - t187*t230
     t233 = t229 - t188*t230
-    t234 = t214*(t206*t233 + t213*t232)
+    t234 = t214*(t206*t233 + t232*t213)
     t235 = t232 - t213*t234
     t236 = t233 - t206*t234
     t237 = xp.abs(t236)
     t238 = t237
     t239 = t238*xp.where(xp.greater_equal(t236, 0), xp.asarray(1, dtype=dtype), -1)
     t240 = t236 + t239
-    t241 = xp.where(xp.greater(t238, 0), 1/(t238*(t237 + t238)), 0)
+    t241 = xp.where(xp.greater(t238, 0), 1/(t238*(t238 + t237)), 0)
     t242 = t217 - t217*t241*t240**2
     t243 = xp.where(xp.not_equal(t239, 0), -t242/t239, 0)
     t244 = xp.where(xp.not_equal(t212, 0), -(t216 - t235*t243)/t212, 0)
-    t245 = xp.where(xp.not_equal(t200, 0), -(t208 - t204*t244 - t231*t243)/t200, 0)
-    t246 = xp.where(xp.not_equal(t181, 0), -(t195 - t185*t245 - t190*t244 - t226*t243)/t181, 0)
-    t247 = xp.where(xp.not_equal(t121, 0), -(t125 + t147*t245 + t175*t246 - t161*t244 - t220*t243)/t121, 0)
+    t245 = xp.where(xp.not_equal(t200, 0), -(t208 - (t204*t244 + t231*t243))/t200, 0)
+    t246 = xp.where(xp.not_equal(t181, 0), -(t195 - (t185*t245 + t190*t244 + t226*t243))/t181, 0)
+    t247 = xp.where(xp.not_equal(t121, 0), -(t125 - (t161*t244 + t220*t243 - t175*t246 - t147*t245))/t121, 0)
     t248 = xp.where(xp.not_equal(t102, 0), -(t106 + t132*t246 + t139*t245 + t168*t243 - t114*t247 - t154*t244)/t102, 0)
-    t249 = q1 + t243 + t247*t51 - t248*t52
-    t250 = q4 + c23*t243 - t16*t245 - t244*t25
+    t249 = t243 + q1 + t51*t247 - t52*t248
+    t250 = q4 + t243*c23 - t244*t25 - t245*t16
     t251 = q5 + t14*t245 + t243*t39 - t11*t244
-    t252 = q6 + t243*t38 - t18*t245 - t244*t27
-    t253 = s1*t247
-    t254 = c1*t248
-    t255 = s1*t245 - c1*t244
-    t256 = q2 + t255 + t246*t53 - t1*t253 - t1*t254
-    t257 = q3 + t255 + t246*t31 - t0*t253 - t0*t254
+    t252 = q6 + t38*t243 - t18*t245 - t27*t244
+    t253 = t247*s1
+    t254 = t248*c1
+    t255 = t245*s1 - t244*c1
+    t256 = t255 + q2 + t53*t246 - t1*t253 - t1*t254
+    t257 = t255 + q3 + t31*t246 - t0*t253 - t0*t254
     q_start = _stack(xp, [
         xp.broadcast_to(q1, batch),  # 0
         xp.broadcast_to(q2, batch),  # 1
@@ -2219,7 +2219,7 @@ def ik_numeric_step(target, q, damping=0.0):
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def ik_branches(T):
-    """every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits: (8 x 6 and 8 x 1 and 8 x 1), 1357 operations."""
+    """every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits: (8 x 6 and 8 x 1 and 8 x 1), 1354 operations."""
     xp, dtype, device, batch, (T,) = _arguments(("T", T, (4, 4)))
     T00 = T[..., 0, 0]
     T01 = T[..., 0, 1]
@@ -2258,30 +2258,30 @@ def ik_branches(T):
     t22 = xp.where(t21, 0.15005*t19, xp.where(xp.greater(t19, 0), xp.asarray(1, dtype=dtype), -1))
     t23 = xp.where(t21, xp.sqrt(t20), 0)
     t24 = xp.atan2(t23, t22)
-    t25 = xp.where(t18, 0, t24 + t9)
+    t25 = xp.where(t18, 0, t9 + t24)
     t26 = t9 - t24
-    t27 = t25 - 6.283185307179586*xp.ceil(-0.5 + 0.15915494309189535*t25)
-    t28 = t27 - 6.283185307179586*xp.floor(0.4444444444444444 + 0.15915494309189535*t27)
-    t29 = t26 - 6.283185307179586*xp.ceil(-0.5 + 0.15915494309189535*t26)
-    t30 = t29 - 6.283185307179586*xp.floor(0.4444444444444444 + 0.15915494309189535*t29)
-    t31 = t19*t4
+    t27 = t25 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t25))
+    t28 = t27 - 6.283185307179586*xp.floor(0.15915494309189535*(2.792526803190927 + t27))
+    t29 = t26 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t26))
+    t30 = t29 - 6.283185307179586*xp.floor(0.15915494309189535*(2.792526803190927 + t29))
+    t31 = t4*t19
     t32 = t23*t31
-    t33 = t19*t8
+    t33 = t8*t19
     t34 = t22*t33
-    t35 = xp.where(t18, 1, -t32 - t34)
+    t35 = xp.where(t18, 1, -(t34 + t32))
     t36 = t32 - t34
     t37 = t22*t31
     t38 = t23*t33
     t39 = xp.where(t18, 0, t37 - t38)
     t40 = t37 + t38
-    t41 = t35*t4 + t39*t8
-    t42 = t35*t8 - t39*t4
+    t41 = t4*t35 + t8*t39
+    t42 = t8*t35 - t4*t39
     t43 = T02*t35 + T12*t39
     t44 = T12*t35 - T02*t39
     t45 = T00*t35 + T10*t39
     t46 = T10*t35 - T00*t39
-    t47 = t36*t4 + t40*t8
-    t48 = t36*t8 - t4*t40
+    t47 = t4*t36 + t8*t40
+    t48 = t8*t36 - t4*t40
     t49 = T02*t36 + T12*t40
     t50 = T12*t36 - T02*t40
     t51 = T00*t36 + T10*t40
@@ -2291,7 +2291,7 @@ def ik_branches(T):
     t55 = t54 + t13*t35
     t56 = -0.67183 + t55
     t57 = t41**2 + t42**2 + t56**2
-    t58 = 0.19791478625 - 0.5*t57
+    t58 = 0.5*(0.3958295725 - t57)
     t59 = T22*t53
     t60 = t59 + T22*t35
     t61 = T20*t53
@@ -2305,19 +2305,19 @@ def ik_branches(T):
     t69 = xp.atan2(t68, t67)
     t70 = 1.6177742431429796 + t69
     t71 = 1.6177742431429796 - t69
-    t72 = t70 - 6.283185307179586*xp.ceil(-0.5 + 0.15915494309189535*t70)
-    t73 = t72 - 6.283185307179586*xp.floor(0.625 + 0.15915494309189535*t72)
-    t74 = t71 - 6.283185307179586*xp.ceil(-0.5 + 0.15915494309189535*t71)
-    t75 = t74 - 6.283185307179586*xp.floor(0.625 + 0.15915494309189535*t74)
+    t72 = t70 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t70))
+    t73 = t72 - 6.283185307179586*xp.floor(0.15915494309189535*(3.9269908169872414 + t72))
+    t74 = t71 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t71))
+    t75 = t74 - 6.283185307179586*xp.floor(0.15915494309189535*(3.9269908169872414 + t74))
     t76 = 5.357415379007653*t67
     t77 = 0.00876554*t76
     t78 = 5.357415379007653*t68
     t79 = 0.18645124*t78
-    t80 = -t77 - t79
+    t80 = -(t77 + t79)
     t81 = t79 - t77
-    t82 = 0.15005 - 0.15005*t80
+    t82 = 0.15005*(1 - t80)
     t83 = t82 + 0.15005*t80
-    t84 = 0.15005 - 0.15005*t81
+    t84 = 0.15005*(1 - t81)
     t85 = t84 + 0.15005*t81
     t86 = 0.18645124*t76
     t87 = 0.00876554*t78
@@ -2335,36 +2335,36 @@ def ik_branches(T):
     t99 = 0.4318 + t97
     t100 = 0.67183 + t98
     t101 = -0.67183 + t100
-    t102 = t101*t41 - t56*t99
-    t103 = t101**2 + t85**2 + t99**2
+    t102 = t41*t101 - t56*t99
+    t103 = t85**2 + t99**2 + t101**2
     t104 = t42*t83
     t105 = -t104 + t41*t92 + t56*t94
-    t106 = t104 + t105
+    t106 = t105 + t104
     t107 = t106**2 + t95**2
     t108 = 1e-24*t57
-    t109 = xp.less_equal(t107, t108*t96)
+    t109 = xp.less_equal(t107, t96*t108)
     t110 = xp.where(t109, 1, 1/xp.sqrt(t107))
     t111 = xp.where(t109, 1, t106*t110)
-    t112 = xp.where(t109, 0, -t110*t95)
-    t113 = t111*t80 - t112*t88
-    t114 = t111*t88 + t112*t80
+    t112 = xp.where(t109, 0, -t95*t110)
+    t113 = t80*t111 - t88*t112
+    t114 = t80*t112 + t88*t111
     t115 = t113*t43 + t114*t60
     t116 = t113*t60 - t114*t43
     t117 = t113*t45 + t114*t62
     t118 = t113*t62 - t114*t45
     t119 = xp.where(t109, 0, xp.atan2(-t95, t106))
-    t120 = t119 - 6.283185307179586*xp.floor(0.125 + 0.15915494309189535*t119)
+    t120 = t119 - 6.283185307179586*xp.floor(0.15915494309189535*(0.7853981633974483 + t119))
     t121 = 1 - t113
-    t122 = t121*t44
+    t122 = t44*t121
     t123 = t122 + t113*t44
-    t124 = t121*t46
+    t124 = t46*t121
     t125 = t124 + t113*t46
     t126 = t116**2
     t127 = -t126
     t128 = 1 + t127
-    t129 = xp.where(xp.greater(t128, 1e-12), xp.sqrt(t128), 0)
+    t129 = xp.where(xp.less(1e-12, t128), xp.sqrt(t128), 0)
     t130 = t126 + t115*t129
-    t131 = t127 + t130
+    t131 = t130 + t127
     t132 = t123**2
     t133 = t126 + t132 + t115**2
     t134 = t129**2
@@ -2385,39 +2385,39 @@ def ik_branches(T):
     t149 = xp.where(t147, 1, t116*t148)
     t150 = xp.where(t147, 0, -t129*t148)
     t151 = t146*(1 - t149)
-    t152 = t142*t150 + t145*t149
-    t153 = t151 + t146*t149
-    t154 = t142*t149 - t145*t150
+    t152 = t149*t145 + t150*t142
+    t153 = t151 + t149*t146
+    t154 = t149*t142 - t150*t145
     t155 = t152**2 + t153**2
     t156 = t155
     t157 = t155 + t154**2
     t158 = t42*t85
-    t159 = -t158 + t101*t56 + t41*t99
-    t160 = t158 + t159
-    t161 = t102**2 + t160**2
+    t159 = -t158 + t41*t99 + t56*t101
+    t160 = t159 + t158
+    t161 = t160**2 + t102**2
     t162 = xp.less_equal(t161, t103*t108)
     t163 = xp.where(t162, 1, 1/xp.sqrt(t161))
     t164 = xp.where(t162, 1, t160*t163)
     t165 = xp.where(t162, 0, -t102*t163)
-    t166 = t164*t81 - t165*t89
-    t167 = t164*t89 + t165*t81
-    t168 = t166*t43 + t167*t60
-    t169 = t166*t60 - t167*t43
-    t170 = t166*t45 + t167*t62
-    t171 = t166*t62 - t167*t45
+    t166 = t81*t164 - t89*t165
+    t167 = t81*t165 + t89*t164
+    t168 = t43*t166 + t60*t167
+    t169 = t60*t166 - t43*t167
+    t170 = t45*t166 + t62*t167
+    t171 = t62*t166 - t45*t167
     t172 = xp.where(t162, 0, xp.atan2(-t102, t160))
-    t173 = t172 - 6.283185307179586*xp.floor(0.125 + 0.15915494309189535*t172)
+    t173 = t172 - 6.283185307179586*xp.floor(0.15915494309189535*(0.7853981633974483 + t172))
     t174 = 1 - t166
-    t175 = t174*t44
-    t176 = t175 + t166*t44
-    t177 = t174*t46
-    t178 = t177 + t166*t46
+    t175 = t44*t174
+    t176 = t175 + t44*t166
+    t177 = t46*t174
+    t178 = t177 + t46*t166
     t179 = t169**2
     t180 = -t179
     t181 = 1 + t180
-    t182 = xp.where(xp.greater(t181, 1e-12), xp.sqrt(t181), 0)
+    t182 = xp.where(xp.less(1e-12, t181), xp.sqrt(t181), 0)
     t183 = t179 + t168*t182
-    t184 = t180 + t183
+    t184 = t183 + t180
     t185 = t176**2
     t186 = t179 + t185 + t168**2
     t187 = t182**2
@@ -2438,9 +2438,9 @@ def ik_branches(T):
     t202 = xp.where(t200, 1, t169*t201)
     t203 = xp.where(t200, 0, -t182*t201)
     t204 = t199*(1 - t202)
-    t205 = t195*t203 + t198*t202
-    t206 = t204 + t199*t202
-    t207 = t195*t202 - t198*t203
+    t205 = t202*t198 + t203*t195
+    t206 = t204 + t202*t199
+    t207 = t202*t195 - t203*t198
     t208 = t205**2 + t206**2
     t209 = t208
     t210 = t208 + t207**2
@@ -2448,8 +2448,8 @@ def ik_branches(T):
     t212 = t13*t211
     t213 = t212 + t13*t36
     t214 = -0.67183 + t213
-    t215 = t214**2 + t47**2 + t48**2
-    t216 = 0.19791478625 - 0.5*t215
+    t215 = t47**2 + t48**2 + t214**2
+    t216 = 0.5*(0.3958295725 - t215)
     t217 = T22*t211
     t218 = t217 + T22*t36
     t219 = T20*t211
@@ -2463,19 +2463,19 @@ def ik_branches(T):
     t227 = xp.atan2(t226, t225)
     t228 = 1.6177742431429796 + t227
     t229 = 1.6177742431429796 - t227
-    t230 = t228 - 6.283185307179586*xp.ceil(-0.5 + 0.15915494309189535*t228)
-    t231 = t230 - 6.283185307179586*xp.floor(0.625 + 0.15915494309189535*t230)
-    t232 = t229 - 6.283185307179586*xp.ceil(-0.5 + 0.15915494309189535*t229)
-    t233 = t232 - 6.283185307179586*xp.floor(0.625 + 0.15915494309189535*t232)
+    t230 = t228 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t228))
+    t231 = t230 - 6.283185307179586*xp.floor(0.15915494309189535*(3.9269908169872414 + t230))
+    t232 = t229 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t229))
+    t233 = t232 - 6.283185307179586*xp.floor(0.15915494309189535*(3.9269908169872414 + t232))
     t234 = 5.357415379007653*t225
     t235 = 0.00876554*t234
     t236 = 5.357415379007653*t226
     t237 = 0.18645124*t236
-    t238 = -t235 - t237
+    t238 = -(t235 + t237)
     t239 = t237 - t235
-    t240 = 0.15005 - 0.15005*t238
+    t240 = 0.15005*(1 - t238)
     t241 = t240 + 0.15005*t238
-    t242 = 0.15005 - 0.15005*t239
+    t242 = 0.15005*(1 - t239)
     t243 = t242 + 0.15005*t239
     t244 = 0.18645124*t234
     t245 = 0.00876554*t236
@@ -2486,19 +2486,19 @@ def ik_branches(T):
     t250 = 0.4318 + t248
     t251 = 0.67183 + t249
     t252 = -0.67183 + t251
-    t253 = t252*t47 - t214*t250
+    t253 = t47*t252 - t214*t250
     t254 = t241**2 + t250**2 + t252**2
     t255 = 0.0203*t239 - 0.4318*t247
     t256 = 0.0203*t247 + 0.4318*t239
     t257 = 0.4318 + t255
     t258 = 0.67183 + t256
     t259 = -0.67183 + t258
-    t260 = t259*t47 - t214*t257
+    t260 = t47*t259 - t214*t257
     t261 = t243**2 + t257**2 + t259**2
-    t262 = t241*t48
-    t263 = -t262 + t214*t252 + t250*t47
-    t264 = t262 + t263
-    t265 = t253**2 + t264**2
+    t262 = t48*t241
+    t263 = -t262 + t47*t250 + t214*t252
+    t264 = t263 + t262
+    t265 = t264**2 + t253**2
     t266 = 1e-24*t215
     t267 = xp.less_equal(t265, t254*t266)
     t268 = xp.where(t267, 1, 1/xp.sqrt(t265))
@@ -2506,23 +2506,23 @@ def ik_branches(T):
     t270 = xp.where(t267, 0, -t253*t268)
     t271 = t238*t269 - t246*t270
     t272 = t238*t270 + t246*t269
-    t273 = t218*t272 + t271*t49
-    t274 = t218*t271 - t272*t49
-    t275 = t220*t272 + t271*t51
-    t276 = t220*t271 - t272*t51
+    t273 = t271*t49 + t272*t218
+    t274 = t271*t218 - t272*t49
+    t275 = t271*t51 + t272*t220
+    t276 = t271*t220 - t272*t51
     t277 = xp.where(t267, 0, xp.atan2(-t253, t264))
-    t278 = t277 - 6.283185307179586*xp.floor(0.125 + 0.15915494309189535*t277)
+    t278 = t277 - 6.283185307179586*xp.floor(0.15915494309189535*(0.7853981633974483 + t277))
     t279 = 1 - t271
-    t280 = t279*t50
+    t280 = t50*t279
     t281 = t280 + t271*t50
-    t282 = t279*t52
+    t282 = t52*t279
     t283 = t282 + t271*t52
     t284 = t274**2
     t285 = -t284
     t286 = 1 + t285
-    t287 = xp.where(xp.greater(t286, 1e-12), xp.sqrt(t286), 0)
+    t287 = xp.where(xp.less(1e-12, t286), xp.sqrt(t286), 0)
     t288 = t284 + t273*t287
-    t289 = t285 + t288
+    t289 = t288 + t285
     t290 = t281**2
     t291 = t284 + t290 + t273**2
     t292 = t287**2
@@ -2543,39 +2543,39 @@ def ik_branches(T):
     t307 = xp.where(t305, 1, t274*t306)
     t308 = xp.where(t305, 0, -t287*t306)
     t309 = t304*(1 - t307)
-    t310 = t300*t308 + t303*t307
-    t311 = t309 + t304*t307
-    t312 = t300*t307 - t303*t308
+    t310 = t307*t303 + t308*t300
+    t311 = t309 + t307*t304
+    t312 = t307*t300 - t308*t303
     t313 = t310**2 + t311**2
     t314 = t313
     t315 = t313 + t312**2
-    t316 = t243*t48
-    t317 = -t316 + t214*t259 + t257*t47
-    t318 = t316 + t317
-    t319 = t260**2 + t318**2
+    t316 = t48*t243
+    t317 = -t316 + t47*t257 + t214*t259
+    t318 = t317 + t316
+    t319 = t318**2 + t260**2
     t320 = xp.less_equal(t319, t261*t266)
     t321 = xp.where(t320, 1, 1/xp.sqrt(t319))
     t322 = xp.where(t320, 1, t318*t321)
     t323 = xp.where(t320, 0, -t260*t321)
     t324 = t239*t322 - t247*t323
     t325 = t239*t323 + t247*t322
-    t326 = t218*t325 + t324*t49
-    t327 = t218*t324 - t325*t49
-    t328 = t220*t325 + t324*t51
-    t329 = t220*t324 - t325*t51
+    t326 = t49*t324 + t218*t325
+    t327 = t218*t324 - t49*t325
+    t328 = t51*t324 + t220*t325
+    t329 = t220*t324 - t51*t325
     t330 = xp.where(t320, 0, xp.atan2(-t260, t318))
-    t331 = t330 - 6.283185307179586*xp.floor(0.125 + 0.15915494309189535*t330)
+    t331 = t330 - 6.283185307179586*xp.floor(0.15915494309189535*(0.7853981633974483 + t330))
     t332 = 1 - t324
-    t333 = t332*t50
-    t334 = t333 + t324*t50
-    t335 = t332*t52
-    t336 = t335 + t324*t52
+    t333 = t50*t332
+    t334 = t333 + t50*t324
+    t335 = t52*t332
+    t336 = t335 + t52*t324
     t337 = t327**2
     t338 = -t337
     t339 = 1 + t338
-    t340 = xp.where(xp.greater(t339, 1e-12), xp.sqrt(t339), 0)
+    t340 = xp.where(xp.less(1e-12, t339), xp.sqrt(t339), 0)
     t341 = t337 + t326*t340
-    t342 = t338 + t341
+    t342 = t341 + t338
     t343 = t334**2
     t344 = t337 + t343 + t326**2
     t345 = t340**2
@@ -2596,153 +2596,153 @@ def ik_branches(T):
     t360 = xp.where(t358, 1, t327*t359)
     t361 = xp.where(t358, 0, -t340*t359)
     t362 = t357*(1 - t360)
-    t363 = t353*t361 + t356*t360
-    t364 = t362 + t357*t360
-    t365 = t353*t360 - t356*t361
+    t363 = t360*t356 + t361*t353
+    t364 = t362 + t360*t357
+    t365 = t360*t353 - t361*t356
     t366 = t363**2 + t364**2
     t367 = t366
     t368 = t366 + t365**2
     t369 = xp.where(t138, 0, xp.atan2(t143, t131))
     t370 = t369
-    t371 = t370 - 6.283185307179586*xp.floor(0.3055555555555555 + 0.15915494309189535*t370)
+    t371 = t370 - 6.283185307179586*xp.floor(0.15915494309189535*(1.9198621771937625 + t370))
     t372 = 3.141592653589793 + t369 - 6.283185307179586*xp.ceil(0.15915494309189535*t369)
-    t373 = t372 - 6.283185307179586*xp.floor(0.3055555555555555 + 0.15915494309189535*t372)
+    t373 = t372 - 6.283185307179586*xp.floor(0.15915494309189535*(1.9198621771937625 + t372))
     t374 = xp.where(t147, 0, xp.atan2(-t129, t116))
     t375 = t374
-    t376 = t375 - 6.283185307179586*xp.floor(0.2777777777777778 + 0.15915494309189535*t375)
-    t377 = t374 + 6.283185307179586*xp.ceil(-0.5 - 0.15915494309189535*t374)
+    t376 = t375 - 6.283185307179586*xp.floor(0.15915494309189535*(1.7453292519943295 + t375))
+    t377 = t374 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t374))
     t378 = xp.where(xp.less_equal(t156, 1e-24*t157), 0, xp.atan2(t153, t152))
     t379 = t378
-    t380 = t379 - 6.283185307179586*xp.floor(0.7388888888888888 + 0.15915494309189535*t379)
+    t380 = t379 - 6.283185307179586*xp.floor(0.15915494309189535*(4.642575810304916 + t379))
     t381 = 3.141592653589793 + t378 - 6.283185307179586*xp.ceil(0.15915494309189535*t378)
-    t382 = t381 - 6.283185307179586*xp.floor(0.7388888888888888 + 0.15915494309189535*t381)
+    t382 = t381 - 6.283185307179586*xp.floor(0.15915494309189535*(4.642575810304916 + t381))
     t383 = -t377
-    t384 = t377 + 6.283185307179586*xp.floor(0.2777777777777778 + 0.15915494309189535*t383)
+    t384 = t377 + 6.283185307179586*xp.floor(0.15915494309189535*(1.7453292519943295 + t383))
     t385 = xp.where(t191, 0, xp.atan2(t196, t184))
     t386 = t385
-    t387 = t386 - 6.283185307179586*xp.floor(0.3055555555555555 + 0.15915494309189535*t386)
+    t387 = t386 - 6.283185307179586*xp.floor(0.15915494309189535*(1.9198621771937625 + t386))
     t388 = 3.141592653589793 + t385 - 6.283185307179586*xp.ceil(0.15915494309189535*t385)
-    t389 = t388 - 6.283185307179586*xp.floor(0.3055555555555555 + 0.15915494309189535*t388)
+    t389 = t388 - 6.283185307179586*xp.floor(0.15915494309189535*(1.9198621771937625 + t388))
     t390 = xp.where(t200, 0, xp.atan2(-t182, t169))
     t391 = t390
-    t392 = t391 - 6.283185307179586*xp.floor(0.2777777777777778 + 0.15915494309189535*t391)
-    t393 = t390 + 6.283185307179586*xp.ceil(-0.5 - 0.15915494309189535*t390)
+    t392 = t391 - 6.283185307179586*xp.floor(0.15915494309189535*(1.7453292519943295 + t391))
+    t393 = t390 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t390))
     t394 = xp.where(xp.less_equal(t209, 1e-24*t210), 0, xp.atan2(t206, t205))
     t395 = t394
-    t396 = t395 - 6.283185307179586*xp.floor(0.7388888888888888 + 0.15915494309189535*t395)
+    t396 = t395 - 6.283185307179586*xp.floor(0.15915494309189535*(4.642575810304916 + t395))
     t397 = 3.141592653589793 + t394 - 6.283185307179586*xp.ceil(0.15915494309189535*t394)
-    t398 = t397 - 6.283185307179586*xp.floor(0.7388888888888888 + 0.15915494309189535*t397)
+    t398 = t397 - 6.283185307179586*xp.floor(0.15915494309189535*(4.642575810304916 + t397))
     t399 = -t393
-    t400 = t393 + 6.283185307179586*xp.floor(0.2777777777777778 + 0.15915494309189535*t399)
+    t400 = t393 + 6.283185307179586*xp.floor(0.15915494309189535*(1.7453292519943295 + t399))
     t401 = xp.where(t296, 0, xp.atan2(t301, t289))
     t402 = t401
-    t403 = t402 - 6.283185307179586*xp.floor(0.3055555555555555 + 0.15915494309189535*t402)
+    t403 = t402 - 6.283185307179586*xp.floor(0.15915494309189535*(1.9198621771937625 + t402))
     t404 = 3.141592653589793 + t401 - 6.283185307179586*xp.ceil(0.15915494309189535*t401)
-    t405 = t404 - 6.283185307179586*xp.floor(0.3055555555555555 + 0.15915494309189535*t404)
+    t405 = t404 - 6.283185307179586*xp.floor(0.15915494309189535*(1.9198621771937625 + t404))
     t406 = xp.where(t305, 0, xp.atan2(-t287, t274))
     t407 = t406
-    t408 = t407 - 6.283185307179586*xp.floor(0.2777777777777778 + 0.15915494309189535*t407)
-    t409 = t406 + 6.283185307179586*xp.ceil(-0.5 - 0.15915494309189535*t406)
+    t408 = t407 - 6.283185307179586*xp.floor(0.15915494309189535*(1.7453292519943295 + t407))
+    t409 = t406 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t406))
     t410 = xp.where(xp.less_equal(t314, 1e-24*t315), 0, xp.atan2(t311, t310))
     t411 = t410
-    t412 = t411 - 6.283185307179586*xp.floor(0.7388888888888888 + 0.15915494309189535*t411)
+    t412 = t411 - 6.283185307179586*xp.floor(0.15915494309189535*(4.642575810304916 + t411))
     t413 = 3.141592653589793 + t410 - 6.283185307179586*xp.ceil(0.15915494309189535*t410)
-    t414 = t413 - 6.283185307179586*xp.floor(0.7388888888888888 + 0.15915494309189535*t413)
+    t414 = t413 - 6.283185307179586*xp.floor(0.15915494309189535*(4.642575810304916 + t413))
     t415 = -t409
-    t416 = t409 + 6.283185307179586*xp.floor(0.2777777777777778 + 0.15915494309189535*t415)
+    t416 = t409 + 6.283185307179586*xp.floor(0.15915494309189535*(1.7453292519943295 + t415))
     t417 = xp.where(t349, 0, xp.atan2(t354, t342))
     t418 = t417
-    t419 = t418 - 6.283185307179586*xp.floor(0.3055555555555555 + 0.15915494309189535*t418)
+    t419 = t418 - 6.283185307179586*xp.floor(0.15915494309189535*(1.9198621771937625 + t418))
     t420 = 3.141592653589793 + t417 - 6.283185307179586*xp.ceil(0.15915494309189535*t417)
-    t421 = t420 - 6.283185307179586*xp.floor(0.3055555555555555 + 0.15915494309189535*t420)
+    t421 = t420 - 6.283185307179586*xp.floor(0.15915494309189535*(1.9198621771937625 + t420))
     t422 = xp.where(t358, 0, xp.atan2(-t340, t327))
     t423 = t422
-    t424 = t423 - 6.283185307179586*xp.floor(0.2777777777777778 + 0.15915494309189535*t423)
-    t425 = t422 + 6.283185307179586*xp.ceil(-0.5 - 0.15915494309189535*t422)
+    t424 = t423 - 6.283185307179586*xp.floor(0.15915494309189535*(1.7453292519943295 + t423))
+    t425 = t422 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t422))
     t426 = xp.where(xp.less_equal(t367, 1e-24*t368), 0, xp.atan2(t364, t363))
     t427 = t426
-    t428 = t427 - 6.283185307179586*xp.floor(0.7388888888888888 + 0.15915494309189535*t427)
+    t428 = t427 - 6.283185307179586*xp.floor(0.15915494309189535*(4.642575810304916 + t427))
     t429 = 3.141592653589793 + t426 - 6.283185307179586*xp.ceil(0.15915494309189535*t426)
-    t430 = t429 - 6.283185307179586*xp.floor(0.7388888888888888 + 0.15915494309189535*t429)
+    t430 = t429 - 6.283185307179586*xp.floor(0.15915494309189535*(4.642575810304916 + t429))
     t431 = -t425
-    t432 = t425 + 6.283185307179586*xp.floor(0.2777777777777778 + 0.15915494309189535*t431)
+    t432 = t425 + 6.283185307179586*xp.floor(0.15915494309189535*(1.7453292519943295 + t431))
     t433 = xp.less_equal(t28, 2.792526803190927)
-    t434 = (xp.greater_equal(t27, -2.792526803190927)) & (xp.less_equal(t27, 2.792526803190927))
+    t434 = xp.greater_equal(t27, -2.792526803190927) & xp.less_equal(t27, 2.792526803190927)
     t435 = xp.where(t433 & xp.logical_not(t434), t28, t27)
     t436 = xp.less_equal(t120, 3.9269908169872414)
-    t437 = (xp.greater_equal(t119, -0.7853981633974483)) & (xp.less_equal(t119, 3.9269908169872414))
+    t437 = xp.greater_equal(t119, -0.7853981633974483) & xp.less_equal(t119, 3.9269908169872414)
     t438 = xp.where(t436 & xp.logical_not(t437), t120, t119)
     t439 = xp.less_equal(t73, 0.7853981633974483)
-    t440 = (xp.greater_equal(t72, -3.9269908169872414)) & (xp.less_equal(t72, 0.7853981633974483))
+    t440 = xp.greater_equal(t72, -3.9269908169872414) & xp.less_equal(t72, 0.7853981633974483)
     t441 = xp.where(t439 & xp.logical_not(t440), t73, t72)
     t442 = xp.less_equal(t371, 2.9670597283903604)
-    t443 = (xp.greater_equal(t370, -1.9198621771937625)) & (xp.less_equal(t370, 2.9670597283903604))
+    t443 = xp.greater_equal(t370, -1.9198621771937625) & xp.less_equal(t370, 2.9670597283903604)
     t444 = xp.less_equal(t376, 1.7453292519943295)
-    t445 = (xp.greater_equal(t375, -1.7453292519943295)) & (xp.less_equal(t375, 1.7453292519943295))
+    t445 = xp.greater_equal(t375, -1.7453292519943295) & xp.less_equal(t375, 1.7453292519943295)
     t446 = xp.less_equal(t380, 4.642575810304916)
-    t447 = (xp.greater_equal(t379, -4.642575810304916)) & (xp.less_equal(t379, 4.642575810304916))
+    t447 = xp.greater_equal(t379, -4.642575810304916) & xp.less_equal(t379, 4.642575810304916)
     t448 = xp.less_equal(t373, 2.9670597283903604)
-    t449 = (xp.greater_equal(t372, -1.9198621771937625)) & (xp.less_equal(t372, 2.9670597283903604))
+    t449 = xp.greater_equal(t372, -1.9198621771937625) & xp.less_equal(t372, 2.9670597283903604)
     t450 = -t384
     t451 = xp.less_equal(t382, 4.642575810304916)
-    t452 = (xp.greater_equal(t381, -4.642575810304916)) & (xp.less_equal(t381, 4.642575810304916))
+    t452 = xp.greater_equal(t381, -4.642575810304916) & xp.less_equal(t381, 4.642575810304916)
     t453 = xp.less_equal(t173, 3.9269908169872414)
-    t454 = (xp.greater_equal(t172, -0.7853981633974483)) & (xp.less_equal(t172, 3.9269908169872414))
+    t454 = xp.greater_equal(t172, -0.7853981633974483) & xp.less_equal(t172, 3.9269908169872414)
     t455 = xp.where(t453 & xp.logical_not(t454), t173, t172)
     t456 = xp.less_equal(t75, 0.7853981633974483)
-    t457 = (xp.greater_equal(t74, -3.9269908169872414)) & (xp.less_equal(t74, 0.7853981633974483))
+    t457 = xp.greater_equal(t74, -3.9269908169872414) & xp.less_equal(t74, 0.7853981633974483)
     t458 = xp.where(t456 & xp.logical_not(t457), t75, t74)
     t459 = xp.less_equal(t387, 2.9670597283903604)
-    t460 = (xp.greater_equal(t386, -1.9198621771937625)) & (xp.less_equal(t386, 2.9670597283903604))
+    t460 = xp.greater_equal(t386, -1.9198621771937625) & xp.less_equal(t386, 2.9670597283903604)
     t461 = xp.less_equal(t392, 1.7453292519943295)
-    t462 = (xp.greater_equal(t391, -1.7453292519943295)) & (xp.less_equal(t391, 1.7453292519943295))
+    t462 = xp.greater_equal(t391, -1.7453292519943295) & xp.less_equal(t391, 1.7453292519943295)
     t463 = xp.less_equal(t396, 4.642575810304916)
-    t464 = (xp.greater_equal(t395, -4.642575810304916)) & (xp.less_equal(t395, 4.642575810304916))
+    t464 = xp.greater_equal(t395, -4.642575810304916) & xp.less_equal(t395, 4.642575810304916)
     t465 = xp.less_equal(t389, 2.9670597283903604)
-    t466 = (xp.greater_equal(t388, -1.9198621771937625)) & (xp.less_equal(t388, 2.9670597283903604))
+    t466 = xp.greater_equal(t388, -1.9198621771937625) & xp.less_equal(t388, 2.9670597283903604)
     t467 = -t400
     t468 = xp.less_equal(t398, 4.642575810304916)
-    t469 = (xp.greater_equal(t397, -4.642575810304916)) & (xp.less_equal(t397, 4.642575810304916))
+    t469 = xp.greater_equal(t397, -4.642575810304916) & xp.less_equal(t397, 4.642575810304916)
     t470 = xp.less_equal(t30, 2.792526803190927)
-    t471 = (xp.greater_equal(t29, -2.792526803190927)) & (xp.less_equal(t29, 2.792526803190927))
+    t471 = xp.greater_equal(t29, -2.792526803190927) & xp.less_equal(t29, 2.792526803190927)
     t472 = xp.where(t470 & xp.logical_not(t471), t30, t29)
     t473 = xp.less_equal(t278, 3.9269908169872414)
-    t474 = (xp.greater_equal(t277, -0.7853981633974483)) & (xp.less_equal(t277, 3.9269908169872414))
+    t474 = xp.greater_equal(t277, -0.7853981633974483) & xp.less_equal(t277, 3.9269908169872414)
     t475 = xp.where(t473 & xp.logical_not(t474), t278, t277)
     t476 = xp.less_equal(t231, 0.7853981633974483)
-    t477 = (xp.greater_equal(t230, -3.9269908169872414)) & (xp.less_equal(t230, 0.7853981633974483))
+    t477 = xp.greater_equal(t230, -3.9269908169872414) & xp.less_equal(t230, 0.7853981633974483)
     t478 = xp.where(t476 & xp.logical_not(t477), t231, t230)
     t479 = xp.less_equal(t403, 2.9670597283903604)
-    t480 = (xp.greater_equal(t402, -1.9198621771937625)) & (xp.less_equal(t402, 2.9670597283903604))
+    t480 = xp.greater_equal(t402, -1.9198621771937625) & xp.less_equal(t402, 2.9670597283903604)
     t481 = xp.less_equal(t408, 1.7453292519943295)
-    t482 = (xp.greater_equal(t407, -1.7453292519943295)) & (xp.less_equal(t407, 1.7453292519943295))
+    t482 = xp.greater_equal(t407, -1.7453292519943295) & xp.less_equal(t407, 1.7453292519943295)
     t483 = xp.less_equal(t412, 4.642575810304916)
-    t484 = (xp.greater_equal(t411, -4.642575810304916)) & (xp.less_equal(t411, 4.642575810304916))
+    t484 = xp.greater_equal(t411, -4.642575810304916) & xp.less_equal(t411, 4.642575810304916)
     t485 = xp.less_equal(t405, 2.9670597283903604)
-    t486 = (xp.greater_equal(t404, -1.9198621771937625)) & (xp.less_equal(t404, 2.9670597283903604))
+    t486 = xp.greater_equal(t404, -1.9198621771937625) & xp.less_equal(t404, 2.9670597283903604)
     t487 = -t416
     t488 = xp.less_equal(t414, 4.642575810304916)
-    t489 = (xp.greater_equal(t413, -4.642575810304916)) & (xp.less_equal(t413, 4.642575810304916))
+    t489 = xp.greater_equal(t413, -4.642575810304916) & xp.less_equal(t413, 4.642575810304916)
     t490 = xp.less_equal(t331, 3.9269908169872414)
-    t491 = (xp.greater_equal(t330, -0.7853981633974483)) & (xp.less_equal(t330, 3.9269908169872414))
+    t491 = xp.greater_equal(t330, -0.7853981633974483) & xp.less_equal(t330, 3.9269908169872414)
     t492 = xp.where(t490 & xp.logical_not(t491), t331, t330)
     t493 = xp.less_equal(t233, 0.7853981633974483)
-    t494 = (xp.greater_equal(t232, -3.9269908169872414)) & (xp.less_equal(t232, 0.7853981633974483))
+    t494 = xp.greater_equal(t232, -3.9269908169872414) & xp.less_equal(t232, 0.7853981633974483)
     t495 = xp.where(t493 & xp.logical_not(t494), t233, t232)
     t496 = xp.less_equal(t419, 2.9670597283903604)
-    t497 = (xp.greater_equal(t418, -1.9198621771937625)) & (xp.less_equal(t418, 2.9670597283903604))
+    t497 = xp.greater_equal(t418, -1.9198621771937625) & xp.less_equal(t418, 2.9670597283903604)
     t498 = xp.less_equal(t424, 1.7453292519943295)
-    t499 = (xp.greater_equal(t423, -1.7453292519943295)) & (xp.less_equal(t423, 1.7453292519943295))
+    t499 = xp.greater_equal(t423, -1.7453292519943295) & xp.less_equal(t423, 1.7453292519943295)
     t500 = xp.less_equal(t428, 4.642575810304916)
-    t501 = (xp.greater_equal(t427, -4.642575810304916)) & (xp.less_equal(t427, 4.642575810304916))
+    t501 = xp.greater_equal(t427, -4.642575810304916) & xp.less_equal(t427, 4.642575810304916)
     t502 = xp.less_equal(t421, 2.9670597283903604)
-    t503 = (xp.greater_equal(t420, -1.9198621771937625)) & (xp.less_equal(t420, 2.9670597283903604))
+    t503 = xp.greater_equal(t420, -1.9198621771937625) & xp.less_equal(t420, 2.9670597283903604)
     t504 = -t432
     t505 = xp.less_equal(t430, 4.642575810304916)
-    t506 = (xp.greater_equal(t429, -4.642575810304916)) & (xp.less_equal(t429, 4.642575810304916))
+    t506 = xp.greater_equal(t429, -4.642575810304916) & xp.less_equal(t429, 4.642575810304916)
     t507 = xp.isfinite(t0)
     t508 = xp.greater(t15, t17)
-    t509 = (t508 & (xp.greater_equal(t20, -1e-12))) | (t18 & (xp.less_equal(0.0225150025, 1e-12*t16)))
+    t509 = (t18 & xp.less_equal(0.0225150025, 1e-12*t16)) | (t508 & xp.greater_equal(t20, -1e-12))
     t510 = xp.greater_equal(t64, -1e-12)
     t511 = xp.greater(t64, 1e-12)
     t512 = xp.greater(t20, 1e-12)
@@ -2769,7 +2769,7 @@ def ik_branches(T):
         t438,  # 1, 1
         t441,  # 1, 2
         xp.where(t448 & xp.logical_not(t449), t373, t372),  # 1, 3
-        xp.where((xp.greater_equal(t384, -1.7453292519943295)) & xp.logical_not((xp.greater_equal(t377, -1.7453292519943295)) & (xp.less_equal(t377, 1.7453292519943295))), t450, t383),  # 1, 4
+        xp.where(xp.greater_equal(t384, -1.7453292519943295) & xp.logical_not(xp.greater_equal(t377, -1.7453292519943295) & xp.less_equal(t377, 1.7453292519943295)), t450, t383),  # 1, 4
         xp.where(t451 & xp.logical_not(t452), t382, t381),  # 1, 5
         t435,  # 2, 0
         t455,  # 2, 1
@@ -2781,7 +2781,7 @@ def ik_branches(T):
         t455,  # 3, 1
         t458,  # 3, 2
         xp.where(t465 & xp.logical_not(t466), t389, t388),  # 3, 3
-        xp.where((xp.greater_equal(t400, -1.7453292519943295)) & xp.logical_not((xp.greater_equal(t393, -1.7453292519943295)) & (xp.less_equal(t393, 1.7453292519943295))), t467, t399),  # 3, 4
+        xp.where(xp.greater_equal(t400, -1.7453292519943295) & xp.logical_not(xp.greater_equal(t393, -1.7453292519943295) & xp.less_equal(t393, 1.7453292519943295)), t467, t399),  # 3, 4
         xp.where(t468 & xp.logical_not(t469), t398, t397),  # 3, 5
         t472,  # 4, 0
         t475,  # 4, 1
@@ -2793,7 +2793,7 @@ def ik_branches(T):
         t475,  # 5, 1
         t478,  # 5, 2
         xp.where(t485 & xp.logical_not(t486), t405, t404),  # 5, 3
-        xp.where((xp.greater_equal(t416, -1.7453292519943295)) & xp.logical_not((xp.greater_equal(t409, -1.7453292519943295)) & (xp.less_equal(t409, 1.7453292519943295))), t487, t415),  # 5, 4
+        xp.where(xp.greater_equal(t416, -1.7453292519943295) & xp.logical_not(xp.greater_equal(t409, -1.7453292519943295) & xp.less_equal(t409, 1.7453292519943295)), t487, t415),  # 5, 4
         xp.where(t488 & xp.logical_not(t489), t414, t413),  # 5, 5
         t472,  # 6, 0
         t492,  # 6, 1
@@ -2805,28 +2805,28 @@ def ik_branches(T):
         t492,  # 7, 1
         t495,  # 7, 2
         xp.where(t502 & xp.logical_not(t503), t421, t420),  # 7, 3
-        xp.where((xp.greater_equal(t432, -1.7453292519943295)) & xp.logical_not((xp.greater_equal(t425, -1.7453292519943295)) & (xp.less_equal(t425, 1.7453292519943295))), t504, t431),  # 7, 4
+        xp.where(xp.greater_equal(t432, -1.7453292519943295) & xp.logical_not(xp.greater_equal(t425, -1.7453292519943295) & xp.less_equal(t425, 1.7453292519943295)), t504, t431),  # 7, 4
         xp.where(t505 & xp.logical_not(t506), t430, t429),  # 7, 5
     ], (8, 6))
     valid = _stack(xp, [
-        t507 & t509 & t510 & (xp.greater_equal(t128, -1e-12)),  # 0
-        t507 & t509 & t510 & (xp.greater(t128, 1e-12)),  # 1
-        t507 & t509 & t511 & (xp.greater_equal(t181, -1e-12)),  # 2
-        t507 & t509 & t511 & (xp.greater(t181, 1e-12)),  # 3
-        t507 & t508 & t512 & t513 & (xp.greater_equal(t286, -1e-12)),  # 4
-        t507 & t508 & t512 & t513 & (xp.greater(t286, 1e-12)),  # 5
-        t507 & t508 & t512 & t514 & (xp.greater_equal(t339, -1e-12)),  # 6
-        t507 & t508 & t512 & t514 & (xp.greater(t339, 1e-12)),  # 7
+        t507 & t509 & t510 & xp.greater_equal(t128, -1e-12),  # 0
+        t507 & t509 & t510 & xp.greater(t128, 1e-12),  # 1
+        t507 & t509 & t511 & xp.greater_equal(t181, -1e-12),  # 2
+        t507 & t509 & t511 & xp.greater(t181, 1e-12),  # 3
+        t507 & t508 & t512 & t513 & xp.greater_equal(t286, -1e-12),  # 4
+        t507 & t508 & t512 & t513 & xp.greater(t286, 1e-12),  # 5
+        t507 & t508 & t512 & t514 & xp.greater_equal(t339, -1e-12),  # 6
+        t507 & t508 & t512 & t514 & xp.greater(t339, 1e-12),  # 7
     ], (8,))
     in_limits = _stack(xp, [
         t515 & t516 & t517 & (t442 | t443) & (t444 | t445) & (t446 | t447),  # 0
-        t515 & t516 & t517 & (t448 | t449) & (t451 | t452) & ((xp.less_equal(t450, 1.7453292519943295)) | ((xp.greater_equal(t383, -1.7453292519943295)) & (xp.less_equal(t383, 1.7453292519943295)))),  # 1
+        t515 & t516 & t517 & (t448 | t449) & (t451 | t452) & (xp.less_equal(t450, 1.7453292519943295) | (xp.greater_equal(t383, -1.7453292519943295) & xp.less_equal(t383, 1.7453292519943295))),  # 1
         t515 & t518 & t519 & (t459 | t460) & (t461 | t462) & (t463 | t464),  # 2
-        t515 & t518 & t519 & (t465 | t466) & (t468 | t469) & ((xp.less_equal(t467, 1.7453292519943295)) | ((xp.greater_equal(t399, -1.7453292519943295)) & (xp.less_equal(t399, 1.7453292519943295)))),  # 3
+        t515 & t518 & t519 & (t465 | t466) & (t468 | t469) & (xp.less_equal(t467, 1.7453292519943295) | (xp.greater_equal(t399, -1.7453292519943295) & xp.less_equal(t399, 1.7453292519943295))),  # 3
         t520 & t521 & t522 & (t479 | t480) & (t481 | t482) & (t483 | t484),  # 4
-        t520 & t521 & t522 & (t485 | t486) & (t488 | t489) & ((xp.less_equal(t487, 1.7453292519943295)) | ((xp.greater_equal(t415, -1.7453292519943295)) & (xp.less_equal(t415, 1.7453292519943295)))),  # 5
+        t520 & t521 & t522 & (t485 | t486) & (t488 | t489) & (xp.less_equal(t487, 1.7453292519943295) | (xp.greater_equal(t415, -1.7453292519943295) & xp.less_equal(t415, 1.7453292519943295))),  # 5
         t520 & t523 & t524 & (t496 | t497) & (t498 | t499) & (t500 | t501),  # 6
-        t520 & t523 & t524 & (t502 | t503) & (t505 | t506) & ((xp.less_equal(t504, 1.7453292519943295)) | ((xp.greater_equal(t431, -1.7453292519943295)) & (xp.less_equal(t431, 1.7453292519943295)))),  # 7
+        t520 & t523 & t524 & (t502 | t503) & (t505 | t506) & (xp.less_equal(t504, 1.7453292519943295) | (xp.greater_equal(t431, -1.7453292519943295) & xp.less_equal(t431, 1.7453292519943295))),  # 7
     ], (8,))
     return q, valid, in_limits
 
@@ -2982,30 +2982,30 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     t55 = qb7_5 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn6 - qb7_5))
     t56 = xp.where(lb7 & vb7, xp.asarray(1, dtype=dtype), 0)
     t57 = T00 + T01 + T02 + T03 + T10 + T11 + T12 + T13 + T20 + T21 + T22 + T23 + qn1 + qn2 + qn3 + qn4 + qn5 + qn6 + qw1 + qw2 + qw3 + qw4 + qw5 + qw6
-    t58 = xp.where(xp.greater(qn1, t0), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t58 = xp.where(xp.less(t0, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t59 = t0 + t58
     t60 = t0 - t58
-    t61 = xp.where((xp.greater_equal(t0, -2.792526803190927)) & (xp.less_equal(t0, 2.792526803190927)), t0, xp.where((xp.greater_equal(t59, -2.792526803190927)) & (xp.less_equal(t59, 2.792526803190927)), t59, xp.where((xp.greater_equal(t60, -2.792526803190927)) & (xp.less_equal(t60, 2.792526803190927)), t60, qb0_0)))
-    t62 = xp.where(xp.greater(qn2, t1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t61 = xp.where(xp.greater_equal(t0, -2.792526803190927) & xp.less_equal(t0, 2.792526803190927), t0, xp.where(xp.greater_equal(t59, -2.792526803190927) & xp.less_equal(t59, 2.792526803190927), t59, xp.where(xp.greater_equal(t60, -2.792526803190927) & xp.less_equal(t60, 2.792526803190927), t60, qb0_0)))
+    t62 = xp.where(xp.less(t1, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t63 = t1 + t62
     t64 = t1 - t62
-    t65 = xp.where((xp.greater_equal(t1, -0.7853981633974483)) & (xp.less_equal(t1, 3.9269908169872414)), t1, xp.where((xp.greater_equal(t63, -0.7853981633974483)) & (xp.less_equal(t63, 3.9269908169872414)), t63, xp.where((xp.greater_equal(t64, -0.7853981633974483)) & (xp.less_equal(t64, 3.9269908169872414)), t64, qb0_1)))
-    t66 = xp.where(xp.greater(qn3, t2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t65 = xp.where(xp.greater_equal(t1, -0.7853981633974483) & xp.less_equal(t1, 3.9269908169872414), t1, xp.where(xp.greater_equal(t63, -0.7853981633974483) & xp.less_equal(t63, 3.9269908169872414), t63, xp.where(xp.greater_equal(t64, -0.7853981633974483) & xp.less_equal(t64, 3.9269908169872414), t64, qb0_1)))
+    t66 = xp.where(xp.less(t2, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t67 = t2 + t66
     t68 = t2 - t66
-    t69 = xp.where((xp.greater_equal(t2, -3.9269908169872414)) & (xp.less_equal(t2, 0.7853981633974483)), t2, xp.where((xp.greater_equal(t67, -3.9269908169872414)) & (xp.less_equal(t67, 0.7853981633974483)), t67, xp.where((xp.greater_equal(t68, -3.9269908169872414)) & (xp.less_equal(t68, 0.7853981633974483)), t68, qb0_2)))
-    t70 = xp.where(xp.greater(qn4, t3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t69 = xp.where(xp.greater_equal(t2, -3.9269908169872414) & xp.less_equal(t2, 0.7853981633974483), t2, xp.where(xp.greater_equal(t67, -3.9269908169872414) & xp.less_equal(t67, 0.7853981633974483), t67, xp.where(xp.greater_equal(t68, -3.9269908169872414) & xp.less_equal(t68, 0.7853981633974483), t68, qb0_2)))
+    t70 = xp.where(xp.less(t3, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t71 = t3 + t70
     t72 = t3 - t70
-    t73 = xp.where((xp.greater_equal(t3, -1.9198621771937625)) & (xp.less_equal(t3, 2.9670597283903604)), t3, xp.where((xp.greater_equal(t71, -1.9198621771937625)) & (xp.less_equal(t71, 2.9670597283903604)), t71, xp.where((xp.greater_equal(t72, -1.9198621771937625)) & (xp.less_equal(t72, 2.9670597283903604)), t72, qb0_3)))
-    t74 = xp.where(xp.greater(qn5, t4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t73 = xp.where(xp.greater_equal(t3, -1.9198621771937625) & xp.less_equal(t3, 2.9670597283903604), t3, xp.where(xp.greater_equal(t71, -1.9198621771937625) & xp.less_equal(t71, 2.9670597283903604), t71, xp.where(xp.greater_equal(t72, -1.9198621771937625) & xp.less_equal(t72, 2.9670597283903604), t72, qb0_3)))
+    t74 = xp.where(xp.less(t4, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t75 = t4 + t74
     t76 = t4 - t74
-    t77 = xp.where((xp.greater_equal(t4, -1.7453292519943295)) & (xp.less_equal(t4, 1.7453292519943295)), t4, xp.where((xp.greater_equal(t75, -1.7453292519943295)) & (xp.less_equal(t75, 1.7453292519943295)), t75, xp.where((xp.greater_equal(t76, -1.7453292519943295)) & (xp.less_equal(t76, 1.7453292519943295)), t76, qb0_4)))
-    t78 = xp.where(xp.greater(qn6, t5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t77 = xp.where(xp.greater_equal(t4, -1.7453292519943295) & xp.less_equal(t4, 1.7453292519943295), t4, xp.where(xp.greater_equal(t75, -1.7453292519943295) & xp.less_equal(t75, 1.7453292519943295), t75, xp.where(xp.greater_equal(t76, -1.7453292519943295) & xp.less_equal(t76, 1.7453292519943295), t76, qb0_4)))
+    t78 = xp.where(xp.less(t5, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t79 = t5 + t78
     t80 = t5 - t78
-    t81 = xp.where((xp.greater_equal(t5, -4.642575810304916)) & (xp.less_equal(t5, 4.642575810304916)), t5, xp.where((xp.greater_equal(t79, -4.642575810304916)) & (xp.less_equal(t79, 4.642575810304916)), t79, xp.where((xp.greater_equal(t80, -4.642575810304916)) & (xp.less_equal(t80, 4.642575810304916)), t80, qb0_5)))
+    t81 = xp.where(xp.greater_equal(t5, -4.642575810304916) & xp.less_equal(t5, 4.642575810304916), t5, xp.where(xp.greater_equal(t79, -4.642575810304916) & xp.less_equal(t79, 4.642575810304916), t79, xp.where(xp.greater_equal(t80, -4.642575810304916) & xp.less_equal(t80, 4.642575810304916), t80, qb0_5)))
     t82 = -qn1
     t83 = -qn2
     t84 = -qn3
@@ -3021,33 +3021,33 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     t94 = xp.where(t89, t77, qn5)
     t95 = xp.where(t89, t81, qn6)
     t96 = xp.where(t89, t88, 0)
-    t97 = xp.where(xp.greater(qn1, t8), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t97 = xp.where(xp.less(t8, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t98 = t8 + t97
     t99 = t8 - t97
-    t100 = xp.where((xp.greater_equal(t8, -2.792526803190927)) & (xp.less_equal(t8, 2.792526803190927)), t8, xp.where((xp.greater_equal(t98, -2.792526803190927)) & (xp.less_equal(t98, 2.792526803190927)), t98, xp.where((xp.greater_equal(t99, -2.792526803190927)) & (xp.less_equal(t99, 2.792526803190927)), t99, qb1_0)))
-    t101 = xp.where(xp.greater(qn2, t9), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t102 = t101 + t9
+    t100 = xp.where(xp.greater_equal(t8, -2.792526803190927) & xp.less_equal(t8, 2.792526803190927), t8, xp.where(xp.greater_equal(t98, -2.792526803190927) & xp.less_equal(t98, 2.792526803190927), t98, xp.where(xp.greater_equal(t99, -2.792526803190927) & xp.less_equal(t99, 2.792526803190927), t99, qb1_0)))
+    t101 = xp.where(xp.less(t9, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t102 = t9 + t101
     t103 = t9 - t101
-    t104 = xp.where((xp.greater_equal(t9, -0.7853981633974483)) & (xp.less_equal(t9, 3.9269908169872414)), t9, xp.where((xp.greater_equal(t102, -0.7853981633974483)) & (xp.less_equal(t102, 3.9269908169872414)), t102, xp.where((xp.greater_equal(t103, -0.7853981633974483)) & (xp.less_equal(t103, 3.9269908169872414)), t103, qb1_1)))
-    t105 = xp.where(xp.greater(qn3, t10), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t104 = xp.where(xp.greater_equal(t9, -0.7853981633974483) & xp.less_equal(t9, 3.9269908169872414), t9, xp.where(xp.greater_equal(t102, -0.7853981633974483) & xp.less_equal(t102, 3.9269908169872414), t102, xp.where(xp.greater_equal(t103, -0.7853981633974483) & xp.less_equal(t103, 3.9269908169872414), t103, qb1_1)))
+    t105 = xp.where(xp.less(t10, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t106 = t10 + t105
     t107 = t10 - t105
-    t108 = xp.where((xp.greater_equal(t10, -3.9269908169872414)) & (xp.less_equal(t10, 0.7853981633974483)), t10, xp.where((xp.greater_equal(t106, -3.9269908169872414)) & (xp.less_equal(t106, 0.7853981633974483)), t106, xp.where((xp.greater_equal(t107, -3.9269908169872414)) & (xp.less_equal(t107, 0.7853981633974483)), t107, qb1_2)))
-    t109 = xp.where(xp.greater(qn4, t11), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t110 = t109 + t11
+    t108 = xp.where(xp.greater_equal(t10, -3.9269908169872414) & xp.less_equal(t10, 0.7853981633974483), t10, xp.where(xp.greater_equal(t106, -3.9269908169872414) & xp.less_equal(t106, 0.7853981633974483), t106, xp.where(xp.greater_equal(t107, -3.9269908169872414) & xp.less_equal(t107, 0.7853981633974483), t107, qb1_2)))
+    t109 = xp.where(xp.less(t11, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t110 = t11 + t109
     t111 = t11 - t109
-    t112 = xp.where((xp.greater_equal(t11, -1.9198621771937625)) & (xp.less_equal(t11, 2.9670597283903604)), t11, xp.where((xp.greater_equal(t110, -1.9198621771937625)) & (xp.less_equal(t110, 2.9670597283903604)), t110, xp.where((xp.greater_equal(t111, -1.9198621771937625)) & (xp.less_equal(t111, 2.9670597283903604)), t111, qb1_3)))
-    t113 = xp.where(xp.greater(qn5, t12), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t114 = t113 + t12
+    t112 = xp.where(xp.greater_equal(t11, -1.9198621771937625) & xp.less_equal(t11, 2.9670597283903604), t11, xp.where(xp.greater_equal(t110, -1.9198621771937625) & xp.less_equal(t110, 2.9670597283903604), t110, xp.where(xp.greater_equal(t111, -1.9198621771937625) & xp.less_equal(t111, 2.9670597283903604), t111, qb1_3)))
+    t113 = xp.where(xp.less(t12, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t114 = t12 + t113
     t115 = t12 - t113
-    t116 = xp.where((xp.greater_equal(t12, -1.7453292519943295)) & (xp.less_equal(t12, 1.7453292519943295)), t12, xp.where((xp.greater_equal(t114, -1.7453292519943295)) & (xp.less_equal(t114, 1.7453292519943295)), t114, xp.where((xp.greater_equal(t115, -1.7453292519943295)) & (xp.less_equal(t115, 1.7453292519943295)), t115, qb1_4)))
-    t117 = xp.where(xp.greater(qn6, t13), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t118 = t117 + t13
+    t116 = xp.where(xp.greater_equal(t12, -1.7453292519943295) & xp.less_equal(t12, 1.7453292519943295), t12, xp.where(xp.greater_equal(t114, -1.7453292519943295) & xp.less_equal(t114, 1.7453292519943295), t114, xp.where(xp.greater_equal(t115, -1.7453292519943295) & xp.less_equal(t115, 1.7453292519943295), t115, qb1_4)))
+    t117 = xp.where(xp.less(t13, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t118 = t13 + t117
     t119 = t13 - t117
-    t120 = xp.where((xp.greater_equal(t13, -4.642575810304916)) & (xp.less_equal(t13, 4.642575810304916)), t13, xp.where((xp.greater_equal(t118, -4.642575810304916)) & (xp.less_equal(t118, 4.642575810304916)), t118, xp.where((xp.greater_equal(t119, -4.642575810304916)) & (xp.less_equal(t119, 4.642575810304916)), t119, qb1_5)))
+    t120 = xp.where(xp.greater_equal(t13, -4.642575810304916) & xp.less_equal(t13, 4.642575810304916), t13, xp.where(xp.greater_equal(t118, -4.642575810304916) & xp.less_equal(t118, 4.642575810304916), t118, xp.where(xp.greater_equal(t119, -4.642575810304916) & xp.less_equal(t119, 4.642575810304916), t119, qb1_5)))
     t121 = qw1*(t100 + t82)**2 + qw2*(t104 + t83)**2 + qw3*(t108 + t84)**2 + qw4*(t112 + t85)**2 + qw5*(t116 + t86)**2 + qw6*(t120 + t87)**2
     t122 = xp.greater(t14, 0)
-    t123 = xp.where(t122 & ((xp.less(t121, t96)) | (xp.less(t7, 1))), xp.asarray(1, dtype=dtype), 0)
+    t123 = xp.where(t122 & (xp.greater(t96, t121) | xp.less(t7, 1)), xp.asarray(1, dtype=dtype), 0)
     t124 = xp.where(t122, 1, t7)
     t125 = xp.greater(t123, 0)
     t126 = xp.where(t125, t100, t90)
@@ -3057,33 +3057,33 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     t130 = xp.where(t125, t116, t94)
     t131 = xp.where(t125, t120, t95)
     t132 = xp.where(t125, t121, t96)
-    t133 = xp.where(xp.greater(qn1, t15), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t134 = t133 + t15
+    t133 = xp.where(xp.less(t15, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t134 = t15 + t133
     t135 = t15 - t133
-    t136 = xp.where((xp.greater_equal(t15, -2.792526803190927)) & (xp.less_equal(t15, 2.792526803190927)), t15, xp.where((xp.greater_equal(t134, -2.792526803190927)) & (xp.less_equal(t134, 2.792526803190927)), t134, xp.where((xp.greater_equal(t135, -2.792526803190927)) & (xp.less_equal(t135, 2.792526803190927)), t135, qb2_0)))
-    t137 = xp.where(xp.greater(qn2, t16), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t138 = t137 + t16
+    t136 = xp.where(xp.greater_equal(t15, -2.792526803190927) & xp.less_equal(t15, 2.792526803190927), t15, xp.where(xp.greater_equal(t134, -2.792526803190927) & xp.less_equal(t134, 2.792526803190927), t134, xp.where(xp.greater_equal(t135, -2.792526803190927) & xp.less_equal(t135, 2.792526803190927), t135, qb2_0)))
+    t137 = xp.where(xp.less(t16, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t138 = t16 + t137
     t139 = t16 - t137
-    t140 = xp.where((xp.greater_equal(t16, -0.7853981633974483)) & (xp.less_equal(t16, 3.9269908169872414)), t16, xp.where((xp.greater_equal(t138, -0.7853981633974483)) & (xp.less_equal(t138, 3.9269908169872414)), t138, xp.where((xp.greater_equal(t139, -0.7853981633974483)) & (xp.less_equal(t139, 3.9269908169872414)), t139, qb2_1)))
-    t141 = xp.where(xp.greater(qn3, t17), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t142 = t141 + t17
+    t140 = xp.where(xp.greater_equal(t16, -0.7853981633974483) & xp.less_equal(t16, 3.9269908169872414), t16, xp.where(xp.greater_equal(t138, -0.7853981633974483) & xp.less_equal(t138, 3.9269908169872414), t138, xp.where(xp.greater_equal(t139, -0.7853981633974483) & xp.less_equal(t139, 3.9269908169872414), t139, qb2_1)))
+    t141 = xp.where(xp.less(t17, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t142 = t17 + t141
     t143 = t17 - t141
-    t144 = xp.where((xp.greater_equal(t17, -3.9269908169872414)) & (xp.less_equal(t17, 0.7853981633974483)), t17, xp.where((xp.greater_equal(t142, -3.9269908169872414)) & (xp.less_equal(t142, 0.7853981633974483)), t142, xp.where((xp.greater_equal(t143, -3.9269908169872414)) & (xp.less_equal(t143, 0.7853981633974483)), t143, qb2_2)))
-    t145 = xp.where(xp.greater(qn4, t18), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t146 = t145 + t18
+    t144 = xp.where(xp.greater_equal(t17, -3.9269908169872414) & xp.less_equal(t17, 0.7853981633974483), t17, xp.where(xp.greater_equal(t142, -3.9269908169872414) & xp.less_equal(t142, 0.7853981633974483), t142, xp.where(xp.greater_equal(t143, -3.9269908169872414) & xp.less_equal(t143, 0.7853981633974483), t143, qb2_2)))
+    t145 = xp.where(xp.less(t18, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t146 = t18 + t145
     t147 = t18 - t145
-    t148 = xp.where((xp.greater_equal(t18, -1.9198621771937625)) & (xp.less_equal(t18, 2.9670597283903604)), t18, xp.where((xp.greater_equal(t146, -1.9198621771937625)) & (xp.less_equal(t146, 2.9670597283903604)), t146, xp.where((xp.greater_equal(t147, -1.9198621771937625)) & (xp.less_equal(t147, 2.9670597283903604)), t147, qb2_3)))
-    t149 = xp.where(xp.greater(qn5, t19), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t150 = t149 + t19
+    t148 = xp.where(xp.greater_equal(t18, -1.9198621771937625) & xp.less_equal(t18, 2.9670597283903604), t18, xp.where(xp.greater_equal(t146, -1.9198621771937625) & xp.less_equal(t146, 2.9670597283903604), t146, xp.where(xp.greater_equal(t147, -1.9198621771937625) & xp.less_equal(t147, 2.9670597283903604), t147, qb2_3)))
+    t149 = xp.where(xp.less(t19, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t150 = t19 + t149
     t151 = t19 - t149
-    t152 = xp.where((xp.greater_equal(t19, -1.7453292519943295)) & (xp.less_equal(t19, 1.7453292519943295)), t19, xp.where((xp.greater_equal(t150, -1.7453292519943295)) & (xp.less_equal(t150, 1.7453292519943295)), t150, xp.where((xp.greater_equal(t151, -1.7453292519943295)) & (xp.less_equal(t151, 1.7453292519943295)), t151, qb2_4)))
-    t153 = xp.where(xp.greater(qn6, t20), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t154 = t153 + t20
+    t152 = xp.where(xp.greater_equal(t19, -1.7453292519943295) & xp.less_equal(t19, 1.7453292519943295), t19, xp.where(xp.greater_equal(t150, -1.7453292519943295) & xp.less_equal(t150, 1.7453292519943295), t150, xp.where(xp.greater_equal(t151, -1.7453292519943295) & xp.less_equal(t151, 1.7453292519943295), t151, qb2_4)))
+    t153 = xp.where(xp.less(t20, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t154 = t20 + t153
     t155 = t20 - t153
-    t156 = xp.where((xp.greater_equal(t20, -4.642575810304916)) & (xp.less_equal(t20, 4.642575810304916)), t20, xp.where((xp.greater_equal(t154, -4.642575810304916)) & (xp.less_equal(t154, 4.642575810304916)), t154, xp.where((xp.greater_equal(t155, -4.642575810304916)) & (xp.less_equal(t155, 4.642575810304916)), t155, qb2_5)))
+    t156 = xp.where(xp.greater_equal(t20, -4.642575810304916) & xp.less_equal(t20, 4.642575810304916), t20, xp.where(xp.greater_equal(t154, -4.642575810304916) & xp.less_equal(t154, 4.642575810304916), t154, xp.where(xp.greater_equal(t155, -4.642575810304916) & xp.less_equal(t155, 4.642575810304916), t155, qb2_5)))
     t157 = qw1*(t136 + t82)**2 + qw2*(t140 + t83)**2 + qw3*(t144 + t84)**2 + qw4*(t148 + t85)**2 + qw5*(t152 + t86)**2 + qw6*(t156 + t87)**2
     t158 = xp.greater(t21, 0)
-    t159 = xp.where(t158 & ((xp.greater(t132, t157)) | (xp.less(t124, 1))), xp.asarray(1, dtype=dtype), 0)
+    t159 = xp.where(t158 & (xp.less(t157, t132) | xp.less(t124, 1)), xp.asarray(1, dtype=dtype), 0)
     t160 = xp.where(t158, 1, t124)
     t161 = xp.greater(t159, 0)
     t162 = xp.where(t161, t136, t126)
@@ -3093,33 +3093,33 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     t166 = xp.where(t161, t152, t130)
     t167 = xp.where(t161, t156, t131)
     t168 = xp.where(t161, t157, t132)
-    t169 = xp.where(xp.greater(qn1, t22), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t170 = t169 + t22
+    t169 = xp.where(xp.less(t22, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t170 = t22 + t169
     t171 = t22 - t169
-    t172 = xp.where((xp.greater_equal(t22, -2.792526803190927)) & (xp.less_equal(t22, 2.792526803190927)), t22, xp.where((xp.greater_equal(t170, -2.792526803190927)) & (xp.less_equal(t170, 2.792526803190927)), t170, xp.where((xp.greater_equal(t171, -2.792526803190927)) & (xp.less_equal(t171, 2.792526803190927)), t171, qb3_0)))
-    t173 = xp.where(xp.greater(qn2, t23), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t174 = t173 + t23
+    t172 = xp.where(xp.greater_equal(t22, -2.792526803190927) & xp.less_equal(t22, 2.792526803190927), t22, xp.where(xp.greater_equal(t170, -2.792526803190927) & xp.less_equal(t170, 2.792526803190927), t170, xp.where(xp.greater_equal(t171, -2.792526803190927) & xp.less_equal(t171, 2.792526803190927), t171, qb3_0)))
+    t173 = xp.where(xp.less(t23, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t174 = t23 + t173
     t175 = t23 - t173
-    t176 = xp.where((xp.greater_equal(t23, -0.7853981633974483)) & (xp.less_equal(t23, 3.9269908169872414)), t23, xp.where((xp.greater_equal(t174, -0.7853981633974483)) & (xp.less_equal(t174, 3.9269908169872414)), t174, xp.where((xp.greater_equal(t175, -0.7853981633974483)) & (xp.less_equal(t175, 3.9269908169872414)), t175, qb3_1)))
-    t177 = xp.where(xp.greater(qn3, t24), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t178 = t177 + t24
+    t176 = xp.where(xp.greater_equal(t23, -0.7853981633974483) & xp.less_equal(t23, 3.9269908169872414), t23, xp.where(xp.greater_equal(t174, -0.7853981633974483) & xp.less_equal(t174, 3.9269908169872414), t174, xp.where(xp.greater_equal(t175, -0.7853981633974483) & xp.less_equal(t175, 3.9269908169872414), t175, qb3_1)))
+    t177 = xp.where(xp.less(t24, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t178 = t24 + t177
     t179 = t24 - t177
-    t180 = xp.where((xp.greater_equal(t24, -3.9269908169872414)) & (xp.less_equal(t24, 0.7853981633974483)), t24, xp.where((xp.greater_equal(t178, -3.9269908169872414)) & (xp.less_equal(t178, 0.7853981633974483)), t178, xp.where((xp.greater_equal(t179, -3.9269908169872414)) & (xp.less_equal(t179, 0.7853981633974483)), t179, qb3_2)))
-    t181 = xp.where(xp.greater(qn4, t25), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t182 = t181 + t25
+    t180 = xp.where(xp.greater_equal(t24, -3.9269908169872414) & xp.less_equal(t24, 0.7853981633974483), t24, xp.where(xp.greater_equal(t178, -3.9269908169872414) & xp.less_equal(t178, 0.7853981633974483), t178, xp.where(xp.greater_equal(t179, -3.9269908169872414) & xp.less_equal(t179, 0.7853981633974483), t179, qb3_2)))
+    t181 = xp.where(xp.less(t25, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t182 = t25 + t181
     t183 = t25 - t181
-    t184 = xp.where((xp.greater_equal(t25, -1.9198621771937625)) & (xp.less_equal(t25, 2.9670597283903604)), t25, xp.where((xp.greater_equal(t182, -1.9198621771937625)) & (xp.less_equal(t182, 2.9670597283903604)), t182, xp.where((xp.greater_equal(t183, -1.9198621771937625)) & (xp.less_equal(t183, 2.9670597283903604)), t183, qb3_3)))
-    t185 = xp.where(xp.greater(qn5, t26), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t186 = t185 + t26
+    t184 = xp.where(xp.greater_equal(t25, -1.9198621771937625) & xp.less_equal(t25, 2.9670597283903604), t25, xp.where(xp.greater_equal(t182, -1.9198621771937625) & xp.less_equal(t182, 2.9670597283903604), t182, xp.where(xp.greater_equal(t183, -1.9198621771937625) & xp.less_equal(t183, 2.9670597283903604), t183, qb3_3)))
+    t185 = xp.where(xp.less(t26, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t186 = t26 + t185
     t187 = t26 - t185
-    t188 = xp.where((xp.greater_equal(t26, -1.7453292519943295)) & (xp.less_equal(t26, 1.7453292519943295)), t26, xp.where((xp.greater_equal(t186, -1.7453292519943295)) & (xp.less_equal(t186, 1.7453292519943295)), t186, xp.where((xp.greater_equal(t187, -1.7453292519943295)) & (xp.less_equal(t187, 1.7453292519943295)), t187, qb3_4)))
-    t189 = xp.where(xp.greater(qn6, t27), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t190 = t189 + t27
+    t188 = xp.where(xp.greater_equal(t26, -1.7453292519943295) & xp.less_equal(t26, 1.7453292519943295), t26, xp.where(xp.greater_equal(t186, -1.7453292519943295) & xp.less_equal(t186, 1.7453292519943295), t186, xp.where(xp.greater_equal(t187, -1.7453292519943295) & xp.less_equal(t187, 1.7453292519943295), t187, qb3_4)))
+    t189 = xp.where(xp.less(t27, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t190 = t27 + t189
     t191 = t27 - t189
-    t192 = xp.where((xp.greater_equal(t27, -4.642575810304916)) & (xp.less_equal(t27, 4.642575810304916)), t27, xp.where((xp.greater_equal(t190, -4.642575810304916)) & (xp.less_equal(t190, 4.642575810304916)), t190, xp.where((xp.greater_equal(t191, -4.642575810304916)) & (xp.less_equal(t191, 4.642575810304916)), t191, qb3_5)))
+    t192 = xp.where(xp.greater_equal(t27, -4.642575810304916) & xp.less_equal(t27, 4.642575810304916), t27, xp.where(xp.greater_equal(t190, -4.642575810304916) & xp.less_equal(t190, 4.642575810304916), t190, xp.where(xp.greater_equal(t191, -4.642575810304916) & xp.less_equal(t191, 4.642575810304916), t191, qb3_5)))
     t193 = qw1*(t172 + t82)**2 + qw2*(t176 + t83)**2 + qw3*(t180 + t84)**2 + qw4*(t184 + t85)**2 + qw5*(t188 + t86)**2 + qw6*(t192 + t87)**2
     t194 = xp.greater(t28, 0)
-    t195 = xp.where(t194 & ((xp.greater(t168, t193)) | (xp.less(t160, 1))), xp.asarray(1, dtype=dtype), 0)
+    t195 = xp.where(t194 & (xp.greater(t168, t193) | xp.less(t160, 1)), xp.asarray(1, dtype=dtype), 0)
     t196 = xp.where(t194, 1, t160)
     t197 = xp.greater(t195, 0)
     t198 = xp.where(t197, t172, t162)
@@ -3129,33 +3129,33 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     t202 = xp.where(t197, t188, t166)
     t203 = xp.where(t197, t192, t167)
     t204 = xp.where(t197, t193, t168)
-    t205 = xp.where(xp.greater(qn1, t29), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t206 = t205 + t29
+    t205 = xp.where(xp.less(t29, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t206 = t29 + t205
     t207 = t29 - t205
-    t208 = xp.where((xp.greater_equal(t29, -2.792526803190927)) & (xp.less_equal(t29, 2.792526803190927)), t29, xp.where((xp.greater_equal(t206, -2.792526803190927)) & (xp.less_equal(t206, 2.792526803190927)), t206, xp.where((xp.greater_equal(t207, -2.792526803190927)) & (xp.less_equal(t207, 2.792526803190927)), t207, qb4_0)))
-    t209 = xp.where(xp.greater(qn2, t30), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t210 = t209 + t30
+    t208 = xp.where(xp.greater_equal(t29, -2.792526803190927) & xp.less_equal(t29, 2.792526803190927), t29, xp.where(xp.greater_equal(t206, -2.792526803190927) & xp.less_equal(t206, 2.792526803190927), t206, xp.where(xp.greater_equal(t207, -2.792526803190927) & xp.less_equal(t207, 2.792526803190927), t207, qb4_0)))
+    t209 = xp.where(xp.less(t30, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t210 = t30 + t209
     t211 = t30 - t209
-    t212 = xp.where((xp.greater_equal(t30, -0.7853981633974483)) & (xp.less_equal(t30, 3.9269908169872414)), t30, xp.where((xp.greater_equal(t210, -0.7853981633974483)) & (xp.less_equal(t210, 3.9269908169872414)), t210, xp.where((xp.greater_equal(t211, -0.7853981633974483)) & (xp.less_equal(t211, 3.9269908169872414)), t211, qb4_1)))
-    t213 = xp.where(xp.greater(qn3, t31), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t214 = t213 + t31
+    t212 = xp.where(xp.greater_equal(t30, -0.7853981633974483) & xp.less_equal(t30, 3.9269908169872414), t30, xp.where(xp.greater_equal(t210, -0.7853981633974483) & xp.less_equal(t210, 3.9269908169872414), t210, xp.where(xp.greater_equal(t211, -0.7853981633974483) & xp.less_equal(t211, 3.9269908169872414), t211, qb4_1)))
+    t213 = xp.where(xp.less(t31, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t214 = t31 + t213
     t215 = t31 - t213
-    t216 = xp.where((xp.greater_equal(t31, -3.9269908169872414)) & (xp.less_equal(t31, 0.7853981633974483)), t31, xp.where((xp.greater_equal(t214, -3.9269908169872414)) & (xp.less_equal(t214, 0.7853981633974483)), t214, xp.where((xp.greater_equal(t215, -3.9269908169872414)) & (xp.less_equal(t215, 0.7853981633974483)), t215, qb4_2)))
-    t217 = xp.where(xp.greater(qn4, t32), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t218 = t217 + t32
+    t216 = xp.where(xp.greater_equal(t31, -3.9269908169872414) & xp.less_equal(t31, 0.7853981633974483), t31, xp.where(xp.greater_equal(t214, -3.9269908169872414) & xp.less_equal(t214, 0.7853981633974483), t214, xp.where(xp.greater_equal(t215, -3.9269908169872414) & xp.less_equal(t215, 0.7853981633974483), t215, qb4_2)))
+    t217 = xp.where(xp.less(t32, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t218 = t32 + t217
     t219 = t32 - t217
-    t220 = xp.where((xp.greater_equal(t32, -1.9198621771937625)) & (xp.less_equal(t32, 2.9670597283903604)), t32, xp.where((xp.greater_equal(t218, -1.9198621771937625)) & (xp.less_equal(t218, 2.9670597283903604)), t218, xp.where((xp.greater_equal(t219, -1.9198621771937625)) & (xp.less_equal(t219, 2.9670597283903604)), t219, qb4_3)))
-    t221 = xp.where(xp.greater(qn5, t33), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t222 = t221 + t33
+    t220 = xp.where(xp.greater_equal(t32, -1.9198621771937625) & xp.less_equal(t32, 2.9670597283903604), t32, xp.where(xp.greater_equal(t218, -1.9198621771937625) & xp.less_equal(t218, 2.9670597283903604), t218, xp.where(xp.greater_equal(t219, -1.9198621771937625) & xp.less_equal(t219, 2.9670597283903604), t219, qb4_3)))
+    t221 = xp.where(xp.less(t33, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t222 = t33 + t221
     t223 = t33 - t221
-    t224 = xp.where((xp.greater_equal(t33, -1.7453292519943295)) & (xp.less_equal(t33, 1.7453292519943295)), t33, xp.where((xp.greater_equal(t222, -1.7453292519943295)) & (xp.less_equal(t222, 1.7453292519943295)), t222, xp.where((xp.greater_equal(t223, -1.7453292519943295)) & (xp.less_equal(t223, 1.7453292519943295)), t223, qb4_4)))
-    t225 = xp.where(xp.greater(qn6, t34), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t226 = t225 + t34
+    t224 = xp.where(xp.greater_equal(t33, -1.7453292519943295) & xp.less_equal(t33, 1.7453292519943295), t33, xp.where(xp.greater_equal(t222, -1.7453292519943295) & xp.less_equal(t222, 1.7453292519943295), t222, xp.where(xp.greater_equal(t223, -1.7453292519943295) & xp.less_equal(t223, 1.7453292519943295), t223, qb4_4)))
+    t225 = xp.where(xp.less(t34, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t226 = t34 + t225
     t227 = t34 - t225
-    t228 = xp.where((xp.greater_equal(t34, -4.642575810304916)) & (xp.less_equal(t34, 4.642575810304916)), t34, xp.where((xp.greater_equal(t226, -4.642575810304916)) & (xp.less_equal(t226, 4.642575810304916)), t226, xp.where((xp.greater_equal(t227, -4.642575810304916)) & (xp.less_equal(t227, 4.642575810304916)), t227, qb4_5)))
+    t228 = xp.where(xp.greater_equal(t34, -4.642575810304916) & xp.less_equal(t34, 4.642575810304916), t34, xp.where(xp.greater_equal(t226, -4.642575810304916) & xp.less_equal(t226, 4.642575810304916), t226, xp.where(xp.greater_equal(t227, -4.642575810304916) & xp.less_equal(t227, 4.642575810304916), t227, qb4_5)))
     t229 = qw1*(t208 + t82)**2 + qw2*(t212 + t83)**2 + qw3*(t216 + t84)**2 + qw4*(t220 + t85)**2 + qw5*(t224 + t86)**2 + qw6*(t228 + t87)**2
     t230 = xp.greater(t35, 0)
-    t231 = xp.where(t230 & ((xp.greater(t204, t229)) | (xp.less(t196, 1))), xp.asarray(1, dtype=dtype), 0)
+    t231 = xp.where(t230 & (xp.greater(t204, t229) | xp.less(t196, 1)), xp.asarray(1, dtype=dtype), 0)
     t232 = xp.where(t230, 1, t196)
     t233 = xp.greater(t231, 0)
     t234 = xp.where(t233, t208, t198)
@@ -3165,33 +3165,33 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     t238 = xp.where(t233, t224, t202)
     t239 = xp.where(t233, t228, t203)
     t240 = xp.where(t233, t229, t204)
-    t241 = xp.where(xp.greater(qn1, t36), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t242 = t241 + t36
+    t241 = xp.where(xp.less(t36, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t242 = t36 + t241
     t243 = t36 - t241
-    t244 = xp.where((xp.greater_equal(t36, -2.792526803190927)) & (xp.less_equal(t36, 2.792526803190927)), t36, xp.where((xp.greater_equal(t242, -2.792526803190927)) & (xp.less_equal(t242, 2.792526803190927)), t242, xp.where((xp.greater_equal(t243, -2.792526803190927)) & (xp.less_equal(t243, 2.792526803190927)), t243, qb5_0)))
-    t245 = xp.where(xp.greater(qn2, t37), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t246 = t245 + t37
+    t244 = xp.where(xp.greater_equal(t36, -2.792526803190927) & xp.less_equal(t36, 2.792526803190927), t36, xp.where(xp.greater_equal(t242, -2.792526803190927) & xp.less_equal(t242, 2.792526803190927), t242, xp.where(xp.greater_equal(t243, -2.792526803190927) & xp.less_equal(t243, 2.792526803190927), t243, qb5_0)))
+    t245 = xp.where(xp.less(t37, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t246 = t37 + t245
     t247 = t37 - t245
-    t248 = xp.where((xp.greater_equal(t37, -0.7853981633974483)) & (xp.less_equal(t37, 3.9269908169872414)), t37, xp.where((xp.greater_equal(t246, -0.7853981633974483)) & (xp.less_equal(t246, 3.9269908169872414)), t246, xp.where((xp.greater_equal(t247, -0.7853981633974483)) & (xp.less_equal(t247, 3.9269908169872414)), t247, qb5_1)))
-    t249 = xp.where(xp.greater(qn3, t38), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t250 = t249 + t38
+    t248 = xp.where(xp.greater_equal(t37, -0.7853981633974483) & xp.less_equal(t37, 3.9269908169872414), t37, xp.where(xp.greater_equal(t246, -0.7853981633974483) & xp.less_equal(t246, 3.9269908169872414), t246, xp.where(xp.greater_equal(t247, -0.7853981633974483) & xp.less_equal(t247, 3.9269908169872414), t247, qb5_1)))
+    t249 = xp.where(xp.less(t38, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t250 = t38 + t249
     t251 = t38 - t249
-    t252 = xp.where((xp.greater_equal(t38, -3.9269908169872414)) & (xp.less_equal(t38, 0.7853981633974483)), t38, xp.where((xp.greater_equal(t250, -3.9269908169872414)) & (xp.less_equal(t250, 0.7853981633974483)), t250, xp.where((xp.greater_equal(t251, -3.9269908169872414)) & (xp.less_equal(t251, 0.7853981633974483)), t251, qb5_2)))
-    t253 = xp.where(xp.greater(qn4, t39), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t254 = t253 + t39
+    t252 = xp.where(xp.greater_equal(t38, -3.9269908169872414) & xp.less_equal(t38, 0.7853981633974483), t38, xp.where(xp.greater_equal(t250, -3.9269908169872414) & xp.less_equal(t250, 0.7853981633974483), t250, xp.where(xp.greater_equal(t251, -3.9269908169872414) & xp.less_equal(t251, 0.7853981633974483), t251, qb5_2)))
+    t253 = xp.where(xp.less(t39, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t254 = t39 + t253
     t255 = t39 - t253
-    t256 = xp.where((xp.greater_equal(t39, -1.9198621771937625)) & (xp.less_equal(t39, 2.9670597283903604)), t39, xp.where((xp.greater_equal(t254, -1.9198621771937625)) & (xp.less_equal(t254, 2.9670597283903604)), t254, xp.where((xp.greater_equal(t255, -1.9198621771937625)) & (xp.less_equal(t255, 2.9670597283903604)), t255, qb5_3)))
-    t257 = xp.where(xp.greater(qn5, t40), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t258 = t257 + t40
+    t256 = xp.where(xp.greater_equal(t39, -1.9198621771937625) & xp.less_equal(t39, 2.9670597283903604), t39, xp.where(xp.greater_equal(t254, -1.9198621771937625) & xp.less_equal(t254, 2.9670597283903604), t254, xp.where(xp.greater_equal(t255, -1.9198621771937625) & xp.less_equal(t255, 2.9670597283903604), t255, qb5_3)))
+    t257 = xp.where(xp.less(t40, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t258 = t40 + t257
     t259 = t40 - t257
-    t260 = xp.where((xp.greater_equal(t40, -1.7453292519943295)) & (xp.less_equal(t40, 1.7453292519943295)), t40, xp.where((xp.greater_equal(t258, -1.7453292519943295)) & (xp.less_equal(t258, 1.7453292519943295)), t258, xp.where((xp.greater_equal(t259, -1.7453292519943295)) & (xp.less_equal(t259, 1.7453292519943295)), t259, qb5_4)))
-    t261 = xp.where(xp.greater(qn6, t41), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t262 = t261 + t41
+    t260 = xp.where(xp.greater_equal(t40, -1.7453292519943295) & xp.less_equal(t40, 1.7453292519943295), t40, xp.where(xp.greater_equal(t258, -1.7453292519943295) & xp.less_equal(t258, 1.7453292519943295), t258, xp.where(xp.greater_equal(t259, -1.7453292519943295) & xp.less_equal(t259, 1.7453292519943295), t259, qb5_4)))
+    t261 = xp.where(xp.less(t41, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t262 = t41 + t261
     t263 = t41 - t261
-    t264 = xp.where((xp.greater_equal(t41, -4.642575810304916)) & (xp.less_equal(t41, 4.642575810304916)), t41, xp.where((xp.greater_equal(t262, -4.642575810304916)) & (xp.less_equal(t262, 4.642575810304916)), t262, xp.where((xp.greater_equal(t263, -4.642575810304916)) & (xp.less_equal(t263, 4.642575810304916)), t263, qb5_5)))
+    t264 = xp.where(xp.greater_equal(t41, -4.642575810304916) & xp.less_equal(t41, 4.642575810304916), t41, xp.where(xp.greater_equal(t262, -4.642575810304916) & xp.less_equal(t262, 4.642575810304916), t262, xp.where(xp.greater_equal(t263, -4.642575810304916) & xp.less_equal(t263, 4.642575810304916), t263, qb5_5)))
     t265 = qw1*(t244 + t82)**2 + qw2*(t248 + t83)**2 + qw3*(t252 + t84)**2 + qw4*(t256 + t85)**2 + qw5*(t260 + t86)**2 + qw6*(t264 + t87)**2
     t266 = xp.greater(t42, 0)
-    t267 = xp.where(t266 & ((xp.greater(t240, t265)) | (xp.less(t232, 1))), xp.asarray(1, dtype=dtype), 0)
+    t267 = xp.where(t266 & (xp.greater(t240, t265) | xp.less(t232, 1)), xp.asarray(1, dtype=dtype), 0)
     t268 = xp.where(t266, 1, t232)
     t269 = xp.greater(t267, 0)
     t270 = xp.where(t269, t244, t234)
@@ -3201,33 +3201,33 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     t274 = xp.where(t269, t260, t238)
     t275 = xp.where(t269, t264, t239)
     t276 = xp.where(t269, t265, t240)
-    t277 = xp.where(xp.greater(qn1, t43), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t278 = t277 + t43
+    t277 = xp.where(xp.less(t43, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t278 = t43 + t277
     t279 = t43 - t277
-    t280 = xp.where((xp.greater_equal(t43, -2.792526803190927)) & (xp.less_equal(t43, 2.792526803190927)), t43, xp.where((xp.greater_equal(t278, -2.792526803190927)) & (xp.less_equal(t278, 2.792526803190927)), t278, xp.where((xp.greater_equal(t279, -2.792526803190927)) & (xp.less_equal(t279, 2.792526803190927)), t279, qb6_0)))
-    t281 = xp.where(xp.greater(qn2, t44), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t282 = t281 + t44
+    t280 = xp.where(xp.greater_equal(t43, -2.792526803190927) & xp.less_equal(t43, 2.792526803190927), t43, xp.where(xp.greater_equal(t278, -2.792526803190927) & xp.less_equal(t278, 2.792526803190927), t278, xp.where(xp.greater_equal(t279, -2.792526803190927) & xp.less_equal(t279, 2.792526803190927), t279, qb6_0)))
+    t281 = xp.where(xp.less(t44, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t282 = t44 + t281
     t283 = t44 - t281
-    t284 = xp.where((xp.greater_equal(t44, -0.7853981633974483)) & (xp.less_equal(t44, 3.9269908169872414)), t44, xp.where((xp.greater_equal(t282, -0.7853981633974483)) & (xp.less_equal(t282, 3.9269908169872414)), t282, xp.where((xp.greater_equal(t283, -0.7853981633974483)) & (xp.less_equal(t283, 3.9269908169872414)), t283, qb6_1)))
-    t285 = xp.where(xp.greater(qn3, t45), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t286 = t285 + t45
+    t284 = xp.where(xp.greater_equal(t44, -0.7853981633974483) & xp.less_equal(t44, 3.9269908169872414), t44, xp.where(xp.greater_equal(t282, -0.7853981633974483) & xp.less_equal(t282, 3.9269908169872414), t282, xp.where(xp.greater_equal(t283, -0.7853981633974483) & xp.less_equal(t283, 3.9269908169872414), t283, qb6_1)))
+    t285 = xp.where(xp.less(t45, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t286 = t45 + t285
     t287 = t45 - t285
-    t288 = xp.where((xp.greater_equal(t45, -3.9269908169872414)) & (xp.less_equal(t45, 0.7853981633974483)), t45, xp.where((xp.greater_equal(t286, -3.9269908169872414)) & (xp.less_equal(t286, 0.7853981633974483)), t286, xp.where((xp.greater_equal(t287, -3.9269908169872414)) & (xp.less_equal(t287, 0.7853981633974483)), t287, qb6_2)))
-    t289 = xp.where(xp.greater(qn4, t46), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t290 = t289 + t46
+    t288 = xp.where(xp.greater_equal(t45, -3.9269908169872414) & xp.less_equal(t45, 0.7853981633974483), t45, xp.where(xp.greater_equal(t286, -3.9269908169872414) & xp.less_equal(t286, 0.7853981633974483), t286, xp.where(xp.greater_equal(t287, -3.9269908169872414) & xp.less_equal(t287, 0.7853981633974483), t287, qb6_2)))
+    t289 = xp.where(xp.less(t46, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t290 = t46 + t289
     t291 = t46 - t289
-    t292 = xp.where((xp.greater_equal(t46, -1.9198621771937625)) & (xp.less_equal(t46, 2.9670597283903604)), t46, xp.where((xp.greater_equal(t290, -1.9198621771937625)) & (xp.less_equal(t290, 2.9670597283903604)), t290, xp.where((xp.greater_equal(t291, -1.9198621771937625)) & (xp.less_equal(t291, 2.9670597283903604)), t291, qb6_3)))
-    t293 = xp.where(xp.greater(qn5, t47), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t294 = t293 + t47
+    t292 = xp.where(xp.greater_equal(t46, -1.9198621771937625) & xp.less_equal(t46, 2.9670597283903604), t46, xp.where(xp.greater_equal(t290, -1.9198621771937625) & xp.less_equal(t290, 2.9670597283903604), t290, xp.where(xp.greater_equal(t291, -1.9198621771937625) & xp.less_equal(t291, 2.9670597283903604), t291, qb6_3)))
+    t293 = xp.where(xp.less(t47, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t294 = t47 + t293
     t295 = t47 - t293
-    t296 = xp.where((xp.greater_equal(t47, -1.7453292519943295)) & (xp.less_equal(t47, 1.7453292519943295)), t47, xp.where((xp.greater_equal(t294, -1.7453292519943295)) & (xp.less_equal(t294, 1.7453292519943295)), t294, xp.where((xp.greater_equal(t295, -1.7453292519943295)) & (xp.less_equal(t295, 1.7453292519943295)), t295, qb6_4)))
-    t297 = xp.where(xp.greater(qn6, t48), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t298 = t297 + t48
+    t296 = xp.where(xp.greater_equal(t47, -1.7453292519943295) & xp.less_equal(t47, 1.7453292519943295), t47, xp.where(xp.greater_equal(t294, -1.7453292519943295) & xp.less_equal(t294, 1.7453292519943295), t294, xp.where(xp.greater_equal(t295, -1.7453292519943295) & xp.less_equal(t295, 1.7453292519943295), t295, qb6_4)))
+    t297 = xp.where(xp.less(t48, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t298 = t48 + t297
     t299 = t48 - t297
-    t300 = xp.where((xp.greater_equal(t48, -4.642575810304916)) & (xp.less_equal(t48, 4.642575810304916)), t48, xp.where((xp.greater_equal(t298, -4.642575810304916)) & (xp.less_equal(t298, 4.642575810304916)), t298, xp.where((xp.greater_equal(t299, -4.642575810304916)) & (xp.less_equal(t299, 4.642575810304916)), t299, qb6_5)))
+    t300 = xp.where(xp.greater_equal(t48, -4.642575810304916) & xp.less_equal(t48, 4.642575810304916), t48, xp.where(xp.greater_equal(t298, -4.642575810304916) & xp.less_equal(t298, 4.642575810304916), t298, xp.where(xp.greater_equal(t299, -4.642575810304916) & xp.less_equal(t299, 4.642575810304916), t299, qb6_5)))
     t301 = qw1*(t280 + t82)**2 + qw2*(t284 + t83)**2 + qw3*(t288 + t84)**2 + qw4*(t292 + t85)**2 + qw5*(t296 + t86)**2 + qw6*(t300 + t87)**2
     t302 = xp.greater(t49, 0)
-    t303 = xp.where(t302 & ((xp.greater(t276, t301)) | (xp.less(t268, 1))), xp.asarray(1, dtype=dtype), 0)
+    t303 = xp.where(t302 & (xp.greater(t276, t301) | xp.less(t268, 1)), xp.asarray(1, dtype=dtype), 0)
     t304 = xp.where(t302, 1, t268)
     t305 = xp.greater(t303, 0)
     t306 = xp.where(t305, t280, t270)
@@ -3237,33 +3237,33 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     t310 = xp.where(t305, t296, t274)
     t311 = xp.where(t305, t300, t275)
     t312 = xp.where(t305, t301, t276)
-    t313 = xp.where(xp.greater(qn1, t50), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t314 = t313 + t50
+    t313 = xp.where(xp.less(t50, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t314 = t50 + t313
     t315 = t50 - t313
-    t316 = xp.where((xp.greater_equal(t50, -2.792526803190927)) & (xp.less_equal(t50, 2.792526803190927)), t50, xp.where((xp.greater_equal(t314, -2.792526803190927)) & (xp.less_equal(t314, 2.792526803190927)), t314, xp.where((xp.greater_equal(t315, -2.792526803190927)) & (xp.less_equal(t315, 2.792526803190927)), t315, qb7_0)))
-    t317 = xp.where(xp.greater(qn2, t51), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t318 = t317 + t51
+    t316 = xp.where(xp.greater_equal(t50, -2.792526803190927) & xp.less_equal(t50, 2.792526803190927), t50, xp.where(xp.greater_equal(t314, -2.792526803190927) & xp.less_equal(t314, 2.792526803190927), t314, xp.where(xp.greater_equal(t315, -2.792526803190927) & xp.less_equal(t315, 2.792526803190927), t315, qb7_0)))
+    t317 = xp.where(xp.less(t51, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t318 = t51 + t317
     t319 = t51 - t317
-    t320 = xp.where((xp.greater_equal(t51, -0.7853981633974483)) & (xp.less_equal(t51, 3.9269908169872414)), t51, xp.where((xp.greater_equal(t318, -0.7853981633974483)) & (xp.less_equal(t318, 3.9269908169872414)), t318, xp.where((xp.greater_equal(t319, -0.7853981633974483)) & (xp.less_equal(t319, 3.9269908169872414)), t319, qb7_1)))
-    t321 = xp.where(xp.greater(qn3, t52), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t322 = t321 + t52
+    t320 = xp.where(xp.greater_equal(t51, -0.7853981633974483) & xp.less_equal(t51, 3.9269908169872414), t51, xp.where(xp.greater_equal(t318, -0.7853981633974483) & xp.less_equal(t318, 3.9269908169872414), t318, xp.where(xp.greater_equal(t319, -0.7853981633974483) & xp.less_equal(t319, 3.9269908169872414), t319, qb7_1)))
+    t321 = xp.where(xp.less(t52, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t322 = t52 + t321
     t323 = t52 - t321
-    t324 = xp.where((xp.greater_equal(t52, -3.9269908169872414)) & (xp.less_equal(t52, 0.7853981633974483)), t52, xp.where((xp.greater_equal(t322, -3.9269908169872414)) & (xp.less_equal(t322, 0.7853981633974483)), t322, xp.where((xp.greater_equal(t323, -3.9269908169872414)) & (xp.less_equal(t323, 0.7853981633974483)), t323, qb7_2)))
-    t325 = xp.where(xp.greater(qn4, t53), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t326 = t325 + t53
+    t324 = xp.where(xp.greater_equal(t52, -3.9269908169872414) & xp.less_equal(t52, 0.7853981633974483), t52, xp.where(xp.greater_equal(t322, -3.9269908169872414) & xp.less_equal(t322, 0.7853981633974483), t322, xp.where(xp.greater_equal(t323, -3.9269908169872414) & xp.less_equal(t323, 0.7853981633974483), t323, qb7_2)))
+    t325 = xp.where(xp.less(t53, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t326 = t53 + t325
     t327 = t53 - t325
-    t328 = xp.where((xp.greater_equal(t53, -1.9198621771937625)) & (xp.less_equal(t53, 2.9670597283903604)), t53, xp.where((xp.greater_equal(t326, -1.9198621771937625)) & (xp.less_equal(t326, 2.9670597283903604)), t326, xp.where((xp.greater_equal(t327, -1.9198621771937625)) & (xp.less_equal(t327, 2.9670597283903604)), t327, qb7_3)))
-    t329 = xp.where(xp.greater(qn5, t54), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t330 = t329 + t54
+    t328 = xp.where(xp.greater_equal(t53, -1.9198621771937625) & xp.less_equal(t53, 2.9670597283903604), t53, xp.where(xp.greater_equal(t326, -1.9198621771937625) & xp.less_equal(t326, 2.9670597283903604), t326, xp.where(xp.greater_equal(t327, -1.9198621771937625) & xp.less_equal(t327, 2.9670597283903604), t327, qb7_3)))
+    t329 = xp.where(xp.less(t54, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t330 = t54 + t329
     t331 = t54 - t329
-    t332 = xp.where((xp.greater_equal(t54, -1.7453292519943295)) & (xp.less_equal(t54, 1.7453292519943295)), t54, xp.where((xp.greater_equal(t330, -1.7453292519943295)) & (xp.less_equal(t330, 1.7453292519943295)), t330, xp.where((xp.greater_equal(t331, -1.7453292519943295)) & (xp.less_equal(t331, 1.7453292519943295)), t331, qb7_4)))
-    t333 = xp.where(xp.greater(qn6, t55), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t334 = t333 + t55
+    t332 = xp.where(xp.greater_equal(t54, -1.7453292519943295) & xp.less_equal(t54, 1.7453292519943295), t54, xp.where(xp.greater_equal(t330, -1.7453292519943295) & xp.less_equal(t330, 1.7453292519943295), t330, xp.where(xp.greater_equal(t331, -1.7453292519943295) & xp.less_equal(t331, 1.7453292519943295), t331, qb7_4)))
+    t333 = xp.where(xp.less(t55, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t334 = t55 + t333
     t335 = t55 - t333
-    t336 = xp.where((xp.greater_equal(t55, -4.642575810304916)) & (xp.less_equal(t55, 4.642575810304916)), t55, xp.where((xp.greater_equal(t334, -4.642575810304916)) & (xp.less_equal(t334, 4.642575810304916)), t334, xp.where((xp.greater_equal(t335, -4.642575810304916)) & (xp.less_equal(t335, 4.642575810304916)), t335, qb7_5)))
+    t336 = xp.where(xp.greater_equal(t55, -4.642575810304916) & xp.less_equal(t55, 4.642575810304916), t55, xp.where(xp.greater_equal(t334, -4.642575810304916) & xp.less_equal(t334, 4.642575810304916), t334, xp.where(xp.greater_equal(t335, -4.642575810304916) & xp.less_equal(t335, 4.642575810304916), t335, qb7_5)))
     t337 = qw1*(t316 + t82)**2 + qw2*(t320 + t83)**2 + qw3*(t324 + t84)**2 + qw4*(t328 + t85)**2 + qw5*(t332 + t86)**2 + qw6*(t336 + t87)**2
     t338 = xp.greater(t56, 0)
-    t339 = xp.where(t338 & ((xp.greater(t312, t337)) | (xp.less(t304, 1))), xp.asarray(1, dtype=dtype), 0)
+    t339 = xp.where(t338 & (xp.greater(t312, t337) | xp.less(t304, 1)), xp.asarray(1, dtype=dtype), 0)
     t340 = xp.where(t338, 1, t304)
     t341 = xp.greater(t339, 0)
     t342 = xp.where(t341, t316, t306)

@@ -45,7 +45,7 @@ void rexarm_jacobian(const rexarm_real q[REXARM_DOF], rexarm_real J[6 * REXARM_D
 void rexarm_fk_jacobian(const rexarm_real q[REXARM_DOF], rexarm_real T[16], rexarm_real J[6 * REXARM_DOF]);
 
 /* Geometric Jacobian in the tool frame (6 x DOF, rows vx vy vz wx wy wz).
- * Result: J: 6 x 4 row-major, element (r, c) at J[r * 4 + c]. 97 operations. */
+ * Result: J: 6 x 4 row-major, element (r, c) at J[r * 4 + c]. 96 operations. */
 void rexarm_jacobian_tool(const rexarm_real q[REXARM_DOF], rexarm_real J[6 * REXARM_DOF]);
 
 /* Task vector mu = (x, y, z, pitch).
@@ -61,7 +61,7 @@ void rexarm_task_jacobian(const rexarm_real q[REXARM_DOF], rexarm_real J[REXARM_
 void rexarm_fk_jacobian_dot(const rexarm_real q[REXARM_DOF], const rexarm_real q_dot[REXARM_DOF], rexarm_real T[16], rexarm_real J[6 * REXARM_DOF], rexarm_real a[6]);
 
 /* Time derivative dJ/dt of the world geometric Jacobian along q_dot (6 x DOF).
- * Result: Jd: 6 x 4 row-major, element (r, c) at Jd[r * 4 + c]. 138 operations. */
+ * Result: Jd: 6 x 4 row-major, element (r, c) at Jd[r * 4 + c]. 126 operations. */
 void rexarm_jacobian_dot(const rexarm_real q[REXARM_DOF], const rexarm_real q_dot[REXARM_DOF], rexarm_real Jd[6 * REXARM_DOF]);
 
 /* J' q_dot: the tool's classical linear and angular acceleration at zero joint acceleration, world frame (6).
@@ -73,11 +73,11 @@ void rexarm_bias_acceleration(const rexarm_real q[REXARM_DOF], const rexarm_real
 void rexarm_task_jacobian_dot(const rexarm_real q[REXARM_DOF], const rexarm_real q_dot[REXARM_DOF], rexarm_real Jd[REXARM_TASK_DIM * REXARM_DOF]);
 
 /* Partial derivatives dJ/dq_k of the world geometric Jacobian (DOF x 6 x DOF, indexed [k, r, c]).
- * Result: H: 4 x 6 x 4 row-major, element (k, r, c) at H[k * 24 + r * 4 + c]. 85 operations. */
+ * Result: H: 4 x 6 x 4 row-major, element (k, r, c) at H[k * 24 + r * 4 + c]. 82 operations. */
 void rexarm_hessian(const rexarm_real q[REXARM_DOF], rexarm_real H[REXARM_DOF * 6 * REXARM_DOF]);
 
 /* Factors of det(Js): the robot is singular where one is 0.
- * Result: f[i], i < 2. 22 operations. */
+ * Result: f[i], i < 2. 20 operations. */
 void rexarm_singularity_factors(const rexarm_real q[REXARM_DOF], rexarm_real f[REXARM_NUM_SINGULARITY_FACTORS]);
 
 /* Manipulability |det(Js)|.
@@ -97,7 +97,7 @@ int rexarm_velocity_ik(const rexarm_real q[REXARM_DOF], const rexarm_real mu_dot
 rexarm_real rexarm_ik_numeric_step(const rexarm_real target[REXARM_TASK_DIM], const rexarm_real q[REXARM_DOF], rexarm_real damping, rexarm_real q_start[REXARM_DOF], rexarm_real q_next[REXARM_DOF]);
 
 /* Every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits.
- * Result: q: 8 x 4 row-major, element (r, c) at q[r * 4 + c]; valid[i], i < 8; in_limits[i], i < 8. 878 operations. */
+ * Result: q: 8 x 4 row-major, element (r, c) at q[r * 4 + c]; valid[i], i < 8; in_limits[i], i < 8. 870 operations. */
 void rexarm_ik_branches(const rexarm_real mu[REXARM_TASK_DIM], rexarm_real q[REXARM_MAX_IK_SOLUTIONS * REXARM_DOF], int valid[REXARM_MAX_IK_SOLUTIONS], int in_limits[REXARM_MAX_IK_SOLUTIONS]);
 
 /* The closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status.

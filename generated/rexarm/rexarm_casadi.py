@@ -39,12 +39,12 @@ def _fk(q):
     t2 = 0.12 + t1
     t3 = 0.1*c23
     t4 = c1*c234
-    t5 = 0.1*t4 + c1*t3
+    t5 = 0.1*t4 + t3*c1
     t6 = c234*s1
-    t7 = 0.1*t6 + s1*t3
+    t7 = 0.1*t6 + t3*s1
     t8 = 0.1*c2
-    t9 = t5 + c1*t8
-    t10 = t7 + s1*t8
+    t9 = t5 + t8*c1
+    t10 = t7 + t8*s1
     T = casadi.SX(4, 4)
     T[0, 0] = t4
     T[0, 1] = -s1
@@ -80,11 +80,11 @@ def _jacobian(q):
     c234 = c23*c4 - s23*s4
     s234 = c23*s4 + c4*s23
     t0 = 0.1*c1
-    t1 = c23*t0 + c234*t0
-    t2 = t1 + c2*t0
+    t1 = t0*c23 + t0*c234
+    t2 = t1 + t0*c2
     t3 = 0.1*s1
-    t4 = c23*t3 + c234*t3
-    t5 = t4 + c2*t3
+    t4 = t3*c23 + t3*c234
+    t5 = t4 + t3*c2
     t6 = 0.1*s234
     t7 = t6 + 0.1*s23
     t8 = t7 + 0.1*s2
@@ -92,15 +92,15 @@ def _jacobian(q):
     t10 = -c1
     J = casadi.SX(6, 4)
     J[0, 0] = -t5
-    J[0, 1] = -c1*t8
-    J[0, 2] = -c1*t7
-    J[0, 3] = -c1*t6
+    J[0, 1] = -t8*c1
+    J[0, 2] = -t7*c1
+    J[0, 3] = -t6*c1
     J[1, 0] = t2
-    J[1, 1] = -s1*t8
-    J[1, 2] = -s1*t7
-    J[1, 3] = -s1*t6
-    J[2, 1] = c1*t2 + s1*t5
-    J[2, 2] = c1*t1 + s1*t4
+    J[1, 1] = -t8*s1
+    J[1, 2] = -t7*s1
+    J[1, 3] = -t6*s1
+    J[2, 1] = t2*c1 + t5*s1
+    J[2, 2] = t1*c1 + t4*s1
     J[2, 3] = t9*c1**2 + t9*s1**2
     J[3, 1] = s1
     J[3, 2] = s1
@@ -132,16 +132,16 @@ def _fk_jacobian(q):
     s234 = c23*s4 + c4*s23
     t0 = 0.1*c23
     t1 = c1*c234
-    t2 = 0.1*t1 + c1*t0
+    t2 = 0.1*t1 + t0*c1
     t3 = c234*s1
-    t4 = 0.1*t3 + s1*t0
+    t4 = 0.1*t3 + t0*s1
     t5 = 0.1*s234
     t6 = t5 + 0.1*s23
     t7 = t6 + 0.1*s2
     t8 = 0.12 + t7
     t9 = 0.1*c2
-    t10 = t2 + c1*t9
-    t11 = t4 + s1*t9
+    t10 = t2 + t9*c1
+    t11 = t4 + t9*s1
     t12 = 0.1*c234
     t13 = -c1
     T = casadi.SX(4, 4)
@@ -159,15 +159,15 @@ def _fk_jacobian(q):
     T[3, 3] = 1
     J = casadi.SX(6, 4)
     J[0, 0] = -t11
-    J[0, 1] = -c1*t7
-    J[0, 2] = -c1*t6
-    J[0, 3] = -c1*t5
+    J[0, 1] = -t7*c1
+    J[0, 2] = -t6*c1
+    J[0, 3] = -t5*c1
     J[1, 0] = t10
-    J[1, 1] = -s1*t7
-    J[1, 2] = -s1*t6
-    J[1, 3] = -s1*t5
-    J[2, 1] = c1*t10 + s1*t11
-    J[2, 2] = c1*t2 + s1*t4
+    J[1, 1] = -t7*s1
+    J[1, 2] = -t6*s1
+    J[1, 3] = -t5*s1
+    J[2, 1] = t10*c1 + t11*s1
+    J[2, 2] = t2*c1 + t4*s1
     J[2, 3] = t12*c1**2 + t12*s1**2
     J[3, 1] = s1
     J[3, 2] = s1
@@ -180,7 +180,7 @@ def _fk_jacobian(q):
 
 
 def _jacobian_tool(q):
-    """Geometric Jacobian in the tool frame (6 x DOF, rows vx vy vz wx wy wz): 97 operations."""
+    """Geometric Jacobian in the tool frame (6 x DOF, rows vx vy vz wx wy wz): 96 operations."""
     q1 = q[0]
     q2 = q[1]
     q3 = q[2]
@@ -198,39 +198,39 @@ def _jacobian_tool(q):
     c234 = c23*c4 - s23*s4
     s234 = c23*s4 + c4*s23
     t0 = 0.1*c1
-    t1 = c23*t0 + c234*t0
-    t2 = t1 + c2*t0
+    t1 = t0*c23 + t0*c234
+    t2 = t1 + t0*c2
     t3 = 0.1*s1
-    t4 = c23*t3 + c234*t3
-    t5 = t4 + c2*t3
+    t4 = t3*c23 + t3*c234
+    t5 = t4 + t3*c2
     t6 = 0.1*s234
     t7 = t6 + 0.1*s23
     t8 = t7 + 0.1*s2
-    t9 = s1*t2
-    t10 = c1*t5
+    t9 = t2*s1
+    t10 = t5*c1
     t11 = c1**2
-    t12 = c234*t8
+    t12 = t8*c234
     t13 = s1**2
-    t14 = c1*t2 + s1*t5
-    t15 = c234*t7
-    t16 = c1*t1 + s1*t4
-    t17 = c234*t6
+    t14 = t2*c1 + t5*s1
+    t15 = t7*c234
+    t16 = t1*c1 + t4*s1
+    t17 = t6*c234
     t18 = 0.1*c234
-    t19 = t11*t18 + t13*t18
-    t20 = s234*t8
-    t21 = s234*t7
+    t19 = t18*t11 + t18*t13
+    t20 = t8*s234
+    t21 = t7*s234
     t22 = 0.1*s234**2
-    t23 = -t11 - t13
+    t23 = -(t11 + t13)
     J = casadi.SX(6, 4)
-    J[0, 0] = c234*t9 - c234*t10
-    J[0, 1] = s234*t14 - t11*t12 - t12*t13
-    J[0, 2] = s234*t16 - t11*t15 - t13*t15
-    J[0, 3] = s234*t19 - t11*t17 - t13*t17
+    J[0, 0] = t9*c234 - t10*c234
+    J[0, 1] = -(t11*t12 + t12*t13 - t14*s234)
+    J[0, 2] = -(t11*t15 + t13*t15 - t16*s234)
+    J[0, 3] = -(t17*t11 + t17*t13 - t19*s234)
     J[1, 0] = t14
-    J[2, 0] = s234*t10 - s234*t9
-    J[2, 1] = c234*t14 + t11*t20 + t13*t20
-    J[2, 2] = c234*t16 + t11*t21 + t13*t21
-    J[2, 3] = c234*t19 + t11*t22 + t13*t22
+    J[2, 0] = t10*s234 - t9*s234
+    J[2, 1] = t20*t11 + t20*t13 + t14*c234
+    J[2, 2] = t16*c234 + t21*t11 + t21*t13
+    J[2, 3] = t19*c234 + t22*t11 + t22*t13
     J[3, 0] = s234
     J[4, 1] = t23
     J[4, 2] = t23
@@ -261,11 +261,11 @@ def _task(q):
     t1 = t0 + 0.1*s2
     t2 = 0.12 + t1
     t3 = 0.1*c1
-    t4 = c23*t3 + c234*t3
-    t5 = t4 + c2*t3
+    t4 = t3*c23 + t3*c234
+    t5 = t4 + t3*c2
     t6 = 0.1*s1
-    t7 = c23*t6 + c234*t6
-    t8 = t7 + c2*t6
+    t7 = t6*c23 + t6*c234
+    t8 = t7 + t6*c2
     t9 = c234**2
     mu = casadi.SX(4, 1)
     mu[0, 0] = t5
@@ -294,31 +294,31 @@ def _task_jacobian(q):
     c234 = c23*c4 - s23*s4
     s234 = c23*s4 + c4*s23
     t0 = 0.1*c1
-    t1 = c23*t0 + c234*t0
-    t2 = t1 + c2*t0
+    t1 = t0*c23 + t0*c234
+    t2 = t1 + t0*c2
     t3 = 0.1*s1
-    t4 = c23*t3 + c234*t3
-    t5 = t4 + c2*t3
+    t4 = t3*c23 + t3*c234
+    t5 = t4 + t3*c2
     t6 = 0.1*s234
     t7 = t6 + 0.1*s23
     t8 = t7 + 0.1*s2
     t9 = c1**2
-    t10 = c234*t9
+    t10 = t9*c234
     t11 = s1**2
-    t12 = c234*t11
+    t12 = t11*c234
     t13 = c234**2
-    t14 = -(t10 + t12)/casadi.sqrt(t11*t13 + t13*t9)
+    t14 = -(t10 + t12)/casadi.sqrt(t9*t13 + t11*t13)
     J = casadi.SX(4, 4)
     J[0, 0] = -t5
-    J[0, 1] = -c1*t8
-    J[0, 2] = -c1*t7
-    J[0, 3] = -c1*t6
+    J[0, 1] = -t8*c1
+    J[0, 2] = -t7*c1
+    J[0, 3] = -t6*c1
     J[1, 0] = t2
-    J[1, 1] = -s1*t8
-    J[1, 2] = -s1*t7
-    J[1, 3] = -s1*t6
-    J[2, 1] = c1*t2 + s1*t5
-    J[2, 2] = c1*t1 + s1*t4
+    J[1, 1] = -t8*s1
+    J[1, 2] = -t7*s1
+    J[1, 3] = -t6*s1
+    J[2, 1] = t2*c1 + t5*s1
+    J[2, 2] = t1*c1 + t4*s1
     J[2, 3] = 0.1*t10 + 0.1*t12
     J[3, 1] = t14
     J[3, 2] = t14
@@ -350,19 +350,19 @@ def _fk_jacobian_dot(q, q_dot):
     s234 = c23*s4 + c4*s23
     t0 = 0.1*c23
     t1 = c1*c234
-    t2 = 0.1*t1 + c1*t0
+    t2 = 0.1*t1 + t0*c1
     t3 = c234*s1
-    t4 = 0.1*t3 + s1*t0
+    t4 = 0.1*t3 + t0*s1
     t5 = 0.1*s234
     t6 = t5 + 0.1*s23
     t7 = t6 + 0.1*s2
     t8 = 0.12 + t7
     t9 = 0.1*c2
-    t10 = t2 + c1*t9
-    t11 = t4 + s1*t9
-    t12 = c1*t10 + s1*t11
+    t10 = t2 + t9*c1
+    t11 = t4 + t9*s1
+    t12 = t10*c1 + t11*s1
     t13 = t12
-    t14 = c1*t2 + s1*t4
+    t14 = t2*c1 + t4*s1
     t15 = t14
     t16 = c1**2
     t17 = 0.1*c234
@@ -375,23 +375,23 @@ def _fk_jacobian_dot(q, q_dot):
     t24 = c1*qd2
     t25 = c1*qd3
     t26 = t24 + t25
-    t27 = c1*t5
-    t28 = qd4*t27 + t25*t6
-    t29 = t28 + t24*t7
-    t30 = t29 + qd1*t11
-    t31 = s1*t5
-    t32 = qd4*t31 + t22*t6
-    t33 = t32 + t21*t7
-    t34 = -t33 + qd1*t10
-    t35 = qd4*t20
-    t36 = t35 + qd3*t15
-    t37 = t36 + qd2*t13
-    t38 = c1*t7
-    t39 = c1*t6
-    t40 = s1*t7
+    t27 = t5*c1
+    t28 = t6*t25 + t27*qd4
+    t29 = t28 + t7*t24
+    t30 = t29 + t11*qd1
+    t31 = t5*s1
+    t32 = t6*t22 + t31*qd4
+    t33 = t32 + t7*t21
+    t34 = -t33 + t10*qd1
+    t35 = t20*qd4
+    t36 = t35 + t15*qd3
+    t37 = t36 + t13*qd2
+    t38 = t7*c1
+    t39 = t6*c1
+    t40 = t7*s1
     t41 = -c1
-    t42 = qd2*t6
-    t43 = qd4*t5
+    t42 = t6*qd2
+    t43 = t5*qd4
     t44 = qd1*qd4
     T = casadi.SX(4, 4)
     T[0, 0] = t1
@@ -413,7 +413,7 @@ def _fk_jacobian_dot(q, q_dot):
     J[0, 3] = -t27
     J[1, 0] = t10
     J[1, 1] = -t40
-    J[1, 2] = -s1*t6
+    J[1, 2] = -t6*s1
     J[1, 3] = -t31
     J[2, 1] = t12
     J[2, 2] = t14
@@ -426,17 +426,17 @@ def _fk_jacobian_dot(q, q_dot):
     J[4, 3] = t41
     J[5, 0] = 1
     a = casadi.SX(6, 1)
-    a[0, 0] = qd2*(qd1*t40 - c1*t37) - qd1*t34 - qd3*(c1*t36 + t15*t24 - qd1*s1*t6) - qd4*(c1*t35 + t20*t26 - 0.1*qd1*s1*s234)
-    a[1, 0] = -qd1*t30 - qd2*(qd1*t38 + s1*t37) - qd3*(qd1*t39 + s1*t36 + t15*t21) - qd4*(qd1*t27 + s1*t35 + t20*t23)
-    a[2, 0] = -qd2*(c1*t29 + s1*t33) - qd3*(c1*t28 + s1*t32 + t16*t42 + t18*t42) - qd4*(t16*t43 + t18*t43 + t23*t31 + t26*t27)
-    a[3, 0] = c1*t44 + qd1*t24 + qd1*t25
-    a[4, 0] = qd1*t21 + qd1*t22 + s1*t44
-    a[5, 0] = qd4*(s1*t26 - c1*t23)
+    a[0, 0] = qd2*(t40*qd1 - t37*c1) - t34*qd1 - qd3*(t15*t24 + t36*c1 - t6*qd1*s1) - qd4*(t20*t26 + t35*c1 - 0.1*qd1*s1*s234)
+    a[1, 0] = -t30*qd1 - qd2*(t37*s1 + t38*qd1) - qd3*(t15*t21 + t36*s1 + t39*qd1) - qd4*(t20*t23 + t27*qd1 + t35*s1)
+    a[2, 0] = -qd2*(t29*c1 + t33*s1) - qd3*(t28*c1 + t32*s1 + t42*t16 + t42*t18) - qd4*(t23*t31 + t26*t27 + t43*t16 + t43*t18)
+    a[3, 0] = t24*qd1 + t25*qd1 + t44*c1
+    a[4, 0] = t21*qd1 + t22*qd1 + t44*s1
+    a[5, 0] = qd4*(t26*s1 - t23*c1)
     return [T, J, a]
 
 
 def _jacobian_dot(q, q_dot):
-    """Time derivative dJ/dt of the world geometric Jacobian along q_dot (6 x DOF): 138 operations."""
+    """Time derivative dJ/dt of the world geometric Jacobian along q_dot (6 x DOF): 126 operations."""
     q1 = q[0]
     q2 = q[1]
     q3 = q[2]
@@ -458,13 +458,13 @@ def _jacobian_dot(q, q_dot):
     c234 = c23*c4 - s23*s4
     s234 = c23*s4 + c4*s23
     t0 = 0.1*c1
-    t1 = c23*t0 + c234*t0
-    t2 = t1 + c2*t0
+    t1 = t0*c23 + t0*c234
+    t2 = t1 + t0*c2
     t3 = 0.1*s1
-    t4 = c23*t3 + c234*t3
-    t5 = t4 + c2*t3
-    t6 = c1*t2 + s1*t5
-    t7 = c1*t1 + s1*t4
+    t4 = t3*c23 + t3*c234
+    t5 = t4 + t3*c2
+    t6 = t2*c1 + t5*s1
+    t7 = t1*c1 + t4*s1
     t8 = 0.1*s234
     t9 = t8 + 0.1*s23
     t10 = t9 + 0.1*s2
@@ -478,38 +478,38 @@ def _jacobian_dot(q, q_dot):
     t18 = c1*qd2
     t19 = c1*qd3
     t20 = t18 + t19
-    t21 = qd4*t8
-    t22 = c1*t21 + t19*t9
-    t23 = s1*t21 + t16*t9
+    t21 = t8*qd4
+    t22 = t9*t19 + t21*c1
+    t23 = t9*t16 + t21*s1
     t24 = t22 + t10*t18
     t25 = t23 + t10*t15
-    t26 = t24 + qd1*t5
-    t27 = -t25 + qd1*t2
-    t28 = qd4*t14
-    t29 = t28 + qd3*t7
-    t30 = t29 + qd2*t6
+    t26 = t24 + t5*qd1
+    t27 = -t25 + t2*qd1
+    t28 = t14*qd4
+    t29 = t28 + t7*qd3
+    t30 = t29 + t6*qd2
     t31 = qd1*s1
     t32 = c1*qd1
-    t33 = qd2*t9
+    t33 = t9*qd2
     Jd = casadi.SX(6, 4)
     Jd[0, 0] = -t27
-    Jd[0, 1] = t10*t31 - c1*t30
-    Jd[0, 2] = -c1*t29 - t18*t7 + qd1*s1*t9
-    Jd[0, 3] = -c1*t28 - t14*t20 + 0.1*qd1*s1*s234
+    Jd[0, 1] = t10*t31 - t30*c1
+    Jd[0, 2] = -(t7*t18 + t29*c1 - t9*qd1*s1)
+    Jd[0, 3] = -(t14*t20 + t28*c1 - 0.1*qd1*s1*s234)
     Jd[1, 0] = -t26
-    Jd[1, 1] = -s1*t30 - t10*t32
-    Jd[1, 2] = -s1*t29 - t15*t7 - t32*t9
-    Jd[1, 3] = -s1*t28 - t14*t17 - t32*t8
-    Jd[2, 1] = -c1*t24 - s1*t25
-    Jd[2, 2] = -c1*t22 - s1*t23 - t11*t33 - t13*t33
-    Jd[2, 3] = -t11*t21 - t13*t21 - c1*t20*t8 - s1*t17*t8
+    Jd[1, 1] = -(t10*t32 + t30*s1)
+    Jd[1, 2] = -(t9*t32 + t7*t15 + t29*s1)
+    Jd[1, 3] = -(t14*t17 + t28*s1 + t32*t8)
+    Jd[2, 1] = -(t24*c1 + t25*s1)
+    Jd[2, 2] = -(t22*c1 + t23*s1 + t33*t11 + t33*t13)
+    Jd[2, 3] = -(t21*t11 + t21*t13 + t17*t8*s1 + t20*t8*c1)
     Jd[3, 1] = t32
     Jd[3, 2] = t32
     Jd[3, 3] = t32
     Jd[4, 1] = t31
     Jd[4, 2] = t31
     Jd[4, 3] = t31
-    Jd[5, 3] = s1*t20 - c1*t17
+    Jd[5, 3] = t20*s1 - t17*c1
     return [Jd]
 
 
@@ -536,13 +536,13 @@ def _bias_acceleration(q, q_dot):
     c234 = c23*c4 - s23*s4
     s234 = c23*s4 + c4*s23
     t0 = 0.1*c1
-    t1 = c23*t0 + c234*t0
-    t2 = t1 + c2*t0
+    t1 = t0*c23 + t0*c234
+    t2 = t1 + t0*c2
     t3 = 0.1*s1
-    t4 = c23*t3 + c234*t3
-    t5 = t4 + c2*t3
-    t6 = c1*t2 + s1*t5
-    t7 = c1*t1 + s1*t4
+    t4 = t3*c23 + t3*c234
+    t5 = t4 + t3*c2
+    t6 = t2*c1 + t5*s1
+    t7 = t1*c1 + t4*s1
     t8 = 0.1*s234
     t9 = t8 + 0.1*s23
     t10 = t9 + 0.1*s2
@@ -556,26 +556,26 @@ def _bias_acceleration(q, q_dot):
     t18 = c1*qd2
     t19 = c1*qd3
     t20 = t18 + t19
-    t21 = qd4*t8
-    t22 = c1*t21 + t19*t9
-    t23 = s1*t21 + t16*t9
+    t21 = t8*qd4
+    t22 = t9*t19 + t21*c1
+    t23 = t9*t16 + t21*s1
     t24 = t22 + t10*t18
     t25 = t23 + t10*t15
-    t26 = t24 + qd1*t5
-    t27 = -t25 + qd1*t2
-    t28 = qd4*t14
-    t29 = t28 + qd3*t7
-    t30 = t29 + qd2*t6
+    t26 = t24 + t5*qd1
+    t27 = -t25 + t2*qd1
+    t28 = t14*qd4
+    t29 = t28 + t7*qd3
+    t30 = t29 + t6*qd2
     t31 = qd1*s1
     t32 = c1*qd1
-    t33 = qd2*t9
+    t33 = t9*qd2
     a = casadi.SX(6, 1)
-    a[0, 0] = qd2*(t10*t31 - c1*t30) - qd1*t27 - qd3*(c1*t29 + t18*t7 - qd1*s1*t9) - qd4*(c1*t28 + t14*t20 - 0.1*qd1*s1*s234)
-    a[1, 0] = -qd1*t26 - qd2*(s1*t30 + t10*t32) - qd3*(s1*t29 + t15*t7 + t32*t9) - qd4*(s1*t28 + t14*t17 + t32*t8)
-    a[2, 0] = -qd2*(c1*t24 + s1*t25) - qd3*(c1*t22 + s1*t23 + t11*t33 + t13*t33) - qd4*(t11*t21 + t13*t21 + c1*t20*t8 + s1*t17*t8)
-    a[3, 0] = qd1*t18 + qd1*t19 + qd4*t32
-    a[4, 0] = qd1*t15 + qd1*t16 + qd4*t31
-    a[5, 0] = qd4*(s1*t20 - c1*t17)
+    a[0, 0] = qd2*(t10*t31 - t30*c1) - t27*qd1 - qd3*(t7*t18 + t29*c1 - t9*qd1*s1) - qd4*(t14*t20 + t28*c1 - 0.1*qd1*s1*s234)
+    a[1, 0] = -t26*qd1 - qd2*(t10*t32 + t30*s1) - qd3*(t9*t32 + t7*t15 + t29*s1) - qd4*(t14*t17 + t28*s1 + t32*t8)
+    a[2, 0] = -qd2*(t24*c1 + t25*s1) - qd3*(t22*c1 + t23*s1 + t33*t11 + t33*t13) - qd4*(t21*t11 + t21*t13 + t17*t8*s1 + t20*t8*c1)
+    a[3, 0] = t32*qd4 + t18*qd1 + t19*qd1
+    a[4, 0] = t31*qd4 + t15*qd1 + t16*qd1
+    a[5, 0] = qd4*(t20*s1 - t17*c1)
     return [a]
 
 
@@ -602,20 +602,20 @@ def _task_jacobian_dot(q, q_dot):
     c234 = c23*c4 - s23*s4
     s234 = c23*s4 + c4*s23
     t0 = 0.1*c1
-    t1 = c23*t0 + c234*t0
-    t2 = t1 + c2*t0
+    t1 = t0*c23 + t0*c234
+    t2 = t1 + t0*c2
     t3 = 0.1*s1
-    t4 = c23*t3 + c234*t3
-    t5 = t4 + c2*t3
-    t6 = c1*t2 + s1*t5
-    t7 = c1*t1 + s1*t4
+    t4 = t3*c23 + t3*c234
+    t5 = t4 + t3*c2
+    t6 = t2*c1 + t5*s1
+    t7 = t1*c1 + t4*s1
     t8 = 0.1*s234
     t9 = t8 + 0.1*s23
     t10 = t9 + 0.1*s2
     t11 = c1**2
-    t12 = c234*t11
+    t12 = t11*c234
     t13 = s1**2
-    t14 = c234*t13
+    t14 = t13*c234
     t15 = 0.1*t12 + 0.1*t14
     t16 = qd2*s1
     t17 = qd3*s1
@@ -626,38 +626,38 @@ def _task_jacobian_dot(q, q_dot):
     t22 = t20 + t21
     t23 = t22
     t24 = c1*qd4
-    t25 = t21*t9 + t24*t8
+    t25 = t9*t21 + t24*t8
     t26 = t25 + t10*t20
-    t27 = t26 + qd1*t5
+    t27 = t26 + t5*qd1
     t28 = t22 + t24
     t29 = qd4*s1
-    t30 = t17*t9 + t29*t8
+    t30 = t9*t17 + t29*t8
     t31 = t30 + t10*t16
-    t32 = -t31 + qd1*t2
-    t33 = c1*t26 + s1*t31
-    t34 = t18 + t29
-    t35 = qd4*t15
-    t36 = t35 + qd3*t7
-    t37 = t36 + qd2*t6
+    t32 = -t31 + t2*qd1
+    t33 = t26*c1 + t31*s1
+    t34 = t29 + t18
+    t35 = t15*qd4
+    t36 = t35 + t7*qd3
+    t37 = t36 + t6*qd2
     t38 = qd1*s1
-    t39 = t10*t38 - c1*t37
-    t40 = c1*t36 + t20*t7 - t38*t9
-    t41 = c1*t35 + t15*t23 - t38*t8
-    t42 = c234*t38 + s234*t28
+    t39 = t10*t38 - t37*c1
+    t40 = t7*t20 + t36*c1 - t9*t38
+    t41 = t15*t23 + t35*c1 - t38*t8
+    t42 = t28*s234 + t38*c234
     t43 = c1*qd1
-    t44 = s1*t37 + t10*t43
-    t45 = s1*t36 + t16*t7 + t43*t9
-    t46 = s1*t35 + t15*t19 + t43*t8
-    t47 = c234*t43 - s234*t34
-    t48 = qd2*t9
-    t49 = c1*t25 + s1*t30 + t11*t48 + t13*t48
-    t50 = qd4*t8
-    t51 = t11*t50 + t13*t50 + c1*t23*t8 + s1*t19*t8
+    t44 = t10*t43 + t37*s1
+    t45 = t9*t43 + t7*t16 + t36*s1
+    t46 = t15*t19 + t35*s1 + t43*t8
+    t47 = t43*c234 - t34*s234
+    t48 = t9*qd2
+    t49 = t25*c1 + t30*s1 + t48*t11 + t48*t13
+    t50 = t8*qd4
+    t51 = t50*t11 + t50*t13 + t19*t8*s1 + t23*t8*c1
     t52 = c234**2
-    t53 = t11*t52 + t13*t52
+    t53 = t52*t11 + t52*t13
     t54 = 1/casadi.sqrt(t53)
-    t55 = -c234*(t12 + t14)/t53**(3/2)
-    t56 = t42*(c1*t54 + c1*t55) - t47*(s1*t54 + s1*t55)
+    t55 = -c234*(t12 + t14)/t53**1.5
+    t56 = t42*(t54*c1 + t55*c1) - t47*(t54*s1 + t55*s1)
     Jd = casadi.SX(4, 4)
     Jd[0, 0] = -t32
     Jd[0, 1] = t39
@@ -677,7 +677,7 @@ def _task_jacobian_dot(q, q_dot):
 
 
 def _hessian(q):
-    """Partial derivatives dJ/dq_k of the world geometric Jacobian (DOF x 6 x DOF, indexed [k, r, c]): 85 operations."""
+    """Partial derivatives dJ/dq_k of the world geometric Jacobian (DOF x 6 x DOF, indexed [k, r, c]): 82 operations."""
     q1 = q[0]
     q2 = q[1]
     q3 = q[2]
@@ -695,13 +695,13 @@ def _hessian(q):
     c234 = c23*c4 - s23*s4
     s234 = c23*s4 + c4*s23
     t0 = 0.1*c1
-    t1 = c23*t0 + c234*t0
-    t2 = t1 + c2*t0
+    t1 = t0*c23 + t0*c234
+    t2 = t1 + t0*c2
     t3 = 0.1*s1
-    t4 = c23*t3 + c234*t3
-    t5 = t4 + c2*t3
-    t6 = c1*t2 + s1*t5
-    t7 = c1*t1 + s1*t4
+    t4 = t3*c23 + t3*c234
+    t5 = t4 + t3*c2
+    t6 = t2*c1 + t5*s1
+    t7 = t1*c1 + t4*s1
     t8 = 0.1*s234
     t9 = t8 + 0.1*s23
     t10 = t9 + 0.1*s2
@@ -709,18 +709,18 @@ def _hessian(q):
     t12 = 0.1*c234
     t13 = s1**2
     t14 = t11*t12 + t12*t13
-    t15 = s1*t10
-    t16 = s1*t9
-    t17 = s1*t8
-    t18 = -c1*t10
-    t19 = -c1*t9
-    t20 = -c1*t8
-    t21 = -c1*t7
-    t22 = -c1*t14
-    t23 = -s1*t7
-    t24 = -s1*t14
-    t25 = -t11*t9 - t13*t9
-    t26 = -t11*t8 - t13*t8
+    t15 = t10*s1
+    t16 = t9*s1
+    t17 = t8*s1
+    t18 = -t10*c1
+    t19 = -t9*c1
+    t20 = -t8*c1
+    t21 = -t7*c1
+    t22 = -t14*c1
+    t23 = -t7*s1
+    t24 = -t14*s1
+    t25 = -(t9*t11 + t9*t13)
+    t26 = -(t8*t11 + t8*t13)
     H = casadi.SX(24, 4)
     H[0, 0] = -t2
     H[0, 1] = t15
@@ -737,14 +737,14 @@ def _hessian(q):
     H[4, 2] = s1
     H[4, 3] = s1
     H[6, 0] = t15
-    H[6, 1] = -c1*t6
+    H[6, 1] = -t6*c1
     H[6, 2] = t21
     H[6, 3] = t22
     H[7, 0] = t18
-    H[7, 1] = -s1*t6
+    H[7, 1] = -t6*s1
     H[7, 2] = t23
     H[7, 3] = t24
-    H[8, 1] = -t10*t11 - t10*t13
+    H[8, 1] = -(t10*t11 + t10*t13)
     H[8, 2] = t25
     H[8, 3] = t26
     H[12, 0] = t16
@@ -773,7 +773,7 @@ def _hessian(q):
 
 
 def _singularity_factors(q):
-    """Factors of det(Js): the robot is singular where one is 0: 22 operations."""
+    """Factors of det(Js): the robot is singular where one is 0: 20 operations."""
     q2 = q[1]
     q3 = q[2]
     q4 = q[3]
@@ -786,7 +786,7 @@ def _singularity_factors(q):
     t0 = s2*s3
     f = casadi.SX(2, 1)
     f[0, 0] = s3
-    f[1, 0] = c2 - t0 + c2*c3 - c4*t0 + c2*c3*c4 - c2*s3*s4 - c3*s2*s4
+    f[1, 0] = -(t0 - c2 + t0*c4 - c2*c3 + c2*s3*s4 + c3*s2*s4 - c2*c3*c4)
     return [f]
 
 
@@ -809,8 +809,8 @@ def _manipulability(q):
     c234 = c23*c4 - s23*s4
     t0 = c234**2
     t1 = s2*s3
-    t2 = c4*t1 + c2*s3*s4 + c3*s2*s4 - c2*c3*c4
-    t3 = 0.001*s3*t2*(t1 + t2 - c2 - c2*c3)/casadi.sqrt(t0*c1**2 + t0*s1**2)
+    t2 = t1*c4 + c2*s3*s4 + c3*s2*s4 - c2*c3*c4
+    t3 = 0.001*t2*s3*(t1 + t2 - c2 - c2*c3)/casadi.sqrt(t0*c1**2 + t0*s1**2)
     w = casadi.SX(1, 1)
     w[0, 0] = casadi.fabs(t3)
     return [w]
@@ -835,9 +835,9 @@ def _jacobian_det(q):
     c234 = c23*c4 - s23*s4
     t0 = c234**2
     t1 = s2*s3
-    t2 = c4*t1 + c2*s3*s4 + c3*s2*s4 - c2*c3*c4
+    t2 = t1*c4 + c2*s3*s4 + c3*s2*s4 - c2*c3*c4
     d = casadi.SX(1, 1)
-    d[0, 0] = 0.001*s3*t2*(t1 + t2 - c2 - c2*c3)/casadi.sqrt(t0*c1**2 + t0*s1**2)
+    d[0, 0] = 0.001*t2*s3*(t1 + t2 - c2 - c2*c3)/casadi.sqrt(t0*c1**2 + t0*s1**2)
     return [d]
 
 
@@ -864,47 +864,47 @@ def _velocity_ik(q, mu_dot, damping):
     c234 = c23*c4 - s23*s4
     s234 = c23*s4 + c4*s23
     t0 = 0.1*c1
-    t1 = c23*t0 + c234*t0
-    t2 = t1 + c2*t0
+    t1 = t0*c23 + t0*c234
+    t2 = t1 + t0*c2
     t3 = 0.1*s1
-    t4 = c23*t3 + c234*t3
-    t5 = t4 + c2*t3
-    t6 = c1*t2 + s1*t5
-    t7 = c1*t1 + s1*t4
+    t4 = t3*c23 + t3*c234
+    t5 = t4 + t3*c2
+    t6 = t2*c1 + t5*s1
+    t7 = t1*c1 + t4*s1
     t8 = 0.1*s234
     t9 = t8 + 0.1*s23
     t10 = t9 + 0.1*s2
     t11 = c1**2
-    t12 = c234*t11
+    t12 = t11*c234
     t13 = s1**2
-    t14 = c234*t13
+    t14 = t13*c234
     t15 = 0.1*t12 + 0.1*t14
     t16 = c234**2
     t17 = -(t12 + t14)/casadi.sqrt(t11*t16 + t13*t16)
-    t18 = t15*t17 + t17*t6 + t17*t7
+    t18 = t6*t17 + t7*t17 + t15*t17
     t19 = t5**2
     t20 = t9**2
     t21 = t10**2
     t22 = 0.01*s234**2
-    t23 = t11*t20 + t11*t21 + t11*t22
-    t24 = t19 + t23
+    t23 = t21*t11 + t22*t11 + t11*t20
+    t24 = t23 + t19
     t25 = c1*s1
-    t26 = t20*t25 + t21*t25 + t22*t25 - t2*t5
-    t27 = c1*t9
-    t28 = c1*t10
-    t29 = c1*t8
-    t30 = t15*t29 + t27*t7 + t28*t6
+    t26 = t21*t25 + t22*t25 + t25*t20 - t2*t5
+    t27 = t9*c1
+    t28 = t10*c1
+    t29 = t8*c1
+    t30 = t6*t28 + t7*t27 + t15*t29
     t31 = t17*t27 + t17*t28 + t17*t29
     t32 = t2**2
-    t33 = t13*t20 + t13*t21 + t13*t22
+    t33 = t21*t13 + t22*t13 + t13*t20
     t34 = t32 + t33
-    t35 = s1*t9
-    t36 = s1*t10
-    t37 = s1*t8
-    t38 = t15*t37 + t35*t7 + t36*t6
+    t35 = t9*s1
+    t36 = t10*s1
+    t37 = t8*s1
+    t38 = t6*t36 + t7*t35 + t15*t37
     t39 = t17*t35 + t17*t36 + t17*t37
     t40 = t6**2
-    t41 = t40 + t15**2 + t7**2
+    t41 = t40 + t7**2 + t15**2
     t42 = t41
     t43 = t17**2
     t44 = 3*t43
@@ -917,9 +917,9 @@ def _velocity_ik(q, mu_dot, damping):
     t51 = t50**2
     t52 = casadi.sqrt(t46 + t47 + t48 + t51)
     t53 = t52*casadi.if_else((t50 >= 0), 1, -1)
-    t54 = t50 + t53
+    t54 = t53 + t50
     t55 = casadi.if_else((t52 > 0), 1/(t52*(t52 + casadi.fabs(t50))), 0)
-    t56 = t55*(mu_dot0*t54 + mu_dot1*t26 - mu_dot2*t30 - mu_dot3*t31)
+    t56 = t55*(t26*mu_dot1 + t54*mu_dot0 - t30*mu_dot2 - t31*mu_dot3)
     t57 = mu_dot0 - t54*t56
     t58 = mu_dot1 - t26*t56
     t59 = mu_dot2 + t30*t56
@@ -934,47 +934,47 @@ def _velocity_ik(q, mu_dot, damping):
     t68 = t67*casadi.if_else((t64 >= 0), 1, -1)
     t69 = t64 + t68
     t70 = casadi.if_else((t67 > 0), 1/(t67*(t67 + casadi.fabs(t64))), 0)
-    t71 = t70*(t58*t69 + t59*t65 + t60*t66)
-    t72 = t58 - t69*t71
-    t73 = t59 - t65*t71
-    t74 = t60 - t66*t71
+    t71 = t70*(t65*t59 + t66*t60 + t58*t69)
+    t72 = t58 - t71*t69
+    t73 = t59 - t71*t65
+    t74 = t60 - t71*t66
     t75 = t42 + t49
-    t76 = -t55*(t18*t31 + t26*t38 + t30*t54 + t30*t75)
+    t76 = -t55*(t26*t38 + t30*t54 + t30*t75 + t31*t18)
     t77 = t30 + t54*t76
     t78 = t38 + t26*t76
     t79 = t75 + t30*t76
     t80 = t18 + t31*t76
-    t81 = t70*(t65*t79 + t66*t80 - t69*t78)
+    t81 = t70*(t65*t79 + t66*t80 - t78*t69)
     t82 = t78 + t69*t81
     t83 = t79 - t65*t81
     t84 = t80 - t66*t81
-    t85 = casadi.sqrt(t83**2 + t84**2)
+    t85 = casadi.sqrt(t84**2 + t83**2)
     t86 = t85*casadi.if_else((t83 >= 0), 1, -1)
-    t87 = t83 + t86
+    t87 = t86 + t83
     t88 = casadi.if_else((t85 > 0), 1/(t85*(t85 + casadi.fabs(t83))), 0)
-    t89 = t88*(t73*t87 + t74*t84)
+    t89 = t88*(t84*t74 + t73*t87)
     t90 = t73 - t87*t89
     t91 = t74 - t84*t89
     t92 = t45 + t49
-    t93 = casadi.sqrt(t51 + t61**2 + t75**2 + t92**2 + 2*t46 + 2*t47 + 2*t48 + 2*t18**2 + 2*t38**2 + 2*t39**2)
-    t94 = -t55*(t18*t30 + t26*t39 + t31*t54 + t31*t92)
+    t93 = casadi.sqrt(t51 + t61**2 + t75**2 + t92**2 + 2*t46 + 2*t47 + 2*t48 + 2*t38**2 + 2*t39**2 + 2*t18**2)
+    t94 = -t55*(t26*t39 + t30*t18 + t31*t54 + t31*t92)
     t95 = t31 + t54*t94
     t96 = t39 + t26*t94
     t97 = t18 + t30*t94
     t98 = t92 + t31*t94
-    t99 = t70*(t65*t97 + t66*t98 - t69*t96)
-    t100 = t96 + t69*t99
-    t101 = t97 - t65*t99
-    t102 = t98 - t66*t99
-    t103 = t88*(t101*t87 + t102*t84)
-    t104 = t101 - t103*t87
-    t105 = t102 - t103*t84
+    t99 = t70*(t65*t97 + t66*t98 - t96*t69)
+    t100 = t96 + t99*t69
+    t101 = t97 - t99*t65
+    t102 = t98 - t99*t66
+    t103 = t88*(t84*t102 + t101*t87)
+    t104 = t101 - t87*t103
+    t105 = t102 - t84*t103
     t106 = casadi.fabs(t105)
     t107 = t106
     t108 = t107*casadi.if_else((t105 >= 0), 1, -1)
     t109 = t105 + t108
-    t110 = casadi.if_else((t107 > 0), 1/(t107*(t106 + t107)), 0)
-    t111 = t91 - t110*t91*t109**2
+    t110 = casadi.if_else((t107 > 0), 1/(t107*(t107 + t106)), 0)
+    t111 = t91 - t91*t110*t109**2
     t112 = casadi.if_else((t108 != 0), -t111/t108, 0)
     t113 = casadi.if_else((t86 != 0), -(t90 - t104*t112)/t86, 0)
     t114 = casadi.if_else((t68 != 0), -(t72 + t100*t112 + t113*t82)/t68, 0)
@@ -984,8 +984,8 @@ def _velocity_ik(q, mu_dot, damping):
     t118 = t117 + t113*t6 - t114*t36 - t115*t28
     t119 = t117 + t113*t7 - t114*t35 - t115*t27
     t120 = t117 + t113*t15 - t114*t37 - t115*t29
-    t121 = t19 + t32
-    t122 = casadi.sqrt(t121 + t23 + t33 + t41 + t44)
+    t121 = t32 + t19
+    t122 = casadi.sqrt(t23 + t33 + t41 + t44 + t121)
     t123 = casadi.sqrt(t121)
     t124 = t123*casadi.if_else((t5 <= 0), 1, -1)
     t125 = casadi.if_else((t123 > 0), 1/(t123*(t123 + casadi.fabs(t5))), 0)
@@ -1000,7 +1000,7 @@ def _velocity_ik(q, mu_dot, damping):
     t134 = -t125*(t127*t29 + t2*t37)
     t135 = t29 + t127*t134
     t136 = t37 + t134*t2
-    t137 = t125*(mu_dot0*t127 + mu_dot1*t2)
+    t137 = t125*(t127*mu_dot0 + t2*mu_dot1)
     t138 = mu_dot0 - t127*t137
     t139 = mu_dot1 - t137*t2
     t140 = casadi.sqrt(t40 + t43 + t130**2)
@@ -1011,11 +1011,11 @@ def _velocity_ik(q, mu_dot, damping):
     t145 = t133 + t142*t144
     t146 = t7 - t144*t6
     t147 = t17 - t144*t17
-    t148 = t143*(t43 + t15*t6 - t136*t142)
+    t148 = t143*(t43 + t6*t15 - t136*t142)
     t149 = t136 + t142*t148
     t150 = t15 - t148*t6
     t151 = t17 - t148*t17
-    t152 = t143*(mu_dot2*t6 + mu_dot3*t17 + t139*t142)
+    t152 = t143*(t139*t142 + t6*mu_dot2 + t17*mu_dot3)
     t153 = t139 - t142*t152
     t154 = mu_dot2 - t152*t6
     t155 = mu_dot3 - t152*t17
@@ -1029,12 +1029,12 @@ def _velocity_ik(q, mu_dot, damping):
     t163 = t159*(t147*t155 + t154*t158)
     t164 = t154 - t158*t163
     t165 = t155 - t147*t163
-    t166 = damping + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + q1 + q2 + q3 + q4 + t126 + t15 + t2 + t6 + t7 - t27 - t28 - t29 - t35 - t36 - t37 + 3*t17
+    t166 = t2 + t6 + t7 + t15 + t126 + damping + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + q1 + q2 + q3 + q4 - t27 - t28 - t29 - t35 - t36 - t37 + 3*t17
     t167 = casadi.fabs(t162)
     t168 = t167
     t169 = t168*casadi.if_else((t162 >= 0), 1, -1)
     t170 = t162 + t169
-    t171 = casadi.if_else((t168 > 0), 1/(t168*(t167 + t168)), 0)
+    t171 = casadi.if_else((t168 > 0), 1/(t168*(t168 + t167)), 0)
     t172 = t165 - t165*t171*t170**2
     t173 = casadi.if_else((t169 != 0), -t172/t169, 0)
     t174 = casadi.if_else((t157 != 0), -(t164 - t161*t173)/t157, 0)
@@ -1045,7 +1045,7 @@ def _velocity_ik(q, mu_dot, damping):
     t179 = (damping >= 0)
     t180 = 1e-12*t122
     t181 = 1e-12*t93
-    t182 = casadi.logic_or(casadi.logic_and(t177, casadi.logic_or(casadi.logic_or(casadi.logic_or((t107 <= t181), (t52 <= t181)), (t67 <= t181)), (t85 <= t181))), casadi.logic_and((damping <= 0), casadi.logic_or(casadi.logic_or(casadi.logic_or((t123 <= t180), (t140 <= t180)), (t156 <= t180)), (t168 <= t180))))
+    t182 = casadi.logic_or(casadi.logic_and(t177, casadi.logic_or(casadi.logic_or(casadi.logic_or((t85 <= t181), (t107 <= t181)), (t52 <= t181)), (t67 <= t181))), casadi.logic_and((damping <= 0), casadi.logic_or(casadi.logic_or(casadi.logic_or((t123 <= t180), (t140 <= t180)), (t156 <= t180)), (t168 <= t180))))
     t183 = casadi.logic_and(casadi.logic_and(t178, t179), casadi.logic_not(t182))
     q_dot = casadi.SX(4, 1)
     q_dot[0, 0] = casadi.if_else(t183, casadi.if_else(t177, t116, t176), 0)
@@ -1085,14 +1085,14 @@ def _ik_numeric_step(target, q, damping):
     s234 = c23*s4 + c4*s23
     t0 = mu0 + mu1 + mu2 + mu3 + qs1 + qs2 + qs3 + qs4
     t1 = 0.1*c1
-    t2 = c23*t1 + c234*t1
-    t3 = t2 + c2*t1
+    t2 = t1*c23 + t1*c234
+    t3 = t2 + t1*c2
     t4 = mu0 - t3
     t5 = 0.1*s1
-    t6 = c23*t5 + c234*t5
-    t7 = t6 + c2*t5
-    t8 = c1*t3 + s1*t7
-    t9 = c1*t2 + s1*t6
+    t6 = t5*c23 + t5*c234
+    t7 = t6 + t5*c2
+    t8 = t3*c1 + t7*s1
+    t9 = t2*c1 + t6*s1
     t10 = mu1 - t7
     t11 = 0.1*s234
     t12 = t11 + 0.1*s23
@@ -1100,67 +1100,67 @@ def _ik_numeric_step(target, q, damping):
     t14 = 0.12 + t13
     t15 = mu2 - t14
     t16 = c1**2
-    t17 = c234*t16
+    t17 = t16*c234
     t18 = s1**2
-    t19 = c234*t18
+    t19 = t18*c234
     t20 = 0.1*t17 + 0.1*t19
-    t21 = t20**2 + t8**2 + t9**2
+    t21 = t8**2 + t9**2 + t20**2
     t22 = c234**2
     t23 = casadi.sqrt(t16*t22 + t18*t22)
     t24 = -(t17 + t19)/t23
-    t25 = t20*t24 + t24*t8 + t24*t9
+    t25 = t8*t24 + t9*t24 + t20*t24
     t26 = 3*t24**2
     t27 = t12**2
     t28 = t13**2
     t29 = 0.01*s234**2
-    t30 = t7**2 + t16*t27 + t16*t28 + t16*t29
-    t31 = t3**2 + t18*t27 + t18*t28 + t18*t29
+    t30 = t7**2 + t28*t16 + t29*t16 + t16*t27
+    t31 = t3**2 + t28*t18 + t29*t18 + t18*t27
     t32 = c1*s1
-    t33 = t27*t32 + t28*t32 + t29*t32 - t3*t7
-    t34 = c1*t12
-    t35 = c1*t13
-    t36 = c1*t11
-    t37 = t20*t36 + t34*t9 + t35*t8
+    t33 = t28*t32 + t29*t32 + t32*t27 - t3*t7
+    t34 = t12*c1
+    t35 = t13*c1
+    t36 = t11*c1
+    t37 = t8*t35 + t9*t34 + t20*t36
     t38 = t24*t34 + t24*t35 + t24*t36
-    t39 = s1*t12
-    t40 = s1*t13
-    t41 = s1*t11
-    t42 = t20*t41 + t39*t9 + t40*t8
+    t39 = t12*s1
+    t40 = t13*s1
+    t41 = t11*s1
+    t42 = t8*t40 + t9*t39 + t20*t41
     t43 = t24*t39 + t24*t40 + t24*t41
     t44 = -mu3 + casadi.atan2(-s234, t23)
-    t45 = t44 + 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t44)
-    t46 = t10**2 + t15**2 + t4**2 + t45**2
-    t47 = damping + t30
+    t45 = t44 + 6.283185307179586*casadi.ceil(-0.15915494309189535*(3.141592653589793 + t44))
+    t46 = t4**2 + t10**2 + t15**2 + t45**2
+    t47 = t30 + damping
     t48 = casadi.sqrt(t33**2 + t37**2 + t38**2 + t47**2)
     t49 = t48*casadi.if_else((t47 >= 0), 1, -1)
-    t50 = t47 + t49
+    t50 = t49 + t47
     t51 = casadi.if_else((t48 > 0), 1/(t48*(t48 + casadi.fabs(t47))), 0)
-    t52 = t51*(t10*t33 + t38*t45 + t4*t50 - t15*t37)
+    t52 = t51*(t4*t50 + t10*t33 + t45*t38 - t15*t37)
     t53 = t4 - t50*t52
-    t54 = t10 - t33*t52
-    t55 = t15 + t37*t52
-    t56 = -t45 + t38*t52
-    t57 = damping + t31
-    t58 = t51*(t33*t50 + t33*t57 + t37*t42 + t38*t43)
+    t54 = t10 - t52*t33
+    t55 = t15 + t52*t37
+    t56 = -t45 + t52*t38
+    t57 = t31 + damping
+    t58 = t51*(t50*t33 + t33*t57 + t37*t42 + t38*t43)
     t59 = t33 - t50*t58
-    t60 = t57 - t33*t58
-    t61 = -t42 + t37*t58
-    t62 = -t43 + t38*t58
+    t60 = t57 - t58*t33
+    t61 = -t42 + t58*t37
+    t62 = -t43 + t58*t38
     t63 = casadi.sqrt(t60**2 + t61**2 + t62**2)
     t64 = t63*casadi.if_else((t60 >= 0), 1, -1)
     t65 = t60 + t64
     t66 = casadi.if_else((t63 > 0), 1/(t63*(t63 + casadi.fabs(t60))), 0)
-    t67 = t66*(t54*t65 + t55*t61 + t56*t62)
+    t67 = t66*(t61*t55 + t62*t56 + t54*t65)
     t68 = t54 - t65*t67
     t69 = t55 - t61*t67
     t70 = t56 - t62*t67
-    t71 = damping + t21
-    t72 = -t51*(t25*t38 + t33*t42 + t37*t50 + t37*t71)
+    t71 = t21 + damping
+    t72 = -t51*(t50*t37 + t33*t42 + t37*t71 + t38*t25)
     t73 = t37 + t50*t72
-    t74 = t42 + t33*t72
-    t75 = t71 + t37*t72
-    t76 = t25 + t38*t72
-    t77 = t66*(t61*t75 + t62*t76 - t65*t74)
+    t74 = t42 + t72*t33
+    t75 = t71 + t72*t37
+    t76 = t25 + t72*t38
+    t77 = t66*(t61*t75 + t62*t76 - t74*t65)
     t78 = t74 + t65*t77
     t79 = t75 - t61*t77
     t80 = t76 - t62*t77
@@ -1168,37 +1168,37 @@ def _ik_numeric_step(target, q, damping):
     t82 = t81*casadi.if_else((t79 >= 0), 1, -1)
     t83 = t79 + t82
     t84 = casadi.if_else((t81 > 0), 1/(t81*(t81 + casadi.fabs(t79))), 0)
-    t85 = t84*(t69*t83 + t70*t80)
+    t85 = t84*(t80*t70 + t69*t83)
     t86 = t69 - t83*t85
     t87 = t70 - t80*t85
-    t88 = damping + t26
-    t89 = -t51*(t25*t37 + t33*t43 + t38*t50 + t38*t88)
+    t88 = t26 + damping
+    t89 = -t51*(t50*t38 + t33*t43 + t37*t25 + t38*t88)
     t90 = t38 + t50*t89
-    t91 = t43 + t33*t89
-    t92 = t25 + t37*t89
-    t93 = t88 + t38*t89
-    t94 = t66*(t61*t92 + t62*t93 - t65*t91)
+    t91 = t43 + t89*t33
+    t92 = t25 + t89*t37
+    t93 = t88 + t89*t38
+    t94 = t66*(t61*t92 + t62*t93 - t91*t65)
     t95 = t91 + t65*t94
     t96 = t92 - t61*t94
     t97 = t93 - t62*t94
-    t98 = t84*(t80*t97 + t83*t96)
+    t98 = t84*(t80*t97 + t96*t83)
     t99 = t96 - t83*t98
     t100 = t97 - t80*t98
     t101 = casadi.fabs(t100)
     t102 = t101
     t103 = t102*casadi.if_else((t100 >= 0), 1, -1)
     t104 = t100 + t103
-    t105 = casadi.if_else((t102 > 0), 1/(t102*(t101 + t102)), 0)
-    t106 = t87 - t105*t87*t104**2
+    t105 = casadi.if_else((t102 > 0), 1/(t102*(t102 + t101)), 0)
+    t106 = t87 - t87*t105*t104**2
     t107 = casadi.if_else((t103 != 0), -t106/t103, 0)
-    t108 = casadi.if_else((t82 != 0), -(t86 - t107*t99)/t82, 0)
-    t109 = casadi.if_else((t64 != 0), -(t68 + t107*t95 + t108*t78)/t64, 0)
-    t110 = casadi.if_else((t49 != 0), -(t53 + t107*t90 + t108*t73 - t109*t59)/t49, 0)
-    t111 = q1 + t109*t3 - t110*t7
+    t108 = casadi.if_else((t82 != 0), -(t86 - t99*t107)/t82, 0)
+    t109 = casadi.if_else((t64 != 0), -(t68 + t78*t108 + t95*t107)/t64, 0)
+    t110 = casadi.if_else((t49 != 0), -(t53 + t73*t108 + t90*t107 - t59*t109)/t49, 0)
+    t111 = q1 + t3*t109 - t7*t110
     t112 = t107*t24
-    t113 = q2 + t112 + t108*t8 - t109*t40 - t110*t35
-    t114 = q3 + t112 + t108*t9 - t109*t39 - t110*t34
-    t115 = q4 + t112 + t108*t20 - t109*t41 - t110*t36
+    t113 = t112 + q2 + t108*t8 - t109*t40 - t110*t35
+    t114 = t112 + q3 + t108*t9 - t109*t39 - t110*t34
+    t115 = t112 + q4 + t108*t20 - t109*t41 - t110*t36
     q_start = casadi.SX(4, 1)
     q_start[0, 0] = q1
     q_start[1, 0] = q2
@@ -1215,7 +1215,7 @@ def _ik_numeric_step(target, q, damping):
 
 
 def _ik_branches(mu):
-    """Every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits: 878 operations."""
+    """Every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits: 870 operations."""
     mu0 = mu[0]
     mu1 = mu[1]
     mu2 = mu[2]
@@ -1238,27 +1238,27 @@ def _ik_branches(mu):
     t15 = 1e-24*t14
     t16 = (t13 <= t15)
     t17 = casadi.if_else(t16, 1, 1/casadi.sqrt(t13))
-    t18 = casadi.if_else(t16, 0, t1 + (1/2)*casadi.pi)
-    t19 = t1 - 1/2*casadi.pi
-    t20 = t18 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t18)
-    t21 = t20 - 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*t20)
-    t22 = t19 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t19)
-    t23 = t22 - 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*t22)
+    t18 = casadi.if_else(t16, 0, t1 + 1.5707963267948966)
+    t19 = t1 - 1.5707963267948966
+    t20 = t18 - 6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t18))
+    t21 = t20 - 6.283185307179586*casadi.floor(0.15915494309189535*(3.141592653589793 + t20))
+    t22 = t19 - 6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t19))
+    t23 = t22 - 6.283185307179586*casadi.floor(0.15915494309189535*(3.141592653589793 + t22))
     t24 = t17
-    t25 = mu0*t24
+    t25 = t24*mu0
     t26 = casadi.if_else(t16, 1, -t25)
     t27 = t25
     t28 = mu2*(1 - t26)
-    t29 = t28 + mu2*t26
+    t29 = t28 + t26*mu2
     t30 = mu2*(1 - t27)
-    t31 = t30 + mu2*t27
-    t32 = mu1*t24
+    t31 = t30 + t27*mu2
+    t32 = t24*mu1
     t33 = casadi.if_else(t16, 0, -t32)
     t34 = t32
-    t35 = mu0*t26 + mu1*t33
-    t36 = mu1*t26 - mu0*t33
-    t37 = mu0*t27 + mu1*t34
-    t38 = mu1*t27 - mu0*t34
+    t35 = t26*mu0 + t33*mu1
+    t36 = t26*mu1 - t33*mu0
+    t37 = t27*mu0 + t34*mu1
+    t38 = t27*mu1 - t34*mu0
     t39 = 0.1*t11
     t40 = t35 + t39
     t41 = t37 + t39
@@ -1269,7 +1269,7 @@ def _ik_branches(mu):
     t46 = -0.12 + t45
     t47 = t36**2
     t48 = t47 + t40**2 + t44**2
-    t49 = 0.01 - 0.5*t48
+    t49 = 0.5*(0.02 - t48)
     t50 = t49**2
     t51 = 1 - 10000*t50
     t52 = 100*t49
@@ -1279,10 +1279,10 @@ def _ik_branches(mu):
     t56 = casadi.atan2(t55, t54)
     t57 = 3.141592653589793 + t56
     t58 = 3.141592653589793 - t56
-    t59 = t57 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t57)
-    t60 = t59 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t59)
-    t61 = t58 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t58)
-    t62 = t61 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t61)
+    t59 = t57 - 6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t57))
+    t60 = t59 - 6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t59))
+    t61 = t58 - 6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t58))
+    t62 = t61 - 6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t61))
     t63 = -1.0*t54
     t64 = -1.0*t55
     t65 = 0.22 + 0.1*t63
@@ -1306,7 +1306,7 @@ def _ik_branches(mu):
     t83 = t29 + t82
     t84 = -0.12 + t83
     t85 = t47 + t80**2 + t84**2
-    t86 = 0.01 - 0.5*t85
+    t86 = 0.5*(0.02 - t85)
     t87 = t31 + t82
     t88 = -0.12 + t87
     t89 = t86**2
@@ -1326,23 +1326,23 @@ def _ik_branches(mu):
     t103 = 0.22 - 0.1*t93
     t104 = -0.12 + t103
     t105 = t104**2 + 0.01*t94**2
-    t106 = t96 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t96)
-    t107 = t106 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t106)
-    t108 = t99 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t99)
-    t109 = t108 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t108)
+    t106 = t96 - 6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t96))
+    t107 = t106 - 6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t106))
+    t108 = t99 - 6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t99))
+    t109 = t108 - 6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t108))
     t110 = 0.1*t98
-    t111 = t101*t84 - t110*t80
-    t112 = t101*t80 + t110*t84
+    t111 = t84*t101 - t80*t110
+    t112 = t80*t101 + t84*t110
     t113 = t111**2 + t112**2
     t114 = 0.1*t94
-    t115 = t104*t84 - t114*t80
-    t116 = t104*t80 + t114*t84
+    t115 = t84*t104 - t80*t114
+    t116 = t80*t104 + t84*t114
     t117 = t115**2 + t116**2
     t118 = t38**2
     t119 = t118 + t41**2 + t46**2
-    t120 = 0.01 - 0.5*t119
+    t120 = 0.5*(0.02 - t119)
     t121 = t118 + t81**2 + t88**2
-    t122 = 0.01 - 0.5*t121
+    t122 = 0.5*(0.02 - t121)
     t123 = t120**2
     t124 = 1 - 10000*t123
     t125 = 100*t120
@@ -1360,17 +1360,17 @@ def _ik_branches(mu):
     t137 = 0.22 - 0.1*t127
     t138 = -0.12 + t137
     t139 = t138**2 + 0.01*t128**2
-    t140 = t130 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t130)
-    t141 = t140 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t140)
-    t142 = t133 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t133)
-    t143 = t142 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t142)
+    t140 = t130 - 6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t130))
+    t141 = t140 - 6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t140))
+    t142 = t133 - 6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t133))
+    t143 = t142 - 6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t142))
     t144 = 0.1*t132
-    t145 = t135*t46 - t144*t41
-    t146 = t135*t41 + t144*t46
+    t145 = t46*t135 - t41*t144
+    t146 = t41*t135 + t46*t144
     t147 = t145**2 + t146**2
     t148 = 0.1*t128
-    t149 = t138*t46 - t148*t41
-    t150 = t138*t41 + t148*t46
+    t149 = t46*t138 - t41*t148
+    t150 = t41*t138 + t46*t148
     t151 = t149**2 + t150**2
     t152 = t122**2
     t153 = 1 - 10000*t152
@@ -1389,81 +1389,81 @@ def _ik_branches(mu):
     t166 = 0.22 - 0.1*t156
     t167 = -0.12 + t166
     t168 = t167**2 + 0.01*t157**2
-    t169 = t159 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t159)
-    t170 = t169 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t169)
-    t171 = t162 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t162)
-    t172 = t171 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t171)
+    t169 = t159 - 6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t159))
+    t170 = t169 - 6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t169))
+    t171 = t162 - 6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t162))
+    t172 = t171 - 6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t171))
     t173 = 0.1*t161
-    t174 = t164*t88 - t173*t81
-    t175 = t164*t81 + t173*t88
+    t174 = t88*t164 - t81*t173
+    t175 = t81*t164 + t88*t173
     t176 = t174**2 + t175**2
     t177 = 0.1*t157
-    t178 = t167*t88 - t177*t81
-    t179 = t167*t81 + t177*t88
+    t178 = t88*t167 - t81*t177
+    t179 = t81*t167 + t88*t177
     t180 = t178**2 + t179**2
     t181 = 1e-24*t48
-    t182 = casadi.if_else((t71 <= t181*t67), 0, casadi.atan2(-t70, t69))
+    t182 = casadi.if_else((t71 <= t67*t181), 0, casadi.atan2(-t70, t69))
     t183 = t182
-    t184 = t183 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t183)
+    t184 = t183 - 6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t183))
     t185 = -t9
     t186 = 3.141592653589793 + t185
-    t187 = t182 + t57
-    t188 = t185 + t187 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t186 - 0.15915494309189535*t187)
+    t187 = t57 + t182
+    t188 = t185 + t187 + 6.283185307179586*casadi.ceil(-0.15915494309189535*(t186 + t187))
     t189 = -t188
-    t190 = t188 + 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t189)
-    t191 = casadi.if_else((t77 <= t181*t78), 0, casadi.atan2(-t76, t75))
+    t190 = t188 + 6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t189))
+    t191 = casadi.if_else((t77 <= t78*t181), 0, casadi.atan2(-t76, t75))
     t192 = t191
-    t193 = t192 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t192)
-    t194 = t191 + t58
-    t195 = t185 + t194 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t186 - 0.15915494309189535*t194)
+    t193 = t192 - 6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t192))
+    t194 = t58 + t191
+    t195 = t185 + t194 + 6.283185307179586*casadi.ceil(-0.15915494309189535*(t186 + t194))
     t196 = -t195
-    t197 = t195 + 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t196)
+    t197 = t195 + 6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t196))
     t198 = 1e-24*t85
     t199 = casadi.if_else((t113 <= t102*t198), 0, casadi.atan2(-t112, t111))
     t200 = t199
-    t201 = t200 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t200)
+    t201 = t200 - 6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t200))
     t202 = 3.141592653589793 + t8
-    t203 = t199 + t96
-    t204 = t203 + t8 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t202 - 0.15915494309189535*t203)
+    t203 = t96 + t199
+    t204 = t8 + t203 + 6.283185307179586*casadi.ceil(-0.15915494309189535*(t202 + t203))
     t205 = -t204
-    t206 = t204 + 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t205)
+    t206 = t204 + 6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t205))
     t207 = casadi.if_else((t117 <= t105*t198), 0, casadi.atan2(-t116, t115))
     t208 = t207
-    t209 = t208 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t208)
-    t210 = t207 + t99
-    t211 = t210 + t8 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t202 - 0.15915494309189535*t210)
+    t209 = t208 - 6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t208))
+    t210 = t99 + t207
+    t211 = t8 + t210 + 6.283185307179586*casadi.ceil(-0.15915494309189535*(t202 + t210))
     t212 = -t211
-    t213 = t211 + 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t212)
+    t213 = t211 + 6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t212))
     t214 = 1e-24*t119
     t215 = casadi.if_else((t147 <= t136*t214), 0, casadi.atan2(-t146, t145))
     t216 = t215
-    t217 = t216 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t216)
+    t217 = t216 - 6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t216))
     t218 = t130 + t215
-    t219 = t185 + t218 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t186 - 0.15915494309189535*t218)
+    t219 = t185 + t218 + 6.283185307179586*casadi.ceil(-0.15915494309189535*(t186 + t218))
     t220 = -t219
-    t221 = t219 + 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t220)
+    t221 = t219 + 6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t220))
     t222 = casadi.if_else((t151 <= t139*t214), 0, casadi.atan2(-t150, t149))
     t223 = t222
-    t224 = t223 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t223)
+    t224 = t223 - 6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t223))
     t225 = t133 + t222
-    t226 = t185 + t225 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t186 - 0.15915494309189535*t225)
+    t226 = t185 + t225 + 6.283185307179586*casadi.ceil(-0.15915494309189535*(t186 + t225))
     t227 = -t226
-    t228 = t226 + 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t227)
+    t228 = t226 + 6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t227))
     t229 = 1e-24*t121
     t230 = casadi.if_else((t176 <= t165*t229), 0, casadi.atan2(-t175, t174))
     t231 = t230
-    t232 = t231 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t231)
+    t232 = t231 - 6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t231))
     t233 = t159 + t230
-    t234 = t233 + t8 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t202 - 0.15915494309189535*t233)
+    t234 = t8 + t233 + 6.283185307179586*casadi.ceil(-0.15915494309189535*(t202 + t233))
     t235 = -t234
-    t236 = t234 + 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t235)
+    t236 = t234 + 6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t235))
     t237 = casadi.if_else((t180 <= t168*t229), 0, casadi.atan2(-t179, t178))
     t238 = t237
-    t239 = t238 - 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t238)
+    t239 = t238 - 6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t238))
     t240 = t162 + t237
-    t241 = t240 + t8 + 6.283185307179586*casadi.ceil(-0.15915494309189535*t202 - 0.15915494309189535*t240)
+    t241 = t8 + t240 + 6.283185307179586*casadi.ceil(-0.15915494309189535*(t202 + t240))
     t242 = -t241
-    t243 = t241 + 6.283185307179586*casadi.floor(0.3333333333333333 + 0.15915494309189535*t242)
+    t243 = t241 + 6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t242))
     t244 = (t21 <= 3.141592653589793)
     t245 = casadi.logic_and((t20 >= -3.141592653589793), (t20 <= 3.141592653589793))
     t246 = casadi.if_else(casadi.logic_and(t244, casadi.logic_not(t245)), t21, t20)
@@ -1514,7 +1514,7 @@ def _ik_branches(mu):
     t291 = (casadi.fabs(mu3) <= 1.5707963267948966)
     t292 = (t13 > t15)
     t293 = casadi.logic_or(t292, casadi.logic_and(t16, (0 <= 1e-12*t14)))
-    t294 = (t4 >= -1e-12)
+    t294 = casadi.logic_or((t4 >= -1e-12), casadi.logic_and(False, (t3 <= 1e-12)))
     t295 = (t4 > 1e-12)
     t296 = casadi.logic_or(t244, t245)
     t297 = casadi.logic_or(t267, t268)
@@ -1677,19 +1677,19 @@ def _ik_nearest(mu, q_seed, weights):
     t39 = qb7_3 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn4 - qb7_3))
     t40 = casadi.if_else(casadi.logic_and(lb7, vb7), 1, 0)
     t41 = mu0 + mu1 + mu2 + mu3 + qn1 + qn2 + qn3 + qn4 + qw1 + qw2 + qw3 + qw4
-    t42 = casadi.if_else((qn1 > t0), 6.283185307179586, -6.283185307179586)
+    t42 = casadi.if_else((t0 < qn1), 6.283185307179586, -6.283185307179586)
     t43 = t0 + t42
     t44 = t0 - t42
     t45 = casadi.if_else(casadi.logic_and((t0 >= -3.141592653589793), (t0 <= 3.141592653589793)), t0, casadi.if_else(casadi.logic_and((t43 >= -3.141592653589793), (t43 <= 3.141592653589793)), t43, casadi.if_else(casadi.logic_and((t44 >= -3.141592653589793), (t44 <= 3.141592653589793)), t44, qb0_0)))
-    t46 = casadi.if_else((qn2 > t1), 6.283185307179586, -6.283185307179586)
+    t46 = casadi.if_else((t1 < qn2), 6.283185307179586, -6.283185307179586)
     t47 = t1 + t46
     t48 = t1 - t46
     t49 = casadi.if_else(casadi.logic_and((t1 >= -2.0943951023931953), (t1 <= 2.0943951023931953)), t1, casadi.if_else(casadi.logic_and((t47 >= -2.0943951023931953), (t47 <= 2.0943951023931953)), t47, casadi.if_else(casadi.logic_and((t48 >= -2.0943951023931953), (t48 <= 2.0943951023931953)), t48, qb0_1)))
-    t50 = casadi.if_else((qn3 > t2), 6.283185307179586, -6.283185307179586)
+    t50 = casadi.if_else((t2 < qn3), 6.283185307179586, -6.283185307179586)
     t51 = t2 + t50
     t52 = t2 - t50
     t53 = casadi.if_else(casadi.logic_and((t2 >= -2.0943951023931953), (t2 <= 2.0943951023931953)), t2, casadi.if_else(casadi.logic_and((t51 >= -2.0943951023931953), (t51 <= 2.0943951023931953)), t51, casadi.if_else(casadi.logic_and((t52 >= -2.0943951023931953), (t52 <= 2.0943951023931953)), t52, qb0_2)))
-    t54 = casadi.if_else((qn4 > t3), 6.283185307179586, -6.283185307179586)
+    t54 = casadi.if_else((t3 < qn4), 6.283185307179586, -6.283185307179586)
     t55 = t3 + t54
     t56 = t3 - t54
     t57 = casadi.if_else(casadi.logic_and((t3 >= -2.0943951023931953), (t3 <= 2.0943951023931953)), t3, casadi.if_else(casadi.logic_and((t55 >= -2.0943951023931953), (t55 <= 2.0943951023931953)), t55, casadi.if_else(casadi.logic_and((t56 >= -2.0943951023931953), (t56 <= 2.0943951023931953)), t56, qb0_3)))
@@ -1704,23 +1704,23 @@ def _ik_nearest(mu, q_seed, weights):
     t66 = casadi.if_else(t63, t53, qn3)
     t67 = casadi.if_else(t63, t57, qn4)
     t68 = casadi.if_else(t63, t62, 0)
-    t69 = casadi.if_else((qn1 > t6), 6.283185307179586, -6.283185307179586)
+    t69 = casadi.if_else((t6 < qn1), 6.283185307179586, -6.283185307179586)
     t70 = t6 + t69
     t71 = t6 - t69
     t72 = casadi.if_else(casadi.logic_and((t6 >= -3.141592653589793), (t6 <= 3.141592653589793)), t6, casadi.if_else(casadi.logic_and((t70 >= -3.141592653589793), (t70 <= 3.141592653589793)), t70, casadi.if_else(casadi.logic_and((t71 >= -3.141592653589793), (t71 <= 3.141592653589793)), t71, qb1_0)))
-    t73 = casadi.if_else((qn2 > t7), 6.283185307179586, -6.283185307179586)
+    t73 = casadi.if_else((t7 < qn2), 6.283185307179586, -6.283185307179586)
     t74 = t7 + t73
     t75 = t7 - t73
     t76 = casadi.if_else(casadi.logic_and((t7 >= -2.0943951023931953), (t7 <= 2.0943951023931953)), t7, casadi.if_else(casadi.logic_and((t74 >= -2.0943951023931953), (t74 <= 2.0943951023931953)), t74, casadi.if_else(casadi.logic_and((t75 >= -2.0943951023931953), (t75 <= 2.0943951023931953)), t75, qb1_1)))
-    t77 = casadi.if_else((qn3 > t8), 6.283185307179586, -6.283185307179586)
-    t78 = t77 + t8
+    t77 = casadi.if_else((t8 < qn3), 6.283185307179586, -6.283185307179586)
+    t78 = t8 + t77
     t79 = t8 - t77
     t80 = casadi.if_else(casadi.logic_and((t8 >= -2.0943951023931953), (t8 <= 2.0943951023931953)), t8, casadi.if_else(casadi.logic_and((t78 >= -2.0943951023931953), (t78 <= 2.0943951023931953)), t78, casadi.if_else(casadi.logic_and((t79 >= -2.0943951023931953), (t79 <= 2.0943951023931953)), t79, qb1_2)))
-    t81 = casadi.if_else((qn4 > t9), 6.283185307179586, -6.283185307179586)
-    t82 = t81 + t9
+    t81 = casadi.if_else((t9 < qn4), 6.283185307179586, -6.283185307179586)
+    t82 = t9 + t81
     t83 = t9 - t81
     t84 = casadi.if_else(casadi.logic_and((t9 >= -2.0943951023931953), (t9 <= 2.0943951023931953)), t9, casadi.if_else(casadi.logic_and((t82 >= -2.0943951023931953), (t82 <= 2.0943951023931953)), t82, casadi.if_else(casadi.logic_and((t83 >= -2.0943951023931953), (t83 <= 2.0943951023931953)), t83, qb1_3)))
-    t85 = qw1*(t58 + t72)**2 + qw2*(t59 + t76)**2 + qw3*(t60 + t80)**2 + qw4*(t61 + t84)**2
+    t85 = qw1*(t72 + t58)**2 + qw2*(t76 + t59)**2 + qw3*(t80 + t60)**2 + qw4*(t84 + t61)**2
     t86 = (t10 > 0)
     t87 = casadi.if_else(casadi.logic_and(t86, casadi.logic_or((t68 > t85), (t5 < 1))), 1, 0)
     t88 = casadi.if_else(t86, 1, t5)
@@ -1730,25 +1730,25 @@ def _ik_nearest(mu, q_seed, weights):
     t92 = casadi.if_else(t89, t80, t66)
     t93 = casadi.if_else(t89, t84, t67)
     t94 = casadi.if_else(t89, t85, t68)
-    t95 = casadi.if_else((qn1 > t11), 6.283185307179586, -6.283185307179586)
+    t95 = casadi.if_else((t11 < qn1), 6.283185307179586, -6.283185307179586)
     t96 = t11 + t95
     t97 = t11 - t95
     t98 = casadi.if_else(casadi.logic_and((t11 >= -3.141592653589793), (t11 <= 3.141592653589793)), t11, casadi.if_else(casadi.logic_and((t96 >= -3.141592653589793), (t96 <= 3.141592653589793)), t96, casadi.if_else(casadi.logic_and((t97 >= -3.141592653589793), (t97 <= 3.141592653589793)), t97, qb2_0)))
-    t99 = casadi.if_else((qn2 > t12), 6.283185307179586, -6.283185307179586)
+    t99 = casadi.if_else((t12 < qn2), 6.283185307179586, -6.283185307179586)
     t100 = t12 + t99
     t101 = t12 - t99
     t102 = casadi.if_else(casadi.logic_and((t12 >= -2.0943951023931953), (t12 <= 2.0943951023931953)), t12, casadi.if_else(casadi.logic_and((t100 >= -2.0943951023931953), (t100 <= 2.0943951023931953)), t100, casadi.if_else(casadi.logic_and((t101 >= -2.0943951023931953), (t101 <= 2.0943951023931953)), t101, qb2_1)))
-    t103 = casadi.if_else((qn3 > t13), 6.283185307179586, -6.283185307179586)
-    t104 = t103 + t13
+    t103 = casadi.if_else((t13 < qn3), 6.283185307179586, -6.283185307179586)
+    t104 = t13 + t103
     t105 = t13 - t103
     t106 = casadi.if_else(casadi.logic_and((t13 >= -2.0943951023931953), (t13 <= 2.0943951023931953)), t13, casadi.if_else(casadi.logic_and((t104 >= -2.0943951023931953), (t104 <= 2.0943951023931953)), t104, casadi.if_else(casadi.logic_and((t105 >= -2.0943951023931953), (t105 <= 2.0943951023931953)), t105, qb2_2)))
-    t107 = casadi.if_else((qn4 > t14), 6.283185307179586, -6.283185307179586)
-    t108 = t107 + t14
+    t107 = casadi.if_else((t14 < qn4), 6.283185307179586, -6.283185307179586)
+    t108 = t14 + t107
     t109 = t14 - t107
     t110 = casadi.if_else(casadi.logic_and((t14 >= -2.0943951023931953), (t14 <= 2.0943951023931953)), t14, casadi.if_else(casadi.logic_and((t108 >= -2.0943951023931953), (t108 <= 2.0943951023931953)), t108, casadi.if_else(casadi.logic_and((t109 >= -2.0943951023931953), (t109 <= 2.0943951023931953)), t109, qb2_3)))
-    t111 = qw1*(t58 + t98)**2 + qw2*(t102 + t59)**2 + qw3*(t106 + t60)**2 + qw4*(t110 + t61)**2
+    t111 = qw1*(t98 + t58)**2 + qw2*(t102 + t59)**2 + qw3*(t106 + t60)**2 + qw4*(t110 + t61)**2
     t112 = (t15 > 0)
-    t113 = casadi.if_else(casadi.logic_and(t112, casadi.logic_or((t111 < t94), (t88 < 1))), 1, 0)
+    t113 = casadi.if_else(casadi.logic_and(t112, casadi.logic_or((t94 > t111), (t88 < 1))), 1, 0)
     t114 = casadi.if_else(t112, 1, t88)
     t115 = (t113 > 0)
     t116 = casadi.if_else(t115, t98, t90)
@@ -1756,20 +1756,20 @@ def _ik_nearest(mu, q_seed, weights):
     t118 = casadi.if_else(t115, t106, t92)
     t119 = casadi.if_else(t115, t110, t93)
     t120 = casadi.if_else(t115, t111, t94)
-    t121 = casadi.if_else((qn1 > t16), 6.283185307179586, -6.283185307179586)
-    t122 = t121 + t16
+    t121 = casadi.if_else((t16 < qn1), 6.283185307179586, -6.283185307179586)
+    t122 = t16 + t121
     t123 = t16 - t121
     t124 = casadi.if_else(casadi.logic_and((t16 >= -3.141592653589793), (t16 <= 3.141592653589793)), t16, casadi.if_else(casadi.logic_and((t122 >= -3.141592653589793), (t122 <= 3.141592653589793)), t122, casadi.if_else(casadi.logic_and((t123 >= -3.141592653589793), (t123 <= 3.141592653589793)), t123, qb3_0)))
-    t125 = casadi.if_else((qn2 > t17), 6.283185307179586, -6.283185307179586)
-    t126 = t125 + t17
+    t125 = casadi.if_else((t17 < qn2), 6.283185307179586, -6.283185307179586)
+    t126 = t17 + t125
     t127 = t17 - t125
     t128 = casadi.if_else(casadi.logic_and((t17 >= -2.0943951023931953), (t17 <= 2.0943951023931953)), t17, casadi.if_else(casadi.logic_and((t126 >= -2.0943951023931953), (t126 <= 2.0943951023931953)), t126, casadi.if_else(casadi.logic_and((t127 >= -2.0943951023931953), (t127 <= 2.0943951023931953)), t127, qb3_1)))
-    t129 = casadi.if_else((qn3 > t18), 6.283185307179586, -6.283185307179586)
-    t130 = t129 + t18
+    t129 = casadi.if_else((t18 < qn3), 6.283185307179586, -6.283185307179586)
+    t130 = t18 + t129
     t131 = t18 - t129
     t132 = casadi.if_else(casadi.logic_and((t18 >= -2.0943951023931953), (t18 <= 2.0943951023931953)), t18, casadi.if_else(casadi.logic_and((t130 >= -2.0943951023931953), (t130 <= 2.0943951023931953)), t130, casadi.if_else(casadi.logic_and((t131 >= -2.0943951023931953), (t131 <= 2.0943951023931953)), t131, qb3_2)))
-    t133 = casadi.if_else((qn4 > t19), 6.283185307179586, -6.283185307179586)
-    t134 = t133 + t19
+    t133 = casadi.if_else((t19 < qn4), 6.283185307179586, -6.283185307179586)
+    t134 = t19 + t133
     t135 = t19 - t133
     t136 = casadi.if_else(casadi.logic_and((t19 >= -2.0943951023931953), (t19 <= 2.0943951023931953)), t19, casadi.if_else(casadi.logic_and((t134 >= -2.0943951023931953), (t134 <= 2.0943951023931953)), t134, casadi.if_else(casadi.logic_and((t135 >= -2.0943951023931953), (t135 <= 2.0943951023931953)), t135, qb3_3)))
     t137 = qw1*(t124 + t58)**2 + qw2*(t128 + t59)**2 + qw3*(t132 + t60)**2 + qw4*(t136 + t61)**2
@@ -1782,20 +1782,20 @@ def _ik_nearest(mu, q_seed, weights):
     t144 = casadi.if_else(t141, t132, t118)
     t145 = casadi.if_else(t141, t136, t119)
     t146 = casadi.if_else(t141, t137, t120)
-    t147 = casadi.if_else((qn1 > t21), 6.283185307179586, -6.283185307179586)
-    t148 = t147 + t21
+    t147 = casadi.if_else((t21 < qn1), 6.283185307179586, -6.283185307179586)
+    t148 = t21 + t147
     t149 = t21 - t147
     t150 = casadi.if_else(casadi.logic_and((t21 >= -3.141592653589793), (t21 <= 3.141592653589793)), t21, casadi.if_else(casadi.logic_and((t148 >= -3.141592653589793), (t148 <= 3.141592653589793)), t148, casadi.if_else(casadi.logic_and((t149 >= -3.141592653589793), (t149 <= 3.141592653589793)), t149, qb4_0)))
-    t151 = casadi.if_else((qn2 > t22), 6.283185307179586, -6.283185307179586)
-    t152 = t151 + t22
+    t151 = casadi.if_else((t22 < qn2), 6.283185307179586, -6.283185307179586)
+    t152 = t22 + t151
     t153 = t22 - t151
     t154 = casadi.if_else(casadi.logic_and((t22 >= -2.0943951023931953), (t22 <= 2.0943951023931953)), t22, casadi.if_else(casadi.logic_and((t152 >= -2.0943951023931953), (t152 <= 2.0943951023931953)), t152, casadi.if_else(casadi.logic_and((t153 >= -2.0943951023931953), (t153 <= 2.0943951023931953)), t153, qb4_1)))
-    t155 = casadi.if_else((qn3 > t23), 6.283185307179586, -6.283185307179586)
-    t156 = t155 + t23
+    t155 = casadi.if_else((t23 < qn3), 6.283185307179586, -6.283185307179586)
+    t156 = t23 + t155
     t157 = t23 - t155
     t158 = casadi.if_else(casadi.logic_and((t23 >= -2.0943951023931953), (t23 <= 2.0943951023931953)), t23, casadi.if_else(casadi.logic_and((t156 >= -2.0943951023931953), (t156 <= 2.0943951023931953)), t156, casadi.if_else(casadi.logic_and((t157 >= -2.0943951023931953), (t157 <= 2.0943951023931953)), t157, qb4_2)))
-    t159 = casadi.if_else((qn4 > t24), 6.283185307179586, -6.283185307179586)
-    t160 = t159 + t24
+    t159 = casadi.if_else((t24 < qn4), 6.283185307179586, -6.283185307179586)
+    t160 = t24 + t159
     t161 = t24 - t159
     t162 = casadi.if_else(casadi.logic_and((t24 >= -2.0943951023931953), (t24 <= 2.0943951023931953)), t24, casadi.if_else(casadi.logic_and((t160 >= -2.0943951023931953), (t160 <= 2.0943951023931953)), t160, casadi.if_else(casadi.logic_and((t161 >= -2.0943951023931953), (t161 <= 2.0943951023931953)), t161, qb4_3)))
     t163 = qw1*(t150 + t58)**2 + qw2*(t154 + t59)**2 + qw3*(t158 + t60)**2 + qw4*(t162 + t61)**2
@@ -1808,20 +1808,20 @@ def _ik_nearest(mu, q_seed, weights):
     t170 = casadi.if_else(t167, t158, t144)
     t171 = casadi.if_else(t167, t162, t145)
     t172 = casadi.if_else(t167, t163, t146)
-    t173 = casadi.if_else((qn1 > t26), 6.283185307179586, -6.283185307179586)
-    t174 = t173 + t26
+    t173 = casadi.if_else((t26 < qn1), 6.283185307179586, -6.283185307179586)
+    t174 = t26 + t173
     t175 = t26 - t173
     t176 = casadi.if_else(casadi.logic_and((t26 >= -3.141592653589793), (t26 <= 3.141592653589793)), t26, casadi.if_else(casadi.logic_and((t174 >= -3.141592653589793), (t174 <= 3.141592653589793)), t174, casadi.if_else(casadi.logic_and((t175 >= -3.141592653589793), (t175 <= 3.141592653589793)), t175, qb5_0)))
-    t177 = casadi.if_else((qn2 > t27), 6.283185307179586, -6.283185307179586)
-    t178 = t177 + t27
+    t177 = casadi.if_else((t27 < qn2), 6.283185307179586, -6.283185307179586)
+    t178 = t27 + t177
     t179 = t27 - t177
     t180 = casadi.if_else(casadi.logic_and((t27 >= -2.0943951023931953), (t27 <= 2.0943951023931953)), t27, casadi.if_else(casadi.logic_and((t178 >= -2.0943951023931953), (t178 <= 2.0943951023931953)), t178, casadi.if_else(casadi.logic_and((t179 >= -2.0943951023931953), (t179 <= 2.0943951023931953)), t179, qb5_1)))
-    t181 = casadi.if_else((qn3 > t28), 6.283185307179586, -6.283185307179586)
-    t182 = t181 + t28
+    t181 = casadi.if_else((t28 < qn3), 6.283185307179586, -6.283185307179586)
+    t182 = t28 + t181
     t183 = t28 - t181
     t184 = casadi.if_else(casadi.logic_and((t28 >= -2.0943951023931953), (t28 <= 2.0943951023931953)), t28, casadi.if_else(casadi.logic_and((t182 >= -2.0943951023931953), (t182 <= 2.0943951023931953)), t182, casadi.if_else(casadi.logic_and((t183 >= -2.0943951023931953), (t183 <= 2.0943951023931953)), t183, qb5_2)))
-    t185 = casadi.if_else((qn4 > t29), 6.283185307179586, -6.283185307179586)
-    t186 = t185 + t29
+    t185 = casadi.if_else((t29 < qn4), 6.283185307179586, -6.283185307179586)
+    t186 = t29 + t185
     t187 = t29 - t185
     t188 = casadi.if_else(casadi.logic_and((t29 >= -2.0943951023931953), (t29 <= 2.0943951023931953)), t29, casadi.if_else(casadi.logic_and((t186 >= -2.0943951023931953), (t186 <= 2.0943951023931953)), t186, casadi.if_else(casadi.logic_and((t187 >= -2.0943951023931953), (t187 <= 2.0943951023931953)), t187, qb5_3)))
     t189 = qw1*(t176 + t58)**2 + qw2*(t180 + t59)**2 + qw3*(t184 + t60)**2 + qw4*(t188 + t61)**2
@@ -1834,20 +1834,20 @@ def _ik_nearest(mu, q_seed, weights):
     t196 = casadi.if_else(t193, t184, t170)
     t197 = casadi.if_else(t193, t188, t171)
     t198 = casadi.if_else(t193, t189, t172)
-    t199 = casadi.if_else((qn1 > t31), 6.283185307179586, -6.283185307179586)
-    t200 = t199 + t31
+    t199 = casadi.if_else((t31 < qn1), 6.283185307179586, -6.283185307179586)
+    t200 = t31 + t199
     t201 = t31 - t199
     t202 = casadi.if_else(casadi.logic_and((t31 >= -3.141592653589793), (t31 <= 3.141592653589793)), t31, casadi.if_else(casadi.logic_and((t200 >= -3.141592653589793), (t200 <= 3.141592653589793)), t200, casadi.if_else(casadi.logic_and((t201 >= -3.141592653589793), (t201 <= 3.141592653589793)), t201, qb6_0)))
-    t203 = casadi.if_else((qn2 > t32), 6.283185307179586, -6.283185307179586)
-    t204 = t203 + t32
+    t203 = casadi.if_else((t32 < qn2), 6.283185307179586, -6.283185307179586)
+    t204 = t32 + t203
     t205 = t32 - t203
     t206 = casadi.if_else(casadi.logic_and((t32 >= -2.0943951023931953), (t32 <= 2.0943951023931953)), t32, casadi.if_else(casadi.logic_and((t204 >= -2.0943951023931953), (t204 <= 2.0943951023931953)), t204, casadi.if_else(casadi.logic_and((t205 >= -2.0943951023931953), (t205 <= 2.0943951023931953)), t205, qb6_1)))
-    t207 = casadi.if_else((qn3 > t33), 6.283185307179586, -6.283185307179586)
-    t208 = t207 + t33
+    t207 = casadi.if_else((t33 < qn3), 6.283185307179586, -6.283185307179586)
+    t208 = t33 + t207
     t209 = t33 - t207
     t210 = casadi.if_else(casadi.logic_and((t33 >= -2.0943951023931953), (t33 <= 2.0943951023931953)), t33, casadi.if_else(casadi.logic_and((t208 >= -2.0943951023931953), (t208 <= 2.0943951023931953)), t208, casadi.if_else(casadi.logic_and((t209 >= -2.0943951023931953), (t209 <= 2.0943951023931953)), t209, qb6_2)))
-    t211 = casadi.if_else((qn4 > t34), 6.283185307179586, -6.283185307179586)
-    t212 = t211 + t34
+    t211 = casadi.if_else((t34 < qn4), 6.283185307179586, -6.283185307179586)
+    t212 = t34 + t211
     t213 = t34 - t211
     t214 = casadi.if_else(casadi.logic_and((t34 >= -2.0943951023931953), (t34 <= 2.0943951023931953)), t34, casadi.if_else(casadi.logic_and((t212 >= -2.0943951023931953), (t212 <= 2.0943951023931953)), t212, casadi.if_else(casadi.logic_and((t213 >= -2.0943951023931953), (t213 <= 2.0943951023931953)), t213, qb6_3)))
     t215 = qw1*(t202 + t58)**2 + qw2*(t206 + t59)**2 + qw3*(t210 + t60)**2 + qw4*(t214 + t61)**2
@@ -1860,20 +1860,20 @@ def _ik_nearest(mu, q_seed, weights):
     t222 = casadi.if_else(t219, t210, t196)
     t223 = casadi.if_else(t219, t214, t197)
     t224 = casadi.if_else(t219, t215, t198)
-    t225 = casadi.if_else((qn1 > t36), 6.283185307179586, -6.283185307179586)
-    t226 = t225 + t36
+    t225 = casadi.if_else((t36 < qn1), 6.283185307179586, -6.283185307179586)
+    t226 = t36 + t225
     t227 = t36 - t225
     t228 = casadi.if_else(casadi.logic_and((t36 >= -3.141592653589793), (t36 <= 3.141592653589793)), t36, casadi.if_else(casadi.logic_and((t226 >= -3.141592653589793), (t226 <= 3.141592653589793)), t226, casadi.if_else(casadi.logic_and((t227 >= -3.141592653589793), (t227 <= 3.141592653589793)), t227, qb7_0)))
-    t229 = casadi.if_else((qn2 > t37), 6.283185307179586, -6.283185307179586)
-    t230 = t229 + t37
+    t229 = casadi.if_else((t37 < qn2), 6.283185307179586, -6.283185307179586)
+    t230 = t37 + t229
     t231 = t37 - t229
     t232 = casadi.if_else(casadi.logic_and((t37 >= -2.0943951023931953), (t37 <= 2.0943951023931953)), t37, casadi.if_else(casadi.logic_and((t230 >= -2.0943951023931953), (t230 <= 2.0943951023931953)), t230, casadi.if_else(casadi.logic_and((t231 >= -2.0943951023931953), (t231 <= 2.0943951023931953)), t231, qb7_1)))
-    t233 = casadi.if_else((qn3 > t38), 6.283185307179586, -6.283185307179586)
-    t234 = t233 + t38
+    t233 = casadi.if_else((t38 < qn3), 6.283185307179586, -6.283185307179586)
+    t234 = t38 + t233
     t235 = t38 - t233
     t236 = casadi.if_else(casadi.logic_and((t38 >= -2.0943951023931953), (t38 <= 2.0943951023931953)), t38, casadi.if_else(casadi.logic_and((t234 >= -2.0943951023931953), (t234 <= 2.0943951023931953)), t234, casadi.if_else(casadi.logic_and((t235 >= -2.0943951023931953), (t235 <= 2.0943951023931953)), t235, qb7_2)))
-    t237 = casadi.if_else((qn4 > t39), 6.283185307179586, -6.283185307179586)
-    t238 = t237 + t39
+    t237 = casadi.if_else((t39 < qn4), 6.283185307179586, -6.283185307179586)
+    t238 = t39 + t237
     t239 = t39 - t237
     t240 = casadi.if_else(casadi.logic_and((t39 >= -2.0943951023931953), (t39 <= 2.0943951023931953)), t39, casadi.if_else(casadi.logic_and((t238 >= -2.0943951023931953), (t238 <= 2.0943951023931953)), t238, casadi.if_else(casadi.logic_and((t239 >= -2.0943951023931953), (t239 <= 2.0943951023931953)), t239, qb7_3)))
     t241 = qw1*(t228 + t58)**2 + qw2*(t232 + t59)**2 + qw3*(t236 + t60)**2 + qw4*(t240 + t61)**2

@@ -167,7 +167,7 @@ void scara_fk_jacobian(const scara_real q[SCARA_DOF], scara_real T[16], scara_re
 
 void scara_jacobian_tool(const scara_real q[SCARA_DOF], scara_real J[6 * SCARA_DOF])
 {
-    /* 40 operations */
+    /* 38 operations */
 
     /* Inputs */
     const scara_real q1 = q[0];
@@ -195,8 +195,8 @@ void scara_jacobian_tool(const scara_real q[SCARA_DOF], scara_real J[6 * SCARA_D
     J[1] = t1*t2 - t0*t4;
     J[2] = 0;
     J[3] = 0;
-    J[4] = -t0*t3 - t1*t5;
-    J[5] = -t0*t2 - t1*t4;
+    J[4] = -(t0*t3 + t1*t5);
+    J[5] = -(t0*t2 + t1*t4);
     J[6] = 0;
     J[7] = 0;
     J[8] = 0;
@@ -316,10 +316,10 @@ void scara_fk_jacobian_dot(const scara_real q[SCARA_DOF], const scara_real q_dot
     const scara_real t4 = t3 + 0.325*c1;
     const scara_real t5 = 0.275*s12;
     const scara_real t6 = t5 + 0.325*s1;
-    const scara_real t7 = qd2*t5;
-    const scara_real t8 = t7 + qd1*t6;
-    const scara_real t9 = qd2*t3;
-    const scara_real t10 = t9 + qd1*t4;
+    const scara_real t7 = t5*qd2;
+    const scara_real t8 = t7 + t6*qd1;
+    const scara_real t9 = t3*qd2;
+    const scara_real t10 = t9 + t4*qd1;
 
     /* Outputs */
     T[0] = t1;
@@ -362,8 +362,8 @@ void scara_fk_jacobian_dot(const scara_real q[SCARA_DOF], const scara_real q_dot
     J[21] = 1;
     J[22] = 0;
     J[23] = -1;
-    a[0] = -qd1*t10 - qd2*(t9 + qd1*t3);
-    a[1] = -qd1*t8 - qd2*(t7 + qd1*t5);
+    a[0] = -t10*qd1 - qd2*(t9 + t3*qd1);
+    a[1] = -t8*qd1 - qd2*(t7 + t5*qd1);
     a[2] = 0;
     a[3] = 0;
     a[4] = 0;
@@ -372,7 +372,7 @@ void scara_fk_jacobian_dot(const scara_real q[SCARA_DOF], const scara_real q_dot
 
 void scara_jacobian_dot(const scara_real q[SCARA_DOF], const scara_real q_dot[SCARA_DOF], scara_real Jd[6 * SCARA_DOF])
 {
-    /* 30 operations */
+    /* 28 operations */
 
     /* Inputs */
     const scara_real q1 = q[0];
@@ -391,18 +391,18 @@ void scara_jacobian_dot(const scara_real q[SCARA_DOF], const scara_real q_dot[SC
     const scara_real t1 = t0 + 0.325*c1;
     const scara_real t2 = 0.275*s12;
     const scara_real t3 = t2 + 0.325*s1;
-    const scara_real t4 = qd2*t2;
-    const scara_real t5 = t4 + qd1*t3;
-    const scara_real t6 = qd2*t0;
-    const scara_real t7 = t6 + qd1*t1;
+    const scara_real t4 = t2*qd2;
+    const scara_real t5 = t4 + t3*qd1;
+    const scara_real t6 = t0*qd2;
+    const scara_real t7 = t6 + t1*qd1;
 
     /* Outputs */
     Jd[0] = -t7;
-    Jd[1] = -t6 - qd1*t0;
+    Jd[1] = -(t6 + t0*qd1);
     Jd[2] = 0;
     Jd[3] = 0;
     Jd[4] = -t5;
-    Jd[5] = -t4 - qd1*t2;
+    Jd[5] = -(t4 + t2*qd1);
     Jd[6] = 0;
     Jd[7] = 0;
     Jd[8] = 0;
@@ -444,14 +444,14 @@ void scara_bias_acceleration(const scara_real q[SCARA_DOF], const scara_real q_d
     const scara_real t1 = t0 + 0.325*c1;
     const scara_real t2 = 0.275*s12;
     const scara_real t3 = t2 + 0.325*s1;
-    const scara_real t4 = qd2*t2;
-    const scara_real t5 = t4 + qd1*t3;
-    const scara_real t6 = qd2*t0;
-    const scara_real t7 = t6 + qd1*t1;
+    const scara_real t4 = t2*qd2;
+    const scara_real t5 = t4 + t3*qd1;
+    const scara_real t6 = t0*qd2;
+    const scara_real t7 = t6 + t1*qd1;
 
     /* Outputs */
-    a[0] = -qd1*t7 - qd2*(t6 + qd1*t0);
-    a[1] = -qd1*t5 - qd2*(t4 + qd1*t2);
+    a[0] = -t7*qd1 - qd2*(t6 + t0*qd1);
+    a[1] = -t5*qd1 - qd2*(t4 + t2*qd1);
     a[2] = 0;
     a[3] = 0;
     a[4] = 0;
@@ -479,12 +479,12 @@ void scara_task_jacobian_dot(const scara_real q[SCARA_DOF], const scara_real q_d
     const scara_real t1 = t0 + 0.325*c1;
     const scara_real t2 = 0.275*s12;
     const scara_real t3 = t2 + 0.325*s1;
-    const scara_real t4 = qd2*t2;
-    const scara_real t5 = t4 + qd1*t3;
-    const scara_real t6 = t4 + qd1*t2;
-    const scara_real t7 = qd2*t0;
-    const scara_real t8 = t7 + qd1*t1;
-    const scara_real t9 = t7 + qd1*t0;
+    const scara_real t4 = t2*qd2;
+    const scara_real t5 = t4 + t3*qd1;
+    const scara_real t6 = t4 + t2*qd1;
+    const scara_real t7 = t0*qd2;
+    const scara_real t8 = t7 + t1*qd1;
+    const scara_real t9 = t7 + t0*qd1;
 
     /* Outputs */
     Jd[0] = -t8;
@@ -659,7 +659,7 @@ scara_real scara_manipulability(const scara_real q[SCARA_DOF])
     const scara_real t1 = t0 + 0.325*c1;
     const scara_real t2 = 0.275*s12;
     const scara_real t3 = t2 + 0.325*s1;
-    const scara_real t4 = t1*t2 - t0*t3;
+    const scara_real t4 = t1*t2 - t3*t0;
 
     /* Outputs */
     return fabs(t4);
@@ -686,7 +686,7 @@ scara_real scara_jacobian_det(const scara_real q[SCARA_DOF])
     const scara_real t3 = t2 + 0.325*s1;
 
     /* Outputs */
-    return t1*t2 - t0*t3;
+    return t1*t2 - t3*t0;
 }
 
 int scara_velocity_ik(const scara_real q[SCARA_DOF], const scara_real mu_dot[SCARA_TASK_DIM], scara_real damping, scara_real q_dot[SCARA_DOF])
@@ -715,7 +715,7 @@ int scara_velocity_ik(const scara_real q[SCARA_DOF], const scara_real mu_dot[SCA
     const scara_real t2 = 0.275*s12;
     const scara_real t3 = t2 + 0.325*s1;
     const scara_real t4 = t1*t3 + 0.075625*c12*s12;
-    const scara_real t5 = t2 + t3;
+    const scara_real t5 = t3 + t2;
     const scara_real t6 = (t3*t3);
     const scara_real t7 = t6 + 0.075625*(s12*s12);
     const scara_real t8 = t7;
@@ -726,70 +726,70 @@ int scara_velocity_ik(const scara_real q[SCARA_DOF], const scara_real mu_dot[SCA
     const scara_real t13 = -1 + t12;
     const scara_real t14 = t9 + 0.075625*(c12*c12);
     const scara_real t15 = t14;
-    const scara_real t16 = sqrt(4 + t14 + t7);
-    const scara_real t17 = t0 + t1;
+    const scara_real t16 = sqrt(4 + t7 + t14);
+    const scara_real t17 = t1 + t0;
     const scara_real t18 = t17;
     const scara_real t19 = (t4*t4);
     const scara_real t20 = (t5*t5);
     const scara_real t21 = (damping*damping);
-    const scara_real t22 = t21 + t8;
+    const scara_real t22 = t8 + t21;
     const scara_real t23 = (t22*t22);
-    const scara_real t24 = sqrt(t19 + t20 + t23);
+    const scara_real t24 = sqrt(t23 + t19 + t20);
     const scara_real t25 = t24*(t22 >= 0 ? 1 : -1);
-    const scara_real t26 = t22 + t25;
+    const scara_real t26 = t25 + t22;
     const scara_real t27 = (t24 > 0 ? 1/(t24*(t24 + fabs(t22))) : 0);
-    const scara_real t28 = -t27*(mu_dot1*t4 + mu_dot3*t5 - mu_dot0*t26);
+    const scara_real t28 = -t27*(t4*mu_dot1 + t5*mu_dot3 - t26*mu_dot0);
     const scara_real t29 = mu_dot0 - t26*t28;
-    const scara_real t30 = mu_dot1 + t28*t4;
-    const scara_real t31 = mu_dot3 + t28*t5;
+    const scara_real t30 = mu_dot1 + t4*t28;
+    const scara_real t31 = mu_dot3 + t5*t28;
     const scara_real t32 = t15 + t21;
-    const scara_real t33 = -t27*(t18*t5 + t26*t4 + t32*t4);
+    const scara_real t33 = -t27*(t4*t26 + t4*t32 + t5*t18);
     const scara_real t34 = t4 + t26*t33;
-    const scara_real t35 = t32 + t33*t4;
-    const scara_real t36 = t18 + t33*t5;
+    const scara_real t35 = t32 + t4*t33;
+    const scara_real t36 = t18 + t5*t33;
     const scara_real t37 = sqrt((t35*t35) + (t36*t36));
     const scara_real t38 = t37*(t35 >= 0 ? 1 : -1);
     const scara_real t39 = t35 + t38;
     const scara_real t40 = (t37 > 0 ? 1/(t37*(t37 + fabs(t35))) : 0);
-    const scara_real t41 = t40*(t30*t39 + t31*t36);
+    const scara_real t41 = t40*(t36*t31 + t30*t39);
     const scara_real t42 = t30 - t39*t41;
     const scara_real t43 = t31 - t36*t41;
     const scara_real t44 = 1 + t21;
     const scara_real t45 = t44;
     const scara_real t46 = 3 + t21;
-    const scara_real t47 = sqrt(t23 + 2*t19 + 2*t20 + 2*(t18*t18) + (t32*t32) + (t44*t44) + (t46*t46));
-    const scara_real t48 = -t27*(t18*t4 + t26*t5 + t46*t5);
+    const scara_real t47 = sqrt(t23 + (t32*t32) + (t44*t44) + (t46*t46) + 2*t19 + 2*t20 + 2*(t18*t18));
+    const scara_real t48 = -t27*(t4*t18 + t5*t26 + t5*t46);
     const scara_real t49 = t5 + t26*t48;
     const scara_real t50 = t18 + t4*t48;
-    const scara_real t51 = t46 + t48*t5;
-    const scara_real t52 = t40*(t36*t51 + t39*t50);
+    const scara_real t51 = t46 + t5*t48;
+    const scara_real t52 = t40*(t36*t51 + t50*t39);
     const scara_real t53 = t50 - t39*t52;
     const scara_real t54 = t51 - t36*t52;
     const scara_real t55 = fabs(t45);
     const scara_real t56 = t55;
     const scara_real t57 = t56*(t45 >= 0 ? 1 : -1);
     const scara_real t58 = t45 + t57;
-    const scara_real t59 = (t56 > 0 ? 1/(t56*(t55 + t56)) : 0);
-    const scara_real t60 = mu_dot2 - mu_dot2*t59*(t58*t58);
+    const scara_real t59 = (t56 > 0 ? 1/(t56*(t56 + t55)) : 0);
+    const scara_real t60 = mu_dot2 - t59*mu_dot2*(t58*t58);
     const scara_real t61 = (t57 != 0 ? -t60/t57 : 0);
     const scara_real t62 = fabs(t54);
     const scara_real t63 = t62;
     const scara_real t64 = t63*(t54 >= 0 ? 1 : -1);
     const scara_real t65 = t54 + t64;
-    const scara_real t66 = (t63 > 0 ? 1/(t63*(t62 + t63)) : 0);
+    const scara_real t66 = (t63 > 0 ? 1/(t63*(t63 + t62)) : 0);
     const scara_real t67 = t43 - t43*t66*(t65*t65);
     const scara_real t68 = (t64 != 0 ? -t67/t64 : 0);
     const scara_real t69 = (t38 != 0 ? -(t42 - t53*t68)/t38 : 0);
     const scara_real t70 = (t25 != 0 ? -(t29 + t34*t69 + t49*t68)/t25 : 0);
-    const scara_real t71 = t68 + t1*t69 - t3*t70;
-    const scara_real t72 = t68 + t0*t69 - t2*t70;
+    const scara_real t71 = t68 + t1*t69 - t70*t3;
+    const scara_real t72 = t68 + t69*t0 - t70*t2;
     const scara_real t73 = -t3;
     const scara_real t74 = t11 + t73;
-    const scara_real t75 = t12*(1 + t0*t1 - t2*t74);
+    const scara_real t75 = t12*(1 + t1*t0 - t74*t2);
     const scara_real t76 = t2 + t74*t75;
     const scara_real t77 = t0 - t1*t75;
     const scara_real t78 = 1 - t75;
-    const scara_real t79 = t12*(mu_dot3 + mu_dot0*t74 + mu_dot1*t1);
+    const scara_real t79 = t12*(mu_dot3 + t1*mu_dot1 + t74*mu_dot0);
     const scara_real t80 = mu_dot0 - t74*t79;
     const scara_real t81 = mu_dot1 - t1*t79;
     const scara_real t82 = mu_dot3 - t79;
@@ -800,20 +800,20 @@ int scara_velocity_ik(const scara_real q[SCARA_DOF], const scara_real mu_dot[SCA
     const scara_real t87 = t86*(t78*t82 + t81*t85);
     const scara_real t88 = t81 - t85*t87;
     const scara_real t89 = t82 - t78*t87;
-    const scara_real t90 = damping + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + q1 + q2 + q3 + q4 + t17 + t73 - t2;
+    const scara_real t90 = t73 + t17 + damping + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + q1 + q2 + q3 + q4 - t2;
     const scara_real t91 = t1*t12;
-    const scara_real t92 = t86*(t13*t78 + t85*t91);
+    const scara_real t92 = t86*(t78*t13 + t85*t91);
     const scara_real t93 = t91 - t85*t92;
     const scara_real t94 = t13 - t78*t92;
     const scara_real t95 = fabs(t94);
     const scara_real t96 = t95;
     const scara_real t97 = t96*(t94 >= 0 ? 1 : -1);
     const scara_real t98 = t94 + t97;
-    const scara_real t99 = (t96 > 0 ? 1/(t96*(t95 + t96)) : 0);
+    const scara_real t99 = (t96 > 0 ? 1/(t96*(t96 + t95)) : 0);
     const scara_real t100 = t89 - t89*t99*(t98*t98);
     const scara_real t101 = (t97 != 0 ? -t100/t97 : 0);
-    const scara_real t102 = (t84 != 0 ? -(t88 - t101*t93)/t84 : 0);
-    const scara_real t103 = (t11 != 0 ? -(t80 + t102*t76 - t101*t12*t74)/t11 : 0);
+    const scara_real t102 = (t84 != 0 ? -(t88 - t93*t101)/t84 : 0);
+    const scara_real t103 = (t11 != 0 ? -(t80 - (-t102*t76 + t74*t12*t101))/t11 : 0);
     const int t104 = damping > 0;
     const int t105 = isfinite(t90);
     const int t106 = damping >= 0;
@@ -865,52 +865,52 @@ scara_real scara_ik_numeric_step(const scara_real target[SCARA_TASK_DIM], const 
     const scara_real t5 = mu0 + mu1 + mu2 + mu3 + qs1 + qs2 + qs3 + qs4;
     const scara_real t6 = 0.275*c12;
     const scara_real t7 = t6 + 0.325*c1;
-    const scara_real t8 = 0.075625*(c12*c12) + (t7*t7);
-    const scara_real t9 = t6 + t7;
+    const scara_real t8 = (t7*t7) + 0.075625*(c12*c12);
+    const scara_real t9 = t7 + t6;
     const scara_real t10 = mu0 - t7;
     const scara_real t11 = 0.275*s12;
     const scara_real t12 = t11 + 0.325*s1;
-    const scara_real t13 = 0.075625*(s12*s12) + (t12*t12);
-    const scara_real t14 = t12*t7 + 0.075625*c12*s12;
-    const scara_real t15 = t11 + t12;
+    const scara_real t13 = (t12*t12) + 0.075625*(s12*s12);
+    const scara_real t14 = t7*t12 + 0.075625*c12*s12;
+    const scara_real t15 = t12 + t11;
     const scara_real t16 = mu1 - t12;
     const scara_real t17 = -mu3 + atan2(t2, t1);
-    const scara_real t18 = t17 + 6.283185307179586*ceil(-0.5 - 0.15915494309189535*t17);
-    const scara_real t19 = (t10*t10) + (t16*t16) + (t18*t18) + (t3*t3);
-    const scara_real t20 = damping + t13;
+    const scara_real t18 = t17 + 6.283185307179586*ceil(-0.15915494309189535*(3.141592653589793 + t17));
+    const scara_real t19 = (t10*t10) + (t16*t16) + (t3*t3) + (t18*t18);
+    const scara_real t20 = t13 + damping;
     const scara_real t21 = sqrt((t14*t14) + (t15*t15) + (t20*t20));
     const scara_real t22 = t21*(t20 >= 0 ? 1 : -1);
-    const scara_real t23 = t20 + t22;
+    const scara_real t23 = t22 + t20;
     const scara_real t24 = (t21 > 0 ? 1/(t21*(t21 + fabs(t20))) : 0);
-    const scara_real t25 = t24*(t10*t23 + t15*t18 - t14*t16);
+    const scara_real t25 = t24*(t10*t23 + t18*t15 - t16*t14);
     const scara_real t26 = t10 - t23*t25;
-    const scara_real t27 = t16 + t14*t25;
-    const scara_real t28 = -t18 + t15*t25;
-    const scara_real t29 = damping + t8;
-    const scara_real t30 = -t24*(t14*t23 + t14*t29 + t15*t9);
+    const scara_real t27 = t16 + t25*t14;
+    const scara_real t28 = -t18 + t25*t15;
+    const scara_real t29 = t8 + damping;
+    const scara_real t30 = -t24*(t23*t14 + t14*t29 + t15*t9);
     const scara_real t31 = t14 + t23*t30;
-    const scara_real t32 = t29 + t14*t30;
-    const scara_real t33 = t9 + t15*t30;
+    const scara_real t32 = t29 + t30*t14;
+    const scara_real t33 = t9 + t30*t15;
     const scara_real t34 = sqrt((t32*t32) + (t33*t33));
     const scara_real t35 = t34*(t32 >= 0 ? 1 : -1);
     const scara_real t36 = t32 + t35;
     const scara_real t37 = (t34 > 0 ? 1/(t34*(t34 + fabs(t32))) : 0);
-    const scara_real t38 = t37*(t27*t36 + t28*t33);
+    const scara_real t38 = t37*(t33*t28 + t27*t36);
     const scara_real t39 = t27 - t36*t38;
     const scara_real t40 = t28 - t33*t38;
     const scara_real t41 = 3 + damping;
-    const scara_real t42 = -t24*(t14*t9 + t15*t23 + t15*t41);
+    const scara_real t42 = -t24*(t23*t15 + t14*t9 + t15*t41);
     const scara_real t43 = t15 + t23*t42;
-    const scara_real t44 = t9 + t14*t42;
-    const scara_real t45 = t41 + t15*t42;
-    const scara_real t46 = t37*(t33*t45 + t36*t44);
+    const scara_real t44 = t9 + t42*t14;
+    const scara_real t45 = t41 + t42*t15;
+    const scara_real t46 = t37*(t33*t45 + t44*t36);
     const scara_real t47 = t44 - t36*t46;
     const scara_real t48 = t45 - t33*t46;
     const scara_real t49 = fabs(t4);
     const scara_real t50 = t49;
     const scara_real t51 = t50*(t4 >= 0 ? 1 : -1);
     const scara_real t52 = t4 + t51;
-    const scara_real t53 = (t50 > 0 ? 1/(t50*(t49 + t50)) : 0);
+    const scara_real t53 = (t50 > 0 ? 1/(t50*(t50 + t49)) : 0);
     const scara_real t54 = t3 - t3*t53*(t52*t52);
     const scara_real t55 = (t51 != 0 ? -t54/t51 : 0);
     const scara_real t56 = q3 - t55;
@@ -918,13 +918,13 @@ scara_real scara_ik_numeric_step(const scara_real target[SCARA_TASK_DIM], const 
     const scara_real t58 = t57;
     const scara_real t59 = t58*(t48 >= 0 ? 1 : -1);
     const scara_real t60 = t48 + t59;
-    const scara_real t61 = (t58 > 0 ? 1/(t58*(t57 + t58)) : 0);
+    const scara_real t61 = (t58 > 0 ? 1/(t58*(t58 + t57)) : 0);
     const scara_real t62 = t40 - t40*t61*(t60*t60);
     const scara_real t63 = (t59 != 0 ? -t62/t59 : 0);
     const scara_real t64 = (t35 != 0 ? -(t39 - t47*t63)/t35 : 0);
     const scara_real t65 = (t22 != 0 ? -(t26 + t31*t64 + t43*t63)/t22 : 0);
-    const scara_real t66 = q1 + t63 + t64*t7 - t12*t65;
-    const scara_real t67 = q2 + t63 + t6*t64 - t11*t65;
+    const scara_real t66 = t63 + q1 + t64*t7 - t65*t12;
+    const scara_real t67 = t63 + q2 + t64*t6 - t65*t11;
     const scara_real t68 = q4 - t63;
 
     /* Outputs */
@@ -941,7 +941,7 @@ scara_real scara_ik_numeric_step(const scara_real target[SCARA_TASK_DIM], const 
 
 void scara_ik_branches(const scara_real mu[SCARA_TASK_DIM], scara_real q[SCARA_MAX_IK_SOLUTIONS * SCARA_DOF], int valid[SCARA_MAX_IK_SOLUTIONS], int in_limits[SCARA_MAX_IK_SOLUTIONS])
 {
-    /* 202 operations */
+    /* 198 operations */
 
     /* Inputs */
     const scara_real mu0 = mu[0];
@@ -951,7 +951,7 @@ void scara_ik_branches(const scara_real mu[SCARA_TASK_DIM], scara_real q[SCARA_M
 
     /* Intermediate terms */
     const scara_real t0 = 0.149769 + (mu0*mu0) + (mu1*mu1);
-    const scara_real t1 = 0.1655095 - 0.5*t0;
+    const scara_real t1 = 0.5*(0.331019 - t0);
     const scara_real t2 = mu0 + mu1 + mu2 + mu3;
     const scara_real t3 = (t1*t1);
     const scara_real t4 = 1 - 125.18949581886645*t3;
@@ -962,42 +962,42 @@ void scara_ik_branches(const scara_real mu[SCARA_TASK_DIM], scara_real q[SCARA_M
     const scara_real t9 = atan2(t8, t7);
     const scara_real t10 = 3.141592653589793 + t9;
     const scara_real t11 = 3.141592653589793 - t9;
-    const scara_real t12 = t10 - 6.283185307179586*ceil(-0.5 + 0.15915494309189535*t10);
-    const scara_real t13 = t12 - 6.283185307179586*floor(0.24444444444444444 + 0.15915494309189535*t12);
-    const scara_real t14 = t11 - 6.283185307179586*ceil(-0.5 + 0.15915494309189535*t11);
-    const scara_real t15 = t14 - 6.283185307179586*floor(0.24444444444444444 + 0.15915494309189535*t14);
+    const scara_real t12 = t10 - 6.283185307179586*ceil(0.15915494309189535*(-3.141592653589793 + t10));
+    const scara_real t13 = t12 - 6.283185307179586*floor(0.15915494309189535*(1.53588974175501 + t12));
+    const scara_real t14 = t11 - 6.283185307179586*ceil(0.15915494309189535*(-3.141592653589793 + t11));
+    const scara_real t15 = t14 - 6.283185307179586*floor(0.15915494309189535*(1.53588974175501 + t14));
     const scara_real t16 = -1.0*t7;
     const scara_real t17 = -1.0*t8;
     const scara_real t18 = 0.325 + 0.275*t16;
-    const scara_real t19 = 0.149769 + 0.075625*(t17*t17) + (t18*t18);
+    const scara_real t19 = 0.149769 + (t18*t18) + 0.075625*(t17*t17);
     const scara_real t20 = 0.275*t17;
-    const scara_real t21 = 0.149769 + mu0*t18 + mu1*t20;
+    const scara_real t21 = 0.149769 + t18*mu0 + t20*mu1;
     const scara_real t22 = -0.149769 + t21;
-    const scara_real t23 = mu1*t18 - mu0*t20;
+    const scara_real t23 = t18*mu1 - t20*mu0;
     const scara_real t24 = (t22*t22) + (t23*t23);
     const scara_real t25 = 0.325 - 0.275*t7;
-    const scara_real t26 = 0.149769 + 0.075625*(t8*t8) + (t25*t25);
+    const scara_real t26 = 0.149769 + (t25*t25) + 0.075625*(t8*t8);
     const scara_real t27 = 0.275*t8;
-    const scara_real t28 = 0.149769 + mu0*t25 + mu1*t27;
+    const scara_real t28 = 0.149769 + t25*mu0 + t27*mu1;
     const scara_real t29 = -0.149769 + t28;
-    const scara_real t30 = mu1*t25 - mu0*t27;
+    const scara_real t30 = t25*mu1 - t27*mu0;
     const scara_real t31 = (t29*t29) + (t30*t30);
     const scara_real t32 = 1e-24*t0;
     const scara_real t33 = (t24 <= t19*t32 ? 0 : atan2(t23, t22));
     const scara_real t34 = t33;
-    const scara_real t35 = t34 - 6.283185307179586*floor(0.1388888888888889 + 0.15915494309189535*t34);
+    const scara_real t35 = t34 - 6.283185307179586*floor(0.15915494309189535*(0.8726646259971648 + t34));
     const scara_real t36 = -mu3;
-    const scara_real t37 = -t10 - t33 - t36;
-    const scara_real t38 = t37 + 6.283185307179586*ceil(-0.5 - 0.15915494309189535*t37);
+    const scara_real t37 = -(t10 + t33 + t36);
+    const scara_real t38 = t37 + 6.283185307179586*ceil(-0.15915494309189535*(3.141592653589793 + t37));
     const scara_real t39 = -t38;
-    const scara_real t40 = t38 + 6.283185307179586*floor(1.0 + 0.15915494309189535*t39);
+    const scara_real t40 = t38 + 6.283185307179586*floor(0.15915494309189535*(6.283185307179586 + t39));
     const scara_real t41 = (t31 <= t26*t32 ? 0 : atan2(t30, t29));
     const scara_real t42 = t41;
-    const scara_real t43 = t42 - 6.283185307179586*floor(0.1388888888888889 + 0.15915494309189535*t42);
-    const scara_real t44 = -t11 - t36 - t41;
-    const scara_real t45 = t44 + 6.283185307179586*ceil(-0.5 - 0.15915494309189535*t44);
+    const scara_real t43 = t42 - 6.283185307179586*floor(0.15915494309189535*(0.8726646259971648 + t42));
+    const scara_real t44 = -(t11 + t36 + t41);
+    const scara_real t45 = t44 + 6.283185307179586*ceil(-0.15915494309189535*(3.141592653589793 + t44));
     const scara_real t46 = -t45;
-    const scara_real t47 = t45 + 6.283185307179586*floor(1.0 + 0.15915494309189535*t46);
+    const scara_real t47 = t45 + 6.283185307179586*floor(0.15915494309189535*(6.283185307179586 + t46));
     const int t48 = t35 <= 0.8726646259971648;
     const int t49 = t34 >= -0.8726646259971648 && t34 <= 0.8726646259971648;
     const int t50 = t13 <= 1.53588974175501;
@@ -1022,7 +1022,7 @@ void scara_ik_branches(const scara_real mu[SCARA_TASK_DIM], scara_real q[SCARA_M
     q[5] = (t56 && !t57 ? t15 : t14);
     q[6] = t52;
     q[7] = (t47 >= -6.283185307179586 && !(t45 >= -6.283185307179586 && t45 <= 6.283185307179586) ? t58 : t46);
-    valid[0] = t59 && t4 >= -1e-12;
+    valid[0] = t59 && ((t4 >= -1e-12) || (0 && t3 <= 1.931417125e-14));
     valid[1] = t59 && t4 > 1e-12;
     in_limits[0] = t60 && t61 && (t48 || t49) && (t50 || t51) && ((t53 <= 6.283185307179586) || (t39 >= -6.283185307179586 && t39 <= 6.283185307179586));
     in_limits[1] = t60 && t61 && (t54 || t55) && (t56 || t57) && ((t58 <= 6.283185307179586) || (t46 >= -6.283185307179586 && t46 <= 6.283185307179586));
@@ -1073,42 +1073,42 @@ int scara_ik_nearest(const scara_real mu[SCARA_TASK_DIM], const scara_real q_see
     const scara_real t7 = qb1_3 + 6.283185307179586*floor(0.5 + 0.15915494309189535*(qn4 - qb1_3));
     const scara_real t8 = (lb1 && vb1 ? 1 : 0);
     const scara_real t9 = mu0 + mu1 + mu2 + mu3 + qn1 + qn2 + qn3 + qn4 + qw1 + qw2 + qw3 + qw4;
-    const scara_real t10 = (qn1 > t0 ? 6.283185307179586 : -6.283185307179586);
+    const scara_real t10 = (t0 < qn1 ? 6.283185307179586 : -6.283185307179586);
     const scara_real t11 = t0 + t10;
     const scara_real t12 = t0 - t10;
     const scara_real t13 = (t0 >= -0.8726646259971648 && t0 <= 0.8726646259971648 ? t0 : (t11 >= -0.8726646259971648 && t11 <= 0.8726646259971648 ? t11 : (t12 >= -0.8726646259971648 && t12 <= 0.8726646259971648 ? t12 : qb0_0)));
-    const scara_real t14 = (qn2 > t1 ? 6.283185307179586 : -6.283185307179586);
+    const scara_real t14 = (t1 < qn2 ? 6.283185307179586 : -6.283185307179586);
     const scara_real t15 = t1 + t14;
     const scara_real t16 = t1 - t14;
     const scara_real t17 = (t1 >= -1.53588974175501 && t1 <= 1.53588974175501 ? t1 : (t15 >= -1.53588974175501 && t15 <= 1.53588974175501 ? t15 : (t16 >= -1.53588974175501 && t16 <= 1.53588974175501 ? t16 : qb0_1)));
-    const scara_real t18 = (qn4 > t2 ? 6.283185307179586 : -6.283185307179586);
-    const scara_real t19 = t18 + t2;
+    const scara_real t18 = (t2 < qn4 ? 6.283185307179586 : -6.283185307179586);
+    const scara_real t19 = t2 + t18;
     const scara_real t20 = t2 - t18;
     const scara_real t21 = (t2 >= -6.283185307179586 && t2 <= 6.283185307179586 ? t2 : (t19 >= -6.283185307179586 && t19 <= 6.283185307179586 ? t19 : (t20 >= -6.283185307179586 && t20 <= 6.283185307179586 ? t20 : qb0_3)));
     const scara_real t22 = -qn1;
     const scara_real t23 = -qn2;
     const scara_real t24 = -qn3;
     const scara_real t25 = -qn4;
-    const scara_real t26 = qw1*((t13 + t22)*(t13 + t22)) + qw2*((t17 + t23)*(t17 + t23)) + qw3*((qb0_2 + t24)*(qb0_2 + t24)) + qw4*((t21 + t25)*(t21 + t25));
+    const scara_real t26 = qw1*((t13 + t22)*(t13 + t22)) + qw2*((t17 + t23)*(t17 + t23)) + qw3*((t24 + qb0_2)*(t24 + qb0_2)) + qw4*((t21 + t25)*(t21 + t25));
     const int t27 = t4 > 0;
     const scara_real t28 = (t27 ? t13 : qn1);
     const scara_real t29 = (t27 ? t17 : qn2);
     const scara_real t30 = (t27 ? qb0_2 : qn3);
     const scara_real t31 = (t27 ? t21 : qn4);
     const scara_real t32 = (t27 ? t26 : 0);
-    const scara_real t33 = (qn1 > t5 ? 6.283185307179586 : -6.283185307179586);
-    const scara_real t34 = t33 + t5;
+    const scara_real t33 = (t5 < qn1 ? 6.283185307179586 : -6.283185307179586);
+    const scara_real t34 = t5 + t33;
     const scara_real t35 = t5 - t33;
     const scara_real t36 = (t5 >= -0.8726646259971648 && t5 <= 0.8726646259971648 ? t5 : (t34 >= -0.8726646259971648 && t34 <= 0.8726646259971648 ? t34 : (t35 >= -0.8726646259971648 && t35 <= 0.8726646259971648 ? t35 : qb1_0)));
-    const scara_real t37 = (qn2 > t6 ? 6.283185307179586 : -6.283185307179586);
-    const scara_real t38 = t37 + t6;
+    const scara_real t37 = (t6 < qn2 ? 6.283185307179586 : -6.283185307179586);
+    const scara_real t38 = t6 + t37;
     const scara_real t39 = t6 - t37;
     const scara_real t40 = (t6 >= -1.53588974175501 && t6 <= 1.53588974175501 ? t6 : (t38 >= -1.53588974175501 && t38 <= 1.53588974175501 ? t38 : (t39 >= -1.53588974175501 && t39 <= 1.53588974175501 ? t39 : qb1_1)));
-    const scara_real t41 = (qn4 > t7 ? 6.283185307179586 : -6.283185307179586);
-    const scara_real t42 = t41 + t7;
+    const scara_real t41 = (t7 < qn4 ? 6.283185307179586 : -6.283185307179586);
+    const scara_real t42 = t7 + t41;
     const scara_real t43 = t7 - t41;
     const scara_real t44 = (t7 >= -6.283185307179586 && t7 <= 6.283185307179586 ? t7 : (t42 >= -6.283185307179586 && t42 <= 6.283185307179586 ? t42 : (t43 >= -6.283185307179586 && t43 <= 6.283185307179586 ? t43 : qb1_3)));
-    const scara_real t45 = qw1*((t22 + t36)*(t22 + t36)) + qw2*((t23 + t40)*(t23 + t40)) + qw3*((qb1_2 + t24)*(qb1_2 + t24)) + qw4*((t25 + t44)*(t25 + t44));
+    const scara_real t45 = qw1*((t36 + t22)*(t36 + t22)) + qw2*((t40 + t23)*(t40 + t23)) + qw3*((t24 + qb1_2)*(t24 + qb1_2)) + qw4*((t44 + t25)*(t44 + t25));
     const int t46 = t8 > 0;
     const scara_real t47 = (t46 && ((t32 > t45) || (t4 < 1)) ? 1 : 0);
     const scara_real t48 = (t46 ? 1 : t4);

@@ -45,7 +45,7 @@ void scara_jacobian(const scara_real q[SCARA_DOF], scara_real J[6 * SCARA_DOF]);
 void scara_fk_jacobian(const scara_real q[SCARA_DOF], scara_real T[16], scara_real J[6 * SCARA_DOF]);
 
 /* Geometric Jacobian in the tool frame (6 x DOF, rows vx vy vz wx wy wz).
- * Result: J: 6 x 4 row-major, element (r, c) at J[r * 4 + c]. 40 operations. */
+ * Result: J: 6 x 4 row-major, element (r, c) at J[r * 4 + c]. 38 operations. */
 void scara_jacobian_tool(const scara_real q[SCARA_DOF], scara_real J[6 * SCARA_DOF]);
 
 /* Task vector mu = (x, y, z, yaw).
@@ -61,7 +61,7 @@ void scara_task_jacobian(const scara_real q[SCARA_DOF], scara_real J[SCARA_TASK_
 void scara_fk_jacobian_dot(const scara_real q[SCARA_DOF], const scara_real q_dot[SCARA_DOF], scara_real T[16], scara_real J[6 * SCARA_DOF], scara_real a[6]);
 
 /* Time derivative dJ/dt of the world geometric Jacobian along q_dot (6 x DOF).
- * Result: Jd: 6 x 4 row-major, element (r, c) at Jd[r * 4 + c]. 30 operations. */
+ * Result: Jd: 6 x 4 row-major, element (r, c) at Jd[r * 4 + c]. 28 operations. */
 void scara_jacobian_dot(const scara_real q[SCARA_DOF], const scara_real q_dot[SCARA_DOF], scara_real Jd[6 * SCARA_DOF]);
 
 /* J' q_dot: the tool's classical linear and angular acceleration at zero joint acceleration, world frame (6).
@@ -97,7 +97,7 @@ int scara_velocity_ik(const scara_real q[SCARA_DOF], const scara_real mu_dot[SCA
 scara_real scara_ik_numeric_step(const scara_real target[SCARA_TASK_DIM], const scara_real q[SCARA_DOF], scara_real damping, scara_real q_start[SCARA_DOF], scara_real q_next[SCARA_DOF]);
 
 /* Every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits.
- * Result: q: 2 x 4 row-major, element (r, c) at q[r * 4 + c]; valid[i], i < 2; in_limits[i], i < 2. 202 operations. */
+ * Result: q: 2 x 4 row-major, element (r, c) at q[r * 4 + c]; valid[i], i < 2; in_limits[i], i < 2. 198 operations. */
 void scara_ik_branches(const scara_real mu[SCARA_TASK_DIM], scara_real q[SCARA_MAX_IK_SOLUTIONS * SCARA_DOF], int valid[SCARA_MAX_IK_SOLUTIONS], int in_limits[SCARA_MAX_IK_SOLUTIONS]);
 
 /* The closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status.

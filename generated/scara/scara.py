@@ -219,7 +219,7 @@ def fk_jacobian(q):
 
 
 def jacobian_tool(q):
-    """geometric Jacobian in the tool frame (6 x DOF, rows vx vy vz wx wy wz): (6 x 4), 40 operations."""
+    """geometric Jacobian in the tool frame (6 x DOF, rows vx vy vz wx wy wz): (6 x 4), 38 operations."""
     xp, dtype, device, batch, (q,) = _arguments(("q", q, (4,)))
     trig = _cos_sin(xp, q, (0.0, 0.0, 0.0, 0.0), device)
     c1 = trig[..., 0]
@@ -241,8 +241,8 @@ def jacobian_tool(q):
         t1*t2 - t0*t4,  # 0, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 3
-        -t0*t3 - t1*t5,  # 1, 0
-        -t0*t2 - t1*t4,  # 1, 1
+        -(t0*t3 + t1*t5),  # 1, 0
+        -(t0*t2 + t1*t4),  # 1, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
@@ -349,10 +349,10 @@ def fk_jacobian_dot(q, q_dot):
     t4 = t3 + 0.325*c1
     t5 = 0.275*s12
     t6 = t5 + 0.325*s1
-    t7 = qd2*t5
-    t8 = t7 + qd1*t6
-    t9 = qd2*t3
-    t10 = t9 + qd1*t4
+    t7 = t5*qd2
+    t8 = t7 + t6*qd1
+    t9 = t3*qd2
+    t10 = t9 + t4*qd1
     T = _stack(xp, [
         xp.broadcast_to(t1, batch),  # 0, 0
         xp.broadcast_to(t2, batch),  # 0, 1
@@ -398,8 +398,8 @@ def fk_jacobian_dot(q, q_dot):
         xp.full(batch, -1, dtype=dtype, device=device),  # 5, 3
     ], (6, 4))
     a = _stack(xp, [
-        xp.broadcast_to(-qd1*t10 - qd2*(t9 + qd1*t3), batch),  # 0
-        xp.broadcast_to(-qd1*t8 - qd2*(t7 + qd1*t5), batch),  # 1
+        xp.broadcast_to(-t10*qd1 - qd2*(t9 + t3*qd1), batch),  # 0
+        xp.broadcast_to(-t8*qd1 - qd2*(t7 + t5*qd1), batch),  # 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 4
@@ -409,7 +409,7 @@ def fk_jacobian_dot(q, q_dot):
 
 
 def jacobian_dot(q, q_dot):
-    """time derivative dJ/dt of the world geometric Jacobian along q_dot (6 x DOF): (6 x 4), 30 operations."""
+    """time derivative dJ/dt of the world geometric Jacobian along q_dot (6 x DOF): (6 x 4), 28 operations."""
     xp, dtype, device, batch, (q, q_dot,) = _arguments(("q", q, (4,)), ("q_dot", q_dot, (4,)))
     qd1 = q_dot[..., 0]
     qd2 = q_dot[..., 1]
@@ -424,17 +424,17 @@ def jacobian_dot(q, q_dot):
     t1 = t0 + 0.325*c1
     t2 = 0.275*s12
     t3 = t2 + 0.325*s1
-    t4 = qd2*t2
-    t5 = t4 + qd1*t3
-    t6 = qd2*t0
-    t7 = t6 + qd1*t1
+    t4 = t2*qd2
+    t5 = t4 + t3*qd1
+    t6 = t0*qd2
+    t7 = t6 + t1*qd1
     Jd = _stack(xp, [
         xp.broadcast_to(-t7, batch),  # 0, 0
-        xp.broadcast_to(-t6 - qd1*t0, batch),  # 0, 1
+        xp.broadcast_to(-(t6 + t0*qd1), batch),  # 0, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 3
         xp.broadcast_to(-t5, batch),  # 1, 0
-        xp.broadcast_to(-t4 - qd1*t2, batch),  # 1, 1
+        xp.broadcast_to(-(t4 + t2*qd1), batch),  # 1, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
@@ -473,13 +473,13 @@ def bias_acceleration(q, q_dot):
     t1 = t0 + 0.325*c1
     t2 = 0.275*s12
     t3 = t2 + 0.325*s1
-    t4 = qd2*t2
-    t5 = t4 + qd1*t3
-    t6 = qd2*t0
-    t7 = t6 + qd1*t1
+    t4 = t2*qd2
+    t5 = t4 + t3*qd1
+    t6 = t0*qd2
+    t7 = t6 + t1*qd1
     a = _stack(xp, [
-        xp.broadcast_to(-qd1*t7 - qd2*(t6 + qd1*t0), batch),  # 0
-        xp.broadcast_to(-qd1*t5 - qd2*(t4 + qd1*t2), batch),  # 1
+        xp.broadcast_to(-t7*qd1 - qd2*(t6 + t0*qd1), batch),  # 0
+        xp.broadcast_to(-t5*qd1 - qd2*(t4 + t2*qd1), batch),  # 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 4
@@ -504,12 +504,12 @@ def task_jacobian_dot(q, q_dot):
     t1 = t0 + 0.325*c1
     t2 = 0.275*s12
     t3 = t2 + 0.325*s1
-    t4 = qd2*t2
-    t5 = t4 + qd1*t3
-    t6 = t4 + qd1*t2
-    t7 = qd2*t0
-    t8 = t7 + qd1*t1
-    t9 = t7 + qd1*t0
+    t4 = t2*qd2
+    t5 = t4 + t3*qd1
+    t6 = t4 + t2*qd1
+    t7 = t0*qd2
+    t8 = t7 + t1*qd1
+    t9 = t7 + t0*qd1
     Jd = _stack(xp, [
         xp.broadcast_to(-t8, batch),  # 0, 0
         xp.broadcast_to(-t9, batch),  # 0, 1
@@ -673,7 +673,7 @@ def manipulability(q):
     t1 = t0 + 0.325*c1
     t2 = 0.275*s12
     t3 = t2 + 0.325*s1
-    t4 = t1*t2 - t0*t3
+    t4 = t1*t2 - t3*t0
     w = xp.broadcast_to(xp.abs(t4), batch)
     return w
 
@@ -692,7 +692,7 @@ def jacobian_det(q):
     t1 = t0 + 0.325*c1
     t2 = 0.275*s12
     t3 = t2 + 0.325*s1
-    d = xp.broadcast_to(t1*t2 - t0*t3, batch)
+    d = xp.broadcast_to(t1*t2 - t3*t0, batch)
     return d
 
 
@@ -720,7 +720,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t2 = 0.275*s12
     t3 = t2 + 0.325*s1
     t4 = t1*t3 + 0.075625*c12*s12
-    t5 = t2 + t3
+    t5 = t3 + t2
     t6 = t3**2
     t7 = t6 + 0.075625*s12**2
     t8 = t7
@@ -731,70 +731,70 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t13 = -1 + t12
     t14 = t9 + 0.075625*c12**2
     t15 = t14
-    t16 = xp.sqrt(4 + t14 + t7)
-    t17 = t0 + t1
+    t16 = xp.sqrt(4 + t7 + t14)
+    t17 = t1 + t0
     t18 = t17
     t19 = t4**2
     t20 = t5**2
     t21 = damping**2
-    t22 = t21 + t8
+    t22 = t8 + t21
     t23 = t22**2
-    t24 = xp.sqrt(t19 + t20 + t23)
+    t24 = xp.sqrt(t23 + t19 + t20)
     t25 = t24*xp.where(xp.greater_equal(t22, 0), xp.asarray(1, dtype=dtype), -1)
-    t26 = t22 + t25
+    t26 = t25 + t22
     t27 = xp.where(xp.greater(t24, 0), 1/(t24*(t24 + xp.abs(t22))), 0)
-    t28 = -t27*(mu_dot1*t4 + mu_dot3*t5 - mu_dot0*t26)
+    t28 = -t27*(t4*mu_dot1 + t5*mu_dot3 - t26*mu_dot0)
     t29 = mu_dot0 - t26*t28
-    t30 = mu_dot1 + t28*t4
-    t31 = mu_dot3 + t28*t5
+    t30 = mu_dot1 + t4*t28
+    t31 = mu_dot3 + t5*t28
     t32 = t15 + t21
-    t33 = -t27*(t18*t5 + t26*t4 + t32*t4)
+    t33 = -t27*(t4*t26 + t4*t32 + t5*t18)
     t34 = t4 + t26*t33
-    t35 = t32 + t33*t4
-    t36 = t18 + t33*t5
+    t35 = t32 + t4*t33
+    t36 = t18 + t5*t33
     t37 = xp.sqrt(t35**2 + t36**2)
     t38 = t37*xp.where(xp.greater_equal(t35, 0), xp.asarray(1, dtype=dtype), -1)
     t39 = t35 + t38
     t40 = xp.where(xp.greater(t37, 0), 1/(t37*(t37 + xp.abs(t35))), 0)
-    t41 = t40*(t30*t39 + t31*t36)
+    t41 = t40*(t36*t31 + t30*t39)
     t42 = t30 - t39*t41
     t43 = t31 - t36*t41
     t44 = 1 + t21
     t45 = t44
     t46 = 3 + t21
     t47 = xp.sqrt(t23 + t32**2 + t44**2 + t46**2 + 2*t19 + 2*t20 + 2*t18**2)
-    t48 = -t27*(t18*t4 + t26*t5 + t46*t5)
+    t48 = -t27*(t4*t18 + t5*t26 + t5*t46)
     t49 = t5 + t26*t48
     t50 = t18 + t4*t48
-    t51 = t46 + t48*t5
-    t52 = t40*(t36*t51 + t39*t50)
+    t51 = t46 + t5*t48
+    t52 = t40*(t36*t51 + t50*t39)
     t53 = t50 - t39*t52
     t54 = t51 - t36*t52
     t55 = xp.abs(t45)
     t56 = t55
     t57 = t56*xp.where(xp.greater_equal(t45, 0), xp.asarray(1, dtype=dtype), -1)
     t58 = t45 + t57
-    t59 = xp.where(xp.greater(t56, 0), 1/(t56*(t55 + t56)), 0)
-    t60 = mu_dot2 - mu_dot2*t59*t58**2
+    t59 = xp.where(xp.greater(t56, 0), 1/(t56*(t56 + t55)), 0)
+    t60 = mu_dot2 - t59*mu_dot2*t58**2
     t61 = xp.where(xp.not_equal(t57, 0), -t60/t57, 0)
     t62 = xp.abs(t54)
     t63 = t62
     t64 = t63*xp.where(xp.greater_equal(t54, 0), xp.asarray(1, dtype=dtype), -1)
     t65 = t54 + t64
-    t66 = xp.where(xp.greater(t63, 0), 1/(t63*(t62 + t63)), 0)
+    t66 = xp.where(xp.greater(t63, 0), 1/(t63*(t63 + t62)), 0)
     t67 = t43 - t43*t66*t65**2
     t68 = xp.where(xp.not_equal(t64, 0), -t67/t64, 0)
     t69 = xp.where(xp.not_equal(t38, 0), -(t42 - t53*t68)/t38, 0)
     t70 = xp.where(xp.not_equal(t25, 0), -(t29 + t34*t69 + t49*t68)/t25, 0)
-    t71 = t68 + t1*t69 - t3*t70
-    t72 = t68 + t0*t69 - t2*t70
+    t71 = t68 + t1*t69 - t70*t3
+    t72 = t68 + t69*t0 - t70*t2
     t73 = -t3
     t74 = t11 + t73
-    t75 = t12*(1 + t0*t1 - t2*t74)
+    t75 = t12*(1 + t1*t0 - t74*t2)
     t76 = t2 + t74*t75
     t77 = t0 - t1*t75
     t78 = 1 - t75
-    t79 = t12*(mu_dot3 + mu_dot0*t74 + mu_dot1*t1)
+    t79 = t12*(mu_dot3 + t1*mu_dot1 + t74*mu_dot0)
     t80 = mu_dot0 - t74*t79
     t81 = mu_dot1 - t1*t79
     t82 = mu_dot3 - t79
@@ -805,26 +805,26 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t87 = t86*(t78*t82 + t81*t85)
     t88 = t81 - t85*t87
     t89 = t82 - t78*t87
-    t90 = damping + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + q1 + q2 + q3 + q4 + t17 + t73 - t2
+    t90 = t73 + t17 + damping + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + q1 + q2 + q3 + q4 - t2
     t91 = t1*t12
-    t92 = t86*(t13*t78 + t85*t91)
+    t92 = t86*(t78*t13 + t85*t91)
     t93 = t91 - t85*t92
     t94 = t13 - t78*t92
     t95 = xp.abs(t94)
     t96 = t95
     t97 = t96*xp.where(xp.greater_equal(t94, 0), xp.asarray(1, dtype=dtype), -1)
     t98 = t94 + t97
-    t99 = xp.where(xp.greater(t96, 0), 1/(t96*(t95 + t96)), 0)
+    t99 = xp.where(xp.greater(t96, 0), 1/(t96*(t96 + t95)), 0)
     t100 = t89 - t89*t99*t98**2
     t101 = xp.where(xp.not_equal(t97, 0), -t100/t97, 0)
-    t102 = xp.where(xp.not_equal(t84, 0), -(t88 - t101*t93)/t84, 0)
-    t103 = xp.where(xp.not_equal(t11, 0), -(t80 + t102*t76 - t101*t12*t74)/t11, 0)
+    t102 = xp.where(xp.not_equal(t84, 0), -(t88 - t93*t101)/t84, 0)
+    t103 = xp.where(xp.not_equal(t11, 0), -(t80 - (-t102*t76 + t74*t12*t101))/t11, 0)
     t104 = xp.greater(damping, 0)
     t105 = xp.isfinite(t90)
     t106 = xp.greater_equal(damping, 0)
     t107 = 1e-12*t16
     t108 = 1e-12*t47
-    t109 = (t104 & ((xp.less_equal(t24, t108)) | (xp.less_equal(t37, t108)) | (xp.less_equal(t56, t108)) | (xp.less_equal(t63, t108)))) | ((xp.less_equal(damping, 0)) & ((xp.greater_equal(t107, 1)) | (xp.less_equal(t10, t107)) | (xp.less_equal(t83, t107)) | (xp.less_equal(t96, t107))))
+    t109 = (t104 & (xp.less_equal(t24, t108) | xp.less_equal(t37, t108) | xp.less_equal(t56, t108) | xp.less_equal(t63, t108))) | (xp.less_equal(damping, 0) & (xp.greater_equal(t107, 1) | xp.less_equal(t10, t107) | xp.less_equal(t83, t107) | xp.less_equal(t96, t107)))
     t110 = t105 & t106 & xp.logical_not(t109)
     q_dot = _stack(xp, [
         xp.broadcast_to(xp.where(t110, xp.where(t104, t71, t103), 0), batch),  # 0
@@ -869,51 +869,51 @@ def ik_numeric_step(target, q, damping=0.0):
     t6 = 0.275*c12
     t7 = t6 + 0.325*c1
     t8 = t7**2 + 0.075625*c12**2
-    t9 = t6 + t7
+    t9 = t7 + t6
     t10 = mu0 - t7
     t11 = 0.275*s12
     t12 = t11 + 0.325*s1
     t13 = t12**2 + 0.075625*s12**2
-    t14 = t12*t7 + 0.075625*c12*s12
-    t15 = t11 + t12
+    t14 = t7*t12 + 0.075625*c12*s12
+    t15 = t12 + t11
     t16 = mu1 - t12
     t17 = -mu3 + xp.atan2(t2, t1)
-    t18 = t17 + 6.283185307179586*xp.ceil(-0.5 - 0.15915494309189535*t17)
-    t19 = t10**2 + t16**2 + t18**2 + t3**2
-    t20 = damping + t13
+    t18 = t17 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t17))
+    t19 = t10**2 + t16**2 + t3**2 + t18**2
+    t20 = t13 + damping
     t21 = xp.sqrt(t14**2 + t15**2 + t20**2)
     t22 = t21*xp.where(xp.greater_equal(t20, 0), xp.asarray(1, dtype=dtype), -1)
-    t23 = t20 + t22
+    t23 = t22 + t20
     t24 = xp.where(xp.greater(t21, 0), 1/(t21*(t21 + xp.abs(t20))), 0)
-    t25 = t24*(t10*t23 + t15*t18 - t14*t16)
+    t25 = t24*(t10*t23 + t18*t15 - t16*t14)
     t26 = t10 - t23*t25
-    t27 = t16 + t14*t25
-    t28 = -t18 + t15*t25
-    t29 = damping + t8
-    t30 = -t24*(t14*t23 + t14*t29 + t15*t9)
+    t27 = t16 + t25*t14
+    t28 = -t18 + t25*t15
+    t29 = t8 + damping
+    t30 = -t24*(t23*t14 + t14*t29 + t15*t9)
     t31 = t14 + t23*t30
-    t32 = t29 + t14*t30
-    t33 = t9 + t15*t30
+    t32 = t29 + t30*t14
+    t33 = t9 + t30*t15
     t34 = xp.sqrt(t32**2 + t33**2)
     t35 = t34*xp.where(xp.greater_equal(t32, 0), xp.asarray(1, dtype=dtype), -1)
     t36 = t32 + t35
     t37 = xp.where(xp.greater(t34, 0), 1/(t34*(t34 + xp.abs(t32))), 0)
-    t38 = t37*(t27*t36 + t28*t33)
+    t38 = t37*(t33*t28 + t27*t36)
     t39 = t27 - t36*t38
     t40 = t28 - t33*t38
     t41 = 3 + damping
-    t42 = -t24*(t14*t9 + t15*t23 + t15*t41)
+    t42 = -t24*(t23*t15 + t14*t9 + t15*t41)
     t43 = t15 + t23*t42
-    t44 = t9 + t14*t42
-    t45 = t41 + t15*t42
-    t46 = t37*(t33*t45 + t36*t44)
+    t44 = t9 + t42*t14
+    t45 = t41 + t42*t15
+    t46 = t37*(t33*t45 + t44*t36)
     t47 = t44 - t36*t46
     t48 = t45 - t33*t46
     t49 = xp.abs(t4)
     t50 = t49
     t51 = t50*xp.where(xp.greater_equal(t4, 0), xp.asarray(1, dtype=dtype), -1)
     t52 = t4 + t51
-    t53 = xp.where(xp.greater(t50, 0), 1/(t50*(t49 + t50)), 0)
+    t53 = xp.where(xp.greater(t50, 0), 1/(t50*(t50 + t49)), 0)
     t54 = t3 - t3*t53*t52**2
     t55 = xp.where(xp.not_equal(t51, 0), -t54/t51, 0)
     t56 = q3 - t55
@@ -921,13 +921,13 @@ def ik_numeric_step(target, q, damping=0.0):
     t58 = t57
     t59 = t58*xp.where(xp.greater_equal(t48, 0), xp.asarray(1, dtype=dtype), -1)
     t60 = t48 + t59
-    t61 = xp.where(xp.greater(t58, 0), 1/(t58*(t57 + t58)), 0)
+    t61 = xp.where(xp.greater(t58, 0), 1/(t58*(t58 + t57)), 0)
     t62 = t40 - t40*t61*t60**2
     t63 = xp.where(xp.not_equal(t59, 0), -t62/t59, 0)
     t64 = xp.where(xp.not_equal(t35, 0), -(t39 - t47*t63)/t35, 0)
     t65 = xp.where(xp.not_equal(t22, 0), -(t26 + t31*t64 + t43*t63)/t22, 0)
-    t66 = q1 + t63 + t64*t7 - t12*t65
-    t67 = q2 + t63 + t6*t64 - t11*t65
+    t66 = t63 + q1 + t64*t7 - t65*t12
+    t67 = t63 + q2 + t64*t6 - t65*t11
     t68 = q4 - t63
     q_start = _stack(xp, [
         xp.broadcast_to(q1, batch),  # 0
@@ -947,14 +947,14 @@ def ik_numeric_step(target, q, damping=0.0):
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def ik_branches(mu):
-    """every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits: (2 x 4 and 2 x 1 and 2 x 1), 202 operations."""
+    """every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits: (2 x 4 and 2 x 1 and 2 x 1), 198 operations."""
     xp, dtype, device, batch, (mu,) = _arguments(("mu", mu, (4,)))
     mu0 = mu[..., 0]
     mu1 = mu[..., 1]
     mu2 = mu[..., 2]
     mu3 = mu[..., 3]
     t0 = 0.149769 + mu0**2 + mu1**2
-    t1 = 0.1655095 - 0.5*t0
+    t1 = 0.5*(0.331019 - t0)
     t2 = mu0 + mu1 + mu2 + mu3
     t3 = t1**2
     t4 = 1 - 125.18949581886645*t3
@@ -965,52 +965,52 @@ def ik_branches(mu):
     t9 = xp.atan2(t8, t7)
     t10 = 3.141592653589793 + t9
     t11 = 3.141592653589793 - t9
-    t12 = t10 - 6.283185307179586*xp.ceil(-0.5 + 0.15915494309189535*t10)
-    t13 = t12 - 6.283185307179586*xp.floor(0.24444444444444444 + 0.15915494309189535*t12)
-    t14 = t11 - 6.283185307179586*xp.ceil(-0.5 + 0.15915494309189535*t11)
-    t15 = t14 - 6.283185307179586*xp.floor(0.24444444444444444 + 0.15915494309189535*t14)
+    t12 = t10 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t10))
+    t13 = t12 - 6.283185307179586*xp.floor(0.15915494309189535*(1.53588974175501 + t12))
+    t14 = t11 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t11))
+    t15 = t14 - 6.283185307179586*xp.floor(0.15915494309189535*(1.53588974175501 + t14))
     t16 = -1.0*t7
     t17 = -1.0*t8
     t18 = 0.325 + 0.275*t16
     t19 = 0.149769 + t18**2 + 0.075625*t17**2
     t20 = 0.275*t17
-    t21 = 0.149769 + mu0*t18 + mu1*t20
+    t21 = 0.149769 + t18*mu0 + t20*mu1
     t22 = -0.149769 + t21
-    t23 = mu1*t18 - mu0*t20
+    t23 = t18*mu1 - t20*mu0
     t24 = t22**2 + t23**2
     t25 = 0.325 - 0.275*t7
     t26 = 0.149769 + t25**2 + 0.075625*t8**2
     t27 = 0.275*t8
-    t28 = 0.149769 + mu0*t25 + mu1*t27
+    t28 = 0.149769 + t25*mu0 + t27*mu1
     t29 = -0.149769 + t28
-    t30 = mu1*t25 - mu0*t27
+    t30 = t25*mu1 - t27*mu0
     t31 = t29**2 + t30**2
     t32 = 1e-24*t0
     t33 = xp.where(xp.less_equal(t24, t19*t32), 0, xp.atan2(t23, t22))
     t34 = t33
-    t35 = t34 - 6.283185307179586*xp.floor(0.1388888888888889 + 0.15915494309189535*t34)
+    t35 = t34 - 6.283185307179586*xp.floor(0.15915494309189535*(0.8726646259971648 + t34))
     t36 = -mu3
-    t37 = -t10 - t33 - t36
-    t38 = t37 + 6.283185307179586*xp.ceil(-0.5 - 0.15915494309189535*t37)
+    t37 = -(t10 + t33 + t36)
+    t38 = t37 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t37))
     t39 = -t38
-    t40 = t38 + 6.283185307179586*xp.floor(1.0 + 0.15915494309189535*t39)
+    t40 = t38 + 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t39))
     t41 = xp.where(xp.less_equal(t31, t26*t32), 0, xp.atan2(t30, t29))
     t42 = t41
-    t43 = t42 - 6.283185307179586*xp.floor(0.1388888888888889 + 0.15915494309189535*t42)
-    t44 = -t11 - t36 - t41
-    t45 = t44 + 6.283185307179586*xp.ceil(-0.5 - 0.15915494309189535*t44)
+    t43 = t42 - 6.283185307179586*xp.floor(0.15915494309189535*(0.8726646259971648 + t42))
+    t44 = -(t11 + t36 + t41)
+    t45 = t44 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t44))
     t46 = -t45
-    t47 = t45 + 6.283185307179586*xp.floor(1.0 + 0.15915494309189535*t46)
+    t47 = t45 + 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t46))
     t48 = xp.less_equal(t35, 0.8726646259971648)
-    t49 = (xp.greater_equal(t34, -0.8726646259971648)) & (xp.less_equal(t34, 0.8726646259971648))
+    t49 = xp.greater_equal(t34, -0.8726646259971648) & xp.less_equal(t34, 0.8726646259971648)
     t50 = xp.less_equal(t13, 1.53588974175501)
-    t51 = (xp.greater_equal(t12, -1.53588974175501)) & (xp.less_equal(t12, 1.53588974175501))
+    t51 = xp.greater_equal(t12, -1.53588974175501) & xp.less_equal(t12, 1.53588974175501)
     t52 = -(-0.387 + mu2)
     t53 = -t40
     t54 = xp.less_equal(t43, 0.8726646259971648)
-    t55 = (xp.greater_equal(t42, -0.8726646259971648)) & (xp.less_equal(t42, 0.8726646259971648))
+    t55 = xp.greater_equal(t42, -0.8726646259971648) & xp.less_equal(t42, 0.8726646259971648)
     t56 = xp.less_equal(t15, 1.53588974175501)
-    t57 = (xp.greater_equal(t14, -1.53588974175501)) & (xp.less_equal(t14, 1.53588974175501))
+    t57 = xp.greater_equal(t14, -1.53588974175501) & xp.less_equal(t14, 1.53588974175501)
     t58 = -t47
     t59 = xp.isfinite(t2)
     t60 = xp.greater_equal(t52, 0.0)
@@ -1019,19 +1019,19 @@ def ik_branches(mu):
         xp.where(t48 & xp.logical_not(t49), t35, t34),  # 0, 0
         xp.where(t50 & xp.logical_not(t51), t13, t12),  # 0, 1
         t52,  # 0, 2
-        xp.where((xp.greater_equal(t40, -6.283185307179586)) & xp.logical_not((xp.greater_equal(t38, -6.283185307179586)) & (xp.less_equal(t38, 6.283185307179586))), t53, t39),  # 0, 3
+        xp.where(xp.greater_equal(t40, -6.283185307179586) & xp.logical_not(xp.greater_equal(t38, -6.283185307179586) & xp.less_equal(t38, 6.283185307179586)), t53, t39),  # 0, 3
         xp.where(t54 & xp.logical_not(t55), t43, t42),  # 1, 0
         xp.where(t56 & xp.logical_not(t57), t15, t14),  # 1, 1
         t52,  # 1, 2
-        xp.where((xp.greater_equal(t47, -6.283185307179586)) & xp.logical_not((xp.greater_equal(t45, -6.283185307179586)) & (xp.less_equal(t45, 6.283185307179586))), t58, t46),  # 1, 3
+        xp.where(xp.greater_equal(t47, -6.283185307179586) & xp.logical_not(xp.greater_equal(t45, -6.283185307179586) & xp.less_equal(t45, 6.283185307179586)), t58, t46),  # 1, 3
     ], (2, 4))
     valid = _stack(xp, [
-        t59 & (xp.greater_equal(t4, -1e-12)),  # 0
-        t59 & (xp.greater(t4, 1e-12)),  # 1
+        t59 & (xp.greater_equal(t4, -1e-12) | (False & xp.less_equal(t3, 1.931417125e-14))),  # 0
+        t59 & xp.greater(t4, 1e-12),  # 1
     ], (2,))
     in_limits = _stack(xp, [
-        t60 & t61 & (t48 | t49) & (t50 | t51) & ((xp.less_equal(t53, 6.283185307179586)) | ((xp.greater_equal(t39, -6.283185307179586)) & (xp.less_equal(t39, 6.283185307179586)))),  # 0
-        t60 & t61 & (t54 | t55) & (t56 | t57) & ((xp.less_equal(t58, 6.283185307179586)) | ((xp.greater_equal(t46, -6.283185307179586)) & (xp.less_equal(t46, 6.283185307179586)))),  # 1
+        t60 & t61 & (t48 | t49) & (t50 | t51) & (xp.less_equal(t53, 6.283185307179586) | (xp.greater_equal(t39, -6.283185307179586) & xp.less_equal(t39, 6.283185307179586))),  # 0
+        t60 & t61 & (t54 | t55) & (t56 | t57) & (xp.less_equal(t58, 6.283185307179586) | (xp.greater_equal(t46, -6.283185307179586) & xp.less_equal(t46, 6.283185307179586))),  # 1
     ], (2,))
     return q, valid, in_limits
 
@@ -1075,44 +1075,44 @@ def ik_nearest(mu, q_seed, weights=(1.0,) * DOF):
     t7 = qb1_3 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn4 - qb1_3))
     t8 = xp.where(lb1 & vb1, xp.asarray(1, dtype=dtype), 0)
     t9 = mu0 + mu1 + mu2 + mu3 + qn1 + qn2 + qn3 + qn4 + qw1 + qw2 + qw3 + qw4
-    t10 = xp.where(xp.greater(qn1, t0), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t10 = xp.where(xp.less(t0, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t11 = t0 + t10
     t12 = t0 - t10
-    t13 = xp.where((xp.greater_equal(t0, -0.8726646259971648)) & (xp.less_equal(t0, 0.8726646259971648)), t0, xp.where((xp.greater_equal(t11, -0.8726646259971648)) & (xp.less_equal(t11, 0.8726646259971648)), t11, xp.where((xp.greater_equal(t12, -0.8726646259971648)) & (xp.less_equal(t12, 0.8726646259971648)), t12, qb0_0)))
-    t14 = xp.where(xp.greater(qn2, t1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t13 = xp.where(xp.greater_equal(t0, -0.8726646259971648) & xp.less_equal(t0, 0.8726646259971648), t0, xp.where(xp.greater_equal(t11, -0.8726646259971648) & xp.less_equal(t11, 0.8726646259971648), t11, xp.where(xp.greater_equal(t12, -0.8726646259971648) & xp.less_equal(t12, 0.8726646259971648), t12, qb0_0)))
+    t14 = xp.where(xp.less(t1, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t15 = t1 + t14
     t16 = t1 - t14
-    t17 = xp.where((xp.greater_equal(t1, -1.53588974175501)) & (xp.less_equal(t1, 1.53588974175501)), t1, xp.where((xp.greater_equal(t15, -1.53588974175501)) & (xp.less_equal(t15, 1.53588974175501)), t15, xp.where((xp.greater_equal(t16, -1.53588974175501)) & (xp.less_equal(t16, 1.53588974175501)), t16, qb0_1)))
-    t18 = xp.where(xp.greater(qn4, t2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t19 = t18 + t2
+    t17 = xp.where(xp.greater_equal(t1, -1.53588974175501) & xp.less_equal(t1, 1.53588974175501), t1, xp.where(xp.greater_equal(t15, -1.53588974175501) & xp.less_equal(t15, 1.53588974175501), t15, xp.where(xp.greater_equal(t16, -1.53588974175501) & xp.less_equal(t16, 1.53588974175501), t16, qb0_1)))
+    t18 = xp.where(xp.less(t2, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t19 = t2 + t18
     t20 = t2 - t18
-    t21 = xp.where((xp.greater_equal(t2, -6.283185307179586)) & (xp.less_equal(t2, 6.283185307179586)), t2, xp.where((xp.greater_equal(t19, -6.283185307179586)) & (xp.less_equal(t19, 6.283185307179586)), t19, xp.where((xp.greater_equal(t20, -6.283185307179586)) & (xp.less_equal(t20, 6.283185307179586)), t20, qb0_3)))
+    t21 = xp.where(xp.greater_equal(t2, -6.283185307179586) & xp.less_equal(t2, 6.283185307179586), t2, xp.where(xp.greater_equal(t19, -6.283185307179586) & xp.less_equal(t19, 6.283185307179586), t19, xp.where(xp.greater_equal(t20, -6.283185307179586) & xp.less_equal(t20, 6.283185307179586), t20, qb0_3)))
     t22 = -qn1
     t23 = -qn2
     t24 = -qn3
     t25 = -qn4
-    t26 = qw1*(t13 + t22)**2 + qw2*(t17 + t23)**2 + qw3*(qb0_2 + t24)**2 + qw4*(t21 + t25)**2
+    t26 = qw1*(t13 + t22)**2 + qw2*(t17 + t23)**2 + qw3*(t24 + qb0_2)**2 + qw4*(t21 + t25)**2
     t27 = xp.greater(t4, 0)
     t28 = xp.where(t27, t13, qn1)
     t29 = xp.where(t27, t17, qn2)
     t30 = xp.where(t27, qb0_2, qn3)
     t31 = xp.where(t27, t21, qn4)
     t32 = xp.where(t27, t26, 0)
-    t33 = xp.where(xp.greater(qn1, t5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t34 = t33 + t5
+    t33 = xp.where(xp.less(t5, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t34 = t5 + t33
     t35 = t5 - t33
-    t36 = xp.where((xp.greater_equal(t5, -0.8726646259971648)) & (xp.less_equal(t5, 0.8726646259971648)), t5, xp.where((xp.greater_equal(t34, -0.8726646259971648)) & (xp.less_equal(t34, 0.8726646259971648)), t34, xp.where((xp.greater_equal(t35, -0.8726646259971648)) & (xp.less_equal(t35, 0.8726646259971648)), t35, qb1_0)))
-    t37 = xp.where(xp.greater(qn2, t6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t38 = t37 + t6
+    t36 = xp.where(xp.greater_equal(t5, -0.8726646259971648) & xp.less_equal(t5, 0.8726646259971648), t5, xp.where(xp.greater_equal(t34, -0.8726646259971648) & xp.less_equal(t34, 0.8726646259971648), t34, xp.where(xp.greater_equal(t35, -0.8726646259971648) & xp.less_equal(t35, 0.8726646259971648), t35, qb1_0)))
+    t37 = xp.where(xp.less(t6, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t38 = t6 + t37
     t39 = t6 - t37
-    t40 = xp.where((xp.greater_equal(t6, -1.53588974175501)) & (xp.less_equal(t6, 1.53588974175501)), t6, xp.where((xp.greater_equal(t38, -1.53588974175501)) & (xp.less_equal(t38, 1.53588974175501)), t38, xp.where((xp.greater_equal(t39, -1.53588974175501)) & (xp.less_equal(t39, 1.53588974175501)), t39, qb1_1)))
-    t41 = xp.where(xp.greater(qn4, t7), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t42 = t41 + t7
+    t40 = xp.where(xp.greater_equal(t6, -1.53588974175501) & xp.less_equal(t6, 1.53588974175501), t6, xp.where(xp.greater_equal(t38, -1.53588974175501) & xp.less_equal(t38, 1.53588974175501), t38, xp.where(xp.greater_equal(t39, -1.53588974175501) & xp.less_equal(t39, 1.53588974175501), t39, qb1_1)))
+    t41 = xp.where(xp.less(t7, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t42 = t7 + t41
     t43 = t7 - t41
-    t44 = xp.where((xp.greater_equal(t7, -6.283185307179586)) & (xp.less_equal(t7, 6.283185307179586)), t7, xp.where((xp.greater_equal(t42, -6.283185307179586)) & (xp.less_equal(t42, 6.283185307179586)), t42, xp.where((xp.greater_equal(t43, -6.283185307179586)) & (xp.less_equal(t43, 6.283185307179586)), t43, qb1_3)))
-    t45 = qw1*(t22 + t36)**2 + qw2*(t23 + t40)**2 + qw3*(qb1_2 + t24)**2 + qw4*(t25 + t44)**2
+    t44 = xp.where(xp.greater_equal(t7, -6.283185307179586) & xp.less_equal(t7, 6.283185307179586), t7, xp.where(xp.greater_equal(t42, -6.283185307179586) & xp.less_equal(t42, 6.283185307179586), t42, xp.where(xp.greater_equal(t43, -6.283185307179586) & xp.less_equal(t43, 6.283185307179586), t43, qb1_3)))
+    t45 = qw1*(t36 + t22)**2 + qw2*(t40 + t23)**2 + qw3*(t24 + qb1_2)**2 + qw4*(t44 + t25)**2
     t46 = xp.greater(t8, 0)
-    t47 = xp.where(t46 & ((xp.greater(t32, t45)) | (xp.less(t4, 1))), xp.asarray(1, dtype=dtype), 0)
+    t47 = xp.where(t46 & (xp.greater(t32, t45) | xp.less(t4, 1)), xp.asarray(1, dtype=dtype), 0)
     t48 = xp.where(t46, 1, t4)
     t49 = xp.greater(t47, 0)
     t50 = xp.where(t49, t36, t28)

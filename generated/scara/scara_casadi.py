@@ -118,7 +118,7 @@ def _fk_jacobian(q):
 
 
 def _jacobian_tool(q):
-    """Geometric Jacobian in the tool frame (6 x DOF, rows vx vy vz wx wy wz): 40 operations."""
+    """Geometric Jacobian in the tool frame (6 x DOF, rows vx vy vz wx wy wz): 38 operations."""
     q1 = q[0]
     q2 = q[1]
     q4 = q[3]
@@ -139,8 +139,8 @@ def _jacobian_tool(q):
     J = casadi.SX(6, 4)
     J[0, 0] = t1*t3 - t0*t5
     J[0, 1] = t1*t2 - t0*t4
-    J[1, 0] = -t0*t3 - t1*t5
-    J[1, 1] = -t0*t2 - t1*t4
+    J[1, 0] = -(t0*t3 + t1*t5)
+    J[1, 1] = -(t0*t2 + t1*t4)
     J[2, 2] = 1
     J[5, 0] = -1
     J[5, 1] = -1
@@ -224,10 +224,10 @@ def _fk_jacobian_dot(q, q_dot):
     t4 = t3 + 0.325*c1
     t5 = 0.275*s12
     t6 = t5 + 0.325*s1
-    t7 = qd2*t5
-    t8 = t7 + qd1*t6
-    t9 = qd2*t3
-    t10 = t9 + qd1*t4
+    t7 = t5*qd2
+    t8 = t7 + t6*qd1
+    t9 = t3*qd2
+    t10 = t9 + t4*qd1
     T = casadi.SX(4, 4)
     T[0, 0] = t1
     T[0, 1] = t2
@@ -248,13 +248,13 @@ def _fk_jacobian_dot(q, q_dot):
     J[5, 1] = 1
     J[5, 3] = -1
     a = casadi.SX(6, 1)
-    a[0, 0] = -qd1*t10 - qd2*(t9 + qd1*t3)
-    a[1, 0] = -qd1*t8 - qd2*(t7 + qd1*t5)
+    a[0, 0] = -t10*qd1 - qd2*(t9 + t3*qd1)
+    a[1, 0] = -t8*qd1 - qd2*(t7 + t5*qd1)
     return [T, J, a]
 
 
 def _jacobian_dot(q, q_dot):
-    """Time derivative dJ/dt of the world geometric Jacobian along q_dot (6 x DOF): 30 operations."""
+    """Time derivative dJ/dt of the world geometric Jacobian along q_dot (6 x DOF): 28 operations."""
     q1 = q[0]
     q2 = q[1]
     qd1 = q_dot[0]
@@ -269,15 +269,15 @@ def _jacobian_dot(q, q_dot):
     t1 = t0 + 0.325*c1
     t2 = 0.275*s12
     t3 = t2 + 0.325*s1
-    t4 = qd2*t2
-    t5 = t4 + qd1*t3
-    t6 = qd2*t0
-    t7 = t6 + qd1*t1
+    t4 = t2*qd2
+    t5 = t4 + t3*qd1
+    t6 = t0*qd2
+    t7 = t6 + t1*qd1
     Jd = casadi.SX(6, 4)
     Jd[0, 0] = -t7
-    Jd[0, 1] = -t6 - qd1*t0
+    Jd[0, 1] = -(t6 + t0*qd1)
     Jd[1, 0] = -t5
-    Jd[1, 1] = -t4 - qd1*t2
+    Jd[1, 1] = -(t4 + t2*qd1)
     return [Jd]
 
 
@@ -297,13 +297,13 @@ def _bias_acceleration(q, q_dot):
     t1 = t0 + 0.325*c1
     t2 = 0.275*s12
     t3 = t2 + 0.325*s1
-    t4 = qd2*t2
-    t5 = t4 + qd1*t3
-    t6 = qd2*t0
-    t7 = t6 + qd1*t1
+    t4 = t2*qd2
+    t5 = t4 + t3*qd1
+    t6 = t0*qd2
+    t7 = t6 + t1*qd1
     a = casadi.SX(6, 1)
-    a[0, 0] = -qd1*t7 - qd2*(t6 + qd1*t0)
-    a[1, 0] = -qd1*t5 - qd2*(t4 + qd1*t2)
+    a[0, 0] = -t7*qd1 - qd2*(t6 + t0*qd1)
+    a[1, 0] = -t5*qd1 - qd2*(t4 + t2*qd1)
     return [a]
 
 
@@ -323,12 +323,12 @@ def _task_jacobian_dot(q, q_dot):
     t1 = t0 + 0.325*c1
     t2 = 0.275*s12
     t3 = t2 + 0.325*s1
-    t4 = qd2*t2
-    t5 = t4 + qd1*t3
-    t6 = t4 + qd1*t2
-    t7 = qd2*t0
-    t8 = t7 + qd1*t1
-    t9 = t7 + qd1*t0
+    t4 = t2*qd2
+    t5 = t4 + t3*qd1
+    t6 = t4 + t2*qd1
+    t7 = t0*qd2
+    t8 = t7 + t1*qd1
+    t9 = t7 + t0*qd1
     Jd = casadi.SX(4, 4)
     Jd[0, 0] = -t8
     Jd[0, 1] = -t9
@@ -388,7 +388,7 @@ def _manipulability(q):
     t1 = t0 + 0.325*c1
     t2 = 0.275*s12
     t3 = t2 + 0.325*s1
-    t4 = t1*t2 - t0*t3
+    t4 = t1*t2 - t3*t0
     w = casadi.SX(1, 1)
     w[0, 0] = casadi.fabs(t4)
     return [w]
@@ -409,7 +409,7 @@ def _jacobian_det(q):
     t2 = 0.275*s12
     t3 = t2 + 0.325*s1
     d = casadi.SX(1, 1)
-    d[0, 0] = t1*t2 - t0*t3
+    d[0, 0] = t1*t2 - t3*t0
     return [d]
 
 
@@ -434,7 +434,7 @@ def _velocity_ik(q, mu_dot, damping):
     t2 = 0.275*s12
     t3 = t2 + 0.325*s1
     t4 = t1*t3 + 0.075625*c12*s12
-    t5 = t2 + t3
+    t5 = t3 + t2
     t6 = t3**2
     t7 = t6 + 0.075625*s12**2
     t8 = t7
@@ -445,70 +445,70 @@ def _velocity_ik(q, mu_dot, damping):
     t13 = -1 + t12
     t14 = t9 + 0.075625*c12**2
     t15 = t14
-    t16 = casadi.sqrt(4 + t14 + t7)
-    t17 = t0 + t1
+    t16 = casadi.sqrt(4 + t7 + t14)
+    t17 = t1 + t0
     t18 = t17
     t19 = t4**2
     t20 = t5**2
     t21 = damping**2
-    t22 = t21 + t8
+    t22 = t8 + t21
     t23 = t22**2
-    t24 = casadi.sqrt(t19 + t20 + t23)
+    t24 = casadi.sqrt(t23 + t19 + t20)
     t25 = t24*casadi.if_else((t22 >= 0), 1, -1)
-    t26 = t22 + t25
+    t26 = t25 + t22
     t27 = casadi.if_else((t24 > 0), 1/(t24*(t24 + casadi.fabs(t22))), 0)
-    t28 = -t27*(mu_dot1*t4 + mu_dot3*t5 - mu_dot0*t26)
+    t28 = -t27*(t4*mu_dot1 + t5*mu_dot3 - t26*mu_dot0)
     t29 = mu_dot0 - t26*t28
-    t30 = mu_dot1 + t28*t4
-    t31 = mu_dot3 + t28*t5
+    t30 = mu_dot1 + t4*t28
+    t31 = mu_dot3 + t5*t28
     t32 = t15 + t21
-    t33 = -t27*(t18*t5 + t26*t4 + t32*t4)
+    t33 = -t27*(t4*t26 + t4*t32 + t5*t18)
     t34 = t4 + t26*t33
-    t35 = t32 + t33*t4
-    t36 = t18 + t33*t5
+    t35 = t32 + t4*t33
+    t36 = t18 + t5*t33
     t37 = casadi.sqrt(t35**2 + t36**2)
     t38 = t37*casadi.if_else((t35 >= 0), 1, -1)
     t39 = t35 + t38
     t40 = casadi.if_else((t37 > 0), 1/(t37*(t37 + casadi.fabs(t35))), 0)
-    t41 = t40*(t30*t39 + t31*t36)
+    t41 = t40*(t36*t31 + t30*t39)
     t42 = t30 - t39*t41
     t43 = t31 - t36*t41
     t44 = 1 + t21
     t45 = t44
     t46 = 3 + t21
     t47 = casadi.sqrt(t23 + t32**2 + t44**2 + t46**2 + 2*t19 + 2*t20 + 2*t18**2)
-    t48 = -t27*(t18*t4 + t26*t5 + t46*t5)
+    t48 = -t27*(t4*t18 + t5*t26 + t5*t46)
     t49 = t5 + t26*t48
     t50 = t18 + t4*t48
-    t51 = t46 + t48*t5
-    t52 = t40*(t36*t51 + t39*t50)
+    t51 = t46 + t5*t48
+    t52 = t40*(t36*t51 + t50*t39)
     t53 = t50 - t39*t52
     t54 = t51 - t36*t52
     t55 = casadi.fabs(t45)
     t56 = t55
     t57 = t56*casadi.if_else((t45 >= 0), 1, -1)
     t58 = t45 + t57
-    t59 = casadi.if_else((t56 > 0), 1/(t56*(t55 + t56)), 0)
-    t60 = mu_dot2 - mu_dot2*t59*t58**2
+    t59 = casadi.if_else((t56 > 0), 1/(t56*(t56 + t55)), 0)
+    t60 = mu_dot2 - t59*mu_dot2*t58**2
     t61 = casadi.if_else((t57 != 0), -t60/t57, 0)
     t62 = casadi.fabs(t54)
     t63 = t62
     t64 = t63*casadi.if_else((t54 >= 0), 1, -1)
     t65 = t54 + t64
-    t66 = casadi.if_else((t63 > 0), 1/(t63*(t62 + t63)), 0)
+    t66 = casadi.if_else((t63 > 0), 1/(t63*(t63 + t62)), 0)
     t67 = t43 - t43*t66*t65**2
     t68 = casadi.if_else((t64 != 0), -t67/t64, 0)
     t69 = casadi.if_else((t38 != 0), -(t42 - t53*t68)/t38, 0)
     t70 = casadi.if_else((t25 != 0), -(t29 + t34*t69 + t49*t68)/t25, 0)
-    t71 = t68 + t1*t69 - t3*t70
-    t72 = t68 + t0*t69 - t2*t70
+    t71 = t68 + t1*t69 - t70*t3
+    t72 = t68 + t69*t0 - t70*t2
     t73 = -t3
     t74 = t11 + t73
-    t75 = t12*(1 + t0*t1 - t2*t74)
+    t75 = t12*(1 + t1*t0 - t74*t2)
     t76 = t2 + t74*t75
     t77 = t0 - t1*t75
     t78 = 1 - t75
-    t79 = t12*(mu_dot3 + mu_dot0*t74 + mu_dot1*t1)
+    t79 = t12*(mu_dot3 + t1*mu_dot1 + t74*mu_dot0)
     t80 = mu_dot0 - t74*t79
     t81 = mu_dot1 - t1*t79
     t82 = mu_dot3 - t79
@@ -519,20 +519,20 @@ def _velocity_ik(q, mu_dot, damping):
     t87 = t86*(t78*t82 + t81*t85)
     t88 = t81 - t85*t87
     t89 = t82 - t78*t87
-    t90 = damping + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + q1 + q2 + q3 + q4 + t17 + t73 - t2
+    t90 = t73 + t17 + damping + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + q1 + q2 + q3 + q4 - t2
     t91 = t1*t12
-    t92 = t86*(t13*t78 + t85*t91)
+    t92 = t86*(t78*t13 + t85*t91)
     t93 = t91 - t85*t92
     t94 = t13 - t78*t92
     t95 = casadi.fabs(t94)
     t96 = t95
     t97 = t96*casadi.if_else((t94 >= 0), 1, -1)
     t98 = t94 + t97
-    t99 = casadi.if_else((t96 > 0), 1/(t96*(t95 + t96)), 0)
+    t99 = casadi.if_else((t96 > 0), 1/(t96*(t96 + t95)), 0)
     t100 = t89 - t89*t99*t98**2
     t101 = casadi.if_else((t97 != 0), -t100/t97, 0)
-    t102 = casadi.if_else((t84 != 0), -(t88 - t101*t93)/t84, 0)
-    t103 = casadi.if_else((t11 != 0), -(t80 + t102*t76 - t101*t12*t74)/t11, 0)
+    t102 = casadi.if_else((t84 != 0), -(t88 - t93*t101)/t84, 0)
+    t103 = casadi.if_else((t11 != 0), -(t80 - (-t102*t76 + t74*t12*t101))/t11, 0)
     t104 = (damping > 0)
     t105 = (casadi.fabs(t90) < casadi.inf)
     t106 = (damping >= 0)
@@ -581,51 +581,51 @@ def _ik_numeric_step(target, q, damping):
     t6 = 0.275*c12
     t7 = t6 + 0.325*c1
     t8 = t7**2 + 0.075625*c12**2
-    t9 = t6 + t7
+    t9 = t7 + t6
     t10 = mu0 - t7
     t11 = 0.275*s12
     t12 = t11 + 0.325*s1
     t13 = t12**2 + 0.075625*s12**2
-    t14 = t12*t7 + 0.075625*c12*s12
-    t15 = t11 + t12
+    t14 = t7*t12 + 0.075625*c12*s12
+    t15 = t12 + t11
     t16 = mu1 - t12
     t17 = -mu3 + casadi.atan2(t2, t1)
-    t18 = t17 + 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t17)
-    t19 = t10**2 + t16**2 + t18**2 + t3**2
-    t20 = damping + t13
+    t18 = t17 + 6.283185307179586*casadi.ceil(-0.15915494309189535*(3.141592653589793 + t17))
+    t19 = t10**2 + t16**2 + t3**2 + t18**2
+    t20 = t13 + damping
     t21 = casadi.sqrt(t14**2 + t15**2 + t20**2)
     t22 = t21*casadi.if_else((t20 >= 0), 1, -1)
-    t23 = t20 + t22
+    t23 = t22 + t20
     t24 = casadi.if_else((t21 > 0), 1/(t21*(t21 + casadi.fabs(t20))), 0)
-    t25 = t24*(t10*t23 + t15*t18 - t14*t16)
+    t25 = t24*(t10*t23 + t18*t15 - t16*t14)
     t26 = t10 - t23*t25
-    t27 = t16 + t14*t25
-    t28 = -t18 + t15*t25
-    t29 = damping + t8
-    t30 = -t24*(t14*t23 + t14*t29 + t15*t9)
+    t27 = t16 + t25*t14
+    t28 = -t18 + t25*t15
+    t29 = t8 + damping
+    t30 = -t24*(t23*t14 + t14*t29 + t15*t9)
     t31 = t14 + t23*t30
-    t32 = t29 + t14*t30
-    t33 = t9 + t15*t30
+    t32 = t29 + t30*t14
+    t33 = t9 + t30*t15
     t34 = casadi.sqrt(t32**2 + t33**2)
     t35 = t34*casadi.if_else((t32 >= 0), 1, -1)
     t36 = t32 + t35
     t37 = casadi.if_else((t34 > 0), 1/(t34*(t34 + casadi.fabs(t32))), 0)
-    t38 = t37*(t27*t36 + t28*t33)
+    t38 = t37*(t33*t28 + t27*t36)
     t39 = t27 - t36*t38
     t40 = t28 - t33*t38
     t41 = 3 + damping
-    t42 = -t24*(t14*t9 + t15*t23 + t15*t41)
+    t42 = -t24*(t23*t15 + t14*t9 + t15*t41)
     t43 = t15 + t23*t42
-    t44 = t9 + t14*t42
-    t45 = t41 + t15*t42
-    t46 = t37*(t33*t45 + t36*t44)
+    t44 = t9 + t42*t14
+    t45 = t41 + t42*t15
+    t46 = t37*(t33*t45 + t44*t36)
     t47 = t44 - t36*t46
     t48 = t45 - t33*t46
     t49 = casadi.fabs(t4)
     t50 = t49
     t51 = t50*casadi.if_else((t4 >= 0), 1, -1)
     t52 = t4 + t51
-    t53 = casadi.if_else((t50 > 0), 1/(t50*(t49 + t50)), 0)
+    t53 = casadi.if_else((t50 > 0), 1/(t50*(t50 + t49)), 0)
     t54 = t3 - t3*t53*t52**2
     t55 = casadi.if_else((t51 != 0), -t54/t51, 0)
     t56 = q3 - t55
@@ -633,13 +633,13 @@ def _ik_numeric_step(target, q, damping):
     t58 = t57
     t59 = t58*casadi.if_else((t48 >= 0), 1, -1)
     t60 = t48 + t59
-    t61 = casadi.if_else((t58 > 0), 1/(t58*(t57 + t58)), 0)
+    t61 = casadi.if_else((t58 > 0), 1/(t58*(t58 + t57)), 0)
     t62 = t40 - t40*t61*t60**2
     t63 = casadi.if_else((t59 != 0), -t62/t59, 0)
     t64 = casadi.if_else((t35 != 0), -(t39 - t47*t63)/t35, 0)
     t65 = casadi.if_else((t22 != 0), -(t26 + t31*t64 + t43*t63)/t22, 0)
-    t66 = q1 + t63 + t64*t7 - t12*t65
-    t67 = q2 + t63 + t6*t64 - t11*t65
+    t66 = t63 + q1 + t64*t7 - t65*t12
+    t67 = t63 + q2 + t64*t6 - t65*t11
     t68 = q4 - t63
     q_start = casadi.SX(4, 1)
     q_start[0, 0] = q1
@@ -657,13 +657,13 @@ def _ik_numeric_step(target, q, damping):
 
 
 def _ik_branches(mu):
-    """Every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits: 202 operations."""
+    """Every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits: 198 operations."""
     mu0 = mu[0]
     mu1 = mu[1]
     mu2 = mu[2]
     mu3 = mu[3]
     t0 = 0.149769 + mu0**2 + mu1**2
-    t1 = 0.1655095 - 0.5*t0
+    t1 = 0.5*(0.331019 - t0)
     t2 = mu0 + mu1 + mu2 + mu3
     t3 = t1**2
     t4 = 1 - 125.18949581886645*t3
@@ -674,42 +674,42 @@ def _ik_branches(mu):
     t9 = casadi.atan2(t8, t7)
     t10 = 3.141592653589793 + t9
     t11 = 3.141592653589793 - t9
-    t12 = t10 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t10)
-    t13 = t12 - 6.283185307179586*casadi.floor(0.24444444444444444 + 0.15915494309189535*t12)
-    t14 = t11 - 6.283185307179586*casadi.ceil(-0.5 + 0.15915494309189535*t11)
-    t15 = t14 - 6.283185307179586*casadi.floor(0.24444444444444444 + 0.15915494309189535*t14)
+    t12 = t10 - 6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t10))
+    t13 = t12 - 6.283185307179586*casadi.floor(0.15915494309189535*(1.53588974175501 + t12))
+    t14 = t11 - 6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t11))
+    t15 = t14 - 6.283185307179586*casadi.floor(0.15915494309189535*(1.53588974175501 + t14))
     t16 = -1.0*t7
     t17 = -1.0*t8
     t18 = 0.325 + 0.275*t16
     t19 = 0.149769 + t18**2 + 0.075625*t17**2
     t20 = 0.275*t17
-    t21 = 0.149769 + mu0*t18 + mu1*t20
+    t21 = 0.149769 + t18*mu0 + t20*mu1
     t22 = -0.149769 + t21
-    t23 = mu1*t18 - mu0*t20
+    t23 = t18*mu1 - t20*mu0
     t24 = t22**2 + t23**2
     t25 = 0.325 - 0.275*t7
     t26 = 0.149769 + t25**2 + 0.075625*t8**2
     t27 = 0.275*t8
-    t28 = 0.149769 + mu0*t25 + mu1*t27
+    t28 = 0.149769 + t25*mu0 + t27*mu1
     t29 = -0.149769 + t28
-    t30 = mu1*t25 - mu0*t27
+    t30 = t25*mu1 - t27*mu0
     t31 = t29**2 + t30**2
     t32 = 1e-24*t0
     t33 = casadi.if_else((t24 <= t19*t32), 0, casadi.atan2(t23, t22))
     t34 = t33
-    t35 = t34 - 6.283185307179586*casadi.floor(0.1388888888888889 + 0.15915494309189535*t34)
+    t35 = t34 - 6.283185307179586*casadi.floor(0.15915494309189535*(0.8726646259971648 + t34))
     t36 = -mu3
-    t37 = -t10 - t33 - t36
-    t38 = t37 + 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t37)
+    t37 = -(t10 + t33 + t36)
+    t38 = t37 + 6.283185307179586*casadi.ceil(-0.15915494309189535*(3.141592653589793 + t37))
     t39 = -t38
-    t40 = t38 + 6.283185307179586*casadi.floor(1.0 + 0.15915494309189535*t39)
+    t40 = t38 + 6.283185307179586*casadi.floor(0.15915494309189535*(6.283185307179586 + t39))
     t41 = casadi.if_else((t31 <= t26*t32), 0, casadi.atan2(t30, t29))
     t42 = t41
-    t43 = t42 - 6.283185307179586*casadi.floor(0.1388888888888889 + 0.15915494309189535*t42)
-    t44 = -t11 - t36 - t41
-    t45 = t44 + 6.283185307179586*casadi.ceil(-0.5 - 0.15915494309189535*t44)
+    t43 = t42 - 6.283185307179586*casadi.floor(0.15915494309189535*(0.8726646259971648 + t42))
+    t44 = -(t11 + t36 + t41)
+    t45 = t44 + 6.283185307179586*casadi.ceil(-0.15915494309189535*(3.141592653589793 + t44))
     t46 = -t45
-    t47 = t45 + 6.283185307179586*casadi.floor(1.0 + 0.15915494309189535*t46)
+    t47 = t45 + 6.283185307179586*casadi.floor(0.15915494309189535*(6.283185307179586 + t46))
     t48 = (t35 <= 0.8726646259971648)
     t49 = casadi.logic_and((t34 >= -0.8726646259971648), (t34 <= 0.8726646259971648))
     t50 = (t13 <= 1.53588974175501)
@@ -734,7 +734,7 @@ def _ik_branches(mu):
     q[1, 2] = t52
     q[1, 3] = casadi.if_else(casadi.logic_and((t47 >= -6.283185307179586), casadi.logic_not(casadi.logic_and((t45 >= -6.283185307179586), (t45 <= 6.283185307179586)))), t58, t46)
     valid = casadi.SX(2, 1)
-    valid[0, 0] = casadi.logic_and(t59, (t4 >= -1e-12))
+    valid[0, 0] = casadi.logic_and(t59, casadi.logic_or((t4 >= -1e-12), casadi.logic_and(False, (t3 <= 1.931417125e-14))))
     valid[1, 0] = casadi.logic_and(t59, (t4 > 1e-12))
     in_limits = casadi.SX(2, 1)
     in_limits[0, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t60, t61), casadi.logic_or(t48, t49)), casadi.logic_or(t50, t51)), casadi.logic_or((t53 <= 6.283185307179586), casadi.logic_and((t39 >= -6.283185307179586), (t39 <= 6.283185307179586))))
@@ -779,42 +779,42 @@ def _ik_nearest(mu, q_seed, weights):
     t7 = qb1_3 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn4 - qb1_3))
     t8 = casadi.if_else(casadi.logic_and(lb1, vb1), 1, 0)
     t9 = mu0 + mu1 + mu2 + mu3 + qn1 + qn2 + qn3 + qn4 + qw1 + qw2 + qw3 + qw4
-    t10 = casadi.if_else((qn1 > t0), 6.283185307179586, -6.283185307179586)
+    t10 = casadi.if_else((t0 < qn1), 6.283185307179586, -6.283185307179586)
     t11 = t0 + t10
     t12 = t0 - t10
     t13 = casadi.if_else(casadi.logic_and((t0 >= -0.8726646259971648), (t0 <= 0.8726646259971648)), t0, casadi.if_else(casadi.logic_and((t11 >= -0.8726646259971648), (t11 <= 0.8726646259971648)), t11, casadi.if_else(casadi.logic_and((t12 >= -0.8726646259971648), (t12 <= 0.8726646259971648)), t12, qb0_0)))
-    t14 = casadi.if_else((qn2 > t1), 6.283185307179586, -6.283185307179586)
+    t14 = casadi.if_else((t1 < qn2), 6.283185307179586, -6.283185307179586)
     t15 = t1 + t14
     t16 = t1 - t14
     t17 = casadi.if_else(casadi.logic_and((t1 >= -1.53588974175501), (t1 <= 1.53588974175501)), t1, casadi.if_else(casadi.logic_and((t15 >= -1.53588974175501), (t15 <= 1.53588974175501)), t15, casadi.if_else(casadi.logic_and((t16 >= -1.53588974175501), (t16 <= 1.53588974175501)), t16, qb0_1)))
-    t18 = casadi.if_else((qn4 > t2), 6.283185307179586, -6.283185307179586)
-    t19 = t18 + t2
+    t18 = casadi.if_else((t2 < qn4), 6.283185307179586, -6.283185307179586)
+    t19 = t2 + t18
     t20 = t2 - t18
     t21 = casadi.if_else(casadi.logic_and((t2 >= -6.283185307179586), (t2 <= 6.283185307179586)), t2, casadi.if_else(casadi.logic_and((t19 >= -6.283185307179586), (t19 <= 6.283185307179586)), t19, casadi.if_else(casadi.logic_and((t20 >= -6.283185307179586), (t20 <= 6.283185307179586)), t20, qb0_3)))
     t22 = -qn1
     t23 = -qn2
     t24 = -qn3
     t25 = -qn4
-    t26 = qw1*(t13 + t22)**2 + qw2*(t17 + t23)**2 + qw3*(qb0_2 + t24)**2 + qw4*(t21 + t25)**2
+    t26 = qw1*(t13 + t22)**2 + qw2*(t17 + t23)**2 + qw3*(t24 + qb0_2)**2 + qw4*(t21 + t25)**2
     t27 = (t4 > 0)
     t28 = casadi.if_else(t27, t13, qn1)
     t29 = casadi.if_else(t27, t17, qn2)
     t30 = casadi.if_else(t27, qb0_2, qn3)
     t31 = casadi.if_else(t27, t21, qn4)
     t32 = casadi.if_else(t27, t26, 0)
-    t33 = casadi.if_else((qn1 > t5), 6.283185307179586, -6.283185307179586)
-    t34 = t33 + t5
+    t33 = casadi.if_else((t5 < qn1), 6.283185307179586, -6.283185307179586)
+    t34 = t5 + t33
     t35 = t5 - t33
     t36 = casadi.if_else(casadi.logic_and((t5 >= -0.8726646259971648), (t5 <= 0.8726646259971648)), t5, casadi.if_else(casadi.logic_and((t34 >= -0.8726646259971648), (t34 <= 0.8726646259971648)), t34, casadi.if_else(casadi.logic_and((t35 >= -0.8726646259971648), (t35 <= 0.8726646259971648)), t35, qb1_0)))
-    t37 = casadi.if_else((qn2 > t6), 6.283185307179586, -6.283185307179586)
-    t38 = t37 + t6
+    t37 = casadi.if_else((t6 < qn2), 6.283185307179586, -6.283185307179586)
+    t38 = t6 + t37
     t39 = t6 - t37
     t40 = casadi.if_else(casadi.logic_and((t6 >= -1.53588974175501), (t6 <= 1.53588974175501)), t6, casadi.if_else(casadi.logic_and((t38 >= -1.53588974175501), (t38 <= 1.53588974175501)), t38, casadi.if_else(casadi.logic_and((t39 >= -1.53588974175501), (t39 <= 1.53588974175501)), t39, qb1_1)))
-    t41 = casadi.if_else((qn4 > t7), 6.283185307179586, -6.283185307179586)
-    t42 = t41 + t7
+    t41 = casadi.if_else((t7 < qn4), 6.283185307179586, -6.283185307179586)
+    t42 = t7 + t41
     t43 = t7 - t41
     t44 = casadi.if_else(casadi.logic_and((t7 >= -6.283185307179586), (t7 <= 6.283185307179586)), t7, casadi.if_else(casadi.logic_and((t42 >= -6.283185307179586), (t42 <= 6.283185307179586)), t42, casadi.if_else(casadi.logic_and((t43 >= -6.283185307179586), (t43 <= 6.283185307179586)), t43, qb1_3)))
-    t45 = qw1*(t22 + t36)**2 + qw2*(t23 + t40)**2 + qw3*(qb1_2 + t24)**2 + qw4*(t25 + t44)**2
+    t45 = qw1*(t36 + t22)**2 + qw2*(t40 + t23)**2 + qw3*(t24 + qb1_2)**2 + qw4*(t44 + t25)**2
     t46 = (t8 > 0)
     t47 = casadi.if_else(casadi.logic_and(t46, casadi.logic_or((t32 > t45), (t4 < 1))), 1, 0)
     t48 = casadi.if_else(t46, 1, t4)

@@ -39,15 +39,15 @@ typedef double stanford_real;
 void stanford_fk(const stanford_real q[STANFORD_DOF], stanford_real T[16]);
 
 /* Geometric Jacobian in the world frame (6 x DOF, rows vx vy vz wx wy wz).
- * Result: J: 6 x 6 row-major, element (r, c) at J[r * 6 + c]. 50 operations. */
+ * Result: J: 6 x 6 row-major, element (r, c) at J[r * 6 + c]. 49 operations. */
 void stanford_jacobian(const stanford_real q[STANFORD_DOF], stanford_real J[6 * STANFORD_DOF]);
 
 /* Fk and jacobian in one pass, sharing their terms.
- * Result: T: 4 x 4 row-major, element (r, c) at T[r * 4 + c]; J: 6 x 6 row-major, element (r, c) at J[r * 6 + c]. 81 operations. */
+ * Result: T: 4 x 4 row-major, element (r, c) at T[r * 4 + c]; J: 6 x 6 row-major, element (r, c) at J[r * 6 + c]. 80 operations. */
 void stanford_fk_jacobian(const stanford_real q[STANFORD_DOF], stanford_real T[16], stanford_real J[6 * STANFORD_DOF]);
 
 /* Geometric Jacobian in the tool frame (6 x DOF, rows vx vy vz wx wy wz).
- * Result: J: 6 x 6 row-major, element (r, c) at J[r * 6 + c]. 156 operations. */
+ * Result: J: 6 x 6 row-major, element (r, c) at J[r * 6 + c]. 155 operations. */
 void stanford_jacobian_tool(const stanford_real q[STANFORD_DOF], stanford_real J[6 * STANFORD_DOF]);
 
 /* Task vector mu = (x, y, z, roll, pitch, yaw).
@@ -55,27 +55,27 @@ void stanford_jacobian_tool(const stanford_real q[STANFORD_DOF], stanford_real J
 void stanford_task(const stanford_real q[STANFORD_DOF], stanford_real mu[STANFORD_TASK_DIM]);
 
 /* Analytic Jacobian d mu / d q (6 x DOF).
- * Result: J: 6 x 6 row-major, element (r, c) at J[r * 6 + c]. 113 operations. */
+ * Result: J: 6 x 6 row-major, element (r, c) at J[r * 6 + c]. 112 operations. */
 void stanford_task_jacobian(const stanford_real q[STANFORD_DOF], stanford_real J[STANFORD_TASK_DIM * STANFORD_DOF]);
 
 /* Fk, jacobian and bias_acceleration in one pass, sharing their terms.
- * Result: T: 4 x 4 row-major, element (r, c) at T[r * 4 + c]; J: 6 x 6 row-major, element (r, c) at J[r * 6 + c]; a[i], i < 6. 180 operations. */
+ * Result: T: 4 x 4 row-major, element (r, c) at T[r * 4 + c]; J: 6 x 6 row-major, element (r, c) at J[r * 6 + c]; a[i], i < 6. 179 operations. */
 void stanford_fk_jacobian_dot(const stanford_real q[STANFORD_DOF], const stanford_real q_dot[STANFORD_DOF], stanford_real T[16], stanford_real J[6 * STANFORD_DOF], stanford_real a[6]);
 
 /* Time derivative dJ/dt of the world geometric Jacobian along q_dot (6 x DOF).
- * Result: Jd: 6 x 6 row-major, element (r, c) at Jd[r * 6 + c]. 120 operations. */
+ * Result: Jd: 6 x 6 row-major, element (r, c) at Jd[r * 6 + c]. 116 operations. */
 void stanford_jacobian_dot(const stanford_real q[STANFORD_DOF], const stanford_real q_dot[STANFORD_DOF], stanford_real Jd[6 * STANFORD_DOF]);
 
 /* J' q_dot: the tool's classical linear and angular acceleration at zero joint acceleration, world frame (6).
- * Result: a[i], i < 6. 146 operations. */
+ * Result: a[i], i < 6. 145 operations. */
 void stanford_bias_acceleration(const stanford_real q[STANFORD_DOF], const stanford_real q_dot[STANFORD_DOF], stanford_real a[6]);
 
 /* Time derivative of the analytic Jacobian along q_dot (6 x DOF): mu'' = J_a q'' + J_a' q'.
- * Result: Jd: 6 x 6 row-major, element (r, c) at Jd[r * 6 + c]. 372 operations. */
+ * Result: Jd: 6 x 6 row-major, element (r, c) at Jd[r * 6 + c]. 371 operations. */
 void stanford_task_jacobian_dot(const stanford_real q[STANFORD_DOF], const stanford_real q_dot[STANFORD_DOF], stanford_real Jd[STANFORD_TASK_DIM * STANFORD_DOF]);
 
 /* Partial derivatives dJ/dq_k of the world geometric Jacobian (DOF x 6 x DOF, indexed [k, r, c]).
- * Result: H: 6 x 6 x 6 row-major, element (k, r, c) at H[k * 36 + r * 6 + c]. 115 operations. */
+ * Result: H: 6 x 6 x 6 row-major, element (k, r, c) at H[k * 36 + r * 6 + c]. 109 operations. */
 void stanford_hessian(const stanford_real q[STANFORD_DOF], stanford_real H[STANFORD_DOF * 6 * STANFORD_DOF]);
 
 /* Factors of det(Js): the robot is singular where one is 0.
@@ -95,7 +95,7 @@ stanford_real stanford_jacobian_det(const stanford_real q[STANFORD_DOF]);
 int stanford_velocity_ik(const stanford_real q[STANFORD_DOF], const stanford_real mu_dot[STANFORD_TASK_DIM], stanford_real damping, stanford_real q_dot[STANFORD_DOF]);
 
 /* One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite).
- * Result: q_start[i], i < 6; q_next[i], i < 6; returned as a scalar. 876 operations. */
+ * Result: q_start[i], i < 6; q_next[i], i < 6; returned as a scalar. 871 operations. */
 stanford_real stanford_ik_numeric_step(const stanford_real target[16], const stanford_real q[STANFORD_DOF], stanford_real damping, stanford_real q_start[STANFORD_DOF], stanford_real q_next[STANFORD_DOF]);
 
 /* Every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits.

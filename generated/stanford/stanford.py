@@ -86,32 +86,32 @@ def fk(q):
     s6 = trig[..., 11]
     t0 = 0.412 + c2*q3
     t1 = q3*s2
-    t2 = -0.1337*s1 + c1*t1
-    t3 = 0.1337*c1 + s1*t1
+    t2 = -0.1337*s1 + t1*c1
+    t3 = 0.1337*c1 + t1*s1
     t4 = c4*s1
     t5 = c1*s4
-    t6 = t4 + c2*t5
-    t7 = t5 + c2*t4
+    t6 = t4 + t5*c2
+    t7 = t5 + t4*c2
     t8 = s1*s4
     t9 = c1*c4
-    t10 = -t8 + c2*t9
-    t11 = -t9 + c2*t8
+    t10 = -t8 + t9*c2
+    t11 = -t9 + t8*c2
     t12 = c1*s2
-    t13 = c5*t6 - s5*t12
-    t14 = c5*t12 + s5*t6
-    t15 = c6*t13 + s6*t10
-    t16 = c6*t10 - s6*t13
+    t13 = t6*c5 - t12*s5
+    t14 = t6*s5 + t12*c5
+    t15 = t10*s6 + t13*c6
+    t16 = t10*c6 - t13*s6
     t17 = s1*s2
-    t18 = c5*t11 - s5*t17
-    t19 = c5*t17 + s5*t11
-    t20 = c6*t18 + s6*t7
-    t21 = c6*t7 - s6*t18
+    t18 = t11*c5 - t17*s5
+    t19 = t11*s5 + t17*c5
+    t20 = t7*s6 + t18*c6
+    t21 = t7*c6 - t18*s6
     t22 = s2*s4
-    t23 = c2*s5 + c5*t22
-    t24 = s5*t22 - c2*c5
+    t23 = t22*c5 + c2*s5
+    t24 = t22*s5 - c2*c5
     t25 = c4*s2
-    t26 = c6*t23 + s6*t25
-    t27 = s6*t23 - c6*t25
+    t26 = t23*c6 + t25*s6
+    t27 = t23*s6 - t25*c6
     T = _stack(xp, [
         t15,  # 0, 0
         t16,  # 0, 1
@@ -134,7 +134,7 @@ def fk(q):
 
 
 def jacobian(q):
-    """geometric Jacobian in the world frame (6 x DOF, rows vx vy vz wx wy wz): (6 x 6), 50 operations."""
+    """geometric Jacobian in the world frame (6 x DOF, rows vx vy vz wx wy wz): (6 x 6), 49 operations."""
     xp, dtype, device, batch, (q,) = _arguments(("q", q, (6,)))
     q3 = q[..., 2]
     trig = _cos_sin(xp, q, (0.0, 0.0, 0.0, 0.0, 0.0, 0.0), device)
@@ -148,35 +148,35 @@ def jacobian(q):
     s5 = trig[..., 9]
     t0 = -c2*c5 + s2*s4*s5
     t1 = c1*s2
-    t2 = -0.1337*s1 + q3*t1
+    t2 = -0.1337*s1 + t1*q3
     t3 = s1*s2
-    t4 = 0.1337*c1 + q3*t3
+    t4 = 0.1337*c1 + t3*q3
     t5 = c4*s1
     t6 = c1*s4
-    t7 = t5 + c2*t6
-    t8 = t6 + c2*t5
-    t9 = c5*t1 + s5*t7
+    t7 = t5 + t6*c2
+    t8 = t6 + t5*c2
+    t9 = t7*s5 + t1*c5
     t10 = s1*s4
     t11 = c1*c4
-    t12 = -t10 + c2*t11
-    t13 = -t11 + c2*t10
-    t14 = c5*t3 + s5*t13
+    t12 = -t10 + t11*c2
+    t13 = -t11 + t10*c2
+    t14 = t13*s5 + t3*c5
     t15 = c2*q3
     J = _stack(xp, [
         -t4,  # 0, 0
-        c1*t15,  # 0, 1
+        t15*c1,  # 0, 1
         t1,  # 0, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5
         t2,  # 1, 0
-        s1*t15,  # 1, 1
+        t15*s1,  # 1, 1
         t3,  # 1, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
-        -c1*t2 - s1*t4,  # 2, 1
+        -(t2*c1 + t4*s1),  # 2, 1
         c2,  # 2, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 4
@@ -204,7 +204,7 @@ def jacobian(q):
 
 
 def fk_jacobian(q):
-    """fk and jacobian in one pass, sharing their terms: (4 x 4 and 6 x 6), 81 operations."""
+    """fk and jacobian in one pass, sharing their terms: (4 x 4 and 6 x 6), 80 operations."""
     xp, dtype, device, batch, (q,) = _arguments(("q", q, (6,)))
     q3 = q[..., 2]
     trig = _cos_sin(xp, q, (0.0, 0.0, 0.0, 0.0, 0.0, 0.0), device)
@@ -219,33 +219,33 @@ def fk_jacobian(q):
     c6 = trig[..., 10]
     s6 = trig[..., 11]
     t0 = c1*s2
-    t1 = -0.1337*s1 + q3*t0
+    t1 = -0.1337*s1 + t0*q3
     t2 = s1*s2
-    t3 = 0.1337*c1 + q3*t2
+    t3 = 0.1337*c1 + t2*q3
     t4 = c2*q3
     t5 = 0.412 + t4
     t6 = c4*s1
     t7 = c1*s4
-    t8 = t6 + c2*t7
-    t9 = t7 + c2*t6
-    t10 = c5*t8 - s5*t0
-    t11 = c5*t0 + s5*t8
+    t8 = t6 + t7*c2
+    t9 = t7 + t6*c2
+    t10 = t8*c5 - t0*s5
+    t11 = t8*s5 + t0*c5
     t12 = s1*s4
     t13 = c1*c4
-    t14 = -t12 + c2*t13
-    t15 = -t13 + c2*t12
-    t16 = c5*t15 - s5*t2
-    t17 = c5*t2 + s5*t15
-    t18 = c6*t10 + s6*t14
-    t19 = c6*t14 - s6*t10
-    t20 = c6*t16 + s6*t9
-    t21 = c6*t9 - s6*t16
+    t14 = -t12 + t13*c2
+    t15 = -t13 + t12*c2
+    t16 = t15*c5 - t2*s5
+    t17 = t15*s5 + t2*c5
+    t18 = t14*s6 + t10*c6
+    t19 = t14*c6 - t10*s6
+    t20 = t9*s6 + t16*c6
+    t21 = t9*c6 - t16*s6
     t22 = s2*s4
-    t23 = c2*s5 + c5*t22
-    t24 = s5*t22 - c2*c5
+    t23 = t22*c5 + c2*s5
+    t24 = t22*s5 - c2*c5
     t25 = c4*s2
-    t26 = c6*t23 + s6*t25
-    t27 = s6*t23 - c6*t25
+    t26 = t23*c6 + t25*s6
+    t27 = t23*s6 - t25*c6
     t28 = -t24
     T = _stack(xp, [
         t18,  # 0, 0
@@ -267,19 +267,19 @@ def fk_jacobian(q):
     ], (4, 4))
     J = _stack(xp, [
         -t3,  # 0, 0
-        c1*t4,  # 0, 1
+        t4*c1,  # 0, 1
         t0,  # 0, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5
         t1,  # 1, 0
-        s1*t4,  # 1, 1
+        t4*s1,  # 1, 1
         t2,  # 1, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
-        -c1*t1 - s1*t3,  # 2, 1
+        -(t1*c1 + t3*s1),  # 2, 1
         c2,  # 2, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 4
@@ -307,7 +307,7 @@ def fk_jacobian(q):
 
 
 def jacobian_tool(q):
-    """geometric Jacobian in the tool frame (6 x DOF, rows vx vy vz wx wy wz): (6 x 6), 156 operations."""
+    """geometric Jacobian in the tool frame (6 x DOF, rows vx vy vz wx wy wz): (6 x 6), 155 operations."""
     xp, dtype, device, batch, (q,) = _arguments(("q", q, (6,)))
     q3 = q[..., 2]
     trig = _cos_sin(xp, q, (0.0, 0.0, 0.0, 0.0, 0.0, 0.0), device)
@@ -322,75 +322,75 @@ def jacobian_tool(q):
     c6 = trig[..., 10]
     s6 = trig[..., 11]
     t0 = q3*s2
-    t1 = -0.1337*s1 + c1*t0
-    t2 = 0.1337*c1 + s1*t0
+    t1 = -0.1337*s1 + t0*c1
+    t2 = 0.1337*c1 + t0*s1
     t3 = c4*s1
     t4 = c1*s4
-    t5 = t3 + c2*t4
-    t6 = t4 + c2*t3
+    t5 = t3 + t4*c2
+    t6 = t4 + t3*c2
     t7 = s1*s4
     t8 = c1*c4
-    t9 = -t7 + c2*t8
-    t10 = -t8 + c2*t7
+    t9 = -t7 + t8*c2
+    t10 = -t8 + t7*c2
     t11 = c1*s2
-    t12 = c5*t5 - s5*t11
-    t13 = c5*t11 + s5*t5
-    t14 = c6*t12 + s6*t9
-    t15 = c6*t9 - s6*t12
+    t12 = t5*c5 - t11*s5
+    t13 = t5*s5 + t11*c5
+    t14 = t9*s6 + t12*c6
+    t15 = t9*c6 - t12*s6
     t16 = s1*s2
-    t17 = c5*t10 - s5*t16
-    t18 = c5*t16 + s5*t10
-    t19 = c6*t17 + s6*t6
-    t20 = c6*t6 - s6*t17
+    t17 = t10*c5 - t16*s5
+    t18 = t10*s5 + t16*c5
+    t19 = t6*s6 + t17*c6
+    t20 = t6*c6 - t17*s6
     t21 = s2*s4
-    t22 = c2*s5 + c5*t21
-    t23 = s5*t21 - c2*c5
+    t22 = t21*c5 + c2*s5
+    t23 = t21*s5 - c2*c5
     t24 = c4*s2
-    t25 = c6*t22 + s6*t24
-    t26 = s6*t22 - c6*t24
+    t25 = t22*c6 + t24*s6
+    t26 = t22*s6 - t24*c6
     t27 = c2*q3
-    t28 = c1*t27
-    t29 = s1*t27
-    t30 = -c1*t1 - s1*t2
-    t31 = t11*t14 + t16*t19 - c2*t25
-    t32 = c2*t26 + t11*t15 + t16*t20
-    t33 = t11*t13 + t16*t18 - c2*t23
+    t28 = t27*c1
+    t29 = t27*s1
+    t30 = -(t1*c1 + t2*s1)
+    t31 = t14*t11 + t19*t16 - t25*c2
+    t32 = t15*t11 + t20*t16 + t26*c2
+    t33 = t13*t11 + t18*t16 - t23*c2
     J = _stack(xp, [
-        t1*t19 - t14*t2,  # 0, 0
+        t19*t1 - t14*t2,  # 0, 0
         t14*t28 + t19*t29 - t25*t30,  # 0, 1
         t31,  # 0, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5
-        t1*t20 - t15*t2,  # 1, 0
+        t20*t1 - t15*t2,  # 1, 0
         t15*t28 + t20*t29 + t26*t30,  # 1, 1
         t32,  # 1, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5
-        t1*t18 - t13*t2,  # 2, 0
+        t18*t1 - t13*t2,  # 2, 0
         t13*t28 + t18*t29 - t23*t30,  # 2, 1
         t33,  # 2, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 5
         -t25,  # 3, 0
-        c1*t19 - s1*t14,  # 3, 1
+        t19*c1 - t14*s1,  # 3, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 2
         t31,  # 3, 3
-        t14*t9 + t19*t6 + t24*t25,  # 3, 4
+        t9*t14 + t6*t19 + t25*t24,  # 3, 4
         t13*t14 + t18*t19 + t23*t25,  # 3, 5
         t26,  # 4, 0
-        c1*t20 - s1*t15,  # 4, 1
+        t20*c1 - t15*s1,  # 4, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 2
         t32,  # 4, 3
-        t15*t9 + t20*t6 - t24*t26,  # 4, 4
+        t9*t15 + t6*t20 - t26*t24,  # 4, 4
         t13*t15 + t18*t20 - t23*t26,  # 4, 5
         -t23,  # 5, 0
-        c1*t18 - s1*t13,  # 5, 1
+        t18*c1 - t13*s1,  # 5, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 2
         t33,  # 5, 3
-        t13*t9 + t18*t6 + t23*t24,  # 5, 4
+        t9*t13 + t6*t18 + t23*t24,  # 5, 4
         t13**2 + t18**2 + t23**2,  # 5, 5
     ], (6, 6))
     return J
@@ -414,25 +414,25 @@ def task(q):
     t0 = 0.412 + c2*q3
     t1 = c2*s5 + c5*s2*s4
     t2 = q3*s2
-    t3 = -0.1337*s1 + c1*t2
-    t4 = 0.1337*c1 + s1*t2
+    t3 = -0.1337*s1 + t2*c1
+    t4 = 0.1337*c1 + t2*s1
     t5 = c4*s1
     t6 = c1*s4
-    t7 = t5 + c2*t6
-    t8 = t6 + c2*t5
+    t7 = t5 + t6*c2
+    t8 = t6 + t5*c2
     t9 = s1*s4
     t10 = c1*c4
-    t11 = -t9 + c2*t10
-    t12 = -t10 + c2*t9
+    t11 = -t9 + t10*c2
+    t12 = -t10 + t9*c2
     t13 = s2*s5
-    t14 = c5*t7 - c1*t13
-    t15 = c5*t12 - s1*t13
-    t16 = s4*t13 - c2*c5
-    t17 = c6*t14 + s6*t11
-    t18 = c6*t15 + s6*t8
+    t14 = t7*c5 - t13*c1
+    t15 = t12*c5 - t13*s1
+    t16 = t13*s4 - c2*c5
+    t17 = t11*s6 + t14*c6
+    t18 = t8*s6 + t15*c6
     t19 = c4*s2
-    t20 = c6*t1 + s6*t19
-    t21 = s6*t1 - c6*t19
+    t20 = t1*c6 + t19*s6
+    t21 = t1*s6 - t19*c6
     mu = _stack(xp, [
         t3,  # 0
         t4,  # 1
@@ -445,7 +445,7 @@ def task(q):
 
 
 def task_jacobian(q):
-    """analytic Jacobian d mu / d q (6 x DOF): (6 x 6), 113 operations."""
+    """analytic Jacobian d mu / d q (6 x DOF): (6 x 6), 112 operations."""
     xp, dtype, device, batch, (q,) = _arguments(("q", q, (6,)))
     q3 = q[..., 2]
     trig = _cos_sin(xp, q, (0.0, 0.0, 0.0, 0.0, 0.0, 0.0), device)
@@ -460,51 +460,51 @@ def task_jacobian(q):
     c6 = trig[..., 10]
     s6 = trig[..., 11]
     t0 = c1*s2
-    t1 = -0.1337*s1 + q3*t0
+    t1 = -0.1337*s1 + t0*q3
     t2 = s1*s2
-    t3 = 0.1337*c1 + q3*t2
+    t3 = 0.1337*c1 + t2*q3
     t4 = c4*s1
     t5 = c1*s4
-    t6 = t4 + c2*t5
-    t7 = t5 + c2*t4
-    t8 = c5*t6 - s5*t0
-    t9 = c5*t0 + s5*t6
+    t6 = t4 + t5*c2
+    t7 = t5 + t4*c2
+    t8 = t6*c5 - t0*s5
+    t9 = t6*s5 + t0*c5
     t10 = s1*s4
     t11 = c1*c4
-    t12 = -t10 + c2*t11
-    t13 = -t11 + c2*t10
-    t14 = c5*t13 - s5*t2
-    t15 = c5*t2 + s5*t13
-    t16 = c6*t8 + s6*t12
-    t17 = c6*t14 + s6*t7
+    t12 = -t10 + t11*c2
+    t13 = -t11 + t10*c2
+    t14 = t13*c5 - t2*s5
+    t15 = t13*s5 + t2*c5
+    t16 = t12*s6 + t8*c6
+    t17 = t7*s6 + t14*c6
     t18 = s2*s4
-    t19 = c2*s5 + c5*t18
-    t20 = s5*t18 - c2*c5
+    t19 = t18*c5 + c2*s5
+    t20 = t18*s5 - c2*c5
     t21 = c4*s2
-    t22 = c6*t19 + s6*t21
+    t22 = t19*c6 + t21*s6
     t23 = c2*q3
     t24 = t16**2 + t17**2
-    t25 = t24**(-1.0)
-    t26 = t25*(c1*t17 - s1*t16)
-    t27 = t25*(t0*t16 + t17*t2)
-    t28 = t25*(t12*t16 + t17*t7)
-    t29 = t25*(t15*t17 + t16*t9)
+    t25 = 1/t24
+    t26 = t25*(t17*c1 - t16*s1)
+    t27 = t25*(t16*t0 + t17*t2)
+    t28 = t25*(t12*t16 + t7*t17)
+    t29 = t25*(t9*t16 + t15*t17)
     t30 = 1/xp.sqrt(t24)
     J = _stack(xp, [
         -t3,  # 0, 0
-        c1*t23,  # 0, 1
+        t23*c1,  # 0, 1
         t0,  # 0, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5
         t1,  # 1, 0
-        s1*t23,  # 1, 1
+        t23*s1,  # 1, 1
         t2,  # 1, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
-        -c1*t1 - s1*t3,  # 2, 1
+        -(t1*c1 + t3*s1),  # 2, 1
         c2,  # 2, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 4
@@ -516,11 +516,11 @@ def task_jacobian(q):
         t28,  # 3, 4
         t29,  # 3, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
-        t30*(c1*t16 + s1*t17),  # 4, 1
+        t30*(t16*c1 + t17*s1),  # 4, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 2
-        t30*(t16*t2 - t0*t17),  # 4, 3
-        t30*(t16*t7 - t12*t17),  # 4, 4
-        t30*(t15*t16 - t17*t9),  # 4, 5
+        t30*(t16*t2 - t17*t0),  # 4, 3
+        t30*(t7*t16 - t12*t17),  # 4, 4
+        t30*(t15*t16 - t9*t17),  # 4, 5
         xp.full(batch, 1, dtype=dtype, device=device),  # 5, 0
         t22*t26,  # 5, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 2
@@ -532,7 +532,7 @@ def task_jacobian(q):
 
 
 def fk_jacobian_dot(q, q_dot):
-    """fk, jacobian and bias_acceleration in one pass, sharing their terms: (4 x 4 and 6 x 6 and 6 x 1), 180 operations."""
+    """fk, jacobian and bias_acceleration in one pass, sharing their terms: (4 x 4 and 6 x 6 and 6 x 1), 179 operations."""
     xp, dtype, device, batch, (q, q_dot,) = _arguments(("q", q, (6,)), ("q_dot", q_dot, (6,)))
     q3 = q[..., 2]
     qd1 = q_dot[..., 0]
@@ -554,54 +554,54 @@ def fk_jacobian_dot(q, q_dot):
     s6 = trig[..., 11]
     t0 = qd1 + c2*qd4
     t1 = c1*s2
-    t2 = -0.1337*s1 + q3*t1
+    t2 = -0.1337*s1 + t1*q3
     t3 = s1*s2
-    t4 = 0.1337*c1 + q3*t3
+    t4 = 0.1337*c1 + t3*q3
     t5 = c2*q3
     t6 = 0.412 + t5
     t7 = c4*s1
     t8 = c1*s4
-    t9 = t7 + c2*t8
-    t10 = t8 + c2*t7
-    t11 = c5*t9 - s5*t1
-    t12 = c5*t1 + s5*t9
+    t9 = t7 + t8*c2
+    t10 = t8 + t7*c2
+    t11 = t9*c5 - t1*s5
+    t12 = t9*s5 + t1*c5
     t13 = s1*s4
     t14 = c1*c4
-    t15 = -t13 + c2*t14
-    t16 = -t14 + c2*t13
-    t17 = c5*t16 - s5*t3
-    t18 = c5*t3 + s5*t16
-    t19 = c6*t11 + s6*t15
-    t20 = c6*t15 - s6*t11
-    t21 = c6*t17 + s6*t10
-    t22 = c6*t10 - s6*t17
+    t15 = -t13 + t14*c2
+    t16 = -t14 + t13*c2
+    t17 = t16*c5 - t3*s5
+    t18 = t16*s5 + t3*c5
+    t19 = t15*s6 + t11*c6
+    t20 = t15*c6 - t11*s6
+    t21 = t10*s6 + t17*c6
+    t22 = t10*c6 - t17*s6
     t23 = s2*s4
-    t24 = c2*s5 + c5*t23
-    t25 = s5*t23 - c2*c5
+    t24 = t23*c5 + c2*s5
+    t25 = t23*s5 - c2*c5
     t26 = c4*s2
-    t27 = c6*t24 + s6*t26
-    t28 = s6*t24 - c6*t26
-    t29 = t0 - qd5*t26
-    t30 = c1*t2 + s1*t4
+    t27 = t24*c6 + t26*s6
+    t28 = t24*s6 - t26*c6
+    t29 = t0 - t26*qd5
+    t30 = t2*c1 + t4*s1
     t31 = t30
-    t32 = c2*qd3 - qd2*t31
+    t32 = c2*qd3 - t31*qd2
     t33 = qd2*s1
-    t34 = -t33 + qd4*t1
-    t35 = t34 + qd5*t15
-    t36 = qd3*t3 + t33*t5
-    t37 = t36 + qd1*t2
+    t34 = -t33 + t1*qd4
+    t35 = t34 + t15*qd5
+    t36 = t3*qd3 + t33*t5
+    t37 = t36 + t2*qd1
     t38 = c1*qd2
-    t39 = t38 + qd4*t3
-    t40 = t39 + qd5*t10
-    t41 = qd3*t1 + t38*t5
-    t42 = t41 - qd1*t4
+    t39 = t38 + t3*qd4
+    t40 = t39 + t10*qd5
+    t41 = t1*qd3 + t38*t5
+    t42 = t41 - t4*qd1
     t43 = -t25
-    t44 = c1*t5
-    t45 = s1*t5
-    t46 = c2*t38 - qd1*t3
-    t47 = c2*t33 + qd1*t1
+    t44 = t5*c1
+    t45 = t5*s1
+    t46 = t38*c2 - t3*qd1
+    t47 = t1*qd1 + t33*c2
     t48 = qd2*s2
-    t49 = -t48*c1**2 - t48*s1**2
+    t49 = -(t48*c1**2 + t48*s1**2)
     T = _stack(xp, [
         xp.broadcast_to(t19, batch),  # 0, 0
         xp.broadcast_to(t20, batch),  # 0, 1
@@ -659,18 +659,18 @@ def fk_jacobian_dot(q, q_dot):
         xp.broadcast_to(t43, batch),  # 5, 5
     ], (6, 6))
     a = _stack(xp, [
-        xp.broadcast_to(qd2*(c1*t32 - qd1*t45) + qd3*t46 - qd1*t37, batch),  # 0
-        xp.broadcast_to(qd1*t42 + qd2*(qd1*t44 + s1*t32) + qd3*t47, batch),  # 1
-        xp.broadcast_to(qd3*t49 - qd2*(c1*t41 + s1*t36), batch),  # 2
-        xp.broadcast_to(qd4*t46 - qd1*t38 - qd5*(t0*t10 + t26*t39) - qd6*(t18*t29 + t25*t40), batch),  # 3
-        xp.broadcast_to(qd4*t47 + qd5*(t0*t15 + t26*t34) + qd6*(t12*t29 + t25*t35) - qd1*t33, batch),  # 4
-        xp.broadcast_to(qd4*t49 + qd5*(t10*t34 - t15*t39) + qd6*(t18*t35 - t12*t40), batch),  # 5
+        xp.broadcast_to(t46*qd3 + qd2*(t32*c1 - t45*qd1) - t37*qd1, batch),  # 0
+        xp.broadcast_to(t42*qd1 + t47*qd3 + qd2*(t32*s1 + t44*qd1), batch),  # 1
+        xp.broadcast_to(t49*qd3 - qd2*(t41*c1 + t36*s1), batch),  # 2
+        xp.broadcast_to(t46*qd4 - t38*qd1 - qd5*(t10*t0 + t39*t26) - qd6*(t18*t29 + t25*t40), batch),  # 3
+        xp.broadcast_to(t47*qd4 + qd5*(t15*t0 + t34*t26) + qd6*(t12*t29 + t25*t35) - t33*qd1, batch),  # 4
+        xp.broadcast_to(t49*qd4 + qd5*(t10*t34 - t15*t39) + qd6*(t18*t35 - t12*t40), batch),  # 5
     ], (6,))
     return T, J, a
 
 
 def jacobian_dot(q, q_dot):
-    """time derivative dJ/dt of the world geometric Jacobian along q_dot (6 x DOF): (6 x 6), 120 operations."""
+    """time derivative dJ/dt of the world geometric Jacobian along q_dot (6 x DOF): (6 x 6), 116 operations."""
     xp, dtype, device, batch, (q, q_dot,) = _arguments(("q", q, (6,)), ("q_dot", q_dot, (6,)))
     q3 = q[..., 2]
     qd1 = q_dot[..., 0]
@@ -690,59 +690,59 @@ def jacobian_dot(q, q_dot):
     t0 = -c2*c5 + s2*s4*s5
     t1 = qd1 + c2*qd4
     t2 = q3*s2
-    t3 = -0.1337*s1 + c1*t2
-    t4 = 0.1337*c1 + s1*t2
-    t5 = c1*t3 + s1*t4
-    t6 = c2*qd3 - qd2*t5
+    t3 = -0.1337*s1 + t2*c1
+    t4 = 0.1337*c1 + t2*s1
+    t5 = t3*c1 + t4*s1
+    t6 = c2*qd3 - t5*qd2
     t7 = c4*s1
     t8 = c1*s4
-    t9 = t7 + c2*t8
-    t10 = t8 + c2*t7
+    t9 = t7 + t8*c2
+    t10 = t8 + t7*c2
     t11 = s1*s4
     t12 = c1*c4
-    t13 = -t11 + c2*t12
-    t14 = -t12 + c2*t11
+    t13 = -t11 + t12*c2
+    t14 = -t12 + t11*c2
     t15 = c5*s2
-    t16 = c1*t15 + s5*t9
-    t17 = s1*t15 + s5*t14
+    t16 = t9*s5 + t15*c1
+    t17 = t14*s5 + t15*s1
     t18 = qd2*s1
     t19 = qd4*s2
-    t20 = -t18 + c1*t19
-    t21 = t20 + qd5*t13
+    t20 = -t18 + t19*c1
+    t21 = t20 + t13*qd5
     t22 = c1*qd2
-    t23 = t22 + s1*t19
-    t24 = t23 + qd5*t10
+    t23 = t22 + t19*s1
+    t24 = t23 + t10*qd5
     t25 = c4*s2
-    t26 = t1 - qd5*t25
+    t26 = t1 - t25*qd5
     t27 = qd3*s2
-    t28 = c2*t22
-    t29 = c1*t27 + q3*t28
-    t30 = t29 - qd1*t4
-    t31 = c2*t18
-    t32 = q3*t31 + s1*t27
-    t33 = t32 + qd1*t3
+    t28 = t22*c2
+    t29 = t27*c1 + t28*q3
+    t30 = t29 - t4*qd1
+    t31 = t18*c2
+    t32 = t27*s1 + t31*q3
+    t33 = t32 + t3*qd1
     t34 = qd1*s1
     t35 = c2*q3
-    t36 = t28 - s2*t34
+    t36 = t28 - t34*s2
     t37 = c1*qd1
-    t38 = t31 + s2*t37
+    t38 = t31 + t37*s2
     t39 = qd2*s2
-    t40 = -t39*c1**2 - t39*s1**2
+    t40 = -(t39*c1**2 + t39*s1**2)
     Jd = _stack(xp, [
         xp.broadcast_to(-t33, batch),  # 0, 0
-        xp.broadcast_to(c1*t6 - t34*t35, batch),  # 0, 1
+        xp.broadcast_to(t6*c1 - t34*t35, batch),  # 0, 1
         xp.broadcast_to(t36, batch),  # 0, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5
         xp.broadcast_to(t30, batch),  # 1, 0
-        xp.broadcast_to(s1*t6 + t35*t37, batch),  # 1, 1
+        xp.broadcast_to(t6*s1 + t35*t37, batch),  # 1, 1
         xp.broadcast_to(t38, batch),  # 1, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
-        xp.broadcast_to(-c1*t29 - s1*t32, batch),  # 2, 1
+        xp.broadcast_to(-(t29*c1 + t32*s1), batch),  # 2, 1
         xp.broadcast_to(t40, batch),  # 2, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 4
@@ -751,14 +751,14 @@ def jacobian_dot(q, q_dot):
         xp.broadcast_to(-t37, batch),  # 3, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 2
         xp.broadcast_to(t36, batch),  # 3, 3
-        xp.broadcast_to(-t1*t10 - t23*t25, batch),  # 3, 4
-        xp.broadcast_to(-t0*t24 - t17*t26, batch),  # 3, 5
+        xp.broadcast_to(-(t10*t1 + t23*t25), batch),  # 3, 4
+        xp.broadcast_to(-(t17*t26 + t0*t24), batch),  # 3, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
         xp.broadcast_to(-t34, batch),  # 4, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 2
         xp.broadcast_to(t38, batch),  # 4, 3
-        xp.broadcast_to(t1*t13 + t20*t25, batch),  # 4, 4
-        xp.broadcast_to(t0*t21 + t16*t26, batch),  # 4, 5
+        xp.broadcast_to(t13*t1 + t20*t25, batch),  # 4, 4
+        xp.broadcast_to(t16*t26 + t0*t21, batch),  # 4, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 2
@@ -770,7 +770,7 @@ def jacobian_dot(q, q_dot):
 
 
 def bias_acceleration(q, q_dot):
-    """J' q_dot: the tool's classical linear and angular acceleration at zero joint acceleration, world frame (6): (6 x 1), 146 operations."""
+    """J' q_dot: the tool's classical linear and angular acceleration at zero joint acceleration, world frame (6): (6 x 1), 145 operations."""
     xp, dtype, device, batch, (q, q_dot,) = _arguments(("q", q, (6,)), ("q_dot", q_dot, (6,)))
     q3 = q[..., 2]
     qd1 = q_dot[..., 0]
@@ -791,56 +791,56 @@ def bias_acceleration(q, q_dot):
     t0 = -c2*c5 + s2*s4*s5
     t1 = qd1 + c2*qd4
     t2 = q3*s2
-    t3 = -0.1337*s1 + c1*t2
-    t4 = 0.1337*c1 + s1*t2
-    t5 = c1*t3 + s1*t4
-    t6 = c2*qd3 - qd2*t5
+    t3 = -0.1337*s1 + t2*c1
+    t4 = 0.1337*c1 + t2*s1
+    t5 = t3*c1 + t4*s1
+    t6 = c2*qd3 - t5*qd2
     t7 = c4*s1
     t8 = c1*s4
-    t9 = t7 + c2*t8
-    t10 = t8 + c2*t7
+    t9 = t7 + t8*c2
+    t10 = t8 + t7*c2
     t11 = s1*s4
     t12 = c1*c4
-    t13 = -t11 + c2*t12
-    t14 = -t12 + c2*t11
+    t13 = -t11 + t12*c2
+    t14 = -t12 + t11*c2
     t15 = c5*s2
-    t16 = c1*t15 + s5*t9
-    t17 = s1*t15 + s5*t14
+    t16 = t9*s5 + t15*c1
+    t17 = t14*s5 + t15*s1
     t18 = qd2*s1
     t19 = qd4*s2
-    t20 = -t18 + c1*t19
-    t21 = t20 + qd5*t13
+    t20 = -t18 + t19*c1
+    t21 = t20 + t13*qd5
     t22 = c1*qd2
-    t23 = t22 + s1*t19
-    t24 = t23 + qd5*t10
+    t23 = t22 + t19*s1
+    t24 = t23 + t10*qd5
     t25 = c4*s2
-    t26 = t1 - qd5*t25
+    t26 = t1 - t25*qd5
     t27 = qd3*s2
-    t28 = c2*t22
-    t29 = c1*t27 + q3*t28
-    t30 = t29 - qd1*t4
-    t31 = c2*t18
-    t32 = q3*t31 + s1*t27
-    t33 = t32 + qd1*t3
+    t28 = t22*c2
+    t29 = t27*c1 + t28*q3
+    t30 = t29 - t4*qd1
+    t31 = t18*c2
+    t32 = t27*s1 + t31*q3
+    t33 = t32 + t3*qd1
     t34 = c2*q3*qd1
     t35 = qd1*s2
-    t36 = t28 - s1*t35
-    t37 = t31 + c1*t35
+    t36 = t28 - t35*s1
+    t37 = t31 + t35*c1
     t38 = qd2*s2
-    t39 = -t38*c1**2 - t38*s1**2
+    t39 = -(t38*c1**2 + t38*s1**2)
     a = _stack(xp, [
-        xp.broadcast_to(qd2*(c1*t6 - s1*t34) + qd3*t36 - qd1*t33, batch),  # 0
-        xp.broadcast_to(qd1*t30 + qd2*(c1*t34 + s1*t6) + qd3*t37, batch),  # 1
-        xp.broadcast_to(qd3*t39 - qd2*(c1*t29 + s1*t32), batch),  # 2
-        xp.broadcast_to(qd4*t36 - qd1*t22 - qd5*(t1*t10 + t23*t25) - qd6*(t0*t24 + t17*t26), batch),  # 3
-        xp.broadcast_to(qd4*t37 + qd5*(t1*t13 + t20*t25) + qd6*(t0*t21 + t16*t26) - qd1*t18, batch),  # 4
-        xp.broadcast_to(qd4*t39 + qd5*(t10*t20 - t13*t23) + qd6*(t17*t21 - t16*t24), batch),  # 5
+        xp.broadcast_to(t36*qd3 + qd2*(t6*c1 - t34*s1) - t33*qd1, batch),  # 0
+        xp.broadcast_to(t30*qd1 + t37*qd3 + qd2*(t6*s1 + t34*c1), batch),  # 1
+        xp.broadcast_to(t39*qd3 - qd2*(t29*c1 + t32*s1), batch),  # 2
+        xp.broadcast_to(t36*qd4 - t22*qd1 - qd5*(t10*t1 + t23*t25) - qd6*(t17*t26 + t0*t24), batch),  # 3
+        xp.broadcast_to(t37*qd4 + qd5*(t13*t1 + t20*t25) + qd6*(t16*t26 + t0*t21) - t18*qd1, batch),  # 4
+        xp.broadcast_to(t39*qd4 + qd5*(t10*t20 - t13*t23) + qd6*(t17*t21 - t16*t24), batch),  # 5
     ], (6,))
     return a
 
 
 def task_jacobian_dot(q, q_dot):
-    """time derivative of the analytic Jacobian along q_dot (6 x DOF): mu'' = J_a q'' + J_a' q': (6 x 6), 372 operations."""
+    """time derivative of the analytic Jacobian along q_dot (6 x DOF): mu'' = J_a q'' + J_a' q': (6 x 6), 371 operations."""
     xp, dtype, device, batch, (q, q_dot,) = _arguments(("q", q, (6,)), ("q_dot", q_dot, (6,)))
     q3 = q[..., 2]
     qd1 = q_dot[..., 0]
@@ -861,80 +861,80 @@ def task_jacobian_dot(q, q_dot):
     c6 = trig[..., 10]
     s6 = trig[..., 11]
     t0 = q3*s2
-    t1 = -0.1337*s1 + c1*t0
-    t2 = 0.1337*c1 + s1*t0
-    t3 = c1*t1 + s1*t2
-    t4 = c2*qd3 - qd2*t3
+    t1 = -0.1337*s1 + t0*c1
+    t2 = 0.1337*c1 + t0*s1
+    t3 = t1*c1 + t2*s1
+    t4 = c2*qd3 - t3*qd2
     t5 = c4*s1
     t6 = c1*s4
-    t7 = t5 + c2*t6
-    t8 = t6 + c2*t5
+    t7 = t5 + t6*c2
+    t8 = t6 + t5*c2
     t9 = s1*s4
     t10 = c1*c4
-    t11 = -t9 + c2*t10
-    t12 = -t10 + c2*t9
+    t11 = -t9 + t10*c2
+    t12 = -t10 + t9*c2
     t13 = c1*s2
-    t14 = c5*t7 - s5*t13
-    t15 = c5*t13 + s5*t7
-    t16 = c6*t14 + s6*t11
+    t14 = t7*c5 - t13*s5
+    t15 = t7*s5 + t13*c5
+    t16 = t11*s6 + t14*c6
     t17 = s1*s2
-    t18 = c5*t12 - s5*t17
-    t19 = c5*t17 + s5*t12
-    t20 = c6*t18 + s6*t8
+    t18 = t12*c5 - t17*s5
+    t19 = t12*s5 + t17*c5
+    t20 = t8*s6 + t18*c6
     t21 = s2*s4
-    t22 = c2*s5 + c5*t21
-    t23 = s5*t21 - c2*c5
+    t22 = t21*c5 + c2*s5
+    t23 = t21*s5 - c2*c5
     t24 = c4*s2
-    t25 = c6*t22 + s6*t24
+    t25 = t22*c6 + t24*s6
     t26 = qd2*s1
-    t27 = -t26 + qd4*t13
+    t27 = -t26 + t13*qd4
     t28 = t27
     t29 = c1*qd2
-    t30 = t29 + qd4*t17
+    t30 = t29 + t17*qd4
     t31 = t30
-    t32 = t28*t8 - t11*t31
+    t32 = t8*t28 - t11*t31
     t33 = qd1 + c2*qd4
     t34 = t33
-    t35 = t24*t31 + t34*t8
-    t36 = t11*t34 + t24*t28
-    t37 = qd5*t11
+    t35 = t8*t34 + t31*t24
+    t36 = t11*t34 + t28*t24
+    t37 = t11*qd5
     t38 = t28 + t37
-    t39 = t27 + t37 + qd6*t15
-    t40 = qd5*t8
+    t39 = t27 + t37 + t15*qd6
+    t40 = t8*qd5
     t41 = t31 + t40
     t42 = t19*t38 - t15*t41
-    t43 = t30 + t40 + qd6*t19
+    t43 = t30 + t40 + t19*qd6
     t44 = t20*t39 - t16*t43
-    t45 = -qd5*t24
+    t45 = -t24*qd5
     t46 = t34 + t45
     t47 = t19*t46 + t23*t41
     t48 = t15*t46 + t23*t38
-    t49 = t33 + t45 - qd6*t23
+    t49 = t33 + t45 - t23*qd6
     t50 = t20*t49 + t25*t43
     t51 = t16*t49 + t25*t39
-    t52 = c2*t29
-    t53 = q3*t52 + qd3*t13
-    t54 = t53 - qd1*t2
-    t55 = t52 - qd1*t17
-    t56 = c2*t26
-    t57 = q3*t56 + qd3*t17
-    t58 = t57 + qd1*t1
-    t59 = t56 + qd1*t13
-    t60 = c1*t53 + s1*t57
+    t52 = t29*c2
+    t53 = t52*q3 + t13*qd3
+    t54 = t53 - t2*qd1
+    t55 = t52 - t17*qd1
+    t56 = t26*c2
+    t57 = t56*q3 + t17*qd3
+    t58 = t57 + t1*qd1
+    t59 = t56 + t13*qd1
+    t60 = t53*c1 + t57*s1
     t61 = c2*q3*qd1
-    t62 = c1*t4 - s1*t61
-    t63 = c1*t61 + s1*t4
+    t62 = t4*c1 - t61*s1
+    t63 = t4*s1 + t61*c1
     t64 = qd2*s2
     t65 = t64*c1**2 + t64*s1**2
     t66 = -t65
     t67 = t16**2 + t20**2
-    t68 = t67**(-1.0)
-    t69 = c1*t68
-    t70 = qd1*t16
-    t71 = s1*t68
-    t72 = qd1*t20
-    t73 = c1*t20
-    t74 = s1*t16
+    t68 = 1/t67
+    t69 = t68*c1
+    t70 = t16*qd1
+    t71 = t68*s1
+    t72 = t20*qd1
+    t73 = t20*c1
+    t74 = t16*s1
     t75 = t73 - t74
     t76 = 2/t67**2
     t77 = t75*t76
@@ -944,18 +944,18 @@ def task_jacobian_dot(q, q_dot):
     t81 = t55*t80
     t82 = t20*t68
     t83 = t59*t82
-    t84 = s2*t71
-    t85 = c1*t16
-    t86 = s1*t20
-    t87 = s2*t85 + s2*t86
+    t84 = t71*s2
+    t85 = t16*c1
+    t86 = t20*s1
+    t87 = t85*s2 + t86*s2
     t88 = t76*t87
     t89 = t20*t88
-    t90 = s2*t69
+    t90 = t69*s2
     t91 = t16*t88
     t92 = t36*t82
     t93 = t35*t80
-    t94 = t68*t8
-    t95 = t11*t16 + t20*t8
+    t94 = t8*t68
+    t95 = t11*t16 + t8*t20
     t96 = t76*t95
     t97 = t20*t96
     t98 = t11*t68
@@ -964,21 +964,21 @@ def task_jacobian_dot(q, q_dot):
     t101 = t47*t80
     t102 = t19*t68
     t103 = t15*t16 + t19*t20
-    t104 = t103*t76
-    t105 = t104*t20
+    t104 = t76*t103
+    t105 = t20*t104
     t106 = t15*t68
-    t107 = t104*t16
+    t107 = t16*t104
     t108 = 1/xp.sqrt(t67)
-    t109 = qd1*t108
-    t110 = s1*t108
-    t111 = t67**(-3/2)
+    t109 = t108*qd1
+    t110 = t108*s1
+    t111 = 1/t67**1.5
     t112 = t111*(t85 + t86)
-    t113 = c1*t108
-    t114 = t108*t16
-    t115 = t108*t20
-    t116 = t111*(s2*t74 - s2*t73)
-    t117 = t111*(t16*t8 - t11*t20)
-    t118 = t111*(t16*t19 - t15*t20)
+    t113 = t108*c1
+    t114 = t16*t108
+    t115 = t20*t108
+    t116 = t111*(t74*s2 - t73*s2)
+    t117 = t111*(t8*t16 - t11*t20)
+    t118 = t111*(t19*t16 - t15*t20)
     t119 = t25*t69
     t120 = t25*t71
     t121 = t44*t68
@@ -1002,29 +1002,29 @@ def task_jacobian_dot(q, q_dot):
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
-        xp.broadcast_to(t50*(t71 + t78) + t51*(t69 - t79) - t69*t70 - t71*t72, batch),  # 3, 1
+        xp.broadcast_to(-(t69*t70 + t71*t72 - t50*(t71 + t78) - t51*(t69 - t79)), batch),  # 3, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 2
         xp.broadcast_to(t81 + t83 + t51*(t84 - t89) - t50*(t90 - t91), batch),  # 3, 3
         xp.broadcast_to(t92 - t93 + t51*(t94 - t97) - t50*(t98 - t99), batch),  # 3, 4
         xp.broadcast_to(t100 - t101 + t51*(t102 - t105) - t50*(t106 - t107), batch),  # 3, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
-        xp.broadcast_to(t109*t73 + t51*(t110 - t112*t20) - t109*t74 - t50*(t113 - t112*t16), batch),  # 4, 1
+        xp.broadcast_to(t51*(t110 - t20*t112) + t73*t109 - t50*(t113 - t16*t112) - t74*t109, batch),  # 4, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 2
-        xp.broadcast_to(t114*t59 - t115*t55 - t50*(s2*t110 - t116*t16) - t51*(s2*t113 + t116*t20), batch),  # 4, 3
-        xp.broadcast_to(t114*t36 + t115*t35 - t50*(t108*t8 - t117*t16) - t51*(t108*t11 + t117*t20), batch),  # 4, 4
-        xp.broadcast_to(t114*t48 + t115*t47 - t50*(t108*t19 - t118*t16) - t51*(t108*t15 + t118*t20), batch),  # 4, 5
+        xp.broadcast_to(t59*t114 - t55*t115 - t50*(t110*s2 - t16*t116) - t51*(t20*t116 + t113*s2), batch),  # 4, 3
+        xp.broadcast_to(t35*t115 + t36*t114 - t50*(t8*t108 - t16*t117) - t51*(t11*t108 + t20*t117), batch),  # 4, 4
+        xp.broadcast_to(t47*t115 + t48*t114 - t50*(t19*t108 - t16*t118) - t51*(t15*t108 + t20*t118), batch),  # 4, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 0
-        xp.broadcast_to(t50*(t120 + t25*t78) + t51*(t119 - t25*t79) - t119*t70 - t120*t72 - t121*t75, batch),  # 5, 1
+        xp.broadcast_to(-(t70*t119 + t72*t120 + t75*t121 - t50*(t120 + t25*t78) - t51*(t119 - t25*t79)), batch),  # 5, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 2
-        xp.broadcast_to(t66 + t25*t81 + t25*t83 + t51*(t25*t84 - t25*t89) - t121*t87 - t50*(t25*t90 - t25*t91), batch),  # 5, 3
-        xp.broadcast_to(t32 + t25*t92 + t51*(t25*t94 - t25*t97) - t121*t95 - t25*t93 - t50*(t25*t98 - t25*t99), batch),  # 5, 4
-        xp.broadcast_to(t42 + t100*t25 + t51*(t102*t25 - t105*t25) - t101*t25 - t103*t121 - t50*(t106*t25 - t107*t25), batch),  # 5, 5
+        xp.broadcast_to(t66 + t25*t81 + t25*t83 + t51*(t25*t84 - t25*t89) - t50*(t25*t90 - t25*t91) - t87*t121, batch),  # 5, 3
+        xp.broadcast_to(t32 + t25*t92 + t51*(t25*t94 - t25*t97) - t25*t93 - t50*(t25*t98 - t25*t99) - t95*t121, batch),  # 5, 4
+        xp.broadcast_to(t42 + t25*t100 + t51*(t25*t102 - t25*t105) - t25*t101 - t50*(t25*t106 - t25*t107) - t103*t121, batch),  # 5, 5
     ], (6, 6))
     return Jd
 
 
 def hessian(q):
-    """partial derivatives dJ/dq_k of the world geometric Jacobian (DOF x 6 x DOF, indexed [k, r, c]): (6 x 6 x 6), 115 operations."""
+    """partial derivatives dJ/dq_k of the world geometric Jacobian (DOF x 6 x DOF, indexed [k, r, c]): (6 x 6 x 6), 109 operations."""
     xp, dtype, device, batch, (q,) = _arguments(("q", q, (6,)))
     q3 = q[..., 2]
     trig = _cos_sin(xp, q, (0.0, 0.0, 0.0, 0.0, 0.0, 0.0), device)
@@ -1038,29 +1038,29 @@ def hessian(q):
     s5 = trig[..., 9]
     t0 = -c2*c5 + s2*s4*s5
     t1 = c1*s2
-    t2 = -0.1337*s1 + q3*t1
+    t2 = -0.1337*s1 + t1*q3
     t3 = s1*s2
-    t4 = 0.1337*c1 + q3*t3
-    t5 = c1*t2 + s1*t4
+    t4 = 0.1337*c1 + t3*q3
+    t5 = t2*c1 + t4*s1
     t6 = c4*s1
     t7 = c1*s4
-    t8 = t6 + c2*t7
-    t9 = t7 + c2*t6
-    t10 = c5*t1 + s5*t8
+    t8 = t6 + t7*c2
+    t9 = t7 + t6*c2
+    t10 = t8*s5 + t1*c5
     t11 = s1*s4
     t12 = c1*c4
-    t13 = -t11 + c2*t12
-    t14 = -t12 + c2*t11
-    t15 = c5*t3 + s5*t14
+    t13 = -t11 + t12*c2
+    t14 = -t12 + t11*c2
+    t15 = t14*s5 + t3*c5
     t16 = c2*s1
-    t17 = -q3*t16
+    t17 = -t16*q3
     t18 = -t3
     t19 = c1*c2
-    t20 = q3*t19
+    t20 = t19*q3
     t21 = c1**2
     t22 = c2*q3
     t23 = s1**2
-    t24 = -s2*t21 - s2*t23
+    t24 = -(t21*s2 + t23*s2)
     t25 = s2**2
     t26 = c4*s2
     H = _stack(xp, [
@@ -1101,19 +1101,19 @@ def hessian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5, 5
         t17,  # 1, 0, 0
-        -c1*t5,  # 1, 0, 1
+        -t5*c1,  # 1, 0, 1
         t19,  # 1, 0, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 0, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 0, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 0, 5
         t20,  # 1, 1, 0
-        -s1*t5,  # 1, 1, 1
+        -t5*s1,  # 1, 1, 1
         t16,  # 1, 1, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 1, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 1, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 2, 0
-        -t21*t22 - t22*t23,  # 1, 2, 1
+        -(t21*t22 + t22*t23),  # 1, 2, 1
         t24,  # 1, 2, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 2, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 2, 4
@@ -1122,20 +1122,20 @@ def hessian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 3, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 3, 2
         t19,  # 1, 3, 3
-        -s2*t12,  # 1, 3, 4
-        -c1*t0,  # 1, 3, 5
+        -t12*s2,  # 1, 3, 4
+        -t0*c1,  # 1, 3, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 4, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 4, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 4, 2
         t16,  # 1, 4, 3
-        -s2*t6,  # 1, 4, 4
-        -s1*t0,  # 1, 4, 5
+        -t6*s2,  # 1, 4, 4
+        -t0*s1,  # 1, 4, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5, 2
         t24,  # 1, 5, 3
-        -c1*t13 - s1*t9,  # 1, 5, 4
-        -c1*t10 - s1*t15,  # 1, 5, 5
+        -(t13*c1 + t9*s1),  # 1, 5, 4
+        -(t10*c1 + t15*s1),  # 1, 5, 5
         t18,  # 2, 0, 0
         t19,  # 2, 0, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0, 2
@@ -1194,20 +1194,20 @@ def hessian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 3, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 3, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 3, 3
-        -c2*t9 - t25*t6,  # 3, 3, 4
-        -c2*t15 - t0*t3,  # 3, 3, 5
+        -(t9*c2 + t25*t6),  # 3, 3, 4
+        -(t15*c2 + t0*t3),  # 3, 3, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 4, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 4, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 4, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 4, 3
-        c2*t13 + t12*t25,  # 3, 4, 4
-        c2*t10 + t0*t1,  # 3, 4, 5
+        t13*c2 + t25*t12,  # 3, 4, 4
+        t10*c2 + t0*t1,  # 3, 4, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 5, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 5, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 5, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 5, 3
-        t1*t9 - t13*t3,  # 3, 5, 4
-        t1*t15 - t10*t3,  # 3, 5, 5
+        t9*t1 - t13*t3,  # 3, 5, 4
+        t15*t1 - t10*t3,  # 3, 5, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0, 2
@@ -1231,19 +1231,19 @@ def hessian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 3, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 3, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 3, 4
-        t15*t26 - t0*t9,  # 4, 3, 5
+        t15*t26 - t9*t0,  # 4, 3, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 4, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 4, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 4, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 4, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 4, 4
-        t0*t13 - t10*t26,  # 4, 4, 5
+        t13*t0 - t10*t26,  # 4, 4, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 5, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 5, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 5, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 5, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 5, 4
-        t13*t15 - t10*t9,  # 4, 5, 5
+        t13*t15 - t9*t10,  # 4, 5, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 0, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 0, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 0, 2
@@ -1349,64 +1349,64 @@ def velocity_ik(q, mu_dot, damping=0.0):
     s5 = trig[..., 9]
     t0 = -c2*c5 + s2*s4*s5
     t1 = c1*s2
-    t2 = -0.1337*s1 + q3*t1
+    t2 = -0.1337*s1 + t1*q3
     t3 = s1*s2
-    t4 = 0.1337*c1 + q3*t3
-    t5 = c1*t2 + s1*t4
+    t4 = 0.1337*c1 + t3*q3
+    t5 = t2*c1 + t4*s1
     t6 = c4*s1
     t7 = c1*s4
-    t8 = t6 + c2*t7
-    t9 = t7 + c2*t6
-    t10 = c5*t1 + s5*t8
+    t8 = t6 + t7*c2
+    t9 = t7 + t6*c2
+    t10 = t8*s5 + t1*c5
     t11 = s1*s4
     t12 = c1*c4
-    t13 = -t11 + c2*t12
-    t14 = -t12 + c2*t11
-    t15 = c5*t3 + s5*t14
+    t13 = -t11 + t12*c2
+    t14 = -t12 + t11*c2
+    t15 = t14*s5 + t3*c5
     t16 = c1**2
     t17 = s2**2
     t18 = t16*t17
     t19 = t4**2
     t20 = c2**2
     t21 = t20*q3**2
-    t22 = t16*t21
-    t23 = t19 + t22
-    t24 = t18 + t23
+    t22 = t21*t16
+    t23 = t22 + t19
+    t24 = t23 + t18
     t25 = -t2*t4
     t26 = c1*s1
-    t27 = t17*t26
+    t27 = t26*t17
     t28 = t25 + t27 + t21*t26
-    t29 = t27 - t26 + t10*t15 + t13*t9
-    t30 = c2*t1
-    t31 = c1*t5
+    t29 = t27 - t26 + t13*t9 + t10*t15
+    t30 = t1*c2
+    t31 = t5*c1
     t32 = c2*q3
     t33 = t30 - t31*t32
-    t34 = t16*t32
+    t34 = t32*t16
     t35 = s1**2
-    t36 = t17*t35
+    t36 = t35*t17
     t37 = t2**2
-    t38 = xp.sqrt(1 + t19 + t37)
+    t38 = xp.sqrt(1 + t37 + t19)
     t39 = t38*xp.where(xp.less_equal(t4, 0), xp.asarray(1, dtype=dtype), -1)
     t40 = xp.where(xp.greater(t38, 0), 1/(t38*(t38 + xp.abs(t4))), 0)
     t41 = t37 + t21*t35
     t42 = t36 + t41
-    t43 = c2*t3
-    t44 = s1*t5
+    t43 = t3*c2
+    t44 = t5*s1
     t45 = t43 - t32*t44
     t46 = t32*t35
     t47 = t46
     t48 = t5**2
     t49 = t20 + t48
-    t50 = t35 + t10**2 + t13**2
-    t51 = t18 + t50
+    t50 = t35 + t13**2 + t10**2
+    t51 = t50 + t18
     t52 = c4*s2
-    t53 = -t30 + t0*t10 + t13*t52
-    t54 = -t43 + t0*t15 + t52*t9
-    t55 = t16 + t15**2 + t9**2
+    t53 = -t30 + t13*t52 + t10*t0
+    t54 = -t43 + t9*t52 + t15*t0
+    t55 = t16 + t9**2 + t15**2
     t56 = t36 + t55
     t57 = 1 + t0**2 + t17*c4**2
     t58 = t20 + t57
-    t59 = xp.sqrt(t23 + t41 + t48 + t50 + t55 + t57 + 2*t18 + 2*t20 + 2*t36)
+    t59 = xp.sqrt(t23 + t41 + t48 + t50 + t55 + t57 + 2*t20 + 2*t36 + 2*t18)
     t60 = t28**2
     t61 = t33**2
     t62 = t34**2
@@ -1420,44 +1420,44 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t70 = t58 + t63
     t71 = 2*t48
     t72 = t22*t35
-    t73 = xp.sqrt(t65 + t66**2 + t67**2 + t68**2 + t69**2 + t70**2 + 2*t19 + 2*t37 + 2*t60 + 2*t61 + 2*t62 + 2*t29**2 + 2*t45**2 + 2*t47**2 + 2*t53**2 + 2*t54**2 + 4*t72 + t16*t71 + t35*t71)
-    t74 = xp.sqrt(t19 + t60 + t61 + t62 + t65 + t72)
+    t73 = xp.sqrt(t65 + t66**2 + t67**2 + t68**2 + t69**2 + t70**2 + 2*t37 + 2*t60 + 2*t61 + 2*t62 + 2*t19 + 2*t45**2 + 2*t47**2 + 2*t29**2 + 2*t53**2 + 2*t54**2 + 4*t72 + t35*t71 + t71*t16)
+    t74 = xp.sqrt(t60 + t61 + t62 + t65 + t72 + t19)
     t75 = t74*xp.where(xp.greater_equal(t64, 0), xp.asarray(1, dtype=dtype), -1)
-    t76 = t64 + t75
+    t76 = t75 + t64
     t77 = xp.where(xp.greater(t74, 0), 1/(t74*(t74 + xp.abs(t64))), 0)
-    t78 = t77*(t28*t45 + t33*t67 + t33*t76 - t31*t34 - t31*t46)
+    t78 = t77*(t28*t45 + t33*t76 + t33*t67 - t34*t31 - t31*t46)
     t79 = t33 - t76*t78
     t80 = t45 - t28*t78
     t81 = t67 - t33*t78
     t82 = t31 + t34*t78
-    t83 = -t77*(t34*t54 + t4*t70 + t4*t76 - t2*t28 - c1*c2*q3*s1*t53)
-    t84 = t4 + t76*t83
-    t85 = t2 - t28*t83
-    t86 = t54 + t34*t83
-    t87 = t70 + t4*t83
+    t83 = -t77*(t4*t76 + t4*t70 + t34*t54 - t2*t28 - t53*c1*c2*q3*s1)
+    t84 = t4 + t83*t76
+    t85 = t2 - t83*t28
+    t86 = t54 + t83*t34
+    t87 = t70 + t83*t4
     t88 = t26*t32
-    t89 = t77*(t25 + t28*t66 + t28*t76 + t33*t45 + t34*t88 + t47*t88)
+    t89 = t77*(t25 + t28*t76 + t28*t66 + t33*t45 + t34*t88 + t47*t88)
     t90 = t28 - t76*t89
     t91 = t66 - t28*t89
     t92 = t45 - t33*t89
-    t93 = -t47 + t88*t89
+    t93 = -t47 + t89*t88
     t94 = t88 - t34*t89
     t95 = t2 + t4*t89
     t96 = t44 + t78*t88
-    t97 = t77*(t29*t34 + t33*t44 + t4*t53 - t28*t47 - t68*t88 - t76*t88)
+    t97 = t77*(t4*t53 + t33*t44 + t34*t29 - t28*t47 - t76*t88 - t68*t88)
     t98 = t88 + t76*t97
     t99 = t47 + t28*t97
     t100 = t44 - t33*t97
-    t101 = t68 + t88*t97
+    t101 = t68 + t97*t88
     t102 = t29 - t34*t97
-    t103 = t77*(t28*t88 + t34*t69 + t34*t76 + t4*t54 - t29*t88 - t31*t33)
+    t103 = t77*(t4*t54 + t28*t88 + t34*t76 + t34*t69 - t33*t31 - t29*t88)
     t104 = t34 - t103*t76
     t105 = t88 - t103*t28
     t106 = t31 + t103*t33
     t107 = t29 + t103*t88
     t108 = t69 - t103*t34
     t109 = -t54 + t103*t4
-    t110 = t77*(mu_dot0*t76 + mu_dot1*t28 + mu_dot2*t33 + mu_dot4*t34 - mu_dot3*t88 - mu_dot5*t4)
+    t110 = t77*(t28*mu_dot1 + t33*mu_dot2 + t34*mu_dot4 + t76*mu_dot0 - t4*mu_dot5 - t88*mu_dot3)
     t111 = mu_dot0 - t110*t76
     t112 = mu_dot1 - t110*t28
     t113 = mu_dot2 - t110*t33
@@ -1483,14 +1483,14 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t133 = -t53
     t134 = t133 + t4*t97
     t135 = t133 + t83*t88
-    t136 = t120*(t100*t92 + t101*t93 + t102*t94 + t134*t95 - t119*t99)
+    t136 = t120*(t102*t94 + t134*t95 + t92*t100 + t93*t101 - t119*t99)
     t137 = t99 + t119*t136
     t138 = t100 - t136*t92
     t139 = t101 - t136*t93
     t140 = t102 - t136*t94
     t141 = t134 - t136*t95
     t142 = t4*t78
-    t143 = t120*(t119*t80 + t142*t95 + t81*t92 + t93*t96 - t82*t94)
+    t143 = t120*(t119*t80 + t92*t81 + t93*t96 + t95*t142 - t94*t82)
     t144 = t80 - t119*t143
     t145 = t81 - t143*t92
     t146 = t96 - t143*t93
@@ -1500,17 +1500,17 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t150 = t149*xp.where(xp.greater_equal(t145, 0), xp.asarray(1, dtype=dtype), -1)
     t151 = t145 + t150
     t152 = xp.where(xp.greater(t149, 0), 1/(t149*(t149 + xp.abs(t145))), 0)
-    t153 = t152*(t138*t151 + t139*t146 + t141*t148 - t140*t147)
+    t153 = t152*(t146*t139 + t148*t141 + t138*t151 - t147*t140)
     t154 = t138 - t151*t153
     t155 = t139 - t146*t153
     t156 = t140 + t147*t153
     t157 = t141 - t148*t153
-    t158 = t152*(t124*t146 + t126*t148 - t123*t151 - t125*t147)
+    t158 = t152*(t146*t124 + t148*t126 - t147*t125 - t123*t151)
     t159 = t123 + t151*t158
     t160 = t124 - t146*t158
     t161 = t125 + t147*t158
     t162 = t126 - t148*t158
-    t163 = t152*(t129*t151 + t130*t146 + t132*t148 - t131*t147)
+    t163 = t152*(t146*t130 + t148*t132 + t129*t151 - t147*t131)
     t164 = t129 - t151*t163
     t165 = t130 - t146*t163
     t166 = t131 + t147*t163
@@ -1534,115 +1534,115 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t184 = t183*(t175*t179 + t178*t182)
     t185 = t178 - t182*t184
     t186 = t179 - t175*t184
-    t187 = t33*t83
-    t188 = t120*(t119*t85 + t135*t93 + t87*t95 - t187*t92 - t86*t94)
+    t187 = t83*t33
+    t188 = t120*(t85*t119 + t135*t93 + t87*t95 - t86*t94 - t92*t187)
     t189 = t85 - t119*t188
     t190 = t187 + t188*t92
     t191 = t135 - t188*t93
     t192 = t86 + t188*t94
     t193 = t87 - t188*t95
-    t194 = t152*(t146*t191 + t147*t192 + t148*t193 - t151*t190)
+    t194 = t152*(t146*t191 + t147*t192 + t148*t193 - t190*t151)
     t195 = t190 + t151*t194
     t196 = t191 - t146*t194
     t197 = -t192 + t147*t194
     t198 = t193 - t148*t194
-    t199 = t171*(t156*t197 + t157*t198 + t170*t196)
+    t199 = t171*(t156*t197 + t157*t198 + t196*t170)
     t200 = t196 - t170*t199
     t201 = t197 - t156*t199
     t202 = t198 - t157*t199
-    t203 = t183*(t175*t202 + t182*t201)
+    t203 = t183*(t175*t202 + t201*t182)
     t204 = t201 - t182*t203
     t205 = t202 - t175*t203
     t206 = xp.abs(t205)
     t207 = t206
     t208 = t207*xp.where(xp.greater_equal(t205, 0), xp.asarray(1, dtype=dtype), -1)
     t209 = t205 + t208
-    t210 = xp.where(xp.greater(t207, 0), 1/(t207*(t206 + t207)), 0)
+    t210 = xp.where(xp.greater(t207, 0), 1/(t207*(t207 + t206)), 0)
     t211 = t186 - t186*t210*t209**2
     t212 = xp.where(xp.not_equal(t208, 0), -t211/t208, 0)
     t213 = xp.where(xp.not_equal(t181, 0), -(t185 - t204*t212)/t181, 0)
-    t214 = xp.where(xp.not_equal(t169, 0), -(t177 - t173*t213 - t200*t212)/t169, 0)
+    t214 = xp.where(xp.not_equal(t169, 0), -(t177 - (t173*t213 + t200*t212))/t169, 0)
     t215 = xp.where(xp.not_equal(t150, 0), -(t164 + t159*t213 + t195*t212 - t154*t214)/t150, 0)
-    t216 = xp.where(xp.not_equal(t118, 0), -(t128 + t137*t214 - t122*t213 - t144*t215 - t189*t212)/t118, 0)
-    t217 = xp.where(xp.not_equal(t75, 0), -(t111 + t212*t84 + t214*t98 - t104*t213 - t215*t79 - t216*t90)/t75, 0)
-    t218 = t212 + t2*t216 - t217*t4
-    t219 = c2*t215 + t1*t217 + t216*t3
-    t220 = c2*t212 + t1*t214 + t213*t3
-    t221 = t13*t214 + t213*t9 - t212*t52
+    t216 = xp.where(xp.not_equal(t118, 0), -(t128 - (t144*t215 + t122*t213 + t189*t212 - t137*t214))/t118, 0)
+    t217 = xp.where(xp.not_equal(t75, 0), -(t111 - (t104*t213 + t215*t79 + t216*t90 - t84*t212 - t214*t98))/t75, 0)
+    t218 = t212 + t216*t2 - t217*t4
+    t219 = t215*c2 + t216*t3 + t217*t1
+    t220 = t212*c2 + t213*t3 + t214*t1
+    t221 = t13*t214 + t9*t213 - t212*t52
     t222 = t10*t214 + t15*t213 - t0*t212
-    t223 = s1*t32
-    t224 = c1*t32
-    t225 = c1*t213 + t216*t223 + t217*t224 - s1*t214 - t215*t5
+    t223 = t32*s1
+    t224 = t32*c1
+    t225 = t213*c1 + t216*t223 + t217*t224 - t214*s1 - t215*t5
     t226 = -t4
-    t227 = t226 + t39
-    t228 = t40*(t2*t223 + t224*t227)
+    t227 = t39 + t226
+    t228 = t40*(t227*t224 + t2*t223)
     t229 = t224 - t227*t228
-    t230 = t223 - t2*t228
-    t231 = t40*(t1*t227 + t2*t3)
+    t230 = t223 - t228*t2
+    t231 = t40*(t227*t1 + t2*t3)
     t232 = t1 - t227*t231
-    t233 = t3 - t2*t231
-    t234 = t40*(mu_dot5 + mu_dot0*t227 + mu_dot1*t2)
+    t233 = t3 - t231*t2
+    t234 = t40*(mu_dot5 + t227*mu_dot0 + t2*mu_dot1)
     t235 = mu_dot0 - t227*t234
-    t236 = mu_dot1 - t2*t234
+    t236 = mu_dot1 - t234*t2
     t237 = mu_dot5 - t234
-    t238 = xp.sqrt(t16 + t35 + t48 + t228**2 + t230**2)
+    t238 = xp.sqrt(t35 + t48 + t16 + t228**2 + t230**2)
     t239 = t238*xp.where(xp.greater_equal(t230, 0), xp.asarray(1, dtype=dtype), -1)
     t240 = t230 + t239
     t241 = xp.where(xp.greater(t238, 0), 1/(t238*(t238 + xp.abs(t230))), 0)
-    t242 = t241*(t228*t231 + t233*t240 - c2*t5)
+    t242 = t241*(t228*t231 + t233*t240 - t5*c2)
     t243 = t233 - t240*t242
     t244 = c2 + t242*t5
     t245 = -t231 + t228*t242
-    t246 = -t241*(mu_dot2*t5 + mu_dot3*s1 + t228*t237 - c1*mu_dot4 - t236*t240)
+    t246 = -t241*(t228*t237 + t5*mu_dot2 + mu_dot3*s1 - t236*t240 - c1*mu_dot4)
     t247 = t236 - t240*t246
     t248 = mu_dot2 + t246*t5
-    t249 = mu_dot3 + s1*t246
-    t250 = mu_dot4 - c1*t246
+    t249 = mu_dot3 + t246*s1
+    t250 = mu_dot4 - t246*c1
     t251 = t237 + t228*t246
-    t252 = c2*t40
+    t252 = t40*c2
     t253 = c2 - t252
     t254 = -t52
     t255 = t40*t52
     t256 = t254 + t255
     t257 = -t0
-    t258 = 1 + c1 + damping + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + q1 + q2 + q3 + q4 + q5 + q6 + t10 + t13 + t15 + t2 + t223 + t224 + t226 + t254 + t257 + t9 - s1 - t5 + 2*c2 + 2*t1 + 2*t3
+    t258 = 1 + t13 + t9 + t10 + t15 + t2 + t223 + t224 + t226 + t254 + t257 + c1 + damping + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + q1 + q2 + q3 + q4 + q5 + q6 - t5 - s1 + 2*t1 + 2*t3 + 2*c2
     t259 = t0*t40
     t260 = t257 + t259
     t261 = t2*t252
     t262 = -t241*(t228*t253 + t240*t261)
     t263 = t261 + t240*t262
-    t264 = t1 + s1*t262
-    t265 = t3 - c1*t262
+    t264 = t1 + t262*s1
+    t265 = t3 - t262*c1
     t266 = t253 + t228*t262
     t267 = t2*t255
-    t268 = t241*(c1*t9 + t240*t267 - s1*t13 - t228*t256)
+    t268 = t241*(t9*c1 + t240*t267 - t13*s1 - t228*t256)
     t269 = t267 - t240*t268
-    t270 = t13 + s1*t268
-    t271 = t9 - c1*t268
+    t270 = t13 + t268*s1
+    t271 = t9 - t268*c1
     t272 = t256 + t228*t268
     t273 = t2*t259
-    t274 = t241*(c1*t15 + t240*t273 - s1*t10 - t228*t260)
+    t274 = t241*(t15*c1 + t240*t273 - t10*s1 - t228*t260)
     t275 = t273 - t240*t274
-    t276 = t10 + s1*t274
-    t277 = t15 - c1*t274
+    t276 = t10 + t274*s1
+    t277 = t15 - t274*c1
     t278 = t260 + t228*t274
     t279 = t242**2
-    t280 = xp.sqrt(t244**2 + t245**2 + t16*t279 + t279*t35)
+    t280 = xp.sqrt(t244**2 + t245**2 + t35*t279 + t16*t279)
     t281 = t280*xp.where(xp.greater_equal(t244, 0), xp.asarray(1, dtype=dtype), -1)
     t282 = t244 + t281
     t283 = xp.where(xp.greater(t280, 0), 1/(t280*(t280 + xp.abs(t244))), 0)
-    t284 = s1*t242
+    t284 = t242*s1
     t285 = t262*t5
-    t286 = c1*t242
+    t286 = t242*c1
     t287 = t283*(t245*t266 + t264*t284 + t282*t285 - t265*t286)
     t288 = t285 - t282*t287
-    t289 = t264 - t284*t287
-    t290 = t265 + t286*t287
+    t289 = t264 - t287*t284
+    t290 = t265 + t287*t286
     t291 = t266 - t245*t287
     t292 = t283*(t245*t251 + t248*t282 + t249*t284 - t250*t286)
     t293 = t248 - t282*t292
-    t294 = t249 - t284*t292
-    t295 = t250 + t286*t292
+    t294 = t249 - t292*t284
+    t295 = t250 + t292*t286
     t296 = t251 - t245*t292
     t297 = xp.sqrt(t289**2 + t290**2 + t291**2)
     t298 = t297*xp.where(xp.greater_equal(t289, 0), xp.asarray(1, dtype=dtype), -1)
@@ -1655,10 +1655,10 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t305 = t268*t5
     t306 = t283*(t245*t272 + t270*t284 + t282*t305 - t271*t286)
     t307 = t305 - t282*t306
-    t308 = t270 - t284*t306
-    t309 = t271 + t286*t306
+    t308 = t270 - t306*t284
+    t309 = t271 + t306*t286
     t310 = t272 - t245*t306
-    t311 = t300*(t290*t309 + t291*t310 + t299*t308)
+    t311 = t300*(t290*t309 + t291*t310 + t308*t299)
     t312 = t308 - t299*t311
     t313 = t309 - t290*t311
     t314 = t310 - t291*t311
@@ -1666,40 +1666,40 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t316 = t315*xp.where(xp.greater_equal(t313, 0), xp.asarray(1, dtype=dtype), -1)
     t317 = t313 + t316
     t318 = xp.where(xp.greater(t315, 0), 1/(t315*(t315 + xp.abs(t313))), 0)
-    t319 = t318*(t303*t317 + t304*t314)
+    t319 = t318*(t314*t304 + t303*t317)
     t320 = t303 - t317*t319
     t321 = t304 - t314*t319
     t322 = t274*t5
     t323 = t283*(t245*t278 + t276*t284 + t282*t322 - t277*t286)
     t324 = t322 - t282*t323
-    t325 = t276 - t284*t323
-    t326 = t277 + t286*t323
+    t325 = t276 - t323*t284
+    t326 = t277 + t323*t286
     t327 = t278 - t245*t323
-    t328 = t300*(t290*t326 + t291*t327 + t299*t325)
+    t328 = t300*(t290*t326 + t291*t327 + t325*t299)
     t329 = t325 - t299*t328
     t330 = t326 - t290*t328
     t331 = t327 - t291*t328
-    t332 = t318*(t314*t331 + t317*t330)
+    t332 = t318*(t314*t331 + t330*t317)
     t333 = t330 - t317*t332
     t334 = t331 - t314*t332
     t335 = xp.abs(t334)
     t336 = t335
     t337 = t336*xp.where(xp.greater_equal(t334, 0), xp.asarray(1, dtype=dtype), -1)
     t338 = t334 + t337
-    t339 = xp.where(xp.greater(t336, 0), 1/(t336*(t335 + t336)), 0)
+    t339 = xp.where(xp.greater(t336, 0), 1/(t336*(t336 + t335)), 0)
     t340 = t321 - t321*t339*t338**2
     t341 = xp.where(xp.not_equal(t337, 0), -t340/t337, 0)
     t342 = xp.where(xp.not_equal(t316, 0), -(t320 - t333*t341)/t316, 0)
-    t343 = xp.where(xp.not_equal(t298, 0), -(t302 - t312*t342 - t329*t341)/t298, 0)
-    t344 = xp.where(xp.not_equal(t281, 0), -(t293 - t288*t343 - t307*t342 - t324*t341)/t281, 0)
-    t345 = xp.where(xp.not_equal(t239, 0), -(t247 + t263*t343 - t243*t344 - t269*t342 - t275*t341)/t239, 0)
-    t346 = xp.where(xp.not_equal(t39, 0), -(t235 - t229*t345 - t232*t344 + t227*t252*t343 - t227*t255*t342 - t227*t259*t341)/t39, 0)
+    t343 = xp.where(xp.not_equal(t298, 0), -(t302 - (t312*t342 + t329*t341))/t298, 0)
+    t344 = xp.where(xp.not_equal(t281, 0), -(t293 - (t288*t343 + t307*t342 + t324*t341))/t281, 0)
+    t345 = xp.where(xp.not_equal(t239, 0), -(t247 - (t243*t344 + t269*t342 + t275*t341 - t263*t343))/t239, 0)
+    t346 = xp.where(xp.not_equal(t39, 0), -(t235 - (t229*t345 + t232*t344 + t227*t341*t259 + t227*t342*t255 - t227*t343*t252))/t39, 0)
     t347 = xp.greater(damping, 0)
     t348 = xp.isfinite(t258)
     t349 = xp.greater_equal(damping, 0)
     t350 = 1e-12*t59
     t351 = 1e-12*t73
-    t352 = (t347 & ((xp.less_equal(t117, t351)) | (xp.less_equal(t149, t351)) | (xp.less_equal(t168, t351)) | (xp.less_equal(t180, t351)) | (xp.less_equal(t207, t351)) | (xp.less_equal(t74, t351)))) | ((xp.less_equal(damping, 0)) & ((xp.less_equal(t238, t350)) | (xp.less_equal(t280, t350)) | (xp.less_equal(t297, t350)) | (xp.less_equal(t315, t350)) | (xp.less_equal(t336, t350)) | (xp.less_equal(t38, t350))))
+    t352 = (t347 & (xp.less_equal(t117, t351) | xp.less_equal(t149, t351) | xp.less_equal(t168, t351) | xp.less_equal(t180, t351) | xp.less_equal(t207, t351) | xp.less_equal(t74, t351))) | (xp.less_equal(damping, 0) & (xp.less_equal(t38, t350) | xp.less_equal(t238, t350) | xp.less_equal(t280, t350) | xp.less_equal(t297, t350) | xp.less_equal(t315, t350) | xp.less_equal(t336, t350)))
     t353 = t348 & t349 & xp.logical_not(t352)
     q_dot = _stack(xp, [
         xp.broadcast_to(xp.where(t353, xp.where(t347, t218, t346), 0), batch),  # 0
@@ -1715,7 +1715,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def ik_numeric_step(target, q, damping=0.0):
-    """one step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite): (6 x 1 and 6 x 1 and 1 x 1), 876 operations."""
+    """one step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite): (6 x 1 and 6 x 1 and 1 x 1), 871 operations."""
     xp, dtype, device, batch, (target, q, damping,) = _arguments(("target", target, (4, 4)), ("q", q, (6,)), ("damping", damping, ()))
     T00 = target[..., 0, 0]
     T01 = target[..., 0, 1]
@@ -1753,9 +1753,9 @@ def ik_numeric_step(target, q, damping=0.0):
     s6 = xp.sin(q6)
     t0 = T00 + T01 + T02 + T03 + T10 + T11 + T12 + T13 + T20 + T21 + T22 + T23 + qs1 + qs2 + qs3 + qs4 + qs5 + qs6
     t1 = q3*s2
-    t2 = -0.1337*s1 + c1*t1
-    t3 = 0.1337*c1 + s1*t1
-    t4 = c1*t2 + s1*t3
+    t2 = -0.1337*s1 + t1*c1
+    t3 = 0.1337*c1 + t1*s1
+    t4 = t2*c1 + t3*s1
     t5 = T03 - t2
     t6 = T13 - t3
     t7 = c2*q3
@@ -1763,44 +1763,44 @@ def ik_numeric_step(target, q, damping=0.0):
     t9 = T23 - t8
     t10 = c4*s1
     t11 = c1*s4
-    t12 = t10 + c2*t11
-    t13 = t11 + c2*t10
+    t12 = t10 + t11*c2
+    t13 = t11 + t10*c2
     t14 = s1*s4
     t15 = c1*c4
-    t16 = -t14 + c2*t15
-    t17 = -t15 + c2*t14
+    t16 = -t14 + t15*c2
+    t17 = -t15 + t14*c2
     t18 = c1*s2
-    t19 = c5*t12 - s5*t18
-    t20 = c5*t18 + s5*t12
-    t21 = c6*t19 + s6*t16
-    t22 = c6*t16 - s6*t19
+    t19 = t12*c5 - t18*s5
+    t20 = t12*s5 + t18*c5
+    t21 = t16*s6 + t19*c6
+    t22 = t16*c6 - t19*s6
     t23 = T00*t21 + T01*t22 + T02*t20
     t24 = T10*t21 + T11*t22 + T12*t20
     t25 = T20*t21 + T21*t22 + T22*t20
     t26 = s1*s2
-    t27 = c5*t17 - s5*t26
-    t28 = c5*t26 + s5*t17
-    t29 = c6*t27 + s6*t13
-    t30 = c6*t13 - s6*t27
+    t27 = t17*c5 - t26*s5
+    t28 = t17*s5 + t26*c5
+    t29 = t13*s6 + t27*c6
+    t30 = t13*c6 - t27*s6
     t31 = T00*t29 + T01*t30 + T02*t28
     t32 = T10*t29 + T11*t30 + T12*t28
     t33 = T20*t29 + T21*t30 + T22*t28
-    t34 = 0.5*t24 - 0.5*t31
+    t34 = 0.5*(t24 - t31)
     t35 = s2*s4
-    t36 = c2*s5 + c5*t35
-    t37 = s5*t35 - c2*c5
+    t36 = t35*c5 + c2*s5
+    t37 = t35*s5 - c2*c5
     t38 = c4*s2
-    t39 = c6*t36 + s6*t38
-    t40 = s6*t36 - c6*t38
+    t39 = t36*c6 + t38*s6
+    t40 = t36*s6 - t38*c6
     t41 = T00*t39 + T02*t37 - T01*t40
     t42 = T10*t39 + T12*t37 - T11*t40
     t43 = T20*t39 + T22*t37 - T21*t40
-    t44 = 0.5*t33 + 0.5*t42
-    t45 = -0.5*t25 - 0.5*t41
-    t46 = xp.sqrt(t34**2 + t44**2 + t45**2)
+    t44 = 0.5*(t42 + t33)
+    t45 = -0.5*(t41 + t25)
+    t46 = xp.sqrt(t44**2 + t45**2 + t34**2)
     t47 = t3**2
     t48 = c1**2
-    t49 = t48*t7
+    t49 = t7*t48
     t50 = s2**2
     t51 = t48*t50
     t52 = c2**2
@@ -1813,58 +1813,58 @@ def ik_numeric_step(target, q, damping=0.0):
     t59 = c1*s1
     t60 = t50*t59
     t61 = t58 + t60 + t55*t59
-    t62 = t60 - t59 + t13*t16 + t20*t28
-    t63 = c2*t18
+    t62 = t60 - t59 + t16*t13 + t20*t28
+    t63 = t18*c2
     t64 = -t63 + t16*t38 + t20*t37
-    t65 = c1*t4
-    t66 = t63 - t65*t7
+    t65 = t4*c1
+    t66 = t63 - t7*t65
     t67 = s1**2
     t68 = t51 + t67 + t16**2 + t20**2
     t69 = t50*t67
     t70 = t69 + t2**2 + t55*t67
     t71 = t48 + t69 + t13**2 + t28**2
-    t72 = c2*t26
+    t72 = t26*c2
     t73 = -t72 + t13*t38 + t28*t37
-    t74 = s1*t4
+    t74 = t4*s1
     t75 = t72 - t7*t74
-    t76 = t67*t7
+    t76 = t7*t67
     t77 = t76
     t78 = -t43
-    t79 = -0.5 + 0.5*t23 + 0.5*t32 + 0.5*t78
+    t79 = 0.5*(-1 + t23 + t32 + t78)
     t80 = xp.atan2(t46, t79)
     t81 = xp.where(xp.greater(t46, 0), t80/t46, 1)
-    t82 = (xp.greater_equal(t23, t32)) & (xp.greater_equal(t23, t78))
+    t82 = xp.greater_equal(t23, t32) & xp.greater_equal(t23, t78)
     t83 = xp.greater_equal(t32, t78)
-    t84 = xp.where(t82, 0.5 + 0.5*t23, xp.where(t83, 0.5*t31, -0.5*t41))
-    t85 = xp.where(t82, 0.5*t24, xp.where(t83, 0.5 + 0.5*t32, -0.5*t42))
-    t86 = xp.where(t82, 0.5*t25, xp.where(t83, 0.5*t33, 0.5 + 0.5*t78))
+    t84 = xp.where(t82, 0.5*(1 + t23), xp.where(t83, 0.5*t31, -0.5*t41))
+    t85 = xp.where(t82, 0.5*t24, xp.where(t83, 0.5*(1 + t32), -0.5*t42))
+    t86 = xp.where(t82, 0.5*t25, xp.where(t83, 0.5*t33, 0.5*(1 + t78)))
     t87 = xp.sqrt(t84**2 + t85**2 + t86**2)
-    t88 = xp.where(xp.greater_equal(t34*t86 + t44*t84 + t45*t85, 0), xp.asarray(1, dtype=dtype), -1)
-    t89 = (xp.greater(t46, 1e-06)) | (xp.greater(t79, 0))
+    t88 = xp.where(xp.greater_equal(t44*t84 + t45*t85 + t34*t86, 0), xp.asarray(1, dtype=dtype), -1)
+    t89 = xp.greater(t46, 1e-06) | xp.greater(t79, 0)
     t90 = t80*t88/t87
     t91 = xp.where(t89, t44*t81, t84*t90)
     t92 = xp.where(t89, t45*t81, t85*t90)
     t93 = xp.where(t89, t34*t81, t86*t90)
-    t94 = t5**2 + t6**2 + t9**2 + t91**2 + t92**2 + t93**2
-    t95 = damping + t57
-    t96 = xp.sqrt(t47 + t49**2 + t61**2 + t66**2 + t95**2 + t56*t67)
+    t94 = t91**2 + t92**2 + t93**2 + t5**2 + t6**2 + t9**2
+    t95 = t57 + damping
+    t96 = xp.sqrt(t47 + t61**2 + t66**2 + t49**2 + t95**2 + t56*t67)
     t97 = t96*xp.where(xp.greater_equal(t95, 0), xp.asarray(1, dtype=dtype), -1)
-    t98 = t95 + t97
+    t98 = t97 + t95
     t99 = xp.where(xp.greater(t96, 0), 1/(t96*(t96 + xp.abs(t95))), 0)
-    t100 = damping + t70
-    t101 = t59*t7
-    t102 = t99*(t58 + t100*t61 + t101*t49 + t101*t77 + t61*t98 + t66*t75)
-    t103 = t61 - t102*t98
+    t100 = t70 + damping
+    t101 = t7*t59
+    t102 = t99*(t58 + t98*t61 + t61*t100 + t66*t75 + t49*t101 + t77*t101)
+    t103 = t61 - t98*t102
     t104 = t100 - t102*t61
     t105 = t75 - t102*t66
-    t106 = -t77 + t101*t102
+    t106 = -t77 + t102*t101
     t107 = t101 - t102*t49
     t108 = t2 + t102*t3
-    t109 = t99*(t49*t92 + t5*t98 + t6*t61 + t66*t9 - t101*t91 - t3*t93)
-    t110 = t5 - t109*t98
+    t109 = t99*(t92*t49 + t5*t98 + t6*t61 + t9*t66 - t91*t101 - t93*t3)
+    t110 = t5 - t98*t109
     t111 = t6 - t109*t61
     t112 = t9 - t109*t66
-    t113 = t91 + t101*t109
+    t113 = t91 + t109*t101
     t114 = t92 - t109*t49
     t115 = t93 + t109*t3
     t116 = xp.sqrt(t104**2 + t105**2 + t106**2 + t107**2 + t108**2)
@@ -1877,51 +1877,51 @@ def ik_numeric_step(target, q, damping=0.0):
     t123 = t113 - t106*t120
     t124 = t114 - t107*t120
     t125 = t115 - t108*t120
-    t126 = damping + t53
-    t127 = t99*(t126*t66 + t61*t75 + t66*t98 - t49*t65 - t65*t76)
-    t128 = t66 - t127*t98
+    t126 = t53 + damping
+    t127 = t99*(t98*t66 + t61*t75 + t66*t126 - t49*t65 - t65*t76)
+    t128 = t66 - t98*t127
     t129 = t75 - t127*t61
     t130 = t126 - t127*t66
-    t131 = t74 + t101*t127
+    t131 = t74 + t127*t101
     t132 = t65 + t127*t49
-    t133 = damping + t68
-    t134 = t99*(t3*t64 + t49*t62 + t66*t74 - t101*t133 - t101*t98 - t61*t77)
-    t135 = t101 + t134*t98
+    t133 = t68 + damping
+    t134 = t99*(t3*t64 + t66*t74 + t49*t62 - t98*t101 - t61*t77 - t101*t133)
+    t135 = t101 + t98*t134
     t136 = t77 + t134*t61
     t137 = t74 - t134*t66
-    t138 = t133 + t101*t134
+    t138 = t133 + t134*t101
     t139 = t62 - t134*t49
     t140 = -t64
     t141 = t140 + t134*t3
-    t142 = t119*(t105*t137 + t106*t138 + t107*t139 + t108*t141 - t118*t136)
+    t142 = t119*(t105*t137 + t106*t138 + t107*t139 + t108*t141 - t136*t118)
     t143 = t136 + t118*t142
     t144 = t137 - t105*t142
     t145 = t138 - t106*t142
     t146 = t139 - t107*t142
     t147 = t141 - t108*t142
-    t148 = damping + t71
-    t149 = t99*(t101*t61 + t148*t49 + t3*t73 + t49*t98 - t101*t62 - t65*t66)
-    t150 = t49 - t149*t98
+    t148 = t71 + damping
+    t149 = t99*(t98*t49 + t3*t73 + t61*t101 + t49*t148 - t66*t65 - t62*t101)
+    t150 = t49 - t98*t149
     t151 = t101 - t149*t61
     t152 = t65 + t149*t66
-    t153 = t62 + t101*t149
+    t153 = t62 + t149*t101
     t154 = t148 - t149*t49
     t155 = -t73 + t149*t3
-    t156 = t119*(t106*t153 + t107*t154 + t108*t155 + t118*t151 - t105*t152)
+    t156 = t119*(t106*t153 + t107*t154 + t108*t155 + t151*t118 - t105*t152)
     t157 = t151 - t118*t156
     t158 = t152 + t105*t156
     t159 = t153 - t106*t156
     t160 = t154 - t107*t156
     t161 = t155 - t108*t156
-    t162 = damping + t54
-    t163 = -t99*(t162*t3 + t3*t98 + t49*t73 - t2*t61 - c1*c2*q3*s1*t64)
-    t164 = t3 + t163*t98
+    t162 = t54 + damping
+    t163 = -t99*(t98*t3 + t3*t162 + t49*t73 - t2*t61 - t64*c1*c2*q3*s1)
+    t164 = t3 + t98*t163
     t165 = t2 - t163*t61
-    t166 = t140 + t101*t163
+    t166 = t140 + t163*t101
     t167 = t73 + t163*t49
     t168 = t162 + t163*t3
     t169 = t127*t3
-    t170 = t119*(t105*t130 + t106*t131 + t108*t169 + t118*t129 - t107*t132)
+    t170 = t119*(t105*t130 + t106*t131 + t108*t169 + t129*t118 - t107*t132)
     t171 = t129 - t118*t170
     t172 = t130 - t105*t170
     t173 = t131 - t106*t170
@@ -1931,17 +1931,17 @@ def ik_numeric_step(target, q, damping=0.0):
     t177 = t176*xp.where(xp.greater_equal(t172, 0), xp.asarray(1, dtype=dtype), -1)
     t178 = t172 + t177
     t179 = xp.where(xp.greater(t176, 0), 1/(t176*(t176 + xp.abs(t172))), 0)
-    t180 = t179*(t144*t178 + t145*t173 + t147*t175 - t146*t174)
+    t180 = t179*(t173*t145 + t175*t147 + t144*t178 - t174*t146)
     t181 = t144 - t178*t180
     t182 = t145 - t173*t180
     t183 = t146 + t174*t180
     t184 = t147 - t175*t180
-    t185 = t179*(t159*t173 + t161*t175 - t158*t178 - t160*t174)
+    t185 = t179*(t173*t159 + t175*t161 - t174*t160 - t158*t178)
     t186 = t158 + t178*t185
     t187 = t159 - t173*t185
     t188 = t160 + t174*t185
     t189 = t161 - t175*t185
-    t190 = t179*(t122*t178 + t123*t173 + t125*t175 - t124*t174)
+    t190 = t179*(t173*t123 + t175*t125 + t122*t178 - t174*t124)
     t191 = t122 - t178*t190
     t192 = t123 - t173*t190
     t193 = t124 + t174*t190
@@ -1966,42 +1966,42 @@ def ik_numeric_step(target, q, damping=0.0):
     t212 = t205 - t209*t211
     t213 = t206 - t202*t211
     t214 = t163*t66
-    t215 = t119*(t106*t166 + t108*t168 + t118*t165 - t105*t214 - t107*t167)
+    t215 = t119*(t106*t166 + t108*t168 + t165*t118 - t105*t214 - t107*t167)
     t216 = t165 - t118*t215
     t217 = t214 + t105*t215
     t218 = t166 - t106*t215
     t219 = t167 + t107*t215
     t220 = t168 - t108*t215
-    t221 = t179*(t173*t218 + t174*t219 + t175*t220 - t178*t217)
+    t221 = t179*(t173*t218 + t174*t219 + t175*t220 - t217*t178)
     t222 = t217 + t178*t221
     t223 = t218 - t173*t221
     t224 = -t219 + t174*t221
     t225 = t220 - t175*t221
-    t226 = t198*(t183*t224 + t184*t225 + t197*t223)
+    t226 = t198*(t183*t224 + t184*t225 + t223*t197)
     t227 = t223 - t197*t226
     t228 = t224 - t183*t226
     t229 = t225 - t184*t226
-    t230 = t210*(t202*t229 + t209*t228)
+    t230 = t210*(t202*t229 + t228*t209)
     t231 = t228 - t209*t230
     t232 = t229 - t202*t230
     t233 = xp.abs(t232)
     t234 = t233
     t235 = t234*xp.where(xp.greater_equal(t232, 0), xp.asarray(1, dtype=dtype), -1)
     t236 = t232 + t235
-    t237 = xp.where(xp.greater(t234, 0), 1/(t234*(t233 + t234)), 0)
+    t237 = xp.where(xp.greater(t234, 0), 1/(t234*(t234 + t233)), 0)
     t238 = t213 - t213*t237*t236**2
     t239 = xp.where(xp.not_equal(t235, 0), -t238/t235, 0)
     t240 = xp.where(xp.not_equal(t208, 0), -(t212 - t231*t239)/t208, 0)
-    t241 = xp.where(xp.not_equal(t196, 0), -(t204 - t200*t240 - t227*t239)/t196, 0)
+    t241 = xp.where(xp.not_equal(t196, 0), -(t204 - (t200*t240 + t227*t239))/t196, 0)
     t242 = xp.where(xp.not_equal(t177, 0), -(t191 + t186*t240 + t222*t239 - t181*t241)/t177, 0)
-    t243 = xp.where(xp.not_equal(t117, 0), -(t121 + t143*t241 - t157*t240 - t171*t242 - t216*t239)/t117, 0)
-    t244 = xp.where(xp.not_equal(t97, 0), -(t110 + t135*t241 + t164*t239 - t103*t243 - t128*t242 - t150*t240)/t97, 0)
-    t245 = q1 + t239 + t2*t243 - t244*t3
-    t246 = q2 + c1*t240 - s1*t241 - t242*t4 + c1*t244*t7 + s1*t243*t7
-    t247 = q3 + c2*t242 + t18*t244 + t243*t26
-    t248 = q4 + c2*t239 + t18*t241 + t240*t26
-    t249 = q5 + t13*t240 + t16*t241 - t239*t38
-    t250 = q6 + t20*t241 + t240*t28 - t239*t37
+    t243 = xp.where(xp.not_equal(t117, 0), -(t121 - (t171*t242 + t157*t240 + t216*t239 - t143*t241))/t117, 0)
+    t244 = xp.where(xp.not_equal(t97, 0), -(t110 - (t103*t243 + t128*t242 + t150*t240 - t135*t241 - t164*t239))/t97, 0)
+    t245 = t239 + q1 + t2*t243 - t244*t3
+    t246 = q2 + t240*c1 - t4*t242 - t241*s1 + t243*t7*s1 + t244*t7*c1
+    t247 = q3 + t242*c2 + t243*t26 + t244*t18
+    t248 = q4 + t239*c2 + t240*t26 + t241*t18
+    t249 = q5 + t16*t241 + t13*t240 - t239*t38
+    t250 = q6 + t20*t241 + t28*t240 - t37*t239
     q_start = _stack(xp, [
         xp.broadcast_to(q1, batch),  # 0
         xp.broadcast_to(q2, batch),  # 1
@@ -2068,7 +2068,7 @@ def ik_branches(T):
     t27 = 1e-12*t23
     t28 = -t27
     t29 = xp.where(xp.less(t25, t28), xp.sqrt(t26), 0)
-    t30 = t29*t4
+    t30 = t4*t29
     t31 = t14 + 0.1337*t8
     t32 = t31 - t30
     t33 = t30 + t31
@@ -2076,13 +2076,13 @@ def ik_branches(T):
     t35 = t32 + t34
     t36 = t33 + t34
     t37 = 0.1337*t4
-    t38 = t29*t8
+    t38 = t8*t29
     t39 = t37 + t38
     t40 = t35**2 + t39**2
     t41 = t38 - t37
     t42 = t36**2 + t41**2
     t43 = t29**2
-    t44 = t24 + t43
+    t44 = t43 + t24
     t45 = 1e-24*t44
     t46 = t15*t45
     t47 = xp.less_equal(t40, t46)
@@ -2094,13 +2094,13 @@ def ik_branches(T):
     t53 = T00*t49 + T10*t50
     t54 = T10*t49 - T00*t50
     t55 = xp.where(t47, 0, xp.atan2(-t39, t35))
-    t56 = t55 - 6.283185307179586*xp.floor(0.4722222222222222 + 0.15915494309189535*t55)
+    t56 = t55 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t55))
     t57 = t13*t21
     t58 = 0.01787569 + t57
     t59 = -0.01787569 + t58
     t60 = 0.01787569 - t57
     t61 = -0.01787569 + t60
-    t62 = t22*t43
+    t62 = t43*t22
     t63 = t62 + t59**2
     t64 = t62 + t61**2
     t65 = t23*t45
@@ -2109,7 +2109,7 @@ def ik_branches(T):
     t68 = xp.where(t66, 1, t59*t67)
     t69 = t21*t29
     t70 = xp.where(t66, 0, xp.atan2(t69, t59))
-    t71 = t70 - 6.283185307179586*xp.floor(0.4722222222222222 + 0.15915494309189535*t70)
+    t71 = t70 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t70))
     t72 = t67*t69
     t73 = xp.where(t66, 0, -t72)
     t74 = xp.where(t66, 0, t72)
@@ -2122,21 +2122,21 @@ def ik_branches(T):
     t81 = T00*t77 + T10*t78
     t82 = T10*t77 - T00*t78
     t83 = xp.where(t75, 0, xp.atan2(t41, t36))
-    t84 = t83 - 6.283185307179586*xp.floor(0.4722222222222222 + 0.15915494309189535*t83)
+    t84 = t83 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t83))
     t85 = 1 - t49
     t86 = T22*t85
     t87 = t86 + T22*t49
     t88 = T20*t85
     t89 = t88 + T20*t49
-    t90 = t51*t68 - t73*t87
-    t91 = t51*t73 + t68*t87
-    t92 = t53*t68 - t73*t89
-    t93 = t53*t73 + t68*t89
+    t90 = t68*t51 - t73*t87
+    t91 = t68*t87 + t73*t51
+    t92 = t68*t53 - t73*t89
+    t93 = t68*t89 + t73*t53
     t94 = 1 - t68
     t95 = t52*t94
-    t96 = t95 + t52*t68
+    t96 = t95 + t68*t52
     t97 = t54*t94
-    t98 = t97 + t54*t68
+    t98 = t97 + t68*t54
     t99 = t80*t94
     t100 = t99 + t68*t80
     t101 = t82*t94
@@ -2144,9 +2144,9 @@ def ik_branches(T):
     t103 = t91**2
     t104 = -t103
     t105 = 1 + t104
-    t106 = xp.where(xp.greater(t105, 1e-12), xp.sqrt(t105), 0)
-    t107 = t103 + t106*t96
-    t108 = t104 + t107
+    t106 = xp.where(xp.less(1e-12, t105), xp.sqrt(t105), 0)
+    t107 = t103 + t96*t106
+    t108 = t107 + t104
     t109 = t90**2
     t110 = t103 + t109 + t96**2
     t111 = t106**2
@@ -2157,19 +2157,19 @@ def ik_branches(T):
     t116 = xp.where(t115, 1, 1/xp.sqrt(t112))
     t117 = xp.where(t115, 1, t108*t116)
     t118 = t93*(1 - t117)
-    t119 = t118 + t117*t93
-    t120 = t106*t90
+    t119 = t118 + t93*t117
+    t120 = t90*t106
     t121 = xp.where(t115, 0, -t116*t120)
-    t122 = t117*t92 + t121*t98
-    t123 = t117*t98 - t121*t92
+    t122 = t92*t117 + t98*t121
+    t123 = t98*t117 - t92*t121
     t124 = xp.less_equal(t113, t114)
     t125 = xp.where(t124, 1, 1/xp.sqrt(t113))
-    t126 = xp.where(t124, 1, t125*t91)
+    t126 = xp.where(t124, 1, t91*t125)
     t127 = xp.where(t124, 0, -t106*t125)
     t128 = t122*(1 - t126)
-    t129 = t128 + t122*t126
-    t130 = t119*t127 + t123*t126
-    t131 = t119*t126 - t123*t127
+    t129 = t128 + t126*t122
+    t130 = t126*t123 + t127*t119
+    t131 = t126*t119 - t127*t123
     t132 = t129**2 + t130**2
     t133 = t132
     t134 = t132 + t131**2
@@ -2178,16 +2178,16 @@ def ik_branches(T):
     t137 = t136 + T22*t77
     t138 = T20*t135
     t139 = t138 + T20*t77
-    t140 = t68*t79 - t137*t74
-    t141 = t137*t68 + t74*t79
-    t142 = t68*t81 - t139*t74
-    t143 = t139*t68 + t74*t81
+    t140 = t68*t79 - t74*t137
+    t141 = t68*t137 + t74*t79
+    t142 = t68*t81 - t74*t139
+    t143 = t68*t139 + t74*t81
     t144 = t141**2
     t145 = -t144
     t146 = 1 + t145
-    t147 = xp.where(xp.greater(t146, 1e-12), xp.sqrt(t146), 0)
+    t147 = xp.where(xp.less(1e-12, t146), xp.sqrt(t146), 0)
     t148 = t144 + t100*t147
-    t149 = t145 + t148
+    t149 = t148 + t145
     t150 = t140**2
     t151 = t144 + t150 + t100**2
     t152 = t147**2
@@ -2201,50 +2201,50 @@ def ik_branches(T):
     t160 = t159 + t143*t158
     t161 = t140*t147
     t162 = xp.where(t156, 0, -t157*t161)
-    t163 = t102*t162 + t142*t158
+    t163 = t142*t158 + t102*t162
     t164 = t102*t158 - t142*t162
     t165 = xp.less_equal(t154, t155)
     t166 = xp.where(t165, 1, 1/xp.sqrt(t154))
     t167 = xp.where(t165, 1, t141*t166)
     t168 = xp.where(t165, 0, -t147*t166)
     t169 = t163*(1 - t167)
-    t170 = t169 + t163*t167
-    t171 = t160*t168 + t164*t167
-    t172 = t160*t167 - t164*t168
+    t170 = t169 + t167*t163
+    t171 = t167*t164 + t168*t160
+    t172 = t167*t160 - t168*t164
     t173 = t170**2 + t171**2
     t174 = t173
     t175 = t173 + t172**2
     t176 = xp.less_equal(t64, t65)
     t177 = xp.where(t176, 1, 1/xp.sqrt(t64))
-    t178 = xp.where(t176, 1, t177*t61)
+    t178 = xp.where(t176, 1, t61*t177)
     t179 = xp.where(t176, 0, xp.atan2(t69, t61))
-    t180 = t179 - 6.283185307179586*xp.floor(0.4722222222222222 + 0.15915494309189535*t179)
+    t180 = t179 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t179))
     t181 = t177*t69
     t182 = xp.where(t176, 0, t181)
     t183 = xp.where(t176, 0, -t181)
-    t184 = t178*t51 - t182*t87
-    t185 = t178*t87 + t182*t51
-    t186 = t178*t53 - t182*t89
-    t187 = t178*t89 + t182*t53
-    t188 = t178*t79 - t137*t183
-    t189 = t137*t178 + t183*t79
-    t190 = t178*t81 - t139*t183
-    t191 = t139*t178 + t183*t81
+    t184 = t51*t178 - t87*t182
+    t185 = t51*t182 + t87*t178
+    t186 = t53*t178 - t89*t182
+    t187 = t53*t182 + t89*t178
+    t188 = t79*t178 - t137*t183
+    t189 = t79*t183 + t137*t178
+    t190 = t81*t178 - t139*t183
+    t191 = t81*t183 + t139*t178
     t192 = 1 - t178
-    t193 = t192*t52
-    t194 = t193 + t178*t52
-    t195 = t192*t54
-    t196 = t195 + t178*t54
-    t197 = t192*t80
-    t198 = t197 + t178*t80
-    t199 = t192*t82
-    t200 = t199 + t178*t82
+    t193 = t52*t192
+    t194 = t193 + t52*t178
+    t195 = t54*t192
+    t196 = t195 + t54*t178
+    t197 = t80*t192
+    t198 = t197 + t80*t178
+    t199 = t82*t192
+    t200 = t199 + t82*t178
     t201 = t185**2
     t202 = -t201
     t203 = 1 + t202
-    t204 = xp.where(xp.greater(t203, 1e-12), xp.sqrt(t203), 0)
+    t204 = xp.where(xp.less(1e-12, t203), xp.sqrt(t203), 0)
     t205 = t201 + t194*t204
-    t206 = t202 + t205
+    t206 = t205 + t202
     t207 = t184**2
     t208 = t201 + t207 + t194**2
     t209 = t204**2
@@ -2265,18 +2265,18 @@ def ik_branches(T):
     t224 = xp.where(t222, 1, t185*t223)
     t225 = xp.where(t222, 0, -t204*t223)
     t226 = t220*(1 - t224)
-    t227 = t226 + t220*t224
-    t228 = t217*t225 + t221*t224
-    t229 = t217*t224 - t221*t225
+    t227 = t226 + t224*t220
+    t228 = t224*t221 + t225*t217
+    t229 = t224*t217 - t225*t221
     t230 = t227**2 + t228**2
     t231 = t230
     t232 = t230 + t229**2
     t233 = t189**2
     t234 = -t233
     t235 = 1 + t234
-    t236 = xp.where(xp.greater(t235, 1e-12), xp.sqrt(t235), 0)
+    t236 = xp.where(xp.less(1e-12, t235), xp.sqrt(t235), 0)
     t237 = t233 + t198*t236
-    t238 = t234 + t237
+    t238 = t237 + t234
     t239 = t188**2
     t240 = t233 + t239 + t198**2
     t241 = t236**2
@@ -2297,144 +2297,144 @@ def ik_branches(T):
     t256 = xp.where(t254, 1, t189*t255)
     t257 = xp.where(t254, 0, -t236*t255)
     t258 = t252*(1 - t256)
-    t259 = t258 + t252*t256
-    t260 = t249*t257 + t253*t256
-    t261 = t249*t256 - t253*t257
+    t259 = t258 + t256*t252
+    t260 = t256*t253 + t257*t249
+    t261 = t256*t249 - t257*t253
     t262 = t259**2 + t260**2
     t263 = t262
     t264 = t262 + t261**2
     t265 = -t69
     t266 = xp.where(t66, 0, xp.atan2(t265, t59))
-    t267 = t266 - 6.283185307179586*xp.floor(0.4722222222222222 + 0.15915494309189535*t266)
+    t267 = t266 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t266))
     t268 = xp.where(t176, 0, xp.atan2(t265, t61))
-    t269 = t268 - 6.283185307179586*xp.floor(0.4722222222222222 + 0.15915494309189535*t268)
+    t269 = t268 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t268))
     t270 = xp.where(t115, 0, xp.atan2(-t120, t108))
     t271 = t270
-    t272 = t271 - 6.283185307179586*xp.floor(0.4722222222222222 + 0.15915494309189535*t271)
+    t272 = t271 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t271))
     t273 = 3.141592653589793 + t270 - 6.283185307179586*xp.ceil(0.15915494309189535*t270)
-    t274 = t273 - 6.283185307179586*xp.floor(0.4722222222222222 + 0.15915494309189535*t273)
+    t274 = t273 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t273))
     t275 = xp.where(t124, 0, xp.atan2(-t106, t91))
     t276 = t275
-    t277 = t276 - 6.283185307179586*xp.floor(0.25 + 0.15915494309189535*t276)
-    t278 = t275 + 6.283185307179586*xp.ceil(-0.5 - 0.15915494309189535*t275)
+    t277 = t276 - 6.283185307179586*xp.floor(0.15915494309189535*(1.5707963267948966 + t276))
+    t278 = t275 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t275))
     t279 = xp.where(xp.less_equal(t133, 1e-24*t134), 0, xp.atan2(t129, -t130))
     t280 = t279
-    t281 = t280 - 6.283185307179586*xp.floor(0.4722222222222222 + 0.15915494309189535*t280)
+    t281 = t280 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t280))
     t282 = 3.141592653589793 + t279 - 6.283185307179586*xp.ceil(0.15915494309189535*t279)
-    t283 = t282 - 6.283185307179586*xp.floor(0.4722222222222222 + 0.15915494309189535*t282)
+    t283 = t282 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t282))
     t284 = -t278
-    t285 = t278 + 6.283185307179586*xp.floor(0.25 + 0.15915494309189535*t284)
+    t285 = t278 + 6.283185307179586*xp.floor(0.15915494309189535*(1.5707963267948966 + t284))
     t286 = xp.where(t156, 0, xp.atan2(-t161, t149))
     t287 = t286
-    t288 = t287 - 6.283185307179586*xp.floor(0.4722222222222222 + 0.15915494309189535*t287)
+    t288 = t287 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t287))
     t289 = 3.141592653589793 + t286 - 6.283185307179586*xp.ceil(0.15915494309189535*t286)
-    t290 = t289 - 6.283185307179586*xp.floor(0.4722222222222222 + 0.15915494309189535*t289)
+    t290 = t289 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t289))
     t291 = xp.where(t165, 0, xp.atan2(-t147, t141))
     t292 = t291
-    t293 = t292 - 6.283185307179586*xp.floor(0.25 + 0.15915494309189535*t292)
-    t294 = t291 + 6.283185307179586*xp.ceil(-0.5 - 0.15915494309189535*t291)
+    t293 = t292 - 6.283185307179586*xp.floor(0.15915494309189535*(1.5707963267948966 + t292))
+    t294 = t291 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t291))
     t295 = xp.where(xp.less_equal(t174, 1e-24*t175), 0, xp.atan2(t170, -t171))
     t296 = t295
-    t297 = t296 - 6.283185307179586*xp.floor(0.4722222222222222 + 0.15915494309189535*t296)
+    t297 = t296 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t296))
     t298 = 3.141592653589793 + t295 - 6.283185307179586*xp.ceil(0.15915494309189535*t295)
-    t299 = t298 - 6.283185307179586*xp.floor(0.4722222222222222 + 0.15915494309189535*t298)
+    t299 = t298 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t298))
     t300 = -t294
-    t301 = t294 + 6.283185307179586*xp.floor(0.25 + 0.15915494309189535*t300)
+    t301 = t294 + 6.283185307179586*xp.floor(0.15915494309189535*(1.5707963267948966 + t300))
     t302 = xp.where(t213, 0, xp.atan2(-t218, t206))
     t303 = t302
-    t304 = t303 - 6.283185307179586*xp.floor(0.4722222222222222 + 0.15915494309189535*t303)
+    t304 = t303 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t303))
     t305 = 3.141592653589793 + t302 - 6.283185307179586*xp.ceil(0.15915494309189535*t302)
-    t306 = t305 - 6.283185307179586*xp.floor(0.4722222222222222 + 0.15915494309189535*t305)
+    t306 = t305 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t305))
     t307 = xp.where(t222, 0, xp.atan2(-t204, t185))
     t308 = t307
-    t309 = t308 - 6.283185307179586*xp.floor(0.25 + 0.15915494309189535*t308)
-    t310 = t307 + 6.283185307179586*xp.ceil(-0.5 - 0.15915494309189535*t307)
+    t309 = t308 - 6.283185307179586*xp.floor(0.15915494309189535*(1.5707963267948966 + t308))
+    t310 = t307 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t307))
     t311 = xp.where(xp.less_equal(t231, 1e-24*t232), 0, xp.atan2(t227, -t228))
     t312 = t311
-    t313 = t312 - 6.283185307179586*xp.floor(0.4722222222222222 + 0.15915494309189535*t312)
+    t313 = t312 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t312))
     t314 = 3.141592653589793 + t311 - 6.283185307179586*xp.ceil(0.15915494309189535*t311)
-    t315 = t314 - 6.283185307179586*xp.floor(0.4722222222222222 + 0.15915494309189535*t314)
+    t315 = t314 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t314))
     t316 = -t310
-    t317 = t310 + 6.283185307179586*xp.floor(0.25 + 0.15915494309189535*t316)
+    t317 = t310 + 6.283185307179586*xp.floor(0.15915494309189535*(1.5707963267948966 + t316))
     t318 = xp.where(t245, 0, xp.atan2(-t250, t238))
     t319 = t318
-    t320 = t319 - 6.283185307179586*xp.floor(0.4722222222222222 + 0.15915494309189535*t319)
+    t320 = t319 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t319))
     t321 = 3.141592653589793 + t318 - 6.283185307179586*xp.ceil(0.15915494309189535*t318)
-    t322 = t321 - 6.283185307179586*xp.floor(0.4722222222222222 + 0.15915494309189535*t321)
+    t322 = t321 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t321))
     t323 = xp.where(t254, 0, xp.atan2(-t236, t189))
     t324 = t323
-    t325 = t324 - 6.283185307179586*xp.floor(0.25 + 0.15915494309189535*t324)
-    t326 = t323 + 6.283185307179586*xp.ceil(-0.5 - 0.15915494309189535*t323)
+    t325 = t324 - 6.283185307179586*xp.floor(0.15915494309189535*(1.5707963267948966 + t324))
+    t326 = t323 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t323))
     t327 = xp.where(xp.less_equal(t263, 1e-24*t264), 0, xp.atan2(t259, -t260))
     t328 = t327
-    t329 = t328 - 6.283185307179586*xp.floor(0.4722222222222222 + 0.15915494309189535*t328)
+    t329 = t328 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t328))
     t330 = 3.141592653589793 + t327 - 6.283185307179586*xp.ceil(0.15915494309189535*t327)
-    t331 = t330 - 6.283185307179586*xp.floor(0.4722222222222222 + 0.15915494309189535*t330)
+    t331 = t330 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t330))
     t332 = -t326
-    t333 = t326 + 6.283185307179586*xp.floor(0.25 + 0.15915494309189535*t332)
+    t333 = t326 + 6.283185307179586*xp.floor(0.15915494309189535*(1.5707963267948966 + t332))
     t334 = xp.less_equal(t56, 2.9670597283903604)
-    t335 = (xp.greater_equal(t55, -2.9670597283903604)) & (xp.less_equal(t55, 2.9670597283903604))
+    t335 = xp.greater_equal(t55, -2.9670597283903604) & xp.less_equal(t55, 2.9670597283903604)
     t336 = xp.where(t334 & xp.logical_not(t335), t56, t55)
     t337 = xp.less_equal(t267, 2.9670597283903604)
-    t338 = (xp.greater_equal(t266, -2.9670597283903604)) & (xp.less_equal(t266, 2.9670597283903604))
+    t338 = xp.greater_equal(t266, -2.9670597283903604) & xp.less_equal(t266, 2.9670597283903604)
     t339 = xp.where(t337 & xp.logical_not(t338), t267, t266)
     t340 = xp.less_equal(t272, 2.9670597283903604)
-    t341 = (xp.greater_equal(t271, -2.9670597283903604)) & (xp.less_equal(t271, 2.9670597283903604))
+    t341 = xp.greater_equal(t271, -2.9670597283903604) & xp.less_equal(t271, 2.9670597283903604)
     t342 = xp.less_equal(t277, 1.5707963267948966)
-    t343 = (xp.greater_equal(t276, -1.5707963267948966)) & (xp.less_equal(t276, 1.5707963267948966))
+    t343 = xp.greater_equal(t276, -1.5707963267948966) & xp.less_equal(t276, 1.5707963267948966)
     t344 = xp.less_equal(t281, 2.9670597283903604)
-    t345 = (xp.greater_equal(t280, -2.9670597283903604)) & (xp.less_equal(t280, 2.9670597283903604))
+    t345 = xp.greater_equal(t280, -2.9670597283903604) & xp.less_equal(t280, 2.9670597283903604)
     t346 = xp.less_equal(t274, 2.9670597283903604)
-    t347 = (xp.greater_equal(t273, -2.9670597283903604)) & (xp.less_equal(t273, 2.9670597283903604))
+    t347 = xp.greater_equal(t273, -2.9670597283903604) & xp.less_equal(t273, 2.9670597283903604)
     t348 = -t285
     t349 = xp.less_equal(t283, 2.9670597283903604)
-    t350 = (xp.greater_equal(t282, -2.9670597283903604)) & (xp.less_equal(t282, 2.9670597283903604))
+    t350 = xp.greater_equal(t282, -2.9670597283903604) & xp.less_equal(t282, 2.9670597283903604)
     t351 = xp.less_equal(t84, 2.9670597283903604)
-    t352 = (xp.greater_equal(t83, -2.9670597283903604)) & (xp.less_equal(t83, 2.9670597283903604))
+    t352 = xp.greater_equal(t83, -2.9670597283903604) & xp.less_equal(t83, 2.9670597283903604)
     t353 = xp.where(t351 & xp.logical_not(t352), t84, t83)
     t354 = xp.less_equal(t71, 2.9670597283903604)
-    t355 = (xp.greater_equal(t70, -2.9670597283903604)) & (xp.less_equal(t70, 2.9670597283903604))
+    t355 = xp.greater_equal(t70, -2.9670597283903604) & xp.less_equal(t70, 2.9670597283903604)
     t356 = xp.where(t354 & xp.logical_not(t355), t71, t70)
     t357 = xp.less_equal(t288, 2.9670597283903604)
-    t358 = (xp.greater_equal(t287, -2.9670597283903604)) & (xp.less_equal(t287, 2.9670597283903604))
+    t358 = xp.greater_equal(t287, -2.9670597283903604) & xp.less_equal(t287, 2.9670597283903604)
     t359 = xp.less_equal(t293, 1.5707963267948966)
-    t360 = (xp.greater_equal(t292, -1.5707963267948966)) & (xp.less_equal(t292, 1.5707963267948966))
+    t360 = xp.greater_equal(t292, -1.5707963267948966) & xp.less_equal(t292, 1.5707963267948966)
     t361 = xp.less_equal(t297, 2.9670597283903604)
-    t362 = (xp.greater_equal(t296, -2.9670597283903604)) & (xp.less_equal(t296, 2.9670597283903604))
+    t362 = xp.greater_equal(t296, -2.9670597283903604) & xp.less_equal(t296, 2.9670597283903604)
     t363 = xp.less_equal(t290, 2.9670597283903604)
-    t364 = (xp.greater_equal(t289, -2.9670597283903604)) & (xp.less_equal(t289, 2.9670597283903604))
+    t364 = xp.greater_equal(t289, -2.9670597283903604) & xp.less_equal(t289, 2.9670597283903604)
     t365 = -t301
     t366 = xp.less_equal(t299, 2.9670597283903604)
-    t367 = (xp.greater_equal(t298, -2.9670597283903604)) & (xp.less_equal(t298, 2.9670597283903604))
+    t367 = xp.greater_equal(t298, -2.9670597283903604) & xp.less_equal(t298, 2.9670597283903604)
     t368 = xp.less_equal(t180, 2.9670597283903604)
-    t369 = (xp.greater_equal(t179, -2.9670597283903604)) & (xp.less_equal(t179, 2.9670597283903604))
+    t369 = xp.greater_equal(t179, -2.9670597283903604) & xp.less_equal(t179, 2.9670597283903604)
     t370 = xp.where(t368 & xp.logical_not(t369), t180, t179)
     t371 = -t21
     t372 = xp.less_equal(t304, 2.9670597283903604)
-    t373 = (xp.greater_equal(t303, -2.9670597283903604)) & (xp.less_equal(t303, 2.9670597283903604))
+    t373 = xp.greater_equal(t303, -2.9670597283903604) & xp.less_equal(t303, 2.9670597283903604)
     t374 = xp.less_equal(t309, 1.5707963267948966)
-    t375 = (xp.greater_equal(t308, -1.5707963267948966)) & (xp.less_equal(t308, 1.5707963267948966))
+    t375 = xp.greater_equal(t308, -1.5707963267948966) & xp.less_equal(t308, 1.5707963267948966)
     t376 = xp.less_equal(t313, 2.9670597283903604)
-    t377 = (xp.greater_equal(t312, -2.9670597283903604)) & (xp.less_equal(t312, 2.9670597283903604))
+    t377 = xp.greater_equal(t312, -2.9670597283903604) & xp.less_equal(t312, 2.9670597283903604)
     t378 = xp.less_equal(t306, 2.9670597283903604)
-    t379 = (xp.greater_equal(t305, -2.9670597283903604)) & (xp.less_equal(t305, 2.9670597283903604))
+    t379 = xp.greater_equal(t305, -2.9670597283903604) & xp.less_equal(t305, 2.9670597283903604)
     t380 = -t317
     t381 = xp.less_equal(t315, 2.9670597283903604)
-    t382 = (xp.greater_equal(t314, -2.9670597283903604)) & (xp.less_equal(t314, 2.9670597283903604))
+    t382 = xp.greater_equal(t314, -2.9670597283903604) & xp.less_equal(t314, 2.9670597283903604)
     t383 = xp.less_equal(t269, 2.9670597283903604)
-    t384 = (xp.greater_equal(t268, -2.9670597283903604)) & (xp.less_equal(t268, 2.9670597283903604))
+    t384 = xp.greater_equal(t268, -2.9670597283903604) & xp.less_equal(t268, 2.9670597283903604)
     t385 = xp.where(t383 & xp.logical_not(t384), t269, t268)
     t386 = xp.less_equal(t320, 2.9670597283903604)
-    t387 = (xp.greater_equal(t319, -2.9670597283903604)) & (xp.less_equal(t319, 2.9670597283903604))
+    t387 = xp.greater_equal(t319, -2.9670597283903604) & xp.less_equal(t319, 2.9670597283903604)
     t388 = xp.less_equal(t325, 1.5707963267948966)
-    t389 = (xp.greater_equal(t324, -1.5707963267948966)) & (xp.less_equal(t324, 1.5707963267948966))
+    t389 = xp.greater_equal(t324, -1.5707963267948966) & xp.less_equal(t324, 1.5707963267948966)
     t390 = xp.less_equal(t329, 2.9670597283903604)
-    t391 = (xp.greater_equal(t328, -2.9670597283903604)) & (xp.less_equal(t328, 2.9670597283903604))
+    t391 = xp.greater_equal(t328, -2.9670597283903604) & xp.less_equal(t328, 2.9670597283903604)
     t392 = xp.less_equal(t322, 2.9670597283903604)
-    t393 = (xp.greater_equal(t321, -2.9670597283903604)) & (xp.less_equal(t321, 2.9670597283903604))
+    t393 = xp.greater_equal(t321, -2.9670597283903604) & xp.less_equal(t321, 2.9670597283903604)
     t394 = -t333
     t395 = xp.less_equal(t331, 2.9670597283903604)
-    t396 = (xp.greater_equal(t330, -2.9670597283903604)) & (xp.less_equal(t330, 2.9670597283903604))
+    t396 = xp.greater_equal(t330, -2.9670597283903604) & xp.less_equal(t330, 2.9670597283903604)
     t397 = xp.isfinite(t0)
     t398 = xp.greater_equal(t18, t20)
     t399 = xp.greater_equal(t26, t28)
@@ -2461,7 +2461,7 @@ def ik_branches(T):
         t339,  # 1, 1
         t21,  # 1, 2
         xp.where(t346 & xp.logical_not(t347), t274, t273),  # 1, 3
-        xp.where((xp.greater_equal(t285, -1.5707963267948966)) & xp.logical_not((xp.greater_equal(t278, -1.5707963267948966)) & (xp.less_equal(t278, 1.5707963267948966))), t348, t284),  # 1, 4
+        xp.where(xp.greater_equal(t285, -1.5707963267948966) & xp.logical_not(xp.greater_equal(t278, -1.5707963267948966) & xp.less_equal(t278, 1.5707963267948966)), t348, t284),  # 1, 4
         xp.where(t349 & xp.logical_not(t350), t283, t282),  # 1, 5
         t353,  # 2, 0
         t356,  # 2, 1
@@ -2473,7 +2473,7 @@ def ik_branches(T):
         t356,  # 3, 1
         t21,  # 3, 2
         xp.where(t363 & xp.logical_not(t364), t290, t289),  # 3, 3
-        xp.where((xp.greater_equal(t301, -1.5707963267948966)) & xp.logical_not((xp.greater_equal(t294, -1.5707963267948966)) & (xp.less_equal(t294, 1.5707963267948966))), t365, t300),  # 3, 4
+        xp.where(xp.greater_equal(t301, -1.5707963267948966) & xp.logical_not(xp.greater_equal(t294, -1.5707963267948966) & xp.less_equal(t294, 1.5707963267948966)), t365, t300),  # 3, 4
         xp.where(t366 & xp.logical_not(t367), t299, t298),  # 3, 5
         t336,  # 4, 0
         t370,  # 4, 1
@@ -2485,7 +2485,7 @@ def ik_branches(T):
         t370,  # 5, 1
         t371,  # 5, 2
         xp.where(t378 & xp.logical_not(t379), t306, t305),  # 5, 3
-        xp.where((xp.greater_equal(t317, -1.5707963267948966)) & xp.logical_not((xp.greater_equal(t310, -1.5707963267948966)) & (xp.less_equal(t310, 1.5707963267948966))), t380, t316),  # 5, 4
+        xp.where(xp.greater_equal(t317, -1.5707963267948966) & xp.logical_not(xp.greater_equal(t310, -1.5707963267948966) & xp.less_equal(t310, 1.5707963267948966)), t380, t316),  # 5, 4
         xp.where(t381 & xp.logical_not(t382), t315, t314),  # 5, 5
         t353,  # 6, 0
         t385,  # 6, 1
@@ -2497,28 +2497,28 @@ def ik_branches(T):
         t385,  # 7, 1
         t371,  # 7, 2
         xp.where(t392 & xp.logical_not(t393), t322, t321),  # 7, 3
-        xp.where((xp.greater_equal(t333, -1.5707963267948966)) & xp.logical_not((xp.greater_equal(t326, -1.5707963267948966)) & (xp.less_equal(t326, 1.5707963267948966))), t394, t332),  # 7, 4
+        xp.where(xp.greater_equal(t333, -1.5707963267948966) & xp.logical_not(xp.greater_equal(t326, -1.5707963267948966) & xp.less_equal(t326, 1.5707963267948966)), t394, t332),  # 7, 4
         xp.where(t395 & xp.logical_not(t396), t331, t330),  # 7, 5
     ], (8, 6))
     valid = _stack(xp, [
-        t397 & t398 & t399 & (xp.greater_equal(t105, -1e-12)),  # 0
-        t397 & t398 & t399 & (xp.greater(t105, 1e-12)),  # 1
-        t397 & t398 & t400 & (xp.greater_equal(t146, -1e-12)),  # 2
-        t397 & t398 & t400 & (xp.greater(t146, 1e-12)),  # 3
-        t397 & t399 & t401 & (xp.greater_equal(t203, -1e-12)),  # 4
-        t397 & t399 & t401 & (xp.greater(t203, 1e-12)),  # 5
-        t397 & t400 & t401 & (xp.greater_equal(t235, -1e-12)),  # 6
-        t397 & t400 & t401 & (xp.greater(t235, 1e-12)),  # 7
+        t397 & t398 & t399 & xp.greater_equal(t105, -1e-12),  # 0
+        t397 & t398 & t399 & xp.greater(t105, 1e-12),  # 1
+        t397 & t398 & t400 & xp.greater_equal(t146, -1e-12),  # 2
+        t397 & t398 & t400 & xp.greater(t146, 1e-12),  # 3
+        t397 & t399 & t401 & xp.greater_equal(t203, -1e-12),  # 4
+        t397 & t399 & t401 & xp.greater(t203, 1e-12),  # 5
+        t397 & t400 & t401 & xp.greater_equal(t235, -1e-12),  # 6
+        t397 & t400 & t401 & xp.greater(t235, 1e-12),  # 7
     ], (8,))
     in_limits = _stack(xp, [
         t402 & t403 & t404 & t405 & (t340 | t341) & (t342 | t343) & (t344 | t345),  # 0
-        t402 & t403 & t404 & t405 & (t346 | t347) & (t349 | t350) & ((xp.less_equal(t348, 1.5707963267948966)) | ((xp.greater_equal(t284, -1.5707963267948966)) & (xp.less_equal(t284, 1.5707963267948966)))),  # 1
+        t402 & t403 & t404 & t405 & (t347 | t346) & (t349 | t350) & (xp.less_equal(t348, 1.5707963267948966) | (xp.greater_equal(t284, -1.5707963267948966) & xp.less_equal(t284, 1.5707963267948966))),  # 1
         t402 & t403 & t406 & t407 & (t357 | t358) & (t359 | t360) & (t361 | t362),  # 2
-        t402 & t403 & t406 & t407 & (t363 | t364) & (t366 | t367) & ((xp.less_equal(t365, 1.5707963267948966)) | ((xp.greater_equal(t300, -1.5707963267948966)) & (xp.less_equal(t300, 1.5707963267948966)))),  # 3
+        t402 & t403 & t406 & t407 & (t363 | t364) & (t366 | t367) & (xp.less_equal(t365, 1.5707963267948966) | (xp.greater_equal(t300, -1.5707963267948966) & xp.less_equal(t300, 1.5707963267948966))),  # 3
         t404 & t408 & t409 & t410 & (t372 | t373) & (t374 | t375) & (t376 | t377),  # 4
-        t404 & t408 & t409 & t410 & (t378 | t379) & (t381 | t382) & ((xp.less_equal(t380, 1.5707963267948966)) | ((xp.greater_equal(t316, -1.5707963267948966)) & (xp.less_equal(t316, 1.5707963267948966)))),  # 5
+        t404 & t408 & t409 & t410 & (t378 | t379) & (t381 | t382) & (xp.less_equal(t380, 1.5707963267948966) | (xp.greater_equal(t316, -1.5707963267948966) & xp.less_equal(t316, 1.5707963267948966))),  # 5
         t406 & t408 & t409 & t411 & (t386 | t387) & (t388 | t389) & (t390 | t391),  # 6
-        t406 & t408 & t409 & t411 & (t392 | t393) & (t395 | t396) & ((xp.less_equal(t394, 1.5707963267948966)) | ((xp.greater_equal(t332, -1.5707963267948966)) & (xp.less_equal(t332, 1.5707963267948966)))),  # 7
+        t406 & t408 & t409 & t411 & (t392 | t393) & (t395 | t396) & (xp.less_equal(t394, 1.5707963267948966) | (xp.greater_equal(t332, -1.5707963267948966) & xp.less_equal(t332, 1.5707963267948966))),  # 7
     ], (8,))
     return q, valid, in_limits
 
@@ -2666,33 +2666,33 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     t47 = qb7_5 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn6 - qb7_5))
     t48 = xp.where(lb7 & vb7, xp.asarray(1, dtype=dtype), 0)
     t49 = T00 + T01 + T02 + T03 + T10 + T11 + T12 + T13 + T20 + T21 + T22 + T23 + qn1 + qn2 + qn3 + qn4 + qn5 + qn6 + qw1 + qw2 + qw3 + qw4 + qw5 + qw6
-    t50 = xp.where(xp.greater(qn1, t0), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t50 = xp.where(xp.less(t0, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t51 = t0 + t50
     t52 = t0 - t50
-    t53 = xp.where((xp.greater_equal(t0, -2.9670597283903604)) & (xp.less_equal(t0, 2.9670597283903604)), t0, xp.where((xp.greater_equal(t51, -2.9670597283903604)) & (xp.less_equal(t51, 2.9670597283903604)), t51, xp.where((xp.greater_equal(t52, -2.9670597283903604)) & (xp.less_equal(t52, 2.9670597283903604)), t52, qb0_0)))
-    t54 = xp.where(xp.greater(qn2, t1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t53 = xp.where(xp.greater_equal(t0, -2.9670597283903604) & xp.less_equal(t0, 2.9670597283903604), t0, xp.where(xp.greater_equal(t51, -2.9670597283903604) & xp.less_equal(t51, 2.9670597283903604), t51, xp.where(xp.greater_equal(t52, -2.9670597283903604) & xp.less_equal(t52, 2.9670597283903604), t52, qb0_0)))
+    t54 = xp.where(xp.less(t1, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t55 = t1 + t54
     t56 = t1 - t54
-    t57 = xp.where((xp.greater_equal(t1, -2.9670597283903604)) & (xp.less_equal(t1, 2.9670597283903604)), t1, xp.where((xp.greater_equal(t55, -2.9670597283903604)) & (xp.less_equal(t55, 2.9670597283903604)), t55, xp.where((xp.greater_equal(t56, -2.9670597283903604)) & (xp.less_equal(t56, 2.9670597283903604)), t56, qb0_1)))
-    t58 = xp.where(xp.greater(qn4, t2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t57 = xp.where(xp.greater_equal(t1, -2.9670597283903604) & xp.less_equal(t1, 2.9670597283903604), t1, xp.where(xp.greater_equal(t55, -2.9670597283903604) & xp.less_equal(t55, 2.9670597283903604), t55, xp.where(xp.greater_equal(t56, -2.9670597283903604) & xp.less_equal(t56, 2.9670597283903604), t56, qb0_1)))
+    t58 = xp.where(xp.less(t2, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t59 = t2 + t58
     t60 = t2 - t58
-    t61 = xp.where((xp.greater_equal(t2, -2.9670597283903604)) & (xp.less_equal(t2, 2.9670597283903604)), t2, xp.where((xp.greater_equal(t59, -2.9670597283903604)) & (xp.less_equal(t59, 2.9670597283903604)), t59, xp.where((xp.greater_equal(t60, -2.9670597283903604)) & (xp.less_equal(t60, 2.9670597283903604)), t60, qb0_3)))
-    t62 = xp.where(xp.greater(qn5, t3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t61 = xp.where(xp.greater_equal(t2, -2.9670597283903604) & xp.less_equal(t2, 2.9670597283903604), t2, xp.where(xp.greater_equal(t59, -2.9670597283903604) & xp.less_equal(t59, 2.9670597283903604), t59, xp.where(xp.greater_equal(t60, -2.9670597283903604) & xp.less_equal(t60, 2.9670597283903604), t60, qb0_3)))
+    t62 = xp.where(xp.less(t3, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t63 = t3 + t62
     t64 = t3 - t62
-    t65 = xp.where((xp.greater_equal(t3, -1.5707963267948966)) & (xp.less_equal(t3, 1.5707963267948966)), t3, xp.where((xp.greater_equal(t63, -1.5707963267948966)) & (xp.less_equal(t63, 1.5707963267948966)), t63, xp.where((xp.greater_equal(t64, -1.5707963267948966)) & (xp.less_equal(t64, 1.5707963267948966)), t64, qb0_4)))
-    t66 = xp.where(xp.greater(qn6, t4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t65 = xp.where(xp.greater_equal(t3, -1.5707963267948966) & xp.less_equal(t3, 1.5707963267948966), t3, xp.where(xp.greater_equal(t63, -1.5707963267948966) & xp.less_equal(t63, 1.5707963267948966), t63, xp.where(xp.greater_equal(t64, -1.5707963267948966) & xp.less_equal(t64, 1.5707963267948966), t64, qb0_4)))
+    t66 = xp.where(xp.less(t4, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t67 = t4 + t66
     t68 = t4 - t66
-    t69 = xp.where((xp.greater_equal(t4, -2.9670597283903604)) & (xp.less_equal(t4, 2.9670597283903604)), t4, xp.where((xp.greater_equal(t67, -2.9670597283903604)) & (xp.less_equal(t67, 2.9670597283903604)), t67, xp.where((xp.greater_equal(t68, -2.9670597283903604)) & (xp.less_equal(t68, 2.9670597283903604)), t68, qb0_5)))
+    t69 = xp.where(xp.greater_equal(t4, -2.9670597283903604) & xp.less_equal(t4, 2.9670597283903604), t4, xp.where(xp.greater_equal(t67, -2.9670597283903604) & xp.less_equal(t67, 2.9670597283903604), t67, xp.where(xp.greater_equal(t68, -2.9670597283903604) & xp.less_equal(t68, 2.9670597283903604), t68, qb0_5)))
     t70 = -qn1
     t71 = -qn2
     t72 = -qn3
     t73 = -qn4
     t74 = -qn5
     t75 = -qn6
-    t76 = qw1*(t53 + t70)**2 + qw2*(t57 + t71)**2 + qw3*(qb0_2 + t72)**2 + qw4*(t61 + t73)**2 + qw5*(t65 + t74)**2 + qw6*(t69 + t75)**2
+    t76 = qw1*(t53 + t70)**2 + qw2*(t57 + t71)**2 + qw3*(t72 + qb0_2)**2 + qw4*(t61 + t73)**2 + qw5*(t65 + t74)**2 + qw6*(t69 + t75)**2
     t77 = xp.greater(t6, 0)
     t78 = xp.where(t77, t53, qn1)
     t79 = xp.where(t77, t57, qn2)
@@ -2701,29 +2701,29 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     t82 = xp.where(t77, t65, qn5)
     t83 = xp.where(t77, t69, qn6)
     t84 = xp.where(t77, t76, 0)
-    t85 = xp.where(xp.greater(qn1, t7), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t85 = xp.where(xp.less(t7, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t86 = t7 + t85
     t87 = t7 - t85
-    t88 = xp.where((xp.greater_equal(t7, -2.9670597283903604)) & (xp.less_equal(t7, 2.9670597283903604)), t7, xp.where((xp.greater_equal(t86, -2.9670597283903604)) & (xp.less_equal(t86, 2.9670597283903604)), t86, xp.where((xp.greater_equal(t87, -2.9670597283903604)) & (xp.less_equal(t87, 2.9670597283903604)), t87, qb1_0)))
-    t89 = xp.where(xp.greater(qn2, t8), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t88 = xp.where(xp.greater_equal(t7, -2.9670597283903604) & xp.less_equal(t7, 2.9670597283903604), t7, xp.where(xp.greater_equal(t86, -2.9670597283903604) & xp.less_equal(t86, 2.9670597283903604), t86, xp.where(xp.greater_equal(t87, -2.9670597283903604) & xp.less_equal(t87, 2.9670597283903604), t87, qb1_0)))
+    t89 = xp.where(xp.less(t8, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t90 = t8 + t89
     t91 = t8 - t89
-    t92 = xp.where((xp.greater_equal(t8, -2.9670597283903604)) & (xp.less_equal(t8, 2.9670597283903604)), t8, xp.where((xp.greater_equal(t90, -2.9670597283903604)) & (xp.less_equal(t90, 2.9670597283903604)), t90, xp.where((xp.greater_equal(t91, -2.9670597283903604)) & (xp.less_equal(t91, 2.9670597283903604)), t91, qb1_1)))
-    t93 = xp.where(xp.greater(qn4, t9), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t92 = xp.where(xp.greater_equal(t8, -2.9670597283903604) & xp.less_equal(t8, 2.9670597283903604), t8, xp.where(xp.greater_equal(t90, -2.9670597283903604) & xp.less_equal(t90, 2.9670597283903604), t90, xp.where(xp.greater_equal(t91, -2.9670597283903604) & xp.less_equal(t91, 2.9670597283903604), t91, qb1_1)))
+    t93 = xp.where(xp.less(t9, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t94 = t9 + t93
     t95 = t9 - t93
-    t96 = xp.where((xp.greater_equal(t9, -2.9670597283903604)) & (xp.less_equal(t9, 2.9670597283903604)), t9, xp.where((xp.greater_equal(t94, -2.9670597283903604)) & (xp.less_equal(t94, 2.9670597283903604)), t94, xp.where((xp.greater_equal(t95, -2.9670597283903604)) & (xp.less_equal(t95, 2.9670597283903604)), t95, qb1_3)))
-    t97 = xp.where(xp.greater(qn5, t10), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t96 = xp.where(xp.greater_equal(t9, -2.9670597283903604) & xp.less_equal(t9, 2.9670597283903604), t9, xp.where(xp.greater_equal(t94, -2.9670597283903604) & xp.less_equal(t94, 2.9670597283903604), t94, xp.where(xp.greater_equal(t95, -2.9670597283903604) & xp.less_equal(t95, 2.9670597283903604), t95, qb1_3)))
+    t97 = xp.where(xp.less(t10, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t98 = t10 + t97
     t99 = t10 - t97
-    t100 = xp.where((xp.greater_equal(t10, -1.5707963267948966)) & (xp.less_equal(t10, 1.5707963267948966)), t10, xp.where((xp.greater_equal(t98, -1.5707963267948966)) & (xp.less_equal(t98, 1.5707963267948966)), t98, xp.where((xp.greater_equal(t99, -1.5707963267948966)) & (xp.less_equal(t99, 1.5707963267948966)), t99, qb1_4)))
-    t101 = xp.where(xp.greater(qn6, t11), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t102 = t101 + t11
+    t100 = xp.where(xp.greater_equal(t10, -1.5707963267948966) & xp.less_equal(t10, 1.5707963267948966), t10, xp.where(xp.greater_equal(t98, -1.5707963267948966) & xp.less_equal(t98, 1.5707963267948966), t98, xp.where(xp.greater_equal(t99, -1.5707963267948966) & xp.less_equal(t99, 1.5707963267948966), t99, qb1_4)))
+    t101 = xp.where(xp.less(t11, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t102 = t11 + t101
     t103 = t11 - t101
-    t104 = xp.where((xp.greater_equal(t11, -2.9670597283903604)) & (xp.less_equal(t11, 2.9670597283903604)), t11, xp.where((xp.greater_equal(t102, -2.9670597283903604)) & (xp.less_equal(t102, 2.9670597283903604)), t102, xp.where((xp.greater_equal(t103, -2.9670597283903604)) & (xp.less_equal(t103, 2.9670597283903604)), t103, qb1_5)))
-    t105 = qw1*(t70 + t88)**2 + qw2*(t71 + t92)**2 + qw3*(qb1_2 + t72)**2 + qw4*(t73 + t96)**2 + qw5*(t100 + t74)**2 + qw6*(t104 + t75)**2
+    t104 = xp.where(xp.greater_equal(t11, -2.9670597283903604) & xp.less_equal(t11, 2.9670597283903604), t11, xp.where(xp.greater_equal(t102, -2.9670597283903604) & xp.less_equal(t102, 2.9670597283903604), t102, xp.where(xp.greater_equal(t103, -2.9670597283903604) & xp.less_equal(t103, 2.9670597283903604), t103, qb1_5)))
+    t105 = qw1*(t88 + t70)**2 + qw2*(t92 + t71)**2 + qw3*(t72 + qb1_2)**2 + qw4*(t96 + t73)**2 + qw5*(t100 + t74)**2 + qw6*(t104 + t75)**2
     t106 = xp.greater(t12, 0)
-    t107 = xp.where(t106 & ((xp.less(t105, t84)) | (xp.less(t6, 1))), xp.asarray(1, dtype=dtype), 0)
+    t107 = xp.where(t106 & (xp.greater(t84, t105) | xp.less(t6, 1)), xp.asarray(1, dtype=dtype), 0)
     t108 = xp.where(t106, 1, t6)
     t109 = xp.greater(t107, 0)
     t110 = xp.where(t109, t88, t78)
@@ -2733,29 +2733,29 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     t114 = xp.where(t109, t100, t82)
     t115 = xp.where(t109, t104, t83)
     t116 = xp.where(t109, t105, t84)
-    t117 = xp.where(xp.greater(qn1, t13), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t118 = t117 + t13
+    t117 = xp.where(xp.less(t13, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t118 = t13 + t117
     t119 = t13 - t117
-    t120 = xp.where((xp.greater_equal(t13, -2.9670597283903604)) & (xp.less_equal(t13, 2.9670597283903604)), t13, xp.where((xp.greater_equal(t118, -2.9670597283903604)) & (xp.less_equal(t118, 2.9670597283903604)), t118, xp.where((xp.greater_equal(t119, -2.9670597283903604)) & (xp.less_equal(t119, 2.9670597283903604)), t119, qb2_0)))
-    t121 = xp.where(xp.greater(qn2, t14), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t122 = t121 + t14
+    t120 = xp.where(xp.greater_equal(t13, -2.9670597283903604) & xp.less_equal(t13, 2.9670597283903604), t13, xp.where(xp.greater_equal(t118, -2.9670597283903604) & xp.less_equal(t118, 2.9670597283903604), t118, xp.where(xp.greater_equal(t119, -2.9670597283903604) & xp.less_equal(t119, 2.9670597283903604), t119, qb2_0)))
+    t121 = xp.where(xp.less(t14, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t122 = t14 + t121
     t123 = t14 - t121
-    t124 = xp.where((xp.greater_equal(t14, -2.9670597283903604)) & (xp.less_equal(t14, 2.9670597283903604)), t14, xp.where((xp.greater_equal(t122, -2.9670597283903604)) & (xp.less_equal(t122, 2.9670597283903604)), t122, xp.where((xp.greater_equal(t123, -2.9670597283903604)) & (xp.less_equal(t123, 2.9670597283903604)), t123, qb2_1)))
-    t125 = xp.where(xp.greater(qn4, t15), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t126 = t125 + t15
+    t124 = xp.where(xp.greater_equal(t14, -2.9670597283903604) & xp.less_equal(t14, 2.9670597283903604), t14, xp.where(xp.greater_equal(t122, -2.9670597283903604) & xp.less_equal(t122, 2.9670597283903604), t122, xp.where(xp.greater_equal(t123, -2.9670597283903604) & xp.less_equal(t123, 2.9670597283903604), t123, qb2_1)))
+    t125 = xp.where(xp.less(t15, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t126 = t15 + t125
     t127 = t15 - t125
-    t128 = xp.where((xp.greater_equal(t15, -2.9670597283903604)) & (xp.less_equal(t15, 2.9670597283903604)), t15, xp.where((xp.greater_equal(t126, -2.9670597283903604)) & (xp.less_equal(t126, 2.9670597283903604)), t126, xp.where((xp.greater_equal(t127, -2.9670597283903604)) & (xp.less_equal(t127, 2.9670597283903604)), t127, qb2_3)))
-    t129 = xp.where(xp.greater(qn5, t16), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t130 = t129 + t16
+    t128 = xp.where(xp.greater_equal(t15, -2.9670597283903604) & xp.less_equal(t15, 2.9670597283903604), t15, xp.where(xp.greater_equal(t126, -2.9670597283903604) & xp.less_equal(t126, 2.9670597283903604), t126, xp.where(xp.greater_equal(t127, -2.9670597283903604) & xp.less_equal(t127, 2.9670597283903604), t127, qb2_3)))
+    t129 = xp.where(xp.less(t16, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t130 = t16 + t129
     t131 = t16 - t129
-    t132 = xp.where((xp.greater_equal(t16, -1.5707963267948966)) & (xp.less_equal(t16, 1.5707963267948966)), t16, xp.where((xp.greater_equal(t130, -1.5707963267948966)) & (xp.less_equal(t130, 1.5707963267948966)), t130, xp.where((xp.greater_equal(t131, -1.5707963267948966)) & (xp.less_equal(t131, 1.5707963267948966)), t131, qb2_4)))
-    t133 = xp.where(xp.greater(qn6, t17), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t134 = t133 + t17
+    t132 = xp.where(xp.greater_equal(t16, -1.5707963267948966) & xp.less_equal(t16, 1.5707963267948966), t16, xp.where(xp.greater_equal(t130, -1.5707963267948966) & xp.less_equal(t130, 1.5707963267948966), t130, xp.where(xp.greater_equal(t131, -1.5707963267948966) & xp.less_equal(t131, 1.5707963267948966), t131, qb2_4)))
+    t133 = xp.where(xp.less(t17, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t134 = t17 + t133
     t135 = t17 - t133
-    t136 = xp.where((xp.greater_equal(t17, -2.9670597283903604)) & (xp.less_equal(t17, 2.9670597283903604)), t17, xp.where((xp.greater_equal(t134, -2.9670597283903604)) & (xp.less_equal(t134, 2.9670597283903604)), t134, xp.where((xp.greater_equal(t135, -2.9670597283903604)) & (xp.less_equal(t135, 2.9670597283903604)), t135, qb2_5)))
-    t137 = qw1*(t120 + t70)**2 + qw2*(t124 + t71)**2 + qw3*(qb2_2 + t72)**2 + qw4*(t128 + t73)**2 + qw5*(t132 + t74)**2 + qw6*(t136 + t75)**2
+    t136 = xp.where(xp.greater_equal(t17, -2.9670597283903604) & xp.less_equal(t17, 2.9670597283903604), t17, xp.where(xp.greater_equal(t134, -2.9670597283903604) & xp.less_equal(t134, 2.9670597283903604), t134, xp.where(xp.greater_equal(t135, -2.9670597283903604) & xp.less_equal(t135, 2.9670597283903604), t135, qb2_5)))
+    t137 = qw1*(t120 + t70)**2 + qw2*(t124 + t71)**2 + qw3*(t72 + qb2_2)**2 + qw4*(t128 + t73)**2 + qw5*(t132 + t74)**2 + qw6*(t136 + t75)**2
     t138 = xp.greater(t18, 0)
-    t139 = xp.where(t138 & ((xp.greater(t116, t137)) | (xp.less(t108, 1))), xp.asarray(1, dtype=dtype), 0)
+    t139 = xp.where(t138 & (xp.greater(t116, t137) | xp.less(t108, 1)), xp.asarray(1, dtype=dtype), 0)
     t140 = xp.where(t138, 1, t108)
     t141 = xp.greater(t139, 0)
     t142 = xp.where(t141, t120, t110)
@@ -2765,29 +2765,29 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     t146 = xp.where(t141, t132, t114)
     t147 = xp.where(t141, t136, t115)
     t148 = xp.where(t141, t137, t116)
-    t149 = xp.where(xp.greater(qn1, t19), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t150 = t149 + t19
+    t149 = xp.where(xp.less(t19, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t150 = t19 + t149
     t151 = t19 - t149
-    t152 = xp.where((xp.greater_equal(t19, -2.9670597283903604)) & (xp.less_equal(t19, 2.9670597283903604)), t19, xp.where((xp.greater_equal(t150, -2.9670597283903604)) & (xp.less_equal(t150, 2.9670597283903604)), t150, xp.where((xp.greater_equal(t151, -2.9670597283903604)) & (xp.less_equal(t151, 2.9670597283903604)), t151, qb3_0)))
-    t153 = xp.where(xp.greater(qn2, t20), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t154 = t153 + t20
+    t152 = xp.where(xp.greater_equal(t19, -2.9670597283903604) & xp.less_equal(t19, 2.9670597283903604), t19, xp.where(xp.greater_equal(t150, -2.9670597283903604) & xp.less_equal(t150, 2.9670597283903604), t150, xp.where(xp.greater_equal(t151, -2.9670597283903604) & xp.less_equal(t151, 2.9670597283903604), t151, qb3_0)))
+    t153 = xp.where(xp.less(t20, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t154 = t20 + t153
     t155 = t20 - t153
-    t156 = xp.where((xp.greater_equal(t20, -2.9670597283903604)) & (xp.less_equal(t20, 2.9670597283903604)), t20, xp.where((xp.greater_equal(t154, -2.9670597283903604)) & (xp.less_equal(t154, 2.9670597283903604)), t154, xp.where((xp.greater_equal(t155, -2.9670597283903604)) & (xp.less_equal(t155, 2.9670597283903604)), t155, qb3_1)))
-    t157 = xp.where(xp.greater(qn4, t21), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t158 = t157 + t21
+    t156 = xp.where(xp.greater_equal(t20, -2.9670597283903604) & xp.less_equal(t20, 2.9670597283903604), t20, xp.where(xp.greater_equal(t154, -2.9670597283903604) & xp.less_equal(t154, 2.9670597283903604), t154, xp.where(xp.greater_equal(t155, -2.9670597283903604) & xp.less_equal(t155, 2.9670597283903604), t155, qb3_1)))
+    t157 = xp.where(xp.less(t21, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t158 = t21 + t157
     t159 = t21 - t157
-    t160 = xp.where((xp.greater_equal(t21, -2.9670597283903604)) & (xp.less_equal(t21, 2.9670597283903604)), t21, xp.where((xp.greater_equal(t158, -2.9670597283903604)) & (xp.less_equal(t158, 2.9670597283903604)), t158, xp.where((xp.greater_equal(t159, -2.9670597283903604)) & (xp.less_equal(t159, 2.9670597283903604)), t159, qb3_3)))
-    t161 = xp.where(xp.greater(qn5, t22), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t162 = t161 + t22
+    t160 = xp.where(xp.greater_equal(t21, -2.9670597283903604) & xp.less_equal(t21, 2.9670597283903604), t21, xp.where(xp.greater_equal(t158, -2.9670597283903604) & xp.less_equal(t158, 2.9670597283903604), t158, xp.where(xp.greater_equal(t159, -2.9670597283903604) & xp.less_equal(t159, 2.9670597283903604), t159, qb3_3)))
+    t161 = xp.where(xp.less(t22, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t162 = t22 + t161
     t163 = t22 - t161
-    t164 = xp.where((xp.greater_equal(t22, -1.5707963267948966)) & (xp.less_equal(t22, 1.5707963267948966)), t22, xp.where((xp.greater_equal(t162, -1.5707963267948966)) & (xp.less_equal(t162, 1.5707963267948966)), t162, xp.where((xp.greater_equal(t163, -1.5707963267948966)) & (xp.less_equal(t163, 1.5707963267948966)), t163, qb3_4)))
-    t165 = xp.where(xp.greater(qn6, t23), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t166 = t165 + t23
+    t164 = xp.where(xp.greater_equal(t22, -1.5707963267948966) & xp.less_equal(t22, 1.5707963267948966), t22, xp.where(xp.greater_equal(t162, -1.5707963267948966) & xp.less_equal(t162, 1.5707963267948966), t162, xp.where(xp.greater_equal(t163, -1.5707963267948966) & xp.less_equal(t163, 1.5707963267948966), t163, qb3_4)))
+    t165 = xp.where(xp.less(t23, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t166 = t23 + t165
     t167 = t23 - t165
-    t168 = xp.where((xp.greater_equal(t23, -2.9670597283903604)) & (xp.less_equal(t23, 2.9670597283903604)), t23, xp.where((xp.greater_equal(t166, -2.9670597283903604)) & (xp.less_equal(t166, 2.9670597283903604)), t166, xp.where((xp.greater_equal(t167, -2.9670597283903604)) & (xp.less_equal(t167, 2.9670597283903604)), t167, qb3_5)))
-    t169 = qw1*(t152 + t70)**2 + qw2*(t156 + t71)**2 + qw3*(qb3_2 + t72)**2 + qw4*(t160 + t73)**2 + qw5*(t164 + t74)**2 + qw6*(t168 + t75)**2
+    t168 = xp.where(xp.greater_equal(t23, -2.9670597283903604) & xp.less_equal(t23, 2.9670597283903604), t23, xp.where(xp.greater_equal(t166, -2.9670597283903604) & xp.less_equal(t166, 2.9670597283903604), t166, xp.where(xp.greater_equal(t167, -2.9670597283903604) & xp.less_equal(t167, 2.9670597283903604), t167, qb3_5)))
+    t169 = qw1*(t152 + t70)**2 + qw2*(t156 + t71)**2 + qw3*(t72 + qb3_2)**2 + qw4*(t160 + t73)**2 + qw5*(t164 + t74)**2 + qw6*(t168 + t75)**2
     t170 = xp.greater(t24, 0)
-    t171 = xp.where(t170 & ((xp.greater(t148, t169)) | (xp.less(t140, 1))), xp.asarray(1, dtype=dtype), 0)
+    t171 = xp.where(t170 & (xp.greater(t148, t169) | xp.less(t140, 1)), xp.asarray(1, dtype=dtype), 0)
     t172 = xp.where(t170, 1, t140)
     t173 = xp.greater(t171, 0)
     t174 = xp.where(t173, t152, t142)
@@ -2797,29 +2797,29 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     t178 = xp.where(t173, t164, t146)
     t179 = xp.where(t173, t168, t147)
     t180 = xp.where(t173, t169, t148)
-    t181 = xp.where(xp.greater(qn1, t25), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t182 = t181 + t25
+    t181 = xp.where(xp.less(t25, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t182 = t25 + t181
     t183 = t25 - t181
-    t184 = xp.where((xp.greater_equal(t25, -2.9670597283903604)) & (xp.less_equal(t25, 2.9670597283903604)), t25, xp.where((xp.greater_equal(t182, -2.9670597283903604)) & (xp.less_equal(t182, 2.9670597283903604)), t182, xp.where((xp.greater_equal(t183, -2.9670597283903604)) & (xp.less_equal(t183, 2.9670597283903604)), t183, qb4_0)))
-    t185 = xp.where(xp.greater(qn2, t26), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t186 = t185 + t26
+    t184 = xp.where(xp.greater_equal(t25, -2.9670597283903604) & xp.less_equal(t25, 2.9670597283903604), t25, xp.where(xp.greater_equal(t182, -2.9670597283903604) & xp.less_equal(t182, 2.9670597283903604), t182, xp.where(xp.greater_equal(t183, -2.9670597283903604) & xp.less_equal(t183, 2.9670597283903604), t183, qb4_0)))
+    t185 = xp.where(xp.less(t26, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t186 = t26 + t185
     t187 = t26 - t185
-    t188 = xp.where((xp.greater_equal(t26, -2.9670597283903604)) & (xp.less_equal(t26, 2.9670597283903604)), t26, xp.where((xp.greater_equal(t186, -2.9670597283903604)) & (xp.less_equal(t186, 2.9670597283903604)), t186, xp.where((xp.greater_equal(t187, -2.9670597283903604)) & (xp.less_equal(t187, 2.9670597283903604)), t187, qb4_1)))
-    t189 = xp.where(xp.greater(qn4, t27), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t190 = t189 + t27
+    t188 = xp.where(xp.greater_equal(t26, -2.9670597283903604) & xp.less_equal(t26, 2.9670597283903604), t26, xp.where(xp.greater_equal(t186, -2.9670597283903604) & xp.less_equal(t186, 2.9670597283903604), t186, xp.where(xp.greater_equal(t187, -2.9670597283903604) & xp.less_equal(t187, 2.9670597283903604), t187, qb4_1)))
+    t189 = xp.where(xp.less(t27, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t190 = t27 + t189
     t191 = t27 - t189
-    t192 = xp.where((xp.greater_equal(t27, -2.9670597283903604)) & (xp.less_equal(t27, 2.9670597283903604)), t27, xp.where((xp.greater_equal(t190, -2.9670597283903604)) & (xp.less_equal(t190, 2.9670597283903604)), t190, xp.where((xp.greater_equal(t191, -2.9670597283903604)) & (xp.less_equal(t191, 2.9670597283903604)), t191, qb4_3)))
-    t193 = xp.where(xp.greater(qn5, t28), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t194 = t193 + t28
+    t192 = xp.where(xp.greater_equal(t27, -2.9670597283903604) & xp.less_equal(t27, 2.9670597283903604), t27, xp.where(xp.greater_equal(t190, -2.9670597283903604) & xp.less_equal(t190, 2.9670597283903604), t190, xp.where(xp.greater_equal(t191, -2.9670597283903604) & xp.less_equal(t191, 2.9670597283903604), t191, qb4_3)))
+    t193 = xp.where(xp.less(t28, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t194 = t28 + t193
     t195 = t28 - t193
-    t196 = xp.where((xp.greater_equal(t28, -1.5707963267948966)) & (xp.less_equal(t28, 1.5707963267948966)), t28, xp.where((xp.greater_equal(t194, -1.5707963267948966)) & (xp.less_equal(t194, 1.5707963267948966)), t194, xp.where((xp.greater_equal(t195, -1.5707963267948966)) & (xp.less_equal(t195, 1.5707963267948966)), t195, qb4_4)))
-    t197 = xp.where(xp.greater(qn6, t29), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t198 = t197 + t29
+    t196 = xp.where(xp.greater_equal(t28, -1.5707963267948966) & xp.less_equal(t28, 1.5707963267948966), t28, xp.where(xp.greater_equal(t194, -1.5707963267948966) & xp.less_equal(t194, 1.5707963267948966), t194, xp.where(xp.greater_equal(t195, -1.5707963267948966) & xp.less_equal(t195, 1.5707963267948966), t195, qb4_4)))
+    t197 = xp.where(xp.less(t29, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t198 = t29 + t197
     t199 = t29 - t197
-    t200 = xp.where((xp.greater_equal(t29, -2.9670597283903604)) & (xp.less_equal(t29, 2.9670597283903604)), t29, xp.where((xp.greater_equal(t198, -2.9670597283903604)) & (xp.less_equal(t198, 2.9670597283903604)), t198, xp.where((xp.greater_equal(t199, -2.9670597283903604)) & (xp.less_equal(t199, 2.9670597283903604)), t199, qb4_5)))
-    t201 = qw1*(t184 + t70)**2 + qw2*(t188 + t71)**2 + qw3*(qb4_2 + t72)**2 + qw4*(t192 + t73)**2 + qw5*(t196 + t74)**2 + qw6*(t200 + t75)**2
+    t200 = xp.where(xp.greater_equal(t29, -2.9670597283903604) & xp.less_equal(t29, 2.9670597283903604), t29, xp.where(xp.greater_equal(t198, -2.9670597283903604) & xp.less_equal(t198, 2.9670597283903604), t198, xp.where(xp.greater_equal(t199, -2.9670597283903604) & xp.less_equal(t199, 2.9670597283903604), t199, qb4_5)))
+    t201 = qw1*(t184 + t70)**2 + qw2*(t188 + t71)**2 + qw3*(t72 + qb4_2)**2 + qw4*(t192 + t73)**2 + qw5*(t196 + t74)**2 + qw6*(t200 + t75)**2
     t202 = xp.greater(t30, 0)
-    t203 = xp.where(t202 & ((xp.greater(t180, t201)) | (xp.less(t172, 1))), xp.asarray(1, dtype=dtype), 0)
+    t203 = xp.where(t202 & (xp.greater(t180, t201) | xp.less(t172, 1)), xp.asarray(1, dtype=dtype), 0)
     t204 = xp.where(t202, 1, t172)
     t205 = xp.greater(t203, 0)
     t206 = xp.where(t205, t184, t174)
@@ -2829,29 +2829,29 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     t210 = xp.where(t205, t196, t178)
     t211 = xp.where(t205, t200, t179)
     t212 = xp.where(t205, t201, t180)
-    t213 = xp.where(xp.greater(qn1, t31), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t214 = t213 + t31
+    t213 = xp.where(xp.less(t31, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t214 = t31 + t213
     t215 = t31 - t213
-    t216 = xp.where((xp.greater_equal(t31, -2.9670597283903604)) & (xp.less_equal(t31, 2.9670597283903604)), t31, xp.where((xp.greater_equal(t214, -2.9670597283903604)) & (xp.less_equal(t214, 2.9670597283903604)), t214, xp.where((xp.greater_equal(t215, -2.9670597283903604)) & (xp.less_equal(t215, 2.9670597283903604)), t215, qb5_0)))
-    t217 = xp.where(xp.greater(qn2, t32), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t218 = t217 + t32
+    t216 = xp.where(xp.greater_equal(t31, -2.9670597283903604) & xp.less_equal(t31, 2.9670597283903604), t31, xp.where(xp.greater_equal(t214, -2.9670597283903604) & xp.less_equal(t214, 2.9670597283903604), t214, xp.where(xp.greater_equal(t215, -2.9670597283903604) & xp.less_equal(t215, 2.9670597283903604), t215, qb5_0)))
+    t217 = xp.where(xp.less(t32, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t218 = t32 + t217
     t219 = t32 - t217
-    t220 = xp.where((xp.greater_equal(t32, -2.9670597283903604)) & (xp.less_equal(t32, 2.9670597283903604)), t32, xp.where((xp.greater_equal(t218, -2.9670597283903604)) & (xp.less_equal(t218, 2.9670597283903604)), t218, xp.where((xp.greater_equal(t219, -2.9670597283903604)) & (xp.less_equal(t219, 2.9670597283903604)), t219, qb5_1)))
-    t221 = xp.where(xp.greater(qn4, t33), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t222 = t221 + t33
+    t220 = xp.where(xp.greater_equal(t32, -2.9670597283903604) & xp.less_equal(t32, 2.9670597283903604), t32, xp.where(xp.greater_equal(t218, -2.9670597283903604) & xp.less_equal(t218, 2.9670597283903604), t218, xp.where(xp.greater_equal(t219, -2.9670597283903604) & xp.less_equal(t219, 2.9670597283903604), t219, qb5_1)))
+    t221 = xp.where(xp.less(t33, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t222 = t33 + t221
     t223 = t33 - t221
-    t224 = xp.where((xp.greater_equal(t33, -2.9670597283903604)) & (xp.less_equal(t33, 2.9670597283903604)), t33, xp.where((xp.greater_equal(t222, -2.9670597283903604)) & (xp.less_equal(t222, 2.9670597283903604)), t222, xp.where((xp.greater_equal(t223, -2.9670597283903604)) & (xp.less_equal(t223, 2.9670597283903604)), t223, qb5_3)))
-    t225 = xp.where(xp.greater(qn5, t34), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t226 = t225 + t34
+    t224 = xp.where(xp.greater_equal(t33, -2.9670597283903604) & xp.less_equal(t33, 2.9670597283903604), t33, xp.where(xp.greater_equal(t222, -2.9670597283903604) & xp.less_equal(t222, 2.9670597283903604), t222, xp.where(xp.greater_equal(t223, -2.9670597283903604) & xp.less_equal(t223, 2.9670597283903604), t223, qb5_3)))
+    t225 = xp.where(xp.less(t34, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t226 = t34 + t225
     t227 = t34 - t225
-    t228 = xp.where((xp.greater_equal(t34, -1.5707963267948966)) & (xp.less_equal(t34, 1.5707963267948966)), t34, xp.where((xp.greater_equal(t226, -1.5707963267948966)) & (xp.less_equal(t226, 1.5707963267948966)), t226, xp.where((xp.greater_equal(t227, -1.5707963267948966)) & (xp.less_equal(t227, 1.5707963267948966)), t227, qb5_4)))
-    t229 = xp.where(xp.greater(qn6, t35), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t230 = t229 + t35
+    t228 = xp.where(xp.greater_equal(t34, -1.5707963267948966) & xp.less_equal(t34, 1.5707963267948966), t34, xp.where(xp.greater_equal(t226, -1.5707963267948966) & xp.less_equal(t226, 1.5707963267948966), t226, xp.where(xp.greater_equal(t227, -1.5707963267948966) & xp.less_equal(t227, 1.5707963267948966), t227, qb5_4)))
+    t229 = xp.where(xp.less(t35, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t230 = t35 + t229
     t231 = t35 - t229
-    t232 = xp.where((xp.greater_equal(t35, -2.9670597283903604)) & (xp.less_equal(t35, 2.9670597283903604)), t35, xp.where((xp.greater_equal(t230, -2.9670597283903604)) & (xp.less_equal(t230, 2.9670597283903604)), t230, xp.where((xp.greater_equal(t231, -2.9670597283903604)) & (xp.less_equal(t231, 2.9670597283903604)), t231, qb5_5)))
-    t233 = qw1*(t216 + t70)**2 + qw2*(t220 + t71)**2 + qw3*(qb5_2 + t72)**2 + qw4*(t224 + t73)**2 + qw5*(t228 + t74)**2 + qw6*(t232 + t75)**2
+    t232 = xp.where(xp.greater_equal(t35, -2.9670597283903604) & xp.less_equal(t35, 2.9670597283903604), t35, xp.where(xp.greater_equal(t230, -2.9670597283903604) & xp.less_equal(t230, 2.9670597283903604), t230, xp.where(xp.greater_equal(t231, -2.9670597283903604) & xp.less_equal(t231, 2.9670597283903604), t231, qb5_5)))
+    t233 = qw1*(t216 + t70)**2 + qw2*(t220 + t71)**2 + qw3*(t72 + qb5_2)**2 + qw4*(t224 + t73)**2 + qw5*(t228 + t74)**2 + qw6*(t232 + t75)**2
     t234 = xp.greater(t36, 0)
-    t235 = xp.where(t234 & ((xp.greater(t212, t233)) | (xp.less(t204, 1))), xp.asarray(1, dtype=dtype), 0)
+    t235 = xp.where(t234 & (xp.greater(t212, t233) | xp.less(t204, 1)), xp.asarray(1, dtype=dtype), 0)
     t236 = xp.where(t234, 1, t204)
     t237 = xp.greater(t235, 0)
     t238 = xp.where(t237, t216, t206)
@@ -2861,29 +2861,29 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     t242 = xp.where(t237, t228, t210)
     t243 = xp.where(t237, t232, t211)
     t244 = xp.where(t237, t233, t212)
-    t245 = xp.where(xp.greater(qn1, t37), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t246 = t245 + t37
+    t245 = xp.where(xp.less(t37, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t246 = t37 + t245
     t247 = t37 - t245
-    t248 = xp.where((xp.greater_equal(t37, -2.9670597283903604)) & (xp.less_equal(t37, 2.9670597283903604)), t37, xp.where((xp.greater_equal(t246, -2.9670597283903604)) & (xp.less_equal(t246, 2.9670597283903604)), t246, xp.where((xp.greater_equal(t247, -2.9670597283903604)) & (xp.less_equal(t247, 2.9670597283903604)), t247, qb6_0)))
-    t249 = xp.where(xp.greater(qn2, t38), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t250 = t249 + t38
+    t248 = xp.where(xp.greater_equal(t37, -2.9670597283903604) & xp.less_equal(t37, 2.9670597283903604), t37, xp.where(xp.greater_equal(t246, -2.9670597283903604) & xp.less_equal(t246, 2.9670597283903604), t246, xp.where(xp.greater_equal(t247, -2.9670597283903604) & xp.less_equal(t247, 2.9670597283903604), t247, qb6_0)))
+    t249 = xp.where(xp.less(t38, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t250 = t38 + t249
     t251 = t38 - t249
-    t252 = xp.where((xp.greater_equal(t38, -2.9670597283903604)) & (xp.less_equal(t38, 2.9670597283903604)), t38, xp.where((xp.greater_equal(t250, -2.9670597283903604)) & (xp.less_equal(t250, 2.9670597283903604)), t250, xp.where((xp.greater_equal(t251, -2.9670597283903604)) & (xp.less_equal(t251, 2.9670597283903604)), t251, qb6_1)))
-    t253 = xp.where(xp.greater(qn4, t39), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t254 = t253 + t39
+    t252 = xp.where(xp.greater_equal(t38, -2.9670597283903604) & xp.less_equal(t38, 2.9670597283903604), t38, xp.where(xp.greater_equal(t250, -2.9670597283903604) & xp.less_equal(t250, 2.9670597283903604), t250, xp.where(xp.greater_equal(t251, -2.9670597283903604) & xp.less_equal(t251, 2.9670597283903604), t251, qb6_1)))
+    t253 = xp.where(xp.less(t39, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t254 = t39 + t253
     t255 = t39 - t253
-    t256 = xp.where((xp.greater_equal(t39, -2.9670597283903604)) & (xp.less_equal(t39, 2.9670597283903604)), t39, xp.where((xp.greater_equal(t254, -2.9670597283903604)) & (xp.less_equal(t254, 2.9670597283903604)), t254, xp.where((xp.greater_equal(t255, -2.9670597283903604)) & (xp.less_equal(t255, 2.9670597283903604)), t255, qb6_3)))
-    t257 = xp.where(xp.greater(qn5, t40), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t258 = t257 + t40
+    t256 = xp.where(xp.greater_equal(t39, -2.9670597283903604) & xp.less_equal(t39, 2.9670597283903604), t39, xp.where(xp.greater_equal(t254, -2.9670597283903604) & xp.less_equal(t254, 2.9670597283903604), t254, xp.where(xp.greater_equal(t255, -2.9670597283903604) & xp.less_equal(t255, 2.9670597283903604), t255, qb6_3)))
+    t257 = xp.where(xp.less(t40, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t258 = t40 + t257
     t259 = t40 - t257
-    t260 = xp.where((xp.greater_equal(t40, -1.5707963267948966)) & (xp.less_equal(t40, 1.5707963267948966)), t40, xp.where((xp.greater_equal(t258, -1.5707963267948966)) & (xp.less_equal(t258, 1.5707963267948966)), t258, xp.where((xp.greater_equal(t259, -1.5707963267948966)) & (xp.less_equal(t259, 1.5707963267948966)), t259, qb6_4)))
-    t261 = xp.where(xp.greater(qn6, t41), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t262 = t261 + t41
+    t260 = xp.where(xp.greater_equal(t40, -1.5707963267948966) & xp.less_equal(t40, 1.5707963267948966), t40, xp.where(xp.greater_equal(t258, -1.5707963267948966) & xp.less_equal(t258, 1.5707963267948966), t258, xp.where(xp.greater_equal(t259, -1.5707963267948966) & xp.less_equal(t259, 1.5707963267948966), t259, qb6_4)))
+    t261 = xp.where(xp.less(t41, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t262 = t41 + t261
     t263 = t41 - t261
-    t264 = xp.where((xp.greater_equal(t41, -2.9670597283903604)) & (xp.less_equal(t41, 2.9670597283903604)), t41, xp.where((xp.greater_equal(t262, -2.9670597283903604)) & (xp.less_equal(t262, 2.9670597283903604)), t262, xp.where((xp.greater_equal(t263, -2.9670597283903604)) & (xp.less_equal(t263, 2.9670597283903604)), t263, qb6_5)))
-    t265 = qw1*(t248 + t70)**2 + qw2*(t252 + t71)**2 + qw3*(qb6_2 + t72)**2 + qw4*(t256 + t73)**2 + qw5*(t260 + t74)**2 + qw6*(t264 + t75)**2
+    t264 = xp.where(xp.greater_equal(t41, -2.9670597283903604) & xp.less_equal(t41, 2.9670597283903604), t41, xp.where(xp.greater_equal(t262, -2.9670597283903604) & xp.less_equal(t262, 2.9670597283903604), t262, xp.where(xp.greater_equal(t263, -2.9670597283903604) & xp.less_equal(t263, 2.9670597283903604), t263, qb6_5)))
+    t265 = qw1*(t248 + t70)**2 + qw2*(t252 + t71)**2 + qw3*(t72 + qb6_2)**2 + qw4*(t256 + t73)**2 + qw5*(t260 + t74)**2 + qw6*(t264 + t75)**2
     t266 = xp.greater(t42, 0)
-    t267 = xp.where(t266 & ((xp.greater(t244, t265)) | (xp.less(t236, 1))), xp.asarray(1, dtype=dtype), 0)
+    t267 = xp.where(t266 & (xp.less(t265, t244) | xp.less(t236, 1)), xp.asarray(1, dtype=dtype), 0)
     t268 = xp.where(t266, 1, t236)
     t269 = xp.greater(t267, 0)
     t270 = xp.where(t269, t248, t238)
@@ -2893,29 +2893,29 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     t274 = xp.where(t269, t260, t242)
     t275 = xp.where(t269, t264, t243)
     t276 = xp.where(t269, t265, t244)
-    t277 = xp.where(xp.greater(qn1, t43), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t278 = t277 + t43
+    t277 = xp.where(xp.less(t43, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t278 = t43 + t277
     t279 = t43 - t277
-    t280 = xp.where((xp.greater_equal(t43, -2.9670597283903604)) & (xp.less_equal(t43, 2.9670597283903604)), t43, xp.where((xp.greater_equal(t278, -2.9670597283903604)) & (xp.less_equal(t278, 2.9670597283903604)), t278, xp.where((xp.greater_equal(t279, -2.9670597283903604)) & (xp.less_equal(t279, 2.9670597283903604)), t279, qb7_0)))
-    t281 = xp.where(xp.greater(qn2, t44), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t282 = t281 + t44
+    t280 = xp.where(xp.greater_equal(t43, -2.9670597283903604) & xp.less_equal(t43, 2.9670597283903604), t43, xp.where(xp.greater_equal(t278, -2.9670597283903604) & xp.less_equal(t278, 2.9670597283903604), t278, xp.where(xp.greater_equal(t279, -2.9670597283903604) & xp.less_equal(t279, 2.9670597283903604), t279, qb7_0)))
+    t281 = xp.where(xp.less(t44, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t282 = t44 + t281
     t283 = t44 - t281
-    t284 = xp.where((xp.greater_equal(t44, -2.9670597283903604)) & (xp.less_equal(t44, 2.9670597283903604)), t44, xp.where((xp.greater_equal(t282, -2.9670597283903604)) & (xp.less_equal(t282, 2.9670597283903604)), t282, xp.where((xp.greater_equal(t283, -2.9670597283903604)) & (xp.less_equal(t283, 2.9670597283903604)), t283, qb7_1)))
-    t285 = xp.where(xp.greater(qn4, t45), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t286 = t285 + t45
+    t284 = xp.where(xp.greater_equal(t44, -2.9670597283903604) & xp.less_equal(t44, 2.9670597283903604), t44, xp.where(xp.greater_equal(t282, -2.9670597283903604) & xp.less_equal(t282, 2.9670597283903604), t282, xp.where(xp.greater_equal(t283, -2.9670597283903604) & xp.less_equal(t283, 2.9670597283903604), t283, qb7_1)))
+    t285 = xp.where(xp.less(t45, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t286 = t45 + t285
     t287 = t45 - t285
-    t288 = xp.where((xp.greater_equal(t45, -2.9670597283903604)) & (xp.less_equal(t45, 2.9670597283903604)), t45, xp.where((xp.greater_equal(t286, -2.9670597283903604)) & (xp.less_equal(t286, 2.9670597283903604)), t286, xp.where((xp.greater_equal(t287, -2.9670597283903604)) & (xp.less_equal(t287, 2.9670597283903604)), t287, qb7_3)))
-    t289 = xp.where(xp.greater(qn5, t46), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t290 = t289 + t46
+    t288 = xp.where(xp.greater_equal(t45, -2.9670597283903604) & xp.less_equal(t45, 2.9670597283903604), t45, xp.where(xp.greater_equal(t286, -2.9670597283903604) & xp.less_equal(t286, 2.9670597283903604), t286, xp.where(xp.greater_equal(t287, -2.9670597283903604) & xp.less_equal(t287, 2.9670597283903604), t287, qb7_3)))
+    t289 = xp.where(xp.less(t46, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t290 = t46 + t289
     t291 = t46 - t289
-    t292 = xp.where((xp.greater_equal(t46, -1.5707963267948966)) & (xp.less_equal(t46, 1.5707963267948966)), t46, xp.where((xp.greater_equal(t290, -1.5707963267948966)) & (xp.less_equal(t290, 1.5707963267948966)), t290, xp.where((xp.greater_equal(t291, -1.5707963267948966)) & (xp.less_equal(t291, 1.5707963267948966)), t291, qb7_4)))
-    t293 = xp.where(xp.greater(qn6, t47), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t294 = t293 + t47
+    t292 = xp.where(xp.greater_equal(t46, -1.5707963267948966) & xp.less_equal(t46, 1.5707963267948966), t46, xp.where(xp.greater_equal(t290, -1.5707963267948966) & xp.less_equal(t290, 1.5707963267948966), t290, xp.where(xp.greater_equal(t291, -1.5707963267948966) & xp.less_equal(t291, 1.5707963267948966), t291, qb7_4)))
+    t293 = xp.where(xp.less(t47, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t294 = t47 + t293
     t295 = t47 - t293
-    t296 = xp.where((xp.greater_equal(t47, -2.9670597283903604)) & (xp.less_equal(t47, 2.9670597283903604)), t47, xp.where((xp.greater_equal(t294, -2.9670597283903604)) & (xp.less_equal(t294, 2.9670597283903604)), t294, xp.where((xp.greater_equal(t295, -2.9670597283903604)) & (xp.less_equal(t295, 2.9670597283903604)), t295, qb7_5)))
-    t297 = qw1*(t280 + t70)**2 + qw2*(t284 + t71)**2 + qw3*(qb7_2 + t72)**2 + qw4*(t288 + t73)**2 + qw5*(t292 + t74)**2 + qw6*(t296 + t75)**2
+    t296 = xp.where(xp.greater_equal(t47, -2.9670597283903604) & xp.less_equal(t47, 2.9670597283903604), t47, xp.where(xp.greater_equal(t294, -2.9670597283903604) & xp.less_equal(t294, 2.9670597283903604), t294, xp.where(xp.greater_equal(t295, -2.9670597283903604) & xp.less_equal(t295, 2.9670597283903604), t295, qb7_5)))
+    t297 = qw1*(t280 + t70)**2 + qw2*(t284 + t71)**2 + qw3*(t72 + qb7_2)**2 + qw4*(t288 + t73)**2 + qw5*(t292 + t74)**2 + qw6*(t296 + t75)**2
     t298 = xp.greater(t48, 0)
-    t299 = xp.where(t298 & ((xp.greater(t276, t297)) | (xp.less(t268, 1))), xp.asarray(1, dtype=dtype), 0)
+    t299 = xp.where(t298 & (xp.greater(t276, t297) | xp.less(t268, 1)), xp.asarray(1, dtype=dtype), 0)
     t300 = xp.where(t298, 1, t268)
     t301 = xp.greater(t299, 0)
     t302 = xp.where(t301, t280, t270)

@@ -47,7 +47,7 @@ void ur5_jacobian(const ur5_real q[UR5_DOF], ur5_real J[6 * UR5_DOF]);
 void ur5_fk_jacobian(const ur5_real q[UR5_DOF], ur5_real T[16], ur5_real J[6 * UR5_DOF]);
 
 /* Geometric Jacobian in the tool frame (6 x DOF, rows vx vy vz wx wy wz).
- * Result: J: 6 x 6 row-major, element (r, c) at J[r * 6 + c]. 224 operations. */
+ * Result: J: 6 x 6 row-major, element (r, c) at J[r * 6 + c]. 221 operations. */
 void ur5_jacobian_tool(const ur5_real q[UR5_DOF], ur5_real J[6 * UR5_DOF]);
 
 /* Task vector mu = (x, y, z, roll, pitch, yaw).
@@ -55,7 +55,7 @@ void ur5_jacobian_tool(const ur5_real q[UR5_DOF], ur5_real J[6 * UR5_DOF]);
 void ur5_task(const ur5_real q[UR5_DOF], ur5_real mu[UR5_TASK_DIM]);
 
 /* Analytic Jacobian d mu / d q (6 x DOF).
- * Result: J: 6 x 6 row-major, element (r, c) at J[r * 6 + c]. 144 operations. */
+ * Result: J: 6 x 6 row-major, element (r, c) at J[r * 6 + c]. 142 operations. */
 void ur5_task_jacobian(const ur5_real q[UR5_DOF], ur5_real J[UR5_TASK_DIM * UR5_DOF]);
 
 /* Fk, jacobian and bias_acceleration in one pass, sharing their terms.
@@ -63,7 +63,7 @@ void ur5_task_jacobian(const ur5_real q[UR5_DOF], ur5_real J[UR5_TASK_DIM * UR5_
 void ur5_fk_jacobian_dot(const ur5_real q[UR5_DOF], const ur5_real q_dot[UR5_DOF], ur5_real T[16], ur5_real J[6 * UR5_DOF], ur5_real a[6]);
 
 /* Time derivative dJ/dt of the world geometric Jacobian along q_dot (6 x DOF).
- * Result: Jd: 6 x 6 row-major, element (r, c) at Jd[r * 6 + c]. 219 operations. */
+ * Result: Jd: 6 x 6 row-major, element (r, c) at Jd[r * 6 + c]. 212 operations. */
 void ur5_jacobian_dot(const ur5_real q[UR5_DOF], const ur5_real q_dot[UR5_DOF], ur5_real Jd[6 * UR5_DOF]);
 
 /* J' q_dot: the tool's classical linear and angular acceleration at zero joint acceleration, world frame (6).
@@ -71,11 +71,11 @@ void ur5_jacobian_dot(const ur5_real q[UR5_DOF], const ur5_real q_dot[UR5_DOF], 
 void ur5_bias_acceleration(const ur5_real q[UR5_DOF], const ur5_real q_dot[UR5_DOF], ur5_real a[6]);
 
 /* Time derivative of the analytic Jacobian along q_dot (6 x DOF): mu'' = J_a q'' + J_a' q'.
- * Result: Jd: 6 x 6 row-major, element (r, c) at Jd[r * 6 + c]. 430 operations. */
+ * Result: Jd: 6 x 6 row-major, element (r, c) at Jd[r * 6 + c]. 426 operations. */
 void ur5_task_jacobian_dot(const ur5_real q[UR5_DOF], const ur5_real q_dot[UR5_DOF], ur5_real Jd[UR5_TASK_DIM * UR5_DOF]);
 
 /* Partial derivatives dJ/dq_k of the world geometric Jacobian (DOF x 6 x DOF, indexed [k, r, c]).
- * Result: H: 6 x 6 x 6 row-major, element (k, r, c) at H[k * 36 + r * 6 + c]. 152 operations. */
+ * Result: H: 6 x 6 x 6 row-major, element (k, r, c) at H[k * 36 + r * 6 + c]. 149 operations. */
 void ur5_hessian(const ur5_real q[UR5_DOF], ur5_real H[UR5_DOF * 6 * UR5_DOF]);
 
 /* Factors of det(Js): the robot is singular where one is 0.
@@ -95,11 +95,11 @@ ur5_real ur5_jacobian_det(const ur5_real q[UR5_DOF]);
 int ur5_velocity_ik(const ur5_real q[UR5_DOF], const ur5_real mu_dot[UR5_TASK_DIM], ur5_real damping, ur5_real q_dot[UR5_DOF]);
 
 /* One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite).
- * Result: q_start[i], i < 6; q_next[i], i < 6; returned as a scalar. 979 operations. */
+ * Result: q_start[i], i < 6; q_next[i], i < 6; returned as a scalar. 974 operations. */
 ur5_real ur5_ik_numeric_step(const ur5_real target[16], const ur5_real q[UR5_DOF], ur5_real damping, ur5_real q_start[UR5_DOF], ur5_real q_next[UR5_DOF]);
 
 /* Every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits.
- * Result: q: 8 x 6 row-major, element (r, c) at q[r * 6 + c]; valid[i], i < 8; in_limits[i], i < 8. 1283 operations. */
+ * Result: q: 8 x 6 row-major, element (r, c) at q[r * 6 + c]; valid[i], i < 8; in_limits[i], i < 8. 1270 operations. */
 void ur5_ik_branches(const ur5_real T[16], ur5_real q[UR5_MAX_IK_SOLUTIONS * UR5_DOF], int valid[UR5_MAX_IK_SOLUTIONS], int in_limits[UR5_MAX_IK_SOLUTIONS]);
 
 /* The closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status.

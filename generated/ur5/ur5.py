@@ -91,36 +91,36 @@ def fk(q):
     s6 = trig[..., 11]
     t0 = s1*s5
     t1 = c1*c5
-    t2 = t0 + c234*t1
-    t3 = t1 + c234*t0
+    t2 = t0 + t1*c234
+    t3 = t1 + t0*c234
     t4 = c5*s1
     t5 = c1*s5
-    t6 = t4 - c234*t5
-    t7 = -t5 + c234*t4
+    t6 = t4 - t5*c234
+    t7 = -t5 + t4*c234
     t8 = c1*s234
-    t9 = c6*t2 - s6*t8
-    t10 = c6*t8 + s6*t2
+    t9 = t2*c6 - t8*s6
+    t10 = t2*s6 + t8*c6
     t11 = 0.0823*t6 + 0.09465*t8
     t12 = t11 + 0.10915*s1
     t13 = s1*s234
-    t14 = c6*t7 - s6*t13
-    t15 = c6*t13 + s6*t7
+    t14 = t7*c6 - t13*s6
+    t15 = t7*s6 + t13*c6
     t16 = 0.09465*t13 - 0.0823*t3
     t17 = t16 - 0.10915*c1
     t18 = c5*s234
-    t19 = c234*s6 + c6*t18
-    t20 = c234*c6 - s6*t18
+    t19 = t18*c6 + c234*s6
+    t20 = c234*c6 - t18*s6
     t21 = s234*s5
     t22 = 0.0823*t21 + 0.09465*c234
     t23 = t22 + 0.39225*s23
     t24 = t23 + 0.425*s2
     t25 = 0.089459 - t24
     t26 = 0.39225*c23
-    t27 = t12 - c1*t26
-    t28 = t17 - s1*t26
+    t27 = t12 - t26*c1
+    t28 = t17 - t26*s1
     t29 = 0.425*c2
-    t30 = t27 - c1*t29
-    t31 = t28 - s1*t29
+    t30 = t27 - t29*c1
+    t31 = t28 - t29*s1
     T = _stack(xp, [
         t9,  # 0, 0
         -t10,  # 0, 1
@@ -161,8 +161,8 @@ def jacobian(q):
     c5 = trig[..., 8]
     s5 = trig[..., 9]
     t0 = c234*s5
-    t1 = c5*s1 - c1*t0
-    t2 = c1*c5 + s1*t0
+    t1 = c5*s1 - t0*c1
+    t2 = t0*s1 + c1*c5
     t3 = c1*s234
     t4 = 0.0823*t1 + 0.09465*t3
     t5 = t4 + 0.10915*s1
@@ -174,32 +174,32 @@ def jacobian(q):
     t11 = t10 + 0.39225*s23
     t12 = t11 + 0.425*s2
     t13 = 0.39225*c23
-    t14 = t5 - c1*t13
-    t15 = t8 - s1*t13
+    t14 = t5 - t13*c1
+    t15 = t8 - t13*s1
     t16 = 0.425*c2
-    t17 = t14 - c1*t16
-    t18 = t15 - s1*t16
-    t19 = c1*t10
-    t20 = s1*t10
+    t17 = t14 - t16*c1
+    t18 = t15 - t16*s1
+    t19 = t10*c1
+    t20 = t10*s1
     t21 = -c1
     J = _stack(xp, [
         -t18,  # 0, 0
-        c1*t12,  # 0, 1
-        c1*t11,  # 0, 2
+        t12*c1,  # 0, 1
+        t11*c1,  # 0, 2
         t19,  # 0, 3
-        c234*t7 - s234*t20,  # 0, 4
+        t7*c234 - t20*s234,  # 0, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5
         t17,  # 1, 0
-        s1*t12,  # 1, 1
-        s1*t11,  # 1, 2
+        t12*s1,  # 1, 1
+        t11*s1,  # 1, 2
         t20,  # 1, 3
-        s234*t19 - c234*t4,  # 1, 4
+        t19*s234 - t4*c234,  # 1, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
-        c1*t17 + s1*t18,  # 2, 1
-        c1*t14 + s1*t15,  # 2, 2
-        c1*t5 + s1*t8,  # 2, 3
-        t3*t7 - t4*t6,  # 2, 4
+        t17*c1 + t18*s1,  # 2, 1
+        t14*c1 + t15*s1,  # 2, 2
+        t5*c1 + t8*s1,  # 2, 3
+        t7*t3 - t4*t6,  # 2, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
         s1,  # 3, 1
@@ -245,40 +245,40 @@ def fk_jacobian(q):
     s6 = trig[..., 11]
     t0 = s1*s5
     t1 = c1*c5
-    t2 = t0 + c234*t1
-    t3 = t1 + c234*t0
+    t2 = t0 + t1*c234
+    t3 = t1 + t0*c234
     t4 = c5*s1
     t5 = c1*s5
-    t6 = t4 - c234*t5
-    t7 = -t5 + c234*t4
+    t6 = t4 - t5*c234
+    t7 = -t5 + t4*c234
     t8 = c1*s234
-    t9 = c6*t2 - s6*t8
-    t10 = c6*t8 + s6*t2
+    t9 = t2*c6 - t8*s6
+    t10 = t2*s6 + t8*c6
     t11 = 0.0823*t6 + 0.09465*t8
     t12 = t11 + 0.10915*s1
     t13 = s1*s234
-    t14 = c6*t7 - s6*t13
-    t15 = c6*t13 + s6*t7
+    t14 = t7*c6 - t13*s6
+    t15 = t7*s6 + t13*c6
     t16 = 0.09465*t13 - 0.0823*t3
     t17 = t16 - 0.10915*c1
     t18 = c5*s234
-    t19 = c234*s6 + c6*t18
-    t20 = c234*c6 - s6*t18
+    t19 = t18*c6 + c234*s6
+    t20 = c234*c6 - t18*s6
     t21 = s234*s5
     t22 = 0.0823*t21 + 0.09465*c234
     t23 = t22 + 0.39225*s23
     t24 = t23 + 0.425*s2
     t25 = 0.089459 - t24
     t26 = 0.39225*c23
-    t27 = t12 - c1*t26
-    t28 = t17 - s1*t26
+    t27 = t12 - t26*c1
+    t28 = t17 - t26*s1
     t29 = 0.425*c2
-    t30 = t27 - c1*t29
-    t31 = t28 - s1*t29
+    t30 = t27 - t29*c1
+    t31 = t28 - t29*s1
     t32 = -t3
     t33 = -t21
-    t34 = c1*t22
-    t35 = s1*t22
+    t34 = t22*c1
+    t35 = t22*s1
     t36 = -c1
     T = _stack(xp, [
         t9,  # 0, 0
@@ -300,21 +300,21 @@ def fk_jacobian(q):
     ], (4, 4))
     J = _stack(xp, [
         -t31,  # 0, 0
-        c1*t24,  # 0, 1
-        c1*t23,  # 0, 2
+        t24*c1,  # 0, 1
+        t23*c1,  # 0, 2
         t34,  # 0, 3
-        c234*t16 - s234*t35,  # 0, 4
+        t16*c234 - t35*s234,  # 0, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5
         t30,  # 1, 0
-        s1*t24,  # 1, 1
-        s1*t23,  # 1, 2
+        t24*s1,  # 1, 1
+        t23*s1,  # 1, 2
         t35,  # 1, 3
-        s234*t34 - c234*t11,  # 1, 4
+        t34*s234 - t11*c234,  # 1, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
-        c1*t30 + s1*t31,  # 2, 1
-        c1*t27 + s1*t28,  # 2, 2
-        c1*t12 + s1*t17,  # 2, 3
+        t30*c1 + t31*s1,  # 2, 1
+        t27*c1 + t28*s1,  # 2, 2
+        t12*c1 + t17*s1,  # 2, 3
         t16*t8 - t11*t13,  # 2, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
@@ -340,7 +340,7 @@ def fk_jacobian(q):
 
 
 def jacobian_tool(q):
-    """geometric Jacobian in the tool frame (6 x DOF, rows vx vy vz wx wy wz): (6 x 6), 224 operations."""
+    """geometric Jacobian in the tool frame (6 x DOF, rows vx vy vz wx wy wz): (6 x 6), 221 operations."""
     xp, dtype, device, batch, (q,) = _arguments(("q", q, (6,)))
     trig = _cos_sin(xp, q, (0.0, 0.0, 0.0, 0.0, 0.0, 0.0), device)
     c1 = trig[..., 0]
@@ -361,86 +361,86 @@ def jacobian_tool(q):
     s6 = trig[..., 11]
     t0 = s1*s5
     t1 = c1*c5
-    t2 = t0 + c234*t1
-    t3 = t1 + c234*t0
+    t2 = t0 + t1*c234
+    t3 = t1 + t0*c234
     t4 = c5*s1
     t5 = c1*s5
-    t6 = t4 - c234*t5
-    t7 = -t5 + c234*t4
+    t6 = t4 - t5*c234
+    t7 = -t5 + t4*c234
     t8 = c1*s234
-    t9 = c6*t2 - s6*t8
-    t10 = c6*t8 + s6*t2
+    t9 = t2*c6 - t8*s6
+    t10 = t2*s6 + t8*c6
     t11 = 0.0823*t6 + 0.09465*t8
     t12 = t11 + 0.10915*s1
     t13 = s1*s234
-    t14 = c6*t7 - s6*t13
-    t15 = c6*t13 + s6*t7
+    t14 = t7*c6 - t13*s6
+    t15 = t7*s6 + t13*c6
     t16 = 0.09465*t13 - 0.0823*t3
     t17 = t16 - 0.10915*c1
     t18 = c5*s234
-    t19 = c234*s6 + c6*t18
-    t20 = c234*c6 - s6*t18
+    t19 = t18*c6 + c234*s6
+    t20 = c234*c6 - t18*s6
     t21 = s234*s5
     t22 = 0.0823*t21 + 0.09465*c234
     t23 = t22 + 0.39225*s23
     t24 = t23 + 0.425*s2
     t25 = 0.39225*c23
-    t26 = t12 - c1*t25
-    t27 = t17 - s1*t25
+    t26 = t12 - t25*c1
+    t27 = t17 - t25*s1
     t28 = 0.425*c2
-    t29 = t26 - c1*t28
-    t30 = t27 - s1*t28
-    t31 = c1*t9
-    t32 = s1*t14
-    t33 = c1*t29 + s1*t30
-    t34 = c1*t26 + s1*t27
-    t35 = c1*t12 + s1*t17
-    t36 = c234*t16 - t13*t22
-    t37 = t22*t8 - c234*t11
+    t29 = t26 - t28*c1
+    t30 = t27 - t28*s1
+    t31 = t9*c1
+    t32 = t14*s1
+    t33 = t29*c1 + t30*s1
+    t34 = t26*c1 + t27*s1
+    t35 = t12*c1 + t17*s1
+    t36 = t16*c234 - t22*t13
+    t37 = t22*t8 - t11*c234
     t38 = t16*t8 - t11*t13
-    t39 = c1*t10
-    t40 = s1*t15
-    t41 = s1*t3
-    t42 = s1*t9 - c1*t14
-    t43 = c1*t15 - s1*t10
-    t44 = c1*t3 + s1*t6
+    t39 = t10*c1
+    t40 = t15*s1
+    t41 = t3*s1
+    t42 = t9*s1 - t14*c1
+    t43 = t15*c1 - t10*s1
+    t44 = t6*s1 + t3*c1
     J = _stack(xp, [
-        t14*t29 - t30*t9,  # 0, 0
+        t14*t29 - t9*t30,  # 0, 0
         t19*t33 + t24*t31 + t24*t32,  # 0, 1
         t19*t34 + t23*t31 + t23*t32,  # 0, 2
         t19*t35 + t22*t31 + t22*t32,  # 0, 3
-        t14*t37 + t19*t38 + t36*t9,  # 0, 4
+        t9*t36 + t14*t37 + t19*t38,  # 0, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5
         t10*t30 - t15*t29,  # 1, 0
-        t20*t33 - t24*t39 - t24*t40,  # 1, 1
-        t20*t34 - t23*t39 - t23*t40,  # 1, 2
-        t20*t35 - t22*t39 - t22*t40,  # 1, 3
-        t20*t38 - t10*t36 - t15*t37,  # 1, 4
+        -(t24*t39 + t24*t40 - t20*t33),  # 1, 1
+        -(t23*t39 + t23*t40 - t20*t34),  # 1, 2
+        -(t22*t39 + t22*t40 - t20*t35),  # 1, 3
+        -(t10*t36 + t15*t37 - t20*t38),  # 1, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5
-        -t29*t3 - t30*t6,  # 2, 0
-        -t21*t33 - t24*t41 + c1*t24*t6,  # 2, 1
-        -t21*t34 - t23*t41 + c1*t23*t6,  # 2, 2
-        -t21*t35 - t22*t41 + c1*t22*t6,  # 2, 3
-        t36*t6 - t21*t38 - t3*t37,  # 2, 4
+        -(t6*t30 + t3*t29),  # 2, 0
+        -(t24*t41 + t33*t21 - t6*t24*c1),  # 2, 1
+        -(t23*t41 + t34*t21 - t6*t23*c1),  # 2, 2
+        -(t22*t41 + t35*t21 - t6*t22*c1),  # 2, 3
+        -(t3*t37 + t38*t21 - t6*t36),  # 2, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 5
         t19,  # 3, 0
         t42,  # 3, 1
         t42,  # 3, 2
         t42,  # 3, 3
-        t13*t14 + t8*t9 - c234*t19,  # 3, 4
-        t6*t9 - t14*t3 - t19*t21,  # 3, 5
+        t9*t8 + t14*t13 - t19*c234,  # 3, 4
+        -(t3*t14 + t19*t21 - t6*t9),  # 3, 5
         t20,  # 4, 0
         t43,  # 4, 1
         t43,  # 4, 2
         t43,  # 4, 3
-        -c234*t20 - t10*t8 - t13*t15,  # 4, 4
-        t15*t3 - t10*t6 - t20*t21,  # 4, 5
+        -(t10*t8 + t15*t13 + t20*c234),  # 4, 4
+        -(t6*t10 + t20*t21 - t3*t15),  # 4, 5
         -t21,  # 5, 0
         t44,  # 5, 1
         t44,  # 5, 2
         t44,  # 5, 3
-        c234*t21 + t6*t8 - t13*t3,  # 5, 4
-        t3**2 + t6**2 + s234**2*s5**2,  # 5, 5
+        t6*t8 + t21*c234 - t3*t13,  # 5, 4
+        t6**2 + t3**2 + s234**2*s5**2,  # 5, 5
     ], (6, 6))
     return J
 
@@ -468,19 +468,19 @@ def task(q):
     t0 = c234*s6 + c5*c6*s234
     t1 = s1*s5
     t2 = c1*c5
-    t3 = t1 + c234*t2
-    t4 = t2 + c234*t1
+    t3 = t1 + t2*c234
+    t4 = t2 + t1*c234
     t5 = c5*s1
     t6 = c1*s5
-    t7 = t5 - c234*t6
-    t8 = -t6 + c234*t5
+    t7 = t5 - t6*c234
+    t8 = -t6 + t5*c234
     t9 = s234*s6
-    t10 = c6*t3 - c1*t9
-    t11 = c6*t8 - s1*t9
-    t12 = c234*c6 - c5*t9
+    t10 = t3*c6 - t9*c1
+    t11 = t8*c6 - t9*s1
+    t12 = c234*c6 - t9*c5
     t13 = 0.09465*s234
-    t14 = 0.0823*t7 + c1*t13
-    t15 = -0.0823*t4 + s1*t13
+    t14 = 0.0823*t7 + t13*c1
+    t15 = -0.0823*t4 + t13*s1
     t16 = t14 + 0.10915*s1
     t17 = t15 - 0.10915*c1
     t18 = s234*s5
@@ -489,11 +489,11 @@ def task(q):
     t21 = t20 + 0.425*s2
     t22 = 0.089459 - t21
     t23 = 0.39225*c23
-    t24 = t16 - c1*t23
-    t25 = t17 - s1*t23
+    t24 = t16 - t23*c1
+    t25 = t17 - t23*s1
     t26 = 0.425*c2
-    t27 = t24 - c1*t26
-    t28 = t25 - s1*t26
+    t27 = t24 - t26*c1
+    t28 = t25 - t26*s1
     mu = _stack(xp, [
         t27,  # 0
         t28,  # 1
@@ -506,7 +506,7 @@ def task(q):
 
 
 def task_jacobian(q):
-    """analytic Jacobian d mu / d q (6 x DOF): (6 x 6), 144 operations."""
+    """analytic Jacobian d mu / d q (6 x DOF): (6 x 6), 142 operations."""
     xp, dtype, device, batch, (q,) = _arguments(("q", q, (6,)))
     trig = _cos_sin(xp, q, (0.0, 0.0, 0.0, 0.0, 0.0, 0.0), device)
     c1 = trig[..., 0]
@@ -528,18 +528,18 @@ def task_jacobian(q):
     t0 = c234*s6 + c5*c6*s234
     t1 = s1*s5
     t2 = c1*c5
-    t3 = t1 + c234*t2
-    t4 = t2 + c234*t1
+    t3 = t1 + t2*c234
+    t4 = t2 + t1*c234
     t5 = c5*s1
     t6 = c1*s5
-    t7 = t5 - c234*t6
-    t8 = -t6 + c234*t5
+    t7 = t5 - t6*c234
+    t8 = -t6 + t5*c234
     t9 = s234*s6
-    t10 = c6*t3 - c1*t9
-    t11 = c6*t8 - s1*t9
+    t10 = t3*c6 - t9*c1
+    t11 = t8*c6 - t9*s1
     t12 = 0.09465*s234
-    t13 = 0.0823*t7 + c1*t12
-    t14 = -0.0823*t4 + s1*t12
+    t13 = 0.0823*t7 + t12*c1
+    t14 = -0.0823*t4 + t12*s1
     t15 = t13 + 0.10915*s1
     t16 = t14 - 0.10915*c1
     t17 = s234*s5
@@ -547,43 +547,43 @@ def task_jacobian(q):
     t19 = t18 + 0.39225*s23
     t20 = t19 + 0.425*s2
     t21 = 0.39225*c23
-    t22 = t15 - c1*t21
-    t23 = t16 - s1*t21
+    t22 = t15 - t21*c1
+    t23 = t16 - t21*s1
     t24 = 0.425*c2
-    t25 = t22 - c1*t24
-    t26 = t23 - s1*t24
-    t27 = c1*t18
-    t28 = s1*t18
-    t29 = s1*t10
-    t30 = c1*t11
+    t25 = t22 - t24*c1
+    t26 = t23 - t24*s1
+    t27 = t18*c1
+    t28 = t18*s1
+    t29 = t10*s1
+    t30 = t11*c1
     t31 = t10**2 + t11**2
-    t32 = t31**(-1.0)
+    t32 = 1/t31
     t33 = t32*(t29 - t30)
-    t34 = c1*t10
-    t35 = s1*t11
-    t36 = t32*(s234*t34 + s234*t35)
-    t37 = t32*(t10*t7 - t11*t4)
+    t34 = t10*c1
+    t35 = t11*s1
+    t36 = t32*(t34*s234 + t35*s234)
+    t37 = t32*(t7*t10 - t4*t11)
     t38 = 1/xp.sqrt(t31)
     t39 = -t38*(t34 + t35)
     t40 = -t0*t33
     J = _stack(xp, [
         -t26,  # 0, 0
-        c1*t20,  # 0, 1
-        c1*t19,  # 0, 2
+        t20*c1,  # 0, 1
+        t19*c1,  # 0, 2
         t27,  # 0, 3
-        c234*t14 - s234*t28,  # 0, 4
+        t14*c234 - t28*s234,  # 0, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5
         t25,  # 1, 0
-        s1*t20,  # 1, 1
-        s1*t19,  # 1, 2
+        t20*s1,  # 1, 1
+        t19*s1,  # 1, 2
         t28,  # 1, 3
-        s234*t27 - c234*t13,  # 1, 4
+        t27*s234 - t13*c234,  # 1, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
-        c1*t25 + s1*t26,  # 2, 1
-        c1*t22 + s1*t23,  # 2, 2
-        c1*t15 + s1*t16,  # 2, 3
-        c1*s234*t14 - s1*s234*t13,  # 2, 4
+        t25*c1 + t26*s1,  # 2, 1
+        t22*c1 + t23*s1,  # 2, 2
+        t15*c1 + t16*s1,  # 2, 3
+        t14*c1*s234 - t13*s1*s234,  # 2, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
         t33,  # 3, 1
@@ -595,14 +595,14 @@ def task_jacobian(q):
         t39,  # 4, 1
         t39,  # 4, 2
         t39,  # 4, 3
-        t38*(s234*t29 - s234*t30),  # 4, 4
-        -t38*(t10*t4 + t11*t7),  # 4, 5
+        t38*(t29*s234 - t30*s234),  # 4, 4
+        -t38*(t7*t11 + t4*t10),  # 4, 5
         xp.full(batch, 1, dtype=dtype, device=device),  # 5, 0
         t40,  # 5, 1
         t40,  # 5, 2
         t40,  # 5, 3
-        -c234 - t0*t36,  # 5, 4
-        -t17 - t0*t37,  # 5, 5
+        -(c234 + t0*t36),  # 5, 4
+        -(t17 + t0*t37),  # 5, 5
     ], (6, 6))
     return J
 
@@ -635,47 +635,47 @@ def fk_jacobian_dot(q, q_dot):
     s6 = trig[..., 11]
     t0 = s1*s5
     t1 = c1*c5
-    t2 = t0 + c234*t1
-    t3 = t1 + c234*t0
+    t2 = t0 + t1*c234
+    t3 = t1 + t0*c234
     t4 = c5*s1
     t5 = c1*s5
-    t6 = t4 - c234*t5
-    t7 = -t5 + c234*t4
+    t6 = t4 - t5*c234
+    t7 = -t5 + t4*c234
     t8 = c1*s234
-    t9 = c6*t2 - s6*t8
-    t10 = c6*t8 + s6*t2
+    t9 = t2*c6 - t8*s6
+    t10 = t2*s6 + t8*c6
     t11 = 0.0823*t6 + 0.09465*t8
     t12 = t11 + 0.10915*s1
     t13 = s1*s234
-    t14 = c6*t7 - s6*t13
-    t15 = c6*t13 + s6*t7
+    t14 = t7*c6 - t13*s6
+    t15 = t7*s6 + t13*c6
     t16 = 0.09465*t13 - 0.0823*t3
     t17 = t16 - 0.10915*c1
     t18 = c5*s234
-    t19 = c234*s6 + c6*t18
-    t20 = c234*c6 - s6*t18
+    t19 = t18*c6 + c234*s6
+    t20 = c234*c6 - t18*s6
     t21 = s234*s5
     t22 = 0.0823*t21 + 0.09465*c234
     t23 = t22 + 0.39225*s23
     t24 = t23 + 0.425*s2
     t25 = 0.089459 - t24
     t26 = 0.39225*c23
-    t27 = t12 - c1*t26
-    t28 = t17 - s1*t26
+    t27 = t12 - t26*c1
+    t28 = t17 - t26*s1
     t29 = 0.425*c2
-    t30 = t27 - c1*t29
-    t31 = t28 - s1*t29
-    t32 = s1*t22
-    t33 = c234*t16 - s234*t32
+    t30 = t27 - t29*c1
+    t31 = t28 - t29*s1
+    t32 = t22*s1
+    t33 = t16*c234 - t32*s234
     t34 = t33
-    t35 = c1*t22
-    t36 = s234*t35 - c234*t11
+    t35 = t22*c1
+    t36 = t35*s234 - t11*c234
     t37 = t36
-    t38 = c1*t30 + s1*t31
+    t38 = t30*c1 + t31*s1
     t39 = t38
-    t40 = c1*t27 + s1*t28
+    t40 = t27*c1 + t28*s1
     t41 = t40
-    t42 = c1*t12 + s1*t17
+    t42 = t12*c1 + t17*s1
     t43 = t42
     t44 = t16*t8 - t11*t13
     t45 = t44
@@ -687,33 +687,33 @@ def fk_jacobian_dot(q, q_dot):
     t51 = t49 + t50
     t52 = qd4*s1
     t53 = t48 + t52
-    t54 = t53 + qd5*t8
+    t54 = t53 + t8*qd5
     t55 = c1*qd4
     t56 = t51 + t55
-    t57 = -t56 + qd5*t13
+    t57 = -t56 + t13*qd5
     t58 = c234*qd5
     t59 = qd1 - t58
-    t60 = qd5*t34
+    t60 = t34*qd5
     t61 = t60 + t22*t55
     t62 = t61 + t23*t50
     t63 = t62 + t24*t49
-    t64 = t63 - qd1*t31
-    t65 = qd5*t37
+    t64 = t63 - t31*qd1
+    t65 = t37*qd5
     t66 = t65 + t22*t52
     t67 = t66 + t23*t47
     t68 = t67 + t24*t46
-    t69 = t68 + qd1*t30
-    t70 = qd5*t45
-    t71 = t70 + qd4*t43
-    t72 = t71 + qd3*t41
-    t73 = t72 + qd2*t39
+    t69 = t68 + t30*qd1
+    t70 = t45*qd5
+    t71 = t70 + t43*qd4
+    t72 = t71 + t41*qd3
+    t73 = t72 + t39*qd2
     t74 = -t3
     t75 = -t21
-    t76 = c1*t24
-    t77 = s1*t24
-    t78 = s1*t23
+    t76 = t24*c1
+    t77 = t24*s1
+    t78 = t23*s1
     t79 = -c1
-    t80 = qd2*t23
+    t80 = t23*qd2
     T = _stack(xp, [
         xp.broadcast_to(t9, batch),  # 0, 0
         xp.broadcast_to(-t10, batch),  # 0, 1
@@ -735,7 +735,7 @@ def fk_jacobian_dot(q, q_dot):
     J = _stack(xp, [
         xp.broadcast_to(-t31, batch),  # 0, 0
         xp.broadcast_to(t76, batch),  # 0, 1
-        xp.broadcast_to(c1*t23, batch),  # 0, 2
+        xp.broadcast_to(t23*c1, batch),  # 0, 2
         xp.broadcast_to(t35, batch),  # 0, 3
         xp.broadcast_to(t33, batch),  # 0, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5
@@ -771,18 +771,18 @@ def fk_jacobian_dot(q, q_dot):
         xp.broadcast_to(t75, batch),  # 5, 5
     ], (6, 6))
     a = _stack(xp, [
-        xp.broadcast_to(qd5*(t13*t70 + t37*t58 - qd1*t37 - t45*t56) - qd1*t69 - qd2*(c1*t73 + qd1*t77) - qd3*(c1*t72 + qd1*t78 + t41*t49) - qd4*(c1*t71 + qd1*t32 + t43*t51), batch),  # 0
-        xp.broadcast_to(qd1*t64 + qd2*(qd1*t76 - s1*t73) - qd3*(s1*t72 + t41*t46 - c1*qd1*t23) - qd4*(s1*t71 + t43*t48 - c1*qd1*t22) - qd5*(t34*t58 + t45*t53 + t70*t8 - qd1*t34), batch),  # 1
-        xp.broadcast_to(qd2*(c1*t63 + s1*t68) + qd3*(c1*t62 + s1*t67 + t80*c1**2 + t80*s1**2) + qd4*(c1*t61 + s1*t66 + t32*t48 + t35*t51) + qd5*(t34*t56 + t37*t53 + t65*t8 - t13*t60), batch),  # 2
-        xp.broadcast_to(qd1*t49 + qd1*t50 + qd1*t55 + qd5*(c234*t56 - qd1*t13) + qd6*(t3*t59 - t21*t57), batch),  # 3
-        xp.broadcast_to(qd1*t46 + qd1*t47 + qd1*t52 + qd5*(c234*t53 + qd1*t8) + qd6*(t21*t54 + t59*t6), batch),  # 4
-        xp.broadcast_to(qd4*(s1*t51 - c1*t48) + qd5*(t13*t53 + t56*t8) - qd6*(t3*t54 + t57*t6), batch),  # 5
+        xp.broadcast_to(qd5*(t37*t58 + t70*t13 - t37*qd1 - t45*t56) - t69*qd1 - qd2*(t73*c1 + t77*qd1) - qd3*(t41*t49 + t72*c1 + t78*qd1) - qd4*(t43*t51 + t71*c1 + t32*qd1), batch),  # 0
+        xp.broadcast_to(t64*qd1 + qd2*(t76*qd1 - t73*s1) - qd3*(t41*t46 + t72*s1 - t23*c1*qd1) - qd4*(t43*t48 + t71*s1 - t22*c1*qd1) - qd5*(t34*t58 + t45*t53 + t70*t8 - t34*qd1), batch),  # 1
+        xp.broadcast_to(qd2*(t63*c1 + t68*s1) + qd3*(t62*c1 + t67*s1 + t80*c1**2 + t80*s1**2) + qd4*(t48*t32 + t51*t35 + t61*c1 + t66*s1) + qd5*(t34*t56 + t37*t53 + t65*t8 - t60*t13), batch),  # 2
+        xp.broadcast_to(t49*qd1 + t50*qd1 + t55*qd1 + qd5*(t56*c234 - t13*qd1) + qd6*(t3*t59 - t57*t21), batch),  # 3
+        xp.broadcast_to(t46*qd1 + t47*qd1 + t52*qd1 + qd5*(t53*c234 + t8*qd1) + qd6*(t6*t59 + t54*t21), batch),  # 4
+        xp.broadcast_to(qd4*(t51*s1 - t48*c1) + qd5*(t53*t13 + t56*t8) - qd6*(t6*t57 + t3*t54), batch),  # 5
     ], (6,))
     return T, J, a
 
 
 def jacobian_dot(q, q_dot):
-    """time derivative dJ/dt of the world geometric Jacobian along q_dot (6 x DOF): (6 x 6), 219 operations."""
+    """time derivative dJ/dt of the world geometric Jacobian along q_dot (6 x DOF): (6 x 6), 212 operations."""
     xp, dtype, device, batch, (q, q_dot,) = _arguments(("q", q, (6,)), ("q_dot", q_dot, (6,)))
     qd1 = q_dot[..., 0]
     qd2 = q_dot[..., 1]
@@ -805,32 +805,32 @@ def jacobian_dot(q, q_dot):
     c5 = trig[..., 8]
     s5 = trig[..., 9]
     t0 = c234*s5
-    t1 = c5*s1 - c1*t0
-    t2 = c1*c5 + s1*t0
+    t1 = c5*s1 - t0*c1
+    t2 = t0*s1 + c1*c5
     t3 = 0.09465*s234
-    t4 = 0.0823*t1 + c1*t3
-    t5 = -0.0823*t2 + s1*t3
+    t4 = 0.0823*t1 + t3*c1
+    t5 = -0.0823*t2 + t3*s1
     t6 = t4 + 0.10915*s1
     t7 = t5 - 0.10915*c1
-    t8 = c1*t6 + s1*t7
+    t8 = t6*c1 + t7*s1
     t9 = s234*s5
     t10 = 0.0823*t9 + 0.09465*c234
     t11 = t10 + 0.39225*s23
     t12 = t11 + 0.425*s2
     t13 = 0.39225*c23
-    t14 = t6 - c1*t13
-    t15 = t7 - s1*t13
-    t16 = c1*t14 + s1*t15
+    t14 = t6 - t13*c1
+    t15 = t7 - t13*s1
+    t16 = t14*c1 + t15*s1
     t17 = 0.425*c2
-    t18 = t14 - c1*t17
-    t19 = t15 - s1*t17
-    t20 = c1*t18 + s1*t19
-    t21 = s234*t10
-    t22 = c234*t5 - s1*t21
-    t23 = c1*t21 - c234*t4
+    t18 = t14 - t17*c1
+    t19 = t15 - t17*s1
+    t20 = t18*c1 + t19*s1
+    t21 = t10*s234
+    t22 = t5*c234 - t21*s1
+    t23 = t21*c1 - t4*c234
     t24 = c1*s234
     t25 = s1*s234
-    t26 = t24*t5 - t25*t4
+    t26 = t5*t24 - t4*t25
     t27 = qd2*s1
     t28 = qd3*s1
     t29 = t27 + t28
@@ -839,66 +839,66 @@ def jacobian_dot(q, q_dot):
     t32 = t30 + t31
     t33 = qd4*s1
     t34 = t29 + t33
-    t35 = t34 + qd5*t24
+    t35 = t34 + t24*qd5
     t36 = c1*qd4
     t37 = t32 + t36
-    t38 = -t37 + qd5*t25
+    t38 = -t37 + t25*qd5
     t39 = c234*qd5
     t40 = qd1 - t39
-    t41 = qd5*t22
+    t41 = t22*qd5
     t42 = t41 + t10*t36
     t43 = t42 + t11*t31
     t44 = t43 + t12*t30
-    t45 = t44 - qd1*t19
-    t46 = qd5*t23
+    t45 = t44 - t19*qd1
+    t46 = t23*qd5
     t47 = t46 + t10*t33
     t48 = t47 + t11*t28
     t49 = t48 + t12*t27
-    t50 = t49 + qd1*t18
-    t51 = qd5*t26
-    t52 = t51 + qd4*t8
-    t53 = t52 + qd3*t16
-    t54 = t53 + qd2*t20
+    t50 = t49 + t18*qd1
+    t51 = t26*qd5
+    t52 = t51 + t8*qd4
+    t53 = t52 + t16*qd3
+    t54 = t53 + t20*qd2
     t55 = qd1*s1
     t56 = c1*qd1
-    t57 = qd2*t11
+    t57 = t11*qd2
     Jd = _stack(xp, [
         xp.broadcast_to(-t50, batch),  # 0, 0
-        xp.broadcast_to(-c1*t54 - t12*t55, batch),  # 0, 1
-        xp.broadcast_to(-c1*t53 - t11*t55 - t16*t30, batch),  # 0, 2
-        xp.broadcast_to(-c1*t52 - t10*t55 - t32*t8, batch),  # 0, 3
-        xp.broadcast_to(t23*t39 + t25*t51 - qd1*t23 - t26*t37, batch),  # 0, 4
+        xp.broadcast_to(-(t12*t55 + t54*c1), batch),  # 0, 1
+        xp.broadcast_to(-(t11*t55 + t16*t30 + t53*c1), batch),  # 0, 2
+        xp.broadcast_to(-(t10*t55 + t8*t32 + t52*c1), batch),  # 0, 3
+        xp.broadcast_to(t23*t39 + t51*t25 - t23*qd1 - t26*t37, batch),  # 0, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5
         xp.broadcast_to(t45, batch),  # 1, 0
-        xp.broadcast_to(t12*t56 - s1*t54, batch),  # 1, 1
-        xp.broadcast_to(-s1*t53 - t16*t27 + c1*qd1*t11, batch),  # 1, 2
-        xp.broadcast_to(-s1*t52 - t29*t8 + c1*qd1*t10, batch),  # 1, 3
-        xp.broadcast_to(qd1*t22 - t22*t39 - t24*t51 - t26*t34, batch),  # 1, 4
+        xp.broadcast_to(t12*t56 - t54*s1, batch),  # 1, 1
+        xp.broadcast_to(-(t16*t27 + t53*s1 - t11*c1*qd1), batch),  # 1, 2
+        xp.broadcast_to(-(t8*t29 + t52*s1 - t10*c1*qd1), batch),  # 1, 3
+        xp.broadcast_to(-(t22*t39 + t26*t34 + t51*t24 - t22*qd1), batch),  # 1, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
-        xp.broadcast_to(c1*t44 + s1*t49, batch),  # 2, 1
-        xp.broadcast_to(c1*t43 + s1*t48 + t57*c1**2 + t57*s1**2, batch),  # 2, 2
-        xp.broadcast_to(c1*t42 + s1*t47 + c1*t10*t32 + s1*t10*t29, batch),  # 2, 3
-        xp.broadcast_to(t22*t37 + t23*t34 + t24*t46 - t25*t41, batch),  # 2, 4
+        xp.broadcast_to(t44*c1 + t49*s1, batch),  # 2, 1
+        xp.broadcast_to(t43*c1 + t48*s1 + t57*c1**2 + t57*s1**2, batch),  # 2, 2
+        xp.broadcast_to(t42*c1 + t47*s1 + t10*t29*s1 + t10*t32*c1, batch),  # 2, 3
+        xp.broadcast_to(t22*t37 + t23*t34 + t46*t24 - t41*t25, batch),  # 2, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
         xp.broadcast_to(t56, batch),  # 3, 1
         xp.broadcast_to(t56, batch),  # 3, 2
         xp.broadcast_to(t56, batch),  # 3, 3
-        xp.broadcast_to(c234*t37 - s234*t55, batch),  # 3, 4
+        xp.broadcast_to(t37*c234 - t55*s234, batch),  # 3, 4
         xp.broadcast_to(t2*t40 - t38*t9, batch),  # 3, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
         xp.broadcast_to(t55, batch),  # 4, 1
         xp.broadcast_to(t55, batch),  # 4, 2
         xp.broadcast_to(t55, batch),  # 4, 3
-        xp.broadcast_to(c234*t34 + s234*t56, batch),  # 4, 4
+        xp.broadcast_to(t34*c234 + t56*s234, batch),  # 4, 4
         xp.broadcast_to(t1*t40 + t35*t9, batch),  # 4, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 2
-        xp.broadcast_to(s1*t32 - c1*t29, batch),  # 5, 3
-        xp.broadcast_to(t24*t37 + t25*t34, batch),  # 5, 4
-        xp.broadcast_to(-t1*t38 - t2*t35, batch),  # 5, 5
+        xp.broadcast_to(t32*s1 - t29*c1, batch),  # 5, 3
+        xp.broadcast_to(t34*t25 + t37*t24, batch),  # 5, 4
+        xp.broadcast_to(-(t1*t38 + t2*t35), batch),  # 5, 5
     ], (6, 6))
     return Jd
 
@@ -928,32 +928,32 @@ def bias_acceleration(q, q_dot):
     c5 = trig[..., 8]
     s5 = trig[..., 9]
     t0 = c234*s5
-    t1 = c5*s1 - c1*t0
-    t2 = c1*c5 + s1*t0
+    t1 = c5*s1 - t0*c1
+    t2 = t0*s1 + c1*c5
     t3 = 0.09465*s234
-    t4 = 0.0823*t1 + c1*t3
-    t5 = -0.0823*t2 + s1*t3
+    t4 = 0.0823*t1 + t3*c1
+    t5 = -0.0823*t2 + t3*s1
     t6 = t4 + 0.10915*s1
     t7 = t5 - 0.10915*c1
-    t8 = c1*t6 + s1*t7
+    t8 = t6*c1 + t7*s1
     t9 = s234*s5
     t10 = 0.0823*t9 + 0.09465*c234
     t11 = t10 + 0.39225*s23
     t12 = t11 + 0.425*s2
     t13 = 0.39225*c23
-    t14 = t6 - c1*t13
-    t15 = t7 - s1*t13
-    t16 = c1*t14 + s1*t15
+    t14 = t6 - t13*c1
+    t15 = t7 - t13*s1
+    t16 = t14*c1 + t15*s1
     t17 = 0.425*c2
-    t18 = t14 - c1*t17
-    t19 = t15 - s1*t17
-    t20 = c1*t18 + s1*t19
-    t21 = s234*t10
-    t22 = c234*t5 - s1*t21
-    t23 = c1*t21 - c234*t4
+    t18 = t14 - t17*c1
+    t19 = t15 - t17*s1
+    t20 = t18*c1 + t19*s1
+    t21 = t10*s234
+    t22 = t5*c234 - t21*s1
+    t23 = t21*c1 - t4*c234
     t24 = c1*s234
     t25 = s1*s234
-    t26 = t24*t5 - t25*t4
+    t26 = t5*t24 - t4*t25
     t27 = qd2*s1
     t28 = qd3*s1
     t29 = t27 + t28
@@ -962,41 +962,41 @@ def bias_acceleration(q, q_dot):
     t32 = t30 + t31
     t33 = qd4*s1
     t34 = t29 + t33
-    t35 = t34 + qd5*t24
+    t35 = t34 + t24*qd5
     t36 = c1*qd4
     t37 = t32 + t36
-    t38 = -t37 + qd5*t25
+    t38 = -t37 + t25*qd5
     t39 = c234*qd5
     t40 = qd1 - t39
-    t41 = qd5*t22
+    t41 = t22*qd5
     t42 = t41 + t10*t36
     t43 = t42 + t11*t31
     t44 = t43 + t12*t30
-    t45 = t44 - qd1*t19
-    t46 = qd5*t23
+    t45 = t44 - t19*qd1
+    t46 = t23*qd5
     t47 = t46 + t10*t33
     t48 = t47 + t11*t28
     t49 = t48 + t12*t27
-    t50 = t49 + qd1*t18
-    t51 = qd5*t26
-    t52 = t51 + qd4*t8
-    t53 = t52 + qd3*t16
-    t54 = t53 + qd2*t20
+    t50 = t49 + t18*qd1
+    t51 = t26*qd5
+    t52 = t51 + t8*qd4
+    t53 = t52 + t16*qd3
+    t54 = t53 + t20*qd2
     t55 = qd1*s1
-    t56 = qd2*t11
+    t56 = t11*qd2
     a = _stack(xp, [
-        xp.broadcast_to(qd5*(t23*t39 + t25*t51 - qd1*t23 - t26*t37) - qd1*t50 - qd2*(c1*t54 + t12*t55) - qd3*(c1*t53 + t11*t55 + t16*t30) - qd4*(c1*t52 + t10*t55 + t32*t8), batch),  # 0
-        xp.broadcast_to(qd1*t45 + qd2*(-s1*t54 + c1*qd1*t12) - qd3*(s1*t53 + t16*t27 - c1*qd1*t11) - qd4*(s1*t52 + t29*t8 - c1*qd1*t10) - qd5*(t22*t39 + t24*t51 + t26*t34 - qd1*t22), batch),  # 1
-        xp.broadcast_to(qd2*(c1*t44 + s1*t49) + qd3*(c1*t43 + s1*t48 + t56*c1**2 + t56*s1**2) + qd4*(c1*t42 + s1*t47 + c1*t10*t32 + s1*t10*t29) + qd5*(t22*t37 + t23*t34 + t24*t46 - t25*t41), batch),  # 2
-        xp.broadcast_to(qd1*t30 + qd1*t31 + qd1*t36 + qd5*(c234*t37 - qd1*t25) + qd6*(t2*t40 - t38*t9), batch),  # 3
-        xp.broadcast_to(qd1*t27 + qd1*t28 + qd1*t33 + qd5*(c234*t34 + qd1*t24) + qd6*(t1*t40 + t35*t9), batch),  # 4
-        xp.broadcast_to(qd4*(s1*t32 - c1*t29) + qd5*(t24*t37 + t25*t34) - qd6*(t1*t38 + t2*t35), batch),  # 5
+        xp.broadcast_to(qd5*(t23*t39 + t51*t25 - t23*qd1 - t26*t37) - t50*qd1 - qd2*(t12*t55 + t54*c1) - qd3*(t11*t55 + t16*t30 + t53*c1) - qd4*(t10*t55 + t8*t32 + t52*c1), batch),  # 0
+        xp.broadcast_to(t45*qd1 + qd2*(-t54*s1 + t12*c1*qd1) - qd3*(t16*t27 + t53*s1 - t11*c1*qd1) - qd4*(t8*t29 + t52*s1 - t10*c1*qd1) - qd5*(t22*t39 + t26*t34 + t51*t24 - t22*qd1), batch),  # 1
+        xp.broadcast_to(qd2*(t44*c1 + t49*s1) + qd3*(t43*c1 + t48*s1 + t56*c1**2 + t56*s1**2) + qd4*(t42*c1 + t47*s1 + t10*t29*s1 + t10*t32*c1) + qd5*(t22*t37 + t23*t34 + t46*t24 - t41*t25), batch),  # 2
+        xp.broadcast_to(t30*qd1 + t31*qd1 + t36*qd1 + qd5*(t37*c234 - t25*qd1) + qd6*(t2*t40 - t38*t9), batch),  # 3
+        xp.broadcast_to(t33*qd1 + t27*qd1 + t28*qd1 + qd5*(t34*c234 + t24*qd1) + qd6*(t1*t40 + t35*t9), batch),  # 4
+        xp.broadcast_to(qd4*(t32*s1 - t29*c1) + qd5*(t34*t25 + t37*t24) - qd6*(t1*t38 + t2*t35), batch),  # 5
     ], (6,))
     return a
 
 
 def task_jacobian_dot(q, q_dot):
-    """time derivative of the analytic Jacobian along q_dot (6 x DOF): mu'' = J_a q'' + J_a' q': (6 x 6), 430 operations."""
+    """time derivative of the analytic Jacobian along q_dot (6 x DOF): mu'' = J_a q'' + J_a' q': (6 x 6), 426 operations."""
     xp, dtype, device, batch, (q, q_dot,) = _arguments(("q", q, (6,)), ("q_dot", q_dot, (6,)))
     qd1 = q_dot[..., 0]
     qd2 = q_dot[..., 1]
@@ -1024,36 +1024,36 @@ def task_jacobian_dot(q, q_dot):
     t0 = c234*s6 + c5*c6*s234
     t1 = s1*s5
     t2 = c1*c5
-    t3 = t1 + c234*t2
-    t4 = t2 + c234*t1
+    t3 = t1 + t2*c234
+    t4 = t2 + t1*c234
     t5 = c5*s1
     t6 = c1*s5
-    t7 = t5 - c234*t6
-    t8 = -t6 + c234*t5
+    t7 = t5 - t6*c234
+    t8 = -t6 + t5*c234
     t9 = s234*s6
-    t10 = c6*t3 - c1*t9
-    t11 = c6*t8 - s1*t9
+    t10 = t3*c6 - t9*c1
+    t11 = t8*c6 - t9*s1
     t12 = 0.09465*s234
-    t13 = 0.0823*t7 + c1*t12
-    t14 = -0.0823*t4 + s1*t12
+    t13 = 0.0823*t7 + t12*c1
+    t14 = -0.0823*t4 + t12*s1
     t15 = t13 + 0.10915*s1
     t16 = t14 - 0.10915*c1
-    t17 = c1*t15 + s1*t16
+    t17 = t15*c1 + t16*s1
     t18 = s234*s5
     t19 = 0.0823*t18 + 0.09465*c234
     t20 = t19 + 0.39225*s23
     t21 = t20 + 0.425*s2
     t22 = 0.39225*c23
-    t23 = t15 - c1*t22
-    t24 = t16 - s1*t22
-    t25 = c1*t23 + s1*t24
+    t23 = t15 - t22*c1
+    t24 = t16 - t22*s1
+    t25 = t23*c1 + t24*s1
     t26 = 0.425*c2
-    t27 = t23 - c1*t26
-    t28 = t24 - s1*t26
-    t29 = c1*t27 + s1*t28
-    t30 = s234*t19
-    t31 = c234*t14 - s1*t30
-    t32 = c1*t30 - c234*t13
+    t27 = t23 - t26*c1
+    t28 = t24 - t26*s1
+    t29 = t27*c1 + t28*s1
+    t30 = t19*s234
+    t31 = t14*c234 - t30*s1
+    t32 = t30*c1 - t13*c234
     t33 = c1*s234
     t34 = s1*s234
     t35 = t14*t33 - t13*t34
@@ -1065,107 +1065,107 @@ def task_jacobian_dot(q, q_dot):
     t41 = c1*qd3
     t42 = t40 + t41
     t43 = t42
-    t44 = s1*t43 - c1*t39
+    t44 = t43*s1 - t39*c1
     t45 = qd4*s1
     t46 = t39 + t45
-    t47 = c234*t46 + qd1*t33
+    t47 = t46*c234 + t33*qd1
     t48 = c1*qd4
     t49 = t43 + t48
-    t50 = c234*t49 - qd1*t34
-    t51 = t33*t49 + t34*t46
-    t52 = qd5*t33
+    t50 = t49*c234 - t34*qd1
+    t51 = t46*t34 + t49*t33
+    t52 = t33*qd5
     t53 = t46 + t52
-    t54 = t38 + t45 + t52 + qd6*t7
-    t55 = qd5*t34
+    t54 = t38 + t45 + t52 + t7*qd6
+    t55 = t34*qd5
     t56 = t55 - t49
-    t57 = t4*t53 + t56*t7
-    t58 = t42 + t48 - t55 + qd6*t4
+    t57 = t7*t56 + t4*t53
+    t58 = t42 + t48 - t55 + t4*qd6
     t59 = t10*t58 + t11*t54
     t60 = c234*qd5
     t61 = qd1 - t60
-    t62 = t4*t61 - t18*t56
-    t63 = t18*t53 + t61*t7
-    t64 = t60 - qd1 + qd6*t18
+    t62 = t4*t61 - t56*t18
+    t63 = t7*t61 + t53*t18
+    t64 = t60 - qd1 + t18*qd6
     t65 = t11*t64 - t0*t58
-    t66 = t0*t54 + t10*t64
-    t67 = qd5*t31
+    t66 = t10*t64 + t0*t54
+    t67 = t31*qd5
     t68 = t67 + t19*t48
     t69 = t68 + t20*t41
     t70 = t69 + t21*t40
-    t71 = t70 - qd1*t28
-    t72 = qd5*t32
+    t71 = t70 - t28*qd1
+    t72 = t32*qd5
     t73 = t72 + t19*t45
     t74 = t73 + t20*t37
     t75 = t74 + t21*t36
-    t76 = t75 + qd1*t27
-    t77 = c1*t70 + s1*t75
-    t78 = c1*t68 + s1*t73 + c1*t19*t43 + s1*t19*t39
+    t76 = t75 + t27*qd1
+    t77 = t70*c1 + t75*s1
+    t78 = t68*c1 + t73*s1 + t19*t39*s1 + t19*t43*c1
     t79 = t31*t49 + t32*t46 + t33*t72 - t34*t67
-    t80 = qd5*t35
-    t81 = t80 + qd4*t17
-    t82 = t81 + qd3*t25
-    t83 = t82 + qd2*t29
-    t84 = t32*t60 + t34*t80 - qd1*t32 - t35*t49
-    t85 = t31*t60 + t33*t80 + t35*t46 - qd1*t31
+    t80 = t35*qd5
+    t81 = t80 + t17*qd4
+    t82 = t81 + t25*qd3
+    t83 = t82 + t29*qd2
+    t84 = t32*t60 + t34*t80 - t32*qd1 - t35*t49
+    t85 = t31*t60 + t35*t46 + t33*t80 - t31*qd1
     t86 = qd1*s1
-    t87 = c1*t83 + t21*t86
-    t88 = c1*t82 + t20*t86 + t25*t40
-    t89 = c1*t81 + t17*t43 + t19*t86
+    t87 = t21*t86 + t83*c1
+    t88 = t20*t86 + t25*t40 + t82*c1
+    t89 = t19*t86 + t17*t43 + t81*c1
     t90 = c1*qd1
-    t91 = t21*t90 - s1*t83
-    t92 = s1*t82 + t25*t36 - t20*t90
-    t93 = s1*t81 + t17*t39 - t19*t90
-    t94 = qd2*t20
-    t95 = c1*t69 + s1*t74 + t94*c1**2 + t94*s1**2
+    t91 = t21*t90 - t83*s1
+    t92 = t25*t36 + t82*s1 - t20*t90
+    t93 = t17*t39 + t81*s1 - t19*t90
+    t94 = t20*qd2
+    t95 = t69*c1 + t74*s1 + t94*c1**2 + t94*s1**2
     t96 = t10**2 + t11**2
-    t97 = t96**(-1.0)
-    t98 = c1*t97
-    t99 = qd1*t10
-    t100 = s1*t97
-    t101 = qd1*t11
-    t102 = s1*t10
-    t103 = c1*t11
+    t97 = 1/t96
+    t98 = t97*c1
+    t99 = t10*qd1
+    t100 = t97*s1
+    t101 = t11*qd1
+    t102 = t10*s1
+    t103 = t11*c1
     t104 = t102 - t103
     t105 = 2/t96**2
     t106 = t104*t105
     t107 = t10*t106
-    t108 = t106*t11
-    t109 = t100*t101 + t65*(t100 - t107) + t66*(t108 + t98) + t98*t99
+    t108 = t11*t106
+    t109 = t66*(t98 + t108) + t65*(t100 - t107) + t98*t99 + t100*t101
     t110 = t10*t97
-    t111 = t110*t50
+    t111 = t50*t110
     t112 = t11*t97
-    t113 = t112*t47
-    t114 = s234*t98
-    t115 = c1*t10
-    t116 = s1*t11
-    t117 = s234*t115 + s234*t116
+    t113 = t47*t112
+    t114 = t98*s234
+    t115 = t10*c1
+    t116 = t11*s1
+    t117 = t115*s234 + t116*s234
     t118 = t105*t117
     t119 = t10*t118
-    t120 = s234*t100
+    t120 = t100*s234
     t121 = t11*t118
-    t122 = t110*t62
-    t123 = t112*t63
+    t122 = t62*t110
+    t123 = t63*t112
     t124 = t7*t97
-    t125 = t10*t7 - t11*t4
+    t125 = t7*t10 - t4*t11
     t126 = t105*t125
     t127 = t10*t126
     t128 = t4*t97
     t129 = t11*t126
     t130 = 1/xp.sqrt(t96)
-    t131 = qd1*t130
-    t132 = c1*t130
-    t133 = t96**(-3/2)
+    t131 = t130*qd1
+    t132 = t130*c1
+    t133 = 1/t96**1.5
     t134 = -t133*(t115 + t116)
-    t135 = s1*t130
-    t136 = t102*t131 + t66*(t135 + t11*t134) - t103*t131 - t65*(t132 + t10*t134)
+    t135 = t130*s1
+    t136 = t66*(t135 + t11*t134) + t102*t131 - t65*(t132 + t10*t134) - t103*t131
     t137 = t10*t130
     t138 = t11*t130
-    t139 = t133*(s234*t102 - s234*t103)
-    t140 = -t133*(t10*t4 + t11*t7)
+    t139 = t133*(t102*s234 - t103*s234)
+    t140 = -t133*(t7*t11 + t4*t10)
     t141 = t0*t98
     t142 = t0*t100
     t143 = t59*t97
-    t144 = t101*t142 + t104*t143 + t141*t99 + t66*(t141 + t0*t108) - t65*(-t142 + t0*t107)
+    t144 = t66*(t141 + t0*t108) + t99*t141 + t101*t142 + t104*t143 - t65*(-t142 + t0*t107)
     t145 = -t144
     Jd = _stack(xp, [
         xp.broadcast_to(-t76, batch),  # 0, 0
@@ -1191,25 +1191,25 @@ def task_jacobian_dot(q, q_dot):
         xp.broadcast_to(t109, batch),  # 3, 2
         xp.broadcast_to(t109, batch),  # 3, 3
         xp.broadcast_to(t111 + t113 + t65*(t114 - t119) - t66*(t120 - t121), batch),  # 3, 4
-        xp.broadcast_to(t122 + t123 + t65*(t124 - t127) + t66*(t128 + t129), batch),  # 3, 5
+        xp.broadcast_to(t122 + t123 + t66*(t128 + t129) + t65*(t124 - t127), batch),  # 3, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
         xp.broadcast_to(t136, batch),  # 4, 1
         xp.broadcast_to(t136, batch),  # 4, 2
         xp.broadcast_to(t136, batch),  # 4, 3
-        xp.broadcast_to(t137*t47 + t65*(s234*t135 - t10*t139) + t66*(s234*t132 + t11*t139) - t138*t50, batch),  # 4, 4
-        xp.broadcast_to(t137*t63 + t66*(t11*t140 + t130*t7) - t138*t62 - t65*(t10*t140 + t130*t4), batch),  # 4, 5
+        xp.broadcast_to(t66*(t11*t139 + t132*s234) + t47*t137 + t65*(t135*s234 - t10*t139) - t50*t138, batch),  # 4, 4
+        xp.broadcast_to(t66*(t7*t130 + t11*t140) + t63*t137 - t62*t138 - t65*(t4*t130 + t10*t140), batch),  # 4, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 0
         xp.broadcast_to(t145, batch),  # 5, 1
         xp.broadcast_to(t145, batch),  # 5, 2
-        xp.broadcast_to(t44 - t144, batch),  # 5, 3
-        xp.broadcast_to(t51 + t65*(t0*t119 - t0*t114) - t0*t111 - t0*t113 - t117*t143 - t66*(t0*t121 - t0*t120), batch),  # 5, 4
-        xp.broadcast_to(-t57 + t65*(t0*t127 - t0*t124) - t0*t122 - t0*t123 - t125*t143 - t66*(t0*t128 + t0*t129), batch),  # 5, 5
+        xp.broadcast_to(-(t144 - t44), batch),  # 5, 3
+        xp.broadcast_to(-(-t51 + t66*(t0*t121 - t0*t120) + t0*t111 + t0*t113 + t117*t143 - t65*(t0*t119 - t0*t114)), batch),  # 5, 4
+        xp.broadcast_to(-(t57 + t66*(t0*t128 + t0*t129) + t0*t122 + t0*t123 + t125*t143 - t65*(t0*t127 - t0*t124)), batch),  # 5, 5
     ], (6, 6))
     return Jd
 
 
 def hessian(q):
-    """partial derivatives dJ/dq_k of the world geometric Jacobian (DOF x 6 x DOF, indexed [k, r, c]): (6 x 6 x 6), 152 operations."""
+    """partial derivatives dJ/dq_k of the world geometric Jacobian (DOF x 6 x DOF, indexed [k, r, c]): (6 x 6 x 6), 149 operations."""
     xp, dtype, device, batch, (q,) = _arguments(("q", q, (6,)))
     trig = _cos_sin(xp, q, (0.0, 0.0, 0.0, 0.0, 0.0, 0.0), device)
     c1 = trig[..., 0]
@@ -1230,50 +1230,50 @@ def hessian(q):
     t1 = t0 + 0.39225*s23
     t2 = t1 + 0.425*s2
     t3 = c1*c234
-    t4 = c5*s1 - s5*t3
+    t4 = c5*s1 - t3*s5
     t5 = c234*s1
-    t6 = c1*c5 + s5*t5
+    t6 = t5*s5 + c1*c5
     t7 = c1*s234
     t8 = 0.0823*t4 + 0.09465*t7
     t9 = t8 + 0.10915*s1
     t10 = s1*s234
     t11 = 0.09465*t10 - 0.0823*t6
     t12 = t11 - 0.10915*c1
-    t13 = c1*t9 + s1*t12
-    t14 = t11*t7 - t10*t8
+    t13 = t9*c1 + t12*s1
+    t14 = t11*t7 - t8*t10
     t15 = 0.39225*c23
-    t16 = t9 - c1*t15
-    t17 = t12 - s1*t15
-    t18 = c1*t16 + s1*t17
+    t16 = t9 - t15*c1
+    t17 = t12 - t15*s1
+    t18 = t16*c1 + t17*s1
     t19 = 0.425*c2
-    t20 = t16 - c1*t19
-    t21 = t17 - s1*t19
-    t22 = c1*t20 + s1*t21
-    t23 = s1*t0
-    t24 = c234*t11 - s234*t23
-    t25 = c1*t0
-    t26 = s234*t25 - c234*t8
-    t27 = -s1*t2
-    t28 = -s1*t1
+    t20 = t16 - t19*c1
+    t21 = t17 - t19*s1
+    t22 = t20*c1 + t21*s1
+    t23 = t0*s1
+    t24 = t11*c234 - t23*s234
+    t25 = t0*c1
+    t26 = t25*s234 - t8*c234
+    t27 = -t2*s1
+    t28 = -t1*s1
     t29 = -t23
     t30 = -t26
-    t31 = c1*t2
-    t32 = c1*t1
-    t33 = -c1*t18
-    t34 = -c1*t13
-    t35 = -c1*t14
-    t36 = -s1*t18
-    t37 = -s1*t13
-    t38 = -s1*t14
+    t31 = t2*c1
+    t32 = t1*c1
+    t33 = -t18*c1
+    t34 = -t13*c1
+    t35 = -t14*c1
+    t36 = -t18*s1
+    t37 = -t13*s1
+    t38 = -t14*s1
     t39 = c1**2
     t40 = s1**2
     t41 = t1*t39 + t1*t40
     t42 = t0*t39 + t0*t40
-    t43 = c1*t24 + s1*t26
-    t44 = s5*t7
-    t45 = s5*t10
-    t46 = s234*t39 + s234*t40
-    t47 = c1*t4 - s1*t6
+    t43 = t24*c1 + t26*s1
+    t44 = t7*s5
+    t45 = t10*s5
+    t46 = t39*s234 + t40*s234
+    t47 = t4*c1 - t6*s1
     t48 = s5*s234**2
     H = _stack(xp, [
         -t20,  # 0, 0, 0
@@ -1313,13 +1313,13 @@ def hessian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5, 5
         t27,  # 1, 0, 0
-        -c1*t22,  # 1, 0, 1
+        -t22*c1,  # 1, 0, 1
         t33,  # 1, 0, 2
         t34,  # 1, 0, 3
         t35,  # 1, 0, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 0, 5
         t31,  # 1, 1, 0
-        -s1*t22,  # 1, 1, 1
+        -t22*s1,  # 1, 1, 1
         t36,  # 1, 1, 2
         t37,  # 1, 1, 3
         t38,  # 1, 1, 4
@@ -1424,38 +1424,38 @@ def hessian(q):
         t35,  # 4, 0, 1
         t35,  # 4, 0, 2
         t35,  # 4, 0, 3
-        c234*t26 + t10*t14,  # 4, 0, 4
+        t26*c234 + t14*t10,  # 4, 0, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0, 5
         t24,  # 4, 1, 0
         t38,  # 4, 1, 1
         t38,  # 4, 1, 2
         t38,  # 4, 1, 3
-        -c234*t24 - t14*t7,  # 4, 1, 4
+        -(t24*c234 + t14*t7),  # 4, 1, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 2, 0
         t43,  # 4, 2, 1
         t43,  # 4, 2, 2
         t43,  # 4, 2, 3
-        t26*t7 - t10*t24,  # 4, 2, 4
+        t26*t7 - t24*t10,  # 4, 2, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 3, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 3, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 3, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 3, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 3, 4
-        -c234*t6 - s1*t48,  # 4, 3, 5
+        -(t6*c234 + t48*s1),  # 4, 3, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 4, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 4, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 4, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 4, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 4, 4
-        c1*t48 - c234*t4,  # 4, 4, 5
+        t48*c1 - t4*c234,  # 4, 4, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 5, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 5, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 5, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 5, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 5, 4
-        -t10*t4 - t6*t7,  # 4, 5, 5
+        -(t4*t10 + t6*t7),  # 4, 5, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 0, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 0, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 0, 2
@@ -1514,7 +1514,7 @@ def singularity_factors(q):
     f = _stack(xp, [
         s3,  # 0
         s5,  # 1
-        -c2 + 0.9229411764705883*t1 - 0.9229411764705883*t0 + t0*t2 - t1*t2 + c2*s3*t3 + c3*s2*t3,  # 2
+        -c2 + 0.9229411764705883*t1 - 0.9229411764705883*t0 + t0*t2 - t1*t2 + t3*c2*s3 + t3*c3*s2,  # 2
     ], (3,))
     return f
 
@@ -1534,7 +1534,7 @@ def manipulability(q):
     t1 = s2*s3
     t2 = 0.22270588235294117*s4
     t3 = 0.22270588235294117*c4
-    t4 = 0.07085015625*s3*s5*(-c2 + 0.9229411764705883*t1 - 0.9229411764705883*t0 + t0*t2 - t1*t2 + c2*s3*t3 + c3*s2*t3)
+    t4 = 0.07085015625*s3*s5*(-c2 + 0.9229411764705883*t1 - 0.9229411764705883*t0 + t0*t2 - t1*t2 + t3*c2*s3 + t3*c3*s2)
     w = xp.broadcast_to(xp.abs(t4), batch)
     return w
 
@@ -1554,7 +1554,7 @@ def jacobian_det(q):
     t1 = s2*s3
     t2 = 0.22270588235294117*s4
     t3 = 0.22270588235294117*c4
-    d = xp.broadcast_to(0.07085015625*s3*s5*(-c2 + 0.9229411764705883*t1 - 0.9229411764705883*t0 + t0*t2 - t1*t2 + c2*s3*t3 + c3*s2*t3), batch)
+    d = xp.broadcast_to(0.07085015625*s3*s5*(-c2 + 0.9229411764705883*t1 - 0.9229411764705883*t0 + t0*t2 - t1*t2 + t3*c2*s3 + t3*c3*s2), batch)
     return d
 
 
@@ -1590,65 +1590,65 @@ def velocity_ik(q, mu_dot, damping=0.0):
     c5 = trig[..., 8]
     s5 = trig[..., 9]
     t0 = c234*s5
-    t1 = c5*s1 - c1*t0
-    t2 = c1*c5 + s1*t0
+    t1 = c5*s1 - t0*c1
+    t2 = t0*s1 + c1*c5
     t3 = c1*s234
     t4 = 0.0823*t1 + 0.09465*t3
     t5 = t4 + 0.10915*s1
     t6 = s1*s234
     t7 = 0.09465*t6 - 0.0823*t2
     t8 = t7 - 0.10915*c1
-    t9 = c1*t5 + s1*t8
-    t10 = t3*t7 - t4*t6
+    t9 = t5*c1 + t8*s1
+    t10 = t7*t3 - t4*t6
     t11 = s234*s5
     t12 = 0.0823*t11 + 0.09465*c234
     t13 = t12 + 0.39225*s23
     t14 = t13 + 0.425*s2
-    t15 = c234*t3 + t1*t11
-    t16 = t11*t2 - c234*t6
+    t15 = t1*t11 + t3*c234
+    t16 = t2*t11 - t6*c234
     t17 = 0.39225*c23
-    t18 = t5 - c1*t17
-    t19 = t8 - s1*t17
-    t20 = c1*t18 + s1*t19
+    t18 = t5 - t17*c1
+    t19 = t8 - t17*s1
+    t20 = t18*c1 + t19*s1
     t21 = 0.425*c2
-    t22 = t18 - c1*t21
-    t23 = t19 - s1*t21
-    t24 = c1*t22 + s1*t23
-    t25 = s1*t12
-    t26 = c234*t7 - s234*t25
-    t27 = t23 + c234*t26
-    t28 = c1*t12
-    t29 = s234*t28 - c234*t4
-    t30 = t22 - c234*t29
+    t22 = t18 - t21*c1
+    t23 = t19 - t21*s1
+    t24 = t22*c1 + t23*s1
+    t25 = t12*s1
+    t26 = t7*c234 - t25*s234
+    t27 = t23 + t26*c234
+    t28 = t12*c1
+    t29 = t28*s234 - t4*c234
+    t30 = t22 - t29*c234
     t31 = t23**2
     t32 = t12**2
     t33 = c1**2
     t34 = t12*t33 + t13*t33 + t14*t33 - t26*t6
     t35 = t13**2
     t36 = t14**2
-    t37 = t26**2 + t32*t33 + t33*t35 + t33*t36
-    t38 = t31 + t37
+    t37 = t26**2 + t33*t35 + t33*t36 + t33*t32
+    t38 = t37 + t31
     t39 = c1*s1
-    t40 = t26*t29 + t32*t39 + t35*t39 + t36*t39 - t22*t23
-    t41 = c1*t9
-    t42 = c1*t20
-    t43 = c1*t24
-    t44 = t10*t26 + t12*t41 + t13*t42 + t14*t43
+    t40 = t26*t29 + t35*t39 + t36*t39 + t39*t32 - t22*t23
+    t41 = t9*c1
+    t42 = t20*c1
+    t43 = t24*c1
+    t44 = t12*t41 + t13*t42 + t14*t43 + t26*t10
     t45 = t41 + t42 + t43 - t10*t6
-    t46 = c1*t13
-    t47 = c1*t14
-    t48 = s1*t28 + s1*t46 + s1*t47
+    t46 = t13*c1
+    t47 = t14*c1
+    t48 = t46*s1 + t47*s1 + t28*s1
     t49 = t48 + t26*t3
     t50 = t48 - t29*t6
     t51 = t22**2
     t52 = s1**2
     t53 = t12*t52 + t13*t52 + t14*t52 + t29*t3
-    t54 = t29**2 + t32*t52 + t35*t52 + t36*t52
+    t54 = t29**2 + t35*t52 + t36*t52 + t52*t32
     t55 = t51 + t54
-    t56 = s1*t9
-    t57 = s1*t20
-    t58 = s1*t24
-    t59 = t10*t29 + t12*t56 + t13*t57 + t14*t58
+    t56 = t9*s1
+    t57 = t20*s1
+    t58 = t24*s1
+    t59 = t12*t56 + t13*t57 + t14*t58 + t29*t10
     t60 = t56 + t57 + t58 + t10*t3
     t61 = t24**2
     t62 = t10**2
@@ -1658,7 +1658,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t66 = t1**2 + 3*t52 + t33*t65
     t67 = t66
     t68 = 3*c1
-    t69 = s1*t68 + t1*t2 - t39*t65
+    t69 = t1*t2 + t68*s1 - t39*t65
     t70 = t2**2 + 3*t33 + t52*t65
     t71 = t70
     t72 = c234**2
@@ -1674,9 +1674,9 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t82 = t81**2
     t83 = xp.sqrt(t75 + t76 + t77 + t78 + t79 + t82)
     t84 = t83*xp.where(xp.greater_equal(t81, 0), xp.asarray(1, dtype=dtype), -1)
-    t85 = t81 + t84
+    t85 = t84 + t81
     t86 = xp.where(xp.greater(t83, 0), 1/(t83*(t83 + xp.abs(t81))), 0)
-    t87 = t86*(mu_dot0*t85 + mu_dot1*t40 + mu_dot2*t44 + mu_dot3*t49 - mu_dot4*t34 - mu_dot5*t27)
+    t87 = t86*(t40*mu_dot1 + t44*mu_dot2 + t49*mu_dot3 + t85*mu_dot0 - t27*mu_dot5 - t34*mu_dot4)
     t88 = mu_dot0 - t85*t87
     t89 = mu_dot1 - t40*t87
     t90 = mu_dot2 - t44*t87
@@ -1684,91 +1684,91 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t92 = mu_dot4 + t34*t87
     t93 = mu_dot5 + t27*t87
     t94 = t55 + t80
-    t95 = t86*(t34*t50 + t40*t85 + t40*t94 + t44*t59 + t49*t53 - t27*t30)
+    t95 = t86*(t40*t85 + t40*t94 + t44*t59 + t49*t53 + t34*t50 - t27*t30)
     t96 = t40 - t85*t95
     t97 = t94 - t40*t95
     t98 = t59 - t44*t95
     t99 = t53 - t49*t95
     t100 = -t50 + t34*t95
     t101 = t30 + t27*t95
-    t102 = xp.sqrt(t100**2 + t101**2 + t97**2 + t98**2 + t99**2)
+    t102 = xp.sqrt(t97**2 + t98**2 + t99**2 + t100**2 + t101**2)
     t103 = t102*xp.where(xp.greater_equal(t97, 0), xp.asarray(1, dtype=dtype), -1)
-    t104 = t103 + t97
+    t104 = t97 + t103
     t105 = xp.where(xp.greater(t102, 0), 1/(t102*(t102 + xp.abs(t97))), 0)
-    t106 = t105*(t100*t92 + t101*t93 + t104*t89 + t90*t98 + t91*t99)
+    t106 = t105*(t98*t90 + t99*t91 + t100*t92 + t101*t93 + t89*t104)
     t107 = t89 - t104*t106
-    t108 = t90 - t106*t98
-    t109 = t91 - t106*t99
+    t108 = t90 - t98*t106
+    t109 = t91 - t99*t106
     t110 = t92 - t100*t106
     t111 = t93 - t101*t106
     t112 = t64 + t80
     t113 = t67 + t80
-    t114 = t86*(t113*t49 + t15*t27 + t34*t69 + t40*t53 + t44*t60 + t49*t85)
-    t115 = t49 - t114*t85
-    t116 = t53 - t114*t40
-    t117 = t60 - t114*t44
-    t118 = t113 - t114*t49
-    t119 = -t69 + t114*t34
-    t120 = -t15 + t114*t27
-    t121 = t105*(t100*t119 + t101*t120 + t104*t116 + t117*t98 + t118*t99)
+    t114 = t86*(t40*t53 + t27*t15 + t44*t60 + t49*t85 + t49*t113 + t34*t69)
+    t115 = t49 - t85*t114
+    t116 = t53 - t40*t114
+    t117 = t60 - t44*t114
+    t118 = t113 - t49*t114
+    t119 = -t69 + t34*t114
+    t120 = -t15 + t27*t114
+    t121 = t105*(t98*t117 + t99*t118 + t100*t119 + t101*t120 + t116*t104)
     t122 = t116 - t104*t121
-    t123 = t117 - t121*t98
-    t124 = t118 - t121*t99
+    t123 = t117 - t98*t121
+    t124 = t118 - t99*t121
     t125 = t119 - t100*t121
     t126 = t120 - t101*t121
     t127 = t71 + t80
-    t128 = -t86*(t127*t34 + t16*t27 + t34*t85 + t40*t50 + t44*t45 + t49*t69)
-    t129 = t34 + t128*t85
-    t130 = t50 + t128*t40
-    t131 = t45 + t128*t44
-    t132 = t69 + t128*t49
-    t133 = t127 + t128*t34
-    t134 = t16 + t128*t27
-    t135 = -t105*(t104*t130 + t131*t98 + t132*t99 - t100*t133 - t101*t134)
+    t128 = -t86*(t40*t50 + t27*t16 + t44*t45 + t49*t69 + t34*t85 + t34*t127)
+    t129 = t34 + t85*t128
+    t130 = t50 + t40*t128
+    t131 = t45 + t44*t128
+    t132 = t69 + t49*t128
+    t133 = t127 + t34*t128
+    t134 = t16 + t27*t128
+    t135 = -t105*(t98*t131 + t99*t132 + t130*t104 - t100*t133 - t101*t134)
     t136 = t130 + t104*t135
-    t137 = t131 + t135*t98
-    t138 = t132 + t135*t99
+    t137 = t131 + t98*t135
+    t138 = t132 + t99*t135
     t139 = t133 - t100*t135
     t140 = t134 - t101*t135
     t141 = t74 + t80
-    t142 = xp.sqrt(t82 + t112**2 + t113**2 + t127**2 + t141**2 + t94**2 + 2*t75 + 2*t76 + 2*t77 + 2*t78 + 2*t79 + 2*t15**2 + 2*t16**2 + 2*t30**2 + 2*t45**2 + 2*t50**2 + 2*t53**2 + 2*t59**2 + 2*t60**2 + 2*t69**2 + 2*t62*t72)
-    t143 = c234*t10
-    t144 = t86*(t112*t44 + t143*t27 + t34*t45 + t40*t59 + t44*t85 + t49*t60)
-    t145 = t44 - t144*t85
-    t146 = t59 - t144*t40
-    t147 = t112 - t144*t44
-    t148 = t60 - t144*t49
-    t149 = -t45 + t144*t34
-    t150 = -t143 + t144*t27
-    t151 = -t86*(t141*t27 + t143*t44 + t15*t49 + t16*t34 + t27*t85 - t30*t40)
-    t152 = t27 + t151*t85
-    t153 = t30 - t151*t40
-    t154 = t143 + t151*t44
-    t155 = t15 + t151*t49
-    t156 = t16 + t151*t34
-    t157 = t141 + t151*t27
-    t158 = t105*(t100*t149 + t101*t150 + t104*t146 + t147*t98 + t148*t99)
+    t142 = xp.sqrt(t82 + t94**2 + t112**2 + t113**2 + t127**2 + t141**2 + 2*t75 + 2*t76 + 2*t77 + 2*t78 + 2*t79 + 2*t30**2 + 2*t59**2 + 2*t53**2 + 2*t50**2 + 2*t60**2 + 2*t45**2 + 2*t69**2 + 2*t15**2 + 2*t16**2 + 2*t62*t72)
+    t143 = t10*c234
+    t144 = t86*(t40*t59 + t27*t143 + t44*t85 + t44*t112 + t49*t60 + t34*t45)
+    t145 = t44 - t85*t144
+    t146 = t59 - t40*t144
+    t147 = t112 - t44*t144
+    t148 = t60 - t49*t144
+    t149 = -t45 + t34*t144
+    t150 = -t143 + t27*t144
+    t151 = -t86*(t27*t85 + t27*t141 + t44*t143 + t49*t15 + t34*t16 - t40*t30)
+    t152 = t27 + t85*t151
+    t153 = t30 - t40*t151
+    t154 = t143 + t44*t151
+    t155 = t15 + t49*t151
+    t156 = t16 + t34*t151
+    t157 = t141 + t27*t151
+    t158 = t105*(t98*t147 + t99*t148 + t100*t149 + t101*t150 + t146*t104)
     t159 = t146 - t104*t158
-    t160 = t147 - t158*t98
-    t161 = t148 - t158*t99
+    t160 = t147 - t98*t158
+    t161 = t148 - t99*t158
     t162 = t149 - t100*t158
     t163 = t150 - t101*t158
-    t164 = t105*(t100*t156 + t101*t157 + t104*t153 - t154*t98 - t155*t99)
+    t164 = t105*(t100*t156 + t101*t157 + t153*t104 - t98*t154 - t99*t155)
     t165 = t153 - t104*t164
-    t166 = t154 + t164*t98
-    t167 = t155 + t164*t99
+    t166 = t154 + t98*t164
+    t167 = t155 + t99*t164
     t168 = t156 - t100*t164
     t169 = t157 - t101*t164
     t170 = xp.sqrt(t160**2 + t161**2 + t162**2 + t163**2)
     t171 = t170*xp.where(xp.greater_equal(t160, 0), xp.asarray(1, dtype=dtype), -1)
     t172 = t160 + t171
     t173 = xp.where(xp.greater(t170, 0), 1/(t170*(t170 + xp.abs(t160))), 0)
-    t174 = t173*(t123*t172 + t124*t161 + t125*t162 + t126*t163)
+    t174 = t173*(t161*t124 + t162*t125 + t163*t126 + t123*t172)
     t175 = t123 - t172*t174
     t176 = t124 - t161*t174
     t177 = t125 - t162*t174
     t178 = t126 - t163*t174
-    t179 = t173*(t139*t162 + t140*t163 - t137*t172 - t138*t161)
+    t179 = t173*(t162*t139 + t163*t140 - t161*t138 - t137*t172)
     t180 = t137 + t172*t179
     t181 = t138 + t161*t179
     t182 = t139 - t162*t179
@@ -1778,7 +1778,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t186 = t167 + t161*t184
     t187 = t168 - t162*t184
     t188 = t169 - t163*t184
-    t189 = t173*(t108*t172 + t109*t161 + t110*t162 + t111*t163)
+    t189 = t173*(t161*t109 + t162*t110 + t163*t111 + t108*t172)
     t190 = t108 - t172*t189
     t191 = t109 - t161*t189
     t192 = t110 - t162*t189
@@ -1813,96 +1813,96 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t221 = t220
     t222 = t221*xp.where(xp.greater_equal(t216, 0), xp.asarray(1, dtype=dtype), -1)
     t223 = t216 + t222
-    t224 = xp.where(xp.greater(t221, 0), 1/(t221*(t220 + t221)), 0)
+    t224 = xp.where(xp.greater(t221, 0), 1/(t221*(t221 + t220)), 0)
     t225 = t219 - t219*t224*t223**2
     t226 = xp.where(xp.not_equal(t222, 0), -t225/t222, 0)
     t227 = xp.where(xp.not_equal(t211, 0), -(t218 - t215*t226)/t211, 0)
     t228 = xp.where(xp.not_equal(t195, 0), -(t207 + t199*t227 + t203*t226)/t195, 0)
     t229 = xp.where(xp.not_equal(t171, 0), -(t190 + t180*t227 + t185*t226 - t175*t228)/t171, 0)
-    t230 = xp.where(xp.not_equal(t103, 0), -(t107 + t136*t227 - t122*t228 - t159*t229 - t165*t226)/t103, 0)
-    t231 = xp.where(xp.not_equal(t84, 0), -(t88 + t129*t227 + t152*t226 - t115*t228 - t145*t229 - t230*t96)/t84, 0)
-    t232 = t226 + t22*t230 - t23*t231
-    t233 = t10*t229 + t227*t6 + t228*t3 + t230*t29 + t231*t26 - c234*t226
-    t234 = t11*t226 + t2*t227 - t1*t228
-    t235 = s1*t14
-    t236 = s1*t228 - c1*t227
+    t230 = xp.where(xp.not_equal(t103, 0), -(t107 - (t159*t229 + t122*t228 + t165*t226 - t136*t227))/t103, 0)
+    t231 = xp.where(xp.not_equal(t84, 0), -(t88 - (t96*t230 + t145*t229 + t115*t228 - t129*t227 - t152*t226))/t84, 0)
+    t232 = t226 + t230*t22 - t231*t23
+    t233 = t227*t6 + t228*t3 + t229*t10 + t230*t29 + t231*t26 - t226*c234
+    t234 = t2*t227 + t226*t11 - t1*t228
+    t235 = t14*s1
+    t236 = t228*s1 - t227*c1
     t237 = t236 + t229*t24 + t230*t235 + t231*t47
     t238 = t236 + t229*t9 + t230*t25 + t231*t28
-    t239 = s1*t13
-    t240 = t236 + t20*t229 + t230*t239 + t231*t46
-    t241 = t31 + t51
-    t242 = xp.sqrt(t241 + t37 + t54 + t63 + t66 + t70 + t73)
+    t239 = t13*s1
+    t240 = t236 + t229*t20 + t230*t239 + t231*t46
+    t241 = t51 + t31
+    t242 = xp.sqrt(t37 + t54 + t63 + t66 + t70 + t73 + t241)
     t243 = xp.sqrt(1 + t241)
     t244 = t243*xp.where(xp.less_equal(t23, 0), xp.asarray(1, dtype=dtype), -1)
     t245 = xp.where(xp.greater(t243, 0), 1/(t243*(t243 + xp.abs(t23))), 0)
     t246 = -t23
     t247 = t244 + t246
-    t248 = t245*(t22*t235 + t247*t47)
+    t248 = t245*(t247*t47 + t22*t235)
     t249 = t47 - t247*t248
-    t250 = t235 - t22*t248
-    t251 = t245*(t22*t239 + t247*t46)
+    t250 = t235 - t248*t22
+    t251 = t245*(t247*t46 + t22*t239)
     t252 = t46 - t247*t251
-    t253 = t239 - t22*t251
-    t254 = t245*(t22*t25 + t247*t28)
+    t253 = t239 - t251*t22
+    t254 = t245*(t247*t28 + t22*t25)
     t255 = t28 - t247*t254
-    t256 = t25 - t22*t254
-    t257 = t245*(mu_dot5 + mu_dot0*t247 + mu_dot1*t22)
+    t256 = t25 - t254*t22
+    t257 = t245*(mu_dot5 + t247*mu_dot0 + t22*mu_dot1)
     t258 = mu_dot0 - t247*t257
-    t259 = mu_dot1 - t22*t257
+    t259 = mu_dot1 - t257*t22
     t260 = mu_dot5 - t257
     t261 = -c234
-    t262 = t245*(t261 + t22*t29 + t247*t26)
+    t262 = t245*(t261 + t247*t26 + t22*t29)
     t263 = t26 - t247*t262
-    t264 = t29 - t22*t262
-    t265 = c234 + t262
+    t264 = t29 - t262*t22
+    t265 = t262 + c234
     t266 = -t11
-    t267 = t11*t245
+    t267 = t245*t11
     t268 = t266 + t267
     t269 = t33 + t52
-    t270 = xp.sqrt(t269 + t61 + t248**2 + t250**2)
+    t270 = xp.sqrt(t61 + t269 + t248**2 + t250**2)
     t271 = t270*xp.where(xp.greater_equal(t250, 0), xp.asarray(1, dtype=dtype), -1)
     t272 = t250 + t271
     t273 = xp.where(xp.greater(t270, 0), 1/(t270*(t270 + xp.abs(t250))), 0)
-    t274 = t273*(t269 + t20*t24 + t248*t251 + t253*t272)
+    t274 = t273*(t269 + t248*t251 + t253*t272 + t24*t20)
     t275 = t253 - t272*t274
-    t276 = t20 - t24*t274
-    t277 = s1 - s1*t274
+    t276 = t20 - t274*t24
+    t277 = s1 - t274*s1
     t278 = -t251 + t248*t274
-    t279 = t273*(t269 + t24*t9 + t248*t254 + t256*t272)
+    t279 = t273*(t269 + t248*t254 + t256*t272 + t24*t9)
     t280 = t256 - t272*t279
-    t281 = t9 - t24*t279
-    t282 = s1 - s1*t279
+    t281 = t9 - t279*t24
+    t282 = s1 - t279*s1
     t283 = -t254 + t248*t279
-    t284 = t273*(t10*t24 + t248*t265 + t264*t272)
+    t284 = t273*(t248*t265 + t264*t272 + t24*t10)
     t285 = t264 - t272*t284
-    t286 = t10 - t24*t284
-    t287 = t3 - s1*t284
-    t288 = t6 + c1*t284
+    t286 = t10 - t284*t24
+    t287 = t3 - t284*s1
+    t288 = t6 + t284*c1
     t289 = -t265 + t248*t284
-    t290 = t273*(mu_dot2*t24 + mu_dot3*s1 + t259*t272 - c1*mu_dot4 - t248*t260)
+    t290 = t273*(t259*t272 + t24*mu_dot2 + mu_dot3*s1 - t248*t260 - c1*mu_dot4)
     t291 = t259 - t272*t290
-    t292 = mu_dot2 - t24*t290
-    t293 = mu_dot3 - s1*t290
-    t294 = mu_dot4 + c1*t290
+    t292 = mu_dot2 - t290*t24
+    t293 = mu_dot3 - t290*s1
+    t294 = mu_dot4 + t290*c1
     t295 = t260 + t248*t290
     t296 = -c1
-    t297 = t296 + c1*t274
-    t298 = t296 + c1*t279
-    t299 = xp.sqrt(t276**2 + t277**2 + t278**2 + t297**2)
+    t297 = t296 + t274*c1
+    t298 = t296 + t279*c1
+    t299 = xp.sqrt(t276**2 + t277**2 + t297**2 + t278**2)
     t300 = t299*xp.where(xp.greater_equal(t276, 0), xp.asarray(1, dtype=dtype), -1)
     t301 = t276 + t300
     t302 = xp.where(xp.greater(t299, 0), 1/(t299*(t299 + xp.abs(t276))), 0)
-    t303 = t302*(t277*t282 + t278*t283 + t281*t301 + t297*t298)
+    t303 = t302*(t277*t282 + t297*t298 + t278*t283 + t281*t301)
     t304 = t281 - t301*t303
     t305 = t282 - t277*t303
     t306 = t298 - t297*t303
     t307 = t283 - t278*t303
-    t308 = t302*(t277*t287 + t278*t289 + t286*t301 + t288*t297)
+    t308 = t302*(t277*t287 + t297*t288 + t278*t289 + t286*t301)
     t309 = t286 - t301*t308
     t310 = t287 - t277*t308
     t311 = t288 - t297*t308
     t312 = t289 - t278*t308
-    t313 = t302*(t277*t293 + t278*t295 + t292*t301 + t294*t297)
+    t313 = t302*(t277*t293 + t297*t294 + t278*t295 + t292*t301)
     t314 = t292 - t301*t313
     t315 = t293 - t277*t313
     t316 = t294 - t297*t313
@@ -1927,44 +1927,44 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t335 = t328 - t332*t334
     t336 = t329 - t325*t334
     t337 = t22*t267
-    t338 = t273*(c1*t2 + s1*t1 + t272*t337 - t248*t268)
+    t338 = t273*(t1*s1 + t2*c1 + t272*t337 - t248*t268)
     t339 = t337 - t272*t338
-    t340 = t1 - s1*t338
+    t340 = t1 - t338*s1
     t341 = t268 + t248*t338
     t342 = -t2
-    t343 = t342 + c1*t338
-    t344 = 1 + damping + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + q1 + q2 + q3 + q4 + q5 + q6 + t1 + t10 + t20 + t22 + t235 + t239 + t24 + t246 + t25 + t26 + t261 + t266 + t28 + t29 + t3 + t342 + t46 + t47 + t6 + t9 - t68 + 3*s1
-    t345 = t24*t338
-    t346 = t302*(t277*t340 + t278*t341 + t297*t343 - t301*t345)
+    t343 = t342 + t338*c1
+    t344 = 1 + t1 + t22 + t26 + t29 + t24 + t20 + t9 + t10 + t3 + t46 + t47 + t6 + t235 + t239 + t246 + t261 + t266 + t25 + t342 + t28 + damping + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + q1 + q2 + q3 + q4 + q5 + q6 - t68 + 3*s1
+    t345 = t338*t24
+    t346 = t302*(t277*t340 + t297*t343 + t278*t341 - t301*t345)
     t347 = t345 + t301*t346
     t348 = t340 - t277*t346
     t349 = t343 - t297*t346
     t350 = t341 - t278*t346
-    t351 = t321*(t306*t349 + t307*t350 + t320*t348)
+    t351 = t321*(t306*t349 + t307*t350 + t348*t320)
     t352 = t348 - t320*t351
     t353 = t349 - t306*t351
     t354 = t350 - t307*t351
-    t355 = t333*(t325*t354 + t332*t353)
+    t355 = t333*(t325*t354 + t353*t332)
     t356 = t353 - t332*t355
     t357 = t354 - t325*t355
     t358 = xp.abs(t357)
     t359 = t358
     t360 = t359*xp.where(xp.greater_equal(t357, 0), xp.asarray(1, dtype=dtype), -1)
     t361 = t357 + t360
-    t362 = xp.where(xp.greater(t359, 0), 1/(t359*(t358 + t359)), 0)
+    t362 = xp.where(xp.greater(t359, 0), 1/(t359*(t359 + t358)), 0)
     t363 = t336 - t336*t362*t361**2
     t364 = xp.where(xp.not_equal(t360, 0), -t363/t360, 0)
     t365 = xp.where(xp.not_equal(t331, 0), -(t335 - t356*t364)/t331, 0)
-    t366 = xp.where(xp.not_equal(t319, 0), -(t327 - t323*t365 - t352*t364)/t319, 0)
-    t367 = xp.where(xp.not_equal(t300, 0), -(t314 + t347*t364 - t304*t366 - t309*t365)/t300, 0)
-    t368 = xp.where(xp.not_equal(t271, 0), -(t291 - t275*t367 - t280*t366 - t285*t365 - t339*t364)/t271, 0)
-    t369 = xp.where(xp.not_equal(t244, 0), -(t258 - t249*t368 - t252*t367 - t255*t366 - t263*t365 - t247*t267*t364)/t244, 0)
+    t366 = xp.where(xp.not_equal(t319, 0), -(t327 - (t323*t365 + t352*t364))/t319, 0)
+    t367 = xp.where(xp.not_equal(t300, 0), -(t314 - (t304*t366 + t309*t365 - t347*t364))/t300, 0)
+    t368 = xp.where(xp.not_equal(t271, 0), -(t291 - (t275*t367 + t280*t366 + t285*t365 + t339*t364))/t271, 0)
+    t369 = xp.where(xp.not_equal(t244, 0), -(t258 - (t249*t368 + t252*t367 + t255*t366 + t263*t365 + t247*t364*t267))/t244, 0)
     t370 = xp.greater(damping, 0)
     t371 = xp.isfinite(t344)
     t372 = xp.greater_equal(damping, 0)
     t373 = 1e-12*t242
     t374 = 1e-12*t142
-    t375 = (t370 & ((xp.less_equal(t102, t374)) | (xp.less_equal(t170, t374)) | (xp.less_equal(t194, t374)) | (xp.less_equal(t210, t374)) | (xp.less_equal(t221, t374)) | (xp.less_equal(t83, t374)))) | ((xp.less_equal(damping, 0)) & ((xp.less_equal(t243, t373)) | (xp.less_equal(t270, t373)) | (xp.less_equal(t299, t373)) | (xp.less_equal(t318, t373)) | (xp.less_equal(t330, t373)) | (xp.less_equal(t359, t373))))
+    t375 = (t370 & (xp.less_equal(t83, t374) | xp.less_equal(t102, t374) | xp.less_equal(t170, t374) | xp.less_equal(t194, t374) | xp.less_equal(t210, t374) | xp.less_equal(t221, t374))) | (xp.less_equal(damping, 0) & (xp.less_equal(t243, t373) | xp.less_equal(t270, t373) | xp.less_equal(t299, t373) | xp.less_equal(t318, t373) | xp.less_equal(t330, t373) | xp.less_equal(t359, t373)))
     t376 = t371 & t372 & xp.logical_not(t375)
     q_dot = _stack(xp, [
         xp.broadcast_to(xp.where(t376, xp.where(t370, t232, t369), 0), batch),  # 0
@@ -1980,7 +1980,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def ik_numeric_step(target, q, damping=0.0):
-    """one step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite): (6 x 1 and 6 x 1 and 1 x 1), 979 operations."""
+    """one step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite): (6 x 1 and 6 x 1 and 1 x 1), 974 operations."""
     xp, dtype, device, batch, (target, q, damping,) = _arguments(("target", target, (4, 4)), ("q", q, (6,)), ("damping", damping, ()))
     T00 = target[..., 0, 0]
     T01 = target[..., 0, 1]
@@ -2025,149 +2025,149 @@ def ik_numeric_step(target, q, damping=0.0):
     t0 = T00 + T01 + T02 + T03 + T10 + T11 + T12 + T13 + T20 + T21 + T22 + T23 + qs1 + qs2 + qs3 + qs4 + qs5 + qs6
     t1 = s1*s5
     t2 = c1*c5
-    t3 = t1 + c234*t2
-    t4 = t2 + c234*t1
+    t3 = t1 + t2*c234
+    t4 = t2 + t1*c234
     t5 = c5*s1
     t6 = c1*s5
-    t7 = t5 - c234*t6
-    t8 = -t6 + c234*t5
+    t7 = t5 - t6*c234
+    t8 = -t6 + t5*c234
     t9 = c1*s234
-    t10 = c6*t3 - s6*t9
-    t11 = c6*t9 + s6*t3
+    t10 = t3*c6 - t9*s6
+    t11 = t3*s6 + t9*c6
     t12 = 0.0823*t7 + 0.09465*t9
     t13 = t12 + 0.10915*s1
     t14 = T00*t10 + T02*t7 - T01*t11
     t15 = T10*t10 + T12*t7 - T11*t11
     t16 = T20*t10 + T22*t7 - T21*t11
     t17 = s1*s234
-    t18 = c6*t8 - s6*t17
-    t19 = c6*t17 + s6*t8
+    t18 = t8*c6 - t17*s6
+    t19 = t8*s6 + t17*c6
     t20 = 0.09465*t17 - 0.0823*t4
     t21 = t20 - 0.10915*c1
-    t22 = c1*t13 + s1*t21
+    t22 = t13*c1 + t21*s1
     t23 = t20*t9 - t12*t17
     t24 = T01*t19 + T02*t4 - T00*t18
     t25 = T11*t19 + T12*t4 - T10*t18
     t26 = T21*t19 + T22*t4 - T20*t18
-    t27 = 0.5*t15 + 0.5*t24
+    t27 = 0.5*(t24 + t15)
     t28 = c5*s234
-    t29 = c234*s6 + c6*t28
-    t30 = c234*c6 - s6*t28
+    t29 = t28*c6 + c234*s6
+    t30 = c234*c6 - t28*s6
     t31 = s234*s5
     t32 = 0.0823*t31 + 0.09465*c234
     t33 = t32 + 0.39225*s23
     t34 = t33 + 0.425*s2
     t35 = 0.089459 - t34
-    t36 = c234*t20 - t17*t32
-    t37 = t32*t9 - c234*t12
-    t38 = c234*t9 + t31*t7
-    t39 = t31*t4 - c234*t17
+    t36 = t20*c234 - t32*t17
+    t37 = t32*t9 - t12*c234
+    t38 = t7*t31 + t9*c234
+    t39 = t4*t31 - t17*c234
     t40 = T00*t29 + T01*t30 - T02*t31
     t41 = T10*t29 + T11*t30 - T12*t31
     t42 = T20*t29 + T21*t30 - T22*t31
-    t43 = -0.5*t26 - 0.5*t41
-    t44 = 0.5*t40 - 0.5*t16
-    t45 = xp.sqrt(t27**2 + t43**2 + t44**2)
+    t43 = -0.5*(t41 + t26)
+    t44 = 0.5*(t40 - t16)
+    t45 = xp.sqrt(t43**2 + t44**2 + t27**2)
     t46 = T23 - t35
     t47 = 0.39225*c23
-    t48 = t13 - c1*t47
-    t49 = t21 - s1*t47
-    t50 = c1*t48 + s1*t49
+    t48 = t13 - t47*c1
+    t49 = t21 - t47*s1
+    t50 = t48*c1 + t49*s1
     t51 = 0.425*c2
-    t52 = t48 - c1*t51
-    t53 = t49 - s1*t51
-    t54 = c1*t52 + s1*t53
-    t55 = t53 + c234*t36
-    t56 = t52 - c234*t37
-    t57 = t22**2 + t23**2 + t50**2 + t54**2
+    t52 = t48 - t51*c1
+    t53 = t49 - t51*s1
+    t54 = t52*c1 + t53*s1
+    t55 = t53 + t36*c234
+    t56 = t52 - t37*c234
+    t57 = t54**2 + t50**2 + t22**2 + t23**2
     t58 = T03 - t52
     t59 = T13 - t53
     t60 = t32**2
     t61 = c1**2
-    t62 = t32*t61 + t33*t61 + t34*t61 - t17*t36
+    t62 = t32*t61 + t33*t61 + t34*t61 - t36*t17
     t63 = t33**2
     t64 = t34**2
-    t65 = t36**2 + t53**2 + t60*t61 + t61*t63 + t61*t64
+    t65 = t53**2 + t36**2 + t60*t61 + t61*t63 + t61*t64
     t66 = c1*s1
     t67 = t36*t37 + t60*t66 + t63*t66 + t64*t66 - t52*t53
-    t68 = c1*t22
-    t69 = c1*t50
-    t70 = c1*t54
-    t71 = t23*t36 + t32*t68 + t33*t69 + t34*t70
-    t72 = t68 + t69 + t70 - t17*t23
+    t68 = t22*c1
+    t69 = t50*c1
+    t70 = t54*c1
+    t71 = t32*t68 + t33*t69 + t34*t70 + t36*t23
+    t72 = t68 + t69 + t70 - t23*t17
     t73 = t32*t66 + t33*t66 + t34*t66
     t74 = t73 + t36*t9
-    t75 = t73 - t17*t37
+    t75 = t73 - t37*t17
     t76 = s1**2
-    t77 = t37**2 + t52**2 + t60*t76 + t63*t76 + t64*t76
+    t77 = t52**2 + t37**2 + t60*t76 + t63*t76 + t64*t76
     t78 = t32*t76 + t33*t76 + t34*t76 + t37*t9
-    t79 = s1*t22
-    t80 = s1*t50
-    t81 = s1*t54
-    t82 = t23*t37 + t32*t79 + t33*t80 + t34*t81
+    t79 = t22*s1
+    t80 = t50*s1
+    t81 = t54*s1
+    t82 = t32*t79 + t33*t80 + t34*t81 + t37*t23
     t83 = t79 + t80 + t81 + t23*t9
     t84 = s234**2
     t85 = t7**2 + 3*t76 + t61*t84
-    t86 = 3*t66 + t4*t7 - t66*t84
+    t86 = 3*t66 + t7*t4 - t66*t84
     t87 = t4**2 + 3*t61 + t76*t84
     t88 = 1 + c234**2 + t84*s5**2
     t89 = -t25
-    t90 = -0.5 + 0.5*t14 + 0.5*t42 + 0.5*t89
+    t90 = 0.5*(-1 + t14 + t42 + t89)
     t91 = xp.atan2(t45, t90)
     t92 = xp.where(xp.greater(t45, 0), t91/t45, 1)
-    t93 = (xp.greater_equal(t14, t42)) & (xp.greater_equal(t14, t89))
+    t93 = xp.greater_equal(t14, t42) & xp.greater_equal(t14, t89)
     t94 = xp.less_equal(t25, -t42)
-    t95 = xp.where(t93, 0.5 + 0.5*t14, xp.where(t94, -0.5*t24, 0.5*t40))
-    t96 = xp.where(t93, 0.5*t15, xp.where(t94, 0.5 + 0.5*t89, 0.5*t41))
-    t97 = xp.where(t93, 0.5*t16, xp.where(t94, -0.5*t26, 0.5 + 0.5*t42))
+    t95 = xp.where(t93, 0.5*(1 + t14), xp.where(t94, -0.5*t24, 0.5*t40))
+    t96 = xp.where(t93, 0.5*t15, xp.where(t94, 0.5*(1 + t89), 0.5*t41))
+    t97 = xp.where(t93, 0.5*t16, xp.where(t94, -0.5*t26, 0.5*(1 + t42)))
     t98 = xp.sqrt(t95**2 + t96**2 + t97**2)
-    t99 = xp.where(xp.greater_equal(t27*t97 + t43*t95 + t44*t96, 0), xp.asarray(1, dtype=dtype), -1)
-    t100 = (xp.greater(t45, 1e-06)) | (xp.greater(t90, 0))
+    t99 = xp.where(xp.greater_equal(t43*t95 + t44*t96 + t27*t97, 0), xp.asarray(1, dtype=dtype), -1)
+    t100 = xp.greater(t45, 1e-06) | xp.greater(t90, 0)
     t101 = t91*t99/t98
-    t102 = xp.where(t100, t43*t92, t101*t95)
-    t103 = xp.where(t100, t44*t92, t101*t96)
-    t104 = xp.where(t100, t27*t92, t101*t97)
-    t105 = t102**2 + t103**2 + t104**2 + t46**2 + t58**2 + t59**2
-    t106 = damping + t65
-    t107 = xp.sqrt(t106**2 + t55**2 + t62**2 + t67**2 + t71**2 + t74**2)
+    t102 = xp.where(t100, t43*t92, t95*t101)
+    t103 = xp.where(t100, t44*t92, t96*t101)
+    t104 = xp.where(t100, t27*t92, t97*t101)
+    t105 = t102**2 + t103**2 + t104**2 + t58**2 + t59**2 + t46**2
+    t106 = t65 + damping
+    t107 = xp.sqrt(t67**2 + t55**2 + t71**2 + t74**2 + t62**2 + t106**2)
     t108 = t107*xp.where(xp.greater_equal(t106, 0), xp.asarray(1, dtype=dtype), -1)
-    t109 = t106 + t108
+    t109 = t108 + t106
     t110 = xp.where(xp.greater(t107, 0), 1/(t107*(t107 + xp.abs(t106))), 0)
-    t111 = t110*(t102*t74 + t109*t58 + t46*t71 + t59*t67 - t103*t62 - t104*t55)
+    t111 = t110*(t67*t59 + t71*t46 + t74*t102 + t58*t109 - t55*t104 - t62*t103)
     t112 = t58 - t109*t111
-    t113 = t59 - t111*t67
-    t114 = t46 - t111*t71
-    t115 = t102 - t111*t74
-    t116 = t103 + t111*t62
-    t117 = t104 + t111*t55
-    t118 = damping + t77
-    t119 = t110*(t109*t67 + t118*t67 + t62*t75 + t71*t82 + t74*t78 - t55*t56)
+    t113 = t59 - t67*t111
+    t114 = t46 - t71*t111
+    t115 = t102 - t74*t111
+    t116 = t103 + t62*t111
+    t117 = t104 + t55*t111
+    t118 = t77 + damping
+    t119 = t110*(t67*t109 + t67*t118 + t71*t82 + t74*t78 + t62*t75 - t55*t56)
     t120 = t67 - t109*t119
-    t121 = t118 - t119*t67
-    t122 = t82 - t119*t71
-    t123 = t78 - t119*t74
-    t124 = -t75 + t119*t62
-    t125 = t56 + t119*t55
+    t121 = t118 - t67*t119
+    t122 = t82 - t71*t119
+    t123 = t78 - t74*t119
+    t124 = -t75 + t62*t119
+    t125 = t56 + t55*t119
     t126 = xp.sqrt(t121**2 + t122**2 + t123**2 + t124**2 + t125**2)
     t127 = t126*xp.where(xp.greater_equal(t121, 0), xp.asarray(1, dtype=dtype), -1)
     t128 = t121 + t127
     t129 = xp.where(xp.greater(t126, 0), 1/(t126*(t126 + xp.abs(t121))), 0)
-    t130 = t129*(t113*t128 + t114*t122 + t115*t123 + t116*t124 + t117*t125)
+    t130 = t129*(t122*t114 + t123*t115 + t124*t116 + t125*t117 + t113*t128)
     t131 = t113 - t128*t130
     t132 = t114 - t122*t130
     t133 = t115 - t123*t130
     t134 = t116 - t124*t130
     t135 = t117 - t125*t130
-    t136 = c234*t23
-    t137 = damping + t57
-    t138 = t110*(t109*t71 + t136*t55 + t137*t71 + t62*t72 + t67*t82 + t74*t83)
+    t136 = t23*c234
+    t137 = t57 + damping
+    t138 = t110*(t67*t82 + t55*t136 + t71*t109 + t71*t137 + t74*t83 + t62*t72)
     t139 = t71 - t109*t138
-    t140 = t82 - t138*t67
-    t141 = t137 - t138*t71
-    t142 = t83 - t138*t74
-    t143 = -t72 + t138*t62
-    t144 = -t136 + t138*t55
-    t145 = t129*(t122*t141 + t123*t142 + t124*t143 + t125*t144 + t128*t140)
+    t140 = t82 - t67*t138
+    t141 = t137 - t71*t138
+    t142 = t83 - t74*t138
+    t143 = -t72 + t62*t138
+    t144 = -t136 + t55*t138
+    t145 = t129*(t122*t141 + t123*t142 + t124*t143 + t125*t144 + t140*t128)
     t146 = t140 - t128*t145
     t147 = t141 - t122*t145
     t148 = t142 - t123*t145
@@ -2177,26 +2177,26 @@ def ik_numeric_step(target, q, damping=0.0):
     t152 = t151*xp.where(xp.greater_equal(t147, 0), xp.asarray(1, dtype=dtype), -1)
     t153 = t147 + t152
     t154 = xp.where(xp.greater(t151, 0), 1/(t151*(t151 + xp.abs(t147))), 0)
-    t155 = t154*(t132*t153 + t133*t148 + t134*t149 + t135*t150)
+    t155 = t154*(t148*t133 + t149*t134 + t150*t135 + t132*t153)
     t156 = t132 - t153*t155
     t157 = t133 - t148*t155
     t158 = t134 - t149*t155
     t159 = t135 - t150*t155
-    t160 = damping + t85
-    t161 = t110*(t109*t74 + t160*t74 + t38*t55 + t62*t86 + t67*t78 + t71*t83)
+    t160 = t85 + damping
+    t161 = t110*(t67*t78 + t55*t38 + t71*t83 + t74*t109 + t74*t160 + t62*t86)
     t162 = t74 - t109*t161
-    t163 = t78 - t161*t67
-    t164 = t83 - t161*t71
-    t165 = t160 - t161*t74
-    t166 = -t86 + t161*t62
-    t167 = -t38 + t161*t55
-    t168 = t129*(t122*t164 + t123*t165 + t124*t166 + t125*t167 + t128*t163)
+    t163 = t78 - t67*t161
+    t164 = t83 - t71*t161
+    t165 = t160 - t74*t161
+    t166 = -t86 + t62*t161
+    t167 = -t38 + t55*t161
+    t168 = t129*(t122*t164 + t123*t165 + t124*t166 + t125*t167 + t163*t128)
     t169 = t163 - t128*t168
     t170 = t164 - t122*t168
     t171 = t165 - t123*t168
     t172 = t166 - t124*t168
     t173 = t167 - t125*t168
-    t174 = t154*(t148*t171 + t149*t172 + t150*t173 + t153*t170)
+    t174 = t154*(t148*t171 + t149*t172 + t150*t173 + t170*t153)
     t175 = t170 - t153*t174
     t176 = t171 - t148*t174
     t177 = t172 - t149*t174
@@ -2205,30 +2205,30 @@ def ik_numeric_step(target, q, damping=0.0):
     t180 = t179*xp.where(xp.greater_equal(t176, 0), xp.asarray(1, dtype=dtype), -1)
     t181 = t176 + t180
     t182 = xp.where(xp.greater(t179, 0), 1/(t179*(t179 + xp.abs(t176))), 0)
-    t183 = t182*(t157*t181 + t158*t177 + t159*t178)
+    t183 = t182*(t177*t158 + t178*t159 + t157*t181)
     t184 = t157 - t181*t183
     t185 = t158 - t177*t183
     t186 = t159 - t178*t183
-    t187 = damping + t87
-    t188 = -t110*(t109*t62 + t187*t62 + t39*t55 + t67*t75 + t71*t72 + t74*t86)
+    t187 = t87 + damping
+    t188 = -t110*(t67*t75 + t55*t39 + t71*t72 + t74*t86 + t62*t109 + t62*t187)
     t189 = t62 + t109*t188
-    t190 = t75 + t188*t67
-    t191 = t72 + t188*t71
-    t192 = t86 + t188*t74
-    t193 = t187 + t188*t62
-    t194 = t39 + t188*t55
-    t195 = -t129*(t122*t191 + t123*t192 + t128*t190 - t124*t193 - t125*t194)
+    t190 = t75 + t67*t188
+    t191 = t72 + t71*t188
+    t192 = t86 + t74*t188
+    t193 = t187 + t62*t188
+    t194 = t39 + t55*t188
+    t195 = -t129*(t122*t191 + t123*t192 + t190*t128 - t124*t193 - t125*t194)
     t196 = t190 + t128*t195
     t197 = t191 + t122*t195
     t198 = t192 + t123*t195
     t199 = t193 - t124*t195
     t200 = t194 - t125*t195
-    t201 = t154*(t149*t199 + t150*t200 - t148*t198 - t153*t197)
+    t201 = t154*(t149*t199 + t150*t200 - t148*t198 - t197*t153)
     t202 = t197 + t153*t201
     t203 = t198 + t148*t201
     t204 = t199 - t149*t201
     t205 = t200 - t150*t201
-    t206 = t182*(t177*t204 + t178*t205 - t181*t203)
+    t206 = t182*(t177*t204 + t178*t205 - t203*t181)
     t207 = t203 + t181*t206
     t208 = t204 - t177*t206
     t209 = t205 - t178*t206
@@ -2236,56 +2236,56 @@ def ik_numeric_step(target, q, damping=0.0):
     t211 = t210*xp.where(xp.greater_equal(t208, 0), xp.asarray(1, dtype=dtype), -1)
     t212 = t208 + t211
     t213 = xp.where(xp.greater(t210, 0), 1/(t210*(t210 + xp.abs(t208))), 0)
-    t214 = t213*(t185*t212 + t186*t209)
+    t214 = t213*(t209*t186 + t185*t212)
     t215 = t185 - t212*t214
     t216 = t186 - t209*t214
-    t217 = damping + t88
-    t218 = -t110*(t109*t55 + t136*t71 + t217*t55 + t38*t74 + t39*t62 - t56*t67)
+    t217 = t88 + damping
+    t218 = -t110*(t55*t109 + t55*t217 + t71*t136 + t74*t38 + t62*t39 - t67*t56)
     t219 = t55 + t109*t218
-    t220 = t56 - t218*t67
-    t221 = t136 + t218*t71
-    t222 = t38 + t218*t74
-    t223 = t39 + t218*t62
-    t224 = t217 + t218*t55
-    t225 = t129*(t124*t223 + t125*t224 + t128*t220 - t122*t221 - t123*t222)
+    t220 = t56 - t67*t218
+    t221 = t136 + t71*t218
+    t222 = t38 + t74*t218
+    t223 = t39 + t62*t218
+    t224 = t217 + t55*t218
+    t225 = t129*(t124*t223 + t125*t224 + t220*t128 - t122*t221 - t123*t222)
     t226 = t220 - t128*t225
     t227 = t221 + t122*t225
     t228 = t222 + t123*t225
     t229 = t223 - t124*t225
     t230 = t224 - t125*t225
-    t231 = t154*(t149*t229 + t150*t230 - t148*t228 - t153*t227)
+    t231 = t154*(t149*t229 + t150*t230 - t148*t228 - t227*t153)
     t232 = t227 + t153*t231
     t233 = t228 + t148*t231
     t234 = t229 - t149*t231
     t235 = t230 - t150*t231
-    t236 = t182*(t177*t234 + t178*t235 - t181*t233)
+    t236 = t182*(t177*t234 + t178*t235 - t233*t181)
     t237 = t233 + t181*t236
     t238 = t234 - t177*t236
     t239 = t235 - t178*t236
-    t240 = t213*(t209*t239 + t212*t238)
+    t240 = t213*(t209*t239 + t238*t212)
     t241 = t238 - t212*t240
     t242 = t239 - t209*t240
     t243 = xp.abs(t242)
     t244 = t243
     t245 = t244*xp.where(xp.greater_equal(t242, 0), xp.asarray(1, dtype=dtype), -1)
     t246 = t242 + t245
-    t247 = xp.where(xp.greater(t244, 0), 1/(t244*(t243 + t244)), 0)
+    t247 = xp.where(xp.greater(t244, 0), 1/(t244*(t244 + t243)), 0)
     t248 = t216 - t216*t247*t246**2
     t249 = xp.where(xp.not_equal(t245, 0), -t248/t245, 0)
     t250 = xp.where(xp.not_equal(t211, 0), -(t215 - t241*t249)/t211, 0)
     t251 = xp.where(xp.not_equal(t180, 0), -(t184 + t207*t250 + t237*t249)/t180, 0)
     t252 = xp.where(xp.not_equal(t152, 0), -(t156 + t202*t250 + t232*t249 - t175*t251)/t152, 0)
-    t253 = xp.where(xp.not_equal(t127, 0), -(t131 + t196*t250 - t146*t252 - t169*t251 - t226*t249)/t127, 0)
-    t254 = xp.where(xp.not_equal(t108, 0), -(t112 + t189*t250 + t219*t249 - t120*t253 - t139*t252 - t162*t251)/t108, 0)
-    t255 = q1 + t249 + t253*t52 - t254*t53
-    t256 = q5 + t17*t250 + t23*t252 + t251*t9 + t253*t37 + t254*t36 - c234*t249
-    t257 = q6 + t251*t7 - t249*t31 - t250*t4
-    t258 = s1*t253
-    t259 = c1*t254
-    t260 = s1*t251 - c1*t250
-    t261 = q2 + t260 + t252*t54 + t258*t34 + t259*t34
-    t262 = q3 + t260 + t252*t50 + t258*t33 + t259*t33
-    t263 = q4 + t260 + t22*t252 + t258*t32 + t259*t32
+    t253 = xp.where(xp.not_equal(t127, 0), -(t131 - (t146*t252 + t169*t251 + t226*t249 - t196*t250))/t127, 0)
+    t254 = xp.where(xp.not_equal(t108, 0), -(t112 - (t120*t253 + t139*t252 + t162*t251 - t189*t250 - t219*t249))/t108, 0)
+    t255 = t249 + q1 + t52*t253 - t53*t254
+    t256 = q5 + t36*t254 + t37*t253 + t23*t252 + t250*t17 + t251*t9 - t249*c234
+    t257 = q6 + t7*t251 - t4*t250 - t249*t31
+    t258 = t253*s1
+    t259 = t254*c1
+    t260 = t251*s1 - t250*c1
+    t261 = t260 + q2 + t34*t258 + t34*t259 + t54*t252
+    t262 = t260 + q3 + t33*t258 + t33*t259 + t50*t252
+    t263 = t260 + q4 + t32*t258 + t32*t259 + t22*t252
     q_start = _stack(xp, [
         xp.broadcast_to(q1, batch),  # 0
         xp.broadcast_to(q2, batch),  # 1
@@ -2308,7 +2308,7 @@ def ik_numeric_step(target, q, damping=0.0):
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def ik_branches(T):
-    """every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits: (8 x 6 and 8 x 1 and 8 x 1), 1283 operations."""
+    """every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits: (8 x 6 and 8 x 1 and 8 x 1), 1270 operations."""
     xp, dtype, device, batch, (T,) = _arguments(("T", T, (4, 4)))
     T00 = T[..., 0, 0]
     T01 = T[..., 0, 1]
@@ -2347,521 +2347,515 @@ def ik_branches(T):
     t22 = xp.where(t21, 0.10915*t19, xp.where(xp.greater(t19, 0), xp.asarray(1, dtype=dtype), -1))
     t23 = xp.where(t21, xp.sqrt(t20), 0)
     t24 = xp.atan2(t23, t22)
-    t25 = xp.where(t18, 0, t24 + t9)
+    t25 = xp.where(t18, 0, t9 + t24)
     t26 = t9 - t24
-    t27 = t25 - 6.283185307179586*xp.ceil(-0.5 + 0.15915494309189535*t25)
-    t28 = t27 - 6.283185307179586*xp.floor(1.0 + 0.15915494309189535*t27)
-    t29 = t26 - 6.283185307179586*xp.ceil(-0.5 + 0.15915494309189535*t26)
-    t30 = t29 - 6.283185307179586*xp.floor(1.0 + 0.15915494309189535*t29)
-    t31 = t19*t4
+    t27 = t25 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t25))
+    t28 = t27 - 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t27))
+    t29 = t26 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t26))
+    t30 = t29 - 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t29))
+    t31 = t4*t19
     t32 = t23*t31
-    t33 = t19*t8
+    t33 = t8*t19
     t34 = t22*t33
-    t35 = xp.where(t18, 1, -t32 - t34)
+    t35 = xp.where(t18, 1, -(t34 + t32))
     t36 = t32 - t34
     t37 = t22*t31
     t38 = t23*t33
     t39 = xp.where(t18, 0, t37 - t38)
     t40 = t37 + t38
-    t41 = t35*t4 + t39*t8
-    t42 = t35*t8 - t39*t4
-    t43 = T00*t39 - T10*t35
-    t44 = T01*t39 - T11*t35
-    t45 = t36*t4 + t40*t8
-    t46 = t36*t8 - t4*t40
-    t47 = T00*t40 - T10*t36
-    t48 = T01*t40 - T11*t36
-    t49 = 1 - t35
-    t50 = t13*t49
-    t51 = t50 + t13*t35
-    t52 = T02*t39
-    t53 = T12*t35
-    t54 = t52 - t53
-    t55 = t53 - t52
-    t56 = t54**2
-    t57 = 1 - t56
-    t58 = xp.less(1e-12, t57)
-    t59 = xp.where(t58, t54, xp.where(xp.greater(t54, 0), xp.asarray(1, dtype=dtype), -1))
-    t60 = xp.where(t58, xp.sqrt(t57), 0)
-    t61 = xp.atan2(t60, t59)
-    t62 = t61 + 6.283185307179586*xp.ceil(-0.5 - 0.15915494309189535*t61)
-    t63 = t61
-    t64 = t59
-    t65 = t60
-    t66 = t63 - 6.283185307179586*xp.ceil(-0.5 + 0.15915494309189535*t63)
-    t67 = t66 - 6.283185307179586*xp.floor(1.0 + 0.15915494309189535*t66)
-    t68 = t55*t64
-    t69 = -t68 + t43*t65
-    t70 = t68 + t69
-    t71 = t65**2
-    t72 = t71 + t64**2
-    t73 = t44**2
-    t74 = t70**2 + t71*t73
-    t75 = t73 + t43**2 + t55**2
-    t76 = xp.less_equal(t74, 1e-24*t72*t75)
-    t77 = xp.where(t76, 1, 1/xp.sqrt(t74))
-    t78 = xp.where(t76, 1, t70*t77)
-    t79 = t65*(1 - t78)
-    t80 = t79 + t65*t78
-    t81 = t44*t65
-    t82 = xp.where(t76, 0, -t77*t81)
-    t83 = t64*t82
-    t84 = t64*t78
-    t85 = T01*t83 + T02*t80 - T00*t84
-    t86 = T11*t83 + T12*t80 - T10*t84
-    t87 = T21*t83 + T22*t80 - T20*t84
-    t88 = t49*t87
-    t89 = t35*t85 + t39*t86
-    t90 = t39*t85 - t35*t86
-    t91 = t88 + t35*t87
-    t92 = t89**2 + t91**2
-    t93 = t92
-    t94 = t92 + t90**2
-    t95 = xp.less_equal(t93, 1e-24*t94)
-    t96 = xp.where(t95, 1, 1/xp.sqrt(t93))
-    t97 = xp.where(t95, 1, -t89*t96)
-    t98 = xp.where(t95, 0, -t91*t96)
-    t99 = 0.10915 - 0.10915*t97
-    t100 = 0.10915 + 0.10915*t97
-    t101 = 0.10915*t97
-    t102 = t101 + t99
-    t103 = t102 + t42
-    t104 = t101 - t100
-    t105 = t42 - t104
-    t106 = 0.09465*t98
-    t107 = t41 - t106
-    t108 = t106 + t41
-    t109 = 0.09465*t97
-    t110 = t109 + t51
-    t111 = -0.089459 + t110
-    t112 = t103**2 + t107**2 + t111**2
-    t113 = 0.16724253125 - 0.5*t112
-    t114 = t51 - t109
-    t115 = -0.089459 + t114
-    t116 = t105**2 + t108**2 + t115**2
-    t117 = 0.16724253125 - 0.5*t116
-    t118 = t113**2
-    t119 = 1 - 35.98290608994648*t118
-    t120 = 5.99857533835714*t113
-    t121 = xp.less(1e-12, t119)
-    t122 = xp.where(t121, t120, xp.where(xp.greater(t120, 0), xp.asarray(1, dtype=dtype), -1))
-    t123 = xp.where(t121, xp.sqrt(t119), 0)
-    t124 = xp.atan2(t123, t122)
-    t125 = 3.141592653589793 + t124
-    t126 = 3.141592653589793 - t124
-    t127 = t125 - 6.283185307179586*xp.ceil(-0.5 + 0.15915494309189535*t125)
-    t128 = t127 - 6.283185307179586*xp.floor(1.0 + 0.15915494309189535*t127)
-    t129 = t126 - 6.283185307179586*xp.ceil(-0.5 + 0.15915494309189535*t126)
-    t130 = t129 - 6.283185307179586*xp.floor(1.0 + 0.15915494309189535*t129)
-    t131 = -1.0*t122
-    t132 = -1.0*t123
-    t133 = 0.425 + 0.39225*t131
-    t134 = 0.089459 - 0.39225*t132
-    t135 = -0.089459 + t134
-    t136 = t111*t135 - t107*t133
-    t137 = t107*t135 + t111*t133
-    t138 = t136**2 + t137**2
-    t139 = t133**2 + t135**2
-    t140 = -0.425 + 0.39225*t122
-    t141 = 0.089459 - 0.39225*t123
-    t142 = -0.089459 + t141
-    t143 = t107*t140 + t111*t142
-    t144 = t107*t142 - t111*t140
-    t145 = t143**2 + t144**2
-    t146 = t140**2 + t142**2
-    t147 = t117**2
-    t148 = 1 - 35.98290608994648*t147
-    t149 = 5.99857533835714*t117
-    t150 = xp.less(1e-12, t148)
-    t151 = xp.where(t150, t149, xp.where(xp.greater(t149, 0), xp.asarray(1, dtype=dtype), -1))
-    t152 = xp.where(t150, xp.sqrt(t148), 0)
-    t153 = xp.atan2(t152, t151)
-    t154 = 3.141592653589793 + t153
-    t155 = -1.0*t151
-    t156 = -1.0*t152
-    t157 = 3.141592653589793 - t153
-    t158 = 0.425 + 0.39225*t155
-    t159 = 0.089459 - 0.39225*t156
-    t160 = -0.089459 + t159
-    t161 = t115*t160 - t108*t158
-    t162 = t108*t160 + t115*t158
-    t163 = t161**2 + t162**2
-    t164 = t158**2 + t160**2
-    t165 = -0.425 + 0.39225*t151
-    t166 = 0.089459 - 0.39225*t152
-    t167 = -0.089459 + t166
-    t168 = t108*t165 + t115*t167
-    t169 = t108*t167 - t115*t165
-    t170 = t168**2 + t169**2
-    t171 = t165**2 + t167**2
-    t172 = 1 - t36
-    t173 = t13*t172
-    t174 = t173 + t13*t36
-    t175 = T02*t40
-    t176 = T12*t36
-    t177 = t175 - t176
-    t178 = t176 - t175
-    t179 = t177**2
-    t180 = 1 - t179
-    t181 = xp.less(1e-12, t180)
-    t182 = xp.where(t181, t177, xp.where(xp.greater(t177, 0), xp.asarray(1, dtype=dtype), -1))
-    t183 = xp.where(t181, xp.sqrt(t180), 0)
-    t184 = xp.atan2(t183, t182)
-    t185 = t184
-    t186 = t182
-    t187 = t183
-    t188 = t185 - 6.283185307179586*xp.ceil(-0.5 + 0.15915494309189535*t185)
-    t189 = t188 - 6.283185307179586*xp.floor(1.0 + 0.15915494309189535*t188)
-    t190 = t184 + 6.283185307179586*xp.ceil(-0.5 - 0.15915494309189535*t184)
-    t191 = t178*t186
-    t192 = -t191 + t187*t47
-    t193 = t191 + t192
-    t194 = t187**2
-    t195 = t194 + t186**2
-    t196 = t48**2
-    t197 = t193**2 + t194*t196
-    t198 = t196 + t178**2 + t47**2
-    t199 = xp.less_equal(t197, 1e-24*t195*t198)
-    t200 = xp.where(t199, 1, 1/xp.sqrt(t197))
-    t201 = xp.where(t199, 1, t193*t200)
-    t202 = t187*(1 - t201)
-    t203 = t202 + t187*t201
-    t204 = t187*t48
-    t205 = xp.where(t199, 0, -t200*t204)
-    t206 = t186*t205
-    t207 = t186*t201
-    t208 = T01*t206 + T02*t203 - T00*t207
-    t209 = T11*t206 + T12*t203 - T10*t207
-    t210 = T21*t206 + T22*t203 - T20*t207
-    t211 = t172*t210
-    t212 = t208*t36 + t209*t40
-    t213 = t208*t40 - t209*t36
-    t214 = t211 + t210*t36
-    t215 = t212**2 + t214**2
-    t216 = t215
-    t217 = t215 + t213**2
-    t218 = xp.less_equal(t216, 1e-24*t217)
-    t219 = xp.where(t218, 1, 1/xp.sqrt(t216))
-    t220 = xp.where(t218, 1, -t212*t219)
-    t221 = xp.where(t218, 0, -t214*t219)
-    t222 = 0.10915 - 0.10915*t220
-    t223 = 0.10915 + 0.10915*t220
-    t224 = 0.10915*t220
-    t225 = t222 + t224
-    t226 = t225 + t46
-    t227 = t224 - t223
-    t228 = t46 - t227
-    t229 = 0.09465*t221
-    t230 = t45 - t229
-    t231 = t229 + t45
-    t232 = 0.09465*t220
-    t233 = t174 + t232
-    t234 = -0.089459 + t233
-    t235 = t226**2 + t230**2 + t234**2
-    t236 = 0.16724253125 - 0.5*t235
-    t237 = t174 - t232
-    t238 = -0.089459 + t237
-    t239 = t228**2 + t231**2 + t238**2
-    t240 = 0.16724253125 - 0.5*t239
-    t241 = t236**2
-    t242 = 1 - 35.98290608994648*t241
-    t243 = 5.99857533835714*t236
-    t244 = xp.less(1e-12, t242)
-    t245 = xp.where(t244, t243, xp.where(xp.greater(t243, 0), xp.asarray(1, dtype=dtype), -1))
-    t246 = xp.where(t244, xp.sqrt(t242), 0)
-    t247 = xp.atan2(t246, t245)
-    t248 = 3.141592653589793 + t247
-    t249 = -1.0*t245
-    t250 = -1.0*t246
-    t251 = 3.141592653589793 - t247
-    t252 = 0.425 + 0.39225*t249
-    t253 = 0.089459 - 0.39225*t250
-    t254 = -0.089459 + t253
-    t255 = t234*t254 - t230*t252
-    t256 = t230*t254 + t234*t252
-    t257 = t255**2 + t256**2
-    t258 = t252**2 + t254**2
-    t259 = -0.425 + 0.39225*t245
-    t260 = 0.089459 - 0.39225*t246
-    t261 = -0.089459 + t260
-    t262 = t230*t259 + t234*t261
-    t263 = t230*t261 - t234*t259
-    t264 = t262**2 + t263**2
-    t265 = t259**2 + t261**2
-    t266 = t248 - 6.283185307179586*xp.ceil(-0.5 + 0.15915494309189535*t248)
-    t267 = t266 - 6.283185307179586*xp.floor(1.0 + 0.15915494309189535*t266)
-    t268 = t251 - 6.283185307179586*xp.ceil(-0.5 + 0.15915494309189535*t251)
-    t269 = t268 - 6.283185307179586*xp.floor(1.0 + 0.15915494309189535*t268)
-    t270 = t240**2
-    t271 = 1 - 35.98290608994648*t270
-    t272 = 5.99857533835714*t240
-    t273 = xp.less(1e-12, t271)
-    t274 = xp.where(t273, t272, xp.where(xp.greater(t272, 0), xp.asarray(1, dtype=dtype), -1))
-    t275 = xp.where(t273, xp.sqrt(t271), 0)
-    t276 = xp.atan2(t275, t274)
-    t277 = 3.141592653589793 + t276
-    t278 = -1.0*t274
-    t279 = -1.0*t275
-    t280 = 3.141592653589793 - t276
-    t281 = 0.425 + 0.39225*t278
-    t282 = 0.089459 - 0.39225*t279
-    t283 = -0.089459 + t282
-    t284 = t238*t283 - t231*t281
-    t285 = t231*t283 + t238*t281
-    t286 = t284**2 + t285**2
-    t287 = t281**2 + t283**2
-    t288 = -0.425 + 0.39225*t274
-    t289 = 0.089459 - 0.39225*t275
-    t290 = -0.089459 + t289
-    t291 = t231*t288 + t238*t290
-    t292 = t231*t290 - t238*t288
-    t293 = t291**2 + t292**2
-    t294 = t288**2 + t290**2
-    t295 = 1e-24*t112
-    t296 = xp.where(xp.less_equal(t138, t139*t295), 0, xp.atan2(-t137, t136))
-    t297 = t296
-    t298 = t297 - 6.283185307179586*xp.floor(1.0 + 0.15915494309189535*t297)
-    t299 = -xp.where(t95, 0, xp.atan2(-t91, -t89))
-    t300 = 3.141592653589793 + t299
-    t301 = t125 + t296
-    t302 = t299 + t301 + 6.283185307179586*xp.ceil(-0.15915494309189535*t300 - 0.15915494309189535*t301)
-    t303 = -t302
-    t304 = t302 + 6.283185307179586*xp.floor(1.0 + 0.15915494309189535*t303)
-    t305 = xp.where(t76, 0, xp.atan2(-t81, t70))
-    t306 = t305
-    t307 = t306 - 6.283185307179586*xp.floor(1.0 + 0.15915494309189535*t306)
-    t308 = 3.141592653589793 + t305 - 6.283185307179586*xp.ceil(0.15915494309189535*t305)
-    t309 = t308 - 6.283185307179586*xp.floor(1.0 + 0.15915494309189535*t308)
-    t310 = xp.where(xp.less_equal(t145, t146*t295), 0, xp.atan2(-t144, t143))
-    t311 = t310
-    t312 = t311 - 6.283185307179586*xp.floor(1.0 + 0.15915494309189535*t311)
-    t313 = t126 + t310
-    t314 = t299 + t313 + 6.283185307179586*xp.ceil(-0.15915494309189535*t300 - 0.15915494309189535*t313)
-    t315 = -t314
-    t316 = t314 + 6.283185307179586*xp.floor(1.0 + 0.15915494309189535*t315)
-    t317 = 1e-24*t116
-    t318 = xp.where(xp.less_equal(t163, t164*t317), 0, xp.atan2(-t162, t161))
-    t319 = t318
-    t320 = t319 - 6.283185307179586*xp.floor(1.0 + 0.15915494309189535*t319)
-    t321 = -3.141592653589793 + t154
-    t322 = t154 - 6.283185307179586*xp.ceil(0.15915494309189535*t321)
-    t323 = t322 - 6.283185307179586*xp.floor(1.0 + 0.15915494309189535*t322)
-    t324 = t299 + t318
-    t325 = t321 + t324 + 6.283185307179586*xp.ceil(-0.15915494309189535*t154 - 0.15915494309189535*t324)
-    t326 = -t325
-    t327 = t325 + 6.283185307179586*xp.floor(1.0 + 0.15915494309189535*t326)
-    t328 = -t62
-    t329 = t62 + 6.283185307179586*xp.floor(1.0 + 0.15915494309189535*t328)
-    t330 = xp.where(xp.less_equal(t170, t171*t317), 0, xp.atan2(-t169, t168))
-    t331 = t330
-    t332 = t331 - 6.283185307179586*xp.floor(1.0 + 0.15915494309189535*t331)
-    t333 = -3.141592653589793 + t157
-    t334 = t157 - 6.283185307179586*xp.ceil(0.15915494309189535*t333)
-    t335 = t334 - 6.283185307179586*xp.floor(1.0 + 0.15915494309189535*t334)
-    t336 = t299 + t330
-    t337 = t333 + t336 + 6.283185307179586*xp.ceil(-0.15915494309189535*t157 - 0.15915494309189535*t336)
-    t338 = -t337
-    t339 = t337 + 6.283185307179586*xp.floor(1.0 + 0.15915494309189535*t338)
-    t340 = 1e-24*t235
-    t341 = xp.where(xp.less_equal(t257, t258*t340), 0, xp.atan2(-t256, t255))
-    t342 = t341
-    t343 = t342 - 6.283185307179586*xp.floor(1.0 + 0.15915494309189535*t342)
-    t344 = -xp.where(t218, 0, xp.atan2(-t214, -t212))
-    t345 = 3.141592653589793 + t344
-    t346 = t248 + t341
-    t347 = t344 + t346 + 6.283185307179586*xp.ceil(-0.15915494309189535*t345 - 0.15915494309189535*t346)
-    t348 = -t347
-    t349 = t347 + 6.283185307179586*xp.floor(1.0 + 0.15915494309189535*t348)
-    t350 = xp.where(t199, 0, xp.atan2(-t204, t193))
-    t351 = t350
-    t352 = t351 - 6.283185307179586*xp.floor(1.0 + 0.15915494309189535*t351)
-    t353 = 3.141592653589793 + t350 - 6.283185307179586*xp.ceil(0.15915494309189535*t350)
-    t354 = t353 - 6.283185307179586*xp.floor(1.0 + 0.15915494309189535*t353)
-    t355 = xp.where(xp.less_equal(t264, t265*t340), 0, xp.atan2(-t263, t262))
-    t356 = t355
-    t357 = t356 - 6.283185307179586*xp.floor(1.0 + 0.15915494309189535*t356)
-    t358 = t251 + t355
-    t359 = t344 + t358 + 6.283185307179586*xp.ceil(-0.15915494309189535*t345 - 0.15915494309189535*t358)
-    t360 = -t359
-    t361 = t359 + 6.283185307179586*xp.floor(1.0 + 0.15915494309189535*t360)
-    t362 = 1e-24*t239
-    t363 = xp.where(xp.less_equal(t286, t287*t362), 0, xp.atan2(-t285, t284))
-    t364 = t363
-    t365 = t364 - 6.283185307179586*xp.floor(1.0 + 0.15915494309189535*t364)
-    t366 = -3.141592653589793 + t277
-    t367 = t277 - 6.283185307179586*xp.ceil(0.15915494309189535*t366)
-    t368 = t367 - 6.283185307179586*xp.floor(1.0 + 0.15915494309189535*t367)
-    t369 = t344 + t363
-    t370 = t366 + t369 + 6.283185307179586*xp.ceil(-0.15915494309189535*t277 - 0.15915494309189535*t369)
-    t371 = -t370
-    t372 = t370 + 6.283185307179586*xp.floor(1.0 + 0.15915494309189535*t371)
-    t373 = -t190
-    t374 = t190 + 6.283185307179586*xp.floor(1.0 + 0.15915494309189535*t373)
-    t375 = xp.where(xp.less_equal(t293, t294*t362), 0, xp.atan2(-t292, t291))
-    t376 = t375
-    t377 = t376 - 6.283185307179586*xp.floor(1.0 + 0.15915494309189535*t376)
-    t378 = -3.141592653589793 + t280
-    t379 = t280 - 6.283185307179586*xp.ceil(0.15915494309189535*t378)
-    t380 = t379 - 6.283185307179586*xp.floor(1.0 + 0.15915494309189535*t379)
-    t381 = t344 + t375
-    t382 = t378 + t381 + 6.283185307179586*xp.ceil(-0.15915494309189535*t280 - 0.15915494309189535*t381)
-    t383 = -t382
-    t384 = t382 + 6.283185307179586*xp.floor(1.0 + 0.15915494309189535*t383)
-    t385 = xp.less_equal(t28, 6.283185307179586)
-    t386 = (xp.greater_equal(t27, -6.283185307179586)) & (xp.less_equal(t27, 6.283185307179586))
-    t387 = xp.where(t385 & xp.logical_not(t386), t28, t27)
-    t388 = xp.less_equal(t298, 6.283185307179586)
-    t389 = (xp.greater_equal(t297, -6.283185307179586)) & (xp.less_equal(t297, 6.283185307179586))
-    t390 = xp.less_equal(t128, 6.283185307179586)
-    t391 = (xp.greater_equal(t127, -6.283185307179586)) & (xp.less_equal(t127, 6.283185307179586))
-    t392 = -t304
-    t393 = xp.less_equal(t67, 6.283185307179586)
-    t394 = (xp.greater_equal(t66, -6.283185307179586)) & (xp.less_equal(t66, 6.283185307179586))
-    t395 = xp.where(t393 & xp.logical_not(t394), t67, t66)
-    t396 = xp.less_equal(t307, 6.283185307179586)
-    t397 = (xp.greater_equal(t306, -6.283185307179586)) & (xp.less_equal(t306, 6.283185307179586))
-    t398 = xp.where(t396 & xp.logical_not(t397), t307, t306)
-    t399 = xp.less_equal(t312, 6.283185307179586)
-    t400 = (xp.greater_equal(t311, -6.283185307179586)) & (xp.less_equal(t311, 6.283185307179586))
-    t401 = xp.less_equal(t130, 6.283185307179586)
-    t402 = (xp.greater_equal(t129, -6.283185307179586)) & (xp.less_equal(t129, 6.283185307179586))
-    t403 = -t316
-    t404 = xp.less_equal(t320, 6.283185307179586)
-    t405 = (xp.greater_equal(t319, -6.283185307179586)) & (xp.less_equal(t319, 6.283185307179586))
-    t406 = xp.less_equal(t323, 6.283185307179586)
-    t407 = (xp.greater_equal(t322, -6.283185307179586)) & (xp.less_equal(t322, 6.283185307179586))
-    t408 = -t327
-    t409 = -t329
-    t410 = xp.where((xp.greater_equal(t329, -6.283185307179586)) & xp.logical_not((xp.greater_equal(t62, -6.283185307179586)) & (xp.less_equal(t62, 6.283185307179586))), t409, t328)
-    t411 = xp.less_equal(t309, 6.283185307179586)
-    t412 = (xp.greater_equal(t308, -6.283185307179586)) & (xp.less_equal(t308, 6.283185307179586))
-    t413 = xp.where(t411 & xp.logical_not(t412), t309, t308)
-    t414 = xp.less_equal(t332, 6.283185307179586)
-    t415 = (xp.greater_equal(t331, -6.283185307179586)) & (xp.less_equal(t331, 6.283185307179586))
-    t416 = xp.less_equal(t335, 6.283185307179586)
-    t417 = (xp.greater_equal(t334, -6.283185307179586)) & (xp.less_equal(t334, 6.283185307179586))
-    t418 = -t339
-    t419 = xp.less_equal(t30, 6.283185307179586)
-    t420 = (xp.greater_equal(t29, -6.283185307179586)) & (xp.less_equal(t29, 6.283185307179586))
-    t421 = xp.where(t419 & xp.logical_not(t420), t30, t29)
-    t422 = xp.less_equal(t343, 6.283185307179586)
-    t423 = (xp.greater_equal(t342, -6.283185307179586)) & (xp.less_equal(t342, 6.283185307179586))
-    t424 = xp.less_equal(t267, 6.283185307179586)
-    t425 = (xp.greater_equal(t266, -6.283185307179586)) & (xp.less_equal(t266, 6.283185307179586))
-    t426 = -t349
-    t427 = xp.less_equal(t189, 6.283185307179586)
-    t428 = (xp.greater_equal(t188, -6.283185307179586)) & (xp.less_equal(t188, 6.283185307179586))
-    t429 = xp.where(t427 & xp.logical_not(t428), t189, t188)
-    t430 = xp.less_equal(t352, 6.283185307179586)
-    t431 = (xp.greater_equal(t351, -6.283185307179586)) & (xp.less_equal(t351, 6.283185307179586))
-    t432 = xp.where(t430 & xp.logical_not(t431), t352, t351)
-    t433 = xp.less_equal(t357, 6.283185307179586)
-    t434 = (xp.greater_equal(t356, -6.283185307179586)) & (xp.less_equal(t356, 6.283185307179586))
-    t435 = xp.less_equal(t269, 6.283185307179586)
-    t436 = (xp.greater_equal(t268, -6.283185307179586)) & (xp.less_equal(t268, 6.283185307179586))
-    t437 = -t361
-    t438 = xp.less_equal(t365, 6.283185307179586)
-    t439 = (xp.greater_equal(t364, -6.283185307179586)) & (xp.less_equal(t364, 6.283185307179586))
-    t440 = xp.less_equal(t368, 6.283185307179586)
-    t441 = (xp.greater_equal(t367, -6.283185307179586)) & (xp.less_equal(t367, 6.283185307179586))
-    t442 = -t372
-    t443 = -t374
-    t444 = xp.where((xp.greater_equal(t374, -6.283185307179586)) & xp.logical_not((xp.greater_equal(t190, -6.283185307179586)) & (xp.less_equal(t190, 6.283185307179586))), t443, t373)
-    t445 = xp.less_equal(t354, 6.283185307179586)
-    t446 = (xp.greater_equal(t353, -6.283185307179586)) & (xp.less_equal(t353, 6.283185307179586))
-    t447 = xp.where(t445 & xp.logical_not(t446), t354, t353)
-    t448 = xp.less_equal(t377, 6.283185307179586)
-    t449 = (xp.greater_equal(t376, -6.283185307179586)) & (xp.less_equal(t376, 6.283185307179586))
-    t450 = xp.less_equal(t380, 6.283185307179586)
-    t451 = (xp.greater_equal(t379, -6.283185307179586)) & (xp.less_equal(t379, 6.283185307179586))
-    t452 = -t384
-    t453 = xp.isfinite(t0)
-    t454 = xp.greater_equal(t57, -1e-12)
-    t455 = xp.greater(t15, t17)
-    t456 = (t455 & (xp.greater_equal(t20, -1e-12))) | (t18 & (xp.less_equal(0.0119137225, 1e-12*t16)))
-    t457 = xp.greater(t57, 1e-12)
-    t458 = xp.greater(t20, 1e-12)
-    t459 = xp.greater_equal(t180, -1e-12)
-    t460 = xp.greater(t180, 1e-12)
-    t461 = t385 | t386
-    t462 = t393 | t394
-    t463 = t396 | t397
-    t464 = t411 | t412
-    t465 = (xp.less_equal(t409, 6.283185307179586)) | ((xp.greater_equal(t328, -6.283185307179586)) & (xp.less_equal(t328, 6.283185307179586)))
-    t466 = t419 | t420
-    t467 = t427 | t428
-    t468 = t430 | t431
-    t469 = t445 | t446
-    t470 = (xp.less_equal(t443, 6.283185307179586)) | ((xp.greater_equal(t373, -6.283185307179586)) & (xp.less_equal(t373, 6.283185307179586)))
+    t41 = t4*t35 + t8*t39
+    t42 = t8*t35 - t4*t39
+    t43 = T02*t39 - T12*t35
+    t44 = T00*t39 - T10*t35
+    t45 = T01*t39 - T11*t35
+    t46 = t4*t36 + t8*t40
+    t47 = t8*t36 - t4*t40
+    t48 = T02*t40 - T12*t36
+    t49 = T00*t40 - T10*t36
+    t50 = T01*t40 - T11*t36
+    t51 = 1 - t35
+    t52 = t13*t51
+    t53 = t52 + t13*t35
+    t54 = t43**2
+    t55 = 1 - t54
+    t56 = xp.less(1e-12, t55)
+    t57 = xp.where(t56, t43, xp.where(xp.greater(t43, 0), xp.asarray(1, dtype=dtype), -1))
+    t58 = xp.where(t56, xp.sqrt(t55), 0)
+    t59 = xp.atan2(t58, t57)
+    t60 = t59 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t59))
+    t61 = t59
+    t62 = t57
+    t63 = t58
+    t64 = t61 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t61))
+    t65 = t64 - 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t64))
+    t66 = t43*t62
+    t67 = t66 + t63*t44
+    t68 = t67 - t66
+    t69 = t63**2
+    t70 = t69 + t62**2
+    t71 = t45**2
+    t72 = t68**2 + t69*t71
+    t73 = t54 + t71 + t44**2
+    t74 = xp.less_equal(t72, 1e-24*t73*t70)
+    t75 = xp.where(t74, 1, 1/xp.sqrt(t72))
+    t76 = xp.where(t74, 1, t68*t75)
+    t77 = t63*(1 - t76)
+    t78 = t77 + t63*t76
+    t79 = t63*t45
+    t80 = xp.where(t74, 0, -t75*t79)
+    t81 = t62*t80
+    t82 = t62*t76
+    t83 = T01*t81 + T02*t78 - T00*t82
+    t84 = T11*t81 + T12*t78 - T10*t82
+    t85 = T21*t81 + T22*t78 - T20*t82
+    t86 = t85*t51
+    t87 = t35*t83 + t39*t84
+    t88 = t39*t83 - t35*t84
+    t89 = t86 + t35*t85
+    t90 = t87**2 + t89**2
+    t91 = t90
+    t92 = t90 + t88**2
+    t93 = xp.less_equal(t91, 1e-24*t92)
+    t94 = xp.where(t93, 1, 1/xp.sqrt(t91))
+    t95 = xp.where(t93, 1, -t87*t94)
+    t96 = xp.where(t93, 0, -t89*t94)
+    t97 = 0.10915*(1 - t95)
+    t98 = 0.10915*(1 + t95)
+    t99 = 0.10915*t95
+    t100 = t97 + t99
+    t101 = t42 + t100
+    t102 = t99 - t98
+    t103 = t42 - t102
+    t104 = 0.09465*t96
+    t105 = t41 - t104
+    t106 = t41 + t104
+    t107 = 0.09465*t95
+    t108 = t53 + t107
+    t109 = -0.089459 + t108
+    t110 = t105**2 + t101**2 + t109**2
+    t111 = 0.5*(0.3344850625 - t110)
+    t112 = t53 - t107
+    t113 = -0.089459 + t112
+    t114 = t106**2 + t103**2 + t113**2
+    t115 = 0.5*(0.3344850625 - t114)
+    t116 = t111**2
+    t117 = 1 - 35.98290608994648*t116
+    t118 = 5.99857533835714*t111
+    t119 = xp.less(1e-12, t117)
+    t120 = xp.where(t119, t118, xp.where(xp.greater(t118, 0), xp.asarray(1, dtype=dtype), -1))
+    t121 = xp.where(t119, xp.sqrt(t117), 0)
+    t122 = xp.atan2(t121, t120)
+    t123 = 3.141592653589793 + t122
+    t124 = 3.141592653589793 - t122
+    t125 = t123 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t123))
+    t126 = t125 - 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t125))
+    t127 = t124 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t124))
+    t128 = t127 - 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t127))
+    t129 = -1.0*t120
+    t130 = -1.0*t121
+    t131 = 0.425 + 0.39225*t129
+    t132 = 0.089459 - 0.39225*t130
+    t133 = -0.089459 + t132
+    t134 = t109*t133 - t105*t131
+    t135 = t105*t133 + t109*t131
+    t136 = t134**2 + t135**2
+    t137 = t131**2 + t133**2
+    t138 = -0.425 + 0.39225*t120
+    t139 = 0.089459 - 0.39225*t121
+    t140 = -0.089459 + t139
+    t141 = t105*t138 + t109*t140
+    t142 = t105*t140 - t109*t138
+    t143 = t141**2 + t142**2
+    t144 = t138**2 + t140**2
+    t145 = t115**2
+    t146 = 1 - 35.98290608994648*t145
+    t147 = 5.99857533835714*t115
+    t148 = xp.less(1e-12, t146)
+    t149 = xp.where(t148, t147, xp.where(xp.greater(t147, 0), xp.asarray(1, dtype=dtype), -1))
+    t150 = xp.where(t148, xp.sqrt(t146), 0)
+    t151 = xp.atan2(t150, t149)
+    t152 = 3.141592653589793 + t151
+    t153 = -1.0*t149
+    t154 = -1.0*t150
+    t155 = 3.141592653589793 - t151
+    t156 = 0.425 + 0.39225*t153
+    t157 = 0.089459 - 0.39225*t154
+    t158 = -0.089459 + t157
+    t159 = t113*t158 - t106*t156
+    t160 = t106*t158 + t113*t156
+    t161 = t159**2 + t160**2
+    t162 = t156**2 + t158**2
+    t163 = -0.425 + 0.39225*t149
+    t164 = 0.089459 - 0.39225*t150
+    t165 = -0.089459 + t164
+    t166 = t106*t163 + t113*t165
+    t167 = t106*t165 - t113*t163
+    t168 = t166**2 + t167**2
+    t169 = t163**2 + t165**2
+    t170 = 1 - t36
+    t171 = t13*t170
+    t172 = t171 + t13*t36
+    t173 = t48**2
+    t174 = 1 - t173
+    t175 = xp.less(1e-12, t174)
+    t176 = xp.where(t175, t48, xp.where(xp.greater(t48, 0), xp.asarray(1, dtype=dtype), -1))
+    t177 = xp.where(t175, xp.sqrt(t174), 0)
+    t178 = xp.atan2(t177, t176)
+    t179 = t178
+    t180 = t176
+    t181 = t177
+    t182 = t179 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t179))
+    t183 = t182 - 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t182))
+    t184 = t178 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t178))
+    t185 = t48*t180
+    t186 = t185 + t181*t49
+    t187 = t186 - t185
+    t188 = t181**2
+    t189 = t188 + t180**2
+    t190 = t50**2
+    t191 = t187**2 + t188*t190
+    t192 = t173 + t190 + t49**2
+    t193 = xp.less_equal(t191, 1e-24*t192*t189)
+    t194 = xp.where(t193, 1, 1/xp.sqrt(t191))
+    t195 = xp.where(t193, 1, t187*t194)
+    t196 = t181*(1 - t195)
+    t197 = t196 + t181*t195
+    t198 = t181*t50
+    t199 = xp.where(t193, 0, -t194*t198)
+    t200 = t180*t199
+    t201 = t180*t195
+    t202 = T01*t200 + T02*t197 - T00*t201
+    t203 = T11*t200 + T12*t197 - T10*t201
+    t204 = T21*t200 + T22*t197 - T20*t201
+    t205 = t204*t170
+    t206 = t36*t202 + t40*t203
+    t207 = t40*t202 - t36*t203
+    t208 = t205 + t36*t204
+    t209 = t206**2 + t208**2
+    t210 = t209
+    t211 = t209 + t207**2
+    t212 = xp.less_equal(t210, 1e-24*t211)
+    t213 = xp.where(t212, 1, 1/xp.sqrt(t210))
+    t214 = xp.where(t212, 1, -t206*t213)
+    t215 = xp.where(t212, 0, -t208*t213)
+    t216 = 0.10915*(1 - t214)
+    t217 = 0.10915*(1 + t214)
+    t218 = 0.10915*t214
+    t219 = t216 + t218
+    t220 = t47 + t219
+    t221 = t218 - t217
+    t222 = t47 - t221
+    t223 = 0.09465*t215
+    t224 = t46 - t223
+    t225 = t46 + t223
+    t226 = 0.09465*t214
+    t227 = t172 + t226
+    t228 = -0.089459 + t227
+    t229 = t224**2 + t220**2 + t228**2
+    t230 = 0.5*(0.3344850625 - t229)
+    t231 = t172 - t226
+    t232 = -0.089459 + t231
+    t233 = t225**2 + t222**2 + t232**2
+    t234 = 0.5*(0.3344850625 - t233)
+    t235 = t230**2
+    t236 = 1 - 35.98290608994648*t235
+    t237 = 5.99857533835714*t230
+    t238 = xp.less(1e-12, t236)
+    t239 = xp.where(t238, t237, xp.where(xp.greater(t237, 0), xp.asarray(1, dtype=dtype), -1))
+    t240 = xp.where(t238, xp.sqrt(t236), 0)
+    t241 = xp.atan2(t240, t239)
+    t242 = 3.141592653589793 + t241
+    t243 = -1.0*t239
+    t244 = -1.0*t240
+    t245 = 3.141592653589793 - t241
+    t246 = 0.425 + 0.39225*t243
+    t247 = 0.089459 - 0.39225*t244
+    t248 = -0.089459 + t247
+    t249 = t228*t248 - t224*t246
+    t250 = t224*t248 + t228*t246
+    t251 = t249**2 + t250**2
+    t252 = t246**2 + t248**2
+    t253 = -0.425 + 0.39225*t239
+    t254 = 0.089459 - 0.39225*t240
+    t255 = -0.089459 + t254
+    t256 = t224*t253 + t228*t255
+    t257 = t224*t255 - t228*t253
+    t258 = t256**2 + t257**2
+    t259 = t253**2 + t255**2
+    t260 = t242 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t242))
+    t261 = t260 - 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t260))
+    t262 = t245 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t245))
+    t263 = t262 - 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t262))
+    t264 = t234**2
+    t265 = 1 - 35.98290608994648*t264
+    t266 = 5.99857533835714*t234
+    t267 = xp.less(1e-12, t265)
+    t268 = xp.where(t267, t266, xp.where(xp.greater(t266, 0), xp.asarray(1, dtype=dtype), -1))
+    t269 = xp.where(t267, xp.sqrt(t265), 0)
+    t270 = xp.atan2(t269, t268)
+    t271 = 3.141592653589793 + t270
+    t272 = -1.0*t268
+    t273 = -1.0*t269
+    t274 = 3.141592653589793 - t270
+    t275 = 0.425 + 0.39225*t272
+    t276 = 0.089459 - 0.39225*t273
+    t277 = -0.089459 + t276
+    t278 = t232*t277 - t225*t275
+    t279 = t225*t277 + t232*t275
+    t280 = t278**2 + t279**2
+    t281 = t275**2 + t277**2
+    t282 = -0.425 + 0.39225*t268
+    t283 = 0.089459 - 0.39225*t269
+    t284 = -0.089459 + t283
+    t285 = t225*t282 + t232*t284
+    t286 = t225*t284 - t232*t282
+    t287 = t285**2 + t286**2
+    t288 = t282**2 + t284**2
+    t289 = 1e-24*t110
+    t290 = xp.where(xp.less_equal(t136, t137*t289), 0, xp.atan2(-t135, t134))
+    t291 = t290
+    t292 = t291 - 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t291))
+    t293 = -xp.where(t93, 0, xp.atan2(-t89, -t87))
+    t294 = 3.141592653589793 + t293
+    t295 = t123 + t290
+    t296 = t293 + t295 + 6.283185307179586*xp.ceil(-0.15915494309189535*(t294 + t295))
+    t297 = -t296
+    t298 = t296 + 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t297))
+    t299 = xp.where(t74, 0, xp.atan2(-t79, t68))
+    t300 = t299
+    t301 = t300 - 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t300))
+    t302 = 3.141592653589793 + t299 - 6.283185307179586*xp.ceil(0.15915494309189535*t299)
+    t303 = t302 - 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t302))
+    t304 = xp.where(xp.less_equal(t143, t144*t289), 0, xp.atan2(-t142, t141))
+    t305 = t304
+    t306 = t305 - 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t305))
+    t307 = t124 + t304
+    t308 = t293 + t307 + 6.283185307179586*xp.ceil(-0.15915494309189535*(t294 + t307))
+    t309 = -t308
+    t310 = t308 + 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t309))
+    t311 = 1e-24*t114
+    t312 = xp.where(xp.less_equal(t161, t162*t311), 0, xp.atan2(-t160, t159))
+    t313 = t312
+    t314 = t313 - 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t313))
+    t315 = -3.141592653589793 + t152
+    t316 = t152 - 6.283185307179586*xp.ceil(0.15915494309189535*t315)
+    t317 = t316 - 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t316))
+    t318 = t293 + t312
+    t319 = t315 + t318 + 6.283185307179586*xp.ceil(-0.15915494309189535*(t152 + t318))
+    t320 = -t319
+    t321 = t319 + 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t320))
+    t322 = -t60
+    t323 = t60 + 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t322))
+    t324 = xp.where(xp.less_equal(t168, t169*t311), 0, xp.atan2(-t167, t166))
+    t325 = t324
+    t326 = t325 - 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t325))
+    t327 = -3.141592653589793 + t155
+    t328 = t155 - 6.283185307179586*xp.ceil(0.15915494309189535*t327)
+    t329 = t328 - 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t328))
+    t330 = t293 + t324
+    t331 = t327 + t330 + 6.283185307179586*xp.ceil(-0.15915494309189535*(t155 + t330))
+    t332 = -t331
+    t333 = t331 + 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t332))
+    t334 = 1e-24*t229
+    t335 = xp.where(xp.less_equal(t251, t252*t334), 0, xp.atan2(-t250, t249))
+    t336 = t335
+    t337 = t336 - 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t336))
+    t338 = -xp.where(t212, 0, xp.atan2(-t208, -t206))
+    t339 = 3.141592653589793 + t338
+    t340 = t242 + t335
+    t341 = t338 + t340 + 6.283185307179586*xp.ceil(-0.15915494309189535*(t339 + t340))
+    t342 = -t341
+    t343 = t341 + 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t342))
+    t344 = xp.where(t193, 0, xp.atan2(-t198, t187))
+    t345 = t344
+    t346 = t345 - 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t345))
+    t347 = 3.141592653589793 + t344 - 6.283185307179586*xp.ceil(0.15915494309189535*t344)
+    t348 = t347 - 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t347))
+    t349 = xp.where(xp.less_equal(t258, t259*t334), 0, xp.atan2(-t257, t256))
+    t350 = t349
+    t351 = t350 - 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t350))
+    t352 = t245 + t349
+    t353 = t338 + t352 + 6.283185307179586*xp.ceil(-0.15915494309189535*(t339 + t352))
+    t354 = -t353
+    t355 = t353 + 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t354))
+    t356 = 1e-24*t233
+    t357 = xp.where(xp.less_equal(t280, t281*t356), 0, xp.atan2(-t279, t278))
+    t358 = t357
+    t359 = t358 - 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t358))
+    t360 = -3.141592653589793 + t271
+    t361 = t271 - 6.283185307179586*xp.ceil(0.15915494309189535*t360)
+    t362 = t361 - 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t361))
+    t363 = t338 + t357
+    t364 = t360 + t363 + 6.283185307179586*xp.ceil(-0.15915494309189535*(t271 + t363))
+    t365 = -t364
+    t366 = t364 + 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t365))
+    t367 = -t184
+    t368 = t184 + 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t367))
+    t369 = xp.where(xp.less_equal(t287, t288*t356), 0, xp.atan2(-t286, t285))
+    t370 = t369
+    t371 = t370 - 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t370))
+    t372 = -3.141592653589793 + t274
+    t373 = t274 - 6.283185307179586*xp.ceil(0.15915494309189535*t372)
+    t374 = t373 - 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t373))
+    t375 = t338 + t369
+    t376 = t372 + t375 + 6.283185307179586*xp.ceil(-0.15915494309189535*(t274 + t375))
+    t377 = -t376
+    t378 = t376 + 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t377))
+    t379 = xp.less_equal(t28, 6.283185307179586)
+    t380 = xp.greater_equal(t27, -6.283185307179586) & xp.less_equal(t27, 6.283185307179586)
+    t381 = xp.where(t379 & xp.logical_not(t380), t28, t27)
+    t382 = xp.less_equal(t292, 6.283185307179586)
+    t383 = xp.greater_equal(t291, -6.283185307179586) & xp.less_equal(t291, 6.283185307179586)
+    t384 = xp.less_equal(t126, 6.283185307179586)
+    t385 = xp.greater_equal(t125, -6.283185307179586) & xp.less_equal(t125, 6.283185307179586)
+    t386 = -t298
+    t387 = xp.less_equal(t65, 6.283185307179586)
+    t388 = xp.greater_equal(t64, -6.283185307179586) & xp.less_equal(t64, 6.283185307179586)
+    t389 = xp.where(t387 & xp.logical_not(t388), t65, t64)
+    t390 = xp.less_equal(t301, 6.283185307179586)
+    t391 = xp.greater_equal(t300, -6.283185307179586) & xp.less_equal(t300, 6.283185307179586)
+    t392 = xp.where(t390 & xp.logical_not(t391), t301, t300)
+    t393 = xp.less_equal(t306, 6.283185307179586)
+    t394 = xp.greater_equal(t305, -6.283185307179586) & xp.less_equal(t305, 6.283185307179586)
+    t395 = xp.less_equal(t128, 6.283185307179586)
+    t396 = xp.greater_equal(t127, -6.283185307179586) & xp.less_equal(t127, 6.283185307179586)
+    t397 = -t310
+    t398 = xp.less_equal(t314, 6.283185307179586)
+    t399 = xp.greater_equal(t313, -6.283185307179586) & xp.less_equal(t313, 6.283185307179586)
+    t400 = xp.less_equal(t317, 6.283185307179586)
+    t401 = xp.greater_equal(t316, -6.283185307179586) & xp.less_equal(t316, 6.283185307179586)
+    t402 = -t321
+    t403 = -t323
+    t404 = xp.where(xp.greater_equal(t323, -6.283185307179586) & xp.logical_not(xp.greater_equal(t60, -6.283185307179586) & xp.less_equal(t60, 6.283185307179586)), t403, t322)
+    t405 = xp.less_equal(t303, 6.283185307179586)
+    t406 = xp.greater_equal(t302, -6.283185307179586) & xp.less_equal(t302, 6.283185307179586)
+    t407 = xp.where(t405 & xp.logical_not(t406), t303, t302)
+    t408 = xp.less_equal(t326, 6.283185307179586)
+    t409 = xp.greater_equal(t325, -6.283185307179586) & xp.less_equal(t325, 6.283185307179586)
+    t410 = xp.less_equal(t329, 6.283185307179586)
+    t411 = xp.greater_equal(t328, -6.283185307179586) & xp.less_equal(t328, 6.283185307179586)
+    t412 = -t333
+    t413 = xp.less_equal(t30, 6.283185307179586)
+    t414 = xp.greater_equal(t29, -6.283185307179586) & xp.less_equal(t29, 6.283185307179586)
+    t415 = xp.where(t413 & xp.logical_not(t414), t30, t29)
+    t416 = xp.less_equal(t337, 6.283185307179586)
+    t417 = xp.greater_equal(t336, -6.283185307179586) & xp.less_equal(t336, 6.283185307179586)
+    t418 = xp.less_equal(t261, 6.283185307179586)
+    t419 = xp.greater_equal(t260, -6.283185307179586) & xp.less_equal(t260, 6.283185307179586)
+    t420 = -t343
+    t421 = xp.less_equal(t183, 6.283185307179586)
+    t422 = xp.greater_equal(t182, -6.283185307179586) & xp.less_equal(t182, 6.283185307179586)
+    t423 = xp.where(t421 & xp.logical_not(t422), t183, t182)
+    t424 = xp.less_equal(t346, 6.283185307179586)
+    t425 = xp.greater_equal(t345, -6.283185307179586) & xp.less_equal(t345, 6.283185307179586)
+    t426 = xp.where(t424 & xp.logical_not(t425), t346, t345)
+    t427 = xp.less_equal(t351, 6.283185307179586)
+    t428 = xp.greater_equal(t350, -6.283185307179586) & xp.less_equal(t350, 6.283185307179586)
+    t429 = xp.less_equal(t263, 6.283185307179586)
+    t430 = xp.greater_equal(t262, -6.283185307179586) & xp.less_equal(t262, 6.283185307179586)
+    t431 = -t355
+    t432 = xp.less_equal(t359, 6.283185307179586)
+    t433 = xp.greater_equal(t358, -6.283185307179586) & xp.less_equal(t358, 6.283185307179586)
+    t434 = xp.less_equal(t362, 6.283185307179586)
+    t435 = xp.greater_equal(t361, -6.283185307179586) & xp.less_equal(t361, 6.283185307179586)
+    t436 = -t366
+    t437 = -t368
+    t438 = xp.where(xp.greater_equal(t368, -6.283185307179586) & xp.logical_not(xp.greater_equal(t184, -6.283185307179586) & xp.less_equal(t184, 6.283185307179586)), t437, t367)
+    t439 = xp.less_equal(t348, 6.283185307179586)
+    t440 = xp.greater_equal(t347, -6.283185307179586) & xp.less_equal(t347, 6.283185307179586)
+    t441 = xp.where(t439 & xp.logical_not(t440), t348, t347)
+    t442 = xp.less_equal(t371, 6.283185307179586)
+    t443 = xp.greater_equal(t370, -6.283185307179586) & xp.less_equal(t370, 6.283185307179586)
+    t444 = xp.less_equal(t374, 6.283185307179586)
+    t445 = xp.greater_equal(t373, -6.283185307179586) & xp.less_equal(t373, 6.283185307179586)
+    t446 = -t378
+    t447 = xp.isfinite(t0)
+    t448 = xp.greater_equal(t55, -1e-12)
+    t449 = xp.greater(t15, t17)
+    t450 = (t18 & xp.less_equal(0.0119137225, 1e-12*t16)) | (t449 & xp.greater_equal(t20, -1e-12))
+    t451 = xp.greater(t55, 1e-12)
+    t452 = xp.greater(t20, 1e-12)
+    t453 = xp.greater_equal(t174, -1e-12)
+    t454 = xp.greater(t174, 1e-12)
+    t455 = t380 | t379
+    t456 = t387 | t388
+    t457 = t390 | t391
+    t458 = t405 | t406
+    t459 = xp.less_equal(t403, 6.283185307179586) | (xp.greater_equal(t322, -6.283185307179586) & xp.less_equal(t322, 6.283185307179586))
+    t460 = t413 | t414
+    t461 = t421 | t422
+    t462 = t424 | t425
+    t463 = t439 | t440
+    t464 = xp.less_equal(t437, 6.283185307179586) | (xp.greater_equal(t367, -6.283185307179586) & xp.less_equal(t367, 6.283185307179586))
     q = _stack(xp, [
-        t387,  # 0, 0
-        xp.where(t388 & xp.logical_not(t389), t298, t297),  # 0, 1
-        xp.where(t390 & xp.logical_not(t391), t128, t127),  # 0, 2
-        xp.where((xp.greater_equal(t304, -6.283185307179586)) & xp.logical_not((xp.greater_equal(t302, -6.283185307179586)) & (xp.less_equal(t302, 6.283185307179586))), t392, t303),  # 0, 3
-        t395,  # 0, 4
-        t398,  # 0, 5
-        t387,  # 1, 0
-        xp.where(t399 & xp.logical_not(t400), t312, t311),  # 1, 1
-        xp.where(t401 & xp.logical_not(t402), t130, t129),  # 1, 2
-        xp.where((xp.greater_equal(t316, -6.283185307179586)) & xp.logical_not((xp.greater_equal(t314, -6.283185307179586)) & (xp.less_equal(t314, 6.283185307179586))), t403, t315),  # 1, 3
-        t395,  # 1, 4
-        t398,  # 1, 5
-        t387,  # 2, 0
-        xp.where(t404 & xp.logical_not(t405), t320, t319),  # 2, 1
-        xp.where(t406 & xp.logical_not(t407), t323, t322),  # 2, 2
-        xp.where((xp.greater_equal(t327, -6.283185307179586)) & xp.logical_not((xp.greater_equal(t325, -6.283185307179586)) & (xp.less_equal(t325, 6.283185307179586))), t408, t326),  # 2, 3
-        t410,  # 2, 4
-        t413,  # 2, 5
-        t387,  # 3, 0
-        xp.where(t414 & xp.logical_not(t415), t332, t331),  # 3, 1
-        xp.where(t416 & xp.logical_not(t417), t335, t334),  # 3, 2
-        xp.where((xp.greater_equal(t339, -6.283185307179586)) & xp.logical_not((xp.greater_equal(t337, -6.283185307179586)) & (xp.less_equal(t337, 6.283185307179586))), t418, t338),  # 3, 3
-        t410,  # 3, 4
-        t413,  # 3, 5
-        t421,  # 4, 0
-        xp.where(t422 & xp.logical_not(t423), t343, t342),  # 4, 1
-        xp.where(t424 & xp.logical_not(t425), t267, t266),  # 4, 2
-        xp.where((xp.greater_equal(t349, -6.283185307179586)) & xp.logical_not((xp.greater_equal(t347, -6.283185307179586)) & (xp.less_equal(t347, 6.283185307179586))), t426, t348),  # 4, 3
-        t429,  # 4, 4
-        t432,  # 4, 5
-        t421,  # 5, 0
-        xp.where(t433 & xp.logical_not(t434), t357, t356),  # 5, 1
-        xp.where(t435 & xp.logical_not(t436), t269, t268),  # 5, 2
-        xp.where((xp.greater_equal(t361, -6.283185307179586)) & xp.logical_not((xp.greater_equal(t359, -6.283185307179586)) & (xp.less_equal(t359, 6.283185307179586))), t437, t360),  # 5, 3
-        t429,  # 5, 4
-        t432,  # 5, 5
-        t421,  # 6, 0
-        xp.where(t438 & xp.logical_not(t439), t365, t364),  # 6, 1
-        xp.where(t440 & xp.logical_not(t441), t368, t367),  # 6, 2
-        xp.where((xp.greater_equal(t372, -6.283185307179586)) & xp.logical_not((xp.greater_equal(t370, -6.283185307179586)) & (xp.less_equal(t370, 6.283185307179586))), t442, t371),  # 6, 3
-        t444,  # 6, 4
-        t447,  # 6, 5
-        t421,  # 7, 0
-        xp.where(t448 & xp.logical_not(t449), t377, t376),  # 7, 1
-        xp.where(t450 & xp.logical_not(t451), t380, t379),  # 7, 2
-        xp.where((xp.greater_equal(t384, -6.283185307179586)) & xp.logical_not((xp.greater_equal(t382, -6.283185307179586)) & (xp.less_equal(t382, 6.283185307179586))), t452, t383),  # 7, 3
-        t444,  # 7, 4
-        t447,  # 7, 5
+        t381,  # 0, 0
+        xp.where(t382 & xp.logical_not(t383), t292, t291),  # 0, 1
+        xp.where(t384 & xp.logical_not(t385), t126, t125),  # 0, 2
+        xp.where(xp.greater_equal(t298, -6.283185307179586) & xp.logical_not(xp.greater_equal(t296, -6.283185307179586) & xp.less_equal(t296, 6.283185307179586)), t386, t297),  # 0, 3
+        t389,  # 0, 4
+        t392,  # 0, 5
+        t381,  # 1, 0
+        xp.where(t393 & xp.logical_not(t394), t306, t305),  # 1, 1
+        xp.where(t395 & xp.logical_not(t396), t128, t127),  # 1, 2
+        xp.where(xp.greater_equal(t310, -6.283185307179586) & xp.logical_not(xp.greater_equal(t308, -6.283185307179586) & xp.less_equal(t308, 6.283185307179586)), t397, t309),  # 1, 3
+        t389,  # 1, 4
+        t392,  # 1, 5
+        t381,  # 2, 0
+        xp.where(t398 & xp.logical_not(t399), t314, t313),  # 2, 1
+        xp.where(t400 & xp.logical_not(t401), t317, t316),  # 2, 2
+        xp.where(xp.greater_equal(t321, -6.283185307179586) & xp.logical_not(xp.greater_equal(t319, -6.283185307179586) & xp.less_equal(t319, 6.283185307179586)), t402, t320),  # 2, 3
+        t404,  # 2, 4
+        t407,  # 2, 5
+        t381,  # 3, 0
+        xp.where(t408 & xp.logical_not(t409), t326, t325),  # 3, 1
+        xp.where(t410 & xp.logical_not(t411), t329, t328),  # 3, 2
+        xp.where(xp.greater_equal(t333, -6.283185307179586) & xp.logical_not(xp.greater_equal(t331, -6.283185307179586) & xp.less_equal(t331, 6.283185307179586)), t412, t332),  # 3, 3
+        t404,  # 3, 4
+        t407,  # 3, 5
+        t415,  # 4, 0
+        xp.where(t416 & xp.logical_not(t417), t337, t336),  # 4, 1
+        xp.where(t418 & xp.logical_not(t419), t261, t260),  # 4, 2
+        xp.where(xp.greater_equal(t343, -6.283185307179586) & xp.logical_not(xp.greater_equal(t341, -6.283185307179586) & xp.less_equal(t341, 6.283185307179586)), t420, t342),  # 4, 3
+        t423,  # 4, 4
+        t426,  # 4, 5
+        t415,  # 5, 0
+        xp.where(t427 & xp.logical_not(t428), t351, t350),  # 5, 1
+        xp.where(t429 & xp.logical_not(t430), t263, t262),  # 5, 2
+        xp.where(xp.greater_equal(t355, -6.283185307179586) & xp.logical_not(xp.greater_equal(t353, -6.283185307179586) & xp.less_equal(t353, 6.283185307179586)), t431, t354),  # 5, 3
+        t423,  # 5, 4
+        t426,  # 5, 5
+        t415,  # 6, 0
+        xp.where(t432 & xp.logical_not(t433), t359, t358),  # 6, 1
+        xp.where(t434 & xp.logical_not(t435), t362, t361),  # 6, 2
+        xp.where(xp.greater_equal(t366, -6.283185307179586) & xp.logical_not(xp.greater_equal(t364, -6.283185307179586) & xp.less_equal(t364, 6.283185307179586)), t436, t365),  # 6, 3
+        t438,  # 6, 4
+        t441,  # 6, 5
+        t415,  # 7, 0
+        xp.where(t442 & xp.logical_not(t443), t371, t370),  # 7, 1
+        xp.where(t444 & xp.logical_not(t445), t374, t373),  # 7, 2
+        xp.where(xp.greater_equal(t378, -6.283185307179586) & xp.logical_not(xp.greater_equal(t376, -6.283185307179586) & xp.less_equal(t376, 6.283185307179586)), t446, t377),  # 7, 3
+        t438,  # 7, 4
+        t441,  # 7, 5
     ], (8, 6))
     valid = _stack(xp, [
-        t453 & t454 & t456 & (xp.greater_equal(t119, -1e-12)),  # 0
-        t453 & t454 & t456 & (xp.greater(t119, 1e-12)),  # 1
-        t453 & t456 & t457 & (xp.greater_equal(t148, -1e-12)),  # 2
-        t453 & t456 & t457 & (xp.greater(t148, 1e-12)),  # 3
-        t453 & t455 & t458 & t459 & (xp.greater_equal(t242, -1e-12)),  # 4
-        t453 & t455 & t458 & t459 & (xp.greater(t242, 1e-12)),  # 5
-        t453 & t455 & t458 & t460 & (xp.greater_equal(t271, -1e-12)),  # 6
-        t453 & t455 & t458 & t460 & (xp.greater(t271, 1e-12)),  # 7
+        t447 & t448 & t450 & xp.greater_equal(t117, -1e-12),  # 0
+        t447 & t448 & t450 & xp.greater(t117, 1e-12),  # 1
+        t447 & t450 & t451 & xp.greater_equal(t146, -1e-12),  # 2
+        t447 & t450 & t451 & xp.greater(t146, 1e-12),  # 3
+        t447 & t449 & t452 & t453 & xp.greater_equal(t236, -1e-12),  # 4
+        t447 & t449 & t452 & t453 & xp.greater(t236, 1e-12),  # 5
+        t447 & t449 & t452 & t454 & xp.greater_equal(t265, -1e-12),  # 6
+        t447 & t449 & t452 & t454 & xp.greater(t265, 1e-12),  # 7
     ], (8,))
     in_limits = _stack(xp, [
-        t461 & t462 & t463 & (t388 | t389) & (t390 | t391) & ((xp.less_equal(t392, 6.283185307179586)) | ((xp.greater_equal(t303, -6.283185307179586)) & (xp.less_equal(t303, 6.283185307179586)))),  # 0
-        t461 & t462 & t463 & (t399 | t400) & (t401 | t402) & ((xp.less_equal(t403, 6.283185307179586)) | ((xp.greater_equal(t315, -6.283185307179586)) & (xp.less_equal(t315, 6.283185307179586)))),  # 1
-        t461 & t464 & t465 & (t404 | t405) & (t406 | t407) & ((xp.less_equal(t408, 6.283185307179586)) | ((xp.greater_equal(t326, -6.283185307179586)) & (xp.less_equal(t326, 6.283185307179586)))),  # 2
-        t461 & t464 & t465 & (t414 | t415) & (t416 | t417) & ((xp.less_equal(t418, 6.283185307179586)) | ((xp.greater_equal(t338, -6.283185307179586)) & (xp.less_equal(t338, 6.283185307179586)))),  # 3
-        t466 & t467 & t468 & (t422 | t423) & (t424 | t425) & ((xp.less_equal(t426, 6.283185307179586)) | ((xp.greater_equal(t348, -6.283185307179586)) & (xp.less_equal(t348, 6.283185307179586)))),  # 4
-        t466 & t467 & t468 & (t433 | t434) & (t435 | t436) & ((xp.less_equal(t437, 6.283185307179586)) | ((xp.greater_equal(t360, -6.283185307179586)) & (xp.less_equal(t360, 6.283185307179586)))),  # 5
-        t466 & t469 & t470 & (t438 | t439) & (t440 | t441) & ((xp.less_equal(t442, 6.283185307179586)) | ((xp.greater_equal(t371, -6.283185307179586)) & (xp.less_equal(t371, 6.283185307179586)))),  # 6
-        t466 & t469 & t470 & (t448 | t449) & (t450 | t451) & ((xp.less_equal(t452, 6.283185307179586)) | ((xp.greater_equal(t383, -6.283185307179586)) & (xp.less_equal(t383, 6.283185307179586)))),  # 7
+        t455 & t456 & t457 & (t382 | t383) & (t384 | t385) & (xp.less_equal(t386, 6.283185307179586) | (xp.greater_equal(t297, -6.283185307179586) & xp.less_equal(t297, 6.283185307179586))),  # 0
+        t455 & t456 & t457 & (t393 | t394) & (t395 | t396) & (xp.less_equal(t397, 6.283185307179586) | (xp.greater_equal(t309, -6.283185307179586) & xp.less_equal(t309, 6.283185307179586))),  # 1
+        t455 & t458 & t459 & (t398 | t399) & (t400 | t401) & (xp.less_equal(t402, 6.283185307179586) | (xp.greater_equal(t320, -6.283185307179586) & xp.less_equal(t320, 6.283185307179586))),  # 2
+        t455 & t458 & t459 & (t408 | t409) & (t410 | t411) & (xp.less_equal(t412, 6.283185307179586) | (xp.greater_equal(t332, -6.283185307179586) & xp.less_equal(t332, 6.283185307179586))),  # 3
+        t460 & t461 & t462 & (t416 | t417) & (t418 | t419) & (xp.less_equal(t420, 6.283185307179586) | (xp.greater_equal(t342, -6.283185307179586) & xp.less_equal(t342, 6.283185307179586))),  # 4
+        t460 & t461 & t462 & (t427 | t428) & (t429 | t430) & (xp.less_equal(t431, 6.283185307179586) | (xp.greater_equal(t354, -6.283185307179586) & xp.less_equal(t354, 6.283185307179586))),  # 5
+        t460 & t463 & t464 & (t432 | t433) & (t434 | t435) & (xp.less_equal(t436, 6.283185307179586) | (xp.greater_equal(t365, -6.283185307179586) & xp.less_equal(t365, 6.283185307179586))),  # 6
+        t460 & t463 & t464 & (t442 | t443) & (t444 | t445) & (xp.less_equal(t446, 6.283185307179586) | (xp.greater_equal(t377, -6.283185307179586) & xp.less_equal(t377, 6.283185307179586))),  # 7
     ], (8,))
     return q, valid, in_limits
 
@@ -3017,30 +3011,30 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     t55 = qb7_5 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn6 - qb7_5))
     t56 = xp.where(lb7 & vb7, xp.asarray(1, dtype=dtype), 0)
     t57 = T00 + T01 + T02 + T03 + T10 + T11 + T12 + T13 + T20 + T21 + T22 + T23 + qn1 + qn2 + qn3 + qn4 + qn5 + qn6 + qw1 + qw2 + qw3 + qw4 + qw5 + qw6
-    t58 = xp.where(xp.greater(qn1, t0), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t58 = xp.where(xp.less(t0, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t59 = t0 + t58
     t60 = t0 - t58
-    t61 = xp.where((xp.greater_equal(t0, -6.283185307179586)) & (xp.less_equal(t0, 6.283185307179586)), t0, xp.where((xp.greater_equal(t59, -6.283185307179586)) & (xp.less_equal(t59, 6.283185307179586)), t59, xp.where((xp.greater_equal(t60, -6.283185307179586)) & (xp.less_equal(t60, 6.283185307179586)), t60, qb0_0)))
-    t62 = xp.where(xp.greater(qn2, t1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t61 = xp.where(xp.greater_equal(t0, -6.283185307179586) & xp.less_equal(t0, 6.283185307179586), t0, xp.where(xp.greater_equal(t59, -6.283185307179586) & xp.less_equal(t59, 6.283185307179586), t59, xp.where(xp.greater_equal(t60, -6.283185307179586) & xp.less_equal(t60, 6.283185307179586), t60, qb0_0)))
+    t62 = xp.where(xp.less(t1, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t63 = t1 + t62
     t64 = t1 - t62
-    t65 = xp.where((xp.greater_equal(t1, -6.283185307179586)) & (xp.less_equal(t1, 6.283185307179586)), t1, xp.where((xp.greater_equal(t63, -6.283185307179586)) & (xp.less_equal(t63, 6.283185307179586)), t63, xp.where((xp.greater_equal(t64, -6.283185307179586)) & (xp.less_equal(t64, 6.283185307179586)), t64, qb0_1)))
-    t66 = xp.where(xp.greater(qn3, t2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t65 = xp.where(xp.greater_equal(t1, -6.283185307179586) & xp.less_equal(t1, 6.283185307179586), t1, xp.where(xp.greater_equal(t63, -6.283185307179586) & xp.less_equal(t63, 6.283185307179586), t63, xp.where(xp.greater_equal(t64, -6.283185307179586) & xp.less_equal(t64, 6.283185307179586), t64, qb0_1)))
+    t66 = xp.where(xp.less(t2, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t67 = t2 + t66
     t68 = t2 - t66
-    t69 = xp.where((xp.greater_equal(t2, -6.283185307179586)) & (xp.less_equal(t2, 6.283185307179586)), t2, xp.where((xp.greater_equal(t67, -6.283185307179586)) & (xp.less_equal(t67, 6.283185307179586)), t67, xp.where((xp.greater_equal(t68, -6.283185307179586)) & (xp.less_equal(t68, 6.283185307179586)), t68, qb0_2)))
-    t70 = xp.where(xp.greater(qn4, t3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t69 = xp.where(xp.greater_equal(t2, -6.283185307179586) & xp.less_equal(t2, 6.283185307179586), t2, xp.where(xp.greater_equal(t67, -6.283185307179586) & xp.less_equal(t67, 6.283185307179586), t67, xp.where(xp.greater_equal(t68, -6.283185307179586) & xp.less_equal(t68, 6.283185307179586), t68, qb0_2)))
+    t70 = xp.where(xp.less(t3, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t71 = t3 + t70
     t72 = t3 - t70
-    t73 = xp.where((xp.greater_equal(t3, -6.283185307179586)) & (xp.less_equal(t3, 6.283185307179586)), t3, xp.where((xp.greater_equal(t71, -6.283185307179586)) & (xp.less_equal(t71, 6.283185307179586)), t71, xp.where((xp.greater_equal(t72, -6.283185307179586)) & (xp.less_equal(t72, 6.283185307179586)), t72, qb0_3)))
-    t74 = xp.where(xp.greater(qn5, t4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t73 = xp.where(xp.greater_equal(t3, -6.283185307179586) & xp.less_equal(t3, 6.283185307179586), t3, xp.where(xp.greater_equal(t71, -6.283185307179586) & xp.less_equal(t71, 6.283185307179586), t71, xp.where(xp.greater_equal(t72, -6.283185307179586) & xp.less_equal(t72, 6.283185307179586), t72, qb0_3)))
+    t74 = xp.where(xp.less(t4, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t75 = t4 + t74
     t76 = t4 - t74
-    t77 = xp.where((xp.greater_equal(t4, -6.283185307179586)) & (xp.less_equal(t4, 6.283185307179586)), t4, xp.where((xp.greater_equal(t75, -6.283185307179586)) & (xp.less_equal(t75, 6.283185307179586)), t75, xp.where((xp.greater_equal(t76, -6.283185307179586)) & (xp.less_equal(t76, 6.283185307179586)), t76, qb0_4)))
-    t78 = xp.where(xp.greater(qn6, t5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t77 = xp.where(xp.greater_equal(t4, -6.283185307179586) & xp.less_equal(t4, 6.283185307179586), t4, xp.where(xp.greater_equal(t75, -6.283185307179586) & xp.less_equal(t75, 6.283185307179586), t75, xp.where(xp.greater_equal(t76, -6.283185307179586) & xp.less_equal(t76, 6.283185307179586), t76, qb0_4)))
+    t78 = xp.where(xp.less(t5, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t79 = t5 + t78
     t80 = t5 - t78
-    t81 = xp.where((xp.greater_equal(t5, -6.283185307179586)) & (xp.less_equal(t5, 6.283185307179586)), t5, xp.where((xp.greater_equal(t79, -6.283185307179586)) & (xp.less_equal(t79, 6.283185307179586)), t79, xp.where((xp.greater_equal(t80, -6.283185307179586)) & (xp.less_equal(t80, 6.283185307179586)), t80, qb0_5)))
+    t81 = xp.where(xp.greater_equal(t5, -6.283185307179586) & xp.less_equal(t5, 6.283185307179586), t5, xp.where(xp.greater_equal(t79, -6.283185307179586) & xp.less_equal(t79, 6.283185307179586), t79, xp.where(xp.greater_equal(t80, -6.283185307179586) & xp.less_equal(t80, 6.283185307179586), t80, qb0_5)))
     t82 = -qn1
     t83 = -qn2
     t84 = -qn3
@@ -3056,33 +3050,33 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     t94 = xp.where(t89, t77, qn5)
     t95 = xp.where(t89, t81, qn6)
     t96 = xp.where(t89, t88, 0)
-    t97 = xp.where(xp.greater(qn1, t8), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t97 = xp.where(xp.less(t8, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t98 = t8 + t97
     t99 = t8 - t97
-    t100 = xp.where((xp.greater_equal(t8, -6.283185307179586)) & (xp.less_equal(t8, 6.283185307179586)), t8, xp.where((xp.greater_equal(t98, -6.283185307179586)) & (xp.less_equal(t98, 6.283185307179586)), t98, xp.where((xp.greater_equal(t99, -6.283185307179586)) & (xp.less_equal(t99, 6.283185307179586)), t99, qb1_0)))
-    t101 = xp.where(xp.greater(qn2, t9), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t102 = t101 + t9
+    t100 = xp.where(xp.greater_equal(t8, -6.283185307179586) & xp.less_equal(t8, 6.283185307179586), t8, xp.where(xp.greater_equal(t98, -6.283185307179586) & xp.less_equal(t98, 6.283185307179586), t98, xp.where(xp.greater_equal(t99, -6.283185307179586) & xp.less_equal(t99, 6.283185307179586), t99, qb1_0)))
+    t101 = xp.where(xp.less(t9, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t102 = t9 + t101
     t103 = t9 - t101
-    t104 = xp.where((xp.greater_equal(t9, -6.283185307179586)) & (xp.less_equal(t9, 6.283185307179586)), t9, xp.where((xp.greater_equal(t102, -6.283185307179586)) & (xp.less_equal(t102, 6.283185307179586)), t102, xp.where((xp.greater_equal(t103, -6.283185307179586)) & (xp.less_equal(t103, 6.283185307179586)), t103, qb1_1)))
-    t105 = xp.where(xp.greater(qn3, t10), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t104 = xp.where(xp.greater_equal(t9, -6.283185307179586) & xp.less_equal(t9, 6.283185307179586), t9, xp.where(xp.greater_equal(t102, -6.283185307179586) & xp.less_equal(t102, 6.283185307179586), t102, xp.where(xp.greater_equal(t103, -6.283185307179586) & xp.less_equal(t103, 6.283185307179586), t103, qb1_1)))
+    t105 = xp.where(xp.less(t10, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t106 = t10 + t105
     t107 = t10 - t105
-    t108 = xp.where((xp.greater_equal(t10, -6.283185307179586)) & (xp.less_equal(t10, 6.283185307179586)), t10, xp.where((xp.greater_equal(t106, -6.283185307179586)) & (xp.less_equal(t106, 6.283185307179586)), t106, xp.where((xp.greater_equal(t107, -6.283185307179586)) & (xp.less_equal(t107, 6.283185307179586)), t107, qb1_2)))
-    t109 = xp.where(xp.greater(qn4, t11), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t110 = t109 + t11
+    t108 = xp.where(xp.greater_equal(t10, -6.283185307179586) & xp.less_equal(t10, 6.283185307179586), t10, xp.where(xp.greater_equal(t106, -6.283185307179586) & xp.less_equal(t106, 6.283185307179586), t106, xp.where(xp.greater_equal(t107, -6.283185307179586) & xp.less_equal(t107, 6.283185307179586), t107, qb1_2)))
+    t109 = xp.where(xp.less(t11, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t110 = t11 + t109
     t111 = t11 - t109
-    t112 = xp.where((xp.greater_equal(t11, -6.283185307179586)) & (xp.less_equal(t11, 6.283185307179586)), t11, xp.where((xp.greater_equal(t110, -6.283185307179586)) & (xp.less_equal(t110, 6.283185307179586)), t110, xp.where((xp.greater_equal(t111, -6.283185307179586)) & (xp.less_equal(t111, 6.283185307179586)), t111, qb1_3)))
-    t113 = xp.where(xp.greater(qn5, t12), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t114 = t113 + t12
+    t112 = xp.where(xp.greater_equal(t11, -6.283185307179586) & xp.less_equal(t11, 6.283185307179586), t11, xp.where(xp.greater_equal(t110, -6.283185307179586) & xp.less_equal(t110, 6.283185307179586), t110, xp.where(xp.greater_equal(t111, -6.283185307179586) & xp.less_equal(t111, 6.283185307179586), t111, qb1_3)))
+    t113 = xp.where(xp.less(t12, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t114 = t12 + t113
     t115 = t12 - t113
-    t116 = xp.where((xp.greater_equal(t12, -6.283185307179586)) & (xp.less_equal(t12, 6.283185307179586)), t12, xp.where((xp.greater_equal(t114, -6.283185307179586)) & (xp.less_equal(t114, 6.283185307179586)), t114, xp.where((xp.greater_equal(t115, -6.283185307179586)) & (xp.less_equal(t115, 6.283185307179586)), t115, qb1_4)))
-    t117 = xp.where(xp.greater(qn6, t13), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t118 = t117 + t13
+    t116 = xp.where(xp.greater_equal(t12, -6.283185307179586) & xp.less_equal(t12, 6.283185307179586), t12, xp.where(xp.greater_equal(t114, -6.283185307179586) & xp.less_equal(t114, 6.283185307179586), t114, xp.where(xp.greater_equal(t115, -6.283185307179586) & xp.less_equal(t115, 6.283185307179586), t115, qb1_4)))
+    t117 = xp.where(xp.less(t13, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t118 = t13 + t117
     t119 = t13 - t117
-    t120 = xp.where((xp.greater_equal(t13, -6.283185307179586)) & (xp.less_equal(t13, 6.283185307179586)), t13, xp.where((xp.greater_equal(t118, -6.283185307179586)) & (xp.less_equal(t118, 6.283185307179586)), t118, xp.where((xp.greater_equal(t119, -6.283185307179586)) & (xp.less_equal(t119, 6.283185307179586)), t119, qb1_5)))
+    t120 = xp.where(xp.greater_equal(t13, -6.283185307179586) & xp.less_equal(t13, 6.283185307179586), t13, xp.where(xp.greater_equal(t118, -6.283185307179586) & xp.less_equal(t118, 6.283185307179586), t118, xp.where(xp.greater_equal(t119, -6.283185307179586) & xp.less_equal(t119, 6.283185307179586), t119, qb1_5)))
     t121 = qw1*(t100 + t82)**2 + qw2*(t104 + t83)**2 + qw3*(t108 + t84)**2 + qw4*(t112 + t85)**2 + qw5*(t116 + t86)**2 + qw6*(t120 + t87)**2
     t122 = xp.greater(t14, 0)
-    t123 = xp.where(t122 & ((xp.less(t121, t96)) | (xp.less(t7, 1))), xp.asarray(1, dtype=dtype), 0)
+    t123 = xp.where(t122 & (xp.greater(t96, t121) | xp.less(t7, 1)), xp.asarray(1, dtype=dtype), 0)
     t124 = xp.where(t122, 1, t7)
     t125 = xp.greater(t123, 0)
     t126 = xp.where(t125, t100, t90)
@@ -3092,33 +3086,33 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     t130 = xp.where(t125, t116, t94)
     t131 = xp.where(t125, t120, t95)
     t132 = xp.where(t125, t121, t96)
-    t133 = xp.where(xp.greater(qn1, t15), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t134 = t133 + t15
+    t133 = xp.where(xp.less(t15, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t134 = t15 + t133
     t135 = t15 - t133
-    t136 = xp.where((xp.greater_equal(t15, -6.283185307179586)) & (xp.less_equal(t15, 6.283185307179586)), t15, xp.where((xp.greater_equal(t134, -6.283185307179586)) & (xp.less_equal(t134, 6.283185307179586)), t134, xp.where((xp.greater_equal(t135, -6.283185307179586)) & (xp.less_equal(t135, 6.283185307179586)), t135, qb2_0)))
-    t137 = xp.where(xp.greater(qn2, t16), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t138 = t137 + t16
+    t136 = xp.where(xp.greater_equal(t15, -6.283185307179586) & xp.less_equal(t15, 6.283185307179586), t15, xp.where(xp.greater_equal(t134, -6.283185307179586) & xp.less_equal(t134, 6.283185307179586), t134, xp.where(xp.greater_equal(t135, -6.283185307179586) & xp.less_equal(t135, 6.283185307179586), t135, qb2_0)))
+    t137 = xp.where(xp.less(t16, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t138 = t16 + t137
     t139 = t16 - t137
-    t140 = xp.where((xp.greater_equal(t16, -6.283185307179586)) & (xp.less_equal(t16, 6.283185307179586)), t16, xp.where((xp.greater_equal(t138, -6.283185307179586)) & (xp.less_equal(t138, 6.283185307179586)), t138, xp.where((xp.greater_equal(t139, -6.283185307179586)) & (xp.less_equal(t139, 6.283185307179586)), t139, qb2_1)))
-    t141 = xp.where(xp.greater(qn3, t17), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t142 = t141 + t17
+    t140 = xp.where(xp.greater_equal(t16, -6.283185307179586) & xp.less_equal(t16, 6.283185307179586), t16, xp.where(xp.greater_equal(t138, -6.283185307179586) & xp.less_equal(t138, 6.283185307179586), t138, xp.where(xp.greater_equal(t139, -6.283185307179586) & xp.less_equal(t139, 6.283185307179586), t139, qb2_1)))
+    t141 = xp.where(xp.less(t17, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t142 = t17 + t141
     t143 = t17 - t141
-    t144 = xp.where((xp.greater_equal(t17, -6.283185307179586)) & (xp.less_equal(t17, 6.283185307179586)), t17, xp.where((xp.greater_equal(t142, -6.283185307179586)) & (xp.less_equal(t142, 6.283185307179586)), t142, xp.where((xp.greater_equal(t143, -6.283185307179586)) & (xp.less_equal(t143, 6.283185307179586)), t143, qb2_2)))
-    t145 = xp.where(xp.greater(qn4, t18), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t146 = t145 + t18
+    t144 = xp.where(xp.greater_equal(t17, -6.283185307179586) & xp.less_equal(t17, 6.283185307179586), t17, xp.where(xp.greater_equal(t142, -6.283185307179586) & xp.less_equal(t142, 6.283185307179586), t142, xp.where(xp.greater_equal(t143, -6.283185307179586) & xp.less_equal(t143, 6.283185307179586), t143, qb2_2)))
+    t145 = xp.where(xp.less(t18, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t146 = t18 + t145
     t147 = t18 - t145
-    t148 = xp.where((xp.greater_equal(t18, -6.283185307179586)) & (xp.less_equal(t18, 6.283185307179586)), t18, xp.where((xp.greater_equal(t146, -6.283185307179586)) & (xp.less_equal(t146, 6.283185307179586)), t146, xp.where((xp.greater_equal(t147, -6.283185307179586)) & (xp.less_equal(t147, 6.283185307179586)), t147, qb2_3)))
-    t149 = xp.where(xp.greater(qn5, t19), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t150 = t149 + t19
+    t148 = xp.where(xp.greater_equal(t18, -6.283185307179586) & xp.less_equal(t18, 6.283185307179586), t18, xp.where(xp.greater_equal(t146, -6.283185307179586) & xp.less_equal(t146, 6.283185307179586), t146, xp.where(xp.greater_equal(t147, -6.283185307179586) & xp.less_equal(t147, 6.283185307179586), t147, qb2_3)))
+    t149 = xp.where(xp.less(t19, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t150 = t19 + t149
     t151 = t19 - t149
-    t152 = xp.where((xp.greater_equal(t19, -6.283185307179586)) & (xp.less_equal(t19, 6.283185307179586)), t19, xp.where((xp.greater_equal(t150, -6.283185307179586)) & (xp.less_equal(t150, 6.283185307179586)), t150, xp.where((xp.greater_equal(t151, -6.283185307179586)) & (xp.less_equal(t151, 6.283185307179586)), t151, qb2_4)))
-    t153 = xp.where(xp.greater(qn6, t20), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t154 = t153 + t20
+    t152 = xp.where(xp.greater_equal(t19, -6.283185307179586) & xp.less_equal(t19, 6.283185307179586), t19, xp.where(xp.greater_equal(t150, -6.283185307179586) & xp.less_equal(t150, 6.283185307179586), t150, xp.where(xp.greater_equal(t151, -6.283185307179586) & xp.less_equal(t151, 6.283185307179586), t151, qb2_4)))
+    t153 = xp.where(xp.less(t20, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t154 = t20 + t153
     t155 = t20 - t153
-    t156 = xp.where((xp.greater_equal(t20, -6.283185307179586)) & (xp.less_equal(t20, 6.283185307179586)), t20, xp.where((xp.greater_equal(t154, -6.283185307179586)) & (xp.less_equal(t154, 6.283185307179586)), t154, xp.where((xp.greater_equal(t155, -6.283185307179586)) & (xp.less_equal(t155, 6.283185307179586)), t155, qb2_5)))
+    t156 = xp.where(xp.greater_equal(t20, -6.283185307179586) & xp.less_equal(t20, 6.283185307179586), t20, xp.where(xp.greater_equal(t154, -6.283185307179586) & xp.less_equal(t154, 6.283185307179586), t154, xp.where(xp.greater_equal(t155, -6.283185307179586) & xp.less_equal(t155, 6.283185307179586), t155, qb2_5)))
     t157 = qw1*(t136 + t82)**2 + qw2*(t140 + t83)**2 + qw3*(t144 + t84)**2 + qw4*(t148 + t85)**2 + qw5*(t152 + t86)**2 + qw6*(t156 + t87)**2
     t158 = xp.greater(t21, 0)
-    t159 = xp.where(t158 & ((xp.greater(t132, t157)) | (xp.less(t124, 1))), xp.asarray(1, dtype=dtype), 0)
+    t159 = xp.where(t158 & (xp.greater(t132, t157) | xp.less(t124, 1)), xp.asarray(1, dtype=dtype), 0)
     t160 = xp.where(t158, 1, t124)
     t161 = xp.greater(t159, 0)
     t162 = xp.where(t161, t136, t126)
@@ -3128,33 +3122,33 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     t166 = xp.where(t161, t152, t130)
     t167 = xp.where(t161, t156, t131)
     t168 = xp.where(t161, t157, t132)
-    t169 = xp.where(xp.greater(qn1, t22), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t170 = t169 + t22
+    t169 = xp.where(xp.less(t22, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t170 = t22 + t169
     t171 = t22 - t169
-    t172 = xp.where((xp.greater_equal(t22, -6.283185307179586)) & (xp.less_equal(t22, 6.283185307179586)), t22, xp.where((xp.greater_equal(t170, -6.283185307179586)) & (xp.less_equal(t170, 6.283185307179586)), t170, xp.where((xp.greater_equal(t171, -6.283185307179586)) & (xp.less_equal(t171, 6.283185307179586)), t171, qb3_0)))
-    t173 = xp.where(xp.greater(qn2, t23), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t174 = t173 + t23
+    t172 = xp.where(xp.greater_equal(t22, -6.283185307179586) & xp.less_equal(t22, 6.283185307179586), t22, xp.where(xp.greater_equal(t170, -6.283185307179586) & xp.less_equal(t170, 6.283185307179586), t170, xp.where(xp.greater_equal(t171, -6.283185307179586) & xp.less_equal(t171, 6.283185307179586), t171, qb3_0)))
+    t173 = xp.where(xp.less(t23, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t174 = t23 + t173
     t175 = t23 - t173
-    t176 = xp.where((xp.greater_equal(t23, -6.283185307179586)) & (xp.less_equal(t23, 6.283185307179586)), t23, xp.where((xp.greater_equal(t174, -6.283185307179586)) & (xp.less_equal(t174, 6.283185307179586)), t174, xp.where((xp.greater_equal(t175, -6.283185307179586)) & (xp.less_equal(t175, 6.283185307179586)), t175, qb3_1)))
-    t177 = xp.where(xp.greater(qn3, t24), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t178 = t177 + t24
+    t176 = xp.where(xp.greater_equal(t23, -6.283185307179586) & xp.less_equal(t23, 6.283185307179586), t23, xp.where(xp.greater_equal(t174, -6.283185307179586) & xp.less_equal(t174, 6.283185307179586), t174, xp.where(xp.greater_equal(t175, -6.283185307179586) & xp.less_equal(t175, 6.283185307179586), t175, qb3_1)))
+    t177 = xp.where(xp.less(t24, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t178 = t24 + t177
     t179 = t24 - t177
-    t180 = xp.where((xp.greater_equal(t24, -6.283185307179586)) & (xp.less_equal(t24, 6.283185307179586)), t24, xp.where((xp.greater_equal(t178, -6.283185307179586)) & (xp.less_equal(t178, 6.283185307179586)), t178, xp.where((xp.greater_equal(t179, -6.283185307179586)) & (xp.less_equal(t179, 6.283185307179586)), t179, qb3_2)))
-    t181 = xp.where(xp.greater(qn4, t25), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t182 = t181 + t25
+    t180 = xp.where(xp.greater_equal(t24, -6.283185307179586) & xp.less_equal(t24, 6.283185307179586), t24, xp.where(xp.greater_equal(t178, -6.283185307179586) & xp.less_equal(t178, 6.283185307179586), t178, xp.where(xp.greater_equal(t179, -6.283185307179586) & xp.less_equal(t179, 6.283185307179586), t179, qb3_2)))
+    t181 = xp.where(xp.less(t25, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t182 = t25 + t181
     t183 = t25 - t181
-    t184 = xp.where((xp.greater_equal(t25, -6.283185307179586)) & (xp.less_equal(t25, 6.283185307179586)), t25, xp.where((xp.greater_equal(t182, -6.283185307179586)) & (xp.less_equal(t182, 6.283185307179586)), t182, xp.where((xp.greater_equal(t183, -6.283185307179586)) & (xp.less_equal(t183, 6.283185307179586)), t183, qb3_3)))
-    t185 = xp.where(xp.greater(qn5, t26), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t186 = t185 + t26
+    t184 = xp.where(xp.greater_equal(t25, -6.283185307179586) & xp.less_equal(t25, 6.283185307179586), t25, xp.where(xp.greater_equal(t182, -6.283185307179586) & xp.less_equal(t182, 6.283185307179586), t182, xp.where(xp.greater_equal(t183, -6.283185307179586) & xp.less_equal(t183, 6.283185307179586), t183, qb3_3)))
+    t185 = xp.where(xp.less(t26, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t186 = t26 + t185
     t187 = t26 - t185
-    t188 = xp.where((xp.greater_equal(t26, -6.283185307179586)) & (xp.less_equal(t26, 6.283185307179586)), t26, xp.where((xp.greater_equal(t186, -6.283185307179586)) & (xp.less_equal(t186, 6.283185307179586)), t186, xp.where((xp.greater_equal(t187, -6.283185307179586)) & (xp.less_equal(t187, 6.283185307179586)), t187, qb3_4)))
-    t189 = xp.where(xp.greater(qn6, t27), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t190 = t189 + t27
+    t188 = xp.where(xp.greater_equal(t26, -6.283185307179586) & xp.less_equal(t26, 6.283185307179586), t26, xp.where(xp.greater_equal(t186, -6.283185307179586) & xp.less_equal(t186, 6.283185307179586), t186, xp.where(xp.greater_equal(t187, -6.283185307179586) & xp.less_equal(t187, 6.283185307179586), t187, qb3_4)))
+    t189 = xp.where(xp.less(t27, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t190 = t27 + t189
     t191 = t27 - t189
-    t192 = xp.where((xp.greater_equal(t27, -6.283185307179586)) & (xp.less_equal(t27, 6.283185307179586)), t27, xp.where((xp.greater_equal(t190, -6.283185307179586)) & (xp.less_equal(t190, 6.283185307179586)), t190, xp.where((xp.greater_equal(t191, -6.283185307179586)) & (xp.less_equal(t191, 6.283185307179586)), t191, qb3_5)))
+    t192 = xp.where(xp.greater_equal(t27, -6.283185307179586) & xp.less_equal(t27, 6.283185307179586), t27, xp.where(xp.greater_equal(t190, -6.283185307179586) & xp.less_equal(t190, 6.283185307179586), t190, xp.where(xp.greater_equal(t191, -6.283185307179586) & xp.less_equal(t191, 6.283185307179586), t191, qb3_5)))
     t193 = qw1*(t172 + t82)**2 + qw2*(t176 + t83)**2 + qw3*(t180 + t84)**2 + qw4*(t184 + t85)**2 + qw5*(t188 + t86)**2 + qw6*(t192 + t87)**2
     t194 = xp.greater(t28, 0)
-    t195 = xp.where(t194 & ((xp.greater(t168, t193)) | (xp.less(t160, 1))), xp.asarray(1, dtype=dtype), 0)
+    t195 = xp.where(t194 & (xp.less(t193, t168) | xp.less(t160, 1)), xp.asarray(1, dtype=dtype), 0)
     t196 = xp.where(t194, 1, t160)
     t197 = xp.greater(t195, 0)
     t198 = xp.where(t197, t172, t162)
@@ -3164,33 +3158,33 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     t202 = xp.where(t197, t188, t166)
     t203 = xp.where(t197, t192, t167)
     t204 = xp.where(t197, t193, t168)
-    t205 = xp.where(xp.greater(qn1, t29), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t206 = t205 + t29
+    t205 = xp.where(xp.less(t29, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t206 = t29 + t205
     t207 = t29 - t205
-    t208 = xp.where((xp.greater_equal(t29, -6.283185307179586)) & (xp.less_equal(t29, 6.283185307179586)), t29, xp.where((xp.greater_equal(t206, -6.283185307179586)) & (xp.less_equal(t206, 6.283185307179586)), t206, xp.where((xp.greater_equal(t207, -6.283185307179586)) & (xp.less_equal(t207, 6.283185307179586)), t207, qb4_0)))
-    t209 = xp.where(xp.greater(qn2, t30), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t210 = t209 + t30
+    t208 = xp.where(xp.greater_equal(t29, -6.283185307179586) & xp.less_equal(t29, 6.283185307179586), t29, xp.where(xp.greater_equal(t206, -6.283185307179586) & xp.less_equal(t206, 6.283185307179586), t206, xp.where(xp.greater_equal(t207, -6.283185307179586) & xp.less_equal(t207, 6.283185307179586), t207, qb4_0)))
+    t209 = xp.where(xp.less(t30, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t210 = t30 + t209
     t211 = t30 - t209
-    t212 = xp.where((xp.greater_equal(t30, -6.283185307179586)) & (xp.less_equal(t30, 6.283185307179586)), t30, xp.where((xp.greater_equal(t210, -6.283185307179586)) & (xp.less_equal(t210, 6.283185307179586)), t210, xp.where((xp.greater_equal(t211, -6.283185307179586)) & (xp.less_equal(t211, 6.283185307179586)), t211, qb4_1)))
-    t213 = xp.where(xp.greater(qn3, t31), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t214 = t213 + t31
+    t212 = xp.where(xp.greater_equal(t30, -6.283185307179586) & xp.less_equal(t30, 6.283185307179586), t30, xp.where(xp.greater_equal(t210, -6.283185307179586) & xp.less_equal(t210, 6.283185307179586), t210, xp.where(xp.greater_equal(t211, -6.283185307179586) & xp.less_equal(t211, 6.283185307179586), t211, qb4_1)))
+    t213 = xp.where(xp.less(t31, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t214 = t31 + t213
     t215 = t31 - t213
-    t216 = xp.where((xp.greater_equal(t31, -6.283185307179586)) & (xp.less_equal(t31, 6.283185307179586)), t31, xp.where((xp.greater_equal(t214, -6.283185307179586)) & (xp.less_equal(t214, 6.283185307179586)), t214, xp.where((xp.greater_equal(t215, -6.283185307179586)) & (xp.less_equal(t215, 6.283185307179586)), t215, qb4_2)))
-    t217 = xp.where(xp.greater(qn4, t32), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t218 = t217 + t32
+    t216 = xp.where(xp.greater_equal(t31, -6.283185307179586) & xp.less_equal(t31, 6.283185307179586), t31, xp.where(xp.greater_equal(t214, -6.283185307179586) & xp.less_equal(t214, 6.283185307179586), t214, xp.where(xp.greater_equal(t215, -6.283185307179586) & xp.less_equal(t215, 6.283185307179586), t215, qb4_2)))
+    t217 = xp.where(xp.less(t32, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t218 = t32 + t217
     t219 = t32 - t217
-    t220 = xp.where((xp.greater_equal(t32, -6.283185307179586)) & (xp.less_equal(t32, 6.283185307179586)), t32, xp.where((xp.greater_equal(t218, -6.283185307179586)) & (xp.less_equal(t218, 6.283185307179586)), t218, xp.where((xp.greater_equal(t219, -6.283185307179586)) & (xp.less_equal(t219, 6.283185307179586)), t219, qb4_3)))
-    t221 = xp.where(xp.greater(qn5, t33), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t222 = t221 + t33
+    t220 = xp.where(xp.greater_equal(t32, -6.283185307179586) & xp.less_equal(t32, 6.283185307179586), t32, xp.where(xp.greater_equal(t218, -6.283185307179586) & xp.less_equal(t218, 6.283185307179586), t218, xp.where(xp.greater_equal(t219, -6.283185307179586) & xp.less_equal(t219, 6.283185307179586), t219, qb4_3)))
+    t221 = xp.where(xp.less(t33, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t222 = t33 + t221
     t223 = t33 - t221
-    t224 = xp.where((xp.greater_equal(t33, -6.283185307179586)) & (xp.less_equal(t33, 6.283185307179586)), t33, xp.where((xp.greater_equal(t222, -6.283185307179586)) & (xp.less_equal(t222, 6.283185307179586)), t222, xp.where((xp.greater_equal(t223, -6.283185307179586)) & (xp.less_equal(t223, 6.283185307179586)), t223, qb4_4)))
-    t225 = xp.where(xp.greater(qn6, t34), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t226 = t225 + t34
+    t224 = xp.where(xp.greater_equal(t33, -6.283185307179586) & xp.less_equal(t33, 6.283185307179586), t33, xp.where(xp.greater_equal(t222, -6.283185307179586) & xp.less_equal(t222, 6.283185307179586), t222, xp.where(xp.greater_equal(t223, -6.283185307179586) & xp.less_equal(t223, 6.283185307179586), t223, qb4_4)))
+    t225 = xp.where(xp.less(t34, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t226 = t34 + t225
     t227 = t34 - t225
-    t228 = xp.where((xp.greater_equal(t34, -6.283185307179586)) & (xp.less_equal(t34, 6.283185307179586)), t34, xp.where((xp.greater_equal(t226, -6.283185307179586)) & (xp.less_equal(t226, 6.283185307179586)), t226, xp.where((xp.greater_equal(t227, -6.283185307179586)) & (xp.less_equal(t227, 6.283185307179586)), t227, qb4_5)))
+    t228 = xp.where(xp.greater_equal(t34, -6.283185307179586) & xp.less_equal(t34, 6.283185307179586), t34, xp.where(xp.greater_equal(t226, -6.283185307179586) & xp.less_equal(t226, 6.283185307179586), t226, xp.where(xp.greater_equal(t227, -6.283185307179586) & xp.less_equal(t227, 6.283185307179586), t227, qb4_5)))
     t229 = qw1*(t208 + t82)**2 + qw2*(t212 + t83)**2 + qw3*(t216 + t84)**2 + qw4*(t220 + t85)**2 + qw5*(t224 + t86)**2 + qw6*(t228 + t87)**2
     t230 = xp.greater(t35, 0)
-    t231 = xp.where(t230 & ((xp.greater(t204, t229)) | (xp.less(t196, 1))), xp.asarray(1, dtype=dtype), 0)
+    t231 = xp.where(t230 & (xp.greater(t204, t229) | xp.less(t196, 1)), xp.asarray(1, dtype=dtype), 0)
     t232 = xp.where(t230, 1, t196)
     t233 = xp.greater(t231, 0)
     t234 = xp.where(t233, t208, t198)
@@ -3200,33 +3194,33 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     t238 = xp.where(t233, t224, t202)
     t239 = xp.where(t233, t228, t203)
     t240 = xp.where(t233, t229, t204)
-    t241 = xp.where(xp.greater(qn1, t36), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t242 = t241 + t36
+    t241 = xp.where(xp.less(t36, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t242 = t36 + t241
     t243 = t36 - t241
-    t244 = xp.where((xp.greater_equal(t36, -6.283185307179586)) & (xp.less_equal(t36, 6.283185307179586)), t36, xp.where((xp.greater_equal(t242, -6.283185307179586)) & (xp.less_equal(t242, 6.283185307179586)), t242, xp.where((xp.greater_equal(t243, -6.283185307179586)) & (xp.less_equal(t243, 6.283185307179586)), t243, qb5_0)))
-    t245 = xp.where(xp.greater(qn2, t37), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t246 = t245 + t37
+    t244 = xp.where(xp.greater_equal(t36, -6.283185307179586) & xp.less_equal(t36, 6.283185307179586), t36, xp.where(xp.greater_equal(t242, -6.283185307179586) & xp.less_equal(t242, 6.283185307179586), t242, xp.where(xp.greater_equal(t243, -6.283185307179586) & xp.less_equal(t243, 6.283185307179586), t243, qb5_0)))
+    t245 = xp.where(xp.less(t37, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t246 = t37 + t245
     t247 = t37 - t245
-    t248 = xp.where((xp.greater_equal(t37, -6.283185307179586)) & (xp.less_equal(t37, 6.283185307179586)), t37, xp.where((xp.greater_equal(t246, -6.283185307179586)) & (xp.less_equal(t246, 6.283185307179586)), t246, xp.where((xp.greater_equal(t247, -6.283185307179586)) & (xp.less_equal(t247, 6.283185307179586)), t247, qb5_1)))
-    t249 = xp.where(xp.greater(qn3, t38), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t250 = t249 + t38
+    t248 = xp.where(xp.greater_equal(t37, -6.283185307179586) & xp.less_equal(t37, 6.283185307179586), t37, xp.where(xp.greater_equal(t246, -6.283185307179586) & xp.less_equal(t246, 6.283185307179586), t246, xp.where(xp.greater_equal(t247, -6.283185307179586) & xp.less_equal(t247, 6.283185307179586), t247, qb5_1)))
+    t249 = xp.where(xp.less(t38, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t250 = t38 + t249
     t251 = t38 - t249
-    t252 = xp.where((xp.greater_equal(t38, -6.283185307179586)) & (xp.less_equal(t38, 6.283185307179586)), t38, xp.where((xp.greater_equal(t250, -6.283185307179586)) & (xp.less_equal(t250, 6.283185307179586)), t250, xp.where((xp.greater_equal(t251, -6.283185307179586)) & (xp.less_equal(t251, 6.283185307179586)), t251, qb5_2)))
-    t253 = xp.where(xp.greater(qn4, t39), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t254 = t253 + t39
+    t252 = xp.where(xp.greater_equal(t38, -6.283185307179586) & xp.less_equal(t38, 6.283185307179586), t38, xp.where(xp.greater_equal(t250, -6.283185307179586) & xp.less_equal(t250, 6.283185307179586), t250, xp.where(xp.greater_equal(t251, -6.283185307179586) & xp.less_equal(t251, 6.283185307179586), t251, qb5_2)))
+    t253 = xp.where(xp.less(t39, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t254 = t39 + t253
     t255 = t39 - t253
-    t256 = xp.where((xp.greater_equal(t39, -6.283185307179586)) & (xp.less_equal(t39, 6.283185307179586)), t39, xp.where((xp.greater_equal(t254, -6.283185307179586)) & (xp.less_equal(t254, 6.283185307179586)), t254, xp.where((xp.greater_equal(t255, -6.283185307179586)) & (xp.less_equal(t255, 6.283185307179586)), t255, qb5_3)))
-    t257 = xp.where(xp.greater(qn5, t40), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t258 = t257 + t40
+    t256 = xp.where(xp.greater_equal(t39, -6.283185307179586) & xp.less_equal(t39, 6.283185307179586), t39, xp.where(xp.greater_equal(t254, -6.283185307179586) & xp.less_equal(t254, 6.283185307179586), t254, xp.where(xp.greater_equal(t255, -6.283185307179586) & xp.less_equal(t255, 6.283185307179586), t255, qb5_3)))
+    t257 = xp.where(xp.less(t40, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t258 = t40 + t257
     t259 = t40 - t257
-    t260 = xp.where((xp.greater_equal(t40, -6.283185307179586)) & (xp.less_equal(t40, 6.283185307179586)), t40, xp.where((xp.greater_equal(t258, -6.283185307179586)) & (xp.less_equal(t258, 6.283185307179586)), t258, xp.where((xp.greater_equal(t259, -6.283185307179586)) & (xp.less_equal(t259, 6.283185307179586)), t259, qb5_4)))
-    t261 = xp.where(xp.greater(qn6, t41), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t262 = t261 + t41
+    t260 = xp.where(xp.greater_equal(t40, -6.283185307179586) & xp.less_equal(t40, 6.283185307179586), t40, xp.where(xp.greater_equal(t258, -6.283185307179586) & xp.less_equal(t258, 6.283185307179586), t258, xp.where(xp.greater_equal(t259, -6.283185307179586) & xp.less_equal(t259, 6.283185307179586), t259, qb5_4)))
+    t261 = xp.where(xp.less(t41, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t262 = t41 + t261
     t263 = t41 - t261
-    t264 = xp.where((xp.greater_equal(t41, -6.283185307179586)) & (xp.less_equal(t41, 6.283185307179586)), t41, xp.where((xp.greater_equal(t262, -6.283185307179586)) & (xp.less_equal(t262, 6.283185307179586)), t262, xp.where((xp.greater_equal(t263, -6.283185307179586)) & (xp.less_equal(t263, 6.283185307179586)), t263, qb5_5)))
+    t264 = xp.where(xp.greater_equal(t41, -6.283185307179586) & xp.less_equal(t41, 6.283185307179586), t41, xp.where(xp.greater_equal(t262, -6.283185307179586) & xp.less_equal(t262, 6.283185307179586), t262, xp.where(xp.greater_equal(t263, -6.283185307179586) & xp.less_equal(t263, 6.283185307179586), t263, qb5_5)))
     t265 = qw1*(t244 + t82)**2 + qw2*(t248 + t83)**2 + qw3*(t252 + t84)**2 + qw4*(t256 + t85)**2 + qw5*(t260 + t86)**2 + qw6*(t264 + t87)**2
     t266 = xp.greater(t42, 0)
-    t267 = xp.where(t266 & ((xp.greater(t240, t265)) | (xp.less(t232, 1))), xp.asarray(1, dtype=dtype), 0)
+    t267 = xp.where(t266 & (xp.greater(t240, t265) | xp.less(t232, 1)), xp.asarray(1, dtype=dtype), 0)
     t268 = xp.where(t266, 1, t232)
     t269 = xp.greater(t267, 0)
     t270 = xp.where(t269, t244, t234)
@@ -3236,33 +3230,33 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     t274 = xp.where(t269, t260, t238)
     t275 = xp.where(t269, t264, t239)
     t276 = xp.where(t269, t265, t240)
-    t277 = xp.where(xp.greater(qn1, t43), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t278 = t277 + t43
+    t277 = xp.where(xp.less(t43, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t278 = t43 + t277
     t279 = t43 - t277
-    t280 = xp.where((xp.greater_equal(t43, -6.283185307179586)) & (xp.less_equal(t43, 6.283185307179586)), t43, xp.where((xp.greater_equal(t278, -6.283185307179586)) & (xp.less_equal(t278, 6.283185307179586)), t278, xp.where((xp.greater_equal(t279, -6.283185307179586)) & (xp.less_equal(t279, 6.283185307179586)), t279, qb6_0)))
-    t281 = xp.where(xp.greater(qn2, t44), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t282 = t281 + t44
+    t280 = xp.where(xp.greater_equal(t43, -6.283185307179586) & xp.less_equal(t43, 6.283185307179586), t43, xp.where(xp.greater_equal(t278, -6.283185307179586) & xp.less_equal(t278, 6.283185307179586), t278, xp.where(xp.greater_equal(t279, -6.283185307179586) & xp.less_equal(t279, 6.283185307179586), t279, qb6_0)))
+    t281 = xp.where(xp.less(t44, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t282 = t44 + t281
     t283 = t44 - t281
-    t284 = xp.where((xp.greater_equal(t44, -6.283185307179586)) & (xp.less_equal(t44, 6.283185307179586)), t44, xp.where((xp.greater_equal(t282, -6.283185307179586)) & (xp.less_equal(t282, 6.283185307179586)), t282, xp.where((xp.greater_equal(t283, -6.283185307179586)) & (xp.less_equal(t283, 6.283185307179586)), t283, qb6_1)))
-    t285 = xp.where(xp.greater(qn3, t45), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t286 = t285 + t45
+    t284 = xp.where(xp.greater_equal(t44, -6.283185307179586) & xp.less_equal(t44, 6.283185307179586), t44, xp.where(xp.greater_equal(t282, -6.283185307179586) & xp.less_equal(t282, 6.283185307179586), t282, xp.where(xp.greater_equal(t283, -6.283185307179586) & xp.less_equal(t283, 6.283185307179586), t283, qb6_1)))
+    t285 = xp.where(xp.less(t45, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t286 = t45 + t285
     t287 = t45 - t285
-    t288 = xp.where((xp.greater_equal(t45, -6.283185307179586)) & (xp.less_equal(t45, 6.283185307179586)), t45, xp.where((xp.greater_equal(t286, -6.283185307179586)) & (xp.less_equal(t286, 6.283185307179586)), t286, xp.where((xp.greater_equal(t287, -6.283185307179586)) & (xp.less_equal(t287, 6.283185307179586)), t287, qb6_2)))
-    t289 = xp.where(xp.greater(qn4, t46), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t290 = t289 + t46
+    t288 = xp.where(xp.greater_equal(t45, -6.283185307179586) & xp.less_equal(t45, 6.283185307179586), t45, xp.where(xp.greater_equal(t286, -6.283185307179586) & xp.less_equal(t286, 6.283185307179586), t286, xp.where(xp.greater_equal(t287, -6.283185307179586) & xp.less_equal(t287, 6.283185307179586), t287, qb6_2)))
+    t289 = xp.where(xp.less(t46, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t290 = t46 + t289
     t291 = t46 - t289
-    t292 = xp.where((xp.greater_equal(t46, -6.283185307179586)) & (xp.less_equal(t46, 6.283185307179586)), t46, xp.where((xp.greater_equal(t290, -6.283185307179586)) & (xp.less_equal(t290, 6.283185307179586)), t290, xp.where((xp.greater_equal(t291, -6.283185307179586)) & (xp.less_equal(t291, 6.283185307179586)), t291, qb6_3)))
-    t293 = xp.where(xp.greater(qn5, t47), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t294 = t293 + t47
+    t292 = xp.where(xp.greater_equal(t46, -6.283185307179586) & xp.less_equal(t46, 6.283185307179586), t46, xp.where(xp.greater_equal(t290, -6.283185307179586) & xp.less_equal(t290, 6.283185307179586), t290, xp.where(xp.greater_equal(t291, -6.283185307179586) & xp.less_equal(t291, 6.283185307179586), t291, qb6_3)))
+    t293 = xp.where(xp.less(t47, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t294 = t47 + t293
     t295 = t47 - t293
-    t296 = xp.where((xp.greater_equal(t47, -6.283185307179586)) & (xp.less_equal(t47, 6.283185307179586)), t47, xp.where((xp.greater_equal(t294, -6.283185307179586)) & (xp.less_equal(t294, 6.283185307179586)), t294, xp.where((xp.greater_equal(t295, -6.283185307179586)) & (xp.less_equal(t295, 6.283185307179586)), t295, qb6_4)))
-    t297 = xp.where(xp.greater(qn6, t48), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t298 = t297 + t48
+    t296 = xp.where(xp.greater_equal(t47, -6.283185307179586) & xp.less_equal(t47, 6.283185307179586), t47, xp.where(xp.greater_equal(t294, -6.283185307179586) & xp.less_equal(t294, 6.283185307179586), t294, xp.where(xp.greater_equal(t295, -6.283185307179586) & xp.less_equal(t295, 6.283185307179586), t295, qb6_4)))
+    t297 = xp.where(xp.less(t48, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t298 = t48 + t297
     t299 = t48 - t297
-    t300 = xp.where((xp.greater_equal(t48, -6.283185307179586)) & (xp.less_equal(t48, 6.283185307179586)), t48, xp.where((xp.greater_equal(t298, -6.283185307179586)) & (xp.less_equal(t298, 6.283185307179586)), t298, xp.where((xp.greater_equal(t299, -6.283185307179586)) & (xp.less_equal(t299, 6.283185307179586)), t299, qb6_5)))
+    t300 = xp.where(xp.greater_equal(t48, -6.283185307179586) & xp.less_equal(t48, 6.283185307179586), t48, xp.where(xp.greater_equal(t298, -6.283185307179586) & xp.less_equal(t298, 6.283185307179586), t298, xp.where(xp.greater_equal(t299, -6.283185307179586) & xp.less_equal(t299, 6.283185307179586), t299, qb6_5)))
     t301 = qw1*(t280 + t82)**2 + qw2*(t284 + t83)**2 + qw3*(t288 + t84)**2 + qw4*(t292 + t85)**2 + qw5*(t296 + t86)**2 + qw6*(t300 + t87)**2
     t302 = xp.greater(t49, 0)
-    t303 = xp.where(t302 & ((xp.greater(t276, t301)) | (xp.less(t268, 1))), xp.asarray(1, dtype=dtype), 0)
+    t303 = xp.where(t302 & (xp.greater(t276, t301) | xp.less(t268, 1)), xp.asarray(1, dtype=dtype), 0)
     t304 = xp.where(t302, 1, t268)
     t305 = xp.greater(t303, 0)
     t306 = xp.where(t305, t280, t270)
@@ -3272,33 +3266,33 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     t310 = xp.where(t305, t296, t274)
     t311 = xp.where(t305, t300, t275)
     t312 = xp.where(t305, t301, t276)
-    t313 = xp.where(xp.greater(qn1, t50), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t314 = t313 + t50
+    t313 = xp.where(xp.less(t50, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t314 = t50 + t313
     t315 = t50 - t313
-    t316 = xp.where((xp.greater_equal(t50, -6.283185307179586)) & (xp.less_equal(t50, 6.283185307179586)), t50, xp.where((xp.greater_equal(t314, -6.283185307179586)) & (xp.less_equal(t314, 6.283185307179586)), t314, xp.where((xp.greater_equal(t315, -6.283185307179586)) & (xp.less_equal(t315, 6.283185307179586)), t315, qb7_0)))
-    t317 = xp.where(xp.greater(qn2, t51), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t318 = t317 + t51
+    t316 = xp.where(xp.greater_equal(t50, -6.283185307179586) & xp.less_equal(t50, 6.283185307179586), t50, xp.where(xp.greater_equal(t314, -6.283185307179586) & xp.less_equal(t314, 6.283185307179586), t314, xp.where(xp.greater_equal(t315, -6.283185307179586) & xp.less_equal(t315, 6.283185307179586), t315, qb7_0)))
+    t317 = xp.where(xp.less(t51, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t318 = t51 + t317
     t319 = t51 - t317
-    t320 = xp.where((xp.greater_equal(t51, -6.283185307179586)) & (xp.less_equal(t51, 6.283185307179586)), t51, xp.where((xp.greater_equal(t318, -6.283185307179586)) & (xp.less_equal(t318, 6.283185307179586)), t318, xp.where((xp.greater_equal(t319, -6.283185307179586)) & (xp.less_equal(t319, 6.283185307179586)), t319, qb7_1)))
-    t321 = xp.where(xp.greater(qn3, t52), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t322 = t321 + t52
+    t320 = xp.where(xp.greater_equal(t51, -6.283185307179586) & xp.less_equal(t51, 6.283185307179586), t51, xp.where(xp.greater_equal(t318, -6.283185307179586) & xp.less_equal(t318, 6.283185307179586), t318, xp.where(xp.greater_equal(t319, -6.283185307179586) & xp.less_equal(t319, 6.283185307179586), t319, qb7_1)))
+    t321 = xp.where(xp.less(t52, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t322 = t52 + t321
     t323 = t52 - t321
-    t324 = xp.where((xp.greater_equal(t52, -6.283185307179586)) & (xp.less_equal(t52, 6.283185307179586)), t52, xp.where((xp.greater_equal(t322, -6.283185307179586)) & (xp.less_equal(t322, 6.283185307179586)), t322, xp.where((xp.greater_equal(t323, -6.283185307179586)) & (xp.less_equal(t323, 6.283185307179586)), t323, qb7_2)))
-    t325 = xp.where(xp.greater(qn4, t53), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t326 = t325 + t53
+    t324 = xp.where(xp.greater_equal(t52, -6.283185307179586) & xp.less_equal(t52, 6.283185307179586), t52, xp.where(xp.greater_equal(t322, -6.283185307179586) & xp.less_equal(t322, 6.283185307179586), t322, xp.where(xp.greater_equal(t323, -6.283185307179586) & xp.less_equal(t323, 6.283185307179586), t323, qb7_2)))
+    t325 = xp.where(xp.less(t53, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t326 = t53 + t325
     t327 = t53 - t325
-    t328 = xp.where((xp.greater_equal(t53, -6.283185307179586)) & (xp.less_equal(t53, 6.283185307179586)), t53, xp.where((xp.greater_equal(t326, -6.283185307179586)) & (xp.less_equal(t326, 6.283185307179586)), t326, xp.where((xp.greater_equal(t327, -6.283185307179586)) & (xp.less_equal(t327, 6.283185307179586)), t327, qb7_3)))
-    t329 = xp.where(xp.greater(qn5, t54), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t330 = t329 + t54
+    t328 = xp.where(xp.greater_equal(t53, -6.283185307179586) & xp.less_equal(t53, 6.283185307179586), t53, xp.where(xp.greater_equal(t326, -6.283185307179586) & xp.less_equal(t326, 6.283185307179586), t326, xp.where(xp.greater_equal(t327, -6.283185307179586) & xp.less_equal(t327, 6.283185307179586), t327, qb7_3)))
+    t329 = xp.where(xp.less(t54, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t330 = t54 + t329
     t331 = t54 - t329
-    t332 = xp.where((xp.greater_equal(t54, -6.283185307179586)) & (xp.less_equal(t54, 6.283185307179586)), t54, xp.where((xp.greater_equal(t330, -6.283185307179586)) & (xp.less_equal(t330, 6.283185307179586)), t330, xp.where((xp.greater_equal(t331, -6.283185307179586)) & (xp.less_equal(t331, 6.283185307179586)), t331, qb7_4)))
-    t333 = xp.where(xp.greater(qn6, t55), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t334 = t333 + t55
+    t332 = xp.where(xp.greater_equal(t54, -6.283185307179586) & xp.less_equal(t54, 6.283185307179586), t54, xp.where(xp.greater_equal(t330, -6.283185307179586) & xp.less_equal(t330, 6.283185307179586), t330, xp.where(xp.greater_equal(t331, -6.283185307179586) & xp.less_equal(t331, 6.283185307179586), t331, qb7_4)))
+    t333 = xp.where(xp.less(t55, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t334 = t55 + t333
     t335 = t55 - t333
-    t336 = xp.where((xp.greater_equal(t55, -6.283185307179586)) & (xp.less_equal(t55, 6.283185307179586)), t55, xp.where((xp.greater_equal(t334, -6.283185307179586)) & (xp.less_equal(t334, 6.283185307179586)), t334, xp.where((xp.greater_equal(t335, -6.283185307179586)) & (xp.less_equal(t335, 6.283185307179586)), t335, qb7_5)))
+    t336 = xp.where(xp.greater_equal(t55, -6.283185307179586) & xp.less_equal(t55, 6.283185307179586), t55, xp.where(xp.greater_equal(t334, -6.283185307179586) & xp.less_equal(t334, 6.283185307179586), t334, xp.where(xp.greater_equal(t335, -6.283185307179586) & xp.less_equal(t335, 6.283185307179586), t335, qb7_5)))
     t337 = qw1*(t316 + t82)**2 + qw2*(t320 + t83)**2 + qw3*(t324 + t84)**2 + qw4*(t328 + t85)**2 + qw5*(t332 + t86)**2 + qw6*(t336 + t87)**2
     t338 = xp.greater(t56, 0)
-    t339 = xp.where(t338 & ((xp.greater(t312, t337)) | (xp.less(t304, 1))), xp.asarray(1, dtype=dtype), 0)
+    t339 = xp.where(t338 & (xp.greater(t312, t337) | xp.less(t304, 1)), xp.asarray(1, dtype=dtype), 0)
     t340 = xp.where(t338, 1, t304)
     t341 = xp.greater(t339, 0)
     t342 = xp.where(t341, t316, t306)
