@@ -10,7 +10,7 @@ from .functions import Call, Function, Generator, Output
 from .lowering import is_boolean
 from .printers import CasadiPrinter, CPrinter, PythonPrinter
 from .robot import Robot
-from .subproblems import RANK, TOLERANCES
+from .subproblems import RANK, TOLERANCES, Select
 
 # The contract's C array extent of each argument and output (`function.output`, or the function
 # when it has one), as factors that are numbers or the suffixes of size macros
@@ -87,7 +87,7 @@ def _python_function(function: Function, printer: PythonPrinter, parameters: lis
         "arguments": [(a.name, repr(shape)) for a, shape in zip(function.arguments, shapes)],
         "signature": ", ".join([f"{a.name}={a.default}" if a.default else a.name for a in function.arguments] + ["*"] * bool(parameters)
                                + [f"{p['name']}={p['value']}" for p in parameters]),
-        "selects": any(e.has(sympy.Piecewise) for e in [v for _, v in body.definitions] + list(body.outputs)),
+        "selects": any(e.has(Select) for e in [v for _, v in body.definitions] + list(body.outputs)),
         "calls": [(", ".join(r.name for r in call.results), f"{call.function}({', '.join(call.passes)}"
                    + "".join(f", {p['name']}={p['name']}" for p in parameters) + ")") for call in function.calls],
         "inputs": [(str(symbol), f"{argument.name}[..., {row}]" if argument.vector else f"{argument.name}[..., {row}, {col}]")

@@ -51,7 +51,7 @@ def fold_constants(expr: sympy.Expr, _folded: dict | None = None) -> sympy.Expr:
         elif expr.is_Pow:
             base = fold_constants(expr.base, folded)
             folded[expr] = expr if base is expr.base else sympy.Pow(base, expr.exp)
-        else:  # rebuilt only when an argument changed: a rebuild evaluates (Piecewise, floor, relations)
+        else:  # rebuilt only when an argument changed
             args = tuple(fold_constants(arg, folded) for arg in expr.args)
             changed = any(new is not old and new != old for new, old in zip(args, expr.args))
             folded[expr] = expr.func(*args) if changed else expr

@@ -1,7 +1,6 @@
 """Expression printers: one walk over a lowered Body's nodes, with the rules of each language.
 
-A Body holds few kinds of node: sums, products, powers, the math functions, selects
-(Piecewise), comparisons, and/or/not, `isfinite`. `Printer` walks them once each (the
+A Body holds few kinds of node: sums, products, powers, the math functions, selects, comparisons, and/or/not, `isfinite`. `Printer` walks them once each (the
 text of a node is kept for every later reader of it) and prints the arguments of sums and
 products in the order sympy stores them, which it sorts by structure, never by hash: the
 text is deterministic and nothing is re-sorted or rebuilt while printing. Each language
@@ -16,7 +15,7 @@ import numpy
 import sympy
 
 from .lowering import Body, is_boolean
-from .subproblems import TOLERANCE_SYMBOLS, TOLERANCES
+from .subproblems import TOLERANCE_SYMBOLS, TOLERANCES, Select
 
 # Binding strength of what a node prints as: an operand binding more loosely than its
 # operator is parenthesised.
@@ -78,8 +77,8 @@ class Printer:
             return self._product(expr.args)
         if expr.is_Pow:
             return self._power(expr.base, expr.exp)
-        if isinstance(expr, sympy.Piecewise):
-            return self._piecewise(expr.args), ATOM
+        if isinstance(expr, Select):
+            return self._select(expr.pairs, expr.args[-1]), ATOM
         name = type(expr).__name__
         if name not in self.functions:
             raise ValueError(f"unsupported in {type(self).__name__}: {name} ({expr})")
@@ -138,16 +137,12 @@ class Printer:
             return f"{self.one}/" + (f"({text})" if binding <= PRODUCT else text), PRODUCT
         return self.power(base, exponent)
 
-    def _piecewise(self, pairs) -> str:
-        """Nested selects, one per condition: the last pair's condition is `True`."""
-        (value, condition), *rest = pairs
-        if not rest:
-            if condition is not sympy.true:
-                raise ValueError("a Piecewise without an otherwise value")
-            return self.doprint(value)
-        otherwise = rest[0][0] if len(rest) == 1 else None
-        numbers = value.is_number and otherwise is not None and otherwise.is_number
-        return self.select(self.doprint(condition), self.doprint(value), self._piecewise(rest), numbers)
+    def _select(self, pairs, otherwise) -> str:
+        """Nested selects, one per condition."""
+        (condition, value), *rest = pairs
+        other = self._select(rest, otherwise) if rest else self.doprint(otherwise)
+        numbers = value.is_number and not rest and otherwise.is_number
+        return self.select(self.doprint(condition), self.doprint(value), other, numbers)
 
     def _boolean(self, expr) -> tuple[str, int]:
         name = type(expr).__name__

@@ -20,7 +20,8 @@ from dataclasses import dataclass
 from typing import Callable
 
 import sympy
-from sympy.logic.boolalg import BooleanFunction
+from sympy.core.logic import fuzzy_and
+from sympy.logic.boolalg import BooleanAtom, BooleanFunction
 
 EPS, TINY = sympy.symbols("EPS TINY", positive=True)
 RANK = sympy.Symbol("RANK", positive=True)  # velocity_ik's singularity threshold (see `differential`)
@@ -54,17 +55,22 @@ class Floor(sympy.Function):
 
 class _Plain:
     """A comparison decided only between numbers and the positive tolerances (or of a value with
-    itself). sympy's own asks its assumption system whether the difference of its sides is
-    nonnegative each time it is built, and CSE and every substitution build each comparison
+    itself), and -x against 0 turned into x against 0. sympy's own asks its assumption system
+    about its sides each time it is built, and CSE and every substitution build each comparison
     again (a fifth of a robot's generation time). It sorts and prints as sympy's comparison of
     the same kind; its negation and its reversals (which sympy's And and Not form) are
     comparisons of this family."""
 
-    @classmethod
-    def _eval_relation(cls, lhs, rhs, **options):
-        if lhs == rhs or (lhs.free_symbols | rhs.free_symbols) <= TOLERANCE_SYMBOLS:  # 1 >= -EPS: true
-            return super()._eval_relation(lhs, rhs, **options)
-        return cls(lhs, rhs, evaluate=False)
+    def __new__(cls, lhs, rhs, evaluate=True):
+        lhs, rhs = sympy.sympify(lhs), sympy.sympify(rhs)
+        if evaluate:
+            if lhs == rhs or (lhs.free_symbols | rhs.free_symbols) <= TOLERANCE_SYMBOLS:  # 1 >= -EPS: true
+                decided = cls.kind(lhs, rhs)
+                if isinstance(decided, BooleanAtom):
+                    return decided
+            if rhs == 0 and lhs.is_Mul and lhs.args[0] == -1:  # -x >= 0 is x <= 0: no negation to compute
+                return PLAIN[REVERSED[cls.kind]](-lhs, rhs)
+        return sympy.Basic.__new__(cls, lhs, rhs)
 
     @classmethod
     def class_key(cls):
@@ -98,9 +104,48 @@ REVERSED = {sympy.Ge: sympy.Le, sympy.Gt: sympy.Lt, sympy.Le: sympy.Ge, sympy.Lt
             sympy.Ne: sympy.Ne}
 
 
+class Select(sympy.Function):
+    """Args (condition, value, condition, value, ..., otherwise): the value of the first
+    condition that holds, else `otherwise`; every value is computed. Decided only where a
+    condition is a truth value or every value is the same (sympy's Piecewise asks its
+    assumption system about each condition every time CSE or a substitution rebuilds it).
+    A select in the otherwise position joins its parent, as Piecewise's pairs do."""
+
+    is_commutative = True
+
+    @classmethod
+    def eval(cls, *args):
+        *pairs, otherwise = args
+        pairs = list(zip(pairs[::2], pairs[1::2]))
+        changed = isinstance(otherwise, Select)
+        if changed:
+            pairs += otherwise.pairs
+            otherwise = otherwise.args[-1]
+        kept = []
+        for condition, value in pairs:
+            if condition is sympy.true:
+                otherwise, changed = value, True
+                break
+            if condition is sympy.false:
+                changed = True
+            else:
+                kept.append((condition, value))
+        if all(value == otherwise for _, value in kept):
+            return otherwise
+        return cls(*(arg for pair in kept for arg in pair), otherwise) if changed else None
+
+    @property
+    def pairs(self) -> list[tuple[sympy.Basic, sympy.Expr]]:
+        """(condition, value) in order; the last argument is the otherwise value."""
+        return list(zip(self.args[:-1:2], self.args[1:-1:2]))
+
+    def _eval_is_extended_real(self):
+        return fuzzy_and(value.is_extended_real for value in self.args[1::2] + self.args[-1:])
+
+
 def select(condition, if_true, if_false) -> sympy.Expr:
     """`if_true` where `condition` holds, else `if_false`; both are computed."""
-    return sympy.Piecewise((if_true, condition), (if_false, True))
+    return Select(condition, if_true, if_false)
 
 
 @dataclass(frozen=True)
@@ -268,8 +313,8 @@ def times_transposed(sp: Subproblems, R, v: Vector) -> Vector:
 
 def _in_range(angle: sympy.Expr) -> bool:
     """An atan2, a number in (-pi, pi], or a select of such."""
-    if isinstance(angle, sympy.Piecewise):
-        return all(_in_range(value) for value, _ in angle.args)
+    if isinstance(angle, Select):
+        return all(_in_range(value) for value in angle.args[1::2] + angle.args[-1:])
     return isinstance(angle, sympy.atan2) or (angle.is_Number and -sympy.pi < angle <= sympy.pi)
 
 

@@ -12,6 +12,7 @@ from numpy.testing import assert_allclose
 from jacgen import reference
 from jacgen.functions import Generator
 from jacgen.printers import CasadiPrinter
+from jacgen.subproblems import Select
 from jacgen.render import render_robot, write_files
 from jacgen.robot import load_robot
 from jacgen.verify import compare
@@ -104,7 +105,7 @@ def test_printer():
     printer = CasadiPrinter()
     assert printer.doprint(sympy.atan2(x, sympy.sqrt(y)) + 0.4318 / x**2) == \
         "0.4318/x**2 + casadi.atan2(x, casadi.sqrt(y))"  # terms in sympy's stored order
-    assert printer.doprint(sympy.Piecewise((x, (x > 0) & (y <= 1)), (y, True))) == \
+    assert printer.doprint(Select((x > 0) & (y <= 1), x, y)) == \
         "casadi.if_else(casadi.logic_and((y <= 1), (x > 0)), x, y)"
     for unsupported in (sympy.gamma(x), sympy.Mod(x, y), sympy.Max(x, y)):
         with pytest.raises(Exception, match="[Uu]nsupported|not supported"):

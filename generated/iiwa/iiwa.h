@@ -89,19 +89,19 @@ void iiwa_singularity_factors(const iiwa_real q[IIWA_DOF], iiwa_real f[IIWA_NUM_
 iiwa_real iiwa_manipulability(const iiwa_real q[IIWA_DOF]);
 
 /* Joint rates q_dot solving Js q_dot = mu_dot: Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status.
- * Result: q_dot[i], i < 7; returned as a scalar. 1035 operations. */
+ * Result: q_dot[i], i < 7; returned as a scalar. 1034 operations. */
 int iiwa_velocity_ik(const iiwa_real q[IIWA_DOF], const iiwa_real mu_dot[IIWA_TASK_DIM], iiwa_real damping, iiwa_real q_dot[IIWA_DOF]);
 
 /* One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite).
- * Result: q_start[i], i < 7; q_next[i], i < 7; returned as a scalar. 1126 operations. */
+ * Result: q_start[i], i < 7; q_next[i], i < 7; returned as a scalar. 1109 operations. */
 iiwa_real iiwa_ik_numeric_step(const iiwa_real target[16], const iiwa_real q[IIWA_DOF], iiwa_real damping, iiwa_real q_start[IIWA_DOF], iiwa_real q_next[IIWA_DOF]);
 
 /* Every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits.
- * Result: q: 8 x 7 row-major, element (r, c) at q[r * 7 + c]; valid[i], i < 8; in_limits[i], i < 8. 1635 operations. */
+ * Result: q: 8 x 7 row-major, element (r, c) at q[r * 7 + c]; valid[i], i < 8; in_limits[i], i < 8. 1623 operations. */
 void iiwa_ik_branches(const iiwa_real T[16], iiwa_real q_free, iiwa_real q[IIWA_MAX_IK_SOLUTIONS * IIWA_DOF], int valid[IIWA_MAX_IK_SOLUTIONS], int in_limits[IIWA_MAX_IK_SOLUTIONS]);
 
 /* The closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status.
- * Result: q[i], i < 7; returned as a scalar. 1104 operations. */
+ * Result: q[i], i < 7; returned as a scalar. 1007 operations. */
 int iiwa_ik_nearest(const iiwa_real T[16], const iiwa_real q_seed[IIWA_DOF], iiwa_real q_free, const iiwa_real weights[IIWA_DOF], iiwa_real q[IIWA_DOF]);
 
 /* Statuses of iiwa_velocity_ik: OK, singular (a diagonal entry of the QR factor R of the

@@ -89,19 +89,19 @@ void panda_singularity_factors(const panda_real q[PANDA_DOF], panda_real f[PANDA
 panda_real panda_manipulability(const panda_real q[PANDA_DOF]);
 
 /* Joint rates q_dot solving Js q_dot = mu_dot: Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status.
- * Result: q_dot[i], i < 7; returned as a scalar. 1062 operations. */
+ * Result: q_dot[i], i < 7; returned as a scalar. 1061 operations. */
 int panda_velocity_ik(const panda_real q[PANDA_DOF], const panda_real mu_dot[PANDA_TASK_DIM], panda_real damping, panda_real q_dot[PANDA_DOF]);
 
 /* One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite).
- * Result: q_start[i], i < 7; q_next[i], i < 7; returned as a scalar. 1157 operations. */
+ * Result: q_start[i], i < 7; q_next[i], i < 7; returned as a scalar. 1140 operations. */
 panda_real panda_ik_numeric_step(const panda_real target[16], const panda_real q[PANDA_DOF], panda_real damping, panda_real q_start[PANDA_DOF], panda_real q_next[PANDA_DOF]);
 
 /* Every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits.
- * Result: q: 8 x 7 row-major, element (r, c) at q[r * 7 + c]; valid[i], i < 8; in_limits[i], i < 8. 1583 operations. */
+ * Result: q: 8 x 7 row-major, element (r, c) at q[r * 7 + c]; valid[i], i < 8; in_limits[i], i < 8. 1545 operations. */
 void panda_ik_branches(const panda_real T[16], panda_real q_free, panda_real q[PANDA_MAX_IK_SOLUTIONS * PANDA_DOF], int valid[PANDA_MAX_IK_SOLUTIONS], int in_limits[PANDA_MAX_IK_SOLUTIONS]);
 
 /* The closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status.
- * Result: q[i], i < 7; returned as a scalar. 1104 operations. */
+ * Result: q[i], i < 7; returned as a scalar. 1007 operations. */
 int panda_ik_nearest(const panda_real T[16], const panda_real q_seed[PANDA_DOF], panda_real q_free, const panda_real weights[PANDA_DOF], panda_real q[PANDA_DOF]);
 
 /* Statuses of panda_velocity_ik: OK, singular (a diagonal entry of the QR factor R of the

@@ -463,7 +463,7 @@ planar_2r_real planar_2r_jacobian_det(const planar_2r_real q[PLANAR_2R_DOF])
 
 int planar_2r_velocity_ik(const planar_2r_real q[PLANAR_2R_DOF], const planar_2r_real mu_dot[PLANAR_2R_TASK_DIM], planar_2r_real damping, planar_2r_real q_dot[PLANAR_2R_DOF])
 {
-    /* 174 operations */
+    /* 173 operations */
 
     /* Inputs */
     const planar_2r_real q1 = q[0];
@@ -534,18 +534,18 @@ int planar_2r_velocity_ik(const planar_2r_real q[PLANAR_2R_DOF], const planar_2r
     const planar_2r_real t53 = t46 - t46*t52*(t51*t51);
     const planar_2r_real t54 = (t50 != 0 ? -t53/t50 : 0);
     const planar_2r_real t55 = (t8 != 0 ? -(t45 + t42*t54)/t8 : 0);
-    const int t56 = damping > 0;
-    const int t57 = isfinite(t47);
-    const int t58 = damping >= 0;
-    const planar_2r_real t59 = 1e-12*t12;
+    const int t56 = isfinite(t47);
+    const int t57 = damping >= 0;
+    const planar_2r_real t58 = 1e-12*t12;
+    const int t59 = damping > 0;
     const planar_2r_real t60 = 1e-12*t25;
-    const int t61 = (t56 && ((t17 <= t60) || (t30 <= t60))) || (damping <= 0 && ((t7 <= t59) || (t49 <= t59)));
-    const int t62 = t57 && t58 && !t61;
+    const int t61 = (t59 && ((t17 <= t60) || (t30 <= t60))) || (damping <= 0 && ((t7 <= t58) || (t49 <= t58)));
+    const int t62 = t56 && t57 && !t61;
 
     /* Outputs */
-    q_dot[0] = (t62 ? (t56 ? t37 : t55) : 0);
-    q_dot[1] = (t62 ? (t56 ? t38 : t54) : 0);
-    return (!(t57 && t58) ? 2 : (t61 ? 1 : 0));
+    q_dot[0] = (t62 ? (t59 ? t37 : t55) : 0);
+    q_dot[1] = (t62 ? (t59 ? t38 : t54) : 0);
+    return (!(t56 && t57) ? 2 : (t61 ? 1 : 0));
 }
 
 planar_2r_real planar_2r_ik_numeric_step(const planar_2r_real target[PLANAR_2R_TASK_DIM], const planar_2r_real q[PLANAR_2R_DOF], planar_2r_real damping, planar_2r_real q_start[PLANAR_2R_DOF], planar_2r_real q_next[PLANAR_2R_DOF])
@@ -609,7 +609,7 @@ planar_2r_real planar_2r_ik_numeric_step(const planar_2r_real target[PLANAR_2R_T
 
 void planar_2r_ik_branches(const planar_2r_real mu[PLANAR_2R_TASK_DIM], planar_2r_real q[PLANAR_2R_MAX_IK_SOLUTIONS * PLANAR_2R_DOF], int valid[PLANAR_2R_MAX_IK_SOLUTIONS], int in_limits[PLANAR_2R_MAX_IK_SOLUTIONS])
 {
-    /* 73 operations */
+    /* 67 operations */
 
     /* Inputs */
     const planar_2r_real mu0 = mu[0];
@@ -621,7 +621,7 @@ void planar_2r_ik_branches(const planar_2r_real mu[PLANAR_2R_TASK_DIM], planar_2
     const planar_2r_real t2 = mu0 + mu1;
     const planar_2r_real t3 = (t1*t1);
     const planar_2r_real t4 = 1 - t3;
-    const int t5 = 1e-12 < t4;
+    const int t5 = t4 > 1e-12;
     const planar_2r_real t6 = (t5 ? t1 : (t1 > 0 ? 1 : -1));
     const planar_2r_real t7 = (t5 ? sqrt(t4) : 0);
     const planar_2r_real t8 = atan2(t7, t6);
@@ -648,15 +648,15 @@ void planar_2r_ik_branches(const planar_2r_real mu[PLANAR_2R_TASK_DIM], planar_2
     q[1] = t10 - 6.283185307179586*ceil(0.15915494309189535*(-3.141592653589793 + t10));
     q[2] = (t22 <= t23*t24 ? 0 : atan2(t21, t20));
     q[3] = t9 - 6.283185307179586*ceil(0.15915494309189535*(-3.141592653589793 + t9));
-    valid[0] = t25 && ((t4 >= -1e-12) || (0 && t3 <= 1e-12));
-    valid[1] = t25 && t4 > 1e-12;
+    valid[0] = t25 && t4 >= -1e-12;
+    valid[1] = t5 && t25;
     in_limits[0] = 1;
     in_limits[1] = 1;
 }
 
 int planar_2r_ik_nearest(const planar_2r_real mu[PLANAR_2R_TASK_DIM], const planar_2r_real q_seed[PLANAR_2R_DOF], const planar_2r_real weights[PLANAR_2R_DOF], planar_2r_real q[PLANAR_2R_DOF])
 {
-    /* 70 operations */
+    /* 69 operations */
     planar_2r_real branches_q[PLANAR_2R_MAX_IK_SOLUTIONS * PLANAR_2R_DOF];
     int branches_valid[PLANAR_2R_MAX_IK_SOLUTIONS];
     int branches_in_limits[PLANAR_2R_MAX_IK_SOLUTIONS];
@@ -696,7 +696,7 @@ int planar_2r_ik_nearest(const planar_2r_real mu[PLANAR_2R_TASK_DIM], const plan
     const planar_2r_real t14 = (t12 ? t1 : qn2);
     const planar_2r_real t15 = (t12 ? t10 : 0);
     const int t16 = t6 > 0;
-    const planar_2r_real t17 = (t16 && ((t15 > t11) || (t3 < 1)) ? 1 : 0);
+    const planar_2r_real t17 = (t16 && ((t3 < 1) || (t11 < t15)) ? 1 : 0);
     const planar_2r_real t18 = (t16 ? 1 : t3);
     const int t19 = t17 > 0;
     const planar_2r_real t20 = (t19 ? t4 : t13);

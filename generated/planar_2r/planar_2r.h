@@ -86,7 +86,7 @@ planar_2r_real planar_2r_manipulability(const planar_2r_real q[PLANAR_2R_DOF]);
 planar_2r_real planar_2r_jacobian_det(const planar_2r_real q[PLANAR_2R_DOF]);
 
 /* Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status.
- * Result: q_dot[i], i < 2; returned as a scalar. 174 operations. */
+ * Result: q_dot[i], i < 2; returned as a scalar. 173 operations. */
 int planar_2r_velocity_ik(const planar_2r_real q[PLANAR_2R_DOF], const planar_2r_real mu_dot[PLANAR_2R_TASK_DIM], planar_2r_real damping, planar_2r_real q_dot[PLANAR_2R_DOF]);
 
 /* One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite).
@@ -94,11 +94,11 @@ int planar_2r_velocity_ik(const planar_2r_real q[PLANAR_2R_DOF], const planar_2r
 planar_2r_real planar_2r_ik_numeric_step(const planar_2r_real target[PLANAR_2R_TASK_DIM], const planar_2r_real q[PLANAR_2R_DOF], planar_2r_real damping, planar_2r_real q_start[PLANAR_2R_DOF], planar_2r_real q_next[PLANAR_2R_DOF]);
 
 /* Every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits.
- * Result: q: 2 x 2 row-major, element (r, c) at q[r * 2 + c]; valid[i], i < 2; in_limits[i], i < 2. 73 operations. */
+ * Result: q: 2 x 2 row-major, element (r, c) at q[r * 2 + c]; valid[i], i < 2; in_limits[i], i < 2. 67 operations. */
 void planar_2r_ik_branches(const planar_2r_real mu[PLANAR_2R_TASK_DIM], planar_2r_real q[PLANAR_2R_MAX_IK_SOLUTIONS * PLANAR_2R_DOF], int valid[PLANAR_2R_MAX_IK_SOLUTIONS], int in_limits[PLANAR_2R_MAX_IK_SOLUTIONS]);
 
 /* The closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status.
- * Result: q[i], i < 2; returned as a scalar. 70 operations. */
+ * Result: q[i], i < 2; returned as a scalar. 69 operations. */
 int planar_2r_ik_nearest(const planar_2r_real mu[PLANAR_2R_TASK_DIM], const planar_2r_real q_seed[PLANAR_2R_DOF], const planar_2r_real weights[PLANAR_2R_DOF], planar_2r_real q[PLANAR_2R_DOF]);
 
 /* Statuses of planar_2r_velocity_ik: OK, singular (a diagonal entry of the QR factor R of the

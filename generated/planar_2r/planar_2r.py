@@ -477,7 +477,7 @@ def jacobian_det(q):
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def velocity_ik(q, mu_dot, damping=0.0):
-    """joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: (2 x 1 and 1 x 1), 174 operations."""
+    """joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: (2 x 1 and 1 x 1), 173 operations."""
     xp, dtype, device, batch, (q, mu_dot, damping,) = _arguments(("q", q, (2,)), ("mu_dot", mu_dot, (2,)), ("damping", damping, ()))
     q1 = q[..., 0]
     q2 = q[..., 1]
@@ -546,18 +546,18 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t53 = t46 - t46*t52*t51**2
     t54 = xp.where(xp.not_equal(t50, 0), -t53/t50, 0)
     t55 = xp.where(xp.not_equal(t8, 0), -(t45 + t42*t54)/t8, 0)
-    t56 = xp.greater(damping, 0)
-    t57 = xp.isfinite(t47)
-    t58 = xp.greater_equal(damping, 0)
-    t59 = 1e-12*t12
+    t56 = xp.isfinite(t47)
+    t57 = xp.greater_equal(damping, 0)
+    t58 = 1e-12*t12
+    t59 = xp.greater(damping, 0)
     t60 = 1e-12*t25
-    t61 = (t56 & (xp.less_equal(t17, t60) | xp.less_equal(t30, t60))) | (xp.less_equal(damping, 0) & (xp.less_equal(t7, t59) | xp.less_equal(t49, t59)))
-    t62 = t57 & t58 & xp.logical_not(t61)
+    t61 = (t59 & (xp.less_equal(t17, t60) | xp.less_equal(t30, t60))) | (xp.less_equal(damping, 0) & (xp.less_equal(t7, t58) | xp.less_equal(t49, t58)))
+    t62 = t56 & t57 & xp.logical_not(t61)
     q_dot = _stack(xp, [
-        xp.broadcast_to(xp.where(t62, xp.where(t56, t37, t55), 0), batch),  # 0
-        xp.broadcast_to(xp.where(t62, xp.where(t56, t38, t54), 0), batch),  # 1
+        xp.broadcast_to(xp.where(t62, xp.where(t59, t37, t55), 0), batch),  # 0
+        xp.broadcast_to(xp.where(t62, xp.where(t59, t38, t54), 0), batch),  # 1
     ], (2,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t57 & t58), 2, xp.where(t61, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t56 & t57), 2, xp.where(t61, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
     return q_dot, status
 
 
@@ -622,7 +622,7 @@ def ik_numeric_step(target, q, damping=0.0):
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def ik_branches(mu):
-    """every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits: (2 x 2 and 2 x 1 and 2 x 1), 73 operations."""
+    """every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits: (2 x 2 and 2 x 1 and 2 x 1), 67 operations."""
     xp, dtype, device, batch, (mu,) = _arguments(("mu", mu, (2,)))
     mu0 = mu[..., 0]
     mu1 = mu[..., 1]
@@ -631,7 +631,7 @@ def ik_branches(mu):
     t2 = mu0 + mu1
     t3 = t1**2
     t4 = 1 - t3
-    t5 = xp.less(1e-12, t4)
+    t5 = xp.greater(t4, 1e-12)
     t6 = xp.where(t5, t1, xp.where(xp.greater(t1, 0), xp.asarray(1, dtype=dtype), -1))
     t7 = xp.where(t5, xp.sqrt(t4), 0)
     t8 = xp.atan2(t7, t6)
@@ -659,8 +659,8 @@ def ik_branches(mu):
         t9 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t9)),  # 1, 1
     ], (2, 2))
     valid = _stack(xp, [
-        t25 & (xp.greater_equal(t4, -1e-12) | (False & xp.less_equal(t3, 1e-12))),  # 0
-        t25 & xp.greater(t4, 1e-12),  # 1
+        t25 & xp.greater_equal(t4, -1e-12),  # 0
+        t5 & t25,  # 1
     ], (2,))
     in_limits = _stack(xp, [
         xp.full(batch, True, dtype=xp.bool, device=device),  # 0
@@ -671,7 +671,7 @@ def ik_branches(mu):
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def ik_nearest(mu, q_seed, weights=(1.0,) * DOF):
-    """the closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status: (2 x 1 and 1 x 1), 70 operations."""
+    """the closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status: (2 x 1 and 1 x 1), 69 operations."""
     xp, dtype, device, batch, (mu, q_seed, weights,) = _arguments(("mu", mu, (2,)), ("q_seed", q_seed, (2,)), ("weights", weights, (2,)))
     branches_q, branches_valid, branches_in_limits = ik_branches(mu)
     mu0 = mu[..., 0]
@@ -705,7 +705,7 @@ def ik_nearest(mu, q_seed, weights=(1.0,) * DOF):
     t14 = xp.where(t12, t1, qn2)
     t15 = xp.where(t12, t10, 0)
     t16 = xp.greater(t6, 0)
-    t17 = xp.where(t16 & (xp.greater(t15, t11) | xp.less(t3, 1)), xp.asarray(1, dtype=dtype), 0)
+    t17 = xp.where(t16 & (xp.less(t3, 1) | xp.less(t11, t15)), xp.asarray(1, dtype=dtype), 0)
     t18 = xp.where(t16, 1, t3)
     t19 = xp.greater(t17, 0)
     t20 = xp.where(t19, t4, t13)

@@ -326,7 +326,7 @@ def _jacobian_det(q):
 
 
 def _velocity_ik(q, mu_dot, damping):
-    """Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: 174 operations."""
+    """Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: 173 operations."""
     q1 = q[0]
     q2 = q[1]
     mu_dot0 = mu_dot[0]
@@ -393,18 +393,18 @@ def _velocity_ik(q, mu_dot, damping):
     t53 = t46 - t46*t52*t51**2
     t54 = casadi.if_else((t50 != 0), -t53/t50, 0)
     t55 = casadi.if_else((t8 != 0), -(t45 + t42*t54)/t8, 0)
-    t56 = (damping > 0)
-    t57 = (casadi.fabs(t47) < casadi.inf)
-    t58 = (damping >= 0)
-    t59 = 1e-12*t12
+    t56 = (casadi.fabs(t47) < casadi.inf)
+    t57 = (damping >= 0)
+    t58 = 1e-12*t12
+    t59 = (damping > 0)
     t60 = 1e-12*t25
-    t61 = casadi.logic_or(casadi.logic_and(t56, casadi.logic_or((t17 <= t60), (t30 <= t60))), casadi.logic_and((damping <= 0), casadi.logic_or((t7 <= t59), (t49 <= t59))))
-    t62 = casadi.logic_and(casadi.logic_and(t57, t58), casadi.logic_not(t61))
+    t61 = casadi.logic_or(casadi.logic_and(t59, casadi.logic_or((t17 <= t60), (t30 <= t60))), casadi.logic_and((damping <= 0), casadi.logic_or((t7 <= t58), (t49 <= t58))))
+    t62 = casadi.logic_and(casadi.logic_and(t56, t57), casadi.logic_not(t61))
     q_dot = casadi.SX(2, 1)
-    q_dot[0, 0] = casadi.if_else(t62, casadi.if_else(t56, t37, t55), 0)
-    q_dot[1, 0] = casadi.if_else(t62, casadi.if_else(t56, t38, t54), 0)
+    q_dot[0, 0] = casadi.if_else(t62, casadi.if_else(t59, t37, t55), 0)
+    q_dot[1, 0] = casadi.if_else(t62, casadi.if_else(t59, t38, t54), 0)
     status = casadi.SX(1, 1)
-    status[0, 0] = casadi.if_else(casadi.logic_not(casadi.logic_and(t57, t58)), 2, casadi.if_else(t61, 1, 0))
+    status[0, 0] = casadi.if_else(casadi.logic_not(casadi.logic_and(t56, t57)), 2, casadi.if_else(t61, 1, 0))
     return [q_dot, status]
 
 
@@ -465,7 +465,7 @@ def _ik_numeric_step(target, q, damping):
 
 
 def _ik_branches(mu):
-    """Every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits: 73 operations."""
+    """Every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits: 67 operations."""
     mu0 = mu[0]
     mu1 = mu[1]
     t0 = mu0**2 + mu1**2
@@ -473,7 +473,7 @@ def _ik_branches(mu):
     t2 = mu0 + mu1
     t3 = t1**2
     t4 = 1 - t3
-    t5 = (1e-12 < t4)
+    t5 = (t4 > 1e-12)
     t6 = casadi.if_else(t5, t1, casadi.if_else((t1 > 0), 1, -1))
     t7 = casadi.if_else(t5, casadi.sqrt(t4), 0)
     t8 = casadi.atan2(t7, t6)
@@ -500,8 +500,8 @@ def _ik_branches(mu):
     q[1, 0] = casadi.if_else((t22 <= t23*t24), 0, casadi.atan2(t21, t20))
     q[1, 1] = t9 - 6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t9))
     valid = casadi.SX(2, 1)
-    valid[0, 0] = casadi.logic_and(t25, casadi.logic_or((t4 >= -1e-12), casadi.logic_and(False, (t3 <= 1e-12))))
-    valid[1, 0] = casadi.logic_and(t25, (t4 > 1e-12))
+    valid[0, 0] = casadi.logic_and(t25, (t4 >= -1e-12))
+    valid[1, 0] = casadi.logic_and(t5, t25)
     in_limits = casadi.SX(2, 1)
     in_limits[0, 0] = True
     in_limits[1, 0] = True
@@ -509,7 +509,7 @@ def _ik_branches(mu):
 
 
 def _ik_nearest(mu, q_seed, weights):
-    """The closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status: 70 operations."""
+    """The closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status: 69 operations."""
     branches_q, branches_valid, branches_in_limits = _ik_branches(mu)
     mu0 = mu[0]
     mu1 = mu[1]
@@ -542,7 +542,7 @@ def _ik_nearest(mu, q_seed, weights):
     t14 = casadi.if_else(t12, t1, qn2)
     t15 = casadi.if_else(t12, t10, 0)
     t16 = (t6 > 0)
-    t17 = casadi.if_else(casadi.logic_and(t16, casadi.logic_or((t15 > t11), (t3 < 1))), 1, 0)
+    t17 = casadi.if_else(casadi.logic_and(t16, casadi.logic_or((t3 < 1), (t11 < t15))), 1, 0)
     t18 = casadi.if_else(t16, 1, t3)
     t19 = (t17 > 0)
     t20 = casadi.if_else(t19, t4, t13)

@@ -654,7 +654,7 @@ planar_3r_real planar_3r_jacobian_det(const planar_3r_real q[PLANAR_3R_DOF])
 
 int planar_3r_velocity_ik(const planar_3r_real q[PLANAR_3R_DOF], const planar_3r_real mu_dot[PLANAR_3R_TASK_DIM], planar_3r_real damping, planar_3r_real q_dot[PLANAR_3R_DOF])
 {
-    /* 329 operations */
+    /* 328 operations */
 
     /* Inputs */
     const planar_3r_real q1 = q[0];
@@ -773,19 +773,19 @@ int planar_3r_velocity_ik(const planar_3r_real q[PLANAR_3R_DOF], const planar_3r
     const planar_3r_real t95 = (t91 != 0 ? -t94/t91 : 0);
     const planar_3r_real t96 = (t79 != 0 ? -(t86 - t95*t83)/t79 : 0);
     const planar_3r_real t97 = (t11 != 0 ? -(t75 + t95*t71 + t96*t67)/t11 : 0);
-    const int t98 = damping > 0;
-    const int t99 = isfinite(t88);
-    const int t100 = damping >= 0;
-    const planar_3r_real t101 = 1e-12*t15;
+    const int t98 = isfinite(t88);
+    const int t99 = damping >= 0;
+    const planar_3r_real t100 = 1e-12*t15;
+    const int t101 = damping > 0;
     const planar_3r_real t102 = 1e-12*t44;
-    const int t103 = (t98 && ((t23 <= t102) || (t36 <= t102) || (t53 <= t102))) || (damping <= 0 && ((t90 <= t101) || (t10 <= t101) || (t78 <= t101)));
-    const int t104 = t99 && t100 && !t103;
+    const int t103 = (t101 && ((t23 <= t102) || (t36 <= t102) || (t53 <= t102))) || (damping <= 0 && ((t90 <= t100) || (t10 <= t100) || (t78 <= t100)));
+    const int t104 = t98 && t99 && !t103;
 
     /* Outputs */
-    q_dot[0] = (t104 ? (t98 ? t61 : t97) : 0);
-    q_dot[1] = (t104 ? (t98 ? t62 : t96) : 0);
-    q_dot[2] = (t104 ? (t98 ? t63 : t95) : 0);
-    return (!(t99 && t100) ? 2 : (t103 ? 1 : 0));
+    q_dot[0] = (t104 ? (t101 ? t61 : t97) : 0);
+    q_dot[1] = (t104 ? (t101 ? t62 : t96) : 0);
+    q_dot[2] = (t104 ? (t101 ? t63 : t95) : 0);
+    return (!(t98 && t99) ? 2 : (t103 ? 1 : 0));
 }
 
 planar_3r_real planar_3r_ik_numeric_step(const planar_3r_real target[PLANAR_3R_TASK_DIM], const planar_3r_real q[PLANAR_3R_DOF], planar_3r_real damping, planar_3r_real q_start[PLANAR_3R_DOF], planar_3r_real q_next[PLANAR_3R_DOF])
@@ -883,7 +883,7 @@ planar_3r_real planar_3r_ik_numeric_step(const planar_3r_real target[PLANAR_3R_T
 
 void planar_3r_ik_branches(const planar_3r_real mu[PLANAR_3R_TASK_DIM], planar_3r_real q[PLANAR_3R_MAX_IK_SOLUTIONS * PLANAR_3R_DOF], int valid[PLANAR_3R_MAX_IK_SOLUTIONS], int in_limits[PLANAR_3R_MAX_IK_SOLUTIONS])
 {
-    /* 94 operations */
+    /* 88 operations */
 
     /* Inputs */
     const planar_3r_real mu0 = mu[0];
@@ -900,7 +900,7 @@ void planar_3r_ik_branches(const planar_3r_real mu[PLANAR_3R_TASK_DIM], planar_3
     const planar_3r_real t6 = mu0 + mu1 + mu2;
     const planar_3r_real t7 = (t5*t5);
     const planar_3r_real t8 = 1 - t7;
-    const int t9 = 1e-12 < t8;
+    const int t9 = t8 > 1e-12;
     const planar_3r_real t10 = (t9 ? t5 : (t5 > 0 ? 1 : -1));
     const planar_3r_real t11 = (t9 ? sqrt(t8) : 0);
     const planar_3r_real t12 = atan2(t11, t10);
@@ -935,15 +935,15 @@ void planar_3r_ik_branches(const planar_3r_real mu[PLANAR_3R_TASK_DIM], planar_3
     q[3] = t33;
     q[4] = t13 - 6.283185307179586*ceil(0.15915494309189535*(-3.141592653589793 + t13));
     q[5] = -(t34 + t30 + 6.283185307179586*ceil(-0.15915494309189535*(t34 + t31)));
-    valid[0] = t35 && ((t8 >= -1e-12) || (0 && t7 <= 1e-12));
-    valid[1] = t35 && t8 > 1e-12;
+    valid[0] = t35 && t8 >= -1e-12;
+    valid[1] = t9 && t35;
     in_limits[0] = 1;
     in_limits[1] = 1;
 }
 
 int planar_3r_ik_nearest(const planar_3r_real mu[PLANAR_3R_TASK_DIM], const planar_3r_real q_seed[PLANAR_3R_DOF], const planar_3r_real weights[PLANAR_3R_DOF], planar_3r_real q[PLANAR_3R_DOF])
 {
-    /* 97 operations */
+    /* 96 operations */
     planar_3r_real branches_q[PLANAR_3R_MAX_IK_SOLUTIONS * PLANAR_3R_DOF];
     int branches_valid[PLANAR_3R_MAX_IK_SOLUTIONS];
     int branches_in_limits[PLANAR_3R_MAX_IK_SOLUTIONS];
@@ -992,7 +992,7 @@ int planar_3r_ik_nearest(const planar_3r_real mu[PLANAR_3R_TASK_DIM], const plan
     const planar_3r_real t18 = (t15 ? t2 : qn3);
     const planar_3r_real t19 = (t15 ? t13 : 0);
     const int t20 = t8 > 0;
-    const planar_3r_real t21 = (t20 && ((t19 > t14) || (t4 < 1)) ? 1 : 0);
+    const planar_3r_real t21 = (t20 && ((t4 < 1) || (t14 < t19)) ? 1 : 0);
     const planar_3r_real t22 = (t20 ? 1 : t4);
     const int t23 = t21 > 0;
     const planar_3r_real t24 = (t23 ? t5 : t16);

@@ -653,7 +653,7 @@ def jacobian_det(q):
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def velocity_ik(q, mu_dot, damping=0.0):
-    """joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: (3 x 1 and 1 x 1), 329 operations."""
+    """joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: (3 x 1 and 1 x 1), 328 operations."""
     xp, dtype, device, batch, (q, mu_dot, damping,) = _arguments(("q", q, (3,)), ("mu_dot", mu_dot, (3,)), ("damping", damping, ()))
     q1 = q[..., 0]
     q2 = q[..., 1]
@@ -770,19 +770,19 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t95 = xp.where(xp.not_equal(t91, 0), -t94/t91, 0)
     t96 = xp.where(xp.not_equal(t79, 0), -(t86 - t95*t83)/t79, 0)
     t97 = xp.where(xp.not_equal(t11, 0), -(t75 + t95*t71 + t96*t67)/t11, 0)
-    t98 = xp.greater(damping, 0)
-    t99 = xp.isfinite(t88)
-    t100 = xp.greater_equal(damping, 0)
-    t101 = 1e-12*t15
+    t98 = xp.isfinite(t88)
+    t99 = xp.greater_equal(damping, 0)
+    t100 = 1e-12*t15
+    t101 = xp.greater(damping, 0)
     t102 = 1e-12*t44
-    t103 = (t98 & (xp.less_equal(t23, t102) | xp.less_equal(t36, t102) | xp.less_equal(t53, t102))) | (xp.less_equal(damping, 0) & (xp.less_equal(t90, t101) | xp.less_equal(t10, t101) | xp.less_equal(t78, t101)))
-    t104 = t99 & t100 & xp.logical_not(t103)
+    t103 = (t101 & (xp.less_equal(t23, t102) | xp.less_equal(t36, t102) | xp.less_equal(t53, t102))) | (xp.less_equal(damping, 0) & (xp.less_equal(t90, t100) | xp.less_equal(t10, t100) | xp.less_equal(t78, t100)))
+    t104 = t98 & t99 & xp.logical_not(t103)
     q_dot = _stack(xp, [
-        xp.broadcast_to(xp.where(t104, xp.where(t98, t61, t97), 0), batch),  # 0
-        xp.broadcast_to(xp.where(t104, xp.where(t98, t62, t96), 0), batch),  # 1
-        xp.broadcast_to(xp.where(t104, xp.where(t98, t63, t95), 0), batch),  # 2
+        xp.broadcast_to(xp.where(t104, xp.where(t101, t61, t97), 0), batch),  # 0
+        xp.broadcast_to(xp.where(t104, xp.where(t101, t62, t96), 0), batch),  # 1
+        xp.broadcast_to(xp.where(t104, xp.where(t101, t63, t95), 0), batch),  # 2
     ], (3,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t99 & t100), 2, xp.where(t103, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t98 & t99), 2, xp.where(t103, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
     return q_dot, status
 
 
@@ -881,7 +881,7 @@ def ik_numeric_step(target, q, damping=0.0):
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def ik_branches(mu):
-    """every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits: (2 x 3 and 2 x 1 and 2 x 1), 94 operations."""
+    """every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits: (2 x 3 and 2 x 1 and 2 x 1), 88 operations."""
     xp, dtype, device, batch, (mu,) = _arguments(("mu", mu, (3,)))
     mu0 = mu[..., 0]
     mu1 = mu[..., 1]
@@ -895,7 +895,7 @@ def ik_branches(mu):
     t6 = mu0 + mu1 + mu2
     t7 = t5**2
     t8 = 1 - t7
-    t9 = xp.less(1e-12, t8)
+    t9 = xp.greater(t8, 1e-12)
     t10 = xp.where(t9, t5, xp.where(xp.greater(t5, 0), xp.asarray(1, dtype=dtype), -1))
     t11 = xp.where(t9, xp.sqrt(t8), 0)
     t12 = xp.atan2(t11, t10)
@@ -931,8 +931,8 @@ def ik_branches(mu):
         -(t34 + t30 + 6.283185307179586*xp.ceil(-0.15915494309189535*(t34 + t31))),  # 1, 2
     ], (2, 3))
     valid = _stack(xp, [
-        t35 & (xp.greater_equal(t8, -1e-12) | (False & xp.less_equal(t7, 1e-12))),  # 0
-        t35 & xp.greater(t8, 1e-12),  # 1
+        t35 & xp.greater_equal(t8, -1e-12),  # 0
+        t9 & t35,  # 1
     ], (2,))
     in_limits = _stack(xp, [
         xp.full(batch, True, dtype=xp.bool, device=device),  # 0
@@ -943,7 +943,7 @@ def ik_branches(mu):
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def ik_nearest(mu, q_seed, weights=(1.0,) * DOF):
-    """the closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status: (3 x 1 and 1 x 1), 97 operations."""
+    """the closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status: (3 x 1 and 1 x 1), 96 operations."""
     xp, dtype, device, batch, (mu, q_seed, weights,) = _arguments(("mu", mu, (3,)), ("q_seed", q_seed, (3,)), ("weights", weights, (3,)))
     branches_q, branches_valid, branches_in_limits = ik_branches(mu)
     mu0 = mu[..., 0]
@@ -986,7 +986,7 @@ def ik_nearest(mu, q_seed, weights=(1.0,) * DOF):
     t18 = xp.where(t15, t2, qn3)
     t19 = xp.where(t15, t13, 0)
     t20 = xp.greater(t8, 0)
-    t21 = xp.where(t20 & (xp.greater(t19, t14) | xp.less(t4, 1)), xp.asarray(1, dtype=dtype), 0)
+    t21 = xp.where(t20 & (xp.less(t4, 1) | xp.less(t14, t19)), xp.asarray(1, dtype=dtype), 0)
     t22 = xp.where(t20, 1, t4)
     t23 = xp.greater(t21, 0)
     t24 = xp.where(t23, t5, t16)

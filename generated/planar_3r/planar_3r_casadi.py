@@ -478,7 +478,7 @@ def _jacobian_det(q):
 
 
 def _velocity_ik(q, mu_dot, damping):
-    """Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: 329 operations."""
+    """Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: 328 operations."""
     q1 = q[0]
     q2 = q[1]
     q3 = q[2]
@@ -593,19 +593,19 @@ def _velocity_ik(q, mu_dot, damping):
     t95 = casadi.if_else((t91 != 0), -t94/t91, 0)
     t96 = casadi.if_else((t79 != 0), -(t86 - t95*t83)/t79, 0)
     t97 = casadi.if_else((t11 != 0), -(t75 + t95*t71 + t96*t67)/t11, 0)
-    t98 = (damping > 0)
-    t99 = (casadi.fabs(t88) < casadi.inf)
-    t100 = (damping >= 0)
-    t101 = 1e-12*t15
+    t98 = (casadi.fabs(t88) < casadi.inf)
+    t99 = (damping >= 0)
+    t100 = 1e-12*t15
+    t101 = (damping > 0)
     t102 = 1e-12*t44
-    t103 = casadi.logic_or(casadi.logic_and(t98, casadi.logic_or(casadi.logic_or((t23 <= t102), (t36 <= t102)), (t53 <= t102))), casadi.logic_and((damping <= 0), casadi.logic_or(casadi.logic_or((t90 <= t101), (t10 <= t101)), (t78 <= t101))))
-    t104 = casadi.logic_and(casadi.logic_and(t99, t100), casadi.logic_not(t103))
+    t103 = casadi.logic_or(casadi.logic_and(t101, casadi.logic_or(casadi.logic_or((t23 <= t102), (t36 <= t102)), (t53 <= t102))), casadi.logic_and((damping <= 0), casadi.logic_or(casadi.logic_or((t90 <= t100), (t10 <= t100)), (t78 <= t100))))
+    t104 = casadi.logic_and(casadi.logic_and(t98, t99), casadi.logic_not(t103))
     q_dot = casadi.SX(3, 1)
-    q_dot[0, 0] = casadi.if_else(t104, casadi.if_else(t98, t61, t97), 0)
-    q_dot[1, 0] = casadi.if_else(t104, casadi.if_else(t98, t62, t96), 0)
-    q_dot[2, 0] = casadi.if_else(t104, casadi.if_else(t98, t63, t95), 0)
+    q_dot[0, 0] = casadi.if_else(t104, casadi.if_else(t101, t61, t97), 0)
+    q_dot[1, 0] = casadi.if_else(t104, casadi.if_else(t101, t62, t96), 0)
+    q_dot[2, 0] = casadi.if_else(t104, casadi.if_else(t101, t63, t95), 0)
     status = casadi.SX(1, 1)
-    status[0, 0] = casadi.if_else(casadi.logic_not(casadi.logic_and(t99, t100)), 2, casadi.if_else(t103, 1, 0))
+    status[0, 0] = casadi.if_else(casadi.logic_not(casadi.logic_and(t98, t99)), 2, casadi.if_else(t103, 1, 0))
     return [q_dot, status]
 
 
@@ -700,7 +700,7 @@ def _ik_numeric_step(target, q, damping):
 
 
 def _ik_branches(mu):
-    """Every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits: 94 operations."""
+    """Every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits: 88 operations."""
     mu0 = mu[0]
     mu1 = mu[1]
     mu2 = mu[2]
@@ -713,7 +713,7 @@ def _ik_branches(mu):
     t6 = mu0 + mu1 + mu2
     t7 = t5**2
     t8 = 1 - t7
-    t9 = (1e-12 < t8)
+    t9 = (t8 > 1e-12)
     t10 = casadi.if_else(t9, t5, casadi.if_else((t5 > 0), 1, -1))
     t11 = casadi.if_else(t9, casadi.sqrt(t8), 0)
     t12 = casadi.atan2(t11, t10)
@@ -748,8 +748,8 @@ def _ik_branches(mu):
     q[1, 1] = t13 - 6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t13))
     q[1, 2] = -(t34 + t30 + 6.283185307179586*casadi.ceil(-0.15915494309189535*(t34 + t31)))
     valid = casadi.SX(2, 1)
-    valid[0, 0] = casadi.logic_and(t35, casadi.logic_or((t8 >= -1e-12), casadi.logic_and(False, (t7 <= 1e-12))))
-    valid[1, 0] = casadi.logic_and(t35, (t8 > 1e-12))
+    valid[0, 0] = casadi.logic_and(t35, (t8 >= -1e-12))
+    valid[1, 0] = casadi.logic_and(t9, t35)
     in_limits = casadi.SX(2, 1)
     in_limits[0, 0] = True
     in_limits[1, 0] = True
@@ -757,7 +757,7 @@ def _ik_branches(mu):
 
 
 def _ik_nearest(mu, q_seed, weights):
-    """The closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status: 97 operations."""
+    """The closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status: 96 operations."""
     branches_q, branches_valid, branches_in_limits = _ik_branches(mu)
     mu0 = mu[0]
     mu1 = mu[1]
@@ -799,7 +799,7 @@ def _ik_nearest(mu, q_seed, weights):
     t18 = casadi.if_else(t15, t2, qn3)
     t19 = casadi.if_else(t15, t13, 0)
     t20 = (t8 > 0)
-    t21 = casadi.if_else(casadi.logic_and(t20, casadi.logic_or((t19 > t14), (t4 < 1))), 1, 0)
+    t21 = casadi.if_else(casadi.logic_and(t20, casadi.logic_or((t4 < 1), (t14 < t19))), 1, 0)
     t22 = casadi.if_else(t20, 1, t4)
     t23 = (t21 > 0)
     t24 = casadi.if_else(t23, t5, t16)

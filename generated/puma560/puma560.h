@@ -91,19 +91,19 @@ puma560_real puma560_manipulability(const puma560_real q[PUMA560_DOF]);
 puma560_real puma560_jacobian_det(const puma560_real q[PUMA560_DOF]);
 
 /* Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status.
- * Result: q_dot[i], i < 6; returned as a scalar. 1220 operations. */
+ * Result: q_dot[i], i < 6; returned as a scalar. 1219 operations. */
 int puma560_velocity_ik(const puma560_real q[PUMA560_DOF], const puma560_real mu_dot[PUMA560_TASK_DIM], puma560_real damping, puma560_real q_dot[PUMA560_DOF]);
 
 /* One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite).
- * Result: q_start[i], i < 6; q_next[i], i < 6; returned as a scalar. 916 operations. */
+ * Result: q_start[i], i < 6; q_next[i], i < 6; returned as a scalar. 899 operations. */
 puma560_real puma560_ik_numeric_step(const puma560_real target[16], const puma560_real q[PUMA560_DOF], puma560_real damping, puma560_real q_start[PUMA560_DOF], puma560_real q_next[PUMA560_DOF]);
 
 /* Every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits.
- * Result: q: 8 x 6 row-major, element (r, c) at q[r * 6 + c]; valid[i], i < 8; in_limits[i], i < 8. 1354 operations. */
+ * Result: q: 8 x 6 row-major, element (r, c) at q[r * 6 + c]; valid[i], i < 8; in_limits[i], i < 8. 1344 operations. */
 void puma560_ik_branches(const puma560_real T[16], puma560_real q[PUMA560_MAX_IK_SOLUTIONS * PUMA560_DOF], int valid[PUMA560_MAX_IK_SOLUTIONS], int in_limits[PUMA560_MAX_IK_SOLUTIONS]);
 
 /* The closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status.
- * Result: q[i], i < 6; returned as a scalar. 1060 operations. */
+ * Result: q[i], i < 6; returned as a scalar. 963 operations. */
 int puma560_ik_nearest(const puma560_real T[16], const puma560_real q_seed[PUMA560_DOF], const puma560_real weights[PUMA560_DOF], puma560_real q[PUMA560_DOF]);
 
 /* Statuses of puma560_velocity_ik: OK, singular (a diagonal entry of the QR factor R of the

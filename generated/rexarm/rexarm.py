@@ -995,7 +995,7 @@ def jacobian_det(q):
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def velocity_ik(q, mu_dot, damping=0.0):
-    """joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: (4 x 1 and 1 x 1), 600 operations."""
+    """joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: (4 x 1 and 1 x 1), 599 operations."""
     xp, dtype, device, batch, (q, mu_dot, damping,) = _arguments(("q", q, (4,)), ("mu_dot", mu_dot, (4,)), ("damping", damping, ()))
     q1 = q[..., 0]
     q2 = q[..., 1]
@@ -1195,26 +1195,26 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t174 = xp.where(xp.not_equal(t157, 0), -(t164 - t161*t173)/t157, 0)
     t175 = xp.where(xp.not_equal(t141, 0), -(t153 + t145*t174 + t149*t173)/t141, 0)
     t176 = xp.where(xp.not_equal(t124, 0), -(t138 + t129*t175 + t132*t174 + t135*t173)/t124, 0)
-    t177 = xp.greater(damping, 0)
-    t178 = xp.isfinite(t166)
-    t179 = xp.greater_equal(damping, 0)
-    t180 = 1e-12*t122
+    t177 = xp.isfinite(t166)
+    t178 = xp.greater_equal(damping, 0)
+    t179 = 1e-12*t122
+    t180 = xp.greater(damping, 0)
     t181 = 1e-12*t93
-    t182 = (t177 & (xp.less_equal(t85, t181) | xp.less_equal(t107, t181) | xp.less_equal(t52, t181) | xp.less_equal(t67, t181))) | (xp.less_equal(damping, 0) & (xp.less_equal(t123, t180) | xp.less_equal(t140, t180) | xp.less_equal(t156, t180) | xp.less_equal(t168, t180)))
-    t183 = t178 & t179 & xp.logical_not(t182)
+    t182 = (t180 & (xp.less_equal(t85, t181) | xp.less_equal(t107, t181) | xp.less_equal(t52, t181) | xp.less_equal(t67, t181))) | (xp.less_equal(damping, 0) & (xp.less_equal(t123, t179) | xp.less_equal(t140, t179) | xp.less_equal(t156, t179) | xp.less_equal(t168, t179)))
+    t183 = t177 & t178 & xp.logical_not(t182)
     q_dot = _stack(xp, [
-        xp.broadcast_to(xp.where(t183, xp.where(t177, t116, t176), 0), batch),  # 0
-        xp.broadcast_to(xp.where(t183, xp.where(t177, t118, t175), 0), batch),  # 1
-        xp.broadcast_to(xp.where(t183, xp.where(t177, t119, t174), 0), batch),  # 2
-        xp.broadcast_to(xp.where(t183, xp.where(t177, t120, t173), 0), batch),  # 3
+        xp.broadcast_to(xp.where(t183, xp.where(t180, t116, t176), 0), batch),  # 0
+        xp.broadcast_to(xp.where(t183, xp.where(t180, t118, t175), 0), batch),  # 1
+        xp.broadcast_to(xp.where(t183, xp.where(t180, t119, t174), 0), batch),  # 2
+        xp.broadcast_to(xp.where(t183, xp.where(t180, t120, t173), 0), batch),  # 3
     ], (4,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t178 & t179), 2, xp.where(t182, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t177 & t178), 2, xp.where(t182, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
     return q_dot, status
 
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def ik_numeric_step(target, q, damping=0.0):
-    """one step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite): (4 x 1 and 4 x 1 and 1 x 1), 403 operations."""
+    """one step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite): (4 x 1 and 4 x 1 and 1 x 1), 395 operations."""
     xp, dtype, device, batch, (target, q, damping,) = _arguments(("target", target, (4,)), ("q", q, (4,)), ("damping", damping, ()))
     mu0 = target[..., 0]
     mu1 = target[..., 1]
@@ -1374,7 +1374,7 @@ def ik_numeric_step(target, q, damping=0.0):
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def ik_branches(mu):
-    """every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits: (8 x 4 and 8 x 1 and 8 x 1), 870 operations."""
+    """every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits: (8 x 4 and 8 x 1 and 8 x 1), 848 operations."""
     xp, dtype, device, batch, (mu,) = _arguments(("mu", mu, (4,)))
     mu0 = mu[..., 0]
     mu1 = mu[..., 1]
@@ -1385,7 +1385,7 @@ def ik_branches(mu):
     t2 = mu0 + mu1 + mu2 + mu3
     t3 = t0**2
     t4 = 1 - t3
-    t5 = xp.less(1e-12, t4)
+    t5 = xp.greater(t4, 1e-12)
     t6 = xp.where(t5, -t0, xp.where(xp.less(t0, 0), xp.asarray(1, dtype=dtype), -1))
     t7 = xp.where(t5, xp.sqrt(t4), 0)
     t8 = xp.atan2(t7, t6)
@@ -1432,19 +1432,19 @@ def ik_branches(mu):
     t49 = 0.5*(0.02 - t48)
     t50 = t49**2
     t51 = 1 - 10000*t50
-    t52 = 100*t49
-    t53 = xp.less(1e-12, t51)
-    t54 = xp.where(t53, t52, xp.where(xp.greater(t52, 0), xp.asarray(1, dtype=dtype), -1))
-    t55 = xp.where(t53, xp.sqrt(t51), 0)
-    t56 = xp.atan2(t55, t54)
+    t52 = xp.greater(t51, 1e-12)
+    t53 = xp.where(t52, xp.sqrt(t51), 0)
+    t54 = 100*t49
+    t55 = xp.where(t52, t54, xp.where(xp.greater(t54, 0), xp.asarray(1, dtype=dtype), -1))
+    t56 = xp.atan2(t53, t55)
     t57 = 3.141592653589793 + t56
     t58 = 3.141592653589793 - t56
     t59 = t57 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t57))
     t60 = t59 - 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t59))
     t61 = t58 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t58))
     t62 = t61 - 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t61))
-    t63 = -1.0*t54
-    t64 = -1.0*t55
+    t63 = -1.0*t55
+    t64 = -1.0*t53
     t65 = 0.22 + 0.1*t63
     t66 = -0.12 + t65
     t67 = t66**2 + 0.01*t64**2
@@ -1452,13 +1452,13 @@ def ik_branches(mu):
     t69 = t44*t66 - t40*t68
     t70 = t40*t66 + t44*t68
     t71 = t69**2 + t70**2
-    t72 = 0.22 - 0.1*t54
+    t72 = 0.22 - 0.1*t55
     t73 = -0.12 + t72
-    t74 = 0.1*t55
+    t74 = 0.1*t53
     t75 = t44*t73 - t40*t74
     t76 = t40*t73 + t44*t74
     t77 = t75**2 + t76**2
-    t78 = t73**2 + 0.01*t55**2
+    t78 = t73**2 + 0.01*t53**2
     t79 = -0.1*t7
     t80 = t35 + t79
     t81 = t37 + t79
@@ -1471,30 +1471,30 @@ def ik_branches(mu):
     t88 = -0.12 + t87
     t89 = t86**2
     t90 = 1 - 10000*t89
-    t91 = 100*t86
-    t92 = xp.less(1e-12, t90)
-    t93 = xp.where(t92, t91, xp.where(xp.greater(t91, 0), xp.asarray(1, dtype=dtype), -1))
-    t94 = xp.where(t92, xp.sqrt(t90), 0)
-    t95 = xp.atan2(t94, t93)
-    t96 = 3.141592653589793 + t95
-    t97 = -1.0*t93
-    t98 = -1.0*t94
-    t99 = 3.141592653589793 - t95
-    t100 = 0.22 + 0.1*t97
+    t91 = xp.greater(t90, 1e-12)
+    t92 = xp.where(t91, xp.sqrt(t90), 0)
+    t93 = -1.0*t92
+    t94 = 100*t86
+    t95 = xp.where(t91, t94, xp.where(xp.greater(t94, 0), xp.asarray(1, dtype=dtype), -1))
+    t96 = xp.atan2(t92, t95)
+    t97 = 3.141592653589793 + t96
+    t98 = -1.0*t95
+    t99 = 3.141592653589793 - t96
+    t100 = 0.22 + 0.1*t98
     t101 = -0.12 + t100
-    t102 = t101**2 + 0.01*t98**2
-    t103 = 0.22 - 0.1*t93
+    t102 = t101**2 + 0.01*t93**2
+    t103 = 0.22 - 0.1*t95
     t104 = -0.12 + t103
-    t105 = t104**2 + 0.01*t94**2
-    t106 = t96 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t96))
+    t105 = t104**2 + 0.01*t92**2
+    t106 = t97 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t97))
     t107 = t106 - 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t106))
     t108 = t99 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t99))
     t109 = t108 - 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t108))
-    t110 = 0.1*t98
+    t110 = 0.1*t93
     t111 = t84*t101 - t80*t110
     t112 = t80*t101 + t84*t110
     t113 = t111**2 + t112**2
-    t114 = 0.1*t94
+    t114 = 0.1*t92
     t115 = t84*t104 - t80*t114
     t116 = t80*t104 + t84*t114
     t117 = t115**2 + t116**2
@@ -1505,59 +1505,59 @@ def ik_branches(mu):
     t122 = 0.5*(0.02 - t121)
     t123 = t120**2
     t124 = 1 - 10000*t123
-    t125 = 100*t120
-    t126 = xp.less(1e-12, t124)
-    t127 = xp.where(t126, t125, xp.where(xp.greater(t125, 0), xp.asarray(1, dtype=dtype), -1))
-    t128 = xp.where(t126, xp.sqrt(t124), 0)
-    t129 = xp.atan2(t128, t127)
-    t130 = 3.141592653589793 + t129
-    t131 = -1.0*t127
-    t132 = -1.0*t128
-    t133 = 3.141592653589793 - t129
-    t134 = 0.22 + 0.1*t131
+    t125 = xp.greater(t124, 1e-12)
+    t126 = xp.where(t125, xp.sqrt(t124), 0)
+    t127 = -1.0*t126
+    t128 = 100*t120
+    t129 = xp.where(t125, t128, xp.where(xp.greater(t128, 0), xp.asarray(1, dtype=dtype), -1))
+    t130 = xp.atan2(t126, t129)
+    t131 = 3.141592653589793 + t130
+    t132 = -1.0*t129
+    t133 = 3.141592653589793 - t130
+    t134 = 0.22 + 0.1*t132
     t135 = -0.12 + t134
-    t136 = t135**2 + 0.01*t132**2
-    t137 = 0.22 - 0.1*t127
+    t136 = t135**2 + 0.01*t127**2
+    t137 = 0.22 - 0.1*t129
     t138 = -0.12 + t137
-    t139 = t138**2 + 0.01*t128**2
-    t140 = t130 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t130))
+    t139 = t138**2 + 0.01*t126**2
+    t140 = t131 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t131))
     t141 = t140 - 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t140))
     t142 = t133 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t133))
     t143 = t142 - 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t142))
-    t144 = 0.1*t132
+    t144 = 0.1*t127
     t145 = t46*t135 - t41*t144
     t146 = t41*t135 + t46*t144
     t147 = t145**2 + t146**2
-    t148 = 0.1*t128
+    t148 = 0.1*t126
     t149 = t46*t138 - t41*t148
     t150 = t41*t138 + t46*t148
     t151 = t149**2 + t150**2
     t152 = t122**2
     t153 = 1 - 10000*t152
-    t154 = 100*t122
-    t155 = xp.less(1e-12, t153)
-    t156 = xp.where(t155, t154, xp.where(xp.greater(t154, 0), xp.asarray(1, dtype=dtype), -1))
-    t157 = xp.where(t155, xp.sqrt(t153), 0)
-    t158 = xp.atan2(t157, t156)
-    t159 = 3.141592653589793 + t158
-    t160 = -1.0*t156
-    t161 = -1.0*t157
-    t162 = 3.141592653589793 - t158
-    t163 = 0.22 + 0.1*t160
+    t154 = xp.greater(t153, 1e-12)
+    t155 = xp.where(t154, xp.sqrt(t153), 0)
+    t156 = -1.0*t155
+    t157 = 100*t122
+    t158 = xp.where(t154, t157, xp.where(xp.greater(t157, 0), xp.asarray(1, dtype=dtype), -1))
+    t159 = xp.atan2(t155, t158)
+    t160 = 3.141592653589793 + t159
+    t161 = -1.0*t158
+    t162 = 3.141592653589793 - t159
+    t163 = 0.22 + 0.1*t161
     t164 = -0.12 + t163
-    t165 = t164**2 + 0.01*t161**2
-    t166 = 0.22 - 0.1*t156
+    t165 = t164**2 + 0.01*t156**2
+    t166 = 0.22 - 0.1*t158
     t167 = -0.12 + t166
-    t168 = t167**2 + 0.01*t157**2
-    t169 = t159 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t159))
+    t168 = t167**2 + 0.01*t155**2
+    t169 = t160 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t160))
     t170 = t169 - 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t169))
     t171 = t162 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t162))
     t172 = t171 - 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t171))
-    t173 = 0.1*t161
+    t173 = 0.1*t156
     t174 = t88*t164 - t81*t173
     t175 = t81*t164 + t88*t173
     t176 = t174**2 + t175**2
-    t177 = 0.1*t157
+    t177 = 0.1*t155
     t178 = t88*t167 - t81*t177
     t179 = t81*t167 + t88*t177
     t180 = t178**2 + t179**2
@@ -1583,7 +1583,7 @@ def ik_branches(mu):
     t200 = t199
     t201 = t200 - 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t200))
     t202 = 3.141592653589793 + t8
-    t203 = t96 + t199
+    t203 = t97 + t199
     t204 = t8 + t203 + 6.283185307179586*xp.ceil(-0.15915494309189535*(t202 + t203))
     t205 = -t204
     t206 = t204 + 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t205))
@@ -1598,7 +1598,7 @@ def ik_branches(mu):
     t215 = xp.where(xp.less_equal(t147, t136*t214), 0, xp.atan2(-t146, t145))
     t216 = t215
     t217 = t216 - 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t216))
-    t218 = t130 + t215
+    t218 = t131 + t215
     t219 = t185 + t218 + 6.283185307179586*xp.ceil(-0.15915494309189535*(t186 + t218))
     t220 = -t219
     t221 = t219 + 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t220))
@@ -1613,7 +1613,7 @@ def ik_branches(mu):
     t230 = xp.where(xp.less_equal(t176, t165*t229), 0, xp.atan2(-t175, t174))
     t231 = t230
     t232 = t231 - 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t231))
-    t233 = t159 + t230
+    t233 = t160 + t230
     t234 = t8 + t233 + 6.283185307179586*xp.ceil(-0.15915494309189535*(t202 + t233))
     t235 = -t234
     t236 = t234 + 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t235))
@@ -1632,112 +1632,127 @@ def ik_branches(mu):
     t249 = xp.less_equal(t60, 2.0943951023931953)
     t250 = xp.greater_equal(t59, -2.0943951023931953) & xp.less_equal(t59, 2.0943951023931953)
     t251 = -t190
-    t252 = xp.less_equal(t193, 2.0943951023931953)
-    t253 = xp.greater_equal(t192, -2.0943951023931953) & xp.less_equal(t192, 2.0943951023931953)
-    t254 = xp.less_equal(t62, 2.0943951023931953)
-    t255 = xp.greater_equal(t61, -2.0943951023931953) & xp.less_equal(t61, 2.0943951023931953)
-    t256 = -t197
-    t257 = xp.less_equal(t201, 2.0943951023931953)
-    t258 = xp.greater_equal(t200, -2.0943951023931953) & xp.less_equal(t200, 2.0943951023931953)
-    t259 = xp.less_equal(t107, 2.0943951023931953)
-    t260 = xp.greater_equal(t106, -2.0943951023931953) & xp.less_equal(t106, 2.0943951023931953)
-    t261 = -t206
-    t262 = xp.less_equal(t209, 2.0943951023931953)
-    t263 = xp.greater_equal(t208, -2.0943951023931953) & xp.less_equal(t208, 2.0943951023931953)
-    t264 = xp.less_equal(t109, 2.0943951023931953)
-    t265 = xp.greater_equal(t108, -2.0943951023931953) & xp.less_equal(t108, 2.0943951023931953)
-    t266 = -t213
-    t267 = xp.less_equal(t23, 3.141592653589793)
-    t268 = xp.greater_equal(t22, -3.141592653589793) & xp.less_equal(t22, 3.141592653589793)
-    t269 = xp.where(t267 & xp.logical_not(t268), t23, t22)
-    t270 = xp.less_equal(t217, 2.0943951023931953)
-    t271 = xp.greater_equal(t216, -2.0943951023931953) & xp.less_equal(t216, 2.0943951023931953)
-    t272 = xp.less_equal(t141, 2.0943951023931953)
-    t273 = xp.greater_equal(t140, -2.0943951023931953) & xp.less_equal(t140, 2.0943951023931953)
-    t274 = -t221
-    t275 = xp.less_equal(t224, 2.0943951023931953)
-    t276 = xp.greater_equal(t223, -2.0943951023931953) & xp.less_equal(t223, 2.0943951023931953)
-    t277 = xp.less_equal(t143, 2.0943951023931953)
-    t278 = xp.greater_equal(t142, -2.0943951023931953) & xp.less_equal(t142, 2.0943951023931953)
-    t279 = -t228
-    t280 = xp.less_equal(t232, 2.0943951023931953)
-    t281 = xp.greater_equal(t231, -2.0943951023931953) & xp.less_equal(t231, 2.0943951023931953)
-    t282 = xp.less_equal(t170, 2.0943951023931953)
-    t283 = xp.greater_equal(t169, -2.0943951023931953) & xp.less_equal(t169, 2.0943951023931953)
-    t284 = -t236
-    t285 = xp.less_equal(t239, 2.0943951023931953)
-    t286 = xp.greater_equal(t238, -2.0943951023931953) & xp.less_equal(t238, 2.0943951023931953)
-    t287 = xp.less_equal(t172, 2.0943951023931953)
-    t288 = xp.greater_equal(t171, -2.0943951023931953) & xp.less_equal(t171, 2.0943951023931953)
-    t289 = -t243
-    t290 = xp.isfinite(t2)
-    t291 = xp.less_equal(xp.abs(mu3), 1.5707963267948966)
-    t292 = xp.greater(t13, t15)
-    t293 = t292 | (t16 & xp.less_equal(0, 1e-12*t14))
-    t294 = xp.greater_equal(t4, -1e-12) | (False & xp.less_equal(t3, 1e-12))
-    t295 = xp.greater(t4, 1e-12)
-    t296 = t244 | t245
-    t297 = t267 | t268
+    t252 = xp.less_equal(t251, 2.0943951023931953)
+    t253 = xp.greater_equal(t189, -2.0943951023931953) & xp.less_equal(t189, 2.0943951023931953)
+    t254 = xp.less_equal(t193, 2.0943951023931953)
+    t255 = xp.greater_equal(t192, -2.0943951023931953) & xp.less_equal(t192, 2.0943951023931953)
+    t256 = xp.less_equal(t62, 2.0943951023931953)
+    t257 = xp.greater_equal(t61, -2.0943951023931953) & xp.less_equal(t61, 2.0943951023931953)
+    t258 = -t197
+    t259 = xp.less_equal(t258, 2.0943951023931953)
+    t260 = xp.greater_equal(t196, -2.0943951023931953) & xp.less_equal(t196, 2.0943951023931953)
+    t261 = xp.less_equal(t201, 2.0943951023931953)
+    t262 = xp.greater_equal(t200, -2.0943951023931953) & xp.less_equal(t200, 2.0943951023931953)
+    t263 = xp.less_equal(t107, 2.0943951023931953)
+    t264 = xp.greater_equal(t106, -2.0943951023931953) & xp.less_equal(t106, 2.0943951023931953)
+    t265 = -t206
+    t266 = xp.less_equal(t265, 2.0943951023931953)
+    t267 = xp.greater_equal(t205, -2.0943951023931953) & xp.less_equal(t205, 2.0943951023931953)
+    t268 = xp.less_equal(t209, 2.0943951023931953)
+    t269 = xp.greater_equal(t208, -2.0943951023931953) & xp.less_equal(t208, 2.0943951023931953)
+    t270 = xp.less_equal(t109, 2.0943951023931953)
+    t271 = xp.greater_equal(t108, -2.0943951023931953) & xp.less_equal(t108, 2.0943951023931953)
+    t272 = -t213
+    t273 = xp.less_equal(t272, 2.0943951023931953)
+    t274 = xp.greater_equal(t212, -2.0943951023931953) & xp.less_equal(t212, 2.0943951023931953)
+    t275 = xp.less_equal(t23, 3.141592653589793)
+    t276 = xp.greater_equal(t22, -3.141592653589793) & xp.less_equal(t22, 3.141592653589793)
+    t277 = xp.where(t275 & xp.logical_not(t276), t23, t22)
+    t278 = xp.less_equal(t217, 2.0943951023931953)
+    t279 = xp.greater_equal(t216, -2.0943951023931953) & xp.less_equal(t216, 2.0943951023931953)
+    t280 = xp.less_equal(t141, 2.0943951023931953)
+    t281 = xp.greater_equal(t140, -2.0943951023931953) & xp.less_equal(t140, 2.0943951023931953)
+    t282 = -t221
+    t283 = xp.less_equal(t282, 2.0943951023931953)
+    t284 = xp.greater_equal(t220, -2.0943951023931953) & xp.less_equal(t220, 2.0943951023931953)
+    t285 = xp.less_equal(t224, 2.0943951023931953)
+    t286 = xp.greater_equal(t223, -2.0943951023931953) & xp.less_equal(t223, 2.0943951023931953)
+    t287 = xp.less_equal(t143, 2.0943951023931953)
+    t288 = xp.greater_equal(t142, -2.0943951023931953) & xp.less_equal(t142, 2.0943951023931953)
+    t289 = -t228
+    t290 = xp.less_equal(t289, 2.0943951023931953)
+    t291 = xp.greater_equal(t227, -2.0943951023931953) & xp.less_equal(t227, 2.0943951023931953)
+    t292 = xp.less_equal(t232, 2.0943951023931953)
+    t293 = xp.greater_equal(t231, -2.0943951023931953) & xp.less_equal(t231, 2.0943951023931953)
+    t294 = xp.less_equal(t170, 2.0943951023931953)
+    t295 = xp.greater_equal(t169, -2.0943951023931953) & xp.less_equal(t169, 2.0943951023931953)
+    t296 = -t236
+    t297 = xp.less_equal(t296, 2.0943951023931953)
+    t298 = xp.greater_equal(t235, -2.0943951023931953) & xp.less_equal(t235, 2.0943951023931953)
+    t299 = xp.less_equal(t239, 2.0943951023931953)
+    t300 = xp.greater_equal(t238, -2.0943951023931953) & xp.less_equal(t238, 2.0943951023931953)
+    t301 = xp.less_equal(t172, 2.0943951023931953)
+    t302 = xp.greater_equal(t171, -2.0943951023931953) & xp.less_equal(t171, 2.0943951023931953)
+    t303 = -t243
+    t304 = xp.less_equal(t303, 2.0943951023931953)
+    t305 = xp.greater_equal(t242, -2.0943951023931953) & xp.less_equal(t242, 2.0943951023931953)
+    t306 = xp.isfinite(t2)
+    t307 = xp.less_equal(xp.abs(mu3), 1.5707963267948966)
+    t308 = xp.greater(t13, t15)
+    t309 = t308 | (t16 & xp.less_equal(0, 1e-12*t14))
+    t310 = xp.greater_equal(t4, -1e-12)
+    t311 = t244 | t245
+    t312 = t275 | t276
     q = _stack(xp, [
         t246,  # 0, 0
         xp.where(t247 & xp.logical_not(t248), t184, t183),  # 0, 1
         xp.where(t249 & xp.logical_not(t250), t60, t59),  # 0, 2
-        xp.where(xp.greater_equal(t190, -2.0943951023931953) & xp.logical_not(xp.greater_equal(t188, -2.0943951023931953) & xp.less_equal(t188, 2.0943951023931953)), t251, t189),  # 0, 3
+        xp.where(t252 & xp.logical_not(t253), t251, t189),  # 0, 3
         t246,  # 1, 0
-        xp.where(t252 & xp.logical_not(t253), t193, t192),  # 1, 1
-        xp.where(t254 & xp.logical_not(t255), t62, t61),  # 1, 2
-        xp.where(xp.greater_equal(t197, -2.0943951023931953) & xp.logical_not(xp.greater_equal(t195, -2.0943951023931953) & xp.less_equal(t195, 2.0943951023931953)), t256, t196),  # 1, 3
+        xp.where(t254 & xp.logical_not(t255), t193, t192),  # 1, 1
+        xp.where(t256 & xp.logical_not(t257), t62, t61),  # 1, 2
+        xp.where(t259 & xp.logical_not(t260), t258, t196),  # 1, 3
         t246,  # 2, 0
-        xp.where(t257 & xp.logical_not(t258), t201, t200),  # 2, 1
-        xp.where(t259 & xp.logical_not(t260), t107, t106),  # 2, 2
-        xp.where(xp.greater_equal(t206, -2.0943951023931953) & xp.logical_not(xp.greater_equal(t204, -2.0943951023931953) & xp.less_equal(t204, 2.0943951023931953)), t261, t205),  # 2, 3
+        xp.where(t261 & xp.logical_not(t262), t201, t200),  # 2, 1
+        xp.where(t263 & xp.logical_not(t264), t107, t106),  # 2, 2
+        xp.where(t266 & xp.logical_not(t267), t265, t205),  # 2, 3
         t246,  # 3, 0
-        xp.where(t262 & xp.logical_not(t263), t209, t208),  # 3, 1
-        xp.where(t264 & xp.logical_not(t265), t109, t108),  # 3, 2
-        xp.where(xp.greater_equal(t213, -2.0943951023931953) & xp.logical_not(xp.greater_equal(t211, -2.0943951023931953) & xp.less_equal(t211, 2.0943951023931953)), t266, t212),  # 3, 3
-        t269,  # 4, 0
-        xp.where(t270 & xp.logical_not(t271), t217, t216),  # 4, 1
-        xp.where(t272 & xp.logical_not(t273), t141, t140),  # 4, 2
-        xp.where(xp.greater_equal(t221, -2.0943951023931953) & xp.logical_not(xp.greater_equal(t219, -2.0943951023931953) & xp.less_equal(t219, 2.0943951023931953)), t274, t220),  # 4, 3
-        t269,  # 5, 0
-        xp.where(t275 & xp.logical_not(t276), t224, t223),  # 5, 1
-        xp.where(t277 & xp.logical_not(t278), t143, t142),  # 5, 2
-        xp.where(xp.greater_equal(t228, -2.0943951023931953) & xp.logical_not(xp.greater_equal(t226, -2.0943951023931953) & xp.less_equal(t226, 2.0943951023931953)), t279, t227),  # 5, 3
-        t269,  # 6, 0
-        xp.where(t280 & xp.logical_not(t281), t232, t231),  # 6, 1
-        xp.where(t282 & xp.logical_not(t283), t170, t169),  # 6, 2
-        xp.where(xp.greater_equal(t236, -2.0943951023931953) & xp.logical_not(xp.greater_equal(t234, -2.0943951023931953) & xp.less_equal(t234, 2.0943951023931953)), t284, t235),  # 6, 3
-        t269,  # 7, 0
-        xp.where(t285 & xp.logical_not(t286), t239, t238),  # 7, 1
-        xp.where(t287 & xp.logical_not(t288), t172, t171),  # 7, 2
-        xp.where(xp.greater_equal(t243, -2.0943951023931953) & xp.logical_not(xp.greater_equal(t241, -2.0943951023931953) & xp.less_equal(t241, 2.0943951023931953)), t289, t242),  # 7, 3
+        xp.where(t268 & xp.logical_not(t269), t209, t208),  # 3, 1
+        xp.where(t270 & xp.logical_not(t271), t109, t108),  # 3, 2
+        xp.where(t273 & xp.logical_not(t274), t272, t212),  # 3, 3
+        t277,  # 4, 0
+        xp.where(t278 & xp.logical_not(t279), t217, t216),  # 4, 1
+        xp.where(t280 & xp.logical_not(t281), t141, t140),  # 4, 2
+        xp.where(t283 & xp.logical_not(t284), t282, t220),  # 4, 3
+        t277,  # 5, 0
+        xp.where(t285 & xp.logical_not(t286), t224, t223),  # 5, 1
+        xp.where(t287 & xp.logical_not(t288), t143, t142),  # 5, 2
+        xp.where(t290 & xp.logical_not(t291), t289, t227),  # 5, 3
+        t277,  # 6, 0
+        xp.where(t292 & xp.logical_not(t293), t232, t231),  # 6, 1
+        xp.where(t294 & xp.logical_not(t295), t170, t169),  # 6, 2
+        xp.where(t297 & xp.logical_not(t298), t296, t235),  # 6, 3
+        t277,  # 7, 0
+        xp.where(t299 & xp.logical_not(t300), t239, t238),  # 7, 1
+        xp.where(t301 & xp.logical_not(t302), t172, t171),  # 7, 2
+        xp.where(t304 & xp.logical_not(t305), t303, t242),  # 7, 3
     ], (8, 4))
     valid = _stack(xp, [
-        t290 & t291 & t293 & t294 & xp.greater_equal(t51, -1e-12),  # 0
-        t290 & t291 & t293 & t294 & xp.greater(t51, 1e-12),  # 1
-        t290 & t291 & t293 & t295 & xp.greater_equal(t90, -1e-12),  # 2
-        t290 & t291 & t293 & t295 & xp.greater(t90, 1e-12),  # 3
-        t290 & t291 & t292 & t294 & xp.greater_equal(t124, -1e-12),  # 4
-        t290 & t291 & t292 & t294 & xp.greater(t124, 1e-12),  # 5
-        t290 & t291 & t292 & t295 & xp.greater_equal(t153, -1e-12),  # 6
-        t290 & t291 & t292 & t295 & xp.greater(t153, 1e-12),  # 7
+        t306 & t307 & t309 & t310 & xp.greater_equal(t51, -1e-12),  # 0
+        t306 & t307 & t309 & t310 & t52,  # 1
+        t5 & t306 & t307 & t309 & xp.greater_equal(t90, -1e-12),  # 2
+        t5 & t306 & t307 & t309 & t91,  # 3
+        t306 & t307 & t308 & t310 & xp.greater_equal(t124, -1e-12),  # 4
+        t306 & t307 & t308 & t310 & t125,  # 5
+        t5 & t306 & t307 & t308 & xp.greater_equal(t153, -1e-12),  # 6
+        t5 & t306 & t307 & t308 & t154,  # 7
     ], (8,))
     in_limits = _stack(xp, [
-        t296 & (t247 | t248) & (t249 | t250) & (xp.less_equal(t251, 2.0943951023931953) | (xp.greater_equal(t189, -2.0943951023931953) & xp.less_equal(t189, 2.0943951023931953))),  # 0
-        t296 & (t252 | t253) & (t254 | t255) & (xp.less_equal(t256, 2.0943951023931953) | (xp.greater_equal(t196, -2.0943951023931953) & xp.less_equal(t196, 2.0943951023931953))),  # 1
-        t296 & (t257 | t258) & (t259 | t260) & (xp.less_equal(t261, 2.0943951023931953) | (xp.greater_equal(t205, -2.0943951023931953) & xp.less_equal(t205, 2.0943951023931953))),  # 2
-        t296 & (t262 | t263) & (t264 | t265) & (xp.less_equal(t266, 2.0943951023931953) | (xp.greater_equal(t212, -2.0943951023931953) & xp.less_equal(t212, 2.0943951023931953))),  # 3
-        t297 & (t270 | t271) & (t272 | t273) & (xp.less_equal(t274, 2.0943951023931953) | (xp.greater_equal(t220, -2.0943951023931953) & xp.less_equal(t220, 2.0943951023931953))),  # 4
-        t297 & (t275 | t276) & (t277 | t278) & (xp.less_equal(t279, 2.0943951023931953) | (xp.greater_equal(t227, -2.0943951023931953) & xp.less_equal(t227, 2.0943951023931953))),  # 5
-        t297 & (t280 | t281) & (t282 | t283) & (xp.less_equal(t284, 2.0943951023931953) | (xp.greater_equal(t235, -2.0943951023931953) & xp.less_equal(t235, 2.0943951023931953))),  # 6
-        t297 & (t285 | t286) & (t287 | t288) & (xp.less_equal(t289, 2.0943951023931953) | (xp.greater_equal(t242, -2.0943951023931953) & xp.less_equal(t242, 2.0943951023931953))),  # 7
+        t311 & (t247 | t248) & (t249 | t250) & (t252 | t253),  # 0
+        t311 & (t254 | t255) & (t256 | t257) & (t259 | t260),  # 1
+        t311 & (t261 | t262) & (t263 | t264) & (t266 | t267),  # 2
+        t311 & (t268 | t269) & (t270 | t271) & (t273 | t274),  # 3
+        t312 & (t278 | t279) & (t280 | t281) & (t283 | t284),  # 4
+        t312 & (t285 | t286) & (t287 | t288) & (t290 | t291),  # 5
+        t312 & (t292 | t293) & (t294 | t295) & (t297 | t298),  # 6
+        t312 & (t299 | t300) & (t301 | t302) & (t304 | t305),  # 7
     ], (8,))
     return q, valid, in_limits
 
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def ik_nearest(mu, q_seed, weights=(1.0,) * DOF):
-    """the closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status: (4 x 1 and 1 x 1), 724 operations."""
+    """the closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status: (4 x 1 and 1 x 1), 659 operations."""
     xp, dtype, device, batch, (mu, q_seed, weights,) = _arguments(("mu", mu, (4,)), ("q_seed", q_seed, (4,)), ("weights", weights, (4,)))
     branches_q, branches_valid, branches_in_limits = ik_branches(mu)
     mu0 = mu[..., 0]
@@ -1887,7 +1902,7 @@ def ik_nearest(mu, q_seed, weights=(1.0,) * DOF):
     t84 = xp.where(xp.greater_equal(t9, -2.0943951023931953) & xp.less_equal(t9, 2.0943951023931953), t9, xp.where(xp.greater_equal(t82, -2.0943951023931953) & xp.less_equal(t82, 2.0943951023931953), t82, xp.where(xp.greater_equal(t83, -2.0943951023931953) & xp.less_equal(t83, 2.0943951023931953), t83, qb1_3)))
     t85 = qw1*(t72 + t58)**2 + qw2*(t76 + t59)**2 + qw3*(t80 + t60)**2 + qw4*(t84 + t61)**2
     t86 = xp.greater(t10, 0)
-    t87 = xp.where(t86 & (xp.greater(t68, t85) | xp.less(t5, 1)), xp.asarray(1, dtype=dtype), 0)
+    t87 = xp.where(t86 & (xp.less(t5, 1) | xp.less(t85, t68)), xp.asarray(1, dtype=dtype), 0)
     t88 = xp.where(t86, 1, t5)
     t89 = xp.greater(t87, 0)
     t90 = xp.where(t89, t72, t64)
@@ -1913,7 +1928,7 @@ def ik_nearest(mu, q_seed, weights=(1.0,) * DOF):
     t110 = xp.where(xp.greater_equal(t14, -2.0943951023931953) & xp.less_equal(t14, 2.0943951023931953), t14, xp.where(xp.greater_equal(t108, -2.0943951023931953) & xp.less_equal(t108, 2.0943951023931953), t108, xp.where(xp.greater_equal(t109, -2.0943951023931953) & xp.less_equal(t109, 2.0943951023931953), t109, qb2_3)))
     t111 = qw1*(t98 + t58)**2 + qw2*(t102 + t59)**2 + qw3*(t106 + t60)**2 + qw4*(t110 + t61)**2
     t112 = xp.greater(t15, 0)
-    t113 = xp.where(t112 & (xp.greater(t94, t111) | xp.less(t88, 1)), xp.asarray(1, dtype=dtype), 0)
+    t113 = xp.where(t112 & (xp.less(t88, 1) | xp.less(t111, t94)), xp.asarray(1, dtype=dtype), 0)
     t114 = xp.where(t112, 1, t88)
     t115 = xp.greater(t113, 0)
     t116 = xp.where(t115, t98, t90)
@@ -1939,7 +1954,7 @@ def ik_nearest(mu, q_seed, weights=(1.0,) * DOF):
     t136 = xp.where(xp.greater_equal(t19, -2.0943951023931953) & xp.less_equal(t19, 2.0943951023931953), t19, xp.where(xp.greater_equal(t134, -2.0943951023931953) & xp.less_equal(t134, 2.0943951023931953), t134, xp.where(xp.greater_equal(t135, -2.0943951023931953) & xp.less_equal(t135, 2.0943951023931953), t135, qb3_3)))
     t137 = qw1*(t124 + t58)**2 + qw2*(t128 + t59)**2 + qw3*(t132 + t60)**2 + qw4*(t136 + t61)**2
     t138 = xp.greater(t20, 0)
-    t139 = xp.where(t138 & (xp.greater(t120, t137) | xp.less(t114, 1)), xp.asarray(1, dtype=dtype), 0)
+    t139 = xp.where(t138 & (xp.less(t114, 1) | xp.less(t137, t120)), xp.asarray(1, dtype=dtype), 0)
     t140 = xp.where(t138, 1, t114)
     t141 = xp.greater(t139, 0)
     t142 = xp.where(t141, t124, t116)
@@ -1965,7 +1980,7 @@ def ik_nearest(mu, q_seed, weights=(1.0,) * DOF):
     t162 = xp.where(xp.greater_equal(t24, -2.0943951023931953) & xp.less_equal(t24, 2.0943951023931953), t24, xp.where(xp.greater_equal(t160, -2.0943951023931953) & xp.less_equal(t160, 2.0943951023931953), t160, xp.where(xp.greater_equal(t161, -2.0943951023931953) & xp.less_equal(t161, 2.0943951023931953), t161, qb4_3)))
     t163 = qw1*(t150 + t58)**2 + qw2*(t154 + t59)**2 + qw3*(t158 + t60)**2 + qw4*(t162 + t61)**2
     t164 = xp.greater(t25, 0)
-    t165 = xp.where(t164 & (xp.greater(t146, t163) | xp.less(t140, 1)), xp.asarray(1, dtype=dtype), 0)
+    t165 = xp.where(t164 & (xp.less(t140, 1) | xp.less(t163, t146)), xp.asarray(1, dtype=dtype), 0)
     t166 = xp.where(t164, 1, t140)
     t167 = xp.greater(t165, 0)
     t168 = xp.where(t167, t150, t142)
@@ -1991,7 +2006,7 @@ def ik_nearest(mu, q_seed, weights=(1.0,) * DOF):
     t188 = xp.where(xp.greater_equal(t29, -2.0943951023931953) & xp.less_equal(t29, 2.0943951023931953), t29, xp.where(xp.greater_equal(t186, -2.0943951023931953) & xp.less_equal(t186, 2.0943951023931953), t186, xp.where(xp.greater_equal(t187, -2.0943951023931953) & xp.less_equal(t187, 2.0943951023931953), t187, qb5_3)))
     t189 = qw1*(t176 + t58)**2 + qw2*(t180 + t59)**2 + qw3*(t184 + t60)**2 + qw4*(t188 + t61)**2
     t190 = xp.greater(t30, 0)
-    t191 = xp.where(t190 & (xp.greater(t172, t189) | xp.less(t166, 1)), xp.asarray(1, dtype=dtype), 0)
+    t191 = xp.where(t190 & (xp.less(t166, 1) | xp.less(t189, t172)), xp.asarray(1, dtype=dtype), 0)
     t192 = xp.where(t190, 1, t166)
     t193 = xp.greater(t191, 0)
     t194 = xp.where(t193, t176, t168)
@@ -2017,7 +2032,7 @@ def ik_nearest(mu, q_seed, weights=(1.0,) * DOF):
     t214 = xp.where(xp.greater_equal(t34, -2.0943951023931953) & xp.less_equal(t34, 2.0943951023931953), t34, xp.where(xp.greater_equal(t212, -2.0943951023931953) & xp.less_equal(t212, 2.0943951023931953), t212, xp.where(xp.greater_equal(t213, -2.0943951023931953) & xp.less_equal(t213, 2.0943951023931953), t213, qb6_3)))
     t215 = qw1*(t202 + t58)**2 + qw2*(t206 + t59)**2 + qw3*(t210 + t60)**2 + qw4*(t214 + t61)**2
     t216 = xp.greater(t35, 0)
-    t217 = xp.where(t216 & (xp.greater(t198, t215) | xp.less(t192, 1)), xp.asarray(1, dtype=dtype), 0)
+    t217 = xp.where(t216 & (xp.less(t192, 1) | xp.less(t215, t198)), xp.asarray(1, dtype=dtype), 0)
     t218 = xp.where(t216, 1, t192)
     t219 = xp.greater(t217, 0)
     t220 = xp.where(t219, t202, t194)
@@ -2043,7 +2058,7 @@ def ik_nearest(mu, q_seed, weights=(1.0,) * DOF):
     t240 = xp.where(xp.greater_equal(t39, -2.0943951023931953) & xp.less_equal(t39, 2.0943951023931953), t39, xp.where(xp.greater_equal(t238, -2.0943951023931953) & xp.less_equal(t238, 2.0943951023931953), t238, xp.where(xp.greater_equal(t239, -2.0943951023931953) & xp.less_equal(t239, 2.0943951023931953), t239, qb7_3)))
     t241 = qw1*(t228 + t58)**2 + qw2*(t232 + t59)**2 + qw3*(t236 + t60)**2 + qw4*(t240 + t61)**2
     t242 = xp.greater(t40, 0)
-    t243 = xp.where(t242 & (xp.greater(t224, t241) | xp.less(t218, 1)), xp.asarray(1, dtype=dtype), 0)
+    t243 = xp.where(t242 & (xp.less(t218, 1) | xp.less(t241, t224)), xp.asarray(1, dtype=dtype), 0)
     t244 = xp.where(t242, 1, t218)
     t245 = xp.greater(t243, 0)
     t246 = xp.where(t245, t228, t220)

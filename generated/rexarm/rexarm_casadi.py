@@ -842,7 +842,7 @@ def _jacobian_det(q):
 
 
 def _velocity_ik(q, mu_dot, damping):
-    """Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: 600 operations."""
+    """Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: 599 operations."""
     q1 = q[0]
     q2 = q[1]
     q3 = q[2]
@@ -1040,25 +1040,25 @@ def _velocity_ik(q, mu_dot, damping):
     t174 = casadi.if_else((t157 != 0), -(t164 - t161*t173)/t157, 0)
     t175 = casadi.if_else((t141 != 0), -(t153 + t145*t174 + t149*t173)/t141, 0)
     t176 = casadi.if_else((t124 != 0), -(t138 + t129*t175 + t132*t174 + t135*t173)/t124, 0)
-    t177 = (damping > 0)
-    t178 = (casadi.fabs(t166) < casadi.inf)
-    t179 = (damping >= 0)
-    t180 = 1e-12*t122
+    t177 = (casadi.fabs(t166) < casadi.inf)
+    t178 = (damping >= 0)
+    t179 = 1e-12*t122
+    t180 = (damping > 0)
     t181 = 1e-12*t93
-    t182 = casadi.logic_or(casadi.logic_and(t177, casadi.logic_or(casadi.logic_or(casadi.logic_or((t85 <= t181), (t107 <= t181)), (t52 <= t181)), (t67 <= t181))), casadi.logic_and((damping <= 0), casadi.logic_or(casadi.logic_or(casadi.logic_or((t123 <= t180), (t140 <= t180)), (t156 <= t180)), (t168 <= t180))))
-    t183 = casadi.logic_and(casadi.logic_and(t178, t179), casadi.logic_not(t182))
+    t182 = casadi.logic_or(casadi.logic_and(t180, casadi.logic_or(casadi.logic_or(casadi.logic_or((t85 <= t181), (t107 <= t181)), (t52 <= t181)), (t67 <= t181))), casadi.logic_and((damping <= 0), casadi.logic_or(casadi.logic_or(casadi.logic_or((t123 <= t179), (t140 <= t179)), (t156 <= t179)), (t168 <= t179))))
+    t183 = casadi.logic_and(casadi.logic_and(t177, t178), casadi.logic_not(t182))
     q_dot = casadi.SX(4, 1)
-    q_dot[0, 0] = casadi.if_else(t183, casadi.if_else(t177, t116, t176), 0)
-    q_dot[1, 0] = casadi.if_else(t183, casadi.if_else(t177, t118, t175), 0)
-    q_dot[2, 0] = casadi.if_else(t183, casadi.if_else(t177, t119, t174), 0)
-    q_dot[3, 0] = casadi.if_else(t183, casadi.if_else(t177, t120, t173), 0)
+    q_dot[0, 0] = casadi.if_else(t183, casadi.if_else(t180, t116, t176), 0)
+    q_dot[1, 0] = casadi.if_else(t183, casadi.if_else(t180, t118, t175), 0)
+    q_dot[2, 0] = casadi.if_else(t183, casadi.if_else(t180, t119, t174), 0)
+    q_dot[3, 0] = casadi.if_else(t183, casadi.if_else(t180, t120, t173), 0)
     status = casadi.SX(1, 1)
-    status[0, 0] = casadi.if_else(casadi.logic_not(casadi.logic_and(t178, t179)), 2, casadi.if_else(t182, 1, 0))
+    status[0, 0] = casadi.if_else(casadi.logic_not(casadi.logic_and(t177, t178)), 2, casadi.if_else(t182, 1, 0))
     return [q_dot, status]
 
 
 def _ik_numeric_step(target, q, damping):
-    """One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite): 403 operations."""
+    """One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite): 395 operations."""
     mu0 = target[0]
     mu1 = target[1]
     mu2 = target[2]
@@ -1215,7 +1215,7 @@ def _ik_numeric_step(target, q, damping):
 
 
 def _ik_branches(mu):
-    """Every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits: 870 operations."""
+    """Every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits: 848 operations."""
     mu0 = mu[0]
     mu1 = mu[1]
     mu2 = mu[2]
@@ -1225,7 +1225,7 @@ def _ik_branches(mu):
     t2 = mu0 + mu1 + mu2 + mu3
     t3 = t0**2
     t4 = 1 - t3
-    t5 = (1e-12 < t4)
+    t5 = (t4 > 1e-12)
     t6 = casadi.if_else(t5, -t0, casadi.if_else((t0 < 0), 1, -1))
     t7 = casadi.if_else(t5, casadi.sqrt(t4), 0)
     t8 = casadi.atan2(t7, t6)
@@ -1272,19 +1272,19 @@ def _ik_branches(mu):
     t49 = 0.5*(0.02 - t48)
     t50 = t49**2
     t51 = 1 - 10000*t50
-    t52 = 100*t49
-    t53 = (1e-12 < t51)
-    t54 = casadi.if_else(t53, t52, casadi.if_else((t52 > 0), 1, -1))
-    t55 = casadi.if_else(t53, casadi.sqrt(t51), 0)
-    t56 = casadi.atan2(t55, t54)
+    t52 = (t51 > 1e-12)
+    t53 = casadi.if_else(t52, casadi.sqrt(t51), 0)
+    t54 = 100*t49
+    t55 = casadi.if_else(t52, t54, casadi.if_else((t54 > 0), 1, -1))
+    t56 = casadi.atan2(t53, t55)
     t57 = 3.141592653589793 + t56
     t58 = 3.141592653589793 - t56
     t59 = t57 - 6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t57))
     t60 = t59 - 6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t59))
     t61 = t58 - 6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t58))
     t62 = t61 - 6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t61))
-    t63 = -1.0*t54
-    t64 = -1.0*t55
+    t63 = -1.0*t55
+    t64 = -1.0*t53
     t65 = 0.22 + 0.1*t63
     t66 = -0.12 + t65
     t67 = t66**2 + 0.01*t64**2
@@ -1292,13 +1292,13 @@ def _ik_branches(mu):
     t69 = t44*t66 - t40*t68
     t70 = t40*t66 + t44*t68
     t71 = t69**2 + t70**2
-    t72 = 0.22 - 0.1*t54
+    t72 = 0.22 - 0.1*t55
     t73 = -0.12 + t72
-    t74 = 0.1*t55
+    t74 = 0.1*t53
     t75 = t44*t73 - t40*t74
     t76 = t40*t73 + t44*t74
     t77 = t75**2 + t76**2
-    t78 = t73**2 + 0.01*t55**2
+    t78 = t73**2 + 0.01*t53**2
     t79 = -0.1*t7
     t80 = t35 + t79
     t81 = t37 + t79
@@ -1311,30 +1311,30 @@ def _ik_branches(mu):
     t88 = -0.12 + t87
     t89 = t86**2
     t90 = 1 - 10000*t89
-    t91 = 100*t86
-    t92 = (1e-12 < t90)
-    t93 = casadi.if_else(t92, t91, casadi.if_else((t91 > 0), 1, -1))
-    t94 = casadi.if_else(t92, casadi.sqrt(t90), 0)
-    t95 = casadi.atan2(t94, t93)
-    t96 = 3.141592653589793 + t95
-    t97 = -1.0*t93
-    t98 = -1.0*t94
-    t99 = 3.141592653589793 - t95
-    t100 = 0.22 + 0.1*t97
+    t91 = (t90 > 1e-12)
+    t92 = casadi.if_else(t91, casadi.sqrt(t90), 0)
+    t93 = -1.0*t92
+    t94 = 100*t86
+    t95 = casadi.if_else(t91, t94, casadi.if_else((t94 > 0), 1, -1))
+    t96 = casadi.atan2(t92, t95)
+    t97 = 3.141592653589793 + t96
+    t98 = -1.0*t95
+    t99 = 3.141592653589793 - t96
+    t100 = 0.22 + 0.1*t98
     t101 = -0.12 + t100
-    t102 = t101**2 + 0.01*t98**2
-    t103 = 0.22 - 0.1*t93
+    t102 = t101**2 + 0.01*t93**2
+    t103 = 0.22 - 0.1*t95
     t104 = -0.12 + t103
-    t105 = t104**2 + 0.01*t94**2
-    t106 = t96 - 6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t96))
+    t105 = t104**2 + 0.01*t92**2
+    t106 = t97 - 6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t97))
     t107 = t106 - 6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t106))
     t108 = t99 - 6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t99))
     t109 = t108 - 6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t108))
-    t110 = 0.1*t98
+    t110 = 0.1*t93
     t111 = t84*t101 - t80*t110
     t112 = t80*t101 + t84*t110
     t113 = t111**2 + t112**2
-    t114 = 0.1*t94
+    t114 = 0.1*t92
     t115 = t84*t104 - t80*t114
     t116 = t80*t104 + t84*t114
     t117 = t115**2 + t116**2
@@ -1345,59 +1345,59 @@ def _ik_branches(mu):
     t122 = 0.5*(0.02 - t121)
     t123 = t120**2
     t124 = 1 - 10000*t123
-    t125 = 100*t120
-    t126 = (1e-12 < t124)
-    t127 = casadi.if_else(t126, t125, casadi.if_else((t125 > 0), 1, -1))
-    t128 = casadi.if_else(t126, casadi.sqrt(t124), 0)
-    t129 = casadi.atan2(t128, t127)
-    t130 = 3.141592653589793 + t129
-    t131 = -1.0*t127
-    t132 = -1.0*t128
-    t133 = 3.141592653589793 - t129
-    t134 = 0.22 + 0.1*t131
+    t125 = (t124 > 1e-12)
+    t126 = casadi.if_else(t125, casadi.sqrt(t124), 0)
+    t127 = -1.0*t126
+    t128 = 100*t120
+    t129 = casadi.if_else(t125, t128, casadi.if_else((t128 > 0), 1, -1))
+    t130 = casadi.atan2(t126, t129)
+    t131 = 3.141592653589793 + t130
+    t132 = -1.0*t129
+    t133 = 3.141592653589793 - t130
+    t134 = 0.22 + 0.1*t132
     t135 = -0.12 + t134
-    t136 = t135**2 + 0.01*t132**2
-    t137 = 0.22 - 0.1*t127
+    t136 = t135**2 + 0.01*t127**2
+    t137 = 0.22 - 0.1*t129
     t138 = -0.12 + t137
-    t139 = t138**2 + 0.01*t128**2
-    t140 = t130 - 6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t130))
+    t139 = t138**2 + 0.01*t126**2
+    t140 = t131 - 6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t131))
     t141 = t140 - 6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t140))
     t142 = t133 - 6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t133))
     t143 = t142 - 6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t142))
-    t144 = 0.1*t132
+    t144 = 0.1*t127
     t145 = t46*t135 - t41*t144
     t146 = t41*t135 + t46*t144
     t147 = t145**2 + t146**2
-    t148 = 0.1*t128
+    t148 = 0.1*t126
     t149 = t46*t138 - t41*t148
     t150 = t41*t138 + t46*t148
     t151 = t149**2 + t150**2
     t152 = t122**2
     t153 = 1 - 10000*t152
-    t154 = 100*t122
-    t155 = (1e-12 < t153)
-    t156 = casadi.if_else(t155, t154, casadi.if_else((t154 > 0), 1, -1))
-    t157 = casadi.if_else(t155, casadi.sqrt(t153), 0)
-    t158 = casadi.atan2(t157, t156)
-    t159 = 3.141592653589793 + t158
-    t160 = -1.0*t156
-    t161 = -1.0*t157
-    t162 = 3.141592653589793 - t158
-    t163 = 0.22 + 0.1*t160
+    t154 = (t153 > 1e-12)
+    t155 = casadi.if_else(t154, casadi.sqrt(t153), 0)
+    t156 = -1.0*t155
+    t157 = 100*t122
+    t158 = casadi.if_else(t154, t157, casadi.if_else((t157 > 0), 1, -1))
+    t159 = casadi.atan2(t155, t158)
+    t160 = 3.141592653589793 + t159
+    t161 = -1.0*t158
+    t162 = 3.141592653589793 - t159
+    t163 = 0.22 + 0.1*t161
     t164 = -0.12 + t163
-    t165 = t164**2 + 0.01*t161**2
-    t166 = 0.22 - 0.1*t156
+    t165 = t164**2 + 0.01*t156**2
+    t166 = 0.22 - 0.1*t158
     t167 = -0.12 + t166
-    t168 = t167**2 + 0.01*t157**2
-    t169 = t159 - 6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t159))
+    t168 = t167**2 + 0.01*t155**2
+    t169 = t160 - 6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t160))
     t170 = t169 - 6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t169))
     t171 = t162 - 6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t162))
     t172 = t171 - 6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t171))
-    t173 = 0.1*t161
+    t173 = 0.1*t156
     t174 = t88*t164 - t81*t173
     t175 = t81*t164 + t88*t173
     t176 = t174**2 + t175**2
-    t177 = 0.1*t157
+    t177 = 0.1*t155
     t178 = t88*t167 - t81*t177
     t179 = t81*t167 + t88*t177
     t180 = t178**2 + t179**2
@@ -1423,7 +1423,7 @@ def _ik_branches(mu):
     t200 = t199
     t201 = t200 - 6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t200))
     t202 = 3.141592653589793 + t8
-    t203 = t96 + t199
+    t203 = t97 + t199
     t204 = t8 + t203 + 6.283185307179586*casadi.ceil(-0.15915494309189535*(t202 + t203))
     t205 = -t204
     t206 = t204 + 6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t205))
@@ -1438,7 +1438,7 @@ def _ik_branches(mu):
     t215 = casadi.if_else((t147 <= t136*t214), 0, casadi.atan2(-t146, t145))
     t216 = t215
     t217 = t216 - 6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t216))
-    t218 = t130 + t215
+    t218 = t131 + t215
     t219 = t185 + t218 + 6.283185307179586*casadi.ceil(-0.15915494309189535*(t186 + t218))
     t220 = -t219
     t221 = t219 + 6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t220))
@@ -1453,7 +1453,7 @@ def _ik_branches(mu):
     t230 = casadi.if_else((t176 <= t165*t229), 0, casadi.atan2(-t175, t174))
     t231 = t230
     t232 = t231 - 6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t231))
-    t233 = t159 + t230
+    t233 = t160 + t230
     t234 = t8 + t233 + 6.283185307179586*casadi.ceil(-0.15915494309189535*(t202 + t233))
     t235 = -t234
     t236 = t234 + 6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t235))
@@ -1472,108 +1472,123 @@ def _ik_branches(mu):
     t249 = (t60 <= 2.0943951023931953)
     t250 = casadi.logic_and((t59 >= -2.0943951023931953), (t59 <= 2.0943951023931953))
     t251 = -t190
-    t252 = (t193 <= 2.0943951023931953)
-    t253 = casadi.logic_and((t192 >= -2.0943951023931953), (t192 <= 2.0943951023931953))
-    t254 = (t62 <= 2.0943951023931953)
-    t255 = casadi.logic_and((t61 >= -2.0943951023931953), (t61 <= 2.0943951023931953))
-    t256 = -t197
-    t257 = (t201 <= 2.0943951023931953)
-    t258 = casadi.logic_and((t200 >= -2.0943951023931953), (t200 <= 2.0943951023931953))
-    t259 = (t107 <= 2.0943951023931953)
-    t260 = casadi.logic_and((t106 >= -2.0943951023931953), (t106 <= 2.0943951023931953))
-    t261 = -t206
-    t262 = (t209 <= 2.0943951023931953)
-    t263 = casadi.logic_and((t208 >= -2.0943951023931953), (t208 <= 2.0943951023931953))
-    t264 = (t109 <= 2.0943951023931953)
-    t265 = casadi.logic_and((t108 >= -2.0943951023931953), (t108 <= 2.0943951023931953))
-    t266 = -t213
-    t267 = (t23 <= 3.141592653589793)
-    t268 = casadi.logic_and((t22 >= -3.141592653589793), (t22 <= 3.141592653589793))
-    t269 = casadi.if_else(casadi.logic_and(t267, casadi.logic_not(t268)), t23, t22)
-    t270 = (t217 <= 2.0943951023931953)
-    t271 = casadi.logic_and((t216 >= -2.0943951023931953), (t216 <= 2.0943951023931953))
-    t272 = (t141 <= 2.0943951023931953)
-    t273 = casadi.logic_and((t140 >= -2.0943951023931953), (t140 <= 2.0943951023931953))
-    t274 = -t221
-    t275 = (t224 <= 2.0943951023931953)
-    t276 = casadi.logic_and((t223 >= -2.0943951023931953), (t223 <= 2.0943951023931953))
-    t277 = (t143 <= 2.0943951023931953)
-    t278 = casadi.logic_and((t142 >= -2.0943951023931953), (t142 <= 2.0943951023931953))
-    t279 = -t228
-    t280 = (t232 <= 2.0943951023931953)
-    t281 = casadi.logic_and((t231 >= -2.0943951023931953), (t231 <= 2.0943951023931953))
-    t282 = (t170 <= 2.0943951023931953)
-    t283 = casadi.logic_and((t169 >= -2.0943951023931953), (t169 <= 2.0943951023931953))
-    t284 = -t236
-    t285 = (t239 <= 2.0943951023931953)
-    t286 = casadi.logic_and((t238 >= -2.0943951023931953), (t238 <= 2.0943951023931953))
-    t287 = (t172 <= 2.0943951023931953)
-    t288 = casadi.logic_and((t171 >= -2.0943951023931953), (t171 <= 2.0943951023931953))
-    t289 = -t243
-    t290 = (casadi.fabs(t2) < casadi.inf)
-    t291 = (casadi.fabs(mu3) <= 1.5707963267948966)
-    t292 = (t13 > t15)
-    t293 = casadi.logic_or(t292, casadi.logic_and(t16, (0 <= 1e-12*t14)))
-    t294 = casadi.logic_or((t4 >= -1e-12), casadi.logic_and(False, (t3 <= 1e-12)))
-    t295 = (t4 > 1e-12)
-    t296 = casadi.logic_or(t244, t245)
-    t297 = casadi.logic_or(t267, t268)
+    t252 = (t251 <= 2.0943951023931953)
+    t253 = casadi.logic_and((t189 >= -2.0943951023931953), (t189 <= 2.0943951023931953))
+    t254 = (t193 <= 2.0943951023931953)
+    t255 = casadi.logic_and((t192 >= -2.0943951023931953), (t192 <= 2.0943951023931953))
+    t256 = (t62 <= 2.0943951023931953)
+    t257 = casadi.logic_and((t61 >= -2.0943951023931953), (t61 <= 2.0943951023931953))
+    t258 = -t197
+    t259 = (t258 <= 2.0943951023931953)
+    t260 = casadi.logic_and((t196 >= -2.0943951023931953), (t196 <= 2.0943951023931953))
+    t261 = (t201 <= 2.0943951023931953)
+    t262 = casadi.logic_and((t200 >= -2.0943951023931953), (t200 <= 2.0943951023931953))
+    t263 = (t107 <= 2.0943951023931953)
+    t264 = casadi.logic_and((t106 >= -2.0943951023931953), (t106 <= 2.0943951023931953))
+    t265 = -t206
+    t266 = (t265 <= 2.0943951023931953)
+    t267 = casadi.logic_and((t205 >= -2.0943951023931953), (t205 <= 2.0943951023931953))
+    t268 = (t209 <= 2.0943951023931953)
+    t269 = casadi.logic_and((t208 >= -2.0943951023931953), (t208 <= 2.0943951023931953))
+    t270 = (t109 <= 2.0943951023931953)
+    t271 = casadi.logic_and((t108 >= -2.0943951023931953), (t108 <= 2.0943951023931953))
+    t272 = -t213
+    t273 = (t272 <= 2.0943951023931953)
+    t274 = casadi.logic_and((t212 >= -2.0943951023931953), (t212 <= 2.0943951023931953))
+    t275 = (t23 <= 3.141592653589793)
+    t276 = casadi.logic_and((t22 >= -3.141592653589793), (t22 <= 3.141592653589793))
+    t277 = casadi.if_else(casadi.logic_and(t275, casadi.logic_not(t276)), t23, t22)
+    t278 = (t217 <= 2.0943951023931953)
+    t279 = casadi.logic_and((t216 >= -2.0943951023931953), (t216 <= 2.0943951023931953))
+    t280 = (t141 <= 2.0943951023931953)
+    t281 = casadi.logic_and((t140 >= -2.0943951023931953), (t140 <= 2.0943951023931953))
+    t282 = -t221
+    t283 = (t282 <= 2.0943951023931953)
+    t284 = casadi.logic_and((t220 >= -2.0943951023931953), (t220 <= 2.0943951023931953))
+    t285 = (t224 <= 2.0943951023931953)
+    t286 = casadi.logic_and((t223 >= -2.0943951023931953), (t223 <= 2.0943951023931953))
+    t287 = (t143 <= 2.0943951023931953)
+    t288 = casadi.logic_and((t142 >= -2.0943951023931953), (t142 <= 2.0943951023931953))
+    t289 = -t228
+    t290 = (t289 <= 2.0943951023931953)
+    t291 = casadi.logic_and((t227 >= -2.0943951023931953), (t227 <= 2.0943951023931953))
+    t292 = (t232 <= 2.0943951023931953)
+    t293 = casadi.logic_and((t231 >= -2.0943951023931953), (t231 <= 2.0943951023931953))
+    t294 = (t170 <= 2.0943951023931953)
+    t295 = casadi.logic_and((t169 >= -2.0943951023931953), (t169 <= 2.0943951023931953))
+    t296 = -t236
+    t297 = (t296 <= 2.0943951023931953)
+    t298 = casadi.logic_and((t235 >= -2.0943951023931953), (t235 <= 2.0943951023931953))
+    t299 = (t239 <= 2.0943951023931953)
+    t300 = casadi.logic_and((t238 >= -2.0943951023931953), (t238 <= 2.0943951023931953))
+    t301 = (t172 <= 2.0943951023931953)
+    t302 = casadi.logic_and((t171 >= -2.0943951023931953), (t171 <= 2.0943951023931953))
+    t303 = -t243
+    t304 = (t303 <= 2.0943951023931953)
+    t305 = casadi.logic_and((t242 >= -2.0943951023931953), (t242 <= 2.0943951023931953))
+    t306 = (casadi.fabs(t2) < casadi.inf)
+    t307 = (casadi.fabs(mu3) <= 1.5707963267948966)
+    t308 = (t13 > t15)
+    t309 = casadi.logic_or(t308, casadi.logic_and(t16, (0 <= 1e-12*t14)))
+    t310 = (t4 >= -1e-12)
+    t311 = casadi.logic_or(t244, t245)
+    t312 = casadi.logic_or(t275, t276)
     q = casadi.SX(8, 4)
     q[0, 0] = t246
     q[0, 1] = casadi.if_else(casadi.logic_and(t247, casadi.logic_not(t248)), t184, t183)
     q[0, 2] = casadi.if_else(casadi.logic_and(t249, casadi.logic_not(t250)), t60, t59)
-    q[0, 3] = casadi.if_else(casadi.logic_and((t190 >= -2.0943951023931953), casadi.logic_not(casadi.logic_and((t188 >= -2.0943951023931953), (t188 <= 2.0943951023931953)))), t251, t189)
+    q[0, 3] = casadi.if_else(casadi.logic_and(t252, casadi.logic_not(t253)), t251, t189)
     q[1, 0] = t246
-    q[1, 1] = casadi.if_else(casadi.logic_and(t252, casadi.logic_not(t253)), t193, t192)
-    q[1, 2] = casadi.if_else(casadi.logic_and(t254, casadi.logic_not(t255)), t62, t61)
-    q[1, 3] = casadi.if_else(casadi.logic_and((t197 >= -2.0943951023931953), casadi.logic_not(casadi.logic_and((t195 >= -2.0943951023931953), (t195 <= 2.0943951023931953)))), t256, t196)
+    q[1, 1] = casadi.if_else(casadi.logic_and(t254, casadi.logic_not(t255)), t193, t192)
+    q[1, 2] = casadi.if_else(casadi.logic_and(t256, casadi.logic_not(t257)), t62, t61)
+    q[1, 3] = casadi.if_else(casadi.logic_and(t259, casadi.logic_not(t260)), t258, t196)
     q[2, 0] = t246
-    q[2, 1] = casadi.if_else(casadi.logic_and(t257, casadi.logic_not(t258)), t201, t200)
-    q[2, 2] = casadi.if_else(casadi.logic_and(t259, casadi.logic_not(t260)), t107, t106)
-    q[2, 3] = casadi.if_else(casadi.logic_and((t206 >= -2.0943951023931953), casadi.logic_not(casadi.logic_and((t204 >= -2.0943951023931953), (t204 <= 2.0943951023931953)))), t261, t205)
+    q[2, 1] = casadi.if_else(casadi.logic_and(t261, casadi.logic_not(t262)), t201, t200)
+    q[2, 2] = casadi.if_else(casadi.logic_and(t263, casadi.logic_not(t264)), t107, t106)
+    q[2, 3] = casadi.if_else(casadi.logic_and(t266, casadi.logic_not(t267)), t265, t205)
     q[3, 0] = t246
-    q[3, 1] = casadi.if_else(casadi.logic_and(t262, casadi.logic_not(t263)), t209, t208)
-    q[3, 2] = casadi.if_else(casadi.logic_and(t264, casadi.logic_not(t265)), t109, t108)
-    q[3, 3] = casadi.if_else(casadi.logic_and((t213 >= -2.0943951023931953), casadi.logic_not(casadi.logic_and((t211 >= -2.0943951023931953), (t211 <= 2.0943951023931953)))), t266, t212)
-    q[4, 0] = t269
-    q[4, 1] = casadi.if_else(casadi.logic_and(t270, casadi.logic_not(t271)), t217, t216)
-    q[4, 2] = casadi.if_else(casadi.logic_and(t272, casadi.logic_not(t273)), t141, t140)
-    q[4, 3] = casadi.if_else(casadi.logic_and((t221 >= -2.0943951023931953), casadi.logic_not(casadi.logic_and((t219 >= -2.0943951023931953), (t219 <= 2.0943951023931953)))), t274, t220)
-    q[5, 0] = t269
-    q[5, 1] = casadi.if_else(casadi.logic_and(t275, casadi.logic_not(t276)), t224, t223)
-    q[5, 2] = casadi.if_else(casadi.logic_and(t277, casadi.logic_not(t278)), t143, t142)
-    q[5, 3] = casadi.if_else(casadi.logic_and((t228 >= -2.0943951023931953), casadi.logic_not(casadi.logic_and((t226 >= -2.0943951023931953), (t226 <= 2.0943951023931953)))), t279, t227)
-    q[6, 0] = t269
-    q[6, 1] = casadi.if_else(casadi.logic_and(t280, casadi.logic_not(t281)), t232, t231)
-    q[6, 2] = casadi.if_else(casadi.logic_and(t282, casadi.logic_not(t283)), t170, t169)
-    q[6, 3] = casadi.if_else(casadi.logic_and((t236 >= -2.0943951023931953), casadi.logic_not(casadi.logic_and((t234 >= -2.0943951023931953), (t234 <= 2.0943951023931953)))), t284, t235)
-    q[7, 0] = t269
-    q[7, 1] = casadi.if_else(casadi.logic_and(t285, casadi.logic_not(t286)), t239, t238)
-    q[7, 2] = casadi.if_else(casadi.logic_and(t287, casadi.logic_not(t288)), t172, t171)
-    q[7, 3] = casadi.if_else(casadi.logic_and((t243 >= -2.0943951023931953), casadi.logic_not(casadi.logic_and((t241 >= -2.0943951023931953), (t241 <= 2.0943951023931953)))), t289, t242)
+    q[3, 1] = casadi.if_else(casadi.logic_and(t268, casadi.logic_not(t269)), t209, t208)
+    q[3, 2] = casadi.if_else(casadi.logic_and(t270, casadi.logic_not(t271)), t109, t108)
+    q[3, 3] = casadi.if_else(casadi.logic_and(t273, casadi.logic_not(t274)), t272, t212)
+    q[4, 0] = t277
+    q[4, 1] = casadi.if_else(casadi.logic_and(t278, casadi.logic_not(t279)), t217, t216)
+    q[4, 2] = casadi.if_else(casadi.logic_and(t280, casadi.logic_not(t281)), t141, t140)
+    q[4, 3] = casadi.if_else(casadi.logic_and(t283, casadi.logic_not(t284)), t282, t220)
+    q[5, 0] = t277
+    q[5, 1] = casadi.if_else(casadi.logic_and(t285, casadi.logic_not(t286)), t224, t223)
+    q[5, 2] = casadi.if_else(casadi.logic_and(t287, casadi.logic_not(t288)), t143, t142)
+    q[5, 3] = casadi.if_else(casadi.logic_and(t290, casadi.logic_not(t291)), t289, t227)
+    q[6, 0] = t277
+    q[6, 1] = casadi.if_else(casadi.logic_and(t292, casadi.logic_not(t293)), t232, t231)
+    q[6, 2] = casadi.if_else(casadi.logic_and(t294, casadi.logic_not(t295)), t170, t169)
+    q[6, 3] = casadi.if_else(casadi.logic_and(t297, casadi.logic_not(t298)), t296, t235)
+    q[7, 0] = t277
+    q[7, 1] = casadi.if_else(casadi.logic_and(t299, casadi.logic_not(t300)), t239, t238)
+    q[7, 2] = casadi.if_else(casadi.logic_and(t301, casadi.logic_not(t302)), t172, t171)
+    q[7, 3] = casadi.if_else(casadi.logic_and(t304, casadi.logic_not(t305)), t303, t242)
     valid = casadi.SX(8, 1)
-    valid[0, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t290, t291), t293), t294), (t51 >= -1e-12))
-    valid[1, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t290, t291), t293), t294), (t51 > 1e-12))
-    valid[2, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t290, t291), t293), t295), (t90 >= -1e-12))
-    valid[3, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t290, t291), t293), t295), (t90 > 1e-12))
-    valid[4, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t290, t291), t292), t294), (t124 >= -1e-12))
-    valid[5, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t290, t291), t292), t294), (t124 > 1e-12))
-    valid[6, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t290, t291), t292), t295), (t153 >= -1e-12))
-    valid[7, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t290, t291), t292), t295), (t153 > 1e-12))
+    valid[0, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t306, t307), t309), t310), (t51 >= -1e-12))
+    valid[1, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t306, t307), t309), t310), t52)
+    valid[2, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t5, t306), t307), t309), (t90 >= -1e-12))
+    valid[3, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t5, t306), t307), t309), t91)
+    valid[4, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t306, t307), t308), t310), (t124 >= -1e-12))
+    valid[5, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t306, t307), t308), t310), t125)
+    valid[6, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t5, t306), t307), t308), (t153 >= -1e-12))
+    valid[7, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t5, t306), t307), t308), t154)
     in_limits = casadi.SX(8, 1)
-    in_limits[0, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t296, casadi.logic_or(t247, t248)), casadi.logic_or(t249, t250)), casadi.logic_or((t251 <= 2.0943951023931953), casadi.logic_and((t189 >= -2.0943951023931953), (t189 <= 2.0943951023931953))))
-    in_limits[1, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t296, casadi.logic_or(t252, t253)), casadi.logic_or(t254, t255)), casadi.logic_or((t256 <= 2.0943951023931953), casadi.logic_and((t196 >= -2.0943951023931953), (t196 <= 2.0943951023931953))))
-    in_limits[2, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t296, casadi.logic_or(t257, t258)), casadi.logic_or(t259, t260)), casadi.logic_or((t261 <= 2.0943951023931953), casadi.logic_and((t205 >= -2.0943951023931953), (t205 <= 2.0943951023931953))))
-    in_limits[3, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t296, casadi.logic_or(t262, t263)), casadi.logic_or(t264, t265)), casadi.logic_or((t266 <= 2.0943951023931953), casadi.logic_and((t212 >= -2.0943951023931953), (t212 <= 2.0943951023931953))))
-    in_limits[4, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t297, casadi.logic_or(t270, t271)), casadi.logic_or(t272, t273)), casadi.logic_or((t274 <= 2.0943951023931953), casadi.logic_and((t220 >= -2.0943951023931953), (t220 <= 2.0943951023931953))))
-    in_limits[5, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t297, casadi.logic_or(t275, t276)), casadi.logic_or(t277, t278)), casadi.logic_or((t279 <= 2.0943951023931953), casadi.logic_and((t227 >= -2.0943951023931953), (t227 <= 2.0943951023931953))))
-    in_limits[6, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t297, casadi.logic_or(t280, t281)), casadi.logic_or(t282, t283)), casadi.logic_or((t284 <= 2.0943951023931953), casadi.logic_and((t235 >= -2.0943951023931953), (t235 <= 2.0943951023931953))))
-    in_limits[7, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t297, casadi.logic_or(t285, t286)), casadi.logic_or(t287, t288)), casadi.logic_or((t289 <= 2.0943951023931953), casadi.logic_and((t242 >= -2.0943951023931953), (t242 <= 2.0943951023931953))))
+    in_limits[0, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t311, casadi.logic_or(t247, t248)), casadi.logic_or(t249, t250)), casadi.logic_or(t252, t253))
+    in_limits[1, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t311, casadi.logic_or(t254, t255)), casadi.logic_or(t256, t257)), casadi.logic_or(t259, t260))
+    in_limits[2, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t311, casadi.logic_or(t261, t262)), casadi.logic_or(t263, t264)), casadi.logic_or(t266, t267))
+    in_limits[3, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t311, casadi.logic_or(t268, t269)), casadi.logic_or(t270, t271)), casadi.logic_or(t273, t274))
+    in_limits[4, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t312, casadi.logic_or(t278, t279)), casadi.logic_or(t280, t281)), casadi.logic_or(t283, t284))
+    in_limits[5, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t312, casadi.logic_or(t285, t286)), casadi.logic_or(t287, t288)), casadi.logic_or(t290, t291))
+    in_limits[6, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t312, casadi.logic_or(t292, t293)), casadi.logic_or(t294, t295)), casadi.logic_or(t297, t298))
+    in_limits[7, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t312, casadi.logic_or(t299, t300)), casadi.logic_or(t301, t302)), casadi.logic_or(t304, t305))
     return [q, valid, in_limits]
 
 
 def _ik_nearest(mu, q_seed, weights):
-    """The closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status: 724 operations."""
+    """The closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status: 659 operations."""
     branches_q, branches_valid, branches_in_limits = _ik_branches(mu)
     mu0 = mu[0]
     mu1 = mu[1]
@@ -1722,7 +1737,7 @@ def _ik_nearest(mu, q_seed, weights):
     t84 = casadi.if_else(casadi.logic_and((t9 >= -2.0943951023931953), (t9 <= 2.0943951023931953)), t9, casadi.if_else(casadi.logic_and((t82 >= -2.0943951023931953), (t82 <= 2.0943951023931953)), t82, casadi.if_else(casadi.logic_and((t83 >= -2.0943951023931953), (t83 <= 2.0943951023931953)), t83, qb1_3)))
     t85 = qw1*(t72 + t58)**2 + qw2*(t76 + t59)**2 + qw3*(t80 + t60)**2 + qw4*(t84 + t61)**2
     t86 = (t10 > 0)
-    t87 = casadi.if_else(casadi.logic_and(t86, casadi.logic_or((t68 > t85), (t5 < 1))), 1, 0)
+    t87 = casadi.if_else(casadi.logic_and(t86, casadi.logic_or((t5 < 1), (t85 < t68))), 1, 0)
     t88 = casadi.if_else(t86, 1, t5)
     t89 = (t87 > 0)
     t90 = casadi.if_else(t89, t72, t64)
@@ -1748,7 +1763,7 @@ def _ik_nearest(mu, q_seed, weights):
     t110 = casadi.if_else(casadi.logic_and((t14 >= -2.0943951023931953), (t14 <= 2.0943951023931953)), t14, casadi.if_else(casadi.logic_and((t108 >= -2.0943951023931953), (t108 <= 2.0943951023931953)), t108, casadi.if_else(casadi.logic_and((t109 >= -2.0943951023931953), (t109 <= 2.0943951023931953)), t109, qb2_3)))
     t111 = qw1*(t98 + t58)**2 + qw2*(t102 + t59)**2 + qw3*(t106 + t60)**2 + qw4*(t110 + t61)**2
     t112 = (t15 > 0)
-    t113 = casadi.if_else(casadi.logic_and(t112, casadi.logic_or((t94 > t111), (t88 < 1))), 1, 0)
+    t113 = casadi.if_else(casadi.logic_and(t112, casadi.logic_or((t88 < 1), (t111 < t94))), 1, 0)
     t114 = casadi.if_else(t112, 1, t88)
     t115 = (t113 > 0)
     t116 = casadi.if_else(t115, t98, t90)
@@ -1774,7 +1789,7 @@ def _ik_nearest(mu, q_seed, weights):
     t136 = casadi.if_else(casadi.logic_and((t19 >= -2.0943951023931953), (t19 <= 2.0943951023931953)), t19, casadi.if_else(casadi.logic_and((t134 >= -2.0943951023931953), (t134 <= 2.0943951023931953)), t134, casadi.if_else(casadi.logic_and((t135 >= -2.0943951023931953), (t135 <= 2.0943951023931953)), t135, qb3_3)))
     t137 = qw1*(t124 + t58)**2 + qw2*(t128 + t59)**2 + qw3*(t132 + t60)**2 + qw4*(t136 + t61)**2
     t138 = (t20 > 0)
-    t139 = casadi.if_else(casadi.logic_and(t138, casadi.logic_or((t120 > t137), (t114 < 1))), 1, 0)
+    t139 = casadi.if_else(casadi.logic_and(t138, casadi.logic_or((t114 < 1), (t137 < t120))), 1, 0)
     t140 = casadi.if_else(t138, 1, t114)
     t141 = (t139 > 0)
     t142 = casadi.if_else(t141, t124, t116)
@@ -1800,7 +1815,7 @@ def _ik_nearest(mu, q_seed, weights):
     t162 = casadi.if_else(casadi.logic_and((t24 >= -2.0943951023931953), (t24 <= 2.0943951023931953)), t24, casadi.if_else(casadi.logic_and((t160 >= -2.0943951023931953), (t160 <= 2.0943951023931953)), t160, casadi.if_else(casadi.logic_and((t161 >= -2.0943951023931953), (t161 <= 2.0943951023931953)), t161, qb4_3)))
     t163 = qw1*(t150 + t58)**2 + qw2*(t154 + t59)**2 + qw3*(t158 + t60)**2 + qw4*(t162 + t61)**2
     t164 = (t25 > 0)
-    t165 = casadi.if_else(casadi.logic_and(t164, casadi.logic_or((t146 > t163), (t140 < 1))), 1, 0)
+    t165 = casadi.if_else(casadi.logic_and(t164, casadi.logic_or((t140 < 1), (t163 < t146))), 1, 0)
     t166 = casadi.if_else(t164, 1, t140)
     t167 = (t165 > 0)
     t168 = casadi.if_else(t167, t150, t142)
@@ -1826,7 +1841,7 @@ def _ik_nearest(mu, q_seed, weights):
     t188 = casadi.if_else(casadi.logic_and((t29 >= -2.0943951023931953), (t29 <= 2.0943951023931953)), t29, casadi.if_else(casadi.logic_and((t186 >= -2.0943951023931953), (t186 <= 2.0943951023931953)), t186, casadi.if_else(casadi.logic_and((t187 >= -2.0943951023931953), (t187 <= 2.0943951023931953)), t187, qb5_3)))
     t189 = qw1*(t176 + t58)**2 + qw2*(t180 + t59)**2 + qw3*(t184 + t60)**2 + qw4*(t188 + t61)**2
     t190 = (t30 > 0)
-    t191 = casadi.if_else(casadi.logic_and(t190, casadi.logic_or((t172 > t189), (t166 < 1))), 1, 0)
+    t191 = casadi.if_else(casadi.logic_and(t190, casadi.logic_or((t166 < 1), (t189 < t172))), 1, 0)
     t192 = casadi.if_else(t190, 1, t166)
     t193 = (t191 > 0)
     t194 = casadi.if_else(t193, t176, t168)
@@ -1852,7 +1867,7 @@ def _ik_nearest(mu, q_seed, weights):
     t214 = casadi.if_else(casadi.logic_and((t34 >= -2.0943951023931953), (t34 <= 2.0943951023931953)), t34, casadi.if_else(casadi.logic_and((t212 >= -2.0943951023931953), (t212 <= 2.0943951023931953)), t212, casadi.if_else(casadi.logic_and((t213 >= -2.0943951023931953), (t213 <= 2.0943951023931953)), t213, qb6_3)))
     t215 = qw1*(t202 + t58)**2 + qw2*(t206 + t59)**2 + qw3*(t210 + t60)**2 + qw4*(t214 + t61)**2
     t216 = (t35 > 0)
-    t217 = casadi.if_else(casadi.logic_and(t216, casadi.logic_or((t198 > t215), (t192 < 1))), 1, 0)
+    t217 = casadi.if_else(casadi.logic_and(t216, casadi.logic_or((t192 < 1), (t215 < t198))), 1, 0)
     t218 = casadi.if_else(t216, 1, t192)
     t219 = (t217 > 0)
     t220 = casadi.if_else(t219, t202, t194)
@@ -1878,7 +1893,7 @@ def _ik_nearest(mu, q_seed, weights):
     t240 = casadi.if_else(casadi.logic_and((t39 >= -2.0943951023931953), (t39 <= 2.0943951023931953)), t39, casadi.if_else(casadi.logic_and((t238 >= -2.0943951023931953), (t238 <= 2.0943951023931953)), t238, casadi.if_else(casadi.logic_and((t239 >= -2.0943951023931953), (t239 <= 2.0943951023931953)), t239, qb7_3)))
     t241 = qw1*(t228 + t58)**2 + qw2*(t232 + t59)**2 + qw3*(t236 + t60)**2 + qw4*(t240 + t61)**2
     t242 = (t40 > 0)
-    t243 = casadi.if_else(casadi.logic_and(t242, casadi.logic_or((t224 > t241), (t218 < 1))), 1, 0)
+    t243 = casadi.if_else(casadi.logic_and(t242, casadi.logic_or((t218 < 1), (t241 < t224))), 1, 0)
     t244 = casadi.if_else(t242, 1, t218)
     t245 = (t243 > 0)
     t246 = casadi.if_else(t245, t228, t220)

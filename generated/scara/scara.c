@@ -691,7 +691,7 @@ scara_real scara_jacobian_det(const scara_real q[SCARA_DOF])
 
 int scara_velocity_ik(const scara_real q[SCARA_DOF], const scara_real mu_dot[SCARA_TASK_DIM], scara_real damping, scara_real q_dot[SCARA_DOF])
 {
-    /* 333 operations */
+    /* 332 operations */
 
     /* Inputs */
     const scara_real q1 = q[0];
@@ -814,25 +814,25 @@ int scara_velocity_ik(const scara_real q[SCARA_DOF], const scara_real mu_dot[SCA
     const scara_real t101 = (t97 != 0 ? -t100/t97 : 0);
     const scara_real t102 = (t84 != 0 ? -(t88 - t93*t101)/t84 : 0);
     const scara_real t103 = (t11 != 0 ? -(t80 - (-t102*t76 + t74*t12*t101))/t11 : 0);
-    const int t104 = damping > 0;
-    const int t105 = isfinite(t90);
-    const int t106 = damping >= 0;
-    const scara_real t107 = 1e-12*t16;
+    const int t104 = isfinite(t90);
+    const int t105 = damping >= 0;
+    const scara_real t106 = 1e-12*t16;
+    const int t107 = damping > 0;
     const scara_real t108 = 1e-12*t47;
-    const int t109 = (t104 && ((t24 <= t108) || (t37 <= t108) || (t56 <= t108) || (t63 <= t108))) || (damping <= 0 && ((t107 >= 1) || (t10 <= t107) || (t83 <= t107) || (t96 <= t107)));
-    const int t110 = t105 && t106 && !t109;
+    const int t109 = (t107 && ((t24 <= t108) || (t37 <= t108) || (t56 <= t108) || (t63 <= t108))) || (damping <= 0 && ((1 <= t106) || (t10 <= t106) || (t83 <= t106) || (t96 <= t106)));
+    const int t110 = t104 && t105 && !t109;
 
     /* Outputs */
-    q_dot[0] = (t110 ? (t104 ? t71 : t103) : 0);
-    q_dot[1] = (t110 ? (t104 ? t72 : t102) : 0);
-    q_dot[2] = (t110 ? (t104 ? -t61 : -mu_dot2) : 0);
-    q_dot[3] = (t110 ? (t104 ? -t68 : t101) : 0);
-    return (!(t105 && t106) ? 2 : (t109 ? 1 : 0));
+    q_dot[0] = (t110 ? (t107 ? t71 : t103) : 0);
+    q_dot[1] = (t110 ? (t107 ? t72 : t102) : 0);
+    q_dot[2] = (t110 ? (t107 ? -t61 : -mu_dot2) : 0);
+    q_dot[3] = (t110 ? (t107 ? -t68 : t101) : 0);
+    return (!(t104 && t105) ? 2 : (t109 ? 1 : 0));
 }
 
 scara_real scara_ik_numeric_step(const scara_real target[SCARA_TASK_DIM], const scara_real q[SCARA_DOF], scara_real damping, scara_real q_start[SCARA_DOF], scara_real q_next[SCARA_DOF])
 {
-    /* 227 operations */
+    /* 219 operations */
 
     /* Inputs */
     const scara_real mu0 = target[0];
@@ -847,7 +847,7 @@ scara_real scara_ik_numeric_step(const scara_real target[SCARA_TASK_DIM], const 
     /* Intermediate terms */
     const scara_real q1 = (qs1 < -0.8726646259971648 ? -0.8726646259971648 : (qs1 > 0.8726646259971648 ? 0.8726646259971648 : qs1));
     const scara_real q2 = (qs2 < -1.53588974175501 ? -1.53588974175501 : (qs2 > 1.53588974175501 ? 1.53588974175501 : qs2));
-    const scara_real q3 = (qs3 < 0 ? 0.0 : (qs3 > 0.21 ? 0.21 : qs3));
+    const scara_real q3 = (qs3 < 0.0 ? 0.0 : (qs3 > 0.21 ? 0.21 : qs3));
     const scara_real q4 = (qs4 < -6.283185307179586 ? -6.283185307179586 : (qs4 > 6.283185307179586 ? 6.283185307179586 : qs4));
     const scara_real c1 = cos(q1);
     const scara_real s1 = sin(q1);
@@ -934,14 +934,14 @@ scara_real scara_ik_numeric_step(const scara_real target[SCARA_TASK_DIM], const 
     q_start[3] = q4;
     q_next[0] = (t66 < -0.8726646259971648 ? -0.8726646259971648 : (t66 > 0.8726646259971648 ? 0.8726646259971648 : t66));
     q_next[1] = (t67 < -1.53588974175501 ? -1.53588974175501 : (t67 > 1.53588974175501 ? 1.53588974175501 : t67));
-    q_next[2] = (t56 < 0 ? 0.0 : (t56 > 0.21 ? 0.21 : t56));
+    q_next[2] = (t56 < 0.0 ? 0.0 : (t56 > 0.21 ? 0.21 : t56));
     q_next[3] = (t68 < -6.283185307179586 ? -6.283185307179586 : (t68 > 6.283185307179586 ? 6.283185307179586 : t68));
     return (isfinite(t5) ? t19 : -1);
 }
 
 void scara_ik_branches(const scara_real mu[SCARA_TASK_DIM], scara_real q[SCARA_MAX_IK_SOLUTIONS * SCARA_DOF], int valid[SCARA_MAX_IK_SOLUTIONS], int in_limits[SCARA_MAX_IK_SOLUTIONS])
 {
-    /* 198 operations */
+    /* 188 operations */
 
     /* Inputs */
     const scara_real mu0 = mu[0];
@@ -955,19 +955,19 @@ void scara_ik_branches(const scara_real mu[SCARA_TASK_DIM], scara_real q[SCARA_M
     const scara_real t2 = mu0 + mu1 + mu2 + mu3;
     const scara_real t3 = (t1*t1);
     const scara_real t4 = 1 - 125.18949581886645*t3;
-    const scara_real t5 = 11.188811188811188*t1;
-    const int t6 = 1e-12 < t4;
-    const scara_real t7 = (t6 ? t5 : (t5 > 0 ? 1 : -1));
-    const scara_real t8 = (t6 ? sqrt(t4) : 0);
-    const scara_real t9 = atan2(t8, t7);
+    const int t5 = t4 > 1e-12;
+    const scara_real t6 = (t5 ? sqrt(t4) : 0);
+    const scara_real t7 = 11.188811188811188*t1;
+    const scara_real t8 = (t5 ? t7 : (t7 > 0 ? 1 : -1));
+    const scara_real t9 = atan2(t6, t8);
     const scara_real t10 = 3.141592653589793 + t9;
     const scara_real t11 = 3.141592653589793 - t9;
     const scara_real t12 = t10 - 6.283185307179586*ceil(0.15915494309189535*(-3.141592653589793 + t10));
     const scara_real t13 = t12 - 6.283185307179586*floor(0.15915494309189535*(1.53588974175501 + t12));
     const scara_real t14 = t11 - 6.283185307179586*ceil(0.15915494309189535*(-3.141592653589793 + t11));
     const scara_real t15 = t14 - 6.283185307179586*floor(0.15915494309189535*(1.53588974175501 + t14));
-    const scara_real t16 = -1.0*t7;
-    const scara_real t17 = -1.0*t8;
+    const scara_real t16 = -1.0*t8;
+    const scara_real t17 = -1.0*t6;
     const scara_real t18 = 0.325 + 0.275*t16;
     const scara_real t19 = 0.149769 + (t18*t18) + 0.075625*(t17*t17);
     const scara_real t20 = 0.275*t17;
@@ -975,9 +975,9 @@ void scara_ik_branches(const scara_real mu[SCARA_TASK_DIM], scara_real q[SCARA_M
     const scara_real t22 = -0.149769 + t21;
     const scara_real t23 = t18*mu1 - t20*mu0;
     const scara_real t24 = (t22*t22) + (t23*t23);
-    const scara_real t25 = 0.325 - 0.275*t7;
-    const scara_real t26 = 0.149769 + (t25*t25) + 0.075625*(t8*t8);
-    const scara_real t27 = 0.275*t8;
+    const scara_real t25 = 0.325 - 0.275*t8;
+    const scara_real t26 = 0.149769 + (t25*t25) + 0.075625*(t6*t6);
+    const scara_real t27 = 0.275*t6;
     const scara_real t28 = 0.149769 + t25*mu0 + t27*mu1;
     const scara_real t29 = -0.149769 + t28;
     const scara_real t30 = t25*mu1 - t27*mu0;
@@ -1004,33 +1004,37 @@ void scara_ik_branches(const scara_real mu[SCARA_TASK_DIM], scara_real q[SCARA_M
     const int t51 = t12 >= -1.53588974175501 && t12 <= 1.53588974175501;
     const scara_real t52 = -(-0.387 + mu2);
     const scara_real t53 = -t40;
-    const int t54 = t43 <= 0.8726646259971648;
-    const int t55 = t42 >= -0.8726646259971648 && t42 <= 0.8726646259971648;
-    const int t56 = t15 <= 1.53588974175501;
-    const int t57 = t14 >= -1.53588974175501 && t14 <= 1.53588974175501;
-    const scara_real t58 = -t47;
-    const int t59 = isfinite(t2);
-    const int t60 = t52 >= 0.0;
-    const int t61 = t52 <= 0.21;
+    const int t54 = t53 <= 6.283185307179586;
+    const int t55 = t39 >= -6.283185307179586 && t39 <= 6.283185307179586;
+    const int t56 = t43 <= 0.8726646259971648;
+    const int t57 = t42 >= -0.8726646259971648 && t42 <= 0.8726646259971648;
+    const int t58 = t15 <= 1.53588974175501;
+    const int t59 = t14 >= -1.53588974175501 && t14 <= 1.53588974175501;
+    const scara_real t60 = -t47;
+    const int t61 = t60 <= 6.283185307179586;
+    const int t62 = t46 >= -6.283185307179586 && t46 <= 6.283185307179586;
+    const int t63 = isfinite(t2);
+    const int t64 = t52 >= 0.0;
+    const int t65 = t52 <= 0.21;
 
     /* Outputs */
     q[0] = (t48 && !t49 ? t35 : t34);
     q[1] = (t50 && !t51 ? t13 : t12);
     q[2] = t52;
-    q[3] = (t40 >= -6.283185307179586 && !(t38 >= -6.283185307179586 && t38 <= 6.283185307179586) ? t53 : t39);
-    q[4] = (t54 && !t55 ? t43 : t42);
-    q[5] = (t56 && !t57 ? t15 : t14);
+    q[3] = (t54 && !t55 ? t53 : t39);
+    q[4] = (t56 && !t57 ? t43 : t42);
+    q[5] = (t58 && !t59 ? t15 : t14);
     q[6] = t52;
-    q[7] = (t47 >= -6.283185307179586 && !(t45 >= -6.283185307179586 && t45 <= 6.283185307179586) ? t58 : t46);
-    valid[0] = t59 && ((t4 >= -1e-12) || (0 && t3 <= 1.931417125e-14));
-    valid[1] = t59 && t4 > 1e-12;
-    in_limits[0] = t60 && t61 && (t48 || t49) && (t50 || t51) && ((t53 <= 6.283185307179586) || (t39 >= -6.283185307179586 && t39 <= 6.283185307179586));
-    in_limits[1] = t60 && t61 && (t54 || t55) && (t56 || t57) && ((t58 <= 6.283185307179586) || (t46 >= -6.283185307179586 && t46 <= 6.283185307179586));
+    q[7] = (t61 && !t62 ? t60 : t46);
+    valid[0] = t63 && t4 >= -1e-12;
+    valid[1] = t63 && t5;
+    in_limits[0] = t64 && t65 && (t48 || t49) && (t50 || t51) && (t54 || t55);
+    in_limits[1] = t64 && t65 && (t56 || t57) && (t58 || t59) && (t61 || t62);
 }
 
 int scara_ik_nearest(const scara_real mu[SCARA_TASK_DIM], const scara_real q_seed[SCARA_DOF], const scara_real weights[SCARA_DOF], scara_real q[SCARA_DOF])
 {
-    /* 166 operations */
+    /* 153 operations */
     scara_real branches_q[SCARA_MAX_IK_SOLUTIONS * SCARA_DOF];
     int branches_valid[SCARA_MAX_IK_SOLUTIONS];
     int branches_in_limits[SCARA_MAX_IK_SOLUTIONS];
@@ -1110,7 +1114,7 @@ int scara_ik_nearest(const scara_real mu[SCARA_TASK_DIM], const scara_real q_see
     const scara_real t44 = (t7 >= -6.283185307179586 && t7 <= 6.283185307179586 ? t7 : (t42 >= -6.283185307179586 && t42 <= 6.283185307179586 ? t42 : (t43 >= -6.283185307179586 && t43 <= 6.283185307179586 ? t43 : qb1_3)));
     const scara_real t45 = qw1*((t36 + t22)*(t36 + t22)) + qw2*((t40 + t23)*(t40 + t23)) + qw3*((t24 + qb1_2)*(t24 + qb1_2)) + qw4*((t44 + t25)*(t44 + t25));
     const int t46 = t8 > 0;
-    const scara_real t47 = (t46 && ((t32 > t45) || (t4 < 1)) ? 1 : 0);
+    const scara_real t47 = (t46 && ((t4 < 1) || (t45 < t32)) ? 1 : 0);
     const scara_real t48 = (t46 ? 1 : t4);
     const int t49 = t47 > 0;
     const scara_real t50 = (t49 ? t36 : t28);

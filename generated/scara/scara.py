@@ -698,7 +698,7 @@ def jacobian_det(q):
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def velocity_ik(q, mu_dot, damping=0.0):
-    """joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: (4 x 1 and 1 x 1), 333 operations."""
+    """joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: (4 x 1 and 1 x 1), 332 operations."""
     xp, dtype, device, batch, (q, mu_dot, damping,) = _arguments(("q", q, (4,)), ("mu_dot", mu_dot, (4,)), ("damping", damping, ()))
     q1 = q[..., 0]
     q2 = q[..., 1]
@@ -819,26 +819,26 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t101 = xp.where(xp.not_equal(t97, 0), -t100/t97, 0)
     t102 = xp.where(xp.not_equal(t84, 0), -(t88 - t93*t101)/t84, 0)
     t103 = xp.where(xp.not_equal(t11, 0), -(t80 - (-t102*t76 + t74*t12*t101))/t11, 0)
-    t104 = xp.greater(damping, 0)
-    t105 = xp.isfinite(t90)
-    t106 = xp.greater_equal(damping, 0)
-    t107 = 1e-12*t16
+    t104 = xp.isfinite(t90)
+    t105 = xp.greater_equal(damping, 0)
+    t106 = 1e-12*t16
+    t107 = xp.greater(damping, 0)
     t108 = 1e-12*t47
-    t109 = (t104 & (xp.less_equal(t24, t108) | xp.less_equal(t37, t108) | xp.less_equal(t56, t108) | xp.less_equal(t63, t108))) | (xp.less_equal(damping, 0) & (xp.greater_equal(t107, 1) | xp.less_equal(t10, t107) | xp.less_equal(t83, t107) | xp.less_equal(t96, t107)))
-    t110 = t105 & t106 & xp.logical_not(t109)
+    t109 = (t107 & (xp.less_equal(t24, t108) | xp.less_equal(t37, t108) | xp.less_equal(t56, t108) | xp.less_equal(t63, t108))) | (xp.less_equal(damping, 0) & (xp.less_equal(1, t106) | xp.less_equal(t10, t106) | xp.less_equal(t83, t106) | xp.less_equal(t96, t106)))
+    t110 = t104 & t105 & xp.logical_not(t109)
     q_dot = _stack(xp, [
-        xp.broadcast_to(xp.where(t110, xp.where(t104, t71, t103), 0), batch),  # 0
-        xp.broadcast_to(xp.where(t110, xp.where(t104, t72, t102), 0), batch),  # 1
-        xp.broadcast_to(xp.where(t110, xp.where(t104, -t61, -mu_dot2), 0), batch),  # 2
-        xp.broadcast_to(xp.where(t110, xp.where(t104, -t68, t101), 0), batch),  # 3
+        xp.broadcast_to(xp.where(t110, xp.where(t107, t71, t103), 0), batch),  # 0
+        xp.broadcast_to(xp.where(t110, xp.where(t107, t72, t102), 0), batch),  # 1
+        xp.broadcast_to(xp.where(t110, xp.where(t107, -t61, -mu_dot2), 0), batch),  # 2
+        xp.broadcast_to(xp.where(t110, xp.where(t107, -t68, t101), 0), batch),  # 3
     ], (4,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t105 & t106), 2, xp.where(t109, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t104 & t105), 2, xp.where(t109, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
     return q_dot, status
 
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def ik_numeric_step(target, q, damping=0.0):
-    """one step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite): (4 x 1 and 4 x 1 and 1 x 1), 227 operations."""
+    """one step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite): (4 x 1 and 4 x 1 and 1 x 1), 219 operations."""
     xp, dtype, device, batch, (target, q, damping,) = _arguments(("target", target, (4,)), ("q", q, (4,)), ("damping", damping, ()))
     mu0 = target[..., 0]
     mu1 = target[..., 1]
@@ -850,7 +850,7 @@ def ik_numeric_step(target, q, damping=0.0):
     qs4 = q[..., 3]
     q1 = xp.where(xp.less(qs1, -0.8726646259971648), -0.8726646259971648, xp.where(xp.greater(qs1, 0.8726646259971648), 0.8726646259971648, qs1))
     q2 = xp.where(xp.less(qs2, -1.53588974175501), -1.53588974175501, xp.where(xp.greater(qs2, 1.53588974175501), 1.53588974175501, qs2))
-    q3 = xp.where(xp.less(qs3, 0), 0.0, xp.where(xp.greater(qs3, 0.21), 0.21, qs3))
+    q3 = xp.where(xp.less(qs3, 0.0), 0.0, xp.where(xp.greater(qs3, 0.21), 0.21, qs3))
     q4 = xp.where(xp.less(qs4, -6.283185307179586), -6.283185307179586, xp.where(xp.greater(qs4, 6.283185307179586), 6.283185307179586, qs4))
     c1 = xp.cos(q1)
     s1 = xp.sin(q1)
@@ -938,7 +938,7 @@ def ik_numeric_step(target, q, damping=0.0):
     q_next = _stack(xp, [
         xp.broadcast_to(xp.where(xp.less(t66, -0.8726646259971648), -0.8726646259971648, xp.where(xp.greater(t66, 0.8726646259971648), 0.8726646259971648, t66)), batch),  # 0
         xp.broadcast_to(xp.where(xp.less(t67, -1.53588974175501), -1.53588974175501, xp.where(xp.greater(t67, 1.53588974175501), 1.53588974175501, t67)), batch),  # 1
-        xp.broadcast_to(xp.where(xp.less(t56, 0), 0.0, xp.where(xp.greater(t56, 0.21), 0.21, t56)), batch),  # 2
+        xp.broadcast_to(xp.where(xp.less(t56, 0.0), 0.0, xp.where(xp.greater(t56, 0.21), 0.21, t56)), batch),  # 2
         xp.broadcast_to(xp.where(xp.less(t68, -6.283185307179586), -6.283185307179586, xp.where(xp.greater(t68, 6.283185307179586), 6.283185307179586, t68)), batch),  # 3
     ], (4,))
     cost = xp.broadcast_to(xp.where(xp.isfinite(t5), t19, -1), batch)
@@ -947,7 +947,7 @@ def ik_numeric_step(target, q, damping=0.0):
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def ik_branches(mu):
-    """every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits: (2 x 4 and 2 x 1 and 2 x 1), 198 operations."""
+    """every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits: (2 x 4 and 2 x 1 and 2 x 1), 188 operations."""
     xp, dtype, device, batch, (mu,) = _arguments(("mu", mu, (4,)))
     mu0 = mu[..., 0]
     mu1 = mu[..., 1]
@@ -958,19 +958,19 @@ def ik_branches(mu):
     t2 = mu0 + mu1 + mu2 + mu3
     t3 = t1**2
     t4 = 1 - 125.18949581886645*t3
-    t5 = 11.188811188811188*t1
-    t6 = xp.less(1e-12, t4)
-    t7 = xp.where(t6, t5, xp.where(xp.greater(t5, 0), xp.asarray(1, dtype=dtype), -1))
-    t8 = xp.where(t6, xp.sqrt(t4), 0)
-    t9 = xp.atan2(t8, t7)
+    t5 = xp.greater(t4, 1e-12)
+    t6 = xp.where(t5, xp.sqrt(t4), 0)
+    t7 = 11.188811188811188*t1
+    t8 = xp.where(t5, t7, xp.where(xp.greater(t7, 0), xp.asarray(1, dtype=dtype), -1))
+    t9 = xp.atan2(t6, t8)
     t10 = 3.141592653589793 + t9
     t11 = 3.141592653589793 - t9
     t12 = t10 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t10))
     t13 = t12 - 6.283185307179586*xp.floor(0.15915494309189535*(1.53588974175501 + t12))
     t14 = t11 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t11))
     t15 = t14 - 6.283185307179586*xp.floor(0.15915494309189535*(1.53588974175501 + t14))
-    t16 = -1.0*t7
-    t17 = -1.0*t8
+    t16 = -1.0*t8
+    t17 = -1.0*t6
     t18 = 0.325 + 0.275*t16
     t19 = 0.149769 + t18**2 + 0.075625*t17**2
     t20 = 0.275*t17
@@ -978,9 +978,9 @@ def ik_branches(mu):
     t22 = -0.149769 + t21
     t23 = t18*mu1 - t20*mu0
     t24 = t22**2 + t23**2
-    t25 = 0.325 - 0.275*t7
-    t26 = 0.149769 + t25**2 + 0.075625*t8**2
-    t27 = 0.275*t8
+    t25 = 0.325 - 0.275*t8
+    t26 = 0.149769 + t25**2 + 0.075625*t6**2
+    t27 = 0.275*t6
     t28 = 0.149769 + t25*mu0 + t27*mu1
     t29 = -0.149769 + t28
     t30 = t25*mu1 - t27*mu0
@@ -1007,38 +1007,42 @@ def ik_branches(mu):
     t51 = xp.greater_equal(t12, -1.53588974175501) & xp.less_equal(t12, 1.53588974175501)
     t52 = -(-0.387 + mu2)
     t53 = -t40
-    t54 = xp.less_equal(t43, 0.8726646259971648)
-    t55 = xp.greater_equal(t42, -0.8726646259971648) & xp.less_equal(t42, 0.8726646259971648)
-    t56 = xp.less_equal(t15, 1.53588974175501)
-    t57 = xp.greater_equal(t14, -1.53588974175501) & xp.less_equal(t14, 1.53588974175501)
-    t58 = -t47
-    t59 = xp.isfinite(t2)
-    t60 = xp.greater_equal(t52, 0.0)
-    t61 = xp.less_equal(t52, 0.21)
+    t54 = xp.less_equal(t53, 6.283185307179586)
+    t55 = xp.greater_equal(t39, -6.283185307179586) & xp.less_equal(t39, 6.283185307179586)
+    t56 = xp.less_equal(t43, 0.8726646259971648)
+    t57 = xp.greater_equal(t42, -0.8726646259971648) & xp.less_equal(t42, 0.8726646259971648)
+    t58 = xp.less_equal(t15, 1.53588974175501)
+    t59 = xp.greater_equal(t14, -1.53588974175501) & xp.less_equal(t14, 1.53588974175501)
+    t60 = -t47
+    t61 = xp.less_equal(t60, 6.283185307179586)
+    t62 = xp.greater_equal(t46, -6.283185307179586) & xp.less_equal(t46, 6.283185307179586)
+    t63 = xp.isfinite(t2)
+    t64 = xp.greater_equal(t52, 0.0)
+    t65 = xp.less_equal(t52, 0.21)
     q = _stack(xp, [
         xp.where(t48 & xp.logical_not(t49), t35, t34),  # 0, 0
         xp.where(t50 & xp.logical_not(t51), t13, t12),  # 0, 1
         t52,  # 0, 2
-        xp.where(xp.greater_equal(t40, -6.283185307179586) & xp.logical_not(xp.greater_equal(t38, -6.283185307179586) & xp.less_equal(t38, 6.283185307179586)), t53, t39),  # 0, 3
-        xp.where(t54 & xp.logical_not(t55), t43, t42),  # 1, 0
-        xp.where(t56 & xp.logical_not(t57), t15, t14),  # 1, 1
+        xp.where(t54 & xp.logical_not(t55), t53, t39),  # 0, 3
+        xp.where(t56 & xp.logical_not(t57), t43, t42),  # 1, 0
+        xp.where(t58 & xp.logical_not(t59), t15, t14),  # 1, 1
         t52,  # 1, 2
-        xp.where(xp.greater_equal(t47, -6.283185307179586) & xp.logical_not(xp.greater_equal(t45, -6.283185307179586) & xp.less_equal(t45, 6.283185307179586)), t58, t46),  # 1, 3
+        xp.where(t61 & xp.logical_not(t62), t60, t46),  # 1, 3
     ], (2, 4))
     valid = _stack(xp, [
-        t59 & (xp.greater_equal(t4, -1e-12) | (False & xp.less_equal(t3, 1.931417125e-14))),  # 0
-        t59 & xp.greater(t4, 1e-12),  # 1
+        t63 & xp.greater_equal(t4, -1e-12),  # 0
+        t63 & t5,  # 1
     ], (2,))
     in_limits = _stack(xp, [
-        t60 & t61 & (t48 | t49) & (t50 | t51) & (xp.less_equal(t53, 6.283185307179586) | (xp.greater_equal(t39, -6.283185307179586) & xp.less_equal(t39, 6.283185307179586))),  # 0
-        t60 & t61 & (t54 | t55) & (t56 | t57) & (xp.less_equal(t58, 6.283185307179586) | (xp.greater_equal(t46, -6.283185307179586) & xp.less_equal(t46, 6.283185307179586))),  # 1
+        t64 & t65 & (t48 | t49) & (t50 | t51) & (t54 | t55),  # 0
+        t64 & t65 & (t56 | t57) & (t58 | t59) & (t61 | t62),  # 1
     ], (2,))
     return q, valid, in_limits
 
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def ik_nearest(mu, q_seed, weights=(1.0,) * DOF):
-    """the closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status: (4 x 1 and 1 x 1), 166 operations."""
+    """the closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status: (4 x 1 and 1 x 1), 153 operations."""
     xp, dtype, device, batch, (mu, q_seed, weights,) = _arguments(("mu", mu, (4,)), ("q_seed", q_seed, (4,)), ("weights", weights, (4,)))
     branches_q, branches_valid, branches_in_limits = ik_branches(mu)
     mu0 = mu[..., 0]
@@ -1112,7 +1116,7 @@ def ik_nearest(mu, q_seed, weights=(1.0,) * DOF):
     t44 = xp.where(xp.greater_equal(t7, -6.283185307179586) & xp.less_equal(t7, 6.283185307179586), t7, xp.where(xp.greater_equal(t42, -6.283185307179586) & xp.less_equal(t42, 6.283185307179586), t42, xp.where(xp.greater_equal(t43, -6.283185307179586) & xp.less_equal(t43, 6.283185307179586), t43, qb1_3)))
     t45 = qw1*(t36 + t22)**2 + qw2*(t40 + t23)**2 + qw3*(t24 + qb1_2)**2 + qw4*(t44 + t25)**2
     t46 = xp.greater(t8, 0)
-    t47 = xp.where(t46 & (xp.greater(t32, t45) | xp.less(t4, 1)), xp.asarray(1, dtype=dtype), 0)
+    t47 = xp.where(t46 & (xp.less(t4, 1) | xp.less(t45, t32)), xp.asarray(1, dtype=dtype), 0)
     t48 = xp.where(t46, 1, t4)
     t49 = xp.greater(t47, 0)
     t50 = xp.where(t49, t36, t28)

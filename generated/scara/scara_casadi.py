@@ -414,7 +414,7 @@ def _jacobian_det(q):
 
 
 def _velocity_ik(q, mu_dot, damping):
-    """Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: 333 operations."""
+    """Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: 332 operations."""
     q1 = q[0]
     q2 = q[1]
     q3 = q[2]
@@ -533,25 +533,25 @@ def _velocity_ik(q, mu_dot, damping):
     t101 = casadi.if_else((t97 != 0), -t100/t97, 0)
     t102 = casadi.if_else((t84 != 0), -(t88 - t93*t101)/t84, 0)
     t103 = casadi.if_else((t11 != 0), -(t80 - (-t102*t76 + t74*t12*t101))/t11, 0)
-    t104 = (damping > 0)
-    t105 = (casadi.fabs(t90) < casadi.inf)
-    t106 = (damping >= 0)
-    t107 = 1e-12*t16
+    t104 = (casadi.fabs(t90) < casadi.inf)
+    t105 = (damping >= 0)
+    t106 = 1e-12*t16
+    t107 = (damping > 0)
     t108 = 1e-12*t47
-    t109 = casadi.logic_or(casadi.logic_and(t104, casadi.logic_or(casadi.logic_or(casadi.logic_or((t24 <= t108), (t37 <= t108)), (t56 <= t108)), (t63 <= t108))), casadi.logic_and((damping <= 0), casadi.logic_or(casadi.logic_or(casadi.logic_or((t107 >= 1), (t10 <= t107)), (t83 <= t107)), (t96 <= t107))))
-    t110 = casadi.logic_and(casadi.logic_and(t105, t106), casadi.logic_not(t109))
+    t109 = casadi.logic_or(casadi.logic_and(t107, casadi.logic_or(casadi.logic_or(casadi.logic_or((t24 <= t108), (t37 <= t108)), (t56 <= t108)), (t63 <= t108))), casadi.logic_and((damping <= 0), casadi.logic_or(casadi.logic_or(casadi.logic_or((1 <= t106), (t10 <= t106)), (t83 <= t106)), (t96 <= t106))))
+    t110 = casadi.logic_and(casadi.logic_and(t104, t105), casadi.logic_not(t109))
     q_dot = casadi.SX(4, 1)
-    q_dot[0, 0] = casadi.if_else(t110, casadi.if_else(t104, t71, t103), 0)
-    q_dot[1, 0] = casadi.if_else(t110, casadi.if_else(t104, t72, t102), 0)
-    q_dot[2, 0] = casadi.if_else(t110, casadi.if_else(t104, -t61, -mu_dot2), 0)
-    q_dot[3, 0] = casadi.if_else(t110, casadi.if_else(t104, -t68, t101), 0)
+    q_dot[0, 0] = casadi.if_else(t110, casadi.if_else(t107, t71, t103), 0)
+    q_dot[1, 0] = casadi.if_else(t110, casadi.if_else(t107, t72, t102), 0)
+    q_dot[2, 0] = casadi.if_else(t110, casadi.if_else(t107, -t61, -mu_dot2), 0)
+    q_dot[3, 0] = casadi.if_else(t110, casadi.if_else(t107, -t68, t101), 0)
     status = casadi.SX(1, 1)
-    status[0, 0] = casadi.if_else(casadi.logic_not(casadi.logic_and(t105, t106)), 2, casadi.if_else(t109, 1, 0))
+    status[0, 0] = casadi.if_else(casadi.logic_not(casadi.logic_and(t104, t105)), 2, casadi.if_else(t109, 1, 0))
     return [q_dot, status]
 
 
 def _ik_numeric_step(target, q, damping):
-    """One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite): 227 operations."""
+    """One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite): 219 operations."""
     mu0 = target[0]
     mu1 = target[1]
     mu2 = target[2]
@@ -562,7 +562,7 @@ def _ik_numeric_step(target, q, damping):
     qs4 = q[3]
     q1 = casadi.if_else((qs1 < -0.8726646259971648), -0.8726646259971648, casadi.if_else((qs1 > 0.8726646259971648), 0.8726646259971648, qs1))
     q2 = casadi.if_else((qs2 < -1.53588974175501), -1.53588974175501, casadi.if_else((qs2 > 1.53588974175501), 1.53588974175501, qs2))
-    q3 = casadi.if_else((qs3 < 0), 0.0, casadi.if_else((qs3 > 0.21), 0.21, qs3))
+    q3 = casadi.if_else((qs3 < 0.0), 0.0, casadi.if_else((qs3 > 0.21), 0.21, qs3))
     q4 = casadi.if_else((qs4 < -6.283185307179586), -6.283185307179586, casadi.if_else((qs4 > 6.283185307179586), 6.283185307179586, qs4))
     c1 = casadi.cos(q1)
     s1 = casadi.sin(q1)
@@ -649,7 +649,7 @@ def _ik_numeric_step(target, q, damping):
     q_next = casadi.SX(4, 1)
     q_next[0, 0] = casadi.if_else((t66 < -0.8726646259971648), -0.8726646259971648, casadi.if_else((t66 > 0.8726646259971648), 0.8726646259971648, t66))
     q_next[1, 0] = casadi.if_else((t67 < -1.53588974175501), -1.53588974175501, casadi.if_else((t67 > 1.53588974175501), 1.53588974175501, t67))
-    q_next[2, 0] = casadi.if_else((t56 < 0), 0.0, casadi.if_else((t56 > 0.21), 0.21, t56))
+    q_next[2, 0] = casadi.if_else((t56 < 0.0), 0.0, casadi.if_else((t56 > 0.21), 0.21, t56))
     q_next[3, 0] = casadi.if_else((t68 < -6.283185307179586), -6.283185307179586, casadi.if_else((t68 > 6.283185307179586), 6.283185307179586, t68))
     cost = casadi.SX(1, 1)
     cost[0, 0] = casadi.if_else((casadi.fabs(t5) < casadi.inf), t19, -1)
@@ -657,7 +657,7 @@ def _ik_numeric_step(target, q, damping):
 
 
 def _ik_branches(mu):
-    """Every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits: 198 operations."""
+    """Every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits: 188 operations."""
     mu0 = mu[0]
     mu1 = mu[1]
     mu2 = mu[2]
@@ -667,19 +667,19 @@ def _ik_branches(mu):
     t2 = mu0 + mu1 + mu2 + mu3
     t3 = t1**2
     t4 = 1 - 125.18949581886645*t3
-    t5 = 11.188811188811188*t1
-    t6 = (1e-12 < t4)
-    t7 = casadi.if_else(t6, t5, casadi.if_else((t5 > 0), 1, -1))
-    t8 = casadi.if_else(t6, casadi.sqrt(t4), 0)
-    t9 = casadi.atan2(t8, t7)
+    t5 = (t4 > 1e-12)
+    t6 = casadi.if_else(t5, casadi.sqrt(t4), 0)
+    t7 = 11.188811188811188*t1
+    t8 = casadi.if_else(t5, t7, casadi.if_else((t7 > 0), 1, -1))
+    t9 = casadi.atan2(t6, t8)
     t10 = 3.141592653589793 + t9
     t11 = 3.141592653589793 - t9
     t12 = t10 - 6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t10))
     t13 = t12 - 6.283185307179586*casadi.floor(0.15915494309189535*(1.53588974175501 + t12))
     t14 = t11 - 6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t11))
     t15 = t14 - 6.283185307179586*casadi.floor(0.15915494309189535*(1.53588974175501 + t14))
-    t16 = -1.0*t7
-    t17 = -1.0*t8
+    t16 = -1.0*t8
+    t17 = -1.0*t6
     t18 = 0.325 + 0.275*t16
     t19 = 0.149769 + t18**2 + 0.075625*t17**2
     t20 = 0.275*t17
@@ -687,9 +687,9 @@ def _ik_branches(mu):
     t22 = -0.149769 + t21
     t23 = t18*mu1 - t20*mu0
     t24 = t22**2 + t23**2
-    t25 = 0.325 - 0.275*t7
-    t26 = 0.149769 + t25**2 + 0.075625*t8**2
-    t27 = 0.275*t8
+    t25 = 0.325 - 0.275*t8
+    t26 = 0.149769 + t25**2 + 0.075625*t6**2
+    t27 = 0.275*t6
     t28 = 0.149769 + t25*mu0 + t27*mu1
     t29 = -0.149769 + t28
     t30 = t25*mu1 - t27*mu0
@@ -716,34 +716,38 @@ def _ik_branches(mu):
     t51 = casadi.logic_and((t12 >= -1.53588974175501), (t12 <= 1.53588974175501))
     t52 = -(-0.387 + mu2)
     t53 = -t40
-    t54 = (t43 <= 0.8726646259971648)
-    t55 = casadi.logic_and((t42 >= -0.8726646259971648), (t42 <= 0.8726646259971648))
-    t56 = (t15 <= 1.53588974175501)
-    t57 = casadi.logic_and((t14 >= -1.53588974175501), (t14 <= 1.53588974175501))
-    t58 = -t47
-    t59 = (casadi.fabs(t2) < casadi.inf)
-    t60 = (t52 >= 0.0)
-    t61 = (t52 <= 0.21)
+    t54 = (t53 <= 6.283185307179586)
+    t55 = casadi.logic_and((t39 >= -6.283185307179586), (t39 <= 6.283185307179586))
+    t56 = (t43 <= 0.8726646259971648)
+    t57 = casadi.logic_and((t42 >= -0.8726646259971648), (t42 <= 0.8726646259971648))
+    t58 = (t15 <= 1.53588974175501)
+    t59 = casadi.logic_and((t14 >= -1.53588974175501), (t14 <= 1.53588974175501))
+    t60 = -t47
+    t61 = (t60 <= 6.283185307179586)
+    t62 = casadi.logic_and((t46 >= -6.283185307179586), (t46 <= 6.283185307179586))
+    t63 = (casadi.fabs(t2) < casadi.inf)
+    t64 = (t52 >= 0.0)
+    t65 = (t52 <= 0.21)
     q = casadi.SX(2, 4)
     q[0, 0] = casadi.if_else(casadi.logic_and(t48, casadi.logic_not(t49)), t35, t34)
     q[0, 1] = casadi.if_else(casadi.logic_and(t50, casadi.logic_not(t51)), t13, t12)
     q[0, 2] = t52
-    q[0, 3] = casadi.if_else(casadi.logic_and((t40 >= -6.283185307179586), casadi.logic_not(casadi.logic_and((t38 >= -6.283185307179586), (t38 <= 6.283185307179586)))), t53, t39)
-    q[1, 0] = casadi.if_else(casadi.logic_and(t54, casadi.logic_not(t55)), t43, t42)
-    q[1, 1] = casadi.if_else(casadi.logic_and(t56, casadi.logic_not(t57)), t15, t14)
+    q[0, 3] = casadi.if_else(casadi.logic_and(t54, casadi.logic_not(t55)), t53, t39)
+    q[1, 0] = casadi.if_else(casadi.logic_and(t56, casadi.logic_not(t57)), t43, t42)
+    q[1, 1] = casadi.if_else(casadi.logic_and(t58, casadi.logic_not(t59)), t15, t14)
     q[1, 2] = t52
-    q[1, 3] = casadi.if_else(casadi.logic_and((t47 >= -6.283185307179586), casadi.logic_not(casadi.logic_and((t45 >= -6.283185307179586), (t45 <= 6.283185307179586)))), t58, t46)
+    q[1, 3] = casadi.if_else(casadi.logic_and(t61, casadi.logic_not(t62)), t60, t46)
     valid = casadi.SX(2, 1)
-    valid[0, 0] = casadi.logic_and(t59, casadi.logic_or((t4 >= -1e-12), casadi.logic_and(False, (t3 <= 1.931417125e-14))))
-    valid[1, 0] = casadi.logic_and(t59, (t4 > 1e-12))
+    valid[0, 0] = casadi.logic_and(t63, (t4 >= -1e-12))
+    valid[1, 0] = casadi.logic_and(t63, t5)
     in_limits = casadi.SX(2, 1)
-    in_limits[0, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t60, t61), casadi.logic_or(t48, t49)), casadi.logic_or(t50, t51)), casadi.logic_or((t53 <= 6.283185307179586), casadi.logic_and((t39 >= -6.283185307179586), (t39 <= 6.283185307179586))))
-    in_limits[1, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t60, t61), casadi.logic_or(t54, t55)), casadi.logic_or(t56, t57)), casadi.logic_or((t58 <= 6.283185307179586), casadi.logic_and((t46 >= -6.283185307179586), (t46 <= 6.283185307179586))))
+    in_limits[0, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t64, t65), casadi.logic_or(t48, t49)), casadi.logic_or(t50, t51)), casadi.logic_or(t54, t55))
+    in_limits[1, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t64, t65), casadi.logic_or(t56, t57)), casadi.logic_or(t58, t59)), casadi.logic_or(t61, t62))
     return [q, valid, in_limits]
 
 
 def _ik_nearest(mu, q_seed, weights):
-    """The closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status: 166 operations."""
+    """The closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status: 153 operations."""
     branches_q, branches_valid, branches_in_limits = _ik_branches(mu)
     mu0 = mu[0]
     mu1 = mu[1]
@@ -816,7 +820,7 @@ def _ik_nearest(mu, q_seed, weights):
     t44 = casadi.if_else(casadi.logic_and((t7 >= -6.283185307179586), (t7 <= 6.283185307179586)), t7, casadi.if_else(casadi.logic_and((t42 >= -6.283185307179586), (t42 <= 6.283185307179586)), t42, casadi.if_else(casadi.logic_and((t43 >= -6.283185307179586), (t43 <= 6.283185307179586)), t43, qb1_3)))
     t45 = qw1*(t36 + t22)**2 + qw2*(t40 + t23)**2 + qw3*(t24 + qb1_2)**2 + qw4*(t44 + t25)**2
     t46 = (t8 > 0)
-    t47 = casadi.if_else(casadi.logic_and(t46, casadi.logic_or((t32 > t45), (t4 < 1))), 1, 0)
+    t47 = casadi.if_else(casadi.logic_and(t46, casadi.logic_or((t4 < 1), (t45 < t32))), 1, 0)
     t48 = casadi.if_else(t46, 1, t4)
     t49 = (t47 > 0)
     t50 = casadi.if_else(t49, t36, t28)

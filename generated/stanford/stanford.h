@@ -91,19 +91,19 @@ stanford_real stanford_manipulability(const stanford_real q[STANFORD_DOF]);
 stanford_real stanford_jacobian_det(const stanford_real q[STANFORD_DOF]);
 
 /* Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status.
- * Result: q_dot[i], i < 6; returned as a scalar. 1168 operations. */
+ * Result: q_dot[i], i < 6; returned as a scalar. 1167 operations. */
 int stanford_velocity_ik(const stanford_real q[STANFORD_DOF], const stanford_real mu_dot[STANFORD_TASK_DIM], stanford_real damping, stanford_real q_dot[STANFORD_DOF]);
 
 /* One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite).
- * Result: q_start[i], i < 6; q_next[i], i < 6; returned as a scalar. 871 operations. */
+ * Result: q_start[i], i < 6; q_next[i], i < 6; returned as a scalar. 856 operations. */
 stanford_real stanford_ik_numeric_step(const stanford_real target[16], const stanford_real q[STANFORD_DOF], stanford_real damping, stanford_real q_start[STANFORD_DOF], stanford_real q_next[STANFORD_DOF]);
 
 /* Every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits.
- * Result: q: 8 x 6 row-major, element (r, c) at q[r * 6 + c]; valid[i], i < 8; in_limits[i], i < 8. 1059 operations. */
+ * Result: q: 8 x 6 row-major, element (r, c) at q[r * 6 + c]; valid[i], i < 8; in_limits[i], i < 8. 1055 operations. */
 void stanford_ik_branches(const stanford_real T[16], stanford_real q[STANFORD_MAX_IK_SOLUTIONS * STANFORD_DOF], int valid[STANFORD_MAX_IK_SOLUTIONS], int in_limits[STANFORD_MAX_IK_SOLUTIONS]);
 
 /* The closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status.
- * Result: q[i], i < 6; returned as a scalar. 940 operations. */
+ * Result: q[i], i < 6; returned as a scalar. 859 operations. */
 int stanford_ik_nearest(const stanford_real T[16], const stanford_real q_seed[STANFORD_DOF], const stanford_real weights[STANFORD_DOF], stanford_real q[STANFORD_DOF]);
 
 /* Statuses of stanford_velocity_ik: OK, singular (a diagonal entry of the QR factor R of the

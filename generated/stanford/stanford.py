@@ -1324,7 +1324,7 @@ def jacobian_det(q):
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def velocity_ik(q, mu_dot, damping=0.0):
-    """joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: (6 x 1 and 1 x 1), 1168 operations."""
+    """joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: (6 x 1 and 1 x 1), 1167 operations."""
     xp, dtype, device, batch, (q, mu_dot, damping,) = _arguments(("q", q, (6,)), ("mu_dot", mu_dot, (6,)), ("damping", damping, ()))
     q1 = q[..., 0]
     q2 = q[..., 1]
@@ -1694,28 +1694,28 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t344 = xp.where(xp.not_equal(t281, 0), -(t293 - (t288*t343 + t307*t342 + t324*t341))/t281, 0)
     t345 = xp.where(xp.not_equal(t239, 0), -(t247 - (t243*t344 + t269*t342 + t275*t341 - t263*t343))/t239, 0)
     t346 = xp.where(xp.not_equal(t39, 0), -(t235 - (t229*t345 + t232*t344 + t227*t341*t259 + t227*t342*t255 - t227*t343*t252))/t39, 0)
-    t347 = xp.greater(damping, 0)
-    t348 = xp.isfinite(t258)
-    t349 = xp.greater_equal(damping, 0)
-    t350 = 1e-12*t59
+    t347 = xp.isfinite(t258)
+    t348 = xp.greater_equal(damping, 0)
+    t349 = 1e-12*t59
+    t350 = xp.greater(damping, 0)
     t351 = 1e-12*t73
-    t352 = (t347 & (xp.less_equal(t117, t351) | xp.less_equal(t149, t351) | xp.less_equal(t168, t351) | xp.less_equal(t180, t351) | xp.less_equal(t207, t351) | xp.less_equal(t74, t351))) | (xp.less_equal(damping, 0) & (xp.less_equal(t38, t350) | xp.less_equal(t238, t350) | xp.less_equal(t280, t350) | xp.less_equal(t297, t350) | xp.less_equal(t315, t350) | xp.less_equal(t336, t350)))
-    t353 = t348 & t349 & xp.logical_not(t352)
+    t352 = (t350 & (xp.less_equal(t117, t351) | xp.less_equal(t149, t351) | xp.less_equal(t168, t351) | xp.less_equal(t180, t351) | xp.less_equal(t207, t351) | xp.less_equal(t74, t351))) | (xp.less_equal(damping, 0) & (xp.less_equal(t38, t349) | xp.less_equal(t238, t349) | xp.less_equal(t280, t349) | xp.less_equal(t297, t349) | xp.less_equal(t315, t349) | xp.less_equal(t336, t349)))
+    t353 = t347 & t348 & xp.logical_not(t352)
     q_dot = _stack(xp, [
-        xp.broadcast_to(xp.where(t353, xp.where(t347, t218, t346), 0), batch),  # 0
-        xp.broadcast_to(xp.where(t353, xp.where(t347, t225, t345), 0), batch),  # 1
-        xp.broadcast_to(xp.where(t353, xp.where(t347, t219, t344), 0), batch),  # 2
-        xp.broadcast_to(xp.where(t353, xp.where(t347, t220, t343), 0), batch),  # 3
-        xp.broadcast_to(xp.where(t353, xp.where(t347, t221, t342), 0), batch),  # 4
-        xp.broadcast_to(xp.where(t353, xp.where(t347, t222, t341), 0), batch),  # 5
+        xp.broadcast_to(xp.where(t353, xp.where(t350, t218, t346), 0), batch),  # 0
+        xp.broadcast_to(xp.where(t353, xp.where(t350, t225, t345), 0), batch),  # 1
+        xp.broadcast_to(xp.where(t353, xp.where(t350, t219, t344), 0), batch),  # 2
+        xp.broadcast_to(xp.where(t353, xp.where(t350, t220, t343), 0), batch),  # 3
+        xp.broadcast_to(xp.where(t353, xp.where(t350, t221, t342), 0), batch),  # 4
+        xp.broadcast_to(xp.where(t353, xp.where(t350, t222, t341), 0), batch),  # 5
     ], (6,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t348 & t349), 2, xp.where(t352, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t347 & t348), 2, xp.where(t352, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
     return q_dot, status
 
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def ik_numeric_step(target, q, damping=0.0):
-    """one step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite): (6 x 1 and 6 x 1 and 1 x 1), 871 operations."""
+    """one step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite): (6 x 1 and 6 x 1 and 1 x 1), 856 operations."""
     xp, dtype, device, batch, (target, q, damping,) = _arguments(("target", target, (4, 4)), ("q", q, (6,)), ("damping", damping, ()))
     T00 = target[..., 0, 0]
     T01 = target[..., 0, 1]
@@ -2024,7 +2024,7 @@ def ik_numeric_step(target, q, damping=0.0):
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def ik_branches(T):
-    """every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits: (8 x 6 and 8 x 1 and 8 x 1), 1059 operations."""
+    """every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits: (8 x 6 and 8 x 1 and 8 x 1), 1055 operations."""
     xp, dtype, device, batch, (T,) = _arguments(("T", T, (4, 4)))
     T00 = T[..., 0, 0]
     T01 = T[..., 0, 1]
@@ -2058,16 +2058,16 @@ def ik_branches(T):
     t17 = 0.01787569 + t15
     t18 = -t16
     t19 = 1e-12*t17
-    t20 = -t19
-    t21 = xp.where(xp.less(t16, t20), xp.sqrt(t18), 0)
+    t20 = xp.greater(t18, t19)
+    t21 = xp.where(t20, xp.sqrt(t18), 0)
     t22 = t21**2
     t23 = 0.01787569 + t22
     t24 = 0.01787569 + t14
     t25 = t24 - t23
     t26 = -t25
     t27 = 1e-12*t23
-    t28 = -t27
-    t29 = xp.where(xp.less(t25, t28), xp.sqrt(t26), 0)
+    t28 = xp.greater(t26, t27)
+    t29 = xp.where(t28, xp.sqrt(t26), 0)
     t30 = t4*t29
     t31 = t14 + 0.1337*t8
     t32 = t31 - t30
@@ -2144,388 +2144,398 @@ def ik_branches(T):
     t103 = t91**2
     t104 = -t103
     t105 = 1 + t104
-    t106 = xp.where(xp.less(1e-12, t105), xp.sqrt(t105), 0)
-    t107 = t103 + t96*t106
-    t108 = t107 + t104
-    t109 = t90**2
-    t110 = t103 + t109 + t96**2
-    t111 = t106**2
-    t112 = t108**2 + t109*t111
-    t113 = t103 + t111
-    t114 = 1e-24*t113
-    t115 = xp.less_equal(t112, t110*t114)
-    t116 = xp.where(t115, 1, 1/xp.sqrt(t112))
-    t117 = xp.where(t115, 1, t108*t116)
-    t118 = t93*(1 - t117)
-    t119 = t118 + t93*t117
-    t120 = t90*t106
-    t121 = xp.where(t115, 0, -t116*t120)
-    t122 = t92*t117 + t98*t121
-    t123 = t98*t117 - t92*t121
-    t124 = xp.less_equal(t113, t114)
-    t125 = xp.where(t124, 1, 1/xp.sqrt(t113))
-    t126 = xp.where(t124, 1, t91*t125)
-    t127 = xp.where(t124, 0, -t106*t125)
-    t128 = t122*(1 - t126)
-    t129 = t128 + t126*t122
-    t130 = t126*t123 + t127*t119
-    t131 = t126*t119 - t127*t123
-    t132 = t129**2 + t130**2
-    t133 = t132
-    t134 = t132 + t131**2
-    t135 = 1 - t77
-    t136 = T22*t135
-    t137 = t136 + T22*t77
-    t138 = T20*t135
-    t139 = t138 + T20*t77
-    t140 = t68*t79 - t74*t137
-    t141 = t68*t137 + t74*t79
-    t142 = t68*t81 - t74*t139
-    t143 = t68*t139 + t74*t81
-    t144 = t141**2
-    t145 = -t144
-    t146 = 1 + t145
-    t147 = xp.where(xp.less(1e-12, t146), xp.sqrt(t146), 0)
-    t148 = t144 + t100*t147
-    t149 = t148 + t145
-    t150 = t140**2
-    t151 = t144 + t150 + t100**2
-    t152 = t147**2
-    t153 = t149**2 + t150*t152
-    t154 = t144 + t152
-    t155 = 1e-24*t154
-    t156 = xp.less_equal(t153, t151*t155)
-    t157 = xp.where(t156, 1, 1/xp.sqrt(t153))
-    t158 = xp.where(t156, 1, t149*t157)
-    t159 = t143*(1 - t158)
-    t160 = t159 + t143*t158
-    t161 = t140*t147
-    t162 = xp.where(t156, 0, -t157*t161)
-    t163 = t142*t158 + t102*t162
-    t164 = t102*t158 - t142*t162
-    t165 = xp.less_equal(t154, t155)
-    t166 = xp.where(t165, 1, 1/xp.sqrt(t154))
-    t167 = xp.where(t165, 1, t141*t166)
-    t168 = xp.where(t165, 0, -t147*t166)
-    t169 = t163*(1 - t167)
-    t170 = t169 + t167*t163
-    t171 = t167*t164 + t168*t160
-    t172 = t167*t160 - t168*t164
-    t173 = t170**2 + t171**2
-    t174 = t173
-    t175 = t173 + t172**2
-    t176 = xp.less_equal(t64, t65)
-    t177 = xp.where(t176, 1, 1/xp.sqrt(t64))
-    t178 = xp.where(t176, 1, t61*t177)
-    t179 = xp.where(t176, 0, xp.atan2(t69, t61))
-    t180 = t179 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t179))
-    t181 = t177*t69
-    t182 = xp.where(t176, 0, t181)
-    t183 = xp.where(t176, 0, -t181)
-    t184 = t51*t178 - t87*t182
-    t185 = t51*t182 + t87*t178
-    t186 = t53*t178 - t89*t182
-    t187 = t53*t182 + t89*t178
-    t188 = t79*t178 - t137*t183
-    t189 = t79*t183 + t137*t178
-    t190 = t81*t178 - t139*t183
-    t191 = t81*t183 + t139*t178
-    t192 = 1 - t178
-    t193 = t52*t192
-    t194 = t193 + t52*t178
-    t195 = t54*t192
-    t196 = t195 + t54*t178
-    t197 = t80*t192
-    t198 = t197 + t80*t178
-    t199 = t82*t192
-    t200 = t199 + t82*t178
-    t201 = t185**2
-    t202 = -t201
-    t203 = 1 + t202
-    t204 = xp.where(xp.less(1e-12, t203), xp.sqrt(t203), 0)
-    t205 = t201 + t194*t204
-    t206 = t205 + t202
-    t207 = t184**2
-    t208 = t201 + t207 + t194**2
-    t209 = t204**2
-    t210 = t206**2 + t207*t209
-    t211 = t201 + t209
-    t212 = 1e-24*t211
-    t213 = xp.less_equal(t210, t208*t212)
-    t214 = xp.where(t213, 1, 1/xp.sqrt(t210))
-    t215 = xp.where(t213, 1, t206*t214)
-    t216 = t187*(1 - t215)
-    t217 = t216 + t187*t215
-    t218 = t184*t204
-    t219 = xp.where(t213, 0, -t214*t218)
-    t220 = t186*t215 + t196*t219
-    t221 = t196*t215 - t186*t219
-    t222 = xp.less_equal(t211, t212)
-    t223 = xp.where(t222, 1, 1/xp.sqrt(t211))
-    t224 = xp.where(t222, 1, t185*t223)
-    t225 = xp.where(t222, 0, -t204*t223)
-    t226 = t220*(1 - t224)
-    t227 = t226 + t224*t220
-    t228 = t224*t221 + t225*t217
-    t229 = t224*t217 - t225*t221
-    t230 = t227**2 + t228**2
-    t231 = t230
-    t232 = t230 + t229**2
-    t233 = t189**2
-    t234 = -t233
-    t235 = 1 + t234
-    t236 = xp.where(xp.less(1e-12, t235), xp.sqrt(t235), 0)
-    t237 = t233 + t198*t236
-    t238 = t237 + t234
-    t239 = t188**2
-    t240 = t233 + t239 + t198**2
-    t241 = t236**2
-    t242 = t238**2 + t239*t241
-    t243 = t233 + t241
-    t244 = 1e-24*t243
-    t245 = xp.less_equal(t242, t240*t244)
-    t246 = xp.where(t245, 1, 1/xp.sqrt(t242))
-    t247 = xp.where(t245, 1, t238*t246)
-    t248 = t191*(1 - t247)
-    t249 = t248 + t191*t247
-    t250 = t188*t236
-    t251 = xp.where(t245, 0, -t246*t250)
-    t252 = t190*t247 + t200*t251
-    t253 = t200*t247 - t190*t251
-    t254 = xp.less_equal(t243, t244)
-    t255 = xp.where(t254, 1, 1/xp.sqrt(t243))
-    t256 = xp.where(t254, 1, t189*t255)
-    t257 = xp.where(t254, 0, -t236*t255)
-    t258 = t252*(1 - t256)
-    t259 = t258 + t256*t252
-    t260 = t256*t253 + t257*t249
-    t261 = t256*t249 - t257*t253
-    t262 = t259**2 + t260**2
-    t263 = t262
-    t264 = t262 + t261**2
-    t265 = -t69
-    t266 = xp.where(t66, 0, xp.atan2(t265, t59))
-    t267 = t266 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t266))
-    t268 = xp.where(t176, 0, xp.atan2(t265, t61))
-    t269 = t268 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t268))
-    t270 = xp.where(t115, 0, xp.atan2(-t120, t108))
-    t271 = t270
-    t272 = t271 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t271))
-    t273 = 3.141592653589793 + t270 - 6.283185307179586*xp.ceil(0.15915494309189535*t270)
-    t274 = t273 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t273))
-    t275 = xp.where(t124, 0, xp.atan2(-t106, t91))
-    t276 = t275
-    t277 = t276 - 6.283185307179586*xp.floor(0.15915494309189535*(1.5707963267948966 + t276))
-    t278 = t275 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t275))
-    t279 = xp.where(xp.less_equal(t133, 1e-24*t134), 0, xp.atan2(t129, -t130))
+    t106 = xp.greater(t105, 1e-12)
+    t107 = xp.where(t106, xp.sqrt(t105), 0)
+    t108 = t103 + t96*t107
+    t109 = t108 + t104
+    t110 = t90**2
+    t111 = t103 + t110 + t96**2
+    t112 = t107**2
+    t113 = t109**2 + t110*t112
+    t114 = t103 + t112
+    t115 = 1e-24*t114
+    t116 = xp.less_equal(t113, t111*t115)
+    t117 = xp.where(t116, 1, 1/xp.sqrt(t113))
+    t118 = xp.where(t116, 1, t109*t117)
+    t119 = t93*(1 - t118)
+    t120 = t119 + t93*t118
+    t121 = t90*t107
+    t122 = xp.where(t116, 0, -t117*t121)
+    t123 = t92*t118 + t98*t122
+    t124 = t98*t118 - t92*t122
+    t125 = xp.less_equal(t114, t115)
+    t126 = xp.where(t125, 1, 1/xp.sqrt(t114))
+    t127 = xp.where(t125, 1, t91*t126)
+    t128 = xp.where(t125, 0, -t107*t126)
+    t129 = t123*(1 - t127)
+    t130 = t129 + t127*t123
+    t131 = t127*t124 + t128*t120
+    t132 = t127*t120 - t128*t124
+    t133 = t130**2 + t131**2
+    t134 = t133
+    t135 = t133 + t132**2
+    t136 = 1 - t77
+    t137 = T22*t136
+    t138 = t137 + T22*t77
+    t139 = T20*t136
+    t140 = t139 + T20*t77
+    t141 = t68*t79 - t74*t138
+    t142 = t68*t138 + t74*t79
+    t143 = t68*t81 - t74*t140
+    t144 = t68*t140 + t74*t81
+    t145 = t142**2
+    t146 = -t145
+    t147 = 1 + t146
+    t148 = xp.greater(t147, 1e-12)
+    t149 = xp.where(t148, xp.sqrt(t147), 0)
+    t150 = t145 + t100*t149
+    t151 = t150 + t146
+    t152 = t141**2
+    t153 = t145 + t152 + t100**2
+    t154 = t149**2
+    t155 = t151**2 + t152*t154
+    t156 = t145 + t154
+    t157 = 1e-24*t156
+    t158 = xp.less_equal(t155, t153*t157)
+    t159 = xp.where(t158, 1, 1/xp.sqrt(t155))
+    t160 = xp.where(t158, 1, t151*t159)
+    t161 = t144*(1 - t160)
+    t162 = t161 + t144*t160
+    t163 = t141*t149
+    t164 = xp.where(t158, 0, -t159*t163)
+    t165 = t143*t160 + t102*t164
+    t166 = t102*t160 - t143*t164
+    t167 = xp.less_equal(t156, t157)
+    t168 = xp.where(t167, 1, 1/xp.sqrt(t156))
+    t169 = xp.where(t167, 1, t142*t168)
+    t170 = xp.where(t167, 0, -t149*t168)
+    t171 = t165*(1 - t169)
+    t172 = t171 + t169*t165
+    t173 = t169*t166 + t170*t162
+    t174 = t169*t162 - t170*t166
+    t175 = t172**2 + t173**2
+    t176 = t175
+    t177 = t175 + t174**2
+    t178 = xp.less_equal(t64, t65)
+    t179 = xp.where(t178, 1, 1/xp.sqrt(t64))
+    t180 = xp.where(t178, 1, t61*t179)
+    t181 = xp.where(t178, 0, xp.atan2(t69, t61))
+    t182 = t181 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t181))
+    t183 = t179*t69
+    t184 = xp.where(t178, 0, t183)
+    t185 = xp.where(t178, 0, -t183)
+    t186 = t51*t180 - t87*t184
+    t187 = t51*t184 + t87*t180
+    t188 = t53*t180 - t89*t184
+    t189 = t53*t184 + t89*t180
+    t190 = t79*t180 - t138*t185
+    t191 = t79*t185 + t138*t180
+    t192 = t81*t180 - t140*t185
+    t193 = t81*t185 + t140*t180
+    t194 = 1 - t180
+    t195 = t52*t194
+    t196 = t195 + t52*t180
+    t197 = t54*t194
+    t198 = t197 + t54*t180
+    t199 = t80*t194
+    t200 = t199 + t80*t180
+    t201 = t82*t194
+    t202 = t201 + t82*t180
+    t203 = t187**2
+    t204 = -t203
+    t205 = 1 + t204
+    t206 = xp.greater(t205, 1e-12)
+    t207 = xp.where(t206, xp.sqrt(t205), 0)
+    t208 = t203 + t196*t207
+    t209 = t208 + t204
+    t210 = t186**2
+    t211 = t203 + t210 + t196**2
+    t212 = t207**2
+    t213 = t209**2 + t210*t212
+    t214 = t203 + t212
+    t215 = 1e-24*t214
+    t216 = xp.less_equal(t213, t211*t215)
+    t217 = xp.where(t216, 1, 1/xp.sqrt(t213))
+    t218 = xp.where(t216, 1, t209*t217)
+    t219 = t189*(1 - t218)
+    t220 = t219 + t189*t218
+    t221 = t186*t207
+    t222 = xp.where(t216, 0, -t217*t221)
+    t223 = t188*t218 + t198*t222
+    t224 = t198*t218 - t188*t222
+    t225 = xp.less_equal(t214, t215)
+    t226 = xp.where(t225, 1, 1/xp.sqrt(t214))
+    t227 = xp.where(t225, 1, t187*t226)
+    t228 = xp.where(t225, 0, -t207*t226)
+    t229 = t223*(1 - t227)
+    t230 = t229 + t227*t223
+    t231 = t227*t224 + t228*t220
+    t232 = t227*t220 - t228*t224
+    t233 = t230**2 + t231**2
+    t234 = t233
+    t235 = t233 + t232**2
+    t236 = t191**2
+    t237 = -t236
+    t238 = 1 + t237
+    t239 = xp.greater(t238, 1e-12)
+    t240 = xp.where(t239, xp.sqrt(t238), 0)
+    t241 = t236 + t200*t240
+    t242 = t241 + t237
+    t243 = t190**2
+    t244 = t236 + t243 + t200**2
+    t245 = t240**2
+    t246 = t242**2 + t243*t245
+    t247 = t236 + t245
+    t248 = 1e-24*t247
+    t249 = xp.less_equal(t246, t244*t248)
+    t250 = xp.where(t249, 1, 1/xp.sqrt(t246))
+    t251 = xp.where(t249, 1, t242*t250)
+    t252 = t193*(1 - t251)
+    t253 = t252 + t193*t251
+    t254 = t190*t240
+    t255 = xp.where(t249, 0, -t250*t254)
+    t256 = t192*t251 + t202*t255
+    t257 = t202*t251 - t192*t255
+    t258 = xp.less_equal(t247, t248)
+    t259 = xp.where(t258, 1, 1/xp.sqrt(t247))
+    t260 = xp.where(t258, 1, t191*t259)
+    t261 = xp.where(t258, 0, -t240*t259)
+    t262 = t256*(1 - t260)
+    t263 = t262 + t260*t256
+    t264 = t260*t257 + t261*t253
+    t265 = t260*t253 - t261*t257
+    t266 = t263**2 + t264**2
+    t267 = t266
+    t268 = t266 + t265**2
+    t269 = -t69
+    t270 = xp.where(t66, 0, xp.atan2(t269, t59))
+    t271 = t270 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t270))
+    t272 = xp.where(t178, 0, xp.atan2(t269, t61))
+    t273 = t272 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t272))
+    t274 = xp.where(t116, 0, xp.atan2(-t121, t109))
+    t275 = t274
+    t276 = t275 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t275))
+    t277 = 3.141592653589793 + t274 - 6.283185307179586*xp.ceil(0.15915494309189535*t274)
+    t278 = t277 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t277))
+    t279 = xp.where(t125, 0, xp.atan2(-t107, t91))
     t280 = t279
-    t281 = t280 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t280))
-    t282 = 3.141592653589793 + t279 - 6.283185307179586*xp.ceil(0.15915494309189535*t279)
-    t283 = t282 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t282))
-    t284 = -t278
-    t285 = t278 + 6.283185307179586*xp.floor(0.15915494309189535*(1.5707963267948966 + t284))
-    t286 = xp.where(t156, 0, xp.atan2(-t161, t149))
-    t287 = t286
-    t288 = t287 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t287))
-    t289 = 3.141592653589793 + t286 - 6.283185307179586*xp.ceil(0.15915494309189535*t286)
-    t290 = t289 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t289))
-    t291 = xp.where(t165, 0, xp.atan2(-t147, t141))
-    t292 = t291
-    t293 = t292 - 6.283185307179586*xp.floor(0.15915494309189535*(1.5707963267948966 + t292))
-    t294 = t291 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t291))
-    t295 = xp.where(xp.less_equal(t174, 1e-24*t175), 0, xp.atan2(t170, -t171))
+    t281 = t280 - 6.283185307179586*xp.floor(0.15915494309189535*(1.5707963267948966 + t280))
+    t282 = t279 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t279))
+    t283 = xp.where(xp.less_equal(t134, 1e-24*t135), 0, xp.atan2(t130, -t131))
+    t284 = t283
+    t285 = t284 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t284))
+    t286 = 3.141592653589793 + t283 - 6.283185307179586*xp.ceil(0.15915494309189535*t283)
+    t287 = t286 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t286))
+    t288 = -t282
+    t289 = t282 + 6.283185307179586*xp.floor(0.15915494309189535*(1.5707963267948966 + t288))
+    t290 = xp.where(t158, 0, xp.atan2(-t163, t151))
+    t291 = t290
+    t292 = t291 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t291))
+    t293 = 3.141592653589793 + t290 - 6.283185307179586*xp.ceil(0.15915494309189535*t290)
+    t294 = t293 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t293))
+    t295 = xp.where(t167, 0, xp.atan2(-t149, t142))
     t296 = t295
-    t297 = t296 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t296))
-    t298 = 3.141592653589793 + t295 - 6.283185307179586*xp.ceil(0.15915494309189535*t295)
-    t299 = t298 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t298))
-    t300 = -t294
-    t301 = t294 + 6.283185307179586*xp.floor(0.15915494309189535*(1.5707963267948966 + t300))
-    t302 = xp.where(t213, 0, xp.atan2(-t218, t206))
-    t303 = t302
-    t304 = t303 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t303))
-    t305 = 3.141592653589793 + t302 - 6.283185307179586*xp.ceil(0.15915494309189535*t302)
-    t306 = t305 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t305))
-    t307 = xp.where(t222, 0, xp.atan2(-t204, t185))
-    t308 = t307
-    t309 = t308 - 6.283185307179586*xp.floor(0.15915494309189535*(1.5707963267948966 + t308))
-    t310 = t307 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t307))
-    t311 = xp.where(xp.less_equal(t231, 1e-24*t232), 0, xp.atan2(t227, -t228))
+    t297 = t296 - 6.283185307179586*xp.floor(0.15915494309189535*(1.5707963267948966 + t296))
+    t298 = t295 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t295))
+    t299 = xp.where(xp.less_equal(t176, 1e-24*t177), 0, xp.atan2(t172, -t173))
+    t300 = t299
+    t301 = t300 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t300))
+    t302 = 3.141592653589793 + t299 - 6.283185307179586*xp.ceil(0.15915494309189535*t299)
+    t303 = t302 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t302))
+    t304 = -t298
+    t305 = t298 + 6.283185307179586*xp.floor(0.15915494309189535*(1.5707963267948966 + t304))
+    t306 = xp.where(t216, 0, xp.atan2(-t221, t209))
+    t307 = t306
+    t308 = t307 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t307))
+    t309 = 3.141592653589793 + t306 - 6.283185307179586*xp.ceil(0.15915494309189535*t306)
+    t310 = t309 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t309))
+    t311 = xp.where(t225, 0, xp.atan2(-t207, t187))
     t312 = t311
-    t313 = t312 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t312))
-    t314 = 3.141592653589793 + t311 - 6.283185307179586*xp.ceil(0.15915494309189535*t311)
-    t315 = t314 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t314))
-    t316 = -t310
-    t317 = t310 + 6.283185307179586*xp.floor(0.15915494309189535*(1.5707963267948966 + t316))
-    t318 = xp.where(t245, 0, xp.atan2(-t250, t238))
-    t319 = t318
-    t320 = t319 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t319))
-    t321 = 3.141592653589793 + t318 - 6.283185307179586*xp.ceil(0.15915494309189535*t318)
-    t322 = t321 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t321))
-    t323 = xp.where(t254, 0, xp.atan2(-t236, t189))
-    t324 = t323
-    t325 = t324 - 6.283185307179586*xp.floor(0.15915494309189535*(1.5707963267948966 + t324))
-    t326 = t323 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t323))
-    t327 = xp.where(xp.less_equal(t263, 1e-24*t264), 0, xp.atan2(t259, -t260))
+    t313 = t312 - 6.283185307179586*xp.floor(0.15915494309189535*(1.5707963267948966 + t312))
+    t314 = t311 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t311))
+    t315 = xp.where(xp.less_equal(t234, 1e-24*t235), 0, xp.atan2(t230, -t231))
+    t316 = t315
+    t317 = t316 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t316))
+    t318 = 3.141592653589793 + t315 - 6.283185307179586*xp.ceil(0.15915494309189535*t315)
+    t319 = t318 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t318))
+    t320 = -t314
+    t321 = t314 + 6.283185307179586*xp.floor(0.15915494309189535*(1.5707963267948966 + t320))
+    t322 = xp.where(t249, 0, xp.atan2(-t254, t242))
+    t323 = t322
+    t324 = t323 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t323))
+    t325 = 3.141592653589793 + t322 - 6.283185307179586*xp.ceil(0.15915494309189535*t322)
+    t326 = t325 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t325))
+    t327 = xp.where(t258, 0, xp.atan2(-t240, t191))
     t328 = t327
-    t329 = t328 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t328))
-    t330 = 3.141592653589793 + t327 - 6.283185307179586*xp.ceil(0.15915494309189535*t327)
-    t331 = t330 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t330))
-    t332 = -t326
-    t333 = t326 + 6.283185307179586*xp.floor(0.15915494309189535*(1.5707963267948966 + t332))
-    t334 = xp.less_equal(t56, 2.9670597283903604)
-    t335 = xp.greater_equal(t55, -2.9670597283903604) & xp.less_equal(t55, 2.9670597283903604)
-    t336 = xp.where(t334 & xp.logical_not(t335), t56, t55)
-    t337 = xp.less_equal(t267, 2.9670597283903604)
-    t338 = xp.greater_equal(t266, -2.9670597283903604) & xp.less_equal(t266, 2.9670597283903604)
-    t339 = xp.where(t337 & xp.logical_not(t338), t267, t266)
-    t340 = xp.less_equal(t272, 2.9670597283903604)
-    t341 = xp.greater_equal(t271, -2.9670597283903604) & xp.less_equal(t271, 2.9670597283903604)
-    t342 = xp.less_equal(t277, 1.5707963267948966)
-    t343 = xp.greater_equal(t276, -1.5707963267948966) & xp.less_equal(t276, 1.5707963267948966)
-    t344 = xp.less_equal(t281, 2.9670597283903604)
-    t345 = xp.greater_equal(t280, -2.9670597283903604) & xp.less_equal(t280, 2.9670597283903604)
-    t346 = xp.less_equal(t274, 2.9670597283903604)
-    t347 = xp.greater_equal(t273, -2.9670597283903604) & xp.less_equal(t273, 2.9670597283903604)
-    t348 = -t285
-    t349 = xp.less_equal(t283, 2.9670597283903604)
-    t350 = xp.greater_equal(t282, -2.9670597283903604) & xp.less_equal(t282, 2.9670597283903604)
-    t351 = xp.less_equal(t84, 2.9670597283903604)
-    t352 = xp.greater_equal(t83, -2.9670597283903604) & xp.less_equal(t83, 2.9670597283903604)
-    t353 = xp.where(t351 & xp.logical_not(t352), t84, t83)
-    t354 = xp.less_equal(t71, 2.9670597283903604)
-    t355 = xp.greater_equal(t70, -2.9670597283903604) & xp.less_equal(t70, 2.9670597283903604)
-    t356 = xp.where(t354 & xp.logical_not(t355), t71, t70)
-    t357 = xp.less_equal(t288, 2.9670597283903604)
-    t358 = xp.greater_equal(t287, -2.9670597283903604) & xp.less_equal(t287, 2.9670597283903604)
-    t359 = xp.less_equal(t293, 1.5707963267948966)
-    t360 = xp.greater_equal(t292, -1.5707963267948966) & xp.less_equal(t292, 1.5707963267948966)
-    t361 = xp.less_equal(t297, 2.9670597283903604)
-    t362 = xp.greater_equal(t296, -2.9670597283903604) & xp.less_equal(t296, 2.9670597283903604)
-    t363 = xp.less_equal(t290, 2.9670597283903604)
-    t364 = xp.greater_equal(t289, -2.9670597283903604) & xp.less_equal(t289, 2.9670597283903604)
-    t365 = -t301
-    t366 = xp.less_equal(t299, 2.9670597283903604)
-    t367 = xp.greater_equal(t298, -2.9670597283903604) & xp.less_equal(t298, 2.9670597283903604)
-    t368 = xp.less_equal(t180, 2.9670597283903604)
-    t369 = xp.greater_equal(t179, -2.9670597283903604) & xp.less_equal(t179, 2.9670597283903604)
-    t370 = xp.where(t368 & xp.logical_not(t369), t180, t179)
-    t371 = -t21
-    t372 = xp.less_equal(t304, 2.9670597283903604)
-    t373 = xp.greater_equal(t303, -2.9670597283903604) & xp.less_equal(t303, 2.9670597283903604)
-    t374 = xp.less_equal(t309, 1.5707963267948966)
-    t375 = xp.greater_equal(t308, -1.5707963267948966) & xp.less_equal(t308, 1.5707963267948966)
-    t376 = xp.less_equal(t313, 2.9670597283903604)
-    t377 = xp.greater_equal(t312, -2.9670597283903604) & xp.less_equal(t312, 2.9670597283903604)
-    t378 = xp.less_equal(t306, 2.9670597283903604)
-    t379 = xp.greater_equal(t305, -2.9670597283903604) & xp.less_equal(t305, 2.9670597283903604)
-    t380 = -t317
-    t381 = xp.less_equal(t315, 2.9670597283903604)
-    t382 = xp.greater_equal(t314, -2.9670597283903604) & xp.less_equal(t314, 2.9670597283903604)
-    t383 = xp.less_equal(t269, 2.9670597283903604)
-    t384 = xp.greater_equal(t268, -2.9670597283903604) & xp.less_equal(t268, 2.9670597283903604)
-    t385 = xp.where(t383 & xp.logical_not(t384), t269, t268)
-    t386 = xp.less_equal(t320, 2.9670597283903604)
-    t387 = xp.greater_equal(t319, -2.9670597283903604) & xp.less_equal(t319, 2.9670597283903604)
-    t388 = xp.less_equal(t325, 1.5707963267948966)
-    t389 = xp.greater_equal(t324, -1.5707963267948966) & xp.less_equal(t324, 1.5707963267948966)
-    t390 = xp.less_equal(t329, 2.9670597283903604)
-    t391 = xp.greater_equal(t328, -2.9670597283903604) & xp.less_equal(t328, 2.9670597283903604)
-    t392 = xp.less_equal(t322, 2.9670597283903604)
-    t393 = xp.greater_equal(t321, -2.9670597283903604) & xp.less_equal(t321, 2.9670597283903604)
-    t394 = -t333
-    t395 = xp.less_equal(t331, 2.9670597283903604)
-    t396 = xp.greater_equal(t330, -2.9670597283903604) & xp.less_equal(t330, 2.9670597283903604)
-    t397 = xp.isfinite(t0)
-    t398 = xp.greater_equal(t18, t20)
-    t399 = xp.greater_equal(t26, t28)
-    t400 = xp.greater(t26, t27)
-    t401 = xp.greater(t18, t19)
-    t402 = xp.greater_equal(t21, 0.30479999999999996)
-    t403 = xp.less_equal(t21, 1.27)
-    t404 = t334 | t335
-    t405 = t337 | t338
-    t406 = t351 | t352
-    t407 = t354 | t355
-    t408 = xp.greater_equal(t371, 0.30479999999999996)
-    t409 = xp.less_equal(t371, 1.27)
-    t410 = t368 | t369
-    t411 = t383 | t384
+    t329 = t328 - 6.283185307179586*xp.floor(0.15915494309189535*(1.5707963267948966 + t328))
+    t330 = t327 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t327))
+    t331 = xp.where(xp.less_equal(t267, 1e-24*t268), 0, xp.atan2(t263, -t264))
+    t332 = t331
+    t333 = t332 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t332))
+    t334 = 3.141592653589793 + t331 - 6.283185307179586*xp.ceil(0.15915494309189535*t331)
+    t335 = t334 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t334))
+    t336 = -t330
+    t337 = t330 + 6.283185307179586*xp.floor(0.15915494309189535*(1.5707963267948966 + t336))
+    t338 = xp.less_equal(t56, 2.9670597283903604)
+    t339 = xp.greater_equal(t55, -2.9670597283903604) & xp.less_equal(t55, 2.9670597283903604)
+    t340 = xp.where(t338 & xp.logical_not(t339), t56, t55)
+    t341 = xp.less_equal(t271, 2.9670597283903604)
+    t342 = xp.greater_equal(t270, -2.9670597283903604) & xp.less_equal(t270, 2.9670597283903604)
+    t343 = xp.where(t341 & xp.logical_not(t342), t271, t270)
+    t344 = xp.less_equal(t276, 2.9670597283903604)
+    t345 = xp.greater_equal(t275, -2.9670597283903604) & xp.less_equal(t275, 2.9670597283903604)
+    t346 = xp.less_equal(t281, 1.5707963267948966)
+    t347 = xp.greater_equal(t280, -1.5707963267948966) & xp.less_equal(t280, 1.5707963267948966)
+    t348 = xp.less_equal(t285, 2.9670597283903604)
+    t349 = xp.greater_equal(t284, -2.9670597283903604) & xp.less_equal(t284, 2.9670597283903604)
+    t350 = xp.less_equal(t278, 2.9670597283903604)
+    t351 = xp.greater_equal(t277, -2.9670597283903604) & xp.less_equal(t277, 2.9670597283903604)
+    t352 = -t289
+    t353 = xp.less_equal(t352, 1.5707963267948966)
+    t354 = xp.greater_equal(t288, -1.5707963267948966) & xp.less_equal(t288, 1.5707963267948966)
+    t355 = xp.less_equal(t287, 2.9670597283903604)
+    t356 = xp.greater_equal(t286, -2.9670597283903604) & xp.less_equal(t286, 2.9670597283903604)
+    t357 = xp.less_equal(t84, 2.9670597283903604)
+    t358 = xp.greater_equal(t83, -2.9670597283903604) & xp.less_equal(t83, 2.9670597283903604)
+    t359 = xp.where(t357 & xp.logical_not(t358), t84, t83)
+    t360 = xp.less_equal(t71, 2.9670597283903604)
+    t361 = xp.greater_equal(t70, -2.9670597283903604) & xp.less_equal(t70, 2.9670597283903604)
+    t362 = xp.where(t360 & xp.logical_not(t361), t71, t70)
+    t363 = xp.less_equal(t292, 2.9670597283903604)
+    t364 = xp.greater_equal(t291, -2.9670597283903604) & xp.less_equal(t291, 2.9670597283903604)
+    t365 = xp.less_equal(t297, 1.5707963267948966)
+    t366 = xp.greater_equal(t296, -1.5707963267948966) & xp.less_equal(t296, 1.5707963267948966)
+    t367 = xp.less_equal(t301, 2.9670597283903604)
+    t368 = xp.greater_equal(t300, -2.9670597283903604) & xp.less_equal(t300, 2.9670597283903604)
+    t369 = xp.less_equal(t294, 2.9670597283903604)
+    t370 = xp.greater_equal(t293, -2.9670597283903604) & xp.less_equal(t293, 2.9670597283903604)
+    t371 = -t305
+    t372 = xp.less_equal(t371, 1.5707963267948966)
+    t373 = xp.greater_equal(t304, -1.5707963267948966) & xp.less_equal(t304, 1.5707963267948966)
+    t374 = xp.less_equal(t303, 2.9670597283903604)
+    t375 = xp.greater_equal(t302, -2.9670597283903604) & xp.less_equal(t302, 2.9670597283903604)
+    t376 = xp.less_equal(t182, 2.9670597283903604)
+    t377 = xp.greater_equal(t181, -2.9670597283903604) & xp.less_equal(t181, 2.9670597283903604)
+    t378 = xp.where(t376 & xp.logical_not(t377), t182, t181)
+    t379 = -t21
+    t380 = xp.less_equal(t308, 2.9670597283903604)
+    t381 = xp.greater_equal(t307, -2.9670597283903604) & xp.less_equal(t307, 2.9670597283903604)
+    t382 = xp.less_equal(t313, 1.5707963267948966)
+    t383 = xp.greater_equal(t312, -1.5707963267948966) & xp.less_equal(t312, 1.5707963267948966)
+    t384 = xp.less_equal(t317, 2.9670597283903604)
+    t385 = xp.greater_equal(t316, -2.9670597283903604) & xp.less_equal(t316, 2.9670597283903604)
+    t386 = xp.less_equal(t310, 2.9670597283903604)
+    t387 = xp.greater_equal(t309, -2.9670597283903604) & xp.less_equal(t309, 2.9670597283903604)
+    t388 = -t321
+    t389 = xp.less_equal(t388, 1.5707963267948966)
+    t390 = xp.greater_equal(t320, -1.5707963267948966) & xp.less_equal(t320, 1.5707963267948966)
+    t391 = xp.less_equal(t319, 2.9670597283903604)
+    t392 = xp.greater_equal(t318, -2.9670597283903604) & xp.less_equal(t318, 2.9670597283903604)
+    t393 = xp.less_equal(t273, 2.9670597283903604)
+    t394 = xp.greater_equal(t272, -2.9670597283903604) & xp.less_equal(t272, 2.9670597283903604)
+    t395 = xp.where(t393 & xp.logical_not(t394), t273, t272)
+    t396 = xp.less_equal(t324, 2.9670597283903604)
+    t397 = xp.greater_equal(t323, -2.9670597283903604) & xp.less_equal(t323, 2.9670597283903604)
+    t398 = xp.less_equal(t329, 1.5707963267948966)
+    t399 = xp.greater_equal(t328, -1.5707963267948966) & xp.less_equal(t328, 1.5707963267948966)
+    t400 = xp.less_equal(t333, 2.9670597283903604)
+    t401 = xp.greater_equal(t332, -2.9670597283903604) & xp.less_equal(t332, 2.9670597283903604)
+    t402 = xp.less_equal(t326, 2.9670597283903604)
+    t403 = xp.greater_equal(t325, -2.9670597283903604) & xp.less_equal(t325, 2.9670597283903604)
+    t404 = -t337
+    t405 = xp.less_equal(t404, 1.5707963267948966)
+    t406 = xp.greater_equal(t336, -1.5707963267948966) & xp.less_equal(t336, 1.5707963267948966)
+    t407 = xp.less_equal(t335, 2.9670597283903604)
+    t408 = xp.greater_equal(t334, -2.9670597283903604) & xp.less_equal(t334, 2.9670597283903604)
+    t409 = xp.isfinite(t0)
+    t410 = xp.greater_equal(t18, -t19)
+    t411 = xp.greater_equal(t26, -t27)
+    t412 = xp.greater_equal(t21, 0.30479999999999996)
+    t413 = xp.less_equal(t21, 1.27)
+    t414 = t338 | t339
+    t415 = t341 | t342
+    t416 = t357 | t358
+    t417 = t360 | t361
+    t418 = xp.greater_equal(t379, 0.30479999999999996)
+    t419 = xp.less_equal(t379, 1.27)
+    t420 = t376 | t377
+    t421 = t393 | t394
     q = _stack(xp, [
-        t336,  # 0, 0
-        t339,  # 0, 1
+        t340,  # 0, 0
+        t343,  # 0, 1
         t21,  # 0, 2
-        xp.where(t340 & xp.logical_not(t341), t272, t271),  # 0, 3
-        xp.where(t342 & xp.logical_not(t343), t277, t276),  # 0, 4
-        xp.where(t344 & xp.logical_not(t345), t281, t280),  # 0, 5
-        t336,  # 1, 0
-        t339,  # 1, 1
+        xp.where(t344 & xp.logical_not(t345), t276, t275),  # 0, 3
+        xp.where(t346 & xp.logical_not(t347), t281, t280),  # 0, 4
+        xp.where(t348 & xp.logical_not(t349), t285, t284),  # 0, 5
+        t340,  # 1, 0
+        t343,  # 1, 1
         t21,  # 1, 2
-        xp.where(t346 & xp.logical_not(t347), t274, t273),  # 1, 3
-        xp.where(xp.greater_equal(t285, -1.5707963267948966) & xp.logical_not(xp.greater_equal(t278, -1.5707963267948966) & xp.less_equal(t278, 1.5707963267948966)), t348, t284),  # 1, 4
-        xp.where(t349 & xp.logical_not(t350), t283, t282),  # 1, 5
-        t353,  # 2, 0
-        t356,  # 2, 1
+        xp.where(t350 & xp.logical_not(t351), t278, t277),  # 1, 3
+        xp.where(t353 & xp.logical_not(t354), t352, t288),  # 1, 4
+        xp.where(t355 & xp.logical_not(t356), t287, t286),  # 1, 5
+        t359,  # 2, 0
+        t362,  # 2, 1
         t21,  # 2, 2
-        xp.where(t357 & xp.logical_not(t358), t288, t287),  # 2, 3
-        xp.where(t359 & xp.logical_not(t360), t293, t292),  # 2, 4
-        xp.where(t361 & xp.logical_not(t362), t297, t296),  # 2, 5
-        t353,  # 3, 0
-        t356,  # 3, 1
+        xp.where(t363 & xp.logical_not(t364), t292, t291),  # 2, 3
+        xp.where(t365 & xp.logical_not(t366), t297, t296),  # 2, 4
+        xp.where(t367 & xp.logical_not(t368), t301, t300),  # 2, 5
+        t359,  # 3, 0
+        t362,  # 3, 1
         t21,  # 3, 2
-        xp.where(t363 & xp.logical_not(t364), t290, t289),  # 3, 3
-        xp.where(xp.greater_equal(t301, -1.5707963267948966) & xp.logical_not(xp.greater_equal(t294, -1.5707963267948966) & xp.less_equal(t294, 1.5707963267948966)), t365, t300),  # 3, 4
-        xp.where(t366 & xp.logical_not(t367), t299, t298),  # 3, 5
-        t336,  # 4, 0
-        t370,  # 4, 1
-        t371,  # 4, 2
-        xp.where(t372 & xp.logical_not(t373), t304, t303),  # 4, 3
-        xp.where(t374 & xp.logical_not(t375), t309, t308),  # 4, 4
-        xp.where(t376 & xp.logical_not(t377), t313, t312),  # 4, 5
-        t336,  # 5, 0
-        t370,  # 5, 1
-        t371,  # 5, 2
-        xp.where(t378 & xp.logical_not(t379), t306, t305),  # 5, 3
-        xp.where(xp.greater_equal(t317, -1.5707963267948966) & xp.logical_not(xp.greater_equal(t310, -1.5707963267948966) & xp.less_equal(t310, 1.5707963267948966)), t380, t316),  # 5, 4
-        xp.where(t381 & xp.logical_not(t382), t315, t314),  # 5, 5
-        t353,  # 6, 0
-        t385,  # 6, 1
-        t371,  # 6, 2
-        xp.where(t386 & xp.logical_not(t387), t320, t319),  # 6, 3
-        xp.where(t388 & xp.logical_not(t389), t325, t324),  # 6, 4
-        xp.where(t390 & xp.logical_not(t391), t329, t328),  # 6, 5
-        t353,  # 7, 0
-        t385,  # 7, 1
-        t371,  # 7, 2
-        xp.where(t392 & xp.logical_not(t393), t322, t321),  # 7, 3
-        xp.where(xp.greater_equal(t333, -1.5707963267948966) & xp.logical_not(xp.greater_equal(t326, -1.5707963267948966) & xp.less_equal(t326, 1.5707963267948966)), t394, t332),  # 7, 4
-        xp.where(t395 & xp.logical_not(t396), t331, t330),  # 7, 5
+        xp.where(t369 & xp.logical_not(t370), t294, t293),  # 3, 3
+        xp.where(t372 & xp.logical_not(t373), t371, t304),  # 3, 4
+        xp.where(t374 & xp.logical_not(t375), t303, t302),  # 3, 5
+        t340,  # 4, 0
+        t378,  # 4, 1
+        t379,  # 4, 2
+        xp.where(t380 & xp.logical_not(t381), t308, t307),  # 4, 3
+        xp.where(t382 & xp.logical_not(t383), t313, t312),  # 4, 4
+        xp.where(t384 & xp.logical_not(t385), t317, t316),  # 4, 5
+        t340,  # 5, 0
+        t378,  # 5, 1
+        t379,  # 5, 2
+        xp.where(t386 & xp.logical_not(t387), t310, t309),  # 5, 3
+        xp.where(t389 & xp.logical_not(t390), t388, t320),  # 5, 4
+        xp.where(t391 & xp.logical_not(t392), t319, t318),  # 5, 5
+        t359,  # 6, 0
+        t395,  # 6, 1
+        t379,  # 6, 2
+        xp.where(t396 & xp.logical_not(t397), t324, t323),  # 6, 3
+        xp.where(t398 & xp.logical_not(t399), t329, t328),  # 6, 4
+        xp.where(t400 & xp.logical_not(t401), t333, t332),  # 6, 5
+        t359,  # 7, 0
+        t395,  # 7, 1
+        t379,  # 7, 2
+        xp.where(t402 & xp.logical_not(t403), t326, t325),  # 7, 3
+        xp.where(t405 & xp.logical_not(t406), t404, t336),  # 7, 4
+        xp.where(t407 & xp.logical_not(t408), t335, t334),  # 7, 5
     ], (8, 6))
     valid = _stack(xp, [
-        t397 & t398 & t399 & xp.greater_equal(t105, -1e-12),  # 0
-        t397 & t398 & t399 & xp.greater(t105, 1e-12),  # 1
-        t397 & t398 & t400 & xp.greater_equal(t146, -1e-12),  # 2
-        t397 & t398 & t400 & xp.greater(t146, 1e-12),  # 3
-        t397 & t399 & t401 & xp.greater_equal(t203, -1e-12),  # 4
-        t397 & t399 & t401 & xp.greater(t203, 1e-12),  # 5
-        t397 & t400 & t401 & xp.greater_equal(t235, -1e-12),  # 6
-        t397 & t400 & t401 & xp.greater(t235, 1e-12),  # 7
+        t409 & t410 & t411 & xp.greater_equal(t105, -1e-12),  # 0
+        t409 & t410 & t411 & t106,  # 1
+        t28 & t409 & t410 & xp.greater_equal(t147, -1e-12),  # 2
+        t28 & t409 & t410 & t148,  # 3
+        t409 & t411 & t20 & xp.greater_equal(t205, -1e-12),  # 4
+        t409 & t411 & t206 & t20,  # 5
+        t28 & t409 & t20 & xp.greater_equal(t238, -1e-12),  # 6
+        t28 & t409 & t20 & t239,  # 7
     ], (8,))
     in_limits = _stack(xp, [
-        t402 & t403 & t404 & t405 & (t340 | t341) & (t342 | t343) & (t344 | t345),  # 0
-        t402 & t403 & t404 & t405 & (t347 | t346) & (t349 | t350) & (xp.less_equal(t348, 1.5707963267948966) | (xp.greater_equal(t284, -1.5707963267948966) & xp.less_equal(t284, 1.5707963267948966))),  # 1
-        t402 & t403 & t406 & t407 & (t357 | t358) & (t359 | t360) & (t361 | t362),  # 2
-        t402 & t403 & t406 & t407 & (t363 | t364) & (t366 | t367) & (xp.less_equal(t365, 1.5707963267948966) | (xp.greater_equal(t300, -1.5707963267948966) & xp.less_equal(t300, 1.5707963267948966))),  # 3
-        t404 & t408 & t409 & t410 & (t372 | t373) & (t374 | t375) & (t376 | t377),  # 4
-        t404 & t408 & t409 & t410 & (t378 | t379) & (t381 | t382) & (xp.less_equal(t380, 1.5707963267948966) | (xp.greater_equal(t316, -1.5707963267948966) & xp.less_equal(t316, 1.5707963267948966))),  # 5
-        t406 & t408 & t409 & t411 & (t386 | t387) & (t388 | t389) & (t390 | t391),  # 6
-        t406 & t408 & t409 & t411 & (t392 | t393) & (t395 | t396) & (xp.less_equal(t394, 1.5707963267948966) | (xp.greater_equal(t332, -1.5707963267948966) & xp.less_equal(t332, 1.5707963267948966))),  # 7
+        t412 & t413 & t414 & t415 & (t347 | t346) & (t348 | t349) & (t344 | t345),  # 0
+        t412 & t413 & t414 & t415 & (t350 | t351) & (t353 | t354) & (t355 | t356),  # 1
+        t412 & t413 & t416 & t417 & (t363 | t364) & (t365 | t366) & (t367 | t368),  # 2
+        t412 & t413 & t416 & t417 & (t369 | t370) & (t372 | t373) & (t374 | t375),  # 3
+        t414 & t418 & t419 & t420 & (t380 | t381) & (t382 | t383) & (t384 | t385),  # 4
+        t414 & t418 & t419 & t420 & (t386 | t387) & (t389 | t390) & (t391 | t392),  # 5
+        t416 & t418 & t419 & t421 & (t396 | t397) & (t398 | t399) & (t400 | t401),  # 6
+        t416 & t418 & t419 & t421 & (t402 | t403) & (t405 | t406) & (t407 | t408),  # 7
     ], (8,))
     return q, valid, in_limits
 
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
-    """the closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status: (6 x 1 and 1 x 1), 940 operations."""
+    """the closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status: (6 x 1 and 1 x 1), 859 operations."""
     xp, dtype, device, batch, (T, q_seed, weights,) = _arguments(("T", T, (4, 4)), ("q_seed", q_seed, (6,)), ("weights", weights, (6,)))
     branches_q, branches_valid, branches_in_limits = ik_branches(T)
     T00 = T[..., 0, 0]
@@ -2723,7 +2733,7 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     t104 = xp.where(xp.greater_equal(t11, -2.9670597283903604) & xp.less_equal(t11, 2.9670597283903604), t11, xp.where(xp.greater_equal(t102, -2.9670597283903604) & xp.less_equal(t102, 2.9670597283903604), t102, xp.where(xp.greater_equal(t103, -2.9670597283903604) & xp.less_equal(t103, 2.9670597283903604), t103, qb1_5)))
     t105 = qw1*(t88 + t70)**2 + qw2*(t92 + t71)**2 + qw3*(t72 + qb1_2)**2 + qw4*(t96 + t73)**2 + qw5*(t100 + t74)**2 + qw6*(t104 + t75)**2
     t106 = xp.greater(t12, 0)
-    t107 = xp.where(t106 & (xp.greater(t84, t105) | xp.less(t6, 1)), xp.asarray(1, dtype=dtype), 0)
+    t107 = xp.where(t106 & (xp.less(t6, 1) | xp.less(t105, t84)), xp.asarray(1, dtype=dtype), 0)
     t108 = xp.where(t106, 1, t6)
     t109 = xp.greater(t107, 0)
     t110 = xp.where(t109, t88, t78)
@@ -2755,7 +2765,7 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     t136 = xp.where(xp.greater_equal(t17, -2.9670597283903604) & xp.less_equal(t17, 2.9670597283903604), t17, xp.where(xp.greater_equal(t134, -2.9670597283903604) & xp.less_equal(t134, 2.9670597283903604), t134, xp.where(xp.greater_equal(t135, -2.9670597283903604) & xp.less_equal(t135, 2.9670597283903604), t135, qb2_5)))
     t137 = qw1*(t120 + t70)**2 + qw2*(t124 + t71)**2 + qw3*(t72 + qb2_2)**2 + qw4*(t128 + t73)**2 + qw5*(t132 + t74)**2 + qw6*(t136 + t75)**2
     t138 = xp.greater(t18, 0)
-    t139 = xp.where(t138 & (xp.greater(t116, t137) | xp.less(t108, 1)), xp.asarray(1, dtype=dtype), 0)
+    t139 = xp.where(t138 & (xp.less(t108, 1) | xp.less(t137, t116)), xp.asarray(1, dtype=dtype), 0)
     t140 = xp.where(t138, 1, t108)
     t141 = xp.greater(t139, 0)
     t142 = xp.where(t141, t120, t110)
@@ -2787,7 +2797,7 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     t168 = xp.where(xp.greater_equal(t23, -2.9670597283903604) & xp.less_equal(t23, 2.9670597283903604), t23, xp.where(xp.greater_equal(t166, -2.9670597283903604) & xp.less_equal(t166, 2.9670597283903604), t166, xp.where(xp.greater_equal(t167, -2.9670597283903604) & xp.less_equal(t167, 2.9670597283903604), t167, qb3_5)))
     t169 = qw1*(t152 + t70)**2 + qw2*(t156 + t71)**2 + qw3*(t72 + qb3_2)**2 + qw4*(t160 + t73)**2 + qw5*(t164 + t74)**2 + qw6*(t168 + t75)**2
     t170 = xp.greater(t24, 0)
-    t171 = xp.where(t170 & (xp.greater(t148, t169) | xp.less(t140, 1)), xp.asarray(1, dtype=dtype), 0)
+    t171 = xp.where(t170 & (xp.less(t140, 1) | xp.less(t169, t148)), xp.asarray(1, dtype=dtype), 0)
     t172 = xp.where(t170, 1, t140)
     t173 = xp.greater(t171, 0)
     t174 = xp.where(t173, t152, t142)
@@ -2819,7 +2829,7 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     t200 = xp.where(xp.greater_equal(t29, -2.9670597283903604) & xp.less_equal(t29, 2.9670597283903604), t29, xp.where(xp.greater_equal(t198, -2.9670597283903604) & xp.less_equal(t198, 2.9670597283903604), t198, xp.where(xp.greater_equal(t199, -2.9670597283903604) & xp.less_equal(t199, 2.9670597283903604), t199, qb4_5)))
     t201 = qw1*(t184 + t70)**2 + qw2*(t188 + t71)**2 + qw3*(t72 + qb4_2)**2 + qw4*(t192 + t73)**2 + qw5*(t196 + t74)**2 + qw6*(t200 + t75)**2
     t202 = xp.greater(t30, 0)
-    t203 = xp.where(t202 & (xp.greater(t180, t201) | xp.less(t172, 1)), xp.asarray(1, dtype=dtype), 0)
+    t203 = xp.where(t202 & (xp.less(t172, 1) | xp.less(t201, t180)), xp.asarray(1, dtype=dtype), 0)
     t204 = xp.where(t202, 1, t172)
     t205 = xp.greater(t203, 0)
     t206 = xp.where(t205, t184, t174)
@@ -2851,7 +2861,7 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     t232 = xp.where(xp.greater_equal(t35, -2.9670597283903604) & xp.less_equal(t35, 2.9670597283903604), t35, xp.where(xp.greater_equal(t230, -2.9670597283903604) & xp.less_equal(t230, 2.9670597283903604), t230, xp.where(xp.greater_equal(t231, -2.9670597283903604) & xp.less_equal(t231, 2.9670597283903604), t231, qb5_5)))
     t233 = qw1*(t216 + t70)**2 + qw2*(t220 + t71)**2 + qw3*(t72 + qb5_2)**2 + qw4*(t224 + t73)**2 + qw5*(t228 + t74)**2 + qw6*(t232 + t75)**2
     t234 = xp.greater(t36, 0)
-    t235 = xp.where(t234 & (xp.greater(t212, t233) | xp.less(t204, 1)), xp.asarray(1, dtype=dtype), 0)
+    t235 = xp.where(t234 & (xp.less(t204, 1) | xp.less(t233, t212)), xp.asarray(1, dtype=dtype), 0)
     t236 = xp.where(t234, 1, t204)
     t237 = xp.greater(t235, 0)
     t238 = xp.where(t237, t216, t206)
@@ -2915,7 +2925,7 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     t296 = xp.where(xp.greater_equal(t47, -2.9670597283903604) & xp.less_equal(t47, 2.9670597283903604), t47, xp.where(xp.greater_equal(t294, -2.9670597283903604) & xp.less_equal(t294, 2.9670597283903604), t294, xp.where(xp.greater_equal(t295, -2.9670597283903604) & xp.less_equal(t295, 2.9670597283903604), t295, qb7_5)))
     t297 = qw1*(t280 + t70)**2 + qw2*(t284 + t71)**2 + qw3*(t72 + qb7_2)**2 + qw4*(t288 + t73)**2 + qw5*(t292 + t74)**2 + qw6*(t296 + t75)**2
     t298 = xp.greater(t48, 0)
-    t299 = xp.where(t298 & (xp.greater(t276, t297) | xp.less(t268, 1)), xp.asarray(1, dtype=dtype), 0)
+    t299 = xp.where(t298 & (xp.less(t268, 1) | xp.less(t297, t276)), xp.asarray(1, dtype=dtype), 0)
     t300 = xp.where(t298, 1, t268)
     t301 = xp.greater(t299, 0)
     t302 = xp.where(t301, t280, t270)

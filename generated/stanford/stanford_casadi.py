@@ -998,7 +998,7 @@ def _jacobian_det(q):
 
 
 def _velocity_ik(q, mu_dot, damping):
-    """Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: 1168 operations."""
+    """Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: 1167 operations."""
     q1 = q[0]
     q2 = q[1]
     q3 = q[2]
@@ -1366,27 +1366,27 @@ def _velocity_ik(q, mu_dot, damping):
     t344 = casadi.if_else((t281 != 0), -(t293 - (t288*t343 + t307*t342 + t324*t341))/t281, 0)
     t345 = casadi.if_else((t239 != 0), -(t247 - (t243*t344 + t269*t342 + t275*t341 - t263*t343))/t239, 0)
     t346 = casadi.if_else((t39 != 0), -(t235 - (t229*t345 + t232*t344 + t227*t341*t259 + t227*t342*t255 - t227*t343*t252))/t39, 0)
-    t347 = (damping > 0)
-    t348 = (casadi.fabs(t258) < casadi.inf)
-    t349 = (damping >= 0)
-    t350 = 1e-12*t59
+    t347 = (casadi.fabs(t258) < casadi.inf)
+    t348 = (damping >= 0)
+    t349 = 1e-12*t59
+    t350 = (damping > 0)
     t351 = 1e-12*t73
-    t352 = casadi.logic_or(casadi.logic_and(t347, casadi.logic_or(casadi.logic_or(casadi.logic_or(casadi.logic_or(casadi.logic_or((t117 <= t351), (t149 <= t351)), (t168 <= t351)), (t180 <= t351)), (t207 <= t351)), (t74 <= t351))), casadi.logic_and((damping <= 0), casadi.logic_or(casadi.logic_or(casadi.logic_or(casadi.logic_or(casadi.logic_or((t38 <= t350), (t238 <= t350)), (t280 <= t350)), (t297 <= t350)), (t315 <= t350)), (t336 <= t350))))
-    t353 = casadi.logic_and(casadi.logic_and(t348, t349), casadi.logic_not(t352))
+    t352 = casadi.logic_or(casadi.logic_and(t350, casadi.logic_or(casadi.logic_or(casadi.logic_or(casadi.logic_or(casadi.logic_or((t117 <= t351), (t149 <= t351)), (t168 <= t351)), (t180 <= t351)), (t207 <= t351)), (t74 <= t351))), casadi.logic_and((damping <= 0), casadi.logic_or(casadi.logic_or(casadi.logic_or(casadi.logic_or(casadi.logic_or((t38 <= t349), (t238 <= t349)), (t280 <= t349)), (t297 <= t349)), (t315 <= t349)), (t336 <= t349))))
+    t353 = casadi.logic_and(casadi.logic_and(t347, t348), casadi.logic_not(t352))
     q_dot = casadi.SX(6, 1)
-    q_dot[0, 0] = casadi.if_else(t353, casadi.if_else(t347, t218, t346), 0)
-    q_dot[1, 0] = casadi.if_else(t353, casadi.if_else(t347, t225, t345), 0)
-    q_dot[2, 0] = casadi.if_else(t353, casadi.if_else(t347, t219, t344), 0)
-    q_dot[3, 0] = casadi.if_else(t353, casadi.if_else(t347, t220, t343), 0)
-    q_dot[4, 0] = casadi.if_else(t353, casadi.if_else(t347, t221, t342), 0)
-    q_dot[5, 0] = casadi.if_else(t353, casadi.if_else(t347, t222, t341), 0)
+    q_dot[0, 0] = casadi.if_else(t353, casadi.if_else(t350, t218, t346), 0)
+    q_dot[1, 0] = casadi.if_else(t353, casadi.if_else(t350, t225, t345), 0)
+    q_dot[2, 0] = casadi.if_else(t353, casadi.if_else(t350, t219, t344), 0)
+    q_dot[3, 0] = casadi.if_else(t353, casadi.if_else(t350, t220, t343), 0)
+    q_dot[4, 0] = casadi.if_else(t353, casadi.if_else(t350, t221, t342), 0)
+    q_dot[5, 0] = casadi.if_else(t353, casadi.if_else(t350, t222, t341), 0)
     status = casadi.SX(1, 1)
-    status[0, 0] = casadi.if_else(casadi.logic_not(casadi.logic_and(t348, t349)), 2, casadi.if_else(t352, 1, 0))
+    status[0, 0] = casadi.if_else(casadi.logic_not(casadi.logic_and(t347, t348)), 2, casadi.if_else(t352, 1, 0))
     return [q_dot, status]
 
 
 def _ik_numeric_step(target, q, damping):
-    """One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite): 871 operations."""
+    """One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite): 856 operations."""
     T00 = target[0, 0]
     T01 = target[0, 1]
     T02 = target[0, 2]
@@ -1692,7 +1692,7 @@ def _ik_numeric_step(target, q, damping):
 
 
 def _ik_branches(T):
-    """Every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits: 1059 operations."""
+    """Every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits: 1055 operations."""
     T00 = T[0, 0]
     T01 = T[0, 1]
     T02 = T[0, 2]
@@ -1725,16 +1725,16 @@ def _ik_branches(T):
     t17 = 0.01787569 + t15
     t18 = -t16
     t19 = 1e-12*t17
-    t20 = -t19
-    t21 = casadi.if_else((t16 < t20), casadi.sqrt(t18), 0)
+    t20 = (t18 > t19)
+    t21 = casadi.if_else(t20, casadi.sqrt(t18), 0)
     t22 = t21**2
     t23 = 0.01787569 + t22
     t24 = 0.01787569 + t14
     t25 = t24 - t23
     t26 = -t25
     t27 = 1e-12*t23
-    t28 = -t27
-    t29 = casadi.if_else((t25 < t28), casadi.sqrt(t26), 0)
+    t28 = (t26 > t27)
+    t29 = casadi.if_else(t28, casadi.sqrt(t26), 0)
     t30 = t4*t29
     t31 = t14 + 0.1337*t8
     t32 = t31 - t30
@@ -1811,384 +1811,394 @@ def _ik_branches(T):
     t103 = t91**2
     t104 = -t103
     t105 = 1 + t104
-    t106 = casadi.if_else((1e-12 < t105), casadi.sqrt(t105), 0)
-    t107 = t103 + t96*t106
-    t108 = t107 + t104
-    t109 = t90**2
-    t110 = t103 + t109 + t96**2
-    t111 = t106**2
-    t112 = t108**2 + t109*t111
-    t113 = t103 + t111
-    t114 = 1e-24*t113
-    t115 = (t112 <= t110*t114)
-    t116 = casadi.if_else(t115, 1, 1/casadi.sqrt(t112))
-    t117 = casadi.if_else(t115, 1, t108*t116)
-    t118 = t93*(1 - t117)
-    t119 = t118 + t93*t117
-    t120 = t90*t106
-    t121 = casadi.if_else(t115, 0, -t116*t120)
-    t122 = t92*t117 + t98*t121
-    t123 = t98*t117 - t92*t121
-    t124 = (t113 <= t114)
-    t125 = casadi.if_else(t124, 1, 1/casadi.sqrt(t113))
-    t126 = casadi.if_else(t124, 1, t91*t125)
-    t127 = casadi.if_else(t124, 0, -t106*t125)
-    t128 = t122*(1 - t126)
-    t129 = t128 + t126*t122
-    t130 = t126*t123 + t127*t119
-    t131 = t126*t119 - t127*t123
-    t132 = t129**2 + t130**2
-    t133 = t132
-    t134 = t132 + t131**2
-    t135 = 1 - t77
-    t136 = T22*t135
-    t137 = t136 + T22*t77
-    t138 = T20*t135
-    t139 = t138 + T20*t77
-    t140 = t68*t79 - t74*t137
-    t141 = t68*t137 + t74*t79
-    t142 = t68*t81 - t74*t139
-    t143 = t68*t139 + t74*t81
-    t144 = t141**2
-    t145 = -t144
-    t146 = 1 + t145
-    t147 = casadi.if_else((1e-12 < t146), casadi.sqrt(t146), 0)
-    t148 = t144 + t100*t147
-    t149 = t148 + t145
-    t150 = t140**2
-    t151 = t144 + t150 + t100**2
-    t152 = t147**2
-    t153 = t149**2 + t150*t152
-    t154 = t144 + t152
-    t155 = 1e-24*t154
-    t156 = (t153 <= t151*t155)
-    t157 = casadi.if_else(t156, 1, 1/casadi.sqrt(t153))
-    t158 = casadi.if_else(t156, 1, t149*t157)
-    t159 = t143*(1 - t158)
-    t160 = t159 + t143*t158
-    t161 = t140*t147
-    t162 = casadi.if_else(t156, 0, -t157*t161)
-    t163 = t142*t158 + t102*t162
-    t164 = t102*t158 - t142*t162
-    t165 = (t154 <= t155)
-    t166 = casadi.if_else(t165, 1, 1/casadi.sqrt(t154))
-    t167 = casadi.if_else(t165, 1, t141*t166)
-    t168 = casadi.if_else(t165, 0, -t147*t166)
-    t169 = t163*(1 - t167)
-    t170 = t169 + t167*t163
-    t171 = t167*t164 + t168*t160
-    t172 = t167*t160 - t168*t164
-    t173 = t170**2 + t171**2
-    t174 = t173
-    t175 = t173 + t172**2
-    t176 = (t64 <= t65)
-    t177 = casadi.if_else(t176, 1, 1/casadi.sqrt(t64))
-    t178 = casadi.if_else(t176, 1, t61*t177)
-    t179 = casadi.if_else(t176, 0, casadi.atan2(t69, t61))
-    t180 = t179 - 6.283185307179586*casadi.floor(0.15915494309189535*(2.9670597283903604 + t179))
-    t181 = t177*t69
-    t182 = casadi.if_else(t176, 0, t181)
-    t183 = casadi.if_else(t176, 0, -t181)
-    t184 = t51*t178 - t87*t182
-    t185 = t51*t182 + t87*t178
-    t186 = t53*t178 - t89*t182
-    t187 = t53*t182 + t89*t178
-    t188 = t79*t178 - t137*t183
-    t189 = t79*t183 + t137*t178
-    t190 = t81*t178 - t139*t183
-    t191 = t81*t183 + t139*t178
-    t192 = 1 - t178
-    t193 = t52*t192
-    t194 = t193 + t52*t178
-    t195 = t54*t192
-    t196 = t195 + t54*t178
-    t197 = t80*t192
-    t198 = t197 + t80*t178
-    t199 = t82*t192
-    t200 = t199 + t82*t178
-    t201 = t185**2
-    t202 = -t201
-    t203 = 1 + t202
-    t204 = casadi.if_else((1e-12 < t203), casadi.sqrt(t203), 0)
-    t205 = t201 + t194*t204
-    t206 = t205 + t202
-    t207 = t184**2
-    t208 = t201 + t207 + t194**2
-    t209 = t204**2
-    t210 = t206**2 + t207*t209
-    t211 = t201 + t209
-    t212 = 1e-24*t211
-    t213 = (t210 <= t208*t212)
-    t214 = casadi.if_else(t213, 1, 1/casadi.sqrt(t210))
-    t215 = casadi.if_else(t213, 1, t206*t214)
-    t216 = t187*(1 - t215)
-    t217 = t216 + t187*t215
-    t218 = t184*t204
-    t219 = casadi.if_else(t213, 0, -t214*t218)
-    t220 = t186*t215 + t196*t219
-    t221 = t196*t215 - t186*t219
-    t222 = (t211 <= t212)
-    t223 = casadi.if_else(t222, 1, 1/casadi.sqrt(t211))
-    t224 = casadi.if_else(t222, 1, t185*t223)
-    t225 = casadi.if_else(t222, 0, -t204*t223)
-    t226 = t220*(1 - t224)
-    t227 = t226 + t224*t220
-    t228 = t224*t221 + t225*t217
-    t229 = t224*t217 - t225*t221
-    t230 = t227**2 + t228**2
-    t231 = t230
-    t232 = t230 + t229**2
-    t233 = t189**2
-    t234 = -t233
-    t235 = 1 + t234
-    t236 = casadi.if_else((1e-12 < t235), casadi.sqrt(t235), 0)
-    t237 = t233 + t198*t236
-    t238 = t237 + t234
-    t239 = t188**2
-    t240 = t233 + t239 + t198**2
-    t241 = t236**2
-    t242 = t238**2 + t239*t241
-    t243 = t233 + t241
-    t244 = 1e-24*t243
-    t245 = (t242 <= t240*t244)
-    t246 = casadi.if_else(t245, 1, 1/casadi.sqrt(t242))
-    t247 = casadi.if_else(t245, 1, t238*t246)
-    t248 = t191*(1 - t247)
-    t249 = t248 + t191*t247
-    t250 = t188*t236
-    t251 = casadi.if_else(t245, 0, -t246*t250)
-    t252 = t190*t247 + t200*t251
-    t253 = t200*t247 - t190*t251
-    t254 = (t243 <= t244)
-    t255 = casadi.if_else(t254, 1, 1/casadi.sqrt(t243))
-    t256 = casadi.if_else(t254, 1, t189*t255)
-    t257 = casadi.if_else(t254, 0, -t236*t255)
-    t258 = t252*(1 - t256)
-    t259 = t258 + t256*t252
-    t260 = t256*t253 + t257*t249
-    t261 = t256*t249 - t257*t253
-    t262 = t259**2 + t260**2
-    t263 = t262
-    t264 = t262 + t261**2
-    t265 = -t69
-    t266 = casadi.if_else(t66, 0, casadi.atan2(t265, t59))
-    t267 = t266 - 6.283185307179586*casadi.floor(0.15915494309189535*(2.9670597283903604 + t266))
-    t268 = casadi.if_else(t176, 0, casadi.atan2(t265, t61))
-    t269 = t268 - 6.283185307179586*casadi.floor(0.15915494309189535*(2.9670597283903604 + t268))
-    t270 = casadi.if_else(t115, 0, casadi.atan2(-t120, t108))
-    t271 = t270
-    t272 = t271 - 6.283185307179586*casadi.floor(0.15915494309189535*(2.9670597283903604 + t271))
-    t273 = 3.141592653589793 + t270 - 6.283185307179586*casadi.ceil(0.15915494309189535*t270)
-    t274 = t273 - 6.283185307179586*casadi.floor(0.15915494309189535*(2.9670597283903604 + t273))
-    t275 = casadi.if_else(t124, 0, casadi.atan2(-t106, t91))
-    t276 = t275
-    t277 = t276 - 6.283185307179586*casadi.floor(0.15915494309189535*(1.5707963267948966 + t276))
-    t278 = t275 + 6.283185307179586*casadi.ceil(-0.15915494309189535*(3.141592653589793 + t275))
-    t279 = casadi.if_else((t133 <= 1e-24*t134), 0, casadi.atan2(t129, -t130))
+    t106 = (t105 > 1e-12)
+    t107 = casadi.if_else(t106, casadi.sqrt(t105), 0)
+    t108 = t103 + t96*t107
+    t109 = t108 + t104
+    t110 = t90**2
+    t111 = t103 + t110 + t96**2
+    t112 = t107**2
+    t113 = t109**2 + t110*t112
+    t114 = t103 + t112
+    t115 = 1e-24*t114
+    t116 = (t113 <= t111*t115)
+    t117 = casadi.if_else(t116, 1, 1/casadi.sqrt(t113))
+    t118 = casadi.if_else(t116, 1, t109*t117)
+    t119 = t93*(1 - t118)
+    t120 = t119 + t93*t118
+    t121 = t90*t107
+    t122 = casadi.if_else(t116, 0, -t117*t121)
+    t123 = t92*t118 + t98*t122
+    t124 = t98*t118 - t92*t122
+    t125 = (t114 <= t115)
+    t126 = casadi.if_else(t125, 1, 1/casadi.sqrt(t114))
+    t127 = casadi.if_else(t125, 1, t91*t126)
+    t128 = casadi.if_else(t125, 0, -t107*t126)
+    t129 = t123*(1 - t127)
+    t130 = t129 + t127*t123
+    t131 = t127*t124 + t128*t120
+    t132 = t127*t120 - t128*t124
+    t133 = t130**2 + t131**2
+    t134 = t133
+    t135 = t133 + t132**2
+    t136 = 1 - t77
+    t137 = T22*t136
+    t138 = t137 + T22*t77
+    t139 = T20*t136
+    t140 = t139 + T20*t77
+    t141 = t68*t79 - t74*t138
+    t142 = t68*t138 + t74*t79
+    t143 = t68*t81 - t74*t140
+    t144 = t68*t140 + t74*t81
+    t145 = t142**2
+    t146 = -t145
+    t147 = 1 + t146
+    t148 = (t147 > 1e-12)
+    t149 = casadi.if_else(t148, casadi.sqrt(t147), 0)
+    t150 = t145 + t100*t149
+    t151 = t150 + t146
+    t152 = t141**2
+    t153 = t145 + t152 + t100**2
+    t154 = t149**2
+    t155 = t151**2 + t152*t154
+    t156 = t145 + t154
+    t157 = 1e-24*t156
+    t158 = (t155 <= t153*t157)
+    t159 = casadi.if_else(t158, 1, 1/casadi.sqrt(t155))
+    t160 = casadi.if_else(t158, 1, t151*t159)
+    t161 = t144*(1 - t160)
+    t162 = t161 + t144*t160
+    t163 = t141*t149
+    t164 = casadi.if_else(t158, 0, -t159*t163)
+    t165 = t143*t160 + t102*t164
+    t166 = t102*t160 - t143*t164
+    t167 = (t156 <= t157)
+    t168 = casadi.if_else(t167, 1, 1/casadi.sqrt(t156))
+    t169 = casadi.if_else(t167, 1, t142*t168)
+    t170 = casadi.if_else(t167, 0, -t149*t168)
+    t171 = t165*(1 - t169)
+    t172 = t171 + t169*t165
+    t173 = t169*t166 + t170*t162
+    t174 = t169*t162 - t170*t166
+    t175 = t172**2 + t173**2
+    t176 = t175
+    t177 = t175 + t174**2
+    t178 = (t64 <= t65)
+    t179 = casadi.if_else(t178, 1, 1/casadi.sqrt(t64))
+    t180 = casadi.if_else(t178, 1, t61*t179)
+    t181 = casadi.if_else(t178, 0, casadi.atan2(t69, t61))
+    t182 = t181 - 6.283185307179586*casadi.floor(0.15915494309189535*(2.9670597283903604 + t181))
+    t183 = t179*t69
+    t184 = casadi.if_else(t178, 0, t183)
+    t185 = casadi.if_else(t178, 0, -t183)
+    t186 = t51*t180 - t87*t184
+    t187 = t51*t184 + t87*t180
+    t188 = t53*t180 - t89*t184
+    t189 = t53*t184 + t89*t180
+    t190 = t79*t180 - t138*t185
+    t191 = t79*t185 + t138*t180
+    t192 = t81*t180 - t140*t185
+    t193 = t81*t185 + t140*t180
+    t194 = 1 - t180
+    t195 = t52*t194
+    t196 = t195 + t52*t180
+    t197 = t54*t194
+    t198 = t197 + t54*t180
+    t199 = t80*t194
+    t200 = t199 + t80*t180
+    t201 = t82*t194
+    t202 = t201 + t82*t180
+    t203 = t187**2
+    t204 = -t203
+    t205 = 1 + t204
+    t206 = (t205 > 1e-12)
+    t207 = casadi.if_else(t206, casadi.sqrt(t205), 0)
+    t208 = t203 + t196*t207
+    t209 = t208 + t204
+    t210 = t186**2
+    t211 = t203 + t210 + t196**2
+    t212 = t207**2
+    t213 = t209**2 + t210*t212
+    t214 = t203 + t212
+    t215 = 1e-24*t214
+    t216 = (t213 <= t211*t215)
+    t217 = casadi.if_else(t216, 1, 1/casadi.sqrt(t213))
+    t218 = casadi.if_else(t216, 1, t209*t217)
+    t219 = t189*(1 - t218)
+    t220 = t219 + t189*t218
+    t221 = t186*t207
+    t222 = casadi.if_else(t216, 0, -t217*t221)
+    t223 = t188*t218 + t198*t222
+    t224 = t198*t218 - t188*t222
+    t225 = (t214 <= t215)
+    t226 = casadi.if_else(t225, 1, 1/casadi.sqrt(t214))
+    t227 = casadi.if_else(t225, 1, t187*t226)
+    t228 = casadi.if_else(t225, 0, -t207*t226)
+    t229 = t223*(1 - t227)
+    t230 = t229 + t227*t223
+    t231 = t227*t224 + t228*t220
+    t232 = t227*t220 - t228*t224
+    t233 = t230**2 + t231**2
+    t234 = t233
+    t235 = t233 + t232**2
+    t236 = t191**2
+    t237 = -t236
+    t238 = 1 + t237
+    t239 = (t238 > 1e-12)
+    t240 = casadi.if_else(t239, casadi.sqrt(t238), 0)
+    t241 = t236 + t200*t240
+    t242 = t241 + t237
+    t243 = t190**2
+    t244 = t236 + t243 + t200**2
+    t245 = t240**2
+    t246 = t242**2 + t243*t245
+    t247 = t236 + t245
+    t248 = 1e-24*t247
+    t249 = (t246 <= t244*t248)
+    t250 = casadi.if_else(t249, 1, 1/casadi.sqrt(t246))
+    t251 = casadi.if_else(t249, 1, t242*t250)
+    t252 = t193*(1 - t251)
+    t253 = t252 + t193*t251
+    t254 = t190*t240
+    t255 = casadi.if_else(t249, 0, -t250*t254)
+    t256 = t192*t251 + t202*t255
+    t257 = t202*t251 - t192*t255
+    t258 = (t247 <= t248)
+    t259 = casadi.if_else(t258, 1, 1/casadi.sqrt(t247))
+    t260 = casadi.if_else(t258, 1, t191*t259)
+    t261 = casadi.if_else(t258, 0, -t240*t259)
+    t262 = t256*(1 - t260)
+    t263 = t262 + t260*t256
+    t264 = t260*t257 + t261*t253
+    t265 = t260*t253 - t261*t257
+    t266 = t263**2 + t264**2
+    t267 = t266
+    t268 = t266 + t265**2
+    t269 = -t69
+    t270 = casadi.if_else(t66, 0, casadi.atan2(t269, t59))
+    t271 = t270 - 6.283185307179586*casadi.floor(0.15915494309189535*(2.9670597283903604 + t270))
+    t272 = casadi.if_else(t178, 0, casadi.atan2(t269, t61))
+    t273 = t272 - 6.283185307179586*casadi.floor(0.15915494309189535*(2.9670597283903604 + t272))
+    t274 = casadi.if_else(t116, 0, casadi.atan2(-t121, t109))
+    t275 = t274
+    t276 = t275 - 6.283185307179586*casadi.floor(0.15915494309189535*(2.9670597283903604 + t275))
+    t277 = 3.141592653589793 + t274 - 6.283185307179586*casadi.ceil(0.15915494309189535*t274)
+    t278 = t277 - 6.283185307179586*casadi.floor(0.15915494309189535*(2.9670597283903604 + t277))
+    t279 = casadi.if_else(t125, 0, casadi.atan2(-t107, t91))
     t280 = t279
-    t281 = t280 - 6.283185307179586*casadi.floor(0.15915494309189535*(2.9670597283903604 + t280))
-    t282 = 3.141592653589793 + t279 - 6.283185307179586*casadi.ceil(0.15915494309189535*t279)
-    t283 = t282 - 6.283185307179586*casadi.floor(0.15915494309189535*(2.9670597283903604 + t282))
-    t284 = -t278
-    t285 = t278 + 6.283185307179586*casadi.floor(0.15915494309189535*(1.5707963267948966 + t284))
-    t286 = casadi.if_else(t156, 0, casadi.atan2(-t161, t149))
-    t287 = t286
-    t288 = t287 - 6.283185307179586*casadi.floor(0.15915494309189535*(2.9670597283903604 + t287))
-    t289 = 3.141592653589793 + t286 - 6.283185307179586*casadi.ceil(0.15915494309189535*t286)
-    t290 = t289 - 6.283185307179586*casadi.floor(0.15915494309189535*(2.9670597283903604 + t289))
-    t291 = casadi.if_else(t165, 0, casadi.atan2(-t147, t141))
-    t292 = t291
-    t293 = t292 - 6.283185307179586*casadi.floor(0.15915494309189535*(1.5707963267948966 + t292))
-    t294 = t291 + 6.283185307179586*casadi.ceil(-0.15915494309189535*(3.141592653589793 + t291))
-    t295 = casadi.if_else((t174 <= 1e-24*t175), 0, casadi.atan2(t170, -t171))
+    t281 = t280 - 6.283185307179586*casadi.floor(0.15915494309189535*(1.5707963267948966 + t280))
+    t282 = t279 + 6.283185307179586*casadi.ceil(-0.15915494309189535*(3.141592653589793 + t279))
+    t283 = casadi.if_else((t134 <= 1e-24*t135), 0, casadi.atan2(t130, -t131))
+    t284 = t283
+    t285 = t284 - 6.283185307179586*casadi.floor(0.15915494309189535*(2.9670597283903604 + t284))
+    t286 = 3.141592653589793 + t283 - 6.283185307179586*casadi.ceil(0.15915494309189535*t283)
+    t287 = t286 - 6.283185307179586*casadi.floor(0.15915494309189535*(2.9670597283903604 + t286))
+    t288 = -t282
+    t289 = t282 + 6.283185307179586*casadi.floor(0.15915494309189535*(1.5707963267948966 + t288))
+    t290 = casadi.if_else(t158, 0, casadi.atan2(-t163, t151))
+    t291 = t290
+    t292 = t291 - 6.283185307179586*casadi.floor(0.15915494309189535*(2.9670597283903604 + t291))
+    t293 = 3.141592653589793 + t290 - 6.283185307179586*casadi.ceil(0.15915494309189535*t290)
+    t294 = t293 - 6.283185307179586*casadi.floor(0.15915494309189535*(2.9670597283903604 + t293))
+    t295 = casadi.if_else(t167, 0, casadi.atan2(-t149, t142))
     t296 = t295
-    t297 = t296 - 6.283185307179586*casadi.floor(0.15915494309189535*(2.9670597283903604 + t296))
-    t298 = 3.141592653589793 + t295 - 6.283185307179586*casadi.ceil(0.15915494309189535*t295)
-    t299 = t298 - 6.283185307179586*casadi.floor(0.15915494309189535*(2.9670597283903604 + t298))
-    t300 = -t294
-    t301 = t294 + 6.283185307179586*casadi.floor(0.15915494309189535*(1.5707963267948966 + t300))
-    t302 = casadi.if_else(t213, 0, casadi.atan2(-t218, t206))
-    t303 = t302
-    t304 = t303 - 6.283185307179586*casadi.floor(0.15915494309189535*(2.9670597283903604 + t303))
-    t305 = 3.141592653589793 + t302 - 6.283185307179586*casadi.ceil(0.15915494309189535*t302)
-    t306 = t305 - 6.283185307179586*casadi.floor(0.15915494309189535*(2.9670597283903604 + t305))
-    t307 = casadi.if_else(t222, 0, casadi.atan2(-t204, t185))
-    t308 = t307
-    t309 = t308 - 6.283185307179586*casadi.floor(0.15915494309189535*(1.5707963267948966 + t308))
-    t310 = t307 + 6.283185307179586*casadi.ceil(-0.15915494309189535*(3.141592653589793 + t307))
-    t311 = casadi.if_else((t231 <= 1e-24*t232), 0, casadi.atan2(t227, -t228))
+    t297 = t296 - 6.283185307179586*casadi.floor(0.15915494309189535*(1.5707963267948966 + t296))
+    t298 = t295 + 6.283185307179586*casadi.ceil(-0.15915494309189535*(3.141592653589793 + t295))
+    t299 = casadi.if_else((t176 <= 1e-24*t177), 0, casadi.atan2(t172, -t173))
+    t300 = t299
+    t301 = t300 - 6.283185307179586*casadi.floor(0.15915494309189535*(2.9670597283903604 + t300))
+    t302 = 3.141592653589793 + t299 - 6.283185307179586*casadi.ceil(0.15915494309189535*t299)
+    t303 = t302 - 6.283185307179586*casadi.floor(0.15915494309189535*(2.9670597283903604 + t302))
+    t304 = -t298
+    t305 = t298 + 6.283185307179586*casadi.floor(0.15915494309189535*(1.5707963267948966 + t304))
+    t306 = casadi.if_else(t216, 0, casadi.atan2(-t221, t209))
+    t307 = t306
+    t308 = t307 - 6.283185307179586*casadi.floor(0.15915494309189535*(2.9670597283903604 + t307))
+    t309 = 3.141592653589793 + t306 - 6.283185307179586*casadi.ceil(0.15915494309189535*t306)
+    t310 = t309 - 6.283185307179586*casadi.floor(0.15915494309189535*(2.9670597283903604 + t309))
+    t311 = casadi.if_else(t225, 0, casadi.atan2(-t207, t187))
     t312 = t311
-    t313 = t312 - 6.283185307179586*casadi.floor(0.15915494309189535*(2.9670597283903604 + t312))
-    t314 = 3.141592653589793 + t311 - 6.283185307179586*casadi.ceil(0.15915494309189535*t311)
-    t315 = t314 - 6.283185307179586*casadi.floor(0.15915494309189535*(2.9670597283903604 + t314))
-    t316 = -t310
-    t317 = t310 + 6.283185307179586*casadi.floor(0.15915494309189535*(1.5707963267948966 + t316))
-    t318 = casadi.if_else(t245, 0, casadi.atan2(-t250, t238))
-    t319 = t318
-    t320 = t319 - 6.283185307179586*casadi.floor(0.15915494309189535*(2.9670597283903604 + t319))
-    t321 = 3.141592653589793 + t318 - 6.283185307179586*casadi.ceil(0.15915494309189535*t318)
-    t322 = t321 - 6.283185307179586*casadi.floor(0.15915494309189535*(2.9670597283903604 + t321))
-    t323 = casadi.if_else(t254, 0, casadi.atan2(-t236, t189))
-    t324 = t323
-    t325 = t324 - 6.283185307179586*casadi.floor(0.15915494309189535*(1.5707963267948966 + t324))
-    t326 = t323 + 6.283185307179586*casadi.ceil(-0.15915494309189535*(3.141592653589793 + t323))
-    t327 = casadi.if_else((t263 <= 1e-24*t264), 0, casadi.atan2(t259, -t260))
+    t313 = t312 - 6.283185307179586*casadi.floor(0.15915494309189535*(1.5707963267948966 + t312))
+    t314 = t311 + 6.283185307179586*casadi.ceil(-0.15915494309189535*(3.141592653589793 + t311))
+    t315 = casadi.if_else((t234 <= 1e-24*t235), 0, casadi.atan2(t230, -t231))
+    t316 = t315
+    t317 = t316 - 6.283185307179586*casadi.floor(0.15915494309189535*(2.9670597283903604 + t316))
+    t318 = 3.141592653589793 + t315 - 6.283185307179586*casadi.ceil(0.15915494309189535*t315)
+    t319 = t318 - 6.283185307179586*casadi.floor(0.15915494309189535*(2.9670597283903604 + t318))
+    t320 = -t314
+    t321 = t314 + 6.283185307179586*casadi.floor(0.15915494309189535*(1.5707963267948966 + t320))
+    t322 = casadi.if_else(t249, 0, casadi.atan2(-t254, t242))
+    t323 = t322
+    t324 = t323 - 6.283185307179586*casadi.floor(0.15915494309189535*(2.9670597283903604 + t323))
+    t325 = 3.141592653589793 + t322 - 6.283185307179586*casadi.ceil(0.15915494309189535*t322)
+    t326 = t325 - 6.283185307179586*casadi.floor(0.15915494309189535*(2.9670597283903604 + t325))
+    t327 = casadi.if_else(t258, 0, casadi.atan2(-t240, t191))
     t328 = t327
-    t329 = t328 - 6.283185307179586*casadi.floor(0.15915494309189535*(2.9670597283903604 + t328))
-    t330 = 3.141592653589793 + t327 - 6.283185307179586*casadi.ceil(0.15915494309189535*t327)
-    t331 = t330 - 6.283185307179586*casadi.floor(0.15915494309189535*(2.9670597283903604 + t330))
-    t332 = -t326
-    t333 = t326 + 6.283185307179586*casadi.floor(0.15915494309189535*(1.5707963267948966 + t332))
-    t334 = (t56 <= 2.9670597283903604)
-    t335 = casadi.logic_and((t55 >= -2.9670597283903604), (t55 <= 2.9670597283903604))
-    t336 = casadi.if_else(casadi.logic_and(t334, casadi.logic_not(t335)), t56, t55)
-    t337 = (t267 <= 2.9670597283903604)
-    t338 = casadi.logic_and((t266 >= -2.9670597283903604), (t266 <= 2.9670597283903604))
-    t339 = casadi.if_else(casadi.logic_and(t337, casadi.logic_not(t338)), t267, t266)
-    t340 = (t272 <= 2.9670597283903604)
-    t341 = casadi.logic_and((t271 >= -2.9670597283903604), (t271 <= 2.9670597283903604))
-    t342 = (t277 <= 1.5707963267948966)
-    t343 = casadi.logic_and((t276 >= -1.5707963267948966), (t276 <= 1.5707963267948966))
-    t344 = (t281 <= 2.9670597283903604)
-    t345 = casadi.logic_and((t280 >= -2.9670597283903604), (t280 <= 2.9670597283903604))
-    t346 = (t274 <= 2.9670597283903604)
-    t347 = casadi.logic_and((t273 >= -2.9670597283903604), (t273 <= 2.9670597283903604))
-    t348 = -t285
-    t349 = (t283 <= 2.9670597283903604)
-    t350 = casadi.logic_and((t282 >= -2.9670597283903604), (t282 <= 2.9670597283903604))
-    t351 = (t84 <= 2.9670597283903604)
-    t352 = casadi.logic_and((t83 >= -2.9670597283903604), (t83 <= 2.9670597283903604))
-    t353 = casadi.if_else(casadi.logic_and(t351, casadi.logic_not(t352)), t84, t83)
-    t354 = (t71 <= 2.9670597283903604)
-    t355 = casadi.logic_and((t70 >= -2.9670597283903604), (t70 <= 2.9670597283903604))
-    t356 = casadi.if_else(casadi.logic_and(t354, casadi.logic_not(t355)), t71, t70)
-    t357 = (t288 <= 2.9670597283903604)
-    t358 = casadi.logic_and((t287 >= -2.9670597283903604), (t287 <= 2.9670597283903604))
-    t359 = (t293 <= 1.5707963267948966)
-    t360 = casadi.logic_and((t292 >= -1.5707963267948966), (t292 <= 1.5707963267948966))
-    t361 = (t297 <= 2.9670597283903604)
-    t362 = casadi.logic_and((t296 >= -2.9670597283903604), (t296 <= 2.9670597283903604))
-    t363 = (t290 <= 2.9670597283903604)
-    t364 = casadi.logic_and((t289 >= -2.9670597283903604), (t289 <= 2.9670597283903604))
-    t365 = -t301
-    t366 = (t299 <= 2.9670597283903604)
-    t367 = casadi.logic_and((t298 >= -2.9670597283903604), (t298 <= 2.9670597283903604))
-    t368 = (t180 <= 2.9670597283903604)
-    t369 = casadi.logic_and((t179 >= -2.9670597283903604), (t179 <= 2.9670597283903604))
-    t370 = casadi.if_else(casadi.logic_and(t368, casadi.logic_not(t369)), t180, t179)
-    t371 = -t21
-    t372 = (t304 <= 2.9670597283903604)
-    t373 = casadi.logic_and((t303 >= -2.9670597283903604), (t303 <= 2.9670597283903604))
-    t374 = (t309 <= 1.5707963267948966)
-    t375 = casadi.logic_and((t308 >= -1.5707963267948966), (t308 <= 1.5707963267948966))
-    t376 = (t313 <= 2.9670597283903604)
-    t377 = casadi.logic_and((t312 >= -2.9670597283903604), (t312 <= 2.9670597283903604))
-    t378 = (t306 <= 2.9670597283903604)
-    t379 = casadi.logic_and((t305 >= -2.9670597283903604), (t305 <= 2.9670597283903604))
-    t380 = -t317
-    t381 = (t315 <= 2.9670597283903604)
-    t382 = casadi.logic_and((t314 >= -2.9670597283903604), (t314 <= 2.9670597283903604))
-    t383 = (t269 <= 2.9670597283903604)
-    t384 = casadi.logic_and((t268 >= -2.9670597283903604), (t268 <= 2.9670597283903604))
-    t385 = casadi.if_else(casadi.logic_and(t383, casadi.logic_not(t384)), t269, t268)
-    t386 = (t320 <= 2.9670597283903604)
-    t387 = casadi.logic_and((t319 >= -2.9670597283903604), (t319 <= 2.9670597283903604))
-    t388 = (t325 <= 1.5707963267948966)
-    t389 = casadi.logic_and((t324 >= -1.5707963267948966), (t324 <= 1.5707963267948966))
-    t390 = (t329 <= 2.9670597283903604)
-    t391 = casadi.logic_and((t328 >= -2.9670597283903604), (t328 <= 2.9670597283903604))
-    t392 = (t322 <= 2.9670597283903604)
-    t393 = casadi.logic_and((t321 >= -2.9670597283903604), (t321 <= 2.9670597283903604))
-    t394 = -t333
-    t395 = (t331 <= 2.9670597283903604)
-    t396 = casadi.logic_and((t330 >= -2.9670597283903604), (t330 <= 2.9670597283903604))
-    t397 = (casadi.fabs(t0) < casadi.inf)
-    t398 = (t18 >= t20)
-    t399 = (t26 >= t28)
-    t400 = (t26 > t27)
-    t401 = (t18 > t19)
-    t402 = (t21 >= 0.30479999999999996)
-    t403 = (t21 <= 1.27)
-    t404 = casadi.logic_or(t334, t335)
-    t405 = casadi.logic_or(t337, t338)
-    t406 = casadi.logic_or(t351, t352)
-    t407 = casadi.logic_or(t354, t355)
-    t408 = (t371 >= 0.30479999999999996)
-    t409 = (t371 <= 1.27)
-    t410 = casadi.logic_or(t368, t369)
-    t411 = casadi.logic_or(t383, t384)
+    t329 = t328 - 6.283185307179586*casadi.floor(0.15915494309189535*(1.5707963267948966 + t328))
+    t330 = t327 + 6.283185307179586*casadi.ceil(-0.15915494309189535*(3.141592653589793 + t327))
+    t331 = casadi.if_else((t267 <= 1e-24*t268), 0, casadi.atan2(t263, -t264))
+    t332 = t331
+    t333 = t332 - 6.283185307179586*casadi.floor(0.15915494309189535*(2.9670597283903604 + t332))
+    t334 = 3.141592653589793 + t331 - 6.283185307179586*casadi.ceil(0.15915494309189535*t331)
+    t335 = t334 - 6.283185307179586*casadi.floor(0.15915494309189535*(2.9670597283903604 + t334))
+    t336 = -t330
+    t337 = t330 + 6.283185307179586*casadi.floor(0.15915494309189535*(1.5707963267948966 + t336))
+    t338 = (t56 <= 2.9670597283903604)
+    t339 = casadi.logic_and((t55 >= -2.9670597283903604), (t55 <= 2.9670597283903604))
+    t340 = casadi.if_else(casadi.logic_and(t338, casadi.logic_not(t339)), t56, t55)
+    t341 = (t271 <= 2.9670597283903604)
+    t342 = casadi.logic_and((t270 >= -2.9670597283903604), (t270 <= 2.9670597283903604))
+    t343 = casadi.if_else(casadi.logic_and(t341, casadi.logic_not(t342)), t271, t270)
+    t344 = (t276 <= 2.9670597283903604)
+    t345 = casadi.logic_and((t275 >= -2.9670597283903604), (t275 <= 2.9670597283903604))
+    t346 = (t281 <= 1.5707963267948966)
+    t347 = casadi.logic_and((t280 >= -1.5707963267948966), (t280 <= 1.5707963267948966))
+    t348 = (t285 <= 2.9670597283903604)
+    t349 = casadi.logic_and((t284 >= -2.9670597283903604), (t284 <= 2.9670597283903604))
+    t350 = (t278 <= 2.9670597283903604)
+    t351 = casadi.logic_and((t277 >= -2.9670597283903604), (t277 <= 2.9670597283903604))
+    t352 = -t289
+    t353 = (t352 <= 1.5707963267948966)
+    t354 = casadi.logic_and((t288 >= -1.5707963267948966), (t288 <= 1.5707963267948966))
+    t355 = (t287 <= 2.9670597283903604)
+    t356 = casadi.logic_and((t286 >= -2.9670597283903604), (t286 <= 2.9670597283903604))
+    t357 = (t84 <= 2.9670597283903604)
+    t358 = casadi.logic_and((t83 >= -2.9670597283903604), (t83 <= 2.9670597283903604))
+    t359 = casadi.if_else(casadi.logic_and(t357, casadi.logic_not(t358)), t84, t83)
+    t360 = (t71 <= 2.9670597283903604)
+    t361 = casadi.logic_and((t70 >= -2.9670597283903604), (t70 <= 2.9670597283903604))
+    t362 = casadi.if_else(casadi.logic_and(t360, casadi.logic_not(t361)), t71, t70)
+    t363 = (t292 <= 2.9670597283903604)
+    t364 = casadi.logic_and((t291 >= -2.9670597283903604), (t291 <= 2.9670597283903604))
+    t365 = (t297 <= 1.5707963267948966)
+    t366 = casadi.logic_and((t296 >= -1.5707963267948966), (t296 <= 1.5707963267948966))
+    t367 = (t301 <= 2.9670597283903604)
+    t368 = casadi.logic_and((t300 >= -2.9670597283903604), (t300 <= 2.9670597283903604))
+    t369 = (t294 <= 2.9670597283903604)
+    t370 = casadi.logic_and((t293 >= -2.9670597283903604), (t293 <= 2.9670597283903604))
+    t371 = -t305
+    t372 = (t371 <= 1.5707963267948966)
+    t373 = casadi.logic_and((t304 >= -1.5707963267948966), (t304 <= 1.5707963267948966))
+    t374 = (t303 <= 2.9670597283903604)
+    t375 = casadi.logic_and((t302 >= -2.9670597283903604), (t302 <= 2.9670597283903604))
+    t376 = (t182 <= 2.9670597283903604)
+    t377 = casadi.logic_and((t181 >= -2.9670597283903604), (t181 <= 2.9670597283903604))
+    t378 = casadi.if_else(casadi.logic_and(t376, casadi.logic_not(t377)), t182, t181)
+    t379 = -t21
+    t380 = (t308 <= 2.9670597283903604)
+    t381 = casadi.logic_and((t307 >= -2.9670597283903604), (t307 <= 2.9670597283903604))
+    t382 = (t313 <= 1.5707963267948966)
+    t383 = casadi.logic_and((t312 >= -1.5707963267948966), (t312 <= 1.5707963267948966))
+    t384 = (t317 <= 2.9670597283903604)
+    t385 = casadi.logic_and((t316 >= -2.9670597283903604), (t316 <= 2.9670597283903604))
+    t386 = (t310 <= 2.9670597283903604)
+    t387 = casadi.logic_and((t309 >= -2.9670597283903604), (t309 <= 2.9670597283903604))
+    t388 = -t321
+    t389 = (t388 <= 1.5707963267948966)
+    t390 = casadi.logic_and((t320 >= -1.5707963267948966), (t320 <= 1.5707963267948966))
+    t391 = (t319 <= 2.9670597283903604)
+    t392 = casadi.logic_and((t318 >= -2.9670597283903604), (t318 <= 2.9670597283903604))
+    t393 = (t273 <= 2.9670597283903604)
+    t394 = casadi.logic_and((t272 >= -2.9670597283903604), (t272 <= 2.9670597283903604))
+    t395 = casadi.if_else(casadi.logic_and(t393, casadi.logic_not(t394)), t273, t272)
+    t396 = (t324 <= 2.9670597283903604)
+    t397 = casadi.logic_and((t323 >= -2.9670597283903604), (t323 <= 2.9670597283903604))
+    t398 = (t329 <= 1.5707963267948966)
+    t399 = casadi.logic_and((t328 >= -1.5707963267948966), (t328 <= 1.5707963267948966))
+    t400 = (t333 <= 2.9670597283903604)
+    t401 = casadi.logic_and((t332 >= -2.9670597283903604), (t332 <= 2.9670597283903604))
+    t402 = (t326 <= 2.9670597283903604)
+    t403 = casadi.logic_and((t325 >= -2.9670597283903604), (t325 <= 2.9670597283903604))
+    t404 = -t337
+    t405 = (t404 <= 1.5707963267948966)
+    t406 = casadi.logic_and((t336 >= -1.5707963267948966), (t336 <= 1.5707963267948966))
+    t407 = (t335 <= 2.9670597283903604)
+    t408 = casadi.logic_and((t334 >= -2.9670597283903604), (t334 <= 2.9670597283903604))
+    t409 = (casadi.fabs(t0) < casadi.inf)
+    t410 = (t18 >= -t19)
+    t411 = (t26 >= -t27)
+    t412 = (t21 >= 0.30479999999999996)
+    t413 = (t21 <= 1.27)
+    t414 = casadi.logic_or(t338, t339)
+    t415 = casadi.logic_or(t341, t342)
+    t416 = casadi.logic_or(t357, t358)
+    t417 = casadi.logic_or(t360, t361)
+    t418 = (t379 >= 0.30479999999999996)
+    t419 = (t379 <= 1.27)
+    t420 = casadi.logic_or(t376, t377)
+    t421 = casadi.logic_or(t393, t394)
     q = casadi.SX(8, 6)
-    q[0, 0] = t336
-    q[0, 1] = t339
+    q[0, 0] = t340
+    q[0, 1] = t343
     q[0, 2] = t21
-    q[0, 3] = casadi.if_else(casadi.logic_and(t340, casadi.logic_not(t341)), t272, t271)
-    q[0, 4] = casadi.if_else(casadi.logic_and(t342, casadi.logic_not(t343)), t277, t276)
-    q[0, 5] = casadi.if_else(casadi.logic_and(t344, casadi.logic_not(t345)), t281, t280)
-    q[1, 0] = t336
-    q[1, 1] = t339
+    q[0, 3] = casadi.if_else(casadi.logic_and(t344, casadi.logic_not(t345)), t276, t275)
+    q[0, 4] = casadi.if_else(casadi.logic_and(t346, casadi.logic_not(t347)), t281, t280)
+    q[0, 5] = casadi.if_else(casadi.logic_and(t348, casadi.logic_not(t349)), t285, t284)
+    q[1, 0] = t340
+    q[1, 1] = t343
     q[1, 2] = t21
-    q[1, 3] = casadi.if_else(casadi.logic_and(t346, casadi.logic_not(t347)), t274, t273)
-    q[1, 4] = casadi.if_else(casadi.logic_and((t285 >= -1.5707963267948966), casadi.logic_not(casadi.logic_and((t278 >= -1.5707963267948966), (t278 <= 1.5707963267948966)))), t348, t284)
-    q[1, 5] = casadi.if_else(casadi.logic_and(t349, casadi.logic_not(t350)), t283, t282)
-    q[2, 0] = t353
-    q[2, 1] = t356
+    q[1, 3] = casadi.if_else(casadi.logic_and(t350, casadi.logic_not(t351)), t278, t277)
+    q[1, 4] = casadi.if_else(casadi.logic_and(t353, casadi.logic_not(t354)), t352, t288)
+    q[1, 5] = casadi.if_else(casadi.logic_and(t355, casadi.logic_not(t356)), t287, t286)
+    q[2, 0] = t359
+    q[2, 1] = t362
     q[2, 2] = t21
-    q[2, 3] = casadi.if_else(casadi.logic_and(t357, casadi.logic_not(t358)), t288, t287)
-    q[2, 4] = casadi.if_else(casadi.logic_and(t359, casadi.logic_not(t360)), t293, t292)
-    q[2, 5] = casadi.if_else(casadi.logic_and(t361, casadi.logic_not(t362)), t297, t296)
-    q[3, 0] = t353
-    q[3, 1] = t356
+    q[2, 3] = casadi.if_else(casadi.logic_and(t363, casadi.logic_not(t364)), t292, t291)
+    q[2, 4] = casadi.if_else(casadi.logic_and(t365, casadi.logic_not(t366)), t297, t296)
+    q[2, 5] = casadi.if_else(casadi.logic_and(t367, casadi.logic_not(t368)), t301, t300)
+    q[3, 0] = t359
+    q[3, 1] = t362
     q[3, 2] = t21
-    q[3, 3] = casadi.if_else(casadi.logic_and(t363, casadi.logic_not(t364)), t290, t289)
-    q[3, 4] = casadi.if_else(casadi.logic_and((t301 >= -1.5707963267948966), casadi.logic_not(casadi.logic_and((t294 >= -1.5707963267948966), (t294 <= 1.5707963267948966)))), t365, t300)
-    q[3, 5] = casadi.if_else(casadi.logic_and(t366, casadi.logic_not(t367)), t299, t298)
-    q[4, 0] = t336
-    q[4, 1] = t370
-    q[4, 2] = t371
-    q[4, 3] = casadi.if_else(casadi.logic_and(t372, casadi.logic_not(t373)), t304, t303)
-    q[4, 4] = casadi.if_else(casadi.logic_and(t374, casadi.logic_not(t375)), t309, t308)
-    q[4, 5] = casadi.if_else(casadi.logic_and(t376, casadi.logic_not(t377)), t313, t312)
-    q[5, 0] = t336
-    q[5, 1] = t370
-    q[5, 2] = t371
-    q[5, 3] = casadi.if_else(casadi.logic_and(t378, casadi.logic_not(t379)), t306, t305)
-    q[5, 4] = casadi.if_else(casadi.logic_and((t317 >= -1.5707963267948966), casadi.logic_not(casadi.logic_and((t310 >= -1.5707963267948966), (t310 <= 1.5707963267948966)))), t380, t316)
-    q[5, 5] = casadi.if_else(casadi.logic_and(t381, casadi.logic_not(t382)), t315, t314)
-    q[6, 0] = t353
-    q[6, 1] = t385
-    q[6, 2] = t371
-    q[6, 3] = casadi.if_else(casadi.logic_and(t386, casadi.logic_not(t387)), t320, t319)
-    q[6, 4] = casadi.if_else(casadi.logic_and(t388, casadi.logic_not(t389)), t325, t324)
-    q[6, 5] = casadi.if_else(casadi.logic_and(t390, casadi.logic_not(t391)), t329, t328)
-    q[7, 0] = t353
-    q[7, 1] = t385
-    q[7, 2] = t371
-    q[7, 3] = casadi.if_else(casadi.logic_and(t392, casadi.logic_not(t393)), t322, t321)
-    q[7, 4] = casadi.if_else(casadi.logic_and((t333 >= -1.5707963267948966), casadi.logic_not(casadi.logic_and((t326 >= -1.5707963267948966), (t326 <= 1.5707963267948966)))), t394, t332)
-    q[7, 5] = casadi.if_else(casadi.logic_and(t395, casadi.logic_not(t396)), t331, t330)
+    q[3, 3] = casadi.if_else(casadi.logic_and(t369, casadi.logic_not(t370)), t294, t293)
+    q[3, 4] = casadi.if_else(casadi.logic_and(t372, casadi.logic_not(t373)), t371, t304)
+    q[3, 5] = casadi.if_else(casadi.logic_and(t374, casadi.logic_not(t375)), t303, t302)
+    q[4, 0] = t340
+    q[4, 1] = t378
+    q[4, 2] = t379
+    q[4, 3] = casadi.if_else(casadi.logic_and(t380, casadi.logic_not(t381)), t308, t307)
+    q[4, 4] = casadi.if_else(casadi.logic_and(t382, casadi.logic_not(t383)), t313, t312)
+    q[4, 5] = casadi.if_else(casadi.logic_and(t384, casadi.logic_not(t385)), t317, t316)
+    q[5, 0] = t340
+    q[5, 1] = t378
+    q[5, 2] = t379
+    q[5, 3] = casadi.if_else(casadi.logic_and(t386, casadi.logic_not(t387)), t310, t309)
+    q[5, 4] = casadi.if_else(casadi.logic_and(t389, casadi.logic_not(t390)), t388, t320)
+    q[5, 5] = casadi.if_else(casadi.logic_and(t391, casadi.logic_not(t392)), t319, t318)
+    q[6, 0] = t359
+    q[6, 1] = t395
+    q[6, 2] = t379
+    q[6, 3] = casadi.if_else(casadi.logic_and(t396, casadi.logic_not(t397)), t324, t323)
+    q[6, 4] = casadi.if_else(casadi.logic_and(t398, casadi.logic_not(t399)), t329, t328)
+    q[6, 5] = casadi.if_else(casadi.logic_and(t400, casadi.logic_not(t401)), t333, t332)
+    q[7, 0] = t359
+    q[7, 1] = t395
+    q[7, 2] = t379
+    q[7, 3] = casadi.if_else(casadi.logic_and(t402, casadi.logic_not(t403)), t326, t325)
+    q[7, 4] = casadi.if_else(casadi.logic_and(t405, casadi.logic_not(t406)), t404, t336)
+    q[7, 5] = casadi.if_else(casadi.logic_and(t407, casadi.logic_not(t408)), t335, t334)
     valid = casadi.SX(8, 1)
-    valid[0, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t397, t398), t399), (t105 >= -1e-12))
-    valid[1, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t397, t398), t399), (t105 > 1e-12))
-    valid[2, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t397, t398), t400), (t146 >= -1e-12))
-    valid[3, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t397, t398), t400), (t146 > 1e-12))
-    valid[4, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t397, t399), t401), (t203 >= -1e-12))
-    valid[5, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t397, t399), t401), (t203 > 1e-12))
-    valid[6, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t397, t400), t401), (t235 >= -1e-12))
-    valid[7, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t397, t400), t401), (t235 > 1e-12))
+    valid[0, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t409, t410), t411), (t105 >= -1e-12))
+    valid[1, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t409, t410), t411), t106)
+    valid[2, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t28, t409), t410), (t147 >= -1e-12))
+    valid[3, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t28, t409), t410), t148)
+    valid[4, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t409, t411), t20), (t205 >= -1e-12))
+    valid[5, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t409, t411), t206), t20)
+    valid[6, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t28, t409), t20), (t238 >= -1e-12))
+    valid[7, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t28, t409), t20), t239)
     in_limits = casadi.SX(8, 1)
-    in_limits[0, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t402, t403), t404), t405), casadi.logic_or(t340, t341)), casadi.logic_or(t342, t343)), casadi.logic_or(t344, t345))
-    in_limits[1, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t402, t403), t404), t405), casadi.logic_or(t347, t346)), casadi.logic_or(t349, t350)), casadi.logic_or((t348 <= 1.5707963267948966), casadi.logic_and((t284 >= -1.5707963267948966), (t284 <= 1.5707963267948966))))
-    in_limits[2, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t402, t403), t406), t407), casadi.logic_or(t357, t358)), casadi.logic_or(t359, t360)), casadi.logic_or(t361, t362))
-    in_limits[3, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t402, t403), t406), t407), casadi.logic_or(t363, t364)), casadi.logic_or(t366, t367)), casadi.logic_or((t365 <= 1.5707963267948966), casadi.logic_and((t300 >= -1.5707963267948966), (t300 <= 1.5707963267948966))))
-    in_limits[4, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t404, t408), t409), t410), casadi.logic_or(t372, t373)), casadi.logic_or(t374, t375)), casadi.logic_or(t376, t377))
-    in_limits[5, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t404, t408), t409), t410), casadi.logic_or(t378, t379)), casadi.logic_or(t381, t382)), casadi.logic_or((t380 <= 1.5707963267948966), casadi.logic_and((t316 >= -1.5707963267948966), (t316 <= 1.5707963267948966))))
-    in_limits[6, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t406, t408), t409), t411), casadi.logic_or(t386, t387)), casadi.logic_or(t388, t389)), casadi.logic_or(t390, t391))
-    in_limits[7, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t406, t408), t409), t411), casadi.logic_or(t392, t393)), casadi.logic_or(t395, t396)), casadi.logic_or((t394 <= 1.5707963267948966), casadi.logic_and((t332 >= -1.5707963267948966), (t332 <= 1.5707963267948966))))
+    in_limits[0, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t412, t413), t414), t415), casadi.logic_or(t347, t346)), casadi.logic_or(t348, t349)), casadi.logic_or(t344, t345))
+    in_limits[1, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t412, t413), t414), t415), casadi.logic_or(t350, t351)), casadi.logic_or(t353, t354)), casadi.logic_or(t355, t356))
+    in_limits[2, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t412, t413), t416), t417), casadi.logic_or(t363, t364)), casadi.logic_or(t365, t366)), casadi.logic_or(t367, t368))
+    in_limits[3, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t412, t413), t416), t417), casadi.logic_or(t369, t370)), casadi.logic_or(t372, t373)), casadi.logic_or(t374, t375))
+    in_limits[4, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t414, t418), t419), t420), casadi.logic_or(t380, t381)), casadi.logic_or(t382, t383)), casadi.logic_or(t384, t385))
+    in_limits[5, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t414, t418), t419), t420), casadi.logic_or(t386, t387)), casadi.logic_or(t389, t390)), casadi.logic_or(t391, t392))
+    in_limits[6, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t416, t418), t419), t421), casadi.logic_or(t396, t397)), casadi.logic_or(t398, t399)), casadi.logic_or(t400, t401))
+    in_limits[7, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t416, t418), t419), t421), casadi.logic_or(t402, t403)), casadi.logic_or(t405, t406)), casadi.logic_or(t407, t408))
     return [q, valid, in_limits]
 
 
 def _ik_nearest(T, q_seed, weights):
-    """The closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status: 940 operations."""
+    """The closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status: 859 operations."""
     branches_q, branches_valid, branches_in_limits = _ik_branches(T)
     T00 = T[0, 0]
     T01 = T[0, 1]
@@ -2385,7 +2395,7 @@ def _ik_nearest(T, q_seed, weights):
     t104 = casadi.if_else(casadi.logic_and((t11 >= -2.9670597283903604), (t11 <= 2.9670597283903604)), t11, casadi.if_else(casadi.logic_and((t102 >= -2.9670597283903604), (t102 <= 2.9670597283903604)), t102, casadi.if_else(casadi.logic_and((t103 >= -2.9670597283903604), (t103 <= 2.9670597283903604)), t103, qb1_5)))
     t105 = qw1*(t88 + t70)**2 + qw2*(t92 + t71)**2 + qw3*(t72 + qb1_2)**2 + qw4*(t96 + t73)**2 + qw5*(t100 + t74)**2 + qw6*(t104 + t75)**2
     t106 = (t12 > 0)
-    t107 = casadi.if_else(casadi.logic_and(t106, casadi.logic_or((t84 > t105), (t6 < 1))), 1, 0)
+    t107 = casadi.if_else(casadi.logic_and(t106, casadi.logic_or((t6 < 1), (t105 < t84))), 1, 0)
     t108 = casadi.if_else(t106, 1, t6)
     t109 = (t107 > 0)
     t110 = casadi.if_else(t109, t88, t78)
@@ -2417,7 +2427,7 @@ def _ik_nearest(T, q_seed, weights):
     t136 = casadi.if_else(casadi.logic_and((t17 >= -2.9670597283903604), (t17 <= 2.9670597283903604)), t17, casadi.if_else(casadi.logic_and((t134 >= -2.9670597283903604), (t134 <= 2.9670597283903604)), t134, casadi.if_else(casadi.logic_and((t135 >= -2.9670597283903604), (t135 <= 2.9670597283903604)), t135, qb2_5)))
     t137 = qw1*(t120 + t70)**2 + qw2*(t124 + t71)**2 + qw3*(t72 + qb2_2)**2 + qw4*(t128 + t73)**2 + qw5*(t132 + t74)**2 + qw6*(t136 + t75)**2
     t138 = (t18 > 0)
-    t139 = casadi.if_else(casadi.logic_and(t138, casadi.logic_or((t116 > t137), (t108 < 1))), 1, 0)
+    t139 = casadi.if_else(casadi.logic_and(t138, casadi.logic_or((t108 < 1), (t137 < t116))), 1, 0)
     t140 = casadi.if_else(t138, 1, t108)
     t141 = (t139 > 0)
     t142 = casadi.if_else(t141, t120, t110)
@@ -2449,7 +2459,7 @@ def _ik_nearest(T, q_seed, weights):
     t168 = casadi.if_else(casadi.logic_and((t23 >= -2.9670597283903604), (t23 <= 2.9670597283903604)), t23, casadi.if_else(casadi.logic_and((t166 >= -2.9670597283903604), (t166 <= 2.9670597283903604)), t166, casadi.if_else(casadi.logic_and((t167 >= -2.9670597283903604), (t167 <= 2.9670597283903604)), t167, qb3_5)))
     t169 = qw1*(t152 + t70)**2 + qw2*(t156 + t71)**2 + qw3*(t72 + qb3_2)**2 + qw4*(t160 + t73)**2 + qw5*(t164 + t74)**2 + qw6*(t168 + t75)**2
     t170 = (t24 > 0)
-    t171 = casadi.if_else(casadi.logic_and(t170, casadi.logic_or((t148 > t169), (t140 < 1))), 1, 0)
+    t171 = casadi.if_else(casadi.logic_and(t170, casadi.logic_or((t140 < 1), (t169 < t148))), 1, 0)
     t172 = casadi.if_else(t170, 1, t140)
     t173 = (t171 > 0)
     t174 = casadi.if_else(t173, t152, t142)
@@ -2481,7 +2491,7 @@ def _ik_nearest(T, q_seed, weights):
     t200 = casadi.if_else(casadi.logic_and((t29 >= -2.9670597283903604), (t29 <= 2.9670597283903604)), t29, casadi.if_else(casadi.logic_and((t198 >= -2.9670597283903604), (t198 <= 2.9670597283903604)), t198, casadi.if_else(casadi.logic_and((t199 >= -2.9670597283903604), (t199 <= 2.9670597283903604)), t199, qb4_5)))
     t201 = qw1*(t184 + t70)**2 + qw2*(t188 + t71)**2 + qw3*(t72 + qb4_2)**2 + qw4*(t192 + t73)**2 + qw5*(t196 + t74)**2 + qw6*(t200 + t75)**2
     t202 = (t30 > 0)
-    t203 = casadi.if_else(casadi.logic_and(t202, casadi.logic_or((t180 > t201), (t172 < 1))), 1, 0)
+    t203 = casadi.if_else(casadi.logic_and(t202, casadi.logic_or((t172 < 1), (t201 < t180))), 1, 0)
     t204 = casadi.if_else(t202, 1, t172)
     t205 = (t203 > 0)
     t206 = casadi.if_else(t205, t184, t174)
@@ -2513,7 +2523,7 @@ def _ik_nearest(T, q_seed, weights):
     t232 = casadi.if_else(casadi.logic_and((t35 >= -2.9670597283903604), (t35 <= 2.9670597283903604)), t35, casadi.if_else(casadi.logic_and((t230 >= -2.9670597283903604), (t230 <= 2.9670597283903604)), t230, casadi.if_else(casadi.logic_and((t231 >= -2.9670597283903604), (t231 <= 2.9670597283903604)), t231, qb5_5)))
     t233 = qw1*(t216 + t70)**2 + qw2*(t220 + t71)**2 + qw3*(t72 + qb5_2)**2 + qw4*(t224 + t73)**2 + qw5*(t228 + t74)**2 + qw6*(t232 + t75)**2
     t234 = (t36 > 0)
-    t235 = casadi.if_else(casadi.logic_and(t234, casadi.logic_or((t212 > t233), (t204 < 1))), 1, 0)
+    t235 = casadi.if_else(casadi.logic_and(t234, casadi.logic_or((t204 < 1), (t233 < t212))), 1, 0)
     t236 = casadi.if_else(t234, 1, t204)
     t237 = (t235 > 0)
     t238 = casadi.if_else(t237, t216, t206)
@@ -2577,7 +2587,7 @@ def _ik_nearest(T, q_seed, weights):
     t296 = casadi.if_else(casadi.logic_and((t47 >= -2.9670597283903604), (t47 <= 2.9670597283903604)), t47, casadi.if_else(casadi.logic_and((t294 >= -2.9670597283903604), (t294 <= 2.9670597283903604)), t294, casadi.if_else(casadi.logic_and((t295 >= -2.9670597283903604), (t295 <= 2.9670597283903604)), t295, qb7_5)))
     t297 = qw1*(t280 + t70)**2 + qw2*(t284 + t71)**2 + qw3*(t72 + qb7_2)**2 + qw4*(t288 + t73)**2 + qw5*(t292 + t74)**2 + qw6*(t296 + t75)**2
     t298 = (t48 > 0)
-    t299 = casadi.if_else(casadi.logic_and(t298, casadi.logic_or((t276 > t297), (t268 < 1))), 1, 0)
+    t299 = casadi.if_else(casadi.logic_and(t298, casadi.logic_or((t268 < 1), (t297 < t276))), 1, 0)
     t300 = casadi.if_else(t298, 1, t268)
     t301 = (t299 > 0)
     t302 = casadi.if_else(t301, t280, t270)
