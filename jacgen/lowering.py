@@ -15,6 +15,7 @@ import sympy
 from sympy.core.parameters import distribute
 from sympy.core.operations import LatticeOp
 from sympy.logic.boolalg import Boolean, BooleanFunction
+from sympy.simplify.cse_main import Unevaluated, match_common_args
 
 from .subproblems import TOLERANCES
 
@@ -156,6 +157,7 @@ class Lowering:
         self.definitions: list[tuple[sympy.Symbol, sympy.Expr]] = []  # in an order that defines before use
         self._names: dict[sympy.Expr, sympy.Symbol] = {}  # named values (see `name`)
         self._folded: dict[sympy.Expr, sympy.Expr] = {}  # fold_constants' results, shared by every lowering
+        self._negations: dict[sympy.Expr, sympy.Expr | None] = {}  # eliminate_common's, likewise
         self._lowered: dict[tuple, Body] = {}
 
     def define(self, symbol: sympy.Symbol, value: sympy.Expr):
@@ -207,8 +209,8 @@ class Lowering:
                 if s in needed and s not in named_symbols and s not in bindings]
         named = [(s, v) for s, v in self.definitions if s in needed and s in named_symbols]
         with distribute(False):
-            replacements, reduced = sympy.cse([fold(v) for _, v in named] + [fold(e) for e in outputs],
-                                              symbols=sympy.numbered_symbols("_r", real=True), order="canonical")
+            replacements, reduced = eliminate_common([fold(v) for _, v in named] + [fold(e) for e in outputs],
+                                                     sympy.numbered_symbols("_r", real=True), self._negations)
         bound = [(s, fold(v)) for s, v in bindings.items() if s in needed]
         definitions = _in_dependency_order(bound + trig + list(zip((s for s, _ in named), reduced)) + replacements)
         definitions, reduced = _without_constants(definitions, reduced[len(named):])
@@ -275,3 +277,106 @@ def _in_dependency_order(definitions: list[tuple[sympy.Symbol, sympy.Expr]]) -> 
             if waiting[reader] == 0:
                 heapq.heappush(ready, reader)
     return ordered
+
+
+def eliminate_common(exprs: list[sympy.Basic], symbols, negations: dict) -> tuple[list, list]:
+    """sympy's `cse(exprs, symbols, order="none")` (its opt_cse, then tree_cse) at a fraction
+    of its cost, with the same temporaries: a sum or product with more negative terms is
+    shared with its negation, x**-n is 1/x**n, sums and products that share two or more terms
+    share their sum or product (sympy's own `match_common_args`), and every node reached twice
+    becomes a temporary. What costs less: the sign of a sum is decided from its terms'
+    coefficients (sympy compares sort keys of whole expressions), products are not rebuilt to
+    split commutative factors (all are), arguments keep their stored order, what is rebuilt
+    is not evaluated again where nothing in it can combine (`_rebuilt`), and `negations`
+    keeps each node's negation for the robot's other functions."""
+    rewritten: dict = {}  # node -> the form tree_cse walks (sympy's opt_subs)
+    adds, muls = {}, {}  # candidates for common arguments, in the order first met
+    seen = set()
+
+    def find_rewrites(expr):
+        if not isinstance(expr, sympy.Basic) or expr.is_Atom or expr in seen:
+            return
+        seen.add(expr)
+        for arg in expr.args:
+            find_rewrites(arg)
+        if expr.is_Add or expr.is_Mul:
+            if expr not in negations:
+                negations[expr] = _negation(expr)
+            negated = negations[expr]
+            if negated is not None and not negated.is_Atom:
+                rewritten[expr] = Unevaluated(sympy.Mul, (sympy.S.NegativeOne, negated))
+                seen.add(negated)
+                expr = negated
+            if (expr.is_Add or expr.is_Mul) and len(expr.args) > 1:
+                (adds if expr.is_Add else muls)[expr] = None
+        elif expr.is_Pow and _negative_coefficient(expr.exp):
+            rewritten[expr] = Unevaluated(sympy.Pow, (sympy.Pow(expr.base, -expr.exp), -1))
+
+    for expr in exprs:
+        find_rewrites(expr)
+    match_common_args(sympy.Add, list(adds), rewritten)
+    match_common_args(sympy.Mul, list(muls), rewritten)
+
+    repeated, reached = set(), set()
+
+    def find_repeated(expr):
+        if not isinstance(expr, Unevaluated) and (not isinstance(expr, sympy.Basic) or expr.is_Atom):
+            return
+        if expr in reached:
+            repeated.add(expr)
+            return
+        reached.add(expr)
+        for arg in rewritten.get(expr, expr).args:
+            find_repeated(arg)
+
+    for expr in exprs:
+        find_repeated(expr)
+
+    replacements, named = [], {}
+
+    def rebuild(expr):
+        if not isinstance(expr, Unevaluated) and (not isinstance(expr, sympy.Basic) or not expr.args):
+            return expr
+        if expr in named:
+            return named[expr]
+        form = rewritten.get(expr, expr)
+        args = [rebuild(arg) for arg in form.args]
+        if isinstance(form, Unevaluated):
+            new = form.func(*args)
+        elif all(new is old for new, old in zip(args, form.args)):
+            new = form
+        else:
+            new = _rebuilt(form, args)
+        if expr in repeated:
+            symbol = next(symbols)
+            named[expr] = symbol
+            replacements.append((symbol, new))
+            return symbol
+        return new
+
+    return replacements, [rebuild(expr) for expr in exprs]
+
+
+def _negation(expr: sympy.Expr) -> sympy.Expr | None:
+    """-expr when sympy's cse would share expr with it (`could_extract_minus_sign`): a
+    product with a negative coefficient or a sum with more such terms than others, else None.
+    (On a tie sympy compares the sort keys of the sum and its negation; without distribution
+    the negation is -1 times the sum, whose key is the larger: never.)"""
+    if expr.is_Mul:
+        return _negated(expr) if _negative_coefficient(expr) else None
+    if 2 * sum(map(_negative_coefficient, expr.args)) <= len(expr.args):
+        return None
+    return sympy.Add(*(-term for term in expr.args))
+
+
+def _rebuilt(form: sympy.Basic, args: list) -> sympy.Basic:
+    """form with new arguments, without evaluating what cannot change: a function of
+    temporaries (a function of numbers was folded before), or a sum or product whose
+    arguments cannot combine (no repeats, no nested sum or product of its kind, no number
+    after the first). Anything else by sympy's constructor."""
+    if isinstance(form, sympy.Function):
+        return form.func(*args, evaluate=False)
+    if (form.is_Add or form.is_Mul) and len(set(args)) == len(args) and not any(
+            arg.func is form.func or (k and arg.is_Number) for k, arg in enumerate(args)):
+        return form.func._from_args(args)
+    return form.func(*args)

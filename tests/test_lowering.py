@@ -1,11 +1,12 @@
-"""The lowering core's operation count: sympy's `count_ops` (the reference every report and
-bench quotes), counted by jacgen without building count_ops' intermediate expressions."""
+"""The lowering core against sympy: its operation count against `count_ops` (the reference
+every report and bench quotes), its common-subexpression elimination against `cse`."""
 
 import pytest
 import sympy
+from sympy.core.parameters import distribute
 
 from jacgen.functions import Generator
-from jacgen.lowering import operation_count
+from jacgen.lowering import eliminate_common, operation_count
 from jacgen.robot import load_robot, parse_robot
 from jacgen.subproblems import AtLeast, Below, IsFinite, Select
 from conftest import ROOT
@@ -34,3 +35,42 @@ def test_every_body_counts_as_count_ops(source):
         body = function.body
         expressions = [e for _, e in body.definitions] + list(body.outputs)
         assert body.operation_count == sympy.count_ops(expressions), function.name
+
+
+def _dh_chain_jacobian(joints: int) -> list[sympy.Expr]:
+    """The position Jacobian of a plain DH chain, written out (shared products, sums with
+    negative terms, the shapes CSE works on)."""
+    q = sympy.symbols(f"q1:{joints + 1}", real=True)
+    transform = sympy.eye(4)
+    for k, angle in enumerate(q):
+        a, d, alpha = sympy.Rational(k + 2, 7), sympy.Rational(1, k + 3), sympy.pi / (k + 2)
+        ct, st, ca, sa = sympy.cos(angle), sympy.sin(angle), sympy.cos(alpha), sympy.sin(alpha)
+        transform = transform * sympy.Matrix([[ct, -st * ca, st * sa, a * ct], [st, ct * ca, -ct * sa, a * st],
+                                              [0, sa, ca, d], [0, 0, 0, 1]])
+    position = transform[:3, 3]
+    return list(position.jacobian(q)) + list(transform[:3, :3])
+
+
+COMMON = [x * y + z, -x * y - z, sympy.sin(x * y + z), x + y + z, x + y + w, 1 - x - y - w, 2 * x * y * z, -3 * x * y * w]
+
+
+@pytest.mark.parametrize("exprs", [SHAPES[:-3] + COMMON,
+                                   _dh_chain_jacobian(3), _dh_chain_jacobian(4)], ids=["shapes", "dh3", "dh4"])
+def test_eliminate_common_as_sympy_cse(exprs):
+    """eliminate_common finds what sympy's cse finds: as many temporaries, the same operation
+    count, and the same values (at a random point)."""
+    with distribute(False):
+        ours = eliminate_common(exprs, sympy.numbered_symbols("_r", real=True), {})
+        theirs = sympy.cse(exprs, sympy.numbered_symbols("_r", real=True), order="none")
+    for (replacements, reduced), reference in ((ours, exprs), (theirs, exprs)):
+        assert len(replacements) == len(theirs[0])
+        assert operation_count([v for _, v in replacements] + reduced) == \
+            operation_count([v for _, v in theirs[0]] + theirs[1])
+        point = {s: 0.1 + 0.37 * k for k, s in enumerate(sorted(set().union(*(e.free_symbols for e in reference)),
+                                                                  key=str))}
+        values = dict(point)
+        for symbol, value in replacements:
+            values[symbol] = sympy.N(value.subs(values), 30)
+        for expr, expected in zip(reduced, reference):
+            assert float(sympy.N(expr.subs(values), 30)) == pytest.approx(float(sympy.N(expected.subs(point), 30)),
+                                                                          rel=1e-12, abs=1e-12)

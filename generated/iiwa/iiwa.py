@@ -97,7 +97,7 @@ def fk(q):
     t7 = t5 + t4*c2
     t8 = c1*s2
     t9 = t2*c4 + t8*s4
-    t10 = t8*c4 - t2*s4
+    t10 = -t2*s4 + t8*c4
     t11 = t9*c5 - t6*s5
     t12 = t9*s5 + t6*c5
     t13 = t11*c6 - t10*s6
@@ -108,7 +108,7 @@ def fk(q):
     t18 = t17 + 0.42*t8
     t19 = s1*s2
     t20 = t7*c4 + t19*s4
-    t21 = t19*c4 - t7*s4
+    t21 = -t7*s4 + t19*c4
     t22 = t20*c5 + t3*s5
     t23 = t3*c5 - t20*s5
     t24 = t22*c6 - t21*s6
@@ -119,10 +119,10 @@ def fk(q):
     t29 = t28 + 0.42*t19
     t30 = c3*s2
     t31 = c2*s4 - t30*c4
-    t32 = t30*s4 + c2*c4
+    t32 = c2*c4 + t30*s4
     t33 = s2*s3
     t34 = t31*c5 + t33*s5
-    t35 = t33*c5 - t31*s5
+    t35 = -t31*s5 + t33*c5
     t36 = t34*c6 - t32*s6
     t37 = t32*c6 + t34*s6
     t38 = t35*s7 + t36*c7
@@ -177,22 +177,22 @@ def jacobian(q):
     t7 = t5 + t4*c2
     t8 = c1*s2
     t9 = t2*c4 + t8*s4
-    t10 = t8*c4 - t2*s4
+    t10 = -t2*s4 + t8*c4
     t11 = t9*c5 - t6*s5
     t12 = t9*s5 + t6*c5
     t13 = t10*c6 + t11*s6
     t14 = s1*s2
     t15 = t7*c4 + t14*s4
-    t16 = t14*c4 - t7*s4
+    t16 = -t7*s4 + t14*c4
     t17 = t15*c5 + t3*s5
     t18 = t3*c5 - t15*s5
     t19 = t16*c6 + t17*s6
     t20 = c3*s2
     t21 = c2*s4 - t20*c4
-    t22 = t20*s4 + c2*c4
+    t22 = c2*c4 + t20*s4
     t23 = s2*s3
     t24 = t21*c5 + t23*s5
-    t25 = t23*c5 - t21*s5
+    t25 = -t21*s5 + t23*c5
     t26 = t22*c6 + t24*s6
     t27 = 0.126*t13
     t28 = t27 + 0.4*t10
@@ -208,15 +208,15 @@ def jacobian(q):
     J = _stack(xp, [
         -t32,  # 0, 0
         t36,  # 0, 1
-        t37*s2 - t32*c2,  # 0, 2
-        t31*t23 - t34*t3,  # 0, 3
+        -t32*c2 + t37*s2,  # 0, 2
+        -t34*t3 + t31*t23,  # 0, 3
         t16*t34 - t22*t31,  # 0, 4
         t18*t33 - t25*t30,  # 0, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 6
         t29,  # 1, 0
         t37,  # 1, 1
         t29*c2 - t36*s2,  # 1, 2
-        -(t28*t23 + t34*t6),  # 1, 3
+        -(t34*t6 + t28*t23),  # 1, 3
         t22*t28 - t10*t34,  # 1, 4
         t12*t33 + t25*t27,  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 6
@@ -280,7 +280,7 @@ def fk_jacobian(q):
     t7 = t5 + t4*c2
     t8 = c1*s2
     t9 = t2*c4 + t8*s4
-    t10 = t8*c4 - t2*s4
+    t10 = -t2*s4 + t8*c4
     t11 = t9*c5 - t6*s5
     t12 = t9*s5 + t6*c5
     t13 = t11*c6 - t10*s6
@@ -289,7 +289,7 @@ def fk_jacobian(q):
     t16 = t12*c7 + t13*s7
     t17 = s1*s2
     t18 = t7*c4 + t17*s4
-    t19 = t17*c4 - t7*s4
+    t19 = -t7*s4 + t17*c4
     t20 = t18*c5 + t3*s5
     t21 = t3*c5 - t18*s5
     t22 = t20*c6 - t19*s6
@@ -298,10 +298,10 @@ def fk_jacobian(q):
     t25 = t21*c7 - t22*s7
     t26 = c3*s2
     t27 = c2*s4 - t26*c4
-    t28 = t26*s4 + c2*c4
+    t28 = c2*c4 + t26*s4
     t29 = s2*s3
     t30 = t27*c5 + t29*s5
-    t31 = t29*c5 - t27*s5
+    t31 = -t27*s5 + t29*c5
     t32 = t30*c6 - t28*s6
     t33 = t28*c6 + t30*s6
     t34 = t31*s7 + t32*c7
@@ -339,15 +339,15 @@ def fk_jacobian(q):
     J = _stack(xp, [
         -t41,  # 0, 0
         t46,  # 0, 1
-        t47*s2 - t41*c2,  # 0, 2
-        t40*t29 - t43*t3,  # 0, 3
+        -t41*c2 + t47*s2,  # 0, 2
+        -t43*t3 + t40*t29,  # 0, 3
         t19*t43 - t28*t40,  # 0, 4
         t21*t42 - t31*t39,  # 0, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 6
         t38,  # 1, 0
         t47,  # 1, 1
         t38*c2 - t46*s2,  # 1, 2
-        -(t37*t29 + t43*t6),  # 1, 3
+        -(t43*t6 + t37*t29),  # 1, 3
         t28*t37 - t10*t43,  # 1, 4
         t12*t42 + t31*t36,  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 6
@@ -411,7 +411,7 @@ def jacobian_tool(q):
     t7 = t5 + t4*c2
     t8 = c1*s2
     t9 = t2*c4 + t8*s4
-    t10 = t8*c4 - t2*s4
+    t10 = -t2*s4 + t8*c4
     t11 = t9*c5 - t6*s5
     t12 = t9*s5 + t6*c5
     t13 = t11*c6 - t10*s6
@@ -420,7 +420,7 @@ def jacobian_tool(q):
     t16 = t12*c7 + t13*s7
     t17 = s1*s2
     t18 = t7*c4 + t17*s4
-    t19 = t17*c4 - t7*s4
+    t19 = -t7*s4 + t17*c4
     t20 = t18*c5 + t3*s5
     t21 = t3*c5 - t18*s5
     t22 = t20*c6 - t19*s6
@@ -429,10 +429,10 @@ def jacobian_tool(q):
     t25 = t21*c7 - t22*s7
     t26 = c3*s2
     t27 = c2*s4 - t26*c4
-    t28 = t26*s4 + c2*c4
+    t28 = c2*c4 + t26*s4
     t29 = s2*s3
     t30 = t27*c5 + t29*s5
-    t31 = t29*c5 - t27*s5
+    t31 = -t27*s5 + t29*c5
     t32 = t30*c6 - t28*s6
     t33 = t28*c6 + t30*s6
     t34 = t31*s7 + t32*c7
@@ -446,15 +446,15 @@ def jacobian_tool(q):
     t42 = 0.126*t33
     t43 = t42 + 0.4*t28
     t44 = t43 + 0.42*c2
-    t45 = t44*c1
-    t46 = t44*s1
-    t47 = -(t38*c1 + t41*s1)
-    t48 = t44*t17 - t41*c2
+    t45 = -(t38*c1 + t41*s1)
+    t46 = t44*c1
+    t47 = t44*s1
+    t48 = -t41*c2 + t44*t17
     t49 = t38*c2 - t44*t8
     t50 = t41*t8 - t38*t17
-    t51 = t37*t3 + t40*t6
-    t52 = t40*t29 - t43*t3
-    t53 = -(t37*t29 + t43*t6)
+    t51 = -t43*t3 + t40*t29
+    t52 = -(t43*t6 + t37*t29)
+    t53 = t37*t3 + t40*t6
     t54 = t19*t43 - t28*t40
     t55 = t28*t37 - t10*t43
     t56 = t10*t40 - t19*t37
@@ -463,44 +463,44 @@ def jacobian_tool(q):
     t59 = -(t12*t39 + t21*t36)
     J = _stack(xp, [
         t24*t38 - t15*t41,  # 0, 0
-        t15*t45 + t24*t46 + t34*t47,  # 0, 1
+        t34*t45 + t15*t46 + t24*t47,  # 0, 1
         t15*t48 + t24*t49 + t34*t50,  # 0, 2
-        t15*t52 + t24*t53 + t34*t51,  # 0, 3
+        t15*t51 + t24*t52 + t34*t53,  # 0, 3
         t15*t54 + t24*t55 + t34*t56,  # 0, 4
         t15*t57 + t24*t58 + t34*t59,  # 0, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 6
         t16*t41 + t25*t38,  # 1, 0
-        t25*t46 + t35*t47 - t16*t45,  # 1, 1
+        t35*t45 + t25*t47 - t16*t46,  # 1, 1
         t25*t49 + t35*t50 - t16*t48,  # 1, 2
-        t25*t53 + t35*t51 - t16*t52,  # 1, 3
+        t25*t52 + t35*t53 - t16*t51,  # 1, 3
         t25*t55 + t35*t56 - t16*t54,  # 1, 4
         t25*t58 + t35*t59 - t16*t57,  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 6
         t23*t38 - t14*t41,  # 2, 0
-        t14*t45 + t23*t46 + t33*t47,  # 2, 1
+        t33*t45 + t14*t46 + t23*t47,  # 2, 1
         t14*t48 + t23*t49 + t33*t50,  # 2, 2
-        t14*t52 + t23*t53 + t33*t51,  # 2, 3
+        t14*t51 + t23*t52 + t33*t53,  # 2, 3
         t14*t54 + t23*t55 + t33*t56,  # 2, 4
         t14*t57 + t23*t58 + t33*t59,  # 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 6
         t34,  # 3, 0
         t24*c1 - t15*s1,  # 3, 1
-        t15*t8 + t24*t17 + t34*c2,  # 3, 2
-        -(t24*t3 + t34*t29 - t15*t6),  # 3, 3
+        t34*c2 + t15*t8 + t24*t17,  # 3, 2
+        -(t24*t3 - t15*t6 + t34*t29),  # 3, 3
         t10*t15 + t19*t24 + t28*t34,  # 3, 4
         t21*t24 + t31*t34 - t12*t15,  # 3, 5
         t14*t15 + t23*t24 + t33*t34,  # 3, 6
         t35,  # 4, 0
         t16*s1 + t25*c1,  # 4, 1
-        t25*t17 + t35*c2 - t16*t8,  # 4, 2
+        t35*c2 + t25*t17 - t16*t8,  # 4, 2
         -(t16*t6 + t25*t3 + t35*t29),  # 4, 3
         t19*t25 + t28*t35 - t10*t16,  # 4, 4
         t12*t16 + t21*t25 + t31*t35,  # 4, 5
         t23*t25 + t33*t35 - t14*t16,  # 4, 6
         t33,  # 5, 0
         t23*c1 - t14*s1,  # 5, 1
-        t14*t8 + t23*t17 + t33*c2,  # 5, 2
-        -(t23*t3 + t33*t29 - t14*t6),  # 5, 3
+        t33*c2 + t14*t8 + t23*t17,  # 5, 2
+        -(t23*t3 - t14*t6 + t33*t29),  # 5, 3
         t10*t14 + t19*t23 + t28*t33,  # 5, 4
         t21*t23 + t31*t33 - t12*t14,  # 5, 5
         t14**2 + t23**2 + t33**2,  # 5, 6
@@ -536,7 +536,7 @@ def task(q):
     t7 = t5 + t4*c2
     t8 = c1*s2
     t9 = t2*c4 + t8*s4
-    t10 = t8*c4 - t2*s4
+    t10 = -t2*s4 + t8*c4
     t11 = t9*c5 - t6*s5
     t12 = t9*s5 + t6*c5
     t13 = t11*c6 - t10*s6
@@ -546,7 +546,7 @@ def task(q):
     t17 = t16 + 0.42*t8
     t18 = s1*s2
     t19 = t7*c4 + t18*s4
-    t20 = t18*c4 - t7*s4
+    t20 = -t7*s4 + t18*c4
     t21 = t19*c5 + t3*s5
     t22 = t3*c5 - t19*s5
     t23 = t21*c6 - t20*s6
@@ -556,10 +556,10 @@ def task(q):
     t27 = t26 + 0.42*t18
     t28 = c3*s2
     t29 = c2*s4 - t28*c4
-    t30 = t28*s4 + c2*c4
+    t30 = c2*c4 + t28*s4
     t31 = s2*s3
     t32 = t29*c5 + t31*s5
-    t33 = t31*c5 - t29*s5
+    t33 = -t29*s5 + t31*c5
     t34 = t32*c6 - t30*s6
     t35 = t30*c6 + t32*s6
     t36 = t33*s7 + t34*c7
@@ -606,7 +606,7 @@ def task_jacobian(q):
     t7 = t5 + t4*c2
     t8 = c1*s2
     t9 = t2*c4 + t8*s4
-    t10 = t8*c4 - t2*s4
+    t10 = -t2*s4 + t8*c4
     t11 = t9*c5 - t6*s5
     t12 = t9*s5 + t6*c5
     t13 = t11*c6 - t10*s6
@@ -614,7 +614,7 @@ def task_jacobian(q):
     t15 = t13*c7 - t12*s7
     t16 = s1*s2
     t17 = t7*c4 + t16*s4
-    t18 = t16*c4 - t7*s4
+    t18 = -t7*s4 + t16*c4
     t19 = t17*c5 + t3*s5
     t20 = t3*c5 - t17*s5
     t21 = t19*c6 - t18*s6
@@ -622,10 +622,10 @@ def task_jacobian(q):
     t23 = t20*s7 + t21*c7
     t24 = c3*s2
     t25 = c2*s4 - t24*c4
-    t26 = t24*s4 + c2*c4
+    t26 = c2*c4 + t24*s4
     t27 = s2*s3
     t28 = t25*c5 + t27*s5
-    t29 = t27*c5 - t25*s5
+    t29 = -t25*s5 + t27*c5
     t30 = t28*c6 - t26*s6
     t31 = t26*c6 + t28*s6
     t32 = t29*s7 + t30*c7
@@ -640,31 +640,31 @@ def task_jacobian(q):
     t41 = t40 + 0.42*c2
     t42 = t41*c1
     t43 = t41*s1
-    t44 = t23*c1
-    t45 = t15*s1
-    t46 = t15**2 + t23**2
-    t47 = 1/t46
-    t48 = t47*(t44 - t45)
+    t44 = t15**2 + t23**2
+    t45 = 1/t44
+    t46 = t23*c1
+    t47 = t15*s1
+    t48 = t45*(t46 - t47)
     t49 = t15*c1
     t50 = t23*s1
-    t51 = t47*(t49*s2 + t50*s2)
-    t52 = t47*(t15*t6 - t23*t3)
-    t53 = t47*(t10*t15 + t18*t23)
-    t54 = t47*(t20*t23 - t12*t15)
-    t55 = t47*(t14*t15 + t22*t23)
-    t56 = 1/xp.sqrt(t46)
+    t51 = t45*(t49*s2 + t50*s2)
+    t52 = t45*(t15*t6 - t23*t3)
+    t53 = t45*(t10*t15 + t18*t23)
+    t54 = t45*(t20*t23 - t12*t15)
+    t55 = t45*(t14*t15 + t22*t23)
+    t56 = 1/xp.sqrt(t44)
     J = _stack(xp, [
         -t38,  # 0, 0
         t42,  # 0, 1
-        t43*s2 - t38*c2,  # 0, 2
-        t37*t27 - t40*t3,  # 0, 3
+        -t38*c2 + t43*s2,  # 0, 2
+        -t40*t3 + t37*t27,  # 0, 3
         t18*t40 - t26*t37,  # 0, 4
         t20*t39 - t29*t36,  # 0, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 6
         t35,  # 1, 0
         t43,  # 1, 1
         t35*c2 - t42*s2,  # 1, 2
-        -(t34*t27 + t40*t6),  # 1, 3
+        -(t40*t6 + t34*t27),  # 1, 3
         t26*t34 - t10*t40,  # 1, 4
         t12*t39 + t29*t33,  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 6
@@ -684,7 +684,7 @@ def task_jacobian(q):
         t55,  # 3, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
         t56*(t49 + t50),  # 4, 1
-        t56*(t45*s2 - t44*s2),  # 4, 2
+        t56*(t47*s2 - t46*s2),  # 4, 2
         -t56*(t15*t3 + t23*t6),  # 4, 3
         t56*(t18*t15 - t10*t23),  # 4, 4
         t56*(t12*t23 + t20*t15),  # 4, 5
@@ -736,7 +736,7 @@ def fk_jacobian_dot(q, q_dot):
     t8 = t6 + t5*c2
     t9 = c1*s2
     t10 = t3*c4 + t9*s4
-    t11 = t9*c4 - t3*s4
+    t11 = -t3*s4 + t9*c4
     t12 = t10*c5 - t7*s5
     t13 = t10*s5 + t7*c5
     t14 = t12*c6 - t11*s6
@@ -745,7 +745,7 @@ def fk_jacobian_dot(q, q_dot):
     t17 = t13*c7 + t14*s7
     t18 = s1*s2
     t19 = t8*c4 + t18*s4
-    t20 = t18*c4 - t8*s4
+    t20 = -t8*s4 + t18*c4
     t21 = t19*c5 + t4*s5
     t22 = t4*c5 - t19*s5
     t23 = t21*c6 - t20*s6
@@ -754,10 +754,10 @@ def fk_jacobian_dot(q, q_dot):
     t26 = t22*c7 - t23*s7
     t27 = c3*s2
     t28 = c2*s4 - t27*c4
-    t29 = t27*s4 + c2*c4
+    t29 = c2*c4 + t27*s4
     t30 = s2*s3
     t31 = t28*c5 + t30*s5
-    t32 = t30*c5 - t28*s5
+    t32 = -t28*s5 + t30*c5
     t33 = t31*c6 - t29*s6
     t34 = t29*c6 + t31*s6
     t35 = t32*s7 + t33*c7
@@ -775,9 +775,9 @@ def fk_jacobian_dot(q, q_dot):
     t47 = t46 + 0.42*c2
     t48 = 0.36 + t47
     t49 = t47*s1
-    t50 = t49*s2 - t44*c2
+    t50 = -t44*c2 + t49*s2
     t51 = t50
-    t52 = t43*t30 - t46*t4
+    t52 = -t46*t4 + t43*t30
     t53 = t52
     t54 = t20*t46 - t29*t43
     t55 = t54
@@ -789,7 +789,7 @@ def fk_jacobian_dot(q, q_dot):
     t61 = t47*c1
     t62 = t41*c2 - t61*s2
     t63 = t62
-    t64 = t40*t30 + t46*t7
+    t64 = t46*t7 + t40*t30
     t65 = t64
     t66 = t29*t40 - t11*t46
     t67 = t66
@@ -894,12 +894,12 @@ def fk_jacobian_dot(q, q_dot):
         xp.broadcast_to(t34, batch),  # 5, 6
     ], (6, 7))
     a = _stack(xp, [
-        xp.broadcast_to(qd2*(t86*c1 - t49*qd1) + qd3*(t76*t93 + t85*t18 - t63*qd1 - t72*c2) + qd4*(t65*t0 + t78*t94 + t71*t30 - t84*t4) + qd5*(t20*t83 + t80*t95 - t29*t70 - t67*t37) - t92*qd1 - qd6*(t69*t38 + t69*t103 + t82*t96 + t82*t101), batch),  # 0
-        xp.broadcast_to(t98*qd1 + qd2*(t86*s1 + t61*qd1) + qd3*(t51*qd1 + t76*t87 + t60*c2 - t85*t9) + qd5*(t29*t58 + t55*t37 - t11*t83 - t80*t89) + qd6*(t57*t38 + t57*t103 + t82*t90 - t82*t99) - qd4*(t78*t88 + t7*t84 + t59*t30 - t53*t0), batch),  # 1
-        xp.broadcast_to(qd4*(t7*t71 + t59*t4 - t53*t94 - t65*t88) + qd5*(t11*t70 + t67*t89 - t20*t58 - t55*t95) - qd2*(t97*c1 + t91*s1) - qd3*(t51*t93 + t63*t87 + t60*t18 - t72*c1*s2) - qd6*(t57*t96 + t57*t101 + t69*t99 - t69*t90), batch),  # 2
+        xp.broadcast_to(qd2*(t86*c1 - t49*qd1) + qd3*(-t63*qd1 - t72*c2 + t76*t93 + t85*t18) + qd4*(t65*t0 + t78*t94 - t84*t4 + t71*t30) + qd5*(t20*t83 + t80*t95 - t29*t70 - t67*t37) - qd6*(t69*t38 + t82*t96 + t82*t101 + t69*t103) - t92*qd1, batch),  # 0
+        xp.broadcast_to(t98*qd1 + qd2*(t86*s1 + t61*qd1) + qd3*(t51*qd1 + t60*c2 + t76*t87 - t85*t9) - qd4*(t78*t88 + t7*t84 - t53*t0 + t59*t30) + qd5*(t29*t58 + t55*t37 - t11*t83 - t80*t89) + qd6*(t57*t38 + t82*t90 + t57*t103 - t82*t99), batch),  # 1
+        xp.broadcast_to(-qd2*(t97*c1 + t91*s1) - qd3*(t51*t93 + t63*t87 + t60*t18 - t72*c1*s2) + qd4*(t7*t71 + t59*t4 - t53*t94 - t65*t88) + qd5*(t11*t70 + t67*t89 - t20*t58 - t55*t95) - qd6*(t57*t96 - t69*t90 + t69*t99 + t57*t101), batch),  # 2
         xp.broadcast_to(qd3*(t93*c2 - t18*qd1) + qd4*(t0*t4 - t94*t30) + qd5*(t29*t95 - t20*t37) + qd6*(t32*t96 - t22*t38) + qd7*(t34*t102 - t24*t104) - t93*qd1, batch),  # 3
-        xp.broadcast_to(qd3*(t87*c2 + t9*qd1) + qd4*(t88*t30 + t7*t0) + qd5*(t11*t37 - t29*t89) + qd7*(t15*t104 - t34*t100) - t87*qd1 - qd6*(t13*t38 + t32*t90), batch),  # 4
-        xp.broadcast_to(qd5*(t20*t89 - t11*t95) + qd6*(t13*t96 + t22*t90) + qd7*(t24*t100 - t15*t102) - qd3*(t105*c1**2 + t105*s1**2) - qd4*(t88*t4 + t7*t94), batch),  # 5
+        xp.broadcast_to(qd3*(t9*qd1 + t87*c2) + qd4*(t7*t0 + t88*t30) + qd5*(t11*t37 - t29*t89) - qd6*(t13*t38 + t32*t90) + qd7*(t15*t104 - t34*t100) - t87*qd1, batch),  # 4
+        xp.broadcast_to(-qd3*(t105*c1**2 + t105*s1**2) - qd4*(t88*t4 + t7*t94) + qd5*(t20*t89 - t11*t95) + qd6*(t13*t96 + t22*t90) + qd7*(t24*t100 - t15*t102), batch),  # 5
     ], (6,))
     return T, J, a
 
@@ -937,22 +937,22 @@ def jacobian_dot(q, q_dot):
     t8 = t6 + t5*c2
     t9 = c1*s2
     t10 = t3*c4 + t9*s4
-    t11 = t9*c4 - t3*s4
+    t11 = -t3*s4 + t9*c4
     t12 = t10*c5 - t7*s5
     t13 = t10*s5 + t7*c5
     t14 = t11*c6 + t12*s6
     t15 = s1*s2
     t16 = t8*c4 + t15*s4
-    t17 = t15*c4 - t8*s4
+    t17 = -t8*s4 + t15*c4
     t18 = t16*c5 + t4*s5
     t19 = t4*c5 - t16*s5
     t20 = t17*c6 + t18*s6
     t21 = c3*s2
     t22 = c2*s4 - t21*c4
-    t23 = t21*s4 + c2*c4
+    t23 = c2*c4 + t21*s4
     t24 = s2*s3
     t25 = t22*c5 + t24*s5
-    t26 = t24*c5 - t22*s5
+    t26 = -t22*s5 + t24*c5
     t27 = t23*c6 + t25*s6
     t28 = t0 - t24*qd4
     t29 = t28 + t23*qd5
@@ -974,12 +974,12 @@ def jacobian_dot(q, q_dot):
     t45 = 0.126*t27
     t46 = t45 + 0.4*t23
     t47 = t46 + 0.42*c2
-    t48 = t47*t15 - t35*c2
-    t49 = t34*t24 - t46*t4
+    t48 = -t35*c2 + t47*t15
+    t49 = -t46*t4 + t34*t24
     t50 = t17*t46 - t23*t34
     t51 = t19*t45 - t26*t33
     t52 = t32*c2 - t47*t9
-    t53 = t31*t24 + t46*t7
+    t53 = t46*t7 + t31*t24
     t54 = t23*t31 - t11*t46
     t55 = t13*t45 + t26*t30
     t56 = t50*qd5 + t51*qd6
@@ -1012,24 +1012,24 @@ def jacobian_dot(q, q_dot):
     Jd = _stack(xp, [
         xp.broadcast_to(-t67, batch),  # 0, 0
         xp.broadcast_to(t44*c1 - t47*t80, batch),  # 0, 1
-        xp.broadcast_to(t37*t68 + t43*t15 - t52*qd1 - t61*c2, batch),  # 0, 2
-        xp.broadcast_to(t53*t0 + t38*t69 + t59*t24 - t42*t4, batch),  # 0, 3
+        xp.broadcast_to(-t52*qd1 - t61*c2 + t37*t68 + t43*t15, batch),  # 0, 2
+        xp.broadcast_to(t53*t0 + t38*t69 - t42*t4 + t59*t24, batch),  # 0, 3
         xp.broadcast_to(t17*t41 + t39*t70 - t23*t57 - t54*t28, batch),  # 0, 4
-        xp.broadcast_to(-(t55*t29 + t55*t78 + t40*t71 + t40*t76), batch),  # 0, 5
+        xp.broadcast_to(-(t55*t29 + t40*t71 + t40*t76 + t55*t78), batch),  # 0, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 6
         xp.broadcast_to(t73, batch),  # 1, 0
-        xp.broadcast_to(t47*t81 + t44*s1, batch),  # 1, 1
-        xp.broadcast_to(t48*qd1 + t37*t62 + t60*c2 - t43*t9, batch),  # 1, 2
-        xp.broadcast_to(-(t38*t63 + t7*t42 + t58*t24 - t49*t0), batch),  # 1, 3
+        xp.broadcast_to(t44*s1 + t47*t81, batch),  # 1, 1
+        xp.broadcast_to(t48*qd1 + t60*c2 + t37*t62 - t43*t9, batch),  # 1, 2
+        xp.broadcast_to(-(t38*t63 + t7*t42 - t49*t0 + t58*t24), batch),  # 1, 3
         xp.broadcast_to(t23*t56 + t50*t28 - t11*t41 - t39*t64, batch),  # 1, 4
-        xp.broadcast_to(t51*t29 + t51*t78 + t40*t65 - t40*t74, batch),  # 1, 5
+        xp.broadcast_to(t51*t29 + t40*t65 + t51*t78 - t40*t74, batch),  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
         xp.broadcast_to(-(t72*c1 + t66*s1), batch),  # 2, 1
         xp.broadcast_to(-(t48*t68 + t52*t62 + t60*t15 - t61*c1*s2), batch),  # 2, 2
         xp.broadcast_to(t7*t59 + t58*t4 - t49*t69 - t53*t63, batch),  # 2, 3
         xp.broadcast_to(t11*t57 + t54*t64 - t17*t56 - t50*t70, batch),  # 2, 4
-        xp.broadcast_to(-(t51*t71 + t51*t76 + t55*t74 - t55*t65), batch),  # 2, 5
+        xp.broadcast_to(-(t51*t71 - t55*t65 + t55*t74 + t51*t76), batch),  # 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
         xp.broadcast_to(-t81, batch),  # 3, 1
@@ -1040,8 +1040,8 @@ def jacobian_dot(q, q_dot):
         xp.broadcast_to(t27*t77 - t20*t79, batch),  # 3, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
         xp.broadcast_to(-t80, batch),  # 4, 1
-        xp.broadcast_to(t62*c2 + t81*s2, batch),  # 4, 2
-        xp.broadcast_to(t63*t24 + t7*t0, batch),  # 4, 3
+        xp.broadcast_to(t81*s2 + t62*c2, batch),  # 4, 2
+        xp.broadcast_to(t7*t0 + t63*t24, batch),  # 4, 3
         xp.broadcast_to(t11*t28 - t23*t64, batch),  # 4, 4
         xp.broadcast_to(-(t13*t29 + t26*t65), batch),  # 4, 5
         xp.broadcast_to(t14*t79 - t27*t75, batch),  # 4, 6
@@ -1090,22 +1090,22 @@ def bias_acceleration(q, q_dot):
     t8 = t6 + t5*c2
     t9 = c1*s2
     t10 = t3*c4 + t9*s4
-    t11 = t9*c4 - t3*s4
+    t11 = -t3*s4 + t9*c4
     t12 = t10*c5 - t7*s5
     t13 = t10*s5 + t7*c5
     t14 = t11*c6 + t12*s6
     t15 = s1*s2
     t16 = t8*c4 + t15*s4
-    t17 = t15*c4 - t8*s4
+    t17 = -t8*s4 + t15*c4
     t18 = t16*c5 + t4*s5
     t19 = t4*c5 - t16*s5
     t20 = t17*c6 + t18*s6
     t21 = c3*s2
     t22 = c2*s4 - t21*c4
-    t23 = t21*s4 + c2*c4
+    t23 = c2*c4 + t21*s4
     t24 = s2*s3
     t25 = t22*c5 + t24*s5
-    t26 = t24*c5 - t22*s5
+    t26 = -t22*s5 + t24*c5
     t27 = t23*c6 + t25*s6
     t28 = t0 - t24*qd4
     t29 = t28 + t23*qd5
@@ -1127,12 +1127,12 @@ def bias_acceleration(q, q_dot):
     t45 = 0.126*t27
     t46 = t45 + 0.4*t23
     t47 = t46 + 0.42*c2
-    t48 = t47*t15 - t35*c2
-    t49 = t34*t24 - t46*t4
+    t48 = -t35*c2 + t47*t15
+    t49 = -t46*t4 + t34*t24
     t50 = t17*t46 - t23*t34
     t51 = t19*t45 - t26*t33
     t52 = t32*c2 - t47*t9
-    t53 = t31*t24 + t46*t7
+    t53 = t46*t7 + t31*t24
     t54 = t23*t31 - t11*t46
     t55 = t13*t45 + t26*t30
     t56 = t50*qd5 + t51*qd6
@@ -1162,12 +1162,12 @@ def bias_acceleration(q, q_dot):
     t80 = t47*qd1
     t81 = qd2*s2
     a = _stack(xp, [
-        xp.broadcast_to(qd2*(t44*c1 - t80*s1) + qd3*(t37*t68 + t43*t15 - t52*qd1 - t61*c2) + qd4*(t53*t0 + t38*t69 + t59*t24 - t42*t4) + qd5*(t17*t41 + t39*t70 - t23*t57 - t54*t28) - t67*qd1 - qd6*(t55*t29 + t55*t78 + t40*t71 + t40*t76), batch),  # 0
-        xp.broadcast_to(t73*qd1 + qd2*(t44*s1 + t80*c1) + qd3*(t48*qd1 + t37*t62 + t60*c2 - t43*t9) + qd5*(t23*t56 + t50*t28 - t11*t41 - t39*t64) + qd6*(t51*t29 + t51*t78 + t40*t65 - t40*t74) - qd4*(t38*t63 + t7*t42 + t58*t24 - t49*t0), batch),  # 1
-        xp.broadcast_to(qd4*(t7*t59 + t58*t4 - t49*t69 - t53*t63) + qd5*(t11*t57 + t54*t64 - t17*t56 - t50*t70) - qd2*(t72*c1 + t66*s1) - qd3*(t48*t68 + t52*t62 + t60*t15 - t61*c1*s2) - qd6*(t51*t71 + t51*t76 + t55*t74 - t55*t65), batch),  # 2
+        xp.broadcast_to(qd2*(t44*c1 - t80*s1) + qd3*(-t52*qd1 - t61*c2 + t37*t68 + t43*t15) + qd4*(t53*t0 + t38*t69 - t42*t4 + t59*t24) + qd5*(t17*t41 + t39*t70 - t23*t57 - t54*t28) - qd6*(t55*t29 + t40*t71 + t40*t76 + t55*t78) - t67*qd1, batch),  # 0
+        xp.broadcast_to(t73*qd1 + qd2*(t44*s1 + t80*c1) + qd3*(t48*qd1 + t60*c2 + t37*t62 - t43*t9) - qd4*(t38*t63 + t7*t42 - t49*t0 + t58*t24) + qd5*(t23*t56 + t50*t28 - t11*t41 - t39*t64) + qd6*(t51*t29 + t40*t65 + t51*t78 - t40*t74), batch),  # 1
+        xp.broadcast_to(-qd2*(t72*c1 + t66*s1) - qd3*(t48*t68 + t52*t62 + t60*t15 - t61*c1*s2) + qd4*(t7*t59 + t58*t4 - t49*t69 - t53*t63) + qd5*(t11*t57 + t54*t64 - t17*t56 - t50*t70) - qd6*(t51*t71 - t55*t65 + t55*t74 + t51*t76), batch),  # 2
         xp.broadcast_to(qd3*(t68*c2 - t15*qd1) + qd4*(t0*t4 - t69*t24) + qd5*(t23*t70 - t17*t28) + qd6*(t26*t71 - t19*t29) + qd7*(t27*t77 - t20*t79) - t68*qd1, batch),  # 3
-        xp.broadcast_to(qd3*(t62*c2 + t9*qd1) + qd4*(t63*t24 + t7*t0) + qd5*(t11*t28 - t23*t64) + qd7*(t14*t79 - t27*t75) - t62*qd1 - qd6*(t13*t29 + t26*t65), batch),  # 4
-        xp.broadcast_to(qd5*(t17*t64 - t11*t70) + qd6*(t13*t71 + t19*t65) + qd7*(t20*t75 - t14*t77) - qd3*(t81*c1**2 + t81*s1**2) - qd4*(t63*t4 + t7*t69), batch),  # 5
+        xp.broadcast_to(qd3*(t9*qd1 + t62*c2) + qd4*(t7*t0 + t63*t24) + qd5*(t11*t28 - t23*t64) - qd6*(t13*t29 + t26*t65) + qd7*(t14*t79 - t27*t75) - t62*qd1, batch),  # 4
+        xp.broadcast_to(-qd3*(t81*c1**2 + t81*s1**2) - qd4*(t63*t4 + t7*t69) + qd5*(t17*t64 - t11*t70) + qd6*(t13*t71 + t19*t65) + qd7*(t20*t75 - t14*t77), batch),  # 5
     ], (6,))
     return a
 
@@ -1207,7 +1207,7 @@ def task_jacobian_dot(q, q_dot):
     t7 = t5 + t4*c2
     t8 = c1*s2
     t9 = t2*c4 + t8*s4
-    t10 = t8*c4 - t2*s4
+    t10 = -t2*s4 + t8*c4
     t11 = t9*c5 - t6*s5
     t12 = t9*s5 + t6*c5
     t13 = t11*c6 - t10*s6
@@ -1215,7 +1215,7 @@ def task_jacobian_dot(q, q_dot):
     t15 = t13*c7 - t12*s7
     t16 = s1*s2
     t17 = t7*c4 + t16*s4
-    t18 = t16*c4 - t7*s4
+    t18 = -t7*s4 + t16*c4
     t19 = t17*c5 + t3*s5
     t20 = t3*c5 - t17*s5
     t21 = t19*c6 - t18*s6
@@ -1223,10 +1223,10 @@ def task_jacobian_dot(q, q_dot):
     t23 = t20*s7 + t21*c7
     t24 = c3*s2
     t25 = c2*s4 - t24*c4
-    t26 = t24*s4 + c2*c4
+    t26 = c2*c4 + t24*s4
     t27 = s2*s3
     t28 = t25*c5 + t27*s5
-    t29 = t27*c5 - t25*s5
+    t29 = -t25*s5 + t27*c5
     t30 = t28*c6 - t26*s6
     t31 = t26*c6 + t28*s6
     t32 = t29*s7 + t30*c7
@@ -1248,12 +1248,12 @@ def task_jacobian_dot(q, q_dot):
     t48 = 0.126*t31
     t49 = t48 + 0.4*t26
     t50 = t49 + 0.42*c2
-    t51 = t50*t16 - t38*c2
-    t52 = t37*t27 - t49*t3
+    t51 = -t38*c2 + t50*t16
+    t52 = -t49*t3 + t37*t27
     t53 = t18*t49 - t26*t37
     t54 = t20*t48 - t29*t36
     t55 = t35*c2 - t50*t8
-    t56 = t34*t27 + t49*t6
+    t56 = t49*t6 + t34*t27
     t57 = t26*t34 - t10*t49
     t58 = t12*t48 + t29*t33
     t59 = t53*qd5 + t54*qd6
@@ -1265,14 +1265,14 @@ def task_jacobian_dot(q, q_dot):
     t65 = qd2*s1
     t66 = t64 + t50*t65
     t67 = t66 + t35*qd1
-    t68 = t51*qd1 + t40*t65 + t63*c2 - t46*t8
-    t69 = t65*c2 + t8*qd1
+    t68 = t51*qd1 + t63*c2 + t40*t65 - t46*t8
+    t69 = t8*qd1 + t65*c2
     t70 = -t65 + t8*qd3
     t71 = t70
     t72 = c1*qd2
     t73 = t63 + t50*t72
     t74 = t73 - t38*qd1
-    t75 = t40*t72 + t46*t16 - t55*qd1 - t64*c2
+    t75 = -t55*qd1 - t64*c2 + t40*t72 + t46*t16
     t76 = t73*c1 + t66*s1
     t77 = t51*t72 + t55*t65 + t63*t16 - t64*t8
     t78 = t72*c2 - t16*qd1
@@ -1282,10 +1282,10 @@ def task_jacobian_dot(q, q_dot):
     t82 = t71*t3 + t6*t80
     t83 = qd1 + c2*qd3
     t84 = t83
-    t85 = t56*t84 + t41*t80 + t62*t27 - t45*t3
-    t86 = t41*t71 + t6*t45 + t61*t27 - t52*t84
+    t85 = t56*t84 + t41*t80 - t45*t3 + t62*t27
+    t86 = t41*t71 + t6*t45 - t52*t84 + t61*t27
     t87 = t84*t3 - t80*t27
-    t88 = t71*t27 + t6*t84
+    t88 = t6*t84 + t71*t27
     t89 = t6*qd4
     t90 = t71 + t89
     t91 = -t3*qd4
@@ -1313,14 +1313,14 @@ def task_jacobian_dot(q, q_dot):
     t113 = t70 + t89 + t101 + t111 + t14*qd7
     t114 = t20*qd6
     t115 = t104 + t114
-    t116 = t54*t104 + t54*t114 + t58*t110 - t58*t102
+    t116 = t54*t104 - t58*t102 + t58*t110 + t54*t114
     t117 = t22*t112 - t14*t115
     t118 = t79 + t91 + t103 + t114 + t22*qd7
     t119 = t113*t23 - t118*t15
     t120 = t29*qd6
     t121 = t107 + t120
-    t122 = t58*t107 + t58*t120 + t43*t104 + t43*t114
-    t123 = t54*t107 + t54*t120 + t43*t102 - t43*t110
+    t122 = t58*t107 + t43*t104 + t43*t114 + t58*t120
+    t123 = t54*t107 + t43*t102 + t54*t120 - t43*t110
     t124 = t31*t115 - t22*t121
     t125 = t14*t121 - t31*t112
     t126 = t83 + t95 + t106 + t120 + t31*qd7
@@ -1333,76 +1333,76 @@ def task_jacobian_dot(q, q_dot):
     t133 = t132*c1**2 + t132*s1**2
     t134 = t15**2 + t23**2
     t135 = 1/t134
-    t136 = t135*c1
-    t137 = t15*qd1
-    t138 = t135*s1
-    t139 = t23*qd1
-    t140 = t23*c1
-    t141 = t15*s1
-    t142 = t140 - t141
-    t143 = 2/t134**2
-    t144 = t142*t143
-    t145 = t23*t144
-    t146 = t15*t144
-    t147 = t15*t135
-    t148 = t78*t147
-    t149 = t23*t135
-    t150 = t69*t149
-    t151 = t136*s2
-    t152 = t15*c1
-    t153 = t23*s1
-    t154 = t152*s2 + t153*s2
-    t155 = t143*t154
-    t156 = t15*t155
-    t157 = t138*s2
-    t158 = t23*t155
-    t159 = t87*t147
-    t160 = t88*t149
-    t161 = t6*t135
-    t162 = t15*t6 - t23*t3
-    t163 = t143*t162
-    t164 = t15*t163
-    t165 = t3*t135
-    t166 = t23*t163
-    t167 = t99*t147
-    t168 = t100*t149
-    t169 = t10*t135
-    t170 = t10*t15 + t18*t23
-    t171 = t143*t170
-    t172 = t15*t171
-    t173 = t18*t135
-    t174 = t23*t171
-    t175 = t108*t147
-    t176 = t109*t149
-    t177 = t20*t135
-    t178 = t20*t23 - t12*t15
-    t179 = t143*t178
-    t180 = t23*t179
-    t181 = t12*t135
-    t182 = t15*t179
-    t183 = t124*t147
-    t184 = t125*t149
-    t185 = t14*t135
-    t186 = t14*t15 + t22*t23
-    t187 = t143*t186
-    t188 = t15*t187
-    t189 = t22*t135
-    t190 = t23*t187
+    t136 = s1*t135
+    t137 = t23*c1
+    t138 = t15*s1
+    t139 = t137 - t138
+    t140 = 2/t134**2
+    t141 = t139*t140
+    t142 = t15*t141
+    t143 = c1*t135
+    t144 = t23*t141
+    t145 = t15*qd1
+    t146 = t23*qd1
+    t147 = t143*s2
+    t148 = t15*c1
+    t149 = t23*s1
+    t150 = t148*s2 + t149*s2
+    t151 = t140*t150
+    t152 = t15*t151
+    t153 = t136*s2
+    t154 = t23*t151
+    t155 = t15*t135
+    t156 = t78*t155
+    t157 = t23*t135
+    t158 = t69*t157
+    t159 = t6*t135
+    t160 = t15*t6 - t23*t3
+    t161 = t140*t160
+    t162 = t15*t161
+    t163 = t3*t135
+    t164 = t23*t161
+    t165 = t87*t155
+    t166 = t88*t157
+    t167 = t10*t135
+    t168 = t10*t15 + t18*t23
+    t169 = t140*t168
+    t170 = t15*t169
+    t171 = t18*t135
+    t172 = t23*t169
+    t173 = t99*t155
+    t174 = t100*t157
+    t175 = t12*t135
+    t176 = t20*t23 - t12*t15
+    t177 = t140*t176
+    t178 = t15*t177
+    t179 = t20*t135
+    t180 = t23*t177
+    t181 = t108*t155
+    t182 = t109*t157
+    t183 = t14*t135
+    t184 = t14*t15 + t22*t23
+    t185 = t140*t184
+    t186 = t15*t185
+    t187 = t22*t135
+    t188 = t23*t185
+    t189 = t124*t155
+    t190 = t125*t157
     t191 = 1/xp.sqrt(t134)
-    t192 = t191*qd1
-    t193 = t191*c1
-    t194 = 1/t134**1.5
-    t195 = t194*(t152 + t153)
-    t196 = t191*s1
-    t197 = t15*t191
-    t198 = t23*t191
-    t199 = t194*(t141*s2 - t140*s2)
-    t200 = -t194*(t15*t3 + t23*t6)
-    t201 = t194*(t18*t15 - t10*t23)
-    t202 = t194*(t12*t23 + t20*t15)
-    t203 = t194*(t22*t15 - t14*t23)
+    t192 = c1*t191
+    t193 = 1/t134**1.5
+    t194 = t193*(t148 + t149)
+    t195 = s1*t191
+    t196 = t191*qd1
+    t197 = t193*(t138*s2 - t137*s2)
+    t198 = t15*t191
+    t199 = t23*t191
+    t200 = -t193*(t15*t3 + t23*t6)
+    t201 = t193*(t18*t15 - t10*t23)
+    t202 = t193*(t12*t23 + t20*t15)
+    t203 = t193*(t22*t15 - t14*t23)
     t204 = t32*t136
-    t205 = t32*t138
+    t205 = t32*t143
     t206 = t119*t135
     Jd = _stack(xp, [
         xp.broadcast_to(-t67, batch),  # 0, 0
@@ -1427,26 +1427,26 @@ def task_jacobian_dot(q, q_dot):
         xp.broadcast_to(-t116, batch),  # 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
-        xp.broadcast_to(t128*(t136 - t145) - t127*(t138 + t146) - t136*t137 - t138*t139, batch),  # 3, 1
-        xp.broadcast_to(t148 + t150 + t127*(t151 - t156) + t128*(t157 - t158), batch),  # 3, 2
-        xp.broadcast_to(t159 + t160 + t127*(t161 - t164) - t128*(t165 + t166), batch),  # 3, 3
-        xp.broadcast_to(t167 + t168 + t127*(t169 - t172) + t128*(t173 - t174), batch),  # 3, 4
-        xp.broadcast_to(t175 - t176 + t128*(t177 - t180) - t127*(t181 + t182), batch),  # 3, 5
-        xp.broadcast_to(t183 + t184 + t127*(t185 - t188) + t128*(t189 - t190), batch),  # 3, 6
+        xp.broadcast_to(-t127*(t136 + t142) + t128*(t143 - t144) - t143*t145 - t136*t146, batch),  # 3, 1
+        xp.broadcast_to(t127*(t147 - t152) + t128*(t153 - t154) + t156 + t158, batch),  # 3, 2
+        xp.broadcast_to(t127*(t159 - t162) - t128*(t163 + t164) + t165 + t166, batch),  # 3, 3
+        xp.broadcast_to(t127*(t167 - t170) + t128*(t171 - t172) + t173 + t174, batch),  # 3, 4
+        xp.broadcast_to(-t127*(t175 + t178) + t128*(t179 - t180) + t181 - t182, batch),  # 3, 5
+        xp.broadcast_to(t127*(t183 - t186) + t128*(t187 - t188) + t189 + t190, batch),  # 3, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
-        xp.broadcast_to(t127*(t193 - t15*t195) + t128*(t196 - t23*t195) + t140*t192 - t141*t192, batch),  # 4, 1
-        xp.broadcast_to(t69*t197 + t127*(t196*s2 - t15*t199) - t78*t198 - t128*(t23*t199 + t193*s2), batch),  # 4, 2
-        xp.broadcast_to(t88*t197 - t87*t198 - t127*(t15*t200 + t3*t191) - t128*(t23*t200 + t6*t191), batch),  # 4, 3
-        xp.broadcast_to(t100*t197 + t127*(t18*t191 - t15*t201) - t99*t198 - t128*(t10*t191 + t23*t201), batch),  # 4, 4
-        xp.broadcast_to(t127*(t20*t191 - t15*t202) + t128*(t12*t191 - t23*t202) - t108*t198 - t109*t197, batch),  # 4, 5
-        xp.broadcast_to(t125*t197 + t127*(t22*t191 - t15*t203) - t124*t198 - t128*(t14*t191 + t23*t203), batch),  # 4, 6
+        xp.broadcast_to(t127*(t192 - t15*t194) + t128*(t195 - t23*t194) + t137*t196 - t138*t196, batch),  # 4, 1
+        xp.broadcast_to(t127*(t195*s2 - t15*t197) - t128*(t23*t197 + t192*s2) + t69*t198 - t78*t199, batch),  # 4, 2
+        xp.broadcast_to(-t127*(t3*t191 + t15*t200) - t128*(t6*t191 + t23*t200) + t88*t198 - t87*t199, batch),  # 4, 3
+        xp.broadcast_to(t127*(t18*t191 - t15*t201) - t128*(t10*t191 + t23*t201) + t100*t198 - t99*t199, batch),  # 4, 4
+        xp.broadcast_to(t127*(t20*t191 - t15*t202) + t128*(t12*t191 - t23*t202) - t108*t199 - t109*t198, batch),  # 4, 5
+        xp.broadcast_to(t127*(t22*t191 - t15*t203) - t128*(t14*t191 + t23*t203) + t125*t198 - t124*t199, batch),  # 4, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 0
-        xp.broadcast_to(t127*(t205 + t32*t146) + t128*(-t204 + t32*t145) + t137*t204 + t139*t205 - t206*t142, batch),  # 5, 1
-        xp.broadcast_to(-(t133 + t32*t148 + t32*t150 + t206*t154 - t127*(t32*t156 - t32*t151) - t128*(t32*t158 - t32*t157)), batch),  # 5, 2
-        xp.broadcast_to(-(t82 + t32*t159 + t32*t160 + t206*t162 - t127*(t32*t164 - t32*t161) - t128*(t32*t165 + t32*t166)), batch),  # 5, 3
-        xp.broadcast_to(t94 + t127*(t32*t172 - t32*t169) + t128*(t32*t174 - t32*t173) - t32*t167 - t32*t168 - t206*t170, batch),  # 5, 4
-        xp.broadcast_to(t105 + t127*(t32*t181 + t32*t182) + t128*(t32*t180 - t32*t177) + t32*t176 - t32*t175 - t206*t178, batch),  # 5, 5
-        xp.broadcast_to(t117 + t127*(t32*t188 - t32*t185) + t128*(t32*t190 - t32*t189) - t32*t183 - t32*t184 - t206*t186, batch),  # 5, 6
+        xp.broadcast_to(t127*(t204 + t32*t142) + t128*(-t205 + t32*t144) - t206*t139 + t145*t205 + t146*t204, batch),  # 5, 1
+        xp.broadcast_to(-(t133 - t127*(-t32*t147 + t32*t152) - t128*(-t32*t153 + t32*t154) + t206*t150 + t32*t156 + t32*t158), batch),  # 5, 2
+        xp.broadcast_to(-(t82 - t127*(-t32*t159 + t32*t162) - t128*(t32*t163 + t32*t164) + t206*t160 + t32*t165 + t32*t166), batch),  # 5, 3
+        xp.broadcast_to(t94 + t127*(-t32*t167 + t32*t170) + t128*(-t32*t171 + t32*t172) - t206*t168 - t32*t173 - t32*t174, batch),  # 5, 4
+        xp.broadcast_to(t105 + t127*(t32*t175 + t32*t178) + t128*(-t32*t179 + t32*t180) - t206*t176 + t32*t182 - t32*t181, batch),  # 5, 5
+        xp.broadcast_to(t117 + t127*(-t32*t183 + t32*t186) + t128*(-t32*t187 + t32*t188) - t206*t184 - t32*t189 - t32*t190, batch),  # 5, 6
     ], (6, 7))
     return Jd
 
@@ -1477,22 +1477,22 @@ def hessian(q):
     t7 = t5 + t4*c2
     t8 = c1*s2
     t9 = t2*c4 + t8*s4
-    t10 = t8*c4 - t2*s4
+    t10 = -t2*s4 + t8*c4
     t11 = t9*c5 - t6*s5
     t12 = t9*s5 + t6*c5
     t13 = t10*c6 + t11*s6
     t14 = s1*s2
     t15 = t7*c4 + t14*s4
-    t16 = t14*c4 - t7*s4
+    t16 = -t7*s4 + t14*c4
     t17 = t15*c5 + t3*s5
     t18 = t3*c5 - t15*s5
     t19 = t16*c6 + t17*s6
     t20 = c3*s2
     t21 = c2*s4 - t20*c4
-    t22 = t20*s4 + c2*c4
+    t22 = c2*c4 + t20*s4
     t23 = s2*s3
     t24 = t21*c5 + t23*s5
-    t25 = t23*c5 - t21*s5
+    t25 = -t21*s5 + t23*c5
     t26 = t22*c6 + t24*s6
     t27 = 0.126*t13
     t28 = t27 + 0.4*t10
@@ -1508,14 +1508,14 @@ def hessian(q):
     t38 = 0.126*t26
     t39 = t38 + 0.4*t22
     t40 = t39 + 0.42*c2
-    t41 = t31*t23 - t39*t3
+    t41 = -t39*t3 + t31*t23
     t42 = t16*t39 - t22*t31
     t43 = t18*t38 - t25*t30
-    t44 = t28*t23 + t39*t6
+    t44 = t39*t6 + t28*t23
     t45 = t22*t28 - t10*t39
     t46 = t12*t38 + t25*t27
     t47 = t40*s1
-    t48 = t47*s2 - t32*c2
+    t48 = -t32*c2 + t47*s2
     t49 = t40*c1
     t50 = t29*c2 - t49*s2
     t51 = -t47
@@ -1537,7 +1537,7 @@ def hessian(q):
     t67 = -(t42*c1 + t45*s1)
     t68 = -(t43*c1 + t46*s1)
     t69 = t44*c2 + t35*t14
-    t70 = t36*t14 - t45*c2
+    t70 = -t45*c2 + t36*t14
     t71 = -(t46*c2 + t37*t14)
     t72 = t41*c2 - t35*t8
     t73 = t42*c2 - t36*t8
@@ -1546,9 +1546,9 @@ def hessian(q):
     t76 = t45*t8 - t42*t14
     t77 = t46*t8 - t43*t14
     t78 = s2**2
-    t79 = t45*t23 - t36*t3
-    t80 = t46*t23 + t37*t3
-    t81 = -(t42*t23 + t36*t6)
+    t79 = -t36*t3 + t45*t23
+    t80 = t37*t3 + t46*t23
+    t81 = -(t36*t6 + t42*t23)
     t82 = t37*t6 - t43*t23
     t83 = t42*t3 + t45*t6
     t84 = t43*t3 + t46*t6
@@ -1635,14 +1635,14 @@ def hessian(q):
         t26*s1,  # 1, 4, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5, 1
-        -(t63*s2 + t64*s2),  # 1, 5, 2
+        -(s2*t63 + s2*t64),  # 1, 5, 2
         t3*s1 - t6*c1,  # 1, 5, 3
         -(t10*c1 + t16*s1),  # 1, 5, 4
         t12*c1 - t18*s1,  # 1, 5, 5
         -(t13*c1 + t19*s1),  # 1, 5, 6
         t52,  # 2, 0, 0
         t55,  # 2, 0, 1
-        t34*t14 - t50*c2,  # 2, 0, 2
+        -t50*c2 + t34*t14,  # 2, 0, 2
         t69,  # 2, 0, 3
         t70,  # 2, 0, 4
         t71,  # 2, 0, 5
@@ -1665,9 +1665,9 @@ def hessian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 3, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 3, 2
         t3*c2 - t0*t78,  # 2, 3, 3
-        t22*t14 - t16*c2,  # 2, 3, 4
-        t25*t14 - t18*c2,  # 2, 3, 5
-        t26*t14 - t19*c2,  # 2, 3, 6
+        -t16*c2 + t22*t14,  # 2, 3, 4
+        -t18*c2 + t25*t14,  # 2, 3, 5
+        -t19*c2 + t26*t14,  # 2, 3, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 4, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 4, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 4, 2
@@ -1685,14 +1685,14 @@ def hessian(q):
         t44,  # 3, 0, 0
         t56,  # 3, 0, 1
         t69,  # 3, 0, 2
-        -(t44*t23 + t35*t3),  # 3, 0, 3
+        -(t35*t3 + t44*t23),  # 3, 0, 3
         t79,  # 3, 0, 4
         t80,  # 3, 0, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0, 6
         t41,  # 3, 1, 0
         t60,  # 3, 1, 1
         t72,  # 3, 1, 2
-        -(t41*t23 + t35*t6),  # 3, 1, 3
+        -(t35*t6 + t41*t23),  # 3, 1, 3
         t81,  # 3, 1, 4
         t82,  # 3, 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 1, 6
@@ -1707,16 +1707,16 @@ def hessian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 3, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 3, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 3, 3
-        t16*t23 - t22*t3,  # 3, 3, 4
-        t18*t23 - t25*t3,  # 3, 3, 5
-        t19*t23 - t26*t3,  # 3, 3, 6
+        -t22*t3 + t16*t23,  # 3, 3, 4
+        -t25*t3 + t18*t23,  # 3, 3, 5
+        -t26*t3 + t19*t23,  # 3, 3, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 4, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 4, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 4, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 4, 3
-        -(t10*t23 + t22*t6),  # 3, 4, 4
-        t12*t23 - t25*t6,  # 3, 4, 5
-        -(t13*t23 + t26*t6),  # 3, 4, 6
+        -(t22*t6 + t10*t23),  # 3, 4, 4
+        -t25*t6 + t12*t23,  # 3, 4, 5
+        -(t26*t6 + t13*t23),  # 3, 4, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 5, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 5, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 5, 2
@@ -1880,22 +1880,22 @@ def singularity_factors(q):
     t7 = t5 + t4*c2
     t8 = c1*s2
     t9 = t2*c4 + t8*s4
-    t10 = t8*c4 - t2*s4
+    t10 = -t2*s4 + t8*c4
     t11 = t9*c5 - t6*s5
     t12 = t9*s5 + t6*c5
     t13 = t10*c6 + t11*s6
     t14 = s1*s2
     t15 = t7*c4 + t14*s4
-    t16 = t14*c4 - t7*s4
+    t16 = -t7*s4 + t14*c4
     t17 = t15*c5 + t3*s5
     t18 = t3*c5 - t15*s5
     t19 = t16*c6 + t17*s6
     t20 = c3*s2
     t21 = c2*s4 - t20*c4
-    t22 = t20*s4 + c2*c4
+    t22 = c2*c4 + t20*s4
     t23 = s2*s3
     t24 = t21*c5 + t23*s5
-    t25 = t23*c5 - t21*s5
+    t25 = -t21*s5 + t23*c5
     t26 = t22*c6 + t24*s6
     t27 = 0.126*t13
     t28 = t27 + 0.4*t10
@@ -1911,126 +1911,126 @@ def singularity_factors(q):
     t38 = 0.126*t26
     t39 = t38 + 0.4*t22
     t40 = t39 + 0.42*c2
-    t41 = t40*t14 - t32*c2
-    t42 = t31*t23 - t39*t3
+    t41 = -t32*c2 + t40*t14
+    t42 = -t39*t3 + t31*t23
     t43 = t16*t39 - t22*t31
     t44 = t18*t38 - t25*t30
     t45 = t29*c2 - t40*t8
-    t46 = t28*t23 + t39*t6
+    t46 = t39*t6 + t28*t23
     t47 = t22*t28 - t10*t39
     t48 = t12*t38 + t25*t27
-    t49 = t10*t18 + t16*t12
-    t50 = t12*c1
-    t51 = t50 - t18*s1
-    t52 = t10*c1
-    t53 = -(t52 + t16*s1)
-    t54 = t33*t49 + t36*t51 + t37*t53
-    t55 = t18*t6 - t12*t3
-    t56 = t6*c1
-    t57 = -t56 + t3*s1
-    t58 = t33*t55 + t35*t51 + t37*t57
-    t59 = t10*t3 + t16*t6
-    t60 = t36*t55 + t37*t59 - t35*t49
-    t61 = t40*s1
-    t62 = t33*t59 + t35*t53 - t36*t57
-    t63 = t16*t25 - t22*t18
-    t64 = -(t22*t50 + t25*t52 + t63*s1)
-    t65 = t18*t23 - t25*t3
-    t66 = -(t25*t56 + t65*s1 - t12*c1*s2*s3)
-    t67 = t5*s2
-    t68 = t16*t23 - t22*t3
-    t69 = -(t10*t67 + t22*t56 + t68*s1)
-    t70 = -(t10*t65 + t12*t68 - t6*t63)
-    t71 = t36*t66 + t37*t69 - t33*t70 - t35*t64
-    t72 = t12*t14 + t18*t8
-    t73 = t16*t8 - t10*t14
-    t74 = t36*t72 + t37*t73 - t34*t49
-    t75 = c1**2
-    t76 = t75*s2
-    t77 = -(t76 + s2*s1**2)
-    t78 = t33*t72 + t34*t51 + t37*t77
-    t79 = t33*t73 + t34*t53 - t36*t77
-    t80 = t22*t14 - t16*c2
-    t81 = -(t22*t76 + t80*s1 - t10*c1*c2)
-    t82 = t25*t14 - t18*c2
-    t83 = -(t25*t76 + t50*c2 + t82*s1)
-    t84 = -(t10*t82 + t12*t80 - t63*c1*s2)
-    t85 = t36*t83 + t37*t81 - t33*t84 - t34*t64
-    t86 = -(t6*t14 + t3*t8)
-    t87 = t35*t72 + t37*t86 - t34*t55
-    t88 = t33*t86 + t34*t57 - t35*t77
-    t89 = s2**2
-    t90 = t3*c2 - t0*t89
-    t91 = t56*c2 - t90*s1 + t75*t89*s3
-    t92 = -(t12*t90 + t6*t82 - t65*c1*s2)
-    t93 = t35*t83 + t37*t91 - t33*t92 - t34*t66
-    t94 = -(t34*t59 + t36*t86 - t35*t73)
-    t95 = t10*t90 + t68*t8 - t6*t80
-    t96 = -(t33*t95 + t34*t69 + t36*t91 - t35*t81)
-    t97 = t34*t70 + t36*t92 + t37*t95 - t35*t84
+    t49 = -t25*t3 + t18*t23
+    t50 = t6*c1
+    t51 = -(s1*t49 + t25*t50 - t12*c1*s2*s3)
+    t52 = -t22*t3 + t16*t23
+    t53 = t5*s2
+    t54 = -(s1*t52 + t22*t50 + t10*t53)
+    t55 = t16*t25 - t22*t18
+    t56 = -(t10*t49 + t12*t52 - t6*t55)
+    t57 = t10*c1
+    t58 = t12*c1
+    t59 = -(s1*t55 + t25*t57 + t22*t58)
+    t60 = t36*t51 + t37*t54 - t33*t56 - t35*t59
+    t61 = -t18*c2 + t25*t14
+    t62 = c1**2
+    t63 = s2*t62
+    t64 = -(s1*t61 + t58*c2 + t25*t63)
+    t65 = -t16*c2 + t22*t14
+    t66 = -(s1*t65 + t22*t63 - t10*c1*c2)
+    t67 = -(t10*t61 + t12*t65 - c1*s2*t55)
+    t68 = t36*t64 + t37*t66 - t33*t67 - t34*t59
+    t69 = s2**2
+    t70 = t3*c2 - t0*t69
+    t71 = -t70*s1 + t50*c2 + s3*t62*t69
+    t72 = -(t12*t70 + t6*t61 - c1*s2*t49)
+    t73 = t35*t64 + t37*t71 - t33*t72 - t34*t51
+    t74 = t10*t70 - t6*t65 + t52*t8
+    t75 = -(t33*t74 + t34*t54 + t36*t71 - t35*t66)
+    t76 = t34*t56 + t36*t72 + t37*t74 - t35*t67
+    t77 = t10*t18 + t16*t12
+    t78 = t58 - t18*s1
+    t79 = -(t57 + t16*s1)
+    t80 = t33*t77 + t36*t78 + t37*t79
+    t81 = t16*t8 - t10*t14
+    t82 = -(t63 + s2*s1**2)
+    t83 = t33*t81 + t34*t79 - t36*t82
+    t84 = t12*t14 + t18*t8
+    t85 = t33*t84 + t34*t78 + t37*t82
+    t86 = t36*t84 + t37*t81 - t34*t77
+    t87 = t40*s1
+    t88 = t10*t3 + t16*t6
+    t89 = t3*s1 - t50
+    t90 = t33*t88 + t35*t79 - t36*t89
+    t91 = -(t6*t14 + t3*t8)
+    t92 = t33*t91 + t34*t89 - t35*t82
+    t93 = -(t34*t88 + t36*t91 - t35*t81)
+    t94 = t18*t6 - t12*t3
+    t95 = t33*t94 + t35*t78 + t37*t89
+    t96 = t36*t94 + t37*t88 - t35*t77
+    t97 = t35*t84 + t37*t91 - t34*t94
     t98 = t40*c1
-    t99 = t41*(t46*t54 + t47*t58 + t60*t61 - t29*t71 - t48*t62) + t42*(t29*t85 + t45*t54 + t48*t79 - t47*t78 - t61*t74) + t44*(t29*t96 + t45*t62 + t46*t79 + t47*t88 - t61*t94) - t32*(t45*t71 + t46*t85 + t47*t93 - t48*t96 - t40*t97*s1) - t43*(t29*t93 + t45*t58 + t46*t78 + t48*t88 - t61*t87) - t98*(t45*t60 + t46*t74 + t47*t87 - t29*t97 - t48*t94)
-    t100 = t13*t3 + t19*t6
-    t101 = t13*c1
-    t102 = -(t101 + t19*s1)
-    t103 = t33*t100 + t35*t102
-    t104 = t10*t19 - t16*t13
-    t105 = t33*t104 + t36*t102
-    t106 = t36*t100 - t35*t104
-    t107 = t16*t26 - t22*t19
-    t108 = -(t26*t52 + t107*s1 - t22*t13*c1)
-    t109 = t19*t23 - t26*t3
-    t110 = -(t13*t67 + t26*t56 + t109*s1)
-    t111 = t13*t68 + t6*t107 - t10*t109
-    t112 = -(t33*t111 + t35*t108 - t36*t110)
-    t113 = -(t46*t105 + t47*t103 + t61*t106 - t29*t112)
-    t114 = t19*t8 - t13*t14
-    t115 = t33*t114 + t34*t102
-    t116 = t36*t114 - t34*t104
-    t117 = t26*t14 - t19*c2
-    t118 = -(t26*t76 + t117*s1 - t13*c1*c2)
-    t119 = t13*t80 + t8*t107 - t10*t117
-    t120 = -(t33*t119 + t34*t108 - t36*t118)
-    t121 = t29*t120 + t45*t105 - t47*t115 - t61*t116
-    t122 = t35*t114 - t34*t100
-    t123 = t13*t90 + t8*t109 - t6*t117
-    t124 = -(t33*t123 + t34*t110 - t35*t118)
-    t125 = t29*t124 + t45*t103 + t46*t115 - t61*t122
-    t126 = t34*t111 + t36*t123 - t35*t119
-    t127 = -(t45*t106 + t46*t116 + t47*t122 - t29*t126)
-    t128 = -(t45*t112 + t46*t120 + t47*t124 - t40*t126*s1)
-    t129 = t32*t128 + t42*t121 + t98*t127 - t41*t113 - t43*t125
-    t130 = -(t12*t19 + t18*t13)
-    t131 = t33*t130 - t37*t102
-    t132 = -(t35*t130 + t37*t100)
-    t133 = t18*t26 - t25*t19
-    t134 = t25*t101 + t26*t50 - t133*s1
-    t135 = t12*t109 + t13*t65 + t6*t133
-    t136 = -(t33*t135 + t35*t134 + t37*t110)
-    t137 = -(t46*t131 + t48*t103 + t61*t132 - t29*t136)
-    t138 = -(t34*t130 + t37*t114)
-    t139 = t12*t117 + t13*t82 + t8*t133
-    t140 = -(t33*t139 + t34*t134 + t37*t118)
-    t141 = t29*t140 + t45*t131 - t48*t115 - t61*t138
-    t142 = -(t35*t139 + t37*t123 - t34*t135)
-    t143 = -(t45*t132 + t46*t138 + t48*t122 - t29*t142)
-    t144 = -(t45*t136 + t46*t140 + t48*t124 - t40*t142*s1)
-    t145 = t32*t144 + t42*t141 + t143*t98 - t41*t137 - t44*t125
-    t146 = -(t36*t130 + t37*t104)
-    t147 = t10*t133 + t12*t107 + t13*t63
-    t148 = -(t33*t147 + t36*t134 + t37*t108)
-    t149 = t29*t148 + t47*t131 - t48*t105 - t146*t61
-    t150 = -(t36*t139 + t37*t119 - t34*t147)
-    t151 = t29*t150 + t47*t138 - t45*t146 - t48*t116
-    t152 = t47*t140 + t150*t61 - t45*t148 - t48*t120
-    t153 = t32*t152 + t43*t141 + t151*t98 - t41*t149 - t44*t121
-    t154 = -(t36*t135 + t37*t111 - t35*t147)
-    t155 = t29*t154 + t46*t146 + t47*t132 - t48*t106
-    t156 = t46*t148 + t47*t136 + t154*t61 - t48*t112
-    t157 = t32*t156 + t43*t137 + t155*t98 - t42*t149 - t44*t113
-    t158 = t45*t154 + t46*t150 + t47*t142 - t48*t126
-    t159 = t32*t158 + t41*t155 + t43*t143 - t42*t151 - t44*t127
-    t160 = t42*t152 + t44*t128 + t158*t98 - t41*t156 - t43*t144
+    t99 = -t32*(t45*t60 + t46*t68 + t47*t73 - t48*t75 - t40*s1*t76) + t42*(t29*t68 + t45*t80 + t48*t83 - t47*t85 - t86*t87) + t44*(t29*t75 + t45*t90 + t46*t83 + t47*t92 - t87*t93) + t41*(t46*t80 + t47*t95 - t29*t60 - t48*t90 + t87*t96) - t43*(t29*t73 + t45*t95 + t46*t85 + t48*t92 - t87*t97) - t98*(t45*t96 + t46*t86 + t47*t97 - t29*t76 - t48*t93)
+    t100 = t16*t26 - t22*t19
+    t101 = -t26*t3 + t19*t23
+    t102 = t13*t52 + t6*t100 - t10*t101
+    t103 = -(s1*t100 + t26*t57 - t22*t13*c1)
+    t104 = -(s1*t101 + t26*t50 + t13*t53)
+    t105 = -(t33*t102 + t35*t103 - t36*t104)
+    t106 = -t19*c2 + t26*t14
+    t107 = t13*t65 - t10*t106 + t8*t100
+    t108 = -(s1*t106 + t26*t63 - t13*c1*c2)
+    t109 = -(t33*t107 + t34*t103 - t36*t108)
+    t110 = t13*t70 - t6*t106 + t8*t101
+    t111 = -(t33*t110 + t34*t104 - t35*t108)
+    t112 = t34*t102 + t36*t110 - t35*t107
+    t113 = -(t45*t105 + t46*t109 + t47*t111 - t40*s1*t112)
+    t114 = t10*t19 - t16*t13
+    t115 = t13*c1
+    t116 = -(t115 + t19*s1)
+    t117 = t33*t114 + t36*t116
+    t118 = t19*t8 - t13*t14
+    t119 = t33*t118 + t34*t116
+    t120 = t36*t118 - t34*t114
+    t121 = t29*t109 + t45*t117 - t47*t119 - t87*t120
+    t122 = t13*t3 + t19*t6
+    t123 = t33*t122 + t35*t116
+    t124 = t36*t122 - t35*t114
+    t125 = -(t46*t117 + t47*t123 - t29*t105 + t87*t124)
+    t126 = t35*t118 - t34*t122
+    t127 = t29*t111 + t45*t123 + t46*t119 - t87*t126
+    t128 = -(t45*t124 + t46*t120 + t47*t126 - t29*t112)
+    t129 = t32*t113 + t42*t121 - t41*t125 - t43*t127 + t98*t128
+    t130 = t18*t26 - t25*t19
+    t131 = t12*t101 + t13*t49 + t6*t130
+    t132 = -t130*s1 + t26*t58 + t25*t115
+    t133 = -(t33*t131 + t35*t132 + t37*t104)
+    t134 = t12*t106 + t13*t61 + t8*t130
+    t135 = -(t33*t134 + t34*t132 + t37*t108)
+    t136 = -(t35*t134 + t37*t110 - t34*t131)
+    t137 = -(t45*t133 + t46*t135 + t48*t111 - t40*s1*t136)
+    t138 = -(t12*t19 + t18*t13)
+    t139 = t33*t138 - t37*t116
+    t140 = -(t34*t138 + t37*t118)
+    t141 = t29*t135 + t45*t139 - t48*t119 - t140*t87
+    t142 = -(t35*t138 + t37*t122)
+    t143 = -(t46*t139 + t48*t123 - t29*t133 + t142*t87)
+    t144 = -(t45*t142 + t46*t140 + t48*t126 - t29*t136)
+    t145 = t32*t137 + t42*t141 - t41*t143 - t44*t127 + t144*t98
+    t146 = t10*t130 + t12*t100 + t13*t55
+    t147 = -(t33*t146 + t36*t132 + t37*t103)
+    t148 = -(t36*t134 + t37*t107 - t34*t146)
+    t149 = t47*t135 - t45*t147 - t48*t109 + t148*t87
+    t150 = -(t36*t138 + t37*t114)
+    t151 = t29*t147 + t47*t139 - t48*t117 - t150*t87
+    t152 = t29*t148 + t47*t140 - t45*t150 - t48*t120
+    t153 = t32*t149 + t43*t141 - t41*t151 - t44*t121 + t152*t98
+    t154 = -(t36*t131 + t37*t102 - t35*t146)
+    t155 = t46*t147 + t47*t133 - t48*t105 + t154*t87
+    t156 = t29*t154 + t46*t150 + t47*t142 - t48*t124
+    t157 = t32*t155 + t43*t143 - t42*t151 - t44*t125 + t156*t98
+    t158 = t45*t154 + t46*t148 + t47*t136 - t48*t112
+    t159 = t32*t158 + t41*t156 + t43*t144 - t42*t152 - t44*t128
+    t160 = t42*t149 + t44*t113 - t41*t155 - t43*t137 + t158*t98
     f = _stack(xp, [
         s4,  # 0
         t99**2 + t129**2 + t145**2 + t153**2 + t157**2 + t159**2 + t160**2,  # 1
@@ -2064,22 +2064,22 @@ def manipulability(q):
     t7 = t5 + t4*c2
     t8 = c1*s2
     t9 = t2*c4 + t8*s4
-    t10 = t8*c4 - t2*s4
+    t10 = -t2*s4 + t8*c4
     t11 = t9*c5 - t6*s5
     t12 = t9*s5 + t6*c5
     t13 = t10*c6 + t11*s6
     t14 = s1*s2
     t15 = t7*c4 + t14*s4
-    t16 = t14*c4 - t7*s4
+    t16 = -t7*s4 + t14*c4
     t17 = t15*c5 + t3*s5
     t18 = t3*c5 - t15*s5
     t19 = t16*c6 + t17*s6
     t20 = c3*s2
     t21 = c2*s4 - t20*c4
-    t22 = t20*s4 + c2*c4
+    t22 = c2*c4 + t20*s4
     t23 = s2*s3
     t24 = t21*c5 + t23*s5
-    t25 = t23*c5 - t21*s5
+    t25 = -t21*s5 + t23*c5
     t26 = t22*c6 + t24*s6
     t27 = 0.126*t13
     t28 = t27 + 0.4*t10
@@ -2095,126 +2095,126 @@ def manipulability(q):
     t38 = 0.126*t26
     t39 = t38 + 0.4*t22
     t40 = t39 + 0.42*c2
-    t41 = t40*t14 - t32*c2
-    t42 = t31*t23 - t39*t3
+    t41 = -t32*c2 + t40*t14
+    t42 = -t39*t3 + t31*t23
     t43 = t16*t39 - t22*t31
     t44 = t18*t38 - t25*t30
     t45 = t29*c2 - t40*t8
-    t46 = t28*t23 + t39*t6
+    t46 = t39*t6 + t28*t23
     t47 = t22*t28 - t10*t39
     t48 = t12*t38 + t25*t27
-    t49 = t10*t18 + t16*t12
-    t50 = t12*c1
-    t51 = t50 - t18*s1
-    t52 = t10*c1
-    t53 = -(t52 + t16*s1)
-    t54 = t33*t49 + t36*t51 + t37*t53
-    t55 = t18*t6 - t12*t3
-    t56 = t6*c1
-    t57 = -t56 + t3*s1
-    t58 = t33*t55 + t35*t51 + t37*t57
-    t59 = t10*t3 + t16*t6
-    t60 = t36*t55 + t37*t59 - t35*t49
-    t61 = t40*s1
-    t62 = t33*t59 + t35*t53 - t36*t57
-    t63 = t16*t25 - t22*t18
-    t64 = -(t22*t50 + t25*t52 + t63*s1)
-    t65 = t18*t23 - t25*t3
-    t66 = -(t25*t56 + t65*s1 - t12*c1*s2*s3)
-    t67 = t5*s2
-    t68 = t16*t23 - t22*t3
-    t69 = -(t10*t67 + t22*t56 + t68*s1)
-    t70 = -(t10*t65 + t12*t68 - t6*t63)
-    t71 = t36*t66 + t37*t69 - t33*t70 - t35*t64
-    t72 = t12*t14 + t18*t8
-    t73 = t16*t8 - t10*t14
-    t74 = t36*t72 + t37*t73 - t34*t49
-    t75 = c1**2
-    t76 = t75*s2
-    t77 = -(t76 + s2*s1**2)
-    t78 = t33*t72 + t34*t51 + t37*t77
-    t79 = t33*t73 + t34*t53 - t36*t77
-    t80 = t22*t14 - t16*c2
-    t81 = -(t22*t76 + t80*s1 - t10*c1*c2)
-    t82 = t25*t14 - t18*c2
-    t83 = -(t25*t76 + t50*c2 + t82*s1)
-    t84 = -(t10*t82 + t12*t80 - t63*c1*s2)
-    t85 = t36*t83 + t37*t81 - t33*t84 - t34*t64
-    t86 = -(t6*t14 + t3*t8)
-    t87 = t35*t72 + t37*t86 - t34*t55
-    t88 = t33*t86 + t34*t57 - t35*t77
-    t89 = s2**2
-    t90 = t3*c2 - t0*t89
-    t91 = t56*c2 - t90*s1 + t75*t89*s3
-    t92 = -(t12*t90 + t6*t82 - t65*c1*s2)
-    t93 = t35*t83 + t37*t91 - t33*t92 - t34*t66
-    t94 = -(t34*t59 + t36*t86 - t35*t73)
-    t95 = t10*t90 + t68*t8 - t6*t80
-    t96 = -(t33*t95 + t34*t69 + t36*t91 - t35*t81)
-    t97 = t34*t70 + t36*t92 + t37*t95 - t35*t84
+    t49 = -t25*t3 + t18*t23
+    t50 = t6*c1
+    t51 = -(s1*t49 + t25*t50 - t12*c1*s2*s3)
+    t52 = -t22*t3 + t16*t23
+    t53 = t5*s2
+    t54 = -(s1*t52 + t22*t50 + t10*t53)
+    t55 = t16*t25 - t22*t18
+    t56 = -(t10*t49 + t12*t52 - t6*t55)
+    t57 = t10*c1
+    t58 = t12*c1
+    t59 = -(s1*t55 + t25*t57 + t22*t58)
+    t60 = t36*t51 + t37*t54 - t33*t56 - t35*t59
+    t61 = -t18*c2 + t25*t14
+    t62 = c1**2
+    t63 = s2*t62
+    t64 = -(s1*t61 + t58*c2 + t25*t63)
+    t65 = -t16*c2 + t22*t14
+    t66 = -(s1*t65 + t22*t63 - t10*c1*c2)
+    t67 = -(t10*t61 + t12*t65 - c1*s2*t55)
+    t68 = t36*t64 + t37*t66 - t33*t67 - t34*t59
+    t69 = s2**2
+    t70 = t3*c2 - t0*t69
+    t71 = -t70*s1 + t50*c2 + s3*t62*t69
+    t72 = -(t12*t70 + t6*t61 - c1*s2*t49)
+    t73 = t35*t64 + t37*t71 - t33*t72 - t34*t51
+    t74 = t10*t70 - t6*t65 + t52*t8
+    t75 = -(t33*t74 + t34*t54 + t36*t71 - t35*t66)
+    t76 = t34*t56 + t36*t72 + t37*t74 - t35*t67
+    t77 = t10*t18 + t16*t12
+    t78 = t58 - t18*s1
+    t79 = -(t57 + t16*s1)
+    t80 = t33*t77 + t36*t78 + t37*t79
+    t81 = t16*t8 - t10*t14
+    t82 = -(t63 + s2*s1**2)
+    t83 = t33*t81 + t34*t79 - t36*t82
+    t84 = t12*t14 + t18*t8
+    t85 = t33*t84 + t34*t78 + t37*t82
+    t86 = t36*t84 + t37*t81 - t34*t77
+    t87 = t40*s1
+    t88 = t10*t3 + t16*t6
+    t89 = t3*s1 - t50
+    t90 = t33*t88 + t35*t79 - t36*t89
+    t91 = -(t6*t14 + t3*t8)
+    t92 = t33*t91 + t34*t89 - t35*t82
+    t93 = -(t34*t88 + t36*t91 - t35*t81)
+    t94 = t18*t6 - t12*t3
+    t95 = t33*t94 + t35*t78 + t37*t89
+    t96 = t36*t94 + t37*t88 - t35*t77
+    t97 = t35*t84 + t37*t91 - t34*t94
     t98 = t40*c1
-    t99 = t41*(t46*t54 + t47*t58 + t60*t61 - t29*t71 - t48*t62) + t42*(t29*t85 + t45*t54 + t48*t79 - t47*t78 - t61*t74) + t44*(t29*t96 + t45*t62 + t46*t79 + t47*t88 - t61*t94) - t32*(t45*t71 + t46*t85 + t47*t93 - t48*t96 - t40*t97*s1) - t43*(t29*t93 + t45*t58 + t46*t78 + t48*t88 - t61*t87) - t98*(t45*t60 + t46*t74 + t47*t87 - t29*t97 - t48*t94)
-    t100 = t13*t3 + t19*t6
-    t101 = t13*c1
-    t102 = -(t101 + t19*s1)
-    t103 = t33*t100 + t35*t102
-    t104 = t10*t19 - t16*t13
-    t105 = t33*t104 + t36*t102
-    t106 = t36*t100 - t35*t104
-    t107 = t16*t26 - t22*t19
-    t108 = -(t26*t52 + t107*s1 - t22*t13*c1)
-    t109 = t19*t23 - t26*t3
-    t110 = -(t13*t67 + t26*t56 + t109*s1)
-    t111 = t13*t68 + t6*t107 - t10*t109
-    t112 = -(t33*t111 + t35*t108 - t36*t110)
-    t113 = -(t46*t105 + t47*t103 + t61*t106 - t29*t112)
-    t114 = t19*t8 - t13*t14
-    t115 = t33*t114 + t34*t102
-    t116 = t36*t114 - t34*t104
-    t117 = t26*t14 - t19*c2
-    t118 = -(t26*t76 + t117*s1 - t13*c1*c2)
-    t119 = t13*t80 + t8*t107 - t10*t117
-    t120 = -(t33*t119 + t34*t108 - t36*t118)
-    t121 = t29*t120 + t45*t105 - t47*t115 - t61*t116
-    t122 = t35*t114 - t34*t100
-    t123 = t13*t90 + t8*t109 - t6*t117
-    t124 = -(t33*t123 + t34*t110 - t35*t118)
-    t125 = t29*t124 + t45*t103 + t46*t115 - t61*t122
-    t126 = t34*t111 + t36*t123 - t35*t119
-    t127 = -(t45*t106 + t46*t116 + t47*t122 - t29*t126)
-    t128 = -(t45*t112 + t46*t120 + t47*t124 - t40*t126*s1)
-    t129 = t32*t128 + t42*t121 + t98*t127 - t41*t113 - t43*t125
-    t130 = -(t12*t19 + t18*t13)
-    t131 = t33*t130 - t37*t102
-    t132 = -(t35*t130 + t37*t100)
-    t133 = t18*t26 - t25*t19
-    t134 = t25*t101 + t26*t50 - t133*s1
-    t135 = t12*t109 + t13*t65 + t6*t133
-    t136 = -(t33*t135 + t35*t134 + t37*t110)
-    t137 = -(t46*t131 + t48*t103 + t61*t132 - t29*t136)
-    t138 = -(t34*t130 + t37*t114)
-    t139 = t12*t117 + t13*t82 + t8*t133
-    t140 = -(t33*t139 + t34*t134 + t37*t118)
-    t141 = t29*t140 + t45*t131 - t48*t115 - t61*t138
-    t142 = -(t35*t139 + t37*t123 - t34*t135)
-    t143 = -(t45*t132 + t46*t138 + t48*t122 - t29*t142)
-    t144 = -(t45*t136 + t46*t140 + t48*t124 - t40*t142*s1)
-    t145 = t32*t144 + t42*t141 + t143*t98 - t41*t137 - t44*t125
-    t146 = -(t36*t130 + t37*t104)
-    t147 = t10*t133 + t12*t107 + t13*t63
-    t148 = -(t33*t147 + t36*t134 + t37*t108)
-    t149 = t29*t148 + t47*t131 - t48*t105 - t146*t61
-    t150 = -(t36*t139 + t37*t119 - t34*t147)
-    t151 = t29*t150 + t47*t138 - t45*t146 - t48*t116
-    t152 = t47*t140 + t150*t61 - t45*t148 - t48*t120
-    t153 = t32*t152 + t43*t141 + t151*t98 - t41*t149 - t44*t121
-    t154 = -(t36*t135 + t37*t111 - t35*t147)
-    t155 = t29*t154 + t46*t146 + t47*t132 - t48*t106
-    t156 = t46*t148 + t47*t136 + t154*t61 - t48*t112
-    t157 = t32*t156 + t43*t137 + t155*t98 - t42*t149 - t44*t113
-    t158 = t45*t154 + t46*t150 + t47*t142 - t48*t126
-    t159 = t32*t158 + t41*t155 + t43*t143 - t42*t151 - t44*t127
-    t160 = t42*t152 + t44*t128 + t158*t98 - t41*t156 - t43*t144
+    t99 = -t32*(t45*t60 + t46*t68 + t47*t73 - t48*t75 - t40*s1*t76) + t42*(t29*t68 + t45*t80 + t48*t83 - t47*t85 - t86*t87) + t44*(t29*t75 + t45*t90 + t46*t83 + t47*t92 - t87*t93) + t41*(t46*t80 + t47*t95 - t29*t60 - t48*t90 + t87*t96) - t43*(t29*t73 + t45*t95 + t46*t85 + t48*t92 - t87*t97) - t98*(t45*t96 + t46*t86 + t47*t97 - t29*t76 - t48*t93)
+    t100 = t16*t26 - t22*t19
+    t101 = -t26*t3 + t19*t23
+    t102 = t13*t52 + t6*t100 - t10*t101
+    t103 = -(s1*t100 + t26*t57 - t22*t13*c1)
+    t104 = -(s1*t101 + t26*t50 + t13*t53)
+    t105 = -(t33*t102 + t35*t103 - t36*t104)
+    t106 = -t19*c2 + t26*t14
+    t107 = t13*t65 - t10*t106 + t8*t100
+    t108 = -(s1*t106 + t26*t63 - t13*c1*c2)
+    t109 = -(t33*t107 + t34*t103 - t36*t108)
+    t110 = t13*t70 - t6*t106 + t8*t101
+    t111 = -(t33*t110 + t34*t104 - t35*t108)
+    t112 = t34*t102 + t36*t110 - t35*t107
+    t113 = -(t45*t105 + t46*t109 + t47*t111 - t40*s1*t112)
+    t114 = t10*t19 - t16*t13
+    t115 = t13*c1
+    t116 = -(t115 + t19*s1)
+    t117 = t33*t114 + t36*t116
+    t118 = t19*t8 - t13*t14
+    t119 = t33*t118 + t34*t116
+    t120 = t36*t118 - t34*t114
+    t121 = t29*t109 + t45*t117 - t47*t119 - t87*t120
+    t122 = t13*t3 + t19*t6
+    t123 = t33*t122 + t35*t116
+    t124 = t36*t122 - t35*t114
+    t125 = -(t46*t117 + t47*t123 - t29*t105 + t87*t124)
+    t126 = t35*t118 - t34*t122
+    t127 = t29*t111 + t45*t123 + t46*t119 - t87*t126
+    t128 = -(t45*t124 + t46*t120 + t47*t126 - t29*t112)
+    t129 = t32*t113 + t42*t121 - t41*t125 - t43*t127 + t98*t128
+    t130 = t18*t26 - t25*t19
+    t131 = t12*t101 + t13*t49 + t6*t130
+    t132 = -t130*s1 + t26*t58 + t25*t115
+    t133 = -(t33*t131 + t35*t132 + t37*t104)
+    t134 = t12*t106 + t13*t61 + t8*t130
+    t135 = -(t33*t134 + t34*t132 + t37*t108)
+    t136 = -(t35*t134 + t37*t110 - t34*t131)
+    t137 = -(t45*t133 + t46*t135 + t48*t111 - t40*s1*t136)
+    t138 = -(t12*t19 + t18*t13)
+    t139 = t33*t138 - t37*t116
+    t140 = -(t34*t138 + t37*t118)
+    t141 = t29*t135 + t45*t139 - t48*t119 - t140*t87
+    t142 = -(t35*t138 + t37*t122)
+    t143 = -(t46*t139 + t48*t123 - t29*t133 + t142*t87)
+    t144 = -(t45*t142 + t46*t140 + t48*t126 - t29*t136)
+    t145 = t32*t137 + t42*t141 - t41*t143 - t44*t127 + t144*t98
+    t146 = t10*t130 + t12*t100 + t13*t55
+    t147 = -(t33*t146 + t36*t132 + t37*t103)
+    t148 = -(t36*t134 + t37*t107 - t34*t146)
+    t149 = t47*t135 - t45*t147 - t48*t109 + t148*t87
+    t150 = -(t36*t138 + t37*t114)
+    t151 = t29*t147 + t47*t139 - t48*t117 - t150*t87
+    t152 = t29*t148 + t47*t140 - t45*t150 - t48*t120
+    t153 = t32*t149 + t43*t141 - t41*t151 - t44*t121 + t152*t98
+    t154 = -(t36*t131 + t37*t102 - t35*t146)
+    t155 = t46*t147 + t47*t133 - t48*t105 + t154*t87
+    t156 = t29*t154 + t46*t150 + t47*t142 - t48*t124
+    t157 = t32*t155 + t43*t143 - t42*t151 - t44*t125 + t156*t98
+    t158 = t45*t154 + t46*t148 + t47*t136 - t48*t112
+    t159 = t32*t158 + t41*t156 + t43*t144 - t42*t152 - t44*t128
+    t160 = t42*t149 + t44*t113 - t41*t155 - t43*t137 + t158*t98
     t161 = t99**2 + t129**2 + t145**2 + t153**2 + t157**2 + t159**2 + t160**2
     w = xp.broadcast_to(xp.sqrt(xp.abs(t161)), batch)
     return w
@@ -2260,24 +2260,24 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t7 = t5 + t4*c2
     t8 = c1*s2
     t9 = t2*c4 + t8*s4
-    t10 = t8*c4 - t2*s4
+    t10 = -t2*s4 + t8*c4
     t11 = t9*c5 - t6*s5
     t12 = t9*s5 + t6*c5
     t13 = t10*c6 + t11*s6
     t14 = s1*s2
     t15 = t7*c4 + t14*s4
-    t16 = t14*c4 - t7*s4
+    t16 = -t7*s4 + t14*c4
     t17 = t15*c5 + t3*s5
     t18 = t3*c5 - t15*s5
     t19 = t16*c6 + t17*s6
     t20 = c3*s2
     t21 = c2*s4 - t20*c4
-    t22 = t20*s4 + c2*c4
+    t22 = c2*c4 + t20*s4
     t23 = s2*s3
     t24 = t21*c5 + t23*s5
-    t25 = t23*c5 - t21*s5
+    t25 = -t21*s5 + t23*c5
     t26 = t22*c6 + t24*s6
-    t27 = t10*t22 + t13*t26 + t8*c2 - t12*t25 - t6*t23
+    t27 = t10*t22 + t13*t26 - t12*t25 + t8*c2 - t6*t23
     t28 = t16*t22 + t18*t25 + t19*t26 + t3*t23 + t14*c2
     t29 = 0.126*t13
     t30 = t29 + 0.4*t10
@@ -2295,210 +2295,210 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t42 = 0.126*t26
     t43 = t42 + 0.4*t22
     t44 = t43 + 0.42*c2
-    t45 = t33*t23 - t43*t3
+    t45 = -t43*t3 + t33*t23
     t46 = t16*t43 - t22*t33
     t47 = t18*t42 - t25*t32
-    t48 = t30*t23 + t43*t6
+    t48 = t43*t6 + t30*t23
     t49 = t22*t30 - t10*t43
     t50 = t12*t42 + t25*t29
     t51 = t44*s1
-    t52 = t51*s2 - t34*c2
+    t52 = -t34*c2 + t51*s2
     t53 = t44*c1
     t54 = t31*c2 - t53*s2
     t55 = t31 + t22*t49 + t25*t50 + t54*c2 + t48*t23
     t56 = t44**2
     t57 = c1**2
     t58 = t34**2 + t52**2 + t45**2 + t46**2 + t47**2 + t56*t57
-    t59 = t16*t46 + t18*t47 + t44*t57 + t52*t14 - t45*t3
+    t59 = t16*t46 + t18*t47 + t44*t57 - t45*t3 + t52*t14
     t60 = c1*s1
-    t61 = t52*t54 + t46*t49 + t47*t50 + t56*t60 - t31*t34 - t45*t48
+    t61 = t52*t54 + t46*t49 + t47*t50 - t31*t34 - t45*t48 + t56*t60
     t62 = -t34
     t63 = t62 + t22*t46 + t25*t47 + t52*c2 - t45*t23
-    t64 = 1 + t10 + t16 + t22 + t18 + t25 + t13 + t19 + t26 + t31 + t52 + t45 + t46 + t47 + t54 + t49 + t50 + t36 + t37 + t38 + t6 + t51 + t53 + t62 + t8 + t14 + c1 + c2 + damping + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + q1 + q2 + q3 + q4 + q5 + q6 + q7 - t12 - t48 - t35 - t39 - t3 - t23 - s1
+    t64 = 1 + t10 + t16 + t22 + t18 + t25 + t13 + t19 + t26 + t31 + t52 + t45 + t46 + t47 + t54 + t49 + t50 + t36 + t37 + t38 + t6 + c1 + c2 + damping + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + q1 + q2 + q3 + q4 + q5 + q6 + q7 - t12 + t62 - t48 - t35 - t39 - t3 - s1 + t53 + t51 + t8 + t14 - t23
     t65 = t35*c1
-    t66 = t52*t36 + t45*t37 + t46*t38 - t44*t65 - t47*t39
-    t67 = t65 + t18*t39 + t37*t3 - t16*t38 - t36*t14
+    t66 = t52*t36 + t45*t37 + t46*t38 - t47*t39 - t44*t65
+    t67 = t18*t39 + t65 + t37*t3 - t16*t38 - t36*t14
     t68 = t44*t60
-    t69 = -t68 + t10*t46 + t52*t8 + t45*t6 - t12*t47
-    t70 = t68 + t16*t49 + t18*t50 + t54*t14 + t48*t3
+    t69 = t10*t46 + t45*t6 - t12*t47 + t52*t8 - t68
+    t70 = t16*t49 + t18*t50 + t48*t3 + t68 + t54*t14
     t71 = s1**2
     t72 = t31**2 + t54**2 + t48**2 + t49**2 + t50**2 + t56*t71
     t73 = t12*t50 + t44*t71 + t48*t6 - t10*t49 - t54*t8
     t74 = t35*s1
-    t75 = t44*t74 + t48*t37 + t50*t39 - t54*t36 - t49*t38
-    t76 = t74 + t10*t38 + t12*t39 + t36*t8 + t37*t6
+    t75 = t48*t37 + t50*t39 - t54*t36 - t49*t38 + t44*t74
+    t76 = t10*t38 + t12*t39 + t74 + t37*t6 + t36*t8
     t77 = s2**2
-    t78 = t71 + t10**2 + t12**2 + t13**2 + t6**2 + t57*t77
-    t79 = -t60 + t10*t16 + t13*t19 + t60*t77 - t12*t18 - t6*t3
-    t80 = t57 + t16**2 + t18**2 + t19**2 + t3**2 + t71*t77
+    t78 = t10**2 + t12**2 + t13**2 + t6**2 + t71 + t57*t77
+    t79 = t10*t16 + t13*t19 - t12*t18 - t6*t3 - t60 + t60*t77
+    t80 = t16**2 + t18**2 + t19**2 + t3**2 + t57 + t71*t77
     t81 = 1 + t22**2 + t25**2 + t26**2 + c2**2 + t77*s3**2
-    t82 = t61**2
-    t83 = t63**2
-    t84 = t66**2
-    t85 = t69**2
-    t86 = t59**2
-    t87 = damping**2
-    t88 = t58 + t87
-    t89 = t88**2
-    t90 = xp.sqrt(t82 + t83 + t84 + t85 + t86 + t89)
-    t91 = t90*xp.where(xp.greater_equal(t88, 0), xp.asarray(1, dtype=dtype), -1)
-    t92 = t91 + t88
-    t93 = xp.where(xp.greater(t90, 0), 1/(t90*(t90 + xp.abs(t88))), 0)
-    t94 = t93*(t61*mu_dot1 + t63*mu_dot5 + t66*mu_dot2 + t69*mu_dot3 + t59*mu_dot4 + t92*mu_dot0)
-    t95 = mu_dot0 - t92*t94
-    t96 = mu_dot1 - t61*t94
-    t97 = mu_dot2 - t66*t94
-    t98 = mu_dot3 - t69*t94
-    t99 = mu_dot4 - t59*t94
-    t100 = mu_dot5 - t63*t94
-    t101 = t72 + t87
-    t102 = t93*(t61*t92 + t61*t101 + t63*t55 + t59*t70 - t66*t75 - t69*t73)
-    t103 = t61 - t92*t102
-    t104 = t101 - t61*t102
-    t105 = t75 + t66*t102
-    t106 = t73 + t69*t102
-    t107 = t70 - t59*t102
-    t108 = t55 - t63*t102
-    t109 = xp.sqrt(t104**2 + t105**2 + t106**2 + t107**2 + t108**2)
-    t110 = t109*xp.where(xp.greater_equal(t104, 0), xp.asarray(1, dtype=dtype), -1)
-    t111 = t104 + t110
-    t112 = xp.where(xp.greater(t109, 0), 1/(t109*(t109 + xp.abs(t104))), 0)
-    t113 = t112*(t107*t99 + t108*t100 + t96*t111 - t105*t97 - t106*t98)
-    t114 = t96 - t111*t113
-    t115 = t97 + t105*t113
-    t116 = t98 + t106*t113
-    t117 = t99 - t107*t113
-    t118 = t100 - t108*t113
-    t119 = t40 + t87
-    t120 = t93*(t63*t41 + t66*t92 + t66*t119 + t69*t76 - t61*t75 - t59*t67)
-    t121 = t66 - t92*t120
-    t122 = t75 + t61*t120
-    t123 = t119 - t66*t120
-    t124 = t76 - t69*t120
-    t125 = t67 + t59*t120
-    t126 = t41 - t63*t120
-    t127 = -t112*(t105*t123 + t106*t124 + t107*t125 + t122*t111 - t108*t126)
-    t128 = t122 + t111*t127
-    t129 = t123 + t105*t127
-    t130 = t124 + t106*t127
-    t131 = t125 + t107*t127
-    t132 = t126 - t108*t127
-    t133 = xp.sqrt(t129**2 + t130**2 + t131**2 + t132**2)
-    t134 = t133*xp.where(xp.greater_equal(t129, 0), xp.asarray(1, dtype=dtype), -1)
-    t135 = t129 + t134
-    t136 = xp.where(xp.greater(t133, 0), 1/(t133*(t133 + xp.abs(t129))), 0)
-    t137 = t136*(t130*t116 + t132*t118 + t115*t135 - t131*t117)
-    t138 = t115 - t135*t137
-    t139 = t116 - t130*t137
-    t140 = t117 + t131*t137
-    t141 = t118 - t132*t137
-    t142 = t78 + t87
-    t143 = t93*(t63*t27 + t66*t76 + t69*t92 + t69*t142 + t59*t79 - t61*t73)
-    t144 = t69 - t92*t143
-    t145 = t73 + t61*t143
-    t146 = t76 - t66*t143
-    t147 = t142 - t69*t143
-    t148 = t79 - t59*t143
-    t149 = t27 - t63*t143
-    t150 = -t112*(t105*t146 + t106*t147 + t145*t111 - t107*t148 - t108*t149)
-    t151 = t145 + t111*t150
-    t152 = t146 + t105*t150
-    t153 = t147 + t106*t150
-    t154 = t148 - t107*t150
-    t155 = t149 - t108*t150
-    t156 = t136*(t130*t153 + t132*t155 + t152*t135 - t131*t154)
-    t157 = t152 - t135*t156
-    t158 = t153 - t130*t156
-    t159 = t154 + t131*t156
-    t160 = t155 - t132*t156
-    t161 = xp.sqrt(t158**2 + t159**2 + t160**2)
-    t162 = t161*xp.where(xp.greater_equal(t158, 0), xp.asarray(1, dtype=dtype), -1)
-    t163 = t158 + t162
-    t164 = xp.where(xp.greater(t161, 0), 1/(t161*(t161 + xp.abs(t158))), 0)
-    t165 = t164*(t159*t140 + t160*t141 + t139*t163)
-    t166 = t139 - t163*t165
-    t167 = t140 - t159*t165
-    t168 = t141 - t160*t165
-    t169 = t80 + t87
-    t170 = t93*(t61*t70 + t63*t28 + t69*t79 + t59*t92 + t59*t169 - t66*t67)
-    t171 = t59 - t92*t170
-    t172 = t70 - t61*t170
-    t173 = t67 + t66*t170
-    t174 = t79 - t69*t170
-    t175 = t169 - t59*t170
-    t176 = t28 - t63*t170
-    t177 = t112*(t105*t173 + t107*t175 + t108*t176 + t172*t111 - t106*t174)
-    t178 = t172 - t111*t177
-    t179 = -t173 + t105*t177
-    t180 = t174 + t106*t177
-    t181 = t175 - t107*t177
-    t182 = t176 - t108*t177
-    t183 = t136*(t130*t180 + t132*t182 + t179*t135 - t131*t181)
-    t184 = t179 - t135*t183
-    t185 = t180 - t130*t183
-    t186 = t181 + t131*t183
-    t187 = t182 - t132*t183
-    t188 = t164*(t159*t186 + t160*t187 + t185*t163)
-    t189 = t185 - t163*t188
-    t190 = t186 - t159*t188
-    t191 = t187 - t160*t188
-    t192 = xp.sqrt(t190**2 + t191**2)
-    t193 = t192*xp.where(xp.greater_equal(t190, 0), xp.asarray(1, dtype=dtype), -1)
-    t194 = t190 + t193
-    t195 = xp.where(xp.greater(t192, 0), 1/(t192*(t192 + xp.abs(t190))), 0)
-    t196 = t195*(t191*t168 + t167*t194)
-    t197 = t167 - t194*t196
-    t198 = t168 - t191*t196
-    t199 = t81 + t87
-    t200 = xp.sqrt(t89 + t101**2 + t119**2 + t142**2 + t169**2 + t199**2 + 2*t82 + 2*t83 + 2*t84 + 2*t85 + 2*t86 + 2*t55**2 + 2*t75**2 + 2*t73**2 + 2*t70**2 + 2*t76**2 + 2*t67**2 + 2*t41**2 + 2*t79**2 + 2*t27**2 + 2*t28**2)
-    t201 = t93*(t61*t55 + t63*t92 + t63*t199 + t66*t41 + t69*t27 + t59*t28)
-    t202 = t63 - t92*t201
-    t203 = t55 - t61*t201
-    t204 = t41 - t66*t201
-    t205 = t27 - t69*t201
-    t206 = t28 - t59*t201
-    t207 = t199 - t63*t201
-    t208 = t112*(t107*t206 + t108*t207 + t203*t111 - t105*t204 - t106*t205)
-    t209 = t203 - t111*t208
-    t210 = t204 + t105*t208
-    t211 = t205 + t106*t208
-    t212 = t206 - t107*t208
-    t213 = t207 - t108*t208
-    t214 = t136*(t130*t211 + t132*t213 + t210*t135 - t131*t212)
-    t215 = t210 - t135*t214
-    t216 = t211 - t130*t214
-    t217 = t212 + t131*t214
-    t218 = t213 - t132*t214
-    t219 = t164*(t159*t217 + t160*t218 + t216*t163)
-    t220 = t216 - t163*t219
-    t221 = t217 - t159*t219
-    t222 = t218 - t160*t219
-    t223 = t195*(t191*t222 + t221*t194)
-    t224 = t221 - t194*t223
-    t225 = t222 - t191*t223
-    t226 = xp.abs(t225)
+    t82 = damping**2
+    t83 = t58 + t82
+    t84 = t83**2
+    t85 = t72 + t82
+    t86 = t40 + t82
+    t87 = t78 + t82
+    t88 = t80 + t82
+    t89 = t81 + t82
+    t90 = t61**2
+    t91 = t63**2
+    t92 = t66**2
+    t93 = t69**2
+    t94 = t59**2
+    t95 = xp.sqrt(t84 + t85**2 + t86**2 + t87**2 + t88**2 + t89**2 + 2*t90 + 2*t91 + 2*t92 + 2*t93 + 2*t94 + 2*t55**2 + 2*t75**2 + 2*t73**2 + 2*t70**2 + 2*t76**2 + 2*t67**2 + 2*t41**2 + 2*t79**2 + 2*t27**2 + 2*t28**2)
+    t96 = xp.sqrt(t90 + t91 + t92 + t93 + t94 + t84)
+    t97 = t96*xp.where(xp.greater_equal(t83, 0), xp.asarray(1, dtype=dtype), -1)
+    t98 = t97 + t83
+    t99 = xp.where(xp.greater(t96, 0), 1/(t96*(t96 + xp.abs(t83))), 0)
+    t100 = t99*(t61*t98 + t61*t85 + t63*t55 + t59*t70 - t66*t75 - t69*t73)
+    t101 = t61 - t98*t100
+    t102 = t85 - t61*t100
+    t103 = t75 + t66*t100
+    t104 = t73 + t69*t100
+    t105 = t70 - t59*t100
+    t106 = t55 - t63*t100
+    t107 = t99*(t63*t41 + t66*t98 + t66*t86 + t69*t76 - t61*t75 - t59*t67)
+    t108 = t66 - t98*t107
+    t109 = t75 + t61*t107
+    t110 = t86 - t66*t107
+    t111 = t76 - t69*t107
+    t112 = t67 + t59*t107
+    t113 = t41 - t63*t107
+    t114 = t99*(t63*t27 + t66*t76 + t69*t98 + t69*t87 + t59*t79 - t61*t73)
+    t115 = t69 - t98*t114
+    t116 = t73 + t61*t114
+    t117 = t76 - t66*t114
+    t118 = t87 - t69*t114
+    t119 = t79 - t59*t114
+    t120 = t27 - t63*t114
+    t121 = t99*(t61*t70 + t63*t28 + t69*t79 + t59*t98 + t59*t88 - t66*t67)
+    t122 = t59 - t98*t121
+    t123 = t70 - t61*t121
+    t124 = t67 + t66*t121
+    t125 = t79 - t69*t121
+    t126 = t88 - t59*t121
+    t127 = t28 - t63*t121
+    t128 = t99*(t61*t55 + t63*t98 + t63*t89 + t66*t41 + t69*t27 + t59*t28)
+    t129 = t63 - t98*t128
+    t130 = t55 - t61*t128
+    t131 = t41 - t66*t128
+    t132 = t27 - t69*t128
+    t133 = t28 - t59*t128
+    t134 = t89 - t63*t128
+    t135 = t99*(t61*mu_dot1 + t63*mu_dot5 + t66*mu_dot2 + t69*mu_dot3 + t59*mu_dot4 + t98*mu_dot0)
+    t136 = mu_dot0 - t98*t135
+    t137 = mu_dot1 - t61*t135
+    t138 = mu_dot2 - t66*t135
+    t139 = mu_dot3 - t69*t135
+    t140 = mu_dot4 - t59*t135
+    t141 = mu_dot5 - t63*t135
+    t142 = xp.sqrt(t102**2 + t103**2 + t104**2 + t105**2 + t106**2)
+    t143 = t142*xp.where(xp.greater_equal(t102, 0), xp.asarray(1, dtype=dtype), -1)
+    t144 = t102 + t143
+    t145 = xp.where(xp.greater(t142, 0), 1/(t142*(t142 + xp.abs(t102))), 0)
+    t146 = -t145*(t103*t110 + t104*t111 + t105*t112 + t109*t144 - t106*t113)
+    t147 = t109 + t144*t146
+    t148 = t110 + t103*t146
+    t149 = t111 + t104*t146
+    t150 = t112 + t105*t146
+    t151 = t113 - t106*t146
+    t152 = -t145*(t103*t117 + t104*t118 + t116*t144 - t105*t119 - t106*t120)
+    t153 = t116 + t144*t152
+    t154 = t117 + t103*t152
+    t155 = t118 + t104*t152
+    t156 = t119 - t105*t152
+    t157 = t120 - t106*t152
+    t158 = t145*(t103*t124 + t105*t126 + t106*t127 + t123*t144 - t104*t125)
+    t159 = t123 - t144*t158
+    t160 = -t124 + t103*t158
+    t161 = t125 + t104*t158
+    t162 = t126 - t105*t158
+    t163 = t127 - t106*t158
+    t164 = t145*(t105*t133 + t106*t134 + t130*t144 - t103*t131 - t104*t132)
+    t165 = t130 - t144*t164
+    t166 = t131 + t103*t164
+    t167 = t132 + t104*t164
+    t168 = t133 - t105*t164
+    t169 = t134 - t106*t164
+    t170 = t145*(t105*t140 + t106*t141 + t137*t144 - t103*t138 - t104*t139)
+    t171 = t137 - t144*t170
+    t172 = t138 + t103*t170
+    t173 = t139 + t104*t170
+    t174 = t140 - t105*t170
+    t175 = t141 - t106*t170
+    t176 = xp.sqrt(t148**2 + t149**2 + t150**2 + t151**2)
+    t177 = t176*xp.where(xp.greater_equal(t148, 0), xp.asarray(1, dtype=dtype), -1)
+    t178 = t148 + t177
+    t179 = xp.where(xp.greater(t176, 0), 1/(t176*(t176 + xp.abs(t148))), 0)
+    t180 = t179*(t149*t155 + t151*t157 + t154*t178 - t150*t156)
+    t181 = t154 - t178*t180
+    t182 = t155 - t149*t180
+    t183 = t156 + t150*t180
+    t184 = t157 - t151*t180
+    t185 = t179*(t149*t161 + t151*t163 + t160*t178 - t150*t162)
+    t186 = t160 - t178*t185
+    t187 = t161 - t149*t185
+    t188 = t162 + t150*t185
+    t189 = t163 - t151*t185
+    t190 = t179*(t149*t167 + t151*t169 + t166*t178 - t150*t168)
+    t191 = t166 - t178*t190
+    t192 = t167 - t149*t190
+    t193 = t168 + t150*t190
+    t194 = t169 - t151*t190
+    t195 = t179*(t149*t173 + t151*t175 + t172*t178 - t150*t174)
+    t196 = t172 - t178*t195
+    t197 = t173 - t149*t195
+    t198 = t174 + t150*t195
+    t199 = t175 - t151*t195
+    t200 = xp.sqrt(t182**2 + t183**2 + t184**2)
+    t201 = t200*xp.where(xp.greater_equal(t182, 0), xp.asarray(1, dtype=dtype), -1)
+    t202 = t182 + t201
+    t203 = xp.where(xp.greater(t200, 0), 1/(t200*(t200 + xp.abs(t182))), 0)
+    t204 = t203*(t183*t188 + t184*t189 + t187*t202)
+    t205 = t187 - t202*t204
+    t206 = t188 - t183*t204
+    t207 = t189 - t184*t204
+    t208 = t203*(t183*t193 + t184*t194 + t192*t202)
+    t209 = t192 - t202*t208
+    t210 = t193 - t183*t208
+    t211 = t194 - t184*t208
+    t212 = t203*(t183*t198 + t184*t199 + t197*t202)
+    t213 = t197 - t202*t212
+    t214 = t198 - t183*t212
+    t215 = t199 - t184*t212
+    t216 = xp.sqrt(t206**2 + t207**2)
+    t217 = t216*xp.where(xp.greater_equal(t206, 0), xp.asarray(1, dtype=dtype), -1)
+    t218 = t206 + t217
+    t219 = xp.where(xp.greater(t216, 0), 1/(t216*(t216 + xp.abs(t206))), 0)
+    t220 = t219*(t207*t211 + t210*t218)
+    t221 = t210 - t218*t220
+    t222 = t211 - t207*t220
+    t223 = t219*(t207*t215 + t214*t218)
+    t224 = t214 - t218*t223
+    t225 = t215 - t207*t223
+    t226 = xp.abs(t222)
     t227 = t226
-    t228 = t227*xp.where(xp.greater_equal(t225, 0), xp.asarray(1, dtype=dtype), -1)
-    t229 = t225 + t228
+    t228 = t227*xp.where(xp.greater_equal(t222, 0), xp.asarray(1, dtype=dtype), -1)
+    t229 = t222 + t228
     t230 = xp.where(xp.greater(t227, 0), 1/(t227*(t227 + t226)), 0)
-    t231 = t198 - t198*t230*t229**2
+    t231 = t225 - t225*t230*t229**2
     t232 = xp.where(xp.not_equal(t228, 0), -t231/t228, 0)
-    t233 = xp.where(xp.not_equal(t193, 0), -(t197 - t224*t232)/t193, 0)
-    t234 = xp.where(xp.not_equal(t162, 0), -(t166 - (t189*t233 + t220*t232))/t162, 0)
-    t235 = xp.where(xp.not_equal(t134, 0), -(t138 - (t157*t234 + t184*t233 + t215*t232))/t134, 0)
-    t236 = xp.where(xp.not_equal(t110, 0), -(t114 - (t178*t233 + t209*t232 - t128*t235 - t151*t234))/t110, 0)
-    t237 = xp.where(xp.not_equal(t91, 0), -(t95 - (t103*t236 + t121*t235 + t144*t234 + t171*t233 + t202*t232))/t91, 0)
+    t233 = xp.where(xp.not_equal(t217, 0), -(t224 - t221*t232)/t217, 0)
+    t234 = xp.where(xp.not_equal(t201, 0), -(t213 - (t205*t233 + t209*t232))/t201, 0)
+    t235 = xp.where(xp.not_equal(t177, 0), -(t196 - (t181*t234 + t186*t233 + t191*t232))/t177, 0)
+    t236 = xp.where(xp.not_equal(t143, 0), -(t171 - (t159*t233 + t165*t232 - t147*t235 - t153*t234))/t143, 0)
+    t237 = xp.where(xp.not_equal(t97, 0), -(t136 - (t101*t236 + t108*t235 + t115*t234 + t122*t233 + t129*t232))/t97, 0)
     t238 = t232 + t236*t31 - t237*t34
-    t239 = t233*c1 + t236*t51 + t237*t53 - t234*s1 - t235*t35
-    t240 = t232*c2 + t233*t14 + t234*t8 + t235*t36 + t236*t54 + t237*t52
-    t241 = t234*t6 + t235*t37 + t237*t45 - t232*t23 - t233*t3 - t236*t48
+    t239 = t233*c1 - t234*s1 - t235*t35 + t236*t51 + t237*t53
+    t240 = t232*c2 + t235*t36 + t236*t54 + t237*t52 + t233*t14 + t234*t8
+    t241 = t234*t6 + t235*t37 + t237*t45 - t233*t3 - t236*t48 - t232*t23
     t242 = t10*t234 + t16*t233 + t22*t232 + t235*t38 + t236*t49 + t237*t46
     t243 = t18*t233 + t25*t232 + t236*t50 + t237*t47 - t12*t234 - t235*t39
     t244 = t232*t26 + t233*t19 + t234*t13
     t245 = xp.isfinite(t64)
     t246 = xp.greater_equal(damping, 0)
-    t247 = 1e-12*t200
-    t248 = xp.less_equal(t90, t247) | xp.less_equal(t109, t247) | xp.less_equal(t133, t247) | xp.less_equal(t161, t247) | xp.less_equal(t192, t247) | xp.less_equal(t227, t247)
+    t247 = 1e-12*t95
+    t248 = xp.less_equal(t96, t247) | xp.less_equal(t142, t247) | xp.less_equal(t176, t247) | xp.less_equal(t200, t247) | xp.less_equal(t216, t247) | xp.less_equal(t227, t247)
     t249 = t245 & t246 & xp.logical_not(t248)
     q_dot = _stack(xp, [
         xp.broadcast_to(xp.where(t249, t238, 0), batch),  # 0
@@ -2568,7 +2568,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t8 = t6 + t5*c2
     t9 = c1*s2
     t10 = t3*c4 + t9*s4
-    t11 = t9*c4 - t3*s4
+    t11 = -t3*s4 + t9*c4
     t12 = t10*c5 - t7*s5
     t13 = t10*s5 + t7*c5
     t14 = t12*c6 - t11*s6
@@ -2580,7 +2580,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t20 = T20*t16 + T22*t15 - T21*t17
     t21 = s1*s2
     t22 = t8*c4 + t21*s4
-    t23 = t21*c4 - t8*s4
+    t23 = -t8*s4 + t21*c4
     t24 = t22*c5 + t4*s5
     t25 = t4*c5 - t22*s5
     t26 = t24*c6 - t23*s6
@@ -2593,15 +2593,15 @@ def ik_numeric_step(target, q, damping=0.0):
     t33 = 0.5*(t19 - t30)
     t34 = c3*s2
     t35 = c2*s4 - t34*c4
-    t36 = t34*s4 + c2*c4
+    t36 = c2*c4 + t34*s4
     t37 = s2*s3
     t38 = t35*c5 + t37*s5
-    t39 = t37*c5 - t35*s5
+    t39 = -t35*s5 + t37*c5
     t40 = t38*c6 - t36*s6
     t41 = t36*c6 + t38*s6
     t42 = t39*s7 + t40*c7
     t43 = t39*c7 - t40*s7
-    t44 = t11*t36 + t15*t41 + t9*c2 - t13*t39 - t7*t37
+    t44 = t11*t36 + t15*t41 - t13*t39 + t9*c2 - t7*t37
     t45 = t23*t36 + t25*t39 + t27*t41 + t4*t37 + t21*c2
     t46 = T00*t42 + T01*t43 + T02*t41
     t47 = T10*t42 + T11*t43 + T12*t41
@@ -2630,12 +2630,12 @@ def ik_numeric_step(target, q, damping=0.0):
     t70 = t69 + 0.4*t36
     t71 = t70 + 0.42*c2
     t72 = 0.36 + t71
-    t73 = t71*t21 - t61*c2
-    t74 = t60*t37 - t70*t4
+    t73 = -t61*c2 + t71*t21
+    t74 = -t70*t4 + t60*t37
     t75 = t23*t70 - t36*t60
     t76 = t25*t69 - t39*t59
     t77 = t57*c2 - t71*t9
-    t78 = t56*t37 + t70*t7
+    t78 = t70*t7 + t56*t37
     t79 = t36*t56 - t11*t70
     t80 = t13*t69 + t39*t55
     t81 = t57 + t36*t79 + t39*t80 + t77*c2 + t78*t37
@@ -2643,28 +2643,28 @@ def ik_numeric_step(target, q, damping=0.0):
     t83 = t71**2
     t84 = c1**2
     t85 = t61**2 + t73**2 + t74**2 + t75**2 + t76**2 + t83*t84
-    t86 = t23*t75 + t25*t76 + t71*t84 + t73*t21 - t74*t4
+    t86 = t23*t75 + t25*t76 + t71*t84 - t74*t4 + t73*t21
     t87 = c1*s1
-    t88 = t73*t77 + t75*t79 + t76*t80 + t83*t87 - t57*t61 - t74*t78
+    t88 = t73*t77 + t75*t79 + t76*t80 - t57*t61 - t74*t78 + t83*t87
     t89 = -t61
     t90 = t89 + t36*t75 + t39*t76 + t73*c2 - t74*t37
     t91 = T13 + t89
     t92 = t62*c1
-    t93 = t73*t63 + t74*t64 + t75*t65 - t71*t92 - t76*t66
-    t94 = t92 + t25*t66 + t64*t4 - t23*t65 - t63*t21
+    t93 = t73*t63 + t74*t64 + t75*t65 - t76*t66 - t71*t92
+    t94 = t25*t66 + t92 + t64*t4 - t23*t65 - t63*t21
     t95 = t71*t87
-    t96 = -t95 + t11*t75 + t73*t9 + t74*t7 - t13*t76
-    t97 = t95 + t23*t79 + t25*t80 + t77*t21 + t78*t4
+    t96 = t11*t75 + t74*t7 - t13*t76 + t73*t9 - t95
+    t97 = t23*t79 + t25*t80 + t78*t4 + t95 + t77*t21
     t98 = s1**2
     t99 = t57**2 + t77**2 + t78**2 + t79**2 + t80**2 + t83*t98
     t100 = t13*t80 + t71*t98 + t78*t7 - t11*t79 - t77*t9
     t101 = t62*s1
-    t102 = t71*t101 + t78*t64 + t80*t66 - t77*t63 - t79*t65
-    t103 = t101 + t11*t65 + t13*t66 + t63*t9 + t64*t7
+    t102 = t78*t64 + t80*t66 - t77*t63 - t79*t65 + t71*t101
+    t103 = t11*t65 + t13*t66 + t101 + t64*t7 + t63*t9
     t104 = s2**2
-    t105 = t98 + t11**2 + t13**2 + t15**2 + t7**2 + t84*t104
-    t106 = -t87 + t11*t23 + t15*t27 + t87*t104 - t13*t25 - t7*t4
-    t107 = t84 + t23**2 + t25**2 + t27**2 + t4**2 + t98*t104
+    t105 = t11**2 + t13**2 + t15**2 + t7**2 + t98 + t84*t104
+    t106 = t11*t23 + t15*t27 - t13*t25 - t7*t4 - t87 + t87*t104
+    t107 = t23**2 + t25**2 + t27**2 + t4**2 + t84 + t98*t104
     t108 = 1 + t36**2 + t39**2 + t41**2 + c2**2 + t104*s3**2
     t109 = xp.greater_equal(t18, t31) & xp.greater_equal(t18, t48)
     t110 = xp.greater_equal(t31, t48)
@@ -2829,8 +2829,8 @@ def ik_numeric_step(target, q, damping=0.0):
     t269 = xp.where(xp.not_equal(t124, 0), -(t128 - (t136*t268 + t154*t267 + t177*t266 + t204*t265 + t234*t264))/t124, 0)
     t270 = t264 + q1 + t268*t57 - t269*t61
     t271 = q2 + t265*c1 - t266*s1 - t267*t62 + t268*t71*s1 + t269*t71*c1
-    t272 = q3 + t264*c2 + t265*t21 + t266*t9 + t267*t63 + t268*t77 + t269*t73
-    t273 = q4 + t266*t7 + t267*t64 + t269*t74 - t264*t37 - t265*t4 - t268*t78
+    t272 = q3 + t264*c2 + t267*t63 + t268*t77 + t269*t73 + t265*t21 + t266*t9
+    t273 = q4 + t266*t7 + t267*t64 + t269*t74 - t265*t4 - t268*t78 - t264*t37
     t274 = q5 + t11*t266 + t23*t265 + t36*t264 + t267*t65 + t268*t79 + t269*t75
     t275 = q6 + t25*t265 + t39*t264 + t268*t80 + t269*t76 - t13*t266 - t267*t66
     t276 = q7 + t15*t266 + t27*t265 + t41*t264
@@ -2893,7 +2893,7 @@ def ik_branches(T, q_free):
     t15 = t4*c3 + t5*s3
     t16 = T00 + T01 + T02 + T03 + T10 + T11 + T12 + T13 + T20 + T21 + T22 + T23
     t17 = t12**2
-    t18 = t17 + t9**2 + t10**2
+    t18 = t9**2 + t10**2 + t17
     t19 = 0.5*(0.3364 - t18)
     t20 = t19**2
     t21 = 1 - 35.430839002267575*t20
@@ -2919,7 +2919,7 @@ def ik_branches(T, q_free):
     t41 = s3**2
     t42 = t39 + t41
     t43 = t40*t41
-    t44 = t43 + t36**2 + t39*t40
+    t44 = t36**2 + t39*t40 + t43
     t45 = t17 + t43
     t46 = t45 - t44
     t47 = -t46
@@ -2927,35 +2927,35 @@ def ik_branches(T, q_free):
     t49 = xp.greater(t47, t48)
     t50 = xp.where(t49, xp.sqrt(t47), 0)
     t51 = t45 + t50**2
-    t52 = t9*t50
-    t53 = 0.4*t38
-    t54 = t10*s3
-    t55 = t53*t54
-    t56 = t17 + t52 - t55
-    t57 = -t17
-    t58 = t52 + t55 + t57
-    t59 = t58 + t17
-    t60 = t56 + t57
+    t52 = -t17
+    t53 = t9*t50
+    t54 = 0.4*t38
+    t55 = t10*s3
+    t56 = t54*t55
+    t57 = t52 + t53 + t56
+    t58 = t57 + t17
+    t59 = t17 + t53 - t56
+    t60 = t59 + t52
     t61 = t10*t50
     t62 = t9*s3
-    t63 = t53*t62
-    t64 = t63 - t61
-    t65 = t59**2 + t64**2
+    t63 = t54*t62
+    t64 = -t61 + t63
+    t65 = t58**2 + t64**2
     t66 = t61 + t63
     t67 = t60**2 + t66**2
     t68 = 1e-24*t51
     t69 = t18*t68
     t70 = xp.less_equal(t65, t69)
     t71 = xp.where(t70, 1, 1/xp.sqrt(t65))
-    t72 = xp.where(t70, 1, -t59*t71)
+    t72 = xp.where(t70, 1, -t58*t71)
     t73 = xp.where(t70, 0, t64*t71)
     t74 = T02*t72 + T12*t73
     t75 = T12*t72 - T02*t73
     t76 = t72*t13 + t73*t14
     t77 = t72*t14 - t73*t13
-    t78 = xp.where(t70, 0, xp.atan2(t64, -t59))
+    t78 = xp.where(t70, 0, xp.atan2(t64, -t58))
     t79 = t78 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t78))
-    t80 = t53*c3
+    t80 = t54*c3
     t81 = t50*t80
     t82 = t43 + t12*t36
     t83 = t81 + t82
@@ -2965,7 +2965,7 @@ def ik_branches(T, q_free):
     t87 = t84 + t85
     t88 = t36*t50
     t89 = t12*t80
-    t90 = t89 - t88
+    t90 = -t88 + t89
     t91 = t86**2 + t90**2
     t92 = t88 + t89
     t93 = t87**2 + t92**2
@@ -3017,12 +3017,12 @@ def ik_branches(T, q_free):
     t139 = t135*t137
     t140 = t38*t123
     t141 = t34*t122 + t138*s3 + t140*c3
-    t142 = t34*t128 + t140*s3 - t138*c3
+    t142 = t34*t128 - t138*c3 + t140*s3
     t143 = t38*t125
     t144 = t34*t124 + t139*s3 + t143*c3
-    t145 = t34*t130 + t143*s3 - t139*c3
+    t145 = t34*t130 - t139*c3 + t143*s3
     t146 = t133**2
-    t147 = t146 + t141**2 + t142**2
+    t147 = t141**2 + t142**2 + t146
     t148 = -t146
     t149 = 1 + t148
     t150 = xp.greater(t149, 1e-12)
@@ -3036,7 +3036,7 @@ def ik_branches(T, q_free):
     t158 = t154*s3 - t155*c3
     t159 = t157**2 + t158**2
     t160 = t151**2
-    t161 = t146 + t39*t160 + t41*t160
+    t161 = t146 + t160*t39 + t160*t41
     t162 = 1e-24*t161
     t163 = xp.less_equal(t159, t147*t162)
     t164 = xp.where(t163, 1, 1/xp.sqrt(t159))
@@ -3055,7 +3055,7 @@ def ik_branches(T, q_free):
     t177 = t172*(1 - t175)
     t178 = t175*t170 + t176*t171
     t179 = t176*t170
-    t180 = t177*s3 + t179*c3 - t175*t168
+    t180 = t177*s3 - t175*t168 + t179*c3
     t181 = t175*t169 + t177*c3 - t179*s3
     t182 = t181*s3 - t180*c3
     t183 = t180*s3 + t181*c3
@@ -3085,12 +3085,12 @@ def ik_branches(T, q_free):
     t207 = t34*t194 - t38*t204
     t208 = t38*t192
     t209 = t34*t191 + t202*s3 + t208*c3
-    t210 = t34*t197 + t208*s3 - t202*c3
+    t210 = t34*t197 - t202*c3 + t208*s3
     t211 = t38*t194
     t212 = t34*t193 + t206*s3 + t211*c3
-    t213 = t34*t199 + t211*s3 - t206*c3
+    t213 = t34*t199 - t206*c3 + t211*s3
     t214 = t203**2
-    t215 = t214 + t209**2 + t210**2
+    t215 = t209**2 + t210**2 + t214
     t216 = -t214
     t217 = 1 + t216
     t218 = xp.greater(t217, 1e-12)
@@ -3104,7 +3104,7 @@ def ik_branches(T, q_free):
     t226 = t222*s3 - t223*c3
     t227 = t225**2 + t226**2
     t228 = t219**2
-    t229 = t214 + t39*t228 + t41*t228
+    t229 = t214 + t228*t39 + t228*t41
     t230 = 1e-24*t229
     t231 = xp.less_equal(t227, t215*t230)
     t232 = xp.where(t231, 1, 1/xp.sqrt(t227))
@@ -3123,7 +3123,7 @@ def ik_branches(T, q_free):
     t245 = t240*(1 - t243)
     t246 = t243*t238 + t244*t239
     t247 = t244*t238
-    t248 = t245*s3 + t247*c3 - t243*t236
+    t248 = t245*s3 - t243*t236 + t247*c3
     t249 = t243*t237 + t245*c3 - t247*s3
     t250 = t249*s3 - t248*c3
     t251 = t248*s3 + t249*c3
@@ -3133,7 +3133,7 @@ def ik_branches(T, q_free):
     t255 = -0.36 + t254
     t256 = 0.16*t23**2
     t257 = t41*t256
-    t258 = t257 + t255**2 + t39*t256
+    t258 = t255**2 + t39*t256 + t257
     t259 = t17 + t257
     t260 = t259 - t258
     t261 = -t260
@@ -3143,14 +3143,14 @@ def ik_branches(T, q_free):
     t265 = t259 + t264**2
     t266 = t9*t264
     t267 = 0.4*t23
-    t268 = t54*t267
-    t269 = t57 + t266 + t268
+    t268 = t55*t267
+    t269 = t52 + t266 + t268
     t270 = t269 + t17
     t271 = t17 + t266 - t268
-    t272 = t271 + t57
+    t272 = t271 + t52
     t273 = t10*t264
     t274 = t62*t267
-    t275 = t274 - t273
+    t275 = -t273 + t274
     t276 = t270**2 + t275**2
     t277 = t273 + t274
     t278 = t272**2 + t277**2
@@ -3176,7 +3176,7 @@ def ik_branches(T, q_free):
     t298 = t295 + t296
     t299 = t255*t264
     t300 = t12*t291
-    t301 = t300 - t299
+    t301 = -t299 + t300
     t302 = t297**2 + t301**2
     t303 = t299 + t300
     t304 = t298**2 + t303**2
@@ -3227,13 +3227,13 @@ def ik_branches(T, q_free):
     t349 = t343*t348
     t350 = t346*t348
     t351 = t334*t37
-    t352 = t349*s3 + t351*c3 - t333*t33
-    t353 = t339*t33 + t349*c3 - t351*s3
+    t352 = t349*s3 - t333*t33 + t351*c3
+    t353 = t349*c3 + t339*t33 - t351*s3
     t354 = t336*t37
-    t355 = t350*s3 + t354*c3 - t335*t33
-    t356 = t341*t33 + t350*c3 - t354*s3
+    t355 = t350*s3 - t335*t33 + t354*c3
+    t356 = t350*c3 + t341*t33 - t354*s3
     t357 = t344**2
-    t358 = t357 + t352**2 + t353**2
+    t358 = t352**2 + t353**2 + t357
     t359 = -t357
     t360 = 1 + t359
     t361 = xp.greater(t360, 1e-12)
@@ -3247,7 +3247,7 @@ def ik_branches(T, q_free):
     t369 = t352*t365 + t353*t366
     t370 = t368**2 + t369**2
     t371 = t362**2
-    t372 = t357 + t39*t371 + t371*t41
+    t372 = t357 + t371*t39 + t371*t41
     t373 = 1e-24*t372
     t374 = xp.less_equal(t370, t358*t373)
     t375 = xp.where(t374, 1, 1/xp.sqrt(t370))
@@ -3295,13 +3295,13 @@ def ik_branches(T, q_free):
     t417 = t416*t348
     t418 = t405*t33 + t415*t37
     t419 = t403*t37
-    t420 = t413*s3 + t419*c3 - t402*t33
-    t421 = t408*t33 + t413*c3 - t419*s3
+    t420 = t413*s3 - t402*t33 + t419*c3
+    t421 = t413*c3 + t408*t33 - t419*s3
     t422 = t405*t37
-    t423 = t417*s3 + t422*c3 - t404*t33
-    t424 = t410*t33 + t417*c3 - t422*s3
+    t423 = t417*s3 - t404*t33 + t422*c3
+    t424 = t417*c3 + t410*t33 - t422*s3
     t425 = t414**2
-    t426 = t425 + t420**2 + t421**2
+    t426 = t420**2 + t421**2 + t425
     t427 = -t425
     t428 = 1 + t427
     t429 = xp.greater(t428, 1e-12)
@@ -3315,7 +3315,7 @@ def ik_branches(T, q_free):
     t437 = t420*t433 + t421*t434
     t438 = t436**2 + t437**2
     t439 = t430**2
-    t440 = t425 + t39*t439 + t439*t41
+    t440 = t425 + t439*t39 + t439*t41
     t441 = 1e-24*t440
     t442 = xp.less_equal(t438, t426*t441)
     t443 = xp.where(t442, 1, 1/xp.sqrt(t438))
@@ -3343,65 +3343,65 @@ def ik_branches(T, q_free):
     t465 = xp.where(t163, 0, xp.atan2(t158, -t157))
     t466 = t465
     t467 = t466 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t466))
-    t468 = 3.141592653589793 + t465 - 6.283185307179586*xp.ceil(0.15915494309189535*t465)
+    t468 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t465) + t465
     t469 = t468 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t468))
     t470 = xp.where(t173, 0, xp.atan2(-t152, t133))
     t471 = t470
     t472 = t471 - 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t471))
-    t473 = t470 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t470))
+    t473 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t470)) + t470
     t474 = 1e-24*t42
     t475 = xp.where(xp.less_equal(t184, t185*t474), 0, xp.atan2(t183, t182))
     t476 = t475
     t477 = t476 - 6.283185307179586*xp.floor(0.15915494309189535*(3.0543261909900767 + t476))
-    t478 = 3.141592653589793 + t475 - 6.283185307179586*xp.ceil(0.15915494309189535*t475)
+    t478 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t475) + t475
     t479 = t478 - 6.283185307179586*xp.floor(0.15915494309189535*(3.0543261909900767 + t478))
     t480 = -t473
     t481 = t473 + 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t480))
     t482 = xp.where(t231, 0, xp.atan2(t226, -t225))
     t483 = t482
     t484 = t483 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t483))
-    t485 = 3.141592653589793 + t482 - 6.283185307179586*xp.ceil(0.15915494309189535*t482)
+    t485 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t482) + t482
     t486 = t485 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t485))
     t487 = xp.where(t241, 0, xp.atan2(-t220, t203))
     t488 = t487
     t489 = t488 - 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t488))
-    t490 = t487 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t487))
+    t490 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t487)) + t487
     t491 = xp.where(xp.less_equal(t252, t253*t474), 0, xp.atan2(t251, t250))
     t492 = t491
     t493 = t492 - 6.283185307179586*xp.floor(0.15915494309189535*(3.0543261909900767 + t492))
-    t494 = 3.141592653589793 + t491 - 6.283185307179586*xp.ceil(0.15915494309189535*t491)
+    t494 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t491) + t491
     t495 = t494 - 6.283185307179586*xp.floor(0.15915494309189535*(3.0543261909900767 + t494))
     t496 = -t490
     t497 = t490 + 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t496))
     t498 = xp.where(t374, 0, xp.atan2(t369, t368))
     t499 = t498
     t500 = t499 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t499))
-    t501 = 3.141592653589793 + t498 - 6.283185307179586*xp.ceil(0.15915494309189535*t498)
+    t501 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t498) + t498
     t502 = t501 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t501))
     t503 = xp.where(t384, 0, xp.atan2(-t363, -t344))
     t504 = t503
     t505 = t504 - 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t504))
-    t506 = t503 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t503))
+    t506 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t503)) + t503
     t507 = xp.where(xp.less_equal(t395, t396*t474), 0, xp.atan2(-t394, t393))
     t508 = t507
     t509 = t508 - 6.283185307179586*xp.floor(0.15915494309189535*(3.0543261909900767 + t508))
-    t510 = 3.141592653589793 + t507 - 6.283185307179586*xp.ceil(0.15915494309189535*t507)
+    t510 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t507) + t507
     t511 = t510 - 6.283185307179586*xp.floor(0.15915494309189535*(3.0543261909900767 + t510))
     t512 = -t506
     t513 = t506 + 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t512))
     t514 = xp.where(t442, 0, xp.atan2(t437, t436))
     t515 = t514
     t516 = t515 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t515))
-    t517 = 3.141592653589793 + t514 - 6.283185307179586*xp.ceil(0.15915494309189535*t514)
+    t517 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t514) + t514
     t518 = t517 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t517))
     t519 = xp.where(t452, 0, xp.atan2(-t431, -t414))
     t520 = t519
     t521 = t520 - 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t520))
-    t522 = t519 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t519))
+    t522 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t519)) + t519
     t523 = xp.where(xp.less_equal(t463, t464*t474), 0, xp.atan2(-t462, t461))
     t524 = t523
     t525 = t524 - 6.283185307179586*xp.floor(0.15915494309189535*(3.0543261909900767 + t524))
-    t526 = 3.141592653589793 + t523 - 6.283185307179586*xp.ceil(0.15915494309189535*t523)
+    t526 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t523) + t523
     t527 = t526 - 6.283185307179586*xp.floor(0.15915494309189535*(3.0543261909900767 + t526))
     t528 = -t522
     t529 = t522 + 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t528))
@@ -3776,7 +3776,7 @@ def ik_nearest(T, q_seed, q_free, weights=(1.0,) * DOF):
     t86 = -qn5
     t87 = -qn6
     t88 = -qn7
-    t89 = qw1*(t61 + t82)**2 + qw2*(t65 + t83)**2 + qw3*(t84 + qb0_2)**2 + qw4*(t69 + t85)**2 + qw5*(t73 + t86)**2 + qw6*(t77 + t87)**2 + qw7*(t81 + t88)**2
+    t89 = qw1*(t61 + t82)**2 + qw2*(t65 + t83)**2 + qw3*(qb0_2 + t84)**2 + qw4*(t69 + t85)**2 + qw5*(t73 + t86)**2 + qw6*(t77 + t87)**2 + qw7*(t81 + t88)**2
     t90 = xp.greater(t7, 0)
     t91 = xp.where(t90, t61, qn1)
     t92 = xp.where(t90, t65, qn2)
@@ -3810,7 +3810,7 @@ def ik_nearest(T, q_seed, q_free, weights=(1.0,) * DOF):
     t120 = t13 + t119
     t121 = t13 - t119
     t122 = xp.where(xp.greater_equal(t13, -3.0543261909900767) & xp.less_equal(t13, 3.0543261909900767), t13, xp.where(xp.greater_equal(t120, -3.0543261909900767) & xp.less_equal(t120, 3.0543261909900767), t120, xp.where(xp.greater_equal(t121, -3.0543261909900767) & xp.less_equal(t121, 3.0543261909900767), t121, qb1_6)))
-    t123 = qw1*(t102 + t82)**2 + qw2*(t106 + t83)**2 + qw3*(t84 + qb1_2)**2 + qw4*(t110 + t85)**2 + qw5*(t114 + t86)**2 + qw6*(t118 + t87)**2 + qw7*(t122 + t88)**2
+    t123 = qw1*(t102 + t82)**2 + qw2*(t106 + t83)**2 + qw3*(qb1_2 + t84)**2 + qw4*(t110 + t85)**2 + qw5*(t114 + t86)**2 + qw6*(t118 + t87)**2 + qw7*(t122 + t88)**2
     t124 = xp.greater(t14, 0)
     t125 = xp.where(t124 & (xp.less(t123, t98) | xp.less(t7, 1)), xp.asarray(1, dtype=dtype), 0)
     t126 = xp.where(t124, 1, t7)
@@ -3847,7 +3847,7 @@ def ik_nearest(T, q_seed, q_free, weights=(1.0,) * DOF):
     t157 = t20 + t156
     t158 = t20 - t156
     t159 = xp.where(xp.greater_equal(t20, -3.0543261909900767) & xp.less_equal(t20, 3.0543261909900767), t20, xp.where(xp.greater_equal(t157, -3.0543261909900767) & xp.less_equal(t157, 3.0543261909900767), t157, xp.where(xp.greater_equal(t158, -3.0543261909900767) & xp.less_equal(t158, 3.0543261909900767), t158, qb2_6)))
-    t160 = qw1*(t139 + t82)**2 + qw2*(t143 + t83)**2 + qw3*(t84 + qb2_2)**2 + qw4*(t147 + t85)**2 + qw5*(t151 + t86)**2 + qw6*(t155 + t87)**2 + qw7*(t159 + t88)**2
+    t160 = qw1*(t139 + t82)**2 + qw2*(t143 + t83)**2 + qw3*(qb2_2 + t84)**2 + qw4*(t147 + t85)**2 + qw5*(t151 + t86)**2 + qw6*(t155 + t87)**2 + qw7*(t159 + t88)**2
     t161 = xp.greater(t21, 0)
     t162 = xp.where(t161 & (xp.less(t126, 1) | xp.less(t160, t135)), xp.asarray(1, dtype=dtype), 0)
     t163 = xp.where(t161, 1, t126)
@@ -3884,7 +3884,7 @@ def ik_nearest(T, q_seed, q_free, weights=(1.0,) * DOF):
     t194 = t27 + t193
     t195 = t27 - t193
     t196 = xp.where(xp.greater_equal(t27, -3.0543261909900767) & xp.less_equal(t27, 3.0543261909900767), t27, xp.where(xp.greater_equal(t194, -3.0543261909900767) & xp.less_equal(t194, 3.0543261909900767), t194, xp.where(xp.greater_equal(t195, -3.0543261909900767) & xp.less_equal(t195, 3.0543261909900767), t195, qb3_6)))
-    t197 = qw1*(t176 + t82)**2 + qw2*(t180 + t83)**2 + qw3*(t84 + qb3_2)**2 + qw4*(t184 + t85)**2 + qw5*(t188 + t86)**2 + qw6*(t192 + t87)**2 + qw7*(t196 + t88)**2
+    t197 = qw1*(t176 + t82)**2 + qw2*(t180 + t83)**2 + qw3*(qb3_2 + t84)**2 + qw4*(t184 + t85)**2 + qw5*(t188 + t86)**2 + qw6*(t192 + t87)**2 + qw7*(t196 + t88)**2
     t198 = xp.greater(t28, 0)
     t199 = xp.where(t198 & (xp.less(t163, 1) | xp.less(t197, t172)), xp.asarray(1, dtype=dtype), 0)
     t200 = xp.where(t198, 1, t163)
@@ -3921,7 +3921,7 @@ def ik_nearest(T, q_seed, q_free, weights=(1.0,) * DOF):
     t231 = t34 + t230
     t232 = t34 - t230
     t233 = xp.where(xp.greater_equal(t34, -3.0543261909900767) & xp.less_equal(t34, 3.0543261909900767), t34, xp.where(xp.greater_equal(t231, -3.0543261909900767) & xp.less_equal(t231, 3.0543261909900767), t231, xp.where(xp.greater_equal(t232, -3.0543261909900767) & xp.less_equal(t232, 3.0543261909900767), t232, qb4_6)))
-    t234 = qw1*(t213 + t82)**2 + qw2*(t217 + t83)**2 + qw3*(t84 + qb4_2)**2 + qw4*(t221 + t85)**2 + qw5*(t225 + t86)**2 + qw6*(t229 + t87)**2 + qw7*(t233 + t88)**2
+    t234 = qw1*(t213 + t82)**2 + qw2*(t217 + t83)**2 + qw3*(qb4_2 + t84)**2 + qw4*(t221 + t85)**2 + qw5*(t225 + t86)**2 + qw6*(t229 + t87)**2 + qw7*(t233 + t88)**2
     t235 = xp.greater(t35, 0)
     t236 = xp.where(t235 & (xp.less(t200, 1) | xp.less(t234, t209)), xp.asarray(1, dtype=dtype), 0)
     t237 = xp.where(t235, 1, t200)
@@ -3958,7 +3958,7 @@ def ik_nearest(T, q_seed, q_free, weights=(1.0,) * DOF):
     t268 = t41 + t267
     t269 = t41 - t267
     t270 = xp.where(xp.greater_equal(t41, -3.0543261909900767) & xp.less_equal(t41, 3.0543261909900767), t41, xp.where(xp.greater_equal(t268, -3.0543261909900767) & xp.less_equal(t268, 3.0543261909900767), t268, xp.where(xp.greater_equal(t269, -3.0543261909900767) & xp.less_equal(t269, 3.0543261909900767), t269, qb5_6)))
-    t271 = qw1*(t250 + t82)**2 + qw2*(t254 + t83)**2 + qw3*(t84 + qb5_2)**2 + qw4*(t258 + t85)**2 + qw5*(t262 + t86)**2 + qw6*(t266 + t87)**2 + qw7*(t270 + t88)**2
+    t271 = qw1*(t250 + t82)**2 + qw2*(t254 + t83)**2 + qw3*(qb5_2 + t84)**2 + qw4*(t258 + t85)**2 + qw5*(t262 + t86)**2 + qw6*(t266 + t87)**2 + qw7*(t270 + t88)**2
     t272 = xp.greater(t42, 0)
     t273 = xp.where(t272 & (xp.less(t237, 1) | xp.less(t271, t246)), xp.asarray(1, dtype=dtype), 0)
     t274 = xp.where(t272, 1, t237)
@@ -3995,7 +3995,7 @@ def ik_nearest(T, q_seed, q_free, weights=(1.0,) * DOF):
     t305 = t48 + t304
     t306 = t48 - t304
     t307 = xp.where(xp.greater_equal(t48, -3.0543261909900767) & xp.less_equal(t48, 3.0543261909900767), t48, xp.where(xp.greater_equal(t305, -3.0543261909900767) & xp.less_equal(t305, 3.0543261909900767), t305, xp.where(xp.greater_equal(t306, -3.0543261909900767) & xp.less_equal(t306, 3.0543261909900767), t306, qb6_6)))
-    t308 = qw1*(t287 + t82)**2 + qw2*(t291 + t83)**2 + qw3*(t84 + qb6_2)**2 + qw4*(t295 + t85)**2 + qw5*(t299 + t86)**2 + qw6*(t303 + t87)**2 + qw7*(t307 + t88)**2
+    t308 = qw1*(t287 + t82)**2 + qw2*(t291 + t83)**2 + qw3*(qb6_2 + t84)**2 + qw4*(t295 + t85)**2 + qw5*(t299 + t86)**2 + qw6*(t303 + t87)**2 + qw7*(t307 + t88)**2
     t309 = xp.greater(t49, 0)
     t310 = xp.where(t309 & (xp.less(t274, 1) | xp.less(t308, t283)), xp.asarray(1, dtype=dtype), 0)
     t311 = xp.where(t309, 1, t274)
@@ -4032,7 +4032,7 @@ def ik_nearest(T, q_seed, q_free, weights=(1.0,) * DOF):
     t342 = t55 + t341
     t343 = t55 - t341
     t344 = xp.where(xp.greater_equal(t55, -3.0543261909900767) & xp.less_equal(t55, 3.0543261909900767), t55, xp.where(xp.greater_equal(t342, -3.0543261909900767) & xp.less_equal(t342, 3.0543261909900767), t342, xp.where(xp.greater_equal(t343, -3.0543261909900767) & xp.less_equal(t343, 3.0543261909900767), t343, qb7_6)))
-    t345 = qw1*(t324 + t82)**2 + qw2*(t328 + t83)**2 + qw3*(t84 + qb7_2)**2 + qw4*(t332 + t85)**2 + qw5*(t336 + t86)**2 + qw6*(t340 + t87)**2 + qw7*(t344 + t88)**2
+    t345 = qw1*(t324 + t82)**2 + qw2*(t328 + t83)**2 + qw3*(qb7_2 + t84)**2 + qw4*(t332 + t85)**2 + qw5*(t336 + t86)**2 + qw6*(t340 + t87)**2 + qw7*(t344 + t88)**2
     t346 = xp.greater(t56, 0)
     t347 = xp.where(t346 & (xp.less(t311, 1) | xp.less(t345, t320)), xp.asarray(1, dtype=dtype), 0)
     t348 = xp.where(t346, 1, t311)

@@ -100,22 +100,22 @@ def fk(q):
     t10 = t2*s5 + t8*c5
     t11 = t9*c6 - t6*s6
     t12 = t6*c6 + t9*s6
-    t13 = 0.62*t8 + 0.115*t10
+    t13 = 0.115*t10 + 0.62*t8
     t14 = s1*s23
     t15 = t7*c5 - t14*s5
     t16 = t7*s5 + t14*c5
     t17 = t3*s6 + t15*c6
     t18 = t3*c6 - t15*s6
-    t19 = 0.62*t14 + 0.115*t16
+    t19 = 0.115*t16 + 0.62*t14
     t20 = c4*s23
-    t21 = t20*c5 + c23*s5
-    t22 = t20*s5 - c23*c5
+    t21 = c23*s5 + t20*c5
+    t22 = -c23*c5 + t20*s5
     t23 = 0.115*t22 - 0.62*c23
     t24 = t23 - 0.12*s23
     t25 = t24 - 0.6*s2
     t26 = 0.4 + t25
     t27 = s23*s4
-    t28 = t27*s6 - t21*c6
+    t28 = -t21*c6 + t27*s6
     t29 = t21*s6 + t27*c6
     t30 = 0.12*c23
     t31 = -t13 + t30*c1
@@ -271,10 +271,10 @@ def fk_jacobian(q):
     t16 = t3*s6 + t14*c6
     t17 = t3*c6 - t14*s6
     t18 = c4*s23
-    t19 = t18*c5 + c23*s5
-    t20 = t18*s5 - c23*c5
+    t19 = c23*s5 + t18*c5
+    t20 = -c23*c5 + t18*s5
     t21 = s23*s4
-    t22 = t21*s6 - t19*c6
+    t22 = -t19*c6 + t21*s6
     t23 = t19*s6 + t21*c6
     t24 = 0.115*t10
     t25 = t24 + 0.62*t8
@@ -390,10 +390,10 @@ def jacobian_tool(q):
     t16 = t3*s6 + t14*c6
     t17 = t3*c6 - t14*s6
     t18 = c4*s23
-    t19 = t18*c5 + c23*s5
-    t20 = t18*s5 - c23*c5
+    t19 = c23*s5 + t18*c5
+    t20 = -c23*c5 + t18*s5
     t21 = s23*s4
-    t22 = t21*s6 - t19*c6
+    t22 = -t19*c6 + t21*s6
     t23 = t19*s6 + t21*c6
     t24 = 0.115*t10
     t25 = t24 + 0.62*t8
@@ -411,16 +411,16 @@ def jacobian_tool(q):
     t37 = t34 + t35*s1
     t38 = t36 + 0.18*c1
     t39 = t37 + 0.18*s1
-    t40 = t11*c1
-    t41 = t16*s1
-    t42 = -(t36*c1 + t37*s1)
+    t40 = -(t36*c1 + t37*s1)
+    t41 = t11*c1
+    t42 = t16*s1
     t43 = -(t33*c1 + t34*s1)
     t44 = t27*c23 + t29*t13
     t45 = -(t25*c23 + t29*t8)
     t46 = t25*t13 - t27*t8
-    t47 = t6*t26 + t3*t24
-    t48 = t3*t28 + t21*t26
-    t49 = t6*t28 - t21*t24
+    t47 = t3*t28 + t21*t26
+    t48 = t6*t28 - t21*t24
+    t49 = t6*t26 + t3*t24
     t50 = t17*s1
     t51 = t10*c1
     t52 = t15*s1
@@ -429,40 +429,40 @@ def jacobian_tool(q):
     t55 = t10*s1 - t15*c1
     J = _stack(xp, [
         t16*t38 - t11*t39,  # 0, 0
-        t22*t42 + t31*t40 + t31*t41,  # 0, 1
-        t22*t43 + t30*t40 + t30*t41,  # 0, 2
+        t22*t40 + t31*t41 + t31*t42,  # 0, 1
+        t22*t43 + t30*t41 + t30*t42,  # 0, 2
         t11*t44 + t16*t45 + t22*t46,  # 0, 3
-        t11*t48 + t16*t49 + t22*t47,  # 0, 4
+        t11*t47 + t16*t48 + t22*t49,  # 0, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5
         -(t12*t39 + t17*t38),  # 1, 0
-        -(t23*t42 + t31*t50 - t12*t31*c1),  # 1, 1
+        -(t23*t40 + t31*t50 - t12*t31*c1),  # 1, 1
         -(t23*t43 + t30*t50 - t12*t30*c1),  # 1, 2
         -(t17*t45 + t23*t46 - t12*t44),  # 1, 3
-        -(t17*t49 + t23*t47 - t12*t48),  # 1, 4
+        -(t17*t48 + t23*t49 - t12*t47),  # 1, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5
         t10*t39 - t15*t38,  # 2, 0
-        -(t31*t51 + t31*t52 - t20*t42),  # 2, 1
-        -(t30*t51 + t30*t52 - t20*t43),  # 2, 2
+        -(-t20*t40 + t31*t51 + t31*t52),  # 2, 1
+        -(-t20*t43 + t30*t51 + t30*t52),  # 2, 2
         -(t10*t44 + t15*t45 - t20*t46),  # 2, 3
-        -(t10*t48 + t15*t49 - t20*t47),  # 2, 4
+        -(t10*t47 + t15*t48 - t20*t49),  # 2, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 5
         t22,  # 3, 0
         t53,  # 3, 1
         t53,  # 3, 2
-        t11*t8 + t16*t13 + t22*c23,  # 3, 3
-        t3*t16 + t22*t21 - t6*t11,  # 3, 4
+        t22*c23 + t11*t8 + t16*t13,  # 3, 3
+        t3*t16 - t6*t11 + t22*t21,  # 3, 4
         t10*t11 + t15*t16 - t20*t22,  # 3, 5
         -t23,  # 4, 0
         t54,  # 4, 1
         t54,  # 4, 2
-        -(t17*t13 + t23*c23 - t12*c1*s23),  # 4, 3
+        -(t23*c23 + t17*t13 - t12*c1*s23),  # 4, 3
         -(t6*t12 + t3*t17 + t23*t21),  # 4, 4
         t10*t12 + t20*t23 - t15*t17,  # 4, 5
         t20,  # 5, 0
         t55,  # 5, 1
         t55,  # 5, 2
-        -(t10*t8 + t15*t13 - t20*c23),  # 5, 3
-        t6*t10 + t20*t21 - t3*t15,  # 5, 4
+        -(-t20*c23 + t10*t8 + t15*t13),  # 5, 3
+        t6*t10 - t3*t15 + t20*t21,  # 5, 4
         -(t10**2 + t15**2 + t20**2),  # 5, 5
     ], (6, 6))
     return J
@@ -498,21 +498,21 @@ def task(q):
     t9 = t2*c5 - t8*s5
     t10 = t2*s5 + t8*c5
     t11 = t9*c6 - t6*s6
-    t12 = 0.62*t8 + 0.115*t10
+    t12 = 0.115*t10 + 0.62*t8
     t13 = s1*s23
     t14 = t7*c5 - t13*s5
     t15 = t7*s5 + t13*c5
     t16 = t3*s6 + t14*c6
-    t17 = 0.62*t13 + 0.115*t15
+    t17 = 0.115*t15 + 0.62*t13
     t18 = c4*s23
-    t19 = t18*c5 + c23*s5
-    t20 = t18*s5 - c23*c5
+    t19 = c23*s5 + t18*c5
+    t20 = -c23*c5 + t18*s5
     t21 = 0.115*t20 - 0.62*c23
     t22 = t21 - 0.12*s23
     t23 = t22 - 0.6*s2
     t24 = 0.4 + t23
     t25 = s23*s4
-    t26 = t25*s6 - t19*c6
+    t26 = -t19*c6 + t25*s6
     t27 = t19*s6 + t25*c6
     t28 = 0.12*c23
     t29 = -t12 + t28*c1
@@ -568,10 +568,10 @@ def task_jacobian(q):
     t14 = t7*s5 + t12*c5
     t15 = t3*s6 + t13*c6
     t16 = c4*s23
-    t17 = t16*c5 + c23*s5
-    t18 = t16*s5 - c23*c5
+    t17 = c23*s5 + t16*c5
+    t18 = -c23*c5 + t16*s5
     t19 = s23*s4
-    t20 = t19*s6 - t17*c6
+    t20 = -t17*c6 + t19*s6
     t21 = 0.115*t10
     t22 = t21 + 0.62*t8
     t23 = 0.115*t14
@@ -588,17 +588,17 @@ def task_jacobian(q):
     t34 = t31 + t32*s1
     t35 = t33 + 0.18*c1
     t36 = t34 + 0.18*s1
-    t37 = t15*c1
-    t38 = t11*s1
-    t39 = t11**2 + t15**2
-    t40 = 1/t39
-    t41 = t40*(t37 - t38)
+    t37 = t11**2 + t15**2
+    t38 = 1/t37
+    t39 = t15*c1
+    t40 = t11*s1
+    t41 = t38*(t39 - t40)
     t42 = t11*c1
     t43 = t15*s1
-    t44 = t40*(t42*s23 + t43*s23)
-    t45 = t40*(t3*t15 - t6*t11)
-    t46 = t40*(t10*t11 + t14*t15)
-    t47 = 1/xp.sqrt(t39)
+    t44 = t38*(t42*s23 + t43*s23)
+    t45 = t38*(t3*t15 - t6*t11)
+    t46 = t38*(t10*t11 + t14*t15)
+    t47 = 1/xp.sqrt(t37)
     t48 = t47*(t42 + t43)
     t49 = -t20*t41
     J = _stack(xp, [
@@ -629,7 +629,7 @@ def task_jacobian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
         t48,  # 4, 1
         t48,  # 4, 2
-        t47*(t38*s23 - t37*s23),  # 4, 3
+        t47*(t40*s23 - t39*s23),  # 4, 3
         t47*(t6*t15 + t3*t11),  # 4, 4
         t47*(t14*t11 - t10*t15),  # 4, 5
         xp.full(batch, 1, dtype=dtype, device=device),  # 5, 0
@@ -686,10 +686,10 @@ def fk_jacobian_dot(q, q_dot):
     t17 = t4*s6 + t15*c6
     t18 = t4*c6 - t15*s6
     t19 = c4*s23
-    t20 = t19*c5 + c23*s5
-    t21 = t19*s5 - c23*c5
+    t20 = c23*s5 + t19*c5
+    t21 = -c23*c5 + t19*s5
     t22 = s23*s4
-    t23 = t22*s6 - t20*c6
+    t23 = -t20*c6 + t22*s6
     t24 = t20*s6 + t22*c6
     t25 = t0 + t22*qd5
     t26 = 0.115*t11
@@ -741,7 +741,7 @@ def fk_jacobian_dot(q, q_dot):
     t72 = t4*qd5
     t73 = t69 + t72
     t74 = t46*qd5
-    t75 = t74 + t44*qd4
+    t75 = t44*qd4 + t74
     t76 = t75 + t32*t67
     t77 = t76 + t33*t66
     t78 = t77 - t42*qd1
@@ -813,12 +813,12 @@ def fk_jacobian_dot(q, q_dot):
         xp.broadcast_to(-t21, batch),  # 5, 5
     ], (6, 6))
     a = _stack(xp, [
-        xp.broadcast_to(qd2*(t61*c1 - t86*qd1) + qd4*(t48*qd1 + t56*t68 + t59*t14 - t80*c23) + qd5*(t58*t69 + t58*t72 - t50*t0 - t79*t22) - t83*qd1 - qd3*(t54*t66 + t87*qd1 - t60*c1), batch),  # 0
-        xp.broadcast_to(t78*qd1 + qd2*(t61*s1 + t84*qd1) + qd3*(t60*s1 + t85*qd1 - t54*t62) + qd4*(t44*qd1 + t56*t64 + t75*c23 - t59*t9) + qd5*(t46*t0 + t58*t70 + t74*t22 - t58*t65), batch),  # 1
-        xp.broadcast_to(qd4*(t48*t64 + t80*t9 - t44*t68 - t75*t14) - qd2*(t77*c1 + t82*s1) - qd3*(t76*c1 + t81*s1 + t89*c1**2 + t89*s1**2) - qd5*(t46*t69 + t46*t72 + t50*t70 - t50*t65), batch),  # 2
-        xp.broadcast_to(qd4*(t68*c23 - t14*qd1) + qd5*(t69*t22 - t4*t0) - t66*qd1 - t67*qd1 - qd6*(t16*t25 + t21*t73), batch),  # 3
-        xp.broadcast_to(qd4*(t64*c23 + t9*qd1) + qd6*(t11*t25 + t21*t71) - t62*qd1 - t63*qd1 - qd5*(t7*t0 + t65*t22), batch),  # 4
-        xp.broadcast_to(qd5*(t7*t69 + t4*t65) + qd6*(t16*t71 - t11*t73) - qd4*(t64*t14 + t68*t9), batch),  # 5
+        xp.broadcast_to(qd2*(t61*c1 - t86*qd1) - qd3*(-t60*c1 + t87*qd1 + t54*t66) + qd4*(t48*qd1 + t56*t68 - t80*c23 + t59*t14) + qd5*(t58*t69 - t50*t0 + t58*t72 - t79*t22) - t83*qd1, batch),  # 0
+        xp.broadcast_to(t78*qd1 + qd2*(t61*s1 + t84*qd1) + qd3*(t60*s1 + t85*qd1 - t54*t62) + qd4*(t44*qd1 + t56*t64 + t75*c23 - t59*t9) + qd5*(t46*t0 - t58*t65 + t58*t70 + t74*t22), batch),  # 1
+        xp.broadcast_to(-qd2*(t77*c1 + t82*s1) - qd3*(t76*c1 + t81*s1 + t89*c1**2 + t89*s1**2) + qd4*(t48*t64 - t44*t68 + t80*t9 - t75*t14) - qd5*(t46*t69 - t50*t65 + t50*t70 + t46*t72), batch),  # 2
+        xp.broadcast_to(qd4*(t68*c23 - t14*qd1) + qd5*(-t4*t0 + t69*t22) - qd6*(t16*t25 + t21*t73) - t66*qd1 - t67*qd1, batch),  # 3
+        xp.broadcast_to(qd4*(t64*c23 + t9*qd1) - qd5*(t7*t0 + t65*t22) + qd6*(t11*t25 + t21*t71) - t62*qd1 - t63*qd1, batch),  # 4
+        xp.broadcast_to(-qd4*(t64*t14 + t68*t9) + qd5*(t7*t69 + t4*t65) + qd6*(t16*t71 - t11*t73), batch),  # 5
     ], (6,))
     return T, J, a
 
@@ -903,7 +903,7 @@ def jacobian_dot(q, q_dot):
     t56 = t5*qd5
     t57 = t53 + t56
     t58 = t37*qd5
-    t59 = t58 + t34*qd4
+    t59 = t34*qd4 + t58
     t60 = t59 + t21*t51
     t61 = t60 + t22*t50
     t62 = t61 - t31*qd1
@@ -920,27 +920,27 @@ def jacobian_dot(q, q_dot):
     Jd = _stack(xp, [
         xp.broadcast_to(-t67, batch),  # 0, 0
         xp.broadcast_to(t45*c1 - t22*t68, batch),  # 0, 1
-        xp.broadcast_to(-(t21*t68 + t26*t50 - t44*c1), batch),  # 0, 2
-        xp.broadcast_to(t35*qd1 + t42*t52 + t43*t40 - t64*c23, batch),  # 0, 3
-        xp.broadcast_to(t18*t53 + t18*t56 - t38*t1 - t36*t63, batch),  # 0, 4
+        xp.broadcast_to(-(-t44*c1 + t21*t68 + t26*t50), batch),  # 0, 2
+        xp.broadcast_to(t35*qd1 + t42*t52 - t64*c23 + t43*t40, batch),  # 0, 3
+        xp.broadcast_to(t18*t53 - t38*t1 + t18*t56 - t36*t63, batch),  # 0, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5
         xp.broadcast_to(t62, batch),  # 1, 0
-        xp.broadcast_to(t22*t69 + t45*s1, batch),  # 1, 1
-        xp.broadcast_to(t21*t69 + t44*s1 - t26*t46, batch),  # 1, 2
+        xp.broadcast_to(t45*s1 + t22*t69, batch),  # 1, 1
+        xp.broadcast_to(t44*s1 + t21*t69 - t26*t46, batch),  # 1, 2
         xp.broadcast_to(t34*qd1 + t42*t48 + t59*c23 - t43*t41, batch),  # 1, 3
-        xp.broadcast_to(t37*t1 + t18*t54 + t36*t58 - t18*t49, batch),  # 1, 4
+        xp.broadcast_to(t37*t1 - t18*t49 + t18*t54 + t36*t58, batch),  # 1, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
         xp.broadcast_to(-(t61*c1 + t66*s1), batch),  # 2, 1
         xp.broadcast_to(-(t60*c1 + t65*s1 + t70*c1**2 + t70*s1**2), batch),  # 2, 2
-        xp.broadcast_to(t35*t48 + t64*t41 - t34*t52 - t59*t40, batch),  # 2, 3
-        xp.broadcast_to(-(t37*t53 + t37*t56 + t38*t54 - t38*t49), batch),  # 2, 4
+        xp.broadcast_to(t35*t48 - t34*t52 + t64*t41 - t59*t40, batch),  # 2, 3
+        xp.broadcast_to(-(t37*t53 - t38*t49 + t38*t54 + t37*t56), batch),  # 2, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
         xp.broadcast_to(t71, batch),  # 3, 1
         xp.broadcast_to(t71, batch),  # 3, 2
         xp.broadcast_to(t52*c23 - t68*s23, batch),  # 3, 3
-        xp.broadcast_to(t53*t36 - t5*t1, batch),  # 3, 4
+        xp.broadcast_to(-t5*t1 + t53*t36, batch),  # 3, 4
         xp.broadcast_to(-(t12*t39 + t0*t57), batch),  # 3, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
         xp.broadcast_to(t72, batch),  # 4, 1
@@ -1039,7 +1039,7 @@ def bias_acceleration(q, q_dot):
     t56 = t5*qd5
     t57 = t53 + t56
     t58 = t37*qd5
-    t59 = t58 + t34*qd4
+    t59 = t34*qd4 + t58
     t60 = t59 + t21*t51
     t61 = t60 + t22*t50
     t62 = t61 - t31*qd1
@@ -1052,12 +1052,12 @@ def bias_acceleration(q, q_dot):
     t69 = c1*qd1
     t70 = t21*qd2
     a = _stack(xp, [
-        xp.broadcast_to(qd2*(t45*c1 - t22*t68) + qd4*(t35*qd1 + t42*t52 + t43*t40 - t64*c23) + qd5*(t18*t53 + t18*t56 - t38*t1 - t36*t63) - t67*qd1 - qd3*(t21*t68 + t26*t50 - t44*c1), batch),  # 0
-        xp.broadcast_to(t62*qd1 + qd2*(t22*t69 + t45*s1) + qd3*(t21*t69 + t44*s1 - t26*t46) + qd4*(t34*qd1 + t42*t48 + t59*c23 - t43*t41) + qd5*(t37*t1 + t18*t54 + t36*t58 - t18*t49), batch),  # 1
-        xp.broadcast_to(qd4*(t35*t48 + t64*t41 - t34*t52 - t59*t40) - qd2*(t61*c1 + t66*s1) - qd3*(t60*c1 + t65*s1 + t70*c1**2 + t70*s1**2) - qd5*(t37*t53 + t37*t56 + t38*t54 - t38*t49), batch),  # 2
-        xp.broadcast_to(qd4*(t52*c23 - t40*qd1) + qd5*(t53*t36 - t5*t1) - t50*qd1 - t51*qd1 - qd6*(t12*t39 + t0*t57), batch),  # 3
-        xp.broadcast_to(qd4*(t48*c23 + t41*qd1) + qd6*(t11*t39 + t0*t55) - t46*qd1 - t47*qd1 - qd5*(t8*t1 + t49*t36), batch),  # 4
-        xp.broadcast_to(qd5*(t8*t53 + t5*t49) + qd6*(t12*t55 - t11*t57) - qd4*(t48*t40 + t52*t41), batch),  # 5
+        xp.broadcast_to(qd2*(t45*c1 - t22*t68) - qd3*(-t44*c1 + t21*t68 + t26*t50) + qd4*(t35*qd1 + t42*t52 - t64*c23 + t43*t40) + qd5*(t18*t53 - t38*t1 + t18*t56 - t36*t63) - t67*qd1, batch),  # 0
+        xp.broadcast_to(t62*qd1 + qd2*(t45*s1 + t22*t69) + qd3*(t44*s1 + t21*t69 - t26*t46) + qd4*(t34*qd1 + t42*t48 + t59*c23 - t43*t41) + qd5*(t37*t1 - t18*t49 + t18*t54 + t36*t58), batch),  # 1
+        xp.broadcast_to(-qd2*(t61*c1 + t66*s1) - qd3*(t60*c1 + t65*s1 + t70*c1**2 + t70*s1**2) + qd4*(t35*t48 - t34*t52 + t64*t41 - t59*t40) - qd5*(t37*t53 - t38*t49 + t38*t54 + t37*t56), batch),  # 2
+        xp.broadcast_to(qd4*(t52*c23 - t40*qd1) + qd5*(-t5*t1 + t53*t36) - qd6*(t12*t39 + t0*t57) - t50*qd1 - t51*qd1, batch),  # 3
+        xp.broadcast_to(qd4*(t48*c23 + t41*qd1) - qd5*(t8*t1 + t49*t36) + qd6*(t11*t39 + t0*t55) - t46*qd1 - t47*qd1, batch),  # 4
+        xp.broadcast_to(-qd4*(t48*t40 + t52*t41) + qd5*(t8*t53 + t5*t49) + qd6*(t12*t55 - t11*t57), batch),  # 5
     ], (6,))
     return a
 
@@ -1103,10 +1103,10 @@ def task_jacobian_dot(q, q_dot):
     t14 = t7*s5 + t12*c5
     t15 = t3*s6 + t13*c6
     t16 = c4*s23
-    t17 = t16*c5 + c23*s5
-    t18 = t16*s5 - c23*c5
+    t17 = c23*s5 + t16*c5
+    t18 = -c23*c5 + t16*s5
     t19 = s23*s4
-    t20 = t19*s6 - t17*c6
+    t20 = -t17*c6 + t19*s6
     t21 = 0.115*t10
     t22 = t21 + 0.62*t8
     t23 = 0.115*t14
@@ -1146,20 +1146,20 @@ def task_jacobian_dot(q, q_dot):
     t57 = t56*c23 - t12*qd1
     t58 = t51*t12 + t56*t8
     t59 = t8*qd4
-    t60 = t59 - t51
+    t60 = -t51 + t59
     t61 = t12*qd4
     t62 = t56 + t61
     t63 = t6*t62 + t3*t60
     t64 = qd1 + c23*qd4
     t65 = t64
-    t66 = t62*t19 - t3*t65
+    t66 = -t3*t65 + t62*t19
     t67 = t6*t65 + t60*t19
     t68 = t6*qd5
     t69 = t60 - t68
     t70 = t50 + t68 - t59 - t10*qd6
     t71 = t3*qd5
     t72 = t62 + t71
-    t73 = t33*t62 + t33*t71 + t35*t68 - t35*t60
+    t73 = t33*t62 - t35*t60 + t35*t68 + t33*t71
     t74 = t14*t69 - t10*t72
     t75 = t55 + t61 + t71 + t14*qd6
     t76 = t70*t15 + t75*t11
@@ -1171,87 +1171,87 @@ def task_jacobian_dot(q, q_dot):
     t82 = t75*t20 - t81*t15
     t83 = t70*t20 + t81*t11
     t84 = t33*qd5
-    t85 = t84 + t32*qd4
+    t85 = t32*qd4 + t84
     t86 = t85 + t30*t54
     t87 = t86 + t31*t53
     t88 = t87 - t45*qd1
     t89 = t32*qd1 + t25*t51 + t85*c23 - t27*t8
-    t90 = t33*t65 + t26*t68 + t84*t19 - t26*t60
+    t90 = t33*t65 - t26*t60 + t26*t68 + t84*t19
     t91 = t35*qd5
     t92 = t91 - t34*qd4
     t93 = t92 + t30*t49
     t94 = t93 + t31*t48
     t95 = t94 + t44*qd1
-    t96 = t34*qd1 + t25*t56 + t27*t12 - t92*c23
-    t97 = t26*t62 + t26*t71 - t35*t65 - t91*t19
+    t96 = t34*qd1 + t25*t56 - t92*c23 + t27*t12
+    t97 = t26*t62 - t35*t65 + t26*t71 - t91*t19
     t98 = t87*c1 + t94*s1
-    t99 = t34*t51 + t92*t8 - t32*t56 - t85*t12
+    t99 = t34*t51 - t32*t56 + t92*t8 - t85*t12
     t100 = qd1*s1
     t101 = t47*c1 - t31*t100
-    t102 = t30*t100 + t39*t53 - t40*c1
+    t102 = -t40*c1 + t30*t100 + t39*t53
     t103 = c1*qd1
-    t104 = t31*t103 + t47*s1
-    t105 = t30*t103 + t40*s1 - t39*t48
+    t104 = t47*s1 + t31*t103
+    t105 = t40*s1 + t30*t103 - t39*t48
     t106 = t30*qd2
     t107 = t86*c1 + t93*s1 + t106*c1**2 + t106*s1**2
     t108 = t11**2 + t15**2
     t109 = 1/t108
-    t110 = t109*c1
-    t111 = t11*qd1
-    t112 = t109*s1
-    t113 = t15*qd1
-    t114 = t15*c1
-    t115 = t11*s1
-    t116 = t114 - t115
-    t117 = 2/t108**2
-    t118 = t116*t117
-    t119 = t15*t118
-    t120 = t11*t118
-    t121 = t83*(t110 - t119) - t82*(t112 + t120) - t110*t111 - t112*t113
-    t122 = t11*t109
-    t123 = t57*t122
-    t124 = t15*t109
-    t125 = t52*t124
-    t126 = t110*s23
-    t127 = t11*c1
-    t128 = t15*s1
-    t129 = t127*s23 + t128*s23
-    t130 = t117*t129
-    t131 = t11*t130
-    t132 = t112*s23
-    t133 = t15*t130
-    t134 = t66*t122
-    t135 = t67*t124
-    t136 = t3*t109
-    t137 = t3*t15 - t6*t11
-    t138 = t117*t137
-    t139 = t15*t138
-    t140 = t6*t109
-    t141 = t11*t138
-    t142 = t80*t124
-    t143 = t79*t122
-    t144 = t10*t109
-    t145 = t10*t11 + t14*t15
-    t146 = t117*t145
-    t147 = t11*t146
-    t148 = t14*t109
-    t149 = t15*t146
+    t110 = s1*t109
+    t111 = t15*c1
+    t112 = t11*s1
+    t113 = t111 - t112
+    t114 = 2/t108**2
+    t115 = t113*t114
+    t116 = t11*t115
+    t117 = c1*t109
+    t118 = t15*t115
+    t119 = t11*qd1
+    t120 = t15*qd1
+    t121 = -t82*(t110 + t116) + t83*(t117 - t118) - t117*t119 - t110*t120
+    t122 = t117*s23
+    t123 = t11*c1
+    t124 = t15*s1
+    t125 = t123*s23 + t124*s23
+    t126 = t114*t125
+    t127 = t11*t126
+    t128 = t110*s23
+    t129 = t15*t126
+    t130 = t11*t109
+    t131 = t57*t130
+    t132 = t15*t109
+    t133 = t52*t132
+    t134 = t6*t109
+    t135 = t3*t15 - t6*t11
+    t136 = t114*t135
+    t137 = t11*t136
+    t138 = t3*t109
+    t139 = t15*t136
+    t140 = t66*t130
+    t141 = t67*t132
+    t142 = t10*t109
+    t143 = t10*t11 + t14*t15
+    t144 = t114*t143
+    t145 = t11*t144
+    t146 = t14*t109
+    t147 = t15*t144
+    t148 = t80*t132
+    t149 = t79*t130
     t150 = 1/xp.sqrt(t108)
-    t151 = t150*qd1
-    t152 = t150*c1
-    t153 = 1/t108**1.5
-    t154 = t153*(t127 + t128)
-    t155 = t150*s1
-    t156 = t82*(t152 - t11*t154) + t83*(t155 - t15*t154) + t114*t151 - t115*t151
-    t157 = t11*t150
-    t158 = t15*t150
-    t159 = t153*(t115*s23 - t114*s23)
-    t160 = t153*(t6*t15 + t3*t11)
-    t161 = t153*(t14*t11 - t10*t15)
+    t151 = c1*t150
+    t152 = 1/t108**1.5
+    t153 = t152*(t123 + t124)
+    t154 = s1*t150
+    t155 = t150*qd1
+    t156 = t82*(t151 - t11*t153) + t83*(t154 - t15*t153) + t111*t155 - t112*t155
+    t157 = t152*(t112*s23 - t111*s23)
+    t158 = t11*t150
+    t159 = t15*t150
+    t160 = t152*(t6*t15 + t3*t11)
+    t161 = t152*(t14*t11 - t10*t15)
     t162 = t20*t110
-    t163 = t20*t112
+    t163 = t20*t117
     t164 = t76*t109
-    t165 = t82*(t163 + t20*t120) + t83*(-t162 + t20*t119) + t111*t162 + t113*t163 + t116*t164
+    t165 = t82*(t162 + t20*t116) + t83*(-t163 + t20*t118) + t113*t164 + t119*t163 + t120*t162
     Jd = _stack(xp, [
         xp.broadcast_to(-t95, batch),  # 0, 0
         xp.broadcast_to(t101, batch),  # 0, 1
@@ -1274,21 +1274,21 @@ def task_jacobian_dot(q, q_dot):
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
         xp.broadcast_to(t121, batch),  # 3, 1
         xp.broadcast_to(t121, batch),  # 3, 2
-        xp.broadcast_to(t123 + t125 + t82*(t126 - t131) + t83*(t132 - t133), batch),  # 3, 3
-        xp.broadcast_to(t134 - t135 + t83*(t136 - t139) - t82*(t140 + t141), batch),  # 3, 4
-        xp.broadcast_to(t142 - t143 + t82*(t144 - t147) + t83*(t148 - t149), batch),  # 3, 5
+        xp.broadcast_to(t82*(t122 - t127) + t83*(t128 - t129) + t131 + t133, batch),  # 3, 3
+        xp.broadcast_to(-t82*(t134 + t137) + t83*(t138 - t139) + t140 - t141, batch),  # 3, 4
+        xp.broadcast_to(t82*(t142 - t145) + t83*(t146 - t147) + t148 - t149, batch),  # 3, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
         xp.broadcast_to(t156, batch),  # 4, 1
         xp.broadcast_to(t156, batch),  # 4, 2
-        xp.broadcast_to(t82*(t155*s23 - t11*t159) + t52*t157 - t83*(t15*t159 + t152*s23) - t57*t158, batch),  # 4, 3
-        xp.broadcast_to(t82*(t3*t150 - t11*t160) + t83*(t6*t150 - t15*t160) - t67*t157 - t66*t158, batch),  # 4, 4
-        xp.broadcast_to(t80*t157 + t82*(t14*t150 - t11*t161) + t79*t158 - t83*(t10*t150 + t15*t161), batch),  # 4, 5
+        xp.broadcast_to(t82*(t154*s23 - t11*t157) - t83*(t15*t157 + t151*s23) + t52*t158 - t57*t159, batch),  # 4, 3
+        xp.broadcast_to(t82*(t3*t150 - t11*t160) + t83*(t6*t150 - t15*t160) - t67*t158 - t66*t159, batch),  # 4, 4
+        xp.broadcast_to(t82*(t14*t150 - t11*t161) - t83*(t10*t150 + t15*t161) + t80*t158 + t79*t159, batch),  # 4, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 0
         xp.broadcast_to(t165, batch),  # 5, 1
         xp.broadcast_to(t165, batch),  # 5, 2
-        xp.broadcast_to(-t58 + t82*(t20*t131 - t20*t126) + t83*(t20*t133 - t20*t132) + t129*t164 - t20*t123 - t20*t125, batch),  # 5, 3
-        xp.broadcast_to(t63 + t82*(t20*t140 + t20*t141) + t83*(t20*t139 - t20*t136) + t20*t135 + t137*t164 - t20*t134, batch),  # 5, 4
-        xp.broadcast_to(t74 + t82*(t20*t147 - t20*t144) + t83*(t20*t149 - t20*t148) + t20*t143 + t145*t164 - t20*t142, batch),  # 5, 5
+        xp.broadcast_to(-t58 + t82*(-t20*t122 + t20*t127) + t83*(-t20*t128 + t20*t129) + t125*t164 - t20*t131 - t20*t133, batch),  # 5, 3
+        xp.broadcast_to(t63 + t82*(t20*t134 + t20*t137) + t83*(-t20*t138 + t20*t139) + t135*t164 + t20*t141 - t20*t140, batch),  # 5, 4
+        xp.broadcast_to(t74 + t82*(-t20*t142 + t20*t145) + t83*(-t20*t146 + t20*t147) + t143*t164 + t20*t149 - t20*t148, batch),  # 5, 5
     ], (6, 6))
     return Jd
 
@@ -1370,10 +1370,10 @@ def hessian(q):
     t58 = -t0*c1
     t59 = t1*s23
     t60 = -t0*s1
-    t61 = -(t52*s23 + t53*s23)
+    t61 = -(s23*t52 + s23*t53)
     t62 = t7*c1 - t4*s1
     t63 = -(t10*c1 + t12*s1)
-    t64 = t18*t11 - t38*c23
+    t64 = -t38*c23 + t18*t11
     t65 = t37*c23 - t18*t9
     t66 = t38*t9 - t37*t11
     t67 = s23**2
@@ -1508,7 +1508,7 @@ def hessian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 3, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 3, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 3, 3
-        t1*t67 - t4*c23,  # 3, 3, 4
+        -t4*c23 + t1*t67,  # 3, 3, 4
         -(t12*c23 + t0*t11),  # 3, 3, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 4, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 4, 1
@@ -1551,7 +1551,7 @@ def hessian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 4, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 4, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 4, 4
-        t10*t36 - t7*t0,  # 4, 4, 5
+        -t7*t0 + t10*t36,  # 4, 4, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 5, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 5, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 5, 2
@@ -1609,9 +1609,9 @@ def singularity_factors(q):
     s5 = trig[..., 9]
     t0 = 0.1935483870967742*s3
     f = _stack(xp, [
-        t0 + c3,  # 0
+        c3 + t0,  # 0
         s5,  # 1
-        0.2903225806451613 + 0.967741935483871*c2 - t0*s2 - c2*s3 - c3*s2 + 0.1935483870967742*c2*c3,  # 2
+        0.2903225806451613 + 0.967741935483871*c2 - c2*s3 - c3*s2 + 0.1935483870967742*c2*c3 - t0*s2,  # 2
     ], (3,))
     return f
 
@@ -1626,7 +1626,7 @@ def manipulability(q):
     s3 = trig[..., 5]
     s5 = trig[..., 9]
     t0 = 0.1935483870967742*s3
-    t1 = 0.23064*s5*(t0 + c3)*(0.2903225806451613 + 0.967741935483871*c2 - t0*s2 - c2*s3 - c3*s2 + 0.1935483870967742*c2*c3)
+    t1 = 0.23064*s5*(c3 + t0)*(0.2903225806451613 + 0.967741935483871*c2 - c2*s3 - c3*s2 + 0.1935483870967742*c2*c3 - t0*s2)
     w = xp.broadcast_to(xp.abs(t1), batch)
     return w
 
@@ -1641,7 +1641,7 @@ def jacobian_det(q):
     s3 = trig[..., 5]
     s5 = trig[..., 9]
     t0 = 0.1935483870967742*s3
-    d = xp.broadcast_to(-0.23064*s5*(t0 + c3)*(0.2903225806451613 + 0.967741935483871*c2 - t0*s2 - c2*s3 - c3*s2 + 0.1935483870967742*c2*c3), batch)
+    d = xp.broadcast_to(-0.23064*s5*(c3 + t0)*(0.2903225806451613 + 0.967741935483871*c2 - c2*s3 - c3*s2 + 0.1935483870967742*c2*c3 - t0*s2), batch)
     return d
 
 
@@ -1712,25 +1712,25 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t35 = s23*s4
     t36 = t4*t19 + t35*t15
     t37 = t7*t19 - t35*t13
-    t38 = t32 + t37*t35 - t24*c23
+    t38 = t32 - t24*c23 + t37*t35
     t39 = t17*c23 + t18*t35
-    t40 = t7*t35 + t10*t0 - t9*c23
-    t41 = t4*t35 + t11*c23 - t12*t0
+    t40 = t10*t0 + t7*t35 - t9*c23
+    t41 = -t12*t0 + t4*t35 + t11*c23
     t42 = t33**2
     t43 = t21**2
     t44 = c1**2
     t45 = t4*t36 + t21*t44 + t22*t44 + t23*t11
     t46 = t22**2
-    t47 = t23**2 + t36**2 + t43*t44 + t44*t46
+    t47 = t23**2 + t36**2 + t43*t44 + t46*t44
     t48 = t42 + t47
     t49 = c1*s1
-    t50 = t36*t37 + t43*t49 + t46*t49 - t32*t33 - t23*t24
+    t50 = t36*t37 - t32*t33 - t23*t24 + t43*t49 + t46*t49
     t51 = -t33
     t52 = t51 + t23*c23 + t36*t35
     t53 = t28*c1
     t54 = t34*c1
     t55 = t23*t17 + t36*t18 - t21*t53 - t22*t54
-    t56 = -t53 - t54 + t4*t18 + t17*t11
+    t56 = t4*t18 - t54 - t53 + t17*t11
     t57 = t21*c1
     t58 = t22*c1
     t59 = t57*s1 + t58*s1
@@ -1743,8 +1743,8 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t66 = t62 + t65
     t67 = t28*s1
     t68 = t34*s1
-    t69 = t21*t67 + t22*t68 + t24*t17 - t37*t18
-    t70 = t67 + t68 + t17*t9 - t7*t18
+    t69 = t24*t17 - t37*t18 + t21*t67 + t22*t68
+    t70 = t68 + t67 - t7*t18 + t17*t9
     t71 = t34**2
     t72 = t71 + t28**2 + t17**2 + t18**2
     t73 = t72
@@ -1752,177 +1752,177 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t75 = t7**2 + t10**2 + 2*t63 + t44*t74
     t76 = t75
     t77 = 2*s1
-    t78 = t10*t12 + t49*t74 - t7*t4 - t77*c1
+    t78 = t10*t12 - t7*t4 - t77*c1 + t49*t74
     t79 = t4**2 + t12**2 + 2*t44 + t63*t74
     t80 = t79
     t81 = t0**2 + c23**2 + t74*s4**2
     t82 = 1 + t81
-    t83 = t50**2
-    t84 = t52**2
-    t85 = t55**2
-    t86 = t60**2
-    t87 = t45**2
-    t88 = damping**2
-    t89 = t48 + t88
-    t90 = t89**2
-    t91 = xp.sqrt(t83 + t84 + t85 + t86 + t87 + t90)
-    t92 = t91*xp.where(xp.greater_equal(t89, 0), xp.asarray(1, dtype=dtype), -1)
-    t93 = t92 + t89
-    t94 = xp.where(xp.greater(t91, 0), 1/(t91*(t91 + xp.abs(t89))), 0)
-    t95 = t94*(t50*mu_dot1 + t52*mu_dot5 + t55*mu_dot2 + t45*mu_dot4 + t93*mu_dot0 - t60*mu_dot3)
-    t96 = mu_dot0 - t93*t95
-    t97 = mu_dot1 - t50*t95
-    t98 = mu_dot2 - t55*t95
-    t99 = mu_dot3 + t60*t95
-    t100 = mu_dot4 - t45*t95
-    t101 = mu_dot5 - t52*t95
-    t102 = t66 + t88
-    t103 = t94*(t50*t93 + t50*t102 + t52*t38 + t60*t64 + t45*t61 - t55*t69)
-    t104 = t50 - t93*t103
-    t105 = t102 - t50*t103
-    t106 = t69 + t55*t103
-    t107 = -t64 + t60*t103
-    t108 = t61 - t45*t103
-    t109 = t38 - t52*t103
-    t110 = xp.sqrt(t105**2 + t106**2 + t107**2 + t108**2 + t109**2)
-    t111 = t110*xp.where(xp.greater_equal(t105, 0), xp.asarray(1, dtype=dtype), -1)
-    t112 = t105 + t111
-    t113 = xp.where(xp.greater(t110, 0), 1/(t110*(t110 + xp.abs(t105))), 0)
-    t114 = t113*(t107*t99 + t108*t100 + t109*t101 + t97*t112 - t106*t98)
-    t115 = t97 - t112*t114
-    t116 = t98 + t106*t114
-    t117 = t99 - t107*t114
-    t118 = t100 - t108*t114
-    t119 = t101 - t109*t114
-    t120 = t73 + t88
-    t121 = t94*(t52*t39 + t55*t93 + t55*t120 + t45*t56 - t50*t69 - t60*t70)
-    t122 = t55 - t93*t121
-    t123 = t69 + t50*t121
-    t124 = t120 - t55*t121
-    t125 = t70 + t60*t121
-    t126 = t56 - t45*t121
-    t127 = t39 - t52*t121
-    t128 = t113*(t107*t125 + t108*t126 + t109*t127 - t106*t124 - t123*t112)
-    t129 = t123 + t112*t128
-    t130 = t124 + t106*t128
-    t131 = t125 - t107*t128
-    t132 = t126 - t108*t128
-    t133 = t127 - t109*t128
-    t134 = xp.sqrt(t130**2 + t131**2 + t132**2 + t133**2)
-    t135 = t134*xp.where(xp.greater_equal(t130, 0), xp.asarray(1, dtype=dtype), -1)
-    t136 = t130 + t135
-    t137 = xp.where(xp.greater(t134, 0), 1/(t134*(t134 + xp.abs(t130))), 0)
-    t138 = t137*(t131*t117 + t132*t118 + t133*t119 + t116*t136)
-    t139 = t116 - t136*t138
-    t140 = t117 - t131*t138
-    t141 = t118 - t132*t138
-    t142 = t119 - t133*t138
-    t143 = t76 + t88
-    t144 = -t94*(t50*t64 + t52*t40 + t60*t93 + t60*t143 - t55*t70 - t45*t78)
-    t145 = t60 + t93*t144
-    t146 = t64 + t50*t144
-    t147 = t70 - t55*t144
-    t148 = t143 + t60*t144
-    t149 = t78 - t45*t144
-    t150 = t40 + t52*t144
-    t151 = -t113*(t106*t147 + t109*t150 + t146*t112 - t107*t148 - t108*t149)
-    t152 = t146 + t112*t151
-    t153 = t147 + t106*t151
-    t154 = t148 - t107*t151
-    t155 = t149 - t108*t151
-    t156 = t150 + t109*t151
-    t157 = t137*(t131*t154 + t132*t155 + t153*t136 - t133*t156)
-    t158 = t153 - t136*t157
-    t159 = t154 - t131*t157
-    t160 = t155 - t132*t157
-    t161 = t156 + t133*t157
-    t162 = xp.sqrt(t159**2 + t160**2 + t161**2)
-    t163 = t162*xp.where(xp.greater_equal(t159, 0), xp.asarray(1, dtype=dtype), -1)
-    t164 = t159 + t163
-    t165 = xp.where(xp.greater(t162, 0), 1/(t162*(t162 + xp.abs(t159))), 0)
-    t166 = t165*(t160*t141 + t140*t164 - t161*t142)
-    t167 = t140 - t164*t166
-    t168 = t141 - t160*t166
-    t169 = t142 + t161*t166
-    t170 = t80 + t88
-    t171 = t94*(t50*t61 + t52*t41 + t55*t56 + t45*t93 + t45*t170 - t60*t78)
-    t172 = t45 - t93*t171
-    t173 = t61 - t50*t171
-    t174 = t56 - t55*t171
-    t175 = t78 + t60*t171
-    t176 = t170 - t45*t171
-    t177 = t41 - t52*t171
-    t178 = t113*(t107*t175 + t108*t176 + t109*t177 + t173*t112 - t106*t174)
-    t179 = t173 - t112*t178
-    t180 = t174 + t106*t178
-    t181 = t175 - t107*t178
-    t182 = t176 - t108*t178
-    t183 = t177 - t109*t178
-    t184 = t137*(t131*t181 + t132*t182 + t133*t183 + t180*t136)
-    t185 = t180 - t136*t184
-    t186 = t181 - t131*t184
-    t187 = t182 - t132*t184
-    t188 = t183 - t133*t184
-    t189 = t165*(t160*t187 + t186*t164 - t161*t188)
-    t190 = t186 - t164*t189
-    t191 = t187 - t160*t189
-    t192 = t188 + t161*t189
-    t193 = xp.sqrt(t191**2 + t192**2)
-    t194 = t193*xp.where(xp.greater_equal(t191, 0), xp.asarray(1, dtype=dtype), -1)
-    t195 = t191 + t194
-    t196 = xp.where(xp.greater(t193, 0), 1/(t193*(t193 + xp.abs(t191))), 0)
-    t197 = t196*(t192*t169 + t168*t195)
-    t198 = t168 - t195*t197
-    t199 = t169 - t192*t197
-    t200 = t82 + t88
-    t201 = xp.sqrt(t90 + t102**2 + t120**2 + t143**2 + t170**2 + t200**2 + 2*t83 + 2*t84 + 2*t85 + 2*t86 + 2*t87 + 2*t38**2 + 2*t69**2 + 2*t64**2 + 2*t61**2 + 2*t70**2 + 2*t56**2 + 2*t39**2 + 2*t78**2 + 2*t40**2 + 2*t41**2)
-    t202 = t94*(t50*t38 + t52*t93 + t52*t200 + t55*t39 + t60*t40 + t45*t41)
-    t203 = t52 - t93*t202
-    t204 = t38 - t50*t202
-    t205 = t39 - t55*t202
-    t206 = -t40 + t60*t202
-    t207 = t41 - t45*t202
-    t208 = t200 - t52*t202
-    t209 = t113*(t107*t206 + t108*t207 + t109*t208 + t204*t112 - t106*t205)
-    t210 = t204 - t112*t209
-    t211 = t205 + t106*t209
-    t212 = t206 - t107*t209
-    t213 = t207 - t108*t209
-    t214 = t208 - t109*t209
-    t215 = t137*(t131*t212 + t132*t213 + t133*t214 + t211*t136)
-    t216 = t211 - t136*t215
-    t217 = t212 - t131*t215
-    t218 = t213 - t132*t215
-    t219 = t214 - t133*t215
-    t220 = t165*(t160*t218 + t217*t164 - t161*t219)
-    t221 = t217 - t164*t220
-    t222 = t218 - t160*t220
-    t223 = t219 + t161*t220
-    t224 = t196*(t192*t223 + t222*t195)
-    t225 = t222 - t195*t224
-    t226 = t223 - t192*t224
-    t227 = xp.abs(t226)
+    t83 = damping**2
+    t84 = t48 + t83
+    t85 = t84**2
+    t86 = t66 + t83
+    t87 = t73 + t83
+    t88 = t76 + t83
+    t89 = t80 + t83
+    t90 = t82 + t83
+    t91 = t50**2
+    t92 = t52**2
+    t93 = t55**2
+    t94 = t60**2
+    t95 = t45**2
+    t96 = xp.sqrt(t85 + t86**2 + t87**2 + t88**2 + t89**2 + t90**2 + 2*t91 + 2*t92 + 2*t93 + 2*t94 + 2*t95 + 2*t38**2 + 2*t69**2 + 2*t64**2 + 2*t61**2 + 2*t70**2 + 2*t56**2 + 2*t39**2 + 2*t78**2 + 2*t40**2 + 2*t41**2)
+    t97 = xp.sqrt(t91 + t92 + t93 + t94 + t95 + t85)
+    t98 = t97*xp.where(xp.greater_equal(t84, 0), xp.asarray(1, dtype=dtype), -1)
+    t99 = t98 + t84
+    t100 = xp.where(xp.greater(t97, 0), 1/(t97*(t97 + xp.abs(t84))), 0)
+    t101 = t100*(t50*t99 + t50*t86 + t52*t38 + t60*t64 + t45*t61 - t55*t69)
+    t102 = t50 - t99*t101
+    t103 = t86 - t50*t101
+    t104 = t69 + t55*t101
+    t105 = -t64 + t60*t101
+    t106 = t61 - t45*t101
+    t107 = t38 - t52*t101
+    t108 = t100*(t52*t39 + t55*t99 + t55*t87 + t45*t56 - t50*t69 - t60*t70)
+    t109 = t55 - t99*t108
+    t110 = t69 + t50*t108
+    t111 = t87 - t55*t108
+    t112 = t70 + t60*t108
+    t113 = t56 - t45*t108
+    t114 = t39 - t52*t108
+    t115 = -t100*(t50*t64 + t52*t40 + t60*t99 + t60*t88 - t55*t70 - t45*t78)
+    t116 = t60 + t99*t115
+    t117 = t64 + t50*t115
+    t118 = t70 - t55*t115
+    t119 = t88 + t60*t115
+    t120 = t78 - t45*t115
+    t121 = t40 + t52*t115
+    t122 = t100*(t50*t61 + t52*t41 + t55*t56 + t45*t99 + t45*t89 - t60*t78)
+    t123 = t45 - t99*t122
+    t124 = t61 - t50*t122
+    t125 = t56 - t55*t122
+    t126 = t78 + t60*t122
+    t127 = t89 - t45*t122
+    t128 = t41 - t52*t122
+    t129 = t100*(t50*t38 + t52*t99 + t52*t90 + t55*t39 + t60*t40 + t45*t41)
+    t130 = t52 - t99*t129
+    t131 = t38 - t50*t129
+    t132 = t39 - t55*t129
+    t133 = -t40 + t60*t129
+    t134 = t41 - t45*t129
+    t135 = t90 - t52*t129
+    t136 = t100*(t50*mu_dot1 + t52*mu_dot5 + t55*mu_dot2 + t45*mu_dot4 + t99*mu_dot0 - t60*mu_dot3)
+    t137 = mu_dot0 - t99*t136
+    t138 = mu_dot1 - t50*t136
+    t139 = mu_dot2 - t55*t136
+    t140 = mu_dot3 + t60*t136
+    t141 = mu_dot4 - t45*t136
+    t142 = mu_dot5 - t52*t136
+    t143 = xp.sqrt(t103**2 + t104**2 + t105**2 + t106**2 + t107**2)
+    t144 = t143*xp.where(xp.greater_equal(t103, 0), xp.asarray(1, dtype=dtype), -1)
+    t145 = t103 + t144
+    t146 = xp.where(xp.greater(t143, 0), 1/(t143*(t143 + xp.abs(t103))), 0)
+    t147 = t146*(t105*t112 + t106*t113 + t107*t114 - t104*t111 - t110*t145)
+    t148 = t110 + t145*t147
+    t149 = t111 + t104*t147
+    t150 = t112 - t105*t147
+    t151 = t113 - t106*t147
+    t152 = t114 - t107*t147
+    t153 = -t146*(t104*t118 + t107*t121 + t117*t145 - t105*t119 - t106*t120)
+    t154 = t117 + t145*t153
+    t155 = t118 + t104*t153
+    t156 = t119 - t105*t153
+    t157 = t120 - t106*t153
+    t158 = t121 + t107*t153
+    t159 = t146*(t105*t126 + t106*t127 + t107*t128 + t124*t145 - t104*t125)
+    t160 = t124 - t145*t159
+    t161 = t125 + t104*t159
+    t162 = t126 - t105*t159
+    t163 = t127 - t106*t159
+    t164 = t128 - t107*t159
+    t165 = t146*(t105*t133 + t106*t134 + t107*t135 + t131*t145 - t104*t132)
+    t166 = t131 - t145*t165
+    t167 = t132 + t104*t165
+    t168 = t133 - t105*t165
+    t169 = t134 - t106*t165
+    t170 = t135 - t107*t165
+    t171 = t146*(t105*t140 + t106*t141 + t107*t142 + t138*t145 - t104*t139)
+    t172 = t138 - t145*t171
+    t173 = t139 + t104*t171
+    t174 = t140 - t105*t171
+    t175 = t141 - t106*t171
+    t176 = t142 - t107*t171
+    t177 = xp.sqrt(t149**2 + t150**2 + t151**2 + t152**2)
+    t178 = t177*xp.where(xp.greater_equal(t149, 0), xp.asarray(1, dtype=dtype), -1)
+    t179 = t149 + t178
+    t180 = xp.where(xp.greater(t177, 0), 1/(t177*(t177 + xp.abs(t149))), 0)
+    t181 = t180*(t150*t156 + t151*t157 + t155*t179 - t152*t158)
+    t182 = t155 - t179*t181
+    t183 = t156 - t150*t181
+    t184 = t157 - t151*t181
+    t185 = t158 + t152*t181
+    t186 = t180*(t150*t162 + t151*t163 + t152*t164 + t161*t179)
+    t187 = t161 - t179*t186
+    t188 = t162 - t150*t186
+    t189 = t163 - t151*t186
+    t190 = t164 - t152*t186
+    t191 = t180*(t150*t168 + t151*t169 + t152*t170 + t167*t179)
+    t192 = t167 - t179*t191
+    t193 = t168 - t150*t191
+    t194 = t169 - t151*t191
+    t195 = t170 - t152*t191
+    t196 = t180*(t150*t174 + t151*t175 + t152*t176 + t173*t179)
+    t197 = t173 - t179*t196
+    t198 = t174 - t150*t196
+    t199 = t175 - t151*t196
+    t200 = t176 - t152*t196
+    t201 = xp.sqrt(t183**2 + t184**2 + t185**2)
+    t202 = t201*xp.where(xp.greater_equal(t183, 0), xp.asarray(1, dtype=dtype), -1)
+    t203 = t183 + t202
+    t204 = xp.where(xp.greater(t201, 0), 1/(t201*(t201 + xp.abs(t183))), 0)
+    t205 = t204*(t184*t189 + t188*t203 - t185*t190)
+    t206 = t188 - t203*t205
+    t207 = t189 - t184*t205
+    t208 = t190 + t185*t205
+    t209 = t204*(t184*t194 + t193*t203 - t185*t195)
+    t210 = t193 - t203*t209
+    t211 = t194 - t184*t209
+    t212 = t195 + t185*t209
+    t213 = t204*(t184*t199 + t198*t203 - t185*t200)
+    t214 = t198 - t203*t213
+    t215 = t199 - t184*t213
+    t216 = t200 + t185*t213
+    t217 = xp.sqrt(t207**2 + t208**2)
+    t218 = t217*xp.where(xp.greater_equal(t207, 0), xp.asarray(1, dtype=dtype), -1)
+    t219 = t207 + t218
+    t220 = xp.where(xp.greater(t217, 0), 1/(t217*(t217 + xp.abs(t207))), 0)
+    t221 = t220*(t208*t212 + t211*t219)
+    t222 = t211 - t219*t221
+    t223 = t212 - t208*t221
+    t224 = t220*(t208*t216 + t215*t219)
+    t225 = t215 - t219*t224
+    t226 = t216 - t208*t224
+    t227 = xp.abs(t223)
     t228 = t227
-    t229 = t228*xp.where(xp.greater_equal(t226, 0), xp.asarray(1, dtype=dtype), -1)
-    t230 = t226 + t229
+    t229 = t228*xp.where(xp.greater_equal(t223, 0), xp.asarray(1, dtype=dtype), -1)
+    t230 = t223 + t229
     t231 = xp.where(xp.greater(t228, 0), 1/(t228*(t228 + t227)), 0)
-    t232 = t199 - t199*t231*t230**2
+    t232 = t226 - t226*t231*t230**2
     t233 = xp.where(xp.not_equal(t229, 0), -t232/t229, 0)
-    t234 = xp.where(xp.not_equal(t194, 0), -(t198 - t225*t233)/t194, 0)
-    t235 = xp.where(xp.not_equal(t163, 0), -(t167 - (t190*t234 + t221*t233))/t163, 0)
-    t236 = xp.where(xp.not_equal(t135, 0), -(t139 - (t158*t235 + t185*t234 + t216*t233))/t135, 0)
-    t237 = xp.where(xp.not_equal(t111, 0), -(t115 - (t179*t234 + t210*t233 - t129*t236 - t152*t235))/t111, 0)
-    t238 = xp.where(xp.not_equal(t92, 0), -(t96 - (t104*t237 + t122*t236 + t172*t234 + t203*t233 - t145*t235))/t92, 0)
+    t234 = xp.where(xp.not_equal(t218, 0), -(t225 - t222*t233)/t218, 0)
+    t235 = xp.where(xp.not_equal(t202, 0), -(t214 - (t206*t234 + t210*t233))/t202, 0)
+    t236 = xp.where(xp.not_equal(t178, 0), -(t197 - (t182*t235 + t187*t234 + t192*t233))/t178, 0)
+    t237 = xp.where(xp.not_equal(t144, 0), -(t172 - (t160*t234 + t166*t233 - t148*t236 - t154*t235))/t144, 0)
+    t238 = xp.where(xp.not_equal(t98, 0), -(t137 - (t102*t237 + t109*t236 + t123*t234 + t130*t233 - t116*t235))/t98, 0)
     t239 = t233 + t237*t32 - t238*t33
-    t240 = t233*c23 + t234*t11 + t235*t9 + t236*t17 + t238*t23 - t237*t24
-    t241 = t4*t234 + t233*t35 + t236*t18 + t237*t37 + t238*t36 - t7*t235
+    t240 = t233*c23 + t236*t17 + t238*t23 - t237*t24 + t234*t11 + t235*t9
+    t241 = t4*t234 + t236*t18 + t237*t37 + t238*t36 - t7*t235 + t233*t35
     t242 = t10*t235 + t234*t12 - t233*t0
     t243 = t22*s1
     t244 = t234*c1 - t235*s1
     t245 = t244 + t237*t243 + t238*t58 - t236*t34
     t246 = t21*s1
     t247 = t244 + t237*t246 + t238*t57 - t236*t28
-    t248 = 1 + t42 + t62
+    t248 = 1 + t62 + t42
     t249 = xp.sqrt(t47 + t65 + t72 + t75 + t79 + t81 + t248)
     t250 = xp.sqrt(t248)
     t251 = t250*xp.where(xp.less_equal(t33, 0), xp.asarray(1, dtype=dtype), -1)
@@ -1938,10 +1938,10 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t261 = t23 - t252*t260
     t262 = t24 + t260*t32
     t263 = c23 - t260
-    t264 = t253*(t35 + t252*t36 + t32*t37)
+    t264 = t253*(t252*t36 + t32*t37 + t35)
     t265 = t36 - t252*t264
     t266 = t37 - t264*t32
-    t267 = t35 - t264
+    t267 = -t264 + t35
     t268 = t253*(mu_dot5 + t252*mu_dot0 + t32*mu_dot1)
     t269 = mu_dot0 - t252*t268
     t270 = mu_dot1 - t268*t32
@@ -1962,7 +1962,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t285 = -t279*(t254*t263 + t262*t278 + t34*t17)
     t286 = t262 + t278*t285
     t287 = t17 + t285*t34
-    t288 = t9 + t285*s1
+    t288 = t285*s1 + t9
     t289 = t11 - t285*c1
     t290 = t263 + t254*t285
     t291 = t279*(t7*s1 + t4*c1 + t266*t278 - t254*t267 - t34*t18)
@@ -2018,10 +2018,10 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t341 = t340*(t336*t325 + t324*t339)
     t342 = t324 - t339*t341
     t343 = t325 - t336*t341
-    t344 = 1 + t4 + t10 + t12 + t32 + t23 + t36 + t37 + t17 + t18 + t35 + t51 + t57 + t58 + t9 + t11 + t243 + t246 + t272 + t302 + t326 + c23 + damping + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + q1 + q2 + q3 + q4 + q5 + q6 - t24 - t34 - t77 + 2*c1
+    t344 = 1 + t4 + t10 + t12 + t32 + t23 + t36 + t37 + t17 + t18 + c23 + damping + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + q1 + q2 + q3 + q4 + q5 + q6 + t326 + t272 + t51 - t24 - t34 + t302 - t77 + 2*c1 + t57 + t246 + t58 + t243 + t9 + t11 + t35
     t345 = t32*t273
-    t346 = t279*(t12*c1 + t278*t345 - t10*s1 - t254*t274)
-    t347 = t345 - t278*t346
+    t346 = t279*(t12*c1 - t10*s1 - t254*t274 + t278*t345)
+    t347 = -t278*t346 + t345
     t348 = t10 + t346*s1
     t349 = t12 - t346*c1
     t350 = t274 + t254*t346
@@ -2054,8 +2054,8 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t377 = xp.greater_equal(damping, 0)
     t378 = 1e-12*t249
     t379 = xp.greater(damping, 0)
-    t380 = 1e-12*t201
-    t381 = (t379 & (xp.less_equal(t91, t380) | xp.less_equal(t110, t380) | xp.less_equal(t134, t380) | xp.less_equal(t162, t380) | xp.less_equal(t193, t380) | xp.less_equal(t228, t380))) | (xp.less_equal(damping, 0) & (xp.less_equal(t250, t378) | xp.less_equal(t276, t378) | xp.less_equal(t304, t378) | xp.less_equal(t318, t378) | xp.less_equal(t337, t378) | xp.less_equal(t365, t378)))
+    t380 = 1e-12*t96
+    t381 = (t379 & (xp.less_equal(t97, t380) | xp.less_equal(t143, t380) | xp.less_equal(t177, t380) | xp.less_equal(t201, t380) | xp.less_equal(t217, t380) | xp.less_equal(t228, t380))) | (xp.less_equal(damping, 0) & (xp.less_equal(t250, t378) | xp.less_equal(t276, t378) | xp.less_equal(t304, t378) | xp.less_equal(t318, t378) | xp.less_equal(t337, t378) | xp.less_equal(t365, t378)))
     t382 = t376 & t377 & xp.logical_not(t381)
     q_dot = _stack(xp, [
         xp.broadcast_to(xp.where(t382, xp.where(t379, t239, t375), 0), batch),  # 0
@@ -2138,13 +2138,13 @@ def ik_numeric_step(target, q, damping=0.0):
     t24 = T21*t21 + T22*t19 - T20*t20
     t25 = 0.5*(t22 + t15)
     t26 = c4*s23
-    t27 = t26*c5 + c23*s5
-    t28 = t26*s5 - c23*c5
+    t27 = c23*s5 + t26*c5
+    t28 = -c23*c5 + t26*s5
     t29 = s23*s4
-    t30 = t29*s6 - t27*c6
+    t30 = -t27*c6 + t29*s6
     t31 = t27*s6 + t29*c6
-    t32 = t7*t29 + t11*t28 - t9*c23
-    t33 = t4*t29 + t17*c23 - t19*t28
+    t32 = t11*t28 + t7*t29 - t9*c23
+    t33 = -t19*t28 + t4*t29 + t17*c23
     t34 = T00*t30 + T02*t28 - T01*t31
     t35 = T10*t30 + T12*t28 - T11*t31
     t36 = T20*t30 + T22*t28 - T21*t31
@@ -2178,23 +2178,23 @@ def ik_numeric_step(target, q, damping=0.0):
     t64 = t62 + 0.18*c1
     t65 = t63 + 0.18*s1
     t66 = t62*c1 + t63*s1
-    t67 = t64 + t55*t29 - t54*c23
+    t67 = t64 - t54*c23 + t55*t29
     t68 = t66**2 + t60**2 + t44**2 + t45**2
     t69 = T03 - t64
     t70 = t49**2
     t71 = c1**2
     t72 = t4*t53 + t49*t71 + t50*t71 + t52*t17
     t73 = t50**2
-    t74 = t65**2 + t52**2 + t53**2 + t70*t71 + t71*t73
+    t74 = t65**2 + t52**2 + t53**2 + t70*t71 + t73*t71
     t75 = c1*s1
-    t76 = t53*t55 + t70*t75 + t73*t75 - t64*t65 - t52*t54
+    t76 = t53*t55 - t64*t65 - t52*t54 + t70*t75 + t73*t75
     t77 = -t65
     t78 = t77 + t52*c23 + t53*t29
     t79 = T13 + t77
     t80 = t60*c1
     t81 = t66*c1
     t82 = t52*t44 + t53*t45 - t49*t80 - t50*t81
-    t83 = -t80 - t81 + t4*t45 + t44*t17
+    t83 = t4*t45 - t81 - t80 + t44*t17
     t84 = t49*t75 + t50*t75
     t85 = t84 + t7*t53 - t52*t9
     t86 = t84 + t4*t55 - t54*t17
@@ -2203,11 +2203,11 @@ def ik_numeric_step(target, q, damping=0.0):
     t89 = t7*t55 + t49*t87 + t50*t87 + t54*t9
     t90 = t60*s1
     t91 = t66*s1
-    t92 = t49*t90 + t50*t91 + t54*t44 - t55*t45
-    t93 = t90 + t91 + t44*t9 - t7*t45
+    t92 = t54*t44 - t55*t45 + t49*t90 + t50*t91
+    t93 = t91 + t90 - t7*t45 + t44*t9
     t94 = s23**2
     t95 = t7**2 + t11**2 + 2*t87 + t71*t94
-    t96 = -2*t75 + t11*t19 + t75*t94 - t7*t4
+    t96 = t11*t19 - t7*t4 - 2*t75 + t75*t94
     t97 = t4**2 + t19**2 + 2*t71 + t87*t94
     t98 = 1 + t28**2 + c23**2 + t94*s4**2
     t99 = -t23
@@ -2376,8 +2376,8 @@ def ik_numeric_step(target, q, damping=0.0):
     t262 = xp.where(xp.not_equal(t137, 0), -(t141 - (t205*t259 + t235*t258 - t155*t261 - t178*t260))/t137, 0)
     t263 = xp.where(xp.not_equal(t118, 0), -(t122 - (t130*t262 + t148*t261 + t198*t259 + t228*t258 - t171*t260))/t118, 0)
     t264 = t258 + q1 + t64*t262 - t65*t263
-    t265 = q4 + t52*t263 + t258*c23 + t259*t17 + t260*t9 + t261*t44 - t54*t262
-    t266 = q5 + t4*t259 + t53*t263 + t258*t29 + t261*t45 + t262*t55 - t7*t260
+    t265 = q4 + t52*t263 + t258*c23 + t261*t44 - t54*t262 + t259*t17 + t260*t9
+    t266 = q5 + t4*t259 + t53*t263 + t261*t45 + t262*t55 - t7*t260 + t258*t29
     t267 = q6 + t11*t260 + t19*t259 - t28*t258
     t268 = t262*s1
     t269 = t263*c1
@@ -2422,17 +2422,17 @@ def ik_branches(T):
     T23 = T[..., 2, 3]
     t0 = T00 + T01 + T02 + T03 + T10 + T11 + T12 + T13 + T20 + T21 + T22 + T23
     t1 = 0.9*T00
-    t2 = T03 - (t1 + 0.335*T02)
-    t3 = t1 + 0.22*T02
+    t2 = T03 - (0.335*T02 + t1)
+    t3 = 0.22*T02 + t1
     t4 = t2 + t3
     t5 = 0.9*T10
-    t6 = T13 - (t5 + 0.335*T12)
-    t7 = t5 + 0.22*T12
+    t6 = T13 - (0.335*T12 + t5)
+    t7 = 0.22*T12 + t5
     t8 = t6 + t7
     t9 = xp.atan2(-t4, t8)
     t10 = 0.9*T20
-    t11 = T23 - (t10 + 0.335*T22)
-    t12 = t10 + 0.22*T22
+    t11 = T23 - (0.335*T22 + t10)
+    t12 = 0.22*T22 + t10
     t13 = t11 + t12
     t14 = t4**2 + t8**2
     t15 = t14
@@ -2490,10 +2490,10 @@ def ik_branches(T):
     t67 = t66 - 6.283185307179586*xp.floor(0.15915494309189535*(0.2617993877991494 + t66))
     t68 = t65 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t65))
     t69 = t68 - 6.283185307179586*xp.floor(0.15915494309189535*(0.2617993877991494 + t68))
-    t70 = 0.1900219065658609*t62
-    t71 = 0.9817798505902814*t60
+    t70 = 0.9817798505902814*t60
+    t71 = 0.1900219065658609*t62
     t72 = -(t70 + t71)
-    t73 = t71 - t70
+    t73 = t70 - t71
     t74 = 0.9817798505902814*t62
     t75 = 0.1900219065658609*t60
     t76 = t74 - t75
@@ -2544,7 +2544,7 @@ def ik_branches(T):
     t121 = t116 - t105*t120
     t122 = t121 + t117
     t123 = t113**2
-    t124 = t116 + t123 + t105**2
+    t124 = t105**2 + t123 + t116
     t125 = t120**2
     t126 = t122**2 + t123*t125
     t127 = t116 + t125
@@ -2594,7 +2594,7 @@ def ik_branches(T):
     t171 = t166 - t155*t170
     t172 = t171 + t167
     t173 = t163**2
-    t174 = t166 + t173 + t155**2
+    t174 = t155**2 + t173 + t166
     t175 = t170**2
     t176 = t172**2 + t173*t175
     t177 = t166 + t175
@@ -2642,10 +2642,10 @@ def ik_branches(T):
     t219 = t218 - 6.283185307179586*xp.floor(0.15915494309189535*(0.2617993877991494 + t218))
     t220 = t217 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t217))
     t221 = t220 - 6.283185307179586*xp.floor(0.15915494309189535*(0.2617993877991494 + t220))
-    t222 = 0.1900219065658609*t214
-    t223 = 0.9817798505902814*t212
+    t222 = 0.9817798505902814*t212
+    t223 = 0.1900219065658609*t214
     t224 = -(t222 + t223)
-    t225 = t223 - t222
+    t225 = t222 - t223
     t226 = 0.9817798505902814*t214
     t227 = 0.1900219065658609*t212
     t228 = t226 - t227
@@ -2696,7 +2696,7 @@ def ik_branches(T):
     t273 = t268 - t257*t272
     t274 = t273 + t269
     t275 = t265**2
-    t276 = t268 + t275 + t257**2
+    t276 = t257**2 + t275 + t268
     t277 = t272**2
     t278 = t274**2 + t275*t277
     t279 = t268 + t277
@@ -2746,7 +2746,7 @@ def ik_branches(T):
     t323 = t318 - t307*t322
     t324 = t323 + t319
     t325 = t315**2
-    t326 = t318 + t325 + t307**2
+    t326 = t307**2 + t325 + t318
     t327 = t322**2
     t328 = t324**2 + t325*t327
     t329 = t318 + t327
@@ -2774,64 +2774,64 @@ def ik_branches(T):
     t351 = xp.where(t129, 0, xp.atan2(-t134, t122))
     t352 = t351
     t353 = t352 - 6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t352))
-    t354 = 3.141592653589793 + t351 - 6.283185307179586*xp.ceil(0.15915494309189535*t351)
+    t354 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t351) + t351
     t355 = t354 - 6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t354))
     t356 = xp.where(t138, 0, xp.atan2(-t120, -t106))
     t357 = t356
     t358 = t357 - 6.283185307179586*xp.floor(0.15915494309189535*(2.2689280275926285 + t357))
-    t359 = t356 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t356))
+    t359 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t356)) + t356
     t360 = xp.where(xp.less_equal(t147, 1e-24*t148), 0, xp.atan2(t144, t143))
     t361 = t360
     t362 = t361 - 6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t361))
-    t363 = 3.141592653589793 + t360 - 6.283185307179586*xp.ceil(0.15915494309189535*t360)
+    t363 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t360) + t360
     t364 = t363 - 6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t363))
     t365 = -t359
     t366 = t359 + 6.283185307179586*xp.floor(0.15915494309189535*(2.2689280275926285 + t365))
     t367 = xp.where(t179, 0, xp.atan2(-t184, t172))
     t368 = t367
     t369 = t368 - 6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t368))
-    t370 = 3.141592653589793 + t367 - 6.283185307179586*xp.ceil(0.15915494309189535*t367)
+    t370 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t367) + t367
     t371 = t370 - 6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t370))
     t372 = xp.where(t188, 0, xp.atan2(-t170, -t156))
     t373 = t372
     t374 = t373 - 6.283185307179586*xp.floor(0.15915494309189535*(2.2689280275926285 + t373))
-    t375 = t372 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t372))
+    t375 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t372)) + t372
     t376 = xp.where(xp.less_equal(t197, 1e-24*t198), 0, xp.atan2(t194, t193))
     t377 = t376
     t378 = t377 - 6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t377))
-    t379 = 3.141592653589793 + t376 - 6.283185307179586*xp.ceil(0.15915494309189535*t376)
+    t379 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t376) + t376
     t380 = t379 - 6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t379))
     t381 = -t375
     t382 = t375 + 6.283185307179586*xp.floor(0.15915494309189535*(2.2689280275926285 + t381))
     t383 = xp.where(t281, 0, xp.atan2(t286, t274))
     t384 = t383
     t385 = t384 - 6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t384))
-    t386 = 3.141592653589793 + t383 - 6.283185307179586*xp.ceil(0.15915494309189535*t383)
+    t386 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t383) + t383
     t387 = t386 - 6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t386))
     t388 = xp.where(t290, 0, xp.atan2(-t272, t258))
     t389 = t388
     t390 = t389 - 6.283185307179586*xp.floor(0.15915494309189535*(2.2689280275926285 + t389))
-    t391 = t388 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t388))
+    t391 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t388)) + t388
     t392 = xp.where(xp.less_equal(t299, 1e-24*t300), 0, xp.atan2(t296, t295))
     t393 = t392
     t394 = t393 - 6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t393))
-    t395 = 3.141592653589793 + t392 - 6.283185307179586*xp.ceil(0.15915494309189535*t392)
+    t395 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t392) + t392
     t396 = t395 - 6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t395))
     t397 = -t391
     t398 = t391 + 6.283185307179586*xp.floor(0.15915494309189535*(2.2689280275926285 + t397))
     t399 = xp.where(t331, 0, xp.atan2(t336, t324))
     t400 = t399
     t401 = t400 - 6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t400))
-    t402 = 3.141592653589793 + t399 - 6.283185307179586*xp.ceil(0.15915494309189535*t399)
+    t402 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t399) + t399
     t403 = t402 - 6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t402))
     t404 = xp.where(t340, 0, xp.atan2(-t322, t308))
     t405 = t404
     t406 = t405 - 6.283185307179586*xp.floor(0.15915494309189535*(2.2689280275926285 + t405))
-    t407 = t404 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t404))
+    t407 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t404)) + t404
     t408 = xp.where(xp.less_equal(t349, 1e-24*t350), 0, xp.atan2(t346, t345))
     t409 = t408
     t410 = t409 - 6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t409))
-    t411 = 3.141592653589793 + t408 - 6.283185307179586*xp.ceil(0.15915494309189535*t408)
+    t411 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t408) + t408
     t412 = t411 - 6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t411))
     t413 = -t407
     t414 = t407 + 6.283185307179586*xp.floor(0.15915494309189535*(2.2689280275926285 + t413))

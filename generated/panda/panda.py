@@ -101,10 +101,10 @@ def fk(q):
     t11 = c3*s2
     t12 = 0.316*c2 - 0.0825*t11
     t13 = c2*s4 - t11*c4
-    t14 = t11*s4 + c2*c4
+    t14 = c2*c4 + t11*s4
     t15 = c1*s2
     t16 = t2*c4 + t15*s4
-    t17 = t15*c4 - t2*s4
+    t17 = -t2*s4 + t15*c4
     t18 = t16*c5 - t6*s5
     t19 = t16*s5 + t6*c5
     t20 = t17*s6 + t18*c6
@@ -117,7 +117,7 @@ def fk(q):
     t27 = t9 + t26
     t28 = s1*s2
     t29 = t7*c4 + t28*s4
-    t30 = t28*c4 - t7*s4
+    t30 = -t7*s4 + t28*c4
     t31 = t29*c5 + t3*s5
     t32 = t3*c5 - t29*s5
     t33 = t30*s6 + t31*c6
@@ -130,7 +130,7 @@ def fk(q):
     t40 = t10 + t39
     t41 = s2*s3
     t42 = t13*c5 + t41*s5
-    t43 = t41*c5 - t13*s5
+    t43 = -t13*s5 + t41*c5
     t44 = t14*s6 + t42*c6
     t45 = t14*c6 - t42*s6
     t46 = t44*c7 - t43*s7
@@ -143,7 +143,7 @@ def fk(q):
     t53 = 0.7071067811865476*t22
     t54 = 0.7071067811865476*t23
     t55 = t53 - t54
-    t56 = t54 + t53
+    t56 = t53 + t54
     t57 = 0.7071067811865476*t35
     t58 = 0.7071067811865476*t36
     t59 = t57 + t58
@@ -198,9 +198,9 @@ def jacobian(q):
     t6 = t4 + t5*c2
     t7 = t5 + t4*c2
     t8 = c1*s2
-    t9 = 0.316*t8 + 0.0825*t2
+    t9 = 0.0825*t2 + 0.316*t8
     t10 = t2*c4 + t8*s4
-    t11 = t8*c4 - t2*s4
+    t11 = -t2*s4 + t8*c4
     t12 = t10*c5 - t6*s5
     t13 = t10*s5 + t6*c5
     t14 = t11*s6 + t12*c6
@@ -210,9 +210,9 @@ def jacobian(q):
     t18 = t17 - 0.0825*t10
     t19 = t9 + t18
     t20 = s1*s2
-    t21 = 0.316*t20 + 0.0825*t7
+    t21 = 0.0825*t7 + 0.316*t20
     t22 = t7*c4 + t20*s4
-    t23 = t20*c4 - t7*s4
+    t23 = -t7*s4 + t20*c4
     t24 = t22*c5 + t3*s5
     t25 = t3*c5 - t22*s5
     t26 = t23*s6 + t24*c6
@@ -224,10 +224,10 @@ def jacobian(q):
     t32 = c3*s2
     t33 = 0.316*c2 - 0.0825*t32
     t34 = c2*s4 - t32*c4
-    t35 = t32*s4 + c2*c4
+    t35 = c2*c4 + t32*s4
     t36 = s2*s3
     t37 = t34*c5 + t36*s5
-    t38 = t36*c5 - t34*s5
+    t38 = -t34*s5 + t36*c5
     t39 = t35*s6 + t37*c6
     t40 = t35*c6 - t37*s6
     t41 = 0.088*t39 - 0.21*t40
@@ -239,15 +239,15 @@ def jacobian(q):
     J = _stack(xp, [
         -t31,  # 0, 0
         t45,  # 0, 1
-        t46*s2 - t31*c2,  # 0, 2
-        t30*t36 - t43*t3,  # 0, 3
+        -t31*c2 + t46*s2,  # 0, 2
+        -t43*t3 + t30*t36,  # 0, 3
         t23*t42 - t35*t29,  # 0, 4
         t38*t28 - t25*t41,  # 0, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 6
         t19,  # 1, 0
         t46,  # 1, 1
         t19*c2 - t45*s2,  # 1, 2
-        -(t18*t36 + t43*t6),  # 1, 3
+        -(t43*t6 + t18*t36),  # 1, 3
         t35*t17 - t11*t42,  # 1, 4
         -(t13*t41 + t38*t16),  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 6
@@ -310,9 +310,9 @@ def fk_jacobian(q):
     t6 = t4 + t5*c2
     t7 = t5 + t4*c2
     t8 = c1*s2
-    t9 = 0.316*t8 + 0.0825*t2
+    t9 = 0.0825*t2 + 0.316*t8
     t10 = t2*c4 + t8*s4
-    t11 = t8*c4 - t2*s4
+    t11 = -t2*s4 + t8*c4
     t12 = t10*c5 - t6*s5
     t13 = t10*s5 + t6*c5
     t14 = t11*s6 + t12*c6
@@ -324,9 +324,9 @@ def fk_jacobian(q):
     t20 = t19 - 0.0825*t10
     t21 = t9 + t20
     t22 = s1*s2
-    t23 = 0.316*t22 + 0.0825*t7
+    t23 = 0.0825*t7 + 0.316*t22
     t24 = t7*c4 + t22*s4
-    t25 = t22*c4 - t7*s4
+    t25 = -t7*s4 + t22*c4
     t26 = t24*c5 + t3*s5
     t27 = t3*c5 - t24*s5
     t28 = t25*s6 + t26*c6
@@ -340,10 +340,10 @@ def fk_jacobian(q):
     t36 = c3*s2
     t37 = 0.316*c2 - 0.0825*t36
     t38 = c2*s4 - t36*c4
-    t39 = t36*s4 + c2*c4
+    t39 = c2*c4 + t36*s4
     t40 = s2*s3
     t41 = t38*c5 + t40*s5
-    t42 = t40*c5 - t38*s5
+    t42 = -t38*s5 + t40*c5
     t43 = t39*s6 + t41*c6
     t44 = t39*c6 - t41*s6
     t45 = t43*c7 - t42*s7
@@ -391,15 +391,15 @@ def fk_jacobian(q):
     J = _stack(xp, [
         -t35,  # 0, 0
         t67,  # 0, 1
-        t68*s2 - t35*c2,  # 0, 2
-        t34*t40 - t49*t3,  # 0, 3
+        -t35*c2 + t68*s2,  # 0, 2
+        -t49*t3 + t34*t40,  # 0, 3
         t25*t48 - t39*t33,  # 0, 4
         t42*t32 - t27*t47,  # 0, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 6
         t21,  # 1, 0
         t68,  # 1, 1
         t21*c2 - t67*s2,  # 1, 2
-        -(t20*t40 + t49*t6),  # 1, 3
+        -(t49*t6 + t20*t40),  # 1, 3
         t39*t19 - t11*t48,  # 1, 4
         -(t13*t47 + t42*t18),  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 6
@@ -467,10 +467,10 @@ def jacobian_tool(q):
     t11 = c3*s2
     t12 = 0.316*c2 - 0.0825*t11
     t13 = c2*s4 - t11*c4
-    t14 = t11*s4 + c2*c4
+    t14 = c2*c4 + t11*s4
     t15 = c1*s2
     t16 = t2*c4 + t15*s4
-    t17 = t15*c4 - t2*s4
+    t17 = -t2*s4 + t15*c4
     t18 = t16*c5 - t6*s5
     t19 = t16*s5 + t6*c5
     t20 = t17*s6 + t18*c6
@@ -483,7 +483,7 @@ def jacobian_tool(q):
     t27 = t9 + t26
     t28 = s1*s2
     t29 = t7*c4 + t28*s4
-    t30 = t28*c4 - t7*s4
+    t30 = -t7*s4 + t28*c4
     t31 = t29*c5 + t3*s5
     t32 = t3*c5 - t29*s5
     t33 = t30*s6 + t31*c6
@@ -496,7 +496,7 @@ def jacobian_tool(q):
     t40 = t10 + t39
     t41 = s2*s3
     t42 = t13*c5 + t41*s5
-    t43 = t41*c5 - t13*s5
+    t43 = -t13*s5 + t41*c5
     t44 = t14*s6 + t42*c6
     t45 = t14*c6 - t42*s6
     t46 = t44*c7 - t43*s7
@@ -508,7 +508,7 @@ def jacobian_tool(q):
     t52 = 0.7071067811865476*t22
     t53 = 0.7071067811865476*t23
     t54 = t52 - t53
-    t55 = t53 + t52
+    t55 = t52 + t53
     t56 = 0.7071067811865476*t35
     t57 = 0.7071067811865476*t36
     t58 = t56 + t57
@@ -517,61 +517,61 @@ def jacobian_tool(q):
     t61 = 0.7071067811865476*t47
     t62 = t60 + t61
     t63 = t60 - t61
-    t64 = t51*c1
-    t65 = t51*s1
-    t66 = -(t27*c1 + t40*s1)
-    t67 = t51*t28 - t40*c2
+    t64 = -(t27*c1 + t40*s1)
+    t65 = t51*c1
+    t66 = t51*s1
+    t67 = -t40*c2 + t51*t28
     t68 = t27*c2 - t51*t15
     t69 = t40*t15 - t27*t28
-    t70 = t26*t3 + t39*t6
-    t71 = t39*t41 - t50*t3
-    t72 = -(t26*t41 + t50*t6)
+    t70 = -t50*t3 + t39*t41
+    t71 = -(t50*t6 + t26*t41)
+    t72 = t26*t3 + t39*t6
     t73 = t30*t49 - t14*t38
     t74 = t14*t25 - t17*t49
     t75 = t17*t38 - t30*t25
-    t76 = t19*t37 + t32*t24
-    t77 = t43*t37 - t32*t48
-    t78 = -(t19*t48 + t43*t24)
+    t76 = t43*t37 - t32*t48
+    t77 = -(t19*t48 + t43*t24)
+    t78 = t19*t37 + t32*t24
     J = _stack(xp, [
         t27*t58 - t40*t54,  # 0, 0
-        t54*t64 + t58*t65 + t62*t66,  # 0, 1
+        t62*t64 + t54*t65 + t58*t66,  # 0, 1
         t54*t67 + t58*t68 + t62*t69,  # 0, 2
-        t54*t71 + t58*t72 + t62*t70,  # 0, 3
+        t54*t70 + t58*t71 + t62*t72,  # 0, 3
         t54*t73 + t58*t74 + t62*t75,  # 0, 4
-        t54*t77 + t58*t78 + t62*t76,  # 0, 5
+        t54*t76 + t58*t77 + t62*t78,  # 0, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 6
         t27*t59 - t40*t55,  # 1, 0
-        t55*t64 + t59*t65 + t63*t66,  # 1, 1
+        t63*t64 + t55*t65 + t59*t66,  # 1, 1
         t55*t67 + t59*t68 + t63*t69,  # 1, 2
-        t55*t71 + t59*t72 + t63*t70,  # 1, 3
+        t55*t70 + t59*t71 + t63*t72,  # 1, 3
         t55*t73 + t59*t74 + t63*t75,  # 1, 4
-        t55*t77 + t59*t78 + t63*t76,  # 1, 5
+        t55*t76 + t59*t77 + t63*t78,  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 6
         t21*t40 - t34*t27,  # 2, 0
-        -(t21*t64 + t34*t65 + t45*t66),  # 2, 1
+        -(t45*t64 + t21*t65 + t34*t66),  # 2, 1
         -(t21*t67 + t34*t68 + t45*t69),  # 2, 2
-        -(t21*t71 + t34*t72 + t45*t70),  # 2, 3
+        -(t21*t70 + t34*t71 + t45*t72),  # 2, 3
         -(t21*t73 + t34*t74 + t45*t75),  # 2, 4
-        -(t21*t77 + t34*t78 + t45*t76),  # 2, 5
+        -(t21*t76 + t34*t77 + t45*t78),  # 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 6
         t62,  # 3, 0
         t58*c1 - t54*s1,  # 3, 1
-        t54*t15 + t58*t28 + t62*c2,  # 3, 2
-        -(t58*t3 + t62*t41 - t6*t54),  # 3, 3
+        t62*c2 + t54*t15 + t58*t28,  # 3, 2
+        -(t58*t3 - t6*t54 + t62*t41),  # 3, 3
         t17*t54 + t30*t58 + t14*t62,  # 3, 4
         -(t32*t58 + t43*t62 - t19*t54),  # 3, 5
         -(t21*t54 + t34*t58 + t45*t62),  # 3, 6
         t63,  # 4, 0
         t59*c1 - t55*s1,  # 4, 1
-        t55*t15 + t59*t28 + t63*c2,  # 4, 2
-        -(t59*t3 + t63*t41 - t6*t55),  # 4, 3
+        t63*c2 + t55*t15 + t59*t28,  # 4, 2
+        -(t59*t3 - t6*t55 + t63*t41),  # 4, 3
         t17*t55 + t30*t59 + t14*t63,  # 4, 4
         -(t32*t59 + t43*t63 - t19*t55),  # 4, 5
         -(t21*t55 + t34*t59 + t45*t63),  # 4, 6
         -t45,  # 5, 0
         t21*s1 - t34*c1,  # 5, 1
-        -(t21*t15 + t34*t28 + t45*c2),  # 5, 2
-        t34*t3 + t45*t41 - t21*t6,  # 5, 3
+        -(t45*c2 + t21*t15 + t34*t28),  # 5, 2
+        t34*t3 - t21*t6 + t45*t41,  # 5, 3
         -(t17*t21 + t30*t34 + t14*t45),  # 5, 4
         t32*t34 + t43*t45 - t19*t21,  # 5, 5
         t21**2 + t34**2 + t45**2,  # 5, 6
@@ -611,10 +611,10 @@ def task(q):
     t11 = c3*s2
     t12 = 0.316*c2 - 0.0825*t11
     t13 = c2*s4 - t11*c4
-    t14 = t11*s4 + c2*c4
+    t14 = c2*c4 + t11*s4
     t15 = c1*s2
     t16 = t2*c4 + t15*s4
-    t17 = t15*c4 - t2*s4
+    t17 = -t2*s4 + t15*c4
     t18 = t16*c5 - t6*s5
     t19 = t16*s5 + t6*c5
     t20 = t17*s6 + t18*c6
@@ -628,7 +628,7 @@ def task(q):
     t28 = 0.7071067811865476*t22 - 0.7071067811865476*t23
     t29 = s1*s2
     t30 = t7*c4 + t29*s4
-    t31 = t29*c4 - t7*s4
+    t31 = -t7*s4 + t29*c4
     t32 = t30*c5 + t3*s5
     t33 = t3*c5 - t30*s5
     t34 = t31*s6 + t32*c6
@@ -642,7 +642,7 @@ def task(q):
     t42 = 0.7071067811865476*t36 + 0.7071067811865476*t37
     t43 = s2*s3
     t44 = t13*c5 + t43*s5
-    t45 = t43*c5 - t13*s5
+    t45 = -t13*s5 + t43*c5
     t46 = t14*s6 + t44*c6
     t47 = t14*c6 - t44*s6
     t48 = t46*c7 - t45*s7
@@ -654,7 +654,7 @@ def task(q):
     t54 = 0.333 + t53
     t55 = 0.7071067811865476*t48
     t56 = 0.7071067811865476*t49
-    t57 = t56 + t55
+    t57 = t55 + t56
     t58 = t55 - t56
     mu = _stack(xp, [
         t27,  # 0
@@ -699,10 +699,10 @@ def task_jacobian(q):
     t11 = c3*s2
     t12 = 0.316*c2 - 0.0825*t11
     t13 = c2*s4 - t11*c4
-    t14 = t11*s4 + c2*c4
+    t14 = c2*c4 + t11*s4
     t15 = c1*s2
     t16 = t2*c4 + t15*s4
-    t17 = t15*c4 - t2*s4
+    t17 = -t2*s4 + t15*c4
     t18 = t16*c5 - t6*s5
     t19 = t16*s5 + t6*c5
     t20 = t17*s6 + t18*c6
@@ -716,7 +716,7 @@ def task_jacobian(q):
     t28 = 0.7071067811865476*t22 - 0.7071067811865476*t23
     t29 = s1*s2
     t30 = t7*c4 + t29*s4
-    t31 = t29*c4 - t7*s4
+    t31 = -t7*s4 + t29*c4
     t32 = t30*c5 + t3*s5
     t33 = t3*c5 - t30*s5
     t34 = t31*s6 + t32*c6
@@ -730,7 +730,7 @@ def task_jacobian(q):
     t42 = 0.7071067811865476*t36 + 0.7071067811865476*t37
     t43 = s2*s3
     t44 = t13*c5 + t43*s5
-    t45 = t43*c5 - t13*s5
+    t45 = -t13*s5 + t43*c5
     t46 = t14*s6 + t44*c6
     t47 = t14*c6 - t44*s6
     t48 = t46*c7 - t45*s7
@@ -742,31 +742,31 @@ def task_jacobian(q):
     t54 = 0.7071067811865476*t48 + 0.7071067811865476*t49
     t55 = t53*c1
     t56 = t53*s1
-    t57 = t42*c1
-    t58 = t28*s1
-    t59 = t28**2 + t42**2
-    t60 = 1/t59
-    t61 = t60*(t57 - t58)
+    t57 = t28**2 + t42**2
+    t58 = 1/t57
+    t59 = t42*c1
+    t60 = t28*s1
+    t61 = t58*(t59 - t60)
     t62 = t28*c1
     t63 = t42*s1
-    t64 = t60*(t62*s2 + t63*s2)
-    t65 = t60*(t6*t28 - t42*t3)
-    t66 = t60*(t17*t28 + t31*t42)
-    t67 = t60*(t19*t28 - t33*t42)
-    t68 = -t60*(t21*t28 + t35*t42)
-    t69 = 1/xp.sqrt(t59)
+    t64 = t58*(t62*s2 + t63*s2)
+    t65 = t58*(t6*t28 - t42*t3)
+    t66 = t58*(t17*t28 + t31*t42)
+    t67 = t58*(t19*t28 - t33*t42)
+    t68 = -t58*(t21*t28 + t35*t42)
+    t69 = 1/xp.sqrt(t57)
     J = _stack(xp, [
         -t41,  # 0, 0
         t55,  # 0, 1
-        t56*s2 - t41*c2,  # 0, 2
-        t40*t43 - t52*t3,  # 0, 3
+        -t41*c2 + t56*s2,  # 0, 2
+        -t52*t3 + t40*t43,  # 0, 3
         t31*t51 - t14*t39,  # 0, 4
         t45*t38 - t33*t50,  # 0, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 6
         t27,  # 1, 0
         t56,  # 1, 1
         t27*c2 - t55*s2,  # 1, 2
-        -(t26*t43 + t52*t6),  # 1, 3
+        -(t52*t6 + t26*t43),  # 1, 3
         t14*t25 - t17*t51,  # 1, 4
         -(t19*t50 + t45*t24),  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 6
@@ -786,7 +786,7 @@ def task_jacobian(q):
         t68,  # 3, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
         t69*(t62 + t63),  # 4, 1
-        t69*(t58*s2 - t57*s2),  # 4, 2
+        t69*(t60*s2 - t59*s2),  # 4, 2
         -t69*(t6*t42 + t28*t3),  # 4, 3
         t69*(t31*t28 - t17*t42),  # 4, 4
         -t69*(t19*t42 + t33*t28),  # 4, 5
@@ -837,9 +837,9 @@ def fk_jacobian_dot(q, q_dot):
     t7 = t5 + t6*c2
     t8 = t6 + t5*c2
     t9 = c1*s2
-    t10 = 0.316*t9 + 0.0825*t3
+    t10 = 0.0825*t3 + 0.316*t9
     t11 = t3*c4 + t9*s4
-    t12 = t9*c4 - t3*s4
+    t12 = -t3*s4 + t9*c4
     t13 = t11*c5 - t7*s5
     t14 = t11*s5 + t7*c5
     t15 = t12*s6 + t13*c6
@@ -851,9 +851,9 @@ def fk_jacobian_dot(q, q_dot):
     t21 = t20 - 0.0825*t11
     t22 = t10 + t21
     t23 = s1*s2
-    t24 = 0.316*t23 + 0.0825*t8
+    t24 = 0.0825*t8 + 0.316*t23
     t25 = t8*c4 + t23*s4
-    t26 = t23*c4 - t8*s4
+    t26 = -t8*s4 + t23*c4
     t27 = t25*c5 + t4*s5
     t28 = t4*c5 - t25*s5
     t29 = t26*s6 + t27*c6
@@ -867,10 +867,10 @@ def fk_jacobian_dot(q, q_dot):
     t37 = c3*s2
     t38 = 0.316*c2 - 0.0825*t37
     t39 = c2*s4 - t37*c4
-    t40 = t37*s4 + c2*c4
+    t40 = c2*c4 + t37*s4
     t41 = s2*s3
     t42 = t39*c5 + t41*s5
-    t43 = t41*c5 - t39*s5
+    t43 = -t39*s5 + t41*c5
     t44 = t40*s6 + t42*c6
     t45 = t40*c6 - t42*s6
     t46 = t44*c7 - t43*s7
@@ -895,9 +895,9 @@ def fk_jacobian_dot(q, q_dot):
     t65 = t63 + t64
     t66 = t63 - t64
     t67 = t51*s1
-    t68 = t67*s2 - t36*c2
+    t68 = -t36*c2 + t67*s2
     t69 = t68
-    t70 = t35*t41 - t50*t4
+    t70 = -t50*t4 + t35*t41
     t71 = t70
     t72 = t26*t49 - t40*t34
     t73 = t72
@@ -909,7 +909,7 @@ def fk_jacobian_dot(q, q_dot):
     t79 = t51*c1
     t80 = t22*c2 - t79*s2
     t81 = t80
-    t82 = t21*t41 + t50*t7
+    t82 = t50*t7 + t21*t41
     t83 = t82
     t84 = t40*t20 - t12*t49
     t85 = t84
@@ -1017,12 +1017,12 @@ def fk_jacobian_dot(q, q_dot):
         xp.broadcast_to(t125, batch),  # 5, 6
     ], (6, 7))
     a = _stack(xp, [
-        xp.broadcast_to(qd2*(t104*c1 - t67*qd1) + qd3*(t103*t23 + t94*t111 - t90*c2 - t81*qd1) + qd4*(t89*t41 + t83*t0 + t96*t112 - t102*t4) + qd5*(t101*t26 + t98*t113 - t88*t40 - t85*t53) + qd6*(t87*t54 + t100*t114 - t87*t121 - t100*t119) - t110*qd1, batch),  # 0
-        xp.broadcast_to(t116*qd1 + qd2*(t104*s1 + t79*qd1) + qd3*(t78*c2 + t69*qd1 + t94*t105 - t103*t9) + qd5*(t76*t40 + t73*t53 - t101*t12 - t98*t107) - qd4*(t77*t41 + t102*t7 + t96*t106 - t71*t0) - qd6*(t75*t121 + t100*t108 + t100*t117 - t75*t54), batch),  # 1
-        xp.broadcast_to(qd4*(t77*t4 + t89*t7 - t71*t112 - t83*t106) + qd5*(t88*t12 + t85*t107 - t76*t26 - t73*t113) - qd2*(t115*c1 + t109*s1) - qd3*(t78*t23 + t69*t111 + t81*t105 - t90*c1*s2) - qd6*(t75*t114 + t87*t108 + t87*t117 - t28*t75*qd6), batch),  # 2
+        xp.broadcast_to(qd2*(t104*c1 - t67*qd1) + qd3*(-t90*c2 - t81*qd1 + t103*t23 + t94*t111) + qd4*(t83*t0 + t96*t112 - t102*t4 + t89*t41) + qd5*(t101*t26 + t98*t113 - t88*t40 - t85*t53) + qd6*(t87*t54 + t100*t114 - t100*t119 - t87*t121) - t110*qd1, batch),  # 0
+        xp.broadcast_to(t116*qd1 + qd2*(t104*s1 + t79*qd1) + qd3*(t78*c2 + t69*qd1 + t94*t105 - t103*t9) - qd4*(t102*t7 + t96*t106 - t71*t0 + t77*t41) + qd5*(t76*t40 + t73*t53 - t101*t12 - t98*t107) - qd6*(t100*t108 - t75*t54 + t100*t117 + t75*t121), batch),  # 1
+        xp.broadcast_to(-qd2*(t115*c1 + t109*s1) - qd3*(t78*t23 + t69*t111 + t81*t105 - t90*c1*s2) + qd4*(t77*t4 + t89*t7 - t71*t112 - t83*t106) + qd5*(t88*t12 + t85*t107 - t76*t26 - t73*t113) - qd6*(t75*t114 + t87*t108 + t87*t117 - t28*t75*qd6), batch),  # 2
         xp.broadcast_to(qd3*(t111*c2 - t23*qd1) + qd4*(t4*t0 - t112*t41) + qd5*(t40*t113 - t26*t53) + qd6*(t28*t54 - t43*t114) + qd7*(t122*t30 - t120*t45) - t111*qd1, batch),  # 3
-        xp.broadcast_to(qd3*(t105*c2 + t9*qd1) + qd4*(t7*t0 + t106*t41) + qd5*(t12*t53 - t40*t107) + qd6*(t14*t54 + t43*t108) + qd7*(t45*t118 - t122*t16) - t105*qd1, batch),  # 4
-        xp.broadcast_to(qd5*(t26*t107 - t12*t113) + qd7*(t120*t16 - t30*t118) - qd3*(t126*c1**2 + t126*s1**2) - qd4*(t7*t112 + t4*t106) - qd6*(t14*t114 + t28*t108), batch),  # 5
+        xp.broadcast_to(qd3*(t9*qd1 + t105*c2) + qd4*(t7*t0 + t106*t41) + qd5*(t12*t53 - t40*t107) + qd6*(t14*t54 + t43*t108) + qd7*(t45*t118 - t122*t16) - t105*qd1, batch),  # 4
+        xp.broadcast_to(-qd3*(t126*c1**2 + t126*s1**2) - qd4*(t7*t112 + t4*t106) + qd5*(t26*t107 - t12*t113) - qd6*(t14*t114 + t28*t108) + qd7*(t120*t16 - t30*t118), batch),  # 5
     ], (6,))
     return T, J, a
 
@@ -1064,10 +1064,10 @@ def jacobian_dot(q, q_dot):
     t12 = c3*s2
     t13 = 0.316*c2 - 0.0825*t12
     t14 = c2*s4 - t12*c4
-    t15 = t12*s4 + c2*c4
+    t15 = c2*c4 + t12*s4
     t16 = c1*s2
     t17 = t3*c4 + t16*s4
-    t18 = t16*c4 - t3*s4
+    t18 = -t3*s4 + t16*c4
     t19 = t17*c5 - t7*s5
     t20 = t17*s5 + t7*c5
     t21 = t18*s6 + t19*c6
@@ -1078,7 +1078,7 @@ def jacobian_dot(q, q_dot):
     t26 = t10 + t25
     t27 = s1*s2
     t28 = t8*c4 + t27*s4
-    t29 = t27*c4 - t8*s4
+    t29 = -t8*s4 + t27*c4
     t30 = t28*c5 + t4*s5
     t31 = t4*c5 - t28*s5
     t32 = t29*s6 + t30*c6
@@ -1098,19 +1098,19 @@ def jacobian_dot(q, q_dot):
     t46 = t45 - t38*qd2
     t47 = s2*s3
     t48 = t14*c5 + t47*s5
-    t49 = t47*c5 - t14*s5
+    t49 = -t14*s5 + t47*c5
     t50 = t15*s6 + t48*c6
     t51 = t15*c6 - t48*s6
     t52 = 0.088*t50 - 0.21*t51
     t53 = t52 + 0.384*t15
     t54 = t53 - 0.0825*t14
     t55 = t13 + t54
-    t56 = t55*t27 - t37*c2
-    t57 = t36*t47 - t54*t4
+    t56 = -t37*c2 + t55*t27
+    t57 = -t54*t4 + t36*t47
     t58 = t29*t53 - t15*t35
     t59 = t49*t34 - t31*t52
     t60 = t26*c2 - t55*t16
-    t61 = t25*t47 + t54*t7
+    t61 = t54*t7 + t25*t47
     t62 = t15*t24 - t18*t53
     t63 = t20*t52 + t49*t23
     t64 = t0 - t47*qd4
@@ -1145,17 +1145,17 @@ def jacobian_dot(q, q_dot):
     Jd = _stack(xp, [
         xp.broadcast_to(-t77, batch),  # 0, 0
         xp.broadcast_to(t46*c1 - t55*t90, batch),  # 0, 1
-        xp.broadcast_to(t45*t27 + t39*t78 - t71*c2 - t60*qd1, batch),  # 0, 2
-        xp.broadcast_to(t69*t47 + t61*t0 + t40*t79 - t44*t4, batch),  # 0, 3
+        xp.broadcast_to(-t71*c2 - t60*qd1 + t45*t27 + t39*t78, batch),  # 0, 2
+        xp.broadcast_to(t61*t0 + t40*t79 - t44*t4 + t69*t47, batch),  # 0, 3
         xp.broadcast_to(t43*t29 + t41*t80 - t67*t15 - t62*t64, batch),  # 0, 4
-        xp.broadcast_to(t63*t65 + t42*t81 - t63*t88 - t42*t86, batch),  # 0, 5
+        xp.broadcast_to(t63*t65 + t42*t81 - t42*t86 - t63*t88, batch),  # 0, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 6
         xp.broadcast_to(t83, batch),  # 1, 0
         xp.broadcast_to(t46*s1 + t55*t91, batch),  # 1, 1
         xp.broadcast_to(t70*c2 + t56*qd1 + t39*t72 - t45*t16, batch),  # 1, 2
-        xp.broadcast_to(-(t68*t47 + t44*t7 + t40*t73 - t57*t0), batch),  # 1, 3
+        xp.broadcast_to(-(t44*t7 + t40*t73 - t57*t0 + t68*t47), batch),  # 1, 3
         xp.broadcast_to(t66*t15 + t58*t64 - t43*t18 - t41*t74, batch),  # 1, 4
-        xp.broadcast_to(-(t59*t88 + t42*t75 + t42*t84 - t59*t65), batch),  # 1, 5
+        xp.broadcast_to(-(t42*t75 - t59*t65 + t42*t84 + t59*t88), batch),  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
         xp.broadcast_to(-(t82*c1 + t76*s1), batch),  # 2, 1
@@ -1227,10 +1227,10 @@ def bias_acceleration(q, q_dot):
     t12 = c3*s2
     t13 = 0.316*c2 - 0.0825*t12
     t14 = c2*s4 - t12*c4
-    t15 = t12*s4 + c2*c4
+    t15 = c2*c4 + t12*s4
     t16 = c1*s2
     t17 = t3*c4 + t16*s4
-    t18 = t16*c4 - t3*s4
+    t18 = -t3*s4 + t16*c4
     t19 = t17*c5 - t7*s5
     t20 = t17*s5 + t7*c5
     t21 = t18*s6 + t19*c6
@@ -1241,7 +1241,7 @@ def bias_acceleration(q, q_dot):
     t26 = t10 + t25
     t27 = s1*s2
     t28 = t8*c4 + t27*s4
-    t29 = t27*c4 - t8*s4
+    t29 = -t8*s4 + t27*c4
     t30 = t28*c5 + t4*s5
     t31 = t4*c5 - t28*s5
     t32 = t29*s6 + t30*c6
@@ -1261,19 +1261,19 @@ def bias_acceleration(q, q_dot):
     t46 = t45 - t38*qd2
     t47 = s2*s3
     t48 = t14*c5 + t47*s5
-    t49 = t47*c5 - t14*s5
+    t49 = -t14*s5 + t47*c5
     t50 = t15*s6 + t48*c6
     t51 = t15*c6 - t48*s6
     t52 = 0.088*t50 - 0.21*t51
     t53 = t52 + 0.384*t15
     t54 = t53 - 0.0825*t14
     t55 = t13 + t54
-    t56 = t55*t27 - t37*c2
-    t57 = t36*t47 - t54*t4
+    t56 = -t37*c2 + t55*t27
+    t57 = -t54*t4 + t36*t47
     t58 = t29*t53 - t15*t35
     t59 = t49*t34 - t31*t52
     t60 = t26*c2 - t55*t16
-    t61 = t25*t47 + t54*t7
+    t61 = t54*t7 + t25*t47
     t62 = t15*t24 - t18*t53
     t63 = t20*t52 + t49*t23
     t64 = t0 - t47*qd4
@@ -1305,12 +1305,12 @@ def bias_acceleration(q, q_dot):
     t90 = t55*qd1
     t91 = qd2*s2
     a = _stack(xp, [
-        xp.broadcast_to(qd2*(t46*c1 - t90*s1) + qd3*(t45*t27 + t39*t78 - t71*c2 - t60*qd1) + qd4*(t69*t47 + t61*t0 + t40*t79 - t44*t4) + qd5*(t43*t29 + t41*t80 - t67*t15 - t62*t64) + qd6*(t63*t65 + t42*t81 - t63*t88 - t42*t86) - t77*qd1, batch),  # 0
-        xp.broadcast_to(t83*qd1 + qd2*(t46*s1 + t90*c1) + qd3*(t70*c2 + t56*qd1 + t39*t72 - t45*t16) + qd5*(t66*t15 + t58*t64 - t43*t18 - t41*t74) - qd4*(t68*t47 + t44*t7 + t40*t73 - t57*t0) - qd6*(t59*t88 + t42*t75 + t42*t84 - t59*t65), batch),  # 1
-        xp.broadcast_to(qd4*(t68*t4 + t69*t7 - t57*t79 - t61*t73) + qd5*(t67*t18 + t62*t74 - t66*t29 - t58*t80) - qd2*(t82*c1 + t76*s1) - qd3*(t70*t27 + t56*t78 + t60*t72 - t71*c1*s2) - qd6*(t59*t81 + t63*t75 + t63*t84 - t31*t59*qd6), batch),  # 2
+        xp.broadcast_to(qd2*(t46*c1 - t90*s1) + qd3*(-t71*c2 - t60*qd1 + t45*t27 + t39*t78) + qd4*(t61*t0 + t40*t79 - t44*t4 + t69*t47) + qd5*(t43*t29 + t41*t80 - t67*t15 - t62*t64) + qd6*(t63*t65 + t42*t81 - t42*t86 - t63*t88) - t77*qd1, batch),  # 0
+        xp.broadcast_to(t83*qd1 + qd2*(t46*s1 + t90*c1) + qd3*(t70*c2 + t56*qd1 + t39*t72 - t45*t16) - qd4*(t44*t7 + t40*t73 - t57*t0 + t68*t47) + qd5*(t66*t15 + t58*t64 - t43*t18 - t41*t74) - qd6*(t42*t75 - t59*t65 + t42*t84 + t59*t88), batch),  # 1
+        xp.broadcast_to(-qd2*(t82*c1 + t76*s1) - qd3*(t70*t27 + t56*t78 + t60*t72 - t71*c1*s2) + qd4*(t68*t4 + t69*t7 - t57*t79 - t61*t73) + qd5*(t67*t18 + t62*t74 - t66*t29 - t58*t80) - qd6*(t59*t81 + t63*t75 + t63*t84 - t31*t59*qd6), batch),  # 2
         xp.broadcast_to(qd3*(t78*c2 - t27*qd1) + qd4*(t4*t0 - t79*t47) + qd5*(t15*t80 - t29*t64) + qd6*(t31*t65 - t49*t81) + qd7*(t89*t33 - t87*t51) - t78*qd1, batch),  # 3
         xp.broadcast_to(qd3*(t16*qd1 + t72*c2) + qd4*(t7*t0 + t73*t47) + qd5*(t18*t64 - t15*t74) + qd6*(t20*t65 + t49*t75) + qd7*(t51*t85 - t89*t22) - t72*qd1, batch),  # 4
-        xp.broadcast_to(qd5*(t29*t74 - t18*t80) + qd7*(t87*t22 - t33*t85) - qd3*(t91*c1**2 + t91*s1**2) - qd4*(t7*t79 + t4*t73) - qd6*(t20*t81 + t31*t75), batch),  # 5
+        xp.broadcast_to(-qd3*(t91*c1**2 + t91*s1**2) - qd4*(t7*t79 + t4*t73) + qd5*(t29*t74 - t18*t80) - qd6*(t20*t81 + t31*t75) + qd7*(t87*t22 - t33*t85), batch),  # 5
     ], (6,))
     return a
 
@@ -1354,10 +1354,10 @@ def task_jacobian_dot(q, q_dot):
     t11 = c3*s2
     t12 = 0.316*c2 - 0.0825*t11
     t13 = c2*s4 - t11*c4
-    t14 = t11*s4 + c2*c4
+    t14 = c2*c4 + t11*s4
     t15 = c1*s2
     t16 = t2*c4 + t15*s4
-    t17 = t15*c4 - t2*s4
+    t17 = -t2*s4 + t15*c4
     t18 = t16*c5 - t6*s5
     t19 = t16*s5 + t6*c5
     t20 = t17*s6 + t18*c6
@@ -1371,7 +1371,7 @@ def task_jacobian_dot(q, q_dot):
     t28 = 0.7071067811865476*t22 - 0.7071067811865476*t23
     t29 = s1*s2
     t30 = t7*c4 + t29*s4
-    t31 = t29*c4 - t7*s4
+    t31 = -t7*s4 + t29*c4
     t32 = t30*c5 + t3*s5
     t33 = t3*c5 - t30*s5
     t34 = t31*s6 + t32*c6
@@ -1394,7 +1394,7 @@ def task_jacobian_dot(q, q_dot):
     t51 = t50 - t43*qd2
     t52 = s2*s3
     t53 = t13*c5 + t52*s5
-    t54 = t52*c5 - t13*s5
+    t54 = -t13*s5 + t52*c5
     t55 = t14*s6 + t53*c6
     t56 = t14*c6 - t53*s6
     t57 = t55*c7 - t54*s7
@@ -1404,12 +1404,12 @@ def task_jacobian_dot(q, q_dot):
     t61 = t60 - 0.0825*t13
     t62 = t12 + t61
     t63 = 0.7071067811865476*t57 + 0.7071067811865476*t58
-    t64 = t62*t29 - t41*c2
-    t65 = t40*t52 - t61*t3
+    t64 = -t41*c2 + t62*t29
+    t65 = -t61*t3 + t40*t52
     t66 = t31*t60 - t14*t39
     t67 = t54*t38 - t33*t59
     t68 = t27*c2 - t62*t15
-    t69 = t26*t52 + t61*t6
+    t69 = t61*t6 + t26*t52
     t70 = t14*t25 - t17*t60
     t71 = t19*t59 + t54*t24
     t72 = t66*qd5 + t67*qd6
@@ -1428,7 +1428,7 @@ def task_jacobian_dot(q, q_dot):
     t85 = c1*qd2
     t86 = t76 + t62*t85
     t87 = t86 - t41*qd1
-    t88 = t50*t29 + t44*t85 - t77*c2 - t68*qd1
+    t88 = -t77*c2 - t68*qd1 + t50*t29 + t44*t85
     t89 = t86*c1 + t79*s1
     t90 = t76*t29 + t64*t85 + t68*t78 - t77*t15
     t91 = t85*c2 - t29*qd1
@@ -1438,8 +1438,8 @@ def task_jacobian_dot(q, q_dot):
     t95 = t6*t93 + t3*t84
     t96 = qd1 + c2*qd3
     t97 = t96
-    t98 = t75*t52 + t69*t97 + t45*t93 - t49*t3
-    t99 = t74*t52 + t49*t6 + t45*t84 - t65*t97
+    t98 = t69*t97 + t45*t93 - t49*t3 + t75*t52
+    t99 = t49*t6 + t45*t84 - t65*t97 + t74*t52
     t100 = t3*t97 - t93*t52
     t101 = t6*t97 + t84*t52
     t102 = t6*qd4
@@ -1474,8 +1474,8 @@ def task_jacobian_dot(q, q_dot):
     t131 = t92 + t104 + t116 + t128 - t35*qd7
     t132 = t125*t42 - t131*t28
     t133 = t54*qd6
-    t134 = t71*t120 + t47*t117 - t71*t133 - t47*t126
-    t135 = t67*t133 + t47*t115 + t47*t123 - t67*t120
+    t134 = t71*t120 + t47*t117 - t47*t126 - t71*t133
+    t135 = t47*t115 - t67*t120 + t47*t123 + t67*t133
     t136 = -t133
     t137 = t120 + t136
     t138 = t137*t35 - t129*t56
@@ -1490,76 +1490,76 @@ def task_jacobian_dot(q, q_dot):
     t147 = t146*c1**2 + t146*s1**2
     t148 = t28**2 + t42**2
     t149 = 1/t148
-    t150 = t149*c1
-    t151 = t28*qd1
-    t152 = t149*s1
-    t153 = t42*qd1
-    t154 = t42*c1
-    t155 = t28*s1
-    t156 = t154 - t155
-    t157 = 2/t148**2
-    t158 = t156*t157
-    t159 = t42*t158
-    t160 = t28*t158
-    t161 = t28*t149
-    t162 = t91*t161
-    t163 = t42*t149
-    t164 = t82*t163
-    t165 = t150*s2
-    t166 = t28*c1
-    t167 = t42*s1
-    t168 = t166*s2 + t167*s2
-    t169 = t157*t168
-    t170 = t28*t169
-    t171 = t152*s2
-    t172 = t42*t169
-    t173 = t100*t161
-    t174 = t101*t163
-    t175 = t6*t149
-    t176 = t6*t28 - t42*t3
-    t177 = t157*t176
-    t178 = t28*t177
-    t179 = t3*t149
-    t180 = t42*t177
-    t181 = t112*t161
-    t182 = t113*t163
-    t183 = t17*t149
-    t184 = t17*t28 + t31*t42
-    t185 = t157*t184
-    t186 = t28*t185
-    t187 = t31*t149
-    t188 = t42*t185
-    t189 = t121*t161
-    t190 = t122*t163
-    t191 = t19*t149
-    t192 = t19*t28 - t33*t42
-    t193 = t157*t192
-    t194 = t28*t193
-    t195 = t33*t149
-    t196 = t42*t193
-    t197 = t138*t161
-    t198 = t139*t163
-    t199 = t21*t149
-    t200 = -(t21*t28 + t35*t42)
-    t201 = t157*t200
-    t202 = t28*t201
-    t203 = t35*t149
-    t204 = t42*t201
+    t150 = s1*t149
+    t151 = t42*c1
+    t152 = t28*s1
+    t153 = t151 - t152
+    t154 = 2/t148**2
+    t155 = t153*t154
+    t156 = t28*t155
+    t157 = c1*t149
+    t158 = t42*t155
+    t159 = t28*qd1
+    t160 = t42*qd1
+    t161 = t157*s2
+    t162 = t28*c1
+    t163 = t42*s1
+    t164 = t162*s2 + t163*s2
+    t165 = t154*t164
+    t166 = t28*t165
+    t167 = t150*s2
+    t168 = t42*t165
+    t169 = t28*t149
+    t170 = t91*t169
+    t171 = t42*t149
+    t172 = t82*t171
+    t173 = t6*t149
+    t174 = t6*t28 - t42*t3
+    t175 = t154*t174
+    t176 = t28*t175
+    t177 = t3*t149
+    t178 = t42*t175
+    t179 = t100*t169
+    t180 = t101*t171
+    t181 = t17*t149
+    t182 = t17*t28 + t31*t42
+    t183 = t154*t182
+    t184 = t28*t183
+    t185 = t31*t149
+    t186 = t42*t183
+    t187 = t112*t169
+    t188 = t113*t171
+    t189 = t19*t149
+    t190 = t19*t28 - t33*t42
+    t191 = t154*t190
+    t192 = t28*t191
+    t193 = t33*t149
+    t194 = t42*t191
+    t195 = t121*t169
+    t196 = t122*t171
+    t197 = t21*t149
+    t198 = -(t21*t28 + t35*t42)
+    t199 = t154*t198
+    t200 = t28*t199
+    t201 = t35*t149
+    t202 = t42*t199
+    t203 = t138*t169
+    t204 = t139*t171
     t205 = 1/xp.sqrt(t148)
-    t206 = t205*qd1
-    t207 = t205*c1
-    t208 = 1/t148**1.5
-    t209 = t208*(t166 + t167)
-    t210 = t205*s1
-    t211 = t28*t205
-    t212 = t42*t205
-    t213 = t208*(t155*s2 - t154*s2)
-    t214 = -t208*(t6*t42 + t28*t3)
-    t215 = t208*(t31*t28 - t17*t42)
-    t216 = -t208*(t19*t42 + t33*t28)
-    t217 = t208*(t21*t42 - t35*t28)
+    t206 = c1*t205
+    t207 = 1/t148**1.5
+    t208 = t207*(t162 + t163)
+    t209 = s1*t205
+    t210 = t205*qd1
+    t211 = t207*(t152*s2 - t151*s2)
+    t212 = t28*t205
+    t213 = t42*t205
+    t214 = -t207*(t6*t42 + t28*t3)
+    t215 = t207*(t31*t28 - t17*t42)
+    t216 = -t207*(t19*t42 + t33*t28)
+    t217 = t207*(t21*t42 - t35*t28)
     t218 = t63*t150
-    t219 = t63*t152
+    t219 = t63*t157
     t220 = t132*t149
     Jd = _stack(xp, [
         xp.broadcast_to(-t80, batch),  # 0, 0
@@ -1584,26 +1584,26 @@ def task_jacobian_dot(q, q_dot):
         xp.broadcast_to(-t127, batch),  # 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
-        xp.broadcast_to(t142*(t150 - t159) - t141*(t152 + t160) - t150*t151 - t152*t153, batch),  # 3, 1
-        xp.broadcast_to(t162 + t164 + t141*(t165 - t170) + t142*(t171 - t172), batch),  # 3, 2
-        xp.broadcast_to(t173 + t174 + t141*(t175 - t178) - t142*(t179 + t180), batch),  # 3, 3
-        xp.broadcast_to(t181 + t182 + t141*(t183 - t186) + t142*(t187 - t188), batch),  # 3, 4
-        xp.broadcast_to(t189 + t190 + t141*(t191 - t194) - t142*(t195 + t196), batch),  # 3, 5
-        xp.broadcast_to(t197 + t198 - t141*(t199 + t202) - t142*(t203 + t204), batch),  # 3, 6
+        xp.broadcast_to(-t141*(t150 + t156) + t142*(t157 - t158) - t157*t159 - t150*t160, batch),  # 3, 1
+        xp.broadcast_to(t141*(t161 - t166) + t142*(t167 - t168) + t170 + t172, batch),  # 3, 2
+        xp.broadcast_to(t141*(t173 - t176) - t142*(t177 + t178) + t179 + t180, batch),  # 3, 3
+        xp.broadcast_to(t141*(t181 - t184) + t142*(t185 - t186) + t187 + t188, batch),  # 3, 4
+        xp.broadcast_to(t141*(t189 - t192) - t142*(t193 + t194) + t195 + t196, batch),  # 3, 5
+        xp.broadcast_to(-t141*(t197 + t200) - t142*(t201 + t202) + t203 + t204, batch),  # 3, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
-        xp.broadcast_to(t141*(t207 - t28*t209) + t142*(t210 - t42*t209) + t154*t206 - t155*t206, batch),  # 4, 1
-        xp.broadcast_to(t82*t211 + t141*(t210*s2 - t28*t213) - t91*t212 - t142*(t42*t213 + t207*s2), batch),  # 4, 2
-        xp.broadcast_to(t101*t211 - t100*t212 - t141*(t28*t214 + t3*t205) - t142*(t6*t205 + t42*t214), batch),  # 4, 3
-        xp.broadcast_to(t113*t211 + t141*(t31*t205 - t28*t215) - t112*t212 - t142*(t17*t205 + t42*t215), batch),  # 4, 4
-        xp.broadcast_to(t122*t211 - t121*t212 - t141*(t33*t205 + t28*t216) - t142*(t19*t205 + t42*t216), batch),  # 4, 5
-        xp.broadcast_to(t139*t211 + t142*(t21*t205 - t42*t217) - t138*t212 - t141*(t35*t205 + t28*t217), batch),  # 4, 6
+        xp.broadcast_to(t141*(t206 - t28*t208) + t142*(t209 - t42*t208) + t151*t210 - t152*t210, batch),  # 4, 1
+        xp.broadcast_to(t141*(t209*s2 - t28*t211) - t142*(t42*t211 + t206*s2) + t82*t212 - t91*t213, batch),  # 4, 2
+        xp.broadcast_to(-t141*(t3*t205 + t28*t214) - t142*(t6*t205 + t42*t214) + t101*t212 - t100*t213, batch),  # 4, 3
+        xp.broadcast_to(t141*(t31*t205 - t28*t215) - t142*(t17*t205 + t42*t215) + t113*t212 - t112*t213, batch),  # 4, 4
+        xp.broadcast_to(-t141*(t33*t205 + t28*t216) - t142*(t19*t205 + t42*t216) + t122*t212 - t121*t213, batch),  # 4, 5
+        xp.broadcast_to(-t141*(t35*t205 + t28*t217) + t142*(t21*t205 - t42*t217) + t139*t212 - t138*t213, batch),  # 4, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 0
-        xp.broadcast_to(t141*(t219 + t63*t160) + t142*(-t218 + t63*t159) + t151*t218 + t153*t219 - t156*t220, batch),  # 5, 1
-        xp.broadcast_to(-(t147 + t63*t162 + t63*t164 + t168*t220 - t141*(t63*t170 - t63*t165) - t142*(t63*t172 - t63*t171)), batch),  # 5, 2
-        xp.broadcast_to(-(t95 + t63*t173 + t63*t174 + t176*t220 - t141*(t63*t178 - t63*t175) - t142*(t63*t179 + t63*t180)), batch),  # 5, 3
-        xp.broadcast_to(t107 + t141*(t63*t186 - t63*t183) + t142*(t63*t188 - t63*t187) - t63*t181 - t63*t182 - t184*t220, batch),  # 5, 4
-        xp.broadcast_to(-(t118 + t63*t189 + t63*t190 + t192*t220 - t141*(t63*t194 - t63*t191) - t142*(t63*t195 + t63*t196)), batch),  # 5, 5
-        xp.broadcast_to(t130 + t141*(t63*t199 + t63*t202) + t142*(t63*t203 + t63*t204) - t63*t197 - t63*t198 - t200*t220, batch),  # 5, 6
+        xp.broadcast_to(t141*(t218 + t63*t156) + t142*(-t219 + t63*t158) - t153*t220 + t159*t219 + t160*t218, batch),  # 5, 1
+        xp.broadcast_to(-(t147 - t141*(-t63*t161 + t63*t166) - t142*(-t63*t167 + t63*t168) + t164*t220 + t63*t170 + t63*t172), batch),  # 5, 2
+        xp.broadcast_to(-(t95 - t141*(-t63*t173 + t63*t176) - t142*(t63*t177 + t63*t178) + t174*t220 + t63*t179 + t63*t180), batch),  # 5, 3
+        xp.broadcast_to(t107 + t141*(-t63*t181 + t63*t184) + t142*(-t63*t185 + t63*t186) - t182*t220 - t63*t187 - t63*t188, batch),  # 5, 4
+        xp.broadcast_to(-(t118 - t141*(-t63*t189 + t63*t192) - t142*(t63*t193 + t63*t194) + t190*t220 + t63*t195 + t63*t196), batch),  # 5, 5
+        xp.broadcast_to(t130 + t141*(t63*t197 + t63*t200) + t142*(t63*t201 + t63*t202) - t198*t220 - t63*t203 - t63*t204, batch),  # 5, 6
     ], (6, 7))
     return Jd
 
@@ -1633,9 +1633,9 @@ def hessian(q):
     t6 = t4 + t5*c2
     t7 = t5 + t4*c2
     t8 = c1*s2
-    t9 = 0.316*t8 + 0.0825*t2
+    t9 = 0.0825*t2 + 0.316*t8
     t10 = t2*c4 + t8*s4
-    t11 = t8*c4 - t2*s4
+    t11 = -t2*s4 + t8*c4
     t12 = t10*c5 - t6*s5
     t13 = t10*s5 + t6*c5
     t14 = t11*s6 + t12*c6
@@ -1645,9 +1645,9 @@ def hessian(q):
     t18 = t17 - 0.0825*t10
     t19 = t9 + t18
     t20 = s1*s2
-    t21 = 0.316*t20 + 0.0825*t7
+    t21 = 0.0825*t7 + 0.316*t20
     t22 = t7*c4 + t20*s4
-    t23 = t20*c4 - t7*s4
+    t23 = -t7*s4 + t20*c4
     t24 = t22*c5 + t3*s5
     t25 = t3*c5 - t22*s5
     t26 = t23*s6 + t24*c6
@@ -1664,24 +1664,24 @@ def hessian(q):
     t37 = c3*s2
     t38 = 0.316*c2 - 0.0825*t37
     t39 = c2*s4 - t37*c4
-    t40 = t37*s4 + c2*c4
+    t40 = c2*c4 + t37*s4
     t41 = s2*s3
     t42 = t39*c5 + t41*s5
-    t43 = t41*c5 - t39*s5
+    t43 = -t39*s5 + t41*c5
     t44 = t40*s6 + t42*c6
     t45 = t40*c6 - t42*s6
     t46 = 0.088*t44 - 0.21*t45
     t47 = t46 + 0.384*t40
     t48 = t47 - 0.0825*t39
     t49 = t38 + t48
-    t50 = t30*t41 - t48*t3
+    t50 = -t48*t3 + t30*t41
     t51 = t23*t47 - t40*t29
     t52 = t43*t28 - t25*t46
-    t53 = t18*t41 + t48*t6
+    t53 = t48*t6 + t18*t41
     t54 = t40*t17 - t11*t47
     t55 = t13*t46 + t43*t16
     t56 = t49*s1
-    t57 = t56*s2 - t31*c2
+    t57 = -t31*c2 + t56*s2
     t58 = t49*c1
     t59 = t19*c2 - t58*s2
     t60 = -t56
@@ -1702,7 +1702,7 @@ def hessian(q):
     t75 = -(t51*c1 + t54*s1)
     t76 = t55*s1 - t52*c1
     t77 = t53*c2 + t34*t20
-    t78 = t35*t20 - t54*c2
+    t78 = -t54*c2 + t35*t20
     t79 = t55*c2 + t36*t20
     t80 = t50*c2 - t34*t8
     t81 = t51*c2 - t35*t8
@@ -1711,8 +1711,8 @@ def hessian(q):
     t84 = t54*t8 - t51*t20
     t85 = -(t52*t20 + t55*t8)
     t86 = s2**2
-    t87 = t54*t41 - t35*t3
-    t88 = -(t55*t41 + t36*t3)
+    t87 = -t35*t3 + t54*t41
+    t88 = -(t36*t3 + t55*t41)
     t89 = -(t6*t35 + t51*t41)
     t90 = -(t6*t36 + t52*t41)
     t91 = t6*t54 + t51*t3
@@ -1800,14 +1800,14 @@ def hessian(q):
         -t45*s1,  # 1, 4, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5, 1
-        -(t71*s2 + t72*s2),  # 1, 5, 2
+        -(s2*t71 + s2*t72),  # 1, 5, 2
         t3*s1 - t6*c1,  # 1, 5, 3
         -(t11*c1 + t23*s1),  # 1, 5, 4
         t25*s1 - t13*c1,  # 1, 5, 5
         t15*c1 + t27*s1,  # 1, 5, 6
         t61,  # 2, 0, 0
         t63,  # 2, 0, 1
-        t33*t20 - t59*c2,  # 2, 0, 2
+        -t59*c2 + t33*t20,  # 2, 0, 2
         t77,  # 2, 0, 3
         t78,  # 2, 0, 4
         t79,  # 2, 0, 5
@@ -1830,7 +1830,7 @@ def hessian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 3, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 3, 2
         t3*c2 - t0*t86,  # 2, 3, 3
-        t40*t20 - t23*c2,  # 2, 3, 4
+        -t23*c2 + t40*t20,  # 2, 3, 4
         t25*c2 - t43*t20,  # 2, 3, 5
         t27*c2 - t45*t20,  # 2, 3, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 4, 0
@@ -1839,7 +1839,7 @@ def hessian(q):
         t6*c2 + t5*t86,  # 2, 4, 3
         t11*c2 - t40*t8,  # 2, 4, 4
         t13*c2 + t43*t8,  # 2, 4, 5
-        t45*t8 - t15*c2,  # 2, 4, 6
+        -t15*c2 + t45*t8,  # 2, 4, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 5, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 5, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 5, 2
@@ -1850,7 +1850,7 @@ def hessian(q):
         t53,  # 3, 0, 0
         t64,  # 3, 0, 1
         t77,  # 3, 0, 2
-        -(t53*t41 + t34*t3),  # 3, 0, 3
+        -(t34*t3 + t53*t41),  # 3, 0, 3
         t87,  # 3, 0, 4
         t88,  # 3, 0, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0, 6
@@ -1872,16 +1872,16 @@ def hessian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 3, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 3, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 3, 3
-        t23*t41 - t40*t3,  # 3, 3, 4
+        -t40*t3 + t23*t41,  # 3, 3, 4
         t43*t3 - t25*t41,  # 3, 3, 5
         t45*t3 - t27*t41,  # 3, 3, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 4, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 4, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 4, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 4, 3
-        -(t11*t41 + t40*t6),  # 3, 4, 4
+        -(t40*t6 + t11*t41),  # 3, 4, 4
         t43*t6 - t13*t41,  # 3, 4, 5
-        t15*t41 + t45*t6,  # 3, 4, 6
+        t45*t6 + t15*t41,  # 3, 4, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 5, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 5, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 5, 2
@@ -2049,10 +2049,10 @@ def singularity_factors(q):
     t11 = c3*s2
     t12 = 0.316*c2 - 0.0825*t11
     t13 = c2*s4 - t11*c4
-    t14 = t11*s4 + c2*c4
+    t14 = c2*c4 + t11*s4
     t15 = c1*s2
     t16 = t2*c4 + t15*s4
-    t17 = t15*c4 - t2*s4
+    t17 = -t2*s4 + t15*c4
     t18 = t16*c5 - t6*s5
     t19 = t16*s5 + t6*c5
     t20 = t17*s6 + t18*c6
@@ -2063,7 +2063,7 @@ def singularity_factors(q):
     t25 = t9 + t24
     t26 = s1*s2
     t27 = t7*c4 + t26*s4
-    t28 = t26*c4 - t7*s4
+    t28 = -t7*s4 + t26*c4
     t29 = t27*c5 + t3*s5
     t30 = t3*c5 - t27*s5
     t31 = t28*s6 + t29*c6
@@ -2079,133 +2079,133 @@ def singularity_factors(q):
     t41 = t19*t33 + t30*t22
     t42 = s2*s3
     t43 = t13*c5 + t42*s5
-    t44 = t42*c5 - t13*s5
+    t44 = -t13*s5 + t42*c5
     t45 = t14*s6 + t43*c6
     t46 = t14*c6 - t43*s6
     t47 = 0.088*t45 - 0.21*t46
     t48 = t47 + 0.384*t14
     t49 = t48 - 0.0825*t13
     t50 = t12 + t49
-    t51 = t50*t26 - t36*c2
-    t52 = t35*t42 - t49*t3
+    t51 = -t36*c2 + t50*t26
+    t52 = -t49*t3 + t35*t42
     t53 = t28*t48 - t14*t34
     t54 = t44*t33 - t30*t47
     t55 = t25*c2 - t50*t15
-    t56 = t24*t42 + t49*t6
+    t56 = t49*t6 + t24*t42
     t57 = t14*t23 - t17*t48
     t58 = t19*t47 + t44*t22
-    t59 = t19*t3 - t30*t6
-    t60 = t19*c1
-    t61 = -t60 + t30*s1
-    t62 = t6*c1
-    t63 = -t62 + t3*s1
-    t64 = t37*t59 + t39*t61 - t41*t63
-    t65 = t17*t3 + t28*t6
-    t66 = t17*c1
-    t67 = -(t66 + t28*s1)
-    t68 = t37*t65 + t39*t67 - t40*t63
-    t69 = -(t17*t30 + t28*t19)
-    t70 = t37*t69 + t40*t61 - t41*t67
-    t71 = -(t39*t69 + t41*t65 - t40*t59)
-    t72 = t50*s1
-    t73 = t14*t30 - t28*t44
-    t74 = t14*t60 + t44*t66 - t73*s1
-    t75 = t5*s2
-    t76 = t44*t3 - t30*t42
-    t77 = -(t19*t75 + t76*s1 - t44*t6*c1)
-    t78 = t28*t42 - t14*t3
-    t79 = -(t17*t75 + t14*t62 + t78*s1)
-    t80 = t19*t78 + t6*t73 - t17*t76
-    t81 = -(t37*t80 + t39*t74 + t41*t79 - t40*t77)
-    t82 = -(t19*t26 + t30*t15)
-    t83 = c1**2
-    t84 = t83*s2
-    t85 = -(t84 + s2*s1**2)
-    t86 = t37*t82 + t38*t61 - t41*t85
-    t87 = t28*t15 - t17*t26
-    t88 = t37*t87 + t38*t67 - t40*t85
-    t89 = -(t38*t69 + t41*t87 - t40*t82)
-    t90 = t30*c2 - t44*t26
-    t91 = t44*t84 + t60*c2 - t90*s1
-    t92 = t14*t26 - t28*c2
-    t93 = -(t14*t84 + t92*s1 - t17*c1*c2)
-    t94 = t19*t92 + t73*t15 - t17*t90
-    t95 = -(t37*t94 + t38*t74 + t41*t93 - t40*t91)
-    t96 = -(t6*t26 + t3*t15)
-    t97 = -(t38*t65 + t40*t96 - t39*t87)
-    t98 = t37*t96 + t38*t63 - t39*t85
-    t99 = s2**2
-    t100 = t3*c2 - t0*t99
-    t101 = t62*c2 - t100*s1 + t83*t99*s3
-    t102 = t17*t100 + t78*t15 - t6*t92
-    t103 = -(t37*t102 + t38*t79 + t40*t101 - t39*t93)
-    t104 = -(t38*t59 + t41*t96 - t39*t82)
-    t105 = t19*t100 + t76*t15 - t6*t90
-    t106 = -(t37*t105 + t38*t77 + t41*t101 - t39*t91)
-    t107 = t38*t80 + t40*t105 - t39*t94 - t41*t102
+    t59 = -t14*t3 + t28*t42
+    t60 = t14*t30 - t28*t44
+    t61 = t44*t3 - t30*t42
+    t62 = t19*t59 + t6*t60 - t17*t61
+    t63 = t17*c1
+    t64 = t19*c1
+    t65 = -t60*s1 + t44*t63 + t14*t64
+    t66 = t6*c1
+    t67 = t5*s2
+    t68 = -(s1*t59 + t14*t66 + t17*t67)
+    t69 = -(s1*t61 - t44*t6*c1 + t19*t67)
+    t70 = -(t37*t62 + t39*t65 + t41*t68 - t40*t69)
+    t71 = -t28*c2 + t14*t26
+    t72 = t30*c2 - t44*t26
+    t73 = t19*t71 - t17*t72 + t60*t15
+    t74 = c1**2
+    t75 = s2*t74
+    t76 = -(s1*t71 + t14*t75 - t17*c1*c2)
+    t77 = -t72*s1 + t64*c2 + t44*t75
+    t78 = -(t37*t73 + t38*t65 + t41*t76 - t40*t77)
+    t79 = s2**2
+    t80 = t3*c2 - t0*t79
+    t81 = t19*t80 - t6*t72 + t61*t15
+    t82 = -t80*s1 + t66*c2 + s3*t74*t79
+    t83 = -(t37*t81 + t38*t69 + t41*t82 - t39*t77)
+    t84 = t17*t80 - t6*t71 + t15*t59
+    t85 = -(t37*t84 + t38*t68 + t40*t82 - t39*t76)
+    t86 = t38*t62 + t40*t81 - t39*t73 - t41*t84
+    t87 = -(t19*t26 + t30*t15)
+    t88 = t30*s1 - t64
+    t89 = -(t75 + s2*s1**2)
+    t90 = t37*t87 + t38*t88 - t41*t89
+    t91 = t28*t15 - t17*t26
+    t92 = -(t63 + t28*s1)
+    t93 = t37*t91 + t38*t92 - t40*t89
+    t94 = -(t17*t30 + t28*t19)
+    t95 = t37*t94 + t40*t88 - t41*t92
+    t96 = -(t38*t94 + t41*t91 - t40*t87)
+    t97 = t50*s1
+    t98 = t17*t3 + t28*t6
+    t99 = t3*s1 - t66
+    t100 = t37*t98 + t39*t92 - t40*t99
+    t101 = -(t6*t26 + t3*t15)
+    t102 = t37*t101 + t38*t99 - t39*t89
+    t103 = -(t38*t98 + t40*t101 - t39*t91)
+    t104 = t19*t3 - t30*t6
+    t105 = t37*t104 + t39*t88 - t41*t99
+    t106 = -(t39*t94 + t41*t98 - t40*t104)
+    t107 = -(t38*t104 + t41*t101 - t39*t87)
     t108 = t50*c1
-    t109 = t51*(t56*t70 + t57*t64 + t58*t68 + t71*t72 - t25*t81) + t54*(t25*t103 + t55*t68 + t56*t88 + t57*t98 - t72*t97) - t36*(t55*t81 + t56*t95 + t57*t106 + t58*t103 - t50*t107*s1) - t52*(t57*t86 + t58*t88 + t72*t89 - t25*t95 - t55*t70) - t53*(t25*t106 + t55*t64 + t56*t86 - t58*t98 - t72*t104) - t108*(t55*t71 + t56*t89 + t57*t104 + t58*t97 - t25*t107)
-    t110 = t21*c1
-    t111 = t110 + t32*s1
-    t112 = t28*t21 - t17*t32
-    t113 = t37*t112 + t40*t111
-    t114 = -(t21*t3 + t32*t6)
-    t115 = t37*t114 + t39*t111
-    t116 = t40*t114 - t39*t112
-    t117 = t14*t32 - t28*t46
-    t118 = -(t14*t110 + t117*s1 - t17*t46*c1)
-    t119 = t46*t3 - t32*t42
-    t120 = t21*t75 + t46*t62 - t119*s1
-    t121 = -(t17*t119 + t21*t78 - t6*t117)
-    t122 = -(t37*t121 + t39*t118 - t40*t120)
-    t123 = -(t56*t113 + t57*t115 + t72*t116 - t25*t122)
-    t124 = t21*t26 - t32*t15
-    t125 = t37*t124 + t38*t111
-    t126 = t40*t124 - t38*t112
-    t127 = t32*c2 - t46*t26
-    t128 = -(t110*c2 + t127*s1 - t46*t83*s2)
-    t129 = -(t17*t127 + t21*t92 - t117*c1*s2)
-    t130 = -(t37*t129 + t38*t118 - t40*t128)
-    t131 = t25*t130 + t55*t113 - t57*t125 - t72*t126
-    t132 = t39*t124 - t38*t114
-    t133 = -(t21*t100 + t6*t127 - t119*c1*s2)
-    t134 = -(t37*t133 + t38*t120 - t39*t128)
-    t135 = t25*t134 + t55*t115 + t56*t125 - t72*t132
-    t136 = t38*t121 + t40*t133 - t39*t129
-    t137 = -(t55*t116 + t56*t126 + t57*t132 - t25*t136)
-    t138 = -(t55*t122 + t56*t130 + t57*t134 - t50*t136*s1)
-    t139 = t36*t138 + t52*t131 + t108*t137 - t51*t123 - t53*t135
-    t140 = -(t19*t32 + t30*t21)
-    t141 = t37*t140 + t41*t111
-    t142 = t41*t114 - t39*t140
-    t143 = t30*t46 - t44*t32
-    t144 = t44*t110 + t46*t60 - t143*s1
-    t145 = -(t19*t119 + t21*t76 - t6*t143)
-    t146 = -(t37*t145 + t39*t144 - t41*t120)
-    t147 = t25*t146 + t58*t115 - t56*t141 - t72*t142
-    t148 = t41*t124 - t38*t140
-    t149 = -(t19*t127 + t21*t90 - t143*c1*s2)
-    t150 = -(t37*t149 + t38*t144 - t41*t128)
-    t151 = t25*t150 + t55*t141 + t58*t125 - t72*t148
-    t152 = t38*t145 + t41*t133 - t39*t149
-    t153 = t25*t152 + t58*t132 - t55*t142 - t56*t148
-    t154 = t58*t134 + t152*t72 - t55*t146 - t56*t150
-    t155 = t36*t154 + t52*t151 + t153*t108 - t51*t147 - t54*t135
-    t156 = t41*t112 - t40*t140
-    t157 = -(t19*t117 + t21*t73 - t17*t143)
-    t158 = -(t37*t157 + t40*t144 - t41*t118)
-    t159 = t25*t158 + t57*t141 + t58*t113 - t156*t72
-    t160 = t38*t157 + t41*t129 - t40*t149
-    t161 = t25*t160 + t57*t148 + t58*t126 - t55*t156
-    t162 = t57*t150 + t58*t130 + t160*t72 - t55*t158
-    t163 = t36*t162 + t53*t151 + t161*t108 - t51*t159 - t54*t131
-    t164 = t39*t157 + t41*t121 - t40*t145
-    t165 = t25*t164 + t56*t156 + t57*t142 + t58*t116
-    t166 = t56*t158 + t57*t146 + t58*t122 + t164*t72
-    t167 = t36*t166 + t53*t147 + t165*t108 - t52*t159 - t54*t123
-    t168 = t55*t164 + t56*t160 + t57*t152 + t58*t136
-    t169 = t36*t168 + t51*t165 + t53*t153 - t52*t161 - t54*t137
-    t170 = t52*t162 + t54*t138 + t168*t108 - t51*t166 - t53*t154
+    t109 = -t36*(t55*t70 + t56*t78 + t57*t83 + t58*t85 - t50*s1*t86) - t52*(t57*t90 + t58*t93 - t25*t78 - t55*t95 + t96*t97) + t54*(t25*t85 + t55*t100 + t56*t93 + t57*t102 - t97*t103) + t51*(t56*t95 + t57*t105 + t58*t100 - t25*t70 + t97*t106) - t53*(t25*t83 + t55*t105 + t56*t90 - t58*t102 - t97*t107) - t108*(t55*t106 + t56*t96 + t57*t107 + t58*t103 - t25*t86)
+    t110 = t46*t3 - t32*t42
+    t111 = t14*t32 - t28*t46
+    t112 = -(t17*t110 + t21*t59 - t6*t111)
+    t113 = t21*c1
+    t114 = -(s1*t111 + t14*t113 - t17*t46*c1)
+    t115 = -t110*s1 + t46*t66 + t21*t67
+    t116 = -(t37*t112 + t39*t114 - t40*t115)
+    t117 = t32*c2 - t46*t26
+    t118 = -(t17*t117 + t21*t71 - c1*s2*t111)
+    t119 = -(s1*t117 + t113*c2 - t46*s2*t74)
+    t120 = -(t37*t118 + t38*t114 - t40*t119)
+    t121 = -(t21*t80 + t6*t117 - c1*s2*t110)
+    t122 = -(t37*t121 + t38*t115 - t39*t119)
+    t123 = t38*t112 + t40*t121 - t39*t118
+    t124 = -(t55*t116 + t56*t120 + t57*t122 - t50*s1*t123)
+    t125 = t28*t21 - t17*t32
+    t126 = t113 + t32*s1
+    t127 = t37*t125 + t40*t126
+    t128 = t21*t26 - t32*t15
+    t129 = t37*t128 + t38*t126
+    t130 = t40*t128 - t38*t125
+    t131 = t25*t120 + t55*t127 - t57*t129 - t97*t130
+    t132 = -(t21*t3 + t32*t6)
+    t133 = t37*t132 + t39*t126
+    t134 = t40*t132 - t39*t125
+    t135 = -(t56*t127 + t57*t133 - t25*t116 + t97*t134)
+    t136 = t39*t128 - t38*t132
+    t137 = t25*t122 + t55*t133 + t56*t129 - t97*t136
+    t138 = -(t55*t134 + t56*t130 + t57*t136 - t25*t123)
+    t139 = t36*t124 + t52*t131 - t51*t135 - t53*t137 + t108*t138
+    t140 = t30*t46 - t44*t32
+    t141 = -(t19*t110 + t21*t61 - t6*t140)
+    t142 = -t140*s1 + t46*t64 + t44*t113
+    t143 = -(t37*t141 + t39*t142 - t41*t115)
+    t144 = -(t19*t117 + t21*t72 - c1*s2*t140)
+    t145 = -(t37*t144 + t38*t142 - t41*t119)
+    t146 = t38*t141 + t41*t121 - t39*t144
+    t147 = t58*t122 - t55*t143 - t56*t145 + t97*t146
+    t148 = -(t19*t32 + t30*t21)
+    t149 = t37*t148 + t41*t126
+    t150 = t41*t128 - t38*t148
+    t151 = t25*t145 + t55*t149 + t58*t129 - t97*t150
+    t152 = t41*t132 - t39*t148
+    t153 = t25*t143 + t58*t133 - t56*t149 - t152*t97
+    t154 = t25*t146 + t58*t136 - t55*t152 - t56*t150
+    t155 = t36*t147 + t52*t151 - t51*t153 - t54*t137 + t154*t108
+    t156 = -(t19*t111 + t21*t60 - t17*t140)
+    t157 = -(t37*t156 + t40*t142 - t41*t114)
+    t158 = t38*t156 + t41*t118 - t40*t144
+    t159 = t57*t145 + t58*t120 - t55*t157 + t158*t97
+    t160 = t41*t125 - t40*t148
+    t161 = t25*t157 + t57*t149 + t58*t127 - t160*t97
+    t162 = t25*t158 + t57*t150 + t58*t130 - t55*t160
+    t163 = t36*t159 + t53*t151 - t51*t161 - t54*t131 + t162*t108
+    t164 = t39*t156 + t41*t112 - t40*t141
+    t165 = t56*t157 + t57*t143 + t58*t116 + t164*t97
+    t166 = t25*t164 + t56*t160 + t57*t152 + t58*t134
+    t167 = t36*t165 + t53*t153 - t52*t161 - t54*t135 + t166*t108
+    t168 = t55*t164 + t56*t158 + t57*t146 + t58*t123
+    t169 = t36*t168 + t51*t166 + t53*t154 - t52*t162 - t54*t138
+    t170 = t52*t159 + t54*t124 - t51*t165 - t53*t147 + t168*t108
     f = _stack(xp, [
         t109**2 + t139**2 + t155**2 + t163**2 + t167**2 + t169**2 + t170**2,  # 0
     ], (1,))
@@ -2242,10 +2242,10 @@ def manipulability(q):
     t11 = c3*s2
     t12 = 0.316*c2 - 0.0825*t11
     t13 = c2*s4 - t11*c4
-    t14 = t11*s4 + c2*c4
+    t14 = c2*c4 + t11*s4
     t15 = c1*s2
     t16 = t2*c4 + t15*s4
-    t17 = t15*c4 - t2*s4
+    t17 = -t2*s4 + t15*c4
     t18 = t16*c5 - t6*s5
     t19 = t16*s5 + t6*c5
     t20 = t17*s6 + t18*c6
@@ -2256,7 +2256,7 @@ def manipulability(q):
     t25 = t9 + t24
     t26 = s1*s2
     t27 = t7*c4 + t26*s4
-    t28 = t26*c4 - t7*s4
+    t28 = -t7*s4 + t26*c4
     t29 = t27*c5 + t3*s5
     t30 = t3*c5 - t27*s5
     t31 = t28*s6 + t29*c6
@@ -2272,133 +2272,133 @@ def manipulability(q):
     t41 = t19*t33 + t30*t22
     t42 = s2*s3
     t43 = t13*c5 + t42*s5
-    t44 = t42*c5 - t13*s5
+    t44 = -t13*s5 + t42*c5
     t45 = t14*s6 + t43*c6
     t46 = t14*c6 - t43*s6
     t47 = 0.088*t45 - 0.21*t46
     t48 = t47 + 0.384*t14
     t49 = t48 - 0.0825*t13
     t50 = t12 + t49
-    t51 = t50*t26 - t36*c2
-    t52 = t35*t42 - t49*t3
+    t51 = -t36*c2 + t50*t26
+    t52 = -t49*t3 + t35*t42
     t53 = t28*t48 - t14*t34
     t54 = t44*t33 - t30*t47
     t55 = t25*c2 - t50*t15
-    t56 = t24*t42 + t49*t6
+    t56 = t49*t6 + t24*t42
     t57 = t14*t23 - t17*t48
     t58 = t19*t47 + t44*t22
-    t59 = t19*t3 - t30*t6
-    t60 = t19*c1
-    t61 = -t60 + t30*s1
-    t62 = t6*c1
-    t63 = -t62 + t3*s1
-    t64 = t37*t59 + t39*t61 - t41*t63
-    t65 = t17*t3 + t28*t6
-    t66 = t17*c1
-    t67 = -(t66 + t28*s1)
-    t68 = t37*t65 + t39*t67 - t40*t63
-    t69 = -(t17*t30 + t28*t19)
-    t70 = t37*t69 + t40*t61 - t41*t67
-    t71 = -(t39*t69 + t41*t65 - t40*t59)
-    t72 = t50*s1
-    t73 = t14*t30 - t28*t44
-    t74 = t14*t60 + t44*t66 - t73*s1
-    t75 = t5*s2
-    t76 = t44*t3 - t30*t42
-    t77 = -(t19*t75 + t76*s1 - t44*t6*c1)
-    t78 = t28*t42 - t14*t3
-    t79 = -(t17*t75 + t14*t62 + t78*s1)
-    t80 = t19*t78 + t6*t73 - t17*t76
-    t81 = -(t37*t80 + t39*t74 + t41*t79 - t40*t77)
-    t82 = -(t19*t26 + t30*t15)
-    t83 = c1**2
-    t84 = t83*s2
-    t85 = -(t84 + s2*s1**2)
-    t86 = t37*t82 + t38*t61 - t41*t85
-    t87 = t28*t15 - t17*t26
-    t88 = t37*t87 + t38*t67 - t40*t85
-    t89 = -(t38*t69 + t41*t87 - t40*t82)
-    t90 = t30*c2 - t44*t26
-    t91 = t44*t84 + t60*c2 - t90*s1
-    t92 = t14*t26 - t28*c2
-    t93 = -(t14*t84 + t92*s1 - t17*c1*c2)
-    t94 = t19*t92 + t73*t15 - t17*t90
-    t95 = -(t37*t94 + t38*t74 + t41*t93 - t40*t91)
-    t96 = -(t6*t26 + t3*t15)
-    t97 = -(t38*t65 + t40*t96 - t39*t87)
-    t98 = t37*t96 + t38*t63 - t39*t85
-    t99 = s2**2
-    t100 = t3*c2 - t0*t99
-    t101 = t62*c2 - t100*s1 + t83*t99*s3
-    t102 = t17*t100 + t78*t15 - t6*t92
-    t103 = -(t37*t102 + t38*t79 + t40*t101 - t39*t93)
-    t104 = -(t38*t59 + t41*t96 - t39*t82)
-    t105 = t19*t100 + t76*t15 - t6*t90
-    t106 = -(t37*t105 + t38*t77 + t41*t101 - t39*t91)
-    t107 = t38*t80 + t40*t105 - t39*t94 - t41*t102
+    t59 = -t14*t3 + t28*t42
+    t60 = t14*t30 - t28*t44
+    t61 = t44*t3 - t30*t42
+    t62 = t19*t59 + t6*t60 - t17*t61
+    t63 = t17*c1
+    t64 = t19*c1
+    t65 = -t60*s1 + t44*t63 + t14*t64
+    t66 = t6*c1
+    t67 = t5*s2
+    t68 = -(s1*t59 + t14*t66 + t17*t67)
+    t69 = -(s1*t61 - t44*t6*c1 + t19*t67)
+    t70 = -(t37*t62 + t39*t65 + t41*t68 - t40*t69)
+    t71 = -t28*c2 + t14*t26
+    t72 = t30*c2 - t44*t26
+    t73 = t19*t71 - t17*t72 + t60*t15
+    t74 = c1**2
+    t75 = s2*t74
+    t76 = -(s1*t71 + t14*t75 - t17*c1*c2)
+    t77 = -t72*s1 + t64*c2 + t44*t75
+    t78 = -(t37*t73 + t38*t65 + t41*t76 - t40*t77)
+    t79 = s2**2
+    t80 = t3*c2 - t0*t79
+    t81 = t19*t80 - t6*t72 + t61*t15
+    t82 = -t80*s1 + t66*c2 + s3*t74*t79
+    t83 = -(t37*t81 + t38*t69 + t41*t82 - t39*t77)
+    t84 = t17*t80 - t6*t71 + t15*t59
+    t85 = -(t37*t84 + t38*t68 + t40*t82 - t39*t76)
+    t86 = t38*t62 + t40*t81 - t39*t73 - t41*t84
+    t87 = -(t19*t26 + t30*t15)
+    t88 = t30*s1 - t64
+    t89 = -(t75 + s2*s1**2)
+    t90 = t37*t87 + t38*t88 - t41*t89
+    t91 = t28*t15 - t17*t26
+    t92 = -(t63 + t28*s1)
+    t93 = t37*t91 + t38*t92 - t40*t89
+    t94 = -(t17*t30 + t28*t19)
+    t95 = t37*t94 + t40*t88 - t41*t92
+    t96 = -(t38*t94 + t41*t91 - t40*t87)
+    t97 = t50*s1
+    t98 = t17*t3 + t28*t6
+    t99 = t3*s1 - t66
+    t100 = t37*t98 + t39*t92 - t40*t99
+    t101 = -(t6*t26 + t3*t15)
+    t102 = t37*t101 + t38*t99 - t39*t89
+    t103 = -(t38*t98 + t40*t101 - t39*t91)
+    t104 = t19*t3 - t30*t6
+    t105 = t37*t104 + t39*t88 - t41*t99
+    t106 = -(t39*t94 + t41*t98 - t40*t104)
+    t107 = -(t38*t104 + t41*t101 - t39*t87)
     t108 = t50*c1
-    t109 = t51*(t56*t70 + t57*t64 + t58*t68 + t71*t72 - t25*t81) + t54*(t25*t103 + t55*t68 + t56*t88 + t57*t98 - t72*t97) - t36*(t55*t81 + t56*t95 + t57*t106 + t58*t103 - t50*t107*s1) - t52*(t57*t86 + t58*t88 + t72*t89 - t25*t95 - t55*t70) - t53*(t25*t106 + t55*t64 + t56*t86 - t58*t98 - t72*t104) - t108*(t55*t71 + t56*t89 + t57*t104 + t58*t97 - t25*t107)
-    t110 = t21*c1
-    t111 = t110 + t32*s1
-    t112 = t28*t21 - t17*t32
-    t113 = t37*t112 + t40*t111
-    t114 = -(t21*t3 + t32*t6)
-    t115 = t37*t114 + t39*t111
-    t116 = t40*t114 - t39*t112
-    t117 = t14*t32 - t28*t46
-    t118 = -(t14*t110 + t117*s1 - t17*t46*c1)
-    t119 = t46*t3 - t32*t42
-    t120 = t21*t75 + t46*t62 - t119*s1
-    t121 = -(t17*t119 + t21*t78 - t6*t117)
-    t122 = -(t37*t121 + t39*t118 - t40*t120)
-    t123 = -(t56*t113 + t57*t115 + t72*t116 - t25*t122)
-    t124 = t21*t26 - t32*t15
-    t125 = t37*t124 + t38*t111
-    t126 = t40*t124 - t38*t112
-    t127 = t32*c2 - t46*t26
-    t128 = -(t110*c2 + t127*s1 - t46*t83*s2)
-    t129 = -(t17*t127 + t21*t92 - t117*c1*s2)
-    t130 = -(t37*t129 + t38*t118 - t40*t128)
-    t131 = t25*t130 + t55*t113 - t57*t125 - t72*t126
-    t132 = t39*t124 - t38*t114
-    t133 = -(t21*t100 + t6*t127 - t119*c1*s2)
-    t134 = -(t37*t133 + t38*t120 - t39*t128)
-    t135 = t25*t134 + t55*t115 + t56*t125 - t72*t132
-    t136 = t38*t121 + t40*t133 - t39*t129
-    t137 = -(t55*t116 + t56*t126 + t57*t132 - t25*t136)
-    t138 = -(t55*t122 + t56*t130 + t57*t134 - t50*t136*s1)
-    t139 = t36*t138 + t52*t131 + t108*t137 - t51*t123 - t53*t135
-    t140 = -(t19*t32 + t30*t21)
-    t141 = t37*t140 + t41*t111
-    t142 = t41*t114 - t39*t140
-    t143 = t30*t46 - t44*t32
-    t144 = t44*t110 + t46*t60 - t143*s1
-    t145 = -(t19*t119 + t21*t76 - t6*t143)
-    t146 = -(t37*t145 + t39*t144 - t41*t120)
-    t147 = t25*t146 + t58*t115 - t56*t141 - t72*t142
-    t148 = t41*t124 - t38*t140
-    t149 = -(t19*t127 + t21*t90 - t143*c1*s2)
-    t150 = -(t37*t149 + t38*t144 - t41*t128)
-    t151 = t25*t150 + t55*t141 + t58*t125 - t72*t148
-    t152 = t38*t145 + t41*t133 - t39*t149
-    t153 = t25*t152 + t58*t132 - t55*t142 - t56*t148
-    t154 = t58*t134 + t152*t72 - t55*t146 - t56*t150
-    t155 = t36*t154 + t52*t151 + t153*t108 - t51*t147 - t54*t135
-    t156 = t41*t112 - t40*t140
-    t157 = -(t19*t117 + t21*t73 - t17*t143)
-    t158 = -(t37*t157 + t40*t144 - t41*t118)
-    t159 = t25*t158 + t57*t141 + t58*t113 - t156*t72
-    t160 = t38*t157 + t41*t129 - t40*t149
-    t161 = t25*t160 + t57*t148 + t58*t126 - t55*t156
-    t162 = t57*t150 + t58*t130 + t160*t72 - t55*t158
-    t163 = t36*t162 + t53*t151 + t161*t108 - t51*t159 - t54*t131
-    t164 = t39*t157 + t41*t121 - t40*t145
-    t165 = t25*t164 + t56*t156 + t57*t142 + t58*t116
-    t166 = t56*t158 + t57*t146 + t58*t122 + t164*t72
-    t167 = t36*t166 + t53*t147 + t165*t108 - t52*t159 - t54*t123
-    t168 = t55*t164 + t56*t160 + t57*t152 + t58*t136
-    t169 = t36*t168 + t51*t165 + t53*t153 - t52*t161 - t54*t137
-    t170 = t52*t162 + t54*t138 + t168*t108 - t51*t166 - t53*t154
+    t109 = -t36*(t55*t70 + t56*t78 + t57*t83 + t58*t85 - t50*s1*t86) - t52*(t57*t90 + t58*t93 - t25*t78 - t55*t95 + t96*t97) + t54*(t25*t85 + t55*t100 + t56*t93 + t57*t102 - t97*t103) + t51*(t56*t95 + t57*t105 + t58*t100 - t25*t70 + t97*t106) - t53*(t25*t83 + t55*t105 + t56*t90 - t58*t102 - t97*t107) - t108*(t55*t106 + t56*t96 + t57*t107 + t58*t103 - t25*t86)
+    t110 = t46*t3 - t32*t42
+    t111 = t14*t32 - t28*t46
+    t112 = -(t17*t110 + t21*t59 - t6*t111)
+    t113 = t21*c1
+    t114 = -(s1*t111 + t14*t113 - t17*t46*c1)
+    t115 = -t110*s1 + t46*t66 + t21*t67
+    t116 = -(t37*t112 + t39*t114 - t40*t115)
+    t117 = t32*c2 - t46*t26
+    t118 = -(t17*t117 + t21*t71 - c1*s2*t111)
+    t119 = -(s1*t117 + t113*c2 - t46*s2*t74)
+    t120 = -(t37*t118 + t38*t114 - t40*t119)
+    t121 = -(t21*t80 + t6*t117 - c1*s2*t110)
+    t122 = -(t37*t121 + t38*t115 - t39*t119)
+    t123 = t38*t112 + t40*t121 - t39*t118
+    t124 = -(t55*t116 + t56*t120 + t57*t122 - t50*s1*t123)
+    t125 = t28*t21 - t17*t32
+    t126 = t113 + t32*s1
+    t127 = t37*t125 + t40*t126
+    t128 = t21*t26 - t32*t15
+    t129 = t37*t128 + t38*t126
+    t130 = t40*t128 - t38*t125
+    t131 = t25*t120 + t55*t127 - t57*t129 - t97*t130
+    t132 = -(t21*t3 + t32*t6)
+    t133 = t37*t132 + t39*t126
+    t134 = t40*t132 - t39*t125
+    t135 = -(t56*t127 + t57*t133 - t25*t116 + t97*t134)
+    t136 = t39*t128 - t38*t132
+    t137 = t25*t122 + t55*t133 + t56*t129 - t97*t136
+    t138 = -(t55*t134 + t56*t130 + t57*t136 - t25*t123)
+    t139 = t36*t124 + t52*t131 - t51*t135 - t53*t137 + t108*t138
+    t140 = t30*t46 - t44*t32
+    t141 = -(t19*t110 + t21*t61 - t6*t140)
+    t142 = -t140*s1 + t46*t64 + t44*t113
+    t143 = -(t37*t141 + t39*t142 - t41*t115)
+    t144 = -(t19*t117 + t21*t72 - c1*s2*t140)
+    t145 = -(t37*t144 + t38*t142 - t41*t119)
+    t146 = t38*t141 + t41*t121 - t39*t144
+    t147 = t58*t122 - t55*t143 - t56*t145 + t97*t146
+    t148 = -(t19*t32 + t30*t21)
+    t149 = t37*t148 + t41*t126
+    t150 = t41*t128 - t38*t148
+    t151 = t25*t145 + t55*t149 + t58*t129 - t97*t150
+    t152 = t41*t132 - t39*t148
+    t153 = t25*t143 + t58*t133 - t56*t149 - t152*t97
+    t154 = t25*t146 + t58*t136 - t55*t152 - t56*t150
+    t155 = t36*t147 + t52*t151 - t51*t153 - t54*t137 + t154*t108
+    t156 = -(t19*t111 + t21*t60 - t17*t140)
+    t157 = -(t37*t156 + t40*t142 - t41*t114)
+    t158 = t38*t156 + t41*t118 - t40*t144
+    t159 = t57*t145 + t58*t120 - t55*t157 + t158*t97
+    t160 = t41*t125 - t40*t148
+    t161 = t25*t157 + t57*t149 + t58*t127 - t160*t97
+    t162 = t25*t158 + t57*t150 + t58*t130 - t55*t160
+    t163 = t36*t159 + t53*t151 - t51*t161 - t54*t131 + t162*t108
+    t164 = t39*t156 + t41*t112 - t40*t141
+    t165 = t56*t157 + t57*t143 + t58*t116 + t164*t97
+    t166 = t25*t164 + t56*t160 + t57*t152 + t58*t134
+    t167 = t36*t165 + t53*t153 - t52*t161 - t54*t135 + t166*t108
+    t168 = t55*t164 + t56*t158 + t57*t146 + t58*t123
+    t169 = t36*t168 + t51*t166 + t53*t154 - t52*t162 - t54*t138
+    t170 = t52*t159 + t54*t124 - t51*t165 - t53*t147 + t168*t108
     t171 = t109**2 + t139**2 + t155**2 + t163**2 + t167**2 + t169**2 + t170**2
     w = xp.broadcast_to(xp.sqrt(xp.abs(t171)), batch)
     return w
@@ -2443,9 +2443,9 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t6 = t4 + t5*c2
     t7 = t5 + t4*c2
     t8 = c1*s2
-    t9 = 0.316*t8 + 0.0825*t2
+    t9 = 0.0825*t2 + 0.316*t8
     t10 = t2*c4 + t8*s4
-    t11 = t8*c4 - t2*s4
+    t11 = -t2*s4 + t8*c4
     t12 = t10*c5 - t6*s5
     t13 = t10*s5 + t6*c5
     t14 = t11*s6 + t12*c6
@@ -2455,9 +2455,9 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t18 = t17 - 0.0825*t10
     t19 = t9 + t18
     t20 = s1*s2
-    t21 = 0.316*t20 + 0.0825*t7
+    t21 = 0.0825*t7 + 0.316*t20
     t22 = t7*c4 + t20*s4
-    t23 = t20*c4 - t7*s4
+    t23 = -t7*s4 + t20*c4
     t24 = t22*c5 + t3*s5
     t25 = t3*c5 - t22*s5
     t26 = t23*s6 + t24*c6
@@ -2475,222 +2475,222 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t38 = c3*s2
     t39 = 0.316*c2 - 0.0825*t38
     t40 = c2*s4 - t38*c4
-    t41 = t38*s4 + c2*c4
+    t41 = c2*c4 + t38*s4
     t42 = s2*s3
     t43 = t40*c5 + t42*s5
-    t44 = t42*c5 - t40*s5
+    t44 = -t40*s5 + t42*c5
     t45 = t41*s6 + t43*c6
     t46 = t41*c6 - t43*s6
     t47 = 0.088*t45 - 0.21*t46
     t48 = t47 + 0.384*t41
     t49 = t48 - 0.0825*t40
     t50 = t39 + t49
-    t51 = t30*t42 - t49*t3
+    t51 = -t49*t3 + t30*t42
     t52 = t23*t48 - t41*t29
     t53 = t44*t28 - t25*t47
-    t54 = t18*t42 + t49*t6
+    t54 = t49*t6 + t18*t42
     t55 = t41*t17 - t11*t48
     t56 = t13*t47 + t44*t16
     t57 = t41*t35 + t33*c2 - t44*t36 - t34*t42
-    t58 = t11*t41 + t15*t46 + t8*c2 - t13*t44 - t6*t42
+    t58 = t11*t41 + t15*t46 - t13*t44 + t8*c2 - t6*t42
     t59 = t23*t41 + t25*t44 + t27*t46 + t3*t42 + t20*c2
     t60 = t50*s1
-    t61 = t60*s2 - t31*c2
-    t62 = t31 + t44*t53 + t51*t42 - t41*t52 - t61*c2
+    t61 = -t31*c2 + t60*s2
+    t62 = t31 + t44*t53 - t41*t52 - t61*c2 + t51*t42
     t63 = t50*c1
     t64 = t19*c2 - t63*s2
     t65 = t19 + t41*t55 + t44*t56 + t64*c2 + t54*t42
-    t66 = 1 + t11 + t23 + t41 + t13 + t19 + t6 + t61 + t51 + t52 + t53 + t64 + t55 + t33 + t34 + t35 + t36 + t8 + t20 + t60 + t63 + c1 + c2 + damping + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + q1 + q2 + q3 + q4 + q5 + q6 + q7 - t25 - t44 - t15 - t27 - t46 - t31 - t54 - t56 - t32 - t3 - t42 - s1
+    t66 = 1 + t11 + t23 + t41 + t13 + t19 + t6 + t61 + t51 + t52 + t53 + t64 + t55 + t33 + t34 + t35 + t36 + c1 + c2 + damping + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + q1 + q2 + q3 + q4 + q5 + q6 + q7 - t25 - t44 - t15 - t27 - t46 - t31 - t54 - t56 - t32 - t3 - s1 + t63 + t60 + t8 + t20 - t42
     t67 = t50**2
     t68 = c1**2
     t69 = t31**2 + t61**2 + t51**2 + t52**2 + t53**2 + t67*t68
-    t70 = t23*t52 + t50*t68 + t61*t20 - t25*t53 - t51*t3
+    t70 = t23*t52 + t50*t68 - t25*t53 - t51*t3 + t61*t20
     t71 = c1*s1
-    t72 = t61*t64 + t52*t55 + t67*t71 - t19*t31 - t51*t54 - t53*t56
+    t72 = t61*t64 + t52*t55 - t19*t31 - t51*t54 - t53*t56 + t67*t71
     t73 = t32*c1
     t74 = t61*t33 + t51*t34 + t52*t35 + t53*t36 - t50*t73
-    t75 = t73 + t25*t36 + t34*t3 - t23*t35 - t33*t20
+    t75 = t25*t36 + t73 + t34*t3 - t23*t35 - t33*t20
     t76 = t50*t71
-    t77 = -t76 + t11*t52 + t13*t53 + t6*t51 + t61*t8
-    t78 = t76 + t23*t55 + t25*t56 + t64*t20 + t54*t3
+    t77 = t11*t52 + t13*t53 + t6*t51 + t61*t8 - t76
+    t78 = t23*t55 + t25*t56 + t54*t3 + t76 + t64*t20
     t79 = s1**2
     t80 = t19**2 + t64**2 + t54**2 + t55**2 + t56**2 + t67*t79
     t81 = t13*t56 + t50*t79 + t6*t54 - t11*t55 - t64*t8
     t82 = t32*s1
-    t83 = t50*t82 + t54*t34 + t56*t36 - t64*t33 - t55*t35
-    t84 = t82 + t11*t35 + t13*t36 + t6*t34 + t33*t8
+    t83 = t54*t34 + t56*t36 - t64*t33 - t55*t35 + t50*t82
+    t84 = t11*t35 + t13*t36 + t6*t34 + t82 + t33*t8
     t85 = s2**2
-    t86 = t79 + t11**2 + t13**2 + t15**2 + t6**2 + t68*t85
-    t87 = -t71 + t11*t23 + t15*t27 + t71*t85 - t13*t25 - t6*t3
-    t88 = t68 + t23**2 + t25**2 + t27**2 + t3**2 + t79*t85
+    t86 = t11**2 + t13**2 + t15**2 + t6**2 + t79 + t68*t85
+    t87 = t11*t23 + t15*t27 - t13*t25 - t6*t3 - t71 + t71*t85
+    t88 = t23**2 + t25**2 + t27**2 + t3**2 + t68 + t79*t85
     t89 = 1 + t41**2 + t44**2 + t46**2 + c2**2 + t85*s3**2
-    t90 = t72**2
-    t91 = t62**2
-    t92 = t74**2
-    t93 = t77**2
-    t94 = t70**2
-    t95 = damping**2
-    t96 = t69 + t95
-    t97 = t96**2
-    t98 = xp.sqrt(t90 + t91 + t92 + t93 + t94 + t97)
-    t99 = t98*xp.where(xp.greater_equal(t96, 0), xp.asarray(1, dtype=dtype), -1)
-    t100 = t99 + t96
-    t101 = xp.where(xp.greater(t98, 0), 1/(t98*(t98 + xp.abs(t96))), 0)
-    t102 = t101*(t72*mu_dot1 + t74*mu_dot2 + t77*mu_dot3 + t70*mu_dot4 + t100*mu_dot0 - t62*mu_dot5)
-    t103 = mu_dot0 - t100*t102
-    t104 = mu_dot1 - t72*t102
-    t105 = mu_dot2 - t74*t102
-    t106 = mu_dot3 - t77*t102
-    t107 = mu_dot4 - t70*t102
-    t108 = mu_dot5 + t62*t102
-    t109 = t80 + t95
-    t110 = t101*(t72*t100 + t72*t109 + t70*t78 - t62*t65 - t74*t83 - t77*t81)
-    t111 = t72 - t100*t110
-    t112 = t109 - t72*t110
-    t113 = t83 + t74*t110
-    t114 = t81 + t77*t110
-    t115 = t78 - t70*t110
-    t116 = t65 + t62*t110
-    t117 = xp.sqrt(t112**2 + t113**2 + t114**2 + t115**2 + t116**2)
-    t118 = t117*xp.where(xp.greater_equal(t112, 0), xp.asarray(1, dtype=dtype), -1)
-    t119 = t112 + t118
-    t120 = xp.where(xp.greater(t117, 0), 1/(t117*(t117 + xp.abs(t112))), 0)
-    t121 = t120*(t115*t107 + t116*t108 + t104*t119 - t113*t105 - t114*t106)
-    t122 = t104 - t119*t121
-    t123 = t105 + t113*t121
-    t124 = t106 + t114*t121
-    t125 = t107 - t115*t121
-    t126 = t108 - t116*t121
-    t127 = t37 + t95
-    t128 = t101*(t74*t100 + t74*t127 + t77*t84 - t72*t83 - t62*t57 - t70*t75)
-    t129 = t74 - t100*t128
-    t130 = t83 + t72*t128
-    t131 = t127 - t74*t128
-    t132 = t84 - t77*t128
-    t133 = t75 + t70*t128
-    t134 = t57 + t62*t128
-    t135 = -t120*(t113*t131 + t114*t132 + t115*t133 + t130*t119 - t116*t134)
-    t136 = t130 + t119*t135
-    t137 = t131 + t113*t135
-    t138 = t132 + t114*t135
-    t139 = t133 + t115*t135
-    t140 = t134 - t116*t135
-    t141 = xp.sqrt(t137**2 + t138**2 + t139**2 + t140**2)
-    t142 = t141*xp.where(xp.greater_equal(t137, 0), xp.asarray(1, dtype=dtype), -1)
-    t143 = t137 + t142
-    t144 = xp.where(xp.greater(t141, 0), 1/(t141*(t141 + xp.abs(t137))), 0)
-    t145 = t144*(t138*t124 + t140*t126 + t123*t143 - t139*t125)
-    t146 = t123 - t143*t145
-    t147 = t124 - t138*t145
-    t148 = t125 + t139*t145
-    t149 = t126 - t140*t145
-    t150 = t86 + t95
-    t151 = t101*(t74*t84 + t77*t100 + t77*t150 + t70*t87 - t72*t81 - t62*t58)
-    t152 = t77 - t100*t151
-    t153 = t81 + t72*t151
-    t154 = t84 - t74*t151
-    t155 = t150 - t77*t151
-    t156 = t87 - t70*t151
-    t157 = t58 + t62*t151
-    t158 = -t120*(t113*t154 + t114*t155 + t153*t119 - t115*t156 - t116*t157)
-    t159 = t153 + t119*t158
-    t160 = t154 + t113*t158
-    t161 = t155 + t114*t158
-    t162 = t156 - t115*t158
-    t163 = t157 - t116*t158
-    t164 = t144*(t138*t161 + t140*t163 + t160*t143 - t139*t162)
-    t165 = t160 - t143*t164
-    t166 = t161 - t138*t164
-    t167 = t162 + t139*t164
-    t168 = t163 - t140*t164
-    t169 = xp.sqrt(t166**2 + t167**2 + t168**2)
-    t170 = t169*xp.where(xp.greater_equal(t166, 0), xp.asarray(1, dtype=dtype), -1)
-    t171 = t166 + t170
-    t172 = xp.where(xp.greater(t169, 0), 1/(t169*(t169 + xp.abs(t166))), 0)
-    t173 = t172*(t167*t148 + t168*t149 + t147*t171)
-    t174 = t147 - t171*t173
-    t175 = t148 - t167*t173
-    t176 = t149 - t168*t173
-    t177 = t88 + t95
-    t178 = t101*(t72*t78 + t77*t87 + t70*t100 + t70*t177 - t62*t59 - t74*t75)
-    t179 = t70 - t100*t178
-    t180 = t78 - t72*t178
-    t181 = t75 + t74*t178
-    t182 = t87 - t77*t178
-    t183 = t177 - t70*t178
-    t184 = t59 + t62*t178
-    t185 = t120*(t113*t181 + t115*t183 + t116*t184 + t180*t119 - t114*t182)
-    t186 = t180 - t119*t185
-    t187 = -t181 + t113*t185
-    t188 = t182 + t114*t185
-    t189 = t183 - t115*t185
-    t190 = t184 - t116*t185
-    t191 = t144*(t138*t188 + t140*t190 + t187*t143 - t139*t189)
-    t192 = t187 - t143*t191
-    t193 = t188 - t138*t191
-    t194 = t189 + t139*t191
-    t195 = t190 - t140*t191
-    t196 = t172*(t167*t194 + t168*t195 + t193*t171)
-    t197 = t193 - t171*t196
-    t198 = t194 - t167*t196
-    t199 = t195 - t168*t196
-    t200 = xp.sqrt(t198**2 + t199**2)
-    t201 = t200*xp.where(xp.greater_equal(t198, 0), xp.asarray(1, dtype=dtype), -1)
-    t202 = t198 + t201
-    t203 = xp.where(xp.greater(t200, 0), 1/(t200*(t200 + xp.abs(t198))), 0)
-    t204 = t203*(t199*t176 + t175*t202)
-    t205 = t175 - t202*t204
-    t206 = t176 - t199*t204
-    t207 = t89 + t95
-    t208 = xp.sqrt(t97 + t109**2 + t127**2 + t150**2 + t177**2 + t207**2 + 2*t90 + 2*t91 + 2*t92 + 2*t93 + 2*t94 + 2*t65**2 + 2*t83**2 + 2*t81**2 + 2*t78**2 + 2*t84**2 + 2*t75**2 + 2*t57**2 + 2*t87**2 + 2*t58**2 + 2*t59**2)
-    t209 = t101*(t72*t65 + t74*t57 + t77*t58 + t70*t59 - t62*t100 - t62*t207)
-    t210 = t62 + t100*t209
-    t211 = t65 - t72*t209
-    t212 = t57 - t74*t209
-    t213 = t58 - t77*t209
-    t214 = t59 - t70*t209
-    t215 = t207 + t62*t209
-    t216 = t120*(t115*t214 + t116*t215 + t211*t119 - t113*t212 - t114*t213)
-    t217 = t211 - t119*t216
-    t218 = t212 + t113*t216
-    t219 = t213 + t114*t216
-    t220 = t214 - t115*t216
-    t221 = t215 - t116*t216
-    t222 = t144*(t138*t219 + t140*t221 + t218*t143 - t139*t220)
-    t223 = t218 - t143*t222
-    t224 = t219 - t138*t222
-    t225 = t220 + t139*t222
-    t226 = t221 - t140*t222
-    t227 = t172*(t167*t225 + t168*t226 + t224*t171)
-    t228 = t224 - t171*t227
-    t229 = t225 - t167*t227
-    t230 = t226 - t168*t227
-    t231 = t203*(t199*t230 + t229*t202)
-    t232 = t229 - t202*t231
-    t233 = t230 - t199*t231
-    t234 = xp.abs(t233)
+    t90 = damping**2
+    t91 = t69 + t90
+    t92 = t91**2
+    t93 = t80 + t90
+    t94 = t37 + t90
+    t95 = t86 + t90
+    t96 = t88 + t90
+    t97 = t89 + t90
+    t98 = t72**2
+    t99 = t62**2
+    t100 = t74**2
+    t101 = t77**2
+    t102 = t70**2
+    t103 = xp.sqrt(t92 + t93**2 + t94**2 + t95**2 + t96**2 + t97**2 + 2*t98 + 2*t99 + 2*t100 + 2*t101 + 2*t102 + 2*t65**2 + 2*t83**2 + 2*t81**2 + 2*t78**2 + 2*t84**2 + 2*t75**2 + 2*t57**2 + 2*t87**2 + 2*t58**2 + 2*t59**2)
+    t104 = xp.sqrt(t98 + t99 + t100 + t101 + t102 + t92)
+    t105 = t104*xp.where(xp.greater_equal(t91, 0), xp.asarray(1, dtype=dtype), -1)
+    t106 = t105 + t91
+    t107 = xp.where(xp.greater(t104, 0), 1/(t104*(t104 + xp.abs(t91))), 0)
+    t108 = t107*(t72*t106 + t72*t93 + t70*t78 - t62*t65 - t74*t83 - t77*t81)
+    t109 = t72 - t106*t108
+    t110 = t93 - t72*t108
+    t111 = t83 + t74*t108
+    t112 = t81 + t77*t108
+    t113 = t78 - t70*t108
+    t114 = t65 + t62*t108
+    t115 = t107*(t74*t106 + t74*t94 + t77*t84 - t72*t83 - t62*t57 - t70*t75)
+    t116 = t74 - t106*t115
+    t117 = t83 + t72*t115
+    t118 = t94 - t74*t115
+    t119 = t84 - t77*t115
+    t120 = t75 + t70*t115
+    t121 = t57 + t62*t115
+    t122 = t107*(t74*t84 + t77*t106 + t77*t95 + t70*t87 - t72*t81 - t62*t58)
+    t123 = t77 - t106*t122
+    t124 = t81 + t72*t122
+    t125 = t84 - t74*t122
+    t126 = t95 - t77*t122
+    t127 = t87 - t70*t122
+    t128 = t58 + t62*t122
+    t129 = t107*(t72*t78 + t77*t87 + t70*t106 + t70*t96 - t62*t59 - t74*t75)
+    t130 = t70 - t106*t129
+    t131 = t78 - t72*t129
+    t132 = t75 + t74*t129
+    t133 = t87 - t77*t129
+    t134 = t96 - t70*t129
+    t135 = t59 + t62*t129
+    t136 = t107*(t72*t65 + t74*t57 + t77*t58 + t70*t59 - t62*t106 - t62*t97)
+    t137 = t62 + t106*t136
+    t138 = t65 - t72*t136
+    t139 = t57 - t74*t136
+    t140 = t58 - t77*t136
+    t141 = t59 - t70*t136
+    t142 = t97 + t62*t136
+    t143 = t107*(t72*mu_dot1 + t74*mu_dot2 + t77*mu_dot3 + t70*mu_dot4 + t106*mu_dot0 - t62*mu_dot5)
+    t144 = mu_dot0 - t106*t143
+    t145 = mu_dot1 - t72*t143
+    t146 = mu_dot2 - t74*t143
+    t147 = mu_dot3 - t77*t143
+    t148 = mu_dot4 - t70*t143
+    t149 = mu_dot5 + t62*t143
+    t150 = xp.sqrt(t110**2 + t111**2 + t112**2 + t113**2 + t114**2)
+    t151 = t150*xp.where(xp.greater_equal(t110, 0), xp.asarray(1, dtype=dtype), -1)
+    t152 = t110 + t151
+    t153 = xp.where(xp.greater(t150, 0), 1/(t150*(t150 + xp.abs(t110))), 0)
+    t154 = -t153*(t111*t118 + t112*t119 + t113*t120 + t117*t152 - t114*t121)
+    t155 = t117 + t152*t154
+    t156 = t118 + t111*t154
+    t157 = t119 + t112*t154
+    t158 = t120 + t113*t154
+    t159 = t121 - t114*t154
+    t160 = -t153*(t111*t125 + t112*t126 + t124*t152 - t113*t127 - t114*t128)
+    t161 = t124 + t152*t160
+    t162 = t125 + t111*t160
+    t163 = t126 + t112*t160
+    t164 = t127 - t113*t160
+    t165 = t128 - t114*t160
+    t166 = t153*(t111*t132 + t113*t134 + t114*t135 + t131*t152 - t112*t133)
+    t167 = t131 - t152*t166
+    t168 = -t132 + t111*t166
+    t169 = t133 + t112*t166
+    t170 = t134 - t113*t166
+    t171 = t135 - t114*t166
+    t172 = t153*(t113*t141 + t114*t142 + t138*t152 - t111*t139 - t112*t140)
+    t173 = t138 - t152*t172
+    t174 = t139 + t111*t172
+    t175 = t140 + t112*t172
+    t176 = t141 - t113*t172
+    t177 = t142 - t114*t172
+    t178 = t153*(t113*t148 + t114*t149 + t145*t152 - t111*t146 - t112*t147)
+    t179 = t145 - t152*t178
+    t180 = t146 + t111*t178
+    t181 = t147 + t112*t178
+    t182 = t148 - t113*t178
+    t183 = t149 - t114*t178
+    t184 = xp.sqrt(t156**2 + t157**2 + t158**2 + t159**2)
+    t185 = t184*xp.where(xp.greater_equal(t156, 0), xp.asarray(1, dtype=dtype), -1)
+    t186 = t156 + t185
+    t187 = xp.where(xp.greater(t184, 0), 1/(t184*(t184 + xp.abs(t156))), 0)
+    t188 = t187*(t157*t163 + t159*t165 + t162*t186 - t158*t164)
+    t189 = t162 - t186*t188
+    t190 = t163 - t157*t188
+    t191 = t164 + t158*t188
+    t192 = t165 - t159*t188
+    t193 = t187*(t157*t169 + t159*t171 + t168*t186 - t158*t170)
+    t194 = t168 - t186*t193
+    t195 = t169 - t157*t193
+    t196 = t170 + t158*t193
+    t197 = t171 - t159*t193
+    t198 = t187*(t157*t175 + t159*t177 + t174*t186 - t158*t176)
+    t199 = t174 - t186*t198
+    t200 = t175 - t157*t198
+    t201 = t176 + t158*t198
+    t202 = t177 - t159*t198
+    t203 = t187*(t157*t181 + t159*t183 + t180*t186 - t158*t182)
+    t204 = t180 - t186*t203
+    t205 = t181 - t157*t203
+    t206 = t182 + t158*t203
+    t207 = t183 - t159*t203
+    t208 = xp.sqrt(t190**2 + t191**2 + t192**2)
+    t209 = t208*xp.where(xp.greater_equal(t190, 0), xp.asarray(1, dtype=dtype), -1)
+    t210 = t190 + t209
+    t211 = xp.where(xp.greater(t208, 0), 1/(t208*(t208 + xp.abs(t190))), 0)
+    t212 = t211*(t191*t196 + t192*t197 + t195*t210)
+    t213 = t195 - t210*t212
+    t214 = t196 - t191*t212
+    t215 = t197 - t192*t212
+    t216 = t211*(t191*t201 + t192*t202 + t200*t210)
+    t217 = t200 - t210*t216
+    t218 = t201 - t191*t216
+    t219 = t202 - t192*t216
+    t220 = t211*(t191*t206 + t192*t207 + t205*t210)
+    t221 = t205 - t210*t220
+    t222 = t206 - t191*t220
+    t223 = t207 - t192*t220
+    t224 = xp.sqrt(t214**2 + t215**2)
+    t225 = t224*xp.where(xp.greater_equal(t214, 0), xp.asarray(1, dtype=dtype), -1)
+    t226 = t214 + t225
+    t227 = xp.where(xp.greater(t224, 0), 1/(t224*(t224 + xp.abs(t214))), 0)
+    t228 = t227*(t215*t219 + t218*t226)
+    t229 = t218 - t226*t228
+    t230 = t219 - t215*t228
+    t231 = t227*(t215*t223 + t222*t226)
+    t232 = t222 - t226*t231
+    t233 = t223 - t215*t231
+    t234 = xp.abs(t230)
     t235 = t234
-    t236 = t235*xp.where(xp.greater_equal(t233, 0), xp.asarray(1, dtype=dtype), -1)
-    t237 = t233 + t236
+    t236 = t235*xp.where(xp.greater_equal(t230, 0), xp.asarray(1, dtype=dtype), -1)
+    t237 = t230 + t236
     t238 = xp.where(xp.greater(t235, 0), 1/(t235*(t235 + t234)), 0)
-    t239 = t206 - t206*t238*t237**2
+    t239 = t233 - t233*t238*t237**2
     t240 = xp.where(xp.not_equal(t236, 0), -t239/t236, 0)
-    t241 = xp.where(xp.not_equal(t201, 0), -(t205 - t232*t240)/t201, 0)
-    t242 = xp.where(xp.not_equal(t170, 0), -(t174 - (t197*t241 + t228*t240))/t170, 0)
-    t243 = xp.where(xp.not_equal(t142, 0), -(t146 - (t165*t242 + t192*t241 + t223*t240))/t142, 0)
-    t244 = xp.where(xp.not_equal(t118, 0), -(t122 - (t186*t241 + t217*t240 - t136*t243 - t159*t242))/t118, 0)
-    t245 = xp.where(xp.not_equal(t99, 0), -(t103 - (t111*t244 + t129*t243 + t152*t242 + t179*t241 - t210*t240))/t99, 0)
+    t241 = xp.where(xp.not_equal(t225, 0), -(t232 - t229*t240)/t225, 0)
+    t242 = xp.where(xp.not_equal(t209, 0), -(t221 - (t213*t241 + t217*t240))/t209, 0)
+    t243 = xp.where(xp.not_equal(t185, 0), -(t204 - (t189*t242 + t194*t241 + t199*t240))/t185, 0)
+    t244 = xp.where(xp.not_equal(t151, 0), -(t179 - (t167*t241 + t173*t240 - t155*t243 - t161*t242))/t151, 0)
+    t245 = xp.where(xp.not_equal(t105, 0), -(t144 - (t109*t244 + t116*t243 + t123*t242 + t130*t241 - t137*t240))/t105, 0)
     t246 = t240 + t244*t19 - t245*t31
-    t247 = t241*c1 + t244*t60 + t245*t63 - t242*s1 - t243*t32
-    t248 = t240*c2 + t241*t20 + t242*t8 + t243*t33 + t244*t64 + t245*t61
-    t249 = t242*t6 + t243*t34 + t245*t51 - t240*t42 - t241*t3 - t244*t54
+    t247 = t241*c1 - t242*s1 - t243*t32 + t244*t60 + t245*t63
+    t248 = t240*c2 + t243*t33 + t244*t64 + t245*t61 + t241*t20 + t242*t8
+    t249 = t242*t6 + t243*t34 + t245*t51 - t241*t3 - t244*t54 - t240*t42
     t250 = t11*t242 + t23*t241 + t41*t240 + t243*t35 + t244*t55 + t245*t52
     t251 = t13*t242 + t243*t36 + t245*t53 - t25*t241 - t44*t240 - t244*t56
     t252 = t240*t46 + t241*t27 + t242*t15
     t253 = xp.isfinite(t66)
     t254 = xp.greater_equal(damping, 0)
-    t255 = 1e-12*t208
-    t256 = xp.less_equal(t98, t255) | xp.less_equal(t117, t255) | xp.less_equal(t141, t255) | xp.less_equal(t169, t255) | xp.less_equal(t200, t255) | xp.less_equal(t235, t255)
+    t255 = 1e-12*t103
+    t256 = xp.less_equal(t104, t255) | xp.less_equal(t150, t255) | xp.less_equal(t184, t255) | xp.less_equal(t208, t255) | xp.less_equal(t224, t255) | xp.less_equal(t235, t255)
     t257 = t253 & t254 & xp.logical_not(t256)
     q_dot = _stack(xp, [
         xp.broadcast_to(xp.where(t257, t246, 0), batch),  # 0
@@ -2764,10 +2764,10 @@ def ik_numeric_step(target, q, damping=0.0):
     t12 = c3*s2
     t13 = 0.316*c2 - 0.0825*t12
     t14 = c2*s4 - t12*c4
-    t15 = t12*s4 + c2*c4
+    t15 = c2*c4 + t12*s4
     t16 = c1*s2
     t17 = t3*c4 + t16*s4
-    t18 = t16*c4 - t3*s4
+    t18 = -t3*s4 + t16*c4
     t19 = t17*c5 - t7*s5
     t20 = t17*s5 + t7*c5
     t21 = t18*s6 + t19*c6
@@ -2781,7 +2781,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t29 = T03 - t28
     t30 = s1*s2
     t31 = t8*c4 + t30*s4
-    t32 = t30*c4 - t8*s4
+    t32 = -t8*s4 + t30*c4
     t33 = t31*c5 + t4*s5
     t34 = t4*c5 - t31*s5
     t35 = t32*s6 + t33*c6
@@ -2801,7 +2801,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t49 = T13 - t42
     t50 = s2*s3
     t51 = t14*c5 + t50*s5
-    t52 = t50*c5 - t14*s5
+    t52 = -t14*s5 + t50*c5
     t53 = t15*s6 + t51*c6
     t54 = t15*c6 - t51*s6
     t55 = t53*c7 - t52*s7
@@ -2811,24 +2811,24 @@ def ik_numeric_step(target, q, damping=0.0):
     t59 = t58 - 0.0825*t14
     t60 = t13 + t59
     t61 = 0.333 + t60
-    t62 = t60*t30 - t42*c2
-    t63 = t41*t50 - t59*t4
+    t62 = -t42*c2 + t60*t30
+    t63 = -t59*t4 + t41*t50
     t64 = t32*t58 - t15*t40
     t65 = t52*t39 - t34*t57
     t66 = t28*c2 - t60*t16
-    t67 = t27*t50 + t59*t7
+    t67 = t59*t7 + t27*t50
     t68 = t15*t26 - t18*t58
     t69 = t20*t57 + t52*t25
-    t70 = t42 + t52*t65 + t63*t50 - t15*t64 - t62*c2
+    t70 = t42 + t52*t65 - t15*t64 - t62*c2 + t63*t50
     t71 = t28 + t15*t68 + t52*t69 + t66*c2 + t67*t50
     t72 = t15*t46 + t44*c2 - t52*t47 - t45*t50
-    t73 = t18*t15 + t22*t54 + t16*c2 - t20*t52 - t7*t50
+    t73 = t18*t15 + t22*t54 - t20*t52 + t16*c2 - t7*t50
     t74 = t32*t15 + t34*t52 + t36*t54 + t4*t50 + t30*c2
     t75 = T23 - t61
     t76 = 0.7071067811865476*t23
     t77 = 0.7071067811865476*t24
     t78 = t76 - t77
-    t79 = t77 + t76
+    t79 = t76 + t77
     t80 = T00*t78 + T01*t79 - T02*t22
     t81 = T10*t78 + T11*t79 - T12*t22
     t82 = T20*t78 + T21*t79 - T22*t22
@@ -2856,25 +2856,25 @@ def ik_numeric_step(target, q, damping=0.0):
     t104 = t60**2
     t105 = c1**2
     t106 = t42**2 + t62**2 + t63**2 + t64**2 + t65**2 + t104*t105
-    t107 = t32*t64 + t60*t105 + t62*t30 - t34*t65 - t63*t4
+    t107 = t32*t64 + t60*t105 - t34*t65 - t63*t4 + t62*t30
     t108 = c1*s1
-    t109 = t62*t66 + t64*t68 + t104*t108 - t28*t42 - t63*t67 - t65*t69
+    t109 = t62*t66 + t64*t68 - t28*t42 - t63*t67 - t65*t69 + t104*t108
     t110 = t43*c1
     t111 = t62*t44 + t63*t45 + t64*t46 + t65*t47 - t60*t110
-    t112 = t110 + t34*t47 + t45*t4 - t32*t46 - t44*t30
+    t112 = t34*t47 + t110 + t45*t4 - t32*t46 - t44*t30
     t113 = t60*t108
-    t114 = -t113 + t18*t64 + t20*t65 + t7*t63 + t62*t16
-    t115 = t113 + t32*t68 + t34*t69 + t66*t30 + t67*t4
+    t114 = t18*t64 + t20*t65 + t7*t63 + t62*t16 - t113
+    t115 = t32*t68 + t34*t69 + t67*t4 + t113 + t66*t30
     t116 = s1**2
     t117 = t28**2 + t66**2 + t67**2 + t68**2 + t69**2 + t104*t116
     t118 = t20*t69 + t60*t116 + t7*t67 - t18*t68 - t66*t16
     t119 = t43*s1
-    t120 = t60*t119 + t67*t45 + t69*t47 - t66*t44 - t68*t46
-    t121 = t119 + t18*t46 + t20*t47 + t7*t45 + t44*t16
+    t120 = t67*t45 + t69*t47 - t66*t44 - t68*t46 + t60*t119
+    t121 = t18*t46 + t20*t47 + t7*t45 + t119 + t44*t16
     t122 = s2**2
-    t123 = t116 + t18**2 + t20**2 + t22**2 + t7**2 + t105*t122
-    t124 = -t108 + t18*t32 + t22*t36 + t108*t122 - t20*t34 - t7*t4
-    t125 = t105 + t32**2 + t34**2 + t36**2 + t4**2 + t116*t122
+    t123 = t18**2 + t20**2 + t22**2 + t7**2 + t116 + t105*t122
+    t124 = t18*t32 + t22*t36 - t20*t34 - t7*t4 - t108 + t108*t122
+    t125 = t32**2 + t34**2 + t36**2 + t4**2 + t105 + t116*t122
     t126 = 1 + t15**2 + t52**2 + t54**2 + c2**2 + t122*s3**2
     t127 = xp.greater_equal(t80, t88) & xp.greater_equal(t80, t97)
     t128 = xp.greater_equal(t88, t97)
@@ -3039,8 +3039,8 @@ def ik_numeric_step(target, q, damping=0.0):
     t287 = xp.where(xp.not_equal(t142, 0), -(t146 - (t154*t286 + t172*t285 + t195*t284 + t222*t283 - t252*t282))/t142, 0)
     t288 = t282 + q1 + t286*t28 - t287*t42
     t289 = q2 + t283*c1 - t284*s1 - t285*t43 + t286*t60*s1 + t287*t60*c1
-    t290 = q3 + t282*c2 + t283*t30 + t284*t16 + t285*t44 + t286*t66 + t287*t62
-    t291 = q4 + t284*t7 + t285*t45 + t287*t63 - t282*t50 - t283*t4 - t286*t67
+    t290 = q3 + t282*c2 + t285*t44 + t286*t66 + t287*t62 + t283*t30 + t284*t16
+    t291 = q4 + t284*t7 + t285*t45 + t287*t63 - t283*t4 - t286*t67 - t282*t50
     t292 = q5 + t18*t284 + t32*t283 + t15*t282 + t285*t46 + t286*t68 + t287*t64
     t293 = q6 + t20*t284 + t285*t47 + t287*t65 - t34*t283 - t52*t282 - t286*t69
     t294 = -q7 + t22*t284 + t36*t283 + t54*t282
@@ -3106,7 +3106,7 @@ def ik_branches(T, q_free):
     t17 = T03*t14 + T13*t15 + T23*t16
     t18 = -t17 + 0.333*t16
     t19 = t18**2
-    t20 = t19 + t12**2 + t2**2
+    t20 = t12**2 + t19 + t2**2
     t21 = 0.5*(0.2609245 - t20)
     t22 = t21**2
     t23 = 1 - 60.77564796097323*t22
@@ -3119,16 +3119,16 @@ def ik_branches(T, q_free):
     t30 = -2.6745902299367814 - t28
     t31 = t29 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t29))
     t32 = t30 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t30))
-    t33 = 7.795873777901566*t27
-    t34 = 0.11453775*t33
-    t35 = 7.795873777901566*t25
-    t36 = 0.05775*t35
-    t37 = t36 - t34
-    t38 = t34 + t36
-    t39 = 0.05775*t33
-    t40 = 0.11453775*t35
+    t33 = 7.795873777901566*t25
+    t34 = 0.05775*t33
+    t35 = 7.795873777901566*t27
+    t36 = 0.11453775*t35
+    t37 = t34 - t36
+    t38 = t36 + t34
+    t39 = 0.11453775*t33
+    t40 = 0.05775*t35
     t41 = -(t39 + t40)
-    t42 = t40 - t39
+    t42 = t39 - t40
     t43 = 0.316*t41 - 0.0825*t37
     t44 = 0.316*t37 + 0.0825*t41
     t45 = 0.0825 + t43
@@ -3178,9 +3178,9 @@ def ik_branches(T, q_free):
     t89 = -t54
     t90 = t87 + t89
     t91 = t88 + t89
-    t92 = t53*t19
-    t93 = t92 + t90**2
-    t94 = t92 + t91**2
+    t92 = t19*t53
+    t93 = t90**2 + t92
+    t94 = t91**2 + t92
     t95 = t55*t76
     t96 = xp.less_equal(t93, t95)
     t97 = xp.where(t96, 1, 1/xp.sqrt(t93))
@@ -3230,7 +3230,7 @@ def ik_branches(T, q_free):
     t141 = t136 - t127*t140
     t142 = t141 + t137
     t143 = t133**2
-    t144 = t136 + t143 + t127**2
+    t144 = t127**2 + t143 + t136
     t145 = t140**2
     t146 = t142**2 + t143*t145
     t147 = t136 + t145
@@ -3285,7 +3285,7 @@ def ik_branches(T, q_free):
     t196 = t191 - t187*t195
     t197 = t196 + t192
     t198 = t179**2
-    t199 = t191 + t198 + t187**2
+    t199 = t187**2 + t198 + t191
     t200 = t195**2
     t201 = t197**2 + t198*t200
     t202 = t191 + t200
@@ -3349,8 +3349,8 @@ def ik_branches(T, q_free):
     t260 = t257 + t259
     t261 = t258 + t259
     t262 = t19*t224
-    t263 = t262 + t260**2
-    t264 = t262 + t261**2
+    t263 = t260**2 + t262
+    t264 = t261**2 + t262
     t265 = t226*t246
     t266 = xp.less_equal(t263, t265)
     t267 = xp.where(t266, 1, 1/xp.sqrt(t263))
@@ -3400,7 +3400,7 @@ def ik_branches(T, q_free):
     t311 = t306 + t297*t310
     t312 = t311 + t307
     t313 = t303**2
-    t314 = t306 + t313 + t297**2
+    t314 = t297**2 + t313 + t306
     t315 = t310**2
     t316 = t312**2 + t313*t315
     t317 = t306 + t315
@@ -3455,7 +3455,7 @@ def ik_branches(T, q_free):
     t366 = t361 + t357*t365
     t367 = t366 + t362
     t368 = t349**2
-    t369 = t361 + t368 + t357**2
+    t369 = t357**2 + t368 + t361
     t370 = t365**2
     t371 = t367**2 + t368*t370
     t372 = t361 + t370
@@ -3481,30 +3481,30 @@ def ik_branches(T, q_free):
     t392 = t391
     t393 = t391 + t390**2
     t394 = xp.where(t78, 0, xp.atan2(-t72, t68))
-    t395 = t394 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t394))
+    t395 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t394)) + t394
     t396 = -t395
     t397 = t395 + 6.283185307179586*xp.floor(0.15915494309189535*(0.0175 + t396))
     t398 = xp.where(t96, 0, xp.atan2(t99, t90))
-    t399 = t398 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t398))
+    t399 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t398)) + t398
     t400 = -t399
     t401 = t399 + 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t400))
     t402 = -t31
     t403 = t31 + 6.283185307179586*xp.floor(0.15915494309189535*(3.0718 + t402))
     t404 = xp.where(t149, 0, xp.atan2(-t154, t142))
     t405 = 3.141592653589793 + t404
-    t406 = t404 + 6.283185307179586*xp.ceil(-0.15915494309189535*t405)
+    t406 = 6.283185307179586*xp.ceil(-0.15915494309189535*t405) + t404
     t407 = t405 + 6.283185307179586*xp.ceil(-0.15915494309189535*(6.283185307179586 + t404))
     t408 = -t406
     t409 = t406 + 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t408))
     t410 = xp.where(t158, 0, xp.atan2(-t140, -t128))
-    t411 = t410 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t410))
+    t411 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t410)) + t410
     t412 = t410
     t413 = t412 - 6.283185307179586*xp.floor(0.15915494309189535*(1.7627999999999997 + t412))
     t414 = -t411
     t415 = t411 + 6.283185307179586*xp.floor(0.15915494309189535*(1.7627999999999997 + t414))
     t416 = xp.where(xp.less_equal(t167, 1e-24*t168), 0, xp.atan2(t164, t163))
     t417 = 3.141592653589793 + t416
-    t418 = t416 + 6.283185307179586*xp.ceil(-0.15915494309189535*t417)
+    t418 = 6.283185307179586*xp.ceil(-0.15915494309189535*t417) + t416
     t419 = t417 + 6.283185307179586*xp.ceil(-0.15915494309189535*(6.283185307179586 + t416))
     t420 = -t418
     t421 = t418 + 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t420))
@@ -3513,28 +3513,28 @@ def ik_branches(T, q_free):
     t424 = -t419
     t425 = t419 + 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t424))
     t426 = xp.where(t101, 0, xp.atan2(-t74, t69))
-    t427 = t426 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t426))
+    t427 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t426)) + t426
     t428 = -t427
     t429 = t427 + 6.283185307179586*xp.floor(0.15915494309189535*(0.0175 + t428))
     t430 = xp.where(t109, 0, xp.atan2(t99, t91))
-    t431 = t430 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t430))
+    t431 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t430)) + t430
     t432 = -t431
     t433 = t431 + 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t432))
     t434 = xp.where(t204, 0, xp.atan2(-t209, t197))
     t435 = 3.141592653589793 + t434
-    t436 = t434 + 6.283185307179586*xp.ceil(-0.15915494309189535*t435)
+    t436 = 6.283185307179586*xp.ceil(-0.15915494309189535*t435) + t434
     t437 = t435 + 6.283185307179586*xp.ceil(-0.15915494309189535*(6.283185307179586 + t434))
     t438 = -t436
     t439 = t436 + 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t438))
     t440 = xp.where(t213, 0, xp.atan2(-t195, -t188))
-    t441 = t440 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t440))
+    t441 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t440)) + t440
     t442 = t440
     t443 = t442 - 6.283185307179586*xp.floor(0.15915494309189535*(1.7627999999999997 + t442))
     t444 = -t441
     t445 = t441 + 6.283185307179586*xp.floor(0.15915494309189535*(1.7627999999999997 + t444))
     t446 = xp.where(xp.less_equal(t222, 1e-24*t223), 0, xp.atan2(t219, t218))
     t447 = 3.141592653589793 + t446
-    t448 = t446 + 6.283185307179586*xp.ceil(-0.15915494309189535*t447)
+    t448 = 6.283185307179586*xp.ceil(-0.15915494309189535*t447) + t446
     t449 = t447 + 6.283185307179586*xp.ceil(-0.15915494309189535*(6.283185307179586 + t446))
     t450 = -t448
     t451 = t448 + 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t450))
@@ -3543,30 +3543,30 @@ def ik_branches(T, q_free):
     t454 = -t449
     t455 = t449 + 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t454))
     t456 = xp.where(t248, 0, xp.atan2(-t242, t237))
-    t457 = t456 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t456))
+    t457 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t456)) + t456
     t458 = -t457
     t459 = t457 + 6.283185307179586*xp.floor(0.15915494309189535*(0.0175 + t458))
     t460 = xp.where(t266, 0, xp.atan2(t269, t260))
-    t461 = t460 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t460))
+    t461 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t460)) + t460
     t462 = -t461
     t463 = t461 + 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t462))
     t464 = -t32
     t465 = t32 + 6.283185307179586*xp.floor(0.15915494309189535*(3.0718 + t464))
     t466 = xp.where(t319, 0, xp.atan2(-t324, t312))
     t467 = 3.141592653589793 + t466
-    t468 = t466 + 6.283185307179586*xp.ceil(-0.15915494309189535*t467)
+    t468 = 6.283185307179586*xp.ceil(-0.15915494309189535*t467) + t466
     t469 = t467 + 6.283185307179586*xp.ceil(-0.15915494309189535*(6.283185307179586 + t466))
     t470 = -t468
     t471 = t468 + 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t470))
     t472 = xp.where(t328, 0, xp.atan2(-t310, t298))
-    t473 = t472 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t472))
+    t473 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t472)) + t472
     t474 = t472
     t475 = t474 - 6.283185307179586*xp.floor(0.15915494309189535*(1.7627999999999997 + t474))
     t476 = -t473
     t477 = t473 + 6.283185307179586*xp.floor(0.15915494309189535*(1.7627999999999997 + t476))
     t478 = xp.where(xp.less_equal(t337, 1e-24*t338), 0, xp.atan2(t334, t333))
     t479 = 3.141592653589793 + t478
-    t480 = t478 + 6.283185307179586*xp.ceil(-0.15915494309189535*t479)
+    t480 = 6.283185307179586*xp.ceil(-0.15915494309189535*t479) + t478
     t481 = t479 + 6.283185307179586*xp.ceil(-0.15915494309189535*(6.283185307179586 + t478))
     t482 = -t480
     t483 = t480 + 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t482))
@@ -3575,28 +3575,28 @@ def ik_branches(T, q_free):
     t486 = -t481
     t487 = t481 + 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t486))
     t488 = xp.where(t271, 0, xp.atan2(-t244, t239))
-    t489 = t488 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t488))
+    t489 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t488)) + t488
     t490 = -t489
     t491 = t489 + 6.283185307179586*xp.floor(0.15915494309189535*(0.0175 + t490))
     t492 = xp.where(t279, 0, xp.atan2(t269, t261))
-    t493 = t492 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t492))
+    t493 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t492)) + t492
     t494 = -t493
     t495 = t493 + 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t494))
     t496 = xp.where(t374, 0, xp.atan2(-t379, t367))
     t497 = 3.141592653589793 + t496
-    t498 = t496 + 6.283185307179586*xp.ceil(-0.15915494309189535*t497)
+    t498 = 6.283185307179586*xp.ceil(-0.15915494309189535*t497) + t496
     t499 = t497 + 6.283185307179586*xp.ceil(-0.15915494309189535*(6.283185307179586 + t496))
     t500 = -t498
     t501 = t498 + 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t500))
     t502 = xp.where(t383, 0, xp.atan2(-t365, t358))
-    t503 = t502 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t502))
+    t503 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t502)) + t502
     t504 = t502
     t505 = t504 - 6.283185307179586*xp.floor(0.15915494309189535*(1.7627999999999997 + t504))
     t506 = -t503
     t507 = t503 + 6.283185307179586*xp.floor(0.15915494309189535*(1.7627999999999997 + t506))
     t508 = xp.where(xp.less_equal(t392, 1e-24*t393), 0, xp.atan2(t389, t388))
     t509 = 3.141592653589793 + t508
-    t510 = t508 + 6.283185307179586*xp.ceil(-0.15915494309189535*t509)
+    t510 = 6.283185307179586*xp.ceil(-0.15915494309189535*t509) + t508
     t511 = t509 + 6.283185307179586*xp.ceil(-0.15915494309189535*(6.283185307179586 + t508))
     t512 = -t510
     t513 = t510 + 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t512))
@@ -4001,7 +4001,7 @@ def ik_nearest(T, q_seed, q_free, weights=(1.0,) * DOF):
     t86 = -qn5
     t87 = -qn6
     t88 = -qn7
-    t89 = qw1*(t61 + t82)**2 + qw2*(t65 + t83)**2 + qw3*(t69 + t84)**2 + qw4*(t73 + t85)**2 + qw5*(t77 + t86)**2 + qw6*(t81 + t87)**2 + qw7*(t88 + qb0_6)**2
+    t89 = qw1*(t61 + t82)**2 + qw2*(t65 + t83)**2 + qw3*(t69 + t84)**2 + qw4*(t73 + t85)**2 + qw5*(t77 + t86)**2 + qw6*(t81 + t87)**2 + qw7*(qb0_6 + t88)**2
     t90 = xp.greater(t7, 0)
     t91 = xp.where(t90, t61, qn1)
     t92 = xp.where(t90, t65, qn2)
@@ -4035,7 +4035,7 @@ def ik_nearest(T, q_seed, q_free, weights=(1.0,) * DOF):
     t120 = t13 + t119
     t121 = t13 - t119
     t122 = xp.where(xp.greater_equal(t13, -0.0175) & xp.less_equal(t13, 3.7525000000000004), t13, xp.where(xp.greater_equal(t120, -0.0175) & xp.less_equal(t120, 3.7525000000000004), t120, xp.where(xp.greater_equal(t121, -0.0175) & xp.less_equal(t121, 3.7525000000000004), t121, qb1_5)))
-    t123 = qw1*(t102 + t82)**2 + qw2*(t106 + t83)**2 + qw3*(t110 + t84)**2 + qw4*(t114 + t85)**2 + qw5*(t118 + t86)**2 + qw6*(t122 + t87)**2 + qw7*(t88 + qb1_6)**2
+    t123 = qw1*(t102 + t82)**2 + qw2*(t106 + t83)**2 + qw3*(t110 + t84)**2 + qw4*(t114 + t85)**2 + qw5*(t118 + t86)**2 + qw6*(t122 + t87)**2 + qw7*(qb1_6 + t88)**2
     t124 = xp.greater(t14, 0)
     t125 = xp.where(t124 & (xp.less(t7, 1) | xp.less(t123, t98)), xp.asarray(1, dtype=dtype), 0)
     t126 = xp.where(t124, 1, t7)
@@ -4072,7 +4072,7 @@ def ik_nearest(T, q_seed, q_free, weights=(1.0,) * DOF):
     t157 = t20 + t156
     t158 = t20 - t156
     t159 = xp.where(xp.greater_equal(t20, -0.0175) & xp.less_equal(t20, 3.7525000000000004), t20, xp.where(xp.greater_equal(t157, -0.0175) & xp.less_equal(t157, 3.7525000000000004), t157, xp.where(xp.greater_equal(t158, -0.0175) & xp.less_equal(t158, 3.7525000000000004), t158, qb2_5)))
-    t160 = qw1*(t139 + t82)**2 + qw2*(t143 + t83)**2 + qw3*(t147 + t84)**2 + qw4*(t151 + t85)**2 + qw5*(t155 + t86)**2 + qw6*(t159 + t87)**2 + qw7*(t88 + qb2_6)**2
+    t160 = qw1*(t139 + t82)**2 + qw2*(t143 + t83)**2 + qw3*(t147 + t84)**2 + qw4*(t151 + t85)**2 + qw5*(t155 + t86)**2 + qw6*(t159 + t87)**2 + qw7*(qb2_6 + t88)**2
     t161 = xp.greater(t21, 0)
     t162 = xp.where(t161 & (xp.less(t160, t135) | xp.less(t126, 1)), xp.asarray(1, dtype=dtype), 0)
     t163 = xp.where(t161, 1, t126)
@@ -4109,7 +4109,7 @@ def ik_nearest(T, q_seed, q_free, weights=(1.0,) * DOF):
     t194 = t27 + t193
     t195 = t27 - t193
     t196 = xp.where(xp.greater_equal(t27, -0.0175) & xp.less_equal(t27, 3.7525000000000004), t27, xp.where(xp.greater_equal(t194, -0.0175) & xp.less_equal(t194, 3.7525000000000004), t194, xp.where(xp.greater_equal(t195, -0.0175) & xp.less_equal(t195, 3.7525000000000004), t195, qb3_5)))
-    t197 = qw1*(t176 + t82)**2 + qw2*(t180 + t83)**2 + qw3*(t184 + t84)**2 + qw4*(t188 + t85)**2 + qw5*(t192 + t86)**2 + qw6*(t196 + t87)**2 + qw7*(t88 + qb3_6)**2
+    t197 = qw1*(t176 + t82)**2 + qw2*(t180 + t83)**2 + qw3*(t184 + t84)**2 + qw4*(t188 + t85)**2 + qw5*(t192 + t86)**2 + qw6*(t196 + t87)**2 + qw7*(qb3_6 + t88)**2
     t198 = xp.greater(t28, 0)
     t199 = xp.where(t198 & (xp.less(t163, 1) | xp.less(t197, t172)), xp.asarray(1, dtype=dtype), 0)
     t200 = xp.where(t198, 1, t163)
@@ -4146,7 +4146,7 @@ def ik_nearest(T, q_seed, q_free, weights=(1.0,) * DOF):
     t231 = t34 + t230
     t232 = t34 - t230
     t233 = xp.where(xp.greater_equal(t34, -0.0175) & xp.less_equal(t34, 3.7525000000000004), t34, xp.where(xp.greater_equal(t231, -0.0175) & xp.less_equal(t231, 3.7525000000000004), t231, xp.where(xp.greater_equal(t232, -0.0175) & xp.less_equal(t232, 3.7525000000000004), t232, qb4_5)))
-    t234 = qw1*(t213 + t82)**2 + qw2*(t217 + t83)**2 + qw3*(t221 + t84)**2 + qw4*(t225 + t85)**2 + qw5*(t229 + t86)**2 + qw6*(t233 + t87)**2 + qw7*(t88 + qb4_6)**2
+    t234 = qw1*(t213 + t82)**2 + qw2*(t217 + t83)**2 + qw3*(t221 + t84)**2 + qw4*(t225 + t85)**2 + qw5*(t229 + t86)**2 + qw6*(t233 + t87)**2 + qw7*(qb4_6 + t88)**2
     t235 = xp.greater(t35, 0)
     t236 = xp.where(t235 & (xp.less(t200, 1) | xp.less(t234, t209)), xp.asarray(1, dtype=dtype), 0)
     t237 = xp.where(t235, 1, t200)
@@ -4183,7 +4183,7 @@ def ik_nearest(T, q_seed, q_free, weights=(1.0,) * DOF):
     t268 = t41 + t267
     t269 = t41 - t267
     t270 = xp.where(xp.greater_equal(t41, -0.0175) & xp.less_equal(t41, 3.7525000000000004), t41, xp.where(xp.greater_equal(t268, -0.0175) & xp.less_equal(t268, 3.7525000000000004), t268, xp.where(xp.greater_equal(t269, -0.0175) & xp.less_equal(t269, 3.7525000000000004), t269, qb5_5)))
-    t271 = qw1*(t250 + t82)**2 + qw2*(t254 + t83)**2 + qw3*(t258 + t84)**2 + qw4*(t262 + t85)**2 + qw5*(t266 + t86)**2 + qw6*(t270 + t87)**2 + qw7*(t88 + qb5_6)**2
+    t271 = qw1*(t250 + t82)**2 + qw2*(t254 + t83)**2 + qw3*(t258 + t84)**2 + qw4*(t262 + t85)**2 + qw5*(t266 + t86)**2 + qw6*(t270 + t87)**2 + qw7*(qb5_6 + t88)**2
     t272 = xp.greater(t42, 0)
     t273 = xp.where(t272 & (xp.less(t237, 1) | xp.less(t271, t246)), xp.asarray(1, dtype=dtype), 0)
     t274 = xp.where(t272, 1, t237)
@@ -4220,7 +4220,7 @@ def ik_nearest(T, q_seed, q_free, weights=(1.0,) * DOF):
     t305 = t48 + t304
     t306 = t48 - t304
     t307 = xp.where(xp.greater_equal(t48, -0.0175) & xp.less_equal(t48, 3.7525000000000004), t48, xp.where(xp.greater_equal(t305, -0.0175) & xp.less_equal(t305, 3.7525000000000004), t305, xp.where(xp.greater_equal(t306, -0.0175) & xp.less_equal(t306, 3.7525000000000004), t306, qb6_5)))
-    t308 = qw1*(t287 + t82)**2 + qw2*(t291 + t83)**2 + qw3*(t295 + t84)**2 + qw4*(t299 + t85)**2 + qw5*(t303 + t86)**2 + qw6*(t307 + t87)**2 + qw7*(t88 + qb6_6)**2
+    t308 = qw1*(t287 + t82)**2 + qw2*(t291 + t83)**2 + qw3*(t295 + t84)**2 + qw4*(t299 + t85)**2 + qw5*(t303 + t86)**2 + qw6*(t307 + t87)**2 + qw7*(qb6_6 + t88)**2
     t309 = xp.greater(t49, 0)
     t310 = xp.where(t309 & (xp.less(t274, 1) | xp.less(t308, t283)), xp.asarray(1, dtype=dtype), 0)
     t311 = xp.where(t309, 1, t274)
@@ -4257,7 +4257,7 @@ def ik_nearest(T, q_seed, q_free, weights=(1.0,) * DOF):
     t342 = t55 + t341
     t343 = t55 - t341
     t344 = xp.where(xp.greater_equal(t55, -0.0175) & xp.less_equal(t55, 3.7525000000000004), t55, xp.where(xp.greater_equal(t342, -0.0175) & xp.less_equal(t342, 3.7525000000000004), t342, xp.where(xp.greater_equal(t343, -0.0175) & xp.less_equal(t343, 3.7525000000000004), t343, qb7_5)))
-    t345 = qw1*(t324 + t82)**2 + qw2*(t328 + t83)**2 + qw3*(t332 + t84)**2 + qw4*(t336 + t85)**2 + qw5*(t340 + t86)**2 + qw6*(t344 + t87)**2 + qw7*(t88 + qb7_6)**2
+    t345 = qw1*(t324 + t82)**2 + qw2*(t328 + t83)**2 + qw3*(t332 + t84)**2 + qw4*(t336 + t85)**2 + qw5*(t340 + t86)**2 + qw6*(t344 + t87)**2 + qw7*(qb7_6 + t88)**2
     t346 = xp.greater(t56, 0)
     t347 = xp.where(t346 & (xp.less(t311, 1) | xp.less(t345, t320)), xp.asarray(1, dtype=dtype), 0)
     t348 = xp.where(t346, 1, t311)

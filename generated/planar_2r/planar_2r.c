@@ -225,9 +225,9 @@ void planar_2r_fk_jacobian_dot(const planar_2r_real q[PLANAR_2R_DOF], const plan
     const planar_2r_real t0 = c1 + c12;
     const planar_2r_real t1 = s1 + s12;
     const planar_2r_real t2 = qd2*s12;
-    const planar_2r_real t3 = t2 + t1*qd1;
+    const planar_2r_real t3 = t1*qd1 + t2;
     const planar_2r_real t4 = c12*qd2;
-    const planar_2r_real t5 = t4 + t0*qd1;
+    const planar_2r_real t5 = t0*qd1 + t4;
     const planar_2r_real t6 = -s12;
 
     /* Outputs */
@@ -259,8 +259,8 @@ void planar_2r_fk_jacobian_dot(const planar_2r_real q[PLANAR_2R_DOF], const plan
     J[9] = 0;
     J[10] = 1;
     J[11] = 1;
-    a[0] = -t5*qd1 - qd2*(t4 + c12*qd1);
-    a[1] = -t3*qd1 - qd2*(t2 + qd1*s12);
+    a[0] = -qd2*(c12*qd1 + t4) - t5*qd1;
+    a[1] = -qd2*(qd1*s12 + t2) - t3*qd1;
     a[2] = 0;
     a[3] = 0;
     a[4] = 0;
@@ -287,15 +287,15 @@ void planar_2r_jacobian_dot(const planar_2r_real q[PLANAR_2R_DOF], const planar_
     const planar_2r_real t0 = c1 + c12;
     const planar_2r_real t1 = s1 + s12;
     const planar_2r_real t2 = qd2*s12;
-    const planar_2r_real t3 = t2 + t1*qd1;
+    const planar_2r_real t3 = t1*qd1 + t2;
     const planar_2r_real t4 = c12*qd2;
-    const planar_2r_real t5 = t4 + t0*qd1;
+    const planar_2r_real t5 = t0*qd1 + t4;
 
     /* Outputs */
     Jd[0] = -t5;
-    Jd[1] = -(t4 + c12*qd1);
+    Jd[1] = -(c12*qd1 + t4);
     Jd[2] = -t3;
-    Jd[3] = -(t2 + qd1*s12);
+    Jd[3] = -(qd1*s12 + t2);
     Jd[4] = 0;
     Jd[5] = 0;
     Jd[6] = 0;
@@ -326,13 +326,13 @@ void planar_2r_bias_acceleration(const planar_2r_real q[PLANAR_2R_DOF], const pl
     const planar_2r_real t0 = c1 + c12;
     const planar_2r_real t1 = s1 + s12;
     const planar_2r_real t2 = qd2*s12;
-    const planar_2r_real t3 = t2 + t1*qd1;
+    const planar_2r_real t3 = t1*qd1 + t2;
     const planar_2r_real t4 = c12*qd2;
-    const planar_2r_real t5 = t4 + t0*qd1;
+    const planar_2r_real t5 = t0*qd1 + t4;
 
     /* Outputs */
-    a[0] = -t5*qd1 - qd2*(t4 + c12*qd1);
-    a[1] = -t3*qd1 - qd2*(t2 + qd1*s12);
+    a[0] = -qd2*(c12*qd1 + t4) - t5*qd1;
+    a[1] = -qd2*(qd1*s12 + t2) - t3*qd1;
     a[2] = 0;
     a[3] = 0;
     a[4] = 0;
@@ -359,11 +359,11 @@ void planar_2r_task_jacobian_dot(const planar_2r_real q[PLANAR_2R_DOF], const pl
     const planar_2r_real t0 = c1 + c12;
     const planar_2r_real t1 = s1 + s12;
     const planar_2r_real t2 = qd2*s12;
-    const planar_2r_real t3 = t2 + t1*qd1;
-    const planar_2r_real t4 = t2 + qd1*s12;
+    const planar_2r_real t3 = t1*qd1 + t2;
+    const planar_2r_real t4 = qd1*s12 + t2;
     const planar_2r_real t5 = c12*qd2;
-    const planar_2r_real t6 = t5 + t0*qd1;
-    const planar_2r_real t7 = t5 + c12*qd1;
+    const planar_2r_real t6 = t0*qd1 + t5;
+    const planar_2r_real t7 = c12*qd1 + t5;
 
     /* Outputs */
     Jd[0] = -t6;
@@ -485,36 +485,36 @@ int planar_2r_velocity_ik(const planar_2r_real q[PLANAR_2R_DOF], const planar_2r
     const planar_2r_real t4 = t3 + (s12*s12);
     const planar_2r_real t5 = t4;
     const planar_2r_real t6 = (t0*t0);
-    const planar_2r_real t7 = sqrt(t3 + t6);
+    const planar_2r_real t7 = sqrt(t6 + t3);
     const planar_2r_real t8 = t7*(t1 <= 0 ? 1 : -1);
     const planar_2r_real t9 = (t7 > 0 ? 1/(t7*(t7 + fabs(t1))) : 0);
     const planar_2r_real t10 = t6 + (c12*c12);
     const planar_2r_real t11 = t10;
     const planar_2r_real t12 = sqrt(t4 + t10);
-    const planar_2r_real t13 = (t2*t2);
-    const planar_2r_real t14 = (damping*damping);
-    const planar_2r_real t15 = t5 + t14;
-    const planar_2r_real t16 = (t15*t15);
-    const planar_2r_real t17 = sqrt(t13 + t16);
-    const planar_2r_real t18 = t17*(t15 >= 0 ? 1 : -1);
-    const planar_2r_real t19 = t18 + t15;
-    const planar_2r_real t20 = (t17 > 0 ? 1/(t17*(t17 + fabs(t15))) : 0);
-    const planar_2r_real t21 = t20*(t19*mu_dot0 - t2*mu_dot1);
-    const planar_2r_real t22 = mu_dot0 - t19*t21;
-    const planar_2r_real t23 = mu_dot1 + t2*t21;
-    const planar_2r_real t24 = t11 + t14;
-    const planar_2r_real t25 = sqrt(t16 + (t24*t24) + 2*t13);
-    const planar_2r_real t26 = -t20*(t2*t19 + t2*t24);
-    const planar_2r_real t27 = t2 + t19*t26;
-    const planar_2r_real t28 = t24 + t2*t26;
-    const planar_2r_real t29 = fabs(t28);
+    const planar_2r_real t13 = (damping*damping);
+    const planar_2r_real t14 = t5 + t13;
+    const planar_2r_real t15 = (t14*t14);
+    const planar_2r_real t16 = t11 + t13;
+    const planar_2r_real t17 = (t2*t2);
+    const planar_2r_real t18 = sqrt(t15 + (t16*t16) + 2*t17);
+    const planar_2r_real t19 = sqrt(t17 + t15);
+    const planar_2r_real t20 = t19*(t14 >= 0 ? 1 : -1);
+    const planar_2r_real t21 = t20 + t14;
+    const planar_2r_real t22 = (t19 > 0 ? 1/(t19*(t19 + fabs(t14))) : 0);
+    const planar_2r_real t23 = -t22*(t2*t21 + t2*t16);
+    const planar_2r_real t24 = t2 + t21*t23;
+    const planar_2r_real t25 = t16 + t2*t23;
+    const planar_2r_real t26 = t22*(t21*mu_dot0 - t2*mu_dot1);
+    const planar_2r_real t27 = mu_dot0 - t21*t26;
+    const planar_2r_real t28 = mu_dot1 + t2*t26;
+    const planar_2r_real t29 = fabs(t25);
     const planar_2r_real t30 = t29;
-    const planar_2r_real t31 = t30*(t28 >= 0 ? 1 : -1);
-    const planar_2r_real t32 = t28 + t31;
+    const planar_2r_real t31 = t30*(t25 >= 0 ? 1 : -1);
+    const planar_2r_real t32 = t25 + t31;
     const planar_2r_real t33 = (t30 > 0 ? 1/(t30*(t30 + t29)) : 0);
-    const planar_2r_real t34 = t23 - t23*t33*(t32*t32);
+    const planar_2r_real t34 = t28 - t28*t33*(t32*t32);
     const planar_2r_real t35 = (t31 != 0 ? -t34/t31 : 0);
-    const planar_2r_real t36 = (t18 != 0 ? -(t22 + t27*t35)/t18 : 0);
+    const planar_2r_real t36 = (t20 != 0 ? -(t27 + t24*t35)/t20 : 0);
     const planar_2r_real t37 = t35*t0 - t36*t1;
     const planar_2r_real t38 = t35*c12 - t36*s12;
     const planar_2r_real t39 = -t1;
@@ -525,7 +525,7 @@ int planar_2r_velocity_ik(const planar_2r_real q[PLANAR_2R_DOF], const planar_2r
     const planar_2r_real t44 = t9*(t40*mu_dot0 + t0*mu_dot1);
     const planar_2r_real t45 = mu_dot0 - t40*t44;
     const planar_2r_real t46 = mu_dot1 - t44*t0;
-    const planar_2r_real t47 = t0 + t39 + c12 + damping + mu_dot0 + mu_dot1 + q1 + q2 - s12;
+    const planar_2r_real t47 = t0 + c12 + damping + mu_dot0 + mu_dot1 + q1 + q2 + t39 - s12;
     const planar_2r_real t48 = fabs(t43);
     const planar_2r_real t49 = t48;
     const planar_2r_real t50 = t49*(t43 >= 0 ? 1 : -1);
@@ -538,8 +538,8 @@ int planar_2r_velocity_ik(const planar_2r_real q[PLANAR_2R_DOF], const planar_2r
     const int t57 = damping >= 0;
     const planar_2r_real t58 = 1e-12*t12;
     const int t59 = damping > 0;
-    const planar_2r_real t60 = 1e-12*t25;
-    const int t61 = (t59 && ((t17 <= t60) || (t30 <= t60))) || (damping <= 0 && ((t7 <= t58) || (t49 <= t58)));
+    const planar_2r_real t60 = 1e-12*t18;
+    const int t61 = (t59 && ((t19 <= t60) || (t30 <= t60))) || (damping <= 0 && ((t7 <= t58) || (t49 <= t58)));
     const int t62 = t56 && t57 && !t61;
 
     /* Outputs */

@@ -263,9 +263,9 @@ def fk_jacobian_dot(q, q_dot):
     t0 = c1 + c12
     t1 = s1 + s12
     t2 = qd2*s12
-    t3 = t2 + t1*qd1
+    t3 = t1*qd1 + t2
     t4 = c12*qd2
-    t5 = t4 + t0*qd1
+    t5 = t0*qd1 + t4
     t6 = -s12
     T = _stack(xp, [
         xp.broadcast_to(c12, batch),  # 0, 0
@@ -300,8 +300,8 @@ def fk_jacobian_dot(q, q_dot):
         xp.full(batch, 1, dtype=dtype, device=device),  # 5, 1
     ], (6, 2))
     a = _stack(xp, [
-        xp.broadcast_to(-t5*qd1 - qd2*(t4 + c12*qd1), batch),  # 0
-        xp.broadcast_to(-t3*qd1 - qd2*(t2 + qd1*s12), batch),  # 1
+        xp.broadcast_to(-qd2*(c12*qd1 + t4) - t5*qd1, batch),  # 0
+        xp.broadcast_to(-qd2*(qd1*s12 + t2) - t3*qd1, batch),  # 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 4
@@ -325,14 +325,14 @@ def jacobian_dot(q, q_dot):
     t0 = c1 + c12
     t1 = s1 + s12
     t2 = qd2*s12
-    t3 = t2 + t1*qd1
+    t3 = t1*qd1 + t2
     t4 = c12*qd2
-    t5 = t4 + t0*qd1
+    t5 = t0*qd1 + t4
     Jd = _stack(xp, [
         xp.broadcast_to(-t5, batch),  # 0, 0
-        xp.broadcast_to(-(t4 + c12*qd1), batch),  # 0, 1
+        xp.broadcast_to(-(c12*qd1 + t4), batch),  # 0, 1
         xp.broadcast_to(-t3, batch),  # 1, 0
-        xp.broadcast_to(-(t2 + qd1*s12), batch),  # 1, 1
+        xp.broadcast_to(-(qd1*s12 + t2), batch),  # 1, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
@@ -360,12 +360,12 @@ def bias_acceleration(q, q_dot):
     t0 = c1 + c12
     t1 = s1 + s12
     t2 = qd2*s12
-    t3 = t2 + t1*qd1
+    t3 = t1*qd1 + t2
     t4 = c12*qd2
-    t5 = t4 + t0*qd1
+    t5 = t0*qd1 + t4
     a = _stack(xp, [
-        xp.broadcast_to(-t5*qd1 - qd2*(t4 + c12*qd1), batch),  # 0
-        xp.broadcast_to(-t3*qd1 - qd2*(t2 + qd1*s12), batch),  # 1
+        xp.broadcast_to(-qd2*(c12*qd1 + t4) - t5*qd1, batch),  # 0
+        xp.broadcast_to(-qd2*(qd1*s12 + t2) - t3*qd1, batch),  # 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 4
@@ -389,11 +389,11 @@ def task_jacobian_dot(q, q_dot):
     t0 = c1 + c12
     t1 = s1 + s12
     t2 = qd2*s12
-    t3 = t2 + t1*qd1
-    t4 = t2 + qd1*s12
+    t3 = t1*qd1 + t2
+    t4 = qd1*s12 + t2
     t5 = c12*qd2
-    t6 = t5 + t0*qd1
-    t7 = t5 + c12*qd1
+    t6 = t0*qd1 + t5
+    t7 = c12*qd1 + t5
     Jd = _stack(xp, [
         xp.broadcast_to(-t6, batch),  # 0, 0
         xp.broadcast_to(-t7, batch),  # 0, 1
@@ -497,36 +497,36 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t4 = t3 + s12**2
     t5 = t4
     t6 = t0**2
-    t7 = xp.sqrt(t3 + t6)
+    t7 = xp.sqrt(t6 + t3)
     t8 = t7*xp.where(xp.less_equal(t1, 0), xp.asarray(1, dtype=dtype), -1)
     t9 = xp.where(xp.greater(t7, 0), 1/(t7*(t7 + xp.abs(t1))), 0)
     t10 = t6 + c12**2
     t11 = t10
     t12 = xp.sqrt(t4 + t10)
-    t13 = t2**2
-    t14 = damping**2
-    t15 = t5 + t14
-    t16 = t15**2
-    t17 = xp.sqrt(t13 + t16)
-    t18 = t17*xp.where(xp.greater_equal(t15, 0), xp.asarray(1, dtype=dtype), -1)
-    t19 = t18 + t15
-    t20 = xp.where(xp.greater(t17, 0), 1/(t17*(t17 + xp.abs(t15))), 0)
-    t21 = t20*(t19*mu_dot0 - t2*mu_dot1)
-    t22 = mu_dot0 - t19*t21
-    t23 = mu_dot1 + t2*t21
-    t24 = t11 + t14
-    t25 = xp.sqrt(t16 + t24**2 + 2*t13)
-    t26 = -t20*(t2*t19 + t2*t24)
-    t27 = t2 + t19*t26
-    t28 = t24 + t2*t26
-    t29 = xp.abs(t28)
+    t13 = damping**2
+    t14 = t5 + t13
+    t15 = t14**2
+    t16 = t11 + t13
+    t17 = t2**2
+    t18 = xp.sqrt(t15 + t16**2 + 2*t17)
+    t19 = xp.sqrt(t17 + t15)
+    t20 = t19*xp.where(xp.greater_equal(t14, 0), xp.asarray(1, dtype=dtype), -1)
+    t21 = t20 + t14
+    t22 = xp.where(xp.greater(t19, 0), 1/(t19*(t19 + xp.abs(t14))), 0)
+    t23 = -t22*(t2*t21 + t2*t16)
+    t24 = t2 + t21*t23
+    t25 = t16 + t2*t23
+    t26 = t22*(t21*mu_dot0 - t2*mu_dot1)
+    t27 = mu_dot0 - t21*t26
+    t28 = mu_dot1 + t2*t26
+    t29 = xp.abs(t25)
     t30 = t29
-    t31 = t30*xp.where(xp.greater_equal(t28, 0), xp.asarray(1, dtype=dtype), -1)
-    t32 = t28 + t31
+    t31 = t30*xp.where(xp.greater_equal(t25, 0), xp.asarray(1, dtype=dtype), -1)
+    t32 = t25 + t31
     t33 = xp.where(xp.greater(t30, 0), 1/(t30*(t30 + t29)), 0)
-    t34 = t23 - t23*t33*t32**2
+    t34 = t28 - t28*t33*t32**2
     t35 = xp.where(xp.not_equal(t31, 0), -t34/t31, 0)
-    t36 = xp.where(xp.not_equal(t18, 0), -(t22 + t27*t35)/t18, 0)
+    t36 = xp.where(xp.not_equal(t20, 0), -(t27 + t24*t35)/t20, 0)
     t37 = t35*t0 - t36*t1
     t38 = t35*c12 - t36*s12
     t39 = -t1
@@ -537,7 +537,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t44 = t9*(t40*mu_dot0 + t0*mu_dot1)
     t45 = mu_dot0 - t40*t44
     t46 = mu_dot1 - t44*t0
-    t47 = t0 + t39 + c12 + damping + mu_dot0 + mu_dot1 + q1 + q2 - s12
+    t47 = t0 + c12 + damping + mu_dot0 + mu_dot1 + q1 + q2 + t39 - s12
     t48 = xp.abs(t43)
     t49 = t48
     t50 = t49*xp.where(xp.greater_equal(t43, 0), xp.asarray(1, dtype=dtype), -1)
@@ -550,8 +550,8 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t57 = xp.greater_equal(damping, 0)
     t58 = 1e-12*t12
     t59 = xp.greater(damping, 0)
-    t60 = 1e-12*t25
-    t61 = (t59 & (xp.less_equal(t17, t60) | xp.less_equal(t30, t60))) | (xp.less_equal(damping, 0) & (xp.less_equal(t7, t58) | xp.less_equal(t49, t58)))
+    t60 = 1e-12*t18
+    t61 = (t59 & (xp.less_equal(t19, t60) | xp.less_equal(t30, t60))) | (xp.less_equal(damping, 0) & (xp.less_equal(t7, t58) | xp.less_equal(t49, t58)))
     t62 = t56 & t57 & xp.logical_not(t61)
     q_dot = _stack(xp, [
         xp.broadcast_to(xp.where(t62, xp.where(t59, t37, t55), 0), batch),  # 0

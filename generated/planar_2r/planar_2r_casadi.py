@@ -168,9 +168,9 @@ def _fk_jacobian_dot(q, q_dot):
     t0 = c1 + c12
     t1 = s1 + s12
     t2 = qd2*s12
-    t3 = t2 + t1*qd1
+    t3 = t1*qd1 + t2
     t4 = c12*qd2
-    t5 = t4 + t0*qd1
+    t5 = t0*qd1 + t4
     t6 = -s12
     T = casadi.SX(4, 4)
     T[0, 0] = c12
@@ -189,8 +189,8 @@ def _fk_jacobian_dot(q, q_dot):
     J[5, 0] = 1
     J[5, 1] = 1
     a = casadi.SX(6, 1)
-    a[0, 0] = -t5*qd1 - qd2*(t4 + c12*qd1)
-    a[1, 0] = -t3*qd1 - qd2*(t2 + qd1*s12)
+    a[0, 0] = -qd2*(c12*qd1 + t4) - t5*qd1
+    a[1, 0] = -qd2*(qd1*s12 + t2) - t3*qd1
     return [T, J, a]
 
 
@@ -209,14 +209,14 @@ def _jacobian_dot(q, q_dot):
     t0 = c1 + c12
     t1 = s1 + s12
     t2 = qd2*s12
-    t3 = t2 + t1*qd1
+    t3 = t1*qd1 + t2
     t4 = c12*qd2
-    t5 = t4 + t0*qd1
+    t5 = t0*qd1 + t4
     Jd = casadi.SX(6, 2)
     Jd[0, 0] = -t5
-    Jd[0, 1] = -(t4 + c12*qd1)
+    Jd[0, 1] = -(c12*qd1 + t4)
     Jd[1, 0] = -t3
-    Jd[1, 1] = -(t2 + qd1*s12)
+    Jd[1, 1] = -(qd1*s12 + t2)
     return [Jd]
 
 
@@ -235,12 +235,12 @@ def _bias_acceleration(q, q_dot):
     t0 = c1 + c12
     t1 = s1 + s12
     t2 = qd2*s12
-    t3 = t2 + t1*qd1
+    t3 = t1*qd1 + t2
     t4 = c12*qd2
-    t5 = t4 + t0*qd1
+    t5 = t0*qd1 + t4
     a = casadi.SX(6, 1)
-    a[0, 0] = -t5*qd1 - qd2*(t4 + c12*qd1)
-    a[1, 0] = -t3*qd1 - qd2*(t2 + qd1*s12)
+    a[0, 0] = -qd2*(c12*qd1 + t4) - t5*qd1
+    a[1, 0] = -qd2*(qd1*s12 + t2) - t3*qd1
     return [a]
 
 
@@ -259,11 +259,11 @@ def _task_jacobian_dot(q, q_dot):
     t0 = c1 + c12
     t1 = s1 + s12
     t2 = qd2*s12
-    t3 = t2 + t1*qd1
-    t4 = t2 + qd1*s12
+    t3 = t1*qd1 + t2
+    t4 = qd1*s12 + t2
     t5 = c12*qd2
-    t6 = t5 + t0*qd1
-    t7 = t5 + c12*qd1
+    t6 = t0*qd1 + t5
+    t7 = c12*qd1 + t5
     Jd = casadi.SX(2, 2)
     Jd[0, 0] = -t6
     Jd[0, 1] = -t7
@@ -344,36 +344,36 @@ def _velocity_ik(q, mu_dot, damping):
     t4 = t3 + s12**2
     t5 = t4
     t6 = t0**2
-    t7 = casadi.sqrt(t3 + t6)
+    t7 = casadi.sqrt(t6 + t3)
     t8 = t7*casadi.if_else((t1 <= 0), 1, -1)
     t9 = casadi.if_else((t7 > 0), 1/(t7*(t7 + casadi.fabs(t1))), 0)
     t10 = t6 + c12**2
     t11 = t10
     t12 = casadi.sqrt(t4 + t10)
-    t13 = t2**2
-    t14 = damping**2
-    t15 = t5 + t14
-    t16 = t15**2
-    t17 = casadi.sqrt(t13 + t16)
-    t18 = t17*casadi.if_else((t15 >= 0), 1, -1)
-    t19 = t18 + t15
-    t20 = casadi.if_else((t17 > 0), 1/(t17*(t17 + casadi.fabs(t15))), 0)
-    t21 = t20*(t19*mu_dot0 - t2*mu_dot1)
-    t22 = mu_dot0 - t19*t21
-    t23 = mu_dot1 + t2*t21
-    t24 = t11 + t14
-    t25 = casadi.sqrt(t16 + t24**2 + 2*t13)
-    t26 = -t20*(t2*t19 + t2*t24)
-    t27 = t2 + t19*t26
-    t28 = t24 + t2*t26
-    t29 = casadi.fabs(t28)
+    t13 = damping**2
+    t14 = t5 + t13
+    t15 = t14**2
+    t16 = t11 + t13
+    t17 = t2**2
+    t18 = casadi.sqrt(t15 + t16**2 + 2*t17)
+    t19 = casadi.sqrt(t17 + t15)
+    t20 = t19*casadi.if_else((t14 >= 0), 1, -1)
+    t21 = t20 + t14
+    t22 = casadi.if_else((t19 > 0), 1/(t19*(t19 + casadi.fabs(t14))), 0)
+    t23 = -t22*(t2*t21 + t2*t16)
+    t24 = t2 + t21*t23
+    t25 = t16 + t2*t23
+    t26 = t22*(t21*mu_dot0 - t2*mu_dot1)
+    t27 = mu_dot0 - t21*t26
+    t28 = mu_dot1 + t2*t26
+    t29 = casadi.fabs(t25)
     t30 = t29
-    t31 = t30*casadi.if_else((t28 >= 0), 1, -1)
-    t32 = t28 + t31
+    t31 = t30*casadi.if_else((t25 >= 0), 1, -1)
+    t32 = t25 + t31
     t33 = casadi.if_else((t30 > 0), 1/(t30*(t30 + t29)), 0)
-    t34 = t23 - t23*t33*t32**2
+    t34 = t28 - t28*t33*t32**2
     t35 = casadi.if_else((t31 != 0), -t34/t31, 0)
-    t36 = casadi.if_else((t18 != 0), -(t22 + t27*t35)/t18, 0)
+    t36 = casadi.if_else((t20 != 0), -(t27 + t24*t35)/t20, 0)
     t37 = t35*t0 - t36*t1
     t38 = t35*c12 - t36*s12
     t39 = -t1
@@ -384,7 +384,7 @@ def _velocity_ik(q, mu_dot, damping):
     t44 = t9*(t40*mu_dot0 + t0*mu_dot1)
     t45 = mu_dot0 - t40*t44
     t46 = mu_dot1 - t44*t0
-    t47 = t0 + t39 + c12 + damping + mu_dot0 + mu_dot1 + q1 + q2 - s12
+    t47 = t0 + c12 + damping + mu_dot0 + mu_dot1 + q1 + q2 + t39 - s12
     t48 = casadi.fabs(t43)
     t49 = t48
     t50 = t49*casadi.if_else((t43 >= 0), 1, -1)
@@ -397,8 +397,8 @@ def _velocity_ik(q, mu_dot, damping):
     t57 = (damping >= 0)
     t58 = 1e-12*t12
     t59 = (damping > 0)
-    t60 = 1e-12*t25
-    t61 = casadi.logic_or(casadi.logic_and(t59, casadi.logic_or((t17 <= t60), (t30 <= t60))), casadi.logic_and((damping <= 0), casadi.logic_or((t7 <= t58), (t49 <= t58))))
+    t60 = 1e-12*t18
+    t61 = casadi.logic_or(casadi.logic_and(t59, casadi.logic_or((t19 <= t60), (t30 <= t60))), casadi.logic_and((damping <= 0), casadi.logic_or((t7 <= t58), (t49 <= t58))))
     t62 = casadi.logic_and(casadi.logic_and(t56, t57), casadi.logic_not(t61))
     q_dot = casadi.SX(2, 1)
     q_dot[0, 0] = casadi.if_else(t62, casadi.if_else(t59, t37, t55), 0)

@@ -331,10 +331,10 @@ def fk_jacobian_dot(q, q_dot):
     t3 = t1 + s1
     t4 = qd1 + qd2
     t5 = qd3*s123
-    t6 = t5 + t1*qd2
+    t6 = t1*qd2 + t5
     t7 = t6 + t3*qd1
     t8 = c123*qd3
-    t9 = t8 + t0*qd2
+    t9 = t0*qd2 + t8
     t10 = t9 + t2*qd1
     t11 = -s123
     T = _stack(xp, [
@@ -376,8 +376,8 @@ def fk_jacobian_dot(q, q_dot):
         xp.full(batch, 1, dtype=dtype, device=device),  # 5, 2
     ], (6, 3))
     a = _stack(xp, [
-        xp.broadcast_to(-t10*qd1 - qd2*(t9 + t0*qd1) - qd3*(t8 + t4*c123), batch),  # 0
-        xp.broadcast_to(-t7*qd1 - qd2*(t6 + t1*qd1) - qd3*(t5 + t4*s123), batch),  # 1
+        xp.broadcast_to(-qd2*(t9 + t0*qd1) - qd3*(t4*c123 + t8) - t10*qd1, batch),  # 0
+        xp.broadcast_to(-qd2*(t6 + t1*qd1) - qd3*(t4*s123 + t5) - t7*qd1, batch),  # 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 4
@@ -409,18 +409,18 @@ def jacobian_dot(q, q_dot):
     t3 = t1 + s1
     t4 = qd1 + qd2
     t5 = qd3*s123
-    t6 = t5 + t1*qd2
+    t6 = t1*qd2 + t5
     t7 = t6 + t3*qd1
     t8 = c123*qd3
-    t9 = t8 + t0*qd2
+    t9 = t0*qd2 + t8
     t10 = t9 + t2*qd1
     Jd = _stack(xp, [
         xp.broadcast_to(-t10, batch),  # 0, 0
         xp.broadcast_to(-(t9 + t0*qd1), batch),  # 0, 1
-        xp.broadcast_to(-(t8 + t4*c123), batch),  # 0, 2
+        xp.broadcast_to(-(t4*c123 + t8), batch),  # 0, 2
         xp.broadcast_to(-t7, batch),  # 1, 0
         xp.broadcast_to(-(t6 + t1*qd1), batch),  # 1, 1
-        xp.broadcast_to(-(t5 + t4*s123), batch),  # 1, 2
+        xp.broadcast_to(-(t4*s123 + t5), batch),  # 1, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 2
@@ -460,14 +460,14 @@ def bias_acceleration(q, q_dot):
     t3 = t1 + s1
     t4 = qd1 + qd2
     t5 = qd3*s123
-    t6 = t5 + t1*qd2
+    t6 = t1*qd2 + t5
     t7 = t6 + t3*qd1
     t8 = c123*qd3
-    t9 = t8 + t0*qd2
+    t9 = t0*qd2 + t8
     t10 = t9 + t2*qd1
     a = _stack(xp, [
-        xp.broadcast_to(-t10*qd1 - qd2*(t9 + t0*qd1) - qd3*(t8 + t4*c123), batch),  # 0
-        xp.broadcast_to(-t7*qd1 - qd2*(t6 + t1*qd1) - qd3*(t5 + t4*s123), batch),  # 1
+        xp.broadcast_to(-qd2*(t9 + t0*qd1) - qd3*(t4*c123 + t8) - t10*qd1, batch),  # 0
+        xp.broadcast_to(-qd2*(t6 + t1*qd1) - qd3*(t4*s123 + t5) - t7*qd1, batch),  # 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 4
@@ -499,15 +499,15 @@ def task_jacobian_dot(q, q_dot):
     t3 = t1 + s1
     t4 = qd1 + qd2
     t5 = qd3*s123
-    t6 = t5 + t1*qd2
+    t6 = t1*qd2 + t5
     t7 = t6 + t3*qd1
     t8 = t6 + t1*qd1
-    t9 = t5 + t4*s123
+    t9 = t4*s123 + t5
     t10 = c123*qd3
-    t11 = t10 + t0*qd2
+    t11 = t0*qd2 + t10
     t12 = t11 + t2*qd1
     t13 = t11 + t0*qd1
-    t14 = t10 + t4*c123
+    t14 = t4*c123 + t10
     Jd = _stack(xp, [
         xp.broadcast_to(-t12, batch),  # 0, 0
         xp.broadcast_to(-t13, batch),  # 0, 1
@@ -679,60 +679,60 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t4 = t0*t1 + t2*t3 + c123*s123
     t5 = t1 + t3 + s123
     t6 = t3**2
-    t7 = t6 + t1**2 + s123**2
+    t7 = t1**2 + t6 + s123**2
     t8 = t7
     t9 = t2**2
-    t10 = xp.sqrt(1 + t6 + t9)
+    t10 = xp.sqrt(1 + t9 + t6)
     t11 = t10*xp.where(xp.less_equal(t3, 0), xp.asarray(1, dtype=dtype), -1)
     t12 = xp.where(xp.greater(t10, 0), 1/(t10*(t10 + xp.abs(t3))), 0)
-    t13 = t9 + t0**2 + c123**2
+    t13 = t0**2 + t9 + c123**2
     t14 = t13
     t15 = xp.sqrt(3 + t7 + t13)
     t16 = t0 + t2 + c123
     t17 = t16
-    t18 = t4**2
-    t19 = t5**2
-    t20 = damping**2
-    t21 = t8 + t20
-    t22 = t21**2
-    t23 = xp.sqrt(t18 + t19 + t22)
-    t24 = t23*xp.where(xp.greater_equal(t21, 0), xp.asarray(1, dtype=dtype), -1)
-    t25 = t24 + t21
-    t26 = xp.where(xp.greater(t23, 0), 1/(t23*(t23 + xp.abs(t21))), 0)
-    t27 = -t26*(t4*mu_dot1 + t5*mu_dot2 - t25*mu_dot0)
-    t28 = mu_dot0 - t25*t27
-    t29 = mu_dot1 + t4*t27
-    t30 = mu_dot2 + t5*t27
-    t31 = t14 + t20
-    t32 = -t26*(t4*t25 + t4*t31 + t5*t17)
-    t33 = t4 + t25*t32
-    t34 = t31 + t4*t32
-    t35 = t17 + t5*t32
-    t36 = xp.sqrt(t34**2 + t35**2)
-    t37 = t36*xp.where(xp.greater_equal(t34, 0), xp.asarray(1, dtype=dtype), -1)
-    t38 = t34 + t37
-    t39 = xp.where(xp.greater(t36, 0), 1/(t36*(t36 + xp.abs(t34))), 0)
-    t40 = t39*(t35*t30 + t29*t38)
-    t41 = t29 - t38*t40
-    t42 = t30 - t35*t40
-    t43 = 3 + t20
-    t44 = xp.sqrt(t22 + t31**2 + t43**2 + 2*t18 + 2*t19 + 2*t17**2)
-    t45 = -t26*(t4*t17 + t5*t25 + t5*t43)
-    t46 = t5 + t25*t45
-    t47 = t17 + t4*t45
-    t48 = t43 + t5*t45
-    t49 = t39*(t35*t48 + t47*t38)
-    t50 = t47 - t38*t49
-    t51 = t48 - t35*t49
-    t52 = xp.abs(t51)
+    t18 = damping**2
+    t19 = 3 + t18
+    t20 = t8 + t18
+    t21 = t20**2
+    t22 = t14 + t18
+    t23 = t4**2
+    t24 = t5**2
+    t25 = xp.sqrt(t19**2 + t21 + t22**2 + 2*t23 + 2*t24 + 2*t17**2)
+    t26 = xp.sqrt(t23 + t24 + t21)
+    t27 = t26*xp.where(xp.greater_equal(t20, 0), xp.asarray(1, dtype=dtype), -1)
+    t28 = t27 + t20
+    t29 = xp.where(xp.greater(t26, 0), 1/(t26*(t26 + xp.abs(t20))), 0)
+    t30 = -t29*(t4*t28 + t4*t22 + t5*t17)
+    t31 = t4 + t28*t30
+    t32 = t22 + t4*t30
+    t33 = t17 + t5*t30
+    t34 = -t29*(t4*t17 + t5*t28 + t5*t19)
+    t35 = t5 + t28*t34
+    t36 = t17 + t4*t34
+    t37 = t19 + t5*t34
+    t38 = -t29*(t4*mu_dot1 + t5*mu_dot2 - t28*mu_dot0)
+    t39 = mu_dot0 - t28*t38
+    t40 = mu_dot1 + t4*t38
+    t41 = mu_dot2 + t5*t38
+    t42 = xp.sqrt(t32**2 + t33**2)
+    t43 = t42*xp.where(xp.greater_equal(t32, 0), xp.asarray(1, dtype=dtype), -1)
+    t44 = t32 + t43
+    t45 = xp.where(xp.greater(t42, 0), 1/(t42*(t42 + xp.abs(t32))), 0)
+    t46 = t45*(t33*t37 + t36*t44)
+    t47 = t36 - t44*t46
+    t48 = t37 - t33*t46
+    t49 = t45*(t33*t41 + t40*t44)
+    t50 = t40 - t44*t49
+    t51 = t41 - t33*t49
+    t52 = xp.abs(t48)
     t53 = t52
-    t54 = t53*xp.where(xp.greater_equal(t51, 0), xp.asarray(1, dtype=dtype), -1)
-    t55 = t51 + t54
+    t54 = t53*xp.where(xp.greater_equal(t48, 0), xp.asarray(1, dtype=dtype), -1)
+    t55 = t48 + t54
     t56 = xp.where(xp.greater(t53, 0), 1/(t53*(t53 + t52)), 0)
-    t57 = t42 - t42*t56*t55**2
+    t57 = t51 - t51*t56*t55**2
     t58 = xp.where(xp.not_equal(t54, 0), -t57/t54, 0)
-    t59 = xp.where(xp.not_equal(t37, 0), -(t41 - t50*t58)/t37, 0)
-    t60 = xp.where(xp.not_equal(t24, 0), -(t28 + t33*t59 + t46*t58)/t24, 0)
+    t59 = xp.where(xp.not_equal(t43, 0), -(t50 - t47*t58)/t43, 0)
+    t60 = xp.where(xp.not_equal(t27, 0), -(t39 + t31*t59 + t35*t58)/t27, 0)
     t61 = t58 + t2*t59 - t3*t60
     t62 = t58 + t0*t59 - t1*t60
     t63 = t58 + t59*c123 - t60*s123
@@ -774,8 +774,8 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t99 = xp.greater_equal(damping, 0)
     t100 = 1e-12*t15
     t101 = xp.greater(damping, 0)
-    t102 = 1e-12*t44
-    t103 = (t101 & (xp.less_equal(t23, t102) | xp.less_equal(t36, t102) | xp.less_equal(t53, t102))) | (xp.less_equal(damping, 0) & (xp.less_equal(t90, t100) | xp.less_equal(t10, t100) | xp.less_equal(t78, t100)))
+    t102 = 1e-12*t25
+    t103 = (t101 & (xp.less_equal(t26, t102) | xp.less_equal(t42, t102) | xp.less_equal(t53, t102))) | (xp.less_equal(damping, 0) & (xp.less_equal(t90, t100) | xp.less_equal(t10, t100) | xp.less_equal(t78, t100)))
     t104 = t98 & t99 & xp.logical_not(t103)
     q_dot = _stack(xp, [
         xp.broadcast_to(xp.where(t104, xp.where(t101, t61, t97), 0), batch),  # 0

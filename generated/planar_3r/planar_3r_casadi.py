@@ -234,10 +234,10 @@ def _fk_jacobian_dot(q, q_dot):
     t3 = t1 + s1
     t4 = qd1 + qd2
     t5 = qd3*s123
-    t6 = t5 + t1*qd2
+    t6 = t1*qd2 + t5
     t7 = t6 + t3*qd1
     t8 = c123*qd3
-    t9 = t8 + t0*qd2
+    t9 = t0*qd2 + t8
     t10 = t9 + t2*qd1
     t11 = -s123
     T = casadi.SX(4, 4)
@@ -260,8 +260,8 @@ def _fk_jacobian_dot(q, q_dot):
     J[5, 1] = 1
     J[5, 2] = 1
     a = casadi.SX(6, 1)
-    a[0, 0] = -t10*qd1 - qd2*(t9 + t0*qd1) - qd3*(t8 + t4*c123)
-    a[1, 0] = -t7*qd1 - qd2*(t6 + t1*qd1) - qd3*(t5 + t4*s123)
+    a[0, 0] = -qd2*(t9 + t0*qd1) - qd3*(t4*c123 + t8) - t10*qd1
+    a[1, 0] = -qd2*(t6 + t1*qd1) - qd3*(t4*s123 + t5) - t7*qd1
     return [T, J, a]
 
 
@@ -289,18 +289,18 @@ def _jacobian_dot(q, q_dot):
     t3 = t1 + s1
     t4 = qd1 + qd2
     t5 = qd3*s123
-    t6 = t5 + t1*qd2
+    t6 = t1*qd2 + t5
     t7 = t6 + t3*qd1
     t8 = c123*qd3
-    t9 = t8 + t0*qd2
+    t9 = t0*qd2 + t8
     t10 = t9 + t2*qd1
     Jd = casadi.SX(6, 3)
     Jd[0, 0] = -t10
     Jd[0, 1] = -(t9 + t0*qd1)
-    Jd[0, 2] = -(t8 + t4*c123)
+    Jd[0, 2] = -(t4*c123 + t8)
     Jd[1, 0] = -t7
     Jd[1, 1] = -(t6 + t1*qd1)
-    Jd[1, 2] = -(t5 + t4*s123)
+    Jd[1, 2] = -(t4*s123 + t5)
     return [Jd]
 
 
@@ -328,14 +328,14 @@ def _bias_acceleration(q, q_dot):
     t3 = t1 + s1
     t4 = qd1 + qd2
     t5 = qd3*s123
-    t6 = t5 + t1*qd2
+    t6 = t1*qd2 + t5
     t7 = t6 + t3*qd1
     t8 = c123*qd3
-    t9 = t8 + t0*qd2
+    t9 = t0*qd2 + t8
     t10 = t9 + t2*qd1
     a = casadi.SX(6, 1)
-    a[0, 0] = -t10*qd1 - qd2*(t9 + t0*qd1) - qd3*(t8 + t4*c123)
-    a[1, 0] = -t7*qd1 - qd2*(t6 + t1*qd1) - qd3*(t5 + t4*s123)
+    a[0, 0] = -qd2*(t9 + t0*qd1) - qd3*(t4*c123 + t8) - t10*qd1
+    a[1, 0] = -qd2*(t6 + t1*qd1) - qd3*(t4*s123 + t5) - t7*qd1
     return [a]
 
 
@@ -363,15 +363,15 @@ def _task_jacobian_dot(q, q_dot):
     t3 = t1 + s1
     t4 = qd1 + qd2
     t5 = qd3*s123
-    t6 = t5 + t1*qd2
+    t6 = t1*qd2 + t5
     t7 = t6 + t3*qd1
     t8 = t6 + t1*qd1
-    t9 = t5 + t4*s123
+    t9 = t4*s123 + t5
     t10 = c123*qd3
-    t11 = t10 + t0*qd2
+    t11 = t0*qd2 + t10
     t12 = t11 + t2*qd1
     t13 = t11 + t0*qd1
-    t14 = t10 + t4*c123
+    t14 = t4*c123 + t10
     Jd = casadi.SX(3, 3)
     Jd[0, 0] = -t12
     Jd[0, 1] = -t13
@@ -502,60 +502,60 @@ def _velocity_ik(q, mu_dot, damping):
     t4 = t0*t1 + t2*t3 + c123*s123
     t5 = t1 + t3 + s123
     t6 = t3**2
-    t7 = t6 + t1**2 + s123**2
+    t7 = t1**2 + t6 + s123**2
     t8 = t7
     t9 = t2**2
-    t10 = casadi.sqrt(1 + t6 + t9)
+    t10 = casadi.sqrt(1 + t9 + t6)
     t11 = t10*casadi.if_else((t3 <= 0), 1, -1)
     t12 = casadi.if_else((t10 > 0), 1/(t10*(t10 + casadi.fabs(t3))), 0)
-    t13 = t9 + t0**2 + c123**2
+    t13 = t0**2 + t9 + c123**2
     t14 = t13
     t15 = casadi.sqrt(3 + t7 + t13)
     t16 = t0 + t2 + c123
     t17 = t16
-    t18 = t4**2
-    t19 = t5**2
-    t20 = damping**2
-    t21 = t8 + t20
-    t22 = t21**2
-    t23 = casadi.sqrt(t18 + t19 + t22)
-    t24 = t23*casadi.if_else((t21 >= 0), 1, -1)
-    t25 = t24 + t21
-    t26 = casadi.if_else((t23 > 0), 1/(t23*(t23 + casadi.fabs(t21))), 0)
-    t27 = -t26*(t4*mu_dot1 + t5*mu_dot2 - t25*mu_dot0)
-    t28 = mu_dot0 - t25*t27
-    t29 = mu_dot1 + t4*t27
-    t30 = mu_dot2 + t5*t27
-    t31 = t14 + t20
-    t32 = -t26*(t4*t25 + t4*t31 + t5*t17)
-    t33 = t4 + t25*t32
-    t34 = t31 + t4*t32
-    t35 = t17 + t5*t32
-    t36 = casadi.sqrt(t34**2 + t35**2)
-    t37 = t36*casadi.if_else((t34 >= 0), 1, -1)
-    t38 = t34 + t37
-    t39 = casadi.if_else((t36 > 0), 1/(t36*(t36 + casadi.fabs(t34))), 0)
-    t40 = t39*(t35*t30 + t29*t38)
-    t41 = t29 - t38*t40
-    t42 = t30 - t35*t40
-    t43 = 3 + t20
-    t44 = casadi.sqrt(t22 + t31**2 + t43**2 + 2*t18 + 2*t19 + 2*t17**2)
-    t45 = -t26*(t4*t17 + t5*t25 + t5*t43)
-    t46 = t5 + t25*t45
-    t47 = t17 + t4*t45
-    t48 = t43 + t5*t45
-    t49 = t39*(t35*t48 + t47*t38)
-    t50 = t47 - t38*t49
-    t51 = t48 - t35*t49
-    t52 = casadi.fabs(t51)
+    t18 = damping**2
+    t19 = 3 + t18
+    t20 = t8 + t18
+    t21 = t20**2
+    t22 = t14 + t18
+    t23 = t4**2
+    t24 = t5**2
+    t25 = casadi.sqrt(t19**2 + t21 + t22**2 + 2*t23 + 2*t24 + 2*t17**2)
+    t26 = casadi.sqrt(t23 + t24 + t21)
+    t27 = t26*casadi.if_else((t20 >= 0), 1, -1)
+    t28 = t27 + t20
+    t29 = casadi.if_else((t26 > 0), 1/(t26*(t26 + casadi.fabs(t20))), 0)
+    t30 = -t29*(t4*t28 + t4*t22 + t5*t17)
+    t31 = t4 + t28*t30
+    t32 = t22 + t4*t30
+    t33 = t17 + t5*t30
+    t34 = -t29*(t4*t17 + t5*t28 + t5*t19)
+    t35 = t5 + t28*t34
+    t36 = t17 + t4*t34
+    t37 = t19 + t5*t34
+    t38 = -t29*(t4*mu_dot1 + t5*mu_dot2 - t28*mu_dot0)
+    t39 = mu_dot0 - t28*t38
+    t40 = mu_dot1 + t4*t38
+    t41 = mu_dot2 + t5*t38
+    t42 = casadi.sqrt(t32**2 + t33**2)
+    t43 = t42*casadi.if_else((t32 >= 0), 1, -1)
+    t44 = t32 + t43
+    t45 = casadi.if_else((t42 > 0), 1/(t42*(t42 + casadi.fabs(t32))), 0)
+    t46 = t45*(t33*t37 + t36*t44)
+    t47 = t36 - t44*t46
+    t48 = t37 - t33*t46
+    t49 = t45*(t33*t41 + t40*t44)
+    t50 = t40 - t44*t49
+    t51 = t41 - t33*t49
+    t52 = casadi.fabs(t48)
     t53 = t52
-    t54 = t53*casadi.if_else((t51 >= 0), 1, -1)
-    t55 = t51 + t54
+    t54 = t53*casadi.if_else((t48 >= 0), 1, -1)
+    t55 = t48 + t54
     t56 = casadi.if_else((t53 > 0), 1/(t53*(t53 + t52)), 0)
-    t57 = t42 - t42*t56*t55**2
+    t57 = t51 - t51*t56*t55**2
     t58 = casadi.if_else((t54 != 0), -t57/t54, 0)
-    t59 = casadi.if_else((t37 != 0), -(t41 - t50*t58)/t37, 0)
-    t60 = casadi.if_else((t24 != 0), -(t28 + t33*t59 + t46*t58)/t24, 0)
+    t59 = casadi.if_else((t43 != 0), -(t50 - t47*t58)/t43, 0)
+    t60 = casadi.if_else((t27 != 0), -(t39 + t31*t59 + t35*t58)/t27, 0)
     t61 = t58 + t2*t59 - t3*t60
     t62 = t58 + t0*t59 - t1*t60
     t63 = t58 + t59*c123 - t60*s123
@@ -597,8 +597,8 @@ def _velocity_ik(q, mu_dot, damping):
     t99 = (damping >= 0)
     t100 = 1e-12*t15
     t101 = (damping > 0)
-    t102 = 1e-12*t44
-    t103 = casadi.logic_or(casadi.logic_and(t101, casadi.logic_or(casadi.logic_or((t23 <= t102), (t36 <= t102)), (t53 <= t102))), casadi.logic_and((damping <= 0), casadi.logic_or(casadi.logic_or((t90 <= t100), (t10 <= t100)), (t78 <= t100))))
+    t102 = 1e-12*t25
+    t103 = casadi.logic_or(casadi.logic_and(t101, casadi.logic_or(casadi.logic_or((t26 <= t102), (t42 <= t102)), (t53 <= t102))), casadi.logic_and((damping <= 0), casadi.logic_or(casadi.logic_or((t90 <= t100), (t10 <= t100)), (t78 <= t100))))
     t104 = casadi.logic_and(casadi.logic_and(t98, t99), casadi.logic_not(t103))
     q_dot = casadi.SX(3, 1)
     q_dot[0, 0] = casadi.if_else(t104, casadi.if_else(t101, t61, t97), 0)

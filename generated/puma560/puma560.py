@@ -114,7 +114,7 @@ def fk(q):
     t24 = t9*c6 - t21*s6
     t25 = t5 - 0.4318*t20
     t26 = c4*s23
-    t27 = t26*c5 + c23*s5
+    t27 = c23*s5 + t26*c5
     t28 = c23*c5 - t26*s5
     t29 = s23*s4
     t30 = t27*c6 - t29*s6
@@ -269,7 +269,7 @@ def fk_jacobian(q):
     t24 = t9*c6 - t21*s6
     t25 = t5 - 0.4318*t20
     t26 = c4*s23
-    t27 = t26*c5 + c23*s5
+    t27 = c23*s5 + t26*c5
     t28 = c23*c5 - t26*s5
     t29 = s23*s4
     t30 = t27*c6 - t29*s6
@@ -383,7 +383,7 @@ def jacobian_tool(q):
     t23 = t8*c6 - t20*s6
     t24 = t4 - 0.4318*t19
     t25 = c4*s23
-    t26 = t25*c5 + c23*s5
+    t26 = c23*s5 + t25*c5
     t27 = c23*c5 - t25*s5
     t28 = s23*s4
     t29 = t26*c6 - t28*s6
@@ -391,9 +391,9 @@ def jacobian_tool(q):
     t31 = 0.4318*c2
     t32 = t18 + t31*c1
     t33 = t24 + t31*s1
-    t34 = t16*c1
-    t35 = t22*s1
-    t36 = t32*c1 + t33*s1
+    t34 = t32*c1 + t33*s1
+    t35 = t16*c1
+    t36 = t22*s1
     t37 = t18*c1 + t24*s1
     t38 = t23*s1
     t39 = t15*c1
@@ -403,19 +403,19 @@ def jacobian_tool(q):
     t43 = t21*c1 - t15*s1
     J = _stack(xp, [
         t22*t32 - t16*t33,  # 0, 0
-        -(t1*t34 + t1*t35 - t29*t36),  # 0, 1
-        -(t0*t34 + t0*t35 - t29*t37),  # 0, 2
+        -(-t29*t34 + t1*t35 + t1*t36),  # 0, 1
+        -(-t29*t37 + t0*t35 + t0*t36),  # 0, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5
         t17*t33 + t23*t32,  # 1, 0
-        -(t30*t36 + t1*t38 - t17*t1*c1),  # 1, 1
+        -(t30*t34 + t1*t38 - t17*t1*c1),  # 1, 1
         -(t30*t37 + t0*t38 - t17*t0*c1),  # 1, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5
         t15*t33 - t21*t32,  # 2, 0
-        t27*t36 + t1*t39 + t1*t40,  # 2, 1
+        t27*t34 + t1*t39 + t1*t40,  # 2, 1
         t27*t37 + t0*t39 + t0*t40,  # 2, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 4
@@ -423,20 +423,20 @@ def jacobian_tool(q):
         t29,  # 3, 0
         t41,  # 3, 1
         t41,  # 3, 2
-        -(t16*t13 + t22*t19 - t29*c23),  # 3, 3
-        t11*t16 + t29*t28 - t8*t22,  # 3, 4
+        -(-t29*c23 + t16*t13 + t22*t19),  # 3, 3
+        t11*t16 - t8*t22 + t29*t28,  # 3, 4
         -(t15*t16 + t21*t22 - t27*t29),  # 3, 5
         -t30,  # 4, 0
         t42,  # 4, 1
         t42,  # 4, 2
-        -(t23*t19 + t30*c23 - t17*c1*s23),  # 4, 3
+        -(t30*c23 + t23*t19 - t17*c1*s23),  # 4, 3
         -(t11*t17 + t8*t23 + t30*t28),  # 4, 4
         -(t21*t23 + t27*t30 - t15*t17),  # 4, 5
         t27,  # 5, 0
         t43,  # 5, 1
         t43,  # 5, 2
-        t15*t13 + t21*t19 + t27*c23,  # 5, 3
-        t8*t21 + t27*t28 - t11*t15,  # 5, 4
+        t27*c23 + t15*t13 + t21*t19,  # 5, 3
+        t8*t21 - t11*t15 + t27*t28,  # 5, 4
         t15**2 + t21**2 + t27**2,  # 5, 5
     ], (6, 6))
     return J
@@ -543,24 +543,24 @@ def task_jacobian(q):
     t21 = t8*s6 + t19*c6
     t22 = t4 - 0.4318*t18
     t23 = c4*s23
-    t24 = t23*c5 + c23*s5
+    t24 = c23*s5 + t23*c5
     t25 = c23*c5 - t23*s5
     t26 = s23*s4
     t27 = t24*c6 - t26*s6
     t28 = 0.4318*c2
     t29 = t17 + t28*c1
     t30 = t22 + t28*s1
-    t31 = t16*s1
-    t32 = t21*c1
-    t33 = t16**2 + t21**2
-    t34 = 1/t33
-    t35 = t34*(t31 - t32)
+    t31 = t16**2 + t21**2
+    t32 = 1/t31
+    t33 = t16*s1
+    t34 = t21*c1
+    t35 = t32*(t33 - t34)
     t36 = t16*c1
     t37 = t21*s1
-    t38 = -t34*(t36*s23 + t37*s23)
-    t39 = t34*(t11*t16 - t8*t21)
-    t40 = -t34*(t15*t16 + t20*t21)
-    t41 = 1/xp.sqrt(t33)
+    t38 = -t32*(t36*s23 + t37*s23)
+    t39 = t32*(t11*t16 - t8*t21)
+    t40 = -t32*(t15*t16 + t20*t21)
+    t41 = 1/xp.sqrt(t31)
     t42 = -t41*(t36 + t37)
     t43 = -t27*t35
     J = _stack(xp, [
@@ -591,7 +591,7 @@ def task_jacobian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
         t42,  # 4, 1
         t42,  # 4, 2
-        t41*(t32*s23 - t31*s23),  # 4, 3
+        t41*(t34*s23 - t33*s23),  # 4, 3
         -t41*(t11*t21 + t8*t16),  # 4, 4
         t41*(t15*t21 - t20*t16),  # 4, 5
         xp.full(batch, 1, dtype=dtype, device=device),  # 5, 0
@@ -656,7 +656,7 @@ def fk_jacobian_dot(q, q_dot):
     t25 = t10*c6 - t22*s6
     t26 = t6 - 0.4318*t21
     t27 = c4*s23
-    t28 = t27*c5 + c23*s5
+    t28 = c23*s5 + t27*c5
     t29 = c23*c5 - t27*s5
     t30 = s23*s4
     t31 = t28*c6 - t30*s6
@@ -692,8 +692,8 @@ def fk_jacobian_dot(q, q_dot):
     t61 = -c1
     t62 = c1**2
     t63 = t0*qd2
-    t64 = t0*qd3
-    t65 = s1**2
+    t64 = s1**2
+    t65 = t0*qd3
     T = _stack(xp, [
         xp.broadcast_to(t18, batch),  # 0, 0
         xp.broadcast_to(-t19, batch),  # 0, 1
@@ -751,12 +751,12 @@ def fk_jacobian_dot(q, q_dot):
         xp.broadcast_to(t29, batch),  # 5, 5
     ], (6, 6))
     a = _stack(xp, [
-        xp.broadcast_to(qd2*(t60*qd1 - t41*c1) - t48*qd1 - qd3*(t40*t49 + t40*t50 - t0*qd1*s1), batch),  # 0
-        xp.broadcast_to(-t55*qd1 - qd2*(t41*s1 + t58*qd1) - qd3*(t40*t42 + t40*t43 + t59*qd1), batch),  # 1
-        xp.broadcast_to(-qd2*(t54*c1 + t47*s1) - qd3*(t62*t63 + t62*t64 + t63*t65 + t64*t65), batch),  # 2
-        xp.broadcast_to(t49*qd1 + t50*qd1 + qd4*(t21*qd1 - t51*c23) + qd5*(t10*t3 - t52*t30) + qd6*(t23*t33 - t29*t53), batch),  # 3
-        xp.broadcast_to(t42*qd1 + t43*qd1 + qd5*(t13*t3 - t45*t30) - qd4*(t44*c23 + t15*qd1) - qd6*(t17*t33 + t29*t46), batch),  # 4
-        xp.broadcast_to(qd5*(t13*t52 - t10*t45) - qd4*(t44*t21 + t51*t15) - qd6*(t17*t53 + t23*t46), batch),  # 5
+        xp.broadcast_to(qd2*(-t41*c1 + t60*qd1) - qd3*(t40*t49 + t40*t50 - t0*qd1*s1) - t48*qd1, batch),  # 0
+        xp.broadcast_to(-qd2*(t41*s1 + t58*qd1) - qd3*(t59*qd1 + t40*t42 + t40*t43) - t55*qd1, batch),  # 1
+        xp.broadcast_to(-qd2*(t54*c1 + t47*s1) - qd3*(t62*t63 + t63*t64 + t62*t65 + t64*t65), batch),  # 2
+        xp.broadcast_to(qd4*(-t51*c23 + t21*qd1) + qd5*(t10*t3 - t52*t30) + qd6*(t23*t33 - t29*t53) + t49*qd1 + t50*qd1, batch),  # 3
+        xp.broadcast_to(-qd4*(t44*c23 + t15*qd1) + qd5*(t13*t3 - t45*t30) - qd6*(t17*t33 + t29*t46) + t42*qd1 + t43*qd1, batch),  # 4
+        xp.broadcast_to(-qd4*(t44*t21 + t51*t15) + qd5*(t13*t52 - t10*t45) - qd6*(t17*t53 + t23*t46), batch),  # 5
     ], (6,))
     return T, J, a
 
@@ -830,31 +830,31 @@ def jacobian_dot(q, q_dot):
     t45 = c1*qd1
     t46 = c1**2
     t47 = t1*qd2
-    t48 = t1*qd3
-    t49 = s1**2
+    t48 = s1**2
+    t49 = t1*qd3
     Jd = _stack(xp, [
         xp.broadcast_to(-t31, batch),  # 0, 0
-        xp.broadcast_to(t2*t44 - t26*c1, batch),  # 0, 1
+        xp.broadcast_to(-t26*c1 + t2*t44, batch),  # 0, 1
         xp.broadcast_to(-(t21*t32 + t21*t33 - t1*qd1*s1), batch),  # 0, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5
         xp.broadcast_to(-t36, batch),  # 1, 0
-        xp.broadcast_to(-(t2*t45 + t26*s1), batch),  # 1, 1
+        xp.broadcast_to(-(t26*s1 + t2*t45), batch),  # 1, 1
         xp.broadcast_to(-(t1*t45 + t21*t27 + t21*t28), batch),  # 1, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
         xp.broadcast_to(-(t35*c1 + t30*s1), batch),  # 2, 1
-        xp.broadcast_to(-(t46*t47 + t46*t48 + t47*t49 + t48*t49), batch),  # 2, 2
+        xp.broadcast_to(-(t46*t47 + t47*t48 + t46*t49 + t48*t49), batch),  # 2, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
         xp.broadcast_to(t45, batch),  # 3, 1
         xp.broadcast_to(t45, batch),  # 3, 2
-        xp.broadcast_to(t44*s23 - t34*c23, batch),  # 3, 3
+        xp.broadcast_to(-t34*c23 + t44*s23, batch),  # 3, 3
         xp.broadcast_to(t10*t3 - t39*t42, batch),  # 3, 4
         xp.broadcast_to(t17*t43 - t0*t41, batch),  # 3, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
@@ -943,15 +943,15 @@ def bias_acceleration(q, q_dot):
     t45 = c1*qd1
     t46 = c1**2
     t47 = t1*qd2
-    t48 = t1*qd3
-    t49 = s1**2
+    t48 = s1**2
+    t49 = t1*qd3
     a = _stack(xp, [
-        xp.broadcast_to(qd2*(t2*t44 - t26*c1) - t31*qd1 - qd3*(t21*t32 + t21*t33 - t1*qd1*s1), batch),  # 0
-        xp.broadcast_to(-t36*qd1 - qd2*(t2*t45 + t26*s1) - qd3*(t1*t45 + t21*t27 + t21*t28), batch),  # 1
-        xp.broadcast_to(-qd2*(t35*c1 + t30*s1) - qd3*(t46*t47 + t46*t48 + t47*t49 + t48*t49), batch),  # 2
-        xp.broadcast_to(t32*qd1 + t33*qd1 + qd4*(t44*s23 - t34*c23) + qd5*(t10*t3 - t39*t42) + qd6*(t17*t43 - t0*t41), batch),  # 3
-        xp.broadcast_to(t27*qd1 + t28*qd1 + qd5*(t13*t3 - t38*t42) - qd4*(t29*c23 + t45*s23) - qd6*(t16*t43 + t0*t40), batch),  # 4
-        xp.broadcast_to(qd5*(t13*t39 - t10*t38) - qd4*(t29*s1*s23 + t34*c1*s23) - qd6*(t16*t41 + t17*t40), batch),  # 5
+        xp.broadcast_to(qd2*(-t26*c1 + t2*t44) - qd3*(t21*t32 + t21*t33 - t1*qd1*s1) - t31*qd1, batch),  # 0
+        xp.broadcast_to(-qd2*(t26*s1 + t2*t45) - qd3*(t1*t45 + t21*t27 + t21*t28) - t36*qd1, batch),  # 1
+        xp.broadcast_to(-qd2*(t35*c1 + t30*s1) - qd3*(t46*t47 + t47*t48 + t46*t49 + t48*t49), batch),  # 2
+        xp.broadcast_to(qd4*(-t34*c23 + t44*s23) + qd5*(t10*t3 - t39*t42) + qd6*(t17*t43 - t0*t41) + t32*qd1 + t33*qd1, batch),  # 3
+        xp.broadcast_to(-qd4*(t29*c23 + t45*s23) + qd5*(t13*t3 - t38*t42) - qd6*(t16*t43 + t0*t40) + t27*qd1 + t28*qd1, batch),  # 4
+        xp.broadcast_to(-qd4*(t29*s1*s23 + t34*c1*s23) + qd5*(t13*t39 - t10*t38) - qd6*(t16*t41 + t17*t40), batch),  # 5
     ], (6,))
     return a
 
@@ -1005,7 +1005,7 @@ def task_jacobian_dot(q, q_dot):
     t22 = t4 - 0.4318*t18
     t23 = t17*c1 + t22*s1
     t24 = c4*s23
-    t25 = t24*c5 + c23*s5
+    t25 = c23*s5 + t24*c5
     t26 = c23*c5 - t24*s5
     t27 = s23*s4
     t28 = t25*c6 - t27*s6
@@ -1028,7 +1028,7 @@ def task_jacobian_dot(q, q_dot):
     t45 = t43*c1 + t36*s1
     t46 = t41 + t42
     t47 = t46
-    t48 = t18*qd1 - t47*c23
+    t48 = -t47*c23 + t18*qd1
     t49 = t39*t18 + t47*t13
     t50 = -t13*qd4
     t51 = t39 + t50
@@ -1055,72 +1055,72 @@ def task_jacobian_dot(q, q_dot):
     t72 = t21*t71 + t28*t65
     t73 = t16*t71 - t28*t61
     t74 = qd1*s1
-    t75 = t1*t74 - t33*c1
+    t75 = -t33*c1 + t1*t74
     t76 = t23*t41 + t23*t42 - t0*t74
     t77 = c1*qd1
-    t78 = t1*t77 + t33*s1
+    t78 = t33*s1 + t1*t77
     t79 = t0*t77 + t23*t34 + t23*t35
     t80 = c1**2
     t81 = t0*qd2
-    t82 = t0*qd3
-    t83 = s1**2
-    t84 = t80*t81 + t80*t82 + t81*t83 + t82*t83
+    t82 = s1**2
+    t83 = t0*qd3
+    t84 = t80*t81 + t81*t82 + t80*t83 + t82*t83
     t85 = t16**2 + t21**2
     t86 = 1/t85
-    t87 = t86*c1
-    t88 = t16*qd1
-    t89 = t86*s1
-    t90 = t21*qd1
-    t91 = t16*s1
-    t92 = t21*c1
-    t93 = t91 - t92
-    t94 = 2/t85**2
-    t95 = t93*t94
-    t96 = t16*t95
-    t97 = t21*t95
-    t98 = t87*t88 + t89*t90 - t72*(t89 - t96) - t73*(t87 + t97)
-    t99 = t16*t86
-    t100 = t48*t99
-    t101 = t21*t86
-    t102 = t89*s23
-    t103 = t16*c1
-    t104 = t21*s1
-    t105 = -(t103*s23 + t104*s23)
-    t106 = t94*t105
-    t107 = t21*t106
-    t108 = t87*s23
-    t109 = t16*t106
-    t110 = t57*t99
-    t111 = t58*t101
-    t112 = t11*t86
-    t113 = t11*t16 - t8*t21
-    t114 = t94*t113
-    t115 = t16*t114
-    t116 = t8*t86
-    t117 = t21*t114
-    t118 = t69*t99
-    t119 = t20*t86
-    t120 = -(t15*t16 + t20*t21)
-    t121 = t94*t120
-    t122 = t21*t121
-    t123 = t15*t86
-    t124 = t16*t121
+    t87 = c1*t86
+    t88 = t16*s1
+    t89 = t21*c1
+    t90 = t88 - t89
+    t91 = 2/t85**2
+    t92 = t90*t91
+    t93 = t21*t92
+    t94 = s1*t86
+    t95 = t16*t92
+    t96 = t16*qd1
+    t97 = t21*qd1
+    t98 = -t73*(t87 + t93) - t72*(t94 - t95) + t87*t96 + t94*t97
+    t99 = t94*s23
+    t100 = t16*c1
+    t101 = t21*s1
+    t102 = -(t100*s23 + t101*s23)
+    t103 = t91*t102
+    t104 = t21*t103
+    t105 = t87*s23
+    t106 = t16*t103
+    t107 = t16*t86
+    t108 = t48*t107
+    t109 = t21*t86
+    t110 = t8*t86
+    t111 = t11*t16 - t8*t21
+    t112 = t91*t111
+    t113 = t21*t112
+    t114 = t11*t86
+    t115 = t16*t112
+    t116 = t57*t107
+    t117 = t58*t109
+    t118 = t20*t86
+    t119 = -(t15*t16 + t20*t21)
+    t120 = t91*t119
+    t121 = t21*t120
+    t122 = t15*t86
+    t123 = t16*t120
+    t124 = t69*t107
     t125 = 1/xp.sqrt(t85)
-    t126 = t125*qd1
-    t127 = t125*s1
-    t128 = 1/t85**1.5
-    t129 = -t128*(t103 + t104)
-    t130 = t125*c1
-    t131 = t72*(t130 + t16*t129) + t91*t126 - t73*(t127 + t21*t129) - t92*t126
-    t132 = t16*t125
-    t133 = t21*t125
-    t134 = t128*(t92*s23 - t91*s23)
-    t135 = -t128*(t11*t21 + t8*t16)
-    t136 = t128*(t15*t21 - t20*t16)
-    t137 = t28*t87
-    t138 = t28*t89
+    t126 = s1*t125
+    t127 = 1/t85**1.5
+    t128 = -t127*(t100 + t101)
+    t129 = c1*t125
+    t130 = t125*qd1
+    t131 = -t73*(t126 + t21*t128) + t72*(t129 + t16*t128) + t88*t130 - t89*t130
+    t132 = t127*(t89*s23 - t88*s23)
+    t133 = t16*t125
+    t134 = t21*t125
+    t135 = -t127*(t11*t21 + t8*t16)
+    t136 = t127*(t15*t21 - t20*t16)
+    t137 = t28*t94
+    t138 = t28*t87
     t139 = t66*t86
-    t140 = -(t72*(-t138 + t28*t96) + t88*t137 + t90*t138 + t93*t139 - t73*(t137 + t28*t97))
+    t140 = -(t72*(-t137 + t28*t95) - t73*(t138 + t28*t93) + t90*t139 + t96*t138 + t97*t137)
     Jd = _stack(xp, [
         xp.broadcast_to(-t37, batch),  # 0, 0
         xp.broadcast_to(t75, batch),  # 0, 1
@@ -1143,21 +1143,21 @@ def task_jacobian_dot(q, q_dot):
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
         xp.broadcast_to(t98, batch),  # 3, 1
         xp.broadcast_to(t98, batch),  # 3, 2
-        xp.broadcast_to(t100 + t72*(t108 + t109) - t40*t101 - t73*(t102 + t107), batch),  # 3, 3
-        xp.broadcast_to(t110 + t111 - t72*(t112 - t115) - t73*(t116 + t117), batch),  # 3, 4
-        xp.broadcast_to(t118 + t72*(t123 + t124) - t70*t101 - t73*(t119 + t122), batch),  # 3, 5
+        xp.broadcast_to(-t73*(t99 + t104) + t72*(t105 + t106) + t108 - t40*t109, batch),  # 3, 3
+        xp.broadcast_to(-t73*(t110 + t113) - t72*(t114 - t115) + t116 + t117, batch),  # 3, 4
+        xp.broadcast_to(-t73*(t118 + t121) + t72*(t122 + t123) + t124 - t70*t109, batch),  # 3, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
         xp.broadcast_to(t131, batch),  # 4, 1
         xp.broadcast_to(t131, batch),  # 4, 2
-        xp.broadcast_to(-(t48*t133 + t40*t132 - t72*(t16*t134 + t127*s23) - t73*(t130*s23 - t21*t134)), batch),  # 4, 3
-        xp.broadcast_to(t58*t132 + t72*(t8*t125 + t16*t135) - t57*t133 - t73*(t11*t125 + t21*t135), batch),  # 4, 4
-        xp.broadcast_to(-(t69*t133 + t70*t132 - t72*(t20*t125 + t16*t136) - t73*(t15*t125 - t21*t136)), batch),  # 4, 5
+        xp.broadcast_to(-(-t72*(t16*t132 + t126*s23) - t73*(t129*s23 - t21*t132) + t40*t133 + t48*t134), batch),  # 4, 3
+        xp.broadcast_to(-t73*(t11*t125 + t21*t135) + t72*(t8*t125 + t16*t135) + t58*t133 - t57*t134, batch),  # 4, 4
+        xp.broadcast_to(-(-t72*(t20*t125 + t16*t136) - t73*(t15*t125 - t21*t136) + t70*t133 + t69*t134), batch),  # 4, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 0
         xp.broadcast_to(t140, batch),  # 5, 1
         xp.broadcast_to(t140, batch),  # 5, 2
-        xp.broadcast_to(-(t49 + t28*t100 + t72*(t28*t108 + t28*t109) + t105*t139 - t73*(t28*t102 + t28*t107) - t21*t28*t40*t86), batch),  # 5, 3
-        xp.broadcast_to(-(-t54 + t28*t110 + t28*t111 + t72*(t28*t115 - t28*t112) + t113*t139 - t73*(t28*t116 + t28*t117)), batch),  # 5, 4
-        xp.broadcast_to(-(t64 + t28*t118 + t72*(t28*t123 + t28*t124) + t120*t139 - t73*(t28*t119 + t28*t122) - t21*t28*t70*t86), batch),  # 5, 5
+        xp.broadcast_to(-(t49 + t72*(t28*t105 + t28*t106) - t73*(t28*t99 + t28*t104) + t102*t139 + t28*t108 - t21*t28*t40*t86), batch),  # 5, 3
+        xp.broadcast_to(-(-t54 + t72*(-t28*t114 + t28*t115) - t73*(t28*t110 + t28*t113) + t111*t139 + t28*t116 + t28*t117), batch),  # 5, 4
+        xp.broadcast_to(-(t64 + t72*(t28*t122 + t28*t123) - t73*(t28*t118 + t28*t121) + t119*t139 + t28*t124 - t21*t28*t70*t86), batch),  # 5, 5
     ], (6, 6))
     return Jd
 
@@ -1182,9 +1182,9 @@ def hessian(q):
     t1 = 0.0203*s23 + 0.4318*c23
     t2 = t1 + 0.4318*s2
     t3 = c1*c23
-    t4 = 0.0203*t3 + 0.15005*s1
+    t4 = 0.15005*s1 + 0.0203*t3
     t5 = c23*s1
-    t6 = 0.0203*t5 - 0.15005*c1
+    t6 = -0.15005*c1 + 0.0203*t5
     t7 = s1*s4
     t8 = c1*c4
     t9 = -t7 + t8*c23
@@ -1219,7 +1219,7 @@ def hessian(q):
     t38 = -t5
     t39 = -t7*s23
     t40 = -t0*s1
-    t41 = -(t32*s23 + t33*s23)
+    t41 = -(s23*t32 + s23*t33)
     t42 = t13*c1 - t10*s1
     t43 = -(t16*c1 + t19*s1)
     t44 = s23**2
@@ -1362,7 +1362,7 @@ def hessian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 4, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 4, 3
         t13*c23 + t44*t12,  # 3, 4, 4
-        t0*t15 - t16*c23,  # 3, 4, 5
+        -t16*c23 + t0*t15,  # 3, 4, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 5, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 5, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 5, 2
@@ -1392,7 +1392,7 @@ def hessian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 3, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 3, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 3, 4
-        t19*t45 - t10*t0,  # 4, 3, 5
+        -t10*t0 + t19*t45,  # 4, 3, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 4, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 4, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 4, 2
@@ -1456,9 +1456,9 @@ def singularity_factors(q):
     s5 = trig[..., 9]
     t0 = 0.04701250578971746*s3
     f = _stack(xp, [
-        t0 + c3,  # 0
+        c3 + t0,  # 0
         s5,  # 1
-        -(-c2 + t0*s2 + c2*s3 + c3*s2 - 0.04701250578971746*c2*c3),  # 2
+        -(-c2 + c2*s3 + c3*s2 + t0*s2 - 0.04701250578971746*c2*c3),  # 2
     ], (3,))
     return f
 
@@ -1473,7 +1473,7 @@ def manipulability(q):
     s3 = trig[..., 5]
     s5 = trig[..., 9]
     t0 = 0.04701250578971746*s3
-    t1 = -0.080509645432*s5*(t0 + c3)*(-c2 + t0*s2 + c2*s3 + c3*s2 - 0.04701250578971746*c2*c3)
+    t1 = -0.080509645432*s5*(c3 + t0)*(-c2 + c2*s3 + c3*s2 + t0*s2 - 0.04701250578971746*c2*c3)
     w = xp.broadcast_to(xp.abs(t1), batch)
     return w
 
@@ -1488,7 +1488,7 @@ def jacobian_det(q):
     s3 = trig[..., 5]
     s5 = trig[..., 9]
     t0 = 0.04701250578971746*s3
-    d = xp.broadcast_to(-0.080509645432*s5*(t0 + c3)*(-c2 + t0*s2 + c2*s3 + c3*s2 - 0.04701250578971746*c2*c3), batch)
+    d = xp.broadcast_to(-0.080509645432*s5*(c3 + t0)*(-c2 + c2*s3 + c3*s2 + t0*s2 - 0.04701250578971746*c2*c3), batch)
     return d
 
 
@@ -1551,15 +1551,15 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t27 = c1**2
     t28 = t1*t27 + t2*t27
     t29 = t2**2
-    t30 = t25 + t27*t29 + t27*t26
+    t30 = t25 + t26*t27 + t29*t27
     t31 = t30
     t32 = -t22*t23
     t33 = c1*s1
-    t34 = t32 + t29*t33 + t33*t26
+    t34 = t32 + t33*t26 + t29*t33
     t35 = t20*c1
     t36 = t24*c1
     t37 = t1*t35 + t2*t36
-    t38 = t35 + t36
+    t38 = t36 + t35
     t39 = t1*c1
     t40 = t2*c1
     t41 = t39*s1 + t40*s1
@@ -1569,12 +1569,12 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t45 = xp.where(xp.greater(t43, 0), 1/(t43*(t43 + xp.abs(t23))), 0)
     t46 = s1**2
     t47 = t1*t46 + t2*t46
-    t48 = t42 + t29*t46 + t46*t26
+    t48 = t42 + t26*t46 + t29*t46
     t49 = t48
     t50 = t20*s1
     t51 = t24*s1
     t52 = t1*t50 + t2*t51
-    t53 = t50 + t51
+    t53 = t51 + t50
     t54 = t24**2
     t55 = t54 + t20**2
     t56 = t55
@@ -1582,102 +1582,102 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t58 = t12**2 + t15**2 + 2*t46 + t27*t57
     t59 = t58
     t60 = 2*c1
-    t61 = t15*t18 + t33*t57 - t12*t9 - t60*s1
+    t61 = t15*t18 - t12*t9 - t60*s1 + t33*t57
     t62 = s23*s4
     t63 = t15*t0 + t14*c23 - t12*t62
-    t64 = t9*t62 + t18*t0 + t17*c23
+    t64 = t18*t0 + t9*t62 + t17*c23
     t65 = t9**2 + t18**2 + 2*t27 + t46*t57
     t66 = t65
     t67 = 1 + t0**2 + c23**2 + t57*s4**2
     t68 = t67
     t69 = xp.sqrt(t30 + t48 + t55 + t58 + t65 + t67)
-    t70 = t34**2
-    t71 = t37**2
-    t72 = t41**2
-    t73 = t28**2
-    t74 = damping**2
-    t75 = t66 + t74
-    t76 = t68 + t74
-    t77 = t31 + t74
-    t78 = t77**2
-    t79 = xp.sqrt(t70 + t71 + t72 + t73 + t78 + t25)
-    t80 = t79*xp.where(xp.greater_equal(t77, 0), xp.asarray(1, dtype=dtype), -1)
-    t81 = t80 + t77
-    t82 = xp.where(xp.greater(t79, 0), 1/(t79*(t79 + xp.abs(t77))), 0)
-    t83 = t82*(t64*t23 + t81*t28 + t34*t41 + t37*t38 + t28*t75 - t41*t61)
-    t84 = t28 - t81*t83
-    t85 = t41 - t83*t34
-    t86 = -t38 + t83*t37
-    t87 = t61 + t83*t41
-    t88 = t75 - t83*t28
-    t89 = -t64 + t83*t23
-    t90 = -t82*(t64*t28 + t81*t23 + t23*t76 - t22*t34 - t41*t63)
-    t91 = t23 + t81*t90
-    t92 = t22 - t90*t34
-    t93 = t64 + t90*t28
-    t94 = t76 + t90*t23
-    t95 = t82*(t81*mu_dot0 + t34*mu_dot1 + t28*mu_dot4 - t23*mu_dot5 - t37*mu_dot2 - t41*mu_dot3)
-    t96 = mu_dot0 - t81*t95
-    t97 = mu_dot1 - t95*t34
-    t98 = mu_dot2 + t95*t37
-    t99 = mu_dot3 + t95*t41
-    t100 = mu_dot4 - t95*t28
-    t101 = mu_dot5 + t95*t23
-    t102 = t49 + t74
-    t103 = t82*(t32 + t81*t34 + t34*t102 + t37*t52 + t41*t28 + t41*t47)
-    t104 = t34 - t81*t103
-    t105 = t102 - t103*t34
-    t106 = -t52 + t103*t37
-    t107 = -t47 + t103*t41
-    t108 = t41 - t103*t28
-    t109 = t22 + t103*t23
-    t110 = xp.sqrt(t105**2 + t106**2 + t107**2 + t108**2 + t109**2)
-    t111 = t110*xp.where(xp.greater_equal(t105, 0), xp.asarray(1, dtype=dtype), -1)
-    t112 = t105 + t111
-    t113 = xp.where(xp.greater(t110, 0), 1/(t110*(t110 + xp.abs(t105))), 0)
-    t114 = t113*(t106*t86 + t107*t87 + t108*t88 + t109*t89 + t85*t112)
-    t115 = t85 - t112*t114
-    t116 = t86 - t106*t114
-    t117 = t87 - t107*t114
-    t118 = t88 - t108*t114
-    t119 = t89 - t109*t114
-    t120 = t113*(t106*t98 + t107*t99 + t108*t100 + t109*t101 + t97*t112)
-    t121 = t97 - t112*t120
-    t122 = t98 - t106*t120
-    t123 = t99 - t107*t120
-    t124 = t100 - t108*t120
-    t125 = t101 - t109*t120
-    t126 = t56 + t74
-    t127 = -t82*(t81*t37 + t34*t52 + t37*t126 + t41*t53 + t28*t38)
-    t128 = t37 + t81*t127
-    t129 = t52 + t127*t34
-    t130 = t126 + t127*t37
-    t131 = t53 + t127*t41
-    t132 = t38 + t127*t28
-    t133 = t59 + t74
-    t134 = xp.sqrt(t78 + t75**2 + t76**2 + t102**2 + t126**2 + t133**2 + 2*t42 + 2*t70 + 2*t71 + 2*t73 + 2*t25 + 2*t64**2 + 2*t52**2 + 2*t47**2 + 2*t53**2 + 2*t38**2 + 2*t61**2 + 2*t63**2 + 4*t72)
-    t135 = -t82*(t81*t41 + t34*t47 + t37*t53 + t41*t133 - t23*t63 - t28*t61)
-    t136 = t41 + t81*t135
-    t137 = t47 + t135*t34
-    t138 = t53 + t135*t37
-    t139 = t133 + t135*t41
-    t140 = t61 - t135*t28
+    t70 = damping**2
+    t71 = t66 + t70
+    t72 = t68 + t70
+    t73 = t31 + t70
+    t74 = t73**2
+    t75 = t49 + t70
+    t76 = t56 + t70
+    t77 = t59 + t70
+    t78 = t34**2
+    t79 = t37**2
+    t80 = t28**2
+    t81 = t41**2
+    t82 = xp.sqrt(t71**2 + t72**2 + t74 + t75**2 + t76**2 + t77**2 + 2*t64**2 + 2*t42 + 2*t25 + 2*t78 + 2*t79 + 2*t80 + 2*t52**2 + 2*t47**2 + 2*t53**2 + 2*t38**2 + 2*t61**2 + 2*t63**2 + 4*t81)
+    t83 = xp.sqrt(t25 + t78 + t79 + t81 + t80 + t74)
+    t84 = t83*xp.where(xp.greater_equal(t73, 0), xp.asarray(1, dtype=dtype), -1)
+    t85 = t84 + t73
+    t86 = xp.where(xp.greater(t83, 0), 1/(t83*(t83 + xp.abs(t73))), 0)
+    t87 = t86*(t85*t34 + t34*t75 + t37*t52 + t41*t28 + t41*t47 + t32)
+    t88 = t34 - t85*t87
+    t89 = t75 - t87*t34
+    t90 = -t52 + t87*t37
+    t91 = -t47 + t87*t41
+    t92 = t41 - t87*t28
+    t93 = t22 + t87*t23
+    t94 = -t86*(t85*t37 + t34*t52 + t37*t76 + t41*t53 + t28*t38)
+    t95 = t37 + t85*t94
+    t96 = t52 + t94*t34
+    t97 = t76 + t94*t37
+    t98 = t53 + t94*t41
+    t99 = t38 + t94*t28
+    t100 = -t86*(t85*t41 + t34*t47 + t37*t53 + t41*t77 - t23*t63 - t28*t61)
+    t101 = t41 + t85*t100
+    t102 = t47 + t100*t34
+    t103 = t53 + t100*t37
+    t104 = t77 + t100*t41
+    t105 = t61 - t100*t28
+    t106 = t86*(t64*t23 + t85*t28 + t34*t41 + t37*t38 + t28*t71 - t41*t61)
+    t107 = t28 - t85*t106
+    t108 = t41 - t106*t34
+    t109 = -t38 + t106*t37
+    t110 = t61 + t106*t41
+    t111 = t71 - t106*t28
+    t112 = -t64 + t106*t23
+    t113 = -t86*(t64*t28 + t85*t23 + t23*t72 - t22*t34 - t41*t63)
+    t114 = t23 + t85*t113
+    t115 = t22 - t113*t34
+    t116 = t64 + t113*t28
+    t117 = t72 + t113*t23
+    t118 = t86*(t85*mu_dot0 + t34*mu_dot1 + t28*mu_dot4 - t23*mu_dot5 - t37*mu_dot2 - t41*mu_dot3)
+    t119 = mu_dot0 - t85*t118
+    t120 = mu_dot1 - t118*t34
+    t121 = mu_dot2 + t118*t37
+    t122 = mu_dot3 + t118*t41
+    t123 = mu_dot4 - t118*t28
+    t124 = mu_dot5 + t118*t23
+    t125 = xp.sqrt(t89**2 + t90**2 + t91**2 + t92**2 + t93**2)
+    t126 = t125*xp.where(xp.greater_equal(t89, 0), xp.asarray(1, dtype=dtype), -1)
+    t127 = t89 + t126
+    t128 = xp.where(xp.greater(t125, 0), 1/(t125*(t125 + xp.abs(t89))), 0)
+    t129 = t128*(t90*t109 + t91*t110 + t92*t111 + t93*t112 + t108*t127)
+    t130 = t108 - t127*t129
+    t131 = t109 - t90*t129
+    t132 = t110 - t91*t129
+    t133 = t111 - t92*t129
+    t134 = t112 - t93*t129
+    t135 = t128*(t90*t121 + t91*t122 + t92*t123 + t93*t124 + t120*t127)
+    t136 = t120 - t127*t135
+    t137 = t121 - t90*t135
+    t138 = t122 - t91*t135
+    t139 = t123 - t92*t135
+    t140 = t124 - t93*t135
     t141 = -t63
-    t142 = t141 + t135*t23
-    t143 = t141 + t90*t41
-    t144 = t113*(t106*t138 + t107*t139 + t108*t140 + t109*t142 - t137*t112)
-    t145 = t137 + t112*t144
-    t146 = t138 - t106*t144
-    t147 = t139 - t107*t144
-    t148 = t140 - t108*t144
-    t149 = t142 - t109*t144
-    t150 = t127*t23
-    t151 = t113*(t106*t130 + t107*t131 + t109*t150 - t108*t132 - t129*t112)
-    t152 = t129 + t112*t151
-    t153 = t130 - t106*t151
-    t154 = t131 - t107*t151
-    t155 = t132 + t108*t151
-    t156 = t150 - t109*t151
+    t142 = t141 + t100*t23
+    t143 = t141 + t113*t41
+    t144 = t128*(t90*t103 + t91*t104 + t92*t105 + t93*t142 - t102*t127)
+    t145 = t102 + t127*t144
+    t146 = t103 - t90*t144
+    t147 = t104 - t91*t144
+    t148 = t105 - t92*t144
+    t149 = t142 - t93*t144
+    t150 = t94*t23
+    t151 = t128*(t90*t97 + t91*t98 - t92*t99 - t96*t127 + t93*t150)
+    t152 = t96 + t127*t151
+    t153 = t97 - t90*t151
+    t154 = t98 - t91*t151
+    t155 = t99 + t92*t151
+    t156 = t150 - t93*t151
     t157 = xp.sqrt(t153**2 + t154**2 + t155**2 + t156**2)
     t158 = t157*xp.where(xp.greater_equal(t153, 0), xp.asarray(1, dtype=dtype), -1)
     t159 = t153 + t158
@@ -1687,16 +1687,16 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t163 = t147 - t154*t161
     t164 = t148 + t155*t161
     t165 = t149 - t156*t161
-    t166 = t160*(t154*t117 + t156*t119 + t116*t159 - t155*t118)
-    t167 = t116 - t159*t166
-    t168 = t117 - t154*t166
-    t169 = t118 + t155*t166
-    t170 = t119 - t156*t166
-    t171 = t160*(t154*t123 + t156*t125 + t122*t159 - t155*t124)
-    t172 = t122 - t159*t171
-    t173 = t123 - t154*t171
-    t174 = t124 + t155*t171
-    t175 = t125 - t156*t171
+    t166 = t160*(t154*t132 + t156*t134 + t131*t159 - t155*t133)
+    t167 = t131 - t159*t166
+    t168 = t132 - t154*t166
+    t169 = t133 + t155*t166
+    t170 = t134 - t156*t166
+    t171 = t160*(t154*t138 + t156*t140 + t137*t159 - t155*t139)
+    t172 = t137 - t159*t171
+    t173 = t138 - t154*t171
+    t174 = t139 + t155*t171
+    t175 = t140 - t156*t171
     t176 = xp.sqrt(t163**2 + t164**2 + t165**2)
     t177 = t176*xp.where(xp.greater_equal(t163, 0), xp.asarray(1, dtype=dtype), -1)
     t178 = t163 + t177
@@ -1716,13 +1716,13 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t192 = t191*(t183*t187 + t186*t190)
     t193 = t186 - t190*t192
     t194 = t187 - t183*t192
-    t195 = t90*t37
-    t196 = t113*(t106*t195 + t107*t143 + t109*t94 + t92*t112 - t108*t93)
-    t197 = t92 - t112*t196
-    t198 = t195 - t106*t196
-    t199 = t143 - t107*t196
-    t200 = t93 + t108*t196
-    t201 = t94 - t109*t196
+    t195 = t113*t37
+    t196 = t128*(t91*t143 + t93*t117 + t115*t127 - t92*t116 + t90*t195)
+    t197 = t115 - t127*t196
+    t198 = t195 - t90*t196
+    t199 = t143 - t91*t196
+    t200 = t116 + t92*t196
+    t201 = t117 - t93*t196
     t202 = t160*(t154*t199 + t155*t200 + t156*t201 + t198*t159)
     t203 = t198 - t159*t202
     t204 = t199 - t154*t202
@@ -1745,11 +1745,11 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t221 = xp.where(xp.not_equal(t189, 0), -(t193 - t212*t220)/t189, 0)
     t222 = xp.where(xp.not_equal(t177, 0), -(t185 - (t181*t221 + t208*t220))/t177, 0)
     t223 = xp.where(xp.not_equal(t158, 0), -(t172 - (t162*t222 + t167*t221 + t203*t220))/t158, 0)
-    t224 = xp.where(xp.not_equal(t111, 0), -(t121 - (t115*t221 + t197*t220 - t152*t223 - t145*t222))/t111, 0)
-    t225 = xp.where(xp.not_equal(t80, 0), -(t96 + t128*t223 + t136*t222 + t91*t220 - t104*t224 - t84*t221)/t80, 0)
+    t224 = xp.where(xp.not_equal(t126, 0), -(t136 - (t130*t221 + t197*t220 - t152*t223 - t145*t222))/t126, 0)
+    t225 = xp.where(xp.not_equal(t84, 0), -(t119 + t95*t223 + t101*t222 + t114*t220 - t88*t224 - t107*t221)/t84, 0)
     t226 = t220 + t224*t22 - t225*t23
-    t227 = t221*t17 + t222*t14 - t220*c23
-    t228 = t12*t222 + t220*t62 - t9*t221
+    t227 = -t220*c23 + t221*t17 + t222*t14
+    t228 = t12*t222 - t9*t221 + t220*t62
     t229 = t221*t18 + t222*t15 - t220*t0
     t230 = t2*s1
     t231 = t221*c1 - t222*s1
@@ -1759,11 +1759,11 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t235 = -t23
     t236 = t44 + t235
     t237 = -t45*(t236*t40 + t22*t230)
-    t238 = t40 + t236*t237
-    t239 = t230 + t237*t22
+    t238 = t236*t237 + t40
+    t239 = t237*t22 + t230
     t240 = -t45*(t236*t39 + t22*t233)
-    t241 = t39 + t236*t240
-    t242 = t233 + t240*t22
+    t241 = t236*t240 + t39
+    t242 = t240*t22 + t233
     t243 = t45*(mu_dot5 + t236*mu_dot0 + t22*mu_dot1)
     t244 = mu_dot0 - t236*t243
     t245 = mu_dot1 - t243*t22
@@ -1802,26 +1802,26 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t278 = t269 - t263*t274
     t279 = t22*t247
     t280 = -t257*(t237*t248 + t256*t279)
-    t281 = t279 + t256*t280
-    t282 = t14 + t280*s1
+    t281 = t256*t280 + t279
+    t282 = t280*s1 + t14
     t283 = t248 + t237*t280
     t284 = -t17
-    t285 = t284 + t280*c1
+    t285 = t280*c1 + t284
     t286 = t22*t249
     t287 = t257*(t12*s1 + t9*c1 - t237*t250 - t256*t286)
-    t288 = t286 + t256*t287
+    t288 = t256*t287 + t286
     t289 = t12 - t287*s1
     t290 = t250 + t237*t287
     t291 = -t9
     t292 = t291 + t287*c1
     t293 = t22*t251
-    t294 = -t257*(t237*t252 + t15*s1 + t256*t293 - t18*c1)
-    t295 = t293 + t256*t294
+    t294 = -t257*(t237*t252 + t15*s1 - t18*c1 + t256*t293)
+    t295 = t256*t294 + t293
     t296 = t15 + t294*s1
     t297 = t252 + t237*t294
     t298 = -t18
     t299 = t298 + t294*c1
-    t300 = 1 + t12 + t0 + t22 + t24 + t20 + t62 + t235 + t284 + t291 + t298 + c23 + damping + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + q1 + q2 + q3 + q4 + q5 + q6 - t15 - t39 - t40 - t60 - t230 - t14 - t233 + 2*s1
+    t300 = 1 + t12 + t0 + t22 + t24 + t20 + c23 + damping + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + q1 + q2 + q3 + q4 + q5 + q6 + t291 - t15 + t298 + t235 - t60 + 2*s1 + t62 - t39 - t233 - t40 - t230 - t14 + t284
     t301 = t280*t24
     t302 = t273*(t262*t285 + t263*t283 - t261*t282 - t272*t301)
     t303 = t301 + t272*t302
@@ -1882,8 +1882,8 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t358 = xp.greater_equal(damping, 0)
     t359 = 1e-12*t69
     t360 = xp.greater(damping, 0)
-    t361 = 1e-12*t134
-    t362 = (t360 & (xp.less_equal(t79, t361) | xp.less_equal(t110, t361) | xp.less_equal(t157, t361) | xp.less_equal(t176, t361) | xp.less_equal(t188, t361) | xp.less_equal(t215, t361))) | (xp.less_equal(damping, 0) & (xp.less_equal(t43, t359) | xp.less_equal(t254, t359) | xp.less_equal(t270, t359) | xp.less_equal(t307, t359) | xp.less_equal(t325, t359) | xp.less_equal(t346, t359)))
+    t361 = 1e-12*t82
+    t362 = (t360 & (xp.less_equal(t83, t361) | xp.less_equal(t125, t361) | xp.less_equal(t157, t361) | xp.less_equal(t176, t361) | xp.less_equal(t188, t361) | xp.less_equal(t215, t361))) | (xp.less_equal(damping, 0) & (xp.less_equal(t43, t359) | xp.less_equal(t254, t359) | xp.less_equal(t270, t359) | xp.less_equal(t307, t359) | xp.less_equal(t325, t359) | xp.less_equal(t346, t359)))
     t363 = t357 & t358 & xp.logical_not(t362)
     q_dot = _stack(xp, [
         xp.broadcast_to(xp.where(t363, xp.where(t360, t226, t356), 0), batch),  # 0
@@ -1976,13 +1976,13 @@ def ik_numeric_step(target, q, damping=0.0):
     t34 = T20*t28 + T21*t29 - T22*t27
     t35 = -0.5*(t32 + t23)
     t36 = c4*s23
-    t37 = t36*c5 + c23*s5
+    t37 = c23*s5 + t36*c5
     t38 = c23*c5 - t36*s5
     t39 = s23*s4
     t40 = t37*c6 - t39*s6
     t41 = t37*s6 + t39*c6
     t42 = t18*t38 + t16*c23 - t14*t39
-    t43 = t11*t39 + t27*t38 + t25*c23
+    t43 = t27*t38 + t11*t39 + t25*c23
     t44 = T00*t40 + T02*t38 - T01*t41
     t45 = T10*t40 + T12*t38 - T11*t41
     t46 = T20*t40 + T22*t38 - T21*t41
@@ -2001,7 +2001,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t59 = c1**2
     t60 = t0*t59 + t1*t59
     t61 = t1**2
-    t62 = t57 + t58*t59 + t59*t61
+    t62 = t57 + t58*t59 + t61*t59
     t63 = -t51*t52
     t64 = c1*s1
     t65 = t63 + t58*t64 + t61*t64
@@ -2009,17 +2009,17 @@ def ik_numeric_step(target, q, damping=0.0):
     t67 = t31*c1
     t68 = t53*c1
     t69 = t0*t67 + t1*t68
-    t70 = t67 + t68
+    t70 = t68 + t67
     t71 = s1**2
     t72 = t51**2 + t58*t71 + t61*t71
     t73 = t0*t71 + t1*t71
     t74 = t31*s1
     t75 = t53*s1
     t76 = t0*t74 + t1*t75
-    t77 = t74 + t75
+    t77 = t75 + t74
     t78 = s23**2
     t79 = t14**2 + t18**2 + 2*t71 + t59*t78
-    t80 = -2*t64 + t18*t27 + t64*t78 - t14*t11
+    t80 = t18*t27 - t14*t11 - 2*t64 + t64*t78
     t81 = t11**2 + t27**2 + 2*t59 + t71*t78
     t82 = 1 + t38**2 + c23**2 + t78*s4**2
     t83 = -t22
@@ -2052,7 +2052,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t110 = t97 - t105*t60
     t111 = t98 + t105*t52
     t112 = t72 + damping
-    t113 = t104*(t63 + t103*t65 + t65*t112 + t69*t76 + t66*t60 + t66*t73)
+    t113 = t104*(t103*t65 + t65*t112 + t69*t76 + t66*t60 + t66*t73 + t63)
     t114 = t65 - t103*t113
     t115 = t112 - t113*t65
     t116 = -t76 + t113*t69
@@ -2113,7 +2113,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t171 = t43 + t167*t60
     t172 = t166 + t167*t52
     t173 = t131*t52
-    t174 = t123*(t116*t134 + t117*t135 + t119*t173 - t118*t136 - t133*t122)
+    t174 = t123*(t116*t134 + t117*t135 - t118*t136 - t133*t122 + t119*t173)
     t175 = t133 + t122*t174
     t176 = t134 - t116*t174
     t177 = t135 - t117*t174
@@ -2158,7 +2158,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t216 = t209 - t213*t215
     t217 = t210 - t206*t215
     t218 = t167*t69
-    t219 = t123*(t116*t218 + t117*t170 + t119*t172 + t169*t122 - t118*t171)
+    t219 = t123*(t117*t170 + t119*t172 + t169*t122 - t118*t171 + t116*t218)
     t220 = t169 - t122*t219
     t221 = t218 - t116*t219
     t222 = t170 - t117*t219
@@ -2190,7 +2190,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t248 = xp.where(xp.not_equal(t102, 0), -(t106 + t132*t246 + t139*t245 + t168*t243 - t114*t247 - t154*t244)/t102, 0)
     t249 = t243 + q1 + t51*t247 - t52*t248
     t250 = q4 + t243*c23 - t244*t25 - t245*t16
-    t251 = q5 + t14*t245 + t243*t39 - t11*t244
+    t251 = q5 + t14*t245 - t11*t244 + t243*t39
     t252 = q6 + t38*t243 - t18*t245 - t27*t244
     t253 = t247*s1
     t254 = t248*c1
@@ -2269,7 +2269,7 @@ def ik_branches(T):
     t33 = t22*t32
     t34 = t8*t19
     t35 = t24*t34
-    t36 = xp.where(t18, 1, -(t35 + t33))
+    t36 = xp.where(t18, 1, -(t33 + t35))
     t37 = t33 - t35
     t38 = t24*t32
     t39 = t22*t34
@@ -2323,7 +2323,7 @@ def ik_branches(T):
     t87 = 0.18645124*t77
     t88 = 0.00876554*t79
     t89 = t87 - t88
-    t90 = t87 + t88
+    t90 = t88 + t87
     t91 = 0.0203*t81 - 0.4318*t89
     t92 = 0.0203*t89 + 0.4318*t81
     t93 = 0.4318 + t91
@@ -2339,7 +2339,7 @@ def ik_branches(T):
     t103 = t42*t102 - t57*t100
     t104 = t86**2 + t100**2 + t102**2
     t105 = t43*t84
-    t106 = -t105 + t42*t93 + t57*t95
+    t106 = t42*t93 + t57*t95 - t105
     t107 = t106 + t105
     t108 = t107**2 + t96**2
     t109 = 1e-24*t58
@@ -2368,7 +2368,7 @@ def ik_branches(T):
     t132 = t127 + t116*t131
     t133 = t132 + t128
     t134 = t124**2
-    t135 = t127 + t134 + t116**2
+    t135 = t116**2 + t134 + t127
     t136 = t131**2
     t137 = t133**2 + t134*t136
     t138 = t127 + t136
@@ -2394,7 +2394,7 @@ def ik_branches(T):
     t158 = t157
     t159 = t157 + t156**2
     t160 = t43*t86
-    t161 = -t160 + t42*t100 + t57*t102
+    t161 = t42*t100 + t57*t102 - t160
     t162 = t161 + t160
     t163 = t162**2 + t103**2
     t164 = xp.less_equal(t163, t104*t109)
@@ -2422,7 +2422,7 @@ def ik_branches(T):
     t186 = t181 + t170*t185
     t187 = t186 + t182
     t188 = t178**2
-    t189 = t181 + t188 + t170**2
+    t189 = t170**2 + t188 + t181
     t190 = t185**2
     t191 = t187**2 + t188*t190
     t192 = t181 + t190
@@ -2483,7 +2483,7 @@ def ik_branches(T):
     t247 = 0.18645124*t237
     t248 = 0.00876554*t239
     t249 = t247 - t248
-    t250 = t247 + t248
+    t250 = t248 + t247
     t251 = 0.0203*t241 - 0.4318*t249
     t252 = 0.0203*t249 + 0.4318*t241
     t253 = 0.4318 + t251
@@ -2499,7 +2499,7 @@ def ik_branches(T):
     t263 = t48*t262 - t217*t260
     t264 = t246**2 + t260**2 + t262**2
     t265 = t49*t244
-    t266 = -t265 + t48*t253 + t217*t255
+    t266 = t48*t253 + t217*t255 - t265
     t267 = t266 + t265
     t268 = t267**2 + t256**2
     t269 = 1e-24*t218
@@ -2528,7 +2528,7 @@ def ik_branches(T):
     t292 = t287 + t276*t291
     t293 = t292 + t288
     t294 = t284**2
-    t295 = t287 + t294 + t276**2
+    t295 = t276**2 + t294 + t287
     t296 = t291**2
     t297 = t293**2 + t294*t296
     t298 = t287 + t296
@@ -2554,7 +2554,7 @@ def ik_branches(T):
     t318 = t317
     t319 = t317 + t316**2
     t320 = t49*t246
-    t321 = -t320 + t48*t260 + t217*t262
+    t321 = t48*t260 + t217*t262 - t320
     t322 = t321 + t320
     t323 = t322**2 + t263**2
     t324 = xp.less_equal(t323, t264*t269)
@@ -2582,7 +2582,7 @@ def ik_branches(T):
     t346 = t341 + t330*t345
     t347 = t346 + t342
     t348 = t338**2
-    t349 = t341 + t348 + t330**2
+    t349 = t330**2 + t348 + t341
     t350 = t345**2
     t351 = t347**2 + t348*t350
     t352 = t341 + t350
@@ -2610,64 +2610,64 @@ def ik_branches(T):
     t374 = xp.where(t140, 0, xp.atan2(t145, t133))
     t375 = t374
     t376 = t375 - 6.283185307179586*xp.floor(0.15915494309189535*(1.9198621771937625 + t375))
-    t377 = 3.141592653589793 + t374 - 6.283185307179586*xp.ceil(0.15915494309189535*t374)
+    t377 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t374) + t374
     t378 = t377 - 6.283185307179586*xp.floor(0.15915494309189535*(1.9198621771937625 + t377))
     t379 = xp.where(t149, 0, xp.atan2(-t131, t117))
     t380 = t379
     t381 = t380 - 6.283185307179586*xp.floor(0.15915494309189535*(1.7453292519943295 + t380))
-    t382 = t379 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t379))
+    t382 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t379)) + t379
     t383 = xp.where(xp.less_equal(t158, 1e-24*t159), 0, xp.atan2(t155, t154))
     t384 = t383
     t385 = t384 - 6.283185307179586*xp.floor(0.15915494309189535*(4.642575810304916 + t384))
-    t386 = 3.141592653589793 + t383 - 6.283185307179586*xp.ceil(0.15915494309189535*t383)
+    t386 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t383) + t383
     t387 = t386 - 6.283185307179586*xp.floor(0.15915494309189535*(4.642575810304916 + t386))
     t388 = -t382
     t389 = t382 + 6.283185307179586*xp.floor(0.15915494309189535*(1.7453292519943295 + t388))
     t390 = xp.where(t194, 0, xp.atan2(t199, t187))
     t391 = t390
     t392 = t391 - 6.283185307179586*xp.floor(0.15915494309189535*(1.9198621771937625 + t391))
-    t393 = 3.141592653589793 + t390 - 6.283185307179586*xp.ceil(0.15915494309189535*t390)
+    t393 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t390) + t390
     t394 = t393 - 6.283185307179586*xp.floor(0.15915494309189535*(1.9198621771937625 + t393))
     t395 = xp.where(t203, 0, xp.atan2(-t185, t171))
     t396 = t395
     t397 = t396 - 6.283185307179586*xp.floor(0.15915494309189535*(1.7453292519943295 + t396))
-    t398 = t395 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t395))
+    t398 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t395)) + t395
     t399 = xp.where(xp.less_equal(t212, 1e-24*t213), 0, xp.atan2(t209, t208))
     t400 = t399
     t401 = t400 - 6.283185307179586*xp.floor(0.15915494309189535*(4.642575810304916 + t400))
-    t402 = 3.141592653589793 + t399 - 6.283185307179586*xp.ceil(0.15915494309189535*t399)
+    t402 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t399) + t399
     t403 = t402 - 6.283185307179586*xp.floor(0.15915494309189535*(4.642575810304916 + t402))
     t404 = -t398
     t405 = t398 + 6.283185307179586*xp.floor(0.15915494309189535*(1.7453292519943295 + t404))
     t406 = xp.where(t300, 0, xp.atan2(t305, t293))
     t407 = t406
     t408 = t407 - 6.283185307179586*xp.floor(0.15915494309189535*(1.9198621771937625 + t407))
-    t409 = 3.141592653589793 + t406 - 6.283185307179586*xp.ceil(0.15915494309189535*t406)
+    t409 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t406) + t406
     t410 = t409 - 6.283185307179586*xp.floor(0.15915494309189535*(1.9198621771937625 + t409))
     t411 = xp.where(t309, 0, xp.atan2(-t291, t277))
     t412 = t411
     t413 = t412 - 6.283185307179586*xp.floor(0.15915494309189535*(1.7453292519943295 + t412))
-    t414 = t411 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t411))
+    t414 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t411)) + t411
     t415 = xp.where(xp.less_equal(t318, 1e-24*t319), 0, xp.atan2(t315, t314))
     t416 = t415
     t417 = t416 - 6.283185307179586*xp.floor(0.15915494309189535*(4.642575810304916 + t416))
-    t418 = 3.141592653589793 + t415 - 6.283185307179586*xp.ceil(0.15915494309189535*t415)
+    t418 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t415) + t415
     t419 = t418 - 6.283185307179586*xp.floor(0.15915494309189535*(4.642575810304916 + t418))
     t420 = -t414
     t421 = t414 + 6.283185307179586*xp.floor(0.15915494309189535*(1.7453292519943295 + t420))
     t422 = xp.where(t354, 0, xp.atan2(t359, t347))
     t423 = t422
     t424 = t423 - 6.283185307179586*xp.floor(0.15915494309189535*(1.9198621771937625 + t423))
-    t425 = 3.141592653589793 + t422 - 6.283185307179586*xp.ceil(0.15915494309189535*t422)
+    t425 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t422) + t422
     t426 = t425 - 6.283185307179586*xp.floor(0.15915494309189535*(1.9198621771937625 + t425))
     t427 = xp.where(t363, 0, xp.atan2(-t345, t331))
     t428 = t427
     t429 = t428 - 6.283185307179586*xp.floor(0.15915494309189535*(1.7453292519943295 + t428))
-    t430 = t427 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t427))
+    t430 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t427)) + t427
     t431 = xp.where(xp.less_equal(t372, 1e-24*t373), 0, xp.atan2(t369, t368))
     t432 = t431
     t433 = t432 - 6.283185307179586*xp.floor(0.15915494309189535*(4.642575810304916 + t432))
-    t434 = 3.141592653589793 + t431 - 6.283185307179586*xp.ceil(0.15915494309189535*t431)
+    t434 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t431) + t431
     t435 = t434 - 6.283185307179586*xp.floor(0.15915494309189535*(4.642575810304916 + t434))
     t436 = -t430
     t437 = t430 + 6.283185307179586*xp.floor(0.15915494309189535*(1.7453292519943295 + t436))

@@ -91,9 +91,9 @@ def fk(q):
     t2 = 0.12 + t1
     t3 = 0.1*c23
     t4 = c1*c234
-    t5 = 0.1*t4 + t3*c1
+    t5 = t3*c1 + 0.1*t4
     t6 = c234*s1
-    t7 = 0.1*t6 + t3*s1
+    t7 = t3*s1 + 0.1*t6
     t8 = 0.1*c2
     t9 = t5 + t8*c1
     t10 = t7 + t8*s1
@@ -142,7 +142,7 @@ def jacobian(q):
     t4 = t3*c23 + t3*c234
     t5 = t4 + t3*c2
     t6 = 0.1*s234
-    t7 = t6 + 0.1*s23
+    t7 = 0.1*s23 + t6
     t8 = t7 + 0.1*s2
     t9 = 0.1*c234
     t10 = -c1
@@ -194,11 +194,11 @@ def fk_jacobian(q):
     s234 = c23*s4 + c4*s23
     t0 = 0.1*c23
     t1 = c1*c234
-    t2 = 0.1*t1 + t0*c1
+    t2 = t0*c1 + 0.1*t1
     t3 = c234*s1
-    t4 = 0.1*t3 + t0*s1
+    t4 = t0*s1 + 0.1*t3
     t5 = 0.1*s234
-    t6 = t5 + 0.1*s23
+    t6 = 0.1*s23 + t5
     t7 = t6 + 0.1*s2
     t8 = 0.12 + t7
     t9 = 0.1*c2
@@ -277,36 +277,36 @@ def jacobian_tool(q):
     t4 = t3*c23 + t3*c234
     t5 = t4 + t3*c2
     t6 = 0.1*s234
-    t7 = t6 + 0.1*s23
+    t7 = 0.1*s23 + t6
     t8 = t7 + 0.1*s2
     t9 = t2*s1
     t10 = t5*c1
-    t11 = c1**2
-    t12 = t8*c234
-    t13 = s1**2
-    t14 = t2*c1 + t5*s1
-    t15 = t7*c234
-    t16 = t1*c1 + t4*s1
-    t17 = t6*c234
-    t18 = 0.1*c234
-    t19 = t18*t11 + t18*t13
+    t11 = t2*c1 + t5*s1
+    t12 = c1**2
+    t13 = t8*c234
+    t14 = s1**2
+    t15 = t1*c1 + t4*s1
+    t16 = t7*c234
+    t17 = 0.1*c234
+    t18 = t17*t12 + t17*t14
+    t19 = t6*c234
     t20 = t8*s234
     t21 = t7*s234
     t22 = 0.1*s234**2
-    t23 = -(t11 + t13)
+    t23 = -(t12 + t14)
     J = _stack(xp, [
         t9*c234 - t10*c234,  # 0, 0
-        -(t11*t12 + t12*t13 - t14*s234),  # 0, 1
-        -(t11*t15 + t13*t15 - t16*s234),  # 0, 2
-        -(t17*t11 + t17*t13 - t19*s234),  # 0, 3
-        t14,  # 1, 0
+        -(-s234*t11 + t12*t13 + t13*t14),  # 0, 1
+        -(-s234*t15 + t16*t12 + t16*t14),  # 0, 2
+        -(-s234*t18 + t19*t12 + t19*t14),  # 0, 3
+        t11,  # 1, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 3
         t10*s234 - t9*s234,  # 2, 0
-        t20*t11 + t20*t13 + t14*c234,  # 2, 1
-        t16*c234 + t21*t11 + t21*t13,  # 2, 2
-        t19*c234 + t22*t11 + t22*t13,  # 2, 3
+        c234*t11 + t20*t12 + t20*t14,  # 2, 1
+        c234*t15 + t21*t12 + t21*t14,  # 2, 2
+        c234*t18 + t22*t12 + t22*t14,  # 2, 3
         s234,  # 3, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 2
@@ -354,7 +354,7 @@ def task(q):
         t5,  # 0
         t8,  # 1
         t2,  # 2
-        xp.atan2(-s234, xp.sqrt(t9*c1**2 + t9*s1**2)),  # 3
+        xp.atan2(-s234, xp.sqrt(c1**2*t9 + t9*s1**2)),  # 3
     ], (4,))
     return mu
 
@@ -383,14 +383,14 @@ def task_jacobian(q):
     t4 = t3*c23 + t3*c234
     t5 = t4 + t3*c2
     t6 = 0.1*s234
-    t7 = t6 + 0.1*s23
+    t7 = 0.1*s23 + t6
     t8 = t7 + 0.1*s2
     t9 = c1**2
-    t10 = t9*c234
+    t10 = c234*t9
     t11 = s1**2
-    t12 = t11*c234
+    t12 = c234*t11
     t13 = c234**2
-    t14 = -(t10 + t12)/xp.sqrt(t9*t13 + t11*t13)
+    t14 = -(t10 + t12)/xp.sqrt(t9*t13 + t13*t11)
     J = _stack(xp, [
         -t5,  # 0, 0
         -t8*c1,  # 0, 1
@@ -435,11 +435,11 @@ def fk_jacobian_dot(q, q_dot):
     s234 = c23*s4 + c4*s23
     t0 = 0.1*c23
     t1 = c1*c234
-    t2 = 0.1*t1 + t0*c1
+    t2 = t0*c1 + 0.1*t1
     t3 = c234*s1
-    t4 = 0.1*t3 + t0*s1
+    t4 = t0*s1 + 0.1*t3
     t5 = 0.1*s234
-    t6 = t5 + 0.1*s23
+    t6 = 0.1*s23 + t5
     t7 = t6 + 0.1*s2
     t8 = 0.12 + t7
     t9 = 0.1*c2
@@ -469,7 +469,7 @@ def fk_jacobian_dot(q, q_dot):
     t33 = t32 + t7*t21
     t34 = -t33 + t10*qd1
     t35 = t20*qd4
-    t36 = t35 + t15*qd3
+    t36 = t15*qd3 + t35
     t37 = t36 + t13*qd2
     t38 = t7*c1
     t39 = t6*c1
@@ -523,8 +523,8 @@ def fk_jacobian_dot(q, q_dot):
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 3
     ], (6, 4))
     a = _stack(xp, [
-        xp.broadcast_to(qd2*(t40*qd1 - t37*c1) - t34*qd1 - qd3*(t15*t24 + t36*c1 - t6*qd1*s1) - qd4*(t20*t26 + t35*c1 - 0.1*qd1*s1*s234), batch),  # 0
-        xp.broadcast_to(-t30*qd1 - qd2*(t37*s1 + t38*qd1) - qd3*(t15*t21 + t36*s1 + t39*qd1) - qd4*(t20*t23 + t27*qd1 + t35*s1), batch),  # 1
+        xp.broadcast_to(qd2*(-t37*c1 + t40*qd1) - qd3*(t36*c1 + t15*t24 - t6*qd1*s1) - qd4*(t20*t26 + t35*c1 - 0.1*qd1*s1*s234) - t34*qd1, batch),  # 0
+        xp.broadcast_to(-qd2*(t37*s1 + t38*qd1) - qd3*(t36*s1 + t39*qd1 + t15*t21) - qd4*(t20*t23 + t35*s1 + t27*qd1) - t30*qd1, batch),  # 1
         xp.broadcast_to(-qd2*(t29*c1 + t33*s1) - qd3*(t28*c1 + t32*s1 + t42*t16 + t42*t18) - qd4*(t23*t31 + t26*t27 + t43*t16 + t43*t18), batch),  # 2
         xp.broadcast_to(t24*qd1 + t25*qd1 + t44*c1, batch),  # 3
         xp.broadcast_to(t21*qd1 + t22*qd1 + t44*s1, batch),  # 4
@@ -563,7 +563,7 @@ def jacobian_dot(q, q_dot):
     t6 = t2*c1 + t5*s1
     t7 = t1*c1 + t4*s1
     t8 = 0.1*s234
-    t9 = t8 + 0.1*s23
+    t9 = 0.1*s23 + t8
     t10 = t9 + 0.1*s2
     t11 = c1**2
     t12 = 0.1*c234
@@ -583,24 +583,24 @@ def jacobian_dot(q, q_dot):
     t26 = t24 + t5*qd1
     t27 = -t25 + t2*qd1
     t28 = t14*qd4
-    t29 = t28 + t7*qd3
+    t29 = t7*qd3 + t28
     t30 = t29 + t6*qd2
     t31 = qd1*s1
     t32 = c1*qd1
     t33 = t9*qd2
     Jd = _stack(xp, [
         xp.broadcast_to(-t27, batch),  # 0, 0
-        xp.broadcast_to(t10*t31 - t30*c1, batch),  # 0, 1
-        xp.broadcast_to(-(t7*t18 + t29*c1 - t9*qd1*s1), batch),  # 0, 2
+        xp.broadcast_to(-t30*c1 + t10*t31, batch),  # 0, 1
+        xp.broadcast_to(-(t29*c1 + t7*t18 - t9*qd1*s1), batch),  # 0, 2
         xp.broadcast_to(-(t14*t20 + t28*c1 - 0.1*qd1*s1*s234), batch),  # 0, 3
         xp.broadcast_to(-t26, batch),  # 1, 0
-        xp.broadcast_to(-(t10*t32 + t30*s1), batch),  # 1, 1
-        xp.broadcast_to(-(t9*t32 + t7*t15 + t29*s1), batch),  # 1, 2
+        xp.broadcast_to(-(t30*s1 + t10*t32), batch),  # 1, 1
+        xp.broadcast_to(-(t29*s1 + t9*t32 + t7*t15), batch),  # 1, 2
         xp.broadcast_to(-(t14*t17 + t28*s1 + t32*t8), batch),  # 1, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
         xp.broadcast_to(-(t24*c1 + t25*s1), batch),  # 2, 1
         xp.broadcast_to(-(t22*c1 + t23*s1 + t33*t11 + t33*t13), batch),  # 2, 2
-        xp.broadcast_to(-(t21*t11 + t21*t13 + t17*t8*s1 + t20*t8*c1), batch),  # 2, 3
+        xp.broadcast_to(-(t17*t8*s1 + t20*t8*c1 + t21*t11 + t21*t13), batch),  # 2, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
         xp.broadcast_to(t32, batch),  # 3, 1
         xp.broadcast_to(t32, batch),  # 3, 2
@@ -647,7 +647,7 @@ def bias_acceleration(q, q_dot):
     t6 = t2*c1 + t5*s1
     t7 = t1*c1 + t4*s1
     t8 = 0.1*s234
-    t9 = t8 + 0.1*s23
+    t9 = 0.1*s23 + t8
     t10 = t9 + 0.1*s2
     t11 = c1**2
     t12 = 0.1*c234
@@ -667,17 +667,17 @@ def bias_acceleration(q, q_dot):
     t26 = t24 + t5*qd1
     t27 = -t25 + t2*qd1
     t28 = t14*qd4
-    t29 = t28 + t7*qd3
+    t29 = t7*qd3 + t28
     t30 = t29 + t6*qd2
     t31 = qd1*s1
     t32 = c1*qd1
     t33 = t9*qd2
     a = _stack(xp, [
-        xp.broadcast_to(qd2*(t10*t31 - t30*c1) - t27*qd1 - qd3*(t7*t18 + t29*c1 - t9*qd1*s1) - qd4*(t14*t20 + t28*c1 - 0.1*qd1*s1*s234), batch),  # 0
-        xp.broadcast_to(-t26*qd1 - qd2*(t10*t32 + t30*s1) - qd3*(t9*t32 + t7*t15 + t29*s1) - qd4*(t14*t17 + t28*s1 + t32*t8), batch),  # 1
-        xp.broadcast_to(-qd2*(t24*c1 + t25*s1) - qd3*(t22*c1 + t23*s1 + t33*t11 + t33*t13) - qd4*(t21*t11 + t21*t13 + t17*t8*s1 + t20*t8*c1), batch),  # 2
-        xp.broadcast_to(t32*qd4 + t18*qd1 + t19*qd1, batch),  # 3
-        xp.broadcast_to(t31*qd4 + t15*qd1 + t16*qd1, batch),  # 4
+        xp.broadcast_to(qd2*(-t30*c1 + t10*t31) - qd3*(t29*c1 + t7*t18 - t9*qd1*s1) - qd4*(t14*t20 + t28*c1 - 0.1*qd1*s1*s234) - t27*qd1, batch),  # 0
+        xp.broadcast_to(-qd2*(t30*s1 + t10*t32) - qd3*(t29*s1 + t9*t32 + t7*t15) - qd4*(t14*t17 + t28*s1 + t32*t8) - t26*qd1, batch),  # 1
+        xp.broadcast_to(-qd2*(t24*c1 + t25*s1) - qd3*(t22*c1 + t23*s1 + t33*t11 + t33*t13) - qd4*(t17*t8*s1 + t20*t8*c1 + t21*t11 + t21*t13), batch),  # 2
+        xp.broadcast_to(t18*qd1 + t19*qd1 + t32*qd4, batch),  # 3
+        xp.broadcast_to(t15*qd1 + t16*qd1 + t31*qd4, batch),  # 4
         xp.broadcast_to(qd4*(t20*s1 - t17*c1), batch),  # 5
     ], (6,))
     return a
@@ -713,12 +713,12 @@ def task_jacobian_dot(q, q_dot):
     t6 = t2*c1 + t5*s1
     t7 = t1*c1 + t4*s1
     t8 = 0.1*s234
-    t9 = t8 + 0.1*s23
+    t9 = 0.1*s23 + t8
     t10 = t9 + 0.1*s2
     t11 = c1**2
-    t12 = t11*c234
+    t12 = c234*t11
     t13 = s1**2
-    t14 = t13*c234
+    t14 = c234*t13
     t15 = 0.1*t12 + 0.1*t14
     t16 = qd2*s1
     t17 = qd3*s1
@@ -740,27 +740,27 @@ def task_jacobian_dot(q, q_dot):
     t33 = t26*c1 + t31*s1
     t34 = t29 + t18
     t35 = t15*qd4
-    t36 = t35 + t7*qd3
+    t36 = t7*qd3 + t35
     t37 = t36 + t6*qd2
     t38 = qd1*s1
-    t39 = t10*t38 - t37*c1
-    t40 = t7*t20 + t36*c1 - t9*t38
+    t39 = -t37*c1 + t10*t38
+    t40 = t36*c1 + t7*t20 - t9*t38
     t41 = t15*t23 + t35*c1 - t38*t8
     t42 = t28*s234 + t38*c234
     t43 = c1*qd1
-    t44 = t10*t43 + t37*s1
-    t45 = t9*t43 + t7*t16 + t36*s1
+    t44 = t37*s1 + t10*t43
+    t45 = t36*s1 + t9*t43 + t7*t16
     t46 = t15*t19 + t35*s1 + t43*t8
-    t47 = t43*c234 - t34*s234
+    t47 = -t34*s234 + t43*c234
     t48 = t9*qd2
     t49 = t25*c1 + t30*s1 + t48*t11 + t48*t13
     t50 = t8*qd4
-    t51 = t50*t11 + t50*t13 + t19*t8*s1 + t23*t8*c1
+    t51 = t19*t8*s1 + t23*t8*c1 + t50*t11 + t50*t13
     t52 = c234**2
-    t53 = t52*t11 + t52*t13
+    t53 = t11*t52 + t52*t13
     t54 = 1/xp.sqrt(t53)
     t55 = -c234*(t12 + t14)/t53**1.5
-    t56 = t42*(t54*c1 + t55*c1) - t47*(t54*s1 + t55*s1)
+    t56 = -t47*(s1*t54 + t55*s1) + t42*(c1*t54 + t55*c1)
     Jd = _stack(xp, [
         xp.broadcast_to(-t32, batch),  # 0, 0
         xp.broadcast_to(t39, batch),  # 0, 1
@@ -808,7 +808,7 @@ def hessian(q):
     t6 = t2*c1 + t5*s1
     t7 = t1*c1 + t4*s1
     t8 = 0.1*s234
-    t9 = t8 + 0.1*s23
+    t9 = 0.1*s23 + t8
     t10 = t9 + 0.1*s2
     t11 = c1**2
     t12 = 0.1*c234
@@ -941,7 +941,7 @@ def singularity_factors(q):
     t0 = s2*s3
     f = _stack(xp, [
         s3,  # 0
-        -(t0 - c2 + t0*c4 - c2*c3 + c2*s3*s4 + c3*s2*s4 - c2*c3*c4),  # 1
+        -(-c2 + t0 - c2*c3 + c2*s3*s4 + c3*s2*s4 + t0*c4 - c2*c3*c4),  # 1
     ], (2,))
     return f
 
@@ -964,8 +964,8 @@ def manipulability(q):
     c234 = c23*c4 - s23*s4
     t0 = c234**2
     t1 = s2*s3
-    t2 = t1*c4 + c2*s3*s4 + c3*s2*s4 - c2*c3*c4
-    t3 = 0.001*t2*s3*(t1 + t2 - c2 - c2*c3)/xp.sqrt(t0*c1**2 + t0*s1**2)
+    t2 = c2*s3*s4 + c3*s2*s4 + t1*c4 - c2*c3*c4
+    t3 = 0.001*t2*s3*(t1 + t2 - c2 - c2*c3)/xp.sqrt(c1**2*t0 + t0*s1**2)
     w = xp.broadcast_to(xp.abs(t3), batch)
     return w
 
@@ -988,8 +988,8 @@ def jacobian_det(q):
     c234 = c23*c4 - s23*s4
     t0 = c234**2
     t1 = s2*s3
-    t2 = t1*c4 + c2*s3*s4 + c3*s2*s4 - c2*c3*c4
-    d = xp.broadcast_to(0.001*t2*s3*(t1 + t2 - c2 - c2*c3)/xp.sqrt(t0*c1**2 + t0*s1**2), batch)
+    t2 = c2*s3*s4 + c3*s2*s4 + t1*c4 - c2*c3*c4
+    d = xp.broadcast_to(0.001*t2*s3*(t1 + t2 - c2 - c2*c3)/xp.sqrt(c1**2*t0 + t0*s1**2), batch)
     return d
 
 
@@ -1027,36 +1027,36 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t6 = t2*c1 + t5*s1
     t7 = t1*c1 + t4*s1
     t8 = 0.1*s234
-    t9 = t8 + 0.1*s23
+    t9 = 0.1*s23 + t8
     t10 = t9 + 0.1*s2
     t11 = c1**2
-    t12 = t11*c234
+    t12 = c234*t11
     t13 = s1**2
-    t14 = t13*c234
+    t14 = c234*t13
     t15 = 0.1*t12 + 0.1*t14
     t16 = c234**2
-    t17 = -(t12 + t14)/xp.sqrt(t11*t16 + t13*t16)
+    t17 = -(t12 + t14)/xp.sqrt(t11*t16 + t16*t13)
     t18 = t6*t17 + t7*t17 + t15*t17
     t19 = t5**2
     t20 = t9**2
     t21 = t10**2
     t22 = 0.01*s234**2
-    t23 = t21*t11 + t22*t11 + t11*t20
+    t23 = t21*t11 + t22*t11 + t20*t11
     t24 = t23 + t19
     t25 = c1*s1
-    t26 = t21*t25 + t22*t25 + t25*t20 - t2*t5
+    t26 = -t2*t5 + t25*t20 + t21*t25 + t22*t25
     t27 = t9*c1
     t28 = t10*c1
     t29 = t8*c1
-    t30 = t6*t28 + t7*t27 + t15*t29
+    t30 = t7*t27 + t6*t28 + t15*t29
     t31 = t17*t27 + t17*t28 + t17*t29
     t32 = t2**2
-    t33 = t21*t13 + t22*t13 + t13*t20
+    t33 = t21*t13 + t22*t13 + t20*t13
     t34 = t32 + t33
     t35 = t9*s1
     t36 = t10*s1
     t37 = t8*s1
-    t38 = t6*t36 + t7*t35 + t15*t37
+    t38 = t7*t35 + t6*t36 + t15*t37
     t39 = t17*t35 + t17*t36 + t17*t37
     t40 = t6**2
     t41 = t40 + t7**2 + t15**2
@@ -1064,76 +1064,76 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t43 = t17**2
     t44 = 3*t43
     t45 = t44
-    t46 = t26**2
-    t47 = t30**2
-    t48 = t31**2
-    t49 = damping**2
-    t50 = t24 + t49
-    t51 = t50**2
-    t52 = xp.sqrt(t46 + t47 + t48 + t51)
-    t53 = t52*xp.where(xp.greater_equal(t50, 0), xp.asarray(1, dtype=dtype), -1)
-    t54 = t53 + t50
-    t55 = xp.where(xp.greater(t52, 0), 1/(t52*(t52 + xp.abs(t50))), 0)
-    t56 = t55*(t26*mu_dot1 + t54*mu_dot0 - t30*mu_dot2 - t31*mu_dot3)
-    t57 = mu_dot0 - t54*t56
-    t58 = mu_dot1 - t26*t56
-    t59 = mu_dot2 + t30*t56
-    t60 = mu_dot3 + t31*t56
-    t61 = t34 + t49
-    t62 = t55*(t26*t54 + t26*t61 + t30*t38 + t31*t39)
-    t63 = t26 - t54*t62
-    t64 = t61 - t26*t62
-    t65 = -t38 + t30*t62
-    t66 = -t39 + t31*t62
-    t67 = xp.sqrt(t64**2 + t65**2 + t66**2)
-    t68 = t67*xp.where(xp.greater_equal(t64, 0), xp.asarray(1, dtype=dtype), -1)
-    t69 = t64 + t68
-    t70 = xp.where(xp.greater(t67, 0), 1/(t67*(t67 + xp.abs(t64))), 0)
-    t71 = t70*(t65*t59 + t66*t60 + t58*t69)
-    t72 = t58 - t71*t69
-    t73 = t59 - t71*t65
-    t74 = t60 - t71*t66
-    t75 = t42 + t49
-    t76 = -t55*(t26*t38 + t30*t54 + t30*t75 + t31*t18)
-    t77 = t30 + t54*t76
-    t78 = t38 + t26*t76
-    t79 = t75 + t30*t76
-    t80 = t18 + t31*t76
-    t81 = t70*(t65*t79 + t66*t80 - t78*t69)
-    t82 = t78 + t69*t81
-    t83 = t79 - t65*t81
-    t84 = t80 - t66*t81
-    t85 = xp.sqrt(t84**2 + t83**2)
-    t86 = t85*xp.where(xp.greater_equal(t83, 0), xp.asarray(1, dtype=dtype), -1)
-    t87 = t86 + t83
-    t88 = xp.where(xp.greater(t85, 0), 1/(t85*(t85 + xp.abs(t83))), 0)
-    t89 = t88*(t84*t74 + t73*t87)
-    t90 = t73 - t87*t89
-    t91 = t74 - t84*t89
-    t92 = t45 + t49
-    t93 = xp.sqrt(t51 + t61**2 + t75**2 + t92**2 + 2*t46 + 2*t47 + 2*t48 + 2*t38**2 + 2*t39**2 + 2*t18**2)
-    t94 = -t55*(t26*t39 + t30*t18 + t31*t54 + t31*t92)
-    t95 = t31 + t54*t94
-    t96 = t39 + t26*t94
-    t97 = t18 + t30*t94
-    t98 = t92 + t31*t94
-    t99 = t70*(t65*t97 + t66*t98 - t96*t69)
-    t100 = t96 + t99*t69
-    t101 = t97 - t99*t65
-    t102 = t98 - t99*t66
-    t103 = t88*(t84*t102 + t101*t87)
-    t104 = t101 - t87*t103
-    t105 = t102 - t84*t103
-    t106 = xp.abs(t105)
+    t46 = damping**2
+    t47 = t24 + t46
+    t48 = t47**2
+    t49 = t34 + t46
+    t50 = t42 + t46
+    t51 = t45 + t46
+    t52 = t26**2
+    t53 = t30**2
+    t54 = t31**2
+    t55 = xp.sqrt(t48 + t49**2 + t50**2 + t51**2 + 2*t52 + 2*t53 + 2*t54 + 2*t38**2 + 2*t39**2 + 2*t18**2)
+    t56 = xp.sqrt(t52 + t53 + t54 + t48)
+    t57 = t56*xp.where(xp.greater_equal(t47, 0), xp.asarray(1, dtype=dtype), -1)
+    t58 = t57 + t47
+    t59 = xp.where(xp.greater(t56, 0), 1/(t56*(t56 + xp.abs(t47))), 0)
+    t60 = t59*(t26*t58 + t26*t49 + t30*t38 + t31*t39)
+    t61 = t26 - t58*t60
+    t62 = t49 - t26*t60
+    t63 = -t38 + t30*t60
+    t64 = -t39 + t31*t60
+    t65 = -t59*(t26*t38 + t30*t58 + t30*t50 + t31*t18)
+    t66 = t30 + t58*t65
+    t67 = t38 + t26*t65
+    t68 = t50 + t30*t65
+    t69 = t18 + t31*t65
+    t70 = -t59*(t26*t39 + t30*t18 + t31*t58 + t31*t51)
+    t71 = t31 + t58*t70
+    t72 = t39 + t26*t70
+    t73 = t18 + t30*t70
+    t74 = t51 + t31*t70
+    t75 = t59*(t26*mu_dot1 + t58*mu_dot0 - t30*mu_dot2 - t31*mu_dot3)
+    t76 = mu_dot0 - t58*t75
+    t77 = mu_dot1 - t26*t75
+    t78 = mu_dot2 + t30*t75
+    t79 = mu_dot3 + t31*t75
+    t80 = xp.sqrt(t62**2 + t63**2 + t64**2)
+    t81 = t80*xp.where(xp.greater_equal(t62, 0), xp.asarray(1, dtype=dtype), -1)
+    t82 = t62 + t81
+    t83 = xp.where(xp.greater(t80, 0), 1/(t80*(t80 + xp.abs(t62))), 0)
+    t84 = t83*(t63*t68 + t64*t69 - t67*t82)
+    t85 = t67 + t82*t84
+    t86 = t68 - t63*t84
+    t87 = t69 - t64*t84
+    t88 = t83*(t63*t73 + t64*t74 - t72*t82)
+    t89 = t72 + t88*t82
+    t90 = t73 - t88*t63
+    t91 = t74 - t88*t64
+    t92 = t83*(t63*t78 + t64*t79 + t77*t82)
+    t93 = t77 - t92*t82
+    t94 = t78 - t92*t63
+    t95 = t79 - t92*t64
+    t96 = xp.sqrt(t87**2 + t86**2)
+    t97 = t96*xp.where(xp.greater_equal(t86, 0), xp.asarray(1, dtype=dtype), -1)
+    t98 = t97 + t86
+    t99 = xp.where(xp.greater(t96, 0), 1/(t96*(t96 + xp.abs(t86))), 0)
+    t100 = t99*(t87*t91 + t90*t98)
+    t101 = t90 - t98*t100
+    t102 = t91 - t87*t100
+    t103 = t99*(t87*t95 + t94*t98)
+    t104 = t94 - t98*t103
+    t105 = t95 - t87*t103
+    t106 = xp.abs(t102)
     t107 = t106
-    t108 = t107*xp.where(xp.greater_equal(t105, 0), xp.asarray(1, dtype=dtype), -1)
-    t109 = t105 + t108
+    t108 = t107*xp.where(xp.greater_equal(t102, 0), xp.asarray(1, dtype=dtype), -1)
+    t109 = t102 + t108
     t110 = xp.where(xp.greater(t107, 0), 1/(t107*(t107 + t106)), 0)
-    t111 = t91 - t91*t110*t109**2
+    t111 = t105 - t105*t110*t109**2
     t112 = xp.where(xp.not_equal(t108, 0), -t111/t108, 0)
-    t113 = xp.where(xp.not_equal(t86, 0), -(t90 - t104*t112)/t86, 0)
-    t114 = xp.where(xp.not_equal(t68, 0), -(t72 + t100*t112 + t113*t82)/t68, 0)
-    t115 = xp.where(xp.not_equal(t53, 0), -(t57 + t112*t95 + t113*t77 - t114*t63)/t53, 0)
+    t113 = xp.where(xp.not_equal(t97, 0), -(t104 - t101*t112)/t97, 0)
+    t114 = xp.where(xp.not_equal(t81, 0), -(t93 + t89*t112 + t113*t85)/t81, 0)
+    t115 = xp.where(xp.not_equal(t57, 0), -(t76 + t112*t71 + t113*t66 - t114*t61)/t57, 0)
     t116 = t114*t2 - t115*t5
     t117 = t112*t17
     t118 = t117 + t113*t6 - t114*t36 - t115*t28
@@ -1147,18 +1147,18 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t126 = -t5
     t127 = t124 + t126
     t128 = -t125*(t127*t28 + t2*t36)
-    t129 = t28 + t127*t128
-    t130 = t36 + t128*t2
+    t129 = t127*t128 + t28
+    t130 = t128*t2 + t36
     t131 = -t125*(t127*t27 + t2*t35)
-    t132 = t27 + t127*t131
-    t133 = t35 + t131*t2
+    t132 = t127*t131 + t27
+    t133 = t131*t2 + t35
     t134 = -t125*(t127*t29 + t2*t37)
-    t135 = t29 + t127*t134
-    t136 = t37 + t134*t2
+    t135 = t127*t134 + t29
+    t136 = t134*t2 + t37
     t137 = t125*(t127*mu_dot0 + t2*mu_dot1)
     t138 = mu_dot0 - t127*t137
     t139 = mu_dot1 - t137*t2
-    t140 = xp.sqrt(t40 + t43 + t130**2)
+    t140 = xp.sqrt(t130**2 + t40 + t43)
     t141 = t140*xp.where(xp.less_equal(t130, 0), xp.asarray(1, dtype=dtype), -1)
     t142 = t141 - t130
     t143 = xp.where(xp.greater(t140, 0), 1/(t140*(t140 + xp.abs(t130))), 0)
@@ -1184,7 +1184,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t163 = t159*(t147*t155 + t154*t158)
     t164 = t154 - t158*t163
     t165 = t155 - t147*t163
-    t166 = t2 + t6 + t7 + t15 + t126 + damping + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + q1 + q2 + q3 + q4 - t27 - t28 - t29 - t35 - t36 - t37 + 3*t17
+    t166 = t2 + t6 + t7 + t15 + damping + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + q1 + q2 + q3 + q4 + t126 + 3*t17 - t27 - t35 - t28 - t36 - t29 - t37
     t167 = xp.abs(t162)
     t168 = t167
     t169 = t168*xp.where(xp.greater_equal(t162, 0), xp.asarray(1, dtype=dtype), -1)
@@ -1199,8 +1199,8 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t178 = xp.greater_equal(damping, 0)
     t179 = 1e-12*t122
     t180 = xp.greater(damping, 0)
-    t181 = 1e-12*t93
-    t182 = (t180 & (xp.less_equal(t85, t181) | xp.less_equal(t107, t181) | xp.less_equal(t52, t181) | xp.less_equal(t67, t181))) | (xp.less_equal(damping, 0) & (xp.less_equal(t123, t179) | xp.less_equal(t140, t179) | xp.less_equal(t156, t179) | xp.less_equal(t168, t179)))
+    t181 = 1e-12*t55
+    t182 = (t180 & (xp.less_equal(t96, t181) | xp.less_equal(t107, t181) | xp.less_equal(t56, t181) | xp.less_equal(t80, t181))) | (xp.less_equal(damping, 0) & (xp.less_equal(t123, t179) | xp.less_equal(t140, t179) | xp.less_equal(t156, t179) | xp.less_equal(t168, t179)))
     t183 = t177 & t178 & xp.logical_not(t182)
     q_dot = _stack(xp, [
         xp.broadcast_to(xp.where(t183, xp.where(t180, t116, t176), 0), batch),  # 0
@@ -1252,37 +1252,37 @@ def ik_numeric_step(target, q, damping=0.0):
     t9 = t2*c1 + t6*s1
     t10 = mu1 - t7
     t11 = 0.1*s234
-    t12 = t11 + 0.1*s23
+    t12 = 0.1*s23 + t11
     t13 = t12 + 0.1*s2
     t14 = 0.12 + t13
     t15 = mu2 - t14
     t16 = c1**2
-    t17 = t16*c234
+    t17 = c234*t16
     t18 = s1**2
-    t19 = t18*c234
+    t19 = c234*t18
     t20 = 0.1*t17 + 0.1*t19
     t21 = t8**2 + t9**2 + t20**2
     t22 = c234**2
-    t23 = xp.sqrt(t16*t22 + t18*t22)
+    t23 = xp.sqrt(t16*t22 + t22*t18)
     t24 = -(t17 + t19)/t23
     t25 = t8*t24 + t9*t24 + t20*t24
     t26 = 3*t24**2
     t27 = t12**2
     t28 = t13**2
     t29 = 0.01*s234**2
-    t30 = t7**2 + t28*t16 + t29*t16 + t16*t27
-    t31 = t3**2 + t28*t18 + t29*t18 + t18*t27
+    t30 = t7**2 + t27*t16 + t28*t16 + t29*t16
+    t31 = t3**2 + t27*t18 + t28*t18 + t29*t18
     t32 = c1*s1
-    t33 = t28*t32 + t29*t32 + t32*t27 - t3*t7
+    t33 = -t3*t7 + t32*t27 + t28*t32 + t29*t32
     t34 = t12*c1
     t35 = t13*c1
     t36 = t11*c1
-    t37 = t8*t35 + t9*t34 + t20*t36
+    t37 = t9*t34 + t8*t35 + t20*t36
     t38 = t24*t34 + t24*t35 + t24*t36
     t39 = t12*s1
     t40 = t13*s1
     t41 = t11*s1
-    t42 = t8*t40 + t9*t39 + t20*t41
+    t42 = t9*t39 + t8*t40 + t20*t41
     t43 = t24*t39 + t24*t40 + t24*t41
     t44 = -mu3 + xp.atan2(-s234, t23)
     t45 = t44 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t44))
@@ -1353,9 +1353,9 @@ def ik_numeric_step(target, q, damping=0.0):
     t110 = xp.where(xp.not_equal(t49, 0), -(t53 + t73*t108 + t90*t107 - t59*t109)/t49, 0)
     t111 = q1 + t3*t109 - t7*t110
     t112 = t107*t24
-    t113 = t112 + q2 + t108*t8 - t109*t40 - t110*t35
-    t114 = t112 + q3 + t108*t9 - t109*t39 - t110*t34
-    t115 = t112 + q4 + t108*t20 - t109*t41 - t110*t36
+    t113 = q2 + t112 + t108*t8 - t109*t40 - t110*t35
+    t114 = q3 + t112 + t108*t9 - t109*t39 - t110*t34
+    t115 = q4 + t112 + t108*t20 - t109*t41 - t110*t36
     q_start = _stack(xp, [
         xp.broadcast_to(q1, batch),  # 0
         xp.broadcast_to(q2, batch),  # 1

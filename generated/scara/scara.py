@@ -350,9 +350,9 @@ def fk_jacobian_dot(q, q_dot):
     t5 = 0.275*s12
     t6 = t5 + 0.325*s1
     t7 = t5*qd2
-    t8 = t7 + t6*qd1
+    t8 = t6*qd1 + t7
     t9 = t3*qd2
-    t10 = t9 + t4*qd1
+    t10 = t4*qd1 + t9
     T = _stack(xp, [
         xp.broadcast_to(t1, batch),  # 0, 0
         xp.broadcast_to(t2, batch),  # 0, 1
@@ -398,8 +398,8 @@ def fk_jacobian_dot(q, q_dot):
         xp.full(batch, -1, dtype=dtype, device=device),  # 5, 3
     ], (6, 4))
     a = _stack(xp, [
-        xp.broadcast_to(-t10*qd1 - qd2*(t9 + t3*qd1), batch),  # 0
-        xp.broadcast_to(-t8*qd1 - qd2*(t7 + t5*qd1), batch),  # 1
+        xp.broadcast_to(-qd2*(t3*qd1 + t9) - t10*qd1, batch),  # 0
+        xp.broadcast_to(-qd2*(t5*qd1 + t7) - t8*qd1, batch),  # 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 4
@@ -425,16 +425,16 @@ def jacobian_dot(q, q_dot):
     t2 = 0.275*s12
     t3 = t2 + 0.325*s1
     t4 = t2*qd2
-    t5 = t4 + t3*qd1
+    t5 = t3*qd1 + t4
     t6 = t0*qd2
-    t7 = t6 + t1*qd1
+    t7 = t1*qd1 + t6
     Jd = _stack(xp, [
         xp.broadcast_to(-t7, batch),  # 0, 0
-        xp.broadcast_to(-(t6 + t0*qd1), batch),  # 0, 1
+        xp.broadcast_to(-(t0*qd1 + t6), batch),  # 0, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 3
         xp.broadcast_to(-t5, batch),  # 1, 0
-        xp.broadcast_to(-(t4 + t2*qd1), batch),  # 1, 1
+        xp.broadcast_to(-(t2*qd1 + t4), batch),  # 1, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
@@ -474,12 +474,12 @@ def bias_acceleration(q, q_dot):
     t2 = 0.275*s12
     t3 = t2 + 0.325*s1
     t4 = t2*qd2
-    t5 = t4 + t3*qd1
+    t5 = t3*qd1 + t4
     t6 = t0*qd2
-    t7 = t6 + t1*qd1
+    t7 = t1*qd1 + t6
     a = _stack(xp, [
-        xp.broadcast_to(-t7*qd1 - qd2*(t6 + t0*qd1), batch),  # 0
-        xp.broadcast_to(-t5*qd1 - qd2*(t4 + t2*qd1), batch),  # 1
+        xp.broadcast_to(-qd2*(t0*qd1 + t6) - t7*qd1, batch),  # 0
+        xp.broadcast_to(-qd2*(t2*qd1 + t4) - t5*qd1, batch),  # 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 4
@@ -505,11 +505,11 @@ def task_jacobian_dot(q, q_dot):
     t2 = 0.275*s12
     t3 = t2 + 0.325*s1
     t4 = t2*qd2
-    t5 = t4 + t3*qd1
-    t6 = t4 + t2*qd1
+    t5 = t3*qd1 + t4
+    t6 = t2*qd1 + t4
     t7 = t0*qd2
-    t8 = t7 + t1*qd1
-    t9 = t7 + t0*qd1
+    t8 = t1*qd1 + t7
+    t9 = t0*qd1 + t7
     Jd = _stack(xp, [
         xp.broadcast_to(-t8, batch),  # 0, 0
         xp.broadcast_to(-t9, batch),  # 0, 1
@@ -725,7 +725,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t7 = t6 + 0.075625*s12**2
     t8 = t7
     t9 = t1**2
-    t10 = xp.sqrt(1 + t6 + t9)
+    t10 = xp.sqrt(1 + t9 + t6)
     t11 = t10*xp.where(xp.less_equal(t3, 0), xp.asarray(1, dtype=dtype), -1)
     t12 = xp.where(xp.greater(t10, 0), 1/(t10*(t10 + xp.abs(t3))), 0)
     t13 = -1 + t12
@@ -734,58 +734,58 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t16 = xp.sqrt(4 + t7 + t14)
     t17 = t1 + t0
     t18 = t17
-    t19 = t4**2
-    t20 = t5**2
-    t21 = damping**2
-    t22 = t8 + t21
-    t23 = t22**2
-    t24 = xp.sqrt(t23 + t19 + t20)
-    t25 = t24*xp.where(xp.greater_equal(t22, 0), xp.asarray(1, dtype=dtype), -1)
-    t26 = t25 + t22
-    t27 = xp.where(xp.greater(t24, 0), 1/(t24*(t24 + xp.abs(t22))), 0)
-    t28 = -t27*(t4*mu_dot1 + t5*mu_dot3 - t26*mu_dot0)
-    t29 = mu_dot0 - t26*t28
-    t30 = mu_dot1 + t4*t28
-    t31 = mu_dot3 + t5*t28
-    t32 = t15 + t21
-    t33 = -t27*(t4*t26 + t4*t32 + t5*t18)
-    t34 = t4 + t26*t33
-    t35 = t32 + t4*t33
+    t19 = damping**2
+    t20 = 1 + t19
+    t21 = t20
+    t22 = 3 + t19
+    t23 = t8 + t19
+    t24 = t23**2
+    t25 = t15 + t19
+    t26 = t4**2
+    t27 = t5**2
+    t28 = xp.sqrt(t20**2 + t22**2 + t24 + t25**2 + 2*t26 + 2*t27 + 2*t18**2)
+    t29 = xp.sqrt(t26 + t27 + t24)
+    t30 = t29*xp.where(xp.greater_equal(t23, 0), xp.asarray(1, dtype=dtype), -1)
+    t31 = t30 + t23
+    t32 = xp.where(xp.greater(t29, 0), 1/(t29*(t29 + xp.abs(t23))), 0)
+    t33 = -t32*(t4*t31 + t4*t25 + t5*t18)
+    t34 = t4 + t31*t33
+    t35 = t25 + t4*t33
     t36 = t18 + t5*t33
-    t37 = xp.sqrt(t35**2 + t36**2)
-    t38 = t37*xp.where(xp.greater_equal(t35, 0), xp.asarray(1, dtype=dtype), -1)
-    t39 = t35 + t38
-    t40 = xp.where(xp.greater(t37, 0), 1/(t37*(t37 + xp.abs(t35))), 0)
-    t41 = t40*(t36*t31 + t30*t39)
-    t42 = t30 - t39*t41
-    t43 = t31 - t36*t41
-    t44 = 1 + t21
-    t45 = t44
-    t46 = 3 + t21
-    t47 = xp.sqrt(t23 + t32**2 + t44**2 + t46**2 + 2*t19 + 2*t20 + 2*t18**2)
-    t48 = -t27*(t4*t18 + t5*t26 + t5*t46)
-    t49 = t5 + t26*t48
-    t50 = t18 + t4*t48
-    t51 = t46 + t5*t48
-    t52 = t40*(t36*t51 + t50*t39)
-    t53 = t50 - t39*t52
-    t54 = t51 - t36*t52
-    t55 = xp.abs(t45)
+    t37 = -t32*(t4*t18 + t5*t31 + t5*t22)
+    t38 = t5 + t31*t37
+    t39 = t18 + t4*t37
+    t40 = t22 + t5*t37
+    t41 = -t32*(t4*mu_dot1 + t5*mu_dot3 - t31*mu_dot0)
+    t42 = mu_dot0 - t31*t41
+    t43 = mu_dot1 + t4*t41
+    t44 = mu_dot3 + t5*t41
+    t45 = xp.sqrt(t35**2 + t36**2)
+    t46 = t45*xp.where(xp.greater_equal(t35, 0), xp.asarray(1, dtype=dtype), -1)
+    t47 = t35 + t46
+    t48 = xp.where(xp.greater(t45, 0), 1/(t45*(t45 + xp.abs(t35))), 0)
+    t49 = t48*(t36*t40 + t39*t47)
+    t50 = t39 - t47*t49
+    t51 = t40 - t36*t49
+    t52 = t48*(t36*t44 + t43*t47)
+    t53 = t43 - t47*t52
+    t54 = t44 - t36*t52
+    t55 = xp.abs(t21)
     t56 = t55
-    t57 = t56*xp.where(xp.greater_equal(t45, 0), xp.asarray(1, dtype=dtype), -1)
-    t58 = t45 + t57
+    t57 = t56*xp.where(xp.greater_equal(t21, 0), xp.asarray(1, dtype=dtype), -1)
+    t58 = t21 + t57
     t59 = xp.where(xp.greater(t56, 0), 1/(t56*(t56 + t55)), 0)
     t60 = mu_dot2 - t59*mu_dot2*t58**2
     t61 = xp.where(xp.not_equal(t57, 0), -t60/t57, 0)
-    t62 = xp.abs(t54)
+    t62 = xp.abs(t51)
     t63 = t62
-    t64 = t63*xp.where(xp.greater_equal(t54, 0), xp.asarray(1, dtype=dtype), -1)
-    t65 = t54 + t64
+    t64 = t63*xp.where(xp.greater_equal(t51, 0), xp.asarray(1, dtype=dtype), -1)
+    t65 = t51 + t64
     t66 = xp.where(xp.greater(t63, 0), 1/(t63*(t63 + t62)), 0)
-    t67 = t43 - t43*t66*t65**2
+    t67 = t54 - t54*t66*t65**2
     t68 = xp.where(xp.not_equal(t64, 0), -t67/t64, 0)
-    t69 = xp.where(xp.not_equal(t38, 0), -(t42 - t53*t68)/t38, 0)
-    t70 = xp.where(xp.not_equal(t25, 0), -(t29 + t34*t69 + t49*t68)/t25, 0)
+    t69 = xp.where(xp.not_equal(t46, 0), -(t53 - t50*t68)/t46, 0)
+    t70 = xp.where(xp.not_equal(t30, 0), -(t42 + t34*t69 + t38*t68)/t30, 0)
     t71 = t68 + t1*t69 - t70*t3
     t72 = t68 + t69*t0 - t70*t2
     t73 = -t3
@@ -823,8 +823,8 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t105 = xp.greater_equal(damping, 0)
     t106 = 1e-12*t16
     t107 = xp.greater(damping, 0)
-    t108 = 1e-12*t47
-    t109 = (t107 & (xp.less_equal(t24, t108) | xp.less_equal(t37, t108) | xp.less_equal(t56, t108) | xp.less_equal(t63, t108))) | (xp.less_equal(damping, 0) & (xp.less_equal(1, t106) | xp.less_equal(t10, t106) | xp.less_equal(t83, t106) | xp.less_equal(t96, t106)))
+    t108 = 1e-12*t28
+    t109 = (t107 & (xp.less_equal(t29, t108) | xp.less_equal(t45, t108) | xp.less_equal(t56, t108) | xp.less_equal(t63, t108))) | (xp.less_equal(damping, 0) & (xp.less_equal(1, t106) | xp.less_equal(t10, t106) | xp.less_equal(t83, t106) | xp.less_equal(t96, t106)))
     t110 = t104 & t105 & xp.logical_not(t109)
     q_dot = _stack(xp, [
         xp.broadcast_to(xp.where(t110, xp.where(t107, t71, t103), 0), batch),  # 0
@@ -990,7 +990,7 @@ def ik_branches(mu):
     t34 = t33
     t35 = t34 - 6.283185307179586*xp.floor(0.15915494309189535*(0.8726646259971648 + t34))
     t36 = -mu3
-    t37 = -(t10 + t33 + t36)
+    t37 = -(t10 + t36 + t33)
     t38 = t37 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t37))
     t39 = -t38
     t40 = t38 + 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t39))
@@ -1095,7 +1095,7 @@ def ik_nearest(mu, q_seed, weights=(1.0,) * DOF):
     t23 = -qn2
     t24 = -qn3
     t25 = -qn4
-    t26 = qw1*(t13 + t22)**2 + qw2*(t17 + t23)**2 + qw3*(t24 + qb0_2)**2 + qw4*(t21 + t25)**2
+    t26 = qw1*(t13 + t22)**2 + qw2*(t17 + t23)**2 + qw3*(qb0_2 + t24)**2 + qw4*(t21 + t25)**2
     t27 = xp.greater(t4, 0)
     t28 = xp.where(t27, t13, qn1)
     t29 = xp.where(t27, t17, qn2)
@@ -1114,7 +1114,7 @@ def ik_nearest(mu, q_seed, weights=(1.0,) * DOF):
     t42 = t7 + t41
     t43 = t7 - t41
     t44 = xp.where(xp.greater_equal(t7, -6.283185307179586) & xp.less_equal(t7, 6.283185307179586), t7, xp.where(xp.greater_equal(t42, -6.283185307179586) & xp.less_equal(t42, 6.283185307179586), t42, xp.where(xp.greater_equal(t43, -6.283185307179586) & xp.less_equal(t43, 6.283185307179586), t43, qb1_3)))
-    t45 = qw1*(t36 + t22)**2 + qw2*(t40 + t23)**2 + qw3*(t24 + qb1_2)**2 + qw4*(t44 + t25)**2
+    t45 = qw1*(t36 + t22)**2 + qw2*(t40 + t23)**2 + qw3*(qb1_2 + t24)**2 + qw4*(t44 + t25)**2
     t46 = xp.greater(t8, 0)
     t47 = xp.where(t46 & (xp.less(t4, 1) | xp.less(t45, t32)), xp.asarray(1, dtype=dtype), 0)
     t48 = xp.where(t46, 1, t4)

@@ -225,9 +225,9 @@ def _fk_jacobian_dot(q, q_dot):
     t5 = 0.275*s12
     t6 = t5 + 0.325*s1
     t7 = t5*qd2
-    t8 = t7 + t6*qd1
+    t8 = t6*qd1 + t7
     t9 = t3*qd2
-    t10 = t9 + t4*qd1
+    t10 = t4*qd1 + t9
     T = casadi.SX(4, 4)
     T[0, 0] = t1
     T[0, 1] = t2
@@ -248,8 +248,8 @@ def _fk_jacobian_dot(q, q_dot):
     J[5, 1] = 1
     J[5, 3] = -1
     a = casadi.SX(6, 1)
-    a[0, 0] = -t10*qd1 - qd2*(t9 + t3*qd1)
-    a[1, 0] = -t8*qd1 - qd2*(t7 + t5*qd1)
+    a[0, 0] = -qd2*(t3*qd1 + t9) - t10*qd1
+    a[1, 0] = -qd2*(t5*qd1 + t7) - t8*qd1
     return [T, J, a]
 
 
@@ -270,14 +270,14 @@ def _jacobian_dot(q, q_dot):
     t2 = 0.275*s12
     t3 = t2 + 0.325*s1
     t4 = t2*qd2
-    t5 = t4 + t3*qd1
+    t5 = t3*qd1 + t4
     t6 = t0*qd2
-    t7 = t6 + t1*qd1
+    t7 = t1*qd1 + t6
     Jd = casadi.SX(6, 4)
     Jd[0, 0] = -t7
-    Jd[0, 1] = -(t6 + t0*qd1)
+    Jd[0, 1] = -(t0*qd1 + t6)
     Jd[1, 0] = -t5
-    Jd[1, 1] = -(t4 + t2*qd1)
+    Jd[1, 1] = -(t2*qd1 + t4)
     return [Jd]
 
 
@@ -298,12 +298,12 @@ def _bias_acceleration(q, q_dot):
     t2 = 0.275*s12
     t3 = t2 + 0.325*s1
     t4 = t2*qd2
-    t5 = t4 + t3*qd1
+    t5 = t3*qd1 + t4
     t6 = t0*qd2
-    t7 = t6 + t1*qd1
+    t7 = t1*qd1 + t6
     a = casadi.SX(6, 1)
-    a[0, 0] = -t7*qd1 - qd2*(t6 + t0*qd1)
-    a[1, 0] = -t5*qd1 - qd2*(t4 + t2*qd1)
+    a[0, 0] = -qd2*(t0*qd1 + t6) - t7*qd1
+    a[1, 0] = -qd2*(t2*qd1 + t4) - t5*qd1
     return [a]
 
 
@@ -324,11 +324,11 @@ def _task_jacobian_dot(q, q_dot):
     t2 = 0.275*s12
     t3 = t2 + 0.325*s1
     t4 = t2*qd2
-    t5 = t4 + t3*qd1
-    t6 = t4 + t2*qd1
+    t5 = t3*qd1 + t4
+    t6 = t2*qd1 + t4
     t7 = t0*qd2
-    t8 = t7 + t1*qd1
-    t9 = t7 + t0*qd1
+    t8 = t1*qd1 + t7
+    t9 = t0*qd1 + t7
     Jd = casadi.SX(4, 4)
     Jd[0, 0] = -t8
     Jd[0, 1] = -t9
@@ -439,7 +439,7 @@ def _velocity_ik(q, mu_dot, damping):
     t7 = t6 + 0.075625*s12**2
     t8 = t7
     t9 = t1**2
-    t10 = casadi.sqrt(1 + t6 + t9)
+    t10 = casadi.sqrt(1 + t9 + t6)
     t11 = t10*casadi.if_else((t3 <= 0), 1, -1)
     t12 = casadi.if_else((t10 > 0), 1/(t10*(t10 + casadi.fabs(t3))), 0)
     t13 = -1 + t12
@@ -448,58 +448,58 @@ def _velocity_ik(q, mu_dot, damping):
     t16 = casadi.sqrt(4 + t7 + t14)
     t17 = t1 + t0
     t18 = t17
-    t19 = t4**2
-    t20 = t5**2
-    t21 = damping**2
-    t22 = t8 + t21
-    t23 = t22**2
-    t24 = casadi.sqrt(t23 + t19 + t20)
-    t25 = t24*casadi.if_else((t22 >= 0), 1, -1)
-    t26 = t25 + t22
-    t27 = casadi.if_else((t24 > 0), 1/(t24*(t24 + casadi.fabs(t22))), 0)
-    t28 = -t27*(t4*mu_dot1 + t5*mu_dot3 - t26*mu_dot0)
-    t29 = mu_dot0 - t26*t28
-    t30 = mu_dot1 + t4*t28
-    t31 = mu_dot3 + t5*t28
-    t32 = t15 + t21
-    t33 = -t27*(t4*t26 + t4*t32 + t5*t18)
-    t34 = t4 + t26*t33
-    t35 = t32 + t4*t33
+    t19 = damping**2
+    t20 = 1 + t19
+    t21 = t20
+    t22 = 3 + t19
+    t23 = t8 + t19
+    t24 = t23**2
+    t25 = t15 + t19
+    t26 = t4**2
+    t27 = t5**2
+    t28 = casadi.sqrt(t20**2 + t22**2 + t24 + t25**2 + 2*t26 + 2*t27 + 2*t18**2)
+    t29 = casadi.sqrt(t26 + t27 + t24)
+    t30 = t29*casadi.if_else((t23 >= 0), 1, -1)
+    t31 = t30 + t23
+    t32 = casadi.if_else((t29 > 0), 1/(t29*(t29 + casadi.fabs(t23))), 0)
+    t33 = -t32*(t4*t31 + t4*t25 + t5*t18)
+    t34 = t4 + t31*t33
+    t35 = t25 + t4*t33
     t36 = t18 + t5*t33
-    t37 = casadi.sqrt(t35**2 + t36**2)
-    t38 = t37*casadi.if_else((t35 >= 0), 1, -1)
-    t39 = t35 + t38
-    t40 = casadi.if_else((t37 > 0), 1/(t37*(t37 + casadi.fabs(t35))), 0)
-    t41 = t40*(t36*t31 + t30*t39)
-    t42 = t30 - t39*t41
-    t43 = t31 - t36*t41
-    t44 = 1 + t21
-    t45 = t44
-    t46 = 3 + t21
-    t47 = casadi.sqrt(t23 + t32**2 + t44**2 + t46**2 + 2*t19 + 2*t20 + 2*t18**2)
-    t48 = -t27*(t4*t18 + t5*t26 + t5*t46)
-    t49 = t5 + t26*t48
-    t50 = t18 + t4*t48
-    t51 = t46 + t5*t48
-    t52 = t40*(t36*t51 + t50*t39)
-    t53 = t50 - t39*t52
-    t54 = t51 - t36*t52
-    t55 = casadi.fabs(t45)
+    t37 = -t32*(t4*t18 + t5*t31 + t5*t22)
+    t38 = t5 + t31*t37
+    t39 = t18 + t4*t37
+    t40 = t22 + t5*t37
+    t41 = -t32*(t4*mu_dot1 + t5*mu_dot3 - t31*mu_dot0)
+    t42 = mu_dot0 - t31*t41
+    t43 = mu_dot1 + t4*t41
+    t44 = mu_dot3 + t5*t41
+    t45 = casadi.sqrt(t35**2 + t36**2)
+    t46 = t45*casadi.if_else((t35 >= 0), 1, -1)
+    t47 = t35 + t46
+    t48 = casadi.if_else((t45 > 0), 1/(t45*(t45 + casadi.fabs(t35))), 0)
+    t49 = t48*(t36*t40 + t39*t47)
+    t50 = t39 - t47*t49
+    t51 = t40 - t36*t49
+    t52 = t48*(t36*t44 + t43*t47)
+    t53 = t43 - t47*t52
+    t54 = t44 - t36*t52
+    t55 = casadi.fabs(t21)
     t56 = t55
-    t57 = t56*casadi.if_else((t45 >= 0), 1, -1)
-    t58 = t45 + t57
+    t57 = t56*casadi.if_else((t21 >= 0), 1, -1)
+    t58 = t21 + t57
     t59 = casadi.if_else((t56 > 0), 1/(t56*(t56 + t55)), 0)
     t60 = mu_dot2 - t59*mu_dot2*t58**2
     t61 = casadi.if_else((t57 != 0), -t60/t57, 0)
-    t62 = casadi.fabs(t54)
+    t62 = casadi.fabs(t51)
     t63 = t62
-    t64 = t63*casadi.if_else((t54 >= 0), 1, -1)
-    t65 = t54 + t64
+    t64 = t63*casadi.if_else((t51 >= 0), 1, -1)
+    t65 = t51 + t64
     t66 = casadi.if_else((t63 > 0), 1/(t63*(t63 + t62)), 0)
-    t67 = t43 - t43*t66*t65**2
+    t67 = t54 - t54*t66*t65**2
     t68 = casadi.if_else((t64 != 0), -t67/t64, 0)
-    t69 = casadi.if_else((t38 != 0), -(t42 - t53*t68)/t38, 0)
-    t70 = casadi.if_else((t25 != 0), -(t29 + t34*t69 + t49*t68)/t25, 0)
+    t69 = casadi.if_else((t46 != 0), -(t53 - t50*t68)/t46, 0)
+    t70 = casadi.if_else((t30 != 0), -(t42 + t34*t69 + t38*t68)/t30, 0)
     t71 = t68 + t1*t69 - t70*t3
     t72 = t68 + t69*t0 - t70*t2
     t73 = -t3
@@ -537,8 +537,8 @@ def _velocity_ik(q, mu_dot, damping):
     t105 = (damping >= 0)
     t106 = 1e-12*t16
     t107 = (damping > 0)
-    t108 = 1e-12*t47
-    t109 = casadi.logic_or(casadi.logic_and(t107, casadi.logic_or(casadi.logic_or(casadi.logic_or((t24 <= t108), (t37 <= t108)), (t56 <= t108)), (t63 <= t108))), casadi.logic_and((damping <= 0), casadi.logic_or(casadi.logic_or(casadi.logic_or((1 <= t106), (t10 <= t106)), (t83 <= t106)), (t96 <= t106))))
+    t108 = 1e-12*t28
+    t109 = casadi.logic_or(casadi.logic_and(t107, casadi.logic_or(casadi.logic_or(casadi.logic_or((t29 <= t108), (t45 <= t108)), (t56 <= t108)), (t63 <= t108))), casadi.logic_and((damping <= 0), casadi.logic_or(casadi.logic_or(casadi.logic_or((1 <= t106), (t10 <= t106)), (t83 <= t106)), (t96 <= t106))))
     t110 = casadi.logic_and(casadi.logic_and(t104, t105), casadi.logic_not(t109))
     q_dot = casadi.SX(4, 1)
     q_dot[0, 0] = casadi.if_else(t110, casadi.if_else(t107, t71, t103), 0)
@@ -699,7 +699,7 @@ def _ik_branches(mu):
     t34 = t33
     t35 = t34 - 6.283185307179586*casadi.floor(0.15915494309189535*(0.8726646259971648 + t34))
     t36 = -mu3
-    t37 = -(t10 + t33 + t36)
+    t37 = -(t10 + t36 + t33)
     t38 = t37 + 6.283185307179586*casadi.ceil(-0.15915494309189535*(3.141592653589793 + t37))
     t39 = -t38
     t40 = t38 + 6.283185307179586*casadi.floor(0.15915494309189535*(6.283185307179586 + t39))
@@ -799,7 +799,7 @@ def _ik_nearest(mu, q_seed, weights):
     t23 = -qn2
     t24 = -qn3
     t25 = -qn4
-    t26 = qw1*(t13 + t22)**2 + qw2*(t17 + t23)**2 + qw3*(t24 + qb0_2)**2 + qw4*(t21 + t25)**2
+    t26 = qw1*(t13 + t22)**2 + qw2*(t17 + t23)**2 + qw3*(qb0_2 + t24)**2 + qw4*(t21 + t25)**2
     t27 = (t4 > 0)
     t28 = casadi.if_else(t27, t13, qn1)
     t29 = casadi.if_else(t27, t17, qn2)
@@ -818,7 +818,7 @@ def _ik_nearest(mu, q_seed, weights):
     t42 = t7 + t41
     t43 = t7 - t41
     t44 = casadi.if_else(casadi.logic_and((t7 >= -6.283185307179586), (t7 <= 6.283185307179586)), t7, casadi.if_else(casadi.logic_and((t42 >= -6.283185307179586), (t42 <= 6.283185307179586)), t42, casadi.if_else(casadi.logic_and((t43 >= -6.283185307179586), (t43 <= 6.283185307179586)), t43, qb1_3)))
-    t45 = qw1*(t36 + t22)**2 + qw2*(t40 + t23)**2 + qw3*(t24 + qb1_2)**2 + qw4*(t44 + t25)**2
+    t45 = qw1*(t36 + t22)**2 + qw2*(t40 + t23)**2 + qw3*(qb1_2 + t24)**2 + qw4*(t44 + t25)**2
     t46 = (t8 > 0)
     t47 = casadi.if_else(casadi.logic_and(t46, casadi.logic_or((t4 < 1), (t45 < t32))), 1, 0)
     t48 = casadi.if_else(t46, 1, t4)

@@ -107,8 +107,8 @@ def fk(q):
     t20 = t7*s6 + t18*c6
     t21 = t7*c6 - t18*s6
     t22 = s2*s4
-    t23 = t22*c5 + c2*s5
-    t24 = t22*s5 - c2*c5
+    t23 = c2*s5 + t22*c5
+    t24 = -c2*c5 + t22*s5
     t25 = c4*s2
     t26 = t23*c6 + t25*s6
     t27 = t23*s6 - t25*c6
@@ -241,8 +241,8 @@ def fk_jacobian(q):
     t20 = t9*s6 + t16*c6
     t21 = t9*c6 - t16*s6
     t22 = s2*s4
-    t23 = t22*c5 + c2*s5
-    t24 = t22*s5 - c2*c5
+    t23 = c2*s5 + t22*c5
+    t24 = -c2*c5 + t22*s5
     t25 = c4*s2
     t26 = t23*c6 + t25*s6
     t27 = t23*s6 - t25*c6
@@ -343,33 +343,33 @@ def jacobian_tool(q):
     t19 = t6*s6 + t17*c6
     t20 = t6*c6 - t17*s6
     t21 = s2*s4
-    t22 = t21*c5 + c2*s5
-    t23 = t21*s5 - c2*c5
+    t22 = c2*s5 + t21*c5
+    t23 = -c2*c5 + t21*s5
     t24 = c4*s2
     t25 = t22*c6 + t24*s6
     t26 = t22*s6 - t24*c6
-    t27 = c2*q3
-    t28 = t27*c1
-    t29 = t27*s1
-    t30 = -(t1*c1 + t2*s1)
-    t31 = t14*t11 + t19*t16 - t25*c2
-    t32 = t15*t11 + t20*t16 + t26*c2
-    t33 = t13*t11 + t18*t16 - t23*c2
+    t27 = -(t1*c1 + t2*s1)
+    t28 = c2*q3
+    t29 = t28*c1
+    t30 = t28*s1
+    t31 = -t25*c2 + t14*t11 + t19*t16
+    t32 = t26*c2 + t15*t11 + t20*t16
+    t33 = -t23*c2 + t13*t11 + t18*t16
     J = _stack(xp, [
         t19*t1 - t14*t2,  # 0, 0
-        t14*t28 + t19*t29 - t25*t30,  # 0, 1
+        -t25*t27 + t14*t29 + t19*t30,  # 0, 1
         t31,  # 0, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5
         t20*t1 - t15*t2,  # 1, 0
-        t15*t28 + t20*t29 + t26*t30,  # 1, 1
+        t26*t27 + t15*t29 + t20*t30,  # 1, 1
         t32,  # 1, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5
         t18*t1 - t13*t2,  # 2, 0
-        t13*t28 + t18*t29 - t23*t30,  # 2, 1
+        -t23*t27 + t13*t29 + t18*t30,  # 2, 1
         t33,  # 2, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 4
@@ -427,7 +427,7 @@ def task(q):
     t13 = s2*s5
     t14 = t7*c5 - t13*c1
     t15 = t12*c5 - t13*s1
-    t16 = t13*s4 - c2*c5
+    t16 = -c2*c5 + t13*s4
     t17 = t11*s6 + t14*c6
     t18 = t8*s6 + t15*c6
     t19 = c4*s2
@@ -478,8 +478,8 @@ def task_jacobian(q):
     t16 = t12*s6 + t8*c6
     t17 = t7*s6 + t14*c6
     t18 = s2*s4
-    t19 = t18*c5 + c2*s5
-    t20 = t18*s5 - c2*c5
+    t19 = c2*s5 + t18*c5
+    t20 = -c2*c5 + t18*s5
     t21 = c4*s2
     t22 = t19*c6 + t21*s6
     t23 = c2*q3
@@ -576,8 +576,8 @@ def fk_jacobian_dot(q, q_dot):
     t21 = t10*s6 + t17*c6
     t22 = t10*c6 - t17*s6
     t23 = s2*s4
-    t24 = t23*c5 + c2*s5
-    t25 = t23*s5 - c2*c5
+    t24 = c2*s5 + t23*c5
+    t25 = -c2*c5 + t23*s5
     t26 = c4*s2
     t27 = t24*c6 + t26*s6
     t28 = t24*s6 - t26*c6
@@ -659,12 +659,12 @@ def fk_jacobian_dot(q, q_dot):
         xp.broadcast_to(t43, batch),  # 5, 5
     ], (6, 6))
     a = _stack(xp, [
-        xp.broadcast_to(t46*qd3 + qd2*(t32*c1 - t45*qd1) - t37*qd1, batch),  # 0
-        xp.broadcast_to(t42*qd1 + t47*qd3 + qd2*(t32*s1 + t44*qd1), batch),  # 1
-        xp.broadcast_to(t49*qd3 - qd2*(t41*c1 + t36*s1), batch),  # 2
-        xp.broadcast_to(t46*qd4 - t38*qd1 - qd5*(t10*t0 + t39*t26) - qd6*(t18*t29 + t25*t40), batch),  # 3
-        xp.broadcast_to(t47*qd4 + qd5*(t15*t0 + t34*t26) + qd6*(t12*t29 + t25*t35) - t33*qd1, batch),  # 4
-        xp.broadcast_to(t49*qd4 + qd5*(t10*t34 - t15*t39) + qd6*(t18*t35 - t12*t40), batch),  # 5
+        xp.broadcast_to(qd2*(t32*c1 - t45*qd1) + qd3*t46 - t37*qd1, batch),  # 0
+        xp.broadcast_to(t42*qd1 + qd2*(t32*s1 + t44*qd1) + qd3*t47, batch),  # 1
+        xp.broadcast_to(-qd2*(t41*c1 + t36*s1) + qd3*t49, batch),  # 2
+        xp.broadcast_to(qd4*t46 - qd5*(t10*t0 + t39*t26) - qd6*(t18*t29 + t25*t40) - t38*qd1, batch),  # 3
+        xp.broadcast_to(qd4*t47 + qd5*(t15*t0 + t34*t26) + qd6*(t12*t29 + t25*t35) - t33*qd1, batch),  # 4
+        xp.broadcast_to(qd4*t49 + qd5*(t10*t34 - t15*t39) + qd6*(t18*t35 - t12*t40), batch),  # 5
     ], (6,))
     return T, J, a
 
@@ -725,7 +725,7 @@ def jacobian_dot(q, q_dot):
     t35 = c2*q3
     t36 = t28 - t34*s2
     t37 = c1*qd1
-    t38 = t31 + t37*s2
+    t38 = t37*s2 + t31
     t39 = qd2*s2
     t40 = -(t39*c1**2 + t39*s1**2)
     Jd = _stack(xp, [
@@ -825,16 +825,16 @@ def bias_acceleration(q, q_dot):
     t34 = c2*q3*qd1
     t35 = qd1*s2
     t36 = t28 - t35*s1
-    t37 = t31 + t35*c1
+    t37 = t35*c1 + t31
     t38 = qd2*s2
     t39 = -(t38*c1**2 + t38*s1**2)
     a = _stack(xp, [
-        xp.broadcast_to(t36*qd3 + qd2*(t6*c1 - t34*s1) - t33*qd1, batch),  # 0
-        xp.broadcast_to(t30*qd1 + t37*qd3 + qd2*(t6*s1 + t34*c1), batch),  # 1
-        xp.broadcast_to(t39*qd3 - qd2*(t29*c1 + t32*s1), batch),  # 2
-        xp.broadcast_to(t36*qd4 - t22*qd1 - qd5*(t10*t1 + t23*t25) - qd6*(t17*t26 + t0*t24), batch),  # 3
-        xp.broadcast_to(t37*qd4 + qd5*(t13*t1 + t20*t25) + qd6*(t16*t26 + t0*t21) - t18*qd1, batch),  # 4
-        xp.broadcast_to(t39*qd4 + qd5*(t10*t20 - t13*t23) + qd6*(t17*t21 - t16*t24), batch),  # 5
+        xp.broadcast_to(qd2*(t6*c1 - t34*s1) + qd3*t36 - t33*qd1, batch),  # 0
+        xp.broadcast_to(t30*qd1 + qd2*(t6*s1 + t34*c1) + qd3*t37, batch),  # 1
+        xp.broadcast_to(-qd2*(t29*c1 + t32*s1) + qd3*t39, batch),  # 2
+        xp.broadcast_to(qd4*t36 - qd5*(t10*t1 + t23*t25) - qd6*(t17*t26 + t0*t24) - t22*qd1, batch),  # 3
+        xp.broadcast_to(qd4*t37 + qd5*(t13*t1 + t20*t25) + qd6*(t16*t26 + t0*t21) - t18*qd1, batch),  # 4
+        xp.broadcast_to(qd4*t39 + qd5*(t10*t20 - t13*t23) + qd6*(t17*t21 - t16*t24), batch),  # 5
     ], (6,))
     return a
 
@@ -882,8 +882,8 @@ def task_jacobian_dot(q, q_dot):
     t19 = t12*s5 + t17*c5
     t20 = t8*s6 + t18*c6
     t21 = s2*s4
-    t22 = t21*c5 + c2*s5
-    t23 = t21*s5 - c2*c5
+    t22 = c2*s5 + t21*c5
+    t23 = -c2*c5 + t21*s5
     t24 = c4*s2
     t25 = t22*c6 + t24*s6
     t26 = qd2*s1
@@ -913,13 +913,13 @@ def task_jacobian_dot(q, q_dot):
     t50 = t20*t49 + t25*t43
     t51 = t16*t49 + t25*t39
     t52 = t29*c2
-    t53 = t52*q3 + t13*qd3
+    t53 = t13*qd3 + t52*q3
     t54 = t53 - t2*qd1
     t55 = t52 - t17*qd1
     t56 = t26*c2
-    t57 = t56*q3 + t17*qd3
+    t57 = t17*qd3 + t56*q3
     t58 = t57 + t1*qd1
-    t59 = t56 + t13*qd1
+    t59 = t13*qd1 + t56
     t60 = t53*c1 + t57*s1
     t61 = c2*q3*qd1
     t62 = t4*c1 - t61*s1
@@ -929,58 +929,58 @@ def task_jacobian_dot(q, q_dot):
     t66 = -t65
     t67 = t16**2 + t20**2
     t68 = 1/t67
-    t69 = t68*c1
-    t70 = t16*qd1
-    t71 = t68*s1
-    t72 = t20*qd1
-    t73 = t20*c1
-    t74 = t16*s1
-    t75 = t73 - t74
-    t76 = 2/t67**2
-    t77 = t75*t76
-    t78 = t16*t77
-    t79 = t20*t77
-    t80 = t16*t68
-    t81 = t55*t80
-    t82 = t20*t68
-    t83 = t59*t82
-    t84 = t71*s2
-    t85 = t16*c1
-    t86 = t20*s1
-    t87 = t85*s2 + t86*s2
-    t88 = t76*t87
-    t89 = t20*t88
-    t90 = t69*s2
-    t91 = t16*t88
-    t92 = t36*t82
-    t93 = t35*t80
-    t94 = t8*t68
-    t95 = t11*t16 + t8*t20
-    t96 = t76*t95
-    t97 = t20*t96
-    t98 = t11*t68
-    t99 = t16*t96
-    t100 = t48*t82
-    t101 = t47*t80
-    t102 = t19*t68
-    t103 = t15*t16 + t19*t20
-    t104 = t76*t103
-    t105 = t20*t104
-    t106 = t15*t68
-    t107 = t16*t104
+    t69 = s1*t68
+    t70 = t20*c1
+    t71 = t16*s1
+    t72 = t70 - t71
+    t73 = 2/t67**2
+    t74 = t72*t73
+    t75 = t16*t74
+    t76 = c1*t68
+    t77 = t20*t74
+    t78 = t16*qd1
+    t79 = t20*qd1
+    t80 = t69*s2
+    t81 = t16*c1
+    t82 = t20*s1
+    t83 = t81*s2 + t82*s2
+    t84 = t73*t83
+    t85 = t20*t84
+    t86 = t76*s2
+    t87 = t16*t84
+    t88 = t16*t68
+    t89 = t55*t88
+    t90 = t20*t68
+    t91 = t59*t90
+    t92 = t8*t68
+    t93 = t11*t16 + t8*t20
+    t94 = t73*t93
+    t95 = t20*t94
+    t96 = t11*t68
+    t97 = t16*t94
+    t98 = t36*t90
+    t99 = t35*t88
+    t100 = t19*t68
+    t101 = t15*t16 + t19*t20
+    t102 = t73*t101
+    t103 = t20*t102
+    t104 = t15*t68
+    t105 = t16*t102
+    t106 = t48*t90
+    t107 = t47*t88
     t108 = 1/xp.sqrt(t67)
-    t109 = t108*qd1
-    t110 = t108*s1
-    t111 = 1/t67**1.5
-    t112 = t111*(t85 + t86)
-    t113 = t108*c1
-    t114 = t16*t108
-    t115 = t20*t108
-    t116 = t111*(t74*s2 - t73*s2)
-    t117 = t111*(t8*t16 - t11*t20)
-    t118 = t111*(t19*t16 - t15*t20)
+    t109 = s1*t108
+    t110 = 1/t67**1.5
+    t111 = t110*(t81 + t82)
+    t112 = c1*t108
+    t113 = t108*qd1
+    t114 = t110*(t71*s2 - t70*s2)
+    t115 = t16*t108
+    t116 = t20*t108
+    t117 = t110*(t8*t16 - t11*t20)
+    t118 = t110*(t19*t16 - t15*t20)
     t119 = t25*t69
-    t120 = t25*t71
+    t120 = t25*t76
     t121 = t44*t68
     Jd = _stack(xp, [
         xp.broadcast_to(-t58, batch),  # 0, 0
@@ -1002,23 +1002,23 @@ def task_jacobian_dot(q, q_dot):
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
-        xp.broadcast_to(-(t69*t70 + t71*t72 - t50*(t71 + t78) - t51*(t69 - t79)), batch),  # 3, 1
+        xp.broadcast_to(-(-t50*(t69 + t75) - t51*(t76 - t77) + t76*t78 + t69*t79), batch),  # 3, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 2
-        xp.broadcast_to(t81 + t83 + t51*(t84 - t89) - t50*(t90 - t91), batch),  # 3, 3
-        xp.broadcast_to(t92 - t93 + t51*(t94 - t97) - t50*(t98 - t99), batch),  # 3, 4
-        xp.broadcast_to(t100 - t101 + t51*(t102 - t105) - t50*(t106 - t107), batch),  # 3, 5
+        xp.broadcast_to(t51*(t80 - t85) - t50*(t86 - t87) + t89 + t91, batch),  # 3, 3
+        xp.broadcast_to(t51*(t92 - t95) - t50*(t96 - t97) + t98 - t99, batch),  # 3, 4
+        xp.broadcast_to(t51*(t100 - t103) - t50*(t104 - t105) + t106 - t107, batch),  # 3, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
-        xp.broadcast_to(t51*(t110 - t20*t112) + t73*t109 - t50*(t113 - t16*t112) - t74*t109, batch),  # 4, 1
+        xp.broadcast_to(t51*(t109 - t20*t111) - t50*(t112 - t16*t111) + t70*t113 - t71*t113, batch),  # 4, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 2
-        xp.broadcast_to(t59*t114 - t55*t115 - t50*(t110*s2 - t16*t116) - t51*(t20*t116 + t113*s2), batch),  # 4, 3
-        xp.broadcast_to(t35*t115 + t36*t114 - t50*(t8*t108 - t16*t117) - t51*(t11*t108 + t20*t117), batch),  # 4, 4
-        xp.broadcast_to(t47*t115 + t48*t114 - t50*(t19*t108 - t16*t118) - t51*(t15*t108 + t20*t118), batch),  # 4, 5
+        xp.broadcast_to(-t51*(t20*t114 + t112*s2) - t50*(t109*s2 - t16*t114) + t59*t115 - t55*t116, batch),  # 4, 3
+        xp.broadcast_to(-t51*(t11*t108 + t20*t117) - t50*(t8*t108 - t16*t117) + t36*t115 + t35*t116, batch),  # 4, 4
+        xp.broadcast_to(-t51*(t15*t108 + t20*t118) - t50*(t19*t108 - t16*t118) + t48*t115 + t47*t116, batch),  # 4, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 0
-        xp.broadcast_to(-(t70*t119 + t72*t120 + t75*t121 - t50*(t120 + t25*t78) - t51*(t119 - t25*t79)), batch),  # 5, 1
+        xp.broadcast_to(-(-t50*(t119 + t25*t75) - t51*(t120 - t25*t77) + t72*t121 + t78*t120 + t79*t119), batch),  # 5, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 2
-        xp.broadcast_to(t66 + t25*t81 + t25*t83 + t51*(t25*t84 - t25*t89) - t50*(t25*t90 - t25*t91) - t87*t121, batch),  # 5, 3
-        xp.broadcast_to(t32 + t25*t92 + t51*(t25*t94 - t25*t97) - t25*t93 - t50*(t25*t98 - t25*t99) - t95*t121, batch),  # 5, 4
-        xp.broadcast_to(t42 + t25*t100 + t51*(t25*t102 - t25*t105) - t25*t101 - t50*(t25*t106 - t25*t107) - t103*t121, batch),  # 5, 5
+        xp.broadcast_to(t66 + t51*(t25*t80 - t25*t85) - t50*(t25*t86 - t25*t87) - t83*t121 + t25*t89 + t25*t91, batch),  # 5, 3
+        xp.broadcast_to(t32 + t51*(t25*t92 - t25*t95) - t50*(t25*t96 - t25*t97) - t93*t121 + t25*t98 - t25*t99, batch),  # 5, 4
+        xp.broadcast_to(t42 + t51*(t25*t100 - t25*t103) - t50*(t25*t104 - t25*t105) - t101*t121 + t25*t106 - t25*t107, batch),  # 5, 5
     ], (6, 6))
     return Jd
 
@@ -1060,7 +1060,7 @@ def hessian(q):
     t21 = c1**2
     t22 = c2*q3
     t23 = s1**2
-    t24 = -(t21*s2 + t23*s2)
+    t24 = -(s2*t21 + s2*t23)
     t25 = s2**2
     t26 = c4*s2
     H = _stack(xp, [
@@ -1231,7 +1231,7 @@ def hessian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 3, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 3, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 3, 4
-        t15*t26 - t9*t0,  # 4, 3, 5
+        -t9*t0 + t15*t26,  # 4, 3, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 4, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 4, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 4, 2
@@ -1376,7 +1376,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t26 = c1*s1
     t27 = t26*t17
     t28 = t25 + t27 + t21*t26
-    t29 = t27 - t26 + t13*t9 + t10*t15
+    t29 = t13*t9 + t10*t15 - t26 + t27
     t30 = t1*c2
     t31 = t5*c1
     t32 = c2*q3
@@ -1396,66 +1396,66 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t46 = t32*t35
     t47 = t46
     t48 = t5**2
-    t49 = t20 + t48
+    t49 = t48 + t20
     t50 = t35 + t13**2 + t10**2
     t51 = t50 + t18
     t52 = c4*s2
-    t53 = -t30 + t13*t52 + t10*t0
-    t54 = -t43 + t9*t52 + t15*t0
+    t53 = t10*t0 + t13*t52 - t30
+    t54 = t15*t0 + t9*t52 - t43
     t55 = t16 + t9**2 + t15**2
     t56 = t36 + t55
-    t57 = 1 + t0**2 + t17*c4**2
+    t57 = 1 + t0**2 + c4**2*t17
     t58 = t20 + t57
     t59 = xp.sqrt(t23 + t41 + t48 + t50 + t55 + t57 + 2*t20 + 2*t36 + 2*t18)
-    t60 = t28**2
-    t61 = t33**2
-    t62 = t34**2
-    t63 = damping**2
-    t64 = t24 + t63
-    t65 = t64**2
-    t66 = t42 + t63
-    t67 = t49 + t63
-    t68 = t51 + t63
-    t69 = t56 + t63
-    t70 = t58 + t63
+    t60 = damping**2
+    t61 = t24 + t60
+    t62 = t61**2
+    t63 = t42 + t60
+    t64 = t49 + t60
+    t65 = t51 + t60
+    t66 = t56 + t60
+    t67 = t58 + t60
+    t68 = t28**2
+    t69 = t33**2
+    t70 = t34**2
     t71 = 2*t48
     t72 = t22*t35
-    t73 = xp.sqrt(t65 + t66**2 + t67**2 + t68**2 + t69**2 + t70**2 + 2*t37 + 2*t60 + 2*t61 + 2*t62 + 2*t19 + 2*t45**2 + 2*t47**2 + 2*t29**2 + 2*t53**2 + 2*t54**2 + 4*t72 + t35*t71 + t71*t16)
-    t74 = xp.sqrt(t60 + t61 + t62 + t65 + t72 + t19)
-    t75 = t74*xp.where(xp.greater_equal(t64, 0), xp.asarray(1, dtype=dtype), -1)
-    t76 = t75 + t64
-    t77 = xp.where(xp.greater(t74, 0), 1/(t74*(t74 + xp.abs(t64))), 0)
-    t78 = t77*(t28*t45 + t33*t76 + t33*t67 - t34*t31 - t31*t46)
+    t73 = xp.sqrt(t62 + t63**2 + t64**2 + t65**2 + t66**2 + t67**2 + 2*t37 + 2*t19 + 2*t68 + 2*t69 + 2*t70 + 2*t45**2 + 2*t47**2 + 2*t29**2 + 2*t53**2 + 2*t54**2 + t71*t16 + t35*t71 + 4*t72)
+    t74 = xp.sqrt(t19 + t68 + t69 + t70 + t62 + t72)
+    t75 = t74*xp.where(xp.greater_equal(t61, 0), xp.asarray(1, dtype=dtype), -1)
+    t76 = t75 + t61
+    t77 = xp.where(xp.greater(t74, 0), 1/(t74*(t74 + xp.abs(t61))), 0)
+    t78 = t77*(t28*t45 + t33*t76 + t33*t64 - t34*t31 - t31*t46)
     t79 = t33 - t76*t78
     t80 = t45 - t28*t78
-    t81 = t67 - t33*t78
+    t81 = t64 - t33*t78
     t82 = t31 + t34*t78
-    t83 = -t77*(t4*t76 + t4*t70 + t34*t54 - t2*t28 - t53*c1*c2*q3*s1)
+    t83 = -t77*(t4*t76 + t4*t67 + t34*t54 - t2*t28 - t53*c1*c2*q3*s1)
     t84 = t4 + t83*t76
     t85 = t2 - t83*t28
     t86 = t54 + t83*t34
-    t87 = t70 + t83*t4
+    t87 = t67 + t83*t4
     t88 = t26*t32
-    t89 = t77*(t25 + t28*t76 + t28*t66 + t33*t45 + t34*t88 + t47*t88)
+    t89 = t77*(t28*t76 + t28*t63 + t33*t45 + t25 + t34*t88 + t47*t88)
     t90 = t28 - t76*t89
-    t91 = t66 - t28*t89
+    t91 = t63 - t28*t89
     t92 = t45 - t33*t89
     t93 = -t47 + t89*t88
-    t94 = t88 - t34*t89
+    t94 = -t34*t89 + t88
     t95 = t2 + t4*t89
     t96 = t44 + t78*t88
-    t97 = t77*(t4*t53 + t33*t44 + t34*t29 - t28*t47 - t76*t88 - t68*t88)
-    t98 = t88 + t76*t97
+    t97 = t77*(t4*t53 + t34*t29 - t28*t47 + t33*t44 - t76*t88 - t65*t88)
+    t98 = t76*t97 + t88
     t99 = t47 + t28*t97
     t100 = t44 - t33*t97
-    t101 = t68 + t97*t88
+    t101 = t65 + t97*t88
     t102 = t29 - t34*t97
-    t103 = t77*(t4*t54 + t28*t88 + t34*t76 + t34*t69 - t33*t31 - t29*t88)
+    t103 = t77*(t4*t54 + t34*t76 + t34*t66 - t33*t31 + t28*t88 - t29*t88)
     t104 = t34 - t103*t76
-    t105 = t88 - t103*t28
-    t106 = t31 + t103*t33
+    t105 = -t103*t28 + t88
+    t106 = t103*t33 + t31
     t107 = t29 + t103*t88
-    t108 = t69 - t103*t34
+    t108 = t66 - t103*t34
     t109 = -t54 + t103*t4
     t110 = t77*(t28*mu_dot1 + t33*mu_dot2 + t34*mu_dot4 + t76*mu_dot0 - t4*mu_dot5 - t88*mu_dot3)
     t111 = mu_dot0 - t110*t76
@@ -1490,7 +1490,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t140 = t102 - t136*t94
     t141 = t134 - t136*t95
     t142 = t4*t78
-    t143 = t120*(t119*t80 + t92*t81 + t93*t96 + t95*t142 - t94*t82)
+    t143 = t120*(t119*t80 + t92*t81 + t93*t96 - t94*t82 + t95*t142)
     t144 = t80 - t119*t143
     t145 = t81 - t143*t92
     t146 = t96 - t143*t93
@@ -1572,12 +1572,12 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t222 = t10*t214 + t15*t213 - t0*t212
     t223 = t32*s1
     t224 = t32*c1
-    t225 = t213*c1 + t216*t223 + t217*t224 - t214*s1 - t215*t5
+    t225 = t213*c1 - t214*s1 - t215*t5 + t216*t223 + t217*t224
     t226 = -t4
     t227 = t39 + t226
     t228 = t40*(t227*t224 + t2*t223)
-    t229 = t224 - t227*t228
-    t230 = t223 - t228*t2
+    t229 = -t227*t228 + t224
+    t230 = -t228*t2 + t223
     t231 = t40*(t227*t1 + t2*t3)
     t232 = t1 - t227*t231
     t233 = t3 - t231*t2
@@ -1585,7 +1585,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t235 = mu_dot0 - t227*t234
     t236 = mu_dot1 - t234*t2
     t237 = mu_dot5 - t234
-    t238 = xp.sqrt(t35 + t48 + t16 + t228**2 + t230**2)
+    t238 = xp.sqrt(t228**2 + t230**2 + t48 + t16 + t35)
     t239 = t238*xp.where(xp.greater_equal(t230, 0), xp.asarray(1, dtype=dtype), -1)
     t240 = t230 + t239
     t241 = xp.where(xp.greater(t238, 0), 1/(t238*(t238 + xp.abs(t230))), 0)
@@ -1605,29 +1605,29 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t255 = t40*t52
     t256 = t254 + t255
     t257 = -t0
-    t258 = 1 + t13 + t9 + t10 + t15 + t2 + t223 + t224 + t226 + t254 + t257 + c1 + damping + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + q1 + q2 + q3 + q4 + q5 + q6 - t5 - s1 + 2*t1 + 2*t3 + 2*c2
+    t258 = 1 + t13 + t9 + t10 + t15 + t2 + c1 + damping + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + q1 + q2 + q3 + q4 + q5 + q6 + t257 - t5 + t226 - s1 + 2*c2 + t254 + 2*t1 + 2*t3 + t224 + t223
     t259 = t0*t40
     t260 = t257 + t259
     t261 = t2*t252
     t262 = -t241*(t228*t253 + t240*t261)
-    t263 = t261 + t240*t262
-    t264 = t1 + t262*s1
+    t263 = t240*t262 + t261
+    t264 = t262*s1 + t1
     t265 = t3 - t262*c1
     t266 = t253 + t228*t262
     t267 = t2*t255
-    t268 = t241*(t9*c1 + t240*t267 - t13*s1 - t228*t256)
-    t269 = t267 - t240*t268
+    t268 = t241*(t9*c1 - t13*s1 - t228*t256 + t240*t267)
+    t269 = -t240*t268 + t267
     t270 = t13 + t268*s1
     t271 = t9 - t268*c1
     t272 = t256 + t228*t268
     t273 = t2*t259
-    t274 = t241*(t15*c1 + t240*t273 - t10*s1 - t228*t260)
-    t275 = t273 - t240*t274
+    t274 = t241*(t15*c1 - t10*s1 - t228*t260 + t240*t273)
+    t275 = -t240*t274 + t273
     t276 = t10 + t274*s1
     t277 = t15 - t274*c1
     t278 = t260 + t228*t274
     t279 = t242**2
-    t280 = xp.sqrt(t244**2 + t245**2 + t35*t279 + t16*t279)
+    t280 = xp.sqrt(t244**2 + t245**2 + t279*t16 + t279*t35)
     t281 = t280*xp.where(xp.greater_equal(t244, 0), xp.asarray(1, dtype=dtype), -1)
     t282 = t244 + t281
     t283 = xp.where(xp.greater(t280, 0), 1/(t280*(t280 + xp.abs(t244))), 0)
@@ -1693,7 +1693,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t343 = xp.where(xp.not_equal(t298, 0), -(t302 - (t312*t342 + t329*t341))/t298, 0)
     t344 = xp.where(xp.not_equal(t281, 0), -(t293 - (t288*t343 + t307*t342 + t324*t341))/t281, 0)
     t345 = xp.where(xp.not_equal(t239, 0), -(t247 - (t243*t344 + t269*t342 + t275*t341 - t263*t343))/t239, 0)
-    t346 = xp.where(xp.not_equal(t39, 0), -(t235 - (t229*t345 + t232*t344 + t227*t341*t259 + t227*t342*t255 - t227*t343*t252))/t39, 0)
+    t346 = xp.where(xp.not_equal(t39, 0), -(t235 - (t229*t345 + t232*t344 + t227*t341*t259 - t227*t343*t252 + t227*t342*t255))/t39, 0)
     t347 = xp.isfinite(t258)
     t348 = xp.greater_equal(damping, 0)
     t349 = 1e-12*t59
@@ -1787,8 +1787,8 @@ def ik_numeric_step(target, q, damping=0.0):
     t33 = T20*t29 + T21*t30 + T22*t28
     t34 = 0.5*(t24 - t31)
     t35 = s2*s4
-    t36 = t35*c5 + c2*s5
-    t37 = t35*s5 - c2*c5
+    t36 = c2*s5 + t35*c5
+    t37 = -c2*c5 + t35*s5
     t38 = c4*s2
     t39 = t36*c6 + t38*s6
     t40 = t36*s6 - t38*c6
@@ -1804,8 +1804,8 @@ def ik_numeric_step(target, q, damping=0.0):
     t50 = s2**2
     t51 = t48*t50
     t52 = c2**2
-    t53 = t52 + t4**2
-    t54 = 1 + t52 + t37**2 + t50*c4**2
+    t53 = t4**2 + t52
+    t54 = 1 + t37**2 + t52 + c4**2*t50
     t55 = t52*q3**2
     t56 = t48*t55
     t57 = t47 + t51 + t56
@@ -1813,18 +1813,18 @@ def ik_numeric_step(target, q, damping=0.0):
     t59 = c1*s1
     t60 = t50*t59
     t61 = t58 + t60 + t55*t59
-    t62 = t60 - t59 + t16*t13 + t20*t28
+    t62 = t16*t13 + t20*t28 - t59 + t60
     t63 = t18*c2
-    t64 = -t63 + t16*t38 + t20*t37
+    t64 = t20*t37 + t16*t38 - t63
     t65 = t4*c1
     t66 = t63 - t7*t65
     t67 = s1**2
-    t68 = t51 + t67 + t16**2 + t20**2
-    t69 = t50*t67
-    t70 = t69 + t2**2 + t55*t67
-    t71 = t48 + t69 + t13**2 + t28**2
+    t68 = t16**2 + t20**2 + t67 + t51
+    t69 = t67*t50
+    t70 = t2**2 + t69 + t55*t67
+    t71 = t13**2 + t28**2 + t48 + t69
     t72 = t26*c2
-    t73 = -t72 + t13*t38 + t28*t37
+    t73 = t28*t37 + t13*t38 - t72
     t74 = t4*s1
     t75 = t72 - t7*t74
     t76 = t7*t67
@@ -1853,14 +1853,14 @@ def ik_numeric_step(target, q, damping=0.0):
     t99 = xp.where(xp.greater(t96, 0), 1/(t96*(t96 + xp.abs(t95))), 0)
     t100 = t70 + damping
     t101 = t7*t59
-    t102 = t99*(t58 + t98*t61 + t61*t100 + t66*t75 + t49*t101 + t77*t101)
+    t102 = t99*(t98*t61 + t61*t100 + t66*t75 + t58 + t49*t101 + t77*t101)
     t103 = t61 - t98*t102
     t104 = t100 - t102*t61
     t105 = t75 - t102*t66
     t106 = -t77 + t102*t101
-    t107 = t101 - t102*t49
+    t107 = -t102*t49 + t101
     t108 = t2 + t102*t3
-    t109 = t99*(t92*t49 + t5*t98 + t6*t61 + t9*t66 - t91*t101 - t93*t3)
+    t109 = t99*(t92*t49 + t5*t98 + t6*t61 + t9*t66 - t93*t3 - t91*t101)
     t110 = t5 - t98*t109
     t111 = t6 - t109*t61
     t112 = t9 - t109*t66
@@ -1885,8 +1885,8 @@ def ik_numeric_step(target, q, damping=0.0):
     t131 = t74 + t127*t101
     t132 = t65 + t127*t49
     t133 = t68 + damping
-    t134 = t99*(t3*t64 + t66*t74 + t49*t62 - t98*t101 - t61*t77 - t101*t133)
-    t135 = t101 + t98*t134
+    t134 = t99*(t3*t64 + t49*t62 - t61*t77 + t66*t74 - t98*t101 - t101*t133)
+    t135 = t98*t134 + t101
     t136 = t77 + t134*t61
     t137 = t74 - t134*t66
     t138 = t133 + t134*t101
@@ -1900,9 +1900,9 @@ def ik_numeric_step(target, q, damping=0.0):
     t146 = t139 - t107*t142
     t147 = t141 - t108*t142
     t148 = t71 + damping
-    t149 = t99*(t98*t49 + t3*t73 + t61*t101 + t49*t148 - t66*t65 - t62*t101)
+    t149 = t99*(t98*t49 + t3*t73 + t49*t148 - t66*t65 + t61*t101 - t62*t101)
     t150 = t49 - t98*t149
-    t151 = t101 - t149*t61
+    t151 = -t149*t61 + t101
     t152 = t65 + t149*t66
     t153 = t62 + t149*t101
     t154 = t148 - t149*t49
@@ -1921,7 +1921,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t167 = t73 + t163*t49
     t168 = t162 + t163*t3
     t169 = t127*t3
-    t170 = t119*(t105*t130 + t106*t131 + t108*t169 + t129*t118 - t107*t132)
+    t170 = t119*(t105*t130 + t106*t131 + t129*t118 - t107*t132 + t108*t169)
     t171 = t129 - t118*t170
     t172 = t130 - t105*t170
     t173 = t131 - t106*t170
@@ -1966,9 +1966,9 @@ def ik_numeric_step(target, q, damping=0.0):
     t212 = t205 - t209*t211
     t213 = t206 - t202*t211
     t214 = t163*t66
-    t215 = t119*(t106*t166 + t108*t168 + t165*t118 - t105*t214 - t107*t167)
+    t215 = t119*(t106*t166 + t108*t168 + t165*t118 - t107*t167 - t105*t214)
     t216 = t165 - t118*t215
-    t217 = t214 + t105*t215
+    t217 = t105*t215 + t214
     t218 = t166 - t106*t215
     t219 = t167 + t107*t215
     t220 = t168 - t108*t215
@@ -2053,7 +2053,7 @@ def ik_branches(T):
     t12 = t10 + t11
     t13 = -0.412 + t12
     t14 = t13**2
-    t15 = t14 + t4**2 + t8**2
+    t15 = t4**2 + t8**2 + t14
     t16 = 0.01787569 - t15
     t17 = 0.01787569 + t15
     t18 = -t16
@@ -2079,7 +2079,7 @@ def ik_branches(T):
     t38 = t8*t29
     t39 = t37 + t38
     t40 = t35**2 + t39**2
-    t41 = t38 - t37
+    t41 = -t37 + t38
     t42 = t36**2 + t41**2
     t43 = t29**2
     t44 = t43 + t24
@@ -2100,9 +2100,9 @@ def ik_branches(T):
     t59 = -0.01787569 + t58
     t60 = 0.01787569 - t57
     t61 = -0.01787569 + t60
-    t62 = t43*t22
-    t63 = t62 + t59**2
-    t64 = t62 + t61**2
+    t62 = t22*t43
+    t63 = t59**2 + t62
+    t64 = t61**2 + t62
     t65 = t23*t45
     t66 = xp.less_equal(t63, t65)
     t67 = xp.where(t66, 1, 1/xp.sqrt(t63))
@@ -2149,7 +2149,7 @@ def ik_branches(T):
     t108 = t103 + t96*t107
     t109 = t108 + t104
     t110 = t90**2
-    t111 = t103 + t110 + t96**2
+    t111 = t110 + t96**2 + t103
     t112 = t107**2
     t113 = t109**2 + t110*t112
     t114 = t103 + t112
@@ -2191,7 +2191,7 @@ def ik_branches(T):
     t150 = t145 + t100*t149
     t151 = t150 + t146
     t152 = t141**2
-    t153 = t145 + t152 + t100**2
+    t153 = t152 + t100**2 + t145
     t154 = t149**2
     t155 = t151**2 + t152*t154
     t156 = t145 + t154
@@ -2249,7 +2249,7 @@ def ik_branches(T):
     t208 = t203 + t196*t207
     t209 = t208 + t204
     t210 = t186**2
-    t211 = t203 + t210 + t196**2
+    t211 = t210 + t196**2 + t203
     t212 = t207**2
     t213 = t209**2 + t210*t212
     t214 = t203 + t212
@@ -2282,7 +2282,7 @@ def ik_branches(T):
     t241 = t236 + t200*t240
     t242 = t241 + t237
     t243 = t190**2
-    t244 = t236 + t243 + t200**2
+    t244 = t243 + t200**2 + t236
     t245 = t240**2
     t246 = t242**2 + t243*t245
     t247 = t236 + t245
@@ -2315,64 +2315,64 @@ def ik_branches(T):
     t274 = xp.where(t116, 0, xp.atan2(-t121, t109))
     t275 = t274
     t276 = t275 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t275))
-    t277 = 3.141592653589793 + t274 - 6.283185307179586*xp.ceil(0.15915494309189535*t274)
+    t277 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t274) + t274
     t278 = t277 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t277))
     t279 = xp.where(t125, 0, xp.atan2(-t107, t91))
     t280 = t279
     t281 = t280 - 6.283185307179586*xp.floor(0.15915494309189535*(1.5707963267948966 + t280))
-    t282 = t279 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t279))
+    t282 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t279)) + t279
     t283 = xp.where(xp.less_equal(t134, 1e-24*t135), 0, xp.atan2(t130, -t131))
     t284 = t283
     t285 = t284 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t284))
-    t286 = 3.141592653589793 + t283 - 6.283185307179586*xp.ceil(0.15915494309189535*t283)
+    t286 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t283) + t283
     t287 = t286 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t286))
     t288 = -t282
     t289 = t282 + 6.283185307179586*xp.floor(0.15915494309189535*(1.5707963267948966 + t288))
     t290 = xp.where(t158, 0, xp.atan2(-t163, t151))
     t291 = t290
     t292 = t291 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t291))
-    t293 = 3.141592653589793 + t290 - 6.283185307179586*xp.ceil(0.15915494309189535*t290)
+    t293 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t290) + t290
     t294 = t293 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t293))
     t295 = xp.where(t167, 0, xp.atan2(-t149, t142))
     t296 = t295
     t297 = t296 - 6.283185307179586*xp.floor(0.15915494309189535*(1.5707963267948966 + t296))
-    t298 = t295 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t295))
+    t298 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t295)) + t295
     t299 = xp.where(xp.less_equal(t176, 1e-24*t177), 0, xp.atan2(t172, -t173))
     t300 = t299
     t301 = t300 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t300))
-    t302 = 3.141592653589793 + t299 - 6.283185307179586*xp.ceil(0.15915494309189535*t299)
+    t302 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t299) + t299
     t303 = t302 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t302))
     t304 = -t298
     t305 = t298 + 6.283185307179586*xp.floor(0.15915494309189535*(1.5707963267948966 + t304))
     t306 = xp.where(t216, 0, xp.atan2(-t221, t209))
     t307 = t306
     t308 = t307 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t307))
-    t309 = 3.141592653589793 + t306 - 6.283185307179586*xp.ceil(0.15915494309189535*t306)
+    t309 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t306) + t306
     t310 = t309 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t309))
     t311 = xp.where(t225, 0, xp.atan2(-t207, t187))
     t312 = t311
     t313 = t312 - 6.283185307179586*xp.floor(0.15915494309189535*(1.5707963267948966 + t312))
-    t314 = t311 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t311))
+    t314 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t311)) + t311
     t315 = xp.where(xp.less_equal(t234, 1e-24*t235), 0, xp.atan2(t230, -t231))
     t316 = t315
     t317 = t316 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t316))
-    t318 = 3.141592653589793 + t315 - 6.283185307179586*xp.ceil(0.15915494309189535*t315)
+    t318 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t315) + t315
     t319 = t318 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t318))
     t320 = -t314
     t321 = t314 + 6.283185307179586*xp.floor(0.15915494309189535*(1.5707963267948966 + t320))
     t322 = xp.where(t249, 0, xp.atan2(-t254, t242))
     t323 = t322
     t324 = t323 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t323))
-    t325 = 3.141592653589793 + t322 - 6.283185307179586*xp.ceil(0.15915494309189535*t322)
+    t325 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t322) + t322
     t326 = t325 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t325))
     t327 = xp.where(t258, 0, xp.atan2(-t240, t191))
     t328 = t327
     t329 = t328 - 6.283185307179586*xp.floor(0.15915494309189535*(1.5707963267948966 + t328))
-    t330 = t327 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t327))
+    t330 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t327)) + t327
     t331 = xp.where(xp.less_equal(t267, 1e-24*t268), 0, xp.atan2(t263, -t264))
     t332 = t331
     t333 = t332 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t332))
-    t334 = 3.141592653589793 + t331 - 6.283185307179586*xp.ceil(0.15915494309189535*t331)
+    t334 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t331) + t331
     t335 = t334 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t334))
     t336 = -t330
     t337 = t330 + 6.283185307179586*xp.floor(0.15915494309189535*(1.5707963267948966 + t336))
@@ -2702,7 +2702,7 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     t73 = -qn4
     t74 = -qn5
     t75 = -qn6
-    t76 = qw1*(t53 + t70)**2 + qw2*(t57 + t71)**2 + qw3*(t72 + qb0_2)**2 + qw4*(t61 + t73)**2 + qw5*(t65 + t74)**2 + qw6*(t69 + t75)**2
+    t76 = qw1*(t53 + t70)**2 + qw2*(t57 + t71)**2 + qw3*(qb0_2 + t72)**2 + qw4*(t61 + t73)**2 + qw5*(t65 + t74)**2 + qw6*(t69 + t75)**2
     t77 = xp.greater(t6, 0)
     t78 = xp.where(t77, t53, qn1)
     t79 = xp.where(t77, t57, qn2)
@@ -2731,7 +2731,7 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     t102 = t11 + t101
     t103 = t11 - t101
     t104 = xp.where(xp.greater_equal(t11, -2.9670597283903604) & xp.less_equal(t11, 2.9670597283903604), t11, xp.where(xp.greater_equal(t102, -2.9670597283903604) & xp.less_equal(t102, 2.9670597283903604), t102, xp.where(xp.greater_equal(t103, -2.9670597283903604) & xp.less_equal(t103, 2.9670597283903604), t103, qb1_5)))
-    t105 = qw1*(t88 + t70)**2 + qw2*(t92 + t71)**2 + qw3*(t72 + qb1_2)**2 + qw4*(t96 + t73)**2 + qw5*(t100 + t74)**2 + qw6*(t104 + t75)**2
+    t105 = qw1*(t88 + t70)**2 + qw2*(t92 + t71)**2 + qw3*(qb1_2 + t72)**2 + qw4*(t96 + t73)**2 + qw5*(t100 + t74)**2 + qw6*(t104 + t75)**2
     t106 = xp.greater(t12, 0)
     t107 = xp.where(t106 & (xp.less(t6, 1) | xp.less(t105, t84)), xp.asarray(1, dtype=dtype), 0)
     t108 = xp.where(t106, 1, t6)
@@ -2763,7 +2763,7 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     t134 = t17 + t133
     t135 = t17 - t133
     t136 = xp.where(xp.greater_equal(t17, -2.9670597283903604) & xp.less_equal(t17, 2.9670597283903604), t17, xp.where(xp.greater_equal(t134, -2.9670597283903604) & xp.less_equal(t134, 2.9670597283903604), t134, xp.where(xp.greater_equal(t135, -2.9670597283903604) & xp.less_equal(t135, 2.9670597283903604), t135, qb2_5)))
-    t137 = qw1*(t120 + t70)**2 + qw2*(t124 + t71)**2 + qw3*(t72 + qb2_2)**2 + qw4*(t128 + t73)**2 + qw5*(t132 + t74)**2 + qw6*(t136 + t75)**2
+    t137 = qw1*(t120 + t70)**2 + qw2*(t124 + t71)**2 + qw3*(qb2_2 + t72)**2 + qw4*(t128 + t73)**2 + qw5*(t132 + t74)**2 + qw6*(t136 + t75)**2
     t138 = xp.greater(t18, 0)
     t139 = xp.where(t138 & (xp.less(t108, 1) | xp.less(t137, t116)), xp.asarray(1, dtype=dtype), 0)
     t140 = xp.where(t138, 1, t108)
@@ -2795,7 +2795,7 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     t166 = t23 + t165
     t167 = t23 - t165
     t168 = xp.where(xp.greater_equal(t23, -2.9670597283903604) & xp.less_equal(t23, 2.9670597283903604), t23, xp.where(xp.greater_equal(t166, -2.9670597283903604) & xp.less_equal(t166, 2.9670597283903604), t166, xp.where(xp.greater_equal(t167, -2.9670597283903604) & xp.less_equal(t167, 2.9670597283903604), t167, qb3_5)))
-    t169 = qw1*(t152 + t70)**2 + qw2*(t156 + t71)**2 + qw3*(t72 + qb3_2)**2 + qw4*(t160 + t73)**2 + qw5*(t164 + t74)**2 + qw6*(t168 + t75)**2
+    t169 = qw1*(t152 + t70)**2 + qw2*(t156 + t71)**2 + qw3*(qb3_2 + t72)**2 + qw4*(t160 + t73)**2 + qw5*(t164 + t74)**2 + qw6*(t168 + t75)**2
     t170 = xp.greater(t24, 0)
     t171 = xp.where(t170 & (xp.less(t140, 1) | xp.less(t169, t148)), xp.asarray(1, dtype=dtype), 0)
     t172 = xp.where(t170, 1, t140)
@@ -2827,7 +2827,7 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     t198 = t29 + t197
     t199 = t29 - t197
     t200 = xp.where(xp.greater_equal(t29, -2.9670597283903604) & xp.less_equal(t29, 2.9670597283903604), t29, xp.where(xp.greater_equal(t198, -2.9670597283903604) & xp.less_equal(t198, 2.9670597283903604), t198, xp.where(xp.greater_equal(t199, -2.9670597283903604) & xp.less_equal(t199, 2.9670597283903604), t199, qb4_5)))
-    t201 = qw1*(t184 + t70)**2 + qw2*(t188 + t71)**2 + qw3*(t72 + qb4_2)**2 + qw4*(t192 + t73)**2 + qw5*(t196 + t74)**2 + qw6*(t200 + t75)**2
+    t201 = qw1*(t184 + t70)**2 + qw2*(t188 + t71)**2 + qw3*(qb4_2 + t72)**2 + qw4*(t192 + t73)**2 + qw5*(t196 + t74)**2 + qw6*(t200 + t75)**2
     t202 = xp.greater(t30, 0)
     t203 = xp.where(t202 & (xp.less(t172, 1) | xp.less(t201, t180)), xp.asarray(1, dtype=dtype), 0)
     t204 = xp.where(t202, 1, t172)
@@ -2859,7 +2859,7 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     t230 = t35 + t229
     t231 = t35 - t229
     t232 = xp.where(xp.greater_equal(t35, -2.9670597283903604) & xp.less_equal(t35, 2.9670597283903604), t35, xp.where(xp.greater_equal(t230, -2.9670597283903604) & xp.less_equal(t230, 2.9670597283903604), t230, xp.where(xp.greater_equal(t231, -2.9670597283903604) & xp.less_equal(t231, 2.9670597283903604), t231, qb5_5)))
-    t233 = qw1*(t216 + t70)**2 + qw2*(t220 + t71)**2 + qw3*(t72 + qb5_2)**2 + qw4*(t224 + t73)**2 + qw5*(t228 + t74)**2 + qw6*(t232 + t75)**2
+    t233 = qw1*(t216 + t70)**2 + qw2*(t220 + t71)**2 + qw3*(qb5_2 + t72)**2 + qw4*(t224 + t73)**2 + qw5*(t228 + t74)**2 + qw6*(t232 + t75)**2
     t234 = xp.greater(t36, 0)
     t235 = xp.where(t234 & (xp.less(t204, 1) | xp.less(t233, t212)), xp.asarray(1, dtype=dtype), 0)
     t236 = xp.where(t234, 1, t204)
@@ -2891,7 +2891,7 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     t262 = t41 + t261
     t263 = t41 - t261
     t264 = xp.where(xp.greater_equal(t41, -2.9670597283903604) & xp.less_equal(t41, 2.9670597283903604), t41, xp.where(xp.greater_equal(t262, -2.9670597283903604) & xp.less_equal(t262, 2.9670597283903604), t262, xp.where(xp.greater_equal(t263, -2.9670597283903604) & xp.less_equal(t263, 2.9670597283903604), t263, qb6_5)))
-    t265 = qw1*(t248 + t70)**2 + qw2*(t252 + t71)**2 + qw3*(t72 + qb6_2)**2 + qw4*(t256 + t73)**2 + qw5*(t260 + t74)**2 + qw6*(t264 + t75)**2
+    t265 = qw1*(t248 + t70)**2 + qw2*(t252 + t71)**2 + qw3*(qb6_2 + t72)**2 + qw4*(t256 + t73)**2 + qw5*(t260 + t74)**2 + qw6*(t264 + t75)**2
     t266 = xp.greater(t42, 0)
     t267 = xp.where(t266 & (xp.less(t265, t244) | xp.less(t236, 1)), xp.asarray(1, dtype=dtype), 0)
     t268 = xp.where(t266, 1, t236)
@@ -2923,7 +2923,7 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     t294 = t47 + t293
     t295 = t47 - t293
     t296 = xp.where(xp.greater_equal(t47, -2.9670597283903604) & xp.less_equal(t47, 2.9670597283903604), t47, xp.where(xp.greater_equal(t294, -2.9670597283903604) & xp.less_equal(t294, 2.9670597283903604), t294, xp.where(xp.greater_equal(t295, -2.9670597283903604) & xp.less_equal(t295, 2.9670597283903604), t295, qb7_5)))
-    t297 = qw1*(t280 + t70)**2 + qw2*(t284 + t71)**2 + qw3*(t72 + qb7_2)**2 + qw4*(t288 + t73)**2 + qw5*(t292 + t74)**2 + qw6*(t296 + t75)**2
+    t297 = qw1*(t280 + t70)**2 + qw2*(t284 + t71)**2 + qw3*(qb7_2 + t72)**2 + qw4*(t288 + t73)**2 + qw5*(t292 + t74)**2 + qw6*(t296 + t75)**2
     t298 = xp.greater(t48, 0)
     t299 = xp.where(t298 & (xp.less(t268, 1) | xp.less(t297, t276)), xp.asarray(1, dtype=dtype), 0)
     t300 = xp.where(t298, 1, t268)

@@ -105,13 +105,13 @@ def fk(q):
     t13 = s1*s234
     t14 = t7*c6 - t13*s6
     t15 = t7*s6 + t13*c6
-    t16 = 0.09465*t13 - 0.0823*t3
+    t16 = -0.0823*t3 + 0.09465*t13
     t17 = t16 - 0.10915*c1
     t18 = c5*s234
-    t19 = t18*c6 + c234*s6
+    t19 = c234*s6 + t18*c6
     t20 = c234*c6 - t18*s6
     t21 = s234*s5
-    t22 = 0.0823*t21 + 0.09465*c234
+    t22 = 0.09465*c234 + 0.0823*t21
     t23 = t22 + 0.39225*s23
     t24 = t23 + 0.425*s2
     t25 = 0.089459 - t24
@@ -162,15 +162,15 @@ def jacobian(q):
     s5 = trig[..., 9]
     t0 = c234*s5
     t1 = c5*s1 - t0*c1
-    t2 = t0*s1 + c1*c5
+    t2 = c1*c5 + t0*s1
     t3 = c1*s234
     t4 = 0.0823*t1 + 0.09465*t3
     t5 = t4 + 0.10915*s1
     t6 = s1*s234
-    t7 = 0.09465*t6 - 0.0823*t2
+    t7 = -0.0823*t2 + 0.09465*t6
     t8 = t7 - 0.10915*c1
     t9 = s234*s5
-    t10 = 0.0823*t9 + 0.09465*c234
+    t10 = 0.09465*c234 + 0.0823*t9
     t11 = t10 + 0.39225*s23
     t12 = t11 + 0.425*s2
     t13 = 0.39225*c23
@@ -193,7 +193,7 @@ def jacobian(q):
         t12*s1,  # 1, 1
         t11*s1,  # 1, 2
         t20,  # 1, 3
-        t19*s234 - t4*c234,  # 1, 4
+        -t4*c234 + t19*s234,  # 1, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
         t17*c1 + t18*s1,  # 2, 1
@@ -259,13 +259,13 @@ def fk_jacobian(q):
     t13 = s1*s234
     t14 = t7*c6 - t13*s6
     t15 = t7*s6 + t13*c6
-    t16 = 0.09465*t13 - 0.0823*t3
+    t16 = -0.0823*t3 + 0.09465*t13
     t17 = t16 - 0.10915*c1
     t18 = c5*s234
-    t19 = t18*c6 + c234*s6
+    t19 = c234*s6 + t18*c6
     t20 = c234*c6 - t18*s6
     t21 = s234*s5
-    t22 = 0.0823*t21 + 0.09465*c234
+    t22 = 0.09465*c234 + 0.0823*t21
     t23 = t22 + 0.39225*s23
     t24 = t23 + 0.425*s2
     t25 = 0.089459 - t24
@@ -309,7 +309,7 @@ def fk_jacobian(q):
         t24*s1,  # 1, 1
         t23*s1,  # 1, 2
         t35,  # 1, 3
-        t34*s234 - t11*c234,  # 1, 4
+        -t11*c234 + t34*s234,  # 1, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
         t30*c1 + t31*s1,  # 2, 1
@@ -375,13 +375,13 @@ def jacobian_tool(q):
     t13 = s1*s234
     t14 = t7*c6 - t13*s6
     t15 = t7*s6 + t13*c6
-    t16 = 0.09465*t13 - 0.0823*t3
+    t16 = -0.0823*t3 + 0.09465*t13
     t17 = t16 - 0.10915*c1
     t18 = c5*s234
-    t19 = t18*c6 + c234*s6
+    t19 = c234*s6 + t18*c6
     t20 = c234*c6 - t18*s6
     t21 = s234*s5
-    t22 = 0.0823*t21 + 0.09465*c234
+    t22 = 0.09465*c234 + 0.0823*t21
     t23 = t22 + 0.39225*s23
     t24 = t23 + 0.425*s2
     t25 = 0.39225*c23
@@ -390,13 +390,13 @@ def jacobian_tool(q):
     t28 = 0.425*c2
     t29 = t26 - t28*c1
     t30 = t27 - t28*s1
-    t31 = t9*c1
-    t32 = t14*s1
-    t33 = t29*c1 + t30*s1
+    t31 = t29*c1 + t30*s1
+    t32 = t9*c1
+    t33 = t14*s1
     t34 = t26*c1 + t27*s1
     t35 = t12*c1 + t17*s1
     t36 = t16*c234 - t22*t13
-    t37 = t22*t8 - t11*c234
+    t37 = -t11*c234 + t22*t8
     t38 = t16*t8 - t11*t13
     t39 = t10*c1
     t40 = t15*s1
@@ -406,35 +406,35 @@ def jacobian_tool(q):
     t44 = t6*s1 + t3*c1
     J = _stack(xp, [
         t14*t29 - t9*t30,  # 0, 0
-        t19*t33 + t24*t31 + t24*t32,  # 0, 1
-        t19*t34 + t23*t31 + t23*t32,  # 0, 2
-        t19*t35 + t22*t31 + t22*t32,  # 0, 3
+        t19*t31 + t24*t32 + t24*t33,  # 0, 1
+        t19*t34 + t23*t32 + t23*t33,  # 0, 2
+        t19*t35 + t22*t32 + t22*t33,  # 0, 3
         t9*t36 + t14*t37 + t19*t38,  # 0, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5
         t10*t30 - t15*t29,  # 1, 0
-        -(t24*t39 + t24*t40 - t20*t33),  # 1, 1
-        -(t23*t39 + t23*t40 - t20*t34),  # 1, 2
-        -(t22*t39 + t22*t40 - t20*t35),  # 1, 3
+        -(-t20*t31 + t24*t39 + t24*t40),  # 1, 1
+        -(-t20*t34 + t23*t39 + t23*t40),  # 1, 2
+        -(-t20*t35 + t22*t39 + t22*t40),  # 1, 3
         -(t10*t36 + t15*t37 - t20*t38),  # 1, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5
         -(t6*t30 + t3*t29),  # 2, 0
-        -(t24*t41 + t33*t21 - t6*t24*c1),  # 2, 1
+        -(t24*t41 + t31*t21 - t6*t24*c1),  # 2, 1
         -(t23*t41 + t34*t21 - t6*t23*c1),  # 2, 2
         -(t22*t41 + t35*t21 - t6*t22*c1),  # 2, 3
-        -(t3*t37 + t38*t21 - t6*t36),  # 2, 4
+        -(t3*t37 - t6*t36 + t38*t21),  # 2, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 5
         t19,  # 3, 0
         t42,  # 3, 1
         t42,  # 3, 2
         t42,  # 3, 3
-        t9*t8 + t14*t13 - t19*c234,  # 3, 4
-        -(t3*t14 + t19*t21 - t6*t9),  # 3, 5
+        -t19*c234 + t9*t8 + t14*t13,  # 3, 4
+        -(t3*t14 - t6*t9 + t19*t21),  # 3, 5
         t20,  # 4, 0
         t43,  # 4, 1
         t43,  # 4, 2
         t43,  # 4, 3
-        -(t10*t8 + t15*t13 + t20*c234),  # 4, 4
-        -(t6*t10 + t20*t21 - t3*t15),  # 4, 5
+        -(t20*c234 + t10*t8 + t15*t13),  # 4, 4
+        -(t6*t10 - t3*t15 + t20*t21),  # 4, 5
         -t21,  # 5, 0
         t44,  # 5, 1
         t44,  # 5, 2
@@ -484,7 +484,7 @@ def task(q):
     t16 = t14 + 0.10915*s1
     t17 = t15 - 0.10915*c1
     t18 = s234*s5
-    t19 = 0.0823*t18 + 0.09465*c234
+    t19 = 0.09465*c234 + 0.0823*t18
     t20 = t19 + 0.39225*s23
     t21 = t20 + 0.425*s2
     t22 = 0.089459 - t21
@@ -543,7 +543,7 @@ def task_jacobian(q):
     t15 = t13 + 0.10915*s1
     t16 = t14 - 0.10915*c1
     t17 = s234*s5
-    t18 = 0.0823*t17 + 0.09465*c234
+    t18 = 0.09465*c234 + 0.0823*t17
     t19 = t18 + 0.39225*s23
     t20 = t19 + 0.425*s2
     t21 = 0.39225*c23
@@ -554,16 +554,16 @@ def task_jacobian(q):
     t26 = t23 - t24*s1
     t27 = t18*c1
     t28 = t18*s1
-    t29 = t10*s1
-    t30 = t11*c1
-    t31 = t10**2 + t11**2
-    t32 = 1/t31
-    t33 = t32*(t29 - t30)
+    t29 = t10**2 + t11**2
+    t30 = 1/t29
+    t31 = t10*s1
+    t32 = t11*c1
+    t33 = t30*(t31 - t32)
     t34 = t10*c1
     t35 = t11*s1
-    t36 = t32*(t34*s234 + t35*s234)
-    t37 = t32*(t7*t10 - t4*t11)
-    t38 = 1/xp.sqrt(t31)
+    t36 = t30*(t34*s234 + t35*s234)
+    t37 = t30*(t7*t10 - t4*t11)
+    t38 = 1/xp.sqrt(t29)
     t39 = -t38*(t34 + t35)
     t40 = -t0*t33
     J = _stack(xp, [
@@ -577,7 +577,7 @@ def task_jacobian(q):
         t20*s1,  # 1, 1
         t19*s1,  # 1, 2
         t28,  # 1, 3
-        t27*s234 - t13*c234,  # 1, 4
+        -t13*c234 + t27*s234,  # 1, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
         t25*c1 + t26*s1,  # 2, 1
@@ -595,7 +595,7 @@ def task_jacobian(q):
         t39,  # 4, 1
         t39,  # 4, 2
         t39,  # 4, 3
-        t38*(t29*s234 - t30*s234),  # 4, 4
+        t38*(t31*s234 - t32*s234),  # 4, 4
         -t38*(t7*t11 + t4*t10),  # 4, 5
         xp.full(batch, 1, dtype=dtype, device=device),  # 5, 0
         t40,  # 5, 1
@@ -649,13 +649,13 @@ def fk_jacobian_dot(q, q_dot):
     t13 = s1*s234
     t14 = t7*c6 - t13*s6
     t15 = t7*s6 + t13*c6
-    t16 = 0.09465*t13 - 0.0823*t3
+    t16 = -0.0823*t3 + 0.09465*t13
     t17 = t16 - 0.10915*c1
     t18 = c5*s234
-    t19 = t18*c6 + c234*s6
+    t19 = c234*s6 + t18*c6
     t20 = c234*c6 - t18*s6
     t21 = s234*s5
-    t22 = 0.0823*t21 + 0.09465*c234
+    t22 = 0.09465*c234 + 0.0823*t21
     t23 = t22 + 0.39225*s23
     t24 = t23 + 0.425*s2
     t25 = 0.089459 - t24
@@ -669,7 +669,7 @@ def fk_jacobian_dot(q, q_dot):
     t33 = t16*c234 - t32*s234
     t34 = t33
     t35 = t22*c1
-    t36 = t35*s234 - t11*c234
+    t36 = -t11*c234 + t35*s234
     t37 = t36
     t38 = t30*c1 + t31*s1
     t39 = t38
@@ -704,7 +704,7 @@ def fk_jacobian_dot(q, q_dot):
     t68 = t67 + t24*t46
     t69 = t68 + t30*qd1
     t70 = t45*qd5
-    t71 = t70 + t43*qd4
+    t71 = t43*qd4 + t70
     t72 = t71 + t41*qd3
     t73 = t72 + t39*qd2
     t74 = -t3
@@ -771,11 +771,11 @@ def fk_jacobian_dot(q, q_dot):
         xp.broadcast_to(t75, batch),  # 5, 5
     ], (6, 6))
     a = _stack(xp, [
-        xp.broadcast_to(qd5*(t37*t58 + t70*t13 - t37*qd1 - t45*t56) - t69*qd1 - qd2*(t73*c1 + t77*qd1) - qd3*(t41*t49 + t72*c1 + t78*qd1) - qd4*(t43*t51 + t71*c1 + t32*qd1), batch),  # 0
-        xp.broadcast_to(t64*qd1 + qd2*(t76*qd1 - t73*s1) - qd3*(t41*t46 + t72*s1 - t23*c1*qd1) - qd4*(t43*t48 + t71*s1 - t22*c1*qd1) - qd5*(t34*t58 + t45*t53 + t70*t8 - t34*qd1), batch),  # 1
-        xp.broadcast_to(qd2*(t63*c1 + t68*s1) + qd3*(t62*c1 + t67*s1 + t80*c1**2 + t80*s1**2) + qd4*(t48*t32 + t51*t35 + t61*c1 + t66*s1) + qd5*(t34*t56 + t37*t53 + t65*t8 - t60*t13), batch),  # 2
-        xp.broadcast_to(t49*qd1 + t50*qd1 + t55*qd1 + qd5*(t56*c234 - t13*qd1) + qd6*(t3*t59 - t57*t21), batch),  # 3
-        xp.broadcast_to(t46*qd1 + t47*qd1 + t52*qd1 + qd5*(t53*c234 + t8*qd1) + qd6*(t6*t59 + t54*t21), batch),  # 4
+        xp.broadcast_to(-qd2*(t73*c1 + t77*qd1) - qd3*(t72*c1 + t78*qd1 + t41*t49) - qd4*(t43*t51 + t71*c1 + t32*qd1) + qd5*(-t37*qd1 - t45*t56 + t37*t58 + t70*t13) - t69*qd1, batch),  # 0
+        xp.broadcast_to(t64*qd1 + qd2*(-t73*s1 + t76*qd1) - qd3*(t72*s1 + t41*t46 - t23*c1*qd1) - qd4*(t43*t48 + t71*s1 - t22*c1*qd1) - qd5*(t45*t53 - t34*qd1 + t34*t58 + t70*t8), batch),  # 1
+        xp.broadcast_to(qd2*(t63*c1 + t68*s1) + qd3*(t62*c1 + t67*s1 + t80*c1**2 + t80*s1**2) + qd4*(t61*c1 + t66*s1 + t48*t32 + t51*t35) + qd5*(t34*t56 + t37*t53 + t65*t8 - t60*t13), batch),  # 2
+        xp.broadcast_to(qd5*(t56*c234 - t13*qd1) + qd6*(t3*t59 - t57*t21) + t49*qd1 + t50*qd1 + t55*qd1, batch),  # 3
+        xp.broadcast_to(qd5*(t53*c234 + t8*qd1) + qd6*(t6*t59 + t54*t21) + t46*qd1 + t47*qd1 + t52*qd1, batch),  # 4
         xp.broadcast_to(qd4*(t51*s1 - t48*c1) + qd5*(t53*t13 + t56*t8) - qd6*(t6*t57 + t3*t54), batch),  # 5
     ], (6,))
     return T, J, a
@@ -806,7 +806,7 @@ def jacobian_dot(q, q_dot):
     s5 = trig[..., 9]
     t0 = c234*s5
     t1 = c5*s1 - t0*c1
-    t2 = t0*s1 + c1*c5
+    t2 = c1*c5 + t0*s1
     t3 = 0.09465*s234
     t4 = 0.0823*t1 + t3*c1
     t5 = -0.0823*t2 + t3*s1
@@ -814,7 +814,7 @@ def jacobian_dot(q, q_dot):
     t7 = t5 - 0.10915*c1
     t8 = t6*c1 + t7*s1
     t9 = s234*s5
-    t10 = 0.0823*t9 + 0.09465*c234
+    t10 = 0.09465*c234 + 0.0823*t9
     t11 = t10 + 0.39225*s23
     t12 = t11 + 0.425*s2
     t13 = 0.39225*c23
@@ -827,7 +827,7 @@ def jacobian_dot(q, q_dot):
     t20 = t18*c1 + t19*s1
     t21 = t10*s234
     t22 = t5*c234 - t21*s1
-    t23 = t21*c1 - t4*c234
+    t23 = -t4*c234 + t21*c1
     t24 = c1*s234
     t25 = s1*s234
     t26 = t5*t24 - t4*t25
@@ -856,7 +856,7 @@ def jacobian_dot(q, q_dot):
     t49 = t48 + t12*t27
     t50 = t49 + t18*qd1
     t51 = t26*qd5
-    t52 = t51 + t8*qd4
+    t52 = t8*qd4 + t51
     t53 = t52 + t16*qd3
     t54 = t53 + t20*qd2
     t55 = qd1*s1
@@ -864,16 +864,16 @@ def jacobian_dot(q, q_dot):
     t57 = t11*qd2
     Jd = _stack(xp, [
         xp.broadcast_to(-t50, batch),  # 0, 0
-        xp.broadcast_to(-(t12*t55 + t54*c1), batch),  # 0, 1
-        xp.broadcast_to(-(t11*t55 + t16*t30 + t53*c1), batch),  # 0, 2
-        xp.broadcast_to(-(t10*t55 + t8*t32 + t52*c1), batch),  # 0, 3
-        xp.broadcast_to(t23*t39 + t51*t25 - t23*qd1 - t26*t37, batch),  # 0, 4
+        xp.broadcast_to(-(t54*c1 + t12*t55), batch),  # 0, 1
+        xp.broadcast_to(-(t53*c1 + t11*t55 + t16*t30), batch),  # 0, 2
+        xp.broadcast_to(-(t8*t32 + t52*c1 + t10*t55), batch),  # 0, 3
+        xp.broadcast_to(-t23*qd1 - t26*t37 + t23*t39 + t51*t25, batch),  # 0, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5
         xp.broadcast_to(t45, batch),  # 1, 0
-        xp.broadcast_to(t12*t56 - t54*s1, batch),  # 1, 1
-        xp.broadcast_to(-(t16*t27 + t53*s1 - t11*c1*qd1), batch),  # 1, 2
+        xp.broadcast_to(-t54*s1 + t12*t56, batch),  # 1, 1
+        xp.broadcast_to(-(t53*s1 + t16*t27 - t11*c1*qd1), batch),  # 1, 2
         xp.broadcast_to(-(t8*t29 + t52*s1 - t10*c1*qd1), batch),  # 1, 3
-        xp.broadcast_to(-(t22*t39 + t26*t34 + t51*t24 - t22*qd1), batch),  # 1, 4
+        xp.broadcast_to(-(t26*t34 - t22*qd1 + t22*t39 + t51*t24), batch),  # 1, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
         xp.broadcast_to(t44*c1 + t49*s1, batch),  # 2, 1
@@ -929,7 +929,7 @@ def bias_acceleration(q, q_dot):
     s5 = trig[..., 9]
     t0 = c234*s5
     t1 = c5*s1 - t0*c1
-    t2 = t0*s1 + c1*c5
+    t2 = c1*c5 + t0*s1
     t3 = 0.09465*s234
     t4 = 0.0823*t1 + t3*c1
     t5 = -0.0823*t2 + t3*s1
@@ -937,7 +937,7 @@ def bias_acceleration(q, q_dot):
     t7 = t5 - 0.10915*c1
     t8 = t6*c1 + t7*s1
     t9 = s234*s5
-    t10 = 0.0823*t9 + 0.09465*c234
+    t10 = 0.09465*c234 + 0.0823*t9
     t11 = t10 + 0.39225*s23
     t12 = t11 + 0.425*s2
     t13 = 0.39225*c23
@@ -950,7 +950,7 @@ def bias_acceleration(q, q_dot):
     t20 = t18*c1 + t19*s1
     t21 = t10*s234
     t22 = t5*c234 - t21*s1
-    t23 = t21*c1 - t4*c234
+    t23 = -t4*c234 + t21*c1
     t24 = c1*s234
     t25 = s1*s234
     t26 = t5*t24 - t4*t25
@@ -979,17 +979,17 @@ def bias_acceleration(q, q_dot):
     t49 = t48 + t12*t27
     t50 = t49 + t18*qd1
     t51 = t26*qd5
-    t52 = t51 + t8*qd4
+    t52 = t8*qd4 + t51
     t53 = t52 + t16*qd3
     t54 = t53 + t20*qd2
     t55 = qd1*s1
     t56 = t11*qd2
     a = _stack(xp, [
-        xp.broadcast_to(qd5*(t23*t39 + t51*t25 - t23*qd1 - t26*t37) - t50*qd1 - qd2*(t12*t55 + t54*c1) - qd3*(t11*t55 + t16*t30 + t53*c1) - qd4*(t10*t55 + t8*t32 + t52*c1), batch),  # 0
-        xp.broadcast_to(t45*qd1 + qd2*(-t54*s1 + t12*c1*qd1) - qd3*(t16*t27 + t53*s1 - t11*c1*qd1) - qd4*(t8*t29 + t52*s1 - t10*c1*qd1) - qd5*(t22*t39 + t26*t34 + t51*t24 - t22*qd1), batch),  # 1
+        xp.broadcast_to(-qd2*(t54*c1 + t12*t55) - qd3*(t53*c1 + t11*t55 + t16*t30) - qd4*(t8*t32 + t52*c1 + t10*t55) + qd5*(-t23*qd1 - t26*t37 + t23*t39 + t51*t25) - t50*qd1, batch),  # 0
+        xp.broadcast_to(t45*qd1 + qd2*(-t54*s1 + t12*c1*qd1) - qd3*(t53*s1 + t16*t27 - t11*c1*qd1) - qd4*(t8*t29 + t52*s1 - t10*c1*qd1) - qd5*(t26*t34 - t22*qd1 + t22*t39 + t51*t24), batch),  # 1
         xp.broadcast_to(qd2*(t44*c1 + t49*s1) + qd3*(t43*c1 + t48*s1 + t56*c1**2 + t56*s1**2) + qd4*(t42*c1 + t47*s1 + t10*t29*s1 + t10*t32*c1) + qd5*(t22*t37 + t23*t34 + t46*t24 - t41*t25), batch),  # 2
-        xp.broadcast_to(t30*qd1 + t31*qd1 + t36*qd1 + qd5*(t37*c234 - t25*qd1) + qd6*(t2*t40 - t38*t9), batch),  # 3
-        xp.broadcast_to(t33*qd1 + t27*qd1 + t28*qd1 + qd5*(t34*c234 + t24*qd1) + qd6*(t1*t40 + t35*t9), batch),  # 4
+        xp.broadcast_to(qd5*(t37*c234 - t25*qd1) + qd6*(t2*t40 - t38*t9) + t30*qd1 + t31*qd1 + t36*qd1, batch),  # 3
+        xp.broadcast_to(qd5*(t34*c234 + t24*qd1) + qd6*(t1*t40 + t35*t9) + t27*qd1 + t28*qd1 + t33*qd1, batch),  # 4
         xp.broadcast_to(qd4*(t32*s1 - t29*c1) + qd5*(t34*t25 + t37*t24) - qd6*(t1*t38 + t2*t35), batch),  # 5
     ], (6,))
     return a
@@ -1040,7 +1040,7 @@ def task_jacobian_dot(q, q_dot):
     t16 = t14 - 0.10915*c1
     t17 = t15*c1 + t16*s1
     t18 = s234*s5
-    t19 = 0.0823*t18 + 0.09465*c234
+    t19 = 0.09465*c234 + 0.0823*t18
     t20 = t19 + 0.39225*s23
     t21 = t20 + 0.425*s2
     t22 = 0.39225*c23
@@ -1053,7 +1053,7 @@ def task_jacobian_dot(q, q_dot):
     t29 = t27*c1 + t28*s1
     t30 = t19*s234
     t31 = t14*c234 - t30*s1
-    t32 = t30*c1 - t13*c234
+    t32 = -t13*c234 + t30*c1
     t33 = c1*s234
     t34 = s1*s234
     t35 = t14*t33 - t13*t34
@@ -1077,7 +1077,7 @@ def task_jacobian_dot(q, q_dot):
     t53 = t46 + t52
     t54 = t38 + t45 + t52 + t7*qd6
     t55 = t34*qd5
-    t56 = t55 - t49
+    t56 = -t49 + t55
     t57 = t7*t56 + t4*t53
     t58 = t42 + t48 - t55 + t4*qd6
     t59 = t10*t58 + t11*t54
@@ -1085,7 +1085,7 @@ def task_jacobian_dot(q, q_dot):
     t61 = qd1 - t60
     t62 = t4*t61 - t56*t18
     t63 = t7*t61 + t53*t18
-    t64 = t60 - qd1 + t18*qd6
+    t64 = -qd1 + t60 + t18*qd6
     t65 = t11*t64 - t0*t58
     t66 = t10*t64 + t0*t54
     t67 = t31*qd5
@@ -1102,70 +1102,70 @@ def task_jacobian_dot(q, q_dot):
     t78 = t68*c1 + t73*s1 + t19*t39*s1 + t19*t43*c1
     t79 = t31*t49 + t32*t46 + t33*t72 - t34*t67
     t80 = t35*qd5
-    t81 = t80 + t17*qd4
+    t81 = t17*qd4 + t80
     t82 = t81 + t25*qd3
     t83 = t82 + t29*qd2
-    t84 = t32*t60 + t34*t80 - t32*qd1 - t35*t49
-    t85 = t31*t60 + t35*t46 + t33*t80 - t31*qd1
+    t84 = -t32*qd1 - t35*t49 + t32*t60 + t34*t80
+    t85 = t35*t46 - t31*qd1 + t31*t60 + t33*t80
     t86 = qd1*s1
-    t87 = t21*t86 + t83*c1
-    t88 = t20*t86 + t25*t40 + t82*c1
-    t89 = t19*t86 + t17*t43 + t81*c1
+    t87 = t83*c1 + t21*t86
+    t88 = t82*c1 + t20*t86 + t25*t40
+    t89 = t17*t43 + t81*c1 + t19*t86
     t90 = c1*qd1
-    t91 = t21*t90 - t83*s1
-    t92 = t25*t36 + t82*s1 - t20*t90
+    t91 = -t83*s1 + t21*t90
+    t92 = t82*s1 + t25*t36 - t20*t90
     t93 = t17*t39 + t81*s1 - t19*t90
     t94 = t20*qd2
     t95 = t69*c1 + t74*s1 + t94*c1**2 + t94*s1**2
     t96 = t10**2 + t11**2
     t97 = 1/t96
-    t98 = t97*c1
-    t99 = t10*qd1
-    t100 = t97*s1
-    t101 = t11*qd1
-    t102 = t10*s1
-    t103 = t11*c1
-    t104 = t102 - t103
-    t105 = 2/t96**2
-    t106 = t104*t105
-    t107 = t10*t106
-    t108 = t11*t106
-    t109 = t66*(t98 + t108) + t65*(t100 - t107) + t98*t99 + t100*t101
-    t110 = t10*t97
-    t111 = t50*t110
-    t112 = t11*t97
-    t113 = t47*t112
-    t114 = t98*s234
-    t115 = t10*c1
-    t116 = t11*s1
-    t117 = t115*s234 + t116*s234
-    t118 = t105*t117
-    t119 = t10*t118
-    t120 = t100*s234
-    t121 = t11*t118
-    t122 = t62*t110
-    t123 = t63*t112
-    t124 = t7*t97
-    t125 = t7*t10 - t4*t11
-    t126 = t105*t125
-    t127 = t10*t126
-    t128 = t4*t97
-    t129 = t11*t126
+    t98 = s1*t97
+    t99 = t10*s1
+    t100 = t11*c1
+    t101 = t99 - t100
+    t102 = 2/t96**2
+    t103 = t101*t102
+    t104 = t10*t103
+    t105 = c1*t97
+    t106 = t11*t103
+    t107 = t10*qd1
+    t108 = t11*qd1
+    t109 = t65*(t98 - t104) + t66*(t105 + t106) + t105*t107 + t98*t108
+    t110 = t105*s234
+    t111 = t10*c1
+    t112 = t11*s1
+    t113 = t111*s234 + t112*s234
+    t114 = t102*t113
+    t115 = t10*t114
+    t116 = t98*s234
+    t117 = t11*t114
+    t118 = t10*t97
+    t119 = t50*t118
+    t120 = t11*t97
+    t121 = t47*t120
+    t122 = t7*t97
+    t123 = t7*t10 - t4*t11
+    t124 = t102*t123
+    t125 = t10*t124
+    t126 = t4*t97
+    t127 = t11*t124
+    t128 = t62*t118
+    t129 = t63*t120
     t130 = 1/xp.sqrt(t96)
-    t131 = t130*qd1
-    t132 = t130*c1
-    t133 = 1/t96**1.5
-    t134 = -t133*(t115 + t116)
-    t135 = t130*s1
-    t136 = t66*(t135 + t11*t134) + t102*t131 - t65*(t132 + t10*t134) - t103*t131
-    t137 = t10*t130
-    t138 = t11*t130
-    t139 = t133*(t102*s234 - t103*s234)
-    t140 = -t133*(t7*t11 + t4*t10)
-    t141 = t0*t98
-    t142 = t0*t100
+    t131 = c1*t130
+    t132 = 1/t96**1.5
+    t133 = -t132*(t111 + t112)
+    t134 = s1*t130
+    t135 = t130*qd1
+    t136 = -t65*(t131 + t10*t133) + t66*(t134 + t11*t133) + t99*t135 - t100*t135
+    t137 = t132*(t99*s234 - t100*s234)
+    t138 = t10*t130
+    t139 = t11*t130
+    t140 = -t132*(t7*t11 + t4*t10)
+    t141 = t0*t105
+    t142 = t0*t98
     t143 = t59*t97
-    t144 = t66*(t141 + t0*t108) + t99*t141 + t101*t142 + t104*t143 - t65*(-t142 + t0*t107)
+    t144 = t66*(t141 + t0*t106) - t65*(-t142 + t0*t104) + t101*t143 + t107*t141 + t108*t142
     t145 = -t144
     Jd = _stack(xp, [
         xp.broadcast_to(-t76, batch),  # 0, 0
@@ -1190,20 +1190,20 @@ def task_jacobian_dot(q, q_dot):
         xp.broadcast_to(t109, batch),  # 3, 1
         xp.broadcast_to(t109, batch),  # 3, 2
         xp.broadcast_to(t109, batch),  # 3, 3
-        xp.broadcast_to(t111 + t113 + t65*(t114 - t119) - t66*(t120 - t121), batch),  # 3, 4
-        xp.broadcast_to(t122 + t123 + t66*(t128 + t129) + t65*(t124 - t127), batch),  # 3, 5
+        xp.broadcast_to(t65*(t110 - t115) - t66*(t116 - t117) + t119 + t121, batch),  # 3, 4
+        xp.broadcast_to(t65*(t122 - t125) + t66*(t126 + t127) + t128 + t129, batch),  # 3, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
         xp.broadcast_to(t136, batch),  # 4, 1
         xp.broadcast_to(t136, batch),  # 4, 2
         xp.broadcast_to(t136, batch),  # 4, 3
-        xp.broadcast_to(t66*(t11*t139 + t132*s234) + t47*t137 + t65*(t135*s234 - t10*t139) - t50*t138, batch),  # 4, 4
-        xp.broadcast_to(t66*(t7*t130 + t11*t140) + t63*t137 - t62*t138 - t65*(t4*t130 + t10*t140), batch),  # 4, 5
+        xp.broadcast_to(t65*(t134*s234 - t10*t137) + t66*(t11*t137 + t131*s234) + t47*t138 - t50*t139, batch),  # 4, 4
+        xp.broadcast_to(-t65*(t4*t130 + t10*t140) + t66*(t7*t130 + t11*t140) + t63*t138 - t62*t139, batch),  # 4, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 0
         xp.broadcast_to(t145, batch),  # 5, 1
         xp.broadcast_to(t145, batch),  # 5, 2
         xp.broadcast_to(-(t144 - t44), batch),  # 5, 3
-        xp.broadcast_to(-(-t51 + t66*(t0*t121 - t0*t120) + t0*t111 + t0*t113 + t117*t143 - t65*(t0*t119 - t0*t114)), batch),  # 5, 4
-        xp.broadcast_to(-(t57 + t66*(t0*t128 + t0*t129) + t0*t122 + t0*t123 + t125*t143 - t65*(t0*t127 - t0*t124)), batch),  # 5, 5
+        xp.broadcast_to(-(-t51 + t66*(-t0*t116 + t0*t117) - t65*(-t0*t110 + t0*t115) + t113*t143 + t0*t119 + t0*t121), batch),  # 5, 4
+        xp.broadcast_to(-(t57 + t66*(t0*t126 + t0*t127) - t65*(-t0*t122 + t0*t125) + t123*t143 + t0*t128 + t0*t129), batch),  # 5, 5
     ], (6, 6))
     return Jd
 
@@ -1232,12 +1232,12 @@ def hessian(q):
     t3 = c1*c234
     t4 = c5*s1 - t3*s5
     t5 = c234*s1
-    t6 = t5*s5 + c1*c5
+    t6 = c1*c5 + t5*s5
     t7 = c1*s234
     t8 = 0.0823*t4 + 0.09465*t7
     t9 = t8 + 0.10915*s1
     t10 = s1*s234
-    t11 = 0.09465*t10 - 0.0823*t6
+    t11 = -0.0823*t6 + 0.09465*t10
     t12 = t11 - 0.10915*c1
     t13 = t9*c1 + t12*s1
     t14 = t11*t7 - t8*t10
@@ -1252,7 +1252,7 @@ def hessian(q):
     t23 = t0*s1
     t24 = t11*c234 - t23*s234
     t25 = t0*c1
-    t26 = t25*s234 - t8*c234
+    t26 = -t8*c234 + t25*s234
     t27 = -t2*s1
     t28 = -t1*s1
     t29 = -t23
@@ -1272,7 +1272,7 @@ def hessian(q):
     t43 = t24*c1 + t26*s1
     t44 = t7*s5
     t45 = t10*s5
-    t46 = t39*s234 + t40*s234
+    t46 = s234*t39 + s234*t40
     t47 = t4*c1 - t6*s1
     t48 = s5*s234**2
     H = _stack(xp, [
@@ -1449,7 +1449,7 @@ def hessian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 4, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 4, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 4, 4
-        t48*c1 - t4*c234,  # 4, 4, 5
+        -t4*c234 + t48*c1,  # 4, 4, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 5, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 5, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 5, 2
@@ -1507,14 +1507,14 @@ def singularity_factors(q):
     c4 = trig[..., 6]
     s4 = trig[..., 7]
     s5 = trig[..., 9]
-    t0 = c2*c3
-    t1 = s2*s3
+    t0 = s2*s3
+    t1 = c2*c3
     t2 = 0.22270588235294117*s4
     t3 = 0.22270588235294117*c4
     f = _stack(xp, [
         s3,  # 0
         s5,  # 1
-        -c2 + 0.9229411764705883*t1 - 0.9229411764705883*t0 + t0*t2 - t1*t2 + t3*c2*s3 + t3*c3*s2,  # 2
+        -c2 + 0.9229411764705883*t0 - 0.9229411764705883*t1 + t1*t2 + t3*c2*s3 + t3*c3*s2 - t0*t2,  # 2
     ], (3,))
     return f
 
@@ -1530,11 +1530,11 @@ def manipulability(q):
     c4 = trig[..., 6]
     s4 = trig[..., 7]
     s5 = trig[..., 9]
-    t0 = c2*c3
-    t1 = s2*s3
+    t0 = s2*s3
+    t1 = c2*c3
     t2 = 0.22270588235294117*s4
     t3 = 0.22270588235294117*c4
-    t4 = 0.07085015625*s3*s5*(-c2 + 0.9229411764705883*t1 - 0.9229411764705883*t0 + t0*t2 - t1*t2 + t3*c2*s3 + t3*c3*s2)
+    t4 = 0.07085015625*s3*s5*(-c2 + 0.9229411764705883*t0 - 0.9229411764705883*t1 + t1*t2 + t3*c2*s3 + t3*c3*s2 - t0*t2)
     w = xp.broadcast_to(xp.abs(t4), batch)
     return w
 
@@ -1550,11 +1550,11 @@ def jacobian_det(q):
     c4 = trig[..., 6]
     s4 = trig[..., 7]
     s5 = trig[..., 9]
-    t0 = c2*c3
-    t1 = s2*s3
+    t0 = s2*s3
+    t1 = c2*c3
     t2 = 0.22270588235294117*s4
     t3 = 0.22270588235294117*c4
-    d = xp.broadcast_to(0.07085015625*s3*s5*(-c2 + 0.9229411764705883*t1 - 0.9229411764705883*t0 + t0*t2 - t1*t2 + t3*c2*s3 + t3*c3*s2), batch)
+    d = xp.broadcast_to(0.07085015625*s3*s5*(-c2 + 0.9229411764705883*t0 - 0.9229411764705883*t1 + t1*t2 + t3*c2*s3 + t3*c3*s2 - t0*t2), batch)
     return d
 
 
@@ -1591,17 +1591,17 @@ def velocity_ik(q, mu_dot, damping=0.0):
     s5 = trig[..., 9]
     t0 = c234*s5
     t1 = c5*s1 - t0*c1
-    t2 = t0*s1 + c1*c5
+    t2 = c1*c5 + t0*s1
     t3 = c1*s234
     t4 = 0.0823*t1 + 0.09465*t3
     t5 = t4 + 0.10915*s1
     t6 = s1*s234
-    t7 = 0.09465*t6 - 0.0823*t2
+    t7 = -0.0823*t2 + 0.09465*t6
     t8 = t7 - 0.10915*c1
     t9 = t5*c1 + t8*s1
     t10 = t7*t3 - t4*t6
     t11 = s234*s5
-    t12 = 0.0823*t11 + 0.09465*c234
+    t12 = 0.09465*c234 + 0.0823*t11
     t13 = t12 + 0.39225*s23
     t14 = t13 + 0.425*s2
     t15 = t1*t11 + t3*c234
@@ -1618,7 +1618,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t26 = t7*c234 - t25*s234
     t27 = t23 + t26*c234
     t28 = t12*c1
-    t29 = t28*s234 - t4*c234
+    t29 = -t4*c234 + t28*s234
     t30 = t22 - t29*c234
     t31 = t23**2
     t32 = t12**2
@@ -1626,15 +1626,15 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t34 = t12*t33 + t13*t33 + t14*t33 - t26*t6
     t35 = t13**2
     t36 = t14**2
-    t37 = t26**2 + t33*t35 + t33*t36 + t33*t32
+    t37 = t26**2 + t35*t33 + t36*t33 + t32*t33
     t38 = t37 + t31
     t39 = c1*s1
-    t40 = t26*t29 + t35*t39 + t36*t39 + t39*t32 - t22*t23
+    t40 = t26*t29 - t22*t23 + t39*t32 + t35*t39 + t36*t39
     t41 = t9*c1
     t42 = t20*c1
     t43 = t24*c1
-    t44 = t12*t41 + t13*t42 + t14*t43 + t26*t10
-    t45 = t41 + t42 + t43 - t10*t6
+    t44 = t26*t10 + t12*t41 + t13*t42 + t14*t43
+    t45 = t43 + t42 + t41 - t10*t6
     t46 = t13*c1
     t47 = t14*c1
     t48 = t46*s1 + t47*s1 + t28*s1
@@ -1643,16 +1643,16 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t51 = t22**2
     t52 = s1**2
     t53 = t12*t52 + t13*t52 + t14*t52 + t29*t3
-    t54 = t29**2 + t35*t52 + t36*t52 + t52*t32
+    t54 = t29**2 + t35*t52 + t36*t52 + t32*t52
     t55 = t51 + t54
     t56 = t9*s1
     t57 = t20*s1
     t58 = t24*s1
-    t59 = t12*t56 + t13*t57 + t14*t58 + t29*t10
-    t60 = t56 + t57 + t58 + t10*t3
+    t59 = t29*t10 + t12*t56 + t13*t57 + t14*t58
+    t60 = t58 + t57 + t56 + t10*t3
     t61 = t24**2
     t62 = t10**2
-    t63 = t61 + t62 + t20**2 + t9**2
+    t63 = t61 + t20**2 + t9**2 + t62
     t64 = t63
     t65 = s234**2
     t66 = t1**2 + 3*t52 + t33*t65
@@ -1664,125 +1664,125 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t72 = c234**2
     t73 = 1 + t72 + t65*s5**2
     t74 = t73
-    t75 = t40**2
-    t76 = t27**2
-    t77 = t44**2
-    t78 = t49**2
-    t79 = t34**2
-    t80 = damping**2
-    t81 = t38 + t80
-    t82 = t81**2
-    t83 = xp.sqrt(t75 + t76 + t77 + t78 + t79 + t82)
-    t84 = t83*xp.where(xp.greater_equal(t81, 0), xp.asarray(1, dtype=dtype), -1)
-    t85 = t84 + t81
-    t86 = xp.where(xp.greater(t83, 0), 1/(t83*(t83 + xp.abs(t81))), 0)
-    t87 = t86*(t40*mu_dot1 + t44*mu_dot2 + t49*mu_dot3 + t85*mu_dot0 - t27*mu_dot5 - t34*mu_dot4)
-    t88 = mu_dot0 - t85*t87
-    t89 = mu_dot1 - t40*t87
-    t90 = mu_dot2 - t44*t87
-    t91 = mu_dot3 - t49*t87
-    t92 = mu_dot4 + t34*t87
-    t93 = mu_dot5 + t27*t87
-    t94 = t55 + t80
-    t95 = t86*(t40*t85 + t40*t94 + t44*t59 + t49*t53 + t34*t50 - t27*t30)
-    t96 = t40 - t85*t95
-    t97 = t94 - t40*t95
-    t98 = t59 - t44*t95
-    t99 = t53 - t49*t95
-    t100 = -t50 + t34*t95
-    t101 = t30 + t27*t95
-    t102 = xp.sqrt(t97**2 + t98**2 + t99**2 + t100**2 + t101**2)
-    t103 = t102*xp.where(xp.greater_equal(t97, 0), xp.asarray(1, dtype=dtype), -1)
-    t104 = t97 + t103
-    t105 = xp.where(xp.greater(t102, 0), 1/(t102*(t102 + xp.abs(t97))), 0)
-    t106 = t105*(t98*t90 + t99*t91 + t100*t92 + t101*t93 + t89*t104)
-    t107 = t89 - t104*t106
-    t108 = t90 - t98*t106
-    t109 = t91 - t99*t106
-    t110 = t92 - t100*t106
-    t111 = t93 - t101*t106
-    t112 = t64 + t80
-    t113 = t67 + t80
-    t114 = t86*(t40*t53 + t27*t15 + t44*t60 + t49*t85 + t49*t113 + t34*t69)
-    t115 = t49 - t85*t114
-    t116 = t53 - t40*t114
-    t117 = t60 - t44*t114
-    t118 = t113 - t49*t114
-    t119 = -t69 + t34*t114
-    t120 = -t15 + t27*t114
-    t121 = t105*(t98*t117 + t99*t118 + t100*t119 + t101*t120 + t116*t104)
-    t122 = t116 - t104*t121
-    t123 = t117 - t98*t121
-    t124 = t118 - t99*t121
-    t125 = t119 - t100*t121
-    t126 = t120 - t101*t121
-    t127 = t71 + t80
-    t128 = -t86*(t40*t50 + t27*t16 + t44*t45 + t49*t69 + t34*t85 + t34*t127)
-    t129 = t34 + t85*t128
-    t130 = t50 + t40*t128
-    t131 = t45 + t44*t128
-    t132 = t69 + t49*t128
-    t133 = t127 + t34*t128
-    t134 = t16 + t27*t128
-    t135 = -t105*(t98*t131 + t99*t132 + t130*t104 - t100*t133 - t101*t134)
-    t136 = t130 + t104*t135
-    t137 = t131 + t98*t135
-    t138 = t132 + t99*t135
-    t139 = t133 - t100*t135
-    t140 = t134 - t101*t135
-    t141 = t74 + t80
-    t142 = xp.sqrt(t82 + t94**2 + t112**2 + t113**2 + t127**2 + t141**2 + 2*t75 + 2*t76 + 2*t77 + 2*t78 + 2*t79 + 2*t30**2 + 2*t59**2 + 2*t53**2 + 2*t50**2 + 2*t60**2 + 2*t45**2 + 2*t69**2 + 2*t15**2 + 2*t16**2 + 2*t62*t72)
+    t75 = damping**2
+    t76 = t38 + t75
+    t77 = t76**2
+    t78 = t55 + t75
+    t79 = t64 + t75
+    t80 = t67 + t75
+    t81 = t71 + t75
+    t82 = t74 + t75
+    t83 = t40**2
+    t84 = t27**2
+    t85 = t44**2
+    t86 = t49**2
+    t87 = t34**2
+    t88 = xp.sqrt(t77 + t78**2 + t79**2 + t80**2 + t81**2 + t82**2 + 2*t83 + 2*t84 + 2*t85 + 2*t86 + 2*t87 + 2*t30**2 + 2*t59**2 + 2*t53**2 + 2*t50**2 + 2*t60**2 + 2*t45**2 + 2*t69**2 + 2*t15**2 + 2*t16**2 + 2*t62*t72)
+    t89 = xp.sqrt(t83 + t84 + t85 + t86 + t87 + t77)
+    t90 = t89*xp.where(xp.greater_equal(t76, 0), xp.asarray(1, dtype=dtype), -1)
+    t91 = t90 + t76
+    t92 = xp.where(xp.greater(t89, 0), 1/(t89*(t89 + xp.abs(t76))), 0)
+    t93 = t92*(t40*t91 + t40*t78 + t44*t59 + t49*t53 + t34*t50 - t27*t30)
+    t94 = t40 - t91*t93
+    t95 = t78 - t40*t93
+    t96 = t59 - t44*t93
+    t97 = t53 - t49*t93
+    t98 = -t50 + t34*t93
+    t99 = t30 + t27*t93
+    t100 = t92*(t40*t53 + t27*t15 + t44*t60 + t49*t91 + t49*t80 + t34*t69)
+    t101 = t49 - t91*t100
+    t102 = t53 - t40*t100
+    t103 = t60 - t44*t100
+    t104 = t80 - t49*t100
+    t105 = -t69 + t34*t100
+    t106 = -t15 + t27*t100
+    t107 = -t92*(t40*t50 + t27*t16 + t44*t45 + t49*t69 + t34*t91 + t34*t81)
+    t108 = t34 + t91*t107
+    t109 = t50 + t40*t107
+    t110 = t45 + t44*t107
+    t111 = t69 + t49*t107
+    t112 = t81 + t34*t107
+    t113 = t16 + t27*t107
+    t114 = t92*(t40*mu_dot1 + t44*mu_dot2 + t49*mu_dot3 + t91*mu_dot0 - t27*mu_dot5 - t34*mu_dot4)
+    t115 = mu_dot0 - t91*t114
+    t116 = mu_dot1 - t40*t114
+    t117 = mu_dot2 - t44*t114
+    t118 = mu_dot3 - t49*t114
+    t119 = mu_dot4 + t34*t114
+    t120 = mu_dot5 + t27*t114
+    t121 = xp.sqrt(t95**2 + t96**2 + t97**2 + t98**2 + t99**2)
+    t122 = t121*xp.where(xp.greater_equal(t95, 0), xp.asarray(1, dtype=dtype), -1)
+    t123 = t95 + t122
+    t124 = xp.where(xp.greater(t121, 0), 1/(t121*(t121 + xp.abs(t95))), 0)
+    t125 = t124*(t96*t103 + t97*t104 + t98*t105 + t99*t106 + t102*t123)
+    t126 = t102 - t123*t125
+    t127 = t103 - t96*t125
+    t128 = t104 - t97*t125
+    t129 = t105 - t98*t125
+    t130 = t106 - t99*t125
+    t131 = -t124*(t96*t110 + t97*t111 + t109*t123 - t98*t112 - t99*t113)
+    t132 = t109 + t123*t131
+    t133 = t110 + t96*t131
+    t134 = t111 + t97*t131
+    t135 = t112 - t98*t131
+    t136 = t113 - t99*t131
+    t137 = t124*(t96*t117 + t97*t118 + t98*t119 + t99*t120 + t116*t123)
+    t138 = t116 - t123*t137
+    t139 = t117 - t96*t137
+    t140 = t118 - t97*t137
+    t141 = t119 - t98*t137
+    t142 = t120 - t99*t137
     t143 = t10*c234
-    t144 = t86*(t40*t59 + t27*t143 + t44*t85 + t44*t112 + t49*t60 + t34*t45)
-    t145 = t44 - t85*t144
+    t144 = t92*(t40*t59 + t44*t91 + t44*t79 + t49*t60 + t34*t45 + t27*t143)
+    t145 = t44 - t91*t144
     t146 = t59 - t40*t144
-    t147 = t112 - t44*t144
+    t147 = t79 - t44*t144
     t148 = t60 - t49*t144
     t149 = -t45 + t34*t144
-    t150 = -t143 + t27*t144
-    t151 = -t86*(t27*t85 + t27*t141 + t44*t143 + t49*t15 + t34*t16 - t40*t30)
-    t152 = t27 + t85*t151
+    t150 = t27*t144 - t143
+    t151 = -t92*(t27*t91 + t27*t82 + t49*t15 + t34*t16 - t40*t30 + t44*t143)
+    t152 = t27 + t91*t151
     t153 = t30 - t40*t151
-    t154 = t143 + t44*t151
+    t154 = t44*t151 + t143
     t155 = t15 + t49*t151
     t156 = t16 + t34*t151
-    t157 = t141 + t27*t151
-    t158 = t105*(t98*t147 + t99*t148 + t100*t149 + t101*t150 + t146*t104)
-    t159 = t146 - t104*t158
-    t160 = t147 - t98*t158
-    t161 = t148 - t99*t158
-    t162 = t149 - t100*t158
-    t163 = t150 - t101*t158
-    t164 = t105*(t100*t156 + t101*t157 + t153*t104 - t98*t154 - t99*t155)
-    t165 = t153 - t104*t164
-    t166 = t154 + t98*t164
-    t167 = t155 + t99*t164
-    t168 = t156 - t100*t164
-    t169 = t157 - t101*t164
+    t157 = t82 + t27*t151
+    t158 = t124*(t96*t147 + t97*t148 + t98*t149 + t99*t150 + t146*t123)
+    t159 = t146 - t123*t158
+    t160 = t147 - t96*t158
+    t161 = t148 - t97*t158
+    t162 = t149 - t98*t158
+    t163 = t150 - t99*t158
+    t164 = t124*(t98*t156 + t99*t157 + t153*t123 - t96*t154 - t97*t155)
+    t165 = t153 - t123*t164
+    t166 = t154 + t96*t164
+    t167 = t155 + t97*t164
+    t168 = t156 - t98*t164
+    t169 = t157 - t99*t164
     t170 = xp.sqrt(t160**2 + t161**2 + t162**2 + t163**2)
     t171 = t170*xp.where(xp.greater_equal(t160, 0), xp.asarray(1, dtype=dtype), -1)
     t172 = t160 + t171
     t173 = xp.where(xp.greater(t170, 0), 1/(t170*(t170 + xp.abs(t160))), 0)
-    t174 = t173*(t161*t124 + t162*t125 + t163*t126 + t123*t172)
-    t175 = t123 - t172*t174
-    t176 = t124 - t161*t174
-    t177 = t125 - t162*t174
-    t178 = t126 - t163*t174
-    t179 = t173*(t162*t139 + t163*t140 - t161*t138 - t137*t172)
-    t180 = t137 + t172*t179
-    t181 = t138 + t161*t179
-    t182 = t139 - t162*t179
-    t183 = t140 - t163*t179
+    t174 = t173*(t161*t128 + t162*t129 + t163*t130 + t127*t172)
+    t175 = t127 - t172*t174
+    t176 = t128 - t161*t174
+    t177 = t129 - t162*t174
+    t178 = t130 - t163*t174
+    t179 = t173*(t162*t135 + t163*t136 - t161*t134 - t133*t172)
+    t180 = t133 + t172*t179
+    t181 = t134 + t161*t179
+    t182 = t135 - t162*t179
+    t183 = t136 - t163*t179
     t184 = t173*(t162*t168 + t163*t169 - t161*t167 - t166*t172)
     t185 = t166 + t172*t184
     t186 = t167 + t161*t184
     t187 = t168 - t162*t184
     t188 = t169 - t163*t184
-    t189 = t173*(t161*t109 + t162*t110 + t163*t111 + t108*t172)
-    t190 = t108 - t172*t189
-    t191 = t109 - t161*t189
-    t192 = t110 - t162*t189
-    t193 = t111 - t163*t189
+    t189 = t173*(t161*t140 + t162*t141 + t163*t142 + t139*t172)
+    t190 = t139 - t172*t189
+    t191 = t140 - t161*t189
+    t192 = t141 - t162*t189
+    t193 = t142 - t163*t189
     t194 = xp.sqrt(t176**2 + t177**2 + t178**2)
     t195 = t194*xp.where(xp.greater_equal(t176, 0), xp.asarray(1, dtype=dtype), -1)
     t196 = t176 + t195
@@ -1819,11 +1819,11 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t227 = xp.where(xp.not_equal(t211, 0), -(t218 - t215*t226)/t211, 0)
     t228 = xp.where(xp.not_equal(t195, 0), -(t207 + t199*t227 + t203*t226)/t195, 0)
     t229 = xp.where(xp.not_equal(t171, 0), -(t190 + t180*t227 + t185*t226 - t175*t228)/t171, 0)
-    t230 = xp.where(xp.not_equal(t103, 0), -(t107 - (t159*t229 + t122*t228 + t165*t226 - t136*t227))/t103, 0)
-    t231 = xp.where(xp.not_equal(t84, 0), -(t88 - (t96*t230 + t145*t229 + t115*t228 - t129*t227 - t152*t226))/t84, 0)
+    t230 = xp.where(xp.not_equal(t122, 0), -(t138 - (t159*t229 + t126*t228 + t165*t226 - t132*t227))/t122, 0)
+    t231 = xp.where(xp.not_equal(t90, 0), -(t115 - (t94*t230 + t145*t229 + t101*t228 - t108*t227 - t152*t226))/t90, 0)
     t232 = t226 + t230*t22 - t231*t23
-    t233 = t227*t6 + t228*t3 + t229*t10 + t230*t29 + t231*t26 - t226*c234
-    t234 = t2*t227 + t226*t11 - t1*t228
+    t233 = t229*t10 + t230*t29 + t231*t26 - t226*c234 + t227*t6 + t228*t3
+    t234 = t2*t227 - t1*t228 + t226*t11
     t235 = t14*s1
     t236 = t228*s1 - t227*c1
     t237 = t236 + t229*t24 + t230*t235 + t231*t47
@@ -1877,7 +1877,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t285 = t264 - t272*t284
     t286 = t10 - t284*t24
     t287 = t3 - t284*s1
-    t288 = t6 + t284*c1
+    t288 = t284*c1 + t6
     t289 = -t265 + t248*t284
     t290 = t273*(t259*t272 + t24*mu_dot2 + mu_dot3*s1 - t248*t260 - c1*mu_dot4)
     t291 = t259 - t272*t290
@@ -1927,13 +1927,13 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t335 = t328 - t332*t334
     t336 = t329 - t325*t334
     t337 = t22*t267
-    t338 = t273*(t1*s1 + t2*c1 + t272*t337 - t248*t268)
-    t339 = t337 - t272*t338
+    t338 = t273*(t1*s1 + t2*c1 - t248*t268 + t272*t337)
+    t339 = -t272*t338 + t337
     t340 = t1 - t338*s1
     t341 = t268 + t248*t338
     t342 = -t2
     t343 = t342 + t338*c1
-    t344 = 1 + t1 + t22 + t26 + t29 + t24 + t20 + t9 + t10 + t3 + t46 + t47 + t6 + t235 + t239 + t246 + t261 + t266 + t25 + t342 + t28 + damping + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + q1 + q2 + q3 + q4 + q5 + q6 - t68 + 3*s1
+    t344 = 1 + t1 + t22 + t26 + t29 + t24 + t20 + t9 + t10 + damping + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + q1 + q2 + q3 + q4 + q5 + q6 + t342 + t246 + t261 - t68 + 3*s1 + t28 + t25 + t46 + t239 + t47 + t235 + t3 + t6 + t266
     t345 = t338*t24
     t346 = t302*(t277*t340 + t297*t343 + t278*t341 - t301*t345)
     t347 = t345 + t301*t346
@@ -1963,8 +1963,8 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t371 = xp.greater_equal(damping, 0)
     t372 = 1e-12*t242
     t373 = xp.greater(damping, 0)
-    t374 = 1e-12*t142
-    t375 = (t373 & (xp.less_equal(t83, t374) | xp.less_equal(t102, t374) | xp.less_equal(t170, t374) | xp.less_equal(t194, t374) | xp.less_equal(t210, t374) | xp.less_equal(t221, t374))) | (xp.less_equal(damping, 0) & (xp.less_equal(t243, t372) | xp.less_equal(t270, t372) | xp.less_equal(t299, t372) | xp.less_equal(t318, t372) | xp.less_equal(t330, t372) | xp.less_equal(t359, t372)))
+    t374 = 1e-12*t88
+    t375 = (t373 & (xp.less_equal(t89, t374) | xp.less_equal(t121, t374) | xp.less_equal(t170, t374) | xp.less_equal(t194, t374) | xp.less_equal(t210, t374) | xp.less_equal(t221, t374))) | (xp.less_equal(damping, 0) & (xp.less_equal(t243, t372) | xp.less_equal(t270, t372) | xp.less_equal(t299, t372) | xp.less_equal(t318, t372) | xp.less_equal(t330, t372) | xp.less_equal(t359, t372)))
     t376 = t370 & t371 & xp.logical_not(t375)
     q_dot = _stack(xp, [
         xp.broadcast_to(xp.where(t376, xp.where(t373, t232, t369), 0), batch),  # 0
@@ -2042,7 +2042,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t17 = s1*s234
     t18 = t8*c6 - t17*s6
     t19 = t8*s6 + t17*c6
-    t20 = 0.09465*t17 - 0.0823*t4
+    t20 = -0.0823*t4 + 0.09465*t17
     t21 = t20 - 0.10915*c1
     t22 = t13*c1 + t21*s1
     t23 = t20*t9 - t12*t17
@@ -2051,15 +2051,15 @@ def ik_numeric_step(target, q, damping=0.0):
     t26 = T21*t19 + T22*t4 - T20*t18
     t27 = 0.5*(t24 + t15)
     t28 = c5*s234
-    t29 = t28*c6 + c234*s6
+    t29 = c234*s6 + t28*c6
     t30 = c234*c6 - t28*s6
     t31 = s234*s5
-    t32 = 0.0823*t31 + 0.09465*c234
+    t32 = 0.09465*c234 + 0.0823*t31
     t33 = t32 + 0.39225*s23
     t34 = t33 + 0.425*s2
     t35 = 0.089459 - t34
     t36 = t20*c234 - t32*t17
-    t37 = t32*t9 - t12*c234
+    t37 = -t12*c234 + t32*t9
     t38 = t7*t31 + t9*c234
     t39 = t4*t31 - t17*c234
     t40 = T00*t29 + T01*t30 - T02*t31
@@ -2087,14 +2087,14 @@ def ik_numeric_step(target, q, damping=0.0):
     t62 = t32*t61 + t33*t61 + t34*t61 - t36*t17
     t63 = t33**2
     t64 = t34**2
-    t65 = t53**2 + t36**2 + t60*t61 + t61*t63 + t61*t64
+    t65 = t53**2 + t36**2 + t60*t61 + t63*t61 + t64*t61
     t66 = c1*s1
-    t67 = t36*t37 + t60*t66 + t63*t66 + t64*t66 - t52*t53
+    t67 = t36*t37 - t52*t53 + t60*t66 + t63*t66 + t64*t66
     t68 = t22*c1
     t69 = t50*c1
     t70 = t54*c1
-    t71 = t32*t68 + t33*t69 + t34*t70 + t36*t23
-    t72 = t68 + t69 + t70 - t23*t17
+    t71 = t36*t23 + t32*t68 + t33*t69 + t34*t70
+    t72 = t70 + t69 + t68 - t23*t17
     t73 = t32*t66 + t33*t66 + t34*t66
     t74 = t73 + t36*t9
     t75 = t73 - t37*t17
@@ -2104,11 +2104,11 @@ def ik_numeric_step(target, q, damping=0.0):
     t79 = t22*s1
     t80 = t50*s1
     t81 = t54*s1
-    t82 = t32*t79 + t33*t80 + t34*t81 + t37*t23
-    t83 = t79 + t80 + t81 + t23*t9
+    t82 = t37*t23 + t32*t79 + t33*t80 + t34*t81
+    t83 = t81 + t80 + t79 + t23*t9
     t84 = s234**2
     t85 = t7**2 + 3*t76 + t61*t84
-    t86 = 3*t66 + t7*t4 - t66*t84
+    t86 = t7*t4 + 3*t66 - t66*t84
     t87 = t4**2 + 3*t61 + t76*t84
     t88 = 1 + c234**2 + t84*s5**2
     t89 = -t25
@@ -2158,15 +2158,15 @@ def ik_numeric_step(target, q, damping=0.0):
     t133 = t115 - t123*t130
     t134 = t116 - t124*t130
     t135 = t117 - t125*t130
-    t136 = t23*c234
-    t137 = t57 + damping
-    t138 = t110*(t67*t82 + t55*t136 + t71*t109 + t71*t137 + t74*t83 + t62*t72)
+    t136 = t57 + damping
+    t137 = t23*c234
+    t138 = t110*(t67*t82 + t71*t109 + t71*t136 + t74*t83 + t62*t72 + t55*t137)
     t139 = t71 - t109*t138
     t140 = t82 - t67*t138
-    t141 = t137 - t71*t138
+    t141 = t136 - t71*t138
     t142 = t83 - t74*t138
     t143 = -t72 + t62*t138
-    t144 = -t136 + t55*t138
+    t144 = t55*t138 - t137
     t145 = t129*(t122*t141 + t123*t142 + t124*t143 + t125*t144 + t140*t128)
     t146 = t140 - t128*t145
     t147 = t141 - t122*t145
@@ -2240,10 +2240,10 @@ def ik_numeric_step(target, q, damping=0.0):
     t215 = t185 - t212*t214
     t216 = t186 - t209*t214
     t217 = t88 + damping
-    t218 = -t110*(t55*t109 + t55*t217 + t71*t136 + t74*t38 + t62*t39 - t67*t56)
+    t218 = -t110*(t55*t109 + t55*t217 + t74*t38 + t62*t39 - t67*t56 + t71*t137)
     t219 = t55 + t109*t218
     t220 = t56 - t67*t218
-    t221 = t136 + t71*t218
+    t221 = t71*t218 + t137
     t222 = t38 + t74*t218
     t223 = t39 + t62*t218
     t224 = t217 + t55*t218
@@ -2278,7 +2278,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t253 = xp.where(xp.not_equal(t127, 0), -(t131 - (t146*t252 + t169*t251 + t226*t249 - t196*t250))/t127, 0)
     t254 = xp.where(xp.not_equal(t108, 0), -(t112 - (t120*t253 + t139*t252 + t162*t251 - t189*t250 - t219*t249))/t108, 0)
     t255 = t249 + q1 + t52*t253 - t53*t254
-    t256 = q5 + t36*t254 + t37*t253 + t23*t252 + t250*t17 + t251*t9 - t249*c234
+    t256 = q5 + t36*t254 + t37*t253 + t23*t252 - t249*c234 + t250*t17 + t251*t9
     t257 = q6 + t7*t251 - t4*t250 - t249*t31
     t258 = t253*s1
     t259 = t254*c1
@@ -2358,7 +2358,7 @@ def ik_branches(T):
     t33 = t22*t32
     t34 = t8*t19
     t35 = t24*t34
-    t36 = xp.where(t18, 1, -(t35 + t33))
+    t36 = xp.where(t18, 1, -(t33 + t35))
     t37 = t33 - t35
     t38 = t24*t32
     t39 = t22*t34
@@ -2393,10 +2393,10 @@ def ik_branches(T):
     t68 = t67 + t64*t45
     t69 = t68 - t67
     t70 = t64**2
-    t71 = t70 + t63**2
+    t71 = t63**2 + t70
     t72 = t46**2
     t73 = t69**2 + t70*t72
-    t74 = t55 + t72 + t45**2
+    t74 = t55 + t45**2 + t72
     t75 = xp.less_equal(t73, 1e-24*t74*t71)
     t76 = xp.where(t75, 1, 1/xp.sqrt(t73))
     t77 = xp.where(t75, 1, t69*t76)
@@ -2406,9 +2406,9 @@ def ik_branches(T):
     t81 = xp.where(t75, 0, -t76*t80)
     t82 = t63*t81
     t83 = t63*t77
-    t84 = T01*t82 + T02*t79 - T00*t83
-    t85 = T11*t82 + T12*t79 - T10*t83
-    t86 = T21*t82 + T22*t79 - T20*t83
+    t84 = T02*t79 + T01*t82 - T00*t83
+    t85 = T12*t79 + T11*t82 - T10*t83
+    t86 = T22*t79 + T21*t82 - T20*t83
     t87 = t86*t52
     t88 = t36*t84 + t40*t85
     t89 = t40*t84 - t36*t85
@@ -2425,7 +2425,7 @@ def ik_branches(T):
     t100 = 0.10915*t96
     t101 = t98 + t100
     t102 = t43 + t101
-    t103 = t100 - t99
+    t103 = -t99 + t100
     t104 = t43 - t103
     t105 = 0.09465*t97
     t106 = t42 - t105
@@ -2512,10 +2512,10 @@ def ik_branches(T):
     t187 = t186 + t182*t50
     t188 = t187 - t186
     t189 = t182**2
-    t190 = t189 + t181**2
+    t190 = t181**2 + t189
     t191 = t51**2
     t192 = t188**2 + t189*t191
-    t193 = t174 + t191 + t50**2
+    t193 = t174 + t50**2 + t191
     t194 = xp.less_equal(t192, 1e-24*t193*t190)
     t195 = xp.where(t194, 1, 1/xp.sqrt(t192))
     t196 = xp.where(t194, 1, t188*t195)
@@ -2525,9 +2525,9 @@ def ik_branches(T):
     t200 = xp.where(t194, 0, -t195*t199)
     t201 = t181*t200
     t202 = t181*t196
-    t203 = T01*t201 + T02*t198 - T00*t202
-    t204 = T11*t201 + T12*t198 - T10*t202
-    t205 = T21*t201 + T22*t198 - T20*t202
+    t203 = T02*t198 + T01*t201 - T00*t202
+    t204 = T12*t198 + T11*t201 - T10*t202
+    t205 = T22*t198 + T21*t201 - T20*t202
     t206 = t205*t171
     t207 = t37*t203 + t41*t204
     t208 = t41*t203 - t37*t204
@@ -2544,7 +2544,7 @@ def ik_branches(T):
     t219 = 0.10915*t215
     t220 = t217 + t219
     t221 = t48 + t220
-    t222 = t219 - t218
+    t222 = -t218 + t219
     t223 = t48 - t222
     t224 = 0.09465*t216
     t225 = t47 - t224
@@ -2625,7 +2625,7 @@ def ik_branches(T):
     t300 = xp.where(t75, 0, xp.atan2(-t80, t69))
     t301 = t300
     t302 = t301 - 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t301))
-    t303 = 3.141592653589793 + t300 - 6.283185307179586*xp.ceil(0.15915494309189535*t300)
+    t303 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t300) + t300
     t304 = t303 - 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t303))
     t305 = xp.where(xp.less_equal(t144, t145*t290), 0, xp.atan2(-t143, t142))
     t306 = t305
@@ -2670,7 +2670,7 @@ def ik_branches(T):
     t345 = xp.where(t194, 0, xp.atan2(-t199, t188))
     t346 = t345
     t347 = t346 - 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t346))
-    t348 = 3.141592653589793 + t345 - 6.283185307179586*xp.ceil(0.15915494309189535*t345)
+    t348 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t345) + t345
     t349 = t348 - 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t348))
     t350 = xp.where(xp.less_equal(t259, t260*t335), 0, xp.atan2(-t258, t257))
     t351 = t350
