@@ -1,7 +1,7 @@
 """Arms nobody tuned jacgen for (issue 9): seeded random robots of 1 to 12 joints, each
 generated for every language and checked by `jacgen verify` against the numpy reference;
-and the same arms written in radians, whose arbitrary twists (1.2001 rad) are exact
-rationals with no closed-form cosine.
+and arms of 6, 11 and 16 joints written in radians, whose arbitrary twists (1.2001 rad) are
+exact rationals with no closed-form cosine.
 
 CI runs seeds 0 to STRESS_SEEDS - 1. A larger range runs outside CI:
 
@@ -17,10 +17,10 @@ from click.testing import CliRunner
 from jacgen.cli import main
 from random_arms import random_arm_text
 
-STRESS_SEEDS = int(os.environ.get("JACGEN_STRESS_SEEDS", "8"))
+STRESS_SEEDS = int(os.environ.get("JACGEN_STRESS_SEEDS", "30"))
 
 
-RADIAN_ARMS = [(6, 6001), (11, 11000)]  # (joints, seed): before the structure stage was bounded, 11 joints took minutes
+RADIAN_ARMS = [(6, 6001), (11, 11000), (16, 16000)]  # (joints, seed): before the structure stage was bounded, 11 joints took minutes
 
 
 @pytest.mark.parametrize("seed", range(STRESS_SEEDS))
