@@ -430,9 +430,9 @@ def analyse(robot: Robot) -> Singularities:
     kind = singularity_kind(robot)
     constant, factors, complete, note, cos_pitch_sq = ring.ring.one, [], False, "", None
     try:
-        matrix, sign, cos_pitch_sq = _analysed_matrix(ring)
-        if math.comb(max(m, n), min(m, n)) > MINOR_LIMIT:
+        if math.comb(max(m, n), min(m, n)) > MINOR_LIMIT:  # known before any polynomial is built
             raise TooLarge(f"C({max(m, n)}, {min(m, n)}) maximal minors")
+        matrix, sign, cos_pitch_sq = _analysed_matrix(ring)
         minors = maximal_minors(matrix, ring.ring.zero, ring.ring.one, ring.times)
         if all(not minor for minor in minors):
             return Singularities(kind, (), True, True, sympy.Integer(0), (), 0, (),
