@@ -6,7 +6,7 @@ import numpy
 import sympy
 
 from . import analysis, differential, ik, report
-from .functions import Call, Function, Generator, Output
+from .functions import Argument, Call, Function, Generator, Output
 from .lowering import is_boolean
 from .printers import CasadiPrinter, CPrinter, PythonPrinter
 from .robot import Robot
@@ -15,32 +15,6 @@ from .subproblems import RANK, TOLERANCES, Select
 # The contract's C array extent of each argument and output (`function.output`, or the function
 # when it has one), as factors that are numbers or the suffixes of size macros
 # (`6 * NAME_DOF`); any other function's output gets its size.
-C_EXTENTS = {
-    "q": ("DOF",),
-    "T": (16,),
-    "mu": ("TASK_DIM",),
-    "ik_branches.q": ("MAX_IK_SOLUTIONS", "DOF"),
-    "ik_branches.valid": ("MAX_IK_SOLUTIONS",),
-    "ik_branches.in_limits": ("MAX_IK_SOLUTIONS",),
-    "ik_nearest.q": ("DOF",),
-    "q_seed": ("DOF",),
-    "weights": ("DOF",),
-    "mu_dot": ("TASK_DIM",),
-    "velocity_ik.q_dot": ("DOF",),
-    "ik_numeric_step.q_start": ("DOF",),
-    "ik_numeric_step.q_next": ("DOF",),
-    "fk": (16,),
-    "jacobian": (6, "DOF"),
-    "jacobian_tool": (6, "DOF"),
-    "task": ("TASK_DIM",),
-    "task_jacobian": ("TASK_DIM", "DOF"),
-    "q_dot": ("DOF",),
-    "jacobian_dot": (6, "DOF"),
-    "bias_acceleration": (6,),
-    "task_jacobian_dot": ("TASK_DIM", "DOF"),
-    "hessian": ("DOF", 6, "DOF"),
-    "singularity_factors": ("NUM_SINGULARITY_FACTORS",),
-}
 # SPEC §3 size macros that are the row count of a function, defined when it is generated.
 C_ROW_MACROS = {"singularity_factors": "NUM_SINGULARITY_FACTORS"}
 
@@ -145,20 +119,14 @@ def _c_macros(robot: Robot, functions: list[Function]) -> dict[str, int]:
     return macros
 
 
-def _c_extent(key: str, size: int, macros: dict[str, int], prefix: str) -> str:
-    """`6 * NAME_DOF`: the contract's extent of an array, checked against its size."""
-    factors = C_EXTENTS.get(key, (16,) if size == 16 else ("TASK_DIM",) if key == "target" else (size,))
+def _c_extent(array: Argument | Output, macros: dict[str, int], prefix: str) -> str:
+    """`6 * NAME_DOF`: the catalogue's extent of an array in C macros, checked against its size."""
     product = 1
-    for factor in factors:
+    for factor in array.extent:
         product *= macros[factor] if isinstance(factor, str) else factor
-    if product != size:
-        raise ValueError(f"{key}: contract extent {factors} != {size}")
-    return " * ".join(f"{prefix}_{factor}" if isinstance(factor, str) else str(factor) for factor in factors)
-
-
-def _c_output_key(function: Function, output: Output) -> str:
-    key = f"{function.name}.{output.name}"
-    return key if key in C_EXTENTS else output.equals or function.name
+    if product != array.size:
+        raise ValueError(f"{array.name}: contract extent {array.extent} != {array.size}")
+    return " * ".join(f"{prefix}_{factor}" if isinstance(factor, str) else str(factor) for factor in array.extent)
 
 
 def _parameters_read(body, robot: Robot) -> list[str]:
@@ -173,11 +141,11 @@ def _c_type(output: Output, real: str) -> str:
 def _c_function(function: Function, robot: Robot, printer: CPrinter, macros: dict[str, int],
                 functions: dict[str, Function]) -> dict:
     body, prefix, real = function.body, robot.name.upper(), f"{robot.name}_real"
-    arguments = [f"{real} {a.name}" if a.scalar else f"const {real} {a.name}[{_c_extent(a.name, a.size, macros, prefix)}]"
+    arguments = [f"{real} {a.name}" if a.scalar else f"const {real} {a.name}[{_c_extent(a, macros, prefix)}]"
                  for a in function.arguments]
     returned = function.returned
     arrays = [o for o in function.outputs if o is not returned]
-    arguments += [f"{_c_type(o, real)} {o.name}[{_c_extent(_c_output_key(function, o), o.size, macros, prefix)}]"
+    arguments += [f"{_c_type(o, real)} {o.name}[{_c_extent(o, macros, prefix)}]"
                   for o in arrays]
     parameters = _parameters_read(body, robot)
     if robot.symbolic_parameters:
@@ -211,7 +179,7 @@ def _c_function(function: Function, robot: Robot, printer: CPrinter, macros: dic
 def _c_call(call: Call, callee: Function, robot: Robot, macros: dict[str, int]) -> dict:
     """The local arrays that receive a call's results, and the call."""
     prefix, real = robot.name.upper(), f"{robot.name}_real"
-    arrays = [f"{_c_type(output, real)} {result.name}[{_c_extent(_c_output_key(callee, output), output.size, macros, prefix)}]"
+    arrays = [f"{_c_type(output, real)} {result.name}[{_c_extent(output, macros, prefix)}]"
               for result, output in zip(call.results, callee.outputs)]
     arguments = [*call.passes, *(result.name for result in call.results)] + ["p"] * bool(robot.symbolic_parameters)
     return {"arrays": arrays, "call": f"{robot.name}_{callee.name}({', '.join(arguments)})"}

@@ -31,6 +31,41 @@ FUNCTION_NAMES = ("fk", "jacobian", "fk_jacobian", "jacobian_tool", "task", "tas
 CALLEES = {"ik": ("ik_branches",), "ik_nearest": ("ik_branches",), "ik_numeric": ("ik_numeric_step",)}
 
 
+# The contract's extent of every array, in named dimensions (C's `double J[6 * NAME_DOF]`), by
+# argument name or "function.output", else by the function an output equals or belongs to; an
+# array not listed is a pose (16) or as long as it is.
+EXTENTS = {
+    "q": ("DOF",),
+    "T": (16,),
+    "mu": ("TASK_DIM",),
+    "ik_branches.q": ("MAX_IK_SOLUTIONS", "DOF"),
+    "ik_branches.valid": ("MAX_IK_SOLUTIONS",),
+    "ik_branches.in_limits": ("MAX_IK_SOLUTIONS",),
+    "ik_nearest.q": ("DOF",),
+    "q_seed": ("DOF",),
+    "weights": ("DOF",),
+    "mu_dot": ("TASK_DIM",),
+    "velocity_ik.q_dot": ("DOF",),
+    "ik_numeric_step.q_start": ("DOF",),
+    "ik_numeric_step.q_next": ("DOF",),
+    "fk": (16,),
+    "jacobian": (6, "DOF"),
+    "jacobian_tool": (6, "DOF"),
+    "task": ("TASK_DIM",),
+    "task_jacobian": ("TASK_DIM", "DOF"),
+    "q_dot": ("DOF",),
+    "jacobian_dot": (6, "DOF"),
+    "bias_acceleration": (6,),
+    "task_jacobian_dot": ("TASK_DIM", "DOF"),
+    "hessian": ("DOF", 6, "DOF"),
+    "singularity_factors": ("NUM_SINGULARITY_FACTORS",),
+}
+
+
+def _extent(key: str, size: int) -> tuple[int | str, ...]:
+    return EXTENTS.get(key, (16,) if size == 16 else ("TASK_DIM",) if key == "target" else (size,))
+
+
 def with_callees(names) -> frozenset[str]:
     """The functions named and those they call (ValueError for a name no robot has)."""
     unknown = [name for name in names if name not in FUNCTION_NAMES]
@@ -53,6 +88,10 @@ class Argument:
     def size(self) -> int:
         return len(self.symbols)
 
+    @property
+    def extent(self) -> tuple[int | str, ...]:
+        return _extent(self.name, self.size)
+
 
 @dataclass(frozen=True)
 class Output:
@@ -67,6 +106,7 @@ class Output:
     boolean: bool = False  # truth values
     integer: bool = False  # a status: an int in C and numpy
     layers: int = 1  # > 1: a stack of `layers` matrices of rows / layers x cols (the hessian)
+    extent: tuple[int | str, ...] = ()  # the contract's extent, in named dimensions (see EXTENTS)
 
     @property
     def size(self) -> int:
@@ -384,8 +424,10 @@ class Generator:
             rows, cols = result.shape if isinstance(result, sympy.Matrix) else (len(result), 1)
             boolean = all(map(is_boolean, result))
             integer = output in integers
+            key = f"{name}.{output}"
             outputs.append(Output(output, rows, cols, scalar or integer or output in scalars,
-                                  vector or boolean or output in vectors, equal, boolean, integer, layers))
+                                  vector or boolean or output in vectors, equal, boolean, integer, layers,
+                                  _extent(key if key in EXTENTS else equal or name, rows * cols)))
             values += list(result)
         return Function(name, summary, tuple(outputs), self.lower(values, bindings or {}),
                         arguments or (Argument("q", sympy.Matrix(self.q)),), calls)
