@@ -350,18 +350,28 @@ class Generator:
         determinant) over the named entries: a fixed cost on top of Js, whatever the arm.
 
         The Gram determinant is the sum of the squared maximal minors of Js (Cauchy-Binet)
-        while there are at most analysis.MINOR_LIMIT of them: that stays accurate to
-        rounding near a singularity, where det(Js Js^T) formed from the product loses half
-        the digits (its square root, the manipulability, is then good to sqrt(eps) * |Js|^m).
+        while there are at most analysis.MINOR_LIMIT of them; beyond, the product of the
+        squared diagonal of R in a QR factorisation of the tall one of Js, Js^T (modified
+        Gram-Schmidt, whose R is backward stable). Both stay accurate to rounding near a
+        singularity, where det(Js Js^T) formed from the product loses half the digits (its
+        square root, the manipulability, good only to sqrt(eps) * |Js|^m).
         """
         m, n = js.shape
         if m == n or math.comb(max(m, n), min(m, n)) <= analysis.MINOR_LIMIT:
             named = [[self.name(entry) for entry in row] for row in js.tolist()]
             minors = analysis.maximal_minors(named, sympy.Integer(0), sympy.Integer(1))
             return minors[0] if m == n else sympy.Add(*(self.name(minor) ** 2 for minor in minors))
-        gram = js * js.T if m < n else js.T * js
-        named = [[self.name(entry) for entry in row] for row in gram.tolist()]
-        return analysis.maximal_minors(named, sympy.Integer(0), sympy.Integer(1))[0]
+        tall = js.T if m < n else js
+        columns = [[self.name(entry) for entry in tall[:, k]] for k in range(tall.cols)]
+        squared_diagonal = []
+        for k, column in enumerate(columns):
+            norm = self.name(sympy.Add(*(entry**2 for entry in column)))
+            squared_diagonal.append(norm)
+            divisor = self.name(subproblems.select(subproblems.Above(norm, 0), norm, sympy.Integer(1)))
+            for j in range(k + 1, len(columns)):  # the part of column j orthogonal to column k
+                share = self.name(sympy.Add(*(a * b for a, b in zip(columns[j], column))) / divisor)
+                columns[j] = [self.name(entry - share * value) for entry, value in zip(columns[j], column)]
+        return sympy.Mul(*squared_diagonal)
 
     def magnitude(self, value: sympy.Expr) -> sympy.Expr:
         """|value| of a named value: sympy's sign analysis of a large determinant (at every
