@@ -1,0 +1,100 @@
+"""The C runtime helper of the general 6R solver (templates/c/eigenvalues.c.jinja): compiled
+with the generated code's warning flags, its eigenvalues against matrices whose eigenvalues
+are known by construction (similarity transforms of block-diagonal matrices, companion
+matrices of polynomials with given roots, repeated ones included) and against LAPACK."""
+
+import ctypes
+
+import numpy as np
+import pytest
+
+from conftest import ROOT
+from jacgen.compile import compile_shared
+
+HARNESS = """
+#include <math.h>
+#include "eigenvalues.c.jinja"
+int eigenvalues(int n, const double *matrix, double *re, double *im);
+int eigenvalues(int n, const double *matrix, double *re, double *im) {
+    double a[JACGEN_EIG_MAX][JACGEN_EIG_MAX];
+    for (int i = 0; i < n; i++)
+        for (int j = 0; j < n; j++) a[i][j] = matrix[i * n + j];
+    return jacgen_eigenvalues(n, a, re, im);
+}
+"""
+
+
+@pytest.fixture(scope="module")
+def eigenvalues(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("runtime")
+    harness = folder / "harness.c"
+    harness.write_text(HARNESS)
+    library = ctypes.CDLL(str(compile_shared([harness], folder / "libruntime.so",
+                                             ("-O2", f"-I{ROOT / 'templates' / 'c'}"))))
+    pointer = ctypes.POINTER(ctypes.c_double)
+    library.eigenvalues.argtypes = [ctypes.c_int, pointer, pointer, pointer]
+
+    def call(matrix: np.ndarray) -> np.ndarray:
+        n = len(matrix)
+        a, re, im = np.ascontiguousarray(matrix, dtype=float), np.zeros(n), np.zeros(n)
+        assert library.eigenvalues(n, a.ctypes.data_as(pointer), re.ctypes.data_as(pointer),
+                                   im.ctypes.data_as(pointer)) == 0
+        return re + 1j * im
+
+    return call
+
+
+def _distance(found: np.ndarray, expected: np.ndarray) -> float:
+    """The largest relative distance of a matching of the two multisets (greedy, nearest first)."""
+    left, worst = list(expected), 0.0
+    for value in found:
+        k = int(np.argmin([abs(value - e) for e in left]))
+        worst = max(worst, abs(value - left.pop(k)) / max(1.0, abs(value)))
+    return worst
+
+
+@pytest.mark.parametrize("n", [1, 2, 3, 5, 12, 16, 24])
+def test_similar_to_block_diagonal(eigenvalues, n):
+    """S D S^-1 with D of 1x1 blocks (real eigenvalues) and 2x2 rotation-scalings (complex pairs)."""
+    rng = np.random.default_rng(n)
+    for _ in range(20):
+        d, expected, k = np.zeros((n, n)), [], 0
+        while k < n:
+            if k + 1 < n and rng.random() < 0.4:
+                a, b = rng.normal(), rng.uniform(0.1, 2)
+                d[k:k + 2, k:k + 2] = [[a, -b], [b, a]]
+                expected += [a + 1j * b, a - 1j * b]
+                k += 2
+            else:
+                d[k, k] = rng.normal()
+                expected.append(d[k, k] + 0j)
+                k += 1
+        s = rng.normal(size=(n, n)) + n * np.eye(n)
+        assert _distance(eigenvalues(s @ d @ np.linalg.inv(s)), np.array(expected)) < 1e-9
+
+
+@pytest.mark.parametrize("roots", [
+    [1, 2, 3, 4], [-0.5, 0.25, 3, 7, -2, 1e-3], [2, 2, 1 + 1j, 1 - 1j], [1.5 * np.exp(2j * np.pi * k / 16) for k in range(16)],
+    [0.5 * np.exp(1j * np.pi * k / 12) for k in range(24)]], ids=["4", "6", "repeated", "16", "24-roots-of-unity"])
+def test_companion_matrices(eigenvalues, roots):
+    coefficients = np.poly(roots).real
+    n = len(coefficients) - 1
+    companion = np.zeros((n, n))
+    companion[0] = -coefficients[1:] / coefficients[0]
+    companion[1:, :-1] = np.eye(n - 1)
+    tolerance = 1e-6 if len(set(np.round(roots, 9))) < len(roots) else 1e-7  # a double root: sqrt(eps)
+    assert _distance(eigenvalues(companion), np.array(roots, dtype=complex)) < tolerance
+
+
+def test_random_matrices_as_lapack(eigenvalues):
+    rng = np.random.default_rng(0)
+    for n in (4, 12, 24):
+        for _ in range(50):
+            matrix = rng.normal(size=(n, n)) * rng.choice([1e-3, 1, 1e3], size=(n, n))
+            assert _distance(eigenvalues(matrix), np.linalg.eigvals(matrix)) < 1e-9
+
+
+def test_zero_and_triangular(eigenvalues):
+    assert np.all(eigenvalues(np.zeros((6, 6))) == 0)
+    upper = np.triu(np.arange(1.0, 65.0).reshape(8, 8))
+    assert _distance(eigenvalues(upper), np.diag(upper).astype(complex)) < 1e-12
