@@ -176,17 +176,7 @@ class JointRing:
         same with c and s swapped): linear in the size of the result, which is charged."""
         terms = dict(p)
         for cos, sin in self.circle_gens:
-            power, other = (sin, cos) if toward_cos else (cos, sin)
-            reduced: dict = {}
-            for monomial, coefficient in terms.items():
-                half = monomial[power] // 2
-                for j in range(half + 1):
-                    exponents = list(monomial)
-                    exponents[power] -= 2 * half
-                    exponents[other] += 2 * j
-                    key = tuple(exponents)
-                    reduced[key] = reduced.get(key, 0) + coefficient * math.comb(half, j) * (-1) ** j
-            terms = {m: c for m, c in reduced.items() if c}
+            terms = {m: c for m, c in circle_reduced(terms, *((sin, cos) if toward_cos else (cos, sin))).items() if c}
             self.charge(len(terms))
         return self.ring.from_dict(terms) if terms else self.ring.zero
 
@@ -198,6 +188,22 @@ class JointRing:
                 used.append(i)
             g += len(atoms)
         return tuple(used)
+
+
+def circle_reduced(terms: dict, power: int, other: int) -> dict:
+    """Polynomial terms {exponents: coefficient} with x^(2k + r) -> x^r (1 - y^2)^k, where x and y
+    are the generators at positions `power` and `other` (a sine and cosine): one pass, by the
+    binomial theorem, linear in the size of the result."""
+    reduced: dict = {}
+    for monomial, coefficient in terms.items():
+        half = monomial[power] // 2
+        for j in range(half + 1):
+            exponents = list(monomial)
+            exponents[power] -= 2 * half
+            exponents[other] += 2 * j
+            key = tuple(exponents)
+            reduced[key] = reduced.get(key, 0) + coefficient * math.comb(half, j) * (-1) ** j
+    return reduced
 
 
 class TooLarge(Exception):

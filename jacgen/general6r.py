@@ -24,7 +24,6 @@ reducing s^2 = 1 - c^2 for every joint; the twists' cosines and sines enter as 6
 as in the structure stage, and what cancels between them (below 1e-40) is dropped.
 """
 
-import math
 from dataclasses import dataclass
 
 import sympy
@@ -32,6 +31,7 @@ from sympy.polys.domains import RealField
 from sympy.polys.rings import ring
 
 from . import kinematics
+from .analysis import circle_reduced
 from .robot import Robot
 
 PRECISION = 60  # digits of the twists' cosines and sines
@@ -133,20 +133,11 @@ def _fourteen(axis: list, point: list) -> list:
 
 
 def _reduced(polynomial) -> dict[tuple[int, ...], object]:
-    """The terms of `polynomial` with s_i^2 = 1 - c_i^2 for every joint (binomially, in one pass
-    per joint), cancellations below NEGLIGIBLE dropped."""
+    """The terms of `polynomial` with s_i^2 = 1 - c_i^2 for every joint, cancellations below
+    NEGLIGIBLE dropped."""
     terms = dict(polynomial)
     for sine in range(0, 10, 2):
-        reduced: dict = {}
-        for monomial, coefficient in terms.items():
-            half = monomial[sine] // 2
-            for j in range(half + 1):
-                exponents = list(monomial)
-                exponents[sine] -= 2 * half
-                exponents[sine + 1] += 2 * j
-                key = tuple(exponents)
-                reduced[key] = reduced.get(key, 0) + coefficient * math.comb(half, j) * (-1) ** j
-        terms = reduced
+        terms = circle_reduced(terms, sine, sine + 1)
     return {monomial: coefficient for monomial, coefficient in terms.items() if abs(coefficient) > NEGLIGIBLE}
 
 
