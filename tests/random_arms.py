@@ -15,6 +15,9 @@ import math
 import random
 import re
 
+from click.testing import CliRunner
+
+from jacgen.cli import main
 from jacgen.robot import TASK_COMPONENTS
 
 SPECIAL_ALPHAS = (0.0, 90.0, -90.0, 180.0)
@@ -93,3 +96,14 @@ def _random_arm_text(seed: int, dof: int | None, revolute_only: bool) -> str:
         lines.append(f"tool: {_pose(rng)}")
     lines.append(f"task: [{', '.join(_task(rng, dof))}]")
     return "\n".join(lines) + "\n"
+
+
+def generates_and_verifies(path, text: str):
+    """Write `text` to `path`, then `jacgen verify` it: every language generated, built and
+    within tolerance of the numpy reference, with no fallback."""
+    path.write_text(text)
+    verified = CliRunner().invoke(main, ["verify", str(path), "--samples", "40"], catch_exceptions=False)
+    assert verified.exit_code == 0, verified.output  # generated every language, built, compared
+    assert "warning" not in verified.output  # no fallback: the result does not depend on the machine
+    compared = [line for line in verified.output.splitlines() if re.search(r"\d\.\de-\d\d", line)]
+    assert len(compared) >= 8, verified.output  # every function was evaluated, not skipped
