@@ -16,7 +16,8 @@ delays it until that call returns). Threads cannot be interrupted and a process 
 to pickle every expression back, so this is the cheapest sound choice. `BudgetExceeded`
 derives from BaseException so that sympy's own `except Exception` blocks do not swallow
 it, and the timer keeps firing every few milliseconds until the work has unwound (never
-raising inside this module's own frames, so the step that catches it cannot be hit again).
+raising inside this module's own frames, so the step that catches it cannot be hit again,
+nor inside a finalizer or a hook Python calls on the side, where it would only be printed).
 Budgets nest: an inner step gets at most what its outer step has left. Signals only reach
 the main thread, so elsewhere (or without `setitimer`) the work runs unbounded.
 
@@ -118,7 +119,7 @@ def _on_alarm(signum, frame) -> None:
     Never inside this module's own bookkeeping (the frame that caught an interruption and is
     about to disarm the timer): there the next tick, inside the work, will do.
     """
-    if frame is not None and frame.f_code in _BOOKKEEPING:
+    if frame is not None and (frame.f_code in _BOOKKEEPING or _on_the_side(frame)):
         return
     now = time.monotonic()
     for step in _active:
@@ -126,4 +127,16 @@ def _on_alarm(signum, frame) -> None:
             raise BudgetExceeded(step)
 
 
+def _on_the_side(frame) -> bool:
+    """Whether `frame` runs beside the work rather than in it: a finalizer, or a hook that Python
+    calls on the side (an exception raised there is only printed, "Exception ignored in ...",
+    and the work goes on). The next tick, 5 ms later, lands in the work instead."""
+    while frame is not None and frame.f_code is not within_budget.__code__:
+        if frame.f_code.co_name == "__del__" or frame.f_globals.get("__name__", "").startswith(_SIDE_MODULES):
+            return True
+        frame = frame.f_back
+    return False
+
+
+_SIDE_MODULES = ("traceback", "weakref", "warnings", "logging", "_pytest", "pluggy")
 _BOOKKEEPING = (within_budget.__code__, _arm.__code__)
