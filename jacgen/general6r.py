@@ -1,31 +1,39 @@
 """General 6R inverse kinematics, the per-robot part: Raghavan & Roth's 14 equations
-(Raghavan & Roth 1993; Manocha & Canny 1994), derived for one robot.
+(Raghavan & Roth 1993; Manocha & Canny 1994), derived for one robot and one way of cutting
+its loop.
 
 A 6-joint revolute DH chain is `head Z1 C1 Z2 C2 ... Z5 C5 Z6 tail`, with Z_i = Rz(theta_i),
 theta_i = q_i + offset_i, and C_i = Tz(d_i) Tx(a_i) Rx(alpha_i) constant. A standard table
 is that form as it is (head = base, tail = Tz(d6) Tx(a6) Rx(alpha6) tool); a modified one is
 regrouped into it (head = base Rx(alpha_0) Tx(a_0), C_i from row i's d and row i+1's a and
-alpha, tail = Tz(d6) tool). For a target T, with N = head^-1 T tail^-1:
+alpha, tail = Tz(d6) tool). For a target T, N = head^-1 T tail^-1 closes it into a loop
 
-    Z3 C3 Z4 C4 Z5 C5 Z6 = C2^-1 Z2^-1 C1^-1 Z1^-1 N.
+    Z0 L0 Z1 L1 Z2 L2 Z3 L3 Z4 L4 Z5 L5 = I,   L0..L4 = C1..C5, L5 = N^-1
 
-Z6 leaves the third and fourth columns of the left side alone: an axis l and a point p that
-depend on theta3, theta4, theta5, equal to those of the right side, which depend on theta1,
-theta2 and N. With p.p, p.l, p x l and (p.p) l - 2 (p.l) p these are 14 equations
+(loop positions from 0), or, read backwards, the loop of the joints 6..1 with their angles
+negated and the links inverted (L5 = N). A split cuts the loop at a free joint f: with
+a, b, c the three positions before it and g, h the two after,
 
-    (P0 + s3 Ps + c3 Pc) v45 = Q v12,
-    v45 = (s4 s5, s4 c5, c4 s5, c4 c5, s4, c4, s5, c5, 1),
-    v12 = (s1 s2, s1 c2, c1 s2, c1 c2, s1, c1, s2, c2),
+    Z_a L_a Z_b L_b Z_c L_c Z_f = L_h^-1 Z_h^-1 L_g^-1 Z_g^-1 L_f^-1.
 
-where Q and the last column of P0 are polynomials (degree 3 at most) in N's third column n and
-fourth column m, and the rest of P0, Ps, Pc are constants of the robot. This module derives
-them by sparse polynomial arithmetic over 200-bit floats (a few thousand terms: milliseconds),
-reducing s^2 = 1 - c^2 for every joint; the twists' cosines and sines enter as 60-digit numbers,
-as in the structure stage, and what cancels between them (below 1e-40) is dropped.
+Z_f leaves the third and fourth columns of the left side alone: an axis l and a point p.
+With p.p, p.l, p x l and (p.p) l - 2 (p.l) p these are 14 equations
+
+    (P0 + s_a Ps + c_a Pc) v_bc = Q v_gh,
+    v_bc = (s_b s_c, s_b c_c, c_b s_c, c_b c_c, s_b, c_b, s_c, c_c, 1),
+    v_gh = (s_g s_h, s_g c_h, c_g s_h, c_g c_h, s_g, c_g, s_h, c_h),
+
+whose entries are polynomials in the entries of V, the target's link as it appears in the
+split (N or N^-1): the side that holds it is G V H, and its products are taken through V's
+rotation (|V x| = |x|, V x . V y = x . y) so that no orthogonality of V is needed. This module
+derives them by sparse polynomial arithmetic over 200-bit floats (milliseconds), reducing
+s^2 = 1 - c^2 for every joint; the twists' cosines and sines enter as 60-digit numbers, as in
+the structure stage, and what cancels between them (below 1e-40) is dropped.
 """
 
 from dataclasses import dataclass
 
+import numpy as np
 import sympy
 from sympy.polys.domains import RealField
 from sympy.polys.rings import ring
@@ -36,7 +44,8 @@ from .robot import Robot
 
 PRECISION = 60  # digits of the twists' cosines and sines
 NEGLIGIBLE = 1e-40  # a coefficient below this is a cancellation left by those digits
-GENERATORS = "s1 c1 s2 c2 s3 c3 s4 c4 s5 c5 n0 n1 n2 m0 m1 m2"
+TARGET = ("r00 r01 r02 r10 r11 r12 r20 r21 r22", "t0 t1 t2")  # V's rotation and translation
+GENERATORS = " ".join(f"s{k} c{k}" for k in range(6)) + " " + " ".join(TARGET)
 
 
 @dataclass(frozen=True)
@@ -49,15 +58,68 @@ class Link:
 
 
 @dataclass(frozen=True)
-class Equations:
-    """(p0 + s3 ps + c3 pc) v45 = q v12, over the symbols n (N's third column) and m (fourth)."""
+class Split:
+    """A cut of the loop: read backwards or not, and the loop position of the free joint."""
 
+    backwards: bool
+    free: int
+
+    @property
+    def hidden(self) -> int:
+        """a: the loop position whose tan(theta / 2) the eigenproblem finds."""
+        return (self.free - 3) % 6
+
+    @property
+    def triple(self) -> tuple[int, int, int]:
+        return tuple((self.free + k) % 6 for k in (-3, -2, -1))
+
+    @property
+    def pair(self) -> tuple[int, int]:
+        return (self.free + 1) % 6, (self.free + 2) % 6
+
+    def joint(self, position: int) -> int:
+        """The robot joint (0-based) at a loop position."""
+        return 5 - position if self.backwards else position
+
+    @property
+    def target_inverted(self) -> bool:
+        """Whether V is N^-1 (else N): L5 on the left side, L5^-1 on the right."""
+        on_left = 5 in self.triple
+        return on_left != self.backwards
+
+    @property
+    def text(self) -> str:
+        joints = lambda positions: ", ".join(f"q{self.joint(p) + 1}" for p in positions)  # noqa: E731
+        return (f"tan(q{self.joint(self.hidden) + 1}/2) from the eigenproblem, then {joints(self.triple[1:])}, "
+                f"{joints(self.pair)} and q{self.joint(self.free) + 1}")
+
+
+SPLITS = tuple(Split(backwards, free) for backwards in (False, True) for free in range(6))
+
+
+@dataclass(frozen=True)
+class Equations:
+    """(p0 + s_a ps + c_a pc) v_bc = q v_gh, over the symbols of V's rotation and translation;
+    `terms` holds the same as numbers (see `evaluated`)."""
+
+    split: Split
     p0: sympy.Matrix  # 14 x 9
     ps: sympy.Matrix  # 14 x 9
     pc: sympy.Matrix  # 14 x 9
-    q: sympy.Matrix  # 14 x 8
-    n: tuple[sympy.Symbol, ...]
-    m: tuple[sympy.Symbol, ...]
+    q: sympy.Matrix  # 14 x 8 (as 14 x 9, its last column zero, in `evaluated`)
+    rotation: sympy.Matrix  # V's 3 x 3 symbols
+    translation: sympy.Matrix  # V's 3 x 1 symbols
+    terms: tuple[np.ndarray, np.ndarray, np.ndarray]  # exponents (T x 12), coefficients (T), flat entry (T)
+
+    def evaluated(self, targets: np.ndarray) -> np.ndarray:
+        """p0, ps, pc, q at a batch of V's (..., 12: rotation by rows, then translation), as an
+        array (..., 4, 14, 9)."""
+        exponents, coefficients, entries = self.terms
+        values = coefficients * np.prod(targets[..., None, :] ** exponents, axis=-1)
+        out = np.zeros((*targets.shape[:-1], 4 * 14 * 9))
+        for entry in np.unique(entries):  # a few hundred entries: sum their terms
+            out[..., entry] = values[..., entries == entry].sum(-1)
+        return out.reshape(*targets.shape[:-1], 4, 14, 9)
 
 
 def chain_form(robot: Robot) -> tuple[sympy.Matrix, list[Link], sympy.Matrix]:
@@ -83,88 +145,230 @@ def chain_form(robot: Robot) -> tuple[sympy.Matrix, list[Link], sympy.Matrix]:
     return head, links, kinematics.translation(0, 0, joints[5].d.exact) * tool
 
 
-def equations(links: list[Link]) -> Equations:
-    """Raghavan & Roth's 14 equations of the chain C1 .. C5 (see the module docstring)."""
+def equations(links: list[Link], split: Split) -> Equations:
+    """Raghavan & Roth's 14 equations of the loop of C1 .. C5 cut by `split` (see the module
+    docstring)."""
     field = RealField(PRECISION * 4)
     polynomials, *generators = ring(GENERATORS, field)
-    s1, c1, s2, c2, s3, c3, s4, c4, s5, c5, n0, n1, n2, m0, m1, m2 = generators
-    sines, cosines = (s1, s2, s3, s4, s5), (c1, c2, c3, c4, c5)
-    number = lambda value: field(sympy.N(value, PRECISION))  # noqa: E731
-    d = [number(link.d) for link in links]
-    a = [number(link.a) for link in links]
-    ca = [number(sympy.cos(link.alpha)) for link in links]
-    sa = [number(sympy.sin(link.alpha)) for link in links]
+    sines, cosines = generators[0:12:2], generators[1:12:2]
+    rotation = [generators[12:15], generators[15:18], generators[18:21]]
+    translation = generators[21:24]
     zero, one = polynomials.zero, polynomials.one
+    constants = [_link_matrix(link, field) for link in links]
+    if split.backwards:  # loop joint k is robot joint 5 - k: L'_k = C_(5 - k)^-1, L'_5 = (N^-1)^-1
+        constants = [_inverted(constants[4 - k]) for k in range(5)]
 
-    def rot_z(i, v, sign=1):
-        return [cosines[i] * v[0] - sign * sines[i] * v[1], sign * sines[i] * v[0] + cosines[i] * v[1], v[2]]
+    def apply(step, v, point):
+        kind, position, inverse = step
+        if kind == "z":
+            sign = -1 if inverse else 1
+            return [cosines[position] * v[0] - sign * sines[position] * v[1],
+                    sign * sines[position] * v[0] + cosines[position] * v[1], v[2]]
+        r, t = constants[position]
+        if inverse:
+            w = [v[k] - t[k] for k in range(3)] if point else v
+            return [sum(r[k][i] * w[k] for k in range(3)) for i in range(3)]
+        return [sum(r[i][k] * v[k] for k in range(3)) + (t[i] if point else zero) for i in range(3)]
 
-    def rot_x(i, v, sign=1):
-        return [v[0], ca[i] * v[1] - sign * sa[i] * v[2], sign * sa[i] * v[1] + ca[i] * v[2]]
+    def through(steps, v, point):
+        for step in reversed(steps):
+            v = apply(step, v, point)
+        return v
 
-    # Left: Z3 C3 Z4 C4 Z5 C5 applied to the axis (0, 0, 1) and to the origin.
-    axis, point = rot_x(4, [zero, zero, one]), [one * a[4], zero, one * d[4]]
-    axis, point = rot_z(4, axis), rot_z(4, point)
-    for i in (3, 2):
-        axis, point = rot_x(i, axis), rot_x(i, point)
-        point[0] += a[i]
-        axis, point = rot_z(i, axis), rot_z(i, point)
-        point[2] += d[i]
-    # Right: C2^-1 Z2^-1 C1^-1 Z1^-1 applied to n (an axis) and m (a point).
-    target_axis, target_point = [n0, n1, n2], [m0, m1, m2]
-    for i in (0, 1):
-        target_axis = rot_x(i, rot_z(i, target_axis, -1), -1)
-        target_point = rot_z(i, target_point, -1)
-        target_point[2] -= d[i]
-        target_point[0] -= a[i]
-        target_point = rot_x(i, target_point, -1)
-    left = [_reduced(e) for e in _fourteen(axis, point)]
-    right = [_reduced(e) for e in _fourteen(target_axis, target_point)]
-    return _matrices(left, right)
+    def side(steps):
+        """The 14 quantities of the product of `steps` (rightmost applied first) on (e3, o)."""
+        target = [i for i, (kind, position, _) in enumerate(steps) if kind == "l" and position == 5]
+        if target:
+            outer, inner = steps[:target[0]], steps[target[0] + 1:]
+            rv, tv = rotation, translation
+        else:
+            outer, inner = steps, []
+            rv, tv = [[one if i == j else zero for j in range(3)] for i in range(3)], [zero] * 3
+        h_axis, h_point = through(inner, [zero, zero, one], False), through(inner, [zero] * 3, True)
+        # k = G^-1 o, so that G x = R_G (x - k): the outer motion's inverse, applied to the origin
+        k = [zero] * 3
+        for kind, position, inverse in outer:
+            k = apply((kind, position, not inverse), k, True)
+        turn = lambda v: [sum(rv[i][j] * v[j] for j in range(3)) for i in range(3)]  # noqa: E731
+        w_axis, w_point = turn(h_axis), turn(h_point)
+        offset = [tv[i] - k[i] for i in range(3)]  # V's translation less k
+        axis = through(outer, w_axis, False)
+        point = through(outer, [w_point[i] + offset[i] for i in range(3)], False)
+        pp = _dot(h_point, h_point) + 2 * _dot(w_point, offset) + _dot(offset, offset)
+        pl = _dot(h_point, h_axis) + _dot(offset, w_axis)
+        inner_cross, offset_cross = turn(_cross(h_point, h_axis)), _cross(offset, w_axis)
+        cross = through(outer, [inner_cross[i] + offset_cross[i] for i in range(3)], False)
+        return [*axis, *point, pp, pl, *cross, *(pp * l - 2 * pl * p for l, p in zip(axis, point))]
+
+    a, b, c = split.triple
+    f, (g, h) = split.free, split.pair
+    left = side([("z", a, False), ("l", a, False), ("z", b, False), ("l", b, False), ("z", c, False), ("l", c, False)])
+    right = side([("l", h, True), ("z", h, True), ("l", g, True), ("z", g, True), ("l", f, True)])
+    return _matrices(split, [_reduced(e) for e in left], [_reduced(e) for e in right])
 
 
-def _fourteen(axis: list, point: list) -> list:
-    """l, p, p.p, p.l, p x l, (p.p) l - 2 (p.l) p."""
-    pp = sum(x * x for x in point)
-    pl = sum(x * y for x, y in zip(point, axis))
-    cross = [point[1] * axis[2] - point[2] * axis[1], point[2] * axis[0] - point[0] * axis[2],
-             point[0] * axis[1] - point[1] * axis[0]]
-    return [*axis, *point, pp, pl, *cross, *(pp * l - 2 * pl * p for l, p in zip(axis, point))]
+def _link_matrix(link: Link, field) -> tuple[list, list]:
+    """C = Tz(d) Tx(a) Rx(alpha) as (rotation rows, translation), 60-digit numbers."""
+    number = lambda value: field(sympy.N(value, PRECISION))  # noqa: E731
+    ca, sa = number(sympy.cos(link.alpha)), number(sympy.sin(link.alpha))
+    zero, one = field(0), field(1)
+    return [[one, zero, zero], [zero, ca, -sa], [zero, sa, ca]], [number(link.a), zero, number(link.d)]
+
+
+def _inverted(transform: tuple[list, list]) -> tuple[list, list]:
+    r, t = transform
+    rt = [[r[j][i] for j in range(3)] for i in range(3)]
+    return rt, [-sum(rt[i][k] * t[k] for k in range(3)) for i in range(3)]
+
+
+def _dot(u, v):
+    return sum(x * y for x, y in zip(u, v))
+
+
+def _cross(u, v):
+    return [u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]]
 
 
 def _reduced(polynomial) -> dict[tuple[int, ...], object]:
-    """The terms of `polynomial` with s_i^2 = 1 - c_i^2 for every joint, cancellations below
+    """The terms of `polynomial` with s_k^2 = 1 - c_k^2 for every joint, cancellations below
     NEGLIGIBLE dropped."""
     terms = dict(polynomial)
-    for sine in range(0, 10, 2):
+    for sine in range(0, 12, 2):
         terms = circle_reduced(terms, sine, sine + 1)
     return {monomial: coefficient for monomial, coefficient in terms.items() if abs(coefficient) > NEGLIGIBLE}
 
 
-# Exponents of (s_a, c_a, s_b, c_b) of the products in v45 (a, b = 4, 5) and v12 (a, b = 1, 2).
+# Exponents of (s_x, c_x, s_y, c_y) of the products in v_bc (x, y = b, c) and v_gh (x, y = g, h).
 PRODUCTS = ((1, 0, 1, 0), (1, 0, 0, 1), (0, 1, 1, 0), (0, 1, 0, 1), (1, 0, 0, 0), (0, 1, 0, 0), (0, 0, 1, 0),
             (0, 0, 0, 1), (0, 0, 0, 0))
 
 
-def _matrices(left: list[dict], right: list[dict]) -> Equations:
+def _product(monomial: tuple[int, ...], x: int, y: int, others: tuple[int, ...], where: str) -> int:
+    if any(monomial[2 * k] or monomial[2 * k + 1] for k in others):
+        raise ValueError(f"{where} reads joints outside its side: {monomial}")
+    key = (*monomial[2 * x: 2 * x + 2], *monomial[2 * y: 2 * y + 2])
+    if key not in PRODUCTS:
+        raise ValueError(f"{where} outside the products of Raghavan-Roth: {monomial}")
+    return PRODUCTS.index(key)
+
+
+def _matrices(split: Split, left: list[dict], right: list[dict]) -> Equations:
     symbols = sympy.symbols(GENERATORS, real=True)
-    n, m = symbols[10:13], symbols[13:16]
-    p = [sympy.zeros(14, 9) for _ in range(3)]  # constant, s3, c3
-    q = sympy.zeros(14, 8)
+    target = symbols[12:]
+    a, b, c = split.triple
+    g, h = split.pair
+    matrices = [sympy.zeros(14, 9) for _ in range(4)]  # constant, s_a, c_a; q
+    terms = []  # (exponents of V, coefficient, flat entry)
+
+    def add(part, row, column, coefficient, monomial):
+        matrices[part][row, column] += sympy.Float(coefficient, PRECISION) * _monomial(target, monomial[12:])
+        terms.append((monomial[12:], float(coefficient), (part * 14 + row) * 9 + column))
+
     for row, (lhs, rhs) in enumerate(zip(left, right)):
         for monomial, coefficient in lhs.items():
-            if any(monomial[:4]) or any(monomial[10:]) or monomial[4] + monomial[5] > 1:
-                raise ValueError(f"left side of equation {row} outside the products of Raghavan-Roth: {monomial}")
-            part = 1 if monomial[4] else 2 if monomial[5] else 0
-            p[part][row, PRODUCTS.index(monomial[6:10])] += sympy.Float(coefficient, PRECISION)
+            hidden = monomial[2 * a: 2 * a + 2]
+            if sum(hidden) > 1:
+                raise ValueError(f"left side of equation {row} not linear in the hidden joint: {monomial}")
+            part = 1 if hidden[0] else 2 if hidden[1] else 0
+            add(part, row, _product(monomial, b, c, (split.free, g, h), f"left side of equation {row}"), coefficient,
+                monomial)
         for monomial, coefficient in rhs.items():
-            if any(monomial[4:10]):
-                raise ValueError(f"right side of equation {row} reads joints 3 to 6: {monomial}")
-            target = sympy.Mul(*(s**e for s, e in zip(symbols[10:], monomial[10:])))
-            value = sympy.Float(coefficient, PRECISION) * target
-            column = PRODUCTS.index(monomial[:4])
+            column = _product(monomial, g, h, (split.free, a, b, c), f"right side of equation {row}")
             if column == 8:  # the constant goes to the left side
-                p[0][row, 8] -= value
+                add(0, row, 8, -coefficient, monomial)
             else:
-                q[row, column] += value
-    return Equations(*p, q, n, m)
+                add(3, row, column, coefficient, monomial)
+    exponents, coefficients, entries = zip(*terms)
+    arrays = (np.array(exponents, dtype=float), np.array(coefficients), np.array(entries))
+    return Equations(split, *matrices[:3], matrices[3][:, :8], sympy.Matrix(3, 3, target[:9]),
+                     sympy.Matrix(target[9:]), arrays)
+
+
+def _monomial(symbols, exponents) -> sympy.Expr:
+    return sympy.Mul(*(s**e for s, e in zip(symbols, exponents)))
+
+
+# (sin, cos, 1) of an angle times (1 + x^2), x = tan(angle / 2), as coefficients of (1, x, x^2)
+_HALF_ANGLE = {"s": (0, 2, 0), "c": (1, 0, -1), "1": (1, 0, 1)}
+# v_bc's entries as polynomials in (x_b, x_c): row k holds the coefficients of x_b^i x_c^j at 3 i + j
+_MONOMIALS = np.array([np.outer(_HALF_ANGLE[b], _HALF_ANGLE[c]).ravel()
+                       for b, c in ("ss", "sc", "cs", "cc", "s1", "c1", "1s", "1c", "11")])
+
+
+def half_angle(s: np.ndarray) -> np.ndarray:
+    """Six equations in v_bc (..., 6, 9) as twelve in the monomials x_b^i x_c^j (i <= 3, j <= 2,
+    at 3 i + j): the six, and the six times x_b (..., 12, 12)."""
+    expanded = s @ _MONOMIALS
+    out = np.zeros((*s.shape[:-2], 12, 12))
+    out[..., :6, :9], out[..., 6:, 3:] = expanded, expanded
+    return out
+
+
+def shifted(ps: np.ndarray, pc: np.ndarray, shift: float) -> tuple[np.ndarray, np.ndarray]:
+    """ps, pc for the hidden angle less `shift`: s_a ps + c_a pc = s' ps' + c' pc'."""
+    cos, sin = np.cos(shift), np.sin(shift)
+    return cos * ps - sin * pc, sin * ps + cos * pc
+
+
+SAMPLES = 24  # random configurations that rate a split
+SHIFTS = 16  # origins of the hidden joint's half angle tried per split: multiples of 2 pi / SHIFTS
+
+
+@dataclass(frozen=True)
+class Elimination:
+    """A split's equations and the shift of its hidden angle (theta_a = shift + 2 atan(x)) that
+    make the leading matrix, Q and the null vector best conditioned: `condition` is the largest
+    of their median condition numbers over random configurations."""
+
+    equations: Equations
+    shift: float
+    condition: float
+
+
+def elimination(robot: Robot) -> Elimination:
+    """The best conditioned of the 12 splits and 16 shifts (a matrix polynomial singular for
+    every x, as the Jaco's is for the textbook split, rates as badly as a singular leading
+    matrix; so do a Q of rank below 8, from which v_gh cannot be read back, and equations
+whose null space at a root has more than one vector, from which v_bc cannot). Derivations are milliseconds each; the rating is a few hundred 12 x 12
+    condition numbers."""
+    head, links, tail = chain_form(robot)
+    theta = np.random.default_rng(0).uniform(-np.pi, np.pi, (SAMPLES, 6))
+    n = _numeric_chain(links, theta)
+    best = None
+    for split in SPLITS:
+        equations_ = equations(links, split)
+        v = np.linalg.inv(n) if split.target_inverted else n
+        p0, ps, pc, q = np.moveaxis(equations_.evaluated(np.concatenate([v[:, :3, :3].reshape(-1, 9), v[:, :3, 3]], 1)), 1, 0)
+        left, values = np.linalg.svd(q[..., :8])[:2]
+        left_null = np.swapaxes(left[..., 8:], -1, -2)
+        s0, ss, sc = left_null @ p0, left_null @ ps, left_null @ pc
+        pair = float(np.median(values[..., 0] / np.maximum(values[..., -1], 1e-300)))  # v_gh from Q's columns
+        # v_bc from the null vector of the equations at the configuration's own theta_a: one vector
+        hidden = theta[:, split.joint(split.hidden)] * (-1 if split.backwards else 1)
+        at_root = half_angle(s0 + np.sin(hidden)[:, None, None] * ss + np.cos(hidden)[:, None, None] * sc)
+        singular = np.linalg.svd(at_root, compute_uv=False)
+        vector = float(np.median(singular[..., 0] / np.maximum(singular[..., -2], 1e-300)))
+        for k in range(SHIFTS):
+            shift = 2 * np.pi * k / SHIFTS
+            leading = np.median(np.linalg.cond(half_angle(s0 - shifted(ss, sc, shift)[1])))
+            condition = float(max(leading, pair, vector))
+            if best is None or condition < best.condition:
+                best = Elimination(equations_, shift, condition)
+    return best
+
+
+def _numeric_chain(links: list[Link], theta: np.ndarray) -> np.ndarray:
+    """Z1 C1 ... Z5 C5 Z6 at a batch of joint angles (..., 6), in doubles."""
+    def rz(angle):
+        out = np.zeros((*angle.shape, 4, 4))
+        out[..., 0, 0] = out[..., 1, 1] = np.cos(angle)
+        out[..., 1, 0], out[..., 0, 1] = np.sin(angle), -np.sin(angle)
+        out[..., 2, 2] = out[..., 3, 3] = 1
+        return out
+
+    out = rz(theta[..., 0])
+    for i, link in enumerate(links):
+        constant = np.array((kinematics.translation(0, 0, link.d) * kinematics.translation(link.a, 0, 0)
+                             * kinematics.rot_x(sympy.cos(link.alpha), sympy.sin(link.alpha))).evalf(20).tolist(), dtype=float)
+        out = out @ constant @ rz(theta[..., i + 1])
+    return out
