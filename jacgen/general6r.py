@@ -291,14 +291,14 @@ def _monomial(symbols, exponents) -> sympy.Expr:
 # (sin, cos, 1) of an angle times (1 + x^2), x = tan(angle / 2), as coefficients of (1, x, x^2)
 _HALF_ANGLE = {"s": (0, 2, 0), "c": (1, 0, -1), "1": (1, 0, 1)}
 # v_bc's entries as polynomials in (x_b, x_c): row k holds the coefficients of x_b^i x_c^j at 3 i + j
-_MONOMIALS = np.array([np.outer(_HALF_ANGLE[b], _HALF_ANGLE[c]).ravel()
+MONOMIALS = np.array([np.outer(_HALF_ANGLE[b], _HALF_ANGLE[c]).ravel()
                        for b, c in ("ss", "sc", "cs", "cc", "s1", "c1", "1s", "1c", "11")])
 
 
 def half_angle(s: np.ndarray) -> np.ndarray:
     """Six equations in v_bc (..., 6, 9) as twelve in the monomials x_b^i x_c^j (i <= 3, j <= 2,
     at 3 i + j): the six, and the six times x_b (..., 12, 12)."""
-    expanded = s @ _MONOMIALS
+    expanded = s @ MONOMIALS
     out = np.zeros((*s.shape[:-2], 12, 12))
     out[..., :6, :9], out[..., 6:, 3:] = expanded, expanded
     return out

@@ -1,19 +1,37 @@
-"""The C runtime helper of the general 6R solver (templates/c/eigenvalues.c.jinja): compiled
-with the generated code's warning flags, its eigenvalues against matrices whose eigenvalues
-are known by construction (similarity transforms of block-diagonal matrices, companion
-matrices of polynomials with given roots, repeated ones included) and against LAPACK."""
+"""The C runtime helpers of the general 6R solver, compiled with the generated code's warning
+flags: templates/c/eigenvalues.c.jinja against matrices whose eigenvalues are known by
+construction (similarity transforms of block-diagonal matrices, companion matrices of
+polynomials with given roots, repeated ones included) and against LAPACK;
+templates/c/general6r.c.jinja (the elimination from the equations at a target to the loop
+angles) through whole solutions: the configurations its roots complete to reach the pose on
+the numpy reference, the generating one among them, as many as numpy's eigensolver gives."""
 
 import ctypes
+import math
+
+import jinja2
 
 import numpy as np
 import pytest
 
 from conftest import ROOT
+from jacgen import general6r, reference
 from jacgen.compile import compile_shared
+from test_general6r import ARMS, _solver, _wrapped
 
 HARNESS = """
 #include <math.h>
 #include "eigenvalues.c.jinja"
+#include "general6r.c"
+int roots(const double *p, const double *q, double *angles);
+int roots(const double *p, const double *q, double *angles) {
+    double pm[3][14][9], qm[14][8], out[JACGEN_G6_ROOTS][5];
+    for (int i = 0; i < 3 * 14 * 9; i++) pm[i / 126][i / 9 % 14][i % 9] = p[i];
+    for (int i = 0; i < 14 * 8; i++) qm[i / 8][i % 8] = q[i];
+    int count = jacgen_general6r_roots(pm, qm, out);
+    for (int i = 0; i < count * 5; i++) angles[i] = out[i / 5][i % 5];
+    return count;
+}
 int eigenvalues(int n, const double *matrix, double *re, double *im);
 int eigenvalues(int n, const double *matrix, double *re, double *im) {
     double a[JACGEN_EIG_MAX][JACGEN_EIG_MAX];
@@ -24,15 +42,25 @@ int eigenvalues(int n, const double *matrix, double *re, double *im) {
 """
 
 
+POINTER = ctypes.POINTER(ctypes.c_double)
+
+
 @pytest.fixture(scope="module")
-def eigenvalues(tmp_path_factory):
+def library(tmp_path_factory):
     folder = tmp_path_factory.mktemp("runtime")
-    harness = folder / "harness.c"
-    harness.write_text(HARNESS)
-    library = ctypes.CDLL(str(compile_shared([harness], folder / "libruntime.so",
+    (folder / "harness.c").write_text(HARNESS)
+    template = (ROOT / "templates" / "c" / "general6r.c.jinja").read_text()
+    (folder / "general6r.c").write_text(jinja2.Template(template).render(monomials=general6r.MONOMIALS.astype(int).tolist()))
+    library = ctypes.CDLL(str(compile_shared([folder / "harness.c"], folder / "libruntime.so",
                                              ("-O2", f"-I{ROOT / 'templates' / 'c'}"))))
-    pointer = ctypes.POINTER(ctypes.c_double)
-    library.eigenvalues.argtypes = [ctypes.c_int, pointer, pointer, pointer]
+    library.eigenvalues.argtypes = [ctypes.c_int, POINTER, POINTER, POINTER]
+    library.roots.argtypes = [POINTER, POINTER, POINTER]
+    return library
+
+
+@pytest.fixture(scope="module")
+def eigenvalues(library):
+    pointer = POINTER
 
     def call(matrix: np.ndarray) -> np.ndarray:
         n = len(matrix)
@@ -98,3 +126,19 @@ def test_zero_and_triangular(eigenvalues):
     assert np.all(eigenvalues(np.zeros((6, 6))) == 0)
     upper = np.triu(np.arange(1.0, 65.0).reshape(8, 8))
     assert _distance(eigenvalues(upper), np.diag(upper).astype(complex)) < 1e-12
+
+
+@pytest.mark.parametrize("name", ARMS)
+def test_general6r_roots_complete_to_every_solution(library, name):
+    solver = _solver(name)
+
+    def roots(p: np.ndarray, q: np.ndarray) -> np.ndarray:
+        p, q, angles = np.ascontiguousarray(p), np.ascontiguousarray(q), np.zeros((24, 5))
+        count = library.roots(p.ctypes.data_as(POINTER), q.ctypes.data_as(POINTER), angles.ctypes.data_as(POINTER))
+        return angles[:count]
+
+    for q in np.random.default_rng(21).uniform(-math.pi, math.pi, (60, 6)):
+        pose = reference.fk(solver.robot, q)
+        ours = solver.solve(pose, roots)
+        assert min(np.abs(_wrapped(s - q)).max() for s in ours) < 1e-8
+        assert len(ours) == len(solver.solve(pose))

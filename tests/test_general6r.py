@@ -100,14 +100,19 @@ class Solver:
         self.links = [general6r._numeric_chain([link], np.zeros((1, 2)))[0] for link in links]
         self.offsets = np.array([joint.offset.approx for joint in robot.joints])
 
-    def loop_angles(self, pose: np.ndarray):
-        """Per real eigenvalue: the loop angles of a, b, c, g, h, and N."""
-        split, shift = self.plan.equations.split, self.plan.shift
+    def equations_at(self, pose: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """P0, Ps, Pc (3 x 14 x 9, the hidden angle's shift applied), Q (14 x 8) and N at a pose."""
+        split = self.plan.equations.split
         n = self.head_inverse @ pose @ self.tail_inverse
         v = np.linalg.inv(n) if split.target_inverted else n
         p0, ps, pc, q = self.plan.equations.evaluated(np.concatenate([v[:3, :3].ravel(), v[:3, 3]]))
-        ps, pc = general6r.shifted(ps, pc, shift)
-        orthogonal, r = np.linalg.qr(q[:, :8], mode="complete")
+        return np.array([p0, *general6r.shifted(ps, pc, self.plan.shift)]), q[:, :8], n
+
+    @staticmethod
+    def roots(p: np.ndarray, q: np.ndarray):
+        """Per real eigenvalue: the loop angles of a (less the shift), b, c, g, h."""
+        p0, ps, pc = p
+        orthogonal, r = np.linalg.qr(q, mode="complete")
         left_null = orthogonal[:, 8:].T
         s0, ss, sc = left_null @ p0, left_null @ ps, left_null @ pc
         m2, m1, m0 = (general6r.half_angle(m) for m in (s0 - sc, 2 * ss, s0 + sc))
@@ -124,14 +129,17 @@ class Solver:
             sb, cb, s_c, cc = math.sin(b), math.cos(b), math.sin(c), math.cos(c)
             v_bc = np.array([sb * s_c, sb * cc, cb * s_c, cb * cc, sb, cb, s_c, cc, 1])
             v_gh = np.linalg.solve(r[:8], orthogonal[:, :8].T @ ((p0 + math.sin(a) * ps + math.cos(a) * pc) @ v_bc))
-            yield (a + shift, b, c, math.atan2(v_gh[4], v_gh[5]), math.atan2(v_gh[6], v_gh[7])), n
+            yield a, b, c, math.atan2(v_gh[4], v_gh[5]), math.atan2(v_gh[6], v_gh[7])
 
-    def solve(self, pose: np.ndarray) -> list[np.ndarray]:
-        """Every solution reaching `pose` to 1e-9, each once, wrapped to (-pi, pi]."""
+    def solve(self, pose: np.ndarray, roots=None) -> list[np.ndarray]:
+        """Every solution reaching `pose` to 1e-9, each once, wrapped to (-pi, pi]; `roots` is
+        the kernel (default: numpy's)."""
         split = self.plan.equations.split
         solutions = []
-        for angles, n in self.loop_angles(pose):
+        p, q, n = self.equations_at(pose)
+        for angles in (roots or self.roots)(p, q):
             theta = np.zeros(6)
+            angles = (angles[0] + self.plan.shift, *angles[1:])
             for position, angle in zip((*split.triple, *split.pair), angles):
                 theta[split.joint(position)] = -angle if split.backwards else angle
             free = split.joint(split.free)  # Z_free = (Z1 C1 .. up to it)^-1 N (C_free .. Z6)^-1
