@@ -15,9 +15,9 @@ import numpy as np
 import pytest
 
 from conftest import ROOT
+from general6r_arms import ARMS, solver_of, wrapped
 from jacgen import general6r, reference
 from jacgen.compile import compile_shared
-from test_general6r import ARMS, _solver, _wrapped
 
 HARNESS = """
 #include <math.h>
@@ -130,7 +130,7 @@ def test_zero_and_triangular(eigenvalues):
 
 @pytest.mark.parametrize("name", ARMS)
 def test_general6r_roots_complete_to_every_solution(library, name):
-    solver = _solver(name)
+    arm = solver_of(name)
 
     def roots(p: np.ndarray, q: np.ndarray) -> np.ndarray:
         p, q, angles = np.ascontiguousarray(p), np.ascontiguousarray(q), np.zeros((24, 5))
@@ -138,7 +138,7 @@ def test_general6r_roots_complete_to_every_solution(library, name):
         return angles[:count]
 
     for q in np.random.default_rng(21).uniform(-math.pi, math.pi, (60, 6)):
-        pose = reference.fk(solver.robot, q)
-        ours = solver.solve(pose, roots)
-        assert min(np.abs(_wrapped(s - q)).max() for s in ours) < 1e-8
-        assert len(ours) == len(solver.solve(pose))
+        pose = reference.fk(arm.robot, q)
+        ours = arm.solve(pose, roots)
+        assert min(np.abs(wrapped(s - q)).max() for s in ours) < 1e-8
+        assert len(ours) == len(arm.solve(pose))
