@@ -71,7 +71,7 @@ class CLibrary:
             returned = function.returned
             outputs = [ctypes.POINTER(ctypes.c_int) if o.boolean else pointer for o in function.outputs if o is not returned]
             symbol.argtypes = [scalar if a.scalar else pointer for a in function.arguments] + outputs + extra
-            symbol.restype = None if returned is None else ctypes.c_int if returned.integer else scalar
+            symbol.restype = None if returned is None else ctypes.c_int if returned.integer or returned.boolean else scalar
 
     def evaluate(self, name: str, q: np.ndarray, *more: np.ndarray,
                  parameters: dict[str, float] | None = None) -> np.ndarray:

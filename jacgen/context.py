@@ -5,7 +5,7 @@ that templates only lay text out. `backends.py` names the builder of each langua
 import numpy
 import sympy
 
-from . import analysis, differential, ik, report
+from . import analysis, differential, general6r, ik, report
 from .functions import Argument, Call, Function, Generator, Output
 from .lowering import is_boolean
 from .printers import CasadiPrinter, CPrinter, PythonPrinter
@@ -112,7 +112,7 @@ def _layout(output: Output) -> str:
     return f"{output.name}: {output.rows} x {output.cols} row-major, element (r, c) at {output.name}[r * {output.cols} + c]"
 
 
-def _c_macros(robot: Robot, functions: list[Function]) -> dict[str, int]:
+def _c_macros(robot: Robot, functions: list) -> dict[str, int]:
     macros = {"DOF": robot.dof, "TASK_DIM": len(robot.task)}
     macros.update({C_ROW_MACROS[f.name]: f.outputs[0].rows for f in functions if f.name in C_ROW_MACROS})
     macros.update({"MAX_IK_SOLUTIONS": f.outputs[0].rows for f in functions if f.name == "ik_branches"})
@@ -263,6 +263,12 @@ def _ik_context(robot: Robot, generator: Generator, language: str, real: str) ->
         "signature": ", ".join(arguments),
         "wrapper": generator.generates("ik"),
         "nearest": generator.generates("ik_nearest"),
+        "general": form.solver == "general_6r" and {
+            "monomials": general6r.MONOMIALS.astype(int).tolist(), "along_b": general6r.ALONG_B,
+            "along_c": general6r.ALONG_C, "newton_steps": general6r.NEWTON_STEPS,
+            "tolerance": general6r.TOLERANCE[real], "imaginary": general6r.IMAGINARY[real],
+            "squared": (repr if language == "python" else CPrinter(real).doprint)(
+                sympy.Float(general6r.TOLERANCE[real] ** 2))},
     }
 
 
@@ -327,7 +333,7 @@ def _report_context(robot: Robot, generator: Generator) -> dict:
         "singularities": report.singularity_lines(robot, singular),
         "euler": report.euler_lines(robot, singular),
         "isotropy": report.isotropy_lines(robot),
-        "ik": report.ik_lines(generator.model.structure),
+        "ik": report.ik_lines(generator.model),
         "operations": [{"name": f.name, "operations": f.body.operation_count,
                         "shape": "scalar" if f.scalar else " and ".join(_dimensions(o) for o in f.outputs)}
                        for f in generator.functions()],
@@ -348,8 +354,8 @@ def c_context(robot: Robot, generator: Generator, printer: CPrinter, real: str) 
     """The C header and source: functions with prototypes and size macros, in `real`."""
     context = _common(robot)
     functions = generator.functions()
-    by_name = {f.name: f for f in functions}  # the callees of functions that call another
-    macros = _c_macros(robot, functions)
+    by_name = {f.name: f for f in (*functions, *generator.loops)}  # the callees of functions that call another
+    macros = _c_macros(robot, [*functions, *generator.loops])
     if generator.closed_form and generator.closed_form.free is not None:
         macros["IK_FREE_JOINT"] = generator.closed_form.free  # 0-based index into q of ik's q_free
     context.update({
@@ -369,11 +375,11 @@ def c_context(robot: Robot, generator: Generator, printer: CPrinter, real: str) 
 def casadi_context(robot: Robot, generator: Generator, printer: CasadiPrinter, real: str) -> dict:
     """The CasADi module: every function as an SX graph, with the symbols of its inputs."""
     context = _common(robot)
-    functions = generator.functions()
+    functions = generator.without_loops()
     context["functions"] = [_casadi_function(f, robot, printer) for f in functions]
     context["arguments"] = sorted({(a.name, a.symbols.rows, a.symbols.cols) for f in functions for a in f.arguments},
                                   key=lambda a: ("q", "q_dot", "mu_dot", "damping", "target", "T", "mu", "q_seed", "q_free", "weights").index(a[0]))
-    context["ik"] = generator.closed_form is not None and generator.generates("ik")
+    context["ik"] = generator.closed_form is not None and not generator.loops and generator.generates("ik")
     context["ik_numeric"] = generator.generates("ik_numeric") and _ik_numeric_context(robot, "python", "double")
     return dict(sorted(context.items()))
 

@@ -12,7 +12,7 @@ from functools import cached_property
 import sympy
 from sympy.core.parameters import distribute
 
-from . import analysis, differential, ik, kinematics, subproblems
+from . import analysis, differential, general6r, ik, kinematics, subproblems
 from .lowering import Body, Lowering, is_boolean
 from .model import Model
 from .robot import Robot
@@ -48,6 +48,11 @@ EXTENTS = {
     "velocity_ik.q_dot": ("DOF",),
     "ik_numeric_step.q_start": ("DOF",),
     "ik_numeric_step.q_next": ("DOF",),
+    "ik_general_start.q": ("DOF",),
+    "ik_general_step.q_start": ("DOF",),
+    "ik_general_step.q_next": ("DOF",),
+    "ik_general_limits.q": ("DOF",),
+    "q_solution": ("DOF",),
     "fk": (16,),
     "jacobian": (6, "DOF"),
     "jacobian_tool": (6, "DOF"),
@@ -135,6 +140,15 @@ class Call:
 
 
 @dataclass(frozen=True)
+class Loop:
+    """A function a template writes around generated ones (the general 6R solver's ik_branches,
+    around an eigensolver): its name and outputs, as its callers read them."""
+
+    name: str
+    outputs: tuple[Output, ...]
+
+
+@dataclass(frozen=True)
 class Function:
     """One generated function; its body's outputs are those of `outputs`, concatenated."""
 
@@ -214,7 +228,8 @@ class Generator:
 
     def ik_functions(self) -> list[Function]:
         """ik_branches (every branch of the closed-form solver, whether the target allows it and
-        whether it is inside the joint limits) and ik_nearest (the solution nearest a seed), from
+        whether it is inside the joint limits; for the general 6R solver, the parts its template
+        loop runs, see `general_6r_functions`) and ik_nearest (the solution nearest a seed), from
         the target's symbols (none without a closed form)."""
         form = self.closed_form
         if form is None or not (self.generates("ik_branches") or self.generates("ik_nearest")):
@@ -234,20 +249,23 @@ class Generator:
         weights = Argument("weights", sympy.Matrix([sympy.Symbol(f"qw{i + 1}", real=True) for i in range(n)]),
                            default="(1.0,) * DOF")
         sp = Subproblems(self.name)
-        with distribute(False):
-            q, valid, inside = ik.branches(self.robot, form, sp, target.symbols, free_angle)
-        branches = self.function("ik_branches", "every branch of the closed-form ik, whether the target allows it "
-                                 "and whether it is inside the joint limits", ("q", q), ("valid", valid),
-                                 ("in_limits", inside), arguments=(target, *free), bindings=bindings)
+        if form.solver == "general_6r":
+            parts, rows = self.general_6r_functions(target, sp), form.info.max_solutions
+        else:
+            with distribute(False):
+                q, valid, inside = ik.branches(self.robot, form, sp, target.symbols, free_angle)
+            parts = [self.function("ik_branches", "every branch of the closed-form ik, whether the target allows "
+                                   "it and whether it is inside the joint limits", ("q", q), ("valid", valid),
+                                   ("in_limits", inside), arguments=(target, *free), bindings=bindings)]
+            rows = q.rows
         if not self.generates("ik_nearest"):
-            return [branches]
+            return parts
         # ik_nearest reads ik_branches' results rather than lowering the solver a second time.
-        rows = range(q.rows)
-        table = Call("ik_branches", tuple(a.name for a in branches.arguments), (
-            Argument("branches_q", sympy.Matrix(q.rows, n, lambda r, c: sympy.Symbol(f"qb{r}_{c}", real=True)),
+        table = Call("ik_branches", (target.name, *(a.name for a in free)), (
+            Argument("branches_q", sympy.Matrix(rows, n, lambda r, c: sympy.Symbol(f"qb{r}_{c}", real=True)),
                      vector=False),
-            Argument("branches_valid", sympy.Matrix([sympy.Symbol(f"vb{r}") for r in rows])),
-            Argument("branches_in_limits", sympy.Matrix([sympy.Symbol(f"lb{r}") for r in rows]))))
+            Argument("branches_valid", sympy.Matrix([sympy.Symbol(f"vb{r}") for r in range(rows)])),
+            Argument("branches_in_limits", sympy.Matrix([sympy.Symbol(f"lb{r}") for r in range(rows)]))))
         table_q, table_valid, table_inside = (result.symbols for result in table.results)
         with distribute(False):
             read = target.symbols[:3, :] if form.target == "pose" else target.symbols
@@ -257,7 +275,62 @@ class Generator:
                                 "(sum of weights_j (q_j - q_seed_j)^2), and the status", ("q", sympy.Matrix(closest)),
                                 ("status", sympy.Matrix([status])), vector=True, integers=("status",),
                                 arguments=(target, seed, *free, weights), calls=(table,))
-        return [branches, nearest]
+        return [*parts, nearest]
+
+    def general_6r_functions(self, target: Argument, sp: Subproblems) -> list[Function]:
+        """The generated parts of the general 6R solver (`general6r`), which ik_branches runs
+        around the eigenproblem kernel of its language: the equations at the target (P0, Ps, Pc
+        stacked 42 x 9, the hidden angle's shift applied; Q 14 x 8), the configuration of one
+        root's loop angles (the free joint from the loop), a Newton step on the pose (ik_numeric's
+        step, undamped and unclamped), and ik's form of a configuration with its limits."""
+        plan = self.closed_form.elimination
+        equations, split = plan.equations, plan.equations.split
+        head, links, tail = general6r.chain_form(self.robot)
+        name = self.name
+        with distribute(False):
+            n = (_rigid_inverse(head) * target.symbols * _rigid_inverse(tail)).applyfunc(name)
+            v = _rigid_inverse(n).applyfunc(name) if split.target_inverted else n
+            values = {**{equations.rotation[k]: v[k // 3, k % 3] for k in range(9)},
+                      **{equations.translation[k]: v[k, 3] for k in range(3)}}
+            p0, ps, pc, q = (m.xreplace(values) for m in (equations.p0, equations.ps, equations.pc, equations.q))
+            cos, sin = sympy.Float(math.cos(plan.shift), 17), sympy.Float(math.sin(plan.shift), 17)
+            ps, pc = cos * ps - sin * pc, sin * ps + cos * pc
+            stacked = sympy.Matrix.vstack(p0, ps, pc)
+        equations_function = self.function(
+            "ik_general_equations", "the general 6R solver's equations at T: (P0 + s Ps + c Pc) v_bc = Q v_gh, "
+            "P = [P0; Ps; Pc] (42 x 9)", ("P", stacked), ("Q", q), arguments=(target,), part_of="ik_branches")
+        angles = Argument("angles", sympy.Matrix([sympy.Symbol(f"ga{k}", real=True) for k in range(5)]))
+        loop = dict(zip((*split.triple, *split.pair), angles.symbols))
+        loop[split.hidden] = loop[split.hidden] + sympy.Float(plan.shift, 17)
+        theta = [None] * 6
+        for position, angle in loop.items():
+            theta[split.joint(position)] = -angle if split.backwards else angle
+        free = split.joint(split.free)
+        constants = [kinematics.translation(0, 0, link.d) * kinematics.translation(link.a, 0, 0)
+                     * kinematics.rot_x(sympy.cos(link.alpha), sympy.sin(link.alpha)) for link in links]
+        with distribute(False):
+            before, after = sympy.eye(3), constants[free][:3, :3] if free < 5 else sympy.eye(3)
+            for i in range(6):
+                turn = kinematics.rot_z(sympy.cos(theta[i]), sympy.sin(theta[i]))[:3, :3] if i != free else None
+                if i < free:
+                    before = (before * turn * constants[i][:3, :3]).applyfunc(name)
+                elif i > free:
+                    after = (after * turn * (constants[i][:3, :3] if i < 5 else sympy.eye(3))).applyfunc(name)
+            column = (before.T * n[:3, :3] * after.T[:, 0]).applyfunc(name)  # Z_free's first column
+            theta[free] = sympy.atan2(column[1], column[0])
+            q = [t - joint.offset.exact for t, joint in zip(theta, self.robot.joints)]
+        start = self.function("ik_general_start", "the configuration of one root's loop angles (a - shift, b, c, "
+                              "g, h; the free joint from the loop)", ("q", sympy.Matrix(q)), vector=True,
+                              arguments=(target, angles), part_of="ik_branches")
+        step = self.ik_numeric_step_function(None, "ik_general_step", newton=True)
+        given = Argument("q_solution", sympy.Matrix([sympy.Symbol(f"qg{i + 1}", real=True) for i in range(6)]))
+        with distribute(False):
+            form, inside = ik.limited(self.robot, sp, list(given.symbols), tuple(range(6)))
+        limits = self.function("ik_general_limits", "ik's form of q (revolute angles wrapped, or into the limits) "
+                               "and whether it is inside the joint limits", ("q", sympy.Matrix(form)),
+                               ("in_limits", [inside]), vector=True, scalars=("in_limits",), arguments=(given,),
+                               part_of="ik_branches")
+        return [equations_function, start, step, limits]
 
     def velocity_ik_function(self, js: sympy.Matrix) -> Function:
         """velocity_ik: q_dot solving Js q_dot = mu_dot, and the status (`differential`)."""
@@ -272,8 +345,10 @@ class Generator:
                              ("q_dot", sympy.Matrix(q_dot)), ("status", sympy.Matrix([status])), vector=True,
                              integers=("status",), arguments=(Argument("q", sympy.Matrix(self.q)), mu_dot, damping))
 
-    def ik_numeric_step_function(self, task_jacobian: sympy.Matrix) -> Function:
-        """ik_numeric_step: one damped least-squares step of ik_numeric from q (`differential`)."""
+    def ik_numeric_step_function(self, task_jacobian: sympy.Matrix | None, name: str = "ik_numeric_step",
+                                 newton: bool = False) -> Function:
+        """ik_numeric_step: one damped least-squares step of ik_numeric from q (`differential`);
+        with `newton`, the general 6R solver's polish: undamped, no limits (a pose task)."""
         robot, n = self.robot, self.robot.dof
         pose = len(robot.task) == 6
         if pose:
@@ -282,7 +357,7 @@ class Generator:
             target = Argument("target", sympy.Matrix([sympy.Symbol(f"mu{i}", real=True) for i in range(len(robot.task))]))
         given = Argument("q", sympy.Matrix([sympy.Symbol(f"qs{i + 1}", real=True) for i in range(n)]))
         damping = Argument("damping", sympy.Matrix([sympy.Symbol("damping", real=True)]), scalar=True, default="0.0")
-        limits = [joint.limits for joint in robot.joints]
+        limits = [None if newton else joint.limits for joint in robot.joints]
         bindings = {qi: differential.clamp(given_i, bounds) for qi, given_i, bounds in zip(self.q, given.symbols, limits)}
         with distribute(False):
             if pose:
@@ -300,11 +375,16 @@ class Generator:
             read = target.symbols[:3, :] if pose else target.symbols
             cost = differential.flagged_cost(cost, [*given.symbols, *read], self.name)
         step = "J^T (J J^T + damping I)^-1 e" if jacobian.rows <= n else "(J^T J + damping I)^-1 J^T e"
-        summary = (f"one step of ik_numeric: q clamped to the limits, then q + {step} clamped, and |e|^2 at the "
-                   "clamped q (-1 when target or q is not finite)")
-        return self.function("ik_numeric_step", summary, ("q_start", sympy.Matrix(self.q)),
+        if newton:
+            summary = (f"one Newton step of the general 6R solver's polish: q + {step} (damping 0 for Newton), "
+                       "and |e|^2 at q (-1 when target or q is not finite)")
+        else:
+            summary = (f"one step of ik_numeric: q clamped to the limits, then q + {step} clamped, and |e|^2 at "
+                       "the clamped q (-1 when target or q is not finite)")
+        return self.function(name, summary, ("q_start", sympy.Matrix(self.q)),
                              ("q_next", sympy.Matrix(trial)), ("cost", sympy.Matrix([cost])), vector=True,
-                             scalars=("cost",), arguments=(target, given, damping), bindings=bindings)
+                             scalars=("cost",), arguments=(target, given, damping), bindings=bindings,
+                             part_of="ik_branches" if newton else None)
 
     @cached_property
     def jacobian(self) -> sympy.Matrix:
@@ -419,15 +499,16 @@ class Generator:
                  vector: bool = False, equals: tuple[str, ...] = (),
                  arguments: tuple[Argument, ...] | None = None, scalars: tuple[str, ...] = (),
                  integers: tuple[str, ...] = (), bindings: dict | None = None, layers: int = 1,
-                 vectors: tuple[str, ...] = (), calls: tuple[Call, ...] = ()) -> Function | None:
+                 vectors: tuple[str, ...] = (), calls: tuple[Call, ...] = (), part_of: str | None = None
+                 ) -> Function | None:
         """A function of one or more named results (matrices, or lists of truth values as
         columns), lowered together so they share their terms; its arguments are q unless
         given. The results named in `scalars` are scalars, those in `integers` integer
         scalars (statuses), those in `vectors` (or all, with `vector`) column vectors; `bindings` define symbols (the joints) from the arguments for
         this function alone; `layers` > 1 makes the results stacks of that many matrices; `calls`
-        are the generated functions whose results the body reads. None when `name` is not to be
-        generated (nothing is lowered then)."""
-        if not self.generates(name):
+        are the generated functions whose results the body reads. None when `name` (or the
+        function it is `part_of`) is not to be generated (nothing is lowered then)."""
+        if not self.generates(part_of or name):
             return None
         outputs, values = [], []
         for (output, result), equal in zip(results, equals or ("",) * len(results)):
@@ -446,9 +527,27 @@ class Generator:
         """Every straight-line function, in the order the backends emit them."""
         return list(self._functions)
 
+    def without_loops(self) -> list[Function]:
+        """The functions of a backend that cannot run the template loops (CasADi's SX graphs have
+        no eigensolver): without the general 6R solver's parts, and without ik_nearest, which
+        reads its ik_branches."""
+        skipped = {"ik_nearest"} | {f.name for f in self._functions if f.name.startswith("ik_general")}
+        return [f for f in self._functions if not (self.loops and f.name in skipped)]
+
+    @property
+    def loops(self) -> list[Loop]:
+        """The functions templates write around generated ones: the general 6R solver's ik_branches."""
+        form = self.closed_form
+        if form is None or form.solver != "general_6r" or not self.generates("ik_branches"):
+            return []
+        rows, extent = form.info.max_solutions, ("MAX_IK_SOLUTIONS",)
+        return [Loop("ik_branches", (Output("q", rows, self.robot.dof, extent=(*extent, "DOF")),
+                                     Output("valid", rows, 1, vector=True, boolean=True, extent=extent),
+                                     Output("in_limits", rows, 1, vector=True, boolean=True, extent=extent)))]
+
     def unavailable(self) -> list[str]:
         """The selected functions this robot does not have, each with why."""
-        made = {f.name for f in self._functions}
+        made = {f.name for f in (*self._functions, *self.loops)}
         made |= {name for name, callees in CALLEES.items() if made.issuperset(callees)}
         why = {"ik": f"no closed form ({self.model.structure.reason})",
                "jacobian_det": f"Js is {len(self.robot.task)} x {self.robot.dof}, not square"}
@@ -480,3 +579,10 @@ class Generator:
             *self.ik_functions(),
         )
         return tuple(function for function in functions if function is not None)
+
+
+def _rigid_inverse(transform: sympy.Matrix) -> sympy.Matrix:
+    """[R p; 0 1]^-1 = [R^T -R^T p; 0 1]."""
+    rotation = transform[:3, :3].T
+    return sympy.Matrix.vstack(sympy.Matrix.hstack(rotation, -rotation * transform[:3, 3]),
+                               sympy.Matrix([[0, 0, 0, 1]]))

@@ -295,6 +295,18 @@ MONOMIALS = np.array([np.outer(_HALF_ANGLE[b], _HALF_ANGLE[c]).ravel()
                        for b, c in ("ss", "sc", "cs", "cc", "s1", "c1", "1s", "1c", "11")])
 
 
+# Pairs (i, i + step) of those monomials whose ratio is x_c (step 1) or x_b (step 3): the kernels
+# read each from the pair of largest size in the null vector.
+ALONG_C = (0, 1, 3, 4, 6, 7, 9, 10)
+ALONG_B = tuple(range(9))
+NEWTON_STEPS = 2  # on the pose, after the back-substitution
+TOLERANCE = {"double": 1e-9, "float": 1e-3}  # |pose error| (m and rad) of a solution after them
+# An eigenvalue is a root when |imaginary part| <= this (1 + |x|): a double root the target's
+# rounding splits into a complex pair (by about the square root of that rounding) still counts,
+# and the Newton steps and the tolerance above decide.
+IMAGINARY = {"double": 1e-5, "float": 1e-3}
+
+
 def half_angle(s: np.ndarray) -> np.ndarray:
     """Six equations in v_bc (..., 6, 9) as twelve in the monomials x_b^i x_c^j (i <= 3, j <= 2,
     at 3 i + j): the six, and the six times x_b (..., 12, 12)."""
@@ -311,6 +323,7 @@ def shifted(ps: np.ndarray, pc: np.ndarray, shift: float) -> tuple[np.ndarray, n
 
 
 SAMPLES = 24  # random configurations that rate a split
+WORST_CONDITION = 1e8  # a robot whose best split rates worse gets no general solver (ik_numeric only)
 SHIFTS = 16  # origins of the hidden joint's half angle tried per split: multiples of 2 pi / SHIFTS
 
 

@@ -14,6 +14,7 @@ from dataclasses import dataclass
 
 import sympy
 
+from . import general6r
 from .structure import E_Z, SOLVERS, Geometry, SolverInfo, Structure, classify, is_zero, tidy
 from .subproblems import (EPS, Above, Angle, AtLeast, AtMost, Below, Floor, IsFinite, Subproblems, relative, select,
                           times, times_transposed, wrapped)
@@ -36,6 +37,7 @@ class ClosedForm:
     joints: tuple[int, ...]  # the robot's joint of each of the solver's joints
     signs: tuple[int, ...]  # -1 where the solver turns the robot's joint the other way (a reversed chain)
     free: int | None  # the joint ik takes as an input (a 7-joint arm), else None
+    elimination: "general6r.Elimination | None" = None  # the general 6R solver's split (solver general_6r)
 
 
 def _scalar(value) -> Matrix:
@@ -135,6 +137,12 @@ def closed_form(robot, geometry: Geometry | None = None, structure: Structure | 
     structure = structure or classify(robot, geometry)
     if structure.solver is None:
         return None
+    if structure.solver == "general_6r":
+        plan = general6r.elimination(robot)
+        if plan.condition > general6r.WORST_CONDITION:
+            return None
+        return ClosedForm("general_6r", SOLVERS["general_6r"], "pose", (), (), False, tuple(range(6)), (1,) * 6, None,
+                          plan)
     chain = structure.chain
     constants, indices = _CONSTANTS[structure.solver](chain)
     if chain.start is not None:  # a reversed chain: its target is T(0) T^-1
@@ -181,6 +189,11 @@ def documentation(robot, form: ClosedForm, max_name: str) -> list[str]:
         "when the target is out of reach or not finite. ik_branches also gives the solutions outside "
         "the limits (in_limits 0).",
         f"Solver: {form.info.title}.",
+    ]
+    if form.solver == "general_6r":
+        text.append(f"Order: {form.info.branches[0]}; each solution once (equal to 1e-6 rad).")
+        return [line for paragraph in text for line in textwrap.wrap(paragraph, DOC_WIDTH)]
+    text += [
         *_chain_text(form),
         "Order: nested loops over the branches, outermost first; where a subproblem has two roots "
         "phi +- alpha (alpha in (0, pi)), phi + alpha ('+') comes first:",
@@ -412,17 +425,29 @@ def branches(robot, form: ClosedForm, sp: Subproblems, target, free_angle=None) 
         raise AssertionError(f"{form.solver}: {len(solved)} branches, documented {form.info.max_solutions}")
     # One test for all entries: their sum is finite unless one is not (or they exceed 1e307).
     finite = IsFinite(sp.name(sympy.Add(*(target[:3, :] if form.target == "pose" else target))))
-    free_limits = robot.joints[form.free].limits if form.free is not None else None
     rows, inside = [], []
     for values, _ in solved:
-        q, limited = [free_angle] * robot.dof, [_inside(free_angle, free_limits) if free_limits else sympy.true]
+        q = [free_angle] * robot.dof
         for joint, sign, value in zip(form.joints, form.signs, values):
-            q[joint], joint_inside = _in_limits(sp, wrapped(sign * value) if robot.joints[joint].revolute
-                                                else sign * value, robot.joints[joint])
-            limited.append(joint_inside)
+            q[joint] = sign * value
+        q, row_inside = limited(robot, sp, q, form.joints, form.free)
         rows.append(q)
-        inside.append(sympy.And(*limited))
+        inside.append(row_inside)
     return sympy.Matrix(rows), [sympy.And(finite, valid) for _, valid in solved], inside
+
+
+def limited(robot, sp: Subproblems, q: list, order: tuple[int, ...], free: int | None = None
+            ) -> tuple[list, sympy.Basic]:
+    """ik's form of a configuration (revolute angles wrapped, see `_in_limits`; the free joint
+    as given) and whether it is inside the joint limits; the joints named in `order`."""
+    q = list(q)
+    inside = [] if free is None else [_inside(q[free], robot.joints[free].limits) if robot.joints[free].limits
+                                      else sympy.true]
+    for j in order:
+        joint = robot.joints[j]
+        q[j], joint_inside = _in_limits(sp, wrapped(q[j]) if joint.revolute else q[j], joint)
+        inside.append(joint_inside)
+    return q, sympy.And(*inside)
 
 
 def _nearest_equivalent(sp: Subproblems, value, given, seed, joint):

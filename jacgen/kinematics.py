@@ -329,9 +329,15 @@ def task_jacobian_dot(robot: Robot, pose: Matrix, jacobian: Matrix, jacobian_dot
     return Matrix.vstack(*(rows[component] for component in robot.task))
 
 
+READABLE_TERMS = 64  # a sum with more terms stays expanded: TR10i's pairing grows with their square
+
+
 def simplify_trig(expression: sympy.Expr) -> sympy.Expr:
-    """Expand, then collapse sin/cos products of joint sums (c1 c2 - s1 s2 -> cos(q1 + q2))."""
-    return TR10i(sympy.expand(expression))
+    """Expand, then collapse sin/cos products of joint sums (c1 c2 - s1 s2 -> cos(q1 + q2)),
+    for a sum of at most READABLE_TERMS terms (an arm with irrational twists, the Jaco's 60
+    degrees, makes sums of hundreds: TR10i took minutes on one)."""
+    expanded = sympy.expand(expression)
+    return TR10i(expanded) if len(sympy.Add.make_args(expanded)) <= READABLE_TERMS else expanded
 
 
 class Kinematics:

@@ -9,7 +9,7 @@ from .analysis import READABLE_TERMS, Factor, Singularities, singularity_rows
 from .errors import JacgenError
 from .model import Model
 from .robot import TASK_COMPONENTS, Robot
-from .structure import SOLVERS, Structure
+from .structure import SOLVERS
 
 DH_HEADER = ["#", "name", "type", "a", "alpha", "d", "theta", "offset", "limits"]
 
@@ -131,10 +131,19 @@ def isotropy_lines(robot: Robot) -> list[str]:
             f"best conditioned at {where}, condition number {condition:.6g}"]
 
 
-def ik_lines(structure: Structure) -> list[str]:
+def ik_lines(model: Model) -> list[str]:
+    structure, form = model.structure, model.closed_form
     if structure.solver is None:
         return [f"no closed form ({structure.reason}); ik_numeric only"]
     info = SOLVERS[structure.solver]
+    if structure.solver == "general_6r":
+        if form is None:
+            return [f"no closed form ({structure.reason}, but no split of its loop is conditioned well enough "
+                    f"for it: see general6r.WORST_CONDITION); ik_numeric only"]
+        plan = form.elimination
+        return [f"general 6R: {info.max_solutions} solutions at most ({structure.reason})",
+                f"{info.title}: {plan.equations.split.text}; the half angle shifted by {plan.shift:.6g} rad; "
+                f"median condition number {plan.condition:.2g} over random configurations"]
     chain = structure.chain
     joints = ""
     if chain.joints != tuple(range(len(chain.joints))):
@@ -161,7 +170,7 @@ def describe(model: Model) -> str:
     isotropy = isotropy_lines(robot)
     if isotropy:
         lines += ["", "isotropy:"] + [f"  {line}" for line in isotropy]
-    lines += ["", "inverse kinematics:"] + [f"  {line}" for line in ik_lines(model.structure)]
+    lines += ["", "inverse kinematics:"] + [f"  {line}" for line in ik_lines(model)]
     return "\n".join(lines)
 
 

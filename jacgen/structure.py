@@ -81,6 +81,12 @@ SOLVERS = {
         8, ("shoulder: q1, '+' then '-' (the arm left and right of the base axis)",
             "wrist: q5, '+' then '-' (the two wrist-2 angles, wrist up and down)",
             "elbow: q3, '+' then '-' (elbow up and down)")),
+    "general_6r": SolverInfo(
+        "general 6R: Raghavan & Roth's 14 equations, eliminated to a 12 x 12 quadratic matrix "
+        "polynomial in tan(q_k/2) solved as a 24 x 24 eigenproblem, back-substitution and two "
+        "Newton steps (jacgen/general6r.py)",
+        16, ("the real eigenvalues in the order the eigensolver gives them; a solution that does not "
+             "reach the target after the Newton steps (a spurious root) is skipped",)),
 }
 
 
@@ -385,6 +391,8 @@ def classify(robot: Robot, geometry: Geometry | None = None) -> Structure:
     if task == TASK_COMPONENTS:
         if n == 6:
             solver, reason, chain = _six_dof(g)
+            if solver is None and all(g.revolute) and not robot.symbolic_parameters:
+                solver, reason = "general_6r", f"no special class: {reason}"
         elif n == 7:
             solver, reason, chain = _free_joint(robot)
         elif n > 7:

@@ -321,8 +321,9 @@ def _ik_results(robot: Robot, backends: _Backends, q: np.ndarray, tolerances: di
         solvers = {"python": lambda target, *free: backends.python.ik(target, *free, **nominal)}
         solvers.update({f"c {real}": lambda target, *free, library=library: library.ik(
             target, form.info.max_solutions, None, *free) for real, library in backends.c.items()})
-        solvers["casadi"] = functools.partial(_casadi_ik, backends.casadi, nominal)
-        errors = {}
+        if form.solver != "general_6r":  # CasADi has no ik for it (an eigensolver loop)
+            solvers["casadi"] = functools.partial(_casadi_ik, backends.casadi, nominal)
+        errors = dict.fromkeys(BACKENDS)
         for backend, solve in solvers.items():
             worst = 0.0
             for target, given in zip(targets, free):
