@@ -292,7 +292,7 @@ class Generator:
             v = _rigid_inverse(n).applyfunc(name) if split.target_inverted else n
             values = {**{equations.rotation[k]: v[k // 3, k % 3] for k in range(9)},
                       **{equations.translation[k]: v[k, 3] for k in range(3)}}
-            p0, ps, pc, q = (m.xreplace(values) for m in (equations.p0, equations.ps, equations.pc, equations.q))
+            p0, ps, pc, q = (m.xreplace(values) for m in equations.matrices)
             cos, sin = sympy.Float(math.cos(plan.shift), 17), sympy.Float(math.sin(plan.shift), 17)
             ps, pc = cos * ps - sin * pc, sin * ps + cos * pc
             stacked = sympy.Matrix.vstack(p0, ps, pc)

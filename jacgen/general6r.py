@@ -32,6 +32,7 @@ the structure stage, and what cancels between them (below 1e-40) is dropped.
 """
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 import sympy
@@ -99,27 +100,46 @@ SPLITS = tuple(Split(backwards, free) for backwards in (False, True) for free in
 
 @dataclass(frozen=True)
 class Equations:
-    """(p0 + s_a ps + c_a pc) v_bc = q v_gh, over the symbols of V's rotation and translation;
-    `terms` holds the same as numbers (see `evaluated`)."""
+    """(p0 + s_a ps + c_a pc) v_bc = q v_gh, over the symbols of V's rotation and translation,
+    as terms: (matrix: 0 p0, 1 ps, 2 pc, 3 q; its flat entry; V's exponents; coefficient). The
+    rating of a split reads them as numbers (`evaluated`); the sympy matrices are built for the
+    chosen split alone (`matrices`)."""
 
     split: Split
-    p0: sympy.Matrix  # 14 x 9
-    ps: sympy.Matrix  # 14 x 9
-    pc: sympy.Matrix  # 14 x 9
-    q: sympy.Matrix  # 14 x 8 (as 14 x 9, its last column zero, in `evaluated`)
-    rotation: sympy.Matrix  # V's 3 x 3 symbols
-    translation: sympy.Matrix  # V's 3 x 1 symbols
-    terms: tuple[np.ndarray, np.ndarray, np.ndarray]  # exponents (T x 12), coefficients (T), flat entry (T)
+    terms: tuple[tuple[int, int, tuple[int, ...], object], ...]
+
+    @cached_property
+    def _arrays(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        matrix, entry, exponents, coefficients = zip(*self.terms)
+        return (np.array(exponents, dtype=float), np.array([float(c) for c in coefficients]),
+                np.array(matrix) * 14 * 9 + np.array(entry))
 
     def evaluated(self, targets: np.ndarray) -> np.ndarray:
         """p0, ps, pc, q at a batch of V's (..., 12: rotation by rows, then translation), as an
-        array (..., 4, 14, 9)."""
-        exponents, coefficients, entries = self.terms
+        array (..., 4, 14, 9) (q's last column zero)."""
+        exponents, coefficients, entries = self._arrays
         values = coefficients * np.prod(targets[..., None, :] ** exponents, axis=-1)
         out = np.zeros((*targets.shape[:-1], 4 * 14 * 9))
         for entry in np.unique(entries):  # a few hundred entries: sum their terms
             out[..., entry] = values[..., entries == entry].sum(-1)
         return out.reshape(*targets.shape[:-1], 4, 14, 9)
+
+    @cached_property
+    def matrices(self) -> tuple[sympy.Matrix, sympy.Matrix, sympy.Matrix, sympy.Matrix]:
+        """p0, ps, pc (14 x 9) and q (14 x 8) over `rotation` and `translation`."""
+        target = sympy.symbols(GENERATORS, real=True)[12:]
+        matrices = [sympy.zeros(14, 9) for _ in range(4)]
+        for matrix, entry, exponents, coefficient in self.terms:
+            matrices[matrix][entry] += sympy.Float(coefficient, PRECISION) * _monomial(target, exponents)
+        return (*matrices[:3], matrices[3][:, :8])
+
+    @property
+    def rotation(self) -> sympy.Matrix:
+        return sympy.Matrix(3, 3, sympy.symbols(GENERATORS, real=True)[12:21])
+
+    @property
+    def translation(self) -> sympy.Matrix:
+        return sympy.Matrix(sympy.symbols(GENERATORS, real=True)[21:])
 
 
 def chain_form(robot: Robot) -> tuple[sympy.Matrix, list[Link], sympy.Matrix]:
@@ -167,8 +187,8 @@ def equations(links: list[Link], split: Split) -> Equations:
         r, t = constants[position]
         if inverse:
             w = [v[k] - t[k] for k in range(3)] if point else v
-            return [sum(r[k][i] * w[k] for k in range(3)) for i in range(3)]
-        return [sum(r[i][k] * v[k] for k in range(3)) + (t[i] if point else zero) for i in range(3)]
+            return [sum(w[k] * r[k][i] for k in range(3)) for i in range(3)]  # polynomial * number: sympy's fast path
+        return [sum(v[k] * r[i][k] for k in range(3)) + (t[i] if point else zero) for i in range(3)]
 
     def through(steps, v, point):
         for step in reversed(steps):
@@ -253,16 +273,12 @@ def _product(monomial: tuple[int, ...], x: int, y: int, others: tuple[int, ...],
 
 
 def _matrices(split: Split, left: list[dict], right: list[dict]) -> Equations:
-    symbols = sympy.symbols(GENERATORS, real=True)
-    target = symbols[12:]
     a, b, c = split.triple
     g, h = split.pair
-    matrices = [sympy.zeros(14, 9) for _ in range(4)]  # constant, s_a, c_a; q
-    terms = []  # (exponents of V, coefficient, flat entry)
+    terms = []
 
-    def add(part, row, column, coefficient, monomial):
-        matrices[part][row, column] += sympy.Float(coefficient, PRECISION) * _monomial(target, monomial[12:])
-        terms.append((monomial[12:], float(coefficient), (part * 14 + row) * 9 + column))
+    def add(matrix, row, column, coefficient, monomial):
+        terms.append((matrix, row * 9 + column, monomial[12:], coefficient))
 
     for row, (lhs, rhs) in enumerate(zip(left, right)):
         for monomial, coefficient in lhs.items():
@@ -278,10 +294,7 @@ def _matrices(split: Split, left: list[dict], right: list[dict]) -> Equations:
                 add(0, row, 8, -coefficient, monomial)
             else:
                 add(3, row, column, coefficient, monomial)
-    exponents, coefficients, entries = zip(*terms)
-    arrays = (np.array(exponents, dtype=float), np.array(coefficients), np.array(entries))
-    return Equations(split, *matrices[:3], matrices[3][:, :8], sympy.Matrix(3, 3, target[:9]),
-                     sympy.Matrix(target[9:]), arrays)
+    return Equations(split, tuple(terms))
 
 
 def _monomial(symbols, exponents) -> sympy.Expr:
@@ -325,6 +338,8 @@ def shifted(ps: np.ndarray, pc: np.ndarray, shift: float) -> tuple[np.ndarray, n
 SAMPLES = 24  # random configurations that rate a split
 WORST_CONDITION = 1e8  # a robot whose best split rates worse gets no general solver (ik_numeric only)
 SHIFTS = 16  # origins of the hidden joint's half angle tried per split: multiples of 2 pi / SHIFTS
+TIE = 0.01  # a later candidate must rate 1% better: near ties (a shift and the shift + pi) go to the
+# first, not to rounding noise of the machine's LAPACK, so that generated code is the same everywhere
 
 
 @dataclass(frozen=True)
@@ -365,7 +380,7 @@ whose null space at a root has more than one vector, from which v_bc cannot). De
             shift = 2 * np.pi * k / SHIFTS
             leading = np.median(np.linalg.cond(half_angle(s0 - shifted(ss, sc, shift)[1])))
             condition = float(max(leading, pair, vector))
-            if best is None or condition < best.condition:
+            if best is None or condition < best.condition * (1 - TIE):
                 best = Elimination(equations_, shift, condition)
     return best
 
