@@ -1,12 +1,14 @@
 """Support of the general 6R tests (tests/test_general6r.py, tests/test_c_runtime.py): the
-arms of issue 22 and the whole elimination of `jacgen.general6r` carried out in numpy, with a
-kernel argument so that the C kernel's roots go through the same completion."""
+arms of issue 22; the whole elimination of `jacgen.general6r` carried out in numpy, with a
+kernel argument so that the C kernel's roots go through the same completion; and an independent
+count of solutions, by a multi-start Levenberg-Marquardt search on the numpy reference."""
 
 import functools
 import math
 
 import numpy as np
 import sympy
+from scipy.optimize import least_squares
 
 from jacgen import general6r, reference
 from jacgen.robot import parse_robot
@@ -160,3 +162,14 @@ ARMS = {"manocha_canny": MANOCHA_CANNY, "jaco": JACO, "ur5_calibrated": UR5_CALI
 @functools.cache
 def solver_of(name: str) -> Solver:
     return Solver(robot_of(ARMS[name]))
+
+
+def multi_start(robot, pose: np.ndarray, starts: int, rng) -> list[np.ndarray]:
+    """Solutions found by Levenberg-Marquardt on the reference fk from random starts."""
+    found = []
+    for start in rng.uniform(-math.pi, math.pi, (starts, 6)):
+        result = least_squares(lambda q: (reference.fk(robot, q) - pose)[:3].ravel(), start, method="lm")
+        q = wrapped(result.x)
+        if np.abs(reference.fk(robot, q) - pose).max() < 1e-9 and all(np.abs(wrapped(s - q)).max() > 1e-6 for s in found):
+            found.append(q)
+    return found

@@ -21,18 +21,27 @@ from jacgen.functions import Generator
 from jacgen.printers import CPrinter
 from jacgen.render import render_robot, write_files
 from jacgen.robot import load_robot
+from jacgen.structure import classify
 
 from conftest import ROBOT_FILES, ROOT, random_configurations
 
 ARM_FLAGS = ("-mcpu=cortex-m4", "-mthumb", "-mfloat-abi=hard", "-mfpu=fpv4-sp-d16", "-Os")
-LIBM = {name + suffix for name in "sin cos sincos tan asin acos atan atan2 sqrt fabs hypot ceil floor".split()
+LIBM = {name + suffix for name in "sin cos sincos tan asin acos atan atan2 sqrt fabs hypot ceil floor fmax remainder".split()
         for suffix in ("", "f")}
+# The general 6R solver's eigenproblem kernel computes in double in a float build too (its
+# 24 x 24 eigenproblem needs it; docs/contract.md): those objects may call the double functions
+# and, on the Cortex-M4F, libgcc's software double arithmetic.
+DOUBLE_KERNEL = {f"{path.stem}.o" for path in ROBOT_FILES if classify(load_robot(path)).solver == "general_6r"}
 # GCC may emit calls to these for array copies even in freestanding code, which must provide
 # them ("Standards", GCC manual); the sources call none of them.
 COMPILER_RUNTIME = {"memcpy", "memmove", "memset", "memcmp"}
 # Bytes per function. Straight-line functions keep only scalars (a few hundred bytes); ik
 # keeps its candidate solutions. A change that puts big arrays on the stack fails here.
 STACK_LIMIT = 4096
+# The general 6R solver's ik_branches holds its 24 x 24 companion matrix, the equations and the
+# kernel's work arrays (about 27 kB on the host); to fall to 4 kB it needs the deflated 16 x 16
+# problem (issue 22's next step). Every other function of those robots stays under STACK_LIMIT.
+GENERAL_STACK_LIMIT = 32768
 
 # A robot with runtime parameters in the base translation only: fk and task read `p`, the
 # Jacobians do not (they must still take it, and compile without an unused-parameter warning).
@@ -98,17 +107,24 @@ def _check_objects(folder, nm, real, runtime=()):
     functions in float builds; every function's stack use is static and small."""
     for obj in sorted(folder.glob("*.o")):
         undefined = set(_run([nm, "-u", obj]).split()) - {"U"} - COMPILER_RUNTIME
-        undefined = {name for name in undefined if not name.startswith(runtime)} if runtime else undefined
+        kernel = ("__aeabi_",) if obj.name in DOUBLE_KERNEL else ()
+        undefined = {name for name in undefined if not name.startswith(runtime + kernel)} if runtime + kernel \
+            else undefined
         assert undefined <= LIBM, (obj.name, undefined - LIBM)
-        if real == "float":
+        if real == "float" and obj.name not in DOUBLE_KERNEL:
             assert all(name.endswith("f") for name in undefined), (obj.name, undefined)
     usage = []
-    for line in "".join(path.read_text() for path in folder.glob("*.su")).splitlines():
-        where, size, kind = line.rsplit("\t", 2)
-        usage.append((int(size), where.rsplit(":", 1)[-1], kind))
+    for path in folder.glob("*.su"):
+        general = f"{path.stem}.o" in DOUBLE_KERNEL
+        for line in path.read_text().splitlines():
+            where, size, kind = line.rsplit("\t", 2)
+            function = where.rsplit(":", 1)[-1]
+            limit = GENERAL_STACK_LIMIT if general and function.endswith("_ik_branches") else STACK_LIMIT
+            usage.append((int(size), function, kind, limit))
     worst = max(usage)
     print(f"worst stack usage ({real}): {worst[0]} bytes in {worst[1]} ({worst[2]})")
-    assert worst[0] <= STACK_LIMIT and all(kind == "static" for _, _, kind in usage)
+    assert all(size <= limit and kind == "static" for size, _, kind, limit in usage), \
+        [(size, function) for size, function, _, limit in usage if size > limit]
 
 
 def test_host_compile_is_warning_free_and_needs_only_libm(shipped_c, tmp_path):

@@ -50,7 +50,9 @@ def library(tmp_path_factory):
     folder = tmp_path_factory.mktemp("runtime")
     (folder / "harness.c").write_text(HARNESS)
     template = (ROOT / "templates" / "c" / "general6r.c.jinja").read_text()
-    (folder / "general6r.c").write_text(jinja2.Template(template).render(monomials=general6r.MONOMIALS.astype(int).tolist()))
+    (folder / "general6r.c").write_text(jinja2.Template(template).render(
+        monomials=general6r.MONOMIALS.astype(int).tolist(), along_b=general6r.ALONG_B, along_c=general6r.ALONG_C,
+        imaginary=general6r.IMAGINARY["double"]))
     library = ctypes.CDLL(str(compile_shared([folder / "harness.c"], folder / "libruntime.so",
                                              ("-O2", f"-I{ROOT / 'templates' / 'c'}"))))
     library.eigenvalues.argtypes = [ctypes.c_int, POINTER, POINTER, POINTER]

@@ -38,7 +38,7 @@ def generated(tmp_path_factory):
         robot = shipped_robot(name)
         generator = Generator(robot)
         write_files(render_robot(robot, ("casadi", "python"), "double", generator), folder)
-        return (robot, generator.functions(), import_file(folder / name / f"{name}_casadi.py", f"test_{name}_casadi"),
+        return (robot, generator.without_loops(), import_file(folder / name / f"{name}_casadi.py", f"test_{name}_casadi"),
                 import_file(folder / name / f"{name}.py", f"test_{name}_numpy"))
 
     return load

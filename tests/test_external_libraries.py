@@ -68,7 +68,18 @@ RTB_MODELS = {
     "ur5": lambda: rtb.models.DH.UR5(),
     "kr5": lambda: rtb.models.DH.KR5(),
     "panda": lambda: rtb.models.DH.Panda(),
+    "jaco": lambda: rtb.models.DH.Jaco(),
+    "mico": lambda: rtb.models.DH.Mico(),
+    "manocha_canny": lambda: _rtb_dh("manocha_canny"),
+    "ur5_calibrated": lambda: _rtb_dh("ur5_calibrated"),
 }
+
+
+def _rtb_dh(name):
+    """rtb's DHRobot of the standard DH rows of a shipped arm that rtb has no model of (no base,
+    tool or offsets in those files)."""
+    arm = robot_of(name)
+    return rtb.DHRobot([rtb.RevoluteDH(a=j.a.approx, alpha=j.alpha.approx, d=j.d.approx) for j in arm.joints], name=name)
 
 
 def _rot_x(angle):

@@ -10,9 +10,8 @@ import math
 import numpy as np
 import pytest
 import roboticstoolbox as rtb
-from scipy.optimize import least_squares
 
-from general6r_arms import ARMS, JACO, Solver, numeric, robot_of, solver_of, wrapped
+from general6r_arms import ARMS, JACO, Solver, multi_start, numeric, robot_of, solver_of, wrapped
 from jacgen import general6r, reference
 from random_arms import random_arm_text
 
@@ -95,24 +94,13 @@ def test_random_arms_give_back_their_configurations(text):
         assert min(np.abs(wrapped(s - q)).max() for s in solutions) < 1e-8
 
 
-def _multi_start(robot, pose: np.ndarray, starts: int, rng) -> list[np.ndarray]:
-    """Solutions found by Levenberg-Marquardt on the reference fk from random starts."""
-    found = []
-    for start in rng.uniform(-math.pi, math.pi, (starts, 6)):
-        result = least_squares(lambda q: (reference.fk(robot, q) - pose)[:3].ravel(), start, method="lm")
-        q = wrapped(result.x)
-        if np.abs(reference.fk(robot, q) - pose).max() < 1e-9 and all(np.abs(wrapped(s - q)).max() > 1e-6 for s in found):
-            found.append(q)
-    return found
-
-
 @pytest.mark.parametrize("name", ARMS)
 def test_finds_every_solution_a_multi_start_search_finds(name):
     solver, rng = solver_of(name), np.random.default_rng(4)
     robot = solver.robot
     for q in rng.uniform(-math.pi, math.pi, (2, 6)):
         pose = reference.fk(robot, q)
-        ours, theirs = solver.solve(pose), _multi_start(robot, pose, 100, rng)
+        ours, theirs = solver.solve(pose), multi_start(robot, pose, 100, rng)
         assert len(theirs) >= 2
         for s in theirs:
             assert min(np.abs(wrapped(s - o)).max() for o in ours) < 1e-6

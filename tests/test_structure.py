@@ -23,6 +23,10 @@ EXPECTED = {
     "ur5": "three_parallel",
     "iiwa": "spherical_wrist_intersecting",  # joint 3 free
     "panda": "spherical_wrist_intersecting",  # joint 7 free, solved from the tool back
+    "jaco": "general_6r",
+    "mico": "general_6r",
+    "manocha_canny": "general_6r",
+    "ur5_calibrated": "general_6r",
 }
 
 # Craig's Puma 560 table (modified DH): the same arm class whatever the convention.
@@ -82,7 +86,7 @@ def test_reasons_name_what_is_missing():
     eight = seven.replace(a7, a7 + "\n  - {name: a8, type: revolute, a: 0, alpha: 90, d: 0.1, offset: 0}")
     assert "redundant" in classify(parse_robot(eight.encode())).reason
     skewed = classify(parse_robot(NO_STRUCTURE.encode()))
-    assert skewed.solver is None
+    assert skewed.solver == "general_6r"
     assert "no spherical wrist" in skewed.reason and "no three parallel" in skewed.reason
 
 
@@ -105,16 +109,17 @@ def test_classes_do_not_depend_on_the_convention_or_exact_angles():
     # 89.99 deg is not 90 deg: axes 2 and 3 of the UR5 stop being parallel.
     ur5 = open(robot("ur5").source).read()
     bent = ur5.replace("a: a3, alpha: 0,", "a: a3, alpha: 0.01,")
-    assert classify(parse_robot(bent.encode())).solver is None
+    assert classify(parse_robot(bent.encode())).solver == "general_6r"  # no special class
 
 
 def test_a_calibrated_arm_is_not_parallel():
     """Off by 1e-4 rad (far above the 1e-40 tolerance of the contract), axes 2 and 3 of a UR5
-    are not parallel, and no class applies; within 1e-9 rad of pi/2 the file snaps to it."""
+    are not parallel, and no special class applies (the general 6R solver does); within 1e-9
+    rad of pi/2 the file snaps to it."""
     ur5 = open(robot("ur5").source).read()
     assert "a: a3, alpha: 0," in ur5
     calibrated = ur5.replace("a: a3, alpha: 0,", "a: a3, alpha: 0.0057296,")  # deg: 1e-4 rad
-    assert classify(parse_robot(calibrated.encode())).solver is None
+    assert classify(parse_robot(calibrated.encode())).solver == "general_6r"
 
 
 def test_irrational_twists_are_decided_in_bounded_time():
@@ -142,5 +147,6 @@ def test_planar_needs_a_matching_task():
 
 
 def test_every_solver_is_documented():
-    for info in SOLVERS.values():
-        assert info.max_solutions in (2, 8) and info.branches
+    for name, info in SOLVERS.items():
+        assert info.max_solutions == {"planar": 2, "general_6r": 16}.get(name, 8)
+        assert info.branches

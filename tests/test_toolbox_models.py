@@ -68,12 +68,3 @@ def test_toolbox_model_generates_and_matches(tmp_path, name):
         np.testing.assert_allclose(module.fk(ours), model.fkine(theirs).A, atol=1e-12, rtol=0)
         np.testing.assert_allclose(module.jacobian(ours), model.jacob0(theirs) * flips, atol=1e-12, rtol=0)
         np.testing.assert_allclose(module.jacobian_tool(ours), model.jacobe(theirs) * flips, atol=1e-12, rtol=0)
-
-
-@pytest.mark.parametrize("name", ["Jaco", "Mico"])
-def test_kinova_arms_verify(tmp_path, name):
-    """The two arms that crashed generation before (issue 9): every backend, C included."""
-    path = tmp_path / f"{name}.yaml"
-    path.write_text(robot_file(getattr(rtb.models.DH, name)())[0])
-    result = CliRunner().invoke(main, ["verify", str(path), "--samples", "40"], catch_exceptions=False)
-    assert result.exit_code == 0, result.output

@@ -1,0 +1,101 @@
+"""The generated general 6R solver (class general_6r) of the shipped arms without a special
+class (Jaco, Mico, Manocha-Canny, a calibrated UR5): batched numpy `ik_branches` and C `ik`
+(double and float) by round trip on the numpy reference, the generating configuration among
+the solutions, every solution of a multi-start search among them, degenerate targets giving
+no solution rather than a wrong one; and the class and report of such an arm."""
+
+import math
+
+import numpy as np
+import pytest
+
+from conftest import GENERATED, generated_module, robot
+from general6r_arms import multi_start, wrapped
+from jacgen import reference
+from jacgen.compile import CLibrary, compile_shared
+from jacgen.functions import Generator
+from jacgen.model import Model
+from jacgen.render import render_robot
+
+ARMS = ["jaco", "mico", "manocha_canny", "ur5_calibrated"]
+
+
+def _poses(arm, count: int, seed: int) -> tuple[np.ndarray, np.ndarray]:
+    q = np.random.default_rng(seed).uniform(-math.pi, math.pi, (count, 6))
+    return q, np.array([reference.fk(arm, row) for row in q])
+
+
+@pytest.mark.parametrize("name", ARMS)
+def test_numpy_ik_branches_give_back_every_configuration(name):
+    arm, module = robot(name), generated_module(name)
+    q, poses = _poses(arm, 150, 1)
+    solutions, valid, _ = module.ik_branches(poses)
+    assert solutions.shape == (150, 16, 6) and valid.shape == (150, 16)
+    for k in range(len(q)):
+        found = solutions[k][valid[k]]
+        assert valid[k].sum() % 2 == 0 and np.all(np.isfinite(found))
+        assert max(np.abs(reference.fk(arm, s) - poses[k]).max() for s in found) < 1e-9
+        assert min(np.abs(wrapped(s - q[k])).max() for s in found) < 1e-8
+        assert not valid[k][int(valid[k].sum()):].any()  # the valid rows first
+    if name == "manocha_canny":
+        assert valid.sum(1).max() == 16
+
+
+@pytest.mark.parametrize("name", ARMS)
+def test_numpy_ik_finds_every_solution_of_a_multi_start_search(name):
+    arm, module = robot(name), generated_module(name)
+    rng = np.random.default_rng(8)
+    for q in rng.uniform(-math.pi, math.pi, (2, 6)):
+        pose = reference.fk(arm, q)
+        ours, theirs = module.ik(pose, limits=False), multi_start(arm, pose, 100, rng)
+        assert len(theirs) >= 2 and len(ours) >= len(theirs)
+        for t in theirs:
+            assert min(np.abs(wrapped(t - o)).max() for o in ours) < 1e-6
+
+
+@pytest.fixture(scope="module", params=["double", "float"])
+def c_solver(request, tmp_path_factory):
+    """The C ik of each arm, in double from generated/, in float generated here."""
+    folder = tmp_path_factory.mktemp(request.param)
+    libraries = {}
+    for name in ARMS:
+        arm = robot(name)
+        if request.param == "double":
+            source = GENERATED / name / f"{name}.c"
+        else:  # ik and its callees, rendered in float
+            for relative, text in render_robot(arm, ("c",), "float", Generator(arm, selection=("ik",))).items():
+                (folder / relative.split("/")[-1]).write_text(text)
+            source = folder / f"{name}.c"
+        libraries[name] = CLibrary(compile_shared([source], folder / f"lib{name}.so"), arm, [], request.param)
+    return request.param, libraries
+
+
+@pytest.mark.parametrize("name", ARMS)
+def test_c_ik_gives_back_every_configuration(c_solver, name):
+    real, libraries = c_solver
+    arm, library = robot(name), libraries[name]
+    tolerance = 1e-9 if real == "double" else 2e-3
+    q, poses = _poses(arm, 60, 2)
+    python = generated_module(name)
+    for k in range(len(q)):
+        found = library.ik(poses[k], 16)
+        assert len(found) and max(np.abs(reference.fk(arm, s) - poses[k]).max() for s in found) < tolerance
+        if real == "double":
+            assert min(np.abs(wrapped(s - q[k])).max() for s in found) < 1e-8
+            assert len(found) == len(python.ik(poses[k]))
+
+
+def test_targets_out_of_reach_or_not_finite_give_no_solution():
+    arm, module = robot("jaco"), generated_module("jaco")
+    far = np.eye(4)
+    far[:3, 3] = (5.0, 0.0, 0.0)  # the Jaco reaches about 1 m
+    bad = np.full((4, 4), np.nan)
+    solutions, valid, _ = module.ik_branches(np.array([far, bad]))
+    assert not valid.any() and np.all(np.isfinite(solutions))
+
+
+def test_the_class_and_the_report_name_the_general_solver():
+    model = Model(robot("jaco"))
+    assert model.structure.solver == "general_6r" and model.closed_form.info.max_solutions == 16
+    report = (GENERATED / "jaco" / "jaco.md").read_text()
+    assert "general 6R: 16 solutions at most" in report
