@@ -18,6 +18,14 @@ rounds), the real solutions found (EAIK and ik-geo also return least-squares can
 not counted) and each time over the C-via-ctypes one. The derivation time of every shipped
 robot's closed form (structure detection and exact constants, `jacgen.ik.closed_form`) is
 printed first.
+
+A second table has the general 6R solver (class general_6r) on the shipped Jaco, Manocha-Canny
+arm and calibrated UR5, on random poses (fk of uniform joint vectors): the C `NAME_ik` in a
+native loop, the batched numpy `ik_branches` (all poses in one call), and ssik 8.2.0
+(`ssik.Manipulator.from_dh(...).solve`, its C++ path, when installed; its `prepare` takes
+30-60 s per arm and is not timed). Per solver: microseconds per pose, the mean number of
+solutions, the rate at which the generating configuration is among them, the rate of
+solutions that miss the target by more than 1e-8, and how often the count equals ssik's.
 """
 
 import argparse
@@ -46,6 +54,7 @@ from conftest import without_limits  # noqa: E402
 from test_ik import kinematic_chain  # noqa: E402
 
 ROBOTS = {"ur5": IkGeoRobot.three_parallel_two_intersecting, "puma560": IkGeoRobot.spherical_two_parallel}
+GENERAL = ("jaco", "manocha_canny", "ur5_calibrated")
 
 HARNESS = r"""
 #define _POSIX_C_SOURCE 199309L
@@ -149,10 +158,84 @@ def solvers(robot, library, ik_geo_factory):
     return {"C via ctypes": ours, "EAIK": theirs_eaik, "ik-geo": theirs_ik_geo}
 
 
+def _wrapped(a: np.ndarray) -> np.ndarray:
+    return (a + np.pi) % (2 * np.pi) - np.pi
+
+
+def _quality(robot, q: np.ndarray, targets: np.ndarray, found: list[np.ndarray]) -> tuple[float, float, float]:
+    """Mean solutions, the rate of poses whose configuration q is among them, the rate of
+    solutions off the target by more than 1e-8."""
+    recovered = sum(len(s) > 0 and np.abs(_wrapped(s - row)).max(axis=1).min() < 1e-6 for s, row in zip(found, q))
+    errors = [np.abs(reference.fk(robot, x) - T).max() for s, T in zip(found, targets) for x in s]
+    return (np.mean([len(s) for s in found]), recovered / len(q),
+            sum(e > 1e-8 for e in errors) / max(len(errors), 1))
+
+
+def _ssik_solver(robot):
+    """ssik's solver for the arm as (target -> solutions as jacgen's q), None without ssik."""
+    try:
+        import ssik
+    except ImportError:
+        return None
+    alpha, a, d, offset = (np.array([getattr(joint, key).approx for joint in robot.joints])
+                           for key in ("alpha", "a", "d", "offset"))
+    arm = ssik.Manipulator.from_dh(alpha, a, d)
+    arm.prepare()
+    head = np.linalg.inv(reference._pose(robot.base))  # ssik's chain starts at frame 0, without a base
+    tool = np.linalg.inv(reference._pose(robot.tool))
+
+    def solve(T):
+        return [_wrapped(np.asarray(s.q) - offset) for s in arm.solve(head @ T @ tool, respect_limits=False)]
+    return solve
+
+
+def general_table(targets_count: int, rounds: int, folder: Path) -> None:
+    """The general 6R solver beside ssik (see the module docstring)."""
+    import importlib.util
+    from jacgen.compile import CLibrary
+    print(f"\ngeneral 6R solver, {targets_count} random poses; us per pose (median of {rounds} rounds); "
+          "recovered = the generating configuration among the solutions; off = solutions missing by > 1e-8")
+    print(f"{'robot':15s} {'solver':13s} {'us/pose':>9s} {'mean sol':>9s} {'recovered':>10s} {'off':>8s} "
+          f"{'= ssik count':>12s}")
+    for name in GENERAL:
+        robot = load_robot(ROOT / "robots" / f"{name}.yaml")
+        write_files(render_robot(robot, ("c", "python")), folder)
+        source = folder / name / f"{name}.c"
+        library = CLibrary(compile_shared([source], folder / f"lib{name}.so"), robot, [], "double")
+        spec = importlib.util.spec_from_file_location(f"bench_{name}", folder / name / f"{name}.py")
+        module = importlib.util.module_from_spec(spec)
+        spec.loader.exec_module(module)
+        q = np.random.default_rng(5).uniform(-np.pi, np.pi, (targets_count, 6))
+        targets = np.array([reference.fk(robot, row) for row in q])
+        rows = {}
+        micros, _ = native(robot, source, targets, rounds, folder)
+        rows["C native"] = (micros, [library.ik(T, 16) for T in targets])
+        times = []
+        for _ in range(rounds):
+            start = time.perf_counter()
+            branches, valid, _ = module.ik_branches(targets)
+            times.append((time.perf_counter() - start) * 1e6 / len(targets))
+        rows["numpy batched"] = (statistics.median(times), [b[v] for b, v in zip(branches, valid)])
+        ssik_solve = _ssik_solver(robot)
+        if ssik_solve is not None:
+            times = []
+            for _ in range(rounds):
+                start = time.perf_counter()
+                found = [ssik_solve(T) for T in targets]
+                times.append((time.perf_counter() - start) * 1e6 / len(targets))
+            rows["ssik"] = (statistics.median(times), found)
+        for label, (micros, found) in rows.items():
+            mean, recovered, off = _quality(robot, q, targets, found)
+            same = (f"{np.mean([len(a) == len(b) for a, b in zip(found, rows['ssik'][1])]):12.1%}"
+                    if "ssik" in rows else f"{'-':>12s}")
+            print(f"{name:15s} {label:13s} {micros:9.1f} {mean:9.2f} {recovered:10.1%} {off:8.2%} {same}")
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--targets", type=int, default=2000)
     parser.add_argument("--rounds", type=int, default=7)
+    parser.add_argument("--general-targets", type=int, default=500)
     arguments = parser.parse_args()
 
     print("derivation of the closed form (structure detection + exact constants):")
@@ -179,6 +262,8 @@ def main():
             for label, solve in solvers(robot, library, ik_geo_factory).items():
                 results[label] = timed(solve, targets, arguments.rounds)
             rows.append((name, results))
+
+        general_table(arguments.general_targets, 3, folder)
 
     print(f"\nus per pose (all branches), median of {arguments.rounds} rounds over {arguments.targets} poses;"
           " ratio = time / C via ctypes")
