@@ -3,7 +3,8 @@
 The DH chain is multiplied out with floats, the geometric Jacobian is built column by
 column from the frame origins and axes, and the task Jacobian by central differences.
 It reads only the float side (`approx`) of the robot's values, at the nominal values of
-symbolic parameters.
+symbolic parameters. Every function takes one configuration q (n,) or a batch (..., n): the
+batch is the same arithmetic, broadcast (`jacgen verify` evaluates its samples at once).
 """
 
 import numpy as np
@@ -11,27 +12,36 @@ import numpy as np
 TASK_COMPONENTS = ("x", "y", "z", "roll", "pitch", "yaw")
 
 
+def _matrix(rows):
+    """A matrix from its entries, numbers or arrays of one batch shape: (..., rows, columns)."""
+    shape = np.broadcast_shapes(*(entry.shape for row in rows for entry in row if getattr(entry, "ndim", 0)))
+    if shape:
+        matrix = np.stack([np.broadcast_to(entry, shape) for row in rows for entry in row], -1)
+        matrix = matrix.reshape(*shape, len(rows), len(rows[0]))
+    else:  # one configuration: numbers
+        matrix = np.array(rows)
+    return matrix if matrix.dtype.kind in "fc" else matrix.astype(float)
+
+
 def _rot_x(angle):
     c, s = np.cos(angle), np.sin(angle)
-    return np.array([[1, 0, 0, 0], [0, c, -s, 0], [0, s, c, 0], [0, 0, 0, 1.0]])
+    return _matrix([[1, 0, 0, 0], [0, c, -s, 0], [0, s, c, 0], [0, 0, 0, 1]])
 
 
 def _rot_z(angle):
     c, s = np.cos(angle), np.sin(angle)
-    return np.array([[c, -s, 0, 0], [s, c, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1.0]])
+    return _matrix([[c, -s, 0, 0], [s, c, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]])
 
 
 def _translation(x, y, z):
-    transform = np.eye(4, dtype=np.result_type(x, y, z, float))
-    transform[:3, 3] = (x, y, z)
-    return transform
+    return _matrix([[1, 0, 0, x], [0, 1, 0, y], [0, 0, 1, z], [0, 0, 0, 1]])
 
 
 def _pose(pose):
     """world<-frame transform of a base/tool Pose: Rz(yaw) Ry(pitch) Rx(roll) after xyz."""
     roll, pitch, yaw = (v.approx for v in pose.rpy)
     cp, sp = np.cos(pitch), np.sin(pitch)
-    rot_y = np.array([[cp, 0, sp, 0], [0, 1, 0, 0], [-sp, 0, cp, 0], [0, 0, 0, 1.0]])
+    rot_y = _matrix([[cp, 0, sp, 0], [0, 1, 0, 0], [-sp, 0, cp, 0], [0, 0, 0, 1]])
     return _translation(*(v.approx for v in pose.xyz)) @ _rot_z(yaw) @ rot_y @ _rot_x(roll)
 
 
@@ -55,8 +65,8 @@ def frames(robot, q):
     q = q if np.iscomplexobj(q) else q.astype(float)
     current = _pose(robot.base)
     axes = []
-    for joint, qi in zip(robot.joints, q):
-        link = _link(robot, joint, qi)
+    for i, joint in enumerate(robot.joints):
+        link = _link(robot, joint, q[..., i])
         if robot.convention == "standard":
             axes.append(current)
             current = current @ link
@@ -74,19 +84,21 @@ def fk(robot, q):
 def jacobian(robot, q):
     """Geometric Jacobian in the world frame, rows vx vy vz wx wy wz (column formula)."""
     axes, tool = frames(robot, q)
-    p = tool[:3, 3]
+    p = tool[..., :3, 3]
     columns = []
     for joint, axis_frame in zip(robot.joints, axes):
-        z, o = axis_frame[:3, 2], axis_frame[:3, 3]
-        columns.append(np.concatenate([np.cross(z, p - o), z]) if joint.revolute else np.concatenate([z, np.zeros(3)]))
-    return np.array(columns).T
+        axis_frame = np.broadcast_to(axis_frame, tool.shape)  # the base frame is not batched
+        z, o = axis_frame[..., :3, 2], axis_frame[..., :3, 3]
+        columns.append(np.concatenate([np.cross(z, p - o) if joint.revolute else z,
+                                       z if joint.revolute else np.zeros_like(z)], -1))
+    return np.stack(columns, -1)
 
 
 def jacobian_tool(robot, q):
     """The same twist expressed in the tool frame."""
-    rotation = fk(robot, q)[:3, :3]
+    transposed = np.swapaxes(fk(robot, q)[..., :3, :3], -1, -2)
     J = jacobian(robot, q)
-    return np.vstack([rotation.T @ J[:3], rotation.T @ J[3:]])
+    return np.concatenate([transposed @ J[..., :3, :], transposed @ J[..., 3:, :]], -2)
 
 
 COMPLEX_STEP = 1e-30
@@ -101,25 +113,28 @@ def jacobian_dot(robot, q, q_dot):
 
 def hessian(robot, q):
     """d J / d q_k for each k, shape (n, 6, n): `jacobian_dot` along each joint."""
-    return np.array([jacobian_dot(robot, q, unit) for unit in np.eye(len(q))])
+    q = np.asarray(q, dtype=float)
+    return np.stack([jacobian_dot(robot, q, unit) for unit in np.eye(q.shape[-1])], -3)
 
 
 def bias_acceleration(robot, q, q_dot):
     """J' q_dot: the tool's classical acceleration at zero joint acceleration."""
-    return jacobian_dot(robot, q, q_dot) @ np.asarray(q_dot, dtype=float)
+    q_dot = np.asarray(q_dot, dtype=float)
+    return (jacobian_dot(robot, q, q_dot) @ q_dot[..., None])[..., 0]
 
 
 def rpy(rotation):
     """roll, pitch, yaw with R = Rz(yaw) Ry(pitch) Rx(roll)."""
-    pitch = np.arctan2(-rotation[2, 0], np.hypot(rotation[0, 0], rotation[1, 0]))
-    return np.array([np.arctan2(rotation[2, 1], rotation[2, 2]), pitch, np.arctan2(rotation[1, 0], rotation[0, 0])])
+    r = lambda i, j: rotation[..., i, j]  # noqa: E731
+    pitch = np.arctan2(-r(2, 0), np.hypot(r(0, 0), r(1, 0)))
+    return np.stack([np.arctan2(r(2, 1), r(2, 2)), pitch, np.arctan2(r(1, 0), r(0, 0))], -1)
 
 
 def task(robot, q):
     """The task vector mu(q): declared components of (x, y, z, roll, pitch, yaw)."""
     pose = fk(robot, q)
-    full = np.concatenate([pose[:3, 3], rpy(pose[:3, :3])])
-    return np.array([full[TASK_COMPONENTS.index(name)] for name in robot.task])
+    full = np.concatenate([pose[..., :3, 3], rpy(pose[..., :3, :3])], -1)
+    return full[..., [TASK_COMPONENTS.index(name) for name in robot.task]]
 
 
 def task_jacobian(robot, q, step=1e-4):
@@ -129,12 +144,12 @@ def task_jacobian(robot, q, step=1e-4):
     centre = task(robot, q)
 
     def offset(i, h):
-        difference = task(robot, q + h * np.eye(len(q))[i]) - centre
-        difference[angular] = (difference[angular] + np.pi) % (2 * np.pi) - np.pi
+        difference = task(robot, q + h * np.eye(q.shape[-1])[i]) - centre
+        difference[..., angular] = (difference[..., angular] + np.pi) % (2 * np.pi) - np.pi
         return difference
 
-    return np.array([(8 * (offset(i, step) - offset(i, -step)) - (offset(i, 2 * step) - offset(i, -2 * step)))
-                     / (12 * step) for i in range(len(q))]).T
+    return np.stack([(8 * (offset(i, step) - offset(i, -step)) - (offset(i, 2 * step) - offset(i, -2 * step)))
+                     / (12 * step) for i in range(q.shape[-1])], -1)
 
 
 def _euler_rates_jacobian(robot, q):
@@ -142,12 +157,12 @@ def _euler_rates_jacobian(robot, q):
     E's columns being the world axes of the roll, pitch and yaw rotations, with cos and sin
     of pitch and yaw read off R (no arctan2, so complex q is carried through)."""
     pose, J = fk(robot, q), jacobian(robot, q)
-    r = pose[:3, :3]
-    cos_pitch = np.sqrt(r[0, 0] ** 2 + r[1, 0] ** 2)
-    cos_yaw, sin_yaw, sin_pitch = r[0, 0] / cos_pitch, r[1, 0] / cos_pitch, -r[2, 0]
-    axes = np.array([[cos_yaw * cos_pitch, -sin_yaw, 0], [sin_yaw * cos_pitch, cos_yaw, 0], [-sin_pitch, 0, 1]])
-    rows = np.vstack([J[:3], np.linalg.solve(axes, J[3:])])
-    return rows[[TASK_COMPONENTS.index(name) for name in robot.task]]
+    r = pose[..., :3, :3]
+    cos_pitch = np.sqrt(r[..., 0, 0] ** 2 + r[..., 1, 0] ** 2)
+    cos_yaw, sin_yaw, sin_pitch = r[..., 0, 0] / cos_pitch, r[..., 1, 0] / cos_pitch, -r[..., 2, 0]
+    axes = _matrix([[cos_yaw * cos_pitch, -sin_yaw, 0], [sin_yaw * cos_pitch, cos_yaw, 0], [-sin_pitch, 0, 1]])
+    rows = np.concatenate([J[..., :3, :], np.linalg.solve(axes, J[..., 3:, :])], -2)
+    return rows[..., [TASK_COMPONENTS.index(name) for name in robot.task], :]
 
 
 def task_jacobian_dot(robot, q, q_dot):
@@ -162,14 +177,14 @@ def singularity_jacobian(robot, q):
     yaw (angular velocity for the angles), else the task Jacobian."""
     angles = sum(name in ("roll", "pitch", "yaw") for name in robot.task)
     if angles in (0, 3):
-        return jacobian(robot, q)[[TASK_COMPONENTS.index(name) for name in robot.task]]
+        return jacobian(robot, q)[..., [TASK_COMPONENTS.index(name) for name in robot.task], :]
     return task_jacobian(robot, q)
 
 
 def manipulability(robot, q):
     """sqrt(det(Js Js^T)) (sqrt(det(Js^T Js)) when Js is tall): the product of the singular
     values of Js, which stays accurate near 0 where the square root of a rounded det does not."""
-    return np.prod(np.linalg.svd(singularity_jacobian(robot, q), compute_uv=False))
+    return np.prod(np.linalg.svd(singularity_jacobian(robot, q), compute_uv=False), -1)
 
 
 def jacobian_det(robot, q):
