@@ -184,6 +184,11 @@ class Printer:
 
 
 _FLOAT_MAX = float(numpy.finfo(numpy.float32).max)
+# The functions the expressions use, by sympy's name, and their name in C99's math.h (numpy
+# and CasADi use the same names, numpy's absolute value aside).
+MATH_FUNCTIONS = {"sin": "sin", "cos": "cos", "tan": "tan", "asin": "asin", "acos": "acos", "atan": "atan",
+                  "atan2": "atan2", "exp": "exp", "log": "log", "sqrt": "sqrt", "Abs": "fabs", "Floor": "floor",
+                  "Ceiling": "ceil"}
 
 
 class CPrinter(Printer):
@@ -192,9 +197,6 @@ class CPrinter(Printer):
     as products (`(x*x)`, `(sqrt(x)*x)`), never `pow()`; selects as `(c ? a : b)`. No math
     macro: `M_PI` and `M_SQRT2` are POSIX, not C99."""
 
-    MATH = {"sin": "sin", "cos": "cos", "tan": "tan", "asin": "asin", "acos": "acos", "atan": "atan",
-            "atan2": "atan2", "exp": "exp", "log": "log", "sqrt": "sqrt", "Abs": "fabs", "Floor": "floor",
-            "floor": "floor", "ceiling": "ceil"}
     LARGEST_EXPANDED_POWER = 8
 
     def __init__(self, real: str):
@@ -203,7 +205,7 @@ class CPrinter(Printer):
         super().__init__(real)
         self.real = real
         suffix = "f" if real == "float" else ""
-        self.functions = {name: function + suffix for name, function in self.MATH.items()}
+        self.functions = {name: function + suffix for name, function in MATH_FUNCTIONS.items()}
         self.one = self.literal(1.0)
 
     def literal(self, value: float) -> str:
@@ -253,10 +255,7 @@ class PythonPrinter(Printer):
     array that turns float32 arithmetic into float64 (the context makes statuses integers again).
     """
 
-    functions = {name: f"xp.{function}" for name, function in {
-        "sin": "sin", "cos": "cos", "tan": "tan", "asin": "asin", "acos": "acos", "atan": "atan",
-        "atan2": "atan2", "exp": "exp", "log": "log", "sqrt": "sqrt", "Abs": "abs", "Floor": "floor",
-        "floor": "floor", "ceiling": "ceil"}.items()}
+    functions = {name: f"xp.{function}" for name, function in (MATH_FUNCTIONS | {"Abs": "abs"}).items()}
     COMPARISONS = {">=": "greater_equal", ">": "greater", "<=": "less_equal", "<": "less", "==": "equal",
                    "!=": "not_equal"}
 
@@ -280,10 +279,7 @@ class PythonPrinter(Printer):
 class CasadiPrinter(Printer):
     """Python building CasADi SX expressions: `casadi.cos(q1)`, `casadi.if_else(c, a, b)`."""
 
-    functions = {name: f"casadi.{function}" for name, function in {
-        "sin": "sin", "cos": "cos", "tan": "tan", "asin": "asin", "acos": "acos", "atan": "atan",
-        "atan2": "atan2", "exp": "exp", "log": "log", "sqrt": "sqrt", "Abs": "fabs", "Floor": "floor",
-        "floor": "floor", "ceiling": "ceil"}.items()}
+    functions = {name: f"casadi.{function}" for name, function in MATH_FUNCTIONS.items()}
 
     def select(self, condition, value, otherwise, numbers):
         return f"casadi.if_else({condition}, {value}, {otherwise})"

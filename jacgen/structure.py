@@ -208,16 +208,19 @@ class Geometry:
     exact (irrational numbers to 60 digits), and the relations between the axes.
 
     With a `free` joint, that joint is held at the angle of the symbols (c_k, s_k) and left
-    out of the axes: the geometry is that of the remaining chain. `joints` gives the robot's
-    joint of each axis, `signs` whether the solver's angle is the robot's (1) or its negative."""
+    out of the axes: the geometry is that of the remaining chain; with `generic`, at the first
+    of the generic angles `is_zero` tries instead (numbers only, a fraction of the cost).
+    `joints` gives the robot's joint of each axis, `signs` whether the solver's angle is the
+    robot's (1) or its negative."""
 
-    def __init__(self, robot: Robot, free: int | None = None):
+    def __init__(self, robot: Robot, free: int | None = None, generic: bool = False):
         n = robot.dof
         precise = _precise_robot(robot)
 
         def cos_sin(i):
             if i == free:
-                return kinematics.trig_symbols((i,))
+                symbols = kinematics.trig_symbols((i,))
+                return tuple(_generic_points(set(symbols))[0][s] for s in symbols) if generic else symbols
             return (sympy.cos(precise.joints[i].offset.exact), sympy.sin(precise.joints[i].offset.exact))
 
         chain = kinematics.build_chain(precise, cos_sin, [sympy.Integer(0)] * n)
@@ -338,7 +341,11 @@ def _free_joint(robot: Robot) -> tuple[str | None, str, Geometry | None]:
     for free in candidates:
         if not robot.joints[free].revolute:
             continue
-        solver, reason, chain = _six_dof(Geometry(robot, free))
+        # A relation that holds for every free angle holds at the first generic one: a chain
+        # without a class there has none (and the exact chain of c_k, s_k is not built).
+        solver, reason, chain = _six_dof(Geometry(robot, free, generic=True))
+        if solver is not None:
+            solver, reason, chain = _six_dof(Geometry(robot, free))
         if solver is not None:
             return solver, f"joint {free + 1} free (an input of ik), the other six: {reason}", chain
         reasons.append(f"joint {free + 1} free: {reason}")

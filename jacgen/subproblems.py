@@ -53,6 +53,16 @@ class Floor(sympy.Function):
         return sympy.floor(x) if x.is_Number else None
 
 
+class Ceiling(sympy.Function):
+    """ceil(x), decided only for a number (see Floor)."""
+
+    nargs = 1
+
+    @classmethod
+    def eval(cls, x):
+        return sympy.ceiling(x) if x.is_Number else None
+
+
 class _Plain:
     """A comparison decided only between numbers and the positive tolerances (or of a value with
     itself), and -x against 0 turned into x against 0. sympy's own asks its assumption system
@@ -323,4 +333,4 @@ def wrapped(angle: sympy.Expr) -> sympy.Expr:
     atan2), else angle - 2 pi ceil((angle - pi) / (2 pi))."""
     if _in_range(angle):
         return angle
-    return angle - 2 * sympy.pi * sympy.ceiling((angle - sympy.pi) / (2 * sympy.pi))
+    return angle - 2 * sympy.pi * Ceiling((angle - sympy.pi) / (2 * sympy.pi))
