@@ -111,7 +111,7 @@ def rows_fk_jacobian(name, sizes, rounds):
                 row["pytorch_kinematics"] = best_time(lambda: chain.jacobian(q_torch, ret_eef_pose=True), rounds, sync)
                 if size == sizes[0]:
                     _, pose = chain.jacobian(q_torch[:100], ret_eef_pose=True)
-                    want = np.array([reference.fk(imported, sample) for sample in q[:100]])
+                    want = reference.fk(imported, q[:100])
                     print(f"{name}: pytorch_kinematics pose - jacgen.reference fk of the URDF import: "
                           f"{np.abs(pose.cpu().numpy() - want).max():.1e}")
         table.append((size, row))

@@ -96,12 +96,12 @@ def run(robot, count: int, rounds: int, folder: Path) -> list[tuple[str, float, 
     free, value = robot.free_joint, FREE_VALUE[robot.name]
     q = rng.uniform(limits[:, 0], limits[:, 1], (count, robot.dof))
     q[:, free] = value
-    targets = np.array([reference.fk(robot, row) for row in q])
+    targets = reference.fk(robot, q)
     frees = q[:, free]
 
     write_files(render_robot(robot, ("c", "python")), folder)
     source = folder / robot.name / f"{robot.name}.c"
-    library = CLibrary(compile_shared([source], folder / f"lib{robot.name}.so"), robot, [], "double")
+    library = CLibrary(compile_shared([source], folder / f"lib{robot.name}.so", ("-O2",)), robot, [], "double")
     module = import_file(folder / robot.name / f"{robot.name}.py", f"bench_{robot.name}")
     rows = []
 

@@ -201,12 +201,12 @@ def general_table(targets_count: int, rounds: int, folder: Path) -> None:
         robot = load_robot(ROOT / "robots" / f"{name}.yaml")
         write_files(render_robot(robot, ("c", "python")), folder)
         source = folder / name / f"{name}.c"
-        library = CLibrary(compile_shared([source], folder / f"lib{name}.so"), robot, [], "double")
+        library = CLibrary(compile_shared([source], folder / f"lib{name}.so", ("-O2",)), robot, [], "double")
         spec = importlib.util.spec_from_file_location(f"bench_{name}", folder / name / f"{name}.py")
         module = importlib.util.module_from_spec(spec)
         spec.loader.exec_module(module)
         q = np.random.default_rng(5).uniform(-np.pi, np.pi, (targets_count, 6))
-        targets = np.array([reference.fk(robot, row) for row in q])
+        targets = reference.fk(robot, q)
         rows = {}
         micros, _ = native(robot, source, targets, rounds, folder)
         rows["C native"] = (micros, [library.ik(T, 16) for T in targets])
@@ -253,11 +253,11 @@ def main():
             robot = without_limits(shipped)  # every branch, as EAIK and ik-geo return them
             write_files(render_robot(robot, ("c",)), folder)
             source = folder / name / f"{name}.c"
-            library = ctypes.CDLL(str(compile_shared([source], folder / f"lib{name}.so")))
+            library = ctypes.CDLL(str(compile_shared([source], folder / f"lib{name}.so", ("-O2",))))
             rng = np.random.default_rng(1)
             limits = np.array([joint.limits for joint in shipped.joints])
             q = rng.uniform(limits[:, 0], limits[:, 1], (arguments.targets, robot.dof))
-            targets = np.array([reference.fk(robot, row) for row in q])
+            targets = reference.fk(robot, q)
             results = {"C native": native(robot, source, targets, arguments.rounds, folder)}
             for label, solve in solvers(robot, library, ik_geo_factory).items():
                 results[label] = timed(solve, targets, arguments.rounds)

@@ -295,12 +295,15 @@ def _target(robot: Robot, q: np.ndarray) -> np.ndarray:
     return reference.fk(robot, q) if len(robot.task) == 6 else reference.task(robot, q)
 
 
-def _target_error(robot: Robot, q: np.ndarray, target: np.ndarray) -> float:
-    """How far q misses the target (angles of a task vector compared modulo 2 pi)."""
-    difference = _target(robot, q) - target
+def _target_error(robot: Robot, q: np.ndarray, targets: np.ndarray) -> float:
+    """How far the rows of q miss their targets, at most (angles of a task vector compared
+    modulo 2 pi); 0 for no rows."""
+    if not len(q):
+        return 0.0
+    difference = _target(robot, q) - targets
     if len(robot.task) < 6:
         angular = [i for i, name in enumerate(robot.task) if name in ANGLES]
-        difference[angular] = (difference[angular] + math.pi) % (2 * math.pi) - math.pi
+        difference[:, angular] = (difference[:, angular] + math.pi) % (2 * math.pi) - math.pi
     return float(np.max(np.abs(difference)))
 
 
@@ -312,7 +315,7 @@ def _ik_results(robot: Robot, backends: _Backends, q: np.ndarray, tolerances: di
     error); ik_numeric: started 0.1 rad (or length unit) away from q, wherever it reports
     convergence it must have reached the target (the note says how often it converged).
     """
-    targets = [_target(robot, row) for row in q]
+    targets = _target(robot, q)
     nominal = {p.name: p.value for p in robot.symbolic_parameters}
     results = []
     if form is not None:
@@ -325,13 +328,14 @@ def _ik_results(robot: Robot, backends: _Backends, q: np.ndarray, tolerances: di
             solvers["casadi"] = functools.partial(_casadi_ik, backends.casadi, nominal)
         errors = dict.fromkeys(BACKENDS)
         for backend, solve in solvers.items():
-            worst = 0.0
+            found, missed = [], False
             for target, given in zip(targets, free):
-                solutions = solve(target, *given)
+                solutions = np.reshape(solve(target, *given), (-1, robot.dof))
                 kept = all(solution[form.free] == given[0] for solution in solutions) if given else True
-                worst = max([worst, math.inf if not len(solutions) or not kept else 0.0]
-                            + [_target_error(robot, solution, target) for solution in solutions])
-            errors[backend] = worst
+                missed |= not len(solutions) or not kept
+                found.append(solutions)
+            reached = np.repeat(targets, [len(solutions) for solutions in found], axis=0)
+            errors[backend] = math.inf if missed else _target_error(robot, np.concatenate(found), reached)
         # The closed form divides by sines that vanish at singularities, so float rounding is
         # amplified there: measured up to 7.6e-4 on 2,000 ur5 targets, hence ten times the
         # tolerance of straight-line functions for the float build.
@@ -349,11 +353,11 @@ def _ik_results(robot: Robot, backends: _Backends, q: np.ndarray, tolerances: di
     numeric["casadi"] = functools.partial(_casadi_ik_numeric, backends.casadi, nominal)
     errors, converged = {}, {}
     for backend, solve in numeric.items():
-        runs = [(solve(target, start), target) for target, start in zip(targets[:count], starts[:count])]
+        found, status = zip(*(solve(target, start) for target, start in zip(targets[:count], starts[:count])))
         # Status 0 promises |error| <= tol; a stall (a local minimum of the task error) is allowed.
-        reached = [_target_error(robot, q_found, target) for (q_found, status), target in runs if status == 0]
-        errors[backend] = max(reached, default=0.0)
-        converged[backend] = len(reached)
+        reached = np.array(status) == 0
+        errors[backend] = _target_error(robot, np.array(found)[reached], targets[:count][reached])
+        converged[backend] = int(reached.sum())
     results.append(Result(robot.name, "ik_numeric", errors, tolerances,
                           "error where it reports convergence, from 0.1 away; converged at "
                           + ", ".join(f"{n}/{count} ({backend})" for backend, n in converged.items())))
@@ -395,7 +399,7 @@ def _velocity_ik_residual(robot: Robot, solved: tuple[np.ndarray, np.ndarray], q
     q, q_dot, mu_dot = q[~singular], q_dot[~singular], mu_dot[~singular]
     if not len(q):
         return 0.0, int(singular.sum())
-    js = np.array([reference.singularity_jacobian(robot, row) for row in q])
+    js = reference.singularity_jacobian(robot, q)
     residual = np.einsum("kij,kj->ki", js, q_dot) - mu_dot
     norm = np.linalg.norm(js, ord=2, axis=(1, 2))
     scale = norm * np.linalg.norm(q_dot, axis=1) + np.linalg.norm(mu_dot, axis=1)
@@ -405,23 +409,22 @@ def _velocity_ik_residual(robot: Robot, solved: tuple[np.ndarray, np.ndarray], q
 
 
 def verify(robots: list[Robot], samples: int, seed: int,
-           progress: Callable[[str], None] = lambda message: None) -> list[Result]:
-    """Generate, build and compare every robot; compiles run in the background meanwhile."""
+           progress: Callable[[str], None] = lambda message: None, folder: Path | None = None) -> list[Result]:
+    """Generate, build and compare every robot; compiles run in the background meanwhile.
+    The code is written to `folder` (ROBOT/double/..., ROBOT/float/...) when one is given, to
+    a temporary folder otherwise."""
     c_compiler()  # fail before generating anything when there is none
     results = []
     with tempfile.TemporaryDirectory(prefix="jacgen-verify-") as temporary, ThreadPoolExecutor(2) as pool:
-        folder = Path(temporary)
+        folder = folder or Path(temporary)
         jobs = []
         for robot in robots:
             progress(f"generating {robot.name}")
             work, generator = folder / robot.name, Generator(robot)
             write_files(render_robot(robot, ("c", "python", "casadi"), "double", generator), work / "double")
             write_files(render_robot(robot, ("c",), "float", generator), work / "float")
-            # -O0: under -std=c99 gcc neither contracts nor reassociates, so the numbers are
-            # those of an -O2 build, and the build takes a fifth of the time (0.8 against 3.9 s
-            # for a 245 kB robot.c).
             builds = {real: pool.submit(compile_shared, [work / real / robot.name / f"{robot.name}.c"],
-                                        work / f"{robot.name}_{real}.so", ("-O0",)) for real in ("double", "float")}
+                                        work / f"{robot.name}_{real}.so") for real in ("double", "float")}
             jobs.append((robot, generator, work, builds))
         for robot, generator, work, builds in jobs:
             functions = generator.functions()

@@ -16,6 +16,17 @@ ROBOT_NAMES = [path.stem for path in ROBOT_FILES]
 GENERATED = ROOT / "generated"
 
 
+# The files that take longest, run first: pytest-xdist (`--dist loadfile`) hands files to its
+# workers in collection order, and a long file started last would run on alone.
+SLOWEST_FILES = ("test_shipped_robots.py", "test_urdf_round_trip.py", "test_general6r_generated.py",
+                 "test_array_libraries.py", "test_random_arms.py")
+
+
+def pytest_collection_modifyitems(items):
+    rank = {name: k for k, name in enumerate(SLOWEST_FILES)}
+    items.sort(key=lambda item: rank.get(item.path.name, len(rank)))  # stable: the rest keep their order
+
+
 def pytest_addoption(parser):
     parser.addoption("--update", action="store_true", help="tests/test_golden.py: rewrite generated/ instead of comparing")
 

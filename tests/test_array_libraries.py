@@ -57,19 +57,17 @@ def test_every_function_matches_the_reference(lib, name):
         return [back(r) for r in results]
 
     for function in ("fk", "jacobian", "jacobian_tool"):
-        want = np.array([getattr(reference, function)(arm, sample) for sample in q])
+        want = getattr(reference, function)(arm, q)
         np.testing.assert_allclose(call(function, q)[0], want, atol=1e-12, rtol=0, err_msg=function)
     pose, jacobian = call("fk_jacobian", q)
-    np.testing.assert_allclose(pose, [reference.fk(arm, sample) for sample in q], atol=1e-12, rtol=0)
-    np.testing.assert_allclose(jacobian, [reference.jacobian(arm, sample) for sample in q], atol=1e-12, rtol=0)
-    want = [reference.jacobian_dot(arm, a, b) for a, b in zip(q, q_dot)]
+    np.testing.assert_allclose(pose, reference.fk(arm, q), atol=1e-12, rtol=0)
+    np.testing.assert_allclose(jacobian, reference.jacobian(arm, q), atol=1e-12, rtol=0)
+    want = reference.jacobian_dot(arm, q, q_dot)
     np.testing.assert_allclose(call("jacobian_dot", q, q_dot)[0], want, atol=1e-9, rtol=0)
-    np.testing.assert_allclose(call("hessian", q)[0], [reference.hessian(arm, sample) for sample in q], atol=1e-9,
-                               rtol=0)
-    np.testing.assert_allclose(call("manipulability", q)[0], [reference.manipulability(arm, sample) for sample in q],
-                               atol=1e-10, rtol=1e-9)
+    np.testing.assert_allclose(call("hessian", q)[0], reference.hessian(arm, q), atol=1e-9, rtol=0)
+    np.testing.assert_allclose(call("manipulability", q)[0], reference.manipulability(arm, q), atol=1e-10, rtol=1e-9)
 
-    js = np.array([reference.singularity_jacobian(arm, sample) for sample in q])
+    js = reference.singularity_jacobian(arm, q)
     mu_dot = np.random.default_rng(13).normal(size=js.shape[:2])
     rates, status = call("velocity_ik", q, mu_dot, np.full(SAMPLES, 1e-3))
     regularised = js @ np.swapaxes(js, 1, 2) + 1e-6 * np.eye(js.shape[1]) if js.shape[1] <= js.shape[2] else None
@@ -78,20 +76,20 @@ def test_every_function_matches_the_reference(lib, name):
         np.testing.assert_allclose(rates, want, atol=1e-8, rtol=1e-8)
     assert (status == module.VELOCITY_IK_OK).all()
 
-    targets = np.array([reference.fk(arm, sample) for sample in q])
-    task = targets if len(arm.task) == 6 else np.array([reference.task(arm, sample) for sample in q])
+    targets = reference.fk(arm, q)
+    task = targets if len(arm.task) == 6 else reference.task(arm, q)
     start, step, cost = call("ik_numeric_step", task, q + 0.01, np.zeros(SAMPLES))
     assert (cost >= 0).all() and np.isfinite(step).all()
 
     if hasattr(module, "ik_branches"):
         branches, valid, _ = call("ik_branches", task, *free_joint(module, q))
         assert valid.any(axis=1).all()
-        reached = np.array([reference.fk(arm, solution) for solution in branches[valid]])
+        reached = reference.fk(arm, branches[valid])
         wanted = np.repeat(targets, valid.sum(axis=1), axis=0)
         if len(arm.task) == 6:
             np.testing.assert_allclose(reached, wanted, atol=1e-8, rtol=0)
         else:
-            np.testing.assert_allclose([reference.task(arm, s) for s in branches[valid]],
+            np.testing.assert_allclose(reference.task(arm, branches[valid]),
                                        np.repeat(task, valid.sum(axis=1), axis=0), atol=1e-8, rtol=0)
         nearest, status = call("ik_nearest", task, q + 0.01, *free_joint(module, q))
         assert status.dtype == np.int32 and (status == module.IK_NEAREST_OK).all()

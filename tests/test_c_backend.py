@@ -1,9 +1,7 @@
-"""The C99 backend: clean compiles (host and Cortex-M4F), libm only, SPEC §3 signatures.
-
-Numbers: the C of every shipped robot is compared with the reference by `jacgen verify`
-(tests/test_verify.py); here the C of test robots with runtime parameters, a function
-that reads no joint, a scalar result and a function SPEC does not name is checked
-against jacgen.reference.
+"""The C99 backend: SPEC §3 signatures, a header C++ can include, and the C of test robots
+with runtime parameters, a function that reads no joint, a scalar result and a function SPEC
+does not name, against jacgen.reference. The shipped robots' C is verified, and compiled
+warning-free for the host and a Cortex-M4F, by tests/test_shipped_robots.py.
 """
 
 import re
@@ -16,32 +14,13 @@ import sympy
 from numpy.testing import assert_allclose
 
 from jacgen import reference
-from jacgen.compile import WARNING_FLAGS, CLibrary, compile_shared
+from jacgen.compile import CLibrary, compile_shared
 from jacgen.functions import Generator
 from jacgen.printers import CPrinter
 from jacgen.render import render_robot, write_files
 from jacgen.robot import load_robot
-from jacgen.structure import classify
 
-from conftest import ROBOT_FILES, ROOT, random_configurations
-
-ARM_FLAGS = ("-mcpu=cortex-m4", "-mthumb", "-mfloat-abi=hard", "-mfpu=fpv4-sp-d16", "-Os")
-LIBM = {name + suffix for name in "sin cos sincos tan asin acos atan atan2 sqrt fabs hypot ceil floor fmax remainder".split()
-        for suffix in ("", "f")}
-# The general 6R solver's eigenproblem kernel computes in double in a float build too (its
-# 24 x 24 eigenproblem needs it; docs/contract.md): those objects may call the double functions
-# and, on the Cortex-M4F, libgcc's software double arithmetic.
-DOUBLE_KERNEL = {f"{path.stem}.o" for path in ROBOT_FILES if classify(load_robot(path)).solver == "general_6r"}
-# GCC may emit calls to these for array copies even in freestanding code, which must provide
-# them ("Standards", GCC manual); the sources call none of them.
-COMPILER_RUNTIME = {"memcpy", "memmove", "memset", "memcmp"}
-# Bytes per function. Straight-line functions keep only scalars (a few hundred bytes); ik
-# keeps its candidate solutions. A change that puts big arrays on the stack fails here.
-STACK_LIMIT = 4096
-# The general 6R solver's ik_branches holds its 24 x 24 companion matrix, the equations and the
-# kernel's work arrays (about 27 kB on the host); to fall to 4 kB it needs the deflated 16 x 16
-# problem (issue 22's next step). Every other function of those robots stays under STACK_LIMIT.
-GENERAL_STACK_LIMIT = 32768
+from conftest import ROOT, random_configurations
 
 # A robot with runtime parameters in the base translation only: fk and task read `p`, the
 # Jacobians do not (they must still take it, and compile without an unused-parameter warning).
@@ -85,61 +64,6 @@ def _run(command, cwd=None):
     result = subprocess.run([str(part) for part in command], capture_output=True, text=True, cwd=cwd)
     assert result.returncode == 0 and not result.stderr, result.stderr
     return result.stdout
-
-
-@pytest.fixture(scope="module")
-def generators():
-    """One Generator per shipped robot, shared by both precisions."""
-    return [Generator(load_robot(path)) for path in ROBOT_FILES]
-
-
-@pytest.fixture(scope="module", params=["double", "float"])
-def shipped_c(request, generators, tmp_path_factory):
-    """The C of every shipped robot in one precision: (real, [.c files])."""
-    folder = tmp_path_factory.mktemp(f"c_{request.param}")
-    for generator in generators:
-        write_files(render_robot(generator.robot, ("c",), request.param, generator), folder)
-    return request.param, sorted(folder.glob("*/*.c"))
-
-
-def _check_objects(folder, nm, real, runtime=()):
-    """Only libm symbols (and the compiler's `runtime` helpers) are undefined, only the f
-    functions in float builds; every function's stack use is static and small."""
-    for obj in sorted(folder.glob("*.o")):
-        undefined = set(_run([nm, "-u", obj]).split()) - {"U"} - COMPILER_RUNTIME
-        kernel = ("__aeabi_",) if obj.name in DOUBLE_KERNEL else ()
-        undefined = {name for name in undefined if not name.startswith(runtime + kernel)} if runtime + kernel \
-            else undefined
-        assert undefined <= LIBM, (obj.name, undefined - LIBM)
-        if real == "float" and obj.name not in DOUBLE_KERNEL:
-            assert all(name.endswith("f") for name in undefined), (obj.name, undefined)
-    usage = []
-    for path in folder.glob("*.su"):
-        general = f"{path.stem}.o" in DOUBLE_KERNEL
-        for line in path.read_text().splitlines():
-            where, size, kind = line.rsplit("\t", 2)
-            function = where.rsplit(":", 1)[-1]
-            limit = GENERAL_STACK_LIMIT if general and function.endswith("_ik_branches") else STACK_LIMIT
-            usage.append((int(size), function, kind, limit))
-    worst = max(usage)
-    print(f"worst stack usage ({real}): {worst[0]} bytes in {worst[1]} ({worst[2]})")
-    assert all(size <= limit and kind == "static" for size, _, kind, limit in usage), \
-        [(size, function) for size, function, _, limit in usage if size > limit]
-
-
-def test_host_compile_is_warning_free_and_needs_only_libm(shipped_c, tmp_path):
-    real, sources = shipped_c
-    _run(["gcc", *WARNING_FLAGS, "-O2", "-fstack-usage", "-c", *sources], cwd=tmp_path)
-    _check_objects(tmp_path, "nm", real)
-
-
-@pytest.mark.skipif(shutil.which("arm-none-eabi-gcc") is None, reason="arm-none-eabi-gcc not installed")
-def test_cortex_m4_compile_is_warning_free_and_needs_only_libm(shipped_c, tmp_path):
-    real, sources = shipped_c
-    _run(["arm-none-eabi-gcc", *ARM_FLAGS, *WARNING_FLAGS, "-fstack-usage", "-c", *sources], cwd=tmp_path)
-    # The FPU is single precision: double builds call libgcc's software double arithmetic
-    # and conversions (__aeabi_dmul, __aeabi_i2d...); float builds need no helper.
-    _check_objects(tmp_path, "arm-none-eabi-nm", real, runtime=("__aeabi_",) if real == "double" else ())
 
 
 def test_prototypes_are_those_of_spec():
@@ -215,10 +139,10 @@ def test_functions_beyond_spec_render_generically(tmp_path, monkeypatch):
     library = CLibrary(compile_shared([tmp_path / "gantry" / "gantry.c"], tmp_path / "gantry.so"), robot,
                        Generator(robot).functions(), "double")
     q = random_configurations(robot, 10, seed=4)
-    positions = np.array([reference.fk(robot, row)[:3, 3] for row in q])
+    positions = reference.fk(robot, q)[:, :3, 3]
     assert_allclose(library.evaluate("tool_position", q), positions, atol=1e-12)
     assert_allclose(library.evaluate("reach_squared", q)[:, 0], (positions**2).sum(axis=1), atol=1e-12)
-    assert_allclose(library.evaluate("jacobian", q), [reference.jacobian(robot, row).ravel() for row in q],
+    assert_allclose(library.evaluate("jacobian", q), reference.jacobian(robot, q).reshape(len(q), -1),
                     atol=1e-12)
 
 

@@ -26,13 +26,9 @@ def _wrapped(difference):
     return np.abs((difference + np.pi) % (2 * np.pi) - np.pi)
 
 
-def _reference_fk(arm, q):
-    return np.array([reference.fk(arm, row) for row in q])
-
-
 def _regular(arm, q, free):
     """The six joints left have a well-conditioned Jacobian (smallest singular value > 1e-3)."""
-    jacobians = np.delete(np.array([reference.jacobian(arm, row) for row in q]), free, axis=2)
+    jacobians = np.delete(reference.jacobian(arm, q), free, axis=2)
     return np.linalg.svd(jacobians, compute_uv=False).min(axis=1) > 1e-3
 
 
@@ -41,11 +37,11 @@ def _check_round_trips(arm, module, q, free):
     joint kept, at most 8 solutions, the original q among them where the other six are well
     conditioned.
     Returns (solutions, valid)."""
-    targets = _reference_fk(arm, q)
+    targets = reference.fk(arm, q)
     solutions, valid = module.ik(targets, q[:, free], limits=False)
     assert solutions.shape == (len(q), 8, 7) and valid.shape == (len(q), 8)
     found = solutions[valid]
-    misses = np.abs(_reference_fk(arm, found) - np.repeat(targets, valid.sum(axis=1), axis=0)).max(axis=(1, 2))
+    misses = np.abs(reference.fk(arm, found) - np.repeat(targets, valid.sum(axis=1), axis=0)).max(axis=(1, 2))
     assert misses.max() < MISS, misses.max()
     assert np.array_equal(found[:, free], np.repeat(q[:, free], valid.sum(axis=1)))
     distance = np.where(valid, _wrapped(solutions - q[:, None, :]).max(axis=2), np.inf).min(axis=1)
@@ -71,11 +67,11 @@ def test_c_and_casadi_give_the_numpy_solutions(name, tmp_path):
     library = CLibrary(compile_shared([GENERATED / name / f"{name}.c"], tmp_path / f"lib{name}.so"), arm, [], "double")
     casadi = generated_module(name, "_casadi")
     q = random_configurations(arm, 300, seed=32)
-    for row, target in zip(q, _reference_fk(arm, q)):
+    for row, target in zip(q, reference.fk(arm, q)):
         ours = module.ik(target, row[free])
         in_c = library.ik(target, 8, None, row[free])
         assert in_c.shape == ours.shape and np.abs(in_c - ours).max(initial=0) < 1e-9
-    for row, target in zip(q[:40], _reference_fk(arm, q[:40])):
+    for row, target in zip(q[:40], reference.fk(arm, q[:40])):
         branches, valid, in_limits = casadi.ik(target, row[free])
         in_casadi = branches.full()[(valid.full() * in_limits.full()).ravel() == 1]
         assert np.abs(in_casadi - module.ik(target, row[free])).max(initial=0) < 1e-9

@@ -40,7 +40,7 @@ def _equivalents(arm, value, j):
 def test_limits_keep_exactly_the_solutions_inside(name):
     arm, module = robot(name), generated_module(name)
     q = random_configurations(arm, 500, seed=41)
-    targets = np.array([reference.fk(arm, row) for row in q])
+    targets = reference.fk(arm, q)
     kept, keep = module.ik(targets, *_free(module, q))
     every, valid = module.ik(targets, *_free(module, q), limits=False)
     assert np.array_equal(kept, every) and not np.any(keep & ~valid)
@@ -76,7 +76,7 @@ def test_nearest_is_the_nearest(name):
     q = random_configurations(arm, 300, seed=43)
     seeds = q + rng.normal(0.0, 1.0, q.shape)
     weights = rng.uniform(0.1, 2.0, q.shape)
-    targets = np.array([reference.fk(arm, row) for row in q])
+    targets = reference.fk(arm, q)
     found, status = module.ik_nearest(targets, seeds, *_free(module, q), weights)
     assert np.all(status == module.IK_NEAREST_OK)
     lower, upper = np.array([joint.limits for joint in arm.joints]).T

@@ -106,7 +106,7 @@ def test_fk_equals_pinocchio(name, convention, tmp_path):
     tip = tip or re.search(r"-> (\w+)\)", robot.description).group(1)
     qs = configurations(robot)
     text = (DATA / file).read_text()
-    ours = [reference.fk(robot, q) for q in qs]
+    ours = reference.fk(robot, np.array(qs))
     exact = max(np.abs(a - b).max() for a, b in zip(ours, pinocchio_fk(as_read(text), tmp_path, robot, base, tip, qs)))
     assert exact < FK_TOLERANCE_BY_NAME.get(name, FK_TOLERANCE)
     # Against the numbers as written: each angle made exact turns the rest of the arm by at most

@@ -26,16 +26,16 @@ def _rows(output: str) -> dict[tuple[str, str], list[str]]:
 
 
 def test_every_function_of_every_backend_is_within_tolerance():
-    result = _verify("robots/puma560.yaml", "robots/stanford.yaml", "--samples", "40")
+    result = _verify("robots/planar_3r.yaml", "robots/scara.yaml", "--samples", "40")
     assert result.exit_code == 0, result.output
     assert result.output.splitlines()[0].split()[:6] == ["robot", "function", "python", "casadi", "c", "double"]
     rows = _rows(result.output)
-    assert set(rows) >= {(robot, function) for robot in ("puma560", "stanford") for function in FUNCTIONS}
+    assert set(rows) >= {(robot, function) for robot in ("planar_3r", "scara") for function in FUNCTIONS}
     for (robot, function), cells in rows.items():
         if cells[:4] == ["-"] * 4:  # a function the reference does not have
             assert function not in FUNCTIONS and " ".join(cells[5:]) == "not compared: no reference"
             continue
-        errors = [0.0 if cell == "-" else float(cell) for cell in cells[:4]]  # velocity_ik: Python only
+        errors = [0.0 if cell == "-" else float(cell) for cell in cells[:4]]
         assert max(errors[:3]) <= 1e-9 and errors[3] <= float(cells[4])
     assert f"0 of {len(rows)} functions above tolerance" in result.output
     assert result.stderr == ""  # no progress when stderr is not a terminal
