@@ -8,7 +8,6 @@ import math
 
 import numpy as np
 import sympy
-from scipy.optimize import least_squares
 
 from jacgen import general6r, reference
 from jacgen.robot import parse_robot
@@ -164,12 +163,31 @@ def solver_of(name: str) -> Solver:
     return Solver(robot_of(ARMS[name]))
 
 
-def multi_start(robot, pose: np.ndarray, starts: int, rng) -> list[np.ndarray]:
-    """Solutions found by Levenberg-Marquardt on the reference fk from random starts."""
+def multi_start(robot, pose: np.ndarray, starts: int, rng, iterations: int = 150) -> list[np.ndarray]:
+    """Solutions found by Levenberg-Marquardt on the reference fk from random starts, every
+    start at once. The residual is fk's top three rows minus the pose's; its Jacobian comes
+    from the reference's geometric Jacobian: d R / d q_i = [w_i]x R, d p / d q_i = v_i."""
+    q = rng.uniform(-math.pi, math.pi, (starts, 6))
+    damping = np.full(starts, 1e-3)
+
+    def residual(q):
+        return (reference.fk(robot, q) - pose)[:, :3].reshape(len(q), 12)
+
+    error = residual(q)
+    for _ in range(iterations):
+        rotation, geometric = reference.fk(robot, q)[:, :3, :3], reference.jacobian(robot, q)
+        angular = np.swapaxes(geometric[:, 3:], 1, 2)  # (starts, joint, 3)
+        turned = np.cross(angular[:, :, None, :], np.swapaxes(rotation, 1, 2)[:, None])  # [joint, column, row]
+        jacobian = np.concatenate([np.swapaxes(turned, 2, 3), geometric[:, None, :3].transpose(0, 3, 2, 1)],
+                                  axis=3).reshape(starts, 6, 12).transpose(0, 2, 1)
+        normal = np.swapaxes(jacobian, 1, 2) @ jacobian + damping[:, None, None] * np.eye(6)
+        trial = q - np.linalg.solve(normal, (np.swapaxes(jacobian, 1, 2) @ error[..., None]))[..., 0]
+        trial_error = residual(trial)
+        better = (trial_error**2).sum(1) < (error**2).sum(1)
+        q, error = np.where(better[:, None], trial, q), np.where(better[:, None], trial_error, error)
+        damping = np.where(better, damping / 3, damping * 4).clip(1e-12, 1e6)
     found = []
-    for start in rng.uniform(-math.pi, math.pi, (starts, 6)):
-        result = least_squares(lambda q: (reference.fk(robot, q) - pose)[:3].ravel(), start, method="lm")
-        q = wrapped(result.x)
+    for q in wrapped(q):
         if np.abs(reference.fk(robot, q) - pose).max() < 1e-9 and all(np.abs(wrapped(s - q)).max() > 1e-6 for s in found):
             found.append(q)
     return found
