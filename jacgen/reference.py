@@ -137,6 +137,11 @@ def task(robot, q):
     return full[..., [TASK_COMPONENTS.index(name) for name in robot.task]]
 
 
+def ik_target(robot, q):
+    """What `ik` takes at q: the 4x4 pose for a six-component task, the task vector otherwise."""
+    return fk(robot, q) if len(robot.task) == 6 else task(robot, q)
+
+
 def task_jacobian(robot, q, step=1e-4):
     """d mu / d q by fourth-order central differences (angles unwrapped across the ±pi seam)."""
     q = np.asarray(q, dtype=float)

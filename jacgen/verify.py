@@ -290,17 +290,12 @@ def _vanishing_error(factors: np.ndarray, ranks: np.ndarray) -> float:
     return float(np.max(np.min(np.abs(factors[singular]), axis=1), initial=0.0))
 
 
-def _target(robot: Robot, q: np.ndarray) -> np.ndarray:
-    """What `ik` takes: the 4x4 pose for a six-component task, the task vector otherwise."""
-    return reference.fk(robot, q) if len(robot.task) == 6 else reference.task(robot, q)
-
-
 def _target_error(robot: Robot, q: np.ndarray, targets: np.ndarray) -> float:
     """How far the rows of q miss their targets, at most (angles of a task vector compared
     modulo 2 pi); 0 for no rows."""
     if not len(q):
         return 0.0
-    difference = _target(robot, q) - targets
+    difference = reference.ik_target(robot, q) - targets
     if len(robot.task) < 6:
         angular = [i for i, name in enumerate(robot.task) if name in ANGLES]
         difference[:, angular] = (difference[:, angular] + math.pi) % (2 * math.pi) - math.pi
@@ -315,7 +310,7 @@ def _ik_results(robot: Robot, backends: _Backends, q: np.ndarray, tolerances: di
     error); ik_numeric: started 0.1 rad (or length unit) away from q, wherever it reports
     convergence it must have reached the target (the note says how often it converged).
     """
-    targets = _target(robot, q)
+    targets = reference.ik_target(robot, q)
     nominal = {p.name: p.value for p in robot.symbolic_parameters}
     results = []
     if form is not None:

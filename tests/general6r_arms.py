@@ -170,21 +170,19 @@ def multi_start(robot, pose: np.ndarray, starts: int, rng, iterations: int = 150
     q = rng.uniform(-math.pi, math.pi, (starts, 6))
     damping = np.full(starts, 1e-3)
 
-    def residual(q):
-        return (reference.fk(robot, q) - pose)[:, :3].reshape(len(q), 12)
-
-    error = residual(q)
+    reached = reference.fk(robot, q)
     for _ in range(iterations):
-        rotation, geometric = reference.fk(robot, q)[:, :3, :3], reference.jacobian(robot, q)
+        error = (reached - pose)[:, :3].reshape(starts, 12)
+        geometric = reference.jacobian(robot, q)
         angular = np.swapaxes(geometric[:, 3:], 1, 2)  # (starts, joint, 3)
-        turned = np.cross(angular[:, :, None, :], np.swapaxes(rotation, 1, 2)[:, None])  # [joint, column, row]
+        turned = np.cross(angular[:, :, None, :], np.swapaxes(reached[:, :3, :3], 1, 2)[:, None])  # [joint, column, row]
         jacobian = np.concatenate([np.swapaxes(turned, 2, 3), geometric[:, None, :3].transpose(0, 3, 2, 1)],
                                   axis=3).reshape(starts, 6, 12).transpose(0, 2, 1)
         normal = np.swapaxes(jacobian, 1, 2) @ jacobian + damping[:, None, None] * np.eye(6)
         trial = q - np.linalg.solve(normal, (np.swapaxes(jacobian, 1, 2) @ error[..., None]))[..., 0]
-        trial_error = residual(trial)
-        better = (trial_error**2).sum(1) < (error**2).sum(1)
-        q, error = np.where(better[:, None], trial, q), np.where(better[:, None], trial_error, error)
+        trial_reached = reference.fk(robot, trial)
+        better = ((trial_reached - pose)[:, :3] ** 2).sum((1, 2)) < (error**2).sum(1)
+        q, reached = np.where(better[:, None], trial, q), np.where(better[:, None, None], trial_reached, reached)
         damping = np.where(better, damping / 3, damping * 4).clip(1e-12, 1e6)
     found = []
     for q in wrapped(q):
