@@ -154,14 +154,28 @@ def show(robot_file, plot_file):
 @click.option("--samples", default=200, show_default=True, type=click.IntRange(min=1),
               help="Random configurations per robot, besides those near singularities.")
 @click.option("--seed", default=0, show_default=True, type=int, help="Seed of the random configurations.")
-def verify(robot_files, samples, seed):
+@click.option("--target", type=click.Choice(["cortex-m4f"]), default=None,
+              help="Check the float C on an emulated target instead of the host backends (needs "
+                   "arm-none-eabi-gcc and qemu-system-arm), and print its flash, stack and instructions.")
+@click.option("--sources", type=click.Path(file_okay=False, exists=True), default=None, metavar="DIR",
+              help="With --target: run DIR/NAME/NAME.c and .h (the float C you ship, as `generate --real float -o DIR` "
+                   "writes it) instead of generating them.")
+def verify(robot_files, samples, seed, target, sources):
     """Compare every generated function of every backend with the numpy reference."""
     from .verify import format_table, verify as verify_robots  # numpy/ctypes only when verifying
 
+    if sources and not target:
+        raise click.UsageError("--sources needs --target")
     robots = [load_robot(path) for path in dict.fromkeys(robot_files)]
     _check_unique_names(robots)
-    results = verify_robots(robots, samples, seed, _progress)
+    emulators = []
+    results = verify_robots(robots, samples, seed, _progress, target=target, sources=sources and Path(sources),
+                            emulators=emulators)
     click.echo(format_table(results))
+    if emulators:
+        from .target import format_resources
+
+        click.echo("\n" + format_resources(emulators))
     if any(result.failed for result in results):
         sys.exit(1)
 

@@ -24,7 +24,7 @@ TEMPLATE_DIR_CANDIDATES = (
 )
 
 
-def _environment() -> jinja2.Environment:
+def environment() -> jinja2.Environment:
     folder = next(path for path in TEMPLATE_DIR_CANDIDATES if path.is_dir())
     return jinja2.Environment(
         loader=jinja2.FileSystemLoader(str(folder)),
@@ -49,7 +49,7 @@ def render_robot(robot: Robot, languages=DEFAULT_LANGUAGES, real: str = "double"
 
     Pass the robot's `generator` to share its symbolic work between renderings.
     """
-    environment = _environment()
+    templates = environment()
     generator = generator or Generator(robot, selection=functions)
     unavailable = generator.unavailable()
     if unavailable:
@@ -59,7 +59,7 @@ def render_robot(robot: Robot, languages=DEFAULT_LANGUAGES, real: str = "double"
         backend = BACKENDS[name]
         context = backend.context(robot, generator, backend.printer(real) if backend.printer else None, real)
         for template, pattern in backend.templates:
-            text = environment.get_template(template).render(context)
+            text = templates.get_template(template).render(context)
             path = f"{robot.name}/{pattern.format(name=robot.name)}"
             files[path] = backend.comment.format(header(robot)) + "\n" + text
     return files

@@ -13,7 +13,6 @@ sees, and its error is the error of its arithmetic alone. `ik` and `ik_numeric` 
 checked by round trip, `velocity_ik` by its backward error.
 """
 
-import functools
 import importlib.util
 import inspect
 import itertools
@@ -31,8 +30,10 @@ from .compile import CLibrary, c_compiler, compile_shared
 from .functions import Function, Generator
 from .render import render_robot, write_files
 from .robot import Robot
+from .target import Emulator, check_tools
 
 BACKENDS = ("python", "casadi", "c double", "c float")
+TARGET_BACKENDS = {"cortex-m4f": "cortex-m4f float"}  # `verify --target`: the target's float C alone
 DOUBLE_TOLERANCE = 1e-9
 # float32 keeps 24 bits (relative rounding 6e-8). An output is a sum of products along a
 # chain of at most 32 links, so its rounding error is a few tens of roundings of values no
@@ -137,14 +138,18 @@ def _import(path: Path, module_name: str):
 
 
 class _Backends:
-    """The generated code of one robot, each backend evaluating a function on a batch of q."""
+    """The generated code of one robot, each backend evaluating a function on a batch of q:
+    the host's (Python, CasADi, C double and float) or the emulated target's float C."""
 
-    def __init__(self, robot: Robot, functions: list[Function], folder: Path, libraries: dict[str, Path]):
-        self.robot = robot
+    def __init__(self, robot: Robot, functions: list[Function], folder: Path, libraries: dict[str, Path],
+                 emulator: Emulator | None = None):
+        self.robot, self.emulator = robot, emulator
+        self.names = BACKENDS if emulator is None else (TARGET_BACKENDS["cortex-m4f"],)
         self.functions = {f.name: f for f in functions}
-        self.python = _import(folder / "double" / robot.name / f"{robot.name}.py", f"_jacgen_verify_{robot.name}")
-        self.casadi = _import(folder / "double" / robot.name / f"{robot.name}_casadi.py",
-                              f"_jacgen_verify_{robot.name}_casadi")
+        if emulator is None:
+            self.python = _import(folder / "double" / robot.name / f"{robot.name}.py", f"_jacgen_verify_{robot.name}")
+            self.casadi = _import(folder / "double" / robot.name / f"{robot.name}_casadi.py",
+                                  f"_jacgen_verify_{robot.name}_casadi")
         self.c = {real: CLibrary(path, robot, functions, real) for real, path in libraries.items()}
 
     def evaluate(self, backend: str, name: str, q: np.ndarray, *more: np.ndarray) -> np.ndarray:
@@ -158,6 +163,8 @@ class _Backends:
             function = getattr(self.casadi, name)
             extra = [list(self.casadi.PARAMETERS.values())] if nominal else []
             return np.vstack([_side_by_side(function(*rows, *extra), 1) for rows in zip(q, *more)])
+        if self.emulator is not None:
+            return self.emulator.evaluate(name, q, *more)
         return self.c[backend.split()[1]].evaluate(name, q, *more)
 
 
@@ -171,8 +178,44 @@ class _Backends:
             rows = [self.casadi.velocity_ik(x, rates, 0.0, *extra) for x, rates in zip(q, mu_dot)]
             return (np.array([q_dot.full().ravel() for q_dot, _ in rows]).reshape(len(q), -1),
                     np.array([float(status) for _, status in rows]))
+        if self.emulator is not None:
+            return self.emulator.velocity_ik(q, mu_dot, 0.0)
         rows = [self.c[backend.split()[1]].velocity_ik(x, rates, 0.0) for x, rates in zip(q, mu_dot)]
         return np.array([q_dot for q_dot, _ in rows]).reshape(len(q), -1), np.array([status for _, status in rows])
+
+    def ik(self, backend: str, targets: np.ndarray, free: np.ndarray | None,
+           max_solutions: int) -> tuple[list[np.ndarray], np.ndarray | None]:
+        """ik at each target (with the free joint's angle, if any): the solutions (k_i, dof) per
+        target, and the target's own check of them (None on the host)."""
+        if self.emulator is not None:
+            return self.emulator.ik(targets, free)
+        nominal = {p.name: p.value for p in self.robot.symbolic_parameters}
+
+        def solve(target: np.ndarray, *angle: float) -> np.ndarray:
+            if backend == "python":
+                return self.python.ik(target, *angle, **nominal)
+            if backend == "casadi":
+                return _casadi_ik(self.casadi, nominal, target, *angle)
+            return self.c[backend.split()[1]].ik(target, max_solutions, None, *angle)
+
+        given = [()] * len(targets) if free is None else [(value,) for value in free]
+        return [np.reshape(solve(target, *angle), (-1, self.robot.dof)) for target, angle in zip(targets, given)], None
+
+    def ik_numeric(self, backend: str, targets: np.ndarray, starts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """ik_numeric from each start: (q (k, dof), status (k,))."""
+        nominal = {p.name: p.value for p in self.robot.symbolic_parameters}
+        if self.emulator is not None:
+            return self.emulator.ik_numeric(targets, starts, 200, 1e-5)
+
+        def solve(target: np.ndarray, start: np.ndarray) -> tuple[np.ndarray, int]:
+            if backend == "python":
+                return self.python.ik_numeric(target, start, 200, 1e-12, **nominal)
+            if backend == "casadi":
+                return _casadi_ik_numeric(self.casadi, nominal, target, start)
+            return _c_ik_numeric(self.c[backend.split()[1]], backend.split()[1], target, start)
+
+        found, status = zip(*(solve(target, start) for target, start in zip(targets, starts)))
+        return np.array(found), np.array(status)
 
 
 def _side_by_side(results, count: int) -> np.ndarray:
@@ -227,8 +270,9 @@ def compare(robot: Robot, function: Function, value: np.ndarray, expected: np.nd
 def verify_robot(robot: Robot, backends: _Backends, functions: list[Function], q: np.ndarray,
                  random_count: int, form: ik.ClosedForm | None) -> list[Result]:
     """Every function at q, whose first `random_count` rows are random (not singular) samples."""
-    tolerances = {backend: DOUBLE_TOLERANCE for backend in BACKENDS}
-    tolerances["c float"] = FLOAT_TOLERANCE * (1 + reach(robot))
+    names = backends.names
+    tolerances = {backend: FLOAT_TOLERANCE * (1 + reach(robot)) if _is_float(backend) else DOUBLE_TOLERANCE
+                  for backend in names}
     results = []
     ranks = _rank_ratios(robot, q)
     q_dot = np.random.default_rng(1).normal(size=q.shape)  # joint rates, for the second-order functions
@@ -237,19 +281,19 @@ def verify_robot(robot: Robot, backends: _Backends, functions: list[Function], q
         more = (q_dot,) if len(function.arguments) == 2 else ()
         if function.name == "singularity_factors":
             errors = {backend: _vanishing_error(backends.evaluate(backend, function.name, q), ranks)
-                      for backend in BACKENDS}
+                      for backend in names}
             results.append(Result(robot.name, function.name, errors, tolerances,
                                   f"min |factor| at the {int((ranks < SINGULAR_RANK).sum())} samples where Js is singular"))
             continue
         expected = _reference(robot, function, q, *more)
         if expected is None or expected.shape[1] != sum(output.size for output in function.outputs):
             note = "not compared: " + ("no reference" if expected is None else "reference has another shape")
-            results.append(Result(robot.name, function.name, dict.fromkeys(BACKENDS), tolerances, note))
+            results.append(Result(robot.name, function.name, dict.fromkeys(names), tolerances, note))
             continue
         errors = {}
-        for backend in BACKENDS:
+        for backend in names:
             errors[backend], skipped = compare(robot, function, backends.evaluate(backend, function.name, q, *more),
-                                               expected, q, relative=backend == "c float")
+                                               expected, q, relative=_is_float(backend))
         note = (f"angle rows not compared at {skipped} of {len(q)} samples (cos(pitch) < {EULER_MARGIN})"
                 if skipped else "")
         results.append(Result(robot.name, function.name, errors, tolerances, note))
@@ -257,17 +301,21 @@ def verify_robot(robot: Robot, backends: _Backends, functions: list[Function], q
     results += _ik_results(robot, backends, q[:random_count], tolerances, form)
     mu_dot = np.random.default_rng(0).normal(size=(int(regular.sum()), len(robot.task)))
     residuals, flagged = {}, {}
-    for backend in BACKENDS:
+    for backend in names:
         residuals[backend], flagged[backend] = _velocity_ik_residual(
             robot, backends.velocity_ik(backend, q[regular], mu_dot), q[regular], mu_dot,
-            allow_singular=backend == "c float")
+            allow_singular=_is_float(backend))
     results.append(Result(robot.name, "velocity_ik", residuals, tolerances,
                           ("|Js^T (Js q_dot - mu_dot)| / |Js| (|Js| |q_dot| + |mu_dot|)" if len(robot.task) > robot.dof
                            else "|Js q_dot - mu_dot| / (|Js| |q_dot| + |mu_dot|)")
                           + f" at the {int(regular.sum())} samples where Js is regular"
-                          + (f"; c float: {flagged['c float']} reported singular (float's threshold)"
-                             if flagged["c float"] else "")))
+                          + "".join(f"; {backend}: {flagged[backend]} reported singular (float's threshold)"
+                                    for backend in names if _is_float(backend) and flagged[backend])))
     return results
+
+
+def _is_float(backend: str) -> bool:
+    return backend.endswith("float")
 
 
 def _rank_ratios(robot: Robot, q: np.ndarray) -> np.ndarray:
@@ -311,47 +359,42 @@ def _ik_results(robot: Robot, backends: _Backends, q: np.ndarray, tolerances: di
     convergence it must have reached the target (the note says how often it converged).
     """
     targets = reference.ik_target(robot, q)
-    nominal = {p.name: p.value for p in robot.symbolic_parameters}
     results = []
     if form is not None:
         # With a free joint, ik takes its angle: q's, which every solution must keep.
-        free = [[] if form.free is None else [row[form.free]] for row in q]
-        solvers = {"python": lambda target, *free: backends.python.ik(target, *free, **nominal)}
-        solvers.update({f"c {real}": lambda target, *free, library=library: library.ik(
-            target, form.info.max_solutions, None, *free) for real, library in backends.c.items()})
-        if form.solver != "general_6r":  # CasADi has no ik for it (an eigensolver loop)
-            solvers["casadi"] = functools.partial(_casadi_ik, backends.casadi, nominal)
-        errors = dict.fromkeys(BACKENDS)
-        for backend, solve in solvers.items():
-            found, missed = [], False
-            for target, given in zip(targets, free):
-                solutions = np.reshape(solve(target, *given), (-1, robot.dof))
-                kept = all(solution[form.free] == given[0] for solution in solutions) if given else True
-                missed |= not len(solutions) or not kept
-                found.append(solutions)
+        free = None if form.free is None else q[:, form.free]
+        errors, checked = {}, {}
+        for backend in backends.names:
+            if backend == "casadi" and form.solver == "general_6r":  # CasADi has no ik for it (an eigensolver loop)
+                errors[backend] = None
+                continue
+            found, checked[backend] = backends.ik(backend, targets, free, form.info.max_solutions)
+            kept = free is None or all((solutions[:, form.free] == given).all() for solutions, given in zip(found, free))
             reached = np.repeat(targets, [len(solutions) for solutions in found], axis=0)
-            errors[backend] = math.inf if missed else _target_error(robot, np.concatenate(found), reached)
+            errors[backend] = (math.inf if not kept or not all(len(solutions) for solutions in found)
+                               else _target_error(robot, np.concatenate(found), reached))
+            if checked[backend] is not None:  # the target's own check of its solutions counts too
+                errors[backend] = max(errors[backend], float(np.max(checked[backend], initial=0.0)))
         # The closed form divides by sines that vanish at singularities, so float rounding is
         # amplified there: measured up to 7.6e-4 on 2,000 ur5 targets, hence ten times the
-        # tolerance of straight-line functions for the float build.
-        ik_tolerances = tolerances | {"c float": 10 * tolerances["c float"]}
+        # tolerance of straight-line functions for the float builds.
+        ik_tolerances = {backend: 10 * tolerance if _is_float(backend) else tolerance
+                         for backend, tolerance in tolerances.items()}
+        on_target = [backend for backend, error in checked.items() if error is not None]
         results.append(Result(robot.name, "ik", errors, ik_tolerances,
                               f"every solution of {len(targets)} targets fk(q) reaches the target"
-                          + (f", with joint {form.free + 1} as given" if form.free is not None else "")))
+                              + (f", with joint {form.free + 1} as given" if form.free is not None else "")
+                              + "".join(f"; checked on the target too ({backend})" for backend in on_target)))
     starts = q + 0.1 * np.random.default_rng(1).choice([-1.0, 1.0], size=q.shape)
     limits = bounds(robot)
     starts = np.clip(starts, limits[:, 0], limits[:, 1])
     count = min(len(q), NUMERIC_IK_SAMPLES)
-    numeric = {"python": lambda target, start: backends.python.ik_numeric(target, start, 200, 1e-12, **nominal)}
-    numeric.update({f"c {real}": functools.partial(_c_ik_numeric, library, real)
-                    for real, library in backends.c.items()})
-    numeric["casadi"] = functools.partial(_casadi_ik_numeric, backends.casadi, nominal)
     errors, converged = {}, {}
-    for backend, solve in numeric.items():
-        found, status = zip(*(solve(target, start) for target, start in zip(targets[:count], starts[:count])))
+    for backend in backends.names:
+        found, status = backends.ik_numeric(backend, targets[:count], starts[:count])
         # Status 0 promises |error| <= tol; a stall (a local minimum of the task error) is allowed.
-        reached = np.array(status) == 0
-        errors[backend] = _target_error(robot, np.array(found)[reached], targets[:count][reached])
+        reached = np.asarray(status) == 0
+        errors[backend] = _target_error(robot, np.asarray(found)[reached], targets[:count][reached])
         converged[backend] = int(reached.sum())
     results.append(Result(robot.name, "ik_numeric", errors, tolerances,
                           "error where it reports convergence, from 0.1 away; converged at "
@@ -404,11 +447,20 @@ def _velocity_ik_residual(robot: Robot, solved: tuple[np.ndarray, np.ndarray], q
 
 
 def verify(robots: list[Robot], samples: int, seed: int,
-           progress: Callable[[str], None] = lambda message: None, folder: Path | None = None) -> list[Result]:
+           progress: Callable[[str], None] = lambda message: None, folder: Path | None = None,
+           target: str | None = None, sources: Path | None = None,
+           emulators: list[Emulator] | None = None) -> list[Result]:
     """Generate, build and compare every robot; compiles run in the background meanwhile.
     The code is written to `folder` (ROBOT/double/..., ROBOT/float/...) when one is given, to
-    a temporary folder otherwise."""
-    c_compiler()  # fail before generating anything when there is none
+    a temporary folder otherwise.
+
+    With a `target` ("cortex-m4f"), only the float C is checked, run on the emulated target
+    (`jacgen.target`): the C generated now, or NAME.h and NAME.c from `sources`. Each robot's
+    Emulator, with the instructions and stack it measured, is appended to `emulators`."""
+    if target is None:
+        c_compiler()  # fail before generating anything when there is none
+    else:
+        check_tools()
     results = []
     with tempfile.TemporaryDirectory(prefix="jacgen-verify-") as temporary, ThreadPoolExecutor(2) as pool:
         folder = folder or Path(temporary)
@@ -416,36 +468,47 @@ def verify(robots: list[Robot], samples: int, seed: int,
         for robot in robots:
             progress(f"generating {robot.name}")
             work, generator = folder / robot.name, Generator(robot)
-            write_files(render_robot(robot, ("c", "python", "casadi"), "double", generator), work / "double")
-            write_files(render_robot(robot, ("c",), "float", generator), work / "float")
-            builds = {real: pool.submit(compile_shared, [work / real / robot.name / f"{robot.name}.c"],
-                                        work / f"{robot.name}_{real}.so") for real in ("double", "float")}
+            if target is None:
+                write_files(render_robot(robot, ("c", "python", "casadi"), "double", generator), work / "double")
+                write_files(render_robot(robot, ("c",), "float", generator), work / "float")
+                builds = {real: pool.submit(compile_shared, [work / real / robot.name / f"{robot.name}.c"],
+                                            work / f"{robot.name}_{real}.so") for real in ("double", "float")}
+            else:
+                emulator = Emulator(robot, generator, work / target, sources)
+                builds = {target: pool.submit(emulator.build)}
             jobs.append((robot, generator, work, builds))
         for robot, generator, work, builds in jobs:
             functions = generator.functions()
-            progress(f"verifying {robot.name}")
+            progress(f"verifying {robot.name}" + (f" on the emulated {target}" if target else ""))
             rng = np.random.default_rng(seed)
             # Random samples are rounded to float32 so the float build sees exactly the reference's
             # input; singular ones are not, since rounding would move them off the singular set.
             random = random_configurations(robot, samples, rng).astype(np.float32).astype(np.float64)
             q = np.vstack([random, singular_configurations(robot, generator.singularities)])
-            libraries = {real: build.result() for real, build in builds.items()}
-            results += verify_robot(robot, _Backends(robot, functions, work, libraries), functions, q, len(random),
-                                    generator.closed_form)
+            built = {name: build.result() for name, build in builds.items()}
+            emulator = built.pop(target, None)
+            results += verify_robot(robot, _Backends(robot, functions, work, built, emulator), functions, q,
+                                    len(random), generator.closed_form)
+            if emulator is not None:
+                emulator.measure_remaining(random, generator.closed_form and generator.closed_form.free)
+                emulator.resources  # read from the build folder while it exists
+                if emulators is not None:
+                    emulators.append(emulator)
     return results
 
 
 def format_table(results: list[Result]) -> str:
     """One row per robot and function, one column per backend: the largest error."""
-    header = ["robot", "function", *BACKENDS, "float tol", "note"]
+    names = list(results[0].errors) if results else list(BACKENDS)
+    header = ["robot", "function", *names, "float tol", "note"]
     rows = [header]
     for result in results:
         cells = [result.robot, result.function]
-        for backend in BACKENDS:
+        for backend in names:
             error = result.errors[backend]
             mark = "" if error is None or error <= result.tolerances[backend] else " FAIL"
             cells.append("-" if error is None else f"{error:.1e}{mark}")
-        cells += [f"{result.tolerances['c float']:.1e}", result.note]
+        cells += [f"{max(result.tolerances[backend] for backend in names if _is_float(backend)):.1e}", result.note]
         rows.append(cells)
     widths = [max(len(row[c]) for row in rows) for c in range(len(header))]
     lines = ["  ".join(cell.ljust(width) for cell, width in zip(row, widths)).rstrip() for row in rows]
