@@ -180,12 +180,14 @@ class Emulator:
         self.program = folder / f"{robot.name}.elf"
         self.measured: dict[str, Batch] = {}  # the last batch of each function run
 
-    def build(self) -> "Emulator":
-        """Cross-compile (the contract's warning flags, any warning an error) and link."""
-        flags = [*WARNING_FLAGS, *CPU_FLAGS, *BUILD_FLAGS, f"-I{self.sources[0].parent}", f"-I{self.folder}"]
+    def build(self, warnings: tuple[str, ...] = WARNING_FLAGS) -> "Emulator":
+        """Cross-compile (the robot's C with `warnings`: by default the contract's, any warning
+        an error) and link."""
         objects = [self.folder / f"{source.stem}.o" for source in self.sources]
         for source, built in zip(self.sources, objects):
-            _run(["arm-none-eabi-gcc", *flags, "-c", str(source), "-o", str(built)],
+            flags = warnings if source is self.sources[0] else WARNING_FLAGS
+            _run(["arm-none-eabi-gcc", *flags, *CPU_FLAGS, *BUILD_FLAGS, f"-I{self.sources[0].parent}",
+                  f"-I{self.folder}", "-c", str(source), "-o", str(built)],
                  f"arm-none-eabi-gcc on {source.name}", cwd=self.folder)
         _run(["arm-none-eabi-gcc", *CPU_FLAGS, "--specs=rdimon.specs", "-T", str(self.folder / "mps2_an386.ld"),
               "-Wl,--gc-sections", *map(str, objects), "-lm", "-o", str(self.program)], "linking for the target")
@@ -300,12 +302,17 @@ _EDGE = re.compile(r'edge: \{ sourcename: "([^"]+)" targetname: "([^"]+)"')
 
 def _call_graph(path: Path) -> tuple[dict[str, tuple[int, bool]], dict[str, set[str]]]:
     """gcc's -fcallgraph-info=su file: {function: (frame bytes, static)} of the functions it
-    compiled, and {caller: callees}."""
+    compiled, and {caller: callees}, by their symbols (gcc titles a file-local function
+    `file.c:name`)."""
     text = path.read_text()
-    frames = {name: (int(size), kind == "static") for name, size, kind in _NODE.findall(text)}
+
+    def symbol(title: str) -> str:
+        return title.rsplit(":", 1)[-1]
+
+    frames = {symbol(name): (int(size), kind == "static") for name, size, kind in _NODE.findall(text)}
     callees: dict[str, set[str]] = {}
     for source, target in _EDGE.findall(text):
-        callees.setdefault(source, set()).add(target)
+        callees.setdefault(symbol(source), set()).add(symbol(target))
     return frames, callees
 
 
