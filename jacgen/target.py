@@ -23,7 +23,7 @@ import numpy as np
 from . import reference
 from .compile import WARNING_FLAGS
 from .errors import JacgenError
-from .functions import Generator
+from .functions import FUNCTION_NAMES, Generator
 from .render import environment, render_robot, write_files
 from .robot import Robot
 
@@ -87,10 +87,12 @@ def check_tools() -> None:
 
 
 def calls(robot: Robot, generator: Generator) -> list[Call]:
-    """Every function of the C header the harness can call: the catalogue's, then ik and
-    ik_numeric (loops the C templates write)."""
+    """Every function of the contract the robot has: the catalogue's, then ik and ik_numeric
+    (loops the C templates write). The general 6R solver's parts are measured through ik."""
     found = []
     for function in generator.functions():
+        if function.name not in FUNCTION_NAMES:
+            continue
         returned = function.returned
         outputs = tuple((o.size, o.boolean or o.integer) for o in function.outputs if o is not returned)
         kind = None if returned is None else "int" if returned.boolean or returned.integer else "real"

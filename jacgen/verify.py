@@ -11,6 +11,9 @@ The random joint vectors are rounded to float32 first, so that the float build, 
 only read float32 joint angles, is compared at exactly the configuration the reference
 sees, and its error is the error of its arithmetic alone. `ik` and `ik_numeric` are
 checked by round trip, `velocity_ik` by its backward error.
+
+`--target cortex-m4f` checks the float C alone, run on an emulated Cortex-M4F
+(`jacgen.target`), with the same samples, comparisons and tolerances.
 """
 
 import importlib.util
