@@ -120,6 +120,33 @@ class CLibrary:
                                                                  *self._extra(parameters))
         return solutions[: count * self.robot.dof].reshape(count, self.robot.dof).astype(np.float64)
 
+    def ik_branches(self, target: np.ndarray, max_solutions: int,
+                    q_free: float | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """`NAME_ik_branches` for one target: every branch (max_solutions, dof), and whether
+        each is valid and inside the limits."""
+        pointer = ctypes.POINTER(C_TYPES[self.real])
+        target = np.ascontiguousarray(np.ravel(target), dtype=self.dtype)
+        q = np.zeros(max_solutions * self.robot.dof, dtype=self.dtype)
+        valid, in_limits = (np.zeros(max_solutions, dtype=np.intc) for _ in range(2))
+        free = [] if q_free is None else [C_TYPES[self.real](q_free)]
+        flags = ctypes.POINTER(ctypes.c_int)
+        getattr(self._library, f"{self.robot.name}_ik_branches")(
+            target.ctypes.data_as(pointer), *free, q.ctypes.data_as(pointer), valid.ctypes.data_as(flags),
+            in_limits.ctypes.data_as(flags), *self._extra())
+        return q.reshape(max_solutions, self.robot.dof).astype(np.float64), valid, in_limits
+
+    def ik_nearest(self, target: np.ndarray, q_seed: np.ndarray, weights: np.ndarray,
+                   q_free: float | None = None) -> tuple[np.ndarray, int]:
+        """`NAME_ik_nearest`: (q, status)."""
+        pointer = ctypes.POINTER(C_TYPES[self.real])
+        target, q_seed, weights = (np.ascontiguousarray(np.ravel(a), dtype=self.dtype) for a in (target, q_seed, weights))
+        q = np.zeros(self.robot.dof, dtype=self.dtype)
+        free = [] if q_free is None else [C_TYPES[self.real](q_free)]
+        status = getattr(self._library, f"{self.robot.name}_ik_nearest")(
+            target.ctypes.data_as(pointer), q_seed.ctypes.data_as(pointer), *free, weights.ctypes.data_as(pointer),
+            q.ctypes.data_as(pointer), *self._extra())
+        return q.astype(np.float64), int(status)
+
     def velocity_ik(self, q: np.ndarray, mu_dot: np.ndarray, damping: float) -> tuple[np.ndarray, int]:
         """`NAME_velocity_ik`: (q_dot, status)."""
         pointer = ctypes.POINTER(C_TYPES[self.real])

@@ -229,18 +229,22 @@ class Emulator:
         self.measured[name] = batch
         return batch
 
+    def call(self, name: str, values: dict[str, np.ndarray]) -> Batch:
+        """`name` with each argument taken from `values` by its name (k rows each)."""
+        return self.run(name, *(values[argument] for argument, _, _, _ in self.calls[name].inputs))
+
     def measure_remaining(self, q: np.ndarray, free: int | None) -> None:
         """Run each function not run yet at q, so that every one has instruction and stack
         figures: targets reached at q, seeds and starts 0.1 away, unit weights, damping 0.01."""
         rng = np.random.default_rng(2)
+        target = reference.ik_target(self.robot, q)
         values = {"q": q, "q_dot": rng.normal(size=q.shape), "mu_dot": rng.normal(size=(len(q), len(self.robot.task))),
-                  "damping": np.full(len(q), 0.01), "target": reference.ik_target(self.robot, q),
+                  "damping": np.full(len(q), 0.01), "target": target, "T": target, "mu": target,
                   "q_seed": q + 0.1, "q0": q + 0.1, "weights": np.ones_like(q), "max_iter": np.full(len(q), 100),
                   "tol": np.full(len(q), 1e-5), "q_free": q[:, free] if free is not None else None}
-        values["T"] = values["mu"] = values["target"]
-        for name, call in self.calls.items():
+        for name in self.calls:
             if name not in self.measured:
-                self.run(name, *(values[argument] for argument, _, _, _ in call.inputs))
+                self.call(name, values)
 
     # -- the verify backend: the same methods as compile.CLibrary, one QEMU run each -----------
     def evaluate(self, name: str, q: np.ndarray, *more: np.ndarray) -> np.ndarray:
@@ -258,6 +262,21 @@ class Emulator:
         batch = self.run("ik", np.reshape(targets, (len(targets), -1)), *(() if free is None else (free,)))
         solutions = batch.outputs[0].reshape(len(targets), -1, self.robot.dof)
         return [found[:int(n)] for found, n in zip(solutions, batch.returned)], batch.ik_error
+
+    def ik_branches(self, targets: np.ndarray, free: np.ndarray | None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Every branch at each target (k, m, dof), and whether each is valid and inside the limits (k, m)."""
+        count = len(targets)
+        targets = np.reshape(targets, (count, -1))
+        batch = self.call("ik_branches", {"T": targets, "mu": targets, "q_free": free})
+        q, valid, in_limits = batch.outputs
+        return q.reshape(count, -1, self.robot.dof), valid.astype(bool), in_limits.astype(bool)
+
+    def ik_nearest(self, targets: np.ndarray, seeds: np.ndarray, weights: np.ndarray,
+                   free: np.ndarray | None) -> tuple[np.ndarray, np.ndarray]:
+        count = len(targets)
+        targets = np.reshape(targets, (count, -1))
+        batch = self.call("ik_nearest", {"T": targets, "mu": targets, "q_seed": seeds, "weights": weights, "q_free": free})
+        return batch.outputs[0], batch.returned
 
     def ik_numeric(self, targets: np.ndarray, starts: np.ndarray, max_iter: int, tol: float) -> tuple[np.ndarray, np.ndarray]:
         count = len(targets)

@@ -204,6 +204,56 @@ class _Backends:
         given = [()] * len(targets) if free is None else [(value,) for value in free]
         return [np.reshape(solve(target, *angle), (-1, self.robot.dof)) for target, angle in zip(targets, given)], None
 
+    def ik_branches(self, backend: str, targets: np.ndarray, free: np.ndarray | None,
+                    max_solutions: int) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+        """ik_branches at each target: every branch (k, m, dof) and whether each is valid and
+        inside the limits (k, m); None where the backend has no ik_branches (general 6R: only C
+        and Python, as loops around the eigensolver)."""
+        given = [()] * len(targets) if free is None else [(value,) for value in free]
+        if self.emulator is not None:
+            return self.emulator.ik_branches(targets, free) if "ik_branches" in self.emulator.calls else None
+        nominal = {p.name: p.value for p in self.robot.symbolic_parameters}
+        if backend == "python":
+            found = self.python.ik_branches(targets, *(() if free is None else (free,)), **nominal)
+        elif backend == "casadi":
+            if not hasattr(self.casadi, "ik_branches"):
+                return None
+            extra = [list(self.casadi.PARAMETERS.values())] if nominal else []
+            rows = [[value.full() for value in self.casadi.ik_branches(target if target.ndim == 2 else target[:, None],
+                                                                       *angle, *extra)]
+                    for target, angle in zip(targets, given)]
+            found = [np.array(values) for values in zip(*rows)]
+        else:
+            library = self.c[backend.split()[1]]
+            found = [np.array(values) for values in zip(*(library.ik_branches(target, max_solutions, *angle)
+                                                           for target, angle in zip(targets, given)))]
+        q, valid, in_limits = (np.asarray(value) for value in found)
+        count = len(targets)
+        return (q.reshape(count, -1, self.robot.dof), valid.reshape(count, -1).astype(bool),
+                in_limits.reshape(count, -1).astype(bool))
+
+    def ik_nearest(self, backend: str, targets: np.ndarray, seeds: np.ndarray, weights: np.ndarray,
+                   free: np.ndarray | None) -> tuple[np.ndarray, np.ndarray] | None:
+        """ik_nearest at each target from each seed: (q (k, dof), status (k,)); None where the
+        backend has none."""
+        given = [()] * len(targets) if free is None else [(value,) for value in free]
+        if self.emulator is not None:
+            return self.emulator.ik_nearest(targets, seeds, weights, free) if "ik_nearest" in self.emulator.calls else None
+        nominal = {p.name: p.value for p in self.robot.symbolic_parameters}
+        if backend == "python":
+            return self.python.ik_nearest(targets, seeds, *(() if free is None else (free,)), weights, **nominal)
+        if backend == "casadi":
+            if not hasattr(self.casadi, "ik_nearest"):
+                return None
+            extra = [list(self.casadi.PARAMETERS.values())] if nominal else []
+            rows = [self.casadi.ik_nearest(target if target.ndim == 2 else target[:, None], seed, *angle, weight, *extra)
+                    for target, seed, angle, weight in zip(targets, seeds, given, weights)]
+            return np.array([q.full().ravel() for q, _ in rows]), np.array([float(status) for _, status in rows])
+        library = self.c[backend.split()[1]]
+        rows = [library.ik_nearest(target, seed, weight, *angle)
+                for target, seed, weight, angle in zip(targets, seeds, weights, given)]
+        return np.array([q for q, _ in rows]), np.array([status for _, status in rows])
+
     def ik_numeric(self, backend: str, targets: np.ndarray, starts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """ik_numeric from each start: (q (k, dof), status (k,))."""
         nominal = {p.name: p.value for p in self.robot.symbolic_parameters}
@@ -388,10 +438,12 @@ def _ik_results(robot: Robot, backends: _Backends, q: np.ndarray, tolerances: di
                               f"every solution of {len(targets)} targets fk(q) reaches the target"
                               + (f", with joint {form.free + 1} as given" if form.free is not None else "")
                               + "".join(f"; checked on the target too ({backend})" for backend in on_target)))
+        results += _branch_results(robot, backends, q, targets, free, ik_tolerances, form.info.max_solutions)
     starts = q + 0.1 * np.random.default_rng(1).choice([-1.0, 1.0], size=q.shape)
     limits = bounds(robot)
     starts = np.clip(starts, limits[:, 0], limits[:, 1])
-    count = min(len(q), NUMERIC_IK_SAMPLES)
+    # On the target the whole batch is one QEMU run: every random sample.
+    count = len(q) if backends.emulator is not None else min(len(q), NUMERIC_IK_SAMPLES)
     errors, converged = {}, {}
     for backend in backends.names:
         found, status = backends.ik_numeric(backend, targets[:count], starts[:count])
@@ -403,6 +455,43 @@ def _ik_results(robot: Robot, backends: _Backends, q: np.ndarray, tolerances: di
                           "error where it reports convergence, from 0.1 away; converged at "
                           + ", ".join(f"{n}/{count} ({backend})" for backend, n in converged.items())))
     return results
+
+
+def _branch_results(robot: Robot, backends: _Backends, q: np.ndarray, targets: np.ndarray, free: np.ndarray | None,
+                    tolerances: dict, max_solutions: int) -> list[Result]:
+    """ik_branches: every valid branch reaches its target, and at least one branch is valid
+    (each target was reached at q); ik_nearest, seeded 0.05 away from q with random weights:
+    status OK, a solution that reaches the target, and no valid branch inside the limits
+    nearer the seed (its own metric, sum of weights_j (q_j - seed_j)^2, on the backend's own
+    branches)."""
+    rng = np.random.default_rng(3)
+    seeds = q + 0.05 * rng.choice([-1.0, 1.0], size=q.shape)
+    weights = rng.uniform(0.5, 2.0, size=q.shape)
+    branch_errors, nearest_errors, nearer = {}, {}, {}
+    for backend in backends.names:
+        branches = backends.ik_branches(backend, targets, free, max_solutions)
+        nearest = backends.ik_nearest(backend, targets, seeds, weights, free)
+        if branches is None or nearest is None:
+            branch_errors[backend] = nearest_errors[backend] = None
+            continue
+        solutions, valid, in_limits = branches
+        reached = np.repeat(targets, valid.sum(axis=1), axis=0)
+        branch_errors[backend] = (math.inf if not valid.any(axis=1).all()
+                                  else _target_error(robot, solutions[valid], reached))
+        found, status = nearest
+        ok = np.asarray(status) == 0
+        nearest_errors[backend] = math.inf if not ok.all() else _target_error(robot, np.asarray(found), targets)
+        distance = np.einsum("kj,kj->k", weights, (np.asarray(found) - seeds) ** 2)
+        branch_distance = np.einsum("kj,kmj->km", weights, (solutions - seeds[:, None, :]) ** 2)
+        best = np.min(np.where(valid & in_limits, branch_distance, np.inf), axis=1)
+        nearer[backend] = int((distance > best * (1 + 1e-5) + 1e-12).sum())
+        if nearer[backend]:
+            nearest_errors[backend] = math.inf
+    return [Result(robot.name, "ik_branches", branch_errors, tolerances,
+                   f"every valid branch of {len(targets)} targets reaches the target"),
+            Result(robot.name, "ik_nearest", nearest_errors, tolerances,
+                   "reaches the target, and no valid branch in the limits is nearer the seed"
+                   + "".join(f"; {backend}: {n} not the nearest" for backend, n in nearer.items() if n))]
 
 
 def _casadi_ik(module, nominal: dict, target: np.ndarray, *free: float) -> np.ndarray:

@@ -14,7 +14,7 @@ from jacgen.functions import Generator
 
 from conftest import robot as shipped_robot
 
-FUNCTIONS = ("fk", "jacobian", "jacobian_tool", "task", "task_jacobian")
+FUNCTIONS = ("fk", "jacobian", "jacobian_tool", "task", "task_jacobian", "ik", "ik_branches", "ik_nearest")
 
 
 def _verify(*arguments, **environment):
