@@ -8,11 +8,10 @@ Scripting entry points::
     files = jacgen.render_robot(robot)      # {"puma560/puma560.py": text, ...}
 """
 
-__version__ = "0.1.0"
-
-from .errors import JacgenError, RobotFileError  # noqa: E402
-from .kinematics import Kinematics  # noqa: E402
-from .render import render_robot  # noqa: E402
-from .robot import Robot, load_robot  # noqa: E402
+from .errors import JacgenError, RobotFileError
+from .kinematics import Kinematics
+from .render import render_robot
+from .robot import Robot, load_robot
+from .version import __version__
 
 __all__ = ["JacgenError", "Kinematics", "Robot", "RobotFileError", "load_robot", "render_robot", "__version__"]

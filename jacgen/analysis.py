@@ -539,8 +539,7 @@ class _Numeric:
         return sympy.lambdify([self.ring.q], condition.xreplace(self.nominal), "numpy")
 
     def _configuration(self) -> np.ndarray:
-        bounds = [joint.limits or (-np.pi, np.pi) for joint in self.robot.joints]
-        return np.array([self.rng.uniform(lo, hi) for lo, hi in bounds])
+        return np.array([self.rng.uniform(lo, hi) for lo, hi in self.robot.ranges])
 
     def zero_set_points(self, factor: Factor, count: int = 3) -> list[np.ndarray]:
         """Configurations where the factor vanishes: random ones with one joint solved for."""

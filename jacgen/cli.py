@@ -5,7 +5,8 @@ from pathlib import Path
 
 import click
 
-from . import __version__, budget
+from . import budget
+from .version import __version__
 from .errors import JacgenError
 from .functions import with_callees
 from .model import Model

@@ -10,7 +10,7 @@ from .functions import Argument, Call, Function, Generator, Output
 from .lowering import is_boolean
 from .printers import CasadiPrinter, CPrinter, PythonPrinter
 from .robot import Robot
-from .subproblems import RANK, TOLERANCES, Select
+from .nodes import RANK, TOLERANCES, Select
 
 # The contract's C array extent of each argument and output (`function.output`, or the function
 # when it has one), as factors that are numbers or the suffixes of size macros

@@ -12,7 +12,7 @@ from typing import Callable
 
 import sympy
 
-from .subproblems import RANK, Above, AtLeast, AtMost, Below, IsFinite, Unequal, select
+from .nodes import RANK, Above, AtLeast, AtMost, Below, IsFinite, Unequal, select
 
 # Statuses of velocity_ik, the same in every backend.
 VELOCITY_IK_OK, VELOCITY_IK_SINGULAR, VELOCITY_IK_NOT_FINITE = 0, 1, 2

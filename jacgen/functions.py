@@ -12,11 +12,12 @@ from functools import cached_property
 import sympy
 from sympy.core.parameters import distribute
 
-from . import analysis, differential, general6r, ik, kinematics, subproblems
+from . import analysis, differential, general6r, ik, kinematics
 from .lowering import Body, Lowering, is_boolean
 from .model import Model
+from .nodes import Above, select
 from .robot import Robot
-from .subproblems import Subproblems
+from .subproblems import Subproblems, wrapped
 
 ANGLES = ("roll", "pitch", "yaw")
 SECOND_ORDER = ("fk_jacobian_dot", "jacobian_dot", "bias_acceleration", "task_jacobian_dot", "hessian")
@@ -367,7 +368,7 @@ class Generator:
                 jacobian = self.jacobian
             else:
                 mu = kinematics.task_vector(robot, self.chain.tool)
-                error = [subproblems.wrapped(goal - value) if component in ANGLES else goal - value
+                error = [wrapped(goal - value) if component in ANGLES else goal - value
                          for goal, value, component in zip(target.symbols, mu, robot.task)]
                 jacobian = task_jacobian
             trial, cost = differential.ik_numeric_step(error, jacobian, list(self.q), damping.symbols[0], limits,
@@ -447,7 +448,7 @@ class Generator:
         for k, column in enumerate(columns):
             norm = self.name(sympy.Add(*(entry**2 for entry in column)))
             squared_diagonal.append(norm)
-            divisor = self.name(subproblems.select(subproblems.Above(norm, 0), norm, sympy.Integer(1)))
+            divisor = self.name(select(Above(norm, 0), norm, sympy.Integer(1)))
             for j in range(k + 1, len(columns)):  # the part of column j orthogonal to column k
                 share = self.name(sympy.Add(*(a * b for a, b in zip(columns[j], column))) / divisor)
                 columns[j] = [self.name(entry - share * value) for entry, value in zip(columns[j], column)]

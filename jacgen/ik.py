@@ -16,8 +16,8 @@ import sympy
 
 from . import general6r
 from .structure import E_Z, SOLVERS, Geometry, SolverInfo, Structure, classify, is_zero, tidy
-from .subproblems import (EPS, Above, Angle, AtLeast, AtMost, Below, Floor, IsFinite, Subproblems, relative, select,
-                          times, times_transposed, wrapped)
+from .nodes import EPS, Above, AtLeast, AtMost, Below, Floor, IsFinite, select
+from .subproblems import Angle, Subproblems, relative, times, times_transposed, wrapped
 
 Matrix = sympy.Matrix
 

@@ -15,13 +15,13 @@ import numpy as np
 import sympy
 import yaml
 
-from . import __version__, reference
+from . import reference
 from .dh_fit import Axis, fit, tidy
 from .errors import JacgenError
 from .names import robot_name_problem
 from .robot import FORBIDDEN_IN_TEXT, IDENTIFIER_PATTERN, NAME_PATTERN, TASK_COMPONENTS, Robot, parse_robot
 from .urdf import MOVABLE, SNAP_TOLERANCE, Chain, Snapper, read_chain
-from .verify import bounds
+from .version import __version__
 
 CHECK_CONFIGURATIONS = 20
 CHECK_SEED = 0
@@ -228,7 +228,7 @@ def urdf_fk(chain: Chain, q) -> np.ndarray:
 
 def _fk_difference(robot, chain: Chain) -> float:
     rng = np.random.default_rng(CHECK_SEED)
-    low, high = bounds(robot).T
+    low, high = np.array(robot.ranges).T
     worst = 0.0
     for _ in range(CHECK_CONFIGURATIONS):
         q = rng.uniform(low, high)

@@ -17,7 +17,7 @@ from sympy.core.operations import LatticeOp
 from sympy.logic.boolalg import Boolean, BooleanFunction
 from sympy.simplify.cse_main import Unevaluated, match_common_args
 
-from .subproblems import TOLERANCES
+from .nodes import TOLERANCES
 
 
 @dataclass(frozen=True)

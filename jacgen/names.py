@@ -101,18 +101,18 @@ def robot_name_problem(name: str) -> str | None:
     return None
 
 
-# The words each language reserves, by the reason given (see `backends.Backend.reserved`).
+# The words each language reserves, by the reason given; each backend names its table
+# (`backends.Backend.reserved`).
 C_RESERVED = {"is a keyword": C_KEYWORDS | CPP_KEYWORDS, "is a <math.h> name": C_MATH_NAMES}
 PYTHON_RESERVED = {"is a keyword": PYTHON_KEYWORDS, "is a Python builtin": PYTHON_BUILTINS}
+RESERVED = (C_RESERVED, PYTHON_RESERVED)
 
 
 def parameter_name_problem(name: str, robot_name: str) -> str | None:
     """Why `name` cannot name a parameter of robot `robot_name` (None when it can): a word a
     backend reserves, or one the generated code uses."""
-    from .backends import BACKENDS  # the backends' modules import the robot model, which imports this one
-
-    for backend in BACKENDS.values():
-        for reason, words in backend.reserved.items():
+    for reserved in RESERVED:
+        for reason, words in reserved.items():
             if name in words:
                 return reason
     if name in GENERATED_NAMES or name in GENERATED_IMPORTS or _GENERATED_PATTERN.match(name):

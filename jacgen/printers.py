@@ -15,7 +15,7 @@ import numpy
 import sympy
 
 from .lowering import Body, is_boolean
-from .subproblems import TOLERANCE_SYMBOLS, TOLERANCES, Select
+from .nodes import TOLERANCE_SYMBOLS, TOLERANCES, Select
 
 # Binding strength of what a node prints as: an operand binding more loosely than its
 # operator is parenthesised.

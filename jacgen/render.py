@@ -12,11 +12,11 @@ from pathlib import Path
 
 import jinja2
 
-from . import __version__
 from .backends import BACKENDS, DEFAULT_LANGUAGES
 from .errors import JacgenError
 from .functions import Generator
 from .robot import Robot
+from .version import __version__
 
 TEMPLATE_DIR_CANDIDATES = (
     Path(__file__).resolve().parent.parent / "templates",  # a source checkout

@@ -198,7 +198,7 @@ def plot_workspace(robot: Robot, path: str, samples: int = 4000, ellipses: int =
 
     rows = [TASK_COMPONENTS.index(c) for c in robot.task]  # planar: yaw rate = wz, roll = pitch = 0
     rng = np.random.default_rng(0)
-    bounds = np.array([joint.limits or (-np.pi, np.pi) for joint in robot.joints])
+    bounds = np.array(robot.ranges)
     configurations = rng.uniform(bounds[:, 0], bounds[:, 1], size=(samples, robot.dof))
     points, measure = [], []
     for q in configurations:

@@ -99,6 +99,11 @@ class Robot:
     def symbolic_parameters(self) -> tuple[Parameter, ...]:
         return tuple(p for p in self.parameters if p.symbolic)
 
+    @property
+    def ranges(self) -> tuple[tuple[float, float], ...]:
+        """Each joint's range: its limits, or [-pi, pi] for a joint without."""
+        return tuple(joint.limits or (-math.pi, math.pi) for joint in self.joints)
+
 
 def load_robot(path: str | Path) -> Robot:
     """Read and validate a robot file; raises RobotFileError with the position of the mistake."""

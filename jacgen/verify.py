@@ -94,13 +94,8 @@ def reach(robot: Robot) -> float:
     return total
 
 
-def bounds(robot: Robot) -> np.ndarray:
-    """(dof, 2) joint ranges: the limits, or [-pi, pi] for a joint without limits."""
-    return np.array([joint.limits or (-math.pi, math.pi) for joint in robot.joints])
-
-
 def random_configurations(robot: Robot, count: int, rng: np.random.Generator) -> np.ndarray:
-    ranges = bounds(robot)
+    ranges = np.array(robot.ranges)
     return rng.uniform(ranges[:, 0], ranges[:, 1], size=(count, robot.dof))
 
 
@@ -113,7 +108,7 @@ def singular_configurations(robot: Robot, singular: analysis.Singularities | Non
     mid-travel, clipped into the limits; every combination for up to 4 revolute joints,
     otherwise all zero, one joint at +-pi/2 at a time, and pairs of joints at +-pi/2.
     """
-    ranges = bounds(robot)
+    ranges = np.array(robot.ranges)
     revolute = [i for i, joint in enumerate(robot.joints) if joint.revolute]
     values = (0.0, math.pi / 2, -math.pi / 2)
     if len(revolute) <= 4:
@@ -440,7 +435,7 @@ def _ik_results(robot: Robot, backends: _Backends, q: np.ndarray, tolerances: di
                               + "".join(f"; checked on the target too ({backend})" for backend in on_target)))
         results += _branch_results(robot, backends, q, targets, free, ik_tolerances, form.info.max_solutions)
     starts = q + 0.1 * np.random.default_rng(1).choice([-1.0, 1.0], size=q.shape)
-    limits = bounds(robot)
+    limits = np.array(robot.ranges)
     starts = np.clip(starts, limits[:, 0], limits[:, 1])
     # On the target the whole batch is one QEMU run: every random sample.
     count = len(q) if backends.emulator is not None else min(len(q), NUMERIC_IK_SAMPLES)

@@ -8,7 +8,7 @@ from sympy.core.parameters import distribute
 from jacgen.functions import Generator
 from jacgen.lowering import eliminate_common, operation_count
 from jacgen.robot import load_robot, parse_robot
-from jacgen.subproblems import AtLeast, Below, IsFinite, Select
+from jacgen.nodes import AtLeast, Below, IsFinite, Select
 from conftest import ROOT
 from random_arms import random_arm_text
 

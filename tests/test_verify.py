@@ -82,7 +82,7 @@ def test_singular_configurations_are_inside_the_limits():
     for name in ("puma560", "stanford", "planar_3r"):
         robot = shipped_robot(name)
         q = verify.singular_configurations(robot)
-        bounds = verify.bounds(robot)
+        bounds = np.array(robot.ranges)
         assert ((q >= bounds[:, 0]) & (q <= bounds[:, 1])).all()
         revolute = [joint.revolute for joint in robot.joints]
         zero = np.clip(np.where(revolute, 0.0, bounds.mean(axis=1)), bounds[:, 0], bounds[:, 1])
