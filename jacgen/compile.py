@@ -13,6 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .differential import IK_NUMERIC_DEFAULTS
 from .errors import JacgenError
 from .functions import Function
 from .robot import Robot
@@ -158,8 +159,8 @@ class CLibrary:
             q_dot.ctypes.data_as(pointer), *self._extra())
         return q_dot.astype(np.float64), int(status)
 
-    def ik_numeric(self, target: np.ndarray, q0: np.ndarray, max_iter: int = 100,
-                   tol: float = 1e-10) -> tuple[np.ndarray, int]:
+    def ik_numeric(self, target: np.ndarray, q0: np.ndarray, max_iter: int = IK_NUMERIC_DEFAULTS["max_iter"],
+                   tol: float = IK_NUMERIC_DEFAULTS["tol"]) -> tuple[np.ndarray, int]:
         """`NAME_ik_numeric` from q0: (q, status); the defaults are the generated Python's."""
         pointer = ctypes.POINTER(C_TYPES[self.real])
         target = np.ascontiguousarray(np.ravel(target), dtype=self.dtype)

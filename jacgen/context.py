@@ -233,12 +233,6 @@ def _casadi_function(function: Function, robot: Robot, printer: CasadiPrinter) -
     }
 
 
-# CasADi's ik_numeric takes this many steps (a fixed graph; the C and numpy stop when done).
-IK_NUMERIC_ITERATIONS = 100
-# ik_numeric's Levenberg-Marquardt damping (added to the diagonal): start, least, most.
-IK_NUMERIC_DAMPING = {"start": 1e-6, "min": 1e-12, "max": 1e8}
-
-
 def _ik_context(robot: Robot, generator: Generator, language: str, real: str) -> dict | None:
     """What the ik wrapper around ik_branches (`wrapper`) and ik_nearest's statuses (`nearest`)
     document and declare, None without ik_branches."""
@@ -289,9 +283,11 @@ def _ik_numeric_context(robot: Robot, language: str, real: str) -> dict:
         else "target - mu(q), angles wrapped into (-pi, pi]",
         "jacobian": "the geometric Jacobian" if pose else "the task Jacobian",
         "step_text": "q += J^T (J J^T + damping I)^-1 e" if m <= n else "q += (J^T J + damping I)^-1 J^T e",
-        "damping": {key: number(sympy.Float(value)) for key, value in IK_NUMERIC_DAMPING.items()},
+        "damping": {key: number(sympy.Float(value)) for key, value in differential.IK_NUMERIC_DAMPING.items()},
         "tenth": number(sympy.Float(0.1)),
-        "iterations": IK_NUMERIC_ITERATIONS,
+        "iterations": differential.IK_NUMERIC_ITERATIONS,
+        "statuses": differential.IK_NUMERIC_STATUSES,
+        "defaults": {key: repr(value) for key, value in differential.IK_NUMERIC_DEFAULTS.items()},
         "python": {"where": "xp.where", "logical_and": "xp.logical_and", "maximum": "xp.maximum",
                    "finite": "(cost >= 0.0) & (max_iter >= 0)", "iterations": "max(max_iter, 0)",
                    "widen": "[..., None]", "q0": "xp.asarray(q0, dtype=q.dtype)", "fixed": False},

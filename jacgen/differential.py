@@ -17,6 +17,20 @@ from .nodes import RANK, Above, AtLeast, AtMost, Below, IsFinite, Unequal, selec
 # Statuses of velocity_ik, the same in every backend.
 VELOCITY_IK_OK, VELOCITY_IK_SINGULAR, VELOCITY_IK_NOT_FINITE = 0, 1, 2
 
+# ik_numeric: the loop each language's template writes around ik_numeric_step (its step, built
+# below), one source for its statuses, defaults and damping in every backend and in compile.py.
+IK_NUMERIC_STATUSES = (
+    ("CONVERGED", 0, "|error| <= tol"),
+    ("ITERATION_LIMIT", 1, "max_iter steps tried, |error| still above tol"),
+    ("STALLED", 2, "no step lowers |error|: out of reach, joint limit or local minimum"),
+    ("INVALID", 3, "target or q0 not finite, or max_iter < 0: q = q0"),
+)
+IK_NUMERIC_DEFAULTS = {"max_iter": 100, "tol": 1e-10}
+# CasADi's ik_numeric takes this many steps (a fixed graph; the C and numpy stop when done).
+IK_NUMERIC_ITERATIONS = 100
+# The Levenberg-Marquardt damping (added to the diagonal): start, least, most.
+IK_NUMERIC_DAMPING = {"start": 1e-6, "min": 1e-12, "max": 1e8}
+
 
 def householder_solve(A: list[list[sympy.Expr]], b: list[sympy.Expr], name: Callable) -> tuple[list, sympy.Basic]:
     """x with A x = b, and whether A is numerically singular (see the module's rule)."""

@@ -4440,7 +4440,7 @@ def ik(T, limits=True):
 
 IK_NUMERIC_CONVERGED = 0  # |error| <= tol
 IK_NUMERIC_ITERATION_LIMIT = 1  # max_iter steps tried, |error| still above tol
-IK_NUMERIC_STALLED = 2  # no step reduces the error: unreachable target, joint limit or local minimum
+IK_NUMERIC_STALLED = 2  # no step lowers |error|: out of reach, joint limit or local minimum
 IK_NUMERIC_INVALID = 3  # target or q0 not finite, or max_iter < 0: q = q0
 _DAMPING = (1e-06, 1e-12, 100000000.0)  # added to the diagonal: start, least, most
 

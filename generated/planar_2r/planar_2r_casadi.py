@@ -587,10 +587,10 @@ ik_nearest = casadi.Function("ik_nearest", [_mu, _q_seed, _weights], _ik_nearest
 ik = ik_branches  # CasADi functions have fixed-size outputs: every branch, its validity and its limits
 
 IK_NUMERIC_CONVERGED = 0  # |error| <= tol
-IK_NUMERIC_ITERATION_LIMIT = 1  # IK_NUMERIC_ITERATIONS steps taken, |error| still above tol
-IK_NUMERIC_STALLED = 2  # no step reduces the error: unreachable target, joint limit or local minimum
-IK_NUMERIC_INVALID = 3  # target or q0 not finite: q = q0
-IK_NUMERIC_ITERATIONS = 100
+IK_NUMERIC_ITERATION_LIMIT = 1  # max_iter steps tried, |error| still above tol
+IK_NUMERIC_STALLED = 2  # no step lowers |error|: out of reach, joint limit or local minimum
+IK_NUMERIC_INVALID = 3  # target or q0 not finite, or max_iter < 0: q = q0
+IK_NUMERIC_ITERATIONS = 100  # max_iter: the steps every call takes (a fixed graph)
 _DAMPING = (1e-06, 1e-12, 100000000.0)  # added to the diagonal: start, least, most
 
 
@@ -625,5 +625,5 @@ ik_numeric = casadi.Function("ik_numeric", _inputs, _ik_numeric(*_inputs), ["tar
 
 
 def functions():
-    """All functions by name."""
-    return {"fk": fk, "jacobian": jacobian, "fk_jacobian": fk_jacobian, "jacobian_tool": jacobian_tool, "task": task, "task_jacobian": task_jacobian, "fk_jacobian_dot": fk_jacobian_dot, "jacobian_dot": jacobian_dot, "bias_acceleration": bias_acceleration, "task_jacobian_dot": task_jacobian_dot, "hessian": hessian, "singularity_factors": singularity_factors, "manipulability": manipulability, "jacobian_det": jacobian_det, "velocity_ik": velocity_ik, "ik_numeric_step": ik_numeric_step, "ik_branches": ik_branches, "ik_nearest": ik_nearest}
+    """All functions by name (`ik` is `ik_branches`)."""
+    return {"fk": fk, "jacobian": jacobian, "fk_jacobian": fk_jacobian, "jacobian_tool": jacobian_tool, "task": task, "task_jacobian": task_jacobian, "fk_jacobian_dot": fk_jacobian_dot, "jacobian_dot": jacobian_dot, "bias_acceleration": bias_acceleration, "task_jacobian_dot": task_jacobian_dot, "hessian": hessian, "singularity_factors": singularity_factors, "manipulability": manipulability, "jacobian_det": jacobian_det, "velocity_ik": velocity_ik, "ik_numeric_step": ik_numeric_step, "ik_branches": ik_branches, "ik_nearest": ik_nearest, "ik": ik, "ik_numeric": ik_numeric}
