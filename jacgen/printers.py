@@ -11,7 +11,6 @@ Every number that is not an integer, and every subexpression of the IK's toleran
 the shortest decimal that reads back as the same value of that type.
 """
 
-import numpy
 import sympy
 
 from .lowering import Body, is_boolean
@@ -183,117 +182,8 @@ class Printer:
         raise NotImplementedError
 
 
-_FLOAT_MAX = float(numpy.finfo(numpy.float32).max)
 # The functions the expressions use, by sympy's name, and their name in C99's math.h (numpy
 # and CasADi use the same names, numpy's absolute value aside).
 MATH_FUNCTIONS = {"sin": "sin", "cos": "cos", "tan": "tan", "asin": "asin", "acos": "acos", "atan": "atan",
                   "atan2": "atan2", "exp": "exp", "log": "log", "sqrt": "sqrt", "Abs": "fabs", "Floor": "floor",
                   "Ceiling": "ceil"}
-
-
-class CPrinter(Printer):
-    """C99 for `double` or `float` builds: the type's functions (`sinf`, `atan2f`) and literals
-    (`0.5F`), so a float build has no double promotion; small integer and half-integer powers
-    as products (`(x*x)`, `(sqrt(x)*x)`), never `pow()`; selects as `(c ? a : b)`. No math
-    macro: `M_PI` and `M_SQRT2` are POSIX, not C99."""
-
-    LARGEST_EXPANDED_POWER = 8
-
-    def __init__(self, real: str):
-        if real not in TOLERANCES:
-            raise ValueError(f"real must be one of {', '.join(TOLERANCES)}, got {real!r}")
-        super().__init__(real)
-        self.real = real
-        suffix = "f" if real == "float" else ""
-        self.functions = {name: function + suffix for name, function in MATH_FUNCTIONS.items()}
-        self.one = self.literal(1.0)
-
-    def literal(self, value: float) -> str:
-        """Shortest literal that reads back as the nearest value of the build's type."""
-        if self.real == "double":
-            return repr(value)
-        if not abs(value) <= _FLOAT_MAX:
-            raise ValueError(f"constant {value!r} is out of the range of float")
-        return str(numpy.float32(value)) + "F"
-
-    def truth(self, value: bool) -> str:
-        return str(int(value))
-
-    def power(self, base, exponent):
-        if exponent.q not in (1, 2) or exponent > self.LARGEST_EXPANDED_POWER:
-            return f"pow{'f' * (self.real == 'float')}({self.doprint(base)}, {self.literal(float(exponent))})", ATOM
-        factor = self._operand(base, PRODUCT + 1)
-        root = [f"{self.functions['sqrt']}({self.doprint(base)})"] * (exponent.q == 2)
-        return "(" + "*".join(root + [factor] * int(exponent)) + ")", ATOM
-
-    def relation(self, lhs, operator, rhs):
-        return f"{lhs} {operator} {rhs}", RELATION
-
-    def select(self, condition, value, otherwise, numbers):
-        return f"({condition} ? {value} : {otherwise})"
-
-    def logic(self, name, operands):
-        """`a && b`, and every operand of `||` that is not an atom in parentheses (gcc's
-        -Wparentheses)."""
-        if name == "And":
-            return " && ".join(self._operand(operand, AND + 1) for operand in operands)
-        return " || ".join(self._operand(operand, ATOM) for operand in operands)
-
-    def negation(self, operand):
-        return "!" + self._operand(operand, ATOM)
-
-    def finite(self, text):
-        return f"isfinite({text})"
-
-
-class PythonPrinter(Printer):
-    """Python over the array API namespace `xp` of the inputs (numpy, JAX, PyTorch), batched.
-
-    A select is `xp.where`, both sides computed (the generated function ignores numpy's
-    floating-point warnings of the side not taken). A select of two numbers makes the first an
-    array of the function's `dtype`: otherwise PyTorch makes it float32, and numpy an integer
-    array that turns float32 arithmetic into float64 (the context makes statuses integers again).
-    """
-
-    functions = {name: f"xp.{function}" for name, function in (MATH_FUNCTIONS | {"Abs": "abs"}).items()}
-    COMPARISONS = {">=": "greater_equal", ">": "greater", "<=": "less_equal", "<": "less", "==": "equal",
-                   "!=": "not_equal"}
-
-    def relation(self, lhs, operator, rhs):
-        return f"xp.{self.COMPARISONS[operator]}({lhs}, {rhs})", ATOM
-
-    def select(self, condition, value, otherwise, numbers):
-        value = f"xp.asarray({value}, dtype=dtype)" if numbers else value
-        return f"xp.where({condition}, {value}, {otherwise})"
-
-    def logic(self, name, operands):
-        return (" & " if name == "And" else " | ").join(self._operand(operand, RELATION) for operand in operands)
-
-    def negation(self, operand):
-        return f"xp.logical_not({self.doprint(operand)})"
-
-    def finite(self, text):
-        return f"xp.isfinite({text})"
-
-
-class CasadiPrinter(Printer):
-    """Python building CasADi SX expressions: `casadi.cos(q1)`, `casadi.if_else(c, a, b)`."""
-
-    functions = {name: f"casadi.{function}" for name, function in MATH_FUNCTIONS.items()}
-
-    def select(self, condition, value, otherwise, numbers):
-        return f"casadi.if_else({condition}, {value}, {otherwise})"
-
-    def logic(self, name, operands):
-        function = "casadi.logic_and" if name == "And" else "casadi.logic_or"
-        text = self.doprint(operands[0])
-        for operand in operands[1:]:
-            text = f"{function}({text}, {self.doprint(operand)})"
-        return text
-
-    def negation(self, operand):
-        return f"casadi.logic_not({self.doprint(operand)})"
-
-    def finite(self, text):
-        """NaN < inf is false, as is inf < inf."""
-        return f"(casadi.fabs({text}) < casadi.inf)"

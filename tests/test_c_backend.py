@@ -16,7 +16,7 @@ from numpy.testing import assert_allclose
 from jacgen import reference
 from jacgen.compile import CLibrary, compile_shared
 from jacgen.functions import Generator
-from jacgen.printers import CPrinter
+from jacgen.backends.c import CPrinter
 from jacgen.render import render_robot, write_files
 from jacgen.robot import load_robot
 

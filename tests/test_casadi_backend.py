@@ -11,7 +11,7 @@ from numpy.testing import assert_allclose
 
 from jacgen import reference
 from jacgen.functions import Generator
-from jacgen.printers import CasadiPrinter
+from jacgen.backends.casadi import CasadiPrinter
 from jacgen.nodes import Select
 from jacgen.render import render_robot, write_files
 from jacgen.robot import load_robot
