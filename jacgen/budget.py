@@ -1,6 +1,6 @@
 """A time budget: the safety net around each robot's exact singularity analysis.
 
-The analysis is bounded by design (analysis.WORK_LIMIT and the other size limits); the
+The analysis is bounded by design (joint_ring.WORK_LIMIT and the size limits of analysis.py); the
 budget is there only in case a limit is ever wrong, and no arm tried reaches it:
 
     singular = budget.within_budget(lambda: analysis.analyse(robot), lambda: analysis.unanalysed(robot),

@@ -14,6 +14,7 @@ from sympy.core.parameters import distribute
 
 from . import analysis, differential, general6r, ik, kinematics
 from .lowering import Body, Lowering, is_boolean
+from .joint_ring import joint_atoms, maximal_minors
 from .model import Model
 from .nodes import Above, select
 from .robot import Robot
@@ -440,7 +441,7 @@ class Generator:
         m, n = js.shape
         if m == n or math.comb(max(m, n), min(m, n)) <= analysis.MINOR_LIMIT:
             named = [[self.name(entry) for entry in row] for row in js.tolist()]
-            minors = analysis.maximal_minors(named, sympy.Integer(0), sympy.Integer(1))
+            minors = maximal_minors(named, sympy.Integer(0), sympy.Integer(1))
             return minors[0] if m == n else sympy.Add(*(self.name(minor) ** 2 for minor in minors))
         tall = js.T if m < n else js
         columns = [[self.name(entry) for entry in tall[:, k]] for k in range(tall.cols)]
@@ -469,7 +470,7 @@ class Generator:
             return []
         singular, (m, n) = self.singularities, js.shape
         atoms = {}
-        for i, symbols in enumerate(analysis.joint_atoms(self.robot)):
+        for i, symbols in enumerate(joint_atoms(self.robot)):
             if len(symbols) == 2:
                 atoms.update(zip(symbols, self.cos_sin((i,))))
         numeric = sympy.Integer(0) if singular.everywhere else self.rank_determinant(js)

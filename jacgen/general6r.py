@@ -40,7 +40,7 @@ from sympy.polys.domains import RealField
 from sympy.polys.rings import ring
 
 from . import kinematics
-from .analysis import circle_reduced
+from .joint_ring import circle_reduced
 from .robot import Robot
 
 PRECISION = 60  # digits of the twists' cosines and sines

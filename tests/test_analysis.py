@@ -248,7 +248,8 @@ def test_show_plot_writes_a_png(tmp_path):
 def test_roots_of_a_one_joint_factor(polynomial):
     """Roots from the polynomial in tan(q/2) (numeric above degree 2), against a dense scan
     of the factor over one turn: the same roots, each within 1e-9 (q = pi included)."""
-    from jacgen.analysis import JointRing, _Numeric
+    from jacgen.analysis import _Numeric
+    from jacgen.joint_ring import JointRing
 
     arm = robot("planar_2r")
     ring = JointRing(arm)
