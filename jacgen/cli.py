@@ -8,7 +8,7 @@ import click
 from . import budget
 from .version import __version__
 from .errors import JacgenError
-from .functions import with_callees
+from .catalogue import with_callees
 from .model import Model
 from .backends import BACKENDS, DEFAULT_LANGUAGES
 from .render import render_robot, stale_files, write_files

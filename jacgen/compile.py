@@ -15,7 +15,7 @@ import numpy as np
 
 from .differential import IK_NUMERIC_DEFAULTS
 from .errors import JacgenError
-from .functions import Function
+from .catalogue import Function
 from .robot import Robot
 
 # SPEC §3: the generated C compiles without a warning under these flags.

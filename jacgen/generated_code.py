@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 
 from .compile import CLibrary
-from .functions import Function
+from .catalogue import Function
 from .robot import Robot
 from .target import Emulator
 

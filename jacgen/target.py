@@ -23,7 +23,8 @@ import numpy as np
 from . import reference
 from .compile import WARNING_FLAGS
 from .errors import JacgenError
-from .functions import FUNCTION_NAMES, Generator
+from .catalogue import FUNCTION_NAMES
+from .functions import Generator
 from .render import environment, render_robot, write_files
 from .robot import Robot
 

@@ -29,7 +29,8 @@ import numpy as np
 
 from . import analysis, ik, reference
 from .compile import c_compiler, compile_shared
-from .functions import Function, Generator
+from .catalogue import Function
+from .functions import Generator
 from .render import render_robot, write_files
 from .robot import Robot
 from .generated_code import BACKENDS, GeneratedCode

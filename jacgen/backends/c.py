@@ -5,7 +5,8 @@ eigensolver's runtime), and its reserved words."""
 import numpy
 
 from .. import names
-from ..functions import Argument, Call, Function, Generator, Output
+from ..catalogue import Argument, Call, Function, Output
+from ..functions import Generator
 from ..lowering import is_boolean
 from ..nodes import TOLERANCES
 from ..printers import AND, ATOM, MATH_FUNCTIONS, PRODUCT, RELATION, Printer

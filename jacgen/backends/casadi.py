@@ -4,7 +4,8 @@ its printer, and its reserved words (Python's)."""
 import sympy
 
 from .. import names
-from ..functions import Function, Generator
+from ..catalogue import Function
+from ..functions import Generator
 from ..printers import MATH_FUNCTIONS, Printer
 from ..robot import Robot
 from .common import Backend, common_context, ik_numeric_context, parameters_read, sentence

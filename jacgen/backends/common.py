@@ -7,7 +7,8 @@ from typing import Callable
 import sympy
 
 from .. import analysis, differential, general6r, ik
-from ..functions import Generator, Output
+from ..catalogue import Output
+from ..functions import Generator
 from ..nodes import RANK, TOLERANCES
 from ..robot import Robot
 

@@ -5,7 +5,8 @@ import numpy
 import sympy
 
 from .. import names
-from ..functions import Function, Generator
+from ..catalogue import Function
+from ..functions import Generator
 from ..nodes import Select
 from ..printers import ATOM, MATH_FUNCTIONS, RELATION, Printer
 from ..robot import Robot
