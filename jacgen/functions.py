@@ -11,7 +11,7 @@ from functools import cached_property
 import sympy
 from sympy.core.parameters import distribute
 
-from . import analysis, differential, general6r, ik, kinematics
+from . import analysis, differential, general6r, ik, ik_limits, kinematics
 from .catalogue import (ANGLES, CALLEES, EXTENTS, FUNCTION_NAMES, SECOND_ORDER, Argument, Call, Function, Loop, Output,
                         extent_of, with_callees)
 from .joint_ring import joint_atoms, maximal_minors
@@ -104,7 +104,7 @@ class Generator:
         table_q, table_valid, table_inside = (result.symbols for result in table.results)
         with distribute(False):
             read = target.symbols[:3, :] if form.target == "pose" else target.symbols
-            closest, status = ik.nearest(self.robot, sp, table_q, list(table_valid), list(table_inside),
+            closest, status = ik_limits.nearest(self.robot, sp, table_q, list(table_valid), list(table_inside),
                                          list(seed.symbols), list(weights.symbols), form.free, list(read))
         nearest = self.function("ik_nearest", "the closed-form ik solution inside the joint limits nearest q_seed "
                                 "(sum of weights_j (q_j - q_seed_j)^2), and the status", ("q", sympy.Matrix(closest)),
@@ -160,7 +160,7 @@ class Generator:
         step = self.ik_numeric_step_function(None, "ik_general_step", newton=True)
         given = Argument("q_solution", sympy.Matrix([sympy.Symbol(f"qg{i + 1}", real=True) for i in range(6)]))
         with distribute(False):
-            form, inside = ik.limited(self.robot, sp, list(given.symbols), tuple(range(6)))
+            form, inside = ik_limits.limited(self.robot, sp, list(given.symbols), tuple(range(6)))
         limits = self.function("ik_general_limits", "ik's form of q (revolute angles wrapped, or into the limits) "
                                "and whether it is inside the joint limits", ("q", sympy.Matrix(form)),
                                ("in_limits", [inside]), vector=True, scalars=("in_limits",), arguments=(given,),

@@ -6,7 +6,7 @@ from typing import Callable
 
 import sympy
 
-from .. import analysis, differential, general6r, ik
+from .. import analysis, differential, general6r, ik, ik_limits
 from ..catalogue import Output
 from ..functions import Generator
 from ..nodes import RANK, TOLERANCES
@@ -96,8 +96,8 @@ def ik_context(robot: Robot, generator: Generator, real: str, number: Callable, 
         "doc": ik.documentation(robot, form, solutions_macro),
         "inputs": ", ".join(inputs),
         "free_joint": form.free,
-        "nearest_statuses": [("OK", ik.IK_NEAREST_OK), ("NO_SOLUTION", ik.IK_NEAREST_NO_SOLUTION),
-                             ("NOT_FINITE", ik.IK_NEAREST_NOT_FINITE)],
+        "nearest_statuses": [("OK", ik_limits.IK_NEAREST_OK), ("NO_SOLUTION", ik_limits.IK_NEAREST_NO_SOLUTION),
+                             ("NOT_FINITE", ik_limits.IK_NEAREST_NOT_FINITE)],
         "signature": ", ".join(arguments),
         "wrapper": generator.generates("ik"),
         "nearest": generator.generates("ik_nearest"),
