@@ -1,4 +1,4 @@
-"""Singularity analysis (SPEC §2): the singularity Jacobian Js, its polynomial and factors.
+"""Singularity analysis (docs/contract.md §2): the singularity Jacobian Js, its polynomial and factors.
 
 Js is the task Jacobian, except that a task holding all of roll, pitch and yaw uses the
 geometric angular-velocity rows instead (so the Euler-angle singularity at pitch = ±90°
@@ -32,9 +32,8 @@ from sympy.polys.rings import PolyElement
 from . import reference
 from .joint_ring import (READABLE_TERMS, JointRing, TooLarge, factorise, frames_about, geometric_columns, maximal_minors,
                          multiply, permutation_sign, term_count)
-from .robot import TASK_COMPONENTS, Robot
+from .robot import EULER_ANGLES, TASK_COMPONENTS, Robot
 
-EULER = ("roll", "pitch", "yaw")
 # The exact analysis is bounded by counts, never by a clock, so its outcome is the same on
 # every machine: the monomial products of all polynomial multiplications of one robot
 # (joint_ring.WORK_LIMIT); MINOR_LIMIT the maximal minors whose common factors are sought
@@ -50,7 +49,7 @@ PARALLEL_TOLERANCE = 1e-9  # |z_a x z_b| for parallel unit axes
 def singularity_rows(robot: Robot) -> tuple[int, ...] | None:
     """Rows of the geometric Jacobian (vx vy vz wx wy wz) forming Js, in task order;
     None when Js is the task Jacobian itself (a task with some but not all Euler angles)."""
-    if sum(component in EULER for component in robot.task) in (0, 3):
+    if sum(component in EULER_ANGLES for component in robot.task) in (0, 3):
         return tuple(TASK_COMPONENTS.index(component) for component in robot.task)
     return None
 

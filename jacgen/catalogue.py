@@ -10,7 +10,6 @@ import sympy
 
 from .lowering import Body
 
-ANGLES = ("roll", "pitch", "yaw")
 SECOND_ORDER = ("fk_jacobian_dot", "jacobian_dot", "bias_acceleration", "task_jacobian_dot", "hessian")
 
 # Every function a robot can get, in the order the backends emit them (`ik` and `ik_numeric`

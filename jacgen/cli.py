@@ -1,4 +1,4 @@
-"""The `jacgen` command line (SPEC §4). Exit codes: 0 ok, 1 check failed, 2 invalid input."""
+"""The `jacgen` command line (contract §4). Exit codes: 0 ok, 1 check failed, 2 invalid input."""
 
 import sys
 from pathlib import Path

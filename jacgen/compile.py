@@ -1,6 +1,6 @@
 """Generated C as a shared library called from Python: for `jacgen verify` and the tests.
 
-The C is compiled with the warning flags SPEC §3 promises (any warning is an error) and
+The C is compiled with the warning flags contract §3 promises (any warning is an error) and
 loaded with ctypes; `CLibrary.evaluate` runs one generated function on a batch of joint
 vectors, one native call per configuration.
 """
@@ -18,7 +18,7 @@ from .errors import JacgenError
 from .catalogue import Function
 from .robot import Robot
 
-# SPEC §3: the generated C compiles without a warning under these flags.
+# contract §3: the generated C compiles without a warning under these flags.
 WARNING_FLAGS = ("-std=c99", "-Wall", "-Wextra", "-Wpedantic", "-Wconversion", "-Wshadow",
                  "-Wdouble-promotion", "-Werror")
 C_TYPES = {"double": ctypes.c_double, "float": ctypes.c_float}

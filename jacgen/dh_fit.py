@@ -50,7 +50,7 @@ class Table:
     tool: tuple[tuple, tuple]
 
 
-def tidy(x) -> sympy.Expr:
+def exact_or_float(x) -> sympy.Expr:
     """x, kept exact inside the exact domain, else as a 30-digit float (tiny ones: zero)."""
     x = sympy.sympify(x)
     if x.is_Rational or (not x.has(sympy.Float) and _simple(x)):
@@ -66,19 +66,19 @@ def _simple(x: sympy.Expr) -> bool:
 
 
 def dot(u: Matrix, v: Matrix) -> sympy.Expr:
-    return tidy(sum(a * b for a, b in zip(u, v)))
+    return exact_or_float(sum(a * b for a, b in zip(u, v)))
 
 
 def cross(u: Matrix, v: Matrix) -> Matrix:
-    return u.cross(v).applyfunc(tidy)
+    return u.cross(v).applyfunc(exact_or_float)
 
 
 def unit(v: Matrix) -> Matrix:
-    return (v / sympy.sqrt(dot(v, v))).applyfunc(tidy)
+    return (v / sympy.sqrt(dot(v, v))).applyfunc(exact_or_float)
 
 
 def is_zero_vector(v: Matrix) -> bool:
-    return all(tidy(e) == 0 for e in v)
+    return all(exact_or_float(e) == 0 for e in v)
 
 
 class _Fit:
@@ -87,7 +87,7 @@ class _Fit:
 
     def angle(self, y, x) -> sympy.Expr:
         """atan2(y, x), exactly k*pi/2 when nearly so (robot files snap such angles anyway)."""
-        value = tidy(sympy.atan2(y, x))
+        value = exact_or_float(sympy.atan2(y, x))
         return self.snapper.angle(value) if value.has(sympy.Float) else value
 
     def parallel(self, z: Matrix, w: Matrix) -> bool:
@@ -100,17 +100,17 @@ class _Fit:
     def rpy(self, rotation: Matrix) -> tuple:
         """(roll, pitch, yaw) with R = Rz(yaw) Ry(pitch) Rx(roll); roll = 0 at pitch = +-90 deg."""
         pitch = self.angle(-rotation[2, 0], sympy.sqrt(dot(rotation[:2, 0], rotation[:2, 0])))
-        if sympy.cos(pitch) == 0 or tidy(sympy.cos(pitch)) == 0:
+        if sympy.cos(pitch) == 0 or exact_or_float(sympy.cos(pitch)) == 0:
             return (sympy.Integer(0), pitch, self.angle(-rotation[0, 1], rotation[1, 1]))
         return (self.angle(rotation[2, 1], rotation[2, 2]), pitch, self.angle(rotation[1, 0], rotation[0, 0]))
 
     def pose(self, frame: Matrix) -> tuple[tuple, tuple]:
-        return tuple(tidy(e) for e in frame[:3, 3]), self.rpy(frame[:3, :3])
+        return tuple(exact_or_float(e) for e in frame[:3, 3]), self.rpy(frame[:3, :3])
 
 
 def _foot(point: Matrix, axis: Axis) -> Matrix:
     """The point of the axis line nearest `point`."""
-    return (axis.point + dot(point - axis.point, axis.direction) * axis.direction).applyfunc(tidy)
+    return (axis.point + dot(point - axis.point, axis.direction) * axis.direction).applyfunc(exact_or_float)
 
 
 def _placed(axes: list[Axis], tip: Matrix, fitting: "_Fit") -> list[Axis]:
@@ -133,10 +133,10 @@ def _placed(axes: list[Axis], tip: Matrix, fitting: "_Fit") -> list[Axis]:
 def _closest_points(here: Axis, there: Axis) -> tuple[Matrix, Matrix]:
     """The points of two axis lines that are not parallel nearest each other: the feet of
     their common normal on `here` and on `there`."""
-    r = (there.point - here.point).applyfunc(tidy)
+    r = (there.point - here.point).applyfunc(exact_or_float)
     b, d1, d2 = dot(here.direction, there.direction), dot(here.direction, r), dot(there.direction, r)
-    s, t = tidy((d1 - b * d2) / (1 - b * b)), tidy((b * d1 - d2) / (1 - b * b))
-    return (here.point + s * here.direction).applyfunc(tidy), (there.point + t * there.direction).applyfunc(tidy)
+    s, t = exact_or_float((d1 - b * d2) / (1 - b * b)), exact_or_float((b * d1 - d2) / (1 - b * b))
+    return (here.point + s * here.direction).applyfunc(exact_or_float), (there.point + t * there.direction).applyfunc(exact_or_float)
 
 
 def _oriented(x: Matrix, previous: Matrix, z: Matrix) -> Matrix:
@@ -167,7 +167,7 @@ def fit(axes: list[Axis], tip: Matrix, convention: str, snapper: Snapper) -> Tab
         previous_foot, previous_x = feet[-1][1], x[-1]
         if fitting.parallel(here.direction, there.direction):
             start, end = previous_foot, _foot(previous_foot, there)  # the normal through the last foot: d_i = 0
-            between = (end - start).applyfunc(tidy)
+            between = (end - start).applyfunc(exact_or_float)
             direction = previous_x if is_zero_vector(between) else unit(between)
         else:
             start, end = _closest_points(here, there)
@@ -196,4 +196,4 @@ def fit(axes: list[Axis], tip: Matrix, convention: str, snapper: Snapper) -> Tab
         rows.append(Row(axis, a, alpha, d, theta))
     base = _frame(origin, x[0], first.direction)
     tool = inverse_transform(_frame(end, x[n], last.direction)) * tip
-    return Table(tuple(rows), fitting.pose(base), fitting.pose(tool.applyfunc(tidy)))
+    return Table(tuple(rows), fitting.pose(base), fitting.pose(tool.applyfunc(exact_or_float)))

@@ -12,13 +12,13 @@ import sympy
 from sympy.core.parameters import distribute
 
 from . import analysis, differential, general6r, ik, ik_limits, kinematics
-from .catalogue import (ANGLES, CALLEES, EXTENTS, FUNCTION_NAMES, SECOND_ORDER, Argument, Call, Function, Loop, Output,
+from .catalogue import (CALLEES, EXTENTS, FUNCTION_NAMES, SECOND_ORDER, Argument, Call, Function, Loop, Output,
                         extent_of, with_callees)
 from .joint_ring import joint_atoms, maximal_minors
 from .lowering import Lowering, is_boolean
 from .model import Model
 from .nodes import Above, select
-from .robot import Robot
+from .robot import EULER_ANGLES, Robot
 from .subproblems import Subproblems, wrapped
 
 class Generator:
@@ -202,7 +202,7 @@ class Generator:
                 jacobian = self.jacobian
             else:
                 mu = kinematics.task_vector(robot, self.chain.tool)
-                error = [wrapped(goal - value) if component in ANGLES else goal - value
+                error = [wrapped(goal - value) if component in EULER_ANGLES else goal - value
                          for goal, value, component in zip(target.symbols, mu, robot.task)]
                 jacobian = task_jacobian
             trial, cost = differential.ik_numeric_step(error, jacobian, list(self.q), damping.symbols[0], limits,

@@ -13,7 +13,7 @@ from .catalogue import Function
 from .robot import Robot
 from .target import Emulator
 
-BACKENDS = ("python", "casadi", "c double", "c float")  # the host's
+HOST_BACKENDS = ("python", "casadi", "c double", "c float")  # what `jacgen verify` compares on the host
 TARGET_BACKENDS = {"cortex-m4f": "cortex-m4f float"}  # `verify --target`: the target's float C alone
 
 
@@ -31,7 +31,7 @@ class GeneratedCode:
     def __init__(self, robot: Robot, functions: list[Function], folder: Path, libraries: dict[str, Path],
                  emulator: Emulator | None = None):
         self.robot, self.emulator = robot, emulator
-        self.names = BACKENDS if emulator is None else (TARGET_BACKENDS["cortex-m4f"],)
+        self.names = HOST_BACKENDS if emulator is None else (TARGET_BACKENDS["cortex-m4f"],)
         self.functions = {f.name: f for f in functions}
         if emulator is None:
             self.python = import_module(folder / "double" / robot.name / f"{robot.name}.py", f"_jacgen_verify_{robot.name}")

@@ -17,7 +17,7 @@ import sympy
 from . import general6r
 from .ik_limits import limited
 from .nodes import EPS, Above, AtLeast, AtMost, IsFinite, select
-from .structure import E_Z, SOLVERS, Geometry, SolverInfo, Structure, classify, is_zero, tidy
+from .structure import E_Z, SOLVERS, Geometry, SolverInfo, Structure, classify, is_zero, readable
 from .subproblems import Angle, Subproblems, relative, times, times_transposed
 
 Matrix = sympy.Matrix
@@ -42,7 +42,7 @@ class ClosedForm:
 
 
 def _scalar(value) -> Matrix:
-    return Matrix([tidy(value)])
+    return Matrix([readable(value)])
 
 
 def _pose(g: Geometry) -> list[tuple[str, Matrix]]:
@@ -152,7 +152,7 @@ def closed_form(robot, geometry: Geometry | None = None, structure: Structure | 
     h = chain.axes
     flip = structure.solver in _FLIPS and all(is_zero(h[4].dot(h[i])) for i in _FLIPS[structure.solver])
     if flip and structure.solver.startswith("spherical_wrist"):
-        turn = sympy.atan2(tidy(h[4].dot(h[3].cross(h[5]))), tidy(h[3].dot(h[5])))  # h6 = rot(h5, turn) h4
+        turn = sympy.atan2(readable(h[4].dot(h[3].cross(h[5]))), readable(h[3].dot(h[5])))  # h6 = rot(h5, turn) h4
         constants.append(("wrist_flip", _scalar(-2 * turn)))
     return ClosedForm(structure.solver, SOLVERS[structure.solver], target,
                       tuple((name, Matrix(value)) for name, value in constants), tuple(indices), flip,

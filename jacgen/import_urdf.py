@@ -16,11 +16,11 @@ import sympy
 import yaml
 
 from . import reference
-from .dh_fit import Axis, fit, tidy
+from .dh_fit import Axis, fit, exact_or_float
 from .errors import JacgenError
 from .names import robot_name_problem
 from .robot import FORBIDDEN_IN_TEXT, IDENTIFIER_PATTERN, NAME_PATTERN, TASK_COMPONENTS, Robot, parse_robot
-from .urdf import MOVABLE, SNAP_TOLERANCE, Chain, Snapper, read_chain
+from .urdf import MOVABLE, SNAP_TOLERANCE, LinkChain, Snapper, read_chain
 from .version import __version__
 
 CHECK_CONFIGURATIONS = 20
@@ -84,14 +84,14 @@ def _read_back(text: str) -> Robot:
         raise RuntimeError(f"the imported robot file does not read back: {error}") from None
 
 
-def _axes(chain: Chain) -> tuple[list[Axis], sympy.Matrix]:
+def _axes(chain: LinkChain) -> tuple[list[Axis], sympy.Matrix]:
     """The moving joints' axis lines at q = 0 in the base link's frame, and the tip frame."""
     frame, axes = chain.start, []
     for joint in chain.joints:
-        frame = (frame * joint.origin).applyfunc(tidy)
+        frame = (frame * joint.origin).applyfunc(exact_or_float)
         if joint.kind in MOVABLE:
             axes.append(Axis(joint.name, "prismatic" if joint.kind == "prismatic" else "revolute",
-                             frame[:3, 3].applyfunc(tidy), (frame[:3, :3] * joint.axis).applyfunc(tidy),
+                             frame[:3, 3].applyfunc(exact_or_float), (frame[:3, :3] * joint.axis).applyfunc(exact_or_float),
                              joint.limits))
     return axes, frame
 
@@ -207,7 +207,7 @@ def _independent_task(robot) -> tuple[str, ...]:
     return tuple(TASK_COMPONENTS[k] for k in chosen)
 
 
-def urdf_fk(chain: Chain, q) -> np.ndarray:
+def urdf_fk(chain: LinkChain, q) -> np.ndarray:
     """The URDF's own fk: its joint transforms multiplied out in floats (no DH involved)."""
     frame = np.array(chain.start.evalf(), dtype=float)
     movable = iter(q)
@@ -226,7 +226,7 @@ def urdf_fk(chain: Chain, q) -> np.ndarray:
     return frame
 
 
-def _fk_difference(robot, chain: Chain) -> float:
+def _fk_difference(robot, chain: LinkChain) -> float:
     rng = np.random.default_rng(CHECK_SEED)
     low, high = np.array(robot.ranges).T
     worst = 0.0

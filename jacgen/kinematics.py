@@ -1,4 +1,4 @@
-"""Symbolic kinematics (SPEC §2): the DH chain, fk, geometric and task Jacobians.
+"""Symbolic kinematics (contract §2): the DH chain, fk, geometric and task Jacobians.
 
 The chain is built once over *trig atoms*: for the readable matrices the atoms are
 `cos(q_i + offset_i)` and `sin(...)`; for code generation they are plain symbols `c_i`,
@@ -111,6 +111,9 @@ def build_chain(robot: Robot, cos_sin: CosSin, q, simplify=lambda e: e, angle_su
     the steps after it, added up backwards from the tool, each lever the next one plus a
     step; the tool origin is the base origin plus every step. With `simplify` naming each
     sum, every lever costs three additions, not a sum over the rest of the chain.
+
+    One walk down the chain in one function: the pending rotation, the translation steps and
+    the levers are state of the same walk, and split apart they would be passed back and forth.
     """
     base = pose_transform(robot.base)
     rotation = base[:3, :3]  # the running frame's rotation, before the pending rotation
@@ -180,7 +183,7 @@ def build_chain(robot: Robot, cos_sin: CosSin, q, simplify=lambda e: e, angle_su
 
 
 def column_jacobian(robot: Robot, chain: Chain) -> Matrix:
-    """Geometric Jacobian in the world frame by the column formula of SPEC §2."""
+    """Geometric Jacobian in the world frame by the column formula of contract §2."""
     columns = []
     for joint, axis, lever in zip(robot.joints, chain.axes, chain.levers):
         z = axis[:3, 2]

@@ -63,7 +63,10 @@ def fold_constants(expr: sympy.Expr, _folded: dict | None = None) -> sympy.Expr:
 def operation_count(exprs) -> int:
     """sympy's `count_ops` of `exprs`, the figure every report and bench shows, by its rules
     (quirks included: a sum under a product's -1 adds no operations), counted once per node
-    and without building the negations and fractions that count_ops builds for each."""
+    and without building the negations and fractions that count_ops builds for each.
+
+    Its rules are one table in one function, in count_ops' order, so that a test can hold
+    the two equal rule by rule (tests/test_lowering.py)."""
     counts: dict[sympy.Basic, int] = {}
 
     def count(expr) -> int:  # count_ops' walk of an expression
@@ -288,7 +291,10 @@ def eliminate_common(exprs: list[sympy.Basic], symbols, negations: dict) -> tupl
     coefficients (sympy compares sort keys of whole expressions), products are not rebuilt to
     split commutative factors (all are), arguments keep their stored order, what is rebuilt
     is not evaluated again where nothing in it can combine (`_rebuilt`), and `negations`
-    keeps each node's negation for the robot's other functions."""
+    keeps each node's negation for the robot's other functions.
+
+    One function, longer than most, because it follows sympy's cse_main step by step (opt_cse's
+    passes, then tree_cse's walk): read side by side with it, a difference is a choice."""
     rewritten: dict = {}  # node -> the form tree_cse walks (sympy's opt_subs)
     adds, muls = {}, {}  # candidates for common arguments, in the order first met
     seen = set()

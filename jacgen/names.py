@@ -61,7 +61,7 @@ PYTHON_KEYWORDS = frozenset(keyword.kwlist)
 PYTHON_BUILTINS = frozenset(name for name in dir(builtins) if not name.startswith("_"))
 # Modules the generated Python imports.
 GENERATED_IMPORTS = frozenset({"numpy", "casadi", "math"})
-# Words of the value grammar and of the generated code (SPEC §2, §3): arguments, functions
+# Words of the value grammar and of the generated code (contract §2, §3): arguments, functions
 # and module constants, and the locals of generated functions that also take the parameters
 # (tests/test_adversarial.py finds any the templates add; new locals had better start with
 # '_', which no parameter name can).

@@ -1,4 +1,4 @@
-"""Independent numeric reference (SPEC §5): numpy only, sharing no code with the symbolic path.
+"""Independent numeric reference (contract §5): numpy only, sharing no code with the symbolic path.
 
 The DH chain is multiplied out with floats, the geometric Jacobian is built column by
 column from the frame origins and axes, and the task Jacobian by central differences.
@@ -178,7 +178,7 @@ def task_jacobian_dot(robot, q, q_dot):
 
 
 def singularity_jacobian(robot, q):
-    """Js (SPEC §2): the geometric rows of the task when it holds all or none of roll, pitch,
+    """Js (contract §2): the geometric rows of the task when it holds all or none of roll, pitch,
     yaw (angular velocity for the angles), else the task Jacobian."""
     angles = sum(name in ("roll", "pitch", "yaw") for name in robot.task)
     if angles in (0, 3):

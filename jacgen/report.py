@@ -97,7 +97,7 @@ def euler_lines(robot: Robot, singular: Singularities) -> list[str]:
         f"  {condition_text(robot, factor)}" for factor in singular.euler]
 
 
-def _planar(robot: Robot) -> bool:
+def _all_axes_vertical(robot: Robot) -> bool:
     """Every joint axis parallel to the world z axis (checked at a generic configuration)."""
     frames, _ = reference.frames(robot, np.linspace(0.3, 0.9, robot.dof))
     return all(np.linalg.norm(np.cross(frame[:3, 2], [0.0, 0.0, 1.0])) < 1e-9 for frame in frames)
@@ -111,7 +111,7 @@ def isotropy_lines(robot: Robot) -> list[str]:
     cos(phi) = -2 l1 l2 / (l1^2 + 2 l2^2), where cond(J) = 1 exactly when l1 = sqrt(2) l2.
     """
     if not (robot.dof == 2 and all(j.revolute for j in robot.joints) and robot.task == ("x", "y")
-            and _planar(robot)):
+            and _all_axes_vertical(robot)):
         return []
     frames, tool = reference.frames(robot, np.zeros(2))
     l1 = float(np.linalg.norm((frames[1][:3, 3] - frames[0][:3, 3])[:2]))
@@ -185,7 +185,7 @@ def js_text(robot: Robot) -> str:
 def plot_workspace(robot: Robot, path: str, samples: int = 4000, ellipses: int = 6) -> None:
     """PNG of a planar arm: tool positions coloured by manipulability, and at a few
     configurations the arm and its velocity ellipse (J_xy J_xy^T, x and y rows)."""
-    if not _planar(robot):
+    if not _all_axes_vertical(robot):
         raise JacgenError(f"{robot.source}: --plot needs a planar arm (every joint axis parallel to world z)")
     try:
         import matplotlib

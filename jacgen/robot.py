@@ -1,4 +1,4 @@
-"""Robot files (SPEC §1): YAML -> a validated, frozen Robot.
+"""Robot files (contract §1): YAML -> a validated, frozen Robot.
 
 The YAML is composed into nodes (never constructed into Python objects) so that every
 error can name the file, line, column and key path of the offending value.
@@ -18,6 +18,7 @@ from .expr import ExpressionError, Value, parse
 from .names import PARAMETER_NAME_RULE, ROBOT_NAME_RULE, parameter_name_problem, robot_name_problem
 
 TASK_COMPONENTS = ("x", "y", "z", "roll", "pitch", "yaw")
+EULER_ANGLES = TASK_COMPONENTS[3:]  # ZYX Euler angles of the tool: R = Rz(yaw) Ry(pitch) Rx(roll)
 MAX_JOINTS = 32
 MAX_FILE_BYTES = 1 << 20
 MAX_NESTING = 16  # a robot file needs 4 levels: file, joints, a joint, its limits

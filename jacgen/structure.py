@@ -154,7 +154,7 @@ def is_zero(expr) -> bool:
     return all(abs(complex(sympy.N(expr.xreplace(point), PRECISION))) < TOLERANCE for point in points)
 
 
-def tidy(expr: sympy.Expr) -> sympy.Expr:
+def readable(expr: sympy.Expr) -> sympy.Expr:
     """Simplified when symbolic (for readable reports), reduced on the circle when a function of
     the free joint; numbers stay as they are, since their value is all that is used."""
     circle = _circle(expr)
@@ -265,7 +265,7 @@ class Geometry:
         if not is_zero(offset.dot(normal)):
             return None
         along = offset.cross(self.axes[j]).dot(normal) / squared_norm(normal)
-        return (self.points[i] + along * self.axes[i]).applyfunc(tidy)
+        return (self.points[i] + along * self.axes[i]).applyfunc(readable)
 
     def wrist_centre(self, i: int) -> Matrix | None:
         """The point where revolute axes i, i+1, i+2 meet (consecutive ones not parallel), else None."""
@@ -279,7 +279,7 @@ class Geometry:
 
 def _point_text(point: Matrix) -> str:
     if any(e.free_symbols for e in point):
-        return "(" + ", ".join(str(tidy(e)) for e in point) + ")"
+        return "(" + ", ".join(str(readable(e)) for e in point) + ")"
     return "(" + ", ".join(f"{float(e):.6g}" for e in point) + ")"
 
 
@@ -352,7 +352,7 @@ def _free_joint(robot: Robot) -> tuple[str | None, str, Geometry | None]:
     return None, "; ".join(reasons) or "no revolute joint to leave free", None
 
 
-def _planar(g: Geometry, task: tuple[str, ...]) -> tuple[str | None, str] | None:
+def _planar_class(g: Geometry, task: tuple[str, ...]) -> tuple[str | None, str] | None:
     """Solver and reason for an arm whose axes are all parallel to world z (None: not such an arm)."""
     if not all(is_zero(squared_norm(h.cross(E_Z))) for h in g.axes):
         return None
@@ -376,7 +376,7 @@ def _planar(g: Geometry, task: tuple[str, ...]) -> tuple[str | None, str] | None
     return "planar", f"planar {kinds}: every axis parallel to world z"
 
 
-def _yaw_pitch(g: Geometry, task: tuple[str, ...]) -> tuple[str | None, str] | None:
+def _yaw_pitch_class(g: Geometry, task: tuple[str, ...]) -> tuple[str | None, str] | None:
     """Solver and reason for a base-yaw + three-pitch arm (None: not such an arm)."""
     if len(g.axes) != 4 or not all(g.revolute) or task != ("x", "y", "z", "pitch"):
         return None
@@ -407,7 +407,7 @@ def classify(robot: Robot, geometry: Geometry | None = None) -> Structure:
         else:
             solver, reason, chain = None, f"{n} joints cannot reach every pose of a 6-component task", None
         return Structure(solver, reason, chain)
-    for candidate in (_planar, _yaw_pitch):
+    for candidate in (_planar_class, _yaw_pitch_class):
         found = candidate(g, task)
         if found is not None:
             return Structure(found[0], found[1], g)

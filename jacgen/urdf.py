@@ -59,7 +59,7 @@ class UrdfJoint:
 
 
 @dataclass(frozen=True)
-class Chain:
+class LinkChain:
     """The joints from `base` to `tip`: `start` is the transform from `base` to the first
     joint's parent link (the identity unless `base` hangs below it on fixed joints)."""
 
@@ -121,7 +121,7 @@ def parse_xml(data: bytes, path: str) -> Element:
     return roots[0]
 
 
-def read_chain(path: str, base: str | None = None, tip: str | None = None, snapper: Snapper | None = None) -> Chain:
+def read_chain(path: str, base: str | None = None, tip: str | None = None, snapper: Snapper | None = None) -> LinkChain:
     """The chain of the URDF file at `path` from `base` (default: the root) to `tip`
     (default: the one leaf below `base`); `snapper` makes nearly exact angles and axes exact."""
     try:
@@ -146,7 +146,7 @@ class _UrdfReader:
             raise self.error(element, key, "missing attribute 'name'")
         return name
 
-    def chain(self, root: Element, base: str | None, tip: str | None) -> Chain:
+    def chain(self, root: Element, base: str | None, tip: str | None) -> LinkChain:
         if root.tag != "robot":
             raise self.error(root, root.tag, "expected a <robot> element (is this a URDF?)")
         links = self.declared(root, "link")
@@ -196,7 +196,7 @@ class _UrdfReader:
             raise RobotFileError(self.path, root.line, root.column, "", f"no moving joint between "
                                  f"links {base!r} and {tip!r}")
         folded = tuple(j.attributes["name"] for j in up) + tuple(j.name for j in chain if j.kind == "fixed")
-        return Chain(root.attributes.get("name", ""), base, tip, start, tuple(chain), folded)
+        return LinkChain(root.attributes.get("name", ""), base, tip, start, tuple(chain), folded)
 
     def declared(self, root: Element, tag: str) -> dict[str, Element]:
         found: dict[str, Element] = {}

@@ -1,4 +1,4 @@
-"""`jacgen verify` (SPEC §4): every function of every backend against the numpy reference.
+"""`jacgen verify` (contract §4): every function of every backend against the numpy reference.
 
 For each robot the code is generated into a temporary folder, the C is compiled twice
 (double and float) into shared libraries called through ctypes, and the Python and
@@ -32,8 +32,8 @@ from .compile import c_compiler, compile_shared
 from .catalogue import Function
 from .functions import Generator
 from .render import render_robot, write_files
-from .robot import Robot
-from .generated_code import BACKENDS, GeneratedCode
+from .robot import EULER_ANGLES, Robot
+from .generated_code import HOST_BACKENDS, GeneratedCode
 from .target import Emulator, check_tools
 
 DOUBLE_TOLERANCE = 1e-9
@@ -50,7 +50,6 @@ FLOAT_TOLERANCE = 1e-4
 # most 1/0.05^2 = 400-fold and the reference's central differences (step 1e-4) agree with
 # the exact rates to 3e-11; at 0.01 they were measured 4e-9 off (stanford).
 EULER_MARGIN = 0.05
-ANGLES = ("roll", "pitch", "yaw")
 EULER_FUNCTIONS = ("task", "task_jacobian", "task_jacobian_dot")
 # Functions of Js: undefined where cos(pitch) = 0 when Js is the task Jacobian.
 JS_FUNCTIONS = ("manipulability", "jacobian_det")
@@ -151,7 +150,7 @@ def compare(robot: Robot, function: Function, value: np.ndarray, expected: np.nd
     """
     elements = np.zeros(value.shape[1], dtype=bool)  # the entries undefined where cos(pitch) = 0
     if function.name in EULER_FUNCTIONS:
-        elements = np.repeat([name in ANGLES for name in robot.task], function.outputs[0].cols)
+        elements = np.repeat([name in EULER_ANGLES for name in robot.task], function.outputs[0].cols)
     elif function.name in JS_FUNCTIONS and analysis.singularity_rows(robot) is None:
         elements[:] = True
     compared = np.ones(value.shape, dtype=bool)
@@ -248,7 +247,7 @@ def _target_error(robot: Robot, q: np.ndarray, targets: np.ndarray) -> float:
         return 0.0
     difference = reference.ik_target(robot, q) - targets
     if len(robot.task) < 6:
-        angular = [i for i, name in enumerate(robot.task) if name in ANGLES]
+        angular = [i for i, name in enumerate(robot.task) if name in EULER_ANGLES]
         difference[:, angular] = (difference[:, angular] + math.pi) % (2 * math.pi) - math.pi
     return float(np.max(np.abs(difference)))
 
@@ -423,7 +422,7 @@ def verify(robots: list[Robot], samples: int, seed: int,
 
 def format_table(results: list[Result]) -> str:
     """One row per robot and function, one column per backend: the largest error."""
-    names = list(results[0].errors) if results else list(BACKENDS)
+    names = list(results[0].errors) if results else list(HOST_BACKENDS)
     header = ["robot", "function", *names, "float tol", "note"]
     rows = [header]
     for result in results:

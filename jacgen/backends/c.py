@@ -76,7 +76,7 @@ class CPrinter(Printer):
 # The contract's C array extent of each argument and output (`function.output`, or the function
 # when it has one), as factors that are numbers or the suffixes of size macros
 # (`6 * NAME_DOF`); any other function's output gets its size.
-# SPEC §3 size macros that are the row count of a function, defined when it is generated.
+# contract §3 size macros that are the row count of a function, defined when it is generated.
 C_ROW_MACROS = {"singularity_factors": "NUM_SINGULARITY_FACTORS"}
 
 
