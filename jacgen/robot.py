@@ -69,10 +69,6 @@ class Pose:
     xyz: tuple[Value, Value, Value]
     rpy: tuple[Value, Value, Value]
 
-    @property
-    def is_identity(self) -> bool:
-        return all(v.exact == 0 for v in self.xyz + self.rpy)
-
 
 IDENTITY_POSE = Pose((ZERO,) * 3, (ZERO,) * 3)
 

@@ -182,7 +182,7 @@ def test_ur5_is_universal_robots_published_table():
     for key, values in published.items():
         assert [getattr(joint, key).exact for joint in robot.joints] == [sympy.Rational(v) if isinstance(v, str) else v for v in values], key
     assert all(joint.offset.exact == 0 for joint in robot.joints)
-    assert robot.base.is_identity and robot.tool.is_identity
+    assert all(v.exact == 0 for pose in (robot.base, robot.tool) for v in pose.xyz + pose.rpy)  # identity poses
 
 
 def test_ur5_matches_the_shipped_robot_file():
