@@ -29,7 +29,7 @@ import numpy as np
 import sympy
 from sympy.polys.rings import PolyElement
 
-from . import reference
+from . import numeric_chain
 from .joint_ring import (READABLE_TERMS, JointRing, TooLarge, factorise, frames_about, geometric_columns, maximal_minors,
                          multiply, permutation_sign, term_count)
 from .robot import EULER_ANGLES, TASK_COMPONENTS, Robot
@@ -231,7 +231,7 @@ def unanalysed(robot: Robot) -> Singularities:
 
 class _Numeric:
     """Numbers about the factors: roots, zero sets, and the axes there (from the numeric
-    reference chain) to name the configuration."""
+    chain, `numeric_chain`) to name the configuration."""
 
     def __init__(self, robot: Robot, ring: JointRing):
         self.robot, self.ring = robot, ring
@@ -326,7 +326,7 @@ class _Numeric:
             return ""
         points = self.zero_set_points(factor) if len(sympy.Add.make_args(factor.polynomial)) <= READABLE_TERMS else []
         for name, point in (("wrist point", lambda q: _axes(robot, q)[-1][0]),
-                            ("tool point", lambda q: reference.fk(robot, q)[:3, 3])):
+                            ("tool point", lambda q: numeric_chain.axis_frames(robot, q)[1][:3, 3])):
             if n >= 3 and points and all(_over_first_axis(robot, q, point(q)) for q in points):
                 return f"shoulder: {name} in the plane of the axes of joints 1 and 2 (over the axis of joint 1)"
         return ""
@@ -354,8 +354,8 @@ def _solve_along(value, q: np.ndarray, joint: int, spec) -> np.ndarray | None:
 
 
 def _axes(robot: Robot, q: np.ndarray) -> list[tuple[np.ndarray, np.ndarray]]:
-    """(point, unit direction) of every joint axis, from the numeric reference chain."""
-    frames, _ = reference.frames(robot, q)
+    """(point, unit direction) of every joint axis, from `numeric_chain`."""
+    frames, _ = numeric_chain.axis_frames(robot, q)
     return [(frame[:3, 3], frame[:3, 2]) for frame in frames]
 
 

@@ -4,7 +4,7 @@ the generated NAME.md report), and the workspace plot of a planar arm (`show --p
 import numpy as np
 import sympy
 
-from . import reference
+from . import numeric_chain
 from .analysis import READABLE_TERMS, Factor, Singularities, singularity_rows
 from .errors import JacgenError
 from .model import Model
@@ -99,7 +99,7 @@ def euler_lines(robot: Robot, singular: Singularities) -> list[str]:
 
 def _all_axes_vertical(robot: Robot) -> bool:
     """Every joint axis parallel to the world z axis (checked at a generic configuration)."""
-    frames, _ = reference.frames(robot, np.linspace(0.3, 0.9, robot.dof))
+    frames, _ = numeric_chain.axis_frames(robot, np.linspace(0.3, 0.9, robot.dof))
     return all(np.linalg.norm(np.cross(frame[:3, 2], [0.0, 0.0, 1.0])) < 1e-9 for frame in frames)
 
 
@@ -113,7 +113,7 @@ def isotropy_lines(robot: Robot) -> list[str]:
     if not (robot.dof == 2 and all(j.revolute for j in robot.joints) and robot.task == ("x", "y")
             and _all_axes_vertical(robot)):
         return []
-    frames, tool = reference.frames(robot, np.zeros(2))
+    frames, tool = numeric_chain.axis_frames(robot, np.zeros(2))
     l1 = float(np.linalg.norm((frames[1][:3, 3] - frames[0][:3, 3])[:2]))
     l2 = float(np.linalg.norm((tool[:3, 3] - frames[1][:3, 3])[:2]))
     if l1 == 0 or l2 == 0:
@@ -123,7 +123,7 @@ def isotropy_lines(robot: Robot) -> list[str]:
     phi0 = np.arctan2(link1[0] * link2[1] - link1[1] * link2[0], np.dot(link1, link2))  # elbow angle at q2 = 0
     phi = np.arccos(-2 * l1 * l2 / (l1**2 + 2 * l2**2))
     angles = sorted(float((s * phi - phi0 + np.pi) % (2 * np.pi) - np.pi) for s in (1, -1))
-    condition = np.linalg.cond(reference.jacobian(robot, np.array([0.0, angles[0]]))[:2])
+    condition = np.linalg.cond(numeric_chain.jacobian(robot, np.array([0.0, angles[0]]))[:2])
     where = f"q2 in {{{', '.join(f'{np.degrees(a):.4g} deg' for a in angles)}}}"
     if abs(condition - 1) < 1e-9:
         return [f"isotropic (condition number 1) at {where}: l1 = sqrt(2) l2"]
@@ -202,9 +202,9 @@ def plot_workspace(robot: Robot, path: str, samples: int = 4000, ellipses: int =
     configurations = rng.uniform(bounds[:, 0], bounds[:, 1], size=(samples, robot.dof))
     points, measure = [], []
     for q in configurations:
-        js = reference.jacobian(robot, q)[rows]
+        js = numeric_chain.jacobian(robot, q)[rows]
         gram = js @ js.T if js.shape[0] <= js.shape[1] else js.T @ js
-        points.append(reference.fk(robot, q)[:2, 3])
+        points.append(numeric_chain.axis_frames(robot, q)[1][:2, 3])
         measure.append(np.sqrt(max(np.linalg.det(gram), 0.0)))
     points = np.array(points)
     figure, axes = plt.subplots(figsize=(7, 6), dpi=100)
@@ -212,10 +212,10 @@ def plot_workspace(robot: Robot, path: str, samples: int = 4000, ellipses: int =
     figure.colorbar(cloud, ax=axes, label="manipulability sqrt(det(Js Js^T))")
     reach = float(np.max(np.linalg.norm(points, axis=1))) or 1.0
     shown = configurations[:ellipses]
-    jacobians = [reference.jacobian(robot, q)[:2] for q in shown]
+    jacobians = [numeric_chain.jacobian(robot, q)[:2] for q in shown]
     largest = max(np.linalg.svd(j, compute_uv=False)[0] for j in jacobians) or 1.0
     for q, j in zip(shown, jacobians):
-        frames, tool = reference.frames(robot, q)
+        frames, tool = numeric_chain.axis_frames(robot, q)
         chain = np.array([f[:2, 3] for f in frames] + [tool[:2, 3]])
         axes.plot(chain[:, 0], chain[:, 1], "-o", color="0.3", lw=1, ms=2)
         u, s, _ = np.linalg.svd(j)

@@ -74,3 +74,15 @@ def test_no_import_circle_in_jacgen():
 
 def test_a_circle_is_found():
     assert cycles({"a": {"b"}, "b": {"c"}, "c": {"a"}, "d": {"a"}}) == [["a", "b", "c"]]
+
+
+# The modules that check generated code or an imported file against the oracle; nothing that
+# generates may read it (its numbers come from `numeric_chain`, a separate implementation).
+CHECKERS = {"jacgen.verify", "jacgen.generated_code", "jacgen.target", "jacgen.import_urdf"}
+
+
+def test_only_the_checkers_import_the_reference():
+    paths = sorted(PACKAGE.rglob("*.py"))
+    modules = {module_name(path) for path in paths}
+    readers = {module_name(path) for path in paths if "jacgen.reference" in imports(path, modules)}
+    assert readers and readers <= CHECKERS, readers - CHECKERS

@@ -1,0 +1,69 @@
+"""The DH chain in floating point, for the few numbers production needs: the configurations
+where a singularity factor vanishes and what they mean (`analysis`), and the planar maps of
+`jacgen show` (`report`). Built from the closed-form link matrices of the textbooks (Spong's
+standard, Craig's modified DH), apart from `jacgen.reference`, which multiplies elementary
+transforms and stays an independent oracle that no production module imports.
+
+Every function takes one configuration q (n,) or a batch (..., n).
+"""
+
+import numpy as np
+
+
+def _stack(rows, shape) -> np.ndarray:
+    """A (..., 4, 4) matrix from 16 entries, numbers or arrays of the batch `shape`."""
+    return np.stack([np.broadcast_to(np.asarray(entry, dtype=float), shape) for row in rows for entry in row],
+                    -1).reshape(*shape, 4, 4)
+
+
+def _link(robot, joint, qi: np.ndarray) -> np.ndarray:
+    """The link transform of one DH row at joint value qi."""
+    theta = qi + joint.offset.approx if joint.revolute else np.full(qi.shape, joint.theta.approx)
+    d = np.full(qi.shape, joint.d.approx) if joint.revolute else qi + joint.offset.approx
+    a, ca, sa = joint.a.approx, np.cos(joint.alpha.approx), np.sin(joint.alpha.approx)
+    ct, st = np.cos(theta), np.sin(theta)
+    if robot.convention == "standard":  # Rz(theta) Tz(d) Tx(a) Rx(alpha)
+        rows = [[ct, -st * ca, st * sa, a * ct], [st, ct * ca, -ct * sa, a * st], [0, sa, ca, d], [0, 0, 0, 1]]
+    else:  # Rx(alpha) Tx(a) Rz(theta) Tz(d)
+        rows = [[ct, -st, 0, a], [st * ca, ct * ca, -sa, -d * sa], [st * sa, ct * sa, ca, d * ca], [0, 0, 0, 1]]
+    return _stack(rows, qi.shape)
+
+
+def _fixed(pose) -> np.ndarray:
+    """A base or tool pose: translation xyz, rotation Rz(yaw) Ry(pitch) Rx(roll)."""
+    (cr, cp, cy), (sr, sp, sy) = ([f(v.approx) for v in pose.rpy] for f in (np.cos, np.sin))
+    x, y, z = (v.approx for v in pose.xyz)
+    return _stack([[cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr, x],
+                   [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr, y],
+                   [-sp, cp * sr, cp * cr, z], [0, 0, 0, 1]], ())
+
+
+def axis_frames(robot, q) -> tuple[list[np.ndarray], np.ndarray]:
+    """The world frame of each joint whose z axis is the joint's axis, and the tool's pose."""
+    q = np.asarray(q, dtype=float)
+    current, frames = np.broadcast_to(_fixed(robot.base), (*q.shape[:-1], 4, 4)), []
+    for i, joint in enumerate(robot.joints):
+        link = _link(robot, joint, q[..., i])
+        if robot.convention == "standard":  # joint i turns about z of the frame before its row
+            frames.append(current)
+        else:  # about z of the frame after the row's twist Rx(alpha) Tx(a)
+            frames.append(current @ _twist(joint, q.shape[:-1]))
+        current = current @ link
+    return frames, current @ _fixed(robot.tool)
+
+
+def _twist(joint, shape) -> np.ndarray:
+    """Rx(alpha) Tx(a): the part of a modified-DH row before its joint."""
+    a, ca, sa = joint.a.approx, np.cos(joint.alpha.approx), np.sin(joint.alpha.approx)
+    return _stack([[1, 0, 0, a], [0, ca, -sa, 0], [0, sa, ca, 0], [0, 0, 0, 1]], shape)
+
+
+def jacobian(robot, q) -> np.ndarray:
+    """The geometric Jacobian in the world frame (..., 6, n), rows vx vy vz wx wy wz."""
+    frames, tool = axis_frames(robot, q)
+    columns = []
+    for joint, frame in zip(robot.joints, frames):
+        z, origin = frame[..., :3, 2], frame[..., :3, 3]
+        linear = np.cross(z, tool[..., :3, 3] - origin) if joint.revolute else z
+        columns.append(np.concatenate([linear, z if joint.revolute else np.zeros_like(z)], -1))
+    return np.stack(columns, -1)
