@@ -1,6 +1,7 @@
-"""Shared fixtures: the shipped robots and the generated modules under test."""
+"""Shared fixtures: the shipped robots and the generated modules under test. What the test
+modules share beyond these is in tests/support/ (`generated`, the fixture of generated and
+compiled code, is registered here)."""
 
-import importlib.util
 import re
 from pathlib import Path
 
@@ -9,6 +10,7 @@ import pytest
 
 from jacgen import load_robot
 from jacgen.robot import parse_robot
+from support.generated import generated, import_file  # noqa: F401 (the fixture, and the loader tests use)
 
 ROOT = Path(__file__).resolve().parent.parent
 ROBOT_FILES = sorted((ROOT / "robots").glob("*.yaml"))
@@ -40,14 +42,6 @@ def without_limits(arm):
     alone: every solution, none dropped by the limits)."""
     text = re.sub(r",\s*limits: \[[^]]*\]", "", open(arm.source).read())
     return parse_robot(text.encode(), arm.source)
-
-
-def import_file(path: Path, module_name: str | None = None):
-    """Import a generated Python file by path (generated modules are not a package)."""
-    spec = importlib.util.spec_from_file_location(module_name or path.stem, path)
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
 
 
 def generated_module(name: str, suffix: str = ""):

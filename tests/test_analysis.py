@@ -19,25 +19,9 @@ from jacgen.analysis import analyse
 from jacgen.cli import main
 
 from conftest import ROOT, ROBOT_NAMES, generated_module, random_configurations, robot
+from support.ik import reference_js
 
-EULER = ("roll", "pitch", "yaw")
 RANK_TOLERANCE = 1e-9  # smallest / largest singular value of Js at a singular configuration
-
-
-def reference_js(arm, q):
-    """Js from jacgen.reference alone: geometric rows, or the ZYX Euler-angle rates
-    omega = E(roll, pitch, yaw) rpy_dot solved for rpy_dot when the task has some angles."""
-    J = reference.jacobian(arm, q)
-    angles = [c for c in arm.task if c in EULER]
-    if len(angles) in (0, 3):
-        return J[[("x", "y", "z", "roll", "pitch", "yaw").index(c) for c in arm.task]]
-    _, pitch, yaw = reference.rpy(reference.fk(arm, q)[:3, :3])
-    E = np.array([[np.cos(yaw) * np.cos(pitch), -np.sin(yaw), 0],
-                  [np.sin(yaw) * np.cos(pitch), np.cos(yaw), 0],
-                  [-np.sin(pitch), 0, 1]])
-    rates = np.linalg.solve(E, J[3:])
-    rows = {"x": J[0], "y": J[1], "z": J[2], "roll": rates[0], "pitch": rates[1], "yaw": rates[2]}
-    return np.array([rows[c] for c in arm.task])
 
 
 def rank_ratio(arm, q) -> float:

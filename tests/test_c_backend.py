@@ -21,24 +21,8 @@ from jacgen.render import render_robot, write_files
 from jacgen.robot import load_robot
 
 from conftest import ROOT, random_configurations
+from support.robot_texts import PARAMETRIC
 
-# A robot with runtime parameters in the base translation only: fk and task read `p`, the
-# Jacobians do not (they must still take it, and compile without an unused-parameter warning).
-PARAMETRIC = """
-name: lifted
-convention: standard
-angle_unit: deg
-parameters:
-  height: {value: 0.25, symbolic: true}
-  shift: {value: -0.1, symbolic: true}
-  a1: 0.4
-joints:
-  - {type: revolute, a: a1, alpha: 90, d: 0.1, offset: 30, limits: [-170, 170]}
-  - {type: revolute, a: 0.3, alpha: 0, d: 0, offset: 0}
-  - {type: prismatic, a: 0, alpha: 0, theta: 90, offset: 0.05, limits: [0, 0.2]}
-base: {xyz: [shift, 0, height], rpy: [0, 0, 0]}
-task: [x, y, z]
-"""
 # Cartesian gantry: its Jacobians read no joint (q must be marked unused).
 GANTRY = """
 name: gantry

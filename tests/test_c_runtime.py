@@ -14,10 +14,12 @@ import jinja2
 import numpy as np
 import pytest
 
-from conftest import ROOT
-from general6r_arms import ARMS, solver_of, wrapped
 from jacgen import general6r, reference
 from jacgen.compile import compile_shared
+
+from conftest import ROOT
+from support.general6r_arms import ARMS, solver_of
+from support.ik import wrapped
 
 HARNESS = """
 #include <math.h>

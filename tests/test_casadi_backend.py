@@ -1,8 +1,6 @@
 """The CasADi backend: casadi.Function objects that match jacgen.reference, and whose
 symbolic derivatives agree with the generated Jacobians."""
 
-import functools
-
 import casadi
 import numpy as np
 import pytest
@@ -10,38 +8,20 @@ import sympy
 from numpy.testing import assert_allclose
 
 from jacgen import reference
-from jacgen.functions import Generator
 from jacgen.backends.casadi import CasadiPrinter
 from jacgen.nodes import Select
-from jacgen.render import render_robot, write_files
 from jacgen.robot import load_robot
 from jacgen.verify import compare
 
-from conftest import import_file, random_configurations, robot as shipped_robot
-from test_c_backend import PARAMETRIC
+from conftest import random_configurations, robot as shipped_robot
+from support.robot_texts import PARAMETRIC
 
 SAMPLES = 25
 
 
-def _module(robot, folder):
-    write_files(render_robot(robot, ("casadi",)), folder)
-    return import_file(folder / robot.name / f"{robot.name}_casadi.py", f"test_{robot.name}_casadi")
-
-
-@pytest.fixture(scope="module")
-def generated(tmp_path_factory):
-    """name -> (robot, functions, CasADi module, numpy module), each robot generated once."""
-    folder = tmp_path_factory.mktemp("casadi")
-
-    @functools.cache
-    def load(name):
-        robot = shipped_robot(name)
-        generator = Generator(robot)
-        write_files(render_robot(robot, ("casadi", "python"), "double", generator), folder)
-        return (robot, generator.without_loops(), import_file(folder / name / f"{name}_casadi.py", f"test_{name}_casadi"),
-                import_file(folder / name / f"{name}.py", f"test_{name}_numpy"))
-
-    return load
+def _code(generated, name):
+    """The shipped robot's CasADi and numpy code, generated once in this module."""
+    return generated(shipped_robot(name), ("casadi", "python"))
 
 
 def _as_list(result):
@@ -59,7 +39,8 @@ def test_functions_match_reference(name, generated):
     """Every function's name, inputs and output shapes; its values against jacgen.reference,
     or, where the reference lacks it (manipulability...), against the generated numpy module,
     which prints the same expressions another way."""
-    robot, functions, module, numpy_module = generated(name)
+    code = _code(generated, name)
+    robot, functions, module, numpy_module = code.robot, code.generator.without_loops(), code.casadi, code.python
     names = [f.name for f in functions]
     assert list(module.functions()) == names + ["ik"] * ("ik_branches" in names) + ["ik_numeric"]
     q = random_configurations(robot, SAMPLES, seed=5)
@@ -82,7 +63,8 @@ def test_functions_match_reference(name, generated):
 
 @pytest.mark.parametrize("name", ["puma560", "stanford", "panda", "scara"])
 def test_derivative_of_fk_position_is_the_linear_jacobian(name, generated):
-    robot, _, module, _ = generated(name)
+    code = _code(generated, name)
+    robot, module = code.robot, code.casadi
     q = casadi.SX.sym("q", robot.dof)
     derivative = casadi.Function("d", [q], [casadi.jacobian(module.fk(q)[0:3, 3], q)])
     for row in random_configurations(robot, 10, seed=6):
@@ -91,11 +73,11 @@ def test_derivative_of_fk_position_is_the_linear_jacobian(name, generated):
         assert_allclose(linear, reference.jacobian(robot, row)[:3], atol=1e-12)
 
 
-def test_runtime_parameters_are_input_p(tmp_path):
+def test_runtime_parameters_are_input_p(tmp_path, generated):
     path = tmp_path / "lifted.yaml"
     path.write_text(PARAMETRIC)
     robot = load_robot(path)
-    module = _module(robot, tmp_path)
+    module = generated(robot, ("casadi",)).casadi
     assert module.PARAMETERS == {"height": 0.25, "shift": -0.1}
     moved_path = tmp_path / "moved.yaml"
     moved_path.write_text(PARAMETRIC.replace("height: {value: 0.25, symbolic: true}", "height: 0.75"))

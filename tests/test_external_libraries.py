@@ -7,7 +7,7 @@ random configurations inside the joint limits, to 1e-9:
 - rtb: `fkine(q).A`, `jacob0(q)` and `jacobe(q)` of the rtb DH model the robot file was
   transcribed from (rexarm has none: it is checked against an rtb `DHRobot` written out here
   from the numbers of the lecture example, independently of the robot file's parser).
-- Pinocchio: a `pinocchio.Model` built from the robot's DH table by the small helper below
+- Pinocchio: a `pinocchio.Model` built from the robot's DH table by tests/support/pinocchio_chain.py
   (test code, sharing nothing with jacgen's kinematics): fk, and `computeFrameJacobian` in
   LOCAL_WORLD_ALIGNED (= our world-frame Jacobian at the tool origin) and LOCAL (= tool frame).
 - iiwa (no rtb model): also a Pinocchio model from URDF-style joint placements written out
@@ -19,7 +19,6 @@ rtb's Jacobian rows are vx vy vz wx wy wz, the same as jacgen's.
 import importlib.util
 import math
 import warnings
-import zlib
 from functools import lru_cache
 from pathlib import Path
 
@@ -28,18 +27,18 @@ import pytest
 from numpy.testing import assert_allclose
 
 from jacgen import reference
-from jacgen.robot import load_robot
 
 with warnings.catch_warnings():
     warnings.simplefilter("ignore")
     rtb = pytest.importorskip("roboticstoolbox")
     pin = pytest.importorskip("pinocchio")
 
+from support.pinocchio_chain import pinocchio_from_dh, robot_of, samples, translation  # noqa: E402
+
 ROOT = Path(__file__).resolve().parents[1]
 ROBOTS = ROOT / "robots"
 GENERATED = ROOT / "generated"
 ROBOT_NAMES = sorted(path.stem for path in ROBOTS.glob("*.yaml"))
-SAMPLES = 200
 ATOL = 1e-9
 IMPLEMENTATIONS = ("reference", "generated", "generated_batch")
 
@@ -82,53 +81,6 @@ def _rtb_dh(name):
     return rtb.DHRobot([rtb.RevoluteDH(a=j.a.approx, alpha=j.alpha.approx, d=j.d.approx) for j in arm.joints], name=name)
 
 
-def _rot_x(angle):
-    return pin.SE3(pin.utils.rotate("x", angle), np.zeros(3))
-
-
-def _rot_z(angle):
-    return pin.SE3(pin.utils.rotate("z", angle), np.zeros(3))
-
-
-def _translation(x, y, z):
-    return pin.SE3(np.eye(3), np.array([x, y, z], dtype=float))
-
-
-def _pose(pose):
-    roll, pitch, yaw = (v.approx for v in pose.rpy)
-    rotation = pin.utils.rotate("z", yaw) @ pin.utils.rotate("y", pitch) @ pin.utils.rotate("x", roll)
-    return pin.SE3(rotation, np.array([v.approx for v in pose.xyz]))
-
-
-def pinocchio_from_dh(robot):
-    """A Pinocchio chain for a DH table: joint i is RZ/PZ about the axis frame of row i.
-
-    theta = q + offset (revolute) and d = q + offset (prismatic) commute with the joint's own
-    motion along/about z, so every row splits into `before * motion(q) * after`:
-    standard  Rz(theta) Tz(d) Tx(a) Rx(alpha): before = 1,           after = Rz(t0) Tz(d0) Tx(a) Rx(alpha)
-    modified  Rx(alpha) Tx(a) Rz(theta) Tz(d): before = Rx(alpha) Tx(a), after = Rz(t0) Tz(d0)
-    with (t0, d0) = (offset, d) for a revolute and (theta, offset) for a prismatic joint. The
-    placement of joint i in joint i-1 is after_{i-1} * before_i (after_0 = the base), and the
-    tool frame sits at after_n * tool on the last joint.
-    """
-    model = pin.Model()
-    parent, placement = 0, _pose(robot.base)
-    for joint in robot.joints:
-        a, alpha = joint.a.approx, joint.alpha.approx
-        if joint.revolute:
-            theta0, d0, motion = joint.offset.approx, joint.d.approx, pin.JointModelRZ()
-        else:
-            theta0, d0, motion = joint.theta.approx, joint.offset.approx, pin.JointModelPZ()
-        if robot.convention == "modified":
-            placement = placement * _rot_x(alpha) * _translation(a, 0, 0)
-        parent = model.addJoint(parent, motion, placement, joint.name)
-        placement = _rot_z(theta0) * _translation(0, 0, d0)
-        if robot.convention == "standard":
-            placement = placement * _translation(a, 0, 0) * _rot_x(alpha)
-    model.addFrame(pin.Frame("tool", parent, placement * _pose(robot.tool), pin.FrameType.OP_FRAME))
-    return model
-
-
 def iiwa_pinocchio_urdf_style():
     """LBR iiwa 14 R820 as the URDF describes it, independent of the DH table.
 
@@ -142,8 +94,8 @@ def iiwa_pinocchio_urdf_style():
             pin.JointModelRevoluteUnaligned(np.array([0.0, -1.0, 0.0])),
             pin.JointModelRZ(), pin.JointModelRY(), pin.JointModelRZ())
     for index, (z, axis) in enumerate(zip(origins, axes)):
-        parent = model.addJoint(parent, axis, _translation(0, 0, z), f"a{index + 1}")
-    model.addFrame(pin.Frame("tool", parent, _translation(0, 0, 0.126), pin.FrameType.OP_FRAME))
+        parent = model.addJoint(parent, axis, translation(0, 0, z), f"a{index + 1}")
+    model.addFrame(pin.Frame("tool", parent, translation(0, 0, 0.126), pin.FrameType.OP_FRAME))
     return model
 
 
@@ -156,20 +108,6 @@ def iiwa_urdf_path():
 
 
 # -- jacgen's side ---------------------------------------------------------------------------
-@lru_cache(maxsize=None)
-def robot_of(name):
-    return load_robot(ROBOTS / f"{name}.yaml")
-
-
-@lru_cache(maxsize=None)
-def samples(name):
-    """SAMPLES configurations uniform within the joint limits (+-pi where there are none)."""
-    robot = robot_of(name)
-    limits = np.array([joint.limits if joint.limits is not None else (-math.pi, math.pi) for joint in robot.joints])
-    rng = np.random.default_rng(zlib.crc32(name.encode()))
-    return limits[:, 0] + (limits[:, 1] - limits[:, 0]) * rng.random((SAMPLES, robot.dof))
-
-
 @lru_cache(maxsize=None)
 def generated_module(name):
     path = GENERATED / name / f"{name}.py"

@@ -12,24 +12,13 @@ import numpy as np
 import pytest
 
 from jacgen import reference
-from jacgen.compile import CLibrary, compile_shared
-from jacgen.render import render_robot, write_files
 from jacgen.robot import parse_robot
 
-from conftest import GENERATED, generated_module, import_file, random_configurations, robot
+from conftest import random_configurations, robot
+from support.ik import regular, wrapped
 
 SHIPPED = {"panda": 6, "iiwa": 2}  # robot -> free joint, 0-based
 MISS = 1e-8  # a returned solution farther than this from its target is a miss (issue 13)
-
-
-def _wrapped(difference):
-    return np.abs((difference + np.pi) % (2 * np.pi) - np.pi)
-
-
-def _regular(arm, q, free):
-    """The six joints left have a well-conditioned Jacobian (smallest singular value > 1e-3)."""
-    jacobians = np.delete(reference.jacobian(arm, q), free, axis=2)
-    return np.linalg.svd(jacobians, compute_uv=False).min(axis=1) > 1e-3
 
 
 def _check_round_trips(arm, module, q, free):
@@ -44,15 +33,15 @@ def _check_round_trips(arm, module, q, free):
     misses = np.abs(reference.fk(arm, found) - np.repeat(targets, valid.sum(axis=1), axis=0)).max(axis=(1, 2))
     assert misses.max() < MISS, misses.max()
     assert np.array_equal(found[:, free], np.repeat(q[:, free], valid.sum(axis=1)))
-    distance = np.where(valid, _wrapped(solutions - q[:, None, :]).max(axis=2), np.inf).min(axis=1)
-    regular = _regular(arm, q, free)
-    assert np.all(distance[regular] < 1e-6), np.flatnonzero(regular & (distance >= 1e-6))[:5]
+    distance = np.where(valid, np.abs(wrapped(solutions - q[:, None, :])).max(axis=2), np.inf).min(axis=1)
+    well = regular(arm, q, free)  # the six joints left are well conditioned
+    assert np.all(distance[well] < 1e-6), np.flatnonzero(well & (distance >= 1e-6))[:5]
     return solutions, valid
 
 
 @pytest.mark.parametrize("name", SHIPPED)
-def test_shipped_arms_round_trip(name):
-    arm, module, free = robot(name), generated_module(name), SHIPPED[name]
+def test_shipped_arms_round_trip(name, generated):
+    arm, module, free = robot(name), generated.committed(name).python, SHIPPED[name]
     assert arm.free_joint == free == module.IK_FREE_JOINT
     q = random_configurations(arm, 10_000, seed=31)
     _, valid = _check_round_trips(arm, module, q, free)
@@ -61,11 +50,10 @@ def test_shipped_arms_round_trip(name):
 
 
 @pytest.mark.parametrize("name", SHIPPED)
-def test_c_and_casadi_give_the_numpy_solutions(name, tmp_path):
+def test_c_and_casadi_give_the_numpy_solutions(name, generated):
     """The committed C (double) and CasADi: the numpy's solutions, in its order, to 1e-9."""
-    arm, module, free = robot(name), generated_module(name), SHIPPED[name]
-    library = CLibrary(compile_shared([GENERATED / name / f"{name}.c"], tmp_path / f"lib{name}.so"), arm, [], "double")
-    casadi = generated_module(name, "_casadi")
+    arm, code, free = robot(name), generated.committed(name), SHIPPED[name]
+    module, library, casadi = code.python, code.library(), code.casadi
     q = random_configurations(arm, 300, seed=32)
     for row, target in zip(q, reference.fk(arm, q)):
         ours = module.ik(target, row[free])
@@ -77,7 +65,7 @@ def test_c_and_casadi_give_the_numpy_solutions(name, tmp_path):
         assert np.abs(in_casadi - module.ik(target, row[free])).max(initial=0) < 1e-9
 
 
-def test_panda_contains_frankik_solutions(tmp_path):
+def test_panda_contains_frankik_solutions(generated):
     """frankik (He & Liu's solver) returns up to 4 of the solutions for a given q7: every one it
     returns that reaches the target is one of ours. Its fk ends at a hand TCP 0.1034 m beyond
     the flange (ours is 0.103 m) and its ik takes the flange pose: the test checks that its fk
@@ -85,8 +73,7 @@ def test_panda_contains_frankik_solutions(tmp_path):
     text = open(robot("panda").source).read().replace("name: panda", "name: panda_flange")
     tcp = parse_robot(text.replace("tool: {xyz: [0, 0, 0.103]", "tool: {xyz: [0, 0, 0.1034]").encode())
     flange = parse_robot(text.replace("tool: {xyz: [0, 0, 0.103], rpy: [0, 0, -45]}", "").encode())
-    write_files(render_robot(flange, ("python",), functions=("ik",)), tmp_path)
-    module = import_file(tmp_path / flange.name / f"{flange.name}.py", "free_joint_panda_flange")
+    module = generated(flange, functions=("ik",)).python
     q = random_configurations(flange, 1000, seed=33)
     compared = 0
     for row in q:
@@ -95,7 +82,7 @@ def test_panda_contains_frankik_solutions(tmp_path):
         ours = module.ik(target, row[6], limits=False)
         for theirs in frankik.ik_full(target, row, row[6]):
             if np.all(np.isfinite(theirs)) and np.abs(reference.fk(flange, theirs) - target).max() < MISS:
-                assert _wrapped(ours - theirs).max(axis=1).min() < 1e-7, (row, theirs)
+                assert np.abs(wrapped(ours - theirs)).max(axis=1).min() < 1e-7, (row, theirs)
                 compared += 1
     assert compared > 1000
 
@@ -134,13 +121,12 @@ def _arm(name, convention, rows, offset, rng) -> str:
 @pytest.mark.parametrize("kind, seed, free", [
     ("srs", 0, 1), ("srs", 2, 3), ("srs", 3, 5), ("srs", 4, None), ("offset_elbow", 1, None),
 ])
-def test_random_arms_round_trip(kind, seed, free, tmp_path):
+def test_random_arms_round_trip(kind, seed, free, generated):
     """Random arms with the free joint given (1-based) or chosen by the structure detection
     (None: joint 7, the first it tries, works for both kinds)."""
     text = (_srs if kind == "srs" else _offset_elbow)(seed) + (f"ik: {{free_joint: {free}}}\n" if free else "")
     arm = parse_robot(text.encode())
-    write_files(render_robot(arm, ("python",), functions=("ik",)), tmp_path)
-    module = import_file(tmp_path / arm.name / f"{arm.name}.py", f"free_joint_{arm.name}")
+    module = generated(arm, functions=("ik",)).python
     assert module.IK_FREE_JOINT == (free or 7) - 1
     q = np.random.default_rng(seed).uniform(-np.pi, np.pi, (300, 7))
     _check_round_trips(arm, module, q, module.IK_FREE_JOINT)

@@ -11,9 +11,11 @@ import numpy as np
 import pytest
 import roboticstoolbox as rtb
 
-from general6r_arms import ARMS, JACO, Solver, multi_start, numeric, robot_of, solver_of, wrapped
 from jacgen import general6r, reference
-from random_arms import random_arm_text
+
+from support.general6r_arms import ARMS, JACO, Solver, multi_start, numeric, robot_of, solver_of
+from support.ik import wrapped
+from support.random_arms import random_arm_text
 
 
 def _six_revolute_arms():

@@ -9,13 +9,12 @@ import math
 import numpy as np
 import pytest
 
-from conftest import GENERATED, generated_module, robot
-from general6r_arms import multi_start, wrapped
 from jacgen import reference
-from jacgen.compile import CLibrary, compile_shared
-from jacgen.functions import Generator
 from jacgen.model import Model
-from jacgen.render import render_robot
+
+from conftest import GENERATED, generated_module, robot
+from support.general6r_arms import multi_start
+from support.ik import wrapped
 
 ARMS = ["jaco", "mico", "manocha_canny", "ur5_calibrated"]
 
@@ -54,20 +53,11 @@ def test_numpy_ik_finds_every_solution_of_a_multi_start_search(name):
 
 
 @pytest.fixture(scope="module", params=["double", "float"])
-def c_solver(request, tmp_path_factory):
-    """The C ik of each arm, in double from generated/, in float generated here."""
-    folder = tmp_path_factory.mktemp(request.param)
-    libraries = {}
-    for name in ARMS:
-        arm = robot(name)
-        if request.param == "double":
-            source = GENERATED / name / f"{name}.c"
-        else:  # ik and its callees, rendered in float
-            for relative, text in render_robot(arm, ("c",), "float", Generator(arm, selection=("ik",))).items():
-                (folder / relative.split("/")[-1]).write_text(text)
-            source = folder / f"{name}.c"
-        libraries[name] = CLibrary(compile_shared([source], folder / f"lib{name}.so"), arm, [], request.param)
-    return request.param, libraries
+def c_solver(request, generated):
+    """The C ik of each arm, in double from generated/, in float (ik and its callees) generated here."""
+    if request.param == "double":
+        return "double", {name: generated.committed(name).library() for name in ARMS}
+    return "float", {name: generated(robot(name), ("c",), "float", ("ik",)).library() for name in ARMS}
 
 
 @pytest.mark.parametrize("name", ARMS)

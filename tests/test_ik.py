@@ -2,13 +2,13 @@
 
 Round trips on random configurations (every solution reproduces fk(q), the original q is
 among them), solution counts against EAIK and ik-geo on the arms they solve, random robots
-of every class, unreachable and singular targets, and the C (double and float) against the
-Python. Forward kinematics is the generated fk, itself checked against jacgen.reference
-elsewhere; the random robots are checked against jacgen.reference.fk directly.
+of every class, unreachable targets, and the C (double and float) against the Python (the
+targets on singularities, on every backend: tests/test_ik_contract.py). Forward kinematics is
+the generated fk, itself checked against jacgen.reference elsewhere; the random robots are
+checked against jacgen.reference.fk directly.
 """
 
 import functools
-import itertools
 
 import numpy as np
 import pytest
@@ -16,12 +16,10 @@ from eaik.IK_HP import HPRobot
 from ik_geo import Robot as IkGeoRobot
 
 from jacgen import reference
-from jacgen.compile import CLibrary, compile_shared
-from jacgen.functions import Generator
-from jacgen.render import render_robot
 from jacgen.robot import parse_robot
 
-from conftest import GENERATED, generated_module, import_file, random_configurations, robot
+from conftest import random_configurations, robot
+from support.ik import regular, target_error, wrapped_distance
 
 WITH_IK = ["planar_2r", "planar_3r", "scara", "rexarm", "puma560", "kr5", "stanford", "ur5"]
 FREE_JOINT = ["iiwa", "panda"]  # closed form with a free joint: tests/test_free_joint.py
@@ -29,23 +27,10 @@ SAMPLES = 1000  # random configurations per shipped robot (Python); the C takes 
 TOLERANCE = 1e-9
 
 
-def _generate(arm, folder, languages=("python",), real="double", generator=None):
-    """Render `arm` into `folder` (with its `generator` when given, to share the symbolic
-    work); the Python module (imported) or the C source path."""
-    files = render_robot(arm, languages, real, generator)
-    for relative, text in files.items():
-        path = folder / relative
-        path.parent.mkdir(parents=True, exist_ok=True)
-        path.write_text(text)
-    if languages == ("python",):
-        return import_file(folder / arm.name / f"{arm.name}.py", f"ik_test_{arm.name}_{folder.name}")
-    return folder / arm.name / f"{arm.name}.c"
-
-
 @pytest.fixture(scope="module")
-def modules():
+def modules(generated):
     """The committed generated modules of the shipped robots (test_golden checks they are current)."""
-    return {name: generated_module(name) for name in WITH_IK + FREE_JOINT}
+    return {name: generated.committed(name).python for name in WITH_IK + FREE_JOINT}
 
 
 def _pose_task(arm) -> bool:
@@ -54,23 +39,6 @@ def _pose_task(arm) -> bool:
 
 def _targets(module, arm, q):
     return module.fk(q) if _pose_task(arm) else module.task(q)
-
-
-def _target_error(arm, reached, target):
-    """Largest difference; angles of a task vector compared modulo 2 pi."""
-    difference = np.abs(reached - target)
-    if not _pose_task(arm):
-        angles = [i for i, name in enumerate(arm.task) if name in ("roll", "pitch", "yaw")]
-        difference[..., angles] = np.abs((difference[..., angles] + np.pi) % (2 * np.pi) - np.pi)
-    return difference.reshape(len(difference), -1).max(axis=1) if difference.size else np.zeros(0)
-
-
-def _joint_distance(arm, a, b):
-    """Largest joint difference, revolute joints modulo 2 pi."""
-    difference = np.abs(a - b)
-    revolute = [joint.revolute for joint in arm.joints]
-    difference[..., revolute] = np.abs((difference[..., revolute] + np.pi) % (2 * np.pi) - np.pi)
-    return difference.max(axis=-1)
 
 
 def _batched(module, limits=False):
@@ -98,12 +66,12 @@ def _check_round_trip(arm, ik, targets_of, q, regular):
     owner = np.concatenate([np.full(len(s), i) for i, s in enumerate(solutions)]).astype(int)
     stacked = np.concatenate(solutions)
     assert np.all(np.isfinite(stacked))
-    errors = _target_error(arm, targets_of(stacked), targets[owner])
+    errors = target_error(arm, targets_of(stacked), targets[owner])
     assert errors.max() < TOLERANCE, (arm.name, errors.max())
     assert np.all(_wrapped_or_inside(arm, stacked))
     for row, found in enumerate(solutions):
         if regular[row]:
-            assert len(found) and _joint_distance(arm, found, q[row]).min() < 1e-7, (arm.name, q[row])
+            assert len(found) and wrapped_distance(arm, found, q[row]).min() < 1e-7, (arm.name, q[row])
     return np.array([len(s) for s in solutions])
 
 
@@ -142,7 +110,7 @@ def _real_solutions(solutions):
 def _assert_same_sets(arm, ours, theirs, context):
     assert len(ours) == len(theirs), (context, ours, theirs)
     if len(ours):
-        distance = _joint_distance(arm, ours[:, None, :], theirs[None, :, :])
+        distance = wrapped_distance(arm, ours[:, None, :], theirs[None, :, :])
         assert distance.min(axis=1).max() < 1e-6 and distance.min(axis=0).max() < 1e-6, context
 
 
@@ -249,12 +217,10 @@ RANDOM_CLASSES = ["planar_2r", "planar_3r", "scara", "yaw_pitch", "spherical_wri
                   "spherical_wrist_intersecting", "spherical_wrist_prismatic", "three_parallel"]
 
 
-def _c_ik(arm, folder, real, generator=None):
-    """A function target -> solutions (k, n) calling the C NAME_ik of `arm` (compiled with the
-    contract's warning flags)."""
-    source = _generate(arm, folder / real, ("c",), real, generator)
-    library = CLibrary(compile_shared([source], folder / real / f"lib{arm.name}.so"), arm, [], real)
-    return functools.partial(library.ik, max_solutions=8)
+def _c_ik(generated, arm, real):
+    """A function target -> solutions (k, n) calling the C NAME_ik of `arm` (ik and its
+    callees, compiled with the contract's warning flags)."""
+    return functools.partial(generated(arm, ("c",), real, ("ik",)).library().ik, max_solutions=8)
 
 
 def _reference_targets(arm):
@@ -263,36 +229,29 @@ def _reference_targets(arm):
     return lambda q: np.array([single(arm, row) for row in q])
 
 
-def _regular(arm, q):
-    """Smallest singular value of the reference (geometric or task) Jacobian above 1e-3."""
-    jacobian = reference.jacobian if _pose_task(arm) else reference.task_jacobian
-    return np.array([np.linalg.svd(jacobian(arm, row), compute_uv=False).min() > 1e-3 for row in q])
-
-
 @pytest.mark.parametrize("kind", RANDOM_CLASSES)
-def test_random_robots_of_each_class(kind, tmp_path):
+def test_random_robots_of_each_class(kind, generated):
     """Random dimensions, offsets, axis directions, base and tool: round trips through
     jacgen.reference, the revolute 6R classes also against EAIK."""
     for seed in range(2):
         arm = _random_robot(kind, seed)
-        generator = Generator(arm, selection=("ik",))  # the function under test, and ik_branches
-        module = _generate(arm, tmp_path, generator=generator)
+        module = generated(arm, functions=("ik",)).python  # the function under test, and its callees
         q = np.random.default_rng(seed).uniform(-np.pi, np.pi, (100, arm.dof))
         q[:, [not joint.revolute for joint in arm.joints]] *= 0.1
-        counts = _check_round_trip(arm, _batched(module), _reference_targets(arm), q, _regular(arm, q))
+        counts = _check_round_trip(arm, _batched(module), _reference_targets(arm), q, regular(arm, q))
         assert counts.max() == module.MAX_IK_SOLUTIONS
         if seed == 0:  # the C: the Python's solutions in the Python's order; float compiles cleanly
-            solve = _c_ik(arm, tmp_path, "double", generator)
+            solve = _c_ik(generated, arm, "double")
             targets = _reference_targets(arm)(q[:50])
             for target, python in zip(targets, _batched(module, limits=True)(targets)):
                 ours = solve(target)
-                assert len(ours) == len(python) and (not len(ours) or _joint_distance(arm, ours, python).max() < 1e-6)
-            _c_ik(arm, tmp_path, "float", generator)
+                assert len(ours) == len(python) and (not len(ours) or wrapped_distance(arm, ours, python).max() < 1e-6)
+            _c_ik(generated, arm, "float")
         if kind in EAIK_CLASSES:
             _compare_with_eaik(module, arm, q[:50], _reference_targets(arm))
 
 
-# -- edges: out of reach, not finite, singular ---------------------------------------------------
+# -- edges: out of reach, not finite -----------------------------------------------------------
 
 
 def test_unreachable_targets_give_no_solution(modules):
@@ -317,48 +276,19 @@ def test_unreachable_targets_give_no_solution(modules):
     assert modules["stanford"].ik(shoulder).shape == (0, 6)
 
 
-def _assert_distinct_and_exact(module, arm, q):
-    target = _targets(module, arm, q)
-    found = module.ik(target, limits=False)
-    assert len(found) and np.all(np.isfinite(found))
-    reached = _targets(module, arm, found)
-    assert _target_error(arm, reached, np.broadcast_to(target, reached.shape)).max() < TOLERANCE
-    for a, b in itertools.combinations(found, 2):
-        assert _joint_distance(arm, a, b) > 1e-6, (arm.name, found)
-    return found
-
-
-def test_singular_targets_give_finite_distinct_solutions(modules):
-    """A double root is returned once and a free angle is set to 0. Stretched planar arms: 1
-    solution. Puma with q5 = 0: that branch's wrist is singular (1 solution, q4 = 0), the three
-    other arm branches are not (2 each): 7. Puma with the elbow stretched: both shoulders have a
-    double elbow root: 2 x 1 x 2 = 4. UR5 with q5 = 0: 2 + 4 = 6 (the other shoulder branch is
-    regular)."""
-    assert len(_assert_distinct_and_exact(modules["planar_2r"], robot("planar_2r"), np.array([0.3, 0.0]))) == 1
-    assert len(_assert_distinct_and_exact(modules["planar_3r"], robot("planar_3r"), np.array([0.3, 0.0, 1.0]))) == 1
-    puma, module = robot("puma560"), modules["puma560"]
-    found = _assert_distinct_and_exact(module, puma, np.array([0.3, 0.5, -0.4, 0.6, 0.0, -0.2]))
-    assert len(found) == 7 and [0.3, 0.5, -0.4, 0.0, 0.0, 0.4] in np.round(found, 12).tolist()
-    stretched = np.arctan2(0.0203, 0.4318) - np.pi / 2  # forearm (a3, d4) in line with the upper arm
-    assert len(_assert_distinct_and_exact(module, puma, np.array([0.3, 0.5, stretched, 0.6, 0.4, -0.2]))) == 4
-    ur5 = np.array([0.3, -1.0, 1.2, 0.4, 0.0, 0.7])
-    assert len(_assert_distinct_and_exact(modules["ur5"], robot("ur5"), ur5)) == 6
-
-
 # -- the C, double and float ------------------------------------------------------------------------
 
 
 @pytest.fixture(scope="module", params=["double", "float"])
-def c_solvers(request, tmp_path_factory):
-    """Per robot: a function target -> solutions (k, n) calling NAME_ik, and NAME_ik_numeric."""
+def c_solvers(request, generated):
+    """Per robot: a function target -> solutions (k, n) calling NAME_ik, and NAME_ik_numeric
+    (double: the committed C; float: the functions this fixture calls, generated here)."""
     real = request.param
-    folder = tmp_path_factory.mktemp(f"c_{real}")
     solvers = {}
     for name in WITH_IK + FREE_JOINT:
-        arm = robot(name)
-        float_ik = Generator(arm, selection=("ik", "ik_numeric"))  # the functions this fixture calls
-        source = GENERATED / name / f"{name}.c" if real == "double" else _generate(arm, folder, ("c",), real, float_ik)
-        library = CLibrary(compile_shared([source], folder / f"lib{name}.so"), arm, [], real)
+        code = generated.committed(name) if real == "double" else generated(robot(name), ("c",), real,
+                                                                            ("ik", "ik_numeric"))
+        library = code.library()
         closed = functools.partial(library.ik, max_solutions=8) if name in WITH_IK else None  # see test_free_joint
         solvers[name] = (closed, library.ik_numeric)
     return real, solvers
@@ -383,9 +313,9 @@ def test_c_ik_agrees_with_python(modules, c_solvers, name):
         if len(ours) == 0:
             continue
         reached = _targets(module, arm, ours)
-        worst = max(worst, _target_error(arm, reached, np.broadcast_to(target, reached.shape)).max())
+        worst = max(worst, target_error(arm, reached, np.broadcast_to(target, reached.shape)).max())
         if real == "double":  # the same branches in the same order (angles near a singularity
-            assert _joint_distance(arm, ours, python).max() < 1e-6  # are ill-conditioned)
+            assert wrapped_distance(arm, ours, python).max() < 1e-6  # are ill-conditioned)
     assert different == 0 if real == "double" else different <= len(q) // 200
     assert worst < (TOLERANCE if real == "double" else 1e-2)
     assert len(solve(np.full(targets.shape[1:], np.nan))) == 0
@@ -406,7 +336,7 @@ def test_ik_numeric_converges_from_nearby(modules, c_solvers, name):
         for solve in (module.ik_numeric, numeric):
             found, status = solve(target, start, 100, tolerance)
             assert status == 0, (name, solve, status)
-            assert _target_error(arm, _targets(module, arm, found)[None], target[None])[0] < 10 * tolerance
+            assert target_error(arm, _targets(module, arm, found)[None], target[None])[0] < 10 * tolerance
 
 
 def test_ik_numeric_statuses_and_limits(modules, c_solvers):
@@ -426,21 +356,19 @@ def test_ik_numeric_statuses_and_limits(modules, c_solvers):
     assert module.ik_numeric(module.fk(np.zeros(6)), np.zeros(6), 0)[1] == 0
 
 
-def test_runtime_parameters(tmp_path):
+def test_runtime_parameters(generated):
     """A symbolic d3 on the Puma: the constants become expressions in it, in Python (keyword)
     and C (the params struct)."""
     text = open(robot("puma560").source).read().replace("name: puma560", "name: puma_runtime")
     text = text.replace("  d3: 0.15005 ", "  d3: {value: 0.15005, symbolic: true} ")
-    arm = parse_robot(text.encode())
-    module = _generate(arm, tmp_path)
-    source = _generate(arm, tmp_path, ("c",))
-    library = CLibrary(compile_shared([source], tmp_path / "libpuma_runtime.so"), arm, [], "double")
+    code = generated(parse_robot(text.encode()), ("python", "c"))
+    arm, module, library = code.robot, code.python, code.library()
     q = random_configurations(robot("puma560"), 20, seed=18)
     for d3 in (0.15005, 0.3):
         for row in q:
             T = module.fk(row, d3=d3)
             assert len(module.ik(T, limits=False, d3=d3)) == 8
             found = module.ik(T, d3=d3)  # inside the limits, as the C returns them
-            assert _joint_distance(arm, found, row).min() < 1e-7
+            assert wrapped_distance(arm, found, row).min() < 1e-7
             in_c = library.ik(T, 8, {"d3": d3})
             assert in_c.shape == found.shape and np.abs(in_c - found).max() < 1e-9

@@ -1,22 +1,20 @@
 """One behaviour for the closed-form ik and velocity_ik: tables of cases, each run on every
 backend with the same expectations (C double through ctypes, numpy one target at a time,
-numpy over a batch, CasADi). Targets and checks come from jacgen.reference and numpy's
-linear algebra, never from a backend.
+numpy over a batch, CasADi), and velocity_ik of every shipped robot's committed code (numpy
+over a batch, C). Targets and checks come from jacgen.reference and numpy's linear algebra,
+never from a backend.
 
 For ik every backend is a function `solve(targets) -> [solutions (k, n) per target]`; for
 velocity_ik a function `(q, mu_dot, damping) -> (q_dot, status)`.
 """
 
-import functools
-
 import numpy as np
 import pytest
 
 from jacgen import reference
-from jacgen.compile import CLibrary, compile_shared
-from jacgen.render import render_robot, write_files
 
-from conftest import import_file, random_configurations, robot, without_limits
+from conftest import ROBOT_NAMES, random_configurations, robot, without_limits
+from support.ik import reference_js, regular, target_error, wrapped_distance
 
 ROBOTS = ["puma560", "ur5", "stanford", "rexarm", "planar_3r", "scara"]
 BACKENDS = ["c", "numpy", "numpy_batch", "casadi"]
@@ -24,18 +22,13 @@ TOLERANCE = 1e-9
 
 
 @pytest.fixture(scope="module")
-def backends(tmp_path_factory):
-    """name -> {backend: solve}, each robot generated and compiled once."""
-    folder = tmp_path_factory.mktemp("contract")
-
-    @functools.cache
+def backends(generated):
+    """name -> (arm, {backend: solve}, {backend: ik_numeric}, {backend: velocity_ik}), each
+    robot generated and compiled once (the `generated` fixture)."""
     def load(name):
         arm = without_limits(robot(name))  # these cases are about the branches (limits: test_ik_limits)
-        write_files(render_robot(arm, ("c", "python", "casadi")), folder)
-        numpy_module = import_file(folder / name / f"{name}.py", f"contract_{name}")
-        casadi_module = import_file(folder / name / f"{name}_casadi.py", f"contract_{name}_casadi")
-        library = CLibrary(compile_shared([folder / name / f"{name}.c"], folder / name / f"lib{name}.so"), arm, [],
-                           "double")
+        code = generated(arm, ("c", "python", "casadi"))
+        numpy_module, casadi_module, library = code.python, code.casadi, code.library()
 
         def batch(targets):
             q, valid = numpy_module.ik(np.asarray(targets)[None])  # a batch of one batch
@@ -77,22 +70,6 @@ def backends(tmp_path_factory):
     return load
 
 
-def _target_errors(arm, solutions, target):
-    reached = reference.ik_target(arm, solutions)
-    difference = np.abs(reached - target)
-    if len(arm.task) < 6:
-        angles = [i for i, name in enumerate(arm.task) if name in ("roll", "pitch", "yaw")]
-        difference[..., angles] = np.abs((difference[..., angles] + np.pi) % (2 * np.pi) - np.pi)
-    return difference.reshape(len(difference), -1).max(axis=1)
-
-
-def _wrapped_distance(arm, a, b):
-    difference = np.abs(np.asarray(a) - b)
-    revolute = [joint.revolute for joint in arm.joints]
-    difference[..., revolute] = np.abs((difference[..., revolute] + np.pi) % (2 * np.pi) - np.pi)
-    return difference.max(axis=-1)
-
-
 def _check_solutions(arm, solutions, target, count=None, original=None):
     """Every solution finite, revolute angles in (-pi, pi], reaching the target to 1e-9,
     distinct; the expected count; the original configuration among them."""
@@ -102,16 +79,11 @@ def _check_solutions(arm, solutions, target, count=None, original=None):
     if len(solutions):
         revolute = solutions[:, [joint.revolute for joint in arm.joints]]
         assert np.all((revolute > -np.pi) & (revolute <= np.pi))
-        assert _target_errors(arm, solutions, target).max() < TOLERANCE
-        distances = [_wrapped_distance(arm, a, b) for i, a in enumerate(solutions) for b in solutions[i + 1:]]
+        assert target_error(arm, reference.ik_target(arm, solutions), target).max() < TOLERANCE
+        distances = [wrapped_distance(arm, a, b) for i, a in enumerate(solutions) for b in solutions[i + 1:]]
         assert min(distances, default=1.0) > 1e-6
     if original is not None:
-        assert len(solutions) and _wrapped_distance(arm, solutions, original).min() < 1e-7
-
-
-def _regular(arm, q):
-    jacobian = reference.jacobian if len(arm.task) == 6 else reference.task_jacobian
-    return np.linalg.svd(jacobian(arm, q), compute_uv=False).min() > 1e-3
+        assert len(solutions) and wrapped_distance(arm, solutions, original).min() < 1e-7
 
 
 @pytest.mark.parametrize("backend", BACKENDS)
@@ -123,7 +95,7 @@ def test_round_trips(backends, name, backend):
     q = random_configurations(robot(name), 60, seed=21)
     targets = reference.ik_target(arm, q)
     for row, target, solutions in zip(q, targets, solvers[backend](targets)):
-        _check_solutions(arm, solutions, target, original=row if _regular(arm, row) else None)
+        _check_solutions(arm, solutions, target, original=row if regular(arm, row) else None)
 
 
 @pytest.mark.parametrize("backend", BACKENDS)
@@ -151,24 +123,29 @@ def test_not_finite_and_out_of_reach(backends, name, backend):
         assert solutions.shape == (0, arm.dof), (case, solutions)
 
 
-# Targets on singularities: (robot, configuration, solutions expected). A double root is
-# returned once and an angle the target leaves free is 0.
+# Targets on singularities: (robot, configuration, solutions expected, a solution expected
+# among them or None). A double root is returned once and an angle the target leaves free is 0.
 SINGULAR = {
-    "wrist (puma q5 = 0): 3 regular arm branches x 2 + 1": ("puma560", [0.3, 0.5, -0.4, 0.6, 0.0, -0.2], 7),
+    "wrist (puma q5 = 0): 3 regular arm branches x 2 + 1, with q4 = 0": (
+        "puma560", [0.3, 0.5, -0.4, 0.6, 0.0, -0.2], 7, [0.3, 0.5, -0.4, 0.0, 0.0, 0.4]),
     "elbow stretched (puma): 2 shoulders x 1 elbow x 2 wrists": (
-        "puma560", [0.3, 0.5, np.arctan2(0.0203, 0.4318) - np.pi / 2, 0.6, 0.4, -0.2], 4),
-    "wrist (ur5 q5 = 0)": ("ur5", [0.3, -1.0, 1.2, 0.4, 0.0, 0.7], 6),
-    "stretched planar arm": ("planar_3r", [0.3, 0.0, 1.0], 1),
+        "puma560", [0.3, 0.5, np.arctan2(0.0203, 0.4318) - np.pi / 2, 0.6, 0.4, -0.2], 4, None),
+    "wrist (ur5 q5 = 0): the other shoulder branch regular, 2 + 4": ("ur5", [0.3, -1.0, 1.2, 0.4, 0.0, 0.7], 6, None),
+    "stretched planar 3R arm": ("planar_3r", [0.3, 0.0, 1.0], 1, None),
+    "stretched planar 2R arm": ("planar_2r", [0.3, 0.0], 1, None),
 }
 
 
 @pytest.mark.parametrize("backend", BACKENDS)
 @pytest.mark.parametrize("case", SINGULAR)
 def test_singular_targets(backends, case, backend):
-    name, q, count = SINGULAR[case]
+    name, q, count, among = SINGULAR[case]
     arm, solvers, _, _ = backends(name)
     target = reference.ik_target(arm, np.array(q, dtype=float))
-    _check_solutions(arm, solvers[backend]([target])[0], target, count=count)
+    solutions = solvers[backend]([target])[0]
+    _check_solutions(arm, solutions, target, count=count)
+    if among is not None:
+        assert wrapped_distance(arm, solutions, among).min() < 1e-12, solutions
 
 
 def _puma_on_shoulder_singularity():
@@ -214,6 +191,9 @@ def test_batched_numpy_finds_the_c_solution_sets(backends):
 # -- velocity_ik ------------------------------------------------------------------------------
 
 
+DAMPING = 0.1
+
+
 def _expected_rates(js, mu_dot, damping):
     """The closed forms of the contract, with numpy."""
     m, n = js.shape
@@ -225,7 +205,8 @@ def _expected_rates(js, mu_dot, damping):
 
 
 VELOCITY_ROBOTS = ["puma560", "ur5", "rexarm", "planar_2r", "iiwa"]
-# Configurations where Js is singular (checked with the reference's SVD below).
+# Configurations where Js is singular (checked below with the SVD of the reference's Js and of
+# the Js made from its geometric Jacobian alone).
 SINGULAR_JS = {"puma560": [0.1, 0.5, -0.3, 0.2, 0.0, 0.4], "ur5": [0.3, -1.0, 1.2, 0.4, 0.0, 0.7],
                "planar_2r": [0.4, 0.0], "iiwa": [0.1, 0.5, 0.2, 0.0, 0.3, 0.4, 0.3]}
 
@@ -234,14 +215,15 @@ SINGULAR_JS = {"puma560": [0.1, 0.5, -0.3, 0.2, 0.0, 0.4], "ur5": [0.3, -1.0, 1.
 @pytest.mark.parametrize("name", VELOCITY_ROBOTS)
 def test_velocity_ik_cases(backends, name, backend):
     """Regular Js with damping 0 and 0.1; singular Js: status 1 and q_dot 0 without damping,
-    the damped solution with; NaN or inf in q, mu_dot or damping, or damping < 0: status 2."""
+    the damped solution with; NaN or inf in q (first or last joint), mu_dot or damping, or
+    damping < 0: status 2."""
     arm, _, _, velocity = backends(name)
     solve = velocity[backend]
     rng = np.random.default_rng(24)
     for q in random_configurations(arm, 5, seed=24):
         mu_dot = rng.normal(size=len(arm.task))
         js = reference.singularity_jacobian(arm, q)
-        for damping in (0.0, 0.1):
+        for damping in (0.0, DAMPING):
             q_dot, status = solve(q, mu_dot, damping)
             assert status == 0
             np.testing.assert_allclose(q_dot, _expected_rates(js, mu_dot, damping), atol=1e-9)
@@ -250,22 +232,51 @@ def test_velocity_ik_cases(backends, name, backend):
         q = np.array(SINGULAR_JS[name])
         js = reference.singularity_jacobian(arm, q)
         assert np.linalg.svd(js, compute_uv=False)[-1] < 1e-12
+        assert np.linalg.svd(reference_js(arm, q), compute_uv=False)[-1] < 1e-12
         q_dot, status = solve(q, mu_dot, 0.0)
         assert status == 1 and np.all(np.asarray(q_dot) == 0)
-        q_dot, status = solve(q, mu_dot, 0.1)
+        q_dot, status = solve(q, mu_dot, DAMPING)
         assert status == 0
-        np.testing.assert_allclose(q_dot, _expected_rates(js, mu_dot, 0.1), atol=1e-9)
+        np.testing.assert_allclose(q_dot, _expected_rates(js, mu_dot, DAMPING), atol=1e-9)
     q = random_configurations(arm, 1, seed=25)[0]
     for bad in (np.nan, np.inf):
-        broken = q.copy()
-        broken[-1] = bad  # the last joint: often absent from Js, and still checked
-        assert solve(broken, mu_dot, 0.0)[1] == 2
+        for joint in (0, -1):  # the first, and the last: often absent from Js, and still checked
+            broken = q.copy()
+            broken[joint] = bad
+            assert solve(broken, mu_dot, 0.0)[1] == 2
         broken = mu_dot.copy()
         broken[0] = bad
         assert solve(q, broken, 0.0)[1] == 2
         assert solve(q, mu_dot, bad)[1] == 2
     q_dot, status = solve(q, mu_dot, -0.1)
     assert status == 2 and np.all(np.asarray(q_dot) == 0)
+
+
+@pytest.mark.parametrize("name", ROBOT_NAMES)
+def test_velocity_ik_of_every_shipped_robot(generated, name):
+    """The committed code, 20 random configurations: the batched numpy without damping (its
+    default) solves Js q_dot = mu_dot with the minimum-norm solution (numpy's pinv: 7 axes), with
+    damping gives the damped least squares, statuses VELOCITY_IK_OK; the C gives the closed
+    forms with and without damping. Js here is made from the reference's geometric Jacobian
+    alone (support.ik.reference_js), not taken from the reference's singularity_jacobian."""
+    code = generated.committed(name)
+    arm, module, library = code.robot, code.python, code.library()
+    assert (module.VELOCITY_IK_OK, module.VELOCITY_IK_SINGULAR, module.VELOCITY_IK_NOT_FINITE) == (0, 1, 2)
+    q = random_configurations(arm, 20, seed=8)
+    mu_dot = np.random.default_rng(1).normal(size=(20, len(arm.task)))
+    undamped, status = module.velocity_ik(q, mu_dot)
+    assert np.all(status == module.VELOCITY_IK_OK) and undamped.shape == (20, arm.dof)
+    damped, status = module.velocity_ik(q, mu_dot, DAMPING)
+    assert np.all(status == module.VELOCITY_IK_OK)
+    for x, target, rates, damped_rates in zip(q, mu_dot, undamped, damped):
+        js = reference_js(arm, x)
+        assert np.abs(js @ rates - target).max() < 1e-9
+        np.testing.assert_allclose(rates, np.linalg.pinv(js) @ target, atol=1e-9)
+        np.testing.assert_allclose(damped_rates, _expected_rates(js, target, DAMPING), atol=1e-9)
+        for damping in (0.0, DAMPING):
+            c_rates, c_status = library.velocity_ik(x, target, damping)
+            assert c_status == 0
+            np.testing.assert_allclose(c_rates, _expected_rates(js, target, damping), atol=1e-9)
 
 
 # -- ik_numeric -------------------------------------------------------------------------------
@@ -290,7 +301,7 @@ def test_ik_numeric_cases(backends, name, backend):
         start = np.clip(row + 0.1, *np.array([j.limits or (-np.inf, np.inf) for j in arm.joints]).T)
         found, status = solve(target, start)
         assert status == 0
-        assert _target_errors(arm, np.array([found]), target).max() < 1e-8
+        assert target_error(arm, reference.ik_target(arm, np.array([found])), target).max() < 1e-8
     target = reference.ik_target(arm, q[:1])[0]
     for bad in (np.nan, np.inf):
         broken = target.copy()

@@ -14,9 +14,9 @@ import numpy as np
 import pytest
 
 from jacgen import reference
-from jacgen.compile import CLibrary, compile_shared
 
-from conftest import GENERATED, generated_module, random_configurations, robot
+from conftest import generated_module, random_configurations, robot
+from support.ik import wrapped
 
 ROBOTS = ["puma560", "ur5", "kr5", "panda"]  # limits within one turn, +-2 pi, +-350 deg, a free joint
 MISS = 1e-8
@@ -50,8 +50,8 @@ def test_limits_keep_exactly_the_solutions_inside(name):
     assert all(any(not len(_equivalents(arm, value, j)) for j, value in enumerate(row)) for row in dropped)
     revolute = [joint.revolute for joint in arm.joints]
     outside = every[valid][:, revolute]
-    wrapped = (outside > -np.pi) & (outside <= np.pi)
-    assert np.all(wrapped | ((every[valid] >= lower) & (every[valid] <= upper))[:, revolute])
+    inside_one_turn = (outside > -np.pi) & (outside <= np.pi)
+    assert np.all(inside_one_turn | ((every[valid] >= lower) & (every[valid] <= upper))[:, revolute])
     assert keep.sum() > 0 and (name == "ur5" or (valid & ~keep).sum() > 0)
 
 
@@ -102,15 +102,14 @@ def test_nearest_statuses():
 
 
 @pytest.mark.parametrize("name", ["puma560", "panda"])
-def test_c_and_casadi_nearest_match_numpy(name, tmp_path):
-    arm, module = robot(name), generated_module(name)
-    library = CLibrary(compile_shared([GENERATED / name / f"{name}.c"], tmp_path / f"lib{name}.so"), arm, [], "double")
-    function = getattr(library._library, f"{name}_ik_nearest")
+def test_c_and_casadi_nearest_match_numpy(name, generated):
+    arm, code = robot(name), generated.committed(name)
+    module, casadi = code.python, code.casadi
+    function = getattr(code.library()._library, f"{name}_ik_nearest")
     free = getattr(module, "IK_FREE_JOINT", None)
     pointer = ctypes.POINTER(ctypes.c_double)
     function.argtypes = [pointer, pointer] + [ctypes.c_double] * (free is not None) + [pointer, pointer]
     function.restype = ctypes.c_int
-    casadi = generated_module(name, "_casadi")
     rng = np.random.default_rng(45)
     q = random_configurations(arm, 200, seed=46)
     for k, row in enumerate(q):
@@ -145,5 +144,4 @@ def test_kr5_wrist_beyond_one_turn():
     assert np.all(np.abs(found[:, [3, 5]]) <= np.pi)
     nearest, status = module.ik_nearest(target, q)
     assert status == 0 and np.abs(nearest - q).max() < 1e-9
-    wrapped = (q + np.pi) % (2 * np.pi) - np.pi
-    assert np.abs(found - wrapped).max(axis=1).min() < 1e-9  # q's wrapped copy is among ik's solutions
+    assert np.abs(found - wrapped(q)).max(axis=1).min() < 1e-9  # q's wrapped copy is among ik's solutions

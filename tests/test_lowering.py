@@ -10,7 +10,7 @@ from jacgen.lowering import eliminate_common, operation_count
 from jacgen.robot import load_robot, parse_robot
 from jacgen.nodes import AtLeast, Below, IsFinite, Select
 from conftest import ROOT
-from random_arms import random_arm_text
+from support.random_arms import random_arm_text
 
 x, y, z, w = sympy.symbols("x y z w", real=True)
 SHAPES = [

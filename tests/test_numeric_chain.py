@@ -6,7 +6,7 @@ import pytest
 
 from jacgen import numeric_chain, reference
 from jacgen.robot import parse_robot
-from random_arms import random_arm_text
+from support.random_arms import random_arm_text
 
 
 @pytest.mark.parametrize("seed", range(12))

@@ -7,7 +7,7 @@ import re
 
 import pytest
 
-from random_arms import generates_and_verifies, random_arm_text
+from support.random_arms import generates_and_verifies, random_arm_text
 
 RADIAN_ARMS = [(6, 6001), (11, 11000), (16, 16000)]  # (joints, seed): before the structure stage was bounded, 11 joints took minutes
 

@@ -14,7 +14,7 @@ import pytest
 from click.testing import CliRunner
 
 from jacgen.cli import main
-from random_arms import generates_and_verifies, random_arm_text
+from support.random_arms import generates_and_verifies, random_arm_text
 
 STRESS_SEEDS = int(os.environ.get("JACGEN_STRESS_SEEDS", "30"))
 

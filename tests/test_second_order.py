@@ -1,6 +1,7 @@
 """Second-order kinematics (contract §2): jacobian_dot, bias_acceleration, task_jacobian_dot,
 hessian and fk_jacobian_dot of every shipped robot against Pinocchio, on the DH chain that
-test_external_libraries builds from the robot file, and against the complex-step reference."""
+tests/support/pinocchio_chain.py builds from the robot file (test_external_libraries checks its
+fk and Jacobians), and against the complex-step reference."""
 
 import numpy as np
 import pinocchio as pin
@@ -8,13 +9,11 @@ import pytest
 from numpy.testing import assert_allclose
 
 from jacgen import reference
-from jacgen.compile import CLibrary, compile_shared
 from jacgen.functions import Generator
-from jacgen.render import render_robot, write_files
 from jacgen.robot import parse_robot
 
-from conftest import ROBOT_NAMES, ROOT, import_file
-from test_external_libraries import generated_module, pinocchio_from_dh, robot_of, samples
+from conftest import ROBOT_NAMES, ROOT
+from support.pinocchio_chain import pinocchio_from_dh, robot_of, samples
 
 ATOL = 1e-9
 
@@ -60,8 +59,8 @@ def pinocchio_second_order(name):
 
 
 @pytest.mark.parametrize("name", ROBOT_NAMES)
-def test_numpy_against_pinocchio(name):
-    module, qs, q_dots = generated_module(name), samples(name), rates(name)
+def test_numpy_against_pinocchio(name, generated):
+    module, qs, q_dots = generated.committed(name).python, samples(name), rates(name)
     jacobian_dot, hessian = pinocchio_second_order(name)
     assert_allclose(module.jacobian_dot(qs, q_dots), jacobian_dot, atol=ATOL, rtol=0)
     assert_allclose(module.bias_acceleration(qs, q_dots), np.einsum("krc,kc->kr", jacobian_dot, q_dots), atol=ATOL, rtol=0)
@@ -74,9 +73,9 @@ def test_numpy_against_pinocchio(name):
 
 
 @pytest.mark.parametrize("name", ROBOT_NAMES)
-def test_numpy_task_jacobian_dot_against_reference(name):
+def test_numpy_task_jacobian_dot_against_reference(name, generated):
     """The reference differentiates its own Euler-rate form of the task Jacobian by complex step."""
-    robot, module = robot_of(name), generated_module(name)
+    robot, module = robot_of(name), generated.committed(name).python
     for q, q_dot in zip(samples(name), rates(name)):
         rotation = reference.fk(robot, q)[:3, :3]
         if np.hypot(rotation[0, 0], rotation[1, 0]) < 0.05 and set(robot.task) & {"roll", "pitch", "yaw"}:
@@ -85,10 +84,10 @@ def test_numpy_task_jacobian_dot_against_reference(name):
                         atol=ATOL, rtol=0)
 
 
-def test_task_jacobian_dot_is_the_rate_of_task_jacobian():
+def test_task_jacobian_dot_is_the_rate_of_task_jacobian(generated):
     """mu'' = J_a q'' + J_a' q': along a path q(t) = q0 + t v + t^2 w / 2, the second difference
     of mu equals J_a(q0) w + J_a'(q0, v) v."""
-    module = generated_module("stanford")
+    module = generated.committed("stanford").python
     rng = np.random.default_rng(3)
     q0, v, w = rng.uniform(-1, 1, 6), rng.normal(size=6), rng.normal(size=6)
     h = 1e-4
@@ -98,11 +97,10 @@ def test_task_jacobian_dot_is_the_rate_of_task_jacobian():
 
 
 @pytest.mark.parametrize("name", ["puma560", "ur5", "panda"])
-def test_c_double_against_pinocchio(name, tmp_path):
+def test_c_double_against_pinocchio(name, generated):
     robot = robot_of(name)
     functions = [f for f in Generator(robot).functions() if f.name in ("jacobian_dot", "hessian", "fk_jacobian_dot")]
-    library = CLibrary(compile_shared([ROOT / "generated" / name / f"{name}.c"], tmp_path / f"{name}.so"), robot,
-                       functions, "double")
+    library = generated.committed(name).library(functions)
     qs, q_dots, n = samples(name), rates(name), robot.dof
     jacobian_dot, hessian = pinocchio_second_order(name)
     assert_allclose(library.evaluate("jacobian_dot", qs, q_dots).reshape(-1, 6, n), jacobian_dot, atol=ATOL, rtol=0)
@@ -111,16 +109,14 @@ def test_c_double_against_pinocchio(name, tmp_path):
     assert_allclose(fused[:, 16 + 6 * n:], np.einsum("krc,kc->kr", jacobian_dot, q_dots), atol=ATOL, rtol=0)
 
 
-def test_symbolic_parameters_are_arguments(tmp_path):
+def test_symbolic_parameters_are_arguments(generated):
     """With a2 and d3 runtime parameters, jacobian_dot and hessian at given values equal the
     reference of the arm with those values written in."""
     text = (ROOT / "robots" / "puma560.yaml").read_text()
     symbolic = text.replace("  a2: 0.4318 ", "  a2: {value: 0.4318, symbolic: true} ").replace(
         "  d3: 0.15005 ", "  d3: {value: 0.15005, symbolic: true} ")
     assert symbolic.count("symbolic: true") == 2
-    robot = parse_robot(symbolic.encode(), "puma560.yaml")
-    write_files(render_robot(robot, ("python",)), tmp_path)
-    module = import_file(tmp_path / "puma560" / "puma560.py", "_second_order_parameters")
+    module = generated(parse_robot(symbolic.encode(), "puma560.yaml")).python
     moved = parse_robot(text.replace("  a2: 0.4318 ", "  a2: 0.5 ").replace("  d3: 0.15005 ", "  d3: 0.1 ").encode())
     for q, q_dot in zip(samples("puma560")[:20], rates("puma560")[:20]):
         assert_allclose(module.jacobian_dot(q, q_dot, a2=0.5, d3=0.1), reference.jacobian_dot(moved, q, q_dot),

@@ -1,6 +1,7 @@
 """Structure detection: the zero-configuration geometry against the numpy reference, the class
 of every shipped robot, and robots built to fall in (or just outside) each class."""
 
+import re
 import time
 
 import numpy as np
@@ -92,15 +93,20 @@ def test_reasons_name_what_is_missing():
 
 @pytest.mark.parametrize("name", ["puma560", "kr5", "stanford"])
 def test_the_wrist_centre_lies_on_the_reference_axes(name):
-    """The spherical wrist's centre, as found (and printed in the reason), is on axes 4, 5 and 6
-    of the numpy DH chain at q = 0."""
+    """The spherical wrist's centre, as the structure holds it (the chain its solver solves,
+    numbered from the base), is where axes 4, 5 and 6 of the numpy DH chain meet at q = 0: the
+    point nearest all three (least squares), on each of them. The reason names its coordinates."""
     arm = robot(name)
-    centre = np.array(Geometry(arm).wrist_centre(3), dtype=float).ravel()
     frames, _ = reference.frames(arm, np.zeros(arm.dof))
-    for frame in frames[3:6]:
-        offset = centre - frame[:3, 3]
-        assert np.linalg.norm(np.cross(offset, frame[:3, 2])) < 1e-12
-    assert ", ".join(f"{x:.6g}" for x in centre) in classify(arm).reason
+    across = [np.eye(3) - np.outer(frame[:3, 2], frame[:3, 2]) for frame in frames[3:6]]  # across each axis
+    points = [frame[:3, 3] for frame in frames[3:6]]
+    meeting = np.linalg.lstsq(np.vstack(across), np.concatenate([m @ p for m, p in zip(across, points)]), rcond=None)[0]
+    assert max(np.linalg.norm(m @ (meeting - p)) for m, p in zip(across, points)) < 1e-12
+    structure = classify(arm)
+    assert structure.solver.startswith("spherical_wrist") and structure.chain.joints == tuple(range(6))
+    np.testing.assert_allclose(np.array(structure.chain.wrist_centre(3), dtype=float).ravel(), meeting, atol=1e-12)
+    named = [float(x) for x in re.findall(r"-?\d+(?:\.\d+)?(?:e[-+]?\d+)?", structure.reason)]
+    assert all(any(abs(x - c) <= 1e-5 * max(1.0, abs(c)) for x in named) for c in meeting), structure.reason
 
 
 def test_classes_do_not_depend_on_the_convention_or_exact_angles():

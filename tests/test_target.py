@@ -12,6 +12,7 @@ import pytest
 from click.testing import CliRunner
 
 from jacgen.cli import main
+from jacgen.robot import load_robot
 from jacgen.target import INSTALL
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -30,12 +31,9 @@ def check_m4(sources: Path) -> subprocess.CompletedProcess:
 
 
 @pytest.fixture(scope="module")
-def float_c(tmp_path_factory) -> Path:
-    folder = tmp_path_factory.mktemp("float")
-    result = CliRunner().invoke(main, ["generate", str(ROOT / "robots" / "puma560.yaml"), "--real", "float",
-                                       "--lang", "c", "-o", str(folder)])
-    assert result.exit_code == 0, result.output
-    return folder
+def float_c(generated) -> Path:
+    """The folder `jacgen generate robots/puma560.yaml --real float --lang c -o` writes."""
+    return generated(load_robot(ROOT / "robots" / "puma560.yaml"), ("c",), "float").folder
 
 
 def rows(output: str, table: int) -> dict[str, list[str]]:

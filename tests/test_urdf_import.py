@@ -19,34 +19,13 @@ from jacgen.robot import load_robot, parse_robot
 from jacgen.structure import classify
 
 from conftest import ROOT
+from support.urdf import DATA, URDFS, imported
 
-DATA = ROOT / "tests" / "data" / "urdf"
-# name: (file, base link, tip link, closed-form ik class of the imported arm)
-URDFS = {
-    "ur5": ("ur5_robot.urdf", "base", "tool0", "three_parallel"),
-    "ur10": ("ur10_robot.urdf", "base_link", "ee_link", "three_parallel"),
-    "panda": ("panda.urdf", None, "panda_hand_tcp", "spherical_wrist_intersecting"),  # joint 7 free
-    "kinova_jaco2": ("kinova.urdf", None, "j2s6s200_end_effector", "spherical_wrist_parallel"),
-    "xarm7": ("xarm7.urdf", None, None, None),
-    "z1": ("z1.urdf", None, "link06", "three_parallel"),
-    "tiago": ("tiago_no_hand.urdf", "base_footprint", "arm_tool_link", None),
-    "pr2": ("pr2.urdf", "base_link", "r_gripper_palm_link", None),
-    "so101": ("so101.urdf", None, "gripper_frame_link", None),
-    "talos_arm": ("talos_left_arm.urdf", None, "gripper_left_base_link", "spherical_wrist_intersecting"),
-    "pendulum": ("double_pendulum_continuous.urdf", None, None, None),
-    "finger_edu": ("finger_edu.urdf", None, None, None),
-    "baxter": ("baxter.urdf", "base", "left_gripper_base_link", None),
-}
 FK_TOLERANCE = 1e-12
 # so101's URDF writes angles to 5 or 6 digits; one DH angle comes out 1.4e-11 rad from 90
 # degrees and is made exact, as robot files make every such angle (docs/urdf.md).
 FK_TOLERANCE_BY_NAME = {"so101": 5e-11}
 REACH = 2.0  # metres: bounds the lever arm of every arm here
-
-
-def imported(key: str, convention: str = "standard", **options):
-    file, base, tip, _ = URDFS[key]
-    return import_urdf(str(DATA / file), base, tip, convention, **options)
 
 
 def as_read(text: str, snap: float = 1e-9) -> str:

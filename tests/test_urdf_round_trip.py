@@ -5,7 +5,7 @@ test_urdf_import; this file checks that what the import writes generates."""
 
 from jacgen.verify import verify
 
-from test_urdf_import import URDFS, imported
+from support.urdf import URDFS, imported
 
 ROUND_TRIP = list(URDFS)
 

@@ -12,6 +12,8 @@ import sympy
 from jacgen import general6r, reference
 from jacgen.robot import parse_robot
 
+from .ik import wrapped
+
 MANOCHA_CANNY = """
 name: manocha_canny
 convention: standard
@@ -70,10 +72,6 @@ def numeric(matrix: sympy.Matrix) -> np.ndarray:
 def _rz(angle: float) -> np.ndarray:
     c, s = math.cos(angle), math.sin(angle)
     return np.array([[c, -s, 0, 0], [s, c, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1.0]])
-
-
-def wrapped(a: np.ndarray) -> np.ndarray:
-    return (a + math.pi) % (2 * math.pi) - math.pi
 
 
 def _pose_error(target: np.ndarray, pose: np.ndarray) -> np.ndarray:
