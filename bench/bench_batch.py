@@ -17,26 +17,20 @@ For ur5 and panda, the time per batch of `fk_jacobian` (the pose and the world J
   robot jacgen imports from that URDF, so both compute the same quantity.
 Then the batched closed-form `ik` of ur5 (every branch, (q, keep) of fixed size) in numpy and
 under `jax.jit`. All in double precision (jax_enable_x64), plus JAX in float32 for
-fk_jacobian. Time is the best of `--rounds` after a warm-up call; the device of each library
-is printed (a GPU is used when JAX or PyTorch sees one). Ratios are against numpy in the same
-run.
+fk_jacobian. Time is the median of `--rounds` after a warm-up call (common.py's timer
+policy); the device of each library is printed (a GPU is used when JAX or PyTorch sees
+one). Ratios are against numpy in the same run.
 """
 
 import argparse
 import contextlib
-import importlib.util
 import io
-import sys
-import time
-from pathlib import Path
 
 import numpy as np
 
-ROOT = Path(__file__).resolve().parent.parent
-sys.path.insert(0, str(ROOT))
-
-from jacgen import reference  # noqa: E402
-from jacgen.import_urdf import import_urdf  # noqa: E402
+import common
+from jacgen import reference
+from jacgen.import_urdf import import_urdf
 
 URDFS = {"ur5": ("ur5_robot.urdf", "base_link", "tool0"), "panda": ("panda.urdf", "panda_link0", "panda_hand_tcp")}
 
@@ -57,21 +51,13 @@ if jax:
 
 
 def module(name):
-    spec = importlib.util.spec_from_file_location(name, ROOT / "generated" / name / f"{name}.py")
-    generated = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(generated)
-    return generated
+    """The committed generated/NAME/NAME.py."""
+    return common.load_module(common.ROOT / "generated" / name / f"{name}.py")
 
 
-def best_time(function, rounds, ready=lambda result: result):
-    """Best of `rounds` wall times of `function()`, after one warm-up call."""
-    ready(function())
-    times = []
-    for _ in range(rounds):
-        start = time.perf_counter()
-        ready(function())
-        times.append(time.perf_counter() - start)
-    return min(times)
+def seconds(function, rounds, ready=lambda result: result):
+    """Median wall seconds of `function()` over `rounds` rounds, after a warm-up call."""
+    return common.timed(function, rounds, ready).seconds
 
 
 def torch_device():
@@ -81,7 +67,7 @@ def torch_device():
 def urdf_chain(name):
     """pytorch_kinematics' chain of the URDF, and the robot jacgen imports from it."""
     file, base, tip = URDFS[name]
-    path = ROOT / "tests" / "data" / "urdf" / file
+    path = common.ROOT / "tests" / "data" / "urdf" / file
     with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()):  # its parser's notes
         chain = pk.build_serial_chain_from_urdf(path.read_bytes(), tip, base)
     chain = chain.to(dtype=torch.float64, device=torch_device())
@@ -94,21 +80,21 @@ def rows_fk_jacobian(name, sizes, rounds):
     table = []
     for size in sizes:
         q = rng.uniform(-np.pi, np.pi, (size, generated.DOF))
-        row = {"numpy": best_time(lambda: generated.fk_jacobian(q), rounds)}
+        row = {"numpy": seconds(lambda: generated.fk_jacobian(q), rounds)}
         if jax:
             compiled = jax.jit(generated.fk_jacobian)
             q_jax, q_single = jax.numpy.asarray(q), jax.numpy.asarray(q, dtype=jax.numpy.float32)
-            row["JAX jit"] = best_time(lambda: compiled(q_jax), rounds, jax.block_until_ready)
-            row["JAX jit float32"] = best_time(lambda: compiled(q_single), rounds, jax.block_until_ready)
+            row["JAX jit"] = seconds(lambda: compiled(q_jax), rounds, jax.block_until_ready)
+            row["JAX jit float32"] = seconds(lambda: compiled(q_single), rounds, jax.block_until_ready)
         if torch:
             q_torch = torch.from_numpy(q).to(torch_device())
             sync = (lambda result: torch.cuda.synchronize()) if torch_device() == "cuda" else (lambda result: result)
-            row["PyTorch eager"] = best_time(lambda: generated.fk_jacobian(q_torch), rounds, sync)
+            row["PyTorch eager"] = seconds(lambda: generated.fk_jacobian(q_torch), rounds, sync)
             compiled = torch.compile(generated.fk_jacobian, fullgraph=True, dynamic=False)
-            row["PyTorch compile"] = best_time(lambda: compiled(q_torch), rounds, sync)
+            row["PyTorch compile"] = seconds(lambda: compiled(q_torch), rounds, sync)
             if pk:
                 chain, imported = urdf_chain(name)
-                row["pytorch_kinematics"] = best_time(lambda: chain.jacobian(q_torch, ret_eef_pose=True), rounds, sync)
+                row["pytorch_kinematics"] = seconds(lambda: chain.jacobian(q_torch, ret_eef_pose=True), rounds, sync)
                 if size == sizes[0]:
                     _, pose = chain.jacobian(q_torch[:100], ret_eef_pose=True)
                     want = reference.fk(imported, q[:100])
@@ -124,10 +110,10 @@ def rows_ik(sizes, rounds):
     table = []
     for size in sizes:
         targets = generated.fk(rng.uniform(-np.pi, np.pi, (size, generated.DOF)))
-        row = {"numpy": best_time(lambda: generated.ik(targets), rounds)}
+        row = {"numpy": seconds(lambda: generated.ik(targets), rounds)}
         if jax:
             compiled, targets_jax = jax.jit(generated.ik), jax.numpy.asarray(targets)
-            row["JAX jit"] = best_time(lambda: compiled(targets_jax), rounds, jax.block_until_ready)
+            row["JAX jit"] = seconds(lambda: compiled(targets_jax), rounds, jax.block_until_ready)
         table.append((size, row))
     return table
 

@@ -9,7 +9,7 @@ UR5 and the Panda, both are built the same way in the same run (-O2, Cortex-M4F 
 - jacgen: `NAME_fk_jacobian` and `NAME_jacobian_det` (`NAME_manipulability` for the 7-axis
   Panda, which has no square Jacobian) as generated with `--real float`;
 - CasADi: T and J as one SX function built from the DH table and passed through `casadi.cse`
-  (`bench_fk_jacobian.casadi_variants`), and `det(J)` (`sqrt(det(J J^T))`), written out by
+  (`common.casadi_variants`), and `det(J)` (`sqrt(det(J J^T))`), written out by
   `casadi.CodeGenerator` with casadi_real = float, behind a wrapper with jacgen's signature.
   CasADi's float C calls sin, cos and sqrt in double and writes double constants; for a fair
   count its calls are renamed to sinf, cosf, sqrtf and it is built with
@@ -23,23 +23,17 @@ stack (gcc) the deepest chain of -fstack-usage frames; measured, what the calls 
 
 import argparse
 import re
-import sys
 import tempfile
 from pathlib import Path
 
 import casadi
 import numpy as np
 
-ROOT = Path(__file__).resolve().parent.parent
-sys.path.insert(0, str(ROOT))
-sys.path.insert(0, str(ROOT / "bench"))
-
-from bench_fk_jacobian import casadi_variants  # noqa: E402
-from jacgen import reference  # noqa: E402
-from jacgen.functions import Generator  # noqa: E402
-from jacgen.robot import load_robot  # noqa: E402
-from jacgen.target import Emulator, check_tools  # noqa: E402
-from jacgen.verify import FLOAT_TOLERANCE, reach  # noqa: E402
+import common
+from jacgen import reference
+from jacgen.functions import Generator
+from jacgen.target import Emulator, check_tools
+from jacgen.verify import FLOAT_TOLERANCE, reach
 
 ROBOTS = ("puma560", "ur5", "panda")
 MATH = ("sin", "cos", "tan", "sqrt", "fabs", "atan2", "asin", "acos", "exp", "log", "pow", "fmin", "fmax", "floor")
@@ -51,7 +45,7 @@ def scalar_name(robot) -> str:
 
 def casadi_source(robot, folder: Path) -> None:
     """folder/NAME/NAME.h and .c: CasADi's C of fk+J and of the scalar, behind jacgen's signatures."""
-    built = casadi_variants(robot)["casadi_cse"]
+    built = common.casadi_variants(robot)["casadi_cse"]
     q = built.sx_in()[0]
     T, J = built(q)
     # CasADi stores matrices column-major, jacgen row-major: the transposes, stored, are the same arrays.
@@ -60,14 +54,8 @@ def casadi_source(robot, folder: Path) -> None:
     scalar = casadi.Function(f"casadi_{scalar_name(robot)}", [q], casadi.cse([scalar]))
     name, code = robot.name, folder / robot.name
     code.mkdir(parents=True, exist_ok=True)
-    parts = []
-    for function in (fk_jacobian, scalar):
-        generator = casadi.CodeGenerator(f"{function.name()}.c", {"casadi_real": "float", "casadi_int": "int",
-                                                                 "prefix": f"{function.name()}_"})
-        generator.add(function)
-        generator.generate(str(code) + "/")
-        parts.append((code / f"{function.name()}.c").read_text())
-    text = "\n".join(parts)
+    text = "\n".join(common.casadi_c(function, code, "float", "int", prefix=f"{function.name()}_").read_text()
+                     for function in (fk_jacobian, scalar))
     text = re.sub(r"\b(" + "|".join(MATH) + r")\(", r"\1f(", text)
     real = f"{name}_real"
     header = (f"typedef float {real};\n"
@@ -129,7 +117,7 @@ def main() -> None:
     with tempfile.TemporaryDirectory() as temporary:
         folder = Path(temporary)
         for name in ROBOTS:
-            robot = load_robot(ROOT / "robots" / f"{name}.yaml")
+            robot = common.shipped(name)
             ranges = np.array([joint.limits or (-np.pi, np.pi) for joint in robot.joints])
             q = np.random.default_rng(0).uniform(ranges[:, 0], ranges[:, 1], size=(arguments.samples, robot.dof))
             q = q.astype(np.float32).astype(np.float64)

@@ -6,15 +6,15 @@ For the UR5 and the Puma 560, the same random reachable poses (fk of random join
 inside the limits) are solved by (every branch: the arms are generated without their joint
 limits, which EAIK and ik-geo do not apply):
 
-- "C native": the generated `NAME_ik` (double) called in a native loop by a C harness
-  compiled with -O2 (the generated file in its own translation unit);
-- "C via ctypes": the same shared library called from Python, one call per pose;
+- "C native": the generated `NAME_ik` (double) called in a native loop by common.py's
+  harness and flags (-O2; the generated file in its own translation unit);
+- "C via ctypes": the same C as a shared library called from Python, one call per pose;
 - "EAIK": `eaik.IK_DH.DhRobot(...).IK(T)` from Python (its C++ solver through pybind11);
 - "ik-geo": `ik_geo.Robot.three_parallel_two_intersecting` / `spherical_two_parallel`
   `.get_ik(R, t)` from Python (its Rust solver through PyO3).
 
 Every solver returns all branches; the table gives microseconds per pose (median over
-rounds), the real solutions found (EAIK and ik-geo also return least-squares candidates,
+rounds after a warm-up round), the real solutions found (EAIK and ik-geo also return least-squares candidates,
 not counted) and each time over the C-via-ctypes one. The derivation time of every shipped
 robot's closed form (structure detection and exact constants, `jacgen.ik.closed_form`) is
 printed first.
@@ -30,9 +30,6 @@ solutions that miss the target by more than 1e-8, and how often the count equals
 
 import argparse
 import ctypes
-import statistics
-import subprocess
-import sys
 import tempfile
 import time
 from pathlib import Path
@@ -41,96 +38,20 @@ import numpy as np
 from eaik.IK_DH import DhRobot
 from ik_geo import Robot as IkGeoRobot
 
-ROOT = Path(__file__).resolve().parent.parent
-sys.path.insert(0, str(ROOT))
-sys.path.insert(0, str(ROOT / "tests"))
-
-from jacgen import reference  # noqa: E402
-from jacgen.compile import WARNING_FLAGS, compile_shared  # noqa: E402
-from jacgen.ik import closed_form  # noqa: E402
-from jacgen.render import render_robot, write_files  # noqa: E402
-from jacgen.robot import load_robot  # noqa: E402
-from conftest import without_limits  # noqa: E402
-from test_ik import kinematic_chain  # noqa: E402
+import common
+from common import kinematic_chain, without_limits
+from jacgen import reference
+from jacgen.compile import CLibrary
+from jacgen.ik import closed_form
 
 ROBOTS = {"ur5": IkGeoRobot.three_parallel_two_intersecting, "puma560": IkGeoRobot.spherical_two_parallel}
 GENERAL = ("jaco", "manocha_canny", "ur5_calibrated")
 
-HARNESS = r"""
-#define _POSIX_C_SOURCE 199309L
-#include <stdio.h>
-#include <stdlib.h>
-#include <time.h>
-#include "NAME.h"
 
-#ifdef NAME_UPPER_IK_FREE_JOINT /* a 7-joint arm: the free joint's angle per target, from argv[4] */
-#define FREE(i) frees[i],
-#else
-#define FREE(i)
-#endif
-
-static double now(void) { struct timespec t; clock_gettime(CLOCK_MONOTONIC, &t); return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec; }
-
-static int load(const char *path, double *values, long count)
-{
-    FILE *file = fopen(path, "rb");
-    int ok = file && fread(values, sizeof(double), (size_t)count, file) == (size_t)count;
-    if (file) fclose(file);
-    return ok;
-}
-
-int main(int argc, char **argv)
-{
-    const long count = argc >= 4 ? atol(argv[2]) : 0;
-    const int rounds = argc >= 4 ? atoi(argv[3]) : 0;
-    double *targets = malloc(sizeof(double) * 16 * (size_t)count), *frees = malloc(sizeof(double) * (size_t)count);
-    double q[NAME_UPPER_MAX_IK_SOLUTIONS * NAME_UPPER_DOF];
-    long solutions = 0;
-    if (!targets || !frees || !load(argv[1], targets, 16 * count) || (argc > 4 && !load(argv[4], frees, count))) {
-        return 2;
-    }
-    (void)frees;
-    for (int round = 0; round < rounds; ++round) {
-        const double t0 = now();
-        solutions = 0;
-        for (long i = 0; i < count; ++i) solutions += NAME_ik(targets + 16 * i, FREE(i) q);
-        printf("%.4f %ld\n", (now() - t0) * 1e6 / (double)count, solutions);
-    }
-    free(targets);
-    free(frees);
-    return 0;
-}
-"""
-
-
-def native(robot, source: Path, targets: np.ndarray, rounds: int, folder: Path,
-           frees: np.ndarray | None = None) -> tuple[float, int]:
-    """Median microseconds per pose of NAME_ik in a native loop (with the free joint's angle per
-    target for a 7-joint arm), and the solutions found."""
-    harness = folder / f"harness_{robot.name}.c"
-    harness.write_text(HARNESS.replace("NAME_UPPER", robot.name.upper()).replace("NAME", robot.name))
-    binary, data = folder / f"harness_{robot.name}", folder / f"targets_{robot.name}.bin"
-    targets.astype(np.float64).tofile(data)
-    extra = []
-    if frees is not None:
-        extra = [folder / f"frees_{robot.name}.bin"]
-        frees.astype(np.float64).tofile(extra[0])
-    subprocess.run(["gcc", *WARNING_FLAGS, "-O2", "-I", source.parent, "-o", binary, harness, source, "-lm"],
-                   check=True)
-    output = subprocess.run([binary, data, str(len(targets)), str(rounds), *extra], check=True, capture_output=True,
-                            text=True).stdout.split("\n")
-    rows = [line.split() for line in output if line]
-    return statistics.median(float(row[0]) for row in rows), int(rows[-1][1])
-
-
-def timed(solve, targets, rounds: int) -> tuple[float, int]:
+def per_pose(solve, targets, rounds: int) -> tuple[float, int]:
     """Median microseconds per pose of `solve(T) -> count` called from Python, and the count."""
-    times, found = [], 0
-    for _ in range(rounds):
-        start = time.perf_counter()
-        found = sum(solve(T) for T in targets)
-        times.append((time.perf_counter() - start) * 1e6 / len(targets))
-    return statistics.median(times), found
+    timing = common.timed(lambda: sum(solve(T) for T in targets), rounds)
+    return timing.seconds * 1e6 / len(targets), timing.result
 
 
 def solvers(robot, library, ik_geo_factory):
@@ -158,19 +79,6 @@ def solvers(robot, library, ik_geo_factory):
     return {"C via ctypes": ours, "EAIK": theirs_eaik, "ik-geo": theirs_ik_geo}
 
 
-def _wrapped(a: np.ndarray) -> np.ndarray:
-    return (a + np.pi) % (2 * np.pi) - np.pi
-
-
-def _quality(robot, q: np.ndarray, targets: np.ndarray, found: list[np.ndarray]) -> tuple[float, float, float]:
-    """Mean solutions, the rate of poses whose configuration q is among them, the rate of
-    solutions off the target by more than 1e-8."""
-    recovered = sum(len(s) > 0 and np.abs(_wrapped(s - row)).max(axis=1).min() < 1e-6 for s, row in zip(found, q))
-    errors = [np.abs(reference.fk(robot, x) - T).max() for s, T in zip(found, targets) for x in s]
-    return (np.mean([len(s) for s in found]), recovered / len(q),
-            sum(e > 1e-8 for e in errors) / max(len(errors), 1))
-
-
 def _ssik_solver(robot):
     """ssik's solver for the arm as (target -> solutions as jacgen's q), None without ssik."""
     try:
@@ -185,47 +93,35 @@ def _ssik_solver(robot):
     tool = np.linalg.inv(reference._pose(robot.tool))
 
     def solve(T):
-        return [_wrapped(np.asarray(s.q) - offset) for s in arm.solve(head @ T @ tool, respect_limits=False)]
+        return [common.wrapped(np.asarray(s.q) - offset) for s in arm.solve(head @ T @ tool, respect_limits=False)]
     return solve
 
 
 def general_table(targets_count: int, rounds: int, folder: Path) -> None:
     """The general 6R solver beside ssik (see the module docstring)."""
-    import importlib.util
-    from jacgen.compile import CLibrary
     print(f"\ngeneral 6R solver, {targets_count} random poses; us per pose (median of {rounds} rounds); "
           "recovered = the generating configuration among the solutions; off = solutions missing by > 1e-8")
     print(f"{'robot':15s} {'solver':13s} {'us/pose':>9s} {'mean sol':>9s} {'recovered':>10s} {'off':>8s} "
           f"{'= ssik count':>12s}")
     for name in GENERAL:
-        robot = load_robot(ROOT / "robots" / f"{name}.yaml")
-        write_files(render_robot(robot, ("c", "python")), folder)
-        source = folder / name / f"{name}.c"
-        library = CLibrary(compile_shared([source], folder / f"lib{name}.so", ("-O2",)), robot, [], "double")
-        spec = importlib.util.spec_from_file_location(f"bench_{name}", folder / name / f"{name}.py")
-        module = importlib.util.module_from_spec(spec)
-        spec.loader.exec_module(module)
+        robot = common.shipped(name)
+        code = common.generate(robot, folder, ("c", "python"))
+        library = CLibrary(common.shared_library(code / f"{name}.c"), robot, [], "double")
+        module = common.load_module(code / f"{name}.py")
         q = np.random.default_rng(5).uniform(-np.pi, np.pi, (targets_count, 6))
         targets = reference.fk(robot, q)
         rows = {}
-        micros, _ = native(robot, source, targets, rounds, folder)
+        micros, _ = common.native_ik(robot, code / f"{name}.c", targets, rounds, folder)
         rows["C native"] = (micros, [library.ik(T, 16) for T in targets])
-        times = []
-        for _ in range(rounds):
-            start = time.perf_counter()
-            branches, valid, _ = module.ik_branches(targets)
-            times.append((time.perf_counter() - start) * 1e6 / len(targets))
-        rows["numpy batched"] = (statistics.median(times), [b[v] for b, v in zip(branches, valid)])
+        batch = common.timed(lambda: module.ik_branches(targets), rounds)
+        branches, valid, _ = batch.result
+        rows["numpy batched"] = (batch.seconds * 1e6 / len(targets), [b[v] for b, v in zip(branches, valid)])
         ssik_solve = _ssik_solver(robot)
         if ssik_solve is not None:
-            times = []
-            for _ in range(rounds):
-                start = time.perf_counter()
-                found = [ssik_solve(T) for T in targets]
-                times.append((time.perf_counter() - start) * 1e6 / len(targets))
-            rows["ssik"] = (statistics.median(times), found)
+            timing = common.timed(lambda: [ssik_solve(T) for T in targets], rounds)
+            rows["ssik"] = (timing.seconds * 1e6 / len(targets), timing.result)
         for label, (micros, found) in rows.items():
-            mean, recovered, off = _quality(robot, q, targets, found)
+            mean, recovered, off = common.ik_quality(robot, q, targets, found)
             same = (f"{np.mean([len(a) == len(b) for a, b in zip(found, rows['ssik'][1])]):12.1%}"
                     if "ssik" in rows else f"{'-':>12s}")
             print(f"{name:15s} {label:13s} {micros:9.1f} {mean:9.2f} {recovered:10.1%} {off:8.2%} {same}")
@@ -239,8 +135,8 @@ def main():
     arguments = parser.parse_args()
 
     print("derivation of the closed form (structure detection + exact constants):")
-    for path in sorted((ROOT / "robots").glob("*.yaml")):
-        robot = load_robot(path)
+    for path in sorted((common.ROOT / "robots").glob("*.yaml")):
+        robot = common.shipped(path.stem)
         start = time.perf_counter()
         form = closed_form(robot)
         print(f"  {robot.name:10s} {1e3 * (time.perf_counter() - start):7.1f} ms  {form.solver if form else '-'}")
@@ -249,18 +145,17 @@ def main():
     with tempfile.TemporaryDirectory() as temporary:
         folder = Path(temporary)
         for name, ik_geo_factory in ROBOTS.items():
-            shipped = load_robot(ROOT / "robots" / f"{name}.yaml")
+            shipped = common.shipped(name)
             robot = without_limits(shipped)  # every branch, as EAIK and ik-geo return them
-            write_files(render_robot(robot, ("c",)), folder)
-            source = folder / name / f"{name}.c"
-            library = ctypes.CDLL(str(compile_shared([source], folder / f"lib{name}.so", ("-O2",))))
+            source = common.generate(robot, folder) / f"{name}.c"
+            library = ctypes.CDLL(str(common.shared_library(source)))
             rng = np.random.default_rng(1)
             limits = np.array([joint.limits for joint in shipped.joints])
             q = rng.uniform(limits[:, 0], limits[:, 1], (arguments.targets, robot.dof))
             targets = reference.fk(robot, q)
-            results = {"C native": native(robot, source, targets, arguments.rounds, folder)}
+            results = {"C native": common.native_ik(robot, source, targets, arguments.rounds, folder)}
             for label, solve in solvers(robot, library, ik_geo_factory).items():
-                results[label] = timed(solve, targets, arguments.rounds)
+                results[label] = per_pose(solve, targets, arguments.rounds)
             rows.append((name, results))
 
         general_table(arguments.general_targets, 3, folder)

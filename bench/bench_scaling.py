@@ -1,25 +1,23 @@
 """How generation scales with the number of joints (issue 9).
 
-For random arms of 1 to 32 joints (tests/random_arms.py: both conventions, prismatic
-joints, arbitrary twists, base and tool, any task shape; fixed seeds), renders every
-language in a fresh process and reports, averaged over the arms of each size: generation
-time (Python start-up excluded), the process's peak memory, and the operation counts of
-`fk_jacobian`, `singularity_factors` and `manipulability`; then the log-log slopes
-(least squares on the logs) of each against n, over all sizes and from 6 joints up.
+For random arms of 1 to 32 joints (the test suite's `random_arm_text`: both conventions,
+prismatic joints, arbitrary twists, base and tool, any task shape; fixed seeds), renders
+every language in a fresh process (`common.render_in_process`, bench_generate's worker)
+and reports, averaged over the arms of each size: generation time (Python start-up
+excluded), the process's peak memory, and the operation counts of `fk_jacobian`,
+`singularity_factors` and `manipulability`; then the log-log slopes (least squares on the
+logs) of each against n, over all sizes and from 6 joints up.
 
     PYTHONPATH=. python bench/bench_scaling.py [--sizes 1,2,4,6,8,12,16,24,32] [--repeats 3]
 """
 
 import argparse
-import math
-import sys
 import tempfile
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parent.parent
-sys.path[:0] = [str(ROOT / "bench"), str(ROOT / "tests")]
-import bench_generate  # noqa: E402 (one worker renders a robot in a fresh process for both benches)
-from random_arms import random_arm_text  # noqa: E402
+import common
+from common import random_arm_text
+
 COLUMNS = ("seconds", "peak_mb", "fk_jacobian", "singularity_factors", "manipulability")
 
 
@@ -30,19 +28,12 @@ def measure(dof: int, repeats: int, folder: Path) -> dict:
         seed = 1000 * dof + repeat
         path = folder / f"arm{seed}.yaml"
         path.write_text(random_arm_text(seed, dof=dof))
-        result = bench_generate.measure(ROOT, path, timeout=3600)
+        result = common.render_in_process(common.ROOT, path, timeout=3600)
         rows.append({"seconds": result["seconds"], "peak_mb": result["peak_mb"], "complete": result["complete"],
                      **{name: result["operations"][name] for name in COLUMNS[2:]}})
     mean = {key: sum(row[key] for row in rows) / len(rows) for key in COLUMNS}
     return {"n": dof, **mean, "peak_mb": max(row["peak_mb"] for row in rows),
             "max_seconds": max(row["seconds"] for row in rows), "exact": sum(row["complete"] for row in rows)}
-
-
-def slope(xs, ys) -> float:
-    """Least-squares slope of log(y) against log(x)."""
-    lx, ly = [math.log(x) for x in xs], [math.log(y) for y in ys]
-    mx, my = sum(lx) / len(lx), sum(ly) / len(ly)
-    return sum((a - mx) * (b - my) for a, b in zip(lx, ly)) / sum((a - mx) ** 2 for a in lx)
 
 
 def main() -> None:
@@ -64,7 +55,7 @@ def main() -> None:
     for label, chosen in (("all sizes", rows), ("n >= 6", [row for row in rows if row["n"] >= 6])):
         if len(chosen) >= 2:
             sizes = [row["n"] for row in chosen]
-            slopes = ", ".join(f"{key} n^{slope(sizes, [row[key] for row in chosen]):.2f}" for key in COLUMNS
+            slopes = ", ".join(f"{key} n^{common.slope(sizes, [row[key] for row in chosen]):.2f}" for key in COLUMNS
                                if all(row[key] > 0 for row in chosen))  # a log needs positive values
             print(f"log-log slopes ({label}): {slopes}")
 

@@ -2,10 +2,11 @@
 
     PYTHONPATH=. python bench/bench_second_order.py [--calls 200000] [--rounds 7] [--sizes 2,3,4,6,8,10,12,16,24] [--repeats 3]
 
-One C++ program, compiled with -O2 against Pinocchio (from the `pin` wheel) and linked with
-jacgen's generated C (double, compiled as C with -O2, its own translation unit), times per
-robot and per round, in the same loop (the joint vector changes every call, results go to
-a sink):
+One C++ program (common.py's harness, compiled as C++ with its flags, -O2, against
+Pinocchio from the `pin` wheel; Eigen's headers come from `pip install cmeel-eigen`) linked
+with jacgen's generated C (double, compiled as C with the same flags, its own translation
+unit), times per robot and per round, after a warm-up round, in the same loop (the joint
+vector changes every call, q_dot is fixed, results go to a sink):
 
 - ours fk_jacobian: `NAME_fk_jacobian(q, T, J)`;
 - ours fk_jacobian_dot: `NAME_fk_jacobian_dot(q, q_dot, T, J, a)` (T, J and J' q_dot);
@@ -13,135 +14,61 @@ a sink):
 - pinocchio dot: forwardKinematics + computeJointJacobiansTimeVariation, then the frame's
   J and J' (getFrameJacobian, getFrameJacobianTimeVariation, LOCAL_WORLD_ALIGNED) and J' q_dot.
 
-The Pinocchio models are built from the robot files (tests/test_external_libraries.py), so
-both sides compute the same numbers; the table shows medians over the rounds in ns per
-call, then the operation counts. Then the mean operation count of bias_acceleration over
-random arms of each size (tests/random_arms.py) and its log-log slope against the joint count.
+The Pinocchio models are built from the robot files (`pinocchio_from_dh`, from the test
+suite through common.py), so both sides compute the same numbers; the table shows medians
+over the rounds in ns per call, then the operation counts. Then the mean operation count of
+bias_acceleration over random arms of each size (`random_arm_text`, the test suite's seeded
+arms) and its log-log slope against the joint count.
 """
 
 import argparse
-import statistics
-import subprocess
-import sys
 import tempfile
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parent.parent
-sys.path[:0] = [str(ROOT), str(ROOT / "bench"), str(ROOT / "tests")]
-
-from bench_peers import PINOCCHIO_DEFINITIONS, PREFIX  # noqa: E402
-from bench_scaling import slope  # noqa: E402
-from jacgen.functions import Generator  # noqa: E402
-from jacgen.render import render_robot, write_files  # noqa: E402
-from jacgen.robot import load_robot, parse_robot  # noqa: E402
+import common
+from common import random_arm_text
+from jacgen.functions import Generator
+from jacgen.robot import parse_robot
 
 ROBOTS = ("puma560", "ur5", "panda")
 VARIANTS = ("ours fk_jacobian", "ours fk_jacobian_dot", "pinocchio fk_jacobian", "pinocchio dot")
+VELOCITY = "double qd[{n}]; for (int j = 0; j < {n}; ++j) qd[j] = 0.5 - 0.1 * (double)j;"  # q_dot, every call
 
-HARNESS = """
-#include <pinocchio/multibody.hpp>
-#include <pinocchio/algorithm/kinematics.hpp>
-#include <pinocchio/algorithm/jacobian.hpp>
-#include <pinocchio/algorithm/frames.hpp>
-#include <pinocchio/serialization.hpp>
-#include <chrono>
-#include <cstdio>
-#include <cstdlib>
-#include <string>
-extern "C" {
-%(declarations)s
-}
 
-template <class F> static double time_per_call(long calls, int n, F body)
-{
-    double q[32], qd[32];
-    for (int j = 0; j < n; ++j) qd[j] = 0.5 - 0.1 * j;
-    const auto t0 = std::chrono::steady_clock::now();
-    for (long i = 0; i < calls; ++i) {
-        const double step = (double)(i & 1023) * 1e-6;
-        for (int j = 0; j < n; ++j) q[j] = 0.3 + 0.1 * j + step * (double)(j + 1);
-        body(q, qd);
-    }
-    const auto t1 = std::chrono::steady_clock::now();
-    return std::chrono::duration<double, std::nano>(t1 - t0).count() / (double)calls;
-}
-
-int main(int argc, char **argv)
-{
-    const long calls = std::atol(argv[1]);
-    const int rounds = std::atoi(argv[2]);
-    volatile double sink = 0;
-    double T[16], J[6 * 32], a[6];
-    for (int round = 0; round < rounds; ++round) {
-%(robots)s
-    }
-    return sink != sink;
-}
-"""
-
-ROBOT = """
-        {
-            pinocchio::Model model;
-            model.loadFromBinary(argv[%(index)d]);
-            pinocchio::Data data(model);
-            const pinocchio::FrameIndex frame = model.getFrameId("tool");
-            const int n = %(dof)d;
-            Eigen::VectorXd q(n), v(n);
-            pinocchio::Data::Matrix6x Jp = pinocchio::Data::Matrix6x::Zero(6, n), Jdp = Jp;
-            std::printf("%(name)s ours_fk_jacobian %%d %%.3f\\n", round, time_per_call(calls, n, [&](double *x, double *) {
-                %(name)s_fk_jacobian(x, T, J); sink = sink + T[3] + J[6 * n - 1]; }));
-            std::printf("%(name)s ours_fk_jacobian_dot %%d %%.3f\\n", round, time_per_call(calls, n, [&](double *x, double *xd) {
-                %(name)s_fk_jacobian_dot(x, xd, T, J, a); sink = sink + T[3] + J[6 * n - 1] + a[5]; }));
-            std::printf("%(name)s pinocchio_fk_jacobian %%d %%.3f\\n", round, time_per_call(calls, n, [&](double *x, double *) {
-                for (int j = 0; j < n; ++j) q[j] = x[j];
-                pinocchio::forwardKinematics(model, data, q);
-                pinocchio::computeFrameJacobian(model, data, q, frame, pinocchio::LOCAL_WORLD_ALIGNED, Jp);
-                sink = sink + data.oMf[frame].translation()[0] + Jp(5, n - 1); }));
-            std::printf("%(name)s pinocchio_dot %%d %%.3f\\n", round, time_per_call(calls, n, [&](double *x, double *xd) {
-                for (int j = 0; j < n; ++j) { q[j] = x[j]; v[j] = xd[j]; }
-                pinocchio::forwardKinematics(model, data, q);
-                pinocchio::computeJointJacobiansTimeVariation(model, data, q, v);
-                pinocchio::updateFramePlacement(model, data, frame);
-                pinocchio::getFrameJacobian(model, data, frame, pinocchio::LOCAL_WORLD_ALIGNED, Jp);
-                pinocchio::getFrameJacobianTimeVariation(model, data, frame, pinocchio::LOCAL_WORLD_ALIGNED, Jdp);
-                const Eigen::VectorXd acc = Jdp * v;
-                sink = sink + data.oMf[frame].translation()[0] + Jp(5, n - 1) + acc[5]; }));
-        }
-"""
+def dot_loops(robot) -> list[common.Loop]:
+    """jacgen's fk_jacobian_dot, and Pinocchio's J, J' and J' q_dot of the tool frame."""
+    name, n, model, velocity = robot.name, robot.dof, f"model_{robot.name}", VELOCITY.format(n=robot.dof)
+    ours = common.Loop(name, VARIANTS[1], n, f"{name}_fk_jacobian_dot(q, qd, T, J, a);",
+                       f"T[3] + J[{6 * n - 1}] + a[5]", setup=f"double T[16], J[{6 * n}], a[6]; {velocity}")
+    pinocchio = common.Loop(
+        name, VARIANTS[3], n,
+        f"for (int j = 0; j < {n}; ++j) x[j] = q[j]; "
+        f"pinocchio::forwardKinematics({model}, data, x); "
+        f"pinocchio::computeJointJacobiansTimeVariation({model}, data, x, v); "
+        f"pinocchio::updateFramePlacement({model}, data, frame); "
+        f"pinocchio::getFrameJacobian({model}, data, frame, pinocchio::LOCAL_WORLD_ALIGNED, Jp); "
+        f"pinocchio::getFrameJacobianTimeVariation({model}, data, frame, pinocchio::LOCAL_WORLD_ALIGNED, Jdp); "
+        "const Eigen::VectorXd acc = Jdp * v;",
+        f"data.oMf[frame].translation()[0] + Jp(5, {n - 1}) + acc[5]",
+        setup=f"{common.pinocchio_setup(robot)} pinocchio::Data::Matrix6x Jdp = Jp; Eigen::VectorXd v({n}); "
+              f"{velocity} for (int j = 0; j < {n}; ++j) v[j] = qd[j];")
+    return [ours, pinocchio]
 
 
 def native_table(calls: int, rounds: int) -> None:
-    from test_external_libraries import pinocchio_from_dh
-
-    robots = [load_robot(ROOT / "robots" / f"{name}.yaml") for name in ROBOTS]
+    robots = [common.shipped(name) for name in ROBOTS]
     with tempfile.TemporaryDirectory(prefix="jacgen-bench-") as temporary:
         folder = Path(temporary)
-        sources, declarations, blocks, arguments = [], [], [], []
-        for index, robot in enumerate(robots):
-            write_files(render_robot(robot, ("c",), "double"), folder)
-            sources.append(folder / robot.name / f"{robot.name}.c")
-            declarations.append(f'#include "{folder / robot.name / robot.name}.h"')
-            pinocchio_from_dh(robot).saveToBinary(str(folder / f"{robot.name}.pin"))
-            arguments.append(str(folder / f"{robot.name}.pin"))
-            blocks.append(ROBOT % {"index": 3 + index, "dof": robot.dof, "name": robot.name})
-        objects = []
-        for source in sources:
-            objects.append(source.with_suffix(".o"))
-            subprocess.run(["gcc", "-std=c99", "-O2", "-c", "-o", str(objects[-1]), str(source)], check=True)
-        (folder / "harness.cpp").write_text(HARNESS % {"declarations": "\n".join(declarations),
-                                                       "robots": "".join(blocks)})
-        include, lib = PREFIX / "include", PREFIX / "lib"
-        subprocess.run(["g++", "-std=c++17", "-O2", "-DNDEBUG", *PINOCCHIO_DEFINITIONS, f"-I{include}",
-                        f"-I{include / 'eigen3'}", "-o", str(folder / "harness"), str(folder / "harness.cpp"),
-                        *map(str, objects), f"-L{lib}", f"-Wl,-rpath,{lib}", "-lpinocchio_default",
-                        "-lboost_serialization", "-lm"], check=True)
-        output = subprocess.run([str(folder / "harness"), str(calls), str(rounds), *arguments],
-                                check=True, capture_output=True, text=True).stdout
-    times: dict[tuple[str, str], list[float]] = {}
-    for line in output.splitlines():
-        name, variant, _, nanoseconds = line.split()
-        times.setdefault((name, variant.replace("_", " ", 1)), []).append(float(nanoseconds))
-    median = {key: statistics.median(values) for key, values in times.items()}
+        sources = [common.generate(robot, folder) / f"{robot.name}.c" for robot in robots]
+        loops = []
+        for robot in robots:
+            loops += [common.fk_jacobian_loop(robot, VARIANTS[0]),
+                      common.pinocchio_fk_jacobian_loop(robot, VARIANTS[2]), *dot_loops(robot)]
+        models, setup, arguments = common.pinocchio_models(robots, folder)
+        header = "\n".join([models] + [f'#include "{robot.name}.h"' for robot in robots])
+        program = common.build(folder, "harness", common.harness(loops, header, setup), sources, "c++",
+                               common.PINOCCHIO_OPTIONS, common.PINOCCHIO_LIBRARIES)
+        median = common.run_loops(program, calls, rounds, *arguments)
     print(f"ns per call, median of {rounds} rounds of {calls} calls (one C++ harness, -O2)")
     print(f"{'robot':8} " + " ".join(f"{v:>22}" for v in VARIANTS) + f" {'dot / fk_jac':>12} {'ours / pin dot':>14}")
     for robot in robots:
@@ -160,8 +87,6 @@ def scaling_table(sizes: list[int], repeats: int) -> None:
     Jacobian is linear in n (bench_scaling: slope 0.94 up to 32 joints), and bias_acceleration
     adds O(1) per joint to it; small arms have more zero terms, so per-joint counts grow
     until about 8 joints."""
-    from random_arms import random_arm_text
-
     print(f"random arms (revolute and prismatic, both conventions, {repeats} per size): mean operation counts")
     print(f"{'n':>3} {'bias_acceleration':>18} {'jacobian':>9} {'ratio':>6} {'bias per joint':>15}")
     counts = []
@@ -177,8 +102,8 @@ def scaling_table(sizes: list[int], repeats: int) -> None:
     for label, rows in (("all sizes", counts), ("from 8 joints up", [c for c in counts if c[0] >= 8])):
         if len(rows) > 1:
             sizes_, biases, jacobians = zip(*rows)
-            print(f"log-log slope against n, {label}: bias_acceleration {slope(sizes_, biases):.2f}, "
-                  f"jacobian {slope(sizes_, jacobians):.2f}")
+            print(f"log-log slope against n, {label}: bias_acceleration {common.slope(sizes_, biases):.2f}, "
+                  f"jacobian {common.slope(sizes_, jacobians):.2f}")
 
 
 def main() -> None:
