@@ -5,7 +5,7 @@ Python puts bench/ first on sys.path, and a bench's `import common` puts the rep
 root there (for `jacgen`) and appends tests/ (for the seeded arms and the test suite's
 builders of peer models). Benches reach tests/ only through this module: `random_arm_text`,
 `without_limits`, `kinematic_chain` and `pinocchio_from_dh` are imported from it, each from
-its test module when first asked for (FROM_TESTS), so a bench loads only what it uses.
+tests/support/ when first asked for (FROM_TESTS), so a bench loads only what it uses.
 No bench imports another bench.
 
 Timer policy, for Python and native timings alike: one untimed warm-up round, then the
@@ -60,7 +60,7 @@ from jacgen.robot import load_robot  # noqa: E402
 
 # What benches take from tests/: {name: the module of tests/ that defines it}.
 FROM_TESTS = {"random_arm_text": "support.random_arms", "pinocchio_from_dh": "support.pinocchio_chain",
-              "without_limits": "conftest", "kinematic_chain": "test_ik"}
+              "without_limits": "support.ik", "kinematic_chain": "support.ik"}
 
 
 def from_tests(name: str):

@@ -2,14 +2,12 @@
 modules share beyond these is in tests/support/ (`generated`, the fixture of generated and
 compiled code, is registered here)."""
 
-import re
 from pathlib import Path
 
 import numpy as np
 import pytest
 
 from jacgen import load_robot
-from jacgen.robot import parse_robot
 from support.generated import generated, import_file  # noqa: F401 (the fixture, and the loader tests use)
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -35,13 +33,6 @@ def pytest_addoption(parser):
 
 def robot(name: str):
     return load_robot(ROOT / "robots" / f"{name}.yaml")
-
-
-def without_limits(arm):
-    """The arm read from its file with every `limits: [...]` removed (for the ik's branches
-    alone: every solution, none dropped by the limits)."""
-    text = re.sub(r",\s*limits: \[[^]]*\]", "", open(arm.source).read())
-    return parse_robot(text.encode(), arm.source)
 
 
 def generated_module(name: str, suffix: str = ""):

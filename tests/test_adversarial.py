@@ -29,8 +29,8 @@ from jacgen.robot import parse_robot
 
 from conftest import ROOT
 
-# SPEC §3: the files of robot NAME, by language.
-SPEC_FILES = {"c": ("{name}.h", "{name}.c"), "python": ("{name}.py",), "casadi": ("{name}_casadi.py",),
+# contract §3: the files of robot NAME, by language.
+CONTRACT_FILES = {"c": ("{name}.h", "{name}.c"), "python": ("{name}.py",), "casadi": ("{name}_casadi.py",),
               "report": ("{name}.md",)}
 
 
@@ -206,7 +206,7 @@ def tree(folder: Path) -> dict[str, bytes]:
 
 
 def expected_files(name: str) -> set[str]:
-    return {f"{name}/{pattern.format(name=name)}" for language in DEFAULT_LANGUAGES for pattern in SPEC_FILES[language]}
+    return {f"{name}/{pattern.format(name=name)}" for language in DEFAULT_LANGUAGES for pattern in CONTRACT_FILES[language]}
 
 
 def test_generate_writes_only_into_the_output_folder(tmp_path, monkeypatch):

@@ -1,5 +1,5 @@
-"""The C99 backend: SPEC §3 signatures, a header C++ can include, and the C of test robots
-with runtime parameters, a function that reads no joint, a scalar result and a function SPEC
+"""The C99 backend: contract §3 signatures, a header C++ can include, and the C of test robots
+with runtime parameters, a function that reads no joint, a scalar result and a function the contract
 does not name, against jacgen.reference. The shipped robots' C is verified, and compiled
 warning-free for the host and a Cortex-M4F, by tests/test_shipped_robots.py.
 """
@@ -101,7 +101,7 @@ def test_runtime_parameters(tmp_path, real):
 
 
 def test_functions_beyond_spec_render_generically(tmp_path, monkeypatch):
-    """A scalar function returns NAME_real; an output SPEC does not name gets its literal size."""
+    """A scalar function returns NAME_real; an output the contract does not name gets its literal size."""
     def functions(self):
         pose = self.chain.tool
         position = pose[:3, 3]

@@ -1,5 +1,5 @@
 """Generated C on NaN, infinite and huge inputs: no undefined behaviour (UBSan, including
-float-to-int casts), statuses instead of garbage where the SPEC promises them."""
+float-to-int casts), statuses instead of garbage where the contract promises them."""
 
 import shutil
 import subprocess

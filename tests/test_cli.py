@@ -1,4 +1,4 @@
-"""The command line (SPEC §4): version, generate and its idempotence, --check with a diff,
+"""The command line (contract §4): version, generate and its idempotence, --check with a diff,
 usage mistakes as one line. (Byte-identical output under any PYTHONHASHSEED: test_golden.)"""
 
 import re

@@ -76,7 +76,7 @@ def test_c_ik_gives_back_every_configuration(c_solver, name):
 
 
 def test_targets_out_of_reach_or_not_finite_give_no_solution():
-    arm, module = robot("jaco"), generated_module("jaco")
+    module = generated_module("jaco")
     far = np.eye(4)
     far[:3, 3] = (5.0, 0.0, 0.0)  # the Jaco reaches about 1 m
     bad = np.full((4, 4), np.nan)

@@ -19,7 +19,7 @@ from jacgen import reference
 from jacgen.robot import parse_robot
 
 from conftest import random_configurations, robot
-from support.ik import regular, target_error, wrapped_distance
+from support.ik import kinematic_chain, regular, target_error, wrapped_distance
 
 WITH_IK = ["planar_2r", "planar_3r", "scara", "rexarm", "puma560", "kr5", "stanford", "ur5"]
 FREE_JOINT = ["iiwa", "panda"]  # closed form with a free joint: tests/test_free_joint.py
@@ -85,22 +85,6 @@ def test_round_trip_of_random_configurations(modules, name):
                 "rexarm": {4, 8}, "kr5": {4, 8}, "ur5": {2, 4, 6, 8}}[name]
     assert set(counts) <= expected and max(counts) == max(expected)
     assert module.MAX_IK_SOLUTIONS == max(expected)
-
-
-def kinematic_chain(arm):
-    """The arm as EAIK and ik-geo take it, from jacgen.reference at q = 0: axes H, offsets P
-    between points on consecutive axes, and the tool rotation (theirs is the identity at q = 0).
-    When axes 4, 5, 6 meet, their points are moved to the common point (ik-geo needs that)."""
-    frames, tool = reference.frames(arm, np.zeros(arm.dof))
-    points = [frame[:3, 3] for frame in frames]
-    H = np.array([frame[:3, 2] for frame in frames])
-    projections = [np.eye(3) - np.outer(h, h) for h in H[3:]]
-    centre = np.linalg.lstsq(np.vstack(projections), np.concatenate(
-        [m @ p for m, p in zip(projections, points[3:])]), rcond=None)[0]
-    if all(np.linalg.norm(m @ (centre - p)) < 1e-12 for m, p in zip(projections, points[3:])):
-        points[3:] = [centre] * 3
-    P = np.array([points[0]] + [b - a for a, b in zip(points, points[1:])] + [tool[:3, 3] - points[-1]])
-    return H, P, tool[:3, :3]
 
 
 def _real_solutions(solutions):

@@ -13,8 +13,8 @@ import pytest
 
 from jacgen import reference
 
-from conftest import ROBOT_NAMES, random_configurations, robot, without_limits
-from support.ik import reference_js, regular, target_error, wrapped_distance
+from conftest import ROBOT_NAMES, random_configurations, robot
+from support.ik import reference_js, regular, target_error, without_limits, wrapped_distance
 
 ROBOTS = ["puma560", "ur5", "stanford", "rexarm", "planar_3r", "scara"]
 BACKENDS = ["c", "numpy", "numpy_batch", "casadi"]

@@ -2,11 +2,13 @@
 regular, how far a reached target is from its target, joint distances modulo 2 pi, and the
 Jacobian Js that velocity_ik inverts."""
 
+import re
+
 import numpy as np
 
 from jacgen import reference
-
-EULER = ("roll", "pitch", "yaw")
+from jacgen.robot import EULER_ANGLES as EULER
+from jacgen.robot import parse_robot
 
 
 def wrapped(angles):
@@ -58,3 +60,26 @@ def reference_js(arm, q):
     rates = np.linalg.solve(E, J[3:])
     rows = {"x": J[0], "y": J[1], "z": J[2], "roll": rates[0], "pitch": rates[1], "yaw": rates[2]}
     return np.array([rows[c] for c in arm.task])
+
+
+def without_limits(arm):
+    """The arm read from its file with every `limits: [...]` removed (for the ik's branches
+    alone: every solution, none dropped by the limits)."""
+    text = re.sub(r",\s*limits: \[[^]]*\]", "", open(arm.source).read())
+    return parse_robot(text.encode(), arm.source)
+
+
+def kinematic_chain(arm):
+    """The arm as EAIK and ik-geo take it, from jacgen.reference at q = 0: axes H, offsets P
+    between points on consecutive axes, and the tool rotation (theirs is the identity at q = 0).
+    When axes 4, 5, 6 meet, their points are moved to the common point (ik-geo needs that)."""
+    frames, tool = reference.frames(arm, np.zeros(arm.dof))
+    points = [frame[:3, 3] for frame in frames]
+    H = np.array([frame[:3, 2] for frame in frames])
+    projections = [np.eye(3) - np.outer(h, h) for h in H[3:]]
+    centre = np.linalg.lstsq(np.vstack(projections), np.concatenate(
+        [m @ p for m, p in zip(projections, points[3:])]), rcond=None)[0]
+    if all(np.linalg.norm(m @ (centre - p)) < 1e-12 for m, p in zip(projections, points[3:])):
+        points[3:] = [centre] * 3
+    P = np.array([points[0]] + [b - a for a, b in zip(points, points[1:])] + [tool[:3, 3] - points[-1]])
+    return H, P, tool[:3, :3]
