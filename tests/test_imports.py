@@ -86,3 +86,13 @@ def test_only_the_checkers_import_the_reference():
     modules = {module_name(path) for path in paths}
     readers = {module_name(path) for path in paths if "jacgen.reference" in imports(path, modules)}
     assert readers and readers <= CHECKERS, readers - CHECKERS
+
+
+def test_every_package_is_installed():
+    """`pip install .` (not editable) installs the packages pyproject.toml lists: each folder of
+    jacgen/ with an __init__.py must be among them, or the installed jacgen cannot import it."""
+    import tomllib
+
+    listed = set(tomllib.loads((PACKAGE.parent / "pyproject.toml").read_text())["tool"]["setuptools"]["packages"])
+    found = {module_name(path.parent / "__init__.py") for path in PACKAGE.rglob("__init__.py")}
+    assert found <= listed, found - listed
