@@ -60,7 +60,7 @@ from jacgen.robot import load_robot  # noqa: E402
 
 # What benches take from tests/: {name: the module of tests/ that defines it}.
 FROM_TESTS = {"random_arm_text": "support.random_arms", "pinocchio_from_dh": "support.pinocchio_chain",
-              "without_limits": "support.ik", "kinematic_chain": "support.ik"}
+              "without_limits": "support.ik", "kinematic_chain": "support.ik", "wrapped": "support.ik"}
 
 
 def from_tests(name: str):
@@ -389,17 +389,12 @@ def native_ik(robot, source: Path, targets: np.ndarray, rounds: int, folder: Pat
     return median(float(row[1]) for row in rows) / 1e3, int(rows[-1][2])
 
 
-def wrapped(angles: np.ndarray) -> np.ndarray:
-    """Angles (or differences of angles) wrapped into [-pi, pi)."""
-    return (angles + np.pi) % (2 * np.pi) - np.pi
-
-
 def ik_quality(robot, q: np.ndarray, targets: np.ndarray, found: list) -> tuple[float, float, float]:
     """The mean number of solutions per pose, the share of poses whose configuration (a row of
     q) is among them (every joint within 1e-6 rad, modulo 2 pi), and the share of solutions
     off their target by more than 1e-8 (largest entry of the 4x4 difference, jacgen.reference fk)."""
     found = [np.asarray(s, dtype=float).reshape(-1, robot.dof) for s in found]
-    recovered = sum(len(s) > 0 and np.abs(wrapped(s - row)).max(axis=1).min() < 1e-6 for s, row in zip(found, q))
+    recovered = sum(len(s) > 0 and np.abs(from_tests("wrapped")(s - row)).max(axis=1).min() < 1e-6 for s, row in zip(found, q))
     errors = [np.abs(reference.fk(robot, x) - T).max() for s, T in zip(found, targets) for x in s]
     return (float(np.mean([len(s) for s in found])), recovered / len(q),
             sum(e > 1e-8 for e in errors) / max(len(errors), 1))

@@ -48,11 +48,15 @@ def compile_shared(sources: list[Path], output: Path, flags: tuple[str, ...] = (
                *(str(source) for source in sources), "-lm"]
     result = subprocess.run(command, capture_output=True, text=True)
     if result.returncode != 0:
-        lines = result.stderr.splitlines()
-        first = next((line for line in lines if " error: " in line), lines[0] if lines else "no output")
         names = ", ".join(Path(source).name for source in sources)
-        raise CompileError(f"{compiler} failed on {names}: {first.strip()}")
+        raise CompileError(f"{compiler} failed on {names}: {first_error(result.stderr)}")
     return output
+
+
+def first_error(output: str) -> str:
+    """The line of a compiler's (or tool's) output worth one error line: its first error."""
+    lines = output.splitlines()
+    return next((line for line in lines if " error: " in line), lines[0] if lines else "no output").strip()
 
 
 class CLibrary:

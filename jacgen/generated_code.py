@@ -11,10 +11,13 @@ import numpy as np
 from .compile import CLibrary
 from .catalogue import Function
 from .robot import Robot
-from .target import Emulator
+from .target import FLOAT_IK_TOL, Emulator
 
 HOST_BACKENDS = ("python", "casadi", "c double", "c float")  # what `jacgen verify` compares on the host
 TARGET_BACKENDS = {"cortex-m4f": "cortex-m4f float"}  # `verify --target`: the target's float C alone
+# ik_numeric as verify runs it: up to this many steps, to this |error| by real type.
+IK_NUMERIC_STEPS = 200
+IK_NUMERIC_TOL = {"double": 1e-12, "float": FLOAT_IK_TOL}
 
 
 def import_module(path: Path, module_name: str):
@@ -32,37 +35,34 @@ class GeneratedCode:
                  emulator: Emulator | None = None):
         self.robot, self.emulator = robot, emulator
         self.names = HOST_BACKENDS if emulator is None else (TARGET_BACKENDS["cortex-m4f"],)
-        self.functions = {f.name: f for f in functions}
+        self.nominal = {p.name: p.value for p in robot.symbolic_parameters}  # keywords of the Python functions
         if emulator is None:
             self.python = import_module(folder / "double" / robot.name / f"{robot.name}.py", f"_jacgen_verify_{robot.name}")
             self.casadi = import_module(folder / "double" / robot.name / f"{robot.name}_casadi.py",
                                   f"_jacgen_verify_{robot.name}_casadi")
+            # CasADi's functions take the parameters as one trailing vector
+            self.casadi_parameters = [list(self.casadi.PARAMETERS.values())] if self.nominal else []
         self.c = {real: CLibrary(path, robot, functions, real) for real, path in libraries.items()}
 
     def evaluate(self, backend: str, name: str, q: np.ndarray, *more: np.ndarray) -> np.ndarray:
         """(k, size) results at the rows of q (and of q_dot, for the functions that take it),
         each output row-major, several outputs side by side, at the nominal parameter values."""
-        nominal = {p.name: p.value for p in self.robot.symbolic_parameters}
         if backend == "python":
             with np.errstate(divide="ignore", invalid="ignore"):  # NaN at Euler singularities
-                return _side_by_side(getattr(self.python, name)(q, *more, **nominal), len(q))
+                return _side_by_side(getattr(self.python, name)(q, *more, **self.nominal), len(q))
         if backend == "casadi":
             function = getattr(self.casadi, name)
-            extra = [list(self.casadi.PARAMETERS.values())] if nominal else []
-            return np.vstack([_side_by_side(function(*rows, *extra), 1) for rows in zip(q, *more)])
+            return np.vstack([_side_by_side(function(*rows, *self.casadi_parameters), 1) for rows in zip(q, *more)])
         if self.emulator is not None:
             return self.emulator.evaluate(name, q, *more)
         return self.c[backend.split()[1]].evaluate(name, q, *more)
 
-
     def velocity_ik(self, backend: str, q: np.ndarray, mu_dot: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """velocity_ik without damping at each row of q and mu_dot: (q_dot (k, dof), status (k,))."""
-        nominal = {p.name: p.value for p in self.robot.symbolic_parameters}
         if backend == "python" or not len(q):
-            return self.python.velocity_ik(q, mu_dot, **nominal)
+            return self.python.velocity_ik(q, mu_dot, **self.nominal)
         if backend == "casadi":
-            extra = [list(self.casadi.PARAMETERS.values())] if nominal else []
-            rows = [self.casadi.velocity_ik(x, rates, 0.0, *extra) for x, rates in zip(q, mu_dot)]
+            rows = [self.casadi.velocity_ik(x, rates, 0.0, *self.casadi_parameters) for x, rates in zip(q, mu_dot)]
             return (np.array([q_dot.full().ravel() for q_dot, _ in rows]).reshape(len(q), -1),
                     np.array([float(status) for _, status in rows]))
         if self.emulator is not None:
@@ -76,41 +76,36 @@ class GeneratedCode:
         target, and the target's own check of them (None on the host)."""
         if self.emulator is not None:
             return self.emulator.ik(targets, free)
-        nominal = {p.name: p.value for p in self.robot.symbolic_parameters}
 
         def solve(target: np.ndarray, *angle: float) -> np.ndarray:
             if backend == "python":
-                return self.python.ik(target, *angle, **nominal)
-            if backend == "casadi":
-                return _casadi_ik(self.casadi, nominal, target, *angle)
+                return self.python.ik(target, *angle, **self.nominal)
+            if backend == "casadi":  # every branch, its validity and its limits: keep the solutions
+                q, valid, in_limits = self.casadi.ik(_column(target), *angle, *self.casadi_parameters)
+                return q.full()[(valid.full() * in_limits.full()).ravel() == 1]
             return self.c[backend.split()[1]].ik(target, max_solutions, None, *angle)
 
-        given = [()] * len(targets) if free is None else [(value,) for value in free]
-        return [np.reshape(solve(target, *angle), (-1, self.robot.dof)) for target, angle in zip(targets, given)], None
+        return [np.reshape(solve(target, *angle), (-1, self.robot.dof)) for target, angle in _with_free(targets, free)], None
 
     def ik_branches(self, backend: str, targets: np.ndarray, free: np.ndarray | None,
                     max_solutions: int) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
         """ik_branches at each target: every branch (k, m, dof) and whether each is valid and
         inside the limits (k, m); None where the backend has no ik_branches (general 6R: only C
         and Python, as loops around the eigensolver)."""
-        given = [()] * len(targets) if free is None else [(value,) for value in free]
         if self.emulator is not None:
             return self.emulator.ik_branches(targets, free) if "ik_branches" in self.emulator.calls else None
-        nominal = {p.name: p.value for p in self.robot.symbolic_parameters}
         if backend == "python":
-            found = self.python.ik_branches(targets, *(() if free is None else (free,)), **nominal)
+            found = self.python.ik_branches(targets, *(() if free is None else (free,)), **self.nominal)
         elif backend == "casadi":
             if not hasattr(self.casadi, "ik_branches"):
                 return None
-            extra = [list(self.casadi.PARAMETERS.values())] if nominal else []
-            rows = [[value.full() for value in self.casadi.ik_branches(target if target.ndim == 2 else target[:, None],
-                                                                       *angle, *extra)]
-                    for target, angle in zip(targets, given)]
+            rows = [[value.full() for value in self.casadi.ik_branches(_column(target), *angle, *self.casadi_parameters)]
+                    for target, angle in _with_free(targets, free)]
             found = [np.array(values) for values in zip(*rows)]
         else:
             library = self.c[backend.split()[1]]
             found = [np.array(values) for values in zip(*(library.ik_branches(target, max_solutions, *angle)
-                                                           for target, angle in zip(targets, given)))]
+                                                           for target, angle in _with_free(targets, free)))]
         q, valid, in_limits = (np.asarray(value) for value in found)
         count = len(targets)
         return (q.reshape(count, -1, self.robot.dof), valid.reshape(count, -1).astype(bool),
@@ -120,36 +115,35 @@ class GeneratedCode:
                    free: np.ndarray | None) -> tuple[np.ndarray, np.ndarray] | None:
         """ik_nearest at each target from each seed: (q (k, dof), status (k,)); None where the
         backend has none."""
-        given = [()] * len(targets) if free is None else [(value,) for value in free]
         if self.emulator is not None:
             return self.emulator.ik_nearest(targets, seeds, weights, free) if "ik_nearest" in self.emulator.calls else None
-        nominal = {p.name: p.value for p in self.robot.symbolic_parameters}
         if backend == "python":
-            return self.python.ik_nearest(targets, seeds, *(() if free is None else (free,)), weights, **nominal)
+            return self.python.ik_nearest(targets, seeds, *(() if free is None else (free,)), weights, **self.nominal)
         if backend == "casadi":
             if not hasattr(self.casadi, "ik_nearest"):
                 return None
-            extra = [list(self.casadi.PARAMETERS.values())] if nominal else []
-            rows = [self.casadi.ik_nearest(target if target.ndim == 2 else target[:, None], seed, *angle, weight, *extra)
-                    for target, seed, angle, weight in zip(targets, seeds, given, weights)]
+            rows = [self.casadi.ik_nearest(_column(target), seed, *angle, weight, *self.casadi_parameters)
+                    for (target, angle), seed, weight in zip(_with_free(targets, free), seeds, weights)]
             return np.array([q.full().ravel() for q, _ in rows]), np.array([float(status) for _, status in rows])
         library = self.c[backend.split()[1]]
         rows = [library.ik_nearest(target, seed, weight, *angle)
-                for target, seed, weight, angle in zip(targets, seeds, weights, given)]
+                for (target, angle), seed, weight in zip(_with_free(targets, free), seeds, weights)]
         return np.array([q for q, _ in rows]), np.array([status for _, status in rows])
 
     def ik_numeric(self, backend: str, targets: np.ndarray, starts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """ik_numeric from each start: (q (k, dof), status (k,))."""
-        nominal = {p.name: p.value for p in self.robot.symbolic_parameters}
         if self.emulator is not None:
-            return self.emulator.ik_numeric(targets, starts, 200, 1e-5)
+            return self.emulator.ik_numeric(targets, starts, IK_NUMERIC_STEPS, IK_NUMERIC_TOL["float"])
 
         def solve(target: np.ndarray, start: np.ndarray) -> tuple[np.ndarray, int]:
             if backend == "python":
-                return self.python.ik_numeric(target, start, 200, 1e-12, **nominal)
-            if backend == "casadi":
-                return _casadi_ik_numeric(self.casadi, nominal, target, start)
-            return _c_ik_numeric(self.c[backend.split()[1]], backend.split()[1], target, start)
+                return self.python.ik_numeric(target, start, IK_NUMERIC_STEPS, IK_NUMERIC_TOL["double"], **self.nominal)
+            if backend == "casadi":  # a fixed number of steps
+                q, status = self.casadi.ik_numeric(_column(target), start, IK_NUMERIC_TOL["double"],
+                                                   *self.casadi_parameters)
+                return q.full().ravel(), int(status)
+            real = backend.split()[1]
+            return self.c[real].ik_numeric(target, start, IK_NUMERIC_STEPS, IK_NUMERIC_TOL[real])
 
         found, status = zip(*(solve(target, start) for target, start in zip(targets, starts)))
         return np.array(found), np.array(status)
@@ -161,19 +155,11 @@ def _side_by_side(results, count: int) -> np.ndarray:
     return np.hstack([np.reshape(np.asarray(part), (count, -1)) for part in parts])
 
 
-def _casadi_ik(module, nominal: dict, target: np.ndarray, *free: float) -> np.ndarray:
-    """The CasADi ik's valid branches, (k, dof)."""
-    extra = [list(module.PARAMETERS.values())] if nominal else []
-    q, valid, in_limits = module.ik(target if target.ndim == 2 else target[:, None], *free, *extra)
-    return q.full()[(valid.full() * in_limits.full()).ravel() == 1]
+def _column(target: np.ndarray) -> np.ndarray:
+    """A target as CasADi takes it: a 4x4 pose as it is, a task vector as a column."""
+    return target if target.ndim == 2 else target[:, None]
 
 
-def _casadi_ik_numeric(module, nominal: dict, target: np.ndarray, start: np.ndarray) -> tuple[np.ndarray, int]:
-    """CasADi's ik_numeric (a fixed number of steps): (q, status)."""
-    extra = [list(module.PARAMETERS.values())] if nominal else []
-    q, status = module.ik_numeric(target if target.ndim == 2 else target[:, None], start, 1e-12, *extra)
-    return q.full().ravel(), int(status)
-
-
-def _c_ik_numeric(library: CLibrary, real: str, target: np.ndarray, start: np.ndarray) -> tuple[np.ndarray, int]:
-    return library.ik_numeric(target, start, 200, 1e-12 if real == "double" else 1e-5)
+def _with_free(targets: np.ndarray, free: np.ndarray | None) -> list[tuple[np.ndarray, tuple]]:
+    """Each target with the free joint's angle as a trailing argument (none without a free joint)."""
+    return [(target, () if free is None else (free[k],)) for k, target in enumerate(targets)]

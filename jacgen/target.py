@@ -21,7 +21,8 @@ from pathlib import Path
 import numpy as np
 
 from . import reference
-from .compile import WARNING_FLAGS
+from .compile import WARNING_FLAGS, first_error
+from .differential import IK_NUMERIC_DEFAULTS
 from .errors import JacgenError
 from .catalogue import FUNCTION_NAMES
 from .functions import Generator
@@ -40,6 +41,7 @@ INSTRUCTIONS_PER_TICK = 40 / 64
 PAINTED_BYTES = 65536  # the stack painted below each call: a deeper call is reported as this
 RUN_SECONDS = 300  # a run that takes longer is stopped (it hangs)
 TEMPLATES = ("runtime.h", "runtime.c", "mps2_an386.ld", "harness.c")
+FLOAT_IK_TOL = 1e-5  # ik_numeric's tol in float: |error| the float step can reach
 
 
 class TargetError(JacgenError):
@@ -58,6 +60,15 @@ class Call:
     @property
     def reads(self) -> int:
         return sum(size for _, size, _, _ in self.inputs)
+
+    @property
+    def reals(self) -> int:
+        """Values of the real output arrays (the integer ones follow them in a result)."""
+        return sum(size for size, integer in self.outputs if not integer)
+
+    @property
+    def integers(self) -> int:
+        return sum(size for size, integer in self.outputs if integer)
 
 
 @dataclass(frozen=True)
@@ -128,8 +139,7 @@ def harness_context(robot: Robot, found: list[Call]) -> dict:
     real = f"{robot.name}_real"
     cases = [{"name": call.name, "reads": call.reads, "arguments": _arguments(call, bool(robot.symbolic_parameters)),
               "returns": {"real": real, "int": "int", None: None}[call.returns],
-              "reals": sum(size for size, integer in call.outputs if not integer),
-              "integers": sum(size for size, integer in call.outputs if integer)} for call in found]
+              "reals": call.reals, "integers": call.integers} for call in found]
     target = next((call.inputs[0][1] for call in found if call.name == "ik"), None)
     pose = target == 16
     return {
@@ -147,9 +157,7 @@ def harness_context(robot: Robot, found: list[Call]) -> dict:
 def _run(command: list[str], what: str, **options) -> subprocess.CompletedProcess:
     result = subprocess.run(command, capture_output=True, text=True, **options)
     if result.returncode != 0:
-        lines = (result.stderr or result.stdout).splitlines()
-        first = next((line for line in lines if " error: " in line), lines[0] if lines else "no output")
-        raise TargetError(f"{what} failed (exit {result.returncode}): {first.strip()}")
+        raise TargetError(f"{what} failed (exit {result.returncode}): {first_error(result.stderr or result.stdout)}")
     return result
 
 
@@ -212,15 +220,14 @@ class Emulator:
             raise TargetError(f"{self.robot.name}_{name} on the emulated target: no exit after {RUN_SECONDS} s") from None
         values = np.fromfile(self.folder / "results.bin", dtype="<f8")
         empty, values = values[0], values[1:]
-        reals = sum(size for size, integer in call.outputs if not integer)
-        width = (call.returns is not None) + sum(size for size, _ in call.outputs) + (name == "ik") + 2
+        width = (call.returns is not None) + call.reals + call.integers + (name == "ik") + 2
         if values.size != count * width:
             raise TargetError(f"{self.robot.name}_{name} on the emulated target wrote {values.size} of "
                               f"{count * width} results")
         table = values.reshape(count, width)
         returned = table[:, 0] if call.returns else None
         column = call.returns is not None
-        blocks = {False: column, True: column + reals}  # where the real and the integer outputs start
+        blocks = {False: column, True: column + call.reals}  # where the real and the integer outputs start
         outputs = []
         for size, integer in call.outputs:
             outputs.append(table[:, blocks[integer]:blocks[integer] + size])
@@ -241,8 +248,8 @@ class Emulator:
         target = reference.ik_target(self.robot, q)
         values = {"q": q, "q_dot": rng.normal(size=q.shape), "mu_dot": rng.normal(size=(len(q), len(self.robot.task))),
                   "damping": np.full(len(q), 0.01), "target": target, "T": target, "mu": target,
-                  "q_seed": q + 0.1, "q0": q + 0.1, "weights": np.ones_like(q), "max_iter": np.full(len(q), 100),
-                  "tol": np.full(len(q), 1e-5), "q_free": q[:, free] if free is not None else None}
+                  "q_seed": q + 0.1, "q0": q + 0.1, "weights": np.ones_like(q),
+                  "max_iter": np.full(len(q), IK_NUMERIC_DEFAULTS["max_iter"]), "tol": np.full(len(q), FLOAT_IK_TOL), "q_free": q[:, free] if free is not None else None}
         for name in self.calls:
             if name not in self.measured:
                 self.call(name, values)

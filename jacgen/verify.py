@@ -160,7 +160,7 @@ def compare(robot: Robot, function: Function, value: np.ndarray, expected: np.nd
         compared[np.ix_(euler_singular, elements)] = False
     difference = value - expected
     if function.name == "task":
-        difference[:, elements] = (difference[:, elements] + math.pi) % (2 * math.pi) - math.pi
+        difference[:, elements] = _wrapped(difference[:, elements])
     skipped = int((~compared.all(axis=1)).sum())
     if not np.isfinite(value[compared]).all():
         return math.inf, skipped
@@ -216,6 +216,11 @@ def verify_robot(robot: Robot, backends: GeneratedCode, functions: list[Function
     return results
 
 
+def _wrapped(angles: np.ndarray) -> np.ndarray:
+    """Differences of angles in [-pi, pi)."""
+    return (angles + math.pi) % (2 * math.pi) - math.pi
+
+
 def _is_float(backend: str) -> bool:
     return backend.endswith("float")
 
@@ -248,7 +253,7 @@ def _target_error(robot: Robot, q: np.ndarray, targets: np.ndarray) -> float:
     difference = reference.ik_target(robot, q) - targets
     if len(robot.task) < 6:
         angular = [i for i, name in enumerate(robot.task) if name in EULER_ANGLES]
-        difference[:, angular] = (difference[:, angular] + math.pi) % (2 * math.pi) - math.pi
+        difference[:, angular] = _wrapped(difference[:, angular])
     return float(np.max(np.abs(difference)))
 
 
