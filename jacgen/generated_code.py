@@ -33,13 +33,14 @@ class GeneratedCode:
 
     def __init__(self, robot: Robot, functions: list[Function], folder: Path, libraries: dict[str, Path],
                  emulator: Emulator | None = None):
+        """folder: where `generate -o` wrote the double-precision Python and CasADi (folder/NAME/);
+        libraries: the compiled C by real type; emulator: the target instead of the host."""
         self.robot, self.emulator = robot, emulator
         self.names = HOST_BACKENDS if emulator is None else (TARGET_BACKENDS["cortex-m4f"],)
         self.nominal = {p.name: p.value for p in robot.symbolic_parameters}  # keywords of the Python functions
         if emulator is None:
-            self.python = import_module(folder / "double" / robot.name / f"{robot.name}.py", f"_jacgen_verify_{robot.name}")
-            self.casadi = import_module(folder / "double" / robot.name / f"{robot.name}_casadi.py",
-                                  f"_jacgen_verify_{robot.name}_casadi")
+            self.python = import_module(folder / robot.name / f"{robot.name}.py", f"_jacgen_{robot.name}")
+            self.casadi = import_module(folder / robot.name / f"{robot.name}_casadi.py", f"_jacgen_{robot.name}_casadi")
             # CasADi's functions take the parameters as one trailing vector
             self.casadi_parameters = [list(self.casadi.PARAMETERS.values())] if self.nominal else []
         self.c = {real: CLibrary(path, robot, functions, real) for real, path in libraries.items()}
@@ -57,17 +58,18 @@ class GeneratedCode:
             return self.emulator.evaluate(name, q, *more)
         return self.c[backend.split()[1]].evaluate(name, q, *more)
 
-    def velocity_ik(self, backend: str, q: np.ndarray, mu_dot: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """velocity_ik without damping at each row of q and mu_dot: (q_dot (k, dof), status (k,))."""
+    def velocity_ik(self, backend: str, q: np.ndarray, mu_dot: np.ndarray,
+                    damping: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
+        """velocity_ik at each row of q and mu_dot: (q_dot (k, dof), status (k,))."""
         if backend == "python" or not len(q):
-            return self.python.velocity_ik(q, mu_dot, **self.nominal)
+            return self.python.velocity_ik(q, mu_dot, damping, **self.nominal)
         if backend == "casadi":
-            rows = [self.casadi.velocity_ik(x, rates, 0.0, *self.casadi_parameters) for x, rates in zip(q, mu_dot)]
+            rows = [self.casadi.velocity_ik(x, rates, damping, *self.casadi_parameters) for x, rates in zip(q, mu_dot)]
             return (np.array([q_dot.full().ravel() for q_dot, _ in rows]).reshape(len(q), -1),
                     np.array([float(status) for _, status in rows]))
         if self.emulator is not None:
-            return self.emulator.velocity_ik(q, mu_dot, 0.0)
-        rows = [self.c[backend.split()[1]].velocity_ik(x, rates, 0.0) for x, rates in zip(q, mu_dot)]
+            return self.emulator.velocity_ik(q, mu_dot, damping)
+        rows = [self.c[backend.split()[1]].velocity_ik(x, rates, damping) for x, rates in zip(q, mu_dot)]
         return np.array([q_dot for q_dot, _ in rows]).reshape(len(q), -1), np.array([status for _, status in rows])
 
     def ik(self, backend: str, targets: np.ndarray, free: np.ndarray | None,
@@ -76,10 +78,11 @@ class GeneratedCode:
         target, and the target's own check of them (None on the host)."""
         if self.emulator is not None:
             return self.emulator.ik(targets, free)
+        if backend == "python":  # one batched call
+            q, keep = self.python.ik(targets, *(() if free is None else (free,)), **self.nominal)
+            return [rows[mask] for rows, mask in zip(q, keep)], None
 
         def solve(target: np.ndarray, *angle: float) -> np.ndarray:
-            if backend == "python":
-                return self.python.ik(target, *angle, **self.nominal)
             if backend == "casadi":  # every branch, its validity and its limits: keep the solutions
                 q, valid, in_limits = self.casadi.ik(_column(target), *angle, *self.casadi_parameters)
                 return q.full()[(valid.full() * in_limits.full()).ravel() == 1]
@@ -134,10 +137,10 @@ class GeneratedCode:
         """ik_numeric from each start: (q (k, dof), status (k,))."""
         if self.emulator is not None:
             return self.emulator.ik_numeric(targets, starts, IK_NUMERIC_STEPS, IK_NUMERIC_TOL["float"])
+        if backend == "python":  # one batched call
+            return self.python.ik_numeric(targets, starts, IK_NUMERIC_STEPS, IK_NUMERIC_TOL["double"], **self.nominal)
 
         def solve(target: np.ndarray, start: np.ndarray) -> tuple[np.ndarray, int]:
-            if backend == "python":
-                return self.python.ik_numeric(target, start, IK_NUMERIC_STEPS, IK_NUMERIC_TOL["double"], **self.nominal)
             if backend == "casadi":  # a fixed number of steps
                 q, status = self.casadi.ik_numeric(_column(target), start, IK_NUMERIC_TOL["double"],
                                                    *self.casadi_parameters)

@@ -415,7 +415,7 @@ def verify(robots: list[Robot], samples: int, seed: int,
             q = np.vstack([random, singular_configurations(robot, generator.singularities)])
             built = {name: build.result() for name, build in builds.items()}
             emulator = built.pop(target, None)
-            results += verify_robot(robot, GeneratedCode(robot, functions, work, built, emulator), functions, q,
+            results += verify_robot(robot, GeneratedCode(robot, functions, work / "double", built, emulator), functions, q,
                                     len(random), generator.closed_form)
             if emulator is not None:
                 emulator.measure_remaining(random, generator.closed_form and generator.closed_form.free)

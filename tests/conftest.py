@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from jacgen import load_robot
-from support.generated import generated, import_file  # noqa: F401 (the fixture, and the loader tests use)
+from support.generated import generated, import_module  # noqa: F401 (the fixture, and the loader tests use)
 
 ROOT = Path(__file__).resolve().parent.parent
 ROBOT_FILES = sorted((ROOT / "robots").glob("*.yaml"))
@@ -36,7 +36,7 @@ def robot(name: str):
 
 
 def generated_module(name: str, suffix: str = ""):
-    return import_file(GENERATED / name / f"{name}{suffix}.py", f"generated_{name}{suffix}")
+    return import_module(GENERATED / name / f"{name}{suffix}.py", f"generated_{name}{suffix}")
 
 
 def random_configurations(robot, count: int, seed: int = 0) -> np.ndarray:

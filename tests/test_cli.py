@@ -11,7 +11,7 @@ from jacgen.cli import main
 from jacgen.compile import CLibrary, compile_shared
 from jacgen.functions import Generator
 
-from conftest import ROOT, import_file, random_configurations
+from conftest import ROOT, import_module, random_configurations
 
 
 def run(*arguments):
@@ -125,7 +125,7 @@ def test_functions_option_emits_only_the_named_functions_and_their_callees(tmp_p
     expected = np.array([np.concatenate([reference.fk(robot, x).ravel(), reference.jacobian(robot, x).ravel()])
                          for x in q])
     np.testing.assert_allclose(values, expected, atol=1e-13)
-    module = import_file(tmp_path / "ur5" / "ur5.py", "ur5_selected")
+    module = import_module(tmp_path / "ur5" / "ur5.py", "ur5_selected")
     assert not hasattr(module, "jacobian") and not hasattr(module, "ik_numeric") and hasattr(module, "ik_nearest")
 
 

@@ -21,50 +21,41 @@ BACKENDS = ["c", "numpy", "numpy_batch", "casadi"]
 TOLERANCE = 1e-9
 
 
+# Our name for each backend -> the name `jacgen verify` calls it by (jacgen.generated_code); the
+# numpy module one target at a time is this file's own.
+VERIFIED = {"c": "c double", "numpy_batch": "python", "casadi": "casadi"}
+
+
 @pytest.fixture(scope="module")
 def backends(generated):
     """name -> (arm, {backend: solve}, {backend: ik_numeric}, {backend: velocity_ik}), each
-    robot generated and compiled once (the `generated` fixture)."""
+    robot generated and compiled once (the `generated` fixture). Batches are called through
+    jacgen.generated_code, as `jacgen verify` calls them; single targets through this wrapper."""
     def load(name):
         arm = without_limits(robot(name))  # these cases are about the branches (limits: test_ik_limits)
         code = generated(arm, ("c", "python", "casadi"))
-        numpy_module, casadi_module, library = code.python, code.casadi, code.library()
+        module, calls = code.python, code.backends
 
-        def batch(targets):
-            q, valid = numpy_module.ik(np.asarray(targets)[None])  # a batch of one batch
-            return [rows[mask] for rows, mask in zip(q[0], valid[0])]
+        def solve(backend):
+            return lambda targets: calls.ik(backend, np.asarray(targets), None, module.MAX_IK_SOLUTIONS)[0]
 
-        def casadi(targets):
-            found = []
-            for target in targets:
-                q, valid, _ = casadi_module.ik(target if target.ndim == 2 else target[:, None])
-                found.append(q.full()[valid.full().ravel() == 1])
-            return found
+        def numeric(backend):
+            return lambda target, q0: tuple(v[0] for v in calls.ik_numeric(backend, np.asarray(target)[None],
+                                                                             np.asarray(q0)[None]))
 
-        def casadi_velocity(q, mu_dot, damping):
-            q_dot, status = casadi_module.velocity_ik(q, mu_dot, damping)
-            return q_dot.full().ravel(), int(status)
-
-        def batch_velocity(q, mu_dot, damping):
-            q_dot, status = numpy_module.velocity_ik(np.asarray(q)[None], np.asarray(mu_dot)[None], damping)
-            return q_dot[0], int(status[0])
+        def velocity(backend):
+            return lambda q, mu_dot, damping: tuple(v[0] for v in calls.velocity_ik(
+                backend, np.asarray(q)[None], np.asarray(mu_dot)[None], damping))
 
         return arm, {
-            "c": lambda targets: [library.ik(t, max_solutions=numpy_module.MAX_IK_SOLUTIONS) for t in targets],
-            "numpy": lambda targets: [numpy_module.ik(t) for t in targets],
-            "numpy_batch": batch,
-            "casadi": casadi,
+            "numpy": lambda targets: [module.ik(t) for t in targets],
+            **{ours: solve(theirs) for ours, theirs in VERIFIED.items()},
         }, {
-            "c": library.ik_numeric,
-            "numpy": lambda target, q0, max_iter=100, tol=1e-10: numpy_module.ik_numeric(target, q0, max_iter, tol),
-            "numpy_batch": lambda target, q0, max_iter=100, tol=1e-10: tuple(
-                v[0] for v in numpy_module.ik_numeric(np.asarray(target)[None], np.asarray(q0)[None], max_iter, tol)),
-            "casadi": lambda target, q0, max_iter=100, tol=1e-10: _casadi_numeric(casadi_module, target, q0, tol),
+            "numpy": lambda target, q0: module.ik_numeric(target, q0),
+            **{ours: numeric(theirs) for ours, theirs in VERIFIED.items()},
         }, {
-            "c": library.velocity_ik,
-            "numpy": lambda q, mu_dot, damping: tuple(np.asarray(v) for v in numpy_module.velocity_ik(q, mu_dot, damping)),
-            "numpy_batch": batch_velocity,
-            "casadi": casadi_velocity,
+            "numpy": lambda q, mu_dot, damping: tuple(np.asarray(v) for v in module.velocity_ik(q, mu_dot, damping)),
+            **{ours: velocity(theirs) for ours, theirs in VERIFIED.items()},
         }
 
     return load
@@ -280,12 +271,6 @@ def test_velocity_ik_of_every_shipped_robot(generated, name):
 
 
 # -- ik_numeric -------------------------------------------------------------------------------
-
-
-def _casadi_numeric(module, target, q0, tol):
-    """CasADi's ik_numeric (IK_NUMERIC_ITERATIONS steps, no max_iter)."""
-    q, status = module.ik_numeric(target if np.ndim(target) == 2 else np.reshape(target, (-1, 1)), q0, tol)
-    return q.full().ravel(), int(status)
 
 
 @pytest.mark.parametrize("backend", BACKENDS)

@@ -19,7 +19,7 @@ rtb = pytest.importorskip("roboticstoolbox")
 from click.testing import CliRunner  # noqa: E402
 
 from jacgen.cli import main  # noqa: E402
-from conftest import import_file  # noqa: E402
+from conftest import import_module  # noqa: E402
 
 MODELS = ["AL5D", "Ball", "Baxter", "Cobra600", "Coil", "Hyper", "Hyper3d", "IRB140", "Jaco", "KR5", "LWR4",
           "Mico", "Orion5", "P8", "Panda", "Planar2", "Planar3", "Puma560", "Sawyer", "Stanford", "TwoLink",
@@ -59,7 +59,7 @@ def test_toolbox_model_generates_and_matches(tmp_path, name):
     result = CliRunner().invoke(main, ["generate", str(path), "-o", str(tmp_path)], catch_exceptions=False)
     assert result.exit_code == 0 and "warning" not in result.output, result.output
     robot_name = text.split("\n")[0].split(": ")[1]
-    module = import_file(tmp_path / robot_name / f"{robot_name}.py", f"toolbox_{robot_name}")
+    module = import_module(tmp_path / robot_name / f"{robot_name}.py", f"toolbox_{robot_name}")
     rng = np.random.default_rng(3)
     for _ in range(5):
         ours = rng.uniform(-math.pi, math.pi, model.n)

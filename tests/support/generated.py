@@ -13,26 +13,19 @@ worker, so each robot is generated and compiled once per file that asks for it.
 """
 
 import functools
-import importlib.util
 from pathlib import Path
 
 import pytest
 
+from jacgen import generated_code
 from jacgen.compile import CLibrary, compile_shared
 from jacgen.functions import Generator
+from jacgen.generated_code import import_module
 from jacgen.render import render_robot, write_files
 from jacgen.robot import Robot, load_robot
 
 ROOT = Path(__file__).resolve().parents[2]
 GENERATED = ROOT / "generated"
-
-
-def import_file(path: Path, module_name: str | None = None):
-    """Import a generated Python file by path (generated modules are not a package)."""
-    spec = importlib.util.spec_from_file_location(module_name or path.stem, path)
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
 
 
 class Code:
@@ -48,7 +41,7 @@ class Code:
         return self.folder / self.robot.name / f"{self.robot.name}{suffix}"
 
     def _import(self, suffix: str):
-        return import_file(self._path(f"{suffix}.py"), f"generated_{self.build.name}_{self.robot.name}{suffix}")
+        return import_module(self._path(f"{suffix}.py"), f"generated_{self.build.name}_{self.robot.name}{suffix}")
 
     @functools.cached_property
     def python(self):
@@ -69,6 +62,12 @@ class Code:
     def library(self, functions=()) -> CLibrary:
         """The compiled C called from Python (`functions`: those `CLibrary.evaluate` is to call)."""
         return CLibrary(self.shared_library, self.robot, list(functions), self.real)
+
+    @functools.cached_property
+    def backends(self) -> generated_code.GeneratedCode:
+        """Python, CasADi and this C, called on batches as `jacgen verify` calls them (backend
+        names "python", "casadi", "c double" or "c float")."""
+        return generated_code.GeneratedCode(self.robot, [], self.folder, {self.real: self.shared_library})
 
 
 class GeneratedCode:
