@@ -4,6 +4,7 @@ import sys
 from pathlib import Path
 
 import click
+import numpy as np
 
 from . import budget
 from .version import __version__
@@ -12,7 +13,9 @@ from .catalogue import with_callees
 from .model import Model
 from .backends import BACKENDS, DEFAULT_LANGUAGES
 from .render import render_robot, stale_files, write_files
-from .report import describe, plot_workspace
+from .compare_urdf import DEFAULT_TOLERANCE, compare_urdf, comparison_lines, first_difference
+from .drawing import default_configurations, draw
+from .report import describe
 from .robot import load_robot
 
 robot_files = click.argument("robot_files", nargs=-1, required=True, type=click.Path(dir_okay=False))
@@ -137,17 +140,44 @@ def validate(robot_files):
         click.echo(f"{path}: ok ({robot.name}, {robot.dof} joints)")
 
 
+def _configuration(ctx, param, value: str | None):
+    if value is None:
+        return None
+    try:
+        return [float(part) for part in value.split(",")]
+    except ValueError:
+        raise click.BadParameter(f"expected comma-separated numbers, got {value!r}") from None
+
+
 @main.command()
 @click.argument("robot_file", type=click.Path(dir_okay=False))
 @click.option("--plot", "plot_file", type=click.Path(dir_okay=False), default=None, metavar="FILE.png",
-              help="Also write a PNG of the manipulability over the workspace (planar arms).")
-def show(robot_file, plot_file):
-    """Describe a robot in words: DH table, task, singularities, inverse kinematics."""
+              help="Also draw the arm (3D, at q; planar arms: with the manipulability map and workspace "
+                   "boundary) into FILE (.png, .svg, .pdf); needs matplotlib.")
+@click.option("--q", "q", callback=_configuration, default=None, metavar="q1,q2,...",
+              help="The configuration to draw (radians, and lengths for prismatic joints; default: q = 0 "
+                   "and the middle of the limits).")
+@click.option("--compare-urdf", "urdf_file", type=click.Path(dir_okay=False), default=None, metavar="FILE.urdf",
+              help="Compare the joint axes and tool pose with a URDF's chain; exit 1 where they differ.")
+@click.option("--base", default=None, metavar="LINK", help="--compare-urdf: first link (default: the root).")
+@click.option("--tip", default=None, metavar="LINK", help="--compare-urdf: last link (default: the one leaf).")
+@click.option("--tolerance", default=DEFAULT_TOLERANCE, show_default=True, type=click.FloatRange(min=0),
+              help="--compare-urdf: largest difference (radians, robot's length unit) that agrees.")
+def show(robot_file, plot_file, q, urdf_file, base, tip, tolerance):
+    """Describe a robot in words (DH table, task, singularities, inverse kinematics), draw it,
+    compare it with a URDF."""
     robot = load_robot(robot_file)
+    if q is not None and len(q) != robot.dof:
+        raise JacgenError(f"--q: expected {robot.dof} values (one per joint of {robot.name}), got {len(q)}")
     click.echo(describe(Model(robot)))
     if plot_file:
-        plot_workspace(robot, plot_file)
+        draw(robot, plot_file, [np.array(q)] if q is not None else default_configurations(robot))
         click.echo(f"jacgen: wrote {plot_file}", err=True)
+    if urdf_file:
+        comparison = compare_urdf(robot, urdf_file, base, tip)
+        click.echo("\n" + "\n".join(comparison_lines(robot, urdf_file, comparison, tolerance)))
+        if first_difference(comparison, tolerance) is not None:
+            sys.exit(1)
 
 
 @main.command()

@@ -1,6 +1,6 @@
 """The DH chain in floating point, for the few numbers production needs: the configurations
-where a singularity factor vanishes and what they mean (`analysis`), and the planar maps of
-`jacgen show` (`report`). Built from the closed-form link matrices of the textbooks (Spong's
+where a singularity factor vanishes and what they mean (`analysis`), and the drawings of
+`jacgen show` (`drawing`) and its comparison with a URDF (`compare_urdf`). Built from the closed-form link matrices of the textbooks (Spong's
 standard, Craig's modified DH), apart from `jacgen.reference`, which multiplies elementary
 transforms and stays an independent oracle that no production module imports.
 
@@ -38,18 +38,23 @@ def _fixed(pose) -> np.ndarray:
                    [-sp, cp * sr, cp * cr, z], [0, 0, 0, 1]], ())
 
 
+def link_frames(robot, q) -> tuple[list[np.ndarray], np.ndarray]:
+    """The world frames 0..n of the DH table (frame 0 the base, frame i after row i), and the
+    tool's pose."""
+    q = np.asarray(q, dtype=float)
+    frames = [np.broadcast_to(_fixed(robot.base), (*q.shape[:-1], 4, 4))]
+    for i, joint in enumerate(robot.joints):
+        frames.append(frames[-1] @ _link(robot, joint, q[..., i]))
+    return frames, frames[-1] @ _fixed(robot.tool)
+
+
 def axis_frames(robot, q) -> tuple[list[np.ndarray], np.ndarray]:
     """The world frame of each joint whose z axis is the joint's axis, and the tool's pose."""
-    q = np.asarray(q, dtype=float)
-    current, frames = np.broadcast_to(_fixed(robot.base), (*q.shape[:-1], 4, 4)), []
-    for i, joint in enumerate(robot.joints):
-        link = _link(robot, joint, q[..., i])
-        if robot.convention == "standard":  # joint i turns about z of the frame before its row
-            frames.append(current)
-        else:  # about z of the frame after the row's twist Rx(alpha) Tx(a)
-            frames.append(current @ _twist(joint, q.shape[:-1]))
-        current = current @ link
-    return frames, current @ _fixed(robot.tool)
+    frames, tool = link_frames(robot, q)
+    if robot.convention == "standard":  # joint i turns about z of the frame before its row
+        return frames[:-1], tool
+    shape = np.shape(q)[:-1]  # modified: about z of the frame after the row's twist Rx(alpha) Tx(a)
+    return [frame @ _twist(joint, shape) for frame, joint in zip(frames, robot.joints)], tool
 
 
 def _twist(joint, shape) -> np.ndarray:

@@ -1,14 +1,13 @@
 """Words a person reads: DH table, task, singularities and IK of a robot (`jacgen show`,
-the generated NAME.md report), and the workspace plot of a planar arm (`show --plot`)."""
+the generated NAME.md report)."""
 
 import numpy as np
 import sympy
 
 from . import numeric_chain
 from .analysis import READABLE_TERMS, Factor, Singularities, singularity_rows
-from .errors import JacgenError
 from .model import Model
-from .robot import TASK_COMPONENTS, Robot
+from .robot import Robot
 from .structure import SOLVERS
 
 DH_HEADER = ["#", "name", "type", "a", "alpha", "d", "theta", "offset", "limits"]
@@ -97,7 +96,7 @@ def euler_lines(robot: Robot, singular: Singularities) -> list[str]:
         f"  {condition_text(robot, factor)}" for factor in singular.euler]
 
 
-def _all_axes_vertical(robot: Robot) -> bool:
+def moves_in_plane(robot: Robot) -> bool:
     """Every joint axis parallel to the world z axis (checked at a generic configuration)."""
     frames, _ = numeric_chain.axis_frames(robot, np.linspace(0.3, 0.9, robot.dof))
     return all(np.linalg.norm(np.cross(frame[:3, 2], [0.0, 0.0, 1.0])) < 1e-9 for frame in frames)
@@ -111,7 +110,7 @@ def isotropy_lines(robot: Robot) -> list[str]:
     cos(phi) = -2 l1 l2 / (l1^2 + 2 l2^2), where cond(J) = 1 exactly when l1 = sqrt(2) l2.
     """
     if not (robot.dof == 2 and all(j.revolute for j in robot.joints) and robot.task == ("x", "y")
-            and _all_axes_vertical(robot)):
+            and moves_in_plane(robot)):
         return []
     frames, tool = numeric_chain.axis_frames(robot, np.zeros(2))
     l1 = float(np.linalg.norm((frames[1][:3, 3] - frames[0][:3, 3])[:2]))
@@ -180,51 +179,3 @@ def js_text(robot: Robot) -> str:
         return "task_jacobian"
     names = ("vx", "vy", "vz", "wx", "wy", "wz")
     return "jacobian rows (" + ", ".join(names[r] for r in rows) + ")"
-
-
-def plot_workspace(robot: Robot, path: str, samples: int = 4000, ellipses: int = 6) -> None:
-    """PNG of a planar arm: tool positions coloured by manipulability, and at a few
-    configurations the arm and its velocity ellipse (J_xy J_xy^T, x and y rows)."""
-    if not _all_axes_vertical(robot):
-        raise JacgenError(f"{robot.source}: --plot needs a planar arm (every joint axis parallel to world z)")
-    try:
-        import matplotlib
-    except ImportError:
-        raise JacgenError("--plot needs matplotlib: pip install 'jacgen[plot]'") from None
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    from matplotlib.patches import Ellipse
-
-    rows = [TASK_COMPONENTS.index(c) for c in robot.task]  # planar: yaw rate = wz, roll = pitch = 0
-    rng = np.random.default_rng(0)
-    bounds = np.array(robot.ranges)
-    configurations = rng.uniform(bounds[:, 0], bounds[:, 1], size=(samples, robot.dof))
-    points, measure = [], []
-    for q in configurations:
-        js = numeric_chain.jacobian(robot, q)[rows]
-        gram = js @ js.T if js.shape[0] <= js.shape[1] else js.T @ js
-        points.append(numeric_chain.axis_frames(robot, q)[1][:2, 3])
-        measure.append(np.sqrt(max(np.linalg.det(gram), 0.0)))
-    points = np.array(points)
-    figure, axes = plt.subplots(figsize=(7, 6), dpi=100)
-    cloud = axes.scatter(points[:, 0], points[:, 1], c=measure, s=4, cmap="viridis")
-    figure.colorbar(cloud, ax=axes, label="manipulability sqrt(det(Js Js^T))")
-    reach = float(np.max(np.linalg.norm(points, axis=1))) or 1.0
-    shown = configurations[:ellipses]
-    jacobians = [numeric_chain.jacobian(robot, q)[:2] for q in shown]
-    largest = max(np.linalg.svd(j, compute_uv=False)[0] for j in jacobians) or 1.0
-    for q, j in zip(shown, jacobians):
-        frames, tool = numeric_chain.axis_frames(robot, q)
-        chain = np.array([f[:2, 3] for f in frames] + [tool[:2, 3]])
-        axes.plot(chain[:, 0], chain[:, 1], "-o", color="0.3", lw=1, ms=2)
-        u, s, _ = np.linalg.svd(j)
-        scale = 0.25 * reach / largest
-        axes.add_patch(Ellipse(tool[:2, 3], 2 * scale * s[0], 2 * scale * (s[1] if len(s) > 1 else 0),
-                               angle=np.degrees(np.arctan2(u[1, 0], u[0, 0])), fill=False, color="tab:red"))
-    axes.set_aspect("equal")
-    axes.set_xlabel(f"x ({robot.length_unit})")
-    axes.set_ylabel(f"y ({robot.length_unit})")
-    axes.set_title(f"{robot.name}: manipulability over the workspace\nand velocity ellipses (red)", fontsize=10)
-    figure.savefig(path)
-    plt.close(figure)

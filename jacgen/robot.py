@@ -97,6 +97,12 @@ class Robot:
         return tuple(p for p in self.parameters if p.symbolic)
 
     @property
+    def file_name(self) -> str:
+        """The robot file's name without its folder, unprintable characters as '?' (it goes
+        into one-line comments and the report's commands)."""
+        return "".join(c if c.isprintable() else "?" for c in Path(self.source).name)
+
+    @property
     def ranges(self) -> tuple[tuple[float, float], ...]:
         """Each joint's range: its limits, or [-pi, pi] for a joint without."""
         return tuple(joint.limits or (-math.pi, math.pi) for joint in self.joints)

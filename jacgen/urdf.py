@@ -17,6 +17,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from xml.parsers import expat
 
+import numpy as np
 import sympy
 from sympy import Matrix
 
@@ -329,3 +330,26 @@ def inverse_transform(transform: Matrix) -> Matrix:
     inverse[:3, :3] = rotation
     inverse[:3, 3] = -rotation * transform[:3, 3]
     return inverse
+
+
+def joint_axes(chain: LinkChain, q) -> tuple[list[tuple[np.ndarray, np.ndarray]], np.ndarray]:
+    """The URDF's own kinematics at q (n,) or a batch (..., n), its joint transforms multiplied
+    out in floats (no DH involved): each moving joint's axis line (a point on it and its unit
+    direction, (..., 3) each, in the base link's frame) and the tip link's pose (..., 4, 4)."""
+    q = np.asarray(q, dtype=float)
+    frame = np.broadcast_to(np.array(chain.start.evalf(), dtype=float), (*q.shape[:-1], 4, 4))
+    movable, axes = iter(np.moveaxis(q, -1, 0)), []
+    for joint in chain.joints:
+        frame = frame @ np.array(joint.origin.evalf(), dtype=float)
+        if joint.kind in MOVABLE:
+            value = next(movable)[..., None, None]
+            axis = np.array(joint.axis.evalf(), dtype=float).ravel()
+            axes.append((frame[..., :3, 3], frame[..., :3, :3] @ axis))
+            motion = np.broadcast_to(np.eye(4), frame.shape).copy()
+            if joint.kind == "prismatic":
+                motion[..., :3, 3] = value[..., 0] * axis
+            else:  # Rodrigues
+                skew = np.array([[0, -axis[2], axis[1]], [axis[2], 0, -axis[0]], [-axis[1], axis[0], 0]])
+                motion[..., :3, :3] = np.eye(3) + np.sin(value) * skew + (1 - np.cos(value)) * skew @ skew
+            frame = frame @ motion
+    return axes, frame

@@ -12,6 +12,7 @@ def _report_context(robot: Robot, generator: Generator) -> dict:
     singular = generator.singularities
     return {
         "convention": robot.convention,
+        "file_name": robot.file_name,
         "dh_header": words.DH_HEADER,
         "dh_rows": words.dh_table(robot),
         "singularity_kind": singular.kind,

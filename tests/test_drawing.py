@@ -1,0 +1,221 @@
+"""`jacgen show --plot` and `--compare-urdf` (contract §4, docs/contract.md "Drawing and
+comparing an arm"): the drawing read back from matplotlib's artists (never the pixels) against
+jacgen.reference's frames, the planar workspace boundary against the annulus of a 2R arm,
+and the URDF comparison against imports that agree and tables with one twist flipped."""
+
+import re
+
+import numpy as np
+import pytest
+from click.testing import CliRunner
+
+from jacgen import reference
+from jacgen.cli import main
+from jacgen.compare_urdf import compare_urdf, first_difference
+from jacgen.drawing import BOUNDARY_CELLS, draw_arm, draw_workspace
+from jacgen.robot import parse_robot
+
+from conftest import ROBOT_NAMES, ROOT, random_configurations, robot
+from support.random_arms import random_arm_text
+from support.urdf import DATA, URDFS, imported
+
+matplotlib = pytest.importorskip("matplotlib")
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+from mpl_toolkits.mplot3d import proj3d  # noqa: E402
+
+STRESS_SEEDS = 30  # tests/test_random_arms.py's arms, 1 to 12 joints, and two of 16 and 32
+ARMS = {name: robot(name) for name in ROBOT_NAMES} | {
+    f"random{seed}_{dof or ''}": parse_robot(random_arm_text(seed, dof=dof).encode(), f"random{seed}.yaml")
+    for seed, dof in [(seed, None) for seed in range(STRESS_SEEDS)] + [(16, 16), (32, 32)]}
+
+
+def _artist(axes, gid):
+    found = [a for a in axes.get_children() if a.get_gid() == gid]
+    assert len(found) == 1, gid
+    return found[0]
+
+
+def _projected(axes, points):
+    """Points (k, 3) as the 3D axes project them onto the screen plane."""
+    return np.transpose(proj3d.proj_transform(*np.transpose(points), axes.get_proj())[:2])
+
+
+@pytest.mark.parametrize("name", ARMS)
+def test_drawing_is_the_reference_chain(name):
+    """At a random configuration: the chain's polyline passes, in order, through the
+    reference's joint-axis origins and ends at its tool origin, in 3D and as projected on
+    screen; each joint's arrow starts at its axis origin along the reference's axis; the base
+    and tool triads start at the reference's origins along its x, y, z."""
+    arm = ARMS[name]
+    q = random_configurations(arm, 1, seed=31)[0]
+    axes_frames, tool = reference.frames(arm, q)
+    figure = plt.figure()
+    axes = figure.add_subplot(projection="3d")
+    draw_arm(axes, arm, q)
+    figure.canvas.draw()
+    chain = _artist(axes, "chain")
+    vertices = np.transpose(chain.get_data_3d())
+    on_screen = chain.get_xydata()
+    expected = [frame[:3, 3] for frame in axes_frames] + [tool[:3, 3]]
+    size = np.ptp(vertices, axis=0).max()
+    k = 0
+    for point, shown in zip(expected, _projected(axes, np.array(expected))):
+        while k < len(vertices) and np.abs(vertices[k] - point).max() > 1e-12 * max(1.0, size):
+            k += 1
+        assert k < len(vertices), (name, point)
+        assert np.abs(on_screen[k] - shown).max() < 1e-12
+    assert np.abs(vertices[-1] - tool[:3, 3]).max() < 1e-12 * max(1.0, size)
+    for i, frame in enumerate(axes_frames):
+        end, start = _artist(axes, f"axis {i + 1}").get_segments()[0]  # the shaft, from its tip
+        origin, along = _projected(axes, np.array([frame[:3, 3], frame[:3, 3] + 1e-3 * size * frame[:3, 2]]))
+        assert np.abs(start - origin).max() < 1e-9
+        direction = (end - start) / np.linalg.norm(end - start)
+        expected_direction = (along - origin) / np.linalg.norm(along - origin)
+        assert np.linalg.norm(along - origin) < 1e-9 or np.abs(direction - expected_direction).max() < 1e-6
+    for label, pose in (("base", _base_pose(arm, axes_frames[0])), ("tool", tool)):
+        for column, letter in enumerate("xyz"):
+            line = np.transpose(_artist(axes, f"{label} {letter}").get_data_3d())
+            assert np.abs(line[0] - pose[:3, 3]).max() < 1e-12 * max(1.0, size)
+            step = line[1] - line[0]
+            assert np.abs(step / np.linalg.norm(step) - pose[:3, column]).max() < 1e-12
+    plt.close(figure)
+
+
+def _base_pose(arm, first_axis):
+    """The base frame: joint 1's axis frame (standard DH), or that frame with the first row's
+    Rx(alpha) Tx(a) taken off (modified)."""
+    if arm.convention == "standard":
+        return first_axis
+    joint = arm.joints[0]
+    c, s = np.cos(joint.alpha.approx), np.sin(joint.alpha.approx)
+    twist = np.array([[1, 0, 0, joint.a.approx], [0, c, -s, 0], [0, s, c, 0], [0, 0, 0, 1]])
+    return first_axis @ np.linalg.inv(twist)
+
+
+TWO_LINKS = """
+name: two_links
+convention: standard
+angle_unit: deg
+joints:
+  - {type: revolute, a: 1.0, alpha: 0, d: 0, offset: 0}
+  - {type: revolute, a: 0.6, alpha: 0, d: 0, offset: 0}
+task: [x, y]
+"""
+
+
+def test_workspace_boundary_of_a_2r_arm_is_its_annulus():
+    """Links 1 and 0.6 without limits reach the annulus 0.4 <= r <= 1.6: every vertex of the
+    drawn boundary lies within two grid cells of one of its circles, and both are drawn."""
+    arm = parse_robot(TWO_LINKS.encode(), "two_links.yaml")
+    figure, axes = plt.subplots()
+    draw_workspace(figure, axes, arm)
+    vertices = np.vstack([path.vertices for path in _artist(axes, "workspace boundary").get_paths()])
+    cell = 1.1 * 3.2 / BOUNDARY_CELLS
+    radius = np.linalg.norm(vertices, axis=1)
+    assert np.all(np.minimum(abs(radius - 1.6), abs(radius - 0.4)) < 2 * cell)
+    assert np.any(abs(radius - 0.4) < 2 * cell) and np.any(abs(radius - 1.6) < 2 * cell)
+    plt.close(figure)
+
+
+def test_workspace_boundary_with_limits():
+    """The same arm with q1 in [0, 90] deg and q2 in [0, 60] deg: the region is bounded by
+    arcs of the circles the limits leave; every boundary vertex lies within two cells of the
+    tool positions with a joint at a limit or q2 = 0 (the only singular q2 in range)."""
+    arm = parse_robot(TWO_LINKS.replace("offset: 0}", "offset: 0, limits: [0, 90]}", 1)
+                      .replace("a: 0.6, alpha: 0, d: 0, offset: 0}", "a: 0.6, alpha: 0, d: 0, offset: 0, limits: [0, 60]}")
+                      .encode(), "limited.yaml")
+    figure, axes = plt.subplots()
+    draw_workspace(figure, axes, arm)
+    vertices = np.vstack([path.vertices for path in _artist(axes, "workspace boundary").get_paths()])
+    t = np.linspace(0, 1, 2000)
+    edges = [(np.radians(90) * t, 0 * t), (np.radians(90) * t, np.radians(60) + 0 * t),
+             (0 * t, np.radians(60) * t), (np.radians(90) + 0 * t, np.radians(60) * t)]
+    curve = np.vstack([reference.fk(arm, np.stack([q1, q2], -1))[:, :2, 3] for q1, q2 in edges])
+    distance = np.min(np.linalg.norm(vertices[:, None] - curve[None], axis=-1), axis=1)
+    assert distance.max() < 2 * 1.1 * (np.ptp(curve, axis=0).max()) / BOUNDARY_CELLS
+    plt.close(figure)
+
+
+# -- --compare-urdf ---------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("convention", ["standard", "modified"])
+@pytest.mark.parametrize("key", URDFS)
+def test_imported_robot_files_agree_with_their_urdf(key, convention):
+    """The robot file import-urdf writes describes the URDF's chain: every axis and the tool
+    pose agree to 1e-9."""
+    result = imported(key, convention)
+    file, base, tip, _ = URDFS[key]
+    comparison = compare_urdf(result.robot, str(DATA / file), base, tip)
+    assert max(max(axis) for axis in comparison.axes) < 1e-9 and max(comparison.tool) < 1e-9, comparison
+    assert first_difference(comparison, 1e-9) is None
+
+
+def _flip_twist(text: str, row: int) -> str:
+    """The robot file text with the sign of joint `row`'s (0-based) alpha flipped."""
+    rows = [m for m in re.finditer(r"(?m)^  - .*$", text)]
+    line = rows[row].group(0)
+    value = re.search(r"alpha: ([^,}]+)", line).group(1).strip().strip('"')
+    flipped = re.sub(r"alpha: ([^,}]+)", f'alpha: "-({value})"', line)
+    return text[:rows[row].start()] + flipped + text[rows[row].end():]
+
+
+@pytest.mark.parametrize("convention", ["standard", "modified"])
+@pytest.mark.parametrize("key", ["ur5", "panda", "kinova_jaco2"])
+def test_a_flipped_twist_names_its_row(key, convention, tmp_path):
+    """One twist sign flipped in the imported table: `show --compare-urdf` exits 1 and names the
+    row: in standard DH row k places the axis of joint k + 1, in modified DH that of joint k."""
+    result = imported(key, convention)
+    rows = [i for i, joint in enumerate(result.robot.joints) if abs(np.sin(joint.alpha.approx)) > 0.1
+            and (convention == "modified" or i < result.robot.dof - 1)]
+    k = rows[len(rows) // 2]
+    path = tmp_path / f"{result.robot.name}.yaml"
+    path.write_text(_flip_twist(result.text, k))
+    file, base, tip, _ = URDFS[key]
+    options = [arg for flag, value in (("--base", base), ("--tip", tip)) if value for arg in (flag, value)]
+    run = CliRunner().invoke(main, ["show", str(path), "--compare-urdf", str(DATA / file), *options])
+    assert run.exit_code == 1, run.output
+    verdict = run.output.strip().splitlines()[-1]
+    name = result.robot.joints[k].name
+    if convention == "standard":
+        assert f"the axis of joint {k + 2} " in verdict and f"check joint {k + 1}'s DH row ({name}:" in verdict
+    else:
+        assert f"the axis of joint {k + 1} " in verdict and f"check joint {k + 1}'s DH row ({name}:" in verdict
+
+
+def test_compare_needs_the_same_number_of_joints():
+    """A URDF chain with another number of moving joints: one line naming both, exit 2."""
+    run = CliRunner().invoke(main, ["show", str(ROOT / "robots" / "puma560.yaml"), "--compare-urdf",
+                                    str(DATA / "panda.urdf"), "--tip", "panda_hand_tcp"])
+    assert run.exit_code == 2
+    assert run.output.strip().splitlines()[-1] == (
+        f"jacgen: error: {DATA / 'panda.urdf'}: the chain panda_link0 -> panda_hand_tcp has 7 moving joints, "
+        f"{ROOT / 'robots' / 'puma560.yaml'} has 6; choose the links with --base and --tip")
+
+
+# -- the command ------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("name", ["puma560", "planar_3r", "scara"])
+def test_show_plot_writes_a_picture(name, tmp_path):
+    """`show --plot` writes a PNG (and with --q one configuration); a wrong --q length is one
+    line and exit 2."""
+    out = tmp_path / f"{name}.png"
+    arm = robot(name)
+    q = ",".join(["0.3"] * arm.dof)
+    run = CliRunner().invoke(main, ["show", str(ROOT / "robots" / f"{name}.yaml"), "--plot", str(out), "--q", q])
+    assert run.exit_code == 0, run.output
+    assert out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    run = CliRunner().invoke(main, ["show", str(ROOT / "robots" / f"{name}.yaml"), "--plot", str(out), "--q", "0.3"])
+    assert run.exit_code == 2 and run.output.strip() == (
+        f"jacgen: error: --q: expected {arm.dof} values (one per joint of {name}), got 1")
+
+
+def test_plot_without_matplotlib_is_one_line(tmp_path, monkeypatch):
+    """Without matplotlib: `show` still describes, `--plot` is one line and exit 2."""
+    monkeypatch.setitem(__import__("sys").modules, "matplotlib", None)
+    run = CliRunner().invoke(main, ["show", str(ROOT / "robots" / "ur5.yaml"), "--plot", str(tmp_path / "a.png")])
+    assert run.exit_code == 2
+    assert run.output.strip().splitlines()[-1] == "jacgen: error: --plot needs matplotlib: pip install 'jacgen[plot]'"
+    assert not (tmp_path / "a.png").exists()
