@@ -1,5 +1,6 @@
 """The `jacgen` command line (contract §4). Exit codes: 0 ok, 1 check failed, 2 invalid input."""
 
+import math
 import sys
 from pathlib import Path
 
@@ -144,9 +145,12 @@ def _configuration(ctx, param, value: str | None):
     if value is None:
         return None
     try:
-        return [float(part) for part in value.split(",")]
+        q = [float(part) for part in value.split(",")]
     except ValueError:
-        raise click.BadParameter(f"expected comma-separated numbers, got {value!r}") from None
+        q = [math.nan]
+    if not all(math.isfinite(x) for x in q):
+        raise click.BadParameter(f"expected comma-separated finite numbers, got {value!r}")
+    return q
 
 
 @main.command()

@@ -219,3 +219,13 @@ def test_plot_without_matplotlib_is_one_line(tmp_path, monkeypatch):
     assert run.exit_code == 2
     assert run.output.strip().splitlines()[-1] == "jacgen: error: --plot needs matplotlib: pip install 'jacgen[plot]'"
     assert not (tmp_path / "a.png").exists()
+
+
+@pytest.mark.parametrize("q", ["0,nan", "0,x", "0,,1", "inf,0"])
+def test_q_must_be_finite_numbers(q, tmp_path):
+    run = CliRunner().invoke(main, ["show", str(ROOT / "robots" / "planar_2r.yaml"), "--plot", str(tmp_path / "a.png"),
+                                    "--q", q])
+    assert run.exit_code == 2
+    assert run.output.strip().splitlines()[-1] == (
+        f"jacgen: error: Invalid value for '--q': expected comma-separated finite numbers, got '{q}'")
+    assert not (tmp_path / "a.png").exists()
