@@ -219,15 +219,6 @@ def test_isotropy_of_planar_2r(tmp_path, a1, a2):
     assert ("isotropic (condition number 1)" in line) == (a1 == "sqrt(2)")
 
 
-def test_show_plot_writes_a_png(tmp_path):
-    target = tmp_path / "workspace.png"
-    result = CliRunner().invoke(main, ["show", str(ROOT / "robots" / "planar_2r.yaml"), "--plot", str(target)])
-    assert result.exit_code == 0, result.output
-    assert target.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
-    refused = CliRunner().invoke(main, ["show", str(ROOT / "robots" / "puma560.yaml"), "--plot", str(target)])
-    assert refused.exit_code == 2 and "planar" in refused.output
-
-
 @pytest.mark.parametrize("polynomial", ["c2**3 - 1/2", "4*c2**3 - 3*c2 - 1/5", "s2*c2 + s2 - 1/3", "c2 + 1"])
 def test_roots_of_a_one_joint_factor(polynomial):
     """Roots from the polynomial in tan(q/2) (numeric above degree 2), against a dense scan
