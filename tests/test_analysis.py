@@ -18,7 +18,7 @@ from jacgen import kinematics, load_robot, reference
 from jacgen.analysis import analyse
 from jacgen.cli import main
 
-from conftest import ROOT, ROBOT_NAMES, generated_module, random_configurations, robot
+from conftest import ROBOT_NAMES, generated_module, random_configurations, robot
 from support.ik import reference_js
 
 RANK_TOLERANCE = 1e-9  # smallest / largest singular value of Js at a singular configuration
