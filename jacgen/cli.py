@@ -13,7 +13,7 @@ from .errors import JacgenError
 from .catalogue import with_callees
 from .model import Model
 from .backends import BACKENDS, DEFAULT_LANGUAGES
-from .render import render_robot, stale_files, write_files
+from .render import render_robots, stale_files, usable_cpus, write_files
 from .compare_urdf import DEFAULT_TOLERANCE, compare_urdf, comparison_lines, first_difference
 from .drawing import default_configurations, draw
 from .report import describe
@@ -109,15 +109,14 @@ def main(debug):
               help="Safety net on the exact singularity analysis of each robot, whose work is "
                    "bounded by size limits anyway: past it the numeric rank determinant stands as the "
                    "condition, with a warning (0: no limit).")
-def generate(robot_files, output, languages, real, check, functions, budget_seconds):
+@click.option("-j", "--jobs", default=usable_cpus(), show_default="the processors usable",
+              type=click.IntRange(min=1), help="Robots generated at once, each in a process of its own.")
+def generate(robot_files, output, languages, real, check, functions, budget_seconds, jobs):
     """Generate code for each ROBOT_FILE."""
     budget.set_seconds(budget_seconds)
     robots = [load_robot(path) for path in dict.fromkeys(robot_files)]  # validate all before writing any
     _check_unique_names(robots)
-    files = {}
-    for robot in robots:
-        _progress(f"generating {robot.name}")
-        files.update(render_robot(robot, languages, real, functions=functions))
+    files = render_robots(robots, languages, real, functions, jobs, lambda robot: _progress(f"generated {robot.name}"))
     folder = Path(output)
     if check:
         diffs = stale_files(files, folder)

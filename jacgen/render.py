@@ -6,16 +6,20 @@ not by each template, and holds no date, host or absolute path.
 """
 
 import difflib
+import multiprocessing
 import os
 import tempfile
+from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
+from typing import Callable
 
 import jinja2
 
+from . import budget
 from .backends import BACKENDS, DEFAULT_LANGUAGES
 from .errors import JacgenError
 from .functions import Generator
-from .robot import Robot
+from .robot import Robot, load_robot
 from .version import __version__
 
 TEMPLATE_DIR_CANDIDATES = (
@@ -61,6 +65,49 @@ def render_robot(robot: Robot, languages=DEFAULT_LANGUAGES, real: str = "double"
             path = f"{robot.name}/{pattern.format(name=robot.name)}"
             files[path] = backend.comment.format(header(robot)) + "\n" + text
     return files
+
+
+def usable_cpus() -> int:
+    """The processors this process may run on."""
+    return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1
+
+
+def render_robots(robots: list[Robot], languages, real: str, functions, jobs: int,
+                  done: Callable[[Robot], None] = lambda robot: None) -> dict[str, str]:
+    """The files of every robot (render_robot), merged in the robots' order. With jobs > 1
+    each robot is rendered in a process of its own, up to `jobs` at once: robots share no
+    symbolic work, so this divides the time by the processors used; each worker reads the
+    robot file again (it was validated here) and sends back text only. `done(robot)` is
+    called as each robot's files arrive, in order."""
+    if jobs <= 1 or len(robots) <= 1:
+        files = {}
+        for robot in robots:
+            files.update(render_robot(robot, languages, real, functions=functions))
+            done(robot)
+        return files
+    # fork where there is one: a worker starts with jacgen and sympy already imported
+    context = multiprocessing.get_context("fork" if "fork" in multiprocessing.get_all_start_methods() else None)
+    files = {}
+    with ProcessPoolExecutor(min(jobs, len(robots)), mp_context=context) as pool:
+        futures = [pool.submit(_render_file, robot.source, tuple(languages), real, functions, budget.seconds())
+                   for robot in robots]
+        for robot, future in zip(robots, futures):
+            rendered, error = future.result()
+            if error is not None:
+                raise JacgenError(error)
+            files.update(rendered)
+            done(robot)
+    return files
+
+
+def _render_file(path: str, languages, real: str, functions, seconds) -> tuple[dict[str, str], str | None]:
+    """render_robot in a worker process: the files, or the line of a JacgenError (sent as
+    text: its subclasses do not pickle)."""
+    budget.set_seconds(seconds)
+    try:
+        return render_robot(load_robot(path), languages, real, functions=functions), None
+    except JacgenError as error:
+        return {}, str(error)
 
 
 def stale_files(files: dict[str, str], folder: Path) -> list[str]:

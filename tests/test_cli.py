@@ -87,7 +87,7 @@ def test_usage_mistakes_are_one_line():
 def test_internal_error_is_one_line_and_debug_shows_the_traceback(tmp_path, monkeypatch):
     """A bug of jacgen's is one line and exit 1, the traceback only with --debug, and
     nothing already on disk is touched (files are written after everything is generated)."""
-    import jacgen.cli
+    import jacgen.render
 
     def broken(*args, **kwargs):
         raise ZeroDivisionError("polynomial division")
@@ -95,7 +95,7 @@ def test_internal_error_is_one_line_and_debug_shows_the_traceback(tmp_path, monk
     existing = tmp_path / "planar_2r" / "planar_2r.py"
     existing.parent.mkdir()
     existing.write_text("earlier output\n")
-    monkeypatch.setattr(jacgen.cli, "render_robot", broken)
+    monkeypatch.setattr(jacgen.render, "render_robot", broken)
     arguments = ["generate", str(ROOT / "robots" / "planar_2r.yaml"), "-o", str(tmp_path)]
     result = CliRunner().invoke(main, arguments)
     assert result.exit_code == 1
@@ -137,3 +137,20 @@ def test_functions_option_rejects_what_cannot_be_made(tmp_path):
     assert missing.exit_code == 2
     assert missing.stderr.endswith("iiwa.yaml: robot iiwa has no jacobian_det: Js is 6 x 7, not square\n")
     assert len(missing.stderr.splitlines()) == 1 and not list(tmp_path.iterdir())
+
+
+def test_robots_in_parallel_processes_write_the_same_bytes(tmp_path):
+    """`--jobs 2` (a process per robot) writes exactly what `--jobs 1` writes; a robot the
+    functions asked for cannot be made for is one line from the worker, exit 2, nothing written."""
+    robots = [ROOT / "robots" / f"{name}.yaml" for name in ("planar_2r", "scara", "rexarm")]
+    for jobs in ("1", "2"):
+        result = run("generate", *robots, "-o", tmp_path / jobs, "--jobs", jobs, "--functions", "fk_jacobian,ik")
+        assert result.exit_code == 0, result.output
+    written = files_under(tmp_path / "1")
+    assert len(written) == 15 and written == files_under(tmp_path / "2")  # 3 robots x (h, c, py, casadi, md)
+    assert all((tmp_path / "1" / path).read_bytes() == (tmp_path / "2" / path).read_bytes() for path in written)
+    missing = run("generate", robots[0], ROOT / "robots" / "iiwa.yaml", "-o", tmp_path / "3", "--jobs", "2",
+                  "--functions", "fk,jacobian_det")
+    assert missing.exit_code == 2 and not (tmp_path / "3").exists()
+    assert missing.stderr.endswith("iiwa.yaml: robot iiwa has no jacobian_det: Js is 6 x 7, not square\n")
+    assert len(missing.stderr.splitlines()) == 1
