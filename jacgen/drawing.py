@@ -53,10 +53,9 @@ def chain_points(robot: Robot, q: np.ndarray) -> np.ndarray:
 def draw(robot: Robot, path: str, configurations: list[np.ndarray]) -> None:
     """Write the drawing of `robot` at each configuration (and its planar map) to `path`;
     the format follows the file's extension, as matplotlib's savefig does."""
-    plt = _pyplot()
     planar = moves_in_plane(robot)
     panels = len(configurations) + planar
-    figure = plt.figure(figsize=(5.5 * panels, 5.5), dpi=100)
+    figure = _figure(figsize=(5.5 * panels, 5.5), dpi=100)
     figure.subplots_adjust(left=0.02, right=0.94, bottom=0.1, top=0.9, wspace=0.3)
     for k, q in enumerate(configurations):
         draw_arm(figure.add_subplot(1, panels, k + 1, projection="3d"), robot, q)
@@ -65,7 +64,6 @@ def draw(robot: Robot, path: str, configurations: list[np.ndarray]) -> None:
     figure.text(0.01, 0.01, "arrows: joint axes (solid: revolute, dashed: prismatic), numbered; "
                 "red, green, blue: x, y, z of the base and tool frames", fontsize=7, color="0.3")
     figure.savefig(path)
-    plt.close(figure)
 
 
 def draw_arm(axes, robot: Robot, q: np.ndarray) -> None:
@@ -166,13 +164,11 @@ def _erode(cells: np.ndarray) -> np.ndarray:
     return ~_dilate(~cells)
 
 
-def _pyplot():
-    """matplotlib's pyplot on the Agg backend (files only, no window); one error line without it."""
+def _figure(**options):
+    """A matplotlib Figure drawn by Agg (files only, no window, no pyplot state); one error
+    line without matplotlib."""
     try:
-        import matplotlib
+        from matplotlib.figure import Figure
     except ImportError:
         raise JacgenError("--plot needs matplotlib: pip install 'jacgen[plot]'") from None
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    return plt
+    return Figure(**options)
