@@ -214,7 +214,9 @@ def test_show_plot_writes_a_picture(name, tmp_path):
 
 def test_plot_without_matplotlib_is_one_line(tmp_path, monkeypatch):
     """Without matplotlib: `show` still describes, `--plot` is one line and exit 2."""
-    monkeypatch.setitem(__import__("sys").modules, "matplotlib", None)
+    modules = __import__("sys").modules
+    for name in [name for name in modules if name.split(".")[0] in ("matplotlib", "mpl_toolkits")] + ["matplotlib"]:
+        monkeypatch.setitem(modules, name, None)  # as if never installed, submodules too
     run = CliRunner().invoke(main, ["show", str(ROOT / "robots" / "ur5.yaml"), "--plot", str(tmp_path / "a.png")])
     assert run.exit_code == 2
     assert run.output.strip().splitlines()[-1] == "jacgen: error: --plot needs matplotlib: pip install 'jacgen[plot]'"
