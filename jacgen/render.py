@@ -9,7 +9,7 @@ import difflib
 import multiprocessing
 import os
 import tempfile
-from concurrent.futures import ProcessPoolExecutor
+from concurrent.futures import ProcessPoolExecutor, as_completed
 from pathlib import Path
 from typing import Callable
 
@@ -19,6 +19,7 @@ from . import budget
 from .backends import BACKENDS, DEFAULT_LANGUAGES
 from .errors import JacgenError
 from .functions import Generator
+from .model import Model
 from .robot import Robot, load_robot
 from .version import __version__
 
@@ -78,7 +79,7 @@ def render_robots(robots: list[Robot], languages, real: str, functions, jobs: in
     each robot is rendered in a process of its own, up to `jobs` at once: robots share no
     symbolic work, so this divides the time by the processors used; each worker reads the
     robot file again (it was validated here) and sends back text only. `done(robot)` is
-    called as each robot's files arrive, in order."""
+    called as each robot's files arrive."""
     if jobs <= 1 or len(robots) <= 1:
         files = {}
         for robot in robots:
@@ -87,17 +88,26 @@ def render_robots(robots: list[Robot], languages, real: str, functions, jobs: in
         return files
     # fork where there is one: a worker starts with jacgen and sympy already imported
     context = multiprocessing.get_context("fork" if "fork" in multiprocessing.get_all_start_methods() else None)
-    files = {}
+    rendered: dict[int, dict[str, str]] = {}
     with ProcessPoolExecutor(min(jobs, len(robots)), mp_context=context) as pool:
-        futures = [pool.submit(_render_file, robot.source, tuple(languages), real, functions, budget.seconds())
-                   for robot in robots]
-        for robot, future in zip(robots, futures):
-            rendered, error = future.result()
+        # the longest first, so that no long robot starts last (general 6R arms, then by joints)
+        order = sorted(range(len(robots)), key=lambda k: _expected_cost(robots[k]), reverse=True)
+        futures = {pool.submit(_render_file, robots[k].source, tuple(languages), real, functions,
+                               budget.seconds()): k for k in order}
+        for future in as_completed(futures):
+            files, error = future.result()
             if error is not None:
+                pool.shutdown(wait=False, cancel_futures=True)  # what has not started never will
                 raise JacgenError(error)
-            files.update(rendered)
-            done(robot)
-    return files
+            rendered[futures[future]] = files
+            done(robots[futures[future]])
+    return {path: text for k in range(len(robots)) for path, text in rendered[k].items()}
+
+
+def _expected_cost(robot: Robot) -> tuple[bool, int]:
+    """What orders robots by generation time, roughly: the general 6R solver is the longest,
+    then the more joints the longer (the structure is found in milliseconds)."""
+    return Model(robot).structure.solver == "general_6r", robot.dof
 
 
 def _render_file(path: str, languages, real: str, functions, seconds) -> tuple[dict[str, str], str | None]:
