@@ -77,7 +77,7 @@ def draw_arm(axes, robot: Robot, q: np.ndarray) -> None:
         axes.quiver(*origin, *(tip - origin), arrow_length_ratio=0.3, linewidth=1.5, gid=f"axis {i + 1}",
                     **AXIS_STYLE[joint.revolute])
         axes.text(*(tip + 0.02 * size * frame[:3, 2]), str(i + 1), fontsize=8, color=AXIS_STYLE[joint.revolute]["color"])
-    for name, pose in (("base", numeric_chain.link_frames(robot, q)[0][0]), ("tool", tool)):
+    for name, pose in (("base", numeric_chain.fixed_pose(robot.base)), ("tool", tool)):
         for column, colour in enumerate(TRIAD_COLOURS):
             end = pose[:3, 3] + TRIAD_LENGTH * size * pose[:3, column]
             axes.plot(*np.transpose([pose[:3, 3], end]), color=colour, linewidth=1.5, gid=f"{name} {'xyz'[column]}")

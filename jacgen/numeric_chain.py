@@ -29,7 +29,7 @@ def _link(robot, joint, qi: np.ndarray) -> np.ndarray:
     return _stack(rows, qi.shape)
 
 
-def _fixed(pose) -> np.ndarray:
+def fixed_pose(pose) -> np.ndarray:
     """A base or tool pose: translation xyz, rotation Rz(yaw) Ry(pitch) Rx(roll)."""
     (cr, cp, cy), (sr, sp, sy) = ([f(v.approx) for v in pose.rpy] for f in (np.cos, np.sin))
     x, y, z = (v.approx for v in pose.xyz)
@@ -42,10 +42,10 @@ def link_frames(robot, q) -> tuple[list[np.ndarray], np.ndarray]:
     """The world frames 0..n of the DH table (frame 0 the base, frame i after row i), and the
     tool's pose."""
     q = np.asarray(q, dtype=float)
-    frames = [np.broadcast_to(_fixed(robot.base), (*q.shape[:-1], 4, 4))]
+    frames = [np.broadcast_to(fixed_pose(robot.base), (*q.shape[:-1], 4, 4))]
     for i, joint in enumerate(robot.joints):
         frames.append(frames[-1] @ _link(robot, joint, q[..., i]))
-    return frames, frames[-1] @ _fixed(robot.tool)
+    return frames, frames[-1] @ fixed_pose(robot.tool)
 
 
 def axis_frames(robot, q) -> tuple[list[np.ndarray], np.ndarray]:
