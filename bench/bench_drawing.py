@@ -51,7 +51,7 @@ def main():
     for label, arm in (arms | stress_arms()).items():
         path = folder / f"{label}.png"
         times[label] = (arm.dof, common.timed(
-            lambda: drawing.draw(arm, str(path), drawing.default_configurations(arm)), args.rounds).seconds)
+            lambda: path.write_bytes(drawing.draw(arm, drawing.default_configurations(arm))), args.rounds).seconds)
     print("1. jacgen show --plot, default configurations, seconds per drawing (median)")
     print(f"{'arm':<18}{'joints':>7}{'seconds':>9}")
     for name, (dof, seconds) in times.items():
@@ -73,7 +73,7 @@ def main():
             environment.fig.savefig(folder / f"rtb_{name}.png")
             plt.close("all")
 
-        measured = common.median_times({"jacgen": lambda: drawing.draw(arm, str(folder / f"one_{name}.png"), [q]),
+        measured = common.median_times({"jacgen": lambda: (folder / f"one_{name}.png").write_bytes(drawing.draw(arm, [q])),
                                         "rtb": rtb_plot}, args.rounds)
         ours, peer = measured["jacgen"].seconds, measured["rtb"].seconds
         print(f"{name:<10}{ours:>9.3f}{peer:>9.3f}{ours / peer:>8.2f}")

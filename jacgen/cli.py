@@ -174,7 +174,9 @@ def show(robot_file, plot_file, q, urdf_file, base, tip, tolerance):
         raise JacgenError(f"--q: expected {robot.dof} values (one per joint of {robot.name}), got {len(q)}")
     click.echo(describe(Model(robot)))
     if plot_file:
-        draw(robot, plot_file, [np.array(q)] if q is not None else default_configurations(robot))
+        drawing = draw(robot, [np.array(q)] if q is not None else default_configurations(robot),
+                       Path(plot_file).suffix[1:].lower() or "png")
+        write_files({Path(plot_file).name: drawing}, Path(plot_file).parent)
         click.echo(f"jacgen: wrote {plot_file}", err=True)
     if urdf_file:
         comparison = compare_urdf(robot, urdf_file, base, tip)

@@ -12,6 +12,8 @@ generated/, since PNG bytes change with matplotlib's version and `generate --che
 stay exact everywhere.
 """
 
+import io
+
 import numpy as np
 
 from . import numeric_chain
@@ -50,12 +52,15 @@ def chain_points(robot: Robot, q: np.ndarray) -> np.ndarray:
     return np.array(points)
 
 
-def draw(robot: Robot, path: str, configurations: list[np.ndarray]) -> None:
-    """Write the drawing of `robot` at each configuration (and its planar map) to `path`;
-    the format follows the file's extension, as matplotlib's savefig does."""
+def draw(robot: Robot, configurations: list[np.ndarray], file_format: str = "png") -> bytes:
+    """The drawing of `robot` at each configuration (and its planar map) as the bytes of a
+    file in `file_format` (png, svg, pdf, ...: what matplotlib writes)."""
     planar = moves_in_plane(robot)
     panels = len(configurations) + planar
     figure = _figure(figsize=(5.5 * panels, 5.5), dpi=100)
+    formats = figure.canvas.get_supported_filetypes()
+    if file_format not in formats:
+        raise JacgenError(f"--plot: matplotlib writes no '{file_format}' files; use one of {', '.join(sorted(formats))}")
     figure.subplots_adjust(left=0.02, right=0.94, bottom=0.1, top=0.9, wspace=0.3)
     for k, q in enumerate(configurations):
         draw_arm(figure.add_subplot(1, panels, k + 1, projection="3d"), robot, q)
@@ -63,7 +68,9 @@ def draw(robot: Robot, path: str, configurations: list[np.ndarray]) -> None:
         draw_workspace(figure, figure.add_subplot(1, panels, panels), robot)
     figure.text(0.01, 0.01, "arrows: joint axes (solid: revolute, dashed: prismatic), numbered; "
                 "red, green, blue: x, y, z of the base and tool frames", fontsize=7, color="0.3")
-    figure.savefig(path)
+    stream = io.BytesIO()
+    figure.savefig(stream, format=file_format)
+    return stream.getvalue()
 
 
 def draw_arm(axes, robot: Robot, q: np.ndarray) -> None:

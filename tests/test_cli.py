@@ -1,6 +1,7 @@
 """The command line (contract §4): version, generate and its idempotence, --check with a diff,
 usage mistakes as one line. (Byte-identical output under any PYTHONHASHSEED: test_golden.)"""
 
+import os
 import re
 
 import numpy as np
@@ -35,6 +36,9 @@ def test_generate_writes_then_is_idempotent(tmp_path):
     written = files_under(tmp_path)
     assert written and all(path.startswith("planar_2r/") for path in written)
     assert first.stderr == f"jacgen: wrote {len(written)} file(s), 0 unchanged, in {tmp_path}\n"
+    umask = os.umask(0)
+    os.umask(umask)
+    assert {(tmp_path / path).stat().st_mode & 0o777 for path in written} == {0o666 & ~umask}  # not mkstemp's 0600
     times = {path: (tmp_path / path).stat().st_mtime_ns for path in written}
     second = run("generate", robot, "-o", tmp_path)
     assert second.exit_code == 0

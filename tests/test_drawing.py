@@ -223,6 +223,14 @@ def test_plot_without_matplotlib_is_one_line(tmp_path, monkeypatch):
     assert not (tmp_path / "a.png").exists()
 
 
+def test_a_format_matplotlib_cannot_write_is_one_line(tmp_path):
+    run = CliRunner().invoke(main, ["show", str(ROOT / "robots" / "planar_2r.yaml"), "--plot", str(tmp_path / "a.xyz")])
+    assert run.exit_code == 2
+    assert run.output.strip().splitlines()[-1].startswith(
+        "jacgen: error: --plot: matplotlib writes no 'xyz' files; use one of ")
+    assert not (tmp_path / "a.xyz").exists()
+
+
 @pytest.mark.parametrize("q", ["0,nan", "0,x", "0,,1", "inf,0"])
 def test_q_must_be_finite_numbers(q, tmp_path):
     run = CliRunner().invoke(main, ["show", str(ROOT / "robots" / "planar_2r.yaml"), "--plot", str(tmp_path / "a.png"),
