@@ -7,9 +7,9 @@ the base and tool frames as x, y, z triads in red, green, blue, equal scaling on
 axes. An arm that moves in a plane (every axis parallel to world z) gets one more panel:
 the manipulability over its workspace and the workspace boundary.
 
-matplotlib is needed here only: `generate` never imports this module. No drawing goes into
-generated/, since PNG bytes change with matplotlib's version and `generate --check` must
-stay exact everywhere.
+matplotlib is imported here only, when a drawing is made: generating code never needs it.
+No drawing goes into generated/, since PNG bytes change with matplotlib's version and
+`generate --check` must stay exact everywhere.
 """
 
 import io
