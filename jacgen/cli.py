@@ -13,13 +13,16 @@ from .errors import JacgenError
 from .catalogue import with_callees
 from .model import Model
 from .backends import BACKENDS, DEFAULT_LANGUAGES
-from .render import render_robots, stale_files, usable_cpus, write_files
+from .parallel import usable_cpus
+from .render import render_robots, stale_files, write_files
 from .compare_urdf import DEFAULT_TOLERANCE, compare_urdf, comparison_lines, first_difference
 from .drawing import default_configurations, draw
 from .report import describe
 from .robot import load_robot
 
 robot_files = click.argument("robot_files", nargs=-1, required=True, type=click.Path(dir_okay=False))
+jobs_option = click.option("-j", "--jobs", default=usable_cpus(), show_default="the processors usable",
+                           type=click.IntRange(min=1), help="Robots at once, each in a process of its own.")
 
 
 def _languages(ctx, param, value: str) -> tuple[str, ...]:
@@ -109,8 +112,7 @@ def main(debug):
               help="Safety net on the exact singularity analysis of each robot, whose work is "
                    "bounded by size limits anyway: past it the numeric rank determinant stands as the "
                    "condition, with a warning (0: no limit).")
-@click.option("-j", "--jobs", default=usable_cpus(), show_default="the processors usable",
-              type=click.IntRange(min=1), help="Robots generated at once, each in a process of its own.")
+@jobs_option
 def generate(robot_files, output, languages, real, check, functions, budget_seconds, jobs):
     """Generate code for each ROBOT_FILE."""
     budget.set_seconds(budget_seconds)
@@ -196,7 +198,8 @@ def show(robot_file, plot_file, q, urdf_file, base, tip, tolerance):
 @click.option("--sources", type=click.Path(file_okay=False, exists=True), default=None, metavar="DIR",
               help="With --target: run DIR/NAME/NAME.c and .h (the float C you ship, as `generate --real float -o DIR` "
                    "writes it) instead of generating them.")
-def verify(robot_files, samples, seed, target, sources):
+@jobs_option
+def verify(robot_files, samples, seed, target, sources, jobs):
     """Compare every generated function of every backend with the numpy reference."""
     from .verify import format_table, verify as verify_robots  # numpy/ctypes only when verifying
 
@@ -206,7 +209,7 @@ def verify(robot_files, samples, seed, target, sources):
     _check_unique_names(robots)
     emulators = []
     results = verify_robots(robots, samples, seed, _progress, target=target, sources=sources and Path(sources),
-                            emulators=emulators)
+                            emulators=emulators, jobs=jobs)
     click.echo(format_table(results))
     if emulators:
         from .target import format_resources

@@ -6,21 +6,18 @@ not by each template, and holds no date, host or absolute path.
 """
 
 import difflib
-import multiprocessing
 import os
 import tempfile
-from concurrent.futures import ProcessPoolExecutor, as_completed
 from pathlib import Path
 from typing import Callable
 
 import jinja2
 
-from . import budget
 from .backends import BACKENDS, DEFAULT_LANGUAGES
 from .errors import JacgenError
 from .functions import Generator
-from .model import Model
-from .robot import Robot, load_robot
+from .parallel import for_each_robot
+from .robot import Robot
 from .version import __version__
 
 TEMPLATE_DIR_CANDIDATES = (
@@ -68,56 +65,16 @@ def render_robot(robot: Robot, languages=DEFAULT_LANGUAGES, real: str = "double"
     return files
 
 
-def usable_cpus() -> int:
-    """The processors this process may run on."""
-    return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1
-
-
 def render_robots(robots: list[Robot], languages, real: str, functions, jobs: int,
                   done: Callable[[Robot], None] = lambda robot: None) -> dict[str, str]:
-    """The files of every robot (render_robot), merged in the robots' order. With jobs > 1
-    each robot is rendered in a process of its own, up to `jobs` at once: robots share no
-    symbolic work, so this divides the time by the processors used; each worker reads the
-    robot file again (it was validated here) and sends back text only. `done(robot)` is
-    called as each robot's files arrive."""
-    if jobs <= 1 or len(robots) <= 1:
-        files = {}
-        for robot in robots:
-            files.update(render_robot(robot, languages, real, functions=functions))
-            done(robot)
-        return files
-    # fork where there is one: a worker starts with jacgen and sympy already imported
-    context = multiprocessing.get_context("fork" if "fork" in multiprocessing.get_all_start_methods() else None)
-    rendered: dict[int, dict[str, str]] = {}
-    with ProcessPoolExecutor(min(jobs, len(robots)), mp_context=context) as pool:
-        # the longest first, so that no long robot starts last (general 6R arms, then by joints)
-        order = sorted(range(len(robots)), key=lambda k: _expected_cost(robots[k]), reverse=True)
-        futures = {pool.submit(_render_file, robots[k].source, tuple(languages), real, functions,
-                               budget.seconds()): k for k in order}
-        for future in as_completed(futures):
-            files, error = future.result()
-            if error is not None:
-                pool.shutdown(wait=False, cancel_futures=True)  # what has not started never will
-                raise JacgenError(error)
-            rendered[futures[future]] = files
-            done(robots[futures[future]])
-    return {path: text for k in range(len(robots)) for path, text in rendered[k].items()}
+    """The files of every robot (render_robot), merged in the robots' order, up to `jobs`
+    robots at once in processes of their own (`parallel`)."""
+    rendered = for_each_robot(_render, robots, jobs, (tuple(languages), real, functions), done)
+    return {path: text for files in rendered for path, text in files.items()}
 
 
-def _expected_cost(robot: Robot) -> tuple[bool, int]:
-    """What orders robots by generation time, roughly: the general 6R solver is the longest,
-    then the more joints the longer (the structure is found in milliseconds)."""
-    return Model(robot).structure.solver == "general_6r", robot.dof
-
-
-def _render_file(path: str, languages, real: str, functions, seconds) -> tuple[dict[str, str], str | None]:
-    """render_robot in a worker process: the files, or the line of a JacgenError (sent as
-    text: its subclasses do not pickle)."""
-    budget.set_seconds(seconds)
-    try:
-        return render_robot(load_robot(path), languages, real, functions=functions), None
-    except JacgenError as error:
-        return {}, str(error)
+def _render(robot: Robot, languages, real: str, functions) -> dict[str, str]:
+    return render_robot(robot, languages, real, functions=functions)
 
 
 def stale_files(files: dict[str, str], folder: Path) -> list[str]:

@@ -31,6 +31,7 @@ from . import analysis, ik, reference
 from .compile import c_compiler, compile_shared
 from .catalogue import Function
 from .functions import Generator
+from .parallel import for_each_robot
 from .render import render_robot, write_files
 from .robot import EULER_ANGLES, Robot
 from .generated_code import HOST_BACKENDS, GeneratedCode
@@ -377,52 +378,66 @@ def _velocity_ik_residual(robot: Robot, solved: tuple[np.ndarray, np.ndarray], q
 def verify(robots: list[Robot], samples: int, seed: int,
            progress: Callable[[str], None] = lambda message: None, folder: Path | None = None,
            target: str | None = None, sources: Path | None = None,
-           emulators: list[Emulator] | None = None) -> list[Result]:
-    """Generate, build and compare every robot; compiles run in the background meanwhile.
-    The code is written to `folder` (ROBOT/double/..., ROBOT/float/...) when one is given, to
-    a temporary folder otherwise.
+           emulators: list[Emulator] | None = None, jobs: int = 1) -> list[Result]:
+    """Generate, build and compare every robot, up to `jobs` robots at once in processes of
+    their own (`parallel`). The code is written to `folder` (ROBOT/double/...,
+    ROBOT/float/...) when one is given, to a temporary folder otherwise.
 
     With a `target` ("cortex-m4f"), only the float C is checked, run on the emulated target
-    (`jacgen.target`): the C generated now, or NAME.h and NAME.c from `sources`. Each robot's
-    Emulator, with the instructions and stack it measured, is appended to `emulators`."""
+    (`jacgen.target`), one robot after the other: the C generated now, or NAME.h and NAME.c
+    from `sources`. Each robot's Emulator, with the instructions and stack it measured, is
+    appended to `emulators`."""
     if target is None:
         c_compiler()  # fail before generating anything when there is none
     else:
         check_tools()
-    results = []
-    with tempfile.TemporaryDirectory(prefix="jacgen-verify-") as temporary, ThreadPoolExecutor(2) as pool:
+    with tempfile.TemporaryDirectory(prefix="jacgen-verify-") as temporary:
         folder = folder or Path(temporary)
-        jobs = []
+        if target is None:
+            progress(f"generating and verifying {', '.join(robot.name for robot in robots)}")
+            found = for_each_robot(verify_on_host, robots, jobs, (samples, seed, folder),
+                                   lambda robot: progress(f"verified {robot.name}"))
+            return [result for results in found for result in results]
+        results = []
         for robot in robots:
-            progress(f"generating {robot.name}")
-            work, generator = folder / robot.name, Generator(robot)
-            if target is None:
-                write_files(render_robot(robot, ("c", "python", "casadi"), "double", generator), work / "double")
-                write_files(render_robot(robot, ("c",), "float", generator), work / "float")
-                builds = {real: pool.submit(compile_shared, [work / real / robot.name / f"{robot.name}.c"],
-                                            work / f"{robot.name}_{real}.so") for real in ("double", "float")}
-            else:
-                emulator = Emulator(robot, generator, work / target, sources)
-                builds = {target: pool.submit(emulator.build)}
-            jobs.append((robot, generator, work, builds))
-        for robot, generator, work, builds in jobs:
-            functions = generator.functions()
-            progress(f"verifying {robot.name}" + (f" on the emulated {target}" if target else ""))
-            rng = np.random.default_rng(seed)
-            # Random samples are rounded to float32 so the float build sees exactly the reference's
-            # input; singular ones are not, since rounding would move them off the singular set.
-            random = random_configurations(robot, samples, rng).astype(np.float32).astype(np.float64)
-            q = np.vstack([random, singular_configurations(robot, generator.singularities)])
-            built = {name: build.result() for name, build in builds.items()}
-            emulator = built.pop(target, None)
-            results += verify_robot(robot, GeneratedCode(robot, functions, work / "double", built, emulator), functions, q,
-                                    len(random), generator.closed_form)
-            if emulator is not None:
-                emulator.measure_remaining(random, generator.closed_form and generator.closed_form.free)
-                emulator.resources  # read from the build folder while it exists
-                if emulators is not None:
-                    emulators.append(emulator)
-    return results
+            progress(f"verifying {robot.name} on the emulated {target}")
+            generator = Generator(robot)
+            emulator = Emulator(robot, generator, folder / robot.name / target, sources)
+            emulator.build()
+            random, q = _configurations(robot, generator, samples, seed)
+            results += verify_robot(robot, GeneratedCode(robot, generator.functions(), folder / robot.name / "double",
+                                                         {}, emulator), generator.functions(), q, len(random),
+                                    generator.closed_form)
+            emulator.measure_remaining(random, generator.closed_form and generator.closed_form.free)
+            emulator.resources  # read from the build folder while it exists
+            if emulators is not None:
+                emulators.append(emulator)
+        return results
+
+
+def verify_on_host(robot: Robot, samples: int, seed: int, folder: Path) -> list[Result]:
+    """One robot on the host: generated into folder/NAME/{double,float}, its C built for
+    both real types (at once), every backend compared with the reference."""
+    work, generator = folder / robot.name, Generator(robot)
+    write_files(render_robot(robot, ("c", "python", "casadi"), "double", generator), work / "double")
+    write_files(render_robot(robot, ("c",), "float", generator), work / "float")
+    with ThreadPoolExecutor(2) as pool:
+        builds = {real: pool.submit(compile_shared, [work / real / robot.name / f"{robot.name}.c"],
+                                    work / f"{robot.name}_{real}.so") for real in ("double", "float")}
+        built = {real: build.result() for real, build in builds.items()}
+    random, q = _configurations(robot, generator, samples, seed)
+    functions = generator.functions()
+    return verify_robot(robot, GeneratedCode(robot, functions, work / "double", built), functions, q, len(random),
+                        generator.closed_form)
+
+
+def _configurations(robot: Robot, generator: Generator, samples: int, seed: int) -> tuple[np.ndarray, np.ndarray]:
+    """The random samples, and those with the configurations near each singularity after
+    them. The random ones are rounded to float32 so the float build sees exactly the
+    reference's input; singular ones are not, since rounding would move them off the
+    singular set."""
+    random = random_configurations(robot, samples, np.random.default_rng(seed)).astype(np.float32).astype(np.float64)
+    return random, np.vstack([random, singular_configurations(robot, generator.singularities)])
 
 
 def format_table(results: list[Result]) -> str:

@@ -11,6 +11,7 @@ import pytest
 
 from jacgen.compile import WARNING_FLAGS
 from jacgen.structure import classify
+from jacgen.parallel import usable_cpus
 from jacgen.verify import verify
 
 from conftest import ROBOT_NAMES, robot
@@ -42,9 +43,11 @@ def _run(command, cwd=None):
 
 @pytest.fixture(scope="module")
 def verified(tmp_path_factory):
-    """verify's results for every shipped robot, and the folder it generated them in."""
+    """verify's results for every shipped robot (a process per robot, as `jacgen verify` runs
+    them), and the folder it generated them in."""
     folder = tmp_path_factory.mktemp("shipped")
-    return verify([robot(name) for name in ROBOT_NAMES], samples=200, seed=0, folder=folder), folder
+    return verify([robot(name) for name in ROBOT_NAMES], samples=200, seed=0, folder=folder,
+                  jobs=usable_cpus()), folder
 
 
 def test_shipped_robots_pass_verify(verified):

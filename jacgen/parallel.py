@@ -1,0 +1,67 @@
+"""Robots in parallel: `generate` and `verify` run each robot in a process of its own.
+
+Robots share no symbolic work, so a process per robot divides the time by the processors
+used. Workers are forked where the system can (they start with jacgen and sympy already
+imported) and get the Robot itself (it pickles in microseconds); what comes back must
+pickle too (text, numbers). The longest robots start first, so that none starts last:
+general 6R arms, then by number of joints (the structure is found in milliseconds).
+"""
+
+import multiprocessing
+import os
+from concurrent.futures import ProcessPoolExecutor, as_completed
+from typing import Callable, TypeVar
+
+from . import budget
+from .errors import JacgenError
+from .model import Model
+from .robot import Robot
+
+T = TypeVar("T")
+
+
+def usable_cpus() -> int:
+    """The processors this process may run on."""
+    return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1
+
+
+def for_each_robot(work: Callable[..., T], robots: list[Robot], jobs: int, arguments: tuple = (),
+                   done: Callable[[Robot], None] = lambda robot: None) -> list[T]:
+    """[work(robot, *arguments) for robot in robots]: in this process when jobs is 1 (or there
+    is one robot), else in up to `jobs` processes. `work` is a module-level function (it is
+    sent by name). A JacgenError in a worker is raised here with its line (its subclasses do
+    not pickle), after cancelling what has not started. `done(robot)` as each one finishes."""
+    if jobs <= 1 or len(robots) <= 1:
+        results = []
+        for robot in robots:
+            results.append(work(robot, *arguments))
+            done(robot)
+        return results
+    context = multiprocessing.get_context("fork" if "fork" in multiprocessing.get_all_start_methods() else None)
+    results: dict[int, T] = {}
+    with ProcessPoolExecutor(min(jobs, len(robots)), mp_context=context) as pool:
+        order = sorted(range(len(robots)), key=lambda k: _expected_cost(robots[k]), reverse=True)
+        futures = {pool.submit(_run, work, robots[k], arguments, budget.seconds()): k for k in order}
+        for future in as_completed(futures):
+            result, error = future.result()
+            if error is not None:
+                pool.shutdown(wait=False, cancel_futures=True)
+                raise JacgenError(error)
+            results[futures[future]] = result
+            done(robots[futures[future]])
+    return [results[k] for k in range(len(robots))]
+
+
+def _run(work: Callable[..., T], robot: Robot, arguments: tuple, seconds: float | None) -> tuple[T | None, str | None]:
+    """work in a worker, under the parent's budget: its result, or the line of a JacgenError."""
+    budget.set_seconds(seconds)
+    try:
+        return work(robot, *arguments), None
+    except JacgenError as error:
+        return None, str(error)
+
+
+def _expected_cost(robot: Robot) -> tuple[bool, int]:
+    """What orders robots by generation time, roughly: the general 6R solver is the longest,
+    then the more joints the longer."""
+    return Model(robot).structure.solver == "general_6r", robot.dof
