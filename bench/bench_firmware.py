@@ -33,7 +33,8 @@ import common
 from jacgen import reference
 from jacgen.functions import Generator
 from jacgen.target import Emulator, check_tools
-from jacgen.verify import FLOAT_TOLERANCE, reach
+from jacgen.samples import reach
+from jacgen.verify import FLOAT_TOLERANCE
 
 ROBOTS = ("puma560", "ur5", "panda")
 MATH = ("sin", "cos", "tan", "sqrt", "fabs", "atan2", "asin", "acos", "exp", "log", "pow", "fmin", "fmax", "floor")

