@@ -143,10 +143,14 @@ class Generator:
         free = split.joint(split.free)
         constants = [kinematics.translation(0, 0, link.d) * kinematics.translation(link.a, 0, 0)
                      * kinematics.rot_x(sympy.cos(link.alpha), sympy.sin(link.alpha)) for link in links]
+        # The loop angles' rotations, made before distribute(False): under it the -(g + shift) of a
+        # backwards split is not canonical, and cos's "could extract a minus sign" negates it back
+        # and forth forever.
+        turns = [None if i == free else kinematics.rot_z(sympy.cos(theta[i]), sympy.sin(theta[i]))[:3, :3]
+                 for i in range(6)]
         with distribute(False):
             before, after = sympy.eye(3), constants[free][:3, :3] if free < 5 else sympy.eye(3)
-            for i in range(6):
-                turn = kinematics.rot_z(sympy.cos(theta[i]), sympy.sin(theta[i]))[:3, :3] if i != free else None
+            for i, turn in enumerate(turns):
                 if i < free:
                     before = (before * turn * constants[i][:3, :3]).applyfunc(name)
                 elif i > free:

@@ -11,6 +11,7 @@ import pytest
 
 from jacgen import reference
 from jacgen.model import Model
+from jacgen.robot import parse_robot
 
 from conftest import GENERATED, generated_module, robot
 from support.general6r_arms import multi_start
@@ -89,3 +90,35 @@ def test_the_class_and_the_report_name_the_general_solver():
     assert model.structure.solver == "general_6r" and model.closed_form.info.max_solutions == 16
     report = (GENERATED / "jaco" / "jaco.md").read_text()
     assert "general 6R: 16 solutions at most" in report
+
+
+# A calibrated 6R arm (../shared/tools/random_arm.py --seed 380175037) whose chosen split runs
+# the loop backwards with the hidden angle shifted (no shipped arm does): building
+# ik_general_start recursed forever (cos of an unevaluated -(g + c) under distribute(False)).
+BACKWARDS_SHIFTED = """
+name: arm_75037
+convention: standard
+angle_unit: rad
+joints:
+  - {type: revolute, a: -8.36e-05, alpha: 1.5702249, d: 0.6719973, offset: 0.0004128, limits: [-3.1, 3.1]}
+  - {type: revolute, a: 0.4316648, alpha: 0.0019664, d: -7.75e-05, offset: -0.0005013, limits: [-3.1, 3.1]}
+  - {type: revolute, a: 0.0202426, alpha: -1.5696174, d: 0.1500003, offset: -0.0007412, limits: [-3.1, 3.1]}
+  - {type: revolute, a: 0.0001441, alpha: 1.5706244, d: 0.4316002, offset: 0.0002873, limits: [-3.1, 3.1]}
+  - {type: revolute, a: -0.0001265, alpha: -1.5712539, d: -0.0001612, offset: -0.0003699, limits: [-3.1, 3.1]}
+  - {type: revolute, a: 0.0001163, alpha: 0.0006432, d: -0.0001397, offset: -0.0006262, limits: [-3.1, 3.1]}
+"""
+
+
+def test_a_backwards_shifted_split_generates_and_solves(generated):
+    """That arm's numpy ik_branches gives back every configuration, each solution reaching its
+    pose (the reference's fk) to 1e-9."""
+    arm = parse_robot(BACKWARDS_SHIFTED.encode(), "arm_75037.yaml")
+    plan = Model(arm).closed_form.elimination
+    assert plan.equations.split.backwards and plan.shift != 0
+    module = generated(arm, ("python",), functions=("ik_branches",)).python
+    q = np.random.default_rng(2).uniform(-3.1, 3.1, (60, 6))
+    solutions, valid, _ = module.ik_branches(reference.fk(arm, q))
+    for k in range(len(q)):
+        found = solutions[k][valid[k]]
+        assert max(np.abs(reference.fk(arm, s) - reference.fk(arm, q[k])).max() for s in found) < 1e-9
+        assert min(np.abs(wrapped(s - q[k])).max() for s in found) < 1e-8
