@@ -14,7 +14,6 @@ from concurrent.futures import ProcessPoolExecutor, as_completed
 from typing import Callable, TypeVar
 
 from . import budget
-from .errors import JacgenError
 from .model import Model
 from .robot import Robot
 
@@ -31,8 +30,8 @@ def for_each_robot(work: Callable[..., T], robots: list[Robot], jobs: int, argum
                    done: Callable[[Robot], None] = lambda robot: None) -> list[T]:
     """[work(robot, *arguments) for robot in robots]: in this process when jobs is 1 (or there
     is one robot), else in up to `jobs` processes. `work` is a module-level function (it is
-    sent by name). A JacgenError in a worker is raised here with its line (its subclasses do
-    not pickle), after cancelling what has not started. `done(robot)` as each one finishes."""
+    sent by name). An exception in a worker is raised here, after cancelling what has not
+    started. `done(robot)` as each one finishes."""
     if jobs <= 1 or len(robots) <= 1:
         results = []
         for robot in robots:
@@ -44,13 +43,13 @@ def for_each_robot(work: Callable[..., T], robots: list[Robot], jobs: int, argum
     with ProcessPoolExecutor(min(jobs, len(robots)), mp_context=context) as pool:
         order = sorted(range(len(robots)), key=lambda k: _expected_cost(robots[k]), reverse=True)
         futures = {pool.submit(_run, work, robots[k], arguments, budget.seconds()): k for k in order}
-        for future in as_completed(futures):
-            result, error = future.result()
-            if error is not None:
-                pool.shutdown(wait=False, cancel_futures=True)
-                raise JacgenError(error)
-            results[futures[future]] = result
-            done(robots[futures[future]])
+        try:
+            for future in as_completed(futures):
+                results[futures[future]] = future.result()
+                done(robots[futures[future]])
+        except BaseException:
+            pool.shutdown(wait=False, cancel_futures=True)  # what has not started never will
+            raise
     return [results[k] for k in range(len(robots))]
 
 
@@ -72,13 +71,10 @@ def _context(work: Callable) -> multiprocessing.context.BaseContext:
     return context
 
 
-def _run(work: Callable[..., T], robot: Robot, arguments: tuple, seconds: float | None) -> tuple[T | None, str | None]:
-    """work in a worker, under the parent's budget: its result, or the line of a JacgenError."""
+def _run(work: Callable[..., T], robot: Robot, arguments: tuple, seconds: float | None) -> T:
+    """work in a worker, under the parent's budget."""
     budget.set_seconds(seconds)
-    try:
-        return work(robot, *arguments), None
-    except JacgenError as error:
-        return None, str(error)
+    return work(robot, *arguments)
 
 
 def _expected_cost(robot: Robot) -> tuple[bool, int]:
