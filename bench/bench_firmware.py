@@ -33,7 +33,6 @@ import common
 from jacgen import reference
 from jacgen.functions import Generator
 from jacgen.target import Emulator, check_tools
-from jacgen.samples import reach
 from jacgen.verify import FLOAT_TOLERANCE
 
 ROBOTS = ("puma560", "ur5", "panda")
@@ -100,7 +99,7 @@ def measure(robot, folder: Path, q: np.ndarray, sources: Path | None) -> dict[st
     for name, value in expected.items():
         found = emulator.evaluate(name, q)
         error = np.max(np.abs(found - value) / (1 + np.abs(value)))
-        if not error <= FLOAT_TOLERANCE * (1 + reach(robot)):  # `jacgen verify`'s float tolerance
+        if not error <= FLOAT_TOLERANCE * (1 + robot.reach):  # `jacgen verify`'s float tolerance
             raise SystemExit(f"{robot.name} {name} ({'casadi' if sources else 'jacgen'}): off by {error:.1e}")
         batch, cost = emulator.measured[name], emulator.resources[name]
         figures[name] = (cost.flash, cost.stack, int(batch.stack.max()), float(batch.instructions.mean()))

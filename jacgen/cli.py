@@ -47,6 +47,13 @@ def _functions(ctx, param, value: str | None) -> tuple[str, ...] | None:
     return names
 
 
+def _error_line(message: str) -> None:
+    """`jacgen: message` as one line on stderr, whatever the user's text in it holds: a
+    character that is not printable (a newline, U+0085, a control) is escaped as Python would."""
+    line = "".join(c if c.isprintable() else repr(c)[1:-1] for c in message)
+    click.echo(f"jacgen: {line}", err=True)
+
+
 class JacgenGroup(click.Group):
     """Turns every JacgenError, a file that cannot be written and a usage mistake into one
     line on stderr and exit code 2, and any other exception (a bug of jacgen's) into one
@@ -61,7 +68,7 @@ class JacgenGroup(click.Group):
             error.show()
             code = error.exit_code
         except click.ClickException as error:
-            click.echo(f"jacgen: error: {error.format_message()}", err=True)
+            _error_line(f"error: {error.format_message()}")
             code = error.exit_code
         except click.Abort:
             click.echo("jacgen: aborted", err=True)
@@ -72,19 +79,19 @@ class JacgenGroup(click.Group):
         try:
             return super().invoke(ctx)
         except JacgenError as error:
-            click.echo(f"jacgen: error: {error}", err=True)
+            _error_line(f"error: {error}")
             ctx.exit(2)
         except OSError as error:
-            click.echo(f"jacgen: error: {error.filename or ''}: {error.strerror or error}", err=True)
+            _error_line(f"error: {error.filename or ''}: {error.strerror or error}")
             ctx.exit(2)
         except (click.exceptions.Exit, click.ClickException, click.Abort):
             raise
         except Exception as error:  # noqa: BLE001 (a bug: one line, the traceback on request)
             if ctx.params.get("debug"):
                 raise
-            what = str(error).splitlines()[0][:200] if str(error) else ""
-            click.echo(f"jacgen: internal error: {type(error).__name__}{': ' if what else ''}{what} "
-                       f"(a bug in jacgen; run with --debug for the traceback)", err=True)
+            what = str(error)[:200]
+            _error_line(f"internal error: {type(error).__name__}{': ' if what else ''}{what} "
+                        f"(a bug in jacgen; run with --debug for the traceback)")
             ctx.exit(1)
 
 

@@ -21,11 +21,14 @@ MAX_LENGTH = 200
 MAX_DEPTH = 32
 MAX_MAGNITUDE = 1e6
 MAX_EXPONENT = 16
+MAX_DIGITS = 64  # of a number's mantissa, before any exact arithmetic on it
 
+# ASCII only: no other script's digits ("١٢" is not 12) or spaces.
+_NUMBER = r"(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][+-]?[0-9]+)?"
 _TOKEN = re.compile(
-    r"\s*(?:(?P<number>(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?)|(?P<name>[A-Za-z_][A-Za-z0-9_]*)"
-    r"|(?P<op>\*\*|[-+*/()]))"
-)
+    rf"[ \t\r\n]*(?:(?P<number>{_NUMBER})|(?P<name>[A-Za-z_][A-Za-z0-9_]*)|(?P<op>\*\*|[-+*/()]))", re.ASCII)
+_DECIMAL = re.compile(rf"[+-]?{_NUMBER}", re.ASCII)
+_PARTS = re.compile(r"([+-]?)([0-9]*)\.?([0-9]*)(?:[eE]([+-]?[0-9]+))?", re.ASCII)
 
 
 class Value(NamedTuple):
@@ -67,7 +70,26 @@ def parse(text: str, resolve: Callable[[str], Value]) -> Value:
 
 
 def number(text: str) -> Value:
-    return _checked(sympy.Rational(text), float(text))
+    """A decimal number ([+-]digits[.digits][e[+-]digits], ASCII), exact. Its size is checked
+    from its digits before any exact arithmetic, so 1e999999999 or 5,000 digits cost nothing."""
+    if not _DECIMAL.fullmatch(text):
+        raise ExpressionError(f"not a decimal number: {text[:40]!r}")
+    sign, integer, fraction, exponent = _PARTS.fullmatch(text).groups()
+    if len(integer) + len(fraction) > MAX_DIGITS:
+        raise ExpressionError(f"number with more than {MAX_DIGITS} digits")
+    significant = (integer + fraction).lstrip("0")
+    if not significant:
+        return Value(sympy.Integer(0), 0.0)
+    if exponent and len(exponent.lstrip("+-").lstrip("0")) > 4:  # beyond any double: out of range or underflow
+        exponent = exponent[0] + "99999" if exponent[0] == "-" else "99999"
+    scale = int(exponent or 0) - len(fraction)  # the value is int(integer + fraction) * 10**scale
+    order = len(significant) + scale  # 10**(order - 1) <= |value| < 10**order
+    if order > 7:
+        raise ExpressionError(f"value {text[:40]} is out of range (|value| <= {MAX_MAGNITUDE:g})")
+    if order < -330:
+        raise ExpressionError(f"value {text[:40]} is too small for a double (underflows)")
+    magnitude = sympy.Integer(int(integer + fraction)) * sympy.Integer(10) ** scale
+    return _checked(-magnitude if sign == "-" else magnitude, float(text))
 
 
 def _checked(exact: sympy.Expr, approx: float) -> Value:
@@ -131,6 +153,8 @@ class _Parser:
             return base
         self.take()
         exponent = self.unary(depth + 1)
+        if exponent.exact.free_symbols:  # its domain (a negative base, 0**x) would depend on the runtime value
+            raise ExpressionError("an exponent may not hold a symbolic parameter")
         if abs(exponent.approx) > MAX_EXPONENT:
             raise ExpressionError(f"exponent {exponent.approx:g} too large (|exponent| <= {MAX_EXPONENT})")
         if base.approx < 0 and exponent.approx != int(exponent.approx):

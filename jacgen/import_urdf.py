@@ -17,9 +17,9 @@ import yaml
 
 from . import reference
 from .dh_fit import Axis, fit, exact_or_float
-from .errors import JacgenError
+from .errors import JacgenError, RobotFileError
 from .names import robot_name_problem
-from .robot import FORBIDDEN_IN_TEXT, IDENTIFIER_PATTERN, NAME_PATTERN, TASK_COMPONENTS, Robot, parse_robot
+from .robot import FORBIDDEN_IN_TEXT, IDENTIFIER_PATTERN, NAME_PATTERN, TASK_COMPONENTS, Robot, parse_robot, task_problem
 from .urdf import MOVABLE, SNAP_TOLERANCE, LinkChain, Snapper, joint_axes, read_chain
 from .version import __version__
 
@@ -69,19 +69,22 @@ def import_urdf(path: str, base: str | None = None, tip: str | None = None, conv
 
     if task is not None and (not task or any(component not in TASK_COMPONENTS for component in task)):
         raise JacgenError(f"--task: expected components of {', '.join(TASK_COMPONENTS)}, got {','.join(task)!r}")
+    if task is not None and (problem := task_problem(list(task))):
+        raise JacgenError(f"--task: {problem}")
     if task is None:
-        task = () if len(axes) >= 6 else _independent_task(_read_back(text(TASK_COMPONENTS)))
+        task = () if len(axes) >= 6 else _independent_task(_read_back(text(TASK_COMPONENTS), path))
     result = text(task)
-    robot = _read_back(result)
+    robot = _read_back(result, path)
     return Imported(result, robot, _fk_difference(robot, chain), snapped)
 
 
-def _read_back(text: str) -> Robot:
-    """The robot of a file we wrote; one that does not read back is a bug of ours."""
+def _read_back(text: str, path: str) -> Robot:
+    """The robot of the file written for the URDF at `path`, validated as every robot file is:
+    a rule the chain breaks there (its size, equal limits) is the URDF's, and named."""
     try:
         return parse_robot(text.encode(), "<imported robot file>")
-    except JacgenError as error:
-        raise RuntimeError(f"the imported robot file does not read back: {error}") from None
+    except RobotFileError as error:
+        raise JacgenError(f"{path}: the chain makes no valid robot file: {error.key}: {error.message}") from None
 
 
 def _axes(chain: LinkChain) -> tuple[list[Axis], sympy.Matrix]:

@@ -13,7 +13,7 @@ import sympy
 from sympy.polys.orderings import lex
 from sympy.polys.rings import PolyElement, PolyRing
 
-from . import kinematics
+from . import kinematics, names
 from .robot import Robot
 
 # The monomial products of all polynomial multiplications of one robot (about 3 s of sympy's
@@ -26,7 +26,7 @@ def joint_atoms(robot: Robot) -> tuple[tuple[sympy.Symbol, ...], ...]:
     """Per joint, the symbols analysis polynomials are written in: (c_i, s_i), the cos and
     sin of q_i + offset_i, for a revolute joint; (q_i,) for a prismatic one."""
     q = kinematics.joint_symbols(robot)
-    return tuple(sympy.symbols(f"c{i + 1} s{i + 1}", real=True) if joint.revolute else (q[i],)
+    return tuple(kinematics.trig_symbols((i,), robot.dof) if joint.revolute else (q[i],)
                  for i, joint in enumerate(robot.joints))
 
 
@@ -92,7 +92,7 @@ class JointRing:
         if expr.is_number or not (expr.is_Add or expr.is_Mul or (expr.is_Pow and expr.exp.is_Integer
                                                                     and expr.exp >= 0)):
             if expr not in self.opaque:
-                self.opaque[expr] = sympy.Symbol(f"_k{len(self.opaque)}", real=True)
+                self.opaque[expr] = sympy.Symbol(f"{names.INTERNAL_PREFIX}k{len(self.opaque)}", real=True)
             return self.opaque[expr]
         return expr.func(*(self._hide_constants(arg) for arg in expr.args))
 

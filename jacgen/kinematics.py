@@ -13,6 +13,7 @@ from typing import Callable
 import sympy
 from sympy.simplify.fu import TR10i
 
+from . import names
 from .robot import TASK_COMPONENTS, Pose, Robot
 
 Matrix = sympy.Matrix
@@ -20,15 +21,13 @@ CosSin = Callable[[int], tuple[sympy.Expr, sympy.Expr]]
 
 
 def joint_symbols(robot: Robot) -> tuple[sympy.Symbol, ...]:
-    return sympy.symbols(f"q1:{robot.dof + 1}", real=True)
+    return tuple(sympy.Symbol(names.indexed("q", i + 1), real=True) for i in range(robot.dof))
 
 
-def trig_symbols(joints: tuple[int, ...]) -> tuple[sympy.Symbol, sympy.Symbol]:
-    """The symbols of the cos and sin of a sum of joint angles (0-based joints): c2, s2 for
-    joint 2, c23, s23 for joints 2 and 3, c9_10 once a joint number has two digits."""
-    separator = "_" if any(i >= 9 for i in joints) else ""
-    label = separator.join(str(i + 1) for i in joints)
-    return sympy.symbols(f"c{label} s{label}", real=True)
+def trig_symbols(joints: tuple[int, ...], dof: int) -> tuple[sympy.Symbol, sympy.Symbol]:
+    """The symbols of the cos and sin of a sum of joint angles (0-based joints of a `dof`-joint
+    robot), named by `names.trig`: c2, s2 for joint 2, c23, s23 for joints 2 and 3."""
+    return tuple(sympy.Symbol(name, real=True) for name in names.trig(joints, dof))
 
 
 def rot_x(c, s) -> Matrix:
@@ -260,7 +259,7 @@ def propagated_jacobian_tool(robot: Robot, cos_sin: CosSin, q) -> Matrix:
     frame to frame in local coordinates, w' = R^T (w + qd z), v' = R^T (v + w x p) (+ dd z),
     and the Jacobian read off as the coefficients of the joint rates.
     """
-    rates = sympy.symbols(f"qd1:{robot.dof + 1}", real=True)
+    rates = tuple(sympy.Symbol(names.indexed("qd", i + 1), real=True) for i in range(robot.dof))
     z = Matrix([0, 0, 1])
     omega, velocity = sympy.zeros(3, 1), sympy.zeros(3, 1)  # of the base, in base coordinates
 
@@ -316,7 +315,8 @@ def task_jacobian_dot(robot: Robot, pose: Matrix, jacobian: Matrix, jacobian_dot
     """d/dt of task_jacobian: the position rows of J', and for the angles the Euler-angle rates
     differentiated through what they read, the first column r of R (r' = w x r with
     w = Jw q_dot) and the angular rows of J (whose rate is that of J')."""
-    r, w = sympy.symbols("_r0:3", real=True), sympy.symbols("_w0:3", real=True)
+    r = sympy.symbols(f"{names.INTERNAL_PREFIX}r0:3", real=True)
+    w = sympy.symbols(f"{names.INTERNAL_PREFIX}w0:3", real=True)
     rates = rpy_rates(Matrix([[r[0], 0, 0], [r[1], 0, 0], [r[2], 0, 0]]), Matrix(w))
     by_r, by_w = rates.jacobian(r), rates.jacobian(w)
     column = pose[:3, 0]

@@ -17,6 +17,7 @@ from sympy.core.operations import LatticeOp
 from sympy.logic.boolalg import Boolean, BooleanFunction
 from sympy.simplify.cse_main import Unevaluated, match_common_args
 
+from . import names
 from .nodes import TOLERANCES
 
 
@@ -181,7 +182,7 @@ class Lowering:
             return -self._names[negated]
         if _mostly_negative(value):
             return -self.name(negated)
-        symbol = sympy.Symbol(f"_n{len(self.definitions)}", real=True)
+        symbol = sympy.Symbol(f"{names.INTERNAL_PREFIX}n{len(self.definitions)}", real=True)
         self.definitions.append((symbol, value))
         self._names[value] = symbol
         return symbol
@@ -213,12 +214,12 @@ class Lowering:
         named = [(s, v) for s, v in self.definitions if s in needed and s in named_symbols]
         with distribute(False):
             replacements, reduced = eliminate_common([fold(v) for _, v in named] + [fold(e) for e in outputs],
-                                                     sympy.numbered_symbols("_r", real=True), self._negations)
+                                                     sympy.numbered_symbols(f"{names.INTERNAL_PREFIX}r", real=True), self._negations)
         bound = [(s, fold(v)) for s, v in bindings.items() if s in needed]
         definitions = _in_dependency_order(bound + trig + list(zip((s for s, _ in named), reduced)) + replacements)
         definitions, reduced = _without_constants(definitions, reduced[len(named):])
         # The temporaries are named when printed: renaming them here would rebuild every expression.
-        temporaries = [symbol for symbol, _ in definitions if symbol.name.startswith("_")]
+        temporaries = [symbol for symbol, _ in definitions if symbol.name.startswith(names.INTERNAL_PREFIX)]
         read = set().union(*(e.free_symbols for _, e in definitions), *(e.free_symbols for e in reduced))
         return Body(frozenset(read - {symbol for symbol, _ in definitions}), tuple(definitions), tuple(reduced),
                     {symbol: f"t{k}" for k, symbol in enumerate(temporaries)})

@@ -78,9 +78,46 @@ GENERATED_NAMES = frozenset("""
     IK_NEAREST_NOT_FINITE limits keep xp dtype device trig branches_q branches_valid
     branches_in_limits
 """.split())
-# Temporaries t0.., trig terms c1.. s1.., joint variables q1.., rates qd1.., seeds qn1.. and weights qw1.., the entries of an ik target
-# T00.. and mu0.., the ik_branches table read by ik_nearest (qb0_0.., vb0.., lb0..); names starting with '_'; <math.h>'s M_PI, FP_NAN...
-_GENERATED_PATTERN = re.compile(r"^(?:[tcsqT]\d+(?:_\d+)*|mu(?:_dot)?\d+|q[sdnw]\d+|qb\d+_\d+|[vl]b\d+|_.*|M_\w+|FP_\w+)$")
+# Every symbol name the generator makes up: a prefix and indices (`qb3_1`). This table is their
+# one owner: the generator builds its symbols with `indexed` and `trig`, and a parameter may
+# not take a name of this form.
+GENERATED_PREFIXES = {
+    "q": "joint positions q1..", "qd": "joint rates qd1..", "qs": "ik_numeric_step's q qs1..",
+    "qn": "ik_nearest's seed qn1..", "qw": "ik_nearest's weights qw1..", "qb": "the ik_branches table qb0_0..",
+    "vb": "its valid flags vb0..", "lb": "its in-limits flags lb0..", "ga": "the general 6R angles ga0..",
+    "qg": "a general 6R solution qg1..", "T": "the entries of an ik target T00..",
+    "mu": "the entries of a task target mu0..", "mu_dot": "task rates mu_dot0..",
+    "c": "cos of a joint or a sum of joints c1.., c23..", "s": "sin of the same s1.., s23..",
+    "t": "printed temporaries t0..",
+}
+INTERNAL_PREFIX = "_"  # the generator's own temporaries (`_n3`), never printed under that name
+_GENERATED_PATTERN = re.compile(
+    "^(?:(?:" + "|".join(sorted(GENERATED_PREFIXES, key=len, reverse=True)) + r")[0-9]+(?:_[0-9]+)*"
+    + "|" + INTERNAL_PREFIX + r".*|M_\w+|FP_\w+)$")  # and <math.h>'s M_PI, FP_NAN...
+
+
+def indexed(prefix: str, *indices: int, separator: str = "_") -> str:
+    """The generated symbol `prefix` of GENERATED_PREFIXES with its indices: q3, qb3_1 (T03 for
+    a 4x4 matrix's entry, with no separator)."""
+    if prefix not in GENERATED_PREFIXES:
+        raise ValueError(f"{prefix!r} is not a generated prefix")
+    return prefix + separator.join(map(str, indices))
+
+
+def trig(joints: tuple[int, ...], dof: int) -> tuple[str, str]:
+    """The names of the cos and sin of a sum of joint angles (0-based joints of a `dof`-joint
+    robot): c2, s2 for joint 2; c23, s23 for joints 2 and 3. On a robot of ten joints or more the
+    joints of a sum are separated, c1_2, so that the sum of joints 1 and 2 is not joint 12."""
+    label = ("_" if dof > 9 else "").join(str(i + 1) for i in joints)
+    return f"c{label}", f"s{label}"
+
+
+def trig_joint(name: str) -> int | None:
+    """The 0-based joint k of a name `trig((k,), dof)` gives, else None. (On a robot of nine
+    joints or fewer, c23 reads as joint 23: ask only where no sum's symbol can be.)"""
+    match = re.fullmatch(r"[cs]([1-9][0-9]*)", name)
+    return None if match is None else int(match[1]) - 1
+
 
 ROBOT_NAME_RULE = ("a robot name may not be a C or Python keyword, a C standard header or a "
                    "Python module name, since it names the generated files and modules")

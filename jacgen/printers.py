@@ -6,7 +6,7 @@ products in the order sympy stores them, which it sorts by structure, never by h
 text is deterministic and nothing is re-sorted or rebuilt while printing. Each language
 is a subclass that says how a function, a literal, a power, a select and the logic read.
 
-Every number that is not an integer, and every subexpression of the IK's tolerances alone
+Every number that is not a small integer (EXACT_INTEGER), and every subexpression of the IK's tolerances alone
 (EPS, TINY, RANK, replaced by the numbers of the build's real type), prints as one literal:
 the shortest decimal that reads back as the same value of that type.
 """
@@ -15,6 +15,10 @@ import sympy
 
 from .lowering import Body, is_boolean
 from .nodes import TOLERANCE_SYMBOLS, TOLERANCES, Select
+
+# Integers up to this size print as integer literals (exact in float and double, and an `int`
+# in C); larger ones as floating literals, which cannot overflow an integer type.
+EXACT_INTEGER = 2**24
 
 # Binding strength of what a node prints as: an operand binding more loosely than its
 # operator is parenthesised.
@@ -59,7 +63,7 @@ class Printer:
     def _node(self, expr: sympy.Basic) -> tuple[str, int]:
         if expr.is_Symbol and expr not in TOLERANCE_SYMBOLS:
             return self._names.get(expr, expr.name), ATOM
-        if expr.is_Integer:
+        if expr.is_Integer and abs(expr) <= EXACT_INTEGER:
             return str(expr), SUM if expr < 0 else ATOM
         constant = self._constant(expr)
         if is_boolean(expr):

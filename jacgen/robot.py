@@ -10,9 +10,11 @@ import re
 from dataclasses import dataclass
 from pathlib import Path
 
+import numpy as np
 import sympy
 import yaml
 
+from . import numeric_chain
 from .errors import RobotFileError
 from .expr import ExpressionError, Value, parse
 from .names import PARAMETER_NAME_RULE, ROBOT_NAME_RULE, parameter_name_problem, robot_name_problem
@@ -28,6 +30,14 @@ IDENTIFIER_PATTERN = re.compile(r"^[A-Za-z_][A-Za-z0-9_]{0,47}$")
 # strings: printable lines (one for length_unit, any number for the description) without
 # what could end or escape them there. Its length is bounded only by MAX_FILE_BYTES.
 FORBIDDEN_IN_TEXT = ('\\', '"""', "/*", "*/", "??")
+# The sizes jacgen is right for (contract §1, "Numbers"): the reach (Robot.reach) is 0 or within
+# REACH, in the file's length unit, since the generated code's tolerances are absolute; a length
+# of a link (a, d) that is not 0 is at least SMALLEST_LENGTH times the reach (below it the arm is singular everywhere
+# to double rounding).
+REACH = (1e-2, 1e3)
+SMALLEST_LENGTH = 1e-7
+# Below this, cos(pitch) is the rounding of 0 (check_euler_angles).
+GIMBAL_LOCK = 1e-12
 # Within this many radians of a multiple of pi/2, an angle becomes that multiple exactly.
 ANGLE_SNAP_TOLERANCE = 1e-9
 ZERO = Value(sympy.Integer(0), 0.0)
@@ -101,6 +111,20 @@ class Robot:
         """The robot file's name without its folder, unprintable characters as '?' (it goes
         into one-line comments and the report's commands)."""
         return "".join(c if c.isprintable() else "?" for c in Path(self.source).name)
+
+    @property
+    def reach(self) -> float:
+        """An upper bound of the distance of any frame origin from the world origin: the sum of
+        every length of the file (a, d, the base's and tool's xyz, prismatic travel)."""
+        total = sum(abs(v.approx) for pose in (self.base, self.tool) for v in pose.xyz)
+        for joint in self.joints:
+            total += abs(joint.a.approx)
+            if joint.revolute:
+                total += abs(joint.d.approx)
+            else:
+                lo, hi = joint.limits or (-math.pi, math.pi)
+                total += max(abs(lo), abs(hi)) + abs(joint.offset.approx)
+        return total
 
     @property
     def ranges(self) -> tuple[tuple[float, float], ...]:
@@ -177,6 +201,7 @@ class _RobotReader:
         self.path, self.data = path, data
         self.values: dict[str, Value] = {}
         self.angle_scale = Value(sympy.Integer(1), 1.0)
+        self.lengths: list[tuple[yaml.Node, str, Value]] = []  # the link lengths read, for check_sizes
 
     # -- errors and structure ------------------------------------------------------------
     def error(self, node, key: str, message: str) -> RobotFileError:
@@ -238,8 +263,9 @@ class _RobotReader:
                              f"comments and strings; not allowed: {' '.join(FORBIDDEN_IN_TEXT)})")
         return text
 
-    def value(self, node, key: str, angle: bool = False) -> Value:
-        """A number, parameter name or expression; angles converted to radians and snapped."""
+    def value(self, node, key: str, angle: bool = False, length: bool = False) -> Value:
+        """A number, parameter name or expression; angles converted to radians and snapped,
+        link lengths (a, d) kept for `check_sizes`."""
         numeric_tags = ("tag:yaml.org,2002:int", "tag:yaml.org,2002:float", "tag:yaml.org,2002:str")
         if not isinstance(node, yaml.ScalarNode) or node.tag not in numeric_tags:
             raise self.error(node, key, f"expected a number or expression, got {_describe(node)}")
@@ -252,6 +278,8 @@ class _RobotReader:
             value = parse(text, self.resolve)
         except ExpressionError as error:
             raise self.error(node, key, f"{error} in {_shown(node.value)}") from None
+        if length:
+            self.lengths.append((node, key, value))
         return _snap_angle(_scaled(value, self.angle_scale)) if angle else value
 
     def resolve(self, name: str) -> Value:
@@ -282,8 +310,37 @@ class _RobotReader:
         tool = self.pose(top["tool"], "tool") if "tool" in top else IDENTITY_POSE
         task = self.task(top.get("task"), root, len(joints))
         free_joint = self.free_joint(top["ik"], joints, task) if "ik" in top else None
-        return Robot(name, description, convention, length_unit, parameters, joints, base, tool,
-                     task, self.path, hashlib.sha256(self.data).hexdigest()[:16], free_joint)
+        robot = Robot(name, description, convention, length_unit, parameters, joints, base, tool,
+                      task, self.path, hashlib.sha256(self.data).hexdigest()[:16], free_joint)
+        self.check_sizes(robot, top["joints"])
+        if "task" in top:
+            self.check_euler_angles(robot, top["task"])
+        return robot
+
+    def check_euler_angles(self, robot: Robot, task_node) -> None:
+        """Roll and yaw are defined somewhere: not when the tool's x axis stays along the world
+        z axis (pitch +-90 deg) at every configuration, as it does when no joint turns it (at
+        the symbolic parameters' values; checked at a few fixed random configurations)."""
+        if not {"roll", "yaw"} & set(robot.task):
+            return
+        ranges = np.array(robot.ranges)
+        q = np.random.default_rng(0).uniform(ranges[:, 0], ranges[:, 1], (4, robot.dof))
+        x_axis = numeric_chain.link_frames(robot, q)[1][:, :3, 0]
+        if np.all(np.hypot(x_axis[:, 0], x_axis[:, 1]) < GIMBAL_LOCK):
+            raise self.error(task_node, "task", "roll and yaw are undefined at every configuration: the tool's x "
+                             "axis stays along the world z axis (pitch +-90 deg), where ZYX Euler angles have no "
+                             "roll or yaw; leave them out of the task, or turn the tool")
+    def check_sizes(self, robot: Robot, joints_node) -> None:
+        """The reach within REACH, and no link length (a, d) but 0 below SMALLEST_LENGTH of it."""
+        reach = robot.reach
+        if reach and not REACH[0] <= reach <= REACH[1]:
+            raise self.error(joints_node, "joints", f"the arm's size (the sum of its lengths) is {reach:.3g} "
+                             f"{robot.length_unit}: jacgen supports {REACH[0]:g} to {REACH[1]:g} (its tolerances "
+                             f"are absolute); write the lengths in another unit")
+        for node, key, value in self.lengths:
+            if value.approx and abs(value.approx) < SMALLEST_LENGTH * reach:
+                raise self.error(node, key, f"length {value.approx:.3g} is below {SMALLEST_LENGTH:g} of the arm's "
+                                 f"size {reach:.3g}, where the arm is singular everywhere to rounding: write 0")
 
     def parameters(self, node, robot_name: str) -> tuple[Parameter, ...]:
         if not isinstance(node, yaml.MappingNode):
@@ -338,10 +395,10 @@ class _RobotReader:
                 raise self.error(entries.get("name", row), f"{key}.name",
                                  f"duplicate joint name {name!r} (also joints[{names[name]}])")
             names[name] = index
-            fixed = self.value(entries[constant], f"{key}.{constant}", angle=constant == "theta")
+            fixed = self.value(entries[constant], f"{key}.{constant}", angle=constant == "theta", length=constant == "d")
             joints.append(Joint(
                 name=name, kind=kind,
-                a=self.value(entries["a"], f"{key}.a"),
+                a=self.value(entries["a"], f"{key}.a", length=True),
                 alpha=self.value(entries["alpha"], f"{key}.alpha", angle=True),
                 d=fixed if kind == "revolute" else None,
                 theta=fixed if kind == "prismatic" else None,
@@ -356,7 +413,10 @@ class _RobotReader:
         items = self.sequence(node, key, 2)
         lower, upper = (self.value(item, f"{key}[{i}]", angle) for i, item in enumerate(items))
         if lower.approx > upper.approx:
-            raise self.error(node, key, f"lower limit {items[0].value} is above upper limit {items[1].value}")
+            raise self.error(node, key, f"lower limit {_shown(items[0].value)} is above upper limit {_shown(items[1].value)}")
+        if lower.approx == upper.approx:
+            raise self.error(node, key, f"the limits are equal ({_shown(items[0].value)}): the joint could not move; "
+                             "give it a range, or fold it into the neighbouring rows")
         return (lower.approx, upper.approx)
 
     def pose(self, node, key: str) -> Pose:
@@ -375,12 +435,9 @@ class _RobotReader:
             return TASK_COMPONENTS
         items = self.sequence(node, "task")
         names = [self.string(item, f"task[{i}]", TASK_COMPONENTS) for i, item in enumerate(items)]
-        if not names:
-            raise self.error(node, "task", "expected at least one component")
-        if len(set(names)) != len(names) or names != sorted(names, key=TASK_COMPONENTS.index):
-            canonical = ", ".join(sorted(set(names), key=TASK_COMPONENTS.index))
-            raise self.error(node, "task", f"components must be distinct and in the order "
-                             f"x, y, z, roll, pitch, yaw: write [{canonical}]")
+        problem = task_problem(names)
+        if problem:
+            raise self.error(node, "task", problem)
         return tuple(names)
 
 
@@ -401,6 +458,16 @@ class _RobotReader:
         if not joints[number - 1].revolute:
             raise self.error(item, "ik.free_joint", f"joint {number} is prismatic: the free joint must be revolute")
         return number - 1
+
+
+def task_problem(components: list[str]) -> str | None:
+    """Why `components` (each one of TASK_COMPONENTS) is not a task, None when it is."""
+    if not components:
+        return "expected at least one component"
+    if len(set(components)) != len(components) or components != sorted(components, key=TASK_COMPONENTS.index):
+        canonical = ", ".join(sorted(set(components), key=TASK_COMPONENTS.index))
+        return f"components must be distinct and in the order x, y, z, roll, pitch, yaw: write [{canonical}]"
+    return None
 
 
 def _scaled(value: Value, scale: Value) -> Value:

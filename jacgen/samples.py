@@ -1,5 +1,5 @@
 """The configurations `jacgen verify` checks at: random ones inside the joint ranges, and
-those at or near each singularity; and the arm's reach, which scales the float tolerance.
+those at or near each singularity.
 """
 
 import itertools
@@ -9,19 +9,6 @@ import numpy as np
 
 from . import analysis
 from .robot import Robot
-
-
-def reach(robot: Robot) -> float:
-    """An upper bound of the distance of any frame origin from the world origin."""
-    total = sum(abs(v.approx) for pose in (robot.base, robot.tool) for v in pose.xyz)
-    for joint in robot.joints:
-        total += abs(joint.a.approx)
-        if joint.revolute:
-            total += abs(joint.d.approx)
-        else:
-            lo, hi = joint.limits or (-math.pi, math.pi)
-            total += max(abs(lo), abs(hi)) + abs(joint.offset.approx)
-    return total
 
 
 def random_configurations(robot: Robot, count: int, rng: np.random.Generator) -> np.ndarray:

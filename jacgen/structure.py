@@ -16,12 +16,11 @@ meet in a point (a spherical shoulder) is solved backwards: `Geometry.reversed`.
 """
 
 import copy
-import re
 from dataclasses import dataclass, field, replace
 
 import sympy
 
-from . import kinematics
+from . import kinematics, names
 from .expr import Value
 from .robot import TASK_COMPONENTS, Pose, Robot
 
@@ -99,13 +98,10 @@ class Structure:
     chain: "Geometry | None" = field(default=None, compare=False)  # what the solver solves (see Geometry)
 
 
-_FREE_TRIG = re.compile(r"[cs](\d+)")  # the free joint's cos and sin (kinematics.trig_symbols); no parameter is named so
-
-
 def _circle(expr: sympy.Expr) -> tuple[sympy.Symbol, sympy.Symbol] | None:
     """The cos and sin symbols of the free joint when `expr` depends on them."""
-    match = next((m for x in expr.free_symbols if (m := _FREE_TRIG.fullmatch(x.name))), None)
-    return None if match is None else sympy.symbols(f"c{match[1]} s{match[1]}", real=True)
+    joint = next((k for x in expr.free_symbols if (k := names.trig_joint(x.name)) is not None), None)
+    return None if joint is None else kinematics.trig_symbols((joint,), joint + 1)
 
 
 def _on_circle(polynomial: sympy.Expr, cos: sympy.Symbol, sin: sympy.Symbol) -> sympy.Expr:
@@ -134,8 +130,8 @@ def _generic_points(symbols: set[sympy.Symbol]) -> list[dict[sympy.Symbol, sympy
     for k in range(1, GENERIC_POINTS + 1):
         point = {}
         for j, symbol in enumerate(sorted(symbols, key=lambda x: x.name), 1):
-            if joint := _FREE_TRIG.fullmatch(symbol.name):
-                angle = 2 * sympy.pi * fraction(k, int(joint[1]))  # one angle for c_k and s_k
+            if (joint := names.trig_joint(symbol.name)) is not None:
+                angle = 2 * sympy.pi * fraction(k, joint + 1)  # one angle for c_k and s_k
                 value = (sympy.cos if symbol.name[0] == "c" else sympy.sin)(angle)
             else:
                 value = 0.5 + fraction(k, j)
@@ -219,7 +215,7 @@ class Geometry:
 
         def cos_sin(i):
             if i == free:
-                symbols = kinematics.trig_symbols((i,))
+                symbols = kinematics.trig_symbols((i,), n)
                 return tuple(_generic_points(set(symbols))[0][s] for s in symbols) if generic else symbols
             return (sympy.cos(precise.joints[i].offset.exact), sympy.sin(precise.joints[i].offset.exact))
 

@@ -21,16 +21,17 @@ import numpy as np
 import sympy
 from sympy import Matrix
 
+from . import expr
 from .errors import RobotFileError
+from .expr import ExpressionError
 from .kinematics import xyz_rpy_transform
-from .robot import ANGLE_SNAP_TOLERANCE
+from .robot import ANGLE_SNAP_TOLERANCE, MAX_JOINTS
 
 MAX_URDF_BYTES = 16 << 20
 SNAP_TOLERANCE = ANGLE_SNAP_TOLERANCE  # as robot files snap their angles
 DIGITS = 30  # of the numbers that are not exact (cos and sin of general angles)
 MOVABLE = ("revolute", "continuous", "prismatic")
 JOINT_TYPES = MOVABLE + ("fixed", "floating", "planar")
-_DECIMAL = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?")
 
 
 @dataclass
@@ -93,8 +94,9 @@ class Snapper:
 
 
 def parse_xml(data: bytes, path: str) -> Element:
-    """The element tree of `data`; refuses a DOCTYPE, so entities can never be declared."""
-    parser = expat.ParserCreate()
+    """The element tree of `data`, read as UTF-8 whatever encoding it declares (ROS reads URDFs
+    so); refuses a DOCTYPE, so entities can never be declared."""
+    parser = expat.ParserCreate(encoding="utf-8")
     parser.SetParamEntityParsing(expat.XML_PARAM_ENTITY_PARSING_NEVER)
     stack: list[Element] = []
     roots: list[Element] = []
@@ -193,9 +195,14 @@ class _UrdfReader:
         for joint in up:  # base -> common ancestor: the fixed transforms, inverted
             start = inverse_transform(self.joint(joint).origin) * start
         chain = [self.joint(j) for j in down]
-        if not any(j.kind in MOVABLE for j in chain):
+        moving = [j for j in down if j.attributes.get("type") in MOVABLE]
+        if not moving:
             raise RobotFileError(self.path, root.line, root.column, "", f"no moving joint between "
                                  f"links {base!r} and {tip!r}")
+        if len(moving) > MAX_JOINTS:
+            raise self.error(moving[MAX_JOINTS], f"joint[{moving[MAX_JOINTS].attributes['name']}]",
+                             f"the chain {base!r} -> {tip!r} has {len(moving)} moving joints; a robot file "
+                             f"holds at most {MAX_JOINTS}")
         folded = tuple(j.attributes["name"] for j in up) + tuple(j.name for j in chain if j.kind == "fixed")
         return LinkChain(root.attributes.get("name", ""), base, tip, start, tuple(chain), folded)
 
@@ -277,19 +284,23 @@ class _UrdfReader:
             limit = element.child("limit")
             if kind != "continuous" and limit is not None and ("lower" in limit.attributes or "upper" in limit.attributes):
                 lower, upper = (limit.attributes.get(side, "0") for side in ("lower", "upper"))
-                for side, text in (("lower", lower), ("upper", upper)):
-                    self.number(text, limit, f"{key}.limit.{side}")
-                if float(lower) > float(upper):
-                    raise self.error(limit, f"{key}.limit", f"lower limit {lower} is above upper limit {upper}")
+                low, high = (self.number(text, limit, f"{key}.limit.{side}") for side, text in
+                             (("lower", lower), ("upper", upper)))
+                if low > high:
+                    raise self.error(limit, f"{key}.limit", f"lower limit {lower!r} is above upper limit {upper!r}")
+                if low == high:
+                    raise self.error(limit, f"{key}.limit", f"the limits are equal ({lower!r}): the joint could not "
+                                     "move; give it a range, or make it a fixed joint")
                 limits = (lower.strip(), upper.strip())
         return UrdfJoint(name, kind, transform, axis, limits)
 
     def number(self, text: str, element: Element, key: str) -> sympy.Rational:
-        text = text.strip()
-        if not _DECIMAL.fullmatch(text) or not math.isfinite(float(text)) or abs(float(text)) > 1e6:
+        """A decimal, exact, by the robot files' bounded number parser."""
+        try:
+            return expr.number(text.strip(" \t\r\n")).exact
+        except ExpressionError as error:
             hint = " (a xacro file? run xacro on it first)" if "$" in text else ""
-            raise self.error(element, key, f"expected a finite number up to 1e6, got {text[:40]!r}{hint}")
-        return sympy.Rational(text)
+            raise self.error(element, key, f"{error}{hint}") from None
 
     def numbers(self, element: Element | None, key: str, attribute: str) -> list[sympy.Rational]:
         if element is None or attribute not in element.attributes:

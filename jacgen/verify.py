@@ -32,7 +32,7 @@ from .catalogue import Function
 from .functions import Generator
 from .parallel import for_each_robot
 from .render import render_robot, write_files
-from .samples import configurations, reach
+from .samples import configurations
 from .robot import EULER_ANGLES, Robot
 from .generated_code import HOST_BACKENDS, GeneratedCode
 from .target import Emulator, check_tools
@@ -43,7 +43,7 @@ DOUBLE_TOLERANCE = 1e-9
 # larger than the reach (positions, Jacobian entries) or 1 (rotations): ~1e-6 * (1 + reach)
 # for the shipped arms. 1e-4 * (1 + reach) leaves a margin of ~100 for long chains and
 # cancellation, and is still far below any modelling error (a wrong term is >= 1e-3). Each
-# float error is divided by 1 + |expected| (`compare`): float rounds relative to the value.
+# error is divided by 1 + |expected| (`compare`): float and double round relative to the value.
 FLOAT_TOLERANCE = 1e-4
 # Where cos(pitch) < this, roll and yaw and the Euler-angle rates are ill-conditioned (they
 # are undefined at pitch = +-90 deg): the angle rows of `task` and `task_jacobian` are not
@@ -93,14 +93,14 @@ def _reference(robot: Robot, function: Function, q: np.ndarray, *more: np.ndarra
 
 
 def compare(robot: Robot, function: Function, value: np.ndarray, expected: np.ndarray,
-            q: np.ndarray, relative: bool = False) -> tuple[float, int]:
+            q: np.ndarray) -> tuple[float, int]:
     """Largest error of results (k, rows * cols) against the reference at q (k, dof), and the
     number of samples whose Euler-angle rows were not compared.
 
     Angles of the task vector are compared modulo 2 pi; a NaN or infinity that is compared
-    is an infinite error. `relative` (float builds) divides each error by 1 + |expected|:
-    float rounds relative to the value, and the Euler-rate rows of task_jacobian_dot reach
-    |q_dot|^2 / cos(pitch)^2 near the margin.
+    is an infinite error. Each error is divided by 1 + |expected|: float and double round
+    relative to the value (manipulability grows as the reach cubed), and the Euler-rate rows
+    of task_jacobian_dot reach |q_dot|^2 / cos(pitch)^2 near the margin.
     """
     elements = np.zeros(value.shape[1], dtype=bool)  # the entries undefined where cos(pitch) = 0
     if function.name in EULER_FUNCTIONS:
@@ -118,17 +118,20 @@ def compare(robot: Robot, function: Function, value: np.ndarray, expected: np.nd
     skipped = int((~compared.all(axis=1)).sum())
     if not np.isfinite(value[compared]).all():
         return math.inf, skipped
-    if relative:
-        difference = difference / (1 + np.abs(expected))
-    return float(np.max(np.abs(difference[compared]), initial=0.0)), skipped
+    relative = difference / (1 + np.abs(expected))
+    return float(np.max(np.abs(relative[compared]), initial=0.0)), skipped
 
 
 def verify_robot(robot: Robot, backends: GeneratedCode, functions: list[Function], q: np.ndarray,
                  random_count: int, form: ik.ClosedForm | None) -> list[Result]:
     """Every function at q, whose first `random_count` rows are random (not singular) samples."""
     names = backends.names
-    tolerances = {backend: FLOAT_TOLERANCE * (1 + reach(robot)) if _is_float(backend) else DOUBLE_TOLERANCE
+    tolerances = {backend: (FLOAT_TOLERANCE if _is_float(backend) else DOUBLE_TOLERANCE) * (1 + robot.reach)
                   for backend in names}
+    # Js's determinant and manipulability are products of one entry per position row, each up to the reach
+    positions = sum(component in ("x", "y", "z") for component in robot.task)
+    product_tolerances = {backend: tolerance * (1 + robot.reach) ** max(positions - 1, 0)
+                          for backend, tolerance in tolerances.items()}
     results = []
     ranks = _rank_ratios(robot, q)
     q_dot = np.random.default_rng(1).normal(size=q.shape)  # joint rates, for the second-order functions
@@ -149,10 +152,11 @@ def verify_robot(robot: Robot, backends: GeneratedCode, functions: list[Function
         errors = {}
         for backend in names:
             errors[backend], skipped = compare(robot, function, backends.evaluate(backend, function.name, q, *more),
-                                               expected, q, relative=_is_float(backend))
+                                               expected, q)
         note = (f"angle rows not compared at {skipped} of {len(q)} samples (cos(pitch) < {EULER_MARGIN})"
                 if skipped else "")
-        results.append(Result(robot.name, function.name, errors, tolerances, note))
+        results.append(Result(robot.name, function.name, errors,
+                              product_tolerances if function.name in JS_FUNCTIONS else tolerances, note))
     regular = ranks > REGULAR_RANK
     results += _ik_results(robot, backends, q[:random_count], tolerances, form)
     mu_dot = np.random.default_rng(0).normal(size=(int(regular.sum()), len(robot.task)))
@@ -181,15 +185,19 @@ def _is_float(backend: str) -> bool:
 
 def _rank_ratios(robot: Robot, q: np.ndarray) -> np.ndarray:
     """Smallest over largest singular value of the reference Js at each sample (NaN where
-    Js is undefined: Euler-angle rows at cos(pitch) < EULER_MARGIN)."""
+    Js is undefined: Euler-angle rows at cos(pitch) < EULER_MARGIN), made free of the length
+    unit: position rows divided by the reach, prismatic columns multiplied by it."""
     ratios = np.full(len(q), np.nan)
+    length = robot.reach or 1.0
+    rows = np.array([length if component in ("x", "y", "z") else 1.0 for component in robot.task])
+    columns = np.array([1.0 if joint.revolute else length for joint in robot.joints])
     for k, row in enumerate(q):
         rotation = reference.fk(robot, row)[:3, :3]
         if analysis.singularity_rows(robot) is None and np.hypot(rotation[0, 0], rotation[1, 0]) < EULER_MARGIN:
             continue
-        values = np.linalg.svd(reference.singularity_jacobian(robot, row), compute_uv=False)
+        values = np.linalg.svd(reference.singularity_jacobian(robot, row) * columns / rows[:, None], compute_uv=False)
         # A Js that is zero to rounding (a 1 x 1 Js of a task the joint cannot move) is singular.
-        ratios[k] = values[-1] / values[0] if values[0] > ZERO_JACOBIAN * (1 + reach(robot)) else 0.0
+        ratios[k] = values[-1] / values[0] if values[0] > ZERO_JACOBIAN * (1 + robot.reach) else 0.0
     return ratios
 
 
@@ -400,5 +408,5 @@ def format_table(results: list[Result]) -> str:
     widths = [max(len(row[c]) for row in rows) for c in range(len(header))]
     lines = ["  ".join(cell.ljust(width) for cell, width in zip(row, widths)).rstrip() for row in rows]
     failed = sum(result.failed for result in results)
-    lines.append(f"double tolerance {DOUBLE_TOLERANCE:.0e}; {failed} of {len(results)} functions above tolerance")
+    lines.append(f"double tolerance {DOUBLE_TOLERANCE:.0e} x (1 + reach); {failed} of {len(results)} functions above tolerance")
     return "\n".join(lines)

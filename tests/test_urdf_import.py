@@ -268,10 +268,10 @@ HOSTILE = {
                  "3:", "joint[j1].type: a floating joint is on the chain"),
     "xacro": ('<robot name="r">\n<link name="a"/><link name="b"/>\n<joint name="j" type="revolute">'
               '<parent link="a"/><child link="b"/><origin xyz="0 0 ${d1}"/></joint>\n</robot>\n',
-              "3:", "joint[j].origin.xyz: expected a finite number up to 1e6, got '${d1}' (a xacro file?"),
+              "3:", "joint[j].origin.xyz: not a decimal number: '${d1}' (a xacro file?"),
     "nan": ('<robot name="r">\n<link name="a"/><link name="b"/>\n<joint name="j" type="revolute">'
             '<parent link="a"/><child link="b"/><axis xyz="nan 0 1"/></joint>\n</robot>\n',
-            "3:", "joint[j].axis.xyz: expected a finite number"),
+            "3:", "joint[j].axis.xyz: not a decimal number: 'nan'"),
     "no_moving_joint": ('<robot name="r">\n<link name="a"/><link name="b"/>\n<joint name="j" type="fixed">'
                         '<parent link="a"/><child link="b"/></joint>\n</robot>\n', "1:1", "no moving joint"),
     "empty": ("", "1:", "invalid XML: no element found"),

@@ -104,7 +104,7 @@ def test_task_angles_compare_modulo_two_pi():
 
 @pytest.mark.parametrize("name, expected", [("planar_2r", 2.0), ("stanford", 0.412 + 0.154 + 0.0203 + 50 * 0.0254)])
 def test_reach(name, expected):
-    assert samples.reach(shipped_robot(name)) == pytest.approx(expected)
+    assert shipped_robot(name).reach == pytest.approx(expected)
 
 
 def test_compile_error_is_one_line(tmp_path):

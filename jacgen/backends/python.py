@@ -59,6 +59,7 @@ def _python_function(function: Function, printer: PythonPrinter, parameters: lis
     definitions, outputs = printer.body(body)
     shapes = [() if a.scalar else a.symbols.shape[:1] if a.vector else a.symbols.shape for a in function.arguments]
     batched = sum(not a.scalar for a in function.arguments)
+    of_parameters = _of_only(body, {sympy.Symbol(p["name"], real=True) for p in parameters})
     results = []
     for (output, values), (_, texts) in zip(function.parts(body.outputs), function.parts(outputs)):
         dtype = ", dtype=xp.bool" if output.boolean else ", dtype=dtype"
@@ -66,6 +67,8 @@ def _python_function(function: Function, printer: PythonPrinter, parameters: lis
         for k, (value, code) in enumerate(zip(values, texts)):
             if not value.free_symbols:  # a number or truth value: an array of the batch shape, like the others
                 code = f"xp.full(batch, {code}{dtype}, device=device)"
+            elif value.free_symbols <= of_parameters:  # of symbolic parameters alone
+                code = f"xp.broadcast_to(xp.asarray({code}{dtype}, device=device), batch)"
             elif batched > 1 or output.scalar:  # it may read only some of the batched arguments
                 code = f"xp.broadcast_to({code}, batch)"
             if output.integer:  # a status, computed as a real number
@@ -81,7 +84,9 @@ def _python_function(function: Function, printer: PythonPrinter, parameters: lis
         "summary": function.summary,
         "shape": " and ".join(dimensions(o) for o in function.outputs),
         "operations": body.operation_count,
-        "arguments": [(a.name, repr(shape)) for a, shape in zip(function.arguments, shapes)],
+        # symbolic parameters are arguments of shape (): in the arguments' dtype, and broadcast with them
+        "arguments": [(a.name, repr(shape)) for a, shape in zip(function.arguments, shapes)]
+                     + [(p["name"], "()") for p in parameters],
         "signature": ", ".join([f"{a.name}={a.default}" if a.default else a.name for a in function.arguments] + ["*"] * bool(parameters)
                                + [f"{p['name']}={p['value']}" for p in parameters]),
         "selects": any(e.has(Select) for e in [v for _, v in body.definitions] + list(body.outputs)),
@@ -93,6 +98,15 @@ def _python_function(function: Function, printer: PythonPrinter, parameters: lis
         "definitions": [(body.name(symbol), trig.get(symbol) or text) for (symbol, _), text in zip(body.definitions, definitions)],
         "results": results,
     }
+
+
+def _of_only(body, symbols: set) -> set:
+    """`symbols`, and the temporaries of `body` that read nothing else (directly or not)."""
+    found = set(symbols)
+    for symbol, value in body.definitions:
+        if value.free_symbols <= found:
+            found.add(symbol)
+    return found
 
 
 def _joint_trig(function: Function) -> tuple[dict, list]:
