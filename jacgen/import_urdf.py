@@ -48,7 +48,7 @@ def import_urdf(path: str, base: str | None = None, tip: str | None = None, conv
     axes, tip_frame = _axes(chain)
     table = fit(axes, tip_frame, convention, snapper)
     name = name or _robot_name(chain.robot_name)
-    problem = robot_name_problem(name) if NAME_PATTERN.match(name) else f"does not match {NAME_PATTERN.pattern}"
+    problem = robot_name_problem(name) if NAME_PATTERN.fullmatch(name) else f"does not match {NAME_PATTERN.pattern}"
     if problem:
         raise JacgenError(f"{path}: robot name {name!r} {problem}; choose another with --name")
     snapped = snapper.largest
@@ -116,7 +116,7 @@ def _joint_names(axes: list[Axis]) -> list[str]:
         name, candidate, k = name[:44], name[:44], 2
         while candidate in names:
             candidate, k = f"{name}_{k}", k + 1
-        assert IDENTIFIER_PATTERN.match(candidate)
+        assert IDENTIFIER_PATTERN.fullmatch(candidate)
         names.append(candidate)
     return names
 

@@ -152,7 +152,7 @@ def parameter_name_problem(name: str, robot_name: str) -> str | None:
         for reason, words in reserved.items():
             if name in words:
                 return reason
-    if name in GENERATED_NAMES or name in GENERATED_IMPORTS or _GENERATED_PATTERN.match(name):
+    if name in GENERATED_NAMES or name in GENERATED_IMPORTS or _GENERATED_PATTERN.fullmatch(name):
         return "is used by the generated code"
     if name.lower().startswith(robot_name + "_"):
         return f"starts with the robot's prefix {robot_name + '_'!r}"

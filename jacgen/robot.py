@@ -245,7 +245,7 @@ class _RobotReader:
             raise self.error(node, key, f"expected a string, got {_describe(node)}")
         if choices is not None and node.value not in choices:
             raise self.error(node, key, f"expected one of {', '.join(choices)}, got {_shown(node.value)}")
-        if pattern is not None and not pattern.match(node.value):
+        if pattern is not None and not pattern.fullmatch(node.value):
             raise self.error(node, key, f"invalid name {_shown(node.value)} (expected {pattern.pattern})")
         return node.value
 
@@ -349,7 +349,7 @@ class _RobotReader:
         for key_node, value_node in node.value:
             name = self.key(key_node, "parameters")
             key = _key_path("parameters", name)
-            if not IDENTIFIER_PATTERN.match(name):
+            if not IDENTIFIER_PATTERN.fullmatch(name):
                 raise self.error(key_node, key, f"invalid parameter name {_shown(name)} "
                                  f"(expected {IDENTIFIER_PATTERN.pattern})")
             problem = parameter_name_problem(name, robot_name)

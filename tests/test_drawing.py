@@ -1,11 +1,13 @@
 """`jacgen show --plot` and `--compare-urdf` (contract §4, docs/contract.md "Drawing and
 comparing an arm"): the drawing read back from matplotlib's artists (never the pixels) against
 jacgen.reference's frames, the planar workspace boundary against the annulus of a 2R arm,
-and the URDF comparison against imports that agree and tables with one twist flipped."""
+and the URDF comparison against imports that agree (as Pinocchio reads the URDF) and tables
+with one twist flipped."""
 
 import re
 
 import numpy as np
+import pinocchio as pin
 import pytest
 from click.testing import CliRunner
 
@@ -140,14 +142,49 @@ def test_workspace_boundary_with_limits():
 # -- --compare-urdf ---------------------------------------------------------------------------
 
 
+def _pinocchio_chain(path, base, tip, arm, q):
+    """Pinocchio's reading of the URDF (no jacgen code) at the robot file's configuration q,
+    joints matched by name (a continuous joint takes (cos, sin)), in the frame of the link
+    `base` (None: the root): per joint a point of its axis and its signed direction, and the
+    pose of the link `tip`."""
+    model = pin.buildModelFromUrdf(str(path))
+    data = model.createData()
+    joints = [model.getJointId(joint.name) for joint in arm.joints]
+    q_pin = pin.neutral(model)
+    for k, value in zip(joints, q):
+        start, nq = model.joints[k].idx_q, model.joints[k].nq
+        q_pin[start:start + nq] = (np.cos(value), np.sin(value)) if nq == 2 else value
+    pin.computeJointJacobians(model, data, q_pin)
+    pin.framesForwardKinematics(model, data, q_pin)
+    world = data.oMf[model.getFrameId(base)].inverse() if base else pin.SE3.Identity()
+    axes = []
+    for k in joints:
+        motion = pin.getJointJacobian(model, data, k, pin.LOCAL_WORLD_ALIGNED)[:, model.joints[k].idx_v]
+        direction = motion[3:] if np.linalg.norm(motion[3:]) > 0.5 else motion[:3]  # revolute, else prismatic
+        axes.append(((world * data.oMi[k]).translation, world.rotation @ direction))
+    return axes, (world * data.oMf[model.getFrameId(tip)]).homogeneous
+
+
 @pytest.mark.parametrize("convention", ["standard", "modified"])
 @pytest.mark.parametrize("key", URDFS)
 def test_imported_robot_files_agree_with_their_urdf(key, convention):
-    """The robot file import-urdf writes describes the URDF's chain: every axis and the tool
-    pose agree to 1e-9."""
+    """The robot file import-urdf writes describes the URDF's chain as Pinocchio reads it (not
+    jacgen's URDF reader, which import and compare share): at q = 0 and random configurations
+    every axis (direction, and the URDF joint's origin on the robot file's line) and the tool
+    pose agree to 1e-9; and compare_urdf finds them agreeing."""
     result = imported(key, convention)
+    arm = result.robot
     file, base, tip, _ = URDFS[key]
-    comparison = compare_urdf(result.robot, str(DATA / file), base, tip)
+    tip_link = tip or re.search(r"-> (\w+)\)", arm.description).group(1)
+    for q in [np.zeros(arm.dof), *random_configurations(arm, 10, seed=32)]:
+        frames, tool = reference.frames(arm, q)
+        axes, tip_pose = _pinocchio_chain(DATA / file, base, tip_link, arm, q)
+        for joint, frame, (point, direction) in zip(arm.joints, frames, axes):
+            ours, offset = frame[:3, 2], point - frame[:3, 3]
+            assert np.abs(direction - ours).max() < 1e-9, (key, joint.name, q)
+            assert not joint.revolute or np.abs(offset - offset @ ours * ours).max() < 1e-9, (key, joint.name, q)
+        assert np.abs(tool - tip_pose).max() < 1e-9, (key, q)
+    comparison = compare_urdf(arm, str(DATA / file), base, tip)
     assert max(max(axis) for axis in comparison.axes) < 1e-9 and max(comparison.tool) < 1e-9, comparison
     assert first_difference(comparison, 1e-9) is None
 

@@ -80,12 +80,16 @@ def _check_solutions(arm, solutions, target, count=None, original=None):
 @pytest.mark.parametrize("backend", BACKENDS)
 @pytest.mark.parametrize("name", ROBOTS)
 def test_round_trips(backends, name, backend):
-    """Random configurations inside the limits: the target of each is reached by every
-    solution, and the configuration itself is among them where the arm is regular."""
+    """Random configurations inside the limits: one solution set per target, none empty (each
+    target was reached at its configuration), every solution reaching it, and the configuration
+    itself among them where the arm is regular."""
     arm, solvers, _, _ = backends(name)
     q = random_configurations(robot(name), 60, seed=21)
     targets = reference.ik_target(arm, q)
-    for row, target, solutions in zip(q, targets, solvers[backend](targets)):
+    found = solvers[backend](targets)
+    assert len(found) == len(targets), (len(found), len(targets))
+    for row, target, solutions in zip(q, targets, found):
+        assert len(solutions), (row, target)
         _check_solutions(arm, solutions, target, original=row if regular(arm, row) else None)
 
 
@@ -110,7 +114,9 @@ def test_not_finite_and_out_of_reach(backends, name, backend):
         cases.append(far)
     if name == "rexarm":
         cases.append(np.array([0.2, 0.0, 0.1, 2.0]))  # pitch beyond 90 degrees
-    for case, solutions in zip(cases, solvers[backend](np.array(cases))):
+    found = solvers[backend](np.array(cases))
+    assert len(found) == len(cases), (len(found), len(cases))  # one empty set per case, not none at all
+    for case, solutions in zip(cases, found):
         assert solutions.shape == (0, arm.dof), (case, solutions)
 
 
@@ -174,6 +180,7 @@ def test_batched_numpy_finds_the_c_solution_sets(backends):
     q = random_configurations(robot("ur5"), 100_000, seed=23)
     targets = reference.ik_target(arm, q)
     batch, c = solvers["numpy_batch"](targets), solvers["c"](targets)
+    assert len(batch) == len(c) == len(q), (len(batch), len(c), len(q))
     assert sum(map(len, batch)) > 4 * len(q)
     for ours, theirs in zip(batch, c):
         assert ours.shape == theirs.shape and (not len(ours) or np.abs(ours - theirs).max() < 1e-9)
@@ -258,7 +265,7 @@ def test_velocity_ik_of_every_shipped_robot(generated, name):
     undamped, status = module.velocity_ik(q, mu_dot)
     assert np.all(status == module.VELOCITY_IK_OK) and undamped.shape == (20, arm.dof)
     damped, status = module.velocity_ik(q, mu_dot, DAMPING)
-    assert np.all(status == module.VELOCITY_IK_OK)
+    assert np.all(status == module.VELOCITY_IK_OK) and damped.shape == (20, arm.dof)
     for x, target, rates, damped_rates in zip(q, mu_dot, undamped, damped):
         js = reference_js(arm, x)
         assert np.abs(js @ rates - target).max() < 1e-9
