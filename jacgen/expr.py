@@ -81,7 +81,7 @@ def number(text: str) -> Value:
     if not significant:
         return Value(sympy.Integer(0), 0.0)
     if exponent and len(exponent.lstrip("+-").lstrip("0")) > 4:  # beyond any double: out of range or underflow
-        exponent = exponent[0] + "99999" if exponent[0] == "-" else "99999"
+        exponent = "-99999" if exponent.startswith("-") else "99999"
     scale = int(exponent or 0) - len(fraction)  # the value is int(integer + fraction) * 10**scale
     order = len(significant) + scale  # 10**(order - 1) <= |value| < 10**order
     if order > 7:

@@ -11,19 +11,16 @@ from functools import cached_property
 import sympy
 from sympy.core.parameters import distribute
 
-from . import analysis, differential, general6r, ik, ik_limits, kinematics, names
+from . import analysis, differential, general6r, ik, ik_limits, kinematics
 from .catalogue import (CALLEES, EXTENTS, FUNCTION_NAMES, SECOND_ORDER, Argument, Call, Function, Loop, Output,
                         extent_of, with_callees)
 from .joint_ring import joint_atoms, maximal_minors
+from .kinematics import generated_symbol
 from .lowering import Lowering, is_boolean
 from .model import Model
 from .nodes import Above, select
 from .robot import EULER_ANGLES, Robot
 from .subproblems import Subproblems, wrapped
-
-def _symbol(prefix: str, *indices: int, separator: str = "_", real: bool | None = True) -> sympy.Symbol:
-    """A generated input symbol, named by `names.indexed`."""
-    return sympy.Symbol(names.indexed(prefix, *indices, separator=separator), real=real)
 
 
 class Generator:
@@ -75,9 +72,9 @@ class Generator:
         if form is None or not (self.generates("ik_branches") or self.generates("ik_nearest")):
             return []
         if form.target == "pose":
-            target = Argument("T", sympy.Matrix(4, 4, lambda r, c: _symbol("T", r, c, separator="")), vector=False)
+            target = Argument("T", sympy.Matrix(4, 4, lambda r, c: generated_symbol("T", r, c, separator="")), vector=False)
         else:
-            target = Argument("mu", sympy.Matrix([_symbol("mu", i) for i in range(len(self.robot.task))]))
+            target = Argument("mu", sympy.Matrix([generated_symbol("mu", i) for i in range(len(self.robot.task))]))
         free, bindings, free_angle = (), {}, None
         if form.free is not None:  # the free joint's angle is an input; its cos and sin are the usual c_k, s_k
             free = (Argument("q_free", sympy.Matrix([sympy.Symbol("q_free", real=True)]), scalar=True),)
@@ -85,8 +82,8 @@ class Generator:
             bindings = {free_angle: free[0].symbols[0]}
             self.cos_sin((form.free,))
         n = self.robot.dof
-        seed = Argument("q_seed", sympy.Matrix([_symbol("qn", i + 1) for i in range(n)]))
-        weights = Argument("weights", sympy.Matrix([_symbol("qw", i + 1) for i in range(n)]),
+        seed = Argument("q_seed", sympy.Matrix([generated_symbol("qn", i + 1) for i in range(n)]))
+        weights = Argument("weights", sympy.Matrix([generated_symbol("qw", i + 1) for i in range(n)]),
                            default="(1.0,) * DOF")
         sp = Subproblems(self.name)
         if form.solver == "general_6r":
@@ -102,10 +99,10 @@ class Generator:
             return parts
         # ik_nearest reads ik_branches' results rather than lowering the solver a second time.
         table = Call("ik_branches", (target.name, *(a.name for a in free)), (
-            Argument("branches_q", sympy.Matrix(rows, n, lambda r, c: _symbol("qb", r, c)),
+            Argument("branches_q", sympy.Matrix(rows, n, lambda r, c: generated_symbol("qb", r, c)),
                      vector=False),
-            Argument("branches_valid", sympy.Matrix([_symbol("vb", r, real=None) for r in range(rows)])),
-            Argument("branches_in_limits", sympy.Matrix([_symbol("lb", r, real=None) for r in range(rows)]))))
+            Argument("branches_valid", sympy.Matrix([generated_symbol("vb", r, real=None) for r in range(rows)])),
+            Argument("branches_in_limits", sympy.Matrix([generated_symbol("lb", r, real=None) for r in range(rows)]))))
         table_q, table_valid, table_inside = (result.symbols for result in table.results)
         with distribute(False):
             read = target.symbols[:3, :] if form.target == "pose" else target.symbols
@@ -139,7 +136,7 @@ class Generator:
         equations_function = self.function(
             "ik_general_equations", "the general 6R solver's equations at T: (P0 + s Ps + c Pc) v_bc = Q v_gh, "
             "P = [P0; Ps; Pc] (42 x 9)", ("P", stacked), ("Q", q), arguments=(target,), part_of="ik_branches")
-        angles = Argument("angles", sympy.Matrix([_symbol("ga", k) for k in range(5)]))
+        angles = Argument("angles", sympy.Matrix([generated_symbol("ga", k) for k in range(5)]))
         loop = dict(zip((*split.triple, *split.pair), angles.symbols))
         loop[split.hidden] = loop[split.hidden] + sympy.Float(plan.shift, 17)
         theta = [None] * 6
@@ -167,7 +164,7 @@ class Generator:
                               "g, h; the free joint from the loop)", ("q", sympy.Matrix(q)), vector=True,
                               arguments=(target, angles), part_of="ik_branches")
         step = self.ik_numeric_step_function(None, "ik_general_step", newton=True)
-        given = Argument("q_solution", sympy.Matrix([_symbol("qg", i + 1) for i in range(6)]))
+        given = Argument("q_solution", sympy.Matrix([generated_symbol("qg", i + 1) for i in range(6)]))
         with distribute(False):
             form, inside = ik_limits.limited(self.robot, sp, list(given.symbols), tuple(range(6)))
         limits = self.function("ik_general_limits", "ik's form of q (revolute angles wrapped, or into the limits) "
@@ -179,7 +176,7 @@ class Generator:
     def velocity_ik_function(self, js: sympy.Matrix) -> Function:
         """velocity_ik: q_dot solving Js q_dot = mu_dot, and the status (`differential`)."""
         m, n = js.shape
-        mu_dot = Argument("mu_dot", sympy.Matrix([_symbol("mu_dot", i) for i in range(m)]))
+        mu_dot = Argument("mu_dot", sympy.Matrix([generated_symbol("mu_dot", i) for i in range(m)]))
         damping = Argument("damping", sympy.Matrix([sympy.Symbol("damping", real=True)]), scalar=True, default="0.0")
         with distribute(False):
             q_dot, status = differential.velocity_ik(js, list(self.q), list(mu_dot.symbols), damping.symbols[0], self.name)
@@ -196,10 +193,10 @@ class Generator:
         robot, n = self.robot, self.robot.dof
         pose = len(robot.task) == 6
         if pose:
-            target = Argument("target", sympy.Matrix(4, 4, lambda r, c: _symbol("T", r, c, separator="")), vector=False)
+            target = Argument("target", sympy.Matrix(4, 4, lambda r, c: generated_symbol("T", r, c, separator="")), vector=False)
         else:
-            target = Argument("target", sympy.Matrix([_symbol("mu", i) for i in range(len(robot.task))]))
-        given = Argument("q", sympy.Matrix([_symbol("qs", i + 1) for i in range(n)]))
+            target = Argument("target", sympy.Matrix([generated_symbol("mu", i) for i in range(len(robot.task))]))
+        given = Argument("q", sympy.Matrix([generated_symbol("qs", i + 1) for i in range(n)]))
         damping = Argument("damping", sympy.Matrix([sympy.Symbol("damping", real=True)]), scalar=True, default="0.0")
         limits = [None if newton else joint.limits for joint in robot.joints]
         bindings = {qi: differential.clamp(given_i, bounds) for qi, given_i, bounds in zip(self.q, given.symbols, limits)}
@@ -240,7 +237,7 @@ class Generator:
         if not any(map(self.generates, SECOND_ORDER)):
             return []
         robot, n, m = self.robot, self.robot.dof, len(self.robot.task)
-        q_dot = Argument("q_dot", sympy.Matrix([_symbol("qd", i + 1) for i in range(n)]))
+        q_dot = Argument("q_dot", sympy.Matrix([generated_symbol("qd", i + 1) for i in range(n)]))
         arguments = (Argument("q", sympy.Matrix(self.q)), q_dot)
         with distribute(False):
             columns = self.jacobian.applyfunc(self.name)

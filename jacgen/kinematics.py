@@ -20,8 +20,13 @@ Matrix = sympy.Matrix
 CosSin = Callable[[int], tuple[sympy.Expr, sympy.Expr]]
 
 
+def generated_symbol(prefix: str, *indices: int, separator: str = "_", real: bool | None = True) -> sympy.Symbol:
+    """A symbol the generator makes up, named by `names.indexed`: q3, qb3_1, T03."""
+    return sympy.Symbol(names.indexed(prefix, *indices, separator=separator), real=real)
+
+
 def joint_symbols(robot: Robot) -> tuple[sympy.Symbol, ...]:
-    return tuple(sympy.Symbol(names.indexed("q", i + 1), real=True) for i in range(robot.dof))
+    return tuple(generated_symbol("q", i + 1) for i in range(robot.dof))
 
 
 def trig_symbols(joints: tuple[int, ...], dof: int) -> tuple[sympy.Symbol, sympy.Symbol]:
@@ -259,7 +264,7 @@ def propagated_jacobian_tool(robot: Robot, cos_sin: CosSin, q) -> Matrix:
     frame to frame in local coordinates, w' = R^T (w + qd z), v' = R^T (v + w x p) (+ dd z),
     and the Jacobian read off as the coefficients of the joint rates.
     """
-    rates = tuple(sympy.Symbol(names.indexed("qd", i + 1), real=True) for i in range(robot.dof))
+    rates = tuple(generated_symbol("qd", i + 1) for i in range(robot.dof))
     z = Matrix([0, 0, 1])
     omega, velocity = sympy.zeros(3, 1), sympy.zeros(3, 1)  # of the base, in base coordinates
 

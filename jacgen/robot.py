@@ -330,6 +330,7 @@ class _RobotReader:
             raise self.error(task_node, "task", "roll and yaw are undefined at every configuration: the tool's x "
                              "axis stays along the world z axis (pitch +-90 deg), where ZYX Euler angles have no "
                              "roll or yaw; leave them out of the task, or turn the tool")
+
     def check_sizes(self, robot: Robot, joints_node) -> None:
         """The reach within REACH, and no link length (a, d) but 0 below SMALLEST_LENGTH of it."""
         reach = robot.reach

@@ -101,7 +101,7 @@ class Structure:
 def _circle(expr: sympy.Expr) -> tuple[sympy.Symbol, sympy.Symbol] | None:
     """The cos and sin symbols of the free joint when `expr` depends on them."""
     joint = next((k for x in expr.free_symbols if (k := names.trig_joint(x.name)) is not None), None)
-    return None if joint is None else kinematics.trig_symbols((joint,), joint + 1)
+    return None if joint is None else kinematics.trig_symbols((joint,), joint + 1)  # one joint's names: any dof
 
 
 def _on_circle(polynomial: sympy.Expr, cos: sympy.Symbol, sin: sympy.Symbol) -> sympy.Expr:

@@ -12,7 +12,6 @@ makes is recorded; everything else is a 30-digit float.
 """
 
 import math
-import re
 from dataclasses import dataclass, field
 from pathlib import Path
 from xml.parsers import expat

@@ -23,6 +23,7 @@ from collections import Counter
 
 import numpy as np
 import pytest
+import sympy
 from click.testing import CliRunner
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
@@ -170,8 +171,6 @@ def test_parameter_only_entries_batch(generated):
 def test_large_integers_print_as_floating_literals():
     """F14: an integer too large for an int (10^36 = 1/a^4 for a = 1e-9) is a floating literal
     in C; small integers stay integers."""
-    import sympy
-
     x = sympy.Symbol("x", real=True)
     assert CPrinter("double").doprint(sympy.Integer(10) ** 36 * x) == "1e+36*x"
     assert CPrinter("double").doprint(2 * x) == "2*x"
