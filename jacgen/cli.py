@@ -107,9 +107,10 @@ def main(debug):
 @click.option("-o", "--output", "output", default="generated", show_default=True,
               type=click.Path(file_okay=False), help="Folder that receives NAME/ for each robot.")
 @click.option("--lang", "languages", default=",".join(DEFAULT_LANGUAGES), show_default=True,
-              callback=_languages, help="Comma-separated targets.")
+              callback=_languages, help="Comma-separated targets, of c, python, casadi, report and native (a Python "
+                                        "extension module of the C, to pip install).")
 @click.option("--real", type=click.Choice(["double", "float"]), default="double", show_default=True,
-              help="Floating-point type of the generated C.")
+              help="Floating-point type of the generated C (native has both).")
 @click.option("--check", is_flag=True, help="Write nothing; exit 1 with a diff if a file would change.")
 @click.option("--functions", "functions", default=None, callback=_functions, metavar="NAMES",
               help="Comma-separated functions to generate (with those they call), e.g. fk_jacobian,ik; "
@@ -122,6 +123,9 @@ def main(debug):
 @jobs_option
 def generate(robot_files, output, languages, real, check, functions, budget_seconds, jobs):
     """Generate code for each ROBOT_FILE."""
+    if real == "float" and {"c", "native"} <= set(languages):
+        raise click.UsageError("--lang native writes NAME.c in double beside NAME_float.c; with --real float, "
+                               "write the float C of --lang c into another folder")
     budget.set_seconds(budget_seconds)
     robots = [load_robot(path) for path in dict.fromkeys(robot_files)]  # validate all before writing any
     _check_unique_names(robots)
@@ -205,18 +209,23 @@ def show(robot_file, plot_file, q, urdf_file, base, tip, tolerance):
 @click.option("--sources", type=click.Path(file_okay=False, exists=True), default=None, metavar="DIR",
               help="With --target: run DIR/NAME/NAME.c and .h (the float C you ship, as `generate --real float -o DIR` "
                    "writes it) instead of generating them.")
+@click.option("--native", is_flag=True,
+              help="Build NAME_native too (generate --lang native, as pip builds it) and compare every function "
+                   "of it, one call and batched, SIMD and scalar, double and float (about 20 s of compiling per robot).")
 @jobs_option
-def verify(robot_files, samples, seed, target, sources, jobs):
+def verify(robot_files, samples, seed, target, sources, native, jobs):
     """Compare every generated function of every backend with the numpy reference."""
     from .verify import format_table, verify as verify_robots  # numpy/ctypes only when verifying
 
     if sources and not target:
         raise click.UsageError("--sources needs --target")
+    if native and target:
+        raise click.UsageError("--native checks the host's native module; --target the emulated target's C")
     robots = [load_robot(path) for path in dict.fromkeys(robot_files)]
     _check_unique_names(robots)
     emulators = []
     results = verify_robots(robots, samples, seed, _progress, target=target, sources=sources and Path(sources),
-                            emulators=emulators, jobs=jobs)
+                            emulators=emulators, jobs=jobs, native=native)
     click.echo(format_table(results))
     if emulators:
         from .target import format_resources

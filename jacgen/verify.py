@@ -27,7 +27,7 @@ from typing import Callable
 import numpy as np
 
 from . import analysis, ik, reference
-from .compile import c_compiler, compile_shared
+from .compile import build_native, c_compiler, compile_shared
 from .catalogue import Function
 from .functions import Generator
 from .parallel import for_each_robot
@@ -180,7 +180,7 @@ def _wrapped(angles: np.ndarray) -> np.ndarray:
 
 
 def _is_float(backend: str) -> bool:
-    return backend.endswith("float")
+    return "float" in backend.split()
 
 
 def _rank_ratios(robot: Robot, q: np.ndarray) -> np.ndarray:
@@ -339,7 +339,7 @@ def _velocity_ik_residual(robot: Robot, solved: tuple[np.ndarray, np.ndarray], q
 def verify(robots: list[Robot], samples: int, seed: int,
            progress: Callable[[str], None] = lambda message: None, folder: Path | None = None,
            target: str | None = None, sources: Path | None = None,
-           emulators: list[Emulator] | None = None, jobs: int = 1) -> list[Result]:
+           emulators: list[Emulator] | None = None, jobs: int = 1, native: bool = False) -> list[Result]:
     """Generate, build and compare every robot, up to `jobs` robots at once in processes of
     their own (`parallel`). The code is written to `folder` (ROBOT/double/...,
     ROBOT/float/...) when one is given, to a temporary folder otherwise.
@@ -347,7 +347,7 @@ def verify(robots: list[Robot], samples: int, seed: int,
     With a `target` ("cortex-m4f"), only the float C is checked, run on the emulated target
     (`jacgen.target`), one robot after the other: the C generated now, or NAME.h and NAME.c
     from `sources`. Each robot's Emulator, with the instructions and stack it measured, is
-    appended to `emulators`."""
+    appended to `emulators`. With `native`, NAME_native is built and compared as well."""
     if target is None:
         c_compiler()  # fail before generating anything when there is none
     else:
@@ -356,7 +356,7 @@ def verify(robots: list[Robot], samples: int, seed: int,
         folder = folder or Path(temporary)
         if target is None:
             progress(f"generating and verifying {', '.join(robot.name for robot in robots)}")
-            found = for_each_robot(verify_on_host, robots, jobs, (samples, seed, folder),
+            found = for_each_robot(verify_on_host, robots, jobs, (samples, seed, folder, native),
                                    lambda robot: progress(f"verified {robot.name}"))
             return [result for results in found for result in results]
         results = []
@@ -376,20 +376,24 @@ def verify(robots: list[Robot], samples: int, seed: int,
         return results
 
 
-def verify_on_host(robot: Robot, samples: int, seed: int, folder: Path) -> list[Result]:
+def verify_on_host(robot: Robot, samples: int, seed: int, folder: Path, native: bool = False) -> list[Result]:
     """One robot on the host: generated into folder/NAME/{double,float}, its C built for
-    both real types (at once), every backend compared with the reference."""
+    both real types (at once), every backend compared with the reference; with `native`,
+    NAME_native too (generated into folder/NAME/native and built by its setup.py)."""
     work, generator = folder / robot.name, Generator(robot)
     write_files(render_robot(robot, ("c", "python", "casadi"), "double", generator), work / "double")
     write_files(render_robot(robot, ("c",), "float", generator), work / "float")
+    if native:
+        write_files(render_robot(robot, ("native",), "double", generator), work / "native")
     with ThreadPoolExecutor(2) as pool:
         builds = {real: pool.submit(compile_shared, [work / real / robot.name / f"{robot.name}.c"],
                                     work / f"{robot.name}_{real}.so") for real in ("double", "float")}
+        module = native and build_native(work / "native" / robot.name, robot.name)
         built = {real: build.result() for real, build in builds.items()}
     random, q = configurations(robot, generator.singularities, samples, seed)
     functions = generator.functions()
-    return verify_robot(robot, GeneratedCode(robot, functions, work / "double", built), functions, q, len(random),
-                        generator.closed_form)
+    return verify_robot(robot, GeneratedCode(robot, functions, work / "double", built, native=module or None),
+                        functions, q, len(random), generator.closed_form)
 
 
 def format_table(results: list[Result]) -> str:

@@ -9,7 +9,9 @@ straight-line `Body`s (`lowering.py`): a backend only prints and lays out. Addin
 is one module, its templates, and one line here.
 """
 
-from . import c, casadi, python, report
+from . import c, casadi, native, python, report
 
-BACKENDS = {module.BACKEND.name: module.BACKEND for module in (c, python, casadi, report)}
-DEFAULT_LANGUAGES = tuple(BACKENDS)
+BACKENDS = {module.BACKEND.name: module.BACKEND for module in (c, python, casadi, report, native)}
+# `generate` without --lang: native is asked for by name (it is a package to build, and writes
+# the C in both builds)
+DEFAULT_LANGUAGES = ("c", "python", "casadi", "report")

@@ -183,5 +183,5 @@ def c_context(robot: Robot, generator: Generator, printer: CPrinter, real: str) 
     return dict(sorted(context.items()))
 
 
-BACKEND = Backend("c", (("c/robot.h.jinja", "{name}.h"), ("c/robot.c.jinja", "{name}.c")), "/* {} */",
-                  CPrinter, c_context, names.C_RESERVED)
+BACKEND = Backend("c", (("c/robot.h.jinja", "{name}.h"), ("c/robot.c.jinja", "{name}.c")), CPrinter, c_context,
+                  names.C_RESERVED)

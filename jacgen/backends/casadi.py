@@ -80,5 +80,5 @@ def casadi_context(robot: Robot, generator: Generator, printer: CasadiPrinter, r
     return dict(sorted(context.items()))
 
 
-BACKEND = Backend("casadi", (("casadi/robot_casadi.py.jinja", "{name}_casadi.py"),), "# {}",
+BACKEND = Backend("casadi", (("casadi/robot_casadi.py.jinja", "{name}_casadi.py"),),
                   lambda real: CasadiPrinter(), casadi_context, names.PYTHON_RESERVED)

@@ -15,13 +15,13 @@ from ..robot import Robot
 
 @dataclass(frozen=True)
 class Backend:
-    """One target language: its templates with the file each becomes, its comment syntax, its
-    expression printer for a real type ("double", "float"; None: prints no expression), the
-    builder of what its templates receive, and the words it reserves (by reason)."""
+    """One target language: its templates with the file each becomes, its expression printer
+    for a real type ("double", "float"; None: prints no expression), the builder of what its
+    templates receive, and the words it reserves (by reason)."""
 
     name: str
-    templates: tuple[tuple[str, str], ...]  # (template, output file pattern with {name})
-    comment: str  # a one-line comment around {}
+    # (template, output file pattern with {name}[, the key of the context's part it renders])
+    templates: tuple[tuple[str, ...], ...]
     printer: Callable[[str], object] | None
     context: Callable  # (robot, generator, printer, real) -> the templates' data
     reserved: dict[str, frozenset[str]]

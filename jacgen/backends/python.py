@@ -137,5 +137,5 @@ def python_context(robot: Robot, generator: Generator, printer: PythonPrinter, r
     return dict(sorted(context.items()))
 
 
-BACKEND = Backend("python", (("python/robot.py.jinja", "{name}.py"),), "# {}",
+BACKEND = Backend("python", (("python/robot.py.jinja", "{name}.py"),),
                   lambda real: PythonPrinter(), python_context, names.PYTHON_RESERVED)
