@@ -12,6 +12,10 @@ numpy >= 2, JAX, or PyTorch through array-api-compat) and returns its arrays, in
 arguments' floating-point dtype and on their device; lists and numbers are numpy. The
 functions are straight-line code, without in-place writes or branches on values, so
 jax.jit, jax.vmap, jax.grad, torch.autograd and torch.compile apply to them.
+
+For numpy arrays at the C's speed, `jacgen generate ROBOT.yaml --lang native` writes
+planar_3r_native, an extension module of the generated C with these functions (JAX arrays and
+PyTorch tensors stay with this module).
 """
 
 import numpy

@@ -71,9 +71,10 @@ def _entry(name: str, summary: str, inputs: list[dict], outputs: list[dict], ret
     inputs = inputs + [_operand(p["name"], (), "real", p["value"]) for p in parameters]
     operands = inputs + outputs
     shown = [f"{o['name']}={o['default']}" if o["default"] else o["name"] for o in inputs]
-    shown.insert(len(inputs) - len(parameters), "*")
-    shown += ["limits=True"] * (name == "ik") + ["out=None"] * (name != "ik") + ["threads=None", "simd=True"]
-    arguments = [f"b{k}[l]" if not o["shape"] else f"b{k} + {o['pad']} * l" for k, o in enumerate(inputs)]
+    shown.insert(len(inputs) - len(parameters), "limits=True, *" if name == "ik" else "*")
+    shown += ["out=None"] * (name != "ik") + ["threads=None", "simd=True"]
+    arguments = [f"b{k}[l]" if not o["shape"] else f"b{k} + {o['pad']} * l"
+                 for k, o in enumerate(inputs[:len(inputs) - len(parameters)])]
     arguments += [f"b{len(inputs) + k} + {o['pad']} * l" for k, o in enumerate(outputs) if k != returned]
     return {
         "name": name,
