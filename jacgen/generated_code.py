@@ -75,7 +75,9 @@ class GeneratedCode:
     def velocity_ik(self, backend: str, q: np.ndarray, mu_dot: np.ndarray,
                     damping: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
         """velocity_ik at each row of q and mu_dot: (q_dot (k, dof), status (k,))."""
-        if backend == "python" or backend in self.native or not len(q):
+        if not len(q):  # no regular configuration: the numpy module says what nothing looks like
+            return self.python.velocity_ik(q, mu_dot, damping, **self.nominal)
+        if backend == "python" or backend in self.native:
             return self.module(backend).velocity_ik(q, mu_dot, damping, **self.nominal)
         if backend == "casadi":
             rows = [self.casadi.velocity_ik(x, rates, damping, *self.casadi_parameters) for x, rates in zip(q, mu_dot)]
