@@ -35,17 +35,9 @@ from jacgen.import_urdf import import_urdf
 URDFS = {"ur5": ("ur5_robot.urdf", "base_link", "tool0"), "panda": ("panda.urdf", "panda_link0", "panda_hand_tcp")}
 
 
-def optional(name):
-    try:
-        return __import__(name)
-    except ImportError:
-        print(f"({name} is not installed: its rows are skipped)")
-        return None
-
-
-jax = optional("jax")
-torch = optional("torch")
-pk = optional("pytorch_kinematics")
+jax = common.optional("jax")
+torch = common.optional("torch")
+pk = common.optional("pytorch_kinematics")
 if jax:
     jax.config.update("jax_enable_x64", True)
 

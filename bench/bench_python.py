@@ -52,11 +52,9 @@ splits a batch over every usable processor, and a busy one delays the whole batc
 """
 
 import argparse
-import importlib
 import os
 import tempfile
 import time
-import warnings
 from dataclasses import dataclass
 from functools import partial
 from pathlib import Path
@@ -80,17 +78,6 @@ BATCH_SECONDS = 3.0  # a batch run longer than this is timed on a slice and scal
 LOOP_CALLS = 1_000  # a Python loop standing for a batch is timed over this many calls
 PROBE_ROWS = 1_000  # rows of the call that estimates a batch's time
 USABLE_PROCESSORS = len(os.sched_getaffinity(0))
-
-
-def optional(name: str, notes: list):
-    """The module `name`, or None and a note when it is not installed."""
-    try:
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")  # rtb's and pinocchio's import-time deprecations
-            return importlib.import_module(name)
-    except ImportError as error:
-        notes.append(f"{name} is not installed ({error}): its columns are '-'")
-        return None
 
 
 # -- inputs ----------------------------------------------------------------------------------------
@@ -485,7 +472,7 @@ def main():
     sizes = sorted(int(size) for size in arguments.sizes.split(","))
     robots = [common.shipped(name) for name in arguments.robots.split(",")]
     notes = []
-    libraries = {name: optional(name, notes) for name in ("jax", "pinocchio", "roboticstoolbox", "eaik.IK_DH")}
+    libraries = {name: common.optional(name, notes.append) for name in ("jax", "pinocchio", "roboticstoolbox", "eaik.IK_DH")}
     if libraries["jax"]:
         libraries["jax"].config.update("jax_enable_x64", True)
     print(f"numpy {np.__version__}; {USABLE_PROCESSORS} usable processors (NAME_native's batches use them all); "

@@ -40,6 +40,7 @@ import subprocess
 import sys
 import sysconfig
 import time
+import warnings
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable, NamedTuple
@@ -76,6 +77,18 @@ def __getattr__(name: str):
 
 
 # -- robots and generated code --------------------------------------------------------------------
+def optional(name: str, note: Callable[[str], None] = print):
+    """The module `name`, or None and a note when it is not installed (its rows or columns
+    are then skipped); the peers' import-time deprecation warnings silenced."""
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            return importlib.import_module(name)
+    except ImportError as error:
+        note(f"{name} is not installed ({error}): skipped")
+        return None
+
+
 def shipped(name: str):
     """The robot of robots/NAME.yaml."""
     return load_robot(ROOT / "robots" / f"{name}.yaml")
