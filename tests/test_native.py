@@ -19,7 +19,9 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from click.testing import CliRunner
 
+from jacgen.cli import main
 from jacgen.functions import Generator
 from jacgen.generated_code import NATIVE_BACKENDS, import_module
 from jacgen.render import render_robot, write_files
@@ -234,3 +236,13 @@ def test_no_compiler_is_one_line(tmp_path):
     assert built.returncode != 0
     assert built.stderr.strip().splitlines()[-1] == ("planar_2r_native: cannot build: no C compiler: no-such-compiler "
                                                      "is not on PATH (install gcc or clang, e.g. apt-get install gcc)")
+
+
+def test_command_line_refuses_what_cannot_be():
+    """--real float with c and native (both would write NAME.c), and verify --native with --target:
+    one line each, exit 2."""
+    robot = str(ROOT / "robots" / "ur5.yaml")
+    for arguments, said in ((["generate", robot, "--lang", "c,native", "--real", "float"], "--lang native writes NAME.c"),
+                            (["verify", robot, "--native", "--target", "cortex-m4f"], "--native checks the host")):
+        result = CliRunner().invoke(main, arguments)
+        assert result.exit_code == 2 and said in result.output, result.output
