@@ -130,7 +130,7 @@ def entries(robot: Robot, generator: Generator, parameters: list[dict]) -> list[
     return made
 
 
-def constants(robot: Robot, generator: Generator, c: dict) -> list[tuple[str, str]]:
+def constants(robot: Robot, c: dict) -> list[tuple[str, str]]:
     """The module's constants, as NAME.py has them: (name, Python expression)."""
     made = [("DOF", str(robot.dof)), ("TASK", repr(tuple(robot.task)))]
     if robot.symbolic_parameters:
@@ -158,17 +158,15 @@ def native_context(robot: Robot, generator: Generator, printer, real: str) -> di
         "name": robot.name,
         "module": f"{robot.name}_native",
         "version": __version__,
-        "description": builds["double"]["description"],
         "dof": robot.dof,
         "entries": functions,
-        "constants": [(constant, c_string(value)) for constant, value in constants(robot, generator, builds["double"])],
-        "module_doc": c_string(MODULE_DOC.format(name=robot.name, dof=robot.dof)),
+        "constants": [(constant, c_string(value)) for constant, value in constants(robot, builds["double"])],
+        "module_doc": c_string(MODULE_DOC.format(name=robot.name)),
         "builds": [(build, build_name(robot, build)) for build in BUILDS],
         "vector_math": VECTOR_MATH,
         "work_per_thread": WORK_PER_THREAD,
         "largest_operands": max(len(e["operands"]) for e in functions),
         "largest_flags": max([o["size"] for e in functions for o in e["operands"] if o["kind"] == "bool"] or [1]),
-        "scratch": max(sum(o["pad"] for o in e["operands"]) for e in functions),
     }
     for build in BUILDS:
         builds[build]["native"] = native | {"build": build, "c_name": build_name(robot, build)}
