@@ -15,7 +15,6 @@ Medians after a warm-up (common.py's policy).
 """
 
 import argparse
-import importlib.util
 import subprocess
 import sys
 import tempfile
@@ -68,9 +67,7 @@ def main():
     parser.add_argument("--robots", default="ur5,puma560", help="6R arms with a closed-form ik (the warm start)")
     parser.add_argument("--rounds", type=int, default=7)
     arguments = parser.parse_args()
-    spec = importlib.util.spec_from_file_location("casadi_opti", EXAMPLE)
-    example = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(example)
+    example = common.load_module(EXAMPLE, "casadi_opti")
     robots = [common.shipped(name) for name in arguments.robots.split(",")]
     with tempfile.TemporaryDirectory() as folder:
         loops = [common.fk_jacobian_loop(robot, "c") for robot in robots]

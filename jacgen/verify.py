@@ -388,11 +388,11 @@ def verify_on_host(robot: Robot, samples: int, seed: int, folder: Path, native: 
     with ThreadPoolExecutor(2) as pool:
         builds = {real: pool.submit(compile_shared, [work / real / robot.name / f"{robot.name}.c"],
                                     work / f"{robot.name}_{real}.so") for real in ("double", "float")}
-        module = native and build_native(work / "native" / robot.name, robot.name)
+        module = build_native(work / "native" / robot.name, robot.name) if native else None
         built = {real: build.result() for real, build in builds.items()}
     random, q = configurations(robot, generator.singularities, samples, seed)
     functions = generator.functions()
-    return verify_robot(robot, GeneratedCode(robot, functions, work / "double", built, native=module or None),
+    return verify_robot(robot, GeneratedCode(robot, functions, work / "double", built, native=module),
                         functions, q, len(random), generator.closed_form)
 
 

@@ -3,7 +3,6 @@
 derivative of `fk` equals jacgen's symbolic `jacobian` on every shipped robot; and CasADi's
 C code generation of a jacgen function compiles and computes what jacgen's C computes."""
 
-import importlib.util
 import subprocess
 from pathlib import Path
 
@@ -21,16 +20,9 @@ ROOT = Path(__file__).resolve().parent.parent
 SHIPPED = sorted(path.stem for path in (ROOT / "robots").glob("*.yaml"))
 
 
-def _example():
-    spec = importlib.util.spec_from_file_location("casadi_opti", ROOT / "examples" / "casadi_opti.py")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
-
-
 @pytest.fixture(scope="module")
 def example():
-    return _example()
+    return import_module(ROOT / "examples" / "casadi_opti.py", "casadi_opti")
 
 
 @pytest.fixture(scope="module")

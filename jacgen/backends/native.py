@@ -160,6 +160,9 @@ def native_context(robot: Robot, generator: Generator, printer, real: str) -> di
         "version": __version__,
         "dof": robot.dof,
         "entries": functions,
+        # the functions with kernels of their own (and gufuncs): all but ik, which comes last and
+        # uses ik_branches', so that an entry's index is its kernels' index
+        "kernels": [e for e in functions if "wraps" not in e],
         "constants": [(constant, c_string(value)) for constant, value in constants(robot, builds["double"])],
         "module_doc": c_string(MODULE_DOC.format(name=robot.name)),
         "builds": [(build, build_name(robot, build)) for build in BUILDS],
