@@ -20,8 +20,10 @@ robot's closed form (structure detection and exact constants, `jacgen.ik.closed_
 printed first.
 
 A second table has the general 6R solver (class general_6r) on the shipped Jaco, Manocha-Canny
-arm and calibrated UR5, on random poses (fk of uniform joint vectors): the C `NAME_ik` in a
-native loop, the batched numpy `ik_branches` (all poses in one call), and ssik 8.2.0
+arm and calibrated UR5, and the calibrated Puma 560 and KR5 of tests/data/calibrated/, on
+random poses (fk of uniform joint vectors): the C `NAME_ik` in a native loop (for a
+calibrated arm: with its fast path, with the eigenproblem alone, and the nominal arm's own
+closed form as the yardstick), the batched numpy `ik_branches` (all poses in one call), and ssik 8.2.0
 (`ssik.Manipulator.from_dh(...).solve`, its C++ path, when installed; its `prepare` takes
 30-60 s per arm and is not timed). Per solver: microseconds per pose, the mean number of
 solutions, the rate at which the generating configuration is among them, the rate of
@@ -32,6 +34,7 @@ import argparse
 import ctypes
 import tempfile
 import time
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -43,9 +46,11 @@ from common import kinematic_chain, without_limits
 from jacgen import reference
 from jacgen.compile import CLibrary
 from jacgen.ik import closed_form
+from jacgen.model import Model
+from jacgen.robot import load_robot
 
 ROBOTS = {"ur5": IkGeoRobot.three_parallel_two_intersecting, "puma560": IkGeoRobot.spherical_two_parallel}
-GENERAL = ("jaco", "manocha_canny", "ur5_calibrated")
+GENERAL = ("jaco", "manocha_canny", "ur5_calibrated", "puma560_calibrated", "kr5_calibrated")
 
 
 def per_pose(solve, targets, rounds: int) -> tuple[float, int]:
@@ -97,14 +102,20 @@ def _ssik_solver(robot):
     return solve
 
 
+def _general_arm(name: str):
+    """A shipped arm, or one of the calibrated arms of tests/data/calibrated/."""
+    path = common.ROOT / "robots" / f"{name}.yaml"
+    return load_robot(path if path.exists() else common.ROOT / "tests" / "data" / "calibrated" / f"{name}.yaml")
+
+
 def general_table(targets_count: int, rounds: int, folder: Path) -> None:
     """The general 6R solver beside ssik (see the module docstring)."""
     print(f"\ngeneral 6R solver, {targets_count} random poses; us per pose (median of {rounds} rounds); "
           "recovered = the generating configuration among the solutions; off = solutions missing by > 1e-8")
-    print(f"{'robot':15s} {'solver':13s} {'us/pose':>9s} {'mean sol':>9s} {'recovered':>10s} {'off':>8s} "
+    print(f"{'robot':19s} {'solver':32s} {'us/pose':>9s} {'mean sol':>9s} {'recovered':>10s} {'off':>8s} "
           f"{'= ssik count':>12s}")
     for name in GENERAL:
-        robot = common.shipped(name)
+        robot = _general_arm(name)
         code = common.generate(robot, folder, ("c", "python"))
         library = CLibrary(common.shared_library(code / f"{name}.c"), robot, [], "double")
         module = common.load_module(code / f"{name}.py")
@@ -112,7 +123,21 @@ def general_table(targets_count: int, rounds: int, folder: Path) -> None:
         targets = reference.fk(robot, q)
         rows = {}
         micros, _ = common.native_ik(robot, code / f"{name}.c", targets, rounds, folder)
-        rows["C native"] = (micros, [library.ik(T, 16) for T in targets])
+        fast = Model(robot).closed_form.fast_path
+        label = "C native, fast path" if fast else "C native"
+        rows[label] = (micros, [library.ik(T, 16) for T in targets])
+        if fast:
+            alone = replace(robot, name=f"{name}_eigen", nearest_class=False)
+            source = common.generate(alone, folder) / f"{alone.name}.c"
+            alone_library = CLibrary(common.shared_library(source), alone, [], "double")
+            micros, _ = common.native_ik(alone, source, targets, rounds, folder)
+            rows["C native, eigenproblem only"] = (micros, [alone_library.ik(T, 16) for T in targets])
+            nominal = replace(fast.nominal.robot, name=f"{name}_nominal")
+            source = common.generate(nominal, folder) / f"{nominal.name}.c"
+            micros, _ = common.native_ik(nominal, source, targets, rounds, folder)
+            rows["C native, nominal arm's closed form"] = (micros, None)
+            decided = module._fast_branches(targets)[2].mean()
+            print(f"{name:19s} the fast path decides {decided:.1%} of the poses; the rest go to the eigenproblem")
         batch = common.timed(lambda: module.ik_branches(targets), rounds)
         branches, valid, _ = batch.result
         rows["numpy batched"] = (batch.seconds * 1e6 / len(targets), [b[v] for b, v in zip(branches, valid)])
@@ -121,10 +146,13 @@ def general_table(targets_count: int, rounds: int, folder: Path) -> None:
             timing = common.timed(lambda: [ssik_solve(T) for T in targets], rounds)
             rows["ssik"] = (timing.seconds * 1e6 / len(targets), timing.result)
         for label, (micros, found) in rows.items():
+            if found is None:  # the nominal arm's own solutions, not this arm's: its time only
+                print(f"{name:19s} {label:32s} {micros:9.2f}")
+                continue
             mean, recovered, off = common.ik_quality(robot, q, targets, found)
             same = (f"{np.mean([len(a) == len(b) for a, b in zip(found, rows['ssik'][1])]):12.1%}"
                     if "ssik" in rows else f"{'-':>12s}")
-            print(f"{name:15s} {label:13s} {micros:9.1f} {mean:9.2f} {recovered:10.1%} {off:8.2%} {same}")
+            print(f"{name:19s} {label:32s} {micros:9.2f} {mean:9.2f} {recovered:10.1%} {off:8.2%} {same}")
 
 
 def main():

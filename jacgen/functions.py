@@ -18,7 +18,7 @@ from .joint_ring import joint_atoms, maximal_minors
 from .kinematics import generated_symbol
 from .lowering import Lowering, is_boolean
 from .model import Model
-from .nodes import Above, select
+from .nodes import Above, AtMost, select
 from .robot import EULER_ANGLES, Robot
 from .subproblems import Subproblems, wrapped
 
@@ -118,8 +118,9 @@ class Generator:
         """The generated parts of the general 6R solver (`general6r`), which ik_branches runs
         around the eigenproblem kernel of its language: the equations at the target (P0, Ps, Pc
         stacked 42 x 9, the hidden angle's shift applied; Q 14 x 8), the configuration of one
-        root's loop angles (the free joint from the loop), a Newton step on the pose (ik_numeric's
-        step, undamped and unclamped), and ik's form of a configuration with its limits."""
+        root's loop angles (the free joint from the loop), the pose error and Jacobian of a Newton
+        step, ik's form of a configuration with its limits, and for a
+        calibrated arm the branches of its nominal arm's closed form, which start the fast path."""
         plan = self.closed_form.elimination
         equations, split = plan.equations, plan.equations.split
         head, links, tail = general6r.chain_form(self.robot)
@@ -163,7 +164,15 @@ class Generator:
         start = self.function("ik_general_start", "the configuration of one root's loop angles (a - shift, b, c, "
                               "g, h; the free joint from the loop)", ("q", sympy.Matrix(q)), vector=True,
                               arguments=(target, angles), part_of="ik_branches")
-        step = self.ik_numeric_step_function(None, "ik_general_step", newton=True)
+        target_pose = self._ik_target()
+        given = Argument("q", sympy.Matrix([generated_symbol("qs", i + 1) for i in range(6)]))
+        with distribute(False):
+            error, jacobian = self._task_error(target_pose, None)
+        step = self.function("ik_general_residual", "the pose error e at q (the position error and the rotation "
+                             "vector of R_target R^T, world frame) and the geometric Jacobian J: the Newton step of "
+                             "the solver's polish is q + J^-1 e", ("e", sympy.Matrix(error)), ("J", jacobian),
+                             vectors=("e",), arguments=(target_pose, given), bindings=dict(zip(self.q, given.symbols)),
+                             part_of="ik_branches")
         given = Argument("q_solution", sympy.Matrix([generated_symbol("qg", i + 1) for i in range(6)]))
         with distribute(False):
             form, inside = ik_limits.limited(self.robot, sp, list(given.symbols), tuple(range(6)))
@@ -171,7 +180,19 @@ class Generator:
                                "and whether it is inside the joint limits", ("q", sympy.Matrix(form)),
                                ("in_limits", [inside]), vector=True, scalars=("in_limits",), arguments=(given,),
                                part_of="ik_branches")
-        return [equations_function, start, step, limits]
+        parts = [equations_function, start, step, limits]
+        if fast := self.closed_form.fast_path:
+            sp.margins.clear()
+            with distribute(False):
+                q, valid, _ = ik.branches(fast.nominal.robot, fast.form, sp, target.symbols)
+                margin = sympy.Abs(sp.margins[0])
+                for other in sp.margins[1:]:
+                    margin = self.name(select(AtMost(margin, sympy.Abs(other)), margin, sympy.Abs(other)))
+            parts.append(self.function("ik_general_nominal", "the fast path's starting points: every branch of the "
+                                       "nearest special class's closed form (the nominal arm's), whether its target "
+                                       "allows it, and the least margin of its subproblems", ("q", q), ("valid", valid),
+                                       ("margin", sympy.Matrix([margin])), scalars=("margin",), arguments=(target,), part_of="ik_branches"))
+        return parts
 
     def velocity_ik_function(self, js: sympy.Matrix) -> Function:
         """velocity_ik: q_dot solving Js q_dot = mu_dot, and the status (`differential`)."""
@@ -186,46 +207,46 @@ class Generator:
                              ("q_dot", sympy.Matrix(q_dot)), ("status", sympy.Matrix([status])), vector=True,
                              integers=("status",), arguments=(Argument("q", sympy.Matrix(self.q)), mu_dot, damping))
 
-    def ik_numeric_step_function(self, task_jacobian: sympy.Matrix | None, name: str = "ik_numeric_step",
-                                 newton: bool = False) -> Function:
-        """ik_numeric_step: one damped least-squares step of ik_numeric from q (`differential`);
-        with `newton`, the general 6R solver's polish: undamped, no limits (a pose task)."""
+    def ik_numeric_step_function(self, task_jacobian: sympy.Matrix) -> Function:
+        """ik_numeric_step: one damped least-squares step of ik_numeric from q (`differential`)."""
         robot, n = self.robot, self.robot.dof
-        pose = len(robot.task) == 6
-        if pose:
-            target = Argument("target", sympy.Matrix(4, 4, lambda r, c: generated_symbol("T", r, c, separator="")), vector=False)
-        else:
-            target = Argument("target", sympy.Matrix([generated_symbol("mu", i) for i in range(len(robot.task))]))
+        target = self._ik_target()
         given = Argument("q", sympy.Matrix([generated_symbol("qs", i + 1) for i in range(n)]))
         damping = Argument("damping", sympy.Matrix([sympy.Symbol("damping", real=True)]), scalar=True, default="0.0")
-        limits = [None if newton else joint.limits for joint in robot.joints]
+        limits = [joint.limits for joint in robot.joints]
         bindings = {qi: differential.clamp(given_i, bounds) for qi, given_i, bounds in zip(self.q, given.symbols, limits)}
         with distribute(False):
-            if pose:
-                tool, goal = self.chain.tool, target.symbols
-                rotation = (goal[:3, :3] * tool[:3, :3].T).applyfunc(self.name)
-                error = [goal[i, 3] - tool[i, 3] for i in range(3)] + differential.rotation_vector(rotation, self.name)
-                jacobian = self.jacobian
-            else:
-                mu = kinematics.task_vector(robot, self.chain.tool)
-                error = [wrapped(goal - value) if component in EULER_ANGLES else goal - value
-                         for goal, value, component in zip(target.symbols, mu, robot.task)]
-                jacobian = task_jacobian
+            error, jacobian = self._task_error(target, task_jacobian)
             trial, cost = differential.ik_numeric_step(error, jacobian, list(self.q), damping.symbols[0], limits,
                                                        self.name)
-            read = target.symbols[:3, :] if pose else target.symbols
+            read = target.symbols[:3, :] if len(robot.task) == 6 else target.symbols
             cost = differential.flagged_cost(cost, [*given.symbols, *read], self.name)
         step = "J^T (J J^T + damping I)^-1 e" if jacobian.rows <= n else "(J^T J + damping I)^-1 J^T e"
-        if newton:
-            summary = (f"one Newton step of the general 6R solver's polish: q + {step} (damping 0 for Newton), "
-                       "and |e|^2 at q (-1 when target or q is not finite)")
-        else:
-            summary = (f"one step of ik_numeric: q clamped to the limits, then q + {step} clamped, and |e|^2 at "
-                       "the clamped q (-1 when target or q is not finite)")
-        return self.function(name, summary, ("q_start", sympy.Matrix(self.q)),
+        summary = (f"one step of ik_numeric: q clamped to the limits, then q + {step} clamped, and |e|^2 at "
+                   "the clamped q (-1 when target or q is not finite)")
+        return self.function("ik_numeric_step", summary, ("q_start", sympy.Matrix(self.q)),
                              ("q_next", sympy.Matrix(trial)), ("cost", sympy.Matrix([cost])), vector=True,
-                             scalars=("cost",), arguments=(target, given, damping), bindings=bindings,
-                             part_of="ik_branches" if newton else None)
+                             scalars=("cost",), arguments=(target, given, damping), bindings=bindings)
+
+    def _ik_target(self) -> Argument:
+        """ik_numeric's target: the 4x4 pose for a six-component task, else the task vector."""
+        if len(self.robot.task) == 6:
+            return Argument("target", sympy.Matrix(4, 4, lambda r, c: generated_symbol("T", r, c, separator="")),
+                            vector=False)
+        return Argument("target", sympy.Matrix([generated_symbol("mu", i) for i in range(len(self.robot.task))]))
+
+    def _task_error(self, target: Argument, task_jacobian: sympy.Matrix | None) -> tuple[list, sympy.Matrix]:
+        """The error e that ik's iterations drive to 0, at the chain's q, and its Jacobian: for a
+        pose, the position error and the rotation vector of R_target R^T (world frame) with the
+        geometric Jacobian; else the task error (Euler angles wrapped) with the task Jacobian."""
+        if len(self.robot.task) == 6:
+            tool, goal = self.chain.tool, target.symbols
+            rotation = (goal[:3, :3] * tool[:3, :3].T).applyfunc(self.name)
+            return [goal[i, 3] - tool[i, 3] for i in range(3)] + differential.rotation_vector(rotation, self.name), \
+                self.jacobian
+        mu = kinematics.task_vector(self.robot, self.chain.tool)
+        return [wrapped(goal - value) if component in EULER_ANGLES else goal - value
+                for goal, value, component in zip(target.symbols, mu, self.robot.task)], task_jacobian
 
     @cached_property
     def jacobian(self) -> sympy.Matrix:

@@ -39,7 +39,7 @@ import sympy
 from sympy.polys.domains import RealField
 from sympy.polys.rings import ring
 
-from . import kinematics
+from . import kinematics, numeric_chain
 from .joint_ring import circle_reduced
 from .robot import Robot
 
@@ -314,6 +314,20 @@ ALONG_C = (0, 1, 3, 4, 6, 7, 9, 10)
 ALONG_B = tuple(range(9))
 NEWTON_STEPS = 2  # on the pose, after the back-substitution
 TOLERANCE = {"double": 1e-9, "float": 1e-3}  # |pose error| (m and rad) of a solution after them
+# The fast path of a calibrated arm (a structure.Nominal): the nominal arm's closed form, then up
+# to FAST_STEPS Newton steps on the exact arm from each branch that the target allows or that
+# misses it by at most FAST_BAND times the arms' mismatch (the largest position and rotation error
+# between them at one configuration, over FAST_SAMPLES random ones). Each must reach T to
+# CONVERGED (1 + reach), at a solution of its own, and every discriminant of the closed form (a
+# squared sine, see Subproblems.margins) must be at least FAST_MARGIN times the relative mismatch
+# (position / reach, or rotation) from 0: near a double root the two arms' solutions differ by far
+# more than the mismatch, and may be more or fewer. Else the eigenproblem decides. FAST_MARGIN = 10
+# is the least multiple of 5 that missed no solution on 3 calibrated arms (tests/test_calibrated.py).
+FAST_STEPS = 4
+FAST_BAND = 3.0
+FAST_MARGIN = 10.0
+FAST_SAMPLES = 1000
+CONVERGED = {"double": 1e-12, "float": 1e-5}
 # An eigenvalue is a root when |imaginary part| <= this (1 + |x|): a double root the target's
 # rounding splits into a complex pair (by about the square root of that rounding) still counts,
 # and the Newton steps and the tolerance above decide.
@@ -400,3 +414,14 @@ def _numeric_chain(links: list[Link], theta: np.ndarray) -> np.ndarray:
                              * kinematics.rot_x(sympy.cos(link.alpha), sympy.sin(link.alpha))).evalf(20).tolist(), dtype=float)
         out = out @ constant @ rz(theta[..., i + 1])
     return out
+
+
+def mismatch(robot: Robot, nominal: Robot) -> tuple[float, float]:
+    """The largest position error and the largest rotation angle between the two arms' tool
+    poses at one configuration, over FAST_SAMPLES random configurations: how far a nominal
+    solution can miss."""
+    q = np.random.default_rng(0).uniform(-np.pi, np.pi, (FAST_SAMPLES, robot.dof))
+    exact, near = numeric_chain.link_frames(robot, q)[1], numeric_chain.link_frames(nominal, q)[1]
+    position = np.linalg.norm(exact[:, :3, 3] - near[:, :3, 3], axis=-1)
+    cos = (np.einsum("nij,nij->n", exact[:, :3, :3], near[:, :3, :3]) - 1) / 2
+    return float(position.max()), float(np.arccos(np.clip(cos, -1.0, 1.0)).max())

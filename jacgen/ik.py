@@ -9,6 +9,7 @@ Paden-Kahan subproblems of `subproblems.py`, and the fk pipeline prints them for
 backend as `ik_branches`.
 """
 
+import math
 import textwrap
 from dataclasses import dataclass
 
@@ -17,7 +18,7 @@ import sympy
 from . import general6r
 from .ik_limits import limited
 from .nodes import EPS, Above, AtLeast, AtMost, IsFinite, select
-from .structure import E_Z, SOLVERS, Geometry, SolverInfo, Structure, classify, is_zero, readable
+from .structure import E_Z, SOLVERS, Geometry, Nominal, SolverInfo, Structure, classify, is_zero, readable
 from .subproblems import Angle, Subproblems, relative, times, times_transposed
 
 Matrix = sympy.Matrix
@@ -39,6 +40,28 @@ class ClosedForm:
     signs: tuple[int, ...]  # -1 where the solver turns the robot's joint the other way (a reversed chain)
     free: int | None  # the joint ik takes as an input (a 7-joint arm), else None
     elimination: "general6r.Elimination | None" = None  # the general 6R solver's split (solver general_6r)
+    fast_path: "FastPath | None" = None  # general_6r: a calibrated arm's nominal closed form
+
+
+@dataclass(frozen=True)
+class FastPath:
+    """A calibrated arm's fast path (see general6r.FAST_STEPS): the nominal arm, its closed
+    form, and how far the two arms' tool poses differ at one configuration at most."""
+
+    nominal: Nominal
+    form: ClosedForm
+    position: float  # in the robot's length unit
+    rotation: float  # rad
+
+    @property
+    def band(self) -> float:
+        """|pose error| within which a branch the target does not allow is polished."""
+        return general6r.FAST_BAND * math.hypot(self.position, self.rotation)
+
+    @property
+    def margin(self) -> float:
+        """The least discriminant of the closed form at which the fast path decides."""
+        return general6r.FAST_MARGIN * max(self.position / self.nominal.robot.reach, self.rotation)
 
 
 def _scalar(value) -> Matrix:
@@ -142,8 +165,13 @@ def closed_form(robot, geometry: Geometry | None = None, structure: Structure | 
         plan = general6r.elimination(robot)
         if plan.condition > general6r.WORST_CONDITION:
             return None
+        fast_path = None
+        if structure.nominal is not None:
+            nominal = structure.nominal
+            fast_path = FastPath(nominal, closed_form(nominal.robot, structure=nominal.structure),
+                                 *general6r.mismatch(robot, nominal.robot))
         return ClosedForm("general_6r", SOLVERS["general_6r"], "pose", (), (), False, tuple(range(6)), (1,) * 6, None,
-                          plan)
+                          plan, fast_path)
     chain = structure.chain
     constants, indices = _CONSTANTS[structure.solver](chain)
     if chain.start is not None:  # a reversed chain: its target is T(0) T^-1

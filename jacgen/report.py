@@ -4,7 +4,7 @@ the generated NAME.md report)."""
 import numpy as np
 import sympy
 
-from . import numeric_chain
+from . import general6r, numeric_chain, structure
 from .analysis import READABLE_TERMS, Factor, Singularities, singularity_rows
 from .model import Model
 from .robot import Robot
@@ -142,7 +142,8 @@ def ik_lines(model: Model) -> list[str]:
         plan = form.elimination
         return [f"general 6R: {info.max_solutions} solutions at most ({structure.reason})",
                 f"{info.title}: {plan.equations.split.text}; the half angle shifted by {plan.shift:.6g} rad; "
-                f"median condition number {plan.condition:.2g} over random configurations"]
+                f"median condition number {plan.condition:.2g} over random configurations",
+                _fast_path_line(model)]
     chain = structure.chain
     joints = ""
     if chain.joints != tuple(range(len(chain.joints))):
@@ -150,6 +151,21 @@ def ik_lines(model: Model) -> list[str]:
         joints = f" (the solver's q1..q6 are joints {', '.join(str(j + 1) for j in chain.joints)}{turned})"
     return [f"{info.title} ({structure.reason}), at most {info.max_solutions} solutions, branches "
             f"(outermost first){joints}: {'; '.join(info.branches)}"]
+
+
+def _fast_path_line(model: Model) -> str:
+    """Which path a 6R arm without a special class takes: the nearest class's fast path or not."""
+    fast = model.closed_form.fast_path
+    if fast is None:
+        why = ("ik.nearest_class: false" if not model.robot.nearest_class else
+               f"no special class within {structure.NEAR_TWIST} rad of its twists and "
+               f"{structure.NEAR_LENGTH * 100:g} % of its reach of its lengths")
+        return f"path: every target to the eigenproblem ({why})"
+    solver = fast.form.solver
+    return (f"path: calibrated fast path. Nearest special class: {solver}, with {', '.join(fast.nominal.snapped)} "
+            f"(the arms differ by {fast.position:.3g} {model.robot.length_unit} and {fast.rotation:.3g} rad at most). Its closed form, then up to "
+            f"{general6r.FAST_STEPS} Newton steps per branch on this arm; the eigenproblem decides when a branch "
+            f"does not converge, two reach one solution, or a subproblem is within {fast.margin:.2g} of a double root")
 
 
 def describe(model: Model) -> str:

@@ -97,6 +97,7 @@ class Robot:
     source: str  # the path as given, for messages
     digest: str  # sha256 of the file's bytes, first 16 hex digits
     free_joint: int | None = None  # `ik: {free_joint: k}`, 0-based: the joint the closed-form ik takes as input
+    nearest_class: bool = True  # `ik: {nearest_class: false}` turns off the calibrated arms' fast path
 
     @property
     def dof(self) -> int:
@@ -309,9 +310,9 @@ class _RobotReader:
         base = self.pose(top["base"], "base") if "base" in top else IDENTITY_POSE
         tool = self.pose(top["tool"], "tool") if "tool" in top else IDENTITY_POSE
         task = self.task(top.get("task"), root, len(joints))
-        free_joint = self.free_joint(top["ik"], joints, task) if "ik" in top else None
+        free_joint, nearest_class = self.ik_options(top["ik"], joints, task) if "ik" in top else (None, True)
         robot = Robot(name, description, convention, length_unit, parameters, joints, base, tool,
-                      task, self.path, hashlib.sha256(self.data).hexdigest()[:16], free_joint)
+                      task, self.path, hashlib.sha256(self.data).hexdigest()[:16], free_joint, nearest_class)
         self.check_sizes(robot, top["joints"])
         if "task" in top:
             self.check_euler_angles(robot, top["task"])
@@ -362,10 +363,7 @@ class _RobotReader:
             if isinstance(value_node, yaml.MappingNode):
                 entries = self.mapping(value_node, key, ("value", "symbolic"), ("value",))
                 if "symbolic" in entries:
-                    flag = entries["symbolic"]
-                    if not (isinstance(flag, yaml.ScalarNode) and flag.tag == "tag:yaml.org,2002:bool"):
-                        raise self.error(flag, f"{key}.symbolic", f"expected true or false, got {_describe(flag)}")
-                    symbolic = flag.value.lower() in ("true", "yes", "on")
+                    symbolic = self.flag(entries["symbolic"], f"{key}.symbolic")
                 value = self.value(entries["value"], f"{key}.value")
             else:
                 value = self.value(value_node, key)
@@ -442,11 +440,23 @@ class _RobotReader:
         return tuple(names)
 
 
-    def free_joint(self, node, joints: tuple[Joint, ...], task: tuple[str, ...]) -> int:
-        """`ik: {free_joint: k}` (1-based, as the joint table is read): a revolute joint of a
-        7-joint arm with the full pose task. Returned 0-based."""
-        entries = self.mapping(node, "ik", ("free_joint",), ("free_joint",))
-        item = entries["free_joint"]
+    def flag(self, node, key: str) -> bool:
+        """A YAML boolean."""
+        if not (isinstance(node, yaml.ScalarNode) and node.tag == "tag:yaml.org,2002:bool"):
+            raise self.error(node, key, f"expected true or false, got {_describe(node)}")
+        return node.value.lower() in ("true", "yes", "on")
+
+    def ik_options(self, node, joints: tuple[Joint, ...], task: tuple[str, ...]) -> tuple[int | None, bool]:
+        """`ik: {free_joint: k, nearest_class: false}`: the free joint (0-based) and whether a
+        calibrated arm may take the nearest special class's fast path."""
+        entries = self.mapping(node, "ik", ("free_joint", "nearest_class"))
+        free = self.free_joint(entries["free_joint"], joints, task) if "free_joint" in entries else None
+        nearest_class = self.flag(entries["nearest_class"], "ik.nearest_class") if "nearest_class" in entries else True
+        return free, nearest_class
+
+    def free_joint(self, item, joints: tuple[Joint, ...], task: tuple[str, ...]) -> int:
+        """`ik.free_joint` (1-based, as the joint table is read): a revolute joint of a 7-joint
+        arm with the full pose task. Returned 0-based."""
         number = item.value if isinstance(item, yaml.ScalarNode) and item.tag == "tag:yaml.org,2002:int" else ""
         if not number.isdigit():
             raise self.error(item, "ik.free_joint", f"expected a joint number 1 to {len(joints)}, got {_describe(item)}")

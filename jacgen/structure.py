@@ -16,6 +16,7 @@ meet in a point (a spherical shoulder) is solved backwards: `Geometry.reversed`.
 """
 
 import copy
+import math
 from dataclasses import dataclass, field, replace
 
 import sympy
@@ -82,8 +83,8 @@ SOLVERS = {
             "elbow: q3, '+' then '-' (elbow up and down)")),
     "general_6r": SolverInfo(
         "general 6R: Raghavan & Roth's 14 equations, eliminated to a 12 x 12 quadratic matrix "
-        "polynomial in tan(q_k/2) solved as a 24 x 24 eigenproblem, back-substitution and two "
-        "Newton steps (jacgen/general6r.py)",
+        "polynomial in tan(q_k/2) solved as a 24 x 24 eigenproblem, back-substitution and up to "
+        "two Newton steps (jacgen/general6r.py)",
         16, ("the real eigenvalues in the order the eigensolver gives them; a solution that does not "
              "reach the target after the Newton steps (a spurious root) is skipped",)),
 }
@@ -96,6 +97,66 @@ class Structure:
     solver: str | None
     reason: str  # why the solver applies, or why no solver does
     chain: "Geometry | None" = field(default=None, compare=False)  # what the solver solves (see Geometry)
+    nominal: "Nominal | None" = field(default=None, compare=False)  # general_6r: the nearest special class
+
+
+# A calibrated arm's nearest special class (contract §2, "Calibrated arms"): twists within NEAR_TWIST
+# of a multiple of pi/2 and lengths a, d within NEAR_LENGTH times the reach of 0 may be snapped.
+NEAR_TWIST = 0.02  # rad
+NEAR_LENGTH = 0.005
+
+
+@dataclass(frozen=True)
+class Nominal:
+    """The arm with the fewest of its near-special DH values snapped to the special ones that
+    puts it in a special class: the calibrated arm's nominal arm, whose closed form seeds the
+    general solver's fast path."""
+
+    robot: Robot
+    snapped: tuple[str, ...]  # each snapped value, e.g. "alpha2 -0.001 -> 0 rad"
+    structure: Structure
+
+
+def _near_special(robot: Robot) -> list[tuple[float, int, str, Value, str]]:
+    """The DH values within NEAR_TWIST or NEAR_LENGTH of a special one: (how far, in the
+    robot's length unit at its reach, joint index, key, the special value, text), farthest first."""
+    found = []
+    for i, joint in enumerate(robot.joints):
+        quarter = round(joint.alpha.approx / (math.pi / 2))
+        off = joint.alpha.approx - quarter * math.pi / 2
+        if 0 < abs(off) <= NEAR_TWIST:
+            special = Value(quarter * sympy.pi / 2, quarter * math.pi / 2)
+            found.append((abs(off) * robot.reach, i, "alpha", special,
+                          f"alpha{i + 1} {joint.alpha.approx:.8g} -> {special.approx:.8g} rad"))
+        for key in ("a", "d"):
+            value = getattr(joint, key)
+            if value is not None and 0 < abs(value.approx) <= NEAR_LENGTH * robot.reach:
+                found.append((abs(value.approx), i, key, Value(sympy.Integer(0), 0.0),
+                              f"{key}{i + 1} {value.approx:.8g} -> 0 {robot.length_unit}"))
+    return sorted(found, key=lambda entry: -entry[0])
+
+
+def _snapped(robot: Robot, values) -> Robot:
+    joints = list(robot.joints)
+    for _, i, key, special, _ in values:
+        joints[i] = replace(joints[i], **{key: special})
+    return replace(robot, joints=tuple(joints), nearest_class=False)
+
+
+def nearest_class(robot: Robot) -> Nominal | None:
+    """The nominal arm of a 6R arm without a special class, None when snapping every near-special
+    value does not give one. Greedy: from all of them snapped, each (farthest first) is put back
+    when the arm stays in a special class without it."""
+    snapped = _near_special(robot)
+    structure = classify(_snapped(robot, snapped))
+    if structure.solver in (None, "general_6r"):
+        return None
+    for value in list(snapped):
+        trial = [other for other in snapped if other is not value]
+        candidate = classify(_snapped(robot, trial))
+        if candidate.solver not in (None, "general_6r"):
+            snapped, structure = trial, candidate
+    return Nominal(_snapped(robot, snapped), tuple(entry[4] for entry in snapped), structure)
 
 
 def _circle(expr: sympy.Expr) -> tuple[sympy.Symbol, sympy.Symbol] | None:
@@ -395,7 +456,8 @@ def classify(robot: Robot, geometry: Geometry | None = None) -> Structure:
         if n == 6:
             solver, reason, chain = _six_dof(g)
             if solver is None and all(g.revolute) and not robot.symbolic_parameters:
-                solver, reason = "general_6r", f"no special class: {reason}"
+                nominal = nearest_class(robot) if robot.nearest_class else None
+                return Structure("general_6r", f"no special class: {reason}", None, nominal)
         elif n == 7:
             solver, reason, chain = _free_joint(robot)
         elif n > 7:

@@ -55,6 +55,9 @@ class Subproblems:
 
     def __init__(self, name: Callable[[sympy.Expr], sympy.Expr]):
         self.name = lambda value: name(sympy.sympify(value))
+        # SP2's and SP4's discriminants, dimensionless (a squared sine): near 0 two roots are near
+        # one double root, and sensitive to the target. The fast path reads their least size.
+        self.margins: list[sympy.Expr] = []
 
     def vector(self, values) -> Vector:
         return tuple(self.name(v) for v in values)
@@ -116,6 +119,7 @@ class Subproblems:
         cos_phi, sin_phi = self.name(a * inverse_r), self.name(b * inverse_r)
         cos_alpha = self.name(rhs * inverse_r)
         disc = self.name(1 - cos_alpha**2)
+        self.margins.append(disc)
         two = Above(disc, EPS)
         # a double root: cos(alpha) = +-1, sin(alpha) = 0
         cos_alpha = self.name(select(two, cos_alpha, select(Above(cos_alpha, 0), 1, -1)))
@@ -143,6 +147,7 @@ class Subproblems:
         alpha, beta = self.name((u - k12 * v) / nn), self.name((v - k12 * u) / nn)
         pp = self.dot(p, p)
         gg = self.name((pp - alpha**2 - beta**2 - 2 * alpha * beta * k12) / nn)
+        self.margins.append(select(Above(pp, 0), gg / pp, 0))
         two = Above(gg, EPS * pp)
         gamma = self.name(select(two, sympy.sqrt(gg), 0))
         normal = self.cross(k1, k2)

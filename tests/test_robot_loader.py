@@ -152,7 +152,10 @@ CASES = [
     ("free_joint_out_of_range", BASE + "ik: {free_joint: 4}\n", "4}", "ik.free_joint", "expected a joint number 1 to 3, got 4"),
     ("free_joint_not_a_number", BASE + "ik: {free_joint: last}\n", "last", "ik.free_joint",
      "expected a joint number 1 to 3, got a string ('last')"),
-    ("free_joint_misspelt", BASE + "ik: {free: 2}\n", "free", "ik.free", "unknown key; expected one of: free_joint"),
+    ("free_joint_misspelt", BASE + "ik: {free: 2}\n", "free", "ik.free",
+     "unknown key; expected one of: free_joint, nearest_class"),
+    ("nearest_class_not_a_flag", BASE + "ik: {nearest_class: 0}\n", "0}", "ik.nearest_class",
+     "expected true or false, got a number ('0')"),
     ("free_joint_prismatic", "name: slide7\nconvention: standard\njoints:\n" + rows(6)
      + "  - {type: prismatic, a: 0, alpha: 0, theta: 0}\nik: {free_joint: 7}\n", "7}", "ik.free_joint",
      "joint 7 is prismatic: the free joint must be revolute"),

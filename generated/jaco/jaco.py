@@ -3455,9 +3455,9 @@ def ik_general_start(T, angles):
 
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
-def ik_general_step(target, q, damping=0.0):
-    """one Newton step of the general 6R solver's polish: q + J^T (J J^T + damping I)^-1 e (damping 0 for Newton), and |e|^2 at q (-1 when target or q is not finite): (6 x 1 and 6 x 1 and 1 x 1), 1090 operations."""
-    xp, dtype, device, batch, (target, q, damping,) = _arguments(("target", target, (4, 4)), ("q", q, (6,)), ("damping", damping, ()))
+def ik_general_residual(target, q):
+    """the pose error e at q (the position error and the rotation vector of R_target R^T, world frame) and the geometric Jacobian J: the Newton step of the solver's polish is q + J^-1 e: (6 x 1 and 6 x 6), 324 operations."""
+    xp, dtype, device, batch, (target, q,) = _arguments(("target", target, (4, 4)), ("q", q, (6,)))
     T00 = target[..., 0, 0]
     T01 = target[..., 0, 1]
     T02 = target[..., 0, 2]
@@ -3494,326 +3494,151 @@ def ik_general_step(target, q, damping=0.0):
     s5 = -xp.sin(q5)
     c6 = -xp.sin(0.17453292519943295 + q6)
     s6 = xp.cos(0.17453292519943295 + q6)
-    t0 = T00 + T01 + T02 + T03 + T10 + T11 + T12 + T13 + T20 + T21 + T22 + T23 + qs1 + qs2 + qs3 + qs4 + qs5 + qs6
-    t1 = c2*c3
-    t2 = s2*s3
-    t3 = t1*c1 + t2*c1
-    t4 = t1*s1 + t2*s1
-    t5 = t1 + t2
-    t6 = t3*c4 + s1*s4
-    t7 = c4*s1 - t3*s4
-    t8 = c1*s4 - t4*c4
-    t9 = t4*s4 + c1*c4
-    t10 = -0.25019712500078917*t5
-    t11 = c3*s2
-    t12 = c2*s3
-    t13 = t11*c1 - t12*c1
-    t14 = t12*s1 - t11*s1
-    t15 = t11 - t12
+    t0 = c2*c3
+    t1 = s2*s3
+    t2 = t0*c1 + t1*c1
+    t3 = t0*s1 + t1*s1
+    t4 = t0 + t1
+    t5 = t2*c4 + s1*s4
+    t6 = c4*s1 - t2*s4
+    t7 = c1*s4 - t3*c4
+    t8 = t3*s4 + c1*c4
+    t9 = -0.25019712500078917*t4
+    t10 = c3*s2
+    t11 = c2*s3
+    t12 = t10*c1 - t11*c1
+    t13 = t11*s1 - t10*s1
+    t14 = t10 - t11
+    t15 = -0.25019712500078917*t12
     t16 = -0.25019712500078917*t13
-    t17 = -0.25019712500078917*t14
-    t18 = 0.5*t13 + 0.8660254037844386*t7
-    t19 = t18
-    t20 = -0.08579425000157839*t18
-    t21 = 0.5*t14 + 0.8660254037844386*t9
-    t22 = t21
-    t23 = -0.08579425000157839*t21
-    t24 = t15*s4
-    t25 = 0.5*t5 + 0.8660254037844386*t24
-    t26 = t25
-    t27 = 0.08579425000157839*t25
-    t28 = 0.5*t7 - 0.8660254037844386*t13
-    t29 = t6*c5 + s5*t28
-    t30 = c5*t28 - t6*s5
-    t31 = 0.5*t9 - 0.8660254037844386*t14
-    t32 = t8*c5 + s5*t31
-    t33 = c5*t31 - t8*s5
-    t34 = 0.8660254037844386*t5 - 0.5*t24
-    t35 = t15*c4
-    t36 = s5*t34 + t35*c5
-    t37 = c5*t34 - t35*s5
-    t38 = 0.5*t19 + 0.8660254037844386*t30
-    t39 = t38
-    t40 = 0.2115971250007892*t38
-    t41 = t40 - t20
-    t42 = t41 - t16
-    t43 = t42 - 0.0098*s1
-    t44 = 0.5*t22 + 0.8660254037844386*t33
-    t45 = t44
-    t46 = 0.2115971250007892*t44
-    t47 = t46 - t23
-    t48 = t47 - t17
-    t49 = t48 - 0.0098*c1
-    t50 = t49*s1 - t43*c1
-    t51 = t14*t42 - t48*t13
-    t52 = t22*t41 - t19*t47
-    t53 = t45*t40 - t39*t46
-    t54 = 0.5*t26 - 0.8660254037844386*t37
-    t55 = t54
-    t56 = -0.2115971250007892*t54
-    t57 = t56 - t27
-    t58 = t10 + t57
-    t59 = t58 + 0.41*s2
-    t60 = 0.2755 + t59
-    t61 = t14*t58 + t5*t48
-    t62 = t22*t57 + t26*t47
-    t63 = t45*t56 + t55*t46
-    t64 = t5*t42 + t58*t13
-    t65 = t19*t57 + t26*t41
-    t66 = t39*t56 + t55*t40
-    t67 = t5*t51 + t26*t52 + t55*t53
-    t68 = t5*t13 + t19*t26 + t39*t55
-    t69 = t14*t5 + t22*t26 + t45*t55
-    t70 = 1 + t5**2 + t26**2 + t55**2
-    t71 = T23 - t60
-    t72 = 0.5*t30 - 0.8660254037844386*t19
-    t73 = t29*c6 + s6*t72
-    t74 = c6*t72 - t29*s6
-    t75 = T00*t73 + T02*t39 - T01*t74
-    t76 = T10*t73 + T12*t39 - T11*t74
-    t77 = T20*t73 + T22*t39 - T21*t74
-    t78 = 0.5*t33 - 0.8660254037844386*t22
-    t79 = t32*c6 + s6*t78
-    t80 = c6*t78 - t32*s6
-    t81 = T00*t79 + T02*t45 - T01*t80
-    t82 = T10*t79 + T12*t45 - T11*t80
-    t83 = T20*t79 + T22*t45 - T21*t80
-    t84 = 0.5*(t76 - t81)
-    t85 = 0.5*t37 + 0.8660254037844386*t26
-    t86 = t36*c6 + s6*t85
-    t87 = c6*t85 - t36*s6
-    t88 = T01*t87 + T02*t55 - T00*t86
-    t89 = T11*t87 + T12*t55 - T10*t86
-    t90 = T21*t87 + T22*t55 - T20*t86
-    t91 = 0.5*(t89 + t83)
-    t92 = -0.5*(t88 + t77)
-    t93 = xp.sqrt(t91**2 + t92**2 + t84**2)
-    t94 = 0.41*c2
-    t95 = t43 + t94*c1
-    t96 = t49 - t94*s1
-    t97 = t95*c1 - t96*s1
-    t98 = t96 + t5*t61 + t26*t62 + t55*t63
-    t99 = t95 + t5*t64 + t26*t65 + t55*t66
-    t100 = t97**2 + t50**2 + t51**2 + t52**2 + t53**2
-    t101 = T03 - t95
-    t102 = T13 - t96
-    t103 = t58**2
-    t104 = c1**2
-    t105 = t14*t61 + t22*t62 + t45*t63 + t58*t104 + t59*t104
-    t106 = t14**2 + t22**2 + t45**2 + 2*t104
-    t107 = t59**2
-    t108 = t96**2 + t61**2 + t62**2 + t63**2 + t103*t104 + t107*t104
-    t109 = c1*s1
-    t110 = t95*t96 + t61*t64 + t62*t65 + t63*t66 + t103*t109 + t107*t109
-    t111 = t14*t13 + t19*t22 + t39*t45 + 2*t109
-    t112 = t97*c1
-    t113 = t50*c1
-    t114 = t61*t51 + t62*t52 + t63*t53 + t59*t112 - t58*t113
-    t115 = t14*t51 + t22*t52 + t45*t53 + t112 - t113
-    t116 = t58*t109 + t59*t109
-    t117 = t116 + t19*t62 + t39*t63 + t61*t13
-    t118 = t116 + t14*t64 + t22*t65 + t45*t66
-    t119 = s1**2
-    t120 = t95**2 + t64**2 + t65**2 + t66**2 + t103*t119 + t107*t119
-    t121 = t19*t65 + t39*t66 + t58*t119 + t59*t119 + t13*t64
-    t122 = t19**2 + t39**2 + t13**2 + 2*t119
-    t123 = t97*s1
-    t124 = t50*s1
-    t125 = t64*t51 + t65*t52 + t66*t53 + t59*t123 - t58*t124
-    t126 = t19*t52 + t39*t53 + t13*t51 + t123 - t124
-    t127 = -t90
-    t128 = 0.5*(-1 + t75 + t82 + t127)
-    t129 = xp.atan2(t93, t128)
-    t130 = xp.where(xp.greater(t93, 0), t129/t93, 1)
-    t131 = xp.greater_equal(t75, t82) & xp.greater_equal(t75, t127)
-    t132 = xp.greater_equal(t82, t127)
-    t133 = xp.where(t131, 0.5*(1 + t75), xp.where(t132, 0.5*t81, -0.5*t88))
-    t134 = xp.where(t131, 0.5*t76, xp.where(t132, 0.5*(1 + t82), -0.5*t89))
-    t135 = xp.where(t131, 0.5*t77, xp.where(t132, 0.5*t83, 0.5*(1 + t127)))
-    t136 = xp.sqrt(t133**2 + t134**2 + t135**2)
-    t137 = xp.where(xp.greater_equal(t91*t133 + t92*t134 + t84*t135, 0), xp.asarray(1, dtype=dtype), -1)
-    t138 = xp.greater(t93, 1e-06) | xp.greater(t128, 0)
-    t139 = t129*t137/t136
-    t140 = xp.where(t138, t91*t130, t133*t139)
-    t141 = xp.where(t138, t92*t130, t134*t139)
-    t142 = xp.where(t138, t84*t130, t135*t139)
-    t143 = t140**2 + t141**2 + t142**2 + t101**2 + t102**2 + t71**2
-    t144 = t108 + damping
-    t145 = xp.sqrt(t110**2 + t98**2 + t114**2 + t117**2 + t105**2 + t144**2)
-    t146 = t145*xp.where(xp.greater_equal(t144, 0), xp.asarray(1, dtype=dtype), -1)
-    t147 = t146 + t144
-    t148 = xp.where(xp.greater(t145, 0), 1/(t145*(t145 + xp.abs(t144))), 0)
-    t149 = t148*(t117*t140 + t105*t141 + t101*t147 - t110*t102 - t98*t142 - t114*t71)
-    t150 = t101 - t147*t149
-    t151 = t102 + t110*t149
-    t152 = t71 + t114*t149
-    t153 = t140 - t117*t149
-    t154 = t141 - t105*t149
-    t155 = t142 + t98*t149
-    t156 = t120 + damping
-    t157 = -t148*(t110*t147 + t110*t156 + t98*t99 + t114*t125 + t117*t121 + t105*t118)
-    t158 = t110 + t147*t157
-    t159 = t156 + t110*t157
-    t160 = t125 + t114*t157
-    t161 = t121 + t117*t157
-    t162 = t118 + t105*t157
-    t163 = t99 + t98*t157
-    t164 = xp.sqrt(t159**2 + t160**2 + t161**2 + t162**2 + t163**2)
-    t165 = t164*xp.where(xp.greater_equal(t159, 0), xp.asarray(1, dtype=dtype), -1)
-    t166 = t159 + t165
-    t167 = xp.where(xp.greater(t164, 0), 1/(t164*(t164 + xp.abs(t159))), 0)
-    t168 = t167*(t160*t152 + t163*t155 + t151*t166 - t161*t153 - t162*t154)
-    t169 = t151 - t166*t168
-    t170 = t152 - t160*t168
-    t171 = t153 + t161*t168
-    t172 = t154 + t162*t168
-    t173 = t155 - t163*t168
-    t174 = t100 + damping
-    t175 = -t148*(t110*t125 + t98*t67 + t114*t147 + t114*t174 + t117*t126 + t105*t115)
-    t176 = t114 + t147*t175
-    t177 = t125 + t110*t175
-    t178 = t174 + t114*t175
-    t179 = t126 + t117*t175
-    t180 = t115 + t105*t175
-    t181 = t67 + t98*t175
-    t182 = t167*(t160*t178 + t161*t179 + t162*t180 + t163*t181 + t177*t166)
-    t183 = t177 - t166*t182
-    t184 = t178 - t160*t182
-    t185 = -t179 + t161*t182
-    t186 = -t180 + t162*t182
-    t187 = t181 - t163*t182
-    t188 = xp.sqrt(t184**2 + t185**2 + t186**2 + t187**2)
-    t189 = t188*xp.where(xp.greater_equal(t184, 0), xp.asarray(1, dtype=dtype), -1)
-    t190 = t184 + t189
-    t191 = xp.where(xp.greater(t188, 0), 1/(t188*(t188 + xp.abs(t184))), 0)
-    t192 = t191*(t185*t171 + t186*t172 + t187*t173 + t170*t190)
-    t193 = t170 - t190*t192
-    t194 = t171 - t185*t192
-    t195 = t172 - t186*t192
-    t196 = t173 - t187*t192
-    t197 = t122 + damping
-    t198 = t148*(t110*t121 + t98*t68 + t114*t126 + t117*t147 + t117*t197 + t105*t111)
-    t199 = t117 - t147*t198
-    t200 = -t121 + t110*t198
-    t201 = -t126 + t114*t198
-    t202 = t197 - t117*t198
-    t203 = t111 - t105*t198
-    t204 = -t68 + t98*t198
-    t205 = t167*(t160*t201 + t163*t204 + t200*t166 - t161*t202 - t162*t203)
-    t206 = t200 - t166*t205
-    t207 = t201 - t160*t205
-    t208 = t202 + t161*t205
-    t209 = t203 + t162*t205
-    t210 = t204 - t163*t205
-    t211 = t191*(t185*t208 + t186*t209 + t187*t210 + t207*t190)
-    t212 = t207 - t190*t211
-    t213 = t208 - t185*t211
-    t214 = t209 - t186*t211
-    t215 = t210 - t187*t211
-    t216 = xp.sqrt(t213**2 + t214**2 + t215**2)
-    t217 = t216*xp.where(xp.greater_equal(t213, 0), xp.asarray(1, dtype=dtype), -1)
-    t218 = t213 + t217
-    t219 = xp.where(xp.greater(t216, 0), 1/(t216*(t216 + xp.abs(t213))), 0)
-    t220 = t219*(t214*t195 + t215*t196 + t194*t218)
-    t221 = t194 - t218*t220
-    t222 = t195 - t214*t220
-    t223 = t196 - t215*t220
-    t224 = t106 + damping
-    t225 = t148*(t110*t118 + t98*t69 + t114*t115 + t117*t111 + t105*t147 + t105*t224)
-    t226 = t105 - t147*t225
-    t227 = -t118 + t110*t225
-    t228 = -t115 + t114*t225
-    t229 = t111 - t117*t225
-    t230 = t224 - t105*t225
-    t231 = -t69 + t98*t225
-    t232 = t167*(t160*t228 + t163*t231 + t227*t166 - t161*t229 - t162*t230)
-    t233 = t227 - t166*t232
-    t234 = t228 - t160*t232
-    t235 = t229 + t161*t232
-    t236 = t230 + t162*t232
-    t237 = t231 - t163*t232
-    t238 = t191*(t185*t235 + t186*t236 + t187*t237 + t234*t190)
-    t239 = t234 - t190*t238
-    t240 = t235 - t185*t238
-    t241 = t236 - t186*t238
-    t242 = t237 - t187*t238
-    t243 = t219*(t214*t241 + t215*t242 + t240*t218)
-    t244 = t240 - t218*t243
-    t245 = t241 - t214*t243
-    t246 = t242 - t215*t243
-    t247 = xp.sqrt(t245**2 + t246**2)
-    t248 = t247*xp.where(xp.greater_equal(t245, 0), xp.asarray(1, dtype=dtype), -1)
-    t249 = t245 + t248
-    t250 = xp.where(xp.greater(t247, 0), 1/(t247*(t247 + xp.abs(t245))), 0)
-    t251 = t250*(t246*t223 + t222*t249)
-    t252 = t222 - t249*t251
-    t253 = t223 - t246*t251
-    t254 = t70 + damping
-    t255 = -t148*(t110*t99 + t98*t147 + t98*t254 + t114*t67 + t117*t68 + t105*t69)
-    t256 = t98 + t147*t255
-    t257 = t99 + t110*t255
-    t258 = t67 + t114*t255
-    t259 = t68 + t117*t255
-    t260 = t69 + t105*t255
-    t261 = t254 + t98*t255
-    t262 = t167*(t160*t258 + t161*t259 + t162*t260 + t163*t261 + t257*t166)
-    t263 = t257 - t166*t262
-    t264 = t258 - t160*t262
-    t265 = -t259 + t161*t262
-    t266 = -t260 + t162*t262
-    t267 = t261 - t163*t262
-    t268 = t191*(t185*t265 + t186*t266 + t187*t267 + t264*t190)
-    t269 = t264 - t190*t268
-    t270 = t265 - t185*t268
-    t271 = t266 - t186*t268
-    t272 = t267 - t187*t268
-    t273 = t219*(t214*t271 + t215*t272 + t270*t218)
-    t274 = t270 - t218*t273
-    t275 = t271 - t214*t273
-    t276 = t272 - t215*t273
-    t277 = t250*(t246*t276 + t275*t249)
-    t278 = t275 - t249*t277
-    t279 = t276 - t246*t277
-    t280 = xp.abs(t279)
-    t281 = t280
-    t282 = t281*xp.where(xp.greater_equal(t279, 0), xp.asarray(1, dtype=dtype), -1)
-    t283 = t279 + t282
-    t284 = xp.where(xp.greater(t281, 0), 1/(t281*(t281 + t280)), 0)
-    t285 = t253 - t253*t284*t283**2
-    t286 = xp.where(xp.not_equal(t282, 0), -t285/t282, 0)
-    t287 = xp.where(xp.not_equal(t248, 0), -(t252 - t278*t286)/t248, 0)
-    t288 = xp.where(xp.not_equal(t217, 0), -(t221 - (t244*t287 + t274*t286))/t217, 0)
-    t289 = xp.where(xp.not_equal(t189, 0), -(t193 - (t212*t288 + t239*t287 + t269*t286))/t189, 0)
-    t290 = xp.where(xp.not_equal(t165, 0), -(t169 - (t183*t289 + t206*t288 + t233*t287 + t263*t286))/t165, 0)
-    t291 = xp.where(xp.not_equal(t146, 0), -(t150 + t158*t290 + t176*t289 + t256*t286 - t199*t288 - t226*t287)/t146, 0)
-    t292 = q1 - t286 + t291*t96 - t290*t95
-    t293 = q4 + t5*t286 + t289*t51 + t290*t64 - t14*t287 - t288*t13 - t291*t61
-    t294 = q5 + t26*t286 + t289*t52 + t290*t65 - t19*t288 - t22*t287 - t291*t62
-    t295 = q6 + t55*t286 + t289*t53 + t290*t66 - t39*t288 - t45*t287 - t291*t63
-    t296 = t287*c1
-    t297 = t288*s1
-    t298 = t290*s1
-    t299 = t291*c1
-    t300 = q2 + t289*t97 - t296 - t297 + t59*t298 - t59*t299
-    t301 = q3 + t296 + t297 + t289*t50 + t58*t299 - t58*t298
-    q_start = _stack(xp, [
-        xp.broadcast_to(q1, batch),  # 0
-        xp.broadcast_to(q2, batch),  # 1
-        xp.broadcast_to(q3, batch),  # 2
-        xp.broadcast_to(q4, batch),  # 3
-        xp.broadcast_to(q5, batch),  # 4
-        xp.broadcast_to(q6, batch),  # 5
+    t17 = 0.5*t12 + 0.8660254037844386*t6
+    t18 = t17
+    t19 = -0.08579425000157839*t17
+    t20 = 0.5*t13 + 0.8660254037844386*t8
+    t21 = t20
+    t22 = -0.08579425000157839*t20
+    t23 = t14*s4
+    t24 = 0.5*t4 + 0.8660254037844386*t23
+    t25 = t24
+    t26 = 0.08579425000157839*t24
+    t27 = 0.5*t6 - 0.8660254037844386*t12
+    t28 = t5*c5 + s5*t27
+    t29 = c5*t27 - t5*s5
+    t30 = 0.5*t8 - 0.8660254037844386*t13
+    t31 = t7*c5 + s5*t30
+    t32 = c5*t30 - t7*s5
+    t33 = 0.8660254037844386*t4 - 0.5*t23
+    t34 = t14*c4
+    t35 = s5*t33 + t34*c5
+    t36 = c5*t33 - t34*s5
+    t37 = 0.5*t18 + 0.8660254037844386*t29
+    t38 = t37
+    t39 = 0.2115971250007892*t37
+    t40 = t39 - t19
+    t41 = t40 - t15
+    t42 = t41 - 0.0098*s1
+    t43 = 0.5*t21 + 0.8660254037844386*t32
+    t44 = t43
+    t45 = 0.2115971250007892*t43
+    t46 = t45 - t22
+    t47 = t46 - t16
+    t48 = t47 - 0.0098*c1
+    t49 = 0.5*t25 - 0.8660254037844386*t36
+    t50 = t49
+    t51 = -0.2115971250007892*t49
+    t52 = t51 - t26
+    t53 = t9 + t52
+    t54 = t53 + 0.41*s2
+    t55 = 0.2755 + t54
+    t56 = 0.5*t29 - 0.8660254037844386*t18
+    t57 = t28*c6 + s6*t56
+    t58 = c6*t56 - t28*s6
+    t59 = T00*t57 + T02*t38 - T01*t58
+    t60 = T10*t57 + T12*t38 - T11*t58
+    t61 = T20*t57 + T22*t38 - T21*t58
+    t62 = 0.5*t32 - 0.8660254037844386*t21
+    t63 = t31*c6 + s6*t62
+    t64 = c6*t62 - t31*s6
+    t65 = T00*t63 + T02*t44 - T01*t64
+    t66 = T10*t63 + T12*t44 - T11*t64
+    t67 = T20*t63 + T22*t44 - T21*t64
+    t68 = 0.5*(t60 - t65)
+    t69 = 0.5*t36 + 0.8660254037844386*t25
+    t70 = t35*c6 + s6*t69
+    t71 = c6*t69 - t35*s6
+    t72 = T01*t71 + T02*t50 - T00*t70
+    t73 = T11*t71 + T12*t50 - T10*t70
+    t74 = T21*t71 + T22*t50 - T20*t70
+    t75 = 0.5*(t73 + t67)
+    t76 = -0.5*(t72 + t61)
+    t77 = xp.sqrt(t75**2 + t76**2 + t68**2)
+    t78 = 0.41*c2
+    t79 = t42 + t78*c1
+    t80 = t48 - t78*s1
+    t81 = -t74
+    t82 = 0.5*(-1 + t59 + t66 + t81)
+    t83 = xp.atan2(t77, t82)
+    t84 = xp.where(xp.greater(t77, 0), t83/t77, 1)
+    t85 = xp.greater_equal(t59, t66) & xp.greater_equal(t59, t81)
+    t86 = xp.greater_equal(t66, t81)
+    t87 = xp.where(t85, 0.5*(1 + t59), xp.where(t86, 0.5*t65, -0.5*t72))
+    t88 = xp.where(t85, 0.5*t60, xp.where(t86, 0.5*(1 + t66), -0.5*t73))
+    t89 = xp.where(t85, 0.5*t61, xp.where(t86, 0.5*t67, 0.5*(1 + t81)))
+    t90 = xp.sqrt(t87**2 + t88**2 + t89**2)
+    t91 = xp.where(xp.greater_equal(t75*t87 + t76*t88 + t68*t89, 0), xp.asarray(1, dtype=dtype), -1)
+    t92 = xp.greater(t77, 1e-06) | xp.greater(t82, 0)
+    t93 = t83*t91/t90
+    t94 = xp.where(t92, t75*t84, t87*t93)
+    t95 = xp.where(t92, t76*t84, t88*t93)
+    t96 = xp.where(t92, t68*t84, t89*t93)
+    t97 = -t79
+    e = _stack(xp, [
+        xp.broadcast_to(T03 + t97, batch),  # 0
+        xp.broadcast_to(T13 - t80, batch),  # 1
+        xp.broadcast_to(T23 - t55, batch),  # 2
+        xp.broadcast_to(t94, batch),  # 3
+        xp.broadcast_to(t95, batch),  # 4
+        xp.broadcast_to(t96, batch),  # 5
     ], (6,))
-    q_next = _stack(xp, [
-        xp.broadcast_to(t292, batch),  # 0
-        xp.broadcast_to(t300, batch),  # 1
-        xp.broadcast_to(t301, batch),  # 2
-        xp.broadcast_to(t293, batch),  # 3
-        xp.broadcast_to(t294, batch),  # 4
-        xp.broadcast_to(t295, batch),  # 5
-    ], (6,))
-    cost = xp.broadcast_to(xp.where(xp.isfinite(t0), t143, -1), batch)
-    return q_start, q_next, cost
+    J = _stack(xp, [
+        xp.broadcast_to(t80, batch),  # 0, 0
+        xp.broadcast_to(-t54*c1, batch),  # 0, 1
+        xp.broadcast_to(t53*c1, batch),  # 0, 2
+        xp.broadcast_to(-(t13*t53 + t4*t47), batch),  # 0, 3
+        xp.broadcast_to(-(t21*t52 + t25*t46), batch),  # 0, 4
+        xp.broadcast_to(-(t44*t51 + t50*t45), batch),  # 0, 5
+        xp.broadcast_to(t97, batch),  # 1, 0
+        xp.broadcast_to(t54*s1, batch),  # 1, 1
+        xp.broadcast_to(-t53*s1, batch),  # 1, 2
+        xp.broadcast_to(t4*t41 + t53*t12, batch),  # 1, 3
+        xp.broadcast_to(t18*t52 + t25*t40, batch),  # 1, 4
+        xp.broadcast_to(t38*t51 + t50*t39, batch),  # 1, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
+        xp.broadcast_to(t79*c1 - t80*s1, batch),  # 2, 1
+        xp.broadcast_to(t48*s1 - t42*c1, batch),  # 2, 2
+        xp.broadcast_to(t13*t41 - t47*t12, batch),  # 2, 3
+        xp.broadcast_to(t21*t40 - t18*t46, batch),  # 2, 4
+        xp.broadcast_to(t44*t39 - t38*t45, batch),  # 2, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
+        xp.broadcast_to(-s1, batch),  # 3, 1
+        xp.broadcast_to(s1, batch),  # 3, 2
+        xp.broadcast_to(-t12, batch),  # 3, 3
+        xp.broadcast_to(-t18, batch),  # 3, 4
+        xp.broadcast_to(-t38, batch),  # 3, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
+        xp.broadcast_to(-c1, batch),  # 4, 1
+        xp.broadcast_to(c1, batch),  # 4, 2
+        xp.broadcast_to(-t13, batch),  # 4, 3
+        xp.broadcast_to(-t21, batch),  # 4, 4
+        xp.broadcast_to(-t44, batch),  # 4, 5
+        xp.full(batch, -1, dtype=dtype, device=device),  # 5, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 5, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 5, 2
+        xp.broadcast_to(t4, batch),  # 5, 3
+        xp.broadcast_to(t25, batch),  # 5, 4
+        xp.broadcast_to(t50, batch),  # 5, 5
+    ], (6, 6))
+    return e, J
 
 
 def ik_general_limits(q_solution):
@@ -4331,6 +4156,7 @@ _MONOMIALS = numpy.array([[0, 0, 0, 0, 4, 0, 0, 0, 0], [0, 0, 0, 2, 0, -2, 0, 0,
 _ALONG_C, _ALONG_B = numpy.array([0, 1, 3, 4, 6, 7, 9, 10]), numpy.array([0, 1, 2, 3, 4, 5, 6, 7, 8])  # ratios x_c (step 1), x_b (step 3)
 _NEWTON_STEPS = 2
 _TOLERANCE_SQUARED = 1.00000000000000e-18  # |pose error|^2 of a solution after the Newton steps
+_CONVERGED_SQUARED = 5.03054882344641e-24  # |pose error|^2 at which the Newton steps stop
 
 
 def _twelve(s):
@@ -4387,28 +4213,50 @@ def _roots(P, Q):
     return angles, real
 
 
-def ik_branches(T):
-    """Every solution of the general 6R solver (up to MAX_IK_SOLUTIONS = 16), whether the
-    target allows it, and whether it is inside the joint limits: q (..., MAX_IK_SOLUTIONS, DOF),
-    valid and in_limits (..., MAX_IK_SOLUTIONS). The valid rows come first, in the order of the
-    eigenvalues, each solution once; a root whose configuration does not reach the target to
-    1e-09 after 2 Newton steps is not valid; the rows that are not valid are 0. numpy
-    arrays only (numpy's eigensolver).
-    """
-    T = numpy.asarray(T, dtype=float)
+def _newton(targets, q):
+    """|e|^2 at q; and where q has not converged (|e|^2 <= _CONVERGED_SQUARED), q moved by one
+    Newton step q + J^-1 e (q stays where J is singular)."""
+    e, J = ik_general_residual(targets, q)
+    cost = (e * e).sum(axis=-1)
+    usable = numpy.isfinite(J).all(axis=(-2, -1)) & numpy.isfinite(e).all(axis=-1)
+    usable &= numpy.linalg.det(numpy.where(usable[..., None, None], J, numpy.eye(6))) != 0.0
+    step = numpy.linalg.solve(numpy.where(usable[..., None, None], J, numpy.eye(6)),
+                              numpy.where(usable[..., None], e, 0.0)[..., None])[..., 0]
+    return cost, numpy.where((usable & ~(cost <= _CONVERGED_SQUARED))[..., None], q + step, q)
+
+
+def _general_branches(T):
+    """The eigenproblem's solutions at targets T (..., 4, 4): q (..., 16, DOF) and valid (..., 16),
+    each solution once (the first of equal ones), after up to 2 Newton steps within 1e-09."""
     P, Q = ik_general_equations(T)
     finite = (numpy.isfinite(P).all(axis=(-2, -1)) & numpy.isfinite(Q).all(axis=(-2, -1)))[..., None, None]
     P, Q = numpy.where(finite, P, 0.0), numpy.where(finite, Q, 0.0)  # no root: a singular leading matrix
     angles, real = _roots(numpy.reshape(P, (*P.shape[:-2], 3, 14, 9)), Q)
     targets = T[..., None, :, :]
     q = ik_general_start(targets, angles)
+    cost, q = _newton(targets, q)
     for _ in range(_NEWTON_STEPS):
-        q = ik_general_step(targets, q, 0.0)[1]
-    cost = ik_general_step(targets, q, 0.0)[2]
-    valid = real & (cost >= 0.0) & (cost <= _TOLERANCE_SQUARED)
+        cost, q = _newton(targets, q)
+    return q, _first_of_equals(q, real & (cost <= _TOLERANCE_SQUARED))
+
+
+def _first_of_equals(q, valid):
+    """valid, without the rows equal (to 1e-6 rad) to an earlier valid row."""
     difference = (q[..., :, None, :] - q[..., None, :, :] + numpy.pi) % (2.0 * numpy.pi) - numpy.pi
     same = (numpy.abs(difference).max(axis=-1) < 1e-6) & valid[..., None, :]
-    valid &= ~numpy.tril(same, -1).any(axis=-1)  # the first of equal solutions stays
+    return valid & ~numpy.tril(same, -1).any(axis=-1)
+
+
+def ik_branches(T):
+    """Every solution of the general 6R solver (up to MAX_IK_SOLUTIONS = 16), whether the
+    target allows it, and whether it is inside the joint limits: q (..., MAX_IK_SOLUTIONS, DOF),
+    valid and in_limits (..., MAX_IK_SOLUTIONS). The valid rows come first, in the order of the
+    eigenvalues, each solution once; a root whose configuration does not reach the target to
+    1e-09 after up to 2 Newton steps is not valid; the rows that are not valid are 0. numpy
+    arrays only (numpy's eigensolver).
+    """
+    T = numpy.asarray(T, dtype=float)
+    q, valid = _general_branches(T)
     order = numpy.argsort(~valid, axis=-1, kind="stable")[..., :MAX_IK_SOLUTIONS]
     q = numpy.take_along_axis(q, order[..., None], -2)
     valid = numpy.take_along_axis(valid, order, -1)
@@ -4430,7 +4278,7 @@ def ik(T, limits=True):
     solutions outside the limits (in_limits 0).
     Solver: general 6R: Raghavan & Roth's 14 equations, eliminated to a 12 x 12 quadratic
     matrix polynomial in tan(q_k/2) solved as a 24 x 24 eigenproblem, back-substitution and
-    two Newton steps (jacgen/general6r.py).
+    up to two Newton steps (jacgen/general6r.py).
     Order: the real eigenvalues in the order the eigensolver gives them; a solution that
     does not reach the target after the Newton steps (a spurious root) is skipped; each
     solution once (equal to 1e-6 rad).

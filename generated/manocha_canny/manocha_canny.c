@@ -227,26 +227,27 @@ static void jacgen_g6_transpose_times(double q[14][8], const double beta[8], dou
     }
 }
 
-/* x solving a x = b (12 x 12, columns of b: nb) in place, by LU with partial pivoting. */
-static int jacgen_g6_solve(double a[12][12], int nb, double b[12][24]) {
-    for (int k = 0; k < 12; k++) {
+/* x solving a x = b in place (a: n x n, b: n x nb, both row by row), by LU with partial pivoting.
+ * Returns -1 when a pivot is 0. */
+static int jacgen_g6_solve(int n, double *a, int nb, double *b) {
+    for (int k = 0; k < n; k++) {
         int p = k;
-        for (int i = k + 1; i < 12; i++)
-            if (fabs(a[i][k]) > fabs(a[p][k])) p = i;
-        if (!(fabs(a[p][k]) > 0.0)) return -1;
-        for (int j = 0; j < 12; j++) { double t = a[k][j]; a[k][j] = a[p][j]; a[p][j] = t; }
-        for (int j = 0; j < nb; j++) { double t = b[k][j]; b[k][j] = b[p][j]; b[p][j] = t; }
-        for (int i = k + 1; i < 12; i++) {
-            double f = a[i][k] / a[k][k];
-            for (int j = k; j < 12; j++) a[i][j] -= f * a[k][j];
-            for (int j = 0; j < nb; j++) b[i][j] -= f * b[k][j];
+        for (int i = k + 1; i < n; i++)
+            if (fabs(a[i * n + k]) > fabs(a[p * n + k])) p = i;
+        if (!(fabs(a[p * n + k]) > 0.0)) return -1;
+        for (int j = 0; j < n; j++) { double t = a[k * n + j]; a[k * n + j] = a[p * n + j]; a[p * n + j] = t; }
+        for (int j = 0; j < nb; j++) { double t = b[k * nb + j]; b[k * nb + j] = b[p * nb + j]; b[p * nb + j] = t; }
+        for (int i = k + 1; i < n; i++) {
+            double f = a[i * n + k] / a[k * n + k];
+            for (int j = k; j < n; j++) a[i * n + j] -= f * a[k * n + j];
+            for (int j = 0; j < nb; j++) b[i * nb + j] -= f * b[k * nb + j];
         }
     }
-    for (int k = 11; k >= 0; k--)
+    for (int k = n - 1; k >= 0; k--)
         for (int j = 0; j < nb; j++) {
-            double s = b[k][j];
-            for (int i = k + 1; i < 12; i++) s -= a[k][i] * b[i][j];
-            b[k][j] = s / a[k][k];
+            double s = b[k * nb + j];
+            for (int i = k + 1; i < n; i++) s -= a[k * n + i] * b[i * nb + j];
+            b[k * nb + j] = s / a[k * n + k];
         }
     return 0;
 }
@@ -323,7 +324,7 @@ static int jacgen_general6r_roots(double p[3][14][9], double q_matrix[14][8],
     double lead[12][12], rhs[12][24], companion[JACGEN_EIG_MAX][JACGEN_EIG_MAX];
     for (int i = 0; i < 12; i++)
         for (int j = 0; j < 12; j++) { lead[i][j] = m[2][i][j]; rhs[i][j] = m[0][i][j]; rhs[i][j + 12] = m[1][i][j]; }
-    if (jacgen_g6_solve(lead, 24, rhs) != 0) return 0;
+    if (jacgen_g6_solve(12, &lead[0][0], 24, &rhs[0][0]) != 0) return 0;
     for (int i = 0; i < 12; i++) {
         for (int j = 0; j < 24; j++) companion[i][j] = j == i + 12 ? 1.0 : 0.0;
         for (int j = 0; j < 24; j++) companion[i + 12][j] = -rhs[i][j];
@@ -3709,9 +3710,9 @@ void manocha_canny_ik_general_start(const manocha_canny_real T[16], const manoch
     q[5] = atan2(-t40, t46);
 }
 
-manocha_canny_real manocha_canny_ik_general_step(const manocha_canny_real target[16], const manocha_canny_real q[MANOCHA_CANNY_DOF], manocha_canny_real damping, manocha_canny_real q_start[MANOCHA_CANNY_DOF], manocha_canny_real q_next[MANOCHA_CANNY_DOF])
+void manocha_canny_ik_general_residual(const manocha_canny_real target[16], const manocha_canny_real q[MANOCHA_CANNY_DOF], manocha_canny_real e[6], manocha_canny_real J[6 * MANOCHA_CANNY_DOF])
 {
-    /* 1026 operations */
+    /* 309 operations */
 
     /* Inputs */
     const manocha_canny_real T00 = target[0];
@@ -3754,311 +3755,147 @@ manocha_canny_real manocha_canny_ik_general_step(const manocha_canny_real target
     const manocha_canny_real s6 = sin(q6);
     const manocha_canny_real t0 = 0.01745240643728351*c2;
     const manocha_canny_real t1 = 0.0034904812874567027*c2;
-    const manocha_canny_real t2 = T00 + T01 + T02 + T03 + T10 + T11 + T12 + T13 + T20 + T21 + T22 + T23 + qs1 + qs2 + qs3 + qs4 + qs5 + qs6;
-    const manocha_canny_real t3 = 0.9998476951563913*s1;
-    const manocha_canny_real t4 = 0.01745240643728351*c1;
-    const manocha_canny_real t5 = t3 + t4*s2;
-    const manocha_canny_real t6 = t5;
-    const manocha_canny_real t7 = 0.2*t5;
-    const manocha_canny_real t8 = 0.9998476951563913*c1;
-    const manocha_canny_real t9 = 0.01745240643728351*s1;
-    const manocha_canny_real t10 = -t8 + t9*s2;
-    const manocha_canny_real t11 = t10;
-    const manocha_canny_real t12 = 0.2*t10;
-    const manocha_canny_real t13 = t9 - t8*s2;
-    const manocha_canny_real t14 = c1*c2;
-    const manocha_canny_real t15 = s3*t13 + t14*c3;
-    const manocha_canny_real t16 = c3*t13 - t14*s3;
-    const manocha_canny_real t17 = t6*c4 - t15*s4;
-    const manocha_canny_real t18 = 0.01745240643728351*t17 + 0.9998476951563913*t16;
-    const manocha_canny_real t19 = -(t4 + t3*s2);
-    const manocha_canny_real t20 = c2*s1;
-    const manocha_canny_real t21 = s3*t19 + t20*c3;
-    const manocha_canny_real t22 = c3*t19 - t20*s3;
-    const manocha_canny_real t23 = t11*c4 - t21*s4;
-    const manocha_canny_real t24 = 0.01745240643728351*t23 + 0.9998476951563913*t22;
-    const manocha_canny_real t25 = 0.9998476951563913*c2;
-    const manocha_canny_real t26 = c3*s2 + t25*s3;
-    const manocha_canny_real t27 = -s2*s3 + t25*c3;
-    const manocha_canny_real t28 = t0*c4 + t26*s4;
-    const manocha_canny_real t29 = 0.01745240643728351*t28 - 0.9998476951563913*t27;
-    const manocha_canny_real t30 = t15*c4;
-    const manocha_canny_real t31 = t6*s4;
-    const manocha_canny_real t32 = t30 + t31;
-    const manocha_canny_real t33 = 1.5*t30 + 1.5*t31;
-    const manocha_canny_real t34 = t7 + t33;
-    const manocha_canny_real t35 = t34 + t14;
-    const manocha_canny_real t36 = t35 + 0.3*c1;
-    const manocha_canny_real t37 = T03 - t36;
-    const manocha_canny_real t38 = t21*c4;
-    const manocha_canny_real t39 = t11*s4;
-    const manocha_canny_real t40 = t38 + t39;
-    const manocha_canny_real t41 = 1.5*t38 + 1.5*t39;
-    const manocha_canny_real t42 = t12 + t41;
-    const manocha_canny_real t43 = t42 + t20;
-    const manocha_canny_real t44 = t43 + 0.3*s1;
-    const manocha_canny_real t45 = t35*c1 + t43*s1;
-    const manocha_canny_real t46 = t42*t6 - t34*t11;
-    const manocha_canny_real t47 = t22*t33 - t16*t41;
-    const manocha_canny_real t48 = (t45*t45) + (t46*t46) + (t47*t47);
-    const manocha_canny_real t49 = t0*t46 + t27*t47;
-    const manocha_canny_real t50 = T13 - t44;
-    const manocha_canny_real t51 = t26*c4;
-    const manocha_canny_real t52 = t0*s4;
-    const manocha_canny_real t53 = t51 - t52;
-    const manocha_canny_real t54 = 1.5*t51 - 1.5*t52;
-    const manocha_canny_real t55 = t54 - t1;
-    const manocha_canny_real t56 = t55 + s2;
-    const manocha_canny_real t57 = t0*t42 + t55*t11;
-    const manocha_canny_real t58 = t27*t41 - t22*t54;
-    const manocha_canny_real t59 = t0*t34 + t6*t55;
-    const manocha_canny_real t60 = t16*t54 - t27*t33;
-    const manocha_canny_real t61 = t44 + t0*t57 + t27*t58;
-    const manocha_canny_real t62 = t36 + t0*t59 - t27*t60;
-    const manocha_canny_real t63 = T23 - t56;
-    const manocha_canny_real t64 = 0.9998476951563913*t17 - 0.01745240643728351*t16;
-    const manocha_canny_real t65 = t32*c5 + s5*t64;
-    const manocha_canny_real t66 = c5*t64 - t32*s5;
-    const manocha_canny_real t67 = t65*c6 - t18*s6;
-    const manocha_canny_real t68 = t18*c6 + t65*s6;
-    const manocha_canny_real t69 = 0.01745240643728351*t66 + 0.9998476951563913*t68;
-    const manocha_canny_real t70 = 0.01745240643728351*t68 - 0.9998476951563913*t66;
-    const manocha_canny_real t71 = T00*t67 + T02*t70 - T01*t69;
-    const manocha_canny_real t72 = T10*t67 + T12*t70 - T11*t69;
-    const manocha_canny_real t73 = T20*t67 + T22*t70 - T21*t69;
-    const manocha_canny_real t74 = 0.9998476951563913*t23 - 0.01745240643728351*t22;
-    const manocha_canny_real t75 = t40*c5 + s5*t74;
-    const manocha_canny_real t76 = c5*t74 - t40*s5;
-    const manocha_canny_real t77 = t75*c6 - t24*s6;
-    const manocha_canny_real t78 = t24*c6 + t75*s6;
-    const manocha_canny_real t79 = 0.01745240643728351*t76 + 0.9998476951563913*t78;
-    const manocha_canny_real t80 = 0.01745240643728351*t78 - 0.9998476951563913*t76;
-    const manocha_canny_real t81 = T00*t77 + T02*t80 - T01*t79;
-    const manocha_canny_real t82 = T10*t77 + T12*t80 - T11*t79;
-    const manocha_canny_real t83 = T20*t77 + T22*t80 - T21*t79;
-    const manocha_canny_real t84 = 0.5*(t72 - t81);
-    const manocha_canny_real t85 = -(0.01745240643728351*t27 + 0.9998476951563913*t28);
-    const manocha_canny_real t86 = t53*c5 + s5*t85;
-    const manocha_canny_real t87 = c5*t85 - t53*s5;
-    const manocha_canny_real t88 = t29*s6 + t86*c6;
-    const manocha_canny_real t89 = t29*c6 - t86*s6;
-    const manocha_canny_real t90 = 0.9998476951563913*t89 - 0.01745240643728351*t87;
-    const manocha_canny_real t91 = 0.01745240643728351*t89 + 0.9998476951563913*t87;
-    const manocha_canny_real t92 = t16*t27 + t66*t87 - t0*t6 - t18*t29;
-    const manocha_canny_real t93 = t22*t27 + t76*t87 - t0*t11 - t24*t29;
-    const manocha_canny_real t94 = 1 + (t0*t0) + (t27*t27) + (t29*t29) + (t87*t87);
-    const manocha_canny_real t95 = T00*t88 + T01*t90 - T02*t91;
-    const manocha_canny_real t96 = T10*t88 + T11*t90 - T12*t91;
-    const manocha_canny_real t97 = T20*t88 + T21*t90 - T22*t91;
-    const manocha_canny_real t98 = 0.5*(t83 - t96);
-    const manocha_canny_real t99 = 0.5*(t95 - t73);
-    const manocha_canny_real t100 = 0.5*(-1 + t71 + t82 + t97);
-    const manocha_canny_real t101 = sqrt((t98*t98) + (t99*t99) + (t84*t84));
-    const manocha_canny_real t102 = atan2(t101, t100);
-    const manocha_canny_real t103 = (t101 > 0 ? t102/t101 : 1);
-    const manocha_canny_real t104 = (t56*t56);
-    const manocha_canny_real t105 = (c1*c1);
-    const manocha_canny_real t106 = (t44*t44) + (t57*t57) + (t58*t58) + t104*t105;
-    const manocha_canny_real t107 = t56*t105 + t57*t11 - t22*t58;
-    const manocha_canny_real t108 = (t22*t22) + (t24*t24) + (t76*t76) + (t11*t11) + t105;
-    const manocha_canny_real t109 = c1*s1;
-    const manocha_canny_real t110 = t58*t60 - t36*t44 - t57*t59 + t104*t109;
-    const manocha_canny_real t111 = t16*t22 + t18*t24 + t66*t76 + t6*t11 - t109;
-    const manocha_canny_real t112 = t45*c1;
-    const manocha_canny_real t113 = t57*t46 + t58*t47 - t56*t112;
-    const manocha_canny_real t114 = t22*t47 + t112 - t46*t11;
-    const manocha_canny_real t115 = t56*t109;
-    const manocha_canny_real t116 = t16*t58 - t6*t57 + t115;
-    const manocha_canny_real t117 = t22*t60 + t59*t11 - t115;
-    const manocha_canny_real t118 = (s1*s1);
-    const manocha_canny_real t119 = (t36*t36) + (t59*t59) + (t60*t60) + t104*t118;
-    const manocha_canny_real t120 = t16*t60 + t6*t59 + t56*t118;
-    const manocha_canny_real t121 = (t16*t16) + (t18*t18) + (t66*t66) + (t6*t6) + t118;
-    const manocha_canny_real t122 = t45*s1;
-    const manocha_canny_real t123 = t59*t46 - t60*t47 + t56*t122;
-    const manocha_canny_real t124 = t6*t46 + t122 - t16*t47;
-    const int t125 = t71 >= t82 && t71 >= t97;
-    const int t126 = t82 >= t97;
-    const manocha_canny_real t127 = (t125 ? 0.5*(1 + t71) : (t126 ? 0.5*t81 : 0.5*t95));
-    const manocha_canny_real t128 = (t125 ? 0.5*t72 : (t126 ? 0.5*(1 + t82) : 0.5*t96));
-    const manocha_canny_real t129 = (t125 ? 0.5*t73 : (t126 ? 0.5*t83 : 0.5*(1 + t97)));
-    const manocha_canny_real t130 = sqrt((t127*t127) + (t128*t128) + (t129*t129));
-    const manocha_canny_real t131 = (t98*t127 + t99*t128 + t84*t129 >= 0 ? 1 : -1);
-    const int t132 = (t101 > 1e-06) || (t100 > 0);
-    const manocha_canny_real t133 = t102*t131/t130;
-    const manocha_canny_real t134 = (t132 ? t98*t103 : t127*t133);
-    const manocha_canny_real t135 = (t132 ? t99*t103 : t128*t133);
-    const manocha_canny_real t136 = (t132 ? t84*t103 : t129*t133);
-    const manocha_canny_real t137 = (t134*t134) + (t135*t135) + (t136*t136) + (t37*t37) + (t50*t50) + (t63*t63);
-    const manocha_canny_real t138 = t106 + damping;
-    const manocha_canny_real t139 = sqrt((t110*t110) + (t61*t61) + (t113*t113) + (t116*t116) + (t107*t107) + (t138*t138));
-    const manocha_canny_real t140 = t139*(t138 >= 0 ? 1 : -1);
-    const manocha_canny_real t141 = t140 + t138;
-    const manocha_canny_real t142 = (t139 > 0 ? 1/(t139*(t139 + fabs(t138))) : 0);
-    const manocha_canny_real t143 = t142*(t110*t50 + t113*t63 + t107*t135 + t37*t141 - t61*t136 - t116*t134);
-    const manocha_canny_real t144 = t37 - t141*t143;
-    const manocha_canny_real t145 = t50 - t110*t143;
-    const manocha_canny_real t146 = t63 - t113*t143;
-    const manocha_canny_real t147 = t134 + t116*t143;
-    const manocha_canny_real t148 = t135 - t107*t143;
-    const manocha_canny_real t149 = t136 + t61*t143;
-    const manocha_canny_real t150 = t119 + damping;
-    const manocha_canny_real t151 = t142*(t110*t141 + t110*t150 + t116*t120 - t61*t62 - t113*t123 - t107*t117);
-    const manocha_canny_real t152 = t110 - t141*t151;
-    const manocha_canny_real t153 = t150 - t110*t151;
-    const manocha_canny_real t154 = t123 + t113*t151;
-    const manocha_canny_real t155 = -t120 + t116*t151;
-    const manocha_canny_real t156 = t117 + t107*t151;
-    const manocha_canny_real t157 = t62 + t61*t151;
-    const manocha_canny_real t158 = sqrt((t153*t153) + (t154*t154) + (t155*t155) + (t156*t156) + (t157*t157));
-    const manocha_canny_real t159 = t158*(t153 >= 0 ? 1 : -1);
-    const manocha_canny_real t160 = t153 + t159;
-    const manocha_canny_real t161 = (t158 > 0 ? 1/(t158*(t158 + fabs(t153))) : 0);
-    const manocha_canny_real t162 = t161*(t155*t147 + t157*t149 + t145*t160 - t154*t146 - t156*t148);
-    const manocha_canny_real t163 = t145 - t160*t162;
-    const manocha_canny_real t164 = t146 + t154*t162;
-    const manocha_canny_real t165 = t147 - t155*t162;
-    const manocha_canny_real t166 = t148 + t156*t162;
-    const manocha_canny_real t167 = t149 - t157*t162;
-    const manocha_canny_real t168 = t48 + damping;
-    const manocha_canny_real t169 = t142*(t61*t49 + t113*t141 + t113*t168 - t110*t123 - t116*t124 - t107*t114);
-    const manocha_canny_real t170 = t113 - t141*t169;
-    const manocha_canny_real t171 = t123 + t110*t169;
-    const manocha_canny_real t172 = t168 - t113*t169;
-    const manocha_canny_real t173 = t124 + t116*t169;
-    const manocha_canny_real t174 = t114 + t107*t169;
-    const manocha_canny_real t175 = -t49 + t61*t169;
-    const manocha_canny_real t176 = t161*(t155*t173 + t156*t174 + t157*t175 - t154*t172 - t171*t160);
-    const manocha_canny_real t177 = t171 + t160*t176;
-    const manocha_canny_real t178 = t172 + t154*t176;
-    const manocha_canny_real t179 = t173 - t155*t176;
-    const manocha_canny_real t180 = -t174 + t156*t176;
-    const manocha_canny_real t181 = t175 - t157*t176;
-    const manocha_canny_real t182 = sqrt((t178*t178) + (t179*t179) + (t180*t180) + (t181*t181));
-    const manocha_canny_real t183 = t182*(t178 >= 0 ? 1 : -1);
-    const manocha_canny_real t184 = t178 + t183;
-    const manocha_canny_real t185 = (t182 > 0 ? 1/(t182*(t182 + fabs(t178))) : 0);
-    const manocha_canny_real t186 = t185*(t179*t165 + t180*t166 + t181*t167 + t164*t184);
-    const manocha_canny_real t187 = t164 - t184*t186;
-    const manocha_canny_real t188 = t165 - t179*t186;
-    const manocha_canny_real t189 = t166 - t180*t186;
-    const manocha_canny_real t190 = t167 - t181*t186;
-    const manocha_canny_real t191 = t121 + damping;
-    const manocha_canny_real t192 = -t142*(t110*t120 + t61*t92 + t116*t141 + t116*t191 - t113*t124 - t107*t111);
-    const manocha_canny_real t193 = t116 + t141*t192;
-    const manocha_canny_real t194 = t120 + t110*t192;
-    const manocha_canny_real t195 = t124 - t113*t192;
-    const manocha_canny_real t196 = t191 + t116*t192;
-    const manocha_canny_real t197 = t111 - t107*t192;
-    const manocha_canny_real t198 = t92 + t61*t192;
-    const manocha_canny_real t199 = -t161*(t154*t195 + t156*t197 + t194*t160 - t155*t196 - t157*t198);
-    const manocha_canny_real t200 = t194 + t160*t199;
-    const manocha_canny_real t201 = t195 + t154*t199;
-    const manocha_canny_real t202 = t196 - t155*t199;
-    const manocha_canny_real t203 = t197 + t156*t199;
-    const manocha_canny_real t204 = t198 - t157*t199;
-    const manocha_canny_real t205 = t185*(t179*t202 + t180*t203 + t181*t204 + t201*t184);
-    const manocha_canny_real t206 = t201 - t184*t205;
-    const manocha_canny_real t207 = t202 - t179*t205;
-    const manocha_canny_real t208 = t203 - t180*t205;
-    const manocha_canny_real t209 = t204 - t181*t205;
-    const manocha_canny_real t210 = sqrt((t207*t207) + (t208*t208) + (t209*t209));
-    const manocha_canny_real t211 = t210*(t207 >= 0 ? 1 : -1);
-    const manocha_canny_real t212 = t207 + t211;
-    const manocha_canny_real t213 = (t210 > 0 ? 1/(t210*(t210 + fabs(t207))) : 0);
-    const manocha_canny_real t214 = t213*(t208*t189 + t209*t190 + t188*t212);
-    const manocha_canny_real t215 = t188 - t212*t214;
-    const manocha_canny_real t216 = t189 - t208*t214;
-    const manocha_canny_real t217 = t190 - t209*t214;
-    const manocha_canny_real t218 = t108 + damping;
-    const manocha_canny_real t219 = -t142*(t110*t117 + t61*t93 + t113*t114 + t116*t111 - t107*t141 - t107*t218);
-    const manocha_canny_real t220 = t107 - t141*t219;
-    const manocha_canny_real t221 = t117 + t110*t219;
-    const manocha_canny_real t222 = t114 + t113*t219;
-    const manocha_canny_real t223 = t111 + t116*t219;
-    const manocha_canny_real t224 = t218 - t107*t219;
-    const manocha_canny_real t225 = t93 + t61*t219;
-    const manocha_canny_real t226 = t161*(t154*t222 + t155*t223 + t157*t225 - t156*t224 - t221*t160);
-    const manocha_canny_real t227 = t221 + t160*t226;
-    const manocha_canny_real t228 = -t222 + t154*t226;
-    const manocha_canny_real t229 = t223 - t155*t226;
-    const manocha_canny_real t230 = t224 + t156*t226;
-    const manocha_canny_real t231 = t225 - t157*t226;
-    const manocha_canny_real t232 = t185*(t179*t229 + t180*t230 + t181*t231 + t228*t184);
-    const manocha_canny_real t233 = t228 - t184*t232;
-    const manocha_canny_real t234 = t229 - t179*t232;
-    const manocha_canny_real t235 = t230 - t180*t232;
-    const manocha_canny_real t236 = t231 - t181*t232;
-    const manocha_canny_real t237 = t213*(t208*t235 + t209*t236 + t234*t212);
-    const manocha_canny_real t238 = t234 - t212*t237;
-    const manocha_canny_real t239 = t235 - t208*t237;
-    const manocha_canny_real t240 = t236 - t209*t237;
-    const manocha_canny_real t241 = sqrt((t239*t239) + (t240*t240));
-    const manocha_canny_real t242 = t241*(t239 >= 0 ? 1 : -1);
-    const manocha_canny_real t243 = t239 + t242;
-    const manocha_canny_real t244 = (t241 > 0 ? 1/(t241*(t241 + fabs(t239))) : 0);
-    const manocha_canny_real t245 = t244*(t240*t217 + t216*t243);
-    const manocha_canny_real t246 = t216 - t243*t245;
-    const manocha_canny_real t247 = t217 - t240*t245;
-    const manocha_canny_real t248 = t94 + damping;
-    const manocha_canny_real t249 = -t142*(t61*t141 + t61*t248 + t113*t49 + t116*t92 - t110*t62 - t107*t93);
-    const manocha_canny_real t250 = t61 + t141*t249;
-    const manocha_canny_real t251 = t62 - t110*t249;
-    const manocha_canny_real t252 = t49 + t113*t249;
-    const manocha_canny_real t253 = t92 + t116*t249;
-    const manocha_canny_real t254 = t93 - t107*t249;
-    const manocha_canny_real t255 = t248 + t61*t249;
-    const manocha_canny_real t256 = t161*(t154*t252 + t155*t253 + t157*t255 + t251*t160 - t156*t254);
-    const manocha_canny_real t257 = t251 - t160*t256;
-    const manocha_canny_real t258 = -t252 + t154*t256;
-    const manocha_canny_real t259 = t253 - t155*t256;
-    const manocha_canny_real t260 = t254 + t156*t256;
-    const manocha_canny_real t261 = t255 - t157*t256;
-    const manocha_canny_real t262 = t185*(t179*t259 + t180*t260 + t181*t261 + t258*t184);
-    const manocha_canny_real t263 = t258 - t184*t262;
-    const manocha_canny_real t264 = t259 - t179*t262;
-    const manocha_canny_real t265 = t260 - t180*t262;
-    const manocha_canny_real t266 = t261 - t181*t262;
-    const manocha_canny_real t267 = t213*(t208*t265 + t209*t266 + t264*t212);
-    const manocha_canny_real t268 = t264 - t212*t267;
-    const manocha_canny_real t269 = t265 - t208*t267;
-    const manocha_canny_real t270 = t266 - t209*t267;
-    const manocha_canny_real t271 = t244*(t240*t270 + t269*t243);
-    const manocha_canny_real t272 = t269 - t243*t271;
-    const manocha_canny_real t273 = t270 - t240*t271;
-    const manocha_canny_real t274 = fabs(t273);
-    const manocha_canny_real t275 = t274;
-    const manocha_canny_real t276 = t275*(t273 >= 0 ? 1 : -1);
-    const manocha_canny_real t277 = t273 + t276;
-    const manocha_canny_real t278 = (t275 > 0 ? 1/(t275*(t275 + t274)) : 0);
-    const manocha_canny_real t279 = t247 - t247*t278*(t277*t277);
-    const manocha_canny_real t280 = (t276 != 0 ? -t279/t276 : 0);
-    const manocha_canny_real t281 = (t242 != 0 ? -(t246 - t272*t280)/t242 : 0);
-    const manocha_canny_real t282 = (t211 != 0 ? -(t215 - (t238*t281 + t268*t280))/t211 : 0);
-    const manocha_canny_real t283 = (t183 != 0 ? -(t187 - (t206*t282 + t233*t281 + t263*t280))/t183 : 0);
-    const manocha_canny_real t284 = (t159 != 0 ? -(t163 + t177*t283 + t200*t282 + t227*t281 - t257*t280)/t159 : 0);
-    const manocha_canny_real t285 = (t140 != 0 ? -(t144 - (t152*t284 + t170*t283 + t220*t281 - t193*t282 - t250*t280))/t140 : 0);
-    const manocha_canny_real t286 = t280 + q1 + t284*t36 - t285*t44;
-    const manocha_canny_real t287 = q2 + t282*s1 + t283*t45 - t281*c1 - t284*t56*s1 - t285*t56*c1;
-    const manocha_canny_real t288 = q3 + t281*t11 + t282*t6 + t283*t46 + t285*t57 - t0*t280 - t284*t59;
-    const manocha_canny_real t289 = q4 + t283*t47 + t284*t60 + t285*t58 - t16*t282 - t22*t281 - t27*t280;
-    const manocha_canny_real t290 = q5 + t29*t280 - t18*t282 - t24*t281;
-    const manocha_canny_real t291 = -q6 + t66*t282 + t76*t281 + t87*t280;
+    const manocha_canny_real t2 = 0.9998476951563913*s1;
+    const manocha_canny_real t3 = 0.01745240643728351*c1;
+    const manocha_canny_real t4 = t2 + t3*s2;
+    const manocha_canny_real t5 = t4;
+    const manocha_canny_real t6 = 0.2*t4;
+    const manocha_canny_real t7 = 0.9998476951563913*c1;
+    const manocha_canny_real t8 = 0.01745240643728351*s1;
+    const manocha_canny_real t9 = -t7 + t8*s2;
+    const manocha_canny_real t10 = t9;
+    const manocha_canny_real t11 = 0.2*t9;
+    const manocha_canny_real t12 = t8 - t7*s2;
+    const manocha_canny_real t13 = c1*c2;
+    const manocha_canny_real t14 = s3*t12 + t13*c3;
+    const manocha_canny_real t15 = c3*t12 - t13*s3;
+    const manocha_canny_real t16 = t5*c4 - t14*s4;
+    const manocha_canny_real t17 = 0.01745240643728351*t16 + 0.9998476951563913*t15;
+    const manocha_canny_real t18 = -(t3 + t2*s2);
+    const manocha_canny_real t19 = c2*s1;
+    const manocha_canny_real t20 = s3*t18 + t19*c3;
+    const manocha_canny_real t21 = c3*t18 - t19*s3;
+    const manocha_canny_real t22 = t10*c4 - t20*s4;
+    const manocha_canny_real t23 = 0.01745240643728351*t22 + 0.9998476951563913*t21;
+    const manocha_canny_real t24 = 0.9998476951563913*c2;
+    const manocha_canny_real t25 = c3*s2 + t24*s3;
+    const manocha_canny_real t26 = -s2*s3 + t24*c3;
+    const manocha_canny_real t27 = t0*c4 + t25*s4;
+    const manocha_canny_real t28 = 0.01745240643728351*t27 - 0.9998476951563913*t26;
+    const manocha_canny_real t29 = t14*c4;
+    const manocha_canny_real t30 = t5*s4;
+    const manocha_canny_real t31 = t29 + t30;
+    const manocha_canny_real t32 = 1.5*t29 + 1.5*t30;
+    const manocha_canny_real t33 = t6 + t32;
+    const manocha_canny_real t34 = t33 + t13;
+    const manocha_canny_real t35 = t34 + 0.3*c1;
+    const manocha_canny_real t36 = t20*c4;
+    const manocha_canny_real t37 = t10*s4;
+    const manocha_canny_real t38 = t36 + t37;
+    const manocha_canny_real t39 = 1.5*t36 + 1.5*t37;
+    const manocha_canny_real t40 = t11 + t39;
+    const manocha_canny_real t41 = t40 + t19;
+    const manocha_canny_real t42 = t41 + 0.3*s1;
+    const manocha_canny_real t43 = t25*c4;
+    const manocha_canny_real t44 = t0*s4;
+    const manocha_canny_real t45 = t43 - t44;
+    const manocha_canny_real t46 = 1.5*t43 - 1.5*t44;
+    const manocha_canny_real t47 = t46 - t1;
+    const manocha_canny_real t48 = t47 + s2;
+    const manocha_canny_real t49 = 0.9998476951563913*t16 - 0.01745240643728351*t15;
+    const manocha_canny_real t50 = t31*c5 + s5*t49;
+    const manocha_canny_real t51 = c5*t49 - t31*s5;
+    const manocha_canny_real t52 = t50*c6 - t17*s6;
+    const manocha_canny_real t53 = t17*c6 + t50*s6;
+    const manocha_canny_real t54 = 0.01745240643728351*t51 + 0.9998476951563913*t53;
+    const manocha_canny_real t55 = 0.01745240643728351*t53 - 0.9998476951563913*t51;
+    const manocha_canny_real t56 = T00*t52 + T02*t55 - T01*t54;
+    const manocha_canny_real t57 = T10*t52 + T12*t55 - T11*t54;
+    const manocha_canny_real t58 = T20*t52 + T22*t55 - T21*t54;
+    const manocha_canny_real t59 = 0.9998476951563913*t22 - 0.01745240643728351*t21;
+    const manocha_canny_real t60 = t38*c5 + s5*t59;
+    const manocha_canny_real t61 = c5*t59 - t38*s5;
+    const manocha_canny_real t62 = t60*c6 - t23*s6;
+    const manocha_canny_real t63 = t23*c6 + t60*s6;
+    const manocha_canny_real t64 = 0.01745240643728351*t61 + 0.9998476951563913*t63;
+    const manocha_canny_real t65 = 0.01745240643728351*t63 - 0.9998476951563913*t61;
+    const manocha_canny_real t66 = T00*t62 + T02*t65 - T01*t64;
+    const manocha_canny_real t67 = T10*t62 + T12*t65 - T11*t64;
+    const manocha_canny_real t68 = T20*t62 + T22*t65 - T21*t64;
+    const manocha_canny_real t69 = 0.5*(t57 - t66);
+    const manocha_canny_real t70 = -(0.01745240643728351*t26 + 0.9998476951563913*t27);
+    const manocha_canny_real t71 = t45*c5 + s5*t70;
+    const manocha_canny_real t72 = c5*t70 - t45*s5;
+    const manocha_canny_real t73 = t28*s6 + t71*c6;
+    const manocha_canny_real t74 = t28*c6 - t71*s6;
+    const manocha_canny_real t75 = 0.9998476951563913*t74 - 0.01745240643728351*t72;
+    const manocha_canny_real t76 = 0.01745240643728351*t74 + 0.9998476951563913*t72;
+    const manocha_canny_real t77 = T00*t73 + T01*t75 - T02*t76;
+    const manocha_canny_real t78 = T10*t73 + T11*t75 - T12*t76;
+    const manocha_canny_real t79 = T20*t73 + T21*t75 - T22*t76;
+    const manocha_canny_real t80 = 0.5*(t68 - t78);
+    const manocha_canny_real t81 = 0.5*(t77 - t58);
+    const manocha_canny_real t82 = 0.5*(-1 + t56 + t67 + t79);
+    const manocha_canny_real t83 = sqrt((t80*t80) + (t81*t81) + (t69*t69));
+    const manocha_canny_real t84 = atan2(t83, t82);
+    const manocha_canny_real t85 = (t83 > 0 ? t84/t83 : 1);
+    const int t86 = t56 >= t67 && t56 >= t79;
+    const int t87 = t67 >= t79;
+    const manocha_canny_real t88 = (t86 ? 0.5*(1 + t56) : (t87 ? 0.5*t66 : 0.5*t77));
+    const manocha_canny_real t89 = (t86 ? 0.5*t57 : (t87 ? 0.5*(1 + t67) : 0.5*t78));
+    const manocha_canny_real t90 = (t86 ? 0.5*t58 : (t87 ? 0.5*t68 : 0.5*(1 + t79)));
+    const manocha_canny_real t91 = sqrt((t88*t88) + (t89*t89) + (t90*t90));
+    const manocha_canny_real t92 = (t80*t88 + t81*t89 + t69*t90 >= 0 ? 1 : -1);
+    const int t93 = (t83 > 1e-06) || (t82 > 0);
+    const manocha_canny_real t94 = t84*t92/t91;
+    const manocha_canny_real t95 = (t93 ? t80*t85 : t88*t94);
+    const manocha_canny_real t96 = (t93 ? t81*t85 : t89*t94);
+    const manocha_canny_real t97 = (t93 ? t69*t85 : t90*t94);
+    const manocha_canny_real t98 = -t42;
 
     /* Outputs */
-    q_start[0] = q1;
-    q_start[1] = q2;
-    q_start[2] = q3;
-    q_start[3] = q4;
-    q_start[4] = q5;
-    q_start[5] = q6;
-    q_next[0] = t286;
-    q_next[1] = t287;
-    q_next[2] = t288;
-    q_next[3] = t289;
-    q_next[4] = t290;
-    q_next[5] = -t291;
-    return (isfinite(t2) ? t137 : -1);
+    e[0] = T03 - t35;
+    e[1] = T13 + t98;
+    e[2] = T23 - t48;
+    e[3] = t95;
+    e[4] = t96;
+    e[5] = t97;
+    J[0] = t98;
+    J[1] = -t48*c1;
+    J[2] = t0*t40 + t47*t10;
+    J[3] = t26*t39 - t21*t46;
+    J[4] = 0;
+    J[5] = 0;
+    J[6] = t35;
+    J[7] = -t48*s1;
+    J[8] = -(t0*t33 + t5*t47);
+    J[9] = t15*t46 - t26*t32;
+    J[10] = 0;
+    J[11] = 0;
+    J[12] = 0;
+    J[13] = t34*c1 + t41*s1;
+    J[14] = t40*t5 - t33*t10;
+    J[15] = t21*t32 - t15*t39;
+    J[16] = 0;
+    J[17] = 0;
+    J[18] = 0;
+    J[19] = s1;
+    J[20] = t5;
+    J[21] = -t15;
+    J[22] = -t17;
+    J[23] = -t51;
+    J[24] = 0;
+    J[25] = -c1;
+    J[26] = t10;
+    J[27] = -t21;
+    J[28] = -t23;
+    J[29] = -t61;
+    J[30] = 1;
+    J[31] = 0;
+    J[32] = -t0;
+    J[33] = -t26;
+    J[34] = t28;
+    J[35] = -t72;
 }
 
 int manocha_canny_ik_general_limits(const manocha_canny_real q_solution[MANOCHA_CANNY_DOF], manocha_canny_real q[MANOCHA_CANNY_DOF])
@@ -4568,47 +4405,78 @@ int manocha_canny_ik_nearest(const manocha_canny_real T[16], const manocha_canny
     return (!t308 ? 2 : (t309 ? 0 : 1));
 }
 
-/* The general 6R solver: the equations at T, the kernel's roots (jacgen_general6r_roots, in
- * double), each completed to a configuration, polished by Newton steps and kept when it reaches
- * T, once; the valid rows first. */
-void manocha_canny_ik_branches(const manocha_canny_real T[16], manocha_canny_real q[MANOCHA_CANNY_MAX_IK_SOLUTIONS * MANOCHA_CANNY_DOF],
-                     int valid[MANOCHA_CANNY_MAX_IK_SOLUTIONS], int in_limits[MANOCHA_CANNY_MAX_IK_SOLUTIONS])
+/* Clears the result rows of ik_branches. */
+static void manocha_canny_ik_general_clear(manocha_canny_real q[MANOCHA_CANNY_MAX_IK_SOLUTIONS * MANOCHA_CANNY_DOF], int valid[MANOCHA_CANNY_MAX_IK_SOLUTIONS],
+                                 int in_limits[MANOCHA_CANNY_MAX_IK_SOLUTIONS])
 {
-    manocha_canny_real P[378], Q[112], angles[5], x[MANOCHA_CANNY_DOF], start[MANOCHA_CANNY_DOF], next[MANOCHA_CANNY_DOF];
-    double p[3][14][9], qm[14][8], roots[JACGEN_G6_ROOTS][5];
-    int count = 0, found, i, j, k, s;
+    int i, j;
     for (i = 0; i < MANOCHA_CANNY_MAX_IK_SOLUTIONS; ++i) {
         valid[i] = 0;
         in_limits[i] = 0;
         for (j = 0; j < MANOCHA_CANNY_DOF; ++j) q[MANOCHA_CANNY_DOF * i + j] = 0;
     }
+}
+
+/* Writes the solution x as row `count` (ik's form, in_limits), unless it equals an earlier row
+ * to 1e-6 rad; returns whether it did. */
+static int manocha_canny_ik_general_add(const manocha_canny_real x[MANOCHA_CANNY_DOF], int count, manocha_canny_real q[MANOCHA_CANNY_MAX_IK_SOLUTIONS * MANOCHA_CANNY_DOF],
+                              int valid[MANOCHA_CANNY_MAX_IK_SOLUTIONS], int in_limits[MANOCHA_CANNY_MAX_IK_SOLUTIONS])
+{
+    int i, j;
+    for (i = 0; i < count; ++i) {
+        double largest = 0.0;
+        for (j = 0; j < MANOCHA_CANNY_DOF; ++j) {
+            double d = remainder((double)x[j] - (double)q[MANOCHA_CANNY_DOF * i + j], 6.283185307179586);
+            largest = fmax(largest, fabs(d));
+        }
+        if (largest < 1e-6) return 0;
+    }
+    in_limits[count] = manocha_canny_ik_general_limits(x, q + MANOCHA_CANNY_DOF * count);
+    valid[count] = 1;
+    return 1;
+}
+
+/* |e|^2 at x; and unless x has converged (|e|^2 <= 1.6e-23), x moved by one Newton step
+ * x + J^-1 e (in double; x stays where J is singular). */
+static manocha_canny_real manocha_canny_ik_general_newton(const manocha_canny_real T[16], manocha_canny_real x[MANOCHA_CANNY_DOF])
+{
+    manocha_canny_real e[6], J[36], cost = 0;
+    double a[36], b[6];
+    int i;
+    manocha_canny_ik_general_residual(T, x, e, J);
+    for (i = 0; i < 36; ++i) a[i] = (double)J[i];
+    for (i = 0; i < 6; ++i) {
+        b[i] = (double)e[i];
+        cost += e[i] * e[i];
+    }
+    if (!(cost <= 1.6e-23) && jacgen_g6_solve(6, a, 1, b) == 0)
+        for (i = 0; i < 6; ++i) x[i] += (manocha_canny_real)b[i];
+    return cost;
+}
+
+/* The general 6R solver: the equations at T, the kernel's
+ * roots (jacgen_general6r_roots, in double), each completed to a configuration, polished by
+ * Newton steps and kept when it reaches T, once; the valid rows first. */
+void manocha_canny_ik_branches(const manocha_canny_real T[16], manocha_canny_real q[MANOCHA_CANNY_MAX_IK_SOLUTIONS * MANOCHA_CANNY_DOF],
+                     int valid[MANOCHA_CANNY_MAX_IK_SOLUTIONS], int in_limits[MANOCHA_CANNY_MAX_IK_SOLUTIONS])
+{
+    manocha_canny_real P[378], Q[112], angles[5], x[MANOCHA_CANNY_DOF];
+    double p[3][14][9], qm[14][8], roots[JACGEN_G6_ROOTS][5];
+    int count = 0, found, i, j, k, s;
+    manocha_canny_ik_general_clear(q, valid, in_limits);
     manocha_canny_ik_general_equations(T, P, Q);
     for (i = 0; i < 378; ++i) p[i / 126][i / 9 % 14][i % 9] = (double)P[i];
     for (i = 0; i < 112; ++i) qm[i / 8][i % 8] = (double)Q[i];
     found = jacgen_general6r_roots(p, qm, roots);
     for (k = 0; k < found && count < MANOCHA_CANNY_MAX_IK_SOLUTIONS; ++k) {
         manocha_canny_real cost;
-        int duplicate = 0;
         for (j = 0; j < 5; ++j) angles[j] = (manocha_canny_real)roots[k][j];
         manocha_canny_ik_general_start(T, angles, x);
-        for (s = 0; s < 2; ++s) {
-            manocha_canny_ik_general_step(T, x, 0, start, next);
-            for (j = 0; j < MANOCHA_CANNY_DOF; ++j) x[j] = next[j];
-        }
-        cost = manocha_canny_ik_general_step(T, x, 0, start, next);
-        if (!(cost >= 0 && cost <= 1e-18)) continue;
-        for (i = 0; i < count && !duplicate; ++i) {
-            double largest = 0.0;
-            for (j = 0; j < MANOCHA_CANNY_DOF; ++j) {
-                double d = remainder((double)x[j] - (double)q[MANOCHA_CANNY_DOF * i + j], 6.283185307179586);
-                largest = fmax(largest, fabs(d));
-            }
-            duplicate = largest < 1e-6;
-        }
-        if (duplicate) continue;
-        in_limits[count] = manocha_canny_ik_general_limits(x, q + MANOCHA_CANNY_DOF * count);
-        valid[count] = 1;
-        ++count;
+        cost = manocha_canny_ik_general_newton(T, x);
+        for (s = 0; s < 2 && cost > 1.6e-23; ++s)
+            cost = manocha_canny_ik_general_newton(T, x);
+        if (!(cost <= 1e-18)) continue;
+        count += manocha_canny_ik_general_add(x, count, q, valid, in_limits);
     }
 }
 

@@ -106,9 +106,9 @@ void manocha_canny_ik_general_equations(const manocha_canny_real T[16], manocha_
  * Result: q[i], i < 6. 102 operations. */
 void manocha_canny_ik_general_start(const manocha_canny_real T[16], const manocha_canny_real angles[5], manocha_canny_real q[MANOCHA_CANNY_DOF]);
 
-/* One Newton step of the general 6R solver's polish: q + J^T (J J^T + damping I)^-1 e (damping 0 for Newton), and |e|^2 at q (-1 when target or q is not finite).
- * Result: q_start[i], i < 6; q_next[i], i < 6; returned as a scalar. 1026 operations. */
-manocha_canny_real manocha_canny_ik_general_step(const manocha_canny_real target[16], const manocha_canny_real q[MANOCHA_CANNY_DOF], manocha_canny_real damping, manocha_canny_real q_start[MANOCHA_CANNY_DOF], manocha_canny_real q_next[MANOCHA_CANNY_DOF]);
+/* The pose error e at q (the position error and the rotation vector of R_target R^T, world frame) and the geometric Jacobian J: the Newton step of the solver's polish is q + J^-1 e.
+ * Result: e[i], i < 6; J: 6 x 6 row-major, element (r, c) at J[r * 6 + c]. 309 operations. */
+void manocha_canny_ik_general_residual(const manocha_canny_real target[16], const manocha_canny_real q[MANOCHA_CANNY_DOF], manocha_canny_real e[6], manocha_canny_real J[6 * MANOCHA_CANNY_DOF]);
 
 /* Ik's form of q (revolute angles wrapped, or into the limits) and whether it is inside the joint limits.
  * Result: q[i], i < 6; returned as a scalar. 30 operations. */
@@ -144,7 +144,7 @@ void manocha_canny_ik_branches(const manocha_canny_real T[16], manocha_canny_rea
  * also gives the solutions outside the limits (in_limits 0).
  * Solver: general 6R: Raghavan & Roth's 14 equations, eliminated to a 12 x 12 quadratic
  * matrix polynomial in tan(q_k/2) solved as a 24 x 24 eigenproblem, back-substitution and
- * two Newton steps (jacgen/general6r.py).
+ * up to two Newton steps (jacgen/general6r.py).
  * Order: the real eigenvalues in the order the eigensolver gives them; a solution that
  * does not reach the target after the Newton steps (a spurious root) is skipped; each
  * solution once (equal to 1e-6 rad).

@@ -3317,9 +3317,9 @@ def ik_general_start(T, angles):
 
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
-def ik_general_step(target, q, damping=0.0):
-    """one Newton step of the general 6R solver's polish: q + J^T (J J^T + damping I)^-1 e (damping 0 for Newton), and |e|^2 at q (-1 when target or q is not finite): (6 x 1 and 6 x 1 and 1 x 1), 1026 operations."""
-    xp, dtype, device, batch, (target, q, damping,) = _arguments(("target", target, (4, 4)), ("q", q, (6,)), ("damping", damping, ()))
+def ik_general_residual(target, q):
+    """the pose error e at q (the position error and the rotation vector of R_target R^T, world frame) and the geometric Jacobian J: the Newton step of the solver's polish is q + J^-1 e: (6 x 1 and 6 x 6), 309 operations."""
+    xp, dtype, device, batch, (target, q,) = _arguments(("target", target, (4, 4)), ("q", q, (6,)))
     T00 = target[..., 0, 0]
     T01 = target[..., 0, 1]
     T02 = target[..., 0, 2]
@@ -3358,314 +3358,150 @@ def ik_general_step(target, q, damping=0.0):
     s6 = xp.sin(q6)
     t0 = 0.01745240643728351*c2
     t1 = 0.0034904812874567027*c2
-    t2 = T00 + T01 + T02 + T03 + T10 + T11 + T12 + T13 + T20 + T21 + T22 + T23 + qs1 + qs2 + qs3 + qs4 + qs5 + qs6
-    t3 = 0.9998476951563913*s1
-    t4 = 0.01745240643728351*c1
-    t5 = t3 + t4*s2
-    t6 = t5
-    t7 = 0.2*t5
-    t8 = 0.9998476951563913*c1
-    t9 = 0.01745240643728351*s1
-    t10 = -t8 + t9*s2
-    t11 = t10
-    t12 = 0.2*t10
-    t13 = t9 - t8*s2
-    t14 = c1*c2
-    t15 = s3*t13 + t14*c3
-    t16 = c3*t13 - t14*s3
-    t17 = t6*c4 - t15*s4
-    t18 = 0.01745240643728351*t17 + 0.9998476951563913*t16
-    t19 = -(t4 + t3*s2)
-    t20 = c2*s1
-    t21 = s3*t19 + t20*c3
-    t22 = c3*t19 - t20*s3
-    t23 = t11*c4 - t21*s4
-    t24 = 0.01745240643728351*t23 + 0.9998476951563913*t22
-    t25 = 0.9998476951563913*c2
-    t26 = c3*s2 + t25*s3
-    t27 = -s2*s3 + t25*c3
-    t28 = t0*c4 + t26*s4
-    t29 = 0.01745240643728351*t28 - 0.9998476951563913*t27
-    t30 = t15*c4
-    t31 = t6*s4
-    t32 = t30 + t31
-    t33 = 1.5*t30 + 1.5*t31
-    t34 = t7 + t33
-    t35 = t34 + t14
-    t36 = t35 + 0.3*c1
-    t37 = T03 - t36
-    t38 = t21*c4
-    t39 = t11*s4
-    t40 = t38 + t39
-    t41 = 1.5*t38 + 1.5*t39
-    t42 = t12 + t41
-    t43 = t42 + t20
-    t44 = t43 + 0.3*s1
-    t45 = t35*c1 + t43*s1
-    t46 = t42*t6 - t34*t11
-    t47 = t22*t33 - t16*t41
-    t48 = t45**2 + t46**2 + t47**2
-    t49 = t0*t46 + t27*t47
-    t50 = T13 - t44
-    t51 = t26*c4
-    t52 = t0*s4
-    t53 = t51 - t52
-    t54 = 1.5*t51 - 1.5*t52
-    t55 = t54 - t1
-    t56 = t55 + s2
-    t57 = t0*t42 + t55*t11
-    t58 = t27*t41 - t22*t54
-    t59 = t0*t34 + t6*t55
-    t60 = t16*t54 - t27*t33
-    t61 = t44 + t0*t57 + t27*t58
-    t62 = t36 + t0*t59 - t27*t60
-    t63 = T23 - t56
-    t64 = 0.9998476951563913*t17 - 0.01745240643728351*t16
-    t65 = t32*c5 + s5*t64
-    t66 = c5*t64 - t32*s5
-    t67 = t65*c6 - t18*s6
-    t68 = t18*c6 + t65*s6
-    t69 = 0.01745240643728351*t66 + 0.9998476951563913*t68
-    t70 = 0.01745240643728351*t68 - 0.9998476951563913*t66
-    t71 = T00*t67 + T02*t70 - T01*t69
-    t72 = T10*t67 + T12*t70 - T11*t69
-    t73 = T20*t67 + T22*t70 - T21*t69
-    t74 = 0.9998476951563913*t23 - 0.01745240643728351*t22
-    t75 = t40*c5 + s5*t74
-    t76 = c5*t74 - t40*s5
-    t77 = t75*c6 - t24*s6
-    t78 = t24*c6 + t75*s6
-    t79 = 0.01745240643728351*t76 + 0.9998476951563913*t78
-    t80 = 0.01745240643728351*t78 - 0.9998476951563913*t76
-    t81 = T00*t77 + T02*t80 - T01*t79
-    t82 = T10*t77 + T12*t80 - T11*t79
-    t83 = T20*t77 + T22*t80 - T21*t79
-    t84 = 0.5*(t72 - t81)
-    t85 = -(0.01745240643728351*t27 + 0.9998476951563913*t28)
-    t86 = t53*c5 + s5*t85
-    t87 = c5*t85 - t53*s5
-    t88 = t29*s6 + t86*c6
-    t89 = t29*c6 - t86*s6
-    t90 = 0.9998476951563913*t89 - 0.01745240643728351*t87
-    t91 = 0.01745240643728351*t89 + 0.9998476951563913*t87
-    t92 = t16*t27 + t66*t87 - t0*t6 - t18*t29
-    t93 = t22*t27 + t76*t87 - t0*t11 - t24*t29
-    t94 = 1 + t0**2 + t27**2 + t29**2 + t87**2
-    t95 = T00*t88 + T01*t90 - T02*t91
-    t96 = T10*t88 + T11*t90 - T12*t91
-    t97 = T20*t88 + T21*t90 - T22*t91
-    t98 = 0.5*(t83 - t96)
-    t99 = 0.5*(t95 - t73)
-    t100 = 0.5*(-1 + t71 + t82 + t97)
-    t101 = xp.sqrt(t98**2 + t99**2 + t84**2)
-    t102 = xp.atan2(t101, t100)
-    t103 = xp.where(xp.greater(t101, 0), t102/t101, 1)
-    t104 = t56**2
-    t105 = c1**2
-    t106 = t44**2 + t57**2 + t58**2 + t104*t105
-    t107 = t56*t105 + t57*t11 - t22*t58
-    t108 = t22**2 + t24**2 + t76**2 + t11**2 + t105
-    t109 = c1*s1
-    t110 = t58*t60 - t36*t44 - t57*t59 + t104*t109
-    t111 = t16*t22 + t18*t24 + t66*t76 + t6*t11 - t109
-    t112 = t45*c1
-    t113 = t57*t46 + t58*t47 - t56*t112
-    t114 = t22*t47 + t112 - t46*t11
-    t115 = t56*t109
-    t116 = t16*t58 - t6*t57 + t115
-    t117 = t22*t60 + t59*t11 - t115
-    t118 = s1**2
-    t119 = t36**2 + t59**2 + t60**2 + t104*t118
-    t120 = t16*t60 + t6*t59 + t56*t118
-    t121 = t16**2 + t18**2 + t66**2 + t6**2 + t118
-    t122 = t45*s1
-    t123 = t59*t46 - t60*t47 + t56*t122
-    t124 = t6*t46 + t122 - t16*t47
-    t125 = xp.greater_equal(t71, t82) & xp.greater_equal(t71, t97)
-    t126 = xp.greater_equal(t82, t97)
-    t127 = xp.where(t125, 0.5*(1 + t71), xp.where(t126, 0.5*t81, 0.5*t95))
-    t128 = xp.where(t125, 0.5*t72, xp.where(t126, 0.5*(1 + t82), 0.5*t96))
-    t129 = xp.where(t125, 0.5*t73, xp.where(t126, 0.5*t83, 0.5*(1 + t97)))
-    t130 = xp.sqrt(t127**2 + t128**2 + t129**2)
-    t131 = xp.where(xp.greater_equal(t98*t127 + t99*t128 + t84*t129, 0), xp.asarray(1, dtype=dtype), -1)
-    t132 = xp.greater(t101, 1e-06) | xp.greater(t100, 0)
-    t133 = t102*t131/t130
-    t134 = xp.where(t132, t98*t103, t127*t133)
-    t135 = xp.where(t132, t99*t103, t128*t133)
-    t136 = xp.where(t132, t84*t103, t129*t133)
-    t137 = t134**2 + t135**2 + t136**2 + t37**2 + t50**2 + t63**2
-    t138 = t106 + damping
-    t139 = xp.sqrt(t110**2 + t61**2 + t113**2 + t116**2 + t107**2 + t138**2)
-    t140 = t139*xp.where(xp.greater_equal(t138, 0), xp.asarray(1, dtype=dtype), -1)
-    t141 = t140 + t138
-    t142 = xp.where(xp.greater(t139, 0), 1/(t139*(t139 + xp.abs(t138))), 0)
-    t143 = t142*(t110*t50 + t113*t63 + t107*t135 + t37*t141 - t61*t136 - t116*t134)
-    t144 = t37 - t141*t143
-    t145 = t50 - t110*t143
-    t146 = t63 - t113*t143
-    t147 = t134 + t116*t143
-    t148 = t135 - t107*t143
-    t149 = t136 + t61*t143
-    t150 = t119 + damping
-    t151 = t142*(t110*t141 + t110*t150 + t116*t120 - t61*t62 - t113*t123 - t107*t117)
-    t152 = t110 - t141*t151
-    t153 = t150 - t110*t151
-    t154 = t123 + t113*t151
-    t155 = -t120 + t116*t151
-    t156 = t117 + t107*t151
-    t157 = t62 + t61*t151
-    t158 = xp.sqrt(t153**2 + t154**2 + t155**2 + t156**2 + t157**2)
-    t159 = t158*xp.where(xp.greater_equal(t153, 0), xp.asarray(1, dtype=dtype), -1)
-    t160 = t153 + t159
-    t161 = xp.where(xp.greater(t158, 0), 1/(t158*(t158 + xp.abs(t153))), 0)
-    t162 = t161*(t155*t147 + t157*t149 + t145*t160 - t154*t146 - t156*t148)
-    t163 = t145 - t160*t162
-    t164 = t146 + t154*t162
-    t165 = t147 - t155*t162
-    t166 = t148 + t156*t162
-    t167 = t149 - t157*t162
-    t168 = t48 + damping
-    t169 = t142*(t61*t49 + t113*t141 + t113*t168 - t110*t123 - t116*t124 - t107*t114)
-    t170 = t113 - t141*t169
-    t171 = t123 + t110*t169
-    t172 = t168 - t113*t169
-    t173 = t124 + t116*t169
-    t174 = t114 + t107*t169
-    t175 = -t49 + t61*t169
-    t176 = t161*(t155*t173 + t156*t174 + t157*t175 - t154*t172 - t171*t160)
-    t177 = t171 + t160*t176
-    t178 = t172 + t154*t176
-    t179 = t173 - t155*t176
-    t180 = -t174 + t156*t176
-    t181 = t175 - t157*t176
-    t182 = xp.sqrt(t178**2 + t179**2 + t180**2 + t181**2)
-    t183 = t182*xp.where(xp.greater_equal(t178, 0), xp.asarray(1, dtype=dtype), -1)
-    t184 = t178 + t183
-    t185 = xp.where(xp.greater(t182, 0), 1/(t182*(t182 + xp.abs(t178))), 0)
-    t186 = t185*(t179*t165 + t180*t166 + t181*t167 + t164*t184)
-    t187 = t164 - t184*t186
-    t188 = t165 - t179*t186
-    t189 = t166 - t180*t186
-    t190 = t167 - t181*t186
-    t191 = t121 + damping
-    t192 = -t142*(t110*t120 + t61*t92 + t116*t141 + t116*t191 - t113*t124 - t107*t111)
-    t193 = t116 + t141*t192
-    t194 = t120 + t110*t192
-    t195 = t124 - t113*t192
-    t196 = t191 + t116*t192
-    t197 = t111 - t107*t192
-    t198 = t92 + t61*t192
-    t199 = -t161*(t154*t195 + t156*t197 + t194*t160 - t155*t196 - t157*t198)
-    t200 = t194 + t160*t199
-    t201 = t195 + t154*t199
-    t202 = t196 - t155*t199
-    t203 = t197 + t156*t199
-    t204 = t198 - t157*t199
-    t205 = t185*(t179*t202 + t180*t203 + t181*t204 + t201*t184)
-    t206 = t201 - t184*t205
-    t207 = t202 - t179*t205
-    t208 = t203 - t180*t205
-    t209 = t204 - t181*t205
-    t210 = xp.sqrt(t207**2 + t208**2 + t209**2)
-    t211 = t210*xp.where(xp.greater_equal(t207, 0), xp.asarray(1, dtype=dtype), -1)
-    t212 = t207 + t211
-    t213 = xp.where(xp.greater(t210, 0), 1/(t210*(t210 + xp.abs(t207))), 0)
-    t214 = t213*(t208*t189 + t209*t190 + t188*t212)
-    t215 = t188 - t212*t214
-    t216 = t189 - t208*t214
-    t217 = t190 - t209*t214
-    t218 = t108 + damping
-    t219 = -t142*(t110*t117 + t61*t93 + t113*t114 + t116*t111 - t107*t141 - t107*t218)
-    t220 = t107 - t141*t219
-    t221 = t117 + t110*t219
-    t222 = t114 + t113*t219
-    t223 = t111 + t116*t219
-    t224 = t218 - t107*t219
-    t225 = t93 + t61*t219
-    t226 = t161*(t154*t222 + t155*t223 + t157*t225 - t156*t224 - t221*t160)
-    t227 = t221 + t160*t226
-    t228 = -t222 + t154*t226
-    t229 = t223 - t155*t226
-    t230 = t224 + t156*t226
-    t231 = t225 - t157*t226
-    t232 = t185*(t179*t229 + t180*t230 + t181*t231 + t228*t184)
-    t233 = t228 - t184*t232
-    t234 = t229 - t179*t232
-    t235 = t230 - t180*t232
-    t236 = t231 - t181*t232
-    t237 = t213*(t208*t235 + t209*t236 + t234*t212)
-    t238 = t234 - t212*t237
-    t239 = t235 - t208*t237
-    t240 = t236 - t209*t237
-    t241 = xp.sqrt(t239**2 + t240**2)
-    t242 = t241*xp.where(xp.greater_equal(t239, 0), xp.asarray(1, dtype=dtype), -1)
-    t243 = t239 + t242
-    t244 = xp.where(xp.greater(t241, 0), 1/(t241*(t241 + xp.abs(t239))), 0)
-    t245 = t244*(t240*t217 + t216*t243)
-    t246 = t216 - t243*t245
-    t247 = t217 - t240*t245
-    t248 = t94 + damping
-    t249 = -t142*(t61*t141 + t61*t248 + t113*t49 + t116*t92 - t110*t62 - t107*t93)
-    t250 = t61 + t141*t249
-    t251 = t62 - t110*t249
-    t252 = t49 + t113*t249
-    t253 = t92 + t116*t249
-    t254 = t93 - t107*t249
-    t255 = t248 + t61*t249
-    t256 = t161*(t154*t252 + t155*t253 + t157*t255 + t251*t160 - t156*t254)
-    t257 = t251 - t160*t256
-    t258 = -t252 + t154*t256
-    t259 = t253 - t155*t256
-    t260 = t254 + t156*t256
-    t261 = t255 - t157*t256
-    t262 = t185*(t179*t259 + t180*t260 + t181*t261 + t258*t184)
-    t263 = t258 - t184*t262
-    t264 = t259 - t179*t262
-    t265 = t260 - t180*t262
-    t266 = t261 - t181*t262
-    t267 = t213*(t208*t265 + t209*t266 + t264*t212)
-    t268 = t264 - t212*t267
-    t269 = t265 - t208*t267
-    t270 = t266 - t209*t267
-    t271 = t244*(t240*t270 + t269*t243)
-    t272 = t269 - t243*t271
-    t273 = t270 - t240*t271
-    t274 = xp.abs(t273)
-    t275 = t274
-    t276 = t275*xp.where(xp.greater_equal(t273, 0), xp.asarray(1, dtype=dtype), -1)
-    t277 = t273 + t276
-    t278 = xp.where(xp.greater(t275, 0), 1/(t275*(t275 + t274)), 0)
-    t279 = t247 - t247*t278*t277**2
-    t280 = xp.where(xp.not_equal(t276, 0), -t279/t276, 0)
-    t281 = xp.where(xp.not_equal(t242, 0), -(t246 - t272*t280)/t242, 0)
-    t282 = xp.where(xp.not_equal(t211, 0), -(t215 - (t238*t281 + t268*t280))/t211, 0)
-    t283 = xp.where(xp.not_equal(t183, 0), -(t187 - (t206*t282 + t233*t281 + t263*t280))/t183, 0)
-    t284 = xp.where(xp.not_equal(t159, 0), -(t163 + t177*t283 + t200*t282 + t227*t281 - t257*t280)/t159, 0)
-    t285 = xp.where(xp.not_equal(t140, 0), -(t144 - (t152*t284 + t170*t283 + t220*t281 - t193*t282 - t250*t280))/t140, 0)
-    t286 = t280 + q1 + t284*t36 - t285*t44
-    t287 = q2 + t282*s1 + t283*t45 - t281*c1 - t284*t56*s1 - t285*t56*c1
-    t288 = q3 + t281*t11 + t282*t6 + t283*t46 + t285*t57 - t0*t280 - t284*t59
-    t289 = q4 + t283*t47 + t284*t60 + t285*t58 - t16*t282 - t22*t281 - t27*t280
-    t290 = q5 + t29*t280 - t18*t282 - t24*t281
-    t291 = -q6 + t66*t282 + t76*t281 + t87*t280
-    q_start = _stack(xp, [
-        xp.broadcast_to(q1, batch),  # 0
-        xp.broadcast_to(q2, batch),  # 1
-        xp.broadcast_to(q3, batch),  # 2
-        xp.broadcast_to(q4, batch),  # 3
-        xp.broadcast_to(q5, batch),  # 4
-        xp.broadcast_to(q6, batch),  # 5
+    t2 = 0.9998476951563913*s1
+    t3 = 0.01745240643728351*c1
+    t4 = t2 + t3*s2
+    t5 = t4
+    t6 = 0.2*t4
+    t7 = 0.9998476951563913*c1
+    t8 = 0.01745240643728351*s1
+    t9 = -t7 + t8*s2
+    t10 = t9
+    t11 = 0.2*t9
+    t12 = t8 - t7*s2
+    t13 = c1*c2
+    t14 = s3*t12 + t13*c3
+    t15 = c3*t12 - t13*s3
+    t16 = t5*c4 - t14*s4
+    t17 = 0.01745240643728351*t16 + 0.9998476951563913*t15
+    t18 = -(t3 + t2*s2)
+    t19 = c2*s1
+    t20 = s3*t18 + t19*c3
+    t21 = c3*t18 - t19*s3
+    t22 = t10*c4 - t20*s4
+    t23 = 0.01745240643728351*t22 + 0.9998476951563913*t21
+    t24 = 0.9998476951563913*c2
+    t25 = c3*s2 + t24*s3
+    t26 = -s2*s3 + t24*c3
+    t27 = t0*c4 + t25*s4
+    t28 = 0.01745240643728351*t27 - 0.9998476951563913*t26
+    t29 = t14*c4
+    t30 = t5*s4
+    t31 = t29 + t30
+    t32 = 1.5*t29 + 1.5*t30
+    t33 = t6 + t32
+    t34 = t33 + t13
+    t35 = t34 + 0.3*c1
+    t36 = t20*c4
+    t37 = t10*s4
+    t38 = t36 + t37
+    t39 = 1.5*t36 + 1.5*t37
+    t40 = t11 + t39
+    t41 = t40 + t19
+    t42 = t41 + 0.3*s1
+    t43 = t25*c4
+    t44 = t0*s4
+    t45 = t43 - t44
+    t46 = 1.5*t43 - 1.5*t44
+    t47 = t46 - t1
+    t48 = t47 + s2
+    t49 = 0.9998476951563913*t16 - 0.01745240643728351*t15
+    t50 = t31*c5 + s5*t49
+    t51 = c5*t49 - t31*s5
+    t52 = t50*c6 - t17*s6
+    t53 = t17*c6 + t50*s6
+    t54 = 0.01745240643728351*t51 + 0.9998476951563913*t53
+    t55 = 0.01745240643728351*t53 - 0.9998476951563913*t51
+    t56 = T00*t52 + T02*t55 - T01*t54
+    t57 = T10*t52 + T12*t55 - T11*t54
+    t58 = T20*t52 + T22*t55 - T21*t54
+    t59 = 0.9998476951563913*t22 - 0.01745240643728351*t21
+    t60 = t38*c5 + s5*t59
+    t61 = c5*t59 - t38*s5
+    t62 = t60*c6 - t23*s6
+    t63 = t23*c6 + t60*s6
+    t64 = 0.01745240643728351*t61 + 0.9998476951563913*t63
+    t65 = 0.01745240643728351*t63 - 0.9998476951563913*t61
+    t66 = T00*t62 + T02*t65 - T01*t64
+    t67 = T10*t62 + T12*t65 - T11*t64
+    t68 = T20*t62 + T22*t65 - T21*t64
+    t69 = 0.5*(t57 - t66)
+    t70 = -(0.01745240643728351*t26 + 0.9998476951563913*t27)
+    t71 = t45*c5 + s5*t70
+    t72 = c5*t70 - t45*s5
+    t73 = t28*s6 + t71*c6
+    t74 = t28*c6 - t71*s6
+    t75 = 0.9998476951563913*t74 - 0.01745240643728351*t72
+    t76 = 0.01745240643728351*t74 + 0.9998476951563913*t72
+    t77 = T00*t73 + T01*t75 - T02*t76
+    t78 = T10*t73 + T11*t75 - T12*t76
+    t79 = T20*t73 + T21*t75 - T22*t76
+    t80 = 0.5*(t68 - t78)
+    t81 = 0.5*(t77 - t58)
+    t82 = 0.5*(-1 + t56 + t67 + t79)
+    t83 = xp.sqrt(t80**2 + t81**2 + t69**2)
+    t84 = xp.atan2(t83, t82)
+    t85 = xp.where(xp.greater(t83, 0), t84/t83, 1)
+    t86 = xp.greater_equal(t56, t67) & xp.greater_equal(t56, t79)
+    t87 = xp.greater_equal(t67, t79)
+    t88 = xp.where(t86, 0.5*(1 + t56), xp.where(t87, 0.5*t66, 0.5*t77))
+    t89 = xp.where(t86, 0.5*t57, xp.where(t87, 0.5*(1 + t67), 0.5*t78))
+    t90 = xp.where(t86, 0.5*t58, xp.where(t87, 0.5*t68, 0.5*(1 + t79)))
+    t91 = xp.sqrt(t88**2 + t89**2 + t90**2)
+    t92 = xp.where(xp.greater_equal(t80*t88 + t81*t89 + t69*t90, 0), xp.asarray(1, dtype=dtype), -1)
+    t93 = xp.greater(t83, 1e-06) | xp.greater(t82, 0)
+    t94 = t84*t92/t91
+    t95 = xp.where(t93, t80*t85, t88*t94)
+    t96 = xp.where(t93, t81*t85, t89*t94)
+    t97 = xp.where(t93, t69*t85, t90*t94)
+    t98 = -t42
+    e = _stack(xp, [
+        xp.broadcast_to(T03 - t35, batch),  # 0
+        xp.broadcast_to(T13 + t98, batch),  # 1
+        xp.broadcast_to(T23 - t48, batch),  # 2
+        xp.broadcast_to(t95, batch),  # 3
+        xp.broadcast_to(t96, batch),  # 4
+        xp.broadcast_to(t97, batch),  # 5
     ], (6,))
-    q_next = _stack(xp, [
-        xp.broadcast_to(t286, batch),  # 0
-        xp.broadcast_to(t287, batch),  # 1
-        xp.broadcast_to(t288, batch),  # 2
-        xp.broadcast_to(t289, batch),  # 3
-        xp.broadcast_to(t290, batch),  # 4
-        xp.broadcast_to(-t291, batch),  # 5
-    ], (6,))
-    cost = xp.broadcast_to(xp.where(xp.isfinite(t2), t137, -1), batch)
-    return q_start, q_next, cost
+    J = _stack(xp, [
+        xp.broadcast_to(t98, batch),  # 0, 0
+        xp.broadcast_to(-t48*c1, batch),  # 0, 1
+        xp.broadcast_to(t0*t40 + t47*t10, batch),  # 0, 2
+        xp.broadcast_to(t26*t39 - t21*t46, batch),  # 0, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 0, 4
+        xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5
+        xp.broadcast_to(t35, batch),  # 1, 0
+        xp.broadcast_to(-t48*s1, batch),  # 1, 1
+        xp.broadcast_to(-(t0*t33 + t5*t47), batch),  # 1, 2
+        xp.broadcast_to(t15*t46 - t26*t32, batch),  # 1, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 1, 4
+        xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
+        xp.broadcast_to(t34*c1 + t41*s1, batch),  # 2, 1
+        xp.broadcast_to(t40*t5 - t33*t10, batch),  # 2, 2
+        xp.broadcast_to(t21*t32 - t15*t39, batch),  # 2, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 2, 4
+        xp.full(batch, 0, dtype=dtype, device=device),  # 2, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
+        xp.broadcast_to(s1, batch),  # 3, 1
+        xp.broadcast_to(t5, batch),  # 3, 2
+        xp.broadcast_to(-t15, batch),  # 3, 3
+        xp.broadcast_to(-t17, batch),  # 3, 4
+        xp.broadcast_to(-t51, batch),  # 3, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
+        xp.broadcast_to(-c1, batch),  # 4, 1
+        xp.broadcast_to(t10, batch),  # 4, 2
+        xp.broadcast_to(-t21, batch),  # 4, 3
+        xp.broadcast_to(-t23, batch),  # 4, 4
+        xp.broadcast_to(-t61, batch),  # 4, 5
+        xp.full(batch, 1, dtype=dtype, device=device),  # 5, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 5, 1
+        xp.broadcast_to(-t0, batch),  # 5, 2
+        xp.broadcast_to(-t26, batch),  # 5, 3
+        xp.broadcast_to(t28, batch),  # 5, 4
+        xp.broadcast_to(-t72, batch),  # 5, 5
+    ], (6, 6))
+    return e, J
 
 
 def ik_general_limits(q_solution):
@@ -4183,6 +4019,7 @@ _MONOMIALS = numpy.array([[0, 0, 0, 0, 4, 0, 0, 0, 0], [0, 0, 0, 2, 0, -2, 0, 0,
 _ALONG_C, _ALONG_B = numpy.array([0, 1, 3, 4, 6, 7, 9, 10]), numpy.array([0, 1, 2, 3, 4, 5, 6, 7, 8])  # ratios x_c (step 1), x_b (step 3)
 _NEWTON_STEPS = 2
 _TOLERANCE_SQUARED = 1.00000000000000e-18  # |pose error|^2 of a solution after the Newton steps
+_CONVERGED_SQUARED = 1.60000000000000e-23  # |pose error|^2 at which the Newton steps stop
 
 
 def _twelve(s):
@@ -4239,28 +4076,50 @@ def _roots(P, Q):
     return angles, real
 
 
-def ik_branches(T):
-    """Every solution of the general 6R solver (up to MAX_IK_SOLUTIONS = 16), whether the
-    target allows it, and whether it is inside the joint limits: q (..., MAX_IK_SOLUTIONS, DOF),
-    valid and in_limits (..., MAX_IK_SOLUTIONS). The valid rows come first, in the order of the
-    eigenvalues, each solution once; a root whose configuration does not reach the target to
-    1e-09 after 2 Newton steps is not valid; the rows that are not valid are 0. numpy
-    arrays only (numpy's eigensolver).
-    """
-    T = numpy.asarray(T, dtype=float)
+def _newton(targets, q):
+    """|e|^2 at q; and where q has not converged (|e|^2 <= _CONVERGED_SQUARED), q moved by one
+    Newton step q + J^-1 e (q stays where J is singular)."""
+    e, J = ik_general_residual(targets, q)
+    cost = (e * e).sum(axis=-1)
+    usable = numpy.isfinite(J).all(axis=(-2, -1)) & numpy.isfinite(e).all(axis=-1)
+    usable &= numpy.linalg.det(numpy.where(usable[..., None, None], J, numpy.eye(6))) != 0.0
+    step = numpy.linalg.solve(numpy.where(usable[..., None, None], J, numpy.eye(6)),
+                              numpy.where(usable[..., None], e, 0.0)[..., None])[..., 0]
+    return cost, numpy.where((usable & ~(cost <= _CONVERGED_SQUARED))[..., None], q + step, q)
+
+
+def _general_branches(T):
+    """The eigenproblem's solutions at targets T (..., 4, 4): q (..., 16, DOF) and valid (..., 16),
+    each solution once (the first of equal ones), after up to 2 Newton steps within 1e-09."""
     P, Q = ik_general_equations(T)
     finite = (numpy.isfinite(P).all(axis=(-2, -1)) & numpy.isfinite(Q).all(axis=(-2, -1)))[..., None, None]
     P, Q = numpy.where(finite, P, 0.0), numpy.where(finite, Q, 0.0)  # no root: a singular leading matrix
     angles, real = _roots(numpy.reshape(P, (*P.shape[:-2], 3, 14, 9)), Q)
     targets = T[..., None, :, :]
     q = ik_general_start(targets, angles)
+    cost, q = _newton(targets, q)
     for _ in range(_NEWTON_STEPS):
-        q = ik_general_step(targets, q, 0.0)[1]
-    cost = ik_general_step(targets, q, 0.0)[2]
-    valid = real & (cost >= 0.0) & (cost <= _TOLERANCE_SQUARED)
+        cost, q = _newton(targets, q)
+    return q, _first_of_equals(q, real & (cost <= _TOLERANCE_SQUARED))
+
+
+def _first_of_equals(q, valid):
+    """valid, without the rows equal (to 1e-6 rad) to an earlier valid row."""
     difference = (q[..., :, None, :] - q[..., None, :, :] + numpy.pi) % (2.0 * numpy.pi) - numpy.pi
     same = (numpy.abs(difference).max(axis=-1) < 1e-6) & valid[..., None, :]
-    valid &= ~numpy.tril(same, -1).any(axis=-1)  # the first of equal solutions stays
+    return valid & ~numpy.tril(same, -1).any(axis=-1)
+
+
+def ik_branches(T):
+    """Every solution of the general 6R solver (up to MAX_IK_SOLUTIONS = 16), whether the
+    target allows it, and whether it is inside the joint limits: q (..., MAX_IK_SOLUTIONS, DOF),
+    valid and in_limits (..., MAX_IK_SOLUTIONS). The valid rows come first, in the order of the
+    eigenvalues, each solution once; a root whose configuration does not reach the target to
+    1e-09 after up to 2 Newton steps is not valid; the rows that are not valid are 0. numpy
+    arrays only (numpy's eigensolver).
+    """
+    T = numpy.asarray(T, dtype=float)
+    q, valid = _general_branches(T)
     order = numpy.argsort(~valid, axis=-1, kind="stable")[..., :MAX_IK_SOLUTIONS]
     q = numpy.take_along_axis(q, order[..., None], -2)
     valid = numpy.take_along_axis(valid, order, -1)
@@ -4282,7 +4141,7 @@ def ik(T, limits=True):
     solutions outside the limits (in_limits 0).
     Solver: general 6R: Raghavan & Roth's 14 equations, eliminated to a 12 x 12 quadratic
     matrix polynomial in tan(q_k/2) solved as a 24 x 24 eigenproblem, back-substitution and
-    two Newton steps (jacgen/general6r.py).
+    up to two Newton steps (jacgen/general6r.py).
     Order: the real eigenvalues in the order the eigensolver gives them; a solution that
     does not reach the target after the Newton steps (a spurious root) is skipped; each
     solution once (equal to 1e-6 rad).

@@ -227,26 +227,27 @@ static void jacgen_g6_transpose_times(double q[14][8], const double beta[8], dou
     }
 }
 
-/* x solving a x = b (12 x 12, columns of b: nb) in place, by LU with partial pivoting. */
-static int jacgen_g6_solve(double a[12][12], int nb, double b[12][24]) {
-    for (int k = 0; k < 12; k++) {
+/* x solving a x = b in place (a: n x n, b: n x nb, both row by row), by LU with partial pivoting.
+ * Returns -1 when a pivot is 0. */
+static int jacgen_g6_solve(int n, double *a, int nb, double *b) {
+    for (int k = 0; k < n; k++) {
         int p = k;
-        for (int i = k + 1; i < 12; i++)
-            if (fabs(a[i][k]) > fabs(a[p][k])) p = i;
-        if (!(fabs(a[p][k]) > 0.0)) return -1;
-        for (int j = 0; j < 12; j++) { double t = a[k][j]; a[k][j] = a[p][j]; a[p][j] = t; }
-        for (int j = 0; j < nb; j++) { double t = b[k][j]; b[k][j] = b[p][j]; b[p][j] = t; }
-        for (int i = k + 1; i < 12; i++) {
-            double f = a[i][k] / a[k][k];
-            for (int j = k; j < 12; j++) a[i][j] -= f * a[k][j];
-            for (int j = 0; j < nb; j++) b[i][j] -= f * b[k][j];
+        for (int i = k + 1; i < n; i++)
+            if (fabs(a[i * n + k]) > fabs(a[p * n + k])) p = i;
+        if (!(fabs(a[p * n + k]) > 0.0)) return -1;
+        for (int j = 0; j < n; j++) { double t = a[k * n + j]; a[k * n + j] = a[p * n + j]; a[p * n + j] = t; }
+        for (int j = 0; j < nb; j++) { double t = b[k * nb + j]; b[k * nb + j] = b[p * nb + j]; b[p * nb + j] = t; }
+        for (int i = k + 1; i < n; i++) {
+            double f = a[i * n + k] / a[k * n + k];
+            for (int j = k; j < n; j++) a[i * n + j] -= f * a[k * n + j];
+            for (int j = 0; j < nb; j++) b[i * nb + j] -= f * b[k * nb + j];
         }
     }
-    for (int k = 11; k >= 0; k--)
+    for (int k = n - 1; k >= 0; k--)
         for (int j = 0; j < nb; j++) {
-            double s = b[k][j];
-            for (int i = k + 1; i < 12; i++) s -= a[k][i] * b[i][j];
-            b[k][j] = s / a[k][k];
+            double s = b[k * nb + j];
+            for (int i = k + 1; i < n; i++) s -= a[k * n + i] * b[i * nb + j];
+            b[k * nb + j] = s / a[k * n + k];
         }
     return 0;
 }
@@ -323,7 +324,7 @@ static int jacgen_general6r_roots(double p[3][14][9], double q_matrix[14][8],
     double lead[12][12], rhs[12][24], companion[JACGEN_EIG_MAX][JACGEN_EIG_MAX];
     for (int i = 0; i < 12; i++)
         for (int j = 0; j < 12; j++) { lead[i][j] = m[2][i][j]; rhs[i][j] = m[0][i][j]; rhs[i][j + 12] = m[1][i][j]; }
-    if (jacgen_g6_solve(lead, 24, rhs) != 0) return 0;
+    if (jacgen_g6_solve(12, &lead[0][0], 24, &rhs[0][0]) != 0) return 0;
     for (int i = 0; i < 12; i++) {
         for (int j = 0; j < 24; j++) companion[i][j] = j == i + 12 ? 1.0 : 0.0;
         for (int j = 0; j < 24; j++) companion[i + 12][j] = -rhs[i][j];
@@ -3797,9 +3798,9 @@ void mico_ik_general_start(const mico_real T[16], const mico_real angles[5], mic
     q[5] = -1.7453292519943295 + ga3;
 }
 
-mico_real mico_ik_general_step(const mico_real target[16], const mico_real q[MICO_DOF], mico_real damping, mico_real q_start[MICO_DOF], mico_real q_next[MICO_DOF])
+void mico_ik_general_residual(const mico_real target[16], const mico_real q[MICO_DOF], mico_real e[6], mico_real J[6 * MICO_DOF])
 {
-    /* 1090 operations */
+    /* 324 operations */
 
     /* Inputs */
     const mico_real T00 = target[0];
@@ -3840,323 +3841,148 @@ mico_real mico_ik_general_step(const mico_real target[16], const mico_real q[MIC
     const mico_real s5 = -sin(q5);
     const mico_real c6 = -sin(0.17453292519943295 + q6);
     const mico_real s6 = cos(0.17453292519943295 + q6);
-    const mico_real t0 = T00 + T01 + T02 + T03 + T10 + T11 + T12 + T13 + T20 + T21 + T22 + T23 + qs1 + qs2 + qs3 + qs4 + qs5 + qs6;
-    const mico_real t1 = c2*c3;
-    const mico_real t2 = s2*s3;
-    const mico_real t3 = t1*c1 + t2*c1;
-    const mico_real t4 = t1*s1 + t2*s1;
-    const mico_real t5 = t1 + t2;
-    const mico_real t6 = t3*c4 + s1*s4;
-    const mico_real t7 = c4*s1 - t3*s4;
-    const mico_real t8 = c1*s4 - t4*c4;
-    const mico_real t9 = t4*s4 + c1*c4;
-    const mico_real t10 = -0.16608165494695126*t5;
-    const mico_real t11 = c3*s2;
-    const mico_real t12 = c2*s3;
-    const mico_real t13 = t11*c1 - t12*c1;
-    const mico_real t14 = t12*s1 - t11*s1;
-    const mico_real t15 = t11 - t12;
+    const mico_real t0 = c2*c3;
+    const mico_real t1 = s2*s3;
+    const mico_real t2 = t0*c1 + t1*c1;
+    const mico_real t3 = t0*s1 + t1*s1;
+    const mico_real t4 = t0 + t1;
+    const mico_real t5 = t2*c4 + s1*s4;
+    const mico_real t6 = c4*s1 - t2*s4;
+    const mico_real t7 = c1*s4 - t3*c4;
+    const mico_real t8 = t3*s4 + c1*c4;
+    const mico_real t9 = -0.16608165494695126*t4;
+    const mico_real t10 = c3*s2;
+    const mico_real t11 = c2*s3;
+    const mico_real t12 = t10*c1 - t11*c1;
+    const mico_real t13 = t11*s1 - t10*s1;
+    const mico_real t14 = t10 - t11;
+    const mico_real t15 = -0.16608165494695126*t12;
     const mico_real t16 = -0.16608165494695126*t13;
-    const mico_real t17 = -0.16608165494695126*t14;
-    const mico_real t18 = 0.5*t13 + 0.8660254037844386*t7;
-    const mico_real t19 = t18;
-    const mico_real t20 = -0.08556330989390254*t18;
-    const mico_real t21 = 0.5*t14 + 0.8660254037844386*t9;
-    const mico_real t22 = t21;
-    const mico_real t23 = -0.08556330989390254*t21;
-    const mico_real t24 = t15*s4;
-    const mico_real t25 = 0.5*t5 + 0.8660254037844386*t24;
-    const mico_real t26 = t25;
-    const mico_real t27 = 0.08556330989390254*t25;
-    const mico_real t28 = 0.5*t7 - 0.8660254037844386*t13;
-    const mico_real t29 = t6*c5 + s5*t28;
-    const mico_real t30 = c5*t28 - t6*s5;
-    const mico_real t31 = 0.5*t9 - 0.8660254037844386*t14;
-    const mico_real t32 = t8*c5 + s5*t31;
-    const mico_real t33 = c5*t31 - t8*s5;
-    const mico_real t34 = 0.8660254037844386*t5 - 0.5*t24;
-    const mico_real t35 = t15*c4;
-    const mico_real t36 = s5*t34 + t35*c5;
-    const mico_real t37 = c5*t34 - t35*s5;
-    const mico_real t38 = 0.5*t19 + 0.8660254037844386*t30;
-    const mico_real t39 = t38;
-    const mico_real t40 = 0.20278165494695127*t38;
-    const mico_real t41 = t40 - t20;
-    const mico_real t42 = t41 - t16;
-    const mico_real t43 = t42 - 0.007*s1;
-    const mico_real t44 = 0.5*t22 + 0.8660254037844386*t33;
-    const mico_real t45 = t44;
-    const mico_real t46 = 0.20278165494695127*t44;
-    const mico_real t47 = t46 - t23;
-    const mico_real t48 = t47 - t17;
-    const mico_real t49 = t48 - 0.007*c1;
-    const mico_real t50 = t49*s1 - t43*c1;
-    const mico_real t51 = t14*t42 - t48*t13;
-    const mico_real t52 = t22*t41 - t19*t47;
-    const mico_real t53 = t45*t40 - t39*t46;
-    const mico_real t54 = 0.5*t26 - 0.8660254037844386*t37;
-    const mico_real t55 = t54;
-    const mico_real t56 = -0.20278165494695127*t54;
-    const mico_real t57 = t56 - t27;
-    const mico_real t58 = t10 + t57;
-    const mico_real t59 = t58 + 0.29*s2;
-    const mico_real t60 = 0.2755 + t59;
-    const mico_real t61 = t14*t58 + t5*t48;
-    const mico_real t62 = t22*t57 + t26*t47;
-    const mico_real t63 = t45*t56 + t55*t46;
-    const mico_real t64 = t5*t42 + t58*t13;
-    const mico_real t65 = t19*t57 + t26*t41;
-    const mico_real t66 = t39*t56 + t55*t40;
-    const mico_real t67 = t5*t51 + t26*t52 + t55*t53;
-    const mico_real t68 = t5*t13 + t19*t26 + t39*t55;
-    const mico_real t69 = t14*t5 + t22*t26 + t45*t55;
-    const mico_real t70 = 1 + (t5*t5) + (t26*t26) + (t55*t55);
-    const mico_real t71 = T23 - t60;
-    const mico_real t72 = 0.5*t30 - 0.8660254037844386*t19;
-    const mico_real t73 = t29*c6 + s6*t72;
-    const mico_real t74 = c6*t72 - t29*s6;
-    const mico_real t75 = T00*t73 + T02*t39 - T01*t74;
-    const mico_real t76 = T10*t73 + T12*t39 - T11*t74;
-    const mico_real t77 = T20*t73 + T22*t39 - T21*t74;
-    const mico_real t78 = 0.5*t33 - 0.8660254037844386*t22;
-    const mico_real t79 = t32*c6 + s6*t78;
-    const mico_real t80 = c6*t78 - t32*s6;
-    const mico_real t81 = T00*t79 + T02*t45 - T01*t80;
-    const mico_real t82 = T10*t79 + T12*t45 - T11*t80;
-    const mico_real t83 = T20*t79 + T22*t45 - T21*t80;
-    const mico_real t84 = 0.5*(t76 - t81);
-    const mico_real t85 = 0.5*t37 + 0.8660254037844386*t26;
-    const mico_real t86 = t36*c6 + s6*t85;
-    const mico_real t87 = c6*t85 - t36*s6;
-    const mico_real t88 = T01*t87 + T02*t55 - T00*t86;
-    const mico_real t89 = T11*t87 + T12*t55 - T10*t86;
-    const mico_real t90 = T21*t87 + T22*t55 - T20*t86;
-    const mico_real t91 = 0.5*(t89 + t83);
-    const mico_real t92 = -0.5*(t88 + t77);
-    const mico_real t93 = sqrt((t91*t91) + (t92*t92) + (t84*t84));
-    const mico_real t94 = 0.29*c2;
-    const mico_real t95 = t43 + t94*c1;
-    const mico_real t96 = t49 - t94*s1;
-    const mico_real t97 = t95*c1 - t96*s1;
-    const mico_real t98 = t96 + t5*t61 + t26*t62 + t55*t63;
-    const mico_real t99 = t95 + t5*t64 + t26*t65 + t55*t66;
-    const mico_real t100 = (t97*t97) + (t50*t50) + (t51*t51) + (t52*t52) + (t53*t53);
-    const mico_real t101 = T03 - t95;
-    const mico_real t102 = T13 - t96;
-    const mico_real t103 = (t58*t58);
-    const mico_real t104 = (c1*c1);
-    const mico_real t105 = t14*t61 + t22*t62 + t45*t63 + t58*t104 + t59*t104;
-    const mico_real t106 = (t14*t14) + (t22*t22) + (t45*t45) + 2*t104;
-    const mico_real t107 = (t59*t59);
-    const mico_real t108 = (t96*t96) + (t61*t61) + (t62*t62) + (t63*t63) + t103*t104 + t107*t104;
-    const mico_real t109 = c1*s1;
-    const mico_real t110 = t95*t96 + t61*t64 + t62*t65 + t63*t66 + t103*t109 + t107*t109;
-    const mico_real t111 = t14*t13 + t19*t22 + t39*t45 + 2*t109;
-    const mico_real t112 = t97*c1;
-    const mico_real t113 = t50*c1;
-    const mico_real t114 = t61*t51 + t62*t52 + t63*t53 + t59*t112 - t58*t113;
-    const mico_real t115 = t14*t51 + t22*t52 + t45*t53 + t112 - t113;
-    const mico_real t116 = t58*t109 + t59*t109;
-    const mico_real t117 = t116 + t19*t62 + t39*t63 + t61*t13;
-    const mico_real t118 = t116 + t14*t64 + t22*t65 + t45*t66;
-    const mico_real t119 = (s1*s1);
-    const mico_real t120 = (t95*t95) + (t64*t64) + (t65*t65) + (t66*t66) + t103*t119 + t107*t119;
-    const mico_real t121 = t19*t65 + t39*t66 + t58*t119 + t59*t119 + t13*t64;
-    const mico_real t122 = (t19*t19) + (t39*t39) + (t13*t13) + 2*t119;
-    const mico_real t123 = t97*s1;
-    const mico_real t124 = t50*s1;
-    const mico_real t125 = t64*t51 + t65*t52 + t66*t53 + t59*t123 - t58*t124;
-    const mico_real t126 = t19*t52 + t39*t53 + t13*t51 + t123 - t124;
-    const mico_real t127 = -t90;
-    const mico_real t128 = 0.5*(-1 + t75 + t82 + t127);
-    const mico_real t129 = atan2(t93, t128);
-    const mico_real t130 = (t93 > 0 ? t129/t93 : 1);
-    const int t131 = t75 >= t82 && t75 >= t127;
-    const int t132 = t82 >= t127;
-    const mico_real t133 = (t131 ? 0.5*(1 + t75) : (t132 ? 0.5*t81 : -0.5*t88));
-    const mico_real t134 = (t131 ? 0.5*t76 : (t132 ? 0.5*(1 + t82) : -0.5*t89));
-    const mico_real t135 = (t131 ? 0.5*t77 : (t132 ? 0.5*t83 : 0.5*(1 + t127)));
-    const mico_real t136 = sqrt((t133*t133) + (t134*t134) + (t135*t135));
-    const mico_real t137 = (t91*t133 + t92*t134 + t84*t135 >= 0 ? 1 : -1);
-    const int t138 = (t93 > 1e-06) || (t128 > 0);
-    const mico_real t139 = t129*t137/t136;
-    const mico_real t140 = (t138 ? t91*t130 : t133*t139);
-    const mico_real t141 = (t138 ? t92*t130 : t134*t139);
-    const mico_real t142 = (t138 ? t84*t130 : t135*t139);
-    const mico_real t143 = (t140*t140) + (t141*t141) + (t142*t142) + (t101*t101) + (t102*t102) + (t71*t71);
-    const mico_real t144 = t108 + damping;
-    const mico_real t145 = sqrt((t110*t110) + (t98*t98) + (t114*t114) + (t117*t117) + (t105*t105) + (t144*t144));
-    const mico_real t146 = t145*(t144 >= 0 ? 1 : -1);
-    const mico_real t147 = t146 + t144;
-    const mico_real t148 = (t145 > 0 ? 1/(t145*(t145 + fabs(t144))) : 0);
-    const mico_real t149 = t148*(t117*t140 + t105*t141 + t101*t147 - t110*t102 - t98*t142 - t114*t71);
-    const mico_real t150 = t101 - t147*t149;
-    const mico_real t151 = t102 + t110*t149;
-    const mico_real t152 = t71 + t114*t149;
-    const mico_real t153 = t140 - t117*t149;
-    const mico_real t154 = t141 - t105*t149;
-    const mico_real t155 = t142 + t98*t149;
-    const mico_real t156 = t120 + damping;
-    const mico_real t157 = -t148*(t110*t147 + t110*t156 + t98*t99 + t114*t125 + t117*t121 + t105*t118);
-    const mico_real t158 = t110 + t147*t157;
-    const mico_real t159 = t156 + t110*t157;
-    const mico_real t160 = t125 + t114*t157;
-    const mico_real t161 = t121 + t117*t157;
-    const mico_real t162 = t118 + t105*t157;
-    const mico_real t163 = t99 + t98*t157;
-    const mico_real t164 = sqrt((t159*t159) + (t160*t160) + (t161*t161) + (t162*t162) + (t163*t163));
-    const mico_real t165 = t164*(t159 >= 0 ? 1 : -1);
-    const mico_real t166 = t159 + t165;
-    const mico_real t167 = (t164 > 0 ? 1/(t164*(t164 + fabs(t159))) : 0);
-    const mico_real t168 = t167*(t160*t152 + t163*t155 + t151*t166 - t161*t153 - t162*t154);
-    const mico_real t169 = t151 - t166*t168;
-    const mico_real t170 = t152 - t160*t168;
-    const mico_real t171 = t153 + t161*t168;
-    const mico_real t172 = t154 + t162*t168;
-    const mico_real t173 = t155 - t163*t168;
-    const mico_real t174 = t100 + damping;
-    const mico_real t175 = -t148*(t110*t125 + t98*t67 + t114*t147 + t114*t174 + t117*t126 + t105*t115);
-    const mico_real t176 = t114 + t147*t175;
-    const mico_real t177 = t125 + t110*t175;
-    const mico_real t178 = t174 + t114*t175;
-    const mico_real t179 = t126 + t117*t175;
-    const mico_real t180 = t115 + t105*t175;
-    const mico_real t181 = t67 + t98*t175;
-    const mico_real t182 = t167*(t160*t178 + t161*t179 + t162*t180 + t163*t181 + t177*t166);
-    const mico_real t183 = t177 - t166*t182;
-    const mico_real t184 = t178 - t160*t182;
-    const mico_real t185 = -t179 + t161*t182;
-    const mico_real t186 = -t180 + t162*t182;
-    const mico_real t187 = t181 - t163*t182;
-    const mico_real t188 = sqrt((t184*t184) + (t185*t185) + (t186*t186) + (t187*t187));
-    const mico_real t189 = t188*(t184 >= 0 ? 1 : -1);
-    const mico_real t190 = t184 + t189;
-    const mico_real t191 = (t188 > 0 ? 1/(t188*(t188 + fabs(t184))) : 0);
-    const mico_real t192 = t191*(t185*t171 + t186*t172 + t187*t173 + t170*t190);
-    const mico_real t193 = t170 - t190*t192;
-    const mico_real t194 = t171 - t185*t192;
-    const mico_real t195 = t172 - t186*t192;
-    const mico_real t196 = t173 - t187*t192;
-    const mico_real t197 = t122 + damping;
-    const mico_real t198 = t148*(t110*t121 + t98*t68 + t114*t126 + t117*t147 + t117*t197 + t105*t111);
-    const mico_real t199 = t117 - t147*t198;
-    const mico_real t200 = -t121 + t110*t198;
-    const mico_real t201 = -t126 + t114*t198;
-    const mico_real t202 = t197 - t117*t198;
-    const mico_real t203 = t111 - t105*t198;
-    const mico_real t204 = -t68 + t98*t198;
-    const mico_real t205 = t167*(t160*t201 + t163*t204 + t200*t166 - t161*t202 - t162*t203);
-    const mico_real t206 = t200 - t166*t205;
-    const mico_real t207 = t201 - t160*t205;
-    const mico_real t208 = t202 + t161*t205;
-    const mico_real t209 = t203 + t162*t205;
-    const mico_real t210 = t204 - t163*t205;
-    const mico_real t211 = t191*(t185*t208 + t186*t209 + t187*t210 + t207*t190);
-    const mico_real t212 = t207 - t190*t211;
-    const mico_real t213 = t208 - t185*t211;
-    const mico_real t214 = t209 - t186*t211;
-    const mico_real t215 = t210 - t187*t211;
-    const mico_real t216 = sqrt((t213*t213) + (t214*t214) + (t215*t215));
-    const mico_real t217 = t216*(t213 >= 0 ? 1 : -1);
-    const mico_real t218 = t213 + t217;
-    const mico_real t219 = (t216 > 0 ? 1/(t216*(t216 + fabs(t213))) : 0);
-    const mico_real t220 = t219*(t214*t195 + t215*t196 + t194*t218);
-    const mico_real t221 = t194 - t218*t220;
-    const mico_real t222 = t195 - t214*t220;
-    const mico_real t223 = t196 - t215*t220;
-    const mico_real t224 = t106 + damping;
-    const mico_real t225 = t148*(t110*t118 + t98*t69 + t114*t115 + t117*t111 + t105*t147 + t105*t224);
-    const mico_real t226 = t105 - t147*t225;
-    const mico_real t227 = -t118 + t110*t225;
-    const mico_real t228 = -t115 + t114*t225;
-    const mico_real t229 = t111 - t117*t225;
-    const mico_real t230 = t224 - t105*t225;
-    const mico_real t231 = -t69 + t98*t225;
-    const mico_real t232 = t167*(t160*t228 + t163*t231 + t227*t166 - t161*t229 - t162*t230);
-    const mico_real t233 = t227 - t166*t232;
-    const mico_real t234 = t228 - t160*t232;
-    const mico_real t235 = t229 + t161*t232;
-    const mico_real t236 = t230 + t162*t232;
-    const mico_real t237 = t231 - t163*t232;
-    const mico_real t238 = t191*(t185*t235 + t186*t236 + t187*t237 + t234*t190);
-    const mico_real t239 = t234 - t190*t238;
-    const mico_real t240 = t235 - t185*t238;
-    const mico_real t241 = t236 - t186*t238;
-    const mico_real t242 = t237 - t187*t238;
-    const mico_real t243 = t219*(t214*t241 + t215*t242 + t240*t218);
-    const mico_real t244 = t240 - t218*t243;
-    const mico_real t245 = t241 - t214*t243;
-    const mico_real t246 = t242 - t215*t243;
-    const mico_real t247 = sqrt((t245*t245) + (t246*t246));
-    const mico_real t248 = t247*(t245 >= 0 ? 1 : -1);
-    const mico_real t249 = t245 + t248;
-    const mico_real t250 = (t247 > 0 ? 1/(t247*(t247 + fabs(t245))) : 0);
-    const mico_real t251 = t250*(t246*t223 + t222*t249);
-    const mico_real t252 = t222 - t249*t251;
-    const mico_real t253 = t223 - t246*t251;
-    const mico_real t254 = t70 + damping;
-    const mico_real t255 = -t148*(t110*t99 + t98*t147 + t98*t254 + t114*t67 + t117*t68 + t105*t69);
-    const mico_real t256 = t98 + t147*t255;
-    const mico_real t257 = t99 + t110*t255;
-    const mico_real t258 = t67 + t114*t255;
-    const mico_real t259 = t68 + t117*t255;
-    const mico_real t260 = t69 + t105*t255;
-    const mico_real t261 = t254 + t98*t255;
-    const mico_real t262 = t167*(t160*t258 + t161*t259 + t162*t260 + t163*t261 + t257*t166);
-    const mico_real t263 = t257 - t166*t262;
-    const mico_real t264 = t258 - t160*t262;
-    const mico_real t265 = -t259 + t161*t262;
-    const mico_real t266 = -t260 + t162*t262;
-    const mico_real t267 = t261 - t163*t262;
-    const mico_real t268 = t191*(t185*t265 + t186*t266 + t187*t267 + t264*t190);
-    const mico_real t269 = t264 - t190*t268;
-    const mico_real t270 = t265 - t185*t268;
-    const mico_real t271 = t266 - t186*t268;
-    const mico_real t272 = t267 - t187*t268;
-    const mico_real t273 = t219*(t214*t271 + t215*t272 + t270*t218);
-    const mico_real t274 = t270 - t218*t273;
-    const mico_real t275 = t271 - t214*t273;
-    const mico_real t276 = t272 - t215*t273;
-    const mico_real t277 = t250*(t246*t276 + t275*t249);
-    const mico_real t278 = t275 - t249*t277;
-    const mico_real t279 = t276 - t246*t277;
-    const mico_real t280 = fabs(t279);
-    const mico_real t281 = t280;
-    const mico_real t282 = t281*(t279 >= 0 ? 1 : -1);
-    const mico_real t283 = t279 + t282;
-    const mico_real t284 = (t281 > 0 ? 1/(t281*(t281 + t280)) : 0);
-    const mico_real t285 = t253 - t253*t284*(t283*t283);
-    const mico_real t286 = (t282 != 0 ? -t285/t282 : 0);
-    const mico_real t287 = (t248 != 0 ? -(t252 - t278*t286)/t248 : 0);
-    const mico_real t288 = (t217 != 0 ? -(t221 - (t244*t287 + t274*t286))/t217 : 0);
-    const mico_real t289 = (t189 != 0 ? -(t193 - (t212*t288 + t239*t287 + t269*t286))/t189 : 0);
-    const mico_real t290 = (t165 != 0 ? -(t169 - (t183*t289 + t206*t288 + t233*t287 + t263*t286))/t165 : 0);
-    const mico_real t291 = (t146 != 0 ? -(t150 + t158*t290 + t176*t289 + t256*t286 - t199*t288 - t226*t287)/t146 : 0);
-    const mico_real t292 = q1 - t286 + t291*t96 - t290*t95;
-    const mico_real t293 = q4 + t5*t286 + t289*t51 + t290*t64 - t14*t287 - t288*t13 - t291*t61;
-    const mico_real t294 = q5 + t26*t286 + t289*t52 + t290*t65 - t19*t288 - t22*t287 - t291*t62;
-    const mico_real t295 = q6 + t55*t286 + t289*t53 + t290*t66 - t39*t288 - t45*t287 - t291*t63;
-    const mico_real t296 = t287*c1;
-    const mico_real t297 = t288*s1;
-    const mico_real t298 = t290*s1;
-    const mico_real t299 = t291*c1;
-    const mico_real t300 = q2 + t289*t97 - t296 - t297 + t59*t298 - t59*t299;
-    const mico_real t301 = q3 + t296 + t297 + t289*t50 + t58*t299 - t58*t298;
+    const mico_real t17 = 0.5*t12 + 0.8660254037844386*t6;
+    const mico_real t18 = t17;
+    const mico_real t19 = -0.08556330989390254*t17;
+    const mico_real t20 = 0.5*t13 + 0.8660254037844386*t8;
+    const mico_real t21 = t20;
+    const mico_real t22 = -0.08556330989390254*t20;
+    const mico_real t23 = t14*s4;
+    const mico_real t24 = 0.5*t4 + 0.8660254037844386*t23;
+    const mico_real t25 = t24;
+    const mico_real t26 = 0.08556330989390254*t24;
+    const mico_real t27 = 0.5*t6 - 0.8660254037844386*t12;
+    const mico_real t28 = t5*c5 + s5*t27;
+    const mico_real t29 = c5*t27 - t5*s5;
+    const mico_real t30 = 0.5*t8 - 0.8660254037844386*t13;
+    const mico_real t31 = t7*c5 + s5*t30;
+    const mico_real t32 = c5*t30 - t7*s5;
+    const mico_real t33 = 0.8660254037844386*t4 - 0.5*t23;
+    const mico_real t34 = t14*c4;
+    const mico_real t35 = s5*t33 + t34*c5;
+    const mico_real t36 = c5*t33 - t34*s5;
+    const mico_real t37 = 0.5*t18 + 0.8660254037844386*t29;
+    const mico_real t38 = t37;
+    const mico_real t39 = 0.20278165494695127*t37;
+    const mico_real t40 = t39 - t19;
+    const mico_real t41 = t40 - t15;
+    const mico_real t42 = t41 - 0.007*s1;
+    const mico_real t43 = 0.5*t21 + 0.8660254037844386*t32;
+    const mico_real t44 = t43;
+    const mico_real t45 = 0.20278165494695127*t43;
+    const mico_real t46 = t45 - t22;
+    const mico_real t47 = t46 - t16;
+    const mico_real t48 = t47 - 0.007*c1;
+    const mico_real t49 = 0.5*t25 - 0.8660254037844386*t36;
+    const mico_real t50 = t49;
+    const mico_real t51 = -0.20278165494695127*t49;
+    const mico_real t52 = t51 - t26;
+    const mico_real t53 = t9 + t52;
+    const mico_real t54 = t53 + 0.29*s2;
+    const mico_real t55 = 0.2755 + t54;
+    const mico_real t56 = 0.5*t29 - 0.8660254037844386*t18;
+    const mico_real t57 = t28*c6 + s6*t56;
+    const mico_real t58 = c6*t56 - t28*s6;
+    const mico_real t59 = T00*t57 + T02*t38 - T01*t58;
+    const mico_real t60 = T10*t57 + T12*t38 - T11*t58;
+    const mico_real t61 = T20*t57 + T22*t38 - T21*t58;
+    const mico_real t62 = 0.5*t32 - 0.8660254037844386*t21;
+    const mico_real t63 = t31*c6 + s6*t62;
+    const mico_real t64 = c6*t62 - t31*s6;
+    const mico_real t65 = T00*t63 + T02*t44 - T01*t64;
+    const mico_real t66 = T10*t63 + T12*t44 - T11*t64;
+    const mico_real t67 = T20*t63 + T22*t44 - T21*t64;
+    const mico_real t68 = 0.5*(t60 - t65);
+    const mico_real t69 = 0.5*t36 + 0.8660254037844386*t25;
+    const mico_real t70 = t35*c6 + s6*t69;
+    const mico_real t71 = c6*t69 - t35*s6;
+    const mico_real t72 = T01*t71 + T02*t50 - T00*t70;
+    const mico_real t73 = T11*t71 + T12*t50 - T10*t70;
+    const mico_real t74 = T21*t71 + T22*t50 - T20*t70;
+    const mico_real t75 = 0.5*(t73 + t67);
+    const mico_real t76 = -0.5*(t72 + t61);
+    const mico_real t77 = sqrt((t75*t75) + (t76*t76) + (t68*t68));
+    const mico_real t78 = 0.29*c2;
+    const mico_real t79 = t42 + t78*c1;
+    const mico_real t80 = t48 - t78*s1;
+    const mico_real t81 = -t74;
+    const mico_real t82 = 0.5*(-1 + t59 + t66 + t81);
+    const mico_real t83 = atan2(t77, t82);
+    const mico_real t84 = (t77 > 0 ? t83/t77 : 1);
+    const int t85 = t59 >= t66 && t59 >= t81;
+    const int t86 = t66 >= t81;
+    const mico_real t87 = (t85 ? 0.5*(1 + t59) : (t86 ? 0.5*t65 : -0.5*t72));
+    const mico_real t88 = (t85 ? 0.5*t60 : (t86 ? 0.5*(1 + t66) : -0.5*t73));
+    const mico_real t89 = (t85 ? 0.5*t61 : (t86 ? 0.5*t67 : 0.5*(1 + t81)));
+    const mico_real t90 = sqrt((t87*t87) + (t88*t88) + (t89*t89));
+    const mico_real t91 = (t75*t87 + t76*t88 + t68*t89 >= 0 ? 1 : -1);
+    const int t92 = (t77 > 1e-06) || (t82 > 0);
+    const mico_real t93 = t83*t91/t90;
+    const mico_real t94 = (t92 ? t75*t84 : t87*t93);
+    const mico_real t95 = (t92 ? t76*t84 : t88*t93);
+    const mico_real t96 = (t92 ? t68*t84 : t89*t93);
+    const mico_real t97 = -t79;
 
     /* Outputs */
-    q_start[0] = q1;
-    q_start[1] = q2;
-    q_start[2] = q3;
-    q_start[3] = q4;
-    q_start[4] = q5;
-    q_start[5] = q6;
-    q_next[0] = t292;
-    q_next[1] = t300;
-    q_next[2] = t301;
-    q_next[3] = t293;
-    q_next[4] = t294;
-    q_next[5] = t295;
-    return (isfinite(t0) ? t143 : -1);
+    e[0] = T03 + t97;
+    e[1] = T13 - t80;
+    e[2] = T23 - t55;
+    e[3] = t94;
+    e[4] = t95;
+    e[5] = t96;
+    J[0] = t80;
+    J[1] = -t54*c1;
+    J[2] = t53*c1;
+    J[3] = -(t13*t53 + t4*t47);
+    J[4] = -(t21*t52 + t25*t46);
+    J[5] = -(t44*t51 + t50*t45);
+    J[6] = t97;
+    J[7] = t54*s1;
+    J[8] = -t53*s1;
+    J[9] = t4*t41 + t53*t12;
+    J[10] = t18*t52 + t25*t40;
+    J[11] = t38*t51 + t50*t39;
+    J[12] = 0;
+    J[13] = t79*c1 - t80*s1;
+    J[14] = t48*s1 - t42*c1;
+    J[15] = t13*t41 - t47*t12;
+    J[16] = t21*t40 - t18*t46;
+    J[17] = t44*t39 - t38*t45;
+    J[18] = 0;
+    J[19] = -s1;
+    J[20] = s1;
+    J[21] = -t12;
+    J[22] = -t18;
+    J[23] = -t38;
+    J[24] = 0;
+    J[25] = -c1;
+    J[26] = c1;
+    J[27] = -t13;
+    J[28] = -t21;
+    J[29] = -t44;
+    J[30] = -1;
+    J[31] = 0;
+    J[32] = 0;
+    J[33] = t4;
+    J[34] = t25;
+    J[35] = t50;
 }
 
 int mico_ik_general_limits(const mico_real q_solution[MICO_DOF], mico_real q[MICO_DOF])
@@ -4666,47 +4492,78 @@ int mico_ik_nearest(const mico_real T[16], const mico_real q_seed[MICO_DOF], con
     return (!t308 ? 2 : (t309 ? 0 : 1));
 }
 
-/* The general 6R solver: the equations at T, the kernel's roots (jacgen_general6r_roots, in
- * double), each completed to a configuration, polished by Newton steps and kept when it reaches
- * T, once; the valid rows first. */
-void mico_ik_branches(const mico_real T[16], mico_real q[MICO_MAX_IK_SOLUTIONS * MICO_DOF],
-                     int valid[MICO_MAX_IK_SOLUTIONS], int in_limits[MICO_MAX_IK_SOLUTIONS])
+/* Clears the result rows of ik_branches. */
+static void mico_ik_general_clear(mico_real q[MICO_MAX_IK_SOLUTIONS * MICO_DOF], int valid[MICO_MAX_IK_SOLUTIONS],
+                                 int in_limits[MICO_MAX_IK_SOLUTIONS])
 {
-    mico_real P[378], Q[112], angles[5], x[MICO_DOF], start[MICO_DOF], next[MICO_DOF];
-    double p[3][14][9], qm[14][8], roots[JACGEN_G6_ROOTS][5];
-    int count = 0, found, i, j, k, s;
+    int i, j;
     for (i = 0; i < MICO_MAX_IK_SOLUTIONS; ++i) {
         valid[i] = 0;
         in_limits[i] = 0;
         for (j = 0; j < MICO_DOF; ++j) q[MICO_DOF * i + j] = 0;
     }
+}
+
+/* Writes the solution x as row `count` (ik's form, in_limits), unless it equals an earlier row
+ * to 1e-6 rad; returns whether it did. */
+static int mico_ik_general_add(const mico_real x[MICO_DOF], int count, mico_real q[MICO_MAX_IK_SOLUTIONS * MICO_DOF],
+                              int valid[MICO_MAX_IK_SOLUTIONS], int in_limits[MICO_MAX_IK_SOLUTIONS])
+{
+    int i, j;
+    for (i = 0; i < count; ++i) {
+        double largest = 0.0;
+        for (j = 0; j < MICO_DOF; ++j) {
+            double d = remainder((double)x[j] - (double)q[MICO_DOF * i + j], 6.283185307179586);
+            largest = fmax(largest, fabs(d));
+        }
+        if (largest < 1e-6) return 0;
+    }
+    in_limits[count] = mico_ik_general_limits(x, q + MICO_DOF * count);
+    valid[count] = 1;
+    return 1;
+}
+
+/* |e|^2 at x; and unless x has converged (|e|^2 <= 4.108431522004417e-24), x moved by one Newton step
+ * x + J^-1 e (in double; x stays where J is singular). */
+static mico_real mico_ik_general_newton(const mico_real T[16], mico_real x[MICO_DOF])
+{
+    mico_real e[6], J[36], cost = 0;
+    double a[36], b[6];
+    int i;
+    mico_ik_general_residual(T, x, e, J);
+    for (i = 0; i < 36; ++i) a[i] = (double)J[i];
+    for (i = 0; i < 6; ++i) {
+        b[i] = (double)e[i];
+        cost += e[i] * e[i];
+    }
+    if (!(cost <= 4.108431522004417e-24) && jacgen_g6_solve(6, a, 1, b) == 0)
+        for (i = 0; i < 6; ++i) x[i] += (mico_real)b[i];
+    return cost;
+}
+
+/* The general 6R solver: the equations at T, the kernel's
+ * roots (jacgen_general6r_roots, in double), each completed to a configuration, polished by
+ * Newton steps and kept when it reaches T, once; the valid rows first. */
+void mico_ik_branches(const mico_real T[16], mico_real q[MICO_MAX_IK_SOLUTIONS * MICO_DOF],
+                     int valid[MICO_MAX_IK_SOLUTIONS], int in_limits[MICO_MAX_IK_SOLUTIONS])
+{
+    mico_real P[378], Q[112], angles[5], x[MICO_DOF];
+    double p[3][14][9], qm[14][8], roots[JACGEN_G6_ROOTS][5];
+    int count = 0, found, i, j, k, s;
+    mico_ik_general_clear(q, valid, in_limits);
     mico_ik_general_equations(T, P, Q);
     for (i = 0; i < 378; ++i) p[i / 126][i / 9 % 14][i % 9] = (double)P[i];
     for (i = 0; i < 112; ++i) qm[i / 8][i % 8] = (double)Q[i];
     found = jacgen_general6r_roots(p, qm, roots);
     for (k = 0; k < found && count < MICO_MAX_IK_SOLUTIONS; ++k) {
         mico_real cost;
-        int duplicate = 0;
         for (j = 0; j < 5; ++j) angles[j] = (mico_real)roots[k][j];
         mico_ik_general_start(T, angles, x);
-        for (s = 0; s < 2; ++s) {
-            mico_ik_general_step(T, x, 0, start, next);
-            for (j = 0; j < MICO_DOF; ++j) x[j] = next[j];
-        }
-        cost = mico_ik_general_step(T, x, 0, start, next);
-        if (!(cost >= 0 && cost <= 1e-18)) continue;
-        for (i = 0; i < count && !duplicate; ++i) {
-            double largest = 0.0;
-            for (j = 0; j < MICO_DOF; ++j) {
-                double d = remainder((double)x[j] - (double)q[MICO_DOF * i + j], 6.283185307179586);
-                largest = fmax(largest, fabs(d));
-            }
-            duplicate = largest < 1e-6;
-        }
-        if (duplicate) continue;
-        in_limits[count] = mico_ik_general_limits(x, q + MICO_DOF * count);
-        valid[count] = 1;
-        ++count;
+        cost = mico_ik_general_newton(T, x);
+        for (s = 0; s < 2 && cost > 4.108431522004417e-24; ++s)
+            cost = mico_ik_general_newton(T, x);
+        if (!(cost <= 1e-18)) continue;
+        count += mico_ik_general_add(x, count, q, valid, in_limits);
     }
 }
 

@@ -106,9 +106,9 @@ void mico_ik_general_equations(const mico_real T[16], mico_real P[378], mico_rea
  * Result: q[i], i < 6. 88 operations. */
 void mico_ik_general_start(const mico_real T[16], const mico_real angles[5], mico_real q[MICO_DOF]);
 
-/* One Newton step of the general 6R solver's polish: q + J^T (J J^T + damping I)^-1 e (damping 0 for Newton), and |e|^2 at q (-1 when target or q is not finite).
- * Result: q_start[i], i < 6; q_next[i], i < 6; returned as a scalar. 1090 operations. */
-mico_real mico_ik_general_step(const mico_real target[16], const mico_real q[MICO_DOF], mico_real damping, mico_real q_start[MICO_DOF], mico_real q_next[MICO_DOF]);
+/* The pose error e at q (the position error and the rotation vector of R_target R^T, world frame) and the geometric Jacobian J: the Newton step of the solver's polish is q + J^-1 e.
+ * Result: e[i], i < 6; J: 6 x 6 row-major, element (r, c) at J[r * 6 + c]. 324 operations. */
+void mico_ik_general_residual(const mico_real target[16], const mico_real q[MICO_DOF], mico_real e[6], mico_real J[6 * MICO_DOF]);
 
 /* Ik's form of q (revolute angles wrapped, or into the limits) and whether it is inside the joint limits.
  * Result: q[i], i < 6; returned as a scalar. 30 operations. */
@@ -144,7 +144,7 @@ void mico_ik_branches(const mico_real T[16], mico_real q[MICO_MAX_IK_SOLUTIONS *
  * the solutions outside the limits (in_limits 0).
  * Solver: general 6R: Raghavan & Roth's 14 equations, eliminated to a 12 x 12 quadratic
  * matrix polynomial in tan(q_k/2) solved as a 24 x 24 eigenproblem, back-substitution and
- * two Newton steps (jacgen/general6r.py).
+ * up to two Newton steps (jacgen/general6r.py).
  * Order: the real eigenvalues in the order the eigensolver gives them; a solution that
  * does not reach the target after the Newton steps (a spurious root) is skipped; each
  * solution once (equal to 1e-6 rad).

@@ -106,13 +106,17 @@ void ur5_calibrated_ik_general_equations(const ur5_calibrated_real T[16], ur5_ca
  * Result: q[i], i < 6. 146 operations. */
 void ur5_calibrated_ik_general_start(const ur5_calibrated_real T[16], const ur5_calibrated_real angles[5], ur5_calibrated_real q[UR5_CALIBRATED_DOF]);
 
-/* One Newton step of the general 6R solver's polish: q + J^T (J J^T + damping I)^-1 e (damping 0 for Newton), and |e|^2 at q (-1 when target or q is not finite).
- * Result: q_start[i], i < 6; q_next[i], i < 6; returned as a scalar. 1248 operations. */
-ur5_calibrated_real ur5_calibrated_ik_general_step(const ur5_calibrated_real target[16], const ur5_calibrated_real q[UR5_CALIBRATED_DOF], ur5_calibrated_real damping, ur5_calibrated_real q_start[UR5_CALIBRATED_DOF], ur5_calibrated_real q_next[UR5_CALIBRATED_DOF]);
+/* The pose error e at q (the position error and the rotation vector of R_target R^T, world frame) and the geometric Jacobian J: the Newton step of the solver's polish is q + J^-1 e.
+ * Result: e[i], i < 6; J: 6 x 6 row-major, element (r, c) at J[r * 6 + c]. 440 operations. */
+void ur5_calibrated_ik_general_residual(const ur5_calibrated_real target[16], const ur5_calibrated_real q[UR5_CALIBRATED_DOF], ur5_calibrated_real e[6], ur5_calibrated_real J[6 * UR5_CALIBRATED_DOF]);
 
 /* Ik's form of q (revolute angles wrapped, or into the limits) and whether it is inside the joint limits.
  * Result: q[i], i < 6; returned as a scalar. 109 operations. */
 int ur5_calibrated_ik_general_limits(const ur5_calibrated_real q_solution[UR5_CALIBRATED_DOF], ur5_calibrated_real q[UR5_CALIBRATED_DOF]);
+
+/* The fast path's starting points: every branch of the nearest special class's closed form (the nominal arm's), whether its target allows it, and the least margin of its subproblems.
+ * Result: q: 8 x 6 row-major, element (r, c) at q[r * 6 + c]; valid[i], i < 8; returned as a scalar. 1838 operations. */
+ur5_calibrated_real ur5_calibrated_ik_general_nominal(const ur5_calibrated_real T[16], ur5_calibrated_real q[48], int valid[8]);
 
 /* The closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status.
  * Result: q[i], i < 6; returned as a scalar. 1891 operations. */
@@ -144,7 +148,7 @@ void ur5_calibrated_ik_branches(const ur5_calibrated_real T[16], ur5_calibrated_
  * also gives the solutions outside the limits (in_limits 0).
  * Solver: general 6R: Raghavan & Roth's 14 equations, eliminated to a 12 x 12 quadratic
  * matrix polynomial in tan(q_k/2) solved as a 24 x 24 eigenproblem, back-substitution and
- * two Newton steps (jacgen/general6r.py).
+ * up to two Newton steps (jacgen/general6r.py).
  * Order: the real eigenvalues in the order the eigensolver gives them; a solution that
  * does not reach the target after the Newton steps (a spurious root) is skipped; each
  * solution once (equal to 1e-6 rad).

@@ -105,7 +105,12 @@ def ik_context(robot: Robot, generator: Generator, real: str, number: Callable, 
             "monomials": general6r.MONOMIALS.astype(int).tolist(), "along_b": general6r.ALONG_B,
             "along_c": general6r.ALONG_C, "newton_steps": general6r.NEWTON_STEPS,
             "tolerance": general6r.TOLERANCE[real], "imaginary": general6r.IMAGINARY[real],
-            "squared": number(sympy.Float(general6r.TOLERANCE[real] ** 2))},
+            "squared": number(sympy.Float(general6r.TOLERANCE[real] ** 2)),
+            "converged_squared": number(sympy.Float((general6r.CONVERGED[real] * (1 + robot.reach)) ** 2)),
+            "fast": form.fast_path and {
+                "rows": form.fast_path.form.info.max_solutions, "steps": general6r.FAST_STEPS,
+                "band_squared": number(sympy.Float(form.fast_path.band ** 2)),
+                "margin": number(sympy.Float(form.fast_path.margin))}},
     }
 
 
