@@ -425,3 +425,12 @@ def mismatch(robot: Robot, nominal: Robot) -> tuple[float, float]:
     position = np.linalg.norm(exact[:, :3, 3] - near[:, :3, 3], axis=-1)
     cos = (np.einsum("nij,nij->n", exact[:, :3, :3], near[:, :3, :3]) - 1) / 2
     return float(position.max()), float(np.arccos(np.clip(cos, -1.0, 1.0)).max())
+
+
+def work_bytes(real: str) -> int:
+    """The size of the C solver's working memory (struct NAME_ik_work in templates/c/ik.c.jinja:
+    the equations in the build's real type and in double, the kernel's matrices in double), as
+    the contract documents it; tests/test_shipped_robots.py checks it against the compiler's."""
+    reals = 378 + 112
+    doubles = 3 * 14 * 9 + 14 * 8 + 24 * 5 + (14 * 8 + 8 + 8 + 3 * 6 * 9 + 3 * 12 * 12 + 24 * 24 + 12 * 12 + 24 + 24)
+    return reals * {"double": 8, "float": 4}[real] + doubles * 8

@@ -196,7 +196,9 @@ class Emulator:
         an error) and link."""
         objects = [self.folder / f"{source.stem}.o" for source in self.sources]
         for source, built in zip(self.sources, objects):
-            flags = warnings if source is self.sources[0] else WARNING_FLAGS
+            # the robot's C with the general 6R solver's working memory static (contract §4)
+            flags = [*warnings, f"-D{self.robot.name.upper()}_IK_STATIC_WORK"] if source is self.sources[0] \
+                else WARNING_FLAGS
             _run(["arm-none-eabi-gcc", *flags, *CPU_FLAGS, *BUILD_FLAGS, f"-I{self.sources[0].parent}",
                   f"-I{self.folder}", "-c", str(source), "-o", str(built)],
                  f"arm-none-eabi-gcc on {source.name}", cwd=self.folder)

@@ -4,12 +4,14 @@ class (Jaco, Mico, Manocha-Canny, a calibrated UR5): batched numpy `ik_branches`
 the solutions, every solution of a multi-start search among them, degenerate targets giving
 no solution rather than a wrong one; and the class and report of such an arm."""
 
+import ctypes
 import math
 
 import numpy as np
 import pytest
 
-from jacgen import reference
+from jacgen import general6r, reference
+from jacgen.compile import compile_shared
 from jacgen.model import Model
 from jacgen.robot import parse_robot
 
@@ -122,3 +124,17 @@ def test_a_backwards_shifted_split_generates_and_solves(generated):
         found = solutions[k][valid[k]]
         assert max(np.abs(reference.fk(arm, s) - reference.fk(arm, q[k])).max() for s in found) < 1e-9
         assert min(np.abs(wrapped(s - q[k])).max() for s in found) < 1e-8
+
+
+@pytest.mark.parametrize("real", ["double", "float"])
+def test_the_working_memory_is_the_documented_size(real, generated, tmp_path):
+    """struct NAME_ik_work, as the compiler lays it out, is the size the generated comment (and
+    the contract) states."""
+    folder = generated(robot("jaco"), ("c",), real, ("ik",)).folder / "jaco"
+    probe = tmp_path / "probe.c"
+    probe.write_text('#include "jaco.c"\nunsigned long jaco_work_size(void);\n'
+                     "unsigned long jaco_work_size(void) { return sizeof(struct jaco_ik_work); }\n")
+    library = ctypes.CDLL(str(compile_shared([probe], tmp_path / "probe.so", ("-O0", f"-I{folder}"))))
+    library.jaco_work_size.restype = ctypes.c_ulong
+    assert library.jaco_work_size() == general6r.work_bytes(real)
+    assert f"{general6r.work_bytes(real)} bytes in this build" in (folder / "jaco.c").read_text()

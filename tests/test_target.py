@@ -97,3 +97,22 @@ def test_missing_toolchain_is_one_line(monkeypatch, tmp_path):
     assert result.exit_code == 2
     lines = result.output.strip().splitlines()
     assert len(lines) == 1 and "arm-none-eabi-gcc" in lines[0] and "qemu-system-arm" in lines[0], result.output
+
+
+@needs_target
+def test_general_6r_float_verifies_within_the_stack_bound():
+    """The Jaco (general 6R: the eigenproblem, in double on the float build) on the target: ik,
+    ik_branches and ik_nearest reach their targets, and with its working memory static (as the
+    target build compiles it) no function's stack is over 4 KB."""
+    result = subprocess.run([sys.executable, "-m", "jacgen", "verify", str(ROOT / "robots" / "jaco.yaml"),
+                             "--target", "cortex-m4f", "--samples", "12"], capture_output=True, text=True, timeout=600)
+    assert result.returncode == 0, result.stdout + result.stderr
+    output = result.stdout.split("\n\n")
+    errors = {cells[1]: cells[2:] for cells in (re.split(r"\s{2,}", line.strip()) for line in output[0].splitlines())
+              if cells[0] == "jaco"}
+    assert "checked on the target too" in errors["ik"][-1] and "0 of" in result.stdout
+    resources = {cells[1]: cells[2:] for cells in (re.split(r"\s{2,}", line.strip()) for line in output[1].splitlines())
+                 if cells[0] == "jaco"}
+    for name in ("ik", "ik_nearest"):
+        flash, stack, measured, instructions = resources[name]
+        assert int(stack) <= STACK_LIMIT and int(measured) <= STACK_LIMIT, (name, stack, measured)

@@ -289,73 +289,84 @@ static double jacgen_g6_half_angle(const double v[12], const int *from, int coun
     return 2.0 * atan2(v[best + step], v[best]);
 }
 
+/* The kernel's working memory: the QR of Q, the six v_gh-free equations, M0, M1, M2, the
+ * companion matrix (eigenvalues in re, im) and one 12 x 12 matrix (M2's LU, then M(x) at each
+ * root). */
+struct jacgen_g6_work {
+    double q[14][8], beta[8], rdiag[8], free[3][6][9], m[3][12][12];
+    double companion[JACGEN_EIG_MAX][JACGEN_EIG_MAX], square[12][12], re[JACGEN_EIG_MAX], im[JACGEN_EIG_MAX];
+};
+
+/* c0 M0 + c1 M1 + c2 M2 into out (12 x 12): M_e the coefficient of x^e of (1 + x^2) (S0 + s Ss
+ * + c Sc) (free: S0, Ss, Sc; s = 2x / (1 + x^2), c = (1 - x^2) / (1 + x^2)), in the monomials
+ * x_b^i x_c^j; rows 6..11 are rows 0..5 times x_b. */
+static void jacgen_g6_pencil(double free[3][6][9], double c0, double c1, double c2, double out[12][12]) {
+    for (int i = 0; i < 12; i++)
+        for (int j = 0; j < 12; j++) out[i][j] = 0.0;
+    for (int r = 0; r < 6; r++)
+        for (int k = 0; k < 9; k++) {
+            double s0 = free[0][r][k], ss = free[1][r][k], sc = free[2][r][k];
+            double coefficient = c0 * (s0 + sc) + c1 * 2.0 * ss + c2 * (s0 - sc);
+            for (int j = 0; j < 9; j++) {
+                out[r][j] += coefficient * jacgen_g6_monomials[k][j];
+                out[r + 6][j + 3] += coefficient * jacgen_g6_monomials[k][j];
+            }
+        }
+}
+
 static int jacgen_general6r_roots(double p[3][14][9], double q_matrix[14][8],
-                                  double angles[JACGEN_G6_ROOTS][5]) {
-    double q[14][8], beta[8], rdiag[8];
+                                  double angles[JACGEN_G6_ROOTS][5], struct jacgen_g6_work *w) {
     for (int i = 0; i < 14; i++)
-        for (int j = 0; j < 8; j++) q[i][j] = q_matrix[i][j];
-    if (jacgen_g6_qr(q, beta, rdiag) != 0) return 0;
-    /* Q^T P, every column of P0, Ps, Pc; rows 8..13 are the six equations free of v_gh. */
-    double qtp[3][14][9];
+        for (int j = 0; j < 8; j++) w->q[i][j] = q_matrix[i][j];
+    if (jacgen_g6_qr(w->q, w->beta, w->rdiag) != 0) return 0;
+    /* Q^T P, every column of P0, Ps, Pc; its rows 8..13 are the six equations free of v_gh. */
     for (int m = 0; m < 3; m++)
         for (int j = 0; j < 9; j++) {
             double column[14];
             for (int i = 0; i < 14; i++) column[i] = p[m][i][j];
-            jacgen_g6_transpose_times(q, beta, column);
-            for (int i = 0; i < 14; i++) qtp[m][i][j] = column[i];
-        }
-    /* M0, M1, M2: the coefficients of 1, x, x^2 of (1 + x^2) (S0 + s Ss + c Sc), s = 2x / (1 + x^2),
-     * c = (1 - x^2) / (1 + x^2); rows 6..11 are rows 0..5 times x_b. */
-    double m[3][12][12];
-    for (int e = 0; e < 3; e++)
-        for (int i = 0; i < 12; i++)
-            for (int j = 0; j < 12; j++) m[e][i][j] = 0.0;
-    for (int r = 0; r < 6; r++)
-        for (int k = 0; k < 9; k++) {
-            double s0 = qtp[0][8 + r][k], ss = qtp[1][8 + r][k], sc = qtp[2][8 + r][k];
-            double coefficient[3] = {s0 + sc, 2.0 * ss, s0 - sc};
-            for (int e = 0; e < 3; e++)
-                for (int j = 0; j < 9; j++) {
-                    m[e][r][j] += coefficient[e] * jacgen_g6_monomials[k][j];
-                    m[e][r + 6][j + 3] += coefficient[e] * jacgen_g6_monomials[k][j];
-                }
+            jacgen_g6_transpose_times(w->q, w->beta, column);
+            for (int i = 0; i < 6; i++) w->free[m][i][j] = column[8 + i];
         }
     /* companion [0 I; -M2^-1 M0  -M2^-1 M1] */
-    double lead[12][12], rhs[12][24], companion[JACGEN_EIG_MAX][JACGEN_EIG_MAX];
+    double (*a)[JACGEN_EIG_MAX] = w->companion;
+    for (int e = 0; e < 3; e++) jacgen_g6_pencil(w->free, e == 0, e == 1, e == 2, w->m[e]);
     for (int i = 0; i < 12; i++)
-        for (int j = 0; j < 12; j++) { lead[i][j] = m[2][i][j]; rhs[i][j] = m[0][i][j]; rhs[i][j + 12] = m[1][i][j]; }
-    if (jacgen_g6_solve(12, &lead[0][0], 24, &rhs[0][0]) != 0) return 0;
+        for (int j = 0; j < 12; j++) {
+            w->square[i][j] = w->m[2][i][j];
+            a[12 + i][j] = w->m[0][i][j];
+            a[12 + i][12 + j] = w->m[1][i][j];
+        }
+    if (jacgen_g6_solve(12, &w->square[0][0], 24, &a[12][0]) != 0) return 0;
     for (int i = 0; i < 12; i++) {
-        for (int j = 0; j < 24; j++) companion[i][j] = j == i + 12 ? 1.0 : 0.0;
-        for (int j = 0; j < 24; j++) companion[i + 12][j] = -rhs[i][j];
+        for (int j = 0; j < 24; j++) a[i][j] = j == i + 12 ? 1.0 : 0.0;
+        for (int j = 0; j < 24; j++) a[i + 12][j] = -a[i + 12][j];
     }
-    double re[24], im[24];
-    if (jacgen_eigenvalues(24, companion, re, im) != 0) return 0;
+    if (jacgen_eigenvalues(24, a, w->re, w->im) != 0) return 0;
     static const int along_c[8] = {0, 1, 3, 4, 6, 7, 9, 10};
     static const int along_b[9] = {0, 1, 2, 3, 4, 5, 6, 7, 8};
     int found = 0;
     for (int k = 0; k < 24; k++) {
-        if (!(fabs(im[k]) <= 1e-05 * (1.0 + fabs(re[k])))) continue;
-        double x = re[k], at_root[12][12], v[12];
+        double x = w->re[k], v[12];
+        if (!(fabs(w->im[k]) <= 1e-05 * (1.0 + fabs(x)))) continue;
         for (int i = 0; i < 12; i++)
-            for (int j = 0; j < 12; j++) at_root[i][j] = m[0][i][j] + x * (m[1][i][j] + x * m[2][i][j]);
-        jacgen_g6_null_vector(at_root, v);
-        double a = 2.0 * atan(x);
+            for (int j = 0; j < 12; j++) w->square[i][j] = w->m[0][i][j] + x * (w->m[1][i][j] + x * w->m[2][i][j]);
+        jacgen_g6_null_vector(w->square, v);
+        double a_angle = 2.0 * atan(x);
         double b = jacgen_g6_half_angle(v, along_b, 9, 3);
         double c = jacgen_g6_half_angle(v, along_c, 8, 1);
-        double sa = sin(a), ca = cos(a), sb = sin(b), cb = cos(b), sc = sin(c), cc = cos(c);
-        double v_bc[9] = {sb * sc, sb * cc, cb * sc, cb * cc, sb, cb, sc, cc, 1.0}, w[14], v_gh[8];
+        double sa = sin(a_angle), ca = cos(a_angle), sb = sin(b), cb = cos(b), sc = sin(c), cc = cos(c);
+        double v_bc[9] = {sb * sc, sb * cc, cb * sc, cb * cc, sb, cb, sc, cc, 1.0}, equations[14], v_gh[8];
         for (int i = 0; i < 14; i++) {
-            w[i] = 0.0;
-            for (int j = 0; j < 9; j++) w[i] += (p[0][i][j] + sa * p[1][i][j] + ca * p[2][i][j]) * v_bc[j];
+            equations[i] = 0.0;
+            for (int j = 0; j < 9; j++) equations[i] += (p[0][i][j] + sa * p[1][i][j] + ca * p[2][i][j]) * v_bc[j];
         }
-        jacgen_g6_transpose_times(q, beta, w);
+        jacgen_g6_transpose_times(w->q, w->beta, equations);
         for (int i = 7; i >= 0; i--) {
-            double s = w[i];
-            for (int j = i + 1; j < 8; j++) s -= q[i][j] * v_gh[j];
-            v_gh[i] = s / rdiag[i];
+            double s = equations[i];
+            for (int j = i + 1; j < 8; j++) s -= w->q[i][j] * v_gh[j];
+            v_gh[i] = s / w->rdiag[i];
         }
-        double out[5] = {a, b, c, atan2(v_gh[4], v_gh[5]), atan2(v_gh[6], v_gh[7])};
+        double out[5] = {a_angle, b, c, atan2(v_gh[4], v_gh[5]), atan2(v_gh[6], v_gh[7])};
         for (int j = 0; j < 5; j++) angles[found][j] = out[j];
         found++;
     }
@@ -4541,23 +4552,39 @@ static mico_real mico_ik_general_newton(const mico_real T[16], mico_real x[MICO_
     return cost;
 }
 
+/* The general 6R solver's working memory: 20720 bytes in this build. A local of
+ * mico_ik_branches (on its stack) unless MICO_IK_STATIC_WORK is defined: then one static
+ * object, and mico_ik_branches (with mico_ik and mico_ik_nearest) is not reentrant. */
+struct mico_ik_work {
+    mico_real P[378], Q[112];
+    double p[3][14][9], q[14][8], roots[JACGEN_G6_ROOTS][5];
+    struct jacgen_g6_work kernel;
+};
+#ifdef MICO_IK_STATIC_WORK
+static struct mico_ik_work mico_ik_static_work;
+#endif
+
 /* The general 6R solver: the equations at T, the kernel's
  * roots (jacgen_general6r_roots, in double), each completed to a configuration, polished by
  * Newton steps and kept when it reaches T, once; the valid rows first. */
 void mico_ik_branches(const mico_real T[16], mico_real q[MICO_MAX_IK_SOLUTIONS * MICO_DOF],
                      int valid[MICO_MAX_IK_SOLUTIONS], int in_limits[MICO_MAX_IK_SOLUTIONS])
 {
-    mico_real P[378], Q[112], angles[5], x[MICO_DOF];
-    double p[3][14][9], qm[14][8], roots[JACGEN_G6_ROOTS][5];
+#ifdef MICO_IK_STATIC_WORK
+    struct mico_ik_work *w = &mico_ik_static_work;
+#else
+    struct mico_ik_work work, *w = &work;
+#endif
+    mico_real angles[5], x[MICO_DOF];
     int count = 0, found, i, j, k, s;
     mico_ik_general_clear(q, valid, in_limits);
-    mico_ik_general_equations(T, P, Q);
-    for (i = 0; i < 378; ++i) p[i / 126][i / 9 % 14][i % 9] = (double)P[i];
-    for (i = 0; i < 112; ++i) qm[i / 8][i % 8] = (double)Q[i];
-    found = jacgen_general6r_roots(p, qm, roots);
+    mico_ik_general_equations(T, w->P, w->Q);
+    for (i = 0; i < 378; ++i) w->p[i / 126][i / 9 % 14][i % 9] = (double)w->P[i];
+    for (i = 0; i < 112; ++i) w->q[i / 8][i % 8] = (double)w->Q[i];
+    found = jacgen_general6r_roots(w->p, w->q, w->roots, &w->kernel);
     for (k = 0; k < found && count < MICO_MAX_IK_SOLUTIONS; ++k) {
         mico_real cost;
-        for (j = 0; j < 5; ++j) angles[j] = (mico_real)roots[k][j];
+        for (j = 0; j < 5; ++j) angles[j] = (mico_real)w->roots[k][j];
         mico_ik_general_start(T, angles, x);
         cost = mico_ik_general_newton(T, x);
         for (s = 0; s < 2 && cost > 4.108431522004417e-24; ++s)
