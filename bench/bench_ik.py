@@ -20,8 +20,9 @@ robot's closed form (structure detection and exact constants, `jacgen.ik.closed_
 printed first.
 
 A second table has the general 6R solver (class general_6r) on the shipped Jaco, Manocha-Canny
-arm and calibrated UR5, and the calibrated Puma 560 and KR5 of tests/data/calibrated/, on
-random poses (fk of uniform joint vectors): the C `NAME_ik` in a native loop (for a
+arm and calibrated UR5, the calibrated Puma 560 and KR5 of tests/data/calibrated/, and the
+7-axis Sawyer and calibrated Panda with joint 7 free (at its generating value), on random
+poses (fk of uniform joint vectors): the C `NAME_ik` in a native loop (for a
 calibrated arm: with its fast path, with the eigenproblem alone, and the nominal arm's own
 closed form as the yardstick), the batched numpy `ik_branches` (all poses in one call), and ssik 8.2.0
 (`ssik.Manipulator.from_dh(...).solve`, its C++ path, when installed; its `prepare` takes
@@ -50,7 +51,7 @@ from jacgen.model import Model
 from jacgen.robot import load_robot
 
 ROBOTS = {"ur5": IkGeoRobot.three_parallel_two_intersecting, "puma560": IkGeoRobot.spherical_two_parallel}
-GENERAL = ("jaco", "manocha_canny", "ur5_calibrated", "puma560_calibrated", "kr5_calibrated")
+GENERAL = ("jaco", "manocha_canny", "ur5_calibrated", "puma560_calibrated", "kr5_calibrated", "sawyer", "panda_calibrated")
 
 
 def per_pose(solve, targets, rounds: int) -> tuple[float, int]:
@@ -119,29 +120,33 @@ def general_table(targets_count: int, rounds: int, folder: Path) -> None:
         code = common.generate(robot, folder, ("c", "python"))
         library = CLibrary(common.shared_library(code / f"{name}.c"), robot, [], "double")
         module = common.load_module(code / f"{name}.py")
-        q = np.random.default_rng(5).uniform(-np.pi, np.pi, (targets_count, 6))
+        q = np.random.default_rng(5).uniform(-np.pi, np.pi, (targets_count, robot.dof))
         targets = reference.fk(robot, q)
+        form = Model(robot).closed_form
+        frees = None if form.free is None else q[:, form.free]  # a 7R arm: the free joint's angle
+        free = (lambda k: {}) if frees is None else (lambda k: {"q_free": frees[k]})
         rows = {}
-        micros, _ = common.native_ik(robot, code / f"{name}.c", targets, rounds, folder)
-        fast = Model(robot).closed_form.fast_path
+        micros, _ = common.native_ik(robot, code / f"{name}.c", targets, rounds, folder, frees)
+        fast = form.fast_path
         label = "C native, fast path" if fast else "C native"
-        rows[label] = (micros, [library.ik(T, 16) for T in targets])
+        rows[label] = (micros, [library.ik(T, 16, **free(k)) for k, T in enumerate(targets)])
         if fast:
             alone = replace(robot, name=f"{name}_eigen", nearest_class=False)
             source = common.generate(alone, folder) / f"{alone.name}.c"
             alone_library = CLibrary(common.shared_library(source), alone, [], "double")
-            micros, _ = common.native_ik(alone, source, targets, rounds, folder)
-            rows["C native, eigenproblem only"] = (micros, [alone_library.ik(T, 16) for T in targets])
+            micros, _ = common.native_ik(alone, source, targets, rounds, folder, frees)
+            rows["C native, eigenproblem only"] = (micros, [alone_library.ik(T, 16, **free(k))
+                                                            for k, T in enumerate(targets)])
             nominal = replace(fast.nominal.robot, name=f"{name}_nominal")
             source = common.generate(nominal, folder) / f"{nominal.name}.c"
-            micros, _ = common.native_ik(nominal, source, targets, rounds, folder)
+            micros, _ = common.native_ik(nominal, source, targets, rounds, folder, frees)
             rows["C native, nominal arm's closed form"] = (micros, None)
-            decided = module._fast_branches(targets)[2].mean()
+            decided = module._fast_branches(targets, *([] if frees is None else [frees]))[2].mean()
             print(f"{name:19s} the fast path decides {decided:.1%} of the poses; the rest go to the eigenproblem")
-        batch = common.timed(lambda: module.ik_branches(targets), rounds)
+        batch = common.timed(lambda: module.ik_branches(targets, *([] if frees is None else [frees])), rounds)
         branches, valid, _ = batch.result
         rows["numpy batched"] = (batch.seconds * 1e6 / len(targets), [b[v] for b, v in zip(branches, valid)])
-        ssik_solve = _ssik_solver(robot)
+        ssik_solve = _ssik_solver(robot) if robot.dof == 6 else None
         if ssik_solve is not None:
             timing = common.timed(lambda: [ssik_solve(T) for T in targets], rounds)
             rows["ssik"] = (timing.seconds * 1e6 / len(targets), timing.result)

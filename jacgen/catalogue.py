@@ -41,7 +41,7 @@ EXTENTS = {
     "ik_numeric_step.q_next": ("DOF",),
     "ik_general_start.q": ("DOF",),
     "ik_general_residual.e": (6,),
-    "ik_general_residual.J": (6, "DOF"),
+    "ik_general_residual.J": (6, 6),
     "ik_general_limits.q": ("DOF",),
     "q_solution": ("DOF",),
     "fk": (16,),

@@ -87,7 +87,7 @@ class Generator:
                            default="(1.0,) * DOF")
         sp = Subproblems(self.name)
         if form.solver == "general_6r":
-            parts, rows = self.general_6r_functions(target, sp), form.info.max_solutions
+            parts, rows = self.general_6r_functions(target, free, bindings, sp), form.info.max_solutions
         else:
             with distribute(False):
                 q, valid, inside = ik.branches(self.robot, form, sp, target.symbols, free_angle)
@@ -114,16 +114,20 @@ class Generator:
                                 arguments=(target, seed, *free, weights), calls=(table,))
         return [*parts, nearest]
 
-    def general_6r_functions(self, target: Argument, sp: Subproblems) -> list[Function]:
+    def general_6r_functions(self, target: Argument, free_input: tuple, bindings: dict,
+                             sp: Subproblems) -> list[Function]:
         """The generated parts of the general 6R solver (`general6r`), which ik_branches runs
         around the eigenproblem kernel of its language: the equations at the target (P0, Ps, Pc
         stacked 42 x 9, the hidden angle's shift applied; Q 14 x 8), the configuration of one
-        root's loop angles (the free joint from the loop), the pose error and Jacobian of a Newton
-        step, ik's form of a configuration with its limits, and for a
-        calibrated arm the branches of its nominal arm's closed form, which start the fast path."""
-        plan = self.closed_form.elimination
+        root's loop angles (the loop's free joint from the loop), the pose error and Jacobian of
+        a Newton step, ik's form of a configuration with its limits, and for a calibrated arm the
+        branches of its nominal arm's closed form, which start the fast path. A 7R arm's free
+        joint (`free_input`, bound by `bindings`) is in the chain's head or tail."""
+        form = self.closed_form
+        plan = form.elimination
         equations, split = plan.equations, plan.equations.split
-        head, links, tail = general6r.chain_form(self.robot)
+        head, links, tail = general6r.chain_form(self.robot, form.free)
+        six = form.joints  # the robot's joint of each of the chain's six
         name = self.name
         with distribute(False):
             n = (_rigid_inverse(head) * target.symbols * _rigid_inverse(tail)).applyfunc(name)
@@ -136,7 +140,8 @@ class Generator:
             stacked = sympy.Matrix.vstack(p0, ps, pc)
         equations_function = self.function(
             "ik_general_equations", "the general 6R solver's equations at T: (P0 + s Ps + c Pc) v_bc = Q v_gh, "
-            "P = [P0; Ps; Pc] (42 x 9)", ("P", stacked), ("Q", q), arguments=(target,), part_of="ik_branches")
+            "P = [P0; Ps; Pc] (42 x 9)", ("P", stacked), ("Q", q), arguments=(target, *free_input), bindings=bindings,
+            part_of="ik_branches")
         angles = Argument("angles", sympy.Matrix([generated_symbol("ga", k) for k in range(5)]))
         loop = dict(zip((*split.triple, *split.pair), angles.symbols))
         loop[split.hidden] = loop[split.hidden] + sympy.Float(plan.shift, 17)
@@ -160,38 +165,44 @@ class Generator:
                     after = (after * turn * (constants[i][:3, :3] if i < 5 else sympy.eye(3))).applyfunc(name)
             column = (before.T * n[:3, :3] * after.T[:, 0]).applyfunc(name)  # Z_free's first column
             theta[free] = sympy.atan2(column[1], column[0])
-            q = [t - joint.offset.exact for t, joint in zip(theta, self.robot.joints)]
+            q = list(self.q)  # the free joint of a 7R arm: its symbol, bound to q_free
+            for k, t in zip(six, theta):
+                q[k] = t - self.robot.joints[k].offset.exact
         start = self.function("ik_general_start", "the configuration of one root's loop angles (a - shift, b, c, "
-                              "g, h; the free joint from the loop)", ("q", sympy.Matrix(q)), vector=True,
-                              arguments=(target, angles), part_of="ik_branches")
+                              "g, h; the loop's free joint from the loop)", ("q", sympy.Matrix(q)), vector=True,
+                              arguments=(target, *free_input, angles), bindings=bindings, part_of="ik_branches")
+        dof = self.robot.dof
         target_pose = self._ik_target()
-        given = Argument("q", sympy.Matrix([generated_symbol("qs", i + 1) for i in range(6)]))
+        given = Argument("q", sympy.Matrix([generated_symbol("qs", i + 1) for i in range(dof)]))
         with distribute(False):
             error, jacobian = self._task_error(target_pose, None)
         step = self.function("ik_general_residual", "the pose error e at q (the position error and the rotation "
-                             "vector of R_target R^T, world frame) and the geometric Jacobian J: the Newton step of "
-                             "the solver's polish is q + J^-1 e", ("e", sympy.Matrix(error)), ("J", jacobian),
-                             vectors=("e",), arguments=(target_pose, given), bindings=dict(zip(self.q, given.symbols)),
+                             "vector of R_target R^T, world frame) and the geometric Jacobian J of the six joints "
+                             "ik solves: the Newton step of the solver's polish is q + J^-1 e",
+                             ("e", sympy.Matrix(error)), ("J", jacobian[:, list(six)]), vectors=("e",),
+                             arguments=(target_pose, given), bindings=dict(zip(self.q, given.symbols)),
                              part_of="ik_branches")
-        given = Argument("q_solution", sympy.Matrix([generated_symbol("qg", i + 1) for i in range(6)]))
+        given = Argument("q_solution", sympy.Matrix([generated_symbol("qg", i + 1) for i in range(dof)]))
         with distribute(False):
-            form, inside = ik_limits.limited(self.robot, sp, list(given.symbols), tuple(range(6)))
+            limited, inside = ik_limits.limited(self.robot, sp, list(given.symbols), six, form.free)
         limits = self.function("ik_general_limits", "ik's form of q (revolute angles wrapped, or into the limits) "
-                               "and whether it is inside the joint limits", ("q", sympy.Matrix(form)),
+                               "and whether it is inside the joint limits", ("q", sympy.Matrix(limited)),
                                ("in_limits", [inside]), vector=True, scalars=("in_limits",), arguments=(given,),
                                part_of="ik_branches")
         parts = [equations_function, start, step, limits]
-        if fast := self.closed_form.fast_path:
+        if fast := form.fast_path:
             sp.margins.clear()
+            free_angle = None if form.free is None else self.q[form.free]
             with distribute(False):
-                q, valid, _ = ik.branches(fast.nominal.robot, fast.form, sp, target.symbols)
+                q, valid, _ = ik.branches(fast.nominal.robot, fast.form, sp, target.symbols, free_angle)
                 margin = sympy.Abs(sp.margins[0])
                 for other in sp.margins[1:]:
                     margin = self.name(select(AtMost(margin, sympy.Abs(other)), margin, sympy.Abs(other)))
             parts.append(self.function("ik_general_nominal", "the fast path's starting points: every branch of the "
                                        "nearest special class's closed form (the nominal arm's), whether its target "
                                        "allows it, and the least margin of its subproblems", ("q", q), ("valid", valid),
-                                       ("margin", sympy.Matrix([margin])), scalars=("margin",), arguments=(target,), part_of="ik_branches"))
+                                       ("margin", sympy.Matrix([margin])), scalars=("margin",),
+                                       arguments=(target, *free_input), bindings=bindings, part_of="ik_branches"))
         return parts
 
     def velocity_ik_function(self, js: sympy.Matrix) -> Function:

@@ -31,7 +31,7 @@ s^2 = 1 - c^2 for every joint; the twists' cosines and sines enter as 60-digit n
 the structure stage, and what cancels between them (below 1e-40) is dropped.
 """
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from functools import cached_property
 
 import numpy as np
@@ -88,11 +88,13 @@ class Split:
         on_left = 5 in self.triple
         return on_left != self.backwards
 
-    @property
-    def text(self) -> str:
-        joints = lambda positions: ", ".join(f"q{self.joint(p) + 1}" for p in positions)  # noqa: E731
-        return (f"tan(q{self.joint(self.hidden) + 1}/2) from the eigenproblem, then {joints(self.triple[1:])}, "
-                f"{joints(self.pair)} and q{self.joint(self.free) + 1}")
+    def text(self, joints: tuple[int, ...] = tuple(range(6))) -> str:
+        """The order in which the solver finds the joints, named as the robot's (`joints`: the
+        robot's joint of each of the chain's six)."""
+        def names(positions) -> str:
+            return ", ".join(f"q{joints[self.joint(p)] + 1}" for p in positions)
+        return (f"tan({names((self.hidden,))}/2) from the eigenproblem, then {names(self.triple[1:])}, "
+                f"{names(self.pair)} and {names((self.free,))}")
 
 
 SPLITS = tuple(Split(backwards, free) for backwards in (False, True) for free in range(6))
@@ -142,14 +144,22 @@ class Equations:
         return sympy.Matrix(sympy.symbols(GENERATORS, real=True)[21:])
 
 
-def chain_form(robot: Robot) -> tuple[sympy.Matrix, list[Link], sympy.Matrix]:
-    """(head, [C1 .. C5], tail) of a 6R robot: its chain is head Z1 C1 ... Z5 C5 Z6 tail."""
-    if robot.dof != 6 or not all(joint.revolute for joint in robot.joints):
-        raise ValueError(f"{robot.name}: the general 6R solver needs six revolute joints")
+def chain_form(robot: Robot, free: int | None = None) -> tuple[sympy.Matrix, list[Link], sympy.Matrix]:
+    """(head, [C1 .. C5], tail) of a 6R robot, or of a 7R robot's six joints other than `free`
+    (its first or last joint, an input of ik): the chain is head Z1 C1 ... Z5 C5 Z6 tail, and the
+    free joint's row, at the cos and sin symbols of its angle, is part of the head or the tail."""
+    if not all(joint.revolute for joint in robot.joints) or robot.dof - (free is not None) != 6 \
+            or free not in (None, 0, robot.dof - 1):
+        raise ValueError(f"{robot.name}: the general 6R solver needs six revolute joints (and a 7th free, first or last)")
     if robot.symbolic_parameters:
         raise ValueError(f"{robot.name}: the general 6R solver needs numeric DH parameters")
-    joints = robot.joints
     base, tool = kinematics.pose_transform(robot.base), kinematics.pose_transform(robot.tool)
+    if free is not None:
+        row = kinematics.link_transforms(replace(robot, joints=(robot.joints[free],)),
+                                         lambda _: kinematics.trig_symbols((free,), robot.dof), ())[0]
+        moved = row[0] * row[1]
+        base, tool = (base * moved, tool) if free == 0 else (base, moved * tool)
+    joints = [joint for k, joint in enumerate(robot.joints) if k != free]
 
     def step(d, a, alpha) -> sympy.Matrix:
         return (kinematics.translation(0, 0, d) * kinematics.translation(a, 0, 0)
@@ -312,7 +322,7 @@ MONOMIALS = np.array([np.outer(_HALF_ANGLE[b], _HALF_ANGLE[c]).ravel()
 # read each from the pair of largest size in the null vector.
 ALONG_C = (0, 1, 3, 4, 6, 7, 9, 10)
 ALONG_B = tuple(range(9))
-NEWTON_STEPS = 2  # on the pose, after the back-substitution
+NEWTON_STEPS = 6  # at most, on the pose, after the back-substitution (a near-double root needs more than 2)
 TOLERANCE = {"double": 1e-9, "float": 1e-3}  # |pose error| (m and rad) of a solution after them
 # The fast path of a calibrated arm (a structure.Nominal): the nominal arm's closed form, then up
 # to FAST_STEPS Newton steps on the exact arm from each branch that the target allows or that
@@ -367,13 +377,13 @@ class Elimination:
     condition: float
 
 
-def elimination(robot: Robot) -> Elimination:
+def elimination(robot: Robot, free: int | None = None) -> Elimination:
     """The best conditioned of the 12 splits and 16 shifts (a matrix polynomial singular for
     every x, as the Jaco's is for the textbook split, rates as badly as a singular leading
     matrix; so do a Q of rank below 8, from which v_gh cannot be read back, and equations
 whose null space at a root has more than one vector, from which v_bc cannot). Derivations are milliseconds each; the rating is a few hundred 12 x 12
     condition numbers."""
-    head, links, tail = chain_form(robot)
+    head, links, tail = chain_form(robot, free)
     theta = np.random.default_rng(0).uniform(-np.pi, np.pi, (SAMPLES, 6))
     n = _numeric_chain(links, theta)
     best = None

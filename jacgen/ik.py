@@ -18,7 +18,8 @@ import sympy
 from . import general6r
 from .ik_limits import limited
 from .nodes import EPS, Above, AtLeast, AtMost, IsFinite, select
-from .structure import E_Z, SOLVERS, Geometry, Nominal, SolverInfo, Structure, classify, is_zero, readable
+from .structure import (E_Z, SOLVERS, Geometry, Nominal, SolverInfo, Structure, classify, is_zero, nearest_class,
+                        readable)
 from .subproblems import Angle, Subproblems, relative, times, times_transposed
 
 Matrix = sympy.Matrix
@@ -162,16 +163,7 @@ def closed_form(robot, geometry: Geometry | None = None, structure: Structure | 
     if structure.solver is None:
         return None
     if structure.solver == "general_6r":
-        plan = general6r.elimination(robot)
-        if plan.condition > general6r.WORST_CONDITION:
-            return None
-        fast_path = None
-        if structure.nominal is not None:
-            nominal = structure.nominal
-            fast_path = FastPath(nominal, closed_form(nominal.robot, structure=nominal.structure),
-                                 *general6r.mismatch(robot, nominal.robot))
-        return ClosedForm("general_6r", SOLVERS["general_6r"], "pose", (), (), False, tuple(range(6)), (1,) * 6, None,
-                          plan, fast_path)
+        return _general(robot)
     chain = structure.chain
     constants, indices = _CONSTANTS[structure.solver](chain)
     if chain.start is not None:  # a reversed chain: its target is T(0) T^-1
@@ -185,6 +177,23 @@ def closed_form(robot, geometry: Geometry | None = None, structure: Structure | 
     return ClosedForm(structure.solver, SOLVERS[structure.solver], target,
                       tuple((name, Matrix(value)) for name, value in constants), tuple(indices), flip,
                       chain.joints, chain.signs, chain.free)
+
+
+def _general(robot) -> ClosedForm | None:
+    """The general 6R solver of a 6R arm, or of a 7R arm with its first or last joint free (the
+    file's `ik.free_joint`, else the one whose split rates better); with the fast path when a
+    special class is near. None when no split is conditioned well enough."""
+    candidates = (None,) if robot.dof == 6 else (robot.free_joint,) if robot.free_joint is not None else (6, 0)
+    plan, free = min(((general6r.elimination(robot, free), free) for free in candidates),
+                     key=lambda pair: pair[0].condition)
+    if plan.condition > general6r.WORST_CONDITION:
+        return None
+    nominal = nearest_class(robot, free) if robot.nearest_class else None
+    fast_path = nominal and FastPath(nominal, closed_form(nominal.robot, structure=nominal.structure),
+                                     *general6r.mismatch(robot, nominal.robot))
+    joints = tuple(j for j in range(robot.dof) if j != free)
+    return ClosedForm("general_6r", SOLVERS["general_6r"], "pose", (), (), False, joints, (1,) * 6, free, plan,
+                      fast_path)
 
 
 def _chain_text(form: ClosedForm) -> list[str]:
@@ -220,6 +229,7 @@ def documentation(robot, form: ClosedForm, max_name: str) -> list[str]:
         f"Solver: {form.info.title}.",
     ]
     if form.solver == "general_6r":
+        text += _chain_text(form)[:1] if form.free is not None else []
         text.append(f"Order: {form.info.branches[0]}; each solution once (equal to 1e-6 rad).")
         return [line for paragraph in text for line in textwrap.wrap(paragraph, DOC_WIDTH)]
     text += [

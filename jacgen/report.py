@@ -140,8 +140,9 @@ def ik_lines(model: Model) -> list[str]:
             return [f"no closed form ({structure.reason}, but no split of its loop is conditioned well enough "
                     f"for it: see general6r.WORST_CONDITION); ik_numeric only"]
         plan = form.elimination
-        return [f"general 6R: {info.max_solutions} solutions at most ({structure.reason})",
-                f"{info.title}: {plan.equations.split.text}; the half angle shifted by {plan.shift:.6g} rad; "
+        free = "" if form.free is None else f", joint {form.free + 1} free (an input of ik, q_free)"
+        return [f"general 6R{free}: {info.max_solutions} solutions at most ({structure.reason})",
+                f"{info.title}: {plan.equations.split.text(form.joints)}; the half angle shifted by {plan.shift:.6g} rad; "
                 f"median condition number {plan.condition:.2g} over random configurations",
                 _fast_path_line(model)]
     chain = structure.chain

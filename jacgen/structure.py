@@ -84,7 +84,7 @@ SOLVERS = {
     "general_6r": SolverInfo(
         "general 6R: Raghavan & Roth's 14 equations, eliminated to a 12 x 12 quadratic matrix "
         "polynomial in tan(q_k/2) solved as a 24 x 24 eigenproblem, back-substitution and up to "
-        "two Newton steps (jacgen/general6r.py)",
+        "six Newton steps (jacgen/general6r.py)",
         16, ("the real eigenvalues in the order the eigensolver gives them; a solution that does not "
              "reach the target after the Newton steps (a spurious root) is skipped",)),
 }
@@ -97,7 +97,6 @@ class Structure:
     solver: str | None
     reason: str  # why the solver applies, or why no solver does
     chain: "Geometry | None" = field(default=None, compare=False)  # what the solver solves (see Geometry)
-    nominal: "Nominal | None" = field(default=None, compare=False)  # general_6r: the nearest special class
 
 
 # A calibrated arm's nearest special class (contract §2, "Calibrated arms"): twists within NEAR_TWIST
@@ -136,27 +135,28 @@ def _near_special(robot: Robot) -> list[tuple[float, int, str, Value, str]]:
     return sorted(found, key=lambda entry: -entry[0])
 
 
-def _snapped(robot: Robot, values) -> Robot:
+def _snapped(robot: Robot, values, free: int | None) -> Robot:
     joints = list(robot.joints)
     for _, i, key, special, _ in values:
         joints[i] = replace(joints[i], **{key: special})
-    return replace(robot, joints=tuple(joints), nearest_class=False)
+    return replace(robot, joints=tuple(joints), nearest_class=False, free_joint=free)
 
 
-def nearest_class(robot: Robot) -> Nominal | None:
-    """The nominal arm of a 6R arm without a special class, None when snapping every near-special
-    value does not give one. Greedy: from all of them snapped, each (farthest first) is put back
-    when the arm stays in a special class without it."""
+def nearest_class(robot: Robot, free: int | None = None) -> Nominal | None:
+    """The nominal arm of a 6R arm without a special class (of a 7R arm: with joint `free` free,
+    as the general solver has it), None when snapping every near-special value does not give
+    one. Greedy: from all of them snapped, each (farthest first) is put back when the arm stays
+    in a special class without it."""
     snapped = _near_special(robot)
-    structure = classify(_snapped(robot, snapped))
+    structure = classify(_snapped(robot, snapped, free))
     if structure.solver in (None, "general_6r"):
         return None
     for value in list(snapped):
         trial = [other for other in snapped if other is not value]
-        candidate = classify(_snapped(robot, trial))
+        candidate = classify(_snapped(robot, trial, free))
         if candidate.solver not in (None, "general_6r"):
             snapped, structure = trial, candidate
-    return Nominal(_snapped(robot, snapped), tuple(entry[4] for entry in snapped), structure)
+    return Nominal(_snapped(robot, snapped, free), tuple(entry[4] for entry in snapped), structure)
 
 
 def _circle(expr: sympy.Expr) -> tuple[sympy.Symbol, sympy.Symbol] | None:
@@ -453,13 +453,15 @@ def classify(robot: Robot, geometry: Geometry | None = None) -> Structure:
     g = geometry or Geometry(robot)
     n, task = robot.dof, robot.task
     if task == TASK_COMPONENTS:
+        general = all(g.revolute) and not robot.symbolic_parameters
         if n == 6:
             solver, reason, chain = _six_dof(g)
-            if solver is None and all(g.revolute) and not robot.symbolic_parameters:
-                nominal = nearest_class(robot) if robot.nearest_class else None
-                return Structure("general_6r", f"no special class: {reason}", None, nominal)
+            if solver is None and general:
+                solver, reason = "general_6r", f"no special class: {reason}"
         elif n == 7:
             solver, reason, chain = _free_joint(robot)
+            if solver is None and general and robot.free_joint in (None, 0, 6):
+                solver, reason = "general_6r", f"joint 1 or 7 free, the other six: no special class ({reason})"
         elif n > 7:
             solver, reason, chain = None, f"{n} joints for a 6-component task: redundant, infinitely many solutions", None
         else:

@@ -59,16 +59,16 @@ def _differences(ours, valid, theirs, valid_theirs) -> tuple[int, int]:
 @pytest.mark.parametrize("name", ARMS)
 def test_the_nearest_special_class_snaps_the_fewest_values(name):
     arm = ARMS[name]
-    nominal = Model(arm).structure.nominal
+    nominal = Model(arm).closed_form.fast_path.nominal
     solver, snapped = NOMINAL[name]
     assert nominal.structure.solver == solver and len(nominal.snapped) == snapped
     assert structure.classify(arm).solver == "general_6r"
-    assert Model(_eigenproblem_only(arm)).structure.nominal is None
-    assert Model(robot("jaco")).structure.nominal is None  # the 60-degree wrist is not near a class
+    assert Model(_eigenproblem_only(arm)).closed_form.fast_path is None
+    assert Model(robot("jaco")).closed_form.fast_path is None  # the 60-degree wrist is not near a class
 
 
 def test_ur5_calibrated_snaps_its_two_twists_and_the_wrist_offset():
-    nominal = Model(robot("ur5_calibrated")).structure.nominal
+    nominal = Model(robot("ur5_calibrated")).closed_form.fast_path.nominal
     assert nominal.snapped == ("alpha2 -0.001 -> 0 rad", "alpha3 0.001 -> 0 rad", "a5 0.0001 -> 0 m")
     assert "path: calibrated fast path. Nearest special class: three_parallel" in \
         (GENERATED / "ur5_calibrated" / "ur5_calibrated.md").read_text()

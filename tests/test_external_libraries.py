@@ -26,12 +26,13 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 
-from jacgen import reference
+from jacgen import numeric_chain, reference
 
 with warnings.catch_warnings():
     warnings.simplefilter("ignore")
     rtb = pytest.importorskip("roboticstoolbox")
     pin = pytest.importorskip("pinocchio")
+    from spatialmath import SE3
 
 from support.pinocchio_chain import pinocchio_from_dh, robot_of, samples, translation  # noqa: E402
 
@@ -71,14 +72,19 @@ RTB_MODELS = {
     "mico": lambda: rtb.models.DH.Mico(),
     "manocha_canny": lambda: _rtb_dh("manocha_canny"),
     "ur5_calibrated": lambda: _rtb_dh("ur5_calibrated"),
+    "sawyer": lambda: rtb.models.DH.Sawyer(),
+    "panda_calibrated": lambda: _rtb_dh("panda_calibrated"),
 }
 
 
 def _rtb_dh(name):
-    """rtb's DHRobot of the standard DH rows of a shipped arm that rtb has no model of (no base,
-    tool or offsets in those files)."""
+    """rtb's DHRobot of the DH rows and tool of a shipped arm that rtb has no model of (no base or
+    offsets in those files)."""
     arm = robot_of(name)
-    return rtb.DHRobot([rtb.RevoluteDH(a=j.a.approx, alpha=j.alpha.approx, d=j.d.approx) for j in arm.joints], name=name)
+    link = rtb.RevoluteDH if arm.convention == "standard" else rtb.RevoluteMDH
+    tool = SE3(numeric_chain.fixed_pose(arm.tool), check=False)
+    return rtb.DHRobot([link(a=j.a.approx, alpha=j.alpha.approx, d=j.d.approx) for j in arm.joints], tool=tool,
+                       name=name)
 
 
 def iiwa_pinocchio_urdf_style():

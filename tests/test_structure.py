@@ -28,6 +28,8 @@ EXPECTED = {
     "mico": "general_6r",
     "manocha_canny": "general_6r",
     "ur5_calibrated": "general_6r",
+    "sawyer": "general_6r",  # joint 7 free
+    "panda_calibrated": "general_6r",  # joint 7 free
 }
 
 # Craig's Puma 560 table (modified DH): the same arm class whatever the convention.

@@ -3810,7 +3810,7 @@ void jaco_ik_general_start(const jaco_real T[16], const jaco_real angles[5], jac
     q[5] = -1.7453292519943295 + ga3;
 }
 
-void jaco_ik_general_residual(const jaco_real target[16], const jaco_real q[JACO_DOF], jaco_real e[6], jaco_real J[6 * JACO_DOF])
+void jaco_ik_general_residual(const jaco_real target[16], const jaco_real q[JACO_DOF], jaco_real e[6], jaco_real J[6 * 6])
 {
     /* 324 operations */
 
@@ -4588,7 +4588,7 @@ void jaco_ik_branches(const jaco_real T[16], jaco_real q[JACO_MAX_IK_SOLUTIONS *
         for (j = 0; j < 5; ++j) angles[j] = (jaco_real)w->roots[k][j];
         jaco_ik_general_start(T, angles, x);
         cost = jaco_ik_general_newton(T, x);
-        for (s = 0; s < 2 && cost > 5.0305488234464105e-24; ++s)
+        for (s = 0; s < 6 && cost > 5.0305488234464105e-24; ++s)
             cost = jaco_ik_general_newton(T, x);
         if (!(cost <= 1e-18)) continue;
         count += jaco_ik_general_add(x, count, q, valid, in_limits);

@@ -3721,7 +3721,7 @@ void manocha_canny_ik_general_start(const manocha_canny_real T[16], const manoch
     q[5] = atan2(-t40, t46);
 }
 
-void manocha_canny_ik_general_residual(const manocha_canny_real target[16], const manocha_canny_real q[MANOCHA_CANNY_DOF], manocha_canny_real e[6], manocha_canny_real J[6 * MANOCHA_CANNY_DOF])
+void manocha_canny_ik_general_residual(const manocha_canny_real target[16], const manocha_canny_real q[MANOCHA_CANNY_DOF], manocha_canny_real e[6], manocha_canny_real J[6 * 6])
 {
     /* 309 operations */
 
@@ -4500,7 +4500,7 @@ void manocha_canny_ik_branches(const manocha_canny_real T[16], manocha_canny_rea
         for (j = 0; j < 5; ++j) angles[j] = (manocha_canny_real)w->roots[k][j];
         manocha_canny_ik_general_start(T, angles, x);
         cost = manocha_canny_ik_general_newton(T, x);
-        for (s = 0; s < 2 && cost > 1.6e-23; ++s)
+        for (s = 0; s < 6 && cost > 1.6e-23; ++s)
             cost = manocha_canny_ik_general_newton(T, x);
         if (!(cost <= 1e-18)) continue;
         count += manocha_canny_ik_general_add(x, count, q, valid, in_limits);

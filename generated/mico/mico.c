@@ -3809,7 +3809,7 @@ void mico_ik_general_start(const mico_real T[16], const mico_real angles[5], mic
     q[5] = -1.7453292519943295 + ga3;
 }
 
-void mico_ik_general_residual(const mico_real target[16], const mico_real q[MICO_DOF], mico_real e[6], mico_real J[6 * MICO_DOF])
+void mico_ik_general_residual(const mico_real target[16], const mico_real q[MICO_DOF], mico_real e[6], mico_real J[6 * 6])
 {
     /* 324 operations */
 
@@ -4587,7 +4587,7 @@ void mico_ik_branches(const mico_real T[16], mico_real q[MICO_MAX_IK_SOLUTIONS *
         for (j = 0; j < 5; ++j) angles[j] = (mico_real)w->roots[k][j];
         mico_ik_general_start(T, angles, x);
         cost = mico_ik_general_newton(T, x);
-        for (s = 0; s < 2 && cost > 4.108431522004417e-24; ++s)
+        for (s = 0; s < 6 && cost > 4.108431522004417e-24; ++s)
             cost = mico_ik_general_newton(T, x);
         if (!(cost <= 1e-18)) continue;
         count += mico_ik_general_add(x, count, q, valid, in_limits);

@@ -102,13 +102,13 @@ mico_real mico_ik_numeric_step(const mico_real target[16], const mico_real q[MIC
  * Result: P: 42 x 9 row-major, element (r, c) at P[r * 9 + c]; Q: 14 x 8 row-major, element (r, c) at Q[r * 8 + c]. 332 operations. */
 void mico_ik_general_equations(const mico_real T[16], mico_real P[378], mico_real Q[112]);
 
-/* The configuration of one root's loop angles (a - shift, b, c, g, h; the free joint from the loop).
+/* The configuration of one root's loop angles (a - shift, b, c, g, h; the loop's free joint from the loop).
  * Result: q[i], i < 6. 88 operations. */
 void mico_ik_general_start(const mico_real T[16], const mico_real angles[5], mico_real q[MICO_DOF]);
 
-/* The pose error e at q (the position error and the rotation vector of R_target R^T, world frame) and the geometric Jacobian J: the Newton step of the solver's polish is q + J^-1 e.
+/* The pose error e at q (the position error and the rotation vector of R_target R^T, world frame) and the geometric Jacobian J of the six joints ik solves: the Newton step of the solver's polish is q + J^-1 e.
  * Result: e[i], i < 6; J: 6 x 6 row-major, element (r, c) at J[r * 6 + c]. 324 operations. */
-void mico_ik_general_residual(const mico_real target[16], const mico_real q[MICO_DOF], mico_real e[6], mico_real J[6 * MICO_DOF]);
+void mico_ik_general_residual(const mico_real target[16], const mico_real q[MICO_DOF], mico_real e[6], mico_real J[6 * 6]);
 
 /* Ik's form of q (revolute angles wrapped, or into the limits) and whether it is inside the joint limits.
  * Result: q[i], i < 6; returned as a scalar. 30 operations. */
@@ -144,7 +144,7 @@ void mico_ik_branches(const mico_real T[16], mico_real q[MICO_MAX_IK_SOLUTIONS *
  * the solutions outside the limits (in_limits 0).
  * Solver: general 6R: Raghavan & Roth's 14 equations, eliminated to a 12 x 12 quadratic
  * matrix polynomial in tan(q_k/2) solved as a 24 x 24 eigenproblem, back-substitution and
- * up to two Newton steps (jacgen/general6r.py).
+ * up to six Newton steps (jacgen/general6r.py).
  * Order: the real eigenvalues in the order the eigensolver gives them; a solution that
  * does not reach the target after the Newton steps (a spurious root) is skipped; each
  * solution once (equal to 1e-6 rad).

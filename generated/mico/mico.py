@@ -3399,7 +3399,7 @@ def ik_general_equations(T):
 
 
 def ik_general_start(T, angles):
-    """the configuration of one root's loop angles (a - shift, b, c, g, h; the free joint from the loop): (6 x 1), 88 operations."""
+    """the configuration of one root's loop angles (a - shift, b, c, g, h; the loop's free joint from the loop): (6 x 1), 88 operations."""
     xp, dtype, device, batch, (T, angles,) = _arguments(("T", T, (4, 4)), ("angles", angles, (5,)))
     T00 = T[..., 0, 0]
     T01 = T[..., 0, 1]
@@ -3455,7 +3455,7 @@ def ik_general_start(T, angles):
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def ik_general_residual(target, q):
-    """the pose error e at q (the position error and the rotation vector of R_target R^T, world frame) and the geometric Jacobian J: the Newton step of the solver's polish is q + J^-1 e: (6 x 1 and 6 x 6), 324 operations."""
+    """the pose error e at q (the position error and the rotation vector of R_target R^T, world frame) and the geometric Jacobian J of the six joints ik solves: the Newton step of the solver's polish is q + J^-1 e: (6 x 1 and 6 x 6), 324 operations."""
     xp, dtype, device, batch, (target, q,) = _arguments(("target", target, (4, 4)), ("q", q, (6,)))
     T00 = target[..., 0, 0]
     T01 = target[..., 0, 1]
@@ -4153,7 +4153,7 @@ IK_NEAREST_NOT_FINITE = 2
 
 _MONOMIALS = numpy.array([[0, 0, 0, 0, 4, 0, 0, 0, 0], [0, 0, 0, 2, 0, -2, 0, 0, 0], [0, 2, 0, 0, 0, 0, 0, -2, 0], [1, 0, -1, 0, 0, 0, -1, 0, 1], [0, 0, 0, 2, 0, 2, 0, 0, 0], [1, 0, 1, 0, 0, 0, -1, 0, -1], [0, 2, 0, 0, 0, 0, 0, 2, 0], [1, 0, -1, 0, 0, 0, 1, 0, -1], [1, 0, 1, 0, 0, 0, 1, 0, 1]], dtype=float)  # v_bc's entries in the monomials x_b^i x_c^j, at 3 i + j
 _ALONG_C, _ALONG_B = numpy.array([0, 1, 3, 4, 6, 7, 9, 10]), numpy.array([0, 1, 2, 3, 4, 5, 6, 7, 8])  # ratios x_c (step 1), x_b (step 3)
-_NEWTON_STEPS = 2
+_NEWTON_STEPS = 6
 _TOLERANCE_SQUARED = 1.00000000000000e-18  # |pose error|^2 of a solution after the Newton steps
 _CONVERGED_SQUARED = 4.10843152200442e-24  # |pose error|^2 at which the Newton steps stop
 
@@ -4226,7 +4226,7 @@ def _newton(targets, q):
 
 def _general_branches(T):
     """The eigenproblem's solutions at targets T (..., 4, 4): q (..., 16, DOF) and valid (..., 16),
-    each solution once (the first of equal ones), after up to 2 Newton steps within 1e-09."""
+    each solution once (the first of equal ones), after up to 6 Newton steps within 1e-09."""
     P, Q = ik_general_equations(T)
     finite = (numpy.isfinite(P).all(axis=(-2, -1)) & numpy.isfinite(Q).all(axis=(-2, -1)))[..., None, None]
     P, Q = numpy.where(finite, P, 0.0), numpy.where(finite, Q, 0.0)  # no root: a singular leading matrix
@@ -4251,7 +4251,7 @@ def ik_branches(T):
     target allows it, and whether it is inside the joint limits: q (..., MAX_IK_SOLUTIONS, DOF),
     valid and in_limits (..., MAX_IK_SOLUTIONS). The valid rows come first, in the order of the
     eigenvalues, each solution once; a root whose configuration does not reach the target to
-    1e-09 after up to 2 Newton steps is not valid; the rows that are not valid are 0. numpy
+    1e-09 after up to 6 Newton steps is not valid; the rows that are not valid are 0. numpy
     arrays only (numpy's eigensolver).
     """
     T = numpy.asarray(T, dtype=float)
@@ -4277,7 +4277,7 @@ def ik(T, limits=True):
     solutions outside the limits (in_limits 0).
     Solver: general 6R: Raghavan & Roth's 14 equations, eliminated to a 12 x 12 quadratic
     matrix polynomial in tan(q_k/2) solved as a 24 x 24 eigenproblem, back-substitution and
-    up to two Newton steps (jacgen/general6r.py).
+    up to six Newton steps (jacgen/general6r.py).
     Order: the real eigenvalues in the order the eigensolver gives them; a solution that
     does not reach the target after the Newton steps (a spurious root) is skipped; each
     solution once (equal to 1e-6 rad).

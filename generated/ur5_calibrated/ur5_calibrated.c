@@ -5231,7 +5231,7 @@ void ur5_calibrated_ik_general_start(const ur5_calibrated_real T[16], const ur5_
     q[5] = ga3;
 }
 
-void ur5_calibrated_ik_general_residual(const ur5_calibrated_real target[16], const ur5_calibrated_real q[UR5_CALIBRATED_DOF], ur5_calibrated_real e[6], ur5_calibrated_real J[6 * UR5_CALIBRATED_DOF])
+void ur5_calibrated_ik_general_residual(const ur5_calibrated_real target[16], const ur5_calibrated_real q[UR5_CALIBRATED_DOF], ur5_calibrated_real e[6], ur5_calibrated_real J[6 * 6])
 {
     /* 440 operations */
 
@@ -7176,8 +7176,8 @@ static ur5_calibrated_real ur5_calibrated_ik_general_newton(const ur5_calibrated
  * each must reach T to |e|^2 <= 4.8108237028810006e-24, at a solution of its own. Returns their number, or -1
  * when one does not, or when a subproblem of the closed form is within 0.01999998589200235 of a double root:
  * then the eigenproblem decides. */
-static int ur5_calibrated_ik_general_fast(const ur5_calibrated_real T[16], ur5_calibrated_real q[UR5_CALIBRATED_MAX_IK_SOLUTIONS * UR5_CALIBRATED_DOF], int valid[UR5_CALIBRATED_MAX_IK_SOLUTIONS],
-                               int in_limits[UR5_CALIBRATED_MAX_IK_SOLUTIONS])
+static int ur5_calibrated_ik_general_fast(const ur5_calibrated_real T[16], ur5_calibrated_real q[UR5_CALIBRATED_MAX_IK_SOLUTIONS * UR5_CALIBRATED_DOF],
+                               int valid[UR5_CALIBRATED_MAX_IK_SOLUTIONS], int in_limits[UR5_CALIBRATED_MAX_IK_SOLUTIONS])
 {
     ur5_calibrated_real starts[8 * UR5_CALIBRATED_DOF], x[UR5_CALIBRATED_DOF], cost;
     int nominal[8], count = 0, j, k, s;
@@ -7233,7 +7233,7 @@ void ur5_calibrated_ik_branches(const ur5_calibrated_real T[16], ur5_calibrated_
         for (j = 0; j < 5; ++j) angles[j] = (ur5_calibrated_real)w->roots[k][j];
         ur5_calibrated_ik_general_start(T, angles, x);
         cost = ur5_calibrated_ik_general_newton(T, x);
-        for (s = 0; s < 2 && cost > 4.8108237028810006e-24; ++s)
+        for (s = 0; s < 6 && cost > 4.8108237028810006e-24; ++s)
             cost = ur5_calibrated_ik_general_newton(T, x);
         if (!(cost <= 1e-18)) continue;
         count += ur5_calibrated_ik_general_add(x, count, q, valid, in_limits);

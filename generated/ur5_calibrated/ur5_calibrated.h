@@ -102,13 +102,13 @@ ur5_calibrated_real ur5_calibrated_ik_numeric_step(const ur5_calibrated_real tar
  * Result: P: 42 x 9 row-major, element (r, c) at P[r * 9 + c]; Q: 14 x 8 row-major, element (r, c) at Q[r * 8 + c]. 1362 operations. */
 void ur5_calibrated_ik_general_equations(const ur5_calibrated_real T[16], ur5_calibrated_real P[378], ur5_calibrated_real Q[112]);
 
-/* The configuration of one root's loop angles (a - shift, b, c, g, h; the free joint from the loop).
+/* The configuration of one root's loop angles (a - shift, b, c, g, h; the loop's free joint from the loop).
  * Result: q[i], i < 6. 146 operations. */
 void ur5_calibrated_ik_general_start(const ur5_calibrated_real T[16], const ur5_calibrated_real angles[5], ur5_calibrated_real q[UR5_CALIBRATED_DOF]);
 
-/* The pose error e at q (the position error and the rotation vector of R_target R^T, world frame) and the geometric Jacobian J: the Newton step of the solver's polish is q + J^-1 e.
+/* The pose error e at q (the position error and the rotation vector of R_target R^T, world frame) and the geometric Jacobian J of the six joints ik solves: the Newton step of the solver's polish is q + J^-1 e.
  * Result: e[i], i < 6; J: 6 x 6 row-major, element (r, c) at J[r * 6 + c]. 440 operations. */
-void ur5_calibrated_ik_general_residual(const ur5_calibrated_real target[16], const ur5_calibrated_real q[UR5_CALIBRATED_DOF], ur5_calibrated_real e[6], ur5_calibrated_real J[6 * UR5_CALIBRATED_DOF]);
+void ur5_calibrated_ik_general_residual(const ur5_calibrated_real target[16], const ur5_calibrated_real q[UR5_CALIBRATED_DOF], ur5_calibrated_real e[6], ur5_calibrated_real J[6 * 6]);
 
 /* Ik's form of q (revolute angles wrapped, or into the limits) and whether it is inside the joint limits.
  * Result: q[i], i < 6; returned as a scalar. 109 operations. */
@@ -132,7 +132,7 @@ int ur5_calibrated_ik_nearest(const ur5_calibrated_real T[16], const ur5_calibra
 
 /* Every solution of the general 6R solver: q[i * UR5_CALIBRATED_DOF + j], valid[i], in_limits[i] for
  * i < UR5_CALIBRATED_MAX_IK_SOLUTIONS, the valid rows first (each solution once, in the order of the
- * eigenvalues), revolute angles as ik returns them. The loop around the generated
+ * nominal arm's branches when the fast path decides, else of the eigenvalues), revolute angles as ik returns them. The loop around the generated
  * ur5_calibrated_ik_general_* functions and the eigenproblem kernel; no allocation, no recursion. */
 void ur5_calibrated_ik_branches(const ur5_calibrated_real T[16], ur5_calibrated_real q[UR5_CALIBRATED_MAX_IK_SOLUTIONS * UR5_CALIBRATED_DOF],
                      int valid[UR5_CALIBRATED_MAX_IK_SOLUTIONS], int in_limits[UR5_CALIBRATED_MAX_IK_SOLUTIONS]);
@@ -148,7 +148,7 @@ void ur5_calibrated_ik_branches(const ur5_calibrated_real T[16], ur5_calibrated_
  * also gives the solutions outside the limits (in_limits 0).
  * Solver: general 6R: Raghavan & Roth's 14 equations, eliminated to a 12 x 12 quadratic
  * matrix polynomial in tan(q_k/2) solved as a 24 x 24 eigenproblem, back-substitution and
- * up to two Newton steps (jacgen/general6r.py).
+ * up to six Newton steps (jacgen/general6r.py).
  * Order: the real eigenvalues in the order the eigensolver gives them; a solution that
  * does not reach the target after the Newton steps (a spurious root) is skipped; each
  * solution once (equal to 1e-6 rad).

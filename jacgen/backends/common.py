@@ -108,6 +108,7 @@ def ik_context(robot: Robot, generator: Generator, real: str, number: Callable, 
             "squared": number(sympy.Float(general6r.TOLERANCE[real] ** 2)),
             "converged_squared": number(sympy.Float((general6r.CONVERGED[real] * (1 + robot.reach)) ** 2)),
             "work_bytes": general6r.work_bytes(real),
+            "joints": form.joints,
             "fast": form.fast_path and {
                 "rows": form.fast_path.form.info.max_solutions, "steps": general6r.FAST_STEPS,
                 "band_squared": number(sympy.Float(form.fast_path.band ** 2)),

@@ -105,11 +105,12 @@ def entries(robot: Robot, generator: Generator, parameters: list[dict]) -> list[
         made.append(_entry(f.name, f.summary, inputs, outputs, returned, f.body.operation_count, simd, parameters))
     form = generator.closed_form
     target = (4, 4) if len(robot.task) == 6 else (len(robot.task),)
-    for loop in generator.loops:  # the general 6R solver: a pose, no free joint
+    for loop in generator.loops:  # the general 6R solver: a pose, and a 7R arm's free joint
         outputs = [_operand(o.name, o.shape, _kind(o)) for o in loop.outputs]
+        inputs = [_operand("T", (4, 4), "real")] + [_operand("q_free", (), "real")] * (form.free is not None)
         made.append(_entry(loop.name, "every branch of the general 6R ik, whether the target allows it and whether "
-                           "it is inside the joint limits", [_operand("T", (4, 4), "real")], outputs, None,
-                           LOOP_OPERATIONS[loop.name], False, parameters))
+                           "it is inside the joint limits", inputs, outputs, None, LOOP_OPERATIONS[loop.name], False,
+                           parameters))
     if generator.generates("ik_numeric"):
         defaults = differential.IK_NUMERIC_DEFAULTS
         inputs = [_operand("target", target, "real"), _operand("q0", (robot.dof,), "real"),

@@ -13,7 +13,7 @@ URDFS = {
     "ur10": ("ur10_robot.urdf", "base_link", "ee_link", "three_parallel"),
     "panda": ("panda.urdf", None, "panda_hand_tcp", "spherical_wrist_intersecting"),  # joint 7 free
     "kinova_jaco2": ("kinova.urdf", None, "j2s6s200_end_effector", "spherical_wrist_parallel"),
-    "xarm7": ("xarm7.urdf", None, None, None),
+    "xarm7": ("xarm7.urdf", None, None, "general_6r"),  # joint 7 (or 1) free
     "z1": ("z1.urdf", None, "link06", "three_parallel"),
     "tiago": ("tiago_no_hand.urdf", "base_footprint", "arm_tool_link", None),
     "pr2": ("pr2.urdf", "base_link", "r_gripper_palm_link", None),
@@ -21,7 +21,7 @@ URDFS = {
     "talos_arm": ("talos_left_arm.urdf", None, "gripper_left_base_link", "spherical_wrist_intersecting"),
     "pendulum": ("double_pendulum_continuous.urdf", None, None, None),
     "finger_edu": ("finger_edu.urdf", None, None, None),
-    "baxter": ("baxter.urdf", "base", "left_gripper_base_link", None),
+    "baxter": ("baxter.urdf", "base", "left_gripper_base_link", "general_6r"),  # joint 7 (or 1) free
 }
 
 
