@@ -1,11 +1,12 @@
 """7-axis arms without a special class (contract §2): the general 6R solver with joint 7 free,
 on the shipped Sawyer (offsets at every joint, from rtb's public DH table) and calibrated Panda
-(with the fast path from the nominal Panda). Every random configuration is recovered for its
+(with the fast path from the nominal Panda), and both with joint 1 free. Every random configuration is recovered for its
 free joint's value, every solution reaches its pose by the reference's fk, and no solution of a
 multi-start numeric search on the six other joints is missing; numpy and C."""
 
 import dataclasses
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -14,7 +15,7 @@ import sympy
 from jacgen import numeric_chain, reference
 from jacgen.expr import Value
 from jacgen.model import Model
-from jacgen.robot import Pose
+from jacgen.robot import Pose, parse_robot
 
 from conftest import generated_module, robot
 from support.general6r_arms import multi_start
@@ -83,3 +84,19 @@ def test_no_solution_of_a_multi_start_search_is_missing(name):
         assert len(theirs) >= 2 and len(ours) >= len(theirs)
         for t in theirs:
             assert min(np.abs(wrapped(t - o[:FREE])).max() for o in ours) < 1e-6
+
+
+@pytest.mark.parametrize("name", ARMS)  # standard and modified DH
+def test_joint_1_free_recovers_every_configuration(name, generated):
+    """With `ik: {free_joint: 1}` the free joint's row is part of the chain's head instead of
+    its tail: 500 random configurations, numpy, all recovered for their q1."""
+    text = Path(robot(name).source).read_text().replace("ik: {free_joint: 7}\n", "")
+    arm = parse_robot((text + "ik: {free_joint: 1}\n").encode(), f"{name}.yaml")
+    assert Model(arm).closed_form.free == 0
+    module = generated(arm, functions=("ik_branches",)).python
+    q = _configurations(500, 4)
+    poses = reference.fk(arm, q)
+    solutions, valid, _ = module.ik_branches(poses, q[:, 0])
+    recovered = ((np.abs(wrapped(solutions - q[:, None])).max(axis=-1) < 1e-8) & valid).any(axis=-1)
+    assert recovered.all()
+    assert np.abs(reference.fk(arm, solutions) - poses[:, None]).max(axis=(-2, -1))[valid].max() < 1e-9 * (1 + arm.reach)
