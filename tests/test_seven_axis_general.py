@@ -1,8 +1,9 @@
 """7-axis arms without a special class (contract §2): the general 6R solver with joint 7 free,
 on the shipped Sawyer (offsets at every joint, from rtb's public DH table) and calibrated Panda
-(with the fast path from the nominal Panda), and both with joint 1 free. Every random configuration is recovered for its
-free joint's value, every solution reaches its pose by the reference's fk, and no solution of a
-multi-start numeric search on the six other joints is missing; numpy and C."""
+(with the fast path from the nominal Panda), and both with joint 1 free. Every random
+configuration is recovered for its free joint's value, every solution reaches its pose by the
+reference's fk, and no solution of a multi-start numeric search on the six other joints is
+missing; numpy and C."""
 
 import dataclasses
 import math
