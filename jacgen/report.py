@@ -142,8 +142,8 @@ def ik_lines(model: Model) -> list[str]:
         plan = form.elimination
         free = "" if form.free is None else f", joint {form.free + 1} free (an input of ik, q_free)"
         return [f"general 6R{free}: {info.max_solutions} solutions at most ({structure.reason})",
-                f"{info.title}: {plan.equations.split.text(form.joints)}; the half angle shifted by {plan.shift:.6g} rad; "
-                f"median condition number {plan.condition:.2g} over random configurations",
+                f"{info.title}: {plan.equations.split.text(form.joints)}; the half angle shifted by "
+                f"{plan.shift:.6g} rad; median condition number {plan.condition:.2g} over random configurations",
                 _fast_path_line(model)]
     chain = structure.chain
     joints = ""
@@ -162,11 +162,11 @@ def _fast_path_line(model: Model) -> str:
                f"no special class within {structure.NEAR_TWIST} rad of its twists and "
                f"{structure.NEAR_LENGTH * 100:g} % of its reach of its lengths")
         return f"path: every target to the eigenproblem ({why})"
-    solver = fast.form.solver
-    return (f"path: calibrated fast path. Nearest special class: {solver}, with {', '.join(fast.nominal.snapped)} "
-            f"(the arms differ by {fast.position:.3g} {model.robot.length_unit} and {fast.rotation:.3g} rad at most). Its closed form, then up to "
-            f"{general6r.FAST_STEPS} Newton steps per branch on this arm; the eigenproblem decides when a branch "
-            f"does not converge, two reach one solution, or a subproblem is within {fast.margin:.2g} of a double root")
+    return (f"path: calibrated fast path. Nearest special class: {fast.form.solver}, with "
+            f"{', '.join(fast.nominal.snapped)} (the arms differ by {fast.position:.3g} {model.robot.length_unit} "
+            f"and {fast.rotation:.3g} rad at most). Its closed form, then up to {general6r.FAST_STEPS} Newton steps "
+            f"per branch on this arm; the eigenproblem decides when a branch does not converge, two reach one "
+            f"solution, or a subproblem is within {fast.margin:.2g} of a double root")
 
 
 def describe(model: Model) -> str:

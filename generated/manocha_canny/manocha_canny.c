@@ -297,16 +297,16 @@ struct jacgen_g6_work {
     double companion[JACGEN_EIG_MAX][JACGEN_EIG_MAX], square[12][12], re[JACGEN_EIG_MAX], im[JACGEN_EIG_MAX];
 };
 
-/* c0 M0 + c1 M1 + c2 M2 into out (12 x 12): M_e the coefficient of x^e of (1 + x^2) (S0 + s Ss
- * + c Sc) (free: S0, Ss, Sc; s = 2x / (1 + x^2), c = (1 - x^2) / (1 + x^2)), in the monomials
- * x_b^i x_c^j; rows 6..11 are rows 0..5 times x_b. */
-static void jacgen_g6_pencil(double free[3][6][9], double c0, double c1, double c2, double out[12][12]) {
+/* M_e into out (12 x 12): the coefficient of x^e of (1 + x^2) (S0 + s Ss + c Sc) (free: S0, Ss,
+ * Sc; s = 2x / (1 + x^2), c = (1 - x^2) / (1 + x^2)), in the monomials x_b^i x_c^j; rows 6..11 are
+ * rows 0..5 times x_b. */
+static void jacgen_g6_pencil(double free[3][6][9], int e, double out[12][12]) {
     for (int i = 0; i < 12; i++)
         for (int j = 0; j < 12; j++) out[i][j] = 0.0;
     for (int r = 0; r < 6; r++)
         for (int k = 0; k < 9; k++) {
             double s0 = free[0][r][k], ss = free[1][r][k], sc = free[2][r][k];
-            double coefficient = c0 * (s0 + sc) + c1 * 2.0 * ss + c2 * (s0 - sc);
+            double coefficient = e == 0 ? s0 + sc : e == 1 ? 2.0 * ss : s0 - sc;
             for (int j = 0; j < 9; j++) {
                 out[r][j] += coefficient * jacgen_g6_monomials[k][j];
                 out[r + 6][j + 3] += coefficient * jacgen_g6_monomials[k][j];
@@ -329,7 +329,7 @@ static int jacgen_general6r_roots(double p[3][14][9], double q_matrix[14][8],
         }
     /* companion [0 I; -M2^-1 M0  -M2^-1 M1] */
     double (*a)[JACGEN_EIG_MAX] = w->companion;
-    for (int e = 0; e < 3; e++) jacgen_g6_pencil(w->free, e == 0, e == 1, e == 2, w->m[e]);
+    for (int e = 0; e < 3; e++) jacgen_g6_pencil(w->free, e, w->m[e]);
     for (int i = 0; i < 12; i++)
         for (int j = 0; j < 12; j++) {
             w->square[i][j] = w->m[2][i][j];
@@ -4465,6 +4465,15 @@ static manocha_canny_real manocha_canny_ik_general_newton(const manocha_canny_re
     return cost;
 }
 
+/* |e|^2 at x after up to `steps` more Newton steps from x, at which it is `cost` (fewer once x has
+ * converged). */
+static manocha_canny_real manocha_canny_ik_general_polish(const manocha_canny_real T[16], manocha_canny_real x[MANOCHA_CANNY_DOF], manocha_canny_real cost, int steps)
+{
+    int s;
+    for (s = 0; s < steps && cost > 1.6e-23; ++s) cost = manocha_canny_ik_general_newton(T, x);
+    return cost;
+}
+
 /* The general 6R solver's working memory: 20720 bytes in this build. A local of
  * manocha_canny_ik_branches (on its stack) unless MANOCHA_CANNY_IK_STATIC_WORK is defined: then one static
  * object, and manocha_canny_ik_branches (with manocha_canny_ik and manocha_canny_ik_nearest) is not reentrant. */
@@ -4489,20 +4498,17 @@ void manocha_canny_ik_branches(const manocha_canny_real T[16], manocha_canny_rea
     struct manocha_canny_ik_work work, *w = &work;
 #endif
     manocha_canny_real angles[5], x[MANOCHA_CANNY_DOF];
-    int count = 0, found, i, j, k, s;
+    int count = 0, found, i, j, k;
     manocha_canny_ik_general_clear(q, valid, in_limits);
     manocha_canny_ik_general_equations(T, w->P, w->Q);
     for (i = 0; i < 378; ++i) w->p[i / 126][i / 9 % 14][i % 9] = (double)w->P[i];
     for (i = 0; i < 112; ++i) w->q[i / 8][i % 8] = (double)w->Q[i];
     found = jacgen_general6r_roots(w->p, w->q, w->roots, &w->kernel);
     for (k = 0; k < found && count < MANOCHA_CANNY_MAX_IK_SOLUTIONS; ++k) {
-        manocha_canny_real cost;
         for (j = 0; j < 5; ++j) angles[j] = (manocha_canny_real)w->roots[k][j];
         manocha_canny_ik_general_start(T, angles, x);
-        cost = manocha_canny_ik_general_newton(T, x);
-        for (s = 0; s < 6 && cost > 1.6e-23; ++s)
-            cost = manocha_canny_ik_general_newton(T, x);
-        if (!(cost <= 1e-18)) continue;
+        if (!(manocha_canny_ik_general_polish(T, x, manocha_canny_ik_general_newton(T, x), 6)
+              <= 1e-18)) continue;
         count += manocha_canny_ik_general_add(x, count, q, valid, in_limits);
     }
 }

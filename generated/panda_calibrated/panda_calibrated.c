@@ -297,16 +297,16 @@ struct jacgen_g6_work {
     double companion[JACGEN_EIG_MAX][JACGEN_EIG_MAX], square[12][12], re[JACGEN_EIG_MAX], im[JACGEN_EIG_MAX];
 };
 
-/* c0 M0 + c1 M1 + c2 M2 into out (12 x 12): M_e the coefficient of x^e of (1 + x^2) (S0 + s Ss
- * + c Sc) (free: S0, Ss, Sc; s = 2x / (1 + x^2), c = (1 - x^2) / (1 + x^2)), in the monomials
- * x_b^i x_c^j; rows 6..11 are rows 0..5 times x_b. */
-static void jacgen_g6_pencil(double free[3][6][9], double c0, double c1, double c2, double out[12][12]) {
+/* M_e into out (12 x 12): the coefficient of x^e of (1 + x^2) (S0 + s Ss + c Sc) (free: S0, Ss,
+ * Sc; s = 2x / (1 + x^2), c = (1 - x^2) / (1 + x^2)), in the monomials x_b^i x_c^j; rows 6..11 are
+ * rows 0..5 times x_b. */
+static void jacgen_g6_pencil(double free[3][6][9], int e, double out[12][12]) {
     for (int i = 0; i < 12; i++)
         for (int j = 0; j < 12; j++) out[i][j] = 0.0;
     for (int r = 0; r < 6; r++)
         for (int k = 0; k < 9; k++) {
             double s0 = free[0][r][k], ss = free[1][r][k], sc = free[2][r][k];
-            double coefficient = c0 * (s0 + sc) + c1 * 2.0 * ss + c2 * (s0 - sc);
+            double coefficient = e == 0 ? s0 + sc : e == 1 ? 2.0 * ss : s0 - sc;
             for (int j = 0; j < 9; j++) {
                 out[r][j] += coefficient * jacgen_g6_monomials[k][j];
                 out[r + 6][j + 3] += coefficient * jacgen_g6_monomials[k][j];
@@ -329,7 +329,7 @@ static int jacgen_general6r_roots(double p[3][14][9], double q_matrix[14][8],
         }
     /* companion [0 I; -M2^-1 M0  -M2^-1 M1] */
     double (*a)[JACGEN_EIG_MAX] = w->companion;
-    for (int e = 0; e < 3; e++) jacgen_g6_pencil(w->free, e == 0, e == 1, e == 2, w->m[e]);
+    for (int e = 0; e < 3; e++) jacgen_g6_pencil(w->free, e, w->m[e]);
     for (int i = 0; i < 12; i++)
         for (int j = 0; j < 12; j++) {
             w->square[i][j] = w->m[2][i][j];
@@ -7852,6 +7852,15 @@ static panda_calibrated_real panda_calibrated_ik_general_newton(const panda_cali
     return cost;
 }
 
+/* |e|^2 at x after up to `steps` more Newton steps from x, at which it is `cost` (fewer once x has
+ * converged). */
+static panda_calibrated_real panda_calibrated_ik_general_polish(const panda_calibrated_real T[16], panda_calibrated_real x[PANDA_CALIBRATED_DOF], panda_calibrated_real cost, int steps)
+{
+    int s;
+    for (s = 0; s < steps && cost > 6.235108880399999e-24; ++s) cost = panda_calibrated_ik_general_newton(T, x);
+    return cost;
+}
+
 /* The fast path of a calibrated arm: the nominal arm's closed form at T, then up to 4 Newton steps
  * on this arm from each branch that its target allows or that misses T by at most |e|^2 = 7.425950871674113e-07;
  * each must reach T to |e|^2 <= 6.235108880399999e-24, at a solution of its own. Returns their number, or -1
@@ -7861,7 +7870,7 @@ static int panda_calibrated_ik_general_fast(const panda_calibrated_real T[16], p
                                int valid[PANDA_CALIBRATED_MAX_IK_SOLUTIONS], int in_limits[PANDA_CALIBRATED_MAX_IK_SOLUTIONS])
 {
     panda_calibrated_real starts[8 * PANDA_CALIBRATED_DOF], x[PANDA_CALIBRATED_DOF], cost;
-    int nominal[8], count = 0, j, k, s;
+    int nominal[8], count = 0, j, k;
     panda_calibrated_ik_general_clear(q, valid, in_limits);
     if (!(panda_calibrated_ik_general_nominal(T, q_free, starts, nominal) >= 0.0019192246967665919)) return -1;
     for (k = 0; k < 8; ++k) {
@@ -7869,9 +7878,7 @@ static int panda_calibrated_ik_general_fast(const panda_calibrated_real T[16], p
         cost = panda_calibrated_ik_general_newton(T, x);
         if (!(cost >= 0)) return -1; /* T not finite */
         if (!nominal[k] && cost > 7.425950871674113e-07) continue; /* no solution near this branch */
-        for (s = 0; s < 4 && cost > 6.235108880399999e-24; ++s)
-            cost = panda_calibrated_ik_general_newton(T, x);
-        if (!(cost <= 6.235108880399999e-24)) return -1;
+        if (!(panda_calibrated_ik_general_polish(T, x, cost, 4) <= 6.235108880399999e-24)) return -1;
         if (!panda_calibrated_ik_general_add(x, count, q, valid, in_limits)) return -1;
         ++count;
     }
@@ -7902,7 +7909,7 @@ void panda_calibrated_ik_branches(const panda_calibrated_real T[16], panda_calib
     struct panda_calibrated_ik_work work, *w = &work;
 #endif
     panda_calibrated_real angles[5], x[PANDA_CALIBRATED_DOF];
-    int count = 0, found, i, j, k, s;
+    int count = 0, found, i, j, k;
     if (panda_calibrated_ik_general_fast(T, q_free, q, valid, in_limits) >= 0) return;
     panda_calibrated_ik_general_clear(q, valid, in_limits);
     panda_calibrated_ik_general_equations(T, q_free, w->P, w->Q);
@@ -7910,13 +7917,10 @@ void panda_calibrated_ik_branches(const panda_calibrated_real T[16], panda_calib
     for (i = 0; i < 112; ++i) w->q[i / 8][i % 8] = (double)w->Q[i];
     found = jacgen_general6r_roots(w->p, w->q, w->roots, &w->kernel);
     for (k = 0; k < found && count < PANDA_CALIBRATED_MAX_IK_SOLUTIONS; ++k) {
-        panda_calibrated_real cost;
         for (j = 0; j < 5; ++j) angles[j] = (panda_calibrated_real)w->roots[k][j];
         panda_calibrated_ik_general_start(T, q_free, angles, x);
-        cost = panda_calibrated_ik_general_newton(T, x);
-        for (s = 0; s < 6 && cost > 6.235108880399999e-24; ++s)
-            cost = panda_calibrated_ik_general_newton(T, x);
-        if (!(cost <= 1e-18)) continue;
+        if (!(panda_calibrated_ik_general_polish(T, x, panda_calibrated_ik_general_newton(T, x), 6)
+              <= 1e-18)) continue;
         count += panda_calibrated_ik_general_add(x, count, q, valid, in_limits);
     }
 }

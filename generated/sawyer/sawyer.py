@@ -4873,6 +4873,14 @@ def _newton(targets, q):
     return cost, numpy.where((usable & ~(cost <= _CONVERGED_SQUARED))[..., None], q + step, q)
 
 
+def _polish(targets, q, cost, steps):
+    """|e|^2 and q after up to `steps` more Newton steps from q, at which it is `cost` (none
+    once q has converged)."""
+    for _ in range(steps):
+        cost, q = _newton(targets, q)
+    return cost, q
+
+
 def _general_branches(T, q_free):
     """The eigenproblem's solutions at targets T (..., 4, 4): q (..., 16, DOF) and valid (..., 16),
     each solution once (the first of equal ones), after up to 6 Newton steps within 1e-09."""
@@ -4883,8 +4891,7 @@ def _general_branches(T, q_free):
     targets = T[..., None, :, :]
     q = ik_general_start(targets, q_free[..., None], angles)
     cost, q = _newton(targets, q)
-    for _ in range(_NEWTON_STEPS):
-        cost, q = _newton(targets, q)
+    cost, q = _polish(targets, q, cost, _NEWTON_STEPS)
     return q, _first_of_equals(q, real & (cost <= _TOLERANCE_SQUARED))
 
 

@@ -6783,6 +6783,14 @@ def _newton(targets, q):
     return cost, numpy.where((usable & ~(cost <= _CONVERGED_SQUARED))[..., None], q + step, q)
 
 
+def _polish(targets, q, cost, steps):
+    """|e|^2 and q after up to `steps` more Newton steps from q, at which it is `cost` (none
+    once q has converged)."""
+    for _ in range(steps):
+        cost, q = _newton(targets, q)
+    return cost, q
+
+
 def _general_branches(T):
     """The eigenproblem's solutions at targets T (..., 4, 4): q (..., 16, DOF) and valid (..., 16),
     each solution once (the first of equal ones), after up to 6 Newton steps within 1e-09."""
@@ -6793,8 +6801,7 @@ def _general_branches(T):
     targets = T[..., None, :, :]
     q = ik_general_start(targets, angles)
     cost, q = _newton(targets, q)
-    for _ in range(_NEWTON_STEPS):
-        cost, q = _newton(targets, q)
+    cost, q = _polish(targets, q, cost, _NEWTON_STEPS)
     return q, _first_of_equals(q, real & (cost <= _TOLERANCE_SQUARED))
 
 
@@ -6815,8 +6822,7 @@ def _fast_branches(T):
     q, nominal, margin = ik_general_nominal(T)
     cost, q = _newton(targets, q)
     polished = nominal | (cost <= 4.03681162048258e-5)
-    for _ in range(4):
-        cost, q = _newton(targets, q)
+    cost, q = _polish(targets, q, cost, 4)
     converged = polished & (cost <= _CONVERGED_SQUARED)
     valid = _first_of_equals(q, converged)
     decided = (margin >= 0.0199999858920023) & (converged == polished).all(axis=-1) & (valid == converged).all(axis=-1)
