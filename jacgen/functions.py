@@ -195,9 +195,9 @@ class Generator:
             free_angle = None if form.free is None else self.q[form.free]
             with distribute(False):
                 q, valid, _ = ik.branches(fast.nominal.robot, fast.form, sp, target.symbols, free_angle)
-                margin = sympy.Abs(sp.margins[0])
+                margin = sp.margins[0]
                 for other in sp.margins[1:]:
-                    margin = self.name(select(AtMost(margin, sympy.Abs(other)), margin, sympy.Abs(other)))
+                    margin = self.name(select(AtMost(margin, other), margin, other))
             parts.append(self.function("ik_general_nominal", "the fast path's starting points: every branch of the "
                                        "nearest special class's closed form (the nominal arm's), whether its target "
                                        "allows it, and the least margin of its subproblems", ("q", q), ("valid", valid),

@@ -37,11 +37,13 @@ def _random_poses(arm, count: int, seed: int) -> np.ndarray:
 
 
 def _near_singular_poses(arm, count: int, seed: int) -> np.ndarray:
-    """Poses with the wrist within 1e-3 rad of singular (q5 near 0 or pi; axes 4 and 6 parallel)."""
+    """`count` poses per joint with that joint within 1e-3 rad of 0 or pi (for these arms the
+    wrist's, the elbow's and the shoulder's singular configurations are among them)."""
     rng = np.random.default_rng(seed)
-    q = rng.uniform(-math.pi, math.pi, (count, 6))
-    q[:, 4] = rng.choice([0.0, math.pi], count) + rng.uniform(-1e-3, 1e-3, count)
-    return reference.fk(arm, q)
+    q = rng.uniform(-math.pi, math.pi, (6, count, 6))
+    for joint in range(6):
+        q[joint, :, joint] = rng.choice([0.0, math.pi], count) + rng.uniform(-1e-3, 1e-3, count)
+    return reference.fk(arm, q.reshape(-1, 6))
 
 
 def _differences(ours, valid, theirs, valid_theirs) -> tuple[int, int]:
@@ -76,12 +78,12 @@ def test_ur5_calibrated_snaps_its_two_twists_and_the_wrist_offset():
 
 @pytest.mark.parametrize("name", ARMS)
 def test_numpy_finds_what_the_eigenproblem_finds(name, generated):
-    """10^4 random poses and 10^3 poses with a near-singular wrist: 0 missed, 0 extra; every
-    solution reaches its pose to 1e-9 (1 + reach); the fast path decides most random poses."""
+    """10^4 random poses and 6 x 500 near-singular ones: 0 missed, 0 extra; every solution
+    reaches its pose to 1e-9 (1 + reach); the fast path decides most random poses."""
     arm = ARMS[name]
     fast = generated(arm, functions=("ik_branches",)).python
     general = generated(_eigenproblem_only(arm), functions=("ik_branches",)).python
-    for poses, decided_at_least in ((_random_poses(arm, 10_000, 1), 0.7), (_near_singular_poses(arm, 1000, 2), 0.0)):
+    for poses, decided_at_least in ((_random_poses(arm, 10_000, 1), 0.5), (_near_singular_poses(arm, 500, 2), 0.0)):
         q, valid, _ = fast.ik_branches(poses)
         q_general, valid_general, _ = general.ik_branches(poses)
         assert _differences(q, valid, q_general, valid_general) == (0, 0)
@@ -95,7 +97,7 @@ def test_c_finds_what_its_eigenproblem_finds(name, generated):
     arm = ARMS[name]
     fast = generated(arm, ("c",), functions=("ik_branches",)).library()
     general = generated(_eigenproblem_only(arm), ("c",), functions=("ik_branches",)).library()
-    poses = np.concatenate([_random_poses(arm, 1500, 3), _near_singular_poses(arm, 500, 4)])
+    poses = np.concatenate([_random_poses(arm, 1400, 3), _near_singular_poses(arm, 100, 4)])
     ours, theirs = zip(*([fast.ik_branches(T, 16)[:2], general.ik_branches(T, 16)[:2]] for T in poses))
     q, valid = map(np.array, zip(*ours))
     assert _differences(q, valid, *map(np.array, zip(*theirs))) == (0, 0)
