@@ -56,7 +56,8 @@ import sympy  # noqa: E402
 
 from jacgen import reference  # noqa: E402
 from jacgen.compile import c_compiler, compile_shared  # noqa: E402
-from jacgen.render import render_robot, write_files  # noqa: E402
+from jacgen.files import write_files  # noqa: E402
+from jacgen.render import render_robot  # noqa: E402
 from jacgen.robot import load_robot  # noqa: E402
 
 # What benches take from tests/: {name: the module of tests/ that defines it}.

@@ -6,12 +6,22 @@ Scripting entry points::
     robot = jacgen.load_robot("robots/puma560.yaml")
     kin = jacgen.Kinematics(robot)          # readable sympy matrices: kin.fk, kin.jacobian, ...
     files = jacgen.render_robot(robot)      # {"puma560/puma560.py": text, ...}
+
+The names are imported when first used, so that `jacgen --help` and a cached
+`jacgen generate --check` do not import sympy.
 """
 
-from .errors import JacgenError, RobotFileError
-from .kinematics import Kinematics
-from .render import render_robot
-from .robot import Robot, load_robot
+from importlib import import_module
+
 from .version import __version__
 
+_HOMES = {"JacgenError": "errors", "RobotFileError": "errors", "Kinematics": "kinematics",
+          "render_robot": "render", "Robot": "robot", "load_robot": "robot"}
+
 __all__ = ["JacgenError", "Kinematics", "Robot", "RobotFileError", "load_robot", "render_robot", "__version__"]
+
+
+def __getattr__(name: str):
+    if name not in _HOMES:
+        raise AttributeError(f"module 'jacgen' has no attribute {name!r}")
+    return getattr(import_module(f".{_HOMES[name]}", __name__), name)

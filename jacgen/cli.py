@@ -5,20 +5,17 @@ import sys
 from pathlib import Path
 
 import click
-import numpy as np
 
 from . import budget
-from .version import __version__
+from .backends import DEFAULT_LANGUAGES, LANGUAGES
 from .errors import JacgenError
-from .catalogue import with_callees
-from .model import Model
-from .backends import BACKENDS, DEFAULT_LANGUAGES
+from .files import stale_files, write_files
 from .parallel import usable_cpus
-from .render import render_robots, stale_files, write_files
-from .compare_urdf import DEFAULT_TOLERANCE, compare_urdf, comparison_lines, first_difference
-from .drawing import default_configurations, draw
-from .report import describe
-from .robot import load_robot
+from .tolerances import URDF_AGREEMENT
+from .version import __version__
+
+# Each command imports what it needs when it runs: `jacgen --help` and a cached
+# `generate --check` start without sympy, casadi or matplotlib.
 
 robot_files = click.argument("robot_files", nargs=-1, required=True, type=click.Path(dir_okay=False))
 jobs_option = click.option("-j", "--jobs", default=usable_cpus(), show_default="the processors usable",
@@ -27,10 +24,10 @@ jobs_option = click.option("-j", "--jobs", default=usable_cpus(), show_default="
 
 def _languages(ctx, param, value: str) -> tuple[str, ...]:
     names = tuple(dict.fromkeys(part.strip() for part in value.split(",") if part.strip()))
-    unknown = [name for name in names if name not in BACKENDS]
+    unknown = [name for name in names if name not in LANGUAGES]
     if unknown or not names:
         what = f"unknown language {unknown[0]!r}; " if unknown else ""
-        raise click.BadParameter(f"{what}expected a comma-separated list of {', '.join(BACKENDS)}")
+        raise click.BadParameter(f"{what}expected a comma-separated list of {', '.join(LANGUAGES)}")
     return names
 
 
@@ -40,6 +37,8 @@ def _functions(ctx, param, value: str | None) -> tuple[str, ...] | None:
     names = tuple(dict.fromkeys(part.strip() for part in value.split(",") if part.strip()))
     if not names:
         raise click.BadParameter("expected a comma-separated list of function names")
+    from .catalogue import with_callees
+
     try:
         with_callees(names)
     except ValueError as error:
@@ -120,17 +119,36 @@ def main(debug):
               help="Safety net on the exact singularity analysis of each robot, whose work is "
                    "bounded by size limits anyway: past it the numeric rank determinant stands as the "
                    "condition, with a warning (0: no limit).")
+@click.option("--no-cache", "no_cache", is_flag=True,
+              help="Render every robot, even one whose file, options and jacgen are unchanged since the files "
+                   "were last written (cache: $XDG_CACHE_HOME/jacgen).")
 @jobs_option
-def generate(robot_files, output, languages, real, check, functions, budget_seconds, jobs):
+def generate(robot_files, output, languages, real, check, functions, budget_seconds, no_cache, jobs):
     """Generate code for each ROBOT_FILE."""
     if real == "float" and {"c", "native"} <= set(languages):
         raise click.UsageError("--lang native writes NAME.c in double beside NAME_float.c; with --real float, "
                                "write the float C of --lang c into another folder")
-    budget.set_seconds(budget_seconds)
-    robots = [load_robot(path) for path in dict.fromkeys(robot_files)]  # validate all before writing any
-    _check_unique_names(robots)
-    files = render_robots(robots, languages, real, functions, jobs, lambda robot: _progress(f"generated {robot.name}"))
+    from . import cache
+
     folder = Path(output)
+    options = {"languages": list(languages), "real": real, "functions": functions and list(functions),
+               "budget": budget_seconds}
+    paths = list(dict.fromkeys(Path(path) for path in robot_files))
+    keys = {path: None if no_cache else _cache_key(path, options) for path in paths}
+    cached = {path: entry for path in paths if keys[path] and (entry := cache.hit(keys[path], folder))}
+    robots, files = [], {}
+    if len(cached) < len(paths):
+        from .render import render_robots
+        from .robot import load_robot
+
+        budget.set_seconds(budget_seconds)
+        robots = [load_robot(path) for path in paths if path not in cached]  # validate all before writing any
+    _check_unique_names([(robot.name, robot.source) for robot in robots] +
+                        [(entry["robot"], str(path)) for path, entry in cached.items()])
+    if robots:
+        files = render_robots(robots, languages, real, functions, jobs,
+                              lambda robot: _progress(f"generated {robot.name}"))
+    unchanged = sum(len(entry["files"]) for entry in cached.values())
     if check:
         diffs = stale_files(files, folder)
         for diff in diffs:
@@ -138,16 +156,41 @@ def generate(robot_files, output, languages, real, check, functions, budget_seco
         if diffs:
             click.echo(f"jacgen: {len(diffs)} generated file(s) out of date in {folder}", err=True)
             sys.exit(1)
-        click.echo(f"jacgen: {len(files)} generated file(s) up to date", err=True)
+        _remember(robots, files, keys)
+        click.echo(f"jacgen: {len(files) + unchanged} generated file(s) up to date", err=True)
         return
     written = write_files(files, folder)
-    click.echo(f"jacgen: wrote {len(written)} file(s), {len(files) - len(written)} unchanged, in {folder}", err=True)
+    _remember(robots, files, keys)
+    click.echo(f"jacgen: wrote {len(written)} file(s), {len(files) + unchanged - len(written)} unchanged, in {folder}",
+               err=True)
+
+
+def _cache_key(path: Path, options: dict) -> str | None:
+    """The robot file's cache key; None when it cannot be read (load_robot then says why)."""
+    from . import cache
+
+    try:
+        return cache.key(path, options)
+    except OSError:
+        return None
+
+
+def _remember(robots: list, files: dict[str, str], keys: dict[Path, str | None]) -> None:
+    """Records, per robot rendered, the files it has on disk now (cache.store)."""
+    from . import cache
+
+    for robot in robots:
+        if key := keys[Path(robot.source)]:
+            cache.store(key, robot.name, {relative: text for relative, text in files.items()
+                                          if relative.startswith(f"{robot.name}/")})
 
 
 @main.command()
 @robot_files
 def validate(robot_files):
     """Check robot files only."""
+    from .robot import load_robot
+
     for path in robot_files:
         robot = load_robot(path)
         click.echo(f"{path}: ok ({robot.name}, {robot.dof} joints)")
@@ -177,21 +220,31 @@ def _configuration(ctx, param, value: str | None):
               help="Compare the joint axes and tool pose with a URDF's chain; exit 1 where they differ.")
 @click.option("--base", default=None, metavar="LINK", help="--compare-urdf: first link (default: the root).")
 @click.option("--tip", default=None, metavar="LINK", help="--compare-urdf: last link (default: the one leaf).")
-@click.option("--tolerance", default=DEFAULT_TOLERANCE, show_default=True, type=click.FloatRange(min=0),
+@click.option("--tolerance", default=URDF_AGREEMENT, show_default=True, type=click.FloatRange(min=0),
               help="--compare-urdf: largest difference (radians, robot's length unit) that agrees.")
 def show(robot_file, plot_file, q, urdf_file, base, tip, tolerance):
     """Describe a robot in words (DH table, task, singularities, inverse kinematics), draw it,
     compare it with a URDF."""
+    from .model import Model
+    from .report import describe
+    from .robot import load_robot
+
     robot = load_robot(robot_file)
     if q is not None and len(q) != robot.dof:
         raise JacgenError(f"--q: expected {robot.dof} values (one per joint of {robot.name}), got {len(q)}")
     click.echo(describe(Model(robot)))
     if plot_file:
+        import numpy as np
+
+        from .drawing import default_configurations, draw
+
         drawing = draw(robot, [np.array(q)] if q is not None else default_configurations(robot),
                        Path(plot_file).suffix[1:].lower() or "png")
         write_files({Path(plot_file).name: drawing}, Path(plot_file).parent)
         click.echo(f"jacgen: wrote {plot_file}", err=True)
     if urdf_file:
+        from .compare_urdf import compare_urdf, comparison_lines, first_difference
+
         comparison = compare_urdf(robot, urdf_file, base, tip)
         click.echo("\n" + "\n".join(comparison_lines(robot, urdf_file, comparison, tolerance)))
         if first_difference(comparison, tolerance) is not None:
@@ -215,14 +268,15 @@ def show(robot_file, plot_file, q, urdf_file, base, tip, tolerance):
 @jobs_option
 def verify(robot_files, samples, seed, target, sources, native, jobs):
     """Compare every generated function of every backend with the numpy reference."""
-    from .verify import format_table, verify as verify_robots  # numpy/ctypes only when verifying
+    from .robot import load_robot
+    from .verify import format_table, verify as verify_robots
 
     if sources and not target:
         raise click.UsageError("--sources needs --target")
     if native and target:
         raise click.UsageError("--native checks the host's native module; --target the emulated target's C")
     robots = [load_robot(path) for path in dict.fromkeys(robot_files)]
-    _check_unique_names(robots)
+    _check_unique_names([(robot.name, robot.source) for robot in robots])
     emulators = []
     results = verify_robots(robots, samples, seed, _progress, target=target, sources=sources and Path(sources),
                             emulators=emulators, jobs=jobs, native=native)
@@ -265,14 +319,15 @@ def import_urdf_command(urdf_file, base, tip, convention, name, task, snap, outp
                err=True)
 
 
-def _check_unique_names(robots) -> None:
-    """Each robot writes NAME/: two files naming the same robot would overwrite each other."""
+def _check_unique_names(robots: list[tuple[str, str]]) -> None:
+    """Each robot (name, source) writes NAME/: two files naming the same robot would overwrite
+    each other."""
     first = {}
-    for robot in robots:
-        other = first.setdefault(robot.name, robot)
-        if other is not robot:
-            raise JacgenError(f"{robot.source}: name: robot name {robot.name!r} is already used by "
-                              f"{other.source} (each robot is written to its own folder NAME/)")
+    for name, source in robots:
+        other = first.setdefault(name, source)
+        if other != source:
+            raise JacgenError(f"{source}: name: robot name {name!r} is already used by "
+                              f"{other} (each robot is written to its own folder NAME/)")
 
 
 def _progress(message: str) -> None:

@@ -19,7 +19,6 @@ from .robot import Robot
 from .urdf import MOVABLE, Snapper, joint_axes, read_chain
 
 CONFIGURATIONS = 50  # the zero configuration and 49 random ones within the ranges
-DEFAULT_TOLERANCE = 1e-9  # in radians and the robot's length unit
 
 
 @dataclass(frozen=True)

@@ -11,11 +11,12 @@ import multiprocessing
 import os
 import sys
 from concurrent.futures import ProcessPoolExecutor, as_completed
-from typing import Callable, TypeVar
+from typing import TYPE_CHECKING, Callable, TypeVar
 
 from . import budget
-from .model import Model
-from .robot import Robot
+
+if TYPE_CHECKING:  # the command line imports this module to start: sympy comes with the work
+    from .robot import Robot
 
 T = TypeVar("T")
 THREADED_LIBRARIES = ("jax", "torch", "tensorflow")  # loaded, they make forking this process unsafe
@@ -26,8 +27,8 @@ def usable_cpus() -> int:
     return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1
 
 
-def for_each_robot(work: Callable[..., T], robots: list[Robot], jobs: int, arguments: tuple = (),
-                   done: Callable[[Robot], None] = lambda robot: None) -> list[T]:
+def for_each_robot(work: Callable[..., T], robots: "list[Robot]", jobs: int, arguments: tuple = (),
+                   done: "Callable[[Robot], None]" = lambda robot: None) -> list[T]:
     """[work(robot, *arguments) for robot in robots]: in this process when jobs is 1 (or there
     is one robot), else in up to `jobs` processes. `work` is a module-level function (it is
     sent by name). An exception in a worker is raised here, after cancelling what has not
@@ -71,13 +72,15 @@ def _context(work: Callable) -> multiprocessing.context.BaseContext:
     return context
 
 
-def _run(work: Callable[..., T], robot: Robot, arguments: tuple, seconds: float | None) -> T:
+def _run(work: Callable[..., T], robot: "Robot", arguments: tuple, seconds: float | None) -> T:
     """work in a worker, under the parent's budget."""
     budget.set_seconds(seconds)
     return work(robot, *arguments)
 
 
-def _expected_cost(robot: Robot) -> tuple[bool, int]:
+def _expected_cost(robot: "Robot") -> tuple[bool, int]:
     """What orders robots by generation time, roughly: the general 6R solver is the longest,
     then the more joints the longer."""
+    from .model import Model
+
     return Model(robot).structure.solver == "general_6r", robot.dof

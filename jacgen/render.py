@@ -1,35 +1,27 @@
-"""Templates -> files: render every output of a robot in memory, then write or compare.
+"""Templates -> files: render every output of a robot in memory, as {relative path: text}.
 
-Rendering to `{relative path: text}` first lets `generate` and `generate --check` share
-one path, and lets writes be atomic. The "generated, do not edit" header is added here,
+Rendering in memory first lets `generate` and `generate --check` share one path, and lets
+writes be atomic (`files.py`). The "generated, do not edit" header is added here,
 not by each template, and holds no date, host or absolute path.
 """
 
-import difflib
-import os
-import tempfile
 from pathlib import Path
 from typing import Callable
 
 import jinja2
 
-from .backends import BACKENDS, DEFAULT_LANGUAGES
+from . import sources
+from .backends import DEFAULT_LANGUAGES, backend
 from .errors import JacgenError
 from .functions import Generator
 from .parallel import for_each_robot
 from .robot import Robot
 from .version import __version__
 
-TEMPLATE_DIR_CANDIDATES = (
-    Path(__file__).resolve().parent.parent / "templates",  # a source checkout
-    Path(__file__).resolve().parent / "templates",  # an installed package
-)
-
 
 def environment() -> jinja2.Environment:
-    folder = next(path for path in TEMPLATE_DIR_CANDIDATES if path.is_dir())
     return jinja2.Environment(
-        loader=jinja2.FileSystemLoader(str(folder)),
+        loader=jinja2.FileSystemLoader(str(sources.template_folder())),
         undefined=jinja2.StrictUndefined,
         trim_blocks=True,
         lstrip_blocks=True,
@@ -60,9 +52,9 @@ def render_robot(robot: Robot, languages=DEFAULT_LANGUAGES, real: str = "double"
         raise JacgenError(f"{robot.source}: robot {robot.name} has no {unavailable[0]}")
     files = {}
     for name in languages:
-        backend = BACKENDS[name]
-        context = backend.context(robot, generator, backend.printer(real) if backend.printer else None, real)
-        for template, pattern, *part in backend.templates:
+        language = backend(name)
+        context = language.context(robot, generator, language.printer(real) if language.printer else None, real)
+        for template, pattern, *part in language.templates:
             text = templates.get_template(template).render(context[part[0]] if part else context)
             path = f"{robot.name}/{pattern.format(name=robot.name)}"
             files[path] = COMMENTS[Path(path).suffix].format(header(robot)) + "\n" + text
@@ -79,47 +71,3 @@ def render_robots(robots: list[Robot], languages, real: str, functions, jobs: in
 
 def _render(robot: Robot, languages, real: str, functions) -> dict[str, str]:
     return render_robot(robot, languages, real, functions=functions)
-
-
-def stale_files(files: dict[str, str], folder: Path) -> list[str]:
-    """Unified diffs of the files that differ from what is on disk (missing counts as empty)."""
-    diffs = []
-    for relative, text in sorted(files.items()):
-        target = folder / relative
-        current = target.read_text(encoding="utf-8") if target.is_file() else ""
-        if current != text:
-            diffs.append("".join(difflib.unified_diff(
-                current.splitlines(keepends=True), text.splitlines(keepends=True),
-                fromfile=f"a/{relative}", tofile=f"b/{relative}")))
-    return diffs
-
-
-def write_files(files: dict[str, str | bytes], folder: Path) -> list[Path]:
-    """Write each file atomically (temporary file + rename); unchanged files are not touched.
-    Text is written as UTF-8 with \\n line ends, bytes as they are (a drawing)."""
-    written = []
-    for relative, content in sorted(files.items()):
-        target = folder / relative
-        data = content if isinstance(content, bytes) else content.encode("utf-8")
-        if target.is_file() and target.read_bytes() == data:
-            continue
-        target.parent.mkdir(parents=True, exist_ok=True)
-        handle, temporary = tempfile.mkstemp(dir=target.parent, prefix=f".{target.name}.", suffix=".tmp")
-        try:
-            with os.fdopen(handle, "wb") as stream:
-                stream.write(data)
-            # mkstemp makes the file private (0600): give it the mode the file had, or a new file's
-            os.chmod(temporary, target.stat().st_mode & 0o7777 if target.exists() else _new_file_mode())
-            os.replace(temporary, target)
-        except BaseException:
-            os.unlink(temporary)
-            raise
-        written.append(target)
-    return written
-
-
-def _new_file_mode() -> int:
-    """The mode `open` gives a new file: 0666 less the process's umask."""
-    umask = os.umask(0)
-    os.umask(umask)
-    return 0o666 & ~umask

@@ -26,7 +26,8 @@ from .differential import IK_NUMERIC_DEFAULTS
 from .errors import JacgenError
 from .catalogue import FUNCTION_NAMES
 from .functions import Generator
-from .render import environment, render_robot, write_files
+from .files import write_files
+from .render import environment, render_robot
 from .robot import Robot
 
 TARGETS = ("cortex-m4f",)

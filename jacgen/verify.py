@@ -31,7 +31,8 @@ from .compile import build_native, c_compiler, compile_shared
 from .catalogue import Function
 from .functions import Generator
 from .parallel import for_each_robot
-from .render import render_robot, write_files
+from .files import write_files
+from .render import render_robot
 from .samples import configurations
 from .robot import EULER_ANGLES, Robot
 from .generated_code import HOST_BACKENDS, GeneratedCode

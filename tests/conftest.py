@@ -2,6 +2,7 @@
 modules share beyond these is in tests/support/ (`generated`, the fixture of generated and
 compiled code, is registered here)."""
 
+import os
 from pathlib import Path
 
 import numpy as np
@@ -25,6 +26,12 @@ SLOWEST_FILES = ("test_shipped_robots.py", "test_urdf_round_trip.py", "test_gene
 def pytest_collection_modifyitems(items):
     rank = {name: k for k, name in enumerate(SLOWEST_FILES)}
     items.sort(key=lambda item: rank.get(item.path.name, len(rank)))  # stable: the rest keep their order
+
+
+@pytest.fixture(autouse=True, scope="session")
+def _own_generate_cache(tmp_path_factory):
+    """`jacgen generate` keeps its cache in $XDG_CACHE_HOME: the tests' own, not the user's."""
+    os.environ["XDG_CACHE_HOME"] = str(tmp_path_factory.mktemp("xdg_cache"))
 
 
 def pytest_addoption(parser):

@@ -17,7 +17,8 @@ from jacgen import reference
 from jacgen.compile import CLibrary, compile_shared
 from jacgen.functions import Generator
 from jacgen.backends.c import CPrinter
-from jacgen.render import render_robot, write_files
+from jacgen.files import write_files
+from jacgen.render import render_robot
 from jacgen.robot import load_robot
 
 from conftest import ROOT, random_configurations

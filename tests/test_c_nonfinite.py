@@ -7,7 +7,8 @@ import subprocess
 import pytest
 
 from jacgen.compile import WARNING_FLAGS
-from jacgen.render import render_robot, write_files
+from jacgen.files import write_files
+from jacgen.render import render_robot
 
 from conftest import robot
 

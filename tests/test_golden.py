@@ -11,7 +11,8 @@ import sys
 
 import pytest
 
-from jacgen.render import render_robot, stale_files, write_files
+from jacgen.files import stale_files, write_files
+from jacgen.render import render_robot
 
 from conftest import GENERATED, ROBOT_NAMES, robot
 

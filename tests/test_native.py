@@ -24,7 +24,8 @@ from click.testing import CliRunner
 from jacgen.cli import main
 from jacgen.functions import Generator
 from jacgen.generated_code import NATIVE_BACKENDS, import_module
-from jacgen.render import render_robot, write_files
+from jacgen.files import write_files
+from jacgen.render import render_robot
 from jacgen.robot import load_robot, parse_robot
 from jacgen.verify import verify_on_host
 from support.random_arms import random_arm_text

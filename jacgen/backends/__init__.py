@@ -6,12 +6,18 @@ builder of what its templates receive, the list of its templates under `template
 their runtime helpers), its comment syntax and its reserved words (`names.py`'s tables), in
 one `BACKEND` record (`common.Backend`). Every algorithm reaches every language as
 straight-line `Body`s (`lowering.py`): a backend only prints and lays out. Adding a language
-is one module, its templates, and one line here.
+is one module, its templates, and its name in LANGUAGES.
 """
 
-from . import c, casadi, native, python, report
+from importlib import import_module
 
-BACKENDS = {module.BACKEND.name: module.BACKEND for module in (c, python, casadi, report, native)}
+LANGUAGES = ("c", "python", "casadi", "report", "native")  # each the module of its name
 # `generate` without --lang: native is asked for by name (it is a package to build, and writes
 # the C in both builds)
 DEFAULT_LANGUAGES = ("c", "python", "casadi", "report")
+
+
+def backend(language: str):
+    """The `common.Backend` of a language of LANGUAGES, its module imported on first use (so
+    that the command line starts without the printers and sympy)."""
+    return import_module(f".{language}", __name__).BACKEND

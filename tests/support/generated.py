@@ -21,7 +21,8 @@ from jacgen import generated_code
 from jacgen.compile import CLibrary, compile_shared
 from jacgen.functions import Generator
 from jacgen.generated_code import import_module
-from jacgen.render import render_robot, write_files
+from jacgen.files import write_files
+from jacgen.render import render_robot
 from jacgen.robot import Robot, load_robot
 
 ROOT = Path(__file__).resolve().parents[2]
