@@ -14,7 +14,7 @@ from .parallel import usable_cpus
 from .tolerances import URDF_AGREEMENT
 from .version import __version__
 
-# Each command imports what it needs when it runs: `jacgen --help` and a cached
+# Each command imports what it needs when it runs: `jacgen --help`, `validate` and a cached
 # `generate --check` start without sympy, casadi or matplotlib.
 
 robot_files = click.argument("robot_files", nargs=-1, required=True, type=click.Path(dir_okay=False))

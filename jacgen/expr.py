@@ -6,16 +6,16 @@
     power := atom ("**" unary)?
     atom  := NUMBER | NAME | "(" expr ")" | "sqrt" "(" expr ")"
 
-Every node is evaluated twice, exactly (sympy) and in floating point, so that the numpy
-reference never depends on the symbolic path.
+Every node is evaluated twice, exactly and in floating point, so that the numpy reference
+never depends on the symbolic path. The exact form is kept as a recipe of the operations
+and built in sympy when first read (`Value.exact`): loading and validating a robot file
+does not import sympy.
 """
 
 import math
 import re
 import sys
-from typing import Callable, NamedTuple
-
-import sympy
+from typing import Callable
 
 MAX_LENGTH = 200
 MAX_DEPTH = 32
@@ -31,11 +31,79 @@ _DECIMAL = re.compile(rf"[+-]?{_NUMBER}", re.ASCII)
 _PARTS = re.compile(r"([+-]?)([0-9]*)\.?([0-9]*)(?:[eE]([+-]?[0-9]+))?", re.ASCII)
 
 
-class Value(NamedTuple):
-    """A quantity of a robot file: its exact sympy form and its float value."""
+class Value:
+    """A quantity of a robot file: its exact sympy form and its float value.
 
-    exact: sympy.Expr
-    approx: float
+    `Value(exact, approx)` takes a sympy expression, or a recipe that `exact` builds when
+    first read: ("integer", n), ("decimal", m, e) for m 10^e, ("pi",), ("symbol", name) (a
+    parameter kept symbolic), or (operation, form, ...) on other Values' forms, for "add",
+    "mul", "div", "pow", "neg" and "sqrt" (`combined`)."""
+
+    __slots__ = ("_exact", "approx")
+
+    def __init__(self, exact, approx: float):
+        self._exact, self.approx = exact, approx
+
+    @property
+    def exact(self):
+        if isinstance(self._exact, tuple):
+            from sympy.core.parameters import distribute, evaluate
+
+            with evaluate(True), distribute(True):  # the same form whatever sympy's state where it is first read
+                self._exact = _built(self._exact)
+        return self._exact
+
+    @property
+    def symbolic(self) -> bool:
+        """Whether it holds a parameter kept symbolic."""
+        return _symbolic(self._exact)
+
+    def __eq__(self, other) -> bool:
+        return isinstance(other, Value) and self.approx == other.approx and self.exact == other.exact
+
+    def __hash__(self) -> int:
+        return hash((self.exact, self.approx))
+
+    def __repr__(self) -> str:
+        return f"Value({self.exact!r}, {self.approx!r})"
+
+    def __reduce__(self):
+        return Value, (self._exact, self.approx)
+
+
+def combined(operation: str, approx: float, *values: Value) -> Value:
+    """The Value of `operation` on `values`, as a recipe of their forms, whose float is `approx`."""
+    return Value((operation, *(value._exact for value in values)), approx)
+
+
+def _built(form):
+    """The sympy expression of a form (see Value)."""
+    if not isinstance(form, tuple):
+        return form
+    import sympy
+
+    operation, *arguments = form
+    if operation == "integer":
+        return sympy.Integer(arguments[0])
+    if operation == "decimal":
+        return sympy.Integer(arguments[0]) * sympy.Integer(10) ** arguments[1]
+    if operation == "pi":
+        return sympy.pi
+    if operation == "symbol":
+        return sympy.Symbol(arguments[0], real=True)
+    a, *rest = map(_built, arguments)
+    if operation == "neg":
+        return -1 * a  # as a product, which distributes over a sum (sympy's -a does not)
+    if operation == "sqrt":
+        return sympy.sqrt(a)
+    b = rest[0]
+    return a + b if operation == "add" else a * b if operation == "mul" else a / b if operation == "div" else a**b
+
+
+def _symbolic(form) -> bool:
+    if isinstance(form, tuple):
+        return form[0] == "symbol" or any(_symbolic(x) for x in form[1:])
+    return bool(getattr(form, "free_symbols", False))
 
 
 class ExpressionError(ValueError):
@@ -79,7 +147,7 @@ def number(text: str) -> Value:
         raise ExpressionError(f"number with more than {MAX_DIGITS} digits")
     significant = (integer + fraction).lstrip("0")
     if not significant:
-        return Value(sympy.Integer(0), 0.0)
+        return Value(("integer", 0), 0.0)
     if exponent and len(exponent.lstrip("+-").lstrip("0")) > 4:  # beyond any double: out of range or underflow
         exponent = "-99999" if exponent.startswith("-") else "99999"
     scale = int(exponent or 0) - len(fraction)  # the value is int(integer + fraction) * 10**scale
@@ -88,17 +156,18 @@ def number(text: str) -> Value:
         raise ExpressionError(f"value {text[:40]} is out of range (|value| <= {MAX_MAGNITUDE:g})")
     if order < -330:
         raise ExpressionError(f"value {text[:40]} is too small for a double (underflows)")
-    magnitude = sympy.Integer(int(integer + fraction)) * sympy.Integer(10) ** scale
-    return _checked(-magnitude if sign == "-" else magnitude, float(text))
+    magnitude = ("decimal", int(integer + fraction), scale)
+    return _checked(Value(("neg", magnitude) if sign == "-" else magnitude, float(text)))
 
 
-def _checked(exact: sympy.Expr, approx: float) -> Value:
-    """The value, unless its float is out of range or has underflowed away from the exact one."""
-    if not math.isfinite(approx) or abs(approx) > MAX_MAGNITUDE:
-        raise ExpressionError(f"value {approx:g} is out of range (|value| <= {MAX_MAGNITUDE:g})")
-    if abs(approx) < sys.float_info.min and exact.is_zero is False:
-        raise ExpressionError(f"value {sympy.N(exact, 3)} is too small for a double (underflows)")
-    return Value(exact, approx)
+def _checked(value: Value) -> Value:
+    """The value, unless its float is out of range or has underflowed away from the exact one
+    (only then is its exact form built)."""
+    if not math.isfinite(value.approx) or abs(value.approx) > MAX_MAGNITUDE:
+        raise ExpressionError(f"value {value.approx:g} is out of range (|value| <= {MAX_MAGNITUDE:g})")
+    if abs(value.approx) < sys.float_info.min and value.exact.is_zero is False:
+        raise ExpressionError(f"value {value.exact.evalf(3)} is too small for a double (underflows)")
+    return value
 
 
 class _Parser:
@@ -124,7 +193,8 @@ class _Parser:
         while self.peek() in ("+", "-"):
             sign = 1 if self.take()[1] == "+" else -1
             right = self.term(depth)
-            value = _checked(value.exact + sign * right.exact, value.approx + sign * right.approx)
+            right = right if sign > 0 else combined("neg", -right.approx, right)
+            value = _checked(combined("add", value.approx + right.approx, value, right))
         return value
 
     def term(self, depth: int) -> Value:
@@ -132,19 +202,19 @@ class _Parser:
         while self.peek() in ("*", "/"):
             if self.take()[1] == "*":
                 right = self.unary(depth)
-                value = _checked(value.exact * right.exact, value.approx * right.approx)
+                value = _checked(combined("mul", value.approx * right.approx, value, right))
             else:
                 right = self.unary(depth)
                 if right.approx == 0:
                     raise ExpressionError("division by zero")
-                value = _checked(value.exact / right.exact, value.approx / right.approx)
+                value = _checked(combined("div", value.approx / right.approx, value, right))
         return value
 
     def unary(self, depth: int) -> Value:
         if self.peek() in ("+", "-"):
             sign = 1 if self.take()[1] == "+" else -1
             value = self.unary(depth + 1)
-            return Value(sign * value.exact, sign * value.approx)
+            return value if sign > 0 else combined("neg", -value.approx, value)
         return self.power(depth)
 
     def power(self, depth: int) -> Value:
@@ -153,7 +223,7 @@ class _Parser:
             return base
         self.take()
         exponent = self.unary(depth + 1)
-        if exponent.exact.free_symbols:  # its domain (a negative base, 0**x) would depend on the runtime value
+        if exponent.symbolic:  # its domain (a negative base, 0**x) would depend on the runtime value
             raise ExpressionError("an exponent may not hold a symbolic parameter")
         if abs(exponent.approx) > MAX_EXPONENT:
             raise ExpressionError(f"exponent {exponent.approx:g} too large (|exponent| <= {MAX_EXPONENT})")
@@ -161,7 +231,7 @@ class _Parser:
             raise ExpressionError("negative number to a fractional power")
         if base.approx == 0 and exponent.approx < 0:
             raise ExpressionError("division by zero")
-        return _checked(base.exact**exponent.exact, base.approx**exponent.approx)
+        return _checked(combined("pow", base.approx**exponent.approx, base, exponent))
 
     def atom(self, depth: int) -> Value:
         kind, text = self.take()
@@ -173,13 +243,13 @@ class _Parser:
             return value
         if kind == "name":
             if text == "pi":
-                return Value(sympy.pi, math.pi)
+                return Value(("pi",), math.pi)
             if text == "sqrt":
                 self.take("(")
                 argument = self.expr(depth + 1)
                 self.take(")")
                 if argument.approx < 0:
                     raise ExpressionError("sqrt of a negative number")
-                return Value(sympy.sqrt(argument.exact), math.sqrt(argument.approx))
+                return combined("sqrt", math.sqrt(argument.approx), argument)
             return self.resolve(text)
         raise ExpressionError(f"unexpected {text!r}")

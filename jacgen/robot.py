@@ -11,12 +11,11 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-import sympy
 import yaml
 
 from . import numeric_chain
 from .errors import RobotFileError
-from .expr import ExpressionError, Value, parse
+from .expr import ExpressionError, Value, combined, parse
 from .names import PARAMETER_NAME_RULE, ROBOT_NAME_RULE, parameter_name_problem, robot_name_problem
 
 TASK_COMPONENTS = ("x", "y", "z", "roll", "pitch", "yaw")
@@ -40,7 +39,7 @@ SMALLEST_LENGTH = 1e-7
 GIMBAL_LOCK = 1e-12
 # Within this many radians of a multiple of pi/2, an angle becomes that multiple exactly.
 ANGLE_SNAP_TOLERANCE = 1e-9
-ZERO = Value(sympy.Integer(0), 0.0)
+ZERO = Value(("integer", 0), 0.0)
 
 
 @dataclass(frozen=True)
@@ -50,8 +49,9 @@ class Parameter:
     symbolic: bool
 
     @property
-    def symbol(self) -> sympy.Symbol:
-        return sympy.Symbol(self.name, real=True)
+    def symbol(self):
+        """The sympy symbol of a parameter kept symbolic."""
+        return Value(("symbol", self.name), self.value).exact
 
 
 @dataclass(frozen=True)
@@ -201,7 +201,7 @@ class _RobotReader:
     def __init__(self, path: str, data: bytes):
         self.path, self.data = path, data
         self.values: dict[str, Value] = {}
-        self.angle_scale = Value(sympy.Integer(1), 1.0)
+        self.angle_scale = Value(("integer", 1), 1.0)
         self.lengths: list[tuple[yaml.Node, str, Value]] = []  # the link lengths read, for check_sizes
 
     # -- errors and structure ------------------------------------------------------------
@@ -303,7 +303,7 @@ class _RobotReader:
         description = self.text(top["description"], "description", paragraphs=True) if "description" in top else ""
         convention = self.string(top["convention"], "convention", ("standard", "modified"))
         if "angle_unit" in top and self.string(top["angle_unit"], "angle_unit", ("deg", "rad")) == "deg":
-            self.angle_scale = Value(sympy.pi / 180, math.pi / 180)
+            self.angle_scale = Value(("div", ("pi",), ("integer", 180)), math.pi / 180)
         length_unit = self.text(top["length_unit"], "length_unit") if "length_unit" in top else "m"
         parameters = self.parameters(top["parameters"], name) if "parameters" in top else ()
         joints = self.joints(top["joints"])
@@ -368,7 +368,7 @@ class _RobotReader:
             else:
                 value = self.value(value_node, key)
             parameter = Parameter(name, value.approx, symbolic)
-            self.values[name] = Value(parameter.symbol, value.approx) if symbolic else value
+            self.values[name] = Value(("symbol", name), value.approx) if symbolic else value
             result.append(parameter)
         return tuple(result)
 
@@ -482,16 +482,16 @@ def task_problem(components: list[str]) -> str | None:
 
 
 def _scaled(value: Value, scale: Value) -> Value:
-    return Value(value.exact * scale.exact, value.approx * scale.approx)
+    return combined("mul", value.approx * scale.approx, value, scale)
 
 
 def _snap_angle(value: Value) -> Value:
     """Exact k*pi/2 for an angle written as a decimal within ANGLE_SNAP_TOLERANCE of it."""
-    if value.exact.free_symbols:
+    if value.symbolic:
         return value
     quarter_turns = round(value.approx / (math.pi / 2))
     if abs(value.approx - quarter_turns * math.pi / 2) < ANGLE_SNAP_TOLERANCE:
-        return Value(quarter_turns * sympy.pi / 2, quarter_turns * math.pi / 2)
+        return Value(("mul", ("integer", quarter_turns), ("div", ("pi",), ("integer", 2))), quarter_turns * math.pi / 2)
     return value
 
 

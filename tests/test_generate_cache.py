@@ -91,10 +91,10 @@ def test_a_corrupt_or_foreign_entry_is_ignored(tmp_path, rendered, damage):
 
 
 def test_the_command_line_starts_without_the_generator(tmp_path):
-    """--help, and a cached --check, import neither sympy, casadi nor matplotlib."""
+    """--help, validate and a cached --check import neither sympy, casadi nor matplotlib."""
     assert run("generate", ROBOT, "-o", tmp_path, "--lang", "python").exit_code == 0
     probe = ("import sys\nfrom jacgen.cli import main\ntry:\n    main(sys.argv[1:])\nexcept SystemExit:\n    pass\n"
              "print(sorted({name.split('.')[0] for name in sys.modules} & {'sympy', 'casadi', 'matplotlib'}))")
-    for arguments in (["--help"], ["generate", str(ROBOT), "-o", str(tmp_path), "--lang", "python", "--check"]):
+    for arguments in (["--help"], ["validate", *map(str, sorted((ROOT / "robots").glob("*.yaml")))], ["generate", str(ROBOT), "-o", str(tmp_path), "--lang", "python", "--check"]):
         result = subprocess.run([sys.executable, "-c", probe, *arguments], capture_output=True, text=True, check=True)
         assert result.stdout.splitlines()[-1] == "[]", (arguments, result.stdout, result.stderr)
