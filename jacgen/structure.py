@@ -385,8 +385,11 @@ def _six_dof(g: Geometry) -> tuple[str | None, str, Geometry | None]:
             solver, reason = candidate(chain)
             if solver is not None:
                 return solver, how + reason, chain
-            reasons.append(how + reason)
-    return None, "; ".join(reasons), None
+            reasons.append(reason)
+    forward, backward = reasons[:2], reasons[2:]
+    if forward == backward:
+        return None, "; ".join(forward) + " (axes numbered from the base, and from the tool)", None
+    return None, "; ".join(forward + [f"reversed (axes numbered from the tool): {reason}" for reason in backward]), None
 
 
 def _free_joint(robot: Robot) -> tuple[str | None, str, Geometry | None]:
@@ -394,7 +397,7 @@ def _free_joint(robot: Robot) -> tuple[str | None, str, Geometry | None]:
     joint (the file's `ik.free_joint`, else the first of joints 7, 6, ..., 1 that leaves a
     solvable chain) is an input."""
     candidates = (robot.free_joint,) if robot.free_joint is not None else range(robot.dof - 1, -1, -1)
-    reasons = []
+    reasons: dict[str, list[str]] = {}  # each reason once, with the joints whose chain it rules out
     for free in candidates:
         if not robot.joints[free].revolute:
             continue
@@ -405,8 +408,9 @@ def _free_joint(robot: Robot) -> tuple[str | None, str, Geometry | None]:
             solver, reason, chain = _six_dof(Geometry(robot, free))
         if solver is not None:
             return solver, f"joint {free + 1} free (an input of ik), the other six: {reason}", chain
-        reasons.append(f"joint {free + 1} free: {reason}")
-    return None, "; ".join(reasons) or "no revolute joint to leave free", None
+        reasons.setdefault(reason, []).append(str(free + 1))
+    return None, "; ".join(f"joint{'s' * (len(joints) > 1)} {', '.join(joints)} free: {reason}"
+                           for reason, joints in reasons.items()) or "no revolute joint to leave free", None
 
 
 def _planar_class(g: Geometry, task: tuple[str, ...]) -> tuple[str | None, str] | None:

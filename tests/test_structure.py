@@ -93,6 +93,21 @@ def test_reasons_name_what_is_missing():
     assert "no spherical wrist" in skewed.reason and "no three parallel" in skewed.reason
 
 
+def test_a_7_axis_arm_without_a_closed_form_gives_each_reason_once():
+    """A prismatic joint 3 keeps the general solver out; the same two reasons rule out every
+    free joint, from the base and from the tool: said once, with the joints."""
+    joints = ["{type: revolute, a: 0.1, alpha: pi/2, d: 0.3}", "{type: revolute, a: 0.4, alpha: 0.3, d: 0.05}",
+              "{type: prismatic, a: 0.05, alpha: -pi/2, theta: 0.2}", "{type: revolute, a: 0.02, alpha: pi/2, d: 0.3}",
+              "{type: revolute, a: 0.03, alpha: -pi/2, d: 0.1}", "{type: revolute, a: 0, alpha: pi/2, d: 0.05}",
+              "{type: revolute, a: 0, alpha: 0, d: 0.1}"]
+    text = "name: p7\nconvention: standard\njoints:\n" + "".join(f"  - {joint}\n" for joint in joints)
+    structure = classify(parse_robot(text.encode()))
+    assert structure.solver is None
+    assert structure.reason == ("joints 7, 6, 5, 4, 2, 1 free: no spherical wrist (axes 4, 5, 6 do not meet in one "
+                                "point); no three parallel revolute axes 2, 3, 4 (axes numbered from the base, and "
+                                "from the tool)")
+
+
 @pytest.mark.parametrize("name", ["puma560", "kr5", "stanford"])
 def test_the_wrist_centre_lies_on_the_reference_axes(name):
     """The spherical wrist's centre, as the structure holds it (the chain its solver solves,
