@@ -27,7 +27,7 @@ from pathlib import Path
 
 import common
 from common import random_arm_text
-from jacgen.functions import Generator
+from jacgen.functions import Generator, matrix
 from jacgen.robot import parse_robot
 
 ROBOTS = ("puma560", "ur5", "panda")
@@ -96,7 +96,7 @@ def scaling_table(sizes: list[int], repeats: int) -> None:
             robot = parse_robot(random_arm_text(1000 * n + repeat, dof=n).encode(), f"arm{n}.yaml")
             generator = Generator(robot)
             bias += generator.second_order_functions()[2].body.operation_count / repeats
-            jacobian += generator.function("jacobian", "", ("J", generator.jacobian)).body.operation_count / repeats
+            jacobian += generator.function("jacobian", "", matrix("J", generator.jacobian)).body.operation_count / repeats
         counts.append((n, bias, jacobian))
         print(f"{n:3d} {bias:18.0f} {jacobian:9.0f} {bias / jacobian:6.2f} {bias / n:15.0f}")
     for label, rows in (("all sizes", counts), ("from 8 joints up", [c for c in counts if c[0] >= 8])):

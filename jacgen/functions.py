@@ -6,6 +6,7 @@ shares; adding a function touches the catalogue, this module and its algorithm.
 """
 
 import math
+from dataclasses import dataclass
 from functools import cached_property
 
 import sympy
@@ -21,6 +22,36 @@ from .model import Model
 from .nodes import Above, AtMost, select
 from .robot import EULER_ANGLES, Robot
 from .subproblems import Subproblems, wrapped
+
+
+@dataclass(frozen=True)
+class Result:
+    """One named result of a generated function, as `matrix`, `vector`, `scalar` or `status` make it."""
+
+    name: str
+    values: list  # row by row: expressions, or truth values
+    rows: int
+    cols: int
+    shape: str  # "matrix", "vector" (numpy (rows,)), "scalar" or "status" (an integer scalar)
+    equals: str = ""  # in a function that fuses several: the function this result is
+    layers: int = 1  # > 1: a stack of that many matrices (the hessian)
+
+
+def matrix(name: str, value: sympy.Matrix, equals: str = "", layers: int = 1) -> Result:
+    return Result(name, list(value), value.rows, value.cols, "matrix", equals, layers)
+
+
+def vector(name: str, values, equals: str = "") -> Result:
+    values = [sympy.sympify(value) for value in values]
+    return Result(name, values, len(values), 1, "vector", equals)
+
+
+def scalar(name: str, value) -> Result:
+    return Result(name, [sympy.sympify(value)], 1, 1, "scalar")
+
+
+def status(name: str, value) -> Result:
+    return Result(name, [sympy.sympify(value)], 1, 1, "status")
 
 
 class Generator:
@@ -92,8 +123,8 @@ class Generator:
             with distribute(False):
                 q, valid, inside = ik.branches(self.robot, form, sp, target.symbols, free_angle)
             parts = [self.function("ik_branches", "every branch of the closed-form ik, whether the target allows "
-                                   "it and whether it is inside the joint limits", ("q", q), ("valid", valid),
-                                   ("in_limits", inside), arguments=(target, *free), bindings=bindings)]
+                                   "it and whether it is inside the joint limits", matrix("q", q), vector("valid", valid),
+                                   vector("in_limits", inside), arguments=(target, *free), bindings=bindings)]
             rows = q.rows
         if not self.generates("ik_nearest"):
             return parts
@@ -106,12 +137,11 @@ class Generator:
         table_q, table_valid, table_inside = (result.symbols for result in table.results)
         with distribute(False):
             read = target.symbols[:3, :] if form.target == "pose" else target.symbols
-            closest, status = ik_limits.nearest(self.robot, sp, table_q, list(table_valid), list(table_inside),
-                                         list(seed.symbols), list(weights.symbols), form.free, list(read))
+            closest, outcome = ik_limits.nearest(self.robot, sp, table_q, list(table_valid), list(table_inside),
+                                                 list(seed.symbols), list(weights.symbols), form.free, list(read))
         nearest = self.function("ik_nearest", "the closed-form ik solution inside the joint limits nearest q_seed "
-                                "(sum of weights_j (q_j - q_seed_j)^2), and the status", ("q", sympy.Matrix(closest)),
-                                ("status", sympy.Matrix([status])), vector=True, integers=("status",),
-                                arguments=(target, seed, *free, weights), calls=(table,))
+                                "(sum of weights_j (q_j - q_seed_j)^2), and the status", vector("q", closest),
+                                status("status", outcome), arguments=(target, seed, *free, weights), calls=(table,))
         return [*parts, nearest]
 
     def general_6r_functions(self, target: Argument, free_input: tuple, bindings: dict,
@@ -140,7 +170,7 @@ class Generator:
             stacked = sympy.Matrix.vstack(p0, ps, pc)
         equations_function = self.function(
             "ik_general_equations", "the general 6R solver's equations at T: (P0 + s Ps + c Pc) v_bc = Q v_gh, "
-            "P = [P0; Ps; Pc] (42 x 9)", ("P", stacked), ("Q", q), arguments=(target, *free_input), bindings=bindings,
+            "P = [P0; Ps; Pc] (42 x 9)", matrix("P", stacked), matrix("Q", q), arguments=(target, *free_input), bindings=bindings,
             part_of="ik_branches")
         angles = Argument("angles", sympy.Matrix([generated_symbol("ga", k) for k in range(5)]))
         loop = dict(zip((*split.triple, *split.pair), angles.symbols))
@@ -169,7 +199,7 @@ class Generator:
             for k, t in zip(six, theta):
                 q[k] = t - self.robot.joints[k].offset.exact
         start = self.function("ik_general_start", "the configuration of one root's loop angles (a - shift, b, c, "
-                              "g, h; the loop's free joint from the loop)", ("q", sympy.Matrix(q)), vector=True,
+                              "g, h; the loop's free joint from the loop)", vector("q", q),
                               arguments=(target, *free_input, angles), bindings=bindings, part_of="ik_branches")
         dof = self.robot.dof
         target_pose = self._ik_target()
@@ -179,15 +209,15 @@ class Generator:
         step = self.function("ik_general_residual", "the pose error e at q (the position error and the rotation "
                              "vector of R_target R^T, world frame) and the geometric Jacobian J of the six joints "
                              "ik solves: the Newton step of the solver's polish is q + J^-1 e",
-                             ("e", sympy.Matrix(error)), ("J", jacobian[:, list(six)]), vectors=("e",),
+                             vector("e", error), matrix("J", jacobian[:, list(six)]),
                              arguments=(target_pose, given), bindings=dict(zip(self.q, given.symbols)),
                              part_of="ik_branches")
         given = Argument("q_solution", sympy.Matrix([generated_symbol("qg", i + 1) for i in range(dof)]))
         with distribute(False):
             limited, inside = ik_limits.limited(self.robot, sp, list(given.symbols), six, form.free)
         limits = self.function("ik_general_limits", "ik's form of q (revolute angles wrapped, or into the limits) "
-                               "and whether it is inside the joint limits", ("q", sympy.Matrix(limited)),
-                               ("in_limits", [inside]), vector=True, scalars=("in_limits",), arguments=(given,),
+                               "and whether it is inside the joint limits", vector("q", limited),
+                               scalar("in_limits", inside), arguments=(given,),
                                part_of="ik_branches")
         parts = [equations_function, start, step, limits]
         if fast := form.fast_path:
@@ -200,9 +230,8 @@ class Generator:
                     margin = self.name(select(AtMost(margin, other), margin, other))
             parts.append(self.function("ik_general_nominal", "the fast path's starting points: every branch of the "
                                        "nearest special class's closed form (the nominal arm's), whether its target "
-                                       "allows it, and the least margin of its subproblems", ("q", q), ("valid", valid),
-                                       ("margin", sympy.Matrix([margin])), scalars=("margin",),
-                                       arguments=(target, *free_input), bindings=bindings, part_of="ik_branches"))
+                                       "allows it, and the least margin of its subproblems", matrix("q", q),
+                                       vector("valid", valid), scalar("margin", margin), arguments=(target, *free_input), bindings=bindings, part_of="ik_branches"))
         return parts
 
     def velocity_ik_function(self, js: sympy.Matrix) -> Function:
@@ -211,12 +240,13 @@ class Generator:
         mu_dot = Argument("mu_dot", sympy.Matrix([generated_symbol("mu_dot", i) for i in range(m)]))
         damping = Argument("damping", sympy.Matrix([sympy.Symbol("damping", real=True)]), scalar=True, default="0.0")
         with distribute(False):
-            q_dot, status = differential.velocity_ik(js, list(self.q), list(mu_dot.symbols), damping.symbols[0], self.name)
+            q_dot, outcome = differential.velocity_ik(js, list(self.q), list(mu_dot.symbols), damping.symbols[0],
+                                                      self.name)
         form = "Js^-1 mu_dot (damping 0) or " if m == n else ""
         form += ("Js^T (Js Js^T + damping^2 I)^-1 mu_dot" if m <= n else "(Js^T Js + damping^2 I)^-1 Js^T mu_dot")
         return self.function("velocity_ik", f"joint rates q_dot solving Js q_dot = mu_dot: {form}; and the status",
-                             ("q_dot", sympy.Matrix(q_dot)), ("status", sympy.Matrix([status])), vector=True,
-                             integers=("status",), arguments=(Argument("q", sympy.Matrix(self.q)), mu_dot, damping))
+                             vector("q_dot", q_dot), status("status", outcome),
+                             arguments=(Argument("q", sympy.Matrix(self.q)), mu_dot, damping))
 
     def ik_numeric_step_function(self, task_jacobian: sympy.Matrix) -> Function:
         """ik_numeric_step: one damped least-squares step of ik_numeric from q (`differential`)."""
@@ -235,9 +265,8 @@ class Generator:
         step = "J^T (J J^T + damping I)^-1 e" if jacobian.rows <= n else "(J^T J + damping I)^-1 J^T e"
         summary = (f"one step of ik_numeric: q clamped to the limits, then q + {step} clamped, and |e|^2 at "
                    "the clamped q (-1 when target or q is not finite)")
-        return self.function("ik_numeric_step", summary, ("q_start", sympy.Matrix(self.q)),
-                             ("q_next", sympy.Matrix(trial)), ("cost", sympy.Matrix([cost])), vector=True,
-                             scalars=("cost",), arguments=(target, given, damping), bindings=bindings)
+        return self.function("ik_numeric_step", summary, vector("q_start", self.q), vector("q_next", trial),
+                             scalar("cost", cost), arguments=(target, given, damping), bindings=bindings)
 
     def _ik_target(self) -> Argument:
         """ik_numeric's target: the 4x4 pose for a six-component task, else the task vector."""
@@ -281,16 +310,16 @@ class Generator:
             hessian = sympy.Matrix.vstack(*kinematics.hessian(robot, columns))
         return [
             self.function("fk_jacobian_dot", "fk, jacobian and bias_acceleration in one pass, sharing their terms",
-                          ("T", self.chain.tool), ("J", self.jacobian), ("a", bias),
-                          equals=("fk", "jacobian", "bias_acceleration"), vectors=("a",), arguments=arguments),
+                          matrix("T", self.chain.tool, equals="fk"), matrix("J", self.jacobian, equals="jacobian"),
+                          vector("a", bias, equals="bias_acceleration"), arguments=arguments),
             self.function("jacobian_dot", "time derivative dJ/dt of the world geometric Jacobian along q_dot (6 x DOF)",
-                          ("Jd", jacobian_dot), arguments=arguments),
+                          matrix("Jd", jacobian_dot), arguments=arguments),
             self.function("bias_acceleration", "J' q_dot: the tool's classical linear and angular acceleration "
-                          "at zero joint acceleration, world frame (6)", ("a", bias), vector=True, arguments=arguments),
+                          "at zero joint acceleration, world frame (6)", vector("a", bias), arguments=arguments),
             self.function("task_jacobian_dot", f"time derivative of the analytic Jacobian along q_dot ({m} x DOF): "
-                          "mu'' = J_a q'' + J_a' q'", ("Jd", task_jacobian_dot), arguments=arguments),
+                          "mu'' = J_a q'' + J_a' q'", matrix("Jd", task_jacobian_dot), arguments=arguments),
             self.function("hessian", "partial derivatives dJ/dq_k of the world geometric Jacobian "
-                          "(DOF x 6 x DOF, indexed [k, r, c])", ("H", hessian), layers=n),
+                          "(DOF x 6 x DOF, indexed [k, r, c])", matrix("H", hessian, layers=n)),
         ]
 
     @property
@@ -350,10 +379,10 @@ class Generator:
             factors.append(numeric)
         what = "the robot is singular where one is 0" if factors else "never singular: the constant 1"
         functions = [self.function("singularity_factors", f"factors of {singular.kind}: {what}",
-                                   ("f", sympy.Matrix(factors or [1])), vector=True)]
+                                   vector("f", factors or [1]))]
         if m != n:
             return functions + [self.function("manipulability", f"manipulability sqrt({singular.kind})",
-                                              ("w", sympy.Matrix([sympy.sqrt(self.magnitude(numeric))])), scalar=True)]
+                                              scalar("w", sympy.sqrt(self.magnitude(numeric))))]
         determinant = numeric
         if singular.complete and not singular.everywhere:
             rotation = self.chain.tool[:3, :3]
@@ -363,36 +392,28 @@ class Generator:
             if self.lower(sympy.Matrix([exact])).operation_count <= self.lower(sympy.Matrix([numeric])).operation_count:
                 determinant = exact
         return functions + [
-            self.function("manipulability", "manipulability |det(Js)|", ("w", sympy.Matrix([self.magnitude(determinant)])),
-                          scalar=True),
-            self.function("jacobian_det", "det(Js)", ("d", sympy.Matrix([determinant])), scalar=True),
+            self.function("manipulability", "manipulability |det(Js)|", scalar("w", self.magnitude(determinant))),
+            self.function("jacobian_det", "det(Js)", scalar("d", determinant)),
         ]
 
-    def function(self, name: str, summary: str, *results: tuple[str, sympy.Matrix | list], scalar: bool = False,
-                 vector: bool = False, equals: tuple[str, ...] = (),
-                 arguments: tuple[Argument, ...] | None = None, scalars: tuple[str, ...] = (),
-                 integers: tuple[str, ...] = (), bindings: dict | None = None, layers: int = 1,
-                 vectors: tuple[str, ...] = (), calls: tuple[Call, ...] = (), part_of: str | None = None
+    def function(self, name: str, summary: str, *results: Result, arguments: tuple[Argument, ...] | None = None,
+                 bindings: dict | None = None, calls: tuple[Call, ...] = (), part_of: str | None = None
                  ) -> Function | None:
-        """A function of one or more named results (matrices, or lists of truth values as
-        columns), lowered together so they share their terms; its arguments are q unless
-        given. The results named in `scalars` are scalars, those in `integers` integer
-        scalars (statuses), those in `vectors` (or all, with `vector`) column vectors; `bindings` define symbols (the joints) from the arguments for
-        this function alone; `layers` > 1 makes the results stacks of that many matrices; `calls`
-        are the generated functions whose results the body reads. None when `name` (or the
-        function it is `part_of`) is not to be generated (nothing is lowered then)."""
+        """A function of one or more results (`matrix`, `vector`, `scalar`, `status`), lowered
+        together so they share their terms; its arguments are q unless given. `bindings` define
+        symbols (the joints) from the arguments for this function alone; `calls` are the
+        generated functions whose results the body reads. None when `name` (or the function it
+        is `part_of`) is not to be generated (nothing is lowered then)."""
         if not self.generates(part_of or name):
             return None
         outputs, values = [], []
-        for (output, result), equal in zip(results, equals or ("",) * len(results)):
-            rows, cols = result.shape if isinstance(result, sympy.Matrix) else (len(result), 1)
-            boolean = all(map(is_boolean, result))
-            integer = output in integers
-            key = f"{name}.{output}"
-            outputs.append(Output(output, rows, cols, scalar or integer or output in scalars,
-                                  vector or boolean or output in vectors, equal, boolean, integer, layers,
-                                  extent_of(key if key in EXTENTS else equal or name, rows * cols)))
-            values += list(result)
+        for result in results:
+            boolean = all(map(is_boolean, result.values))
+            key, size = f"{name}.{result.name}", result.rows * result.cols
+            outputs.append(Output(result.name, result.rows, result.cols, result.shape in ("scalar", "status"),
+                                  result.shape == "vector" or boolean, result.equals, boolean, result.shape == "status",
+                                  result.layers, extent_of(key if key in EXTENTS else result.equals or name, size)))
+            values += result.values
         return Function(name, summary, tuple(outputs), self.lower(values, bindings or {}),
                         arguments or (Argument("q", sympy.Matrix(self.q)),), calls)
 
@@ -435,16 +456,16 @@ class Generator:
         task_jacobian = kinematics.task_jacobian(robot, pose, self.jacobian)
         js = analysis.singularity_jacobian(robot, self.jacobian, task_jacobian)
         functions = (
-            self.function("fk", "pose of the tool frame in the world frame (4x4 homogeneous)", ("T", pose)),
+            self.function("fk", "pose of the tool frame in the world frame (4x4 homogeneous)", matrix("T", pose)),
             self.function("jacobian", "geometric Jacobian in the world frame (6 x DOF, rows vx vy vz wx wy wz)",
-                          ("J", self.jacobian)),
+                          matrix("J", self.jacobian)),
             self.function("fk_jacobian", "fk and jacobian in one pass, sharing their terms",
-                          ("T", pose), ("J", self.jacobian), equals=("fk", "jacobian")),
+                          matrix("T", pose, equals="fk"), matrix("J", self.jacobian, equals="jacobian")),
             self.function("jacobian_tool", "geometric Jacobian in the tool frame (6 x DOF, rows vx vy vz wx wy wz)",
-                          ("J", kinematics.tool_frame(self.jacobian, pose))),
+                          matrix("J", kinematics.tool_frame(self.jacobian, pose))),
             self.function("task", f"task vector mu = ({', '.join(robot.task)})",
-                          ("mu", kinematics.task_vector(robot, pose)), vector=True),
-            self.function("task_jacobian", f"analytic Jacobian d mu / d q ({m} x DOF)", ("J", task_jacobian)),
+                          vector("mu", kinematics.task_vector(robot, pose))),
+            self.function("task_jacobian", f"analytic Jacobian d mu / d q ({m} x DOF)", matrix("J", task_jacobian)),
             *self.second_order_functions(),
             *self.singularity_functions(js),
             self.velocity_ik_function(js) if self.generates("velocity_ik") else None,

@@ -15,7 +15,7 @@ from numpy.testing import assert_allclose
 
 from jacgen import reference
 from jacgen.compile import CLibrary, compile_shared
-from jacgen.functions import Generator
+from jacgen.functions import Generator, matrix, scalar
 from jacgen.backends.c import CPrinter
 from jacgen.files import write_files
 from jacgen.render import render_robot
@@ -108,8 +108,8 @@ def test_functions_beyond_spec_render_generically(tmp_path, monkeypatch):
         position = pose[:3, 3]
         return original(self) + [
             self.function("reach_squared", "squared distance of the tool from the origin",
-                          ("r", sympy.Matrix([position.dot(position)])), scalar=True),
-            self.function("tool_position", "tool origin", ("v", position)),
+                          scalar("r", position.dot(position))),
+            self.function("tool_position", "tool origin", matrix("v", position)),
         ]
 
     original = Generator.functions

@@ -4,13 +4,12 @@ import math
 
 import numpy as np
 import pytest
-import sympy
 from click.testing import CliRunner
 
 from jacgen import reference, samples, verify
 from jacgen.cli import main
 from jacgen.compile import CompileError, compile_shared
-from jacgen.functions import Generator
+from jacgen.functions import Generator, scalar
 
 from conftest import robot as shipped_robot
 
@@ -56,7 +55,7 @@ def test_functions_without_reference_are_listed_not_compared(monkeypatch):
 
     def functions(self):
         return original(self) + [self.function("tool_height", "z of the tool",
-                                               ("h", sympy.Matrix([self.chain.tool[2, 3]])), scalar=True)]
+                                               scalar("h", self.chain.tool[2, 3]))]
 
     monkeypatch.setattr(Generator, "functions", functions)
     result = _verify("robots/scara.yaml", "--samples", "5")
