@@ -29,8 +29,8 @@ import io
 import numpy as np
 
 import common
-from jacgen import reference
-from jacgen.import_urdf import import_urdf
+from jacgen.checking import reference
+from jacgen.urdf_import import import_urdf
 
 URDFS = {"ur5": ("ur5_robot.urdf", "base_link", "tool0"), "panda": ("panda.urdf", "panda_link0", "panda_hand_tcp")}
 

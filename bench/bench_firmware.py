@@ -30,10 +30,10 @@ import casadi
 import numpy as np
 
 import common
-from jacgen import reference
-from jacgen.functions import Generator
-from jacgen.target import Emulator, check_tools
-from jacgen.verify import FLOAT_TOLERANCE
+from jacgen.checking import reference
+from jacgen.emission.generator import Generator
+from jacgen.checking.cortex_m4f import Emulator, check_tools
+from jacgen.checking.verify import FLOAT_TOLERANCE
 
 ROBOTS = ("puma560", "ur5", "panda")
 MATH = ("sin", "cos", "tan", "sqrt", "fabs", "atan2", "asin", "acos", "exp", "log", "pow", "fmin", "fmax", "floor")

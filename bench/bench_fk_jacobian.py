@@ -34,8 +34,8 @@ import casadi
 import numpy as np
 
 import common
-from jacgen import reference
-from jacgen.functions import Generator
+from jacgen.checking import reference
+from jacgen.emission.generator import Generator
 
 ROBOTS = ("puma560", "ur5", "panda")
 VARIANTS = ("ours", "ours_fk", "ours_jac", "separate", "casadi", "casadi_cse", "floor")

@@ -36,9 +36,9 @@ from eaik.IK_HP import HPRobot
 
 import common
 from common import kinematic_chain
-from jacgen import reference
-from jacgen.compile import CLibrary
-from jacgen.robot import parse_robot
+from jacgen.checking import reference
+from jacgen.checking.c_library import CLibrary
+from jacgen.inputs.robot import parse_robot
 
 FREE_VALUE = {"panda": np.pi / 4, "iiwa": 0.3}
 

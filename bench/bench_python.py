@@ -63,8 +63,8 @@ from typing import Callable
 import numpy as np
 
 import common
-from jacgen import reference
-from jacgen.compile import build_native
+from jacgen.checking import reference
+from jacgen.checking.c_library import build_native
 
 FUNCTIONS = ("fk", "fk_jacobian", "ik", "velocity_ik")
 PEERS = ("pinocchio", "rtb", "eaik", "casadi")

@@ -27,8 +27,8 @@ from pathlib import Path
 
 import common
 from common import random_arm_text
-from jacgen.functions import Generator, matrix
-from jacgen.robot import parse_robot
+from jacgen.emission.generator import Generator, matrix
+from jacgen.inputs.robot import parse_robot
 
 ROBOTS = ("puma560", "ur5", "panda")
 VARIANTS = ("ours fk_jacobian", "ours fk_jacobian_dot", "pinocchio fk_jacobian", "pinocchio dot")

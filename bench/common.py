@@ -54,11 +54,11 @@ import casadi  # noqa: E402 (a dependency of jacgen)
 import numpy as np  # noqa: E402
 import sympy  # noqa: E402
 
-from jacgen import reference  # noqa: E402
-from jacgen.compile import c_compiler, compile_shared  # noqa: E402
+from jacgen.checking import reference  # noqa: E402
+from jacgen.checking.c_library import c_compiler, compile_shared  # noqa: E402
 from jacgen.files import write_files  # noqa: E402
-from jacgen.render import render_robot  # noqa: E402
-from jacgen.robot import load_robot  # noqa: E402
+from jacgen.emission.render import render_robot  # noqa: E402
+from jacgen.inputs.robot import load_robot  # noqa: E402
 
 # What benches take from tests/: {name: the module of tests/ that defines it}.
 FROM_TESTS = {"random_arm_text": "support.random_arms", "pinocchio_from_dh": "support.pinocchio_chain",

@@ -13,10 +13,10 @@ The names are imported when first used, so that `jacgen --help` and a cached
 
 from importlib import import_module
 
-from .version import __version__
+from jacgen.version import __version__
 
-_HOMES = {"JacgenError": "errors", "RobotFileError": "errors", "Kinematics": "kinematics",
-          "render_robot": "render", "Robot": "robot", "load_robot": "robot"}
+_HOMES = {"JacgenError": "errors", "RobotFileError": "errors", "Kinematics": "model.kinematics",
+          "render_robot": "emission.render", "Robot": "inputs.robot", "load_robot": "inputs.robot"}
 
 __all__ = ["JacgenError", "Kinematics", "Robot", "RobotFileError", "load_robot", "render_robot", "__version__"]
 

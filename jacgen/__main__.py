@@ -1,5 +1,5 @@
 """`python -m jacgen` runs the same CLI as `jacgen`."""
 
-from .cli import main
+from jacgen.cli import main
 
 main(prog_name="jacgen")

@@ -14,8 +14,8 @@ import json
 import os
 from pathlib import Path, PurePosixPath
 
-from . import sources
-from .files import write_files
+from jacgen import sources
+from jacgen.files import write_files
 
 FORMAT = 1
 

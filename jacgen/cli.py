@@ -6,13 +6,13 @@ from pathlib import Path
 
 import click
 
-from . import budget
-from .backends import DEFAULT_LANGUAGES, LANGUAGES
-from .errors import JacgenError
-from .files import stale_files, write_files
-from .parallel import usable_cpus
-from .tolerances import URDF_AGREEMENT
-from .version import __version__
+from jacgen import budget
+from jacgen.emission.backends import DEFAULT_LANGUAGES, LANGUAGES
+from jacgen.errors import JacgenError
+from jacgen.files import stale_files, write_files
+from jacgen.parallel import usable_cpus
+from jacgen.tolerances import URDF_AGREEMENT
+from jacgen.version import __version__
 
 # Each command imports what it needs when it runs: `jacgen --help`, `validate` and a cached
 # `generate --check` start without sympy, casadi or matplotlib.
@@ -37,7 +37,7 @@ def _functions(ctx, param, value: str | None) -> tuple[str, ...] | None:
     names = tuple(dict.fromkeys(part.strip() for part in value.split(",") if part.strip()))
     if not names:
         raise click.BadParameter("expected a comma-separated list of function names")
-    from .catalogue import with_callees
+    from jacgen.emission.catalogue import with_callees
 
     try:
         with_callees(names)
@@ -128,7 +128,7 @@ def generate(robot_files, output, languages, real, check, functions, budget_seco
     if real == "float" and {"c", "native"} <= set(languages):
         raise click.UsageError("--lang native writes NAME.c in double beside NAME_float.c; with --real float, "
                                "write the float C of --lang c into another folder")
-    from . import cache
+    from jacgen import cache
 
     folder = Path(output)
     options = {"languages": list(languages), "real": real, "functions": functions and list(functions),
@@ -138,8 +138,8 @@ def generate(robot_files, output, languages, real, check, functions, budget_seco
     cached = {path: entry for path in paths if keys[path] and (entry := cache.hit(keys[path], folder))}
     robots, files = [], {}
     if len(cached) < len(paths):
-        from .render import render_robots
-        from .robot import load_robot
+        from jacgen.emission.render import render_robots
+        from jacgen.inputs.robot import load_robot
 
         budget.set_seconds(budget_seconds)
         robots = [load_robot(path) for path in paths if path not in cached]  # validate all before writing any
@@ -167,7 +167,7 @@ def generate(robot_files, output, languages, real, check, functions, budget_seco
 
 def _cache_key(path: Path, options: dict) -> str | None:
     """The robot file's cache key; None when it cannot be read (load_robot then says why)."""
-    from . import cache
+    from jacgen import cache
 
     try:
         return cache.key(path, options)
@@ -177,7 +177,7 @@ def _cache_key(path: Path, options: dict) -> str | None:
 
 def _remember(robots: list, files: dict[str, str], keys: dict[Path, str | None]) -> None:
     """Records, per robot rendered, the files it has on disk now (cache.store)."""
-    from . import cache
+    from jacgen import cache
 
     for robot in robots:
         if key := keys[Path(robot.source)]:
@@ -189,7 +189,7 @@ def _remember(robots: list, files: dict[str, str], keys: dict[Path, str | None])
 @robot_files
 def validate(robot_files):
     """Check robot files only."""
-    from .robot import load_robot
+    from jacgen.inputs.robot import load_robot
 
     for path in robot_files:
         robot = load_robot(path)
@@ -225,9 +225,9 @@ def _configuration(ctx, param, value: str | None):
 def show(robot_file, plot_file, q, urdf_file, base, tip, tolerance):
     """Describe a robot in words (DH table, task, singularities, inverse kinematics), draw it,
     compare it with a URDF."""
-    from .model import Model
-    from .report import describe
-    from .robot import load_robot
+    from jacgen.inputs.robot import load_robot
+    from jacgen.reports.description import describe
+    from jacgen.solvers.model import Model
 
     robot = load_robot(robot_file)
     if q is not None and len(q) != robot.dof:
@@ -236,14 +236,14 @@ def show(robot_file, plot_file, q, urdf_file, base, tip, tolerance):
     if plot_file:
         import numpy as np
 
-        from .drawing import default_configurations, draw
+        from jacgen.reports.drawing import default_configurations, draw
 
         drawing = draw(robot, [np.array(q)] if q is not None else default_configurations(robot),
                        Path(plot_file).suffix[1:].lower() or "png")
         write_files({Path(plot_file).name: drawing}, Path(plot_file).parent)
         click.echo(f"jacgen: wrote {plot_file}", err=True)
     if urdf_file:
-        from .compare_urdf import compare_urdf, comparison_lines, first_difference
+        from jacgen.reports.urdf_comparison import compare_urdf, comparison_lines, first_difference
 
         comparison = compare_urdf(robot, urdf_file, base, tip)
         click.echo("\n" + "\n".join(comparison_lines(robot, urdf_file, comparison, tolerance)))
@@ -268,8 +268,9 @@ def show(robot_file, plot_file, q, urdf_file, base, tip, tolerance):
 @jobs_option
 def verify(robot_files, samples, seed, target, sources, native, jobs):
     """Compare every generated function of every backend with the numpy reference."""
-    from .robot import load_robot
-    from .verify import format_table, verify as verify_robots
+    from jacgen.checking.verify import format_table
+    from jacgen.checking.verify import verify as verify_robots
+    from jacgen.inputs.robot import load_robot
 
     if sources and not target:
         raise click.UsageError("--sources needs --target")
@@ -282,7 +283,7 @@ def verify(robot_files, samples, seed, target, sources, native, jobs):
                             emulators=emulators, jobs=jobs, native=native)
     click.echo(format_table(results))
     if emulators:
-        from .target import format_resources
+        from jacgen.checking.cortex_m4f import format_resources
 
         click.echo("\n" + format_resources(emulators))
     if any(result.failed for result in results):
@@ -304,7 +305,7 @@ def verify(robot_files, samples, seed, target, sources, native, jobs):
               help="Write the robot file here (default: standard output).")
 def import_urdf_command(urdf_file, base, tip, convention, name, task, snap, output):
     """Convert the serial chain of a URDF into a DH robot file, exactly."""
-    from .import_urdf import CHECK_CONFIGURATIONS, import_urdf
+    from jacgen.urdf_import import CHECK_CONFIGURATIONS, import_urdf
 
     components = tuple(part.strip() for part in task.split(",")) if task else None
     imported = import_urdf(urdf_file, base, tip, convention, name, components, snap)

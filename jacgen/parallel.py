@@ -13,10 +13,10 @@ import sys
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from typing import TYPE_CHECKING, Callable, TypeVar
 
-from . import budget
+from jacgen import budget
 
 if TYPE_CHECKING:  # the command line imports this module to start: sympy comes with the work
-    from .robot import Robot
+    from jacgen.inputs.robot import Robot
 
 T = TypeVar("T")
 THREADED_LIBRARIES = ("jax", "torch", "tensorflow")  # loaded, they make forking this process unsafe
@@ -81,6 +81,6 @@ def _run(work: Callable[..., T], robot: "Robot", arguments: tuple, seconds: floa
 def _expected_cost(robot: "Robot") -> tuple[bool, int]:
     """What orders robots by generation time, roughly: the general 6R solver is the longest,
     then the more joints the longer."""
-    from .model import Model
+    from jacgen.solvers.model import Model
 
     return Model(robot).structure.solver == "general_6r", robot.dof

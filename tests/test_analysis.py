@@ -14,8 +14,10 @@ import sympy
 from click.testing import CliRunner
 from scipy.optimize import brentq, minimize, minimize_scalar
 
-from jacgen import kinematics, load_robot, reference
-from jacgen.analysis import analyse
+from jacgen.model import kinematics
+from jacgen import load_robot
+from jacgen.checking import reference
+from jacgen.model.singularities import analyse
 from jacgen.cli import main
 
 from conftest import ROBOT_NAMES, generated_module, random_configurations, robot
@@ -223,8 +225,8 @@ def test_isotropy_of_planar_2r(tmp_path, a1, a2):
 def test_roots_of_a_one_joint_factor(polynomial):
     """Roots from the polynomial in tan(q/2) (numeric above degree 2), against a dense scan
     of the factor over one turn: the same roots, each within 1e-9 (q = pi included)."""
-    from jacgen.analysis import _Numeric
-    from jacgen.joint_ring import JointRing
+    from jacgen.model.singularities import _Numeric
+    from jacgen.model.joint_ring import JointRing
 
     arm = robot("planar_2r")
     ring = JointRing(arm)

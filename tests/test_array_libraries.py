@@ -6,7 +6,7 @@ PyTorch is tested where it is installed (CI installs the CPU build; see .ci/run)
 import numpy as np
 import pytest
 
-from jacgen import reference
+from jacgen.checking import reference
 
 from conftest import generated_module, random_configurations, robot
 

@@ -128,7 +128,7 @@ def test_generate_sets_the_budget(tmp_path):
 def test_analysis_out_of_budget_falls_back_to_the_numeric_condition(capsys):
     """The budget is a safety net on the robot's whole exact analysis: past it, the numeric
     Gram determinant alone is the condition, with a warning."""
-    from jacgen.functions import Generator
+    from jacgen.emission.generator import Generator
     from conftest import robot
 
     budget.set_seconds(0.01)

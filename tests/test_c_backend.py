@@ -13,13 +13,13 @@ import pytest
 import sympy
 from numpy.testing import assert_allclose
 
-from jacgen import reference
-from jacgen.compile import CLibrary, compile_shared
-from jacgen.functions import Generator, matrix, scalar
-from jacgen.backends.c import CPrinter
+from jacgen.checking import reference
+from jacgen.checking.c_library import CLibrary, compile_shared
+from jacgen.emission.generator import Generator, matrix, scalar
+from jacgen.emission.backends.c import CPrinter
 from jacgen.files import write_files
-from jacgen.render import render_robot
-from jacgen.robot import load_robot
+from jacgen.emission.render import render_robot
+from jacgen.inputs.robot import load_robot
 
 from conftest import ROOT, random_configurations
 from support.robot_texts import PARAMETRIC

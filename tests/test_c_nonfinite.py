@@ -6,9 +6,9 @@ import subprocess
 
 import pytest
 
-from jacgen.compile import WARNING_FLAGS
+from jacgen.checking.c_library import WARNING_FLAGS
 from jacgen.files import write_files
-from jacgen.render import render_robot
+from jacgen.emission.render import render_robot
 
 from conftest import robot
 

@@ -14,8 +14,9 @@ import jinja2
 import numpy as np
 import pytest
 
-from jacgen import general6r, reference
-from jacgen.compile import compile_shared
+from jacgen.solvers import general6r
+from jacgen.checking import reference
+from jacgen.checking.c_library import compile_shared
 
 from conftest import ROOT
 from support.general6r_arms import ARMS, solver_of

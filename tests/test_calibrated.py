@@ -10,9 +10,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from jacgen import reference, structure
-from jacgen.model import Model
-from jacgen.robot import load_robot
+from jacgen.checking import reference
+from jacgen.model import structure
+from jacgen.solvers.model import Model
+from jacgen.inputs.robot import load_robot
 
 from conftest import GENERATED, robot
 from support.ik import wrapped

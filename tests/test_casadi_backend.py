@@ -7,11 +7,11 @@ import pytest
 import sympy
 from numpy.testing import assert_allclose
 
-from jacgen import reference
-from jacgen.backends.casadi import CasadiPrinter
-from jacgen.nodes import Select
-from jacgen.robot import load_robot
-from jacgen.verify import compare
+from jacgen.checking import reference
+from jacgen.emission.backends.casadi import CasadiPrinter
+from jacgen.model.nodes import Select
+from jacgen.inputs.robot import load_robot
+from jacgen.checking.verify import compare
 
 from conftest import random_configurations, robot as shipped_robot
 from support.robot_texts import PARAMETRIC

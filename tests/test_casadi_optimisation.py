@@ -10,11 +10,11 @@ import casadi
 import numpy as np
 import pytest
 
-from jacgen import reference
-from jacgen.compile import CLibrary, c_compiler, compile_shared
-from jacgen.functions import Generator
-from jacgen.generated_code import import_module
-from jacgen.robot import load_robot
+from jacgen.checking import reference
+from jacgen.checking.c_library import CLibrary, c_compiler, compile_shared
+from jacgen.emission.generator import Generator
+from jacgen.checking.generated_code import import_module
+from jacgen.inputs.robot import load_robot
 
 ROOT = Path(__file__).resolve().parent.parent
 SHIPPED = sorted(path.stem for path in (ROOT / "robots").glob("*.yaml"))

@@ -7,10 +7,11 @@ import re
 import numpy as np
 from click.testing import CliRunner
 
-from jacgen import __version__, load_robot, reference
+from jacgen import __version__, load_robot
+from jacgen.checking import reference
 from jacgen.cli import main
-from jacgen.compile import CLibrary, compile_shared
-from jacgen.functions import Generator
+from jacgen.checking.c_library import CLibrary, compile_shared
+from jacgen.emission.generator import Generator
 
 from conftest import ROOT, import_module, random_configurations
 
@@ -91,7 +92,7 @@ def test_usage_mistakes_are_one_line():
 def test_internal_error_is_one_line_and_debug_shows_the_traceback(tmp_path, monkeypatch):
     """A bug of jacgen's is one line and exit 1, the traceback only with --debug, and
     nothing already on disk is touched (files are written after everything is generated)."""
-    import jacgen.render
+    import jacgen.emission.render
 
     def broken(*args, **kwargs):
         raise ZeroDivisionError("polynomial division")
@@ -99,7 +100,7 @@ def test_internal_error_is_one_line_and_debug_shows_the_traceback(tmp_path, monk
     existing = tmp_path / "planar_2r" / "planar_2r.py"
     existing.parent.mkdir()
     existing.write_text("earlier output\n")
-    monkeypatch.setattr(jacgen.render, "render_robot", broken)
+    monkeypatch.setattr(jacgen.emission.render, "render_robot", broken)
     arguments = ["generate", str(ROOT / "robots" / "planar_2r.yaml"), "-o", str(tmp_path)]
     result = CliRunner().invoke(main, arguments)
     assert result.exit_code == 1

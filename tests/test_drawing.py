@@ -11,11 +11,11 @@ import pinocchio as pin
 import pytest
 from click.testing import CliRunner
 
-from jacgen import reference
+from jacgen.checking import reference
 from jacgen.cli import main
-from jacgen.compare_urdf import compare_urdf, first_difference
-from jacgen.drawing import BOUNDARY_CELLS, draw_arm, draw_workspace
-from jacgen.robot import parse_robot
+from jacgen.reports.urdf_comparison import compare_urdf, first_difference
+from jacgen.reports.drawing import BOUNDARY_CELLS, draw_arm, draw_workspace
+from jacgen.inputs.robot import parse_robot
 
 from conftest import ROBOT_NAMES, ROOT, random_configurations, robot
 from support.random_arms import random_arm_text

@@ -26,7 +26,8 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 
-from jacgen import numeric_chain, reference
+from jacgen.inputs import numeric_chain
+from jacgen.checking import reference
 
 with warnings.catch_warnings():
     warnings.simplefilter("ignore")

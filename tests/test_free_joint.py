@@ -11,8 +11,8 @@ import frankik
 import numpy as np
 import pytest
 
-from jacgen import reference
-from jacgen.robot import parse_robot
+from jacgen.checking import reference
+from jacgen.inputs.robot import parse_robot
 
 from conftest import random_configurations, robot
 from support.ik import regular, wrapped
@@ -135,7 +135,7 @@ def test_random_arms_round_trip(kind, seed, free, generated):
 def test_elbow_cannot_be_the_free_joint():
     """With the elbow (joint 4) of an S-R-S arm held, shoulder and wrist are fixed distance
     apart: the six joints left have infinitely many solutions, and no class applies."""
-    from jacgen.structure import classify
+    from jacgen.model.structure import classify
 
     structure = classify(parse_robot((_srs(0) + "ik: {free_joint: 4}\n").encode()))
     assert structure.solver is None and "joint 4 free" in structure.reason

@@ -26,10 +26,10 @@ import yaml
 from hypothesis import HealthCheck, assume, given, settings
 from hypothesis import strategies as st
 
-from jacgen import expr
+from jacgen.inputs import values
 from jacgen.errors import RobotFileError
-from jacgen.expr import ExpressionError, Value
-from jacgen.robot import TASK_COMPONENTS, Robot, parse_robot
+from jacgen.inputs.values import ExpressionError, Value
+from jacgen.inputs.robot import TASK_COMPONENTS, Robot, parse_robot
 
 from conftest import ROBOT_FILES
 
@@ -177,12 +177,12 @@ def resolve(name: str) -> Value:
 def test_random_expression_strings(text):
     counts = OUTCOMES.setdefault("expression_strings", Counter())
     try:
-        value = expr.parse(text, resolve)
+        value = values.parse(text, resolve)
     except ExpressionError as error:
         assert "\n" not in str(error)
         counts["error"] += 1
         return
-    assert math.isfinite(value.approx) and abs(value.approx) <= expr.MAX_MAGNITUDE
+    assert math.isfinite(value.approx) and abs(value.approx) <= values.MAX_MAGNITUDE
     counts["value"] += 1
 
 
@@ -224,14 +224,14 @@ def evaluate(tree) -> tuple[float, float]:
             value = a / b
             error = math.inf if eb >= abs(b) else (ea + abs(value) * eb) / (abs(b) - eb)
         else:  # "**" with a small integer exponent
-            if abs(b) > expr.MAX_EXPONENT or (a == 0 and b < 0):
+            if abs(b) > values.MAX_EXPONENT or (a == 0 and b < 0):
                 raise Invalid
             value = a**b
             error = abs(b) * abs(a) ** (b - 1) * ea * 1.01 if a else 0.0
         if value == 0 and kind in ("*", "/", "**") and a != 0 and (b != 0 or kind == "**"):
             raise Invalid  # a product, quotient or power of non-zero numbers underflowed
         error += EPSILON * abs(value)
-    if abs(value) > expr.MAX_MAGNITUDE or 0 < abs(value) < sys.float_info.min:
+    if abs(value) > values.MAX_MAGNITUDE or 0 < abs(value) < sys.float_info.min:
         raise Invalid
     return value, error
 
@@ -279,10 +279,10 @@ def test_parser_agrees_with_python_arithmetic(tree, parenthesize):
         expected, error_bound = evaluate(tree)
     except Invalid:
         with pytest.raises(ExpressionError):
-            expr.parse(text, resolve)
+            values.parse(text, resolve)
         counts["refused"] += 1
         return
-    value = expr.parse(text, resolve)
+    value = values.parse(text, resolve)
     # Python reads the same text with the same precedence; float literals make it float arithmetic.
     python = eval(re.sub(r"(?<![\d.eE+-])(\d+)(?![\d.eE])", r"\1.0", text), {"pi": math.pi, "sqrt": math.sqrt})
     assert value.approx == pytest.approx(python, rel=1e-12, abs=1e-300)

@@ -11,7 +11,8 @@ import numpy as np
 import pytest
 import roboticstoolbox as rtb
 
-from jacgen import general6r, reference
+from jacgen.solvers import general6r
+from jacgen.checking import reference
 
 from support.general6r_arms import ARMS, JACO, Solver, multi_start, numeric, robot_of, solver_of
 from support.ik import wrapped

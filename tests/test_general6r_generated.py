@@ -10,10 +10,11 @@ import math
 import numpy as np
 import pytest
 
-from jacgen import general6r, reference
-from jacgen.compile import compile_shared
-from jacgen.model import Model
-from jacgen.robot import parse_robot
+from jacgen.solvers import general6r
+from jacgen.checking import reference
+from jacgen.checking.c_library import compile_shared
+from jacgen.solvers.model import Model
+from jacgen.inputs.robot import parse_robot
 
 from conftest import GENERATED, generated_module, robot
 from support.general6r_arms import multi_start

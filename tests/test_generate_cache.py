@@ -9,7 +9,8 @@ import sys
 import pytest
 from click.testing import CliRunner
 
-from jacgen import cache, render
+from jacgen import cache
+from jacgen.emission import render
 from jacgen.cli import main
 
 from conftest import ROOT

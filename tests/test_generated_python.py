@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from jacgen import reference
+from jacgen.checking import reference
 
 from conftest import generated_module, random_configurations, robot
 from support.ik import wrapped

@@ -12,7 +12,7 @@ import sys
 import pytest
 
 from jacgen.files import stale_files, write_files
-from jacgen.render import render_robot
+from jacgen.emission.render import render_robot
 
 from conftest import GENERATED, ROBOT_NAMES, robot
 

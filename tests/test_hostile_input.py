@@ -28,15 +28,16 @@ from click.testing import CliRunner
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from jacgen import names, reference
-from jacgen.backends.c import CPrinter
+from jacgen.inputs import names
+from jacgen.checking import reference
+from jacgen.emission.backends.c import CPrinter
 from jacgen.cli import main
-from jacgen.compile import compile_shared
+from jacgen.checking.c_library import compile_shared
 from jacgen.errors import JacgenError
-from jacgen.functions import Generator
-from jacgen.generated_code import GeneratedCode, import_module
-from jacgen.import_urdf import import_urdf
-from jacgen.robot import load_robot, parse_robot
+from jacgen.emission.generator import Generator
+from jacgen.checking.generated_code import GeneratedCode, import_module
+from jacgen.urdf_import import import_urdf
+from jacgen.inputs.robot import load_robot, parse_robot
 
 from conftest import ROOT
 

@@ -15,8 +15,8 @@ import pytest
 from eaik.IK_HP import HPRobot
 from ik_geo import Robot as IkGeoRobot
 
-from jacgen import reference
-from jacgen.robot import parse_robot
+from jacgen.checking import reference
+from jacgen.inputs.robot import parse_robot
 
 from conftest import random_configurations, robot
 from support.ik import kinematic_chain, regular, target_error, wrapped_distance

@@ -11,7 +11,7 @@ velocity_ik a function `(q, mu_dot, damping) -> (q_dot, status)`.
 import numpy as np
 import pytest
 
-from jacgen import reference
+from jacgen.checking import reference
 
 from conftest import ROBOT_NAMES, random_configurations, robot
 from support.ik import reference_js, regular, target_error, without_limits, wrapped_distance

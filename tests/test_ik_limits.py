@@ -13,7 +13,7 @@ import ctypes
 import numpy as np
 import pytest
 
-from jacgen import reference
+from jacgen.checking import reference
 
 from conftest import generated_module, random_configurations, robot
 from support.ik import wrapped

@@ -1,5 +1,6 @@
-"""The stages of jacgen import one way: no module of jacgen/ reaches, directly or through
-others, back to itself. Lazy imports inside functions count too."""
+"""The stages of jacgen import one way (inputs, model, solvers, reports, emission, checking),
+and no module of jacgen/ reaches, directly or through others, back to itself. Lazy imports
+inside functions count too."""
 
 import ast
 from pathlib import Path
@@ -72,19 +73,39 @@ def test_no_import_circle_in_jacgen():
     assert cycles(graph) == []
 
 
+# The stage folders of jacgen/ in the order the data flows; a stage imports only earlier ones.
+# The modules at the top of jacgen/ are the command line and what its commands share.
+STAGES = ("inputs", "model", "solvers", "reports", "emission", "checking")
+
+
+def stage(module: str) -> int | None:
+    parts = module.split(".")
+    return STAGES.index(parts[1]) if len(parts) > 2 and parts[1] in STAGES else None
+
+
+def test_the_stages_import_one_way():
+    paths = sorted(PACKAGE.rglob("*.py"))
+    modules = {module_name(path) for path in paths}
+    backwards = sorted((module_name(path), target) for path in paths for target in imports(path, modules)
+                       if stage(module_name(path)) is not None and stage(target) is not None
+                       and stage(target) > stage(module_name(path)))
+    assert backwards == []
+
+
 def test_a_circle_is_found():
     assert cycles({"a": {"b"}, "b": {"c"}, "c": {"a"}, "d": {"a"}}) == [["a", "b", "c"]]
 
 
 # The modules that check generated code or an imported file against the oracle; nothing that
 # generates may read it (its numbers come from `numeric_chain`, a separate implementation).
-CHECKERS = {"jacgen.verify", "jacgen.generated_code", "jacgen.target", "jacgen.import_urdf"}
+CHECKERS = {"jacgen.checking.verify", "jacgen.checking.generated_code", "jacgen.checking.cortex_m4f",
+            "jacgen.urdf_import"}
 
 
 def test_only_the_checkers_import_the_reference():
     paths = sorted(PACKAGE.rglob("*.py"))
     modules = {module_name(path) for path in paths}
-    readers = {module_name(path) for path in paths if "jacgen.reference" in imports(path, modules)}
+    readers = {module_name(path) for path in paths if "jacgen.checking.reference" in imports(path, modules)}
     assert readers and readers <= CHECKERS, readers - CHECKERS
 
 

@@ -4,8 +4,10 @@ import numpy as np
 import pytest
 import sympy
 
-from jacgen import Kinematics, kinematics, reference
-from jacgen.functions import Generator
+from jacgen import Kinematics
+from jacgen.model import kinematics
+from jacgen.checking import reference
+from jacgen.emission.generator import Generator
 
 from conftest import ROBOT_NAMES, random_configurations, robot
 

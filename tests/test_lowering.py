@@ -5,10 +5,10 @@ import pytest
 import sympy
 from sympy.core.parameters import distribute
 
-from jacgen.functions import Generator
-from jacgen.lowering import eliminate_common, operation_count
-from jacgen.robot import load_robot, parse_robot
-from jacgen.nodes import AtLeast, Below, IsFinite, Select
+from jacgen.emission.generator import Generator
+from jacgen.emission.lowering import eliminate_common, operation_count
+from jacgen.inputs.robot import load_robot, parse_robot
+from jacgen.model.nodes import AtLeast, Below, IsFinite, Select
 from conftest import ROOT
 from support.random_arms import random_arm_text
 

@@ -22,12 +22,12 @@ import pytest
 from click.testing import CliRunner
 
 from jacgen.cli import main
-from jacgen.functions import Generator
-from jacgen.generated_code import NATIVE_BACKENDS, import_module
+from jacgen.emission.generator import Generator
+from jacgen.checking.generated_code import NATIVE_BACKENDS, import_module
 from jacgen.files import write_files
-from jacgen.render import render_robot
-from jacgen.robot import load_robot, parse_robot
-from jacgen.verify import verify_on_host
+from jacgen.emission.render import render_robot
+from jacgen.inputs.robot import load_robot, parse_robot
+from jacgen.checking.verify import verify_on_host
 from support.random_arms import random_arm_text
 
 ROOT = Path(__file__).resolve().parent.parent

@@ -4,8 +4,9 @@ reference, on random arms of both conventions with prismatic joints, base and to
 import numpy as np
 import pytest
 
-from jacgen import numeric_chain, reference
-from jacgen.robot import parse_robot
+from jacgen.inputs import numeric_chain
+from jacgen.checking import reference
+from jacgen.inputs.robot import parse_robot
 from support.random_arms import random_arm_text
 
 

@@ -8,9 +8,9 @@ import pinocchio as pin
 import pytest
 from numpy.testing import assert_allclose
 
-from jacgen import reference
-from jacgen.functions import Generator
-from jacgen.robot import parse_robot
+from jacgen.checking import reference
+from jacgen.emission.generator import Generator
+from jacgen.inputs.robot import parse_robot
 
 from conftest import ROBOT_NAMES, ROOT
 from support.pinocchio_chain import pinocchio_from_dh, robot_of, samples

@@ -13,10 +13,11 @@ import numpy as np
 import pytest
 import sympy
 
-from jacgen import numeric_chain, reference
-from jacgen.expr import Value
-from jacgen.model import Model
-from jacgen.robot import Pose, parse_robot
+from jacgen.inputs import numeric_chain
+from jacgen.checking import reference
+from jacgen.inputs.values import Value
+from jacgen.solvers.model import Model
+from jacgen.inputs.robot import Pose, parse_robot
 
 from conftest import generated_module, robot
 from support.general6r_arms import multi_start

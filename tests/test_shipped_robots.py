@@ -9,10 +9,10 @@ import subprocess
 
 import pytest
 
-from jacgen.compile import WARNING_FLAGS
-from jacgen.structure import classify
+from jacgen.checking.c_library import WARNING_FLAGS
+from jacgen.model.structure import classify
 from jacgen.parallel import usable_cpus
-from jacgen.verify import verify
+from jacgen.checking.verify import verify
 
 from conftest import ROBOT_NAMES, robot
 

@@ -7,9 +7,9 @@ import time
 import numpy as np
 import pytest
 
-from jacgen import reference
-from jacgen.robot import parse_robot
-from jacgen.structure import SOLVERS, Geometry, classify
+from jacgen.checking import reference
+from jacgen.inputs.robot import parse_robot
+from jacgen.model.structure import SOLVERS, Geometry, classify
 
 from conftest import ROBOT_NAMES, robot
 

@@ -12,8 +12,8 @@ import pytest
 from click.testing import CliRunner
 
 from jacgen.cli import main
-from jacgen.robot import load_robot
-from jacgen.target import INSTALL
+from jacgen.inputs.robot import load_robot
+from jacgen.checking.cortex_m4f import INSTALL
 
 ROOT = Path(__file__).resolve().parent.parent
 MISSING = [tool for tool in ("arm-none-eabi-gcc", "arm-none-eabi-nm", "qemu-system-arm") if shutil.which(tool) is None]

@@ -11,12 +11,12 @@ import pytest
 import sympy
 from click.testing import CliRunner
 
-from jacgen import reference
+from jacgen.checking import reference
 from jacgen.cli import main
-from jacgen.expr import parse
-from jacgen.import_urdf import import_urdf, literal
-from jacgen.robot import load_robot, parse_robot
-from jacgen.structure import classify
+from jacgen.inputs.values import parse
+from jacgen.urdf_import import import_urdf, literal
+from jacgen.inputs.robot import load_robot, parse_robot
+from jacgen.model.structure import classify
 
 from conftest import ROOT
 from support.urdf import DATA, URDFS, imported

@@ -3,7 +3,7 @@ in modified DH too) generates, builds and passes `jacgen verify` (every function
 backend against the numpy reference). The fk of every URDF is checked against Pinocchio in
 test_urdf_import; this file checks that what the import writes generates."""
 
-from jacgen.verify import verify
+from jacgen.checking.verify import verify
 
 from support.urdf import URDFS, imported
 

@@ -6,10 +6,10 @@ import numpy as np
 import pytest
 from click.testing import CliRunner
 
-from jacgen import reference, samples, verify
+from jacgen.checking import reference, samples, verify
 from jacgen.cli import main
-from jacgen.compile import CompileError, compile_shared
-from jacgen.functions import Generator, scalar
+from jacgen.checking.c_library import CompileError, compile_shared
+from jacgen.emission.generator import Generator, scalar
 
 from conftest import robot as shipped_robot
 

@@ -9,8 +9,9 @@ import math
 import numpy as np
 import sympy
 
-from jacgen import general6r, reference
-from jacgen.robot import parse_robot
+from jacgen.solvers import general6r
+from jacgen.checking import reference
+from jacgen.inputs.robot import parse_robot
 
 from .ik import wrapped
 

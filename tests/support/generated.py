@@ -17,13 +17,13 @@ from pathlib import Path
 
 import pytest
 
-from jacgen import generated_code
-from jacgen.compile import CLibrary, compile_shared
-from jacgen.functions import Generator
-from jacgen.generated_code import import_module
+from jacgen.checking import generated_code
+from jacgen.checking.c_library import CLibrary, compile_shared
+from jacgen.emission.generator import Generator
+from jacgen.checking.generated_code import import_module
 from jacgen.files import write_files
-from jacgen.render import render_robot
-from jacgen.robot import Robot, load_robot
+from jacgen.emission.render import render_robot
+from jacgen.inputs.robot import Robot, load_robot
 
 ROOT = Path(__file__).resolve().parents[2]
 GENERATED = ROOT / "generated"

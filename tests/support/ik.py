@@ -6,9 +6,9 @@ import re
 
 import numpy as np
 
-from jacgen import reference
-from jacgen.robot import EULER_ANGLES as EULER
-from jacgen.robot import parse_robot
+from jacgen.checking import reference
+from jacgen.inputs.robot import EULER_ANGLES as EULER
+from jacgen.inputs.robot import parse_robot
 
 
 def wrapped(angles):

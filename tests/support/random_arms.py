@@ -18,7 +18,7 @@ import re
 from click.testing import CliRunner
 
 from jacgen.cli import main
-from jacgen.robot import TASK_COMPONENTS
+from jacgen.inputs.robot import TASK_COMPONENTS
 
 SPECIAL_ALPHAS = (0.0, 90.0, -90.0, 180.0)
 

@@ -4,7 +4,7 @@ and verify)."""
 
 from pathlib import Path
 
-from jacgen.import_urdf import import_urdf
+from jacgen.urdf_import import import_urdf
 
 DATA = Path(__file__).resolve().parents[1] / "data" / "urdf"
 # name: (file, base link, tip link, closed-form ik class of the imported arm)

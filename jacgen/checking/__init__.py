@@ -1,0 +1,2 @@
+"""Checking generated code: the independent numpy reference, `jacgen verify`, the compiled C
+through ctypes, the emulated Cortex-M4F, and the configurations checked at."""

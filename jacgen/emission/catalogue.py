@@ -1,0 +1,177 @@
+"""The catalogue: every function a robot can get, in the order the backends emit them, those
+each one calls, and their arguments and outputs with shapes and the contract's C extents,
+as data. `functions.Generator` builds each one from its algorithm; a backend lays out what
+the catalogue says.
+"""
+
+from dataclasses import dataclass
+
+import sympy
+
+from jacgen.emission.lowering import Body
+
+SECOND_ORDER = ("fk_jacobian_dot", "jacobian_dot", "bias_acceleration", "task_jacobian_dot", "hessian")
+
+# Every function a robot can get, in the order the backends emit them (`ik` and `ik_numeric`
+# are loops the templates write around ik_branches and ik_numeric_step), and the functions each
+# one calls: `--functions` generates the named ones and their callees.
+FUNCTION_NAMES = ("fk", "jacobian", "fk_jacobian", "jacobian_tool", "task", "task_jacobian", "fk_jacobian_dot",
+                  "jacobian_dot", "bias_acceleration", "task_jacobian_dot", "hessian", "singularity_factors",
+                  "manipulability", "jacobian_det", "velocity_ik", "ik_numeric_step", "ik_numeric", "ik_branches",
+                  "ik_nearest", "ik")
+CALLEES = {"ik": ("ik_branches",), "ik_nearest": ("ik_branches",), "ik_numeric": ("ik_numeric_step",)}
+
+
+# The contract's extent of every array, in named dimensions (C's `double J[6 * NAME_DOF]`), by
+# argument name or "function.output", else by the function an output equals or belongs to; an
+# array not listed is a pose (16) or as long as it is.
+EXTENTS = {
+    "q": ("DOF",),
+    "T": (16,),
+    "mu": ("TASK_DIM",),
+    "ik_branches.q": ("MAX_IK_SOLUTIONS", "DOF"),
+    "ik_branches.valid": ("MAX_IK_SOLUTIONS",),
+    "ik_branches.in_limits": ("MAX_IK_SOLUTIONS",),
+    "ik_nearest.q": ("DOF",),
+    "q_seed": ("DOF",),
+    "weights": ("DOF",),
+    "mu_dot": ("TASK_DIM",),
+    "velocity_ik.q_dot": ("DOF",),
+    "ik_numeric_step.q_start": ("DOF",),
+    "ik_numeric_step.q_next": ("DOF",),
+    "ik_general_start.q": ("DOF",),
+    "ik_general_residual.e": (6,),
+    "ik_general_residual.J": (6, 6),
+    "ik_general_limits.q": ("DOF",),
+    "q_solution": ("DOF",),
+    "fk": (16,),
+    "jacobian": (6, "DOF"),
+    "jacobian_tool": (6, "DOF"),
+    "task": ("TASK_DIM",),
+    "task_jacobian": ("TASK_DIM", "DOF"),
+    "q_dot": ("DOF",),
+    "jacobian_dot": (6, "DOF"),
+    "bias_acceleration": (6,),
+    "task_jacobian_dot": ("TASK_DIM", "DOF"),
+    "hessian": ("DOF", 6, "DOF"),
+    "singularity_factors": ("NUM_SINGULARITY_FACTORS",),
+}
+
+
+def extent_of(key: str, size: int) -> tuple[int | str, ...]:
+    return EXTENTS.get(key, (16,) if size == 16 else ("TASK_DIM",) if key == "target" else (size,))
+
+
+def with_callees(names) -> frozenset[str]:
+    """The functions named and those they call (ValueError for a name no robot has)."""
+    unknown = [name for name in names if name not in FUNCTION_NAMES]
+    if unknown:
+        raise ValueError(f"unknown function {unknown[0]!r}; expected some of {', '.join(FUNCTION_NAMES)}")
+    return frozenset(names).union(*(CALLEES.get(name, ()) for name in names))
+
+
+@dataclass(frozen=True)
+class Argument:
+    """An input of a generated function: its name and its symbols, in its shape."""
+
+    name: str
+    symbols: sympy.Matrix
+    vector: bool = True  # numpy shape (..., rows); else (..., rows, cols)
+    scalar: bool = False  # one number: by value in C, shape (...) in numpy, its symbol named as the argument
+    default: str | None = None  # a scalar's default in Python
+
+    @property
+    def size(self) -> int:
+        return len(self.symbols)
+
+    @property
+    def extent(self) -> tuple[int | str, ...]:
+        return extent_of(self.name, self.size)
+
+
+@dataclass(frozen=True)
+class Output:
+    """One result of a generated function: a rows x cols matrix, or a scalar returned by value."""
+
+    name: str  # the array's name in C
+    rows: int
+    cols: int
+    scalar: bool = False
+    vector: bool = False  # a column vector: numpy shape (rows,), even for one row
+    equals: str = ""  # the function whose result this is, when the function fuses several
+    boolean: bool = False  # truth values
+    integer: bool = False  # a status: an int in C and numpy
+    layers: int = 1  # > 1: a stack of `layers` matrices of rows / layers x cols (the hessian)
+    extent: tuple[int | str, ...] = ()  # the contract's extent, in named dimensions (see EXTENTS)
+
+    @property
+    def size(self) -> int:
+        return self.rows * self.cols
+
+    @property
+    def shape(self) -> tuple[int, ...]:
+        """numpy shape: matrices (rows, cols) (a one-joint Jacobian too), vectors (rows,), scalars (),
+        stacks (layers, rows / layers, cols)."""
+        if self.scalar:
+            return ()
+        if self.layers > 1:
+            return (self.layers, self.rows // self.layers, self.cols)
+        return (self.rows,) if self.vector else (self.rows, self.cols)
+
+
+@dataclass(frozen=True)
+class Call:
+    """Another generated function that a function calls before its body, passing some of its
+    arguments; the body reads the callee's results, held as `results` (arguments named as
+    the local arrays, with their symbols)."""
+
+    function: str
+    passes: tuple[str, ...]
+    results: tuple[Argument, ...]
+
+
+@dataclass(frozen=True)
+class Loop:
+    """A function a template writes around generated ones (the general 6R solver's ik_branches,
+    around an eigensolver): its name and outputs, as its callers read them."""
+
+    name: str
+    outputs: tuple[Output, ...]
+
+
+@dataclass(frozen=True)
+class Function:
+    """One generated function; its body's outputs are those of `outputs`, concatenated."""
+
+    name: str
+    summary: str
+    outputs: tuple[Output, ...]
+    body: Body
+    arguments: tuple[Argument, ...]
+    calls: tuple[Call, ...] = ()
+
+    @property
+    def inputs(self):
+        """(symbol, argument, row, col) of every input the body reads, in argument order, then
+        the results of its calls."""
+        for argument in (*self.arguments, *(result for call in self.calls for result in call.results)):
+            for k, symbol in enumerate(argument.symbols):
+                if symbol in self.body.read and not argument.scalar:
+                    yield (symbol, argument, *divmod(k, argument.symbols.cols))
+
+    @property
+    def scalar(self) -> bool:
+        """Returns its one result by value."""
+        return len(self.outputs) == 1 and self.outputs[0].scalar
+
+    @property
+    def returned(self) -> Output | None:
+        """The result C returns by value (a scalar), the others being arrays."""
+        return next((output for output in self.outputs if output.scalar), None)
+
+    def parts(self, values: tuple[sympy.Expr, ...]):
+        """The body's outputs split per output: (Output, its values row-major)."""
+        start = 0
+        for output in self.outputs:
+            yield output, values[start:start + output.size]
+            start += output.size

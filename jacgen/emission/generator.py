@@ -1,0 +1,484 @@
+"""The Generator: each function of the catalogue (`catalogue.py`) a robot gets, built from its
+algorithm and lowered to straight-line code (`lowering`).
+
+The kinematics are rebuilt over trig symbols (`c2 = cos(q2 + offset)`) that every function
+shares; adding a function touches the catalogue, this module and its algorithm.
+"""
+
+import math
+from dataclasses import dataclass
+from functools import cached_property
+
+import sympy
+from sympy.core.parameters import distribute
+
+from jacgen.emission.catalogue import (CALLEES, EXTENTS, FUNCTION_NAMES, SECOND_ORDER, Argument, Call, Function, Loop,
+                                       Output, extent_of, with_callees)
+from jacgen.emission.lowering import Lowering, is_boolean
+from jacgen.inputs.robot import EULER_ANGLES, Robot
+from jacgen.inputs.transforms import rot_z, twist
+from jacgen.model import kinematics
+from jacgen.model.joint_ring import joint_atoms, maximal_minors
+from jacgen.model.kinematics import generated_symbol
+from jacgen.model.nodes import Above, AtMost, select
+from jacgen.model.singularities import MINOR_LIMIT, Singularities, singularity_jacobian
+from jacgen.solvers import differential, general6r, ik, ik_limits
+from jacgen.solvers.model import Model
+from jacgen.solvers.subproblems import Subproblems, wrapped
+
+
+@dataclass(frozen=True)
+class Result:
+    """One named result of a generated function, as `matrix`, `vector`, `scalar` or `status` make it."""
+
+    name: str
+    values: list  # row by row: expressions, or truth values
+    rows: int
+    cols: int
+    shape: str  # "matrix", "vector" (numpy (rows,)), "scalar" or "status" (an integer scalar)
+    equals: str = ""  # in a function that fuses several: the function this result is
+    layers: int = 1  # > 1: a stack of that many matrices (the hessian)
+
+
+def matrix(name: str, value: sympy.Matrix, equals: str = "", layers: int = 1) -> Result:
+    return Result(name, list(value), value.rows, value.cols, "matrix", equals, layers)
+
+
+def vector(name: str, values, equals: str = "") -> Result:
+    values = [sympy.sympify(value) for value in values]
+    return Result(name, values, len(values), 1, "vector", equals)
+
+
+def scalar(name: str, value) -> Result:
+    return Result(name, [sympy.sympify(value)], 1, 1, "scalar")
+
+
+def status(name: str, value) -> Result:
+    return Result(name, [sympy.sympify(value)], 1, 1, "status")
+
+
+class Generator:
+    """Builds the emitted functions of one robot, sharing the symbolic chain between them:
+    every function, or those of `selection` (names of FUNCTION_NAMES, callees included), whose
+    derivation alone is done."""
+
+    def __init__(self, robot: Robot, model: Model | None = None, selection=None):
+        self.robot = robot
+        self.model = model or Model(robot)
+        self.selection = None if selection is None else with_callees(selection)
+        self.q = kinematics.joint_symbols(robot)
+        self.lowering = Lowering()
+        self.name, self.lower = self.lowering.name, self.lowering.lower
+        self._trig: dict[tuple[int, ...], tuple[sympy.Symbol, sympy.Symbol]] = {}  # each defined once
+        with distribute(False):  # keep 0.0825*(a - b) whole, for CSE to share a - b
+            self.chain = kinematics.build_chain(robot, lambda i: self.cos_sin((i,)), self.q, simplify=self.name,
+                                               angle_sum=self.cos_sin)
+
+    def cos_sin(self, joints: tuple[int, ...]) -> tuple[sympy.Symbol, sympy.Symbol]:
+        """Symbols for the cos and sin of a sum of joint angles, defined on first use:
+        `c2 = cos(q2)` for one joint, `c23 = c2*c3 - s2*s3` for a run of parallel joints."""
+        if joints not in self._trig:
+            cos, sin = kinematics.trig_symbols(joints, self.robot.dof)
+            if len(joints) == 1:
+                angle = self.q[joints[0]] + self.robot.joints[joints[0]].offset.exact
+                value = (sympy.cos(angle), sympy.sin(angle))
+            else:
+                value = kinematics.angle_sum_products(self.cos_sin(joints[:-1]), self.cos_sin(joints[-1:]))
+            self.lowering.define(cos, value[0])
+            self.lowering.define(sin, value[1])
+            self._trig[joints] = (cos, sin)
+        return self._trig[joints]
+
+    def generates(self, name: str) -> bool:
+        """Whether `name` is among the functions to generate (when the robot has it)."""
+        return self.selection is None or name in self.selection
+
+    @property
+    def closed_form(self) -> "ik.ClosedForm | None":
+        return self.model.closed_form
+
+    def ik_functions(self) -> list[Function]:
+        """ik_branches (every branch of the closed-form solver, whether the target allows it and
+        whether it is inside the joint limits; for the general 6R solver, the parts its template
+        loop runs, see `general_6r_functions`) and ik_nearest (the solution nearest a seed), from
+        the target's symbols (none without a closed form)."""
+        form = self.closed_form
+        if form is None or not (self.generates("ik_branches") or self.generates("ik_nearest")):
+            return []
+        if form.target == "pose":
+            target = Argument("T", sympy.Matrix(4, 4, lambda r, c: generated_symbol("T", r, c, separator="")), vector=False)
+        else:
+            target = Argument("mu", sympy.Matrix([generated_symbol("mu", i) for i in range(len(self.robot.task))]))
+        free, bindings, free_angle = (), {}, None
+        if form.free is not None:  # the free joint's angle is an input; its cos and sin are the usual c_k, s_k
+            free = (Argument("q_free", sympy.Matrix([sympy.Symbol("q_free", real=True)]), scalar=True),)
+            free_angle = self.q[form.free]
+            bindings = {free_angle: free[0].symbols[0]}
+            self.cos_sin((form.free,))
+        n = self.robot.dof
+        seed = Argument("q_seed", sympy.Matrix([generated_symbol("qn", i + 1) for i in range(n)]))
+        weights = Argument("weights", sympy.Matrix([generated_symbol("qw", i + 1) for i in range(n)]),
+                           default="(1.0,) * DOF")
+        sp = Subproblems(self.name)
+        if form.solver == "general_6r":
+            parts, rows = self.general_6r_functions(target, free, bindings, sp), form.info.max_solutions
+        else:
+            with distribute(False):
+                q, valid, inside = ik.branches(self.robot, form, sp, target.symbols, free_angle)
+            parts = [self.function("ik_branches", "every branch of the closed-form ik, whether the target allows "
+                                   "it and whether it is inside the joint limits", matrix("q", q), vector("valid", valid),
+                                   vector("in_limits", inside), arguments=(target, *free), bindings=bindings)]
+            rows = q.rows
+        if not self.generates("ik_nearest"):
+            return parts
+        # ik_nearest reads ik_branches' results rather than lowering the solver a second time.
+        table = Call("ik_branches", (target.name, *(a.name for a in free)), (
+            Argument("branches_q", sympy.Matrix(rows, n, lambda r, c: generated_symbol("qb", r, c)),
+                     vector=False),
+            Argument("branches_valid", sympy.Matrix([generated_symbol("vb", r, real=None) for r in range(rows)])),
+            Argument("branches_in_limits", sympy.Matrix([generated_symbol("lb", r, real=None) for r in range(rows)]))))
+        table_q, table_valid, table_inside = (result.symbols for result in table.results)
+        with distribute(False):
+            read = target.symbols[:3, :] if form.target == "pose" else target.symbols
+            closest, outcome = ik_limits.nearest(self.robot, sp, table_q, list(table_valid), list(table_inside),
+                                                 list(seed.symbols), list(weights.symbols), form.free, list(read))
+        nearest = self.function("ik_nearest", "the closed-form ik solution inside the joint limits nearest q_seed "
+                                "(sum of weights_j (q_j - q_seed_j)^2), and the status", vector("q", closest),
+                                status("status", outcome), arguments=(target, seed, *free, weights), calls=(table,))
+        return [*parts, nearest]
+
+    def general_6r_functions(self, target: Argument, free_input: tuple, bindings: dict,
+                             sp: Subproblems) -> list[Function]:
+        """The generated parts of the general 6R solver (`general6r`), which ik_branches runs
+        around the eigenproblem kernel of its language: the equations at the target (P0, Ps, Pc
+        stacked 42 x 9, the hidden angle's shift applied; Q 14 x 8), the configuration of one
+        root's loop angles (the loop's free joint from the loop), the pose error and Jacobian of
+        a Newton step, ik's form of a configuration with its limits, and for a calibrated arm the
+        branches of its nominal arm's closed form, which start the fast path. A 7R arm's free
+        joint (`free_input`, bound by `bindings`) is in the chain's head or tail."""
+        form = self.closed_form
+        plan = form.elimination
+        equations, split = plan.equations, plan.equations.split
+        head, links, tail = general6r.chain_form(self.robot, form.free)
+        six = form.joints  # the robot's joint of each of the chain's six
+        name = self.name
+        with distribute(False):
+            n = (_rigid_inverse(head) * target.symbols * _rigid_inverse(tail)).applyfunc(name)
+            v = _rigid_inverse(n).applyfunc(name) if split.target_inverted else n
+            values = {**{equations.rotation[k]: v[k // 3, k % 3] for k in range(9)},
+                      **{equations.translation[k]: v[k, 3] for k in range(3)}}
+            p0, ps, pc, q = (m.xreplace(values) for m in equations.matrices)
+            cos, sin = sympy.Float(math.cos(plan.shift), 17), sympy.Float(math.sin(plan.shift), 17)
+            ps, pc = cos * ps - sin * pc, sin * ps + cos * pc
+            stacked = sympy.Matrix.vstack(p0, ps, pc)
+        equations_function = self.function(
+            "ik_general_equations", "the general 6R solver's equations at T: (P0 + s Ps + c Pc) v_bc = Q v_gh, "
+            "P = [P0; Ps; Pc] (42 x 9)", matrix("P", stacked), matrix("Q", q), arguments=(target, *free_input), bindings=bindings,
+            part_of="ik_branches")
+        angles = Argument("angles", sympy.Matrix([generated_symbol("ga", k) for k in range(5)]))
+        loop = dict(zip((*split.triple, *split.pair), angles.symbols))
+        loop[split.hidden] = loop[split.hidden] + sympy.Float(plan.shift, 17)
+        theta = [None] * 6
+        for position, angle in loop.items():
+            theta[split.joint(position)] = -angle if split.backwards else angle
+        free = split.joint(split.free)
+        constants = [twist(link.d, link.a, link.alpha) for link in links]
+        # The loop angles' rotations, made before distribute(False): under it the -(g + shift) of a
+        # backwards split is not canonical, and cos's "could extract a minus sign" negates it back
+        # and forth forever.
+        turns = [None if i == free else rot_z(sympy.cos(theta[i]), sympy.sin(theta[i]))[:3, :3]
+                 for i in range(6)]
+        with distribute(False):
+            before, after = sympy.eye(3), constants[free][:3, :3] if free < 5 else sympy.eye(3)
+            for i, turn in enumerate(turns):
+                if i < free:
+                    before = (before * turn * constants[i][:3, :3]).applyfunc(name)
+                elif i > free:
+                    after = (after * turn * (constants[i][:3, :3] if i < 5 else sympy.eye(3))).applyfunc(name)
+            column = (before.T * n[:3, :3] * after.T[:, 0]).applyfunc(name)  # Z_free's first column
+            theta[free] = sympy.atan2(column[1], column[0])
+            q = list(self.q)  # the free joint of a 7R arm: its symbol, bound to q_free
+            for k, t in zip(six, theta):
+                q[k] = t - self.robot.joints[k].offset.exact
+        start = self.function("ik_general_start", "the configuration of one root's loop angles (a - shift, b, c, "
+                              "g, h; the loop's free joint from the loop)", vector("q", q),
+                              arguments=(target, *free_input, angles), bindings=bindings, part_of="ik_branches")
+        dof = self.robot.dof
+        target_pose = self._ik_target()
+        given = Argument("q", sympy.Matrix([generated_symbol("qs", i + 1) for i in range(dof)]))
+        with distribute(False):
+            error, jacobian = self._task_error(target_pose, None)
+        step = self.function("ik_general_residual", "the pose error e at q (the position error and the rotation "
+                             "vector of R_target R^T, world frame) and the geometric Jacobian J of the six joints "
+                             "ik solves: the Newton step of the solver's polish is q + J^-1 e",
+                             vector("e", error), matrix("J", jacobian[:, list(six)]),
+                             arguments=(target_pose, given), bindings=dict(zip(self.q, given.symbols)),
+                             part_of="ik_branches")
+        given = Argument("q_solution", sympy.Matrix([generated_symbol("qg", i + 1) for i in range(dof)]))
+        with distribute(False):
+            limited, inside = ik_limits.limited(self.robot, sp, list(given.symbols), six, form.free)
+        limits = self.function("ik_general_limits", "ik's form of q (revolute angles wrapped, or into the limits) "
+                               "and whether it is inside the joint limits", vector("q", limited),
+                               scalar("in_limits", inside), arguments=(given,),
+                               part_of="ik_branches")
+        parts = [equations_function, start, step, limits]
+        if fast := form.fast_path:
+            sp.margins.clear()
+            free_angle = None if form.free is None else self.q[form.free]
+            with distribute(False):
+                q, valid, _ = ik.branches(fast.nominal.robot, fast.form, sp, target.symbols, free_angle)
+                margin = sp.margins[0]
+                for other in sp.margins[1:]:
+                    margin = self.name(select(AtMost(margin, other), margin, other))
+            parts.append(self.function("ik_general_nominal", "the fast path's starting points: every branch of the "
+                                       "nearest special class's closed form (the nominal arm's), whether its target "
+                                       "allows it, and the least margin of its subproblems", matrix("q", q),
+                                       vector("valid", valid), scalar("margin", margin), arguments=(target, *free_input), bindings=bindings, part_of="ik_branches"))
+        return parts
+
+    def velocity_ik_function(self, js: sympy.Matrix) -> Function:
+        """velocity_ik: q_dot solving Js q_dot = mu_dot, and the status (`differential`)."""
+        m, n = js.shape
+        mu_dot = Argument("mu_dot", sympy.Matrix([generated_symbol("mu_dot", i) for i in range(m)]))
+        damping = Argument("damping", sympy.Matrix([sympy.Symbol("damping", real=True)]), scalar=True, default="0.0")
+        with distribute(False):
+            q_dot, outcome = differential.velocity_ik(js, list(self.q), list(mu_dot.symbols), damping.symbols[0],
+                                                      self.name)
+        form = "Js^-1 mu_dot (damping 0) or " if m == n else ""
+        form += ("Js^T (Js Js^T + damping^2 I)^-1 mu_dot" if m <= n else "(Js^T Js + damping^2 I)^-1 Js^T mu_dot")
+        return self.function("velocity_ik", f"joint rates q_dot solving Js q_dot = mu_dot: {form}; and the status",
+                             vector("q_dot", q_dot), status("status", outcome),
+                             arguments=(Argument("q", sympy.Matrix(self.q)), mu_dot, damping))
+
+    def ik_numeric_step_function(self, task_jacobian: sympy.Matrix) -> Function:
+        """ik_numeric_step: one damped least-squares step of ik_numeric from q (`differential`)."""
+        robot, n = self.robot, self.robot.dof
+        target = self._ik_target()
+        given = Argument("q", sympy.Matrix([generated_symbol("qs", i + 1) for i in range(n)]))
+        damping = Argument("damping", sympy.Matrix([sympy.Symbol("damping", real=True)]), scalar=True, default="0.0")
+        limits = [joint.limits for joint in robot.joints]
+        bindings = {qi: differential.clamp(given_i, bounds) for qi, given_i, bounds in zip(self.q, given.symbols, limits)}
+        with distribute(False):
+            error, jacobian = self._task_error(target, task_jacobian)
+            trial, cost = differential.ik_numeric_step(error, jacobian, list(self.q), damping.symbols[0], limits,
+                                                       self.name)
+            read = target.symbols[:3, :] if len(robot.task) == 6 else target.symbols
+            cost = differential.flagged_cost(cost, [*given.symbols, *read], self.name)
+        step = "J^T (J J^T + damping I)^-1 e" if jacobian.rows <= n else "(J^T J + damping I)^-1 J^T e"
+        summary = (f"one step of ik_numeric: q clamped to the limits, then q + {step} clamped, and |e|^2 at "
+                   "the clamped q (-1 when target or q is not finite)")
+        return self.function("ik_numeric_step", summary, vector("q_start", self.q), vector("q_next", trial),
+                             scalar("cost", cost), arguments=(target, given, damping), bindings=bindings)
+
+    def _ik_target(self) -> Argument:
+        """ik_numeric's target: the 4x4 pose for a six-component task, else the task vector."""
+        if len(self.robot.task) == 6:
+            return Argument("target", sympy.Matrix(4, 4, lambda r, c: generated_symbol("T", r, c, separator="")),
+                            vector=False)
+        return Argument("target", sympy.Matrix([generated_symbol("mu", i) for i in range(len(self.robot.task))]))
+
+    def _task_error(self, target: Argument, task_jacobian: sympy.Matrix | None) -> tuple[list, sympy.Matrix]:
+        """The error e that ik's iterations drive to 0, at the chain's q, and its Jacobian: for a
+        pose, the position error and the rotation vector of R_target R^T (world frame) with the
+        geometric Jacobian; else the task error (Euler angles wrapped) with the task Jacobian."""
+        if len(self.robot.task) == 6:
+            tool, goal = self.chain.tool, target.symbols
+            rotation = (goal[:3, :3] * tool[:3, :3].T).applyfunc(self.name)
+            return [goal[i, 3] - tool[i, 3] for i in range(3)] + differential.rotation_vector(rotation, self.name), \
+                self.jacobian
+        mu = kinematics.task_vector(self.robot, self.chain.tool)
+        return [wrapped(goal - value) if component in EULER_ANGLES else goal - value
+                for goal, value, component in zip(target.symbols, mu, self.robot.task)], task_jacobian
+
+    @cached_property
+    def jacobian(self) -> sympy.Matrix:
+        return kinematics.column_jacobian(self.robot, self.chain)
+
+    def second_order_functions(self) -> list[Function]:
+        """fk_jacobian_dot, jacobian_dot, bias_acceleration, task_jacobian_dot and hessian, from
+        the chain and the named columns of J (`kinematics`): O(1) per entry on top of J."""
+        if not any(map(self.generates, SECOND_ORDER)):
+            return []
+        robot, n, m = self.robot, self.robot.dof, len(self.robot.task)
+        q_dot = Argument("q_dot", sympy.Matrix([generated_symbol("qd", i + 1) for i in range(n)]))
+        arguments = (Argument("q", sympy.Matrix(self.q)), q_dot)
+        with distribute(False):
+            columns = self.jacobian.applyfunc(self.name)
+            rates = list(q_dot.symbols)
+            jacobian_dot = kinematics.jacobian_dot(robot, self.chain, columns, rates, self.name)
+            bias = jacobian_dot * q_dot.symbols
+            task_jacobian_dot = kinematics.task_jacobian_dot(robot, self.chain.tool, columns,
+                                                             jacobian_dot.applyfunc(self.name), rates, self.name)
+            hessian = sympy.Matrix.vstack(*kinematics.hessian(robot, columns))
+        return [
+            self.function("fk_jacobian_dot", "fk, jacobian and bias_acceleration in one pass, sharing their terms",
+                          matrix("T", self.chain.tool, equals="fk"), matrix("J", self.jacobian, equals="jacobian"),
+                          vector("a", bias, equals="bias_acceleration"), arguments=arguments),
+            self.function("jacobian_dot", "time derivative dJ/dt of the world geometric Jacobian along q_dot (6 x DOF)",
+                          matrix("Jd", jacobian_dot), arguments=arguments),
+            self.function("bias_acceleration", "J' q_dot: the tool's classical linear and angular acceleration "
+                          "at zero joint acceleration, world frame (6)", vector("a", bias), arguments=arguments),
+            self.function("task_jacobian_dot", f"time derivative of the analytic Jacobian along q_dot ({m} x DOF): "
+                          "mu'' = J_a q'' + J_a' q'", matrix("Jd", task_jacobian_dot), arguments=arguments),
+            self.function("hessian", "partial derivatives dJ/dq_k of the world geometric Jacobian "
+                          "(DOF x 6 x DOF, indexed [k, r, c])", matrix("H", hessian, layers=n)),
+        ]
+
+    @property
+    def singularities(self) -> Singularities:
+        return self.model.singularities
+
+    def rank_determinant(self, js: sympy.Matrix) -> sympy.Expr:
+        """det(Js) for square Js, else the Gram determinant det(Js Js^T) or det(Js^T Js), by
+        Laplace expansion (memoised minors: division-free, at most 6 * 2^5 products per
+        determinant) over the named entries: a fixed cost on top of Js, whatever the arm.
+
+        The Gram determinant is the sum of the squared maximal minors of Js (Cauchy-Binet)
+        while there are at most MINOR_LIMIT of them; beyond, the product of the
+        squared diagonal of R in a QR factorisation of the tall one of Js, Js^T (modified
+        Gram-Schmidt, whose R is backward stable). Both stay accurate to rounding near a
+        singularity, where det(Js Js^T) formed from the product loses half the digits (its
+        square root, the manipulability, good only to sqrt(eps) * |Js|^m).
+        """
+        m, n = js.shape
+        if m == n or math.comb(max(m, n), min(m, n)) <= MINOR_LIMIT:
+            named = [[self.name(entry) for entry in row] for row in js.tolist()]
+            minors = maximal_minors(named, sympy.Integer(0), sympy.Integer(1))
+            return minors[0] if m == n else sympy.Add(*(self.name(minor) ** 2 for minor in minors))
+        tall = js.T if m < n else js
+        columns = [[self.name(entry) for entry in tall[:, k]] for k in range(tall.cols)]
+        squared_diagonal = []
+        for k, column in enumerate(columns):
+            norm = self.name(sympy.Add(*(entry**2 for entry in column)))
+            squared_diagonal.append(norm)
+            divisor = self.name(select(Above(norm, 0), norm, sympy.Integer(1)))
+            for j in range(k + 1, len(columns)):  # the part of column j orthogonal to column k
+                share = self.name(sympy.Add(*(a * b for a, b in zip(columns[j], column))) / divisor)
+                columns[j] = [self.name(entry - share * value) for entry, value in zip(columns[j], column)]
+        return sympy.Mul(*squared_diagonal)
+
+    def magnitude(self, value: sympy.Expr) -> sympy.Expr:
+        """|value| of a named value: sympy's sign analysis of a large determinant (at every
+        rebuild in CSE) takes seconds, or recurses past Python's limit."""
+        return sympy.Abs(self.name(value))
+
+    def singularity_functions(self, js: sympy.Matrix) -> list[Function]:
+        """singularity_factors, manipulability and (square Js) jacobian_det, from Js.
+
+        The exact factors come first; where they are not the whole condition, the numeric
+        rank determinant follows them. jacobian_det is the product of the exact factors
+        when they are complete and cheaper to compute than the expansion of det(Js)."""
+        if not any(map(self.generates, ("singularity_factors", "manipulability", "jacobian_det"))):
+            return []
+        singular, (m, n) = self.singularities, js.shape
+        atoms = {}
+        for i, symbols in enumerate(joint_atoms(self.robot)):
+            if len(symbols) == 2:
+                atoms.update(zip(symbols, self.cos_sin((i,))))
+        numeric = sympy.Integer(0) if singular.everywhere else self.rank_determinant(js)
+        factors = [f.polynomial.xreplace(atoms) for f in singular.factors]
+        if not singular.complete or singular.everywhere:
+            factors.append(numeric)
+        what = "the robot is singular where one is 0" if factors else "never singular: the constant 1"
+        functions = [self.function("singularity_factors", f"factors of {singular.kind}: {what}",
+                                   vector("f", factors or [1]))]
+        if m != n:
+            return functions + [self.function("manipulability", f"manipulability sqrt({singular.kind})",
+                                              scalar("w", sympy.sqrt(self.magnitude(numeric))))]
+        determinant = numeric
+        if singular.complete and not singular.everywhere:
+            rotation = self.chain.tool[:3, :3]
+            cos_pitch = sympy.sqrt(rotation[0, 0] ** 2 + rotation[1, 0] ** 2)
+            exact = singular.constant.xreplace(atoms) * sympy.Mul(
+                *(p.xreplace(atoms) ** k for p, k in singular.determinant)) / cos_pitch**singular.euler_power
+            if self.lower(sympy.Matrix([exact])).operation_count <= self.lower(sympy.Matrix([numeric])).operation_count:
+                determinant = exact
+        return functions + [
+            self.function("manipulability", "manipulability |det(Js)|", scalar("w", self.magnitude(determinant))),
+            self.function("jacobian_det", "det(Js)", scalar("d", determinant)),
+        ]
+
+    def function(self, name: str, summary: str, *results: Result, arguments: tuple[Argument, ...] | None = None,
+                 bindings: dict | None = None, calls: tuple[Call, ...] = (), part_of: str | None = None
+                 ) -> Function | None:
+        """A function of one or more results (`matrix`, `vector`, `scalar`, `status`), lowered
+        together so they share their terms; its arguments are q unless given. `bindings` define
+        symbols (the joints) from the arguments for this function alone; `calls` are the
+        generated functions whose results the body reads. None when `name` (or the function it
+        is `part_of`) is not to be generated (nothing is lowered then)."""
+        if not self.generates(part_of or name):
+            return None
+        outputs, values = [], []
+        for result in results:
+            boolean = all(map(is_boolean, result.values))
+            key, size = f"{name}.{result.name}", result.rows * result.cols
+            outputs.append(Output(result.name, result.rows, result.cols, result.shape in ("scalar", "status"),
+                                  result.shape == "vector" or boolean, result.equals, boolean, result.shape == "status",
+                                  result.layers, extent_of(key if key in EXTENTS else result.equals or name, size)))
+            values += result.values
+        return Function(name, summary, tuple(outputs), self.lower(values, bindings or {}),
+                        arguments or (Argument("q", sympy.Matrix(self.q)),), calls)
+
+    def functions(self) -> list[Function]:
+        """Every straight-line function, in the order the backends emit them."""
+        return list(self._functions)
+
+    def without_loops(self) -> list[Function]:
+        """The functions of a backend that cannot run the template loops (CasADi's SX graphs have
+        no eigensolver): without the general 6R solver's parts, and without ik_nearest, which
+        reads its ik_branches."""
+        skipped = {"ik_nearest"} | {f.name for f in self._functions if f.name.startswith("ik_general")}
+        return [f for f in self._functions if not (self.loops and f.name in skipped)]
+
+    @property
+    def loops(self) -> list[Loop]:
+        """The functions templates write around generated ones: the general 6R solver's ik_branches."""
+        form = self.closed_form
+        if form is None or form.solver != "general_6r" or not self.generates("ik_branches"):
+            return []
+        rows, extent = form.info.max_solutions, ("MAX_IK_SOLUTIONS",)
+        return [Loop("ik_branches", (Output("q", rows, self.robot.dof, extent=(*extent, "DOF")),
+                                     Output("valid", rows, 1, vector=True, boolean=True, extent=extent),
+                                     Output("in_limits", rows, 1, vector=True, boolean=True, extent=extent)))]
+
+    def unavailable(self) -> list[str]:
+        """The selected functions this robot does not have, each with why."""
+        made = {f.name for f in (*self._functions, *self.loops)}
+        made |= {name for name, callees in CALLEES.items() if made.issuperset(callees)}
+        why = {"ik": f"no closed form ({self.model.structure.reason})",
+               "jacobian_det": f"Js is {len(self.robot.task)} x {self.robot.dof}, not square"}
+        why["ik_branches"] = why["ik_nearest"] = why["ik"]
+        return [f"{name}: {why.get(name, 'not generated for this robot')}"
+                for name in FUNCTION_NAMES if name in (self.selection or ()) and name not in made]
+
+    @cached_property
+    def _functions(self) -> tuple[Function, ...]:
+        robot, m = self.robot, len(self.robot.task)
+        pose = self.chain.tool
+        task_jacobian = kinematics.task_jacobian(robot, pose, self.jacobian)
+        js = singularity_jacobian(robot, self.jacobian, task_jacobian)
+        functions = (
+            self.function("fk", "pose of the tool frame in the world frame (4x4 homogeneous)", matrix("T", pose)),
+            self.function("jacobian", "geometric Jacobian in the world frame (6 x DOF, rows vx vy vz wx wy wz)",
+                          matrix("J", self.jacobian)),
+            self.function("fk_jacobian", "fk and jacobian in one pass, sharing their terms",
+                          matrix("T", pose, equals="fk"), matrix("J", self.jacobian, equals="jacobian")),
+            self.function("jacobian_tool", "geometric Jacobian in the tool frame (6 x DOF, rows vx vy vz wx wy wz)",
+                          matrix("J", kinematics.tool_frame(self.jacobian, pose))),
+            self.function("task", f"task vector mu = ({', '.join(robot.task)})",
+                          vector("mu", kinematics.task_vector(robot, pose))),
+            self.function("task_jacobian", f"analytic Jacobian d mu / d q ({m} x DOF)", matrix("J", task_jacobian)),
+            *self.second_order_functions(),
+            *self.singularity_functions(js),
+            self.velocity_ik_function(js) if self.generates("velocity_ik") else None,
+            self.ik_numeric_step_function(task_jacobian) if self.generates("ik_numeric_step") else None,
+            *self.ik_functions(),
+        )
+        return tuple(function for function in functions if function is not None)
+
+
+def _rigid_inverse(transform: sympy.Matrix) -> sympy.Matrix:
+    """[R p; 0 1]^-1 = [R^T -R^T p; 0 1]."""
+    rotation = transform[:3, :3].T
+    return sympy.Matrix.vstack(sympy.Matrix.hstack(rotation, -rotation * transform[:3, 3]),
+                               sympy.Matrix([[0, 0, 0, 1]]))

@@ -1,0 +1,444 @@
+"""General 6R inverse kinematics, the per-robot part: Raghavan & Roth's 14 equations
+(Raghavan & Roth 1993; Manocha & Canny 1994), derived for one robot and one way of cutting
+its loop.
+
+A 6-joint revolute DH chain is `head Z1 C1 Z2 C2 ... Z5 C5 Z6 tail`, with Z_i = Rz(theta_i),
+theta_i = q_i + offset_i, and C_i = Tz(d_i) Tx(a_i) Rx(alpha_i) constant. A standard table
+is that form as it is (head = base, tail = Tz(d6) Tx(a6) Rx(alpha6) tool); a modified one is
+regrouped into it (head = base Rx(alpha_0) Tx(a_0), C_i from row i's d and row i+1's a and
+alpha, tail = Tz(d6) tool). For a target T, N = head^-1 T tail^-1 closes it into a loop
+
+    Z0 L0 Z1 L1 Z2 L2 Z3 L3 Z4 L4 Z5 L5 = I,   L0..L4 = C1..C5, L5 = N^-1
+
+(loop positions from 0), or, read backwards, the loop of the joints 6..1 with their angles
+negated and the links inverted (L5 = N). A split cuts the loop at a free joint f: with
+a, b, c the three positions before it and g, h the two after,
+
+    Z_a L_a Z_b L_b Z_c L_c Z_f = L_h^-1 Z_h^-1 L_g^-1 Z_g^-1 L_f^-1.
+
+Z_f leaves the third and fourth columns of the left side alone: an axis l and a point p.
+With p.p, p.l, p x l and (p.p) l - 2 (p.l) p these are 14 equations
+
+    (P0 + s_a Ps + c_a Pc) v_bc = Q v_gh,
+    v_bc = (s_b s_c, s_b c_c, c_b s_c, c_b c_c, s_b, c_b, s_c, c_c, 1),
+    v_gh = (s_g s_h, s_g c_h, c_g s_h, c_g c_h, s_g, c_g, s_h, c_h),
+
+whose entries are polynomials in the entries of V, the target's link as it appears in the
+split (N or N^-1): the side that holds it is G V H, and its products are taken through V's
+rotation (|V x| = |x|, V x . V y = x . y) so that no orthogonality of V is needed. This module
+derives them by sparse polynomial arithmetic over 200-bit floats (milliseconds), reducing
+s^2 = 1 - c^2 for every joint; the twists' cosines and sines enter as 60-digit numbers, as in
+the structure stage, and what cancels between them (below 1e-40) is dropped.
+"""
+
+from dataclasses import dataclass, replace
+from functools import cached_property
+
+import numpy as np
+import sympy
+from sympy.polys.domains import RealField
+from sympy.polys.rings import ring
+
+from jacgen.inputs import numeric_chain
+from jacgen.inputs.robot import Robot
+from jacgen.inputs.transforms import pose_transform, translation, twist
+from jacgen.model import kinematics
+from jacgen.model.joint_ring import circle_reduced
+
+PRECISION = 60  # digits of the twists' cosines and sines
+NEGLIGIBLE = 1e-40  # a coefficient below this is a cancellation left by those digits
+TARGET = ("r00 r01 r02 r10 r11 r12 r20 r21 r22", "t0 t1 t2")  # V's rotation and translation
+GENERATORS = " ".join(f"s{k} c{k}" for k in range(6)) + " " + " ".join(TARGET)
+
+
+@dataclass(frozen=True)
+class Link:
+    """C_i = Tz(d) Tx(a) Rx(alpha): the constant transform after joint i's rotation."""
+
+    d: sympy.Expr
+    a: sympy.Expr
+    alpha: sympy.Expr
+
+
+@dataclass(frozen=True)
+class Split:
+    """A cut of the loop: read backwards or not, and the loop position of the free joint."""
+
+    backwards: bool
+    free: int
+
+    @property
+    def hidden(self) -> int:
+        """a: the loop position whose tan(theta / 2) the eigenproblem finds."""
+        return (self.free - 3) % 6
+
+    @property
+    def triple(self) -> tuple[int, int, int]:
+        return tuple((self.free + k) % 6 for k in (-3, -2, -1))
+
+    @property
+    def pair(self) -> tuple[int, int]:
+        return (self.free + 1) % 6, (self.free + 2) % 6
+
+    def joint(self, position: int) -> int:
+        """The robot joint (0-based) at a loop position."""
+        return 5 - position if self.backwards else position
+
+    @property
+    def target_inverted(self) -> bool:
+        """Whether V is N^-1 (else N): L5 on the left side, L5^-1 on the right."""
+        on_left = 5 in self.triple
+        return on_left != self.backwards
+
+    def text(self, joints: tuple[int, ...] = tuple(range(6))) -> str:
+        """The order in which the solver finds the joints, named as the robot's (`joints`: the
+        robot's joint of each of the chain's six)."""
+        def names(positions) -> str:
+            return ", ".join(f"q{joints[self.joint(p)] + 1}" for p in positions)
+        return (f"tan({names((self.hidden,))}/2) from the eigenproblem, then {names(self.triple[1:])}, "
+                f"{names(self.pair)} and {names((self.free,))}")
+
+
+SPLITS = tuple(Split(backwards, free) for backwards in (False, True) for free in range(6))
+
+
+@dataclass(frozen=True)
+class Equations:
+    """(p0 + s_a ps + c_a pc) v_bc = q v_gh, over the symbols of V's rotation and translation,
+    as terms: (matrix: 0 p0, 1 ps, 2 pc, 3 q; its flat entry; V's exponents; coefficient). The
+    rating of a split reads them as numbers (`evaluated`); the sympy matrices are built for the
+    chosen split alone (`matrices`)."""
+
+    split: Split
+    terms: tuple[tuple[int, int, tuple[int, ...], object], ...]
+
+    @cached_property
+    def _arrays(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        matrix, entry, exponents, coefficients = zip(*self.terms)
+        return (np.array(exponents, dtype=float), np.array([float(c) for c in coefficients]),
+                np.array(matrix) * 14 * 9 + np.array(entry))
+
+    def evaluated(self, targets: np.ndarray) -> np.ndarray:
+        """p0, ps, pc, q at a batch of V's (..., 12: rotation by rows, then translation), as an
+        array (..., 4, 14, 9) (q's last column zero)."""
+        exponents, coefficients, entries = self._arrays
+        values = coefficients * np.prod(targets[..., None, :] ** exponents, axis=-1)
+        out = np.zeros((*targets.shape[:-1], 4 * 14 * 9))
+        for entry in np.unique(entries):  # a few hundred entries: sum their terms
+            out[..., entry] = values[..., entries == entry].sum(-1)
+        return out.reshape(*targets.shape[:-1], 4, 14, 9)
+
+    @cached_property
+    def matrices(self) -> tuple[sympy.Matrix, sympy.Matrix, sympy.Matrix, sympy.Matrix]:
+        """p0, ps, pc (14 x 9) and q (14 x 8) over `rotation` and `translation`."""
+        target = sympy.symbols(GENERATORS, real=True)[12:]
+        matrices = [sympy.zeros(14, 9) for _ in range(4)]
+        for matrix, entry, exponents, coefficient in self.terms:
+            matrices[matrix][entry] += sympy.Float(coefficient, PRECISION) * _monomial(target, exponents)
+        return (*matrices[:3], matrices[3][:, :8])
+
+    @property
+    def rotation(self) -> sympy.Matrix:
+        return sympy.Matrix(3, 3, sympy.symbols(GENERATORS, real=True)[12:21])
+
+    @property
+    def translation(self) -> sympy.Matrix:
+        return sympy.Matrix(sympy.symbols(GENERATORS, real=True)[21:])
+
+
+def chain_form(robot: Robot, free: int | None = None) -> tuple[sympy.Matrix, list[Link], sympy.Matrix]:
+    """(head, [C1 .. C5], tail) of a 6R robot, or of a 7R robot's six joints other than `free`
+    (its first or last joint, an input of ik): the chain is head Z1 C1 ... Z5 C5 Z6 tail, and the
+    free joint's row, at the cos and sin symbols of its angle, is part of the head or the tail."""
+    if not all(joint.revolute for joint in robot.joints) or robot.dof - (free is not None) != 6 \
+            or free not in (None, 0, robot.dof - 1):
+        raise ValueError(f"{robot.name}: the general 6R solver needs six revolute joints (and a 7th free, first or last)")
+    if robot.symbolic_parameters:
+        raise ValueError(f"{robot.name}: the general 6R solver needs numeric DH parameters")
+    base, tool = pose_transform(robot.base), pose_transform(robot.tool)
+    if free is not None:
+        row = kinematics.link_transforms(replace(robot, joints=(robot.joints[free],)),
+                                         lambda _: kinematics.trig_symbols((free,), robot.dof), ())[0]
+        moved = row[0] * row[1]
+        base, tool = (base * moved, tool) if free == 0 else (base, moved * tool)
+    joints = [joint for k, joint in enumerate(robot.joints) if k != free]
+
+    if robot.convention == "standard":
+        links = [Link(j.d.exact, j.a.exact, j.alpha.exact) for j in joints[:5]]
+        last = joints[5]
+        return base, links, twist(last.d.exact, last.a.exact, last.alpha.exact) * tool
+    first = joints[0]
+    head = base * twist(0, first.a.exact, first.alpha.exact)
+    links = [Link(joints[i].d.exact, joints[i + 1].a.exact, joints[i + 1].alpha.exact) for i in range(5)]
+    return head, links, translation(0, 0, joints[5].d.exact) * tool
+
+
+def equations(links: list[Link], split: Split) -> Equations:
+    """Raghavan & Roth's 14 equations of the loop of C1 .. C5 cut by `split` (see the module
+    docstring)."""
+    field = RealField(PRECISION * 4)
+    polynomials, *generators = ring(GENERATORS, field)
+    sines, cosines = generators[0:12:2], generators[1:12:2]
+    rotation = [generators[12:15], generators[15:18], generators[18:21]]
+    translation = generators[21:24]
+    zero, one = polynomials.zero, polynomials.one
+    constants = [_link_matrix(link, field) for link in links]
+    if split.backwards:  # loop joint k is robot joint 5 - k: L'_k = C_(5 - k)^-1, L'_5 = (N^-1)^-1
+        constants = [_inverted(constants[4 - k]) for k in range(5)]
+
+    def apply(step, v, point):
+        kind, position, inverse = step
+        if kind == "z":
+            sign = -1 if inverse else 1
+            return [cosines[position] * v[0] - sign * sines[position] * v[1],
+                    sign * sines[position] * v[0] + cosines[position] * v[1], v[2]]
+        r, t = constants[position]
+        if inverse:
+            w = [v[k] - t[k] for k in range(3)] if point else v
+            return [sum(w[k] * r[k][i] for k in range(3)) for i in range(3)]  # polynomial * number: sympy's fast path
+        return [sum(v[k] * r[i][k] for k in range(3)) + (t[i] if point else zero) for i in range(3)]
+
+    def through(steps, v, point):
+        for step in reversed(steps):
+            v = apply(step, v, point)
+        return v
+
+    def side(steps):
+        """The 14 quantities of the product of `steps` (rightmost applied first) on (e3, o)."""
+        target = [i for i, (kind, position, _) in enumerate(steps) if kind == "l" and position == 5]
+        if target:
+            outer, inner = steps[:target[0]], steps[target[0] + 1:]
+            rv, tv = rotation, translation
+        else:
+            outer, inner = steps, []
+            rv, tv = [[one if i == j else zero for j in range(3)] for i in range(3)], [zero] * 3
+        h_axis, h_point = through(inner, [zero, zero, one], False), through(inner, [zero] * 3, True)
+        # k = G^-1 o, so that G x = R_G (x - k): the outer motion's inverse, applied to the origin
+        k = [zero] * 3
+        for kind, position, inverse in outer:
+            k = apply((kind, position, not inverse), k, True)
+        turn = lambda v: [sum(rv[i][j] * v[j] for j in range(3)) for i in range(3)]  # noqa: E731
+        w_axis, w_point = turn(h_axis), turn(h_point)
+        offset = [tv[i] - k[i] for i in range(3)]  # V's translation less k
+        axis = through(outer, w_axis, False)
+        point = through(outer, [w_point[i] + offset[i] for i in range(3)], False)
+        pp = _dot(h_point, h_point) + 2 * _dot(w_point, offset) + _dot(offset, offset)
+        pl = _dot(h_point, h_axis) + _dot(offset, w_axis)
+        inner_cross, offset_cross = turn(_cross(h_point, h_axis)), _cross(offset, w_axis)
+        cross = through(outer, [inner_cross[i] + offset_cross[i] for i in range(3)], False)
+        return [*axis, *point, pp, pl, *cross, *(pp * l - 2 * pl * p for l, p in zip(axis, point))]
+
+    a, b, c = split.triple
+    f, (g, h) = split.free, split.pair
+    left = side([("z", a, False), ("l", a, False), ("z", b, False), ("l", b, False), ("z", c, False), ("l", c, False)])
+    right = side([("l", h, True), ("z", h, True), ("l", g, True), ("z", g, True), ("l", f, True)])
+    return _matrices(split, [_reduced(e) for e in left], [_reduced(e) for e in right])
+
+
+def _link_matrix(link: Link, field) -> tuple[list, list]:
+    """C = Tz(d) Tx(a) Rx(alpha) as (rotation rows, translation), 60-digit numbers."""
+    number = lambda value: field(sympy.N(value, PRECISION))  # noqa: E731
+    ca, sa = number(sympy.cos(link.alpha)), number(sympy.sin(link.alpha))
+    zero, one = field(0), field(1)
+    return [[one, zero, zero], [zero, ca, -sa], [zero, sa, ca]], [number(link.a), zero, number(link.d)]
+
+
+def _inverted(transform: tuple[list, list]) -> tuple[list, list]:
+    r, t = transform
+    rt = [[r[j][i] for j in range(3)] for i in range(3)]
+    return rt, [-sum(rt[i][k] * t[k] for k in range(3)) for i in range(3)]
+
+
+def _dot(u, v):
+    return sum(x * y for x, y in zip(u, v))
+
+
+def _cross(u, v):
+    return [u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]]
+
+
+def _reduced(polynomial) -> dict[tuple[int, ...], object]:
+    """The terms of `polynomial` with s_k^2 = 1 - c_k^2 for every joint, cancellations below
+    NEGLIGIBLE dropped."""
+    terms = dict(polynomial)
+    for sine in range(0, 12, 2):
+        terms = circle_reduced(terms, sine, sine + 1)
+    return {monomial: coefficient for monomial, coefficient in terms.items() if abs(coefficient) > NEGLIGIBLE}
+
+
+# Exponents of (s_x, c_x, s_y, c_y) of the products in v_bc (x, y = b, c) and v_gh (x, y = g, h).
+PRODUCTS = ((1, 0, 1, 0), (1, 0, 0, 1), (0, 1, 1, 0), (0, 1, 0, 1), (1, 0, 0, 0), (0, 1, 0, 0), (0, 0, 1, 0),
+            (0, 0, 0, 1), (0, 0, 0, 0))
+
+
+def _product(monomial: tuple[int, ...], x: int, y: int, others: tuple[int, ...], where: str) -> int:
+    if any(monomial[2 * k] or monomial[2 * k + 1] for k in others):
+        raise ValueError(f"{where} reads joints outside its side: {monomial}")
+    key = (*monomial[2 * x: 2 * x + 2], *monomial[2 * y: 2 * y + 2])
+    if key not in PRODUCTS:
+        raise ValueError(f"{where} outside the products of Raghavan-Roth: {monomial}")
+    return PRODUCTS.index(key)
+
+
+def _matrices(split: Split, left: list[dict], right: list[dict]) -> Equations:
+    a, b, c = split.triple
+    g, h = split.pair
+    terms = []
+
+    def add(matrix, row, column, coefficient, monomial):
+        terms.append((matrix, row * 9 + column, monomial[12:], coefficient))
+
+    for row, (lhs, rhs) in enumerate(zip(left, right)):
+        for monomial, coefficient in lhs.items():
+            hidden = monomial[2 * a: 2 * a + 2]
+            if sum(hidden) > 1:
+                raise ValueError(f"left side of equation {row} not linear in the hidden joint: {monomial}")
+            part = 1 if hidden[0] else 2 if hidden[1] else 0
+            add(part, row, _product(monomial, b, c, (split.free, g, h), f"left side of equation {row}"), coefficient,
+                monomial)
+        for monomial, coefficient in rhs.items():
+            column = _product(monomial, g, h, (split.free, a, b, c), f"right side of equation {row}")
+            if column == 8:  # the constant goes to the left side
+                add(0, row, 8, -coefficient, monomial)
+            else:
+                add(3, row, column, coefficient, monomial)
+    return Equations(split, tuple(terms))
+
+
+def _monomial(symbols, exponents) -> sympy.Expr:
+    return sympy.Mul(*(s**e for s, e in zip(symbols, exponents)))
+
+
+# (sin, cos, 1) of an angle times (1 + x^2), x = tan(angle / 2), as coefficients of (1, x, x^2)
+_HALF_ANGLE = {"s": (0, 2, 0), "c": (1, 0, -1), "1": (1, 0, 1)}
+# v_bc's entries as polynomials in (x_b, x_c): row k holds the coefficients of x_b^i x_c^j at 3 i + j
+MONOMIALS = np.array([np.outer(_HALF_ANGLE[b], _HALF_ANGLE[c]).ravel()
+                       for b, c in ("ss", "sc", "cs", "cc", "s1", "c1", "1s", "1c", "11")])
+
+
+# Pairs (i, i + step) of those monomials whose ratio is x_c (step 1) or x_b (step 3): the kernels
+# read each from the pair of largest size in the null vector.
+ALONG_C = (0, 1, 3, 4, 6, 7, 9, 10)
+ALONG_B = tuple(range(9))
+NEWTON_STEPS = 6  # at most, on the pose, after the back-substitution (a near-double root needs more than 2)
+TOLERANCE = {"double": 1e-9, "float": 1e-3}  # |pose error| (m and rad) of a solution after them
+# The fast path of a calibrated arm (a structure.Nominal): the nominal arm's closed form, then up
+# to FAST_STEPS Newton steps on the exact arm from each branch that the target allows or that
+# misses it by at most FAST_BAND times the arms' mismatch (the largest position and rotation error
+# between them at one configuration, over FAST_SAMPLES random ones). Each must reach T to
+# CONVERGED (1 + reach), at a solution of its own, and every margin of the closed form (see
+# Subproblems.margins: its discriminants, and the rotating parts of its SP1s and SP4s) must be at
+# least FAST_MARGIN times the relative mismatch (position / reach, or rotation): near a double root
+# or a nearly free angle the two arms' solutions differ by far more than the mismatch, and may be
+# more or fewer. Else the eigenproblem decides. FAST_MARGIN = 50 is measured, not derived: on 4
+# calibrated arms and 1.9e5 random and near-singular poses, 20 let 1 pose miss solutions, 30 none.
+FAST_STEPS = 4
+FAST_BAND = 3.0
+FAST_MARGIN = 50.0
+FAST_SAMPLES = 1000
+CONVERGED = {"double": 1e-12, "float": 1e-5}
+# An eigenvalue is a root when |imaginary part| <= this (1 + |x|): a double root the target's
+# rounding splits into a complex pair (by about the square root of that rounding) still counts,
+# and the Newton steps and the tolerance above decide.
+IMAGINARY = {"double": 1e-5, "float": 1e-3}
+
+
+def half_angle(s: np.ndarray) -> np.ndarray:
+    """Six equations in v_bc (..., 6, 9) as twelve in the monomials x_b^i x_c^j (i <= 3, j <= 2,
+    at 3 i + j): the six, and the six times x_b (..., 12, 12)."""
+    expanded = s @ MONOMIALS
+    out = np.zeros((*s.shape[:-2], 12, 12))
+    out[..., :6, :9], out[..., 6:, 3:] = expanded, expanded
+    return out
+
+
+def shifted(ps: np.ndarray, pc: np.ndarray, shift: float) -> tuple[np.ndarray, np.ndarray]:
+    """ps, pc for the hidden angle less `shift`: s_a ps + c_a pc = s' ps' + c' pc'."""
+    cos, sin = np.cos(shift), np.sin(shift)
+    return cos * ps - sin * pc, sin * ps + cos * pc
+
+
+SAMPLES = 24  # random configurations that rate a split
+WORST_CONDITION = 1e8  # a robot whose best split rates worse gets no general solver (ik_numeric only)
+SHIFTS = 16  # origins of the hidden joint's half angle tried per split: multiples of 2 pi / SHIFTS
+TIE = 0.01  # a later candidate must rate 1% better: near ties (a shift and the shift + pi) go to the
+# first, not to rounding noise of the machine's LAPACK, so that generated code is the same everywhere
+
+
+@dataclass(frozen=True)
+class Elimination:
+    """A split's equations and the shift of its hidden angle (theta_a = shift + 2 atan(x)) that
+    make the leading matrix, Q and the null vector best conditioned: `condition` is the largest
+    of their median condition numbers over random configurations."""
+
+    equations: Equations
+    shift: float
+    condition: float
+
+
+def elimination(robot: Robot, free: int | None = None) -> Elimination:
+    """The best conditioned of the 12 splits and 16 shifts (a matrix polynomial singular for
+    every x, as the Jaco's is for the textbook split, rates as badly as a singular leading
+    matrix; so do a Q of rank below 8, from which v_gh cannot be read back, and equations
+whose null space at a root has more than one vector, from which v_bc cannot). Derivations are milliseconds each; the rating is a few hundred 12 x 12
+    condition numbers."""
+    head, links, tail = chain_form(robot, free)
+    theta = np.random.default_rng(0).uniform(-np.pi, np.pi, (SAMPLES, 6))
+    n = _numeric_chain(links, theta)
+    best = None
+    for split in SPLITS:
+        equations_ = equations(links, split)
+        v = np.linalg.inv(n) if split.target_inverted else n
+        p0, ps, pc, q = np.moveaxis(equations_.evaluated(np.concatenate([v[:, :3, :3].reshape(-1, 9), v[:, :3, 3]], 1)), 1, 0)
+        left, values = np.linalg.svd(q[..., :8])[:2]
+        left_null = np.swapaxes(left[..., 8:], -1, -2)
+        s0, ss, sc = left_null @ p0, left_null @ ps, left_null @ pc
+        pair = float(np.median(values[..., 0] / np.maximum(values[..., -1], 1e-300)))  # v_gh from Q's columns
+        # v_bc from the null vector of the equations at the configuration's own theta_a: one vector
+        hidden = theta[:, split.joint(split.hidden)] * (-1 if split.backwards else 1)
+        at_root = half_angle(s0 + np.sin(hidden)[:, None, None] * ss + np.cos(hidden)[:, None, None] * sc)
+        singular = np.linalg.svd(at_root, compute_uv=False)
+        vector = float(np.median(singular[..., 0] / np.maximum(singular[..., -2], 1e-300)))
+        for k in range(SHIFTS):
+            shift = 2 * np.pi * k / SHIFTS
+            leading = np.median(np.linalg.cond(half_angle(s0 - shifted(ss, sc, shift)[1])))
+            condition = float(max(leading, pair, vector))
+            if best is None or condition < best.condition * (1 - TIE):
+                best = Elimination(equations_, shift, condition)
+    return best
+
+
+def _numeric_chain(links: list[Link], theta: np.ndarray) -> np.ndarray:
+    """Z1 C1 ... Z5 C5 Z6 at a batch of joint angles (..., 6), in doubles."""
+    def rz(angle):
+        out = np.zeros((*angle.shape, 4, 4))
+        out[..., 0, 0] = out[..., 1, 1] = np.cos(angle)
+        out[..., 1, 0], out[..., 0, 1] = np.sin(angle), -np.sin(angle)
+        out[..., 2, 2] = out[..., 3, 3] = 1
+        return out
+
+    out = rz(theta[..., 0])
+    for i, link in enumerate(links):
+        constant = np.array(twist(link.d, link.a, link.alpha).evalf(20).tolist(), dtype=float)
+        out = out @ constant @ rz(theta[..., i + 1])
+    return out
+
+
+def mismatch(robot: Robot, nominal: Robot) -> tuple[float, float]:
+    """The largest position error and the largest rotation angle between the two arms' tool
+    poses at one configuration, over FAST_SAMPLES random configurations: how far a nominal
+    solution can miss."""
+    q = np.random.default_rng(0).uniform(-np.pi, np.pi, (FAST_SAMPLES, robot.dof))
+    exact, near = numeric_chain.link_frames(robot, q)[1], numeric_chain.link_frames(nominal, q)[1]
+    position = np.linalg.norm(exact[:, :3, 3] - near[:, :3, 3], axis=-1)
+    cos = (np.einsum("nij,nij->n", exact[:, :3, :3], near[:, :3, :3]) - 1) / 2
+    return float(position.max()), float(np.arccos(np.clip(cos, -1.0, 1.0)).max())
+
+
+def work_bytes(real: str) -> int:
+    """The size of the C solver's working memory (struct NAME_ik_work in templates/c/ik.c.jinja:
+    the equations in the build's real type and in double, the kernel's matrices in double), as
+    the contract documents it; tests/test_shipped_robots.py checks it against the compiler's."""
+    reals = 378 + 112
+    doubles = 3 * 14 * 9 + 14 * 8 + 24 * 5 + (14 * 8 + 8 + 8 + 3 * 6 * 9 + 3 * 12 * 12 + 24 * 24 + 12 * 12 + 24 + 24)
+    return reals * {"double": 8, "float": 4}[real] + doubles * 8

@@ -1,0 +1,215 @@
+"""Paden-Kahan subproblems as expressions, every root computed, each with its validity.
+
+The closed-form solvers of `ik.py` are written with these once, and every backend prints
+them. Nothing branches: a root the target does not allow is still computed (from clamped
+values) and flagged invalid, a degenerate case is a `select`. So a solver is straight-line
+code, the same in C, over a numpy batch and in CasADi.
+
+Vectors are 3-tuples of expressions, relative to a point of the axis where it matters;
+every intermediate value is passed to `name` (see `functions.Generator.name`), so that no
+expression grows with the depth of the solver. The tolerances are the symbols EPS and TINY,
+replaced by the numbers of the build's real type when printed (`nodes.TOLERANCES`):
+
+- a discriminant (a squared sine) within EPS of 0 is one double root: its second copy is
+  invalid, so a tangent target or a target on a singularity gives one solution;
+- a vector whose squared length is below TINY times its scale counts as zero: an angle it
+  leaves free is 0.
+"""
+
+from dataclasses import dataclass
+from typing import Callable
+
+import sympy
+
+from jacgen.model.nodes import EPS, TINY, Above, AtLeast, AtMost, Ceiling, Select, select
+
+Vector = tuple[sympy.Expr, sympy.Expr, sympy.Expr]
+
+
+@dataclass(frozen=True)
+class Angle:
+    """An angle with its cosine and sine (the solvers rotate by c and s, never by theta)."""
+
+    theta: sympy.Expr
+    c: sympy.Expr
+    s: sympy.Expr
+
+    def turned_half(self) -> "Angle":
+        """The angle + pi."""
+        return Angle(self.theta + sympy.pi, -self.c, -self.s)
+
+
+@dataclass(frozen=True)
+class Root:
+    """One root of a subproblem and whether it exists for this target."""
+
+    angle: Angle
+    valid: sympy.Basic
+
+
+ZERO = Angle(sympy.Integer(0), sympy.Integer(1), sympy.Integer(0))
+
+
+class Subproblems:
+    """Vector algebra and the subproblems, naming every intermediate with `name`."""
+
+    def __init__(self, name: Callable[[sympy.Expr], sympy.Expr]):
+        self.name = lambda value: name(sympy.sympify(value))
+        # Sizes that are near 0 where the closed form is sensitive to the target, dimensionless;
+        # the fast path reads the least (general6r.FAST_MARGIN):
+        # - an SP2 or SP4 discriminant (a squared sine): two roots near one double root;
+        # - the rotating part of SP1 or SP4 (the product of the sines of its vectors' angles to
+        #   the axis): an angle that is nearly free, as at a wrist singularity.
+        self.margins: list[sympy.Expr] = []
+
+    def vector(self, values) -> Vector:
+        return tuple(self.name(v) for v in values)
+
+    def dot(self, a: Vector, b: Vector) -> sympy.Expr:
+        return self.name(a[0] * b[0] + a[1] * b[1] + a[2] * b[2])
+
+    def cross(self, a: Vector, b: Vector) -> Vector:
+        return self.vector((a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]))
+
+    def add(self, a: Vector, b: Vector) -> Vector:
+        return self.vector(x + y for x, y in zip(a, b))
+
+    def sub(self, a: Vector, b: Vector) -> Vector:
+        return self.vector(x - y for x, y in zip(a, b))
+
+    def scaled(self, a: Vector, factor: sympy.Expr) -> Vector:
+        return self.vector(factor * x for x in a)
+
+    def rot(self, k: Vector, c: sympy.Expr, s: sympy.Expr, v: Vector) -> Vector:
+        """v turned about the unit axis k by the angle whose cosine and sine are c and s (Rodrigues)."""
+        kxv = self.cross(k, v)
+        kv = self.name(self.dot(k, v) * (1 - c))
+        return self.vector(v[i] * c + kxv[i] * s + k[i] * kv for i in range(3))
+
+    def turn(self, k: Vector, angle: Angle, v: Vector, back: bool = False) -> Vector:
+        """v turned about k by `angle` (by -angle when `back`)."""
+        return self.rot(k, angle.c, -angle.s if back else angle.s, v)
+
+    def angle(self, c: sympy.Expr, s: sympy.Expr) -> Angle:
+        c, s = self.name(c), self.name(s)
+        return Angle(sympy.atan2(s, c), c, s)
+
+    def sp1(self, p: Vector, q: Vector, k: Vector) -> Angle:
+        """SP1: the angle turning p into q about the unit axis k (least squares when they
+        differ in length or height along k); 0 when p or q lies on the axis (any angle would do)."""
+        x = self.name(self.dot(p, q) - self.dot(k, p) * self.dot(k, q))
+        y = self.dot(k, self.cross(p, q))
+        rr = self.name(x * x + y * y)
+        pq = self.name(self.dot(p, p) * self.dot(q, q))
+        self.margins.append(select(Above(pq, 0), sympy.sqrt(rr / pq), 0))
+        free = AtMost(rr, TINY * pq)
+        scale = self.name(select(free, 1, 1 / sympy.sqrt(rr)))  # never 1/0, even for constant vectors
+        return Angle(select(free, 0, sympy.atan2(y, x)), self.name(select(free, 1, x * scale)),
+                     self.name(select(free, 0, y * scale)))
+
+    def sp4(self, h: Vector, p: Vector, k: Vector, d: sympy.Expr) -> tuple[Root, Root]:
+        """SP4: the angles t with h . rot(k, t) p = d, (phi + alpha, phi - alpha).
+
+        h . rot(k, t) p = A cos t + B sin t + C. A double root (sin(alpha)^2 within EPS of 0)
+        is the first root only; when the left side does not depend on t, the first root is
+        0 if it equals d."""
+        hk, kp = self.dot(h, k), self.dot(k, p)
+        a = self.name(self.dot(h, p) - hk * kp)
+        b = self.dot(h, self.cross(k, p))
+        rhs = self.name(d - hk * kp)
+        r2 = self.name(a * a + b * b)
+        scale = self.name(self.dot(h, h) * self.dot(p, p))
+        self.margins.append(select(Above(scale, 0), sympy.sqrt(r2 / scale), 0))
+        constant = AtMost(r2, TINY * scale)
+        inverse_r = self.name(select(constant, 1, 1 / sympy.sqrt(r2)))
+        cos_phi, sin_phi = self.name(a * inverse_r), self.name(b * inverse_r)
+        cos_alpha = self.name(rhs * inverse_r)
+        disc = self.name(1 - cos_alpha**2)
+        self.margins.append(sympy.Abs(disc))
+        two = Above(disc, EPS)
+        # a double root: cos(alpha) = +-1, sin(alpha) = 0
+        cos_alpha = self.name(select(two, cos_alpha, select(Above(cos_alpha, 0), 1, -1)))
+        sin_alpha = self.name(select(two, sympy.sqrt(disc), 0))
+        phi, alpha = self.name(sympy.atan2(b, a)), self.name(sympy.atan2(sin_alpha, cos_alpha))
+        plus = Angle(self.name(select(constant, 0, phi + alpha)),
+                     self.name(select(constant, 1, cos_phi * cos_alpha - sin_phi * sin_alpha)),
+                     self.name(select(constant, 0, sin_phi * cos_alpha + cos_phi * sin_alpha)))
+        minus = Angle(self.name(phi - alpha), self.name(cos_phi * cos_alpha + sin_phi * sin_alpha),
+                      self.name(sin_phi * cos_alpha - cos_phi * sin_alpha))
+        plus_valid = sympy.Or(sympy.And(constant, AtMost(rhs**2, EPS * scale)), sympy.And(sympy.Not(constant), AtLeast(disc, -EPS)))
+        return Root(plus, plus_valid), Root(minus, sympy.And(sympy.Not(constant), two))
+
+    def sp3(self, p: Vector, q: Vector, k: Vector, dd: sympy.Expr) -> tuple[Root, Root]:
+        """SP3: the angles t with |rot(k, t) p - q|^2 = dd (p, q relative to a point of the axis)."""
+        return self.sp4(q, p, k, self.name((self.dot(p, p) + self.dot(q, q) - dd) / 2))
+
+    def sp2(self, p: Vector, q: Vector, k1: Vector, k2: Vector) -> tuple[tuple[Angle, Angle, sympy.Basic], ...]:
+        """SP2: the angle pairs (t1, t2, valid) with rot(k1, t1) rot(k2, t2) p = q, for two axes
+        through one point (p, q relative to it): rot(k2, t2) p = rot(k1, -t1) q = c,
+        c = alpha k1 + beta k2 +- gamma k1 x k2. One pair when gamma^2 is within EPS of 0."""
+        k12 = self.dot(k1, k2)
+        nn = self.name(1 - k12**2)
+        u, v = self.dot(k1, q), self.dot(k2, p)
+        alpha, beta = self.name((u - k12 * v) / nn), self.name((v - k12 * u) / nn)
+        pp = self.dot(p, p)
+        gg = self.name((pp - alpha**2 - beta**2 - 2 * alpha * beta * k12) / nn)
+        self.margins.append(select(Above(pp, 0), sympy.Abs(gg) / pp, 0))
+        two = Above(gg, EPS * pp)
+        gamma = self.name(select(two, sympy.sqrt(gg), 0))
+        normal = self.cross(k1, k2)
+        pairs = []
+        for sign, valid in ((1, AtLeast(gg, -EPS * pp)), (-1, two)):
+            c = self.vector(alpha * k1[i] + beta * k2[i] + sign * gamma * normal[i] for i in range(3))
+            pairs.append((self.sp1(c, q, k1), self.sp1(p, c, k2), valid))
+        return tuple(pairs)
+
+    def wrist(self, a: Vector, b: Vector, h4: Vector, h5: Vector, h6: Vector, v6: Vector,
+              flip: sympy.Expr | None) -> tuple[tuple[tuple[sympy.Expr, ...], sympy.Basic], ...]:
+        """Spherical wrist: the angles ((q4, q5, q6), valid) with R4 R5 R6 h6 = a and
+        R4 R5 R6 v6 = b (v6 perpendicular to h6): SP2 for (q4, q5), SP1 for q6.
+
+        With axis 5 perpendicular to axes 4 and 6, `flip` = -2 angle(h4 -> h6 about h5) and
+        the second solution is (q4 + pi, flip - q5, q6 + pi): rot(h4, pi) reflects the plane
+        perpendicular to h5 across h4."""
+        pairs = self.sp2(h6, a, h4, h5)
+        solutions = []
+        for t4, t5, valid in pairs[:1] if flip is not None else pairs:
+            t6 = self.sp1(v6, self.turn(h5, t5, self.turn(h4, t4, b, back=True), back=True), h6)
+            solutions.append(((t4.theta, t5.theta, t6.theta), valid))
+        if flip is not None:
+            (t4, t5, t6), _ = solutions[0]
+            solutions.append(((t4 + sympy.pi, flip - t5, t6 + sympy.pi), pairs[1][2]))
+        return tuple(solutions)
+
+
+def relative(sp: Subproblems, T: sympy.Matrix, rotation: sympy.Matrix, position: sympy.Matrix):
+    """T T(0)^-1 = exp(xi_1 q_1) ... exp(xi_n q_n) as (rows of R, t), T(0) = (rotation,
+    position) the tool pose at q = 0."""
+    R = [sp.vector(sum(T[i, k] * rotation[j, k] for k in range(3)) for j in range(3)) for i in range(3)]
+    t = sp.vector(T[i, 3] - sum(R[i][k] * position[k] for k in range(3)) for i in range(3))
+    return R, t
+
+
+def times(sp: Subproblems, R, v: Vector) -> Vector:
+    """R v for R given by its rows."""
+    return tuple(sp.dot(row, v) for row in R)
+
+
+def times_transposed(sp: Subproblems, R, v: Vector) -> Vector:
+    """R^T v for R given by its rows."""
+    return sp.vector(sum(R[k][i] * v[k] for k in range(3)) for i in range(3))
+
+
+def _in_range(angle: sympy.Expr) -> bool:
+    """An atan2, a number in (-pi, pi], or a select of such."""
+    if isinstance(angle, Select):
+        return all(_in_range(value) for value in angle.args[1::2] + angle.args[-1:])
+    return isinstance(angle, sympy.atan2) or (angle.is_Number and -sympy.pi < angle <= sympy.pi)
+
+
+def wrapped(angle: sympy.Expr) -> sympy.Expr:
+    """The angle wrapped into (-pi, pi]: unchanged when it is there by construction (an
+    atan2), else angle - 2 pi ceil((angle - pi) / (2 pi))."""
+    if _in_range(angle):
+        return angle
+    return angle - 2 * sympy.pi * Ceiling((angle - sympy.pi) / (2 * sympy.pi))

@@ -1,0 +1,221 @@
+"""`jacgen import-urdf`: a URDF chain -> the text of a robot file, checked before it is written.
+
+Stages: urdf.read_chain (XML -> exact joint transforms), dh_fit.fit (axes -> DH table),
+then this module writes the robot file, chooses the task of an arm with fewer than six
+joints, and compares the file's fk with a plain walk of the URDF chain.
+"""
+
+import hashlib
+import re
+from dataclasses import dataclass
+from decimal import Context, Decimal
+from pathlib import Path
+
+import numpy as np
+import sympy
+import yaml
+
+from jacgen.checking import reference
+from jacgen.errors import JacgenError, RobotFileError
+from jacgen.inputs.dh_fit import Axis, exact_or_float, fit
+from jacgen.inputs.names import robot_name_problem
+from jacgen.inputs.robot import (FORBIDDEN_IN_TEXT, IDENTIFIER_PATTERN, NAME_PATTERN, TASK_COMPONENTS, Robot,
+                                 parse_robot, task_problem)
+from jacgen.inputs.urdf import MOVABLE, SNAP_TOLERANCE, LinkChain, Snapper, joint_axes, read_chain
+from jacgen.version import __version__
+
+CHECK_CONFIGURATIONS = 20
+CHECK_SEED = 0
+
+
+@dataclass(frozen=True)
+class Imported:
+    """A robot file made from a URDF: its text, the robot it reads as, the largest fk
+    difference from the URDF chain at CHECK_CONFIGURATIONS random configurations, and the
+    largest change (radians) that making angles exact caused."""
+
+    text: str
+    robot: Robot
+    fk_difference: float
+    snapped: float
+
+
+def import_urdf(path: str, base: str | None = None, tip: str | None = None, convention: str = "standard",
+                name: str | None = None, task: tuple[str, ...] | None = None,
+                snap: float = SNAP_TOLERANCE) -> Imported:
+    """The robot file for the chain of `path`, checked against the URDF's own fk."""
+    snapper = Snapper(snap)
+    chain = read_chain(path, base, tip, snapper)
+    axes, tip_frame = _axes(chain)
+    table = fit(axes, tip_frame, convention, snapper)
+    name = name or _robot_name(chain.robot_name)
+    problem = robot_name_problem(name) if NAME_PATTERN.fullmatch(name) else f"does not match {NAME_PATTERN.pattern}"
+    if problem:
+        raise JacgenError(f"{path}: robot name {name!r} {problem}; choose another with --name")
+    snapped = snapper.largest
+    digest = hashlib.sha256(Path(path).read_bytes()).hexdigest()[:16]
+    source = _text(Path(path).name)
+    header = [
+        f"Imported by jacgen {__version__} import-urdf from {source} (sha256 {digest}), "
+        f"robot {_text(chain.robot_name)!r}, links {_text(chain.base)} -> {_text(chain.tip)}.",
+        f"{len(axes)} moving joint(s); fixed joints folded into the DH, base and tool transforms: "
+        f"{_text(', '.join(chain.folded)) or 'none'}. DH frames as in docs/urdf.md.",
+        f"Angles and axes within {snap:g} rad of a multiple of 90 deg were made exact; "
+        f"largest change {snapped:.2g} rad.",
+    ]
+    description = f"{_text(chain.robot_name)} imported from {source} (links {_text(chain.base)} -> {_text(chain.tip)})"
+
+    def text(components):
+        return _robot_file(name, description, header, convention, table, components)
+
+    if task is not None and (not task or any(component not in TASK_COMPONENTS for component in task)):
+        raise JacgenError(f"--task: expected components of {', '.join(TASK_COMPONENTS)}, got {','.join(task)!r}")
+    if task is not None and (problem := task_problem(list(task))):
+        raise JacgenError(f"--task: {problem}")
+    if task is None:
+        task = () if len(axes) >= 6 else _independent_task(_read_back(text(TASK_COMPONENTS), path))
+    result = text(task)
+    robot = _read_back(result, path)
+    return Imported(result, robot, _fk_difference(robot, chain), snapped)
+
+
+def _read_back(text: str, path: str) -> Robot:
+    """The robot of the file written for the URDF at `path`, validated as every robot file is:
+    a rule the chain breaks there (its size, equal limits) is the URDF's, and named."""
+    try:
+        return parse_robot(text.encode(), "<imported robot file>")
+    except RobotFileError as error:
+        raise JacgenError(f"{path}: the chain makes no valid robot file: {error.key}: {error.message}") from None
+
+
+def _axes(chain: LinkChain) -> tuple[list[Axis], sympy.Matrix]:
+    """The moving joints' axis lines at q = 0 in the base link's frame, and the tip frame."""
+    frame, axes = chain.start, []
+    for joint in chain.joints:
+        frame = (frame * joint.origin).applyfunc(exact_or_float)
+        if joint.kind in MOVABLE:
+            axes.append(Axis(joint.name, "prismatic" if joint.kind == "prismatic" else "revolute",
+                             frame[:3, 3].applyfunc(exact_or_float), (frame[:3, :3] * joint.axis).applyfunc(exact_or_float),
+                             joint.limits))
+    return axes, frame
+
+
+def _robot_name(urdf_name: str) -> str:
+    """The URDF's name made a valid robot name; `_robot` is added to one that would hide
+    a keyword, header or module ("random" -> "random_robot")."""
+    name = re.sub(r"[^a-z0-9_]+", "_", urdf_name.lower()).strip("_")
+    name = re.sub(r"^[^a-z]+", "", name)[:41] or "robot"
+    return f"{name}_robot" if robot_name_problem(name) else name
+
+
+def _joint_names(axes: list[Axis]) -> list[str]:
+    """The URDF names, made identifiers and unique."""
+    names: list[str] = []
+    for axis in axes:
+        name = re.sub(r"\W+", "_", axis.name, flags=re.ASCII).strip("_") or "joint"
+        name = name if not name[0].isdigit() else f"j{name}"
+        name, candidate, k = name[:44], name[:44], 2
+        while candidate in names:
+            candidate, k = f"{name}_{k}", k + 1
+        assert IDENTIFIER_PATTERN.fullmatch(candidate)
+        names.append(candidate)
+    return names
+
+
+def _text(text: str) -> str:
+    """URDF text for a comment or the description: printable, one line, nothing that escapes."""
+    text = "".join(c if c.isprintable() else "_" for c in text)
+    for bad in FORBIDDEN_IN_TEXT:
+        text = text.replace(bad, "_" * len(bad))
+    return text
+
+
+def literal(value: sympy.Expr) -> str:
+    """A robot-file value: an exact decimal, "p/q", "r*sqrt(s)" or "k*pi/m" when exact, else
+    the shortest decimal that round-trips the double."""
+    value = sympy.sympify(value)
+    if value.has(sympy.Float):
+        return repr(float(value)) if value != 0 else "0"
+    if value.is_Rational:
+        return _rational(value)
+    coefficient, rest = value.as_coeff_Mul()
+    if rest is sympy.pi:
+        p, q = coefficient.p, coefficient.q
+        text = "pi" if abs(p) == 1 else f"{abs(p)}*pi"
+        return f'"{"-" if p < 0 else ""}{text}{f"/{q}" if q != 1 else ""}"'
+    radicand = _rational(coefficient**2 * rest.base).strip('"')  # r*sqrt(s) = sign(r)*sqrt(r**2*s)
+    return f'"{"-" if coefficient < 0 else ""}sqrt({radicand})"'
+
+
+def _rational(value: sympy.Rational) -> str:
+    p, q = int(value.p), int(value.q)
+    stripped = q
+    for prime in (2, 5):
+        while stripped % prime == 0:
+            stripped //= prime
+    if stripped != 1:
+        return f'"{p}/{q}"'
+    decimal = Context(prec=100).divide(Decimal(p), Decimal(q)).normalize()
+    if -7 < decimal.adjusted() < 16:
+        return format(decimal, "f")
+    return str(decimal).lower().replace("e+", "e")
+
+
+def _limits(text: tuple[str, str] | None) -> str | None:
+    return None if text is None else f"[{_rational(sympy.Rational(text[0]))}, {_rational(sympy.Rational(text[1]))}]"
+
+
+def _robot_file(name, description, header, convention, table, task) -> str:
+    lines = [f"# {line}" for line in header]
+    lines += [f"name: {name}", f"description: {_quoted(description)}", f"convention: {convention}",
+              "angle_unit: rad", "length_unit: m", "joints:"]
+    rows = []
+    for joint_name, row in zip(_joint_names([r.axis for r in table.rows]), table.rows):
+        fields = [("name", _quoted(joint_name)), ("type", row.axis.kind), ("a", literal(row.a)),
+                  ("alpha", literal(row.alpha))]
+        fields += ([("d", literal(row.d)), ("offset", literal(row.theta))] if row.axis.kind == "revolute"
+                   else [("theta", literal(row.theta)), ("offset", literal(row.d))])
+        if row.axis.limits is not None:
+            fields.append(("limits", _limits(row.axis.limits)))
+        rows.append([f"{key}: {value}" for key, value in fields])
+    widths = [max(len(row[k]) for row in rows if k < len(row)) for k in range(max(map(len, rows)))]
+    for row in rows:
+        cells = [cell + ("," if k < len(row) - 1 else "") for k, cell in enumerate(row)]
+        padded = " ".join(cell.ljust(widths[k] + 1) for k, cell in enumerate(cells)).rstrip()
+        lines.append(f"  - {{{padded}}}")
+    for key, (xyz, rpy) in (("base", table.base), ("tool", table.tool)):
+        if any(v != 0 for v in xyz + rpy):
+            lines.append(f"{key}: {{xyz: [{', '.join(map(literal, xyz))}], rpy: [{', '.join(map(literal, rpy))}]}}")
+    if task:
+        lines.append(f"task: [{', '.join(task)}]")
+    return "\n".join(lines) + "\n"
+
+
+def _quoted(text: str) -> str:
+    """A YAML scalar that reads back as the string `text` (which _text has made safe)."""
+    plain = re.fullmatch(r"[A-Za-z_]\w*", text, re.ASCII) and isinstance(yaml.safe_load(text), str)
+    return text if plain else '"' + text.replace('"', "'") + '"'
+
+
+def _independent_task(robot) -> tuple[str, ...]:
+    """The first components in the order x, y, z, roll, pitch, yaw whose task-Jacobian rows are
+    independent of those taken before, at two random configurations: one per joint at most."""
+    rng = np.random.default_rng(CHECK_SEED)
+    jacobians = [reference.task_jacobian(robot, rng.uniform(-1, 1, robot.dof)) for _ in range(2)]
+    chosen: list[int] = []
+    for k in range(len(TASK_COMPONENTS)):
+        rows = chosen + [k]
+        stacked = np.hstack([J[rows] for J in jacobians])
+        if len(chosen) < robot.dof and np.linalg.matrix_rank(stacked, tol=1e-6 * max(1.0, np.abs(stacked).max())) == len(rows):
+            chosen.append(k)
+    return tuple(TASK_COMPONENTS[k] for k in chosen)
+
+
+def _fk_difference(robot, chain: LinkChain) -> float:
+    rng = np.random.default_rng(CHECK_SEED)
+    low, high = np.array(robot.ranges).T
+    worst = 0.0
+    for _ in range(CHECK_CONFIGURATIONS):
+        q = rng.uniform(low, high)
+        worst = max(worst, float(np.abs(reference.fk(robot, q) - joint_axes(chain, q)[1]).max()))
+    return worst
