@@ -87,7 +87,7 @@ def _distance(found: np.ndarray, expected: np.ndarray) -> float:
     return worst
 
 
-@pytest.mark.parametrize("n", [1, 2, 3, 5, 12, 16, 24])
+@pytest.mark.parametrize("n", [1, 2, 3, 5, 12, 16])
 def test_similar_to_block_diagonal(eigenvalues, n):
     """S D S^-1 with D of 1x1 blocks (real eigenvalues) and 2x2 rotation-scalings (complex pairs)."""
     rng = np.random.default_rng(n)
@@ -109,7 +109,7 @@ def test_similar_to_block_diagonal(eigenvalues, n):
 
 @pytest.mark.parametrize("roots", [
     [1, 2, 3, 4], [-0.5, 0.25, 3, 7, -2, 1e-3], [2, 2, 1 + 1j, 1 - 1j], [1.5 * np.exp(2j * np.pi * k / 16) for k in range(16)],
-    [0.5 * np.exp(1j * np.pi * k / 12) for k in range(24)]], ids=["4", "6", "repeated", "16", "24-roots-of-unity"])
+    [0.5 * np.exp(1j * np.pi * (2 * k + 1) / 16) for k in range(16)]], ids=["4", "6", "repeated", "16", "16-no-real"])
 def test_companion_matrices(eigenvalues, roots):
     coefficients = np.poly(roots).real
     n = len(coefficients) - 1
@@ -122,7 +122,7 @@ def test_companion_matrices(eigenvalues, roots):
 
 def test_random_matrices_as_lapack(eigenvalues):
     rng = np.random.default_rng(0)
-    for n in (4, 12, 24):
+    for n in (4, 12, 16):
         for _ in range(50):
             matrix = rng.normal(size=(n, n)) * rng.choice([1e-3, 1, 1e3], size=(n, n))
             assert _distance(eigenvalues(matrix), np.linalg.eigvals(matrix)) < 1e-9
@@ -139,7 +139,7 @@ def test_general6r_roots_complete_to_every_solution(library, name):
     arm = solver_of(name)
 
     def roots(p: np.ndarray, q: np.ndarray) -> np.ndarray:
-        p, q, angles = np.ascontiguousarray(p), np.ascontiguousarray(q), np.zeros((24, 5))
+        p, q, angles = np.ascontiguousarray(p), np.ascontiguousarray(q), np.zeros((16, 5))
         count = library.roots(p.ctypes.data_as(POINTER), q.ctypes.data_as(POINTER), angles.ctypes.data_as(POINTER))
         return angles[:count]
 

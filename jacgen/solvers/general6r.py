@@ -440,5 +440,6 @@ def work_bytes(real: str) -> int:
     the equations in the build's real type and in double, the kernel's matrices in double), as
     the contract documents it; tests/test_shipped_robots.py checks it against the compiler's."""
     reals = 378 + 112
-    doubles = 3 * 14 * 9 + 14 * 8 + 24 * 5 + (14 * 8 + 8 + 8 + 3 * 6 * 9 + 3 * 12 * 12 + 24 * 24 + 12 * 12 + 24 + 24)
+    doubles = 3 * 14 * 9 + 14 * 8 + 16 * 5 + (14 * 8 + 8 + 8 + 6 * 14 + 3 * 6 * 9 + 3 * 12 * 12 + 2 * 12 * 4 + 12 * 16
+                                           + 16 * 16 + 2 * 12 * 12 + 16 + 16)
     return reals * {"double": 8, "float": 4}[real] + doubles * 8
