@@ -143,8 +143,9 @@ void manocha_canny_ik_branches(const manocha_canny_real T[16], manocha_canny_rea
  * equivalent inside them; k = 0 when the target is out of reach or not finite. ik_branches
  * also gives the solutions outside the limits (in_limits 0).
  * Solver: general 6R: Raghavan & Roth's 14 equations, eliminated to a 12 x 12 quadratic
- * matrix polynomial in tan(q_k/2) solved as a 24 x 24 eigenproblem, back-substitution and
- * up to six Newton steps (jacgen/general6r.py).
+ * matrix polynomial in tan(q_k/2) solved as an eigenproblem (24 x 24, its eight roots +-i
+ * deflated in C), back-substitution and up to six Newton steps
+ * (jacgen/solvers/general6r.py).
  * Order: the real eigenvalues in the order the eigensolver gives them; a solution that
  * does not reach the target after the Newton steps (a spurious root) is skipped; each
  * solution once (equal to 1e-6 rad).

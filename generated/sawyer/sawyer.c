@@ -10,7 +10,7 @@
  * double-shift QR iterations with deflation (Golub & Van Loan, Matrix Computations, 7.5).
  * Fixed size, no allocation, no recursion, at most JACGEN_EIG_ITERATIONS iterations per
  * eigenvalue (exceptional shifts at 10 and 20). */
-#define JACGEN_EIG_MAX 24
+#define JACGEN_EIG_MAX 16
 #define JACGEN_EIG_ITERATIONS 60
 
 static void jacgen_eig_balance(int n, double a[JACGEN_EIG_MAX][JACGEN_EIG_MAX]) {
@@ -172,24 +172,26 @@ static int jacgen_eigenvalues(int n, double a[JACGEN_EIG_MAX][JACGEN_EIG_MAX], d
  * angle's shift already applied (jacgen/general6r.py), the loop angles (a, b, c, g, h) of every
  * real root. Q = QR by Householder reflections: the rows 8..13 of Q^T P are the six equations
  * free of v_gh; their twelve in the monomials x_b^i x_c^j (the six, and the six times x_b) give
- * M0 + x M1 + x^2 M2, whose 24 x 24 companion matrix has the roots x = tan(a / 2) as eigenvalues
- * (jacgen_eigenvalues); per real root, the null vector of M(x) (Gaussian elimination with complete
- * pivoting) gives x_b and x_c, and R^-1 (Q^T P v_bc)[0..7] gives v_gh. Fixed size, no allocation,
- * no recursion. Returns the number of roots (0 when M2 or R is singular). */
-#define JACGEN_G6_ROOTS 24
+ * M(x) = M0 + x M1 + x^2 M2, x = tan(a / 2). Of the 24 eigenvalues of its companion matrix, 8 are
+ * x = +-i for every target (jacgen_g6_spurious); the other 16 are those of the companion matrix
+ * with them deflated (jacgen_g6_deflated, jacgen_eigenvalues). Per real root, the null vector of
+ * M(x) (inverse iteration) gives x_b and x_c, and R^-1 (Q^T P v_bc)[0..7] gives v_gh. Fixed size,
+ * no allocation, no recursion. Returns the number of roots (0 when M2 or R is singular). */
+#define JACGEN_G6_ROOTS 16
 
-/* Entry k of v_bc as a polynomial in x_b, x_c: its coefficient of x_b^i x_c^j at 3 i + j. */
-static const double jacgen_g6_monomials[9][9] = {
-    { 0, 0, 0, 0, 4, 0, 0, 0, 0 },
-    { 0, 0, 0, 2, 0, -2, 0, 0, 0 },
-    { 0, 2, 0, 0, 0, 0, 0, -2, 0 },
-    { 1, 0, -1, 0, 0, 0, -1, 0, 1 },
-    { 0, 0, 0, 2, 0, 2, 0, 0, 0 },
-    { 1, 0, 1, 0, 0, 0, -1, 0, -1 },
-    { 0, 2, 0, 0, 0, 0, 0, 2, 0 },
-    { 1, 0, -1, 0, 0, 0, 1, 0, -1 },
-    { 1, 0, 1, 0, 0, 0, 1, 0, 1 },
-};
+/* sum_k c[k] v_bc[k] times (1 + x_b^2) (1 + x_c^2) as a polynomial in x_b, x_c: its coefficient of
+ * x_b^i x_c^j at 3 i + j (jacgen/general6r.py's MONOMIALS, written out without its zeros). */
+static void jacgen_g6_monomials(const double c[9], double out[9]) {
+    out[0] = c[3] + c[5] + c[7] + c[8];
+    out[1] = 2.0 * c[2] + 2.0 * c[6];
+    out[2] = -c[3] + c[5] - c[7] + c[8];
+    out[3] = 2.0 * c[1] + 2.0 * c[4];
+    out[4] = 4.0 * c[0];
+    out[5] = -2.0 * c[1] + 2.0 * c[4];
+    out[6] = -c[3] - c[5] + c[7] + c[8];
+    out[7] = -2.0 * c[2] + 2.0 * c[6];
+    out[8] = c[3] - c[5] - c[7] + c[8];
+}
 
 /* The Householder reflections of q (14 x 8) in place below the diagonal with their scales; r's
  * diagonal in rdiag. Returns -1 when a column is (numerically) dependent on the others. */
@@ -217,13 +219,24 @@ static int jacgen_g6_qr(double q[14][8], double beta[8], double rdiag[8]) {
     return 0;
 }
 
+/* v <- H_k v (14): Householder reflection k of jacgen_g6_qr (Q = H_0 ... H_7). */
+static void jacgen_g6_reflect(double q[14][8], const double beta[8], int k, double v[14]) {
+    double s = 0.0;
+    for (int i = k; i < 14; i++) s += q[i][k] * v[i];
+    s *= beta[k];
+    for (int i = k; i < 14; i++) v[i] -= s * q[i][k];
+}
+
 /* v <- Q^T v (14) */
 static void jacgen_g6_transpose_times(double q[14][8], const double beta[8], double v[14]) {
-    for (int k = 0; k < 8; k++) {
-        double s = 0.0;
-        for (int i = k; i < 14; i++) s += q[i][k] * v[i];
-        s *= beta[k];
-        for (int i = k; i < 14; i++) v[i] -= s * q[i][k];
+    for (int k = 0; k < 8; k++) jacgen_g6_reflect(q, beta, k, v);
+}
+
+/* The rows 8..13 of Q^T (the left null space of the QR's matrix), as Q e_(8 + r). */
+static void jacgen_g6_left_null(double q[14][8], const double beta[8], double n[6][14]) {
+    for (int r = 0; r < 6; r++) {
+        for (int i = 0; i < 14; i++) n[r][i] = i == 8 + r ? 1.0 : 0.0;
+        for (int k = 7; k >= 0; k--) jacgen_g6_reflect(q, beta, k, n[r]);
     }
 }
 
@@ -252,66 +265,167 @@ static int jacgen_g6_solve(int n, double *a, int nb, double *b) {
     return 0;
 }
 
-/* The null vector of a (12 x 12, singular to rounding): elimination with complete pivoting,
- * the last unknown set to 1, back-substitution, columns put back in order. */
+/* The null vector of a (12 x 12, singular to rounding) by inverse iteration: LU with partial
+ * pivoting, then U v = (1, ..., 1), the start vector L (1, ..., 1) being one whose component
+ * along the null vector the elimination does not cancel (Wilkinson). A zero pivot is taken as
+ * the rounding that it is: 1e-16 times the largest pivot before it. Rows with a zero below the
+ * pivot are skipped: M(x)'s rows 6..11 have none in columns 0..2. (a: overwritten, U with its
+ * inverted diagonal.) */
 static void jacgen_g6_null_vector(double a[12][12], double v[12]) {
-    int column[12];
-    for (int j = 0; j < 12; j++) column[j] = j;
-    for (int k = 0; k < 11; k++) {
-        int pr = k, pc = k;
-        for (int i = k; i < 12; i++)
-            for (int j = k; j < 12; j++)
-                if (fabs(a[i][j]) > fabs(a[pr][pc])) { pr = i; pc = j; }
-        for (int j = 0; j < 12; j++) { double t = a[k][j]; a[k][j] = a[pr][j]; a[pr][j] = t; }
-        for (int i = 0; i < 12; i++) { double t = a[i][k]; a[i][k] = a[i][pc]; a[i][pc] = t; }
-        int t = column[k]; column[k] = column[pc]; column[pc] = t;
-        if (a[k][k] == 0.0) a[k][k] = 1e-300;
+    double largest = 1.0;
+    for (int k = 0; k < 12; k++) {
+        int p = k;
+        for (int i = k + 1; i < 12; i++)
+            if (fabs(a[i][k]) > fabs(a[p][k])) p = i;
+        if (p != k)
+            for (int j = k; j < 12; j++) { double t = a[k][j]; a[k][j] = a[p][j]; a[p][j] = t; }
+        if (a[k][k] == 0.0) a[k][k] = 1e-16 * largest;
+        else if (k == 0 || fabs(a[k][k]) > largest) largest = fabs(a[k][k]);
+        double inverse = 1.0 / a[k][k];
         for (int i = k + 1; i < 12; i++) {
-            double f = a[i][k] / a[k][k];
-            for (int j = k; j < 12; j++) a[i][j] -= f * a[k][j];
+            if (a[i][k] == 0.0) continue;
+            double f = a[i][k] * inverse;
+            for (int j = k + 1; j < 12; j++) a[i][j] -= f * a[k][j];
         }
+        a[k][k] = inverse;
     }
-    double z[12];
-    z[11] = 1.0;
-    for (int k = 10; k >= 0; k--) {
-        double s = 0.0;
-        for (int j = k + 1; j < 12; j++) s -= a[k][j] * z[j];
-        z[k] = s / a[k][k];
+    for (int k = 11; k >= 0; k--) {
+        double s = 1.0;
+        for (int j = k + 1; j < 12; j++) s -= a[k][j] * v[j];
+        v[k] = s * a[k][k];
     }
-    for (int j = 0; j < 12; j++) v[column[j]] = z[j];
 }
 
-/* 2 atan(num / den) of the pair (num, den) = (v[i + step], v[i]) of largest size, i in `from`. */
+/* 2 atan(num / den) of the pair (num, den) = (v[i + step], v[i]) of largest size, i in `from`
+ * (sizes squared: v is a null vector by inverse iteration, about 1 / rounding, far from overflow). */
 static double jacgen_g6_half_angle(const double v[12], const int *from, int count, int step) {
     int best = from[0];
-    for (int k = 1; k < count; k++)
-        if (hypot(v[from[k]], v[from[k] + step]) > hypot(v[best], v[best + step])) best = from[k];
+    double largest = -1.0;
+    for (int k = 0; k < count; k++) {
+        double size = v[from[k]] * v[from[k]] + v[from[k] + step] * v[from[k] + step];
+        if (size > largest) { largest = size; best = from[k]; }
+    }
     return 2.0 * atan2(v[best + step], v[best]);
 }
 
-/* The kernel's working memory: the QR of Q, the six v_gh-free equations, M0, M1, M2, the
- * companion matrix (eigenvalues in re, im) and one 12 x 12 matrix (M2's LU, then M(x) at each
- * root). */
-struct jacgen_g6_work {
-    double q[14][8], beta[8], rdiag[8], free[3][6][9], m[3][12][12];
-    double companion[JACGEN_EIG_MAX][JACGEN_EIG_MAX], square[12][12], re[JACGEN_EIG_MAX], im[JACGEN_EIG_MAX];
-};
-
-/* M_e into out (12 x 12): the coefficient of x^e of (1 + x^2) (S0 + s Ss + c Sc) (free: S0, Ss,
- * Sc; s = 2x / (1 + x^2), c = (1 - x^2) / (1 + x^2)), in the monomials x_b^i x_c^j; rows 6..11 are
- * rows 0..5 times x_b. */
-static void jacgen_g6_pencil(double free[3][6][9], int e, double out[12][12]) {
-    for (int i = 0; i < 12; i++)
-        for (int j = 0; j < 12; j++) out[i][j] = 0.0;
-    for (int r = 0; r < 6; r++)
+/* M_e (12 x 12), e = 0, 1, 2: the coefficient of x^e of (1 + x^2) (S0 + s Ss + c Sc) (free: S0,
+ * Ss, Sc; s = 2x / (1 + x^2), c = (1 - x^2) / (1 + x^2)), in the monomials x_b^i x_c^j; rows 6..11
+ * are rows 0..5 times x_b. */
+static void jacgen_g6_pencil(double free[3][6][9], double m[3][12][12]) {
+    for (int r = 0; r < 6; r++) {
+        double c[3][9];
         for (int k = 0; k < 9; k++) {
             double s0 = free[0][r][k], ss = free[1][r][k], sc = free[2][r][k];
-            double coefficient = e == 0 ? s0 + sc : e == 1 ? 2.0 * ss : s0 - sc;
-            for (int j = 0; j < 9; j++) {
-                out[r][j] += coefficient * jacgen_g6_monomials[k][j];
-                out[r + 6][j + 3] += coefficient * jacgen_g6_monomials[k][j];
+            c[0][k] = s0 + sc;
+            c[1][k] = 2.0 * ss;
+            c[2][k] = s0 - sc;
+        }
+        for (int e = 0; e < 3; e++) {
+            double row[9];
+            jacgen_g6_monomials(c[e], row);
+            for (int j = 0; j < 3; j++) m[e][r][9 + j] = m[e][r + 6][j] = 0.0;
+            for (int j = 0; j < 9; j++) m[e][r][j] = m[e][r + 6][j + 3] = row[j];
+        }
+    }
+}
+
+/* The kernel's working memory: the QR of Q, its left null space, the six v_gh-free equations, M0,
+ * M1, M2, the null space of M(i) (u + i v), M2^-1 [M0 M1] at the deflated matrix's columns, the
+ * deflated matrix (eigenvalues in re, im) and two 12 x 12 matrices (M(i); M2's LU; M(x) at each
+ * root). */
+struct jacgen_g6_work {
+    double q[14][8], beta[8], rdiag[8], left_null[6][14], free[3][6][9], m[3][12][12];
+    double u[12][4], v[12][4], columns[12][16], square[2][12][12];
+    double deflated[JACGEN_EIG_MAX][JACGEN_EIG_MAX], re[JACGEN_EIG_MAX], im[JACGEN_EIG_MAX];
+};
+
+/* The null space of M(i) = (M0 - M2) + i M1 as four complex vectors u + i v (columns of u, v):
+ * the rows of the equations that turn with the hidden angle, by e^(ia) = (1 + ix)^2 / (1 + x^2),
+ * have rank 4 at x = i, so M(i) has rank 8 and x = +-i are roots four times over. Complete
+ * pivoting, eight steps (re, im: scratch), the four unknowns left set to unit vectors: column
+ * order[8 + k] of M(i) is the unit vector of u's column k, and v is 0 there. The eight pivot
+ * columns in order[0..7]; -1 when a pivot is 0. */
+static int jacgen_g6_spurious(double m[3][12][12], double re[12][12], double im[12][12], double u[12][4],
+                              double v[12][4], int order[12]) {
+    int *column = order;
+    for (int i = 0; i < 12; i++) {
+        column[i] = i;
+        for (int j = 0; j < 12; j++) { re[i][j] = m[0][i][j] - m[2][i][j]; im[i][j] = m[1][i][j]; }
+    }
+    for (int k = 0; k < 8; k++) {
+        int pr = k, pc = k;
+        double largest = 0.0;
+        for (int i = k; i < 12; i++)
+            for (int j = k; j < 12; j++) {
+                double size = re[i][j] * re[i][j] + im[i][j] * im[i][j];
+                if (size > largest) { largest = size; pr = i; pc = j; }
+            }
+        if (!(largest > 0.0)) return -1;
+        for (int j = 0; j < 12; j++) {
+            double t = re[k][j]; re[k][j] = re[pr][j]; re[pr][j] = t;
+            t = im[k][j]; im[k][j] = im[pr][j]; im[pr][j] = t;
+        }
+        for (int i = 0; i < 12; i++) {
+            double t = re[i][k]; re[i][k] = re[i][pc]; re[i][pc] = t;
+            t = im[i][k]; im[i][k] = im[i][pc]; im[i][pc] = t;
+        }
+        int t = column[k]; column[k] = column[pc]; column[pc] = t;
+        double inverse_re = re[k][k] / largest, inverse_im = -im[k][k] / largest;
+        for (int i = k + 1; i < 12; i++) {
+            double f_re = re[i][k] * inverse_re - im[i][k] * inverse_im;
+            double f_im = re[i][k] * inverse_im + im[i][k] * inverse_re;
+            for (int j = k + 1; j < 12; j++) {
+                re[i][j] -= f_re * re[k][j] - f_im * im[k][j];
+                im[i][j] -= f_re * im[k][j] + f_im * re[k][j];
             }
         }
+    }
+    for (int f = 0; f < 4; f++) {
+        double z_re[12], z_im[12];
+        for (int j = 8; j < 12; j++) { z_re[j] = j == 8 + f ? 1.0 : 0.0; z_im[j] = 0.0; }
+        for (int k = 7; k >= 0; k--) {
+            double s_re = -re[k][8 + f], s_im = -im[k][8 + f];
+            for (int j = k + 1; j < 8; j++) {
+                s_re -= re[k][j] * z_re[j] - im[k][j] * z_im[j];
+                s_im -= re[k][j] * z_im[j] + im[k][j] * z_re[j];
+            }
+            double size = re[k][k] * re[k][k] + im[k][k] * im[k][k];
+            z_re[k] = (s_re * re[k][k] + s_im * im[k][k]) / size;
+            z_im[k] = (s_im * re[k][k] - s_re * im[k][k]) / size;
+        }
+        for (int j = 0; j < 12; j++) { u[column[j]][f] = z_re[j]; v[column[j]][f] = z_im[j]; }
+    }
+    return 0;
+}
+
+/* The 16 x 16 matrix whose eigenvalues are those of the companion matrix C = [0 I; -S] (S = M2^-1
+ * [M0 M1], on (y, x y) with M(x) y = 0) less x = +-i. Their eigenvectors [z; i z] (z = u + i v in
+ * the null space of M(i)) and conjugates span the invariant subspace W = [u v; -v u]; the
+ * rows of W at the free columns order[8..11] of M(i) and at 12 + those are the identity, so the
+ * unit vectors e_r at the other rows r complete W to a basis and C's map on R^24 / W in that
+ * basis is C[r][r'] - W[r] C[sel][r'] (sel: the identity's rows): with C[sel] = [0; -S[free]] at
+ * the columns r', the rows [0 I] + v S[free] and -S + u S[free] at the pivot columns.
+ * -1 when M2 is singular. */
+static int jacgen_g6_deflated(struct jacgen_g6_work *w, const int order[12]) {
+    double (*s)[16] = w->columns, (*lead)[12] = w->square[0];
+    for (int i = 0; i < 12; i++) {
+        for (int j = 0; j < 12; j++) lead[i][j] = w->m[2][i][j];
+        for (int b = 0; b < 8; b++) { s[i][b] = w->m[0][i][order[b]]; s[i][8 + b] = w->m[1][i][order[b]]; }
+    }
+    if (jacgen_g6_solve(12, &lead[0][0], 16, &s[0][0]) != 0) return -1;
+    for (int a = 0; a < 8; a++) {
+        int r = order[a];
+        for (int b = 0; b < 16; b++) {
+            double top = b == 8 + a ? 1.0 : 0.0, bottom = -s[r][b];
+            for (int k = 0; k < 4; k++) {
+                top += w->v[r][k] * s[order[8 + k]][b];
+                bottom += w->u[r][k] * s[order[8 + k]][b];
+            }
+            w->deflated[a][b] = top;
+            w->deflated[8 + a][b] = bottom;
+        }
+    }
+    return 0;
 }
 
 static int jacgen_general6r_roots(double p[3][14][9], double q_matrix[14][8],
@@ -319,38 +433,27 @@ static int jacgen_general6r_roots(double p[3][14][9], double q_matrix[14][8],
     for (int i = 0; i < 14; i++)
         for (int j = 0; j < 8; j++) w->q[i][j] = q_matrix[i][j];
     if (jacgen_g6_qr(w->q, w->beta, w->rdiag) != 0) return 0;
-    /* Q^T P, every column of P0, Ps, Pc; its rows 8..13 are the six equations free of v_gh. */
+    /* the rows 8..13 of Q^T P0, Q^T Ps, Q^T Pc: the six equations free of v_gh */
+    jacgen_g6_left_null(w->q, w->beta, w->left_null);
     for (int m = 0; m < 3; m++)
-        for (int j = 0; j < 9; j++) {
-            double column[14];
-            for (int i = 0; i < 14; i++) column[i] = p[m][i][j];
-            jacgen_g6_transpose_times(w->q, w->beta, column);
-            for (int i = 0; i < 6; i++) w->free[m][i][j] = column[8 + i];
+        for (int r = 0; r < 6; r++) {
+            for (int j = 0; j < 9; j++) w->free[m][r][j] = 0.0;
+            for (int i = 0; i < 14; i++)
+                for (int j = 0; j < 9; j++) w->free[m][r][j] += w->left_null[r][i] * p[m][i][j];
         }
-    /* companion [0 I; -M2^-1 M0  -M2^-1 M1] */
-    double (*a)[JACGEN_EIG_MAX] = w->companion;
-    for (int e = 0; e < 3; e++) jacgen_g6_pencil(w->free, e, w->m[e]);
-    for (int i = 0; i < 12; i++)
-        for (int j = 0; j < 12; j++) {
-            w->square[i][j] = w->m[2][i][j];
-            a[12 + i][j] = w->m[0][i][j];
-            a[12 + i][12 + j] = w->m[1][i][j];
-        }
-    if (jacgen_g6_solve(12, &w->square[0][0], 24, &a[12][0]) != 0) return 0;
-    for (int i = 0; i < 12; i++) {
-        for (int j = 0; j < 24; j++) a[i][j] = j == i + 12 ? 1.0 : 0.0;
-        for (int j = 0; j < 24; j++) a[i + 12][j] = -a[i + 12][j];
-    }
-    if (jacgen_eigenvalues(24, a, w->re, w->im) != 0) return 0;
+    jacgen_g6_pencil(w->free, w->m);
+    int order[12];
+    if (jacgen_g6_spurious(w->m, w->square[0], w->square[1], w->u, w->v, order) != 0 || jacgen_g6_deflated(w, order) != 0
+        || jacgen_eigenvalues(JACGEN_G6_ROOTS, w->deflated, w->re, w->im) != 0) return 0;
     static const int along_c[8] = {0, 1, 3, 4, 6, 7, 9, 10};
     static const int along_b[9] = {0, 1, 2, 3, 4, 5, 6, 7, 8};
     int found = 0;
-    for (int k = 0; k < 24; k++) {
+    for (int k = 0; k < JACGEN_G6_ROOTS; k++) {
         double x = w->re[k], v[12];
         if (!(fabs(w->im[k]) <= 1e-05 * (1.0 + fabs(x)))) continue;
         for (int i = 0; i < 12; i++)
-            for (int j = 0; j < 12; j++) w->square[i][j] = w->m[0][i][j] + x * (w->m[1][i][j] + x * w->m[2][i][j]);
-        jacgen_g6_null_vector(w->square, v);
+            for (int j = 0; j < 12; j++) w->square[0][i][j] = w->m[0][i][j] + x * (w->m[1][i][j] + x * w->m[2][i][j]);
+        jacgen_g6_null_vector(w->square[0], v);
         double a_angle = 2.0 * atan(x);
         double b = jacgen_g6_half_angle(v, along_b, 9, 3);
         double c = jacgen_g6_half_angle(v, along_c, 8, 1);
@@ -5266,7 +5369,7 @@ static sawyer_real sawyer_ik_general_polish(const sawyer_real T[16], sawyer_real
     return cost;
 }
 
-/* The general 6R solver's working memory: 20720 bytes in this build. A local of
+/* The general 6R solver's working memory: 21840 bytes in this build. A local of
  * sawyer_ik_branches (on its stack) unless SAWYER_IK_STATIC_WORK is defined: then one static
  * object, and sawyer_ik_branches (with sawyer_ik and sawyer_ik_nearest) is not reentrant. */
 struct sawyer_ik_work {

@@ -123,7 +123,7 @@ ROBOT_NAME_RULE = ("a robot name may not be a C or Python keyword, a C standard 
                    "Python module name, since it names the generated files and modules")
 PARAMETER_NAME_RULE = ("parameter names may not be C, C++ or Python keywords, Python builtins, "
                        "<math.h> names, names the generated code uses (q, p, fk, t0, c1, s1, q1, "
-                       "T00, mu0, see jacgen/names.py), start with '_' or with the robot's "
+                       "T00, mu0, see jacgen/inputs/names.py), start with '_' or with the robot's "
                        "name and '_'")
 
 

@@ -84,8 +84,8 @@ SOLVERS = {
             "elbow: q3, '+' then '-' (elbow up and down)")),
     "general_6r": SolverInfo(
         "general 6R: Raghavan & Roth's 14 equations, eliminated to a 12 x 12 quadratic matrix "
-        "polynomial in tan(q_k/2) solved as a 24 x 24 eigenproblem, back-substitution and up to "
-        "six Newton steps (jacgen/general6r.py)",
+        "polynomial in tan(q_k/2) solved as an eigenproblem (24 x 24, its eight roots +-i deflated in C), "
+        "back-substitution and up to six Newton steps (jacgen/solvers/general6r.py)",
         16, ("the real eigenvalues in the order the eigensolver gives them; a solution that does not "
              "reach the target after the Newton steps (a spurious root) is skipped",)),
 }
