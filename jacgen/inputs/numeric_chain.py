@@ -16,16 +16,23 @@ def _stack(rows, shape) -> np.ndarray:
                     -1).reshape(*shape, 4, 4)
 
 
+def standard_link(theta: np.ndarray, d, a: float, alpha: float) -> np.ndarray:
+    """Rz(theta) Tz(d) Tx(a) Rx(alpha), Spong's standard DH link, at a batch of theta."""
+    ca, sa, ct, st = np.cos(alpha), np.sin(alpha), np.cos(theta), np.sin(theta)
+    rows = [[ct, -st * ca, st * sa, a * ct], [st, ct * ca, -ct * sa, a * st], [0, sa, ca, d], [0, 0, 0, 1]]
+    return _stack(rows, np.shape(theta))
+
+
 def _link(robot, joint, qi: np.ndarray) -> np.ndarray:
     """The link transform of one DH row at joint value qi."""
     theta = qi + joint.offset.approx if joint.revolute else np.full(qi.shape, joint.theta.approx)
     d = np.full(qi.shape, joint.d.approx) if joint.revolute else qi + joint.offset.approx
+    if robot.convention == "standard":
+        return standard_link(theta, d, joint.a.approx, joint.alpha.approx)
     a, ca, sa = joint.a.approx, np.cos(joint.alpha.approx), np.sin(joint.alpha.approx)
     ct, st = np.cos(theta), np.sin(theta)
-    if robot.convention == "standard":  # Rz(theta) Tz(d) Tx(a) Rx(alpha)
-        rows = [[ct, -st * ca, st * sa, a * ct], [st, ct * ca, -ct * sa, a * st], [0, sa, ca, d], [0, 0, 0, 1]]
-    else:  # Rx(alpha) Tx(a) Rz(theta) Tz(d)
-        rows = [[ct, -st, 0, a], [st * ca, ct * ca, -sa, -d * sa], [st * sa, ct * sa, ca, d * ca], [0, 0, 0, 1]]
+    # Rx(alpha) Tx(a) Rz(theta) Tz(d)
+    rows = [[ct, -st, 0, a], [st * ca, ct * ca, -sa, -d * sa], [st * sa, ct * sa, ca, d * ca], [0, 0, 0, 1]]
     return _stack(rows, qi.shape)
 
 

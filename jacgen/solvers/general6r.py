@@ -409,18 +409,12 @@ whose null space at a root has more than one vector, from which v_bc cannot). De
 
 
 def _numeric_chain(links: list[Link], theta: np.ndarray) -> np.ndarray:
-    """Z1 C1 ... Z5 C5 Z6 at a batch of joint angles (..., 6), in doubles."""
-    def rz(angle):
-        out = np.zeros((*angle.shape, 4, 4))
-        out[..., 0, 0] = out[..., 1, 1] = np.cos(angle)
-        out[..., 1, 0], out[..., 0, 1] = np.sin(angle), -np.sin(angle)
-        out[..., 2, 2] = out[..., 3, 3] = 1
-        return out
-
-    out = rz(theta[..., 0])
-    for i, link in enumerate(links):
-        constant = np.array(twist(link.d, link.a, link.alpha).evalf(20).tolist(), dtype=float)
-        out = out @ constant @ rz(theta[..., i + 1])
+    """Z1 C1 ... Z5 C5 Z6 at a batch of joint angles (..., 6), in doubles: Z_i C_i is a standard
+    DH link."""
+    out = numeric_chain.standard_link(theta[..., 5], 0.0, 0.0, 0.0)
+    for i in reversed(range(5)):
+        link = links[i]
+        out = numeric_chain.standard_link(theta[..., i], float(link.d), float(link.a), float(link.alpha)) @ out
     return out
 
 
