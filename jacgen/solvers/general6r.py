@@ -409,11 +409,10 @@ whose null space at a root has more than one vector, from which v_bc cannot). De
 
 
 def _numeric_chain(links: list[Link], theta: np.ndarray) -> np.ndarray:
-    """Z1 C1 ... Z5 C5 Z6 at a batch of joint angles (..., 6), in doubles: Z_i C_i is a standard
-    DH link."""
-    out = numeric_chain.standard_link(theta[..., 5], 0.0, 0.0, 0.0)
-    for i in reversed(range(5)):
-        link = links[i]
+    """Z1 C1 ... Zk Ck Zk+1 at a batch of joint angles (..., k + 1), in doubles (k = 5 for the
+    loop): Z_i C_i is a standard DH link."""
+    out = numeric_chain.standard_link(theta[..., len(links)], 0.0, 0.0, 0.0)
+    for i, link in reversed(list(enumerate(links))):
         out = numeric_chain.standard_link(theta[..., i], float(link.d), float(link.a), float(link.alpha)) @ out
     return out
 
