@@ -33,7 +33,7 @@ import common
 from jacgen.checking import reference
 from jacgen.emission.generator import Generator
 from jacgen.checking.cortex_m4f import Emulator, check_tools
-from jacgen.checking.verify import FLOAT_TOLERANCE
+from jacgen.tolerances import VERIFIED
 
 ROBOTS = ("puma560", "ur5", "panda")
 MATH = ("sin", "cos", "tan", "sqrt", "fabs", "atan2", "asin", "acos", "exp", "log", "pow", "fmin", "fmax", "floor")
@@ -99,7 +99,7 @@ def measure(robot, folder: Path, q: np.ndarray, sources: Path | None) -> dict[st
     for name, value in expected.items():
         found = emulator.evaluate(name, q)
         error = np.max(np.abs(found - value) / (1 + np.abs(value)))
-        if not error <= FLOAT_TOLERANCE * (1 + robot.reach):  # `jacgen verify`'s float tolerance
+        if not error <= VERIFIED["float"] * (1 + robot.reach):  # `jacgen verify`'s float tolerance
             raise SystemExit(f"{robot.name} {name} ({'casadi' if sources else 'jacgen'}): off by {error:.1e}")
         batch, cost = emulator.measured[name], emulator.resources[name]
         figures[name] = (cost.flash, cost.stack, int(batch.stack.max()), float(batch.instructions.mean()))

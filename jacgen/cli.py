@@ -11,7 +11,7 @@ from jacgen.emission.backends import DEFAULT_LANGUAGES, LANGUAGES
 from jacgen.errors import JacgenError
 from jacgen.files import stale_files, write_files
 from jacgen.parallel import usable_cpus
-from jacgen.tolerances import URDF_AGREEMENT
+from jacgen.tolerances import ANGLE_SNAP, URDF_AGREEMENT
 from jacgen.version import __version__
 
 # Each command imports what it needs when it runs: `jacgen --help`, `validate` and a cached
@@ -299,7 +299,7 @@ def verify(robot_files, samples, seed, target, sources, native, jobs):
 @click.option("--name", default=None, help="Robot name (default: the URDF's, made a valid name).")
 @click.option("--task", default=None, metavar="x,y,...",
               help="Task components (default: all six, or for fewer than six joints the first independent ones).")
-@click.option("--snap", default=1e-9, show_default=True, type=click.FloatRange(0, 0.01), metavar="RADIANS",
+@click.option("--snap", default=ANGLE_SNAP, show_default=True, type=click.FloatRange(0, 0.01), metavar="RADIANS",
               help="Angles and axes this close to a multiple of 90 degrees become exact (1e-5 takes a URDF's 1.5708).")
 @click.option("-o", "--output", default=None, type=click.Path(dir_okay=False), metavar="FILE.yaml",
               help="Write the robot file here (default: standard output).")

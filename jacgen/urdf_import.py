@@ -21,8 +21,9 @@ from jacgen.inputs.dh_fit import Axis, exact_or_float, fit
 from jacgen.inputs.names import robot_name_problem
 from jacgen.inputs.robot import (FORBIDDEN_IN_TEXT, IDENTIFIER_PATTERN, NAME_PATTERN, TASK_COMPONENTS, Robot,
                                  parse_robot, task_problem)
-from jacgen.inputs.urdf import MOVABLE, SNAP_TOLERANCE, LinkChain, Snapper, joint_axes, read_chain
+from jacgen.inputs.urdf import MOVABLE, LinkChain, Snapper, joint_axes, read_chain
 from jacgen.version import __version__
+from jacgen.tolerances import ANGLE_SNAP
 
 CHECK_CONFIGURATIONS = 20
 CHECK_SEED = 0
@@ -42,7 +43,7 @@ class Imported:
 
 def import_urdf(path: str, base: str | None = None, tip: str | None = None, convention: str = "standard",
                 name: str | None = None, task: tuple[str, ...] | None = None,
-                snap: float = SNAP_TOLERANCE) -> Imported:
+                snap: float = ANGLE_SNAP) -> Imported:
     """The robot file for the chain of `path`, checked against the URDF's own fk."""
     snapper = Snapper(snap)
     chain = read_chain(path, base, tip, snapper)

@@ -29,6 +29,7 @@ from jacgen.errors import JacgenError
 from jacgen.files import write_files
 from jacgen.inputs.robot import Robot
 from jacgen.solvers.differential import IK_NUMERIC_DEFAULTS
+from jacgen.tolerances import IK_NUMERIC_VERIFIED
 
 TARGETS = ("cortex-m4f",)
 INSTALL = "apt-get install gcc-arm-none-eabi libnewlib-arm-none-eabi qemu-system-arm"
@@ -42,7 +43,6 @@ INSTRUCTIONS_PER_TICK = 40 / 64
 PAINTED_BYTES = 65536  # the stack painted below each call: a deeper call is reported as this
 RUN_SECONDS = 300  # a run that takes longer is stopped (it hangs)
 TEMPLATES = ("runtime.h", "runtime.c", "mps2_an386.ld", "harness.c")
-FLOAT_IK_TOL = 1e-5  # ik_numeric's tol in float: |error| the float step can reach
 
 
 class TargetError(JacgenError):
@@ -252,7 +252,7 @@ class Emulator:
         values = {"q": q, "q_dot": rng.normal(size=q.shape), "mu_dot": rng.normal(size=(len(q), len(self.robot.task))),
                   "damping": np.full(len(q), 0.01), "target": target, "T": target, "mu": target,
                   "q_seed": q + 0.1, "q0": q + 0.1, "weights": np.ones_like(q),
-                  "max_iter": np.full(len(q), IK_NUMERIC_DEFAULTS["max_iter"]), "tol": np.full(len(q), FLOAT_IK_TOL), "q_free": q[:, free] if free is not None else None}
+                  "max_iter": np.full(len(q), IK_NUMERIC_DEFAULTS["max_iter"]), "tol": np.full(len(q), IK_NUMERIC_VERIFIED["float"]), "q_free": q[:, free] if free is not None else None}
         for name in self.calls:
             if name not in self.measured:
                 self.call(name, values)

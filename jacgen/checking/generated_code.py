@@ -9,9 +9,10 @@ from pathlib import Path
 import numpy as np
 
 from jacgen.checking.c_library import CLibrary
-from jacgen.checking.cortex_m4f import FLOAT_IK_TOL, Emulator
+from jacgen.checking.cortex_m4f import Emulator
 from jacgen.emission.catalogue import Function
 from jacgen.inputs.robot import Robot
+from jacgen.tolerances import IK_NUMERIC_VERIFIED
 
 HOST_BACKENDS = ("python", "casadi", "c double", "c float")  # what `jacgen verify` compares on the host
 # NAME_native as `verify --native` calls it: batches of float64 (the double C) and float32 (the
@@ -21,7 +22,6 @@ NATIVE_BACKENDS = ("native double", "native double scalar", "native double one",
 TARGET_BACKENDS = {"cortex-m4f": "cortex-m4f float"}  # `verify --target`: the target's float C alone
 # ik_numeric as verify runs it: up to this many steps, to this |error| by real type.
 IK_NUMERIC_STEPS = 200
-IK_NUMERIC_TOL = {"double": 1e-12, "float": FLOAT_IK_TOL}
 
 
 def import_module(path: Path, module_name: str):
@@ -153,19 +153,19 @@ class GeneratedCode:
     def ik_numeric(self, backend: str, targets: np.ndarray, starts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """ik_numeric from each start: (q (k, dof), status (k,))."""
         if self.emulator is not None:
-            return self.emulator.ik_numeric(targets, starts, IK_NUMERIC_STEPS, IK_NUMERIC_TOL["float"])
+            return self.emulator.ik_numeric(targets, starts, IK_NUMERIC_STEPS, IK_NUMERIC_VERIFIED["float"])
         if backend == "python" or backend in self.native:  # one batched call
             real = "float" if "float" in backend else "double"
-            return self.module(backend).ik_numeric(targets, starts, IK_NUMERIC_STEPS, IK_NUMERIC_TOL[real],
+            return self.module(backend).ik_numeric(targets, starts, IK_NUMERIC_STEPS, IK_NUMERIC_VERIFIED[real],
                                                    **self.nominal)
 
         def solve(target: np.ndarray, start: np.ndarray) -> tuple[np.ndarray, int]:
             if backend == "casadi":  # a fixed number of steps
-                q, status = self.casadi.ik_numeric(_column(target), start, IK_NUMERIC_TOL["double"],
+                q, status = self.casadi.ik_numeric(_column(target), start, IK_NUMERIC_VERIFIED["double"],
                                                    *self.casadi_parameters)
                 return q.full().ravel(), int(status)
             real = backend.split()[1]
-            return self.c[real].ik_numeric(target, start, IK_NUMERIC_STEPS, IK_NUMERIC_TOL[real])
+            return self.c[real].ik_numeric(target, start, IK_NUMERIC_STEPS, IK_NUMERIC_VERIFIED[real])
 
         found, status = zip(*(solve(target, start) for target, start in zip(targets, starts)))
         return np.array(found), np.array(status)

@@ -39,15 +39,8 @@ from jacgen.inputs.robot import EULER_ANGLES, Robot
 from jacgen.model import singularities
 from jacgen.parallel import for_each_robot
 from jacgen.solvers import ik
+from jacgen.tolerances import VERIFIED
 
-DOUBLE_TOLERANCE = 1e-9
-# float32 keeps 24 bits (relative rounding 6e-8). An output is a sum of products along a
-# chain of at most 32 links, so its rounding error is a few tens of roundings of values no
-# larger than the reach (positions, Jacobian entries) or 1 (rotations): ~1e-6 * (1 + reach)
-# for the shipped arms. 1e-4 * (1 + reach) leaves a margin of ~100 for long chains and
-# cancellation, and is still far below any modelling error (a wrong term is >= 1e-3). Each
-# error is divided by 1 + |expected| (`compare`): float and double round relative to the value.
-FLOAT_TOLERANCE = 1e-4
 # Where cos(pitch) < this, roll and yaw and the Euler-angle rates are ill-conditioned (they
 # are undefined at pitch = +-90 deg): the angle rows of `task` and `task_jacobian` are not
 # compared there (and may be NaN). Beyond 0.05 (|pitch| < 87 deg) rounding is amplified at
@@ -129,7 +122,7 @@ def verify_robot(robot: Robot, backends: GeneratedCode, functions: list[Function
                  random_count: int, form: ik.ClosedForm | None) -> list[Result]:
     """Every function at q, whose first `random_count` rows are random (not singular) samples."""
     names = backends.names
-    tolerances = {backend: (FLOAT_TOLERANCE if _is_float(backend) else DOUBLE_TOLERANCE) * (1 + robot.reach)
+    tolerances = {backend: VERIFIED["float" if _is_float(backend) else "double"] * (1 + robot.reach)
                   for backend in names}
     # Js's determinant and manipulability are products of one entry per position row, each up to the reach
     positions = sum(component in ("x", "y", "z") for component in robot.task)
@@ -415,5 +408,5 @@ def format_table(results: list[Result]) -> str:
     widths = [max(len(row[c]) for row in rows) for c in range(len(header))]
     lines = ["  ".join(cell.ljust(width) for cell, width in zip(row, widths)).rstrip() for row in rows]
     failed = sum(result.failed for result in results)
-    lines.append(f"double tolerance {DOUBLE_TOLERANCE:.0e} x (1 + reach); {failed} of {len(results)} functions above tolerance")
+    lines.append(f"double tolerance {VERIFIED['double']:.0e} x (1 + reach); {failed} of {len(results)} functions above tolerance")
     return "\n".join(lines)

@@ -17,6 +17,7 @@ from jacgen.errors import RobotFileError
 from jacgen.inputs import numeric_chain
 from jacgen.inputs.names import PARAMETER_NAME_RULE, ROBOT_NAME_RULE, parameter_name_problem, robot_name_problem
 from jacgen.inputs.values import ExpressionError, Value, combined, parse
+from jacgen.tolerances import ANGLE_SNAP
 
 TASK_COMPONENTS = ("x", "y", "z", "roll", "pitch", "yaw")
 EULER_ANGLES = TASK_COMPONENTS[3:]  # ZYX Euler angles of the tool: R = Rz(yaw) Ry(pitch) Rx(roll)
@@ -37,8 +38,6 @@ REACH = (1e-2, 1e3)
 SMALLEST_LENGTH = 1e-7
 # Below this, cos(pitch) is the rounding of 0 (check_euler_angles).
 GIMBAL_LOCK = 1e-12
-# Within this many radians of a multiple of pi/2, an angle becomes that multiple exactly.
-ANGLE_SNAP_TOLERANCE = 1e-9
 ZERO = Value(("integer", 0), 0.0)
 
 
@@ -486,11 +485,11 @@ def _scaled(value: Value, scale: Value) -> Value:
 
 
 def _snap_angle(value: Value) -> Value:
-    """Exact k*pi/2 for an angle written as a decimal within ANGLE_SNAP_TOLERANCE of it."""
+    """Exact k*pi/2 for an angle written as a decimal within tolerances.ANGLE_SNAP of it."""
     if value.symbolic:
         return value
     quarter_turns = round(value.approx / (math.pi / 2))
-    if abs(value.approx - quarter_turns * math.pi / 2) < ANGLE_SNAP_TOLERANCE:
+    if abs(value.approx - quarter_turns * math.pi / 2) < ANGLE_SNAP:
         return Value(("mul", ("integer", quarter_turns), ("div", ("pi",), ("integer", 2))), quarter_turns * math.pi / 2)
     return value
 

@@ -6,7 +6,7 @@ external entities can happen, and an undeclared entity is an XML error. The tree
 without recursion and the file size is capped. Every mistake is one RobotFileError naming
 the file, line, column and element path.
 
-Numbers keep their decimal text as exact rationals. An angle within SNAP_TOLERANCE of a
+Numbers keep their decimal text as exact rationals. An angle within tolerances.ANGLE_SNAP of a
 multiple of pi/2 and an axis within it of +-x/y/z become exact, and the largest change this
 makes is recorded; everything else is a 30-digit float.
 """
@@ -22,12 +22,12 @@ from sympy import Matrix
 
 from jacgen.errors import RobotFileError
 from jacgen.inputs import values
-from jacgen.inputs.robot import ANGLE_SNAP_TOLERANCE, MAX_JOINTS
+from jacgen.inputs.robot import MAX_JOINTS
 from jacgen.inputs.transforms import xyz_rpy_transform
 from jacgen.inputs.values import ExpressionError
+from jacgen.tolerances import ANGLE_SNAP
 
 MAX_URDF_BYTES = 16 << 20
-SNAP_TOLERANCE = ANGLE_SNAP_TOLERANCE  # as robot files snap their angles
 DIGITS = 30  # of the numbers that are not exact (cos and sin of general angles)
 MOVABLE = ("revolute", "continuous", "prismatic")
 JOINT_TYPES = MOVABLE + ("fixed", "floating", "planar")
@@ -76,7 +76,7 @@ class Snapper:
     """Makes angles and directions within `tolerance` of exact (a multiple of pi/2, a
     coordinate axis) exact, and remembers the largest change that made."""
 
-    def __init__(self, tolerance: float = SNAP_TOLERANCE):
+    def __init__(self, tolerance: float = ANGLE_SNAP):
         self.tolerance, self.largest = tolerance, 0.0
 
     def close(self, change: float) -> bool:

@@ -33,6 +33,7 @@ from jacgen.inputs import numeric_chain
 from jacgen.inputs.robot import EULER_ANGLES, TASK_COMPONENTS, Robot
 from jacgen.model.joint_ring import (READABLE_TERMS, JointRing, TooLarge, factorise, frames_about, geometric_columns,
                                      maximal_minors, multiply, permutation_sign, term_count)
+from jacgen.tolerances import PARALLEL, ROOT
 
 # The exact analysis is bounded by counts, never by a clock, so its outcome is the same on
 # every machine: the monomial products of all polynomial multiplications of one robot
@@ -42,8 +43,6 @@ from jacgen.model.joint_ring import (READABLE_TERMS, JointRing, TooLarge, factor
 # rest of the rank condition numerically (det(Js), or det(Js Js^T) / det(Js^T Js)).
 MINOR_LIMIT = 64
 FACTOR_TERM_LIMIT = 400
-ROOT_TOLERANCE = 1e-9  # |factor| at a numerically found root
-PARALLEL_TOLERANCE = 1e-9  # |z_a x z_b| for parallel unit axes
 
 
 def singularity_rows(robot: Robot) -> tuple[int, ...] | None:
@@ -260,7 +259,7 @@ class _Numeric:
             degree = poly.total_degree()
             in_t = sympy.Poly(sum(coefficient * (1 - t**2) ** i * (2 * t) ** j * (1 + t**2) ** (degree - i - j)
                                   for (i, j), coefficient in poly.terms()), t)
-            at_pi = [sympy.pi] if abs(poly.eval((-1, 0))) <= ROOT_TOLERANCE * scale else []
+            at_pi = [sympy.pi] if abs(poly.eval((-1, 0))) <= ROOT * scale else []
         if in_t.is_zero:
             return ()
         if in_t.degree() <= 2 and not in_t.has(sympy.Float):
@@ -274,7 +273,7 @@ class _Numeric:
         unique = {}
         for root in roots + at_pi:
             point = (math.cos(float(root)), math.sin(float(root))) if len(atoms) == 2 else (float(root),)
-            if abs(value(*point)) <= ROOT_TOLERANCE * scale and round(float(root), 9) not in unique:
+            if abs(value(*point)) <= ROOT * scale and round(float(root), 9) not in unique:
                 unique[round(float(root), 9)] = root
         return tuple(unique[key] for key in sorted(unique))
 
@@ -350,7 +349,7 @@ def _solve_along(value, q: np.ndarray, joint: int, spec) -> np.ndarray | None:
             a = point[joint]
         else:
             b = point[joint]
-    return point if abs(value(point)) < ROOT_TOLERANCE else None
+    return point if abs(value(point)) < ROOT else None
 
 
 def _axes(robot: Robot, q: np.ndarray) -> list[tuple[np.ndarray, np.ndarray]]:
@@ -360,7 +359,7 @@ def _axes(robot: Robot, q: np.ndarray) -> list[tuple[np.ndarray, np.ndarray]]:
 
 
 def _parallel(a: np.ndarray, b: np.ndarray) -> bool:
-    return np.linalg.norm(np.cross(a, b)) < PARALLEL_TOLERANCE
+    return np.linalg.norm(np.cross(a, b)) < PARALLEL
 
 
 def _collinear(a, b) -> bool:
@@ -373,7 +372,7 @@ def _over_first_axis(robot: Robot, q: np.ndarray, point: np.ndarray) -> bool:
     axes = _axes(robot, q)
     (origin, first), (_, second) = axes[0], axes[1]
     normal = np.cross(first, second)
-    if np.linalg.norm(normal) < PARALLEL_TOLERANCE:
+    if np.linalg.norm(normal) < PARALLEL:
         return False
     reach = max(1.0, float(np.linalg.norm(point - origin)))
     return abs(np.dot(point - origin, normal / np.linalg.norm(normal))) < 1e-7 * reach

@@ -11,6 +11,7 @@ from jacgen.model.singularities import READABLE_TERMS, Factor, Singularities, si
 from jacgen.model.structure import SOLVERS
 from jacgen.solvers import general6r
 from jacgen.solvers.model import Model
+from jacgen.tolerances import PARALLEL
 
 DH_HEADER = ["#", "name", "type", "a", "alpha", "d", "theta", "offset", "limits"]
 
@@ -101,7 +102,7 @@ def euler_lines(robot: Robot, singular: Singularities) -> list[str]:
 def moves_in_plane(robot: Robot) -> bool:
     """Every joint axis parallel to the world z axis (checked at a generic configuration)."""
     frames, _ = numeric_chain.axis_frames(robot, np.linspace(0.3, 0.9, robot.dof))
-    return all(np.linalg.norm(np.cross(frame[:3, 2], [0.0, 0.0, 1.0])) < 1e-9 for frame in frames)
+    return all(np.linalg.norm(np.cross(frame[:3, 2], [0.0, 0.0, 1.0])) < PARALLEL for frame in frames)
 
 
 def isotropy_lines(robot: Robot) -> list[str]:

@@ -13,6 +13,7 @@ from typing import Callable
 import sympy
 
 from jacgen.model.nodes import RANK, Above, AtLeast, AtMost, Below, IsFinite, Unequal, select
+from jacgen.tolerances import IK_NUMERIC_DEFAULT
 
 # Statuses of velocity_ik, the same in every backend.
 VELOCITY_IK_OK, VELOCITY_IK_SINGULAR, VELOCITY_IK_NOT_FINITE = 0, 1, 2
@@ -25,7 +26,7 @@ IK_NUMERIC_STATUSES = (
     ("STALLED", 2, "no step lowers |error|: out of reach, joint limit or local minimum"),
     ("INVALID", 3, "target or q0 not finite, or max_iter < 0: q = q0"),
 )
-IK_NUMERIC_DEFAULTS = {"max_iter": 100, "tol": 1e-10}
+IK_NUMERIC_DEFAULTS = {"max_iter": 100, "tol": IK_NUMERIC_DEFAULT}
 # CasADi's ik_numeric takes this many steps (a fixed graph; the C and numpy stop when done).
 IK_NUMERIC_ITERATIONS = 100
 # The Levenberg-Marquardt damping (added to the diagonal): start, least, most.

@@ -12,6 +12,7 @@ from jacgen.inputs.robot import Robot
 from jacgen.model import singularities
 from jacgen.model.nodes import RANK, TOLERANCES
 from jacgen.solvers import differential, general6r, ik, ik_limits
+from jacgen.tolerances import REACHED
 
 
 @dataclass(frozen=True)
@@ -105,8 +106,8 @@ def ik_context(robot: Robot, generator: Generator, real: str, number: Callable, 
         "general": form.solver == "general_6r" and {
             "monomials": general6r.MONOMIALS.astype(int).tolist(), "along_b": general6r.ALONG_B,
             "along_c": general6r.ALONG_C, "newton_steps": general6r.NEWTON_STEPS,
-            "tolerance": general6r.TOLERANCE[real], "imaginary": general6r.IMAGINARY[real],
-            "squared": number(sympy.Float(general6r.TOLERANCE[real] ** 2)),
+            "tolerance": REACHED[real], "imaginary": general6r.IMAGINARY[real],
+            "squared": number(sympy.Float(REACHED[real] ** 2)),
             "converged_squared": number(sympy.Float((general6r.CONVERGED[real] * (1 + robot.reach)) ** 2)),
             "work_bytes": general6r.work_bytes(real),
             "joints": form.joints,
