@@ -1,9 +1,9 @@
 """A time budget: the safety net around each robot's exact singularity analysis.
 
-The analysis is bounded by design (joint_ring.WORK_LIMIT and the size limits of analysis.py); the
+The analysis is bounded by design (joint_ring.WORK_LIMIT and the size limits of singularities.py); the
 budget is there only in case a limit is ever wrong, and no arm tried reaches it:
 
-    singular = budget.within_budget(lambda: analysis.analyse(robot), lambda: analysis.unanalysed(robot),
+    singular = budget.within_budget(lambda: singularities.analyse(robot), lambda: singularities.unanalysed(robot),
                                     what=f"the singularity analysis of {robot.name}")
 
 runs the work for at most `budget.seconds()` (set by `jacgen generate --budget`); when time

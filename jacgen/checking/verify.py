@@ -4,7 +4,7 @@ For each robot the code is generated into a temporary folder, the C is compiled 
 (double and float) into shared libraries called through ctypes, and the Python and
 CasADi modules are imported. Every generated function is evaluated at random
 configurations inside the joint limits plus configurations near singularities, and
-compared with the function of the same name in `jacgen.reference` (functions the
+compared with the function of the same name in `jacgen.checking.reference` (functions the
 reference does not have are listed as not compared).
 
 The random joint vectors are rounded to float32 first, so that the float build, which can

@@ -1,6 +1,6 @@
 """The catalogue: every function a robot can get, in the order the backends emit them, those
 each one calls, and their arguments and outputs with shapes and the contract's C extents,
-as data. `functions.Generator` builds each one from its algorithm; a backend lays out what
+as data. `generator.Generator` builds each one from its algorithm; a backend lays out what
 the catalogue says.
 """
 

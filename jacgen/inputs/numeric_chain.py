@@ -1,8 +1,10 @@
-"""The DH chain in floating point, for the few numbers production needs: the configurations
-where a singularity factor vanishes and what they mean (`analysis`), and the drawings of
-`jacgen show` (`drawing`) and its comparison with a URDF (`compare_urdf`). Built from the closed-form link matrices of the textbooks (Spong's
-standard, Craig's modified DH), apart from `jacgen.reference`, which multiplies elementary
-transforms and stays an independent oracle that no production module imports.
+"""The DH chain in floating point, for the few numbers production needs: the robot file's
+checks, the configurations where a singularity factor vanishes and what they mean
+(`singularities`), the general 6R solver's choice of cut, the drawings of `jacgen show`
+(`drawing`) and its comparison with a URDF (`urdf_comparison`). Built from the closed-form
+link matrices of the textbooks (Spong's standard, Craig's modified DH), apart from
+`jacgen.checking.reference`, which multiplies elementary transforms and stays an independent
+oracle that no production module imports.
 
 Every function takes one configuration q (n,) or a batch (..., n).
 """

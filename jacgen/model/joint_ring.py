@@ -1,6 +1,6 @@
 """Exact polynomials in a robot's joints: the ring over the joint atoms c_i, s_i (cos and sin
 of q_i + offset_i), the variables of prismatic joints and the symbolic parameters, where the
-singularity analysis (`analysis.py`) and the general 6R equations (`general6r.py`) multiply,
+singularity analysis (`singularities.py`) and the general 6R equations (`general6r.py`) multiply,
 expand determinants (maximal minors by memoised Laplace expansion) and factor, each product
 counted against one work limit.
 """

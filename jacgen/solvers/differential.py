@@ -19,7 +19,7 @@ from jacgen.tolerances import IK_NUMERIC_DEFAULT
 VELOCITY_IK_OK, VELOCITY_IK_SINGULAR, VELOCITY_IK_NOT_FINITE = 0, 1, 2
 
 # ik_numeric: the loop each language's template writes around ik_numeric_step (its step, built
-# below), one source for its statuses, defaults and damping in every backend and in compile.py.
+# below), one source for its statuses, defaults and damping in every backend and in c_library.py.
 IK_NUMERIC_STATUSES = (
     ("CONVERGED", 0, "|error| <= tol"),
     ("ITERATION_LIMIT", 1, "max_iter steps tried, |error| still above tol"),

@@ -6,7 +6,7 @@ values) and flagged invalid, a degenerate case is a `select`. So a solver is str
 code, the same in C, over a numpy batch and in CasADi.
 
 Vectors are 3-tuples of expressions, relative to a point of the axis where it matters;
-every intermediate value is passed to `name` (see `functions.Generator.name`), so that no
+every intermediate value is passed to `name` (see `generator.Generator.name`), so that no
 expression grows with the depth of the solver. The tolerances are the symbols EPS and TINY,
 replaced by the numbers of the build's real type when printed (`nodes.TOLERANCES`):
 

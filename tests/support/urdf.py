@@ -26,6 +26,6 @@ URDFS = {
 
 
 def imported(key: str, convention: str = "standard", **options):
-    """The import of URDFS[key] (jacgen.import_urdf.Imported)."""
+    """The import of URDFS[key] (jacgen.urdf_import.Imported)."""
     file, base, tip, _ = URDFS[key]
     return import_urdf(str(DATA / file), base, tip, convention, **options)
