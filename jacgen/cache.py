@@ -25,12 +25,17 @@ def folder() -> Path:
     return Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "jacgen"
 
 
-def key(robot_file: Path, options: dict) -> str:
-    """The key of `generate` for this robot file with these options (JSON-able values)."""
+def key(robot_file: Path, options: dict) -> str | None:
+    """The key of `generate` for this robot file with these options (JSON-able values); None
+    when the file cannot be read (loading it then says why)."""
+    try:
+        data = robot_file.read_bytes()
+    except OSError:
+        return None
     sha = hashlib.sha256(f"jacgen generate cache {FORMAT}\0{sources.digest()}\0".encode())
     sha.update(json.dumps(options, sort_keys=True).encode() + b"\0")
     sha.update(robot_file.name.encode() + b"\0")  # the generated header names the file
-    sha.update(robot_file.read_bytes())
+    sha.update(data)
     return sha.hexdigest()
 
 

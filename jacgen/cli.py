@@ -6,7 +6,7 @@ from pathlib import Path
 
 import click
 
-from jacgen import budget
+from jacgen import budget, cache
 from jacgen.emission.backends import DEFAULT_LANGUAGES, LANGUAGES
 from jacgen.errors import JacgenError
 from jacgen.files import stale_files, write_files
@@ -128,13 +128,11 @@ def generate(robot_files, output, languages, real, check, functions, budget_seco
     if real == "float" and {"c", "native"} <= set(languages):
         raise click.UsageError("--lang native writes NAME.c in double beside NAME_float.c; with --real float, "
                                "write the float C of --lang c into another folder")
-    from jacgen import cache
-
     folder = Path(output)
     options = {"languages": list(languages), "real": real, "functions": functions and list(functions),
                "budget": budget_seconds}
     paths = list(dict.fromkeys(Path(path) for path in robot_files))
-    keys = {path: None if no_cache else _cache_key(path, options) for path in paths}
+    keys = {path: None if no_cache else cache.key(path, options) for path in paths}
     cached = {path: entry for path in paths if keys[path] and (entry := cache.hit(keys[path], folder))}
     robots, files = [], {}
     if len(cached) < len(paths):
@@ -165,20 +163,8 @@ def generate(robot_files, output, languages, real, check, functions, budget_seco
                err=True)
 
 
-def _cache_key(path: Path, options: dict) -> str | None:
-    """The robot file's cache key; None when it cannot be read (load_robot then says why)."""
-    from jacgen import cache
-
-    try:
-        return cache.key(path, options)
-    except OSError:
-        return None
-
-
 def _remember(robots: list, files: dict[str, str], keys: dict[Path, str | None]) -> None:
     """Records, per robot rendered, the files it has on disk now (cache.store)."""
-    from jacgen import cache
-
     for robot in robots:
         if key := keys[Path(robot.source)]:
             cache.store(key, robot.name, {relative: text for relative, text in files.items()

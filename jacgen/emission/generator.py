@@ -223,7 +223,7 @@ class Generator:
                                part_of="ik_branches")
         parts = [equations_function, start, step, limits]
         if fast := form.fast_path:
-            sp.margins.clear()
+            sp.margins = []
             free_angle = None if form.free is None else self.q[form.free]
             with distribute(False):
                 q, valid, _ = ik.branches(fast.nominal.robot, fast.form, sp, target.symbols, free_angle)
@@ -233,7 +233,8 @@ class Generator:
             parts.append(self.function("ik_general_nominal", "the fast path's starting points: every branch of the "
                                        "nearest special class's closed form (the nominal arm's), whether its target "
                                        "allows it, and the least margin of its subproblems", matrix("q", q),
-                                       vector("valid", valid), scalar("margin", margin), arguments=(target, *free_input), bindings=bindings, part_of="ik_branches"))
+                                       vector("valid", valid), scalar("margin", margin),
+                                       arguments=(target, *free_input), bindings=bindings, part_of="ik_branches"))
         return parts
 
     def velocity_ik_function(self, js: sympy.Matrix) -> Function:

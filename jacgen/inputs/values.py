@@ -67,9 +67,6 @@ class Value:
     def __repr__(self) -> str:
         return f"Value({self.exact!r}, {self.approx!r})"
 
-    def __reduce__(self):
-        return Value, (self._exact, self.approx)
-
 
 def combined(operation: str, approx: float, *values: Value) -> Value:
     """The Value of `operation` on `values`, as a recipe of their forms, whose float is `approx`."""

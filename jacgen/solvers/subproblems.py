@@ -55,12 +55,17 @@ class Subproblems:
 
     def __init__(self, name: Callable[[sympy.Expr], sympy.Expr]):
         self.name = lambda value: name(sympy.sympify(value))
-        # Sizes that are near 0 where the closed form is sensitive to the target, dimensionless;
-        # the fast path reads the least (general6r.FAST_MARGIN):
+        # Sizes that are near 0 where the closed form is sensitive to the target, dimensionless,
+        # recorded only when the fast path asks (a list here; it reads the least, general6r.FAST_MARGIN):
         # - an SP2 or SP4 discriminant (a squared sine): two roots near one double root;
         # - the rotating part of SP1 or SP4 (the product of the sines of its vectors' angles to
         #   the axis): an angle that is nearly free, as at a wrist singularity.
-        self.margins: list[sympy.Expr] = []
+        self.margins: list[sympy.Expr] | None = None
+
+    def _margin(self, size: Callable[[], sympy.Expr]) -> None:
+        """Records size() when the margins are asked for (built only then)."""
+        if self.margins is not None:
+            self.margins.append(size())
 
     def vector(self, values) -> Vector:
         return tuple(self.name(v) for v in values)
@@ -101,7 +106,7 @@ class Subproblems:
         y = self.dot(k, self.cross(p, q))
         rr = self.name(x * x + y * y)
         pq = self.name(self.dot(p, p) * self.dot(q, q))
-        self.margins.append(select(Above(pq, 0), sympy.sqrt(rr / pq), 0))
+        self._margin(lambda: select(Above(pq, 0), sympy.sqrt(rr / pq), 0))
         free = AtMost(rr, TINY * pq)
         scale = self.name(select(free, 1, 1 / sympy.sqrt(rr)))  # never 1/0, even for constant vectors
         return Angle(select(free, 0, sympy.atan2(y, x)), self.name(select(free, 1, x * scale)),
@@ -119,13 +124,13 @@ class Subproblems:
         rhs = self.name(d - hk * kp)
         r2 = self.name(a * a + b * b)
         scale = self.name(self.dot(h, h) * self.dot(p, p))
-        self.margins.append(select(Above(scale, 0), sympy.sqrt(r2 / scale), 0))
+        self._margin(lambda: select(Above(scale, 0), sympy.sqrt(r2 / scale), 0))
         constant = AtMost(r2, TINY * scale)
         inverse_r = self.name(select(constant, 1, 1 / sympy.sqrt(r2)))
         cos_phi, sin_phi = self.name(a * inverse_r), self.name(b * inverse_r)
         cos_alpha = self.name(rhs * inverse_r)
         disc = self.name(1 - cos_alpha**2)
-        self.margins.append(sympy.Abs(disc))
+        self._margin(lambda: sympy.Abs(disc))
         two = Above(disc, EPS)
         # a double root: cos(alpha) = +-1, sin(alpha) = 0
         cos_alpha = self.name(select(two, cos_alpha, select(Above(cos_alpha, 0), 1, -1)))
@@ -153,7 +158,7 @@ class Subproblems:
         alpha, beta = self.name((u - k12 * v) / nn), self.name((v - k12 * u) / nn)
         pp = self.dot(p, p)
         gg = self.name((pp - alpha**2 - beta**2 - 2 * alpha * beta * k12) / nn)
-        self.margins.append(select(Above(pp, 0), sympy.Abs(gg) / pp, 0))
+        self._margin(lambda: select(Above(pp, 0), sympy.Abs(gg) / pp, 0))
         two = Above(gg, EPS * pp)
         gamma = self.name(select(two, sympy.sqrt(gg), 0))
         normal = self.cross(k1, k2)
