@@ -56,7 +56,7 @@ def library(tmp_path_factory):
     template = (ROOT / "templates" / "c" / "general6r.c.jinja").read_text()
     (folder / "general6r.c").write_text(jinja2.Template(template).render(
         monomials=general6r.MONOMIALS.astype(int).tolist(), along_b=general6r.ALONG_B, along_c=general6r.ALONG_C,
-        imaginary=general6r.IMAGINARY["double"]))
+        imaginary=general6r.IMAGINARY["double"], q_rank=general6r.Q_RANK))
     library = ctypes.CDLL(str(compile_shared([folder / "harness.c"], folder / "libruntime.so",
                                              ("-O2", f"-I{ROOT / 'templates' / 'c'}"))))
     library.eigenvalues.argtypes = [ctypes.c_int, POINTER, POINTER, POINTER]
