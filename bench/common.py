@@ -119,9 +119,14 @@ def shared_library(source: Path) -> Path:
 WORKER = """
 import json, resource, sys, time
 sys.path.insert(0, ".")
-from jacgen.functions import Generator
-from jacgen.render import render_robot
-from jacgen.robot import load_robot
+try:  # the stage folders (issue 38), else the flat layout of earlier commits
+    from jacgen.emission.generator import Generator
+    from jacgen.emission.render import render_robot
+    from jacgen.inputs.robot import load_robot
+except ImportError:
+    from jacgen.functions import Generator
+    from jacgen.render import render_robot
+    from jacgen.robot import load_robot
 robot = load_robot(sys.argv[1])
 start = time.perf_counter()
 generator = Generator(robot)

@@ -22,6 +22,7 @@ from jacgen.emission.render import render_robot
 from jacgen.inputs.robot import load_robot
 
 from conftest import ROOT, random_configurations
+from support.graph_sympy import printed
 from support.robot_texts import PARAMETRIC
 
 # Cartesian gantry: its Jacobians read no joint (q must be marked unused).
@@ -134,14 +135,14 @@ def test_functions_beyond_spec_render_generically(tmp_path, monkeypatch):
 def test_printer():
     x, y = sympy.symbols("x y", real=True)
     double, single = CPrinter("double"), CPrinter("float")
-    assert double.doprint(x**2 + y / x**3) == "(x*x) + y/(x*x*x)"  # terms in sympy's stored order
-    assert double.doprint(0.4318 * sympy.cos(x) / sympy.sqrt(y)) == "0.4318*cos(x)/sqrt(y)"
-    assert double.doprint(1 / sympy.sqrt(x + y)) == "1.0/sqrt(x + y)"
-    assert single.doprint(0.4318 * sympy.atan2(x, sympy.sqrt(y)) + 1 / x) == "1.0F/x + 0.4318F*atan2f(x, sqrtf(y))"
-    assert double.doprint(x ** sympy.Rational(-3, 2) + y ** sympy.Rational(5, 2)) == \
+    assert printed(double, x**2 + y / x**3) == "(x*x) + y/(x*x*x)"  # terms in sympy's stored order
+    assert printed(double, 0.4318 * sympy.cos(x) / sympy.sqrt(y)) == "0.4318*cos(x)/sqrt(y)"
+    assert printed(double, 1 / sympy.sqrt(x + y)) == "1.0/sqrt(x + y)"
+    assert printed(single, 0.4318 * sympy.atan2(x, sympy.sqrt(y)) + 1 / x) == "1.0F/x + 0.4318F*atan2f(x, sqrtf(y))"
+    assert printed(double, x ** sympy.Rational(-3, 2) + y ** sympy.Rational(5, 2)) == \
         "1.0/(sqrt(x)*x) + (sqrt(y)*y*y)"  # no pow(): half-integer powers through sqrt
     with pytest.raises(Exception, match="[Uu]nsupported|not supported"):
-        double.doprint(sympy.Function("mystery")(x))
+        printed(double, sympy.Function("mystery")(x))
     with pytest.raises(ValueError):
         CPrinter("long double")
 
@@ -150,7 +151,7 @@ def test_no_posix_math_macros():
     """C99 has no M_PI or M_SQRT2 (they are POSIX): constants sympy rebuilds after CSE, like
     sqrt(2) out of sqrt(2*x**2), print as literals."""
     x = sympy.Symbol("x", real=True)
-    assert CPrinter("double").doprint(sympy.sqrt(2 * x**2)) == "1.4142135623730951*fabs(x)"
-    assert CPrinter("float").doprint(sympy.pi * x) == "3.1415927F*x"
+    assert printed(CPrinter("double"), sympy.sqrt(2 * x**2)) == "1.4142135623730951*fabs(x)"
+    assert printed(CPrinter("float"), sympy.pi * x) == "3.1415927F*x"
     for path in sorted((ROOT / "generated").glob("*/*.[ch]")):
         assert not re.search(r"\bM_[A-Z0-9_]+\b", path.read_text()), path

@@ -14,6 +14,7 @@ from jacgen.inputs.robot import load_robot
 from jacgen.checking.verify import compare
 
 from conftest import random_configurations, robot as shipped_robot
+from support.graph_sympy import printed
 from support.robot_texts import PARAMETRIC
 
 SAMPLES = 25
@@ -92,10 +93,10 @@ def test_runtime_parameters_are_input_p(tmp_path, generated):
 def test_printer():
     x, y = sympy.symbols("x y", real=True)
     printer = CasadiPrinter()
-    assert printer.doprint(sympy.atan2(x, sympy.sqrt(y)) + 0.4318 / x**2) == \
+    assert printed(printer, sympy.atan2(x, sympy.sqrt(y)) + 0.4318 / x**2) == \
         "0.4318/x**2 + casadi.atan2(x, casadi.sqrt(y))"  # terms in sympy's stored order
-    assert printer.doprint(Select((x > 0) & (y <= 1), x, y)) == \
+    assert printed(printer, Select((x > 0) & (y <= 1), x, y)) == \
         "casadi.if_else(casadi.logic_and((y <= 1), (x > 0)), x, y)"
     for unsupported in (sympy.gamma(x), sympy.Mod(x, y), sympy.Max(x, y)):
         with pytest.raises(Exception, match="[Uu]nsupported|not supported"):
-            printer.doprint(unsupported)
+            printed(printer, unsupported)

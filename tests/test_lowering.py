@@ -1,15 +1,18 @@
-"""The lowering core against sympy: its operation count against `count_ops` (the reference
-every report and bench quotes), its common-subexpression elimination against `cse`."""
+"""The lowering core against sympy: its operation count on the value graph against `count_ops`
+(the reference every report and bench quotes), its common-subexpression elimination against
+`cse`, each on the sympy expression of the same structure (`support.graph_sympy`)."""
 
 import pytest
 import sympy
 from sympy.core.parameters import distribute
 
 from jacgen.emission.generator import Generator
+from jacgen.emission.graph import Graph, evaluate
 from jacgen.emission.lowering import eliminate_common, operation_count
 from jacgen.inputs.robot import load_robot, parse_robot
 from jacgen.model.nodes import AtLeast, Below, IsFinite, Select
 from conftest import ROOT
+from support.graph_sympy import to_sympy
 from support.random_arms import random_arm_text
 
 x, y, z, w = sympy.symbols("x y z w", real=True)
@@ -23,7 +26,8 @@ SHAPES = [
 
 @pytest.mark.parametrize("expr", SHAPES, ids=str)
 def test_counts_as_count_ops(expr):
-    assert operation_count([expr]) == sympy.count_ops(expr)
+    node = Graph().convert(expr)
+    assert operation_count([node]) == sympy.count_ops(to_sympy(node))
 
 
 @pytest.mark.parametrize("source", ["ur5", "stanford", "planar_2r", 3, 5])
@@ -34,7 +38,7 @@ def test_every_body_counts_as_count_ops(source):
     for function in Generator(robot).functions():
         body = function.body
         expressions = [e for _, e in body.definitions] + list(body.outputs)
-        assert body.operation_count == sympy.count_ops(expressions), function.name
+        assert body.operation_count == sympy.count_ops([to_sympy(e) for e in expressions]), function.name
 
 
 def _dh_chain_jacobian(joints: int) -> list[sympy.Expr]:
@@ -58,19 +62,18 @@ COMMON = [x * y + z, -x * y - z, sympy.sin(x * y + z), x + y + z, x + y + w, 1 -
                                    _dh_chain_jacobian(3), _dh_chain_jacobian(4)], ids=["shapes", "dh3", "dh4"])
 def test_eliminate_common_as_sympy_cse(exprs):
     """eliminate_common finds what sympy's cse finds: as many temporaries, the same operation
-    count, and the same values (at a random point)."""
+    count, and the same values (at a point)."""
+    graph = Graph()
+    nodes = [graph.convert(e) for e in exprs]
+    replacements, reduced = eliminate_common(graph, nodes, sympy.numbered_symbols("_r", real=True), {})
     with distribute(False):
-        ours = eliminate_common(exprs, sympy.numbered_symbols("_r", real=True), {})
-        theirs = sympy.cse(exprs, sympy.numbered_symbols("_r", real=True), order="none")
-    for (replacements, reduced), reference in ((ours, exprs), (theirs, exprs)):
-        assert len(replacements) == len(theirs[0])
-        assert operation_count([v for _, v in replacements] + reduced) == \
-            operation_count([v for _, v in theirs[0]] + theirs[1])
-        point = {s: 0.1 + 0.37 * k for k, s in enumerate(sorted(set().union(*(e.free_symbols for e in reference)),
-                                                                  key=str))}
-        values = dict(point)
-        for symbol, value in replacements:
-            values[symbol] = sympy.N(value.subs(values), 30)
-        for expr, expected in zip(reduced, reference):
-            assert float(sympy.N(expr.subs(values), 30)) == pytest.approx(float(sympy.N(expected.subs(point), 30)),
-                                                                          rel=1e-12, abs=1e-12)
+        theirs = sympy.cse([to_sympy(node) for node in nodes], sympy.numbered_symbols("_s", real=True), order="none")
+    assert len(replacements) == len(theirs[0])
+    assert operation_count([v for _, v in replacements] + reduced) == \
+        sympy.count_ops([v for _, v in theirs[0]] + theirs[1])
+    point = {s: 0.1 + 0.37 * k for k, s in enumerate(sorted(set().union(*(e.free_symbols for e in exprs)), key=str))}
+    values = dict(point)
+    for symbol, value in replacements:
+        values[symbol] = evaluate(value, values)
+    for node, expected in zip(reduced, exprs):
+        assert evaluate(node, values) == pytest.approx(float(sympy.N(expected.subs(point), 30)), rel=1e-12, abs=1e-12)

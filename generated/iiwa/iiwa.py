@@ -93,45 +93,45 @@ def fk(q):
     s7 = trig[..., 13]
     t0 = s1*s3
     t1 = c1*c3
-    t2 = -t0 + t1*c2
-    t3 = t1 - t0*c2
+    t2 = -t0 + c2*t1
+    t3 = t1 - c2*t0
     t4 = c3*s1
     t5 = c1*s3
-    t6 = t4 + t5*c2
-    t7 = t5 + t4*c2
+    t6 = t4 + c2*t5
+    t7 = t5 + c2*t4
     t8 = c1*s2
-    t9 = t2*c4 + t8*s4
-    t10 = -t2*s4 + t8*c4
+    t9 = t2*c4 + s4*t8
+    t10 = -t2*s4 + c4*t8
     t11 = t9*c5 - t6*s5
     t12 = t9*s5 + t6*c5
     t13 = t11*c6 - t10*s6
     t14 = t10*c6 + t11*s6
     t15 = t13*c7 - t12*s7
     t16 = t12*c7 + t13*s7
-    t17 = 0.126*t14 + 0.4*t10
+    t17 = 0.4*t10 + 0.126*t14
     t18 = t17 + 0.42*t8
     t19 = s1*s2
-    t20 = t7*c4 + t19*s4
-    t21 = -t7*s4 + t19*c4
+    t20 = t7*c4 + s4*t19
+    t21 = -t7*s4 + c4*t19
     t22 = t20*c5 + t3*s5
     t23 = t3*c5 - t20*s5
     t24 = t22*c6 - t21*s6
     t25 = t21*c6 + t22*s6
     t26 = t23*s7 + t24*c7
     t27 = t23*c7 - t24*s7
-    t28 = 0.126*t25 + 0.4*t21
+    t28 = 0.4*t21 + 0.126*t25
     t29 = t28 + 0.42*t19
     t30 = c3*s2
-    t31 = c2*s4 - t30*c4
-    t32 = c2*c4 + t30*s4
-    t33 = s2*s3
-    t34 = t31*c5 + t33*s5
-    t35 = -t31*s5 + t33*c5
+    t31 = c2*s4 - c4*t30
+    t32 = c2*c4 + s4*t30
+    t33 = s3*s2
+    t34 = t31*c5 + s5*t33
+    t35 = -t31*s5 + c5*t33
     t36 = t34*c6 - t32*s6
     t37 = t32*c6 + t34*s6
     t38 = t35*s7 + t36*c7
     t39 = t35*c7 - t36*s7
-    t40 = 0.126*t37 + 0.4*t32
+    t40 = 0.4*t32 + 0.126*t37
     t41 = t40 + 0.42*c2
     t42 = 0.36 + t41
     T = _stack(xp, [
@@ -173,53 +173,53 @@ def jacobian(q):
     s6 = trig[..., 11]
     t0 = s1*s3
     t1 = c1*c3
-    t2 = -t0 + t1*c2
-    t3 = t1 - t0*c2
+    t2 = -t0 + c2*t1
+    t3 = t1 - c2*t0
     t4 = c3*s1
     t5 = c1*s3
-    t6 = t4 + t5*c2
-    t7 = t5 + t4*c2
+    t6 = t4 + c2*t5
+    t7 = t5 + c2*t4
     t8 = c1*s2
-    t9 = t2*c4 + t8*s4
-    t10 = -t2*s4 + t8*c4
+    t9 = t2*c4 + s4*t8
+    t10 = -t2*s4 + c4*t8
     t11 = t9*c5 - t6*s5
     t12 = t9*s5 + t6*c5
     t13 = t10*c6 + t11*s6
     t14 = s1*s2
-    t15 = t7*c4 + t14*s4
-    t16 = -t7*s4 + t14*c4
+    t15 = t7*c4 + s4*t14
+    t16 = -t7*s4 + c4*t14
     t17 = t15*c5 + t3*s5
     t18 = t3*c5 - t15*s5
     t19 = t16*c6 + t17*s6
     t20 = c3*s2
-    t21 = c2*s4 - t20*c4
-    t22 = c2*c4 + t20*s4
+    t21 = c2*s4 - c4*t20
+    t22 = c2*c4 + s4*t20
     t23 = s2*s3
-    t24 = t21*c5 + t23*s5
-    t25 = -t21*s5 + t23*c5
+    t24 = t21*c5 + s5*t23
+    t25 = -t21*s5 + c5*t23
     t26 = t22*c6 + t24*s6
     t27 = 0.126*t13
-    t28 = t27 + 0.4*t10
+    t28 = 0.4*t10 + t27
     t29 = t28 + 0.42*t8
     t30 = 0.126*t19
-    t31 = t30 + 0.4*t16
+    t31 = 0.4*t16 + t30
     t32 = t31 + 0.42*t14
     t33 = 0.126*t26
-    t34 = t33 + 0.4*t22
+    t34 = 0.4*t22 + t33
     t35 = t34 + 0.42*c2
     t36 = t35*c1
     t37 = t35*s1
     J = _stack(xp, [
         -t32,  # 0, 0
         t36,  # 0, 1
-        -t32*c2 + t37*s2,  # 0, 2
+        -t32*c2 + s2*t37,  # 0, 2
         -t34*t3 + t31*t23,  # 0, 3
         t16*t34 - t22*t31,  # 0, 4
-        t18*t33 - t25*t30,  # 0, 5
+        -t25*t30 + t18*t33,  # 0, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 6
         t29,  # 1, 0
         t37,  # 1, 1
-        t29*c2 - t36*s2,  # 1, 2
+        t29*c2 - s2*t36,  # 1, 2
         -(t34*t6 + t28*t23),  # 1, 3
         t22*t28 - t10*t34,  # 1, 4
         t12*t33 + t25*t27,  # 1, 5
@@ -276,15 +276,15 @@ def fk_jacobian(q):
     s7 = trig[..., 13]
     t0 = s1*s3
     t1 = c1*c3
-    t2 = -t0 + t1*c2
-    t3 = t1 - t0*c2
+    t2 = -t0 + c2*t1
+    t3 = t1 - c2*t0
     t4 = c3*s1
     t5 = c1*s3
-    t6 = t4 + t5*c2
-    t7 = t5 + t4*c2
+    t6 = t4 + c2*t5
+    t7 = t5 + c2*t4
     t8 = c1*s2
-    t9 = t2*c4 + t8*s4
-    t10 = -t2*s4 + t8*c4
+    t9 = t2*c4 + s4*t8
+    t10 = -t2*s4 + c4*t8
     t11 = t9*c5 - t6*s5
     t12 = t9*s5 + t6*c5
     t13 = t11*c6 - t10*s6
@@ -292,8 +292,8 @@ def fk_jacobian(q):
     t15 = t13*c7 - t12*s7
     t16 = t12*c7 + t13*s7
     t17 = s1*s2
-    t18 = t7*c4 + t17*s4
-    t19 = -t7*s4 + t17*c4
+    t18 = t7*c4 + s4*t17
+    t19 = -t7*s4 + c4*t17
     t20 = t18*c5 + t3*s5
     t21 = t3*c5 - t18*s5
     t22 = t20*c6 - t19*s6
@@ -301,23 +301,23 @@ def fk_jacobian(q):
     t24 = t21*s7 + t22*c7
     t25 = t21*c7 - t22*s7
     t26 = c3*s2
-    t27 = c2*s4 - t26*c4
-    t28 = c2*c4 + t26*s4
+    t27 = c2*s4 - c4*t26
+    t28 = c2*c4 + s4*t26
     t29 = s2*s3
-    t30 = t27*c5 + t29*s5
-    t31 = -t27*s5 + t29*c5
+    t30 = t27*c5 + s5*t29
+    t31 = -t27*s5 + c5*t29
     t32 = t30*c6 - t28*s6
     t33 = t28*c6 + t30*s6
     t34 = t31*s7 + t32*c7
     t35 = t31*c7 - t32*s7
     t36 = 0.126*t14
-    t37 = t36 + 0.4*t10
+    t37 = 0.4*t10 + t36
     t38 = t37 + 0.42*t8
     t39 = 0.126*t23
-    t40 = t39 + 0.4*t19
+    t40 = 0.4*t19 + t39
     t41 = t40 + 0.42*t17
     t42 = 0.126*t33
-    t43 = t42 + 0.4*t28
+    t43 = 0.4*t28 + t42
     t44 = t43 + 0.42*c2
     t45 = 0.36 + t44
     t46 = t44*c1
@@ -343,14 +343,14 @@ def fk_jacobian(q):
     J = _stack(xp, [
         -t41,  # 0, 0
         t46,  # 0, 1
-        -t41*c2 + t47*s2,  # 0, 2
+        -t41*c2 + s2*t47,  # 0, 2
         -t43*t3 + t40*t29,  # 0, 3
         t19*t43 - t28*t40,  # 0, 4
-        t21*t42 - t31*t39,  # 0, 5
+        -t31*t39 + t21*t42,  # 0, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 6
         t38,  # 1, 0
         t47,  # 1, 1
-        t38*c2 - t46*s2,  # 1, 2
+        t38*c2 - s2*t46,  # 1, 2
         -(t43*t6 + t37*t29),  # 1, 3
         t28*t37 - t10*t43,  # 1, 4
         t12*t42 + t31*t36,  # 1, 5
@@ -407,15 +407,15 @@ def jacobian_tool(q):
     s7 = trig[..., 13]
     t0 = s1*s3
     t1 = c1*c3
-    t2 = -t0 + t1*c2
-    t3 = t1 - t0*c2
+    t2 = -t0 + c2*t1
+    t3 = t1 - c2*t0
     t4 = c3*s1
     t5 = c1*s3
-    t6 = t4 + t5*c2
-    t7 = t5 + t4*c2
+    t6 = t4 + c2*t5
+    t7 = t5 + c2*t4
     t8 = c1*s2
-    t9 = t2*c4 + t8*s4
-    t10 = -t2*s4 + t8*c4
+    t9 = t2*c4 + s4*t8
+    t10 = -t2*s4 + c4*t8
     t11 = t9*c5 - t6*s5
     t12 = t9*s5 + t6*c5
     t13 = t11*c6 - t10*s6
@@ -423,8 +423,8 @@ def jacobian_tool(q):
     t15 = t13*c7 - t12*s7
     t16 = t12*c7 + t13*s7
     t17 = s1*s2
-    t18 = t7*c4 + t17*s4
-    t19 = -t7*s4 + t17*c4
+    t18 = t7*c4 + s4*t17
+    t19 = -t7*s4 + c4*t17
     t20 = t18*c5 + t3*s5
     t21 = t3*c5 - t18*s5
     t22 = t20*c6 - t19*s6
@@ -432,27 +432,27 @@ def jacobian_tool(q):
     t24 = t21*s7 + t22*c7
     t25 = t21*c7 - t22*s7
     t26 = c3*s2
-    t27 = c2*s4 - t26*c4
-    t28 = c2*c4 + t26*s4
-    t29 = s2*s3
-    t30 = t27*c5 + t29*s5
-    t31 = -t27*s5 + t29*c5
+    t27 = c2*s4 - c4*t26
+    t28 = c2*c4 + s4*t26
+    t29 = s3*s2
+    t30 = t27*c5 + s5*t29
+    t31 = -t27*s5 + c5*t29
     t32 = t30*c6 - t28*s6
     t33 = t28*c6 + t30*s6
     t34 = t31*s7 + t32*c7
     t35 = t31*c7 - t32*s7
     t36 = 0.126*t14
-    t37 = t36 + 0.4*t10
+    t37 = 0.4*t10 + t36
     t38 = t37 + 0.42*t8
     t39 = 0.126*t23
-    t40 = t39 + 0.4*t19
+    t40 = 0.4*t19 + t39
     t41 = t40 + 0.42*t17
     t42 = 0.126*t33
-    t43 = t42 + 0.4*t28
+    t43 = 0.4*t28 + t42
     t44 = t43 + 0.42*c2
     t45 = -(t38*c1 + t41*s1)
-    t46 = t44*c1
-    t47 = t44*s1
+    t46 = c1*t44
+    t47 = s1*t44
     t48 = -t41*c2 + t44*t17
     t49 = t38*c2 - t44*t8
     t50 = t41*t8 - t38*t17
@@ -462,7 +462,7 @@ def jacobian_tool(q):
     t54 = t19*t43 - t28*t40
     t55 = t28*t37 - t10*t43
     t56 = t10*t40 - t19*t37
-    t57 = t21*t42 - t31*t39
+    t57 = -t31*t39 + t21*t42
     t58 = t12*t42 + t31*t36
     t59 = -(t12*t39 + t21*t36)
     J = _stack(xp, [
@@ -490,7 +490,7 @@ def jacobian_tool(q):
         t34,  # 3, 0
         t24*c1 - t15*s1,  # 3, 1
         t34*c2 + t15*t8 + t24*t17,  # 3, 2
-        -(t24*t3 - t15*t6 + t34*t29),  # 3, 3
+        -(-t15*t6 + t24*t3 + t34*t29),  # 3, 3
         t10*t15 + t19*t24 + t28*t34,  # 3, 4
         t21*t24 + t31*t34 - t12*t15,  # 3, 5
         t14*t15 + t23*t24 + t33*t34,  # 3, 6
@@ -504,7 +504,7 @@ def jacobian_tool(q):
         t33,  # 5, 0
         t23*c1 - t14*s1,  # 5, 1
         t33*c2 + t14*t8 + t23*t17,  # 5, 2
-        -(t23*t3 - t14*t6 + t33*t29),  # 5, 3
+        -(-t14*t6 + t23*t3 + t33*t29),  # 5, 3
         t10*t14 + t19*t23 + t28*t33,  # 5, 4
         t21*t23 + t31*t33 - t12*t14,  # 5, 5
         t14**2 + t23**2 + t33**2,  # 5, 6
@@ -532,43 +532,43 @@ def task(q):
     s7 = trig[..., 13]
     t0 = s1*s3
     t1 = c1*c3
-    t2 = -t0 + t1*c2
-    t3 = t1 - t0*c2
+    t2 = -t0 + c2*t1
+    t3 = t1 - c2*t0
     t4 = c3*s1
     t5 = c1*s3
-    t6 = t4 + t5*c2
-    t7 = t5 + t4*c2
+    t6 = t4 + c2*t5
+    t7 = t5 + c2*t4
     t8 = c1*s2
-    t9 = t2*c4 + t8*s4
-    t10 = -t2*s4 + t8*c4
+    t9 = t2*c4 + s4*t8
+    t10 = -t2*s4 + c4*t8
     t11 = t9*c5 - t6*s5
     t12 = t9*s5 + t6*c5
     t13 = t11*c6 - t10*s6
     t14 = t10*c6 + t11*s6
     t15 = t13*c7 - t12*s7
-    t16 = 0.126*t14 + 0.4*t10
+    t16 = 0.4*t10 + 0.126*t14
     t17 = t16 + 0.42*t8
     t18 = s1*s2
-    t19 = t7*c4 + t18*s4
-    t20 = -t7*s4 + t18*c4
+    t19 = t7*c4 + s4*t18
+    t20 = -t7*s4 + c4*t18
     t21 = t19*c5 + t3*s5
     t22 = t3*c5 - t19*s5
     t23 = t21*c6 - t20*s6
     t24 = t20*c6 + t21*s6
     t25 = t22*s7 + t23*c7
-    t26 = 0.126*t24 + 0.4*t20
+    t26 = 0.4*t20 + 0.126*t24
     t27 = t26 + 0.42*t18
     t28 = c3*s2
-    t29 = c2*s4 - t28*c4
-    t30 = c2*c4 + t28*s4
-    t31 = s2*s3
-    t32 = t29*c5 + t31*s5
-    t33 = -t29*s5 + t31*c5
+    t29 = c2*s4 - c4*t28
+    t30 = c2*c4 + s4*t28
+    t31 = s3*s2
+    t32 = t29*c5 + s5*t31
+    t33 = -t29*s5 + c5*t31
     t34 = t32*c6 - t30*s6
     t35 = t30*c6 + t32*s6
     t36 = t33*s7 + t34*c7
     t37 = t33*c7 - t34*s7
-    t38 = 0.126*t35 + 0.4*t30
+    t38 = 0.4*t30 + 0.126*t35
     t39 = t38 + 0.42*c2
     t40 = 0.36 + t39
     mu = _stack(xp, [
@@ -602,45 +602,45 @@ def task_jacobian(q):
     s7 = trig[..., 13]
     t0 = s1*s3
     t1 = c1*c3
-    t2 = -t0 + t1*c2
-    t3 = t1 - t0*c2
+    t2 = -t0 + c2*t1
+    t3 = t1 - c2*t0
     t4 = c3*s1
     t5 = c1*s3
-    t6 = t4 + t5*c2
-    t7 = t5 + t4*c2
+    t6 = t4 + c2*t5
+    t7 = t5 + c2*t4
     t8 = c1*s2
-    t9 = t2*c4 + t8*s4
-    t10 = -t2*s4 + t8*c4
+    t9 = t2*c4 + s4*t8
+    t10 = -t2*s4 + c4*t8
     t11 = t9*c5 - t6*s5
     t12 = t9*s5 + t6*c5
     t13 = t11*c6 - t10*s6
     t14 = t10*c6 + t11*s6
     t15 = t13*c7 - t12*s7
     t16 = s1*s2
-    t17 = t7*c4 + t16*s4
-    t18 = -t7*s4 + t16*c4
+    t17 = t7*c4 + s4*t16
+    t18 = -t7*s4 + c4*t16
     t19 = t17*c5 + t3*s5
     t20 = t3*c5 - t17*s5
     t21 = t19*c6 - t18*s6
     t22 = t18*c6 + t19*s6
     t23 = t20*s7 + t21*c7
     t24 = c3*s2
-    t25 = c2*s4 - t24*c4
-    t26 = c2*c4 + t24*s4
+    t25 = c2*s4 - c4*t24
+    t26 = c2*c4 + s4*t24
     t27 = s2*s3
-    t28 = t25*c5 + t27*s5
-    t29 = -t25*s5 + t27*c5
+    t28 = t25*c5 + s5*t27
+    t29 = -t25*s5 + c5*t27
     t30 = t28*c6 - t26*s6
     t31 = t26*c6 + t28*s6
     t32 = t29*s7 + t30*c7
     t33 = 0.126*t14
-    t34 = t33 + 0.4*t10
+    t34 = 0.4*t10 + t33
     t35 = t34 + 0.42*t8
     t36 = 0.126*t22
-    t37 = t36 + 0.4*t18
+    t37 = 0.4*t18 + t36
     t38 = t37 + 0.42*t16
     t39 = 0.126*t31
-    t40 = t39 + 0.4*t26
+    t40 = 0.4*t26 + t39
     t41 = t40 + 0.42*c2
     t42 = t41*c1
     t43 = t41*s1
@@ -651,7 +651,7 @@ def task_jacobian(q):
     t48 = t45*(t46 - t47)
     t49 = t15*c1
     t50 = t23*s1
-    t51 = t45*(t49*s2 + t50*s2)
+    t51 = t45*(s2*t49 + s2*t50)
     t52 = t45*(t15*t6 - t23*t3)
     t53 = t45*(t10*t15 + t18*t23)
     t54 = t45*(t20*t23 - t12*t15)
@@ -660,14 +660,14 @@ def task_jacobian(q):
     J = _stack(xp, [
         -t38,  # 0, 0
         t42,  # 0, 1
-        -t38*c2 + t43*s2,  # 0, 2
+        -t38*c2 + s2*t43,  # 0, 2
         -t40*t3 + t37*t27,  # 0, 3
         t18*t40 - t26*t37,  # 0, 4
-        t20*t39 - t29*t36,  # 0, 5
+        -t29*t36 + t20*t39,  # 0, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 6
         t35,  # 1, 0
         t43,  # 1, 1
-        t35*c2 - t42*s2,  # 1, 2
+        t35*c2 - s2*t42,  # 1, 2
         -(t40*t6 + t34*t27),  # 1, 3
         t26*t34 - t10*t40,  # 1, 4
         t12*t39 + t29*t33,  # 1, 5
@@ -688,7 +688,7 @@ def task_jacobian(q):
         t55,  # 3, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
         t56*(t49 + t50),  # 4, 1
-        t56*(t47*s2 - t46*s2),  # 4, 2
+        t56*(s2*t47 - s2*t46),  # 4, 2
         -t56*(t15*t3 + t23*t6),  # 4, 3
         t56*(t18*t15 - t10*t23),  # 4, 4
         t56*(t12*t23 + t20*t15),  # 4, 5
@@ -705,7 +705,7 @@ def task_jacobian(q):
 
 
 def fk_jacobian_dot(q, q_dot):
-    """fk, jacobian and bias_acceleration in one pass, sharing their terms: (4 x 4 and 6 x 7 and 6 x 1), 429 operations."""
+    """fk, jacobian and bias_acceleration in one pass, sharing their terms: (4 x 4 and 6 x 7 and 6 x 1), 428 operations."""
     xp, dtype, device, batch, (q, q_dot,) = _arguments(("q", q, (7,)), ("q_dot", q_dot, (7,)))
     qd1 = q_dot[..., 0]
     qd2 = q_dot[..., 1]
@@ -732,15 +732,15 @@ def fk_jacobian_dot(q, q_dot):
     t0 = qd1 + c2*qd3
     t1 = s1*s3
     t2 = c1*c3
-    t3 = -t1 + t2*c2
-    t4 = t2 - t1*c2
+    t3 = -t1 + c2*t2
+    t4 = t2 - c2*t1
     t5 = c3*s1
     t6 = c1*s3
-    t7 = t5 + t6*c2
-    t8 = t6 + t5*c2
+    t7 = t5 + c2*t6
+    t8 = t6 + c2*t5
     t9 = c1*s2
-    t10 = t3*c4 + t9*s4
-    t11 = -t3*s4 + t9*c4
+    t10 = t3*c4 + s4*t9
+    t11 = -t3*s4 + c4*t9
     t12 = t10*c5 - t7*s5
     t13 = t10*s5 + t7*c5
     t14 = t12*c6 - t11*s6
@@ -748,8 +748,8 @@ def fk_jacobian_dot(q, q_dot):
     t16 = t14*c7 - t13*s7
     t17 = t13*c7 + t14*s7
     t18 = s1*s2
-    t19 = t8*c4 + t18*s4
-    t20 = -t8*s4 + t18*c4
+    t19 = t8*c4 + s4*t18
+    t20 = -t8*s4 + c4*t18
     t21 = t19*c5 + t4*s5
     t22 = t4*c5 - t19*s5
     t23 = t21*c6 - t20*s6
@@ -757,41 +757,41 @@ def fk_jacobian_dot(q, q_dot):
     t25 = t22*s7 + t23*c7
     t26 = t22*c7 - t23*s7
     t27 = c3*s2
-    t28 = c2*s4 - t27*c4
-    t29 = c2*c4 + t27*s4
+    t28 = c2*s4 - c4*t27
+    t29 = c2*c4 + s4*t27
     t30 = s2*s3
-    t31 = t28*c5 + t30*s5
-    t32 = -t28*s5 + t30*c5
+    t31 = t28*c5 + s5*t30
+    t32 = -t28*s5 + c5*t30
     t33 = t31*c6 - t29*s6
     t34 = t29*c6 + t31*s6
     t35 = t32*s7 + t33*c7
     t36 = t32*c7 - t33*s7
-    t37 = t0 - t30*qd4
+    t37 = t0 - qd4*t30
     t38 = t37 + t29*qd5
     t39 = 0.126*t15
-    t40 = t39 + 0.4*t11
+    t40 = 0.4*t11 + t39
     t41 = t40 + 0.42*t9
     t42 = 0.126*t24
-    t43 = t42 + 0.4*t20
+    t43 = 0.4*t20 + t42
     t44 = t43 + 0.42*t18
     t45 = 0.126*t34
-    t46 = t45 + 0.4*t29
+    t46 = 0.4*t29 + t45
     t47 = t46 + 0.42*c2
     t48 = 0.36 + t47
     t49 = t47*s1
-    t50 = -t44*c2 + t49*s2
+    t50 = -t44*c2 + s2*t49
     t51 = t50
     t52 = -t46*t4 + t43*t30
     t53 = t52
     t54 = t20*t46 - t29*t43
     t55 = t54
-    t56 = t22*t45 - t32*t42
+    t56 = -t32*t42 + t22*t45
     t57 = t56
     t58 = t55*qd5 + t57*qd6
     t59 = t58 + t53*qd4
     t60 = t59 + t51*qd3
     t61 = t47*c1
-    t62 = t41*c2 - t61*s2
+    t62 = t41*c2 - s2*t61
     t63 = t62
     t64 = t46*t7 + t40*t30
     t65 = t64
@@ -817,13 +817,13 @@ def fk_jacobian_dot(q, q_dot):
     t85 = t84 + t76*qd3
     t86 = t85 - t74*qd2
     t87 = qd2*s1
-    t88 = -t87 + t9*qd3
+    t88 = -t87 + qd3*t9
     t89 = t88 + t7*qd4
     t90 = t89 + t11*qd5
     t91 = t72 + t47*t87
     t92 = t91 + t41*qd1
     t93 = c1*qd2
-    t94 = t93 + t18*qd3
+    t94 = t93 + qd3*t18
     t95 = t94 - t4*qd4
     t96 = t95 + t20*qd5
     t97 = t60 + t47*t93
@@ -898,18 +898,18 @@ def fk_jacobian_dot(q, q_dot):
         xp.broadcast_to(t34, batch),  # 5, 6
     ], (6, 7))
     a = _stack(xp, [
-        xp.broadcast_to(qd2*(t86*c1 - t49*qd1) + qd3*(-t63*qd1 - t72*c2 + t76*t93 + t85*t18) + qd4*(t65*t0 + t78*t94 - t84*t4 + t71*t30) + qd5*(t20*t83 + t80*t95 - t29*t70 - t67*t37) - qd6*(t69*t38 + t82*t96 + t82*t101 + t69*t103) - t92*qd1, batch),  # 0
-        xp.broadcast_to(t98*qd1 + qd2*(t86*s1 + t61*qd1) + qd3*(t51*qd1 + t60*c2 + t76*t87 - t85*t9) - qd4*(t78*t88 + t7*t84 - t53*t0 + t59*t30) + qd5*(t29*t58 + t55*t37 - t11*t83 - t80*t89) + qd6*(t57*t38 + t82*t90 + t57*t103 - t82*t99), batch),  # 1
-        xp.broadcast_to(-qd2*(t97*c1 + t91*s1) - qd3*(t51*t93 + t63*t87 + t60*t18 - t72*c1*s2) + qd4*(t7*t71 + t59*t4 - t53*t94 - t65*t88) + qd5*(t11*t70 + t67*t89 - t20*t58 - t55*t95) - qd6*(t57*t96 - t69*t90 + t69*t99 + t57*t101), batch),  # 2
-        xp.broadcast_to(qd3*(t93*c2 - t18*qd1) + qd4*(t0*t4 - t94*t30) + qd5*(t29*t95 - t20*t37) + qd6*(t32*t96 - t22*t38) + qd7*(t34*t102 - t24*t104) - t93*qd1, batch),  # 3
-        xp.broadcast_to(qd3*(t9*qd1 + t87*c2) + qd4*(t7*t0 + t88*t30) + qd5*(t11*t37 - t29*t89) - qd6*(t13*t38 + t32*t90) + qd7*(t15*t104 - t34*t100) - t87*qd1, batch),  # 4
-        xp.broadcast_to(-qd3*(t105*c1**2 + t105*s1**2) - qd4*(t88*t4 + t7*t94) + qd5*(t20*t89 - t11*t95) + qd6*(t13*t96 + t22*t90) + qd7*(t24*t100 - t15*t102), batch),  # 5
+        xp.broadcast_to(qd2*(t86*c1 - qd1*t49) + qd3*(-t63*qd1 - t72*c2 + t76*t93 + t85*t18) + qd4*(t65*t0 + t78*t94 - t84*t4 + t71*t30) + qd5*(t20*t83 + t80*t95 - t29*t70 - t67*t37) - qd6*(t69*t38 + t82*t96 + t82*t101 + t69*t103) - t92*qd1, batch),  # 0
+        xp.broadcast_to(t98*qd1 + qd2*(t86*s1 + qd1*t61) + qd3*(t51*qd1 + t60*c2 + t76*t87 - t85*t9) - qd4*(-t53*t0 + t78*t88 + t7*t84 + t59*t30) + qd5*(t29*t58 + t55*t37 - t11*t83 - t80*t89) + qd6*(t57*t38 + t82*t90 + t57*t103 - t82*t99), batch),  # 1
+        xp.broadcast_to(-qd2*(t97*c1 + t91*s1) - qd3*(-t72*t9 + t51*t93 + t63*t87 + t60*t18) + qd4*(t7*t71 + t59*t4 - t53*t94 - t65*t88) + qd5*(t11*t70 + t67*t89 - t20*t58 - t55*t95) - qd6*(-t69*t90 + t57*t96 + t69*t99 + t57*t101), batch),  # 2
+        xp.broadcast_to(qd3*(c2*t93 - qd1*t18) + qd4*(t0*t4 - t94*t30) + qd5*(t29*t95 - t20*t37) + qd6*(t32*t96 - t22*t38) + qd7*(t34*t102 - t24*t104) - qd1*t93, batch),  # 3
+        xp.broadcast_to(qd3*(qd1*t9 + c2*t87) + qd4*(t7*t0 + t88*t30) + qd5*(t11*t37 - t29*t89) - qd6*(t13*t38 + t32*t90) + qd7*(t15*t104 - t34*t100) - qd1*t87, batch),  # 4
+        xp.broadcast_to(-qd3*(c1**2*t105 + s1**2*t105) - qd4*(t88*t4 + t7*t94) + qd5*(t20*t89 - t11*t95) + qd6*(t13*t96 + t22*t90) + qd7*(t24*t100 - t15*t102), batch),  # 5
     ], (6,))
     return T, J, a
 
 
 def jacobian_dot(q, q_dot):
-    """time derivative dJ/dt of the world geometric Jacobian along q_dot (6 x DOF): (6 x 7), 326 operations."""
+    """time derivative dJ/dt of the world geometric Jacobian along q_dot (6 x DOF): (6 x 7), 325 operations."""
     xp, dtype, device, batch, (q, q_dot,) = _arguments(("q", q, (7,)), ("q_dot", q_dot, (7,)))
     qd1 = q_dot[..., 0]
     qd2 = q_dot[..., 1]
@@ -933,38 +933,38 @@ def jacobian_dot(q, q_dot):
     t0 = qd1 + c2*qd3
     t1 = s1*s3
     t2 = c1*c3
-    t3 = -t1 + t2*c2
-    t4 = t2 - t1*c2
+    t3 = -t1 + c2*t2
+    t4 = t2 - c2*t1
     t5 = c3*s1
     t6 = c1*s3
-    t7 = t5 + t6*c2
-    t8 = t6 + t5*c2
+    t7 = t5 + c2*t6
+    t8 = t6 + c2*t5
     t9 = c1*s2
-    t10 = t3*c4 + t9*s4
-    t11 = -t3*s4 + t9*c4
+    t10 = t3*c4 + s4*t9
+    t11 = -t3*s4 + c4*t9
     t12 = t10*c5 - t7*s5
     t13 = t10*s5 + t7*c5
     t14 = t11*c6 + t12*s6
     t15 = s1*s2
-    t16 = t8*c4 + t15*s4
-    t17 = -t8*s4 + t15*c4
+    t16 = t8*c4 + s4*t15
+    t17 = -t8*s4 + c4*t15
     t18 = t16*c5 + t4*s5
     t19 = t4*c5 - t16*s5
     t20 = t17*c6 + t18*s6
     t21 = c3*s2
-    t22 = c2*s4 - t21*c4
-    t23 = c2*c4 + t21*s4
-    t24 = s2*s3
-    t25 = t22*c5 + t24*s5
-    t26 = -t22*s5 + t24*c5
+    t22 = c2*s4 - c4*t21
+    t23 = c2*c4 + s4*t21
+    t24 = s3*s2
+    t25 = t22*c5 + s5*t24
+    t26 = -t22*s5 + c5*t24
     t27 = t23*c6 + t25*s6
-    t28 = t0 - t24*qd4
+    t28 = t0 - qd4*t24
     t29 = t28 + t23*qd5
     t30 = 0.126*t14
-    t31 = t30 + 0.4*t11
+    t31 = 0.4*t11 + t30
     t32 = t31 + 0.42*t9
     t33 = 0.126*t20
-    t34 = t33 + 0.4*t17
+    t34 = 0.4*t17 + t33
     t35 = t34 + 0.42*t15
     t36 = t32*c1 + t35*s1
     t37 = t35*t9 - t32*t15
@@ -976,12 +976,12 @@ def jacobian_dot(q, q_dot):
     t43 = t42 + t37*qd3
     t44 = t43 - t36*qd2
     t45 = 0.126*t27
-    t46 = t45 + 0.4*t23
+    t46 = 0.4*t23 + t45
     t47 = t46 + 0.42*c2
     t48 = -t35*c2 + t47*t15
     t49 = -t46*t4 + t34*t24
     t50 = t17*t46 - t23*t34
-    t51 = t19*t45 - t26*t33
+    t51 = -t26*t33 + t19*t45
     t52 = t32*c2 - t47*t9
     t53 = t46*t7 + t31*t24
     t54 = t23*t31 - t11*t46
@@ -993,13 +993,13 @@ def jacobian_dot(q, q_dot):
     t60 = t58 + t48*qd3
     t61 = t59 + t52*qd3
     t62 = qd2*s1
-    t63 = -t62 + t9*qd3
+    t63 = -t62 + qd3*t9
     t64 = t63 + t7*qd4
     t65 = t64 + t11*qd5
     t66 = t61 + t47*t62
     t67 = t66 + t32*qd1
     t68 = c1*qd2
-    t69 = t68 + t15*qd3
+    t69 = t68 + qd3*t15
     t70 = t69 - t4*qd4
     t71 = t70 + t17*qd5
     t72 = t60 + t47*t68
@@ -1024,34 +1024,34 @@ def jacobian_dot(q, q_dot):
         xp.broadcast_to(t73, batch),  # 1, 0
         xp.broadcast_to(t44*s1 + t47*t81, batch),  # 1, 1
         xp.broadcast_to(t48*qd1 + t60*c2 + t37*t62 - t43*t9, batch),  # 1, 2
-        xp.broadcast_to(-(t38*t63 + t7*t42 - t49*t0 + t58*t24), batch),  # 1, 3
+        xp.broadcast_to(-(-t49*t0 + t38*t63 + t7*t42 + t58*t24), batch),  # 1, 3
         xp.broadcast_to(t23*t56 + t50*t28 - t11*t41 - t39*t64, batch),  # 1, 4
         xp.broadcast_to(t51*t29 + t40*t65 + t51*t78 - t40*t74, batch),  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
         xp.broadcast_to(-(t72*c1 + t66*s1), batch),  # 2, 1
-        xp.broadcast_to(-(t48*t68 + t52*t62 + t60*t15 - t61*c1*s2), batch),  # 2, 2
+        xp.broadcast_to(-(-t61*t9 + t48*t68 + t52*t62 + t60*t15), batch),  # 2, 2
         xp.broadcast_to(t7*t59 + t58*t4 - t49*t69 - t53*t63, batch),  # 2, 3
         xp.broadcast_to(t11*t57 + t54*t64 - t17*t56 - t50*t70, batch),  # 2, 4
-        xp.broadcast_to(-(t51*t71 - t55*t65 + t55*t74 + t51*t76), batch),  # 2, 5
+        xp.broadcast_to(-(-t55*t65 + t51*t71 + t55*t74 + t51*t76), batch),  # 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
         xp.broadcast_to(-t81, batch),  # 3, 1
-        xp.broadcast_to(t68*c2 - t80*s2, batch),  # 3, 2
+        xp.broadcast_to(c2*t68 - s2*t80, batch),  # 3, 2
         xp.broadcast_to(t0*t4 - t69*t24, batch),  # 3, 3
         xp.broadcast_to(t23*t70 - t17*t28, batch),  # 3, 4
         xp.broadcast_to(t26*t71 - t19*t29, batch),  # 3, 5
         xp.broadcast_to(t27*t77 - t20*t79, batch),  # 3, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
         xp.broadcast_to(-t80, batch),  # 4, 1
-        xp.broadcast_to(t81*s2 + t62*c2, batch),  # 4, 2
+        xp.broadcast_to(s2*t81 + c2*t62, batch),  # 4, 2
         xp.broadcast_to(t7*t0 + t63*t24, batch),  # 4, 3
         xp.broadcast_to(t11*t28 - t23*t64, batch),  # 4, 4
         xp.broadcast_to(-(t13*t29 + t26*t65), batch),  # 4, 5
         xp.broadcast_to(t14*t79 - t27*t75, batch),  # 4, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 1
-        xp.broadcast_to(-(t82*c1**2 + t82*s1**2), batch),  # 5, 2
+        xp.broadcast_to(-(c1**2*t82 + s1**2*t82), batch),  # 5, 2
         xp.broadcast_to(-(t63*t4 + t7*t69), batch),  # 5, 3
         xp.broadcast_to(t17*t64 - t11*t70, batch),  # 5, 4
         xp.broadcast_to(t13*t71 + t19*t65, batch),  # 5, 5
@@ -1061,7 +1061,7 @@ def jacobian_dot(q, q_dot):
 
 
 def bias_acceleration(q, q_dot):
-    """J' q_dot: the tool's classical linear and angular acceleration at zero joint acceleration, world frame (6): (6 x 1), 389 operations."""
+    """J' q_dot: the tool's classical linear and angular acceleration at zero joint acceleration, world frame (6): (6 x 1), 388 operations."""
     xp, dtype, device, batch, (q, q_dot,) = _arguments(("q", q, (7,)), ("q_dot", q_dot, (7,)))
     qd1 = q_dot[..., 0]
     qd2 = q_dot[..., 1]
@@ -1086,38 +1086,38 @@ def bias_acceleration(q, q_dot):
     t0 = qd1 + c2*qd3
     t1 = s1*s3
     t2 = c1*c3
-    t3 = -t1 + t2*c2
-    t4 = t2 - t1*c2
+    t3 = -t1 + c2*t2
+    t4 = t2 - c2*t1
     t5 = c3*s1
     t6 = c1*s3
-    t7 = t5 + t6*c2
-    t8 = t6 + t5*c2
+    t7 = t5 + c2*t6
+    t8 = t6 + c2*t5
     t9 = c1*s2
-    t10 = t3*c4 + t9*s4
-    t11 = -t3*s4 + t9*c4
+    t10 = t3*c4 + s4*t9
+    t11 = -t3*s4 + c4*t9
     t12 = t10*c5 - t7*s5
     t13 = t10*s5 + t7*c5
     t14 = t11*c6 + t12*s6
     t15 = s1*s2
-    t16 = t8*c4 + t15*s4
-    t17 = -t8*s4 + t15*c4
+    t16 = t8*c4 + s4*t15
+    t17 = -t8*s4 + c4*t15
     t18 = t16*c5 + t4*s5
     t19 = t4*c5 - t16*s5
     t20 = t17*c6 + t18*s6
     t21 = c3*s2
-    t22 = c2*s4 - t21*c4
-    t23 = c2*c4 + t21*s4
-    t24 = s2*s3
-    t25 = t22*c5 + t24*s5
-    t26 = -t22*s5 + t24*c5
+    t22 = c2*s4 - c4*t21
+    t23 = c2*c4 + s4*t21
+    t24 = s3*s2
+    t25 = t22*c5 + s5*t24
+    t26 = -t22*s5 + c5*t24
     t27 = t23*c6 + t25*s6
-    t28 = t0 - t24*qd4
+    t28 = t0 - qd4*t24
     t29 = t28 + t23*qd5
     t30 = 0.126*t14
-    t31 = t30 + 0.4*t11
+    t31 = 0.4*t11 + t30
     t32 = t31 + 0.42*t9
     t33 = 0.126*t20
-    t34 = t33 + 0.4*t17
+    t34 = 0.4*t17 + t33
     t35 = t34 + 0.42*t15
     t36 = t32*c1 + t35*s1
     t37 = t35*t9 - t32*t15
@@ -1129,12 +1129,12 @@ def bias_acceleration(q, q_dot):
     t43 = t42 + t37*qd3
     t44 = t43 - t36*qd2
     t45 = 0.126*t27
-    t46 = t45 + 0.4*t23
+    t46 = 0.4*t23 + t45
     t47 = t46 + 0.42*c2
     t48 = -t35*c2 + t47*t15
     t49 = -t46*t4 + t34*t24
     t50 = t17*t46 - t23*t34
-    t51 = t19*t45 - t26*t33
+    t51 = -t26*t33 + t19*t45
     t52 = t32*c2 - t47*t9
     t53 = t46*t7 + t31*t24
     t54 = t23*t31 - t11*t46
@@ -1146,13 +1146,13 @@ def bias_acceleration(q, q_dot):
     t60 = t58 + t48*qd3
     t61 = t59 + t52*qd3
     t62 = qd2*s1
-    t63 = -t62 + t9*qd3
+    t63 = -t62 + qd3*t9
     t64 = t63 + t7*qd4
     t65 = t64 + t11*qd5
     t66 = t61 + t47*t62
     t67 = t66 + t32*qd1
     t68 = c1*qd2
-    t69 = t68 + t15*qd3
+    t69 = t68 + qd3*t15
     t70 = t69 - t4*qd4
     t71 = t70 + t17*qd5
     t72 = t60 + t47*t68
@@ -1163,15 +1163,15 @@ def bias_acceleration(q, q_dot):
     t77 = t71 + t76
     t78 = t26*qd6
     t79 = t29 + t78
-    t80 = t47*qd1
+    t80 = qd1*t47
     t81 = qd2*s2
     a = _stack(xp, [
-        xp.broadcast_to(qd2*(t44*c1 - t80*s1) + qd3*(-t52*qd1 - t61*c2 + t37*t68 + t43*t15) + qd4*(t53*t0 + t38*t69 - t42*t4 + t59*t24) + qd5*(t17*t41 + t39*t70 - t23*t57 - t54*t28) - qd6*(t55*t29 + t40*t71 + t40*t76 + t55*t78) - t67*qd1, batch),  # 0
-        xp.broadcast_to(t73*qd1 + qd2*(t44*s1 + t80*c1) + qd3*(t48*qd1 + t60*c2 + t37*t62 - t43*t9) - qd4*(t38*t63 + t7*t42 - t49*t0 + t58*t24) + qd5*(t23*t56 + t50*t28 - t11*t41 - t39*t64) + qd6*(t51*t29 + t40*t65 + t51*t78 - t40*t74), batch),  # 1
-        xp.broadcast_to(-qd2*(t72*c1 + t66*s1) - qd3*(t48*t68 + t52*t62 + t60*t15 - t61*c1*s2) + qd4*(t7*t59 + t58*t4 - t49*t69 - t53*t63) + qd5*(t11*t57 + t54*t64 - t17*t56 - t50*t70) - qd6*(t51*t71 - t55*t65 + t55*t74 + t51*t76), batch),  # 2
-        xp.broadcast_to(qd3*(t68*c2 - t15*qd1) + qd4*(t0*t4 - t69*t24) + qd5*(t23*t70 - t17*t28) + qd6*(t26*t71 - t19*t29) + qd7*(t27*t77 - t20*t79) - t68*qd1, batch),  # 3
-        xp.broadcast_to(qd3*(t9*qd1 + t62*c2) + qd4*(t7*t0 + t63*t24) + qd5*(t11*t28 - t23*t64) - qd6*(t13*t29 + t26*t65) + qd7*(t14*t79 - t27*t75) - t62*qd1, batch),  # 4
-        xp.broadcast_to(-qd3*(t81*c1**2 + t81*s1**2) - qd4*(t63*t4 + t7*t69) + qd5*(t17*t64 - t11*t70) + qd6*(t13*t71 + t19*t65) + qd7*(t20*t75 - t14*t77), batch),  # 5
+        xp.broadcast_to(qd2*(t44*c1 - s1*t80) + qd3*(-t52*qd1 - t61*c2 + t37*t68 + t43*t15) + qd4*(t53*t0 + t38*t69 - t42*t4 + t59*t24) + qd5*(t17*t41 + t39*t70 - t23*t57 - t54*t28) - qd6*(t55*t29 + t40*t71 + t40*t76 + t55*t78) - t67*qd1, batch),  # 0
+        xp.broadcast_to(t73*qd1 + qd2*(t44*s1 + c1*t80) + qd3*(t48*qd1 + t60*c2 + t37*t62 - t43*t9) - qd4*(-t49*t0 + t38*t63 + t7*t42 + t58*t24) + qd5*(t23*t56 + t50*t28 - t11*t41 - t39*t64) + qd6*(t51*t29 + t40*t65 + t51*t78 - t40*t74), batch),  # 1
+        xp.broadcast_to(-qd2*(t72*c1 + t66*s1) - qd3*(-t61*t9 + t48*t68 + t52*t62 + t60*t15) + qd4*(t7*t59 + t58*t4 - t49*t69 - t53*t63) + qd5*(t11*t57 + t54*t64 - t17*t56 - t50*t70) - qd6*(-t55*t65 + t51*t71 + t55*t74 + t51*t76), batch),  # 2
+        xp.broadcast_to(qd3*(c2*t68 - qd1*t15) + qd4*(t0*t4 - t69*t24) + qd5*(t23*t70 - t17*t28) + qd6*(t26*t71 - t19*t29) + qd7*(t27*t77 - t20*t79) - qd1*t68, batch),  # 3
+        xp.broadcast_to(qd3*(qd1*t9 + c2*t62) + qd4*(t7*t0 + t63*t24) + qd5*(t11*t28 - t23*t64) - qd6*(t13*t29 + t26*t65) + qd7*(t14*t79 - t27*t75) - qd1*t62, batch),  # 4
+        xp.broadcast_to(-qd3*(c1**2*t81 + s1**2*t81) - qd4*(t63*t4 + t7*t69) + qd5*(t17*t64 - t11*t70) + qd6*(t13*t71 + t19*t65) + qd7*(t20*t75 - t14*t77), batch),  # 5
     ], (6,))
     return a
 
@@ -1203,42 +1203,42 @@ def task_jacobian_dot(q, q_dot):
     s7 = trig[..., 13]
     t0 = s1*s3
     t1 = c1*c3
-    t2 = -t0 + t1*c2
-    t3 = t1 - t0*c2
+    t2 = -t0 + c2*t1
+    t3 = t1 - c2*t0
     t4 = c3*s1
     t5 = c1*s3
-    t6 = t4 + t5*c2
-    t7 = t5 + t4*c2
+    t6 = t4 + c2*t5
+    t7 = t5 + c2*t4
     t8 = c1*s2
-    t9 = t2*c4 + t8*s4
-    t10 = -t2*s4 + t8*c4
+    t9 = t2*c4 + s4*t8
+    t10 = -t2*s4 + c4*t8
     t11 = t9*c5 - t6*s5
     t12 = t9*s5 + t6*c5
     t13 = t11*c6 - t10*s6
     t14 = t10*c6 + t11*s6
     t15 = t13*c7 - t12*s7
     t16 = s1*s2
-    t17 = t7*c4 + t16*s4
-    t18 = -t7*s4 + t16*c4
+    t17 = t7*c4 + s4*t16
+    t18 = -t7*s4 + c4*t16
     t19 = t17*c5 + t3*s5
     t20 = t3*c5 - t17*s5
     t21 = t19*c6 - t18*s6
     t22 = t18*c6 + t19*s6
     t23 = t20*s7 + t21*c7
     t24 = c3*s2
-    t25 = c2*s4 - t24*c4
-    t26 = c2*c4 + t24*s4
-    t27 = s2*s3
-    t28 = t25*c5 + t27*s5
-    t29 = -t25*s5 + t27*c5
+    t25 = c2*s4 - c4*t24
+    t26 = c2*c4 + s4*t24
+    t27 = s3*s2
+    t28 = t25*c5 + s5*t27
+    t29 = -t25*s5 + c5*t27
     t30 = t28*c6 - t26*s6
     t31 = t26*c6 + t28*s6
     t32 = t29*s7 + t30*c7
     t33 = 0.126*t14
-    t34 = t33 + 0.4*t10
+    t34 = 0.4*t10 + t33
     t35 = t34 + 0.42*t8
     t36 = 0.126*t22
-    t37 = t36 + 0.4*t18
+    t37 = 0.4*t18 + t36
     t38 = t37 + 0.42*t16
     t39 = t35*c1 + t38*s1
     t40 = t38*t8 - t35*t16
@@ -1250,12 +1250,12 @@ def task_jacobian_dot(q, q_dot):
     t46 = t45 + t40*qd3
     t47 = t46 - t39*qd2
     t48 = 0.126*t31
-    t49 = t48 + 0.4*t26
+    t49 = 0.4*t26 + t48
     t50 = t49 + 0.42*c2
     t51 = -t38*c2 + t50*t16
     t52 = -t49*t3 + t37*t27
     t53 = t18*t49 - t26*t37
-    t54 = t20*t48 - t29*t36
+    t54 = -t29*t36 + t20*t48
     t55 = t35*c2 - t50*t8
     t56 = t49*t6 + t34*t27
     t57 = t26*t34 - t10*t49
@@ -1270,8 +1270,8 @@ def task_jacobian_dot(q, q_dot):
     t66 = t64 + t50*t65
     t67 = t66 + t35*qd1
     t68 = t51*qd1 + t63*c2 + t40*t65 - t46*t8
-    t69 = t8*qd1 + t65*c2
-    t70 = -t65 + t8*qd3
+    t69 = qd1*t8 + c2*t65
+    t70 = -t65 + qd3*t8
     t71 = t70
     t72 = c1*qd2
     t73 = t63 + t50*t72
@@ -1279,8 +1279,8 @@ def task_jacobian_dot(q, q_dot):
     t75 = -t55*qd1 - t64*c2 + t40*t72 + t46*t16
     t76 = t73*c1 + t66*s1
     t77 = t51*t72 + t55*t65 + t63*t16 - t64*t8
-    t78 = t72*c2 - t16*qd1
-    t79 = t72 + t16*qd3
+    t78 = c2*t72 - qd1*t16
+    t79 = t72 + qd3*t16
     t80 = t79
     t81 = t6*t62 + t61*t3 - t52*t80 - t56*t71
     t82 = t71*t3 + t6*t80
@@ -1296,7 +1296,7 @@ def task_jacobian_dot(q, q_dot):
     t92 = t80 + t91
     t93 = t10*t60 + t57*t90 - t18*t59 - t53*t92
     t94 = t18*t90 - t10*t92
-    t95 = -t27*qd4
+    t95 = -qd4*t27
     t96 = t84 + t95
     t97 = t18*t44 + t42*t92 - t26*t60 - t57*t96
     t98 = t26*t59 + t53*t96 - t10*t44 - t42*t90
@@ -1314,12 +1314,12 @@ def task_jacobian_dot(q, q_dot):
     t110 = t12*qd6
     t111 = -t110
     t112 = t102 + t111
-    t113 = t70 + t89 + t101 + t111 + t14*qd7
+    t113 = t89 + t101 + t111 + t14*qd7 + t70
     t114 = t20*qd6
     t115 = t104 + t114
     t116 = t54*t104 - t58*t102 + t58*t110 + t54*t114
     t117 = t22*t112 - t14*t115
-    t118 = t79 + t91 + t103 + t114 + t22*qd7
+    t118 = t91 + t103 + t114 + t22*qd7 + t79
     t119 = t113*t23 - t118*t15
     t120 = t29*qd6
     t121 = t107 + t120
@@ -1327,14 +1327,14 @@ def task_jacobian_dot(q, q_dot):
     t123 = t54*t107 + t43*t102 + t54*t120 - t43*t110
     t124 = t31*t115 - t22*t121
     t125 = t14*t121 - t31*t112
-    t126 = t83 + t95 + t106 + t120 + t31*qd7
+    t126 = t95 + t106 + t120 + t31*qd7 + t83
     t127 = t118*t32 - t126*t23
     t128 = t126*t15 - t113*t32
-    t129 = t50*qd1
-    t130 = t47*c1 - t129*s1
-    t131 = t47*s1 + t129*c1
+    t129 = qd1*t50
+    t130 = t47*c1 - s1*t129
+    t131 = t47*s1 + c1*t129
     t132 = qd2*s2
-    t133 = t132*c1**2 + t132*s1**2
+    t133 = c1**2*t132 + s1**2*t132
     t134 = t15**2 + t23**2
     t135 = 1/t134
     t136 = s1*t135
@@ -1346,15 +1346,15 @@ def task_jacobian_dot(q, q_dot):
     t142 = t15*t141
     t143 = c1*t135
     t144 = t23*t141
-    t145 = t15*qd1
-    t146 = t23*qd1
-    t147 = t143*s2
+    t145 = qd1*t15
+    t146 = qd1*t23
+    t147 = s2*t143
     t148 = t15*c1
     t149 = t23*s1
-    t150 = t148*s2 + t149*s2
-    t151 = t140*t150
+    t150 = s2*t148 + s2*t149
+    t151 = t150*t140
     t152 = t15*t151
-    t153 = t136*s2
+    t153 = s2*t136
     t154 = t23*t151
     t155 = t15*t135
     t156 = t78*t155
@@ -1362,7 +1362,7 @@ def task_jacobian_dot(q, q_dot):
     t158 = t69*t157
     t159 = t6*t135
     t160 = t15*t6 - t23*t3
-    t161 = t140*t160
+    t161 = t160*t140
     t162 = t15*t161
     t163 = t3*t135
     t164 = t23*t161
@@ -1370,7 +1370,7 @@ def task_jacobian_dot(q, q_dot):
     t166 = t88*t157
     t167 = t10*t135
     t168 = t10*t15 + t18*t23
-    t169 = t140*t168
+    t169 = t168*t140
     t170 = t15*t169
     t171 = t18*t135
     t172 = t23*t169
@@ -1378,7 +1378,7 @@ def task_jacobian_dot(q, q_dot):
     t174 = t100*t157
     t175 = t12*t135
     t176 = t20*t23 - t12*t15
-    t177 = t140*t176
+    t177 = t176*t140
     t178 = t15*t177
     t179 = t20*t135
     t180 = t23*t177
@@ -1386,7 +1386,7 @@ def task_jacobian_dot(q, q_dot):
     t182 = t109*t157
     t183 = t14*t135
     t184 = t14*t15 + t22*t23
-    t185 = t140*t184
+    t185 = t184*t140
     t186 = t15*t185
     t187 = t22*t135
     t188 = t23*t185
@@ -1397,8 +1397,8 @@ def task_jacobian_dot(q, q_dot):
     t193 = 1/t134**1.5
     t194 = t193*(t148 + t149)
     t195 = s1*t191
-    t196 = t191*qd1
-    t197 = t193*(t138*s2 - t137*s2)
+    t196 = qd1*t191
+    t197 = t193*(s2*t138 - s2*t137)
     t198 = t15*t191
     t199 = t23*t191
     t200 = -t193*(t15*t3 + t23*t6)
@@ -1407,7 +1407,7 @@ def task_jacobian_dot(q, q_dot):
     t203 = t193*(t22*t15 - t14*t23)
     t204 = t32*t136
     t205 = t32*t143
-    t206 = t119*t135
+    t206 = t135*t119
     Jd = _stack(xp, [
         xp.broadcast_to(-t67, batch),  # 0, 0
         xp.broadcast_to(t130, batch),  # 0, 1
@@ -1439,18 +1439,18 @@ def task_jacobian_dot(q, q_dot):
         xp.broadcast_to(t127*(t183 - t186) + t128*(t187 - t188) + t189 + t190, batch),  # 3, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
         xp.broadcast_to(t127*(t192 - t15*t194) + t128*(t195 - t23*t194) + t137*t196 - t138*t196, batch),  # 4, 1
-        xp.broadcast_to(t127*(t195*s2 - t15*t197) - t128*(t23*t197 + t192*s2) + t69*t198 - t78*t199, batch),  # 4, 2
+        xp.broadcast_to(t127*(s2*t195 - t15*t197) - t128*(t23*t197 + s2*t192) + t69*t198 - t78*t199, batch),  # 4, 2
         xp.broadcast_to(-t127*(t3*t191 + t15*t200) - t128*(t6*t191 + t23*t200) + t88*t198 - t87*t199, batch),  # 4, 3
         xp.broadcast_to(t127*(t18*t191 - t15*t201) - t128*(t10*t191 + t23*t201) + t100*t198 - t99*t199, batch),  # 4, 4
         xp.broadcast_to(t127*(t20*t191 - t15*t202) + t128*(t12*t191 - t23*t202) - t108*t199 - t109*t198, batch),  # 4, 5
         xp.broadcast_to(t127*(t22*t191 - t15*t203) - t128*(t14*t191 + t23*t203) + t125*t198 - t124*t199, batch),  # 4, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 0
-        xp.broadcast_to(t127*(t204 + t32*t142) + t128*(-t205 + t32*t144) - t206*t139 + t145*t205 + t146*t204, batch),  # 5, 1
-        xp.broadcast_to(-(t133 - t127*(-t32*t147 + t32*t152) - t128*(-t32*t153 + t32*t154) + t206*t150 + t32*t156 + t32*t158), batch),  # 5, 2
-        xp.broadcast_to(-(t82 - t127*(-t32*t159 + t32*t162) - t128*(t32*t163 + t32*t164) + t206*t160 + t32*t165 + t32*t166), batch),  # 5, 3
-        xp.broadcast_to(t94 + t127*(-t32*t167 + t32*t170) + t128*(-t32*t171 + t32*t172) - t206*t168 - t32*t173 - t32*t174, batch),  # 5, 4
-        xp.broadcast_to(t105 + t127*(t32*t175 + t32*t178) + t128*(-t32*t179 + t32*t180) - t206*t176 + t32*t182 - t32*t181, batch),  # 5, 5
-        xp.broadcast_to(t117 + t127*(-t32*t183 + t32*t186) + t128*(-t32*t187 + t32*t188) - t206*t184 - t32*t189 - t32*t190, batch),  # 5, 6
+        xp.broadcast_to(t127*(t204 + t32*t142) + t128*(-t205 + t32*t144) - t139*t206 + t205*t145 + t204*t146, batch),  # 5, 1
+        xp.broadcast_to(-(t133 - t127*(-t32*t147 + t32*t152) - t128*(-t32*t153 + t32*t154) + t150*t206 + t32*t156 + t32*t158), batch),  # 5, 2
+        xp.broadcast_to(-(t82 - t127*(-t32*t159 + t32*t162) - t128*(t32*t163 + t32*t164) + t160*t206 + t32*t165 + t32*t166), batch),  # 5, 3
+        xp.broadcast_to(t94 + t127*(-t32*t167 + t32*t170) + t128*(-t32*t171 + t32*t172) - t168*t206 - t32*t173 - t32*t174, batch),  # 5, 4
+        xp.broadcast_to(t105 + t127*(t32*t175 + t32*t178) + t128*(-t32*t179 + t32*t180) - t176*t206 + t32*t182 - t32*t181, batch),  # 5, 5
+        xp.broadcast_to(t117 + t127*(-t32*t183 + t32*t186) + t128*(-t32*t187 + t32*t188) - t184*t206 - t32*t189 - t32*t190, batch),  # 5, 6
     ], (6, 7))
     return Jd
 
@@ -1473,36 +1473,36 @@ def hessian(q):
     s6 = trig[..., 11]
     t0 = s1*s3
     t1 = c1*c3
-    t2 = -t0 + t1*c2
-    t3 = t1 - t0*c2
+    t2 = -t0 + c2*t1
+    t3 = t1 - c2*t0
     t4 = c3*s1
     t5 = c1*s3
-    t6 = t4 + t5*c2
-    t7 = t5 + t4*c2
+    t6 = t4 + c2*t5
+    t7 = t5 + c2*t4
     t8 = c1*s2
-    t9 = t2*c4 + t8*s4
-    t10 = -t2*s4 + t8*c4
+    t9 = t2*c4 + s4*t8
+    t10 = -t2*s4 + c4*t8
     t11 = t9*c5 - t6*s5
     t12 = t9*s5 + t6*c5
     t13 = t10*c6 + t11*s6
     t14 = s1*s2
-    t15 = t7*c4 + t14*s4
-    t16 = -t7*s4 + t14*c4
+    t15 = t7*c4 + s4*t14
+    t16 = -t7*s4 + c4*t14
     t17 = t15*c5 + t3*s5
     t18 = t3*c5 - t15*s5
     t19 = t16*c6 + t17*s6
     t20 = c3*s2
-    t21 = c2*s4 - t20*c4
-    t22 = c2*c4 + t20*s4
-    t23 = s2*s3
-    t24 = t21*c5 + t23*s5
-    t25 = -t21*s5 + t23*c5
+    t21 = c2*s4 - c4*t20
+    t22 = c2*c4 + s4*t20
+    t23 = s3*s2
+    t24 = t21*c5 + s5*t23
+    t25 = -t21*s5 + c5*t23
     t26 = t22*c6 + t24*s6
     t27 = 0.126*t13
-    t28 = t27 + 0.4*t10
+    t28 = 0.4*t10 + t27
     t29 = t28 + 0.42*t8
     t30 = 0.126*t19
-    t31 = t30 + 0.4*t16
+    t31 = 0.4*t16 + t30
     t32 = t31 + 0.42*t14
     t33 = t29*c1 + t32*s1
     t34 = t32*t8 - t29*t14
@@ -1510,18 +1510,18 @@ def hessian(q):
     t36 = t10*t31 - t16*t28
     t37 = t12*t30 + t18*t27
     t38 = 0.126*t26
-    t39 = t38 + 0.4*t22
+    t39 = 0.4*t22 + t38
     t40 = t39 + 0.42*c2
     t41 = -t39*t3 + t31*t23
     t42 = t16*t39 - t22*t31
-    t43 = t18*t38 - t25*t30
+    t43 = -t25*t30 + t18*t38
     t44 = t39*t6 + t28*t23
     t45 = t22*t28 - t10*t39
     t46 = t12*t38 + t25*t27
     t47 = t40*s1
-    t48 = -t32*c2 + t47*s2
+    t48 = -t32*c2 + s2*t47
     t49 = t40*c1
-    t50 = t29*c2 - t49*s2
+    t50 = t29*c2 - s2*t49
     t51 = -t47
     t52 = -t50
     t53 = -t45
@@ -1626,14 +1626,14 @@ def hessian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 3, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 3, 1
         c1*c2,  # 1, 3, 2
-        -t5*s2,  # 1, 3, 3
+        -s2*t5,  # 1, 3, 3
         t22*c1,  # 1, 3, 4
         t25*c1,  # 1, 3, 5
         t26*c1,  # 1, 3, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 4, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 4, 1
         c2*s1,  # 1, 4, 2
-        -t0*s2,  # 1, 4, 3
+        -s2*t0,  # 1, 4, 3
         t22*s1,  # 1, 4, 4
         t25*s1,  # 1, 4, 5
         t26*s1,  # 1, 4, 6
@@ -1668,14 +1668,14 @@ def hessian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 3, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 3, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 3, 2
-        t3*c2 - t0*t78,  # 2, 3, 3
+        t3*c2 - t78*t0,  # 2, 3, 3
         -t16*c2 + t22*t14,  # 2, 3, 4
         -t18*c2 + t25*t14,  # 2, 3, 5
         -t19*c2 + t26*t14,  # 2, 3, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 4, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 4, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 4, 2
-        t6*c2 + t5*t78,  # 2, 4, 3
+        t6*c2 + t78*t5,  # 2, 4, 3
         t10*c2 - t22*t8,  # 2, 4, 4
         -(t12*c2 + t25*t8),  # 2, 4, 5
         t13*c2 - t26*t8,  # 2, 4, 6
@@ -1859,7 +1859,7 @@ def hessian(q):
 
 
 def singularity_factors(q):
-    """factors of det(Js Js^T): the robot is singular where one is 0: (2 x 1), 707 operations."""
+    """factors of det(Js Js^T): the robot is singular where one is 0: (2 x 1), 697 operations."""
     xp, dtype, device, batch, (q,) = _arguments(("q", q, (7,)))
     trig = _cos_sin(xp, q, (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0), device)
     c1 = trig[..., 0]
@@ -1876,36 +1876,36 @@ def singularity_factors(q):
     s6 = trig[..., 11]
     t0 = s1*s3
     t1 = c1*c3
-    t2 = -t0 + t1*c2
-    t3 = t1 - t0*c2
+    t2 = -t0 + c2*t1
+    t3 = t1 - c2*t0
     t4 = c3*s1
     t5 = c1*s3
-    t6 = t4 + t5*c2
-    t7 = t5 + t4*c2
+    t6 = t4 + c2*t5
+    t7 = t5 + c2*t4
     t8 = c1*s2
-    t9 = t2*c4 + t8*s4
-    t10 = -t2*s4 + t8*c4
+    t9 = t2*c4 + s4*t8
+    t10 = -t2*s4 + c4*t8
     t11 = t9*c5 - t6*s5
     t12 = t9*s5 + t6*c5
     t13 = t10*c6 + t11*s6
     t14 = s1*s2
-    t15 = t7*c4 + t14*s4
-    t16 = -t7*s4 + t14*c4
+    t15 = t7*c4 + s4*t14
+    t16 = -t7*s4 + c4*t14
     t17 = t15*c5 + t3*s5
     t18 = t3*c5 - t15*s5
     t19 = t16*c6 + t17*s6
     t20 = c3*s2
-    t21 = c2*s4 - t20*c4
-    t22 = c2*c4 + t20*s4
-    t23 = s2*s3
-    t24 = t21*c5 + t23*s5
-    t25 = -t21*s5 + t23*c5
+    t21 = c2*s4 - c4*t20
+    t22 = c2*c4 + s4*t20
+    t23 = s3*s2
+    t24 = t21*c5 + s5*t23
+    t25 = -t21*s5 + c5*t23
     t26 = t22*c6 + t24*s6
     t27 = 0.126*t13
-    t28 = t27 + 0.4*t10
+    t28 = 0.4*t10 + t27
     t29 = t28 + 0.42*t8
     t30 = 0.126*t19
-    t31 = t30 + 0.4*t16
+    t31 = 0.4*t16 + t30
     t32 = t31 + 0.42*t14
     t33 = t29*c1 + t32*s1
     t34 = t32*t8 - t29*t14
@@ -1913,128 +1913,128 @@ def singularity_factors(q):
     t36 = t10*t31 - t16*t28
     t37 = t12*t30 + t18*t27
     t38 = 0.126*t26
-    t39 = t38 + 0.4*t22
+    t39 = 0.4*t22 + t38
     t40 = t39 + 0.42*c2
     t41 = -t32*c2 + t40*t14
     t42 = -t39*t3 + t31*t23
     t43 = t16*t39 - t22*t31
-    t44 = t18*t38 - t25*t30
+    t44 = -t25*t30 + t18*t38
     t45 = t29*c2 - t40*t8
     t46 = t39*t6 + t28*t23
     t47 = t22*t28 - t10*t39
     t48 = t12*t38 + t25*t27
-    t49 = -t25*t3 + t18*t23
-    t50 = t6*c1
-    t51 = -(s1*t49 + t25*t50 - t12*c1*s2*s3)
-    t52 = -t22*t3 + t16*t23
-    t53 = t5*s2
-    t54 = -(s1*t52 + t22*t50 + t10*t53)
-    t55 = t16*t25 - t22*t18
-    t56 = -(t10*t49 + t12*t52 - t6*t55)
-    t57 = t10*c1
-    t58 = t12*c1
-    t59 = -(s1*t55 + t25*t57 + t22*t58)
-    t60 = t36*t51 + t37*t54 - t33*t56 - t35*t59
-    t61 = -t18*c2 + t25*t14
-    t62 = c1**2
-    t63 = s2*t62
-    t64 = -(s1*t61 + t58*c2 + t25*t63)
-    t65 = -t16*c2 + t22*t14
-    t66 = -(s1*t65 + t22*t63 - t10*c1*c2)
-    t67 = -(t10*t61 + t12*t65 - c1*s2*t55)
-    t68 = t36*t64 + t37*t66 - t33*t67 - t34*t59
-    t69 = s2**2
-    t70 = t3*c2 - t0*t69
-    t71 = -t70*s1 + t50*c2 + s3*t62*t69
-    t72 = -(t12*t70 + t6*t61 - c1*s2*t49)
-    t73 = t35*t64 + t37*t71 - t33*t72 - t34*t51
-    t74 = t10*t70 - t6*t65 + t52*t8
-    t75 = -(t33*t74 + t34*t54 + t36*t71 - t35*t66)
-    t76 = t34*t56 + t36*t72 + t37*t74 - t35*t67
-    t77 = t10*t18 + t16*t12
-    t78 = t58 - t18*s1
-    t79 = -(t57 + t16*s1)
-    t80 = t33*t77 + t36*t78 + t37*t79
-    t81 = t16*t8 - t10*t14
-    t82 = -(t63 + s2*s1**2)
-    t83 = t33*t81 + t34*t79 - t36*t82
-    t84 = t12*t14 + t18*t8
-    t85 = t33*t84 + t34*t78 + t37*t82
-    t86 = t36*t84 + t37*t81 - t34*t77
-    t87 = t40*s1
+    t49 = -t16*c2 + t22*t14
+    t50 = t10*c1
+    t51 = c1**2
+    t52 = s2*t51
+    t53 = -(s1*t49 - c2*t50 + t22*t52)
+    t54 = s2**2
+    t55 = t3*c2 - t54*t0
+    t56 = -t22*t3 + t16*t23
+    t57 = t10*t55 - t6*t49 + t56*t8
+    t58 = t6*c1
+    t59 = s2*t5
+    t60 = -(s1*t56 + t22*t58 + t10*t59)
+    t61 = -s1*t55 + c2*t58 + s3*t51*t54
+    t62 = -(-t35*t53 + t33*t57 + t34*t60 + t36*t61)
+    t63 = -t25*t3 + t18*t23
+    t64 = -(s1*t63 + t25*t58 - t12*t59)
+    t65 = t16*t25 - t22*t18
+    t66 = -(-t6*t65 + t10*t63 + t12*t56)
+    t67 = t12*c1
+    t68 = -(s1*t65 + t25*t50 + t22*t67)
+    t69 = t36*t64 + t37*t60 - t33*t66 - t35*t68
+    t70 = -t18*c2 + t25*t14
+    t71 = -(s1*t70 + c2*t67 + t25*t52)
+    t72 = -(t10*t70 + t12*t49 - t65*t8)
+    t73 = t36*t71 + t37*t53 - t33*t72 - t34*t68
+    t74 = -(t12*t55 + t6*t70 - t63*t8)
+    t75 = t35*t71 + t37*t61 - t33*t74 - t34*t64
+    t76 = t34*t66 + t36*t74 + t37*t57 - t35*t72
+    t77 = s1*t40
+    t78 = t10*t18 + t16*t12
+    t79 = t67 - t18*s1
+    t80 = -(t50 + t16*s1)
+    t81 = t33*t78 + t36*t79 + t37*t80
+    t82 = t16*t8 - t10*t14
+    t83 = -(t52 + s2*s1**2)
+    t84 = t33*t82 + t34*t80 - t36*t83
+    t85 = t12*t14 + t18*t8
+    t86 = t33*t85 + t34*t79 + t37*t83
+    t87 = t36*t85 + t37*t82 - t34*t78
     t88 = t10*t3 + t16*t6
-    t89 = t3*s1 - t50
-    t90 = t33*t88 + t35*t79 - t36*t89
+    t89 = t3*s1 - t58
+    t90 = t33*t88 + t35*t80 - t36*t89
     t91 = -(t6*t14 + t3*t8)
-    t92 = t33*t91 + t34*t89 - t35*t82
-    t93 = -(t34*t88 + t36*t91 - t35*t81)
+    t92 = t33*t91 + t34*t89 - t35*t83
+    t93 = -(-t35*t82 + t34*t88 + t36*t91)
     t94 = t18*t6 - t12*t3
-    t95 = t33*t94 + t35*t78 + t37*t89
-    t96 = t36*t94 + t37*t88 - t35*t77
-    t97 = t35*t84 + t37*t91 - t34*t94
-    t98 = t40*c1
-    t99 = -t32*(t45*t60 + t46*t68 + t47*t73 - t48*t75 - t40*s1*t76) + t42*(t29*t68 + t45*t80 + t48*t83 - t47*t85 - t86*t87) + t44*(t29*t75 + t45*t90 + t46*t83 + t47*t92 - t87*t93) + t41*(t46*t80 + t47*t95 - t29*t60 - t48*t90 + t87*t96) - t43*(t29*t73 + t45*t95 + t46*t85 + t48*t92 - t87*t97) - t98*(t45*t96 + t46*t86 + t47*t97 - t29*t76 - t48*t93)
-    t100 = t16*t26 - t22*t19
-    t101 = -t26*t3 + t19*t23
-    t102 = t13*t52 + t6*t100 - t10*t101
-    t103 = -(s1*t100 + t26*t57 - t22*t13*c1)
-    t104 = -(s1*t101 + t26*t50 + t13*t53)
-    t105 = -(t33*t102 + t35*t103 - t36*t104)
-    t106 = -t19*c2 + t26*t14
-    t107 = t13*t65 - t10*t106 + t8*t100
-    t108 = -(s1*t106 + t26*t63 - t13*c1*c2)
-    t109 = -(t33*t107 + t34*t103 - t36*t108)
-    t110 = t13*t70 - t6*t106 + t8*t101
-    t111 = -(t33*t110 + t34*t104 - t35*t108)
-    t112 = t34*t102 + t36*t110 - t35*t107
-    t113 = -(t45*t105 + t46*t109 + t47*t111 - t40*s1*t112)
-    t114 = t10*t19 - t16*t13
-    t115 = t13*c1
-    t116 = -(t115 + t19*s1)
-    t117 = t33*t114 + t36*t116
+    t95 = t33*t94 + t35*t79 + t37*t89
+    t96 = t36*t94 + t37*t88 - t35*t78
+    t97 = t35*t85 + t37*t91 - t34*t94
+    t98 = c1*t40
+    t99 = -t32*(-t48*t62 + t45*t69 + t46*t73 + t47*t75 - t76*t77) + t42*(t29*t73 + t45*t81 + t48*t84 - t47*t86 - t87*t77) + t44*(t29*t62 + t45*t90 + t46*t84 + t47*t92 - t93*t77) + t41*(-t29*t69 - t48*t90 + t46*t81 + t47*t95 + t96*t77) - t43*(t29*t75 + t45*t95 + t46*t86 + t48*t92 - t97*t77) - (-t29*t76 - t48*t93 + t45*t96 + t46*t87 + t47*t97)*t98
+    t100 = -t26*t3 + t19*t23
+    t101 = -(s1*t100 + t26*t58 + t13*t59)
+    t102 = t16*t26 - t22*t19
+    t103 = t13*t56 + t6*t102 - t10*t100
+    t104 = t13*c1
+    t105 = -(s1*t102 - t22*t104 + t26*t50)
+    t106 = -(-t36*t101 + t33*t103 + t35*t105)
+    t107 = -t19*c2 + t26*t14
+    t108 = -(s1*t107 - c2*t104 + t26*t52)
+    t109 = t13*t49 - t10*t107 + t102*t8
+    t110 = -(-t36*t108 + t33*t109 + t34*t105)
+    t111 = t13*t55 - t6*t107 + t100*t8
+    t112 = -(-t35*t108 + t33*t111 + t34*t101)
+    t113 = t34*t103 + t36*t111 - t35*t109
+    t114 = -(t45*t106 + t46*t110 + t47*t112 - t113*t77)
+    t115 = t10*t19 - t16*t13
+    t116 = -(t104 + t19*s1)
+    t117 = t33*t115 + t36*t116
     t118 = t19*t8 - t13*t14
     t119 = t33*t118 + t34*t116
-    t120 = t36*t118 - t34*t114
-    t121 = t29*t109 + t45*t117 - t47*t119 - t87*t120
+    t120 = t36*t118 - t34*t115
+    t121 = t29*t110 + t45*t117 - t47*t119 - t120*t77
     t122 = t13*t3 + t19*t6
     t123 = t33*t122 + t35*t116
-    t124 = t36*t122 - t35*t114
-    t125 = -(t46*t117 + t47*t123 - t29*t105 + t87*t124)
+    t124 = t36*t122 - t35*t115
+    t125 = -(-t29*t106 + t46*t117 + t47*t123 + t124*t77)
     t126 = t35*t118 - t34*t122
-    t127 = t29*t111 + t45*t123 + t46*t119 - t87*t126
-    t128 = -(t45*t124 + t46*t120 + t47*t126 - t29*t112)
-    t129 = t32*t113 + t42*t121 - t41*t125 - t43*t127 + t98*t128
+    t127 = t29*t112 + t45*t123 + t46*t119 - t126*t77
+    t128 = -(-t29*t113 + t45*t124 + t46*t120 + t47*t126)
+    t129 = t32*t114 + t42*t121 - t41*t125 - t43*t127 + t128*t98
     t130 = t18*t26 - t25*t19
-    t131 = t12*t101 + t13*t49 + t6*t130
-    t132 = -t130*s1 + t26*t58 + t25*t115
-    t133 = -(t33*t131 + t35*t132 + t37*t104)
-    t134 = t12*t106 + t13*t61 + t8*t130
+    t131 = t12*t100 + t13*t63 + t6*t130
+    t132 = -s1*t130 + t26*t67 + t25*t104
+    t133 = -(t33*t131 + t35*t132 + t37*t101)
+    t134 = t12*t107 + t13*t70 + t130*t8
     t135 = -(t33*t134 + t34*t132 + t37*t108)
-    t136 = -(t35*t134 + t37*t110 - t34*t131)
-    t137 = -(t45*t133 + t46*t135 + t48*t111 - t40*s1*t136)
+    t136 = -(-t34*t131 + t35*t134 + t37*t111)
+    t137 = -(t45*t133 + t46*t135 + t48*t112 - t136*t77)
     t138 = -(t12*t19 + t18*t13)
     t139 = t33*t138 - t37*t116
     t140 = -(t34*t138 + t37*t118)
-    t141 = t29*t135 + t45*t139 - t48*t119 - t140*t87
+    t141 = t29*t135 + t45*t139 - t48*t119 - t140*t77
     t142 = -(t35*t138 + t37*t122)
-    t143 = -(t46*t139 + t48*t123 - t29*t133 + t142*t87)
-    t144 = -(t45*t142 + t46*t140 + t48*t126 - t29*t136)
+    t143 = -(-t29*t133 + t46*t139 + t48*t123 + t142*t77)
+    t144 = -(-t29*t136 + t45*t142 + t46*t140 + t48*t126)
     t145 = t32*t137 + t42*t141 - t41*t143 - t44*t127 + t144*t98
-    t146 = t10*t130 + t12*t100 + t13*t55
-    t147 = -(t33*t146 + t36*t132 + t37*t103)
-    t148 = -(t36*t134 + t37*t107 - t34*t146)
-    t149 = t47*t135 - t45*t147 - t48*t109 + t148*t87
-    t150 = -(t36*t138 + t37*t114)
-    t151 = t29*t147 + t47*t139 - t48*t117 - t150*t87
+    t146 = t10*t130 + t12*t102 + t13*t65
+    t147 = -(t33*t146 + t36*t132 + t37*t105)
+    t148 = -(-t34*t146 + t36*t134 + t37*t109)
+    t149 = t47*t135 - t45*t147 - t48*t110 + t148*t77
+    t150 = -(t36*t138 + t37*t115)
+    t151 = t29*t147 + t47*t139 - t48*t117 - t150*t77
     t152 = t29*t148 + t47*t140 - t45*t150 - t48*t120
     t153 = t32*t149 + t43*t141 - t41*t151 - t44*t121 + t152*t98
-    t154 = -(t36*t131 + t37*t102 - t35*t146)
-    t155 = t46*t147 + t47*t133 - t48*t105 + t154*t87
+    t154 = -(-t35*t146 + t36*t131 + t37*t103)
+    t155 = t46*t147 + t47*t133 - t48*t106 + t154*t77
     t156 = t29*t154 + t46*t150 + t47*t142 - t48*t124
     t157 = t32*t155 + t43*t143 - t42*t151 - t44*t125 + t156*t98
-    t158 = t45*t154 + t46*t148 + t47*t136 - t48*t112
+    t158 = t45*t154 + t46*t148 + t47*t136 - t48*t113
     t159 = t32*t158 + t41*t156 + t43*t144 - t42*t152 - t44*t128
-    t160 = t42*t149 + t44*t113 - t41*t155 - t43*t137 + t158*t98
+    t160 = t42*t149 + t44*t114 - t41*t155 - t43*t137 + t158*t98
     f = _stack(xp, [
         s4,  # 0
         t99**2 + t129**2 + t145**2 + t153**2 + t157**2 + t159**2 + t160**2,  # 1
@@ -2043,7 +2043,7 @@ def singularity_factors(q):
 
 
 def manipulability(q):
-    """manipulability sqrt(det(Js Js^T)): (1 x 1), 710 operations."""
+    """manipulability sqrt(det(Js Js^T)): (1 x 1), 700 operations."""
     xp, dtype, device, batch, (q,) = _arguments(("q", q, (7,)))
     trig = _cos_sin(xp, q, (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0), device)
     c1 = trig[..., 0]
@@ -2060,36 +2060,36 @@ def manipulability(q):
     s6 = trig[..., 11]
     t0 = s1*s3
     t1 = c1*c3
-    t2 = -t0 + t1*c2
-    t3 = t1 - t0*c2
+    t2 = -t0 + c2*t1
+    t3 = t1 - c2*t0
     t4 = c3*s1
     t5 = c1*s3
-    t6 = t4 + t5*c2
-    t7 = t5 + t4*c2
+    t6 = t4 + c2*t5
+    t7 = t5 + c2*t4
     t8 = c1*s2
-    t9 = t2*c4 + t8*s4
-    t10 = -t2*s4 + t8*c4
+    t9 = t2*c4 + s4*t8
+    t10 = -t2*s4 + c4*t8
     t11 = t9*c5 - t6*s5
     t12 = t9*s5 + t6*c5
     t13 = t10*c6 + t11*s6
     t14 = s1*s2
-    t15 = t7*c4 + t14*s4
-    t16 = -t7*s4 + t14*c4
+    t15 = t7*c4 + s4*t14
+    t16 = -t7*s4 + c4*t14
     t17 = t15*c5 + t3*s5
     t18 = t3*c5 - t15*s5
     t19 = t16*c6 + t17*s6
     t20 = c3*s2
-    t21 = c2*s4 - t20*c4
-    t22 = c2*c4 + t20*s4
-    t23 = s2*s3
-    t24 = t21*c5 + t23*s5
-    t25 = -t21*s5 + t23*c5
+    t21 = c2*s4 - c4*t20
+    t22 = c2*c4 + s4*t20
+    t23 = s3*s2
+    t24 = t21*c5 + s5*t23
+    t25 = -t21*s5 + c5*t23
     t26 = t22*c6 + t24*s6
     t27 = 0.126*t13
-    t28 = t27 + 0.4*t10
+    t28 = 0.4*t10 + t27
     t29 = t28 + 0.42*t8
     t30 = 0.126*t19
-    t31 = t30 + 0.4*t16
+    t31 = 0.4*t16 + t30
     t32 = t31 + 0.42*t14
     t33 = t29*c1 + t32*s1
     t34 = t32*t8 - t29*t14
@@ -2097,128 +2097,128 @@ def manipulability(q):
     t36 = t10*t31 - t16*t28
     t37 = t12*t30 + t18*t27
     t38 = 0.126*t26
-    t39 = t38 + 0.4*t22
+    t39 = 0.4*t22 + t38
     t40 = t39 + 0.42*c2
     t41 = -t32*c2 + t40*t14
     t42 = -t39*t3 + t31*t23
     t43 = t16*t39 - t22*t31
-    t44 = t18*t38 - t25*t30
+    t44 = -t25*t30 + t18*t38
     t45 = t29*c2 - t40*t8
     t46 = t39*t6 + t28*t23
     t47 = t22*t28 - t10*t39
     t48 = t12*t38 + t25*t27
-    t49 = -t25*t3 + t18*t23
-    t50 = t6*c1
-    t51 = -(s1*t49 + t25*t50 - t12*c1*s2*s3)
-    t52 = -t22*t3 + t16*t23
-    t53 = t5*s2
-    t54 = -(s1*t52 + t22*t50 + t10*t53)
-    t55 = t16*t25 - t22*t18
-    t56 = -(t10*t49 + t12*t52 - t6*t55)
-    t57 = t10*c1
-    t58 = t12*c1
-    t59 = -(s1*t55 + t25*t57 + t22*t58)
-    t60 = t36*t51 + t37*t54 - t33*t56 - t35*t59
-    t61 = -t18*c2 + t25*t14
-    t62 = c1**2
-    t63 = s2*t62
-    t64 = -(s1*t61 + t58*c2 + t25*t63)
-    t65 = -t16*c2 + t22*t14
-    t66 = -(s1*t65 + t22*t63 - t10*c1*c2)
-    t67 = -(t10*t61 + t12*t65 - c1*s2*t55)
-    t68 = t36*t64 + t37*t66 - t33*t67 - t34*t59
-    t69 = s2**2
-    t70 = t3*c2 - t0*t69
-    t71 = -t70*s1 + t50*c2 + s3*t62*t69
-    t72 = -(t12*t70 + t6*t61 - c1*s2*t49)
-    t73 = t35*t64 + t37*t71 - t33*t72 - t34*t51
-    t74 = t10*t70 - t6*t65 + t52*t8
-    t75 = -(t33*t74 + t34*t54 + t36*t71 - t35*t66)
-    t76 = t34*t56 + t36*t72 + t37*t74 - t35*t67
-    t77 = t10*t18 + t16*t12
-    t78 = t58 - t18*s1
-    t79 = -(t57 + t16*s1)
-    t80 = t33*t77 + t36*t78 + t37*t79
-    t81 = t16*t8 - t10*t14
-    t82 = -(t63 + s2*s1**2)
-    t83 = t33*t81 + t34*t79 - t36*t82
-    t84 = t12*t14 + t18*t8
-    t85 = t33*t84 + t34*t78 + t37*t82
-    t86 = t36*t84 + t37*t81 - t34*t77
-    t87 = t40*s1
+    t49 = -t16*c2 + t22*t14
+    t50 = t10*c1
+    t51 = c1**2
+    t52 = s2*t51
+    t53 = -(s1*t49 - c2*t50 + t22*t52)
+    t54 = s2**2
+    t55 = t3*c2 - t54*t0
+    t56 = -t22*t3 + t16*t23
+    t57 = t10*t55 - t6*t49 + t56*t8
+    t58 = t6*c1
+    t59 = s2*t5
+    t60 = -(s1*t56 + t22*t58 + t10*t59)
+    t61 = -s1*t55 + c2*t58 + s3*t51*t54
+    t62 = -(-t35*t53 + t33*t57 + t34*t60 + t36*t61)
+    t63 = -t25*t3 + t18*t23
+    t64 = -(s1*t63 + t25*t58 - t12*t59)
+    t65 = t16*t25 - t22*t18
+    t66 = -(-t6*t65 + t10*t63 + t12*t56)
+    t67 = t12*c1
+    t68 = -(s1*t65 + t25*t50 + t22*t67)
+    t69 = t36*t64 + t37*t60 - t33*t66 - t35*t68
+    t70 = -t18*c2 + t25*t14
+    t71 = -(s1*t70 + c2*t67 + t25*t52)
+    t72 = -(t10*t70 + t12*t49 - t65*t8)
+    t73 = t36*t71 + t37*t53 - t33*t72 - t34*t68
+    t74 = -(t12*t55 + t6*t70 - t63*t8)
+    t75 = t35*t71 + t37*t61 - t33*t74 - t34*t64
+    t76 = t34*t66 + t36*t74 + t37*t57 - t35*t72
+    t77 = s1*t40
+    t78 = t10*t18 + t16*t12
+    t79 = t67 - t18*s1
+    t80 = -(t50 + t16*s1)
+    t81 = t33*t78 + t36*t79 + t37*t80
+    t82 = t16*t8 - t10*t14
+    t83 = -(t52 + s2*s1**2)
+    t84 = t33*t82 + t34*t80 - t36*t83
+    t85 = t12*t14 + t18*t8
+    t86 = t33*t85 + t34*t79 + t37*t83
+    t87 = t36*t85 + t37*t82 - t34*t78
     t88 = t10*t3 + t16*t6
-    t89 = t3*s1 - t50
-    t90 = t33*t88 + t35*t79 - t36*t89
+    t89 = t3*s1 - t58
+    t90 = t33*t88 + t35*t80 - t36*t89
     t91 = -(t6*t14 + t3*t8)
-    t92 = t33*t91 + t34*t89 - t35*t82
-    t93 = -(t34*t88 + t36*t91 - t35*t81)
+    t92 = t33*t91 + t34*t89 - t35*t83
+    t93 = -(-t35*t82 + t34*t88 + t36*t91)
     t94 = t18*t6 - t12*t3
-    t95 = t33*t94 + t35*t78 + t37*t89
-    t96 = t36*t94 + t37*t88 - t35*t77
-    t97 = t35*t84 + t37*t91 - t34*t94
-    t98 = t40*c1
-    t99 = -t32*(t45*t60 + t46*t68 + t47*t73 - t48*t75 - t40*s1*t76) + t42*(t29*t68 + t45*t80 + t48*t83 - t47*t85 - t86*t87) + t44*(t29*t75 + t45*t90 + t46*t83 + t47*t92 - t87*t93) + t41*(t46*t80 + t47*t95 - t29*t60 - t48*t90 + t87*t96) - t43*(t29*t73 + t45*t95 + t46*t85 + t48*t92 - t87*t97) - t98*(t45*t96 + t46*t86 + t47*t97 - t29*t76 - t48*t93)
-    t100 = t16*t26 - t22*t19
-    t101 = -t26*t3 + t19*t23
-    t102 = t13*t52 + t6*t100 - t10*t101
-    t103 = -(s1*t100 + t26*t57 - t22*t13*c1)
-    t104 = -(s1*t101 + t26*t50 + t13*t53)
-    t105 = -(t33*t102 + t35*t103 - t36*t104)
-    t106 = -t19*c2 + t26*t14
-    t107 = t13*t65 - t10*t106 + t8*t100
-    t108 = -(s1*t106 + t26*t63 - t13*c1*c2)
-    t109 = -(t33*t107 + t34*t103 - t36*t108)
-    t110 = t13*t70 - t6*t106 + t8*t101
-    t111 = -(t33*t110 + t34*t104 - t35*t108)
-    t112 = t34*t102 + t36*t110 - t35*t107
-    t113 = -(t45*t105 + t46*t109 + t47*t111 - t40*s1*t112)
-    t114 = t10*t19 - t16*t13
-    t115 = t13*c1
-    t116 = -(t115 + t19*s1)
-    t117 = t33*t114 + t36*t116
+    t95 = t33*t94 + t35*t79 + t37*t89
+    t96 = t36*t94 + t37*t88 - t35*t78
+    t97 = t35*t85 + t37*t91 - t34*t94
+    t98 = c1*t40
+    t99 = -t32*(-t48*t62 + t45*t69 + t46*t73 + t47*t75 - t76*t77) + t42*(t29*t73 + t45*t81 + t48*t84 - t47*t86 - t87*t77) + t44*(t29*t62 + t45*t90 + t46*t84 + t47*t92 - t93*t77) + t41*(-t29*t69 - t48*t90 + t46*t81 + t47*t95 + t96*t77) - t43*(t29*t75 + t45*t95 + t46*t86 + t48*t92 - t97*t77) - (-t29*t76 - t48*t93 + t45*t96 + t46*t87 + t47*t97)*t98
+    t100 = -t26*t3 + t19*t23
+    t101 = -(s1*t100 + t26*t58 + t13*t59)
+    t102 = t16*t26 - t22*t19
+    t103 = t13*t56 + t6*t102 - t10*t100
+    t104 = t13*c1
+    t105 = -(s1*t102 - t22*t104 + t26*t50)
+    t106 = -(-t36*t101 + t33*t103 + t35*t105)
+    t107 = -t19*c2 + t26*t14
+    t108 = -(s1*t107 - c2*t104 + t26*t52)
+    t109 = t13*t49 - t10*t107 + t102*t8
+    t110 = -(-t36*t108 + t33*t109 + t34*t105)
+    t111 = t13*t55 - t6*t107 + t100*t8
+    t112 = -(-t35*t108 + t33*t111 + t34*t101)
+    t113 = t34*t103 + t36*t111 - t35*t109
+    t114 = -(t45*t106 + t46*t110 + t47*t112 - t113*t77)
+    t115 = t10*t19 - t16*t13
+    t116 = -(t104 + t19*s1)
+    t117 = t33*t115 + t36*t116
     t118 = t19*t8 - t13*t14
     t119 = t33*t118 + t34*t116
-    t120 = t36*t118 - t34*t114
-    t121 = t29*t109 + t45*t117 - t47*t119 - t87*t120
+    t120 = t36*t118 - t34*t115
+    t121 = t29*t110 + t45*t117 - t47*t119 - t120*t77
     t122 = t13*t3 + t19*t6
     t123 = t33*t122 + t35*t116
-    t124 = t36*t122 - t35*t114
-    t125 = -(t46*t117 + t47*t123 - t29*t105 + t87*t124)
+    t124 = t36*t122 - t35*t115
+    t125 = -(-t29*t106 + t46*t117 + t47*t123 + t124*t77)
     t126 = t35*t118 - t34*t122
-    t127 = t29*t111 + t45*t123 + t46*t119 - t87*t126
-    t128 = -(t45*t124 + t46*t120 + t47*t126 - t29*t112)
-    t129 = t32*t113 + t42*t121 - t41*t125 - t43*t127 + t98*t128
+    t127 = t29*t112 + t45*t123 + t46*t119 - t126*t77
+    t128 = -(-t29*t113 + t45*t124 + t46*t120 + t47*t126)
+    t129 = t32*t114 + t42*t121 - t41*t125 - t43*t127 + t128*t98
     t130 = t18*t26 - t25*t19
-    t131 = t12*t101 + t13*t49 + t6*t130
-    t132 = -t130*s1 + t26*t58 + t25*t115
-    t133 = -(t33*t131 + t35*t132 + t37*t104)
-    t134 = t12*t106 + t13*t61 + t8*t130
+    t131 = t12*t100 + t13*t63 + t6*t130
+    t132 = -s1*t130 + t26*t67 + t25*t104
+    t133 = -(t33*t131 + t35*t132 + t37*t101)
+    t134 = t12*t107 + t13*t70 + t130*t8
     t135 = -(t33*t134 + t34*t132 + t37*t108)
-    t136 = -(t35*t134 + t37*t110 - t34*t131)
-    t137 = -(t45*t133 + t46*t135 + t48*t111 - t40*s1*t136)
+    t136 = -(-t34*t131 + t35*t134 + t37*t111)
+    t137 = -(t45*t133 + t46*t135 + t48*t112 - t136*t77)
     t138 = -(t12*t19 + t18*t13)
     t139 = t33*t138 - t37*t116
     t140 = -(t34*t138 + t37*t118)
-    t141 = t29*t135 + t45*t139 - t48*t119 - t140*t87
+    t141 = t29*t135 + t45*t139 - t48*t119 - t140*t77
     t142 = -(t35*t138 + t37*t122)
-    t143 = -(t46*t139 + t48*t123 - t29*t133 + t142*t87)
-    t144 = -(t45*t142 + t46*t140 + t48*t126 - t29*t136)
+    t143 = -(-t29*t133 + t46*t139 + t48*t123 + t142*t77)
+    t144 = -(-t29*t136 + t45*t142 + t46*t140 + t48*t126)
     t145 = t32*t137 + t42*t141 - t41*t143 - t44*t127 + t144*t98
-    t146 = t10*t130 + t12*t100 + t13*t55
-    t147 = -(t33*t146 + t36*t132 + t37*t103)
-    t148 = -(t36*t134 + t37*t107 - t34*t146)
-    t149 = t47*t135 - t45*t147 - t48*t109 + t148*t87
-    t150 = -(t36*t138 + t37*t114)
-    t151 = t29*t147 + t47*t139 - t48*t117 - t150*t87
+    t146 = t10*t130 + t12*t102 + t13*t65
+    t147 = -(t33*t146 + t36*t132 + t37*t105)
+    t148 = -(-t34*t146 + t36*t134 + t37*t109)
+    t149 = t47*t135 - t45*t147 - t48*t110 + t148*t77
+    t150 = -(t36*t138 + t37*t115)
+    t151 = t29*t147 + t47*t139 - t48*t117 - t150*t77
     t152 = t29*t148 + t47*t140 - t45*t150 - t48*t120
     t153 = t32*t149 + t43*t141 - t41*t151 - t44*t121 + t152*t98
-    t154 = -(t36*t131 + t37*t102 - t35*t146)
-    t155 = t46*t147 + t47*t133 - t48*t105 + t154*t87
+    t154 = -(-t35*t146 + t36*t131 + t37*t103)
+    t155 = t46*t147 + t47*t133 - t48*t106 + t154*t77
     t156 = t29*t154 + t46*t150 + t47*t142 - t48*t124
     t157 = t32*t155 + t43*t143 - t42*t151 - t44*t125 + t156*t98
-    t158 = t45*t154 + t46*t148 + t47*t136 - t48*t112
+    t158 = t45*t154 + t46*t148 + t47*t136 - t48*t113
     t159 = t32*t158 + t41*t156 + t43*t144 - t42*t152 - t44*t128
-    t160 = t42*t149 + t44*t113 - t41*t155 - t43*t137 + t158*t98
+    t160 = t42*t149 + t44*t114 - t41*t155 - t43*t137 + t158*t98
     t161 = t99**2 + t129**2 + t145**2 + t153**2 + t157**2 + t159**2 + t160**2
     w = xp.broadcast_to(xp.sqrt(xp.abs(t161)), batch)
     return w
@@ -2256,38 +2256,38 @@ def velocity_ik(q, mu_dot, damping=0.0):
     s6 = trig[..., 11]
     t0 = s1*s3
     t1 = c1*c3
-    t2 = -t0 + t1*c2
-    t3 = t1 - t0*c2
+    t2 = -t0 + c2*t1
+    t3 = t1 - c2*t0
     t4 = c3*s1
     t5 = c1*s3
-    t6 = t4 + t5*c2
-    t7 = t5 + t4*c2
+    t6 = t4 + c2*t5
+    t7 = t5 + c2*t4
     t8 = c1*s2
-    t9 = t2*c4 + t8*s4
-    t10 = -t2*s4 + t8*c4
+    t9 = t2*c4 + s4*t8
+    t10 = -t2*s4 + c4*t8
     t11 = t9*c5 - t6*s5
     t12 = t9*s5 + t6*c5
     t13 = t10*c6 + t11*s6
     t14 = s1*s2
-    t15 = t7*c4 + t14*s4
-    t16 = -t7*s4 + t14*c4
+    t15 = t7*c4 + s4*t14
+    t16 = -t7*s4 + c4*t14
     t17 = t15*c5 + t3*s5
     t18 = t3*c5 - t15*s5
     t19 = t16*c6 + t17*s6
     t20 = c3*s2
-    t21 = c2*s4 - t20*c4
-    t22 = c2*c4 + t20*s4
+    t21 = c2*s4 - c4*t20
+    t22 = c2*c4 + s4*t20
     t23 = s2*s3
-    t24 = t21*c5 + t23*s5
-    t25 = -t21*s5 + t23*c5
+    t24 = t21*c5 + s5*t23
+    t25 = -t21*s5 + c5*t23
     t26 = t22*c6 + t24*s6
-    t27 = t10*t22 + t13*t26 - t12*t25 + t8*c2 - t6*t23
-    t28 = t16*t22 + t18*t25 + t19*t26 + t3*t23 + t14*c2
+    t27 = t10*t22 + t13*t26 - t12*t25 + c2*t8 - t6*t23
+    t28 = t16*t22 + t18*t25 + t19*t26 + t3*t23 + c2*t14
     t29 = 0.126*t13
-    t30 = t29 + 0.4*t10
+    t30 = 0.4*t10 + t29
     t31 = t30 + 0.42*t8
     t32 = 0.126*t19
-    t33 = t32 + 0.4*t16
+    t33 = 0.4*t16 + t32
     t34 = t33 + 0.42*t14
     t35 = t31*c1 + t34*s1
     t36 = t34*t8 - t31*t14
@@ -2297,18 +2297,18 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t40 = t35**2 + t36**2 + t37**2 + t38**2 + t39**2
     t41 = t22*t38 + t36*c2 - t25*t39 - t37*t23
     t42 = 0.126*t26
-    t43 = t42 + 0.4*t22
+    t43 = 0.4*t22 + t42
     t44 = t43 + 0.42*c2
     t45 = -t43*t3 + t33*t23
     t46 = t16*t43 - t22*t33
-    t47 = t18*t42 - t25*t32
+    t47 = -t25*t32 + t18*t42
     t48 = t43*t6 + t30*t23
     t49 = t22*t30 - t10*t43
     t50 = t12*t42 + t25*t29
     t51 = t44*s1
-    t52 = -t34*c2 + t51*s2
+    t52 = -t34*c2 + s2*t51
     t53 = t44*c1
-    t54 = t31*c2 - t53*s2
+    t54 = t31*c2 - s2*t53
     t55 = t31 + t22*t49 + t25*t50 + t54*c2 + t48*t23
     t56 = t44**2
     t57 = c1**2
@@ -2333,7 +2333,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t76 = t10*t38 + t12*t39 + t74 + t37*t6 + t36*t8
     t77 = s2**2
     t78 = t10**2 + t12**2 + t13**2 + t6**2 + t71 + t57*t77
-    t79 = t10*t16 + t13*t19 - t12*t18 - t6*t3 - t60 + t60*t77
+    t79 = t10*t16 + t13*t19 - t12*t18 - t6*t3 - t60 + t77*t60
     t80 = t16**2 + t18**2 + t19**2 + t3**2 + t57 + t71*t77
     t81 = 1 + t22**2 + t25**2 + t26**2 + c2**2 + t77*s3**2
     t82 = damping**2
@@ -2356,7 +2356,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t99 = xp.where(xp.greater(t96, 0), 1/(t96*(t96 + xp.abs(t83))), 0)
     t100 = t99*(t61*t98 + t61*t85 + t63*t55 + t59*t70 - t66*t75 - t69*t73)
     t101 = t61 - t98*t100
-    t102 = t85 - t61*t100
+    t102 = -t61*t100 + t85
     t103 = t75 + t66*t100
     t104 = t73 + t69*t100
     t105 = t70 - t59*t100
@@ -2364,7 +2364,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t107 = t99*(t63*t41 + t66*t98 + t66*t86 + t69*t76 - t61*t75 - t59*t67)
     t108 = t66 - t98*t107
     t109 = t75 + t61*t107
-    t110 = t86 - t66*t107
+    t110 = -t66*t107 + t86
     t111 = t76 - t69*t107
     t112 = t67 + t59*t107
     t113 = t41 - t63*t107
@@ -2372,7 +2372,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t115 = t69 - t98*t114
     t116 = t73 + t61*t114
     t117 = t76 - t66*t114
-    t118 = t87 - t69*t114
+    t118 = -t69*t114 + t87
     t119 = t79 - t59*t114
     t120 = t27 - t63*t114
     t121 = t99*(t61*t70 + t63*t28 + t69*t79 + t59*t98 + t59*t88 - t66*t67)
@@ -2380,7 +2380,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t123 = t70 - t61*t121
     t124 = t67 + t66*t121
     t125 = t79 - t69*t121
-    t126 = t88 - t59*t121
+    t126 = -t59*t121 + t88
     t127 = t28 - t63*t121
     t128 = t99*(t61*t55 + t63*t98 + t63*t89 + t66*t41 + t69*t27 + t59*t28)
     t129 = t63 - t98*t128
@@ -2388,7 +2388,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t131 = t41 - t66*t128
     t132 = t27 - t69*t128
     t133 = t28 - t59*t128
-    t134 = t89 - t63*t128
+    t134 = -t63*t128 + t89
     t135 = t99*(t61*mu_dot1 + t63*mu_dot5 + t66*mu_dot2 + t69*mu_dot3 + t59*mu_dot4 + t98*mu_dot0)
     t136 = mu_dot0 - t98*t135
     t137 = mu_dot1 - t61*t135
@@ -2400,13 +2400,13 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t143 = t142*xp.where(xp.greater_equal(t102, 0), xp.asarray(1, dtype=dtype), -1)
     t144 = t102 + t143
     t145 = xp.where(xp.greater(t142, 0), 1/(t142*(t142 + xp.abs(t102))), 0)
-    t146 = -t145*(t103*t110 + t104*t111 + t105*t112 + t109*t144 - t106*t113)
+    t146 = -t145*(-t106*t113 + t103*t110 + t104*t111 + t105*t112 + t109*t144)
     t147 = t109 + t144*t146
     t148 = t110 + t103*t146
     t149 = t111 + t104*t146
     t150 = t112 + t105*t146
     t151 = t113 - t106*t146
-    t152 = -t145*(t103*t117 + t104*t118 + t116*t144 - t105*t119 - t106*t120)
+    t152 = -t145*(-t105*t119 - t106*t120 + t103*t117 + t104*t118 + t116*t144)
     t153 = t116 + t144*t152
     t154 = t117 + t103*t152
     t155 = t118 + t104*t152
@@ -2564,15 +2564,15 @@ def ik_numeric_step(target, q, damping=0.0):
     t0 = T00 + T01 + T02 + T03 + T10 + T11 + T12 + T13 + T20 + T21 + T22 + T23 + qs1 + qs2 + qs3 + qs4 + qs5 + qs6 + qs7
     t1 = s1*s3
     t2 = c1*c3
-    t3 = -t1 + t2*c2
-    t4 = t2 - t1*c2
+    t3 = -t1 + c2*t2
+    t4 = t2 - c2*t1
     t5 = c3*s1
     t6 = c1*s3
-    t7 = t5 + t6*c2
-    t8 = t6 + t5*c2
+    t7 = t5 + c2*t6
+    t8 = t6 + c2*t5
     t9 = c1*s2
-    t10 = t3*c4 + t9*s4
-    t11 = -t3*s4 + t9*c4
+    t10 = t3*c4 + s4*t9
+    t11 = -t3*s4 + c4*t9
     t12 = t10*c5 - t7*s5
     t13 = t10*s5 + t7*c5
     t14 = t12*c6 - t11*s6
@@ -2583,8 +2583,8 @@ def ik_numeric_step(target, q, damping=0.0):
     t19 = T10*t16 + T12*t15 - T11*t17
     t20 = T20*t16 + T22*t15 - T21*t17
     t21 = s1*s2
-    t22 = t8*c4 + t21*s4
-    t23 = -t8*s4 + t21*c4
+    t22 = t8*c4 + s4*t21
+    t23 = -t8*s4 + c4*t21
     t24 = t22*c5 + t4*s5
     t25 = t4*c5 - t22*s5
     t26 = t24*c6 - t23*s6
@@ -2596,17 +2596,17 @@ def ik_numeric_step(target, q, damping=0.0):
     t32 = T20*t28 + T21*t29 + T22*t27
     t33 = 0.5*(t19 - t30)
     t34 = c3*s2
-    t35 = c2*s4 - t34*c4
-    t36 = c2*c4 + t34*s4
-    t37 = s2*s3
-    t38 = t35*c5 + t37*s5
-    t39 = -t35*s5 + t37*c5
+    t35 = c2*s4 - c4*t34
+    t36 = c2*c4 + s4*t34
+    t37 = s3*s2
+    t38 = t35*c5 + s5*t37
+    t39 = -t35*s5 + c5*t37
     t40 = t38*c6 - t36*s6
     t41 = t36*c6 + t38*s6
     t42 = t39*s7 + t40*c7
     t43 = t39*c7 - t40*s7
-    t44 = t11*t36 + t15*t41 - t13*t39 + t9*c2 - t7*t37
-    t45 = t23*t36 + t25*t39 + t27*t41 + t4*t37 + t21*c2
+    t44 = t11*t36 + t15*t41 - t13*t39 + c2*t9 - t7*t37
+    t45 = t23*t36 + t25*t39 + t27*t41 + t4*t37 + c2*t21
     t46 = T00*t42 + T01*t43 + T02*t41
     t47 = T10*t42 + T11*t43 + T12*t41
     t48 = T20*t42 + T21*t43 + T22*t41
@@ -2617,11 +2617,11 @@ def ik_numeric_step(target, q, damping=0.0):
     t53 = xp.atan2(t52, t51)
     t54 = xp.where(xp.greater(t52, 0), t53/t52, 1)
     t55 = 0.126*t15
-    t56 = t55 + 0.4*t11
+    t56 = 0.4*t11 + t55
     t57 = t56 + 0.42*t9
     t58 = T03 - t57
     t59 = 0.126*t27
-    t60 = t59 + 0.4*t23
+    t60 = 0.4*t23 + t59
     t61 = t60 + 0.42*t21
     t62 = t57*c1 + t61*s1
     t63 = t61*t9 - t57*t21
@@ -2631,13 +2631,13 @@ def ik_numeric_step(target, q, damping=0.0):
     t67 = t62**2 + t63**2 + t64**2 + t65**2 + t66**2
     t68 = t36*t65 + t63*c2 - t39*t66 - t64*t37
     t69 = 0.126*t41
-    t70 = t69 + 0.4*t36
+    t70 = 0.4*t36 + t69
     t71 = t70 + 0.42*c2
     t72 = 0.36 + t71
     t73 = -t61*c2 + t71*t21
     t74 = -t70*t4 + t60*t37
     t75 = t23*t70 - t36*t60
-    t76 = t25*t69 - t39*t59
+    t76 = -t39*t59 + t25*t69
     t77 = t57*c2 - t71*t9
     t78 = t70*t7 + t56*t37
     t79 = t36*t56 - t11*t70
@@ -2667,7 +2667,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t103 = t11*t65 + t13*t66 + t101 + t64*t7 + t63*t9
     t104 = s2**2
     t105 = t11**2 + t13**2 + t15**2 + t7**2 + t98 + t84*t104
-    t106 = t11*t23 + t15*t27 - t13*t25 - t7*t4 - t87 + t87*t104
+    t106 = t11*t23 + t15*t27 - t13*t25 - t7*t4 - t87 + t104*t87
     t107 = t23**2 + t25**2 + t27**2 + t4**2 + t84 + t98*t104
     t108 = 1 + t36**2 + t39**2 + t41**2 + c2**2 + t104*s3**2
     t109 = xp.greater_equal(t18, t31) & xp.greater_equal(t18, t48)
@@ -2698,7 +2698,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t134 = t99 + damping
     t135 = t126*(t88*t125 + t88*t134 + t90*t81 + t86*t97 - t93*t102 - t96*t100)
     t136 = t88 - t125*t135
-    t137 = t134 - t88*t135
+    t137 = -t88*t135 + t134
     t138 = t102 + t93*t135
     t139 = t100 + t96*t135
     t140 = t97 - t86*t135
@@ -2717,11 +2717,11 @@ def ik_numeric_step(target, q, damping=0.0):
     t153 = t126*(t90*t68 + t93*t125 + t93*t152 + t96*t103 - t88*t102 - t86*t94)
     t154 = t93 - t125*t153
     t155 = t102 + t88*t153
-    t156 = t152 - t93*t153
+    t156 = -t93*t153 + t152
     t157 = t103 - t96*t153
     t158 = t94 + t86*t153
     t159 = t68 - t90*t153
-    t160 = -t145*(t138*t156 + t139*t157 + t140*t158 + t155*t144 - t141*t159)
+    t160 = -t145*(-t141*t159 + t138*t156 + t139*t157 + t140*t158 + t155*t144)
     t161 = t155 + t144*t160
     t162 = t156 + t138*t160
     t163 = t157 + t139*t160
@@ -2741,10 +2741,10 @@ def ik_numeric_step(target, q, damping=0.0):
     t177 = t96 - t125*t176
     t178 = t100 + t88*t176
     t179 = t103 - t93*t176
-    t180 = t175 - t96*t176
+    t180 = -t96*t176 + t175
     t181 = t106 - t86*t176
     t182 = t44 - t90*t176
-    t183 = -t145*(t138*t179 + t139*t180 + t178*t144 - t140*t181 - t141*t182)
+    t183 = -t145*(-t140*t181 - t141*t182 + t138*t179 + t139*t180 + t178*t144)
     t184 = t178 + t144*t183
     t185 = t179 + t138*t183
     t186 = t180 + t139*t183
@@ -2769,7 +2769,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t205 = t97 - t88*t203
     t206 = t94 + t93*t203
     t207 = t106 - t96*t203
-    t208 = t202 - t86*t203
+    t208 = -t86*t203 + t202
     t209 = t45 - t90*t203
     t210 = t145*(t138*t206 + t140*t208 + t141*t209 + t205*t144 - t139*t207)
     t211 = t205 - t144*t210
@@ -2800,7 +2800,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t236 = t68 - t93*t233
     t237 = t44 - t96*t233
     t238 = t45 - t86*t233
-    t239 = t232 - t90*t233
+    t239 = -t90*t233 + t232
     t240 = t145*(t140*t238 + t141*t239 + t235*t144 - t138*t236 - t139*t237)
     t241 = t235 - t144*t240
     t242 = t236 + t138*t240
@@ -2906,254 +2906,254 @@ def ik_branches(T, q_free):
     t24 = 5.9523809523809526*t19
     t25 = xp.where(t22, t24, xp.where(xp.greater(t24, 0), xp.asarray(1, dtype=dtype), -1))
     t26 = xp.atan2(t23, t25)
-    t27 = 3.141592653589793 + t26
-    t28 = 3.141592653589793 - t26
-    t29 = t27 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t27))
-    t30 = t29 - 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t29))
-    t31 = t28 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t28))
-    t32 = t31 - 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t31))
-    t33 = 1.0*t25
-    t34 = -t33
-    t35 = 0.78 + 0.4*t34
-    t36 = -0.36 + t35
-    t37 = 1.0*t23
-    t38 = -t37
-    t39 = c3**2
-    t40 = 0.16*t38**2
-    t41 = s3**2
-    t42 = t39 + t41
-    t43 = t40*t41
-    t44 = t36**2 + t39*t40 + t43
-    t45 = t17 + t43
-    t46 = t45 - t44
-    t47 = -t46
-    t48 = 1e-12*t44
-    t49 = xp.greater(t47, t48)
-    t50 = xp.where(t49, xp.sqrt(t47), 0)
-    t51 = t45 + t50**2
-    t52 = -t17
-    t53 = t9*t50
-    t54 = 0.4*t38
-    t55 = t10*s3
-    t56 = t54*t55
-    t57 = t52 + t53 + t56
-    t58 = t57 + t17
-    t59 = t17 + t53 - t56
-    t60 = t59 + t52
-    t61 = t10*t50
-    t62 = t9*s3
-    t63 = t54*t62
-    t64 = -t61 + t63
-    t65 = t58**2 + t64**2
-    t66 = t61 + t63
+    t27 = 3.141592653589793 - t26
+    t28 = 0.78 - 0.4*t25
+    t29 = -0.36 + t28
+    t30 = t27 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t27))
+    t31 = t30 - 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t30))
+    t32 = 3.141592653589793 + t26
+    t33 = t32 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t32))
+    t34 = t33 - 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t33))
+    t35 = 1.0*t25
+    t36 = -t35
+    t37 = 0.78 + 0.4*t36
+    t38 = -0.36 + t37
+    t39 = 1.0*t23
+    t40 = -t39
+    t41 = c3**2
+    t42 = 0.16*t40**2
+    t43 = s3**2
+    t44 = t41 + t43
+    t45 = t43*t42
+    t46 = t38**2 + t41*t42 + t45
+    t47 = t17 + t45
+    t48 = -t46 + t47
+    t49 = -t48
+    t50 = 1e-12*t46
+    t51 = xp.greater(t49, t50)
+    t52 = xp.where(t51, xp.sqrt(t49), 0)
+    t53 = t52**2 + t47
+    t54 = -t17
+    t55 = t9*t52
+    t56 = 0.4*t40
+    t57 = s3*t10
+    t58 = t56*t57
+    t59 = t54 + t55 + t58
+    t60 = t59 + t17
+    t61 = t17 + t55 - t58
+    t62 = t61 + t54
+    t63 = t10*t52
+    t64 = s3*t9
+    t65 = t56*t64
+    t66 = -t63 + t65
     t67 = t60**2 + t66**2
-    t68 = 1e-24*t51
-    t69 = t18*t68
-    t70 = xp.less_equal(t65, t69)
-    t71 = xp.where(t70, 1, 1/xp.sqrt(t65))
-    t72 = xp.where(t70, 1, -t58*t71)
-    t73 = xp.where(t70, 0, t64*t71)
-    t74 = T02*t72 + T12*t73
-    t75 = T12*t72 - T02*t73
-    t76 = t72*t13 + t73*t14
-    t77 = t72*t14 - t73*t13
-    t78 = xp.where(t70, 0, xp.atan2(t64, -t58))
-    t79 = t78 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t78))
-    t80 = t54*c3
-    t81 = t50*t80
-    t82 = t43 + t12*t36
-    t83 = t81 + t82
-    t84 = t82 - t81
-    t85 = -t43
-    t86 = t83 + t85
-    t87 = t84 + t85
-    t88 = t36*t50
-    t89 = t12*t80
-    t90 = -t88 + t89
-    t91 = t86**2 + t90**2
-    t92 = t88 + t89
-    t93 = t87**2 + t92**2
-    t94 = t44*t68
-    t95 = xp.less_equal(t91, t94)
-    t96 = xp.where(t95, 1, 1/xp.sqrt(t91))
-    t97 = xp.where(t95, 1, t86*t96)
-    t98 = xp.where(t95, 0, t90*t96)
-    t99 = xp.where(t95, 0, xp.atan2(t90, t86))
-    t100 = t99 - 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t99))
-    t101 = xp.less_equal(t67, t69)
-    t102 = xp.where(t101, 1, 1/xp.sqrt(t67))
-    t103 = xp.where(t101, 1, t60*t102)
-    t104 = xp.where(t101, 0, t66*t102)
-    t105 = T02*t103 + T12*t104
-    t106 = T12*t103 - T02*t104
-    t107 = t103*t13 + t104*t14
-    t108 = t103*t14 - t104*t13
-    t109 = xp.where(t101, 0, xp.atan2(t66, t60))
-    t110 = t109 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t109))
-    t111 = xp.less_equal(t93, t94)
-    t112 = xp.where(t111, 1, 1/xp.sqrt(t93))
-    t113 = xp.where(t111, 1, t87*t112)
-    t114 = xp.where(t111, 0, t92*t112)
-    t115 = xp.where(t111, 0, xp.atan2(t92, t87))
-    t116 = t115 - 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t115))
-    t117 = 1 - t72
-    t118 = T22*t117
-    t119 = t118 + T22*t72
-    t120 = t15*t117
-    t121 = t120 + t72*t15
-    t122 = t97*t74 - t98*t119
-    t123 = t97*t119 + t98*t74
-    t124 = t97*t76 - t98*t121
-    t125 = t97*t121 + t98*t76
-    t126 = 1 - t97
-    t127 = t75*t126
-    t128 = t127 + t97*t75
-    t129 = t77*t126
-    t130 = t129 + t97*t77
-    t131 = t122*c3 + t128*s3
-    t132 = t122*s3 - t128*c3
-    t133 = t34*t123 - t38*t131
-    t134 = t124*c3 + t130*s3
-    t135 = t124*s3 - t130*c3
-    t136 = t34*t125 - t38*t134
-    t137 = 1 - t34
-    t138 = t132*t137
-    t139 = t135*t137
-    t140 = t38*t123
-    t141 = t34*t122 + t138*s3 + t140*c3
-    t142 = t34*t128 - t138*c3 + t140*s3
-    t143 = t38*t125
-    t144 = t34*t124 + t139*s3 + t143*c3
-    t145 = t34*t130 - t139*c3 + t143*s3
-    t146 = t133**2
-    t147 = t141**2 + t142**2 + t146
-    t148 = -t146
-    t149 = 1 + t148
-    t150 = xp.greater(t149, 1e-12)
-    t151 = xp.where(t150, xp.sqrt(t149), 0)
-    t152 = t151*t39 + t151*t41
-    t153 = t146 + t152**2
-    t154 = t141*t151
-    t155 = t142*t151
-    t156 = t148 + t154*c3 + t155*s3
-    t157 = t156 + t146
-    t158 = t154*s3 - t155*c3
-    t159 = t157**2 + t158**2
-    t160 = t151**2
-    t161 = t146 + t160*t39 + t160*t41
-    t162 = 1e-24*t161
-    t163 = xp.less_equal(t159, t147*t162)
-    t164 = xp.where(t163, 1, 1/xp.sqrt(t159))
-    t165 = xp.where(t163, 1, -t157*t164)
-    t166 = xp.where(t163, 0, t158*t164)
-    t167 = t136*(1 - t165)
-    t168 = t144*t165 + t145*t166
-    t169 = t145*t165 - t144*t166
-    t170 = t167 + t136*t165
-    t171 = t168*c3 + t169*s3
-    t172 = t169*c3 - t168*s3
-    t173 = xp.less_equal(t153, t162)
-    t174 = xp.where(t173, 1, 1/xp.sqrt(t153))
-    t175 = xp.where(t173, 1, t133*t174)
-    t176 = xp.where(t173, 0, -t152*t174)
-    t177 = t172*(1 - t175)
-    t178 = t175*t170 + t176*t171
-    t179 = t176*t170
-    t180 = t177*s3 - t175*t168 + t179*c3
-    t181 = t175*t169 + t177*c3 - t179*s3
-    t182 = t181*s3 - t180*c3
-    t183 = t180*s3 + t181*c3
-    t184 = t182**2 + t183**2
-    t185 = t180**2 + t181**2 + t178**2
-    t186 = 1 - t103
-    t187 = T22*t186
-    t188 = t187 + T22*t103
-    t189 = t15*t186
-    t190 = t189 + t103*t15
-    t191 = t113*t105 - t114*t188
-    t192 = t113*t188 + t114*t105
-    t193 = t113*t107 - t114*t190
-    t194 = t113*t190 + t114*t107
-    t195 = 1 - t113
-    t196 = t106*t195
-    t197 = t196 + t113*t106
-    t198 = t108*t195
-    t199 = t198 + t113*t108
-    t200 = t191*c3 + t197*s3
-    t201 = t191*s3 - t197*c3
-    t202 = t201*t137
-    t203 = t34*t192 - t38*t200
-    t204 = t193*c3 + t199*s3
-    t205 = t193*s3 - t199*c3
-    t206 = t205*t137
-    t207 = t34*t194 - t38*t204
-    t208 = t38*t192
-    t209 = t34*t191 + t202*s3 + t208*c3
-    t210 = t34*t197 - t202*c3 + t208*s3
-    t211 = t38*t194
-    t212 = t34*t193 + t206*s3 + t211*c3
-    t213 = t34*t199 - t206*c3 + t211*s3
-    t214 = t203**2
-    t215 = t209**2 + t210**2 + t214
-    t216 = -t214
-    t217 = 1 + t216
-    t218 = xp.greater(t217, 1e-12)
-    t219 = xp.where(t218, xp.sqrt(t217), 0)
-    t220 = t219*t39 + t219*t41
-    t221 = t214 + t220**2
-    t222 = t209*t219
-    t223 = t210*t219
-    t224 = t216 + t222*c3 + t223*s3
-    t225 = t224 + t214
-    t226 = t222*s3 - t223*c3
-    t227 = t225**2 + t226**2
-    t228 = t219**2
-    t229 = t214 + t228*t39 + t228*t41
-    t230 = 1e-24*t229
-    t231 = xp.less_equal(t227, t215*t230)
-    t232 = xp.where(t231, 1, 1/xp.sqrt(t227))
-    t233 = xp.where(t231, 1, -t225*t232)
-    t234 = xp.where(t231, 0, t226*t232)
-    t235 = t207*(1 - t233)
-    t236 = t212*t233 + t213*t234
-    t237 = t213*t233 - t212*t234
-    t238 = t235 + t207*t233
-    t239 = t236*c3 + t237*s3
-    t240 = t237*c3 - t236*s3
-    t241 = xp.less_equal(t221, t230)
-    t242 = xp.where(t241, 1, 1/xp.sqrt(t221))
-    t243 = xp.where(t241, 1, t203*t242)
-    t244 = xp.where(t241, 0, -t220*t242)
-    t245 = t240*(1 - t243)
-    t246 = t243*t238 + t244*t239
-    t247 = t244*t238
-    t248 = t245*s3 - t243*t236 + t247*c3
-    t249 = t243*t237 + t245*c3 - t247*s3
-    t250 = t249*s3 - t248*c3
-    t251 = t248*s3 + t249*c3
-    t252 = t250**2 + t251**2
-    t253 = t248**2 + t249**2 + t246**2
-    t254 = 0.78 - 0.4*t25
-    t255 = -0.36 + t254
+    t68 = t63 + t65
+    t69 = t62**2 + t68**2
+    t70 = 1e-24*t53
+    t71 = t18*t70
+    t72 = xp.less_equal(t67, t71)
+    t73 = xp.where(t72, 1, 1/xp.sqrt(t67))
+    t74 = xp.where(t72, 1, -t60*t73)
+    t75 = xp.where(t72, 0, t66*t73)
+    t76 = T02*t74 + T12*t75
+    t77 = T12*t74 - T02*t75
+    t78 = t74*t13 + t75*t14
+    t79 = t74*t14 - t75*t13
+    t80 = xp.where(t72, 0, xp.atan2(t66, -t60))
+    t81 = t80 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t80))
+    t82 = c3*t56
+    t83 = t52*t82
+    t84 = t45 + t12*t38
+    t85 = t83 + t84
+    t86 = -t83 + t84
+    t87 = -t45
+    t88 = t85 + t87
+    t89 = t86 + t87
+    t90 = t38*t52
+    t91 = t12*t82
+    t92 = -t90 + t91
+    t93 = t88**2 + t92**2
+    t94 = t90 + t91
+    t95 = t89**2 + t94**2
+    t96 = t46*t70
+    t97 = xp.less_equal(t93, t96)
+    t98 = xp.where(t97, 1, 1/xp.sqrt(t93))
+    t99 = xp.where(t97, 1, t88*t98)
+    t100 = xp.where(t97, 0, t92*t98)
+    t101 = xp.where(t97, 0, xp.atan2(t92, t88))
+    t102 = t101 - 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t101))
+    t103 = xp.less_equal(t69, t71)
+    t104 = xp.where(t103, 1, 1/xp.sqrt(t69))
+    t105 = xp.where(t103, 1, t62*t104)
+    t106 = xp.where(t103, 0, t68*t104)
+    t107 = T02*t105 + T12*t106
+    t108 = T12*t105 - T02*t106
+    t109 = t105*t13 + t106*t14
+    t110 = t105*t14 - t106*t13
+    t111 = xp.where(t103, 0, xp.atan2(t68, t62))
+    t112 = t111 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t111))
+    t113 = xp.less_equal(t95, t96)
+    t114 = xp.where(t113, 1, 1/xp.sqrt(t95))
+    t115 = xp.where(t113, 1, t89*t114)
+    t116 = xp.where(t113, 0, t94*t114)
+    t117 = xp.where(t113, 0, xp.atan2(t94, t89))
+    t118 = t117 - 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t117))
+    t119 = 1 - t74
+    t120 = T22*t119
+    t121 = t120 + T22*t74
+    t122 = t15*t119
+    t123 = t122 + t74*t15
+    t124 = t99*t76 - t100*t121
+    t125 = t99*t121 + t100*t76
+    t126 = t99*t78 - t100*t123
+    t127 = t99*t123 + t100*t78
+    t128 = 1 - t99
+    t129 = t77*t128
+    t130 = t129 + t99*t77
+    t131 = t79*t128
+    t132 = t131 + t99*t79
+    t133 = t124*c3 + t130*s3
+    t134 = t124*s3 - t130*c3
+    t135 = t36*t125 - t40*t133
+    t136 = t126*c3 + t132*s3
+    t137 = t126*s3 - t132*c3
+    t138 = t36*t127 - t40*t136
+    t139 = 1 - t36
+    t140 = t134*t139
+    t141 = t137*t139
+    t142 = t125*t40
+    t143 = t36*t124 + t140*s3 + c3*t142
+    t144 = t36*t130 - t140*c3 + s3*t142
+    t145 = t40*t127
+    t146 = t36*t126 + t141*s3 + c3*t145
+    t147 = t36*t132 - t141*c3 + s3*t145
+    t148 = t135**2
+    t149 = t143**2 + t144**2 + t148
+    t150 = -t148
+    t151 = 1 + t150
+    t152 = xp.greater(t151, 1e-12)
+    t153 = xp.where(t152, xp.sqrt(t151), 0)
+    t154 = t153*t41 + t153*t43
+    t155 = t148 + t154**2
+    t156 = t153*t143
+    t157 = t153*t144
+    t158 = t150 + c3*t156 + s3*t157
+    t159 = t158 + t148
+    t160 = s3*t156 - c3*t157
+    t161 = t159**2 + t160**2
+    t162 = t153**2
+    t163 = t148 + t162*t41 + t162*t43
+    t164 = 1e-24*t163
+    t165 = xp.less_equal(t161, t149*t164)
+    t166 = xp.where(t165, 1, 1/xp.sqrt(t161))
+    t167 = xp.where(t165, 1, -t159*t166)
+    t168 = xp.where(t165, 0, t160*t166)
+    t169 = t138*(1 - t167)
+    t170 = t146*t167 + t147*t168
+    t171 = t147*t167 - t146*t168
+    t172 = t169 + t138*t167
+    t173 = t170*c3 + t171*s3
+    t174 = t171*c3 - t170*s3
+    t175 = xp.less_equal(t155, t164)
+    t176 = xp.where(t175, 1, 1/xp.sqrt(t155))
+    t177 = xp.where(t175, 1, t135*t176)
+    t178 = xp.where(t175, 0, -t154*t176)
+    t179 = t174*(1 - t177)
+    t180 = t177*t172 + t178*t173
+    t181 = t172*t178
+    t182 = t179*s3 - t177*t170 + c3*t181
+    t183 = t177*t171 + t179*c3 - s3*t181
+    t184 = t183*s3 - t182*c3
+    t185 = t182*s3 + t183*c3
+    t186 = t184**2 + t185**2
+    t187 = t182**2 + t183**2 + t180**2
+    t188 = 1 - t105
+    t189 = T22*t188
+    t190 = t189 + T22*t105
+    t191 = t15*t188
+    t192 = t191 + t105*t15
+    t193 = t115*t107 - t116*t190
+    t194 = t115*t190 + t116*t107
+    t195 = t115*t109 - t116*t192
+    t196 = t115*t192 + t116*t109
+    t197 = 1 - t115
+    t198 = t108*t197
+    t199 = t198 + t115*t108
+    t200 = t110*t197
+    t201 = t200 + t115*t110
+    t202 = t193*c3 + t199*s3
+    t203 = t193*s3 - t199*c3
+    t204 = t203*t139
+    t205 = t36*t194 - t40*t202
+    t206 = t195*c3 + t201*s3
+    t207 = t195*s3 - t201*c3
+    t208 = t207*t139
+    t209 = t36*t196 - t40*t206
+    t210 = t40*t194
+    t211 = t36*t193 + t204*s3 + c3*t210
+    t212 = t36*t199 - t204*c3 + s3*t210
+    t213 = t40*t196
+    t214 = t36*t195 + t208*s3 + c3*t213
+    t215 = t36*t201 - t208*c3 + s3*t213
+    t216 = t205**2
+    t217 = t211**2 + t212**2 + t216
+    t218 = -t216
+    t219 = 1 + t218
+    t220 = xp.greater(t219, 1e-12)
+    t221 = xp.where(t220, xp.sqrt(t219), 0)
+    t222 = t221*t41 + t221*t43
+    t223 = t216 + t222**2
+    t224 = t221*t211
+    t225 = t221*t212
+    t226 = t218 + c3*t224 + s3*t225
+    t227 = t226 + t216
+    t228 = s3*t224 - c3*t225
+    t229 = t227**2 + t228**2
+    t230 = t221**2
+    t231 = t216 + t230*t41 + t230*t43
+    t232 = 1e-24*t231
+    t233 = xp.less_equal(t229, t217*t232)
+    t234 = xp.where(t233, 1, 1/xp.sqrt(t229))
+    t235 = xp.where(t233, 1, -t227*t234)
+    t236 = xp.where(t233, 0, t228*t234)
+    t237 = t209*(1 - t235)
+    t238 = t214*t235 + t215*t236
+    t239 = t215*t235 - t214*t236
+    t240 = t237 + t209*t235
+    t241 = t238*c3 + t239*s3
+    t242 = t239*c3 - t238*s3
+    t243 = xp.less_equal(t223, t232)
+    t244 = xp.where(t243, 1, 1/xp.sqrt(t223))
+    t245 = xp.where(t243, 1, t205*t244)
+    t246 = xp.where(t243, 0, -t222*t244)
+    t247 = t242*(1 - t245)
+    t248 = t245*t240 + t246*t241
+    t249 = t240*t246
+    t250 = t247*s3 - t245*t238 + c3*t249
+    t251 = t245*t239 + t247*c3 - s3*t249
+    t252 = t251*s3 - t250*c3
+    t253 = t250*s3 + t251*c3
+    t254 = t252**2 + t253**2
+    t255 = t250**2 + t251**2 + t248**2
     t256 = 0.16*t23**2
-    t257 = t41*t256
-    t258 = t255**2 + t39*t256 + t257
+    t257 = t43*t256
+    t258 = t29**2 + t41*t256 + t257
     t259 = t17 + t257
-    t260 = t259 - t258
+    t260 = -t258 + t259
     t261 = -t260
     t262 = 1e-12*t258
     t263 = xp.greater(t261, t262)
     t264 = xp.where(t263, xp.sqrt(t261), 0)
-    t265 = t259 + t264**2
+    t265 = t264**2 + t259
     t266 = t9*t264
     t267 = 0.4*t23
-    t268 = t55*t267
-    t269 = t52 + t266 + t268
+    t268 = t57*t267
+    t269 = t54 + t266 + t268
     t270 = t269 + t17
     t271 = t17 + t266 - t268
-    t272 = t271 + t52
+    t272 = t271 + t54
     t273 = t10*t264
-    t274 = t62*t267
+    t274 = t64*t267
     t275 = -t273 + t274
     t276 = t270**2 + t275**2
     t277 = t273 + t274
@@ -3170,15 +3170,15 @@ def ik_branches(T, q_free):
     t288 = t14*t283 - t13*t284
     t289 = xp.where(t281, 0, xp.atan2(t275, -t270))
     t290 = t289 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t289))
-    t291 = t267*c3
+    t291 = c3*t267
     t292 = t264*t291
-    t293 = t257 + t12*t255
+    t293 = t257 + t12*t29
     t294 = t292 + t293
-    t295 = t293 - t292
+    t295 = -t292 + t293
     t296 = -t257
     t297 = t294 + t296
     t298 = t295 + t296
-    t299 = t255*t264
+    t299 = t29*t264
     t300 = t12*t291
     t301 = -t299 + t300
     t302 = t297**2 + t301**2
@@ -3223,35 +3223,35 @@ def ik_branches(T, q_free):
     t341 = t340 + t308*t288
     t342 = t333*c3 + t339*s3
     t343 = t333*s3 - t339*c3
-    t344 = t334*t33 + t342*t37
+    t344 = t334*t35 + t342*t39
     t345 = t335*c3 + t341*s3
     t346 = t335*s3 - t341*c3
-    t347 = t336*t33 + t345*t37
-    t348 = 1 + t33
+    t347 = t336*t35 + t345*t39
+    t348 = 1 + t35
     t349 = t343*t348
     t350 = t346*t348
-    t351 = t334*t37
-    t352 = t349*s3 - t333*t33 + t351*c3
-    t353 = t349*c3 + t339*t33 - t351*s3
-    t354 = t336*t37
-    t355 = t350*s3 - t335*t33 + t354*c3
-    t356 = t350*c3 + t341*t33 - t354*s3
+    t351 = t334*t39
+    t352 = t349*s3 - t333*t35 + c3*t351
+    t353 = t349*c3 + t339*t35 - s3*t351
+    t354 = t336*t39
+    t355 = t350*s3 - t335*t35 + c3*t354
+    t356 = t350*c3 + t341*t35 - s3*t354
     t357 = t344**2
     t358 = t352**2 + t353**2 + t357
     t359 = -t357
     t360 = 1 + t359
     t361 = xp.greater(t360, 1e-12)
     t362 = xp.where(t361, xp.sqrt(t360), 0)
-    t363 = t362*t39 + t362*t41
+    t363 = t362*t41 + t362*t43
     t364 = t357 + t363**2
-    t365 = t362*s3
-    t366 = t362*c3
+    t365 = s3*t362
+    t366 = c3*t362
     t367 = t357 + t353*t365 - t352*t366
     t368 = t367 + t359
     t369 = t352*t365 + t353*t366
     t370 = t368**2 + t369**2
     t371 = t362**2
-    t372 = t357 + t371*t39 + t371*t41
+    t372 = t357 + t371*t41 + t371*t43
     t373 = 1e-24*t372
     t374 = xp.less_equal(t370, t358*t373)
     t375 = xp.where(t374, 1, 1/xp.sqrt(t370))
@@ -3269,9 +3269,9 @@ def ik_branches(T, q_free):
     t387 = xp.where(t384, 0, -t363*t385)
     t388 = t383*(1 - t386)
     t389 = t386*t381 + t387*t382
-    t390 = t387*t381
-    t391 = t386*t379 + t388*s3 + t390*c3
-    t392 = t386*t380 + t388*c3 - t390*s3
+    t390 = t381*t387
+    t391 = t386*t379 + t388*s3 + c3*t390
+    t392 = t386*t380 + t388*c3 - s3*t390
     t393 = t391*c3 - t392*s3
     t394 = t391*s3 + t392*c3
     t395 = t393**2 + t394**2
@@ -3293,33 +3293,33 @@ def ik_branches(T, q_free):
     t411 = t402*c3 + t408*s3
     t412 = t402*s3 - t408*c3
     t413 = t412*t348
-    t414 = t403*t33 + t411*t37
+    t414 = t403*t35 + t411*t39
     t415 = t404*c3 + t410*s3
     t416 = t404*s3 - t410*c3
     t417 = t416*t348
-    t418 = t405*t33 + t415*t37
-    t419 = t403*t37
-    t420 = t413*s3 - t402*t33 + t419*c3
-    t421 = t413*c3 + t408*t33 - t419*s3
-    t422 = t405*t37
-    t423 = t417*s3 - t404*t33 + t422*c3
-    t424 = t417*c3 + t410*t33 - t422*s3
+    t418 = t405*t35 + t415*t39
+    t419 = t403*t39
+    t420 = t413*s3 - t402*t35 + c3*t419
+    t421 = t413*c3 + t408*t35 - s3*t419
+    t422 = t405*t39
+    t423 = t417*s3 - t404*t35 + c3*t422
+    t424 = t417*c3 + t410*t35 - s3*t422
     t425 = t414**2
     t426 = t420**2 + t421**2 + t425
     t427 = -t425
     t428 = 1 + t427
     t429 = xp.greater(t428, 1e-12)
     t430 = xp.where(t429, xp.sqrt(t428), 0)
-    t431 = t430*t39 + t430*t41
+    t431 = t430*t41 + t430*t43
     t432 = t425 + t431**2
-    t433 = t430*s3
-    t434 = t430*c3
+    t433 = s3*t430
+    t434 = c3*t430
     t435 = t425 + t421*t433 - t420*t434
     t436 = t435 + t427
     t437 = t420*t433 + t421*t434
     t438 = t436**2 + t437**2
     t439 = t430**2
-    t440 = t425 + t439*t39 + t439*t41
+    t440 = t425 + t439*t41 + t439*t43
     t441 = 1e-24*t440
     t442 = xp.less_equal(t438, t426*t441)
     t443 = xp.where(t442, 1, 1/xp.sqrt(t438))
@@ -3337,40 +3337,40 @@ def ik_branches(T, q_free):
     t455 = xp.where(t452, 0, -t431*t453)
     t456 = t451*(1 - t454)
     t457 = t454*t449 + t455*t450
-    t458 = t455*t449
-    t459 = t454*t447 + t456*s3 + t458*c3
-    t460 = t454*t448 + t456*c3 - t458*s3
+    t458 = t449*t455
+    t459 = t454*t447 + t456*s3 + c3*t458
+    t460 = t454*t448 + t456*c3 - s3*t458
     t461 = t459*c3 - t460*s3
     t462 = t459*s3 + t460*c3
     t463 = t461**2 + t462**2
     t464 = t459**2 + t460**2 + t457**2
-    t465 = xp.where(t163, 0, xp.atan2(t158, -t157))
+    t465 = xp.where(t165, 0, xp.atan2(t160, -t159))
     t466 = t465
     t467 = t466 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t466))
     t468 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t465) + t465
     t469 = t468 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t468))
-    t470 = xp.where(t173, 0, xp.atan2(-t152, t133))
+    t470 = xp.where(t175, 0, xp.atan2(-t154, t135))
     t471 = t470
     t472 = t471 - 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t471))
     t473 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t470)) + t470
-    t474 = 1e-24*t42
-    t475 = xp.where(xp.less_equal(t184, t185*t474), 0, xp.atan2(t183, t182))
+    t474 = 1e-24*t44
+    t475 = xp.where(xp.less_equal(t186, t187*t474), 0, xp.atan2(t185, t184))
     t476 = t475
     t477 = t476 - 6.283185307179586*xp.floor(0.15915494309189535*(3.0543261909900767 + t476))
     t478 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t475) + t475
     t479 = t478 - 6.283185307179586*xp.floor(0.15915494309189535*(3.0543261909900767 + t478))
     t480 = -t473
     t481 = t473 + 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t480))
-    t482 = xp.where(t231, 0, xp.atan2(t226, -t225))
+    t482 = xp.where(t233, 0, xp.atan2(t228, -t227))
     t483 = t482
     t484 = t483 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t483))
     t485 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t482) + t482
     t486 = t485 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t485))
-    t487 = xp.where(t241, 0, xp.atan2(-t220, t203))
+    t487 = xp.where(t243, 0, xp.atan2(-t222, t205))
     t488 = t487
     t489 = t488 - 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t488))
     t490 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t487)) + t487
-    t491 = xp.where(xp.less_equal(t252, t253*t474), 0, xp.atan2(t251, t250))
+    t491 = xp.where(xp.less_equal(t254, t255*t474), 0, xp.atan2(t253, t252))
     t492 = t491
     t493 = t492 - 6.283185307179586*xp.floor(0.15915494309189535*(3.0543261909900767 + t492))
     t494 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t491) + t491
@@ -3409,15 +3409,15 @@ def ik_branches(T, q_free):
     t527 = t526 - 6.283185307179586*xp.floor(0.15915494309189535*(3.0543261909900767 + t526))
     t528 = -t522
     t529 = t522 + 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t528))
-    t530 = xp.less_equal(t79, 2.9670597283903604)
-    t531 = xp.greater_equal(t78, -2.9670597283903604) & xp.less_equal(t78, 2.9670597283903604)
-    t532 = xp.where(t530 & xp.logical_not(t531), t79, t78)
-    t533 = xp.less_equal(t100, 2.0943951023931953)
-    t534 = xp.greater_equal(t99, -2.0943951023931953) & xp.less_equal(t99, 2.0943951023931953)
-    t535 = xp.where(t533 & xp.logical_not(t534), t100, t99)
-    t536 = xp.less_equal(t30, 2.0943951023931953)
-    t537 = xp.greater_equal(t29, -2.0943951023931953) & xp.less_equal(t29, 2.0943951023931953)
-    t538 = xp.where(t536 & xp.logical_not(t537), t30, t29)
+    t530 = xp.less_equal(t81, 2.9670597283903604)
+    t531 = xp.greater_equal(t80, -2.9670597283903604) & xp.less_equal(t80, 2.9670597283903604)
+    t532 = xp.where(t530 & xp.logical_not(t531), t81, t80)
+    t533 = xp.less_equal(t102, 2.0943951023931953)
+    t534 = xp.greater_equal(t101, -2.0943951023931953) & xp.less_equal(t101, 2.0943951023931953)
+    t535 = xp.where(t533 & xp.logical_not(t534), t102, t101)
+    t536 = xp.less_equal(t34, 2.0943951023931953)
+    t537 = xp.greater_equal(t33, -2.0943951023931953) & xp.less_equal(t33, 2.0943951023931953)
+    t538 = xp.where(t536 & xp.logical_not(t537), t34, t33)
     t539 = xp.less_equal(t467, 2.9670597283903604)
     t540 = xp.greater_equal(t466, -2.9670597283903604) & xp.less_equal(t466, 2.9670597283903604)
     t541 = xp.less_equal(t472, 2.0943951023931953)
@@ -3431,12 +3431,12 @@ def ik_branches(T, q_free):
     t549 = xp.greater_equal(t480, -2.0943951023931953) & xp.less_equal(t480, 2.0943951023931953)
     t550 = xp.less_equal(t479, 3.0543261909900767)
     t551 = xp.greater_equal(t478, -3.0543261909900767) & xp.less_equal(t478, 3.0543261909900767)
-    t552 = xp.less_equal(t110, 2.9670597283903604)
-    t553 = xp.greater_equal(t109, -2.9670597283903604) & xp.less_equal(t109, 2.9670597283903604)
-    t554 = xp.where(t552 & xp.logical_not(t553), t110, t109)
-    t555 = xp.less_equal(t116, 2.0943951023931953)
-    t556 = xp.greater_equal(t115, -2.0943951023931953) & xp.less_equal(t115, 2.0943951023931953)
-    t557 = xp.where(t555 & xp.logical_not(t556), t116, t115)
+    t552 = xp.less_equal(t112, 2.9670597283903604)
+    t553 = xp.greater_equal(t111, -2.9670597283903604) & xp.less_equal(t111, 2.9670597283903604)
+    t554 = xp.where(t552 & xp.logical_not(t553), t112, t111)
+    t555 = xp.less_equal(t118, 2.0943951023931953)
+    t556 = xp.greater_equal(t117, -2.0943951023931953) & xp.less_equal(t117, 2.0943951023931953)
+    t557 = xp.where(t555 & xp.logical_not(t556), t118, t117)
     t558 = xp.less_equal(t484, 2.9670597283903604)
     t559 = xp.greater_equal(t483, -2.9670597283903604) & xp.less_equal(t483, 2.9670597283903604)
     t560 = xp.less_equal(t489, 2.0943951023931953)
@@ -3456,9 +3456,9 @@ def ik_branches(T, q_free):
     t574 = xp.less_equal(t311, 2.0943951023931953)
     t575 = xp.greater_equal(t310, -2.0943951023931953) & xp.less_equal(t310, 2.0943951023931953)
     t576 = xp.where(t574 & xp.logical_not(t575), t311, t310)
-    t577 = xp.less_equal(t32, 2.0943951023931953)
-    t578 = xp.greater_equal(t31, -2.0943951023931953) & xp.less_equal(t31, 2.0943951023931953)
-    t579 = xp.where(t577 & xp.logical_not(t578), t32, t31)
+    t577 = xp.less_equal(t31, 2.0943951023931953)
+    t578 = xp.greater_equal(t30, -2.0943951023931953) & xp.less_equal(t30, 2.0943951023931953)
+    t579 = xp.where(t577 & xp.logical_not(t578), t31, t30)
     t580 = xp.less_equal(t500, 2.9670597283903604)
     t581 = xp.greater_equal(t499, -2.9670597283903604) & xp.less_equal(t499, 2.9670597283903604)
     t582 = xp.less_equal(t505, 2.0943951023931953)
@@ -3492,7 +3492,7 @@ def ik_branches(T, q_free):
     t610 = xp.less_equal(t527, 3.0543261909900767)
     t611 = xp.greater_equal(t526, -3.0543261909900767) & xp.less_equal(t526, 3.0543261909900767)
     t612 = xp.isfinite(t16)
-    t613 = xp.greater_equal(t47, -t48)
+    t613 = xp.greater_equal(t49, -t50)
     t614 = xp.greater_equal(t21, -1e-12)
     t615 = xp.greater_equal(t261, -t262)
     t616 = xp.greater_equal(q3, -2.9670597283903604)
@@ -3566,24 +3566,24 @@ def ik_branches(T, q_free):
         xp.where(t610 & xp.logical_not(t611), t527, t526),  # 7, 6
     ], (8, 7))
     valid = _stack(xp, [
-        t612 & t613 & t614 & xp.greater_equal(t149, -1e-12),  # 0
-        t612 & t613 & t614 & t150,  # 1
-        t49 & t612 & t614 & xp.greater_equal(t217, -1e-12),  # 2
-        t49 & t612 & t614 & t218,  # 3
-        t612 & t615 & t22 & xp.greater_equal(t360, -1e-12),  # 4
-        t361 & t612 & t615 & t22,  # 5
-        t612 & t22 & t263 & xp.greater_equal(t428, -1e-12),  # 6
-        t429 & t612 & t22 & t263,  # 7
+        t612 & xp.greater_equal(t151, -1e-12) & t613 & t614,  # 0
+        t612 & t152 & t613 & t614,  # 1
+        t612 & xp.greater_equal(t219, -1e-12) & t51 & t614,  # 2
+        t612 & t220 & t51 & t614,  # 3
+        t612 & t22 & xp.greater_equal(t360, -1e-12) & t615,  # 4
+        t612 & t22 & t361 & t615,  # 5
+        t612 & t22 & xp.greater_equal(t428, -1e-12) & t263,  # 6
+        t612 & t22 & t429 & t263,  # 7
     ], (8,))
     in_limits = _stack(xp, [
         t616 & t617 & t618 & t619 & t620 & (t539 | t540) & (t541 | t542) & (t543 | t544),  # 0
-        t616 & t617 & t618 & t619 & t620 & (t545 | t546) & (t548 | t549) & (t550 | t551),  # 1
+        t616 & t617 & t618 & t619 & t620 & (t545 | t546) & (t550 | t551) & (t548 | t549),  # 1
         t616 & t617 & t620 & t621 & t622 & (t558 | t559) & (t560 | t561) & (t562 | t563),  # 2
-        t616 & t617 & t620 & t621 & t622 & (t564 | t565) & (t567 | t568) & (t569 | t570),  # 3
+        t616 & t617 & t620 & t621 & t622 & (t564 | t565) & (t569 | t570) & (t567 | t568),  # 3
         t616 & t617 & t623 & t624 & t625 & (t580 | t581) & (t582 | t583) & (t584 | t585),  # 4
-        t616 & t617 & t623 & t624 & t625 & (t586 | t587) & (t589 | t590) & (t591 | t592),  # 5
+        t616 & t617 & t623 & t624 & t625 & (t586 | t587) & (t591 | t592) & (t589 | t590),  # 5
         t616 & t617 & t625 & t626 & t627 & (t599 | t600) & (t601 | t602) & (t603 | t604),  # 6
-        t616 & t617 & t625 & t626 & t627 & (t605 | t606) & (t608 | t609) & (t610 | t611),  # 7
+        t616 & t617 & t625 & t626 & t627 & (t605 | t606) & (t610 | t611) & (t608 | t609),  # 7
     ], (8,))
     return q, valid, in_limits
 

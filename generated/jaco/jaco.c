@@ -503,8 +503,8 @@ void jaco_fk(const jaco_real q[JACO_DOF], jaco_real T[16])
     const jaco_real s6 = cos(0.17453292519943295 + q6);
     const jaco_real t0 = c2*c3;
     const jaco_real t1 = s2*s3;
-    const jaco_real t2 = t0*c1 + t1*c1;
-    const jaco_real t3 = t0*s1 + t1*s1;
+    const jaco_real t2 = c1*t0 + c1*t1;
+    const jaco_real t3 = s1*t0 + s1*t1;
     const jaco_real t4 = t0 + t1;
     const jaco_real t5 = t2*c4 + s1*s4;
     const jaco_real t6 = c4*s1 - t2*s4;
@@ -513,8 +513,8 @@ void jaco_fk(const jaco_real q[JACO_DOF], jaco_real T[16])
     const jaco_real t9 = -0.25019712500078917*t4;
     const jaco_real t10 = c3*s2;
     const jaco_real t11 = c2*s3;
-    const jaco_real t12 = t10*c1 - t11*c1;
-    const jaco_real t13 = t11*s1 - t10*s1;
+    const jaco_real t12 = c1*t10 - c1*t11;
+    const jaco_real t13 = s1*t11 - s1*t10;
     const jaco_real t14 = t10 - t11;
     const jaco_real t15 = -0.25019712500078917*t12;
     const jaco_real t16 = -0.25019712500078917*t13;
@@ -524,7 +524,7 @@ void jaco_fk(const jaco_real q[JACO_DOF], jaco_real T[16])
     const jaco_real t20 = 0.5*t13 + 0.8660254037844386*t8;
     const jaco_real t21 = t20;
     const jaco_real t22 = -0.08579425000157839*t20;
-    const jaco_real t23 = t14*s4;
+    const jaco_real t23 = s4*t14;
     const jaco_real t24 = 0.5*t4 + 0.8660254037844386*t23;
     const jaco_real t25 = t24;
     const jaco_real t26 = 0.08579425000157839*t24;
@@ -535,9 +535,9 @@ void jaco_fk(const jaco_real q[JACO_DOF], jaco_real T[16])
     const jaco_real t31 = t7*c5 + s5*t30;
     const jaco_real t32 = c5*t30 - t7*s5;
     const jaco_real t33 = 0.8660254037844386*t4 - 0.5*t23;
-    const jaco_real t34 = t14*c4;
-    const jaco_real t35 = s5*t33 + t34*c5;
-    const jaco_real t36 = c5*t33 - t34*s5;
+    const jaco_real t34 = c4*t14;
+    const jaco_real t35 = s5*t33 + c5*t34;
+    const jaco_real t36 = c5*t33 - s5*t34;
     const jaco_real t37 = 0.5*t18 + 0.8660254037844386*t29;
     const jaco_real t38 = t37;
     const jaco_real t39 = 0.2115971250007892*t37;
@@ -567,8 +567,8 @@ void jaco_fk(const jaco_real q[JACO_DOF], jaco_real T[16])
     const jaco_real t63 = t35*c6 + s6*t62;
     const jaco_real t64 = c6*t62 - t35*s6;
     const jaco_real t65 = 0.41*c2;
-    const jaco_real t66 = t42 + t65*c1;
-    const jaco_real t67 = t48 - t65*s1;
+    const jaco_real t66 = t42 + c1*t65;
+    const jaco_real t67 = t48 - s1*t65;
 
     /* Outputs */
     T[0] = t57;
@@ -613,8 +613,8 @@ void jaco_jacobian(const jaco_real q[JACO_DOF], jaco_real J[6 * JACO_DOF])
     const jaco_real s5 = -sin(q5);
     const jaco_real t0 = c2*c3;
     const jaco_real t1 = s2*s3;
-    const jaco_real t2 = t0*c1 + t1*c1;
-    const jaco_real t3 = t0*s1 + t1*s1;
+    const jaco_real t2 = c1*t0 + c1*t1;
+    const jaco_real t3 = s1*t0 + s1*t1;
     const jaco_real t4 = t0 + t1;
     const jaco_real t5 = t2*c4 + s1*s4;
     const jaco_real t6 = c4*s1 - t2*s4;
@@ -623,8 +623,8 @@ void jaco_jacobian(const jaco_real q[JACO_DOF], jaco_real J[6 * JACO_DOF])
     const jaco_real t9 = -0.25019712500078917*t4;
     const jaco_real t10 = c3*s2;
     const jaco_real t11 = c2*s3;
-    const jaco_real t12 = t10*c1 - t11*c1;
-    const jaco_real t13 = t11*s1 - t10*s1;
+    const jaco_real t12 = c1*t10 - c1*t11;
+    const jaco_real t13 = s1*t11 - s1*t10;
     const jaco_real t14 = t10 - t11;
     const jaco_real t15 = -0.25019712500078917*t12;
     const jaco_real t16 = -0.25019712500078917*t13;
@@ -636,7 +636,7 @@ void jaco_jacobian(const jaco_real q[JACO_DOF], jaco_real J[6 * JACO_DOF])
     const jaco_real t22 = 0.5*t13 + 0.8660254037844386*t8;
     const jaco_real t23 = t22;
     const jaco_real t24 = -0.08579425000157839*t22;
-    const jaco_real t25 = t14*s4;
+    const jaco_real t25 = s4*t14;
     const jaco_real t26 = c5*(0.8660254037844386*t4 - 0.5*t25) - t14*c4*s5;
     const jaco_real t27 = 0.5*t4 + 0.8660254037844386*t25;
     const jaco_real t28 = t27;
@@ -660,8 +660,8 @@ void jaco_jacobian(const jaco_real q[JACO_DOF], jaco_real J[6 * JACO_DOF])
     const jaco_real t46 = t9 + t45;
     const jaco_real t47 = t46 + 0.41*s2;
     const jaco_real t48 = 0.41*c2;
-    const jaco_real t49 = t35 + t48*c1;
-    const jaco_real t50 = t41 - t48*s1;
+    const jaco_real t49 = t35 + c1*t48;
+    const jaco_real t50 = t41 - s1*t48;
 
     /* Outputs */
     J[0] = t50;
@@ -729,8 +729,8 @@ void jaco_fk_jacobian(const jaco_real q[JACO_DOF], jaco_real T[16], jaco_real J[
     const jaco_real s6 = cos(0.17453292519943295 + q6);
     const jaco_real t0 = c2*c3;
     const jaco_real t1 = s2*s3;
-    const jaco_real t2 = t0*c1 + t1*c1;
-    const jaco_real t3 = t0*s1 + t1*s1;
+    const jaco_real t2 = c1*t0 + c1*t1;
+    const jaco_real t3 = s1*t0 + s1*t1;
     const jaco_real t4 = t0 + t1;
     const jaco_real t5 = t2*c4 + s1*s4;
     const jaco_real t6 = c4*s1 - t2*s4;
@@ -739,8 +739,8 @@ void jaco_fk_jacobian(const jaco_real q[JACO_DOF], jaco_real T[16], jaco_real J[
     const jaco_real t9 = -0.25019712500078917*t4;
     const jaco_real t10 = c3*s2;
     const jaco_real t11 = c2*s3;
-    const jaco_real t12 = t10*c1 - t11*c1;
-    const jaco_real t13 = t11*s1 - t10*s1;
+    const jaco_real t12 = c1*t10 - c1*t11;
+    const jaco_real t13 = s1*t11 - s1*t10;
     const jaco_real t14 = t10 - t11;
     const jaco_real t15 = -0.25019712500078917*t12;
     const jaco_real t16 = -0.25019712500078917*t13;
@@ -750,7 +750,7 @@ void jaco_fk_jacobian(const jaco_real q[JACO_DOF], jaco_real T[16], jaco_real J[
     const jaco_real t20 = 0.5*t13 + 0.8660254037844386*t8;
     const jaco_real t21 = t20;
     const jaco_real t22 = -0.08579425000157839*t20;
-    const jaco_real t23 = t14*s4;
+    const jaco_real t23 = s4*t14;
     const jaco_real t24 = 0.5*t4 + 0.8660254037844386*t23;
     const jaco_real t25 = t24;
     const jaco_real t26 = 0.08579425000157839*t24;
@@ -761,9 +761,9 @@ void jaco_fk_jacobian(const jaco_real q[JACO_DOF], jaco_real T[16], jaco_real J[
     const jaco_real t31 = t7*c5 + s5*t30;
     const jaco_real t32 = c5*t30 - t7*s5;
     const jaco_real t33 = 0.8660254037844386*t4 - 0.5*t23;
-    const jaco_real t34 = t14*c4;
-    const jaco_real t35 = s5*t33 + t34*c5;
-    const jaco_real t36 = c5*t33 - t34*s5;
+    const jaco_real t34 = c4*t14;
+    const jaco_real t35 = s5*t33 + c5*t34;
+    const jaco_real t36 = c5*t33 - s5*t34;
     const jaco_real t37 = 0.5*t18 + 0.8660254037844386*t29;
     const jaco_real t38 = t37;
     const jaco_real t39 = 0.2115971250007892*t37;
@@ -793,8 +793,8 @@ void jaco_fk_jacobian(const jaco_real q[JACO_DOF], jaco_real T[16], jaco_real J[
     const jaco_real t63 = t35*c6 + s6*t62;
     const jaco_real t64 = c6*t62 - t35*s6;
     const jaco_real t65 = 0.41*c2;
-    const jaco_real t66 = t42 + t65*c1;
-    const jaco_real t67 = t48 - t65*s1;
+    const jaco_real t66 = t42 + c1*t65;
+    const jaco_real t67 = t48 - s1*t65;
 
     /* Outputs */
     T[0] = t57;
@@ -853,7 +853,7 @@ void jaco_fk_jacobian(const jaco_real q[JACO_DOF], jaco_real T[16], jaco_real J[
 
 void jaco_jacobian_tool(const jaco_real q[JACO_DOF], jaco_real J[6 * JACO_DOF])
 {
-    /* 334 operations */
+    /* 330 operations */
 
     /* Inputs */
     const jaco_real q1 = q[0];
@@ -878,8 +878,8 @@ void jaco_jacobian_tool(const jaco_real q[JACO_DOF], jaco_real J[6 * JACO_DOF])
     const jaco_real s6 = cos(0.17453292519943295 + q6);
     const jaco_real t0 = c2*c3;
     const jaco_real t1 = s2*s3;
-    const jaco_real t2 = t0*c1 + t1*c1;
-    const jaco_real t3 = t0*s1 + t1*s1;
+    const jaco_real t2 = c1*t0 + c1*t1;
+    const jaco_real t3 = s1*t0 + s1*t1;
     const jaco_real t4 = t0 + t1;
     const jaco_real t5 = t2*c4 + s1*s4;
     const jaco_real t6 = c4*s1 - t2*s4;
@@ -888,8 +888,8 @@ void jaco_jacobian_tool(const jaco_real q[JACO_DOF], jaco_real J[6 * JACO_DOF])
     const jaco_real t9 = -0.25019712500078917*t4;
     const jaco_real t10 = c3*s2;
     const jaco_real t11 = c2*s3;
-    const jaco_real t12 = t10*c1 - t11*c1;
-    const jaco_real t13 = t11*s1 - t10*s1;
+    const jaco_real t12 = c1*t10 - c1*t11;
+    const jaco_real t13 = s1*t11 - s1*t10;
     const jaco_real t14 = t10 - t11;
     const jaco_real t15 = -0.25019712500078917*t12;
     const jaco_real t16 = -0.25019712500078917*t13;
@@ -899,7 +899,7 @@ void jaco_jacobian_tool(const jaco_real q[JACO_DOF], jaco_real J[6 * JACO_DOF])
     const jaco_real t20 = 0.5*t13 + 0.8660254037844386*t8;
     const jaco_real t21 = t20;
     const jaco_real t22 = -0.08579425000157839*t20;
-    const jaco_real t23 = t14*s4;
+    const jaco_real t23 = s4*t14;
     const jaco_real t24 = 0.5*t4 + 0.8660254037844386*t23;
     const jaco_real t25 = t24;
     const jaco_real t26 = 0.08579425000157839*t24;
@@ -910,9 +910,9 @@ void jaco_jacobian_tool(const jaco_real q[JACO_DOF], jaco_real J[6 * JACO_DOF])
     const jaco_real t31 = t7*c5 + s5*t30;
     const jaco_real t32 = c5*t30 - t7*s5;
     const jaco_real t33 = 0.8660254037844386*t4 - 0.5*t23;
-    const jaco_real t34 = t14*c4;
-    const jaco_real t35 = s5*t33 + t34*c5;
-    const jaco_real t36 = c5*t33 - t34*s5;
+    const jaco_real t34 = c4*t14;
+    const jaco_real t35 = s5*t33 + c5*t34;
+    const jaco_real t36 = c5*t33 - s5*t34;
     const jaco_real t37 = 0.5*t18 + 0.8660254037844386*t29;
     const jaco_real t38 = t37;
     const jaco_real t39 = 0.2115971250007892*t37;
@@ -941,11 +941,11 @@ void jaco_jacobian_tool(const jaco_real q[JACO_DOF], jaco_real J[6 * JACO_DOF])
     const jaco_real t62 = t35*c6 + s6*t61;
     const jaco_real t63 = c6*t61 - t35*s6;
     const jaco_real t64 = 0.41*c2;
-    const jaco_real t65 = t42 + t64*c1;
-    const jaco_real t66 = t48 - t64*s1;
+    const jaco_real t65 = t42 + c1*t64;
+    const jaco_real t66 = t48 - s1*t64;
     const jaco_real t67 = t65*c1 - t66*s1;
-    const jaco_real t68 = t59*s1;
-    const jaco_real t69 = t56*c1;
+    const jaco_real t68 = s1*t59;
+    const jaco_real t69 = c1*t56;
     const jaco_real t70 = t48*s1 - t42*c1;
     const jaco_real t71 = -(t13*t53 + t4*t47);
     const jaco_real t72 = t4*t41 + t53*t12;
@@ -956,9 +956,13 @@ void jaco_jacobian_tool(const jaco_real q[JACO_DOF], jaco_real J[6 * JACO_DOF])
     const jaco_real t77 = -(t44*t51 + t50*t45);
     const jaco_real t78 = t38*t51 + t50*t39;
     const jaco_real t79 = t44*t39 - t38*t45;
-    const jaco_real t80 = t56*s1 + t59*c1;
-    const jaco_real t81 = t57*s1 + t60*c1;
-    const jaco_real t82 = t38*s1 + t44*c1;
+    const jaco_real t80 = c1*t57;
+    const jaco_real t81 = s1*t60;
+    const jaco_real t82 = s1*t44;
+    const jaco_real t83 = c1*t38;
+    const jaco_real t84 = t56*s1 + t59*c1;
+    const jaco_real t85 = t57*s1 + t60*c1;
+    const jaco_real t86 = t38*s1 + t44*c1;
 
     /* Outputs */
     J[0] = t56*t66 - t59*t65;
@@ -968,32 +972,32 @@ void jaco_jacobian_tool(const jaco_real q[JACO_DOF], jaco_real J[6 * JACO_DOF])
     J[4] = t56*t74 + t59*t75 + t62*t76;
     J[5] = t56*t77 + t59*t78 + t62*t79;
     J[6] = t60*t65 - t57*t66;
-    J[7] = -(t63*t67 + t60*t54*s1 - t57*t54*c1);
-    J[8] = -(t63*t70 + t57*t53*c1 - t60*t53*s1);
+    J[7] = -(t63*t67 - t54*t80 + t54*t81);
+    J[8] = -(t63*t70 - t53*t81 + t53*t80);
     J[9] = -(t57*t71 + t60*t72 + t63*t73);
     J[10] = -(t57*t74 + t60*t75 + t63*t76);
     J[11] = -(t57*t77 + t60*t78 + t63*t79);
     J[12] = t38*t66 - t44*t65;
-    J[13] = -(t50*t67 + t38*t54*c1 - t44*t54*s1);
-    J[14] = -(t50*t70 + t44*t53*s1 - t38*t53*c1);
+    J[13] = -(t50*t67 - t54*t82 + t54*t83);
+    J[14] = -(t50*t70 - t53*t83 + t53*t82);
     J[15] = t38*t71 + t44*t72 - t50*t73;
     J[16] = t38*t74 + t44*t75 - t50*t76;
     J[17] = t38*t77 + t44*t78 - t50*t79;
     J[18] = -t62;
-    J[19] = -t80;
-    J[20] = t80;
-    J[21] = -(t13*t59 + t56*t12 - t4*t62);
-    J[22] = -(t18*t56 + t21*t59 - t25*t62);
-    J[23] = -(t38*t56 + t44*t59 - t50*t62);
+    J[19] = -t84;
+    J[20] = t84;
+    J[21] = -(-t4*t62 + t13*t59 + t56*t12);
+    J[22] = -(-t25*t62 + t18*t56 + t21*t59);
+    J[23] = -(-t50*t62 + t38*t56 + t44*t59);
     J[24] = t63;
-    J[25] = t81;
-    J[26] = -t81;
+    J[25] = t85;
+    J[26] = -t85;
     J[27] = t13*t60 + t57*t12 - t4*t63;
     J[28] = t18*t57 + t21*t60 - t25*t63;
     J[29] = t38*t57 + t44*t60 - t50*t63;
     J[30] = t50;
-    J[31] = -t82;
-    J[32] = t82;
+    J[31] = -t86;
+    J[32] = t86;
     J[33] = -(t13*t44 + t4*t50 + t38*t12);
     J[34] = -(t18*t38 + t21*t44 + t25*t50);
     J[35] = -((t38*t38) + (t44*t44) + (t50*t50));
@@ -1026,8 +1030,8 @@ void jaco_task(const jaco_real q[JACO_DOF], jaco_real mu[JACO_TASK_DIM])
     const jaco_real s6 = cos(0.17453292519943295 + q6);
     const jaco_real t0 = c2*c3;
     const jaco_real t1 = s2*s3;
-    const jaco_real t2 = t0*c1 + t1*c1;
-    const jaco_real t3 = t0*s1 + t1*s1;
+    const jaco_real t2 = c1*t0 + c1*t1;
+    const jaco_real t3 = s1*t0 + s1*t1;
     const jaco_real t4 = t0 + t1;
     const jaco_real t5 = t2*c4 + s1*s4;
     const jaco_real t6 = c4*s1 - t2*s4;
@@ -1036,8 +1040,8 @@ void jaco_task(const jaco_real q[JACO_DOF], jaco_real mu[JACO_TASK_DIM])
     const jaco_real t9 = -0.25019712500078917*t4;
     const jaco_real t10 = c3*s2;
     const jaco_real t11 = c2*s3;
-    const jaco_real t12 = t10*c1 - t11*c1;
-    const jaco_real t13 = t11*s1 - t10*s1;
+    const jaco_real t12 = c1*t10 - c1*t11;
+    const jaco_real t13 = s1*t11 - s1*t10;
     const jaco_real t14 = t10 - t11;
     const jaco_real t15 = -0.25019712500078917*t12;
     const jaco_real t16 = -0.25019712500078917*t13;
@@ -1047,7 +1051,7 @@ void jaco_task(const jaco_real q[JACO_DOF], jaco_real mu[JACO_TASK_DIM])
     const jaco_real t20 = 0.5*t13 + 0.8660254037844386*t8;
     const jaco_real t21 = t20;
     const jaco_real t22 = -0.08579425000157839*t20;
-    const jaco_real t23 = t14*s4;
+    const jaco_real t23 = s4*t14;
     const jaco_real t24 = 0.5*t4 + 0.8660254037844386*t23;
     const jaco_real t25 = t24;
     const jaco_real t26 = 0.08579425000157839*t24;
@@ -1068,9 +1072,9 @@ void jaco_task(const jaco_real q[JACO_DOF], jaco_real mu[JACO_TASK_DIM])
     const jaco_real t41 = t40 - t16;
     const jaco_real t42 = t41 - 0.0098*c1;
     const jaco_real t43 = 0.8660254037844386*t4 - 0.5*t23;
-    const jaco_real t44 = t14*c4;
-    const jaco_real t45 = s5*t43 + t44*c5;
-    const jaco_real t46 = c5*t43 - t44*s5;
+    const jaco_real t44 = c4*t14;
+    const jaco_real t45 = s5*t43 + c5*t44;
+    const jaco_real t46 = c5*t43 - s5*t44;
     const jaco_real t47 = 0.5*t25 - 0.8660254037844386*t46;
     const jaco_real t48 = t47;
     const jaco_real t49 = -0.2115971250007892*t47;
@@ -1082,8 +1086,8 @@ void jaco_task(const jaco_real q[JACO_DOF], jaco_real mu[JACO_TASK_DIM])
     const jaco_real t55 = t45*c6 + s6*t54;
     const jaco_real t56 = c6*t54 - t45*s6;
     const jaco_real t57 = 0.41*c2;
-    const jaco_real t58 = t34 + t57*c1;
-    const jaco_real t59 = t42 - t57*s1;
+    const jaco_real t58 = t34 + c1*t57;
+    const jaco_real t59 = t42 - s1*t57;
 
     /* Outputs */
     mu[0] = t58;
@@ -1121,8 +1125,8 @@ void jaco_task_jacobian(const jaco_real q[JACO_DOF], jaco_real J[JACO_TASK_DIM *
     const jaco_real s6 = cos(0.17453292519943295 + q6);
     const jaco_real t0 = c2*c3;
     const jaco_real t1 = s2*s3;
-    const jaco_real t2 = t0*c1 + t1*c1;
-    const jaco_real t3 = t0*s1 + t1*s1;
+    const jaco_real t2 = c1*t0 + c1*t1;
+    const jaco_real t3 = s1*t0 + s1*t1;
     const jaco_real t4 = t0 + t1;
     const jaco_real t5 = t2*c4 + s1*s4;
     const jaco_real t6 = c4*s1 - t2*s4;
@@ -1131,8 +1135,8 @@ void jaco_task_jacobian(const jaco_real q[JACO_DOF], jaco_real J[JACO_TASK_DIM *
     const jaco_real t9 = -0.25019712500078917*t4;
     const jaco_real t10 = c3*s2;
     const jaco_real t11 = c2*s3;
-    const jaco_real t12 = t10*c1 - t11*c1;
-    const jaco_real t13 = t11*s1 - t10*s1;
+    const jaco_real t12 = c1*t10 - c1*t11;
+    const jaco_real t13 = s1*t11 - s1*t10;
     const jaco_real t14 = t10 - t11;
     const jaco_real t15 = -0.25019712500078917*t12;
     const jaco_real t16 = -0.25019712500078917*t13;
@@ -1142,7 +1146,7 @@ void jaco_task_jacobian(const jaco_real q[JACO_DOF], jaco_real J[JACO_TASK_DIM *
     const jaco_real t20 = 0.5*t13 + 0.8660254037844386*t8;
     const jaco_real t21 = t20;
     const jaco_real t22 = -0.08579425000157839*t20;
-    const jaco_real t23 = t14*s4;
+    const jaco_real t23 = s4*t14;
     const jaco_real t24 = 0.5*t4 + 0.8660254037844386*t23;
     const jaco_real t25 = t24;
     const jaco_real t26 = 0.08579425000157839*t24;
@@ -1155,9 +1159,9 @@ void jaco_task_jacobian(const jaco_real q[JACO_DOF], jaco_real J[JACO_TASK_DIM *
     const jaco_real t33 = c5*t31 - t7*s5;
     const jaco_real t34 = t32*c6 + s6*(0.5*t33 - 0.8660254037844386*t21);
     const jaco_real t35 = 0.8660254037844386*t4 - 0.5*t23;
-    const jaco_real t36 = t14*c4;
-    const jaco_real t37 = s5*t35 + t36*c5;
-    const jaco_real t38 = c5*t35 - t36*s5;
+    const jaco_real t36 = c4*t14;
+    const jaco_real t37 = s5*t35 + c5*t36;
+    const jaco_real t38 = c5*t35 - s5*t36;
     const jaco_real t39 = t37*c6 + s6*(0.5*t38 + 0.8660254037844386*t25);
     const jaco_real t40 = 0.5*t18 + 0.8660254037844386*t29;
     const jaco_real t41 = t40;
@@ -1178,8 +1182,8 @@ void jaco_task_jacobian(const jaco_real q[JACO_DOF], jaco_real J[JACO_TASK_DIM *
     const jaco_real t56 = t9 + t55;
     const jaco_real t57 = t56 + 0.41*s2;
     const jaco_real t58 = 0.41*c2;
-    const jaco_real t59 = t45 + t58*c1;
-    const jaco_real t60 = t51 - t58*s1;
+    const jaco_real t59 = t45 + c1*t58;
+    const jaco_real t60 = t51 - s1*t58;
     const jaco_real t61 = (t30*t30) + (t34*t34);
     const jaco_real t62 = 1.0/t61;
     const jaco_real t63 = t30*s1 + t34*c1;
@@ -1233,7 +1237,7 @@ void jaco_task_jacobian(const jaco_real q[JACO_DOF], jaco_real J[JACO_TASK_DIM *
 
 void jaco_fk_jacobian_dot(const jaco_real q[JACO_DOF], const jaco_real q_dot[JACO_DOF], jaco_real T[16], jaco_real J[6 * JACO_DOF], jaco_real a[6])
 {
-    /* 436 operations */
+    /* 434 operations */
 
     /* Inputs */
     const jaco_real q1 = q[0];
@@ -1264,8 +1268,8 @@ void jaco_fk_jacobian_dot(const jaco_real q[JACO_DOF], const jaco_real q_dot[JAC
     const jaco_real s6 = cos(0.17453292519943295 + q6);
     const jaco_real t0 = c2*c3;
     const jaco_real t1 = s2*s3;
-    const jaco_real t2 = t0*c1 + t1*c1;
-    const jaco_real t3 = t0*s1 + t1*s1;
+    const jaco_real t2 = c1*t0 + c1*t1;
+    const jaco_real t3 = s1*t0 + s1*t1;
     const jaco_real t4 = t0 + t1;
     const jaco_real t5 = t2*c4 + s1*s4;
     const jaco_real t6 = c4*s1 - t2*s4;
@@ -1275,8 +1279,8 @@ void jaco_fk_jacobian_dot(const jaco_real q[JACO_DOF], const jaco_real q_dot[JAC
     const jaco_real t10 = -qd1 + t4*qd4;
     const jaco_real t11 = c3*s2;
     const jaco_real t12 = c2*s3;
-    const jaco_real t13 = t11*c1 - t12*c1;
-    const jaco_real t14 = t12*s1 - t11*s1;
+    const jaco_real t13 = c1*t11 - c1*t12;
+    const jaco_real t14 = s1*t12 - s1*t11;
     const jaco_real t15 = t11 - t12;
     const jaco_real t16 = -0.25019712500078917*t13;
     const jaco_real t17 = -0.25019712500078917*t14;
@@ -1286,7 +1290,7 @@ void jaco_fk_jacobian_dot(const jaco_real q[JACO_DOF], const jaco_real q_dot[JAC
     const jaco_real t21 = 0.5*t14 + 0.8660254037844386*t8;
     const jaco_real t22 = t21;
     const jaco_real t23 = -0.08579425000157839*t21;
-    const jaco_real t24 = t15*s4;
+    const jaco_real t24 = s4*t15;
     const jaco_real t25 = 0.5*t4 + 0.8660254037844386*t24;
     const jaco_real t26 = t25;
     const jaco_real t27 = 0.08579425000157839*t25;
@@ -1298,9 +1302,9 @@ void jaco_fk_jacobian_dot(const jaco_real q[JACO_DOF], const jaco_real q_dot[JAC
     const jaco_real t33 = t7*c5 + s5*t32;
     const jaco_real t34 = c5*t32 - t7*s5;
     const jaco_real t35 = 0.8660254037844386*t4 - 0.5*t24;
-    const jaco_real t36 = t15*c4;
-    const jaco_real t37 = s5*t35 + t36*c5;
-    const jaco_real t38 = c5*t35 - t36*s5;
+    const jaco_real t36 = c4*t15;
+    const jaco_real t37 = s5*t35 + c5*t36;
+    const jaco_real t38 = c5*t35 - s5*t36;
     const jaco_real t39 = 0.5*t19 + 0.8660254037844386*t31;
     const jaco_real t40 = t39;
     const jaco_real t41 = 0.2115971250007892*t39;
@@ -1330,8 +1334,8 @@ void jaco_fk_jacobian_dot(const jaco_real q[JACO_DOF], const jaco_real q_dot[JAC
     const jaco_real t65 = t37*c6 + s6*t64;
     const jaco_real t66 = c6*t64 - t37*s6;
     const jaco_real t67 = 0.41*c2;
-    const jaco_real t68 = t44 + t67*c1;
-    const jaco_real t69 = t50 - t67*s1;
+    const jaco_real t68 = t44 + c1*t67;
+    const jaco_real t69 = t50 - s1*t67;
     const jaco_real t70 = t14*t55 + t4*t49;
     const jaco_real t71 = t70;
     const jaco_real t72 = t22*t54 + t26*t48;
@@ -1440,17 +1444,17 @@ void jaco_fk_jacobian_dot(const jaco_real q[JACO_DOF], const jaco_real q_dot[JAC
     J[33] = t4;
     J[34] = t26;
     J[35] = t52;
-    a[0] = t113*qd1 + qd2*(-t118*c1 + t121*qd1) - qd3*(-t117*c1 + t122*qd1 + t85*t98) + qd4*(t77*qd1 + t87*t99 - t14*t116 - t110*t4) - qd5*(t109*t26 + t115*t22 + t79*t10 - t89*t100) - qd6*(t81*t28 - t91*t101 + t46*t114 + t52*t108);
-    a[1] = qd2*(t118*s1 + t119*qd1) - qd3*(t117*s1 + t120*qd1 - t85*qd2*s1) + qd4*(t116*t13 + t71*qd1 - t104*t4 - t87*t94) - qd5*(t103*t26 + t73*t10 + t89*t95 - t115*t19) - qd6*(t75*t28 + t91*t96 + t52*t102 - t40*t91*qd6) - t107*qd1;
-    a[2] = qd2*(t106*c1 - t112*s1) + qd3*(t111*s1 - t105*c1 + t123*(c1*c1) + t123*(s1*s1)) + qd4*(t71*t99 + t77*t94 - t14*t104 - t110*t13) + qd5*(t73*t100 + t79*t95 - t103*t22 - t109*t19) + qd6*(t75*t101 + t81*t96 - t40*t108 - t46*t102);
-    a[3] = qd4*(t4*t99 - t14*qd1) + qd5*(t22*t10 + t26*t100) + qd6*(t46*t28 + t52*t101) + t97*qd1 - t98*qd1;
-    a[4] = qd4*(t13*qd1 - t4*t94) - qd5*(t19*t10 + t26*t95) - qd6*(t40*t28 + t52*t96) + t93*qd1 - t92*qd1;
+    a[0] = t113*qd1 + qd2*(-t118*c1 + qd1*t121) - qd3*(-t117*c1 + qd1*t122 + t85*t98) + qd4*(t77*qd1 + t87*t99 - t14*t116 - t110*t4) - qd5*(-t89*t100 + t109*t26 + t115*t22 + t79*t10) - qd6*(-t91*t101 + t81*t28 + t46*t114 + t52*t108);
+    a[1] = qd2*(t118*s1 + qd1*t119) - qd3*(t117*s1 - t85*t93 + qd1*t120) + qd4*(t116*t13 + t71*qd1 - t104*t4 - t87*t94) - qd5*(-t115*t19 + t103*t26 + t73*t10 + t89*t95) - qd6*(t75*t28 + t91*t96 - t40*t114 + t52*t102) - t107*qd1;
+    a[2] = qd2*(t106*c1 - t112*s1) + qd3*(t111*s1 - t105*c1 + (c1*c1)*t123 + (s1*s1)*t123) + qd4*(t71*t99 + t77*t94 - t14*t104 - t110*t13) + qd5*(t73*t100 + t79*t95 - t103*t22 - t109*t19) + qd6*(t75*t101 + t81*t96 - t40*t108 - t46*t102);
+    a[3] = qd4*(t4*t99 - t14*qd1) + qd5*(t22*t10 + t26*t100) + qd6*(t46*t28 + t52*t101) + qd1*t97 - qd1*t98;
+    a[4] = qd4*(t13*qd1 - t4*t94) - qd5*(t19*t10 + t26*t95) - qd6*(t40*t28 + t52*t96) + qd1*t93 - qd1*t92;
     a[5] = qd4*(t13*t99 - t14*t94) + qd5*(t19*t100 - t22*t95) + qd6*(t40*t101 - t46*t96);
 }
 
 void jaco_jacobian_dot(const jaco_real q[JACO_DOF], const jaco_real q_dot[JACO_DOF], jaco_real Jd[6 * JACO_DOF])
 {
-    /* 318 operations */
+    /* 316 operations */
 
     /* Inputs */
     const jaco_real q1 = q[0];
@@ -1478,8 +1482,8 @@ void jaco_jacobian_dot(const jaco_real q[JACO_DOF], const jaco_real q_dot[JACO_D
     const jaco_real s5 = -sin(q5);
     const jaco_real t0 = c2*c3;
     const jaco_real t1 = s2*s3;
-    const jaco_real t2 = t0*c1 + t1*c1;
-    const jaco_real t3 = t0*s1 + t1*s1;
+    const jaco_real t2 = c1*t0 + c1*t1;
+    const jaco_real t3 = s1*t0 + s1*t1;
     const jaco_real t4 = t0 + t1;
     const jaco_real t5 = t2*c4 + s1*s4;
     const jaco_real t6 = c4*s1 - t2*s4;
@@ -1489,8 +1493,8 @@ void jaco_jacobian_dot(const jaco_real q[JACO_DOF], const jaco_real q_dot[JACO_D
     const jaco_real t10 = -qd1 + t4*qd4;
     const jaco_real t11 = c3*s2;
     const jaco_real t12 = c2*s3;
-    const jaco_real t13 = t11*c1 - t12*c1;
-    const jaco_real t14 = t12*s1 - t11*s1;
+    const jaco_real t13 = c1*t11 - c1*t12;
+    const jaco_real t14 = s1*t12 - s1*t11;
     const jaco_real t15 = t11 - t12;
     const jaco_real t16 = -0.25019712500078917*t13;
     const jaco_real t17 = -0.25019712500078917*t14;
@@ -1502,7 +1506,7 @@ void jaco_jacobian_dot(const jaco_real q[JACO_DOF], const jaco_real q_dot[JACO_D
     const jaco_real t23 = 0.5*t14 + 0.8660254037844386*t8;
     const jaco_real t24 = t23;
     const jaco_real t25 = -0.08579425000157839*t23;
-    const jaco_real t26 = t15*s4;
+    const jaco_real t26 = s4*t15;
     const jaco_real t27 = c5*(0.8660254037844386*t4 - 0.5*t26) - t15*c4*s5;
     const jaco_real t28 = 0.5*t4 + 0.8660254037844386*t26;
     const jaco_real t29 = t28;
@@ -1537,8 +1541,8 @@ void jaco_jacobian_dot(const jaco_real q[JACO_DOF], const jaco_real q_dot[JACO_D
     const jaco_real t58 = t21*t51 + t29*t35;
     const jaco_real t59 = t33*t50 + t49*t34;
     const jaco_real t60 = 0.41*c2;
-    const jaco_real t61 = t37 + t60*c1;
-    const jaco_real t62 = t43 - t60*s1;
+    const jaco_real t61 = t37 + c1*t60;
+    const jaco_real t62 = t43 - s1*t60;
     const jaco_real t63 = t61*c1 - t62*s1;
     const jaco_real t64 = qd3*s1;
     const jaco_real t65 = qd2*s1;
@@ -1576,17 +1580,17 @@ void jaco_jacobian_dot(const jaco_real q[JACO_DOF], const jaco_real q_dot[JACO_D
     Jd[1] = -t90*c1 + t53*t91;
     Jd[2] = -(-t89*c1 + t52*t91 + t44*t70);
     Jd[3] = t57*qd1 + t45*t71 - t14*t88 - t82*t4;
-    Jd[4] = -(t81*t29 + t87*t24 + t58*t10 - t46*t72);
-    Jd[5] = -(t59*t31 - t47*t73 + t39*t86 + t49*t80);
+    Jd[4] = -(-t46*t72 + t81*t29 + t87*t24 + t58*t10);
+    Jd[5] = -(-t47*t73 + t59*t31 + t39*t86 + t49*t80);
     Jd[6] = -t79;
     Jd[7] = t90*s1 + t53*t92;
-    Jd[8] = -(t89*s1 + t52*t92 - t44*qd2*s1);
+    Jd[8] = -(t89*s1 - t44*t65 + t52*t92);
     Jd[9] = t88*t13 + t54*qd1 - t76*t4 - t45*t66;
-    Jd[10] = -(t75*t29 + t55*t10 + t46*t67 - t87*t21);
-    Jd[11] = -(t56*t31 + t47*t68 + t49*t74 - t33*t47*qd6);
+    Jd[10] = -(-t87*t21 + t75*t29 + t55*t10 + t46*t67);
+    Jd[11] = -(t56*t31 + t47*t68 - t33*t86 + t49*t74);
     Jd[12] = 0;
     Jd[13] = t78*c1 - t84*s1;
-    Jd[14] = t83*s1 - t77*c1 + t93*(c1*c1) + t93*(s1*s1);
+    Jd[14] = t83*s1 - t77*c1 + (c1*c1)*t93 + (s1*s1)*t93;
     Jd[15] = t54*t71 + t57*t66 - t14*t76 - t82*t13;
     Jd[16] = t55*t72 + t58*t67 - t75*t24 - t81*t21;
     Jd[17] = t56*t73 + t59*t68 - t33*t80 - t39*t74;
@@ -1612,7 +1616,7 @@ void jaco_jacobian_dot(const jaco_real q[JACO_DOF], const jaco_real q_dot[JACO_D
 
 void jaco_bias_acceleration(const jaco_real q[JACO_DOF], const jaco_real q_dot[JACO_DOF], jaco_real a[6])
 {
-    /* 373 operations */
+    /* 371 operations */
 
     /* Inputs */
     const jaco_real q1 = q[0];
@@ -1640,8 +1644,8 @@ void jaco_bias_acceleration(const jaco_real q[JACO_DOF], const jaco_real q_dot[J
     const jaco_real s5 = -sin(q5);
     const jaco_real t0 = c2*c3;
     const jaco_real t1 = s2*s3;
-    const jaco_real t2 = t0*c1 + t1*c1;
-    const jaco_real t3 = t0*s1 + t1*s1;
+    const jaco_real t2 = c1*t0 + c1*t1;
+    const jaco_real t3 = s1*t0 + s1*t1;
     const jaco_real t4 = t0 + t1;
     const jaco_real t5 = t2*c4 + s1*s4;
     const jaco_real t6 = c4*s1 - t2*s4;
@@ -1651,8 +1655,8 @@ void jaco_bias_acceleration(const jaco_real q[JACO_DOF], const jaco_real q_dot[J
     const jaco_real t10 = -qd1 + t4*qd4;
     const jaco_real t11 = c3*s2;
     const jaco_real t12 = c2*s3;
-    const jaco_real t13 = t11*c1 - t12*c1;
-    const jaco_real t14 = t12*s1 - t11*s1;
+    const jaco_real t13 = c1*t11 - c1*t12;
+    const jaco_real t14 = s1*t12 - s1*t11;
     const jaco_real t15 = t11 - t12;
     const jaco_real t16 = -0.25019712500078917*t13;
     const jaco_real t17 = -0.25019712500078917*t14;
@@ -1664,7 +1668,7 @@ void jaco_bias_acceleration(const jaco_real q[JACO_DOF], const jaco_real q_dot[J
     const jaco_real t23 = 0.5*t14 + 0.8660254037844386*t8;
     const jaco_real t24 = t23;
     const jaco_real t25 = -0.08579425000157839*t23;
-    const jaco_real t26 = t15*s4;
+    const jaco_real t26 = s4*t15;
     const jaco_real t27 = c5*(0.8660254037844386*t4 - 0.5*t26) - t15*c4*s5;
     const jaco_real t28 = 0.5*t4 + 0.8660254037844386*t26;
     const jaco_real t29 = t28;
@@ -1699,8 +1703,8 @@ void jaco_bias_acceleration(const jaco_real q[JACO_DOF], const jaco_real q_dot[J
     const jaco_real t58 = t21*t51 + t29*t35;
     const jaco_real t59 = t33*t50 + t49*t34;
     const jaco_real t60 = 0.41*c2;
-    const jaco_real t61 = t37 + t60*c1;
-    const jaco_real t62 = t43 - t60*s1;
+    const jaco_real t61 = t37 + c1*t60;
+    const jaco_real t62 = t43 - s1*t60;
     const jaco_real t63 = t61*c1 - t62*s1;
     const jaco_real t64 = qd3*s1;
     const jaco_real t65 = qd2*s1;
@@ -1729,16 +1733,16 @@ void jaco_bias_acceleration(const jaco_real q[JACO_DOF], const jaco_real q_dot[J
     const jaco_real t88 = t87 + t45*qd4;
     const jaco_real t89 = t88 + t44*qd3;
     const jaco_real t90 = t89 + t63*qd2;
-    const jaco_real t91 = qd1*s1;
+    const jaco_real t91 = s1*qd1;
     const jaco_real t92 = c1*qd1;
     const jaco_real t93 = t52*qd2;
 
     /* Outputs */
-    a[0] = t85*qd1 + qd2*(-t90*c1 + t53*t91) - qd3*(-t89*c1 + t52*t91 + t44*t70) + qd4*(t57*qd1 + t45*t71 - t14*t88 - t82*t4) - qd5*(t81*t29 + t87*t24 + t58*t10 - t46*t72) - qd6*(t59*t31 - t47*t73 + t39*t86 + t49*t80);
-    a[1] = qd2*(t90*s1 + t53*t92) - qd3*(t89*s1 + t52*t92 - t44*qd2*s1) + qd4*(t88*t13 + t54*qd1 - t76*t4 - t45*t66) - qd5*(t75*t29 + t55*t10 + t46*t67 - t87*t21) - qd6*(t56*t31 + t47*t68 + t49*t74 - t33*t47*qd6) - t79*qd1;
-    a[2] = qd2*(t78*c1 - t84*s1) + qd3*(t83*s1 - t77*c1 + t93*(c1*c1) + t93*(s1*s1)) + qd4*(t54*t71 + t57*t66 - t14*t76 - t82*t13) + qd5*(t55*t72 + t58*t67 - t75*t24 - t81*t21) + qd6*(t56*t73 + t59*t68 - t33*t80 - t39*t74);
-    a[3] = qd4*(t4*t71 - t14*qd1) + qd5*(t24*t10 + t29*t72) + qd6*(t39*t31 + t49*t73) + t69*qd1 - t70*qd1;
-    a[4] = qd4*(t13*qd1 - t4*t66) - qd5*(t21*t10 + t29*t67) - qd6*(t33*t31 + t49*t68) + t65*qd1 - t64*qd1;
+    a[0] = t85*qd1 + qd2*(-t90*c1 + t53*t91) - qd3*(-t89*c1 + t52*t91 + t44*t70) + qd4*(t57*qd1 + t45*t71 - t14*t88 - t82*t4) - qd5*(-t46*t72 + t81*t29 + t87*t24 + t58*t10) - qd6*(-t47*t73 + t59*t31 + t39*t86 + t49*t80);
+    a[1] = qd2*(t90*s1 + t53*t92) - qd3*(t89*s1 - t44*t65 + t52*t92) + qd4*(t88*t13 + t54*qd1 - t76*t4 - t45*t66) - qd5*(-t87*t21 + t75*t29 + t55*t10 + t46*t67) - qd6*(t56*t31 + t47*t68 - t33*t86 + t49*t74) - t79*qd1;
+    a[2] = qd2*(t78*c1 - t84*s1) + qd3*(t83*s1 - t77*c1 + (c1*c1)*t93 + (s1*s1)*t93) + qd4*(t54*t71 + t57*t66 - t14*t76 - t82*t13) + qd5*(t55*t72 + t58*t67 - t75*t24 - t81*t21) + qd6*(t56*t73 + t59*t68 - t33*t80 - t39*t74);
+    a[3] = qd4*(t4*t71 - t14*qd1) + qd5*(t24*t10 + t29*t72) + qd6*(t39*t31 + t49*t73) + qd1*t69 - qd1*t70;
+    a[4] = qd4*(t13*qd1 - t4*t66) - qd5*(t21*t10 + t29*t67) - qd6*(t33*t31 + t49*t68) + qd1*t65 - qd1*t64;
     a[5] = qd4*(t13*t71 - t14*t66) + qd5*(t21*t72 - t24*t67) + qd6*(t33*t73 - t39*t68);
 }
 
@@ -1775,8 +1779,8 @@ void jaco_task_jacobian_dot(const jaco_real q[JACO_DOF], const jaco_real q_dot[J
     const jaco_real s6 = cos(0.17453292519943295 + q6);
     const jaco_real t0 = c2*c3;
     const jaco_real t1 = s2*s3;
-    const jaco_real t2 = t0*c1 + t1*c1;
-    const jaco_real t3 = t0*s1 + t1*s1;
+    const jaco_real t2 = c1*t0 + c1*t1;
+    const jaco_real t3 = s1*t0 + s1*t1;
     const jaco_real t4 = t0 + t1;
     const jaco_real t5 = t2*c4 + s1*s4;
     const jaco_real t6 = c4*s1 - t2*s4;
@@ -1785,8 +1789,8 @@ void jaco_task_jacobian_dot(const jaco_real q[JACO_DOF], const jaco_real q_dot[J
     const jaco_real t9 = -0.25019712500078917*t4;
     const jaco_real t10 = c3*s2;
     const jaco_real t11 = c2*s3;
-    const jaco_real t12 = t10*c1 - t11*c1;
-    const jaco_real t13 = t11*s1 - t10*s1;
+    const jaco_real t12 = c1*t10 - c1*t11;
+    const jaco_real t13 = s1*t11 - s1*t10;
     const jaco_real t14 = t10 - t11;
     const jaco_real t15 = -0.25019712500078917*t12;
     const jaco_real t16 = -0.25019712500078917*t13;
@@ -1796,7 +1800,7 @@ void jaco_task_jacobian_dot(const jaco_real q[JACO_DOF], const jaco_real q_dot[J
     const jaco_real t20 = 0.5*t13 + 0.8660254037844386*t8;
     const jaco_real t21 = t20;
     const jaco_real t22 = -0.08579425000157839*t20;
-    const jaco_real t23 = t14*s4;
+    const jaco_real t23 = s4*t14;
     const jaco_real t24 = 0.5*t4 + 0.8660254037844386*t23;
     const jaco_real t25 = t24;
     const jaco_real t26 = 0.08579425000157839*t24;
@@ -1809,9 +1813,9 @@ void jaco_task_jacobian_dot(const jaco_real q[JACO_DOF], const jaco_real q_dot[J
     const jaco_real t33 = c5*t31 - t7*s5;
     const jaco_real t34 = t32*c6 + s6*(0.5*t33 - 0.8660254037844386*t21);
     const jaco_real t35 = 0.8660254037844386*t4 - 0.5*t23;
-    const jaco_real t36 = t14*c4;
-    const jaco_real t37 = s5*t35 + t36*c5;
-    const jaco_real t38 = c5*t35 - t36*s5;
+    const jaco_real t36 = c4*t14;
+    const jaco_real t37 = s5*t35 + c5*t36;
+    const jaco_real t38 = c5*t35 - s5*t36;
     const jaco_real t39 = t37*c6 + s6*(0.5*t38 + 0.8660254037844386*t25);
     const jaco_real t40 = 0.5*t18 + 0.8660254037844386*t29;
     const jaco_real t41 = t40;
@@ -1842,8 +1846,8 @@ void jaco_task_jacobian_dot(const jaco_real q[JACO_DOF], const jaco_real q_dot[J
     const jaco_real t66 = t18*t59 + t25*t43;
     const jaco_real t67 = t41*t58 + t57*t42;
     const jaco_real t68 = 0.41*c2;
-    const jaco_real t69 = t45 + t68*c1;
-    const jaco_real t70 = t51 - t68*s1;
+    const jaco_real t69 = t45 + c1*t68;
+    const jaco_real t70 = t51 - s1*t68;
     const jaco_real t71 = t69*c1 - t70*s1;
     const jaco_real t72 = qd3*s1;
     const jaco_real t73 = qd2*s1;
@@ -1875,7 +1879,7 @@ void jaco_task_jacobian_dot(const jaco_real q[JACO_DOF], const jaco_real q_dot[J
     const jaco_real t99 = t87 + t98;
     const jaco_real t100 = t47*t99 + t57*t94;
     const jaco_real t101 = t41*t99 + t57*t91;
-    const jaco_real t102 = t86 + t98 + t57*qd6;
+    const jaco_real t102 = t98 + t57*qd6 + t86;
     const jaco_real t103 = t96*t39 + t102*t34;
     const jaco_real t104 = t92*t39 + t102*t30;
     const jaco_real t105 = t64*qd6;
@@ -1905,14 +1909,14 @@ void jaco_task_jacobian_dot(const jaco_real q[JACO_DOF], const jaco_real q_dot[J
     const jaco_real t129 = t123*t12 + t62*qd1 - t107*t4 - t53*t74;
     const jaco_real t130 = t106*t25 + t63*t87 + t54*t82 - t122*t18;
     const jaco_real t131 = t64*t99 + t55*t91 + t57*t105 - t41*t121;
-    const jaco_real t132 = qd1*s1;
+    const jaco_real t132 = s1*qd1;
     const jaco_real t133 = -t125*c1 + t61*t132;
     const jaco_real t134 = -t124*c1 + t60*t132 + t52*t77;
     const jaco_real t135 = c1*qd1;
     const jaco_real t136 = t125*s1 + t61*t135;
     const jaco_real t137 = t124*s1 + t60*t135 - t52*t73;
     const jaco_real t138 = t60*qd2;
-    const jaco_real t139 = t114*s1 - t108*c1 + t138*(c1*c1) + t138*(s1*s1);
+    const jaco_real t139 = t114*s1 - t108*c1 + (c1*c1)*t138 + (s1*s1)*t138;
     const jaco_real t140 = (t30*t30) + (t34*t34);
     const jaco_real t141 = 1.0/t140;
     const jaco_real t142 = c1*t141;
@@ -1925,16 +1929,16 @@ void jaco_task_jacobian_dot(const jaco_real q[JACO_DOF], const jaco_real q_dot[J
     const jaco_real t149 = t34*t148;
     const jaco_real t150 = s1*t141;
     const jaco_real t151 = t30*t148;
-    const jaco_real t152 = t34*qd1;
+    const jaco_real t152 = qd1*t34;
     const jaco_real t153 = t150*t152;
-    const jaco_real t154 = t30*qd1;
+    const jaco_real t154 = qd1*t30;
     const jaco_real t155 = t142*t154;
     const jaco_real t156 = t145*t147;
     const jaco_real t157 = t34*t156;
     const jaco_real t158 = t30*t156;
     const jaco_real t159 = t13*t141;
     const jaco_real t160 = -(t13*t34 + t30*t12);
-    const jaco_real t161 = t147*t160;
+    const jaco_real t161 = t160*t147;
     const jaco_real t162 = t34*t161;
     const jaco_real t163 = t12*t141;
     const jaco_real t164 = t30*t161;
@@ -1944,7 +1948,7 @@ void jaco_task_jacobian_dot(const jaco_real q[JACO_DOF], const jaco_real q_dot[J
     const jaco_real t168 = t75*t167;
     const jaco_real t169 = t21*t141;
     const jaco_real t170 = -(t18*t30 + t21*t34);
-    const jaco_real t171 = t147*t170;
+    const jaco_real t171 = t170*t147;
     const jaco_real t172 = t34*t171;
     const jaco_real t173 = t18*t141;
     const jaco_real t174 = t30*t171;
@@ -1952,7 +1956,7 @@ void jaco_task_jacobian_dot(const jaco_real q[JACO_DOF], const jaco_real q_dot[J
     const jaco_real t176 = t89*t167;
     const jaco_real t177 = t47*t141;
     const jaco_real t178 = -(t41*t30 + t47*t34);
-    const jaco_real t179 = t147*t178;
+    const jaco_real t179 = t178*t147;
     const jaco_real t180 = t34*t179;
     const jaco_real t181 = t41*t141;
     const jaco_real t182 = t30*t179;
@@ -1965,7 +1969,7 @@ void jaco_task_jacobian_dot(const jaco_real q[JACO_DOF], const jaco_real q_dot[J
     const jaco_real t189 = t30*c1;
     const jaco_real t190 = t187*(t188 - t189);
     const jaco_real t191 = c1*t185;
-    const jaco_real t192 = t185*qd1;
+    const jaco_real t192 = qd1*t185;
     const jaco_real t193 = t143*t192 + t144*t192;
     const jaco_real t194 = t187*(t189 - t188);
     const jaco_real t195 = t187*(t34*t12 - t13*t30);
@@ -1973,11 +1977,11 @@ void jaco_task_jacobian_dot(const jaco_real q[JACO_DOF], const jaco_real q_dot[J
     const jaco_real t197 = t34*t185;
     const jaco_real t198 = t187*(t18*t34 - t21*t30);
     const jaco_real t199 = t187*(t41*t34 - t47*t30);
-    const jaco_real t200 = t39*t150;
-    const jaco_real t201 = t39*t142;
-    const jaco_real t202 = t97*t141;
-    const jaco_real t203 = t152*t200;
-    const jaco_real t204 = t154*t201;
+    const jaco_real t200 = t39*t142;
+    const jaco_real t201 = t39*t150;
+    const jaco_real t202 = t141*t97;
+    const jaco_real t203 = t200*t154;
+    const jaco_real t204 = t201*t152;
 
     /* Outputs */
     Jd[0] = t116;
@@ -2005,15 +2009,15 @@ void jaco_task_jacobian_dot(const jaco_real q[JACO_DOF], const jaco_real q_dot[J
     Jd[22] = -t104*(t169 + t172) + t103*(t173 + t174) + t175 - t176;
     Jd[23] = -t104*(t177 + t180) + t103*(t181 + t182) + t183 - t184;
     Jd[24] = 0;
-    Jd[25] = t193 + t103*(t191 + t30*t190) + t104*(t186 - t34*t190);
-    Jd[26] = -(t193 + t103*(t191 - t30*t194) + t104*(t186 + t34*t194));
+    Jd[25] = t104*(t186 - t34*t190) + t103*(t191 + t30*t190) + t193;
+    Jd[26] = -(t104*(t186 + t34*t194) + t103*(t191 - t30*t194) + t193);
     Jd[27] = t104*(t12*t185 - t34*t195) + t103*(t13*t185 + t30*t195) + t75*t196 - t79*t197;
-    Jd[28] = -(-t103*(t21*t185 + t30*t198) - t104*(t18*t185 - t34*t198) + t88*t197 + t89*t196);
-    Jd[29] = -(-t103*(t47*t185 + t30*t199) - t104*(t41*t185 - t34*t199) + t100*t197 + t101*t196);
+    Jd[28] = -(-t104*(t18*t185 - t34*t198) - t103*(t21*t185 + t30*t198) + t88*t197 + t89*t196);
+    Jd[29] = -(-t104*(t41*t185 - t34*t199) - t103*(t47*t185 + t30*t199) + t100*t197 + t101*t196);
     Jd[30] = 0;
-    Jd[31] = -(t103*(t200 + t39*t151) - t104*(t201 + t39*t149) + t146*t202 + t203 - t204);
-    Jd[32] = -(t103*(-t200 + t39*t158) - t104*(-t201 + t39*t157) + t145*t202 + t204 - t203);
-    Jd[33] = -(-t80 + t103*(t39*t163 + t39*t164) - t104*(t39*t159 + t39*t162) + t160*t202 + t39*t166 + t39*t168);
+    Jd[31] = -(-t104*(t200 + t39*t149) + t103*(t201 + t39*t151) + t146*t202 - t203 + t204);
+    Jd[32] = -(-t104*(-t200 + t39*t157) + t103*(-t201 + t39*t158) + t145*t202 - t204 + t203);
+    Jd[33] = -(-t80 - t104*(t39*t159 + t39*t162) + t103*(t39*t163 + t39*t164) + t160*t202 + t39*t166 + t39*t168);
     Jd[34] = t85 + t104*(t39*t169 + t39*t172) - t103*(t39*t173 + t39*t174) - t170*t202 + t39*t176 - t39*t175;
     Jd[35] = t95 + t104*(t39*t177 + t39*t180) - t103*(t39*t181 + t39*t182) - t178*t202 + t39*t184 - t39*t183;
 }
@@ -2042,8 +2046,8 @@ void jaco_hessian(const jaco_real q[JACO_DOF], jaco_real H[JACO_DOF * 6 * JACO_D
     const jaco_real s5 = -sin(q5);
     const jaco_real t0 = c2*c3;
     const jaco_real t1 = s2*s3;
-    const jaco_real t2 = t0*c1 + t1*c1;
-    const jaco_real t3 = t0*s1 + t1*s1;
+    const jaco_real t2 = c1*t0 + c1*t1;
+    const jaco_real t3 = s1*t0 + s1*t1;
     const jaco_real t4 = t0 + t1;
     const jaco_real t5 = t2*c4 + s1*s4;
     const jaco_real t6 = c4*s1 - t2*s4;
@@ -2052,8 +2056,8 @@ void jaco_hessian(const jaco_real q[JACO_DOF], jaco_real H[JACO_DOF * 6 * JACO_D
     const jaco_real t9 = -0.25019712500078917*t4;
     const jaco_real t10 = c3*s2;
     const jaco_real t11 = c2*s3;
-    const jaco_real t12 = t10*c1 - t11*c1;
-    const jaco_real t13 = t11*s1 - t10*s1;
+    const jaco_real t12 = c1*t10 - c1*t11;
+    const jaco_real t13 = s1*t11 - s1*t10;
     const jaco_real t14 = t10 - t11;
     const jaco_real t15 = -0.25019712500078917*t12;
     const jaco_real t16 = -0.25019712500078917*t13;
@@ -2065,7 +2069,7 @@ void jaco_hessian(const jaco_real q[JACO_DOF], jaco_real H[JACO_DOF * 6 * JACO_D
     const jaco_real t22 = 0.5*t13 + 0.8660254037844386*t8;
     const jaco_real t23 = t22;
     const jaco_real t24 = -0.08579425000157839*t22;
-    const jaco_real t25 = t14*s4;
+    const jaco_real t25 = s4*t14;
     const jaco_real t26 = c5*(0.8660254037844386*t4 - 0.5*t25) - t14*c4*s5;
     const jaco_real t27 = 0.5*t4 + 0.8660254037844386*t25;
     const jaco_real t28 = t27;
@@ -2099,8 +2103,8 @@ void jaco_hessian(const jaco_real q[JACO_DOF], jaco_real H[JACO_DOF * 6 * JACO_D
     const jaco_real t56 = t20*t49 + t28*t33;
     const jaco_real t57 = t31*t48 + t47*t32;
     const jaco_real t58 = 0.41*c2;
-    const jaco_real t59 = t35 + t58*c1;
-    const jaco_real t60 = t41 - t58*s1;
+    const jaco_real t59 = t35 + c1*t58;
+    const jaco_real t60 = t41 - s1*t58;
     const jaco_real t61 = t59*c1 - t60*s1;
     const jaco_real t62 = t51*s1;
     const jaco_real t63 = -t50*s1;
@@ -2390,49 +2394,16 @@ void jaco_singularity_factors(const jaco_real q[JACO_DOF], jaco_real f[JACO_NUM_
     const jaco_real s4 = sin(q4);
     const jaco_real c5 = -cos(q5);
     const jaco_real s5 = -sin(q5);
-    const jaco_real t0 = c2*c3*s5;
-    const jaco_real t1 = (s4*s4);
-    const jaco_real t2 = (s3*s3);
-    const jaco_real t3 = c2*s4*s5;
+    const jaco_real t0 = (s3*s3);
+    const jaco_real t1 = c2*(s4*s4);
+    const jaco_real t2 = s5*c2;
+    const jaco_real t3 = s4*t2;
 
     /* Outputs */
-    f[0] = -(0.07333133870465747*s2*s5 + 0.10258082125032357*t0 + 0.0008407836500154682*c2*c5*t1 - 0.07333133870465747*s2*s5*t2 + 0.01758782125032357*t0*t1 + 0.018589646387558636*t2*t3 + 0.0004203918250077341*t3*c4 - 0.07333133870465747*c2*c3*s3*s5 - 0.030463*c2*s3*s4*s5 - 0.03517564250064714*c2*c3*c4*c5*s4 - 0.018589646387558636*c3*s2*s3*s4*s5);
+    f[0] = -(0.07333133870465747*s2*s5 - 0.07333133870465747*s2*s5*t0 + 0.0008407836500154682*c5*t1 + 0.10258082125032357*c3*t2 - 0.030463*c2*s3*s4*s5 - 0.07333133870465747*c2*c3*s3*s5 + 0.0004203918250077341*c4*t3 + 0.01758782125032357*s5*c3*t1 + 0.018589646387558636*t0*t3 - 0.018589646387558636*c3*s2*s3*s4*s5 - 0.03517564250064714*c2*c3*c4*c5*s4);
 }
 
 jaco_real jaco_manipulability(const jaco_real q[JACO_DOF])
-{
-    /* 55 operations */
-
-    /* Inputs */
-    const jaco_real q2 = q[1];
-    const jaco_real q3 = q[2];
-    const jaco_real q4 = q[3];
-    const jaco_real q5 = q[4];
-
-    /* Intermediate terms */
-    const jaco_real c2 = sin(q2);
-    const jaco_real s2 = -cos(q2);
-    const jaco_real c3 = -sin(q3);
-    const jaco_real s3 = cos(q3);
-    const jaco_real c4 = cos(q4);
-    const jaco_real s4 = sin(q4);
-    const jaco_real c5 = -cos(q5);
-    const jaco_real s5 = -sin(q5);
-    const jaco_real t0 = 0.02254938665168217*s5;
-    const jaco_real t1 = t0*s2;
-    const jaco_real t2 = c2*(s4*s4);
-    const jaco_real t3 = c2*s5;
-    const jaco_real t4 = (s3*s3);
-    const jaco_real t5 = t3*s4;
-    const jaco_real t6 = c3*s5;
-    const jaco_real t7 = c2*c3;
-    const jaco_real t8 = t1 + 0.0002585409723797565*t2*c5 + 0.031543602534474496*t3*c3 - t1*t4 + 0.00012927048618987825*t5*c4 + 0.005716316264174281*t4*t5 + 0.005408255034474498*t2*t6 - 0.0093673725*t5*s3 - t0*t7*s3 - 0.005716316264174281*t6*s2*s3*s4 - 0.010816510068948995*t7*c4*c5*s4;
-
-    /* Outputs */
-    return fabs(t8);
-}
-
-jaco_real jaco_jacobian_det(const jaco_real q[JACO_DOF])
 {
     /* 54 operations */
 
@@ -2452,16 +2423,51 @@ jaco_real jaco_jacobian_det(const jaco_real q[JACO_DOF])
     const jaco_real c5 = -cos(q5);
     const jaco_real s5 = -sin(q5);
     const jaco_real t0 = 0.02254938665168217*s5;
-    const jaco_real t1 = t0*s2;
-    const jaco_real t2 = c2*(s4*s4);
-    const jaco_real t3 = c2*s5;
-    const jaco_real t4 = (s3*s3);
-    const jaco_real t5 = t3*s4;
-    const jaco_real t6 = c3*s5;
-    const jaco_real t7 = c2*c3;
+    const jaco_real t1 = s2*t0;
+    const jaco_real t2 = s5*c2;
+    const jaco_real t3 = s4*t2;
+    const jaco_real t4 = c3*t2;
+    const jaco_real t5 = (s3*s3);
+    const jaco_real t6 = (s4*s4);
+    const jaco_real t7 = c2*c5;
+    const jaco_real t8 = c3*s3;
+    const jaco_real t9 = t1 - 0.0093673725*s3*t3 + 0.031543602534474496*t4 - t5*t1 + 0.0002585409723797565*t6*t7 + 0.005716316264174281*t5*t3 - c2*t0*t8 + 0.005408255034474498*t6*t4 + 0.00012927048618987825*c4*t3 - 0.010816510068948995*c3*s4*c4*t7 - 0.005716316264174281*s2*s5*s4*t8;
 
     /* Outputs */
-    return t1 + 0.0002585409723797565*t2*c5 + 0.031543602534474496*t3*c3 - t1*t4 + 0.00012927048618987825*t5*c4 + 0.005716316264174281*t4*t5 + 0.005408255034474498*t2*t6 - 0.0093673725*t5*s3 - t0*t7*s3 - 0.005716316264174281*t6*s2*s3*s4 - 0.010816510068948995*t7*c4*c5*s4;
+    return fabs(t9);
+}
+
+jaco_real jaco_jacobian_det(const jaco_real q[JACO_DOF])
+{
+    /* 53 operations */
+
+    /* Inputs */
+    const jaco_real q2 = q[1];
+    const jaco_real q3 = q[2];
+    const jaco_real q4 = q[3];
+    const jaco_real q5 = q[4];
+
+    /* Intermediate terms */
+    const jaco_real c2 = sin(q2);
+    const jaco_real s2 = -cos(q2);
+    const jaco_real c3 = -sin(q3);
+    const jaco_real s3 = cos(q3);
+    const jaco_real c4 = cos(q4);
+    const jaco_real s4 = sin(q4);
+    const jaco_real c5 = -cos(q5);
+    const jaco_real s5 = -sin(q5);
+    const jaco_real t0 = 0.02254938665168217*s5;
+    const jaco_real t1 = s2*t0;
+    const jaco_real t2 = s5*c2;
+    const jaco_real t3 = s4*t2;
+    const jaco_real t4 = c3*t2;
+    const jaco_real t5 = (s3*s3);
+    const jaco_real t6 = (s4*s4);
+    const jaco_real t7 = c2*c5;
+    const jaco_real t8 = c3*s3;
+
+    /* Outputs */
+    return t1 - 0.0093673725*s3*t3 + 0.031543602534474496*t4 - t5*t1 + 0.0002585409723797565*t6*t7 + 0.005716316264174281*t5*t3 - c2*t0*t8 + 0.005408255034474498*t6*t4 + 0.00012927048618987825*c4*t3 - 0.010816510068948995*c3*s4*c4*t7 - 0.005716316264174281*s2*s5*s4*t8;
 }
 
 int jaco_velocity_ik(const jaco_real q[JACO_DOF], const jaco_real mu_dot[JACO_TASK_DIM], jaco_real damping, jaco_real q_dot[JACO_DOF])
@@ -2495,8 +2501,8 @@ int jaco_velocity_ik(const jaco_real q[JACO_DOF], const jaco_real mu_dot[JACO_TA
     const jaco_real s5 = -sin(q5);
     const jaco_real t0 = c2*c3;
     const jaco_real t1 = s2*s3;
-    const jaco_real t2 = t0*c1 + t1*c1;
-    const jaco_real t3 = t0*s1 + t1*s1;
+    const jaco_real t2 = c1*t0 + c1*t1;
+    const jaco_real t3 = s1*t0 + s1*t1;
     const jaco_real t4 = t0 + t1;
     const jaco_real t5 = t2*c4 + s1*s4;
     const jaco_real t6 = c4*s1 - t2*s4;
@@ -2505,8 +2511,8 @@ int jaco_velocity_ik(const jaco_real q[JACO_DOF], const jaco_real mu_dot[JACO_TA
     const jaco_real t9 = -0.25019712500078917*t4;
     const jaco_real t10 = c3*s2;
     const jaco_real t11 = c2*s3;
-    const jaco_real t12 = t10*c1 - t11*c1;
-    const jaco_real t13 = t11*s1 - t10*s1;
+    const jaco_real t12 = c1*t10 - c1*t11;
+    const jaco_real t13 = s1*t11 - s1*t10;
     const jaco_real t14 = t10 - t11;
     const jaco_real t15 = -0.25019712500078917*t12;
     const jaco_real t16 = -0.25019712500078917*t13;
@@ -2518,7 +2524,7 @@ int jaco_velocity_ik(const jaco_real q[JACO_DOF], const jaco_real mu_dot[JACO_TA
     const jaco_real t22 = 0.5*t13 + 0.8660254037844386*t8;
     const jaco_real t23 = t22;
     const jaco_real t24 = -0.08579425000157839*t22;
-    const jaco_real t25 = t14*s4;
+    const jaco_real t25 = s4*t14;
     const jaco_real t26 = c5*(0.8660254037844386*t4 - 0.5*t25) - t14*c4*s5;
     const jaco_real t27 = 0.5*t4 + 0.8660254037844386*t25;
     const jaco_real t28 = t27;
@@ -2555,8 +2561,8 @@ int jaco_velocity_ik(const jaco_real q[JACO_DOF], const jaco_real mu_dot[JACO_TA
     const jaco_real t59 = t4*t12 + t20*t28 + t31*t47;
     const jaco_real t60 = t13*t4 + t23*t28 + t37*t47;
     const jaco_real t61 = 0.41*c2;
-    const jaco_real t62 = t35 + t61*c1;
-    const jaco_real t63 = t41 - t61*s1;
+    const jaco_real t62 = t35 + c1*t61;
+    const jaco_real t63 = t41 - s1*t61;
     const jaco_real t64 = t62*c1 - t63*s1;
     const jaco_real t65 = t63 + t4*t52 + t28*t53 + t47*t54;
     const jaco_real t66 = t62 + t4*t55 + t28*t56 + t47*t57;
@@ -2567,7 +2573,7 @@ int jaco_velocity_ik(const jaco_real q[JACO_DOF], const jaco_real mu_dot[JACO_TA
     const jaco_real t71 = (t51*t51);
     const jaco_real t72 = (t52*t52) + (t53*t53) + (t54*t54) + t68*t69 + t71*t69;
     const jaco_real t73 = t67 + t72;
-    const jaco_real t74 = c1*s1;
+    const jaco_real t74 = s1*c1;
     const jaco_real t75 = t62*t63 + t52*t55 + t53*t56 + t54*t57 + t68*t74 + t71*t74;
     const jaco_real t76 = t13*t12 + t20*t23 + t31*t37 + 2*t74;
     const jaco_real t77 = t64*c1;
@@ -2576,9 +2582,9 @@ int jaco_velocity_ik(const jaco_real q[JACO_DOF], const jaco_real mu_dot[JACO_TA
     const jaco_real t80 = t13*t43 + t23*t44 + t37*t45 + t77 - t78;
     const jaco_real t81 = t50*c1;
     const jaco_real t82 = t51*c1;
-    const jaco_real t83 = t81*s1 + t82*s1;
-    const jaco_real t84 = t83 + t20*t53 + t31*t54 + t52*t12;
-    const jaco_real t85 = t83 + t13*t55 + t23*t56 + t37*t57;
+    const jaco_real t83 = s1*t81 + s1*t82;
+    const jaco_real t84 = t20*t53 + t31*t54 + t52*t12 + t83;
+    const jaco_real t85 = t13*t55 + t23*t56 + t37*t57 + t83;
     const jaco_real t86 = (t62*t62);
     const jaco_real t87 = (s1*s1);
     const jaco_real t88 = t20*t56 + t31*t57 + t50*t87 + t51*t87 + t12*t55;
@@ -2617,7 +2623,7 @@ int jaco_velocity_ik(const jaco_real q[JACO_DOF], const jaco_real mu_dot[JACO_TA
     const jaco_real t121 = (t118 > 0 ? 1/(t118*(t118 + fabs(t105))) : 0);
     const jaco_real t122 = -t121*(t75*t120 + t75*t107 + t65*t66 + t79*t93 + t84*t88 + t70*t85);
     const jaco_real t123 = t75 + t120*t122;
-    const jaco_real t124 = t107 + t75*t122;
+    const jaco_real t124 = t75*t122 + t107;
     const jaco_real t125 = t93 + t79*t122;
     const jaco_real t126 = t88 + t84*t122;
     const jaco_real t127 = t85 + t70*t122;
@@ -2625,7 +2631,7 @@ int jaco_velocity_ik(const jaco_real q[JACO_DOF], const jaco_real mu_dot[JACO_TA
     const jaco_real t129 = -t121*(t75*t93 + t65*t58 + t79*t120 + t79*t108 + t84*t94 + t70*t80);
     const jaco_real t130 = t79 + t120*t129;
     const jaco_real t131 = t93 + t75*t129;
-    const jaco_real t132 = t108 + t79*t129;
+    const jaco_real t132 = t79*t129 + t108;
     const jaco_real t133 = t94 + t84*t129;
     const jaco_real t134 = t80 + t70*t129;
     const jaco_real t135 = t58 + t65*t129;
@@ -2633,7 +2639,7 @@ int jaco_velocity_ik(const jaco_real q[JACO_DOF], const jaco_real mu_dot[JACO_TA
     const jaco_real t137 = t84 - t120*t136;
     const jaco_real t138 = -t88 + t75*t136;
     const jaco_real t139 = -t94 + t79*t136;
-    const jaco_real t140 = t109 - t84*t136;
+    const jaco_real t140 = -t84*t136 + t109;
     const jaco_real t141 = t76 - t70*t136;
     const jaco_real t142 = -t59 + t65*t136;
     const jaco_real t143 = t121*(t75*t85 + t65*t60 + t79*t80 + t84*t76 + t70*t120 + t70*t110);
@@ -2641,7 +2647,7 @@ int jaco_velocity_ik(const jaco_real q[JACO_DOF], const jaco_real mu_dot[JACO_TA
     const jaco_real t145 = -t85 + t75*t143;
     const jaco_real t146 = -t80 + t79*t143;
     const jaco_real t147 = t76 - t84*t143;
-    const jaco_real t148 = t110 - t70*t143;
+    const jaco_real t148 = -t70*t143 + t110;
     const jaco_real t149 = -t60 + t65*t143;
     const jaco_real t150 = -t121*(t75*t66 + t65*t120 + t65*t111 + t79*t58 + t84*t59 + t70*t60);
     const jaco_real t151 = t65 + t120*t150;
@@ -2649,7 +2655,7 @@ int jaco_velocity_ik(const jaco_real q[JACO_DOF], const jaco_real mu_dot[JACO_TA
     const jaco_real t153 = t58 + t79*t150;
     const jaco_real t154 = t59 + t84*t150;
     const jaco_real t155 = t60 + t70*t150;
-    const jaco_real t156 = t111 + t65*t150;
+    const jaco_real t156 = t65*t150 + t111;
     const jaco_real t157 = t121*(t84*mu_dot3 + t70*mu_dot4 + t120*mu_dot0 - t75*mu_dot1 - t65*mu_dot5 - t79*mu_dot2);
     const jaco_real t158 = mu_dot0 - t120*t157;
     const jaco_real t159 = mu_dot1 + t75*t157;
@@ -2752,18 +2758,18 @@ int jaco_velocity_ik(const jaco_real q[JACO_DOF], const jaco_real mu_dot[JACO_TA
     const jaco_real t256 = (t223 != 0 ? -(t235 - (t227*t255 + t231*t254))/t223 : 0);
     const jaco_real t257 = (t199 != 0 ? -(t218 - (t203*t256 + t208*t255 + t213*t254))/t199 : 0);
     const jaco_real t258 = (t165 != 0 ? -(t193 - (t169*t257 + t175*t256 + t181*t255 + t187*t254))/t165 : 0);
-    const jaco_real t259 = (t119 != 0 ? -(t158 + t123*t258 + t130*t257 + t151*t254 - t137*t256 - t144*t255)/t119 : 0);
+    const jaco_real t259 = (t119 != 0 ? -(t158 - t137*t256 - t144*t255 + t123*t258 + t130*t257 + t151*t254)/t119 : 0);
     const jaco_real t260 = t254 + t258*t62 - t259*t63;
     const jaco_real t261 = t4*t254 + t257*t43 + t258*t55 - t13*t255 - t256*t12 - t259*t52;
     const jaco_real t262 = t254*t28 + t257*t44 + t258*t56 - t20*t256 - t23*t255 - t259*t53;
     const jaco_real t263 = t254*t47 + t257*t45 + t258*t57 - t255*t37 - t256*t31 - t259*t54;
     const jaco_real t264 = t51*s1;
     const jaco_real t265 = t255*c1 + t256*s1;
-    const jaco_real t266 = t265 + t259*t82 - t257*t64 - t258*t264;
+    const jaco_real t266 = -t257*t64 + t259*t82 - t258*t264 + t265;
     const jaco_real t267 = t50*s1;
-    const jaco_real t268 = t265 + t257*t42 + t259*t81 - t258*t267;
+    const jaco_real t268 = t257*t42 + t259*t81 - t258*t267 + t265;
     const jaco_real t269 = 1 + t86 + t67;
-    const jaco_real t270 = sqrt(t72 + t89 + t96 + t98 + t100 + t102 + t269);
+    const jaco_real t270 = sqrt(t269 + t98 + t100 + t102 + t96 + t72 + t89);
     const jaco_real t271 = sqrt(t269);
     const jaco_real t272 = t271*(t63 >= 0 ? 1 : -1);
     const jaco_real t273 = t272 + t63;
@@ -2785,7 +2791,7 @@ int jaco_velocity_ik(const jaco_real q[JACO_DOF], const jaco_real mu_dot[JACO_TA
     const jaco_real t289 = t54 + t273*t288;
     const jaco_real t290 = t57 + t288*t62;
     const jaco_real t291 = t288 + t47;
-    const jaco_real t292 = -t274*(mu_dot5 + t62*mu_dot1 - t273*mu_dot0);
+    const jaco_real t292 = -t274*(mu_dot5 - t273*mu_dot0 + t62*mu_dot1);
     const jaco_real t293 = mu_dot0 - t273*t292;
     const jaco_real t294 = mu_dot1 + t292*t62;
     const jaco_real t295 = t292 + mu_dot5;
@@ -2893,13 +2899,13 @@ int jaco_velocity_ik(const jaco_real q[JACO_DOF], const jaco_real mu_dot[JACO_TA
     const jaco_real t397 = (t345 != 0 ? -(t349 - (t362*t396 + t382*t395))/t345 : 0);
     const jaco_real t398 = (t327 != 0 ? -(t331 - (t340*t397 + t357*t396 + t377*t395))/t327 : 0);
     const jaco_real t399 = (t297 != 0 ? -(t313 - (t321*t398 + t301*t397 + t305*t396 + t309*t395))/t297 : 0);
-    const jaco_real t400 = (t272 != 0 ? -(t293 + t276*t399 + t281*t397 + t285*t396 + t289*t395 - t279*t398)/t272 : 0);
+    const jaco_real t400 = (t272 != 0 ? -(t293 - t279*t398 + t276*t399 + t281*t397 + t285*t396 + t289*t395)/t272 : 0);
     const int t401 = isfinite(t388);
     const int t402 = damping >= 0;
     const jaco_real t403 = 1e-12*t270;
     const int t404 = damping > 0;
     const jaco_real t405 = 1e-12*t117;
-    const int t406 = (t404 && ((t118 <= t405) || (t164 <= t405) || (t198 <= t405) || (t222 <= t405) || (t238 <= t405) || (t249 <= t405))) || (damping <= 0 && ((t271 <= t403) || (t296 <= t403) || (t326 <= t403) || (t344 <= t403) || (t365 <= t403) || (t390 <= t403)));
+    const int t406 = (damping <= 0 && ((t271 <= t403) || (t296 <= t403) || (t326 <= t403) || (t344 <= t403) || (t365 <= t403) || (t390 <= t403))) || (t404 && ((t118 <= t405) || (t164 <= t405) || (t198 <= t405) || (t222 <= t405) || (t238 <= t405) || (t249 <= t405)));
     const int t407 = t401 && t402 && !t406;
 
     /* Outputs */
@@ -2958,8 +2964,8 @@ jaco_real jaco_ik_numeric_step(const jaco_real target[16], const jaco_real q[JAC
     const jaco_real t0 = T00 + T01 + T02 + T03 + T10 + T11 + T12 + T13 + T20 + T21 + T22 + T23 + qs1 + qs2 + qs3 + qs4 + qs5 + qs6;
     const jaco_real t1 = c2*c3;
     const jaco_real t2 = s2*s3;
-    const jaco_real t3 = t1*c1 + t2*c1;
-    const jaco_real t4 = t1*s1 + t2*s1;
+    const jaco_real t3 = c1*t1 + c1*t2;
+    const jaco_real t4 = s1*t1 + s1*t2;
     const jaco_real t5 = t1 + t2;
     const jaco_real t6 = t3*c4 + s1*s4;
     const jaco_real t7 = c4*s1 - t3*s4;
@@ -2968,8 +2974,8 @@ jaco_real jaco_ik_numeric_step(const jaco_real target[16], const jaco_real q[JAC
     const jaco_real t10 = -0.25019712500078917*t5;
     const jaco_real t11 = c3*s2;
     const jaco_real t12 = c2*s3;
-    const jaco_real t13 = t11*c1 - t12*c1;
-    const jaco_real t14 = t12*s1 - t11*s1;
+    const jaco_real t13 = c1*t11 - c1*t12;
+    const jaco_real t14 = s1*t12 - s1*t11;
     const jaco_real t15 = t11 - t12;
     const jaco_real t16 = -0.25019712500078917*t13;
     const jaco_real t17 = -0.25019712500078917*t14;
@@ -2979,7 +2985,7 @@ jaco_real jaco_ik_numeric_step(const jaco_real target[16], const jaco_real q[JAC
     const jaco_real t21 = 0.5*t14 + 0.8660254037844386*t9;
     const jaco_real t22 = t21;
     const jaco_real t23 = -0.08579425000157839*t21;
-    const jaco_real t24 = t15*s4;
+    const jaco_real t24 = s4*t15;
     const jaco_real t25 = 0.5*t5 + 0.8660254037844386*t24;
     const jaco_real t26 = t25;
     const jaco_real t27 = 0.08579425000157839*t25;
@@ -2990,9 +2996,9 @@ jaco_real jaco_ik_numeric_step(const jaco_real target[16], const jaco_real q[JAC
     const jaco_real t32 = t8*c5 + s5*t31;
     const jaco_real t33 = c5*t31 - t8*s5;
     const jaco_real t34 = 0.8660254037844386*t5 - 0.5*t24;
-    const jaco_real t35 = t15*c4;
-    const jaco_real t36 = s5*t34 + t35*c5;
-    const jaco_real t37 = c5*t34 - t35*s5;
+    const jaco_real t35 = c4*t15;
+    const jaco_real t36 = s5*t34 + c5*t35;
+    const jaco_real t37 = c5*t34 - s5*t35;
     const jaco_real t38 = 0.5*t19 + 0.8660254037844386*t30;
     const jaco_real t39 = t38;
     const jaco_real t40 = 0.2115971250007892*t38;
@@ -3050,8 +3056,8 @@ jaco_real jaco_ik_numeric_step(const jaco_real target[16], const jaco_real q[JAC
     const jaco_real t92 = -0.5*(t88 + t77);
     const jaco_real t93 = sqrt((t91*t91) + (t92*t92) + (t84*t84));
     const jaco_real t94 = 0.41*c2;
-    const jaco_real t95 = t43 + t94*c1;
-    const jaco_real t96 = t49 - t94*s1;
+    const jaco_real t95 = t43 + c1*t94;
+    const jaco_real t96 = t49 - s1*t94;
     const jaco_real t97 = t95*c1 - t96*s1;
     const jaco_real t98 = t96 + t5*t61 + t26*t62 + t55*t63;
     const jaco_real t99 = t95 + t5*t64 + t26*t65 + t55*t66;
@@ -3064,7 +3070,7 @@ jaco_real jaco_ik_numeric_step(const jaco_real target[16], const jaco_real q[JAC
     const jaco_real t106 = (t14*t14) + (t22*t22) + (t45*t45) + 2*t104;
     const jaco_real t107 = (t59*t59);
     const jaco_real t108 = (t96*t96) + (t61*t61) + (t62*t62) + (t63*t63) + t103*t104 + t107*t104;
-    const jaco_real t109 = c1*s1;
+    const jaco_real t109 = s1*c1;
     const jaco_real t110 = t95*t96 + t61*t64 + t62*t65 + t63*t66 + t103*t109 + t107*t109;
     const jaco_real t111 = t14*t13 + t19*t22 + t39*t45 + 2*t109;
     const jaco_real t112 = t97*c1;
@@ -3072,8 +3078,8 @@ jaco_real jaco_ik_numeric_step(const jaco_real target[16], const jaco_real q[JAC
     const jaco_real t114 = t61*t51 + t62*t52 + t63*t53 + t59*t112 - t58*t113;
     const jaco_real t115 = t14*t51 + t22*t52 + t45*t53 + t112 - t113;
     const jaco_real t116 = t58*t109 + t59*t109;
-    const jaco_real t117 = t116 + t19*t62 + t39*t63 + t61*t13;
-    const jaco_real t118 = t116 + t14*t64 + t22*t65 + t45*t66;
+    const jaco_real t117 = t19*t62 + t39*t63 + t61*t13 + t116;
+    const jaco_real t118 = t14*t64 + t22*t65 + t45*t66 + t116;
     const jaco_real t119 = (s1*s1);
     const jaco_real t120 = (t95*t95) + (t64*t64) + (t65*t65) + (t66*t66) + t103*t119 + t107*t119;
     const jaco_real t121 = t19*t65 + t39*t66 + t58*t119 + t59*t119 + t13*t64;
@@ -3114,7 +3120,7 @@ jaco_real jaco_ik_numeric_step(const jaco_real target[16], const jaco_real q[JAC
     const jaco_real t156 = t120 + damping;
     const jaco_real t157 = -t148*(t110*t147 + t110*t156 + t98*t99 + t114*t125 + t117*t121 + t105*t118);
     const jaco_real t158 = t110 + t147*t157;
-    const jaco_real t159 = t156 + t110*t157;
+    const jaco_real t159 = t110*t157 + t156;
     const jaco_real t160 = t125 + t114*t157;
     const jaco_real t161 = t121 + t117*t157;
     const jaco_real t162 = t118 + t105*t157;
@@ -3133,7 +3139,7 @@ jaco_real jaco_ik_numeric_step(const jaco_real target[16], const jaco_real q[JAC
     const jaco_real t175 = -t148*(t110*t125 + t98*t67 + t114*t147 + t114*t174 + t117*t126 + t105*t115);
     const jaco_real t176 = t114 + t147*t175;
     const jaco_real t177 = t125 + t110*t175;
-    const jaco_real t178 = t174 + t114*t175;
+    const jaco_real t178 = t114*t175 + t174;
     const jaco_real t179 = t126 + t117*t175;
     const jaco_real t180 = t115 + t105*t175;
     const jaco_real t181 = t67 + t98*t175;
@@ -3157,7 +3163,7 @@ jaco_real jaco_ik_numeric_step(const jaco_real target[16], const jaco_real q[JAC
     const jaco_real t199 = t117 - t147*t198;
     const jaco_real t200 = -t121 + t110*t198;
     const jaco_real t201 = -t126 + t114*t198;
-    const jaco_real t202 = t197 - t117*t198;
+    const jaco_real t202 = -t117*t198 + t197;
     const jaco_real t203 = t111 - t105*t198;
     const jaco_real t204 = -t68 + t98*t198;
     const jaco_real t205 = t167*(t160*t201 + t163*t204 + t200*t166 - t161*t202 - t162*t203);
@@ -3185,7 +3191,7 @@ jaco_real jaco_ik_numeric_step(const jaco_real target[16], const jaco_real q[JAC
     const jaco_real t227 = -t118 + t110*t225;
     const jaco_real t228 = -t115 + t114*t225;
     const jaco_real t229 = t111 - t117*t225;
-    const jaco_real t230 = t224 - t105*t225;
+    const jaco_real t230 = -t105*t225 + t224;
     const jaco_real t231 = -t69 + t98*t225;
     const jaco_real t232 = t167*(t160*t228 + t163*t231 + t227*t166 - t161*t229 - t162*t230);
     const jaco_real t233 = t227 - t166*t232;
@@ -3216,7 +3222,7 @@ jaco_real jaco_ik_numeric_step(const jaco_real target[16], const jaco_real q[JAC
     const jaco_real t258 = t67 + t114*t255;
     const jaco_real t259 = t68 + t117*t255;
     const jaco_real t260 = t69 + t105*t255;
-    const jaco_real t261 = t254 + t98*t255;
+    const jaco_real t261 = t98*t255 + t254;
     const jaco_real t262 = t167*(t160*t258 + t161*t259 + t162*t260 + t163*t261 + t257*t166);
     const jaco_real t263 = t257 - t166*t262;
     const jaco_real t264 = t258 - t160*t262;
@@ -3246,15 +3252,15 @@ jaco_real jaco_ik_numeric_step(const jaco_real target[16], const jaco_real q[JAC
     const jaco_real t288 = (t217 != 0 ? -(t221 - (t244*t287 + t274*t286))/t217 : 0);
     const jaco_real t289 = (t189 != 0 ? -(t193 - (t212*t288 + t239*t287 + t269*t286))/t189 : 0);
     const jaco_real t290 = (t165 != 0 ? -(t169 - (t183*t289 + t206*t288 + t233*t287 + t263*t286))/t165 : 0);
-    const jaco_real t291 = (t146 != 0 ? -(t150 + t158*t290 + t176*t289 + t256*t286 - t199*t288 - t226*t287)/t146 : 0);
+    const jaco_real t291 = (t146 != 0 ? -(t150 - t199*t288 - t226*t287 + t158*t290 + t176*t289 + t256*t286)/t146 : 0);
     const jaco_real t292 = q1 - t286 + t291*t96 - t290*t95;
     const jaco_real t293 = q4 + t5*t286 + t289*t51 + t290*t64 - t14*t287 - t288*t13 - t291*t61;
     const jaco_real t294 = q5 + t26*t286 + t289*t52 + t290*t65 - t19*t288 - t22*t287 - t291*t62;
     const jaco_real t295 = q6 + t55*t286 + t289*t53 + t290*t66 - t39*t288 - t45*t287 - t291*t63;
     const jaco_real t296 = t287*c1;
     const jaco_real t297 = t288*s1;
-    const jaco_real t298 = t290*s1;
-    const jaco_real t299 = t291*c1;
+    const jaco_real t298 = s1*t290;
+    const jaco_real t299 = c1*t291;
     const jaco_real t300 = q2 + t289*t97 - t296 - t297 + t59*t298 - t59*t299;
     const jaco_real t301 = q3 + t296 + t297 + t289*t50 + t58*t299 - t58*t298;
 
@@ -3276,7 +3282,7 @@ jaco_real jaco_ik_numeric_step(const jaco_real target[16], const jaco_real q[JAC
 
 void jaco_ik_general_equations(const jaco_real T[16], jaco_real P[378], jaco_real Q[112])
 {
-    /* 332 operations */
+    /* 319 operations */
 
     /* Inputs */
     const jaco_real T00 = T[0];
@@ -3297,68 +3303,68 @@ void jaco_ik_general_equations(const jaco_real T[16], jaco_real P[378], jaco_rea
     const jaco_real t1 = T13 - 0.2115971250007892*T12;
     const jaco_real t2 = T23 - 0.2115971250007892*T22;
     const jaco_real t3 = 0.5*T22;
-    const jaco_real t4 = 1.0*t2;
-    const jaco_real t5 = (t0*t0);
-    const jaco_real t6 = (t1*t1);
-    const jaco_real t7 = (t2*t2);
-    const jaco_real t8 = T02*t0;
-    const jaco_real t9 = T12*t1;
-    const jaco_real t10 = T22*t2;
-    const jaco_real t11 = 0.5*T02;
-    const jaco_real t12 = 0.5*T12;
-    const jaco_real t13 = 0.8660254037844386*T10;
-    const jaco_real t14 = -t13;
-    const jaco_real t15 = 0.8660254037844386*T00;
-    const jaco_real t16 = 0.8660254037844386*T11;
-    const jaco_real t17 = 0.8660254037844386*T01;
-    const jaco_real t18 = 0.8660254037844386*T20;
-    const jaco_real t19 = 0.8660254037844386*T21;
-    const jaco_real t20 = -0.0743*T10;
-    const jaco_real t21 = 0.0743*T00;
-    const jaco_real t22 = 0.0743*T11;
-    const jaco_real t23 = 0.0743*T01;
-    const jaco_real t24 = 1.0*t1;
-    const jaco_real t25 = 0.042897125000789196*T12 - t24;
-    const jaco_real t26 = 1.0*t0;
-    const jaco_real t27 = 0.042897125000789196*T02;
-    const jaco_real t28 = 0.1486*t0;
-    const jaco_real t29 = 0.1486*t1;
-    const jaco_real t30 = 0.1486*t2;
-    const jaco_real t31 = 0.23858999874261286*T00 + t0*t18 - t2*t15;
-    const jaco_real t32 = 0.23858999874261286*T10 + t1*t18 - t2*t13;
-    const jaco_real t33 = -(0.23858999874261286*T01 + t0*t19 - 0.8660254037844386*T01*t2);
-    const jaco_real t34 = 0.23858999874261286*T11 + t1*t19 - 0.8660254037844386*T11*t2;
-    const jaco_real t35 = -(0.13775*T02 + t0*t3 - 0.5*T02*t2);
-    const jaco_real t36 = 0.13775*T12 + t1*t3 - 0.5*T12*t2;
-    const jaco_real t37 = 0.4771799974852257*t2;
-    const jaco_real t38 = 0.4771799974852257*T20;
-    const jaco_real t39 = 1.7320508075688772*t1;
-    const jaco_real t40 = t0*t39;
-    const jaco_real t41 = T20*t2;
-    const jaco_real t42 = -0.05935703187847256*T10 + t13*t6 + T10*t37 - t13*t5 - t13*t7 - t1*t38 + T00*t40 + t39*t41;
-    const jaco_real t43 = 0.05935703187847256*T00;
-    const jaco_real t44 = t15*t6;
-    const jaco_real t45 = t15*t7;
-    const jaco_real t46 = t0*t38;
-    const jaco_real t47 = t15*t5;
-    const jaco_real t48 = T00*t37;
-    const jaco_real t49 = T10*t40;
-    const jaco_real t50 = 1.7320508075688772*t0;
-    const jaco_real t51 = t41*t50;
-    const jaco_real t52 = 0.4771799974852257*T21;
-    const jaco_real t53 = T21*t2;
-    const jaco_real t54 = 0.05935703187847256*T11 + t16*t5 + t16*t7 + t1*t52 - t16*t6 - T11*t37 - T01*t40 - t39*t53;
-    const jaco_real t55 = 0.05935703187847256*T01;
-    const jaco_real t56 = t17*t5;
-    const jaco_real t57 = T01*t37;
-    const jaco_real t58 = t17*t6;
-    const jaco_real t59 = t17*t7;
-    const jaco_real t60 = t0*t52;
-    const jaco_real t61 = T11*t40;
-    const jaco_real t62 = t50*t53;
-    const jaco_real t63 = 0.2755*T22;
-    const jaco_real t64 = 0.03426979833333333*T12 + 0.17158850000315679*t1 + t5*t12 + t7*t12 + t1*t63 - t6*t12 - 0.2755*T12*t2 - t24*t8 - T22*t1*t4;
-    const jaco_real t65 = 0.03426979833333333*T02 + 0.17158850000315679*t0 + t6*t11 + t7*t11 + t0*t63 - 0.5*T02*t5 - 0.2755*T02*t2 - 1.0*T12*t0*t1 - 1.0*T22*t0*t2;
+    const jaco_real t4 = (t0*t0);
+    const jaco_real t5 = (t1*t1);
+    const jaco_real t6 = (t2*t2);
+    const jaco_real t7 = T02*t0;
+    const jaco_real t8 = T12*t1;
+    const jaco_real t9 = T22*t2;
+    const jaco_real t10 = 0.5*T02;
+    const jaco_real t11 = 0.5*T12;
+    const jaco_real t12 = 0.8660254037844386*T10;
+    const jaco_real t13 = -t12;
+    const jaco_real t14 = 0.8660254037844386*T00;
+    const jaco_real t15 = 0.8660254037844386*T11;
+    const jaco_real t16 = 0.8660254037844386*T01;
+    const jaco_real t17 = 0.8660254037844386*T20;
+    const jaco_real t18 = 0.8660254037844386*T21;
+    const jaco_real t19 = -0.0743*T10;
+    const jaco_real t20 = 0.0743*T00;
+    const jaco_real t21 = 0.0743*T11;
+    const jaco_real t22 = 0.0743*T01;
+    const jaco_real t23 = 0.042897125000789196*T12 - 1.0*t1;
+    const jaco_real t24 = 0.042897125000789196*T02;
+    const jaco_real t25 = 0.1486*t0;
+    const jaco_real t26 = 0.1486*t1;
+    const jaco_real t27 = 0.1486*t2;
+    const jaco_real t28 = 0.23858999874261286*T00 + t0*t17 - t2*t14;
+    const jaco_real t29 = 0.23858999874261286*T10 + t1*t17 - t2*t12;
+    const jaco_real t30 = -(0.23858999874261286*T01 - 0.8660254037844386*T01*t2 + t0*t18);
+    const jaco_real t31 = 0.23858999874261286*T11 - t2*t15 + t1*t18;
+    const jaco_real t32 = -(0.13775*T02 - 0.5*T02*t2 + t0*t3);
+    const jaco_real t33 = 0.13775*T12 - t2*t11 + t1*t3;
+    const jaco_real t34 = 0.4771799974852257*t2;
+    const jaco_real t35 = 0.4771799974852257*T20;
+    const jaco_real t36 = 1.7320508075688772*t1;
+    const jaco_real t37 = t0*t36;
+    const jaco_real t38 = t2*T20;
+    const jaco_real t39 = -0.05935703187847256*T10 + t5*t12 + T10*t34 - t4*t12 - t6*t12 - t1*t35 + T00*t37 + t36*t38;
+    const jaco_real t40 = 0.05935703187847256*T00;
+    const jaco_real t41 = t5*t14;
+    const jaco_real t42 = t6*t14;
+    const jaco_real t43 = t0*t35;
+    const jaco_real t44 = t4*t14;
+    const jaco_real t45 = T00*t34;
+    const jaco_real t46 = T10*t37;
+    const jaco_real t47 = 1.7320508075688772*t0;
+    const jaco_real t48 = t38*t47;
+    const jaco_real t49 = 0.4771799974852257*T21;
+    const jaco_real t50 = t2*T21;
+    const jaco_real t51 = 0.05935703187847256*T11 + t4*t15 + t6*t15 + t1*t49 - t5*t15 - T11*t34 - T01*t37 - t36*t50;
+    const jaco_real t52 = 0.05935703187847256*T01;
+    const jaco_real t53 = t4*t16;
+    const jaco_real t54 = T01*t34;
+    const jaco_real t55 = t5*t16;
+    const jaco_real t56 = t6*t16;
+    const jaco_real t57 = t0*t49;
+    const jaco_real t58 = T11*t37;
+    const jaco_real t59 = t47*t50;
+    const jaco_real t60 = 0.2755*T22;
+    const jaco_real t61 = 0.2755*t2;
+    const jaco_real t62 = 0.03426979833333333*T12 + 0.17158850000315679*t1 + t4*t11 + t6*t11 + t1*t60 - t5*t11 - T12*t61 - t1*t7 - t1*t9;
+    const jaco_real t63 = t0*t8;
+    const jaco_real t64 = t0*t9;
+    const jaco_real t65 = 0.03426979833333333*T02 + 0.17158850000315679*t0 - t4*t10 - T02*t61 + t5*t10 + t6*t10 + t0*t60;
     const jaco_real t66 = 0.4771799974852257*t0;
     const jaco_real t67 = 0.4771799974852257*t1;
 
@@ -3407,7 +3413,7 @@ void jaco_ik_general_equations(const jaco_real T[16], jaco_real P[378], jaco_rea
     P[41] = 0;
     P[42] = 0;
     P[43] = 0;
-    P[44] = 0.2755 + 0.042897125000789196*T22 - t4;
+    P[44] = 0.2755 + 0.042897125000789196*T22 - 1.0*t2;
     P[45] = 0;
     P[46] = 0;
     P[47] = 0;
@@ -3425,7 +3431,7 @@ void jaco_ik_general_equations(const jaco_real T[16], jaco_real P[378], jaco_rea
     P[59] = 0;
     P[60] = 0;
     P[61] = 0;
-    P[62] = 0.1475337380253272 + 0.551*t2 - 1.0*t5 - 1.0*t6 - 1.0*t7 - 0.023636315875434848*T22 + 0.08579425000157839*t8 + 0.08579425000157839*t9 + 0.08579425000157839*t10;
+    P[62] = 0.1475337380253272 + 0.551*t2 - t4 - t5 - t6 - 0.023636315875434848*T22 + 0.08579425000157839*t7 + 0.08579425000157839*t8 + 0.08579425000157839*t9;
     P[63] = 0;
     P[64] = 0;
     P[65] = 0.35507041555161983;
@@ -3434,7 +3440,7 @@ void jaco_ik_general_equations(const jaco_real T[16], jaco_real P[378], jaco_rea
     P[68] = 0;
     P[69] = 0;
     P[70] = 0.008487048957087498;
-    P[71] = -0.21089281250197298 - 0.13775*T22 + t0*t11 + t1*t12 + t2*t3;
+    P[71] = -0.21089281250197298 - 0.13775*T22 + t0*t10 + t1*t11 + t2*t3;
     P[72] = 0;
     P[73] = 0;
     P[74] = 0;
@@ -3452,7 +3458,7 @@ void jaco_ik_general_equations(const jaco_real T[16], jaco_real P[378], jaco_rea
     P[86] = 0;
     P[87] = 0;
     P[88] = 0;
-    P[89] = t0*t12 - t1*t11;
+    P[89] = t0*t11 - t1*t10;
     P[90] = -0.35507041555161983;
     P[91] = 0;
     P[92] = 0;
@@ -3479,7 +3485,7 @@ void jaco_ik_general_equations(const jaco_real T[16], jaco_real P[378], jaco_rea
     P[113] = 0;
     P[114] = 0;
     P[115] = 0;
-    P[116] = -0.047272631750869695 + 0.17158850000315679*t2 - 0.041630451666666665*T22 + t3*t5 + t3*t6 + 0.2755*t8 + 0.2755*t9 + 0.2755*t10 - t3*t7 - t4*t8 - t4*t9;
+    P[116] = -0.047272631750869695 + 0.17158850000315679*t2 - 0.041630451666666665*T22 + t4*t3 + t5*t3 + 0.2755*t7 + 0.2755*t8 + 0.2755*t9 - t6*t3 - t2*t7 - t2*t8;
     P[117] = 0;
     P[118] = -0.1776751942877016;
     P[119] = -0.006959380144811749;
@@ -3741,38 +3747,38 @@ void jaco_ik_general_equations(const jaco_real T[16], jaco_real P[378], jaco_rea
     P[375] = 0;
     P[376] = 0;
     P[377] = 0;
-    Q[0] = t14;
-    Q[1] = t15;
-    Q[2] = t16;
-    Q[3] = -t17;
+    Q[0] = t13;
+    Q[1] = t14;
+    Q[2] = t15;
+    Q[3] = -t16;
     Q[4] = 0;
     Q[5] = 0;
-    Q[6] = t12;
-    Q[7] = -t11;
+    Q[6] = t11;
+    Q[7] = -t10;
     Q[8] = 0;
     Q[9] = 0;
     Q[10] = 0;
     Q[11] = 0;
-    Q[12] = t18;
-    Q[13] = -t19;
+    Q[12] = t17;
+    Q[13] = -t18;
     Q[14] = 0;
     Q[15] = 0;
-    Q[16] = -t15;
-    Q[17] = t14;
-    Q[18] = t17;
-    Q[19] = t16;
+    Q[16] = -t14;
+    Q[17] = t13;
+    Q[18] = t16;
+    Q[19] = t15;
     Q[20] = 0;
     Q[21] = 0;
-    Q[22] = t11;
-    Q[23] = t12;
-    Q[24] = t20;
-    Q[25] = t21;
-    Q[26] = t22;
-    Q[27] = -t23;
+    Q[22] = t10;
+    Q[23] = t11;
+    Q[24] = t19;
+    Q[25] = t20;
+    Q[26] = t21;
+    Q[27] = -t22;
     Q[28] = 0;
     Q[29] = 0;
-    Q[30] = t25;
-    Q[31] = t26 - t27;
+    Q[30] = t23;
+    Q[31] = t0 - t24;
     Q[32] = 0;
     Q[33] = 0;
     Q[34] = 0;
@@ -3781,78 +3787,78 @@ void jaco_ik_general_equations(const jaco_real T[16], jaco_real P[378], jaco_rea
     Q[37] = -0.0743*T21;
     Q[38] = 0;
     Q[39] = 0;
-    Q[40] = -t21;
-    Q[41] = t20;
-    Q[42] = t23;
-    Q[43] = t22;
+    Q[40] = -t20;
+    Q[41] = t19;
+    Q[42] = t22;
+    Q[43] = t21;
     Q[44] = 0;
     Q[45] = 0;
-    Q[46] = t27 - t26;
-    Q[47] = t25;
+    Q[46] = t24 - 1.0*t0;
+    Q[47] = t23;
     Q[48] = 0;
     Q[49] = 0;
     Q[50] = 0;
     Q[51] = 0;
-    Q[52] = -0.0409393*T20 + T00*t28 + T10*t29 + T20*t30;
-    Q[53] = -(-0.0409393*T21 + T01*t28 + T11*t29 + T21*t30);
+    Q[52] = -0.0409393*T20 + T00*t25 + T10*t26 + T20*t27;
+    Q[53] = -(-0.0409393*T21 + T01*t25 + T11*t26 + T21*t27);
     Q[54] = 0;
     Q[55] = 0;
     Q[56] = 0;
     Q[57] = 0;
     Q[58] = 0;
     Q[59] = 0;
-    Q[60] = -0.23858999874261286*T20 + t0*t15 + t1*t13 + t2*t18;
-    Q[61] = -(-0.23858999874261286*T21 + t0*t17 + t1*t16 + t2*t19);
+    Q[60] = -0.23858999874261286*T20 + t0*t14 + t1*t12 + t2*t17;
+    Q[61] = -(-0.23858999874261286*T21 + t0*t16 + t1*t15 + t2*t18);
     Q[62] = 0;
     Q[63] = 0;
-    Q[64] = t31;
-    Q[65] = t32;
-    Q[66] = t33;
-    Q[67] = -t34;
+    Q[64] = t28;
+    Q[65] = t29;
+    Q[66] = t30;
+    Q[67] = -t31;
     Q[68] = 0;
     Q[69] = 0;
-    Q[70] = t35;
-    Q[71] = -t36;
+    Q[70] = t32;
+    Q[71] = -t33;
     Q[72] = 0;
     Q[73] = 0;
     Q[74] = 0;
     Q[75] = 0;
-    Q[76] = t0*t13 - t1*t15;
-    Q[77] = t1*t17 - t0*t16;
+    Q[76] = t0*t12 - t1*t14;
+    Q[77] = t1*t16 - t0*t15;
     Q[78] = 0;
     Q[79] = 0;
-    Q[80] = -t32;
-    Q[81] = t31;
-    Q[82] = t34;
-    Q[83] = t33;
+    Q[80] = -t29;
+    Q[81] = t28;
+    Q[82] = t31;
+    Q[83] = t30;
     Q[84] = 0;
     Q[85] = 0;
-    Q[86] = t36;
-    Q[87] = t35;
-    Q[88] = t42;
-    Q[89] = t43 + t44 + t45 + t46 - t47 - t48 - t49 - t51;
-    Q[90] = t54;
-    Q[91] = -t55 + t56 + t57 - t58 - t59 - t60 + t61 + t62;
+    Q[86] = t33;
+    Q[87] = t32;
+    Q[88] = t39;
+    Q[89] = t40 + t41 + t42 + t43 - t44 - t45 - t46 - t48;
+    Q[90] = t51;
+    Q[91] = -t52 + t53 + t54 - t55 - t56 - t57 + t58 + t59;
     Q[92] = 0;
     Q[93] = 0;
-    Q[94] = t64;
-    Q[95] = -t65;
+    Q[94] = t62;
+    Q[95] = -(-t63 - t64 + t65);
     Q[96] = 0;
     Q[97] = 0;
     Q[98] = 0;
     Q[99] = 0;
-    Q[100] = -0.07210605742870711*T20 + t18*t5 + t18*t6 + T00*t66 + T10*t67 + T20*t37 - t18*t7 - T00*t2*t50 - T10*t2*t39;
-    Q[101] = -(-0.07210605742870711*T21 + t19*t5 + t19*t6 + T01*t66 + T11*t67 + T21*t37 - 0.8660254037844386*T21*t7 - 1.7320508075688772*T01*t0*t2 - 1.7320508075688772*T11*t1*t2);
+    Q[100] = -0.07210605742870711*T20 + t4*t17 + t5*t17 + T00*t66 + T10*t67 + T20*t34 - t6*t17 - T00*t2*t47 - T10*t2*t36;
+    Q[101] = -(-0.07210605742870711*T21 - 0.8660254037844386*T21*t6 + t4*t18 + t5*t18 + T01*t66 + T11*t67 + T21*t34 - 1.7320508075688772*T01*t0*t2 - 1.7320508075688772*T11*t1*t2);
     Q[102] = 0;
     Q[103] = 0;
-    Q[104] = -t43 + t47 + t48 - t44 - t45 - t46 + t49 + t51;
-    Q[105] = t42;
-    Q[106] = t55 + t58 + t59 + t60 - t56 - t57 - t61 - t62;
-    Q[107] = t54;
+    Q[104] = -t40 + t44 + t45 - t41 - t42 - t43 + t46 + t48;
+    Q[105] = t39;
+    Q[106] = t52 + t55 + t56 + t57 - t53 - t54 - t58 - t59;
+    Q[107] = t51;
     Q[108] = 0;
     Q[109] = 0;
-    Q[110] = t65;
-    Q[111] = t64;
+    Q[110] = -t63 - t64 + t65;
+    Q[111] = t62;
 }
 
 void jaco_ik_general_start(const jaco_real T[16], const jaco_real angles[5], jaco_real q[JACO_DOF])
@@ -3894,15 +3900,15 @@ void jaco_ik_general_start(const jaco_real T[16], const jaco_real angles[5], jac
     const jaco_real t18 = t7*t13 - t11*t12;
     const jaco_real t19 = t11*t13 + t7*t12;
     const jaco_real t20 = sin(ga2);
-    const jaco_real t21 = 0.8660254037844386*t19 + 0.5*t18*t20;
+    const jaco_real t21 = 0.5*t18*t20 + 0.8660254037844386*t19;
     const jaco_real t22 = cos(ga2);
     const jaco_real t23 = t1*t20 + t14*t22;
     const jaco_real t24 = 0.5*(t1*t22 - t14*t20) - 0.8660254037844386*t15;
     const jaco_real t25 = t16*t22 - t0*t20;
     const jaco_real t26 = -0.5*(t0*t22 + t16*t20) - 0.8660254037844386*t17;
     const jaco_real t27 = t18*t22;
-    const jaco_real t28 = -t2*(T10*t25 + T20*t27 - T00*t23) - t3*(T11*t25 + T21*t27 - T01*t23);
-    const jaco_real t29 = t2*(T00*t24 + T20*t21 - T10*t26) + t3*(T01*t24 + T21*t21 - T11*t26);
+    const jaco_real t28 = -t2*(-T00*t23 + T10*t25 + T20*t27) - t3*(T11*t25 + T21*t27 - T01*t23);
+    const jaco_real t29 = t2*(T00*t24 + T20*t21 - T10*t26) + t3*(-T11*t26 + T01*t24 + T21*t21);
 
     /* Outputs */
     q[0] = ga4;
@@ -3958,8 +3964,8 @@ void jaco_ik_general_residual(const jaco_real target[16], const jaco_real q[JACO
     const jaco_real s6 = cos(0.17453292519943295 + q6);
     const jaco_real t0 = c2*c3;
     const jaco_real t1 = s2*s3;
-    const jaco_real t2 = t0*c1 + t1*c1;
-    const jaco_real t3 = t0*s1 + t1*s1;
+    const jaco_real t2 = c1*t0 + c1*t1;
+    const jaco_real t3 = s1*t0 + s1*t1;
     const jaco_real t4 = t0 + t1;
     const jaco_real t5 = t2*c4 + s1*s4;
     const jaco_real t6 = c4*s1 - t2*s4;
@@ -3968,8 +3974,8 @@ void jaco_ik_general_residual(const jaco_real target[16], const jaco_real q[JACO
     const jaco_real t9 = -0.25019712500078917*t4;
     const jaco_real t10 = c3*s2;
     const jaco_real t11 = c2*s3;
-    const jaco_real t12 = t10*c1 - t11*c1;
-    const jaco_real t13 = t11*s1 - t10*s1;
+    const jaco_real t12 = c1*t10 - c1*t11;
+    const jaco_real t13 = s1*t11 - s1*t10;
     const jaco_real t14 = t10 - t11;
     const jaco_real t15 = -0.25019712500078917*t12;
     const jaco_real t16 = -0.25019712500078917*t13;
@@ -3979,7 +3985,7 @@ void jaco_ik_general_residual(const jaco_real target[16], const jaco_real q[JACO
     const jaco_real t20 = 0.5*t13 + 0.8660254037844386*t8;
     const jaco_real t21 = t20;
     const jaco_real t22 = -0.08579425000157839*t20;
-    const jaco_real t23 = t14*s4;
+    const jaco_real t23 = s4*t14;
     const jaco_real t24 = 0.5*t4 + 0.8660254037844386*t23;
     const jaco_real t25 = t24;
     const jaco_real t26 = 0.08579425000157839*t24;
@@ -3990,9 +3996,9 @@ void jaco_ik_general_residual(const jaco_real target[16], const jaco_real q[JACO
     const jaco_real t31 = t7*c5 + s5*t30;
     const jaco_real t32 = c5*t30 - t7*s5;
     const jaco_real t33 = 0.8660254037844386*t4 - 0.5*t23;
-    const jaco_real t34 = t14*c4;
-    const jaco_real t35 = s5*t33 + t34*c5;
-    const jaco_real t36 = c5*t33 - t34*s5;
+    const jaco_real t34 = c4*t14;
+    const jaco_real t35 = s5*t33 + c5*t34;
+    const jaco_real t36 = c5*t33 - s5*t34;
     const jaco_real t37 = 0.5*t18 + 0.8660254037844386*t29;
     const jaco_real t38 = t37;
     const jaco_real t39 = 0.2115971250007892*t37;
@@ -4035,8 +4041,8 @@ void jaco_ik_general_residual(const jaco_real target[16], const jaco_real q[JACO
     const jaco_real t76 = -0.5*(t72 + t61);
     const jaco_real t77 = sqrt((t75*t75) + (t76*t76) + (t68*t68));
     const jaco_real t78 = 0.41*c2;
-    const jaco_real t79 = t42 + t78*c1;
-    const jaco_real t80 = t48 - t78*s1;
+    const jaco_real t79 = t42 + c1*t78;
+    const jaco_real t80 = t48 - s1*t78;
     const jaco_real t81 = -t74;
     const jaco_real t82 = 0.5*(-1 + t59 + t66 + t81);
     const jaco_real t83 = atan2(t77, t82);

@@ -47,7 +47,7 @@ void jaco_jacobian(const jaco_real q[JACO_DOF], jaco_real J[6 * JACO_DOF]);
 void jaco_fk_jacobian(const jaco_real q[JACO_DOF], jaco_real T[16], jaco_real J[6 * JACO_DOF]);
 
 /* Geometric Jacobian in the tool frame (6 x DOF, rows vx vy vz wx wy wz).
- * Result: J: 6 x 6 row-major, element (r, c) at J[r * 6 + c]. 334 operations. */
+ * Result: J: 6 x 6 row-major, element (r, c) at J[r * 6 + c]. 330 operations. */
 void jaco_jacobian_tool(const jaco_real q[JACO_DOF], jaco_real J[6 * JACO_DOF]);
 
 /* Task vector mu = (x, y, z, roll, pitch, yaw).
@@ -59,15 +59,15 @@ void jaco_task(const jaco_real q[JACO_DOF], jaco_real mu[JACO_TASK_DIM]);
 void jaco_task_jacobian(const jaco_real q[JACO_DOF], jaco_real J[JACO_TASK_DIM * JACO_DOF]);
 
 /* Fk, jacobian and bias_acceleration in one pass, sharing their terms.
- * Result: T: 4 x 4 row-major, element (r, c) at T[r * 4 + c]; J: 6 x 6 row-major, element (r, c) at J[r * 6 + c]; a[i], i < 6. 436 operations. */
+ * Result: T: 4 x 4 row-major, element (r, c) at T[r * 4 + c]; J: 6 x 6 row-major, element (r, c) at J[r * 6 + c]; a[i], i < 6. 434 operations. */
 void jaco_fk_jacobian_dot(const jaco_real q[JACO_DOF], const jaco_real q_dot[JACO_DOF], jaco_real T[16], jaco_real J[6 * JACO_DOF], jaco_real a[6]);
 
 /* Time derivative dJ/dt of the world geometric Jacobian along q_dot (6 x DOF).
- * Result: Jd: 6 x 6 row-major, element (r, c) at Jd[r * 6 + c]. 318 operations. */
+ * Result: Jd: 6 x 6 row-major, element (r, c) at Jd[r * 6 + c]. 316 operations. */
 void jaco_jacobian_dot(const jaco_real q[JACO_DOF], const jaco_real q_dot[JACO_DOF], jaco_real Jd[6 * JACO_DOF]);
 
 /* J' q_dot: the tool's classical linear and angular acceleration at zero joint acceleration, world frame (6).
- * Result: a[i], i < 6. 373 operations. */
+ * Result: a[i], i < 6. 371 operations. */
 void jaco_bias_acceleration(const jaco_real q[JACO_DOF], const jaco_real q_dot[JACO_DOF], jaco_real a[6]);
 
 /* Time derivative of the analytic Jacobian along q_dot (6 x DOF): mu'' = J_a q'' + J_a' q'.
@@ -83,11 +83,11 @@ void jaco_hessian(const jaco_real q[JACO_DOF], jaco_real H[JACO_DOF * 6 * JACO_D
 void jaco_singularity_factors(const jaco_real q[JACO_DOF], jaco_real f[JACO_NUM_SINGULARITY_FACTORS]);
 
 /* Manipulability |det(Js)|.
- * Result: returned as a scalar. 55 operations. */
+ * Result: returned as a scalar. 54 operations. */
 jaco_real jaco_manipulability(const jaco_real q[JACO_DOF]);
 
 /* Det(Js).
- * Result: returned as a scalar. 54 operations. */
+ * Result: returned as a scalar. 53 operations. */
 jaco_real jaco_jacobian_det(const jaco_real q[JACO_DOF]);
 
 /* Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status.
@@ -99,7 +99,7 @@ int jaco_velocity_ik(const jaco_real q[JACO_DOF], const jaco_real mu_dot[JACO_TA
 jaco_real jaco_ik_numeric_step(const jaco_real target[16], const jaco_real q[JACO_DOF], jaco_real damping, jaco_real q_start[JACO_DOF], jaco_real q_next[JACO_DOF]);
 
 /* The general 6R solver's equations at T: (P0 + s Ps + c Pc) v_bc = Q v_gh, P = [P0; Ps; Pc] (42 x 9).
- * Result: P: 42 x 9 row-major, element (r, c) at P[r * 9 + c]; Q: 14 x 8 row-major, element (r, c) at Q[r * 8 + c]. 332 operations. */
+ * Result: P: 42 x 9 row-major, element (r, c) at P[r * 9 + c]; Q: 14 x 8 row-major, element (r, c) at Q[r * 8 + c]. 319 operations. */
 void jaco_ik_general_equations(const jaco_real T[16], jaco_real P[378], jaco_real Q[112]);
 
 /* The configuration of one root's loop angles (a - shift, b, c, g, h; the loop's free joint from the loop).

@@ -95,8 +95,8 @@ def fk(q):
     s6 = trig[..., 10]
     t0 = c2*c3
     t1 = s2*s3
-    t2 = t0*c1 + t1*c1
-    t3 = t0*s1 + t1*s1
+    t2 = c1*t0 + c1*t1
+    t3 = s1*t0 + s1*t1
     t4 = t0 + t1
     t5 = t2*c4 + s1*s4
     t6 = c4*s1 - t2*s4
@@ -105,8 +105,8 @@ def fk(q):
     t9 = -0.25019712500078917*t4
     t10 = c3*s2
     t11 = c2*s3
-    t12 = t10*c1 - t11*c1
-    t13 = t11*s1 - t10*s1
+    t12 = c1*t10 - c1*t11
+    t13 = s1*t11 - s1*t10
     t14 = t10 - t11
     t15 = -0.25019712500078917*t12
     t16 = -0.25019712500078917*t13
@@ -116,7 +116,7 @@ def fk(q):
     t20 = 0.5*t13 + 0.8660254037844386*t8
     t21 = t20
     t22 = -0.08579425000157839*t20
-    t23 = t14*s4
+    t23 = s4*t14
     t24 = 0.5*t4 + 0.8660254037844386*t23
     t25 = t24
     t26 = 0.08579425000157839*t24
@@ -127,9 +127,9 @@ def fk(q):
     t31 = t7*c5 + s5*t30
     t32 = c5*t30 - t7*s5
     t33 = 0.8660254037844386*t4 - 0.5*t23
-    t34 = t14*c4
-    t35 = s5*t33 + t34*c5
-    t36 = c5*t33 - t34*s5
+    t34 = c4*t14
+    t35 = s5*t33 + c5*t34
+    t36 = c5*t33 - s5*t34
     t37 = 0.5*t18 + 0.8660254037844386*t29
     t38 = t37
     t39 = 0.2115971250007892*t37
@@ -159,8 +159,8 @@ def fk(q):
     t63 = t35*c6 + s6*t62
     t64 = c6*t62 - t35*s6
     t65 = 0.41*c2
-    t66 = t42 + t65*c1
-    t67 = t48 - t65*s1
+    t66 = t42 + c1*t65
+    t67 = t48 - s1*t65
     T = _stack(xp, [
         t57,  # 0, 0
         -t58,  # 0, 1
@@ -201,8 +201,8 @@ def jacobian(q):
     s5 = -xp.sin(q5)
     t0 = c2*c3
     t1 = s2*s3
-    t2 = t0*c1 + t1*c1
-    t3 = t0*s1 + t1*s1
+    t2 = c1*t0 + c1*t1
+    t3 = s1*t0 + s1*t1
     t4 = t0 + t1
     t5 = t2*c4 + s1*s4
     t6 = c4*s1 - t2*s4
@@ -211,8 +211,8 @@ def jacobian(q):
     t9 = -0.25019712500078917*t4
     t10 = c3*s2
     t11 = c2*s3
-    t12 = t10*c1 - t11*c1
-    t13 = t11*s1 - t10*s1
+    t12 = c1*t10 - c1*t11
+    t13 = s1*t11 - s1*t10
     t14 = t10 - t11
     t15 = -0.25019712500078917*t12
     t16 = -0.25019712500078917*t13
@@ -224,7 +224,7 @@ def jacobian(q):
     t22 = 0.5*t13 + 0.8660254037844386*t8
     t23 = t22
     t24 = -0.08579425000157839*t22
-    t25 = t14*s4
+    t25 = s4*t14
     t26 = c5*(0.8660254037844386*t4 - 0.5*t25) - t14*c4*s5
     t27 = 0.5*t4 + 0.8660254037844386*t25
     t28 = t27
@@ -248,8 +248,8 @@ def jacobian(q):
     t46 = t9 + t45
     t47 = t46 + 0.41*s2
     t48 = 0.41*c2
-    t49 = t35 + t48*c1
-    t50 = t41 - t48*s1
+    t49 = t35 + c1*t48
+    t50 = t41 - s1*t48
     J = _stack(xp, [
         t50,  # 0, 0
         -t47*c1,  # 0, 1
@@ -313,8 +313,8 @@ def fk_jacobian(q):
     s6 = trig[..., 10]
     t0 = c2*c3
     t1 = s2*s3
-    t2 = t0*c1 + t1*c1
-    t3 = t0*s1 + t1*s1
+    t2 = c1*t0 + c1*t1
+    t3 = s1*t0 + s1*t1
     t4 = t0 + t1
     t5 = t2*c4 + s1*s4
     t6 = c4*s1 - t2*s4
@@ -323,8 +323,8 @@ def fk_jacobian(q):
     t9 = -0.25019712500078917*t4
     t10 = c3*s2
     t11 = c2*s3
-    t12 = t10*c1 - t11*c1
-    t13 = t11*s1 - t10*s1
+    t12 = c1*t10 - c1*t11
+    t13 = s1*t11 - s1*t10
     t14 = t10 - t11
     t15 = -0.25019712500078917*t12
     t16 = -0.25019712500078917*t13
@@ -334,7 +334,7 @@ def fk_jacobian(q):
     t20 = 0.5*t13 + 0.8660254037844386*t8
     t21 = t20
     t22 = -0.08579425000157839*t20
-    t23 = t14*s4
+    t23 = s4*t14
     t24 = 0.5*t4 + 0.8660254037844386*t23
     t25 = t24
     t26 = 0.08579425000157839*t24
@@ -345,9 +345,9 @@ def fk_jacobian(q):
     t31 = t7*c5 + s5*t30
     t32 = c5*t30 - t7*s5
     t33 = 0.8660254037844386*t4 - 0.5*t23
-    t34 = t14*c4
-    t35 = s5*t33 + t34*c5
-    t36 = c5*t33 - t34*s5
+    t34 = c4*t14
+    t35 = s5*t33 + c5*t34
+    t36 = c5*t33 - s5*t34
     t37 = 0.5*t18 + 0.8660254037844386*t29
     t38 = t37
     t39 = 0.2115971250007892*t37
@@ -377,8 +377,8 @@ def fk_jacobian(q):
     t63 = t35*c6 + s6*t62
     t64 = c6*t62 - t35*s6
     t65 = 0.41*c2
-    t66 = t42 + t65*c1
-    t67 = t48 - t65*s1
+    t66 = t42 + c1*t65
+    t67 = t48 - s1*t65
     T = _stack(xp, [
         t57,  # 0, 0
         -t58,  # 0, 1
@@ -439,7 +439,7 @@ def fk_jacobian(q):
 
 
 def jacobian_tool(q):
-    """geometric Jacobian in the tool frame (6 x DOF, rows vx vy vz wx wy wz): (6 x 6), 334 operations."""
+    """geometric Jacobian in the tool frame (6 x DOF, rows vx vy vz wx wy wz): (6 x 6), 330 operations."""
     xp, dtype, device, batch, (q,) = _arguments(("q", q, (6,)))
     q2 = q[..., 1]
     q3 = q[..., 2]
@@ -460,8 +460,8 @@ def jacobian_tool(q):
     s6 = trig[..., 10]
     t0 = c2*c3
     t1 = s2*s3
-    t2 = t0*c1 + t1*c1
-    t3 = t0*s1 + t1*s1
+    t2 = c1*t0 + c1*t1
+    t3 = s1*t0 + s1*t1
     t4 = t0 + t1
     t5 = t2*c4 + s1*s4
     t6 = c4*s1 - t2*s4
@@ -470,8 +470,8 @@ def jacobian_tool(q):
     t9 = -0.25019712500078917*t4
     t10 = c3*s2
     t11 = c2*s3
-    t12 = t10*c1 - t11*c1
-    t13 = t11*s1 - t10*s1
+    t12 = c1*t10 - c1*t11
+    t13 = s1*t11 - s1*t10
     t14 = t10 - t11
     t15 = -0.25019712500078917*t12
     t16 = -0.25019712500078917*t13
@@ -481,7 +481,7 @@ def jacobian_tool(q):
     t20 = 0.5*t13 + 0.8660254037844386*t8
     t21 = t20
     t22 = -0.08579425000157839*t20
-    t23 = t14*s4
+    t23 = s4*t14
     t24 = 0.5*t4 + 0.8660254037844386*t23
     t25 = t24
     t26 = 0.08579425000157839*t24
@@ -492,9 +492,9 @@ def jacobian_tool(q):
     t31 = t7*c5 + s5*t30
     t32 = c5*t30 - t7*s5
     t33 = 0.8660254037844386*t4 - 0.5*t23
-    t34 = t14*c4
-    t35 = s5*t33 + t34*c5
-    t36 = c5*t33 - t34*s5
+    t34 = c4*t14
+    t35 = s5*t33 + c5*t34
+    t36 = c5*t33 - s5*t34
     t37 = 0.5*t18 + 0.8660254037844386*t29
     t38 = t37
     t39 = 0.2115971250007892*t37
@@ -523,11 +523,11 @@ def jacobian_tool(q):
     t62 = t35*c6 + s6*t61
     t63 = c6*t61 - t35*s6
     t64 = 0.41*c2
-    t65 = t42 + t64*c1
-    t66 = t48 - t64*s1
+    t65 = t42 + c1*t64
+    t66 = t48 - s1*t64
     t67 = t65*c1 - t66*s1
-    t68 = t59*s1
-    t69 = t56*c1
+    t68 = s1*t59
+    t69 = c1*t56
     t70 = t48*s1 - t42*c1
     t71 = -(t13*t53 + t4*t47)
     t72 = t4*t41 + t53*t12
@@ -538,9 +538,13 @@ def jacobian_tool(q):
     t77 = -(t44*t51 + t50*t45)
     t78 = t38*t51 + t50*t39
     t79 = t44*t39 - t38*t45
-    t80 = t56*s1 + t59*c1
-    t81 = t57*s1 + t60*c1
-    t82 = t38*s1 + t44*c1
+    t80 = c1*t57
+    t81 = s1*t60
+    t82 = s1*t44
+    t83 = c1*t38
+    t84 = t56*s1 + t59*c1
+    t85 = t57*s1 + t60*c1
+    t86 = t38*s1 + t44*c1
     J = _stack(xp, [
         t56*t66 - t59*t65,  # 0, 0
         t62*t67 + t54*t68 - t54*t69,  # 0, 1
@@ -549,32 +553,32 @@ def jacobian_tool(q):
         t56*t74 + t59*t75 + t62*t76,  # 0, 4
         t56*t77 + t59*t78 + t62*t79,  # 0, 5
         t60*t65 - t57*t66,  # 1, 0
-        -(t63*t67 + t60*t54*s1 - t57*t54*c1),  # 1, 1
-        -(t63*t70 + t57*t53*c1 - t60*t53*s1),  # 1, 2
+        -(t63*t67 - t54*t80 + t54*t81),  # 1, 1
+        -(t63*t70 - t53*t81 + t53*t80),  # 1, 2
         -(t57*t71 + t60*t72 + t63*t73),  # 1, 3
         -(t57*t74 + t60*t75 + t63*t76),  # 1, 4
         -(t57*t77 + t60*t78 + t63*t79),  # 1, 5
         t38*t66 - t44*t65,  # 2, 0
-        -(t50*t67 + t38*t54*c1 - t44*t54*s1),  # 2, 1
-        -(t50*t70 + t44*t53*s1 - t38*t53*c1),  # 2, 2
+        -(t50*t67 - t54*t82 + t54*t83),  # 2, 1
+        -(t50*t70 - t53*t83 + t53*t82),  # 2, 2
         t38*t71 + t44*t72 - t50*t73,  # 2, 3
         t38*t74 + t44*t75 - t50*t76,  # 2, 4
         t38*t77 + t44*t78 - t50*t79,  # 2, 5
         -t62,  # 3, 0
-        -t80,  # 3, 1
-        t80,  # 3, 2
-        -(t13*t59 + t56*t12 - t4*t62),  # 3, 3
-        -(t18*t56 + t21*t59 - t25*t62),  # 3, 4
-        -(t38*t56 + t44*t59 - t50*t62),  # 3, 5
+        -t84,  # 3, 1
+        t84,  # 3, 2
+        -(-t4*t62 + t13*t59 + t56*t12),  # 3, 3
+        -(-t25*t62 + t18*t56 + t21*t59),  # 3, 4
+        -(-t50*t62 + t38*t56 + t44*t59),  # 3, 5
         t63,  # 4, 0
-        t81,  # 4, 1
-        -t81,  # 4, 2
+        t85,  # 4, 1
+        -t85,  # 4, 2
         t13*t60 + t57*t12 - t4*t63,  # 4, 3
         t18*t57 + t21*t60 - t25*t63,  # 4, 4
         t38*t57 + t44*t60 - t50*t63,  # 4, 5
         t50,  # 5, 0
-        -t82,  # 5, 1
-        t82,  # 5, 2
+        -t86,  # 5, 1
+        t86,  # 5, 2
         -(t13*t44 + t4*t50 + t38*t12),  # 5, 3
         -(t18*t38 + t21*t44 + t25*t50),  # 5, 4
         -(t38**2 + t44**2 + t50**2),  # 5, 5
@@ -604,8 +608,8 @@ def task(q):
     s6 = trig[..., 10]
     t0 = c2*c3
     t1 = s2*s3
-    t2 = t0*c1 + t1*c1
-    t3 = t0*s1 + t1*s1
+    t2 = c1*t0 + c1*t1
+    t3 = s1*t0 + s1*t1
     t4 = t0 + t1
     t5 = t2*c4 + s1*s4
     t6 = c4*s1 - t2*s4
@@ -614,8 +618,8 @@ def task(q):
     t9 = -0.25019712500078917*t4
     t10 = c3*s2
     t11 = c2*s3
-    t12 = t10*c1 - t11*c1
-    t13 = t11*s1 - t10*s1
+    t12 = c1*t10 - c1*t11
+    t13 = s1*t11 - s1*t10
     t14 = t10 - t11
     t15 = -0.25019712500078917*t12
     t16 = -0.25019712500078917*t13
@@ -625,7 +629,7 @@ def task(q):
     t20 = 0.5*t13 + 0.8660254037844386*t8
     t21 = t20
     t22 = -0.08579425000157839*t20
-    t23 = t14*s4
+    t23 = s4*t14
     t24 = 0.5*t4 + 0.8660254037844386*t23
     t25 = t24
     t26 = 0.08579425000157839*t24
@@ -646,9 +650,9 @@ def task(q):
     t41 = t40 - t16
     t42 = t41 - 0.0098*c1
     t43 = 0.8660254037844386*t4 - 0.5*t23
-    t44 = t14*c4
-    t45 = s5*t43 + t44*c5
-    t46 = c5*t43 - t44*s5
+    t44 = c4*t14
+    t45 = s5*t43 + c5*t44
+    t46 = c5*t43 - s5*t44
     t47 = 0.5*t25 - 0.8660254037844386*t46
     t48 = t47
     t49 = -0.2115971250007892*t47
@@ -660,8 +664,8 @@ def task(q):
     t55 = t45*c6 + s6*t54
     t56 = c6*t54 - t45*s6
     t57 = 0.41*c2
-    t58 = t34 + t57*c1
-    t59 = t42 - t57*s1
+    t58 = t34 + c1*t57
+    t59 = t42 - s1*t57
     mu = _stack(xp, [
         t58,  # 0
         t59,  # 1
@@ -695,8 +699,8 @@ def task_jacobian(q):
     s6 = trig[..., 10]
     t0 = c2*c3
     t1 = s2*s3
-    t2 = t0*c1 + t1*c1
-    t3 = t0*s1 + t1*s1
+    t2 = c1*t0 + c1*t1
+    t3 = s1*t0 + s1*t1
     t4 = t0 + t1
     t5 = t2*c4 + s1*s4
     t6 = c4*s1 - t2*s4
@@ -705,8 +709,8 @@ def task_jacobian(q):
     t9 = -0.25019712500078917*t4
     t10 = c3*s2
     t11 = c2*s3
-    t12 = t10*c1 - t11*c1
-    t13 = t11*s1 - t10*s1
+    t12 = c1*t10 - c1*t11
+    t13 = s1*t11 - s1*t10
     t14 = t10 - t11
     t15 = -0.25019712500078917*t12
     t16 = -0.25019712500078917*t13
@@ -716,7 +720,7 @@ def task_jacobian(q):
     t20 = 0.5*t13 + 0.8660254037844386*t8
     t21 = t20
     t22 = -0.08579425000157839*t20
-    t23 = t14*s4
+    t23 = s4*t14
     t24 = 0.5*t4 + 0.8660254037844386*t23
     t25 = t24
     t26 = 0.08579425000157839*t24
@@ -729,9 +733,9 @@ def task_jacobian(q):
     t33 = c5*t31 - t7*s5
     t34 = t32*c6 + s6*(0.5*t33 - 0.8660254037844386*t21)
     t35 = 0.8660254037844386*t4 - 0.5*t23
-    t36 = t14*c4
-    t37 = s5*t35 + t36*c5
-    t38 = c5*t35 - t36*s5
+    t36 = c4*t14
+    t37 = s5*t35 + c5*t36
+    t38 = c5*t35 - s5*t36
     t39 = t37*c6 + s6*(0.5*t38 + 0.8660254037844386*t25)
     t40 = 0.5*t18 + 0.8660254037844386*t29
     t41 = t40
@@ -752,8 +756,8 @@ def task_jacobian(q):
     t56 = t9 + t55
     t57 = t56 + 0.41*s2
     t58 = 0.41*c2
-    t59 = t45 + t58*c1
-    t60 = t51 - t58*s1
+    t59 = t45 + c1*t58
+    t60 = t51 - s1*t58
     t61 = t30**2 + t34**2
     t62 = 1/t61
     t63 = t30*s1 + t34*c1
@@ -807,7 +811,7 @@ def task_jacobian(q):
 
 
 def fk_jacobian_dot(q, q_dot):
-    """fk, jacobian and bias_acceleration in one pass, sharing their terms: (4 x 4 and 6 x 6 and 6 x 1), 436 operations."""
+    """fk, jacobian and bias_acceleration in one pass, sharing their terms: (4 x 4 and 6 x 6 and 6 x 1), 434 operations."""
     xp, dtype, device, batch, (q, q_dot,) = _arguments(("q", q, (6,)), ("q_dot", q_dot, (6,)))
     q2 = q[..., 1]
     q3 = q[..., 2]
@@ -834,8 +838,8 @@ def fk_jacobian_dot(q, q_dot):
     s6 = trig[..., 10]
     t0 = c2*c3
     t1 = s2*s3
-    t2 = t0*c1 + t1*c1
-    t3 = t0*s1 + t1*s1
+    t2 = c1*t0 + c1*t1
+    t3 = s1*t0 + s1*t1
     t4 = t0 + t1
     t5 = t2*c4 + s1*s4
     t6 = c4*s1 - t2*s4
@@ -845,8 +849,8 @@ def fk_jacobian_dot(q, q_dot):
     t10 = -qd1 + t4*qd4
     t11 = c3*s2
     t12 = c2*s3
-    t13 = t11*c1 - t12*c1
-    t14 = t12*s1 - t11*s1
+    t13 = c1*t11 - c1*t12
+    t14 = s1*t12 - s1*t11
     t15 = t11 - t12
     t16 = -0.25019712500078917*t13
     t17 = -0.25019712500078917*t14
@@ -856,7 +860,7 @@ def fk_jacobian_dot(q, q_dot):
     t21 = 0.5*t14 + 0.8660254037844386*t8
     t22 = t21
     t23 = -0.08579425000157839*t21
-    t24 = t15*s4
+    t24 = s4*t15
     t25 = 0.5*t4 + 0.8660254037844386*t24
     t26 = t25
     t27 = 0.08579425000157839*t25
@@ -868,9 +872,9 @@ def fk_jacobian_dot(q, q_dot):
     t33 = t7*c5 + s5*t32
     t34 = c5*t32 - t7*s5
     t35 = 0.8660254037844386*t4 - 0.5*t24
-    t36 = t15*c4
-    t37 = s5*t35 + t36*c5
-    t38 = c5*t35 - t36*s5
+    t36 = c4*t15
+    t37 = s5*t35 + c5*t36
+    t38 = c5*t35 - s5*t36
     t39 = 0.5*t19 + 0.8660254037844386*t31
     t40 = t39
     t41 = 0.2115971250007892*t39
@@ -900,8 +904,8 @@ def fk_jacobian_dot(q, q_dot):
     t65 = t37*c6 + s6*t64
     t66 = c6*t64 - t37*s6
     t67 = 0.41*c2
-    t68 = t44 + t67*c1
-    t69 = t50 - t67*s1
+    t68 = t44 + c1*t67
+    t69 = t50 - s1*t67
     t70 = t14*t55 + t4*t49
     t71 = t70
     t72 = t22*t54 + t26*t48
@@ -1013,18 +1017,18 @@ def fk_jacobian_dot(q, q_dot):
         xp.broadcast_to(t52, batch),  # 5, 5
     ], (6, 6))
     a = _stack(xp, [
-        xp.broadcast_to(t113*qd1 + qd2*(-t118*c1 + t121*qd1) - qd3*(-t117*c1 + t122*qd1 + t85*t98) + qd4*(t77*qd1 + t87*t99 - t14*t116 - t110*t4) - qd5*(t109*t26 + t115*t22 + t79*t10 - t89*t100) - qd6*(t81*t28 - t91*t101 + t46*t114 + t52*t108), batch),  # 0
-        xp.broadcast_to(qd2*(t118*s1 + t119*qd1) - qd3*(t117*s1 + t120*qd1 - t85*qd2*s1) + qd4*(t116*t13 + t71*qd1 - t104*t4 - t87*t94) - qd5*(t103*t26 + t73*t10 + t89*t95 - t115*t19) - qd6*(t75*t28 + t91*t96 + t52*t102 - t40*t91*qd6) - t107*qd1, batch),  # 1
-        xp.broadcast_to(qd2*(t106*c1 - t112*s1) + qd3*(t111*s1 - t105*c1 + t123*c1**2 + t123*s1**2) + qd4*(t71*t99 + t77*t94 - t14*t104 - t110*t13) + qd5*(t73*t100 + t79*t95 - t103*t22 - t109*t19) + qd6*(t75*t101 + t81*t96 - t40*t108 - t46*t102), batch),  # 2
-        xp.broadcast_to(qd4*(t4*t99 - t14*qd1) + qd5*(t22*t10 + t26*t100) + qd6*(t46*t28 + t52*t101) + t97*qd1 - t98*qd1, batch),  # 3
-        xp.broadcast_to(qd4*(t13*qd1 - t4*t94) - qd5*(t19*t10 + t26*t95) - qd6*(t40*t28 + t52*t96) + t93*qd1 - t92*qd1, batch),  # 4
+        xp.broadcast_to(t113*qd1 + qd2*(-t118*c1 + qd1*t121) - qd3*(-t117*c1 + qd1*t122 + t85*t98) + qd4*(t77*qd1 + t87*t99 - t14*t116 - t110*t4) - qd5*(-t89*t100 + t109*t26 + t115*t22 + t79*t10) - qd6*(-t91*t101 + t81*t28 + t46*t114 + t52*t108), batch),  # 0
+        xp.broadcast_to(qd2*(t118*s1 + qd1*t119) - qd3*(t117*s1 - t85*t93 + qd1*t120) + qd4*(t116*t13 + t71*qd1 - t104*t4 - t87*t94) - qd5*(-t115*t19 + t103*t26 + t73*t10 + t89*t95) - qd6*(t75*t28 + t91*t96 - t40*t114 + t52*t102) - t107*qd1, batch),  # 1
+        xp.broadcast_to(qd2*(t106*c1 - t112*s1) + qd3*(t111*s1 - t105*c1 + c1**2*t123 + s1**2*t123) + qd4*(t71*t99 + t77*t94 - t14*t104 - t110*t13) + qd5*(t73*t100 + t79*t95 - t103*t22 - t109*t19) + qd6*(t75*t101 + t81*t96 - t40*t108 - t46*t102), batch),  # 2
+        xp.broadcast_to(qd4*(t4*t99 - t14*qd1) + qd5*(t22*t10 + t26*t100) + qd6*(t46*t28 + t52*t101) + qd1*t97 - qd1*t98, batch),  # 3
+        xp.broadcast_to(qd4*(t13*qd1 - t4*t94) - qd5*(t19*t10 + t26*t95) - qd6*(t40*t28 + t52*t96) + qd1*t93 - qd1*t92, batch),  # 4
         xp.broadcast_to(qd4*(t13*t99 - t14*t94) + qd5*(t19*t100 - t22*t95) + qd6*(t40*t101 - t46*t96), batch),  # 5
     ], (6,))
     return T, J, a
 
 
 def jacobian_dot(q, q_dot):
-    """time derivative dJ/dt of the world geometric Jacobian along q_dot (6 x DOF): (6 x 6), 318 operations."""
+    """time derivative dJ/dt of the world geometric Jacobian along q_dot (6 x DOF): (6 x 6), 316 operations."""
     xp, dtype, device, batch, (q, q_dot,) = _arguments(("q", q, (6,)), ("q_dot", q_dot, (6,)))
     q2 = q[..., 1]
     q3 = q[..., 2]
@@ -1048,8 +1052,8 @@ def jacobian_dot(q, q_dot):
     s5 = -xp.sin(q5)
     t0 = c2*c3
     t1 = s2*s3
-    t2 = t0*c1 + t1*c1
-    t3 = t0*s1 + t1*s1
+    t2 = c1*t0 + c1*t1
+    t3 = s1*t0 + s1*t1
     t4 = t0 + t1
     t5 = t2*c4 + s1*s4
     t6 = c4*s1 - t2*s4
@@ -1059,8 +1063,8 @@ def jacobian_dot(q, q_dot):
     t10 = -qd1 + t4*qd4
     t11 = c3*s2
     t12 = c2*s3
-    t13 = t11*c1 - t12*c1
-    t14 = t12*s1 - t11*s1
+    t13 = c1*t11 - c1*t12
+    t14 = s1*t12 - s1*t11
     t15 = t11 - t12
     t16 = -0.25019712500078917*t13
     t17 = -0.25019712500078917*t14
@@ -1072,7 +1076,7 @@ def jacobian_dot(q, q_dot):
     t23 = 0.5*t14 + 0.8660254037844386*t8
     t24 = t23
     t25 = -0.08579425000157839*t23
-    t26 = t15*s4
+    t26 = s4*t15
     t27 = c5*(0.8660254037844386*t4 - 0.5*t26) - t15*c4*s5
     t28 = 0.5*t4 + 0.8660254037844386*t26
     t29 = t28
@@ -1107,8 +1111,8 @@ def jacobian_dot(q, q_dot):
     t58 = t21*t51 + t29*t35
     t59 = t33*t50 + t49*t34
     t60 = 0.41*c2
-    t61 = t37 + t60*c1
-    t62 = t43 - t60*s1
+    t61 = t37 + c1*t60
+    t62 = t43 - s1*t60
     t63 = t61*c1 - t62*s1
     t64 = qd3*s1
     t65 = qd2*s1
@@ -1145,17 +1149,17 @@ def jacobian_dot(q, q_dot):
         xp.broadcast_to(-t90*c1 + t53*t91, batch),  # 0, 1
         xp.broadcast_to(-(-t89*c1 + t52*t91 + t44*t70), batch),  # 0, 2
         xp.broadcast_to(t57*qd1 + t45*t71 - t14*t88 - t82*t4, batch),  # 0, 3
-        xp.broadcast_to(-(t81*t29 + t87*t24 + t58*t10 - t46*t72), batch),  # 0, 4
-        xp.broadcast_to(-(t59*t31 - t47*t73 + t39*t86 + t49*t80), batch),  # 0, 5
+        xp.broadcast_to(-(-t46*t72 + t81*t29 + t87*t24 + t58*t10), batch),  # 0, 4
+        xp.broadcast_to(-(-t47*t73 + t59*t31 + t39*t86 + t49*t80), batch),  # 0, 5
         xp.broadcast_to(-t79, batch),  # 1, 0
         xp.broadcast_to(t90*s1 + t53*t92, batch),  # 1, 1
-        xp.broadcast_to(-(t89*s1 + t52*t92 - t44*qd2*s1), batch),  # 1, 2
+        xp.broadcast_to(-(t89*s1 - t44*t65 + t52*t92), batch),  # 1, 2
         xp.broadcast_to(t88*t13 + t54*qd1 - t76*t4 - t45*t66, batch),  # 1, 3
-        xp.broadcast_to(-(t75*t29 + t55*t10 + t46*t67 - t87*t21), batch),  # 1, 4
-        xp.broadcast_to(-(t56*t31 + t47*t68 + t49*t74 - t33*t47*qd6), batch),  # 1, 5
+        xp.broadcast_to(-(-t87*t21 + t75*t29 + t55*t10 + t46*t67), batch),  # 1, 4
+        xp.broadcast_to(-(t56*t31 + t47*t68 - t33*t86 + t49*t74), batch),  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
         xp.broadcast_to(t78*c1 - t84*s1, batch),  # 2, 1
-        xp.broadcast_to(t83*s1 - t77*c1 + t93*c1**2 + t93*s1**2, batch),  # 2, 2
+        xp.broadcast_to(t83*s1 - t77*c1 + c1**2*t93 + s1**2*t93, batch),  # 2, 2
         xp.broadcast_to(t54*t71 + t57*t66 - t14*t76 - t82*t13, batch),  # 2, 3
         xp.broadcast_to(t55*t72 + t58*t67 - t75*t24 - t81*t21, batch),  # 2, 4
         xp.broadcast_to(t56*t73 + t59*t68 - t33*t80 - t39*t74, batch),  # 2, 5
@@ -1182,7 +1186,7 @@ def jacobian_dot(q, q_dot):
 
 
 def bias_acceleration(q, q_dot):
-    """J' q_dot: the tool's classical linear and angular acceleration at zero joint acceleration, world frame (6): (6 x 1), 373 operations."""
+    """J' q_dot: the tool's classical linear and angular acceleration at zero joint acceleration, world frame (6): (6 x 1), 371 operations."""
     xp, dtype, device, batch, (q, q_dot,) = _arguments(("q", q, (6,)), ("q_dot", q_dot, (6,)))
     q2 = q[..., 1]
     q3 = q[..., 2]
@@ -1206,8 +1210,8 @@ def bias_acceleration(q, q_dot):
     s5 = -xp.sin(q5)
     t0 = c2*c3
     t1 = s2*s3
-    t2 = t0*c1 + t1*c1
-    t3 = t0*s1 + t1*s1
+    t2 = c1*t0 + c1*t1
+    t3 = s1*t0 + s1*t1
     t4 = t0 + t1
     t5 = t2*c4 + s1*s4
     t6 = c4*s1 - t2*s4
@@ -1217,8 +1221,8 @@ def bias_acceleration(q, q_dot):
     t10 = -qd1 + t4*qd4
     t11 = c3*s2
     t12 = c2*s3
-    t13 = t11*c1 - t12*c1
-    t14 = t12*s1 - t11*s1
+    t13 = c1*t11 - c1*t12
+    t14 = s1*t12 - s1*t11
     t15 = t11 - t12
     t16 = -0.25019712500078917*t13
     t17 = -0.25019712500078917*t14
@@ -1230,7 +1234,7 @@ def bias_acceleration(q, q_dot):
     t23 = 0.5*t14 + 0.8660254037844386*t8
     t24 = t23
     t25 = -0.08579425000157839*t23
-    t26 = t15*s4
+    t26 = s4*t15
     t27 = c5*(0.8660254037844386*t4 - 0.5*t26) - t15*c4*s5
     t28 = 0.5*t4 + 0.8660254037844386*t26
     t29 = t28
@@ -1265,8 +1269,8 @@ def bias_acceleration(q, q_dot):
     t58 = t21*t51 + t29*t35
     t59 = t33*t50 + t49*t34
     t60 = 0.41*c2
-    t61 = t37 + t60*c1
-    t62 = t43 - t60*s1
+    t61 = t37 + c1*t60
+    t62 = t43 - s1*t60
     t63 = t61*c1 - t62*s1
     t64 = qd3*s1
     t65 = qd2*s1
@@ -1295,15 +1299,15 @@ def bias_acceleration(q, q_dot):
     t88 = t87 + t45*qd4
     t89 = t88 + t44*qd3
     t90 = t89 + t63*qd2
-    t91 = qd1*s1
+    t91 = s1*qd1
     t92 = c1*qd1
     t93 = t52*qd2
     a = _stack(xp, [
-        xp.broadcast_to(t85*qd1 + qd2*(-t90*c1 + t53*t91) - qd3*(-t89*c1 + t52*t91 + t44*t70) + qd4*(t57*qd1 + t45*t71 - t14*t88 - t82*t4) - qd5*(t81*t29 + t87*t24 + t58*t10 - t46*t72) - qd6*(t59*t31 - t47*t73 + t39*t86 + t49*t80), batch),  # 0
-        xp.broadcast_to(qd2*(t90*s1 + t53*t92) - qd3*(t89*s1 + t52*t92 - t44*qd2*s1) + qd4*(t88*t13 + t54*qd1 - t76*t4 - t45*t66) - qd5*(t75*t29 + t55*t10 + t46*t67 - t87*t21) - qd6*(t56*t31 + t47*t68 + t49*t74 - t33*t47*qd6) - t79*qd1, batch),  # 1
-        xp.broadcast_to(qd2*(t78*c1 - t84*s1) + qd3*(t83*s1 - t77*c1 + t93*c1**2 + t93*s1**2) + qd4*(t54*t71 + t57*t66 - t14*t76 - t82*t13) + qd5*(t55*t72 + t58*t67 - t75*t24 - t81*t21) + qd6*(t56*t73 + t59*t68 - t33*t80 - t39*t74), batch),  # 2
-        xp.broadcast_to(qd4*(t4*t71 - t14*qd1) + qd5*(t24*t10 + t29*t72) + qd6*(t39*t31 + t49*t73) + t69*qd1 - t70*qd1, batch),  # 3
-        xp.broadcast_to(qd4*(t13*qd1 - t4*t66) - qd5*(t21*t10 + t29*t67) - qd6*(t33*t31 + t49*t68) + t65*qd1 - t64*qd1, batch),  # 4
+        xp.broadcast_to(t85*qd1 + qd2*(-t90*c1 + t53*t91) - qd3*(-t89*c1 + t52*t91 + t44*t70) + qd4*(t57*qd1 + t45*t71 - t14*t88 - t82*t4) - qd5*(-t46*t72 + t81*t29 + t87*t24 + t58*t10) - qd6*(-t47*t73 + t59*t31 + t39*t86 + t49*t80), batch),  # 0
+        xp.broadcast_to(qd2*(t90*s1 + t53*t92) - qd3*(t89*s1 - t44*t65 + t52*t92) + qd4*(t88*t13 + t54*qd1 - t76*t4 - t45*t66) - qd5*(-t87*t21 + t75*t29 + t55*t10 + t46*t67) - qd6*(t56*t31 + t47*t68 - t33*t86 + t49*t74) - t79*qd1, batch),  # 1
+        xp.broadcast_to(qd2*(t78*c1 - t84*s1) + qd3*(t83*s1 - t77*c1 + c1**2*t93 + s1**2*t93) + qd4*(t54*t71 + t57*t66 - t14*t76 - t82*t13) + qd5*(t55*t72 + t58*t67 - t75*t24 - t81*t21) + qd6*(t56*t73 + t59*t68 - t33*t80 - t39*t74), batch),  # 2
+        xp.broadcast_to(qd4*(t4*t71 - t14*qd1) + qd5*(t24*t10 + t29*t72) + qd6*(t39*t31 + t49*t73) + qd1*t69 - qd1*t70, batch),  # 3
+        xp.broadcast_to(qd4*(t13*qd1 - t4*t66) - qd5*(t21*t10 + t29*t67) - qd6*(t33*t31 + t49*t68) + qd1*t65 - qd1*t64, batch),  # 4
         xp.broadcast_to(qd4*(t13*t71 - t14*t66) + qd5*(t21*t72 - t24*t67) + qd6*(t33*t73 - t39*t68), batch),  # 5
     ], (6,))
     return a
@@ -1337,8 +1341,8 @@ def task_jacobian_dot(q, q_dot):
     s6 = trig[..., 10]
     t0 = c2*c3
     t1 = s2*s3
-    t2 = t0*c1 + t1*c1
-    t3 = t0*s1 + t1*s1
+    t2 = c1*t0 + c1*t1
+    t3 = s1*t0 + s1*t1
     t4 = t0 + t1
     t5 = t2*c4 + s1*s4
     t6 = c4*s1 - t2*s4
@@ -1347,8 +1351,8 @@ def task_jacobian_dot(q, q_dot):
     t9 = -0.25019712500078917*t4
     t10 = c3*s2
     t11 = c2*s3
-    t12 = t10*c1 - t11*c1
-    t13 = t11*s1 - t10*s1
+    t12 = c1*t10 - c1*t11
+    t13 = s1*t11 - s1*t10
     t14 = t10 - t11
     t15 = -0.25019712500078917*t12
     t16 = -0.25019712500078917*t13
@@ -1358,7 +1362,7 @@ def task_jacobian_dot(q, q_dot):
     t20 = 0.5*t13 + 0.8660254037844386*t8
     t21 = t20
     t22 = -0.08579425000157839*t20
-    t23 = t14*s4
+    t23 = s4*t14
     t24 = 0.5*t4 + 0.8660254037844386*t23
     t25 = t24
     t26 = 0.08579425000157839*t24
@@ -1371,9 +1375,9 @@ def task_jacobian_dot(q, q_dot):
     t33 = c5*t31 - t7*s5
     t34 = t32*c6 + s6*(0.5*t33 - 0.8660254037844386*t21)
     t35 = 0.8660254037844386*t4 - 0.5*t23
-    t36 = t14*c4
-    t37 = s5*t35 + t36*c5
-    t38 = c5*t35 - t36*s5
+    t36 = c4*t14
+    t37 = s5*t35 + c5*t36
+    t38 = c5*t35 - s5*t36
     t39 = t37*c6 + s6*(0.5*t38 + 0.8660254037844386*t25)
     t40 = 0.5*t18 + 0.8660254037844386*t29
     t41 = t40
@@ -1404,8 +1408,8 @@ def task_jacobian_dot(q, q_dot):
     t66 = t18*t59 + t25*t43
     t67 = t41*t58 + t57*t42
     t68 = 0.41*c2
-    t69 = t45 + t68*c1
-    t70 = t51 - t68*s1
+    t69 = t45 + c1*t68
+    t70 = t51 - s1*t68
     t71 = t69*c1 - t70*s1
     t72 = qd3*s1
     t73 = qd2*s1
@@ -1437,7 +1441,7 @@ def task_jacobian_dot(q, q_dot):
     t99 = t87 + t98
     t100 = t47*t99 + t57*t94
     t101 = t41*t99 + t57*t91
-    t102 = t86 + t98 + t57*qd6
+    t102 = t98 + t57*qd6 + t86
     t103 = t96*t39 + t102*t34
     t104 = t92*t39 + t102*t30
     t105 = t64*qd6
@@ -1467,14 +1471,14 @@ def task_jacobian_dot(q, q_dot):
     t129 = t123*t12 + t62*qd1 - t107*t4 - t53*t74
     t130 = t106*t25 + t63*t87 + t54*t82 - t122*t18
     t131 = t64*t99 + t55*t91 + t57*t105 - t41*t121
-    t132 = qd1*s1
+    t132 = s1*qd1
     t133 = -t125*c1 + t61*t132
     t134 = -t124*c1 + t60*t132 + t52*t77
     t135 = c1*qd1
     t136 = t125*s1 + t61*t135
     t137 = t124*s1 + t60*t135 - t52*t73
     t138 = t60*qd2
-    t139 = t114*s1 - t108*c1 + t138*c1**2 + t138*s1**2
+    t139 = t114*s1 - t108*c1 + c1**2*t138 + s1**2*t138
     t140 = t30**2 + t34**2
     t141 = 1/t140
     t142 = c1*t141
@@ -1487,16 +1491,16 @@ def task_jacobian_dot(q, q_dot):
     t149 = t34*t148
     t150 = s1*t141
     t151 = t30*t148
-    t152 = t34*qd1
+    t152 = qd1*t34
     t153 = t150*t152
-    t154 = t30*qd1
+    t154 = qd1*t30
     t155 = t142*t154
     t156 = t145*t147
     t157 = t34*t156
     t158 = t30*t156
     t159 = t13*t141
     t160 = -(t13*t34 + t30*t12)
-    t161 = t147*t160
+    t161 = t160*t147
     t162 = t34*t161
     t163 = t12*t141
     t164 = t30*t161
@@ -1506,7 +1510,7 @@ def task_jacobian_dot(q, q_dot):
     t168 = t75*t167
     t169 = t21*t141
     t170 = -(t18*t30 + t21*t34)
-    t171 = t147*t170
+    t171 = t170*t147
     t172 = t34*t171
     t173 = t18*t141
     t174 = t30*t171
@@ -1514,7 +1518,7 @@ def task_jacobian_dot(q, q_dot):
     t176 = t89*t167
     t177 = t47*t141
     t178 = -(t41*t30 + t47*t34)
-    t179 = t147*t178
+    t179 = t178*t147
     t180 = t34*t179
     t181 = t41*t141
     t182 = t30*t179
@@ -1527,7 +1531,7 @@ def task_jacobian_dot(q, q_dot):
     t189 = t30*c1
     t190 = t187*(t188 - t189)
     t191 = c1*t185
-    t192 = t185*qd1
+    t192 = qd1*t185
     t193 = t143*t192 + t144*t192
     t194 = t187*(t189 - t188)
     t195 = t187*(t34*t12 - t13*t30)
@@ -1535,11 +1539,11 @@ def task_jacobian_dot(q, q_dot):
     t197 = t34*t185
     t198 = t187*(t18*t34 - t21*t30)
     t199 = t187*(t41*t34 - t47*t30)
-    t200 = t39*t150
-    t201 = t39*t142
-    t202 = t97*t141
-    t203 = t152*t200
-    t204 = t154*t201
+    t200 = t39*t142
+    t201 = t39*t150
+    t202 = t141*t97
+    t203 = t200*t154
+    t204 = t201*t152
     Jd = _stack(xp, [
         xp.broadcast_to(t116, batch),  # 0, 0
         xp.broadcast_to(t133, batch),  # 0, 1
@@ -1566,15 +1570,15 @@ def task_jacobian_dot(q, q_dot):
         xp.broadcast_to(-t104*(t169 + t172) + t103*(t173 + t174) + t175 - t176, batch),  # 3, 4
         xp.broadcast_to(-t104*(t177 + t180) + t103*(t181 + t182) + t183 - t184, batch),  # 3, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
-        xp.broadcast_to(t193 + t103*(t191 + t30*t190) + t104*(t186 - t34*t190), batch),  # 4, 1
-        xp.broadcast_to(-(t193 + t103*(t191 - t30*t194) + t104*(t186 + t34*t194)), batch),  # 4, 2
+        xp.broadcast_to(t104*(t186 - t34*t190) + t103*(t191 + t30*t190) + t193, batch),  # 4, 1
+        xp.broadcast_to(-(t104*(t186 + t34*t194) + t103*(t191 - t30*t194) + t193), batch),  # 4, 2
         xp.broadcast_to(t104*(t12*t185 - t34*t195) + t103*(t13*t185 + t30*t195) + t75*t196 - t79*t197, batch),  # 4, 3
-        xp.broadcast_to(-(-t103*(t21*t185 + t30*t198) - t104*(t18*t185 - t34*t198) + t88*t197 + t89*t196), batch),  # 4, 4
-        xp.broadcast_to(-(-t103*(t47*t185 + t30*t199) - t104*(t41*t185 - t34*t199) + t100*t197 + t101*t196), batch),  # 4, 5
+        xp.broadcast_to(-(-t104*(t18*t185 - t34*t198) - t103*(t21*t185 + t30*t198) + t88*t197 + t89*t196), batch),  # 4, 4
+        xp.broadcast_to(-(-t104*(t41*t185 - t34*t199) - t103*(t47*t185 + t30*t199) + t100*t197 + t101*t196), batch),  # 4, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 0
-        xp.broadcast_to(-(t103*(t200 + t39*t151) - t104*(t201 + t39*t149) + t146*t202 + t203 - t204), batch),  # 5, 1
-        xp.broadcast_to(-(t103*(-t200 + t39*t158) - t104*(-t201 + t39*t157) + t145*t202 + t204 - t203), batch),  # 5, 2
-        xp.broadcast_to(-(-t80 + t103*(t39*t163 + t39*t164) - t104*(t39*t159 + t39*t162) + t160*t202 + t39*t166 + t39*t168), batch),  # 5, 3
+        xp.broadcast_to(-(-t104*(t200 + t39*t149) + t103*(t201 + t39*t151) + t146*t202 - t203 + t204), batch),  # 5, 1
+        xp.broadcast_to(-(-t104*(-t200 + t39*t157) + t103*(-t201 + t39*t158) + t145*t202 - t204 + t203), batch),  # 5, 2
+        xp.broadcast_to(-(-t80 - t104*(t39*t159 + t39*t162) + t103*(t39*t163 + t39*t164) + t160*t202 + t39*t166 + t39*t168), batch),  # 5, 3
         xp.broadcast_to(t85 + t104*(t39*t169 + t39*t172) - t103*(t39*t173 + t39*t174) - t170*t202 + t39*t176 - t39*t175, batch),  # 5, 4
         xp.broadcast_to(t95 + t104*(t39*t177 + t39*t180) - t103*(t39*t181 + t39*t182) - t178*t202 + t39*t184 - t39*t183, batch),  # 5, 5
     ], (6, 6))
@@ -1600,8 +1604,8 @@ def hessian(q):
     s5 = -xp.sin(q5)
     t0 = c2*c3
     t1 = s2*s3
-    t2 = t0*c1 + t1*c1
-    t3 = t0*s1 + t1*s1
+    t2 = c1*t0 + c1*t1
+    t3 = s1*t0 + s1*t1
     t4 = t0 + t1
     t5 = t2*c4 + s1*s4
     t6 = c4*s1 - t2*s4
@@ -1610,8 +1614,8 @@ def hessian(q):
     t9 = -0.25019712500078917*t4
     t10 = c3*s2
     t11 = c2*s3
-    t12 = t10*c1 - t11*c1
-    t13 = t11*s1 - t10*s1
+    t12 = c1*t10 - c1*t11
+    t13 = s1*t11 - s1*t10
     t14 = t10 - t11
     t15 = -0.25019712500078917*t12
     t16 = -0.25019712500078917*t13
@@ -1623,7 +1627,7 @@ def hessian(q):
     t22 = 0.5*t13 + 0.8660254037844386*t8
     t23 = t22
     t24 = -0.08579425000157839*t22
-    t25 = t14*s4
+    t25 = s4*t14
     t26 = c5*(0.8660254037844386*t4 - 0.5*t25) - t14*c4*s5
     t27 = 0.5*t4 + 0.8660254037844386*t25
     t28 = t27
@@ -1657,8 +1661,8 @@ def hessian(q):
     t56 = t20*t49 + t28*t33
     t57 = t31*t48 + t47*t32
     t58 = 0.41*c2
-    t59 = t35 + t58*c1
-    t60 = t41 - t58*s1
+    t59 = t35 + c1*t58
+    t60 = t41 - s1*t58
     t61 = t59*c1 - t60*s1
     t62 = t51*s1
     t63 = -t50*s1
@@ -1945,18 +1949,18 @@ def singularity_factors(q):
     s4 = trig[..., 7]
     c5 = -xp.cos(q5)
     s5 = -xp.sin(q5)
-    t0 = c2*c3*s5
-    t1 = s4**2
-    t2 = s3**2
-    t3 = c2*s4*s5
+    t0 = s3**2
+    t1 = c2*s4**2
+    t2 = s5*c2
+    t3 = s4*t2
     f = _stack(xp, [
-        -(0.07333133870465747*s2*s5 + 0.10258082125032357*t0 + 0.0008407836500154682*c2*c5*t1 - 0.07333133870465747*s2*s5*t2 + 0.01758782125032357*t0*t1 + 0.018589646387558636*t2*t3 + 0.0004203918250077341*t3*c4 - 0.07333133870465747*c2*c3*s3*s5 - 0.030463*c2*s3*s4*s5 - 0.03517564250064714*c2*c3*c4*c5*s4 - 0.018589646387558636*c3*s2*s3*s4*s5),  # 0
+        -(0.07333133870465747*s2*s5 - 0.07333133870465747*s2*s5*t0 + 0.0008407836500154682*c5*t1 + 0.10258082125032357*c3*t2 - 0.030463*c2*s3*s4*s5 - 0.07333133870465747*c2*c3*s3*s5 + 0.0004203918250077341*c4*t3 + 0.01758782125032357*s5*c3*t1 + 0.018589646387558636*t0*t3 - 0.018589646387558636*c3*s2*s3*s4*s5 - 0.03517564250064714*c2*c3*c4*c5*s4),  # 0
     ], (1,))
     return f
 
 
 def manipulability(q):
-    """manipulability |det(Js)|: (1 x 1), 55 operations."""
+    """manipulability |det(Js)|: (1 x 1), 54 operations."""
     xp, dtype, device, batch, (q,) = _arguments(("q", q, (6,)))
     q2 = q[..., 1]
     q3 = q[..., 2]
@@ -1971,20 +1975,21 @@ def manipulability(q):
     c5 = -xp.cos(q5)
     s5 = -xp.sin(q5)
     t0 = 0.02254938665168217*s5
-    t1 = t0*s2
-    t2 = c2*s4**2
-    t3 = c2*s5
-    t4 = s3**2
-    t5 = t3*s4
-    t6 = c3*s5
-    t7 = c2*c3
-    t8 = t1 + 0.0002585409723797565*t2*c5 + 0.031543602534474496*t3*c3 - t1*t4 + 0.00012927048618987825*t5*c4 + 0.005716316264174281*t4*t5 + 0.005408255034474498*t2*t6 - 0.0093673725*t5*s3 - t0*t7*s3 - 0.005716316264174281*t6*s2*s3*s4 - 0.010816510068948995*t7*c4*c5*s4
-    w = xp.broadcast_to(xp.abs(t8), batch)
+    t1 = s2*t0
+    t2 = s5*c2
+    t3 = s4*t2
+    t4 = c3*t2
+    t5 = s3**2
+    t6 = s4**2
+    t7 = c2*c5
+    t8 = c3*s3
+    t9 = t1 - 0.0093673725*s3*t3 + 0.031543602534474496*t4 - t5*t1 + 0.0002585409723797565*t6*t7 + 0.005716316264174281*t5*t3 - c2*t0*t8 + 0.005408255034474498*t6*t4 + 0.00012927048618987825*c4*t3 - 0.010816510068948995*c3*s4*c4*t7 - 0.005716316264174281*s2*s5*s4*t8
+    w = xp.broadcast_to(xp.abs(t9), batch)
     return w
 
 
 def jacobian_det(q):
-    """det(Js): (1 x 1), 54 operations."""
+    """det(Js): (1 x 1), 53 operations."""
     xp, dtype, device, batch, (q,) = _arguments(("q", q, (6,)))
     q2 = q[..., 1]
     q3 = q[..., 2]
@@ -1999,14 +2004,15 @@ def jacobian_det(q):
     c5 = -xp.cos(q5)
     s5 = -xp.sin(q5)
     t0 = 0.02254938665168217*s5
-    t1 = t0*s2
-    t2 = c2*s4**2
-    t3 = c2*s5
-    t4 = s3**2
-    t5 = t3*s4
-    t6 = c3*s5
-    t7 = c2*c3
-    d = xp.broadcast_to(t1 + 0.0002585409723797565*t2*c5 + 0.031543602534474496*t3*c3 - t1*t4 + 0.00012927048618987825*t5*c4 + 0.005716316264174281*t4*t5 + 0.005408255034474498*t2*t6 - 0.0093673725*t5*s3 - t0*t7*s3 - 0.005716316264174281*t6*s2*s3*s4 - 0.010816510068948995*t7*c4*c5*s4, batch)
+    t1 = s2*t0
+    t2 = s5*c2
+    t3 = s4*t2
+    t4 = c3*t2
+    t5 = s3**2
+    t6 = s4**2
+    t7 = c2*c5
+    t8 = c3*s3
+    d = xp.broadcast_to(t1 - 0.0093673725*s3*t3 + 0.031543602534474496*t4 - t5*t1 + 0.0002585409723797565*t6*t7 + 0.005716316264174281*t5*t3 - c2*t0*t8 + 0.005408255034474498*t6*t4 + 0.00012927048618987825*c4*t3 - 0.010816510068948995*c3*s4*c4*t7 - 0.005716316264174281*s2*s5*s4*t8, batch)
     return d
 
 
@@ -2039,8 +2045,8 @@ def velocity_ik(q, mu_dot, damping=0.0):
     s5 = -xp.sin(q5)
     t0 = c2*c3
     t1 = s2*s3
-    t2 = t0*c1 + t1*c1
-    t3 = t0*s1 + t1*s1
+    t2 = c1*t0 + c1*t1
+    t3 = s1*t0 + s1*t1
     t4 = t0 + t1
     t5 = t2*c4 + s1*s4
     t6 = c4*s1 - t2*s4
@@ -2049,8 +2055,8 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t9 = -0.25019712500078917*t4
     t10 = c3*s2
     t11 = c2*s3
-    t12 = t10*c1 - t11*c1
-    t13 = t11*s1 - t10*s1
+    t12 = c1*t10 - c1*t11
+    t13 = s1*t11 - s1*t10
     t14 = t10 - t11
     t15 = -0.25019712500078917*t12
     t16 = -0.25019712500078917*t13
@@ -2062,7 +2068,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t22 = 0.5*t13 + 0.8660254037844386*t8
     t23 = t22
     t24 = -0.08579425000157839*t22
-    t25 = t14*s4
+    t25 = s4*t14
     t26 = c5*(0.8660254037844386*t4 - 0.5*t25) - t14*c4*s5
     t27 = 0.5*t4 + 0.8660254037844386*t25
     t28 = t27
@@ -2099,8 +2105,8 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t59 = t4*t12 + t20*t28 + t31*t47
     t60 = t13*t4 + t23*t28 + t37*t47
     t61 = 0.41*c2
-    t62 = t35 + t61*c1
-    t63 = t41 - t61*s1
+    t62 = t35 + c1*t61
+    t63 = t41 - s1*t61
     t64 = t62*c1 - t63*s1
     t65 = t63 + t4*t52 + t28*t53 + t47*t54
     t66 = t62 + t4*t55 + t28*t56 + t47*t57
@@ -2111,7 +2117,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t71 = t51**2
     t72 = t52**2 + t53**2 + t54**2 + t68*t69 + t71*t69
     t73 = t67 + t72
-    t74 = c1*s1
+    t74 = s1*c1
     t75 = t62*t63 + t52*t55 + t53*t56 + t54*t57 + t68*t74 + t71*t74
     t76 = t13*t12 + t20*t23 + t31*t37 + 2*t74
     t77 = t64*c1
@@ -2120,9 +2126,9 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t80 = t13*t43 + t23*t44 + t37*t45 + t77 - t78
     t81 = t50*c1
     t82 = t51*c1
-    t83 = t81*s1 + t82*s1
-    t84 = t83 + t20*t53 + t31*t54 + t52*t12
-    t85 = t83 + t13*t55 + t23*t56 + t37*t57
+    t83 = s1*t81 + s1*t82
+    t84 = t20*t53 + t31*t54 + t52*t12 + t83
+    t85 = t13*t55 + t23*t56 + t37*t57 + t83
     t86 = t62**2
     t87 = s1**2
     t88 = t20*t56 + t31*t57 + t50*t87 + t51*t87 + t12*t55
@@ -2161,7 +2167,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t121 = xp.where(xp.greater(t118, 0), 1/(t118*(t118 + xp.abs(t105))), 0)
     t122 = -t121*(t75*t120 + t75*t107 + t65*t66 + t79*t93 + t84*t88 + t70*t85)
     t123 = t75 + t120*t122
-    t124 = t107 + t75*t122
+    t124 = t75*t122 + t107
     t125 = t93 + t79*t122
     t126 = t88 + t84*t122
     t127 = t85 + t70*t122
@@ -2169,7 +2175,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t129 = -t121*(t75*t93 + t65*t58 + t79*t120 + t79*t108 + t84*t94 + t70*t80)
     t130 = t79 + t120*t129
     t131 = t93 + t75*t129
-    t132 = t108 + t79*t129
+    t132 = t79*t129 + t108
     t133 = t94 + t84*t129
     t134 = t80 + t70*t129
     t135 = t58 + t65*t129
@@ -2177,7 +2183,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t137 = t84 - t120*t136
     t138 = -t88 + t75*t136
     t139 = -t94 + t79*t136
-    t140 = t109 - t84*t136
+    t140 = -t84*t136 + t109
     t141 = t76 - t70*t136
     t142 = -t59 + t65*t136
     t143 = t121*(t75*t85 + t65*t60 + t79*t80 + t84*t76 + t70*t120 + t70*t110)
@@ -2185,7 +2191,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t145 = -t85 + t75*t143
     t146 = -t80 + t79*t143
     t147 = t76 - t84*t143
-    t148 = t110 - t70*t143
+    t148 = -t70*t143 + t110
     t149 = -t60 + t65*t143
     t150 = -t121*(t75*t66 + t65*t120 + t65*t111 + t79*t58 + t84*t59 + t70*t60)
     t151 = t65 + t120*t150
@@ -2193,7 +2199,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t153 = t58 + t79*t150
     t154 = t59 + t84*t150
     t155 = t60 + t70*t150
-    t156 = t111 + t65*t150
+    t156 = t65*t150 + t111
     t157 = t121*(t84*mu_dot3 + t70*mu_dot4 + t120*mu_dot0 - t75*mu_dot1 - t65*mu_dot5 - t79*mu_dot2)
     t158 = mu_dot0 - t120*t157
     t159 = mu_dot1 + t75*t157
@@ -2296,18 +2302,18 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t256 = xp.where(xp.not_equal(t223, 0), -(t235 - (t227*t255 + t231*t254))/t223, 0)
     t257 = xp.where(xp.not_equal(t199, 0), -(t218 - (t203*t256 + t208*t255 + t213*t254))/t199, 0)
     t258 = xp.where(xp.not_equal(t165, 0), -(t193 - (t169*t257 + t175*t256 + t181*t255 + t187*t254))/t165, 0)
-    t259 = xp.where(xp.not_equal(t119, 0), -(t158 + t123*t258 + t130*t257 + t151*t254 - t137*t256 - t144*t255)/t119, 0)
+    t259 = xp.where(xp.not_equal(t119, 0), -(t158 - t137*t256 - t144*t255 + t123*t258 + t130*t257 + t151*t254)/t119, 0)
     t260 = t254 + t258*t62 - t259*t63
     t261 = t4*t254 + t257*t43 + t258*t55 - t13*t255 - t256*t12 - t259*t52
     t262 = t254*t28 + t257*t44 + t258*t56 - t20*t256 - t23*t255 - t259*t53
     t263 = t254*t47 + t257*t45 + t258*t57 - t255*t37 - t256*t31 - t259*t54
     t264 = t51*s1
     t265 = t255*c1 + t256*s1
-    t266 = t265 + t259*t82 - t257*t64 - t258*t264
+    t266 = -t257*t64 + t259*t82 - t258*t264 + t265
     t267 = t50*s1
-    t268 = t265 + t257*t42 + t259*t81 - t258*t267
+    t268 = t257*t42 + t259*t81 - t258*t267 + t265
     t269 = 1 + t86 + t67
-    t270 = xp.sqrt(t72 + t89 + t96 + t98 + t100 + t102 + t269)
+    t270 = xp.sqrt(t269 + t98 + t100 + t102 + t96 + t72 + t89)
     t271 = xp.sqrt(t269)
     t272 = t271*xp.where(xp.greater_equal(t63, 0), xp.asarray(1, dtype=dtype), -1)
     t273 = t272 + t63
@@ -2329,7 +2335,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t289 = t54 + t273*t288
     t290 = t57 + t288*t62
     t291 = t288 + t47
-    t292 = -t274*(mu_dot5 + t62*mu_dot1 - t273*mu_dot0)
+    t292 = -t274*(mu_dot5 - t273*mu_dot0 + t62*mu_dot1)
     t293 = mu_dot0 - t273*t292
     t294 = mu_dot1 + t292*t62
     t295 = t292 + mu_dot5
@@ -2437,13 +2443,13 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t397 = xp.where(xp.not_equal(t345, 0), -(t349 - (t362*t396 + t382*t395))/t345, 0)
     t398 = xp.where(xp.not_equal(t327, 0), -(t331 - (t340*t397 + t357*t396 + t377*t395))/t327, 0)
     t399 = xp.where(xp.not_equal(t297, 0), -(t313 - (t321*t398 + t301*t397 + t305*t396 + t309*t395))/t297, 0)
-    t400 = xp.where(xp.not_equal(t272, 0), -(t293 + t276*t399 + t281*t397 + t285*t396 + t289*t395 - t279*t398)/t272, 0)
+    t400 = xp.where(xp.not_equal(t272, 0), -(t293 - t279*t398 + t276*t399 + t281*t397 + t285*t396 + t289*t395)/t272, 0)
     t401 = xp.isfinite(t388)
     t402 = xp.greater_equal(damping, 0)
     t403 = 1e-12*t270
     t404 = xp.greater(damping, 0)
     t405 = 1e-12*t117
-    t406 = (t404 & (xp.less_equal(t118, t405) | xp.less_equal(t164, t405) | xp.less_equal(t198, t405) | xp.less_equal(t222, t405) | xp.less_equal(t238, t405) | xp.less_equal(t249, t405))) | (xp.less_equal(damping, 0) & (xp.less_equal(t271, t403) | xp.less_equal(t296, t403) | xp.less_equal(t326, t403) | xp.less_equal(t344, t403) | xp.less_equal(t365, t403) | xp.less_equal(t390, t403)))
+    t406 = (xp.less_equal(damping, 0) & (xp.less_equal(t271, t403) | xp.less_equal(t296, t403) | xp.less_equal(t326, t403) | xp.less_equal(t344, t403) | xp.less_equal(t365, t403) | xp.less_equal(t390, t403))) | (t404 & (xp.less_equal(t118, t405) | xp.less_equal(t164, t405) | xp.less_equal(t198, t405) | xp.less_equal(t222, t405) | xp.less_equal(t238, t405) | xp.less_equal(t249, t405)))
     t407 = t401 & t402 & xp.logical_not(t406)
     q_dot = _stack(xp, [
         xp.broadcast_to(xp.where(t407, xp.where(t404, -t260, t400), 0), batch),  # 0
@@ -2500,8 +2506,8 @@ def ik_numeric_step(target, q, damping=0.0):
     t0 = T00 + T01 + T02 + T03 + T10 + T11 + T12 + T13 + T20 + T21 + T22 + T23 + qs1 + qs2 + qs3 + qs4 + qs5 + qs6
     t1 = c2*c3
     t2 = s2*s3
-    t3 = t1*c1 + t2*c1
-    t4 = t1*s1 + t2*s1
+    t3 = c1*t1 + c1*t2
+    t4 = s1*t1 + s1*t2
     t5 = t1 + t2
     t6 = t3*c4 + s1*s4
     t7 = c4*s1 - t3*s4
@@ -2510,8 +2516,8 @@ def ik_numeric_step(target, q, damping=0.0):
     t10 = -0.25019712500078917*t5
     t11 = c3*s2
     t12 = c2*s3
-    t13 = t11*c1 - t12*c1
-    t14 = t12*s1 - t11*s1
+    t13 = c1*t11 - c1*t12
+    t14 = s1*t12 - s1*t11
     t15 = t11 - t12
     t16 = -0.25019712500078917*t13
     t17 = -0.25019712500078917*t14
@@ -2521,7 +2527,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t21 = 0.5*t14 + 0.8660254037844386*t9
     t22 = t21
     t23 = -0.08579425000157839*t21
-    t24 = t15*s4
+    t24 = s4*t15
     t25 = 0.5*t5 + 0.8660254037844386*t24
     t26 = t25
     t27 = 0.08579425000157839*t25
@@ -2532,9 +2538,9 @@ def ik_numeric_step(target, q, damping=0.0):
     t32 = t8*c5 + s5*t31
     t33 = c5*t31 - t8*s5
     t34 = 0.8660254037844386*t5 - 0.5*t24
-    t35 = t15*c4
-    t36 = s5*t34 + t35*c5
-    t37 = c5*t34 - t35*s5
+    t35 = c4*t15
+    t36 = s5*t34 + c5*t35
+    t37 = c5*t34 - s5*t35
     t38 = 0.5*t19 + 0.8660254037844386*t30
     t39 = t38
     t40 = 0.2115971250007892*t38
@@ -2592,8 +2598,8 @@ def ik_numeric_step(target, q, damping=0.0):
     t92 = -0.5*(t88 + t77)
     t93 = xp.sqrt(t91**2 + t92**2 + t84**2)
     t94 = 0.41*c2
-    t95 = t43 + t94*c1
-    t96 = t49 - t94*s1
+    t95 = t43 + c1*t94
+    t96 = t49 - s1*t94
     t97 = t95*c1 - t96*s1
     t98 = t96 + t5*t61 + t26*t62 + t55*t63
     t99 = t95 + t5*t64 + t26*t65 + t55*t66
@@ -2606,7 +2612,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t106 = t14**2 + t22**2 + t45**2 + 2*t104
     t107 = t59**2
     t108 = t96**2 + t61**2 + t62**2 + t63**2 + t103*t104 + t107*t104
-    t109 = c1*s1
+    t109 = s1*c1
     t110 = t95*t96 + t61*t64 + t62*t65 + t63*t66 + t103*t109 + t107*t109
     t111 = t14*t13 + t19*t22 + t39*t45 + 2*t109
     t112 = t97*c1
@@ -2614,8 +2620,8 @@ def ik_numeric_step(target, q, damping=0.0):
     t114 = t61*t51 + t62*t52 + t63*t53 + t59*t112 - t58*t113
     t115 = t14*t51 + t22*t52 + t45*t53 + t112 - t113
     t116 = t58*t109 + t59*t109
-    t117 = t116 + t19*t62 + t39*t63 + t61*t13
-    t118 = t116 + t14*t64 + t22*t65 + t45*t66
+    t117 = t19*t62 + t39*t63 + t61*t13 + t116
+    t118 = t14*t64 + t22*t65 + t45*t66 + t116
     t119 = s1**2
     t120 = t95**2 + t64**2 + t65**2 + t66**2 + t103*t119 + t107*t119
     t121 = t19*t65 + t39*t66 + t58*t119 + t59*t119 + t13*t64
@@ -2656,7 +2662,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t156 = t120 + damping
     t157 = -t148*(t110*t147 + t110*t156 + t98*t99 + t114*t125 + t117*t121 + t105*t118)
     t158 = t110 + t147*t157
-    t159 = t156 + t110*t157
+    t159 = t110*t157 + t156
     t160 = t125 + t114*t157
     t161 = t121 + t117*t157
     t162 = t118 + t105*t157
@@ -2675,7 +2681,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t175 = -t148*(t110*t125 + t98*t67 + t114*t147 + t114*t174 + t117*t126 + t105*t115)
     t176 = t114 + t147*t175
     t177 = t125 + t110*t175
-    t178 = t174 + t114*t175
+    t178 = t114*t175 + t174
     t179 = t126 + t117*t175
     t180 = t115 + t105*t175
     t181 = t67 + t98*t175
@@ -2699,7 +2705,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t199 = t117 - t147*t198
     t200 = -t121 + t110*t198
     t201 = -t126 + t114*t198
-    t202 = t197 - t117*t198
+    t202 = -t117*t198 + t197
     t203 = t111 - t105*t198
     t204 = -t68 + t98*t198
     t205 = t167*(t160*t201 + t163*t204 + t200*t166 - t161*t202 - t162*t203)
@@ -2727,7 +2733,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t227 = -t118 + t110*t225
     t228 = -t115 + t114*t225
     t229 = t111 - t117*t225
-    t230 = t224 - t105*t225
+    t230 = -t105*t225 + t224
     t231 = -t69 + t98*t225
     t232 = t167*(t160*t228 + t163*t231 + t227*t166 - t161*t229 - t162*t230)
     t233 = t227 - t166*t232
@@ -2758,7 +2764,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t258 = t67 + t114*t255
     t259 = t68 + t117*t255
     t260 = t69 + t105*t255
-    t261 = t254 + t98*t255
+    t261 = t98*t255 + t254
     t262 = t167*(t160*t258 + t161*t259 + t162*t260 + t163*t261 + t257*t166)
     t263 = t257 - t166*t262
     t264 = t258 - t160*t262
@@ -2788,15 +2794,15 @@ def ik_numeric_step(target, q, damping=0.0):
     t288 = xp.where(xp.not_equal(t217, 0), -(t221 - (t244*t287 + t274*t286))/t217, 0)
     t289 = xp.where(xp.not_equal(t189, 0), -(t193 - (t212*t288 + t239*t287 + t269*t286))/t189, 0)
     t290 = xp.where(xp.not_equal(t165, 0), -(t169 - (t183*t289 + t206*t288 + t233*t287 + t263*t286))/t165, 0)
-    t291 = xp.where(xp.not_equal(t146, 0), -(t150 + t158*t290 + t176*t289 + t256*t286 - t199*t288 - t226*t287)/t146, 0)
+    t291 = xp.where(xp.not_equal(t146, 0), -(t150 - t199*t288 - t226*t287 + t158*t290 + t176*t289 + t256*t286)/t146, 0)
     t292 = q1 - t286 + t291*t96 - t290*t95
     t293 = q4 + t5*t286 + t289*t51 + t290*t64 - t14*t287 - t288*t13 - t291*t61
     t294 = q5 + t26*t286 + t289*t52 + t290*t65 - t19*t288 - t22*t287 - t291*t62
     t295 = q6 + t55*t286 + t289*t53 + t290*t66 - t39*t288 - t45*t287 - t291*t63
     t296 = t287*c1
     t297 = t288*s1
-    t298 = t290*s1
-    t299 = t291*c1
+    t298 = s1*t290
+    t299 = c1*t291
     t300 = q2 + t289*t97 - t296 - t297 + t59*t298 - t59*t299
     t301 = q3 + t296 + t297 + t289*t50 + t58*t299 - t58*t298
     q_start = _stack(xp, [
@@ -2820,7 +2826,7 @@ def ik_numeric_step(target, q, damping=0.0):
 
 
 def ik_general_equations(T):
-    """the general 6R solver's equations at T: (P0 + s Ps + c Pc) v_bc = Q v_gh, P = [P0; Ps; Pc] (42 x 9): (42 x 9 and 14 x 8), 332 operations."""
+    """the general 6R solver's equations at T: (P0 + s Ps + c Pc) v_bc = Q v_gh, P = [P0; Ps; Pc] (42 x 9): (42 x 9 and 14 x 8), 319 operations."""
     xp, dtype, device, batch, (T,) = _arguments(("T", T, (4, 4)))
     T00 = T[..., 0, 0]
     T01 = T[..., 0, 1]
@@ -2838,68 +2844,68 @@ def ik_general_equations(T):
     t1 = T13 - 0.2115971250007892*T12
     t2 = T23 - 0.2115971250007892*T22
     t3 = 0.5*T22
-    t4 = 1.0*t2
-    t5 = t0**2
-    t6 = t1**2
-    t7 = t2**2
-    t8 = T02*t0
-    t9 = T12*t1
-    t10 = T22*t2
-    t11 = 0.5*T02
-    t12 = 0.5*T12
-    t13 = 0.8660254037844386*T10
-    t14 = -t13
-    t15 = 0.8660254037844386*T00
-    t16 = 0.8660254037844386*T11
-    t17 = 0.8660254037844386*T01
-    t18 = 0.8660254037844386*T20
-    t19 = 0.8660254037844386*T21
-    t20 = -0.0743*T10
-    t21 = 0.0743*T00
-    t22 = 0.0743*T11
-    t23 = 0.0743*T01
-    t24 = 1.0*t1
-    t25 = 0.042897125000789196*T12 - t24
-    t26 = 1.0*t0
-    t27 = 0.042897125000789196*T02
-    t28 = 0.1486*t0
-    t29 = 0.1486*t1
-    t30 = 0.1486*t2
-    t31 = 0.23858999874261286*T00 + t0*t18 - t2*t15
-    t32 = 0.23858999874261286*T10 + t1*t18 - t2*t13
-    t33 = -(0.23858999874261286*T01 + t0*t19 - 0.8660254037844386*T01*t2)
-    t34 = 0.23858999874261286*T11 + t1*t19 - 0.8660254037844386*T11*t2
-    t35 = -(0.13775*T02 + t0*t3 - 0.5*T02*t2)
-    t36 = 0.13775*T12 + t1*t3 - 0.5*T12*t2
-    t37 = 0.4771799974852257*t2
-    t38 = 0.4771799974852257*T20
-    t39 = 1.7320508075688772*t1
-    t40 = t0*t39
-    t41 = T20*t2
-    t42 = -0.05935703187847256*T10 + t13*t6 + T10*t37 - t13*t5 - t13*t7 - t1*t38 + T00*t40 + t39*t41
-    t43 = 0.05935703187847256*T00
-    t44 = t15*t6
-    t45 = t15*t7
-    t46 = t0*t38
-    t47 = t15*t5
-    t48 = T00*t37
-    t49 = T10*t40
-    t50 = 1.7320508075688772*t0
-    t51 = t41*t50
-    t52 = 0.4771799974852257*T21
-    t53 = T21*t2
-    t54 = 0.05935703187847256*T11 + t16*t5 + t16*t7 + t1*t52 - t16*t6 - T11*t37 - T01*t40 - t39*t53
-    t55 = 0.05935703187847256*T01
-    t56 = t17*t5
-    t57 = T01*t37
-    t58 = t17*t6
-    t59 = t17*t7
-    t60 = t0*t52
-    t61 = T11*t40
-    t62 = t50*t53
-    t63 = 0.2755*T22
-    t64 = 0.03426979833333333*T12 + 0.17158850000315679*t1 + t5*t12 + t7*t12 + t1*t63 - t6*t12 - 0.2755*T12*t2 - t24*t8 - T22*t1*t4
-    t65 = 0.03426979833333333*T02 + 0.17158850000315679*t0 + t6*t11 + t7*t11 + t0*t63 - 0.5*T02*t5 - 0.2755*T02*t2 - 1.0*T12*t0*t1 - 1.0*T22*t0*t2
+    t4 = t0**2
+    t5 = t1**2
+    t6 = t2**2
+    t7 = T02*t0
+    t8 = T12*t1
+    t9 = T22*t2
+    t10 = 0.5*T02
+    t11 = 0.5*T12
+    t12 = 0.8660254037844386*T10
+    t13 = -t12
+    t14 = 0.8660254037844386*T00
+    t15 = 0.8660254037844386*T11
+    t16 = 0.8660254037844386*T01
+    t17 = 0.8660254037844386*T20
+    t18 = 0.8660254037844386*T21
+    t19 = -0.0743*T10
+    t20 = 0.0743*T00
+    t21 = 0.0743*T11
+    t22 = 0.0743*T01
+    t23 = 0.042897125000789196*T12 - 1.0*t1
+    t24 = 0.042897125000789196*T02
+    t25 = 0.1486*t0
+    t26 = 0.1486*t1
+    t27 = 0.1486*t2
+    t28 = 0.23858999874261286*T00 + t0*t17 - t2*t14
+    t29 = 0.23858999874261286*T10 + t1*t17 - t2*t12
+    t30 = -(0.23858999874261286*T01 - 0.8660254037844386*T01*t2 + t0*t18)
+    t31 = 0.23858999874261286*T11 - t2*t15 + t1*t18
+    t32 = -(0.13775*T02 - 0.5*T02*t2 + t0*t3)
+    t33 = 0.13775*T12 - t2*t11 + t1*t3
+    t34 = 0.4771799974852257*t2
+    t35 = 0.4771799974852257*T20
+    t36 = 1.7320508075688772*t1
+    t37 = t0*t36
+    t38 = t2*T20
+    t39 = -0.05935703187847256*T10 + t5*t12 + T10*t34 - t4*t12 - t6*t12 - t1*t35 + T00*t37 + t36*t38
+    t40 = 0.05935703187847256*T00
+    t41 = t5*t14
+    t42 = t6*t14
+    t43 = t0*t35
+    t44 = t4*t14
+    t45 = T00*t34
+    t46 = T10*t37
+    t47 = 1.7320508075688772*t0
+    t48 = t38*t47
+    t49 = 0.4771799974852257*T21
+    t50 = t2*T21
+    t51 = 0.05935703187847256*T11 + t4*t15 + t6*t15 + t1*t49 - t5*t15 - T11*t34 - T01*t37 - t36*t50
+    t52 = 0.05935703187847256*T01
+    t53 = t4*t16
+    t54 = T01*t34
+    t55 = t5*t16
+    t56 = t6*t16
+    t57 = t0*t49
+    t58 = T11*t37
+    t59 = t47*t50
+    t60 = 0.2755*T22
+    t61 = 0.2755*t2
+    t62 = 0.03426979833333333*T12 + 0.17158850000315679*t1 + t4*t11 + t6*t11 + t1*t60 - t5*t11 - T12*t61 - t1*t7 - t1*t9
+    t63 = t0*t8
+    t64 = t0*t9
+    t65 = 0.03426979833333333*T02 + 0.17158850000315679*t0 - t4*t10 - T02*t61 + t5*t10 + t6*t10 + t0*t60
     t66 = 0.4771799974852257*t0
     t67 = 0.4771799974852257*t1
     P = _stack(xp, [
@@ -2947,7 +2953,7 @@ def ik_general_equations(T):
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 7
-        0.2755 + 0.042897125000789196*T22 - t4,  # 4, 8
+        0.2755 + 0.042897125000789196*T22 - 1.0*t2,  # 4, 8
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 2
@@ -2965,7 +2971,7 @@ def ik_general_equations(T):
         xp.full(batch, 0, dtype=dtype, device=device),  # 6, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 6, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 6, 7
-        0.1475337380253272 + 0.551*t2 - 1.0*t5 - 1.0*t6 - 1.0*t7 - 0.023636315875434848*T22 + 0.08579425000157839*t8 + 0.08579425000157839*t9 + 0.08579425000157839*t10,  # 6, 8
+        0.1475337380253272 + 0.551*t2 - t4 - t5 - t6 - 0.023636315875434848*T22 + 0.08579425000157839*t7 + 0.08579425000157839*t8 + 0.08579425000157839*t9,  # 6, 8
         xp.full(batch, 0, dtype=dtype, device=device),  # 7, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 7, 1
         xp.full(batch, 0.35507041555161983, dtype=dtype, device=device),  # 7, 2
@@ -2974,7 +2980,7 @@ def ik_general_equations(T):
         xp.full(batch, 0, dtype=dtype, device=device),  # 7, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 7, 6
         xp.full(batch, 0.008487048957087498, dtype=dtype, device=device),  # 7, 7
-        -0.21089281250197298 - 0.13775*T22 + t0*t11 + t1*t12 + t2*t3,  # 7, 8
+        -0.21089281250197298 - 0.13775*T22 + t0*t10 + t1*t11 + t2*t3,  # 7, 8
         xp.full(batch, 0, dtype=dtype, device=device),  # 8, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 8, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 8, 2
@@ -2992,7 +2998,7 @@ def ik_general_equations(T):
         xp.full(batch, 0, dtype=dtype, device=device),  # 9, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 9, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 9, 7
-        t0*t12 - t1*t11,  # 9, 8
+        t0*t11 - t1*t10,  # 9, 8
         xp.full(batch, -0.35507041555161983, dtype=dtype, device=device),  # 10, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 10, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 10, 2
@@ -3019,7 +3025,7 @@ def ik_general_equations(T):
         xp.full(batch, 0, dtype=dtype, device=device),  # 12, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 12, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 12, 7
-        -0.047272631750869695 + 0.17158850000315679*t2 - 0.041630451666666665*T22 + t3*t5 + t3*t6 + 0.2755*t8 + 0.2755*t9 + 0.2755*t10 - t3*t7 - t4*t8 - t4*t9,  # 12, 8
+        -0.047272631750869695 + 0.17158850000315679*t2 - 0.041630451666666665*T22 + t4*t3 + t5*t3 + 0.2755*t7 + 0.2755*t8 + 0.2755*t9 - t6*t3 - t2*t7 - t2*t8,  # 12, 8
         xp.full(batch, 0, dtype=dtype, device=device),  # 13, 0
         xp.full(batch, -0.1776751942877016, dtype=dtype, device=device),  # 13, 1
         xp.full(batch, -0.006959380144811749, dtype=dtype, device=device),  # 13, 2
@@ -3283,38 +3289,38 @@ def ik_general_equations(T):
         xp.full(batch, 0, dtype=dtype, device=device),  # 41, 8
     ], (42, 9))
     Q = _stack(xp, [
-        t14,  # 0, 0
-        t15,  # 0, 1
-        t16,  # 0, 2
-        -t17,  # 0, 3
+        t13,  # 0, 0
+        t14,  # 0, 1
+        t15,  # 0, 2
+        -t16,  # 0, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5
-        t12,  # 0, 6
-        -t11,  # 0, 7
+        t11,  # 0, 6
+        -t10,  # 0, 7
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 3
-        t18,  # 1, 4
-        -t19,  # 1, 5
+        t17,  # 1, 4
+        -t18,  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 7
-        -t15,  # 2, 0
-        t14,  # 2, 1
-        t17,  # 2, 2
-        t16,  # 2, 3
+        -t14,  # 2, 0
+        t13,  # 2, 1
+        t16,  # 2, 2
+        t15,  # 2, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 5
-        t11,  # 2, 6
-        t12,  # 2, 7
-        t20,  # 3, 0
-        t21,  # 3, 1
-        t22,  # 3, 2
-        -t23,  # 3, 3
+        t10,  # 2, 6
+        t11,  # 2, 7
+        t19,  # 3, 0
+        t20,  # 3, 1
+        t21,  # 3, 2
+        -t22,  # 3, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 5
-        t25,  # 3, 6
-        t26 - t27,  # 3, 7
+        t23,  # 3, 6
+        t0 - t24,  # 3, 7
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 2
@@ -3323,78 +3329,78 @@ def ik_general_equations(T):
         -0.0743*T21,  # 4, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 7
-        -t21,  # 5, 0
-        t20,  # 5, 1
-        t23,  # 5, 2
-        t22,  # 5, 3
+        -t20,  # 5, 0
+        t19,  # 5, 1
+        t22,  # 5, 2
+        t21,  # 5, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 5
-        t27 - t26,  # 5, 6
-        t25,  # 5, 7
+        t24 - 1.0*t0,  # 5, 6
+        t23,  # 5, 7
         xp.full(batch, 0, dtype=dtype, device=device),  # 6, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 6, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 6, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 6, 3
-        -0.0409393*T20 + T00*t28 + T10*t29 + T20*t30,  # 6, 4
-        -(-0.0409393*T21 + T01*t28 + T11*t29 + T21*t30),  # 6, 5
+        -0.0409393*T20 + T00*t25 + T10*t26 + T20*t27,  # 6, 4
+        -(-0.0409393*T21 + T01*t25 + T11*t26 + T21*t27),  # 6, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 6, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 6, 7
         xp.full(batch, 0, dtype=dtype, device=device),  # 7, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 7, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 7, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 7, 3
-        -0.23858999874261286*T20 + t0*t15 + t1*t13 + t2*t18,  # 7, 4
-        -(-0.23858999874261286*T21 + t0*t17 + t1*t16 + t2*t19),  # 7, 5
+        -0.23858999874261286*T20 + t0*t14 + t1*t12 + t2*t17,  # 7, 4
+        -(-0.23858999874261286*T21 + t0*t16 + t1*t15 + t2*t18),  # 7, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 7, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 7, 7
-        t31,  # 8, 0
-        t32,  # 8, 1
-        t33,  # 8, 2
-        -t34,  # 8, 3
+        t28,  # 8, 0
+        t29,  # 8, 1
+        t30,  # 8, 2
+        -t31,  # 8, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 8, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 8, 5
-        t35,  # 8, 6
-        -t36,  # 8, 7
+        t32,  # 8, 6
+        -t33,  # 8, 7
         xp.full(batch, 0, dtype=dtype, device=device),  # 9, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 9, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 9, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 9, 3
-        t0*t13 - t1*t15,  # 9, 4
-        t1*t17 - t0*t16,  # 9, 5
+        t0*t12 - t1*t14,  # 9, 4
+        t1*t16 - t0*t15,  # 9, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 9, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 9, 7
-        -t32,  # 10, 0
-        t31,  # 10, 1
-        t34,  # 10, 2
-        t33,  # 10, 3
+        -t29,  # 10, 0
+        t28,  # 10, 1
+        t31,  # 10, 2
+        t30,  # 10, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 10, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 10, 5
-        t36,  # 10, 6
-        t35,  # 10, 7
-        t42,  # 11, 0
-        t43 + t44 + t45 + t46 - t47 - t48 - t49 - t51,  # 11, 1
-        t54,  # 11, 2
-        -t55 + t56 + t57 - t58 - t59 - t60 + t61 + t62,  # 11, 3
+        t33,  # 10, 6
+        t32,  # 10, 7
+        t39,  # 11, 0
+        t40 + t41 + t42 + t43 - t44 - t45 - t46 - t48,  # 11, 1
+        t51,  # 11, 2
+        -t52 + t53 + t54 - t55 - t56 - t57 + t58 + t59,  # 11, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 11, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 11, 5
-        t64,  # 11, 6
-        -t65,  # 11, 7
+        t62,  # 11, 6
+        -(-t63 - t64 + t65),  # 11, 7
         xp.full(batch, 0, dtype=dtype, device=device),  # 12, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 12, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 12, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 12, 3
-        -0.07210605742870711*T20 + t18*t5 + t18*t6 + T00*t66 + T10*t67 + T20*t37 - t18*t7 - T00*t2*t50 - T10*t2*t39,  # 12, 4
-        -(-0.07210605742870711*T21 + t19*t5 + t19*t6 + T01*t66 + T11*t67 + T21*t37 - 0.8660254037844386*T21*t7 - 1.7320508075688772*T01*t0*t2 - 1.7320508075688772*T11*t1*t2),  # 12, 5
+        -0.07210605742870711*T20 + t4*t17 + t5*t17 + T00*t66 + T10*t67 + T20*t34 - t6*t17 - T00*t2*t47 - T10*t2*t36,  # 12, 4
+        -(-0.07210605742870711*T21 - 0.8660254037844386*T21*t6 + t4*t18 + t5*t18 + T01*t66 + T11*t67 + T21*t34 - 1.7320508075688772*T01*t0*t2 - 1.7320508075688772*T11*t1*t2),  # 12, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 12, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 12, 7
-        -t43 + t47 + t48 - t44 - t45 - t46 + t49 + t51,  # 13, 0
-        t42,  # 13, 1
-        t55 + t58 + t59 + t60 - t56 - t57 - t61 - t62,  # 13, 2
-        t54,  # 13, 3
+        -t40 + t44 + t45 - t41 - t42 - t43 + t46 + t48,  # 13, 0
+        t39,  # 13, 1
+        t52 + t55 + t56 + t57 - t53 - t54 - t58 - t59,  # 13, 2
+        t51,  # 13, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 13, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 13, 5
-        t65,  # 13, 6
-        t64,  # 13, 7
+        -t63 - t64 + t65,  # 13, 6
+        t62,  # 13, 7
     ], (14, 8))
     return P, Q
 
@@ -3434,15 +3440,15 @@ def ik_general_start(T, angles):
     t18 = t7*t13 - t11*t12
     t19 = t11*t13 + t7*t12
     t20 = xp.sin(ga2)
-    t21 = 0.8660254037844386*t19 + 0.5*t18*t20
+    t21 = 0.5*t18*t20 + 0.8660254037844386*t19
     t22 = xp.cos(ga2)
     t23 = t1*t20 + t14*t22
     t24 = 0.5*(t1*t22 - t14*t20) - 0.8660254037844386*t15
     t25 = t16*t22 - t0*t20
     t26 = -0.5*(t0*t22 + t16*t20) - 0.8660254037844386*t17
     t27 = t18*t22
-    t28 = -t2*(T10*t25 + T20*t27 - T00*t23) - t3*(T11*t25 + T21*t27 - T01*t23)
-    t29 = t2*(T00*t24 + T20*t21 - T10*t26) + t3*(T01*t24 + T21*t21 - T11*t26)
+    t28 = -t2*(-T00*t23 + T10*t25 + T20*t27) - t3*(T11*t25 + T21*t27 - T01*t23)
+    t29 = t2*(T00*t24 + T20*t21 - T10*t26) + t3*(-T11*t26 + T01*t24 + T21*t21)
     q = _stack(xp, [
         xp.broadcast_to(ga4, batch),  # 0
         xp.broadcast_to(1.5707963267948966 + ga0, batch),  # 1
@@ -3496,8 +3502,8 @@ def ik_general_residual(target, q):
     s6 = xp.cos(0.17453292519943295 + q6)
     t0 = c2*c3
     t1 = s2*s3
-    t2 = t0*c1 + t1*c1
-    t3 = t0*s1 + t1*s1
+    t2 = c1*t0 + c1*t1
+    t3 = s1*t0 + s1*t1
     t4 = t0 + t1
     t5 = t2*c4 + s1*s4
     t6 = c4*s1 - t2*s4
@@ -3506,8 +3512,8 @@ def ik_general_residual(target, q):
     t9 = -0.25019712500078917*t4
     t10 = c3*s2
     t11 = c2*s3
-    t12 = t10*c1 - t11*c1
-    t13 = t11*s1 - t10*s1
+    t12 = c1*t10 - c1*t11
+    t13 = s1*t11 - s1*t10
     t14 = t10 - t11
     t15 = -0.25019712500078917*t12
     t16 = -0.25019712500078917*t13
@@ -3517,7 +3523,7 @@ def ik_general_residual(target, q):
     t20 = 0.5*t13 + 0.8660254037844386*t8
     t21 = t20
     t22 = -0.08579425000157839*t20
-    t23 = t14*s4
+    t23 = s4*t14
     t24 = 0.5*t4 + 0.8660254037844386*t23
     t25 = t24
     t26 = 0.08579425000157839*t24
@@ -3528,9 +3534,9 @@ def ik_general_residual(target, q):
     t31 = t7*c5 + s5*t30
     t32 = c5*t30 - t7*s5
     t33 = 0.8660254037844386*t4 - 0.5*t23
-    t34 = t14*c4
-    t35 = s5*t33 + t34*c5
-    t36 = c5*t33 - t34*s5
+    t34 = c4*t14
+    t35 = s5*t33 + c5*t34
+    t36 = c5*t33 - s5*t34
     t37 = 0.5*t18 + 0.8660254037844386*t29
     t38 = t37
     t39 = 0.2115971250007892*t37
@@ -3573,8 +3579,8 @@ def ik_general_residual(target, q):
     t76 = -0.5*(t72 + t61)
     t77 = xp.sqrt(t75**2 + t76**2 + t68**2)
     t78 = 0.41*c2
-    t79 = t42 + t78*c1
-    t80 = t48 - t78*s1
+    t79 = t42 + c1*t78
+    t80 = t48 - s1*t78
     t81 = -t74
     t82 = 0.5*(-1 + t59 + t66 + t81)
     t83 = xp.atan2(t77, t82)
@@ -4155,8 +4161,8 @@ IK_NEAREST_NOT_FINITE = 2
 _MONOMIALS = numpy.array([[0, 0, 0, 0, 4, 0, 0, 0, 0], [0, 0, 0, 2, 0, -2, 0, 0, 0], [0, 2, 0, 0, 0, 0, 0, -2, 0], [1, 0, -1, 0, 0, 0, -1, 0, 1], [0, 0, 0, 2, 0, 2, 0, 0, 0], [1, 0, 1, 0, 0, 0, -1, 0, -1], [0, 2, 0, 0, 0, 0, 0, 2, 0], [1, 0, -1, 0, 0, 0, 1, 0, -1], [1, 0, 1, 0, 0, 0, 1, 0, 1]], dtype=float)  # v_bc's entries in the monomials x_b^i x_c^j, at 3 i + j
 _ALONG_C, _ALONG_B = numpy.array([0, 1, 3, 4, 6, 7, 9, 10]), numpy.array([0, 1, 2, 3, 4, 5, 6, 7, 8])  # ratios x_c (step 1), x_b (step 3)
 _NEWTON_STEPS = 6
-_TOLERANCE_SQUARED = 1.00000000000000e-18  # |pose error|^2 of a solution after the Newton steps
-_CONVERGED_SQUARED = 5.03054882344641e-24  # |pose error|^2 at which the Newton steps stop
+_TOLERANCE_SQUARED = 1e-18  # |pose error|^2 of a solution after the Newton steps
+_CONVERGED_SQUARED = 5.0305488234464105e-24  # |pose error|^2 at which the Newton steps stop
 
 
 def _twelve(s):

@@ -47,7 +47,7 @@ void kr5_jacobian(const kr5_real q[KR5_DOF], kr5_real J[6 * KR5_DOF]);
 void kr5_fk_jacobian(const kr5_real q[KR5_DOF], kr5_real T[16], kr5_real J[6 * KR5_DOF]);
 
 /* Geometric Jacobian in the tool frame (6 x DOF, rows vx vy vz wx wy wz).
- * Result: J: 6 x 6 row-major, element (r, c) at J[r * 6 + c]. 251 operations. */
+ * Result: J: 6 x 6 row-major, element (r, c) at J[r * 6 + c]. 249 operations. */
 void kr5_jacobian_tool(const kr5_real q[KR5_DOF], kr5_real J[6 * KR5_DOF]);
 
 /* Task vector mu = (x, y, z, roll, pitch, yaw).

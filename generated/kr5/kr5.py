@@ -93,40 +93,40 @@ def fk(q):
     s6 = trig[..., 11]
     t0 = s1*s4
     t1 = c1*c4
-    t2 = -t0 + t1*c23
-    t3 = t1 - t0*c23
+    t2 = -t0 + c23*t1
+    t3 = t1 - c23*t0
     t4 = c4*s1
     t5 = c1*s4
-    t6 = t4 + t5*c23
-    t7 = t5 + t4*c23
+    t6 = t4 + c23*t5
+    t7 = t5 + c23*t4
     t8 = c1*s23
-    t9 = t2*c5 - t8*s5
-    t10 = t2*s5 + t8*c5
+    t9 = t2*c5 - s5*t8
+    t10 = t2*s5 + c5*t8
     t11 = t9*c6 - t6*s6
     t12 = t6*c6 + t9*s6
     t13 = 0.115*t10 + 0.62*t8
     t14 = s1*s23
-    t15 = t7*c5 - t14*s5
-    t16 = t7*s5 + t14*c5
+    t15 = t7*c5 - s5*t14
+    t16 = t7*s5 + c5*t14
     t17 = t3*s6 + t15*c6
     t18 = t3*c6 - t15*s6
     t19 = 0.115*t16 + 0.62*t14
     t20 = c4*s23
-    t21 = c23*s5 + t20*c5
-    t22 = -c23*c5 + t20*s5
-    t23 = 0.115*t22 - 0.62*c23
+    t21 = c23*s5 + c5*t20
+    t22 = -c23*c5 + s5*t20
+    t23 = -0.62*c23 + 0.115*t22
     t24 = t23 - 0.12*s23
     t25 = t24 - 0.6*s2
     t26 = 0.4 + t25
-    t27 = s23*s4
-    t28 = -t21*c6 + t27*s6
-    t29 = t21*s6 + t27*c6
+    t27 = s4*s23
+    t28 = -t21*c6 + s6*t27
+    t29 = t21*s6 + c6*t27
     t30 = 0.12*c23
-    t31 = -t13 + t30*c1
-    t32 = -t19 + t30*s1
+    t31 = -t13 + c1*t30
+    t32 = -t19 + s1*t30
     t33 = 0.6*c2
-    t34 = t31 + t33*c1
-    t35 = t32 + t33*s1
+    t34 = t31 + c1*t33
+    t35 = t32 + s1*t33
     t36 = t34 + 0.18*c1
     t37 = t35 + 0.18*s1
     T = _stack(xp, [
@@ -169,30 +169,30 @@ def jacobian(q):
     t0 = -c23*c5 + c4*s23*s5
     t1 = s1*s4
     t2 = c1*c4
-    t3 = -t1 + t2*c23
-    t4 = t2 - t1*c23
+    t3 = -t1 + c23*t2
+    t4 = t2 - c23*t1
     t5 = c4*s1
     t6 = c1*s4
-    t7 = t5 + t6*c23
-    t8 = t6 + t5*c23
+    t7 = t5 + c23*t6
+    t8 = t6 + c23*t5
     t9 = c1*s23
-    t10 = t3*s5 + t9*c5
+    t10 = t3*s5 + c5*t9
     t11 = s1*s23
-    t12 = t8*s5 + t11*c5
+    t12 = t8*s5 + c5*t11
     t13 = 0.115*t10
     t14 = t13 + 0.62*t9
     t15 = 0.115*t12
     t16 = t15 + 0.62*t11
     t17 = 0.115*t0
-    t18 = t17 - 0.62*c23
+    t18 = -0.62*c23 + t17
     t19 = t18 - 0.12*s23
     t20 = t19 - 0.6*s2
     t21 = 0.12*c23
-    t22 = -t14 + t21*c1
-    t23 = -t16 + t21*s1
+    t22 = -t14 + c1*t21
+    t23 = -t16 + s1*t21
     t24 = 0.6*c2
-    t25 = t22 + t24*c1
-    t26 = t23 + t24*s1
+    t25 = t22 + c1*t24
+    t26 = t23 + s1*t24
     t27 = t25 + 0.18*c1
     t28 = t26 + 0.18*s1
     t29 = s23*s4
@@ -202,13 +202,13 @@ def jacobian(q):
         t20*c1,  # 0, 1
         t19*c1,  # 0, 2
         t16*c23 + t18*t11,  # 0, 3
-        t4*t17 + t29*t15,  # 0, 4
+        t4*t17 + t15*t29,  # 0, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5
         t27,  # 1, 0
         t20*s1,  # 1, 1
         t19*s1,  # 1, 2
         -(t14*c23 + t18*t9),  # 1, 3
-        t7*t17 - t29*t13,  # 1, 4
+        t7*t17 - t13*t29,  # 1, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
         -(t25*c1 + t26*s1),  # 2, 1
@@ -258,43 +258,43 @@ def fk_jacobian(q):
     s6 = trig[..., 11]
     t0 = s1*s4
     t1 = c1*c4
-    t2 = -t0 + t1*c23
-    t3 = t1 - t0*c23
+    t2 = -t0 + c23*t1
+    t3 = t1 - c23*t0
     t4 = c4*s1
     t5 = c1*s4
-    t6 = t4 + t5*c23
-    t7 = t5 + t4*c23
+    t6 = t4 + c23*t5
+    t7 = t5 + c23*t4
     t8 = c1*s23
-    t9 = t2*c5 - t8*s5
-    t10 = t2*s5 + t8*c5
+    t9 = t2*c5 - s5*t8
+    t10 = t2*s5 + c5*t8
     t11 = t9*c6 - t6*s6
     t12 = t6*c6 + t9*s6
     t13 = s1*s23
-    t14 = t7*c5 - t13*s5
-    t15 = t7*s5 + t13*c5
+    t14 = t7*c5 - s5*t13
+    t15 = t7*s5 + c5*t13
     t16 = t3*s6 + t14*c6
     t17 = t3*c6 - t14*s6
     t18 = c4*s23
-    t19 = c23*s5 + t18*c5
-    t20 = -c23*c5 + t18*s5
+    t19 = c23*s5 + c5*t18
+    t20 = -c23*c5 + s5*t18
     t21 = s23*s4
-    t22 = -t19*c6 + t21*s6
-    t23 = t19*s6 + t21*c6
+    t22 = -t19*c6 + s6*t21
+    t23 = t19*s6 + c6*t21
     t24 = 0.115*t10
     t25 = t24 + 0.62*t8
     t26 = 0.115*t15
     t27 = t26 + 0.62*t13
     t28 = 0.115*t20
-    t29 = t28 - 0.62*c23
+    t29 = -0.62*c23 + t28
     t30 = t29 - 0.12*s23
     t31 = t30 - 0.6*s2
     t32 = 0.4 + t31
     t33 = 0.12*c23
-    t34 = -t25 + t33*c1
-    t35 = -t27 + t33*s1
+    t34 = -t25 + c1*t33
+    t35 = -t27 + s1*t33
     t36 = 0.6*c2
-    t37 = t34 + t36*c1
-    t38 = t35 + t36*s1
+    t37 = t34 + c1*t36
+    t38 = t35 + s1*t36
     t39 = t37 + 0.18*c1
     t40 = t38 + 0.18*s1
     t41 = -s1
@@ -321,13 +321,13 @@ def fk_jacobian(q):
         t31*c1,  # 0, 1
         t30*c1,  # 0, 2
         t27*c23 + t29*t13,  # 0, 3
-        t3*t28 + t21*t26,  # 0, 4
+        t3*t28 + t26*t21,  # 0, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5
         t39,  # 1, 0
         t31*s1,  # 1, 1
         t30*s1,  # 1, 2
         -(t25*c23 + t29*t8),  # 1, 3
-        t6*t28 - t21*t24,  # 1, 4
+        t6*t28 - t24*t21,  # 1, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
         -(t37*c1 + t38*s1),  # 2, 1
@@ -358,7 +358,7 @@ def fk_jacobian(q):
 
 
 def jacobian_tool(q):
-    """geometric Jacobian in the tool frame (6 x DOF, rows vx vy vz wx wy wz): (6 x 6), 251 operations."""
+    """geometric Jacobian in the tool frame (6 x DOF, rows vx vy vz wx wy wz): (6 x 6), 249 operations."""
     xp, dtype, device, batch, (q,) = _arguments(("q", q, (6,)))
     trig = _cos_sin(xp, q, (0.0, 0.0, 0.0, 0.0, 0.0, 0.0), device)
     c1 = trig[..., 0]
@@ -377,60 +377,61 @@ def jacobian_tool(q):
     s6 = trig[..., 11]
     t0 = s1*s4
     t1 = c1*c4
-    t2 = -t0 + t1*c23
-    t3 = t1 - t0*c23
+    t2 = -t0 + c23*t1
+    t3 = t1 - c23*t0
     t4 = c4*s1
     t5 = c1*s4
-    t6 = t4 + t5*c23
-    t7 = t5 + t4*c23
+    t6 = t4 + c23*t5
+    t7 = t5 + c23*t4
     t8 = c1*s23
-    t9 = t2*c5 - t8*s5
-    t10 = t2*s5 + t8*c5
+    t9 = t2*c5 - s5*t8
+    t10 = t2*s5 + c5*t8
     t11 = t9*c6 - t6*s6
     t12 = t6*c6 + t9*s6
     t13 = s1*s23
-    t14 = t7*c5 - t13*s5
-    t15 = t7*s5 + t13*c5
+    t14 = t7*c5 - s5*t13
+    t15 = t7*s5 + c5*t13
     t16 = t3*s6 + t14*c6
     t17 = t3*c6 - t14*s6
     t18 = c4*s23
-    t19 = c23*s5 + t18*c5
-    t20 = -c23*c5 + t18*s5
-    t21 = s23*s4
-    t22 = -t19*c6 + t21*s6
-    t23 = t19*s6 + t21*c6
+    t19 = c23*s5 + c5*t18
+    t20 = -c23*c5 + s5*t18
+    t21 = s4*s23
+    t22 = -t19*c6 + s6*t21
+    t23 = t19*s6 + c6*t21
     t24 = 0.115*t10
     t25 = t24 + 0.62*t8
     t26 = 0.115*t15
     t27 = t26 + 0.62*t13
     t28 = 0.115*t20
-    t29 = t28 - 0.62*c23
+    t29 = -0.62*c23 + t28
     t30 = t29 - 0.12*s23
     t31 = t30 - 0.6*s2
     t32 = 0.12*c23
-    t33 = -t25 + t32*c1
-    t34 = -t27 + t32*s1
+    t33 = -t25 + c1*t32
+    t34 = -t27 + s1*t32
     t35 = 0.6*c2
-    t36 = t33 + t35*c1
-    t37 = t34 + t35*s1
+    t36 = t33 + c1*t35
+    t37 = t34 + s1*t35
     t38 = t36 + 0.18*c1
     t39 = t37 + 0.18*s1
     t40 = -(t36*c1 + t37*s1)
-    t41 = t11*c1
-    t42 = t16*s1
+    t41 = c1*t11
+    t42 = s1*t16
     t43 = -(t33*c1 + t34*s1)
     t44 = t27*c23 + t29*t13
     t45 = -(t25*c23 + t29*t8)
     t46 = t25*t13 - t27*t8
-    t47 = t3*t28 + t21*t26
-    t48 = t6*t28 - t21*t24
+    t47 = t3*t28 + t26*t21
+    t48 = t6*t28 - t24*t21
     t49 = t6*t26 + t3*t24
-    t50 = t17*s1
-    t51 = t10*c1
-    t52 = t15*s1
-    t53 = t16*c1 - t11*s1
-    t54 = -(t12*s1 + t17*c1)
-    t55 = t10*s1 - t15*c1
+    t50 = c1*t12
+    t51 = s1*t17
+    t52 = c1*t10
+    t53 = s1*t15
+    t54 = t16*c1 - t11*s1
+    t55 = -(t12*s1 + t17*c1)
+    t56 = t10*s1 - t15*c1
     J = _stack(xp, [
         t16*t38 - t11*t39,  # 0, 0
         t22*t40 + t31*t41 + t31*t42,  # 0, 1
@@ -439,32 +440,32 @@ def jacobian_tool(q):
         t11*t47 + t16*t48 + t22*t49,  # 0, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5
         -(t12*t39 + t17*t38),  # 1, 0
-        -(t23*t40 + t31*t50 - t12*t31*c1),  # 1, 1
-        -(t23*t43 + t30*t50 - t12*t30*c1),  # 1, 2
-        -(t17*t45 + t23*t46 - t12*t44),  # 1, 3
-        -(t17*t48 + t23*t49 - t12*t47),  # 1, 4
+        -(t23*t40 - t31*t50 + t31*t51),  # 1, 1
+        -(t23*t43 - t30*t50 + t30*t51),  # 1, 2
+        -(-t12*t44 + t17*t45 + t23*t46),  # 1, 3
+        -(-t12*t47 + t17*t48 + t23*t49),  # 1, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5
         t10*t39 - t15*t38,  # 2, 0
-        -(-t20*t40 + t31*t51 + t31*t52),  # 2, 1
-        -(-t20*t43 + t30*t51 + t30*t52),  # 2, 2
-        -(t10*t44 + t15*t45 - t20*t46),  # 2, 3
-        -(t10*t47 + t15*t48 - t20*t49),  # 2, 4
+        -(-t20*t40 + t31*t52 + t31*t53),  # 2, 1
+        -(-t20*t43 + t30*t52 + t30*t53),  # 2, 2
+        -(-t20*t46 + t10*t44 + t15*t45),  # 2, 3
+        -(-t20*t49 + t10*t47 + t15*t48),  # 2, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 5
         t22,  # 3, 0
-        t53,  # 3, 1
-        t53,  # 3, 2
+        t54,  # 3, 1
+        t54,  # 3, 2
         t22*c23 + t11*t8 + t16*t13,  # 3, 3
         t3*t16 - t6*t11 + t22*t21,  # 3, 4
         t10*t11 + t15*t16 - t20*t22,  # 3, 5
         -t23,  # 4, 0
-        t54,  # 4, 1
-        t54,  # 4, 2
-        -(t23*c23 + t17*t13 - t12*c1*s23),  # 4, 3
+        t55,  # 4, 1
+        t55,  # 4, 2
+        -(t23*c23 - t12*t8 + t17*t13),  # 4, 3
         -(t6*t12 + t3*t17 + t23*t21),  # 4, 4
         t10*t12 + t20*t23 - t15*t17,  # 4, 5
         t20,  # 5, 0
-        t55,  # 5, 1
-        t55,  # 5, 2
+        t56,  # 5, 1
+        t56,  # 5, 2
         -(-t20*c23 + t10*t8 + t15*t13),  # 5, 3
         t6*t10 - t3*t15 + t20*t21,  # 5, 4
         -(t10**2 + t15**2 + t20**2),  # 5, 5
@@ -492,38 +493,38 @@ def task(q):
     s6 = trig[..., 11]
     t0 = s1*s4
     t1 = c1*c4
-    t2 = -t0 + t1*c23
-    t3 = t1 - t0*c23
+    t2 = -t0 + c23*t1
+    t3 = t1 - c23*t0
     t4 = c4*s1
     t5 = c1*s4
-    t6 = t4 + t5*c23
-    t7 = t5 + t4*c23
+    t6 = t4 + c23*t5
+    t7 = t5 + c23*t4
     t8 = c1*s23
-    t9 = t2*c5 - t8*s5
-    t10 = t2*s5 + t8*c5
+    t9 = t2*c5 - s5*t8
+    t10 = t2*s5 + c5*t8
     t11 = t9*c6 - t6*s6
     t12 = 0.115*t10 + 0.62*t8
     t13 = s1*s23
-    t14 = t7*c5 - t13*s5
-    t15 = t7*s5 + t13*c5
+    t14 = t7*c5 - s5*t13
+    t15 = t7*s5 + c5*t13
     t16 = t3*s6 + t14*c6
     t17 = 0.115*t15 + 0.62*t13
     t18 = c4*s23
-    t19 = c23*s5 + t18*c5
-    t20 = -c23*c5 + t18*s5
-    t21 = 0.115*t20 - 0.62*c23
+    t19 = c23*s5 + c5*t18
+    t20 = -c23*c5 + s5*t18
+    t21 = -0.62*c23 + 0.115*t20
     t22 = t21 - 0.12*s23
     t23 = t22 - 0.6*s2
     t24 = 0.4 + t23
-    t25 = s23*s4
-    t26 = -t19*c6 + t25*s6
-    t27 = t19*s6 + t25*c6
+    t25 = s4*s23
+    t26 = -t19*c6 + s6*t25
+    t27 = t19*s6 + c6*t25
     t28 = 0.12*c23
-    t29 = -t12 + t28*c1
-    t30 = -t17 + t28*s1
+    t29 = -t12 + c1*t28
+    t30 = -t17 + s1*t28
     t31 = 0.6*c2
-    t32 = t29 + t31*c1
-    t33 = t30 + t31*s1
+    t32 = t29 + c1*t31
+    t33 = t30 + s1*t31
     t34 = t32 + 0.18*c1
     t35 = t33 + 0.18*s1
     mu = _stack(xp, [
@@ -557,39 +558,39 @@ def task_jacobian(q):
     s6 = trig[..., 11]
     t0 = s1*s4
     t1 = c1*c4
-    t2 = -t0 + t1*c23
-    t3 = t1 - t0*c23
+    t2 = -t0 + c23*t1
+    t3 = t1 - c23*t0
     t4 = c4*s1
     t5 = c1*s4
-    t6 = t4 + t5*c23
-    t7 = t5 + t4*c23
+    t6 = t4 + c23*t5
+    t7 = t5 + c23*t4
     t8 = c1*s23
-    t9 = t2*c5 - t8*s5
-    t10 = t2*s5 + t8*c5
+    t9 = t2*c5 - s5*t8
+    t10 = t2*s5 + c5*t8
     t11 = t9*c6 - t6*s6
     t12 = s1*s23
-    t13 = t7*c5 - t12*s5
-    t14 = t7*s5 + t12*c5
+    t13 = t7*c5 - s5*t12
+    t14 = t7*s5 + c5*t12
     t15 = t3*s6 + t13*c6
     t16 = c4*s23
-    t17 = c23*s5 + t16*c5
-    t18 = -c23*c5 + t16*s5
+    t17 = c23*s5 + c5*t16
+    t18 = -c23*c5 + s5*t16
     t19 = s23*s4
-    t20 = -t17*c6 + t19*s6
+    t20 = -t17*c6 + s6*t19
     t21 = 0.115*t10
     t22 = t21 + 0.62*t8
     t23 = 0.115*t14
     t24 = t23 + 0.62*t12
     t25 = 0.115*t18
-    t26 = t25 - 0.62*c23
+    t26 = -0.62*c23 + t25
     t27 = t26 - 0.12*s23
     t28 = t27 - 0.6*s2
     t29 = 0.12*c23
-    t30 = -t22 + t29*c1
-    t31 = -t24 + t29*s1
+    t30 = -t22 + c1*t29
+    t31 = -t24 + s1*t29
     t32 = 0.6*c2
-    t33 = t30 + t32*c1
-    t34 = t31 + t32*s1
+    t33 = t30 + c1*t32
+    t34 = t31 + s1*t32
     t35 = t33 + 0.18*c1
     t36 = t34 + 0.18*s1
     t37 = t11**2 + t15**2
@@ -599,7 +600,7 @@ def task_jacobian(q):
     t41 = t38*(t39 - t40)
     t42 = t11*c1
     t43 = t15*s1
-    t44 = t38*(t42*s23 + t43*s23)
+    t44 = t38*(s23*t42 + s23*t43)
     t45 = t38*(t3*t15 - t6*t11)
     t46 = t38*(t10*t11 + t14*t15)
     t47 = 1/xp.sqrt(t37)
@@ -610,13 +611,13 @@ def task_jacobian(q):
         t28*c1,  # 0, 1
         t27*c1,  # 0, 2
         t24*c23 + t26*t12,  # 0, 3
-        t3*t25 + t19*t23,  # 0, 4
+        t3*t25 + t23*t19,  # 0, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5
         t35,  # 1, 0
         t28*s1,  # 1, 1
         t27*s1,  # 1, 2
         -(t22*c23 + t26*t8),  # 1, 3
-        t6*t25 - t19*t21,  # 1, 4
+        t6*t25 - t21*t19,  # 1, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
         -(t33*c1 + t34*s1),  # 2, 1
@@ -633,7 +634,7 @@ def task_jacobian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
         t48,  # 4, 1
         t48,  # 4, 2
-        t47*(t40*s23 - t39*s23),  # 4, 3
+        t47*(s23*t40 - s23*t39),  # 4, 3
         t47*(t6*t15 + t3*t11),  # 4, 4
         t47*(t14*t11 - t10*t15),  # 4, 5
         xp.full(batch, 1, dtype=dtype, device=device),  # 5, 0
@@ -673,53 +674,53 @@ def fk_jacobian_dot(q, q_dot):
     t0 = qd1 + c23*qd4
     t1 = s1*s4
     t2 = c1*c4
-    t3 = -t1 + t2*c23
-    t4 = t2 - t1*c23
+    t3 = -t1 + c23*t2
+    t4 = t2 - c23*t1
     t5 = c4*s1
     t6 = c1*s4
-    t7 = t5 + t6*c23
-    t8 = t6 + t5*c23
+    t7 = t5 + c23*t6
+    t8 = t6 + c23*t5
     t9 = c1*s23
-    t10 = t3*c5 - t9*s5
-    t11 = t3*s5 + t9*c5
+    t10 = t3*c5 - s5*t9
+    t11 = t3*s5 + c5*t9
     t12 = t10*c6 - t7*s6
     t13 = t7*c6 + t10*s6
     t14 = s1*s23
-    t15 = t8*c5 - t14*s5
-    t16 = t8*s5 + t14*c5
+    t15 = t8*c5 - s5*t14
+    t16 = t8*s5 + c5*t14
     t17 = t4*s6 + t15*c6
     t18 = t4*c6 - t15*s6
     t19 = c4*s23
-    t20 = c23*s5 + t19*c5
-    t21 = -c23*c5 + t19*s5
+    t20 = c23*s5 + c5*t19
+    t21 = -c23*c5 + s5*t19
     t22 = s23*s4
-    t23 = -t20*c6 + t22*s6
-    t24 = t20*s6 + t22*c6
-    t25 = t0 + t22*qd5
+    t23 = -t20*c6 + s6*t22
+    t24 = t20*s6 + c6*t22
+    t25 = t0 + qd5*t22
     t26 = 0.115*t11
     t27 = t26 + 0.62*t9
     t28 = 0.115*t16
     t29 = t28 + 0.62*t14
     t30 = 0.115*t21
-    t31 = t30 - 0.62*c23
+    t31 = -0.62*c23 + t30
     t32 = t31 - 0.12*s23
     t33 = t32 - 0.6*s2
     t34 = 0.4 + t33
     t35 = 0.12*c23
-    t36 = -t27 + t35*c1
-    t37 = -t29 + t35*s1
+    t36 = -t27 + c1*t35
+    t37 = -t29 + s1*t35
     t38 = 0.6*c2
-    t39 = t36 + t38*c1
-    t40 = t37 + t38*s1
+    t39 = t36 + c1*t38
+    t40 = t37 + s1*t38
     t41 = t39 + 0.18*c1
     t42 = t40 + 0.18*s1
     t43 = t29*c23 + t31*t14
     t44 = t43
-    t45 = t4*t30 + t22*t28
+    t45 = t4*t30 + t28*t22
     t46 = t45
     t47 = t27*c23 + t31*t9
     t48 = t47
-    t49 = t7*t30 - t22*t26
+    t49 = t7*t30 - t26*t22
     t50 = t49
     t51 = t39*c1 + t40*s1
     t52 = t51
@@ -735,11 +736,11 @@ def fk_jacobian_dot(q, q_dot):
     t62 = qd2*s1
     t63 = qd3*s1
     t64 = t62 + t63
-    t65 = -t64 + t9*qd4
+    t65 = -t64 + qd4*t9
     t66 = c1*qd2
     t67 = c1*qd3
     t68 = t66 + t67
-    t69 = t68 + t14*qd4
+    t69 = t68 + qd4*t14
     t70 = t7*qd5
     t71 = t65 - t70
     t72 = t4*qd5
@@ -759,7 +760,7 @@ def fk_jacobian_dot(q, q_dot):
     t86 = t33*s1
     t87 = t32*s1
     t88 = -s1
-    t89 = t32*qd2
+    t89 = qd2*t32
     T = _stack(xp, [
         xp.broadcast_to(t12, batch),  # 0, 0
         xp.broadcast_to(t13, batch),  # 0, 1
@@ -817,11 +818,11 @@ def fk_jacobian_dot(q, q_dot):
         xp.broadcast_to(-t21, batch),  # 5, 5
     ], (6, 6))
     a = _stack(xp, [
-        xp.broadcast_to(qd2*(t61*c1 - t86*qd1) - qd3*(-t60*c1 + t87*qd1 + t54*t66) + qd4*(t48*qd1 + t56*t68 - t80*c23 + t59*t14) + qd5*(t58*t69 - t50*t0 + t58*t72 - t79*t22) - t83*qd1, batch),  # 0
-        xp.broadcast_to(t78*qd1 + qd2*(t61*s1 + t84*qd1) + qd3*(t60*s1 + t85*qd1 - t54*t62) + qd4*(t44*qd1 + t56*t64 + t75*c23 - t59*t9) + qd5*(t46*t0 - t58*t65 + t58*t70 + t74*t22), batch),  # 1
-        xp.broadcast_to(-qd2*(t77*c1 + t82*s1) - qd3*(t76*c1 + t81*s1 + t89*c1**2 + t89*s1**2) + qd4*(t48*t64 - t44*t68 + t80*t9 - t75*t14) - qd5*(t46*t69 - t50*t65 + t50*t70 + t46*t72), batch),  # 2
-        xp.broadcast_to(qd4*(t68*c23 - t14*qd1) + qd5*(-t4*t0 + t69*t22) - qd6*(t16*t25 + t21*t73) - t66*qd1 - t67*qd1, batch),  # 3
-        xp.broadcast_to(qd4*(t64*c23 + t9*qd1) - qd5*(t7*t0 + t65*t22) + qd6*(t11*t25 + t21*t71) - t62*qd1 - t63*qd1, batch),  # 4
+        xp.broadcast_to(qd2*(t61*c1 - qd1*t86) - qd3*(-t60*c1 + qd1*t87 + t54*t66) + qd4*(t48*qd1 + t56*t68 - t80*c23 + t59*t14) + qd5*(t58*t69 - t50*t0 + t58*t72 - t79*t22) - t83*qd1, batch),  # 0
+        xp.broadcast_to(t78*qd1 + qd2*(t61*s1 + qd1*t84) + qd3*(t60*s1 + qd1*t85 - t54*t62) + qd4*(t44*qd1 + t56*t64 + t75*c23 - t59*t9) + qd5*(t46*t0 - t58*t65 + t58*t70 + t74*t22), batch),  # 1
+        xp.broadcast_to(-qd2*(t77*c1 + t82*s1) - qd3*(t76*c1 + t81*s1 + c1**2*t89 + s1**2*t89) + qd4*(t48*t64 - t44*t68 + t80*t9 - t75*t14) - qd5*(-t50*t65 + t46*t69 + t50*t70 + t46*t72), batch),  # 2
+        xp.broadcast_to(qd4*(t68*c23 - qd1*t14) + qd5*(-t4*t0 + t69*t22) - qd6*(t16*t25 + t21*t73) - qd1*t66 - qd1*t67, batch),  # 3
+        xp.broadcast_to(qd4*(t64*c23 + qd1*t9) - qd5*(t7*t0 + t65*t22) + qd6*(t11*t25 + t21*t71) - qd1*t62 - qd1*t63, batch),  # 4
         xp.broadcast_to(-qd4*(t64*t14 + t68*t9) + qd5*(t7*t69 + t4*t65) + qd6*(t16*t71 - t11*t73), batch),  # 5
     ], (6,))
     return T, J, a
@@ -852,42 +853,42 @@ def jacobian_dot(q, q_dot):
     t1 = qd1 + c23*qd4
     t2 = s1*s4
     t3 = c1*c4
-    t4 = -t2 + t3*c23
-    t5 = t3 - t2*c23
+    t4 = -t2 + c23*t3
+    t5 = t3 - c23*t2
     t6 = c4*s1
     t7 = c1*s4
-    t8 = t6 + t7*c23
-    t9 = t7 + t6*c23
+    t8 = t6 + c23*t7
+    t9 = t7 + c23*t6
     t10 = c5*s23
-    t11 = t4*s5 + t10*c1
-    t12 = t9*s5 + t10*s1
+    t11 = t4*s5 + c1*t10
+    t12 = t9*s5 + s1*t10
     t13 = 0.115*t11
     t14 = 0.62*s23
-    t15 = t13 + t14*c1
+    t15 = t13 + c1*t14
     t16 = 0.115*t12
-    t17 = t16 + t14*s1
+    t17 = t16 + s1*t14
     t18 = t8*t16 + t5*t13
     t19 = 0.115*t0
-    t20 = t19 - 0.62*c23
+    t20 = -0.62*c23 + t19
     t21 = t20 - 0.12*s23
     t22 = t21 - 0.6*s2
     t23 = 0.12*c23
-    t24 = -t15 + t23*c1
-    t25 = -t17 + t23*s1
+    t24 = -t15 + c1*t23
+    t25 = -t17 + s1*t23
     t26 = t24*c1 + t25*s1
     t27 = 0.6*c2
-    t28 = t24 + t27*c1
-    t29 = t25 + t27*s1
+    t28 = t24 + c1*t27
+    t29 = t25 + s1*t27
     t30 = t28 + 0.18*c1
     t31 = t29 + 0.18*s1
     t32 = t28*c1 + t29*s1
-    t33 = t20*s23
-    t34 = t17*c23 + t33*s1
-    t35 = t15*c23 + t33*c1
-    t36 = s23*s4
-    t37 = t5*t19 + t36*t16
-    t38 = t8*t19 - t36*t13
-    t39 = t1 + t36*qd5
+    t33 = s23*t20
+    t34 = t17*c23 + s1*t33
+    t35 = t15*c23 + c1*t33
+    t36 = s4*s23
+    t37 = t5*t19 + t16*t36
+    t38 = t8*t19 - t13*t36
+    t39 = t1 + qd5*t36
     t40 = s1*s23
     t41 = c1*s23
     t42 = t15*t40 - t17*t41
@@ -897,11 +898,11 @@ def jacobian_dot(q, q_dot):
     t46 = qd2*s1
     t47 = qd3*s1
     t48 = t46 + t47
-    t49 = -t48 + t41*qd4
+    t49 = -t48 + qd4*t41
     t50 = c1*qd2
     t51 = c1*qd3
     t52 = t50 + t51
-    t53 = t52 + t40*qd4
+    t53 = t52 + qd4*t40
     t54 = t8*qd5
     t55 = t49 - t54
     t56 = t5*qd5
@@ -918,7 +919,7 @@ def jacobian_dot(q, q_dot):
     t67 = t66 + t30*qd1
     t68 = qd1*s1
     t69 = c1*qd1
-    t70 = t21*qd2
+    t70 = qd2*t21
     t71 = -t69
     t72 = -t68
     Jd = _stack(xp, [
@@ -926,30 +927,30 @@ def jacobian_dot(q, q_dot):
         xp.broadcast_to(t45*c1 - t22*t68, batch),  # 0, 1
         xp.broadcast_to(-(-t44*c1 + t21*t68 + t26*t50), batch),  # 0, 2
         xp.broadcast_to(t35*qd1 + t42*t52 - t64*c23 + t43*t40, batch),  # 0, 3
-        xp.broadcast_to(t18*t53 - t38*t1 + t18*t56 - t36*t63, batch),  # 0, 4
+        xp.broadcast_to(t18*t53 - t38*t1 + t18*t56 - t63*t36, batch),  # 0, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5
         xp.broadcast_to(t62, batch),  # 1, 0
         xp.broadcast_to(t45*s1 + t22*t69, batch),  # 1, 1
         xp.broadcast_to(t44*s1 + t21*t69 - t26*t46, batch),  # 1, 2
         xp.broadcast_to(t34*qd1 + t42*t48 + t59*c23 - t43*t41, batch),  # 1, 3
-        xp.broadcast_to(t37*t1 - t18*t49 + t18*t54 + t36*t58, batch),  # 1, 4
+        xp.broadcast_to(t37*t1 - t18*t49 + t18*t54 + t58*t36, batch),  # 1, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
         xp.broadcast_to(-(t61*c1 + t66*s1), batch),  # 2, 1
-        xp.broadcast_to(-(t60*c1 + t65*s1 + t70*c1**2 + t70*s1**2), batch),  # 2, 2
+        xp.broadcast_to(-(t60*c1 + t65*s1 + c1**2*t70 + s1**2*t70), batch),  # 2, 2
         xp.broadcast_to(t35*t48 - t34*t52 + t64*t41 - t59*t40, batch),  # 2, 3
-        xp.broadcast_to(-(t37*t53 - t38*t49 + t38*t54 + t37*t56), batch),  # 2, 4
+        xp.broadcast_to(-(-t38*t49 + t37*t53 + t38*t54 + t37*t56), batch),  # 2, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
         xp.broadcast_to(t71, batch),  # 3, 1
         xp.broadcast_to(t71, batch),  # 3, 2
-        xp.broadcast_to(t52*c23 - t68*s23, batch),  # 3, 3
+        xp.broadcast_to(t52*c23 - s23*t68, batch),  # 3, 3
         xp.broadcast_to(-t5*t1 + t53*t36, batch),  # 3, 4
         xp.broadcast_to(-(t12*t39 + t0*t57), batch),  # 3, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
         xp.broadcast_to(t72, batch),  # 4, 1
         xp.broadcast_to(t72, batch),  # 4, 2
-        xp.broadcast_to(t48*c23 + t69*s23, batch),  # 4, 3
+        xp.broadcast_to(t48*c23 + s23*t69, batch),  # 4, 3
         xp.broadcast_to(-(t8*t1 + t49*t36), batch),  # 4, 4
         xp.broadcast_to(t11*t39 + t0*t55, batch),  # 4, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 0
@@ -988,42 +989,42 @@ def bias_acceleration(q, q_dot):
     t1 = qd1 + c23*qd4
     t2 = s1*s4
     t3 = c1*c4
-    t4 = -t2 + t3*c23
-    t5 = t3 - t2*c23
+    t4 = -t2 + c23*t3
+    t5 = t3 - c23*t2
     t6 = c4*s1
     t7 = c1*s4
-    t8 = t6 + t7*c23
-    t9 = t7 + t6*c23
+    t8 = t6 + c23*t7
+    t9 = t7 + c23*t6
     t10 = c5*s23
-    t11 = t4*s5 + t10*c1
-    t12 = t9*s5 + t10*s1
+    t11 = t4*s5 + c1*t10
+    t12 = t9*s5 + s1*t10
     t13 = 0.115*t11
     t14 = 0.62*s23
-    t15 = t13 + t14*c1
+    t15 = t13 + c1*t14
     t16 = 0.115*t12
-    t17 = t16 + t14*s1
+    t17 = t16 + s1*t14
     t18 = t8*t16 + t5*t13
     t19 = 0.115*t0
-    t20 = t19 - 0.62*c23
+    t20 = -0.62*c23 + t19
     t21 = t20 - 0.12*s23
     t22 = t21 - 0.6*s2
     t23 = 0.12*c23
-    t24 = -t15 + t23*c1
-    t25 = -t17 + t23*s1
+    t24 = -t15 + c1*t23
+    t25 = -t17 + s1*t23
     t26 = t24*c1 + t25*s1
     t27 = 0.6*c2
-    t28 = t24 + t27*c1
-    t29 = t25 + t27*s1
+    t28 = t24 + c1*t27
+    t29 = t25 + s1*t27
     t30 = t28 + 0.18*c1
     t31 = t29 + 0.18*s1
     t32 = t28*c1 + t29*s1
-    t33 = t20*s23
-    t34 = t17*c23 + t33*s1
-    t35 = t15*c23 + t33*c1
-    t36 = s23*s4
-    t37 = t5*t19 + t36*t16
-    t38 = t8*t19 - t36*t13
-    t39 = t1 + t36*qd5
+    t33 = s23*t20
+    t34 = t17*c23 + s1*t33
+    t35 = t15*c23 + c1*t33
+    t36 = s4*s23
+    t37 = t5*t19 + t16*t36
+    t38 = t8*t19 - t13*t36
+    t39 = t1 + qd5*t36
     t40 = s1*s23
     t41 = c1*s23
     t42 = t15*t40 - t17*t41
@@ -1033,11 +1034,11 @@ def bias_acceleration(q, q_dot):
     t46 = qd2*s1
     t47 = qd3*s1
     t48 = t46 + t47
-    t49 = -t48 + t41*qd4
+    t49 = -t48 + qd4*t41
     t50 = c1*qd2
     t51 = c1*qd3
     t52 = t50 + t51
-    t53 = t52 + t40*qd4
+    t53 = t52 + qd4*t40
     t54 = t8*qd5
     t55 = t49 - t54
     t56 = t5*qd5
@@ -1052,15 +1053,15 @@ def bias_acceleration(q, q_dot):
     t65 = t64 + t21*t47
     t66 = t65 + t22*t46
     t67 = t66 + t30*qd1
-    t68 = qd1*s1
+    t68 = s1*qd1
     t69 = c1*qd1
-    t70 = t21*qd2
+    t70 = qd2*t21
     a = _stack(xp, [
-        xp.broadcast_to(qd2*(t45*c1 - t22*t68) - qd3*(-t44*c1 + t21*t68 + t26*t50) + qd4*(t35*qd1 + t42*t52 - t64*c23 + t43*t40) + qd5*(t18*t53 - t38*t1 + t18*t56 - t36*t63) - t67*qd1, batch),  # 0
-        xp.broadcast_to(t62*qd1 + qd2*(t45*s1 + t22*t69) + qd3*(t44*s1 + t21*t69 - t26*t46) + qd4*(t34*qd1 + t42*t48 + t59*c23 - t43*t41) + qd5*(t37*t1 - t18*t49 + t18*t54 + t36*t58), batch),  # 1
-        xp.broadcast_to(-qd2*(t61*c1 + t66*s1) - qd3*(t60*c1 + t65*s1 + t70*c1**2 + t70*s1**2) + qd4*(t35*t48 - t34*t52 + t64*t41 - t59*t40) - qd5*(t37*t53 - t38*t49 + t38*t54 + t37*t56), batch),  # 2
-        xp.broadcast_to(qd4*(t52*c23 - t40*qd1) + qd5*(-t5*t1 + t53*t36) - qd6*(t12*t39 + t0*t57) - t50*qd1 - t51*qd1, batch),  # 3
-        xp.broadcast_to(qd4*(t48*c23 + t41*qd1) - qd5*(t8*t1 + t49*t36) + qd6*(t11*t39 + t0*t55) - t46*qd1 - t47*qd1, batch),  # 4
+        xp.broadcast_to(qd2*(t45*c1 - t22*t68) - qd3*(-t44*c1 + t21*t68 + t26*t50) + qd4*(t35*qd1 + t42*t52 - t64*c23 + t43*t40) + qd5*(t18*t53 - t38*t1 + t18*t56 - t63*t36) - t67*qd1, batch),  # 0
+        xp.broadcast_to(t62*qd1 + qd2*(t45*s1 + t22*t69) + qd3*(t44*s1 + t21*t69 - t26*t46) + qd4*(t34*qd1 + t42*t48 + t59*c23 - t43*t41) + qd5*(t37*t1 - t18*t49 + t18*t54 + t58*t36), batch),  # 1
+        xp.broadcast_to(-qd2*(t61*c1 + t66*s1) - qd3*(t60*c1 + t65*s1 + c1**2*t70 + s1**2*t70) + qd4*(t35*t48 - t34*t52 + t64*t41 - t59*t40) - qd5*(-t38*t49 + t37*t53 + t38*t54 + t37*t56), batch),  # 2
+        xp.broadcast_to(qd4*(t52*c23 - qd1*t40) + qd5*(-t5*t1 + t53*t36) - qd6*(t12*t39 + t0*t57) - qd1*t50 - qd1*t51, batch),  # 3
+        xp.broadcast_to(qd4*(t48*c23 + qd1*t41) - qd5*(t8*t1 + t49*t36) + qd6*(t11*t39 + t0*t55) - qd1*t46 - qd1*t47, batch),  # 4
         xp.broadcast_to(-qd4*(t48*t40 + t52*t41) + qd5*(t8*t53 + t5*t49) + qd6*(t12*t55 - t11*t57), batch),  # 5
     ], (6,))
     return a
@@ -1092,25 +1093,25 @@ def task_jacobian_dot(q, q_dot):
     s6 = trig[..., 11]
     t0 = s1*s4
     t1 = c1*c4
-    t2 = -t0 + t1*c23
-    t3 = t1 - t0*c23
+    t2 = -t0 + c23*t1
+    t3 = t1 - c23*t0
     t4 = c4*s1
     t5 = c1*s4
-    t6 = t4 + t5*c23
-    t7 = t5 + t4*c23
+    t6 = t4 + c23*t5
+    t7 = t5 + c23*t4
     t8 = c1*s23
-    t9 = t2*c5 - t8*s5
-    t10 = t2*s5 + t8*c5
+    t9 = t2*c5 - s5*t8
+    t10 = t2*s5 + c5*t8
     t11 = t9*c6 - t6*s6
     t12 = s1*s23
-    t13 = t7*c5 - t12*s5
-    t14 = t7*s5 + t12*c5
+    t13 = t7*c5 - s5*t12
+    t14 = t7*s5 + c5*t12
     t15 = t3*s6 + t13*c6
     t16 = c4*s23
-    t17 = c23*s5 + t16*c5
-    t18 = -c23*c5 + t16*s5
-    t19 = s23*s4
-    t20 = -t17*c6 + t19*s6
+    t17 = c23*s5 + c5*t16
+    t18 = -c23*c5 + s5*t16
+    t19 = s4*s23
+    t20 = -t17*c6 + s6*t19
     t21 = 0.115*t10
     t22 = t21 + 0.62*t8
     t23 = 0.115*t14
@@ -1119,21 +1120,21 @@ def task_jacobian_dot(q, q_dot):
     t26 = t6*t23 + t3*t21
     t27 = t25*qd4 + t26*qd5
     t28 = 0.115*t18
-    t29 = t28 - 0.62*c23
+    t29 = -0.62*c23 + t28
     t30 = t29 - 0.12*s23
     t31 = t30 - 0.6*s2
     t32 = t24*c23 + t29*t12
-    t33 = t3*t28 + t19*t23
+    t33 = t3*t28 + t23*t19
     t34 = t22*c23 + t29*t8
-    t35 = t6*t28 - t19*t21
+    t35 = t6*t28 - t21*t19
     t36 = 0.12*c23
-    t37 = -t22 + t36*c1
-    t38 = -t24 + t36*s1
+    t37 = -t22 + c1*t36
+    t38 = -t24 + s1*t36
     t39 = t37*c1 + t38*s1
     t40 = t27 - t39*qd3
     t41 = 0.6*c2
-    t42 = t37 + t41*c1
-    t43 = t38 + t41*s1
+    t42 = t37 + c1*t41
+    t43 = t38 + s1*t41
     t44 = t42 + 0.18*c1
     t45 = t43 + 0.18*s1
     t46 = t42*c1 + t43*s1
@@ -1142,16 +1143,16 @@ def task_jacobian_dot(q, q_dot):
     t49 = qd3*s1
     t50 = t48 + t49
     t51 = t50
-    t52 = t51*c23 + t8*qd1
+    t52 = t51*c23 + qd1*t8
     t53 = c1*qd2
     t54 = c1*qd3
     t55 = t53 + t54
     t56 = t55
-    t57 = t56*c23 - t12*qd1
+    t57 = t56*c23 - qd1*t12
     t58 = t51*t12 + t56*t8
-    t59 = t8*qd4
+    t59 = qd4*t8
     t60 = -t51 + t59
-    t61 = t12*qd4
+    t61 = qd4*t12
     t62 = t56 + t61
     t63 = t6*t62 + t3*t60
     t64 = qd1 + c23*qd4
@@ -1160,18 +1161,18 @@ def task_jacobian_dot(q, q_dot):
     t67 = t6*t65 + t60*t19
     t68 = t6*qd5
     t69 = t60 - t68
-    t70 = t50 + t68 - t59 - t10*qd6
+    t70 = t68 - t10*qd6 - t59 + t50
     t71 = t3*qd5
     t72 = t62 + t71
     t73 = t33*t62 - t35*t60 + t35*t68 + t33*t71
     t74 = t14*t69 - t10*t72
-    t75 = t55 + t61 + t71 + t14*qd6
+    t75 = t61 + t71 + t14*qd6 + t55
     t76 = t70*t15 + t75*t11
-    t77 = t19*qd5
+    t77 = qd5*t19
     t78 = t65 + t77
     t79 = t14*t78 + t18*t72
     t80 = t10*t78 + t18*t69
-    t81 = t64 + t77 - t18*qd6
+    t81 = t77 - t18*qd6 + t64
     t82 = t75*t20 - t81*t15
     t83 = t70*t20 + t81*t11
     t84 = t33*qd5
@@ -1190,14 +1191,14 @@ def task_jacobian_dot(q, q_dot):
     t97 = t26*t62 - t35*t65 + t26*t71 - t91*t19
     t98 = t87*c1 + t94*s1
     t99 = t34*t51 - t32*t56 + t92*t8 - t85*t12
-    t100 = qd1*s1
+    t100 = s1*qd1
     t101 = t47*c1 - t31*t100
     t102 = -t40*c1 + t30*t100 + t39*t53
     t103 = c1*qd1
     t104 = t47*s1 + t31*t103
     t105 = t40*s1 + t30*t103 - t39*t48
-    t106 = t30*qd2
-    t107 = t86*c1 + t93*s1 + t106*c1**2 + t106*s1**2
+    t106 = qd2*t30
+    t107 = t86*c1 + t93*s1 + c1**2*t106 + s1**2*t106
     t108 = t11**2 + t15**2
     t109 = 1/t108
     t110 = s1*t109
@@ -1209,16 +1210,16 @@ def task_jacobian_dot(q, q_dot):
     t116 = t11*t115
     t117 = c1*t109
     t118 = t15*t115
-    t119 = t11*qd1
-    t120 = t15*qd1
+    t119 = qd1*t11
+    t120 = qd1*t15
     t121 = -t82*(t110 + t116) + t83*(t117 - t118) - t117*t119 - t110*t120
-    t122 = t117*s23
+    t122 = s23*t117
     t123 = t11*c1
     t124 = t15*s1
-    t125 = t123*s23 + t124*s23
-    t126 = t114*t125
+    t125 = s23*t123 + s23*t124
+    t126 = t125*t114
     t127 = t11*t126
-    t128 = t110*s23
+    t128 = s23*t110
     t129 = t15*t126
     t130 = t11*t109
     t131 = t57*t130
@@ -1226,7 +1227,7 @@ def task_jacobian_dot(q, q_dot):
     t133 = t52*t132
     t134 = t6*t109
     t135 = t3*t15 - t6*t11
-    t136 = t114*t135
+    t136 = t135*t114
     t137 = t11*t136
     t138 = t3*t109
     t139 = t15*t136
@@ -1234,7 +1235,7 @@ def task_jacobian_dot(q, q_dot):
     t141 = t67*t132
     t142 = t10*t109
     t143 = t10*t11 + t14*t15
-    t144 = t114*t143
+    t144 = t143*t114
     t145 = t11*t144
     t146 = t14*t109
     t147 = t15*t144
@@ -1245,17 +1246,17 @@ def task_jacobian_dot(q, q_dot):
     t152 = 1/t108**1.5
     t153 = t152*(t123 + t124)
     t154 = s1*t150
-    t155 = t150*qd1
+    t155 = qd1*t150
     t156 = t82*(t151 - t11*t153) + t83*(t154 - t15*t153) + t111*t155 - t112*t155
-    t157 = t152*(t112*s23 - t111*s23)
+    t157 = t152*(s23*t112 - s23*t111)
     t158 = t11*t150
     t159 = t15*t150
     t160 = t152*(t6*t15 + t3*t11)
     t161 = t152*(t14*t11 - t10*t15)
     t162 = t20*t110
     t163 = t20*t117
-    t164 = t76*t109
-    t165 = t82*(t162 + t20*t116) + t83*(-t163 + t20*t118) + t113*t164 + t119*t163 + t120*t162
+    t164 = t109*t76
+    t165 = t82*(t162 + t20*t116) + t83*(-t163 + t20*t118) + t113*t164 + t163*t119 + t162*t120
     Jd = _stack(xp, [
         xp.broadcast_to(-t95, batch),  # 0, 0
         xp.broadcast_to(t101, batch),  # 0, 1
@@ -1284,7 +1285,7 @@ def task_jacobian_dot(q, q_dot):
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
         xp.broadcast_to(t156, batch),  # 4, 1
         xp.broadcast_to(t156, batch),  # 4, 2
-        xp.broadcast_to(t82*(t154*s23 - t11*t157) - t83*(t15*t157 + t151*s23) + t52*t158 - t57*t159, batch),  # 4, 3
+        xp.broadcast_to(t82*(s23*t154 - t11*t157) - t83*(t15*t157 + s23*t151) + t52*t158 - t57*t159, batch),  # 4, 3
         xp.broadcast_to(t82*(t3*t150 - t11*t160) + t83*(t6*t150 - t15*t160) - t67*t158 - t66*t159, batch),  # 4, 4
         xp.broadcast_to(t82*(t14*t150 - t11*t161) - t83*(t10*t150 + t15*t161) + t80*t158 + t79*t159, batch),  # 4, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 0
@@ -1316,16 +1317,16 @@ def hessian(q):
     t0 = -c23*c5 + c4*s23*s5
     t1 = s1*s4
     t2 = c1*c4
-    t3 = -t1 + t2*c23
-    t4 = t2 - t1*c23
+    t3 = -t1 + c23*t2
+    t4 = t2 - c23*t1
     t5 = c4*s1
     t6 = c1*s4
-    t7 = t5 + t6*c23
-    t8 = t6 + t5*c23
+    t7 = t5 + c23*t6
+    t8 = t6 + c23*t5
     t9 = c1*s23
-    t10 = t3*s5 + t9*c5
+    t10 = t3*s5 + c5*t9
     t11 = s1*s23
-    t12 = t8*s5 + t11*c5
+    t12 = t8*s5 + c5*t11
     t13 = 0.115*t10
     t14 = t13 + 0.62*t9
     t15 = 0.115*t12
@@ -1333,7 +1334,7 @@ def hessian(q):
     t17 = t14*t11 - t16*t9
     t18 = t7*t15 + t4*t13
     t19 = 0.115*t0
-    t20 = t19 - 0.62*c23
+    t20 = -0.62*c23 + t19
     t21 = t20 - 0.12*s23
     t22 = t21 - 0.6*s2
     t23 = t16*c23 + t20*t11
@@ -1344,14 +1345,14 @@ def hessian(q):
     t28 = -t16 + 0.12*t27
     t29 = t26*c1 + t28*s1
     t30 = 0.6*c2
-    t31 = t26 + t30*c1
-    t32 = t28 + t30*s1
+    t31 = t26 + c1*t30
+    t32 = t28 + s1*t30
     t33 = t31 + 0.18*c1
     t34 = t32 + 0.18*s1
     t35 = t31*c1 + t32*s1
-    t36 = s23*s4
-    t37 = t4*t19 + t36*t15
-    t38 = t7*t19 - t36*t13
+    t36 = s4*s23
+    t37 = t4*t19 + t15*t36
+    t38 = t7*t19 - t13*t36
     t39 = -t22*s1
     t40 = -t21*s1
     t41 = -t38
@@ -1370,9 +1371,9 @@ def hessian(q):
     t54 = -(t21*t52 + t21*t53)
     t55 = t24*s1 - t23*c1
     t56 = -(t37*c1 + t38*s1)
-    t57 = t6*s23
+    t57 = s23*t6
     t58 = -t0*c1
-    t59 = t1*s23
+    t59 = s23*t1
     t60 = -t0*s1
     t61 = -(s23*t52 + s23*t53)
     t62 = t7*c1 - t4*s1
@@ -1512,13 +1513,13 @@ def hessian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 3, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 3, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 3, 3
-        -t4*c23 + t1*t67,  # 3, 3, 4
+        -t4*c23 + t67*t1,  # 3, 3, 4
         -(t12*c23 + t0*t11),  # 3, 3, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 4, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 4, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 4, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 4, 3
-        -(t7*c23 + t6*t67),  # 3, 4, 4
+        -(t7*c23 + t67*t6),  # 3, 4, 4
         t10*c23 + t0*t9,  # 3, 4, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 5, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 5, 1
@@ -1615,7 +1616,7 @@ def singularity_factors(q):
     f = _stack(xp, [
         c3 + t0,  # 0
         s5,  # 1
-        0.2903225806451613 + 0.967741935483871*c2 - c2*s3 - c3*s2 + 0.1935483870967742*c2*c3 - t0*s2,  # 2
+        0.2903225806451613 + 0.967741935483871*c2 - c2*s3 - c3*s2 - s2*t0 + 0.1935483870967742*c2*c3,  # 2
     ], (3,))
     return f
 
@@ -1630,7 +1631,7 @@ def manipulability(q):
     s3 = trig[..., 5]
     s5 = trig[..., 9]
     t0 = 0.1935483870967742*s3
-    t1 = 0.23064*s5*(c3 + t0)*(0.2903225806451613 + 0.967741935483871*c2 - c2*s3 - c3*s2 + 0.1935483870967742*c2*c3 - t0*s2)
+    t1 = 0.23064*s5*(c3 + t0)*(0.2903225806451613 + 0.967741935483871*c2 - c2*s3 - c3*s2 - s2*t0 + 0.1935483870967742*c2*c3)
     w = xp.broadcast_to(xp.abs(t1), batch)
     return w
 
@@ -1645,7 +1646,7 @@ def jacobian_det(q):
     s3 = trig[..., 5]
     s5 = trig[..., 9]
     t0 = 0.1935483870967742*s3
-    d = xp.broadcast_to(-0.23064*s5*(c3 + t0)*(0.2903225806451613 + 0.967741935483871*c2 - c2*s3 - c3*s2 + 0.1935483870967742*c2*c3 - t0*s2), batch)
+    d = xp.broadcast_to(-0.23064*s5*(c3 + t0)*(0.2903225806451613 + 0.967741935483871*c2 - c2*s3 - c3*s2 - s2*t0 + 0.1935483870967742*c2*c3), batch)
     return d
 
 
@@ -1681,16 +1682,16 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t0 = -c23*c5 + c4*s23*s5
     t1 = s1*s4
     t2 = c1*c4
-    t3 = -t1 + t2*c23
-    t4 = t2 - t1*c23
+    t3 = -t1 + c23*t2
+    t4 = t2 - c23*t1
     t5 = c4*s1
     t6 = c1*s4
-    t7 = t5 + t6*c23
-    t8 = t6 + t5*c23
+    t7 = t5 + c23*t6
+    t8 = t6 + c23*t5
     t9 = c1*s23
-    t10 = t3*s5 + t9*c5
+    t10 = t3*s5 + c5*t9
     t11 = s1*s23
-    t12 = t8*s5 + t11*c5
+    t12 = t8*s5 + c5*t11
     t13 = 0.115*t10
     t14 = t13 + 0.62*t9
     t15 = 0.115*t12
@@ -1698,28 +1699,28 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t17 = t14*t11 - t16*t9
     t18 = t7*t15 + t4*t13
     t19 = 0.115*t0
-    t20 = t19 - 0.62*c23
+    t20 = -0.62*c23 + t19
     t21 = t20 - 0.12*s23
     t22 = t21 - 0.6*s2
     t23 = t16*c23 + t20*t11
     t24 = t14*c23 + t20*t9
     t25 = 0.12*c23
-    t26 = -t14 + t25*c1
-    t27 = -t16 + t25*s1
+    t26 = -t14 + c1*t25
+    t27 = -t16 + s1*t25
     t28 = t26*c1 + t27*s1
     t29 = 0.6*c2
-    t30 = t26 + t29*c1
-    t31 = t27 + t29*s1
+    t30 = t26 + c1*t29
+    t31 = t27 + s1*t29
     t32 = t30 + 0.18*c1
     t33 = t31 + 0.18*s1
     t34 = t30*c1 + t31*s1
     t35 = s23*s4
-    t36 = t4*t19 + t35*t15
-    t37 = t7*t19 - t35*t13
+    t36 = t4*t19 + t15*t35
+    t37 = t7*t19 - t13*t35
     t38 = t32 - t24*c23 + t37*t35
     t39 = t17*c23 + t18*t35
-    t40 = t10*t0 + t7*t35 - t9*c23
-    t41 = -t12*t0 + t4*t35 + t11*c23
+    t40 = t10*t0 + t7*t35 - c23*t9
+    t41 = -t12*t0 + t4*t35 + c23*t11
     t42 = t33**2
     t43 = t21**2
     t44 = c1**2
@@ -1727,7 +1728,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t46 = t22**2
     t47 = t23**2 + t36**2 + t43*t44 + t46*t44
     t48 = t42 + t47
-    t49 = c1*s1
+    t49 = s1*c1
     t50 = t36*t37 - t32*t33 - t23*t24 + t43*t49 + t46*t49
     t51 = -t33
     t52 = t51 + t23*c23 + t36*t35
@@ -1737,9 +1738,9 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t56 = t4*t18 - t54 - t53 + t17*t11
     t57 = t21*c1
     t58 = t22*c1
-    t59 = t57*s1 + t58*s1
-    t60 = t59 + t7*t36 - t23*t9
-    t61 = t59 + t4*t37 - t24*t11
+    t59 = s1*t57 + s1*t58
+    t60 = t7*t36 - t23*t9 + t59
+    t61 = t4*t37 - t24*t11 + t59
     t62 = t32**2
     t63 = s1**2
     t64 = t7*t37 + t21*t63 + t22*t63 + t24*t9
@@ -1756,7 +1757,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t75 = t7**2 + t10**2 + 2*t63 + t44*t74
     t76 = t75
     t77 = 2*s1
-    t78 = t10*t12 - t7*t4 - t77*c1 + t49*t74
+    t78 = t10*t12 - t7*t4 - c1*t77 + t74*t49
     t79 = t4**2 + t12**2 + 2*t44 + t63*t74
     t80 = t79
     t81 = t0**2 + c23**2 + t74*s4**2
@@ -1781,7 +1782,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t100 = xp.where(xp.greater(t97, 0), 1/(t97*(t97 + xp.abs(t84))), 0)
     t101 = t100*(t50*t99 + t50*t86 + t52*t38 + t60*t64 + t45*t61 - t55*t69)
     t102 = t50 - t99*t101
-    t103 = t86 - t50*t101
+    t103 = -t50*t101 + t86
     t104 = t69 + t55*t101
     t105 = -t64 + t60*t101
     t106 = t61 - t45*t101
@@ -1789,15 +1790,15 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t108 = t100*(t52*t39 + t55*t99 + t55*t87 + t45*t56 - t50*t69 - t60*t70)
     t109 = t55 - t99*t108
     t110 = t69 + t50*t108
-    t111 = t87 - t55*t108
+    t111 = -t55*t108 + t87
     t112 = t70 + t60*t108
     t113 = t56 - t45*t108
     t114 = t39 - t52*t108
-    t115 = -t100*(t50*t64 + t52*t40 + t60*t99 + t60*t88 - t55*t70 - t45*t78)
+    t115 = -t100*(-t55*t70 - t45*t78 + t50*t64 + t52*t40 + t60*t99 + t60*t88)
     t116 = t60 + t99*t115
     t117 = t64 + t50*t115
     t118 = t70 - t55*t115
-    t119 = t88 + t60*t115
+    t119 = t60*t115 + t88
     t120 = t78 - t45*t115
     t121 = t40 + t52*t115
     t122 = t100*(t50*t61 + t52*t41 + t55*t56 + t45*t99 + t45*t89 - t60*t78)
@@ -1805,7 +1806,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t124 = t61 - t50*t122
     t125 = t56 - t55*t122
     t126 = t78 + t60*t122
-    t127 = t89 - t45*t122
+    t127 = -t45*t122 + t89
     t128 = t41 - t52*t122
     t129 = t100*(t50*t38 + t52*t99 + t52*t90 + t55*t39 + t60*t40 + t45*t41)
     t130 = t52 - t99*t129
@@ -1813,7 +1814,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t132 = t39 - t55*t129
     t133 = -t40 + t60*t129
     t134 = t41 - t45*t129
-    t135 = t90 - t52*t129
+    t135 = -t52*t129 + t90
     t136 = t100*(t50*mu_dot1 + t52*mu_dot5 + t55*mu_dot2 + t45*mu_dot4 + t99*mu_dot0 - t60*mu_dot3)
     t137 = mu_dot0 - t99*t136
     t138 = mu_dot1 - t50*t136
@@ -1831,7 +1832,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t150 = t112 - t105*t147
     t151 = t113 - t106*t147
     t152 = t114 - t107*t147
-    t153 = -t146*(t104*t118 + t107*t121 + t117*t145 - t105*t119 - t106*t120)
+    t153 = -t146*(-t105*t119 - t106*t120 + t104*t118 + t107*t121 + t117*t145)
     t154 = t117 + t145*t153
     t155 = t118 + t104*t153
     t156 = t119 - t105*t153
@@ -1923,11 +1924,11 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t242 = t10*t235 + t234*t12 - t233*t0
     t243 = t22*s1
     t244 = t234*c1 - t235*s1
-    t245 = t244 + t237*t243 + t238*t58 - t236*t34
+    t245 = -t236*t34 + t237*t243 + t238*t58 + t244
     t246 = t21*s1
-    t247 = t244 + t237*t246 + t238*t57 - t236*t28
+    t247 = -t236*t28 + t237*t246 + t238*t57 + t244
     t248 = 1 + t62 + t42
-    t249 = xp.sqrt(t47 + t65 + t72 + t75 + t79 + t81 + t248)
+    t249 = xp.sqrt(t248 + t72 + t75 + t79 + t81 + t47 + t65)
     t250 = xp.sqrt(t248)
     t251 = t250*xp.where(xp.less_equal(t33, 0), xp.asarray(1, dtype=dtype), -1)
     t252 = t251 + t51
@@ -1954,11 +1955,11 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t273 = t253*t0
     t274 = t272 + t273
     t275 = t44 + t63
-    t276 = xp.sqrt(t71 + t275 + t254**2 + t256**2)
+    t276 = xp.sqrt(t71 + t254**2 + t256**2 + t275)
     t277 = t276*xp.where(xp.greater_equal(t256, 0), xp.asarray(1, dtype=dtype), -1)
     t278 = t256 + t277
     t279 = xp.where(xp.greater(t276, 0), 1/(t276*(t276 + xp.abs(t256))), 0)
-    t280 = t279*(t275 + t254*t257 + t259*t278 + t34*t28)
+    t280 = t279*(t254*t257 + t259*t278 + t34*t28 + t275)
     t281 = t259 - t278*t280
     t282 = -s1 + t280*s1
     t283 = c1 - t280*c1
@@ -1974,7 +1975,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t293 = t18 + t291*t34
     t294 = t4 - t291*c1
     t295 = t267 + t254*t291
-    t296 = -t279*(t254*t271 + t34*mu_dot2 + mu_dot3*s1 - t270*t278 - c1*mu_dot4)
+    t296 = -t279*(-t270*t278 - c1*mu_dot4 + t254*t271 + t34*mu_dot2 + mu_dot3*s1)
     t297 = t270 - t278*t296
     t298 = mu_dot2 + t296*t34
     t299 = mu_dot3 + t296*s1
@@ -2059,7 +2060,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t378 = 1e-12*t249
     t379 = xp.greater(damping, 0)
     t380 = 1e-12*t96
-    t381 = (t379 & (xp.less_equal(t97, t380) | xp.less_equal(t143, t380) | xp.less_equal(t177, t380) | xp.less_equal(t201, t380) | xp.less_equal(t217, t380) | xp.less_equal(t228, t380))) | (xp.less_equal(damping, 0) & (xp.less_equal(t250, t378) | xp.less_equal(t276, t378) | xp.less_equal(t304, t378) | xp.less_equal(t318, t378) | xp.less_equal(t337, t378) | xp.less_equal(t365, t378)))
+    t381 = (xp.less_equal(damping, 0) & (xp.less_equal(t250, t378) | xp.less_equal(t276, t378) | xp.less_equal(t304, t378) | xp.less_equal(t318, t378) | xp.less_equal(t337, t378) | xp.less_equal(t365, t378))) | (t379 & (xp.less_equal(t97, t380) | xp.less_equal(t143, t380) | xp.less_equal(t177, t380) | xp.less_equal(t201, t380) | xp.less_equal(t217, t380) | xp.less_equal(t228, t380)))
     t382 = t376 & t377 & xp.logical_not(t381)
     q_dot = _stack(xp, [
         xp.broadcast_to(xp.where(t382, xp.where(t379, t239, t375), 0), batch),  # 0
@@ -2118,23 +2119,23 @@ def ik_numeric_step(target, q, damping=0.0):
     t0 = T00 + T01 + T02 + T03 + T10 + T11 + T12 + T13 + T20 + T21 + T22 + T23 + qs1 + qs2 + qs3 + qs4 + qs5 + qs6
     t1 = s1*s4
     t2 = c1*c4
-    t3 = -t1 + t2*c23
-    t4 = t2 - t1*c23
+    t3 = -t1 + c23*t2
+    t4 = t2 - c23*t1
     t5 = c4*s1
     t6 = c1*s4
-    t7 = t5 + t6*c23
-    t8 = t6 + t5*c23
+    t7 = t5 + c23*t6
+    t8 = t6 + c23*t5
     t9 = c1*s23
-    t10 = t3*c5 - t9*s5
-    t11 = t3*s5 + t9*c5
+    t10 = t3*c5 - s5*t9
+    t11 = t3*s5 + c5*t9
     t12 = t10*c6 - t7*s6
     t13 = t7*c6 + t10*s6
     t14 = T00*t12 + T01*t13 - T02*t11
     t15 = T10*t12 + T11*t13 - T12*t11
     t16 = T20*t12 + T21*t13 - T22*t11
     t17 = s1*s23
-    t18 = t8*c5 - t17*s5
-    t19 = t8*s5 + t17*c5
+    t18 = t8*c5 - s5*t17
+    t19 = t8*s5 + c5*t17
     t20 = t4*s6 + t18*c6
     t21 = t4*c6 - t18*s6
     t22 = T01*t21 + T02*t19 - T00*t20
@@ -2142,13 +2143,13 @@ def ik_numeric_step(target, q, damping=0.0):
     t24 = T21*t21 + T22*t19 - T20*t20
     t25 = 0.5*(t22 + t15)
     t26 = c4*s23
-    t27 = c23*s5 + t26*c5
-    t28 = -c23*c5 + t26*s5
-    t29 = s23*s4
-    t30 = -t27*c6 + t29*s6
-    t31 = t27*s6 + t29*c6
-    t32 = t11*t28 + t7*t29 - t9*c23
-    t33 = -t19*t28 + t4*t29 + t17*c23
+    t27 = c23*s5 + c5*t26
+    t28 = -c23*c5 + s5*t26
+    t29 = s4*s23
+    t30 = -t27*c6 + s6*t29
+    t31 = t27*s6 + c6*t29
+    t32 = t11*t28 + t7*t29 - c23*t9
+    t33 = -t19*t28 + t4*t29 + c23*t17
     t34 = T00*t30 + T02*t28 - T01*t31
     t35 = T10*t30 + T12*t28 - T11*t31
     t36 = T20*t30 + T22*t28 - T21*t31
@@ -2163,22 +2164,22 @@ def ik_numeric_step(target, q, damping=0.0):
     t45 = t7*t42 + t4*t40
     t46 = t44*c23 + t45*t29
     t47 = 0.115*t28
-    t48 = t47 - 0.62*c23
+    t48 = -0.62*c23 + t47
     t49 = t48 - 0.12*s23
     t50 = t49 - 0.6*s2
     t51 = 0.4 + t50
     t52 = t43*c23 + t48*t17
-    t53 = t4*t47 + t29*t42
+    t53 = t4*t47 + t42*t29
     t54 = t41*c23 + t48*t9
-    t55 = t7*t47 - t29*t40
+    t55 = t7*t47 - t40*t29
     t56 = T23 - t51
     t57 = 0.12*c23
-    t58 = -t41 + t57*c1
-    t59 = -t43 + t57*s1
+    t58 = -t41 + c1*t57
+    t59 = -t43 + s1*t57
     t60 = t58*c1 + t59*s1
     t61 = 0.6*c2
-    t62 = t58 + t61*c1
-    t63 = t59 + t61*s1
+    t62 = t58 + c1*t61
+    t63 = t59 + s1*t61
     t64 = t62 + 0.18*c1
     t65 = t63 + 0.18*s1
     t66 = t62*c1 + t63*s1
@@ -2190,7 +2191,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t72 = t4*t53 + t49*t71 + t50*t71 + t52*t17
     t73 = t50**2
     t74 = t65**2 + t52**2 + t53**2 + t70*t71 + t73*t71
-    t75 = c1*s1
+    t75 = s1*c1
     t76 = t53*t55 - t64*t65 - t52*t54 + t70*t75 + t73*t75
     t77 = -t65
     t78 = t77 + t52*c23 + t53*t29
@@ -2200,8 +2201,8 @@ def ik_numeric_step(target, q, damping=0.0):
     t82 = t52*t44 + t53*t45 - t49*t80 - t50*t81
     t83 = t4*t45 - t81 - t80 + t44*t17
     t84 = t49*t75 + t50*t75
-    t85 = t84 + t7*t53 - t52*t9
-    t86 = t84 + t4*t55 - t54*t17
+    t85 = t7*t53 - t52*t9 + t84
+    t86 = t4*t55 - t54*t17 + t84
     t87 = s1**2
     t88 = t64**2 + t54**2 + t55**2 + t70*t87 + t73*t87
     t89 = t7*t55 + t49*t87 + t50*t87 + t54*t9
@@ -2211,7 +2212,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t93 = t91 + t90 - t7*t45 + t44*t9
     t94 = s23**2
     t95 = t7**2 + t11**2 + 2*t87 + t71*t94
-    t96 = t11*t19 - t7*t4 - 2*t75 + t75*t94
+    t96 = t11*t19 - t7*t4 - 2*t75 + t94*t75
     t97 = t4**2 + t19**2 + 2*t71 + t87*t94
     t98 = 1 + t28**2 + c23**2 + t94*s4**2
     t99 = -t23
@@ -2246,7 +2247,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t128 = t88 + damping
     t129 = t120*(t76*t119 + t76*t128 + t78*t67 + t85*t89 + t72*t86 - t82*t92)
     t130 = t76 - t119*t129
-    t131 = t128 - t76*t129
+    t131 = -t76*t129 + t128
     t132 = t92 + t82*t129
     t133 = -t89 + t85*t129
     t134 = t86 - t72*t129
@@ -2265,7 +2266,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t147 = t120*(t78*t46 + t82*t119 + t82*t146 + t72*t83 - t76*t92 - t85*t93)
     t148 = t82 - t119*t147
     t149 = t92 + t76*t147
-    t150 = t146 - t82*t147
+    t150 = -t82*t147 + t146
     t151 = t93 + t85*t147
     t152 = t83 - t72*t147
     t153 = t46 - t78*t147
@@ -2285,14 +2286,14 @@ def ik_numeric_step(target, q, damping=0.0):
     t167 = t144 - t158*t164
     t168 = t145 - t159*t164
     t169 = t95 + damping
-    t170 = -t120*(t76*t89 + t78*t32 + t85*t119 + t85*t169 - t82*t93 - t72*t96)
+    t170 = -t120*(-t82*t93 - t72*t96 + t76*t89 + t78*t32 + t85*t119 + t85*t169)
     t171 = t85 + t119*t170
     t172 = t89 + t76*t170
     t173 = t93 - t82*t170
-    t174 = t169 + t85*t170
+    t174 = t85*t170 + t169
     t175 = t96 - t72*t170
     t176 = t32 + t78*t170
-    t177 = -t139*(t132*t173 + t135*t176 + t172*t138 - t133*t174 - t134*t175)
+    t177 = -t139*(-t133*t174 - t134*t175 + t132*t173 + t135*t176 + t172*t138)
     t178 = t172 + t138*t177
     t179 = t173 + t132*t177
     t180 = t174 - t133*t177
@@ -2317,7 +2318,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t199 = t86 - t76*t197
     t200 = t83 - t82*t197
     t201 = t96 + t85*t197
-    t202 = t196 - t72*t197
+    t202 = -t72*t197 + t196
     t203 = t33 - t78*t197
     t204 = t139*(t133*t201 + t134*t202 + t135*t203 + t199*t138 - t132*t200)
     t205 = t199 - t138*t204
@@ -2348,7 +2349,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t230 = t46 - t82*t227
     t231 = -t32 + t85*t227
     t232 = t33 - t72*t227
-    t233 = t226 - t78*t227
+    t233 = -t78*t227 + t226
     t234 = t139*(t133*t231 + t134*t232 + t135*t233 + t229*t138 - t132*t230)
     t235 = t229 - t138*t234
     t236 = t230 + t132*t234
@@ -2383,11 +2384,11 @@ def ik_numeric_step(target, q, damping=0.0):
     t265 = q4 + t52*t263 + t258*c23 + t261*t44 - t54*t262 + t259*t17 + t260*t9
     t266 = q5 + t4*t259 + t53*t263 + t261*t45 + t262*t55 - t7*t260 + t258*t29
     t267 = q6 + t11*t260 + t19*t259 - t28*t258
-    t268 = t262*s1
-    t269 = t263*c1
+    t268 = s1*t262
+    t269 = c1*t263
     t270 = t259*c1 - t260*s1
-    t271 = t270 + q2 + t50*t268 + t50*t269 - t261*t66
-    t272 = t270 + q3 + t49*t268 + t49*t269 - t261*t60
+    t271 = q2 - t261*t66 + t50*t268 + t50*t269 + t270
+    t272 = q3 - t261*t60 + t49*t268 + t49*t269 + t270
     q_start = _stack(xp, [
         xp.broadcast_to(q1, batch),  # 0
         xp.broadcast_to(q2, batch),  # 1
@@ -2426,21 +2427,21 @@ def ik_branches(T):
     T23 = T[..., 2, 3]
     t0 = T00 + T01 + T02 + T03 + T10 + T11 + T12 + T13 + T20 + T21 + T22 + T23
     t1 = 0.9*T00
-    t2 = T03 - (0.335*T02 + t1)
-    t3 = 0.22*T02 + t1
+    t2 = T03 - (t1 + 0.335*T02)
+    t3 = t1 + 0.22*T02
     t4 = t2 + t3
     t5 = 0.9*T10
-    t6 = T13 - (0.335*T12 + t5)
-    t7 = 0.22*T12 + t5
+    t6 = T13 - (t5 + 0.335*T12)
+    t7 = t5 + 0.22*T12
     t8 = t6 + t7
     t9 = xp.atan2(-t4, t8)
     t10 = 0.9*T20
-    t11 = T23 - (0.335*T22 + t10)
-    t12 = 0.22*T22 + t10
+    t11 = T23 - (t10 + 0.335*T22)
+    t12 = t10 + 0.22*T22
     t13 = t11 + t12
     t14 = t4**2 + t8**2
     t15 = t14
-    t16 = t14 + t13**2
+    t16 = t13**2 + t14
     t17 = 1e-24*t16
     t18 = xp.less_equal(t15, t17)
     t19 = xp.where(t18, 1, 1/xp.sqrt(t15))
@@ -2450,561 +2451,560 @@ def ik_branches(T):
     t23 = t22 - 6.283185307179586*xp.floor(0.15915494309189535*(2.705260340591211 + t22))
     t24 = t21 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t21))
     t25 = t24 - 6.283185307179586*xp.floor(0.15915494309189535*(2.705260340591211 + t24))
-    t26 = t19
-    t27 = t4*t26
-    t28 = xp.where(t18, 1, t27)
-    t29 = -t27
-    t30 = t8*t26
-    t31 = xp.where(t18, 0, t30)
-    t32 = t30
-    t33 = t4*t28 + t8*t31
-    t34 = t8*t28 - t4*t31
-    t35 = -0.18 + t33
-    t36 = T02*t28 + T12*t31
-    t37 = T02*t31 - T12*t28
-    t38 = T00*t28 + T10*t31
-    t39 = T10*t28 - T00*t31
-    t40 = t4*t29 - t8*t32
-    t41 = t4*t32 + t8*t29
-    t42 = -0.18 + t40
-    t43 = T12*t32 - T02*t29
-    t44 = T02*t32 + T12*t29
-    t45 = T00*t29 - T10*t32
-    t46 = T00*t32 + T10*t29
-    t47 = 1 - t28
-    t48 = t13*t47
-    t49 = t48 + t13*t28
-    t50 = -0.4 + t49
-    t51 = t34**2 + t35**2 + t50**2
-    t52 = 0.5*(0.7588 - t51)
-    t53 = T22*t47
-    t54 = t53 + T22*t28
-    t55 = T20*t47
-    t56 = t55 + T20*t28
-    t57 = t52**2
-    t58 = 1 - 6.965340465841971*t57
-    t59 = xp.greater(t58, 1e-12)
-    t60 = xp.where(t59, xp.sqrt(t58), 0)
-    t61 = 2.639193146748068*t52
-    t62 = xp.where(t59, t61, xp.where(xp.greater(t61, 0), xp.asarray(1, dtype=dtype), -1))
-    t63 = xp.atan2(t60, t62)
-    t64 = 1.761980786391911 + t63
-    t65 = 1.761980786391911 - t63
-    t66 = t64 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t64))
-    t67 = t66 - 6.283185307179586*xp.floor(0.15915494309189535*(0.2617993877991494 + t66))
-    t68 = t65 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t65))
-    t69 = t68 - 6.283185307179586*xp.floor(0.15915494309189535*(0.2617993877991494 + t68))
-    t70 = 0.9817798505902814*t60
-    t71 = 0.1900219065658609*t62
-    t72 = -(t70 + t71)
-    t73 = t70 - t71
-    t74 = 0.9817798505902814*t62
-    t75 = 0.1900219065658609*t60
-    t76 = t74 - t75
-    t77 = t74 + t75
-    t78 = 0.12*t72 - 0.62*t76
-    t79 = 0.12*t76 + 0.62*t72
-    t80 = 0.78 + t78
-    t81 = 0.4 - t79
-    t82 = -0.18 + t80
-    t83 = -0.4 + t81
-    t84 = t35*t82 + t50*t83
-    t85 = t35*t83 - t50*t82
-    t86 = t84**2 + t85**2
-    t87 = t82**2 + t83**2
-    t88 = 0.12*t73 - 0.62*t77
-    t89 = 0.12*t77 + 0.62*t73
-    t90 = 0.78 + t88
-    t91 = 0.4 - t89
-    t92 = -0.18 + t90
-    t93 = -0.4 + t91
-    t94 = t35*t92 + t50*t93
-    t95 = t35*t93 - t50*t92
-    t96 = t94**2 + t95**2
-    t97 = t92**2 + t93**2
-    t98 = 1e-24*t51
-    t99 = xp.less_equal(t86, t87*t98)
-    t100 = xp.where(t99, 1, 1/xp.sqrt(t86))
-    t101 = xp.where(t99, 1, t84*t100)
-    t102 = xp.where(t99, 0, t85*t100)
-    t103 = t72*t101 - t76*t102
-    t104 = t72*t102 + t76*t101
-    t105 = t104*t54 - t103*t36
-    t106 = t103*t54 + t104*t36
-    t107 = t103*t38 - t104*t56
-    t108 = t103*t56 + t104*t38
-    t109 = xp.where(t99, 0, xp.atan2(t85, t84))
-    t110 = t109 - 6.283185307179586*xp.floor(0.15915494309189535*(3.141592653589793 + t109))
-    t111 = 1 - t103
-    t112 = t37*t111
-    t113 = t112 + t103*t37
-    t114 = t39*t111
-    t115 = t114 + t103*t39
-    t116 = t106**2
-    t117 = -t116
-    t118 = 1 + t117
-    t119 = xp.greater(t118, 1e-12)
-    t120 = xp.where(t119, xp.sqrt(t118), 0)
-    t121 = t116 - t105*t120
-    t122 = t121 + t117
-    t123 = t113**2
-    t124 = t105**2 + t123 + t116
-    t125 = t120**2
-    t126 = t122**2 + t123*t125
-    t127 = t116 + t125
-    t128 = 1e-24*t127
-    t129 = xp.less_equal(t126, t124*t128)
-    t130 = xp.where(t129, 1, 1/xp.sqrt(t126))
-    t131 = xp.where(t129, 1, t122*t130)
-    t132 = t108*(1 - t131)
-    t133 = t132 + t108*t131
-    t134 = t113*t120
-    t135 = xp.where(t129, 0, -t130*t134)
-    t136 = t107*t131 + t115*t135
-    t137 = t115*t131 - t107*t135
-    t138 = xp.less_equal(t127, t128)
-    t139 = xp.where(t138, 1, 1/xp.sqrt(t127))
-    t140 = xp.where(t138, 1, -t106*t139)
-    t141 = xp.where(t138, 0, -t120*t139)
-    t142 = t137*(1 - t140)
-    t143 = t140*t136 - t141*t133
-    t144 = t142 + t140*t137
-    t145 = t140*t133 + t141*t136
-    t146 = t143**2 + t144**2
-    t147 = t146
-    t148 = t146 + t145**2
-    t149 = xp.less_equal(t96, t97*t98)
-    t150 = xp.where(t149, 1, 1/xp.sqrt(t96))
-    t151 = xp.where(t149, 1, t94*t150)
-    t152 = xp.where(t149, 0, t95*t150)
-    t153 = t73*t151 - t77*t152
-    t154 = t73*t152 + t77*t151
-    t155 = t54*t154 - t36*t153
-    t156 = t36*t154 + t54*t153
-    t157 = t38*t153 - t56*t154
-    t158 = t38*t154 + t56*t153
-    t159 = xp.where(t149, 0, xp.atan2(t95, t94))
-    t160 = t159 - 6.283185307179586*xp.floor(0.15915494309189535*(3.141592653589793 + t159))
-    t161 = 1 - t153
-    t162 = t37*t161
-    t163 = t162 + t37*t153
-    t164 = t39*t161
-    t165 = t164 + t39*t153
-    t166 = t156**2
-    t167 = -t166
-    t168 = 1 + t167
-    t169 = xp.greater(t168, 1e-12)
-    t170 = xp.where(t169, xp.sqrt(t168), 0)
-    t171 = t166 - t155*t170
-    t172 = t171 + t167
-    t173 = t163**2
-    t174 = t155**2 + t173 + t166
-    t175 = t170**2
-    t176 = t172**2 + t173*t175
-    t177 = t166 + t175
-    t178 = 1e-24*t177
-    t179 = xp.less_equal(t176, t174*t178)
-    t180 = xp.where(t179, 1, 1/xp.sqrt(t176))
-    t181 = xp.where(t179, 1, t172*t180)
-    t182 = t158*(1 - t181)
-    t183 = t182 + t158*t181
-    t184 = t163*t170
-    t185 = xp.where(t179, 0, -t180*t184)
-    t186 = t157*t181 + t165*t185
-    t187 = t165*t181 - t157*t185
-    t188 = xp.less_equal(t177, t178)
-    t189 = xp.where(t188, 1, 1/xp.sqrt(t177))
-    t190 = xp.where(t188, 1, -t156*t189)
-    t191 = xp.where(t188, 0, -t170*t189)
-    t192 = t187*(1 - t190)
-    t193 = t190*t186 - t191*t183
-    t194 = t192 + t190*t187
-    t195 = t190*t183 + t191*t186
-    t196 = t193**2 + t194**2
-    t197 = t196
-    t198 = t196 + t195**2
-    t199 = 1 - t29
-    t200 = t13*t199
-    t201 = t200 + t13*t29
-    t202 = -0.4 + t201
-    t203 = t41**2 + t42**2 + t202**2
-    t204 = 0.5*(0.7588 - t203)
-    t205 = T22*t199
-    t206 = t205 + T22*t29
-    t207 = T20*t199
-    t208 = t207 + T20*t29
-    t209 = t204**2
-    t210 = 1 - 6.965340465841971*t209
-    t211 = xp.greater(t210, 1e-12)
-    t212 = xp.where(t211, xp.sqrt(t210), 0)
-    t213 = 2.639193146748068*t204
-    t214 = xp.where(t211, t213, xp.where(xp.greater(t213, 0), xp.asarray(1, dtype=dtype), -1))
-    t215 = xp.atan2(t212, t214)
-    t216 = 1.761980786391911 + t215
-    t217 = 1.761980786391911 - t215
-    t218 = t216 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t216))
-    t219 = t218 - 6.283185307179586*xp.floor(0.15915494309189535*(0.2617993877991494 + t218))
-    t220 = t217 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t217))
-    t221 = t220 - 6.283185307179586*xp.floor(0.15915494309189535*(0.2617993877991494 + t220))
-    t222 = 0.9817798505902814*t212
-    t223 = 0.1900219065658609*t214
-    t224 = -(t222 + t223)
-    t225 = t222 - t223
-    t226 = 0.9817798505902814*t214
-    t227 = 0.1900219065658609*t212
-    t228 = t226 - t227
-    t229 = t226 + t227
-    t230 = 0.12*t224 - 0.62*t228
-    t231 = 0.12*t228 + 0.62*t224
-    t232 = 0.78 + t230
-    t233 = 0.4 - t231
-    t234 = -0.18 + t232
-    t235 = -0.4 + t233
-    t236 = t42*t234 + t202*t235
-    t237 = t42*t235 - t202*t234
-    t238 = t236**2 + t237**2
-    t239 = t234**2 + t235**2
-    t240 = 0.12*t225 - 0.62*t229
-    t241 = 0.12*t229 + 0.62*t225
-    t242 = 0.78 + t240
-    t243 = 0.4 - t241
-    t244 = -0.18 + t242
-    t245 = -0.4 + t243
-    t246 = t42*t244 + t202*t245
-    t247 = t42*t245 - t202*t244
-    t248 = t246**2 + t247**2
-    t249 = t244**2 + t245**2
-    t250 = 1e-24*t203
-    t251 = xp.less_equal(t238, t239*t250)
-    t252 = xp.where(t251, 1, 1/xp.sqrt(t238))
-    t253 = xp.where(t251, 1, t236*t252)
-    t254 = xp.where(t251, 0, t237*t252)
-    t255 = t224*t253 - t228*t254
-    t256 = t224*t254 + t228*t253
-    t257 = t255*t43 + t256*t206
-    t258 = t256*t43 - t255*t206
-    t259 = t255*t45 - t256*t208
-    t260 = t255*t208 + t256*t45
-    t261 = xp.where(t251, 0, xp.atan2(t237, t236))
-    t262 = t261 - 6.283185307179586*xp.floor(0.15915494309189535*(3.141592653589793 + t261))
-    t263 = 1 - t255
-    t264 = t44*t263
-    t265 = t264 + t255*t44
-    t266 = t46*t263
-    t267 = t266 + t255*t46
-    t268 = t258**2
-    t269 = -t268
-    t270 = 1 + t269
-    t271 = xp.greater(t270, 1e-12)
-    t272 = xp.where(t271, xp.sqrt(t270), 0)
-    t273 = t268 - t257*t272
-    t274 = t273 + t269
-    t275 = t265**2
-    t276 = t257**2 + t275 + t268
-    t277 = t272**2
-    t278 = t274**2 + t275*t277
-    t279 = t268 + t277
-    t280 = 1e-24*t279
-    t281 = xp.less_equal(t278, t276*t280)
-    t282 = xp.where(t281, 1, 1/xp.sqrt(t278))
-    t283 = xp.where(t281, 1, t274*t282)
-    t284 = t260*(1 - t283)
-    t285 = t284 + t260*t283
-    t286 = t265*t272
-    t287 = xp.where(t281, 0, t282*t286)
-    t288 = t259*t283 + t267*t287
-    t289 = t267*t283 - t259*t287
-    t290 = xp.less_equal(t279, t280)
-    t291 = xp.where(t290, 1, 1/xp.sqrt(t279))
-    t292 = xp.where(t290, 1, t258*t291)
-    t293 = xp.where(t290, 0, -t272*t291)
-    t294 = t289*(1 - t292)
-    t295 = t292*t288 - t293*t285
-    t296 = t294 + t292*t289
-    t297 = t292*t285 + t293*t288
-    t298 = t295**2 + t296**2
-    t299 = t298
-    t300 = t298 + t297**2
-    t301 = xp.less_equal(t248, t249*t250)
-    t302 = xp.where(t301, 1, 1/xp.sqrt(t248))
-    t303 = xp.where(t301, 1, t246*t302)
-    t304 = xp.where(t301, 0, t247*t302)
-    t305 = t225*t303 - t229*t304
-    t306 = t225*t304 + t229*t303
-    t307 = t43*t305 + t206*t306
-    t308 = t43*t306 - t206*t305
-    t309 = t45*t305 - t208*t306
-    t310 = t45*t306 + t208*t305
-    t311 = xp.where(t301, 0, xp.atan2(t247, t246))
-    t312 = t311 - 6.283185307179586*xp.floor(0.15915494309189535*(3.141592653589793 + t311))
-    t313 = 1 - t305
-    t314 = t44*t313
-    t315 = t314 + t44*t305
-    t316 = t46*t313
-    t317 = t316 + t46*t305
-    t318 = t308**2
-    t319 = -t318
-    t320 = 1 + t319
-    t321 = xp.greater(t320, 1e-12)
-    t322 = xp.where(t321, xp.sqrt(t320), 0)
-    t323 = t318 - t307*t322
-    t324 = t323 + t319
-    t325 = t315**2
-    t326 = t307**2 + t325 + t318
-    t327 = t322**2
-    t328 = t324**2 + t325*t327
-    t329 = t318 + t327
-    t330 = 1e-24*t329
-    t331 = xp.less_equal(t328, t326*t330)
-    t332 = xp.where(t331, 1, 1/xp.sqrt(t328))
-    t333 = xp.where(t331, 1, t324*t332)
-    t334 = t310*(1 - t333)
-    t335 = t334 + t310*t333
-    t336 = t315*t322
-    t337 = xp.where(t331, 0, t332*t336)
-    t338 = t309*t333 + t317*t337
-    t339 = t317*t333 - t309*t337
-    t340 = xp.less_equal(t329, t330)
-    t341 = xp.where(t340, 1, 1/xp.sqrt(t329))
-    t342 = xp.where(t340, 1, t308*t341)
-    t343 = xp.where(t340, 0, -t322*t341)
-    t344 = t339*(1 - t342)
-    t345 = t342*t338 - t343*t335
-    t346 = t344 + t342*t339
-    t347 = t342*t335 + t343*t338
-    t348 = t345**2 + t346**2
-    t349 = t348
-    t350 = t348 + t347**2
-    t351 = xp.where(t129, 0, xp.atan2(-t134, t122))
-    t352 = t351
-    t353 = t352 - 6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t352))
-    t354 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t351) + t351
-    t355 = t354 - 6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t354))
-    t356 = xp.where(t138, 0, xp.atan2(-t120, -t106))
-    t357 = t356
-    t358 = t357 - 6.283185307179586*xp.floor(0.15915494309189535*(2.2689280275926285 + t357))
-    t359 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t356)) + t356
-    t360 = xp.where(xp.less_equal(t147, 1e-24*t148), 0, xp.atan2(t144, t143))
-    t361 = t360
-    t362 = t361 - 6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t361))
-    t363 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t360) + t360
-    t364 = t363 - 6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t363))
-    t365 = -t359
-    t366 = t359 + 6.283185307179586*xp.floor(0.15915494309189535*(2.2689280275926285 + t365))
-    t367 = xp.where(t179, 0, xp.atan2(-t184, t172))
-    t368 = t367
-    t369 = t368 - 6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t368))
-    t370 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t367) + t367
-    t371 = t370 - 6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t370))
-    t372 = xp.where(t188, 0, xp.atan2(-t170, -t156))
-    t373 = t372
-    t374 = t373 - 6.283185307179586*xp.floor(0.15915494309189535*(2.2689280275926285 + t373))
-    t375 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t372)) + t372
-    t376 = xp.where(xp.less_equal(t197, 1e-24*t198), 0, xp.atan2(t194, t193))
-    t377 = t376
-    t378 = t377 - 6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t377))
-    t379 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t376) + t376
-    t380 = t379 - 6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t379))
-    t381 = -t375
-    t382 = t375 + 6.283185307179586*xp.floor(0.15915494309189535*(2.2689280275926285 + t381))
-    t383 = xp.where(t281, 0, xp.atan2(t286, t274))
-    t384 = t383
-    t385 = t384 - 6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t384))
-    t386 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t383) + t383
-    t387 = t386 - 6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t386))
-    t388 = xp.where(t290, 0, xp.atan2(-t272, t258))
-    t389 = t388
-    t390 = t389 - 6.283185307179586*xp.floor(0.15915494309189535*(2.2689280275926285 + t389))
-    t391 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t388)) + t388
-    t392 = xp.where(xp.less_equal(t299, 1e-24*t300), 0, xp.atan2(t296, t295))
-    t393 = t392
-    t394 = t393 - 6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t393))
-    t395 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t392) + t392
-    t396 = t395 - 6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t395))
-    t397 = -t391
-    t398 = t391 + 6.283185307179586*xp.floor(0.15915494309189535*(2.2689280275926285 + t397))
-    t399 = xp.where(t331, 0, xp.atan2(t336, t324))
-    t400 = t399
-    t401 = t400 - 6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t400))
-    t402 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t399) + t399
-    t403 = t402 - 6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t402))
-    t404 = xp.where(t340, 0, xp.atan2(-t322, t308))
-    t405 = t404
-    t406 = t405 - 6.283185307179586*xp.floor(0.15915494309189535*(2.2689280275926285 + t405))
-    t407 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t404)) + t404
-    t408 = xp.where(xp.less_equal(t349, 1e-24*t350), 0, xp.atan2(t346, t345))
-    t409 = t408
-    t410 = t409 - 6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t409))
-    t411 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t408) + t408
-    t412 = t411 - 6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t411))
-    t413 = -t407
-    t414 = t407 + 6.283185307179586*xp.floor(0.15915494309189535*(2.2689280275926285 + t413))
-    t415 = xp.less_equal(t23, 2.705260340591211)
-    t416 = xp.greater_equal(t22, -2.705260340591211) & xp.less_equal(t22, 2.705260340591211)
-    t417 = xp.where(t415 & xp.logical_not(t416), t23, t22)
-    t418 = xp.less_equal(t110, 1.1344640137963142)
-    t419 = xp.greater_equal(t109, -3.141592653589793) & xp.less_equal(t109, 1.1344640137963142)
-    t420 = xp.where(t418 & xp.logical_not(t419), t110, t109)
-    t421 = xp.less_equal(t67, 2.7576202181510405)
-    t422 = xp.greater_equal(t66, -0.2617993877991494) & xp.less_equal(t66, 2.7576202181510405)
-    t423 = xp.where(t421 & xp.logical_not(t422), t67, t66)
-    t424 = xp.less_equal(t353, 6.1086523819801535)
-    t425 = xp.greater_equal(t352, -6.1086523819801535) & xp.less_equal(t352, 6.1086523819801535)
-    t426 = xp.less_equal(t358, 2.2689280275926285)
-    t427 = xp.greater_equal(t357, -2.2689280275926285) & xp.less_equal(t357, 2.2689280275926285)
-    t428 = xp.less_equal(t362, 6.1086523819801535)
-    t429 = xp.greater_equal(t361, -6.1086523819801535) & xp.less_equal(t361, 6.1086523819801535)
-    t430 = xp.less_equal(t355, 6.1086523819801535)
-    t431 = xp.greater_equal(t354, -6.1086523819801535) & xp.less_equal(t354, 6.1086523819801535)
-    t432 = -t366
-    t433 = xp.less_equal(t432, 2.2689280275926285)
-    t434 = xp.greater_equal(t365, -2.2689280275926285) & xp.less_equal(t365, 2.2689280275926285)
-    t435 = xp.less_equal(t364, 6.1086523819801535)
-    t436 = xp.greater_equal(t363, -6.1086523819801535) & xp.less_equal(t363, 6.1086523819801535)
-    t437 = xp.less_equal(t160, 1.1344640137963142)
-    t438 = xp.greater_equal(t159, -3.141592653589793) & xp.less_equal(t159, 1.1344640137963142)
-    t439 = xp.where(t437 & xp.logical_not(t438), t160, t159)
-    t440 = xp.less_equal(t69, 2.7576202181510405)
-    t441 = xp.greater_equal(t68, -0.2617993877991494) & xp.less_equal(t68, 2.7576202181510405)
-    t442 = xp.where(t440 & xp.logical_not(t441), t69, t68)
-    t443 = xp.less_equal(t369, 6.1086523819801535)
-    t444 = xp.greater_equal(t368, -6.1086523819801535) & xp.less_equal(t368, 6.1086523819801535)
-    t445 = xp.less_equal(t374, 2.2689280275926285)
-    t446 = xp.greater_equal(t373, -2.2689280275926285) & xp.less_equal(t373, 2.2689280275926285)
-    t447 = xp.less_equal(t378, 6.1086523819801535)
-    t448 = xp.greater_equal(t377, -6.1086523819801535) & xp.less_equal(t377, 6.1086523819801535)
-    t449 = xp.less_equal(t371, 6.1086523819801535)
-    t450 = xp.greater_equal(t370, -6.1086523819801535) & xp.less_equal(t370, 6.1086523819801535)
-    t451 = -t382
-    t452 = xp.less_equal(t451, 2.2689280275926285)
-    t453 = xp.greater_equal(t381, -2.2689280275926285) & xp.less_equal(t381, 2.2689280275926285)
-    t454 = xp.less_equal(t380, 6.1086523819801535)
-    t455 = xp.greater_equal(t379, -6.1086523819801535) & xp.less_equal(t379, 6.1086523819801535)
-    t456 = xp.less_equal(t25, 2.705260340591211)
-    t457 = xp.greater_equal(t24, -2.705260340591211) & xp.less_equal(t24, 2.705260340591211)
-    t458 = xp.where(t456 & xp.logical_not(t457), t25, t24)
-    t459 = xp.less_equal(t262, 1.1344640137963142)
-    t460 = xp.greater_equal(t261, -3.141592653589793) & xp.less_equal(t261, 1.1344640137963142)
-    t461 = xp.where(t459 & xp.logical_not(t460), t262, t261)
-    t462 = xp.less_equal(t219, 2.7576202181510405)
-    t463 = xp.greater_equal(t218, -0.2617993877991494) & xp.less_equal(t218, 2.7576202181510405)
-    t464 = xp.where(t462 & xp.logical_not(t463), t219, t218)
-    t465 = xp.less_equal(t385, 6.1086523819801535)
-    t466 = xp.greater_equal(t384, -6.1086523819801535) & xp.less_equal(t384, 6.1086523819801535)
-    t467 = xp.less_equal(t390, 2.2689280275926285)
-    t468 = xp.greater_equal(t389, -2.2689280275926285) & xp.less_equal(t389, 2.2689280275926285)
-    t469 = xp.less_equal(t394, 6.1086523819801535)
-    t470 = xp.greater_equal(t393, -6.1086523819801535) & xp.less_equal(t393, 6.1086523819801535)
-    t471 = xp.less_equal(t387, 6.1086523819801535)
-    t472 = xp.greater_equal(t386, -6.1086523819801535) & xp.less_equal(t386, 6.1086523819801535)
-    t473 = -t398
-    t474 = xp.less_equal(t473, 2.2689280275926285)
-    t475 = xp.greater_equal(t397, -2.2689280275926285) & xp.less_equal(t397, 2.2689280275926285)
-    t476 = xp.less_equal(t396, 6.1086523819801535)
-    t477 = xp.greater_equal(t395, -6.1086523819801535) & xp.less_equal(t395, 6.1086523819801535)
-    t478 = xp.less_equal(t312, 1.1344640137963142)
-    t479 = xp.greater_equal(t311, -3.141592653589793) & xp.less_equal(t311, 1.1344640137963142)
-    t480 = xp.where(t478 & xp.logical_not(t479), t312, t311)
-    t481 = xp.less_equal(t221, 2.7576202181510405)
-    t482 = xp.greater_equal(t220, -0.2617993877991494) & xp.less_equal(t220, 2.7576202181510405)
-    t483 = xp.where(t481 & xp.logical_not(t482), t221, t220)
-    t484 = xp.less_equal(t401, 6.1086523819801535)
-    t485 = xp.greater_equal(t400, -6.1086523819801535) & xp.less_equal(t400, 6.1086523819801535)
-    t486 = xp.less_equal(t406, 2.2689280275926285)
-    t487 = xp.greater_equal(t405, -2.2689280275926285) & xp.less_equal(t405, 2.2689280275926285)
-    t488 = xp.less_equal(t410, 6.1086523819801535)
-    t489 = xp.greater_equal(t409, -6.1086523819801535) & xp.less_equal(t409, 6.1086523819801535)
-    t490 = xp.less_equal(t403, 6.1086523819801535)
-    t491 = xp.greater_equal(t402, -6.1086523819801535) & xp.less_equal(t402, 6.1086523819801535)
-    t492 = -t414
-    t493 = xp.less_equal(t492, 2.2689280275926285)
-    t494 = xp.greater_equal(t413, -2.2689280275926285) & xp.less_equal(t413, 2.2689280275926285)
-    t495 = xp.less_equal(t412, 6.1086523819801535)
-    t496 = xp.greater_equal(t411, -6.1086523819801535) & xp.less_equal(t411, 6.1086523819801535)
-    t497 = xp.isfinite(t0)
-    t498 = xp.greater(t15, t17)
-    t499 = t498 | (t18 & xp.less_equal(0, 1e-12*t16))
-    t500 = xp.greater_equal(t58, -1e-12)
-    t501 = xp.greater_equal(t210, -1e-12)
-    t502 = t415 | t416
-    t503 = t418 | t419
-    t504 = t421 | t422
-    t505 = t437 | t438
-    t506 = t440 | t441
-    t507 = t456 | t457
-    t508 = t459 | t460
-    t509 = t462 | t463
-    t510 = t478 | t479
-    t511 = t481 | t482
+    t26 = t4*t19
+    t27 = xp.where(t18, 1, t26)
+    t28 = -t26
+    t29 = t8*t19
+    t30 = xp.where(t18, 0, t29)
+    t31 = t29
+    t32 = t4*t27 + t8*t30
+    t33 = t8*t27 - t4*t30
+    t34 = -0.18 + t32
+    t35 = T02*t27 + T12*t30
+    t36 = T02*t30 - T12*t27
+    t37 = T00*t27 + T10*t30
+    t38 = T10*t27 - T00*t30
+    t39 = t4*t28 - t8*t31
+    t40 = t4*t31 + t8*t28
+    t41 = -0.18 + t39
+    t42 = T12*t31 - T02*t28
+    t43 = T02*t31 + T12*t28
+    t44 = T00*t28 - T10*t31
+    t45 = T00*t31 + T10*t28
+    t46 = 1 - t27
+    t47 = t13*t46
+    t48 = t47 + t13*t27
+    t49 = -0.4 + t48
+    t50 = t33**2 + t34**2 + t49**2
+    t51 = 0.5*(0.7588 - t50)
+    t52 = T22*t46
+    t53 = t52 + T22*t27
+    t54 = T20*t46
+    t55 = t54 + T20*t27
+    t56 = t51**2
+    t57 = 1 - 6.965340465841971*t56
+    t58 = xp.greater(t57, 1e-12)
+    t59 = xp.where(t58, xp.sqrt(t57), 0)
+    t60 = 2.639193146748068*t51
+    t61 = xp.where(t58, t60, xp.where(xp.greater(t60, 0), xp.asarray(1, dtype=dtype), -1))
+    t62 = xp.atan2(t59, t61)
+    t63 = 1.761980786391911 - t62
+    t64 = t63 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t63))
+    t65 = t64 - 6.283185307179586*xp.floor(0.15915494309189535*(0.2617993877991494 + t64))
+    t66 = 1.761980786391911 + t62
+    t67 = t66 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t66))
+    t68 = t67 - 6.283185307179586*xp.floor(0.15915494309189535*(0.2617993877991494 + t67))
+    t69 = 0.9817798505902814*t59
+    t70 = 0.1900219065658609*t61
+    t71 = -(t69 + t70)
+    t72 = -t70 + t69
+    t73 = 0.1900219065658609*t59
+    t74 = 0.9817798505902814*t61
+    t75 = -t73 + t74
+    t76 = t73 + t74
+    t77 = -0.62*t75 + 0.12*t71
+    t78 = 0.12*t75 + 0.62*t71
+    t79 = 0.78 + t77
+    t80 = 0.4 - t78
+    t81 = -0.18 + t79
+    t82 = -0.4 + t80
+    t83 = t34*t81 + t49*t82
+    t84 = t34*t82 - t49*t81
+    t85 = t83**2 + t84**2
+    t86 = t81**2 + t82**2
+    t87 = -0.62*t76 + 0.12*t72
+    t88 = 0.12*t76 + 0.62*t72
+    t89 = 0.78 + t87
+    t90 = 0.4 - t88
+    t91 = -0.18 + t89
+    t92 = -0.4 + t90
+    t93 = t34*t91 + t49*t92
+    t94 = t34*t92 - t49*t91
+    t95 = t93**2 + t94**2
+    t96 = t91**2 + t92**2
+    t97 = 1e-24*t50
+    t98 = xp.less_equal(t85, t86*t97)
+    t99 = xp.where(t98, 1, 1/xp.sqrt(t85))
+    t100 = xp.where(t98, 1, t83*t99)
+    t101 = xp.where(t98, 0, t84*t99)
+    t102 = t71*t100 - t75*t101
+    t103 = t71*t101 + t75*t100
+    t104 = t103*t53 - t102*t35
+    t105 = t102*t53 + t103*t35
+    t106 = t102*t37 - t103*t55
+    t107 = t102*t55 + t103*t37
+    t108 = xp.where(t98, 0, xp.atan2(t84, t83))
+    t109 = t108 - 6.283185307179586*xp.floor(0.15915494309189535*(3.141592653589793 + t108))
+    t110 = 1 - t102
+    t111 = t36*t110
+    t112 = t111 + t102*t36
+    t113 = t38*t110
+    t114 = t113 + t102*t38
+    t115 = t105**2
+    t116 = -t115
+    t117 = 1 + t116
+    t118 = xp.greater(t117, 1e-12)
+    t119 = xp.where(t118, xp.sqrt(t117), 0)
+    t120 = t115 - t104*t119
+    t121 = t120 + t116
+    t122 = t112**2
+    t123 = t104**2 + t122 + t115
+    t124 = t119**2
+    t125 = t121**2 + t122*t124
+    t126 = t115 + t124
+    t127 = 1e-24*t126
+    t128 = xp.less_equal(t125, t123*t127)
+    t129 = xp.where(t128, 1, 1/xp.sqrt(t125))
+    t130 = xp.where(t128, 1, t121*t129)
+    t131 = t107*(1 - t130)
+    t132 = t131 + t107*t130
+    t133 = t112*t119
+    t134 = xp.where(t128, 0, -t129*t133)
+    t135 = t106*t130 + t114*t134
+    t136 = t114*t130 - t106*t134
+    t137 = xp.less_equal(t126, t127)
+    t138 = xp.where(t137, 1, 1/xp.sqrt(t126))
+    t139 = xp.where(t137, 1, -t105*t138)
+    t140 = xp.where(t137, 0, -t119*t138)
+    t141 = t136*(1 - t139)
+    t142 = t139*t135 - t140*t132
+    t143 = t141 + t139*t136
+    t144 = t139*t132 + t140*t135
+    t145 = t142**2 + t143**2
+    t146 = t145
+    t147 = t144**2 + t145
+    t148 = xp.less_equal(t95, t96*t97)
+    t149 = xp.where(t148, 1, 1/xp.sqrt(t95))
+    t150 = xp.where(t148, 1, t93*t149)
+    t151 = xp.where(t148, 0, t94*t149)
+    t152 = t72*t150 - t76*t151
+    t153 = t72*t151 + t76*t150
+    t154 = t53*t153 - t35*t152
+    t155 = t35*t153 + t53*t152
+    t156 = t37*t152 - t55*t153
+    t157 = t37*t153 + t55*t152
+    t158 = xp.where(t148, 0, xp.atan2(t94, t93))
+    t159 = t158 - 6.283185307179586*xp.floor(0.15915494309189535*(3.141592653589793 + t158))
+    t160 = 1 - t152
+    t161 = t36*t160
+    t162 = t161 + t36*t152
+    t163 = t38*t160
+    t164 = t163 + t38*t152
+    t165 = t155**2
+    t166 = -t165
+    t167 = 1 + t166
+    t168 = xp.greater(t167, 1e-12)
+    t169 = xp.where(t168, xp.sqrt(t167), 0)
+    t170 = t165 - t154*t169
+    t171 = t170 + t166
+    t172 = t162**2
+    t173 = t154**2 + t172 + t165
+    t174 = t169**2
+    t175 = t171**2 + t172*t174
+    t176 = t165 + t174
+    t177 = 1e-24*t176
+    t178 = xp.less_equal(t175, t173*t177)
+    t179 = xp.where(t178, 1, 1/xp.sqrt(t175))
+    t180 = xp.where(t178, 1, t171*t179)
+    t181 = t157*(1 - t180)
+    t182 = t181 + t157*t180
+    t183 = t162*t169
+    t184 = xp.where(t178, 0, -t179*t183)
+    t185 = t156*t180 + t164*t184
+    t186 = t164*t180 - t156*t184
+    t187 = xp.less_equal(t176, t177)
+    t188 = xp.where(t187, 1, 1/xp.sqrt(t176))
+    t189 = xp.where(t187, 1, -t155*t188)
+    t190 = xp.where(t187, 0, -t169*t188)
+    t191 = t186*(1 - t189)
+    t192 = t189*t185 - t190*t182
+    t193 = t191 + t189*t186
+    t194 = t189*t182 + t190*t185
+    t195 = t192**2 + t193**2
+    t196 = t195
+    t197 = t194**2 + t195
+    t198 = 1 - t28
+    t199 = t13*t198
+    t200 = t199 + t13*t28
+    t201 = -0.4 + t200
+    t202 = t40**2 + t41**2 + t201**2
+    t203 = 0.5*(0.7588 - t202)
+    t204 = T22*t198
+    t205 = t204 + T22*t28
+    t206 = T20*t198
+    t207 = t206 + T20*t28
+    t208 = t203**2
+    t209 = 1 - 6.965340465841971*t208
+    t210 = xp.greater(t209, 1e-12)
+    t211 = xp.where(t210, xp.sqrt(t209), 0)
+    t212 = 2.639193146748068*t203
+    t213 = xp.where(t210, t212, xp.where(xp.greater(t212, 0), xp.asarray(1, dtype=dtype), -1))
+    t214 = xp.atan2(t211, t213)
+    t215 = 1.761980786391911 + t214
+    t216 = 1.761980786391911 - t214
+    t217 = t215 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t215))
+    t218 = t217 - 6.283185307179586*xp.floor(0.15915494309189535*(0.2617993877991494 + t217))
+    t219 = t216 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t216))
+    t220 = t219 - 6.283185307179586*xp.floor(0.15915494309189535*(0.2617993877991494 + t219))
+    t221 = 0.9817798505902814*t211
+    t222 = 0.1900219065658609*t213
+    t223 = -(t221 + t222)
+    t224 = -t222 + t221
+    t225 = 0.1900219065658609*t211
+    t226 = 0.9817798505902814*t213
+    t227 = -t225 + t226
+    t228 = t225 + t226
+    t229 = -0.62*t227 + 0.12*t223
+    t230 = 0.12*t227 + 0.62*t223
+    t231 = 0.78 + t229
+    t232 = 0.4 - t230
+    t233 = -0.18 + t231
+    t234 = -0.4 + t232
+    t235 = t41*t233 + t201*t234
+    t236 = t41*t234 - t201*t233
+    t237 = t235**2 + t236**2
+    t238 = t233**2 + t234**2
+    t239 = -0.62*t228 + 0.12*t224
+    t240 = 0.12*t228 + 0.62*t224
+    t241 = 0.78 + t239
+    t242 = 0.4 - t240
+    t243 = -0.18 + t241
+    t244 = -0.4 + t242
+    t245 = t41*t243 + t201*t244
+    t246 = t41*t244 - t201*t243
+    t247 = t245**2 + t246**2
+    t248 = t243**2 + t244**2
+    t249 = 1e-24*t202
+    t250 = xp.less_equal(t237, t238*t249)
+    t251 = xp.where(t250, 1, 1/xp.sqrt(t237))
+    t252 = xp.where(t250, 1, t235*t251)
+    t253 = xp.where(t250, 0, t236*t251)
+    t254 = t223*t252 - t227*t253
+    t255 = t223*t253 + t227*t252
+    t256 = t254*t42 + t255*t205
+    t257 = t255*t42 - t254*t205
+    t258 = t254*t44 - t255*t207
+    t259 = t254*t207 + t255*t44
+    t260 = xp.where(t250, 0, xp.atan2(t236, t235))
+    t261 = t260 - 6.283185307179586*xp.floor(0.15915494309189535*(3.141592653589793 + t260))
+    t262 = 1 - t254
+    t263 = t43*t262
+    t264 = t263 + t254*t43
+    t265 = t45*t262
+    t266 = t265 + t254*t45
+    t267 = t257**2
+    t268 = -t267
+    t269 = 1 + t268
+    t270 = xp.greater(t269, 1e-12)
+    t271 = xp.where(t270, xp.sqrt(t269), 0)
+    t272 = t267 - t256*t271
+    t273 = t272 + t268
+    t274 = t264**2
+    t275 = t256**2 + t274 + t267
+    t276 = t271**2
+    t277 = t273**2 + t274*t276
+    t278 = t267 + t276
+    t279 = 1e-24*t278
+    t280 = xp.less_equal(t277, t275*t279)
+    t281 = xp.where(t280, 1, 1/xp.sqrt(t277))
+    t282 = xp.where(t280, 1, t273*t281)
+    t283 = t259*(1 - t282)
+    t284 = t283 + t259*t282
+    t285 = t264*t271
+    t286 = xp.where(t280, 0, t281*t285)
+    t287 = t258*t282 + t266*t286
+    t288 = t266*t282 - t258*t286
+    t289 = xp.less_equal(t278, t279)
+    t290 = xp.where(t289, 1, 1/xp.sqrt(t278))
+    t291 = xp.where(t289, 1, t257*t290)
+    t292 = xp.where(t289, 0, -t271*t290)
+    t293 = t288*(1 - t291)
+    t294 = t291*t287 - t292*t284
+    t295 = t293 + t291*t288
+    t296 = t291*t284 + t292*t287
+    t297 = t294**2 + t295**2
+    t298 = t297
+    t299 = t296**2 + t297
+    t300 = xp.less_equal(t247, t248*t249)
+    t301 = xp.where(t300, 1, 1/xp.sqrt(t247))
+    t302 = xp.where(t300, 1, t245*t301)
+    t303 = xp.where(t300, 0, t246*t301)
+    t304 = t224*t302 - t228*t303
+    t305 = t224*t303 + t228*t302
+    t306 = t42*t304 + t205*t305
+    t307 = t42*t305 - t205*t304
+    t308 = t44*t304 - t207*t305
+    t309 = t44*t305 + t207*t304
+    t310 = xp.where(t300, 0, xp.atan2(t246, t245))
+    t311 = t310 - 6.283185307179586*xp.floor(0.15915494309189535*(3.141592653589793 + t310))
+    t312 = 1 - t304
+    t313 = t43*t312
+    t314 = t313 + t43*t304
+    t315 = t45*t312
+    t316 = t315 + t45*t304
+    t317 = t307**2
+    t318 = -t317
+    t319 = 1 + t318
+    t320 = xp.greater(t319, 1e-12)
+    t321 = xp.where(t320, xp.sqrt(t319), 0)
+    t322 = t317 - t306*t321
+    t323 = t322 + t318
+    t324 = t314**2
+    t325 = t306**2 + t324 + t317
+    t326 = t321**2
+    t327 = t323**2 + t324*t326
+    t328 = t317 + t326
+    t329 = 1e-24*t328
+    t330 = xp.less_equal(t327, t325*t329)
+    t331 = xp.where(t330, 1, 1/xp.sqrt(t327))
+    t332 = xp.where(t330, 1, t323*t331)
+    t333 = t309*(1 - t332)
+    t334 = t333 + t309*t332
+    t335 = t314*t321
+    t336 = xp.where(t330, 0, t331*t335)
+    t337 = t308*t332 + t316*t336
+    t338 = t316*t332 - t308*t336
+    t339 = xp.less_equal(t328, t329)
+    t340 = xp.where(t339, 1, 1/xp.sqrt(t328))
+    t341 = xp.where(t339, 1, t307*t340)
+    t342 = xp.where(t339, 0, -t321*t340)
+    t343 = t338*(1 - t341)
+    t344 = t341*t337 - t342*t334
+    t345 = t343 + t341*t338
+    t346 = t341*t334 + t342*t337
+    t347 = t344**2 + t345**2
+    t348 = t347
+    t349 = t346**2 + t347
+    t350 = xp.where(t128, 0, xp.atan2(-t133, t121))
+    t351 = t350
+    t352 = t351 - 6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t351))
+    t353 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t350) + t350
+    t354 = t353 - 6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t353))
+    t355 = xp.where(t137, 0, xp.atan2(-t119, -t105))
+    t356 = t355
+    t357 = t356 - 6.283185307179586*xp.floor(0.15915494309189535*(2.2689280275926285 + t356))
+    t358 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t355)) + t355
+    t359 = xp.where(xp.less_equal(t146, 1e-24*t147), 0, xp.atan2(t143, t142))
+    t360 = t359
+    t361 = t360 - 6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t360))
+    t362 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t359) + t359
+    t363 = t362 - 6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t362))
+    t364 = -t358
+    t365 = t358 + 6.283185307179586*xp.floor(0.15915494309189535*(2.2689280275926285 + t364))
+    t366 = xp.where(t178, 0, xp.atan2(-t183, t171))
+    t367 = t366
+    t368 = t367 - 6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t367))
+    t369 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t366) + t366
+    t370 = t369 - 6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t369))
+    t371 = xp.where(t187, 0, xp.atan2(-t169, -t155))
+    t372 = t371
+    t373 = t372 - 6.283185307179586*xp.floor(0.15915494309189535*(2.2689280275926285 + t372))
+    t374 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t371)) + t371
+    t375 = xp.where(xp.less_equal(t196, 1e-24*t197), 0, xp.atan2(t193, t192))
+    t376 = t375
+    t377 = t376 - 6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t376))
+    t378 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t375) + t375
+    t379 = t378 - 6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t378))
+    t380 = -t374
+    t381 = t374 + 6.283185307179586*xp.floor(0.15915494309189535*(2.2689280275926285 + t380))
+    t382 = xp.where(t280, 0, xp.atan2(t285, t273))
+    t383 = t382
+    t384 = t383 - 6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t383))
+    t385 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t382) + t382
+    t386 = t385 - 6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t385))
+    t387 = xp.where(t289, 0, xp.atan2(-t271, t257))
+    t388 = t387
+    t389 = t388 - 6.283185307179586*xp.floor(0.15915494309189535*(2.2689280275926285 + t388))
+    t390 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t387)) + t387
+    t391 = xp.where(xp.less_equal(t298, 1e-24*t299), 0, xp.atan2(t295, t294))
+    t392 = t391
+    t393 = t392 - 6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t392))
+    t394 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t391) + t391
+    t395 = t394 - 6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t394))
+    t396 = -t390
+    t397 = t390 + 6.283185307179586*xp.floor(0.15915494309189535*(2.2689280275926285 + t396))
+    t398 = xp.where(t330, 0, xp.atan2(t335, t323))
+    t399 = t398
+    t400 = t399 - 6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t399))
+    t401 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t398) + t398
+    t402 = t401 - 6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t401))
+    t403 = xp.where(t339, 0, xp.atan2(-t321, t307))
+    t404 = t403
+    t405 = t404 - 6.283185307179586*xp.floor(0.15915494309189535*(2.2689280275926285 + t404))
+    t406 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t403)) + t403
+    t407 = xp.where(xp.less_equal(t348, 1e-24*t349), 0, xp.atan2(t345, t344))
+    t408 = t407
+    t409 = t408 - 6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t408))
+    t410 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t407) + t407
+    t411 = t410 - 6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t410))
+    t412 = -t406
+    t413 = t406 + 6.283185307179586*xp.floor(0.15915494309189535*(2.2689280275926285 + t412))
+    t414 = xp.less_equal(t23, 2.705260340591211)
+    t415 = xp.greater_equal(t22, -2.705260340591211) & xp.less_equal(t22, 2.705260340591211)
+    t416 = xp.where(t414 & xp.logical_not(t415), t23, t22)
+    t417 = xp.less_equal(t109, 1.1344640137963142)
+    t418 = xp.greater_equal(t108, -3.141592653589793) & xp.less_equal(t108, 1.1344640137963142)
+    t419 = xp.where(t417 & xp.logical_not(t418), t109, t108)
+    t420 = xp.less_equal(t68, 2.7576202181510405)
+    t421 = xp.greater_equal(t67, -0.2617993877991494) & xp.less_equal(t67, 2.7576202181510405)
+    t422 = xp.where(t420 & xp.logical_not(t421), t68, t67)
+    t423 = xp.less_equal(t352, 6.1086523819801535)
+    t424 = xp.greater_equal(t351, -6.1086523819801535) & xp.less_equal(t351, 6.1086523819801535)
+    t425 = xp.less_equal(t357, 2.2689280275926285)
+    t426 = xp.greater_equal(t356, -2.2689280275926285) & xp.less_equal(t356, 2.2689280275926285)
+    t427 = xp.less_equal(t361, 6.1086523819801535)
+    t428 = xp.greater_equal(t360, -6.1086523819801535) & xp.less_equal(t360, 6.1086523819801535)
+    t429 = xp.less_equal(t354, 6.1086523819801535)
+    t430 = xp.greater_equal(t353, -6.1086523819801535) & xp.less_equal(t353, 6.1086523819801535)
+    t431 = -t365
+    t432 = xp.less_equal(t431, 2.2689280275926285)
+    t433 = xp.greater_equal(t364, -2.2689280275926285) & xp.less_equal(t364, 2.2689280275926285)
+    t434 = xp.less_equal(t363, 6.1086523819801535)
+    t435 = xp.greater_equal(t362, -6.1086523819801535) & xp.less_equal(t362, 6.1086523819801535)
+    t436 = xp.less_equal(t159, 1.1344640137963142)
+    t437 = xp.greater_equal(t158, -3.141592653589793) & xp.less_equal(t158, 1.1344640137963142)
+    t438 = xp.where(t436 & xp.logical_not(t437), t159, t158)
+    t439 = xp.less_equal(t65, 2.7576202181510405)
+    t440 = xp.greater_equal(t64, -0.2617993877991494) & xp.less_equal(t64, 2.7576202181510405)
+    t441 = xp.where(t439 & xp.logical_not(t440), t65, t64)
+    t442 = xp.less_equal(t368, 6.1086523819801535)
+    t443 = xp.greater_equal(t367, -6.1086523819801535) & xp.less_equal(t367, 6.1086523819801535)
+    t444 = xp.less_equal(t373, 2.2689280275926285)
+    t445 = xp.greater_equal(t372, -2.2689280275926285) & xp.less_equal(t372, 2.2689280275926285)
+    t446 = xp.less_equal(t377, 6.1086523819801535)
+    t447 = xp.greater_equal(t376, -6.1086523819801535) & xp.less_equal(t376, 6.1086523819801535)
+    t448 = xp.less_equal(t370, 6.1086523819801535)
+    t449 = xp.greater_equal(t369, -6.1086523819801535) & xp.less_equal(t369, 6.1086523819801535)
+    t450 = -t381
+    t451 = xp.less_equal(t450, 2.2689280275926285)
+    t452 = xp.greater_equal(t380, -2.2689280275926285) & xp.less_equal(t380, 2.2689280275926285)
+    t453 = xp.less_equal(t379, 6.1086523819801535)
+    t454 = xp.greater_equal(t378, -6.1086523819801535) & xp.less_equal(t378, 6.1086523819801535)
+    t455 = xp.less_equal(t25, 2.705260340591211)
+    t456 = xp.greater_equal(t24, -2.705260340591211) & xp.less_equal(t24, 2.705260340591211)
+    t457 = xp.where(t455 & xp.logical_not(t456), t25, t24)
+    t458 = xp.less_equal(t261, 1.1344640137963142)
+    t459 = xp.greater_equal(t260, -3.141592653589793) & xp.less_equal(t260, 1.1344640137963142)
+    t460 = xp.where(t458 & xp.logical_not(t459), t261, t260)
+    t461 = xp.less_equal(t218, 2.7576202181510405)
+    t462 = xp.greater_equal(t217, -0.2617993877991494) & xp.less_equal(t217, 2.7576202181510405)
+    t463 = xp.where(t461 & xp.logical_not(t462), t218, t217)
+    t464 = xp.less_equal(t384, 6.1086523819801535)
+    t465 = xp.greater_equal(t383, -6.1086523819801535) & xp.less_equal(t383, 6.1086523819801535)
+    t466 = xp.less_equal(t389, 2.2689280275926285)
+    t467 = xp.greater_equal(t388, -2.2689280275926285) & xp.less_equal(t388, 2.2689280275926285)
+    t468 = xp.less_equal(t393, 6.1086523819801535)
+    t469 = xp.greater_equal(t392, -6.1086523819801535) & xp.less_equal(t392, 6.1086523819801535)
+    t470 = xp.less_equal(t386, 6.1086523819801535)
+    t471 = xp.greater_equal(t385, -6.1086523819801535) & xp.less_equal(t385, 6.1086523819801535)
+    t472 = -t397
+    t473 = xp.less_equal(t472, 2.2689280275926285)
+    t474 = xp.greater_equal(t396, -2.2689280275926285) & xp.less_equal(t396, 2.2689280275926285)
+    t475 = xp.less_equal(t395, 6.1086523819801535)
+    t476 = xp.greater_equal(t394, -6.1086523819801535) & xp.less_equal(t394, 6.1086523819801535)
+    t477 = xp.less_equal(t311, 1.1344640137963142)
+    t478 = xp.greater_equal(t310, -3.141592653589793) & xp.less_equal(t310, 1.1344640137963142)
+    t479 = xp.where(t477 & xp.logical_not(t478), t311, t310)
+    t480 = xp.less_equal(t220, 2.7576202181510405)
+    t481 = xp.greater_equal(t219, -0.2617993877991494) & xp.less_equal(t219, 2.7576202181510405)
+    t482 = xp.where(t480 & xp.logical_not(t481), t220, t219)
+    t483 = xp.less_equal(t400, 6.1086523819801535)
+    t484 = xp.greater_equal(t399, -6.1086523819801535) & xp.less_equal(t399, 6.1086523819801535)
+    t485 = xp.less_equal(t405, 2.2689280275926285)
+    t486 = xp.greater_equal(t404, -2.2689280275926285) & xp.less_equal(t404, 2.2689280275926285)
+    t487 = xp.less_equal(t409, 6.1086523819801535)
+    t488 = xp.greater_equal(t408, -6.1086523819801535) & xp.less_equal(t408, 6.1086523819801535)
+    t489 = xp.less_equal(t402, 6.1086523819801535)
+    t490 = xp.greater_equal(t401, -6.1086523819801535) & xp.less_equal(t401, 6.1086523819801535)
+    t491 = -t413
+    t492 = xp.less_equal(t491, 2.2689280275926285)
+    t493 = xp.greater_equal(t412, -2.2689280275926285) & xp.less_equal(t412, 2.2689280275926285)
+    t494 = xp.less_equal(t411, 6.1086523819801535)
+    t495 = xp.greater_equal(t410, -6.1086523819801535) & xp.less_equal(t410, 6.1086523819801535)
+    t496 = xp.isfinite(t0)
+    t497 = xp.greater(t15, t17)
+    t498 = t497 | (xp.less_equal(0, 1e-12*t16) & t18)
+    t499 = xp.greater_equal(t57, -1e-12)
+    t500 = xp.greater_equal(t209, -1e-12)
+    t501 = t414 | t415
+    t502 = t417 | t418
+    t503 = t420 | t421
+    t504 = t436 | t437
+    t505 = t439 | t440
+    t506 = t455 | t456
+    t507 = t458 | t459
+    t508 = t461 | t462
+    t509 = t477 | t478
+    t510 = t480 | t481
     q = _stack(xp, [
-        t417,  # 0, 0
-        t420,  # 0, 1
-        t423,  # 0, 2
-        xp.where(t424 & xp.logical_not(t425), t353, t352),  # 0, 3
-        xp.where(t426 & xp.logical_not(t427), t358, t357),  # 0, 4
-        xp.where(t428 & xp.logical_not(t429), t362, t361),  # 0, 5
-        t417,  # 1, 0
-        t420,  # 1, 1
-        t423,  # 1, 2
-        xp.where(t430 & xp.logical_not(t431), t355, t354),  # 1, 3
-        xp.where(t433 & xp.logical_not(t434), t432, t365),  # 1, 4
-        xp.where(t435 & xp.logical_not(t436), t364, t363),  # 1, 5
-        t417,  # 2, 0
-        t439,  # 2, 1
-        t442,  # 2, 2
-        xp.where(t443 & xp.logical_not(t444), t369, t368),  # 2, 3
-        xp.where(t445 & xp.logical_not(t446), t374, t373),  # 2, 4
-        xp.where(t447 & xp.logical_not(t448), t378, t377),  # 2, 5
-        t417,  # 3, 0
-        t439,  # 3, 1
-        t442,  # 3, 2
-        xp.where(t449 & xp.logical_not(t450), t371, t370),  # 3, 3
-        xp.where(t452 & xp.logical_not(t453), t451, t381),  # 3, 4
-        xp.where(t454 & xp.logical_not(t455), t380, t379),  # 3, 5
-        t458,  # 4, 0
-        t461,  # 4, 1
-        t464,  # 4, 2
-        xp.where(t465 & xp.logical_not(t466), t385, t384),  # 4, 3
-        xp.where(t467 & xp.logical_not(t468), t390, t389),  # 4, 4
-        xp.where(t469 & xp.logical_not(t470), t394, t393),  # 4, 5
-        t458,  # 5, 0
-        t461,  # 5, 1
-        t464,  # 5, 2
-        xp.where(t471 & xp.logical_not(t472), t387, t386),  # 5, 3
-        xp.where(t474 & xp.logical_not(t475), t473, t397),  # 5, 4
-        xp.where(t476 & xp.logical_not(t477), t396, t395),  # 5, 5
-        t458,  # 6, 0
-        t480,  # 6, 1
-        t483,  # 6, 2
-        xp.where(t484 & xp.logical_not(t485), t401, t400),  # 6, 3
-        xp.where(t486 & xp.logical_not(t487), t406, t405),  # 6, 4
-        xp.where(t488 & xp.logical_not(t489), t410, t409),  # 6, 5
-        t458,  # 7, 0
-        t480,  # 7, 1
-        t483,  # 7, 2
-        xp.where(t490 & xp.logical_not(t491), t403, t402),  # 7, 3
-        xp.where(t493 & xp.logical_not(t494), t492, t413),  # 7, 4
-        xp.where(t495 & xp.logical_not(t496), t412, t411),  # 7, 5
+        t416,  # 0, 0
+        t419,  # 0, 1
+        t422,  # 0, 2
+        xp.where(t423 & xp.logical_not(t424), t352, t351),  # 0, 3
+        xp.where(t425 & xp.logical_not(t426), t357, t356),  # 0, 4
+        xp.where(t427 & xp.logical_not(t428), t361, t360),  # 0, 5
+        t416,  # 1, 0
+        t419,  # 1, 1
+        t422,  # 1, 2
+        xp.where(t429 & xp.logical_not(t430), t354, t353),  # 1, 3
+        xp.where(t432 & xp.logical_not(t433), t431, t364),  # 1, 4
+        xp.where(t434 & xp.logical_not(t435), t363, t362),  # 1, 5
+        t416,  # 2, 0
+        t438,  # 2, 1
+        t441,  # 2, 2
+        xp.where(t442 & xp.logical_not(t443), t368, t367),  # 2, 3
+        xp.where(t444 & xp.logical_not(t445), t373, t372),  # 2, 4
+        xp.where(t446 & xp.logical_not(t447), t377, t376),  # 2, 5
+        t416,  # 3, 0
+        t438,  # 3, 1
+        t441,  # 3, 2
+        xp.where(t448 & xp.logical_not(t449), t370, t369),  # 3, 3
+        xp.where(t451 & xp.logical_not(t452), t450, t380),  # 3, 4
+        xp.where(t453 & xp.logical_not(t454), t379, t378),  # 3, 5
+        t457,  # 4, 0
+        t460,  # 4, 1
+        t463,  # 4, 2
+        xp.where(t464 & xp.logical_not(t465), t384, t383),  # 4, 3
+        xp.where(t466 & xp.logical_not(t467), t389, t388),  # 4, 4
+        xp.where(t468 & xp.logical_not(t469), t393, t392),  # 4, 5
+        t457,  # 5, 0
+        t460,  # 5, 1
+        t463,  # 5, 2
+        xp.where(t470 & xp.logical_not(t471), t386, t385),  # 5, 3
+        xp.where(t473 & xp.logical_not(t474), t472, t396),  # 5, 4
+        xp.where(t475 & xp.logical_not(t476), t395, t394),  # 5, 5
+        t457,  # 6, 0
+        t479,  # 6, 1
+        t482,  # 6, 2
+        xp.where(t483 & xp.logical_not(t484), t400, t399),  # 6, 3
+        xp.where(t485 & xp.logical_not(t486), t405, t404),  # 6, 4
+        xp.where(t487 & xp.logical_not(t488), t409, t408),  # 6, 5
+        t457,  # 7, 0
+        t479,  # 7, 1
+        t482,  # 7, 2
+        xp.where(t489 & xp.logical_not(t490), t402, t401),  # 7, 3
+        xp.where(t492 & xp.logical_not(t493), t491, t412),  # 7, 4
+        xp.where(t494 & xp.logical_not(t495), t411, t410),  # 7, 5
     ], (8, 6))
     valid = _stack(xp, [
-        t497 & t499 & t500 & xp.greater_equal(t118, -1e-12),  # 0
-        t497 & t499 & t500 & t119,  # 1
-        t59 & t497 & t499 & xp.greater_equal(t168, -1e-12),  # 2
-        t59 & t497 & t499 & t169,  # 3
-        t497 & t498 & t501 & xp.greater_equal(t270, -1e-12),  # 4
-        t497 & t498 & t501 & t271,  # 5
-        t497 & t498 & t211 & xp.greater_equal(t320, -1e-12),  # 6
-        t497 & t498 & t211 & t321,  # 7
+        t496 & xp.greater_equal(t117, -1e-12) & t498 & t499,  # 0
+        t496 & t118 & t498 & t499,  # 1
+        t496 & t58 & xp.greater_equal(t167, -1e-12) & t498,  # 2
+        t496 & t58 & t168 & t498,  # 3
+        t496 & xp.greater_equal(t269, -1e-12) & t497 & t500,  # 4
+        t496 & t270 & t497 & t500,  # 5
+        t496 & t210 & xp.greater_equal(t319, -1e-12) & t497,  # 6
+        t496 & t210 & t320 & t497,  # 7
     ], (8,))
     in_limits = _stack(xp, [
-        t502 & t503 & t504 & (t424 | t425) & (t426 | t427) & (t428 | t429),  # 0
-        t502 & t503 & t504 & (t430 | t431) & (t433 | t434) & (t435 | t436),  # 1
-        t502 & t505 & t506 & (t443 | t444) & (t445 | t446) & (t447 | t448),  # 2
-        t502 & t505 & t506 & (t449 | t450) & (t452 | t453) & (t454 | t455),  # 3
-        t507 & t508 & t509 & (t465 | t466) & (t467 | t468) & (t469 | t470),  # 4
-        t507 & t508 & t509 & (t471 | t472) & (t474 | t475) & (t476 | t477),  # 5
-        t507 & t510 & t511 & (t484 | t485) & (t486 | t487) & (t488 | t489),  # 6
-        t507 & t510 & t511 & (t490 | t491) & (t493 | t494) & (t495 | t496),  # 7
+        t501 & t502 & t503 & (t423 | t424) & (t425 | t426) & (t427 | t428),  # 0
+        t501 & t502 & t503 & (t429 | t430) & (t434 | t435) & (t432 | t433),  # 1
+        t501 & t504 & t505 & (t442 | t443) & (t444 | t445) & (t446 | t447),  # 2
+        t501 & t504 & t505 & (t448 | t449) & (t453 | t454) & (t451 | t452),  # 3
+        t506 & t507 & t508 & (t464 | t465) & (t466 | t467) & (t468 | t469),  # 4
+        t506 & t507 & t508 & (t470 | t471) & (t475 | t476) & (t473 | t474),  # 5
+        t506 & t509 & t510 & (t483 | t484) & (t485 | t486) & (t487 | t488),  # 6
+        t506 & t509 & t510 & (t489 | t490) & (t494 | t495) & (t492 | t493),  # 7
     ], (8,))
     return q, valid, in_limits
 

@@ -47,7 +47,7 @@ void mico_jacobian(const mico_real q[MICO_DOF], mico_real J[6 * MICO_DOF]);
 void mico_fk_jacobian(const mico_real q[MICO_DOF], mico_real T[16], mico_real J[6 * MICO_DOF]);
 
 /* Geometric Jacobian in the tool frame (6 x DOF, rows vx vy vz wx wy wz).
- * Result: J: 6 x 6 row-major, element (r, c) at J[r * 6 + c]. 334 operations. */
+ * Result: J: 6 x 6 row-major, element (r, c) at J[r * 6 + c]. 330 operations. */
 void mico_jacobian_tool(const mico_real q[MICO_DOF], mico_real J[6 * MICO_DOF]);
 
 /* Task vector mu = (x, y, z, roll, pitch, yaw).
@@ -59,15 +59,15 @@ void mico_task(const mico_real q[MICO_DOF], mico_real mu[MICO_TASK_DIM]);
 void mico_task_jacobian(const mico_real q[MICO_DOF], mico_real J[MICO_TASK_DIM * MICO_DOF]);
 
 /* Fk, jacobian and bias_acceleration in one pass, sharing their terms.
- * Result: T: 4 x 4 row-major, element (r, c) at T[r * 4 + c]; J: 6 x 6 row-major, element (r, c) at J[r * 6 + c]; a[i], i < 6. 436 operations. */
+ * Result: T: 4 x 4 row-major, element (r, c) at T[r * 4 + c]; J: 6 x 6 row-major, element (r, c) at J[r * 6 + c]; a[i], i < 6. 434 operations. */
 void mico_fk_jacobian_dot(const mico_real q[MICO_DOF], const mico_real q_dot[MICO_DOF], mico_real T[16], mico_real J[6 * MICO_DOF], mico_real a[6]);
 
 /* Time derivative dJ/dt of the world geometric Jacobian along q_dot (6 x DOF).
- * Result: Jd: 6 x 6 row-major, element (r, c) at Jd[r * 6 + c]. 318 operations. */
+ * Result: Jd: 6 x 6 row-major, element (r, c) at Jd[r * 6 + c]. 316 operations. */
 void mico_jacobian_dot(const mico_real q[MICO_DOF], const mico_real q_dot[MICO_DOF], mico_real Jd[6 * MICO_DOF]);
 
 /* J' q_dot: the tool's classical linear and angular acceleration at zero joint acceleration, world frame (6).
- * Result: a[i], i < 6. 373 operations. */
+ * Result: a[i], i < 6. 371 operations. */
 void mico_bias_acceleration(const mico_real q[MICO_DOF], const mico_real q_dot[MICO_DOF], mico_real a[6]);
 
 /* Time derivative of the analytic Jacobian along q_dot (6 x DOF): mu'' = J_a q'' + J_a' q'.
@@ -79,15 +79,15 @@ void mico_task_jacobian_dot(const mico_real q[MICO_DOF], const mico_real q_dot[M
 void mico_hessian(const mico_real q[MICO_DOF], mico_real H[MICO_DOF * 6 * MICO_DOF]);
 
 /* Factors of det(Js): the robot is singular where one is 0.
- * Result: f[i], i < 1. 58 operations. */
+ * Result: f[i], i < 1. 57 operations. */
 void mico_singularity_factors(const mico_real q[MICO_DOF], mico_real f[MICO_NUM_SINGULARITY_FACTORS]);
 
 /* Manipulability |det(Js)|.
- * Result: returned as a scalar. 55 operations. */
+ * Result: returned as a scalar. 54 operations. */
 mico_real mico_manipulability(const mico_real q[MICO_DOF]);
 
 /* Det(Js).
- * Result: returned as a scalar. 54 operations. */
+ * Result: returned as a scalar. 53 operations. */
 mico_real mico_jacobian_det(const mico_real q[MICO_DOF]);
 
 /* Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status.
@@ -99,7 +99,7 @@ int mico_velocity_ik(const mico_real q[MICO_DOF], const mico_real mu_dot[MICO_TA
 mico_real mico_ik_numeric_step(const mico_real target[16], const mico_real q[MICO_DOF], mico_real damping, mico_real q_start[MICO_DOF], mico_real q_next[MICO_DOF]);
 
 /* The general 6R solver's equations at T: (P0 + s Ps + c Pc) v_bc = Q v_gh, P = [P0; Ps; Pc] (42 x 9).
- * Result: P: 42 x 9 row-major, element (r, c) at P[r * 9 + c]; Q: 14 x 8 row-major, element (r, c) at Q[r * 8 + c]. 332 operations. */
+ * Result: P: 42 x 9 row-major, element (r, c) at P[r * 9 + c]; Q: 14 x 8 row-major, element (r, c) at Q[r * 8 + c]. 319 operations. */
 void mico_ik_general_equations(const mico_real T[16], mico_real P[378], mico_real Q[112]);
 
 /* The configuration of one root's loop angles (a - shift, b, c, g, h; the loop's free joint from the loop).

@@ -61,15 +61,15 @@ void panda_task(const panda_real q[PANDA_DOF], panda_real mu[PANDA_TASK_DIM]);
 void panda_task_jacobian(const panda_real q[PANDA_DOF], panda_real J[PANDA_TASK_DIM * PANDA_DOF]);
 
 /* Fk, jacobian and bias_acceleration in one pass, sharing their terms.
- * Result: T: 4 x 4 row-major, element (r, c) at T[r * 4 + c]; J: 6 x 7 row-major, element (r, c) at J[r * 7 + c]; a[i], i < 6. 463 operations. */
+ * Result: T: 4 x 4 row-major, element (r, c) at T[r * 4 + c]; J: 6 x 7 row-major, element (r, c) at J[r * 7 + c]; a[i], i < 6. 461 operations. */
 void panda_fk_jacobian_dot(const panda_real q[PANDA_DOF], const panda_real q_dot[PANDA_DOF], panda_real T[16], panda_real J[6 * PANDA_DOF], panda_real a[6]);
 
 /* Time derivative dJ/dt of the world geometric Jacobian along q_dot (6 x DOF).
- * Result: Jd: 6 x 7 row-major, element (r, c) at Jd[r * 7 + c]. 356 operations. */
+ * Result: Jd: 6 x 7 row-major, element (r, c) at Jd[r * 7 + c]. 354 operations. */
 void panda_jacobian_dot(const panda_real q[PANDA_DOF], const panda_real q_dot[PANDA_DOF], panda_real Jd[6 * PANDA_DOF]);
 
 /* J' q_dot: the tool's classical linear and angular acceleration at zero joint acceleration, world frame (6).
- * Result: a[i], i < 6. 418 operations. */
+ * Result: a[i], i < 6. 416 operations. */
 void panda_bias_acceleration(const panda_real q[PANDA_DOF], const panda_real q_dot[PANDA_DOF], panda_real a[6]);
 
 /* Time derivative of the analytic Jacobian along q_dot (6 x DOF): mu'' = J_a q'' + J_a' q'.
@@ -81,11 +81,11 @@ void panda_task_jacobian_dot(const panda_real q[PANDA_DOF], const panda_real q_d
 void panda_hessian(const panda_real q[PANDA_DOF], panda_real H[PANDA_DOF * 6 * PANDA_DOF]);
 
 /* Factors of det(Js Js^T): the robot is singular where one is 0.
- * Result: f[i], i < 1. 740 operations. */
+ * Result: f[i], i < 1. 731 operations. */
 void panda_singularity_factors(const panda_real q[PANDA_DOF], panda_real f[PANDA_NUM_SINGULARITY_FACTORS]);
 
 /* Manipulability sqrt(det(Js Js^T)).
- * Result: returned as a scalar. 743 operations. */
+ * Result: returned as a scalar. 734 operations. */
 panda_real panda_manipulability(const panda_real q[PANDA_DOF]);
 
 /* Joint rates q_dot solving Js q_dot = mu_dot: Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status.
@@ -97,7 +97,7 @@ int panda_velocity_ik(const panda_real q[PANDA_DOF], const panda_real mu_dot[PAN
 panda_real panda_ik_numeric_step(const panda_real target[16], const panda_real q[PANDA_DOF], panda_real damping, panda_real q_start[PANDA_DOF], panda_real q_next[PANDA_DOF]);
 
 /* Every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits.
- * Result: q: 8 x 7 row-major, element (r, c) at q[r * 7 + c]; valid[i], i < 8; in_limits[i], i < 8. 1545 operations. */
+ * Result: q: 8 x 7 row-major, element (r, c) at q[r * 7 + c]; valid[i], i < 8; in_limits[i], i < 8. 1542 operations. */
 void panda_ik_branches(const panda_real T[16], panda_real q_free, panda_real q[PANDA_MAX_IK_SOLUTIONS * PANDA_DOF], int valid[PANDA_MAX_IK_SOLUTIONS], int in_limits[PANDA_MAX_IK_SOLUTIONS]);
 
 /* The closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status.

@@ -93,53 +93,53 @@ def fk(q):
     s7 = trig[..., 13]
     t0 = s1*s3
     t1 = c1*c3
-    t2 = -t0 + t1*c2
-    t3 = t1 - t0*c2
+    t2 = -t0 + c2*t1
+    t3 = t1 - c2*t0
     t4 = c3*s1
     t5 = c1*s3
-    t6 = t4 + t5*c2
-    t7 = t5 + t4*c2
+    t6 = t4 + c2*t5
+    t7 = t5 + c2*t4
     t8 = 0.316*s2
-    t9 = 0.0825*t2 + t8*c1
-    t10 = 0.0825*t7 + t8*s1
+    t9 = 0.0825*t2 + c1*t8
+    t10 = 0.0825*t7 + s1*t8
     t11 = c3*s2
     t12 = 0.316*c2 - 0.0825*t11
-    t13 = c2*s4 - t11*c4
-    t14 = c2*c4 + t11*s4
+    t13 = c2*s4 - c4*t11
+    t14 = c2*c4 + s4*t11
     t15 = c1*s2
-    t16 = t2*c4 + t15*s4
-    t17 = -t2*s4 + t15*c4
+    t16 = t2*c4 + s4*t15
+    t17 = -t2*s4 + c4*t15
     t18 = t16*c5 - t6*s5
     t19 = t16*s5 + t6*c5
     t20 = t17*s6 + t18*c6
     t21 = t17*c6 - t18*s6
     t22 = t19*s7 + t20*c7
     t23 = t19*c7 - t20*s7
-    t24 = 0.088*t20 - 0.21*t21
+    t24 = -0.21*t21 + 0.088*t20
     t25 = t24 + 0.384*t17
     t26 = t25 - 0.0825*t16
     t27 = t9 + t26
     t28 = s1*s2
-    t29 = t7*c4 + t28*s4
-    t30 = -t7*s4 + t28*c4
+    t29 = t7*c4 + s4*t28
+    t30 = -t7*s4 + c4*t28
     t31 = t29*c5 + t3*s5
     t32 = t3*c5 - t29*s5
     t33 = t30*s6 + t31*c6
     t34 = t30*c6 - t31*s6
     t35 = t33*c7 - t32*s7
     t36 = t32*c7 + t33*s7
-    t37 = 0.088*t33 - 0.21*t34
+    t37 = -0.21*t34 + 0.088*t33
     t38 = t37 + 0.384*t30
     t39 = t38 - 0.0825*t29
     t40 = t10 + t39
-    t41 = s2*s3
-    t42 = t13*c5 + t41*s5
-    t43 = -t13*s5 + t41*c5
+    t41 = s3*s2
+    t42 = t13*c5 + s5*t41
+    t43 = -t13*s5 + c5*t41
     t44 = t14*s6 + t42*c6
     t45 = t14*c6 - t42*s6
     t46 = t44*c7 - t43*s7
     t47 = t43*c7 + t44*s7
-    t48 = 0.088*t44 - 0.21*t45
+    t48 = -0.21*t45 + 0.088*t44
     t49 = t48 + 0.384*t14
     t50 = t49 - 0.0825*t13
     t51 = t12 + t50
@@ -195,46 +195,46 @@ def jacobian(q):
     s6 = trig[..., 11]
     t0 = s1*s3
     t1 = c1*c3
-    t2 = -t0 + t1*c2
-    t3 = t1 - t0*c2
+    t2 = -t0 + c2*t1
+    t3 = t1 - c2*t0
     t4 = c3*s1
     t5 = c1*s3
-    t6 = t4 + t5*c2
-    t7 = t5 + t4*c2
+    t6 = t4 + c2*t5
+    t7 = t5 + c2*t4
     t8 = c1*s2
     t9 = 0.0825*t2 + 0.316*t8
-    t10 = t2*c4 + t8*s4
-    t11 = -t2*s4 + t8*c4
+    t10 = t2*c4 + s4*t8
+    t11 = -t2*s4 + c4*t8
     t12 = t10*c5 - t6*s5
     t13 = t10*s5 + t6*c5
     t14 = t11*s6 + t12*c6
     t15 = t11*c6 - t12*s6
-    t16 = 0.088*t14 - 0.21*t15
+    t16 = -0.21*t15 + 0.088*t14
     t17 = t16 + 0.384*t11
     t18 = t17 - 0.0825*t10
     t19 = t9 + t18
     t20 = s1*s2
     t21 = 0.0825*t7 + 0.316*t20
-    t22 = t7*c4 + t20*s4
-    t23 = -t7*s4 + t20*c4
+    t22 = t7*c4 + s4*t20
+    t23 = -t7*s4 + c4*t20
     t24 = t22*c5 + t3*s5
     t25 = t3*c5 - t22*s5
     t26 = t23*s6 + t24*c6
     t27 = t23*c6 - t24*s6
-    t28 = 0.088*t26 - 0.21*t27
+    t28 = -0.21*t27 + 0.088*t26
     t29 = t28 + 0.384*t23
     t30 = t29 - 0.0825*t22
     t31 = t21 + t30
     t32 = c3*s2
     t33 = 0.316*c2 - 0.0825*t32
-    t34 = c2*s4 - t32*c4
-    t35 = c2*c4 + t32*s4
+    t34 = c2*s4 - c4*t32
+    t35 = c2*c4 + s4*t32
     t36 = s2*s3
-    t37 = t34*c5 + t36*s5
-    t38 = -t34*s5 + t36*c5
+    t37 = t34*c5 + s5*t36
+    t38 = -t34*s5 + c5*t36
     t39 = t35*s6 + t37*c6
     t40 = t35*c6 - t37*s6
-    t41 = 0.088*t39 - 0.21*t40
+    t41 = -0.21*t40 + 0.088*t39
     t42 = t41 + 0.384*t35
     t43 = t42 - 0.0825*t34
     t44 = t33 + t43
@@ -243,14 +243,14 @@ def jacobian(q):
     J = _stack(xp, [
         -t31,  # 0, 0
         t45,  # 0, 1
-        -t31*c2 + t46*s2,  # 0, 2
+        -t31*c2 + s2*t46,  # 0, 2
         -t43*t3 + t30*t36,  # 0, 3
         t23*t42 - t35*t29,  # 0, 4
         t38*t28 - t25*t41,  # 0, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 6
         t19,  # 1, 0
         t46,  # 1, 1
-        t19*c2 - t45*s2,  # 1, 2
+        t19*c2 - s2*t45,  # 1, 2
         -(t43*t6 + t18*t36),  # 1, 3
         t35*t17 - t11*t42,  # 1, 4
         -(t13*t41 + t38*t16),  # 1, 5
@@ -307,52 +307,52 @@ def fk_jacobian(q):
     s7 = trig[..., 13]
     t0 = s1*s3
     t1 = c1*c3
-    t2 = -t0 + t1*c2
-    t3 = t1 - t0*c2
+    t2 = -t0 + c2*t1
+    t3 = t1 - c2*t0
     t4 = c3*s1
     t5 = c1*s3
-    t6 = t4 + t5*c2
-    t7 = t5 + t4*c2
+    t6 = t4 + c2*t5
+    t7 = t5 + c2*t4
     t8 = c1*s2
     t9 = 0.0825*t2 + 0.316*t8
-    t10 = t2*c4 + t8*s4
-    t11 = -t2*s4 + t8*c4
+    t10 = t2*c4 + s4*t8
+    t11 = -t2*s4 + c4*t8
     t12 = t10*c5 - t6*s5
     t13 = t10*s5 + t6*c5
     t14 = t11*s6 + t12*c6
     t15 = t11*c6 - t12*s6
     t16 = t13*s7 + t14*c7
     t17 = t13*c7 - t14*s7
-    t18 = 0.088*t14 - 0.21*t15
+    t18 = -0.21*t15 + 0.088*t14
     t19 = t18 + 0.384*t11
     t20 = t19 - 0.0825*t10
     t21 = t9 + t20
     t22 = s1*s2
     t23 = 0.0825*t7 + 0.316*t22
-    t24 = t7*c4 + t22*s4
-    t25 = -t7*s4 + t22*c4
+    t24 = t7*c4 + s4*t22
+    t25 = -t7*s4 + c4*t22
     t26 = t24*c5 + t3*s5
     t27 = t3*c5 - t24*s5
     t28 = t25*s6 + t26*c6
     t29 = t25*c6 - t26*s6
     t30 = t28*c7 - t27*s7
     t31 = t27*c7 + t28*s7
-    t32 = 0.088*t28 - 0.21*t29
+    t32 = -0.21*t29 + 0.088*t28
     t33 = t32 + 0.384*t25
     t34 = t33 - 0.0825*t24
     t35 = t23 + t34
     t36 = c3*s2
     t37 = 0.316*c2 - 0.0825*t36
-    t38 = c2*s4 - t36*c4
-    t39 = c2*c4 + t36*s4
+    t38 = c2*s4 - c4*t36
+    t39 = c2*c4 + s4*t36
     t40 = s2*s3
-    t41 = t38*c5 + t40*s5
-    t42 = -t38*s5 + t40*c5
+    t41 = t38*c5 + s5*t40
+    t42 = -t38*s5 + c5*t40
     t43 = t39*s6 + t41*c6
     t44 = t39*c6 - t41*s6
     t45 = t43*c7 - t42*s7
     t46 = t42*c7 + t43*s7
-    t47 = 0.088*t43 - 0.21*t44
+    t47 = -0.21*t44 + 0.088*t43
     t48 = t47 + 0.384*t39
     t49 = t48 - 0.0825*t38
     t50 = t37 + t49
@@ -395,14 +395,14 @@ def fk_jacobian(q):
     J = _stack(xp, [
         -t35,  # 0, 0
         t67,  # 0, 1
-        -t35*c2 + t68*s2,  # 0, 2
+        -t35*c2 + s2*t68,  # 0, 2
         -t49*t3 + t34*t40,  # 0, 3
         t25*t48 - t39*t33,  # 0, 4
         t42*t32 - t27*t47,  # 0, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 6
         t21,  # 1, 0
         t68,  # 1, 1
-        t21*c2 - t67*s2,  # 1, 2
+        t21*c2 - s2*t67,  # 1, 2
         -(t49*t6 + t20*t40),  # 1, 3
         t39*t19 - t11*t48,  # 1, 4
         -(t13*t47 + t42*t18),  # 1, 5
@@ -459,53 +459,53 @@ def jacobian_tool(q):
     s7 = trig[..., 13]
     t0 = s1*s3
     t1 = c1*c3
-    t2 = -t0 + t1*c2
-    t3 = t1 - t0*c2
+    t2 = -t0 + c2*t1
+    t3 = t1 - c2*t0
     t4 = c3*s1
     t5 = c1*s3
-    t6 = t4 + t5*c2
-    t7 = t5 + t4*c2
+    t6 = t4 + c2*t5
+    t7 = t5 + c2*t4
     t8 = 0.316*s2
-    t9 = 0.0825*t2 + t8*c1
-    t10 = 0.0825*t7 + t8*s1
+    t9 = 0.0825*t2 + c1*t8
+    t10 = 0.0825*t7 + s1*t8
     t11 = c3*s2
     t12 = 0.316*c2 - 0.0825*t11
-    t13 = c2*s4 - t11*c4
-    t14 = c2*c4 + t11*s4
+    t13 = c2*s4 - c4*t11
+    t14 = c2*c4 + s4*t11
     t15 = c1*s2
-    t16 = t2*c4 + t15*s4
-    t17 = -t2*s4 + t15*c4
+    t16 = t2*c4 + s4*t15
+    t17 = -t2*s4 + c4*t15
     t18 = t16*c5 - t6*s5
     t19 = t16*s5 + t6*c5
     t20 = t17*s6 + t18*c6
     t21 = t17*c6 - t18*s6
     t22 = t19*s7 + t20*c7
     t23 = t19*c7 - t20*s7
-    t24 = 0.088*t20 - 0.21*t21
+    t24 = -0.21*t21 + 0.088*t20
     t25 = t24 + 0.384*t17
     t26 = t25 - 0.0825*t16
     t27 = t9 + t26
     t28 = s1*s2
-    t29 = t7*c4 + t28*s4
-    t30 = -t7*s4 + t28*c4
+    t29 = t7*c4 + s4*t28
+    t30 = -t7*s4 + c4*t28
     t31 = t29*c5 + t3*s5
     t32 = t3*c5 - t29*s5
     t33 = t30*s6 + t31*c6
     t34 = t30*c6 - t31*s6
     t35 = t33*c7 - t32*s7
     t36 = t32*c7 + t33*s7
-    t37 = 0.088*t33 - 0.21*t34
+    t37 = -0.21*t34 + 0.088*t33
     t38 = t37 + 0.384*t30
     t39 = t38 - 0.0825*t29
     t40 = t10 + t39
-    t41 = s2*s3
-    t42 = t13*c5 + t41*s5
-    t43 = -t13*s5 + t41*c5
+    t41 = s3*s2
+    t42 = t13*c5 + s5*t41
+    t43 = -t13*s5 + c5*t41
     t44 = t14*s6 + t42*c6
     t45 = t14*c6 - t42*s6
     t46 = t44*c7 - t43*s7
     t47 = t43*c7 + t44*s7
-    t48 = 0.088*t44 - 0.21*t45
+    t48 = -0.21*t45 + 0.088*t44
     t49 = t48 + 0.384*t14
     t50 = t49 - 0.0825*t13
     t51 = t12 + t50
@@ -522,8 +522,8 @@ def jacobian_tool(q):
     t62 = t60 + t61
     t63 = t60 - t61
     t64 = -(t27*c1 + t40*s1)
-    t65 = t51*c1
-    t66 = t51*s1
+    t65 = c1*t51
+    t66 = s1*t51
     t67 = -t40*c2 + t51*t28
     t68 = t27*c2 - t51*t15
     t69 = t40*t15 - t27*t28
@@ -561,16 +561,16 @@ def jacobian_tool(q):
         t62,  # 3, 0
         t58*c1 - t54*s1,  # 3, 1
         t62*c2 + t54*t15 + t58*t28,  # 3, 2
-        -(t58*t3 - t6*t54 + t62*t41),  # 3, 3
+        -(-t6*t54 + t58*t3 + t62*t41),  # 3, 3
         t17*t54 + t30*t58 + t14*t62,  # 3, 4
-        -(t32*t58 + t43*t62 - t19*t54),  # 3, 5
+        -(-t19*t54 + t32*t58 + t43*t62),  # 3, 5
         -(t21*t54 + t34*t58 + t45*t62),  # 3, 6
         t63,  # 4, 0
         t59*c1 - t55*s1,  # 4, 1
         t63*c2 + t55*t15 + t59*t28,  # 4, 2
-        -(t59*t3 - t6*t55 + t63*t41),  # 4, 3
+        -(-t6*t55 + t59*t3 + t63*t41),  # 4, 3
         t17*t55 + t30*t59 + t14*t63,  # 4, 4
-        -(t32*t59 + t43*t63 - t19*t55),  # 4, 5
+        -(-t19*t55 + t32*t59 + t43*t63),  # 4, 5
         -(t21*t55 + t34*t59 + t45*t63),  # 4, 6
         -t45,  # 5, 0
         t21*s1 - t34*c1,  # 5, 1
@@ -603,55 +603,55 @@ def task(q):
     s7 = trig[..., 13]
     t0 = s1*s3
     t1 = c1*c3
-    t2 = -t0 + t1*c2
-    t3 = t1 - t0*c2
+    t2 = -t0 + c2*t1
+    t3 = t1 - c2*t0
     t4 = c3*s1
     t5 = c1*s3
-    t6 = t4 + t5*c2
-    t7 = t5 + t4*c2
+    t6 = t4 + c2*t5
+    t7 = t5 + c2*t4
     t8 = 0.316*s2
-    t9 = 0.0825*t2 + t8*c1
-    t10 = 0.0825*t7 + t8*s1
+    t9 = 0.0825*t2 + c1*t8
+    t10 = 0.0825*t7 + s1*t8
     t11 = c3*s2
     t12 = 0.316*c2 - 0.0825*t11
-    t13 = c2*s4 - t11*c4
-    t14 = c2*c4 + t11*s4
+    t13 = c2*s4 - c4*t11
+    t14 = c2*c4 + s4*t11
     t15 = c1*s2
-    t16 = t2*c4 + t15*s4
-    t17 = -t2*s4 + t15*c4
+    t16 = t2*c4 + s4*t15
+    t17 = -t2*s4 + c4*t15
     t18 = t16*c5 - t6*s5
     t19 = t16*s5 + t6*c5
     t20 = t17*s6 + t18*c6
     t21 = t17*c6 - t18*s6
     t22 = t19*s7 + t20*c7
     t23 = t19*c7 - t20*s7
-    t24 = 0.088*t20 - 0.21*t21
+    t24 = -0.21*t21 + 0.088*t20
     t25 = t24 + 0.384*t17
     t26 = t25 - 0.0825*t16
     t27 = t9 + t26
     t28 = 0.7071067811865476*t22 - 0.7071067811865476*t23
     t29 = s1*s2
-    t30 = t7*c4 + t29*s4
-    t31 = -t7*s4 + t29*c4
+    t30 = t7*c4 + s4*t29
+    t31 = -t7*s4 + c4*t29
     t32 = t30*c5 + t3*s5
     t33 = t3*c5 - t30*s5
     t34 = t31*s6 + t32*c6
     t35 = t31*c6 - t32*s6
     t36 = t34*c7 - t33*s7
     t37 = t33*c7 + t34*s7
-    t38 = 0.088*t34 - 0.21*t35
+    t38 = -0.21*t35 + 0.088*t34
     t39 = t38 + 0.384*t31
     t40 = t39 - 0.0825*t30
     t41 = t10 + t40
     t42 = 0.7071067811865476*t36 + 0.7071067811865476*t37
-    t43 = s2*s3
-    t44 = t13*c5 + t43*s5
-    t45 = -t13*s5 + t43*c5
+    t43 = s3*s2
+    t44 = t13*c5 + s5*t43
+    t45 = -t13*s5 + c5*t43
     t46 = t14*s6 + t44*c6
     t47 = t14*c6 - t44*s6
     t48 = t46*c7 - t45*s7
     t49 = t45*c7 + t46*s7
-    t50 = 0.088*t46 - 0.21*t47
+    t50 = -0.21*t47 + 0.088*t46
     t51 = t50 + 0.384*t14
     t52 = t51 - 0.0825*t13
     t53 = t12 + t52
@@ -691,55 +691,55 @@ def task_jacobian(q):
     s7 = trig[..., 13]
     t0 = s1*s3
     t1 = c1*c3
-    t2 = -t0 + t1*c2
-    t3 = t1 - t0*c2
+    t2 = -t0 + c2*t1
+    t3 = t1 - c2*t0
     t4 = c3*s1
     t5 = c1*s3
-    t6 = t4 + t5*c2
-    t7 = t5 + t4*c2
+    t6 = t4 + c2*t5
+    t7 = t5 + c2*t4
     t8 = 0.316*s2
-    t9 = 0.0825*t2 + t8*c1
-    t10 = 0.0825*t7 + t8*s1
+    t9 = 0.0825*t2 + c1*t8
+    t10 = 0.0825*t7 + s1*t8
     t11 = c3*s2
     t12 = 0.316*c2 - 0.0825*t11
-    t13 = c2*s4 - t11*c4
-    t14 = c2*c4 + t11*s4
+    t13 = c2*s4 - c4*t11
+    t14 = c2*c4 + s4*t11
     t15 = c1*s2
-    t16 = t2*c4 + t15*s4
-    t17 = -t2*s4 + t15*c4
+    t16 = t2*c4 + s4*t15
+    t17 = -t2*s4 + c4*t15
     t18 = t16*c5 - t6*s5
     t19 = t16*s5 + t6*c5
     t20 = t17*s6 + t18*c6
     t21 = t17*c6 - t18*s6
     t22 = t19*s7 + t20*c7
     t23 = t19*c7 - t20*s7
-    t24 = 0.088*t20 - 0.21*t21
+    t24 = -0.21*t21 + 0.088*t20
     t25 = t24 + 0.384*t17
     t26 = t25 - 0.0825*t16
     t27 = t9 + t26
     t28 = 0.7071067811865476*t22 - 0.7071067811865476*t23
     t29 = s1*s2
-    t30 = t7*c4 + t29*s4
-    t31 = -t7*s4 + t29*c4
+    t30 = t7*c4 + s4*t29
+    t31 = -t7*s4 + c4*t29
     t32 = t30*c5 + t3*s5
     t33 = t3*c5 - t30*s5
     t34 = t31*s6 + t32*c6
     t35 = t31*c6 - t32*s6
     t36 = t34*c7 - t33*s7
     t37 = t33*c7 + t34*s7
-    t38 = 0.088*t34 - 0.21*t35
+    t38 = -0.21*t35 + 0.088*t34
     t39 = t38 + 0.384*t31
     t40 = t39 - 0.0825*t30
     t41 = t10 + t40
     t42 = 0.7071067811865476*t36 + 0.7071067811865476*t37
     t43 = s2*s3
-    t44 = t13*c5 + t43*s5
-    t45 = -t13*s5 + t43*c5
+    t44 = t13*c5 + s5*t43
+    t45 = -t13*s5 + c5*t43
     t46 = t14*s6 + t44*c6
     t47 = t14*c6 - t44*s6
     t48 = t46*c7 - t45*s7
     t49 = t45*c7 + t46*s7
-    t50 = 0.088*t46 - 0.21*t47
+    t50 = -0.21*t47 + 0.088*t46
     t51 = t50 + 0.384*t14
     t52 = t51 - 0.0825*t13
     t53 = t12 + t52
@@ -753,7 +753,7 @@ def task_jacobian(q):
     t61 = t58*(t59 - t60)
     t62 = t28*c1
     t63 = t42*s1
-    t64 = t58*(t62*s2 + t63*s2)
+    t64 = t58*(s2*t62 + s2*t63)
     t65 = t58*(t6*t28 - t42*t3)
     t66 = t58*(t17*t28 + t31*t42)
     t67 = t58*(t19*t28 - t33*t42)
@@ -762,14 +762,14 @@ def task_jacobian(q):
     J = _stack(xp, [
         -t41,  # 0, 0
         t55,  # 0, 1
-        -t41*c2 + t56*s2,  # 0, 2
+        -t41*c2 + s2*t56,  # 0, 2
         -t52*t3 + t40*t43,  # 0, 3
         t31*t51 - t14*t39,  # 0, 4
         t45*t38 - t33*t50,  # 0, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 6
         t27,  # 1, 0
         t56,  # 1, 1
-        t27*c2 - t55*s2,  # 1, 2
+        t27*c2 - s2*t55,  # 1, 2
         -(t52*t6 + t26*t43),  # 1, 3
         t14*t25 - t17*t51,  # 1, 4
         -(t19*t50 + t45*t24),  # 1, 5
@@ -790,7 +790,7 @@ def task_jacobian(q):
         t68,  # 3, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
         t69*(t62 + t63),  # 4, 1
-        t69*(t60*s2 - t59*s2),  # 4, 2
+        t69*(s2*t60 - s2*t59),  # 4, 2
         -t69*(t6*t42 + t28*t3),  # 4, 3
         t69*(t31*t28 - t17*t42),  # 4, 4
         -t69*(t19*t42 + t33*t28),  # 4, 5
@@ -807,7 +807,7 @@ def task_jacobian(q):
 
 
 def fk_jacobian_dot(q, q_dot):
-    """fk, jacobian and bias_acceleration in one pass, sharing their terms: (4 x 4 and 6 x 7 and 6 x 1), 463 operations."""
+    """fk, jacobian and bias_acceleration in one pass, sharing their terms: (4 x 4 and 6 x 7 and 6 x 1), 461 operations."""
     xp, dtype, device, batch, (q, q_dot,) = _arguments(("q", q, (7,)), ("q_dot", q_dot, (7,)))
     qd1 = q_dot[..., 0]
     qd2 = q_dot[..., 1]
@@ -834,57 +834,57 @@ def fk_jacobian_dot(q, q_dot):
     t0 = qd1 + c2*qd3
     t1 = s1*s3
     t2 = c1*c3
-    t3 = -t1 + t2*c2
-    t4 = t2 - t1*c2
+    t3 = -t1 + c2*t2
+    t4 = t2 - c2*t1
     t5 = c3*s1
     t6 = c1*s3
-    t7 = t5 + t6*c2
-    t8 = t6 + t5*c2
+    t7 = t5 + c2*t6
+    t8 = t6 + c2*t5
     t9 = c1*s2
     t10 = 0.0825*t3 + 0.316*t9
-    t11 = t3*c4 + t9*s4
-    t12 = -t3*s4 + t9*c4
+    t11 = t3*c4 + s4*t9
+    t12 = -t3*s4 + c4*t9
     t13 = t11*c5 - t7*s5
     t14 = t11*s5 + t7*c5
     t15 = t12*s6 + t13*c6
     t16 = t12*c6 - t13*s6
     t17 = t14*s7 + t15*c7
     t18 = t14*c7 - t15*s7
-    t19 = 0.088*t15 - 0.21*t16
+    t19 = -0.21*t16 + 0.088*t15
     t20 = t19 + 0.384*t12
     t21 = t20 - 0.0825*t11
     t22 = t10 + t21
     t23 = s1*s2
     t24 = 0.0825*t8 + 0.316*t23
-    t25 = t8*c4 + t23*s4
-    t26 = -t8*s4 + t23*c4
+    t25 = t8*c4 + s4*t23
+    t26 = -t8*s4 + c4*t23
     t27 = t25*c5 + t4*s5
     t28 = t4*c5 - t25*s5
     t29 = t26*s6 + t27*c6
     t30 = t26*c6 - t27*s6
     t31 = t29*c7 - t28*s7
     t32 = t28*c7 + t29*s7
-    t33 = 0.088*t29 - 0.21*t30
+    t33 = -0.21*t30 + 0.088*t29
     t34 = t33 + 0.384*t26
     t35 = t34 - 0.0825*t25
     t36 = t24 + t35
     t37 = c3*s2
     t38 = 0.316*c2 - 0.0825*t37
-    t39 = c2*s4 - t37*c4
-    t40 = c2*c4 + t37*s4
+    t39 = c2*s4 - c4*t37
+    t40 = c2*c4 + s4*t37
     t41 = s2*s3
-    t42 = t39*c5 + t41*s5
-    t43 = -t39*s5 + t41*c5
+    t42 = t39*c5 + s5*t41
+    t43 = -t39*s5 + c5*t41
     t44 = t40*s6 + t42*c6
     t45 = t40*c6 - t42*s6
     t46 = t44*c7 - t43*s7
     t47 = t43*c7 + t44*s7
-    t48 = 0.088*t44 - 0.21*t45
+    t48 = -0.21*t45 + 0.088*t44
     t49 = t48 + 0.384*t40
     t50 = t49 - 0.0825*t39
     t51 = t38 + t50
     t52 = 0.333 + t51
-    t53 = t0 - t41*qd4
+    t53 = t0 - qd4*t41
     t54 = t53 + t40*qd5
     t55 = 0.7071067811865476*t17
     t56 = 0.7071067811865476*t18
@@ -899,7 +899,7 @@ def fk_jacobian_dot(q, q_dot):
     t65 = t63 + t64
     t66 = t63 - t64
     t67 = t51*s1
-    t68 = -t36*c2 + t67*s2
+    t68 = -t36*c2 + s2*t67
     t69 = t68
     t70 = -t50*t4 + t35*t41
     t71 = t70
@@ -911,7 +911,7 @@ def fk_jacobian_dot(q, q_dot):
     t77 = t76 + t71*qd4
     t78 = t77 + t69*qd3
     t79 = t51*c1
-    t80 = t22*c2 - t79*s2
+    t80 = t22*c2 - s2*t79
     t81 = t80
     t82 = t50*t7 + t21*t41
     t83 = t82
@@ -937,13 +937,13 @@ def fk_jacobian_dot(q, q_dot):
     t103 = t102 + t94*qd3
     t104 = t103 - t92*qd2
     t105 = qd2*s1
-    t106 = -t105 + t9*qd3
+    t106 = -t105 + qd3*t9
     t107 = t106 + t7*qd4
     t108 = t107 + t12*qd5
     t109 = t90 + t51*t105
     t110 = t109 + t22*qd1
     t111 = c1*qd2
-    t112 = t111 + t23*qd3
+    t112 = t111 + qd3*t23
     t113 = t112 - t4*qd4
     t114 = t113 + t26*qd5
     t115 = t78 + t51*t111
@@ -1021,18 +1021,18 @@ def fk_jacobian_dot(q, q_dot):
         xp.broadcast_to(t125, batch),  # 5, 6
     ], (6, 7))
     a = _stack(xp, [
-        xp.broadcast_to(qd2*(t104*c1 - t67*qd1) + qd3*(-t90*c2 - t81*qd1 + t103*t23 + t94*t111) + qd4*(t83*t0 + t96*t112 - t102*t4 + t89*t41) + qd5*(t101*t26 + t98*t113 - t88*t40 - t85*t53) + qd6*(t87*t54 + t100*t114 - t100*t119 - t87*t121) - t110*qd1, batch),  # 0
-        xp.broadcast_to(t116*qd1 + qd2*(t104*s1 + t79*qd1) + qd3*(t78*c2 + t69*qd1 + t94*t105 - t103*t9) - qd4*(t102*t7 + t96*t106 - t71*t0 + t77*t41) + qd5*(t76*t40 + t73*t53 - t101*t12 - t98*t107) - qd6*(t100*t108 - t75*t54 + t100*t117 + t75*t121), batch),  # 1
-        xp.broadcast_to(-qd2*(t115*c1 + t109*s1) - qd3*(t78*t23 + t69*t111 + t81*t105 - t90*c1*s2) + qd4*(t77*t4 + t89*t7 - t71*t112 - t83*t106) + qd5*(t88*t12 + t85*t107 - t76*t26 - t73*t113) - qd6*(t75*t114 + t87*t108 + t87*t117 - t28*t75*qd6), batch),  # 2
-        xp.broadcast_to(qd3*(t111*c2 - t23*qd1) + qd4*(t4*t0 - t112*t41) + qd5*(t40*t113 - t26*t53) + qd6*(t28*t54 - t43*t114) + qd7*(t122*t30 - t120*t45) - t111*qd1, batch),  # 3
-        xp.broadcast_to(qd3*(t9*qd1 + t105*c2) + qd4*(t7*t0 + t106*t41) + qd5*(t12*t53 - t40*t107) + qd6*(t14*t54 + t43*t108) + qd7*(t45*t118 - t122*t16) - t105*qd1, batch),  # 4
-        xp.broadcast_to(-qd3*(t126*c1**2 + t126*s1**2) - qd4*(t7*t112 + t4*t106) + qd5*(t26*t107 - t12*t113) - qd6*(t14*t114 + t28*t108) + qd7*(t120*t16 - t30*t118), batch),  # 5
+        xp.broadcast_to(qd2*(t104*c1 - qd1*t67) + qd3*(-t90*c2 - t81*qd1 + t103*t23 + t94*t111) + qd4*(t83*t0 + t96*t112 - t102*t4 + t89*t41) + qd5*(t101*t26 + t98*t113 - t88*t40 - t85*t53) + qd6*(t87*t54 + t100*t114 - t100*t119 - t87*t121) - t110*qd1, batch),  # 0
+        xp.broadcast_to(t116*qd1 + qd2*(t104*s1 + qd1*t79) + qd3*(t78*c2 + t69*qd1 + t94*t105 - t103*t9) - qd4*(-t71*t0 + t102*t7 + t96*t106 + t77*t41) + qd5*(t76*t40 + t73*t53 - t101*t12 - t98*t107) - qd6*(-t75*t54 + t100*t108 + t100*t117 + t75*t121), batch),  # 1
+        xp.broadcast_to(-qd2*(t115*c1 + t109*s1) - qd3*(-t90*t9 + t78*t23 + t69*t111 + t81*t105) + qd4*(t77*t4 + t89*t7 - t71*t112 - t83*t106) + qd5*(t88*t12 + t85*t107 - t76*t26 - t73*t113) - qd6*(t75*t114 + t87*t108 - t75*t119 + t87*t117), batch),  # 2
+        xp.broadcast_to(qd3*(c2*t111 - qd1*t23) + qd4*(t4*t0 - t112*t41) + qd5*(t40*t113 - t26*t53) + qd6*(t28*t54 - t43*t114) + qd7*(t122*t30 - t120*t45) - qd1*t111, batch),  # 3
+        xp.broadcast_to(qd3*(qd1*t9 + c2*t105) + qd4*(t7*t0 + t106*t41) + qd5*(t12*t53 - t40*t107) + qd6*(t14*t54 + t43*t108) + qd7*(t45*t118 - t122*t16) - qd1*t105, batch),  # 4
+        xp.broadcast_to(-qd3*(c1**2*t126 + s1**2*t126) - qd4*(t7*t112 + t4*t106) + qd5*(t26*t107 - t12*t113) - qd6*(t14*t114 + t28*t108) + qd7*(t120*t16 - t30*t118), batch),  # 5
     ], (6,))
     return T, J, a
 
 
 def jacobian_dot(q, q_dot):
-    """time derivative dJ/dt of the world geometric Jacobian along q_dot (6 x DOF): (6 x 7), 356 operations."""
+    """time derivative dJ/dt of the world geometric Jacobian along q_dot (6 x DOF): (6 x 7), 354 operations."""
     xp, dtype, device, batch, (q, q_dot,) = _arguments(("q", q, (7,)), ("q_dot", q_dot, (7,)))
     qd1 = q_dot[..., 0]
     qd2 = q_dot[..., 1]
@@ -1056,38 +1056,38 @@ def jacobian_dot(q, q_dot):
     t0 = qd1 + c2*qd3
     t1 = s1*s3
     t2 = c1*c3
-    t3 = -t1 + t2*c2
-    t4 = t2 - t1*c2
+    t3 = -t1 + c2*t2
+    t4 = t2 - c2*t1
     t5 = c3*s1
     t6 = c1*s3
-    t7 = t5 + t6*c2
-    t8 = t6 + t5*c2
+    t7 = t5 + c2*t6
+    t8 = t6 + c2*t5
     t9 = 0.316*s2
-    t10 = 0.0825*t3 + t9*c1
-    t11 = 0.0825*t8 + t9*s1
+    t10 = 0.0825*t3 + c1*t9
+    t11 = 0.0825*t8 + s1*t9
     t12 = c3*s2
     t13 = 0.316*c2 - 0.0825*t12
-    t14 = c2*s4 - t12*c4
-    t15 = c2*c4 + t12*s4
+    t14 = c2*s4 - c4*t12
+    t15 = c2*c4 + s4*t12
     t16 = c1*s2
-    t17 = t3*c4 + t16*s4
-    t18 = -t3*s4 + t16*c4
+    t17 = t3*c4 + s4*t16
+    t18 = -t3*s4 + c4*t16
     t19 = t17*c5 - t7*s5
     t20 = t17*s5 + t7*c5
     t21 = t18*s6 + t19*c6
     t22 = t18*c6 - t19*s6
-    t23 = 0.088*t21 - 0.21*t22
+    t23 = -0.21*t22 + 0.088*t21
     t24 = t23 + 0.384*t18
     t25 = t24 - 0.0825*t17
     t26 = t10 + t25
     t27 = s1*s2
-    t28 = t8*c4 + t27*s4
-    t29 = -t8*s4 + t27*c4
+    t28 = t8*c4 + s4*t27
+    t29 = -t8*s4 + c4*t27
     t30 = t28*c5 + t4*s5
     t31 = t4*c5 - t28*s5
     t32 = t29*s6 + t30*c6
     t33 = t29*c6 - t30*s6
-    t34 = 0.088*t32 - 0.21*t33
+    t34 = -0.21*t33 + 0.088*t32
     t35 = t34 + 0.384*t29
     t36 = t35 - 0.0825*t28
     t37 = t11 + t36
@@ -1100,12 +1100,12 @@ def jacobian_dot(q, q_dot):
     t44 = t43 + t40*qd4
     t45 = t44 + t39*qd3
     t46 = t45 - t38*qd2
-    t47 = s2*s3
-    t48 = t14*c5 + t47*s5
-    t49 = -t14*s5 + t47*c5
+    t47 = s3*s2
+    t48 = t14*c5 + s5*t47
+    t49 = -t14*s5 + c5*t47
     t50 = t15*s6 + t48*c6
     t51 = t15*c6 - t48*s6
-    t52 = 0.088*t50 - 0.21*t51
+    t52 = -0.21*t51 + 0.088*t50
     t53 = t52 + 0.384*t15
     t54 = t53 - 0.0825*t14
     t55 = t13 + t54
@@ -1117,7 +1117,7 @@ def jacobian_dot(q, q_dot):
     t61 = t54*t7 + t25*t47
     t62 = t15*t24 - t18*t53
     t63 = t20*t52 + t49*t23
-    t64 = t0 - t47*qd4
+    t64 = t0 - qd4*t47
     t65 = t64 + t15*qd5
     t66 = t58*qd5 + t59*qd6
     t67 = t62*qd5 - t63*qd6
@@ -1126,13 +1126,13 @@ def jacobian_dot(q, q_dot):
     t70 = t68 + t56*qd3
     t71 = t69 + t60*qd3
     t72 = qd2*s1
-    t73 = -t72 + t16*qd3
+    t73 = -t72 + qd3*t16
     t74 = t73 + t7*qd4
     t75 = t74 + t18*qd5
     t76 = t71 + t55*t72
     t77 = t76 + t26*qd1
     t78 = c1*qd2
-    t79 = t78 + t27*qd3
+    t79 = t78 + qd3*t27
     t80 = t79 - t4*qd4
     t81 = t80 + t29*qd5
     t82 = t70 + t55*t78
@@ -1157,34 +1157,34 @@ def jacobian_dot(q, q_dot):
         xp.broadcast_to(t83, batch),  # 1, 0
         xp.broadcast_to(t46*s1 + t55*t91, batch),  # 1, 1
         xp.broadcast_to(t70*c2 + t56*qd1 + t39*t72 - t45*t16, batch),  # 1, 2
-        xp.broadcast_to(-(t44*t7 + t40*t73 - t57*t0 + t68*t47), batch),  # 1, 3
+        xp.broadcast_to(-(-t57*t0 + t44*t7 + t40*t73 + t68*t47), batch),  # 1, 3
         xp.broadcast_to(t66*t15 + t58*t64 - t43*t18 - t41*t74, batch),  # 1, 4
-        xp.broadcast_to(-(t42*t75 - t59*t65 + t42*t84 + t59*t88), batch),  # 1, 5
+        xp.broadcast_to(-(-t59*t65 + t42*t75 + t42*t84 + t59*t88), batch),  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
         xp.broadcast_to(-(t82*c1 + t76*s1), batch),  # 2, 1
-        xp.broadcast_to(-(t70*t27 + t56*t78 + t60*t72 - t71*c1*s2), batch),  # 2, 2
+        xp.broadcast_to(-(-t71*t16 + t70*t27 + t56*t78 + t60*t72), batch),  # 2, 2
         xp.broadcast_to(t68*t4 + t69*t7 - t57*t79 - t61*t73, batch),  # 2, 3
         xp.broadcast_to(t67*t18 + t62*t74 - t66*t29 - t58*t80, batch),  # 2, 4
-        xp.broadcast_to(-(t59*t81 + t63*t75 + t63*t84 - t31*t59*qd6), batch),  # 2, 5
+        xp.broadcast_to(-(t59*t81 + t63*t75 - t59*t86 + t63*t84), batch),  # 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
         xp.broadcast_to(-t91, batch),  # 3, 1
-        xp.broadcast_to(t78*c2 - t90*s2, batch),  # 3, 2
+        xp.broadcast_to(c2*t78 - s2*t90, batch),  # 3, 2
         xp.broadcast_to(t4*t0 - t79*t47, batch),  # 3, 3
         xp.broadcast_to(t15*t80 - t29*t64, batch),  # 3, 4
         xp.broadcast_to(t31*t65 - t49*t81, batch),  # 3, 5
         xp.broadcast_to(t89*t33 - t87*t51, batch),  # 3, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
         xp.broadcast_to(-t90, batch),  # 4, 1
-        xp.broadcast_to(t91*s2 + t72*c2, batch),  # 4, 2
+        xp.broadcast_to(s2*t91 + c2*t72, batch),  # 4, 2
         xp.broadcast_to(t7*t0 + t73*t47, batch),  # 4, 3
         xp.broadcast_to(t18*t64 - t15*t74, batch),  # 4, 4
         xp.broadcast_to(t20*t65 + t49*t75, batch),  # 4, 5
         xp.broadcast_to(t51*t85 - t89*t22, batch),  # 4, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 1
-        xp.broadcast_to(-(t92*c1**2 + t92*s1**2), batch),  # 5, 2
+        xp.broadcast_to(-(c1**2*t92 + s1**2*t92), batch),  # 5, 2
         xp.broadcast_to(-(t7*t79 + t4*t73), batch),  # 5, 3
         xp.broadcast_to(t29*t74 - t18*t80, batch),  # 5, 4
         xp.broadcast_to(-(t20*t81 + t31*t75), batch),  # 5, 5
@@ -1194,7 +1194,7 @@ def jacobian_dot(q, q_dot):
 
 
 def bias_acceleration(q, q_dot):
-    """J' q_dot: the tool's classical linear and angular acceleration at zero joint acceleration, world frame (6): (6 x 1), 418 operations."""
+    """J' q_dot: the tool's classical linear and angular acceleration at zero joint acceleration, world frame (6): (6 x 1), 416 operations."""
     xp, dtype, device, batch, (q, q_dot,) = _arguments(("q", q, (7,)), ("q_dot", q_dot, (7,)))
     qd1 = q_dot[..., 0]
     qd2 = q_dot[..., 1]
@@ -1219,38 +1219,38 @@ def bias_acceleration(q, q_dot):
     t0 = qd1 + c2*qd3
     t1 = s1*s3
     t2 = c1*c3
-    t3 = -t1 + t2*c2
-    t4 = t2 - t1*c2
+    t3 = -t1 + c2*t2
+    t4 = t2 - c2*t1
     t5 = c3*s1
     t6 = c1*s3
-    t7 = t5 + t6*c2
-    t8 = t6 + t5*c2
+    t7 = t5 + c2*t6
+    t8 = t6 + c2*t5
     t9 = 0.316*s2
-    t10 = 0.0825*t3 + t9*c1
-    t11 = 0.0825*t8 + t9*s1
+    t10 = 0.0825*t3 + c1*t9
+    t11 = 0.0825*t8 + s1*t9
     t12 = c3*s2
     t13 = 0.316*c2 - 0.0825*t12
-    t14 = c2*s4 - t12*c4
-    t15 = c2*c4 + t12*s4
+    t14 = c2*s4 - c4*t12
+    t15 = c2*c4 + s4*t12
     t16 = c1*s2
-    t17 = t3*c4 + t16*s4
-    t18 = -t3*s4 + t16*c4
+    t17 = t3*c4 + s4*t16
+    t18 = -t3*s4 + c4*t16
     t19 = t17*c5 - t7*s5
     t20 = t17*s5 + t7*c5
     t21 = t18*s6 + t19*c6
     t22 = t18*c6 - t19*s6
-    t23 = 0.088*t21 - 0.21*t22
+    t23 = -0.21*t22 + 0.088*t21
     t24 = t23 + 0.384*t18
     t25 = t24 - 0.0825*t17
     t26 = t10 + t25
     t27 = s1*s2
-    t28 = t8*c4 + t27*s4
-    t29 = -t8*s4 + t27*c4
+    t28 = t8*c4 + s4*t27
+    t29 = -t8*s4 + c4*t27
     t30 = t28*c5 + t4*s5
     t31 = t4*c5 - t28*s5
     t32 = t29*s6 + t30*c6
     t33 = t29*c6 - t30*s6
-    t34 = 0.088*t32 - 0.21*t33
+    t34 = -0.21*t33 + 0.088*t32
     t35 = t34 + 0.384*t29
     t36 = t35 - 0.0825*t28
     t37 = t11 + t36
@@ -1263,12 +1263,12 @@ def bias_acceleration(q, q_dot):
     t44 = t43 + t40*qd4
     t45 = t44 + t39*qd3
     t46 = t45 - t38*qd2
-    t47 = s2*s3
-    t48 = t14*c5 + t47*s5
-    t49 = -t14*s5 + t47*c5
+    t47 = s3*s2
+    t48 = t14*c5 + s5*t47
+    t49 = -t14*s5 + c5*t47
     t50 = t15*s6 + t48*c6
     t51 = t15*c6 - t48*s6
-    t52 = 0.088*t50 - 0.21*t51
+    t52 = -0.21*t51 + 0.088*t50
     t53 = t52 + 0.384*t15
     t54 = t53 - 0.0825*t14
     t55 = t13 + t54
@@ -1280,7 +1280,7 @@ def bias_acceleration(q, q_dot):
     t61 = t54*t7 + t25*t47
     t62 = t15*t24 - t18*t53
     t63 = t20*t52 + t49*t23
-    t64 = t0 - t47*qd4
+    t64 = t0 - qd4*t47
     t65 = t64 + t15*qd5
     t66 = t58*qd5 + t59*qd6
     t67 = t62*qd5 - t63*qd6
@@ -1289,13 +1289,13 @@ def bias_acceleration(q, q_dot):
     t70 = t68 + t56*qd3
     t71 = t69 + t60*qd3
     t72 = qd2*s1
-    t73 = -t72 + t16*qd3
+    t73 = -t72 + qd3*t16
     t74 = t73 + t7*qd4
     t75 = t74 + t18*qd5
     t76 = t71 + t55*t72
     t77 = t76 + t26*qd1
     t78 = c1*qd2
-    t79 = t78 + t27*qd3
+    t79 = t78 + qd3*t27
     t80 = t79 - t4*qd4
     t81 = t80 + t29*qd5
     t82 = t70 + t55*t78
@@ -1306,15 +1306,15 @@ def bias_acceleration(q, q_dot):
     t87 = t81 - t86
     t88 = t49*qd6
     t89 = t65 - t88
-    t90 = t55*qd1
+    t90 = qd1*t55
     t91 = qd2*s2
     a = _stack(xp, [
-        xp.broadcast_to(qd2*(t46*c1 - t90*s1) + qd3*(-t71*c2 - t60*qd1 + t45*t27 + t39*t78) + qd4*(t61*t0 + t40*t79 - t44*t4 + t69*t47) + qd5*(t43*t29 + t41*t80 - t67*t15 - t62*t64) + qd6*(t63*t65 + t42*t81 - t42*t86 - t63*t88) - t77*qd1, batch),  # 0
-        xp.broadcast_to(t83*qd1 + qd2*(t46*s1 + t90*c1) + qd3*(t70*c2 + t56*qd1 + t39*t72 - t45*t16) - qd4*(t44*t7 + t40*t73 - t57*t0 + t68*t47) + qd5*(t66*t15 + t58*t64 - t43*t18 - t41*t74) - qd6*(t42*t75 - t59*t65 + t42*t84 + t59*t88), batch),  # 1
-        xp.broadcast_to(-qd2*(t82*c1 + t76*s1) - qd3*(t70*t27 + t56*t78 + t60*t72 - t71*c1*s2) + qd4*(t68*t4 + t69*t7 - t57*t79 - t61*t73) + qd5*(t67*t18 + t62*t74 - t66*t29 - t58*t80) - qd6*(t59*t81 + t63*t75 + t63*t84 - t31*t59*qd6), batch),  # 2
-        xp.broadcast_to(qd3*(t78*c2 - t27*qd1) + qd4*(t4*t0 - t79*t47) + qd5*(t15*t80 - t29*t64) + qd6*(t31*t65 - t49*t81) + qd7*(t89*t33 - t87*t51) - t78*qd1, batch),  # 3
-        xp.broadcast_to(qd3*(t16*qd1 + t72*c2) + qd4*(t7*t0 + t73*t47) + qd5*(t18*t64 - t15*t74) + qd6*(t20*t65 + t49*t75) + qd7*(t51*t85 - t89*t22) - t72*qd1, batch),  # 4
-        xp.broadcast_to(-qd3*(t91*c1**2 + t91*s1**2) - qd4*(t7*t79 + t4*t73) + qd5*(t29*t74 - t18*t80) - qd6*(t20*t81 + t31*t75) + qd7*(t87*t22 - t33*t85), batch),  # 5
+        xp.broadcast_to(qd2*(t46*c1 - s1*t90) + qd3*(-t71*c2 - t60*qd1 + t45*t27 + t39*t78) + qd4*(t61*t0 + t40*t79 - t44*t4 + t69*t47) + qd5*(t43*t29 + t41*t80 - t67*t15 - t62*t64) + qd6*(t63*t65 + t42*t81 - t42*t86 - t63*t88) - t77*qd1, batch),  # 0
+        xp.broadcast_to(t83*qd1 + qd2*(t46*s1 + c1*t90) + qd3*(t70*c2 + t56*qd1 + t39*t72 - t45*t16) - qd4*(-t57*t0 + t44*t7 + t40*t73 + t68*t47) + qd5*(t66*t15 + t58*t64 - t43*t18 - t41*t74) - qd6*(-t59*t65 + t42*t75 + t42*t84 + t59*t88), batch),  # 1
+        xp.broadcast_to(-qd2*(t82*c1 + t76*s1) - qd3*(-t71*t16 + t70*t27 + t56*t78 + t60*t72) + qd4*(t68*t4 + t69*t7 - t57*t79 - t61*t73) + qd5*(t67*t18 + t62*t74 - t66*t29 - t58*t80) - qd6*(t59*t81 + t63*t75 - t59*t86 + t63*t84), batch),  # 2
+        xp.broadcast_to(qd3*(c2*t78 - qd1*t27) + qd4*(t4*t0 - t79*t47) + qd5*(t15*t80 - t29*t64) + qd6*(t31*t65 - t49*t81) + qd7*(t89*t33 - t87*t51) - qd1*t78, batch),  # 3
+        xp.broadcast_to(qd3*(qd1*t16 + c2*t72) + qd4*(t7*t0 + t73*t47) + qd5*(t18*t64 - t15*t74) + qd6*(t20*t65 + t49*t75) + qd7*(t51*t85 - t89*t22) - qd1*t72, batch),  # 4
+        xp.broadcast_to(-qd3*(c1**2*t91 + s1**2*t91) - qd4*(t7*t79 + t4*t73) + qd5*(t29*t74 - t18*t80) - qd6*(t20*t81 + t31*t75) + qd7*(t87*t22 - t33*t85), batch),  # 5
     ], (6,))
     return a
 
@@ -1346,43 +1346,43 @@ def task_jacobian_dot(q, q_dot):
     s7 = trig[..., 13]
     t0 = s1*s3
     t1 = c1*c3
-    t2 = -t0 + t1*c2
-    t3 = t1 - t0*c2
+    t2 = -t0 + c2*t1
+    t3 = t1 - c2*t0
     t4 = c3*s1
     t5 = c1*s3
-    t6 = t4 + t5*c2
-    t7 = t5 + t4*c2
+    t6 = t4 + c2*t5
+    t7 = t5 + c2*t4
     t8 = 0.316*s2
-    t9 = 0.0825*t2 + t8*c1
-    t10 = 0.0825*t7 + t8*s1
+    t9 = 0.0825*t2 + c1*t8
+    t10 = 0.0825*t7 + s1*t8
     t11 = c3*s2
     t12 = 0.316*c2 - 0.0825*t11
-    t13 = c2*s4 - t11*c4
-    t14 = c2*c4 + t11*s4
+    t13 = c2*s4 - c4*t11
+    t14 = c2*c4 + s4*t11
     t15 = c1*s2
-    t16 = t2*c4 + t15*s4
-    t17 = -t2*s4 + t15*c4
+    t16 = t2*c4 + s4*t15
+    t17 = -t2*s4 + c4*t15
     t18 = t16*c5 - t6*s5
     t19 = t16*s5 + t6*c5
     t20 = t17*s6 + t18*c6
     t21 = t17*c6 - t18*s6
     t22 = t19*s7 + t20*c7
     t23 = t19*c7 - t20*s7
-    t24 = 0.088*t20 - 0.21*t21
+    t24 = -0.21*t21 + 0.088*t20
     t25 = t24 + 0.384*t17
     t26 = t25 - 0.0825*t16
     t27 = t9 + t26
     t28 = 0.7071067811865476*t22 - 0.7071067811865476*t23
     t29 = s1*s2
-    t30 = t7*c4 + t29*s4
-    t31 = -t7*s4 + t29*c4
+    t30 = t7*c4 + s4*t29
+    t31 = -t7*s4 + c4*t29
     t32 = t30*c5 + t3*s5
     t33 = t3*c5 - t30*s5
     t34 = t31*s6 + t32*c6
     t35 = t31*c6 - t32*s6
     t36 = t34*c7 - t33*s7
     t37 = t33*c7 + t34*s7
-    t38 = 0.088*t34 - 0.21*t35
+    t38 = -0.21*t35 + 0.088*t34
     t39 = t38 + 0.384*t31
     t40 = t39 - 0.0825*t30
     t41 = t10 + t40
@@ -1396,14 +1396,14 @@ def task_jacobian_dot(q, q_dot):
     t49 = t48 + t45*qd4
     t50 = t49 + t44*qd3
     t51 = t50 - t43*qd2
-    t52 = s2*s3
-    t53 = t13*c5 + t52*s5
-    t54 = -t13*s5 + t52*c5
+    t52 = s3*s2
+    t53 = t13*c5 + s5*t52
+    t54 = -t13*s5 + c5*t52
     t55 = t14*s6 + t53*c6
     t56 = t14*c6 - t53*s6
     t57 = t55*c7 - t54*s7
     t58 = t54*c7 + t55*s7
-    t59 = 0.088*t55 - 0.21*t56
+    t59 = -0.21*t56 + 0.088*t55
     t60 = t59 + 0.384*t14
     t61 = t60 - 0.0825*t13
     t62 = t12 + t61
@@ -1426,8 +1426,8 @@ def task_jacobian_dot(q, q_dot):
     t79 = t77 + t62*t78
     t80 = t79 + t27*qd1
     t81 = t76*c2 + t64*qd1 + t44*t78 - t50*t15
-    t82 = t15*qd1 + t78*c2
-    t83 = -t78 + t15*qd3
+    t82 = qd1*t15 + c2*t78
+    t83 = -t78 + qd3*t15
     t84 = t83
     t85 = c1*qd2
     t86 = t76 + t62*t85
@@ -1435,8 +1435,8 @@ def task_jacobian_dot(q, q_dot):
     t88 = -t77*c2 - t68*qd1 + t50*t29 + t44*t85
     t89 = t86*c1 + t79*s1
     t90 = t76*t29 + t64*t85 + t68*t78 - t77*t15
-    t91 = t85*c2 - t29*qd1
-    t92 = t85 + t29*qd3
+    t91 = c2*t85 - qd1*t29
+    t92 = t85 + qd3*t29
     t93 = t92
     t94 = t74*t3 + t75*t6 - t65*t93 - t69*t84
     t95 = t6*t93 + t3*t84
@@ -1452,7 +1452,7 @@ def task_jacobian_dot(q, q_dot):
     t105 = t93 + t104
     t106 = t73*t17 + t70*t103 - t72*t31 - t66*t105
     t107 = t31*t103 - t17*t105
-    t108 = -t52*qd4
+    t108 = -qd4*t52
     t109 = t97 + t108
     t110 = t48*t31 + t46*t105 - t73*t14 - t70*t109
     t111 = t72*t14 + t66*t109 - t48*t17 - t46*t103
@@ -1469,13 +1469,13 @@ def task_jacobian_dot(q, q_dot):
     t122 = t19*t120 + t54*t115
     t123 = t19*qd6
     t124 = t115 + t123
-    t125 = t83 + t102 + t114 + t123 - t21*qd7
+    t125 = t102 + t114 + t123 - t21*qd7 + t83
     t126 = t33*qd6
     t127 = t67*t117 + t71*t115 + t71*t123 - t67*t126
     t128 = -t126
     t129 = t117 + t128
     t130 = t129*t21 - t35*t124
-    t131 = t92 + t104 + t116 + t128 - t35*qd7
+    t131 = t104 + t116 + t128 - t35*qd7 + t92
     t132 = t125*t42 - t131*t28
     t133 = t54*qd6
     t134 = t71*t120 + t47*t117 - t47*t126 - t71*t133
@@ -1484,14 +1484,14 @@ def task_jacobian_dot(q, q_dot):
     t137 = t120 + t136
     t138 = t137*t35 - t129*t56
     t139 = t56*t124 - t137*t21
-    t140 = t96 + t108 + t119 + t136 - t56*qd7
+    t140 = t108 + t119 + t136 - t56*qd7 + t96
     t141 = t131*t63 - t140*t42
     t142 = t140*t28 - t125*t63
-    t143 = t62*qd1
-    t144 = t51*c1 - t143*s1
-    t145 = t51*s1 + t143*c1
+    t143 = qd1*t62
+    t144 = t51*c1 - s1*t143
+    t145 = t51*s1 + c1*t143
     t146 = qd2*s2
-    t147 = t146*c1**2 + t146*s1**2
+    t147 = c1**2*t146 + s1**2*t146
     t148 = t28**2 + t42**2
     t149 = 1/t148
     t150 = s1*t149
@@ -1503,15 +1503,15 @@ def task_jacobian_dot(q, q_dot):
     t156 = t28*t155
     t157 = c1*t149
     t158 = t42*t155
-    t159 = t28*qd1
-    t160 = t42*qd1
-    t161 = t157*s2
+    t159 = qd1*t28
+    t160 = qd1*t42
+    t161 = s2*t157
     t162 = t28*c1
     t163 = t42*s1
-    t164 = t162*s2 + t163*s2
-    t165 = t154*t164
+    t164 = s2*t162 + s2*t163
+    t165 = t164*t154
     t166 = t28*t165
-    t167 = t150*s2
+    t167 = s2*t150
     t168 = t42*t165
     t169 = t28*t149
     t170 = t91*t169
@@ -1519,7 +1519,7 @@ def task_jacobian_dot(q, q_dot):
     t172 = t82*t171
     t173 = t6*t149
     t174 = t6*t28 - t42*t3
-    t175 = t154*t174
+    t175 = t174*t154
     t176 = t28*t175
     t177 = t3*t149
     t178 = t42*t175
@@ -1527,7 +1527,7 @@ def task_jacobian_dot(q, q_dot):
     t180 = t101*t171
     t181 = t17*t149
     t182 = t17*t28 + t31*t42
-    t183 = t154*t182
+    t183 = t182*t154
     t184 = t28*t183
     t185 = t31*t149
     t186 = t42*t183
@@ -1535,7 +1535,7 @@ def task_jacobian_dot(q, q_dot):
     t188 = t113*t171
     t189 = t19*t149
     t190 = t19*t28 - t33*t42
-    t191 = t154*t190
+    t191 = t190*t154
     t192 = t28*t191
     t193 = t33*t149
     t194 = t42*t191
@@ -1543,7 +1543,7 @@ def task_jacobian_dot(q, q_dot):
     t196 = t122*t171
     t197 = t21*t149
     t198 = -(t21*t28 + t35*t42)
-    t199 = t154*t198
+    t199 = t198*t154
     t200 = t28*t199
     t201 = t35*t149
     t202 = t42*t199
@@ -1554,8 +1554,8 @@ def task_jacobian_dot(q, q_dot):
     t207 = 1/t148**1.5
     t208 = t207*(t162 + t163)
     t209 = s1*t205
-    t210 = t205*qd1
-    t211 = t207*(t152*s2 - t151*s2)
+    t210 = qd1*t205
+    t211 = t207*(s2*t152 - s2*t151)
     t212 = t28*t205
     t213 = t42*t205
     t214 = -t207*(t6*t42 + t28*t3)
@@ -1564,7 +1564,7 @@ def task_jacobian_dot(q, q_dot):
     t217 = t207*(t21*t42 - t35*t28)
     t218 = t63*t150
     t219 = t63*t157
-    t220 = t132*t149
+    t220 = t149*t132
     Jd = _stack(xp, [
         xp.broadcast_to(-t80, batch),  # 0, 0
         xp.broadcast_to(t144, batch),  # 0, 1
@@ -1596,13 +1596,13 @@ def task_jacobian_dot(q, q_dot):
         xp.broadcast_to(-t141*(t197 + t200) - t142*(t201 + t202) + t203 + t204, batch),  # 3, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
         xp.broadcast_to(t141*(t206 - t28*t208) + t142*(t209 - t42*t208) + t151*t210 - t152*t210, batch),  # 4, 1
-        xp.broadcast_to(t141*(t209*s2 - t28*t211) - t142*(t42*t211 + t206*s2) + t82*t212 - t91*t213, batch),  # 4, 2
+        xp.broadcast_to(t141*(s2*t209 - t28*t211) - t142*(t42*t211 + s2*t206) + t82*t212 - t91*t213, batch),  # 4, 2
         xp.broadcast_to(-t141*(t3*t205 + t28*t214) - t142*(t6*t205 + t42*t214) + t101*t212 - t100*t213, batch),  # 4, 3
         xp.broadcast_to(t141*(t31*t205 - t28*t215) - t142*(t17*t205 + t42*t215) + t113*t212 - t112*t213, batch),  # 4, 4
         xp.broadcast_to(-t141*(t33*t205 + t28*t216) - t142*(t19*t205 + t42*t216) + t122*t212 - t121*t213, batch),  # 4, 5
         xp.broadcast_to(-t141*(t35*t205 + t28*t217) + t142*(t21*t205 - t42*t217) + t139*t212 - t138*t213, batch),  # 4, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 0
-        xp.broadcast_to(t141*(t218 + t63*t156) + t142*(-t219 + t63*t158) - t153*t220 + t159*t219 + t160*t218, batch),  # 5, 1
+        xp.broadcast_to(t141*(t218 + t63*t156) + t142*(-t219 + t63*t158) - t153*t220 + t219*t159 + t218*t160, batch),  # 5, 1
         xp.broadcast_to(-(t147 - t141*(-t63*t161 + t63*t166) - t142*(-t63*t167 + t63*t168) + t164*t220 + t63*t170 + t63*t172), batch),  # 5, 2
         xp.broadcast_to(-(t95 - t141*(-t63*t173 + t63*t176) - t142*(t63*t177 + t63*t178) + t174*t220 + t63*t179 + t63*t180), batch),  # 5, 3
         xp.broadcast_to(t107 + t141*(-t63*t181 + t63*t184) + t142*(-t63*t185 + t63*t186) - t182*t220 - t63*t187 - t63*t188, batch),  # 5, 4
@@ -1630,33 +1630,33 @@ def hessian(q):
     s6 = trig[..., 11]
     t0 = s1*s3
     t1 = c1*c3
-    t2 = -t0 + t1*c2
-    t3 = t1 - t0*c2
+    t2 = -t0 + c2*t1
+    t3 = t1 - c2*t0
     t4 = c3*s1
     t5 = c1*s3
-    t6 = t4 + t5*c2
-    t7 = t5 + t4*c2
+    t6 = t4 + c2*t5
+    t7 = t5 + c2*t4
     t8 = c1*s2
     t9 = 0.0825*t2 + 0.316*t8
-    t10 = t2*c4 + t8*s4
-    t11 = -t2*s4 + t8*c4
+    t10 = t2*c4 + s4*t8
+    t11 = -t2*s4 + c4*t8
     t12 = t10*c5 - t6*s5
     t13 = t10*s5 + t6*c5
     t14 = t11*s6 + t12*c6
     t15 = t11*c6 - t12*s6
-    t16 = 0.088*t14 - 0.21*t15
+    t16 = -0.21*t15 + 0.088*t14
     t17 = t16 + 0.384*t11
     t18 = t17 - 0.0825*t10
     t19 = t9 + t18
     t20 = s1*s2
     t21 = 0.0825*t7 + 0.316*t20
-    t22 = t7*c4 + t20*s4
-    t23 = -t7*s4 + t20*c4
+    t22 = t7*c4 + s4*t20
+    t23 = -t7*s4 + c4*t20
     t24 = t22*c5 + t3*s5
     t25 = t3*c5 - t22*s5
     t26 = t23*s6 + t24*c6
     t27 = t23*c6 - t24*s6
-    t28 = 0.088*t26 - 0.21*t27
+    t28 = -0.21*t27 + 0.088*t26
     t29 = t28 + 0.384*t23
     t30 = t29 - 0.0825*t22
     t31 = t21 + t30
@@ -1667,14 +1667,14 @@ def hessian(q):
     t36 = t13*t28 + t25*t16
     t37 = c3*s2
     t38 = 0.316*c2 - 0.0825*t37
-    t39 = c2*s4 - t37*c4
-    t40 = c2*c4 + t37*s4
-    t41 = s2*s3
-    t42 = t39*c5 + t41*s5
-    t43 = -t39*s5 + t41*c5
+    t39 = c2*s4 - c4*t37
+    t40 = c2*c4 + s4*t37
+    t41 = s3*s2
+    t42 = t39*c5 + s5*t41
+    t43 = -t39*s5 + c5*t41
     t44 = t40*s6 + t42*c6
     t45 = t40*c6 - t42*s6
-    t46 = 0.088*t44 - 0.21*t45
+    t46 = -0.21*t45 + 0.088*t44
     t47 = t46 + 0.384*t40
     t48 = t47 - 0.0825*t39
     t49 = t38 + t48
@@ -1685,9 +1685,9 @@ def hessian(q):
     t54 = t40*t17 - t11*t47
     t55 = t13*t46 + t43*t16
     t56 = t49*s1
-    t57 = -t31*c2 + t56*s2
+    t57 = -t31*c2 + s2*t56
     t58 = t49*c1
-    t59 = t19*c2 - t58*s2
+    t59 = t19*c2 - s2*t58
     t60 = -t56
     t61 = -t59
     t62 = -t54
@@ -1791,14 +1791,14 @@ def hessian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 3, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 3, 1
         c1*c2,  # 1, 3, 2
-        -t5*s2,  # 1, 3, 3
+        -s2*t5,  # 1, 3, 3
         t40*c1,  # 1, 3, 4
         -t43*c1,  # 1, 3, 5
         -t45*c1,  # 1, 3, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 4, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 4, 1
         c2*s1,  # 1, 4, 2
-        -t0*s2,  # 1, 4, 3
+        -s2*t0,  # 1, 4, 3
         t40*s1,  # 1, 4, 4
         -t43*s1,  # 1, 4, 5
         -t45*s1,  # 1, 4, 6
@@ -1833,14 +1833,14 @@ def hessian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 3, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 3, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 3, 2
-        t3*c2 - t0*t86,  # 2, 3, 3
+        t3*c2 - t86*t0,  # 2, 3, 3
         -t23*c2 + t40*t20,  # 2, 3, 4
         t25*c2 - t43*t20,  # 2, 3, 5
         t27*c2 - t45*t20,  # 2, 3, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 4, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 4, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 4, 2
-        t6*c2 + t5*t86,  # 2, 4, 3
+        t6*c2 + t86*t5,  # 2, 4, 3
         t11*c2 - t40*t8,  # 2, 4, 4
         t13*c2 + t43*t8,  # 2, 4, 5
         -t15*c2 + t45*t8,  # 2, 4, 6
@@ -2024,7 +2024,7 @@ def hessian(q):
 
 
 def singularity_factors(q):
-    """factors of det(Js Js^T): the robot is singular where one is 0: (1 x 1), 740 operations."""
+    """factors of det(Js Js^T): the robot is singular where one is 0: (1 x 1), 731 operations."""
     xp, dtype, device, batch, (q,) = _arguments(("q", q, (7,)))
     trig = _cos_sin(xp, q, (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0), device)
     c1 = trig[..., 0]
@@ -2041,38 +2041,38 @@ def singularity_factors(q):
     s6 = trig[..., 11]
     t0 = s1*s3
     t1 = c1*c3
-    t2 = -t0 + t1*c2
-    t3 = t1 - t0*c2
+    t2 = -t0 + c2*t1
+    t3 = t1 - c2*t0
     t4 = c3*s1
     t5 = c1*s3
-    t6 = t4 + t5*c2
-    t7 = t5 + t4*c2
+    t6 = t4 + c2*t5
+    t7 = t5 + c2*t4
     t8 = 0.316*s2
-    t9 = 0.0825*t2 + t8*c1
-    t10 = 0.0825*t7 + t8*s1
+    t9 = 0.0825*t2 + c1*t8
+    t10 = 0.0825*t7 + s1*t8
     t11 = c3*s2
     t12 = 0.316*c2 - 0.0825*t11
-    t13 = c2*s4 - t11*c4
-    t14 = c2*c4 + t11*s4
+    t13 = c2*s4 - c4*t11
+    t14 = c2*c4 + s4*t11
     t15 = c1*s2
-    t16 = t2*c4 + t15*s4
-    t17 = -t2*s4 + t15*c4
+    t16 = t2*c4 + s4*t15
+    t17 = -t2*s4 + c4*t15
     t18 = t16*c5 - t6*s5
     t19 = t16*s5 + t6*c5
     t20 = t17*s6 + t18*c6
     t21 = t17*c6 - t18*s6
-    t22 = 0.088*t20 - 0.21*t21
+    t22 = -0.21*t21 + 0.088*t20
     t23 = t22 + 0.384*t17
     t24 = t23 - 0.0825*t16
     t25 = t9 + t24
     t26 = s1*s2
-    t27 = t7*c4 + t26*s4
-    t28 = -t7*s4 + t26*c4
+    t27 = t7*c4 + s4*t26
+    t28 = -t7*s4 + c4*t26
     t29 = t27*c5 + t3*s5
     t30 = t3*c5 - t27*s5
     t31 = t28*s6 + t29*c6
     t32 = t28*c6 - t29*s6
-    t33 = 0.088*t31 - 0.21*t32
+    t33 = -0.21*t32 + 0.088*t31
     t34 = t33 + 0.384*t28
     t35 = t34 - 0.0825*t27
     t36 = t10 + t35
@@ -2081,12 +2081,12 @@ def singularity_factors(q):
     t39 = t24*t3 + t35*t6
     t40 = t17*t34 - t28*t23
     t41 = t19*t33 + t30*t22
-    t42 = s2*s3
-    t43 = t13*c5 + t42*s5
-    t44 = -t13*s5 + t42*c5
+    t42 = s3*s2
+    t43 = t13*c5 + s5*t42
+    t44 = -t13*s5 + c5*t42
     t45 = t14*s6 + t43*c6
     t46 = t14*c6 - t43*s6
-    t47 = 0.088*t45 - 0.21*t46
+    t47 = -0.21*t46 + 0.088*t45
     t48 = t47 + 0.384*t14
     t49 = t48 - 0.0825*t13
     t50 = t12 + t49
@@ -2098,113 +2098,113 @@ def singularity_factors(q):
     t56 = t49*t6 + t24*t42
     t57 = t14*t23 - t17*t48
     t58 = t19*t47 + t44*t22
-    t59 = -t14*t3 + t28*t42
-    t60 = t14*t30 - t28*t44
-    t61 = t44*t3 - t30*t42
-    t62 = t19*t59 + t6*t60 - t17*t61
-    t63 = t17*c1
-    t64 = t19*c1
-    t65 = -t60*s1 + t44*t63 + t14*t64
-    t66 = t6*c1
-    t67 = t5*s2
-    t68 = -(s1*t59 + t14*t66 + t17*t67)
-    t69 = -(s1*t61 - t44*t6*c1 + t19*t67)
-    t70 = -(t37*t62 + t39*t65 + t41*t68 - t40*t69)
-    t71 = -t28*c2 + t14*t26
-    t72 = t30*c2 - t44*t26
-    t73 = t19*t71 - t17*t72 + t60*t15
-    t74 = c1**2
-    t75 = s2*t74
-    t76 = -(s1*t71 + t14*t75 - t17*c1*c2)
-    t77 = -t72*s1 + t64*c2 + t44*t75
-    t78 = -(t37*t73 + t38*t65 + t41*t76 - t40*t77)
+    t59 = t44*t3 - t30*t42
+    t60 = t6*c1
+    t61 = s2*t5
+    t62 = -(s1*t59 - t44*t60 + t19*t61)
+    t63 = -t14*t3 + t28*t42
+    t64 = t14*t30 - t28*t44
+    t65 = t19*t63 + t6*t64 - t17*t59
+    t66 = t17*c1
+    t67 = t19*c1
+    t68 = -s1*t64 + t44*t66 + t14*t67
+    t69 = -(s1*t63 + t14*t60 + t17*t61)
+    t70 = -(-t40*t62 + t37*t65 + t39*t68 + t41*t69)
+    t71 = t30*c2 - t44*t26
+    t72 = c1**2
+    t73 = s2*t72
+    t74 = -s1*t71 + c2*t67 + t44*t73
+    t75 = -t28*c2 + t14*t26
+    t76 = t19*t75 - t17*t71 + t64*t15
+    t77 = -(s1*t75 - c2*t66 + t14*t73)
+    t78 = -(-t40*t74 + t37*t76 + t38*t68 + t41*t77)
     t79 = s2**2
-    t80 = t3*c2 - t0*t79
-    t81 = t19*t80 - t6*t72 + t61*t15
-    t82 = -t80*s1 + t66*c2 + s3*t74*t79
-    t83 = -(t37*t81 + t38*t69 + t41*t82 - t39*t77)
-    t84 = t17*t80 - t6*t71 + t15*t59
-    t85 = -(t37*t84 + t38*t68 + t40*t82 - t39*t76)
-    t86 = t38*t62 + t40*t81 - t39*t73 - t41*t84
-    t87 = -(t19*t26 + t30*t15)
-    t88 = t30*s1 - t64
-    t89 = -(t75 + s2*s1**2)
-    t90 = t37*t87 + t38*t88 - t41*t89
-    t91 = t28*t15 - t17*t26
-    t92 = -(t63 + t28*s1)
-    t93 = t37*t91 + t38*t92 - t40*t89
-    t94 = -(t17*t30 + t28*t19)
-    t95 = t37*t94 + t40*t88 - t41*t92
-    t96 = -(t38*t94 + t41*t91 - t40*t87)
-    t97 = t50*s1
+    t80 = t3*c2 - t79*t0
+    t81 = t19*t80 - t6*t71 + t59*t15
+    t82 = -s1*t80 + c2*t60 + s3*t72*t79
+    t83 = -(-t39*t74 + t37*t81 + t38*t62 + t41*t82)
+    t84 = t17*t80 - t6*t75 + t63*t15
+    t85 = -(-t39*t77 + t37*t84 + t38*t69 + t40*t82)
+    t86 = t38*t65 + t40*t81 - t39*t76 - t41*t84
+    t87 = s1*t50
+    t88 = -(t17*t30 + t28*t19)
+    t89 = t30*s1 - t67
+    t90 = -(t66 + t28*s1)
+    t91 = t37*t88 + t40*t89 - t41*t90
+    t92 = -(t19*t26 + t30*t15)
+    t93 = -(t73 + s2*s1**2)
+    t94 = t37*t92 + t38*t89 - t41*t93
+    t95 = t28*t15 - t17*t26
+    t96 = t37*t95 + t38*t90 - t40*t93
+    t97 = -(-t40*t92 + t38*t88 + t41*t95)
     t98 = t17*t3 + t28*t6
-    t99 = t3*s1 - t66
-    t100 = t37*t98 + t39*t92 - t40*t99
+    t99 = t3*s1 - t60
+    t100 = t37*t98 + t39*t90 - t40*t99
     t101 = -(t6*t26 + t3*t15)
-    t102 = t37*t101 + t38*t99 - t39*t89
-    t103 = -(t38*t98 + t40*t101 - t39*t91)
+    t102 = t37*t101 + t38*t99 - t39*t93
+    t103 = -(-t39*t95 + t38*t98 + t40*t101)
     t104 = t19*t3 - t30*t6
-    t105 = t37*t104 + t39*t88 - t41*t99
-    t106 = -(t39*t94 + t41*t98 - t40*t104)
-    t107 = -(t38*t104 + t41*t101 - t39*t87)
-    t108 = t50*c1
-    t109 = -t36*(t55*t70 + t56*t78 + t57*t83 + t58*t85 - t50*s1*t86) - t52*(t57*t90 + t58*t93 - t25*t78 - t55*t95 + t96*t97) + t54*(t25*t85 + t55*t100 + t56*t93 + t57*t102 - t97*t103) + t51*(t56*t95 + t57*t105 + t58*t100 - t25*t70 + t97*t106) - t53*(t25*t83 + t55*t105 + t56*t90 - t58*t102 - t97*t107) - t108*(t55*t106 + t56*t96 + t57*t107 + t58*t103 - t25*t86)
+    t105 = t37*t104 + t39*t89 - t41*t99
+    t106 = -(-t40*t104 + t39*t88 + t41*t98)
+    t107 = -(-t39*t92 + t38*t104 + t41*t101)
+    t108 = c1*t50
+    t109 = -t36*(t55*t70 + t56*t78 + t57*t83 + t58*t85 - t86*t87) - t52*(-t25*t78 - t55*t91 + t57*t94 + t58*t96 + t97*t87) + t54*(t25*t85 + t55*t100 + t56*t96 + t57*t102 - t103*t87) + t51*(-t25*t70 + t56*t91 + t57*t105 + t58*t100 + t106*t87) - t53*(t25*t83 + t55*t105 + t56*t94 - t58*t102 - t107*t87) - (-t25*t86 + t55*t106 + t56*t97 + t57*t107 + t58*t103)*t108
     t110 = t46*t3 - t32*t42
-    t111 = t14*t32 - t28*t46
-    t112 = -(t17*t110 + t21*t59 - t6*t111)
-    t113 = t21*c1
-    t114 = -(s1*t111 + t14*t113 - t17*t46*c1)
-    t115 = -t110*s1 + t46*t66 + t21*t67
-    t116 = -(t37*t112 + t39*t114 - t40*t115)
+    t111 = -s1*t110 + t46*t60 + t21*t61
+    t112 = t14*t32 - t28*t46
+    t113 = -(-t6*t112 + t17*t110 + t21*t63)
+    t114 = t21*c1
+    t115 = -(s1*t112 - t46*t66 + t14*t114)
+    t116 = -(-t40*t111 + t37*t113 + t39*t115)
     t117 = t32*c2 - t46*t26
-    t118 = -(t17*t117 + t21*t71 - c1*s2*t111)
-    t119 = -(s1*t117 + t113*c2 - t46*s2*t74)
-    t120 = -(t37*t118 + t38*t114 - t40*t119)
-    t121 = -(t21*t80 + t6*t117 - c1*s2*t110)
-    t122 = -(t37*t121 + t38*t115 - t39*t119)
-    t123 = t38*t112 + t40*t121 - t39*t118
-    t124 = -(t55*t116 + t56*t120 + t57*t122 - t50*s1*t123)
+    t118 = -(s1*t117 - t46*t73 + c2*t114)
+    t119 = -(t17*t117 + t21*t75 - t112*t15)
+    t120 = -(-t40*t118 + t37*t119 + t38*t115)
+    t121 = -(t21*t80 + t6*t117 - t110*t15)
+    t122 = -(-t39*t118 + t37*t121 + t38*t111)
+    t123 = t38*t113 + t40*t121 - t39*t119
+    t124 = -(t55*t116 + t56*t120 + t57*t122 - t123*t87)
     t125 = t28*t21 - t17*t32
-    t126 = t113 + t32*s1
+    t126 = t114 + t32*s1
     t127 = t37*t125 + t40*t126
     t128 = t21*t26 - t32*t15
     t129 = t37*t128 + t38*t126
     t130 = t40*t128 - t38*t125
-    t131 = t25*t120 + t55*t127 - t57*t129 - t97*t130
+    t131 = t25*t120 + t55*t127 - t57*t129 - t130*t87
     t132 = -(t21*t3 + t32*t6)
     t133 = t37*t132 + t39*t126
     t134 = t40*t132 - t39*t125
-    t135 = -(t56*t127 + t57*t133 - t25*t116 + t97*t134)
+    t135 = -(-t25*t116 + t56*t127 + t57*t133 + t134*t87)
     t136 = t39*t128 - t38*t132
-    t137 = t25*t122 + t55*t133 + t56*t129 - t97*t136
-    t138 = -(t55*t134 + t56*t130 + t57*t136 - t25*t123)
-    t139 = t36*t124 + t52*t131 - t51*t135 - t53*t137 + t108*t138
+    t137 = t25*t122 + t55*t133 + t56*t129 - t136*t87
+    t138 = -(-t25*t123 + t55*t134 + t56*t130 + t57*t136)
+    t139 = t36*t124 + t52*t131 - t51*t135 - t53*t137 + t138*t108
     t140 = t30*t46 - t44*t32
-    t141 = -(t19*t110 + t21*t61 - t6*t140)
-    t142 = -t140*s1 + t46*t64 + t44*t113
-    t143 = -(t37*t141 + t39*t142 - t41*t115)
-    t144 = -(t19*t117 + t21*t72 - c1*s2*t140)
-    t145 = -(t37*t144 + t38*t142 - t41*t119)
+    t141 = -(-t6*t140 + t19*t110 + t21*t59)
+    t142 = -s1*t140 + t46*t67 + t44*t114
+    t143 = -(-t41*t111 + t37*t141 + t39*t142)
+    t144 = -(t19*t117 + t21*t71 - t140*t15)
+    t145 = -(-t41*t118 + t37*t144 + t38*t142)
     t146 = t38*t141 + t41*t121 - t39*t144
-    t147 = t58*t122 - t55*t143 - t56*t145 + t97*t146
+    t147 = t58*t122 - t55*t143 - t56*t145 + t146*t87
     t148 = -(t19*t32 + t30*t21)
     t149 = t37*t148 + t41*t126
     t150 = t41*t128 - t38*t148
-    t151 = t25*t145 + t55*t149 + t58*t129 - t97*t150
+    t151 = t25*t145 + t55*t149 + t58*t129 - t150*t87
     t152 = t41*t132 - t39*t148
-    t153 = t25*t143 + t58*t133 - t56*t149 - t152*t97
+    t153 = t25*t143 + t58*t133 - t56*t149 - t152*t87
     t154 = t25*t146 + t58*t136 - t55*t152 - t56*t150
     t155 = t36*t147 + t52*t151 - t51*t153 - t54*t137 + t154*t108
-    t156 = -(t19*t111 + t21*t60 - t17*t140)
-    t157 = -(t37*t156 + t40*t142 - t41*t114)
-    t158 = t38*t156 + t41*t118 - t40*t144
-    t159 = t57*t145 + t58*t120 - t55*t157 + t158*t97
+    t156 = -(-t17*t140 + t19*t112 + t21*t64)
+    t157 = -(-t41*t115 + t37*t156 + t40*t142)
+    t158 = t38*t156 + t41*t119 - t40*t144
+    t159 = t57*t145 + t58*t120 - t55*t157 + t158*t87
     t160 = t41*t125 - t40*t148
-    t161 = t25*t157 + t57*t149 + t58*t127 - t160*t97
+    t161 = t25*t157 + t57*t149 + t58*t127 - t160*t87
     t162 = t25*t158 + t57*t150 + t58*t130 - t55*t160
     t163 = t36*t159 + t53*t151 - t51*t161 - t54*t131 + t162*t108
-    t164 = t39*t156 + t41*t112 - t40*t141
-    t165 = t56*t157 + t57*t143 + t58*t116 + t164*t97
+    t164 = t39*t156 + t41*t113 - t40*t141
+    t165 = t56*t157 + t57*t143 + t58*t116 + t164*t87
     t166 = t25*t164 + t56*t160 + t57*t152 + t58*t134
     t167 = t36*t165 + t53*t153 - t52*t161 - t54*t135 + t166*t108
     t168 = t55*t164 + t56*t158 + t57*t146 + t58*t123
@@ -2217,7 +2217,7 @@ def singularity_factors(q):
 
 
 def manipulability(q):
-    """manipulability sqrt(det(Js Js^T)): (1 x 1), 743 operations."""
+    """manipulability sqrt(det(Js Js^T)): (1 x 1), 734 operations."""
     xp, dtype, device, batch, (q,) = _arguments(("q", q, (7,)))
     trig = _cos_sin(xp, q, (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0), device)
     c1 = trig[..., 0]
@@ -2234,38 +2234,38 @@ def manipulability(q):
     s6 = trig[..., 11]
     t0 = s1*s3
     t1 = c1*c3
-    t2 = -t0 + t1*c2
-    t3 = t1 - t0*c2
+    t2 = -t0 + c2*t1
+    t3 = t1 - c2*t0
     t4 = c3*s1
     t5 = c1*s3
-    t6 = t4 + t5*c2
-    t7 = t5 + t4*c2
+    t6 = t4 + c2*t5
+    t7 = t5 + c2*t4
     t8 = 0.316*s2
-    t9 = 0.0825*t2 + t8*c1
-    t10 = 0.0825*t7 + t8*s1
+    t9 = 0.0825*t2 + c1*t8
+    t10 = 0.0825*t7 + s1*t8
     t11 = c3*s2
     t12 = 0.316*c2 - 0.0825*t11
-    t13 = c2*s4 - t11*c4
-    t14 = c2*c4 + t11*s4
+    t13 = c2*s4 - c4*t11
+    t14 = c2*c4 + s4*t11
     t15 = c1*s2
-    t16 = t2*c4 + t15*s4
-    t17 = -t2*s4 + t15*c4
+    t16 = t2*c4 + s4*t15
+    t17 = -t2*s4 + c4*t15
     t18 = t16*c5 - t6*s5
     t19 = t16*s5 + t6*c5
     t20 = t17*s6 + t18*c6
     t21 = t17*c6 - t18*s6
-    t22 = 0.088*t20 - 0.21*t21
+    t22 = -0.21*t21 + 0.088*t20
     t23 = t22 + 0.384*t17
     t24 = t23 - 0.0825*t16
     t25 = t9 + t24
     t26 = s1*s2
-    t27 = t7*c4 + t26*s4
-    t28 = -t7*s4 + t26*c4
+    t27 = t7*c4 + s4*t26
+    t28 = -t7*s4 + c4*t26
     t29 = t27*c5 + t3*s5
     t30 = t3*c5 - t27*s5
     t31 = t28*s6 + t29*c6
     t32 = t28*c6 - t29*s6
-    t33 = 0.088*t31 - 0.21*t32
+    t33 = -0.21*t32 + 0.088*t31
     t34 = t33 + 0.384*t28
     t35 = t34 - 0.0825*t27
     t36 = t10 + t35
@@ -2274,12 +2274,12 @@ def manipulability(q):
     t39 = t24*t3 + t35*t6
     t40 = t17*t34 - t28*t23
     t41 = t19*t33 + t30*t22
-    t42 = s2*s3
-    t43 = t13*c5 + t42*s5
-    t44 = -t13*s5 + t42*c5
+    t42 = s3*s2
+    t43 = t13*c5 + s5*t42
+    t44 = -t13*s5 + c5*t42
     t45 = t14*s6 + t43*c6
     t46 = t14*c6 - t43*s6
-    t47 = 0.088*t45 - 0.21*t46
+    t47 = -0.21*t46 + 0.088*t45
     t48 = t47 + 0.384*t14
     t49 = t48 - 0.0825*t13
     t50 = t12 + t49
@@ -2291,113 +2291,113 @@ def manipulability(q):
     t56 = t49*t6 + t24*t42
     t57 = t14*t23 - t17*t48
     t58 = t19*t47 + t44*t22
-    t59 = -t14*t3 + t28*t42
-    t60 = t14*t30 - t28*t44
-    t61 = t44*t3 - t30*t42
-    t62 = t19*t59 + t6*t60 - t17*t61
-    t63 = t17*c1
-    t64 = t19*c1
-    t65 = -t60*s1 + t44*t63 + t14*t64
-    t66 = t6*c1
-    t67 = t5*s2
-    t68 = -(s1*t59 + t14*t66 + t17*t67)
-    t69 = -(s1*t61 - t44*t6*c1 + t19*t67)
-    t70 = -(t37*t62 + t39*t65 + t41*t68 - t40*t69)
-    t71 = -t28*c2 + t14*t26
-    t72 = t30*c2 - t44*t26
-    t73 = t19*t71 - t17*t72 + t60*t15
-    t74 = c1**2
-    t75 = s2*t74
-    t76 = -(s1*t71 + t14*t75 - t17*c1*c2)
-    t77 = -t72*s1 + t64*c2 + t44*t75
-    t78 = -(t37*t73 + t38*t65 + t41*t76 - t40*t77)
+    t59 = t44*t3 - t30*t42
+    t60 = t6*c1
+    t61 = s2*t5
+    t62 = -(s1*t59 - t44*t60 + t19*t61)
+    t63 = -t14*t3 + t28*t42
+    t64 = t14*t30 - t28*t44
+    t65 = t19*t63 + t6*t64 - t17*t59
+    t66 = t17*c1
+    t67 = t19*c1
+    t68 = -s1*t64 + t44*t66 + t14*t67
+    t69 = -(s1*t63 + t14*t60 + t17*t61)
+    t70 = -(-t40*t62 + t37*t65 + t39*t68 + t41*t69)
+    t71 = t30*c2 - t44*t26
+    t72 = c1**2
+    t73 = s2*t72
+    t74 = -s1*t71 + c2*t67 + t44*t73
+    t75 = -t28*c2 + t14*t26
+    t76 = t19*t75 - t17*t71 + t64*t15
+    t77 = -(s1*t75 - c2*t66 + t14*t73)
+    t78 = -(-t40*t74 + t37*t76 + t38*t68 + t41*t77)
     t79 = s2**2
-    t80 = t3*c2 - t0*t79
-    t81 = t19*t80 - t6*t72 + t61*t15
-    t82 = -t80*s1 + t66*c2 + s3*t74*t79
-    t83 = -(t37*t81 + t38*t69 + t41*t82 - t39*t77)
-    t84 = t17*t80 - t6*t71 + t15*t59
-    t85 = -(t37*t84 + t38*t68 + t40*t82 - t39*t76)
-    t86 = t38*t62 + t40*t81 - t39*t73 - t41*t84
-    t87 = -(t19*t26 + t30*t15)
-    t88 = t30*s1 - t64
-    t89 = -(t75 + s2*s1**2)
-    t90 = t37*t87 + t38*t88 - t41*t89
-    t91 = t28*t15 - t17*t26
-    t92 = -(t63 + t28*s1)
-    t93 = t37*t91 + t38*t92 - t40*t89
-    t94 = -(t17*t30 + t28*t19)
-    t95 = t37*t94 + t40*t88 - t41*t92
-    t96 = -(t38*t94 + t41*t91 - t40*t87)
-    t97 = t50*s1
+    t80 = t3*c2 - t79*t0
+    t81 = t19*t80 - t6*t71 + t59*t15
+    t82 = -s1*t80 + c2*t60 + s3*t72*t79
+    t83 = -(-t39*t74 + t37*t81 + t38*t62 + t41*t82)
+    t84 = t17*t80 - t6*t75 + t63*t15
+    t85 = -(-t39*t77 + t37*t84 + t38*t69 + t40*t82)
+    t86 = t38*t65 + t40*t81 - t39*t76 - t41*t84
+    t87 = s1*t50
+    t88 = -(t17*t30 + t28*t19)
+    t89 = t30*s1 - t67
+    t90 = -(t66 + t28*s1)
+    t91 = t37*t88 + t40*t89 - t41*t90
+    t92 = -(t19*t26 + t30*t15)
+    t93 = -(t73 + s2*s1**2)
+    t94 = t37*t92 + t38*t89 - t41*t93
+    t95 = t28*t15 - t17*t26
+    t96 = t37*t95 + t38*t90 - t40*t93
+    t97 = -(-t40*t92 + t38*t88 + t41*t95)
     t98 = t17*t3 + t28*t6
-    t99 = t3*s1 - t66
-    t100 = t37*t98 + t39*t92 - t40*t99
+    t99 = t3*s1 - t60
+    t100 = t37*t98 + t39*t90 - t40*t99
     t101 = -(t6*t26 + t3*t15)
-    t102 = t37*t101 + t38*t99 - t39*t89
-    t103 = -(t38*t98 + t40*t101 - t39*t91)
+    t102 = t37*t101 + t38*t99 - t39*t93
+    t103 = -(-t39*t95 + t38*t98 + t40*t101)
     t104 = t19*t3 - t30*t6
-    t105 = t37*t104 + t39*t88 - t41*t99
-    t106 = -(t39*t94 + t41*t98 - t40*t104)
-    t107 = -(t38*t104 + t41*t101 - t39*t87)
-    t108 = t50*c1
-    t109 = -t36*(t55*t70 + t56*t78 + t57*t83 + t58*t85 - t50*s1*t86) - t52*(t57*t90 + t58*t93 - t25*t78 - t55*t95 + t96*t97) + t54*(t25*t85 + t55*t100 + t56*t93 + t57*t102 - t97*t103) + t51*(t56*t95 + t57*t105 + t58*t100 - t25*t70 + t97*t106) - t53*(t25*t83 + t55*t105 + t56*t90 - t58*t102 - t97*t107) - t108*(t55*t106 + t56*t96 + t57*t107 + t58*t103 - t25*t86)
+    t105 = t37*t104 + t39*t89 - t41*t99
+    t106 = -(-t40*t104 + t39*t88 + t41*t98)
+    t107 = -(-t39*t92 + t38*t104 + t41*t101)
+    t108 = c1*t50
+    t109 = -t36*(t55*t70 + t56*t78 + t57*t83 + t58*t85 - t86*t87) - t52*(-t25*t78 - t55*t91 + t57*t94 + t58*t96 + t97*t87) + t54*(t25*t85 + t55*t100 + t56*t96 + t57*t102 - t103*t87) + t51*(-t25*t70 + t56*t91 + t57*t105 + t58*t100 + t106*t87) - t53*(t25*t83 + t55*t105 + t56*t94 - t58*t102 - t107*t87) - (-t25*t86 + t55*t106 + t56*t97 + t57*t107 + t58*t103)*t108
     t110 = t46*t3 - t32*t42
-    t111 = t14*t32 - t28*t46
-    t112 = -(t17*t110 + t21*t59 - t6*t111)
-    t113 = t21*c1
-    t114 = -(s1*t111 + t14*t113 - t17*t46*c1)
-    t115 = -t110*s1 + t46*t66 + t21*t67
-    t116 = -(t37*t112 + t39*t114 - t40*t115)
+    t111 = -s1*t110 + t46*t60 + t21*t61
+    t112 = t14*t32 - t28*t46
+    t113 = -(-t6*t112 + t17*t110 + t21*t63)
+    t114 = t21*c1
+    t115 = -(s1*t112 - t46*t66 + t14*t114)
+    t116 = -(-t40*t111 + t37*t113 + t39*t115)
     t117 = t32*c2 - t46*t26
-    t118 = -(t17*t117 + t21*t71 - c1*s2*t111)
-    t119 = -(s1*t117 + t113*c2 - t46*s2*t74)
-    t120 = -(t37*t118 + t38*t114 - t40*t119)
-    t121 = -(t21*t80 + t6*t117 - c1*s2*t110)
-    t122 = -(t37*t121 + t38*t115 - t39*t119)
-    t123 = t38*t112 + t40*t121 - t39*t118
-    t124 = -(t55*t116 + t56*t120 + t57*t122 - t50*s1*t123)
+    t118 = -(s1*t117 - t46*t73 + c2*t114)
+    t119 = -(t17*t117 + t21*t75 - t112*t15)
+    t120 = -(-t40*t118 + t37*t119 + t38*t115)
+    t121 = -(t21*t80 + t6*t117 - t110*t15)
+    t122 = -(-t39*t118 + t37*t121 + t38*t111)
+    t123 = t38*t113 + t40*t121 - t39*t119
+    t124 = -(t55*t116 + t56*t120 + t57*t122 - t123*t87)
     t125 = t28*t21 - t17*t32
-    t126 = t113 + t32*s1
+    t126 = t114 + t32*s1
     t127 = t37*t125 + t40*t126
     t128 = t21*t26 - t32*t15
     t129 = t37*t128 + t38*t126
     t130 = t40*t128 - t38*t125
-    t131 = t25*t120 + t55*t127 - t57*t129 - t97*t130
+    t131 = t25*t120 + t55*t127 - t57*t129 - t130*t87
     t132 = -(t21*t3 + t32*t6)
     t133 = t37*t132 + t39*t126
     t134 = t40*t132 - t39*t125
-    t135 = -(t56*t127 + t57*t133 - t25*t116 + t97*t134)
+    t135 = -(-t25*t116 + t56*t127 + t57*t133 + t134*t87)
     t136 = t39*t128 - t38*t132
-    t137 = t25*t122 + t55*t133 + t56*t129 - t97*t136
-    t138 = -(t55*t134 + t56*t130 + t57*t136 - t25*t123)
-    t139 = t36*t124 + t52*t131 - t51*t135 - t53*t137 + t108*t138
+    t137 = t25*t122 + t55*t133 + t56*t129 - t136*t87
+    t138 = -(-t25*t123 + t55*t134 + t56*t130 + t57*t136)
+    t139 = t36*t124 + t52*t131 - t51*t135 - t53*t137 + t138*t108
     t140 = t30*t46 - t44*t32
-    t141 = -(t19*t110 + t21*t61 - t6*t140)
-    t142 = -t140*s1 + t46*t64 + t44*t113
-    t143 = -(t37*t141 + t39*t142 - t41*t115)
-    t144 = -(t19*t117 + t21*t72 - c1*s2*t140)
-    t145 = -(t37*t144 + t38*t142 - t41*t119)
+    t141 = -(-t6*t140 + t19*t110 + t21*t59)
+    t142 = -s1*t140 + t46*t67 + t44*t114
+    t143 = -(-t41*t111 + t37*t141 + t39*t142)
+    t144 = -(t19*t117 + t21*t71 - t140*t15)
+    t145 = -(-t41*t118 + t37*t144 + t38*t142)
     t146 = t38*t141 + t41*t121 - t39*t144
-    t147 = t58*t122 - t55*t143 - t56*t145 + t97*t146
+    t147 = t58*t122 - t55*t143 - t56*t145 + t146*t87
     t148 = -(t19*t32 + t30*t21)
     t149 = t37*t148 + t41*t126
     t150 = t41*t128 - t38*t148
-    t151 = t25*t145 + t55*t149 + t58*t129 - t97*t150
+    t151 = t25*t145 + t55*t149 + t58*t129 - t150*t87
     t152 = t41*t132 - t39*t148
-    t153 = t25*t143 + t58*t133 - t56*t149 - t152*t97
+    t153 = t25*t143 + t58*t133 - t56*t149 - t152*t87
     t154 = t25*t146 + t58*t136 - t55*t152 - t56*t150
     t155 = t36*t147 + t52*t151 - t51*t153 - t54*t137 + t154*t108
-    t156 = -(t19*t111 + t21*t60 - t17*t140)
-    t157 = -(t37*t156 + t40*t142 - t41*t114)
-    t158 = t38*t156 + t41*t118 - t40*t144
-    t159 = t57*t145 + t58*t120 - t55*t157 + t158*t97
+    t156 = -(-t17*t140 + t19*t112 + t21*t64)
+    t157 = -(-t41*t115 + t37*t156 + t40*t142)
+    t158 = t38*t156 + t41*t119 - t40*t144
+    t159 = t57*t145 + t58*t120 - t55*t157 + t158*t87
     t160 = t41*t125 - t40*t148
-    t161 = t25*t157 + t57*t149 + t58*t127 - t160*t97
+    t161 = t25*t157 + t57*t149 + t58*t127 - t160*t87
     t162 = t25*t158 + t57*t150 + t58*t130 - t55*t160
     t163 = t36*t159 + t53*t151 - t51*t161 - t54*t131 + t162*t108
-    t164 = t39*t156 + t41*t112 - t40*t141
-    t165 = t56*t157 + t57*t143 + t58*t116 + t164*t97
+    t164 = t39*t156 + t41*t113 - t40*t141
+    t165 = t56*t157 + t57*t143 + t58*t116 + t164*t87
     t166 = t25*t164 + t56*t160 + t57*t152 + t58*t134
     t167 = t36*t165 + t53*t153 - t52*t161 - t54*t135 + t166*t108
     t168 = t55*t164 + t56*t158 + t57*t146 + t58*t123
@@ -2440,33 +2440,33 @@ def velocity_ik(q, mu_dot, damping=0.0):
     s6 = trig[..., 11]
     t0 = s1*s3
     t1 = c1*c3
-    t2 = -t0 + t1*c2
-    t3 = t1 - t0*c2
+    t2 = -t0 + c2*t1
+    t3 = t1 - c2*t0
     t4 = c3*s1
     t5 = c1*s3
-    t6 = t4 + t5*c2
-    t7 = t5 + t4*c2
+    t6 = t4 + c2*t5
+    t7 = t5 + c2*t4
     t8 = c1*s2
     t9 = 0.0825*t2 + 0.316*t8
-    t10 = t2*c4 + t8*s4
-    t11 = -t2*s4 + t8*c4
+    t10 = t2*c4 + s4*t8
+    t11 = -t2*s4 + c4*t8
     t12 = t10*c5 - t6*s5
     t13 = t10*s5 + t6*c5
     t14 = t11*s6 + t12*c6
     t15 = t11*c6 - t12*s6
-    t16 = 0.088*t14 - 0.21*t15
+    t16 = -0.21*t15 + 0.088*t14
     t17 = t16 + 0.384*t11
     t18 = t17 - 0.0825*t10
     t19 = t9 + t18
     t20 = s1*s2
     t21 = 0.0825*t7 + 0.316*t20
-    t22 = t7*c4 + t20*s4
-    t23 = -t7*s4 + t20*c4
+    t22 = t7*c4 + s4*t20
+    t23 = -t7*s4 + c4*t20
     t24 = t22*c5 + t3*s5
     t25 = t3*c5 - t22*s5
     t26 = t23*s6 + t24*c6
     t27 = t23*c6 - t24*s6
-    t28 = 0.088*t26 - 0.21*t27
+    t28 = -0.21*t27 + 0.088*t26
     t29 = t28 + 0.384*t23
     t30 = t29 - 0.0825*t22
     t31 = t21 + t30
@@ -2478,14 +2478,14 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t37 = t32**2 + t33**2 + t34**2 + t35**2 + t36**2
     t38 = c3*s2
     t39 = 0.316*c2 - 0.0825*t38
-    t40 = c2*s4 - t38*c4
-    t41 = c2*c4 + t38*s4
+    t40 = c2*s4 - c4*t38
+    t41 = c2*c4 + s4*t38
     t42 = s2*s3
-    t43 = t40*c5 + t42*s5
-    t44 = -t40*s5 + t42*c5
+    t43 = t40*c5 + s5*t42
+    t44 = -t40*s5 + c5*t42
     t45 = t41*s6 + t43*c6
     t46 = t41*c6 - t43*s6
-    t47 = 0.088*t45 - 0.21*t46
+    t47 = -0.21*t46 + 0.088*t45
     t48 = t47 + 0.384*t41
     t49 = t48 - 0.0825*t40
     t50 = t39 + t49
@@ -2496,13 +2496,13 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t55 = t41*t17 - t11*t48
     t56 = t13*t47 + t44*t16
     t57 = t41*t35 + t33*c2 - t44*t36 - t34*t42
-    t58 = t11*t41 + t15*t46 - t13*t44 + t8*c2 - t6*t42
-    t59 = t23*t41 + t25*t44 + t27*t46 + t3*t42 + t20*c2
+    t58 = t11*t41 + t15*t46 - t13*t44 + c2*t8 - t6*t42
+    t59 = t23*t41 + t25*t44 + t27*t46 + t3*t42 + c2*t20
     t60 = t50*s1
-    t61 = -t31*c2 + t60*s2
+    t61 = -t31*c2 + s2*t60
     t62 = t31 + t44*t53 - t41*t52 - t61*c2 + t51*t42
     t63 = t50*c1
-    t64 = t19*c2 - t63*s2
+    t64 = t19*c2 - s2*t63
     t65 = t19 + t41*t55 + t44*t56 + t64*c2 + t54*t42
     t66 = 1 + t11 + t23 + t41 + t13 + t19 + t6 + t61 + t51 + t52 + t53 + t64 + t55 + t33 + t34 + t35 + t36 + c1 + c2 + damping + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + q1 + q2 + q3 + q4 + q5 + q6 + q7 - t25 - t44 - t15 - t27 - t46 - t31 - t54 - t56 - t32 - t3 - s1 + t63 + t60 + t8 + t20 - t42
     t67 = t50**2
@@ -2525,7 +2525,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t84 = t11*t35 + t13*t36 + t6*t34 + t82 + t33*t8
     t85 = s2**2
     t86 = t11**2 + t13**2 + t15**2 + t6**2 + t79 + t68*t85
-    t87 = t11*t23 + t15*t27 - t13*t25 - t6*t3 - t71 + t71*t85
+    t87 = t11*t23 + t15*t27 - t13*t25 - t6*t3 - t71 + t85*t71
     t88 = t23**2 + t25**2 + t27**2 + t3**2 + t68 + t79*t85
     t89 = 1 + t41**2 + t44**2 + t46**2 + c2**2 + t85*s3**2
     t90 = damping**2
@@ -2548,7 +2548,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t107 = xp.where(xp.greater(t104, 0), 1/(t104*(t104 + xp.abs(t91))), 0)
     t108 = t107*(t72*t106 + t72*t93 + t70*t78 - t62*t65 - t74*t83 - t77*t81)
     t109 = t72 - t106*t108
-    t110 = t93 - t72*t108
+    t110 = -t72*t108 + t93
     t111 = t83 + t74*t108
     t112 = t81 + t77*t108
     t113 = t78 - t70*t108
@@ -2556,7 +2556,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t115 = t107*(t74*t106 + t74*t94 + t77*t84 - t72*t83 - t62*t57 - t70*t75)
     t116 = t74 - t106*t115
     t117 = t83 + t72*t115
-    t118 = t94 - t74*t115
+    t118 = -t74*t115 + t94
     t119 = t84 - t77*t115
     t120 = t75 + t70*t115
     t121 = t57 + t62*t115
@@ -2564,7 +2564,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t123 = t77 - t106*t122
     t124 = t81 + t72*t122
     t125 = t84 - t74*t122
-    t126 = t95 - t77*t122
+    t126 = -t77*t122 + t95
     t127 = t87 - t70*t122
     t128 = t58 + t62*t122
     t129 = t107*(t72*t78 + t77*t87 + t70*t106 + t70*t96 - t62*t59 - t74*t75)
@@ -2572,7 +2572,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t131 = t78 - t72*t129
     t132 = t75 + t74*t129
     t133 = t87 - t77*t129
-    t134 = t96 - t70*t129
+    t134 = -t70*t129 + t96
     t135 = t59 + t62*t129
     t136 = t107*(t72*t65 + t74*t57 + t77*t58 + t70*t59 - t62*t106 - t62*t97)
     t137 = t62 + t106*t136
@@ -2580,7 +2580,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t139 = t57 - t74*t136
     t140 = t58 - t77*t136
     t141 = t59 - t70*t136
-    t142 = t97 + t62*t136
+    t142 = t62*t136 + t97
     t143 = t107*(t72*mu_dot1 + t74*mu_dot2 + t77*mu_dot3 + t70*mu_dot4 + t106*mu_dot0 - t62*mu_dot5)
     t144 = mu_dot0 - t106*t143
     t145 = mu_dot1 - t72*t143
@@ -2592,13 +2592,13 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t151 = t150*xp.where(xp.greater_equal(t110, 0), xp.asarray(1, dtype=dtype), -1)
     t152 = t110 + t151
     t153 = xp.where(xp.greater(t150, 0), 1/(t150*(t150 + xp.abs(t110))), 0)
-    t154 = -t153*(t111*t118 + t112*t119 + t113*t120 + t117*t152 - t114*t121)
+    t154 = -t153*(-t114*t121 + t111*t118 + t112*t119 + t113*t120 + t117*t152)
     t155 = t117 + t152*t154
     t156 = t118 + t111*t154
     t157 = t119 + t112*t154
     t158 = t120 + t113*t154
     t159 = t121 - t114*t154
-    t160 = -t153*(t111*t125 + t112*t126 + t124*t152 - t113*t127 - t114*t128)
+    t160 = -t153*(-t113*t127 - t114*t128 + t111*t125 + t112*t126 + t124*t152)
     t161 = t124 + t152*t160
     t162 = t125 + t111*t160
     t163 = t126 + t112*t160
@@ -2756,43 +2756,43 @@ def ik_numeric_step(target, q, damping=0.0):
     t0 = T00 + T01 + T02 + T03 + T10 + T11 + T12 + T13 + T20 + T21 + T22 + T23 + qs1 + qs2 + qs3 + qs4 + qs5 + qs6 + qs7
     t1 = s1*s3
     t2 = c1*c3
-    t3 = -t1 + t2*c2
-    t4 = t2 - t1*c2
+    t3 = -t1 + c2*t2
+    t4 = t2 - c2*t1
     t5 = c3*s1
     t6 = c1*s3
-    t7 = t5 + t6*c2
-    t8 = t6 + t5*c2
+    t7 = t5 + c2*t6
+    t8 = t6 + c2*t5
     t9 = 0.316*s2
-    t10 = 0.0825*t3 + t9*c1
-    t11 = 0.0825*t8 + t9*s1
+    t10 = 0.0825*t3 + c1*t9
+    t11 = 0.0825*t8 + s1*t9
     t12 = c3*s2
     t13 = 0.316*c2 - 0.0825*t12
-    t14 = c2*s4 - t12*c4
-    t15 = c2*c4 + t12*s4
+    t14 = c2*s4 - c4*t12
+    t15 = c2*c4 + s4*t12
     t16 = c1*s2
-    t17 = t3*c4 + t16*s4
-    t18 = -t3*s4 + t16*c4
+    t17 = t3*c4 + s4*t16
+    t18 = -t3*s4 + c4*t16
     t19 = t17*c5 - t7*s5
     t20 = t17*s5 + t7*c5
     t21 = t18*s6 + t19*c6
     t22 = t18*c6 - t19*s6
     t23 = t20*s7 + t21*c7
     t24 = t20*c7 - t21*s7
-    t25 = 0.088*t21 - 0.21*t22
+    t25 = -0.21*t22 + 0.088*t21
     t26 = t25 + 0.384*t18
     t27 = t26 - 0.0825*t17
     t28 = t10 + t27
     t29 = T03 - t28
     t30 = s1*s2
-    t31 = t8*c4 + t30*s4
-    t32 = -t8*s4 + t30*c4
+    t31 = t8*c4 + s4*t30
+    t32 = -t8*s4 + c4*t30
     t33 = t31*c5 + t4*s5
     t34 = t4*c5 - t31*s5
     t35 = t32*s6 + t33*c6
     t36 = t32*c6 - t33*s6
     t37 = t35*c7 - t34*s7
     t38 = t34*c7 + t35*s7
-    t39 = 0.088*t35 - 0.21*t36
+    t39 = -0.21*t36 + 0.088*t35
     t40 = t39 + 0.384*t32
     t41 = t40 - 0.0825*t31
     t42 = t11 + t41
@@ -2803,14 +2803,14 @@ def ik_numeric_step(target, q, damping=0.0):
     t47 = t20*t39 + t34*t25
     t48 = t43**2 + t44**2 + t45**2 + t46**2 + t47**2
     t49 = T13 - t42
-    t50 = s2*s3
-    t51 = t14*c5 + t50*s5
-    t52 = -t14*s5 + t50*c5
+    t50 = s3*s2
+    t51 = t14*c5 + s5*t50
+    t52 = -t14*s5 + c5*t50
     t53 = t15*s6 + t51*c6
     t54 = t15*c6 - t51*s6
     t55 = t53*c7 - t52*s7
     t56 = t52*c7 + t53*s7
-    t57 = 0.088*t53 - 0.21*t54
+    t57 = -0.21*t54 + 0.088*t53
     t58 = t57 + 0.384*t15
     t59 = t58 - 0.0825*t14
     t60 = t13 + t59
@@ -2826,8 +2826,8 @@ def ik_numeric_step(target, q, damping=0.0):
     t70 = t42 + t52*t65 - t15*t64 - t62*c2 + t63*t50
     t71 = t28 + t15*t68 + t52*t69 + t66*c2 + t67*t50
     t72 = t15*t46 + t44*c2 - t52*t47 - t45*t50
-    t73 = t18*t15 + t22*t54 - t20*t52 + t16*c2 - t7*t50
-    t74 = t32*t15 + t34*t52 + t36*t54 + t4*t50 + t30*c2
+    t73 = t18*t15 + t22*t54 - t20*t52 + c2*t16 - t7*t50
+    t74 = t32*t15 + t34*t52 + t36*t54 + t4*t50 + c2*t30
     t75 = T23 - t61
     t76 = 0.7071067811865476*t23
     t77 = 0.7071067811865476*t24
@@ -2877,7 +2877,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t121 = t18*t46 + t20*t47 + t7*t45 + t119 + t44*t16
     t122 = s2**2
     t123 = t18**2 + t20**2 + t22**2 + t7**2 + t116 + t105*t122
-    t124 = t18*t32 + t22*t36 - t20*t34 - t7*t4 - t108 + t108*t122
+    t124 = t18*t32 + t22*t36 - t20*t34 - t7*t4 - t108 + t122*t108
     t125 = t32**2 + t34**2 + t36**2 + t4**2 + t105 + t116*t122
     t126 = 1 + t15**2 + t52**2 + t54**2 + c2**2 + t122*s3**2
     t127 = xp.greater_equal(t80, t88) & xp.greater_equal(t80, t97)
@@ -2908,7 +2908,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t152 = t117 + damping
     t153 = t144*(t109*t143 + t109*t152 + t107*t115 - t70*t71 - t111*t120 - t114*t118)
     t154 = t109 - t143*t153
-    t155 = t152 - t109*t153
+    t155 = -t109*t153 + t152
     t156 = t120 + t111*t153
     t157 = t118 + t114*t153
     t158 = t115 - t107*t153
@@ -2927,11 +2927,11 @@ def ik_numeric_step(target, q, damping=0.0):
     t171 = t144*(t111*t143 + t111*t170 + t114*t121 - t109*t120 - t70*t72 - t107*t112)
     t172 = t111 - t143*t171
     t173 = t120 + t109*t171
-    t174 = t170 - t111*t171
+    t174 = -t111*t171 + t170
     t175 = t121 - t114*t171
     t176 = t112 + t107*t171
     t177 = t72 + t70*t171
-    t178 = -t163*(t156*t174 + t157*t175 + t158*t176 + t173*t162 - t159*t177)
+    t178 = -t163*(-t159*t177 + t156*t174 + t157*t175 + t158*t176 + t173*t162)
     t179 = t173 + t162*t178
     t180 = t174 + t156*t178
     t181 = t175 + t157*t178
@@ -2951,10 +2951,10 @@ def ik_numeric_step(target, q, damping=0.0):
     t195 = t114 - t143*t194
     t196 = t118 + t109*t194
     t197 = t121 - t111*t194
-    t198 = t193 - t114*t194
+    t198 = -t114*t194 + t193
     t199 = t124 - t107*t194
     t200 = t73 + t70*t194
-    t201 = -t163*(t156*t197 + t157*t198 + t196*t162 - t158*t199 - t159*t200)
+    t201 = -t163*(-t158*t199 - t159*t200 + t156*t197 + t157*t198 + t196*t162)
     t202 = t196 + t162*t201
     t203 = t197 + t156*t201
     t204 = t198 + t157*t201
@@ -2979,7 +2979,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t223 = t115 - t109*t221
     t224 = t112 + t111*t221
     t225 = t124 - t114*t221
-    t226 = t220 - t107*t221
+    t226 = -t107*t221 + t220
     t227 = t74 + t70*t221
     t228 = t163*(t156*t224 + t158*t226 + t159*t227 + t223*t162 - t157*t225)
     t229 = t223 - t162*t228
@@ -3010,7 +3010,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t254 = t72 - t111*t251
     t255 = t73 - t114*t251
     t256 = t74 - t107*t251
-    t257 = t250 + t70*t251
+    t257 = t70*t251 + t250
     t258 = t163*(t158*t256 + t159*t257 + t253*t162 - t156*t254 - t157*t255)
     t259 = t253 - t162*t258
     t260 = t254 + t156*t258
@@ -3073,7 +3073,7 @@ def ik_numeric_step(target, q, damping=0.0):
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def ik_branches(T, q_free):
-    """every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits: (8 x 7 and 8 x 1 and 8 x 1), 1545 operations."""
+    """every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits: (8 x 7 and 8 x 1 and 8 x 1), 1542 operations."""
     xp, dtype, device, batch, (T, q_free,) = _arguments(("T", T, (4, 4)), ("q_free", q_free, ()))
     T00 = T[..., 0, 0]
     T01 = T[..., 0, 1]
@@ -3094,10 +3094,10 @@ def ik_branches(T, q_free):
     t1 = t0 - 0.333*T22
     t2 = -1.033 + t1
     t3 = T00 + T01 + T02 + T03 + T10 + T11 + T12 + T13 + T20 + T21 + T22 + T23
-    t4 = 0.7071067811865476*c7
-    t5 = 0.7071067811865476*s7
+    t4 = 0.7071067811865476*s7
+    t5 = 0.7071067811865476*c7
     t6 = t4 + t5
-    t7 = t4 - t5
+    t7 = t5 - t4
     t8 = T00*t6 + T01*t7
     t9 = T10*t6 + T11*t7
     t10 = T20*t6 + T21*t7
@@ -3119,696 +3119,694 @@ def ik_branches(T, q_free):
     t26 = 7.795873777901566*t21
     t27 = xp.where(t24, t26, xp.where(xp.greater(t26, 0), xp.asarray(1, dtype=dtype), -1))
     t28 = xp.atan2(t25, t27)
-    t29 = -2.6745902299367814 + t28
-    t30 = -2.6745902299367814 - t28
-    t31 = t29 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t29))
-    t32 = t30 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t30))
-    t33 = 7.795873777901566*t25
-    t34 = 0.05775*t33
-    t35 = 7.795873777901566*t27
-    t36 = 0.11453775*t35
-    t37 = t34 - t36
-    t38 = t36 + t34
-    t39 = 0.11453775*t33
-    t40 = 0.05775*t35
-    t41 = -(t39 + t40)
-    t42 = t39 - t40
-    t43 = 0.316*t41 - 0.0825*t37
-    t44 = 0.316*t37 + 0.0825*t41
-    t45 = 0.0825 + t43
-    t46 = 0.649 - t44
-    t47 = -1.033 + t46
-    t48 = 0.316*t42 + 0.0825*t38
-    t49 = 0.316*t38 - 0.0825*t42
-    t50 = 0.0825 + t48
-    t51 = 0.649 + t49
-    t52 = -1.033 + t51
-    t53 = t45**2
-    t54 = t47**2
-    t55 = t53 + t54
-    t56 = t54 + t19
-    t57 = t56 - t55
-    t58 = -t57
-    t59 = 1e-12*t55
-    t60 = xp.greater(t58, t59)
-    t61 = xp.where(t60, xp.sqrt(t58), 0)
-    t62 = t56 + t61**2
-    t63 = t12*t61
-    t64 = t19 + t2*t47
-    t65 = t64 - t63
-    t66 = t63 + t64
-    t67 = -t19
-    t68 = t65 + t67
-    t69 = t66 + t67
-    t70 = t12*t47
-    t71 = t2*t61
-    t72 = t70 + t71
-    t73 = t68**2 + t72**2
-    t74 = t70 - t71
-    t75 = t69**2 + t74**2
-    t76 = 1e-24*t62
-    t77 = t20*t76
-    t78 = xp.less_equal(t73, t77)
-    t79 = xp.where(t78, 1, 1/xp.sqrt(t73))
-    t80 = xp.where(t78, 1, t68*t79)
-    t81 = xp.where(t78, 0, -t72*t79)
-    t82 = t10*t80 - T22*t81
-    t83 = T22*t80 + t10*t81
-    t84 = t8*t80 - T02*t81
-    t85 = T02*t80 + t8*t81
-    t86 = t45*t61
-    t87 = t54 - t86
-    t88 = t54 + t86
-    t89 = -t54
-    t90 = t87 + t89
-    t91 = t88 + t89
-    t92 = t19*t53
-    t93 = t90**2 + t92
-    t94 = t91**2 + t92
-    t95 = t55*t76
-    t96 = xp.less_equal(t93, t95)
-    t97 = xp.where(t96, 1, 1/xp.sqrt(t93))
-    t98 = xp.where(t96, 1, t90*t97)
-    t99 = t18*t45
-    t100 = xp.where(t96, 0, t97*t99)
-    t101 = xp.less_equal(t75, t77)
-    t102 = xp.where(t101, 1, 1/xp.sqrt(t75))
-    t103 = xp.where(t101, 1, t69*t102)
-    t104 = xp.where(t101, 0, -t74*t102)
-    t105 = t10*t103 - T22*t104
-    t106 = T22*t103 + t10*t104
-    t107 = t8*t103 - T02*t104
-    t108 = T02*t103 + t8*t104
-    t109 = xp.less_equal(t94, t95)
-    t110 = xp.where(t109, 1, 1/xp.sqrt(t94))
-    t111 = xp.where(t109, 1, t91*t110)
-    t112 = xp.where(t109, 0, t110*t99)
-    t113 = 1 - t80
-    t114 = t16*t113
-    t115 = t114 + t16*t80
-    t116 = t14*t113
-    t117 = t116 + t14*t80
-    t118 = t98*t82 + t100*t115
-    t119 = t98*t115 - t100*t82
-    t120 = t98*t84 + t100*t117
-    t121 = t98*t117 - t100*t84
-    t122 = 1 - t98
-    t123 = t83*t122
-    t124 = t123 + t98*t83
-    t125 = t85*t122
-    t126 = t125 + t98*t85
-    t127 = t37*t118 - t41*t124
-    t128 = t37*t124 + t41*t118
-    t129 = t37*t120 - t41*t126
-    t130 = t37*t126 + t41*t120
-    t131 = 1 - t37
-    t132 = t119*t131
-    t133 = t132 + t37*t119
-    t134 = t121*t131
-    t135 = t134 + t37*t121
-    t136 = t128**2
-    t137 = -t136
-    t138 = 1 + t137
-    t139 = xp.greater(t138, 1e-12)
-    t140 = xp.where(t139, xp.sqrt(t138), 0)
-    t141 = t136 - t127*t140
-    t142 = t141 + t137
-    t143 = t133**2
-    t144 = t127**2 + t143 + t136
-    t145 = t140**2
-    t146 = t142**2 + t143*t145
-    t147 = t136 + t145
-    t148 = 1e-24*t147
-    t149 = xp.less_equal(t146, t144*t148)
-    t150 = xp.where(t149, 1, 1/xp.sqrt(t146))
-    t151 = xp.where(t149, 1, t142*t150)
-    t152 = t130*(1 - t151)
-    t153 = t152 + t130*t151
-    t154 = t133*t140
-    t155 = xp.where(t149, 0, -t150*t154)
-    t156 = t129*t151 + t135*t155
-    t157 = t135*t151 - t129*t155
-    t158 = xp.less_equal(t147, t148)
-    t159 = xp.where(t158, 1, 1/xp.sqrt(t147))
-    t160 = xp.where(t158, 1, -t128*t159)
-    t161 = xp.where(t158, 0, -t140*t159)
-    t162 = t157*(1 - t160)
-    t163 = t160*t156 + t161*t153
-    t164 = t162 + t160*t157
-    t165 = t161*t156 - t160*t153
-    t166 = t163**2 + t164**2
-    t167 = t166
-    t168 = t166 + t165**2
-    t169 = 1 - t103
-    t170 = t16*t169
-    t171 = t170 + t16*t103
-    t172 = t14*t169
-    t173 = t172 + t14*t103
-    t174 = t111*t105 + t112*t171
-    t175 = t111*t171 - t112*t105
-    t176 = t111*t107 + t112*t173
-    t177 = t111*t173 - t112*t107
-    t178 = t175*t131
-    t179 = t178 + t37*t175
-    t180 = t177*t131
-    t181 = t180 + t37*t177
-    t182 = 1 - t111
-    t183 = t106*t182
-    t184 = t183 + t111*t106
-    t185 = t108*t182
-    t186 = t185 + t111*t108
-    t187 = t37*t174 - t41*t184
-    t188 = t37*t184 + t41*t174
-    t189 = t37*t176 - t41*t186
-    t190 = t37*t186 + t41*t176
-    t191 = t188**2
-    t192 = -t191
-    t193 = 1 + t192
-    t194 = xp.greater(t193, 1e-12)
-    t195 = xp.where(t194, xp.sqrt(t193), 0)
-    t196 = t191 - t187*t195
-    t197 = t196 + t192
-    t198 = t179**2
-    t199 = t187**2 + t198 + t191
-    t200 = t195**2
-    t201 = t197**2 + t198*t200
-    t202 = t191 + t200
-    t203 = 1e-24*t202
-    t204 = xp.less_equal(t201, t199*t203)
-    t205 = xp.where(t204, 1, 1/xp.sqrt(t201))
-    t206 = xp.where(t204, 1, t197*t205)
-    t207 = t190*(1 - t206)
-    t208 = t207 + t190*t206
-    t209 = t179*t195
-    t210 = xp.where(t204, 0, -t205*t209)
-    t211 = t189*t206 + t181*t210
-    t212 = t181*t206 - t189*t210
-    t213 = xp.less_equal(t202, t203)
-    t214 = xp.where(t213, 1, 1/xp.sqrt(t202))
-    t215 = xp.where(t213, 1, -t188*t214)
-    t216 = xp.where(t213, 0, -t195*t214)
-    t217 = t212*(1 - t215)
-    t218 = t215*t211 + t216*t208
-    t219 = t217 + t215*t212
-    t220 = t216*t211 - t215*t208
-    t221 = t218**2 + t219**2
-    t222 = t221
-    t223 = t221 + t220**2
-    t224 = t50**2
-    t225 = t52**2
-    t226 = t224 + t225
-    t227 = t19 + t225
-    t228 = t227 - t226
-    t229 = -t228
-    t230 = 1e-12*t226
-    t231 = xp.greater(t229, t230)
-    t232 = xp.where(t231, xp.sqrt(t229), 0)
-    t233 = t227 + t232**2
-    t234 = t12*t232
-    t235 = t19 + t2*t52
-    t236 = t235 - t234
-    t237 = t236 + t67
-    t238 = t234 + t235
-    t239 = t238 + t67
-    t240 = t12*t52
-    t241 = t2*t232
-    t242 = t240 + t241
+    t29 = -(2.6745902299367814 + t28)
+    t30 = t29 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t29))
+    t31 = -2.6745902299367814 + t28
+    t32 = t31 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t31))
+    t33 = 0.892921841804845*t27
+    t34 = 0.45021171067381544*t25
+    t35 = -t33 + t34
+    t36 = t34 + t33
+    t37 = 0.892921841804845*t25
+    t38 = 0.45021171067381544*t27
+    t39 = -(t37 + t38)
+    t40 = -t38 + t37
+    t41 = -0.0825*t35 + 0.316*t39
+    t42 = 0.0825*t39 + 0.316*t35
+    t43 = 0.0825 + t41
+    t44 = 0.649 - t42
+    t45 = -1.033 + t44
+    t46 = 0.0825*t36 + 0.316*t40
+    t47 = -0.0825*t40 + 0.316*t36
+    t48 = 0.0825 + t46
+    t49 = 0.649 + t47
+    t50 = -1.033 + t49
+    t51 = t43**2
+    t52 = t45**2
+    t53 = t51 + t52
+    t54 = t52 + t19
+    t55 = -t53 + t54
+    t56 = -t55
+    t57 = 1e-12*t53
+    t58 = xp.greater(t56, t57)
+    t59 = xp.where(t58, xp.sqrt(t56), 0)
+    t60 = t59**2 + t54
+    t61 = t12*t59
+    t62 = t19 + t2*t45
+    t63 = -t61 + t62
+    t64 = t61 + t62
+    t65 = -t19
+    t66 = t63 + t65
+    t67 = t64 + t65
+    t68 = t12*t45
+    t69 = t2*t59
+    t70 = t68 + t69
+    t71 = t66**2 + t70**2
+    t72 = t68 - t69
+    t73 = t67**2 + t72**2
+    t74 = 1e-24*t60
+    t75 = t20*t74
+    t76 = xp.less_equal(t71, t75)
+    t77 = xp.where(t76, 1, 1/xp.sqrt(t71))
+    t78 = xp.where(t76, 1, t66*t77)
+    t79 = xp.where(t76, 0, -t70*t77)
+    t80 = t10*t78 - T22*t79
+    t81 = T22*t78 + t10*t79
+    t82 = t8*t78 - T02*t79
+    t83 = T02*t78 + t8*t79
+    t84 = t43*t59
+    t85 = t52 - t84
+    t86 = t52 + t84
+    t87 = -t52
+    t88 = t85 + t87
+    t89 = t86 + t87
+    t90 = t19*t51
+    t91 = t88**2 + t90
+    t92 = t89**2 + t90
+    t93 = t53*t74
+    t94 = xp.less_equal(t91, t93)
+    t95 = xp.where(t94, 1, 1/xp.sqrt(t91))
+    t96 = xp.where(t94, 1, t88*t95)
+    t97 = t18*t43
+    t98 = xp.where(t94, 0, t95*t97)
+    t99 = xp.less_equal(t73, t75)
+    t100 = xp.where(t99, 1, 1/xp.sqrt(t73))
+    t101 = xp.where(t99, 1, t67*t100)
+    t102 = xp.where(t99, 0, -t72*t100)
+    t103 = t10*t101 - T22*t102
+    t104 = T22*t101 + t10*t102
+    t105 = t8*t101 - T02*t102
+    t106 = T02*t101 + t8*t102
+    t107 = xp.less_equal(t92, t93)
+    t108 = xp.where(t107, 1, 1/xp.sqrt(t92))
+    t109 = xp.where(t107, 1, t89*t108)
+    t110 = xp.where(t107, 0, t108*t97)
+    t111 = 1 - t78
+    t112 = t16*t111
+    t113 = t112 + t16*t78
+    t114 = t14*t111
+    t115 = t114 + t14*t78
+    t116 = t96*t80 + t98*t113
+    t117 = t96*t113 - t98*t80
+    t118 = t96*t82 + t98*t115
+    t119 = t96*t115 - t98*t82
+    t120 = 1 - t96
+    t121 = t81*t120
+    t122 = t121 + t96*t81
+    t123 = t83*t120
+    t124 = t123 + t96*t83
+    t125 = t35*t116 - t39*t122
+    t126 = t35*t122 + t39*t116
+    t127 = t35*t118 - t39*t124
+    t128 = t35*t124 + t39*t118
+    t129 = 1 - t35
+    t130 = t117*t129
+    t131 = t130 + t35*t117
+    t132 = t119*t129
+    t133 = t132 + t35*t119
+    t134 = t126**2
+    t135 = -t134
+    t136 = 1 + t135
+    t137 = xp.greater(t136, 1e-12)
+    t138 = xp.where(t137, xp.sqrt(t136), 0)
+    t139 = t134 - t125*t138
+    t140 = t139 + t135
+    t141 = t131**2
+    t142 = t125**2 + t141 + t134
+    t143 = t138**2
+    t144 = t140**2 + t141*t143
+    t145 = t134 + t143
+    t146 = 1e-24*t145
+    t147 = xp.less_equal(t144, t142*t146)
+    t148 = xp.where(t147, 1, 1/xp.sqrt(t144))
+    t149 = xp.where(t147, 1, t140*t148)
+    t150 = t128*(1 - t149)
+    t151 = t150 + t128*t149
+    t152 = t131*t138
+    t153 = xp.where(t147, 0, -t148*t152)
+    t154 = t127*t149 + t133*t153
+    t155 = t133*t149 - t127*t153
+    t156 = xp.less_equal(t145, t146)
+    t157 = xp.where(t156, 1, 1/xp.sqrt(t145))
+    t158 = xp.where(t156, 1, -t126*t157)
+    t159 = xp.where(t156, 0, -t138*t157)
+    t160 = t155*(1 - t158)
+    t161 = t158*t154 + t159*t151
+    t162 = t160 + t158*t155
+    t163 = t159*t154 - t158*t151
+    t164 = t161**2 + t162**2
+    t165 = t164
+    t166 = t163**2 + t164
+    t167 = 1 - t101
+    t168 = t16*t167
+    t169 = t168 + t16*t101
+    t170 = t14*t167
+    t171 = t170 + t14*t101
+    t172 = t109*t103 + t110*t169
+    t173 = t109*t169 - t110*t103
+    t174 = t109*t105 + t110*t171
+    t175 = t109*t171 - t110*t105
+    t176 = t173*t129
+    t177 = t176 + t35*t173
+    t178 = t175*t129
+    t179 = t178 + t35*t175
+    t180 = 1 - t109
+    t181 = t104*t180
+    t182 = t181 + t109*t104
+    t183 = t106*t180
+    t184 = t183 + t109*t106
+    t185 = t35*t172 - t39*t182
+    t186 = t35*t182 + t39*t172
+    t187 = t35*t174 - t39*t184
+    t188 = t35*t184 + t39*t174
+    t189 = t186**2
+    t190 = -t189
+    t191 = 1 + t190
+    t192 = xp.greater(t191, 1e-12)
+    t193 = xp.where(t192, xp.sqrt(t191), 0)
+    t194 = t189 - t185*t193
+    t195 = t194 + t190
+    t196 = t177**2
+    t197 = t185**2 + t196 + t189
+    t198 = t193**2
+    t199 = t195**2 + t196*t198
+    t200 = t189 + t198
+    t201 = 1e-24*t200
+    t202 = xp.less_equal(t199, t197*t201)
+    t203 = xp.where(t202, 1, 1/xp.sqrt(t199))
+    t204 = xp.where(t202, 1, t195*t203)
+    t205 = t188*(1 - t204)
+    t206 = t205 + t188*t204
+    t207 = t177*t193
+    t208 = xp.where(t202, 0, -t203*t207)
+    t209 = t187*t204 + t179*t208
+    t210 = t179*t204 - t187*t208
+    t211 = xp.less_equal(t200, t201)
+    t212 = xp.where(t211, 1, 1/xp.sqrt(t200))
+    t213 = xp.where(t211, 1, -t186*t212)
+    t214 = xp.where(t211, 0, -t193*t212)
+    t215 = t210*(1 - t213)
+    t216 = t213*t209 + t214*t206
+    t217 = t215 + t213*t210
+    t218 = t214*t209 - t213*t206
+    t219 = t216**2 + t217**2
+    t220 = t219
+    t221 = t218**2 + t219
+    t222 = t48**2
+    t223 = t50**2
+    t224 = t222 + t223
+    t225 = t223 + t19
+    t226 = -t224 + t225
+    t227 = -t226
+    t228 = 1e-12*t224
+    t229 = xp.greater(t227, t228)
+    t230 = xp.where(t229, xp.sqrt(t227), 0)
+    t231 = t230**2 + t225
+    t232 = t12*t230
+    t233 = t19 + t2*t50
+    t234 = -t232 + t233
+    t235 = t234 + t65
+    t236 = t232 + t233
+    t237 = t236 + t65
+    t238 = t12*t50
+    t239 = t2*t230
+    t240 = t238 + t239
+    t241 = t235**2 + t240**2
+    t242 = t238 - t239
     t243 = t237**2 + t242**2
-    t244 = t240 - t241
-    t245 = t239**2 + t244**2
-    t246 = 1e-24*t233
-    t247 = t20*t246
-    t248 = xp.less_equal(t243, t247)
-    t249 = xp.where(t248, 1, 1/xp.sqrt(t243))
-    t250 = xp.where(t248, 1, t237*t249)
-    t251 = xp.where(t248, 0, -t242*t249)
-    t252 = t10*t250 - T22*t251
-    t253 = T22*t250 + t10*t251
-    t254 = t8*t250 - T02*t251
-    t255 = T02*t250 + t8*t251
-    t256 = t50*t232
-    t257 = t225 - t256
-    t258 = t225 + t256
-    t259 = -t225
-    t260 = t257 + t259
-    t261 = t258 + t259
-    t262 = t19*t224
-    t263 = t260**2 + t262
-    t264 = t261**2 + t262
-    t265 = t226*t246
-    t266 = xp.less_equal(t263, t265)
-    t267 = xp.where(t266, 1, 1/xp.sqrt(t263))
-    t268 = xp.where(t266, 1, t260*t267)
-    t269 = t18*t50
-    t270 = xp.where(t266, 0, t267*t269)
-    t271 = xp.less_equal(t245, t247)
-    t272 = xp.where(t271, 1, 1/xp.sqrt(t245))
-    t273 = xp.where(t271, 1, t239*t272)
-    t274 = xp.where(t271, 0, -t244*t272)
-    t275 = t10*t273 - T22*t274
-    t276 = T22*t273 + t10*t274
-    t277 = t8*t273 - T02*t274
-    t278 = T02*t273 + t8*t274
-    t279 = xp.less_equal(t264, t265)
-    t280 = xp.where(t279, 1, 1/xp.sqrt(t264))
-    t281 = xp.where(t279, 1, t261*t280)
-    t282 = xp.where(t279, 0, t280*t269)
-    t283 = 1 - t250
-    t284 = t16*t283
-    t285 = t284 + t16*t250
-    t286 = t14*t283
-    t287 = t286 + t14*t250
-    t288 = t268*t252 + t270*t285
-    t289 = t268*t285 - t270*t252
-    t290 = t268*t254 + t270*t287
-    t291 = t268*t287 - t270*t254
-    t292 = 1 - t268
-    t293 = t253*t292
-    t294 = t293 + t268*t253
-    t295 = t255*t292
-    t296 = t295 + t268*t255
-    t297 = t38*t288 + t42*t294
-    t298 = t38*t294 - t42*t288
-    t299 = t38*t290 + t42*t296
-    t300 = t38*t296 - t42*t290
-    t301 = 1 + t38
-    t302 = t289*t301
-    t303 = t302 - t38*t289
-    t304 = t291*t301
-    t305 = t304 - t38*t291
-    t306 = t298**2
-    t307 = -t306
-    t308 = 1 + t307
-    t309 = xp.greater(t308, 1e-12)
-    t310 = xp.where(t309, xp.sqrt(t308), 0)
-    t311 = t306 + t297*t310
-    t312 = t311 + t307
-    t313 = t303**2
-    t314 = t297**2 + t313 + t306
-    t315 = t310**2
-    t316 = t312**2 + t313*t315
-    t317 = t306 + t315
-    t318 = 1e-24*t317
-    t319 = xp.less_equal(t316, t314*t318)
-    t320 = xp.where(t319, 1, 1/xp.sqrt(t316))
-    t321 = xp.where(t319, 1, t312*t320)
-    t322 = t300*(1 - t321)
-    t323 = t322 + t300*t321
-    t324 = t303*t310
-    t325 = xp.where(t319, 0, -t320*t324)
-    t326 = t305*t325 - t299*t321
-    t327 = t299*t325 + t305*t321
-    t328 = xp.less_equal(t317, t318)
-    t329 = xp.where(t328, 1, 1/xp.sqrt(t317))
-    t330 = xp.where(t328, 1, t298*t329)
-    t331 = xp.where(t328, 0, -t310*t329)
-    t332 = t327*(1 - t330)
-    t333 = t330*t326 - t331*t323
-    t334 = t332 + t330*t327
-    t335 = t330*t323 + t331*t326
-    t336 = t333**2 + t334**2
-    t337 = t336
-    t338 = t336 + t335**2
-    t339 = 1 - t273
-    t340 = t16*t339
-    t341 = t340 + t16*t273
-    t342 = t14*t339
-    t343 = t342 + t14*t273
-    t344 = t281*t275 + t282*t341
-    t345 = t281*t341 - t282*t275
-    t346 = t281*t277 + t282*t343
-    t347 = t281*t343 - t282*t277
-    t348 = t345*t301
-    t349 = t348 - t38*t345
-    t350 = t347*t301
-    t351 = t350 - t38*t347
-    t352 = 1 - t281
-    t353 = t276*t352
-    t354 = t353 + t281*t276
-    t355 = t278*t352
-    t356 = t355 + t281*t278
-    t357 = t38*t344 + t42*t354
-    t358 = t38*t354 - t42*t344
-    t359 = t38*t346 + t42*t356
-    t360 = t38*t356 - t42*t346
-    t361 = t358**2
-    t362 = -t361
-    t363 = 1 + t362
-    t364 = xp.greater(t363, 1e-12)
-    t365 = xp.where(t364, xp.sqrt(t363), 0)
-    t366 = t361 + t357*t365
-    t367 = t366 + t362
-    t368 = t349**2
-    t369 = t357**2 + t368 + t361
-    t370 = t365**2
-    t371 = t367**2 + t368*t370
-    t372 = t361 + t370
-    t373 = 1e-24*t372
-    t374 = xp.less_equal(t371, t369*t373)
-    t375 = xp.where(t374, 1, 1/xp.sqrt(t371))
-    t376 = xp.where(t374, 1, t367*t375)
-    t377 = t360*(1 - t376)
-    t378 = t377 + t360*t376
-    t379 = t349*t365
-    t380 = xp.where(t374, 0, -t375*t379)
-    t381 = t351*t380 - t359*t376
-    t382 = t359*t380 + t351*t376
-    t383 = xp.less_equal(t372, t373)
-    t384 = xp.where(t383, 1, 1/xp.sqrt(t372))
-    t385 = xp.where(t383, 1, t358*t384)
-    t386 = xp.where(t383, 0, -t365*t384)
-    t387 = t382*(1 - t385)
-    t388 = t385*t381 - t386*t378
-    t389 = t387 + t385*t382
-    t390 = t385*t378 + t386*t381
-    t391 = t388**2 + t389**2
-    t392 = t391
-    t393 = t391 + t390**2
-    t394 = xp.where(t78, 0, xp.atan2(-t72, t68))
-    t395 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t394)) + t394
-    t396 = -t395
-    t397 = t395 + 6.283185307179586*xp.floor(0.15915494309189535*(0.0175 + t396))
-    t398 = xp.where(t96, 0, xp.atan2(t99, t90))
-    t399 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t398)) + t398
-    t400 = -t399
-    t401 = t399 + 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t400))
-    t402 = -t31
-    t403 = t31 + 6.283185307179586*xp.floor(0.15915494309189535*(3.0718 + t402))
-    t404 = xp.where(t149, 0, xp.atan2(-t154, t142))
-    t405 = 3.141592653589793 + t404
-    t406 = 6.283185307179586*xp.ceil(-0.15915494309189535*t405) + t404
-    t407 = t405 + 6.283185307179586*xp.ceil(-0.15915494309189535*(6.283185307179586 + t404))
-    t408 = -t406
-    t409 = t406 + 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t408))
-    t410 = xp.where(t158, 0, xp.atan2(-t140, -t128))
-    t411 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t410)) + t410
-    t412 = t410
-    t413 = t412 - 6.283185307179586*xp.floor(0.15915494309189535*(1.7627999999999997 + t412))
-    t414 = -t411
-    t415 = t411 + 6.283185307179586*xp.floor(0.15915494309189535*(1.7627999999999997 + t414))
-    t416 = xp.where(xp.less_equal(t167, 1e-24*t168), 0, xp.atan2(t164, t163))
-    t417 = 3.141592653589793 + t416
-    t418 = 6.283185307179586*xp.ceil(-0.15915494309189535*t417) + t416
-    t419 = t417 + 6.283185307179586*xp.ceil(-0.15915494309189535*(6.283185307179586 + t416))
-    t420 = -t418
-    t421 = t418 + 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t420))
-    t422 = -t407
-    t423 = t407 + 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t422))
-    t424 = -t419
-    t425 = t419 + 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t424))
-    t426 = xp.where(t101, 0, xp.atan2(-t74, t69))
-    t427 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t426)) + t426
-    t428 = -t427
-    t429 = t427 + 6.283185307179586*xp.floor(0.15915494309189535*(0.0175 + t428))
-    t430 = xp.where(t109, 0, xp.atan2(t99, t91))
-    t431 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t430)) + t430
-    t432 = -t431
-    t433 = t431 + 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t432))
-    t434 = xp.where(t204, 0, xp.atan2(-t209, t197))
-    t435 = 3.141592653589793 + t434
-    t436 = 6.283185307179586*xp.ceil(-0.15915494309189535*t435) + t434
-    t437 = t435 + 6.283185307179586*xp.ceil(-0.15915494309189535*(6.283185307179586 + t434))
-    t438 = -t436
-    t439 = t436 + 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t438))
-    t440 = xp.where(t213, 0, xp.atan2(-t195, -t188))
-    t441 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t440)) + t440
-    t442 = t440
-    t443 = t442 - 6.283185307179586*xp.floor(0.15915494309189535*(1.7627999999999997 + t442))
-    t444 = -t441
-    t445 = t441 + 6.283185307179586*xp.floor(0.15915494309189535*(1.7627999999999997 + t444))
-    t446 = xp.where(xp.less_equal(t222, 1e-24*t223), 0, xp.atan2(t219, t218))
-    t447 = 3.141592653589793 + t446
-    t448 = 6.283185307179586*xp.ceil(-0.15915494309189535*t447) + t446
-    t449 = t447 + 6.283185307179586*xp.ceil(-0.15915494309189535*(6.283185307179586 + t446))
-    t450 = -t448
-    t451 = t448 + 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t450))
-    t452 = -t437
-    t453 = t437 + 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t452))
-    t454 = -t449
-    t455 = t449 + 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t454))
-    t456 = xp.where(t248, 0, xp.atan2(-t242, t237))
-    t457 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t456)) + t456
-    t458 = -t457
-    t459 = t457 + 6.283185307179586*xp.floor(0.15915494309189535*(0.0175 + t458))
-    t460 = xp.where(t266, 0, xp.atan2(t269, t260))
-    t461 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t460)) + t460
-    t462 = -t461
-    t463 = t461 + 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t462))
-    t464 = -t32
-    t465 = t32 + 6.283185307179586*xp.floor(0.15915494309189535*(3.0718 + t464))
-    t466 = xp.where(t319, 0, xp.atan2(-t324, t312))
-    t467 = 3.141592653589793 + t466
-    t468 = 6.283185307179586*xp.ceil(-0.15915494309189535*t467) + t466
-    t469 = t467 + 6.283185307179586*xp.ceil(-0.15915494309189535*(6.283185307179586 + t466))
-    t470 = -t468
-    t471 = t468 + 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t470))
-    t472 = xp.where(t328, 0, xp.atan2(-t310, t298))
-    t473 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t472)) + t472
-    t474 = t472
-    t475 = t474 - 6.283185307179586*xp.floor(0.15915494309189535*(1.7627999999999997 + t474))
-    t476 = -t473
-    t477 = t473 + 6.283185307179586*xp.floor(0.15915494309189535*(1.7627999999999997 + t476))
-    t478 = xp.where(xp.less_equal(t337, 1e-24*t338), 0, xp.atan2(t334, t333))
-    t479 = 3.141592653589793 + t478
-    t480 = 6.283185307179586*xp.ceil(-0.15915494309189535*t479) + t478
-    t481 = t479 + 6.283185307179586*xp.ceil(-0.15915494309189535*(6.283185307179586 + t478))
-    t482 = -t480
-    t483 = t480 + 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t482))
-    t484 = -t469
-    t485 = t469 + 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t484))
-    t486 = -t481
-    t487 = t481 + 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t486))
-    t488 = xp.where(t271, 0, xp.atan2(-t244, t239))
-    t489 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t488)) + t488
-    t490 = -t489
-    t491 = t489 + 6.283185307179586*xp.floor(0.15915494309189535*(0.0175 + t490))
-    t492 = xp.where(t279, 0, xp.atan2(t269, t261))
-    t493 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t492)) + t492
-    t494 = -t493
-    t495 = t493 + 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t494))
-    t496 = xp.where(t374, 0, xp.atan2(-t379, t367))
-    t497 = 3.141592653589793 + t496
-    t498 = 6.283185307179586*xp.ceil(-0.15915494309189535*t497) + t496
-    t499 = t497 + 6.283185307179586*xp.ceil(-0.15915494309189535*(6.283185307179586 + t496))
-    t500 = -t498
-    t501 = t498 + 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t500))
-    t502 = xp.where(t383, 0, xp.atan2(-t365, t358))
-    t503 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t502)) + t502
-    t504 = t502
-    t505 = t504 - 6.283185307179586*xp.floor(0.15915494309189535*(1.7627999999999997 + t504))
-    t506 = -t503
-    t507 = t503 + 6.283185307179586*xp.floor(0.15915494309189535*(1.7627999999999997 + t506))
-    t508 = xp.where(xp.less_equal(t392, 1e-24*t393), 0, xp.atan2(t389, t388))
-    t509 = 3.141592653589793 + t508
-    t510 = 6.283185307179586*xp.ceil(-0.15915494309189535*t509) + t508
-    t511 = t509 + 6.283185307179586*xp.ceil(-0.15915494309189535*(6.283185307179586 + t508))
-    t512 = -t510
-    t513 = t510 + 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t512))
-    t514 = -t499
-    t515 = t499 + 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t514))
-    t516 = -t511
-    t517 = t511 + 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t516))
-    t518 = -t421
-    t519 = xp.less_equal(t518, 2.8973)
-    t520 = xp.greater_equal(t420, -2.8973) & xp.less_equal(t420, 2.8973)
-    t521 = -t415
-    t522 = xp.less_equal(t521, 1.7627999999999997)
-    t523 = xp.greater_equal(t414, -1.7627999999999997) & xp.less_equal(t414, 1.7627999999999997)
-    t524 = -t409
-    t525 = xp.less_equal(t524, 2.8973)
-    t526 = xp.greater_equal(t408, -2.8973) & xp.less_equal(t408, 2.8973)
-    t527 = -t403
-    t528 = xp.less_equal(t527, -0.0698)
-    t529 = xp.greater_equal(t402, -3.0718) & xp.less_equal(t402, -0.0698)
-    t530 = xp.where(t528 & xp.logical_not(t529), t527, t402)
-    t531 = -t401
-    t532 = xp.less_equal(t531, 2.8973)
-    t533 = xp.greater_equal(t400, -2.8973) & xp.less_equal(t400, 2.8973)
-    t534 = xp.where(t532 & xp.logical_not(t533), t531, t400)
-    t535 = -t397
-    t536 = xp.less_equal(t535, 3.7525000000000004)
-    t537 = xp.greater_equal(t396, -0.0175) & xp.less_equal(t396, 3.7525000000000004)
-    t538 = xp.where(t536 & xp.logical_not(t537), t535, t396)
-    t539 = -t425
-    t540 = xp.less_equal(t539, 2.8973)
-    t541 = xp.greater_equal(t424, -2.8973) & xp.less_equal(t424, 2.8973)
-    t542 = xp.less_equal(t413, 1.7627999999999997)
-    t543 = xp.greater_equal(t412, -1.7627999999999997) & xp.less_equal(t412, 1.7627999999999997)
-    t544 = -t423
-    t545 = xp.less_equal(t544, 2.8973)
-    t546 = xp.greater_equal(t422, -2.8973) & xp.less_equal(t422, 2.8973)
-    t547 = -t451
-    t548 = xp.less_equal(t547, 2.8973)
-    t549 = xp.greater_equal(t450, -2.8973) & xp.less_equal(t450, 2.8973)
-    t550 = -t445
-    t551 = xp.less_equal(t550, 1.7627999999999997)
-    t552 = xp.greater_equal(t444, -1.7627999999999997) & xp.less_equal(t444, 1.7627999999999997)
-    t553 = -t439
-    t554 = xp.less_equal(t553, 2.8973)
-    t555 = xp.greater_equal(t438, -2.8973) & xp.less_equal(t438, 2.8973)
-    t556 = -t433
-    t557 = xp.less_equal(t556, 2.8973)
-    t558 = xp.greater_equal(t432, -2.8973) & xp.less_equal(t432, 2.8973)
-    t559 = xp.where(t557 & xp.logical_not(t558), t556, t432)
-    t560 = -t429
-    t561 = xp.less_equal(t560, 3.7525000000000004)
-    t562 = xp.greater_equal(t428, -0.0175) & xp.less_equal(t428, 3.7525000000000004)
-    t563 = xp.where(t561 & xp.logical_not(t562), t560, t428)
-    t564 = -t455
-    t565 = xp.less_equal(t564, 2.8973)
-    t566 = xp.greater_equal(t454, -2.8973) & xp.less_equal(t454, 2.8973)
-    t567 = xp.less_equal(t443, 1.7627999999999997)
-    t568 = xp.greater_equal(t442, -1.7627999999999997) & xp.less_equal(t442, 1.7627999999999997)
-    t569 = -t453
-    t570 = xp.less_equal(t569, 2.8973)
-    t571 = xp.greater_equal(t452, -2.8973) & xp.less_equal(t452, 2.8973)
-    t572 = -t483
-    t573 = xp.less_equal(t572, 2.8973)
-    t574 = xp.greater_equal(t482, -2.8973) & xp.less_equal(t482, 2.8973)
-    t575 = -t477
-    t576 = xp.less_equal(t575, 1.7627999999999997)
-    t577 = xp.greater_equal(t476, -1.7627999999999997) & xp.less_equal(t476, 1.7627999999999997)
-    t578 = -t471
-    t579 = xp.less_equal(t578, 2.8973)
-    t580 = xp.greater_equal(t470, -2.8973) & xp.less_equal(t470, 2.8973)
-    t581 = -t465
-    t582 = xp.less_equal(t581, -0.0698)
-    t583 = xp.greater_equal(t464, -3.0718) & xp.less_equal(t464, -0.0698)
-    t584 = xp.where(t582 & xp.logical_not(t583), t581, t464)
-    t585 = -t463
-    t586 = xp.less_equal(t585, 2.8973)
-    t587 = xp.greater_equal(t462, -2.8973) & xp.less_equal(t462, 2.8973)
-    t588 = xp.where(t586 & xp.logical_not(t587), t585, t462)
-    t589 = -t459
-    t590 = xp.less_equal(t589, 3.7525000000000004)
-    t591 = xp.greater_equal(t458, -0.0175) & xp.less_equal(t458, 3.7525000000000004)
-    t592 = xp.where(t590 & xp.logical_not(t591), t589, t458)
-    t593 = -t487
-    t594 = xp.less_equal(t593, 2.8973)
-    t595 = xp.greater_equal(t486, -2.8973) & xp.less_equal(t486, 2.8973)
-    t596 = xp.less_equal(t475, 1.7627999999999997)
-    t597 = xp.greater_equal(t474, -1.7627999999999997) & xp.less_equal(t474, 1.7627999999999997)
-    t598 = -t485
-    t599 = xp.less_equal(t598, 2.8973)
-    t600 = xp.greater_equal(t484, -2.8973) & xp.less_equal(t484, 2.8973)
-    t601 = -t513
-    t602 = xp.less_equal(t601, 2.8973)
-    t603 = xp.greater_equal(t512, -2.8973) & xp.less_equal(t512, 2.8973)
-    t604 = -t507
-    t605 = xp.less_equal(t604, 1.7627999999999997)
-    t606 = xp.greater_equal(t506, -1.7627999999999997) & xp.less_equal(t506, 1.7627999999999997)
-    t607 = -t501
-    t608 = xp.less_equal(t607, 2.8973)
-    t609 = xp.greater_equal(t500, -2.8973) & xp.less_equal(t500, 2.8973)
-    t610 = -t495
-    t611 = xp.less_equal(t610, 2.8973)
-    t612 = xp.greater_equal(t494, -2.8973) & xp.less_equal(t494, 2.8973)
-    t613 = xp.where(t611 & xp.logical_not(t612), t610, t494)
-    t614 = -t491
-    t615 = xp.less_equal(t614, 3.7525000000000004)
-    t616 = xp.greater_equal(t490, -0.0175) & xp.less_equal(t490, 3.7525000000000004)
-    t617 = xp.where(t615 & xp.logical_not(t616), t614, t490)
-    t618 = -t517
-    t619 = xp.less_equal(t618, 2.8973)
-    t620 = xp.greater_equal(t516, -2.8973) & xp.less_equal(t516, 2.8973)
-    t621 = xp.less_equal(t505, 1.7627999999999997)
-    t622 = xp.greater_equal(t504, -1.7627999999999997) & xp.less_equal(t504, 1.7627999999999997)
-    t623 = -t515
-    t624 = xp.less_equal(t623, 2.8973)
-    t625 = xp.greater_equal(t514, -2.8973) & xp.less_equal(t514, 2.8973)
-    t626 = xp.isfinite(t3)
-    t627 = xp.greater_equal(t58, -t59)
-    t628 = xp.greater_equal(t23, -1e-12)
-    t629 = xp.greater_equal(t229, -t230)
-    t630 = xp.greater_equal(q7, -2.8973)
-    t631 = xp.less_equal(q7, 2.8973)
-    t632 = t536 | t537
-    t633 = t532 | t533
-    t634 = t528 | t529
-    t635 = t561 | t562
-    t636 = t557 | t558
-    t637 = t590 | t591
-    t638 = t586 | t587
-    t639 = t582 | t583
-    t640 = t615 | t616
-    t641 = t611 | t612
+    t244 = 1e-24*t231
+    t245 = t20*t244
+    t246 = xp.less_equal(t241, t245)
+    t247 = xp.where(t246, 1, 1/xp.sqrt(t241))
+    t248 = xp.where(t246, 1, t235*t247)
+    t249 = xp.where(t246, 0, -t240*t247)
+    t250 = t10*t248 - T22*t249
+    t251 = T22*t248 + t10*t249
+    t252 = t8*t248 - T02*t249
+    t253 = T02*t248 + t8*t249
+    t254 = t48*t230
+    t255 = t223 - t254
+    t256 = t223 + t254
+    t257 = -t223
+    t258 = t255 + t257
+    t259 = t256 + t257
+    t260 = t19*t222
+    t261 = t258**2 + t260
+    t262 = t259**2 + t260
+    t263 = t224*t244
+    t264 = xp.less_equal(t261, t263)
+    t265 = xp.where(t264, 1, 1/xp.sqrt(t261))
+    t266 = xp.where(t264, 1, t258*t265)
+    t267 = t18*t48
+    t268 = xp.where(t264, 0, t265*t267)
+    t269 = xp.less_equal(t243, t245)
+    t270 = xp.where(t269, 1, 1/xp.sqrt(t243))
+    t271 = xp.where(t269, 1, t237*t270)
+    t272 = xp.where(t269, 0, -t242*t270)
+    t273 = t10*t271 - T22*t272
+    t274 = T22*t271 + t10*t272
+    t275 = t8*t271 - T02*t272
+    t276 = T02*t271 + t8*t272
+    t277 = xp.less_equal(t262, t263)
+    t278 = xp.where(t277, 1, 1/xp.sqrt(t262))
+    t279 = xp.where(t277, 1, t259*t278)
+    t280 = xp.where(t277, 0, t278*t267)
+    t281 = 1 - t248
+    t282 = t16*t281
+    t283 = t282 + t16*t248
+    t284 = t14*t281
+    t285 = t284 + t14*t248
+    t286 = t266*t250 + t268*t283
+    t287 = t266*t283 - t268*t250
+    t288 = t266*t252 + t268*t285
+    t289 = t266*t285 - t268*t252
+    t290 = 1 - t266
+    t291 = t251*t290
+    t292 = t291 + t266*t251
+    t293 = t253*t290
+    t294 = t293 + t266*t253
+    t295 = t36*t286 + t40*t292
+    t296 = t36*t292 - t40*t286
+    t297 = t36*t288 + t40*t294
+    t298 = t36*t294 - t40*t288
+    t299 = 1 + t36
+    t300 = t287*t299
+    t301 = t300 - t36*t287
+    t302 = t289*t299
+    t303 = t302 - t36*t289
+    t304 = t296**2
+    t305 = -t304
+    t306 = 1 + t305
+    t307 = xp.greater(t306, 1e-12)
+    t308 = xp.where(t307, xp.sqrt(t306), 0)
+    t309 = t304 + t295*t308
+    t310 = t309 + t305
+    t311 = t301**2
+    t312 = t295**2 + t311 + t304
+    t313 = t308**2
+    t314 = t310**2 + t311*t313
+    t315 = t304 + t313
+    t316 = 1e-24*t315
+    t317 = xp.less_equal(t314, t312*t316)
+    t318 = xp.where(t317, 1, 1/xp.sqrt(t314))
+    t319 = xp.where(t317, 1, t310*t318)
+    t320 = t298*(1 - t319)
+    t321 = t320 + t298*t319
+    t322 = t301*t308
+    t323 = xp.where(t317, 0, -t318*t322)
+    t324 = t303*t323 - t297*t319
+    t325 = t297*t323 + t303*t319
+    t326 = xp.less_equal(t315, t316)
+    t327 = xp.where(t326, 1, 1/xp.sqrt(t315))
+    t328 = xp.where(t326, 1, t296*t327)
+    t329 = xp.where(t326, 0, -t308*t327)
+    t330 = t325*(1 - t328)
+    t331 = t328*t324 - t329*t321
+    t332 = t330 + t328*t325
+    t333 = t328*t321 + t329*t324
+    t334 = t331**2 + t332**2
+    t335 = t334
+    t336 = t333**2 + t334
+    t337 = 1 - t271
+    t338 = t16*t337
+    t339 = t338 + t16*t271
+    t340 = t14*t337
+    t341 = t340 + t14*t271
+    t342 = t279*t273 + t280*t339
+    t343 = t279*t339 - t280*t273
+    t344 = t279*t275 + t280*t341
+    t345 = t279*t341 - t280*t275
+    t346 = t343*t299
+    t347 = t346 - t36*t343
+    t348 = t345*t299
+    t349 = t348 - t36*t345
+    t350 = 1 - t279
+    t351 = t274*t350
+    t352 = t351 + t279*t274
+    t353 = t276*t350
+    t354 = t353 + t279*t276
+    t355 = t36*t342 + t40*t352
+    t356 = t36*t352 - t40*t342
+    t357 = t36*t344 + t40*t354
+    t358 = t36*t354 - t40*t344
+    t359 = t356**2
+    t360 = -t359
+    t361 = 1 + t360
+    t362 = xp.greater(t361, 1e-12)
+    t363 = xp.where(t362, xp.sqrt(t361), 0)
+    t364 = t359 + t355*t363
+    t365 = t364 + t360
+    t366 = t347**2
+    t367 = t355**2 + t366 + t359
+    t368 = t363**2
+    t369 = t365**2 + t366*t368
+    t370 = t359 + t368
+    t371 = 1e-24*t370
+    t372 = xp.less_equal(t369, t367*t371)
+    t373 = xp.where(t372, 1, 1/xp.sqrt(t369))
+    t374 = xp.where(t372, 1, t365*t373)
+    t375 = t358*(1 - t374)
+    t376 = t375 + t358*t374
+    t377 = t347*t363
+    t378 = xp.where(t372, 0, -t373*t377)
+    t379 = t349*t378 - t357*t374
+    t380 = t357*t378 + t349*t374
+    t381 = xp.less_equal(t370, t371)
+    t382 = xp.where(t381, 1, 1/xp.sqrt(t370))
+    t383 = xp.where(t381, 1, t356*t382)
+    t384 = xp.where(t381, 0, -t363*t382)
+    t385 = t380*(1 - t383)
+    t386 = t383*t379 - t384*t376
+    t387 = t385 + t383*t380
+    t388 = t383*t376 + t384*t379
+    t389 = t386**2 + t387**2
+    t390 = t389
+    t391 = t388**2 + t389
+    t392 = xp.where(t76, 0, xp.atan2(-t70, t66))
+    t393 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t392)) + t392
+    t394 = -t393
+    t395 = t393 + 6.283185307179586*xp.floor(0.15915494309189535*(0.0175 + t394))
+    t396 = xp.where(t94, 0, xp.atan2(t97, t88))
+    t397 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t396)) + t396
+    t398 = -t397
+    t399 = t397 + 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t398))
+    t400 = -t32
+    t401 = t32 + 6.283185307179586*xp.floor(0.15915494309189535*(3.0718 + t400))
+    t402 = xp.where(t147, 0, xp.atan2(-t152, t140))
+    t403 = 3.141592653589793 + t402
+    t404 = 6.283185307179586*xp.ceil(-0.15915494309189535*t403) + t402
+    t405 = t403 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t403))
+    t406 = -t404
+    t407 = t404 + 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t406))
+    t408 = xp.where(t156, 0, xp.atan2(-t138, -t126))
+    t409 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t408)) + t408
+    t410 = t408
+    t411 = t410 - 6.283185307179586*xp.floor(0.15915494309189535*(1.7627999999999997 + t410))
+    t412 = -t409
+    t413 = t409 + 6.283185307179586*xp.floor(0.15915494309189535*(1.7627999999999997 + t412))
+    t414 = xp.where(xp.less_equal(t165, 1e-24*t166), 0, xp.atan2(t162, t161))
+    t415 = 3.141592653589793 + t414
+    t416 = 6.283185307179586*xp.ceil(-0.15915494309189535*t415) + t414
+    t417 = t415 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t415))
+    t418 = -t416
+    t419 = t416 + 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t418))
+    t420 = -t405
+    t421 = t405 + 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t420))
+    t422 = -t417
+    t423 = t417 + 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t422))
+    t424 = xp.where(t99, 0, xp.atan2(-t72, t67))
+    t425 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t424)) + t424
+    t426 = -t425
+    t427 = t425 + 6.283185307179586*xp.floor(0.15915494309189535*(0.0175 + t426))
+    t428 = xp.where(t107, 0, xp.atan2(t97, t89))
+    t429 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t428)) + t428
+    t430 = -t429
+    t431 = t429 + 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t430))
+    t432 = xp.where(t202, 0, xp.atan2(-t207, t195))
+    t433 = 3.141592653589793 + t432
+    t434 = 6.283185307179586*xp.ceil(-0.15915494309189535*t433) + t432
+    t435 = t433 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t433))
+    t436 = -t434
+    t437 = t434 + 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t436))
+    t438 = xp.where(t211, 0, xp.atan2(-t193, -t186))
+    t439 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t438)) + t438
+    t440 = t438
+    t441 = t440 - 6.283185307179586*xp.floor(0.15915494309189535*(1.7627999999999997 + t440))
+    t442 = -t439
+    t443 = t439 + 6.283185307179586*xp.floor(0.15915494309189535*(1.7627999999999997 + t442))
+    t444 = xp.where(xp.less_equal(t220, 1e-24*t221), 0, xp.atan2(t217, t216))
+    t445 = 3.141592653589793 + t444
+    t446 = 6.283185307179586*xp.ceil(-0.15915494309189535*t445) + t444
+    t447 = t445 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t445))
+    t448 = -t446
+    t449 = t446 + 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t448))
+    t450 = -t435
+    t451 = t435 + 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t450))
+    t452 = -t447
+    t453 = t447 + 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t452))
+    t454 = xp.where(t246, 0, xp.atan2(-t240, t235))
+    t455 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t454)) + t454
+    t456 = -t455
+    t457 = t455 + 6.283185307179586*xp.floor(0.15915494309189535*(0.0175 + t456))
+    t458 = xp.where(t264, 0, xp.atan2(t267, t258))
+    t459 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t458)) + t458
+    t460 = -t459
+    t461 = t459 + 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t460))
+    t462 = -t30
+    t463 = t30 + 6.283185307179586*xp.floor(0.15915494309189535*(3.0718 + t462))
+    t464 = xp.where(t317, 0, xp.atan2(-t322, t310))
+    t465 = 3.141592653589793 + t464
+    t466 = 6.283185307179586*xp.ceil(-0.15915494309189535*t465) + t464
+    t467 = t465 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t465))
+    t468 = -t466
+    t469 = t466 + 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t468))
+    t470 = xp.where(t326, 0, xp.atan2(-t308, t296))
+    t471 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t470)) + t470
+    t472 = t470
+    t473 = t472 - 6.283185307179586*xp.floor(0.15915494309189535*(1.7627999999999997 + t472))
+    t474 = -t471
+    t475 = t471 + 6.283185307179586*xp.floor(0.15915494309189535*(1.7627999999999997 + t474))
+    t476 = xp.where(xp.less_equal(t335, 1e-24*t336), 0, xp.atan2(t332, t331))
+    t477 = 3.141592653589793 + t476
+    t478 = 6.283185307179586*xp.ceil(-0.15915494309189535*t477) + t476
+    t479 = t477 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t477))
+    t480 = -t478
+    t481 = t478 + 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t480))
+    t482 = -t467
+    t483 = t467 + 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t482))
+    t484 = -t479
+    t485 = t479 + 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t484))
+    t486 = xp.where(t269, 0, xp.atan2(-t242, t237))
+    t487 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t486)) + t486
+    t488 = -t487
+    t489 = t487 + 6.283185307179586*xp.floor(0.15915494309189535*(0.0175 + t488))
+    t490 = xp.where(t277, 0, xp.atan2(t267, t259))
+    t491 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t490)) + t490
+    t492 = -t491
+    t493 = t491 + 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t492))
+    t494 = xp.where(t372, 0, xp.atan2(-t377, t365))
+    t495 = 3.141592653589793 + t494
+    t496 = 6.283185307179586*xp.ceil(-0.15915494309189535*t495) + t494
+    t497 = t495 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t495))
+    t498 = -t496
+    t499 = t496 + 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t498))
+    t500 = xp.where(t381, 0, xp.atan2(-t363, t356))
+    t501 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t500)) + t500
+    t502 = t500
+    t503 = t502 - 6.283185307179586*xp.floor(0.15915494309189535*(1.7627999999999997 + t502))
+    t504 = -t501
+    t505 = t501 + 6.283185307179586*xp.floor(0.15915494309189535*(1.7627999999999997 + t504))
+    t506 = xp.where(xp.less_equal(t390, 1e-24*t391), 0, xp.atan2(t387, t386))
+    t507 = 3.141592653589793 + t506
+    t508 = 6.283185307179586*xp.ceil(-0.15915494309189535*t507) + t506
+    t509 = t507 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t507))
+    t510 = -t508
+    t511 = t508 + 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t510))
+    t512 = -t497
+    t513 = t497 + 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t512))
+    t514 = -t509
+    t515 = t509 + 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t514))
+    t516 = -t419
+    t517 = xp.less_equal(t516, 2.8973)
+    t518 = xp.greater_equal(t418, -2.8973) & xp.less_equal(t418, 2.8973)
+    t519 = -t413
+    t520 = xp.less_equal(t519, 1.7627999999999997)
+    t521 = xp.greater_equal(t412, -1.7627999999999997) & xp.less_equal(t412, 1.7627999999999997)
+    t522 = -t407
+    t523 = xp.less_equal(t522, 2.8973)
+    t524 = xp.greater_equal(t406, -2.8973) & xp.less_equal(t406, 2.8973)
+    t525 = -t401
+    t526 = xp.less_equal(t525, -0.0698)
+    t527 = xp.greater_equal(t400, -3.0718) & xp.less_equal(t400, -0.0698)
+    t528 = xp.where(t526 & xp.logical_not(t527), t525, t400)
+    t529 = -t399
+    t530 = xp.less_equal(t529, 2.8973)
+    t531 = xp.greater_equal(t398, -2.8973) & xp.less_equal(t398, 2.8973)
+    t532 = xp.where(t530 & xp.logical_not(t531), t529, t398)
+    t533 = -t395
+    t534 = xp.less_equal(t533, 3.7525000000000004)
+    t535 = xp.greater_equal(t394, -0.0175) & xp.less_equal(t394, 3.7525000000000004)
+    t536 = xp.where(t534 & xp.logical_not(t535), t533, t394)
+    t537 = -t423
+    t538 = xp.less_equal(t537, 2.8973)
+    t539 = xp.greater_equal(t422, -2.8973) & xp.less_equal(t422, 2.8973)
+    t540 = xp.less_equal(t411, 1.7627999999999997)
+    t541 = xp.greater_equal(t410, -1.7627999999999997) & xp.less_equal(t410, 1.7627999999999997)
+    t542 = -t421
+    t543 = xp.less_equal(t542, 2.8973)
+    t544 = xp.greater_equal(t420, -2.8973) & xp.less_equal(t420, 2.8973)
+    t545 = -t449
+    t546 = xp.less_equal(t545, 2.8973)
+    t547 = xp.greater_equal(t448, -2.8973) & xp.less_equal(t448, 2.8973)
+    t548 = -t443
+    t549 = xp.less_equal(t548, 1.7627999999999997)
+    t550 = xp.greater_equal(t442, -1.7627999999999997) & xp.less_equal(t442, 1.7627999999999997)
+    t551 = -t437
+    t552 = xp.less_equal(t551, 2.8973)
+    t553 = xp.greater_equal(t436, -2.8973) & xp.less_equal(t436, 2.8973)
+    t554 = -t431
+    t555 = xp.less_equal(t554, 2.8973)
+    t556 = xp.greater_equal(t430, -2.8973) & xp.less_equal(t430, 2.8973)
+    t557 = xp.where(t555 & xp.logical_not(t556), t554, t430)
+    t558 = -t427
+    t559 = xp.less_equal(t558, 3.7525000000000004)
+    t560 = xp.greater_equal(t426, -0.0175) & xp.less_equal(t426, 3.7525000000000004)
+    t561 = xp.where(t559 & xp.logical_not(t560), t558, t426)
+    t562 = -t453
+    t563 = xp.less_equal(t562, 2.8973)
+    t564 = xp.greater_equal(t452, -2.8973) & xp.less_equal(t452, 2.8973)
+    t565 = xp.less_equal(t441, 1.7627999999999997)
+    t566 = xp.greater_equal(t440, -1.7627999999999997) & xp.less_equal(t440, 1.7627999999999997)
+    t567 = -t451
+    t568 = xp.less_equal(t567, 2.8973)
+    t569 = xp.greater_equal(t450, -2.8973) & xp.less_equal(t450, 2.8973)
+    t570 = -t481
+    t571 = xp.less_equal(t570, 2.8973)
+    t572 = xp.greater_equal(t480, -2.8973) & xp.less_equal(t480, 2.8973)
+    t573 = -t475
+    t574 = xp.less_equal(t573, 1.7627999999999997)
+    t575 = xp.greater_equal(t474, -1.7627999999999997) & xp.less_equal(t474, 1.7627999999999997)
+    t576 = -t469
+    t577 = xp.less_equal(t576, 2.8973)
+    t578 = xp.greater_equal(t468, -2.8973) & xp.less_equal(t468, 2.8973)
+    t579 = -t463
+    t580 = xp.less_equal(t579, -0.0698)
+    t581 = xp.greater_equal(t462, -3.0718) & xp.less_equal(t462, -0.0698)
+    t582 = xp.where(t580 & xp.logical_not(t581), t579, t462)
+    t583 = -t461
+    t584 = xp.less_equal(t583, 2.8973)
+    t585 = xp.greater_equal(t460, -2.8973) & xp.less_equal(t460, 2.8973)
+    t586 = xp.where(t584 & xp.logical_not(t585), t583, t460)
+    t587 = -t457
+    t588 = xp.less_equal(t587, 3.7525000000000004)
+    t589 = xp.greater_equal(t456, -0.0175) & xp.less_equal(t456, 3.7525000000000004)
+    t590 = xp.where(t588 & xp.logical_not(t589), t587, t456)
+    t591 = -t485
+    t592 = xp.less_equal(t591, 2.8973)
+    t593 = xp.greater_equal(t484, -2.8973) & xp.less_equal(t484, 2.8973)
+    t594 = xp.less_equal(t473, 1.7627999999999997)
+    t595 = xp.greater_equal(t472, -1.7627999999999997) & xp.less_equal(t472, 1.7627999999999997)
+    t596 = -t483
+    t597 = xp.less_equal(t596, 2.8973)
+    t598 = xp.greater_equal(t482, -2.8973) & xp.less_equal(t482, 2.8973)
+    t599 = -t511
+    t600 = xp.less_equal(t599, 2.8973)
+    t601 = xp.greater_equal(t510, -2.8973) & xp.less_equal(t510, 2.8973)
+    t602 = -t505
+    t603 = xp.less_equal(t602, 1.7627999999999997)
+    t604 = xp.greater_equal(t504, -1.7627999999999997) & xp.less_equal(t504, 1.7627999999999997)
+    t605 = -t499
+    t606 = xp.less_equal(t605, 2.8973)
+    t607 = xp.greater_equal(t498, -2.8973) & xp.less_equal(t498, 2.8973)
+    t608 = -t493
+    t609 = xp.less_equal(t608, 2.8973)
+    t610 = xp.greater_equal(t492, -2.8973) & xp.less_equal(t492, 2.8973)
+    t611 = xp.where(t609 & xp.logical_not(t610), t608, t492)
+    t612 = -t489
+    t613 = xp.less_equal(t612, 3.7525000000000004)
+    t614 = xp.greater_equal(t488, -0.0175) & xp.less_equal(t488, 3.7525000000000004)
+    t615 = xp.where(t613 & xp.logical_not(t614), t612, t488)
+    t616 = -t515
+    t617 = xp.less_equal(t616, 2.8973)
+    t618 = xp.greater_equal(t514, -2.8973) & xp.less_equal(t514, 2.8973)
+    t619 = xp.less_equal(t503, 1.7627999999999997)
+    t620 = xp.greater_equal(t502, -1.7627999999999997) & xp.less_equal(t502, 1.7627999999999997)
+    t621 = -t513
+    t622 = xp.less_equal(t621, 2.8973)
+    t623 = xp.greater_equal(t512, -2.8973) & xp.less_equal(t512, 2.8973)
+    t624 = xp.isfinite(t3)
+    t625 = xp.greater_equal(t56, -t57)
+    t626 = xp.greater_equal(t23, -1e-12)
+    t627 = xp.greater_equal(t227, -t228)
+    t628 = xp.greater_equal(q7, -2.8973)
+    t629 = xp.less_equal(q7, 2.8973)
+    t630 = t534 | t535
+    t631 = t530 | t531
+    t632 = t526 | t527
+    t633 = t559 | t560
+    t634 = t555 | t556
+    t635 = t588 | t589
+    t636 = t584 | t585
+    t637 = t580 | t581
+    t638 = t613 | t614
+    t639 = t609 | t610
     q = _stack(xp, [
-        xp.where(t519 & xp.logical_not(t520), t518, t420),  # 0, 0
-        xp.where(t522 & xp.logical_not(t523), t521, t414),  # 0, 1
-        xp.where(t525 & xp.logical_not(t526), t524, t408),  # 0, 2
-        t530,  # 0, 3
-        t534,  # 0, 4
-        t538,  # 0, 5
+        xp.where(t517 & xp.logical_not(t518), t516, t418),  # 0, 0
+        xp.where(t520 & xp.logical_not(t521), t519, t412),  # 0, 1
+        xp.where(t523 & xp.logical_not(t524), t522, t406),  # 0, 2
+        t528,  # 0, 3
+        t532,  # 0, 4
+        t536,  # 0, 5
         q7,  # 0, 6
-        xp.where(t540 & xp.logical_not(t541), t539, t424),  # 1, 0
-        xp.where(t542 & xp.logical_not(t543), t413, t412),  # 1, 1
-        xp.where(t545 & xp.logical_not(t546), t544, t422),  # 1, 2
-        t530,  # 1, 3
-        t534,  # 1, 4
-        t538,  # 1, 5
+        xp.where(t538 & xp.logical_not(t539), t537, t422),  # 1, 0
+        xp.where(t540 & xp.logical_not(t541), t411, t410),  # 1, 1
+        xp.where(t543 & xp.logical_not(t544), t542, t420),  # 1, 2
+        t528,  # 1, 3
+        t532,  # 1, 4
+        t536,  # 1, 5
         q7,  # 1, 6
-        xp.where(t548 & xp.logical_not(t549), t547, t450),  # 2, 0
-        xp.where(t551 & xp.logical_not(t552), t550, t444),  # 2, 1
-        xp.where(t554 & xp.logical_not(t555), t553, t438),  # 2, 2
-        t530,  # 2, 3
-        t559,  # 2, 4
-        t563,  # 2, 5
+        xp.where(t546 & xp.logical_not(t547), t545, t448),  # 2, 0
+        xp.where(t549 & xp.logical_not(t550), t548, t442),  # 2, 1
+        xp.where(t552 & xp.logical_not(t553), t551, t436),  # 2, 2
+        t528,  # 2, 3
+        t557,  # 2, 4
+        t561,  # 2, 5
         q7,  # 2, 6
-        xp.where(t565 & xp.logical_not(t566), t564, t454),  # 3, 0
-        xp.where(t567 & xp.logical_not(t568), t443, t442),  # 3, 1
-        xp.where(t570 & xp.logical_not(t571), t569, t452),  # 3, 2
-        t530,  # 3, 3
-        t559,  # 3, 4
-        t563,  # 3, 5
+        xp.where(t563 & xp.logical_not(t564), t562, t452),  # 3, 0
+        xp.where(t565 & xp.logical_not(t566), t441, t440),  # 3, 1
+        xp.where(t568 & xp.logical_not(t569), t567, t450),  # 3, 2
+        t528,  # 3, 3
+        t557,  # 3, 4
+        t561,  # 3, 5
         q7,  # 3, 6
-        xp.where(t573 & xp.logical_not(t574), t572, t482),  # 4, 0
-        xp.where(t576 & xp.logical_not(t577), t575, t476),  # 4, 1
-        xp.where(t579 & xp.logical_not(t580), t578, t470),  # 4, 2
-        t584,  # 4, 3
-        t588,  # 4, 4
-        t592,  # 4, 5
+        xp.where(t571 & xp.logical_not(t572), t570, t480),  # 4, 0
+        xp.where(t574 & xp.logical_not(t575), t573, t474),  # 4, 1
+        xp.where(t577 & xp.logical_not(t578), t576, t468),  # 4, 2
+        t582,  # 4, 3
+        t586,  # 4, 4
+        t590,  # 4, 5
         q7,  # 4, 6
-        xp.where(t594 & xp.logical_not(t595), t593, t486),  # 5, 0
-        xp.where(t596 & xp.logical_not(t597), t475, t474),  # 5, 1
-        xp.where(t599 & xp.logical_not(t600), t598, t484),  # 5, 2
-        t584,  # 5, 3
-        t588,  # 5, 4
-        t592,  # 5, 5
+        xp.where(t592 & xp.logical_not(t593), t591, t484),  # 5, 0
+        xp.where(t594 & xp.logical_not(t595), t473, t472),  # 5, 1
+        xp.where(t597 & xp.logical_not(t598), t596, t482),  # 5, 2
+        t582,  # 5, 3
+        t586,  # 5, 4
+        t590,  # 5, 5
         q7,  # 5, 6
-        xp.where(t602 & xp.logical_not(t603), t601, t512),  # 6, 0
-        xp.where(t605 & xp.logical_not(t606), t604, t506),  # 6, 1
-        xp.where(t608 & xp.logical_not(t609), t607, t500),  # 6, 2
-        t584,  # 6, 3
-        t613,  # 6, 4
-        t617,  # 6, 5
+        xp.where(t600 & xp.logical_not(t601), t599, t510),  # 6, 0
+        xp.where(t603 & xp.logical_not(t604), t602, t504),  # 6, 1
+        xp.where(t606 & xp.logical_not(t607), t605, t498),  # 6, 2
+        t582,  # 6, 3
+        t611,  # 6, 4
+        t615,  # 6, 5
         q7,  # 6, 6
-        xp.where(t619 & xp.logical_not(t620), t618, t516),  # 7, 0
-        xp.where(t621 & xp.logical_not(t622), t505, t504),  # 7, 1
-        xp.where(t624 & xp.logical_not(t625), t623, t514),  # 7, 2
-        t584,  # 7, 3
-        t613,  # 7, 4
-        t617,  # 7, 5
+        xp.where(t617 & xp.logical_not(t618), t616, t514),  # 7, 0
+        xp.where(t619 & xp.logical_not(t620), t503, t502),  # 7, 1
+        xp.where(t622 & xp.logical_not(t623), t621, t512),  # 7, 2
+        t582,  # 7, 3
+        t611,  # 7, 4
+        t615,  # 7, 5
         q7,  # 7, 6
     ], (8, 7))
     valid = _stack(xp, [
-        t626 & t627 & t628 & xp.greater_equal(t138, -1e-12),  # 0
-        t626 & t627 & t628 & t139,  # 1
-        t60 & t626 & t628 & xp.greater_equal(t193, -1e-12),  # 2
-        t60 & t626 & t628 & t194,  # 3
-        t626 & t629 & t24 & xp.greater_equal(t308, -1e-12),  # 4
-        t626 & t629 & t24 & t309,  # 5
-        t626 & t231 & t24 & xp.greater_equal(t363, -1e-12),  # 6
-        t364 & t626 & t231 & t24,  # 7
+        t624 & xp.greater_equal(t136, -1e-12) & t625 & t626,  # 0
+        t624 & t137 & t625 & t626,  # 1
+        t624 & xp.greater_equal(t191, -1e-12) & t58 & t626,  # 2
+        t624 & t192 & t58 & t626,  # 3
+        t624 & t24 & xp.greater_equal(t306, -1e-12) & t627,  # 4
+        t624 & t24 & t307 & t627,  # 5
+        t624 & t24 & xp.greater_equal(t361, -1e-12) & t229,  # 6
+        t624 & t24 & t362 & t229,  # 7
     ], (8,))
     in_limits = _stack(xp, [
-        t630 & t631 & t632 & t633 & t634 & (t519 | t520) & (t522 | t523) & (t525 | t526),  # 0
-        t630 & t631 & t632 & t633 & t634 & (t540 | t541) & (t542 | t543) & (t545 | t546),  # 1
-        t630 & t631 & t634 & t635 & t636 & (t548 | t549) & (t551 | t552) & (t554 | t555),  # 2
-        t630 & t631 & t634 & t635 & t636 & (t565 | t566) & (t567 | t568) & (t570 | t571),  # 3
-        t630 & t631 & t637 & t638 & t639 & (t573 | t574) & (t576 | t577) & (t579 | t580),  # 4
-        t630 & t631 & t637 & t638 & t639 & (t594 | t595) & (t596 | t597) & (t599 | t600),  # 5
-        t630 & t631 & t639 & t640 & t641 & (t602 | t603) & (t605 | t606) & (t608 | t609),  # 6
-        t630 & t631 & t639 & t640 & t641 & (t619 | t620) & (t621 | t622) & (t624 | t625),  # 7
+        t628 & t629 & t630 & t631 & t632 & (t523 | t524) & (t520 | t521) & (t517 | t518),  # 0
+        t628 & t629 & (t540 | t541) & t630 & t631 & t632 & (t543 | t544) & (t538 | t539),  # 1
+        t628 & t629 & t632 & t633 & t634 & (t552 | t553) & (t549 | t550) & (t546 | t547),  # 2
+        t628 & t629 & (t565 | t566) & t632 & t633 & t634 & (t568 | t569) & (t563 | t564),  # 3
+        t628 & t629 & t635 & t636 & t637 & (t577 | t578) & (t574 | t575) & (t571 | t572),  # 4
+        t628 & t629 & (t594 | t595) & t635 & t636 & t637 & (t597 | t598) & (t592 | t593),  # 5
+        t628 & t629 & t637 & t638 & t639 & (t606 | t607) & (t603 | t604) & (t600 | t601),  # 6
+        t628 & t629 & (t619 | t620) & t637 & t638 & t639 & (t622 | t623) & (t617 | t618),  # 7
     ], (8,))
     return q, valid, in_limits
 

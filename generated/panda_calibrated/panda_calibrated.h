@@ -37,39 +37,39 @@ typedef double panda_calibrated_real;
 #define PANDA_CALIBRATED_IK_FREE_JOINT 6
 
 /* Pose of the tool frame in the world frame (4x4 homogeneous).
- * Result: T: 4 x 4 row-major, element (r, c) at T[r * 4 + c]. 317 operations. */
+ * Result: T: 4 x 4 row-major, element (r, c) at T[r * 4 + c]. 316 operations. */
 void panda_calibrated_fk(const panda_calibrated_real q[PANDA_CALIBRATED_DOF], panda_calibrated_real T[16]);
 
 /* Geometric Jacobian in the world frame (6 x DOF, rows vx vy vz wx wy wz).
- * Result: J: 6 x 7 row-major, element (r, c) at J[r * 7 + c]. 330 operations. */
+ * Result: J: 6 x 7 row-major, element (r, c) at J[r * 7 + c]. 328 operations. */
 void panda_calibrated_jacobian(const panda_calibrated_real q[PANDA_CALIBRATED_DOF], panda_calibrated_real J[6 * PANDA_CALIBRATED_DOF]);
 
 /* Fk and jacobian in one pass, sharing their terms.
- * Result: T: 4 x 4 row-major, element (r, c) at T[r * 4 + c]; J: 6 x 7 row-major, element (r, c) at J[r * 7 + c]. 378 operations. */
+ * Result: T: 4 x 4 row-major, element (r, c) at T[r * 4 + c]; J: 6 x 7 row-major, element (r, c) at J[r * 7 + c]. 376 operations. */
 void panda_calibrated_fk_jacobian(const panda_calibrated_real q[PANDA_CALIBRATED_DOF], panda_calibrated_real T[16], panda_calibrated_real J[6 * PANDA_CALIBRATED_DOF]);
 
 /* Geometric Jacobian in the tool frame (6 x DOF, rows vx vy vz wx wy wz).
- * Result: J: 6 x 7 row-major, element (r, c) at J[r * 7 + c]. 580 operations. */
+ * Result: J: 6 x 7 row-major, element (r, c) at J[r * 7 + c]. 578 operations. */
 void panda_calibrated_jacobian_tool(const panda_calibrated_real q[PANDA_CALIBRATED_DOF], panda_calibrated_real J[6 * PANDA_CALIBRATED_DOF]);
 
 /* Task vector mu = (x, y, z, roll, pitch, yaw).
- * Result: mu[i], i < 6. 320 operations. */
+ * Result: mu[i], i < 6. 319 operations. */
 void panda_calibrated_task(const panda_calibrated_real q[PANDA_CALIBRATED_DOF], panda_calibrated_real mu[PANDA_CALIBRATED_TASK_DIM]);
 
 /* Analytic Jacobian d mu / d q (6 x DOF).
- * Result: J: 6 x 7 row-major, element (r, c) at J[r * 7 + c]. 442 operations. */
+ * Result: J: 6 x 7 row-major, element (r, c) at J[r * 7 + c]. 440 operations. */
 void panda_calibrated_task_jacobian(const panda_calibrated_real q[PANDA_CALIBRATED_DOF], panda_calibrated_real J[PANDA_CALIBRATED_TASK_DIM * PANDA_CALIBRATED_DOF]);
 
 /* Fk, jacobian and bias_acceleration in one pass, sharing their terms.
- * Result: T: 4 x 4 row-major, element (r, c) at T[r * 4 + c]; J: 6 x 7 row-major, element (r, c) at J[r * 7 + c]; a[i], i < 6. 695 operations. */
+ * Result: T: 4 x 4 row-major, element (r, c) at T[r * 4 + c]; J: 6 x 7 row-major, element (r, c) at J[r * 7 + c]; a[i], i < 6. 694 operations. */
 void panda_calibrated_fk_jacobian_dot(const panda_calibrated_real q[PANDA_CALIBRATED_DOF], const panda_calibrated_real q_dot[PANDA_CALIBRATED_DOF], panda_calibrated_real T[16], panda_calibrated_real J[6 * PANDA_CALIBRATED_DOF], panda_calibrated_real a[6]);
 
 /* Time derivative dJ/dt of the world geometric Jacobian along q_dot (6 x DOF).
- * Result: Jd: 6 x 7 row-major, element (r, c) at Jd[r * 7 + c]. 576 operations. */
+ * Result: Jd: 6 x 7 row-major, element (r, c) at Jd[r * 7 + c]. 574 operations. */
 void panda_calibrated_jacobian_dot(const panda_calibrated_real q[PANDA_CALIBRATED_DOF], const panda_calibrated_real q_dot[PANDA_CALIBRATED_DOF], panda_calibrated_real Jd[6 * PANDA_CALIBRATED_DOF]);
 
 /* J' q_dot: the tool's classical linear and angular acceleration at zero joint acceleration, world frame (6).
- * Result: a[i], i < 6. 642 operations. */
+ * Result: a[i], i < 6. 641 operations. */
 void panda_calibrated_bias_acceleration(const panda_calibrated_real q[PANDA_CALIBRATED_DOF], const panda_calibrated_real q_dot[PANDA_CALIBRATED_DOF], panda_calibrated_real a[6]);
 
 /* Time derivative of the analytic Jacobian along q_dot (6 x DOF): mu'' = J_a q'' + J_a' q'.
@@ -77,35 +77,35 @@ void panda_calibrated_bias_acceleration(const panda_calibrated_real q[PANDA_CALI
 void panda_calibrated_task_jacobian_dot(const panda_calibrated_real q[PANDA_CALIBRATED_DOF], const panda_calibrated_real q_dot[PANDA_CALIBRATED_DOF], panda_calibrated_real Jd[PANDA_CALIBRATED_TASK_DIM * PANDA_CALIBRATED_DOF]);
 
 /* Partial derivatives dJ/dq_k of the world geometric Jacobian (DOF x 6 x DOF, indexed [k, r, c]).
- * Result: H: 7 x 6 x 7 row-major, element (k, r, c) at H[k * 42 + r * 7 + c]. 729 operations. */
+ * Result: H: 7 x 6 x 7 row-major, element (k, r, c) at H[k * 42 + r * 7 + c]. 717 operations. */
 void panda_calibrated_hessian(const panda_calibrated_real q[PANDA_CALIBRATED_DOF], panda_calibrated_real H[PANDA_CALIBRATED_DOF * 6 * PANDA_CALIBRATED_DOF]);
 
 /* Factors of det(Js Js^T): the robot is singular where one is 0.
- * Result: f[i], i < 1. 1056 operations. */
+ * Result: f[i], i < 1. 1049 operations. */
 void panda_calibrated_singularity_factors(const panda_calibrated_real q[PANDA_CALIBRATED_DOF], panda_calibrated_real f[PANDA_CALIBRATED_NUM_SINGULARITY_FACTORS]);
 
 /* Manipulability sqrt(det(Js Js^T)).
- * Result: returned as a scalar. 1059 operations. */
+ * Result: returned as a scalar. 1052 operations. */
 panda_calibrated_real panda_calibrated_manipulability(const panda_calibrated_real q[PANDA_CALIBRATED_DOF]);
 
 /* Joint rates q_dot solving Js q_dot = mu_dot: Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status.
- * Result: q_dot[i], i < 7; returned as a scalar. 1306 operations. */
+ * Result: q_dot[i], i < 7; returned as a scalar. 1305 operations. */
 int panda_calibrated_velocity_ik(const panda_calibrated_real q[PANDA_CALIBRATED_DOF], const panda_calibrated_real mu_dot[PANDA_CALIBRATED_TASK_DIM], panda_calibrated_real damping, panda_calibrated_real q_dot[PANDA_CALIBRATED_DOF]);
 
 /* One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite).
- * Result: q_start[i], i < 7; q_next[i], i < 7; returned as a scalar. 1394 operations. */
+ * Result: q_start[i], i < 7; q_next[i], i < 7; returned as a scalar. 1393 operations. */
 panda_calibrated_real panda_calibrated_ik_numeric_step(const panda_calibrated_real target[16], const panda_calibrated_real q[PANDA_CALIBRATED_DOF], panda_calibrated_real damping, panda_calibrated_real q_start[PANDA_CALIBRATED_DOF], panda_calibrated_real q_next[PANDA_CALIBRATED_DOF]);
 
 /* The general 6R solver's equations at T: (P0 + s Ps + c Pc) v_bc = Q v_gh, P = [P0; Ps; Pc] (42 x 9).
- * Result: P: 42 x 9 row-major, element (r, c) at P[r * 9 + c]; Q: 14 x 8 row-major, element (r, c) at Q[r * 8 + c]. 1138 operations. */
+ * Result: P: 42 x 9 row-major, element (r, c) at P[r * 9 + c]; Q: 14 x 8 row-major, element (r, c) at Q[r * 8 + c]. 1105 operations. */
 void panda_calibrated_ik_general_equations(const panda_calibrated_real T[16], panda_calibrated_real q_free, panda_calibrated_real P[378], panda_calibrated_real Q[112]);
 
 /* The configuration of one root's loop angles (a - shift, b, c, g, h; the loop's free joint from the loop).
- * Result: q[i], i < 7. 195 operations. */
+ * Result: q[i], i < 7. 194 operations. */
 void panda_calibrated_ik_general_start(const panda_calibrated_real T[16], panda_calibrated_real q_free, const panda_calibrated_real angles[5], panda_calibrated_real q[PANDA_CALIBRATED_DOF]);
 
 /* The pose error e at q (the position error and the rotation vector of R_target R^T, world frame) and the geometric Jacobian J of the six joints ik solves: the Newton step of the solver's polish is q + J^-1 e.
- * Result: e[i], i < 6; J: 6 x 6 row-major, element (r, c) at J[r * 6 + c]. 484 operations. */
+ * Result: e[i], i < 6; J: 6 x 6 row-major, element (r, c) at J[r * 6 + c]. 482 operations. */
 void panda_calibrated_ik_general_residual(const panda_calibrated_real target[16], const panda_calibrated_real q[PANDA_CALIBRATED_DOF], panda_calibrated_real e[6], panda_calibrated_real J[6 * 6]);
 
 /* Ik's form of q (revolute angles wrapped, or into the limits) and whether it is inside the joint limits.
@@ -113,7 +113,7 @@ void panda_calibrated_ik_general_residual(const panda_calibrated_real target[16]
 int panda_calibrated_ik_general_limits(const panda_calibrated_real q_solution[PANDA_CALIBRATED_DOF], panda_calibrated_real q[PANDA_CALIBRATED_DOF]);
 
 /* The fast path's starting points: every branch of the nearest special class's closed form (the nominal arm's), whether its target allows it, and the least margin of its subproblems.
- * Result: q: 8 x 7 row-major, element (r, c) at q[r * 7 + c]; valid[i], i < 8; returned as a scalar. 2762 operations. */
+ * Result: q: 8 x 7 row-major, element (r, c) at q[r * 7 + c]; valid[i], i < 8; returned as a scalar. 2741 operations. */
 panda_calibrated_real panda_calibrated_ik_general_nominal(const panda_calibrated_real T[16], panda_calibrated_real q_free, panda_calibrated_real q[56], int valid[8]);
 
 /* The closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status.

@@ -503,7 +503,7 @@ int planar_2r_velocity_ik(const planar_2r_real q[PLANAR_2R_DOF], const planar_2r
     const planar_2r_real t22 = (t19 > 0 ? 1/(t19*(t19 + fabs(t14))) : 0);
     const planar_2r_real t23 = -t22*(t2*t21 + t2*t16);
     const planar_2r_real t24 = t2 + t21*t23;
-    const planar_2r_real t25 = t16 + t2*t23;
+    const planar_2r_real t25 = t2*t23 + t16;
     const planar_2r_real t26 = t22*(t21*mu_dot0 - t2*mu_dot1);
     const planar_2r_real t27 = mu_dot0 - t21*t26;
     const planar_2r_real t28 = mu_dot1 + t2*t26;
@@ -539,7 +539,7 @@ int planar_2r_velocity_ik(const planar_2r_real q[PLANAR_2R_DOF], const planar_2r
     const planar_2r_real t58 = 1e-12*t12;
     const int t59 = damping > 0;
     const planar_2r_real t60 = 1e-12*t18;
-    const int t61 = (t59 && ((t19 <= t60) || (t30 <= t60))) || (damping <= 0 && ((t7 <= t58) || (t49 <= t58)));
+    const int t61 = (damping <= 0 && ((t7 <= t58) || (t49 <= t58))) || (t59 && ((t19 <= t60) || (t30 <= t60)));
     const int t62 = t56 && t57 && !t61;
 
     /* Outputs */
@@ -587,7 +587,7 @@ planar_2r_real planar_2r_ik_numeric_step(const planar_2r_real target[PLANAR_2R_T
     const planar_2r_real t17 = t4 + damping;
     const planar_2r_real t18 = -t13*(t3*t12 + t3*t17);
     const planar_2r_real t19 = t3 + t12*t18;
-    const planar_2r_real t20 = t17 + t3*t18;
+    const planar_2r_real t20 = t3*t18 + t17;
     const planar_2r_real t21 = fabs(t20);
     const planar_2r_real t22 = t21;
     const planar_2r_real t23 = t22*(t20 >= 0 ? 1 : -1);
@@ -649,7 +649,7 @@ void planar_2r_ik_branches(const planar_2r_real mu[PLANAR_2R_TASK_DIM], planar_2
     q[2] = (t22 <= t23*t24 ? 0 : atan2(t21, t20));
     q[3] = t9 - 6.283185307179586*ceil(0.15915494309189535*(-3.141592653589793 + t9));
     valid[0] = t25 && t4 >= -1e-12;
-    valid[1] = t5 && t25;
+    valid[1] = t25 && t5;
     in_limits[0] = 1;
     in_limits[1] = 1;
 }

@@ -519,7 +519,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t22 = xp.where(xp.greater(t19, 0), 1/(t19*(t19 + xp.abs(t14))), 0)
     t23 = -t22*(t2*t21 + t2*t16)
     t24 = t2 + t21*t23
-    t25 = t16 + t2*t23
+    t25 = t2*t23 + t16
     t26 = t22*(t21*mu_dot0 - t2*mu_dot1)
     t27 = mu_dot0 - t21*t26
     t28 = mu_dot1 + t2*t26
@@ -555,7 +555,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t58 = 1e-12*t12
     t59 = xp.greater(damping, 0)
     t60 = 1e-12*t18
-    t61 = (t59 & (xp.less_equal(t19, t60) | xp.less_equal(t30, t60))) | (xp.less_equal(damping, 0) & (xp.less_equal(t7, t58) | xp.less_equal(t49, t58)))
+    t61 = (xp.less_equal(damping, 0) & (xp.less_equal(t7, t58) | xp.less_equal(t49, t58))) | (t59 & (xp.less_equal(t19, t60) | xp.less_equal(t30, t60)))
     t62 = t56 & t57 & xp.logical_not(t61)
     q_dot = _stack(xp, [
         xp.broadcast_to(xp.where(t62, xp.where(t59, t37, t55), 0), batch),  # 0
@@ -601,7 +601,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t17 = t4 + damping
     t18 = -t13*(t3*t12 + t3*t17)
     t19 = t3 + t12*t18
-    t20 = t17 + t3*t18
+    t20 = t3*t18 + t17
     t21 = xp.abs(t20)
     t22 = t21
     t23 = t22*xp.where(xp.greater_equal(t20, 0), xp.asarray(1, dtype=dtype), -1)
@@ -664,7 +664,7 @@ def ik_branches(mu):
     ], (2, 2))
     valid = _stack(xp, [
         t25 & xp.greater_equal(t4, -1e-12),  # 0
-        t5 & t25,  # 1
+        t25 & t5,  # 1
     ], (2,))
     in_limits = _stack(xp, [
         xp.full(batch, True, dtype=xp.bool, device=device),  # 0

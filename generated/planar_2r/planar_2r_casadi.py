@@ -362,7 +362,7 @@ def _velocity_ik(q, mu_dot, damping):
     t22 = casadi.if_else((t19 > 0), 1/(t19*(t19 + casadi.fabs(t14))), 0)
     t23 = -t22*(t2*t21 + t2*t16)
     t24 = t2 + t21*t23
-    t25 = t16 + t2*t23
+    t25 = t2*t23 + t16
     t26 = t22*(t21*mu_dot0 - t2*mu_dot1)
     t27 = mu_dot0 - t21*t26
     t28 = mu_dot1 + t2*t26
@@ -398,7 +398,7 @@ def _velocity_ik(q, mu_dot, damping):
     t58 = 1e-12*t12
     t59 = (damping > 0)
     t60 = 1e-12*t18
-    t61 = casadi.logic_or(casadi.logic_and(t59, casadi.logic_or((t19 <= t60), (t30 <= t60))), casadi.logic_and((damping <= 0), casadi.logic_or((t7 <= t58), (t49 <= t58))))
+    t61 = casadi.logic_or(casadi.logic_and((damping <= 0), casadi.logic_or((t7 <= t58), (t49 <= t58))), casadi.logic_and(t59, casadi.logic_or((t19 <= t60), (t30 <= t60))))
     t62 = casadi.logic_and(casadi.logic_and(t56, t57), casadi.logic_not(t61))
     q_dot = casadi.SX(2, 1)
     q_dot[0, 0] = casadi.if_else(t62, casadi.if_else(t59, t37, t55), 0)
@@ -442,7 +442,7 @@ def _ik_numeric_step(target, q, damping):
     t17 = t4 + damping
     t18 = -t13*(t3*t12 + t3*t17)
     t19 = t3 + t12*t18
-    t20 = t17 + t3*t18
+    t20 = t3*t18 + t17
     t21 = casadi.fabs(t20)
     t22 = t21
     t23 = t22*casadi.if_else((t20 >= 0), 1, -1)
@@ -501,7 +501,7 @@ def _ik_branches(mu):
     q[1, 1] = t9 - 6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t9))
     valid = casadi.SX(2, 1)
     valid[0, 0] = casadi.logic_and(t25, (t4 >= -1e-12))
-    valid[1, 0] = casadi.logic_and(t5, t25)
+    valid[1, 0] = casadi.logic_and(t25, t5)
     in_limits = casadi.SX(2, 1)
     in_limits[0, 0] = True
     in_limits[1, 0] = True

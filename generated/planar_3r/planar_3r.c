@@ -707,13 +707,13 @@ int planar_3r_velocity_ik(const planar_3r_real q[PLANAR_3R_DOF], const planar_3r
     const planar_3r_real t29 = (t26 > 0 ? 1/(t26*(t26 + fabs(t20))) : 0);
     const planar_3r_real t30 = -t29*(t4*t28 + t4*t22 + t5*t17);
     const planar_3r_real t31 = t4 + t28*t30;
-    const planar_3r_real t32 = t22 + t4*t30;
+    const planar_3r_real t32 = t4*t30 + t22;
     const planar_3r_real t33 = t17 + t5*t30;
     const planar_3r_real t34 = -t29*(t4*t17 + t5*t28 + t5*t19);
     const planar_3r_real t35 = t5 + t28*t34;
     const planar_3r_real t36 = t17 + t4*t34;
-    const planar_3r_real t37 = t19 + t5*t34;
-    const planar_3r_real t38 = -t29*(t4*mu_dot1 + t5*mu_dot2 - t28*mu_dot0);
+    const planar_3r_real t37 = t5*t34 + t19;
+    const planar_3r_real t38 = -t29*(-t28*mu_dot0 + t4*mu_dot1 + t5*mu_dot2);
     const planar_3r_real t39 = mu_dot0 - t28*t38;
     const planar_3r_real t40 = mu_dot1 + t4*t38;
     const planar_3r_real t41 = mu_dot2 + t5*t38;
@@ -763,7 +763,7 @@ int planar_3r_velocity_ik(const planar_3r_real q[PLANAR_3R_DOF], const planar_3r
     const planar_3r_real t85 = t81*(t69*t77 + t76*t80);
     const planar_3r_real t86 = t76 - t80*t85;
     const planar_3r_real t87 = t77 - t69*t85;
-    const planar_3r_real t88 = 3 + t64 + t16 + damping + mu_dot0 + mu_dot1 + mu_dot2 + q1 + q2 + q3 - t1 - s123;
+    const planar_3r_real t88 = 3 + mu_dot0 + mu_dot1 + mu_dot2 + t64 + damping + q1 + q2 + q3 - t1 - s123 + t16;
     const planar_3r_real t89 = fabs(t84);
     const planar_3r_real t90 = t89;
     const planar_3r_real t91 = t90*(t84 >= 0 ? 1 : -1);
@@ -778,7 +778,7 @@ int planar_3r_velocity_ik(const planar_3r_real q[PLANAR_3R_DOF], const planar_3r
     const planar_3r_real t100 = 1e-12*t15;
     const int t101 = damping > 0;
     const planar_3r_real t102 = 1e-12*t25;
-    const int t103 = (t101 && ((t26 <= t102) || (t42 <= t102) || (t53 <= t102))) || (damping <= 0 && ((t90 <= t100) || (t10 <= t100) || (t78 <= t100)));
+    const int t103 = (damping <= 0 && ((t90 <= t100) || (t10 <= t100) || (t78 <= t100))) || (t101 && ((t26 <= t102) || (t42 <= t102) || (t53 <= t102)));
     const int t104 = t98 && t99 && !t103;
 
     /* Outputs */
@@ -827,7 +827,7 @@ planar_3r_real planar_3r_ik_numeric_step(const planar_3r_real target[PLANAR_3R_T
     const planar_3r_real t10 = mu1 - t3;
     const planar_3r_real t11 = mu0 + mu1 + mu2 + qs1 + qs2 + qs3;
     const planar_3r_real t12 = -mu2 + atan2(s123, c123);
-    const planar_3r_real t13 = t12 + 6.283185307179586*ceil(-0.15915494309189535*(3.141592653589793 + t12));
+    const planar_3r_real t13 = 6.283185307179586*ceil(-0.15915494309189535*(3.141592653589793 + t12)) + t12;
     const planar_3r_real t14 = (t9*t9) + (t10*t10) + (t13*t13);
     const planar_3r_real t15 = t4 + damping;
     const planar_3r_real t16 = sqrt((t5*t5) + (t6*t6) + (t15*t15));
@@ -841,7 +841,7 @@ planar_3r_real planar_3r_ik_numeric_step(const planar_3r_real target[PLANAR_3R_T
     const planar_3r_real t24 = t7 + damping;
     const planar_3r_real t25 = -t19*(t18*t5 + t5*t24 + t6*t8);
     const planar_3r_real t26 = t5 + t18*t25;
-    const planar_3r_real t27 = t24 + t25*t5;
+    const planar_3r_real t27 = t25*t5 + t24;
     const planar_3r_real t28 = t8 + t25*t6;
     const planar_3r_real t29 = sqrt((t27*t27) + (t28*t28));
     const planar_3r_real t30 = t29*(t27 >= 0 ? 1 : -1);
@@ -854,7 +854,7 @@ planar_3r_real planar_3r_ik_numeric_step(const planar_3r_real target[PLANAR_3R_T
     const planar_3r_real t37 = -t19*(t18*t6 + t5*t8 + t6*t36);
     const planar_3r_real t38 = t6 + t18*t37;
     const planar_3r_real t39 = t8 + t37*t5;
-    const planar_3r_real t40 = t36 + t37*t6;
+    const planar_3r_real t40 = t37*t6 + t36;
     const planar_3r_real t41 = t32*(t28*t40 + t39*t31);
     const planar_3r_real t42 = t39 - t31*t41;
     const planar_3r_real t43 = t40 - t28*t41;
@@ -931,12 +931,12 @@ void planar_3r_ik_branches(const planar_3r_real mu[PLANAR_3R_TASK_DIM], planar_3
     /* Outputs */
     q[0] = t29;
     q[1] = t14 - 6.283185307179586*ceil(0.15915494309189535*(-3.141592653589793 + t14));
-    q[2] = -(t30 + t32 + 6.283185307179586*ceil(-0.15915494309189535*(t31 + t32)));
+    q[2] = -(t30 + 6.283185307179586*ceil(-0.15915494309189535*(t31 + t32)) + t32);
     q[3] = t33;
     q[4] = t13 - 6.283185307179586*ceil(0.15915494309189535*(-3.141592653589793 + t13));
-    q[5] = -(t34 + t30 + 6.283185307179586*ceil(-0.15915494309189535*(t34 + t31)));
+    q[5] = -(t30 + 6.283185307179586*ceil(-0.15915494309189535*(t31 + t34)) + t34);
     valid[0] = t35 && t8 >= -1e-12;
-    valid[1] = t9 && t35;
+    valid[1] = t35 && t9;
     in_limits[0] = 1;
     in_limits[1] = 1;
 }

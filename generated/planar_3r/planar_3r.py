@@ -708,13 +708,13 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t29 = xp.where(xp.greater(t26, 0), 1/(t26*(t26 + xp.abs(t20))), 0)
     t30 = -t29*(t4*t28 + t4*t22 + t5*t17)
     t31 = t4 + t28*t30
-    t32 = t22 + t4*t30
+    t32 = t4*t30 + t22
     t33 = t17 + t5*t30
     t34 = -t29*(t4*t17 + t5*t28 + t5*t19)
     t35 = t5 + t28*t34
     t36 = t17 + t4*t34
-    t37 = t19 + t5*t34
-    t38 = -t29*(t4*mu_dot1 + t5*mu_dot2 - t28*mu_dot0)
+    t37 = t5*t34 + t19
+    t38 = -t29*(-t28*mu_dot0 + t4*mu_dot1 + t5*mu_dot2)
     t39 = mu_dot0 - t28*t38
     t40 = mu_dot1 + t4*t38
     t41 = mu_dot2 + t5*t38
@@ -764,7 +764,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t85 = t81*(t69*t77 + t76*t80)
     t86 = t76 - t80*t85
     t87 = t77 - t69*t85
-    t88 = 3 + t64 + t16 + damping + mu_dot0 + mu_dot1 + mu_dot2 + q1 + q2 + q3 - t1 - s123
+    t88 = 3 + mu_dot0 + mu_dot1 + mu_dot2 + t64 + damping + q1 + q2 + q3 - t1 - s123 + t16
     t89 = xp.abs(t84)
     t90 = t89
     t91 = t90*xp.where(xp.greater_equal(t84, 0), xp.asarray(1, dtype=dtype), -1)
@@ -779,7 +779,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t100 = 1e-12*t15
     t101 = xp.greater(damping, 0)
     t102 = 1e-12*t25
-    t103 = (t101 & (xp.less_equal(t26, t102) | xp.less_equal(t42, t102) | xp.less_equal(t53, t102))) | (xp.less_equal(damping, 0) & (xp.less_equal(t90, t100) | xp.less_equal(t10, t100) | xp.less_equal(t78, t100)))
+    t103 = (xp.less_equal(damping, 0) & (xp.less_equal(t90, t100) | xp.less_equal(t10, t100) | xp.less_equal(t78, t100))) | (t101 & (xp.less_equal(t26, t102) | xp.less_equal(t42, t102) | xp.less_equal(t53, t102)))
     t104 = t98 & t99 & xp.logical_not(t103)
     q_dot = _stack(xp, [
         xp.broadcast_to(xp.where(t104, xp.where(t101, t61, t97), 0), batch),  # 0
@@ -826,7 +826,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t10 = mu1 - t3
     t11 = mu0 + mu1 + mu2 + qs1 + qs2 + qs3
     t12 = -mu2 + xp.atan2(s123, c123)
-    t13 = t12 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t12))
+    t13 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t12)) + t12
     t14 = t9**2 + t10**2 + t13**2
     t15 = t4 + damping
     t16 = xp.sqrt(t5**2 + t6**2 + t15**2)
@@ -840,7 +840,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t24 = t7 + damping
     t25 = -t19*(t18*t5 + t5*t24 + t6*t8)
     t26 = t5 + t18*t25
-    t27 = t24 + t25*t5
+    t27 = t25*t5 + t24
     t28 = t8 + t25*t6
     t29 = xp.sqrt(t27**2 + t28**2)
     t30 = t29*xp.where(xp.greater_equal(t27, 0), xp.asarray(1, dtype=dtype), -1)
@@ -853,7 +853,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t37 = -t19*(t18*t6 + t5*t8 + t6*t36)
     t38 = t6 + t18*t37
     t39 = t8 + t37*t5
-    t40 = t36 + t37*t6
+    t40 = t37*t6 + t36
     t41 = t32*(t28*t40 + t39*t31)
     t42 = t39 - t31*t41
     t43 = t40 - t28*t41
@@ -929,14 +929,14 @@ def ik_branches(mu):
     q = _stack(xp, [
         t29,  # 0, 0
         t14 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t14)),  # 0, 1
-        -(t30 + t32 + 6.283185307179586*xp.ceil(-0.15915494309189535*(t31 + t32))),  # 0, 2
+        -(t30 + 6.283185307179586*xp.ceil(-0.15915494309189535*(t31 + t32)) + t32),  # 0, 2
         t33,  # 1, 0
         t13 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t13)),  # 1, 1
-        -(t34 + t30 + 6.283185307179586*xp.ceil(-0.15915494309189535*(t34 + t31))),  # 1, 2
+        -(t30 + 6.283185307179586*xp.ceil(-0.15915494309189535*(t31 + t34)) + t34),  # 1, 2
     ], (2, 3))
     valid = _stack(xp, [
         t35 & xp.greater_equal(t8, -1e-12),  # 0
-        t9 & t35,  # 1
+        t35 & t9,  # 1
     ], (2,))
     in_limits = _stack(xp, [
         xp.full(batch, True, dtype=xp.bool, device=device),  # 0

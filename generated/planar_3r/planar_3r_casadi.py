@@ -527,13 +527,13 @@ def _velocity_ik(q, mu_dot, damping):
     t29 = casadi.if_else((t26 > 0), 1/(t26*(t26 + casadi.fabs(t20))), 0)
     t30 = -t29*(t4*t28 + t4*t22 + t5*t17)
     t31 = t4 + t28*t30
-    t32 = t22 + t4*t30
+    t32 = t4*t30 + t22
     t33 = t17 + t5*t30
     t34 = -t29*(t4*t17 + t5*t28 + t5*t19)
     t35 = t5 + t28*t34
     t36 = t17 + t4*t34
-    t37 = t19 + t5*t34
-    t38 = -t29*(t4*mu_dot1 + t5*mu_dot2 - t28*mu_dot0)
+    t37 = t5*t34 + t19
+    t38 = -t29*(-t28*mu_dot0 + t4*mu_dot1 + t5*mu_dot2)
     t39 = mu_dot0 - t28*t38
     t40 = mu_dot1 + t4*t38
     t41 = mu_dot2 + t5*t38
@@ -583,7 +583,7 @@ def _velocity_ik(q, mu_dot, damping):
     t85 = t81*(t69*t77 + t76*t80)
     t86 = t76 - t80*t85
     t87 = t77 - t69*t85
-    t88 = 3 + t64 + t16 + damping + mu_dot0 + mu_dot1 + mu_dot2 + q1 + q2 + q3 - t1 - s123
+    t88 = 3 + mu_dot0 + mu_dot1 + mu_dot2 + t64 + damping + q1 + q2 + q3 - t1 - s123 + t16
     t89 = casadi.fabs(t84)
     t90 = t89
     t91 = t90*casadi.if_else((t84 >= 0), 1, -1)
@@ -598,7 +598,7 @@ def _velocity_ik(q, mu_dot, damping):
     t100 = 1e-12*t15
     t101 = (damping > 0)
     t102 = 1e-12*t25
-    t103 = casadi.logic_or(casadi.logic_and(t101, casadi.logic_or(casadi.logic_or((t26 <= t102), (t42 <= t102)), (t53 <= t102))), casadi.logic_and((damping <= 0), casadi.logic_or(casadi.logic_or((t90 <= t100), (t10 <= t100)), (t78 <= t100))))
+    t103 = casadi.logic_or(casadi.logic_and((damping <= 0), casadi.logic_or(casadi.logic_or((t90 <= t100), (t10 <= t100)), (t78 <= t100))), casadi.logic_and(t101, casadi.logic_or(casadi.logic_or((t26 <= t102), (t42 <= t102)), (t53 <= t102))))
     t104 = casadi.logic_and(casadi.logic_and(t98, t99), casadi.logic_not(t103))
     q_dot = casadi.SX(3, 1)
     q_dot[0, 0] = casadi.if_else(t104, casadi.if_else(t101, t61, t97), 0)
@@ -643,7 +643,7 @@ def _ik_numeric_step(target, q, damping):
     t10 = mu1 - t3
     t11 = mu0 + mu1 + mu2 + qs1 + qs2 + qs3
     t12 = -mu2 + casadi.atan2(s123, c123)
-    t13 = t12 + 6.283185307179586*casadi.ceil(-0.15915494309189535*(3.141592653589793 + t12))
+    t13 = 6.283185307179586*casadi.ceil(-0.15915494309189535*(3.141592653589793 + t12)) + t12
     t14 = t9**2 + t10**2 + t13**2
     t15 = t4 + damping
     t16 = casadi.sqrt(t5**2 + t6**2 + t15**2)
@@ -657,7 +657,7 @@ def _ik_numeric_step(target, q, damping):
     t24 = t7 + damping
     t25 = -t19*(t18*t5 + t5*t24 + t6*t8)
     t26 = t5 + t18*t25
-    t27 = t24 + t25*t5
+    t27 = t25*t5 + t24
     t28 = t8 + t25*t6
     t29 = casadi.sqrt(t27**2 + t28**2)
     t30 = t29*casadi.if_else((t27 >= 0), 1, -1)
@@ -670,7 +670,7 @@ def _ik_numeric_step(target, q, damping):
     t37 = -t19*(t18*t6 + t5*t8 + t6*t36)
     t38 = t6 + t18*t37
     t39 = t8 + t37*t5
-    t40 = t36 + t37*t6
+    t40 = t37*t6 + t36
     t41 = t32*(t28*t40 + t39*t31)
     t42 = t39 - t31*t41
     t43 = t40 - t28*t41
@@ -743,13 +743,13 @@ def _ik_branches(mu):
     q = casadi.SX(2, 3)
     q[0, 0] = t29
     q[0, 1] = t14 - 6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t14))
-    q[0, 2] = -(t30 + t32 + 6.283185307179586*casadi.ceil(-0.15915494309189535*(t31 + t32)))
+    q[0, 2] = -(t30 + 6.283185307179586*casadi.ceil(-0.15915494309189535*(t31 + t32)) + t32)
     q[1, 0] = t33
     q[1, 1] = t13 - 6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t13))
-    q[1, 2] = -(t34 + t30 + 6.283185307179586*casadi.ceil(-0.15915494309189535*(t34 + t31)))
+    q[1, 2] = -(t30 + 6.283185307179586*casadi.ceil(-0.15915494309189535*(t31 + t34)) + t34)
     valid = casadi.SX(2, 1)
     valid[0, 0] = casadi.logic_and(t35, (t8 >= -1e-12))
-    valid[1, 0] = casadi.logic_and(t9, t35)
+    valid[1, 0] = casadi.logic_and(t35, t9)
     in_limits = casadi.SX(2, 1)
     in_limits[0, 0] = True
     in_limits[1, 0] = True

@@ -47,7 +47,7 @@ void puma560_jacobian(const puma560_real q[PUMA560_DOF], puma560_real J[6 * PUMA
 void puma560_fk_jacobian(const puma560_real q[PUMA560_DOF], puma560_real T[16], puma560_real J[6 * PUMA560_DOF]);
 
 /* Geometric Jacobian in the tool frame (6 x DOF, rows vx vy vz wx wy wz).
- * Result: J: 6 x 6 row-major, element (r, c) at J[r * 6 + c]. 198 operations. */
+ * Result: J: 6 x 6 row-major, element (r, c) at J[r * 6 + c]. 196 operations. */
 void puma560_jacobian_tool(const puma560_real q[PUMA560_DOF], puma560_real J[6 * PUMA560_DOF]);
 
 /* Task vector mu = (x, y, z, roll, pitch, yaw).
@@ -59,19 +59,19 @@ void puma560_task(const puma560_real q[PUMA560_DOF], puma560_real mu[PUMA560_TAS
 void puma560_task_jacobian(const puma560_real q[PUMA560_DOF], puma560_real J[PUMA560_TASK_DIM * PUMA560_DOF]);
 
 /* Fk, jacobian and bias_acceleration in one pass, sharing their terms.
- * Result: T: 4 x 4 row-major, element (r, c) at T[r * 4 + c]; J: 6 x 6 row-major, element (r, c) at J[r * 6 + c]; a[i], i < 6. 242 operations. */
+ * Result: T: 4 x 4 row-major, element (r, c) at T[r * 4 + c]; J: 6 x 6 row-major, element (r, c) at J[r * 6 + c]; a[i], i < 6. 241 operations. */
 void puma560_fk_jacobian_dot(const puma560_real q[PUMA560_DOF], const puma560_real q_dot[PUMA560_DOF], puma560_real T[16], puma560_real J[6 * PUMA560_DOF], puma560_real a[6]);
 
 /* Time derivative dJ/dt of the world geometric Jacobian along q_dot (6 x DOF).
- * Result: Jd: 6 x 6 row-major, element (r, c) at Jd[r * 6 + c]. 161 operations. */
+ * Result: Jd: 6 x 6 row-major, element (r, c) at Jd[r * 6 + c]. 160 operations. */
 void puma560_jacobian_dot(const puma560_real q[PUMA560_DOF], const puma560_real q_dot[PUMA560_DOF], puma560_real Jd[6 * PUMA560_DOF]);
 
 /* J' q_dot: the tool's classical linear and angular acceleration at zero joint acceleration, world frame (6).
- * Result: a[i], i < 6. 200 operations. */
+ * Result: a[i], i < 6. 199 operations. */
 void puma560_bias_acceleration(const puma560_real q[PUMA560_DOF], const puma560_real q_dot[PUMA560_DOF], puma560_real a[6]);
 
 /* Time derivative of the analytic Jacobian along q_dot (6 x DOF): mu'' = J_a q'' + J_a' q'.
- * Result: Jd: 6 x 6 row-major, element (r, c) at Jd[r * 6 + c]. 423 operations. */
+ * Result: Jd: 6 x 6 row-major, element (r, c) at Jd[r * 6 + c]. 419 operations. */
 void puma560_task_jacobian_dot(const puma560_real q[PUMA560_DOF], const puma560_real q_dot[PUMA560_DOF], puma560_real Jd[PUMA560_TASK_DIM * PUMA560_DOF]);
 
 /* Partial derivatives dJ/dq_k of the world geometric Jacobian (DOF x 6 x DOF, indexed [k, r, c]).
@@ -99,7 +99,7 @@ int puma560_velocity_ik(const puma560_real q[PUMA560_DOF], const puma560_real mu
 puma560_real puma560_ik_numeric_step(const puma560_real target[16], const puma560_real q[PUMA560_DOF], puma560_real damping, puma560_real q_start[PUMA560_DOF], puma560_real q_next[PUMA560_DOF]);
 
 /* Every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits.
- * Result: q: 8 x 6 row-major, element (r, c) at q[r * 6 + c]; valid[i], i < 8; in_limits[i], i < 8. 1344 operations. */
+ * Result: q: 8 x 6 row-major, element (r, c) at q[r * 6 + c]; valid[i], i < 8; in_limits[i], i < 8. 1340 operations. */
 void puma560_ik_branches(const puma560_real T[16], puma560_real q[PUMA560_MAX_IK_SOLUTIONS * PUMA560_DOF], int valid[PUMA560_MAX_IK_SOLUTIONS], int in_limits[PUMA560_MAX_IK_SOLUTIONS]);
 
 /* The closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status.

@@ -95,37 +95,37 @@ def fk(q):
     t1 = t0 + 0.4318*s2
     t2 = 0.67183 + t1
     t3 = 0.0203*c23
-    t4 = 0.15005*s1 + t3*c1
-    t5 = -0.15005*c1 + t3*s1
+    t4 = 0.15005*s1 + c1*t3
+    t5 = -0.15005*c1 + s1*t3
     t6 = s1*s4
     t7 = c1*c4
-    t8 = -t6 + t7*c23
-    t9 = t7 - t6*c23
+    t8 = -t6 + c23*t7
+    t9 = t7 - c23*t6
     t10 = c4*s1
     t11 = c1*s4
-    t12 = t10 + t11*c23
-    t13 = t11 + t10*c23
+    t12 = t10 + c23*t11
+    t13 = t11 + c23*t10
     t14 = c1*s23
-    t15 = t8*c5 - t14*s5
-    t16 = t8*s5 + t14*c5
+    t15 = t8*c5 - s5*t14
+    t16 = t8*s5 + c5*t14
     t17 = t15*c6 - t12*s6
     t18 = t12*c6 + t15*s6
     t19 = t4 - 0.4318*t14
     t20 = s1*s23
-    t21 = t13*c5 - t20*s5
-    t22 = t13*s5 + t20*c5
+    t21 = t13*c5 - s5*t20
+    t22 = t13*s5 + c5*t20
     t23 = t9*s6 + t21*c6
     t24 = t9*c6 - t21*s6
     t25 = t5 - 0.4318*t20
     t26 = c4*s23
-    t27 = c23*s5 + t26*c5
-    t28 = c23*c5 - t26*s5
-    t29 = s23*s4
-    t30 = t27*c6 - t29*s6
-    t31 = t27*s6 + t29*c6
+    t27 = c23*s5 + c5*t26
+    t28 = c23*c5 - s5*t26
+    t29 = s4*s23
+    t30 = t27*c6 - s6*t29
+    t31 = t27*s6 + c6*t29
     t32 = 0.4318*c2
-    t33 = t19 + t32*c1
-    t34 = t25 + t32*s1
+    t33 = t19 + c1*t32
+    t34 = t25 + s1*t32
     T = _stack(xp, [
         t17,  # 0, 0
         -t18,  # 0, 1
@@ -167,25 +167,25 @@ def jacobian(q):
     t1 = 0.0203*s23 + 0.4318*c23
     t2 = t1 + 0.4318*s2
     t3 = 0.0203*c23
-    t4 = 0.15005*s1 + t3*c1
-    t5 = -0.15005*c1 + t3*s1
+    t4 = 0.15005*s1 + c1*t3
+    t5 = -0.15005*c1 + s1*t3
     t6 = s1*s4
     t7 = c1*c4
-    t8 = -t6 + t7*c23
-    t9 = t7 - t6*c23
+    t8 = -t6 + c23*t7
+    t9 = t7 - c23*t6
     t10 = c4*s1
     t11 = c1*s4
-    t12 = t10 + t11*c23
-    t13 = t11 + t10*c23
+    t12 = t10 + c23*t11
+    t13 = t11 + c23*t10
     t14 = c1*s23
-    t15 = t8*s5 + t14*c5
+    t15 = t8*s5 + c5*t14
     t16 = t4 - 0.4318*t14
     t17 = s1*s23
-    t18 = t13*s5 + t17*c5
+    t18 = t13*s5 + c5*t17
     t19 = t5 - 0.4318*t17
     t20 = 0.4318*c2
-    t21 = t16 + t20*c1
-    t22 = t19 + t20*s1
+    t21 = t16 + c1*t20
+    t22 = t19 + s1*t20
     t23 = -c1
     J = _stack(xp, [
         -t22,  # 0, 0
@@ -250,37 +250,37 @@ def fk_jacobian(q):
     t1 = t0 + 0.4318*s2
     t2 = 0.67183 + t1
     t3 = 0.0203*c23
-    t4 = 0.15005*s1 + t3*c1
-    t5 = -0.15005*c1 + t3*s1
+    t4 = 0.15005*s1 + c1*t3
+    t5 = -0.15005*c1 + s1*t3
     t6 = s1*s4
     t7 = c1*c4
-    t8 = -t6 + t7*c23
-    t9 = t7 - t6*c23
+    t8 = -t6 + c23*t7
+    t9 = t7 - c23*t6
     t10 = c4*s1
     t11 = c1*s4
-    t12 = t10 + t11*c23
-    t13 = t11 + t10*c23
+    t12 = t10 + c23*t11
+    t13 = t11 + c23*t10
     t14 = c1*s23
-    t15 = t8*c5 - t14*s5
-    t16 = t8*s5 + t14*c5
+    t15 = t8*c5 - s5*t14
+    t16 = t8*s5 + c5*t14
     t17 = t15*c6 - t12*s6
     t18 = t12*c6 + t15*s6
     t19 = t4 - 0.4318*t14
     t20 = s1*s23
-    t21 = t13*c5 - t20*s5
-    t22 = t13*s5 + t20*c5
+    t21 = t13*c5 - s5*t20
+    t22 = t13*s5 + c5*t20
     t23 = t9*s6 + t21*c6
     t24 = t9*c6 - t21*s6
     t25 = t5 - 0.4318*t20
     t26 = c4*s23
-    t27 = c23*s5 + t26*c5
-    t28 = c23*c5 - t26*s5
+    t27 = c23*s5 + c5*t26
+    t28 = c23*c5 - s5*t26
     t29 = s23*s4
-    t30 = t27*c6 - t29*s6
-    t31 = t27*s6 + t29*c6
+    t30 = t27*c6 - s6*t29
+    t31 = t27*s6 + c6*t29
     t32 = 0.4318*c2
-    t33 = t19 + t32*c1
-    t34 = t25 + t32*s1
+    t33 = t19 + c1*t32
+    t34 = t25 + s1*t32
     t35 = -t16
     t36 = -t22
     t37 = -c1
@@ -344,7 +344,7 @@ def fk_jacobian(q):
 
 
 def jacobian_tool(q):
-    """geometric Jacobian in the tool frame (6 x DOF, rows vx vy vz wx wy wz): (6 x 6), 198 operations."""
+    """geometric Jacobian in the tool frame (6 x DOF, rows vx vy vz wx wy wz): (6 x 6), 196 operations."""
     xp, dtype, device, batch, (q,) = _arguments(("q", q, (6,)))
     trig = _cos_sin(xp, q, (0.0, 0.0, 0.0, 0.0, 0.0, 0.0), device)
     c1 = trig[..., 0]
@@ -364,47 +364,48 @@ def jacobian_tool(q):
     t0 = 0.0203*s23 + 0.4318*c23
     t1 = t0 + 0.4318*s2
     t2 = 0.0203*c23
-    t3 = 0.15005*s1 + t2*c1
-    t4 = -0.15005*c1 + t2*s1
+    t3 = 0.15005*s1 + c1*t2
+    t4 = -0.15005*c1 + s1*t2
     t5 = s1*s4
     t6 = c1*c4
-    t7 = -t5 + t6*c23
-    t8 = t6 - t5*c23
+    t7 = -t5 + c23*t6
+    t8 = t6 - c23*t5
     t9 = c4*s1
     t10 = c1*s4
-    t11 = t9 + t10*c23
-    t12 = t10 + t9*c23
+    t11 = t9 + c23*t10
+    t12 = t10 + c23*t9
     t13 = c1*s23
-    t14 = t7*c5 - t13*s5
-    t15 = t7*s5 + t13*c5
+    t14 = t7*c5 - s5*t13
+    t15 = t7*s5 + c5*t13
     t16 = t14*c6 - t11*s6
     t17 = t11*c6 + t14*s6
     t18 = t3 - 0.4318*t13
     t19 = s1*s23
-    t20 = t12*c5 - t19*s5
-    t21 = t12*s5 + t19*c5
+    t20 = t12*c5 - s5*t19
+    t21 = t12*s5 + c5*t19
     t22 = t8*s6 + t20*c6
     t23 = t8*c6 - t20*s6
     t24 = t4 - 0.4318*t19
     t25 = c4*s23
-    t26 = c23*s5 + t25*c5
-    t27 = c23*c5 - t25*s5
-    t28 = s23*s4
-    t29 = t26*c6 - t28*s6
-    t30 = t26*s6 + t28*c6
+    t26 = c23*s5 + c5*t25
+    t27 = c23*c5 - s5*t25
+    t28 = s4*s23
+    t29 = t26*c6 - s6*t28
+    t30 = t26*s6 + c6*t28
     t31 = 0.4318*c2
-    t32 = t18 + t31*c1
-    t33 = t24 + t31*s1
+    t32 = t18 + c1*t31
+    t33 = t24 + s1*t31
     t34 = t32*c1 + t33*s1
-    t35 = t16*c1
-    t36 = t22*s1
+    t35 = c1*t16
+    t36 = s1*t22
     t37 = t18*c1 + t24*s1
-    t38 = t23*s1
-    t39 = t15*c1
-    t40 = t21*s1
-    t41 = t16*s1 - t22*c1
-    t42 = -(t17*s1 + t23*c1)
-    t43 = t21*c1 - t15*s1
+    t38 = c1*t17
+    t39 = s1*t23
+    t40 = c1*t15
+    t41 = s1*t21
+    t42 = t16*s1 - t22*c1
+    t43 = -(t17*s1 + t23*c1)
+    t44 = t21*c1 - t15*s1
     J = _stack(xp, [
         t22*t32 - t16*t33,  # 0, 0
         -(-t29*t34 + t1*t35 + t1*t36),  # 0, 1
@@ -413,32 +414,32 @@ def jacobian_tool(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5
         t17*t33 + t23*t32,  # 1, 0
-        -(t30*t34 + t1*t38 - t17*t1*c1),  # 1, 1
-        -(t30*t37 + t0*t38 - t17*t0*c1),  # 1, 2
+        -(t30*t34 - t1*t38 + t1*t39),  # 1, 1
+        -(t30*t37 - t0*t38 + t0*t39),  # 1, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5
         t15*t33 - t21*t32,  # 2, 0
-        t27*t34 + t1*t39 + t1*t40,  # 2, 1
-        t27*t37 + t0*t39 + t0*t40,  # 2, 2
+        t27*t34 + t1*t40 + t1*t41,  # 2, 1
+        t27*t37 + t0*t40 + t0*t41,  # 2, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 5
         t29,  # 3, 0
-        t41,  # 3, 1
-        t41,  # 3, 2
+        t42,  # 3, 1
+        t42,  # 3, 2
         -(-t29*c23 + t16*t13 + t22*t19),  # 3, 3
         t11*t16 - t8*t22 + t29*t28,  # 3, 4
-        -(t15*t16 + t21*t22 - t27*t29),  # 3, 5
+        -(-t27*t29 + t15*t16 + t21*t22),  # 3, 5
         -t30,  # 4, 0
-        t42,  # 4, 1
-        t42,  # 4, 2
-        -(t30*c23 + t23*t19 - t17*c1*s23),  # 4, 3
+        t43,  # 4, 1
+        t43,  # 4, 2
+        -(t30*c23 - t17*t13 + t23*t19),  # 4, 3
         -(t11*t17 + t8*t23 + t30*t28),  # 4, 4
-        -(t21*t23 + t27*t30 - t15*t17),  # 4, 5
+        -(-t15*t17 + t21*t23 + t27*t30),  # 4, 5
         t27,  # 5, 0
-        t43,  # 5, 1
-        t43,  # 5, 2
+        t44,  # 5, 1
+        t44,  # 5, 2
         t27*c23 + t15*t13 + t21*t19,  # 5, 3
         t8*t21 - t11*t15 + t27*t28,  # 5, 4
         t15**2 + t21**2 + t27**2,  # 5, 5
@@ -469,31 +470,31 @@ def task(q):
     t2 = t1 + 0.4318*s2
     t3 = 0.67183 + t2
     t4 = 0.0203*c23
-    t5 = 0.15005*s1 + t4*c1
-    t6 = -0.15005*c1 + t4*s1
+    t5 = 0.15005*s1 + c1*t4
+    t6 = -0.15005*c1 + s1*t4
     t7 = s1*s4
     t8 = c1*c4
-    t9 = -t7 + t8*c23
-    t10 = t8 - t7*c23
+    t9 = -t7 + c23*t8
+    t10 = t8 - c23*t7
     t11 = c4*s1
     t12 = c1*s4
-    t13 = t11 + t12*c23
-    t14 = t12 + t11*c23
-    t15 = s23*s5
-    t16 = t9*c5 - t15*c1
-    t17 = t14*c5 - t15*s1
-    t18 = c23*c5 - t15*c4
+    t13 = t11 + c23*t12
+    t14 = t12 + c23*t11
+    t15 = s5*s23
+    t16 = t9*c5 - c1*t15
+    t17 = t14*c5 - s1*t15
+    t18 = c23*c5 - c4*t15
     t19 = t16*c6 - t13*s6
     t20 = t10*s6 + t17*c6
-    t21 = s23*s4
-    t22 = t0*c6 - t21*s6
-    t23 = t0*s6 + t21*c6
+    t21 = s4*s23
+    t22 = t0*c6 - s6*t21
+    t23 = t0*s6 + c6*t21
     t24 = 0.4318*s23
-    t25 = t5 - t24*c1
-    t26 = t6 - t24*s1
+    t25 = t5 - c1*t24
+    t26 = t6 - s1*t24
     t27 = 0.4318*c2
-    t28 = t25 + t27*c1
-    t29 = t26 + t27*s1
+    t28 = t25 + c1*t27
+    t29 = t26 + s1*t27
     mu = _stack(xp, [
         t28,  # 0
         t29,  # 1
@@ -526,34 +527,34 @@ def task_jacobian(q):
     t0 = 0.0203*s23 + 0.4318*c23
     t1 = t0 + 0.4318*s2
     t2 = 0.0203*c23
-    t3 = 0.15005*s1 + t2*c1
-    t4 = -0.15005*c1 + t2*s1
+    t3 = 0.15005*s1 + c1*t2
+    t4 = -0.15005*c1 + s1*t2
     t5 = s1*s4
     t6 = c1*c4
-    t7 = -t5 + t6*c23
-    t8 = t6 - t5*c23
+    t7 = -t5 + c23*t6
+    t8 = t6 - c23*t5
     t9 = c4*s1
     t10 = c1*s4
-    t11 = t9 + t10*c23
-    t12 = t10 + t9*c23
+    t11 = t9 + c23*t10
+    t12 = t10 + c23*t9
     t13 = c1*s23
-    t14 = t7*c5 - t13*s5
-    t15 = t7*s5 + t13*c5
+    t14 = t7*c5 - s5*t13
+    t15 = t7*s5 + c5*t13
     t16 = t14*c6 - t11*s6
     t17 = t3 - 0.4318*t13
     t18 = s1*s23
-    t19 = t12*c5 - t18*s5
-    t20 = t12*s5 + t18*c5
+    t19 = t12*c5 - s5*t18
+    t20 = t12*s5 + c5*t18
     t21 = t8*s6 + t19*c6
     t22 = t4 - 0.4318*t18
     t23 = c4*s23
-    t24 = c23*s5 + t23*c5
-    t25 = c23*c5 - t23*s5
+    t24 = c23*s5 + c5*t23
+    t25 = c23*c5 - s5*t23
     t26 = s23*s4
-    t27 = t24*c6 - t26*s6
+    t27 = t24*c6 - s6*t26
     t28 = 0.4318*c2
-    t29 = t17 + t28*c1
-    t30 = t22 + t28*s1
+    t29 = t17 + c1*t28
+    t30 = t22 + s1*t28
     t31 = t16**2 + t21**2
     t32 = 1/t31
     t33 = t16*s1
@@ -561,7 +562,7 @@ def task_jacobian(q):
     t35 = t32*(t33 - t34)
     t36 = t16*c1
     t37 = t21*s1
-    t38 = -t32*(t36*s23 + t37*s23)
+    t38 = -t32*(s23*t36 + s23*t37)
     t39 = t32*(t11*t16 - t8*t21)
     t40 = -t32*(t15*t16 + t20*t21)
     t41 = 1/xp.sqrt(t31)
@@ -595,7 +596,7 @@ def task_jacobian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
         t42,  # 4, 1
         t42,  # 4, 2
-        t41*(t34*s23 - t33*s23),  # 4, 3
+        t41*(s23*t34 - s23*t33),  # 4, 3
         -t41*(t11*t21 + t8*t16),  # 4, 4
         t41*(t15*t21 - t20*t16),  # 4, 5
         xp.full(batch, 1, dtype=dtype, device=device),  # 5, 0
@@ -609,7 +610,7 @@ def task_jacobian(q):
 
 
 def fk_jacobian_dot(q, q_dot):
-    """fk, jacobian and bias_acceleration in one pass, sharing their terms: (4 x 4 and 6 x 6 and 6 x 1), 242 operations."""
+    """fk, jacobian and bias_acceleration in one pass, sharing their terms: (4 x 4 and 6 x 6 and 6 x 1), 241 operations."""
     xp, dtype, device, batch, (q, q_dot,) = _arguments(("q", q, (6,)), ("q_dot", q_dot, (6,)))
     qd1 = q_dot[..., 0]
     qd2 = q_dot[..., 1]
@@ -637,38 +638,38 @@ def fk_jacobian_dot(q, q_dot):
     t2 = 0.67183 + t1
     t3 = qd1 + c23*qd4
     t4 = 0.0203*c23
-    t5 = 0.15005*s1 + t4*c1
-    t6 = -0.15005*c1 + t4*s1
+    t5 = 0.15005*s1 + c1*t4
+    t6 = -0.15005*c1 + s1*t4
     t7 = s1*s4
     t8 = c1*c4
-    t9 = -t7 + t8*c23
-    t10 = t8 - t7*c23
+    t9 = -t7 + c23*t8
+    t10 = t8 - c23*t7
     t11 = c4*s1
     t12 = c1*s4
-    t13 = t11 + t12*c23
-    t14 = t12 + t11*c23
+    t13 = t11 + c23*t12
+    t14 = t12 + c23*t11
     t15 = c1*s23
-    t16 = t9*c5 - t15*s5
-    t17 = t9*s5 + t15*c5
+    t16 = t9*c5 - s5*t15
+    t17 = t9*s5 + c5*t15
     t18 = t16*c6 - t13*s6
     t19 = t13*c6 + t16*s6
     t20 = t5 - 0.4318*t15
     t21 = s1*s23
-    t22 = t14*c5 - t21*s5
-    t23 = t14*s5 + t21*c5
+    t22 = t14*c5 - s5*t21
+    t23 = t14*s5 + c5*t21
     t24 = t10*s6 + t22*c6
     t25 = t10*c6 - t22*s6
     t26 = t6 - 0.4318*t21
     t27 = c4*s23
-    t28 = c23*s5 + t27*c5
-    t29 = c23*c5 - t27*s5
+    t28 = c23*s5 + c5*t27
+    t29 = c23*c5 - s5*t27
     t30 = s23*s4
-    t31 = t28*c6 - t30*s6
-    t32 = t28*s6 + t30*c6
-    t33 = t3 + t30*qd5
+    t31 = t28*c6 - s6*t30
+    t32 = t28*s6 + c6*t30
+    t33 = t3 + qd5*t30
     t34 = 0.4318*c2
-    t35 = t20 + t34*c1
-    t36 = t26 + t34*s1
+    t35 = t20 + c1*t34
+    t36 = t26 + s1*t34
     t37 = t35*c1 + t36*s1
     t38 = t37
     t39 = t20*c1 + t26*s1
@@ -677,14 +678,14 @@ def fk_jacobian_dot(q, q_dot):
     t42 = qd2*s1
     t43 = qd3*s1
     t44 = t42 + t43
-    t45 = t44 - t15*qd4
+    t45 = t44 - qd4*t15
     t46 = t45 + t13*qd5
     t47 = t0*t43 + t1*t42
     t48 = -t47 + t35*qd1
     t49 = c1*qd2
     t50 = c1*qd3
     t51 = t49 + t50
-    t52 = t51 + t21*qd4
+    t52 = t51 + qd4*t21
     t53 = t52 + t10*qd5
     t54 = t0*t50 + t1*t49
     t55 = t54 + t36*qd1
@@ -693,11 +694,12 @@ def fk_jacobian_dot(q, q_dot):
     t58 = t1*c1
     t59 = t0*c1
     t60 = t1*s1
-    t61 = -c1
-    t62 = c1**2
-    t63 = t0*qd2
-    t64 = s1**2
-    t65 = t0*qd3
+    t61 = t0*s1
+    t62 = -c1
+    t63 = c1**2
+    t64 = qd2*t0
+    t65 = s1**2
+    t66 = qd3*t0
     T = _stack(xp, [
         xp.broadcast_to(t18, batch),  # 0, 0
         xp.broadcast_to(-t19, batch),  # 0, 1
@@ -725,7 +727,7 @@ def fk_jacobian_dot(q, q_dot):
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5
         xp.broadcast_to(t35, batch),  # 1, 0
         xp.broadcast_to(-t60, batch),  # 1, 1
-        xp.broadcast_to(-t0*s1, batch),  # 1, 2
+        xp.broadcast_to(-t61, batch),  # 1, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5
@@ -742,8 +744,8 @@ def fk_jacobian_dot(q, q_dot):
         xp.broadcast_to(t13, batch),  # 3, 4
         xp.broadcast_to(t56, batch),  # 3, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
-        xp.broadcast_to(t61, batch),  # 4, 1
-        xp.broadcast_to(t61, batch),  # 4, 2
+        xp.broadcast_to(t62, batch),  # 4, 1
+        xp.broadcast_to(t62, batch),  # 4, 2
         xp.broadcast_to(-t21, batch),  # 4, 3
         xp.broadcast_to(-t10, batch),  # 4, 4
         xp.broadcast_to(t57, batch),  # 4, 5
@@ -755,18 +757,18 @@ def fk_jacobian_dot(q, q_dot):
         xp.broadcast_to(t29, batch),  # 5, 5
     ], (6, 6))
     a = _stack(xp, [
-        xp.broadcast_to(qd2*(-t41*c1 + t60*qd1) - qd3*(t40*t49 + t40*t50 - t0*qd1*s1) - t48*qd1, batch),  # 0
-        xp.broadcast_to(-qd2*(t41*s1 + t58*qd1) - qd3*(t59*qd1 + t40*t42 + t40*t43) - t55*qd1, batch),  # 1
-        xp.broadcast_to(-qd2*(t54*c1 + t47*s1) - qd3*(t62*t63 + t63*t64 + t62*t65 + t64*t65), batch),  # 2
-        xp.broadcast_to(qd4*(-t51*c23 + t21*qd1) + qd5*(t10*t3 - t52*t30) + qd6*(t23*t33 - t29*t53) + t49*qd1 + t50*qd1, batch),  # 3
-        xp.broadcast_to(-qd4*(t44*c23 + t15*qd1) + qd5*(t13*t3 - t45*t30) - qd6*(t17*t33 + t29*t46) + t42*qd1 + t43*qd1, batch),  # 4
+        xp.broadcast_to(qd2*(-t41*c1 + qd1*t60) - qd3*(-qd1*t61 + t40*t49 + t40*t50) - t48*qd1, batch),  # 0
+        xp.broadcast_to(-qd2*(t41*s1 + qd1*t58) - qd3*(qd1*t59 + t40*t42 + t40*t43) - t55*qd1, batch),  # 1
+        xp.broadcast_to(-qd2*(t54*c1 + t47*s1) - qd3*(t63*t64 + t65*t64 + t63*t66 + t65*t66), batch),  # 2
+        xp.broadcast_to(qd4*(-t51*c23 + qd1*t21) + qd5*(t10*t3 - t52*t30) + qd6*(t23*t33 - t29*t53) + qd1*t49 + qd1*t50, batch),  # 3
+        xp.broadcast_to(-qd4*(t44*c23 + qd1*t15) + qd5*(t13*t3 - t45*t30) - qd6*(t17*t33 + t29*t46) + qd1*t42 + qd1*t43, batch),  # 4
         xp.broadcast_to(-qd4*(t44*t21 + t51*t15) + qd5*(t13*t52 - t10*t45) - qd6*(t17*t53 + t23*t46), batch),  # 5
     ], (6,))
     return T, J, a
 
 
 def jacobian_dot(q, q_dot):
-    """time derivative dJ/dt of the world geometric Jacobian along q_dot (6 x DOF): (6 x 6), 161 operations."""
+    """time derivative dJ/dt of the world geometric Jacobian along q_dot (6 x DOF): (6 x 6), 160 operations."""
     xp, dtype, device, batch, (q, q_dot,) = _arguments(("q", q, (6,)), ("q_dot", q_dot, (6,)))
     qd1 = q_dot[..., 0]
     qd2 = q_dot[..., 1]
@@ -791,26 +793,26 @@ def jacobian_dot(q, q_dot):
     t2 = t1 + 0.4318*s2
     t3 = qd1 + c23*qd4
     t4 = 0.0203*c23
-    t5 = 0.15005*s1 + t4*c1
-    t6 = -0.15005*c1 + t4*s1
+    t5 = 0.15005*s1 + c1*t4
+    t6 = -0.15005*c1 + s1*t4
     t7 = s1*s4
     t8 = c1*c4
-    t9 = -t7 + t8*c23
-    t10 = t8 - t7*c23
+    t9 = -t7 + c23*t8
+    t10 = t8 - c23*t7
     t11 = c4*s1
     t12 = c1*s4
-    t13 = t11 + t12*c23
-    t14 = t12 + t11*c23
+    t13 = t11 + c23*t12
+    t14 = t12 + c23*t11
     t15 = c5*s23
-    t16 = t9*s5 + t15*c1
-    t17 = t14*s5 + t15*s1
+    t16 = t9*s5 + c1*t15
+    t17 = t14*s5 + s1*t15
     t18 = 0.4318*s23
-    t19 = t5 - t18*c1
-    t20 = t6 - t18*s1
+    t19 = t5 - c1*t18
+    t20 = t6 - s1*t18
     t21 = t19*c1 + t20*s1
     t22 = 0.4318*c2
-    t23 = t19 + t22*c1
-    t24 = t20 + t22*s1
+    t23 = t19 + c1*t22
+    t24 = t20 + s1*t22
     t25 = t23*c1 + t24*s1
     t26 = t25*qd2 + t21*qd3
     t27 = qd2*s1
@@ -823,23 +825,23 @@ def jacobian_dot(q, q_dot):
     t34 = t32 + t33
     t35 = t1*t33 + t2*t32
     t36 = t35 + t24*qd1
-    t37 = qd4*s23
-    t38 = t29 - t37*c1
-    t39 = t34 + t37*s1
+    t37 = s23*qd4
+    t38 = t29 - c1*t37
+    t39 = t34 + s1*t37
     t40 = t38 + t13*qd5
     t41 = t39 + t10*qd5
-    t42 = s23*s4
-    t43 = t3 + t42*qd5
+    t42 = s4*s23
+    t43 = t3 + qd5*t42
     t44 = qd1*s1
     t45 = c1*qd1
     t46 = c1**2
-    t47 = t1*qd2
+    t47 = qd2*t1
     t48 = s1**2
-    t49 = t1*qd3
+    t49 = qd3*t1
     Jd = _stack(xp, [
         xp.broadcast_to(-t31, batch),  # 0, 0
         xp.broadcast_to(-t26*c1 + t2*t44, batch),  # 0, 1
-        xp.broadcast_to(-(t21*t32 + t21*t33 - t1*qd1*s1), batch),  # 0, 2
+        xp.broadcast_to(-(-t1*t44 + t21*t32 + t21*t33), batch),  # 0, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5
@@ -851,20 +853,20 @@ def jacobian_dot(q, q_dot):
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
         xp.broadcast_to(-(t35*c1 + t30*s1), batch),  # 2, 1
-        xp.broadcast_to(-(t46*t47 + t47*t48 + t46*t49 + t48*t49), batch),  # 2, 2
+        xp.broadcast_to(-(t46*t47 + t48*t47 + t46*t49 + t48*t49), batch),  # 2, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
         xp.broadcast_to(t45, batch),  # 3, 1
         xp.broadcast_to(t45, batch),  # 3, 2
-        xp.broadcast_to(-t34*c23 + t44*s23, batch),  # 3, 3
+        xp.broadcast_to(-t34*c23 + s23*t44, batch),  # 3, 3
         xp.broadcast_to(t10*t3 - t39*t42, batch),  # 3, 4
         xp.broadcast_to(t17*t43 - t0*t41, batch),  # 3, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
         xp.broadcast_to(t44, batch),  # 4, 1
         xp.broadcast_to(t44, batch),  # 4, 2
-        xp.broadcast_to(-(t29*c23 + t45*s23), batch),  # 4, 3
+        xp.broadcast_to(-(t29*c23 + s23*t45), batch),  # 4, 3
         xp.broadcast_to(t13*t3 - t38*t42, batch),  # 4, 4
         xp.broadcast_to(-(t16*t43 + t0*t40), batch),  # 4, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 0
@@ -878,7 +880,7 @@ def jacobian_dot(q, q_dot):
 
 
 def bias_acceleration(q, q_dot):
-    """J' q_dot: the tool's classical linear and angular acceleration at zero joint acceleration, world frame (6): (6 x 1), 200 operations."""
+    """J' q_dot: the tool's classical linear and angular acceleration at zero joint acceleration, world frame (6): (6 x 1), 199 operations."""
     xp, dtype, device, batch, (q, q_dot,) = _arguments(("q", q, (6,)), ("q_dot", q_dot, (6,)))
     qd1 = q_dot[..., 0]
     qd2 = q_dot[..., 1]
@@ -904,26 +906,26 @@ def bias_acceleration(q, q_dot):
     t2 = t1 + 0.4318*s2
     t3 = qd1 + c23*qd4
     t4 = 0.0203*c23
-    t5 = 0.15005*s1 + t4*c1
-    t6 = -0.15005*c1 + t4*s1
+    t5 = 0.15005*s1 + c1*t4
+    t6 = -0.15005*c1 + s1*t4
     t7 = s1*s4
     t8 = c1*c4
-    t9 = -t7 + t8*c23
-    t10 = t8 - t7*c23
+    t9 = -t7 + c23*t8
+    t10 = t8 - c23*t7
     t11 = c4*s1
     t12 = c1*s4
-    t13 = t11 + t12*c23
-    t14 = t12 + t11*c23
+    t13 = t11 + c23*t12
+    t14 = t12 + c23*t11
     t15 = c5*s23
-    t16 = t9*s5 + t15*c1
-    t17 = t14*s5 + t15*s1
+    t16 = t9*s5 + c1*t15
+    t17 = t14*s5 + s1*t15
     t18 = 0.4318*s23
-    t19 = t5 - t18*c1
-    t20 = t6 - t18*s1
+    t19 = t5 - c1*t18
+    t20 = t6 - s1*t18
     t21 = t19*c1 + t20*s1
     t22 = 0.4318*c2
-    t23 = t19 + t22*c1
-    t24 = t20 + t22*s1
+    t23 = t19 + c1*t22
+    t24 = t20 + s1*t22
     t25 = t23*c1 + t24*s1
     t26 = t25*qd2 + t21*qd3
     t27 = qd2*s1
@@ -936,32 +938,32 @@ def bias_acceleration(q, q_dot):
     t34 = t32 + t33
     t35 = t1*t33 + t2*t32
     t36 = t35 + t24*qd1
-    t37 = qd4*s23
-    t38 = t29 - t37*c1
-    t39 = t34 + t37*s1
+    t37 = s23*qd4
+    t38 = t29 - c1*t37
+    t39 = t34 + s1*t37
     t40 = t38 + t13*qd5
     t41 = t39 + t10*qd5
-    t42 = s23*s4
-    t43 = t3 + t42*qd5
-    t44 = qd1*s1
+    t42 = s4*s23
+    t43 = t3 + qd5*t42
+    t44 = s1*qd1
     t45 = c1*qd1
     t46 = c1**2
-    t47 = t1*qd2
+    t47 = qd2*t1
     t48 = s1**2
-    t49 = t1*qd3
+    t49 = qd3*t1
     a = _stack(xp, [
-        xp.broadcast_to(qd2*(-t26*c1 + t2*t44) - qd3*(t21*t32 + t21*t33 - t1*qd1*s1) - t31*qd1, batch),  # 0
+        xp.broadcast_to(qd2*(-t26*c1 + t2*t44) - qd3*(-t1*t44 + t21*t32 + t21*t33) - t31*qd1, batch),  # 0
         xp.broadcast_to(-qd2*(t26*s1 + t2*t45) - qd3*(t1*t45 + t21*t27 + t21*t28) - t36*qd1, batch),  # 1
-        xp.broadcast_to(-qd2*(t35*c1 + t30*s1) - qd3*(t46*t47 + t47*t48 + t46*t49 + t48*t49), batch),  # 2
-        xp.broadcast_to(qd4*(-t34*c23 + t44*s23) + qd5*(t10*t3 - t39*t42) + qd6*(t17*t43 - t0*t41) + t32*qd1 + t33*qd1, batch),  # 3
-        xp.broadcast_to(-qd4*(t29*c23 + t45*s23) + qd5*(t13*t3 - t38*t42) - qd6*(t16*t43 + t0*t40) + t27*qd1 + t28*qd1, batch),  # 4
+        xp.broadcast_to(-qd2*(t35*c1 + t30*s1) - qd3*(t46*t47 + t48*t47 + t46*t49 + t48*t49), batch),  # 2
+        xp.broadcast_to(qd4*(-t34*c23 + s23*t44) + qd5*(t10*t3 - t39*t42) + qd6*(t17*t43 - t0*t41) + qd1*t32 + qd1*t33, batch),  # 3
+        xp.broadcast_to(-qd4*(t29*c23 + s23*t45) + qd5*(t13*t3 - t38*t42) - qd6*(t16*t43 + t0*t40) + qd1*t27 + qd1*t28, batch),  # 4
         xp.broadcast_to(-qd4*(t29*s1*s23 + t34*c1*s23) + qd5*(t13*t39 - t10*t38) - qd6*(t16*t41 + t17*t40), batch),  # 5
     ], (6,))
     return a
 
 
 def task_jacobian_dot(q, q_dot):
-    """time derivative of the analytic Jacobian along q_dot (6 x DOF): mu'' = J_a q'' + J_a' q': (6 x 6), 423 operations."""
+    """time derivative of the analytic Jacobian along q_dot (6 x DOF): mu'' = J_a q'' + J_a' q': (6 x 6), 419 operations."""
     xp, dtype, device, batch, (q, q_dot,) = _arguments(("q", q, (6,)), ("q_dot", q_dot, (6,)))
     qd1 = q_dot[..., 0]
     qd2 = q_dot[..., 1]
@@ -987,35 +989,35 @@ def task_jacobian_dot(q, q_dot):
     t0 = 0.0203*s23 + 0.4318*c23
     t1 = t0 + 0.4318*s2
     t2 = 0.0203*c23
-    t3 = 0.15005*s1 + t2*c1
-    t4 = -0.15005*c1 + t2*s1
+    t3 = 0.15005*s1 + c1*t2
+    t4 = -0.15005*c1 + s1*t2
     t5 = s1*s4
     t6 = c1*c4
-    t7 = -t5 + t6*c23
-    t8 = t6 - t5*c23
+    t7 = -t5 + c23*t6
+    t8 = t6 - c23*t5
     t9 = c4*s1
     t10 = c1*s4
-    t11 = t9 + t10*c23
-    t12 = t10 + t9*c23
+    t11 = t9 + c23*t10
+    t12 = t10 + c23*t9
     t13 = c1*s23
-    t14 = t7*c5 - t13*s5
-    t15 = t7*s5 + t13*c5
+    t14 = t7*c5 - s5*t13
+    t15 = t7*s5 + c5*t13
     t16 = t14*c6 - t11*s6
     t17 = t3 - 0.4318*t13
     t18 = s1*s23
-    t19 = t12*c5 - t18*s5
-    t20 = t12*s5 + t18*c5
+    t19 = t12*c5 - s5*t18
+    t20 = t12*s5 + c5*t18
     t21 = t8*s6 + t19*c6
     t22 = t4 - 0.4318*t18
     t23 = t17*c1 + t22*s1
     t24 = c4*s23
-    t25 = c23*s5 + t24*c5
-    t26 = c23*c5 - t24*s5
-    t27 = s23*s4
-    t28 = t25*c6 - t27*s6
+    t25 = c23*s5 + c5*t24
+    t26 = c23*c5 - s5*t24
+    t27 = s4*s23
+    t28 = t25*c6 - s6*t27
     t29 = 0.4318*c2
-    t30 = t17 + t29*c1
-    t31 = t22 + t29*s1
+    t30 = t17 + c1*t29
+    t31 = t22 + s1*t29
     t32 = t30*c1 + t31*s1
     t33 = t32*qd2 + t23*qd3
     t34 = qd2*s1
@@ -1024,7 +1026,7 @@ def task_jacobian_dot(q, q_dot):
     t37 = -t36 + t30*qd1
     t38 = t34 + t35
     t39 = t38
-    t40 = t39*c23 + t13*qd1
+    t40 = t39*c23 + qd1*t13
     t41 = c1*qd2
     t42 = c1*qd3
     t43 = t0*t42 + t1*t41
@@ -1032,11 +1034,11 @@ def task_jacobian_dot(q, q_dot):
     t45 = t43*c1 + t36*s1
     t46 = t41 + t42
     t47 = t46
-    t48 = -t47*c23 + t18*qd1
+    t48 = -t47*c23 + qd1*t18
     t49 = t39*t18 + t47*t13
-    t50 = -t13*qd4
+    t50 = -qd4*t13
     t51 = t39 + t50
-    t52 = t18*qd4
+    t52 = qd4*t18
     t53 = t47 + t52
     t54 = t11*t53 - t8*t51
     t55 = qd1 + c23*qd4
@@ -1045,30 +1047,30 @@ def task_jacobian_dot(q, q_dot):
     t58 = t11*t56 - t51*t27
     t59 = t11*qd5
     t60 = t51 + t59
-    t61 = t38 + t50 + t59 - t15*qd6
+    t61 = t50 + t59 - t15*qd6 + t38
     t62 = t8*qd5
     t63 = t53 + t62
     t64 = t15*t63 + t20*t60
-    t65 = t46 + t52 + t62 + t20*qd6
+    t65 = t52 + t62 + t20*qd6 + t46
     t66 = t16*t65 + t21*t61
-    t67 = t27*qd5
+    t67 = qd5*t27
     t68 = t56 + t67
     t69 = t20*t68 - t26*t63
     t70 = t15*t68 + t26*t60
-    t71 = t55 + t67 + t26*qd6
+    t71 = t67 + t26*qd6 + t55
     t72 = t21*t71 + t28*t65
     t73 = t16*t71 - t28*t61
-    t74 = qd1*s1
+    t74 = s1*qd1
     t75 = -t33*c1 + t1*t74
     t76 = t23*t41 + t23*t42 - t0*t74
     t77 = c1*qd1
     t78 = t33*s1 + t1*t77
     t79 = t0*t77 + t23*t34 + t23*t35
     t80 = c1**2
-    t81 = t0*qd2
+    t81 = qd2*t0
     t82 = s1**2
-    t83 = t0*qd3
-    t84 = t80*t81 + t81*t82 + t80*t83 + t82*t83
+    t83 = qd3*t0
+    t84 = t80*t81 + t82*t81 + t80*t83 + t82*t83
     t85 = t16**2 + t21**2
     t86 = 1/t85
     t87 = c1*t86
@@ -1080,51 +1082,53 @@ def task_jacobian_dot(q, q_dot):
     t93 = t21*t92
     t94 = s1*t86
     t95 = t16*t92
-    t96 = t16*qd1
-    t97 = t21*qd1
+    t96 = qd1*t16
+    t97 = qd1*t21
     t98 = -t73*(t87 + t93) - t72*(t94 - t95) + t87*t96 + t94*t97
-    t99 = t94*s23
+    t99 = s23*t94
     t100 = t16*c1
     t101 = t21*s1
-    t102 = -(t100*s23 + t101*s23)
-    t103 = t91*t102
+    t102 = -(s23*t100 + s23*t101)
+    t103 = t102*t91
     t104 = t21*t103
-    t105 = t87*s23
+    t105 = s23*t87
     t106 = t16*t103
     t107 = t16*t86
     t108 = t48*t107
     t109 = t21*t86
-    t110 = t8*t86
-    t111 = t11*t16 - t8*t21
-    t112 = t91*t111
-    t113 = t21*t112
-    t114 = t11*t86
-    t115 = t16*t112
-    t116 = t57*t107
-    t117 = t58*t109
-    t118 = t20*t86
-    t119 = -(t15*t16 + t20*t21)
-    t120 = t91*t119
-    t121 = t21*t120
-    t122 = t15*t86
-    t123 = t16*t120
-    t124 = t69*t107
-    t125 = 1/xp.sqrt(t85)
-    t126 = s1*t125
-    t127 = 1/t85**1.5
-    t128 = -t127*(t100 + t101)
-    t129 = c1*t125
-    t130 = t125*qd1
-    t131 = -t73*(t126 + t21*t128) + t72*(t129 + t16*t128) + t88*t130 - t89*t130
-    t132 = t127*(t89*s23 - t88*s23)
-    t133 = t16*t125
-    t134 = t21*t125
-    t135 = -t127*(t11*t21 + t8*t16)
-    t136 = t127*(t15*t21 - t20*t16)
-    t137 = t28*t94
-    t138 = t28*t87
-    t139 = t66*t86
-    t140 = -(t72*(-t137 + t28*t95) - t73*(t138 + t28*t93) + t90*t139 + t96*t138 + t97*t137)
+    t110 = t40*t109
+    t111 = t8*t86
+    t112 = t11*t16 - t8*t21
+    t113 = t112*t91
+    t114 = t21*t113
+    t115 = t11*t86
+    t116 = t16*t113
+    t117 = t57*t107
+    t118 = t58*t109
+    t119 = t20*t86
+    t120 = -(t15*t16 + t20*t21)
+    t121 = t120*t91
+    t122 = t21*t121
+    t123 = t15*t86
+    t124 = t16*t121
+    t125 = t69*t107
+    t126 = t70*t109
+    t127 = 1/xp.sqrt(t85)
+    t128 = s1*t127
+    t129 = 1/t85**1.5
+    t130 = -t129*(t100 + t101)
+    t131 = c1*t127
+    t132 = qd1*t127
+    t133 = -t73*(t128 + t21*t130) + t72*(t131 + t16*t130) + t88*t132 - t89*t132
+    t134 = t129*(s23*t89 - s23*t88)
+    t135 = t16*t127
+    t136 = t21*t127
+    t137 = -t129*(t11*t21 + t8*t16)
+    t138 = t129*(t15*t21 - t20*t16)
+    t139 = t28*t87
+    t140 = t28*t94
+    t141 = t86*t66
+    t142 = -(-t73*(t139 + t28*t93) + t72*(-t140 + t28*t95) + t90*t141 + t139*t96 + t140*t97)
     Jd = _stack(xp, [
         xp.broadcast_to(-t37, batch),  # 0, 0
         xp.broadcast_to(t75, batch),  # 0, 1
@@ -1147,21 +1151,21 @@ def task_jacobian_dot(q, q_dot):
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
         xp.broadcast_to(t98, batch),  # 3, 1
         xp.broadcast_to(t98, batch),  # 3, 2
-        xp.broadcast_to(-t73*(t99 + t104) + t72*(t105 + t106) + t108 - t40*t109, batch),  # 3, 3
-        xp.broadcast_to(-t73*(t110 + t113) - t72*(t114 - t115) + t116 + t117, batch),  # 3, 4
-        xp.broadcast_to(-t73*(t118 + t121) + t72*(t122 + t123) + t124 - t70*t109, batch),  # 3, 5
+        xp.broadcast_to(-t73*(t99 + t104) + t72*(t105 + t106) + t108 - t110, batch),  # 3, 3
+        xp.broadcast_to(-t73*(t111 + t114) - t72*(t115 - t116) + t117 + t118, batch),  # 3, 4
+        xp.broadcast_to(-t73*(t119 + t122) + t72*(t123 + t124) + t125 - t126, batch),  # 3, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
-        xp.broadcast_to(t131, batch),  # 4, 1
-        xp.broadcast_to(t131, batch),  # 4, 2
-        xp.broadcast_to(-(-t72*(t16*t132 + t126*s23) - t73*(t129*s23 - t21*t132) + t40*t133 + t48*t134), batch),  # 4, 3
-        xp.broadcast_to(-t73*(t11*t125 + t21*t135) + t72*(t8*t125 + t16*t135) + t58*t133 - t57*t134, batch),  # 4, 4
-        xp.broadcast_to(-(-t72*(t20*t125 + t16*t136) - t73*(t15*t125 - t21*t136) + t70*t133 + t69*t134), batch),  # 4, 5
+        xp.broadcast_to(t133, batch),  # 4, 1
+        xp.broadcast_to(t133, batch),  # 4, 2
+        xp.broadcast_to(-(-t73*(s23*t131 - t21*t134) - t72*(t16*t134 + s23*t128) + t40*t135 + t48*t136), batch),  # 4, 3
+        xp.broadcast_to(-t73*(t11*t127 + t21*t137) + t72*(t8*t127 + t16*t137) + t58*t135 - t57*t136, batch),  # 4, 4
+        xp.broadcast_to(-(-t73*(t15*t127 - t21*t138) - t72*(t20*t127 + t16*t138) + t70*t135 + t69*t136), batch),  # 4, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 0
-        xp.broadcast_to(t140, batch),  # 5, 1
-        xp.broadcast_to(t140, batch),  # 5, 2
-        xp.broadcast_to(-(t49 + t72*(t28*t105 + t28*t106) - t73*(t28*t99 + t28*t104) + t102*t139 + t28*t108 - t21*t28*t40*t86), batch),  # 5, 3
-        xp.broadcast_to(-(-t54 + t72*(-t28*t114 + t28*t115) - t73*(t28*t110 + t28*t113) + t111*t139 + t28*t116 + t28*t117), batch),  # 5, 4
-        xp.broadcast_to(-(t64 + t72*(t28*t122 + t28*t123) - t73*(t28*t118 + t28*t121) + t119*t139 + t28*t124 - t21*t28*t70*t86), batch),  # 5, 5
+        xp.broadcast_to(t142, batch),  # 5, 1
+        xp.broadcast_to(t142, batch),  # 5, 2
+        xp.broadcast_to(-(t49 - t73*(t28*t99 + t28*t104) + t72*(t28*t105 + t28*t106) + t102*t141 - t28*t110 + t28*t108), batch),  # 5, 3
+        xp.broadcast_to(-(-t54 - t73*(t28*t111 + t28*t114) + t72*(-t28*t115 + t28*t116) + t112*t141 + t28*t117 + t28*t118), batch),  # 5, 4
+        xp.broadcast_to(-(t64 - t73*(t28*t119 + t28*t122) + t72*(t28*t123 + t28*t124) + t120*t141 - t28*t126 + t28*t125), batch),  # 5, 5
     ], (6, 6))
     return Jd
 
@@ -1191,22 +1195,22 @@ def hessian(q):
     t6 = -0.15005*c1 + 0.0203*t5
     t7 = s1*s4
     t8 = c1*c4
-    t9 = -t7 + t8*c23
-    t10 = t8 - t7*c23
+    t9 = -t7 + c23*t8
+    t10 = t8 - c23*t7
     t11 = c4*s1
     t12 = c1*s4
-    t13 = t11 + t12*c23
-    t14 = t12 + t11*c23
+    t13 = t11 + c23*t12
+    t14 = t12 + c23*t11
     t15 = c1*s23
-    t16 = t9*s5 + t15*c5
+    t16 = t9*s5 + c5*t15
     t17 = t4 - 0.4318*t15
     t18 = s1*s23
-    t19 = t14*s5 + t18*c5
+    t19 = t14*s5 + c5*t18
     t20 = t6 - 0.4318*t18
     t21 = t17*c1 + t20*s1
     t22 = 0.4318*c2
-    t23 = t17 + t22*c1
-    t24 = t20 + t22*s1
+    t23 = t17 + c1*t22
+    t24 = t20 + s1*t22
     t25 = t23*c1 + t24*s1
     t26 = t2*s1
     t27 = t1*s1
@@ -1218,16 +1222,16 @@ def hessian(q):
     t33 = s1**2
     t34 = -(t1*t32 + t1*t33)
     t35 = -t3
-    t36 = -t12*s23
+    t36 = -s23*t12
     t37 = -t0*c1
     t38 = -t5
-    t39 = -t7*s23
+    t39 = -s23*t7
     t40 = -t0*s1
     t41 = -(s23*t32 + s23*t33)
     t42 = t13*c1 - t10*s1
     t43 = -(t16*c1 + t19*s1)
     t44 = s23**2
-    t45 = s23*s4
+    t45 = s4*s23
     H = _stack(xp, [
         -t23,  # 0, 0, 0
         t26,  # 0, 0, 1
@@ -1359,7 +1363,7 @@ def hessian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 3, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 3, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 3, 3
-        t10*c23 - t7*t44,  # 3, 3, 4
+        t10*c23 - t44*t7,  # 3, 3, 4
         t19*c23 - t0*t18,  # 3, 3, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 4, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 4, 1
@@ -1462,7 +1466,7 @@ def singularity_factors(q):
     f = _stack(xp, [
         c3 + t0,  # 0
         s5,  # 1
-        -(-c2 + c2*s3 + c3*s2 + t0*s2 - 0.04701250578971746*c2*c3),  # 2
+        -(-c2 + c2*s3 + c3*s2 + s2*t0 - 0.04701250578971746*c2*c3),  # 2
     ], (3,))
     return f
 
@@ -1477,7 +1481,7 @@ def manipulability(q):
     s3 = trig[..., 5]
     s5 = trig[..., 9]
     t0 = 0.04701250578971746*s3
-    t1 = -0.080509645432*s5*(c3 + t0)*(-c2 + c2*s3 + c3*s2 + t0*s2 - 0.04701250578971746*c2*c3)
+    t1 = -0.080509645432*s5*(c3 + t0)*(-c2 + c2*s3 + c3*s2 + s2*t0 - 0.04701250578971746*c2*c3)
     w = xp.broadcast_to(xp.abs(t1), batch)
     return w
 
@@ -1492,7 +1496,7 @@ def jacobian_det(q):
     s3 = trig[..., 5]
     s5 = trig[..., 9]
     t0 = 0.04701250578971746*s3
-    d = xp.broadcast_to(-0.080509645432*s5*(c3 + t0)*(-c2 + c2*s3 + c3*s2 + t0*s2 - 0.04701250578971746*c2*c3), batch)
+    d = xp.broadcast_to(-0.080509645432*s5*(c3 + t0)*(-c2 + c2*s3 + c3*s2 + s2*t0 - 0.04701250578971746*c2*c3), batch)
     return d
 
 
@@ -1529,26 +1533,26 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t1 = 0.0203*s23 + 0.4318*c23
     t2 = t1 + 0.4318*s2
     t3 = 0.0203*c23
-    t4 = 0.15005*s1 + t3*c1
-    t5 = -0.15005*c1 + t3*s1
+    t4 = 0.15005*s1 + c1*t3
+    t5 = -0.15005*c1 + s1*t3
     t6 = s1*s4
     t7 = c1*c4
-    t8 = -t6 + t7*c23
-    t9 = t7 - t6*c23
+    t8 = -t6 + c23*t7
+    t9 = t7 - c23*t6
     t10 = c4*s1
     t11 = c1*s4
-    t12 = t10 + t11*c23
-    t13 = t11 + t10*c23
+    t12 = t10 + c23*t11
+    t13 = t11 + c23*t10
     t14 = c1*s23
-    t15 = t8*s5 + t14*c5
+    t15 = t8*s5 + c5*t14
     t16 = t4 - 0.4318*t14
     t17 = s1*s23
-    t18 = t13*s5 + t17*c5
+    t18 = t13*s5 + c5*t17
     t19 = t5 - 0.4318*t17
     t20 = t16*c1 + t19*s1
     t21 = 0.4318*c2
-    t22 = t16 + t21*c1
-    t23 = t19 + t21*s1
+    t22 = t16 + c1*t21
+    t23 = t19 + s1*t21
     t24 = t22*c1 + t23*s1
     t25 = t23**2
     t26 = t1**2
@@ -1558,15 +1562,15 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t30 = t25 + t26*t27 + t29*t27
     t31 = t30
     t32 = -t22*t23
-    t33 = c1*s1
-    t34 = t32 + t33*t26 + t29*t33
+    t33 = s1*c1
+    t34 = t32 + t26*t33 + t29*t33
     t35 = t20*c1
     t36 = t24*c1
     t37 = t1*t35 + t2*t36
     t38 = t36 + t35
     t39 = t1*c1
     t40 = t2*c1
-    t41 = t39*s1 + t40*s1
+    t41 = s1*t39 + s1*t40
     t42 = t22**2
     t43 = xp.sqrt(1 + t42 + t25)
     t44 = t43*xp.where(xp.less_equal(t23, 0), xp.asarray(1, dtype=dtype), -1)
@@ -1586,15 +1590,15 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t58 = t12**2 + t15**2 + 2*t46 + t27*t57
     t59 = t58
     t60 = 2*c1
-    t61 = t15*t18 - t12*t9 - t60*s1 + t33*t57
+    t61 = t15*t18 - t12*t9 - s1*t60 + t57*t33
     t62 = s23*s4
-    t63 = t15*t0 + t14*c23 - t12*t62
-    t64 = t18*t0 + t9*t62 + t17*c23
+    t63 = t15*t0 + c23*t14 - t12*t62
+    t64 = t18*t0 + t9*t62 + c23*t17
     t65 = t9**2 + t18**2 + 2*t27 + t46*t57
     t66 = t65
     t67 = 1 + t0**2 + c23**2 + t57*s4**2
     t68 = t67
-    t69 = xp.sqrt(t30 + t48 + t55 + t58 + t65 + t67)
+    t69 = xp.sqrt(t55 + t30 + t48 + t58 + t65 + t67)
     t70 = damping**2
     t71 = t66 + t70
     t72 = t68 + t70
@@ -1614,7 +1618,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t86 = xp.where(xp.greater(t83, 0), 1/(t83*(t83 + xp.abs(t73))), 0)
     t87 = t86*(t85*t34 + t34*t75 + t37*t52 + t41*t28 + t41*t47 + t32)
     t88 = t34 - t85*t87
-    t89 = t75 - t87*t34
+    t89 = -t87*t34 + t75
     t90 = -t52 + t87*t37
     t91 = -t47 + t87*t41
     t92 = t41 - t87*t28
@@ -1622,27 +1626,27 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t94 = -t86*(t85*t37 + t34*t52 + t37*t76 + t41*t53 + t28*t38)
     t95 = t37 + t85*t94
     t96 = t52 + t94*t34
-    t97 = t76 + t94*t37
+    t97 = t94*t37 + t76
     t98 = t53 + t94*t41
     t99 = t38 + t94*t28
-    t100 = -t86*(t85*t41 + t34*t47 + t37*t53 + t41*t77 - t23*t63 - t28*t61)
+    t100 = -t86*(-t23*t63 - t28*t61 + t85*t41 + t34*t47 + t37*t53 + t41*t77)
     t101 = t41 + t85*t100
     t102 = t47 + t100*t34
     t103 = t53 + t100*t37
-    t104 = t77 + t100*t41
+    t104 = t100*t41 + t77
     t105 = t61 - t100*t28
     t106 = t86*(t64*t23 + t85*t28 + t34*t41 + t37*t38 + t28*t71 - t41*t61)
     t107 = t28 - t85*t106
     t108 = t41 - t106*t34
     t109 = -t38 + t106*t37
     t110 = t61 + t106*t41
-    t111 = t71 - t106*t28
+    t111 = -t106*t28 + t71
     t112 = -t64 + t106*t23
-    t113 = -t86*(t64*t28 + t85*t23 + t23*t72 - t22*t34 - t41*t63)
+    t113 = -t86*(-t22*t34 - t41*t63 + t64*t28 + t85*t23 + t23*t72)
     t114 = t23 + t85*t113
     t115 = t22 - t113*t34
     t116 = t64 + t113*t28
-    t117 = t72 + t113*t23
+    t117 = t113*t23 + t72
     t118 = t86*(t85*mu_dot0 + t34*mu_dot1 + t28*mu_dot4 - t23*mu_dot5 - t37*mu_dot2 - t41*mu_dot3)
     t119 = mu_dot0 - t85*t118
     t120 = mu_dot1 - t118*t34
@@ -1750,16 +1754,16 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t222 = xp.where(xp.not_equal(t177, 0), -(t185 - (t181*t221 + t208*t220))/t177, 0)
     t223 = xp.where(xp.not_equal(t158, 0), -(t172 - (t162*t222 + t167*t221 + t203*t220))/t158, 0)
     t224 = xp.where(xp.not_equal(t126, 0), -(t136 - (t130*t221 + t197*t220 - t152*t223 - t145*t222))/t126, 0)
-    t225 = xp.where(xp.not_equal(t84, 0), -(t119 + t95*t223 + t101*t222 + t114*t220 - t88*t224 - t107*t221)/t84, 0)
+    t225 = xp.where(xp.not_equal(t84, 0), -(t119 - t88*t224 - t107*t221 + t95*t223 + t101*t222 + t114*t220)/t84, 0)
     t226 = t220 + t224*t22 - t225*t23
     t227 = -t220*c23 + t221*t17 + t222*t14
     t228 = t12*t222 - t9*t221 + t220*t62
     t229 = t221*t18 + t222*t15 - t220*t0
     t230 = t2*s1
     t231 = t221*c1 - t222*s1
-    t232 = t231 + t224*t230 + t225*t40 - t223*t24
+    t232 = -t223*t24 + t224*t230 + t225*t40 + t231
     t233 = t1*s1
-    t234 = t231 + t224*t233 + t225*t39 - t223*t20
+    t234 = -t223*t20 + t224*t233 + t225*t39 + t231
     t235 = -t23
     t236 = t44 + t235
     t237 = -t45*(t236*t40 + t22*t230)
@@ -1779,11 +1783,11 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t251 = t45*t0
     t252 = t0 - t251
     t253 = t27 + t46
-    t254 = xp.sqrt(t54 + t253 + t237**2 + t239**2)
+    t254 = xp.sqrt(t54 + t237**2 + t239**2 + t253)
     t255 = t254*xp.where(xp.less_equal(t239, 0), xp.asarray(1, dtype=dtype), -1)
     t256 = t255 - t239
     t257 = xp.where(xp.greater(t254, 0), 1/(t254*(t254 + xp.abs(t239))), 0)
-    t258 = t257*(t253 + t237*t240 + t24*t20 - t242*t256)
+    t258 = t257*(t237*t240 + t24*t20 - t242*t256 + t253)
     t259 = t242 + t256*t258
     t260 = t20 - t258*t24
     t261 = s1 - t258*s1
@@ -1819,7 +1823,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t291 = -t9
     t292 = t291 + t287*c1
     t293 = t22*t251
-    t294 = -t257*(t237*t252 + t15*s1 - t18*c1 + t256*t293)
+    t294 = -t257*(-t18*c1 + t237*t252 + t15*s1 + t256*t293)
     t295 = t256*t294 + t293
     t296 = t15 + t294*s1
     t297 = t252 + t237*t294
@@ -1881,13 +1885,13 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t353 = xp.where(xp.not_equal(t308, 0), -(t312 - (t322*t352 - t339*t351))/t308, 0)
     t354 = xp.where(xp.not_equal(t271, 0), -(t275 + t303*t353 + t317*t352 + t334*t351)/t271, 0)
     t355 = xp.where(xp.not_equal(t255, 0), -(t265 + t259*t354 + t281*t353 + t288*t352 + t295*t351)/t255, 0)
-    t356 = xp.where(xp.not_equal(t44, 0), -(t244 + t238*t355 + t241*t354 + t236*t351*t251 + t236*t352*t249 + t236*t353*t247)/t44, 0)
+    t356 = xp.where(xp.not_equal(t44, 0), -(t244 + t238*t355 + t241*t354 + t236*t351*t251 + t236*t353*t247 + t236*t352*t249)/t44, 0)
     t357 = xp.isfinite(t300)
     t358 = xp.greater_equal(damping, 0)
     t359 = 1e-12*t69
     t360 = xp.greater(damping, 0)
     t361 = 1e-12*t82
-    t362 = (t360 & (xp.less_equal(t83, t361) | xp.less_equal(t125, t361) | xp.less_equal(t157, t361) | xp.less_equal(t176, t361) | xp.less_equal(t188, t361) | xp.less_equal(t215, t361))) | (xp.less_equal(damping, 0) & (xp.less_equal(t43, t359) | xp.less_equal(t254, t359) | xp.less_equal(t270, t359) | xp.less_equal(t307, t359) | xp.less_equal(t325, t359) | xp.less_equal(t346, t359)))
+    t362 = (xp.less_equal(damping, 0) & (xp.less_equal(t43, t359) | xp.less_equal(t254, t359) | xp.less_equal(t270, t359) | xp.less_equal(t307, t359) | xp.less_equal(t325, t359) | xp.less_equal(t346, t359))) | (t360 & (xp.less_equal(t83, t361) | xp.less_equal(t125, t361) | xp.less_equal(t157, t361) | xp.less_equal(t176, t361) | xp.less_equal(t188, t361) | xp.less_equal(t215, t361)))
     t363 = t357 & t358 & xp.logical_not(t362)
     q_dot = _stack(xp, [
         xp.broadcast_to(xp.where(t363, xp.where(t360, t226, t356), 0), batch),  # 0
@@ -1949,19 +1953,19 @@ def ik_numeric_step(target, q, damping=0.0):
     t3 = T23 - t2
     t4 = T00 + T01 + T02 + T03 + T10 + T11 + T12 + T13 + T20 + T21 + T22 + T23 + qs1 + qs2 + qs3 + qs4 + qs5 + qs6
     t5 = 0.0203*c23
-    t6 = 0.15005*s1 + t5*c1
-    t7 = -0.15005*c1 + t5*s1
+    t6 = 0.15005*s1 + c1*t5
+    t7 = -0.15005*c1 + s1*t5
     t8 = s1*s4
     t9 = c1*c4
-    t10 = -t8 + t9*c23
-    t11 = t9 - t8*c23
+    t10 = -t8 + c23*t9
+    t11 = t9 - c23*t8
     t12 = c4*s1
     t13 = c1*s4
-    t14 = t12 + t13*c23
-    t15 = t13 + t12*c23
+    t14 = t12 + c23*t13
+    t15 = t13 + c23*t12
     t16 = c1*s23
-    t17 = t10*c5 - t16*s5
-    t18 = t10*s5 + t16*c5
+    t17 = t10*c5 - s5*t16
+    t18 = t10*s5 + c5*t16
     t19 = t17*c6 - t14*s6
     t20 = t14*c6 + t17*s6
     t21 = t6 - 0.4318*t16
@@ -1969,8 +1973,8 @@ def ik_numeric_step(target, q, damping=0.0):
     t23 = T11*t20 + T12*t18 - T10*t19
     t24 = T21*t20 + T22*t18 - T20*t19
     t25 = s1*s23
-    t26 = t15*c5 - t25*s5
-    t27 = t15*s5 + t25*c5
+    t26 = t15*c5 - s5*t25
+    t27 = t15*s5 + c5*t25
     t28 = t11*s6 + t26*c6
     t29 = t11*c6 - t26*s6
     t30 = t7 - 0.4318*t25
@@ -1980,13 +1984,13 @@ def ik_numeric_step(target, q, damping=0.0):
     t34 = T20*t28 + T21*t29 - T22*t27
     t35 = -0.5*(t32 + t23)
     t36 = c4*s23
-    t37 = c23*s5 + t36*c5
-    t38 = c23*c5 - t36*s5
-    t39 = s23*s4
-    t40 = t37*c6 - t39*s6
-    t41 = t37*s6 + t39*c6
-    t42 = t18*t38 + t16*c23 - t14*t39
-    t43 = t27*t38 + t11*t39 + t25*c23
+    t37 = c23*s5 + c5*t36
+    t38 = c23*c5 - s5*t36
+    t39 = s4*s23
+    t40 = t37*c6 - s6*t39
+    t41 = t37*s6 + c6*t39
+    t42 = t18*t38 + c23*t16 - t14*t39
+    t43 = t27*t38 + t11*t39 + c23*t25
     t44 = T00*t40 + T02*t38 - T01*t41
     t45 = T10*t40 + T12*t38 - T11*t41
     t46 = T20*t40 + T22*t38 - T21*t41
@@ -1994,8 +1998,8 @@ def ik_numeric_step(target, q, damping=0.0):
     t48 = 0.5*(t44 + t24)
     t49 = xp.sqrt(t47**2 + t48**2 + t35**2)
     t50 = 0.4318*c2
-    t51 = t21 + t50*c1
-    t52 = t30 + t50*s1
+    t51 = t21 + c1*t50
+    t52 = t30 + s1*t50
     t53 = t51*c1 + t52*s1
     t54 = t53**2 + t31**2
     t55 = T03 - t51
@@ -2007,7 +2011,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t61 = t1**2
     t62 = t57 + t58*t59 + t61*t59
     t63 = -t51*t52
-    t64 = c1*s1
+    t64 = s1*c1
     t65 = t63 + t58*t64 + t61*t64
     t66 = t0*t64 + t1*t64
     t67 = t31*c1
@@ -2023,7 +2027,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t77 = t75 + t74
     t78 = s23**2
     t79 = t14**2 + t18**2 + 2*t71 + t59*t78
-    t80 = t18*t27 - t14*t11 - 2*t64 + t64*t78
+    t80 = t18*t27 - t14*t11 - 2*t64 + t78*t64
     t81 = t11**2 + t27**2 + 2*t59 + t71*t78
     t82 = 1 + t38**2 + c23**2 + t78*s4**2
     t83 = -t22
@@ -2058,7 +2062,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t112 = t72 + damping
     t113 = t104*(t103*t65 + t65*t112 + t69*t76 + t66*t60 + t66*t73 + t63)
     t114 = t65 - t103*t113
-    t115 = t112 - t113*t65
+    t115 = -t113*t65 + t112
     t116 = -t76 + t113*t69
     t117 = -t73 + t113*t66
     t118 = t66 - t113*t60
@@ -2077,15 +2081,15 @@ def ik_numeric_step(target, q, damping=0.0):
     t131 = -t104*(t103*t69 + t65*t76 + t69*t130 + t66*t77 + t60*t70)
     t132 = t69 + t103*t131
     t133 = t76 + t131*t65
-    t134 = t130 + t131*t69
+    t134 = t131*t69 + t130
     t135 = t77 + t131*t66
     t136 = t70 + t131*t60
     t137 = t79 + damping
-    t138 = -t104*(t103*t66 + t65*t73 + t69*t77 + t66*t137 - t52*t42 - t60*t80)
+    t138 = -t104*(-t52*t42 - t60*t80 + t103*t66 + t65*t73 + t69*t77 + t66*t137)
     t139 = t66 + t103*t138
     t140 = t73 + t138*t65
     t141 = t77 + t138*t69
-    t142 = t137 + t138*t66
+    t142 = t138*t66 + t137
     t143 = t80 - t138*t60
     t144 = -t42
     t145 = t144 + t138*t52
@@ -2101,7 +2105,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t155 = t66 - t153*t65
     t156 = -t70 + t153*t69
     t157 = t80 + t153*t66
-    t158 = t152 - t153*t60
+    t158 = -t153*t60 + t152
     t159 = -t43 + t153*t52
     t160 = t123*(t116*t156 + t117*t157 + t118*t158 + t119*t159 + t155*t122)
     t161 = t155 - t122*t160
@@ -2110,12 +2114,12 @@ def ik_numeric_step(target, q, damping=0.0):
     t164 = t158 - t118*t160
     t165 = t159 - t119*t160
     t166 = t82 + damping
-    t167 = -t104*(t43*t60 + t103*t52 + t52*t166 - t51*t65 - t66*t42)
+    t167 = -t104*(-t51*t65 - t66*t42 + t43*t60 + t103*t52 + t52*t166)
     t168 = t52 + t103*t167
     t169 = t51 - t167*t65
     t170 = t144 + t167*t66
     t171 = t43 + t167*t60
-    t172 = t166 + t167*t52
+    t172 = t167*t52 + t166
     t173 = t131*t52
     t174 = t123*(t116*t134 + t117*t135 - t118*t136 - t133*t122 + t119*t173)
     t175 = t133 + t122*t174
@@ -2191,16 +2195,16 @@ def ik_numeric_step(target, q, damping=0.0):
     t245 = xp.where(xp.not_equal(t200, 0), -(t208 - (t204*t244 + t231*t243))/t200, 0)
     t246 = xp.where(xp.not_equal(t181, 0), -(t195 - (t185*t245 + t190*t244 + t226*t243))/t181, 0)
     t247 = xp.where(xp.not_equal(t121, 0), -(t125 - (t161*t244 + t220*t243 - t175*t246 - t147*t245))/t121, 0)
-    t248 = xp.where(xp.not_equal(t102, 0), -(t106 + t132*t246 + t139*t245 + t168*t243 - t114*t247 - t154*t244)/t102, 0)
+    t248 = xp.where(xp.not_equal(t102, 0), -(t106 - t114*t247 - t154*t244 + t132*t246 + t139*t245 + t168*t243)/t102, 0)
     t249 = t243 + q1 + t51*t247 - t52*t248
     t250 = q4 + t243*c23 - t244*t25 - t245*t16
     t251 = q5 + t14*t245 - t11*t244 + t243*t39
     t252 = q6 + t38*t243 - t18*t245 - t27*t244
-    t253 = t247*s1
-    t254 = t248*c1
+    t253 = s1*t247
+    t254 = c1*t248
     t255 = t245*s1 - t244*c1
-    t256 = t255 + q2 + t53*t246 - t1*t253 - t1*t254
-    t257 = t255 + q3 + t31*t246 - t0*t253 - t0*t254
+    t256 = q2 + t53*t246 - t1*t253 - t1*t254 + t255
+    t257 = q3 + t31*t246 - t0*t253 - t0*t254 + t255
     q_start = _stack(xp, [
         xp.broadcast_to(q1, batch),  # 0
         xp.broadcast_to(q2, batch),  # 1
@@ -2223,7 +2227,7 @@ def ik_numeric_step(target, q, damping=0.0):
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def ik_branches(T):
-    """every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits: (8 x 6 and 8 x 1 and 8 x 1), 1344 operations."""
+    """every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits: (8 x 6 and 8 x 1 and 8 x 1), 1340 operations."""
     xp, dtype, device, batch, (T,) = _arguments(("T", T, (4, 4)))
     T00 = T[..., 0, 0]
     T01 = T[..., 0, 1]
@@ -2238,22 +2242,22 @@ def ik_branches(T):
     T22 = T[..., 2, 2]
     T23 = T[..., 2, 3]
     t0 = T00 + T01 + T02 + T03 + T10 + T11 + T12 + T13 + T20 + T21 + T22 + T23
-    t1 = 0.4521*T00 + 1.10363*T02 - 0.15005*T01
+    t1 = -0.15005*T01 + 0.4521*T00 + 1.10363*T02
     t2 = T03 - t1
     t3 = t1
     t4 = t2 + t3
-    t5 = 0.4521*T10 + 1.10363*T12 - 0.15005*T11
+    t5 = -0.15005*T11 + 0.4521*T10 + 1.10363*T12
     t6 = T13 - t5
     t7 = t5
     t8 = t6 + t7
     t9 = xp.atan2(t4, -t8)
-    t10 = 0.4521*T20 + 1.10363*T22 - 0.15005*T21
+    t10 = -0.15005*T21 + 0.4521*T20 + 1.10363*T22
     t11 = T23 - t10
     t12 = t10
     t13 = t11 + t12
     t14 = t4**2 + t8**2
     t15 = t14
-    t16 = t14 + t13**2
+    t16 = t13**2 + t14
     t17 = 1e-24*t16
     t18 = xp.less_equal(t15, t17)
     t19 = xp.where(t18, 1, 1/xp.sqrt(t15))
@@ -2269,9 +2273,9 @@ def ik_branches(T):
     t29 = t28 - 6.283185307179586*xp.floor(0.15915494309189535*(2.792526803190927 + t28))
     t30 = t27 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t27))
     t31 = t30 - 6.283185307179586*xp.floor(0.15915494309189535*(2.792526803190927 + t30))
-    t32 = t4*t19
+    t32 = t19*t4
     t33 = t22*t32
-    t34 = t8*t19
+    t34 = t19*t8
     t35 = t24*t34
     t36 = xp.where(t18, 1, -(t33 + t35))
     t37 = t33 - t35
@@ -2308,539 +2312,535 @@ def ik_branches(T):
     t68 = 5.357415379007653*t59
     t69 = xp.where(t66, t68, xp.where(xp.greater(t68, 0), xp.asarray(1, dtype=dtype), -1))
     t70 = xp.atan2(t67, t69)
-    t71 = 1.6177742431429796 + t70
-    t72 = 1.6177742431429796 - t70
-    t73 = t71 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t71))
-    t74 = t73 - 6.283185307179586*xp.floor(0.15915494309189535*(3.9269908169872414 + t73))
-    t75 = t72 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t72))
+    t71 = 1.6177742431429796 - t70
+    t72 = t71 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t71))
+    t73 = t72 - 6.283185307179586*xp.floor(0.15915494309189535*(3.9269908169872414 + t72))
+    t74 = 1.6177742431429796 + t70
+    t75 = t74 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t74))
     t76 = t75 - 6.283185307179586*xp.floor(0.15915494309189535*(3.9269908169872414 + t75))
-    t77 = 5.357415379007653*t69
-    t78 = 0.00876554*t77
-    t79 = 5.357415379007653*t67
-    t80 = 0.18645124*t79
-    t81 = -(t78 + t80)
-    t82 = t80 - t78
-    t83 = 0.15005*(1 - t81)
-    t84 = t83 + 0.15005*t81
-    t85 = 0.15005*(1 - t82)
-    t86 = t85 + 0.15005*t82
-    t87 = 0.18645124*t77
-    t88 = 0.00876554*t79
-    t89 = t87 - t88
-    t90 = t88 + t87
-    t91 = 0.0203*t81 - 0.4318*t89
-    t92 = 0.0203*t89 + 0.4318*t81
-    t93 = 0.4318 + t91
-    t94 = 0.67183 + t92
-    t95 = -0.67183 + t94
-    t96 = t42*t95 - t57*t93
-    t97 = t84**2 + t93**2 + t95**2
-    t98 = 0.0203*t82 - 0.4318*t90
-    t99 = 0.0203*t90 + 0.4318*t82
-    t100 = 0.4318 + t98
-    t101 = 0.67183 + t99
-    t102 = -0.67183 + t101
-    t103 = t42*t102 - t57*t100
-    t104 = t86**2 + t100**2 + t102**2
-    t105 = t43*t84
-    t106 = t42*t93 + t57*t95 - t105
-    t107 = t106 + t105
-    t108 = t107**2 + t96**2
-    t109 = 1e-24*t58
-    t110 = xp.less_equal(t108, t97*t109)
-    t111 = xp.where(t110, 1, 1/xp.sqrt(t108))
-    t112 = xp.where(t110, 1, t107*t111)
-    t113 = xp.where(t110, 0, -t96*t111)
-    t114 = t81*t112 - t89*t113
-    t115 = t81*t113 + t89*t112
-    t116 = t114*t44 + t115*t61
-    t117 = t114*t61 - t115*t44
-    t118 = t114*t46 + t115*t63
-    t119 = t114*t63 - t115*t46
-    t120 = xp.where(t110, 0, xp.atan2(-t96, t107))
-    t121 = t120 - 6.283185307179586*xp.floor(0.15915494309189535*(0.7853981633974483 + t120))
-    t122 = 1 - t114
-    t123 = t45*t122
-    t124 = t123 + t114*t45
-    t125 = t47*t122
-    t126 = t125 + t114*t47
-    t127 = t117**2
-    t128 = -t127
-    t129 = 1 + t128
-    t130 = xp.greater(t129, 1e-12)
-    t131 = xp.where(t130, xp.sqrt(t129), 0)
-    t132 = t127 + t116*t131
-    t133 = t132 + t128
-    t134 = t124**2
-    t135 = t116**2 + t134 + t127
-    t136 = t131**2
-    t137 = t133**2 + t134*t136
-    t138 = t127 + t136
-    t139 = 1e-24*t138
-    t140 = xp.less_equal(t137, t135*t139)
-    t141 = xp.where(t140, 1, 1/xp.sqrt(t137))
-    t142 = xp.where(t140, 1, t133*t141)
-    t143 = t119*(1 - t142)
-    t144 = t143 + t119*t142
-    t145 = t124*t131
-    t146 = xp.where(t140, 0, t141*t145)
-    t147 = t118*t142 + t126*t146
-    t148 = t126*t142 - t118*t146
-    t149 = xp.less_equal(t138, t139)
-    t150 = xp.where(t149, 1, 1/xp.sqrt(t138))
-    t151 = xp.where(t149, 1, t117*t150)
-    t152 = xp.where(t149, 0, -t131*t150)
-    t153 = t148*(1 - t151)
-    t154 = t151*t147 + t152*t144
-    t155 = t153 + t151*t148
-    t156 = t151*t144 - t152*t147
-    t157 = t154**2 + t155**2
-    t158 = t157
-    t159 = t157 + t156**2
-    t160 = t43*t86
-    t161 = t42*t100 + t57*t102 - t160
-    t162 = t161 + t160
-    t163 = t162**2 + t103**2
-    t164 = xp.less_equal(t163, t104*t109)
-    t165 = xp.where(t164, 1, 1/xp.sqrt(t163))
-    t166 = xp.where(t164, 1, t162*t165)
-    t167 = xp.where(t164, 0, -t103*t165)
-    t168 = t82*t166 - t90*t167
-    t169 = t82*t167 + t90*t166
-    t170 = t44*t168 + t61*t169
-    t171 = t61*t168 - t44*t169
-    t172 = t46*t168 + t63*t169
-    t173 = t63*t168 - t46*t169
-    t174 = xp.where(t164, 0, xp.atan2(-t103, t162))
-    t175 = t174 - 6.283185307179586*xp.floor(0.15915494309189535*(0.7853981633974483 + t174))
-    t176 = 1 - t168
-    t177 = t45*t176
-    t178 = t177 + t45*t168
-    t179 = t47*t176
-    t180 = t179 + t47*t168
-    t181 = t171**2
-    t182 = -t181
-    t183 = 1 + t182
-    t184 = xp.greater(t183, 1e-12)
-    t185 = xp.where(t184, xp.sqrt(t183), 0)
-    t186 = t181 + t170*t185
-    t187 = t186 + t182
-    t188 = t178**2
-    t189 = t170**2 + t188 + t181
-    t190 = t185**2
-    t191 = t187**2 + t188*t190
-    t192 = t181 + t190
-    t193 = 1e-24*t192
-    t194 = xp.less_equal(t191, t189*t193)
-    t195 = xp.where(t194, 1, 1/xp.sqrt(t191))
-    t196 = xp.where(t194, 1, t187*t195)
-    t197 = t173*(1 - t196)
-    t198 = t197 + t173*t196
-    t199 = t178*t185
-    t200 = xp.where(t194, 0, t195*t199)
-    t201 = t172*t196 + t180*t200
-    t202 = t180*t196 - t172*t200
-    t203 = xp.less_equal(t192, t193)
-    t204 = xp.where(t203, 1, 1/xp.sqrt(t192))
-    t205 = xp.where(t203, 1, t171*t204)
-    t206 = xp.where(t203, 0, -t185*t204)
-    t207 = t202*(1 - t205)
-    t208 = t205*t201 + t206*t198
-    t209 = t207 + t205*t202
-    t210 = t205*t198 - t206*t201
-    t211 = t208**2 + t209**2
-    t212 = t211
-    t213 = t211 + t210**2
-    t214 = 1 - t37
-    t215 = t13*t214
-    t216 = t215 + t13*t37
-    t217 = -0.67183 + t216
-    t218 = t48**2 + t49**2 + t217**2
-    t219 = 0.5*(0.3958295725 - t218)
-    t220 = T22*t214
-    t221 = t220 + T22*t37
-    t222 = T20*t214
-    t223 = t222 + T20*t37
-    t224 = t219**2
-    t225 = 1 - 28.701899543227718*t224
-    t226 = xp.greater(t225, 1e-12)
-    t227 = xp.where(t226, xp.sqrt(t225), 0)
-    t228 = 5.357415379007653*t219
-    t229 = xp.where(t226, t228, xp.where(xp.greater(t228, 0), xp.asarray(1, dtype=dtype), -1))
-    t230 = xp.atan2(t227, t229)
-    t231 = 1.6177742431429796 + t230
-    t232 = 1.6177742431429796 - t230
-    t233 = t231 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t231))
+    t77 = 0.9988967406110469*t67
+    t78 = 0.04696063880130675*t69
+    t79 = -(t77 + t78)
+    t80 = -t78 + t77
+    t81 = 0.15005*(1 - t79)
+    t82 = t81 + 0.15005*t79
+    t83 = 0.15005*(1 - t80)
+    t84 = t83 + 0.15005*t80
+    t85 = 0.04696063880130675*t67
+    t86 = 0.9988967406110469*t69
+    t87 = -t85 + t86
+    t88 = t85 + t86
+    t89 = -0.4318*t87 + 0.0203*t79
+    t90 = 0.0203*t87 + 0.4318*t79
+    t91 = 0.4318 + t89
+    t92 = 0.67183 + t90
+    t93 = -0.67183 + t92
+    t94 = t42*t93 - t57*t91
+    t95 = t82**2 + t91**2 + t93**2
+    t96 = -0.4318*t88 + 0.0203*t80
+    t97 = 0.0203*t88 + 0.4318*t80
+    t98 = 0.4318 + t96
+    t99 = 0.67183 + t97
+    t100 = -0.67183 + t99
+    t101 = t42*t100 - t57*t98
+    t102 = t84**2 + t98**2 + t100**2
+    t103 = t43*t82
+    t104 = t42*t91 + t57*t93 - t103
+    t105 = t104 + t103
+    t106 = t105**2 + t94**2
+    t107 = 1e-24*t58
+    t108 = xp.less_equal(t106, t95*t107)
+    t109 = xp.where(t108, 1, 1/xp.sqrt(t106))
+    t110 = xp.where(t108, 1, t105*t109)
+    t111 = xp.where(t108, 0, -t94*t109)
+    t112 = t79*t110 - t87*t111
+    t113 = t79*t111 + t87*t110
+    t114 = t112*t44 + t113*t61
+    t115 = t112*t61 - t113*t44
+    t116 = t112*t46 + t113*t63
+    t117 = t112*t63 - t113*t46
+    t118 = xp.where(t108, 0, xp.atan2(-t94, t105))
+    t119 = t118 - 6.283185307179586*xp.floor(0.15915494309189535*(0.7853981633974483 + t118))
+    t120 = 1 - t112
+    t121 = t45*t120
+    t122 = t121 + t112*t45
+    t123 = t47*t120
+    t124 = t123 + t112*t47
+    t125 = t115**2
+    t126 = -t125
+    t127 = 1 + t126
+    t128 = xp.greater(t127, 1e-12)
+    t129 = xp.where(t128, xp.sqrt(t127), 0)
+    t130 = t125 + t114*t129
+    t131 = t130 + t126
+    t132 = t122**2
+    t133 = t114**2 + t132 + t125
+    t134 = t129**2
+    t135 = t131**2 + t132*t134
+    t136 = t125 + t134
+    t137 = 1e-24*t136
+    t138 = xp.less_equal(t135, t133*t137)
+    t139 = xp.where(t138, 1, 1/xp.sqrt(t135))
+    t140 = xp.where(t138, 1, t131*t139)
+    t141 = t117*(1 - t140)
+    t142 = t141 + t117*t140
+    t143 = t122*t129
+    t144 = xp.where(t138, 0, t139*t143)
+    t145 = t116*t140 + t124*t144
+    t146 = t124*t140 - t116*t144
+    t147 = xp.less_equal(t136, t137)
+    t148 = xp.where(t147, 1, 1/xp.sqrt(t136))
+    t149 = xp.where(t147, 1, t115*t148)
+    t150 = xp.where(t147, 0, -t129*t148)
+    t151 = t146*(1 - t149)
+    t152 = t149*t145 + t150*t142
+    t153 = t151 + t149*t146
+    t154 = t149*t142 - t150*t145
+    t155 = t152**2 + t153**2
+    t156 = t155
+    t157 = t154**2 + t155
+    t158 = t43*t84
+    t159 = t42*t98 + t57*t100 - t158
+    t160 = t159 + t158
+    t161 = t160**2 + t101**2
+    t162 = xp.less_equal(t161, t102*t107)
+    t163 = xp.where(t162, 1, 1/xp.sqrt(t161))
+    t164 = xp.where(t162, 1, t160*t163)
+    t165 = xp.where(t162, 0, -t101*t163)
+    t166 = t80*t164 - t88*t165
+    t167 = t80*t165 + t88*t164
+    t168 = t44*t166 + t61*t167
+    t169 = t61*t166 - t44*t167
+    t170 = t46*t166 + t63*t167
+    t171 = t63*t166 - t46*t167
+    t172 = xp.where(t162, 0, xp.atan2(-t101, t160))
+    t173 = t172 - 6.283185307179586*xp.floor(0.15915494309189535*(0.7853981633974483 + t172))
+    t174 = 1 - t166
+    t175 = t45*t174
+    t176 = t175 + t45*t166
+    t177 = t47*t174
+    t178 = t177 + t47*t166
+    t179 = t169**2
+    t180 = -t179
+    t181 = 1 + t180
+    t182 = xp.greater(t181, 1e-12)
+    t183 = xp.where(t182, xp.sqrt(t181), 0)
+    t184 = t179 + t168*t183
+    t185 = t184 + t180
+    t186 = t176**2
+    t187 = t168**2 + t186 + t179
+    t188 = t183**2
+    t189 = t185**2 + t186*t188
+    t190 = t179 + t188
+    t191 = 1e-24*t190
+    t192 = xp.less_equal(t189, t187*t191)
+    t193 = xp.where(t192, 1, 1/xp.sqrt(t189))
+    t194 = xp.where(t192, 1, t185*t193)
+    t195 = t171*(1 - t194)
+    t196 = t195 + t171*t194
+    t197 = t176*t183
+    t198 = xp.where(t192, 0, t193*t197)
+    t199 = t170*t194 + t178*t198
+    t200 = t178*t194 - t170*t198
+    t201 = xp.less_equal(t190, t191)
+    t202 = xp.where(t201, 1, 1/xp.sqrt(t190))
+    t203 = xp.where(t201, 1, t169*t202)
+    t204 = xp.where(t201, 0, -t183*t202)
+    t205 = t200*(1 - t203)
+    t206 = t203*t199 + t204*t196
+    t207 = t205 + t203*t200
+    t208 = t203*t196 - t204*t199
+    t209 = t206**2 + t207**2
+    t210 = t209
+    t211 = t208**2 + t209
+    t212 = 1 - t37
+    t213 = t13*t212
+    t214 = t213 + t13*t37
+    t215 = -0.67183 + t214
+    t216 = t48**2 + t49**2 + t215**2
+    t217 = 0.5*(0.3958295725 - t216)
+    t218 = T22*t212
+    t219 = t218 + T22*t37
+    t220 = T20*t212
+    t221 = t220 + T20*t37
+    t222 = t217**2
+    t223 = 1 - 28.701899543227718*t222
+    t224 = xp.greater(t223, 1e-12)
+    t225 = xp.where(t224, xp.sqrt(t223), 0)
+    t226 = 5.357415379007653*t217
+    t227 = xp.where(t224, t226, xp.where(xp.greater(t226, 0), xp.asarray(1, dtype=dtype), -1))
+    t228 = xp.atan2(t225, t227)
+    t229 = 1.6177742431429796 + t228
+    t230 = 1.6177742431429796 - t228
+    t231 = t229 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t229))
+    t232 = t231 - 6.283185307179586*xp.floor(0.15915494309189535*(3.9269908169872414 + t231))
+    t233 = t230 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t230))
     t234 = t233 - 6.283185307179586*xp.floor(0.15915494309189535*(3.9269908169872414 + t233))
-    t235 = t232 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t232))
-    t236 = t235 - 6.283185307179586*xp.floor(0.15915494309189535*(3.9269908169872414 + t235))
-    t237 = 5.357415379007653*t229
-    t238 = 0.00876554*t237
-    t239 = 5.357415379007653*t227
-    t240 = 0.18645124*t239
-    t241 = -(t238 + t240)
-    t242 = t240 - t238
-    t243 = 0.15005*(1 - t241)
-    t244 = t243 + 0.15005*t241
-    t245 = 0.15005*(1 - t242)
-    t246 = t245 + 0.15005*t242
-    t247 = 0.18645124*t237
-    t248 = 0.00876554*t239
-    t249 = t247 - t248
-    t250 = t248 + t247
-    t251 = 0.0203*t241 - 0.4318*t249
-    t252 = 0.0203*t249 + 0.4318*t241
-    t253 = 0.4318 + t251
-    t254 = 0.67183 + t252
-    t255 = -0.67183 + t254
-    t256 = t48*t255 - t217*t253
-    t257 = t244**2 + t253**2 + t255**2
-    t258 = 0.0203*t242 - 0.4318*t250
-    t259 = 0.0203*t250 + 0.4318*t242
-    t260 = 0.4318 + t258
-    t261 = 0.67183 + t259
-    t262 = -0.67183 + t261
-    t263 = t48*t262 - t217*t260
-    t264 = t246**2 + t260**2 + t262**2
-    t265 = t49*t244
-    t266 = t48*t253 + t217*t255 - t265
-    t267 = t266 + t265
-    t268 = t267**2 + t256**2
-    t269 = 1e-24*t218
-    t270 = xp.less_equal(t268, t257*t269)
-    t271 = xp.where(t270, 1, 1/xp.sqrt(t268))
-    t272 = xp.where(t270, 1, t267*t271)
-    t273 = xp.where(t270, 0, -t256*t271)
-    t274 = t241*t272 - t249*t273
-    t275 = t241*t273 + t249*t272
-    t276 = t274*t50 + t275*t221
-    t277 = t274*t221 - t275*t50
-    t278 = t274*t52 + t275*t223
-    t279 = t274*t223 - t275*t52
-    t280 = xp.where(t270, 0, xp.atan2(-t256, t267))
-    t281 = t280 - 6.283185307179586*xp.floor(0.15915494309189535*(0.7853981633974483 + t280))
-    t282 = 1 - t274
-    t283 = t51*t282
-    t284 = t283 + t274*t51
-    t285 = t53*t282
-    t286 = t285 + t274*t53
-    t287 = t277**2
-    t288 = -t287
-    t289 = 1 + t288
-    t290 = xp.greater(t289, 1e-12)
-    t291 = xp.where(t290, xp.sqrt(t289), 0)
-    t292 = t287 + t276*t291
-    t293 = t292 + t288
-    t294 = t284**2
-    t295 = t276**2 + t294 + t287
-    t296 = t291**2
-    t297 = t293**2 + t294*t296
-    t298 = t287 + t296
-    t299 = 1e-24*t298
-    t300 = xp.less_equal(t297, t295*t299)
-    t301 = xp.where(t300, 1, 1/xp.sqrt(t297))
-    t302 = xp.where(t300, 1, t293*t301)
-    t303 = t279*(1 - t302)
-    t304 = t303 + t279*t302
-    t305 = t284*t291
-    t306 = xp.where(t300, 0, t301*t305)
-    t307 = t278*t302 + t286*t306
-    t308 = t286*t302 - t278*t306
-    t309 = xp.less_equal(t298, t299)
-    t310 = xp.where(t309, 1, 1/xp.sqrt(t298))
-    t311 = xp.where(t309, 1, t277*t310)
-    t312 = xp.where(t309, 0, -t291*t310)
-    t313 = t308*(1 - t311)
-    t314 = t311*t307 + t312*t304
-    t315 = t313 + t311*t308
-    t316 = t311*t304 - t312*t307
-    t317 = t314**2 + t315**2
-    t318 = t317
-    t319 = t317 + t316**2
-    t320 = t49*t246
-    t321 = t48*t260 + t217*t262 - t320
-    t322 = t321 + t320
-    t323 = t322**2 + t263**2
-    t324 = xp.less_equal(t323, t264*t269)
-    t325 = xp.where(t324, 1, 1/xp.sqrt(t323))
-    t326 = xp.where(t324, 1, t322*t325)
-    t327 = xp.where(t324, 0, -t263*t325)
-    t328 = t242*t326 - t250*t327
-    t329 = t242*t327 + t250*t326
-    t330 = t50*t328 + t221*t329
-    t331 = t221*t328 - t50*t329
-    t332 = t52*t328 + t223*t329
-    t333 = t223*t328 - t52*t329
-    t334 = xp.where(t324, 0, xp.atan2(-t263, t322))
-    t335 = t334 - 6.283185307179586*xp.floor(0.15915494309189535*(0.7853981633974483 + t334))
-    t336 = 1 - t328
-    t337 = t51*t336
-    t338 = t337 + t51*t328
-    t339 = t53*t336
-    t340 = t339 + t53*t328
-    t341 = t331**2
-    t342 = -t341
-    t343 = 1 + t342
-    t344 = xp.greater(t343, 1e-12)
-    t345 = xp.where(t344, xp.sqrt(t343), 0)
-    t346 = t341 + t330*t345
-    t347 = t346 + t342
-    t348 = t338**2
-    t349 = t330**2 + t348 + t341
-    t350 = t345**2
-    t351 = t347**2 + t348*t350
-    t352 = t341 + t350
-    t353 = 1e-24*t352
-    t354 = xp.less_equal(t351, t349*t353)
-    t355 = xp.where(t354, 1, 1/xp.sqrt(t351))
-    t356 = xp.where(t354, 1, t347*t355)
-    t357 = t333*(1 - t356)
-    t358 = t357 + t333*t356
-    t359 = t338*t345
-    t360 = xp.where(t354, 0, t355*t359)
-    t361 = t332*t356 + t340*t360
-    t362 = t340*t356 - t332*t360
-    t363 = xp.less_equal(t352, t353)
-    t364 = xp.where(t363, 1, 1/xp.sqrt(t352))
-    t365 = xp.where(t363, 1, t331*t364)
-    t366 = xp.where(t363, 0, -t345*t364)
-    t367 = t362*(1 - t365)
-    t368 = t365*t361 + t366*t358
-    t369 = t367 + t365*t362
-    t370 = t365*t358 - t366*t361
-    t371 = t368**2 + t369**2
-    t372 = t371
-    t373 = t371 + t370**2
-    t374 = xp.where(t140, 0, xp.atan2(t145, t133))
-    t375 = t374
-    t376 = t375 - 6.283185307179586*xp.floor(0.15915494309189535*(1.9198621771937625 + t375))
-    t377 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t374) + t374
-    t378 = t377 - 6.283185307179586*xp.floor(0.15915494309189535*(1.9198621771937625 + t377))
-    t379 = xp.where(t149, 0, xp.atan2(-t131, t117))
+    t235 = 0.9988967406110469*t225
+    t236 = 0.04696063880130675*t227
+    t237 = -(t235 + t236)
+    t238 = -t236 + t235
+    t239 = 0.15005*(1 - t237)
+    t240 = t239 + 0.15005*t237
+    t241 = 0.15005*(1 - t238)
+    t242 = t241 + 0.15005*t238
+    t243 = 0.04696063880130675*t225
+    t244 = 0.9988967406110469*t227
+    t245 = -t243 + t244
+    t246 = t243 + t244
+    t247 = -0.4318*t245 + 0.0203*t237
+    t248 = 0.0203*t245 + 0.4318*t237
+    t249 = 0.4318 + t247
+    t250 = 0.67183 + t248
+    t251 = -0.67183 + t250
+    t252 = t48*t251 - t215*t249
+    t253 = t240**2 + t249**2 + t251**2
+    t254 = -0.4318*t246 + 0.0203*t238
+    t255 = 0.0203*t246 + 0.4318*t238
+    t256 = 0.4318 + t254
+    t257 = 0.67183 + t255
+    t258 = -0.67183 + t257
+    t259 = t48*t258 - t215*t256
+    t260 = t242**2 + t256**2 + t258**2
+    t261 = t49*t240
+    t262 = t48*t249 + t215*t251 - t261
+    t263 = t262 + t261
+    t264 = t263**2 + t252**2
+    t265 = 1e-24*t216
+    t266 = xp.less_equal(t264, t253*t265)
+    t267 = xp.where(t266, 1, 1/xp.sqrt(t264))
+    t268 = xp.where(t266, 1, t263*t267)
+    t269 = xp.where(t266, 0, -t252*t267)
+    t270 = t237*t268 - t245*t269
+    t271 = t237*t269 + t245*t268
+    t272 = t270*t50 + t271*t219
+    t273 = t270*t219 - t271*t50
+    t274 = t270*t52 + t271*t221
+    t275 = t270*t221 - t271*t52
+    t276 = xp.where(t266, 0, xp.atan2(-t252, t263))
+    t277 = t276 - 6.283185307179586*xp.floor(0.15915494309189535*(0.7853981633974483 + t276))
+    t278 = 1 - t270
+    t279 = t51*t278
+    t280 = t279 + t270*t51
+    t281 = t53*t278
+    t282 = t281 + t270*t53
+    t283 = t273**2
+    t284 = -t283
+    t285 = 1 + t284
+    t286 = xp.greater(t285, 1e-12)
+    t287 = xp.where(t286, xp.sqrt(t285), 0)
+    t288 = t283 + t272*t287
+    t289 = t288 + t284
+    t290 = t280**2
+    t291 = t272**2 + t290 + t283
+    t292 = t287**2
+    t293 = t289**2 + t290*t292
+    t294 = t283 + t292
+    t295 = 1e-24*t294
+    t296 = xp.less_equal(t293, t291*t295)
+    t297 = xp.where(t296, 1, 1/xp.sqrt(t293))
+    t298 = xp.where(t296, 1, t289*t297)
+    t299 = t275*(1 - t298)
+    t300 = t299 + t275*t298
+    t301 = t280*t287
+    t302 = xp.where(t296, 0, t297*t301)
+    t303 = t274*t298 + t282*t302
+    t304 = t282*t298 - t274*t302
+    t305 = xp.less_equal(t294, t295)
+    t306 = xp.where(t305, 1, 1/xp.sqrt(t294))
+    t307 = xp.where(t305, 1, t273*t306)
+    t308 = xp.where(t305, 0, -t287*t306)
+    t309 = t304*(1 - t307)
+    t310 = t307*t303 + t308*t300
+    t311 = t309 + t307*t304
+    t312 = t307*t300 - t308*t303
+    t313 = t310**2 + t311**2
+    t314 = t313
+    t315 = t312**2 + t313
+    t316 = t49*t242
+    t317 = t48*t256 + t215*t258 - t316
+    t318 = t317 + t316
+    t319 = t318**2 + t259**2
+    t320 = xp.less_equal(t319, t260*t265)
+    t321 = xp.where(t320, 1, 1/xp.sqrt(t319))
+    t322 = xp.where(t320, 1, t318*t321)
+    t323 = xp.where(t320, 0, -t259*t321)
+    t324 = t238*t322 - t246*t323
+    t325 = t238*t323 + t246*t322
+    t326 = t50*t324 + t219*t325
+    t327 = t219*t324 - t50*t325
+    t328 = t52*t324 + t221*t325
+    t329 = t221*t324 - t52*t325
+    t330 = xp.where(t320, 0, xp.atan2(-t259, t318))
+    t331 = t330 - 6.283185307179586*xp.floor(0.15915494309189535*(0.7853981633974483 + t330))
+    t332 = 1 - t324
+    t333 = t51*t332
+    t334 = t333 + t51*t324
+    t335 = t53*t332
+    t336 = t335 + t53*t324
+    t337 = t327**2
+    t338 = -t337
+    t339 = 1 + t338
+    t340 = xp.greater(t339, 1e-12)
+    t341 = xp.where(t340, xp.sqrt(t339), 0)
+    t342 = t337 + t326*t341
+    t343 = t342 + t338
+    t344 = t334**2
+    t345 = t326**2 + t344 + t337
+    t346 = t341**2
+    t347 = t343**2 + t344*t346
+    t348 = t337 + t346
+    t349 = 1e-24*t348
+    t350 = xp.less_equal(t347, t345*t349)
+    t351 = xp.where(t350, 1, 1/xp.sqrt(t347))
+    t352 = xp.where(t350, 1, t343*t351)
+    t353 = t329*(1 - t352)
+    t354 = t353 + t329*t352
+    t355 = t334*t341
+    t356 = xp.where(t350, 0, t351*t355)
+    t357 = t328*t352 + t336*t356
+    t358 = t336*t352 - t328*t356
+    t359 = xp.less_equal(t348, t349)
+    t360 = xp.where(t359, 1, 1/xp.sqrt(t348))
+    t361 = xp.where(t359, 1, t327*t360)
+    t362 = xp.where(t359, 0, -t341*t360)
+    t363 = t358*(1 - t361)
+    t364 = t361*t357 + t362*t354
+    t365 = t363 + t361*t358
+    t366 = t361*t354 - t362*t357
+    t367 = t364**2 + t365**2
+    t368 = t367
+    t369 = t366**2 + t367
+    t370 = xp.where(t138, 0, xp.atan2(t143, t131))
+    t371 = t370
+    t372 = t371 - 6.283185307179586*xp.floor(0.15915494309189535*(1.9198621771937625 + t371))
+    t373 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t370) + t370
+    t374 = t373 - 6.283185307179586*xp.floor(0.15915494309189535*(1.9198621771937625 + t373))
+    t375 = xp.where(t147, 0, xp.atan2(-t129, t115))
+    t376 = t375
+    t377 = t376 - 6.283185307179586*xp.floor(0.15915494309189535*(1.7453292519943295 + t376))
+    t378 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t375)) + t375
+    t379 = xp.where(xp.less_equal(t156, 1e-24*t157), 0, xp.atan2(t153, t152))
     t380 = t379
-    t381 = t380 - 6.283185307179586*xp.floor(0.15915494309189535*(1.7453292519943295 + t380))
-    t382 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t379)) + t379
-    t383 = xp.where(xp.less_equal(t158, 1e-24*t159), 0, xp.atan2(t155, t154))
-    t384 = t383
-    t385 = t384 - 6.283185307179586*xp.floor(0.15915494309189535*(4.642575810304916 + t384))
-    t386 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t383) + t383
-    t387 = t386 - 6.283185307179586*xp.floor(0.15915494309189535*(4.642575810304916 + t386))
-    t388 = -t382
-    t389 = t382 + 6.283185307179586*xp.floor(0.15915494309189535*(1.7453292519943295 + t388))
-    t390 = xp.where(t194, 0, xp.atan2(t199, t187))
-    t391 = t390
-    t392 = t391 - 6.283185307179586*xp.floor(0.15915494309189535*(1.9198621771937625 + t391))
-    t393 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t390) + t390
-    t394 = t393 - 6.283185307179586*xp.floor(0.15915494309189535*(1.9198621771937625 + t393))
-    t395 = xp.where(t203, 0, xp.atan2(-t185, t171))
+    t381 = t380 - 6.283185307179586*xp.floor(0.15915494309189535*(4.642575810304916 + t380))
+    t382 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t379) + t379
+    t383 = t382 - 6.283185307179586*xp.floor(0.15915494309189535*(4.642575810304916 + t382))
+    t384 = -t378
+    t385 = t378 + 6.283185307179586*xp.floor(0.15915494309189535*(1.7453292519943295 + t384))
+    t386 = xp.where(t192, 0, xp.atan2(t197, t185))
+    t387 = t386
+    t388 = t387 - 6.283185307179586*xp.floor(0.15915494309189535*(1.9198621771937625 + t387))
+    t389 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t386) + t386
+    t390 = t389 - 6.283185307179586*xp.floor(0.15915494309189535*(1.9198621771937625 + t389))
+    t391 = xp.where(t201, 0, xp.atan2(-t183, t169))
+    t392 = t391
+    t393 = t392 - 6.283185307179586*xp.floor(0.15915494309189535*(1.7453292519943295 + t392))
+    t394 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t391)) + t391
+    t395 = xp.where(xp.less_equal(t210, 1e-24*t211), 0, xp.atan2(t207, t206))
     t396 = t395
-    t397 = t396 - 6.283185307179586*xp.floor(0.15915494309189535*(1.7453292519943295 + t396))
-    t398 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t395)) + t395
-    t399 = xp.where(xp.less_equal(t212, 1e-24*t213), 0, xp.atan2(t209, t208))
-    t400 = t399
-    t401 = t400 - 6.283185307179586*xp.floor(0.15915494309189535*(4.642575810304916 + t400))
-    t402 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t399) + t399
-    t403 = t402 - 6.283185307179586*xp.floor(0.15915494309189535*(4.642575810304916 + t402))
-    t404 = -t398
-    t405 = t398 + 6.283185307179586*xp.floor(0.15915494309189535*(1.7453292519943295 + t404))
-    t406 = xp.where(t300, 0, xp.atan2(t305, t293))
-    t407 = t406
-    t408 = t407 - 6.283185307179586*xp.floor(0.15915494309189535*(1.9198621771937625 + t407))
-    t409 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t406) + t406
-    t410 = t409 - 6.283185307179586*xp.floor(0.15915494309189535*(1.9198621771937625 + t409))
-    t411 = xp.where(t309, 0, xp.atan2(-t291, t277))
+    t397 = t396 - 6.283185307179586*xp.floor(0.15915494309189535*(4.642575810304916 + t396))
+    t398 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t395) + t395
+    t399 = t398 - 6.283185307179586*xp.floor(0.15915494309189535*(4.642575810304916 + t398))
+    t400 = -t394
+    t401 = t394 + 6.283185307179586*xp.floor(0.15915494309189535*(1.7453292519943295 + t400))
+    t402 = xp.where(t296, 0, xp.atan2(t301, t289))
+    t403 = t402
+    t404 = t403 - 6.283185307179586*xp.floor(0.15915494309189535*(1.9198621771937625 + t403))
+    t405 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t402) + t402
+    t406 = t405 - 6.283185307179586*xp.floor(0.15915494309189535*(1.9198621771937625 + t405))
+    t407 = xp.where(t305, 0, xp.atan2(-t287, t273))
+    t408 = t407
+    t409 = t408 - 6.283185307179586*xp.floor(0.15915494309189535*(1.7453292519943295 + t408))
+    t410 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t407)) + t407
+    t411 = xp.where(xp.less_equal(t314, 1e-24*t315), 0, xp.atan2(t311, t310))
     t412 = t411
-    t413 = t412 - 6.283185307179586*xp.floor(0.15915494309189535*(1.7453292519943295 + t412))
-    t414 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t411)) + t411
-    t415 = xp.where(xp.less_equal(t318, 1e-24*t319), 0, xp.atan2(t315, t314))
-    t416 = t415
-    t417 = t416 - 6.283185307179586*xp.floor(0.15915494309189535*(4.642575810304916 + t416))
-    t418 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t415) + t415
-    t419 = t418 - 6.283185307179586*xp.floor(0.15915494309189535*(4.642575810304916 + t418))
-    t420 = -t414
-    t421 = t414 + 6.283185307179586*xp.floor(0.15915494309189535*(1.7453292519943295 + t420))
-    t422 = xp.where(t354, 0, xp.atan2(t359, t347))
-    t423 = t422
-    t424 = t423 - 6.283185307179586*xp.floor(0.15915494309189535*(1.9198621771937625 + t423))
-    t425 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t422) + t422
-    t426 = t425 - 6.283185307179586*xp.floor(0.15915494309189535*(1.9198621771937625 + t425))
-    t427 = xp.where(t363, 0, xp.atan2(-t345, t331))
+    t413 = t412 - 6.283185307179586*xp.floor(0.15915494309189535*(4.642575810304916 + t412))
+    t414 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t411) + t411
+    t415 = t414 - 6.283185307179586*xp.floor(0.15915494309189535*(4.642575810304916 + t414))
+    t416 = -t410
+    t417 = t410 + 6.283185307179586*xp.floor(0.15915494309189535*(1.7453292519943295 + t416))
+    t418 = xp.where(t350, 0, xp.atan2(t355, t343))
+    t419 = t418
+    t420 = t419 - 6.283185307179586*xp.floor(0.15915494309189535*(1.9198621771937625 + t419))
+    t421 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t418) + t418
+    t422 = t421 - 6.283185307179586*xp.floor(0.15915494309189535*(1.9198621771937625 + t421))
+    t423 = xp.where(t359, 0, xp.atan2(-t341, t327))
+    t424 = t423
+    t425 = t424 - 6.283185307179586*xp.floor(0.15915494309189535*(1.7453292519943295 + t424))
+    t426 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t423)) + t423
+    t427 = xp.where(xp.less_equal(t368, 1e-24*t369), 0, xp.atan2(t365, t364))
     t428 = t427
-    t429 = t428 - 6.283185307179586*xp.floor(0.15915494309189535*(1.7453292519943295 + t428))
-    t430 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t427)) + t427
-    t431 = xp.where(xp.less_equal(t372, 1e-24*t373), 0, xp.atan2(t369, t368))
-    t432 = t431
-    t433 = t432 - 6.283185307179586*xp.floor(0.15915494309189535*(4.642575810304916 + t432))
-    t434 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t431) + t431
-    t435 = t434 - 6.283185307179586*xp.floor(0.15915494309189535*(4.642575810304916 + t434))
-    t436 = -t430
-    t437 = t430 + 6.283185307179586*xp.floor(0.15915494309189535*(1.7453292519943295 + t436))
-    t438 = xp.less_equal(t29, 2.792526803190927)
-    t439 = xp.greater_equal(t28, -2.792526803190927) & xp.less_equal(t28, 2.792526803190927)
-    t440 = xp.where(t438 & xp.logical_not(t439), t29, t28)
-    t441 = xp.less_equal(t121, 3.9269908169872414)
-    t442 = xp.greater_equal(t120, -0.7853981633974483) & xp.less_equal(t120, 3.9269908169872414)
-    t443 = xp.where(t441 & xp.logical_not(t442), t121, t120)
-    t444 = xp.less_equal(t74, 0.7853981633974483)
-    t445 = xp.greater_equal(t73, -3.9269908169872414) & xp.less_equal(t73, 0.7853981633974483)
-    t446 = xp.where(t444 & xp.logical_not(t445), t74, t73)
-    t447 = xp.less_equal(t376, 2.9670597283903604)
-    t448 = xp.greater_equal(t375, -1.9198621771937625) & xp.less_equal(t375, 2.9670597283903604)
-    t449 = xp.less_equal(t381, 1.7453292519943295)
-    t450 = xp.greater_equal(t380, -1.7453292519943295) & xp.less_equal(t380, 1.7453292519943295)
-    t451 = xp.less_equal(t385, 4.642575810304916)
-    t452 = xp.greater_equal(t384, -4.642575810304916) & xp.less_equal(t384, 4.642575810304916)
-    t453 = xp.less_equal(t378, 2.9670597283903604)
-    t454 = xp.greater_equal(t377, -1.9198621771937625) & xp.less_equal(t377, 2.9670597283903604)
-    t455 = -t389
-    t456 = xp.less_equal(t455, 1.7453292519943295)
-    t457 = xp.greater_equal(t388, -1.7453292519943295) & xp.less_equal(t388, 1.7453292519943295)
-    t458 = xp.less_equal(t387, 4.642575810304916)
-    t459 = xp.greater_equal(t386, -4.642575810304916) & xp.less_equal(t386, 4.642575810304916)
-    t460 = xp.less_equal(t175, 3.9269908169872414)
-    t461 = xp.greater_equal(t174, -0.7853981633974483) & xp.less_equal(t174, 3.9269908169872414)
-    t462 = xp.where(t460 & xp.logical_not(t461), t175, t174)
-    t463 = xp.less_equal(t76, 0.7853981633974483)
-    t464 = xp.greater_equal(t75, -3.9269908169872414) & xp.less_equal(t75, 0.7853981633974483)
-    t465 = xp.where(t463 & xp.logical_not(t464), t76, t75)
-    t466 = xp.less_equal(t392, 2.9670597283903604)
-    t467 = xp.greater_equal(t391, -1.9198621771937625) & xp.less_equal(t391, 2.9670597283903604)
-    t468 = xp.less_equal(t397, 1.7453292519943295)
-    t469 = xp.greater_equal(t396, -1.7453292519943295) & xp.less_equal(t396, 1.7453292519943295)
-    t470 = xp.less_equal(t401, 4.642575810304916)
-    t471 = xp.greater_equal(t400, -4.642575810304916) & xp.less_equal(t400, 4.642575810304916)
-    t472 = xp.less_equal(t394, 2.9670597283903604)
-    t473 = xp.greater_equal(t393, -1.9198621771937625) & xp.less_equal(t393, 2.9670597283903604)
-    t474 = -t405
-    t475 = xp.less_equal(t474, 1.7453292519943295)
-    t476 = xp.greater_equal(t404, -1.7453292519943295) & xp.less_equal(t404, 1.7453292519943295)
-    t477 = xp.less_equal(t403, 4.642575810304916)
-    t478 = xp.greater_equal(t402, -4.642575810304916) & xp.less_equal(t402, 4.642575810304916)
-    t479 = xp.less_equal(t31, 2.792526803190927)
-    t480 = xp.greater_equal(t30, -2.792526803190927) & xp.less_equal(t30, 2.792526803190927)
-    t481 = xp.where(t479 & xp.logical_not(t480), t31, t30)
-    t482 = xp.less_equal(t281, 3.9269908169872414)
-    t483 = xp.greater_equal(t280, -0.7853981633974483) & xp.less_equal(t280, 3.9269908169872414)
-    t484 = xp.where(t482 & xp.logical_not(t483), t281, t280)
-    t485 = xp.less_equal(t234, 0.7853981633974483)
-    t486 = xp.greater_equal(t233, -3.9269908169872414) & xp.less_equal(t233, 0.7853981633974483)
-    t487 = xp.where(t485 & xp.logical_not(t486), t234, t233)
-    t488 = xp.less_equal(t408, 2.9670597283903604)
-    t489 = xp.greater_equal(t407, -1.9198621771937625) & xp.less_equal(t407, 2.9670597283903604)
-    t490 = xp.less_equal(t413, 1.7453292519943295)
-    t491 = xp.greater_equal(t412, -1.7453292519943295) & xp.less_equal(t412, 1.7453292519943295)
-    t492 = xp.less_equal(t417, 4.642575810304916)
-    t493 = xp.greater_equal(t416, -4.642575810304916) & xp.less_equal(t416, 4.642575810304916)
-    t494 = xp.less_equal(t410, 2.9670597283903604)
-    t495 = xp.greater_equal(t409, -1.9198621771937625) & xp.less_equal(t409, 2.9670597283903604)
-    t496 = -t421
-    t497 = xp.less_equal(t496, 1.7453292519943295)
-    t498 = xp.greater_equal(t420, -1.7453292519943295) & xp.less_equal(t420, 1.7453292519943295)
-    t499 = xp.less_equal(t419, 4.642575810304916)
-    t500 = xp.greater_equal(t418, -4.642575810304916) & xp.less_equal(t418, 4.642575810304916)
-    t501 = xp.less_equal(t335, 3.9269908169872414)
-    t502 = xp.greater_equal(t334, -0.7853981633974483) & xp.less_equal(t334, 3.9269908169872414)
-    t503 = xp.where(t501 & xp.logical_not(t502), t335, t334)
-    t504 = xp.less_equal(t236, 0.7853981633974483)
-    t505 = xp.greater_equal(t235, -3.9269908169872414) & xp.less_equal(t235, 0.7853981633974483)
-    t506 = xp.where(t504 & xp.logical_not(t505), t236, t235)
-    t507 = xp.less_equal(t424, 2.9670597283903604)
-    t508 = xp.greater_equal(t423, -1.9198621771937625) & xp.less_equal(t423, 2.9670597283903604)
-    t509 = xp.less_equal(t429, 1.7453292519943295)
-    t510 = xp.greater_equal(t428, -1.7453292519943295) & xp.less_equal(t428, 1.7453292519943295)
-    t511 = xp.less_equal(t433, 4.642575810304916)
-    t512 = xp.greater_equal(t432, -4.642575810304916) & xp.less_equal(t432, 4.642575810304916)
-    t513 = xp.less_equal(t426, 2.9670597283903604)
-    t514 = xp.greater_equal(t425, -1.9198621771937625) & xp.less_equal(t425, 2.9670597283903604)
-    t515 = -t437
-    t516 = xp.less_equal(t515, 1.7453292519943295)
-    t517 = xp.greater_equal(t436, -1.7453292519943295) & xp.less_equal(t436, 1.7453292519943295)
-    t518 = xp.less_equal(t435, 4.642575810304916)
-    t519 = xp.greater_equal(t434, -4.642575810304916) & xp.less_equal(t434, 4.642575810304916)
-    t520 = xp.isfinite(t0)
-    t521 = xp.greater(t15, t17)
-    t522 = (t18 & xp.less_equal(0.0225150025, 1e-12*t16)) | (t521 & xp.greater_equal(t20, -1e-12))
-    t523 = xp.greater_equal(t65, -1e-12)
-    t524 = xp.greater_equal(t225, -1e-12)
-    t525 = t438 | t439
-    t526 = t441 | t442
-    t527 = t444 | t445
-    t528 = t460 | t461
-    t529 = t463 | t464
-    t530 = t479 | t480
-    t531 = t482 | t483
-    t532 = t485 | t486
-    t533 = t501 | t502
-    t534 = t504 | t505
+    t429 = t428 - 6.283185307179586*xp.floor(0.15915494309189535*(4.642575810304916 + t428))
+    t430 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t427) + t427
+    t431 = t430 - 6.283185307179586*xp.floor(0.15915494309189535*(4.642575810304916 + t430))
+    t432 = -t426
+    t433 = t426 + 6.283185307179586*xp.floor(0.15915494309189535*(1.7453292519943295 + t432))
+    t434 = xp.less_equal(t29, 2.792526803190927)
+    t435 = xp.greater_equal(t28, -2.792526803190927) & xp.less_equal(t28, 2.792526803190927)
+    t436 = xp.where(t434 & xp.logical_not(t435), t29, t28)
+    t437 = xp.less_equal(t119, 3.9269908169872414)
+    t438 = xp.greater_equal(t118, -0.7853981633974483) & xp.less_equal(t118, 3.9269908169872414)
+    t439 = xp.where(t437 & xp.logical_not(t438), t119, t118)
+    t440 = xp.less_equal(t76, 0.7853981633974483)
+    t441 = xp.greater_equal(t75, -3.9269908169872414) & xp.less_equal(t75, 0.7853981633974483)
+    t442 = xp.where(t440 & xp.logical_not(t441), t76, t75)
+    t443 = xp.less_equal(t372, 2.9670597283903604)
+    t444 = xp.greater_equal(t371, -1.9198621771937625) & xp.less_equal(t371, 2.9670597283903604)
+    t445 = xp.less_equal(t377, 1.7453292519943295)
+    t446 = xp.greater_equal(t376, -1.7453292519943295) & xp.less_equal(t376, 1.7453292519943295)
+    t447 = xp.less_equal(t381, 4.642575810304916)
+    t448 = xp.greater_equal(t380, -4.642575810304916) & xp.less_equal(t380, 4.642575810304916)
+    t449 = xp.less_equal(t374, 2.9670597283903604)
+    t450 = xp.greater_equal(t373, -1.9198621771937625) & xp.less_equal(t373, 2.9670597283903604)
+    t451 = -t385
+    t452 = xp.less_equal(t451, 1.7453292519943295)
+    t453 = xp.greater_equal(t384, -1.7453292519943295) & xp.less_equal(t384, 1.7453292519943295)
+    t454 = xp.less_equal(t383, 4.642575810304916)
+    t455 = xp.greater_equal(t382, -4.642575810304916) & xp.less_equal(t382, 4.642575810304916)
+    t456 = xp.less_equal(t173, 3.9269908169872414)
+    t457 = xp.greater_equal(t172, -0.7853981633974483) & xp.less_equal(t172, 3.9269908169872414)
+    t458 = xp.where(t456 & xp.logical_not(t457), t173, t172)
+    t459 = xp.less_equal(t73, 0.7853981633974483)
+    t460 = xp.greater_equal(t72, -3.9269908169872414) & xp.less_equal(t72, 0.7853981633974483)
+    t461 = xp.where(t459 & xp.logical_not(t460), t73, t72)
+    t462 = xp.less_equal(t388, 2.9670597283903604)
+    t463 = xp.greater_equal(t387, -1.9198621771937625) & xp.less_equal(t387, 2.9670597283903604)
+    t464 = xp.less_equal(t393, 1.7453292519943295)
+    t465 = xp.greater_equal(t392, -1.7453292519943295) & xp.less_equal(t392, 1.7453292519943295)
+    t466 = xp.less_equal(t397, 4.642575810304916)
+    t467 = xp.greater_equal(t396, -4.642575810304916) & xp.less_equal(t396, 4.642575810304916)
+    t468 = xp.less_equal(t390, 2.9670597283903604)
+    t469 = xp.greater_equal(t389, -1.9198621771937625) & xp.less_equal(t389, 2.9670597283903604)
+    t470 = -t401
+    t471 = xp.less_equal(t470, 1.7453292519943295)
+    t472 = xp.greater_equal(t400, -1.7453292519943295) & xp.less_equal(t400, 1.7453292519943295)
+    t473 = xp.less_equal(t399, 4.642575810304916)
+    t474 = xp.greater_equal(t398, -4.642575810304916) & xp.less_equal(t398, 4.642575810304916)
+    t475 = xp.less_equal(t31, 2.792526803190927)
+    t476 = xp.greater_equal(t30, -2.792526803190927) & xp.less_equal(t30, 2.792526803190927)
+    t477 = xp.where(t475 & xp.logical_not(t476), t31, t30)
+    t478 = xp.less_equal(t277, 3.9269908169872414)
+    t479 = xp.greater_equal(t276, -0.7853981633974483) & xp.less_equal(t276, 3.9269908169872414)
+    t480 = xp.where(t478 & xp.logical_not(t479), t277, t276)
+    t481 = xp.less_equal(t232, 0.7853981633974483)
+    t482 = xp.greater_equal(t231, -3.9269908169872414) & xp.less_equal(t231, 0.7853981633974483)
+    t483 = xp.where(t481 & xp.logical_not(t482), t232, t231)
+    t484 = xp.less_equal(t404, 2.9670597283903604)
+    t485 = xp.greater_equal(t403, -1.9198621771937625) & xp.less_equal(t403, 2.9670597283903604)
+    t486 = xp.less_equal(t409, 1.7453292519943295)
+    t487 = xp.greater_equal(t408, -1.7453292519943295) & xp.less_equal(t408, 1.7453292519943295)
+    t488 = xp.less_equal(t413, 4.642575810304916)
+    t489 = xp.greater_equal(t412, -4.642575810304916) & xp.less_equal(t412, 4.642575810304916)
+    t490 = xp.less_equal(t406, 2.9670597283903604)
+    t491 = xp.greater_equal(t405, -1.9198621771937625) & xp.less_equal(t405, 2.9670597283903604)
+    t492 = -t417
+    t493 = xp.less_equal(t492, 1.7453292519943295)
+    t494 = xp.greater_equal(t416, -1.7453292519943295) & xp.less_equal(t416, 1.7453292519943295)
+    t495 = xp.less_equal(t415, 4.642575810304916)
+    t496 = xp.greater_equal(t414, -4.642575810304916) & xp.less_equal(t414, 4.642575810304916)
+    t497 = xp.less_equal(t331, 3.9269908169872414)
+    t498 = xp.greater_equal(t330, -0.7853981633974483) & xp.less_equal(t330, 3.9269908169872414)
+    t499 = xp.where(t497 & xp.logical_not(t498), t331, t330)
+    t500 = xp.less_equal(t234, 0.7853981633974483)
+    t501 = xp.greater_equal(t233, -3.9269908169872414) & xp.less_equal(t233, 0.7853981633974483)
+    t502 = xp.where(t500 & xp.logical_not(t501), t234, t233)
+    t503 = xp.less_equal(t420, 2.9670597283903604)
+    t504 = xp.greater_equal(t419, -1.9198621771937625) & xp.less_equal(t419, 2.9670597283903604)
+    t505 = xp.less_equal(t425, 1.7453292519943295)
+    t506 = xp.greater_equal(t424, -1.7453292519943295) & xp.less_equal(t424, 1.7453292519943295)
+    t507 = xp.less_equal(t429, 4.642575810304916)
+    t508 = xp.greater_equal(t428, -4.642575810304916) & xp.less_equal(t428, 4.642575810304916)
+    t509 = xp.less_equal(t422, 2.9670597283903604)
+    t510 = xp.greater_equal(t421, -1.9198621771937625) & xp.less_equal(t421, 2.9670597283903604)
+    t511 = -t433
+    t512 = xp.less_equal(t511, 1.7453292519943295)
+    t513 = xp.greater_equal(t432, -1.7453292519943295) & xp.less_equal(t432, 1.7453292519943295)
+    t514 = xp.less_equal(t431, 4.642575810304916)
+    t515 = xp.greater_equal(t430, -4.642575810304916) & xp.less_equal(t430, 4.642575810304916)
+    t516 = xp.isfinite(t0)
+    t517 = xp.greater(t15, t17)
+    t518 = (xp.greater_equal(t20, -1e-12) & t517) | (xp.less_equal(0.0225150025, 1e-12*t16) & t18)
+    t519 = xp.greater_equal(t65, -1e-12)
+    t520 = xp.greater_equal(t223, -1e-12)
+    t521 = t434 | t435
+    t522 = t437 | t438
+    t523 = t440 | t441
+    t524 = t456 | t457
+    t525 = t459 | t460
+    t526 = t475 | t476
+    t527 = t478 | t479
+    t528 = t481 | t482
+    t529 = t497 | t498
+    t530 = t500 | t501
     q = _stack(xp, [
-        t440,  # 0, 0
-        t443,  # 0, 1
-        t446,  # 0, 2
-        xp.where(t447 & xp.logical_not(t448), t376, t375),  # 0, 3
-        xp.where(t449 & xp.logical_not(t450), t381, t380),  # 0, 4
-        xp.where(t451 & xp.logical_not(t452), t385, t384),  # 0, 5
-        t440,  # 1, 0
-        t443,  # 1, 1
-        t446,  # 1, 2
-        xp.where(t453 & xp.logical_not(t454), t378, t377),  # 1, 3
-        xp.where(t456 & xp.logical_not(t457), t455, t388),  # 1, 4
-        xp.where(t458 & xp.logical_not(t459), t387, t386),  # 1, 5
-        t440,  # 2, 0
-        t462,  # 2, 1
-        t465,  # 2, 2
-        xp.where(t466 & xp.logical_not(t467), t392, t391),  # 2, 3
-        xp.where(t468 & xp.logical_not(t469), t397, t396),  # 2, 4
-        xp.where(t470 & xp.logical_not(t471), t401, t400),  # 2, 5
-        t440,  # 3, 0
-        t462,  # 3, 1
-        t465,  # 3, 2
-        xp.where(t472 & xp.logical_not(t473), t394, t393),  # 3, 3
-        xp.where(t475 & xp.logical_not(t476), t474, t404),  # 3, 4
-        xp.where(t477 & xp.logical_not(t478), t403, t402),  # 3, 5
-        t481,  # 4, 0
-        t484,  # 4, 1
-        t487,  # 4, 2
-        xp.where(t488 & xp.logical_not(t489), t408, t407),  # 4, 3
-        xp.where(t490 & xp.logical_not(t491), t413, t412),  # 4, 4
-        xp.where(t492 & xp.logical_not(t493), t417, t416),  # 4, 5
-        t481,  # 5, 0
-        t484,  # 5, 1
-        t487,  # 5, 2
-        xp.where(t494 & xp.logical_not(t495), t410, t409),  # 5, 3
-        xp.where(t497 & xp.logical_not(t498), t496, t420),  # 5, 4
-        xp.where(t499 & xp.logical_not(t500), t419, t418),  # 5, 5
-        t481,  # 6, 0
-        t503,  # 6, 1
-        t506,  # 6, 2
-        xp.where(t507 & xp.logical_not(t508), t424, t423),  # 6, 3
-        xp.where(t509 & xp.logical_not(t510), t429, t428),  # 6, 4
-        xp.where(t511 & xp.logical_not(t512), t433, t432),  # 6, 5
-        t481,  # 7, 0
-        t503,  # 7, 1
-        t506,  # 7, 2
-        xp.where(t513 & xp.logical_not(t514), t426, t425),  # 7, 3
-        xp.where(t516 & xp.logical_not(t517), t515, t436),  # 7, 4
-        xp.where(t518 & xp.logical_not(t519), t435, t434),  # 7, 5
+        t436,  # 0, 0
+        t439,  # 0, 1
+        t442,  # 0, 2
+        xp.where(t443 & xp.logical_not(t444), t372, t371),  # 0, 3
+        xp.where(t445 & xp.logical_not(t446), t377, t376),  # 0, 4
+        xp.where(t447 & xp.logical_not(t448), t381, t380),  # 0, 5
+        t436,  # 1, 0
+        t439,  # 1, 1
+        t442,  # 1, 2
+        xp.where(t449 & xp.logical_not(t450), t374, t373),  # 1, 3
+        xp.where(t452 & xp.logical_not(t453), t451, t384),  # 1, 4
+        xp.where(t454 & xp.logical_not(t455), t383, t382),  # 1, 5
+        t436,  # 2, 0
+        t458,  # 2, 1
+        t461,  # 2, 2
+        xp.where(t462 & xp.logical_not(t463), t388, t387),  # 2, 3
+        xp.where(t464 & xp.logical_not(t465), t393, t392),  # 2, 4
+        xp.where(t466 & xp.logical_not(t467), t397, t396),  # 2, 5
+        t436,  # 3, 0
+        t458,  # 3, 1
+        t461,  # 3, 2
+        xp.where(t468 & xp.logical_not(t469), t390, t389),  # 3, 3
+        xp.where(t471 & xp.logical_not(t472), t470, t400),  # 3, 4
+        xp.where(t473 & xp.logical_not(t474), t399, t398),  # 3, 5
+        t477,  # 4, 0
+        t480,  # 4, 1
+        t483,  # 4, 2
+        xp.where(t484 & xp.logical_not(t485), t404, t403),  # 4, 3
+        xp.where(t486 & xp.logical_not(t487), t409, t408),  # 4, 4
+        xp.where(t488 & xp.logical_not(t489), t413, t412),  # 4, 5
+        t477,  # 5, 0
+        t480,  # 5, 1
+        t483,  # 5, 2
+        xp.where(t490 & xp.logical_not(t491), t406, t405),  # 5, 3
+        xp.where(t493 & xp.logical_not(t494), t492, t416),  # 5, 4
+        xp.where(t495 & xp.logical_not(t496), t415, t414),  # 5, 5
+        t477,  # 6, 0
+        t499,  # 6, 1
+        t502,  # 6, 2
+        xp.where(t503 & xp.logical_not(t504), t420, t419),  # 6, 3
+        xp.where(t505 & xp.logical_not(t506), t425, t424),  # 6, 4
+        xp.where(t507 & xp.logical_not(t508), t429, t428),  # 6, 5
+        t477,  # 7, 0
+        t499,  # 7, 1
+        t502,  # 7, 2
+        xp.where(t509 & xp.logical_not(t510), t422, t421),  # 7, 3
+        xp.where(t512 & xp.logical_not(t513), t511, t432),  # 7, 4
+        xp.where(t514 & xp.logical_not(t515), t431, t430),  # 7, 5
     ], (8, 6))
     valid = _stack(xp, [
-        t520 & t522 & t523 & xp.greater_equal(t129, -1e-12),  # 0
-        t520 & t522 & t523 & t130,  # 1
-        t520 & t66 & t522 & xp.greater_equal(t183, -1e-12),  # 2
-        t520 & t66 & t522 & t184,  # 3
-        t520 & t521 & t524 & t21 & xp.greater_equal(t289, -1e-12),  # 4
-        t520 & t521 & t524 & t21 & t290,  # 5
-        t520 & t521 & t226 & t21 & xp.greater_equal(t343, -1e-12),  # 6
-        t520 & t521 & t226 & t21 & t344,  # 7
+        t516 & xp.greater_equal(t127, -1e-12) & t518 & t519,  # 0
+        t516 & t128 & t518 & t519,  # 1
+        t516 & t66 & xp.greater_equal(t181, -1e-12) & t518,  # 2
+        t516 & t66 & t182 & t518,  # 3
+        t516 & t21 & xp.greater_equal(t285, -1e-12) & t517 & t520,  # 4
+        t516 & t21 & t286 & t517 & t520,  # 5
+        t516 & t21 & t224 & xp.greater_equal(t339, -1e-12) & t517,  # 6
+        t516 & t21 & t224 & t340 & t517,  # 7
     ], (8,))
     in_limits = _stack(xp, [
-        t525 & t526 & t527 & (t447 | t448) & (t449 | t450) & (t451 | t452),  # 0
-        t525 & t526 & t527 & (t453 | t454) & (t456 | t457) & (t458 | t459),  # 1
-        t525 & t528 & t529 & (t466 | t467) & (t468 | t469) & (t470 | t471),  # 2
-        t525 & t528 & t529 & (t472 | t473) & (t475 | t476) & (t477 | t478),  # 3
-        t530 & t531 & t532 & (t488 | t489) & (t490 | t491) & (t492 | t493),  # 4
-        t530 & t531 & t532 & (t494 | t495) & (t497 | t498) & (t499 | t500),  # 5
-        t530 & t533 & t534 & (t507 | t508) & (t509 | t510) & (t511 | t512),  # 6
-        t530 & t533 & t534 & (t513 | t514) & (t516 | t517) & (t518 | t519),  # 7
+        t521 & t522 & t523 & (t443 | t444) & (t445 | t446) & (t447 | t448),  # 0
+        t521 & t522 & t523 & (t449 | t450) & (t454 | t455) & (t452 | t453),  # 1
+        t521 & t524 & t525 & (t462 | t463) & (t464 | t465) & (t466 | t467),  # 2
+        t521 & t524 & t525 & (t468 | t469) & (t473 | t474) & (t471 | t472),  # 3
+        t526 & t527 & t528 & (t484 | t485) & (t486 | t487) & (t488 | t489),  # 4
+        t526 & t527 & t528 & (t490 | t491) & (t495 | t496) & (t493 | t494),  # 5
+        t526 & t529 & t530 & (t503 | t504) & (t505 | t506) & (t507 | t508),  # 6
+        t526 & t529 & t530 & (t509 | t510) & (t514 | t515) & (t512 | t513),  # 7
     ], (8,))
     return q, valid, in_limits
 

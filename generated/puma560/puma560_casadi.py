@@ -42,37 +42,37 @@ def _fk(q):
     t1 = t0 + 0.4318*s2
     t2 = 0.67183 + t1
     t3 = 0.0203*c23
-    t4 = 0.15005*s1 + t3*c1
-    t5 = -0.15005*c1 + t3*s1
+    t4 = 0.15005*s1 + c1*t3
+    t5 = -0.15005*c1 + s1*t3
     t6 = s1*s4
     t7 = c1*c4
-    t8 = -t6 + t7*c23
-    t9 = t7 - t6*c23
+    t8 = -t6 + c23*t7
+    t9 = t7 - c23*t6
     t10 = c4*s1
     t11 = c1*s4
-    t12 = t10 + t11*c23
-    t13 = t11 + t10*c23
+    t12 = t10 + c23*t11
+    t13 = t11 + c23*t10
     t14 = c1*s23
-    t15 = t8*c5 - t14*s5
-    t16 = t8*s5 + t14*c5
+    t15 = t8*c5 - s5*t14
+    t16 = t8*s5 + c5*t14
     t17 = t15*c6 - t12*s6
     t18 = t12*c6 + t15*s6
     t19 = t4 - 0.4318*t14
     t20 = s1*s23
-    t21 = t13*c5 - t20*s5
-    t22 = t13*s5 + t20*c5
+    t21 = t13*c5 - s5*t20
+    t22 = t13*s5 + c5*t20
     t23 = t9*s6 + t21*c6
     t24 = t9*c6 - t21*s6
     t25 = t5 - 0.4318*t20
     t26 = c4*s23
-    t27 = c23*s5 + t26*c5
-    t28 = c23*c5 - t26*s5
-    t29 = s23*s4
-    t30 = t27*c6 - t29*s6
-    t31 = t27*s6 + t29*c6
+    t27 = c23*s5 + c5*t26
+    t28 = c23*c5 - s5*t26
+    t29 = s4*s23
+    t30 = t27*c6 - s6*t29
+    t31 = t27*s6 + c6*t29
     t32 = 0.4318*c2
-    t33 = t19 + t32*c1
-    t34 = t25 + t32*s1
+    t33 = t19 + c1*t32
+    t34 = t25 + s1*t32
     T = casadi.SX(4, 4)
     T[0, 0] = t17
     T[0, 1] = -t18
@@ -113,25 +113,25 @@ def _jacobian(q):
     t1 = 0.0203*s23 + 0.4318*c23
     t2 = t1 + 0.4318*s2
     t3 = 0.0203*c23
-    t4 = 0.15005*s1 + t3*c1
-    t5 = -0.15005*c1 + t3*s1
+    t4 = 0.15005*s1 + c1*t3
+    t5 = -0.15005*c1 + s1*t3
     t6 = s1*s4
     t7 = c1*c4
-    t8 = -t6 + t7*c23
-    t9 = t7 - t6*c23
+    t8 = -t6 + c23*t7
+    t9 = t7 - c23*t6
     t10 = c4*s1
     t11 = c1*s4
-    t12 = t10 + t11*c23
-    t13 = t11 + t10*c23
+    t12 = t10 + c23*t11
+    t13 = t11 + c23*t10
     t14 = c1*s23
-    t15 = t8*s5 + t14*c5
+    t15 = t8*s5 + c5*t14
     t16 = t4 - 0.4318*t14
     t17 = s1*s23
-    t18 = t13*s5 + t17*c5
+    t18 = t13*s5 + c5*t17
     t19 = t5 - 0.4318*t17
     t20 = 0.4318*c2
-    t21 = t16 + t20*c1
-    t22 = t19 + t20*s1
+    t21 = t16 + c1*t20
+    t22 = t19 + s1*t20
     t23 = -c1
     J = casadi.SX(6, 6)
     J[0, 0] = -t22
@@ -185,37 +185,37 @@ def _fk_jacobian(q):
     t1 = t0 + 0.4318*s2
     t2 = 0.67183 + t1
     t3 = 0.0203*c23
-    t4 = 0.15005*s1 + t3*c1
-    t5 = -0.15005*c1 + t3*s1
+    t4 = 0.15005*s1 + c1*t3
+    t5 = -0.15005*c1 + s1*t3
     t6 = s1*s4
     t7 = c1*c4
-    t8 = -t6 + t7*c23
-    t9 = t7 - t6*c23
+    t8 = -t6 + c23*t7
+    t9 = t7 - c23*t6
     t10 = c4*s1
     t11 = c1*s4
-    t12 = t10 + t11*c23
-    t13 = t11 + t10*c23
+    t12 = t10 + c23*t11
+    t13 = t11 + c23*t10
     t14 = c1*s23
-    t15 = t8*c5 - t14*s5
-    t16 = t8*s5 + t14*c5
+    t15 = t8*c5 - s5*t14
+    t16 = t8*s5 + c5*t14
     t17 = t15*c6 - t12*s6
     t18 = t12*c6 + t15*s6
     t19 = t4 - 0.4318*t14
     t20 = s1*s23
-    t21 = t13*c5 - t20*s5
-    t22 = t13*s5 + t20*c5
+    t21 = t13*c5 - s5*t20
+    t22 = t13*s5 + c5*t20
     t23 = t9*s6 + t21*c6
     t24 = t9*c6 - t21*s6
     t25 = t5 - 0.4318*t20
     t26 = c4*s23
-    t27 = c23*s5 + t26*c5
-    t28 = c23*c5 - t26*s5
+    t27 = c23*s5 + c5*t26
+    t28 = c23*c5 - s5*t26
     t29 = s23*s4
-    t30 = t27*c6 - t29*s6
-    t31 = t27*s6 + t29*c6
+    t30 = t27*c6 - s6*t29
+    t31 = t27*s6 + c6*t29
     t32 = 0.4318*c2
-    t33 = t19 + t32*c1
-    t34 = t25 + t32*s1
+    t33 = t19 + c1*t32
+    t34 = t25 + s1*t32
     t35 = -t16
     t36 = -t22
     t37 = -c1
@@ -260,7 +260,7 @@ def _fk_jacobian(q):
 
 
 def _jacobian_tool(q):
-    """Geometric Jacobian in the tool frame (6 x DOF, rows vx vy vz wx wy wz): 198 operations."""
+    """Geometric Jacobian in the tool frame (6 x DOF, rows vx vy vz wx wy wz): 196 operations."""
     q1 = q[0]
     q2 = q[1]
     q3 = q[2]
@@ -284,72 +284,73 @@ def _jacobian_tool(q):
     t0 = 0.0203*s23 + 0.4318*c23
     t1 = t0 + 0.4318*s2
     t2 = 0.0203*c23
-    t3 = 0.15005*s1 + t2*c1
-    t4 = -0.15005*c1 + t2*s1
+    t3 = 0.15005*s1 + c1*t2
+    t4 = -0.15005*c1 + s1*t2
     t5 = s1*s4
     t6 = c1*c4
-    t7 = -t5 + t6*c23
-    t8 = t6 - t5*c23
+    t7 = -t5 + c23*t6
+    t8 = t6 - c23*t5
     t9 = c4*s1
     t10 = c1*s4
-    t11 = t9 + t10*c23
-    t12 = t10 + t9*c23
+    t11 = t9 + c23*t10
+    t12 = t10 + c23*t9
     t13 = c1*s23
-    t14 = t7*c5 - t13*s5
-    t15 = t7*s5 + t13*c5
+    t14 = t7*c5 - s5*t13
+    t15 = t7*s5 + c5*t13
     t16 = t14*c6 - t11*s6
     t17 = t11*c6 + t14*s6
     t18 = t3 - 0.4318*t13
     t19 = s1*s23
-    t20 = t12*c5 - t19*s5
-    t21 = t12*s5 + t19*c5
+    t20 = t12*c5 - s5*t19
+    t21 = t12*s5 + c5*t19
     t22 = t8*s6 + t20*c6
     t23 = t8*c6 - t20*s6
     t24 = t4 - 0.4318*t19
     t25 = c4*s23
-    t26 = c23*s5 + t25*c5
-    t27 = c23*c5 - t25*s5
-    t28 = s23*s4
-    t29 = t26*c6 - t28*s6
-    t30 = t26*s6 + t28*c6
+    t26 = c23*s5 + c5*t25
+    t27 = c23*c5 - s5*t25
+    t28 = s4*s23
+    t29 = t26*c6 - s6*t28
+    t30 = t26*s6 + c6*t28
     t31 = 0.4318*c2
-    t32 = t18 + t31*c1
-    t33 = t24 + t31*s1
+    t32 = t18 + c1*t31
+    t33 = t24 + s1*t31
     t34 = t32*c1 + t33*s1
-    t35 = t16*c1
-    t36 = t22*s1
+    t35 = c1*t16
+    t36 = s1*t22
     t37 = t18*c1 + t24*s1
-    t38 = t23*s1
-    t39 = t15*c1
-    t40 = t21*s1
-    t41 = t16*s1 - t22*c1
-    t42 = -(t17*s1 + t23*c1)
-    t43 = t21*c1 - t15*s1
+    t38 = c1*t17
+    t39 = s1*t23
+    t40 = c1*t15
+    t41 = s1*t21
+    t42 = t16*s1 - t22*c1
+    t43 = -(t17*s1 + t23*c1)
+    t44 = t21*c1 - t15*s1
     J = casadi.SX(6, 6)
     J[0, 0] = t22*t32 - t16*t33
     J[0, 1] = -(-t29*t34 + t1*t35 + t1*t36)
     J[0, 2] = -(-t29*t37 + t0*t35 + t0*t36)
     J[1, 0] = t17*t33 + t23*t32
-    J[1, 1] = -(t30*t34 + t1*t38 - t17*t1*c1)
-    J[1, 2] = -(t30*t37 + t0*t38 - t17*t0*c1)
+    J[1, 1] = -(t30*t34 - t1*t38 + t1*t39)
+    J[1, 2] = -(t30*t37 - t0*t38 + t0*t39)
     J[2, 0] = t15*t33 - t21*t32
-    J[2, 1] = t27*t34 + t1*t39 + t1*t40
-    J[2, 2] = t27*t37 + t0*t39 + t0*t40
+    J[2, 1] = t27*t34 + t1*t40 + t1*t41
+    J[2, 2] = t27*t37 + t0*t40 + t0*t41
     J[3, 0] = t29
-    J[3, 1] = t41
-    J[3, 2] = t41
+    J[3, 1] = t42
+    J[3, 2] = t42
     J[3, 3] = -(-t29*c23 + t16*t13 + t22*t19)
     J[3, 4] = t11*t16 - t8*t22 + t29*t28
-    J[3, 5] = -(t15*t16 + t21*t22 - t27*t29)
+    J[3, 5] = -(-t27*t29 + t15*t16 + t21*t22)
     J[4, 0] = -t30
-    J[4, 1] = t42
-    J[4, 2] = t42
-    J[4, 3] = -(t30*c23 + t23*t19 - t17*c1*s23)
+    J[4, 1] = t43
+    J[4, 2] = t43
+    J[4, 3] = -(t30*c23 - t17*t13 + t23*t19)
     J[4, 4] = -(t11*t17 + t8*t23 + t30*t28)
-    J[4, 5] = -(t21*t23 + t27*t30 - t15*t17)
+    J[4, 5] = -(-t15*t17 + t21*t23 + t27*t30)
     J[5, 0] = t27
-    J[5, 1] = t43
-    J[5, 2] = t43
+    J[5, 1] = t44
+    J[5, 2] = t44
     J[5, 3] = t27*c23 + t15*t13 + t21*t19
     J[5, 4] = t8*t21 - t11*t15 + t27*t28
     J[5, 5] = t15**2 + t21**2 + t27**2
@@ -383,31 +384,31 @@ def _task(q):
     t2 = t1 + 0.4318*s2
     t3 = 0.67183 + t2
     t4 = 0.0203*c23
-    t5 = 0.15005*s1 + t4*c1
-    t6 = -0.15005*c1 + t4*s1
+    t5 = 0.15005*s1 + c1*t4
+    t6 = -0.15005*c1 + s1*t4
     t7 = s1*s4
     t8 = c1*c4
-    t9 = -t7 + t8*c23
-    t10 = t8 - t7*c23
+    t9 = -t7 + c23*t8
+    t10 = t8 - c23*t7
     t11 = c4*s1
     t12 = c1*s4
-    t13 = t11 + t12*c23
-    t14 = t12 + t11*c23
-    t15 = s23*s5
-    t16 = t9*c5 - t15*c1
-    t17 = t14*c5 - t15*s1
-    t18 = c23*c5 - t15*c4
+    t13 = t11 + c23*t12
+    t14 = t12 + c23*t11
+    t15 = s5*s23
+    t16 = t9*c5 - c1*t15
+    t17 = t14*c5 - s1*t15
+    t18 = c23*c5 - c4*t15
     t19 = t16*c6 - t13*s6
     t20 = t10*s6 + t17*c6
-    t21 = s23*s4
-    t22 = t0*c6 - t21*s6
-    t23 = t0*s6 + t21*c6
+    t21 = s4*s23
+    t22 = t0*c6 - s6*t21
+    t23 = t0*s6 + c6*t21
     t24 = 0.4318*s23
-    t25 = t5 - t24*c1
-    t26 = t6 - t24*s1
+    t25 = t5 - c1*t24
+    t26 = t6 - s1*t24
     t27 = 0.4318*c2
-    t28 = t25 + t27*c1
-    t29 = t26 + t27*s1
+    t28 = t25 + c1*t27
+    t29 = t26 + s1*t27
     mu = casadi.SX(6, 1)
     mu[0, 0] = t28
     mu[1, 0] = t29
@@ -443,34 +444,34 @@ def _task_jacobian(q):
     t0 = 0.0203*s23 + 0.4318*c23
     t1 = t0 + 0.4318*s2
     t2 = 0.0203*c23
-    t3 = 0.15005*s1 + t2*c1
-    t4 = -0.15005*c1 + t2*s1
+    t3 = 0.15005*s1 + c1*t2
+    t4 = -0.15005*c1 + s1*t2
     t5 = s1*s4
     t6 = c1*c4
-    t7 = -t5 + t6*c23
-    t8 = t6 - t5*c23
+    t7 = -t5 + c23*t6
+    t8 = t6 - c23*t5
     t9 = c4*s1
     t10 = c1*s4
-    t11 = t9 + t10*c23
-    t12 = t10 + t9*c23
+    t11 = t9 + c23*t10
+    t12 = t10 + c23*t9
     t13 = c1*s23
-    t14 = t7*c5 - t13*s5
-    t15 = t7*s5 + t13*c5
+    t14 = t7*c5 - s5*t13
+    t15 = t7*s5 + c5*t13
     t16 = t14*c6 - t11*s6
     t17 = t3 - 0.4318*t13
     t18 = s1*s23
-    t19 = t12*c5 - t18*s5
-    t20 = t12*s5 + t18*c5
+    t19 = t12*c5 - s5*t18
+    t20 = t12*s5 + c5*t18
     t21 = t8*s6 + t19*c6
     t22 = t4 - 0.4318*t18
     t23 = c4*s23
-    t24 = c23*s5 + t23*c5
-    t25 = c23*c5 - t23*s5
+    t24 = c23*s5 + c5*t23
+    t25 = c23*c5 - s5*t23
     t26 = s23*s4
-    t27 = t24*c6 - t26*s6
+    t27 = t24*c6 - s6*t26
     t28 = 0.4318*c2
-    t29 = t17 + t28*c1
-    t30 = t22 + t28*s1
+    t29 = t17 + c1*t28
+    t30 = t22 + s1*t28
     t31 = t16**2 + t21**2
     t32 = 1/t31
     t33 = t16*s1
@@ -478,7 +479,7 @@ def _task_jacobian(q):
     t35 = t32*(t33 - t34)
     t36 = t16*c1
     t37 = t21*s1
-    t38 = -t32*(t36*s23 + t37*s23)
+    t38 = -t32*(s23*t36 + s23*t37)
     t39 = t32*(t11*t16 - t8*t21)
     t40 = -t32*(t15*t16 + t20*t21)
     t41 = 1/casadi.sqrt(t31)
@@ -500,7 +501,7 @@ def _task_jacobian(q):
     J[3, 5] = t40
     J[4, 1] = t42
     J[4, 2] = t42
-    J[4, 3] = t41*(t34*s23 - t33*s23)
+    J[4, 3] = t41*(s23*t34 - s23*t33)
     J[4, 4] = -t41*(t11*t21 + t8*t16)
     J[4, 5] = t41*(t15*t21 - t20*t16)
     J[5, 0] = 1
@@ -513,7 +514,7 @@ def _task_jacobian(q):
 
 
 def _fk_jacobian_dot(q, q_dot):
-    """Fk, jacobian and bias_acceleration in one pass, sharing their terms: 242 operations."""
+    """Fk, jacobian and bias_acceleration in one pass, sharing their terms: 241 operations."""
     q1 = q[0]
     q2 = q[1]
     q3 = q[2]
@@ -545,38 +546,38 @@ def _fk_jacobian_dot(q, q_dot):
     t2 = 0.67183 + t1
     t3 = qd1 + c23*qd4
     t4 = 0.0203*c23
-    t5 = 0.15005*s1 + t4*c1
-    t6 = -0.15005*c1 + t4*s1
+    t5 = 0.15005*s1 + c1*t4
+    t6 = -0.15005*c1 + s1*t4
     t7 = s1*s4
     t8 = c1*c4
-    t9 = -t7 + t8*c23
-    t10 = t8 - t7*c23
+    t9 = -t7 + c23*t8
+    t10 = t8 - c23*t7
     t11 = c4*s1
     t12 = c1*s4
-    t13 = t11 + t12*c23
-    t14 = t12 + t11*c23
+    t13 = t11 + c23*t12
+    t14 = t12 + c23*t11
     t15 = c1*s23
-    t16 = t9*c5 - t15*s5
-    t17 = t9*s5 + t15*c5
+    t16 = t9*c5 - s5*t15
+    t17 = t9*s5 + c5*t15
     t18 = t16*c6 - t13*s6
     t19 = t13*c6 + t16*s6
     t20 = t5 - 0.4318*t15
     t21 = s1*s23
-    t22 = t14*c5 - t21*s5
-    t23 = t14*s5 + t21*c5
+    t22 = t14*c5 - s5*t21
+    t23 = t14*s5 + c5*t21
     t24 = t10*s6 + t22*c6
     t25 = t10*c6 - t22*s6
     t26 = t6 - 0.4318*t21
     t27 = c4*s23
-    t28 = c23*s5 + t27*c5
-    t29 = c23*c5 - t27*s5
+    t28 = c23*s5 + c5*t27
+    t29 = c23*c5 - s5*t27
     t30 = s23*s4
-    t31 = t28*c6 - t30*s6
-    t32 = t28*s6 + t30*c6
-    t33 = t3 + t30*qd5
+    t31 = t28*c6 - s6*t30
+    t32 = t28*s6 + c6*t30
+    t33 = t3 + qd5*t30
     t34 = 0.4318*c2
-    t35 = t20 + t34*c1
-    t36 = t26 + t34*s1
+    t35 = t20 + c1*t34
+    t36 = t26 + s1*t34
     t37 = t35*c1 + t36*s1
     t38 = t37
     t39 = t20*c1 + t26*s1
@@ -585,14 +586,14 @@ def _fk_jacobian_dot(q, q_dot):
     t42 = qd2*s1
     t43 = qd3*s1
     t44 = t42 + t43
-    t45 = t44 - t15*qd4
+    t45 = t44 - qd4*t15
     t46 = t45 + t13*qd5
     t47 = t0*t43 + t1*t42
     t48 = -t47 + t35*qd1
     t49 = c1*qd2
     t50 = c1*qd3
     t51 = t49 + t50
-    t52 = t51 + t21*qd4
+    t52 = t51 + qd4*t21
     t53 = t52 + t10*qd5
     t54 = t0*t50 + t1*t49
     t55 = t54 + t36*qd1
@@ -601,11 +602,12 @@ def _fk_jacobian_dot(q, q_dot):
     t58 = t1*c1
     t59 = t0*c1
     t60 = t1*s1
-    t61 = -c1
-    t62 = c1**2
-    t63 = t0*qd2
-    t64 = s1**2
-    t65 = t0*qd3
+    t61 = t0*s1
+    t62 = -c1
+    t63 = c1**2
+    t64 = qd2*t0
+    t65 = s1**2
+    t66 = qd3*t0
     T = casadi.SX(4, 4)
     T[0, 0] = t18
     T[0, 1] = -t19
@@ -626,7 +628,7 @@ def _fk_jacobian_dot(q, q_dot):
     J[0, 2] = -t59
     J[1, 0] = t35
     J[1, 1] = -t60
-    J[1, 2] = -t0*s1
+    J[1, 2] = -t61
     J[2, 1] = t37
     J[2, 2] = t39
     J[3, 1] = s1
@@ -634,8 +636,8 @@ def _fk_jacobian_dot(q, q_dot):
     J[3, 3] = -t15
     J[3, 4] = t13
     J[3, 5] = t56
-    J[4, 1] = t61
-    J[4, 2] = t61
+    J[4, 1] = t62
+    J[4, 2] = t62
     J[4, 3] = -t21
     J[4, 4] = -t10
     J[4, 5] = t57
@@ -644,17 +646,17 @@ def _fk_jacobian_dot(q, q_dot):
     J[5, 4] = t30
     J[5, 5] = t29
     a = casadi.SX(6, 1)
-    a[0, 0] = qd2*(-t41*c1 + t60*qd1) - qd3*(t40*t49 + t40*t50 - t0*qd1*s1) - t48*qd1
-    a[1, 0] = -qd2*(t41*s1 + t58*qd1) - qd3*(t59*qd1 + t40*t42 + t40*t43) - t55*qd1
-    a[2, 0] = -qd2*(t54*c1 + t47*s1) - qd3*(t62*t63 + t63*t64 + t62*t65 + t64*t65)
-    a[3, 0] = qd4*(-t51*c23 + t21*qd1) + qd5*(t10*t3 - t52*t30) + qd6*(t23*t33 - t29*t53) + t49*qd1 + t50*qd1
-    a[4, 0] = -qd4*(t44*c23 + t15*qd1) + qd5*(t13*t3 - t45*t30) - qd6*(t17*t33 + t29*t46) + t42*qd1 + t43*qd1
+    a[0, 0] = qd2*(-t41*c1 + qd1*t60) - qd3*(-qd1*t61 + t40*t49 + t40*t50) - t48*qd1
+    a[1, 0] = -qd2*(t41*s1 + qd1*t58) - qd3*(qd1*t59 + t40*t42 + t40*t43) - t55*qd1
+    a[2, 0] = -qd2*(t54*c1 + t47*s1) - qd3*(t63*t64 + t65*t64 + t63*t66 + t65*t66)
+    a[3, 0] = qd4*(-t51*c23 + qd1*t21) + qd5*(t10*t3 - t52*t30) + qd6*(t23*t33 - t29*t53) + qd1*t49 + qd1*t50
+    a[4, 0] = -qd4*(t44*c23 + qd1*t15) + qd5*(t13*t3 - t45*t30) - qd6*(t17*t33 + t29*t46) + qd1*t42 + qd1*t43
     a[5, 0] = -qd4*(t44*t21 + t51*t15) + qd5*(t13*t52 - t10*t45) - qd6*(t17*t53 + t23*t46)
     return [T, J, a]
 
 
 def _jacobian_dot(q, q_dot):
-    """Time derivative dJ/dt of the world geometric Jacobian along q_dot (6 x DOF): 161 operations."""
+    """Time derivative dJ/dt of the world geometric Jacobian along q_dot (6 x DOF): 160 operations."""
     q1 = q[0]
     q2 = q[1]
     q3 = q[2]
@@ -682,26 +684,26 @@ def _jacobian_dot(q, q_dot):
     t2 = t1 + 0.4318*s2
     t3 = qd1 + c23*qd4
     t4 = 0.0203*c23
-    t5 = 0.15005*s1 + t4*c1
-    t6 = -0.15005*c1 + t4*s1
+    t5 = 0.15005*s1 + c1*t4
+    t6 = -0.15005*c1 + s1*t4
     t7 = s1*s4
     t8 = c1*c4
-    t9 = -t7 + t8*c23
-    t10 = t8 - t7*c23
+    t9 = -t7 + c23*t8
+    t10 = t8 - c23*t7
     t11 = c4*s1
     t12 = c1*s4
-    t13 = t11 + t12*c23
-    t14 = t12 + t11*c23
+    t13 = t11 + c23*t12
+    t14 = t12 + c23*t11
     t15 = c5*s23
-    t16 = t9*s5 + t15*c1
-    t17 = t14*s5 + t15*s1
+    t16 = t9*s5 + c1*t15
+    t17 = t14*s5 + s1*t15
     t18 = 0.4318*s23
-    t19 = t5 - t18*c1
-    t20 = t6 - t18*s1
+    t19 = t5 - c1*t18
+    t20 = t6 - s1*t18
     t21 = t19*c1 + t20*s1
     t22 = 0.4318*c2
-    t23 = t19 + t22*c1
-    t24 = t20 + t22*s1
+    t23 = t19 + c1*t22
+    t24 = t20 + s1*t22
     t25 = t23*c1 + t24*s1
     t26 = t25*qd2 + t21*qd3
     t27 = qd2*s1
@@ -714,36 +716,36 @@ def _jacobian_dot(q, q_dot):
     t34 = t32 + t33
     t35 = t1*t33 + t2*t32
     t36 = t35 + t24*qd1
-    t37 = qd4*s23
-    t38 = t29 - t37*c1
-    t39 = t34 + t37*s1
+    t37 = s23*qd4
+    t38 = t29 - c1*t37
+    t39 = t34 + s1*t37
     t40 = t38 + t13*qd5
     t41 = t39 + t10*qd5
-    t42 = s23*s4
-    t43 = t3 + t42*qd5
+    t42 = s4*s23
+    t43 = t3 + qd5*t42
     t44 = qd1*s1
     t45 = c1*qd1
     t46 = c1**2
-    t47 = t1*qd2
+    t47 = qd2*t1
     t48 = s1**2
-    t49 = t1*qd3
+    t49 = qd3*t1
     Jd = casadi.SX(6, 6)
     Jd[0, 0] = -t31
     Jd[0, 1] = -t26*c1 + t2*t44
-    Jd[0, 2] = -(t21*t32 + t21*t33 - t1*qd1*s1)
+    Jd[0, 2] = -(-t1*t44 + t21*t32 + t21*t33)
     Jd[1, 0] = -t36
     Jd[1, 1] = -(t26*s1 + t2*t45)
     Jd[1, 2] = -(t1*t45 + t21*t27 + t21*t28)
     Jd[2, 1] = -(t35*c1 + t30*s1)
-    Jd[2, 2] = -(t46*t47 + t47*t48 + t46*t49 + t48*t49)
+    Jd[2, 2] = -(t46*t47 + t48*t47 + t46*t49 + t48*t49)
     Jd[3, 1] = t45
     Jd[3, 2] = t45
-    Jd[3, 3] = -t34*c23 + t44*s23
+    Jd[3, 3] = -t34*c23 + s23*t44
     Jd[3, 4] = t10*t3 - t39*t42
     Jd[3, 5] = t17*t43 - t0*t41
     Jd[4, 1] = t44
     Jd[4, 2] = t44
-    Jd[4, 3] = -(t29*c23 + t45*s23)
+    Jd[4, 3] = -(t29*c23 + s23*t45)
     Jd[4, 4] = t13*t3 - t38*t42
     Jd[4, 5] = -(t16*t43 + t0*t40)
     Jd[5, 3] = -(t29*s1*s23 + t34*c1*s23)
@@ -753,7 +755,7 @@ def _jacobian_dot(q, q_dot):
 
 
 def _bias_acceleration(q, q_dot):
-    """J' q_dot: the tool's classical linear and angular acceleration at zero joint acceleration, world frame (6): 200 operations."""
+    """J' q_dot: the tool's classical linear and angular acceleration at zero joint acceleration, world frame (6): 199 operations."""
     q1 = q[0]
     q2 = q[1]
     q3 = q[2]
@@ -782,26 +784,26 @@ def _bias_acceleration(q, q_dot):
     t2 = t1 + 0.4318*s2
     t3 = qd1 + c23*qd4
     t4 = 0.0203*c23
-    t5 = 0.15005*s1 + t4*c1
-    t6 = -0.15005*c1 + t4*s1
+    t5 = 0.15005*s1 + c1*t4
+    t6 = -0.15005*c1 + s1*t4
     t7 = s1*s4
     t8 = c1*c4
-    t9 = -t7 + t8*c23
-    t10 = t8 - t7*c23
+    t9 = -t7 + c23*t8
+    t10 = t8 - c23*t7
     t11 = c4*s1
     t12 = c1*s4
-    t13 = t11 + t12*c23
-    t14 = t12 + t11*c23
+    t13 = t11 + c23*t12
+    t14 = t12 + c23*t11
     t15 = c5*s23
-    t16 = t9*s5 + t15*c1
-    t17 = t14*s5 + t15*s1
+    t16 = t9*s5 + c1*t15
+    t17 = t14*s5 + s1*t15
     t18 = 0.4318*s23
-    t19 = t5 - t18*c1
-    t20 = t6 - t18*s1
+    t19 = t5 - c1*t18
+    t20 = t6 - s1*t18
     t21 = t19*c1 + t20*s1
     t22 = 0.4318*c2
-    t23 = t19 + t22*c1
-    t24 = t20 + t22*s1
+    t23 = t19 + c1*t22
+    t24 = t20 + s1*t22
     t25 = t23*c1 + t24*s1
     t26 = t25*qd2 + t21*qd3
     t27 = qd2*s1
@@ -814,31 +816,31 @@ def _bias_acceleration(q, q_dot):
     t34 = t32 + t33
     t35 = t1*t33 + t2*t32
     t36 = t35 + t24*qd1
-    t37 = qd4*s23
-    t38 = t29 - t37*c1
-    t39 = t34 + t37*s1
+    t37 = s23*qd4
+    t38 = t29 - c1*t37
+    t39 = t34 + s1*t37
     t40 = t38 + t13*qd5
     t41 = t39 + t10*qd5
-    t42 = s23*s4
-    t43 = t3 + t42*qd5
-    t44 = qd1*s1
+    t42 = s4*s23
+    t43 = t3 + qd5*t42
+    t44 = s1*qd1
     t45 = c1*qd1
     t46 = c1**2
-    t47 = t1*qd2
+    t47 = qd2*t1
     t48 = s1**2
-    t49 = t1*qd3
+    t49 = qd3*t1
     a = casadi.SX(6, 1)
-    a[0, 0] = qd2*(-t26*c1 + t2*t44) - qd3*(t21*t32 + t21*t33 - t1*qd1*s1) - t31*qd1
+    a[0, 0] = qd2*(-t26*c1 + t2*t44) - qd3*(-t1*t44 + t21*t32 + t21*t33) - t31*qd1
     a[1, 0] = -qd2*(t26*s1 + t2*t45) - qd3*(t1*t45 + t21*t27 + t21*t28) - t36*qd1
-    a[2, 0] = -qd2*(t35*c1 + t30*s1) - qd3*(t46*t47 + t47*t48 + t46*t49 + t48*t49)
-    a[3, 0] = qd4*(-t34*c23 + t44*s23) + qd5*(t10*t3 - t39*t42) + qd6*(t17*t43 - t0*t41) + t32*qd1 + t33*qd1
-    a[4, 0] = -qd4*(t29*c23 + t45*s23) + qd5*(t13*t3 - t38*t42) - qd6*(t16*t43 + t0*t40) + t27*qd1 + t28*qd1
+    a[2, 0] = -qd2*(t35*c1 + t30*s1) - qd3*(t46*t47 + t48*t47 + t46*t49 + t48*t49)
+    a[3, 0] = qd4*(-t34*c23 + s23*t44) + qd5*(t10*t3 - t39*t42) + qd6*(t17*t43 - t0*t41) + qd1*t32 + qd1*t33
+    a[4, 0] = -qd4*(t29*c23 + s23*t45) + qd5*(t13*t3 - t38*t42) - qd6*(t16*t43 + t0*t40) + qd1*t27 + qd1*t28
     a[5, 0] = -qd4*(t29*s1*s23 + t34*c1*s23) + qd5*(t13*t39 - t10*t38) - qd6*(t16*t41 + t17*t40)
     return [a]
 
 
 def _task_jacobian_dot(q, q_dot):
-    """Time derivative of the analytic Jacobian along q_dot (6 x DOF): mu'' = J_a q'' + J_a' q': 423 operations."""
+    """Time derivative of the analytic Jacobian along q_dot (6 x DOF): mu'' = J_a q'' + J_a' q': 419 operations."""
     q1 = q[0]
     q2 = q[1]
     q3 = q[2]
@@ -868,35 +870,35 @@ def _task_jacobian_dot(q, q_dot):
     t0 = 0.0203*s23 + 0.4318*c23
     t1 = t0 + 0.4318*s2
     t2 = 0.0203*c23
-    t3 = 0.15005*s1 + t2*c1
-    t4 = -0.15005*c1 + t2*s1
+    t3 = 0.15005*s1 + c1*t2
+    t4 = -0.15005*c1 + s1*t2
     t5 = s1*s4
     t6 = c1*c4
-    t7 = -t5 + t6*c23
-    t8 = t6 - t5*c23
+    t7 = -t5 + c23*t6
+    t8 = t6 - c23*t5
     t9 = c4*s1
     t10 = c1*s4
-    t11 = t9 + t10*c23
-    t12 = t10 + t9*c23
+    t11 = t9 + c23*t10
+    t12 = t10 + c23*t9
     t13 = c1*s23
-    t14 = t7*c5 - t13*s5
-    t15 = t7*s5 + t13*c5
+    t14 = t7*c5 - s5*t13
+    t15 = t7*s5 + c5*t13
     t16 = t14*c6 - t11*s6
     t17 = t3 - 0.4318*t13
     t18 = s1*s23
-    t19 = t12*c5 - t18*s5
-    t20 = t12*s5 + t18*c5
+    t19 = t12*c5 - s5*t18
+    t20 = t12*s5 + c5*t18
     t21 = t8*s6 + t19*c6
     t22 = t4 - 0.4318*t18
     t23 = t17*c1 + t22*s1
     t24 = c4*s23
-    t25 = c23*s5 + t24*c5
-    t26 = c23*c5 - t24*s5
-    t27 = s23*s4
-    t28 = t25*c6 - t27*s6
+    t25 = c23*s5 + c5*t24
+    t26 = c23*c5 - s5*t24
+    t27 = s4*s23
+    t28 = t25*c6 - s6*t27
     t29 = 0.4318*c2
-    t30 = t17 + t29*c1
-    t31 = t22 + t29*s1
+    t30 = t17 + c1*t29
+    t31 = t22 + s1*t29
     t32 = t30*c1 + t31*s1
     t33 = t32*qd2 + t23*qd3
     t34 = qd2*s1
@@ -905,7 +907,7 @@ def _task_jacobian_dot(q, q_dot):
     t37 = -t36 + t30*qd1
     t38 = t34 + t35
     t39 = t38
-    t40 = t39*c23 + t13*qd1
+    t40 = t39*c23 + qd1*t13
     t41 = c1*qd2
     t42 = c1*qd3
     t43 = t0*t42 + t1*t41
@@ -913,11 +915,11 @@ def _task_jacobian_dot(q, q_dot):
     t45 = t43*c1 + t36*s1
     t46 = t41 + t42
     t47 = t46
-    t48 = -t47*c23 + t18*qd1
+    t48 = -t47*c23 + qd1*t18
     t49 = t39*t18 + t47*t13
-    t50 = -t13*qd4
+    t50 = -qd4*t13
     t51 = t39 + t50
-    t52 = t18*qd4
+    t52 = qd4*t18
     t53 = t47 + t52
     t54 = t11*t53 - t8*t51
     t55 = qd1 + c23*qd4
@@ -926,30 +928,30 @@ def _task_jacobian_dot(q, q_dot):
     t58 = t11*t56 - t51*t27
     t59 = t11*qd5
     t60 = t51 + t59
-    t61 = t38 + t50 + t59 - t15*qd6
+    t61 = t50 + t59 - t15*qd6 + t38
     t62 = t8*qd5
     t63 = t53 + t62
     t64 = t15*t63 + t20*t60
-    t65 = t46 + t52 + t62 + t20*qd6
+    t65 = t52 + t62 + t20*qd6 + t46
     t66 = t16*t65 + t21*t61
-    t67 = t27*qd5
+    t67 = qd5*t27
     t68 = t56 + t67
     t69 = t20*t68 - t26*t63
     t70 = t15*t68 + t26*t60
-    t71 = t55 + t67 + t26*qd6
+    t71 = t67 + t26*qd6 + t55
     t72 = t21*t71 + t28*t65
     t73 = t16*t71 - t28*t61
-    t74 = qd1*s1
+    t74 = s1*qd1
     t75 = -t33*c1 + t1*t74
     t76 = t23*t41 + t23*t42 - t0*t74
     t77 = c1*qd1
     t78 = t33*s1 + t1*t77
     t79 = t0*t77 + t23*t34 + t23*t35
     t80 = c1**2
-    t81 = t0*qd2
+    t81 = qd2*t0
     t82 = s1**2
-    t83 = t0*qd3
-    t84 = t80*t81 + t81*t82 + t80*t83 + t82*t83
+    t83 = qd3*t0
+    t84 = t80*t81 + t82*t81 + t80*t83 + t82*t83
     t85 = t16**2 + t21**2
     t86 = 1/t85
     t87 = c1*t86
@@ -961,51 +963,53 @@ def _task_jacobian_dot(q, q_dot):
     t93 = t21*t92
     t94 = s1*t86
     t95 = t16*t92
-    t96 = t16*qd1
-    t97 = t21*qd1
+    t96 = qd1*t16
+    t97 = qd1*t21
     t98 = -t73*(t87 + t93) - t72*(t94 - t95) + t87*t96 + t94*t97
-    t99 = t94*s23
+    t99 = s23*t94
     t100 = t16*c1
     t101 = t21*s1
-    t102 = -(t100*s23 + t101*s23)
-    t103 = t91*t102
+    t102 = -(s23*t100 + s23*t101)
+    t103 = t102*t91
     t104 = t21*t103
-    t105 = t87*s23
+    t105 = s23*t87
     t106 = t16*t103
     t107 = t16*t86
     t108 = t48*t107
     t109 = t21*t86
-    t110 = t8*t86
-    t111 = t11*t16 - t8*t21
-    t112 = t91*t111
-    t113 = t21*t112
-    t114 = t11*t86
-    t115 = t16*t112
-    t116 = t57*t107
-    t117 = t58*t109
-    t118 = t20*t86
-    t119 = -(t15*t16 + t20*t21)
-    t120 = t91*t119
-    t121 = t21*t120
-    t122 = t15*t86
-    t123 = t16*t120
-    t124 = t69*t107
-    t125 = 1/casadi.sqrt(t85)
-    t126 = s1*t125
-    t127 = 1/t85**1.5
-    t128 = -t127*(t100 + t101)
-    t129 = c1*t125
-    t130 = t125*qd1
-    t131 = -t73*(t126 + t21*t128) + t72*(t129 + t16*t128) + t88*t130 - t89*t130
-    t132 = t127*(t89*s23 - t88*s23)
-    t133 = t16*t125
-    t134 = t21*t125
-    t135 = -t127*(t11*t21 + t8*t16)
-    t136 = t127*(t15*t21 - t20*t16)
-    t137 = t28*t94
-    t138 = t28*t87
-    t139 = t66*t86
-    t140 = -(t72*(-t137 + t28*t95) - t73*(t138 + t28*t93) + t90*t139 + t96*t138 + t97*t137)
+    t110 = t40*t109
+    t111 = t8*t86
+    t112 = t11*t16 - t8*t21
+    t113 = t112*t91
+    t114 = t21*t113
+    t115 = t11*t86
+    t116 = t16*t113
+    t117 = t57*t107
+    t118 = t58*t109
+    t119 = t20*t86
+    t120 = -(t15*t16 + t20*t21)
+    t121 = t120*t91
+    t122 = t21*t121
+    t123 = t15*t86
+    t124 = t16*t121
+    t125 = t69*t107
+    t126 = t70*t109
+    t127 = 1/casadi.sqrt(t85)
+    t128 = s1*t127
+    t129 = 1/t85**1.5
+    t130 = -t129*(t100 + t101)
+    t131 = c1*t127
+    t132 = qd1*t127
+    t133 = -t73*(t128 + t21*t130) + t72*(t131 + t16*t130) + t88*t132 - t89*t132
+    t134 = t129*(s23*t89 - s23*t88)
+    t135 = t16*t127
+    t136 = t21*t127
+    t137 = -t129*(t11*t21 + t8*t16)
+    t138 = t129*(t15*t21 - t20*t16)
+    t139 = t28*t87
+    t140 = t28*t94
+    t141 = t86*t66
+    t142 = -(-t73*(t139 + t28*t93) + t72*(-t140 + t28*t95) + t90*t141 + t139*t96 + t140*t97)
     Jd = casadi.SX(6, 6)
     Jd[0, 0] = -t37
     Jd[0, 1] = t75
@@ -1017,19 +1021,19 @@ def _task_jacobian_dot(q, q_dot):
     Jd[2, 2] = -t84
     Jd[3, 1] = t98
     Jd[3, 2] = t98
-    Jd[3, 3] = -t73*(t99 + t104) + t72*(t105 + t106) + t108 - t40*t109
-    Jd[3, 4] = -t73*(t110 + t113) - t72*(t114 - t115) + t116 + t117
-    Jd[3, 5] = -t73*(t118 + t121) + t72*(t122 + t123) + t124 - t70*t109
-    Jd[4, 1] = t131
-    Jd[4, 2] = t131
-    Jd[4, 3] = -(-t72*(t16*t132 + t126*s23) - t73*(t129*s23 - t21*t132) + t40*t133 + t48*t134)
-    Jd[4, 4] = -t73*(t11*t125 + t21*t135) + t72*(t8*t125 + t16*t135) + t58*t133 - t57*t134
-    Jd[4, 5] = -(-t72*(t20*t125 + t16*t136) - t73*(t15*t125 - t21*t136) + t70*t133 + t69*t134)
-    Jd[5, 1] = t140
-    Jd[5, 2] = t140
-    Jd[5, 3] = -(t49 + t72*(t28*t105 + t28*t106) - t73*(t28*t99 + t28*t104) + t102*t139 + t28*t108 - t21*t28*t40*t86)
-    Jd[5, 4] = -(-t54 + t72*(-t28*t114 + t28*t115) - t73*(t28*t110 + t28*t113) + t111*t139 + t28*t116 + t28*t117)
-    Jd[5, 5] = -(t64 + t72*(t28*t122 + t28*t123) - t73*(t28*t118 + t28*t121) + t119*t139 + t28*t124 - t21*t28*t70*t86)
+    Jd[3, 3] = -t73*(t99 + t104) + t72*(t105 + t106) + t108 - t110
+    Jd[3, 4] = -t73*(t111 + t114) - t72*(t115 - t116) + t117 + t118
+    Jd[3, 5] = -t73*(t119 + t122) + t72*(t123 + t124) + t125 - t126
+    Jd[4, 1] = t133
+    Jd[4, 2] = t133
+    Jd[4, 3] = -(-t73*(s23*t131 - t21*t134) - t72*(t16*t134 + s23*t128) + t40*t135 + t48*t136)
+    Jd[4, 4] = -t73*(t11*t127 + t21*t137) + t72*(t8*t127 + t16*t137) + t58*t135 - t57*t136
+    Jd[4, 5] = -(-t73*(t15*t127 - t21*t138) - t72*(t20*t127 + t16*t138) + t70*t135 + t69*t136)
+    Jd[5, 1] = t142
+    Jd[5, 2] = t142
+    Jd[5, 3] = -(t49 - t73*(t28*t99 + t28*t104) + t72*(t28*t105 + t28*t106) + t102*t141 - t28*t110 + t28*t108)
+    Jd[5, 4] = -(-t54 - t73*(t28*t111 + t28*t114) + t72*(-t28*t115 + t28*t116) + t112*t141 + t28*t117 + t28*t118)
+    Jd[5, 5] = -(t64 - t73*(t28*t119 + t28*t122) + t72*(t28*t123 + t28*t124) + t120*t141 - t28*t126 + t28*t125)
     return [Jd]
 
 
@@ -1061,22 +1065,22 @@ def _hessian(q):
     t6 = -0.15005*c1 + 0.0203*t5
     t7 = s1*s4
     t8 = c1*c4
-    t9 = -t7 + t8*c23
-    t10 = t8 - t7*c23
+    t9 = -t7 + c23*t8
+    t10 = t8 - c23*t7
     t11 = c4*s1
     t12 = c1*s4
-    t13 = t11 + t12*c23
-    t14 = t12 + t11*c23
+    t13 = t11 + c23*t12
+    t14 = t12 + c23*t11
     t15 = c1*s23
-    t16 = t9*s5 + t15*c5
+    t16 = t9*s5 + c5*t15
     t17 = t4 - 0.4318*t15
     t18 = s1*s23
-    t19 = t14*s5 + t18*c5
+    t19 = t14*s5 + c5*t18
     t20 = t6 - 0.4318*t18
     t21 = t17*c1 + t20*s1
     t22 = 0.4318*c2
-    t23 = t17 + t22*c1
-    t24 = t20 + t22*s1
+    t23 = t17 + c1*t22
+    t24 = t20 + s1*t22
     t25 = t23*c1 + t24*s1
     t26 = t2*s1
     t27 = t1*s1
@@ -1088,16 +1092,16 @@ def _hessian(q):
     t33 = s1**2
     t34 = -(t1*t32 + t1*t33)
     t35 = -t3
-    t36 = -t12*s23
+    t36 = -s23*t12
     t37 = -t0*c1
     t38 = -t5
-    t39 = -t7*s23
+    t39 = -s23*t7
     t40 = -t0*s1
     t41 = -(s23*t32 + s23*t33)
     t42 = t13*c1 - t10*s1
     t43 = -(t16*c1 + t19*s1)
     t44 = s23**2
-    t45 = s23*s4
+    t45 = s4*s23
     H = casadi.SX(36, 6)
     H[0, 0] = -t23
     H[0, 1] = t26
@@ -1149,7 +1153,7 @@ def _hessian(q):
     H[17, 3] = t41
     H[17, 4] = t42
     H[17, 5] = t43
-    H[21, 4] = t10*c23 - t7*t44
+    H[21, 4] = t10*c23 - t44*t7
     H[21, 5] = t19*c23 - t0*t18
     H[22, 4] = t13*c23 + t44*t12
     H[22, 5] = -t16*c23 + t0*t15
@@ -1175,7 +1179,7 @@ def _singularity_factors(q):
     f = casadi.SX(3, 1)
     f[0, 0] = c3 + t0
     f[1, 0] = s5
-    f[2, 0] = -(-c2 + c2*s3 + c3*s2 + t0*s2 - 0.04701250578971746*c2*c3)
+    f[2, 0] = -(-c2 + c2*s3 + c3*s2 + s2*t0 - 0.04701250578971746*c2*c3)
     return [f]
 
 
@@ -1190,7 +1194,7 @@ def _manipulability(q):
     s3 = casadi.sin(q3)
     s5 = casadi.sin(q5)
     t0 = 0.04701250578971746*s3
-    t1 = -0.080509645432*s5*(c3 + t0)*(-c2 + c2*s3 + c3*s2 + t0*s2 - 0.04701250578971746*c2*c3)
+    t1 = -0.080509645432*s5*(c3 + t0)*(-c2 + c2*s3 + c3*s2 + s2*t0 - 0.04701250578971746*c2*c3)
     w = casadi.SX(1, 1)
     w[0, 0] = casadi.fabs(t1)
     return [w]
@@ -1208,7 +1212,7 @@ def _jacobian_det(q):
     s5 = casadi.sin(q5)
     t0 = 0.04701250578971746*s3
     d = casadi.SX(1, 1)
-    d[0, 0] = -0.080509645432*s5*(c3 + t0)*(-c2 + c2*s3 + c3*s2 + t0*s2 - 0.04701250578971746*c2*c3)
+    d[0, 0] = -0.080509645432*s5*(c3 + t0)*(-c2 + c2*s3 + c3*s2 + s2*t0 - 0.04701250578971746*c2*c3)
     return [d]
 
 
@@ -1242,26 +1246,26 @@ def _velocity_ik(q, mu_dot, damping):
     t1 = 0.0203*s23 + 0.4318*c23
     t2 = t1 + 0.4318*s2
     t3 = 0.0203*c23
-    t4 = 0.15005*s1 + t3*c1
-    t5 = -0.15005*c1 + t3*s1
+    t4 = 0.15005*s1 + c1*t3
+    t5 = -0.15005*c1 + s1*t3
     t6 = s1*s4
     t7 = c1*c4
-    t8 = -t6 + t7*c23
-    t9 = t7 - t6*c23
+    t8 = -t6 + c23*t7
+    t9 = t7 - c23*t6
     t10 = c4*s1
     t11 = c1*s4
-    t12 = t10 + t11*c23
-    t13 = t11 + t10*c23
+    t12 = t10 + c23*t11
+    t13 = t11 + c23*t10
     t14 = c1*s23
-    t15 = t8*s5 + t14*c5
+    t15 = t8*s5 + c5*t14
     t16 = t4 - 0.4318*t14
     t17 = s1*s23
-    t18 = t13*s5 + t17*c5
+    t18 = t13*s5 + c5*t17
     t19 = t5 - 0.4318*t17
     t20 = t16*c1 + t19*s1
     t21 = 0.4318*c2
-    t22 = t16 + t21*c1
-    t23 = t19 + t21*s1
+    t22 = t16 + c1*t21
+    t23 = t19 + s1*t21
     t24 = t22*c1 + t23*s1
     t25 = t23**2
     t26 = t1**2
@@ -1271,15 +1275,15 @@ def _velocity_ik(q, mu_dot, damping):
     t30 = t25 + t26*t27 + t29*t27
     t31 = t30
     t32 = -t22*t23
-    t33 = c1*s1
-    t34 = t32 + t33*t26 + t29*t33
+    t33 = s1*c1
+    t34 = t32 + t26*t33 + t29*t33
     t35 = t20*c1
     t36 = t24*c1
     t37 = t1*t35 + t2*t36
     t38 = t36 + t35
     t39 = t1*c1
     t40 = t2*c1
-    t41 = t39*s1 + t40*s1
+    t41 = s1*t39 + s1*t40
     t42 = t22**2
     t43 = casadi.sqrt(1 + t42 + t25)
     t44 = t43*casadi.if_else((t23 <= 0), 1, -1)
@@ -1299,15 +1303,15 @@ def _velocity_ik(q, mu_dot, damping):
     t58 = t12**2 + t15**2 + 2*t46 + t27*t57
     t59 = t58
     t60 = 2*c1
-    t61 = t15*t18 - t12*t9 - t60*s1 + t33*t57
+    t61 = t15*t18 - t12*t9 - s1*t60 + t57*t33
     t62 = s23*s4
-    t63 = t15*t0 + t14*c23 - t12*t62
-    t64 = t18*t0 + t9*t62 + t17*c23
+    t63 = t15*t0 + c23*t14 - t12*t62
+    t64 = t18*t0 + t9*t62 + c23*t17
     t65 = t9**2 + t18**2 + 2*t27 + t46*t57
     t66 = t65
     t67 = 1 + t0**2 + c23**2 + t57*s4**2
     t68 = t67
-    t69 = casadi.sqrt(t30 + t48 + t55 + t58 + t65 + t67)
+    t69 = casadi.sqrt(t55 + t30 + t48 + t58 + t65 + t67)
     t70 = damping**2
     t71 = t66 + t70
     t72 = t68 + t70
@@ -1327,7 +1331,7 @@ def _velocity_ik(q, mu_dot, damping):
     t86 = casadi.if_else((t83 > 0), 1/(t83*(t83 + casadi.fabs(t73))), 0)
     t87 = t86*(t85*t34 + t34*t75 + t37*t52 + t41*t28 + t41*t47 + t32)
     t88 = t34 - t85*t87
-    t89 = t75 - t87*t34
+    t89 = -t87*t34 + t75
     t90 = -t52 + t87*t37
     t91 = -t47 + t87*t41
     t92 = t41 - t87*t28
@@ -1335,27 +1339,27 @@ def _velocity_ik(q, mu_dot, damping):
     t94 = -t86*(t85*t37 + t34*t52 + t37*t76 + t41*t53 + t28*t38)
     t95 = t37 + t85*t94
     t96 = t52 + t94*t34
-    t97 = t76 + t94*t37
+    t97 = t94*t37 + t76
     t98 = t53 + t94*t41
     t99 = t38 + t94*t28
-    t100 = -t86*(t85*t41 + t34*t47 + t37*t53 + t41*t77 - t23*t63 - t28*t61)
+    t100 = -t86*(-t23*t63 - t28*t61 + t85*t41 + t34*t47 + t37*t53 + t41*t77)
     t101 = t41 + t85*t100
     t102 = t47 + t100*t34
     t103 = t53 + t100*t37
-    t104 = t77 + t100*t41
+    t104 = t100*t41 + t77
     t105 = t61 - t100*t28
     t106 = t86*(t64*t23 + t85*t28 + t34*t41 + t37*t38 + t28*t71 - t41*t61)
     t107 = t28 - t85*t106
     t108 = t41 - t106*t34
     t109 = -t38 + t106*t37
     t110 = t61 + t106*t41
-    t111 = t71 - t106*t28
+    t111 = -t106*t28 + t71
     t112 = -t64 + t106*t23
-    t113 = -t86*(t64*t28 + t85*t23 + t23*t72 - t22*t34 - t41*t63)
+    t113 = -t86*(-t22*t34 - t41*t63 + t64*t28 + t85*t23 + t23*t72)
     t114 = t23 + t85*t113
     t115 = t22 - t113*t34
     t116 = t64 + t113*t28
-    t117 = t72 + t113*t23
+    t117 = t113*t23 + t72
     t118 = t86*(t85*mu_dot0 + t34*mu_dot1 + t28*mu_dot4 - t23*mu_dot5 - t37*mu_dot2 - t41*mu_dot3)
     t119 = mu_dot0 - t85*t118
     t120 = mu_dot1 - t118*t34
@@ -1463,16 +1467,16 @@ def _velocity_ik(q, mu_dot, damping):
     t222 = casadi.if_else((t177 != 0), -(t185 - (t181*t221 + t208*t220))/t177, 0)
     t223 = casadi.if_else((t158 != 0), -(t172 - (t162*t222 + t167*t221 + t203*t220))/t158, 0)
     t224 = casadi.if_else((t126 != 0), -(t136 - (t130*t221 + t197*t220 - t152*t223 - t145*t222))/t126, 0)
-    t225 = casadi.if_else((t84 != 0), -(t119 + t95*t223 + t101*t222 + t114*t220 - t88*t224 - t107*t221)/t84, 0)
+    t225 = casadi.if_else((t84 != 0), -(t119 - t88*t224 - t107*t221 + t95*t223 + t101*t222 + t114*t220)/t84, 0)
     t226 = t220 + t224*t22 - t225*t23
     t227 = -t220*c23 + t221*t17 + t222*t14
     t228 = t12*t222 - t9*t221 + t220*t62
     t229 = t221*t18 + t222*t15 - t220*t0
     t230 = t2*s1
     t231 = t221*c1 - t222*s1
-    t232 = t231 + t224*t230 + t225*t40 - t223*t24
+    t232 = -t223*t24 + t224*t230 + t225*t40 + t231
     t233 = t1*s1
-    t234 = t231 + t224*t233 + t225*t39 - t223*t20
+    t234 = -t223*t20 + t224*t233 + t225*t39 + t231
     t235 = -t23
     t236 = t44 + t235
     t237 = -t45*(t236*t40 + t22*t230)
@@ -1492,11 +1496,11 @@ def _velocity_ik(q, mu_dot, damping):
     t251 = t45*t0
     t252 = t0 - t251
     t253 = t27 + t46
-    t254 = casadi.sqrt(t54 + t253 + t237**2 + t239**2)
+    t254 = casadi.sqrt(t54 + t237**2 + t239**2 + t253)
     t255 = t254*casadi.if_else((t239 <= 0), 1, -1)
     t256 = t255 - t239
     t257 = casadi.if_else((t254 > 0), 1/(t254*(t254 + casadi.fabs(t239))), 0)
-    t258 = t257*(t253 + t237*t240 + t24*t20 - t242*t256)
+    t258 = t257*(t237*t240 + t24*t20 - t242*t256 + t253)
     t259 = t242 + t256*t258
     t260 = t20 - t258*t24
     t261 = s1 - t258*s1
@@ -1532,7 +1536,7 @@ def _velocity_ik(q, mu_dot, damping):
     t291 = -t9
     t292 = t291 + t287*c1
     t293 = t22*t251
-    t294 = -t257*(t237*t252 + t15*s1 - t18*c1 + t256*t293)
+    t294 = -t257*(-t18*c1 + t237*t252 + t15*s1 + t256*t293)
     t295 = t256*t294 + t293
     t296 = t15 + t294*s1
     t297 = t252 + t237*t294
@@ -1594,13 +1598,13 @@ def _velocity_ik(q, mu_dot, damping):
     t353 = casadi.if_else((t308 != 0), -(t312 - (t322*t352 - t339*t351))/t308, 0)
     t354 = casadi.if_else((t271 != 0), -(t275 + t303*t353 + t317*t352 + t334*t351)/t271, 0)
     t355 = casadi.if_else((t255 != 0), -(t265 + t259*t354 + t281*t353 + t288*t352 + t295*t351)/t255, 0)
-    t356 = casadi.if_else((t44 != 0), -(t244 + t238*t355 + t241*t354 + t236*t351*t251 + t236*t352*t249 + t236*t353*t247)/t44, 0)
+    t356 = casadi.if_else((t44 != 0), -(t244 + t238*t355 + t241*t354 + t236*t351*t251 + t236*t353*t247 + t236*t352*t249)/t44, 0)
     t357 = (casadi.fabs(t300) < casadi.inf)
     t358 = (damping >= 0)
     t359 = 1e-12*t69
     t360 = (damping > 0)
     t361 = 1e-12*t82
-    t362 = casadi.logic_or(casadi.logic_and(t360, casadi.logic_or(casadi.logic_or(casadi.logic_or(casadi.logic_or(casadi.logic_or((t83 <= t361), (t125 <= t361)), (t157 <= t361)), (t176 <= t361)), (t188 <= t361)), (t215 <= t361))), casadi.logic_and((damping <= 0), casadi.logic_or(casadi.logic_or(casadi.logic_or(casadi.logic_or(casadi.logic_or((t43 <= t359), (t254 <= t359)), (t270 <= t359)), (t307 <= t359)), (t325 <= t359)), (t346 <= t359))))
+    t362 = casadi.logic_or(casadi.logic_and((damping <= 0), casadi.logic_or(casadi.logic_or(casadi.logic_or(casadi.logic_or(casadi.logic_or((t43 <= t359), (t254 <= t359)), (t270 <= t359)), (t307 <= t359)), (t325 <= t359)), (t346 <= t359))), casadi.logic_and(t360, casadi.logic_or(casadi.logic_or(casadi.logic_or(casadi.logic_or(casadi.logic_or((t83 <= t361), (t125 <= t361)), (t157 <= t361)), (t176 <= t361)), (t188 <= t361)), (t215 <= t361))))
     t363 = casadi.logic_and(casadi.logic_and(t357, t358), casadi.logic_not(t362))
     q_dot = casadi.SX(6, 1)
     q_dot[0, 0] = casadi.if_else(t363, casadi.if_else(t360, t226, t356), 0)
@@ -1660,19 +1664,19 @@ def _ik_numeric_step(target, q, damping):
     t3 = T23 - t2
     t4 = T00 + T01 + T02 + T03 + T10 + T11 + T12 + T13 + T20 + T21 + T22 + T23 + qs1 + qs2 + qs3 + qs4 + qs5 + qs6
     t5 = 0.0203*c23
-    t6 = 0.15005*s1 + t5*c1
-    t7 = -0.15005*c1 + t5*s1
+    t6 = 0.15005*s1 + c1*t5
+    t7 = -0.15005*c1 + s1*t5
     t8 = s1*s4
     t9 = c1*c4
-    t10 = -t8 + t9*c23
-    t11 = t9 - t8*c23
+    t10 = -t8 + c23*t9
+    t11 = t9 - c23*t8
     t12 = c4*s1
     t13 = c1*s4
-    t14 = t12 + t13*c23
-    t15 = t13 + t12*c23
+    t14 = t12 + c23*t13
+    t15 = t13 + c23*t12
     t16 = c1*s23
-    t17 = t10*c5 - t16*s5
-    t18 = t10*s5 + t16*c5
+    t17 = t10*c5 - s5*t16
+    t18 = t10*s5 + c5*t16
     t19 = t17*c6 - t14*s6
     t20 = t14*c6 + t17*s6
     t21 = t6 - 0.4318*t16
@@ -1680,8 +1684,8 @@ def _ik_numeric_step(target, q, damping):
     t23 = T11*t20 + T12*t18 - T10*t19
     t24 = T21*t20 + T22*t18 - T20*t19
     t25 = s1*s23
-    t26 = t15*c5 - t25*s5
-    t27 = t15*s5 + t25*c5
+    t26 = t15*c5 - s5*t25
+    t27 = t15*s5 + c5*t25
     t28 = t11*s6 + t26*c6
     t29 = t11*c6 - t26*s6
     t30 = t7 - 0.4318*t25
@@ -1691,13 +1695,13 @@ def _ik_numeric_step(target, q, damping):
     t34 = T20*t28 + T21*t29 - T22*t27
     t35 = -0.5*(t32 + t23)
     t36 = c4*s23
-    t37 = c23*s5 + t36*c5
-    t38 = c23*c5 - t36*s5
-    t39 = s23*s4
-    t40 = t37*c6 - t39*s6
-    t41 = t37*s6 + t39*c6
-    t42 = t18*t38 + t16*c23 - t14*t39
-    t43 = t27*t38 + t11*t39 + t25*c23
+    t37 = c23*s5 + c5*t36
+    t38 = c23*c5 - s5*t36
+    t39 = s4*s23
+    t40 = t37*c6 - s6*t39
+    t41 = t37*s6 + c6*t39
+    t42 = t18*t38 + c23*t16 - t14*t39
+    t43 = t27*t38 + t11*t39 + c23*t25
     t44 = T00*t40 + T02*t38 - T01*t41
     t45 = T10*t40 + T12*t38 - T11*t41
     t46 = T20*t40 + T22*t38 - T21*t41
@@ -1705,8 +1709,8 @@ def _ik_numeric_step(target, q, damping):
     t48 = 0.5*(t44 + t24)
     t49 = casadi.sqrt(t47**2 + t48**2 + t35**2)
     t50 = 0.4318*c2
-    t51 = t21 + t50*c1
-    t52 = t30 + t50*s1
+    t51 = t21 + c1*t50
+    t52 = t30 + s1*t50
     t53 = t51*c1 + t52*s1
     t54 = t53**2 + t31**2
     t55 = T03 - t51
@@ -1718,7 +1722,7 @@ def _ik_numeric_step(target, q, damping):
     t61 = t1**2
     t62 = t57 + t58*t59 + t61*t59
     t63 = -t51*t52
-    t64 = c1*s1
+    t64 = s1*c1
     t65 = t63 + t58*t64 + t61*t64
     t66 = t0*t64 + t1*t64
     t67 = t31*c1
@@ -1734,7 +1738,7 @@ def _ik_numeric_step(target, q, damping):
     t77 = t75 + t74
     t78 = s23**2
     t79 = t14**2 + t18**2 + 2*t71 + t59*t78
-    t80 = t18*t27 - t14*t11 - 2*t64 + t64*t78
+    t80 = t18*t27 - t14*t11 - 2*t64 + t78*t64
     t81 = t11**2 + t27**2 + 2*t59 + t71*t78
     t82 = 1 + t38**2 + c23**2 + t78*s4**2
     t83 = -t22
@@ -1769,7 +1773,7 @@ def _ik_numeric_step(target, q, damping):
     t112 = t72 + damping
     t113 = t104*(t103*t65 + t65*t112 + t69*t76 + t66*t60 + t66*t73 + t63)
     t114 = t65 - t103*t113
-    t115 = t112 - t113*t65
+    t115 = -t113*t65 + t112
     t116 = -t76 + t113*t69
     t117 = -t73 + t113*t66
     t118 = t66 - t113*t60
@@ -1788,15 +1792,15 @@ def _ik_numeric_step(target, q, damping):
     t131 = -t104*(t103*t69 + t65*t76 + t69*t130 + t66*t77 + t60*t70)
     t132 = t69 + t103*t131
     t133 = t76 + t131*t65
-    t134 = t130 + t131*t69
+    t134 = t131*t69 + t130
     t135 = t77 + t131*t66
     t136 = t70 + t131*t60
     t137 = t79 + damping
-    t138 = -t104*(t103*t66 + t65*t73 + t69*t77 + t66*t137 - t52*t42 - t60*t80)
+    t138 = -t104*(-t52*t42 - t60*t80 + t103*t66 + t65*t73 + t69*t77 + t66*t137)
     t139 = t66 + t103*t138
     t140 = t73 + t138*t65
     t141 = t77 + t138*t69
-    t142 = t137 + t138*t66
+    t142 = t138*t66 + t137
     t143 = t80 - t138*t60
     t144 = -t42
     t145 = t144 + t138*t52
@@ -1812,7 +1816,7 @@ def _ik_numeric_step(target, q, damping):
     t155 = t66 - t153*t65
     t156 = -t70 + t153*t69
     t157 = t80 + t153*t66
-    t158 = t152 - t153*t60
+    t158 = -t153*t60 + t152
     t159 = -t43 + t153*t52
     t160 = t123*(t116*t156 + t117*t157 + t118*t158 + t119*t159 + t155*t122)
     t161 = t155 - t122*t160
@@ -1821,12 +1825,12 @@ def _ik_numeric_step(target, q, damping):
     t164 = t158 - t118*t160
     t165 = t159 - t119*t160
     t166 = t82 + damping
-    t167 = -t104*(t43*t60 + t103*t52 + t52*t166 - t51*t65 - t66*t42)
+    t167 = -t104*(-t51*t65 - t66*t42 + t43*t60 + t103*t52 + t52*t166)
     t168 = t52 + t103*t167
     t169 = t51 - t167*t65
     t170 = t144 + t167*t66
     t171 = t43 + t167*t60
-    t172 = t166 + t167*t52
+    t172 = t167*t52 + t166
     t173 = t131*t52
     t174 = t123*(t116*t134 + t117*t135 - t118*t136 - t133*t122 + t119*t173)
     t175 = t133 + t122*t174
@@ -1902,16 +1906,16 @@ def _ik_numeric_step(target, q, damping):
     t245 = casadi.if_else((t200 != 0), -(t208 - (t204*t244 + t231*t243))/t200, 0)
     t246 = casadi.if_else((t181 != 0), -(t195 - (t185*t245 + t190*t244 + t226*t243))/t181, 0)
     t247 = casadi.if_else((t121 != 0), -(t125 - (t161*t244 + t220*t243 - t175*t246 - t147*t245))/t121, 0)
-    t248 = casadi.if_else((t102 != 0), -(t106 + t132*t246 + t139*t245 + t168*t243 - t114*t247 - t154*t244)/t102, 0)
+    t248 = casadi.if_else((t102 != 0), -(t106 - t114*t247 - t154*t244 + t132*t246 + t139*t245 + t168*t243)/t102, 0)
     t249 = t243 + q1 + t51*t247 - t52*t248
     t250 = q4 + t243*c23 - t244*t25 - t245*t16
     t251 = q5 + t14*t245 - t11*t244 + t243*t39
     t252 = q6 + t38*t243 - t18*t245 - t27*t244
-    t253 = t247*s1
-    t254 = t248*c1
+    t253 = s1*t247
+    t254 = c1*t248
     t255 = t245*s1 - t244*c1
-    t256 = t255 + q2 + t53*t246 - t1*t253 - t1*t254
-    t257 = t255 + q3 + t31*t246 - t0*t253 - t0*t254
+    t256 = q2 + t53*t246 - t1*t253 - t1*t254 + t255
+    t257 = q3 + t31*t246 - t0*t253 - t0*t254 + t255
     q_start = casadi.SX(6, 1)
     q_start[0, 0] = q1
     q_start[1, 0] = q2
@@ -1932,7 +1936,7 @@ def _ik_numeric_step(target, q, damping):
 
 
 def _ik_branches(T):
-    """Every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits: 1344 operations."""
+    """Every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits: 1340 operations."""
     T00 = T[0, 0]
     T01 = T[0, 1]
     T02 = T[0, 2]
@@ -1946,22 +1950,22 @@ def _ik_branches(T):
     T22 = T[2, 2]
     T23 = T[2, 3]
     t0 = T00 + T01 + T02 + T03 + T10 + T11 + T12 + T13 + T20 + T21 + T22 + T23
-    t1 = 0.4521*T00 + 1.10363*T02 - 0.15005*T01
+    t1 = -0.15005*T01 + 0.4521*T00 + 1.10363*T02
     t2 = T03 - t1
     t3 = t1
     t4 = t2 + t3
-    t5 = 0.4521*T10 + 1.10363*T12 - 0.15005*T11
+    t5 = -0.15005*T11 + 0.4521*T10 + 1.10363*T12
     t6 = T13 - t5
     t7 = t5
     t8 = t6 + t7
     t9 = casadi.atan2(t4, -t8)
-    t10 = 0.4521*T20 + 1.10363*T22 - 0.15005*T21
+    t10 = -0.15005*T21 + 0.4521*T20 + 1.10363*T22
     t11 = T23 - t10
     t12 = t10
     t13 = t11 + t12
     t14 = t4**2 + t8**2
     t15 = t14
-    t16 = t14 + t13**2
+    t16 = t13**2 + t14
     t17 = 1e-24*t16
     t18 = (t15 <= t17)
     t19 = casadi.if_else(t18, 1, 1/casadi.sqrt(t15))
@@ -1977,9 +1981,9 @@ def _ik_branches(T):
     t29 = t28 - 6.283185307179586*casadi.floor(0.15915494309189535*(2.792526803190927 + t28))
     t30 = t27 - 6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t27))
     t31 = t30 - 6.283185307179586*casadi.floor(0.15915494309189535*(2.792526803190927 + t30))
-    t32 = t4*t19
+    t32 = t19*t4
     t33 = t22*t32
-    t34 = t8*t19
+    t34 = t19*t8
     t35 = t24*t34
     t36 = casadi.if_else(t18, 1, -(t33 + t35))
     t37 = t33 - t35
@@ -2016,537 +2020,533 @@ def _ik_branches(T):
     t68 = 5.357415379007653*t59
     t69 = casadi.if_else(t66, t68, casadi.if_else((t68 > 0), 1, -1))
     t70 = casadi.atan2(t67, t69)
-    t71 = 1.6177742431429796 + t70
-    t72 = 1.6177742431429796 - t70
-    t73 = t71 - 6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t71))
-    t74 = t73 - 6.283185307179586*casadi.floor(0.15915494309189535*(3.9269908169872414 + t73))
-    t75 = t72 - 6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t72))
+    t71 = 1.6177742431429796 - t70
+    t72 = t71 - 6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t71))
+    t73 = t72 - 6.283185307179586*casadi.floor(0.15915494309189535*(3.9269908169872414 + t72))
+    t74 = 1.6177742431429796 + t70
+    t75 = t74 - 6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t74))
     t76 = t75 - 6.283185307179586*casadi.floor(0.15915494309189535*(3.9269908169872414 + t75))
-    t77 = 5.357415379007653*t69
-    t78 = 0.00876554*t77
-    t79 = 5.357415379007653*t67
-    t80 = 0.18645124*t79
-    t81 = -(t78 + t80)
-    t82 = t80 - t78
-    t83 = 0.15005*(1 - t81)
-    t84 = t83 + 0.15005*t81
-    t85 = 0.15005*(1 - t82)
-    t86 = t85 + 0.15005*t82
-    t87 = 0.18645124*t77
-    t88 = 0.00876554*t79
-    t89 = t87 - t88
-    t90 = t88 + t87
-    t91 = 0.0203*t81 - 0.4318*t89
-    t92 = 0.0203*t89 + 0.4318*t81
-    t93 = 0.4318 + t91
-    t94 = 0.67183 + t92
-    t95 = -0.67183 + t94
-    t96 = t42*t95 - t57*t93
-    t97 = t84**2 + t93**2 + t95**2
-    t98 = 0.0203*t82 - 0.4318*t90
-    t99 = 0.0203*t90 + 0.4318*t82
-    t100 = 0.4318 + t98
-    t101 = 0.67183 + t99
-    t102 = -0.67183 + t101
-    t103 = t42*t102 - t57*t100
-    t104 = t86**2 + t100**2 + t102**2
-    t105 = t43*t84
-    t106 = t42*t93 + t57*t95 - t105
-    t107 = t106 + t105
-    t108 = t107**2 + t96**2
-    t109 = 1e-24*t58
-    t110 = (t108 <= t97*t109)
-    t111 = casadi.if_else(t110, 1, 1/casadi.sqrt(t108))
-    t112 = casadi.if_else(t110, 1, t107*t111)
-    t113 = casadi.if_else(t110, 0, -t96*t111)
-    t114 = t81*t112 - t89*t113
-    t115 = t81*t113 + t89*t112
-    t116 = t114*t44 + t115*t61
-    t117 = t114*t61 - t115*t44
-    t118 = t114*t46 + t115*t63
-    t119 = t114*t63 - t115*t46
-    t120 = casadi.if_else(t110, 0, casadi.atan2(-t96, t107))
-    t121 = t120 - 6.283185307179586*casadi.floor(0.15915494309189535*(0.7853981633974483 + t120))
-    t122 = 1 - t114
-    t123 = t45*t122
-    t124 = t123 + t114*t45
-    t125 = t47*t122
-    t126 = t125 + t114*t47
-    t127 = t117**2
-    t128 = -t127
-    t129 = 1 + t128
-    t130 = (t129 > 1e-12)
-    t131 = casadi.if_else(t130, casadi.sqrt(t129), 0)
-    t132 = t127 + t116*t131
-    t133 = t132 + t128
-    t134 = t124**2
-    t135 = t116**2 + t134 + t127
-    t136 = t131**2
-    t137 = t133**2 + t134*t136
-    t138 = t127 + t136
-    t139 = 1e-24*t138
-    t140 = (t137 <= t135*t139)
-    t141 = casadi.if_else(t140, 1, 1/casadi.sqrt(t137))
-    t142 = casadi.if_else(t140, 1, t133*t141)
-    t143 = t119*(1 - t142)
-    t144 = t143 + t119*t142
-    t145 = t124*t131
-    t146 = casadi.if_else(t140, 0, t141*t145)
-    t147 = t118*t142 + t126*t146
-    t148 = t126*t142 - t118*t146
-    t149 = (t138 <= t139)
-    t150 = casadi.if_else(t149, 1, 1/casadi.sqrt(t138))
-    t151 = casadi.if_else(t149, 1, t117*t150)
-    t152 = casadi.if_else(t149, 0, -t131*t150)
-    t153 = t148*(1 - t151)
-    t154 = t151*t147 + t152*t144
-    t155 = t153 + t151*t148
-    t156 = t151*t144 - t152*t147
-    t157 = t154**2 + t155**2
-    t158 = t157
-    t159 = t157 + t156**2
-    t160 = t43*t86
-    t161 = t42*t100 + t57*t102 - t160
-    t162 = t161 + t160
-    t163 = t162**2 + t103**2
-    t164 = (t163 <= t104*t109)
-    t165 = casadi.if_else(t164, 1, 1/casadi.sqrt(t163))
-    t166 = casadi.if_else(t164, 1, t162*t165)
-    t167 = casadi.if_else(t164, 0, -t103*t165)
-    t168 = t82*t166 - t90*t167
-    t169 = t82*t167 + t90*t166
-    t170 = t44*t168 + t61*t169
-    t171 = t61*t168 - t44*t169
-    t172 = t46*t168 + t63*t169
-    t173 = t63*t168 - t46*t169
-    t174 = casadi.if_else(t164, 0, casadi.atan2(-t103, t162))
-    t175 = t174 - 6.283185307179586*casadi.floor(0.15915494309189535*(0.7853981633974483 + t174))
-    t176 = 1 - t168
-    t177 = t45*t176
-    t178 = t177 + t45*t168
-    t179 = t47*t176
-    t180 = t179 + t47*t168
-    t181 = t171**2
-    t182 = -t181
-    t183 = 1 + t182
-    t184 = (t183 > 1e-12)
-    t185 = casadi.if_else(t184, casadi.sqrt(t183), 0)
-    t186 = t181 + t170*t185
-    t187 = t186 + t182
-    t188 = t178**2
-    t189 = t170**2 + t188 + t181
-    t190 = t185**2
-    t191 = t187**2 + t188*t190
-    t192 = t181 + t190
-    t193 = 1e-24*t192
-    t194 = (t191 <= t189*t193)
-    t195 = casadi.if_else(t194, 1, 1/casadi.sqrt(t191))
-    t196 = casadi.if_else(t194, 1, t187*t195)
-    t197 = t173*(1 - t196)
-    t198 = t197 + t173*t196
-    t199 = t178*t185
-    t200 = casadi.if_else(t194, 0, t195*t199)
-    t201 = t172*t196 + t180*t200
-    t202 = t180*t196 - t172*t200
-    t203 = (t192 <= t193)
-    t204 = casadi.if_else(t203, 1, 1/casadi.sqrt(t192))
-    t205 = casadi.if_else(t203, 1, t171*t204)
-    t206 = casadi.if_else(t203, 0, -t185*t204)
-    t207 = t202*(1 - t205)
-    t208 = t205*t201 + t206*t198
-    t209 = t207 + t205*t202
-    t210 = t205*t198 - t206*t201
-    t211 = t208**2 + t209**2
-    t212 = t211
-    t213 = t211 + t210**2
-    t214 = 1 - t37
-    t215 = t13*t214
-    t216 = t215 + t13*t37
-    t217 = -0.67183 + t216
-    t218 = t48**2 + t49**2 + t217**2
-    t219 = 0.5*(0.3958295725 - t218)
-    t220 = T22*t214
-    t221 = t220 + T22*t37
-    t222 = T20*t214
-    t223 = t222 + T20*t37
-    t224 = t219**2
-    t225 = 1 - 28.701899543227718*t224
-    t226 = (t225 > 1e-12)
-    t227 = casadi.if_else(t226, casadi.sqrt(t225), 0)
-    t228 = 5.357415379007653*t219
-    t229 = casadi.if_else(t226, t228, casadi.if_else((t228 > 0), 1, -1))
-    t230 = casadi.atan2(t227, t229)
-    t231 = 1.6177742431429796 + t230
-    t232 = 1.6177742431429796 - t230
-    t233 = t231 - 6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t231))
+    t77 = 0.9988967406110469*t67
+    t78 = 0.04696063880130675*t69
+    t79 = -(t77 + t78)
+    t80 = -t78 + t77
+    t81 = 0.15005*(1 - t79)
+    t82 = t81 + 0.15005*t79
+    t83 = 0.15005*(1 - t80)
+    t84 = t83 + 0.15005*t80
+    t85 = 0.04696063880130675*t67
+    t86 = 0.9988967406110469*t69
+    t87 = -t85 + t86
+    t88 = t85 + t86
+    t89 = -0.4318*t87 + 0.0203*t79
+    t90 = 0.0203*t87 + 0.4318*t79
+    t91 = 0.4318 + t89
+    t92 = 0.67183 + t90
+    t93 = -0.67183 + t92
+    t94 = t42*t93 - t57*t91
+    t95 = t82**2 + t91**2 + t93**2
+    t96 = -0.4318*t88 + 0.0203*t80
+    t97 = 0.0203*t88 + 0.4318*t80
+    t98 = 0.4318 + t96
+    t99 = 0.67183 + t97
+    t100 = -0.67183 + t99
+    t101 = t42*t100 - t57*t98
+    t102 = t84**2 + t98**2 + t100**2
+    t103 = t43*t82
+    t104 = t42*t91 + t57*t93 - t103
+    t105 = t104 + t103
+    t106 = t105**2 + t94**2
+    t107 = 1e-24*t58
+    t108 = (t106 <= t95*t107)
+    t109 = casadi.if_else(t108, 1, 1/casadi.sqrt(t106))
+    t110 = casadi.if_else(t108, 1, t105*t109)
+    t111 = casadi.if_else(t108, 0, -t94*t109)
+    t112 = t79*t110 - t87*t111
+    t113 = t79*t111 + t87*t110
+    t114 = t112*t44 + t113*t61
+    t115 = t112*t61 - t113*t44
+    t116 = t112*t46 + t113*t63
+    t117 = t112*t63 - t113*t46
+    t118 = casadi.if_else(t108, 0, casadi.atan2(-t94, t105))
+    t119 = t118 - 6.283185307179586*casadi.floor(0.15915494309189535*(0.7853981633974483 + t118))
+    t120 = 1 - t112
+    t121 = t45*t120
+    t122 = t121 + t112*t45
+    t123 = t47*t120
+    t124 = t123 + t112*t47
+    t125 = t115**2
+    t126 = -t125
+    t127 = 1 + t126
+    t128 = (t127 > 1e-12)
+    t129 = casadi.if_else(t128, casadi.sqrt(t127), 0)
+    t130 = t125 + t114*t129
+    t131 = t130 + t126
+    t132 = t122**2
+    t133 = t114**2 + t132 + t125
+    t134 = t129**2
+    t135 = t131**2 + t132*t134
+    t136 = t125 + t134
+    t137 = 1e-24*t136
+    t138 = (t135 <= t133*t137)
+    t139 = casadi.if_else(t138, 1, 1/casadi.sqrt(t135))
+    t140 = casadi.if_else(t138, 1, t131*t139)
+    t141 = t117*(1 - t140)
+    t142 = t141 + t117*t140
+    t143 = t122*t129
+    t144 = casadi.if_else(t138, 0, t139*t143)
+    t145 = t116*t140 + t124*t144
+    t146 = t124*t140 - t116*t144
+    t147 = (t136 <= t137)
+    t148 = casadi.if_else(t147, 1, 1/casadi.sqrt(t136))
+    t149 = casadi.if_else(t147, 1, t115*t148)
+    t150 = casadi.if_else(t147, 0, -t129*t148)
+    t151 = t146*(1 - t149)
+    t152 = t149*t145 + t150*t142
+    t153 = t151 + t149*t146
+    t154 = t149*t142 - t150*t145
+    t155 = t152**2 + t153**2
+    t156 = t155
+    t157 = t154**2 + t155
+    t158 = t43*t84
+    t159 = t42*t98 + t57*t100 - t158
+    t160 = t159 + t158
+    t161 = t160**2 + t101**2
+    t162 = (t161 <= t102*t107)
+    t163 = casadi.if_else(t162, 1, 1/casadi.sqrt(t161))
+    t164 = casadi.if_else(t162, 1, t160*t163)
+    t165 = casadi.if_else(t162, 0, -t101*t163)
+    t166 = t80*t164 - t88*t165
+    t167 = t80*t165 + t88*t164
+    t168 = t44*t166 + t61*t167
+    t169 = t61*t166 - t44*t167
+    t170 = t46*t166 + t63*t167
+    t171 = t63*t166 - t46*t167
+    t172 = casadi.if_else(t162, 0, casadi.atan2(-t101, t160))
+    t173 = t172 - 6.283185307179586*casadi.floor(0.15915494309189535*(0.7853981633974483 + t172))
+    t174 = 1 - t166
+    t175 = t45*t174
+    t176 = t175 + t45*t166
+    t177 = t47*t174
+    t178 = t177 + t47*t166
+    t179 = t169**2
+    t180 = -t179
+    t181 = 1 + t180
+    t182 = (t181 > 1e-12)
+    t183 = casadi.if_else(t182, casadi.sqrt(t181), 0)
+    t184 = t179 + t168*t183
+    t185 = t184 + t180
+    t186 = t176**2
+    t187 = t168**2 + t186 + t179
+    t188 = t183**2
+    t189 = t185**2 + t186*t188
+    t190 = t179 + t188
+    t191 = 1e-24*t190
+    t192 = (t189 <= t187*t191)
+    t193 = casadi.if_else(t192, 1, 1/casadi.sqrt(t189))
+    t194 = casadi.if_else(t192, 1, t185*t193)
+    t195 = t171*(1 - t194)
+    t196 = t195 + t171*t194
+    t197 = t176*t183
+    t198 = casadi.if_else(t192, 0, t193*t197)
+    t199 = t170*t194 + t178*t198
+    t200 = t178*t194 - t170*t198
+    t201 = (t190 <= t191)
+    t202 = casadi.if_else(t201, 1, 1/casadi.sqrt(t190))
+    t203 = casadi.if_else(t201, 1, t169*t202)
+    t204 = casadi.if_else(t201, 0, -t183*t202)
+    t205 = t200*(1 - t203)
+    t206 = t203*t199 + t204*t196
+    t207 = t205 + t203*t200
+    t208 = t203*t196 - t204*t199
+    t209 = t206**2 + t207**2
+    t210 = t209
+    t211 = t208**2 + t209
+    t212 = 1 - t37
+    t213 = t13*t212
+    t214 = t213 + t13*t37
+    t215 = -0.67183 + t214
+    t216 = t48**2 + t49**2 + t215**2
+    t217 = 0.5*(0.3958295725 - t216)
+    t218 = T22*t212
+    t219 = t218 + T22*t37
+    t220 = T20*t212
+    t221 = t220 + T20*t37
+    t222 = t217**2
+    t223 = 1 - 28.701899543227718*t222
+    t224 = (t223 > 1e-12)
+    t225 = casadi.if_else(t224, casadi.sqrt(t223), 0)
+    t226 = 5.357415379007653*t217
+    t227 = casadi.if_else(t224, t226, casadi.if_else((t226 > 0), 1, -1))
+    t228 = casadi.atan2(t225, t227)
+    t229 = 1.6177742431429796 + t228
+    t230 = 1.6177742431429796 - t228
+    t231 = t229 - 6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t229))
+    t232 = t231 - 6.283185307179586*casadi.floor(0.15915494309189535*(3.9269908169872414 + t231))
+    t233 = t230 - 6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t230))
     t234 = t233 - 6.283185307179586*casadi.floor(0.15915494309189535*(3.9269908169872414 + t233))
-    t235 = t232 - 6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t232))
-    t236 = t235 - 6.283185307179586*casadi.floor(0.15915494309189535*(3.9269908169872414 + t235))
-    t237 = 5.357415379007653*t229
-    t238 = 0.00876554*t237
-    t239 = 5.357415379007653*t227
-    t240 = 0.18645124*t239
-    t241 = -(t238 + t240)
-    t242 = t240 - t238
-    t243 = 0.15005*(1 - t241)
-    t244 = t243 + 0.15005*t241
-    t245 = 0.15005*(1 - t242)
-    t246 = t245 + 0.15005*t242
-    t247 = 0.18645124*t237
-    t248 = 0.00876554*t239
-    t249 = t247 - t248
-    t250 = t248 + t247
-    t251 = 0.0203*t241 - 0.4318*t249
-    t252 = 0.0203*t249 + 0.4318*t241
-    t253 = 0.4318 + t251
-    t254 = 0.67183 + t252
-    t255 = -0.67183 + t254
-    t256 = t48*t255 - t217*t253
-    t257 = t244**2 + t253**2 + t255**2
-    t258 = 0.0203*t242 - 0.4318*t250
-    t259 = 0.0203*t250 + 0.4318*t242
-    t260 = 0.4318 + t258
-    t261 = 0.67183 + t259
-    t262 = -0.67183 + t261
-    t263 = t48*t262 - t217*t260
-    t264 = t246**2 + t260**2 + t262**2
-    t265 = t49*t244
-    t266 = t48*t253 + t217*t255 - t265
-    t267 = t266 + t265
-    t268 = t267**2 + t256**2
-    t269 = 1e-24*t218
-    t270 = (t268 <= t257*t269)
-    t271 = casadi.if_else(t270, 1, 1/casadi.sqrt(t268))
-    t272 = casadi.if_else(t270, 1, t267*t271)
-    t273 = casadi.if_else(t270, 0, -t256*t271)
-    t274 = t241*t272 - t249*t273
-    t275 = t241*t273 + t249*t272
-    t276 = t274*t50 + t275*t221
-    t277 = t274*t221 - t275*t50
-    t278 = t274*t52 + t275*t223
-    t279 = t274*t223 - t275*t52
-    t280 = casadi.if_else(t270, 0, casadi.atan2(-t256, t267))
-    t281 = t280 - 6.283185307179586*casadi.floor(0.15915494309189535*(0.7853981633974483 + t280))
-    t282 = 1 - t274
-    t283 = t51*t282
-    t284 = t283 + t274*t51
-    t285 = t53*t282
-    t286 = t285 + t274*t53
-    t287 = t277**2
-    t288 = -t287
-    t289 = 1 + t288
-    t290 = (t289 > 1e-12)
-    t291 = casadi.if_else(t290, casadi.sqrt(t289), 0)
-    t292 = t287 + t276*t291
-    t293 = t292 + t288
-    t294 = t284**2
-    t295 = t276**2 + t294 + t287
-    t296 = t291**2
-    t297 = t293**2 + t294*t296
-    t298 = t287 + t296
-    t299 = 1e-24*t298
-    t300 = (t297 <= t295*t299)
-    t301 = casadi.if_else(t300, 1, 1/casadi.sqrt(t297))
-    t302 = casadi.if_else(t300, 1, t293*t301)
-    t303 = t279*(1 - t302)
-    t304 = t303 + t279*t302
-    t305 = t284*t291
-    t306 = casadi.if_else(t300, 0, t301*t305)
-    t307 = t278*t302 + t286*t306
-    t308 = t286*t302 - t278*t306
-    t309 = (t298 <= t299)
-    t310 = casadi.if_else(t309, 1, 1/casadi.sqrt(t298))
-    t311 = casadi.if_else(t309, 1, t277*t310)
-    t312 = casadi.if_else(t309, 0, -t291*t310)
-    t313 = t308*(1 - t311)
-    t314 = t311*t307 + t312*t304
-    t315 = t313 + t311*t308
-    t316 = t311*t304 - t312*t307
-    t317 = t314**2 + t315**2
-    t318 = t317
-    t319 = t317 + t316**2
-    t320 = t49*t246
-    t321 = t48*t260 + t217*t262 - t320
-    t322 = t321 + t320
-    t323 = t322**2 + t263**2
-    t324 = (t323 <= t264*t269)
-    t325 = casadi.if_else(t324, 1, 1/casadi.sqrt(t323))
-    t326 = casadi.if_else(t324, 1, t322*t325)
-    t327 = casadi.if_else(t324, 0, -t263*t325)
-    t328 = t242*t326 - t250*t327
-    t329 = t242*t327 + t250*t326
-    t330 = t50*t328 + t221*t329
-    t331 = t221*t328 - t50*t329
-    t332 = t52*t328 + t223*t329
-    t333 = t223*t328 - t52*t329
-    t334 = casadi.if_else(t324, 0, casadi.atan2(-t263, t322))
-    t335 = t334 - 6.283185307179586*casadi.floor(0.15915494309189535*(0.7853981633974483 + t334))
-    t336 = 1 - t328
-    t337 = t51*t336
-    t338 = t337 + t51*t328
-    t339 = t53*t336
-    t340 = t339 + t53*t328
-    t341 = t331**2
-    t342 = -t341
-    t343 = 1 + t342
-    t344 = (t343 > 1e-12)
-    t345 = casadi.if_else(t344, casadi.sqrt(t343), 0)
-    t346 = t341 + t330*t345
-    t347 = t346 + t342
-    t348 = t338**2
-    t349 = t330**2 + t348 + t341
-    t350 = t345**2
-    t351 = t347**2 + t348*t350
-    t352 = t341 + t350
-    t353 = 1e-24*t352
-    t354 = (t351 <= t349*t353)
-    t355 = casadi.if_else(t354, 1, 1/casadi.sqrt(t351))
-    t356 = casadi.if_else(t354, 1, t347*t355)
-    t357 = t333*(1 - t356)
-    t358 = t357 + t333*t356
-    t359 = t338*t345
-    t360 = casadi.if_else(t354, 0, t355*t359)
-    t361 = t332*t356 + t340*t360
-    t362 = t340*t356 - t332*t360
-    t363 = (t352 <= t353)
-    t364 = casadi.if_else(t363, 1, 1/casadi.sqrt(t352))
-    t365 = casadi.if_else(t363, 1, t331*t364)
-    t366 = casadi.if_else(t363, 0, -t345*t364)
-    t367 = t362*(1 - t365)
-    t368 = t365*t361 + t366*t358
-    t369 = t367 + t365*t362
-    t370 = t365*t358 - t366*t361
-    t371 = t368**2 + t369**2
-    t372 = t371
-    t373 = t371 + t370**2
-    t374 = casadi.if_else(t140, 0, casadi.atan2(t145, t133))
-    t375 = t374
-    t376 = t375 - 6.283185307179586*casadi.floor(0.15915494309189535*(1.9198621771937625 + t375))
-    t377 = 3.141592653589793 - 6.283185307179586*casadi.ceil(0.15915494309189535*t374) + t374
-    t378 = t377 - 6.283185307179586*casadi.floor(0.15915494309189535*(1.9198621771937625 + t377))
-    t379 = casadi.if_else(t149, 0, casadi.atan2(-t131, t117))
+    t235 = 0.9988967406110469*t225
+    t236 = 0.04696063880130675*t227
+    t237 = -(t235 + t236)
+    t238 = -t236 + t235
+    t239 = 0.15005*(1 - t237)
+    t240 = t239 + 0.15005*t237
+    t241 = 0.15005*(1 - t238)
+    t242 = t241 + 0.15005*t238
+    t243 = 0.04696063880130675*t225
+    t244 = 0.9988967406110469*t227
+    t245 = -t243 + t244
+    t246 = t243 + t244
+    t247 = -0.4318*t245 + 0.0203*t237
+    t248 = 0.0203*t245 + 0.4318*t237
+    t249 = 0.4318 + t247
+    t250 = 0.67183 + t248
+    t251 = -0.67183 + t250
+    t252 = t48*t251 - t215*t249
+    t253 = t240**2 + t249**2 + t251**2
+    t254 = -0.4318*t246 + 0.0203*t238
+    t255 = 0.0203*t246 + 0.4318*t238
+    t256 = 0.4318 + t254
+    t257 = 0.67183 + t255
+    t258 = -0.67183 + t257
+    t259 = t48*t258 - t215*t256
+    t260 = t242**2 + t256**2 + t258**2
+    t261 = t49*t240
+    t262 = t48*t249 + t215*t251 - t261
+    t263 = t262 + t261
+    t264 = t263**2 + t252**2
+    t265 = 1e-24*t216
+    t266 = (t264 <= t253*t265)
+    t267 = casadi.if_else(t266, 1, 1/casadi.sqrt(t264))
+    t268 = casadi.if_else(t266, 1, t263*t267)
+    t269 = casadi.if_else(t266, 0, -t252*t267)
+    t270 = t237*t268 - t245*t269
+    t271 = t237*t269 + t245*t268
+    t272 = t270*t50 + t271*t219
+    t273 = t270*t219 - t271*t50
+    t274 = t270*t52 + t271*t221
+    t275 = t270*t221 - t271*t52
+    t276 = casadi.if_else(t266, 0, casadi.atan2(-t252, t263))
+    t277 = t276 - 6.283185307179586*casadi.floor(0.15915494309189535*(0.7853981633974483 + t276))
+    t278 = 1 - t270
+    t279 = t51*t278
+    t280 = t279 + t270*t51
+    t281 = t53*t278
+    t282 = t281 + t270*t53
+    t283 = t273**2
+    t284 = -t283
+    t285 = 1 + t284
+    t286 = (t285 > 1e-12)
+    t287 = casadi.if_else(t286, casadi.sqrt(t285), 0)
+    t288 = t283 + t272*t287
+    t289 = t288 + t284
+    t290 = t280**2
+    t291 = t272**2 + t290 + t283
+    t292 = t287**2
+    t293 = t289**2 + t290*t292
+    t294 = t283 + t292
+    t295 = 1e-24*t294
+    t296 = (t293 <= t291*t295)
+    t297 = casadi.if_else(t296, 1, 1/casadi.sqrt(t293))
+    t298 = casadi.if_else(t296, 1, t289*t297)
+    t299 = t275*(1 - t298)
+    t300 = t299 + t275*t298
+    t301 = t280*t287
+    t302 = casadi.if_else(t296, 0, t297*t301)
+    t303 = t274*t298 + t282*t302
+    t304 = t282*t298 - t274*t302
+    t305 = (t294 <= t295)
+    t306 = casadi.if_else(t305, 1, 1/casadi.sqrt(t294))
+    t307 = casadi.if_else(t305, 1, t273*t306)
+    t308 = casadi.if_else(t305, 0, -t287*t306)
+    t309 = t304*(1 - t307)
+    t310 = t307*t303 + t308*t300
+    t311 = t309 + t307*t304
+    t312 = t307*t300 - t308*t303
+    t313 = t310**2 + t311**2
+    t314 = t313
+    t315 = t312**2 + t313
+    t316 = t49*t242
+    t317 = t48*t256 + t215*t258 - t316
+    t318 = t317 + t316
+    t319 = t318**2 + t259**2
+    t320 = (t319 <= t260*t265)
+    t321 = casadi.if_else(t320, 1, 1/casadi.sqrt(t319))
+    t322 = casadi.if_else(t320, 1, t318*t321)
+    t323 = casadi.if_else(t320, 0, -t259*t321)
+    t324 = t238*t322 - t246*t323
+    t325 = t238*t323 + t246*t322
+    t326 = t50*t324 + t219*t325
+    t327 = t219*t324 - t50*t325
+    t328 = t52*t324 + t221*t325
+    t329 = t221*t324 - t52*t325
+    t330 = casadi.if_else(t320, 0, casadi.atan2(-t259, t318))
+    t331 = t330 - 6.283185307179586*casadi.floor(0.15915494309189535*(0.7853981633974483 + t330))
+    t332 = 1 - t324
+    t333 = t51*t332
+    t334 = t333 + t51*t324
+    t335 = t53*t332
+    t336 = t335 + t53*t324
+    t337 = t327**2
+    t338 = -t337
+    t339 = 1 + t338
+    t340 = (t339 > 1e-12)
+    t341 = casadi.if_else(t340, casadi.sqrt(t339), 0)
+    t342 = t337 + t326*t341
+    t343 = t342 + t338
+    t344 = t334**2
+    t345 = t326**2 + t344 + t337
+    t346 = t341**2
+    t347 = t343**2 + t344*t346
+    t348 = t337 + t346
+    t349 = 1e-24*t348
+    t350 = (t347 <= t345*t349)
+    t351 = casadi.if_else(t350, 1, 1/casadi.sqrt(t347))
+    t352 = casadi.if_else(t350, 1, t343*t351)
+    t353 = t329*(1 - t352)
+    t354 = t353 + t329*t352
+    t355 = t334*t341
+    t356 = casadi.if_else(t350, 0, t351*t355)
+    t357 = t328*t352 + t336*t356
+    t358 = t336*t352 - t328*t356
+    t359 = (t348 <= t349)
+    t360 = casadi.if_else(t359, 1, 1/casadi.sqrt(t348))
+    t361 = casadi.if_else(t359, 1, t327*t360)
+    t362 = casadi.if_else(t359, 0, -t341*t360)
+    t363 = t358*(1 - t361)
+    t364 = t361*t357 + t362*t354
+    t365 = t363 + t361*t358
+    t366 = t361*t354 - t362*t357
+    t367 = t364**2 + t365**2
+    t368 = t367
+    t369 = t366**2 + t367
+    t370 = casadi.if_else(t138, 0, casadi.atan2(t143, t131))
+    t371 = t370
+    t372 = t371 - 6.283185307179586*casadi.floor(0.15915494309189535*(1.9198621771937625 + t371))
+    t373 = 3.141592653589793 - 6.283185307179586*casadi.ceil(0.15915494309189535*t370) + t370
+    t374 = t373 - 6.283185307179586*casadi.floor(0.15915494309189535*(1.9198621771937625 + t373))
+    t375 = casadi.if_else(t147, 0, casadi.atan2(-t129, t115))
+    t376 = t375
+    t377 = t376 - 6.283185307179586*casadi.floor(0.15915494309189535*(1.7453292519943295 + t376))
+    t378 = 6.283185307179586*casadi.ceil(-0.15915494309189535*(3.141592653589793 + t375)) + t375
+    t379 = casadi.if_else((t156 <= 1e-24*t157), 0, casadi.atan2(t153, t152))
     t380 = t379
-    t381 = t380 - 6.283185307179586*casadi.floor(0.15915494309189535*(1.7453292519943295 + t380))
-    t382 = 6.283185307179586*casadi.ceil(-0.15915494309189535*(3.141592653589793 + t379)) + t379
-    t383 = casadi.if_else((t158 <= 1e-24*t159), 0, casadi.atan2(t155, t154))
-    t384 = t383
-    t385 = t384 - 6.283185307179586*casadi.floor(0.15915494309189535*(4.642575810304916 + t384))
-    t386 = 3.141592653589793 - 6.283185307179586*casadi.ceil(0.15915494309189535*t383) + t383
-    t387 = t386 - 6.283185307179586*casadi.floor(0.15915494309189535*(4.642575810304916 + t386))
-    t388 = -t382
-    t389 = t382 + 6.283185307179586*casadi.floor(0.15915494309189535*(1.7453292519943295 + t388))
-    t390 = casadi.if_else(t194, 0, casadi.atan2(t199, t187))
-    t391 = t390
-    t392 = t391 - 6.283185307179586*casadi.floor(0.15915494309189535*(1.9198621771937625 + t391))
-    t393 = 3.141592653589793 - 6.283185307179586*casadi.ceil(0.15915494309189535*t390) + t390
-    t394 = t393 - 6.283185307179586*casadi.floor(0.15915494309189535*(1.9198621771937625 + t393))
-    t395 = casadi.if_else(t203, 0, casadi.atan2(-t185, t171))
+    t381 = t380 - 6.283185307179586*casadi.floor(0.15915494309189535*(4.642575810304916 + t380))
+    t382 = 3.141592653589793 - 6.283185307179586*casadi.ceil(0.15915494309189535*t379) + t379
+    t383 = t382 - 6.283185307179586*casadi.floor(0.15915494309189535*(4.642575810304916 + t382))
+    t384 = -t378
+    t385 = t378 + 6.283185307179586*casadi.floor(0.15915494309189535*(1.7453292519943295 + t384))
+    t386 = casadi.if_else(t192, 0, casadi.atan2(t197, t185))
+    t387 = t386
+    t388 = t387 - 6.283185307179586*casadi.floor(0.15915494309189535*(1.9198621771937625 + t387))
+    t389 = 3.141592653589793 - 6.283185307179586*casadi.ceil(0.15915494309189535*t386) + t386
+    t390 = t389 - 6.283185307179586*casadi.floor(0.15915494309189535*(1.9198621771937625 + t389))
+    t391 = casadi.if_else(t201, 0, casadi.atan2(-t183, t169))
+    t392 = t391
+    t393 = t392 - 6.283185307179586*casadi.floor(0.15915494309189535*(1.7453292519943295 + t392))
+    t394 = 6.283185307179586*casadi.ceil(-0.15915494309189535*(3.141592653589793 + t391)) + t391
+    t395 = casadi.if_else((t210 <= 1e-24*t211), 0, casadi.atan2(t207, t206))
     t396 = t395
-    t397 = t396 - 6.283185307179586*casadi.floor(0.15915494309189535*(1.7453292519943295 + t396))
-    t398 = 6.283185307179586*casadi.ceil(-0.15915494309189535*(3.141592653589793 + t395)) + t395
-    t399 = casadi.if_else((t212 <= 1e-24*t213), 0, casadi.atan2(t209, t208))
-    t400 = t399
-    t401 = t400 - 6.283185307179586*casadi.floor(0.15915494309189535*(4.642575810304916 + t400))
-    t402 = 3.141592653589793 - 6.283185307179586*casadi.ceil(0.15915494309189535*t399) + t399
-    t403 = t402 - 6.283185307179586*casadi.floor(0.15915494309189535*(4.642575810304916 + t402))
-    t404 = -t398
-    t405 = t398 + 6.283185307179586*casadi.floor(0.15915494309189535*(1.7453292519943295 + t404))
-    t406 = casadi.if_else(t300, 0, casadi.atan2(t305, t293))
-    t407 = t406
-    t408 = t407 - 6.283185307179586*casadi.floor(0.15915494309189535*(1.9198621771937625 + t407))
-    t409 = 3.141592653589793 - 6.283185307179586*casadi.ceil(0.15915494309189535*t406) + t406
-    t410 = t409 - 6.283185307179586*casadi.floor(0.15915494309189535*(1.9198621771937625 + t409))
-    t411 = casadi.if_else(t309, 0, casadi.atan2(-t291, t277))
+    t397 = t396 - 6.283185307179586*casadi.floor(0.15915494309189535*(4.642575810304916 + t396))
+    t398 = 3.141592653589793 - 6.283185307179586*casadi.ceil(0.15915494309189535*t395) + t395
+    t399 = t398 - 6.283185307179586*casadi.floor(0.15915494309189535*(4.642575810304916 + t398))
+    t400 = -t394
+    t401 = t394 + 6.283185307179586*casadi.floor(0.15915494309189535*(1.7453292519943295 + t400))
+    t402 = casadi.if_else(t296, 0, casadi.atan2(t301, t289))
+    t403 = t402
+    t404 = t403 - 6.283185307179586*casadi.floor(0.15915494309189535*(1.9198621771937625 + t403))
+    t405 = 3.141592653589793 - 6.283185307179586*casadi.ceil(0.15915494309189535*t402) + t402
+    t406 = t405 - 6.283185307179586*casadi.floor(0.15915494309189535*(1.9198621771937625 + t405))
+    t407 = casadi.if_else(t305, 0, casadi.atan2(-t287, t273))
+    t408 = t407
+    t409 = t408 - 6.283185307179586*casadi.floor(0.15915494309189535*(1.7453292519943295 + t408))
+    t410 = 6.283185307179586*casadi.ceil(-0.15915494309189535*(3.141592653589793 + t407)) + t407
+    t411 = casadi.if_else((t314 <= 1e-24*t315), 0, casadi.atan2(t311, t310))
     t412 = t411
-    t413 = t412 - 6.283185307179586*casadi.floor(0.15915494309189535*(1.7453292519943295 + t412))
-    t414 = 6.283185307179586*casadi.ceil(-0.15915494309189535*(3.141592653589793 + t411)) + t411
-    t415 = casadi.if_else((t318 <= 1e-24*t319), 0, casadi.atan2(t315, t314))
-    t416 = t415
-    t417 = t416 - 6.283185307179586*casadi.floor(0.15915494309189535*(4.642575810304916 + t416))
-    t418 = 3.141592653589793 - 6.283185307179586*casadi.ceil(0.15915494309189535*t415) + t415
-    t419 = t418 - 6.283185307179586*casadi.floor(0.15915494309189535*(4.642575810304916 + t418))
-    t420 = -t414
-    t421 = t414 + 6.283185307179586*casadi.floor(0.15915494309189535*(1.7453292519943295 + t420))
-    t422 = casadi.if_else(t354, 0, casadi.atan2(t359, t347))
-    t423 = t422
-    t424 = t423 - 6.283185307179586*casadi.floor(0.15915494309189535*(1.9198621771937625 + t423))
-    t425 = 3.141592653589793 - 6.283185307179586*casadi.ceil(0.15915494309189535*t422) + t422
-    t426 = t425 - 6.283185307179586*casadi.floor(0.15915494309189535*(1.9198621771937625 + t425))
-    t427 = casadi.if_else(t363, 0, casadi.atan2(-t345, t331))
+    t413 = t412 - 6.283185307179586*casadi.floor(0.15915494309189535*(4.642575810304916 + t412))
+    t414 = 3.141592653589793 - 6.283185307179586*casadi.ceil(0.15915494309189535*t411) + t411
+    t415 = t414 - 6.283185307179586*casadi.floor(0.15915494309189535*(4.642575810304916 + t414))
+    t416 = -t410
+    t417 = t410 + 6.283185307179586*casadi.floor(0.15915494309189535*(1.7453292519943295 + t416))
+    t418 = casadi.if_else(t350, 0, casadi.atan2(t355, t343))
+    t419 = t418
+    t420 = t419 - 6.283185307179586*casadi.floor(0.15915494309189535*(1.9198621771937625 + t419))
+    t421 = 3.141592653589793 - 6.283185307179586*casadi.ceil(0.15915494309189535*t418) + t418
+    t422 = t421 - 6.283185307179586*casadi.floor(0.15915494309189535*(1.9198621771937625 + t421))
+    t423 = casadi.if_else(t359, 0, casadi.atan2(-t341, t327))
+    t424 = t423
+    t425 = t424 - 6.283185307179586*casadi.floor(0.15915494309189535*(1.7453292519943295 + t424))
+    t426 = 6.283185307179586*casadi.ceil(-0.15915494309189535*(3.141592653589793 + t423)) + t423
+    t427 = casadi.if_else((t368 <= 1e-24*t369), 0, casadi.atan2(t365, t364))
     t428 = t427
-    t429 = t428 - 6.283185307179586*casadi.floor(0.15915494309189535*(1.7453292519943295 + t428))
-    t430 = 6.283185307179586*casadi.ceil(-0.15915494309189535*(3.141592653589793 + t427)) + t427
-    t431 = casadi.if_else((t372 <= 1e-24*t373), 0, casadi.atan2(t369, t368))
-    t432 = t431
-    t433 = t432 - 6.283185307179586*casadi.floor(0.15915494309189535*(4.642575810304916 + t432))
-    t434 = 3.141592653589793 - 6.283185307179586*casadi.ceil(0.15915494309189535*t431) + t431
-    t435 = t434 - 6.283185307179586*casadi.floor(0.15915494309189535*(4.642575810304916 + t434))
-    t436 = -t430
-    t437 = t430 + 6.283185307179586*casadi.floor(0.15915494309189535*(1.7453292519943295 + t436))
-    t438 = (t29 <= 2.792526803190927)
-    t439 = casadi.logic_and((t28 >= -2.792526803190927), (t28 <= 2.792526803190927))
-    t440 = casadi.if_else(casadi.logic_and(t438, casadi.logic_not(t439)), t29, t28)
-    t441 = (t121 <= 3.9269908169872414)
-    t442 = casadi.logic_and((t120 >= -0.7853981633974483), (t120 <= 3.9269908169872414))
-    t443 = casadi.if_else(casadi.logic_and(t441, casadi.logic_not(t442)), t121, t120)
-    t444 = (t74 <= 0.7853981633974483)
-    t445 = casadi.logic_and((t73 >= -3.9269908169872414), (t73 <= 0.7853981633974483))
-    t446 = casadi.if_else(casadi.logic_and(t444, casadi.logic_not(t445)), t74, t73)
-    t447 = (t376 <= 2.9670597283903604)
-    t448 = casadi.logic_and((t375 >= -1.9198621771937625), (t375 <= 2.9670597283903604))
-    t449 = (t381 <= 1.7453292519943295)
-    t450 = casadi.logic_and((t380 >= -1.7453292519943295), (t380 <= 1.7453292519943295))
-    t451 = (t385 <= 4.642575810304916)
-    t452 = casadi.logic_and((t384 >= -4.642575810304916), (t384 <= 4.642575810304916))
-    t453 = (t378 <= 2.9670597283903604)
-    t454 = casadi.logic_and((t377 >= -1.9198621771937625), (t377 <= 2.9670597283903604))
-    t455 = -t389
-    t456 = (t455 <= 1.7453292519943295)
-    t457 = casadi.logic_and((t388 >= -1.7453292519943295), (t388 <= 1.7453292519943295))
-    t458 = (t387 <= 4.642575810304916)
-    t459 = casadi.logic_and((t386 >= -4.642575810304916), (t386 <= 4.642575810304916))
-    t460 = (t175 <= 3.9269908169872414)
-    t461 = casadi.logic_and((t174 >= -0.7853981633974483), (t174 <= 3.9269908169872414))
-    t462 = casadi.if_else(casadi.logic_and(t460, casadi.logic_not(t461)), t175, t174)
-    t463 = (t76 <= 0.7853981633974483)
-    t464 = casadi.logic_and((t75 >= -3.9269908169872414), (t75 <= 0.7853981633974483))
-    t465 = casadi.if_else(casadi.logic_and(t463, casadi.logic_not(t464)), t76, t75)
-    t466 = (t392 <= 2.9670597283903604)
-    t467 = casadi.logic_and((t391 >= -1.9198621771937625), (t391 <= 2.9670597283903604))
-    t468 = (t397 <= 1.7453292519943295)
-    t469 = casadi.logic_and((t396 >= -1.7453292519943295), (t396 <= 1.7453292519943295))
-    t470 = (t401 <= 4.642575810304916)
-    t471 = casadi.logic_and((t400 >= -4.642575810304916), (t400 <= 4.642575810304916))
-    t472 = (t394 <= 2.9670597283903604)
-    t473 = casadi.logic_and((t393 >= -1.9198621771937625), (t393 <= 2.9670597283903604))
-    t474 = -t405
-    t475 = (t474 <= 1.7453292519943295)
-    t476 = casadi.logic_and((t404 >= -1.7453292519943295), (t404 <= 1.7453292519943295))
-    t477 = (t403 <= 4.642575810304916)
-    t478 = casadi.logic_and((t402 >= -4.642575810304916), (t402 <= 4.642575810304916))
-    t479 = (t31 <= 2.792526803190927)
-    t480 = casadi.logic_and((t30 >= -2.792526803190927), (t30 <= 2.792526803190927))
-    t481 = casadi.if_else(casadi.logic_and(t479, casadi.logic_not(t480)), t31, t30)
-    t482 = (t281 <= 3.9269908169872414)
-    t483 = casadi.logic_and((t280 >= -0.7853981633974483), (t280 <= 3.9269908169872414))
-    t484 = casadi.if_else(casadi.logic_and(t482, casadi.logic_not(t483)), t281, t280)
-    t485 = (t234 <= 0.7853981633974483)
-    t486 = casadi.logic_and((t233 >= -3.9269908169872414), (t233 <= 0.7853981633974483))
-    t487 = casadi.if_else(casadi.logic_and(t485, casadi.logic_not(t486)), t234, t233)
-    t488 = (t408 <= 2.9670597283903604)
-    t489 = casadi.logic_and((t407 >= -1.9198621771937625), (t407 <= 2.9670597283903604))
-    t490 = (t413 <= 1.7453292519943295)
-    t491 = casadi.logic_and((t412 >= -1.7453292519943295), (t412 <= 1.7453292519943295))
-    t492 = (t417 <= 4.642575810304916)
-    t493 = casadi.logic_and((t416 >= -4.642575810304916), (t416 <= 4.642575810304916))
-    t494 = (t410 <= 2.9670597283903604)
-    t495 = casadi.logic_and((t409 >= -1.9198621771937625), (t409 <= 2.9670597283903604))
-    t496 = -t421
-    t497 = (t496 <= 1.7453292519943295)
-    t498 = casadi.logic_and((t420 >= -1.7453292519943295), (t420 <= 1.7453292519943295))
-    t499 = (t419 <= 4.642575810304916)
-    t500 = casadi.logic_and((t418 >= -4.642575810304916), (t418 <= 4.642575810304916))
-    t501 = (t335 <= 3.9269908169872414)
-    t502 = casadi.logic_and((t334 >= -0.7853981633974483), (t334 <= 3.9269908169872414))
-    t503 = casadi.if_else(casadi.logic_and(t501, casadi.logic_not(t502)), t335, t334)
-    t504 = (t236 <= 0.7853981633974483)
-    t505 = casadi.logic_and((t235 >= -3.9269908169872414), (t235 <= 0.7853981633974483))
-    t506 = casadi.if_else(casadi.logic_and(t504, casadi.logic_not(t505)), t236, t235)
-    t507 = (t424 <= 2.9670597283903604)
-    t508 = casadi.logic_and((t423 >= -1.9198621771937625), (t423 <= 2.9670597283903604))
-    t509 = (t429 <= 1.7453292519943295)
-    t510 = casadi.logic_and((t428 >= -1.7453292519943295), (t428 <= 1.7453292519943295))
-    t511 = (t433 <= 4.642575810304916)
-    t512 = casadi.logic_and((t432 >= -4.642575810304916), (t432 <= 4.642575810304916))
-    t513 = (t426 <= 2.9670597283903604)
-    t514 = casadi.logic_and((t425 >= -1.9198621771937625), (t425 <= 2.9670597283903604))
-    t515 = -t437
-    t516 = (t515 <= 1.7453292519943295)
-    t517 = casadi.logic_and((t436 >= -1.7453292519943295), (t436 <= 1.7453292519943295))
-    t518 = (t435 <= 4.642575810304916)
-    t519 = casadi.logic_and((t434 >= -4.642575810304916), (t434 <= 4.642575810304916))
-    t520 = (casadi.fabs(t0) < casadi.inf)
-    t521 = (t15 > t17)
-    t522 = casadi.logic_or(casadi.logic_and(t18, (0.0225150025 <= 1e-12*t16)), casadi.logic_and(t521, (t20 >= -1e-12)))
-    t523 = (t65 >= -1e-12)
-    t524 = (t225 >= -1e-12)
-    t525 = casadi.logic_or(t438, t439)
-    t526 = casadi.logic_or(t441, t442)
-    t527 = casadi.logic_or(t444, t445)
-    t528 = casadi.logic_or(t460, t461)
-    t529 = casadi.logic_or(t463, t464)
-    t530 = casadi.logic_or(t479, t480)
-    t531 = casadi.logic_or(t482, t483)
-    t532 = casadi.logic_or(t485, t486)
-    t533 = casadi.logic_or(t501, t502)
-    t534 = casadi.logic_or(t504, t505)
+    t429 = t428 - 6.283185307179586*casadi.floor(0.15915494309189535*(4.642575810304916 + t428))
+    t430 = 3.141592653589793 - 6.283185307179586*casadi.ceil(0.15915494309189535*t427) + t427
+    t431 = t430 - 6.283185307179586*casadi.floor(0.15915494309189535*(4.642575810304916 + t430))
+    t432 = -t426
+    t433 = t426 + 6.283185307179586*casadi.floor(0.15915494309189535*(1.7453292519943295 + t432))
+    t434 = (t29 <= 2.792526803190927)
+    t435 = casadi.logic_and((t28 >= -2.792526803190927), (t28 <= 2.792526803190927))
+    t436 = casadi.if_else(casadi.logic_and(t434, casadi.logic_not(t435)), t29, t28)
+    t437 = (t119 <= 3.9269908169872414)
+    t438 = casadi.logic_and((t118 >= -0.7853981633974483), (t118 <= 3.9269908169872414))
+    t439 = casadi.if_else(casadi.logic_and(t437, casadi.logic_not(t438)), t119, t118)
+    t440 = (t76 <= 0.7853981633974483)
+    t441 = casadi.logic_and((t75 >= -3.9269908169872414), (t75 <= 0.7853981633974483))
+    t442 = casadi.if_else(casadi.logic_and(t440, casadi.logic_not(t441)), t76, t75)
+    t443 = (t372 <= 2.9670597283903604)
+    t444 = casadi.logic_and((t371 >= -1.9198621771937625), (t371 <= 2.9670597283903604))
+    t445 = (t377 <= 1.7453292519943295)
+    t446 = casadi.logic_and((t376 >= -1.7453292519943295), (t376 <= 1.7453292519943295))
+    t447 = (t381 <= 4.642575810304916)
+    t448 = casadi.logic_and((t380 >= -4.642575810304916), (t380 <= 4.642575810304916))
+    t449 = (t374 <= 2.9670597283903604)
+    t450 = casadi.logic_and((t373 >= -1.9198621771937625), (t373 <= 2.9670597283903604))
+    t451 = -t385
+    t452 = (t451 <= 1.7453292519943295)
+    t453 = casadi.logic_and((t384 >= -1.7453292519943295), (t384 <= 1.7453292519943295))
+    t454 = (t383 <= 4.642575810304916)
+    t455 = casadi.logic_and((t382 >= -4.642575810304916), (t382 <= 4.642575810304916))
+    t456 = (t173 <= 3.9269908169872414)
+    t457 = casadi.logic_and((t172 >= -0.7853981633974483), (t172 <= 3.9269908169872414))
+    t458 = casadi.if_else(casadi.logic_and(t456, casadi.logic_not(t457)), t173, t172)
+    t459 = (t73 <= 0.7853981633974483)
+    t460 = casadi.logic_and((t72 >= -3.9269908169872414), (t72 <= 0.7853981633974483))
+    t461 = casadi.if_else(casadi.logic_and(t459, casadi.logic_not(t460)), t73, t72)
+    t462 = (t388 <= 2.9670597283903604)
+    t463 = casadi.logic_and((t387 >= -1.9198621771937625), (t387 <= 2.9670597283903604))
+    t464 = (t393 <= 1.7453292519943295)
+    t465 = casadi.logic_and((t392 >= -1.7453292519943295), (t392 <= 1.7453292519943295))
+    t466 = (t397 <= 4.642575810304916)
+    t467 = casadi.logic_and((t396 >= -4.642575810304916), (t396 <= 4.642575810304916))
+    t468 = (t390 <= 2.9670597283903604)
+    t469 = casadi.logic_and((t389 >= -1.9198621771937625), (t389 <= 2.9670597283903604))
+    t470 = -t401
+    t471 = (t470 <= 1.7453292519943295)
+    t472 = casadi.logic_and((t400 >= -1.7453292519943295), (t400 <= 1.7453292519943295))
+    t473 = (t399 <= 4.642575810304916)
+    t474 = casadi.logic_and((t398 >= -4.642575810304916), (t398 <= 4.642575810304916))
+    t475 = (t31 <= 2.792526803190927)
+    t476 = casadi.logic_and((t30 >= -2.792526803190927), (t30 <= 2.792526803190927))
+    t477 = casadi.if_else(casadi.logic_and(t475, casadi.logic_not(t476)), t31, t30)
+    t478 = (t277 <= 3.9269908169872414)
+    t479 = casadi.logic_and((t276 >= -0.7853981633974483), (t276 <= 3.9269908169872414))
+    t480 = casadi.if_else(casadi.logic_and(t478, casadi.logic_not(t479)), t277, t276)
+    t481 = (t232 <= 0.7853981633974483)
+    t482 = casadi.logic_and((t231 >= -3.9269908169872414), (t231 <= 0.7853981633974483))
+    t483 = casadi.if_else(casadi.logic_and(t481, casadi.logic_not(t482)), t232, t231)
+    t484 = (t404 <= 2.9670597283903604)
+    t485 = casadi.logic_and((t403 >= -1.9198621771937625), (t403 <= 2.9670597283903604))
+    t486 = (t409 <= 1.7453292519943295)
+    t487 = casadi.logic_and((t408 >= -1.7453292519943295), (t408 <= 1.7453292519943295))
+    t488 = (t413 <= 4.642575810304916)
+    t489 = casadi.logic_and((t412 >= -4.642575810304916), (t412 <= 4.642575810304916))
+    t490 = (t406 <= 2.9670597283903604)
+    t491 = casadi.logic_and((t405 >= -1.9198621771937625), (t405 <= 2.9670597283903604))
+    t492 = -t417
+    t493 = (t492 <= 1.7453292519943295)
+    t494 = casadi.logic_and((t416 >= -1.7453292519943295), (t416 <= 1.7453292519943295))
+    t495 = (t415 <= 4.642575810304916)
+    t496 = casadi.logic_and((t414 >= -4.642575810304916), (t414 <= 4.642575810304916))
+    t497 = (t331 <= 3.9269908169872414)
+    t498 = casadi.logic_and((t330 >= -0.7853981633974483), (t330 <= 3.9269908169872414))
+    t499 = casadi.if_else(casadi.logic_and(t497, casadi.logic_not(t498)), t331, t330)
+    t500 = (t234 <= 0.7853981633974483)
+    t501 = casadi.logic_and((t233 >= -3.9269908169872414), (t233 <= 0.7853981633974483))
+    t502 = casadi.if_else(casadi.logic_and(t500, casadi.logic_not(t501)), t234, t233)
+    t503 = (t420 <= 2.9670597283903604)
+    t504 = casadi.logic_and((t419 >= -1.9198621771937625), (t419 <= 2.9670597283903604))
+    t505 = (t425 <= 1.7453292519943295)
+    t506 = casadi.logic_and((t424 >= -1.7453292519943295), (t424 <= 1.7453292519943295))
+    t507 = (t429 <= 4.642575810304916)
+    t508 = casadi.logic_and((t428 >= -4.642575810304916), (t428 <= 4.642575810304916))
+    t509 = (t422 <= 2.9670597283903604)
+    t510 = casadi.logic_and((t421 >= -1.9198621771937625), (t421 <= 2.9670597283903604))
+    t511 = -t433
+    t512 = (t511 <= 1.7453292519943295)
+    t513 = casadi.logic_and((t432 >= -1.7453292519943295), (t432 <= 1.7453292519943295))
+    t514 = (t431 <= 4.642575810304916)
+    t515 = casadi.logic_and((t430 >= -4.642575810304916), (t430 <= 4.642575810304916))
+    t516 = (casadi.fabs(t0) < casadi.inf)
+    t517 = (t15 > t17)
+    t518 = casadi.logic_or(casadi.logic_and((t20 >= -1e-12), t517), casadi.logic_and((0.0225150025 <= 1e-12*t16), t18))
+    t519 = (t65 >= -1e-12)
+    t520 = (t223 >= -1e-12)
+    t521 = casadi.logic_or(t434, t435)
+    t522 = casadi.logic_or(t437, t438)
+    t523 = casadi.logic_or(t440, t441)
+    t524 = casadi.logic_or(t456, t457)
+    t525 = casadi.logic_or(t459, t460)
+    t526 = casadi.logic_or(t475, t476)
+    t527 = casadi.logic_or(t478, t479)
+    t528 = casadi.logic_or(t481, t482)
+    t529 = casadi.logic_or(t497, t498)
+    t530 = casadi.logic_or(t500, t501)
     q = casadi.SX(8, 6)
-    q[0, 0] = t440
-    q[0, 1] = t443
-    q[0, 2] = t446
-    q[0, 3] = casadi.if_else(casadi.logic_and(t447, casadi.logic_not(t448)), t376, t375)
-    q[0, 4] = casadi.if_else(casadi.logic_and(t449, casadi.logic_not(t450)), t381, t380)
-    q[0, 5] = casadi.if_else(casadi.logic_and(t451, casadi.logic_not(t452)), t385, t384)
-    q[1, 0] = t440
-    q[1, 1] = t443
-    q[1, 2] = t446
-    q[1, 3] = casadi.if_else(casadi.logic_and(t453, casadi.logic_not(t454)), t378, t377)
-    q[1, 4] = casadi.if_else(casadi.logic_and(t456, casadi.logic_not(t457)), t455, t388)
-    q[1, 5] = casadi.if_else(casadi.logic_and(t458, casadi.logic_not(t459)), t387, t386)
-    q[2, 0] = t440
-    q[2, 1] = t462
-    q[2, 2] = t465
-    q[2, 3] = casadi.if_else(casadi.logic_and(t466, casadi.logic_not(t467)), t392, t391)
-    q[2, 4] = casadi.if_else(casadi.logic_and(t468, casadi.logic_not(t469)), t397, t396)
-    q[2, 5] = casadi.if_else(casadi.logic_and(t470, casadi.logic_not(t471)), t401, t400)
-    q[3, 0] = t440
-    q[3, 1] = t462
-    q[3, 2] = t465
-    q[3, 3] = casadi.if_else(casadi.logic_and(t472, casadi.logic_not(t473)), t394, t393)
-    q[3, 4] = casadi.if_else(casadi.logic_and(t475, casadi.logic_not(t476)), t474, t404)
-    q[3, 5] = casadi.if_else(casadi.logic_and(t477, casadi.logic_not(t478)), t403, t402)
-    q[4, 0] = t481
-    q[4, 1] = t484
-    q[4, 2] = t487
-    q[4, 3] = casadi.if_else(casadi.logic_and(t488, casadi.logic_not(t489)), t408, t407)
-    q[4, 4] = casadi.if_else(casadi.logic_and(t490, casadi.logic_not(t491)), t413, t412)
-    q[4, 5] = casadi.if_else(casadi.logic_and(t492, casadi.logic_not(t493)), t417, t416)
-    q[5, 0] = t481
-    q[5, 1] = t484
-    q[5, 2] = t487
-    q[5, 3] = casadi.if_else(casadi.logic_and(t494, casadi.logic_not(t495)), t410, t409)
-    q[5, 4] = casadi.if_else(casadi.logic_and(t497, casadi.logic_not(t498)), t496, t420)
-    q[5, 5] = casadi.if_else(casadi.logic_and(t499, casadi.logic_not(t500)), t419, t418)
-    q[6, 0] = t481
-    q[6, 1] = t503
-    q[6, 2] = t506
-    q[6, 3] = casadi.if_else(casadi.logic_and(t507, casadi.logic_not(t508)), t424, t423)
-    q[6, 4] = casadi.if_else(casadi.logic_and(t509, casadi.logic_not(t510)), t429, t428)
-    q[6, 5] = casadi.if_else(casadi.logic_and(t511, casadi.logic_not(t512)), t433, t432)
-    q[7, 0] = t481
-    q[7, 1] = t503
-    q[7, 2] = t506
-    q[7, 3] = casadi.if_else(casadi.logic_and(t513, casadi.logic_not(t514)), t426, t425)
-    q[7, 4] = casadi.if_else(casadi.logic_and(t516, casadi.logic_not(t517)), t515, t436)
-    q[7, 5] = casadi.if_else(casadi.logic_and(t518, casadi.logic_not(t519)), t435, t434)
+    q[0, 0] = t436
+    q[0, 1] = t439
+    q[0, 2] = t442
+    q[0, 3] = casadi.if_else(casadi.logic_and(t443, casadi.logic_not(t444)), t372, t371)
+    q[0, 4] = casadi.if_else(casadi.logic_and(t445, casadi.logic_not(t446)), t377, t376)
+    q[0, 5] = casadi.if_else(casadi.logic_and(t447, casadi.logic_not(t448)), t381, t380)
+    q[1, 0] = t436
+    q[1, 1] = t439
+    q[1, 2] = t442
+    q[1, 3] = casadi.if_else(casadi.logic_and(t449, casadi.logic_not(t450)), t374, t373)
+    q[1, 4] = casadi.if_else(casadi.logic_and(t452, casadi.logic_not(t453)), t451, t384)
+    q[1, 5] = casadi.if_else(casadi.logic_and(t454, casadi.logic_not(t455)), t383, t382)
+    q[2, 0] = t436
+    q[2, 1] = t458
+    q[2, 2] = t461
+    q[2, 3] = casadi.if_else(casadi.logic_and(t462, casadi.logic_not(t463)), t388, t387)
+    q[2, 4] = casadi.if_else(casadi.logic_and(t464, casadi.logic_not(t465)), t393, t392)
+    q[2, 5] = casadi.if_else(casadi.logic_and(t466, casadi.logic_not(t467)), t397, t396)
+    q[3, 0] = t436
+    q[3, 1] = t458
+    q[3, 2] = t461
+    q[3, 3] = casadi.if_else(casadi.logic_and(t468, casadi.logic_not(t469)), t390, t389)
+    q[3, 4] = casadi.if_else(casadi.logic_and(t471, casadi.logic_not(t472)), t470, t400)
+    q[3, 5] = casadi.if_else(casadi.logic_and(t473, casadi.logic_not(t474)), t399, t398)
+    q[4, 0] = t477
+    q[4, 1] = t480
+    q[4, 2] = t483
+    q[4, 3] = casadi.if_else(casadi.logic_and(t484, casadi.logic_not(t485)), t404, t403)
+    q[4, 4] = casadi.if_else(casadi.logic_and(t486, casadi.logic_not(t487)), t409, t408)
+    q[4, 5] = casadi.if_else(casadi.logic_and(t488, casadi.logic_not(t489)), t413, t412)
+    q[5, 0] = t477
+    q[5, 1] = t480
+    q[5, 2] = t483
+    q[5, 3] = casadi.if_else(casadi.logic_and(t490, casadi.logic_not(t491)), t406, t405)
+    q[5, 4] = casadi.if_else(casadi.logic_and(t493, casadi.logic_not(t494)), t492, t416)
+    q[5, 5] = casadi.if_else(casadi.logic_and(t495, casadi.logic_not(t496)), t415, t414)
+    q[6, 0] = t477
+    q[6, 1] = t499
+    q[6, 2] = t502
+    q[6, 3] = casadi.if_else(casadi.logic_and(t503, casadi.logic_not(t504)), t420, t419)
+    q[6, 4] = casadi.if_else(casadi.logic_and(t505, casadi.logic_not(t506)), t425, t424)
+    q[6, 5] = casadi.if_else(casadi.logic_and(t507, casadi.logic_not(t508)), t429, t428)
+    q[7, 0] = t477
+    q[7, 1] = t499
+    q[7, 2] = t502
+    q[7, 3] = casadi.if_else(casadi.logic_and(t509, casadi.logic_not(t510)), t422, t421)
+    q[7, 4] = casadi.if_else(casadi.logic_and(t512, casadi.logic_not(t513)), t511, t432)
+    q[7, 5] = casadi.if_else(casadi.logic_and(t514, casadi.logic_not(t515)), t431, t430)
     valid = casadi.SX(8, 1)
-    valid[0, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t520, t522), t523), (t129 >= -1e-12))
-    valid[1, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t520, t522), t523), t130)
-    valid[2, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t520, t66), t522), (t183 >= -1e-12))
-    valid[3, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t520, t66), t522), t184)
-    valid[4, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t520, t521), t524), t21), (t289 >= -1e-12))
-    valid[5, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t520, t521), t524), t21), t290)
-    valid[6, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t520, t521), t226), t21), (t343 >= -1e-12))
-    valid[7, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t520, t521), t226), t21), t344)
+    valid[0, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t516, (t127 >= -1e-12)), t518), t519)
+    valid[1, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t516, t128), t518), t519)
+    valid[2, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t516, t66), (t181 >= -1e-12)), t518)
+    valid[3, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t516, t66), t182), t518)
+    valid[4, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t516, t21), (t285 >= -1e-12)), t517), t520)
+    valid[5, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t516, t21), t286), t517), t520)
+    valid[6, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t516, t21), t224), (t339 >= -1e-12)), t517)
+    valid[7, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t516, t21), t224), t340), t517)
     in_limits = casadi.SX(8, 1)
-    in_limits[0, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t525, t526), t527), casadi.logic_or(t447, t448)), casadi.logic_or(t449, t450)), casadi.logic_or(t451, t452))
-    in_limits[1, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t525, t526), t527), casadi.logic_or(t453, t454)), casadi.logic_or(t456, t457)), casadi.logic_or(t458, t459))
-    in_limits[2, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t525, t528), t529), casadi.logic_or(t466, t467)), casadi.logic_or(t468, t469)), casadi.logic_or(t470, t471))
-    in_limits[3, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t525, t528), t529), casadi.logic_or(t472, t473)), casadi.logic_or(t475, t476)), casadi.logic_or(t477, t478))
-    in_limits[4, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t530, t531), t532), casadi.logic_or(t488, t489)), casadi.logic_or(t490, t491)), casadi.logic_or(t492, t493))
-    in_limits[5, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t530, t531), t532), casadi.logic_or(t494, t495)), casadi.logic_or(t497, t498)), casadi.logic_or(t499, t500))
-    in_limits[6, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t530, t533), t534), casadi.logic_or(t507, t508)), casadi.logic_or(t509, t510)), casadi.logic_or(t511, t512))
-    in_limits[7, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t530, t533), t534), casadi.logic_or(t513, t514)), casadi.logic_or(t516, t517)), casadi.logic_or(t518, t519))
+    in_limits[0, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t521, t522), t523), casadi.logic_or(t443, t444)), casadi.logic_or(t445, t446)), casadi.logic_or(t447, t448))
+    in_limits[1, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t521, t522), t523), casadi.logic_or(t449, t450)), casadi.logic_or(t454, t455)), casadi.logic_or(t452, t453))
+    in_limits[2, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t521, t524), t525), casadi.logic_or(t462, t463)), casadi.logic_or(t464, t465)), casadi.logic_or(t466, t467))
+    in_limits[3, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t521, t524), t525), casadi.logic_or(t468, t469)), casadi.logic_or(t473, t474)), casadi.logic_or(t471, t472))
+    in_limits[4, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t526, t527), t528), casadi.logic_or(t484, t485)), casadi.logic_or(t486, t487)), casadi.logic_or(t488, t489))
+    in_limits[5, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t526, t527), t528), casadi.logic_or(t490, t491)), casadi.logic_or(t495, t496)), casadi.logic_or(t493, t494))
+    in_limits[6, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t526, t529), t530), casadi.logic_or(t503, t504)), casadi.logic_or(t505, t506)), casadi.logic_or(t507, t508))
+    in_limits[7, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t526, t529), t530), casadi.logic_or(t509, t510)), casadi.logic_or(t514, t515)), casadi.logic_or(t512, t513))
     return [q, valid, in_limits]
 
 

@@ -57,15 +57,15 @@ void rexarm_task(const rexarm_real q[REXARM_DOF], rexarm_real mu[REXARM_TASK_DIM
 void rexarm_task_jacobian(const rexarm_real q[REXARM_DOF], rexarm_real J[REXARM_TASK_DIM * REXARM_DOF]);
 
 /* Fk, jacobian and bias_acceleration in one pass, sharing their terms.
- * Result: T: 4 x 4 row-major, element (r, c) at T[r * 4 + c]; J: 6 x 4 row-major, element (r, c) at J[r * 4 + c]; a[i], i < 6. 181 operations. */
+ * Result: T: 4 x 4 row-major, element (r, c) at T[r * 4 + c]; J: 6 x 4 row-major, element (r, c) at J[r * 4 + c]; a[i], i < 6. 180 operations. */
 void rexarm_fk_jacobian_dot(const rexarm_real q[REXARM_DOF], const rexarm_real q_dot[REXARM_DOF], rexarm_real T[16], rexarm_real J[6 * REXARM_DOF], rexarm_real a[6]);
 
 /* Time derivative dJ/dt of the world geometric Jacobian along q_dot (6 x DOF).
- * Result: Jd: 6 x 4 row-major, element (r, c) at Jd[r * 4 + c]. 126 operations. */
+ * Result: Jd: 6 x 4 row-major, element (r, c) at Jd[r * 4 + c]. 125 operations. */
 void rexarm_jacobian_dot(const rexarm_real q[REXARM_DOF], const rexarm_real q_dot[REXARM_DOF], rexarm_real Jd[6 * REXARM_DOF]);
 
 /* J' q_dot: the tool's classical linear and angular acceleration at zero joint acceleration, world frame (6).
- * Result: a[i], i < 6. 162 operations. */
+ * Result: a[i], i < 6. 161 operations. */
 void rexarm_bias_acceleration(const rexarm_real q[REXARM_DOF], const rexarm_real q_dot[REXARM_DOF], rexarm_real a[6]);
 
 /* Time derivative of the analytic Jacobian along q_dot (4 x DOF): mu'' = J_a q'' + J_a' q'.
@@ -77,15 +77,15 @@ void rexarm_task_jacobian_dot(const rexarm_real q[REXARM_DOF], const rexarm_real
 void rexarm_hessian(const rexarm_real q[REXARM_DOF], rexarm_real H[REXARM_DOF * 6 * REXARM_DOF]);
 
 /* Factors of det(Js): the robot is singular where one is 0.
- * Result: f[i], i < 2. 20 operations. */
+ * Result: f[i], i < 2. 19 operations. */
 void rexarm_singularity_factors(const rexarm_real q[REXARM_DOF], rexarm_real f[REXARM_NUM_SINGULARITY_FACTORS]);
 
 /* Manipulability |det(Js)|.
- * Result: returned as a scalar. 46 operations. */
+ * Result: returned as a scalar. 45 operations. */
 rexarm_real rexarm_manipulability(const rexarm_real q[REXARM_DOF]);
 
 /* Det(Js).
- * Result: returned as a scalar. 45 operations. */
+ * Result: returned as a scalar. 44 operations. */
 rexarm_real rexarm_jacobian_det(const rexarm_real q[REXARM_DOF]);
 
 /* Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status.
@@ -97,7 +97,7 @@ int rexarm_velocity_ik(const rexarm_real q[REXARM_DOF], const rexarm_real mu_dot
 rexarm_real rexarm_ik_numeric_step(const rexarm_real target[REXARM_TASK_DIM], const rexarm_real q[REXARM_DOF], rexarm_real damping, rexarm_real q_start[REXARM_DOF], rexarm_real q_next[REXARM_DOF]);
 
 /* Every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits.
- * Result: q: 8 x 4 row-major, element (r, c) at q[r * 4 + c]; valid[i], i < 8; in_limits[i], i < 8. 848 operations. */
+ * Result: q: 8 x 4 row-major, element (r, c) at q[r * 4 + c]; valid[i], i < 8; in_limits[i], i < 8. 840 operations. */
 void rexarm_ik_branches(const rexarm_real mu[REXARM_TASK_DIM], rexarm_real q[REXARM_MAX_IK_SOLUTIONS * REXARM_DOF], int valid[REXARM_MAX_IK_SOLUTIONS], int in_limits[REXARM_MAX_IK_SOLUTIONS]);
 
 /* The closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status.

@@ -95,12 +95,12 @@ def fk(q):
     t2 = 0.12 + t1
     t3 = 0.1*c23
     t4 = c1*c234
-    t5 = t3*c1 + 0.1*t4
+    t5 = c1*t3 + 0.1*t4
     t6 = c234*s1
-    t7 = t3*s1 + 0.1*t6
+    t7 = s1*t3 + 0.1*t6
     t8 = 0.1*c2
-    t9 = t5 + t8*c1
-    t10 = t7 + t8*s1
+    t9 = t5 + c1*t8
+    t10 = t7 + s1*t8
     T = _stack(xp, [
         t4,  # 0, 0
         -s1,  # 0, 1
@@ -140,11 +140,11 @@ def jacobian(q):
     c234 = c23*c4 - s23*s4
     s234 = c23*s4 + c4*s23
     t0 = 0.1*c1
-    t1 = t0*c23 + t0*c234
-    t2 = t1 + t0*c2
+    t1 = c23*t0 + c234*t0
+    t2 = t1 + c2*t0
     t3 = 0.1*s1
-    t4 = t3*c23 + t3*c234
-    t5 = t4 + t3*c2
+    t4 = c23*t3 + c234*t3
+    t5 = t4 + c2*t3
     t6 = 0.1*s234
     t7 = 0.1*s23 + t6
     t8 = t7 + 0.1*s2
@@ -154,15 +154,15 @@ def jacobian(q):
         -t5,  # 0, 0
         -t8*c1,  # 0, 1
         -t7*c1,  # 0, 2
-        -t6*c1,  # 0, 3
+        -c1*t6,  # 0, 3
         t2,  # 1, 0
         -t8*s1,  # 1, 1
         -t7*s1,  # 1, 2
-        -t6*s1,  # 1, 3
+        -s1*t6,  # 1, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
         t2*c1 + t5*s1,  # 2, 1
         t1*c1 + t4*s1,  # 2, 2
-        t9*c1**2 + t9*s1**2,  # 2, 3
+        c1**2*t9 + s1**2*t9,  # 2, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
         s1,  # 3, 1
         s1,  # 3, 2
@@ -198,16 +198,16 @@ def fk_jacobian(q):
     s234 = c23*s4 + c4*s23
     t0 = 0.1*c23
     t1 = c1*c234
-    t2 = t0*c1 + 0.1*t1
+    t2 = c1*t0 + 0.1*t1
     t3 = c234*s1
-    t4 = t0*s1 + 0.1*t3
+    t4 = s1*t0 + 0.1*t3
     t5 = 0.1*s234
     t6 = 0.1*s23 + t5
     t7 = t6 + 0.1*s2
     t8 = 0.12 + t7
     t9 = 0.1*c2
-    t10 = t2 + t9*c1
-    t11 = t4 + t9*s1
+    t10 = t2 + c1*t9
+    t11 = t4 + s1*t9
     t12 = 0.1*c234
     t13 = -c1
     T = _stack(xp, [
@@ -232,15 +232,15 @@ def fk_jacobian(q):
         -t11,  # 0, 0
         -t7*c1,  # 0, 1
         -t6*c1,  # 0, 2
-        -t5*c1,  # 0, 3
+        -c1*t5,  # 0, 3
         t10,  # 1, 0
         -t7*s1,  # 1, 1
         -t6*s1,  # 1, 2
-        -t5*s1,  # 1, 3
+        -s1*t5,  # 1, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
         t10*c1 + t11*s1,  # 2, 1
         t2*c1 + t4*s1,  # 2, 2
-        t12*c1**2 + t12*s1**2,  # 2, 3
+        c1**2*t12 + s1**2*t12,  # 2, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
         s1,  # 3, 1
         s1,  # 3, 2
@@ -275,42 +275,42 @@ def jacobian_tool(q):
     c234 = c23*c4 - s23*s4
     s234 = c23*s4 + c4*s23
     t0 = 0.1*c1
-    t1 = t0*c23 + t0*c234
-    t2 = t1 + t0*c2
+    t1 = c23*t0 + c234*t0
+    t2 = t1 + c2*t0
     t3 = 0.1*s1
-    t4 = t3*c23 + t3*c234
-    t5 = t4 + t3*c2
+    t4 = c23*t3 + c234*t3
+    t5 = t4 + c2*t3
     t6 = 0.1*s234
     t7 = 0.1*s23 + t6
     t8 = t7 + 0.1*s2
     t9 = t2*s1
-    t10 = t5*c1
+    t10 = c1*t5
     t11 = t2*c1 + t5*s1
     t12 = c1**2
-    t13 = t8*c234
+    t13 = c234*t8
     t14 = s1**2
     t15 = t1*c1 + t4*s1
-    t16 = t7*c234
+    t16 = c234*t7
     t17 = 0.1*c234
-    t18 = t17*t12 + t17*t14
-    t19 = t6*c234
-    t20 = t8*s234
-    t21 = t7*s234
+    t18 = t12*t17 + t14*t17
+    t19 = c234*t6
+    t20 = s234*t8
+    t21 = s234*t7
     t22 = 0.1*s234**2
     t23 = -(t12 + t14)
     J = _stack(xp, [
-        t9*c234 - t10*c234,  # 0, 0
-        -(-s234*t11 + t12*t13 + t13*t14),  # 0, 1
-        -(-s234*t15 + t16*t12 + t16*t14),  # 0, 2
-        -(-s234*t18 + t19*t12 + t19*t14),  # 0, 3
+        c234*t9 - c234*t10,  # 0, 0
+        -(-s234*t11 + t12*t13 + t14*t13),  # 0, 1
+        -(-s234*t15 + t12*t16 + t14*t16),  # 0, 2
+        -(-s234*t18 + t12*t19 + t14*t19),  # 0, 3
         t11,  # 1, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 3
-        t10*s234 - t9*s234,  # 2, 0
-        c234*t11 + t20*t12 + t20*t14,  # 2, 1
-        c234*t15 + t21*t12 + t21*t14,  # 2, 2
-        c234*t18 + t22*t12 + t22*t14,  # 2, 3
+        s234*t10 - s234*t9,  # 2, 0
+        c234*t11 + t12*t20 + t14*t20,  # 2, 1
+        c234*t15 + t12*t21 + t14*t21,  # 2, 2
+        c234*t18 + t12*t22 + t14*t22,  # 2, 3
         s234,  # 3, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 2
@@ -348,11 +348,11 @@ def task(q):
     t1 = t0 + 0.1*s2
     t2 = 0.12 + t1
     t3 = 0.1*c1
-    t4 = t3*c23 + t3*c234
-    t5 = t4 + t3*c2
+    t4 = c23*t3 + c234*t3
+    t5 = t4 + c2*t3
     t6 = 0.1*s1
-    t7 = t6*c23 + t6*c234
-    t8 = t7 + t6*c2
+    t7 = c23*t6 + c234*t6
+    t8 = t7 + c2*t6
     t9 = c234**2
     mu = _stack(xp, [
         t5,  # 0
@@ -381,11 +381,11 @@ def task_jacobian(q):
     c234 = c23*c4 - s23*s4
     s234 = c23*s4 + c4*s23
     t0 = 0.1*c1
-    t1 = t0*c23 + t0*c234
-    t2 = t1 + t0*c2
+    t1 = c23*t0 + c234*t0
+    t2 = t1 + c2*t0
     t3 = 0.1*s1
-    t4 = t3*c23 + t3*c234
-    t5 = t4 + t3*c2
+    t4 = c23*t3 + c234*t3
+    t5 = t4 + c2*t3
     t6 = 0.1*s234
     t7 = 0.1*s23 + t6
     t8 = t7 + 0.1*s2
@@ -399,11 +399,11 @@ def task_jacobian(q):
         -t5,  # 0, 0
         -t8*c1,  # 0, 1
         -t7*c1,  # 0, 2
-        -t6*c1,  # 0, 3
+        -c1*t6,  # 0, 3
         t2,  # 1, 0
         -t8*s1,  # 1, 1
         -t7*s1,  # 1, 2
-        -t6*s1,  # 1, 3
+        -s1*t6,  # 1, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
         t2*c1 + t5*s1,  # 2, 1
         t1*c1 + t4*s1,  # 2, 2
@@ -417,7 +417,7 @@ def task_jacobian(q):
 
 
 def fk_jacobian_dot(q, q_dot):
-    """fk, jacobian and bias_acceleration in one pass, sharing their terms: (4 x 4 and 6 x 4 and 6 x 1), 181 operations."""
+    """fk, jacobian and bias_acceleration in one pass, sharing their terms: (4 x 4 and 6 x 4 and 6 x 1), 180 operations."""
     xp, dtype, device, batch, (q, q_dot,) = _arguments(("q", q, (4,)), ("q_dot", q_dot, (4,)))
     q2 = q[..., 1]
     qd1 = q_dot[..., 0]
@@ -439,16 +439,16 @@ def fk_jacobian_dot(q, q_dot):
     s234 = c23*s4 + c4*s23
     t0 = 0.1*c23
     t1 = c1*c234
-    t2 = t0*c1 + 0.1*t1
+    t2 = c1*t0 + 0.1*t1
     t3 = c234*s1
-    t4 = t0*s1 + 0.1*t3
+    t4 = s1*t0 + 0.1*t3
     t5 = 0.1*s234
     t6 = 0.1*s23 + t5
     t7 = t6 + 0.1*s2
     t8 = 0.12 + t7
     t9 = 0.1*c2
-    t10 = t2 + t9*c1
-    t11 = t4 + t9*s1
+    t10 = t2 + c1*t9
+    t11 = t4 + s1*t9
     t12 = t10*c1 + t11*s1
     t13 = t12
     t14 = t2*c1 + t4*s1
@@ -456,7 +456,7 @@ def fk_jacobian_dot(q, q_dot):
     t16 = c1**2
     t17 = 0.1*c234
     t18 = s1**2
-    t19 = t16*t17 + t17*t18
+    t19 = t16*t17 + t18*t17
     t20 = t19
     t21 = qd2*s1
     t22 = qd3*s1
@@ -464,12 +464,12 @@ def fk_jacobian_dot(q, q_dot):
     t24 = c1*qd2
     t25 = c1*qd3
     t26 = t24 + t25
-    t27 = t5*c1
-    t28 = t6*t25 + t27*qd4
+    t27 = c1*t5
+    t28 = t6*t25 + qd4*t27
     t29 = t28 + t7*t24
     t30 = t29 + t11*qd1
-    t31 = t5*s1
-    t32 = t6*t22 + t31*qd4
+    t31 = s1*t5
+    t32 = t6*t22 + qd4*t31
     t33 = t32 + t7*t21
     t34 = -t33 + t10*qd1
     t35 = t20*qd4
@@ -478,10 +478,11 @@ def fk_jacobian_dot(q, q_dot):
     t38 = t7*c1
     t39 = t6*c1
     t40 = t7*s1
-    t41 = -c1
-    t42 = t6*qd2
-    t43 = t5*qd4
-    t44 = qd1*qd4
+    t41 = t6*s1
+    t42 = -c1
+    t43 = qd2*t6
+    t44 = qd4*t5
+    t45 = qd4*qd1
     T = _stack(xp, [
         xp.broadcast_to(t1, batch),  # 0, 0
         xp.broadcast_to(-s1, batch),  # 0, 1
@@ -507,7 +508,7 @@ def fk_jacobian_dot(q, q_dot):
         xp.broadcast_to(-t27, batch),  # 0, 3
         xp.broadcast_to(t10, batch),  # 1, 0
         xp.broadcast_to(-t40, batch),  # 1, 1
-        xp.broadcast_to(-t6*s1, batch),  # 1, 2
+        xp.broadcast_to(-t41, batch),  # 1, 2
         xp.broadcast_to(-t31, batch),  # 1, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
         xp.broadcast_to(t12, batch),  # 2, 1
@@ -518,27 +519,27 @@ def fk_jacobian_dot(q, q_dot):
         xp.broadcast_to(s1, batch),  # 3, 2
         xp.broadcast_to(s1, batch),  # 3, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
-        xp.broadcast_to(t41, batch),  # 4, 1
-        xp.broadcast_to(t41, batch),  # 4, 2
-        xp.broadcast_to(t41, batch),  # 4, 3
+        xp.broadcast_to(t42, batch),  # 4, 1
+        xp.broadcast_to(t42, batch),  # 4, 2
+        xp.broadcast_to(t42, batch),  # 4, 3
         xp.full(batch, 1, dtype=dtype, device=device),  # 5, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 3
     ], (6, 4))
     a = _stack(xp, [
-        xp.broadcast_to(qd2*(-t37*c1 + t40*qd1) - qd3*(t36*c1 + t15*t24 - t6*qd1*s1) - qd4*(t20*t26 + t35*c1 - 0.1*qd1*s1*s234) - t34*qd1, batch),  # 0
-        xp.broadcast_to(-qd2*(t37*s1 + t38*qd1) - qd3*(t36*s1 + t39*qd1 + t15*t21) - qd4*(t20*t23 + t35*s1 + t27*qd1) - t30*qd1, batch),  # 1
-        xp.broadcast_to(-qd2*(t29*c1 + t33*s1) - qd3*(t28*c1 + t32*s1 + t42*t16 + t42*t18) - qd4*(t23*t31 + t26*t27 + t43*t16 + t43*t18), batch),  # 2
-        xp.broadcast_to(t24*qd1 + t25*qd1 + t44*c1, batch),  # 3
-        xp.broadcast_to(t21*qd1 + t22*qd1 + t44*s1, batch),  # 4
+        xp.broadcast_to(qd2*(-t37*c1 + qd1*t40) - qd3*(t36*c1 - qd1*t41 + t15*t24) - qd4*(t20*t26 + c1*t35 - 0.1*qd1*s1*s234) - t34*qd1, batch),  # 0
+        xp.broadcast_to(-qd2*(t37*s1 + qd1*t38) - qd3*(t36*s1 + qd1*t39 + t15*t21) - qd4*(t20*t23 + s1*t35 + qd1*t27) - t30*qd1, batch),  # 1
+        xp.broadcast_to(-qd2*(t29*c1 + t33*s1) - qd3*(t28*c1 + t32*s1 + t16*t43 + t18*t43) - qd4*(t23*t31 + t26*t27 + t16*t44 + t18*t44), batch),  # 2
+        xp.broadcast_to(qd1*t24 + qd1*t25 + c1*t45, batch),  # 3
+        xp.broadcast_to(qd1*t21 + qd1*t22 + s1*t45, batch),  # 4
         xp.broadcast_to(qd4*(t26*s1 - t23*c1), batch),  # 5
     ], (6,))
     return T, J, a
 
 
 def jacobian_dot(q, q_dot):
-    """time derivative dJ/dt of the world geometric Jacobian along q_dot (6 x DOF): (6 x 4), 126 operations."""
+    """time derivative dJ/dt of the world geometric Jacobian along q_dot (6 x DOF): (6 x 4), 125 operations."""
     xp, dtype, device, batch, (q, q_dot,) = _arguments(("q", q, (4,)), ("q_dot", q_dot, (4,)))
     q2 = q[..., 1]
     qd1 = q_dot[..., 0]
@@ -559,11 +560,11 @@ def jacobian_dot(q, q_dot):
     c234 = c23*c4 - s23*s4
     s234 = c23*s4 + c4*s23
     t0 = 0.1*c1
-    t1 = t0*c23 + t0*c234
-    t2 = t1 + t0*c2
+    t1 = c23*t0 + c234*t0
+    t2 = t1 + c2*t0
     t3 = 0.1*s1
-    t4 = t3*c23 + t3*c234
-    t5 = t4 + t3*c2
+    t4 = c23*t3 + c234*t3
+    t5 = t4 + c2*t3
     t6 = t2*c1 + t5*s1
     t7 = t1*c1 + t4*s1
     t8 = 0.1*s234
@@ -572,16 +573,16 @@ def jacobian_dot(q, q_dot):
     t11 = c1**2
     t12 = 0.1*c234
     t13 = s1**2
-    t14 = t11*t12 + t12*t13
+    t14 = t11*t12 + t13*t12
     t15 = qd2*s1
     t16 = qd3*s1
     t17 = t15 + t16
     t18 = c1*qd2
     t19 = c1*qd3
     t20 = t18 + t19
-    t21 = t8*qd4
-    t22 = t9*t19 + t21*c1
-    t23 = t9*t16 + t21*s1
+    t21 = qd4*t8
+    t22 = t9*t19 + c1*t21
+    t23 = t9*t16 + s1*t21
     t24 = t22 + t10*t18
     t25 = t23 + t10*t15
     t26 = t24 + t5*qd1
@@ -591,20 +592,20 @@ def jacobian_dot(q, q_dot):
     t30 = t29 + t6*qd2
     t31 = qd1*s1
     t32 = c1*qd1
-    t33 = t9*qd2
+    t33 = qd2*t9
     Jd = _stack(xp, [
         xp.broadcast_to(-t27, batch),  # 0, 0
         xp.broadcast_to(-t30*c1 + t10*t31, batch),  # 0, 1
-        xp.broadcast_to(-(t29*c1 + t7*t18 - t9*qd1*s1), batch),  # 0, 2
-        xp.broadcast_to(-(t14*t20 + t28*c1 - 0.1*qd1*s1*s234), batch),  # 0, 3
+        xp.broadcast_to(-(t29*c1 - t9*t31 + t7*t18), batch),  # 0, 2
+        xp.broadcast_to(-(t14*t20 + c1*t28 - 0.1*qd1*s1*s234), batch),  # 0, 3
         xp.broadcast_to(-t26, batch),  # 1, 0
         xp.broadcast_to(-(t30*s1 + t10*t32), batch),  # 1, 1
         xp.broadcast_to(-(t29*s1 + t9*t32 + t7*t15), batch),  # 1, 2
-        xp.broadcast_to(-(t14*t17 + t28*s1 + t32*t8), batch),  # 1, 3
+        xp.broadcast_to(-(t14*t17 + s1*t28 + t8*t32), batch),  # 1, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
         xp.broadcast_to(-(t24*c1 + t25*s1), batch),  # 2, 1
-        xp.broadcast_to(-(t22*c1 + t23*s1 + t33*t11 + t33*t13), batch),  # 2, 2
-        xp.broadcast_to(-(t17*t8*s1 + t20*t8*c1 + t21*t11 + t21*t13), batch),  # 2, 3
+        xp.broadcast_to(-(t22*c1 + t23*s1 + t11*t33 + t13*t33), batch),  # 2, 2
+        xp.broadcast_to(-(s1*t17*t8 + c1*t20*t8 + t11*t21 + t13*t21), batch),  # 2, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
         xp.broadcast_to(t32, batch),  # 3, 1
         xp.broadcast_to(t32, batch),  # 3, 2
@@ -622,7 +623,7 @@ def jacobian_dot(q, q_dot):
 
 
 def bias_acceleration(q, q_dot):
-    """J' q_dot: the tool's classical linear and angular acceleration at zero joint acceleration, world frame (6): (6 x 1), 162 operations."""
+    """J' q_dot: the tool's classical linear and angular acceleration at zero joint acceleration, world frame (6): (6 x 1), 161 operations."""
     xp, dtype, device, batch, (q, q_dot,) = _arguments(("q", q, (4,)), ("q_dot", q_dot, (4,)))
     q2 = q[..., 1]
     qd1 = q_dot[..., 0]
@@ -643,11 +644,11 @@ def bias_acceleration(q, q_dot):
     c234 = c23*c4 - s23*s4
     s234 = c23*s4 + c4*s23
     t0 = 0.1*c1
-    t1 = t0*c23 + t0*c234
-    t2 = t1 + t0*c2
+    t1 = c23*t0 + c234*t0
+    t2 = t1 + c2*t0
     t3 = 0.1*s1
-    t4 = t3*c23 + t3*c234
-    t5 = t4 + t3*c2
+    t4 = c23*t3 + c234*t3
+    t5 = t4 + c2*t3
     t6 = t2*c1 + t5*s1
     t7 = t1*c1 + t4*s1
     t8 = 0.1*s234
@@ -656,16 +657,16 @@ def bias_acceleration(q, q_dot):
     t11 = c1**2
     t12 = 0.1*c234
     t13 = s1**2
-    t14 = t11*t12 + t12*t13
+    t14 = t11*t12 + t13*t12
     t15 = qd2*s1
     t16 = qd3*s1
     t17 = t15 + t16
     t18 = c1*qd2
     t19 = c1*qd3
     t20 = t18 + t19
-    t21 = t8*qd4
-    t22 = t9*t19 + t21*c1
-    t23 = t9*t16 + t21*s1
+    t21 = qd4*t8
+    t22 = t9*t19 + c1*t21
+    t23 = t9*t16 + s1*t21
     t24 = t22 + t10*t18
     t25 = t23 + t10*t15
     t26 = t24 + t5*qd1
@@ -673,15 +674,15 @@ def bias_acceleration(q, q_dot):
     t28 = t14*qd4
     t29 = t7*qd3 + t28
     t30 = t29 + t6*qd2
-    t31 = qd1*s1
+    t31 = s1*qd1
     t32 = c1*qd1
-    t33 = t9*qd2
+    t33 = qd2*t9
     a = _stack(xp, [
-        xp.broadcast_to(qd2*(-t30*c1 + t10*t31) - qd3*(t29*c1 + t7*t18 - t9*qd1*s1) - qd4*(t14*t20 + t28*c1 - 0.1*qd1*s1*s234) - t27*qd1, batch),  # 0
-        xp.broadcast_to(-qd2*(t30*s1 + t10*t32) - qd3*(t29*s1 + t9*t32 + t7*t15) - qd4*(t14*t17 + t28*s1 + t32*t8) - t26*qd1, batch),  # 1
-        xp.broadcast_to(-qd2*(t24*c1 + t25*s1) - qd3*(t22*c1 + t23*s1 + t33*t11 + t33*t13) - qd4*(t17*t8*s1 + t20*t8*c1 + t21*t11 + t21*t13), batch),  # 2
-        xp.broadcast_to(t18*qd1 + t19*qd1 + t32*qd4, batch),  # 3
-        xp.broadcast_to(t15*qd1 + t16*qd1 + t31*qd4, batch),  # 4
+        xp.broadcast_to(qd2*(-t30*c1 + t10*t31) - qd3*(t29*c1 - t9*t31 + t7*t18) - qd4*(t14*t20 + c1*t28 - 0.1*qd1*s1*s234) - t27*qd1, batch),  # 0
+        xp.broadcast_to(-qd2*(t30*s1 + t10*t32) - qd3*(t29*s1 + t9*t32 + t7*t15) - qd4*(t14*t17 + s1*t28 + t8*t32) - t26*qd1, batch),  # 1
+        xp.broadcast_to(-qd2*(t24*c1 + t25*s1) - qd3*(t22*c1 + t23*s1 + t11*t33 + t13*t33) - qd4*(s1*t17*t8 + c1*t20*t8 + t11*t21 + t13*t21), batch),  # 2
+        xp.broadcast_to(qd1*t18 + qd1*t19 + qd4*t32, batch),  # 3
+        xp.broadcast_to(qd1*t15 + qd1*t16 + qd4*t31, batch),  # 4
         xp.broadcast_to(qd4*(t20*s1 - t17*c1), batch),  # 5
     ], (6,))
     return a
@@ -709,11 +710,11 @@ def task_jacobian_dot(q, q_dot):
     c234 = c23*c4 - s23*s4
     s234 = c23*s4 + c4*s23
     t0 = 0.1*c1
-    t1 = t0*c23 + t0*c234
-    t2 = t1 + t0*c2
+    t1 = c23*t0 + c234*t0
+    t2 = t1 + c2*t0
     t3 = 0.1*s1
-    t4 = t3*c23 + t3*c234
-    t5 = t4 + t3*c2
+    t4 = c23*t3 + c234*t3
+    t5 = t4 + c2*t3
     t6 = t2*c1 + t5*s1
     t7 = t1*c1 + t4*s1
     t8 = 0.1*s234
@@ -733,12 +734,12 @@ def task_jacobian_dot(q, q_dot):
     t22 = t20 + t21
     t23 = t22
     t24 = c1*qd4
-    t25 = t9*t21 + t24*t8
+    t25 = t9*t21 + t8*t24
     t26 = t25 + t10*t20
     t27 = t26 + t5*qd1
-    t28 = t22 + t24
+    t28 = t24 + t22
     t29 = qd4*s1
-    t30 = t9*t17 + t29*t8
+    t30 = t9*t17 + t8*t29
     t31 = t30 + t10*t16
     t32 = -t31 + t2*qd1
     t33 = t26*c1 + t31*s1
@@ -746,25 +747,25 @@ def task_jacobian_dot(q, q_dot):
     t35 = t15*qd4
     t36 = t7*qd3 + t35
     t37 = t36 + t6*qd2
-    t38 = qd1*s1
+    t38 = s1*qd1
     t39 = -t37*c1 + t10*t38
     t40 = t36*c1 + t7*t20 - t9*t38
-    t41 = t15*t23 + t35*c1 - t38*t8
-    t42 = t28*s234 + t38*c234
+    t41 = t15*t23 + c1*t35 - t8*t38
+    t42 = t28*s234 + c234*t38
     t43 = c1*qd1
     t44 = t37*s1 + t10*t43
     t45 = t36*s1 + t9*t43 + t7*t16
-    t46 = t15*t19 + t35*s1 + t43*t8
-    t47 = -t34*s234 + t43*c234
-    t48 = t9*qd2
-    t49 = t25*c1 + t30*s1 + t48*t11 + t48*t13
-    t50 = t8*qd4
-    t51 = t19*t8*s1 + t23*t8*c1 + t50*t11 + t50*t13
+    t46 = t15*t19 + s1*t35 + t8*t43
+    t47 = -t34*s234 + c234*t43
+    t48 = qd2*t9
+    t49 = t25*c1 + t30*s1 + t11*t48 + t13*t48
+    t50 = qd4*t8
+    t51 = s1*t19*t8 + c1*t23*t8 + t11*t50 + t13*t50
     t52 = c234**2
     t53 = t11*t52 + t52*t13
     t54 = 1/xp.sqrt(t53)
     t55 = -c234*(t12 + t14)/t53**1.5
-    t56 = -t47*(s1*t54 + t55*s1) + t42*(c1*t54 + t55*c1)
+    t56 = -t47*(s1*t54 + s1*t55) + t42*(c1*t54 + c1*t55)
     Jd = _stack(xp, [
         xp.broadcast_to(-t32, batch),  # 0, 0
         xp.broadcast_to(t39, batch),  # 0, 1
@@ -804,11 +805,11 @@ def hessian(q):
     c234 = c23*c4 - s23*s4
     s234 = c23*s4 + c4*s23
     t0 = 0.1*c1
-    t1 = t0*c23 + t0*c234
-    t2 = t1 + t0*c2
+    t1 = c23*t0 + c234*t0
+    t2 = t1 + c2*t0
     t3 = 0.1*s1
-    t4 = t3*c23 + t3*c234
-    t5 = t4 + t3*c2
+    t4 = c23*t3 + c234*t3
+    t5 = t4 + c2*t3
     t6 = t2*c1 + t5*s1
     t7 = t1*c1 + t4*s1
     t8 = 0.1*s234
@@ -817,19 +818,19 @@ def hessian(q):
     t11 = c1**2
     t12 = 0.1*c234
     t13 = s1**2
-    t14 = t11*t12 + t12*t13
+    t14 = t11*t12 + t13*t12
     t15 = t10*s1
     t16 = t9*s1
-    t17 = t8*s1
+    t17 = s1*t8
     t18 = -t10*c1
     t19 = -t9*c1
-    t20 = -t8*c1
+    t20 = -c1*t8
     t21 = -t7*c1
     t22 = -t14*c1
     t23 = -t7*s1
     t24 = -t14*s1
     t25 = -(t9*t11 + t9*t13)
-    t26 = -(t8*t11 + t8*t13)
+    t26 = -(t11*t8 + t13*t8)
     H = _stack(xp, [
         -t2,  # 0, 0, 0
         t15,  # 0, 0, 1
@@ -932,7 +933,7 @@ def hessian(q):
 
 
 def singularity_factors(q):
-    """factors of det(Js): the robot is singular where one is 0: (2 x 1), 20 operations."""
+    """factors of det(Js): the robot is singular where one is 0: (2 x 1), 19 operations."""
     xp, dtype, device, batch, (q,) = _arguments(("q", q, (4,)))
     q2 = q[..., 1]
     trig = _cos_sin(xp, q, (0.0, 0.0, 0.0, 0.0), device)
@@ -942,16 +943,17 @@ def singularity_factors(q):
     s3 = trig[..., 5]
     c4 = trig[..., 6]
     s4 = trig[..., 7]
-    t0 = s2*s3
+    t0 = c2*c3
+    t1 = s2*s3
     f = _stack(xp, [
         s3,  # 0
-        -(-c2 + t0 - c2*c3 + c2*s3*s4 + c3*s2*s4 + t0*c4 - c2*c3*c4),  # 1
+        -(-c2 - t0 + t1 - c4*t0 + c2*s3*s4 + c3*s2*s4 + c4*t1),  # 1
     ], (2,))
     return f
 
 
 def manipulability(q):
-    """manipulability |det(Js)|: (1 x 1), 46 operations."""
+    """manipulability |det(Js)|: (1 x 1), 45 operations."""
     xp, dtype, device, batch, (q,) = _arguments(("q", q, (4,)))
     q2 = q[..., 1]
     trig = _cos_sin(xp, q, (0.0, 0.0, 0.0, 0.0), device)
@@ -967,15 +969,16 @@ def manipulability(q):
     s4 = trig[..., 7]
     c234 = c23*c4 - s23*s4
     t0 = c234**2
-    t1 = s2*s3
-    t2 = c2*s3*s4 + c3*s2*s4 + t1*c4 - c2*c3*c4
-    t3 = 0.001*t2*s3*(t1 + t2 - c2 - c2*c3)/xp.sqrt(c1**2*t0 + t0*s1**2)
-    w = xp.broadcast_to(xp.abs(t3), batch)
+    t1 = c2*c3
+    t2 = s2*s3
+    t3 = -c4*t1 + c2*s3*s4 + c3*s2*s4 + c4*t2
+    t4 = 0.001*s3*t3*(-c2 - t1 + t2 + t3)/xp.sqrt(c1**2*t0 + t0*s1**2)
+    w = xp.broadcast_to(xp.abs(t4), batch)
     return w
 
 
 def jacobian_det(q):
-    """det(Js): (1 x 1), 45 operations."""
+    """det(Js): (1 x 1), 44 operations."""
     xp, dtype, device, batch, (q,) = _arguments(("q", q, (4,)))
     q2 = q[..., 1]
     trig = _cos_sin(xp, q, (0.0, 0.0, 0.0, 0.0), device)
@@ -991,9 +994,10 @@ def jacobian_det(q):
     s4 = trig[..., 7]
     c234 = c23*c4 - s23*s4
     t0 = c234**2
-    t1 = s2*s3
-    t2 = c2*s3*s4 + c3*s2*s4 + t1*c4 - c2*c3*c4
-    d = xp.broadcast_to(0.001*t2*s3*(t1 + t2 - c2 - c2*c3)/xp.sqrt(c1**2*t0 + t0*s1**2), batch)
+    t1 = c2*c3
+    t2 = s2*s3
+    t3 = -c4*t1 + c2*s3*s4 + c3*s2*s4 + c4*t2
+    d = xp.broadcast_to(0.001*s3*t3*(-c2 - t1 + t2 + t3)/xp.sqrt(c1**2*t0 + t0*s1**2), batch)
     return d
 
 
@@ -1023,11 +1027,11 @@ def velocity_ik(q, mu_dot, damping=0.0):
     c234 = c23*c4 - s23*s4
     s234 = c23*s4 + c4*s23
     t0 = 0.1*c1
-    t1 = t0*c23 + t0*c234
-    t2 = t1 + t0*c2
+    t1 = c23*t0 + c234*t0
+    t2 = t1 + c2*t0
     t3 = 0.1*s1
-    t4 = t3*c23 + t3*c234
-    t5 = t4 + t3*c2
+    t4 = c23*t3 + c234*t3
+    t5 = t4 + c2*t3
     t6 = t2*c1 + t5*s1
     t7 = t1*c1 + t4*s1
     t8 = 0.1*s234
@@ -1045,21 +1049,21 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t20 = t9**2
     t21 = t10**2
     t22 = 0.01*s234**2
-    t23 = t21*t11 + t22*t11 + t20*t11
-    t24 = t23 + t19
+    t23 = t20*t11 + t21*t11 + t11*t22
+    t24 = t19 + t23
     t25 = c1*s1
-    t26 = -t2*t5 + t25*t20 + t21*t25 + t22*t25
+    t26 = -t2*t5 + t20*t25 + t21*t25 + t22*t25
     t27 = t9*c1
     t28 = t10*c1
-    t29 = t8*c1
+    t29 = c1*t8
     t30 = t7*t27 + t6*t28 + t15*t29
     t31 = t17*t27 + t17*t28 + t17*t29
     t32 = t2**2
-    t33 = t21*t13 + t22*t13 + t20*t13
+    t33 = t20*t13 + t21*t13 + t13*t22
     t34 = t32 + t33
     t35 = t9*s1
     t36 = t10*s1
-    t37 = t8*s1
+    t37 = s1*t8
     t38 = t7*t35 + t6*t36 + t15*t37
     t39 = t17*t35 + t17*t36 + t17*t37
     t40 = t6**2
@@ -1084,19 +1088,19 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t59 = xp.where(xp.greater(t56, 0), 1/(t56*(t56 + xp.abs(t47))), 0)
     t60 = t59*(t26*t58 + t26*t49 + t30*t38 + t31*t39)
     t61 = t26 - t58*t60
-    t62 = t49 - t26*t60
+    t62 = -t26*t60 + t49
     t63 = -t38 + t30*t60
     t64 = -t39 + t31*t60
     t65 = -t59*(t26*t38 + t30*t58 + t30*t50 + t31*t18)
     t66 = t30 + t58*t65
     t67 = t38 + t26*t65
-    t68 = t50 + t30*t65
+    t68 = t30*t65 + t50
     t69 = t18 + t31*t65
     t70 = -t59*(t26*t39 + t30*t18 + t31*t58 + t31*t51)
     t71 = t31 + t58*t70
     t72 = t39 + t26*t70
     t73 = t18 + t30*t70
-    t74 = t51 + t31*t70
+    t74 = t31*t70 + t51
     t75 = t59*(t26*mu_dot1 + t58*mu_dot0 - t30*mu_dot2 - t31*mu_dot3)
     t76 = mu_dot0 - t58*t75
     t77 = mu_dot1 - t26*t75
@@ -1137,14 +1141,14 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t112 = xp.where(xp.not_equal(t108, 0), -t111/t108, 0)
     t113 = xp.where(xp.not_equal(t97, 0), -(t104 - t101*t112)/t97, 0)
     t114 = xp.where(xp.not_equal(t81, 0), -(t93 + t89*t112 + t113*t85)/t81, 0)
-    t115 = xp.where(xp.not_equal(t57, 0), -(t76 + t112*t71 + t113*t66 - t114*t61)/t57, 0)
+    t115 = xp.where(xp.not_equal(t57, 0), -(t76 - t114*t61 + t112*t71 + t113*t66)/t57, 0)
     t116 = t114*t2 - t115*t5
     t117 = t112*t17
     t118 = t117 + t113*t6 - t114*t36 - t115*t28
     t119 = t117 + t113*t7 - t114*t35 - t115*t27
     t120 = t117 + t113*t15 - t114*t37 - t115*t29
     t121 = t32 + t19
-    t122 = xp.sqrt(t23 + t33 + t41 + t44 + t121)
+    t122 = xp.sqrt(t44 + t121 + t41 + t23 + t33)
     t123 = xp.sqrt(t121)
     t124 = t123*xp.where(xp.less_equal(t5, 0), xp.asarray(1, dtype=dtype), -1)
     t125 = xp.where(xp.greater(t123, 0), 1/(t123*(t123 + xp.abs(t5))), 0)
@@ -1204,7 +1208,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t179 = 1e-12*t122
     t180 = xp.greater(damping, 0)
     t181 = 1e-12*t55
-    t182 = (t180 & (xp.less_equal(t96, t181) | xp.less_equal(t107, t181) | xp.less_equal(t56, t181) | xp.less_equal(t80, t181))) | (xp.less_equal(damping, 0) & (xp.less_equal(t123, t179) | xp.less_equal(t140, t179) | xp.less_equal(t156, t179) | xp.less_equal(t168, t179)))
+    t182 = (xp.less_equal(damping, 0) & (xp.less_equal(t123, t179) | xp.less_equal(t140, t179) | xp.less_equal(t156, t179) | xp.less_equal(t168, t179))) | (t180 & (xp.less_equal(t96, t181) | xp.less_equal(t107, t181) | xp.less_equal(t56, t181) | xp.less_equal(t80, t181)))
     t183 = t177 & t178 & xp.logical_not(t182)
     q_dot = _stack(xp, [
         xp.broadcast_to(xp.where(t183, xp.where(t180, t116, t176), 0), batch),  # 0
@@ -1246,12 +1250,12 @@ def ik_numeric_step(target, q, damping=0.0):
     s234 = c23*s4 + c4*s23
     t0 = mu0 + mu1 + mu2 + mu3 + qs1 + qs2 + qs3 + qs4
     t1 = 0.1*c1
-    t2 = t1*c23 + t1*c234
-    t3 = t2 + t1*c2
+    t2 = c23*t1 + c234*t1
+    t3 = t2 + c2*t1
     t4 = mu0 - t3
     t5 = 0.1*s1
-    t6 = t5*c23 + t5*c234
-    t7 = t6 + t5*c2
+    t6 = c23*t5 + c234*t5
+    t7 = t6 + c2*t5
     t8 = t3*c1 + t7*s1
     t9 = t2*c1 + t6*s1
     t10 = mu1 - t7
@@ -1274,22 +1278,22 @@ def ik_numeric_step(target, q, damping=0.0):
     t27 = t12**2
     t28 = t13**2
     t29 = 0.01*s234**2
-    t30 = t7**2 + t27*t16 + t28*t16 + t29*t16
-    t31 = t3**2 + t27*t18 + t28*t18 + t29*t18
+    t30 = t7**2 + t27*t16 + t28*t16 + t16*t29
+    t31 = t3**2 + t27*t18 + t28*t18 + t18*t29
     t32 = c1*s1
-    t33 = -t3*t7 + t32*t27 + t28*t32 + t29*t32
-    t34 = t12*c1
-    t35 = t13*c1
-    t36 = t11*c1
+    t33 = -t3*t7 + t27*t32 + t28*t32 + t29*t32
+    t34 = c1*t12
+    t35 = c1*t13
+    t36 = c1*t11
     t37 = t9*t34 + t8*t35 + t20*t36
     t38 = t24*t34 + t24*t35 + t24*t36
-    t39 = t12*s1
-    t40 = t13*s1
-    t41 = t11*s1
+    t39 = s1*t12
+    t40 = s1*t13
+    t41 = s1*t11
     t42 = t9*t39 + t8*t40 + t20*t41
     t43 = t24*t39 + t24*t40 + t24*t41
     t44 = -mu3 + xp.atan2(-s234, t23)
-    t45 = t44 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t44))
+    t45 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t44)) + t44
     t46 = t4**2 + t10**2 + t15**2 + t45**2
     t47 = t30 + damping
     t48 = xp.sqrt(t33**2 + t37**2 + t38**2 + t47**2)
@@ -1304,7 +1308,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t57 = t31 + damping
     t58 = t51*(t50*t33 + t33*t57 + t37*t42 + t38*t43)
     t59 = t33 - t50*t58
-    t60 = t57 - t58*t33
+    t60 = -t58*t33 + t57
     t61 = -t42 + t58*t37
     t62 = -t43 + t58*t38
     t63 = xp.sqrt(t60**2 + t61**2 + t62**2)
@@ -1319,7 +1323,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t72 = -t51*(t50*t37 + t33*t42 + t37*t71 + t38*t25)
     t73 = t37 + t50*t72
     t74 = t42 + t72*t33
-    t75 = t71 + t72*t37
+    t75 = t72*t37 + t71
     t76 = t25 + t72*t38
     t77 = t66*(t61*t75 + t62*t76 - t74*t65)
     t78 = t74 + t65*t77
@@ -1337,7 +1341,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t90 = t38 + t50*t89
     t91 = t43 + t89*t33
     t92 = t25 + t89*t37
-    t93 = t88 + t89*t38
+    t93 = t89*t38 + t88
     t94 = t66*(t61*t92 + t62*t93 - t91*t65)
     t95 = t91 + t65*t94
     t96 = t92 - t61*t94
@@ -1354,7 +1358,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t107 = xp.where(xp.not_equal(t103, 0), -t106/t103, 0)
     t108 = xp.where(xp.not_equal(t82, 0), -(t86 - t99*t107)/t82, 0)
     t109 = xp.where(xp.not_equal(t64, 0), -(t68 + t78*t108 + t95*t107)/t64, 0)
-    t110 = xp.where(xp.not_equal(t49, 0), -(t53 + t73*t108 + t90*t107 - t59*t109)/t49, 0)
+    t110 = xp.where(xp.not_equal(t49, 0), -(t53 - t59*t109 + t73*t108 + t90*t107)/t49, 0)
     t111 = q1 + t3*t109 - t7*t110
     t112 = t107*t24
     t113 = q2 + t112 + t108*t8 - t109*t40 - t110*t35
@@ -1378,7 +1382,7 @@ def ik_numeric_step(target, q, damping=0.0):
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def ik_branches(mu):
-    """every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits: (8 x 4 and 8 x 1 and 8 x 1), 848 operations."""
+    """every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits: (8 x 4 and 8 x 1 and 8 x 1), 840 operations."""
     xp, dtype, device, batch, (mu,) = _arguments(("mu", mu, (4,)))
     mu0 = mu[..., 0]
     mu1 = mu[..., 1]
@@ -1398,7 +1402,7 @@ def ik_branches(mu):
     t11 = t7
     t12 = mu0**2 + mu1**2
     t13 = t12
-    t14 = t12 + mu2**2
+    t14 = mu2**2 + t12
     t15 = 1e-24*t14
     t16 = xp.less_equal(t13, t15)
     t17 = xp.where(t16, 1, 1/xp.sqrt(t13))
@@ -1408,348 +1412,347 @@ def ik_branches(mu):
     t21 = t20 - 6.283185307179586*xp.floor(0.15915494309189535*(3.141592653589793 + t20))
     t22 = t19 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t19))
     t23 = t22 - 6.283185307179586*xp.floor(0.15915494309189535*(3.141592653589793 + t22))
-    t24 = t17
-    t25 = t24*mu0
-    t26 = xp.where(t16, 1, -t25)
-    t27 = t25
-    t28 = mu2*(1 - t26)
-    t29 = t28 + t26*mu2
-    t30 = mu2*(1 - t27)
-    t31 = t30 + t27*mu2
-    t32 = t24*mu1
-    t33 = xp.where(t16, 0, -t32)
-    t34 = t32
-    t35 = t26*mu0 + t33*mu1
-    t36 = t26*mu1 - t33*mu0
-    t37 = t27*mu0 + t34*mu1
-    t38 = t27*mu1 - t34*mu0
-    t39 = 0.1*t11
-    t40 = t35 + t39
-    t41 = t37 + t39
-    t42 = -0.1*t10
-    t43 = t29 + t42
-    t44 = -0.12 + t43
-    t45 = t31 + t42
-    t46 = -0.12 + t45
-    t47 = t36**2
-    t48 = t47 + t40**2 + t44**2
-    t49 = 0.5*(0.02 - t48)
-    t50 = t49**2
-    t51 = 1 - 10000*t50
-    t52 = xp.greater(t51, 1e-12)
-    t53 = xp.where(t52, xp.sqrt(t51), 0)
-    t54 = 100*t49
-    t55 = xp.where(t52, t54, xp.where(xp.greater(t54, 0), xp.asarray(1, dtype=dtype), -1))
-    t56 = xp.atan2(t53, t55)
-    t57 = 3.141592653589793 + t56
-    t58 = 3.141592653589793 - t56
-    t59 = t57 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t57))
-    t60 = t59 - 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t59))
-    t61 = t58 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t58))
-    t62 = t61 - 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t61))
-    t63 = -1.0*t55
-    t64 = -1.0*t53
+    t24 = t17*mu0
+    t25 = xp.where(t16, 1, -t24)
+    t26 = t24
+    t27 = mu2*(1 - t25)
+    t28 = t27 + t25*mu2
+    t29 = mu2*(1 - t26)
+    t30 = t29 + t26*mu2
+    t31 = t17*mu1
+    t32 = xp.where(t16, 0, -t31)
+    t33 = t31
+    t34 = t25*mu0 + t32*mu1
+    t35 = t25*mu1 - t32*mu0
+    t36 = t26*mu0 + t33*mu1
+    t37 = t26*mu1 - t33*mu0
+    t38 = 0.1*t11
+    t39 = t34 + t38
+    t40 = t36 + t38
+    t41 = -0.1*t10
+    t42 = t28 + t41
+    t43 = -0.12 + t42
+    t44 = t30 + t41
+    t45 = -0.12 + t44
+    t46 = t35**2
+    t47 = t46 + t39**2 + t43**2
+    t48 = 0.5*(0.02 - t47)
+    t49 = t48**2
+    t50 = 1 - 10000.0*t49
+    t51 = xp.greater(t50, 1e-12)
+    t52 = xp.where(t51, xp.sqrt(t50), 0)
+    t53 = 100*t48
+    t54 = xp.where(t51, t53, xp.where(xp.greater(t53, 0), xp.asarray(1, dtype=dtype), -1))
+    t55 = xp.atan2(t52, t54)
+    t56 = 3.141592653589793 - t55
+    t57 = 0.22 - 0.1*t54
+    t58 = -0.12 + t57
+    t59 = t58**2 + 0.01*t52**2
+    t60 = t56 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t56))
+    t61 = t60 - 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t60))
+    t62 = 3.141592653589793 + t55
+    t63 = -1.0*t54
+    t64 = -1.0*t52
     t65 = 0.22 + 0.1*t63
     t66 = -0.12 + t65
     t67 = t66**2 + 0.01*t64**2
-    t68 = 0.1*t64
-    t69 = t44*t66 - t40*t68
-    t70 = t40*t66 + t44*t68
-    t71 = t69**2 + t70**2
-    t72 = 0.22 - 0.1*t55
-    t73 = -0.12 + t72
-    t74 = 0.1*t53
-    t75 = t44*t73 - t40*t74
-    t76 = t40*t73 + t44*t74
+    t68 = t62 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t62))
+    t69 = t68 - 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t68))
+    t70 = 0.1*t64
+    t71 = t43*t66 - t39*t70
+    t72 = t39*t66 + t43*t70
+    t73 = t71**2 + t72**2
+    t74 = 0.1*t52
+    t75 = t43*t58 - t39*t74
+    t76 = t39*t58 + t43*t74
     t77 = t75**2 + t76**2
-    t78 = t73**2 + 0.01*t53**2
-    t79 = -0.1*t7
-    t80 = t35 + t79
-    t81 = t37 + t79
-    t82 = -0.1*t6
-    t83 = t29 + t82
-    t84 = -0.12 + t83
-    t85 = t47 + t80**2 + t84**2
-    t86 = 0.5*(0.02 - t85)
-    t87 = t31 + t82
-    t88 = -0.12 + t87
-    t89 = t86**2
-    t90 = 1 - 10000*t89
-    t91 = xp.greater(t90, 1e-12)
-    t92 = xp.where(t91, xp.sqrt(t90), 0)
-    t93 = -1.0*t92
-    t94 = 100*t86
-    t95 = xp.where(t91, t94, xp.where(xp.greater(t94, 0), xp.asarray(1, dtype=dtype), -1))
-    t96 = xp.atan2(t92, t95)
-    t97 = 3.141592653589793 + t96
-    t98 = -1.0*t95
-    t99 = 3.141592653589793 - t96
-    t100 = 0.22 + 0.1*t98
-    t101 = -0.12 + t100
-    t102 = t101**2 + 0.01*t93**2
-    t103 = 0.22 - 0.1*t95
-    t104 = -0.12 + t103
-    t105 = t104**2 + 0.01*t92**2
-    t106 = t97 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t97))
-    t107 = t106 - 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t106))
-    t108 = t99 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t99))
-    t109 = t108 - 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t108))
-    t110 = 0.1*t93
-    t111 = t84*t101 - t80*t110
-    t112 = t80*t101 + t84*t110
-    t113 = t111**2 + t112**2
-    t114 = 0.1*t92
-    t115 = t84*t104 - t80*t114
-    t116 = t80*t104 + t84*t114
-    t117 = t115**2 + t116**2
-    t118 = t38**2
-    t119 = t118 + t41**2 + t46**2
-    t120 = 0.5*(0.02 - t119)
-    t121 = t118 + t81**2 + t88**2
-    t122 = 0.5*(0.02 - t121)
-    t123 = t120**2
-    t124 = 1 - 10000*t123
-    t125 = xp.greater(t124, 1e-12)
-    t126 = xp.where(t125, xp.sqrt(t124), 0)
-    t127 = -1.0*t126
-    t128 = 100*t120
-    t129 = xp.where(t125, t128, xp.where(xp.greater(t128, 0), xp.asarray(1, dtype=dtype), -1))
-    t130 = xp.atan2(t126, t129)
-    t131 = 3.141592653589793 + t130
-    t132 = -1.0*t129
-    t133 = 3.141592653589793 - t130
-    t134 = 0.22 + 0.1*t132
-    t135 = -0.12 + t134
-    t136 = t135**2 + 0.01*t127**2
-    t137 = 0.22 - 0.1*t129
-    t138 = -0.12 + t137
-    t139 = t138**2 + 0.01*t126**2
-    t140 = t131 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t131))
-    t141 = t140 - 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t140))
-    t142 = t133 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t133))
-    t143 = t142 - 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t142))
-    t144 = 0.1*t127
-    t145 = t46*t135 - t41*t144
-    t146 = t41*t135 + t46*t144
-    t147 = t145**2 + t146**2
-    t148 = 0.1*t126
-    t149 = t46*t138 - t41*t148
-    t150 = t41*t138 + t46*t148
-    t151 = t149**2 + t150**2
-    t152 = t122**2
-    t153 = 1 - 10000*t152
-    t154 = xp.greater(t153, 1e-12)
-    t155 = xp.where(t154, xp.sqrt(t153), 0)
-    t156 = -1.0*t155
-    t157 = 100*t122
-    t158 = xp.where(t154, t157, xp.where(xp.greater(t157, 0), xp.asarray(1, dtype=dtype), -1))
-    t159 = xp.atan2(t155, t158)
-    t160 = 3.141592653589793 + t159
-    t161 = -1.0*t158
-    t162 = 3.141592653589793 - t159
-    t163 = 0.22 + 0.1*t161
-    t164 = -0.12 + t163
-    t165 = t164**2 + 0.01*t156**2
-    t166 = 0.22 - 0.1*t158
-    t167 = -0.12 + t166
-    t168 = t167**2 + 0.01*t155**2
-    t169 = t160 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t160))
-    t170 = t169 - 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t169))
-    t171 = t162 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t162))
-    t172 = t171 - 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t171))
-    t173 = 0.1*t156
-    t174 = t88*t164 - t81*t173
-    t175 = t81*t164 + t88*t173
-    t176 = t174**2 + t175**2
-    t177 = 0.1*t155
-    t178 = t88*t167 - t81*t177
-    t179 = t81*t167 + t88*t177
-    t180 = t178**2 + t179**2
-    t181 = 1e-24*t48
-    t182 = xp.where(xp.less_equal(t71, t67*t181), 0, xp.atan2(-t70, t69))
-    t183 = t182
-    t184 = t183 - 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t183))
-    t185 = -t9
-    t186 = 3.141592653589793 + t185
-    t187 = t57 + t182
-    t188 = t185 + t187 + 6.283185307179586*xp.ceil(-0.15915494309189535*(t186 + t187))
-    t189 = -t188
-    t190 = t188 + 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t189))
-    t191 = xp.where(xp.less_equal(t77, t78*t181), 0, xp.atan2(-t76, t75))
-    t192 = t191
-    t193 = t192 - 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t192))
-    t194 = t58 + t191
-    t195 = t185 + t194 + 6.283185307179586*xp.ceil(-0.15915494309189535*(t186 + t194))
-    t196 = -t195
-    t197 = t195 + 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t196))
-    t198 = 1e-24*t85
-    t199 = xp.where(xp.less_equal(t113, t102*t198), 0, xp.atan2(-t112, t111))
-    t200 = t199
-    t201 = t200 - 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t200))
-    t202 = 3.141592653589793 + t8
-    t203 = t97 + t199
-    t204 = t8 + t203 + 6.283185307179586*xp.ceil(-0.15915494309189535*(t202 + t203))
-    t205 = -t204
-    t206 = t204 + 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t205))
-    t207 = xp.where(xp.less_equal(t117, t105*t198), 0, xp.atan2(-t116, t115))
-    t208 = t207
-    t209 = t208 - 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t208))
-    t210 = t99 + t207
-    t211 = t8 + t210 + 6.283185307179586*xp.ceil(-0.15915494309189535*(t202 + t210))
-    t212 = -t211
-    t213 = t211 + 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t212))
-    t214 = 1e-24*t119
-    t215 = xp.where(xp.less_equal(t147, t136*t214), 0, xp.atan2(-t146, t145))
-    t216 = t215
-    t217 = t216 - 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t216))
-    t218 = t131 + t215
-    t219 = t185 + t218 + 6.283185307179586*xp.ceil(-0.15915494309189535*(t186 + t218))
-    t220 = -t219
-    t221 = t219 + 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t220))
-    t222 = xp.where(xp.less_equal(t151, t139*t214), 0, xp.atan2(-t150, t149))
-    t223 = t222
-    t224 = t223 - 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t223))
-    t225 = t133 + t222
-    t226 = t185 + t225 + 6.283185307179586*xp.ceil(-0.15915494309189535*(t186 + t225))
-    t227 = -t226
-    t228 = t226 + 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t227))
-    t229 = 1e-24*t121
-    t230 = xp.where(xp.less_equal(t176, t165*t229), 0, xp.atan2(-t175, t174))
-    t231 = t230
-    t232 = t231 - 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t231))
-    t233 = t160 + t230
-    t234 = t8 + t233 + 6.283185307179586*xp.ceil(-0.15915494309189535*(t202 + t233))
-    t235 = -t234
-    t236 = t234 + 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t235))
-    t237 = xp.where(xp.less_equal(t180, t168*t229), 0, xp.atan2(-t179, t178))
-    t238 = t237
-    t239 = t238 - 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t238))
-    t240 = t162 + t237
-    t241 = t8 + t240 + 6.283185307179586*xp.ceil(-0.15915494309189535*(t202 + t240))
-    t242 = -t241
-    t243 = t241 + 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t242))
-    t244 = xp.less_equal(t21, 3.141592653589793)
-    t245 = xp.greater_equal(t20, -3.141592653589793) & xp.less_equal(t20, 3.141592653589793)
-    t246 = xp.where(t244 & xp.logical_not(t245), t21, t20)
-    t247 = xp.less_equal(t184, 2.0943951023931953)
-    t248 = xp.greater_equal(t183, -2.0943951023931953) & xp.less_equal(t183, 2.0943951023931953)
-    t249 = xp.less_equal(t60, 2.0943951023931953)
-    t250 = xp.greater_equal(t59, -2.0943951023931953) & xp.less_equal(t59, 2.0943951023931953)
-    t251 = -t190
-    t252 = xp.less_equal(t251, 2.0943951023931953)
-    t253 = xp.greater_equal(t189, -2.0943951023931953) & xp.less_equal(t189, 2.0943951023931953)
-    t254 = xp.less_equal(t193, 2.0943951023931953)
-    t255 = xp.greater_equal(t192, -2.0943951023931953) & xp.less_equal(t192, 2.0943951023931953)
-    t256 = xp.less_equal(t62, 2.0943951023931953)
-    t257 = xp.greater_equal(t61, -2.0943951023931953) & xp.less_equal(t61, 2.0943951023931953)
-    t258 = -t197
-    t259 = xp.less_equal(t258, 2.0943951023931953)
-    t260 = xp.greater_equal(t196, -2.0943951023931953) & xp.less_equal(t196, 2.0943951023931953)
-    t261 = xp.less_equal(t201, 2.0943951023931953)
-    t262 = xp.greater_equal(t200, -2.0943951023931953) & xp.less_equal(t200, 2.0943951023931953)
-    t263 = xp.less_equal(t107, 2.0943951023931953)
-    t264 = xp.greater_equal(t106, -2.0943951023931953) & xp.less_equal(t106, 2.0943951023931953)
-    t265 = -t206
-    t266 = xp.less_equal(t265, 2.0943951023931953)
-    t267 = xp.greater_equal(t205, -2.0943951023931953) & xp.less_equal(t205, 2.0943951023931953)
-    t268 = xp.less_equal(t209, 2.0943951023931953)
-    t269 = xp.greater_equal(t208, -2.0943951023931953) & xp.less_equal(t208, 2.0943951023931953)
-    t270 = xp.less_equal(t109, 2.0943951023931953)
-    t271 = xp.greater_equal(t108, -2.0943951023931953) & xp.less_equal(t108, 2.0943951023931953)
-    t272 = -t213
-    t273 = xp.less_equal(t272, 2.0943951023931953)
-    t274 = xp.greater_equal(t212, -2.0943951023931953) & xp.less_equal(t212, 2.0943951023931953)
-    t275 = xp.less_equal(t23, 3.141592653589793)
-    t276 = xp.greater_equal(t22, -3.141592653589793) & xp.less_equal(t22, 3.141592653589793)
-    t277 = xp.where(t275 & xp.logical_not(t276), t23, t22)
-    t278 = xp.less_equal(t217, 2.0943951023931953)
-    t279 = xp.greater_equal(t216, -2.0943951023931953) & xp.less_equal(t216, 2.0943951023931953)
-    t280 = xp.less_equal(t141, 2.0943951023931953)
-    t281 = xp.greater_equal(t140, -2.0943951023931953) & xp.less_equal(t140, 2.0943951023931953)
-    t282 = -t221
-    t283 = xp.less_equal(t282, 2.0943951023931953)
-    t284 = xp.greater_equal(t220, -2.0943951023931953) & xp.less_equal(t220, 2.0943951023931953)
-    t285 = xp.less_equal(t224, 2.0943951023931953)
-    t286 = xp.greater_equal(t223, -2.0943951023931953) & xp.less_equal(t223, 2.0943951023931953)
-    t287 = xp.less_equal(t143, 2.0943951023931953)
-    t288 = xp.greater_equal(t142, -2.0943951023931953) & xp.less_equal(t142, 2.0943951023931953)
-    t289 = -t228
-    t290 = xp.less_equal(t289, 2.0943951023931953)
-    t291 = xp.greater_equal(t227, -2.0943951023931953) & xp.less_equal(t227, 2.0943951023931953)
-    t292 = xp.less_equal(t232, 2.0943951023931953)
-    t293 = xp.greater_equal(t231, -2.0943951023931953) & xp.less_equal(t231, 2.0943951023931953)
-    t294 = xp.less_equal(t170, 2.0943951023931953)
-    t295 = xp.greater_equal(t169, -2.0943951023931953) & xp.less_equal(t169, 2.0943951023931953)
-    t296 = -t236
-    t297 = xp.less_equal(t296, 2.0943951023931953)
-    t298 = xp.greater_equal(t235, -2.0943951023931953) & xp.less_equal(t235, 2.0943951023931953)
-    t299 = xp.less_equal(t239, 2.0943951023931953)
-    t300 = xp.greater_equal(t238, -2.0943951023931953) & xp.less_equal(t238, 2.0943951023931953)
-    t301 = xp.less_equal(t172, 2.0943951023931953)
-    t302 = xp.greater_equal(t171, -2.0943951023931953) & xp.less_equal(t171, 2.0943951023931953)
-    t303 = -t243
-    t304 = xp.less_equal(t303, 2.0943951023931953)
-    t305 = xp.greater_equal(t242, -2.0943951023931953) & xp.less_equal(t242, 2.0943951023931953)
-    t306 = xp.isfinite(t2)
-    t307 = xp.less_equal(xp.abs(mu3), 1.5707963267948966)
-    t308 = xp.greater(t13, t15)
-    t309 = t308 | (t16 & xp.less_equal(0, 1e-12*t14))
-    t310 = xp.greater_equal(t4, -1e-12)
-    t311 = t244 | t245
-    t312 = t275 | t276
+    t78 = -0.1*t7
+    t79 = t34 + t78
+    t80 = t36 + t78
+    t81 = -0.1*t6
+    t82 = t28 + t81
+    t83 = -0.12 + t82
+    t84 = t46 + t79**2 + t83**2
+    t85 = 0.5*(0.02 - t84)
+    t86 = t30 + t81
+    t87 = -0.12 + t86
+    t88 = t85**2
+    t89 = 1 - 10000.0*t88
+    t90 = xp.greater(t89, 1e-12)
+    t91 = xp.where(t90, xp.sqrt(t89), 0)
+    t92 = -1.0*t91
+    t93 = 100*t85
+    t94 = xp.where(t90, t93, xp.where(xp.greater(t93, 0), xp.asarray(1, dtype=dtype), -1))
+    t95 = xp.atan2(t91, t94)
+    t96 = 3.141592653589793 + t95
+    t97 = -1.0*t94
+    t98 = 3.141592653589793 - t95
+    t99 = 0.22 + 0.1*t97
+    t100 = -0.12 + t99
+    t101 = t100**2 + 0.01*t92**2
+    t102 = 0.22 - 0.1*t94
+    t103 = -0.12 + t102
+    t104 = t103**2 + 0.01*t91**2
+    t105 = t96 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t96))
+    t106 = t105 - 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t105))
+    t107 = t98 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t98))
+    t108 = t107 - 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t107))
+    t109 = 0.1*t92
+    t110 = t83*t100 - t79*t109
+    t111 = t79*t100 + t83*t109
+    t112 = t110**2 + t111**2
+    t113 = 0.1*t91
+    t114 = t83*t103 - t79*t113
+    t115 = t79*t103 + t83*t113
+    t116 = t114**2 + t115**2
+    t117 = t37**2
+    t118 = t117 + t40**2 + t45**2
+    t119 = 0.5*(0.02 - t118)
+    t120 = t117 + t80**2 + t87**2
+    t121 = 0.5*(0.02 - t120)
+    t122 = t119**2
+    t123 = 1 - 10000.0*t122
+    t124 = xp.greater(t123, 1e-12)
+    t125 = xp.where(t124, xp.sqrt(t123), 0)
+    t126 = -1.0*t125
+    t127 = 100*t119
+    t128 = xp.where(t124, t127, xp.where(xp.greater(t127, 0), xp.asarray(1, dtype=dtype), -1))
+    t129 = xp.atan2(t125, t128)
+    t130 = 3.141592653589793 + t129
+    t131 = -1.0*t128
+    t132 = 3.141592653589793 - t129
+    t133 = 0.22 + 0.1*t131
+    t134 = -0.12 + t133
+    t135 = t134**2 + 0.01*t126**2
+    t136 = 0.22 - 0.1*t128
+    t137 = -0.12 + t136
+    t138 = t137**2 + 0.01*t125**2
+    t139 = t130 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t130))
+    t140 = t139 - 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t139))
+    t141 = t132 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t132))
+    t142 = t141 - 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t141))
+    t143 = 0.1*t126
+    t144 = t45*t134 - t40*t143
+    t145 = t40*t134 + t45*t143
+    t146 = t144**2 + t145**2
+    t147 = 0.1*t125
+    t148 = t45*t137 - t40*t147
+    t149 = t40*t137 + t45*t147
+    t150 = t148**2 + t149**2
+    t151 = t121**2
+    t152 = 1 - 10000.0*t151
+    t153 = xp.greater(t152, 1e-12)
+    t154 = xp.where(t153, xp.sqrt(t152), 0)
+    t155 = -1.0*t154
+    t156 = 100*t121
+    t157 = xp.where(t153, t156, xp.where(xp.greater(t156, 0), xp.asarray(1, dtype=dtype), -1))
+    t158 = xp.atan2(t154, t157)
+    t159 = 3.141592653589793 + t158
+    t160 = -1.0*t157
+    t161 = 3.141592653589793 - t158
+    t162 = 0.22 + 0.1*t160
+    t163 = -0.12 + t162
+    t164 = t163**2 + 0.01*t155**2
+    t165 = 0.22 - 0.1*t157
+    t166 = -0.12 + t165
+    t167 = t166**2 + 0.01*t154**2
+    t168 = t159 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t159))
+    t169 = t168 - 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t168))
+    t170 = t161 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t161))
+    t171 = t170 - 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t170))
+    t172 = 0.1*t155
+    t173 = t87*t163 - t80*t172
+    t174 = t80*t163 + t87*t172
+    t175 = t173**2 + t174**2
+    t176 = 0.1*t154
+    t177 = t87*t166 - t80*t176
+    t178 = t80*t166 + t87*t176
+    t179 = t177**2 + t178**2
+    t180 = 1e-24*t47
+    t181 = xp.where(xp.less_equal(t73, t67*t180), 0, xp.atan2(-t72, t71))
+    t182 = t181
+    t183 = t182 - 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t182))
+    t184 = -t9
+    t185 = 3.141592653589793 + t184
+    t186 = t62 + t181
+    t187 = t184 + 6.283185307179586*xp.ceil(-0.15915494309189535*(t185 + t186)) + t186
+    t188 = -t187
+    t189 = t187 + 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t188))
+    t190 = xp.where(xp.less_equal(t77, t59*t180), 0, xp.atan2(-t76, t75))
+    t191 = t190
+    t192 = t191 - 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t191))
+    t193 = t56 + t190
+    t194 = t184 + 6.283185307179586*xp.ceil(-0.15915494309189535*(t185 + t193)) + t193
+    t195 = -t194
+    t196 = t194 + 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t195))
+    t197 = 1e-24*t84
+    t198 = xp.where(xp.less_equal(t112, t101*t197), 0, xp.atan2(-t111, t110))
+    t199 = t198
+    t200 = t199 - 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t199))
+    t201 = 3.141592653589793 + t8
+    t202 = t96 + t198
+    t203 = t8 + 6.283185307179586*xp.ceil(-0.15915494309189535*(t201 + t202)) + t202
+    t204 = -t203
+    t205 = t203 + 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t204))
+    t206 = xp.where(xp.less_equal(t116, t104*t197), 0, xp.atan2(-t115, t114))
+    t207 = t206
+    t208 = t207 - 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t207))
+    t209 = t98 + t206
+    t210 = t8 + 6.283185307179586*xp.ceil(-0.15915494309189535*(t201 + t209)) + t209
+    t211 = -t210
+    t212 = t210 + 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t211))
+    t213 = 1e-24*t118
+    t214 = xp.where(xp.less_equal(t146, t135*t213), 0, xp.atan2(-t145, t144))
+    t215 = t214
+    t216 = t215 - 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t215))
+    t217 = t130 + t214
+    t218 = t184 + 6.283185307179586*xp.ceil(-0.15915494309189535*(t185 + t217)) + t217
+    t219 = -t218
+    t220 = t218 + 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t219))
+    t221 = xp.where(xp.less_equal(t150, t138*t213), 0, xp.atan2(-t149, t148))
+    t222 = t221
+    t223 = t222 - 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t222))
+    t224 = t132 + t221
+    t225 = t184 + 6.283185307179586*xp.ceil(-0.15915494309189535*(t185 + t224)) + t224
+    t226 = -t225
+    t227 = t225 + 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t226))
+    t228 = 1e-24*t120
+    t229 = xp.where(xp.less_equal(t175, t164*t228), 0, xp.atan2(-t174, t173))
+    t230 = t229
+    t231 = t230 - 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t230))
+    t232 = t159 + t229
+    t233 = t8 + 6.283185307179586*xp.ceil(-0.15915494309189535*(t201 + t232)) + t232
+    t234 = -t233
+    t235 = t233 + 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t234))
+    t236 = xp.where(xp.less_equal(t179, t167*t228), 0, xp.atan2(-t178, t177))
+    t237 = t236
+    t238 = t237 - 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t237))
+    t239 = t161 + t236
+    t240 = t8 + 6.283185307179586*xp.ceil(-0.15915494309189535*(t201 + t239)) + t239
+    t241 = -t240
+    t242 = t240 + 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t241))
+    t243 = xp.less_equal(t21, 3.141592653589793)
+    t244 = xp.greater_equal(t20, -3.141592653589793) & xp.less_equal(t20, 3.141592653589793)
+    t245 = xp.where(t243 & xp.logical_not(t244), t21, t20)
+    t246 = xp.less_equal(t183, 2.0943951023931953)
+    t247 = xp.greater_equal(t182, -2.0943951023931953) & xp.less_equal(t182, 2.0943951023931953)
+    t248 = xp.less_equal(t69, 2.0943951023931953)
+    t249 = xp.greater_equal(t68, -2.0943951023931953) & xp.less_equal(t68, 2.0943951023931953)
+    t250 = -t189
+    t251 = xp.less_equal(t250, 2.0943951023931953)
+    t252 = xp.greater_equal(t188, -2.0943951023931953) & xp.less_equal(t188, 2.0943951023931953)
+    t253 = xp.less_equal(t192, 2.0943951023931953)
+    t254 = xp.greater_equal(t191, -2.0943951023931953) & xp.less_equal(t191, 2.0943951023931953)
+    t255 = xp.less_equal(t61, 2.0943951023931953)
+    t256 = xp.greater_equal(t60, -2.0943951023931953) & xp.less_equal(t60, 2.0943951023931953)
+    t257 = -t196
+    t258 = xp.less_equal(t257, 2.0943951023931953)
+    t259 = xp.greater_equal(t195, -2.0943951023931953) & xp.less_equal(t195, 2.0943951023931953)
+    t260 = xp.less_equal(t200, 2.0943951023931953)
+    t261 = xp.greater_equal(t199, -2.0943951023931953) & xp.less_equal(t199, 2.0943951023931953)
+    t262 = xp.less_equal(t106, 2.0943951023931953)
+    t263 = xp.greater_equal(t105, -2.0943951023931953) & xp.less_equal(t105, 2.0943951023931953)
+    t264 = -t205
+    t265 = xp.less_equal(t264, 2.0943951023931953)
+    t266 = xp.greater_equal(t204, -2.0943951023931953) & xp.less_equal(t204, 2.0943951023931953)
+    t267 = xp.less_equal(t208, 2.0943951023931953)
+    t268 = xp.greater_equal(t207, -2.0943951023931953) & xp.less_equal(t207, 2.0943951023931953)
+    t269 = xp.less_equal(t108, 2.0943951023931953)
+    t270 = xp.greater_equal(t107, -2.0943951023931953) & xp.less_equal(t107, 2.0943951023931953)
+    t271 = -t212
+    t272 = xp.less_equal(t271, 2.0943951023931953)
+    t273 = xp.greater_equal(t211, -2.0943951023931953) & xp.less_equal(t211, 2.0943951023931953)
+    t274 = xp.less_equal(t23, 3.141592653589793)
+    t275 = xp.greater_equal(t22, -3.141592653589793) & xp.less_equal(t22, 3.141592653589793)
+    t276 = xp.where(t274 & xp.logical_not(t275), t23, t22)
+    t277 = xp.less_equal(t216, 2.0943951023931953)
+    t278 = xp.greater_equal(t215, -2.0943951023931953) & xp.less_equal(t215, 2.0943951023931953)
+    t279 = xp.less_equal(t140, 2.0943951023931953)
+    t280 = xp.greater_equal(t139, -2.0943951023931953) & xp.less_equal(t139, 2.0943951023931953)
+    t281 = -t220
+    t282 = xp.less_equal(t281, 2.0943951023931953)
+    t283 = xp.greater_equal(t219, -2.0943951023931953) & xp.less_equal(t219, 2.0943951023931953)
+    t284 = xp.less_equal(t223, 2.0943951023931953)
+    t285 = xp.greater_equal(t222, -2.0943951023931953) & xp.less_equal(t222, 2.0943951023931953)
+    t286 = xp.less_equal(t142, 2.0943951023931953)
+    t287 = xp.greater_equal(t141, -2.0943951023931953) & xp.less_equal(t141, 2.0943951023931953)
+    t288 = -t227
+    t289 = xp.less_equal(t288, 2.0943951023931953)
+    t290 = xp.greater_equal(t226, -2.0943951023931953) & xp.less_equal(t226, 2.0943951023931953)
+    t291 = xp.less_equal(t231, 2.0943951023931953)
+    t292 = xp.greater_equal(t230, -2.0943951023931953) & xp.less_equal(t230, 2.0943951023931953)
+    t293 = xp.less_equal(t169, 2.0943951023931953)
+    t294 = xp.greater_equal(t168, -2.0943951023931953) & xp.less_equal(t168, 2.0943951023931953)
+    t295 = -t235
+    t296 = xp.less_equal(t295, 2.0943951023931953)
+    t297 = xp.greater_equal(t234, -2.0943951023931953) & xp.less_equal(t234, 2.0943951023931953)
+    t298 = xp.less_equal(t238, 2.0943951023931953)
+    t299 = xp.greater_equal(t237, -2.0943951023931953) & xp.less_equal(t237, 2.0943951023931953)
+    t300 = xp.less_equal(t171, 2.0943951023931953)
+    t301 = xp.greater_equal(t170, -2.0943951023931953) & xp.less_equal(t170, 2.0943951023931953)
+    t302 = -t242
+    t303 = xp.less_equal(t302, 2.0943951023931953)
+    t304 = xp.greater_equal(t241, -2.0943951023931953) & xp.less_equal(t241, 2.0943951023931953)
+    t305 = xp.isfinite(t2)
+    t306 = xp.less_equal(xp.abs(mu3), 1.5707963267948966)
+    t307 = xp.greater(t13, t15)
+    t308 = t307 | (xp.less_equal(0, 1e-12*t14) & t16)
+    t309 = xp.greater_equal(t4, -1e-12)
+    t310 = t243 | t244
+    t311 = t274 | t275
     q = _stack(xp, [
-        t246,  # 0, 0
-        xp.where(t247 & xp.logical_not(t248), t184, t183),  # 0, 1
-        xp.where(t249 & xp.logical_not(t250), t60, t59),  # 0, 2
-        xp.where(t252 & xp.logical_not(t253), t251, t189),  # 0, 3
-        t246,  # 1, 0
-        xp.where(t254 & xp.logical_not(t255), t193, t192),  # 1, 1
-        xp.where(t256 & xp.logical_not(t257), t62, t61),  # 1, 2
-        xp.where(t259 & xp.logical_not(t260), t258, t196),  # 1, 3
-        t246,  # 2, 0
-        xp.where(t261 & xp.logical_not(t262), t201, t200),  # 2, 1
-        xp.where(t263 & xp.logical_not(t264), t107, t106),  # 2, 2
-        xp.where(t266 & xp.logical_not(t267), t265, t205),  # 2, 3
-        t246,  # 3, 0
-        xp.where(t268 & xp.logical_not(t269), t209, t208),  # 3, 1
-        xp.where(t270 & xp.logical_not(t271), t109, t108),  # 3, 2
-        xp.where(t273 & xp.logical_not(t274), t272, t212),  # 3, 3
-        t277,  # 4, 0
-        xp.where(t278 & xp.logical_not(t279), t217, t216),  # 4, 1
-        xp.where(t280 & xp.logical_not(t281), t141, t140),  # 4, 2
-        xp.where(t283 & xp.logical_not(t284), t282, t220),  # 4, 3
-        t277,  # 5, 0
-        xp.where(t285 & xp.logical_not(t286), t224, t223),  # 5, 1
-        xp.where(t287 & xp.logical_not(t288), t143, t142),  # 5, 2
-        xp.where(t290 & xp.logical_not(t291), t289, t227),  # 5, 3
-        t277,  # 6, 0
-        xp.where(t292 & xp.logical_not(t293), t232, t231),  # 6, 1
-        xp.where(t294 & xp.logical_not(t295), t170, t169),  # 6, 2
-        xp.where(t297 & xp.logical_not(t298), t296, t235),  # 6, 3
-        t277,  # 7, 0
-        xp.where(t299 & xp.logical_not(t300), t239, t238),  # 7, 1
-        xp.where(t301 & xp.logical_not(t302), t172, t171),  # 7, 2
-        xp.where(t304 & xp.logical_not(t305), t303, t242),  # 7, 3
+        t245,  # 0, 0
+        xp.where(t246 & xp.logical_not(t247), t183, t182),  # 0, 1
+        xp.where(t248 & xp.logical_not(t249), t69, t68),  # 0, 2
+        xp.where(t251 & xp.logical_not(t252), t250, t188),  # 0, 3
+        t245,  # 1, 0
+        xp.where(t253 & xp.logical_not(t254), t192, t191),  # 1, 1
+        xp.where(t255 & xp.logical_not(t256), t61, t60),  # 1, 2
+        xp.where(t258 & xp.logical_not(t259), t257, t195),  # 1, 3
+        t245,  # 2, 0
+        xp.where(t260 & xp.logical_not(t261), t200, t199),  # 2, 1
+        xp.where(t262 & xp.logical_not(t263), t106, t105),  # 2, 2
+        xp.where(t265 & xp.logical_not(t266), t264, t204),  # 2, 3
+        t245,  # 3, 0
+        xp.where(t267 & xp.logical_not(t268), t208, t207),  # 3, 1
+        xp.where(t269 & xp.logical_not(t270), t108, t107),  # 3, 2
+        xp.where(t272 & xp.logical_not(t273), t271, t211),  # 3, 3
+        t276,  # 4, 0
+        xp.where(t277 & xp.logical_not(t278), t216, t215),  # 4, 1
+        xp.where(t279 & xp.logical_not(t280), t140, t139),  # 4, 2
+        xp.where(t282 & xp.logical_not(t283), t281, t219),  # 4, 3
+        t276,  # 5, 0
+        xp.where(t284 & xp.logical_not(t285), t223, t222),  # 5, 1
+        xp.where(t286 & xp.logical_not(t287), t142, t141),  # 5, 2
+        xp.where(t289 & xp.logical_not(t290), t288, t226),  # 5, 3
+        t276,  # 6, 0
+        xp.where(t291 & xp.logical_not(t292), t231, t230),  # 6, 1
+        xp.where(t293 & xp.logical_not(t294), t169, t168),  # 6, 2
+        xp.where(t296 & xp.logical_not(t297), t295, t234),  # 6, 3
+        t276,  # 7, 0
+        xp.where(t298 & xp.logical_not(t299), t238, t237),  # 7, 1
+        xp.where(t300 & xp.logical_not(t301), t171, t170),  # 7, 2
+        xp.where(t303 & xp.logical_not(t304), t302, t241),  # 7, 3
     ], (8, 4))
     valid = _stack(xp, [
-        t306 & t307 & t309 & t310 & xp.greater_equal(t51, -1e-12),  # 0
-        t306 & t307 & t309 & t310 & t52,  # 1
-        t5 & t306 & t307 & t309 & xp.greater_equal(t90, -1e-12),  # 2
-        t5 & t306 & t307 & t309 & t91,  # 3
-        t306 & t307 & t308 & t310 & xp.greater_equal(t124, -1e-12),  # 4
-        t306 & t307 & t308 & t310 & t125,  # 5
-        t5 & t306 & t307 & t308 & xp.greater_equal(t153, -1e-12),  # 6
-        t5 & t306 & t307 & t308 & t154,  # 7
+        t305 & t306 & t308 & t309 & xp.greater_equal(t50, -1e-12),  # 0
+        t305 & t51 & t306 & t308 & t309,  # 1
+        t305 & t5 & t306 & t308 & xp.greater_equal(t89, -1e-12),  # 2
+        t305 & t5 & t90 & t306 & t308,  # 3
+        t305 & t307 & t306 & t309 & xp.greater_equal(t123, -1e-12),  # 4
+        t305 & t124 & t307 & t306 & t309,  # 5
+        t305 & t5 & t307 & t306 & xp.greater_equal(t152, -1e-12),  # 6
+        t305 & t5 & t153 & t307 & t306,  # 7
     ], (8,))
     in_limits = _stack(xp, [
-        t311 & (t247 | t248) & (t249 | t250) & (t252 | t253),  # 0
-        t311 & (t254 | t255) & (t256 | t257) & (t259 | t260),  # 1
-        t311 & (t261 | t262) & (t263 | t264) & (t266 | t267),  # 2
-        t311 & (t268 | t269) & (t270 | t271) & (t273 | t274),  # 3
-        t312 & (t278 | t279) & (t280 | t281) & (t283 | t284),  # 4
-        t312 & (t285 | t286) & (t287 | t288) & (t290 | t291),  # 5
-        t312 & (t292 | t293) & (t294 | t295) & (t297 | t298),  # 6
-        t312 & (t299 | t300) & (t301 | t302) & (t304 | t305),  # 7
+        t310 & (t246 | t247) & (t248 | t249) & (t251 | t252),  # 0
+        t310 & (t253 | t254) & (t255 | t256) & (t258 | t259),  # 1
+        t310 & (t260 | t261) & (t262 | t263) & (t265 | t266),  # 2
+        t310 & (t267 | t268) & (t269 | t270) & (t272 | t273),  # 3
+        t311 & (t277 | t278) & (t279 | t280) & (t282 | t283),  # 4
+        t311 & (t284 | t285) & (t286 | t287) & (t289 | t290),  # 5
+        t311 & (t291 | t292) & (t293 | t294) & (t296 | t297),  # 6
+        t311 & (t298 | t299) & (t300 | t301) & (t303 | t304),  # 7
     ], (8,))
     return q, valid, in_limits
 

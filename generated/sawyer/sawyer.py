@@ -93,53 +93,53 @@ def fk(q):
     s7 = trig[..., 13]
     t0 = s1*s3
     t1 = c1*c3
-    t2 = t0 + t1*c2
-    t3 = t1 + t0*c2
+    t2 = t0 + c2*t1
+    t3 = t1 + c2*t0
     t4 = c3*s1
     t5 = c1*s3
-    t6 = t4 - t5*c2
-    t7 = -t5 + t4*c2
+    t6 = t4 - c2*t5
+    t7 = -t5 + c2*t4
     t8 = c1*s2
-    t9 = t2*c4 + t8*s4
-    t10 = -t2*s4 + t8*c4
+    t9 = t2*c4 + s4*t8
+    t10 = -t2*s4 + c4*t8
     t11 = t9*c5 - t6*s5
     t12 = t9*s5 + t6*c5
     t13 = t11*c6 - t10*s6
     t14 = t10*c6 + t11*s6
     t15 = t12*s7 + t13*c7
     t16 = t12*c7 - t13*s7
-    t17 = 0.1363*t12 + 0.13375*t14
+    t17 = 0.13375*t14 + 0.1363*t12
     t18 = -t17 + 0.4*t10
     t19 = t18 + 0.1685*t6
     t20 = t19 - 0.4*t8
     t21 = t20 - 0.1925*s1
     t22 = t21 + 0.081*c1
     t23 = s1*s2
-    t24 = t7*c4 + t23*s4
-    t25 = -t7*s4 + t23*c4
+    t24 = t7*c4 + s4*t23
+    t25 = -t7*s4 + c4*t23
     t26 = t3*s5 + t24*c5
     t27 = t3*c5 - t24*s5
     t28 = t26*c6 - t25*s6
     t29 = t25*c6 + t26*s6
     t30 = t28*c7 - t27*s7
     t31 = t27*c7 + t28*s7
-    t32 = 0.1363*t27 - 0.13375*t29
+    t32 = -0.13375*t29 + 0.1363*t27
     t33 = t32 + 0.4*t25
     t34 = t33 - 0.1685*t3
     t35 = t34 - 0.4*t23
     t36 = t35 + 0.1925*c1
     t37 = t36 + 0.081*s1
     t38 = c3*s2
-    t39 = c2*s4 - t38*c4
-    t40 = c2*c4 + t38*s4
-    t41 = s2*s3
-    t42 = t39*c5 - t41*s5
-    t43 = t39*s5 + t41*c5
+    t39 = c2*s4 - c4*t38
+    t40 = c2*c4 + s4*t38
+    t41 = s3*s2
+    t42 = t39*c5 - s5*t41
+    t43 = t39*s5 + c5*t41
     t44 = t42*c6 - t40*s6
     t45 = t40*c6 + t42*s6
     t46 = t43*s7 + t44*c7
     t47 = t43*c7 - t44*s7
-    t48 = 0.1363*t43 + 0.13375*t45
+    t48 = 0.13375*t45 + 0.1363*t43
     t49 = -t48 + 0.4*t40
     t50 = t49 + 0.1685*t41
     t51 = t50 - 0.4*c2
@@ -183,44 +183,44 @@ def jacobian(q):
     s6 = trig[..., 11]
     t0 = s1*s3
     t1 = c1*c3
-    t2 = t0 + t1*c2
-    t3 = t1 + t0*c2
+    t2 = t0 + c2*t1
+    t3 = t1 + c2*t0
     t4 = c3*s1
     t5 = c1*s3
-    t6 = t4 - t5*c2
-    t7 = -t5 + t4*c2
+    t6 = t4 - c2*t5
+    t7 = -t5 + c2*t4
     t8 = c1*s2
-    t9 = t2*c4 + t8*s4
-    t10 = -t2*s4 + t8*c4
+    t9 = t2*c4 + s4*t8
+    t10 = -t2*s4 + c4*t8
     t11 = t9*c5 - t6*s5
     t12 = t9*s5 + t6*c5
     t13 = t10*c6 + t11*s6
-    t14 = 0.1363*t12 + 0.13375*t13
+    t14 = 0.13375*t13 + 0.1363*t12
     t15 = -t14 + 0.4*t10
     t16 = t15 + 0.1685*t6
     t17 = t16 - 0.4*t8
     t18 = t17 - 0.1925*s1
     t19 = t18 + 0.081*c1
     t20 = s1*s2
-    t21 = t7*c4 + t20*s4
-    t22 = -t7*s4 + t20*c4
+    t21 = t7*c4 + s4*t20
+    t22 = -t7*s4 + c4*t20
     t23 = t3*s5 + t21*c5
     t24 = t3*c5 - t21*s5
     t25 = t22*c6 + t23*s6
-    t26 = 0.1363*t24 - 0.13375*t25
+    t26 = -0.13375*t25 + 0.1363*t24
     t27 = t26 + 0.4*t22
     t28 = t27 - 0.1685*t3
     t29 = t28 - 0.4*t20
     t30 = t29 + 0.1925*c1
     t31 = t30 + 0.081*s1
     t32 = c3*s2
-    t33 = c2*s4 - t32*c4
-    t34 = c2*c4 + t32*s4
+    t33 = c2*s4 - c4*t32
+    t34 = c2*c4 + s4*t32
     t35 = s2*s3
-    t36 = t33*c5 - t35*s5
-    t37 = t33*s5 + t35*c5
+    t36 = t33*c5 - s5*t35
+    t37 = t33*s5 + c5*t35
     t38 = t34*c6 + t36*s6
-    t39 = 0.1363*t37 + 0.13375*t38
+    t39 = 0.13375*t38 + 0.1363*t37
     t40 = -t39 + 0.4*t34
     t41 = t40 + 0.1685*t35
     t42 = t41 - 0.4*c2
@@ -229,14 +229,14 @@ def jacobian(q):
     J = _stack(xp, [
         -t31,  # 0, 0
         t43,  # 0, 1
-        t29*c2 - t44*s2,  # 0, 2
+        t29*c2 - s2*t44,  # 0, 2
         -(t3*t41 + t28*t35),  # 0, 3
         t22*t40 - t34*t27,  # 0, 4
         t37*t26 - t24*t39,  # 0, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 6
         t19,  # 1, 0
         t44,  # 1, 1
-        -t17*c2 + t43*s2,  # 1, 2
+        -t17*c2 + s2*t43,  # 1, 2
         -t41*t6 + t16*t35,  # 1, 3
         t34*t15 - t10*t40,  # 1, 4
         t37*t14 - t12*t39,  # 1, 5
@@ -293,53 +293,53 @@ def fk_jacobian(q):
     s7 = trig[..., 13]
     t0 = s1*s3
     t1 = c1*c3
-    t2 = t0 + t1*c2
-    t3 = t1 + t0*c2
+    t2 = t0 + c2*t1
+    t3 = t1 + c2*t0
     t4 = c3*s1
     t5 = c1*s3
-    t6 = t4 - t5*c2
-    t7 = -t5 + t4*c2
+    t6 = t4 - c2*t5
+    t7 = -t5 + c2*t4
     t8 = c1*s2
-    t9 = t2*c4 + t8*s4
-    t10 = -t2*s4 + t8*c4
+    t9 = t2*c4 + s4*t8
+    t10 = -t2*s4 + c4*t8
     t11 = t9*c5 - t6*s5
     t12 = t9*s5 + t6*c5
     t13 = t11*c6 - t10*s6
     t14 = t10*c6 + t11*s6
     t15 = t12*s7 + t13*c7
     t16 = t12*c7 - t13*s7
-    t17 = 0.1363*t12 + 0.13375*t14
+    t17 = 0.13375*t14 + 0.1363*t12
     t18 = -t17 + 0.4*t10
     t19 = t18 + 0.1685*t6
     t20 = t19 - 0.4*t8
     t21 = t20 - 0.1925*s1
     t22 = t21 + 0.081*c1
     t23 = s1*s2
-    t24 = t7*c4 + t23*s4
-    t25 = -t7*s4 + t23*c4
+    t24 = t7*c4 + s4*t23
+    t25 = -t7*s4 + c4*t23
     t26 = t3*s5 + t24*c5
     t27 = t3*c5 - t24*s5
     t28 = t26*c6 - t25*s6
     t29 = t25*c6 + t26*s6
     t30 = t28*c7 - t27*s7
     t31 = t27*c7 + t28*s7
-    t32 = 0.1363*t27 - 0.13375*t29
+    t32 = -0.13375*t29 + 0.1363*t27
     t33 = t32 + 0.4*t25
     t34 = t33 - 0.1685*t3
     t35 = t34 - 0.4*t23
     t36 = t35 + 0.1925*c1
     t37 = t36 + 0.081*s1
     t38 = c3*s2
-    t39 = c2*s4 - t38*c4
-    t40 = c2*c4 + t38*s4
+    t39 = c2*s4 - c4*t38
+    t40 = c2*c4 + s4*t38
     t41 = s2*s3
-    t42 = t39*c5 - t41*s5
-    t43 = t39*s5 + t41*c5
+    t42 = t39*c5 - s5*t41
+    t43 = t39*s5 + c5*t41
     t44 = t42*c6 - t40*s6
     t45 = t40*c6 + t42*s6
     t46 = t43*s7 + t44*c7
     t47 = t43*c7 - t44*s7
-    t48 = 0.1363*t43 + 0.13375*t45
+    t48 = 0.13375*t45 + 0.1363*t43
     t49 = -t48 + 0.4*t40
     t50 = t49 + 0.1685*t41
     t51 = t50 - 0.4*c2
@@ -370,14 +370,14 @@ def fk_jacobian(q):
     J = _stack(xp, [
         -t37,  # 0, 0
         t56,  # 0, 1
-        t35*c2 - t57*s2,  # 0, 2
+        t35*c2 - s2*t57,  # 0, 2
         -(t3*t50 + t34*t41),  # 0, 3
         t25*t49 - t40*t33,  # 0, 4
         t43*t32 - t27*t48,  # 0, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 6
         t22,  # 1, 0
         t57,  # 1, 1
-        -t20*c2 + t56*s2,  # 1, 2
+        -t20*c2 + s2*t56,  # 1, 2
         -t50*t6 + t19*t41,  # 1, 3
         t40*t18 - t10*t49,  # 1, 4
         t43*t17 - t12*t48,  # 1, 5
@@ -415,7 +415,7 @@ def fk_jacobian(q):
 
 
 def jacobian_tool(q):
-    """geometric Jacobian in the tool frame (6 x DOF, rows vx vy vz wx wy wz): (6 x 7), 339 operations."""
+    """geometric Jacobian in the tool frame (6 x DOF, rows vx vy vz wx wy wz): (6 x 7), 338 operations."""
     xp, dtype, device, batch, (q,) = _arguments(("q", q, (7,)))
     trig = _cos_sin(xp, q, (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0), device)
     c1 = trig[..., 0]
@@ -434,59 +434,59 @@ def jacobian_tool(q):
     s7 = trig[..., 13]
     t0 = s1*s3
     t1 = c1*c3
-    t2 = t0 + t1*c2
-    t3 = t1 + t0*c2
+    t2 = t0 + c2*t1
+    t3 = t1 + c2*t0
     t4 = c3*s1
     t5 = c1*s3
-    t6 = t4 - t5*c2
-    t7 = -t5 + t4*c2
+    t6 = t4 - c2*t5
+    t7 = -t5 + c2*t4
     t8 = c1*s2
-    t9 = t2*c4 + t8*s4
-    t10 = -t2*s4 + t8*c4
+    t9 = t2*c4 + s4*t8
+    t10 = -t2*s4 + c4*t8
     t11 = t9*c5 - t6*s5
     t12 = t9*s5 + t6*c5
     t13 = t11*c6 - t10*s6
     t14 = t10*c6 + t11*s6
     t15 = t12*s7 + t13*c7
     t16 = t12*c7 - t13*s7
-    t17 = 0.1363*t12 + 0.13375*t14
+    t17 = 0.13375*t14 + 0.1363*t12
     t18 = -t17 + 0.4*t10
     t19 = t18 + 0.1685*t6
     t20 = t19 - 0.4*t8
     t21 = t20 - 0.1925*s1
     t22 = t21 + 0.081*c1
     t23 = s1*s2
-    t24 = t7*c4 + t23*s4
-    t25 = -t7*s4 + t23*c4
+    t24 = t7*c4 + s4*t23
+    t25 = -t7*s4 + c4*t23
     t26 = t3*s5 + t24*c5
     t27 = t3*c5 - t24*s5
     t28 = t26*c6 - t25*s6
     t29 = t25*c6 + t26*s6
     t30 = t28*c7 - t27*s7
     t31 = t27*c7 + t28*s7
-    t32 = 0.1363*t27 - 0.13375*t29
+    t32 = -0.13375*t29 + 0.1363*t27
     t33 = t32 + 0.4*t25
     t34 = t33 - 0.1685*t3
     t35 = t34 - 0.4*t23
     t36 = t35 + 0.1925*c1
     t37 = t36 + 0.081*s1
     t38 = c3*s2
-    t39 = c2*s4 - t38*c4
-    t40 = c2*c4 + t38*s4
-    t41 = s2*s3
-    t42 = t39*c5 - t41*s5
-    t43 = t39*s5 + t41*c5
+    t39 = c2*s4 - c4*t38
+    t40 = c2*c4 + s4*t38
+    t41 = s3*s2
+    t42 = t39*c5 - s5*t41
+    t43 = t39*s5 + c5*t41
     t44 = t42*c6 - t40*s6
     t45 = t40*c6 + t42*s6
     t46 = t43*s7 + t44*c7
     t47 = t43*c7 - t44*s7
-    t48 = 0.1363*t43 + 0.13375*t45
+    t48 = 0.13375*t45 + 0.1363*t43
     t49 = -t48 + 0.4*t40
     t50 = t49 + 0.1685*t41
     t51 = t50 - 0.4*c2
     t52 = -(t21*c1 + t36*s1)
-    t53 = t51*c1
-    t54 = t51*s1
+    t53 = c1*t51
+    t54 = s1*t51
     t55 = t35*c2 - t51*t23
     t56 = -t20*c2 + t51*t8
     t57 = t20*t23 - t35*t8
@@ -526,19 +526,19 @@ def jacobian_tool(q):
         -(t46*c2 + t15*t8 + t30*t23),  # 3, 2
         t15*t6 - t3*t30 + t46*t41,  # 3, 3
         t10*t15 + t25*t30 + t40*t46,  # 3, 4
-        -(t12*t15 + t43*t46 - t27*t30),  # 3, 5
+        -(-t27*t30 + t12*t15 + t43*t46),  # 3, 5
         -(t14*t15 + t29*t30 + t45*t46),  # 3, 6
         t47,  # 4, 0
         -(t16*s1 + t31*c1),  # 4, 1
-        -(t47*c2 + t16*t8 - t31*s1*s2),  # 4, 2
+        -(t47*c2 - t31*t23 + t16*t8),  # 4, 2
         t3*t31 + t16*t6 + t47*t41,  # 4, 3
         t10*t16 + t40*t47 - t25*t31,  # 4, 4
         -(t12*t16 + t27*t31 + t43*t47),  # 4, 5
-        -(t14*t16 + t45*t47 - t29*t31),  # 4, 6
+        -(-t29*t31 + t14*t16 + t45*t47),  # 4, 6
         -t45,  # 5, 0
         t14*s1 - t29*c1,  # 5, 1
         t45*c2 + t14*t8 + t29*t23,  # 5, 2
-        -(t14*t6 - t3*t29 + t45*t41),  # 5, 3
+        -(-t3*t29 + t14*t6 + t45*t41),  # 5, 3
         -(t10*t14 + t25*t29 + t40*t45),  # 5, 4
         t12*t14 + t43*t45 - t27*t29,  # 5, 5
         t14**2 + t29**2 + t45**2,  # 5, 6
@@ -566,51 +566,51 @@ def task(q):
     s7 = trig[..., 13]
     t0 = s1*s3
     t1 = c1*c3
-    t2 = t0 + t1*c2
-    t3 = t1 + t0*c2
+    t2 = t0 + c2*t1
+    t3 = t1 + c2*t0
     t4 = c3*s1
     t5 = c1*s3
-    t6 = t4 - t5*c2
-    t7 = -t5 + t4*c2
+    t6 = t4 - c2*t5
+    t7 = -t5 + c2*t4
     t8 = c1*s2
-    t9 = t2*c4 + t8*s4
-    t10 = -t2*s4 + t8*c4
+    t9 = t2*c4 + s4*t8
+    t10 = -t2*s4 + c4*t8
     t11 = t9*c5 - t6*s5
     t12 = t9*s5 + t6*c5
     t13 = t11*c6 - t10*s6
     t14 = t10*c6 + t11*s6
     t15 = t12*s7 + t13*c7
-    t16 = 0.1363*t12 + 0.13375*t14
+    t16 = 0.13375*t14 + 0.1363*t12
     t17 = -t16 + 0.4*t10
     t18 = t17 + 0.1685*t6
     t19 = t18 - 0.4*t8
     t20 = t19 - 0.1925*s1
     t21 = t20 + 0.081*c1
     t22 = s1*s2
-    t23 = t7*c4 + t22*s4
-    t24 = -t7*s4 + t22*c4
+    t23 = t7*c4 + s4*t22
+    t24 = -t7*s4 + c4*t22
     t25 = t3*s5 + t23*c5
     t26 = t3*c5 - t23*s5
     t27 = t25*c6 - t24*s6
     t28 = t24*c6 + t25*s6
     t29 = t27*c7 - t26*s7
-    t30 = 0.1363*t26 - 0.13375*t28
+    t30 = -0.13375*t28 + 0.1363*t26
     t31 = t30 + 0.4*t24
     t32 = t31 - 0.1685*t3
     t33 = t32 - 0.4*t22
     t34 = t33 + 0.1925*c1
     t35 = t34 + 0.081*s1
     t36 = c3*s2
-    t37 = c2*s4 - t36*c4
-    t38 = c2*c4 + t36*s4
-    t39 = s2*s3
-    t40 = t37*c5 - t39*s5
-    t41 = t37*s5 + t39*c5
+    t37 = c2*s4 - c4*t36
+    t38 = c2*c4 + s4*t36
+    t39 = s3*s2
+    t40 = t37*c5 - s5*t39
+    t41 = t37*s5 + c5*t39
     t42 = t40*c6 - t38*s6
     t43 = t38*c6 + t40*s6
     t44 = t41*s7 + t42*c7
     t45 = t41*c7 - t42*s7
-    t46 = 0.1363*t41 + 0.13375*t43
+    t46 = 0.13375*t43 + 0.1363*t41
     t47 = -t46 + 0.4*t38
     t48 = t47 + 0.1685*t39
     t49 = t48 - 0.4*c2
@@ -646,50 +646,50 @@ def task_jacobian(q):
     s7 = trig[..., 13]
     t0 = s1*s3
     t1 = c1*c3
-    t2 = t0 + t1*c2
-    t3 = t1 + t0*c2
+    t2 = t0 + c2*t1
+    t3 = t1 + c2*t0
     t4 = c3*s1
     t5 = c1*s3
-    t6 = t4 - t5*c2
-    t7 = -t5 + t4*c2
+    t6 = t4 - c2*t5
+    t7 = -t5 + c2*t4
     t8 = c1*s2
-    t9 = t2*c4 + t8*s4
-    t10 = -t2*s4 + t8*c4
+    t9 = t2*c4 + s4*t8
+    t10 = -t2*s4 + c4*t8
     t11 = t9*c5 - t6*s5
     t12 = t9*s5 + t6*c5
     t13 = t11*c6 - t10*s6
     t14 = t10*c6 + t11*s6
     t15 = t12*s7 + t13*c7
-    t16 = 0.1363*t12 + 0.13375*t14
+    t16 = 0.13375*t14 + 0.1363*t12
     t17 = -t16 + 0.4*t10
     t18 = t17 + 0.1685*t6
     t19 = t18 - 0.4*t8
     t20 = t19 - 0.1925*s1
     t21 = t20 + 0.081*c1
     t22 = s1*s2
-    t23 = t7*c4 + t22*s4
-    t24 = -t7*s4 + t22*c4
+    t23 = t7*c4 + s4*t22
+    t24 = -t7*s4 + c4*t22
     t25 = t3*s5 + t23*c5
     t26 = t3*c5 - t23*s5
     t27 = t25*c6 - t24*s6
     t28 = t24*c6 + t25*s6
     t29 = t27*c7 - t26*s7
-    t30 = 0.1363*t26 - 0.13375*t28
+    t30 = -0.13375*t28 + 0.1363*t26
     t31 = t30 + 0.4*t24
     t32 = t31 - 0.1685*t3
     t33 = t32 - 0.4*t22
     t34 = t33 + 0.1925*c1
     t35 = t34 + 0.081*s1
     t36 = c3*s2
-    t37 = c2*s4 - t36*c4
-    t38 = c2*c4 + t36*s4
+    t37 = c2*s4 - c4*t36
+    t38 = c2*c4 + s4*t36
     t39 = s2*s3
-    t40 = t37*c5 - t39*s5
-    t41 = t37*s5 + t39*c5
+    t40 = t37*c5 - s5*t39
+    t41 = t37*s5 + c5*t39
     t42 = t40*c6 - t38*s6
     t43 = t38*c6 + t40*s6
     t44 = t41*s7 + t42*c7
-    t45 = 0.1363*t41 + 0.13375*t43
+    t45 = 0.13375*t43 + 0.1363*t41
     t46 = -t45 + 0.4*t38
     t47 = t46 + 0.1685*t39
     t48 = t47 - 0.4*c2
@@ -702,7 +702,7 @@ def task_jacobian(q):
     t55 = t52*(t53 - t54)
     t56 = t15*c1
     t57 = t29*s1
-    t58 = -t52*(t56*s2 + t57*s2)
+    t58 = -t52*(s2*t56 + s2*t57)
     t59 = t52*(t15*t6 - t3*t29)
     t60 = t52*(t10*t15 + t24*t29)
     t61 = t52*(t26*t29 - t12*t15)
@@ -711,14 +711,14 @@ def task_jacobian(q):
     J = _stack(xp, [
         -t35,  # 0, 0
         t49,  # 0, 1
-        t33*c2 - t50*s2,  # 0, 2
+        t33*c2 - s2*t50,  # 0, 2
         -(t3*t47 + t32*t39),  # 0, 3
         t24*t46 - t38*t31,  # 0, 4
         t41*t30 - t26*t45,  # 0, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 6
         t21,  # 1, 0
         t50,  # 1, 1
-        -t19*c2 + t49*s2,  # 1, 2
+        -t19*c2 + s2*t49,  # 1, 2
         -t47*t6 + t18*t39,  # 1, 3
         t38*t17 - t10*t46,  # 1, 4
         t41*t16 - t12*t45,  # 1, 5
@@ -739,7 +739,7 @@ def task_jacobian(q):
         t62,  # 3, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
         t63*(t56 + t57),  # 4, 1
-        t63*(t53*s2 - t54*s2),  # 4, 2
+        t63*(s2*t53 - s2*t54),  # 4, 2
         -t63*(t3*t15 + t29*t6),  # 4, 3
         t63*(t24*t15 - t10*t29),  # 4, 4
         t63*(t12*t29 + t26*t15),  # 4, 5
@@ -756,7 +756,7 @@ def task_jacobian(q):
 
 
 def fk_jacobian_dot(q, q_dot):
-    """fk, jacobian and bias_acceleration in one pass, sharing their terms: (4 x 4 and 6 x 7 and 6 x 1), 454 operations."""
+    """fk, jacobian and bias_acceleration in one pass, sharing their terms: (4 x 4 and 6 x 7 and 6 x 1), 453 operations."""
     xp, dtype, device, batch, (q, q_dot,) = _arguments(("q", q, (7,)), ("q_dot", q_dot, (7,)))
     qd1 = q_dot[..., 0]
     qd2 = q_dot[..., 1]
@@ -783,61 +783,61 @@ def fk_jacobian_dot(q, q_dot):
     t0 = qd1 - c2*qd3
     t1 = s1*s3
     t2 = c1*c3
-    t3 = t1 + t2*c2
-    t4 = t2 + t1*c2
+    t3 = t1 + c2*t2
+    t4 = t2 + c2*t1
     t5 = c3*s1
     t6 = c1*s3
-    t7 = t5 - t6*c2
-    t8 = -t6 + t5*c2
+    t7 = t5 - c2*t6
+    t8 = -t6 + c2*t5
     t9 = c1*s2
-    t10 = t3*c4 + t9*s4
-    t11 = -t3*s4 + t9*c4
+    t10 = t3*c4 + s4*t9
+    t11 = -t3*s4 + c4*t9
     t12 = t10*c5 - t7*s5
     t13 = t10*s5 + t7*c5
     t14 = t12*c6 - t11*s6
     t15 = t11*c6 + t12*s6
     t16 = t13*s7 + t14*c7
     t17 = t13*c7 - t14*s7
-    t18 = 0.1363*t13 + 0.13375*t15
+    t18 = 0.13375*t15 + 0.1363*t13
     t19 = -t18 + 0.4*t11
     t20 = t19 + 0.1685*t7
     t21 = t20 - 0.4*t9
     t22 = t21 - 0.1925*s1
     t23 = t22 + 0.081*c1
     t24 = s1*s2
-    t25 = t8*c4 + t24*s4
-    t26 = -t8*s4 + t24*c4
+    t25 = t8*c4 + s4*t24
+    t26 = -t8*s4 + c4*t24
     t27 = t4*s5 + t25*c5
     t28 = t4*c5 - t25*s5
     t29 = t27*c6 - t26*s6
     t30 = t26*c6 + t27*s6
     t31 = t29*c7 - t28*s7
     t32 = t28*c7 + t29*s7
-    t33 = 0.1363*t28 - 0.13375*t30
+    t33 = -0.13375*t30 + 0.1363*t28
     t34 = t33 + 0.4*t26
     t35 = t34 - 0.1685*t4
     t36 = t35 - 0.4*t24
     t37 = t36 + 0.1925*c1
     t38 = t37 + 0.081*s1
     t39 = c3*s2
-    t40 = c2*s4 - t39*c4
-    t41 = c2*c4 + t39*s4
+    t40 = c2*s4 - c4*t39
+    t41 = c2*c4 + s4*t39
     t42 = s2*s3
-    t43 = t40*c5 - t42*s5
-    t44 = t40*s5 + t42*c5
+    t43 = t40*c5 - s5*t42
+    t44 = t40*s5 + c5*t42
     t45 = t43*c6 - t41*s6
     t46 = t41*c6 + t43*s6
     t47 = t44*s7 + t45*c7
     t48 = t44*c7 - t45*s7
-    t49 = 0.1363*t44 + 0.13375*t46
+    t49 = 0.13375*t46 + 0.1363*t44
     t50 = -t49 + 0.4*t41
     t51 = t50 + 0.1685*t42
     t52 = t51 - 0.4*c2
     t53 = 0.317 + t52
-    t54 = t0 + t42*qd4
+    t54 = t0 + qd4*t42
     t55 = t54 + t41*qd5
     t56 = t52*s1
-    t57 = t36*c2 - t56*s2
+    t57 = t36*c2 - s2*t56
     t58 = t57
     t59 = t4*t51 + t35*t42
     t60 = t59
@@ -849,7 +849,7 @@ def fk_jacobian_dot(q, q_dot):
     t66 = t65 - t60*qd4
     t67 = t66 + t58*qd3
     t68 = t52*c1
-    t69 = -t21*c2 + t68*s2
+    t69 = -t21*c2 + s2*t68
     t70 = t69
     t71 = -t51*t7 + t20*t42
     t72 = t71
@@ -875,13 +875,13 @@ def fk_jacobian_dot(q, q_dot):
     t92 = t91 + t83*qd3
     t93 = t92 - t81*qd2
     t94 = qd2*s1
-    t95 = t94 + t9*qd3
+    t95 = t94 + qd3*t9
     t96 = -t95 + t7*qd4
     t97 = t96 + t11*qd5
     t98 = t79 + t52*t94
     t99 = t98 + t23*qd1
     t100 = c1*qd2
-    t101 = t100 - t24*qd3
+    t101 = t100 - qd3*t24
     t102 = t101 - t4*qd4
     t103 = t102 + t26*qd5
     t104 = t67 + t52*t100
@@ -959,18 +959,18 @@ def fk_jacobian_dot(q, q_dot):
         xp.broadcast_to(t114, batch),  # 5, 6
     ], (6, 7))
     a = _stack(xp, [
-        xp.broadcast_to(qd2*(t93*c1 - t56*qd1) + qd3*(t79*c2 - t70*qd1 + t83*t100 - t92*t24) - qd4*(t91*t4 + t72*t0 - t85*t101 + t78*t42) + qd5*(t90*t26 + t87*t102 - t77*t41 - t74*t54) + qd6*(t89*t103 - t76*t55 + t89*t108 + t76*t110) - t99*qd1, batch),  # 0
-        xp.broadcast_to(t105*qd1 + qd2*(t93*s1 + t68*qd1) + qd3*(t58*qd1 - t67*c2 + t92*t9 + t83*t94) + qd4*(t85*t95 - t91*t7 - t60*t0 + t66*t42) + qd5*(t65*t41 + t62*t54 - t90*t11 - t87*t96) + qd6*(t64*t55 - t89*t97 + t89*t106 - t64*t110), batch),  # 1
-        xp.broadcast_to(-qd2*(t104*c1 + t98*s1) - qd3*(t79*t9 + t58*t100 + t70*t94 - t67*s1*s2) + qd4*(t66*t4 + t78*t7 + t60*t101 - t72*t95) + qd5*(t77*t11 + t74*t96 - t65*t26 - t62*t102) - qd6*(t64*t103 - t76*t97 + t76*t106 + t64*t108), batch),  # 2
-        xp.broadcast_to(qd3*(t24*qd1 - t100*c2) + qd4*(t4*t0 + t101*t42) + qd5*(t41*t102 - t26*t54) - qd6*(t28*t55 + t44*t103) + qd7*(t111*t30 - t46*t109) - t100*qd1, batch),  # 3
-        xp.broadcast_to(-qd3*(t9*qd1 + t94*c2) + qd4*(t7*t0 + t95*t42) + qd5*(t11*t54 - t41*t96) + qd6*(t44*t97 - t13*t55) + qd7*(t46*t107 - t111*t15) - t94*qd1, batch),  # 4
-        xp.broadcast_to(qd3*(t115*c1**2 + t115*s1**2) + qd4*(t4*t95 - t7*t101) + qd5*(t26*t96 - t11*t102) + qd6*(t13*t103 + t28*t97) + qd7*(t15*t109 - t30*t107), batch),  # 5
+        xp.broadcast_to(qd2*(t93*c1 - qd1*t56) + qd3*(t79*c2 - t70*qd1 + t83*t100 - t92*t24) - qd4*(-t85*t101 + t91*t4 + t72*t0 + t78*t42) + qd5*(t90*t26 + t87*t102 - t77*t41 - t74*t54) + qd6*(t89*t103 - t76*t55 + t89*t108 + t76*t110) - t99*qd1, batch),  # 0
+        xp.broadcast_to(t105*qd1 + qd2*(t93*s1 + qd1*t68) + qd3*(t58*qd1 - t67*c2 + t92*t9 + t83*t94) + qd4*(t85*t95 - t91*t7 - t60*t0 + t66*t42) + qd5*(t65*t41 + t62*t54 - t90*t11 - t87*t96) + qd6*(t64*t55 - t89*t97 + t89*t106 - t64*t110), batch),  # 1
+        xp.broadcast_to(-qd2*(t104*c1 + t98*s1) - qd3*(-t67*t24 + t79*t9 + t58*t100 + t70*t94) + qd4*(t66*t4 + t78*t7 + t60*t101 - t72*t95) + qd5*(t77*t11 + t74*t96 - t65*t26 - t62*t102) - qd6*(-t76*t97 + t64*t103 + t76*t106 + t64*t108), batch),  # 2
+        xp.broadcast_to(qd3*(qd1*t24 - c2*t100) + qd4*(t4*t0 + t101*t42) + qd5*(t41*t102 - t26*t54) - qd6*(t28*t55 + t44*t103) + qd7*(t111*t30 - t46*t109) - qd1*t100, batch),  # 3
+        xp.broadcast_to(-qd3*(qd1*t9 + c2*t94) + qd4*(t7*t0 + t95*t42) + qd5*(t11*t54 - t41*t96) + qd6*(t44*t97 - t13*t55) + qd7*(t46*t107 - t111*t15) - qd1*t94, batch),  # 4
+        xp.broadcast_to(qd3*(c1**2*t115 + s1**2*t115) + qd4*(t4*t95 - t7*t101) + qd5*(t26*t96 - t11*t102) + qd6*(t13*t103 + t28*t97) + qd7*(t15*t109 - t30*t107), batch),  # 5
     ], (6,))
     return T, J, a
 
 
 def jacobian_dot(q, q_dot):
-    """time derivative dJ/dt of the world geometric Jacobian along q_dot (6 x DOF): (6 x 7), 348 operations."""
+    """time derivative dJ/dt of the world geometric Jacobian along q_dot (6 x DOF): (6 x 7), 347 operations."""
     xp, dtype, device, batch, (q, q_dot,) = _arguments(("q", q, (7,)), ("q_dot", q_dot, (7,)))
     qd1 = q_dot[..., 0]
     qd2 = q_dot[..., 1]
@@ -994,31 +994,31 @@ def jacobian_dot(q, q_dot):
     t0 = qd1 - c2*qd3
     t1 = s1*s3
     t2 = c1*c3
-    t3 = t1 + t2*c2
-    t4 = t2 + t1*c2
+    t3 = t1 + c2*t2
+    t4 = t2 + c2*t1
     t5 = c3*s1
     t6 = c1*s3
-    t7 = t5 - t6*c2
-    t8 = -t6 + t5*c2
+    t7 = t5 - c2*t6
+    t8 = -t6 + c2*t5
     t9 = c1*s2
-    t10 = t3*c4 + t9*s4
-    t11 = -t3*s4 + t9*c4
+    t10 = t3*c4 + s4*t9
+    t11 = -t3*s4 + c4*t9
     t12 = t10*c5 - t7*s5
     t13 = t10*s5 + t7*c5
     t14 = t11*c6 + t12*s6
-    t15 = 0.1363*t13 + 0.13375*t14
+    t15 = 0.13375*t14 + 0.1363*t13
     t16 = -t15 + 0.4*t11
     t17 = t16 + 0.1685*t7
     t18 = t17 - 0.4*t9
     t19 = t18 - 0.1925*s1
     t20 = t19 + 0.081*c1
     t21 = s1*s2
-    t22 = t8*c4 + t21*s4
-    t23 = -t8*s4 + t21*c4
+    t22 = t8*c4 + s4*t21
+    t23 = -t8*s4 + c4*t21
     t24 = t4*s5 + t22*c5
     t25 = t4*c5 - t22*s5
     t26 = t23*c6 + t24*s6
-    t27 = 0.1363*t25 - 0.13375*t26
+    t27 = -0.13375*t26 + 0.1363*t25
     t28 = t27 + 0.4*t23
     t29 = t28 - 0.1685*t4
     t30 = t29 - 0.4*t21
@@ -1034,13 +1034,13 @@ def jacobian_dot(q, q_dot):
     t40 = t39 + t34*qd3
     t41 = t40 - t33*qd2
     t42 = c3*s2
-    t43 = c2*s4 - t42*c4
-    t44 = c2*c4 + t42*s4
-    t45 = s2*s3
-    t46 = t43*c5 - t45*s5
-    t47 = t43*s5 + t45*c5
+    t43 = c2*s4 - c4*t42
+    t44 = c2*c4 + s4*t42
+    t45 = s3*s2
+    t46 = t43*c5 - s5*t45
+    t47 = t43*s5 + c5*t45
     t48 = t44*c6 + t46*s6
-    t49 = 0.1363*t47 + 0.13375*t48
+    t49 = 0.13375*t48 + 0.1363*t47
     t50 = -t49 + 0.4*t44
     t51 = t50 + 0.1685*t45
     t52 = t51 - 0.4*c2
@@ -1052,7 +1052,7 @@ def jacobian_dot(q, q_dot):
     t58 = -t51*t7 + t17*t45
     t59 = t44*t16 - t11*t50
     t60 = t47*t15 - t13*t49
-    t61 = t0 + t45*qd4
+    t61 = t0 + qd4*t45
     t62 = t61 + t44*qd5
     t63 = t55*qd5 + t56*qd6
     t64 = t59*qd5 + t60*qd6
@@ -1061,13 +1061,13 @@ def jacobian_dot(q, q_dot):
     t67 = t65 + t53*qd3
     t68 = t66 + t57*qd3
     t69 = qd2*s1
-    t70 = t69 + t9*qd3
+    t70 = t69 + qd3*t9
     t71 = -t70 + t7*qd4
     t72 = t71 + t11*qd5
     t73 = t68 + t52*t69
     t74 = t73 + t20*qd1
     t75 = c1*qd2
-    t76 = t75 - t21*qd3
+    t76 = t75 - qd3*t21
     t77 = t76 - t4*qd4
     t78 = t77 + t23*qd5
     t79 = t67 + t52*t75
@@ -1085,7 +1085,7 @@ def jacobian_dot(q, q_dot):
         xp.broadcast_to(-t74, batch),  # 0, 0
         xp.broadcast_to(t41*c1 - t52*t87, batch),  # 0, 1
         xp.broadcast_to(t68*c2 - t57*qd1 + t34*t75 - t40*t21, batch),  # 0, 2
-        xp.broadcast_to(-(t39*t4 + t58*t0 - t35*t76 + t66*t45), batch),  # 0, 3
+        xp.broadcast_to(-(-t35*t76 + t39*t4 + t58*t0 + t66*t45), batch),  # 0, 3
         xp.broadcast_to(t38*t23 + t36*t77 - t64*t44 - t59*t61, batch),  # 0, 4
         xp.broadcast_to(t37*t78 - t60*t62 + t37*t83 + t60*t85, batch),  # 0, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 6
@@ -1098,28 +1098,28 @@ def jacobian_dot(q, q_dot):
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
         xp.broadcast_to(-(t79*c1 + t73*s1), batch),  # 2, 1
-        xp.broadcast_to(-(t68*t9 + t53*t75 + t57*t69 - t67*s1*s2), batch),  # 2, 2
+        xp.broadcast_to(-(-t67*t21 + t68*t9 + t53*t75 + t57*t69), batch),  # 2, 2
         xp.broadcast_to(t65*t4 + t66*t7 + t54*t76 - t58*t70, batch),  # 2, 3
         xp.broadcast_to(t64*t11 + t59*t71 - t63*t23 - t55*t77, batch),  # 2, 4
-        xp.broadcast_to(-(t56*t78 - t60*t72 + t60*t81 + t56*t83), batch),  # 2, 5
+        xp.broadcast_to(-(-t60*t72 + t56*t78 + t60*t81 + t56*t83), batch),  # 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
         xp.broadcast_to(-t88, batch),  # 3, 1
-        xp.broadcast_to(t87*s2 - t75*c2, batch),  # 3, 2
+        xp.broadcast_to(s2*t87 - c2*t75, batch),  # 3, 2
         xp.broadcast_to(t4*t0 + t76*t45, batch),  # 3, 3
         xp.broadcast_to(t44*t77 - t23*t61, batch),  # 3, 4
         xp.broadcast_to(-(t25*t62 + t47*t78), batch),  # 3, 5
         xp.broadcast_to(t86*t26 - t48*t84, batch),  # 3, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
         xp.broadcast_to(-t87, batch),  # 4, 1
-        xp.broadcast_to(-(t88*s2 + t69*c2), batch),  # 4, 2
+        xp.broadcast_to(-(s2*t88 + c2*t69), batch),  # 4, 2
         xp.broadcast_to(t7*t0 + t70*t45, batch),  # 4, 3
         xp.broadcast_to(t11*t61 - t44*t71, batch),  # 4, 4
         xp.broadcast_to(t47*t72 - t13*t62, batch),  # 4, 5
         xp.broadcast_to(t48*t82 - t86*t14, batch),  # 4, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 1
-        xp.broadcast_to(t89*c1**2 + t89*s1**2, batch),  # 5, 2
+        xp.broadcast_to(c1**2*t89 + s1**2*t89, batch),  # 5, 2
         xp.broadcast_to(t4*t70 - t7*t76, batch),  # 5, 3
         xp.broadcast_to(t23*t71 - t11*t77, batch),  # 5, 4
         xp.broadcast_to(t13*t78 + t25*t72, batch),  # 5, 5
@@ -1129,7 +1129,7 @@ def jacobian_dot(q, q_dot):
 
 
 def bias_acceleration(q, q_dot):
-    """J' q_dot: the tool's classical linear and angular acceleration at zero joint acceleration, world frame (6): (6 x 1), 409 operations."""
+    """J' q_dot: the tool's classical linear and angular acceleration at zero joint acceleration, world frame (6): (6 x 1), 408 operations."""
     xp, dtype, device, batch, (q, q_dot,) = _arguments(("q", q, (7,)), ("q_dot", q_dot, (7,)))
     qd1 = q_dot[..., 0]
     qd2 = q_dot[..., 1]
@@ -1154,31 +1154,31 @@ def bias_acceleration(q, q_dot):
     t0 = qd1 - c2*qd3
     t1 = s1*s3
     t2 = c1*c3
-    t3 = t1 + t2*c2
-    t4 = t2 + t1*c2
+    t3 = t1 + c2*t2
+    t4 = t2 + c2*t1
     t5 = c3*s1
     t6 = c1*s3
-    t7 = t5 - t6*c2
-    t8 = -t6 + t5*c2
+    t7 = t5 - c2*t6
+    t8 = -t6 + c2*t5
     t9 = c1*s2
-    t10 = t3*c4 + t9*s4
-    t11 = -t3*s4 + t9*c4
+    t10 = t3*c4 + s4*t9
+    t11 = -t3*s4 + c4*t9
     t12 = t10*c5 - t7*s5
     t13 = t10*s5 + t7*c5
     t14 = t11*c6 + t12*s6
-    t15 = 0.1363*t13 + 0.13375*t14
+    t15 = 0.13375*t14 + 0.1363*t13
     t16 = -t15 + 0.4*t11
     t17 = t16 + 0.1685*t7
     t18 = t17 - 0.4*t9
     t19 = t18 - 0.1925*s1
     t20 = t19 + 0.081*c1
     t21 = s1*s2
-    t22 = t8*c4 + t21*s4
-    t23 = -t8*s4 + t21*c4
+    t22 = t8*c4 + s4*t21
+    t23 = -t8*s4 + c4*t21
     t24 = t4*s5 + t22*c5
     t25 = t4*c5 - t22*s5
     t26 = t23*c6 + t24*s6
-    t27 = 0.1363*t25 - 0.13375*t26
+    t27 = -0.13375*t26 + 0.1363*t25
     t28 = t27 + 0.4*t23
     t29 = t28 - 0.1685*t4
     t30 = t29 - 0.4*t21
@@ -1194,13 +1194,13 @@ def bias_acceleration(q, q_dot):
     t40 = t39 + t34*qd3
     t41 = t40 - t33*qd2
     t42 = c3*s2
-    t43 = c2*s4 - t42*c4
-    t44 = c2*c4 + t42*s4
-    t45 = s2*s3
-    t46 = t43*c5 - t45*s5
-    t47 = t43*s5 + t45*c5
+    t43 = c2*s4 - c4*t42
+    t44 = c2*c4 + s4*t42
+    t45 = s3*s2
+    t46 = t43*c5 - s5*t45
+    t47 = t43*s5 + c5*t45
     t48 = t44*c6 + t46*s6
-    t49 = 0.1363*t47 + 0.13375*t48
+    t49 = 0.13375*t48 + 0.1363*t47
     t50 = -t49 + 0.4*t44
     t51 = t50 + 0.1685*t45
     t52 = t51 - 0.4*c2
@@ -1212,7 +1212,7 @@ def bias_acceleration(q, q_dot):
     t58 = -t51*t7 + t17*t45
     t59 = t44*t16 - t11*t50
     t60 = t47*t15 - t13*t49
-    t61 = t0 + t45*qd4
+    t61 = t0 + qd4*t45
     t62 = t61 + t44*qd5
     t63 = t55*qd5 + t56*qd6
     t64 = t59*qd5 + t60*qd6
@@ -1221,13 +1221,13 @@ def bias_acceleration(q, q_dot):
     t67 = t65 + t53*qd3
     t68 = t66 + t57*qd3
     t69 = qd2*s1
-    t70 = t69 + t9*qd3
+    t70 = t69 + qd3*t9
     t71 = -t70 + t7*qd4
     t72 = t71 + t11*qd5
     t73 = t68 + t52*t69
     t74 = t73 + t20*qd1
     t75 = c1*qd2
-    t76 = t75 - t21*qd3
+    t76 = t75 - qd3*t21
     t77 = t76 - t4*qd4
     t78 = t77 + t23*qd5
     t79 = t67 + t52*t75
@@ -1238,15 +1238,15 @@ def bias_acceleration(q, q_dot):
     t84 = t78 + t83
     t85 = t47*qd6
     t86 = t62 - t85
-    t87 = t52*qd1
+    t87 = qd1*t52
     t88 = qd2*s2
     a = _stack(xp, [
-        xp.broadcast_to(qd2*(t41*c1 - t87*s1) + qd3*(t68*c2 - t57*qd1 + t34*t75 - t40*t21) - qd4*(t39*t4 + t58*t0 - t35*t76 + t66*t45) + qd5*(t38*t23 + t36*t77 - t64*t44 - t59*t61) + qd6*(t37*t78 - t60*t62 + t37*t83 + t60*t85) - t74*qd1, batch),  # 0
-        xp.broadcast_to(t80*qd1 + qd2*(t41*s1 + t87*c1) + qd3*(t53*qd1 - t67*c2 + t40*t9 + t34*t69) + qd4*(t35*t70 - t39*t7 - t54*t0 + t65*t45) + qd5*(t63*t44 + t55*t61 - t38*t11 - t36*t71) + qd6*(t56*t62 - t37*t72 + t37*t81 - t56*t85), batch),  # 1
-        xp.broadcast_to(-qd2*(t79*c1 + t73*s1) - qd3*(t68*t9 + t53*t75 + t57*t69 - t67*s1*s2) + qd4*(t65*t4 + t66*t7 + t54*t76 - t58*t70) + qd5*(t64*t11 + t59*t71 - t63*t23 - t55*t77) - qd6*(t56*t78 - t60*t72 + t60*t81 + t56*t83), batch),  # 2
-        xp.broadcast_to(qd3*(t21*qd1 - t75*c2) + qd4*(t4*t0 + t76*t45) + qd5*(t44*t77 - t23*t61) - qd6*(t25*t62 + t47*t78) + qd7*(t86*t26 - t48*t84) - t75*qd1, batch),  # 3
-        xp.broadcast_to(-qd3*(t9*qd1 + t69*c2) + qd4*(t7*t0 + t70*t45) + qd5*(t11*t61 - t44*t71) + qd6*(t47*t72 - t13*t62) + qd7*(t48*t82 - t86*t14) - t69*qd1, batch),  # 4
-        xp.broadcast_to(qd3*(t88*c1**2 + t88*s1**2) + qd4*(t4*t70 - t7*t76) + qd5*(t23*t71 - t11*t77) + qd6*(t13*t78 + t25*t72) + qd7*(t14*t84 - t26*t82), batch),  # 5
+        xp.broadcast_to(qd2*(t41*c1 - s1*t87) + qd3*(t68*c2 - t57*qd1 + t34*t75 - t40*t21) - qd4*(-t35*t76 + t39*t4 + t58*t0 + t66*t45) + qd5*(t38*t23 + t36*t77 - t64*t44 - t59*t61) + qd6*(t37*t78 - t60*t62 + t37*t83 + t60*t85) - t74*qd1, batch),  # 0
+        xp.broadcast_to(t80*qd1 + qd2*(t41*s1 + c1*t87) + qd3*(t53*qd1 - t67*c2 + t40*t9 + t34*t69) + qd4*(t35*t70 - t39*t7 - t54*t0 + t65*t45) + qd5*(t63*t44 + t55*t61 - t38*t11 - t36*t71) + qd6*(t56*t62 - t37*t72 + t37*t81 - t56*t85), batch),  # 1
+        xp.broadcast_to(-qd2*(t79*c1 + t73*s1) - qd3*(-t67*t21 + t68*t9 + t53*t75 + t57*t69) + qd4*(t65*t4 + t66*t7 + t54*t76 - t58*t70) + qd5*(t64*t11 + t59*t71 - t63*t23 - t55*t77) - qd6*(-t60*t72 + t56*t78 + t60*t81 + t56*t83), batch),  # 2
+        xp.broadcast_to(qd3*(qd1*t21 - c2*t75) + qd4*(t4*t0 + t76*t45) + qd5*(t44*t77 - t23*t61) - qd6*(t25*t62 + t47*t78) + qd7*(t86*t26 - t48*t84) - qd1*t75, batch),  # 3
+        xp.broadcast_to(-qd3*(qd1*t9 + c2*t69) + qd4*(t7*t0 + t70*t45) + qd5*(t11*t61 - t44*t71) + qd6*(t47*t72 - t13*t62) + qd7*(t48*t82 - t86*t14) - qd1*t69, batch),  # 4
+        xp.broadcast_to(qd3*(c1**2*t88 + s1**2*t88) + qd4*(t4*t70 - t7*t76) + qd5*(t23*t71 - t11*t77) + qd6*(t13*t78 + t25*t72) + qd7*(t14*t84 - t26*t82), batch),  # 5
     ], (6,))
     return a
 
@@ -1278,35 +1278,35 @@ def task_jacobian_dot(q, q_dot):
     s7 = trig[..., 13]
     t0 = s1*s3
     t1 = c1*c3
-    t2 = t0 + t1*c2
-    t3 = t1 + t0*c2
+    t2 = t0 + c2*t1
+    t3 = t1 + c2*t0
     t4 = c3*s1
     t5 = c1*s3
-    t6 = t4 - t5*c2
-    t7 = -t5 + t4*c2
+    t6 = t4 - c2*t5
+    t7 = -t5 + c2*t4
     t8 = c1*s2
-    t9 = t2*c4 + t8*s4
-    t10 = -t2*s4 + t8*c4
+    t9 = t2*c4 + s4*t8
+    t10 = -t2*s4 + c4*t8
     t11 = t9*c5 - t6*s5
     t12 = t9*s5 + t6*c5
     t13 = t11*c6 - t10*s6
     t14 = t10*c6 + t11*s6
     t15 = t12*s7 + t13*c7
-    t16 = 0.1363*t12 + 0.13375*t14
+    t16 = 0.13375*t14 + 0.1363*t12
     t17 = -t16 + 0.4*t10
     t18 = t17 + 0.1685*t6
     t19 = t18 - 0.4*t8
     t20 = t19 - 0.1925*s1
     t21 = t20 + 0.081*c1
     t22 = s1*s2
-    t23 = t7*c4 + t22*s4
-    t24 = -t7*s4 + t22*c4
+    t23 = t7*c4 + s4*t22
+    t24 = -t7*s4 + c4*t22
     t25 = t3*s5 + t23*c5
     t26 = t3*c5 - t23*s5
     t27 = t25*c6 - t24*s6
     t28 = t24*c6 + t25*s6
     t29 = t27*c7 - t26*s7
-    t30 = 0.1363*t26 - 0.13375*t28
+    t30 = -0.13375*t28 + 0.1363*t26
     t31 = t30 + 0.4*t24
     t32 = t31 - 0.1685*t3
     t33 = t32 - 0.4*t22
@@ -1322,15 +1322,15 @@ def task_jacobian_dot(q, q_dot):
     t43 = t42 + t37*qd3
     t44 = t43 - t36*qd2
     t45 = c3*s2
-    t46 = c2*s4 - t45*c4
-    t47 = c2*c4 + t45*s4
-    t48 = s2*s3
-    t49 = t46*c5 - t48*s5
-    t50 = t46*s5 + t48*c5
+    t46 = c2*s4 - c4*t45
+    t47 = c2*c4 + s4*t45
+    t48 = s3*s2
+    t49 = t46*c5 - s5*t48
+    t50 = t46*s5 + c5*t48
     t51 = t49*c6 - t47*s6
     t52 = t47*c6 + t49*s6
     t53 = t50*s7 + t51*c7
-    t54 = 0.1363*t50 + 0.13375*t52
+    t54 = 0.13375*t52 + 0.1363*t50
     t55 = -t54 + 0.4*t47
     t56 = t55 + 0.1685*t48
     t57 = t56 - 0.4*c2
@@ -1352,8 +1352,8 @@ def task_jacobian_dot(q, q_dot):
     t73 = t71 + t57*t72
     t74 = t73 + t21*qd1
     t75 = t58*qd1 - t70*c2 + t43*t8 + t37*t72
-    t76 = t8*qd1 + t72*c2
-    t77 = t72 + t8*qd3
+    t76 = qd1*t8 + c2*t72
+    t77 = t72 + qd3*t8
     t78 = t77
     t79 = c1*qd2
     t80 = t70 + t57*t79
@@ -1361,8 +1361,8 @@ def task_jacobian_dot(q, q_dot):
     t82 = t71*c2 - t62*qd1 + t37*t79 - t43*t22
     t83 = t80*c1 + t73*s1
     t84 = t71*t8 + t58*t79 + t62*t72 - t70*t22
-    t85 = t22*qd1 - t79*c2
-    t86 = t79 - t22*qd3
+    t85 = qd1*t22 - c2*t79
+    t86 = t79 - qd3*t22
     t87 = t86
     t88 = t68*t3 + t69*t6 + t59*t87 - t63*t78
     t89 = t3*t78 - t6*t87
@@ -1378,7 +1378,7 @@ def task_jacobian_dot(q, q_dot):
     t99 = t87 + t98
     t100 = t67*t10 + t64*t97 - t66*t24 - t60*t99
     t101 = t24*t97 - t10*t99
-    t102 = t48*qd4
+    t102 = qd4*t48
     t103 = t91 + t102
     t104 = t41*t24 + t39*t99 - t67*t47 - t64*t103
     t105 = t66*t47 + t60*t103 - t41*t10 - t39*t97
@@ -1395,12 +1395,12 @@ def task_jacobian_dot(q, q_dot):
     t116 = t50*t109 - t12*t114
     t117 = t12*qd6
     t118 = t109 - t117
-    t119 = t117 + t77 - t96 - t108 + t14*qd7
+    t119 = t117 + t14*qd7 - t108 - t96 + t77
     t120 = t26*qd6
     t121 = t111 + t120
     t122 = t61*t111 - t65*t109 + t65*t117 + t61*t120
     t123 = t14*t121 - t28*t118
-    t124 = t86 + t98 + t110 + t120 - t28*qd7
+    t124 = t98 + t110 + t120 - t28*qd7 + t86
     t125 = t119*t29 + t124*t15
     t126 = t50*qd6
     t127 = t40*t111 - t65*t114 + t40*t120 + t65*t126
@@ -1409,14 +1409,14 @@ def task_jacobian_dot(q, q_dot):
     t130 = t114 + t129
     t131 = t130*t28 - t52*t121
     t132 = t52*t118 - t130*t14
-    t133 = t90 + t102 + t113 + t129 - t52*qd7
+    t133 = t102 + t113 + t129 - t52*qd7 + t90
     t134 = t124*t53 - t133*t29
     t135 = t119*t53 + t133*t15
-    t136 = t57*qd1
-    t137 = t44*c1 - t136*s1
-    t138 = t44*s1 + t136*c1
+    t136 = qd1*t57
+    t137 = t44*c1 - s1*t136
+    t138 = t44*s1 + c1*t136
     t139 = qd2*s2
-    t140 = t139*c1**2 + t139*s1**2
+    t140 = c1**2*t139 + s1**2*t139
     t141 = t15**2 + t29**2
     t142 = 1/t141
     t143 = s1*t142
@@ -1428,15 +1428,15 @@ def task_jacobian_dot(q, q_dot):
     t149 = t15*t148
     t150 = c1*t142
     t151 = t29*t148
-    t152 = t15*qd1
-    t153 = t29*qd1
-    t154 = t150*s2
+    t152 = qd1*t15
+    t153 = qd1*t29
+    t154 = s2*t150
     t155 = t15*c1
     t156 = t29*s1
-    t157 = -(t155*s2 + t156*s2)
-    t158 = t147*t157
+    t157 = -(s2*t155 + s2*t156)
+    t158 = t157*t147
     t159 = t15*t158
-    t160 = t143*s2
+    t160 = s2*t143
     t161 = t29*t158
     t162 = t15*t142
     t163 = t85*t162
@@ -1444,7 +1444,7 @@ def task_jacobian_dot(q, q_dot):
     t165 = t76*t164
     t166 = t6*t142
     t167 = t15*t6 - t3*t29
-    t168 = t147*t167
+    t168 = t167*t147
     t169 = t15*t168
     t170 = t3*t142
     t171 = t29*t168
@@ -1452,7 +1452,7 @@ def task_jacobian_dot(q, q_dot):
     t173 = t95*t164
     t174 = t10*t142
     t175 = t10*t15 + t24*t29
-    t176 = t147*t175
+    t176 = t175*t147
     t177 = t15*t176
     t178 = t24*t142
     t179 = t29*t176
@@ -1460,7 +1460,7 @@ def task_jacobian_dot(q, q_dot):
     t181 = t107*t164
     t182 = t12*t142
     t183 = t26*t29 - t12*t15
-    t184 = t147*t183
+    t184 = t183*t147
     t185 = t15*t184
     t186 = t26*t142
     t187 = t29*t184
@@ -1468,7 +1468,7 @@ def task_jacobian_dot(q, q_dot):
     t189 = t115*t162
     t190 = t14*t142
     t191 = -(t14*t15 + t28*t29)
-    t192 = t147*t191
+    t192 = t191*t147
     t193 = t15*t192
     t194 = t28*t142
     t195 = t29*t192
@@ -1479,8 +1479,8 @@ def task_jacobian_dot(q, q_dot):
     t200 = 1/t141**1.5
     t201 = t200*(t155 + t156)
     t202 = s1*t198
-    t203 = t198*qd1
-    t204 = t200*(t144*s2 - t145*s2)
+    t203 = qd1*t198
+    t204 = t200*(s2*t144 - s2*t145)
     t205 = t29*t198
     t206 = t15*t198
     t207 = -t200*(t3*t15 + t29*t6)
@@ -1489,7 +1489,7 @@ def task_jacobian_dot(q, q_dot):
     t210 = t200*(t14*t29 - t28*t15)
     t211 = t53*t143
     t212 = t53*t150
-    t213 = t125*t142
+    t213 = t142*t125
     Jd = _stack(xp, [
         xp.broadcast_to(-t74, batch),  # 0, 0
         xp.broadcast_to(t137, batch),  # 0, 1
@@ -1521,13 +1521,13 @@ def task_jacobian_dot(q, q_dot):
         xp.broadcast_to(-t134*(t190 + t193) - t135*(t194 + t195) + t196 + t197, batch),  # 3, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
         xp.broadcast_to(t134*(t199 - t15*t201) + t135*(t202 - t29*t201) + t144*t203 - t145*t203, batch),  # 4, 1
-        xp.broadcast_to(-t134*(t15*t204 + t202*s2) + t135*(t199*s2 - t29*t204) - t85*t205 - t76*t206, batch),  # 4, 2
+        xp.broadcast_to(-t134*(t15*t204 + s2*t202) + t135*(s2*t199 - t29*t204) - t85*t205 - t76*t206, batch),  # 4, 2
         xp.broadcast_to(-t134*(t3*t198 + t15*t207) - t135*(t6*t198 + t29*t207) + t95*t206 - t94*t205, batch),  # 4, 3
         xp.broadcast_to(t134*(t24*t198 - t15*t208) - t135*(t10*t198 + t29*t208) + t107*t206 - t106*t205, batch),  # 4, 4
         xp.broadcast_to(t134*(t26*t198 - t15*t209) + t135*(t12*t198 - t29*t209) + t115*t205 + t116*t206, batch),  # 4, 5
         xp.broadcast_to(-t134*(t28*t198 + t15*t210) + t135*(t14*t198 - t29*t210) + t132*t206 - t131*t205, batch),  # 4, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 0
-        xp.broadcast_to(t134*(t211 + t53*t149) + t135*(-t212 + t53*t151) + t146*t213 + t152*t212 + t153*t211, batch),  # 5, 1
+        xp.broadcast_to(t134*(t211 + t53*t149) + t135*(-t212 + t53*t151) + t146*t213 + t212*t152 + t211*t153, batch),  # 5, 1
         xp.broadcast_to(t140 + t134*(t53*t154 + t53*t159) + t135*(t53*t160 + t53*t161) + t157*t213 + t53*t165 - t53*t163, batch),  # 5, 2
         xp.broadcast_to(t89 + t134*(-t53*t166 + t53*t169) + t135*(t53*t170 + t53*t171) + t167*t213 - t53*t172 - t53*t173, batch),  # 5, 3
         xp.broadcast_to(t101 + t134*(-t53*t174 + t53*t177) + t135*(-t53*t178 + t53*t179) + t175*t213 - t53*t180 - t53*t181, batch),  # 5, 4
@@ -1555,31 +1555,31 @@ def hessian(q):
     s6 = trig[..., 11]
     t0 = s1*s3
     t1 = c1*c3
-    t2 = t0 + t1*c2
-    t3 = t1 + t0*c2
+    t2 = t0 + c2*t1
+    t3 = t1 + c2*t0
     t4 = c3*s1
     t5 = c1*s3
-    t6 = t4 - t5*c2
-    t7 = -t5 + t4*c2
+    t6 = t4 - c2*t5
+    t7 = -t5 + c2*t4
     t8 = c1*s2
-    t9 = t2*c4 + t8*s4
-    t10 = -t2*s4 + t8*c4
+    t9 = t2*c4 + s4*t8
+    t10 = -t2*s4 + c4*t8
     t11 = t9*c5 - t6*s5
     t12 = t9*s5 + t6*c5
     t13 = t10*c6 + t11*s6
-    t14 = 0.1363*t12 + 0.13375*t13
+    t14 = 0.13375*t13 + 0.1363*t12
     t15 = -t14 + 0.4*t10
     t16 = t15 + 0.1685*t6
     t17 = t16 - 0.4*t8
     t18 = t17 - 0.1925*s1
     t19 = t18 + 0.081*c1
     t20 = s1*s2
-    t21 = t7*c4 + t20*s4
-    t22 = -t7*s4 + t20*c4
+    t21 = t7*c4 + s4*t20
+    t22 = -t7*s4 + c4*t20
     t23 = t3*s5 + t21*c5
     t24 = t3*c5 - t21*s5
     t25 = t22*c6 + t23*s6
-    t26 = 0.1363*t24 - 0.13375*t25
+    t26 = -0.13375*t25 + 0.1363*t24
     t27 = t26 + 0.4*t22
     t28 = t27 - 0.1685*t3
     t29 = t28 - 0.4*t20
@@ -1591,13 +1591,13 @@ def hessian(q):
     t35 = t10*t27 - t22*t15
     t36 = t24*t14 - t12*t26
     t37 = c3*s2
-    t38 = c2*s4 - t37*c4
-    t39 = c2*c4 + t37*s4
-    t40 = s2*s3
-    t41 = t38*c5 - t40*s5
-    t42 = t38*s5 + t40*c5
+    t38 = c2*s4 - c4*t37
+    t39 = c2*c4 + s4*t37
+    t40 = s3*s2
+    t41 = t38*c5 - s5*t40
+    t42 = t38*s5 + c5*t40
     t43 = t39*c6 + t41*s6
-    t44 = 0.1363*t42 + 0.13375*t43
+    t44 = 0.13375*t43 + 0.1363*t42
     t45 = -t44 + 0.4*t39
     t46 = t45 + 0.1685*t40
     t47 = t46 - 0.4*c2
@@ -1608,9 +1608,9 @@ def hessian(q):
     t52 = t39*t15 - t10*t45
     t53 = t42*t14 - t12*t44
     t54 = t47*s1
-    t55 = t29*c2 - t54*s2
+    t55 = t29*c2 - s2*t54
     t56 = t47*c1
-    t57 = -t17*c2 + t56*s2
+    t57 = -t17*c2 + s2*t56
     t58 = -t54
     t59 = -t57
     t60 = -t51
@@ -1717,14 +1717,14 @@ def hessian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 3, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 3, 1
         -c1*c2,  # 1, 3, 2
-        t5*s2,  # 1, 3, 3
+        s2*t5,  # 1, 3, 3
         t39*c1,  # 1, 3, 4
         -t42*c1,  # 1, 3, 5
         -t43*c1,  # 1, 3, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 4, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 4, 1
         -c2*s1,  # 1, 4, 2
-        t0*s2,  # 1, 4, 3
+        s2*t0,  # 1, 4, 3
         t39*s1,  # 1, 4, 4
         -t42*s1,  # 1, 4, 5
         -t43*s1,  # 1, 4, 6
@@ -1759,14 +1759,14 @@ def hessian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 3, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 3, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 3, 2
-        -(t3*c2 + t0*t87),  # 2, 3, 3
+        -(t3*c2 + t87*t0),  # 2, 3, 3
         t22*c2 - t39*t20,  # 2, 3, 4
         t24*c2 + t42*t20,  # 2, 3, 5
         -t25*c2 + t43*t20,  # 2, 3, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 4, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 4, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 4, 2
-        -t6*c2 + t5*t87,  # 2, 4, 3
+        -t6*c2 + t87*t5,  # 2, 4, 3
         -t10*c2 + t39*t8,  # 2, 4, 4
         t12*c2 - t42*t8,  # 2, 4, 5
         t13*c2 - t43*t8,  # 2, 4, 6
@@ -1950,7 +1950,7 @@ def hessian(q):
 
 
 def singularity_factors(q):
-    """factors of det(Js Js^T): the robot is singular where one is 0: (1 x 1), 733 operations."""
+    """factors of det(Js Js^T): the robot is singular where one is 0: (1 x 1), 723 operations."""
     xp, dtype, device, batch, (q,) = _arguments(("q", q, (7,)))
     trig = _cos_sin(xp, q, (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0), device)
     c1 = trig[..., 0]
@@ -1967,31 +1967,31 @@ def singularity_factors(q):
     s6 = trig[..., 11]
     t0 = s1*s3
     t1 = c1*c3
-    t2 = t0 + t1*c2
-    t3 = t1 + t0*c2
+    t2 = t0 + c2*t1
+    t3 = t1 + c2*t0
     t4 = c3*s1
     t5 = c1*s3
-    t6 = t4 - t5*c2
-    t7 = -t5 + t4*c2
+    t6 = t4 - c2*t5
+    t7 = -t5 + c2*t4
     t8 = c1*s2
-    t9 = t2*c4 + t8*s4
-    t10 = -t2*s4 + t8*c4
+    t9 = t2*c4 + s4*t8
+    t10 = -t2*s4 + c4*t8
     t11 = t9*c5 - t6*s5
     t12 = t9*s5 + t6*c5
     t13 = t10*c6 + t11*s6
-    t14 = 0.1363*t12 + 0.13375*t13
+    t14 = 0.13375*t13 + 0.1363*t12
     t15 = -t14 + 0.4*t10
     t16 = t15 + 0.1685*t6
     t17 = t16 - 0.4*t8
     t18 = t17 - 0.1925*s1
     t19 = t18 + 0.081*c1
     t20 = s1*s2
-    t21 = t7*c4 + t20*s4
-    t22 = -t7*s4 + t20*c4
+    t21 = t7*c4 + s4*t20
+    t22 = -t7*s4 + c4*t20
     t23 = t3*s5 + t21*c5
     t24 = t3*c5 - t21*s5
     t25 = t22*c6 + t23*s6
-    t26 = 0.1363*t24 - 0.13375*t25
+    t26 = -0.13375*t25 + 0.1363*t24
     t27 = t26 + 0.4*t22
     t28 = t27 - 0.1685*t3
     t29 = t28 - 0.4*t20
@@ -2003,13 +2003,13 @@ def singularity_factors(q):
     t35 = t10*t27 - t22*t15
     t36 = t24*t14 - t12*t26
     t37 = c3*s2
-    t38 = c2*s4 - t37*c4
-    t39 = c2*c4 + t37*s4
-    t40 = s2*s3
-    t41 = t38*c5 - t40*s5
-    t42 = t38*s5 + t40*c5
+    t38 = c2*s4 - c4*t37
+    t39 = c2*c4 + s4*t37
+    t40 = s3*s2
+    t41 = t38*c5 - s5*t40
+    t42 = t38*s5 + c5*t40
     t43 = t39*c6 + t41*s6
-    t44 = 0.1363*t42 + 0.13375*t43
+    t44 = 0.13375*t43 + 0.1363*t42
     t45 = -t44 + 0.4*t39
     t46 = t45 + 0.1685*t40
     t47 = t46 - 0.4*c2
@@ -2022,111 +2022,111 @@ def singularity_factors(q):
     t54 = t39*t15 - t10*t45
     t55 = t42*t14 - t12*t44
     t56 = t3*t42 - t24*t40
-    t57 = -(t3*t39 + t22*t40)
-    t58 = -(t22*t42 + t39*t24)
-    t59 = -(t10*t56 + t12*t57 - t6*t58)
-    t60 = t12*c1
-    t61 = -(s1*t58 + t39*t60 - t10*t42*c1)
-    t62 = t6*c1
-    t63 = -(s1*t57 + t39*t62 - t10*c1*s2*s3)
-    t64 = t5*s2
-    t65 = -(s1*t56 - t42*t6*c1 + t12*t64)
-    t66 = -(t32*t59 + t34*t61 + t36*t63 - t35*t65)
-    t67 = t10*t24 + t22*t12
-    t68 = t60 - t24*s1
-    t69 = t10*c1
-    t70 = -(t69 + t22*s1)
-    t71 = t32*t67 + t35*t68 - t36*t70
+    t57 = t6*c1
+    t58 = s2*t5
+    t59 = -(s1*t56 - t42*t57 + t12*t58)
+    t60 = -(t22*t42 + t39*t24)
+    t61 = -(t3*t39 + t22*t40)
+    t62 = -(-t6*t60 + t10*t56 + t12*t61)
+    t63 = t10*c1
+    t64 = t12*c1
+    t65 = -(s1*t60 - t42*t63 + t39*t64)
+    t66 = -(s1*t61 + t39*t57 - t10*t58)
+    t67 = -(-t35*t59 + t32*t62 + t34*t65 + t36*t66)
+    t68 = t10*t24 + t22*t12
+    t69 = t64 - t24*s1
+    t70 = -(t63 + t22*s1)
+    t71 = t32*t68 + t35*t69 - t36*t70
     t72 = t3*t10 + t22*t6
-    t73 = t3*s1 - t62
+    t73 = t3*s1 - t57
     t74 = t32*t72 + t34*t70 - t35*t73
     t75 = t24*t6 - t3*t12
-    t76 = t32*t75 + t34*t68 - t36*t73
-    t77 = -(t34*t67 + t36*t72 - t35*t75)
-    t78 = t47*s1
+    t76 = t32*t75 + t34*t69 - t36*t73
+    t77 = -(-t35*t75 + t34*t68 + t36*t72)
+    t78 = s1*t47
     t79 = t24*c2 + t42*t20
-    t80 = t22*c2 - t39*t20
-    t81 = -(t10*t79 + t12*t80 + t58*t8)
-    t82 = c1**2
-    t83 = -(s1*t80 + t69*c2 - t39*s2*t82)
-    t84 = s2*t82
-    t85 = -(s1*t79 + t42*t84 - t12*c1*c2)
-    t86 = -(t32*t81 + t33*t61 + t36*t83 - t35*t85)
+    t80 = c1**2
+    t81 = s2*t80
+    t82 = -(s1*t79 - c2*t64 + t42*t81)
+    t83 = t22*c2 - t39*t20
+    t84 = -(t10*t79 + t12*t83 + t60*t8)
+    t85 = -(s1*t83 - t39*t81 + c2*t63)
+    t86 = -(-t35*t82 + t32*t84 + t33*t65 + t36*t85)
     t87 = t10*t20 - t22*t8
-    t88 = t84 + s2*s1**2
+    t88 = t81 + s2*s1**2
     t89 = t32*t87 + t33*t70 - t35*t88
     t90 = -(t12*t20 + t24*t8)
-    t91 = t32*t90 + t33*t68 - t36*t88
-    t92 = -(t33*t67 + t36*t87 - t35*t90)
+    t91 = t32*t90 + t33*t69 - t36*t88
+    t92 = -(-t35*t90 + t33*t68 + t36*t87)
     t93 = s2**2
-    t94 = -(t3*c2 + t0*t93)
-    t95 = -(t12*t94 + t6*t79 + t8*t56)
-    t96 = -(s1*t94 + t62*c2 - s3*t82*t93)
-    t97 = -(t32*t95 + t33*t65 + t36*t96 - t34*t85)
+    t94 = -(t3*c2 + t93*t0)
+    t95 = -(t12*t94 + t6*t79 + t56*t8)
+    t96 = -(s1*t94 - s3*t80*t93 + c2*t57)
+    t97 = -(-t34*t82 + t32*t95 + t33*t59 + t36*t96)
     t98 = t3*t8 + t6*t20
     t99 = t32*t98 + t33*t73 - t34*t88
-    t100 = -(t33*t75 + t36*t98 - t34*t90)
-    t101 = -(t6*t80 - t10*t94 + t8*t57)
-    t102 = -(t32*t101 + t33*t63 + t35*t96 - t34*t83)
-    t103 = t33*t59 + t35*t95 - t34*t81 - t36*t101
-    t104 = -(t33*t72 + t35*t98 - t34*t87)
-    t105 = t47*c1
-    t106 = t48*(t19*t66 + t53*t71 + t55*t74 - t54*t76 - t77*t78) + t49*(t19*t86 + t52*t71 + t55*t89 - t54*t91 - t78*t92) + t50*(t19*t97 + t52*t76 + t55*t99 - t53*t91 - t78*t100) - t31*(t53*t86 + t55*t102 - t52*t66 - t54*t97 + t78*t103) - t51*(t19*t102 + t52*t74 + t54*t99 - t53*t89 - t78*t104) - t105*(t19*t103 + t53*t92 + t55*t104 - t52*t77 - t54*t100)
+    t100 = -(-t34*t90 + t33*t75 + t36*t98)
+    t101 = -(-t10*t94 + t6*t83 + t61*t8)
+    t102 = -(-t34*t85 + t32*t101 + t33*t66 + t35*t96)
+    t103 = t33*t62 + t35*t95 - t34*t84 - t36*t101
+    t104 = -(-t34*t87 + t33*t72 + t35*t98)
+    t105 = c1*t47
+    t106 = t48*(t19*t67 + t53*t71 + t55*t74 - t54*t76 - t77*t78) + t49*(t19*t86 + t52*t71 + t55*t89 - t54*t91 - t92*t78) + t50*(t19*t97 + t52*t76 + t55*t99 - t53*t91 - t100*t78) - t31*(t53*t86 + t55*t102 - t52*t67 - t54*t97 + t103*t78) - t51*(t19*t102 + t52*t74 + t54*t99 - t53*t89 - t104*t78) - (t19*t103 + t53*t92 + t55*t104 - t52*t77 - t54*t100)*t105
     t107 = t3*t43 + t25*t40
-    t108 = t39*t25 - t22*t43
-    t109 = -(t10*t107 + t13*t57 - t6*t108)
-    t110 = t13*c1
-    t111 = -(s1*t108 + t39*t110 - t10*t43*c1)
-    t112 = -(s1*t107 - t43*t6*c1 + t13*t64)
-    t113 = -(t32*t109 + t34*t111 - t35*t112)
+    t108 = -(s1*t107 - t43*t57 + t13*t58)
+    t109 = t39*t25 - t22*t43
+    t110 = -(-t6*t109 + t10*t107 + t13*t61)
+    t111 = t13*c1
+    t112 = -(s1*t109 - t43*t63 + t39*t111)
+    t113 = -(-t35*t108 + t32*t110 + t34*t112)
     t114 = t22*t13 - t10*t25
-    t115 = t110 + t25*s1
+    t115 = t111 + t25*s1
     t116 = t32*t114 + t35*t115
     t117 = -(t3*t13 + t25*t6)
     t118 = t32*t117 + t34*t115
     t119 = t35*t117 - t34*t114
-    t120 = t19*t113 + t53*t116 - t54*t118 - t78*t119
+    t120 = t19*t113 + t53*t116 - t54*t118 - t119*t78
     t121 = -t25*c2 + t43*t20
-    t122 = -(t10*t121 + t13*t80 + t8*t108)
-    t123 = -(s1*t121 + t43*t84 - t13*c1*c2)
-    t124 = -(t32*t122 + t33*t111 - t35*t123)
+    t122 = -(s1*t121 - c2*t111 + t43*t81)
+    t123 = -(t10*t121 + t13*t83 + t109*t8)
+    t124 = -(-t35*t122 + t32*t123 + t33*t112)
     t125 = t25*t8 - t13*t20
     t126 = t32*t125 + t33*t115
     t127 = t35*t125 - t33*t114
-    t128 = t19*t124 + t52*t116 - t54*t126 - t78*t127
-    t129 = -(t13*t94 + t6*t121 + t8*t107)
-    t130 = -(t32*t129 + t33*t112 - t34*t123)
+    t128 = t19*t124 + t52*t116 - t54*t126 - t127*t78
+    t129 = -(t13*t94 + t6*t121 + t107*t8)
+    t130 = -(-t34*t122 + t32*t129 + t33*t108)
     t131 = t34*t125 - t33*t117
-    t132 = t19*t130 + t52*t118 - t53*t126 - t78*t131
-    t133 = t33*t109 + t35*t129 - t34*t122
-    t134 = t53*t124 - t52*t113 - t54*t130 + t78*t133
+    t132 = t19*t130 + t52*t118 - t53*t126 - t131*t78
+    t133 = t33*t110 + t35*t129 - t34*t123
+    t134 = t53*t124 - t52*t113 - t54*t130 + t133*t78
     t135 = t19*t133 + t53*t127 - t52*t119 - t54*t131
-    t136 = t48*t120 + t49*t128 + t50*t132 - t31*t134 - t105*t135
+    t136 = t48*t120 + t49*t128 + t50*t132 - t31*t134 - t135*t105
     t137 = -(t24*t43 + t42*t25)
     t138 = t12*t107 + t6*t137 - t13*t56
-    t139 = -(s1*t137 + t43*t60 - t42*t13*c1)
-    t140 = -(t32*t138 + t34*t139 - t36*t112)
+    t139 = -(s1*t137 - t42*t111 + t43*t64)
+    t140 = -(-t36*t108 + t32*t138 + t34*t139)
     t141 = t12*t25 + t24*t13
     t142 = t32*t141 + t36*t115
     t143 = t36*t117 - t34*t141
-    t144 = t19*t140 + t53*t142 - t55*t118 - t78*t143
-    t145 = -(t13*t79 - t12*t121 + t8*t137)
-    t146 = -(t32*t145 + t33*t139 - t36*t123)
+    t144 = t19*t140 + t53*t142 - t55*t118 - t143*t78
+    t145 = -(-t12*t121 + t13*t79 + t137*t8)
+    t146 = -(-t36*t122 + t32*t145 + t33*t139)
     t147 = t36*t125 - t33*t141
-    t148 = t19*t146 + t52*t142 - t55*t126 - t78*t147
+    t148 = t19*t146 + t52*t142 - t55*t126 - t147*t78
     t149 = t33*t138 + t36*t129 - t34*t145
-    t150 = t53*t146 - t52*t140 - t55*t130 + t78*t149
+    t150 = t53*t146 - t52*t140 - t55*t130 + t149*t78
     t151 = t19*t149 + t53*t147 - t52*t143 - t55*t131
     t152 = t48*t144 + t49*t148 + t51*t132 - t31*t150 - t151*t105
-    t153 = t10*t137 + t12*t108 - t13*t58
-    t154 = -(t32*t153 + t35*t139 - t36*t111)
-    t155 = t33*t153 + t36*t122 - t35*t145
+    t153 = t10*t137 + t12*t109 - t13*t60
+    t154 = -(-t36*t112 + t32*t153 + t35*t139)
+    t155 = t33*t153 + t36*t123 - t35*t145
     t156 = t54*t146 - t52*t154 - t55*t124 + t155*t78
     t157 = t36*t114 - t35*t141
     t158 = t19*t154 + t54*t142 - t55*t116 - t157*t78
     t159 = t19*t155 + t54*t147 - t52*t157 - t55*t127
     t160 = t31*t156 + t50*t148 - t48*t158 - t51*t128 + t159*t105
-    t161 = t34*t153 + t36*t109 - t35*t138
+    t161 = t34*t153 + t36*t110 - t35*t138
     t162 = t54*t140 - t53*t154 - t55*t113 + t161*t78
     t163 = t19*t161 + t54*t143 - t53*t157 - t55*t119
     t164 = t31*t162 + t49*t158 + t50*t144 - t51*t120 + t163*t105
@@ -2140,7 +2140,7 @@ def singularity_factors(q):
 
 
 def manipulability(q):
-    """manipulability sqrt(det(Js Js^T)): (1 x 1), 736 operations."""
+    """manipulability sqrt(det(Js Js^T)): (1 x 1), 726 operations."""
     xp, dtype, device, batch, (q,) = _arguments(("q", q, (7,)))
     trig = _cos_sin(xp, q, (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0), device)
     c1 = trig[..., 0]
@@ -2157,31 +2157,31 @@ def manipulability(q):
     s6 = trig[..., 11]
     t0 = s1*s3
     t1 = c1*c3
-    t2 = t0 + t1*c2
-    t3 = t1 + t0*c2
+    t2 = t0 + c2*t1
+    t3 = t1 + c2*t0
     t4 = c3*s1
     t5 = c1*s3
-    t6 = t4 - t5*c2
-    t7 = -t5 + t4*c2
+    t6 = t4 - c2*t5
+    t7 = -t5 + c2*t4
     t8 = c1*s2
-    t9 = t2*c4 + t8*s4
-    t10 = -t2*s4 + t8*c4
+    t9 = t2*c4 + s4*t8
+    t10 = -t2*s4 + c4*t8
     t11 = t9*c5 - t6*s5
     t12 = t9*s5 + t6*c5
     t13 = t10*c6 + t11*s6
-    t14 = 0.1363*t12 + 0.13375*t13
+    t14 = 0.13375*t13 + 0.1363*t12
     t15 = -t14 + 0.4*t10
     t16 = t15 + 0.1685*t6
     t17 = t16 - 0.4*t8
     t18 = t17 - 0.1925*s1
     t19 = t18 + 0.081*c1
     t20 = s1*s2
-    t21 = t7*c4 + t20*s4
-    t22 = -t7*s4 + t20*c4
+    t21 = t7*c4 + s4*t20
+    t22 = -t7*s4 + c4*t20
     t23 = t3*s5 + t21*c5
     t24 = t3*c5 - t21*s5
     t25 = t22*c6 + t23*s6
-    t26 = 0.1363*t24 - 0.13375*t25
+    t26 = -0.13375*t25 + 0.1363*t24
     t27 = t26 + 0.4*t22
     t28 = t27 - 0.1685*t3
     t29 = t28 - 0.4*t20
@@ -2193,13 +2193,13 @@ def manipulability(q):
     t35 = t10*t27 - t22*t15
     t36 = t24*t14 - t12*t26
     t37 = c3*s2
-    t38 = c2*s4 - t37*c4
-    t39 = c2*c4 + t37*s4
-    t40 = s2*s3
-    t41 = t38*c5 - t40*s5
-    t42 = t38*s5 + t40*c5
+    t38 = c2*s4 - c4*t37
+    t39 = c2*c4 + s4*t37
+    t40 = s3*s2
+    t41 = t38*c5 - s5*t40
+    t42 = t38*s5 + c5*t40
     t43 = t39*c6 + t41*s6
-    t44 = 0.1363*t42 + 0.13375*t43
+    t44 = 0.13375*t43 + 0.1363*t42
     t45 = -t44 + 0.4*t39
     t46 = t45 + 0.1685*t40
     t47 = t46 - 0.4*c2
@@ -2212,111 +2212,111 @@ def manipulability(q):
     t54 = t39*t15 - t10*t45
     t55 = t42*t14 - t12*t44
     t56 = t3*t42 - t24*t40
-    t57 = -(t3*t39 + t22*t40)
-    t58 = -(t22*t42 + t39*t24)
-    t59 = -(t10*t56 + t12*t57 - t6*t58)
-    t60 = t12*c1
-    t61 = -(s1*t58 + t39*t60 - t10*t42*c1)
-    t62 = t6*c1
-    t63 = -(s1*t57 + t39*t62 - t10*c1*s2*s3)
-    t64 = t5*s2
-    t65 = -(s1*t56 - t42*t6*c1 + t12*t64)
-    t66 = -(t32*t59 + t34*t61 + t36*t63 - t35*t65)
-    t67 = t10*t24 + t22*t12
-    t68 = t60 - t24*s1
-    t69 = t10*c1
-    t70 = -(t69 + t22*s1)
-    t71 = t32*t67 + t35*t68 - t36*t70
+    t57 = t6*c1
+    t58 = s2*t5
+    t59 = -(s1*t56 - t42*t57 + t12*t58)
+    t60 = -(t22*t42 + t39*t24)
+    t61 = -(t3*t39 + t22*t40)
+    t62 = -(-t6*t60 + t10*t56 + t12*t61)
+    t63 = t10*c1
+    t64 = t12*c1
+    t65 = -(s1*t60 - t42*t63 + t39*t64)
+    t66 = -(s1*t61 + t39*t57 - t10*t58)
+    t67 = -(-t35*t59 + t32*t62 + t34*t65 + t36*t66)
+    t68 = t10*t24 + t22*t12
+    t69 = t64 - t24*s1
+    t70 = -(t63 + t22*s1)
+    t71 = t32*t68 + t35*t69 - t36*t70
     t72 = t3*t10 + t22*t6
-    t73 = t3*s1 - t62
+    t73 = t3*s1 - t57
     t74 = t32*t72 + t34*t70 - t35*t73
     t75 = t24*t6 - t3*t12
-    t76 = t32*t75 + t34*t68 - t36*t73
-    t77 = -(t34*t67 + t36*t72 - t35*t75)
-    t78 = t47*s1
+    t76 = t32*t75 + t34*t69 - t36*t73
+    t77 = -(-t35*t75 + t34*t68 + t36*t72)
+    t78 = s1*t47
     t79 = t24*c2 + t42*t20
-    t80 = t22*c2 - t39*t20
-    t81 = -(t10*t79 + t12*t80 + t58*t8)
-    t82 = c1**2
-    t83 = -(s1*t80 + t69*c2 - t39*s2*t82)
-    t84 = s2*t82
-    t85 = -(s1*t79 + t42*t84 - t12*c1*c2)
-    t86 = -(t32*t81 + t33*t61 + t36*t83 - t35*t85)
+    t80 = c1**2
+    t81 = s2*t80
+    t82 = -(s1*t79 - c2*t64 + t42*t81)
+    t83 = t22*c2 - t39*t20
+    t84 = -(t10*t79 + t12*t83 + t60*t8)
+    t85 = -(s1*t83 - t39*t81 + c2*t63)
+    t86 = -(-t35*t82 + t32*t84 + t33*t65 + t36*t85)
     t87 = t10*t20 - t22*t8
-    t88 = t84 + s2*s1**2
+    t88 = t81 + s2*s1**2
     t89 = t32*t87 + t33*t70 - t35*t88
     t90 = -(t12*t20 + t24*t8)
-    t91 = t32*t90 + t33*t68 - t36*t88
-    t92 = -(t33*t67 + t36*t87 - t35*t90)
+    t91 = t32*t90 + t33*t69 - t36*t88
+    t92 = -(-t35*t90 + t33*t68 + t36*t87)
     t93 = s2**2
-    t94 = -(t3*c2 + t0*t93)
-    t95 = -(t12*t94 + t6*t79 + t8*t56)
-    t96 = -(s1*t94 + t62*c2 - s3*t82*t93)
-    t97 = -(t32*t95 + t33*t65 + t36*t96 - t34*t85)
+    t94 = -(t3*c2 + t93*t0)
+    t95 = -(t12*t94 + t6*t79 + t56*t8)
+    t96 = -(s1*t94 - s3*t80*t93 + c2*t57)
+    t97 = -(-t34*t82 + t32*t95 + t33*t59 + t36*t96)
     t98 = t3*t8 + t6*t20
     t99 = t32*t98 + t33*t73 - t34*t88
-    t100 = -(t33*t75 + t36*t98 - t34*t90)
-    t101 = -(t6*t80 - t10*t94 + t8*t57)
-    t102 = -(t32*t101 + t33*t63 + t35*t96 - t34*t83)
-    t103 = t33*t59 + t35*t95 - t34*t81 - t36*t101
-    t104 = -(t33*t72 + t35*t98 - t34*t87)
-    t105 = t47*c1
-    t106 = t48*(t19*t66 + t53*t71 + t55*t74 - t54*t76 - t77*t78) + t49*(t19*t86 + t52*t71 + t55*t89 - t54*t91 - t78*t92) + t50*(t19*t97 + t52*t76 + t55*t99 - t53*t91 - t78*t100) - t31*(t53*t86 + t55*t102 - t52*t66 - t54*t97 + t78*t103) - t51*(t19*t102 + t52*t74 + t54*t99 - t53*t89 - t78*t104) - t105*(t19*t103 + t53*t92 + t55*t104 - t52*t77 - t54*t100)
+    t100 = -(-t34*t90 + t33*t75 + t36*t98)
+    t101 = -(-t10*t94 + t6*t83 + t61*t8)
+    t102 = -(-t34*t85 + t32*t101 + t33*t66 + t35*t96)
+    t103 = t33*t62 + t35*t95 - t34*t84 - t36*t101
+    t104 = -(-t34*t87 + t33*t72 + t35*t98)
+    t105 = c1*t47
+    t106 = t48*(t19*t67 + t53*t71 + t55*t74 - t54*t76 - t77*t78) + t49*(t19*t86 + t52*t71 + t55*t89 - t54*t91 - t92*t78) + t50*(t19*t97 + t52*t76 + t55*t99 - t53*t91 - t100*t78) - t31*(t53*t86 + t55*t102 - t52*t67 - t54*t97 + t103*t78) - t51*(t19*t102 + t52*t74 + t54*t99 - t53*t89 - t104*t78) - (t19*t103 + t53*t92 + t55*t104 - t52*t77 - t54*t100)*t105
     t107 = t3*t43 + t25*t40
-    t108 = t39*t25 - t22*t43
-    t109 = -(t10*t107 + t13*t57 - t6*t108)
-    t110 = t13*c1
-    t111 = -(s1*t108 + t39*t110 - t10*t43*c1)
-    t112 = -(s1*t107 - t43*t6*c1 + t13*t64)
-    t113 = -(t32*t109 + t34*t111 - t35*t112)
+    t108 = -(s1*t107 - t43*t57 + t13*t58)
+    t109 = t39*t25 - t22*t43
+    t110 = -(-t6*t109 + t10*t107 + t13*t61)
+    t111 = t13*c1
+    t112 = -(s1*t109 - t43*t63 + t39*t111)
+    t113 = -(-t35*t108 + t32*t110 + t34*t112)
     t114 = t22*t13 - t10*t25
-    t115 = t110 + t25*s1
+    t115 = t111 + t25*s1
     t116 = t32*t114 + t35*t115
     t117 = -(t3*t13 + t25*t6)
     t118 = t32*t117 + t34*t115
     t119 = t35*t117 - t34*t114
-    t120 = t19*t113 + t53*t116 - t54*t118 - t78*t119
+    t120 = t19*t113 + t53*t116 - t54*t118 - t119*t78
     t121 = -t25*c2 + t43*t20
-    t122 = -(t10*t121 + t13*t80 + t8*t108)
-    t123 = -(s1*t121 + t43*t84 - t13*c1*c2)
-    t124 = -(t32*t122 + t33*t111 - t35*t123)
+    t122 = -(s1*t121 - c2*t111 + t43*t81)
+    t123 = -(t10*t121 + t13*t83 + t109*t8)
+    t124 = -(-t35*t122 + t32*t123 + t33*t112)
     t125 = t25*t8 - t13*t20
     t126 = t32*t125 + t33*t115
     t127 = t35*t125 - t33*t114
-    t128 = t19*t124 + t52*t116 - t54*t126 - t78*t127
-    t129 = -(t13*t94 + t6*t121 + t8*t107)
-    t130 = -(t32*t129 + t33*t112 - t34*t123)
+    t128 = t19*t124 + t52*t116 - t54*t126 - t127*t78
+    t129 = -(t13*t94 + t6*t121 + t107*t8)
+    t130 = -(-t34*t122 + t32*t129 + t33*t108)
     t131 = t34*t125 - t33*t117
-    t132 = t19*t130 + t52*t118 - t53*t126 - t78*t131
-    t133 = t33*t109 + t35*t129 - t34*t122
-    t134 = t53*t124 - t52*t113 - t54*t130 + t78*t133
+    t132 = t19*t130 + t52*t118 - t53*t126 - t131*t78
+    t133 = t33*t110 + t35*t129 - t34*t123
+    t134 = t53*t124 - t52*t113 - t54*t130 + t133*t78
     t135 = t19*t133 + t53*t127 - t52*t119 - t54*t131
-    t136 = t48*t120 + t49*t128 + t50*t132 - t31*t134 - t105*t135
+    t136 = t48*t120 + t49*t128 + t50*t132 - t31*t134 - t135*t105
     t137 = -(t24*t43 + t42*t25)
     t138 = t12*t107 + t6*t137 - t13*t56
-    t139 = -(s1*t137 + t43*t60 - t42*t13*c1)
-    t140 = -(t32*t138 + t34*t139 - t36*t112)
+    t139 = -(s1*t137 - t42*t111 + t43*t64)
+    t140 = -(-t36*t108 + t32*t138 + t34*t139)
     t141 = t12*t25 + t24*t13
     t142 = t32*t141 + t36*t115
     t143 = t36*t117 - t34*t141
-    t144 = t19*t140 + t53*t142 - t55*t118 - t78*t143
-    t145 = -(t13*t79 - t12*t121 + t8*t137)
-    t146 = -(t32*t145 + t33*t139 - t36*t123)
+    t144 = t19*t140 + t53*t142 - t55*t118 - t143*t78
+    t145 = -(-t12*t121 + t13*t79 + t137*t8)
+    t146 = -(-t36*t122 + t32*t145 + t33*t139)
     t147 = t36*t125 - t33*t141
-    t148 = t19*t146 + t52*t142 - t55*t126 - t78*t147
+    t148 = t19*t146 + t52*t142 - t55*t126 - t147*t78
     t149 = t33*t138 + t36*t129 - t34*t145
-    t150 = t53*t146 - t52*t140 - t55*t130 + t78*t149
+    t150 = t53*t146 - t52*t140 - t55*t130 + t149*t78
     t151 = t19*t149 + t53*t147 - t52*t143 - t55*t131
     t152 = t48*t144 + t49*t148 + t51*t132 - t31*t150 - t151*t105
-    t153 = t10*t137 + t12*t108 - t13*t58
-    t154 = -(t32*t153 + t35*t139 - t36*t111)
-    t155 = t33*t153 + t36*t122 - t35*t145
+    t153 = t10*t137 + t12*t109 - t13*t60
+    t154 = -(-t36*t112 + t32*t153 + t35*t139)
+    t155 = t33*t153 + t36*t123 - t35*t145
     t156 = t54*t146 - t52*t154 - t55*t124 + t155*t78
     t157 = t36*t114 - t35*t141
     t158 = t19*t154 + t54*t142 - t55*t116 - t157*t78
     t159 = t19*t155 + t54*t147 - t52*t157 - t55*t127
     t160 = t31*t156 + t50*t148 - t48*t158 - t51*t128 + t159*t105
-    t161 = t34*t153 + t36*t109 - t35*t138
+    t161 = t34*t153 + t36*t110 - t35*t138
     t162 = t54*t140 - t53*t154 - t55*t113 + t161*t78
     t163 = t19*t161 + t54*t143 - t53*t157 - t55*t119
     t164 = t31*t162 + t49*t158 + t50*t144 - t51*t120 + t163*t105
@@ -2360,31 +2360,31 @@ def velocity_ik(q, mu_dot, damping=0.0):
     s6 = trig[..., 11]
     t0 = s1*s3
     t1 = c1*c3
-    t2 = t0 + t1*c2
-    t3 = t1 + t0*c2
+    t2 = t0 + c2*t1
+    t3 = t1 + c2*t0
     t4 = c3*s1
     t5 = c1*s3
-    t6 = t4 - t5*c2
-    t7 = -t5 + t4*c2
+    t6 = t4 - c2*t5
+    t7 = -t5 + c2*t4
     t8 = c1*s2
-    t9 = t2*c4 + t8*s4
-    t10 = -t2*s4 + t8*c4
+    t9 = t2*c4 + s4*t8
+    t10 = -t2*s4 + c4*t8
     t11 = t9*c5 - t6*s5
     t12 = t9*s5 + t6*c5
     t13 = t10*c6 + t11*s6
-    t14 = 0.1363*t12 + 0.13375*t13
+    t14 = 0.13375*t13 + 0.1363*t12
     t15 = -t14 + 0.4*t10
     t16 = t15 + 0.1685*t6
     t17 = t16 - 0.4*t8
     t18 = t17 - 0.1925*s1
     t19 = t18 + 0.081*c1
     t20 = s1*s2
-    t21 = t7*c4 + t20*s4
-    t22 = -t7*s4 + t20*c4
+    t21 = t7*c4 + s4*t20
+    t22 = -t7*s4 + c4*t20
     t23 = t3*s5 + t21*c5
     t24 = t3*c5 - t21*s5
     t25 = t22*c6 + t23*s6
-    t26 = 0.1363*t24 - 0.13375*t25
+    t26 = -0.13375*t25 + 0.1363*t24
     t27 = t26 + 0.4*t22
     t28 = t27 - 0.1685*t3
     t29 = t28 - 0.4*t20
@@ -2397,13 +2397,13 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t36 = t24*t14 - t12*t26
     t37 = t32**2 + t33**2 + t34**2 + t35**2 + t36**2
     t38 = c3*s2
-    t39 = c2*s4 - t38*c4
-    t40 = c2*c4 + t38*s4
+    t39 = c2*s4 - c4*t38
+    t40 = c2*c4 + s4*t38
     t41 = s2*s3
-    t42 = t39*c5 - t41*s5
-    t43 = t39*s5 + t41*c5
+    t42 = t39*c5 - s5*t41
+    t43 = t39*s5 + c5*t41
     t44 = t40*c6 + t42*s6
-    t45 = 0.1363*t43 + 0.13375*t44
+    t45 = 0.13375*t44 + 0.1363*t43
     t46 = -t45 + 0.4*t40
     t47 = t46 + 0.1685*t41
     t48 = t47 - 0.4*c2
@@ -2414,13 +2414,13 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t53 = t40*t15 - t10*t46
     t54 = t43*t14 - t12*t45
     t55 = t40*t35 - t43*t36 - t33*c2 + t34*t41
-    t56 = t10*t40 + t12*t43 + t13*t44 + t6*t41 + t8*c2
-    t57 = t22*t40 + t25*t44 - t24*t43 + t20*c2 - t3*t41
+    t56 = t10*t40 + t12*t43 + t13*t44 + t6*t41 + c2*t8
+    t57 = t22*t40 + t25*t44 - t24*t43 + c2*t20 - t3*t41
     t58 = t48*s1
-    t59 = t29*c2 - t58*s2
+    t59 = t29*c2 - s2*t58
     t60 = t31 + t43*t51 + t59*c2 - t40*t50 + t49*t41
     t61 = t48*c1
-    t62 = -t17*c2 + t61*s2
+    t62 = -t17*c2 + s2*t61
     t63 = t19 + t40*t53 - t43*t54 - t62*c2 + t52*t41
     t64 = 1 + t10 + t22 + t40 + t24 + t19 + t59 + t50 + t51 + t62 + t52 + t53 + t54 + t33 + t34 + t35 + t36 + t6 + c1 + damping + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + q1 + q2 + q3 + q4 + q5 + q6 + q7 - t3 - t12 - t43 - t13 - t25 - t44 - t31 - t49 - t32 - c2 - s1 + t61 + t58 + t41 - t8 - t20
     t65 = t48**2
@@ -2443,7 +2443,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t82 = t10*t35 + t80 + t34*t6 - t12*t36 - t33*t8
     t83 = s2**2
     t84 = t10**2 + t12**2 + t13**2 + t6**2 + t77 + t66*t83
-    t85 = t10*t22 + t13*t25 - t3*t6 - t12*t24 - t69 + t69*t83
+    t85 = t10*t22 + t13*t25 - t3*t6 - t12*t24 - t69 + t83*t69
     t86 = t3**2 + t22**2 + t24**2 + t25**2 + t66 + t77*t83
     t87 = 1 + t40**2 + t43**2 + t44**2 + c2**2 + t83*s3**2
     t88 = damping**2
@@ -2466,7 +2466,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t105 = xp.where(xp.greater(t102, 0), 1/(t102*(t102 + xp.abs(t89))), 0)
     t106 = t105*(t70*t104 + t70*t91 + t72*t81 + t75*t79 + t68*t76 - t60*t63)
     t107 = t70 - t104*t106
-    t108 = t91 - t70*t106
+    t108 = -t70*t106 + t91
     t109 = t81 - t72*t106
     t110 = -t79 + t75*t106
     t111 = t76 - t68*t106
@@ -2474,15 +2474,15 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t113 = t105*(t70*t81 + t72*t104 + t72*t92 - t60*t55 - t75*t82 - t68*t73)
     t114 = t72 - t104*t113
     t115 = t81 - t70*t113
-    t116 = t92 - t72*t113
+    t116 = -t72*t113 + t92
     t117 = t82 + t75*t113
     t118 = t73 + t68*t113
     t119 = t55 + t60*t113
-    t120 = -t105*(t70*t79 + t60*t56 + t75*t104 + t75*t93 - t72*t82 - t68*t85)
+    t120 = -t105*(-t72*t82 - t68*t85 + t70*t79 + t60*t56 + t75*t104 + t75*t93)
     t121 = t75 + t104*t120
     t122 = t79 + t70*t120
     t123 = t82 - t72*t120
-    t124 = t93 + t75*t120
+    t124 = t75*t120 + t93
     t125 = t85 - t68*t120
     t126 = t56 + t60*t120
     t127 = t105*(t70*t76 + t68*t104 + t68*t94 - t60*t57 - t72*t73 - t75*t85)
@@ -2490,7 +2490,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t129 = t76 - t70*t127
     t130 = t73 + t72*t127
     t131 = t85 + t75*t127
-    t132 = t94 - t68*t127
+    t132 = -t68*t127 + t94
     t133 = t57 + t60*t127
     t134 = t105*(t70*t63 + t72*t55 + t68*t57 - t60*t104 - t60*t95 - t75*t56)
     t135 = t60 + t104*t134
@@ -2498,7 +2498,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t137 = t55 - t72*t134
     t138 = t56 + t75*t134
     t139 = t57 - t68*t134
-    t140 = t95 + t60*t134
+    t140 = t60*t134 + t95
     t141 = t105*(t70*mu_dot1 + t72*mu_dot2 + t68*mu_dot4 + t104*mu_dot0 - t60*mu_dot5 - t75*mu_dot3)
     t142 = mu_dot0 - t104*t141
     t143 = mu_dot1 - t70*t141
@@ -2674,22 +2674,22 @@ def ik_numeric_step(target, q, damping=0.0):
     t0 = T00 + T01 + T02 + T03 + T10 + T11 + T12 + T13 + T20 + T21 + T22 + T23 + qs1 + qs2 + qs3 + qs4 + qs5 + qs6 + qs7
     t1 = s1*s3
     t2 = c1*c3
-    t3 = t1 + t2*c2
-    t4 = t2 + t1*c2
+    t3 = t1 + c2*t2
+    t4 = t2 + c2*t1
     t5 = c3*s1
     t6 = c1*s3
-    t7 = t5 - t6*c2
-    t8 = -t6 + t5*c2
+    t7 = t5 - c2*t6
+    t8 = -t6 + c2*t5
     t9 = c1*s2
-    t10 = t3*c4 + t9*s4
-    t11 = -t3*s4 + t9*c4
+    t10 = t3*c4 + s4*t9
+    t11 = -t3*s4 + c4*t9
     t12 = t10*c5 - t7*s5
     t13 = t10*s5 + t7*c5
     t14 = t12*c6 - t11*s6
     t15 = t11*c6 + t12*s6
     t16 = t13*s7 + t14*c7
     t17 = t13*c7 - t14*s7
-    t18 = 0.1363*t13 + 0.13375*t15
+    t18 = 0.13375*t15 + 0.1363*t13
     t19 = -t18 + 0.4*t11
     t20 = t19 + 0.1685*t7
     t21 = t20 - 0.4*t9
@@ -2700,15 +2700,15 @@ def ik_numeric_step(target, q, damping=0.0):
     t26 = T20*t16 + T21*t17 - T22*t15
     t27 = T03 - t23
     t28 = s1*s2
-    t29 = t8*c4 + t28*s4
-    t30 = -t8*s4 + t28*c4
+    t29 = t8*c4 + s4*t28
+    t30 = -t8*s4 + c4*t28
     t31 = t4*s5 + t29*c5
     t32 = t4*c5 - t29*s5
     t33 = t31*c6 - t30*s6
     t34 = t30*c6 + t31*s6
     t35 = t33*c7 - t32*s7
     t36 = t32*c7 + t33*s7
-    t37 = 0.1363*t32 - 0.13375*t34
+    t37 = -0.13375*t34 + 0.1363*t32
     t38 = t37 + 0.4*t30
     t39 = t38 - 0.1685*t4
     t40 = t39 - 0.4*t28
@@ -2726,16 +2726,16 @@ def ik_numeric_step(target, q, damping=0.0):
     t52 = 0.5*(t49 + t25)
     t53 = T13 - t42
     t54 = c3*s2
-    t55 = c2*s4 - t54*c4
-    t56 = c2*c4 + t54*s4
-    t57 = s2*s3
-    t58 = t55*c5 - t57*s5
-    t59 = t55*s5 + t57*c5
+    t55 = c2*s4 - c4*t54
+    t56 = c2*c4 + s4*t54
+    t57 = s3*s2
+    t58 = t55*c5 - s5*t57
+    t59 = t55*s5 + c5*t57
     t60 = t58*c6 - t56*s6
     t61 = t56*c6 + t58*s6
     t62 = t59*s7 + t60*c7
     t63 = t59*c7 - t60*s7
-    t64 = 0.1363*t59 + 0.13375*t61
+    t64 = 0.13375*t61 + 0.1363*t59
     t65 = -t64 + 0.4*t56
     t66 = t65 + 0.1685*t57
     t67 = t66 - 0.4*c2
@@ -2751,8 +2751,8 @@ def ik_numeric_step(target, q, damping=0.0):
     t77 = t42 + t59*t72 + t69*c2 - t56*t71 + t70*t57
     t78 = t23 + t56*t75 - t59*t76 - t73*c2 + t74*t57
     t79 = t56*t46 - t59*t47 - t44*c2 + t45*t57
-    t80 = t11*t56 + t13*t59 + t15*t61 + t7*t57 + t9*c2
-    t81 = t30*t56 + t34*t61 - t32*t59 + t28*c2 - t4*t57
+    t80 = t11*t56 + t13*t59 + t15*t61 + t7*t57 + c2*t9
+    t81 = t30*t56 + t34*t61 - t32*t59 + c2*t28 - t4*t57
     t82 = T00*t62 + T01*t63 - T02*t61
     t83 = T10*t62 + T11*t63 - T12*t61
     t84 = T20*t62 + T21*t63 - T22*t61
@@ -2765,7 +2765,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t91 = t42**2 + t69**2 + t70**2 + t71**2 + t72**2 + t89*t90
     t92 = t4*t70 + t30*t71 + t32*t72 + t67*t90 - t69*t28
     t93 = c1*s1
-    t94 = t69*t73 + t71*t75 + t72*t76 - t23*t42 - t70*t74 + t93*t89
+    t94 = t69*t73 + t71*t75 + t72*t76 - t23*t42 - t70*t74 + t89*t93
     t95 = t43*c1
     t96 = t69*t44 + t71*t46 + t72*t47 - t70*t45 - t67*t95
     t97 = t4*t45 + t95 - t30*t46 - t32*t47 + t44*t28
@@ -2780,7 +2780,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t106 = t11*t46 + t104 + t45*t7 - t13*t47 - t44*t9
     t107 = s2**2
     t108 = t11**2 + t13**2 + t15**2 + t7**2 + t101 + t90*t107
-    t109 = t11*t30 + t15*t34 - t4*t7 - t13*t32 - t93 + t93*t107
+    t109 = t11*t30 + t15*t34 - t4*t7 - t13*t32 - t93 + t107*t93
     t110 = t4**2 + t30**2 + t32**2 + t34**2 + t90 + t101*t107
     t111 = 1 + t56**2 + t59**2 + t61**2 + c2**2 + t107*s3**2
     t112 = -t50
@@ -2815,7 +2815,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t141 = t102 + damping
     t142 = t133*(t94*t132 + t94*t141 + t96*t105 + t99*t103 + t92*t100 - t77*t78)
     t143 = t94 - t132*t142
-    t144 = t141 - t94*t142
+    t144 = -t94*t142 + t141
     t145 = t105 - t96*t142
     t146 = -t103 + t99*t142
     t147 = t100 - t92*t142
@@ -2834,7 +2834,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t160 = t133*(t94*t105 + t96*t132 + t96*t159 - t77*t79 - t99*t106 - t92*t97)
     t161 = t96 - t132*t160
     t162 = t105 - t94*t160
-    t163 = t159 - t96*t160
+    t163 = -t96*t160 + t159
     t164 = t106 + t99*t160
     t165 = t97 + t92*t160
     t166 = t79 + t77*t160
@@ -2854,11 +2854,11 @@ def ik_numeric_step(target, q, damping=0.0):
     t180 = t157 + t171*t177
     t181 = t158 - t172*t177
     t182 = t108 + damping
-    t183 = -t133*(t94*t103 + t77*t80 + t99*t132 + t99*t182 - t96*t106 - t92*t109)
+    t183 = -t133*(-t96*t106 - t92*t109 + t94*t103 + t77*t80 + t99*t132 + t99*t182)
     t184 = t99 + t132*t183
     t185 = t103 + t94*t183
     t186 = t106 - t96*t183
-    t187 = t182 + t99*t183
+    t187 = t99*t183 + t182
     t188 = t109 - t92*t183
     t189 = t80 + t77*t183
     t190 = t152*(t145*t186 + t146*t187 + t147*t188 + t148*t189 - t185*t151)
@@ -2886,7 +2886,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t212 = t100 - t94*t210
     t213 = t97 + t96*t210
     t214 = t109 + t99*t210
-    t215 = t209 - t92*t210
+    t215 = -t92*t210 + t209
     t216 = t81 + t77*t210
     t217 = t152*(t146*t214 + t147*t215 + t148*t216 + t212*t151 - t145*t213)
     t218 = t212 - t151*t217
@@ -2917,7 +2917,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t243 = t79 - t96*t240
     t244 = t80 + t99*t240
     t245 = t81 - t92*t240
-    t246 = t239 + t77*t240
+    t246 = t77*t240 + t239
     t247 = t152*(t145*t243 + t146*t244 + t147*t245 + t148*t246 + t242*t151)
     t248 = t242 - t151*t247
     t249 = t243 - t145*t247
@@ -2979,7 +2979,7 @@ def ik_numeric_step(target, q, damping=0.0):
 
 
 def ik_general_equations(T, q_free):
-    """the general 6R solver's equations at T: (P0 + s Ps + c Pc) v_bc = Q v_gh, P = [P0; Ps; Pc] (42 x 9): (42 x 9 and 14 x 8), 449 operations."""
+    """the general 6R solver's equations at T: (P0 + s Ps + c Pc) v_bc = Q v_gh, P = [P0; Ps; Pc] (42 x 9): (42 x 9 and 14 x 8), 412 operations."""
     xp, dtype, device, batch, (T, q_free,) = _arguments(("T", T, (4, 4)), ("q_free", q_free, ()))
     T00 = T[..., 0, 0]
     T01 = T[..., 0, 1]
@@ -3014,103 +3014,101 @@ def ik_general_equations(T, q_free):
     t15 = t0*t6 + t1*t10 + t2*t14
     t16 = T02*t6 + T12*t10 + T22*t14
     t17 = t5*t6 + t9*t10 + t13*t14
-    t18 = 1.0*t17
-    t19 = 1.0*t15**2
-    t20 = t16**2
-    t21 = 1.0*t20
-    t22 = t17**2
-    t23 = 1.0*t22
-    t24 = 0.0648*t1
-    t25 = 0.0648*T12
-    t26 = 0.162*t16
-    t27 = T12*t26
-    t28 = 0.162*t15
-    t29 = t1*t28
-    t30 = T02*t26
-    t31 = t0*t28
-    t32 = 1.0*T02
-    t33 = 1.0*t0
-    t34 = 1.0*T12
-    t35 = 1.0*t1
-    t36 = 1.0*t5
-    t37 = 1.0*t9
-    t38 = 0.081*T12
-    t39 = -0.081*t1
-    t40 = 0.081*T02
-    t41 = 0.081*t0
-    t42 = 0.317*T22
-    t43 = 1.0*t16
-    t44 = 0.317*t2 - 1.0*t15
-    t45 = 0.0648*t0
-    t46 = 0.0648*T02
-    t47 = 0.162*t17
-    t48 = t9*t47
-    t49 = t5*t47
-    t50 = 0.2536*t2
-    t51 = 0.8*t15
-    t52 = 0.8*t16
-    t53 = 0.2536*T22
-    t54 = 0.4*t0
-    t55 = 0.4*T02
-    t56 = 0.4*t1
-    t57 = 0.4*T12
-    t58 = 0.317*T12 + t0*t18 - t15*t36
-    t59 = 0.317*t1 + t16*t36 - T02*t18
-    t60 = 0.317*T02 + t15*t37 - 1.0*t1*t17
-    t61 = -(0.317*t0 + T12*t18 - 1.0*t9*t16)
-    t62 = 0.081*T22
-    t63 = 0.081*t2
-    t64 = T02*t19
-    t65 = T02*t23
-    t66 = T02*t21
-    t67 = 0.634*T22
-    t68 = t0*t15
-    t69 = t67*t68
-    t70 = t5*t17
-    t71 = t67*t70
-    t72 = 2.0*t16
-    t73 = t68*t72
-    t74 = t70*t72
-    t75 = 0.634*t2
-    t76 = t15*t75
-    t77 = T02*t76
-    t78 = 0.634*t13
-    t79 = t17*t78
-    t80 = T02*t79
-    t81 = t0*t19
-    t82 = t16*t75
-    t83 = t15*t72
-    t84 = T02*t83
+    t18 = t15**2
+    t19 = t16**2
+    t20 = t17**2
+    t21 = 0.0648*t1
+    t22 = 0.0648*T12
+    t23 = T12*t16
+    t24 = 0.162*t23
+    t25 = t1*t15
+    t26 = 0.162*t25
+    t27 = T02*t16
+    t28 = 0.162*t27
+    t29 = t0*t15
+    t30 = 0.162*t29
+    t31 = 0.081*T12
+    t32 = -0.081*t1
+    t33 = 0.081*T02
+    t34 = 0.081*t0
+    t35 = 0.317*T22
+    t36 = 0.317*t2 - 1.0*t15
+    t37 = 0.0648*t0
+    t38 = 0.0648*T02
+    t39 = t9*t17
+    t40 = 0.162*t39
+    t41 = t5*t17
+    t42 = 0.162*t41
+    t43 = 0.2536*t2
+    t44 = 0.8*t15
+    t45 = 0.8*t16
+    t46 = 0.2536*T22
+    t47 = 0.4*t0
+    t48 = 0.4*T02
+    t49 = 0.4*t1
+    t50 = 0.4*T12
+    t51 = t5*t15
+    t52 = t0*t17
+    t53 = 0.317*T12 + t52
+    t54 = t5*t16
+    t55 = T02*t17
+    t56 = 0.317*t1 + t54 - t55
+    t57 = t1*t17
+    t58 = t9*t15
+    t59 = 0.317*T02 + t58
+    t60 = t9*t16
+    t61 = T12*t17
+    t62 = -(0.317*t0 - t60 + t61)
+    t63 = 0.081*T22
+    t64 = 0.081*t2
+    t65 = t0*t16
+    t66 = T02*t15
+    t67 = t1*t16
+    t68 = T12*t15
+    t69 = T02*t18
+    t70 = T02*t20
+    t71 = T02*t19
+    t72 = 0.634*T22
+    t73 = t29*t72
+    t74 = t41*t72
+    t75 = 2.0*t16
+    t76 = t29*t75
+    t77 = t41*t75
+    t78 = 0.634*t2
+    t79 = t66*t78
+    t80 = 0.634*t13
+    t81 = t55*t80
+    t82 = t0*t19
+    t83 = t0*t20
+    t84 = t0*t18
     t85 = 2.0*t15
-    t86 = t70*t85
-    t87 = t16*t67
-    t88 = t0*t87
-    t89 = t0*t79
-    t90 = T12*t19
-    t91 = T12*t23
-    t92 = T12*t21
-    t93 = t1*t15
-    t94 = t67*t93
-    t95 = t9*t17
-    t96 = t67*t95
-    t97 = t1*t83
-    t98 = t72*t95
-    t99 = T12*t76
-    t100 = T12*t79
-    t101 = t1*t19
-    t102 = T12*t83
-    t103 = t85*t95
-    t104 = t1*t87
-    t105 = t1*t79
-    t106 = T02*t29
-    t107 = T02*t48
-    t108 = T12*t31
-    t109 = T12*t49
-    t110 = t0*t27 + t0*t48 - t1*t30 - t1*t49
+    t86 = t27*t85
+    t87 = t41*t85
+    t88 = t65*t72
+    t89 = t52*t80
+    t90 = T12*t18
+    t91 = T12*t20
+    t92 = T12*t19
+    t93 = t25*t72
+    t94 = t39*t72
+    t95 = t25*t75
+    t96 = t39*t75
+    t97 = t68*t78
+    t98 = t61*t80
+    t99 = t1*t19
+    t100 = t1*t20
+    t101 = t1*t18
+    t102 = t23*t85
+    t103 = t39*t85
+    t104 = t67*t72
+    t105 = t57*t80
+    t106 = T02*t26
+    t107 = T02*t40
+    t108 = T12*t30
+    t109 = T12*t42
+    t110 = t0*t24 + t0*t40 - t1*t28 - t1*t42
     t111 = 0.2536*t13
-    t112 = 0.8*t17
-    t113 = t17*t72
-    t114 = t16*t78
+    t112 = 2.0*t17
     P = _stack(xp, [
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 1
@@ -3156,7 +3154,7 @@ def ik_general_equations(T, q_free):
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 7
-        0.317*t13 - t18,  # 4, 8
+        0.317*t13 - 1.0*t17,  # 4, 8
         xp.full(batch, -0.1925, dtype=dtype, device=device),  # 5, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 2
@@ -3174,7 +3172,7 @@ def ik_general_equations(T, q_free):
         xp.full(batch, 0, dtype=dtype, device=device),  # 6, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 6, 6
         xp.full(batch, -0.0648725, dtype=dtype, device=device),  # 6, 7
-        -(0.0416015 + t19 + t21 + t23 - 0.634*T22*t16 - 0.634*t2*t15 - 0.634*t13*t17),  # 6, 8
+        -(0.0416015 + t18 + t19 + t20 - 0.634*T22*t16 - 0.634*t2*t15 - 0.634*t13*t17),  # 6, 8
         xp.full(batch, 0, dtype=dtype, device=device),  # 7, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 7, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 7, 2
@@ -3219,7 +3217,7 @@ def ik_general_equations(T, q_free):
         xp.full(batch, 0, dtype=dtype, device=device),  # 11, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 11, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 11, 7
-        T02*t24 - t0*t25,  # 11, 8
+        T02*t21 - t0*t22,  # 11, 8
         xp.full(batch, 0, dtype=dtype, device=device),  # 12, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 12, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 12, 2
@@ -3228,7 +3226,7 @@ def ik_general_equations(T, q_free):
         xp.full(batch, 0, dtype=dtype, device=device),  # 12, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 12, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 12, 7
-        t5*t27 + t5*t29 - t9*t30 - t9*t31,  # 12, 8
+        t5*t24 + t5*t26 - t9*t28 - t9*t30,  # 12, 8
         xp.full(batch, 0.151336, dtype=dtype, device=device),  # 13, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 13, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 13, 2
@@ -3492,10 +3490,10 @@ def ik_general_equations(T, q_free):
         xp.full(batch, 0, dtype=dtype, device=device),  # 41, 8
     ], (42, 9))
     Q = _stack(xp, [
-        t32,  # 0, 0
-        t33,  # 0, 1
-        t34,  # 0, 2
-        t35,  # 0, 3
+        T02,  # 0, 0
+        t0,  # 0, 1
+        T12,  # 0, 2
+        t1,  # 0, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 6
@@ -3504,26 +3502,26 @@ def ik_general_equations(T, q_free):
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 3
-        -t36,  # 1, 4
-        -t37,  # 1, 5
+        -1.0*t5,  # 1, 4
+        -1.0*t9,  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 7
-        t33,  # 2, 0
-        -t32,  # 2, 1
-        t35,  # 2, 2
-        -t34,  # 2, 3
+        t0,  # 2, 0
+        -1.0*T02,  # 2, 1
+        t1,  # 2, 2
+        -1.0*T12,  # 2, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 7
-        -t38,  # 3, 0
-        t39,  # 3, 1
-        t40,  # 3, 2
-        t41,  # 3, 3
+        -t31,  # 3, 0
+        t32,  # 3, 1
+        t33,  # 3, 2
+        t34,  # 3, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 5
-        t42 - t43,  # 3, 6
-        t44,  # 3, 7
+        t35 - 1.0*t16,  # 3, 6
+        t36,  # 3, 7
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 2
@@ -3532,76 +3530,76 @@ def ik_general_equations(T, q_free):
         -0.081*t5,  # 4, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 7
-        t39,  # 5, 0
-        t38,  # 5, 1
-        t41,  # 5, 2
-        -t40,  # 5, 3
+        t32,  # 5, 0
+        t31,  # 5, 1
+        t34,  # 5, 2
+        -t33,  # 5, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 5
-        t44,  # 5, 6
-        t43 - t42,  # 5, 7
-        -t24,  # 6, 0
-        t25,  # 6, 1
-        t45,  # 6, 2
-        -t46,  # 6, 3
-        t27 + t29 + t48,  # 6, 4
-        -(t30 + t31 + t49),  # 6, 5
-        t50 - t51,  # 6, 6
-        t52 - t53,  # 6, 7
-        t54,  # 7, 0
-        -t55,  # 7, 1
-        t56,  # 7, 2
-        -t57,  # 7, 3
-        -(t16*t32 + t15*t33 + t5*t18),  # 7, 4
-        -(t16*t34 + t15*t35 + t9*t18),  # 7, 5
+        t36,  # 5, 6
+        t16 - t35,  # 5, 7
+        -t21,  # 6, 0
+        t22,  # 6, 1
+        t37,  # 6, 2
+        -t38,  # 6, 3
+        t24 + t26 + t40,  # 6, 4
+        -(t28 + t30 + t42),  # 6, 5
+        t43 - t44,  # 6, 6
+        t45 - t46,  # 6, 7
+        t47,  # 7, 0
+        -t48,  # 7, 1
+        t49,  # 7, 2
+        -t50,  # 7, 3
+        -(t27 + t29 + t41),  # 7, 4
+        -(t23 + t25 + t39),  # 7, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 7, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 7, 7
-        t58,  # 8, 0
-        t59,  # 8, 1
-        -t60,  # 8, 2
-        t61,  # 8, 3
+        -t51 + t53,  # 8, 0
+        t56,  # 8, 1
+        -(-t57 + t59),  # 8, 2
+        t62,  # 8, 3
         0.4*t5,  # 8, 4
         0.4*t9,  # 8, 5
-        t62,  # 8, 6
-        t63,  # 8, 7
-        t55,  # 9, 0
-        t54,  # 9, 1
-        t57,  # 9, 2
-        t56,  # 9, 3
-        -(0.317*t9 + t15*t32 - 1.0*t0*t16),  # 9, 4
-        0.317*t5 + t16*t35 - t15*t34,  # 9, 5
+        t63,  # 8, 6
+        t64,  # 8, 7
+        t48,  # 9, 0
+        t47,  # 9, 1
+        t50,  # 9, 2
+        t49,  # 9, 3
+        -(0.317*t9 - t65 + t66),  # 9, 4
+        0.317*t5 + t67 - t68,  # 9, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 9, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 9, 7
-        t59,  # 10, 0
-        -t58,  # 10, 1
-        t61,  # 10, 2
-        t60,  # 10, 3
+        t56,  # 10, 0
+        -(-t51 + t53),  # 10, 1
+        t62,  # 10, 2
+        -t57 + t59,  # 10, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 10, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 10, 5
-        t63,  # 10, 6
-        -t62,  # 10, 7
-        0.26705*T02 + t64 + t65 - t66 + t69 + t71 - t73 - t74 - t77 - t80,  # 11, 0
-        0.26705*t0 + t0*t21 + t0*t23 - t81 + T02*t82 + t70*t75 - t84 - t86 - t88 - t89,  # 11, 1
-        0.26705*T12 + t90 + t91 - t92 + t94 + t96 - t97 - t98 - t99 - t100,  # 11, 2
-        0.26705*t1 + t1*t21 + t1*t23 - t101 + T12*t82 + t75*t95 - t102 - t103 - t104 - t105,  # 11, 3
-        T02*t50 + t0*t52 - t0*t53 - T02*t51,  # 11, 4
-        T12*t50 + t1*t52 - t1*t53 - T12*t51,  # 11, 5
+        t64,  # 10, 6
+        -t63,  # 10, 7
+        0.26705*T02 + t69 + t70 - t71 + t73 + t74 - t76 - t77 - t79 - t81,  # 11, 0
+        0.26705*t0 + t82 + t83 - t84 + t27*t78 + t41*t78 - t86 - t87 - t88 - t89,  # 11, 1
+        0.26705*T12 + t90 + t91 - t92 + t93 + t94 - t95 - t96 - t97 - t98,  # 11, 2
+        0.26705*t1 + t99 + t100 - t101 + t23*t78 + t39*t78 - t102 - t103 - t104 - t105,  # 11, 3
+        t0*t45 + T02*t43 - T02*t44 - t0*t46,  # 11, 4
+        t1*t45 + T12*t43 - T12*t44 - t1*t46,  # 11, 5
         t106 + t107 - t108 - t109,  # 11, 6
         t110,  # 11, 7
-        t0*t111 + t5*t51 - t5*t50 - t0*t112,  # 12, 0
-        t5*t53 + T02*t112 - T02*t111 - t5*t52,  # 12, 1
-        t1*t111 + t9*t51 - t9*t50 - t1*t112,  # 12, 2
-        t9*t53 + T12*t112 - T12*t111 - t9*t52,  # 12, 3
-        -0.26705*t5 + t5*t23 - t5*t19 - t5*t21 + T02*t113 + 2.0*t17*t68 + t5*t87 + t5*t76 - T02*t114 - t68*t78,  # 12, 4
-        -0.26705*t9 + t9*t23 - t9*t19 - t9*t21 + T12*t113 + t1*t17*t85 + t9*t87 + t9*t76 - T12*t114 - t78*t93,  # 12, 5
-        t5*t24 - t9*t45,  # 12, 6
-        t9*t46 - t5*t25,  # 12, 7
-        -(0.05295*t0 + t81 - 1.0*t0*t20 - 1.0*t0*t22 + t84 + t86 + t88 + t89 - 0.634*T02*t2*t16 - 0.634*t5*t2*t17),  # 13, 0
-        0.05295*T02 + t66 - t64 - t65 + t73 + t74 + t77 + t80 - t69 - t71,  # 13, 1
-        -(0.05295*t1 + t101 - 1.0*t1*t20 - 1.0*t1*t22 + t102 + t103 + t104 + t105 - 0.634*T12*t2*t16 - 0.634*t9*t2*t17),  # 13, 2
-        0.05295*T12 + t92 - t90 - t91 + t97 + t98 + t99 + t100 - t94 - t96,  # 13, 3
-        T02*t52 + t0*t51 + t5*t112,  # 13, 4
-        T12*t52 + t1*t51 + t9*t112,  # 13, 5
+        t5*t44 + t0*t111 - 0.8*t52 - t5*t43,  # 12, 0
+        0.8*t55 + t5*t46 - t5*t45 - T02*t111,  # 12, 1
+        t9*t44 + t1*t111 - 0.8*t57 - t9*t43,  # 12, 2
+        0.8*t61 + t9*t46 - t9*t45 - T12*t111,  # 12, 3
+        -0.26705*t5 + t5*t20 - t5*t18 - t5*t19 + t27*t112 + t29*t112 + t54*t72 + t51*t78 - t27*t80 - t29*t80,  # 12, 4
+        -0.26705*t9 + t9*t20 - t9*t18 - t9*t19 + t23*t112 + t25*t112 + t60*t72 + t58*t78 - t23*t80 - t25*t80,  # 12, 5
+        t5*t21 - t9*t37,  # 12, 6
+        t9*t38 - t5*t22,  # 12, 7
+        -(0.05295*t0 - t82 - t83 + t84 - 0.634*T02*t2*t16 - 0.634*t5*t2*t17 + t86 + t87 + t88 + t89),  # 13, 0
+        0.05295*T02 + t71 - t69 - t70 + t76 + t77 + t79 + t81 - t73 - t74,  # 13, 1
+        -(0.05295*t1 - t99 - t100 + t101 - 0.634*T12*t2*t16 - 0.634*t9*t2*t17 + t102 + t103 + t104 + t105),  # 13, 2
+        0.05295*T12 + t92 - t90 - t91 + t95 + t96 + t97 + t98 - t93 - t94,  # 13, 3
+        T02*t45 + t0*t44 + 0.8*t41,  # 13, 4
+        T12*t45 + t1*t44 + 0.8*t39,  # 13, 5
         t110,  # 13, 6
         t108 + t109 - t106 - t107,  # 13, 7
     ], (14, 8))
@@ -3708,22 +3706,22 @@ def ik_general_residual(target, q):
     s7 = xp.sin(q7)
     t0 = s1*s3
     t1 = c1*c3
-    t2 = t0 + t1*c2
-    t3 = t1 + t0*c2
+    t2 = t0 + c2*t1
+    t3 = t1 + c2*t0
     t4 = c3*s1
     t5 = c1*s3
-    t6 = t4 - t5*c2
-    t7 = -t5 + t4*c2
+    t6 = t4 - c2*t5
+    t7 = -t5 + c2*t4
     t8 = c1*s2
-    t9 = t2*c4 + t8*s4
-    t10 = -t2*s4 + t8*c4
+    t9 = t2*c4 + s4*t8
+    t10 = -t2*s4 + c4*t8
     t11 = t9*c5 - t6*s5
     t12 = t9*s5 + t6*c5
     t13 = t11*c6 - t10*s6
     t14 = t10*c6 + t11*s6
     t15 = t12*s7 + t13*c7
     t16 = t12*c7 - t13*s7
-    t17 = 0.1363*t12 + 0.13375*t14
+    t17 = 0.13375*t14 + 0.1363*t12
     t18 = -t17 + 0.4*t10
     t19 = t18 + 0.1685*t6
     t20 = t19 - 0.4*t8
@@ -3733,15 +3731,15 @@ def ik_general_residual(target, q):
     t24 = T10*t15 + T11*t16 - T12*t14
     t25 = T20*t15 + T21*t16 - T22*t14
     t26 = s1*s2
-    t27 = t7*c4 + t26*s4
-    t28 = -t7*s4 + t26*c4
+    t27 = t7*c4 + s4*t26
+    t28 = -t7*s4 + c4*t26
     t29 = t3*s5 + t27*c5
     t30 = t3*c5 - t27*s5
     t31 = t29*c6 - t28*s6
     t32 = t28*c6 + t29*s6
     t33 = t31*c7 - t30*s7
     t34 = t30*c7 + t31*s7
-    t35 = 0.1363*t30 - 0.13375*t32
+    t35 = -0.13375*t32 + 0.1363*t30
     t36 = t35 + 0.4*t28
     t37 = t36 - 0.1685*t3
     t38 = t37 - 0.4*t26
@@ -3752,16 +3750,16 @@ def ik_general_residual(target, q):
     t43 = T21*t34 + T22*t32 - T20*t33
     t44 = 0.5*(t41 + t24)
     t45 = c3*s2
-    t46 = c2*s4 - t45*c4
-    t47 = c2*c4 + t45*s4
+    t46 = c2*s4 - c4*t45
+    t47 = c2*c4 + s4*t45
     t48 = s2*s3
-    t49 = t46*c5 - t48*s5
-    t50 = t46*s5 + t48*c5
+    t49 = t46*c5 - s5*t48
+    t50 = t46*s5 + c5*t48
     t51 = t49*c6 - t47*s6
     t52 = t47*c6 + t49*s6
     t53 = t50*s7 + t51*c7
     t54 = t50*c7 - t51*s7
-    t55 = 0.1363*t50 + 0.13375*t52
+    t55 = 0.13375*t52 + 0.1363*t50
     t56 = -t55 + 0.4*t47
     t57 = t56 + 0.1685*t48
     t58 = t57 - 0.4*c2
@@ -3802,13 +3800,13 @@ def ik_general_residual(target, q):
     J = _stack(xp, [
         xp.broadcast_to(t82, batch),  # 0, 0
         xp.broadcast_to(t83, batch),  # 0, 1
-        xp.broadcast_to(t38*c2 - t84*s2, batch),  # 0, 2
+        xp.broadcast_to(t38*c2 - s2*t84, batch),  # 0, 2
         xp.broadcast_to(-(t3*t57 + t37*t48), batch),  # 0, 3
         xp.broadcast_to(t28*t56 - t47*t36, batch),  # 0, 4
         xp.broadcast_to(t50*t35 - t30*t55, batch),  # 0, 5
         xp.broadcast_to(t22, batch),  # 1, 0
         xp.broadcast_to(t84, batch),  # 1, 1
-        xp.broadcast_to(-t20*c2 + t83*s2, batch),  # 1, 2
+        xp.broadcast_to(-t20*c2 + s2*t83, batch),  # 1, 2
         xp.broadcast_to(-t57*t6 + t19*t48, batch),  # 1, 3
         xp.broadcast_to(t47*t18 - t10*t56, batch),  # 1, 4
         xp.broadcast_to(t50*t17 - t12*t55, batch),  # 1, 5
@@ -3884,7 +3882,7 @@ def ik_general_limits(q_solution):
         xp.where(t22 & xp.logical_not(t23), t11, t10),  # 5
         qg7,  # 6
     ], (7,))
-    in_limits = xp.broadcast_to(xp.greater_equal(qg7, -4.71238898038469) & xp.less_equal(qg7, 4.71238898038469) & (t12 | t13) & (t22 | t23) & (t14 | t15) & (t16 | t17) & (t18 | t19) & (t20 | t21), batch)
+    in_limits = xp.broadcast_to(xp.greater_equal(qg7, -4.71238898038469) & xp.less_equal(qg7, 4.71238898038469) & (t12 | t13) & (t14 | t15) & (t16 | t17) & (t18 | t19) & (t20 | t21) & (t22 | t23), batch)
     return q, in_limits
 
 
@@ -4802,8 +4800,8 @@ IK_NEAREST_NOT_FINITE = 2
 _MONOMIALS = numpy.array([[0, 0, 0, 0, 4, 0, 0, 0, 0], [0, 0, 0, 2, 0, -2, 0, 0, 0], [0, 2, 0, 0, 0, 0, 0, -2, 0], [1, 0, -1, 0, 0, 0, -1, 0, 1], [0, 0, 0, 2, 0, 2, 0, 0, 0], [1, 0, 1, 0, 0, 0, -1, 0, -1], [0, 2, 0, 0, 0, 0, 0, 2, 0], [1, 0, -1, 0, 0, 0, 1, 0, -1], [1, 0, 1, 0, 0, 0, 1, 0, 1]], dtype=float)  # v_bc's entries in the monomials x_b^i x_c^j, at 3 i + j
 _ALONG_C, _ALONG_B = numpy.array([0, 1, 3, 4, 6, 7, 9, 10]), numpy.array([0, 1, 2, 3, 4, 5, 6, 7, 8])  # ratios x_c (step 1), x_b (step 3)
 _NEWTON_STEPS = 6
-_TOLERANCE_SQUARED = 1.00000000000000e-18  # |pose error|^2 of a solution after the Newton steps
-_CONVERGED_SQUARED = 8.00352390250000e-24  # |pose error|^2 at which the Newton steps stop
+_TOLERANCE_SQUARED = 1e-18  # |pose error|^2 of a solution after the Newton steps
+_CONVERGED_SQUARED = 8.003523902500002e-24  # |pose error|^2 at which the Newton steps stop
 
 
 def _twelve(s):

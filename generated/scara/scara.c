@@ -192,7 +192,7 @@ void scara_jacobian_tool(const scara_real q[SCARA_DOF], scara_real J[6 * SCARA_D
 
     /* Outputs */
     J[0] = t1*t3 - t0*t5;
-    J[1] = t1*t2 - t0*t4;
+    J[1] = -t0*t4 + t1*t2;
     J[2] = 0;
     J[3] = 0;
     J[4] = -(t0*t3 + t1*t5);
@@ -316,9 +316,9 @@ void scara_fk_jacobian_dot(const scara_real q[SCARA_DOF], const scara_real q_dot
     const scara_real t4 = t3 + 0.325*c1;
     const scara_real t5 = 0.275*s12;
     const scara_real t6 = t5 + 0.325*s1;
-    const scara_real t7 = t5*qd2;
+    const scara_real t7 = qd2*t5;
     const scara_real t8 = t6*qd1 + t7;
-    const scara_real t9 = t3*qd2;
+    const scara_real t9 = qd2*t3;
     const scara_real t10 = t4*qd1 + t9;
 
     /* Outputs */
@@ -362,8 +362,8 @@ void scara_fk_jacobian_dot(const scara_real q[SCARA_DOF], const scara_real q_dot
     J[21] = 1;
     J[22] = 0;
     J[23] = -1;
-    a[0] = -qd2*(t3*qd1 + t9) - t10*qd1;
-    a[1] = -qd2*(t5*qd1 + t7) - t8*qd1;
+    a[0] = -qd2*(qd1*t3 + t9) - t10*qd1;
+    a[1] = -qd2*(qd1*t5 + t7) - t8*qd1;
     a[2] = 0;
     a[3] = 0;
     a[4] = 0;
@@ -391,18 +391,18 @@ void scara_jacobian_dot(const scara_real q[SCARA_DOF], const scara_real q_dot[SC
     const scara_real t1 = t0 + 0.325*c1;
     const scara_real t2 = 0.275*s12;
     const scara_real t3 = t2 + 0.325*s1;
-    const scara_real t4 = t2*qd2;
+    const scara_real t4 = qd2*t2;
     const scara_real t5 = t3*qd1 + t4;
-    const scara_real t6 = t0*qd2;
+    const scara_real t6 = qd2*t0;
     const scara_real t7 = t1*qd1 + t6;
 
     /* Outputs */
     Jd[0] = -t7;
-    Jd[1] = -(t0*qd1 + t6);
+    Jd[1] = -(qd1*t0 + t6);
     Jd[2] = 0;
     Jd[3] = 0;
     Jd[4] = -t5;
-    Jd[5] = -(t2*qd1 + t4);
+    Jd[5] = -(qd1*t2 + t4);
     Jd[6] = 0;
     Jd[7] = 0;
     Jd[8] = 0;
@@ -444,14 +444,14 @@ void scara_bias_acceleration(const scara_real q[SCARA_DOF], const scara_real q_d
     const scara_real t1 = t0 + 0.325*c1;
     const scara_real t2 = 0.275*s12;
     const scara_real t3 = t2 + 0.325*s1;
-    const scara_real t4 = t2*qd2;
+    const scara_real t4 = qd2*t2;
     const scara_real t5 = t3*qd1 + t4;
-    const scara_real t6 = t0*qd2;
+    const scara_real t6 = qd2*t0;
     const scara_real t7 = t1*qd1 + t6;
 
     /* Outputs */
-    a[0] = -qd2*(t0*qd1 + t6) - t7*qd1;
-    a[1] = -qd2*(t2*qd1 + t4) - t5*qd1;
+    a[0] = -qd2*(qd1*t0 + t6) - t7*qd1;
+    a[1] = -qd2*(qd1*t2 + t4) - t5*qd1;
     a[2] = 0;
     a[3] = 0;
     a[4] = 0;
@@ -479,12 +479,12 @@ void scara_task_jacobian_dot(const scara_real q[SCARA_DOF], const scara_real q_d
     const scara_real t1 = t0 + 0.325*c1;
     const scara_real t2 = 0.275*s12;
     const scara_real t3 = t2 + 0.325*s1;
-    const scara_real t4 = t2*qd2;
+    const scara_real t4 = qd2*t2;
     const scara_real t5 = t3*qd1 + t4;
-    const scara_real t6 = t2*qd1 + t4;
-    const scara_real t7 = t0*qd2;
+    const scara_real t6 = qd1*t2 + t4;
+    const scara_real t7 = qd2*t0;
     const scara_real t8 = t1*qd1 + t7;
-    const scara_real t9 = t0*qd1 + t7;
+    const scara_real t9 = qd1*t0 + t7;
 
     /* Outputs */
     Jd[0] = -t8;
@@ -659,7 +659,7 @@ scara_real scara_manipulability(const scara_real q[SCARA_DOF])
     const scara_real t1 = t0 + 0.325*c1;
     const scara_real t2 = 0.275*s12;
     const scara_real t3 = t2 + 0.325*s1;
-    const scara_real t4 = t1*t2 - t3*t0;
+    const scara_real t4 = -t3*t0 + t1*t2;
 
     /* Outputs */
     return fabs(t4);
@@ -686,7 +686,7 @@ scara_real scara_jacobian_det(const scara_real q[SCARA_DOF])
     const scara_real t3 = t2 + 0.325*s1;
 
     /* Outputs */
-    return t1*t2 - t3*t0;
+    return -t3*t0 + t1*t2;
 }
 
 int scara_velocity_ik(const scara_real q[SCARA_DOF], const scara_real mu_dot[SCARA_TASK_DIM], scara_real damping, scara_real q_dot[SCARA_DOF])
@@ -745,13 +745,13 @@ int scara_velocity_ik(const scara_real q[SCARA_DOF], const scara_real mu_dot[SCA
     const scara_real t32 = (t29 > 0 ? 1/(t29*(t29 + fabs(t23))) : 0);
     const scara_real t33 = -t32*(t4*t31 + t4*t25 + t5*t18);
     const scara_real t34 = t4 + t31*t33;
-    const scara_real t35 = t25 + t4*t33;
+    const scara_real t35 = t4*t33 + t25;
     const scara_real t36 = t18 + t5*t33;
     const scara_real t37 = -t32*(t4*t18 + t5*t31 + t5*t22);
     const scara_real t38 = t5 + t31*t37;
     const scara_real t39 = t18 + t4*t37;
-    const scara_real t40 = t22 + t5*t37;
-    const scara_real t41 = -t32*(t4*mu_dot1 + t5*mu_dot3 - t31*mu_dot0);
+    const scara_real t40 = t5*t37 + t22;
+    const scara_real t41 = -t32*(-t31*mu_dot0 + t4*mu_dot1 + t5*mu_dot3);
     const scara_real t42 = mu_dot0 - t31*t41;
     const scara_real t43 = mu_dot1 + t4*t41;
     const scara_real t44 = mu_dot3 + t5*t41;
@@ -782,10 +782,10 @@ int scara_velocity_ik(const scara_real q[SCARA_DOF], const scara_real mu_dot[SCA
     const scara_real t69 = (t46 != 0 ? -(t53 - t50*t68)/t46 : 0);
     const scara_real t70 = (t30 != 0 ? -(t42 + t34*t69 + t38*t68)/t30 : 0);
     const scara_real t71 = t68 + t1*t69 - t70*t3;
-    const scara_real t72 = t68 + t69*t0 - t70*t2;
+    const scara_real t72 = t68 - t70*t2 + t69*t0;
     const scara_real t73 = -t3;
     const scara_real t74 = t11 + t73;
-    const scara_real t75 = t12*(1 + t1*t0 - t74*t2);
+    const scara_real t75 = t12*(1 - t74*t2 + t1*t0);
     const scara_real t76 = t2 + t74*t75;
     const scara_real t77 = t0 - t1*t75;
     const scara_real t78 = 1 - t75;
@@ -800,7 +800,7 @@ int scara_velocity_ik(const scara_real q[SCARA_DOF], const scara_real mu_dot[SCA
     const scara_real t87 = t86*(t78*t82 + t81*t85);
     const scara_real t88 = t81 - t85*t87;
     const scara_real t89 = t82 - t78*t87;
-    const scara_real t90 = t73 + t17 + damping + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + q1 + q2 + q3 + q4 - t2;
+    const scara_real t90 = mu_dot0 + mu_dot1 + mu_dot3 + mu_dot2 + t73 + damping + q1 + q2 + q3 + q4 - t2 + t17;
     const scara_real t91 = t1*t12;
     const scara_real t92 = t86*(t78*t13 + t85*t91);
     const scara_real t93 = t91 - t85*t92;
@@ -819,7 +819,7 @@ int scara_velocity_ik(const scara_real q[SCARA_DOF], const scara_real mu_dot[SCA
     const scara_real t106 = 1e-12*t16;
     const int t107 = damping > 0;
     const scara_real t108 = 1e-12*t28;
-    const int t109 = (t107 && ((t29 <= t108) || (t45 <= t108) || (t56 <= t108) || (t63 <= t108))) || (damping <= 0 && ((1 <= t106) || (t10 <= t106) || (t83 <= t106) || (t96 <= t106)));
+    const int t109 = (damping <= 0 && ((1 <= t106) || (t10 <= t106) || (t83 <= t106) || (t96 <= t106))) || (t107 && ((t29 <= t108) || (t45 <= t108) || (t56 <= t108) || (t63 <= t108)));
     const int t110 = t104 && t105 && !t109;
 
     /* Outputs */
@@ -875,7 +875,7 @@ scara_real scara_ik_numeric_step(const scara_real target[SCARA_TASK_DIM], const 
     const scara_real t15 = t12 + t11;
     const scara_real t16 = mu1 - t12;
     const scara_real t17 = -mu3 + atan2(t2, t1);
-    const scara_real t18 = t17 + 6.283185307179586*ceil(-0.15915494309189535*(3.141592653589793 + t17));
+    const scara_real t18 = 6.283185307179586*ceil(-0.15915494309189535*(3.141592653589793 + t17)) + t17;
     const scara_real t19 = (t10*t10) + (t16*t16) + (t3*t3) + (t18*t18);
     const scara_real t20 = t13 + damping;
     const scara_real t21 = sqrt((t14*t14) + (t15*t15) + (t20*t20));
@@ -889,7 +889,7 @@ scara_real scara_ik_numeric_step(const scara_real target[SCARA_TASK_DIM], const 
     const scara_real t29 = t8 + damping;
     const scara_real t30 = -t24*(t23*t14 + t14*t29 + t15*t9);
     const scara_real t31 = t14 + t23*t30;
-    const scara_real t32 = t29 + t30*t14;
+    const scara_real t32 = t30*t14 + t29;
     const scara_real t33 = t9 + t30*t15;
     const scara_real t34 = sqrt((t32*t32) + (t33*t33));
     const scara_real t35 = t34*(t32 >= 0 ? 1 : -1);
@@ -902,7 +902,7 @@ scara_real scara_ik_numeric_step(const scara_real target[SCARA_TASK_DIM], const 
     const scara_real t42 = -t24*(t23*t15 + t14*t9 + t15*t41);
     const scara_real t43 = t15 + t23*t42;
     const scara_real t44 = t9 + t42*t14;
-    const scara_real t45 = t41 + t42*t15;
+    const scara_real t45 = t42*t15 + t41;
     const scara_real t46 = t37*(t33*t45 + t44*t36);
     const scara_real t47 = t44 - t36*t46;
     const scara_real t48 = t45 - t33*t46;
@@ -924,7 +924,7 @@ scara_real scara_ik_numeric_step(const scara_real target[SCARA_TASK_DIM], const 
     const scara_real t64 = (t35 != 0 ? -(t39 - t47*t63)/t35 : 0);
     const scara_real t65 = (t22 != 0 ? -(t26 + t31*t64 + t43*t63)/t22 : 0);
     const scara_real t66 = t63 + q1 + t64*t7 - t65*t12;
-    const scara_real t67 = t63 + q2 + t64*t6 - t65*t11;
+    const scara_real t67 = t63 + q2 - t65*t11 + t64*t6;
     const scara_real t68 = q4 - t63;
 
     /* Outputs */
@@ -960,56 +960,56 @@ void scara_ik_branches(const scara_real mu[SCARA_TASK_DIM], scara_real q[SCARA_M
     const scara_real t7 = 11.188811188811188*t1;
     const scara_real t8 = (t5 ? t7 : (t7 > 0 ? 1 : -1));
     const scara_real t9 = atan2(t6, t8);
-    const scara_real t10 = 3.141592653589793 + t9;
-    const scara_real t11 = 3.141592653589793 - t9;
-    const scara_real t12 = t10 - 6.283185307179586*ceil(0.15915494309189535*(-3.141592653589793 + t10));
-    const scara_real t13 = t12 - 6.283185307179586*floor(0.15915494309189535*(1.53588974175501 + t12));
-    const scara_real t14 = t11 - 6.283185307179586*ceil(0.15915494309189535*(-3.141592653589793 + t11));
-    const scara_real t15 = t14 - 6.283185307179586*floor(0.15915494309189535*(1.53588974175501 + t14));
+    const scara_real t10 = 3.141592653589793 - t9;
+    const scara_real t11 = 0.325 - 0.275*t8;
+    const scara_real t12 = 0.149769 + (t11*t11) + 0.075625*(t6*t6);
+    const scara_real t13 = t10 - 6.283185307179586*ceil(0.15915494309189535*(-3.141592653589793 + t10));
+    const scara_real t14 = t13 - 6.283185307179586*floor(0.15915494309189535*(1.53588974175501 + t13));
+    const scara_real t15 = 3.141592653589793 + t9;
     const scara_real t16 = -1.0*t8;
     const scara_real t17 = -1.0*t6;
     const scara_real t18 = 0.325 + 0.275*t16;
     const scara_real t19 = 0.149769 + (t18*t18) + 0.075625*(t17*t17);
-    const scara_real t20 = 0.275*t17;
-    const scara_real t21 = 0.149769 + t18*mu0 + t20*mu1;
-    const scara_real t22 = -0.149769 + t21;
-    const scara_real t23 = t18*mu1 - t20*mu0;
-    const scara_real t24 = (t22*t22) + (t23*t23);
-    const scara_real t25 = 0.325 - 0.275*t8;
-    const scara_real t26 = 0.149769 + (t25*t25) + 0.075625*(t6*t6);
+    const scara_real t20 = t15 - 6.283185307179586*ceil(0.15915494309189535*(-3.141592653589793 + t15));
+    const scara_real t21 = t20 - 6.283185307179586*floor(0.15915494309189535*(1.53588974175501 + t20));
+    const scara_real t22 = 0.275*t17;
+    const scara_real t23 = 0.149769 + t18*mu0 + mu1*t22;
+    const scara_real t24 = -0.149769 + t23;
+    const scara_real t25 = t18*mu1 - mu0*t22;
+    const scara_real t26 = (t24*t24) + (t25*t25);
     const scara_real t27 = 0.275*t6;
-    const scara_real t28 = 0.149769 + t25*mu0 + t27*mu1;
+    const scara_real t28 = 0.149769 + t11*mu0 + mu1*t27;
     const scara_real t29 = -0.149769 + t28;
-    const scara_real t30 = t25*mu1 - t27*mu0;
+    const scara_real t30 = t11*mu1 - mu0*t27;
     const scara_real t31 = (t29*t29) + (t30*t30);
     const scara_real t32 = 1e-24*t0;
-    const scara_real t33 = (t24 <= t19*t32 ? 0 : atan2(t23, t22));
+    const scara_real t33 = (t26 <= t19*t32 ? 0 : atan2(t25, t24));
     const scara_real t34 = t33;
     const scara_real t35 = t34 - 6.283185307179586*floor(0.15915494309189535*(0.8726646259971648 + t34));
     const scara_real t36 = -mu3;
-    const scara_real t37 = -(t10 + t36 + t33);
+    const scara_real t37 = -(t36 + t15 + t33);
     const scara_real t38 = t37 + 6.283185307179586*ceil(-0.15915494309189535*(3.141592653589793 + t37));
     const scara_real t39 = -t38;
     const scara_real t40 = t38 + 6.283185307179586*floor(0.15915494309189535*(6.283185307179586 + t39));
-    const scara_real t41 = (t31 <= t26*t32 ? 0 : atan2(t30, t29));
+    const scara_real t41 = (t31 <= t12*t32 ? 0 : atan2(t30, t29));
     const scara_real t42 = t41;
     const scara_real t43 = t42 - 6.283185307179586*floor(0.15915494309189535*(0.8726646259971648 + t42));
-    const scara_real t44 = -(t11 + t36 + t41);
+    const scara_real t44 = -(t36 + t10 + t41);
     const scara_real t45 = t44 + 6.283185307179586*ceil(-0.15915494309189535*(3.141592653589793 + t44));
     const scara_real t46 = -t45;
     const scara_real t47 = t45 + 6.283185307179586*floor(0.15915494309189535*(6.283185307179586 + t46));
     const int t48 = t35 <= 0.8726646259971648;
     const int t49 = t34 >= -0.8726646259971648 && t34 <= 0.8726646259971648;
-    const int t50 = t13 <= 1.53588974175501;
-    const int t51 = t12 >= -1.53588974175501 && t12 <= 1.53588974175501;
+    const int t50 = t21 <= 1.53588974175501;
+    const int t51 = t20 >= -1.53588974175501 && t20 <= 1.53588974175501;
     const scara_real t52 = -(-0.387 + mu2);
     const scara_real t53 = -t40;
     const int t54 = t53 <= 6.283185307179586;
     const int t55 = t39 >= -6.283185307179586 && t39 <= 6.283185307179586;
     const int t56 = t43 <= 0.8726646259971648;
     const int t57 = t42 >= -0.8726646259971648 && t42 <= 0.8726646259971648;
-    const int t58 = t15 <= 1.53588974175501;
-    const int t59 = t14 >= -1.53588974175501 && t14 <= 1.53588974175501;
+    const int t58 = t14 <= 1.53588974175501;
+    const int t59 = t13 >= -1.53588974175501 && t13 <= 1.53588974175501;
     const scara_real t60 = -t47;
     const int t61 = t60 <= 6.283185307179586;
     const int t62 = t46 >= -6.283185307179586 && t46 <= 6.283185307179586;
@@ -1019,11 +1019,11 @@ void scara_ik_branches(const scara_real mu[SCARA_TASK_DIM], scara_real q[SCARA_M
 
     /* Outputs */
     q[0] = (t48 && !t49 ? t35 : t34);
-    q[1] = (t50 && !t51 ? t13 : t12);
+    q[1] = (t50 && !t51 ? t21 : t20);
     q[2] = t52;
     q[3] = (t54 && !t55 ? t53 : t39);
     q[4] = (t56 && !t57 ? t43 : t42);
-    q[5] = (t58 && !t59 ? t15 : t14);
+    q[5] = (t58 && !t59 ? t14 : t13);
     q[6] = t52;
     q[7] = (t61 && !t62 ? t60 : t46);
     valid[0] = t63 && t4 >= -1e-12;

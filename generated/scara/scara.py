@@ -242,7 +242,7 @@ def jacobian_tool(q):
     t5 = t4 + 0.325*s1
     J = _stack(xp, [
         t1*t3 - t0*t5,  # 0, 0
-        t1*t2 - t0*t4,  # 0, 1
+        -t0*t4 + t1*t2,  # 0, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 3
         -(t0*t3 + t1*t5),  # 1, 0
@@ -353,9 +353,9 @@ def fk_jacobian_dot(q, q_dot):
     t4 = t3 + 0.325*c1
     t5 = 0.275*s12
     t6 = t5 + 0.325*s1
-    t7 = t5*qd2
+    t7 = qd2*t5
     t8 = t6*qd1 + t7
-    t9 = t3*qd2
+    t9 = qd2*t3
     t10 = t4*qd1 + t9
     T = _stack(xp, [
         xp.broadcast_to(t1, batch),  # 0, 0
@@ -402,8 +402,8 @@ def fk_jacobian_dot(q, q_dot):
         xp.full(batch, -1, dtype=dtype, device=device),  # 5, 3
     ], (6, 4))
     a = _stack(xp, [
-        xp.broadcast_to(-qd2*(t3*qd1 + t9) - t10*qd1, batch),  # 0
-        xp.broadcast_to(-qd2*(t5*qd1 + t7) - t8*qd1, batch),  # 1
+        xp.broadcast_to(-qd2*(qd1*t3 + t9) - t10*qd1, batch),  # 0
+        xp.broadcast_to(-qd2*(qd1*t5 + t7) - t8*qd1, batch),  # 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 4
@@ -428,17 +428,17 @@ def jacobian_dot(q, q_dot):
     t1 = t0 + 0.325*c1
     t2 = 0.275*s12
     t3 = t2 + 0.325*s1
-    t4 = t2*qd2
+    t4 = qd2*t2
     t5 = t3*qd1 + t4
-    t6 = t0*qd2
+    t6 = qd2*t0
     t7 = t1*qd1 + t6
     Jd = _stack(xp, [
         xp.broadcast_to(-t7, batch),  # 0, 0
-        xp.broadcast_to(-(t0*qd1 + t6), batch),  # 0, 1
+        xp.broadcast_to(-(qd1*t0 + t6), batch),  # 0, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 3
         xp.broadcast_to(-t5, batch),  # 1, 0
-        xp.broadcast_to(-(t2*qd1 + t4), batch),  # 1, 1
+        xp.broadcast_to(-(qd1*t2 + t4), batch),  # 1, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
@@ -477,13 +477,13 @@ def bias_acceleration(q, q_dot):
     t1 = t0 + 0.325*c1
     t2 = 0.275*s12
     t3 = t2 + 0.325*s1
-    t4 = t2*qd2
+    t4 = qd2*t2
     t5 = t3*qd1 + t4
-    t6 = t0*qd2
+    t6 = qd2*t0
     t7 = t1*qd1 + t6
     a = _stack(xp, [
-        xp.broadcast_to(-qd2*(t0*qd1 + t6) - t7*qd1, batch),  # 0
-        xp.broadcast_to(-qd2*(t2*qd1 + t4) - t5*qd1, batch),  # 1
+        xp.broadcast_to(-qd2*(qd1*t0 + t6) - t7*qd1, batch),  # 0
+        xp.broadcast_to(-qd2*(qd1*t2 + t4) - t5*qd1, batch),  # 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 4
@@ -508,12 +508,12 @@ def task_jacobian_dot(q, q_dot):
     t1 = t0 + 0.325*c1
     t2 = 0.275*s12
     t3 = t2 + 0.325*s1
-    t4 = t2*qd2
+    t4 = qd2*t2
     t5 = t3*qd1 + t4
-    t6 = t2*qd1 + t4
-    t7 = t0*qd2
+    t6 = qd1*t2 + t4
+    t7 = qd2*t0
     t8 = t1*qd1 + t7
-    t9 = t0*qd1 + t7
+    t9 = qd1*t0 + t7
     Jd = _stack(xp, [
         xp.broadcast_to(-t8, batch),  # 0, 0
         xp.broadcast_to(-t9, batch),  # 0, 1
@@ -677,7 +677,7 @@ def manipulability(q):
     t1 = t0 + 0.325*c1
     t2 = 0.275*s12
     t3 = t2 + 0.325*s1
-    t4 = t1*t2 - t3*t0
+    t4 = -t3*t0 + t1*t2
     w = xp.broadcast_to(xp.abs(t4), batch)
     return w
 
@@ -696,7 +696,7 @@ def jacobian_det(q):
     t1 = t0 + 0.325*c1
     t2 = 0.275*s12
     t3 = t2 + 0.325*s1
-    d = xp.broadcast_to(t1*t2 - t3*t0, batch)
+    d = xp.broadcast_to(-t3*t0 + t1*t2, batch)
     return d
 
 
@@ -754,13 +754,13 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t32 = xp.where(xp.greater(t29, 0), 1/(t29*(t29 + xp.abs(t23))), 0)
     t33 = -t32*(t4*t31 + t4*t25 + t5*t18)
     t34 = t4 + t31*t33
-    t35 = t25 + t4*t33
+    t35 = t4*t33 + t25
     t36 = t18 + t5*t33
     t37 = -t32*(t4*t18 + t5*t31 + t5*t22)
     t38 = t5 + t31*t37
     t39 = t18 + t4*t37
-    t40 = t22 + t5*t37
-    t41 = -t32*(t4*mu_dot1 + t5*mu_dot3 - t31*mu_dot0)
+    t40 = t5*t37 + t22
+    t41 = -t32*(-t31*mu_dot0 + t4*mu_dot1 + t5*mu_dot3)
     t42 = mu_dot0 - t31*t41
     t43 = mu_dot1 + t4*t41
     t44 = mu_dot3 + t5*t41
@@ -791,10 +791,10 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t69 = xp.where(xp.not_equal(t46, 0), -(t53 - t50*t68)/t46, 0)
     t70 = xp.where(xp.not_equal(t30, 0), -(t42 + t34*t69 + t38*t68)/t30, 0)
     t71 = t68 + t1*t69 - t70*t3
-    t72 = t68 + t69*t0 - t70*t2
+    t72 = t68 - t70*t2 + t69*t0
     t73 = -t3
     t74 = t11 + t73
-    t75 = t12*(1 + t1*t0 - t74*t2)
+    t75 = t12*(1 - t74*t2 + t1*t0)
     t76 = t2 + t74*t75
     t77 = t0 - t1*t75
     t78 = 1 - t75
@@ -809,7 +809,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t87 = t86*(t78*t82 + t81*t85)
     t88 = t81 - t85*t87
     t89 = t82 - t78*t87
-    t90 = t73 + t17 + damping + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + q1 + q2 + q3 + q4 - t2
+    t90 = mu_dot0 + mu_dot1 + mu_dot3 + mu_dot2 + t73 + damping + q1 + q2 + q3 + q4 - t2 + t17
     t91 = t1*t12
     t92 = t86*(t78*t13 + t85*t91)
     t93 = t91 - t85*t92
@@ -828,7 +828,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t106 = 1e-12*t16
     t107 = xp.greater(damping, 0)
     t108 = 1e-12*t28
-    t109 = (t107 & (xp.less_equal(t29, t108) | xp.less_equal(t45, t108) | xp.less_equal(t56, t108) | xp.less_equal(t63, t108))) | (xp.less_equal(damping, 0) & (xp.less_equal(1, t106) | xp.less_equal(t10, t106) | xp.less_equal(t83, t106) | xp.less_equal(t96, t106)))
+    t109 = (xp.less_equal(damping, 0) & (xp.less_equal(1, t106) | xp.less_equal(t10, t106) | xp.less_equal(t83, t106) | xp.less_equal(t96, t106))) | (t107 & (xp.less_equal(t29, t108) | xp.less_equal(t45, t108) | xp.less_equal(t56, t108) | xp.less_equal(t63, t108)))
     t110 = t104 & t105 & xp.logical_not(t109)
     q_dot = _stack(xp, [
         xp.broadcast_to(xp.where(t110, xp.where(t107, t71, t103), 0), batch),  # 0
@@ -882,7 +882,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t15 = t12 + t11
     t16 = mu1 - t12
     t17 = -mu3 + xp.atan2(t2, t1)
-    t18 = t17 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t17))
+    t18 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t17)) + t17
     t19 = t10**2 + t16**2 + t3**2 + t18**2
     t20 = t13 + damping
     t21 = xp.sqrt(t14**2 + t15**2 + t20**2)
@@ -896,7 +896,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t29 = t8 + damping
     t30 = -t24*(t23*t14 + t14*t29 + t15*t9)
     t31 = t14 + t23*t30
-    t32 = t29 + t30*t14
+    t32 = t30*t14 + t29
     t33 = t9 + t30*t15
     t34 = xp.sqrt(t32**2 + t33**2)
     t35 = t34*xp.where(xp.greater_equal(t32, 0), xp.asarray(1, dtype=dtype), -1)
@@ -909,7 +909,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t42 = -t24*(t23*t15 + t14*t9 + t15*t41)
     t43 = t15 + t23*t42
     t44 = t9 + t42*t14
-    t45 = t41 + t42*t15
+    t45 = t42*t15 + t41
     t46 = t37*(t33*t45 + t44*t36)
     t47 = t44 - t36*t46
     t48 = t45 - t33*t46
@@ -931,7 +931,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t64 = xp.where(xp.not_equal(t35, 0), -(t39 - t47*t63)/t35, 0)
     t65 = xp.where(xp.not_equal(t22, 0), -(t26 + t31*t64 + t43*t63)/t22, 0)
     t66 = t63 + q1 + t64*t7 - t65*t12
-    t67 = t63 + q2 + t64*t6 - t65*t11
+    t67 = t63 + q2 - t65*t11 + t64*t6
     t68 = q4 - t63
     q_start = _stack(xp, [
         xp.broadcast_to(q1, batch),  # 0
@@ -967,56 +967,56 @@ def ik_branches(mu):
     t7 = 11.188811188811188*t1
     t8 = xp.where(t5, t7, xp.where(xp.greater(t7, 0), xp.asarray(1, dtype=dtype), -1))
     t9 = xp.atan2(t6, t8)
-    t10 = 3.141592653589793 + t9
-    t11 = 3.141592653589793 - t9
-    t12 = t10 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t10))
-    t13 = t12 - 6.283185307179586*xp.floor(0.15915494309189535*(1.53588974175501 + t12))
-    t14 = t11 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t11))
-    t15 = t14 - 6.283185307179586*xp.floor(0.15915494309189535*(1.53588974175501 + t14))
+    t10 = 3.141592653589793 - t9
+    t11 = 0.325 - 0.275*t8
+    t12 = 0.149769 + t11**2 + 0.075625*t6**2
+    t13 = t10 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t10))
+    t14 = t13 - 6.283185307179586*xp.floor(0.15915494309189535*(1.53588974175501 + t13))
+    t15 = 3.141592653589793 + t9
     t16 = -1.0*t8
     t17 = -1.0*t6
     t18 = 0.325 + 0.275*t16
     t19 = 0.149769 + t18**2 + 0.075625*t17**2
-    t20 = 0.275*t17
-    t21 = 0.149769 + t18*mu0 + t20*mu1
-    t22 = -0.149769 + t21
-    t23 = t18*mu1 - t20*mu0
-    t24 = t22**2 + t23**2
-    t25 = 0.325 - 0.275*t8
-    t26 = 0.149769 + t25**2 + 0.075625*t6**2
+    t20 = t15 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t15))
+    t21 = t20 - 6.283185307179586*xp.floor(0.15915494309189535*(1.53588974175501 + t20))
+    t22 = 0.275*t17
+    t23 = 0.149769 + t18*mu0 + mu1*t22
+    t24 = -0.149769 + t23
+    t25 = t18*mu1 - mu0*t22
+    t26 = t24**2 + t25**2
     t27 = 0.275*t6
-    t28 = 0.149769 + t25*mu0 + t27*mu1
+    t28 = 0.149769 + t11*mu0 + mu1*t27
     t29 = -0.149769 + t28
-    t30 = t25*mu1 - t27*mu0
+    t30 = t11*mu1 - mu0*t27
     t31 = t29**2 + t30**2
     t32 = 1e-24*t0
-    t33 = xp.where(xp.less_equal(t24, t19*t32), 0, xp.atan2(t23, t22))
+    t33 = xp.where(xp.less_equal(t26, t19*t32), 0, xp.atan2(t25, t24))
     t34 = t33
     t35 = t34 - 6.283185307179586*xp.floor(0.15915494309189535*(0.8726646259971648 + t34))
     t36 = -mu3
-    t37 = -(t10 + t36 + t33)
+    t37 = -(t36 + t15 + t33)
     t38 = t37 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t37))
     t39 = -t38
     t40 = t38 + 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t39))
-    t41 = xp.where(xp.less_equal(t31, t26*t32), 0, xp.atan2(t30, t29))
+    t41 = xp.where(xp.less_equal(t31, t12*t32), 0, xp.atan2(t30, t29))
     t42 = t41
     t43 = t42 - 6.283185307179586*xp.floor(0.15915494309189535*(0.8726646259971648 + t42))
-    t44 = -(t11 + t36 + t41)
+    t44 = -(t36 + t10 + t41)
     t45 = t44 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t44))
     t46 = -t45
     t47 = t45 + 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t46))
     t48 = xp.less_equal(t35, 0.8726646259971648)
     t49 = xp.greater_equal(t34, -0.8726646259971648) & xp.less_equal(t34, 0.8726646259971648)
-    t50 = xp.less_equal(t13, 1.53588974175501)
-    t51 = xp.greater_equal(t12, -1.53588974175501) & xp.less_equal(t12, 1.53588974175501)
+    t50 = xp.less_equal(t21, 1.53588974175501)
+    t51 = xp.greater_equal(t20, -1.53588974175501) & xp.less_equal(t20, 1.53588974175501)
     t52 = -(-0.387 + mu2)
     t53 = -t40
     t54 = xp.less_equal(t53, 6.283185307179586)
     t55 = xp.greater_equal(t39, -6.283185307179586) & xp.less_equal(t39, 6.283185307179586)
     t56 = xp.less_equal(t43, 0.8726646259971648)
     t57 = xp.greater_equal(t42, -0.8726646259971648) & xp.less_equal(t42, 0.8726646259971648)
-    t58 = xp.less_equal(t15, 1.53588974175501)
-    t59 = xp.greater_equal(t14, -1.53588974175501) & xp.less_equal(t14, 1.53588974175501)
+    t58 = xp.less_equal(t14, 1.53588974175501)
+    t59 = xp.greater_equal(t13, -1.53588974175501) & xp.less_equal(t13, 1.53588974175501)
     t60 = -t47
     t61 = xp.less_equal(t60, 6.283185307179586)
     t62 = xp.greater_equal(t46, -6.283185307179586) & xp.less_equal(t46, 6.283185307179586)
@@ -1025,11 +1025,11 @@ def ik_branches(mu):
     t65 = xp.less_equal(t52, 0.21)
     q = _stack(xp, [
         xp.where(t48 & xp.logical_not(t49), t35, t34),  # 0, 0
-        xp.where(t50 & xp.logical_not(t51), t13, t12),  # 0, 1
+        xp.where(t50 & xp.logical_not(t51), t21, t20),  # 0, 1
         t52,  # 0, 2
         xp.where(t54 & xp.logical_not(t55), t53, t39),  # 0, 3
         xp.where(t56 & xp.logical_not(t57), t43, t42),  # 1, 0
-        xp.where(t58 & xp.logical_not(t59), t15, t14),  # 1, 1
+        xp.where(t58 & xp.logical_not(t59), t14, t13),  # 1, 1
         t52,  # 1, 2
         xp.where(t61 & xp.logical_not(t62), t60, t46),  # 1, 3
     ], (2, 4))

@@ -138,7 +138,7 @@ def _jacobian_tool(q):
     t5 = t4 + 0.325*s1
     J = casadi.SX(6, 4)
     J[0, 0] = t1*t3 - t0*t5
-    J[0, 1] = t1*t2 - t0*t4
+    J[0, 1] = -t0*t4 + t1*t2
     J[1, 0] = -(t0*t3 + t1*t5)
     J[1, 1] = -(t0*t2 + t1*t4)
     J[2, 2] = 1
@@ -224,9 +224,9 @@ def _fk_jacobian_dot(q, q_dot):
     t4 = t3 + 0.325*c1
     t5 = 0.275*s12
     t6 = t5 + 0.325*s1
-    t7 = t5*qd2
+    t7 = qd2*t5
     t8 = t6*qd1 + t7
-    t9 = t3*qd2
+    t9 = qd2*t3
     t10 = t4*qd1 + t9
     T = casadi.SX(4, 4)
     T[0, 0] = t1
@@ -248,8 +248,8 @@ def _fk_jacobian_dot(q, q_dot):
     J[5, 1] = 1
     J[5, 3] = -1
     a = casadi.SX(6, 1)
-    a[0, 0] = -qd2*(t3*qd1 + t9) - t10*qd1
-    a[1, 0] = -qd2*(t5*qd1 + t7) - t8*qd1
+    a[0, 0] = -qd2*(qd1*t3 + t9) - t10*qd1
+    a[1, 0] = -qd2*(qd1*t5 + t7) - t8*qd1
     return [T, J, a]
 
 
@@ -269,15 +269,15 @@ def _jacobian_dot(q, q_dot):
     t1 = t0 + 0.325*c1
     t2 = 0.275*s12
     t3 = t2 + 0.325*s1
-    t4 = t2*qd2
+    t4 = qd2*t2
     t5 = t3*qd1 + t4
-    t6 = t0*qd2
+    t6 = qd2*t0
     t7 = t1*qd1 + t6
     Jd = casadi.SX(6, 4)
     Jd[0, 0] = -t7
-    Jd[0, 1] = -(t0*qd1 + t6)
+    Jd[0, 1] = -(qd1*t0 + t6)
     Jd[1, 0] = -t5
-    Jd[1, 1] = -(t2*qd1 + t4)
+    Jd[1, 1] = -(qd1*t2 + t4)
     return [Jd]
 
 
@@ -297,13 +297,13 @@ def _bias_acceleration(q, q_dot):
     t1 = t0 + 0.325*c1
     t2 = 0.275*s12
     t3 = t2 + 0.325*s1
-    t4 = t2*qd2
+    t4 = qd2*t2
     t5 = t3*qd1 + t4
-    t6 = t0*qd2
+    t6 = qd2*t0
     t7 = t1*qd1 + t6
     a = casadi.SX(6, 1)
-    a[0, 0] = -qd2*(t0*qd1 + t6) - t7*qd1
-    a[1, 0] = -qd2*(t2*qd1 + t4) - t5*qd1
+    a[0, 0] = -qd2*(qd1*t0 + t6) - t7*qd1
+    a[1, 0] = -qd2*(qd1*t2 + t4) - t5*qd1
     return [a]
 
 
@@ -323,12 +323,12 @@ def _task_jacobian_dot(q, q_dot):
     t1 = t0 + 0.325*c1
     t2 = 0.275*s12
     t3 = t2 + 0.325*s1
-    t4 = t2*qd2
+    t4 = qd2*t2
     t5 = t3*qd1 + t4
-    t6 = t2*qd1 + t4
-    t7 = t0*qd2
+    t6 = qd1*t2 + t4
+    t7 = qd2*t0
     t8 = t1*qd1 + t7
-    t9 = t0*qd1 + t7
+    t9 = qd1*t0 + t7
     Jd = casadi.SX(4, 4)
     Jd[0, 0] = -t8
     Jd[0, 1] = -t9
@@ -388,7 +388,7 @@ def _manipulability(q):
     t1 = t0 + 0.325*c1
     t2 = 0.275*s12
     t3 = t2 + 0.325*s1
-    t4 = t1*t2 - t3*t0
+    t4 = -t3*t0 + t1*t2
     w = casadi.SX(1, 1)
     w[0, 0] = casadi.fabs(t4)
     return [w]
@@ -409,7 +409,7 @@ def _jacobian_det(q):
     t2 = 0.275*s12
     t3 = t2 + 0.325*s1
     d = casadi.SX(1, 1)
-    d[0, 0] = t1*t2 - t3*t0
+    d[0, 0] = -t3*t0 + t1*t2
     return [d]
 
 
@@ -464,13 +464,13 @@ def _velocity_ik(q, mu_dot, damping):
     t32 = casadi.if_else((t29 > 0), 1/(t29*(t29 + casadi.fabs(t23))), 0)
     t33 = -t32*(t4*t31 + t4*t25 + t5*t18)
     t34 = t4 + t31*t33
-    t35 = t25 + t4*t33
+    t35 = t4*t33 + t25
     t36 = t18 + t5*t33
     t37 = -t32*(t4*t18 + t5*t31 + t5*t22)
     t38 = t5 + t31*t37
     t39 = t18 + t4*t37
-    t40 = t22 + t5*t37
-    t41 = -t32*(t4*mu_dot1 + t5*mu_dot3 - t31*mu_dot0)
+    t40 = t5*t37 + t22
+    t41 = -t32*(-t31*mu_dot0 + t4*mu_dot1 + t5*mu_dot3)
     t42 = mu_dot0 - t31*t41
     t43 = mu_dot1 + t4*t41
     t44 = mu_dot3 + t5*t41
@@ -501,10 +501,10 @@ def _velocity_ik(q, mu_dot, damping):
     t69 = casadi.if_else((t46 != 0), -(t53 - t50*t68)/t46, 0)
     t70 = casadi.if_else((t30 != 0), -(t42 + t34*t69 + t38*t68)/t30, 0)
     t71 = t68 + t1*t69 - t70*t3
-    t72 = t68 + t69*t0 - t70*t2
+    t72 = t68 - t70*t2 + t69*t0
     t73 = -t3
     t74 = t11 + t73
-    t75 = t12*(1 + t1*t0 - t74*t2)
+    t75 = t12*(1 - t74*t2 + t1*t0)
     t76 = t2 + t74*t75
     t77 = t0 - t1*t75
     t78 = 1 - t75
@@ -519,7 +519,7 @@ def _velocity_ik(q, mu_dot, damping):
     t87 = t86*(t78*t82 + t81*t85)
     t88 = t81 - t85*t87
     t89 = t82 - t78*t87
-    t90 = t73 + t17 + damping + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + q1 + q2 + q3 + q4 - t2
+    t90 = mu_dot0 + mu_dot1 + mu_dot3 + mu_dot2 + t73 + damping + q1 + q2 + q3 + q4 - t2 + t17
     t91 = t1*t12
     t92 = t86*(t78*t13 + t85*t91)
     t93 = t91 - t85*t92
@@ -538,7 +538,7 @@ def _velocity_ik(q, mu_dot, damping):
     t106 = 1e-12*t16
     t107 = (damping > 0)
     t108 = 1e-12*t28
-    t109 = casadi.logic_or(casadi.logic_and(t107, casadi.logic_or(casadi.logic_or(casadi.logic_or((t29 <= t108), (t45 <= t108)), (t56 <= t108)), (t63 <= t108))), casadi.logic_and((damping <= 0), casadi.logic_or(casadi.logic_or(casadi.logic_or((1 <= t106), (t10 <= t106)), (t83 <= t106)), (t96 <= t106))))
+    t109 = casadi.logic_or(casadi.logic_and((damping <= 0), casadi.logic_or(casadi.logic_or(casadi.logic_or((1 <= t106), (t10 <= t106)), (t83 <= t106)), (t96 <= t106))), casadi.logic_and(t107, casadi.logic_or(casadi.logic_or(casadi.logic_or((t29 <= t108), (t45 <= t108)), (t56 <= t108)), (t63 <= t108))))
     t110 = casadi.logic_and(casadi.logic_and(t104, t105), casadi.logic_not(t109))
     q_dot = casadi.SX(4, 1)
     q_dot[0, 0] = casadi.if_else(t110, casadi.if_else(t107, t71, t103), 0)
@@ -590,7 +590,7 @@ def _ik_numeric_step(target, q, damping):
     t15 = t12 + t11
     t16 = mu1 - t12
     t17 = -mu3 + casadi.atan2(t2, t1)
-    t18 = t17 + 6.283185307179586*casadi.ceil(-0.15915494309189535*(3.141592653589793 + t17))
+    t18 = 6.283185307179586*casadi.ceil(-0.15915494309189535*(3.141592653589793 + t17)) + t17
     t19 = t10**2 + t16**2 + t3**2 + t18**2
     t20 = t13 + damping
     t21 = casadi.sqrt(t14**2 + t15**2 + t20**2)
@@ -604,7 +604,7 @@ def _ik_numeric_step(target, q, damping):
     t29 = t8 + damping
     t30 = -t24*(t23*t14 + t14*t29 + t15*t9)
     t31 = t14 + t23*t30
-    t32 = t29 + t30*t14
+    t32 = t30*t14 + t29
     t33 = t9 + t30*t15
     t34 = casadi.sqrt(t32**2 + t33**2)
     t35 = t34*casadi.if_else((t32 >= 0), 1, -1)
@@ -617,7 +617,7 @@ def _ik_numeric_step(target, q, damping):
     t42 = -t24*(t23*t15 + t14*t9 + t15*t41)
     t43 = t15 + t23*t42
     t44 = t9 + t42*t14
-    t45 = t41 + t42*t15
+    t45 = t42*t15 + t41
     t46 = t37*(t33*t45 + t44*t36)
     t47 = t44 - t36*t46
     t48 = t45 - t33*t46
@@ -639,7 +639,7 @@ def _ik_numeric_step(target, q, damping):
     t64 = casadi.if_else((t35 != 0), -(t39 - t47*t63)/t35, 0)
     t65 = casadi.if_else((t22 != 0), -(t26 + t31*t64 + t43*t63)/t22, 0)
     t66 = t63 + q1 + t64*t7 - t65*t12
-    t67 = t63 + q2 + t64*t6 - t65*t11
+    t67 = t63 + q2 - t65*t11 + t64*t6
     t68 = q4 - t63
     q_start = casadi.SX(4, 1)
     q_start[0, 0] = q1
@@ -672,56 +672,56 @@ def _ik_branches(mu):
     t7 = 11.188811188811188*t1
     t8 = casadi.if_else(t5, t7, casadi.if_else((t7 > 0), 1, -1))
     t9 = casadi.atan2(t6, t8)
-    t10 = 3.141592653589793 + t9
-    t11 = 3.141592653589793 - t9
-    t12 = t10 - 6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t10))
-    t13 = t12 - 6.283185307179586*casadi.floor(0.15915494309189535*(1.53588974175501 + t12))
-    t14 = t11 - 6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t11))
-    t15 = t14 - 6.283185307179586*casadi.floor(0.15915494309189535*(1.53588974175501 + t14))
+    t10 = 3.141592653589793 - t9
+    t11 = 0.325 - 0.275*t8
+    t12 = 0.149769 + t11**2 + 0.075625*t6**2
+    t13 = t10 - 6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t10))
+    t14 = t13 - 6.283185307179586*casadi.floor(0.15915494309189535*(1.53588974175501 + t13))
+    t15 = 3.141592653589793 + t9
     t16 = -1.0*t8
     t17 = -1.0*t6
     t18 = 0.325 + 0.275*t16
     t19 = 0.149769 + t18**2 + 0.075625*t17**2
-    t20 = 0.275*t17
-    t21 = 0.149769 + t18*mu0 + t20*mu1
-    t22 = -0.149769 + t21
-    t23 = t18*mu1 - t20*mu0
-    t24 = t22**2 + t23**2
-    t25 = 0.325 - 0.275*t8
-    t26 = 0.149769 + t25**2 + 0.075625*t6**2
+    t20 = t15 - 6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t15))
+    t21 = t20 - 6.283185307179586*casadi.floor(0.15915494309189535*(1.53588974175501 + t20))
+    t22 = 0.275*t17
+    t23 = 0.149769 + t18*mu0 + mu1*t22
+    t24 = -0.149769 + t23
+    t25 = t18*mu1 - mu0*t22
+    t26 = t24**2 + t25**2
     t27 = 0.275*t6
-    t28 = 0.149769 + t25*mu0 + t27*mu1
+    t28 = 0.149769 + t11*mu0 + mu1*t27
     t29 = -0.149769 + t28
-    t30 = t25*mu1 - t27*mu0
+    t30 = t11*mu1 - mu0*t27
     t31 = t29**2 + t30**2
     t32 = 1e-24*t0
-    t33 = casadi.if_else((t24 <= t19*t32), 0, casadi.atan2(t23, t22))
+    t33 = casadi.if_else((t26 <= t19*t32), 0, casadi.atan2(t25, t24))
     t34 = t33
     t35 = t34 - 6.283185307179586*casadi.floor(0.15915494309189535*(0.8726646259971648 + t34))
     t36 = -mu3
-    t37 = -(t10 + t36 + t33)
+    t37 = -(t36 + t15 + t33)
     t38 = t37 + 6.283185307179586*casadi.ceil(-0.15915494309189535*(3.141592653589793 + t37))
     t39 = -t38
     t40 = t38 + 6.283185307179586*casadi.floor(0.15915494309189535*(6.283185307179586 + t39))
-    t41 = casadi.if_else((t31 <= t26*t32), 0, casadi.atan2(t30, t29))
+    t41 = casadi.if_else((t31 <= t12*t32), 0, casadi.atan2(t30, t29))
     t42 = t41
     t43 = t42 - 6.283185307179586*casadi.floor(0.15915494309189535*(0.8726646259971648 + t42))
-    t44 = -(t11 + t36 + t41)
+    t44 = -(t36 + t10 + t41)
     t45 = t44 + 6.283185307179586*casadi.ceil(-0.15915494309189535*(3.141592653589793 + t44))
     t46 = -t45
     t47 = t45 + 6.283185307179586*casadi.floor(0.15915494309189535*(6.283185307179586 + t46))
     t48 = (t35 <= 0.8726646259971648)
     t49 = casadi.logic_and((t34 >= -0.8726646259971648), (t34 <= 0.8726646259971648))
-    t50 = (t13 <= 1.53588974175501)
-    t51 = casadi.logic_and((t12 >= -1.53588974175501), (t12 <= 1.53588974175501))
+    t50 = (t21 <= 1.53588974175501)
+    t51 = casadi.logic_and((t20 >= -1.53588974175501), (t20 <= 1.53588974175501))
     t52 = -(-0.387 + mu2)
     t53 = -t40
     t54 = (t53 <= 6.283185307179586)
     t55 = casadi.logic_and((t39 >= -6.283185307179586), (t39 <= 6.283185307179586))
     t56 = (t43 <= 0.8726646259971648)
     t57 = casadi.logic_and((t42 >= -0.8726646259971648), (t42 <= 0.8726646259971648))
-    t58 = (t15 <= 1.53588974175501)
-    t59 = casadi.logic_and((t14 >= -1.53588974175501), (t14 <= 1.53588974175501))
+    t58 = (t14 <= 1.53588974175501)
+    t59 = casadi.logic_and((t13 >= -1.53588974175501), (t13 <= 1.53588974175501))
     t60 = -t47
     t61 = (t60 <= 6.283185307179586)
     t62 = casadi.logic_and((t46 >= -6.283185307179586), (t46 <= 6.283185307179586))
@@ -730,11 +730,11 @@ def _ik_branches(mu):
     t65 = (t52 <= 0.21)
     q = casadi.SX(2, 4)
     q[0, 0] = casadi.if_else(casadi.logic_and(t48, casadi.logic_not(t49)), t35, t34)
-    q[0, 1] = casadi.if_else(casadi.logic_and(t50, casadi.logic_not(t51)), t13, t12)
+    q[0, 1] = casadi.if_else(casadi.logic_and(t50, casadi.logic_not(t51)), t21, t20)
     q[0, 2] = t52
     q[0, 3] = casadi.if_else(casadi.logic_and(t54, casadi.logic_not(t55)), t53, t39)
     q[1, 0] = casadi.if_else(casadi.logic_and(t56, casadi.logic_not(t57)), t43, t42)
-    q[1, 1] = casadi.if_else(casadi.logic_and(t58, casadi.logic_not(t59)), t15, t14)
+    q[1, 1] = casadi.if_else(casadi.logic_and(t58, casadi.logic_not(t59)), t14, t13)
     q[1, 2] = t52
     q[1, 3] = casadi.if_else(casadi.logic_and(t61, casadi.logic_not(t62)), t60, t46)
     valid = casadi.SX(2, 1)

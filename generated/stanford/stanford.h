@@ -91,11 +91,11 @@ stanford_real stanford_manipulability(const stanford_real q[STANFORD_DOF]);
 stanford_real stanford_jacobian_det(const stanford_real q[STANFORD_DOF]);
 
 /* Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status.
- * Result: q_dot[i], i < 6; returned as a scalar. 1167 operations. */
+ * Result: q_dot[i], i < 6; returned as a scalar. 1164 operations. */
 int stanford_velocity_ik(const stanford_real q[STANFORD_DOF], const stanford_real mu_dot[STANFORD_TASK_DIM], stanford_real damping, stanford_real q_dot[STANFORD_DOF]);
 
 /* One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite).
- * Result: q_start[i], i < 6; q_next[i], i < 6; returned as a scalar. 856 operations. */
+ * Result: q_start[i], i < 6; q_next[i], i < 6; returned as a scalar. 853 operations. */
 stanford_real stanford_ik_numeric_step(const stanford_real target[16], const stanford_real q[STANFORD_DOF], stanford_real damping, stanford_real q_start[STANFORD_DOF], stanford_real q_next[STANFORD_DOF]);
 
 /* Every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits.

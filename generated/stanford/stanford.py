@@ -90,32 +90,32 @@ def fk(q):
     s6 = trig[..., 11]
     t0 = 0.412 + c2*q3
     t1 = q3*s2
-    t2 = -0.1337*s1 + t1*c1
-    t3 = 0.1337*c1 + t1*s1
+    t2 = -0.1337*s1 + c1*t1
+    t3 = 0.1337*c1 + s1*t1
     t4 = c4*s1
     t5 = c1*s4
-    t6 = t4 + t5*c2
-    t7 = t5 + t4*c2
+    t6 = t4 + c2*t5
+    t7 = t5 + c2*t4
     t8 = s1*s4
     t9 = c1*c4
-    t10 = -t8 + t9*c2
-    t11 = -t9 + t8*c2
+    t10 = -t8 + c2*t9
+    t11 = -t9 + c2*t8
     t12 = c1*s2
-    t13 = t6*c5 - t12*s5
-    t14 = t6*s5 + t12*c5
+    t13 = t6*c5 - s5*t12
+    t14 = t6*s5 + c5*t12
     t15 = t10*s6 + t13*c6
     t16 = t10*c6 - t13*s6
     t17 = s1*s2
-    t18 = t11*c5 - t17*s5
-    t19 = t11*s5 + t17*c5
+    t18 = t11*c5 - s5*t17
+    t19 = t11*s5 + c5*t17
     t20 = t7*s6 + t18*c6
     t21 = t7*c6 - t18*s6
-    t22 = s2*s4
-    t23 = c2*s5 + t22*c5
-    t24 = -c2*c5 + t22*s5
+    t22 = s4*s2
+    t23 = c2*s5 + c5*t22
+    t24 = -c2*c5 + s5*t22
     t25 = c4*s2
-    t26 = t23*c6 + t25*s6
-    t27 = t23*s6 - t25*c6
+    t26 = t23*c6 + s6*t25
+    t27 = t23*s6 - c6*t25
     T = _stack(xp, [
         t15,  # 0, 0
         t16,  # 0, 1
@@ -152,29 +152,29 @@ def jacobian(q):
     s5 = trig[..., 9]
     t0 = -c2*c5 + s2*s4*s5
     t1 = c1*s2
-    t2 = -0.1337*s1 + t1*q3
+    t2 = -0.1337*s1 + q3*t1
     t3 = s1*s2
-    t4 = 0.1337*c1 + t3*q3
+    t4 = 0.1337*c1 + q3*t3
     t5 = c4*s1
     t6 = c1*s4
-    t7 = t5 + t6*c2
-    t8 = t6 + t5*c2
-    t9 = t7*s5 + t1*c5
+    t7 = t5 + c2*t6
+    t8 = t6 + c2*t5
+    t9 = t7*s5 + c5*t1
     t10 = s1*s4
     t11 = c1*c4
-    t12 = -t10 + t11*c2
-    t13 = -t11 + t10*c2
-    t14 = t13*s5 + t3*c5
+    t12 = -t10 + c2*t11
+    t13 = -t11 + c2*t10
+    t14 = t13*s5 + c5*t3
     t15 = c2*q3
     J = _stack(xp, [
         -t4,  # 0, 0
-        t15*c1,  # 0, 1
+        c1*t15,  # 0, 1
         t1,  # 0, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5
         t2,  # 1, 0
-        t15*s1,  # 1, 1
+        s1*t15,  # 1, 1
         t3,  # 1, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 4
@@ -223,33 +223,33 @@ def fk_jacobian(q):
     c6 = trig[..., 10]
     s6 = trig[..., 11]
     t0 = c1*s2
-    t1 = -0.1337*s1 + t0*q3
+    t1 = -0.1337*s1 + q3*t0
     t2 = s1*s2
-    t3 = 0.1337*c1 + t2*q3
+    t3 = 0.1337*c1 + q3*t2
     t4 = c2*q3
     t5 = 0.412 + t4
     t6 = c4*s1
     t7 = c1*s4
-    t8 = t6 + t7*c2
-    t9 = t7 + t6*c2
-    t10 = t8*c5 - t0*s5
-    t11 = t8*s5 + t0*c5
+    t8 = t6 + c2*t7
+    t9 = t7 + c2*t6
+    t10 = t8*c5 - s5*t0
+    t11 = t8*s5 + c5*t0
     t12 = s1*s4
     t13 = c1*c4
-    t14 = -t12 + t13*c2
-    t15 = -t13 + t12*c2
-    t16 = t15*c5 - t2*s5
-    t17 = t15*s5 + t2*c5
+    t14 = -t12 + c2*t13
+    t15 = -t13 + c2*t12
+    t16 = t15*c5 - s5*t2
+    t17 = t15*s5 + c5*t2
     t18 = t14*s6 + t10*c6
     t19 = t14*c6 - t10*s6
     t20 = t9*s6 + t16*c6
     t21 = t9*c6 - t16*s6
-    t22 = s2*s4
-    t23 = c2*s5 + t22*c5
-    t24 = -c2*c5 + t22*s5
+    t22 = s4*s2
+    t23 = c2*s5 + c5*t22
+    t24 = -c2*c5 + s5*t22
     t25 = c4*s2
-    t26 = t23*c6 + t25*s6
-    t27 = t23*s6 - t25*c6
+    t26 = t23*c6 + s6*t25
+    t27 = t23*s6 - c6*t25
     t28 = -t24
     T = _stack(xp, [
         t18,  # 0, 0
@@ -271,13 +271,13 @@ def fk_jacobian(q):
     ], (4, 4))
     J = _stack(xp, [
         -t3,  # 0, 0
-        t4*c1,  # 0, 1
+        c1*t4,  # 0, 1
         t0,  # 0, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5
         t1,  # 1, 0
-        t4*s1,  # 1, 1
+        s1*t4,  # 1, 1
         t2,  # 1, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 4
@@ -326,36 +326,36 @@ def jacobian_tool(q):
     c6 = trig[..., 10]
     s6 = trig[..., 11]
     t0 = q3*s2
-    t1 = -0.1337*s1 + t0*c1
-    t2 = 0.1337*c1 + t0*s1
+    t1 = -0.1337*s1 + c1*t0
+    t2 = 0.1337*c1 + s1*t0
     t3 = c4*s1
     t4 = c1*s4
-    t5 = t3 + t4*c2
-    t6 = t4 + t3*c2
+    t5 = t3 + c2*t4
+    t6 = t4 + c2*t3
     t7 = s1*s4
     t8 = c1*c4
-    t9 = -t7 + t8*c2
-    t10 = -t8 + t7*c2
+    t9 = -t7 + c2*t8
+    t10 = -t8 + c2*t7
     t11 = c1*s2
-    t12 = t5*c5 - t11*s5
-    t13 = t5*s5 + t11*c5
+    t12 = t5*c5 - s5*t11
+    t13 = t5*s5 + c5*t11
     t14 = t9*s6 + t12*c6
     t15 = t9*c6 - t12*s6
     t16 = s1*s2
-    t17 = t10*c5 - t16*s5
-    t18 = t10*s5 + t16*c5
+    t17 = t10*c5 - s5*t16
+    t18 = t10*s5 + c5*t16
     t19 = t6*s6 + t17*c6
     t20 = t6*c6 - t17*s6
-    t21 = s2*s4
-    t22 = c2*s5 + t21*c5
-    t23 = -c2*c5 + t21*s5
+    t21 = s4*s2
+    t22 = c2*s5 + c5*t21
+    t23 = -c2*c5 + s5*t21
     t24 = c4*s2
-    t25 = t22*c6 + t24*s6
-    t26 = t22*s6 - t24*c6
+    t25 = t22*c6 + s6*t24
+    t26 = t22*s6 - c6*t24
     t27 = -(t1*c1 + t2*s1)
     t28 = c2*q3
-    t29 = t28*c1
-    t30 = t28*s1
+    t29 = c1*t28
+    t30 = s1*t28
     t31 = -t25*c2 + t14*t11 + t19*t16
     t32 = t26*c2 + t15*t11 + t20*t16
     t33 = -t23*c2 + t13*t11 + t18*t16
@@ -418,25 +418,25 @@ def task(q):
     t0 = 0.412 + c2*q3
     t1 = c2*s5 + c5*s2*s4
     t2 = q3*s2
-    t3 = -0.1337*s1 + t2*c1
-    t4 = 0.1337*c1 + t2*s1
+    t3 = -0.1337*s1 + c1*t2
+    t4 = 0.1337*c1 + s1*t2
     t5 = c4*s1
     t6 = c1*s4
-    t7 = t5 + t6*c2
-    t8 = t6 + t5*c2
+    t7 = t5 + c2*t6
+    t8 = t6 + c2*t5
     t9 = s1*s4
     t10 = c1*c4
-    t11 = -t9 + t10*c2
-    t12 = -t10 + t9*c2
-    t13 = s2*s5
-    t14 = t7*c5 - t13*c1
-    t15 = t12*c5 - t13*s1
-    t16 = -c2*c5 + t13*s4
+    t11 = -t9 + c2*t10
+    t12 = -t10 + c2*t9
+    t13 = s5*s2
+    t14 = t7*c5 - c1*t13
+    t15 = t12*c5 - s1*t13
+    t16 = -c2*c5 + s4*t13
     t17 = t11*s6 + t14*c6
     t18 = t8*s6 + t15*c6
     t19 = c4*s2
-    t20 = t1*c6 + t19*s6
-    t21 = t1*s6 - t19*c6
+    t20 = t1*c6 + s6*t19
+    t21 = t1*s6 - c6*t19
     mu = _stack(xp, [
         t3,  # 0
         t4,  # 1
@@ -464,28 +464,28 @@ def task_jacobian(q):
     c6 = trig[..., 10]
     s6 = trig[..., 11]
     t0 = c1*s2
-    t1 = -0.1337*s1 + t0*q3
+    t1 = -0.1337*s1 + q3*t0
     t2 = s1*s2
-    t3 = 0.1337*c1 + t2*q3
+    t3 = 0.1337*c1 + q3*t2
     t4 = c4*s1
     t5 = c1*s4
-    t6 = t4 + t5*c2
-    t7 = t5 + t4*c2
-    t8 = t6*c5 - t0*s5
-    t9 = t6*s5 + t0*c5
+    t6 = t4 + c2*t5
+    t7 = t5 + c2*t4
+    t8 = t6*c5 - s5*t0
+    t9 = t6*s5 + c5*t0
     t10 = s1*s4
     t11 = c1*c4
-    t12 = -t10 + t11*c2
-    t13 = -t11 + t10*c2
-    t14 = t13*c5 - t2*s5
-    t15 = t13*s5 + t2*c5
+    t12 = -t10 + c2*t11
+    t13 = -t11 + c2*t10
+    t14 = t13*c5 - s5*t2
+    t15 = t13*s5 + c5*t2
     t16 = t12*s6 + t8*c6
     t17 = t7*s6 + t14*c6
-    t18 = s2*s4
-    t19 = c2*s5 + t18*c5
-    t20 = -c2*c5 + t18*s5
+    t18 = s4*s2
+    t19 = c2*s5 + c5*t18
+    t20 = -c2*c5 + s5*t18
     t21 = c4*s2
-    t22 = t19*c6 + t21*s6
+    t22 = t19*c6 + s6*t21
     t23 = c2*q3
     t24 = t16**2 + t17**2
     t25 = 1/t24
@@ -496,13 +496,13 @@ def task_jacobian(q):
     t30 = 1/xp.sqrt(t24)
     J = _stack(xp, [
         -t3,  # 0, 0
-        t23*c1,  # 0, 1
+        c1*t23,  # 0, 1
         t0,  # 0, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5
         t1,  # 1, 0
-        t23*s1,  # 1, 1
+        s1*t23,  # 1, 1
         t2,  # 1, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 4
@@ -558,54 +558,54 @@ def fk_jacobian_dot(q, q_dot):
     s6 = trig[..., 11]
     t0 = qd1 + c2*qd4
     t1 = c1*s2
-    t2 = -0.1337*s1 + t1*q3
+    t2 = -0.1337*s1 + q3*t1
     t3 = s1*s2
-    t4 = 0.1337*c1 + t3*q3
+    t4 = 0.1337*c1 + q3*t3
     t5 = c2*q3
     t6 = 0.412 + t5
     t7 = c4*s1
     t8 = c1*s4
-    t9 = t7 + t8*c2
-    t10 = t8 + t7*c2
-    t11 = t9*c5 - t1*s5
-    t12 = t9*s5 + t1*c5
+    t9 = t7 + c2*t8
+    t10 = t8 + c2*t7
+    t11 = t9*c5 - s5*t1
+    t12 = t9*s5 + c5*t1
     t13 = s1*s4
     t14 = c1*c4
-    t15 = -t13 + t14*c2
-    t16 = -t14 + t13*c2
-    t17 = t16*c5 - t3*s5
-    t18 = t16*s5 + t3*c5
+    t15 = -t13 + c2*t14
+    t16 = -t14 + c2*t13
+    t17 = t16*c5 - s5*t3
+    t18 = t16*s5 + c5*t3
     t19 = t15*s6 + t11*c6
     t20 = t15*c6 - t11*s6
     t21 = t10*s6 + t17*c6
     t22 = t10*c6 - t17*s6
-    t23 = s2*s4
-    t24 = c2*s5 + t23*c5
-    t25 = -c2*c5 + t23*s5
+    t23 = s4*s2
+    t24 = c2*s5 + c5*t23
+    t25 = -c2*c5 + s5*t23
     t26 = c4*s2
-    t27 = t24*c6 + t26*s6
-    t28 = t24*s6 - t26*c6
-    t29 = t0 - t26*qd5
+    t27 = t24*c6 + s6*t26
+    t28 = t24*s6 - c6*t26
+    t29 = t0 - qd5*t26
     t30 = t2*c1 + t4*s1
     t31 = t30
     t32 = c2*qd3 - t31*qd2
     t33 = qd2*s1
-    t34 = -t33 + t1*qd4
+    t34 = -t33 + qd4*t1
     t35 = t34 + t15*qd5
-    t36 = t3*qd3 + t33*t5
+    t36 = qd3*t3 + t5*t33
     t37 = t36 + t2*qd1
     t38 = c1*qd2
-    t39 = t38 + t3*qd4
+    t39 = t38 + qd4*t3
     t40 = t39 + t10*qd5
-    t41 = t1*qd3 + t38*t5
+    t41 = qd3*t1 + t5*t38
     t42 = t41 - t4*qd1
     t43 = -t25
-    t44 = t5*c1
-    t45 = t5*s1
-    t46 = t38*c2 - t3*qd1
-    t47 = t1*qd1 + t33*c2
+    t44 = c1*t5
+    t45 = s1*t5
+    t46 = c2*t38 - qd1*t3
+    t47 = qd1*t1 + c2*t33
     t48 = qd2*s2
-    t49 = -(t48*c1**2 + t48*s1**2)
+    t49 = -(c1**2*t48 + s1**2*t48)
     T = _stack(xp, [
         xp.broadcast_to(t19, batch),  # 0, 0
         xp.broadcast_to(t20, batch),  # 0, 1
@@ -663,11 +663,11 @@ def fk_jacobian_dot(q, q_dot):
         xp.broadcast_to(t43, batch),  # 5, 5
     ], (6, 6))
     a = _stack(xp, [
-        xp.broadcast_to(qd2*(t32*c1 - t45*qd1) + qd3*t46 - t37*qd1, batch),  # 0
-        xp.broadcast_to(t42*qd1 + qd2*(t32*s1 + t44*qd1) + qd3*t47, batch),  # 1
+        xp.broadcast_to(qd2*(t32*c1 - qd1*t45) + qd3*t46 - t37*qd1, batch),  # 0
+        xp.broadcast_to(t42*qd1 + qd2*(t32*s1 + qd1*t44) + qd3*t47, batch),  # 1
         xp.broadcast_to(-qd2*(t41*c1 + t36*s1) + qd3*t49, batch),  # 2
-        xp.broadcast_to(qd4*t46 - qd5*(t10*t0 + t39*t26) - qd6*(t18*t29 + t25*t40) - t38*qd1, batch),  # 3
-        xp.broadcast_to(qd4*t47 + qd5*(t15*t0 + t34*t26) + qd6*(t12*t29 + t25*t35) - t33*qd1, batch),  # 4
+        xp.broadcast_to(qd4*t46 - qd5*(t10*t0 + t39*t26) - qd6*(t18*t29 + t25*t40) - qd1*t38, batch),  # 3
+        xp.broadcast_to(qd4*t47 + qd5*(t15*t0 + t34*t26) + qd6*(t12*t29 + t25*t35) - qd1*t33, batch),  # 4
         xp.broadcast_to(qd4*t49 + qd5*(t10*t34 - t15*t39) + qd6*(t18*t35 - t12*t40), batch),  # 5
     ], (6,))
     return T, J, a
@@ -694,44 +694,44 @@ def jacobian_dot(q, q_dot):
     t0 = -c2*c5 + s2*s4*s5
     t1 = qd1 + c2*qd4
     t2 = q3*s2
-    t3 = -0.1337*s1 + t2*c1
-    t4 = 0.1337*c1 + t2*s1
+    t3 = -0.1337*s1 + c1*t2
+    t4 = 0.1337*c1 + s1*t2
     t5 = t3*c1 + t4*s1
     t6 = c2*qd3 - t5*qd2
     t7 = c4*s1
     t8 = c1*s4
-    t9 = t7 + t8*c2
-    t10 = t8 + t7*c2
+    t9 = t7 + c2*t8
+    t10 = t8 + c2*t7
     t11 = s1*s4
     t12 = c1*c4
-    t13 = -t11 + t12*c2
-    t14 = -t12 + t11*c2
+    t13 = -t11 + c2*t12
+    t14 = -t12 + c2*t11
     t15 = c5*s2
-    t16 = t9*s5 + t15*c1
-    t17 = t14*s5 + t15*s1
+    t16 = t9*s5 + c1*t15
+    t17 = t14*s5 + s1*t15
     t18 = qd2*s1
     t19 = qd4*s2
-    t20 = -t18 + t19*c1
+    t20 = -t18 + c1*t19
     t21 = t20 + t13*qd5
     t22 = c1*qd2
-    t23 = t22 + t19*s1
+    t23 = t22 + s1*t19
     t24 = t23 + t10*qd5
     t25 = c4*s2
-    t26 = t1 - t25*qd5
+    t26 = t1 - qd5*t25
     t27 = qd3*s2
-    t28 = t22*c2
-    t29 = t27*c1 + t28*q3
+    t28 = c2*t22
+    t29 = c1*t27 + q3*t28
     t30 = t29 - t4*qd1
-    t31 = t18*c2
-    t32 = t27*s1 + t31*q3
+    t31 = c2*t18
+    t32 = s1*t27 + q3*t31
     t33 = t32 + t3*qd1
     t34 = qd1*s1
     t35 = c2*q3
-    t36 = t28 - t34*s2
+    t36 = t28 - s2*t34
     t37 = c1*qd1
-    t38 = t37*s2 + t31
+    t38 = s2*t37 + t31
     t39 = qd2*s2
-    t40 = -(t39*c1**2 + t39*s1**2)
+    t40 = -(c1**2*t39 + s1**2*t39)
     Jd = _stack(xp, [
         xp.broadcast_to(-t33, batch),  # 0, 0
         xp.broadcast_to(t6*c1 - t34*t35, batch),  # 0, 1
@@ -740,7 +740,7 @@ def jacobian_dot(q, q_dot):
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5
         xp.broadcast_to(t30, batch),  # 1, 0
-        xp.broadcast_to(t6*s1 + t35*t37, batch),  # 1, 1
+        xp.broadcast_to(t6*s1 + t37*t35, batch),  # 1, 1
         xp.broadcast_to(t38, batch),  # 1, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 4
@@ -795,49 +795,49 @@ def bias_acceleration(q, q_dot):
     t0 = -c2*c5 + s2*s4*s5
     t1 = qd1 + c2*qd4
     t2 = q3*s2
-    t3 = -0.1337*s1 + t2*c1
-    t4 = 0.1337*c1 + t2*s1
+    t3 = -0.1337*s1 + c1*t2
+    t4 = 0.1337*c1 + s1*t2
     t5 = t3*c1 + t4*s1
     t6 = c2*qd3 - t5*qd2
     t7 = c4*s1
     t8 = c1*s4
-    t9 = t7 + t8*c2
-    t10 = t8 + t7*c2
+    t9 = t7 + c2*t8
+    t10 = t8 + c2*t7
     t11 = s1*s4
     t12 = c1*c4
-    t13 = -t11 + t12*c2
-    t14 = -t12 + t11*c2
+    t13 = -t11 + c2*t12
+    t14 = -t12 + c2*t11
     t15 = c5*s2
-    t16 = t9*s5 + t15*c1
-    t17 = t14*s5 + t15*s1
+    t16 = t9*s5 + c1*t15
+    t17 = t14*s5 + s1*t15
     t18 = qd2*s1
     t19 = qd4*s2
-    t20 = -t18 + t19*c1
+    t20 = -t18 + c1*t19
     t21 = t20 + t13*qd5
     t22 = c1*qd2
-    t23 = t22 + t19*s1
+    t23 = t22 + s1*t19
     t24 = t23 + t10*qd5
     t25 = c4*s2
-    t26 = t1 - t25*qd5
+    t26 = t1 - qd5*t25
     t27 = qd3*s2
-    t28 = t22*c2
-    t29 = t27*c1 + t28*q3
+    t28 = c2*t22
+    t29 = c1*t27 + q3*t28
     t30 = t29 - t4*qd1
-    t31 = t18*c2
-    t32 = t27*s1 + t31*q3
+    t31 = c2*t18
+    t32 = s1*t27 + q3*t31
     t33 = t32 + t3*qd1
-    t34 = c2*q3*qd1
+    t34 = c2*qd1*q3
     t35 = qd1*s2
-    t36 = t28 - t35*s1
-    t37 = t35*c1 + t31
+    t36 = t28 - s1*t35
+    t37 = c1*t35 + t31
     t38 = qd2*s2
-    t39 = -(t38*c1**2 + t38*s1**2)
+    t39 = -(c1**2*t38 + s1**2*t38)
     a = _stack(xp, [
-        xp.broadcast_to(qd2*(t6*c1 - t34*s1) + qd3*t36 - t33*qd1, batch),  # 0
-        xp.broadcast_to(t30*qd1 + qd2*(t6*s1 + t34*c1) + qd3*t37, batch),  # 1
+        xp.broadcast_to(qd2*(t6*c1 - s1*t34) + qd3*t36 - t33*qd1, batch),  # 0
+        xp.broadcast_to(t30*qd1 + qd2*(t6*s1 + c1*t34) + qd3*t37, batch),  # 1
         xp.broadcast_to(-qd2*(t29*c1 + t32*s1) + qd3*t39, batch),  # 2
-        xp.broadcast_to(qd4*t36 - qd5*(t10*t1 + t23*t25) - qd6*(t17*t26 + t0*t24) - t22*qd1, batch),  # 3
-        xp.broadcast_to(qd4*t37 + qd5*(t13*t1 + t20*t25) + qd6*(t16*t26 + t0*t21) - t18*qd1, batch),  # 4
+        xp.broadcast_to(qd4*t36 - qd5*(t10*t1 + t23*t25) - qd6*(t17*t26 + t0*t24) - qd1*t22, batch),  # 3
+        xp.broadcast_to(qd4*t37 + qd5*(t13*t1 + t20*t25) + qd6*(t16*t26 + t0*t21) - qd1*t18, batch),  # 4
         xp.broadcast_to(qd4*t39 + qd5*(t10*t20 - t13*t23) + qd6*(t17*t21 - t16*t24), batch),  # 5
     ], (6,))
     return a
@@ -865,36 +865,36 @@ def task_jacobian_dot(q, q_dot):
     c6 = trig[..., 10]
     s6 = trig[..., 11]
     t0 = q3*s2
-    t1 = -0.1337*s1 + t0*c1
-    t2 = 0.1337*c1 + t0*s1
+    t1 = -0.1337*s1 + c1*t0
+    t2 = 0.1337*c1 + s1*t0
     t3 = t1*c1 + t2*s1
     t4 = c2*qd3 - t3*qd2
     t5 = c4*s1
     t6 = c1*s4
-    t7 = t5 + t6*c2
-    t8 = t6 + t5*c2
+    t7 = t5 + c2*t6
+    t8 = t6 + c2*t5
     t9 = s1*s4
     t10 = c1*c4
-    t11 = -t9 + t10*c2
-    t12 = -t10 + t9*c2
+    t11 = -t9 + c2*t10
+    t12 = -t10 + c2*t9
     t13 = c1*s2
-    t14 = t7*c5 - t13*s5
-    t15 = t7*s5 + t13*c5
+    t14 = t7*c5 - s5*t13
+    t15 = t7*s5 + c5*t13
     t16 = t11*s6 + t14*c6
     t17 = s1*s2
-    t18 = t12*c5 - t17*s5
-    t19 = t12*s5 + t17*c5
+    t18 = t12*c5 - s5*t17
+    t19 = t12*s5 + c5*t17
     t20 = t8*s6 + t18*c6
-    t21 = s2*s4
-    t22 = c2*s5 + t21*c5
-    t23 = -c2*c5 + t21*s5
+    t21 = s4*s2
+    t22 = c2*s5 + c5*t21
+    t23 = -c2*c5 + s5*t21
     t24 = c4*s2
-    t25 = t22*c6 + t24*s6
+    t25 = t22*c6 + s6*t24
     t26 = qd2*s1
-    t27 = -t26 + t13*qd4
+    t27 = -t26 + qd4*t13
     t28 = t27
     t29 = c1*qd2
-    t30 = t29 + t17*qd4
+    t30 = t29 + qd4*t17
     t31 = t30
     t32 = t8*t28 - t11*t31
     t33 = qd1 + c2*qd4
@@ -903,54 +903,54 @@ def task_jacobian_dot(q, q_dot):
     t36 = t11*t34 + t28*t24
     t37 = t11*qd5
     t38 = t28 + t37
-    t39 = t27 + t37 + t15*qd6
+    t39 = t37 + t15*qd6 + t27
     t40 = t8*qd5
     t41 = t31 + t40
     t42 = t19*t38 - t15*t41
-    t43 = t30 + t40 + t19*qd6
+    t43 = t40 + t19*qd6 + t30
     t44 = t20*t39 - t16*t43
-    t45 = -t24*qd5
+    t45 = -qd5*t24
     t46 = t34 + t45
     t47 = t19*t46 + t23*t41
     t48 = t15*t46 + t23*t38
-    t49 = t33 + t45 - t23*qd6
+    t49 = t45 - t23*qd6 + t33
     t50 = t20*t49 + t25*t43
     t51 = t16*t49 + t25*t39
-    t52 = t29*c2
-    t53 = t13*qd3 + t52*q3
+    t52 = c2*t29
+    t53 = qd3*t13 + q3*t52
     t54 = t53 - t2*qd1
-    t55 = t52 - t17*qd1
-    t56 = t26*c2
-    t57 = t17*qd3 + t56*q3
+    t55 = t52 - qd1*t17
+    t56 = c2*t26
+    t57 = qd3*t17 + q3*t56
     t58 = t57 + t1*qd1
-    t59 = t13*qd1 + t56
+    t59 = qd1*t13 + t56
     t60 = t53*c1 + t57*s1
-    t61 = c2*q3*qd1
-    t62 = t4*c1 - t61*s1
-    t63 = t4*s1 + t61*c1
+    t61 = c2*qd1*q3
+    t62 = t4*c1 - s1*t61
+    t63 = t4*s1 + c1*t61
     t64 = qd2*s2
-    t65 = t64*c1**2 + t64*s1**2
+    t65 = c1**2*t64 + s1**2*t64
     t66 = -t65
     t67 = t16**2 + t20**2
     t68 = 1/t67
-    t69 = s1*t68
+    t69 = c1*t68
     t70 = t20*c1
     t71 = t16*s1
     t72 = t70 - t71
     t73 = 2/t67**2
     t74 = t72*t73
-    t75 = t16*t74
-    t76 = c1*t68
-    t77 = t20*t74
-    t78 = t16*qd1
-    t79 = t20*qd1
-    t80 = t69*s2
+    t75 = t20*t74
+    t76 = s1*t68
+    t77 = t16*t74
+    t78 = qd1*t16
+    t79 = qd1*t20
+    t80 = s2*t76
     t81 = t16*c1
     t82 = t20*s1
-    t83 = t81*s2 + t82*s2
-    t84 = t73*t83
+    t83 = s2*t81 + s2*t82
+    t84 = t83*t73
     t85 = t20*t84
-    t86 = t76*s2
+    t86 = s2*t69
     t87 = t16*t84
     t88 = t16*t68
     t89 = t55*t88
@@ -958,7 +958,7 @@ def task_jacobian_dot(q, q_dot):
     t91 = t59*t90
     t92 = t8*t68
     t93 = t11*t16 + t8*t20
-    t94 = t73*t93
+    t94 = t93*t73
     t95 = t20*t94
     t96 = t11*t68
     t97 = t16*t94
@@ -966,7 +966,7 @@ def task_jacobian_dot(q, q_dot):
     t99 = t35*t88
     t100 = t19*t68
     t101 = t15*t16 + t19*t20
-    t102 = t73*t101
+    t102 = t101*t73
     t103 = t20*t102
     t104 = t15*t68
     t105 = t16*t102
@@ -977,15 +977,15 @@ def task_jacobian_dot(q, q_dot):
     t110 = 1/t67**1.5
     t111 = t110*(t81 + t82)
     t112 = c1*t108
-    t113 = t108*qd1
-    t114 = t110*(t71*s2 - t70*s2)
+    t113 = qd1*t108
+    t114 = t110*(s2*t71 - s2*t70)
     t115 = t16*t108
     t116 = t20*t108
     t117 = t110*(t8*t16 - t11*t20)
     t118 = t110*(t19*t16 - t15*t20)
     t119 = t25*t69
     t120 = t25*t76
-    t121 = t44*t68
+    t121 = t68*t44
     Jd = _stack(xp, [
         xp.broadcast_to(-t58, batch),  # 0, 0
         xp.broadcast_to(t62, batch),  # 0, 1
@@ -1006,7 +1006,7 @@ def task_jacobian_dot(q, q_dot):
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
-        xp.broadcast_to(-(-t50*(t69 + t75) - t51*(t76 - t77) + t76*t78 + t69*t79), batch),  # 3, 1
+        xp.broadcast_to(-(-t51*(t69 - t75) - t50*(t76 + t77) + t69*t78 + t76*t79), batch),  # 3, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 2
         xp.broadcast_to(t51*(t80 - t85) - t50*(t86 - t87) + t89 + t91, batch),  # 3, 3
         xp.broadcast_to(t51*(t92 - t95) - t50*(t96 - t97) + t98 - t99, batch),  # 3, 4
@@ -1014,11 +1014,11 @@ def task_jacobian_dot(q, q_dot):
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
         xp.broadcast_to(t51*(t109 - t20*t111) - t50*(t112 - t16*t111) + t70*t113 - t71*t113, batch),  # 4, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 2
-        xp.broadcast_to(-t51*(t20*t114 + t112*s2) - t50*(t109*s2 - t16*t114) + t59*t115 - t55*t116, batch),  # 4, 3
+        xp.broadcast_to(-t51*(t20*t114 + s2*t112) - t50*(s2*t109 - t16*t114) + t59*t115 - t55*t116, batch),  # 4, 3
         xp.broadcast_to(-t51*(t11*t108 + t20*t117) - t50*(t8*t108 - t16*t117) + t36*t115 + t35*t116, batch),  # 4, 4
         xp.broadcast_to(-t51*(t15*t108 + t20*t118) - t50*(t19*t108 - t16*t118) + t48*t115 + t47*t116, batch),  # 4, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 0
-        xp.broadcast_to(-(-t50*(t119 + t25*t75) - t51*(t120 - t25*t77) + t72*t121 + t78*t120 + t79*t119), batch),  # 5, 1
+        xp.broadcast_to(-(-t51*(t119 - t25*t75) - t50*(t120 + t25*t77) + t72*t121 + t119*t78 + t120*t79), batch),  # 5, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 2
         xp.broadcast_to(t66 + t51*(t25*t80 - t25*t85) - t50*(t25*t86 - t25*t87) - t83*t121 + t25*t89 + t25*t91, batch),  # 5, 3
         xp.broadcast_to(t32 + t51*(t25*t92 - t25*t95) - t50*(t25*t96 - t25*t97) - t93*t121 + t25*t98 - t25*t99, batch),  # 5, 4
@@ -1042,25 +1042,25 @@ def hessian(q):
     s5 = trig[..., 9]
     t0 = -c2*c5 + s2*s4*s5
     t1 = c1*s2
-    t2 = -0.1337*s1 + t1*q3
+    t2 = -0.1337*s1 + q3*t1
     t3 = s1*s2
-    t4 = 0.1337*c1 + t3*q3
+    t4 = 0.1337*c1 + q3*t3
     t5 = t2*c1 + t4*s1
     t6 = c4*s1
     t7 = c1*s4
-    t8 = t6 + t7*c2
-    t9 = t7 + t6*c2
-    t10 = t8*s5 + t1*c5
+    t8 = t6 + c2*t7
+    t9 = t7 + c2*t6
+    t10 = t8*s5 + c5*t1
     t11 = s1*s4
     t12 = c1*c4
-    t13 = -t11 + t12*c2
-    t14 = -t12 + t11*c2
-    t15 = t14*s5 + t3*c5
+    t13 = -t11 + c2*t12
+    t14 = -t12 + c2*t11
+    t15 = t14*s5 + c5*t3
     t16 = c2*s1
-    t17 = -t16*q3
+    t17 = -q3*t16
     t18 = -t3
     t19 = c1*c2
-    t20 = t19*q3
+    t20 = q3*t19
     t21 = c1**2
     t22 = c2*q3
     t23 = s1**2
@@ -1117,7 +1117,7 @@ def hessian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 1, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 2, 0
-        -(t21*t22 + t22*t23),  # 1, 2, 1
+        -(t21*t22 + t23*t22),  # 1, 2, 1
         t24,  # 1, 2, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 2, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 2, 4
@@ -1126,13 +1126,13 @@ def hessian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 3, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 3, 2
         t19,  # 1, 3, 3
-        -t12*s2,  # 1, 3, 4
+        -s2*t12,  # 1, 3, 4
         -t0*c1,  # 1, 3, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 4, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 4, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 4, 2
         t16,  # 1, 4, 3
-        -t6*s2,  # 1, 4, 4
+        -s2*t6,  # 1, 4, 4
         -t0*s1,  # 1, 4, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5, 1
@@ -1328,7 +1328,7 @@ def jacobian_det(q):
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def velocity_ik(q, mu_dot, damping=0.0):
-    """joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: (6 x 1 and 1 x 1), 1167 operations."""
+    """joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: (6 x 1 and 1 x 1), 1164 operations."""
     xp, dtype, device, batch, (q, mu_dot, damping,) = _arguments(("q", q, (6,)), ("mu_dot", mu_dot, (6,)), ("damping", damping, ()))
     q1 = q[..., 0]
     q2 = q[..., 1]
@@ -1353,64 +1353,64 @@ def velocity_ik(q, mu_dot, damping=0.0):
     s5 = trig[..., 9]
     t0 = -c2*c5 + s2*s4*s5
     t1 = c1*s2
-    t2 = -0.1337*s1 + t1*q3
+    t2 = -0.1337*s1 + q3*t1
     t3 = s1*s2
-    t4 = 0.1337*c1 + t3*q3
+    t4 = 0.1337*c1 + q3*t3
     t5 = t2*c1 + t4*s1
     t6 = c4*s1
     t7 = c1*s4
-    t8 = t6 + t7*c2
-    t9 = t7 + t6*c2
-    t10 = t8*s5 + t1*c5
+    t8 = t6 + c2*t7
+    t9 = t7 + c2*t6
+    t10 = t8*s5 + c5*t1
     t11 = s1*s4
     t12 = c1*c4
-    t13 = -t11 + t12*c2
-    t14 = -t12 + t11*c2
-    t15 = t14*s5 + t3*c5
+    t13 = -t11 + c2*t12
+    t14 = -t12 + c2*t11
+    t15 = t14*s5 + c5*t3
     t16 = c1**2
     t17 = s2**2
     t18 = t16*t17
     t19 = t4**2
     t20 = c2**2
     t21 = t20*q3**2
-    t22 = t21*t16
-    t23 = t22 + t19
-    t24 = t23 + t18
+    t22 = t16*t21
+    t23 = t19 + t22
+    t24 = t18 + t23
     t25 = -t2*t4
     t26 = c1*s1
-    t27 = t26*t17
-    t28 = t25 + t27 + t21*t26
+    t27 = t17*t26
+    t28 = t25 + t27 + t26*t21
     t29 = t13*t9 + t10*t15 - t26 + t27
-    t30 = t1*c2
+    t30 = c2*t1
     t31 = t5*c1
     t32 = c2*q3
     t33 = t30 - t31*t32
-    t34 = t32*t16
+    t34 = t16*t32
     t35 = s1**2
     t36 = t35*t17
     t37 = t2**2
     t38 = xp.sqrt(1 + t37 + t19)
     t39 = t38*xp.where(xp.less_equal(t4, 0), xp.asarray(1, dtype=dtype), -1)
     t40 = xp.where(xp.greater(t38, 0), 1/(t38*(t38 + xp.abs(t4))), 0)
-    t41 = t37 + t21*t35
+    t41 = t37 + t35*t21
     t42 = t36 + t41
-    t43 = t3*c2
+    t43 = c2*t3
     t44 = t5*s1
-    t45 = t43 - t32*t44
-    t46 = t32*t35
+    t45 = t43 - t44*t32
+    t46 = t35*t32
     t47 = t46
     t48 = t5**2
     t49 = t48 + t20
-    t50 = t35 + t13**2 + t10**2
-    t51 = t50 + t18
+    t50 = t13**2 + t10**2 + t35
+    t51 = t18 + t50
     t52 = c4*s2
     t53 = t10*t0 + t13*t52 - t30
     t54 = t15*t0 + t9*t52 - t43
-    t55 = t16 + t9**2 + t15**2
+    t55 = t9**2 + t15**2 + t16
     t56 = t36 + t55
     t57 = 1 + t0**2 + c4**2*t17
     t58 = t20 + t57
-    t59 = xp.sqrt(t23 + t41 + t48 + t50 + t55 + t57 + 2*t20 + 2*t36 + 2*t18)
+    t59 = xp.sqrt(t48 + 2*t20 + 2*t18 + 2*t36 + t23 + t41 + t50 + t55 + t57)
     t60 = damping**2
     t61 = t24 + t60
     t62 = t61**2
@@ -1423,8 +1423,8 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t69 = t33**2
     t70 = t34**2
     t71 = 2*t48
-    t72 = t22*t35
-    t73 = xp.sqrt(t62 + t63**2 + t64**2 + t65**2 + t66**2 + t67**2 + 2*t37 + 2*t19 + 2*t68 + 2*t69 + 2*t70 + 2*t45**2 + 2*t47**2 + 2*t29**2 + 2*t53**2 + 2*t54**2 + t71*t16 + t35*t71 + 4*t72)
+    t72 = t35*t22
+    t73 = xp.sqrt(t62 + t63**2 + t64**2 + t65**2 + t66**2 + t67**2 + 2*t37 + 2*t19 + 2*t68 + 2*t69 + 2*t70 + 2*t45**2 + 2*t47**2 + 2*t29**2 + 2*t53**2 + 2*t54**2 + t16*t71 + t35*t71 + 4*t72)
     t74 = xp.sqrt(t19 + t68 + t69 + t70 + t62 + t72)
     t75 = t74*xp.where(xp.greater_equal(t61, 0), xp.asarray(1, dtype=dtype), -1)
     t76 = t75 + t61
@@ -1432,74 +1432,74 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t78 = t77*(t28*t45 + t33*t76 + t33*t64 - t34*t31 - t31*t46)
     t79 = t33 - t76*t78
     t80 = t45 - t28*t78
-    t81 = t64 - t33*t78
+    t81 = -t33*t78 + t64
     t82 = t31 + t34*t78
-    t83 = -t77*(t4*t76 + t4*t67 + t34*t54 - t2*t28 - t53*c1*c2*q3*s1)
-    t84 = t4 + t83*t76
-    t85 = t2 - t83*t28
-    t86 = t54 + t83*t34
-    t87 = t67 + t83*t4
-    t88 = t26*t32
-    t89 = t77*(t28*t76 + t28*t63 + t33*t45 + t25 + t34*t88 + t47*t88)
-    t90 = t28 - t76*t89
-    t91 = t63 - t28*t89
-    t92 = t45 - t33*t89
-    t93 = -t47 + t89*t88
-    t94 = -t34*t89 + t88
-    t95 = t2 + t4*t89
-    t96 = t44 + t78*t88
-    t97 = t77*(t4*t53 + t34*t29 - t28*t47 + t33*t44 - t76*t88 - t65*t88)
-    t98 = t76*t97 + t88
-    t99 = t47 + t28*t97
-    t100 = t44 - t33*t97
-    t101 = t65 + t97*t88
-    t102 = t29 - t34*t97
-    t103 = t77*(t4*t54 + t34*t76 + t34*t66 - t33*t31 + t28*t88 - t29*t88)
-    t104 = t34 - t103*t76
-    t105 = -t103*t28 + t88
-    t106 = t103*t33 + t31
-    t107 = t29 + t103*t88
-    t108 = t66 - t103*t34
-    t109 = -t54 + t103*t4
-    t110 = t77*(t28*mu_dot1 + t33*mu_dot2 + t34*mu_dot4 + t76*mu_dot0 - t4*mu_dot5 - t88*mu_dot3)
+    t83 = t26*t32
+    t84 = t77*(t28*t76 + t28*t63 + t33*t45 + t25 + t34*t83 + t47*t83)
+    t85 = t28 - t76*t84
+    t86 = -t28*t84 + t63
+    t87 = t45 - t33*t84
+    t88 = -t47 + t84*t83
+    t89 = -t34*t84 + t83
+    t90 = t2 + t4*t84
+    t91 = t44 + t78*t83
+    t92 = t77*(t4*t53 + t34*t29 - t28*t47 + t33*t44 - t76*t83 - t65*t83)
+    t93 = t76*t92 + t83
+    t94 = t47 + t28*t92
+    t95 = t44 - t33*t92
+    t96 = t92*t83 + t65
+    t97 = t29 - t34*t92
+    t98 = t77*(t4*t54 + t34*t76 + t34*t66 - t33*t31 + t28*t83 - t29*t83)
+    t99 = t34 - t98*t76
+    t100 = -t98*t28 + t83
+    t101 = t98*t33 + t31
+    t102 = t29 + t98*t83
+    t103 = -t98*t34 + t66
+    t104 = -t54 + t98*t4
+    t105 = -t77*(-t2*t28 + t4*t76 + t4*t67 + t34*t54 - t53*t83)
+    t106 = t4 + t105*t76
+    t107 = t2 - t105*t28
+    t108 = t54 + t105*t34
+    t109 = t105*t4 + t67
+    t110 = t77*(t28*mu_dot1 + t33*mu_dot2 + t34*mu_dot4 + t76*mu_dot0 - t4*mu_dot5 - mu_dot3*t83)
     t111 = mu_dot0 - t110*t76
     t112 = mu_dot1 - t110*t28
     t113 = mu_dot2 - t110*t33
-    t114 = mu_dot3 + t110*t88
+    t114 = mu_dot3 + t110*t83
     t115 = mu_dot4 - t110*t34
     t116 = mu_dot5 + t110*t4
-    t117 = xp.sqrt(t91**2 + t92**2 + t93**2 + t94**2 + t95**2)
-    t118 = t117*xp.where(xp.greater_equal(t91, 0), xp.asarray(1, dtype=dtype), -1)
-    t119 = t118 + t91
-    t120 = xp.where(xp.greater(t117, 0), 1/(t117*(t117 + xp.abs(t91))), 0)
-    t121 = t120*(t105*t119 + t107*t93 + t108*t94 + t109*t95 - t106*t92)
-    t122 = t105 - t119*t121
-    t123 = t106 + t121*t92
-    t124 = t107 - t121*t93
-    t125 = t108 - t121*t94
-    t126 = t109 - t121*t95
-    t127 = t120*(t112*t119 + t113*t92 + t114*t93 + t115*t94 + t116*t95)
+    t117 = xp.sqrt(t86**2 + t87**2 + t88**2 + t89**2 + t90**2)
+    t118 = t117*xp.where(xp.greater_equal(t86, 0), xp.asarray(1, dtype=dtype), -1)
+    t119 = t118 + t86
+    t120 = xp.where(xp.greater(t117, 0), 1/(t117*(t117 + xp.abs(t86))), 0)
+    t121 = t120*(t100*t119 + t102*t88 + t103*t89 + t104*t90 - t101*t87)
+    t122 = t100 - t119*t121
+    t123 = t101 + t121*t87
+    t124 = t102 - t121*t88
+    t125 = t103 - t121*t89
+    t126 = t104 - t121*t90
+    t127 = t120*(t112*t119 + t113*t87 + t114*t88 + t115*t89 + t116*t90)
     t128 = t112 - t119*t127
-    t129 = t113 - t127*t92
-    t130 = t114 - t127*t93
-    t131 = t115 - t127*t94
-    t132 = t116 - t127*t95
+    t129 = t113 - t127*t87
+    t130 = t114 - t127*t88
+    t131 = t115 - t127*t89
+    t132 = t116 - t127*t90
     t133 = -t53
-    t134 = t133 + t4*t97
-    t135 = t133 + t83*t88
-    t136 = t120*(t102*t94 + t134*t95 + t92*t100 + t93*t101 - t119*t99)
-    t137 = t99 + t119*t136
-    t138 = t100 - t136*t92
-    t139 = t101 - t136*t93
-    t140 = t102 - t136*t94
-    t141 = t134 - t136*t95
+    t134 = t133 + t4*t92
+    t135 = t133 + t105*t83
+    t136 = t120*(t97*t89 + t134*t90 + t87*t95 + t88*t96 - t119*t94)
+    t137 = t94 + t119*t136
+    t138 = t95 - t136*t87
+    t139 = t96 - t136*t88
+    t140 = t97 - t136*t89
+    t141 = t134 - t136*t90
     t142 = t4*t78
-    t143 = t120*(t119*t80 + t92*t81 + t93*t96 - t94*t82 + t95*t142)
+    t143 = t120*(t119*t80 + t87*t81 + t88*t91 - t89*t82 + t90*t142)
     t144 = t80 - t119*t143
-    t145 = t81 - t143*t92
-    t146 = t96 - t143*t93
-    t147 = t82 + t143*t94
-    t148 = t142 - t143*t95
+    t145 = t81 - t143*t87
+    t146 = t91 - t143*t88
+    t147 = t82 + t143*t89
+    t148 = t142 - t143*t90
     t149 = xp.sqrt(t145**2 + t146**2 + t147**2 + t148**2)
     t150 = t149*xp.where(xp.greater_equal(t145, 0), xp.asarray(1, dtype=dtype), -1)
     t151 = t145 + t150
@@ -1538,13 +1538,13 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t184 = t183*(t175*t179 + t178*t182)
     t185 = t178 - t182*t184
     t186 = t179 - t175*t184
-    t187 = t83*t33
-    t188 = t120*(t85*t119 + t135*t93 + t87*t95 - t86*t94 - t92*t187)
-    t189 = t85 - t119*t188
-    t190 = t187 + t188*t92
-    t191 = t135 - t188*t93
-    t192 = t86 + t188*t94
-    t193 = t87 - t188*t95
+    t187 = t105*t33
+    t188 = t120*(t107*t119 + t135*t88 + t109*t90 - t108*t89 - t87*t187)
+    t189 = t107 - t119*t188
+    t190 = t187 + t188*t87
+    t191 = t135 - t188*t88
+    t192 = t108 + t188*t89
+    t193 = t109 - t188*t90
     t194 = t152*(t146*t191 + t147*t192 + t148*t193 - t190*t151)
     t195 = t190 + t151*t194
     t196 = t191 - t146*t194
@@ -1566,16 +1566,16 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t212 = xp.where(xp.not_equal(t208, 0), -t211/t208, 0)
     t213 = xp.where(xp.not_equal(t181, 0), -(t185 - t204*t212)/t181, 0)
     t214 = xp.where(xp.not_equal(t169, 0), -(t177 - (t173*t213 + t200*t212))/t169, 0)
-    t215 = xp.where(xp.not_equal(t150, 0), -(t164 + t159*t213 + t195*t212 - t154*t214)/t150, 0)
+    t215 = xp.where(xp.not_equal(t150, 0), -(t164 - t154*t214 + t159*t213 + t195*t212)/t150, 0)
     t216 = xp.where(xp.not_equal(t118, 0), -(t128 - (t144*t215 + t122*t213 + t189*t212 - t137*t214))/t118, 0)
-    t217 = xp.where(xp.not_equal(t75, 0), -(t111 - (t104*t213 + t215*t79 + t216*t90 - t84*t212 - t214*t98))/t75, 0)
+    t217 = xp.where(xp.not_equal(t75, 0), -(t111 - (t99*t213 + t215*t79 + t216*t85 - t106*t212 - t214*t93))/t75, 0)
     t218 = t212 + t216*t2 - t217*t4
     t219 = t215*c2 + t216*t3 + t217*t1
     t220 = t212*c2 + t213*t3 + t214*t1
     t221 = t13*t214 + t9*t213 - t212*t52
     t222 = t10*t214 + t15*t213 - t0*t212
-    t223 = t32*s1
-    t224 = t32*c1
+    t223 = s1*t32
+    t224 = c1*t32
     t225 = t213*c1 - t214*s1 - t215*t5 + t216*t223 + t217*t224
     t226 = -t4
     t227 = t39 + t226
@@ -1597,7 +1597,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t243 = t233 - t240*t242
     t244 = c2 + t242*t5
     t245 = -t231 + t228*t242
-    t246 = -t241*(t228*t237 + t5*mu_dot2 + mu_dot3*s1 - t236*t240 - c1*mu_dot4)
+    t246 = -t241*(-t236*t240 - c1*mu_dot4 + t228*t237 + t5*mu_dot2 + mu_dot3*s1)
     t247 = t236 - t240*t246
     t248 = mu_dot2 + t246*t5
     t249 = mu_dot3 + t246*s1
@@ -1635,9 +1635,9 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t281 = t280*xp.where(xp.greater_equal(t244, 0), xp.asarray(1, dtype=dtype), -1)
     t282 = t244 + t281
     t283 = xp.where(xp.greater(t280, 0), 1/(t280*(t280 + xp.abs(t244))), 0)
-    t284 = t242*s1
+    t284 = s1*t242
     t285 = t262*t5
-    t286 = t242*c1
+    t286 = c1*t242
     t287 = t283*(t245*t266 + t264*t284 + t282*t285 - t265*t286)
     t288 = t285 - t282*t287
     t289 = t264 - t287*t284
@@ -1703,7 +1703,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t349 = 1e-12*t59
     t350 = xp.greater(damping, 0)
     t351 = 1e-12*t73
-    t352 = (t350 & (xp.less_equal(t117, t351) | xp.less_equal(t149, t351) | xp.less_equal(t168, t351) | xp.less_equal(t180, t351) | xp.less_equal(t207, t351) | xp.less_equal(t74, t351))) | (xp.less_equal(damping, 0) & (xp.less_equal(t38, t349) | xp.less_equal(t238, t349) | xp.less_equal(t280, t349) | xp.less_equal(t297, t349) | xp.less_equal(t315, t349) | xp.less_equal(t336, t349)))
+    t352 = (xp.less_equal(damping, 0) & (xp.less_equal(t38, t349) | xp.less_equal(t238, t349) | xp.less_equal(t280, t349) | xp.less_equal(t297, t349) | xp.less_equal(t315, t349) | xp.less_equal(t336, t349))) | (t350 & (xp.less_equal(t117, t351) | xp.less_equal(t149, t351) | xp.less_equal(t168, t351) | xp.less_equal(t180, t351) | xp.less_equal(t207, t351) | xp.less_equal(t74, t351)))
     t353 = t347 & t348 & xp.logical_not(t352)
     q_dot = _stack(xp, [
         xp.broadcast_to(xp.where(t353, xp.where(t350, t218, t346), 0), batch),  # 0
@@ -1719,7 +1719,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def ik_numeric_step(target, q, damping=0.0):
-    """one step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite): (6 x 1 and 6 x 1 and 1 x 1), 856 operations."""
+    """one step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite): (6 x 1 and 6 x 1 and 1 x 1), 853 operations."""
     xp, dtype, device, batch, (target, q, damping,) = _arguments(("target", target, (4, 4)), ("q", q, (6,)), ("damping", damping, ()))
     T00 = target[..., 0, 0]
     T01 = target[..., 0, 1]
@@ -1757,8 +1757,8 @@ def ik_numeric_step(target, q, damping=0.0):
     s6 = xp.sin(q6)
     t0 = T00 + T01 + T02 + T03 + T10 + T11 + T12 + T13 + T20 + T21 + T22 + T23 + qs1 + qs2 + qs3 + qs4 + qs5 + qs6
     t1 = q3*s2
-    t2 = -0.1337*s1 + t1*c1
-    t3 = 0.1337*c1 + t1*s1
+    t2 = -0.1337*s1 + c1*t1
+    t3 = 0.1337*c1 + s1*t1
     t4 = t2*c1 + t3*s1
     t5 = T03 - t2
     t6 = T13 - t3
@@ -1767,35 +1767,35 @@ def ik_numeric_step(target, q, damping=0.0):
     t9 = T23 - t8
     t10 = c4*s1
     t11 = c1*s4
-    t12 = t10 + t11*c2
-    t13 = t11 + t10*c2
+    t12 = t10 + c2*t11
+    t13 = t11 + c2*t10
     t14 = s1*s4
     t15 = c1*c4
-    t16 = -t14 + t15*c2
-    t17 = -t15 + t14*c2
+    t16 = -t14 + c2*t15
+    t17 = -t15 + c2*t14
     t18 = c1*s2
-    t19 = t12*c5 - t18*s5
-    t20 = t12*s5 + t18*c5
+    t19 = t12*c5 - s5*t18
+    t20 = t12*s5 + c5*t18
     t21 = t16*s6 + t19*c6
     t22 = t16*c6 - t19*s6
     t23 = T00*t21 + T01*t22 + T02*t20
     t24 = T10*t21 + T11*t22 + T12*t20
     t25 = T20*t21 + T21*t22 + T22*t20
     t26 = s1*s2
-    t27 = t17*c5 - t26*s5
-    t28 = t17*s5 + t26*c5
+    t27 = t17*c5 - s5*t26
+    t28 = t17*s5 + c5*t26
     t29 = t13*s6 + t27*c6
     t30 = t13*c6 - t27*s6
     t31 = T00*t29 + T01*t30 + T02*t28
     t32 = T10*t29 + T11*t30 + T12*t28
     t33 = T20*t29 + T21*t30 + T22*t28
     t34 = 0.5*(t24 - t31)
-    t35 = s2*s4
-    t36 = c2*s5 + t35*c5
-    t37 = -c2*c5 + t35*s5
+    t35 = s4*s2
+    t36 = c2*s5 + c5*t35
+    t37 = -c2*c5 + s5*t35
     t38 = c4*s2
-    t39 = t36*c6 + t38*s6
-    t40 = t36*s6 - t38*c6
+    t39 = t36*c6 + s6*t38
+    t40 = t36*s6 - c6*t38
     t41 = T00*t39 + T02*t37 - T01*t40
     t42 = T10*t39 + T12*t37 - T11*t40
     t43 = T20*t39 + T22*t37 - T21*t40
@@ -1804,7 +1804,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t46 = xp.sqrt(t44**2 + t45**2 + t34**2)
     t47 = t3**2
     t48 = c1**2
-    t49 = t7*t48
+    t49 = t48*t7
     t50 = s2**2
     t51 = t48*t50
     t52 = c2**2
@@ -1816,22 +1816,22 @@ def ik_numeric_step(target, q, damping=0.0):
     t58 = -t2*t3
     t59 = c1*s1
     t60 = t50*t59
-    t61 = t58 + t60 + t55*t59
+    t61 = t58 + t60 + t59*t55
     t62 = t16*t13 + t20*t28 - t59 + t60
-    t63 = t18*c2
+    t63 = c2*t18
     t64 = t20*t37 + t16*t38 - t63
     t65 = t4*c1
     t66 = t63 - t7*t65
     t67 = s1**2
     t68 = t16**2 + t20**2 + t67 + t51
     t69 = t67*t50
-    t70 = t2**2 + t69 + t55*t67
+    t70 = t2**2 + t69 + t67*t55
     t71 = t13**2 + t28**2 + t48 + t69
-    t72 = t26*c2
+    t72 = c2*t26
     t73 = t28*t37 + t13*t38 - t72
     t74 = t4*s1
     t75 = t72 - t7*t74
-    t76 = t7*t67
+    t76 = t67*t7
     t77 = t76
     t78 = -t43
     t79 = 0.5*(-1 + t23 + t32 + t78)
@@ -1851,7 +1851,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t93 = xp.where(t89, t34*t81, t86*t90)
     t94 = t91**2 + t92**2 + t93**2 + t5**2 + t6**2 + t9**2
     t95 = t57 + damping
-    t96 = xp.sqrt(t47 + t61**2 + t66**2 + t49**2 + t95**2 + t56*t67)
+    t96 = xp.sqrt(t47 + t61**2 + t66**2 + t49**2 + t95**2 + t67*t56)
     t97 = t96*xp.where(xp.greater_equal(t95, 0), xp.asarray(1, dtype=dtype), -1)
     t98 = t97 + t95
     t99 = xp.where(xp.greater(t96, 0), 1/(t96*(t96 + xp.abs(t95))), 0)
@@ -1859,7 +1859,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t101 = t7*t59
     t102 = t99*(t98*t61 + t61*t100 + t66*t75 + t58 + t49*t101 + t77*t101)
     t103 = t61 - t98*t102
-    t104 = t100 - t102*t61
+    t104 = -t102*t61 + t100
     t105 = t75 - t102*t66
     t106 = -t77 + t102*t101
     t107 = -t102*t49 + t101
@@ -1885,15 +1885,15 @@ def ik_numeric_step(target, q, damping=0.0):
     t127 = t99*(t98*t66 + t61*t75 + t66*t126 - t49*t65 - t65*t76)
     t128 = t66 - t98*t127
     t129 = t75 - t127*t61
-    t130 = t126 - t127*t66
+    t130 = -t127*t66 + t126
     t131 = t74 + t127*t101
     t132 = t65 + t127*t49
     t133 = t68 + damping
-    t134 = t99*(t3*t64 + t49*t62 - t61*t77 + t66*t74 - t98*t101 - t101*t133)
+    t134 = t99*(t3*t64 + t49*t62 - t61*t77 + t66*t74 - t98*t101 - t133*t101)
     t135 = t98*t134 + t101
     t136 = t77 + t134*t61
     t137 = t74 - t134*t66
-    t138 = t133 + t134*t101
+    t138 = t134*t101 + t133
     t139 = t62 - t134*t49
     t140 = -t64
     t141 = t140 + t134*t3
@@ -1909,7 +1909,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t151 = -t149*t61 + t101
     t152 = t65 + t149*t66
     t153 = t62 + t149*t101
-    t154 = t148 - t149*t49
+    t154 = -t149*t49 + t148
     t155 = -t73 + t149*t3
     t156 = t119*(t106*t153 + t107*t154 + t108*t155 + t151*t118 - t105*t152)
     t157 = t151 - t118*t156
@@ -1918,12 +1918,12 @@ def ik_numeric_step(target, q, damping=0.0):
     t160 = t154 - t107*t156
     t161 = t155 - t108*t156
     t162 = t54 + damping
-    t163 = -t99*(t98*t3 + t3*t162 + t49*t73 - t2*t61 - t64*c1*c2*q3*s1)
+    t163 = -t99*(-t2*t61 + t98*t3 + t3*t162 + t49*t73 - t64*t101)
     t164 = t3 + t98*t163
     t165 = t2 - t163*t61
     t166 = t140 + t163*t101
     t167 = t73 + t163*t49
-    t168 = t162 + t163*t3
+    t168 = t163*t3 + t162
     t169 = t127*t3
     t170 = t119*(t105*t130 + t106*t131 + t129*t118 - t107*t132 + t108*t169)
     t171 = t129 - t118*t170
@@ -1997,11 +1997,11 @@ def ik_numeric_step(target, q, damping=0.0):
     t239 = xp.where(xp.not_equal(t235, 0), -t238/t235, 0)
     t240 = xp.where(xp.not_equal(t208, 0), -(t212 - t231*t239)/t208, 0)
     t241 = xp.where(xp.not_equal(t196, 0), -(t204 - (t200*t240 + t227*t239))/t196, 0)
-    t242 = xp.where(xp.not_equal(t177, 0), -(t191 + t186*t240 + t222*t239 - t181*t241)/t177, 0)
+    t242 = xp.where(xp.not_equal(t177, 0), -(t191 - t181*t241 + t186*t240 + t222*t239)/t177, 0)
     t243 = xp.where(xp.not_equal(t117, 0), -(t121 - (t171*t242 + t157*t240 + t216*t239 - t143*t241))/t117, 0)
     t244 = xp.where(xp.not_equal(t97, 0), -(t110 - (t103*t243 + t128*t242 + t150*t240 - t135*t241 - t164*t239))/t97, 0)
     t245 = t239 + q1 + t2*t243 - t244*t3
-    t246 = q2 + t240*c1 - t4*t242 - t241*s1 + t243*t7*s1 + t244*t7*c1
+    t246 = q2 + t240*c1 - t4*t242 - t241*s1 + s1*t243*t7 + c1*t244*t7
     t247 = q3 + t242*c2 + t243*t26 + t244*t18
     t248 = q4 + t239*c2 + t240*t26 + t241*t18
     t249 = q5 + t16*t241 + t13*t240 - t239*t38
@@ -2043,15 +2043,15 @@ def ik_branches(T):
     T22 = T[..., 2, 2]
     T23 = T[..., 2, 3]
     t0 = T00 + T01 + T02 + T03 + T10 + T11 + T12 + T13 + T20 + T21 + T22 + T23
-    t1 = 0.412*T02 - 0.1337*T00
+    t1 = -0.1337*T00 + 0.412*T02
     t2 = T03 - t1
     t3 = t1
     t4 = t2 + t3
-    t5 = 0.412*T12 - 0.1337*T10
+    t5 = -0.1337*T10 + 0.412*T12
     t6 = T13 - t5
     t7 = t5
     t8 = t6 + t7
-    t9 = 0.412*T22 - 0.1337*T20
+    t9 = -0.1337*T20 + 0.412*T22
     t10 = T23 - t9
     t11 = t9
     t12 = t10 + t11
@@ -2067,14 +2067,14 @@ def ik_branches(T):
     t22 = t21**2
     t23 = 0.01787569 + t22
     t24 = 0.01787569 + t14
-    t25 = t24 - t23
+    t25 = -t23 + t24
     t26 = -t25
     t27 = 1e-12*t23
     t28 = xp.greater(t26, t27)
     t29 = xp.where(t28, xp.sqrt(t26), 0)
     t30 = t4*t29
     t31 = t14 + 0.1337*t8
-    t32 = t31 - t30
+    t32 = -t30 + t31
     t33 = t30 + t31
     t34 = -t14
     t35 = t32 + t34
@@ -2177,7 +2177,7 @@ def ik_branches(T):
     t132 = t127*t120 - t128*t124
     t133 = t130**2 + t131**2
     t134 = t133
-    t135 = t133 + t132**2
+    t135 = t132**2 + t133
     t136 = 1 - t77
     t137 = T22*t136
     t138 = t137 + T22*t77
@@ -2219,7 +2219,7 @@ def ik_branches(T):
     t174 = t169*t162 - t170*t166
     t175 = t172**2 + t173**2
     t176 = t175
-    t177 = t175 + t174**2
+    t177 = t174**2 + t175
     t178 = xp.less_equal(t64, t65)
     t179 = xp.where(t178, 1, 1/xp.sqrt(t64))
     t180 = xp.where(t178, 1, t61*t179)
@@ -2277,7 +2277,7 @@ def ik_branches(T):
     t232 = t227*t220 - t228*t224
     t233 = t230**2 + t231**2
     t234 = t233
-    t235 = t233 + t232**2
+    t235 = t232**2 + t233
     t236 = t191**2
     t237 = -t236
     t238 = 1 + t237
@@ -2310,7 +2310,7 @@ def ik_branches(T):
     t265 = t260*t253 - t261*t257
     t266 = t263**2 + t264**2
     t267 = t266
-    t268 = t266 + t265**2
+    t268 = t265**2 + t266
     t269 = -t69
     t270 = xp.where(t66, 0, xp.atan2(t269, t59))
     t271 = t270 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t270))
@@ -2515,24 +2515,24 @@ def ik_branches(T):
         xp.where(t407 & xp.logical_not(t408), t335, t334),  # 7, 5
     ], (8, 6))
     valid = _stack(xp, [
-        t409 & t410 & t411 & xp.greater_equal(t105, -1e-12),  # 0
-        t409 & t410 & t411 & t106,  # 1
-        t28 & t409 & t410 & xp.greater_equal(t147, -1e-12),  # 2
-        t28 & t409 & t410 & t148,  # 3
-        t409 & t411 & t20 & xp.greater_equal(t205, -1e-12),  # 4
-        t409 & t411 & t206 & t20,  # 5
-        t28 & t409 & t20 & xp.greater_equal(t238, -1e-12),  # 6
-        t28 & t409 & t20 & t239,  # 7
+        t409 & xp.greater_equal(t105, -1e-12) & t410 & t411,  # 0
+        t409 & t106 & t410 & t411,  # 1
+        t409 & xp.greater_equal(t147, -1e-12) & t28 & t410,  # 2
+        t409 & t148 & t28 & t410,  # 3
+        t409 & xp.greater_equal(t205, -1e-12) & t20 & t411,  # 4
+        t409 & t206 & t20 & t411,  # 5
+        t409 & xp.greater_equal(t238, -1e-12) & t20 & t28,  # 6
+        t409 & t239 & t20 & t28,  # 7
     ], (8,))
     in_limits = _stack(xp, [
-        t412 & t413 & t414 & t415 & (t347 | t346) & (t348 | t349) & (t344 | t345),  # 0
-        t412 & t413 & t414 & t415 & (t350 | t351) & (t353 | t354) & (t355 | t356),  # 1
+        t412 & t413 & t414 & t415 & (t344 | t345) & (t346 | t347) & (t348 | t349),  # 0
+        t412 & t413 & t414 & t415 & (t350 | t351) & (t355 | t356) & (t353 | t354),  # 1
         t412 & t413 & t416 & t417 & (t363 | t364) & (t365 | t366) & (t367 | t368),  # 2
-        t412 & t413 & t416 & t417 & (t369 | t370) & (t372 | t373) & (t374 | t375),  # 3
-        t414 & t418 & t419 & t420 & (t380 | t381) & (t382 | t383) & (t384 | t385),  # 4
-        t414 & t418 & t419 & t420 & (t386 | t387) & (t389 | t390) & (t391 | t392),  # 5
-        t416 & t418 & t419 & t421 & (t396 | t397) & (t398 | t399) & (t400 | t401),  # 6
-        t416 & t418 & t419 & t421 & (t402 | t403) & (t405 | t406) & (t407 | t408),  # 7
+        t412 & t413 & t416 & t417 & (t369 | t370) & (t374 | t375) & (t372 | t373),  # 3
+        t418 & t419 & t414 & t420 & (t380 | t381) & (t382 | t383) & (t384 | t385),  # 4
+        t418 & t419 & t414 & t420 & (t386 | t387) & (t391 | t392) & (t389 | t390),  # 5
+        t418 & t419 & t416 & t421 & (t396 | t397) & (t398 | t399) & (t400 | t401),  # 6
+        t418 & t419 & t416 & t421 & (t402 | t403) & (t407 | t408) & (t405 | t406),  # 7
     ], (8,))
     return q, valid, in_limits
 

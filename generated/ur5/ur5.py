@@ -95,36 +95,36 @@ def fk(q):
     s6 = trig[..., 11]
     t0 = s1*s5
     t1 = c1*c5
-    t2 = t0 + t1*c234
-    t3 = t1 + t0*c234
+    t2 = t0 + c234*t1
+    t3 = t1 + c234*t0
     t4 = c5*s1
     t5 = c1*s5
-    t6 = t4 - t5*c234
-    t7 = -t5 + t4*c234
+    t6 = t4 - c234*t5
+    t7 = -t5 + c234*t4
     t8 = c1*s234
-    t9 = t2*c6 - t8*s6
-    t10 = t2*s6 + t8*c6
+    t9 = t2*c6 - s6*t8
+    t10 = t2*s6 + c6*t8
     t11 = 0.0823*t6 + 0.09465*t8
     t12 = t11 + 0.10915*s1
     t13 = s1*s234
-    t14 = t7*c6 - t13*s6
-    t15 = t7*s6 + t13*c6
+    t14 = t7*c6 - s6*t13
+    t15 = t7*s6 + c6*t13
     t16 = -0.0823*t3 + 0.09465*t13
     t17 = t16 - 0.10915*c1
     t18 = c5*s234
-    t19 = c234*s6 + t18*c6
-    t20 = c234*c6 - t18*s6
+    t19 = c234*s6 + c6*t18
+    t20 = c234*c6 - s6*t18
     t21 = s234*s5
     t22 = 0.09465*c234 + 0.0823*t21
     t23 = t22 + 0.39225*s23
     t24 = t23 + 0.425*s2
     t25 = 0.089459 - t24
     t26 = 0.39225*c23
-    t27 = t12 - t26*c1
-    t28 = t17 - t26*s1
+    t27 = t12 - c1*t26
+    t28 = t17 - s1*t26
     t29 = 0.425*c2
-    t30 = t27 - t29*c1
-    t31 = t28 - t29*s1
+    t30 = t27 - c1*t29
+    t31 = t28 - s1*t29
     T = _stack(xp, [
         t9,  # 0, 0
         -t10,  # 0, 1
@@ -165,8 +165,8 @@ def jacobian(q):
     c5 = trig[..., 8]
     s5 = trig[..., 9]
     t0 = c234*s5
-    t1 = c5*s1 - t0*c1
-    t2 = c1*c5 + t0*s1
+    t1 = c5*s1 - c1*t0
+    t2 = c1*c5 + s1*t0
     t3 = c1*s234
     t4 = 0.0823*t1 + 0.09465*t3
     t5 = t4 + 0.10915*s1
@@ -178,11 +178,11 @@ def jacobian(q):
     t11 = t10 + 0.39225*s23
     t12 = t11 + 0.425*s2
     t13 = 0.39225*c23
-    t14 = t5 - t13*c1
-    t15 = t8 - t13*s1
+    t14 = t5 - c1*t13
+    t15 = t8 - s1*t13
     t16 = 0.425*c2
-    t17 = t14 - t16*c1
-    t18 = t15 - t16*s1
+    t17 = t14 - c1*t16
+    t18 = t15 - s1*t16
     t19 = t10*c1
     t20 = t10*s1
     t21 = -c1
@@ -191,13 +191,13 @@ def jacobian(q):
         t12*c1,  # 0, 1
         t11*c1,  # 0, 2
         t19,  # 0, 3
-        t7*c234 - t20*s234,  # 0, 4
+        t7*c234 - s234*t20,  # 0, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5
         t17,  # 1, 0
         t12*s1,  # 1, 1
         t11*s1,  # 1, 2
         t20,  # 1, 3
-        -t4*c234 + t19*s234,  # 1, 4
+        -t4*c234 + s234*t19,  # 1, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
         t17*c1 + t18*s1,  # 2, 1
@@ -249,36 +249,36 @@ def fk_jacobian(q):
     s6 = trig[..., 11]
     t0 = s1*s5
     t1 = c1*c5
-    t2 = t0 + t1*c234
-    t3 = t1 + t0*c234
+    t2 = t0 + c234*t1
+    t3 = t1 + c234*t0
     t4 = c5*s1
     t5 = c1*s5
-    t6 = t4 - t5*c234
-    t7 = -t5 + t4*c234
+    t6 = t4 - c234*t5
+    t7 = -t5 + c234*t4
     t8 = c1*s234
-    t9 = t2*c6 - t8*s6
-    t10 = t2*s6 + t8*c6
+    t9 = t2*c6 - s6*t8
+    t10 = t2*s6 + c6*t8
     t11 = 0.0823*t6 + 0.09465*t8
     t12 = t11 + 0.10915*s1
     t13 = s1*s234
-    t14 = t7*c6 - t13*s6
-    t15 = t7*s6 + t13*c6
+    t14 = t7*c6 - s6*t13
+    t15 = t7*s6 + c6*t13
     t16 = -0.0823*t3 + 0.09465*t13
     t17 = t16 - 0.10915*c1
     t18 = c5*s234
-    t19 = c234*s6 + t18*c6
-    t20 = c234*c6 - t18*s6
+    t19 = c234*s6 + c6*t18
+    t20 = c234*c6 - s6*t18
     t21 = s234*s5
     t22 = 0.09465*c234 + 0.0823*t21
     t23 = t22 + 0.39225*s23
     t24 = t23 + 0.425*s2
     t25 = 0.089459 - t24
     t26 = 0.39225*c23
-    t27 = t12 - t26*c1
-    t28 = t17 - t26*s1
+    t27 = t12 - c1*t26
+    t28 = t17 - s1*t26
     t29 = 0.425*c2
-    t30 = t27 - t29*c1
-    t31 = t28 - t29*s1
+    t30 = t27 - c1*t29
+    t31 = t28 - s1*t29
     t32 = -t3
     t33 = -t21
     t34 = t22*c1
@@ -307,13 +307,13 @@ def fk_jacobian(q):
         t24*c1,  # 0, 1
         t23*c1,  # 0, 2
         t34,  # 0, 3
-        t16*c234 - t35*s234,  # 0, 4
+        t16*c234 - s234*t35,  # 0, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5
         t30,  # 1, 0
         t24*s1,  # 1, 1
         t23*s1,  # 1, 2
         t35,  # 1, 3
-        -t11*c234 + t34*s234,  # 1, 4
+        -t11*c234 + s234*t34,  # 1, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
         t30*c1 + t31*s1,  # 2, 1
@@ -344,7 +344,7 @@ def fk_jacobian(q):
 
 
 def jacobian_tool(q):
-    """geometric Jacobian in the tool frame (6 x DOF, rows vx vy vz wx wy wz): (6 x 6), 221 operations."""
+    """geometric Jacobian in the tool frame (6 x DOF, rows vx vy vz wx wy wz): (6 x 6), 219 operations."""
     xp, dtype, device, batch, (q,) = _arguments(("q", q, (6,)))
     trig = _cos_sin(xp, q, (0.0, 0.0, 0.0, 0.0, 0.0, 0.0), device)
     c1 = trig[..., 0]
@@ -365,49 +365,50 @@ def jacobian_tool(q):
     s6 = trig[..., 11]
     t0 = s1*s5
     t1 = c1*c5
-    t2 = t0 + t1*c234
-    t3 = t1 + t0*c234
+    t2 = t0 + c234*t1
+    t3 = t1 + c234*t0
     t4 = c5*s1
     t5 = c1*s5
-    t6 = t4 - t5*c234
-    t7 = -t5 + t4*c234
+    t6 = t4 - c234*t5
+    t7 = -t5 + c234*t4
     t8 = c1*s234
-    t9 = t2*c6 - t8*s6
-    t10 = t2*s6 + t8*c6
+    t9 = t2*c6 - s6*t8
+    t10 = t2*s6 + c6*t8
     t11 = 0.0823*t6 + 0.09465*t8
     t12 = t11 + 0.10915*s1
     t13 = s1*s234
-    t14 = t7*c6 - t13*s6
-    t15 = t7*s6 + t13*c6
+    t14 = t7*c6 - s6*t13
+    t15 = t7*s6 + c6*t13
     t16 = -0.0823*t3 + 0.09465*t13
     t17 = t16 - 0.10915*c1
     t18 = c5*s234
-    t19 = c234*s6 + t18*c6
-    t20 = c234*c6 - t18*s6
+    t19 = c234*s6 + c6*t18
+    t20 = c234*c6 - s6*t18
     t21 = s234*s5
     t22 = 0.09465*c234 + 0.0823*t21
     t23 = t22 + 0.39225*s23
     t24 = t23 + 0.425*s2
     t25 = 0.39225*c23
-    t26 = t12 - t25*c1
-    t27 = t17 - t25*s1
+    t26 = t12 - c1*t25
+    t27 = t17 - s1*t25
     t28 = 0.425*c2
-    t29 = t26 - t28*c1
-    t30 = t27 - t28*s1
+    t29 = t26 - c1*t28
+    t30 = t27 - s1*t28
     t31 = t29*c1 + t30*s1
-    t32 = t9*c1
-    t33 = t14*s1
+    t32 = c1*t9
+    t33 = s1*t14
     t34 = t26*c1 + t27*s1
     t35 = t12*c1 + t17*s1
     t36 = t16*c234 - t22*t13
     t37 = -t11*c234 + t22*t8
     t38 = t16*t8 - t11*t13
-    t39 = t10*c1
-    t40 = t15*s1
-    t41 = t3*s1
-    t42 = t9*s1 - t14*c1
-    t43 = t15*c1 - t10*s1
-    t44 = t6*s1 + t3*c1
+    t39 = c1*t10
+    t40 = s1*t15
+    t41 = c1*t6
+    t42 = s1*t3
+    t43 = t9*s1 - t14*c1
+    t44 = t15*c1 - t10*s1
+    t45 = t6*s1 + t3*c1
     J = _stack(xp, [
         t14*t29 - t9*t30,  # 0, 0
         t19*t31 + t24*t32 + t24*t33,  # 0, 1
@@ -419,31 +420,31 @@ def jacobian_tool(q):
         -(-t20*t31 + t24*t39 + t24*t40),  # 1, 1
         -(-t20*t34 + t23*t39 + t23*t40),  # 1, 2
         -(-t20*t35 + t22*t39 + t22*t40),  # 1, 3
-        -(t10*t36 + t15*t37 - t20*t38),  # 1, 4
+        -(-t20*t38 + t10*t36 + t15*t37),  # 1, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5
         -(t6*t30 + t3*t29),  # 2, 0
-        -(t24*t41 + t31*t21 - t6*t24*c1),  # 2, 1
-        -(t23*t41 + t34*t21 - t6*t23*c1),  # 2, 2
-        -(t22*t41 + t35*t21 - t6*t22*c1),  # 2, 3
-        -(t3*t37 - t6*t36 + t38*t21),  # 2, 4
+        -(-t24*t41 + t24*t42 + t31*t21),  # 2, 1
+        -(-t23*t41 + t23*t42 + t34*t21),  # 2, 2
+        -(-t22*t41 + t22*t42 + t35*t21),  # 2, 3
+        -(-t6*t36 + t3*t37 + t38*t21),  # 2, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 5
         t19,  # 3, 0
-        t42,  # 3, 1
-        t42,  # 3, 2
-        t42,  # 3, 3
+        t43,  # 3, 1
+        t43,  # 3, 2
+        t43,  # 3, 3
         -t19*c234 + t9*t8 + t14*t13,  # 3, 4
-        -(t3*t14 - t6*t9 + t19*t21),  # 3, 5
+        -(-t6*t9 + t3*t14 + t19*t21),  # 3, 5
         t20,  # 4, 0
-        t43,  # 4, 1
-        t43,  # 4, 2
-        t43,  # 4, 3
+        t44,  # 4, 1
+        t44,  # 4, 2
+        t44,  # 4, 3
         -(t20*c234 + t10*t8 + t15*t13),  # 4, 4
-        -(t6*t10 - t3*t15 + t20*t21),  # 4, 5
+        -(-t3*t15 + t6*t10 + t20*t21),  # 4, 5
         -t21,  # 5, 0
-        t44,  # 5, 1
-        t44,  # 5, 2
-        t44,  # 5, 3
-        t6*t8 + t21*c234 - t3*t13,  # 5, 4
+        t45,  # 5, 1
+        t45,  # 5, 2
+        t45,  # 5, 3
+        t6*t8 + c234*t21 - t3*t13,  # 5, 4
         t6**2 + t3**2 + s234**2*s5**2,  # 5, 5
     ], (6, 6))
     return J
@@ -472,19 +473,19 @@ def task(q):
     t0 = c234*s6 + c5*c6*s234
     t1 = s1*s5
     t2 = c1*c5
-    t3 = t1 + t2*c234
-    t4 = t2 + t1*c234
+    t3 = t1 + c234*t2
+    t4 = t2 + c234*t1
     t5 = c5*s1
     t6 = c1*s5
-    t7 = t5 - t6*c234
-    t8 = -t6 + t5*c234
-    t9 = s234*s6
-    t10 = t3*c6 - t9*c1
-    t11 = t8*c6 - t9*s1
-    t12 = c234*c6 - t9*c5
+    t7 = t5 - c234*t6
+    t8 = -t6 + c234*t5
+    t9 = s6*s234
+    t10 = t3*c6 - c1*t9
+    t11 = t8*c6 - s1*t9
+    t12 = c234*c6 - c5*t9
     t13 = 0.09465*s234
-    t14 = 0.0823*t7 + t13*c1
-    t15 = -0.0823*t4 + t13*s1
+    t14 = 0.0823*t7 + c1*t13
+    t15 = -0.0823*t4 + s1*t13
     t16 = t14 + 0.10915*s1
     t17 = t15 - 0.10915*c1
     t18 = s234*s5
@@ -493,11 +494,11 @@ def task(q):
     t21 = t20 + 0.425*s2
     t22 = 0.089459 - t21
     t23 = 0.39225*c23
-    t24 = t16 - t23*c1
-    t25 = t17 - t23*s1
+    t24 = t16 - c1*t23
+    t25 = t17 - s1*t23
     t26 = 0.425*c2
-    t27 = t24 - t26*c1
-    t28 = t25 - t26*s1
+    t27 = t24 - c1*t26
+    t28 = t25 - s1*t26
     mu = _stack(xp, [
         t27,  # 0
         t28,  # 1
@@ -532,18 +533,18 @@ def task_jacobian(q):
     t0 = c234*s6 + c5*c6*s234
     t1 = s1*s5
     t2 = c1*c5
-    t3 = t1 + t2*c234
-    t4 = t2 + t1*c234
+    t3 = t1 + c234*t2
+    t4 = t2 + c234*t1
     t5 = c5*s1
     t6 = c1*s5
-    t7 = t5 - t6*c234
-    t8 = -t6 + t5*c234
-    t9 = s234*s6
-    t10 = t3*c6 - t9*c1
-    t11 = t8*c6 - t9*s1
+    t7 = t5 - c234*t6
+    t8 = -t6 + c234*t5
+    t9 = s6*s234
+    t10 = t3*c6 - c1*t9
+    t11 = t8*c6 - s1*t9
     t12 = 0.09465*s234
-    t13 = 0.0823*t7 + t12*c1
-    t14 = -0.0823*t4 + t12*s1
+    t13 = 0.0823*t7 + c1*t12
+    t14 = -0.0823*t4 + s1*t12
     t15 = t13 + 0.10915*s1
     t16 = t14 - 0.10915*c1
     t17 = s234*s5
@@ -551,11 +552,11 @@ def task_jacobian(q):
     t19 = t18 + 0.39225*s23
     t20 = t19 + 0.425*s2
     t21 = 0.39225*c23
-    t22 = t15 - t21*c1
-    t23 = t16 - t21*s1
+    t22 = t15 - c1*t21
+    t23 = t16 - s1*t21
     t24 = 0.425*c2
-    t25 = t22 - t24*c1
-    t26 = t23 - t24*s1
+    t25 = t22 - c1*t24
+    t26 = t23 - s1*t24
     t27 = t18*c1
     t28 = t18*s1
     t29 = t10**2 + t11**2
@@ -565,7 +566,7 @@ def task_jacobian(q):
     t33 = t30*(t31 - t32)
     t34 = t10*c1
     t35 = t11*s1
-    t36 = t30*(t34*s234 + t35*s234)
+    t36 = t30*(s234*t34 + s234*t35)
     t37 = t30*(t7*t10 - t4*t11)
     t38 = 1/xp.sqrt(t29)
     t39 = -t38*(t34 + t35)
@@ -575,13 +576,13 @@ def task_jacobian(q):
         t20*c1,  # 0, 1
         t19*c1,  # 0, 2
         t27,  # 0, 3
-        t14*c234 - t28*s234,  # 0, 4
+        t14*c234 - s234*t28,  # 0, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5
         t25,  # 1, 0
         t20*s1,  # 1, 1
         t19*s1,  # 1, 2
         t28,  # 1, 3
-        -t13*c234 + t27*s234,  # 1, 4
+        -t13*c234 + s234*t27,  # 1, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
         t25*c1 + t26*s1,  # 2, 1
@@ -599,7 +600,7 @@ def task_jacobian(q):
         t39,  # 4, 1
         t39,  # 4, 2
         t39,  # 4, 3
-        t38*(t31*s234 - t32*s234),  # 4, 4
+        t38*(s234*t31 - s234*t32),  # 4, 4
         -t38*(t7*t11 + t4*t10),  # 4, 5
         xp.full(batch, 1, dtype=dtype, device=device),  # 5, 0
         t40,  # 5, 1
@@ -612,7 +613,7 @@ def task_jacobian(q):
 
 
 def fk_jacobian_dot(q, q_dot):
-    """fk, jacobian and bias_acceleration in one pass, sharing their terms: (4 x 4 and 6 x 6 and 6 x 1), 296 operations."""
+    """fk, jacobian and bias_acceleration in one pass, sharing their terms: (4 x 4 and 6 x 6 and 6 x 1), 294 operations."""
     xp, dtype, device, batch, (q, q_dot,) = _arguments(("q", q, (6,)), ("q_dot", q_dot, (6,)))
     qd1 = q_dot[..., 0]
     qd2 = q_dot[..., 1]
@@ -639,41 +640,41 @@ def fk_jacobian_dot(q, q_dot):
     s6 = trig[..., 11]
     t0 = s1*s5
     t1 = c1*c5
-    t2 = t0 + t1*c234
-    t3 = t1 + t0*c234
+    t2 = t0 + c234*t1
+    t3 = t1 + c234*t0
     t4 = c5*s1
     t5 = c1*s5
-    t6 = t4 - t5*c234
-    t7 = -t5 + t4*c234
+    t6 = t4 - c234*t5
+    t7 = -t5 + c234*t4
     t8 = c1*s234
-    t9 = t2*c6 - t8*s6
-    t10 = t2*s6 + t8*c6
+    t9 = t2*c6 - s6*t8
+    t10 = t2*s6 + c6*t8
     t11 = 0.0823*t6 + 0.09465*t8
     t12 = t11 + 0.10915*s1
     t13 = s1*s234
-    t14 = t7*c6 - t13*s6
-    t15 = t7*s6 + t13*c6
+    t14 = t7*c6 - s6*t13
+    t15 = t7*s6 + c6*t13
     t16 = -0.0823*t3 + 0.09465*t13
     t17 = t16 - 0.10915*c1
     t18 = c5*s234
-    t19 = c234*s6 + t18*c6
-    t20 = c234*c6 - t18*s6
+    t19 = c234*s6 + c6*t18
+    t20 = c234*c6 - s6*t18
     t21 = s234*s5
     t22 = 0.09465*c234 + 0.0823*t21
     t23 = t22 + 0.39225*s23
     t24 = t23 + 0.425*s2
     t25 = 0.089459 - t24
     t26 = 0.39225*c23
-    t27 = t12 - t26*c1
-    t28 = t17 - t26*s1
+    t27 = t12 - c1*t26
+    t28 = t17 - s1*t26
     t29 = 0.425*c2
-    t30 = t27 - t29*c1
-    t31 = t28 - t29*s1
+    t30 = t27 - c1*t29
+    t31 = t28 - s1*t29
     t32 = t22*s1
-    t33 = t16*c234 - t32*s234
+    t33 = t16*c234 - s234*t32
     t34 = t33
     t35 = t22*c1
-    t36 = -t11*c234 + t35*s234
+    t36 = -t11*c234 + s234*t35
     t37 = t36
     t38 = t30*c1 + t31*s1
     t39 = t38
@@ -691,10 +692,10 @@ def fk_jacobian_dot(q, q_dot):
     t51 = t49 + t50
     t52 = qd4*s1
     t53 = t48 + t52
-    t54 = t53 + t8*qd5
+    t54 = t53 + qd5*t8
     t55 = c1*qd4
     t56 = t51 + t55
-    t57 = -t56 + t13*qd5
+    t57 = -t56 + qd5*t13
     t58 = c234*qd5
     t59 = qd1 - t58
     t60 = t34*qd5
@@ -714,10 +715,11 @@ def fk_jacobian_dot(q, q_dot):
     t74 = -t3
     t75 = -t21
     t76 = t24*c1
-    t77 = t24*s1
-    t78 = t23*s1
-    t79 = -c1
-    t80 = t23*qd2
+    t77 = t23*c1
+    t78 = t24*s1
+    t79 = t23*s1
+    t80 = -c1
+    t81 = qd2*t23
     T = _stack(xp, [
         xp.broadcast_to(t9, batch),  # 0, 0
         xp.broadcast_to(-t10, batch),  # 0, 1
@@ -739,13 +741,13 @@ def fk_jacobian_dot(q, q_dot):
     J = _stack(xp, [
         xp.broadcast_to(-t31, batch),  # 0, 0
         xp.broadcast_to(t76, batch),  # 0, 1
-        xp.broadcast_to(t23*c1, batch),  # 0, 2
+        xp.broadcast_to(t77, batch),  # 0, 2
         xp.broadcast_to(t35, batch),  # 0, 3
         xp.broadcast_to(t33, batch),  # 0, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5
         xp.broadcast_to(t30, batch),  # 1, 0
-        xp.broadcast_to(t77, batch),  # 1, 1
-        xp.broadcast_to(t78, batch),  # 1, 2
+        xp.broadcast_to(t78, batch),  # 1, 1
+        xp.broadcast_to(t79, batch),  # 1, 2
         xp.broadcast_to(t32, batch),  # 1, 3
         xp.broadcast_to(t36, batch),  # 1, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5
@@ -762,9 +764,9 @@ def fk_jacobian_dot(q, q_dot):
         xp.broadcast_to(t8, batch),  # 3, 4
         xp.broadcast_to(t6, batch),  # 3, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
-        xp.broadcast_to(t79, batch),  # 4, 1
-        xp.broadcast_to(t79, batch),  # 4, 2
-        xp.broadcast_to(t79, batch),  # 4, 3
+        xp.broadcast_to(t80, batch),  # 4, 1
+        xp.broadcast_to(t80, batch),  # 4, 2
+        xp.broadcast_to(t80, batch),  # 4, 3
         xp.broadcast_to(t13, batch),  # 4, 4
         xp.broadcast_to(t74, batch),  # 4, 5
         xp.full(batch, 1, dtype=dtype, device=device),  # 5, 0
@@ -775,18 +777,18 @@ def fk_jacobian_dot(q, q_dot):
         xp.broadcast_to(t75, batch),  # 5, 5
     ], (6, 6))
     a = _stack(xp, [
-        xp.broadcast_to(-qd2*(t73*c1 + t77*qd1) - qd3*(t72*c1 + t78*qd1 + t41*t49) - qd4*(t43*t51 + t71*c1 + t32*qd1) + qd5*(-t37*qd1 - t45*t56 + t37*t58 + t70*t13) - t69*qd1, batch),  # 0
-        xp.broadcast_to(t64*qd1 + qd2*(-t73*s1 + t76*qd1) - qd3*(t72*s1 + t41*t46 - t23*c1*qd1) - qd4*(t43*t48 + t71*s1 - t22*c1*qd1) - qd5*(t45*t53 - t34*qd1 + t34*t58 + t70*t8), batch),  # 1
-        xp.broadcast_to(qd2*(t63*c1 + t68*s1) + qd3*(t62*c1 + t67*s1 + t80*c1**2 + t80*s1**2) + qd4*(t61*c1 + t66*s1 + t48*t32 + t51*t35) + qd5*(t34*t56 + t37*t53 + t65*t8 - t60*t13), batch),  # 2
-        xp.broadcast_to(qd5*(t56*c234 - t13*qd1) + qd6*(t3*t59 - t57*t21) + t49*qd1 + t50*qd1 + t55*qd1, batch),  # 3
-        xp.broadcast_to(qd5*(t53*c234 + t8*qd1) + qd6*(t6*t59 + t54*t21) + t46*qd1 + t47*qd1 + t52*qd1, batch),  # 4
+        xp.broadcast_to(-qd2*(t73*c1 + qd1*t78) - qd3*(t72*c1 + qd1*t79 + t41*t49) - qd4*(t43*t51 + t71*c1 + qd1*t32) + qd5*(-t37*qd1 - t45*t56 + t37*t58 + t70*t13) - t69*qd1, batch),  # 0
+        xp.broadcast_to(t64*qd1 + qd2*(-t73*s1 + qd1*t76) - qd3*(t72*s1 - qd1*t77 + t41*t46) - qd4*(t43*t48 + t71*s1 - qd1*t35) - qd5*(-t34*qd1 + t45*t53 + t34*t58 + t70*t8), batch),  # 1
+        xp.broadcast_to(qd2*(t63*c1 + t68*s1) + qd3*(t62*c1 + t67*s1 + c1**2*t81 + s1**2*t81) + qd4*(t61*c1 + t66*s1 + t48*t32 + t51*t35) + qd5*(t34*t56 + t37*t53 + t65*t8 - t60*t13), batch),  # 2
+        xp.broadcast_to(qd5*(t56*c234 - qd1*t13) + qd6*(t3*t59 - t57*t21) + qd1*t49 + qd1*t50 + qd1*t55, batch),  # 3
+        xp.broadcast_to(qd5*(t53*c234 + qd1*t8) + qd6*(t6*t59 + t54*t21) + qd1*t46 + qd1*t47 + qd1*t52, batch),  # 4
         xp.broadcast_to(qd4*(t51*s1 - t48*c1) + qd5*(t53*t13 + t56*t8) - qd6*(t6*t57 + t3*t54), batch),  # 5
     ], (6,))
     return T, J, a
 
 
 def jacobian_dot(q, q_dot):
-    """time derivative dJ/dt of the world geometric Jacobian along q_dot (6 x DOF): (6 x 6), 212 operations."""
+    """time derivative dJ/dt of the world geometric Jacobian along q_dot (6 x DOF): (6 x 6), 210 operations."""
     xp, dtype, device, batch, (q, q_dot,) = _arguments(("q", q, (6,)), ("q_dot", q_dot, (6,)))
     qd1 = q_dot[..., 0]
     qd2 = q_dot[..., 1]
@@ -809,29 +811,29 @@ def jacobian_dot(q, q_dot):
     c5 = trig[..., 8]
     s5 = trig[..., 9]
     t0 = c234*s5
-    t1 = c5*s1 - t0*c1
-    t2 = c1*c5 + t0*s1
+    t1 = c5*s1 - c1*t0
+    t2 = c1*c5 + s1*t0
     t3 = 0.09465*s234
-    t4 = 0.0823*t1 + t3*c1
-    t5 = -0.0823*t2 + t3*s1
+    t4 = 0.0823*t1 + c1*t3
+    t5 = -0.0823*t2 + s1*t3
     t6 = t4 + 0.10915*s1
     t7 = t5 - 0.10915*c1
     t8 = t6*c1 + t7*s1
-    t9 = s234*s5
+    t9 = s5*s234
     t10 = 0.09465*c234 + 0.0823*t9
     t11 = t10 + 0.39225*s23
     t12 = t11 + 0.425*s2
     t13 = 0.39225*c23
-    t14 = t6 - t13*c1
-    t15 = t7 - t13*s1
+    t14 = t6 - c1*t13
+    t15 = t7 - s1*t13
     t16 = t14*c1 + t15*s1
     t17 = 0.425*c2
-    t18 = t14 - t17*c1
-    t19 = t15 - t17*s1
+    t18 = t14 - c1*t17
+    t19 = t15 - s1*t17
     t20 = t18*c1 + t19*s1
-    t21 = t10*s234
-    t22 = t5*c234 - t21*s1
-    t23 = -t4*c234 + t21*c1
+    t21 = s234*t10
+    t22 = t5*c234 - s1*t21
+    t23 = -t4*c234 + c1*t21
     t24 = c1*s234
     t25 = s1*s234
     t26 = t5*t24 - t4*t25
@@ -843,10 +845,10 @@ def jacobian_dot(q, q_dot):
     t32 = t30 + t31
     t33 = qd4*s1
     t34 = t29 + t33
-    t35 = t34 + t24*qd5
+    t35 = t34 + qd5*t24
     t36 = c1*qd4
     t37 = t32 + t36
-    t38 = -t37 + t25*qd5
+    t38 = -t37 + qd5*t25
     t39 = c234*qd5
     t40 = qd1 - t39
     t41 = t22*qd5
@@ -865,7 +867,7 @@ def jacobian_dot(q, q_dot):
     t54 = t53 + t20*qd2
     t55 = qd1*s1
     t56 = c1*qd1
-    t57 = t11*qd2
+    t57 = qd2*t11
     Jd = _stack(xp, [
         xp.broadcast_to(-t50, batch),  # 0, 0
         xp.broadcast_to(-(t54*c1 + t12*t55), batch),  # 0, 1
@@ -875,13 +877,13 @@ def jacobian_dot(q, q_dot):
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5
         xp.broadcast_to(t45, batch),  # 1, 0
         xp.broadcast_to(-t54*s1 + t12*t56, batch),  # 1, 1
-        xp.broadcast_to(-(t53*s1 + t16*t27 - t11*c1*qd1), batch),  # 1, 2
-        xp.broadcast_to(-(t8*t29 + t52*s1 - t10*c1*qd1), batch),  # 1, 3
-        xp.broadcast_to(-(t26*t34 - t22*qd1 + t22*t39 + t51*t24), batch),  # 1, 4
+        xp.broadcast_to(-(t53*s1 - t11*t56 + t16*t27), batch),  # 1, 2
+        xp.broadcast_to(-(t8*t29 + t52*s1 - t10*t56), batch),  # 1, 3
+        xp.broadcast_to(-(-t22*qd1 + t26*t34 + t22*t39 + t51*t24), batch),  # 1, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
         xp.broadcast_to(t44*c1 + t49*s1, batch),  # 2, 1
-        xp.broadcast_to(t43*c1 + t48*s1 + t57*c1**2 + t57*s1**2, batch),  # 2, 2
+        xp.broadcast_to(t43*c1 + t48*s1 + c1**2*t57 + s1**2*t57, batch),  # 2, 2
         xp.broadcast_to(t42*c1 + t47*s1 + t10*t29*s1 + t10*t32*c1, batch),  # 2, 3
         xp.broadcast_to(t22*t37 + t23*t34 + t46*t24 - t41*t25, batch),  # 2, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 5
@@ -889,13 +891,13 @@ def jacobian_dot(q, q_dot):
         xp.broadcast_to(t56, batch),  # 3, 1
         xp.broadcast_to(t56, batch),  # 3, 2
         xp.broadcast_to(t56, batch),  # 3, 3
-        xp.broadcast_to(t37*c234 - t55*s234, batch),  # 3, 4
+        xp.broadcast_to(t37*c234 - s234*t55, batch),  # 3, 4
         xp.broadcast_to(t2*t40 - t38*t9, batch),  # 3, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
         xp.broadcast_to(t55, batch),  # 4, 1
         xp.broadcast_to(t55, batch),  # 4, 2
         xp.broadcast_to(t55, batch),  # 4, 3
-        xp.broadcast_to(t34*c234 + t56*s234, batch),  # 4, 4
+        xp.broadcast_to(t34*c234 + s234*t56, batch),  # 4, 4
         xp.broadcast_to(t1*t40 + t35*t9, batch),  # 4, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 1
@@ -908,7 +910,7 @@ def jacobian_dot(q, q_dot):
 
 
 def bias_acceleration(q, q_dot):
-    """J' q_dot: the tool's classical linear and angular acceleration at zero joint acceleration, world frame (6): (6 x 1), 262 operations."""
+    """J' q_dot: the tool's classical linear and angular acceleration at zero joint acceleration, world frame (6): (6 x 1), 260 operations."""
     xp, dtype, device, batch, (q, q_dot,) = _arguments(("q", q, (6,)), ("q_dot", q_dot, (6,)))
     qd1 = q_dot[..., 0]
     qd2 = q_dot[..., 1]
@@ -932,29 +934,29 @@ def bias_acceleration(q, q_dot):
     c5 = trig[..., 8]
     s5 = trig[..., 9]
     t0 = c234*s5
-    t1 = c5*s1 - t0*c1
-    t2 = c1*c5 + t0*s1
+    t1 = c5*s1 - c1*t0
+    t2 = c1*c5 + s1*t0
     t3 = 0.09465*s234
-    t4 = 0.0823*t1 + t3*c1
-    t5 = -0.0823*t2 + t3*s1
+    t4 = 0.0823*t1 + c1*t3
+    t5 = -0.0823*t2 + s1*t3
     t6 = t4 + 0.10915*s1
     t7 = t5 - 0.10915*c1
     t8 = t6*c1 + t7*s1
-    t9 = s234*s5
+    t9 = s5*s234
     t10 = 0.09465*c234 + 0.0823*t9
     t11 = t10 + 0.39225*s23
     t12 = t11 + 0.425*s2
     t13 = 0.39225*c23
-    t14 = t6 - t13*c1
-    t15 = t7 - t13*s1
+    t14 = t6 - c1*t13
+    t15 = t7 - s1*t13
     t16 = t14*c1 + t15*s1
     t17 = 0.425*c2
-    t18 = t14 - t17*c1
-    t19 = t15 - t17*s1
+    t18 = t14 - c1*t17
+    t19 = t15 - s1*t17
     t20 = t18*c1 + t19*s1
-    t21 = t10*s234
-    t22 = t5*c234 - t21*s1
-    t23 = -t4*c234 + t21*c1
+    t21 = s234*t10
+    t22 = t5*c234 - s1*t21
+    t23 = -t4*c234 + c1*t21
     t24 = c1*s234
     t25 = s1*s234
     t26 = t5*t24 - t4*t25
@@ -966,10 +968,10 @@ def bias_acceleration(q, q_dot):
     t32 = t30 + t31
     t33 = qd4*s1
     t34 = t29 + t33
-    t35 = t34 + t24*qd5
+    t35 = t34 + qd5*t24
     t36 = c1*qd4
     t37 = t32 + t36
-    t38 = -t37 + t25*qd5
+    t38 = -t37 + qd5*t25
     t39 = c234*qd5
     t40 = qd1 - t39
     t41 = t22*qd5
@@ -986,14 +988,15 @@ def bias_acceleration(q, q_dot):
     t52 = t8*qd4 + t51
     t53 = t52 + t16*qd3
     t54 = t53 + t20*qd2
-    t55 = qd1*s1
-    t56 = t11*qd2
+    t55 = s1*qd1
+    t56 = c1*qd1
+    t57 = qd2*t11
     a = _stack(xp, [
         xp.broadcast_to(-qd2*(t54*c1 + t12*t55) - qd3*(t53*c1 + t11*t55 + t16*t30) - qd4*(t8*t32 + t52*c1 + t10*t55) + qd5*(-t23*qd1 - t26*t37 + t23*t39 + t51*t25) - t50*qd1, batch),  # 0
-        xp.broadcast_to(t45*qd1 + qd2*(-t54*s1 + t12*c1*qd1) - qd3*(t53*s1 + t16*t27 - t11*c1*qd1) - qd4*(t8*t29 + t52*s1 - t10*c1*qd1) - qd5*(t26*t34 - t22*qd1 + t22*t39 + t51*t24), batch),  # 1
-        xp.broadcast_to(qd2*(t44*c1 + t49*s1) + qd3*(t43*c1 + t48*s1 + t56*c1**2 + t56*s1**2) + qd4*(t42*c1 + t47*s1 + t10*t29*s1 + t10*t32*c1) + qd5*(t22*t37 + t23*t34 + t46*t24 - t41*t25), batch),  # 2
-        xp.broadcast_to(qd5*(t37*c234 - t25*qd1) + qd6*(t2*t40 - t38*t9) + t30*qd1 + t31*qd1 + t36*qd1, batch),  # 3
-        xp.broadcast_to(qd5*(t34*c234 + t24*qd1) + qd6*(t1*t40 + t35*t9) + t27*qd1 + t28*qd1 + t33*qd1, batch),  # 4
+        xp.broadcast_to(t45*qd1 + qd2*(-t54*s1 + t12*t56) - qd3*(t53*s1 - t11*t56 + t16*t27) - qd4*(t8*t29 + t52*s1 - t10*t56) - qd5*(-t22*qd1 + t26*t34 + t22*t39 + t51*t24), batch),  # 1
+        xp.broadcast_to(qd2*(t44*c1 + t49*s1) + qd3*(t43*c1 + t48*s1 + c1**2*t57 + s1**2*t57) + qd4*(t42*c1 + t47*s1 + t10*t29*s1 + t10*t32*c1) + qd5*(t22*t37 + t23*t34 + t46*t24 - t41*t25), batch),  # 2
+        xp.broadcast_to(qd5*(t37*c234 - qd1*t25) + qd6*(t2*t40 - t38*t9) + qd1*t30 + qd1*t31 + qd1*t36, batch),  # 3
+        xp.broadcast_to(qd5*(t34*c234 + qd1*t24) + qd6*(t1*t40 + t35*t9) + qd1*t27 + qd1*t28 + qd1*t33, batch),  # 4
         xp.broadcast_to(qd4*(t32*s1 - t29*c1) + qd5*(t34*t25 + t37*t24) - qd6*(t1*t38 + t2*t35), batch),  # 5
     ], (6,))
     return a
@@ -1028,36 +1031,36 @@ def task_jacobian_dot(q, q_dot):
     t0 = c234*s6 + c5*c6*s234
     t1 = s1*s5
     t2 = c1*c5
-    t3 = t1 + t2*c234
-    t4 = t2 + t1*c234
+    t3 = t1 + c234*t2
+    t4 = t2 + c234*t1
     t5 = c5*s1
     t6 = c1*s5
-    t7 = t5 - t6*c234
-    t8 = -t6 + t5*c234
-    t9 = s234*s6
-    t10 = t3*c6 - t9*c1
-    t11 = t8*c6 - t9*s1
+    t7 = t5 - c234*t6
+    t8 = -t6 + c234*t5
+    t9 = s6*s234
+    t10 = t3*c6 - c1*t9
+    t11 = t8*c6 - s1*t9
     t12 = 0.09465*s234
-    t13 = 0.0823*t7 + t12*c1
-    t14 = -0.0823*t4 + t12*s1
+    t13 = 0.0823*t7 + c1*t12
+    t14 = -0.0823*t4 + s1*t12
     t15 = t13 + 0.10915*s1
     t16 = t14 - 0.10915*c1
     t17 = t15*c1 + t16*s1
-    t18 = s234*s5
+    t18 = s5*s234
     t19 = 0.09465*c234 + 0.0823*t18
     t20 = t19 + 0.39225*s23
     t21 = t20 + 0.425*s2
     t22 = 0.39225*c23
-    t23 = t15 - t22*c1
-    t24 = t16 - t22*s1
+    t23 = t15 - c1*t22
+    t24 = t16 - s1*t22
     t25 = t23*c1 + t24*s1
     t26 = 0.425*c2
-    t27 = t23 - t26*c1
-    t28 = t24 - t26*s1
+    t27 = t23 - c1*t26
+    t28 = t24 - s1*t26
     t29 = t27*c1 + t28*s1
-    t30 = t19*s234
-    t31 = t14*c234 - t30*s1
-    t32 = -t13*c234 + t30*c1
+    t30 = s234*t19
+    t31 = t14*c234 - s1*t30
+    t32 = -t13*c234 + c1*t30
     t33 = c1*s234
     t34 = s1*s234
     t35 = t14*t33 - t13*t34
@@ -1072,24 +1075,24 @@ def task_jacobian_dot(q, q_dot):
     t44 = t43*s1 - t39*c1
     t45 = qd4*s1
     t46 = t39 + t45
-    t47 = t46*c234 + t33*qd1
+    t47 = t46*c234 + qd1*t33
     t48 = c1*qd4
     t49 = t43 + t48
-    t50 = t49*c234 - t34*qd1
+    t50 = t49*c234 - qd1*t34
     t51 = t46*t34 + t49*t33
-    t52 = t33*qd5
+    t52 = qd5*t33
     t53 = t46 + t52
-    t54 = t38 + t45 + t52 + t7*qd6
-    t55 = t34*qd5
+    t54 = t45 + t52 + t7*qd6 + t38
+    t55 = qd5*t34
     t56 = -t49 + t55
     t57 = t7*t56 + t4*t53
-    t58 = t42 + t48 - t55 + t4*qd6
+    t58 = t48 + t4*qd6 - t55 + t42
     t59 = t10*t58 + t11*t54
     t60 = c234*qd5
     t61 = qd1 - t60
     t62 = t4*t61 - t56*t18
     t63 = t7*t61 + t53*t18
-    t64 = -qd1 + t60 + t18*qd6
+    t64 = -qd1 + t60 + qd6*t18
     t65 = t11*t64 - t0*t58
     t66 = t10*t64 + t0*t54
     t67 = t31*qd5
@@ -1104,14 +1107,14 @@ def task_jacobian_dot(q, q_dot):
     t76 = t75 + t27*qd1
     t77 = t70*c1 + t75*s1
     t78 = t68*c1 + t73*s1 + t19*t39*s1 + t19*t43*c1
-    t79 = t31*t49 + t32*t46 + t33*t72 - t34*t67
+    t79 = t31*t49 + t32*t46 + t72*t33 - t67*t34
     t80 = t35*qd5
     t81 = t17*qd4 + t80
     t82 = t81 + t25*qd3
     t83 = t82 + t29*qd2
-    t84 = -t32*qd1 - t35*t49 + t32*t60 + t34*t80
-    t85 = t35*t46 - t31*qd1 + t31*t60 + t33*t80
-    t86 = qd1*s1
+    t84 = -t32*qd1 - t35*t49 + t32*t60 + t80*t34
+    t85 = t35*t46 - t31*qd1 + t31*t60 + t80*t33
+    t86 = s1*qd1
     t87 = t83*c1 + t21*t86
     t88 = t82*c1 + t20*t86 + t25*t40
     t89 = t17*t43 + t81*c1 + t19*t86
@@ -1119,8 +1122,8 @@ def task_jacobian_dot(q, q_dot):
     t91 = -t83*s1 + t21*t90
     t92 = t82*s1 + t25*t36 - t20*t90
     t93 = t17*t39 + t81*s1 - t19*t90
-    t94 = t20*qd2
-    t95 = t69*c1 + t74*s1 + t94*c1**2 + t94*s1**2
+    t94 = qd2*t20
+    t95 = t69*c1 + t74*s1 + c1**2*t94 + s1**2*t94
     t96 = t10**2 + t11**2
     t97 = 1/t96
     t98 = s1*t97
@@ -1132,16 +1135,16 @@ def task_jacobian_dot(q, q_dot):
     t104 = t10*t103
     t105 = c1*t97
     t106 = t11*t103
-    t107 = t10*qd1
-    t108 = t11*qd1
+    t107 = qd1*t10
+    t108 = qd1*t11
     t109 = t65*(t98 - t104) + t66*(t105 + t106) + t105*t107 + t98*t108
-    t110 = t105*s234
+    t110 = s234*t105
     t111 = t10*c1
     t112 = t11*s1
-    t113 = t111*s234 + t112*s234
-    t114 = t102*t113
+    t113 = s234*t111 + s234*t112
+    t114 = t113*t102
     t115 = t10*t114
-    t116 = t98*s234
+    t116 = s234*t98
     t117 = t11*t114
     t118 = t10*t97
     t119 = t50*t118
@@ -1149,7 +1152,7 @@ def task_jacobian_dot(q, q_dot):
     t121 = t47*t120
     t122 = t7*t97
     t123 = t7*t10 - t4*t11
-    t124 = t102*t123
+    t124 = t123*t102
     t125 = t10*t124
     t126 = t4*t97
     t127 = t11*t124
@@ -1160,16 +1163,16 @@ def task_jacobian_dot(q, q_dot):
     t132 = 1/t96**1.5
     t133 = -t132*(t111 + t112)
     t134 = s1*t130
-    t135 = t130*qd1
+    t135 = qd1*t130
     t136 = -t65*(t131 + t10*t133) + t66*(t134 + t11*t133) + t99*t135 - t100*t135
-    t137 = t132*(t99*s234 - t100*s234)
+    t137 = t132*(s234*t99 - s234*t100)
     t138 = t10*t130
     t139 = t11*t130
     t140 = -t132*(t7*t11 + t4*t10)
-    t141 = t0*t105
-    t142 = t0*t98
-    t143 = t59*t97
-    t144 = t66*(t141 + t0*t106) - t65*(-t142 + t0*t104) + t101*t143 + t107*t141 + t108*t142
+    t141 = t0*t98
+    t142 = t0*t105
+    t143 = t97*t59
+    t144 = -t65*(-t141 + t0*t104) + t66*(t142 + t0*t106) + t101*t143 + t142*t107 + t141*t108
     t145 = -t144
     Jd = _stack(xp, [
         xp.broadcast_to(-t76, batch),  # 0, 0
@@ -1200,14 +1203,14 @@ def task_jacobian_dot(q, q_dot):
         xp.broadcast_to(t136, batch),  # 4, 1
         xp.broadcast_to(t136, batch),  # 4, 2
         xp.broadcast_to(t136, batch),  # 4, 3
-        xp.broadcast_to(t65*(t134*s234 - t10*t137) + t66*(t11*t137 + t131*s234) + t47*t138 - t50*t139, batch),  # 4, 4
+        xp.broadcast_to(t65*(s234*t134 - t10*t137) + t66*(t11*t137 + s234*t131) + t47*t138 - t50*t139, batch),  # 4, 4
         xp.broadcast_to(-t65*(t4*t130 + t10*t140) + t66*(t7*t130 + t11*t140) + t63*t138 - t62*t139, batch),  # 4, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 0
         xp.broadcast_to(t145, batch),  # 5, 1
         xp.broadcast_to(t145, batch),  # 5, 2
-        xp.broadcast_to(-(t144 - t44), batch),  # 5, 3
-        xp.broadcast_to(-(-t51 + t66*(-t0*t116 + t0*t117) - t65*(-t0*t110 + t0*t115) + t113*t143 + t0*t119 + t0*t121), batch),  # 5, 4
-        xp.broadcast_to(-(t57 + t66*(t0*t126 + t0*t127) - t65*(-t0*t122 + t0*t125) + t123*t143 + t0*t128 + t0*t129), batch),  # 5, 5
+        xp.broadcast_to(-(-t44 + t144), batch),  # 5, 3
+        xp.broadcast_to(-(-t51 - t65*(-t0*t110 + t0*t115) + t66*(-t0*t116 + t0*t117) + t113*t143 + t0*t119 + t0*t121), batch),  # 5, 4
+        xp.broadcast_to(-(t57 - t65*(-t0*t122 + t0*t125) + t66*(t0*t126 + t0*t127) + t123*t143 + t0*t128 + t0*t129), batch),  # 5, 5
     ], (6, 6))
     return Jd
 
@@ -1234,9 +1237,9 @@ def hessian(q):
     t1 = t0 + 0.39225*s23
     t2 = t1 + 0.425*s2
     t3 = c1*c234
-    t4 = c5*s1 - t3*s5
+    t4 = c5*s1 - s5*t3
     t5 = c234*s1
-    t6 = c1*c5 + t5*s5
+    t6 = c1*c5 + s5*t5
     t7 = c1*s234
     t8 = 0.0823*t4 + 0.09465*t7
     t9 = t8 + 0.10915*s1
@@ -1246,17 +1249,17 @@ def hessian(q):
     t13 = t9*c1 + t12*s1
     t14 = t11*t7 - t8*t10
     t15 = 0.39225*c23
-    t16 = t9 - t15*c1
-    t17 = t12 - t15*s1
+    t16 = t9 - c1*t15
+    t17 = t12 - s1*t15
     t18 = t16*c1 + t17*s1
     t19 = 0.425*c2
-    t20 = t16 - t19*c1
-    t21 = t17 - t19*s1
+    t20 = t16 - c1*t19
+    t21 = t17 - s1*t19
     t22 = t20*c1 + t21*s1
     t23 = t0*s1
-    t24 = t11*c234 - t23*s234
+    t24 = t11*c234 - s234*t23
     t25 = t0*c1
-    t26 = -t8*c234 + t25*s234
+    t26 = -t8*c234 + s234*t25
     t27 = -t2*s1
     t28 = -t1*s1
     t29 = -t23
@@ -1274,8 +1277,8 @@ def hessian(q):
     t41 = t1*t39 + t1*t40
     t42 = t0*t39 + t0*t40
     t43 = t24*c1 + t26*s1
-    t44 = t7*s5
-    t45 = t10*s5
+    t44 = s5*t7
+    t45 = s5*t10
     t46 = s234*t39 + s234*t40
     t47 = t4*c1 - t6*s1
     t48 = s5*s234**2
@@ -1447,13 +1450,13 @@ def hessian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 3, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 3, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 3, 4
-        -(t6*c234 + t48*s1),  # 4, 3, 5
+        -(t6*c234 + s1*t48),  # 4, 3, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 4, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 4, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 4, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 4, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 4, 4
-        -t4*c234 + t48*c1,  # 4, 4, 5
+        -t4*c234 + c1*t48,  # 4, 4, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 5, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 5, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 5, 2
@@ -1511,14 +1514,14 @@ def singularity_factors(q):
     c4 = trig[..., 6]
     s4 = trig[..., 7]
     s5 = trig[..., 9]
-    t0 = s2*s3
-    t1 = c2*c3
+    t0 = c2*c3
+    t1 = s2*s3
     t2 = 0.22270588235294117*s4
     t3 = 0.22270588235294117*c4
     f = _stack(xp, [
         s3,  # 0
         s5,  # 1
-        -c2 + 0.9229411764705883*t0 - 0.9229411764705883*t1 + t1*t2 + t3*c2*s3 + t3*c3*s2 - t0*t2,  # 2
+        -c2 - 0.9229411764705883*t0 + 0.9229411764705883*t1 - t1*t2 + t0*t2 + c2*s3*t3 + c3*s2*t3,  # 2
     ], (3,))
     return f
 
@@ -1534,11 +1537,11 @@ def manipulability(q):
     c4 = trig[..., 6]
     s4 = trig[..., 7]
     s5 = trig[..., 9]
-    t0 = s2*s3
-    t1 = c2*c3
+    t0 = c2*c3
+    t1 = s2*s3
     t2 = 0.22270588235294117*s4
     t3 = 0.22270588235294117*c4
-    t4 = 0.07085015625*s3*s5*(-c2 + 0.9229411764705883*t0 - 0.9229411764705883*t1 + t1*t2 + t3*c2*s3 + t3*c3*s2 - t0*t2)
+    t4 = 0.07085015625*s3*s5*(-c2 - 0.9229411764705883*t0 + 0.9229411764705883*t1 - t1*t2 + t0*t2 + c2*s3*t3 + c3*s2*t3)
     w = xp.broadcast_to(xp.abs(t4), batch)
     return w
 
@@ -1554,11 +1557,11 @@ def jacobian_det(q):
     c4 = trig[..., 6]
     s4 = trig[..., 7]
     s5 = trig[..., 9]
-    t0 = s2*s3
-    t1 = c2*c3
+    t0 = c2*c3
+    t1 = s2*s3
     t2 = 0.22270588235294117*s4
     t3 = 0.22270588235294117*c4
-    d = xp.broadcast_to(0.07085015625*s3*s5*(-c2 + 0.9229411764705883*t0 - 0.9229411764705883*t1 + t1*t2 + t3*c2*s3 + t3*c3*s2 - t0*t2), batch)
+    d = xp.broadcast_to(0.07085015625*s3*s5*(-c2 - 0.9229411764705883*t0 + 0.9229411764705883*t1 - t1*t2 + t0*t2 + c2*s3*t3 + c3*s2*t3), batch)
     return d
 
 
@@ -1594,8 +1597,8 @@ def velocity_ik(q, mu_dot, damping=0.0):
     c5 = trig[..., 8]
     s5 = trig[..., 9]
     t0 = c234*s5
-    t1 = c5*s1 - t0*c1
-    t2 = c1*c5 + t0*s1
+    t1 = c5*s1 - c1*t0
+    t2 = c1*c5 + s1*t0
     t3 = c1*s234
     t4 = 0.0823*t1 + 0.09465*t3
     t5 = t4 + 0.10915*s1
@@ -1608,21 +1611,21 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t12 = 0.09465*c234 + 0.0823*t11
     t13 = t12 + 0.39225*s23
     t14 = t13 + 0.425*s2
-    t15 = t1*t11 + t3*c234
-    t16 = t2*t11 - t6*c234
+    t15 = t1*t11 + c234*t3
+    t16 = t2*t11 - c234*t6
     t17 = 0.39225*c23
-    t18 = t5 - t17*c1
-    t19 = t8 - t17*s1
+    t18 = t5 - c1*t17
+    t19 = t8 - s1*t17
     t20 = t18*c1 + t19*s1
     t21 = 0.425*c2
-    t22 = t18 - t21*c1
-    t23 = t19 - t21*s1
+    t22 = t18 - c1*t21
+    t23 = t19 - s1*t21
     t24 = t22*c1 + t23*s1
     t25 = t12*s1
-    t26 = t7*c234 - t25*s234
+    t26 = t7*c234 - s234*t25
     t27 = t23 + t26*c234
     t28 = t12*c1
-    t29 = -t4*c234 + t28*s234
+    t29 = -t4*c234 + s234*t28
     t30 = t22 - t29*c234
     t31 = t23**2
     t32 = t12**2
@@ -1630,10 +1633,10 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t34 = t12*t33 + t13*t33 + t14*t33 - t26*t6
     t35 = t13**2
     t36 = t14**2
-    t37 = t26**2 + t35*t33 + t36*t33 + t32*t33
-    t38 = t37 + t31
-    t39 = c1*s1
-    t40 = t26*t29 - t22*t23 + t39*t32 + t35*t39 + t36*t39
+    t37 = t26**2 + t32*t33 + t35*t33 + t36*t33
+    t38 = t31 + t37
+    t39 = s1*c1
+    t40 = t26*t29 - t22*t23 + t32*t39 + t35*t39 + t36*t39
     t41 = t9*c1
     t42 = t20*c1
     t43 = t24*c1
@@ -1641,13 +1644,13 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t45 = t43 + t42 + t41 - t10*t6
     t46 = t13*c1
     t47 = t14*c1
-    t48 = t46*s1 + t47*s1 + t28*s1
-    t49 = t48 + t26*t3
-    t50 = t48 - t29*t6
+    t48 = s1*t28 + s1*t46 + s1*t47
+    t49 = t26*t3 + t48
+    t50 = -t29*t6 + t48
     t51 = t22**2
     t52 = s1**2
     t53 = t12*t52 + t13*t52 + t14*t52 + t29*t3
-    t54 = t29**2 + t35*t52 + t36*t52 + t32*t52
+    t54 = t29**2 + t32*t52 + t35*t52 + t36*t52
     t55 = t51 + t54
     t56 = t9*s1
     t57 = t20*s1
@@ -1662,7 +1665,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t66 = t1**2 + 3*t52 + t33*t65
     t67 = t66
     t68 = 3*c1
-    t69 = t1*t2 + t68*s1 - t39*t65
+    t69 = t1*t2 + s1*t68 - t65*t39
     t70 = t2**2 + 3*t33 + t52*t65
     t71 = t70
     t72 = c234**2
@@ -1688,7 +1691,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t92 = xp.where(xp.greater(t89, 0), 1/(t89*(t89 + xp.abs(t76))), 0)
     t93 = t92*(t40*t91 + t40*t78 + t44*t59 + t49*t53 + t34*t50 - t27*t30)
     t94 = t40 - t91*t93
-    t95 = t78 - t40*t93
+    t95 = -t40*t93 + t78
     t96 = t59 - t44*t93
     t97 = t53 - t49*t93
     t98 = -t50 + t34*t93
@@ -1697,7 +1700,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t101 = t49 - t91*t100
     t102 = t53 - t40*t100
     t103 = t60 - t44*t100
-    t104 = t80 - t49*t100
+    t104 = -t49*t100 + t80
     t105 = -t69 + t34*t100
     t106 = -t15 + t27*t100
     t107 = -t92*(t40*t50 + t27*t16 + t44*t45 + t49*t69 + t34*t91 + t34*t81)
@@ -1705,7 +1708,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t109 = t50 + t40*t107
     t110 = t45 + t44*t107
     t111 = t69 + t49*t107
-    t112 = t81 + t34*t107
+    t112 = t34*t107 + t81
     t113 = t16 + t27*t107
     t114 = t92*(t40*mu_dot1 + t44*mu_dot2 + t49*mu_dot3 + t91*mu_dot0 - t27*mu_dot5 - t34*mu_dot4)
     t115 = mu_dot0 - t91*t114
@@ -1724,7 +1727,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t128 = t104 - t97*t125
     t129 = t105 - t98*t125
     t130 = t106 - t99*t125
-    t131 = -t124*(t96*t110 + t97*t111 + t109*t123 - t98*t112 - t99*t113)
+    t131 = -t124*(-t98*t112 - t99*t113 + t96*t110 + t97*t111 + t109*t123)
     t132 = t109 + t123*t131
     t133 = t110 + t96*t131
     t134 = t111 + t97*t131
@@ -1740,17 +1743,17 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t144 = t92*(t40*t59 + t44*t91 + t44*t79 + t49*t60 + t34*t45 + t27*t143)
     t145 = t44 - t91*t144
     t146 = t59 - t40*t144
-    t147 = t79 - t44*t144
+    t147 = -t44*t144 + t79
     t148 = t60 - t49*t144
     t149 = -t45 + t34*t144
     t150 = t27*t144 - t143
-    t151 = -t92*(t27*t91 + t27*t82 + t49*t15 + t34*t16 - t40*t30 + t44*t143)
+    t151 = -t92*(-t40*t30 + t27*t91 + t27*t82 + t49*t15 + t34*t16 + t44*t143)
     t152 = t27 + t91*t151
     t153 = t30 - t40*t151
     t154 = t44*t151 + t143
     t155 = t15 + t49*t151
     t156 = t16 + t34*t151
-    t157 = t82 + t27*t151
+    t157 = t27*t151 + t82
     t158 = t124*(t96*t147 + t97*t148 + t98*t149 + t99*t150 + t146*t123)
     t159 = t146 - t123*t158
     t160 = t147 - t96*t158
@@ -1822,7 +1825,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t226 = xp.where(xp.not_equal(t222, 0), -t225/t222, 0)
     t227 = xp.where(xp.not_equal(t211, 0), -(t218 - t215*t226)/t211, 0)
     t228 = xp.where(xp.not_equal(t195, 0), -(t207 + t199*t227 + t203*t226)/t195, 0)
-    t229 = xp.where(xp.not_equal(t171, 0), -(t190 + t180*t227 + t185*t226 - t175*t228)/t171, 0)
+    t229 = xp.where(xp.not_equal(t171, 0), -(t190 - t175*t228 + t180*t227 + t185*t226)/t171, 0)
     t230 = xp.where(xp.not_equal(t122, 0), -(t138 - (t159*t229 + t126*t228 + t165*t226 - t132*t227))/t122, 0)
     t231 = xp.where(xp.not_equal(t90, 0), -(t115 - (t94*t230 + t145*t229 + t101*t228 - t108*t227 - t152*t226))/t90, 0)
     t232 = t226 + t230*t22 - t231*t23
@@ -1830,12 +1833,12 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t234 = t2*t227 - t1*t228 + t226*t11
     t235 = t14*s1
     t236 = t228*s1 - t227*c1
-    t237 = t236 + t229*t24 + t230*t235 + t231*t47
-    t238 = t236 + t229*t9 + t230*t25 + t231*t28
+    t237 = t229*t24 + t230*t235 + t231*t47 + t236
+    t238 = t229*t9 + t230*t25 + t231*t28 + t236
     t239 = t13*s1
-    t240 = t236 + t229*t20 + t230*t239 + t231*t46
+    t240 = t229*t20 + t230*t239 + t231*t46 + t236
     t241 = t51 + t31
-    t242 = xp.sqrt(t37 + t54 + t63 + t66 + t70 + t73 + t241)
+    t242 = xp.sqrt(t66 + t70 + t73 + t241 + t63 + t37 + t54)
     t243 = xp.sqrt(1 + t241)
     t244 = t243*xp.where(xp.less_equal(t23, 0), xp.asarray(1, dtype=dtype), -1)
     t245 = xp.where(xp.greater(t243, 0), 1/(t243*(t243 + xp.abs(t23))), 0)
@@ -1863,16 +1866,16 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t267 = t245*t11
     t268 = t266 + t267
     t269 = t33 + t52
-    t270 = xp.sqrt(t61 + t269 + t248**2 + t250**2)
+    t270 = xp.sqrt(t61 + t248**2 + t250**2 + t269)
     t271 = t270*xp.where(xp.greater_equal(t250, 0), xp.asarray(1, dtype=dtype), -1)
     t272 = t250 + t271
     t273 = xp.where(xp.greater(t270, 0), 1/(t270*(t270 + xp.abs(t250))), 0)
-    t274 = t273*(t269 + t248*t251 + t253*t272 + t24*t20)
+    t274 = t273*(t248*t251 + t253*t272 + t24*t20 + t269)
     t275 = t253 - t272*t274
     t276 = t20 - t274*t24
     t277 = s1 - t274*s1
     t278 = -t251 + t248*t274
-    t279 = t273*(t269 + t248*t254 + t256*t272 + t24*t9)
+    t279 = t273*(t248*t254 + t256*t272 + t24*t9 + t269)
     t280 = t256 - t272*t279
     t281 = t9 - t279*t24
     t282 = s1 - t279*s1
@@ -1968,7 +1971,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t372 = 1e-12*t242
     t373 = xp.greater(damping, 0)
     t374 = 1e-12*t88
-    t375 = (t373 & (xp.less_equal(t89, t374) | xp.less_equal(t121, t374) | xp.less_equal(t170, t374) | xp.less_equal(t194, t374) | xp.less_equal(t210, t374) | xp.less_equal(t221, t374))) | (xp.less_equal(damping, 0) & (xp.less_equal(t243, t372) | xp.less_equal(t270, t372) | xp.less_equal(t299, t372) | xp.less_equal(t318, t372) | xp.less_equal(t330, t372) | xp.less_equal(t359, t372)))
+    t375 = (xp.less_equal(damping, 0) & (xp.less_equal(t243, t372) | xp.less_equal(t270, t372) | xp.less_equal(t299, t372) | xp.less_equal(t318, t372) | xp.less_equal(t330, t372) | xp.less_equal(t359, t372))) | (t373 & (xp.less_equal(t89, t374) | xp.less_equal(t121, t374) | xp.less_equal(t170, t374) | xp.less_equal(t194, t374) | xp.less_equal(t210, t374) | xp.less_equal(t221, t374)))
     t376 = t370 & t371 & xp.logical_not(t375)
     q_dot = _stack(xp, [
         xp.broadcast_to(xp.where(t376, xp.where(t373, t232, t369), 0), batch),  # 0
@@ -2029,23 +2032,23 @@ def ik_numeric_step(target, q, damping=0.0):
     t0 = T00 + T01 + T02 + T03 + T10 + T11 + T12 + T13 + T20 + T21 + T22 + T23 + qs1 + qs2 + qs3 + qs4 + qs5 + qs6
     t1 = s1*s5
     t2 = c1*c5
-    t3 = t1 + t2*c234
-    t4 = t2 + t1*c234
+    t3 = t1 + c234*t2
+    t4 = t2 + c234*t1
     t5 = c5*s1
     t6 = c1*s5
-    t7 = t5 - t6*c234
-    t8 = -t6 + t5*c234
+    t7 = t5 - c234*t6
+    t8 = -t6 + c234*t5
     t9 = c1*s234
-    t10 = t3*c6 - t9*s6
-    t11 = t3*s6 + t9*c6
+    t10 = t3*c6 - s6*t9
+    t11 = t3*s6 + c6*t9
     t12 = 0.0823*t7 + 0.09465*t9
     t13 = t12 + 0.10915*s1
     t14 = T00*t10 + T02*t7 - T01*t11
     t15 = T10*t10 + T12*t7 - T11*t11
     t16 = T20*t10 + T22*t7 - T21*t11
     t17 = s1*s234
-    t18 = t8*c6 - t17*s6
-    t19 = t8*s6 + t17*c6
+    t18 = t8*c6 - s6*t17
+    t19 = t8*s6 + c6*t17
     t20 = -0.0823*t4 + 0.09465*t17
     t21 = t20 - 0.10915*c1
     t22 = t13*c1 + t21*s1
@@ -2055,17 +2058,17 @@ def ik_numeric_step(target, q, damping=0.0):
     t26 = T21*t19 + T22*t4 - T20*t18
     t27 = 0.5*(t24 + t15)
     t28 = c5*s234
-    t29 = c234*s6 + t28*c6
-    t30 = c234*c6 - t28*s6
-    t31 = s234*s5
+    t29 = c234*s6 + c6*t28
+    t30 = c234*c6 - s6*t28
+    t31 = s5*s234
     t32 = 0.09465*c234 + 0.0823*t31
     t33 = t32 + 0.39225*s23
     t34 = t33 + 0.425*s2
     t35 = 0.089459 - t34
     t36 = t20*c234 - t32*t17
     t37 = -t12*c234 + t32*t9
-    t38 = t7*t31 + t9*c234
-    t39 = t4*t31 - t17*c234
+    t38 = t7*t31 + c234*t9
+    t39 = t4*t31 - c234*t17
     t40 = T00*t29 + T01*t30 - T02*t31
     t41 = T10*t29 + T11*t30 - T12*t31
     t42 = T20*t29 + T21*t30 - T22*t31
@@ -2074,12 +2077,12 @@ def ik_numeric_step(target, q, damping=0.0):
     t45 = xp.sqrt(t43**2 + t44**2 + t27**2)
     t46 = T23 - t35
     t47 = 0.39225*c23
-    t48 = t13 - t47*c1
-    t49 = t21 - t47*s1
+    t48 = t13 - c1*t47
+    t49 = t21 - s1*t47
     t50 = t48*c1 + t49*s1
     t51 = 0.425*c2
-    t52 = t48 - t51*c1
-    t53 = t49 - t51*s1
+    t52 = t48 - c1*t51
+    t53 = t49 - s1*t51
     t54 = t52*c1 + t53*s1
     t55 = t53 + t36*c234
     t56 = t52 - t37*c234
@@ -2092,7 +2095,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t63 = t33**2
     t64 = t34**2
     t65 = t53**2 + t36**2 + t60*t61 + t63*t61 + t64*t61
-    t66 = c1*s1
+    t66 = s1*c1
     t67 = t36*t37 - t52*t53 + t60*t66 + t63*t66 + t64*t66
     t68 = t22*c1
     t69 = t50*c1
@@ -2100,8 +2103,8 @@ def ik_numeric_step(target, q, damping=0.0):
     t71 = t36*t23 + t32*t68 + t33*t69 + t34*t70
     t72 = t70 + t69 + t68 - t23*t17
     t73 = t32*t66 + t33*t66 + t34*t66
-    t74 = t73 + t36*t9
-    t75 = t73 - t37*t17
+    t74 = t36*t9 + t73
+    t75 = -t37*t17 + t73
     t76 = s1**2
     t77 = t52**2 + t37**2 + t60*t76 + t63*t76 + t64*t76
     t78 = t32*t76 + t33*t76 + t34*t76 + t37*t9
@@ -2112,7 +2115,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t83 = t81 + t80 + t79 + t23*t9
     t84 = s234**2
     t85 = t7**2 + 3*t76 + t61*t84
-    t86 = t7*t4 + 3*t66 - t66*t84
+    t86 = t7*t4 + 3*t66 - t84*t66
     t87 = t4**2 + 3*t61 + t76*t84
     t88 = 1 + c234**2 + t84*s5**2
     t89 = -t25
@@ -2147,7 +2150,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t118 = t77 + damping
     t119 = t110*(t67*t109 + t67*t118 + t71*t82 + t74*t78 + t62*t75 - t55*t56)
     t120 = t67 - t109*t119
-    t121 = t118 - t67*t119
+    t121 = -t67*t119 + t118
     t122 = t82 - t71*t119
     t123 = t78 - t74*t119
     t124 = -t75 + t62*t119
@@ -2167,7 +2170,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t138 = t110*(t67*t82 + t71*t109 + t71*t136 + t74*t83 + t62*t72 + t55*t137)
     t139 = t71 - t109*t138
     t140 = t82 - t67*t138
-    t141 = t136 - t71*t138
+    t141 = -t71*t138 + t136
     t142 = t83 - t74*t138
     t143 = -t72 + t62*t138
     t144 = t55*t138 - t137
@@ -2191,7 +2194,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t162 = t74 - t109*t161
     t163 = t78 - t67*t161
     t164 = t83 - t71*t161
-    t165 = t160 - t74*t161
+    t165 = -t74*t161 + t160
     t166 = -t86 + t62*t161
     t167 = -t38 + t55*t161
     t168 = t129*(t122*t164 + t123*t165 + t124*t166 + t125*t167 + t163*t128)
@@ -2219,9 +2222,9 @@ def ik_numeric_step(target, q, damping=0.0):
     t190 = t75 + t67*t188
     t191 = t72 + t71*t188
     t192 = t86 + t74*t188
-    t193 = t187 + t62*t188
+    t193 = t62*t188 + t187
     t194 = t39 + t55*t188
-    t195 = -t129*(t122*t191 + t123*t192 + t190*t128 - t124*t193 - t125*t194)
+    t195 = -t129*(-t124*t193 - t125*t194 + t122*t191 + t123*t192 + t190*t128)
     t196 = t190 + t128*t195
     t197 = t191 + t122*t195
     t198 = t192 + t123*t195
@@ -2244,13 +2247,13 @@ def ik_numeric_step(target, q, damping=0.0):
     t215 = t185 - t212*t214
     t216 = t186 - t209*t214
     t217 = t88 + damping
-    t218 = -t110*(t55*t109 + t55*t217 + t74*t38 + t62*t39 - t67*t56 + t71*t137)
+    t218 = -t110*(-t67*t56 + t55*t109 + t55*t217 + t74*t38 + t62*t39 + t71*t137)
     t219 = t55 + t109*t218
     t220 = t56 - t67*t218
     t221 = t71*t218 + t137
     t222 = t38 + t74*t218
     t223 = t39 + t62*t218
-    t224 = t217 + t55*t218
+    t224 = t55*t218 + t217
     t225 = t129*(t124*t223 + t125*t224 + t220*t128 - t122*t221 - t123*t222)
     t226 = t220 - t128*t225
     t227 = t221 + t122*t225
@@ -2278,18 +2281,18 @@ def ik_numeric_step(target, q, damping=0.0):
     t249 = xp.where(xp.not_equal(t245, 0), -t248/t245, 0)
     t250 = xp.where(xp.not_equal(t211, 0), -(t215 - t241*t249)/t211, 0)
     t251 = xp.where(xp.not_equal(t180, 0), -(t184 + t207*t250 + t237*t249)/t180, 0)
-    t252 = xp.where(xp.not_equal(t152, 0), -(t156 + t202*t250 + t232*t249 - t175*t251)/t152, 0)
+    t252 = xp.where(xp.not_equal(t152, 0), -(t156 - t175*t251 + t202*t250 + t232*t249)/t152, 0)
     t253 = xp.where(xp.not_equal(t127, 0), -(t131 - (t146*t252 + t169*t251 + t226*t249 - t196*t250))/t127, 0)
     t254 = xp.where(xp.not_equal(t108, 0), -(t112 - (t120*t253 + t139*t252 + t162*t251 - t189*t250 - t219*t249))/t108, 0)
     t255 = t249 + q1 + t52*t253 - t53*t254
     t256 = q5 + t36*t254 + t37*t253 + t23*t252 - t249*c234 + t250*t17 + t251*t9
     t257 = q6 + t7*t251 - t4*t250 - t249*t31
-    t258 = t253*s1
-    t259 = t254*c1
+    t258 = s1*t253
+    t259 = c1*t254
     t260 = t251*s1 - t250*c1
-    t261 = t260 + q2 + t34*t258 + t34*t259 + t54*t252
-    t262 = t260 + q3 + t33*t258 + t33*t259 + t50*t252
-    t263 = t260 + q4 + t32*t258 + t32*t259 + t22*t252
+    t261 = q2 + t54*t252 + t34*t258 + t34*t259 + t260
+    t262 = q3 + t50*t252 + t33*t258 + t33*t259 + t260
+    t263 = q4 + t22*t252 + t32*t258 + t32*t259 + t260
     q_start = _stack(xp, [
         xp.broadcast_to(q1, batch),  # 0
         xp.broadcast_to(q2, batch),  # 1
@@ -2327,22 +2330,22 @@ def ik_branches(T):
     T22 = T[..., 2, 2]
     T23 = T[..., 2, 3]
     t0 = T00 + T01 + T02 + T03 + T10 + T11 + T12 + T13 + T20 + T21 + T22 + T23
-    t1 = 0.81725*T00 + 0.005191*T01
-    t2 = T03 + t1 - 0.19145*T02
-    t3 = t1 - 0.10915*T02
+    t1 = 0.005191*T01 + 0.81725*T00
+    t2 = T03 - 0.19145*T02 + t1
+    t3 = -0.10915*T02 + t1
     t4 = t2 - t3
-    t5 = 0.81725*T10 + 0.005191*T11
-    t6 = T13 + t5 - 0.19145*T12
-    t7 = t5 - 0.10915*T12
+    t5 = 0.005191*T11 + 0.81725*T10
+    t6 = T13 - 0.19145*T12 + t5
+    t7 = -0.10915*T12 + t5
     t8 = t6 - t7
     t9 = xp.atan2(t4, -t8)
-    t10 = 0.81725*T20 + 0.005191*T21
-    t11 = T23 + t10 - 0.19145*T22
-    t12 = t10 - 0.10915*T22
+    t10 = 0.005191*T21 + 0.81725*T20
+    t11 = T23 - 0.19145*T22 + t10
+    t12 = -0.10915*T22 + t10
     t13 = t11 - t12
     t14 = t4**2 + t8**2
     t15 = t14
-    t16 = t14 + t13**2
+    t16 = t13**2 + t14
     t17 = 1e-24*t16
     t18 = xp.less_equal(t15, t17)
     t19 = xp.where(t18, 1, 1/xp.sqrt(t15))
@@ -2358,9 +2361,9 @@ def ik_branches(T):
     t29 = t28 - 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t28))
     t30 = t27 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t27))
     t31 = t30 - 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t30))
-    t32 = t4*t19
+    t32 = t19*t4
     t33 = t22*t32
-    t34 = t8*t19
+    t34 = t19*t8
     t35 = t24*t34
     t36 = xp.where(t18, 1, -(t33 + t35))
     t37 = t33 - t35
@@ -2419,7 +2422,7 @@ def ik_branches(T):
     t90 = t87 + t36*t86
     t91 = t88**2 + t90**2
     t92 = t91
-    t93 = t91 + t89**2
+    t93 = t89**2 + t91
     t94 = xp.less_equal(t92, 1e-24*t93)
     t95 = xp.where(t94, 1, 1/xp.sqrt(t92))
     t96 = xp.where(t94, 1, -t88*t95)
@@ -2447,31 +2450,31 @@ def ik_branches(T):
     t118 = 1 - 35.98290608994648*t117
     t119 = xp.greater(t118, 1e-12)
     t120 = xp.where(t119, xp.sqrt(t118), 0)
-    t121 = 5.99857533835714*t112
-    t122 = xp.where(t119, t121, xp.where(xp.greater(t121, 0), xp.asarray(1, dtype=dtype), -1))
-    t123 = xp.atan2(t120, t122)
-    t124 = 3.141592653589793 + t123
-    t125 = 3.141592653589793 - t123
-    t126 = t124 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t124))
-    t127 = t126 - 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t126))
-    t128 = t125 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t125))
-    t129 = t128 - 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t128))
-    t130 = -1.0*t122
-    t131 = -1.0*t120
-    t132 = 0.425 + 0.39225*t130
-    t133 = 0.089459 - 0.39225*t131
-    t134 = -0.089459 + t133
-    t135 = t110*t134 - t106*t132
-    t136 = t106*t134 + t110*t132
-    t137 = t135**2 + t136**2
-    t138 = t132**2 + t134**2
-    t139 = -0.425 + 0.39225*t122
-    t140 = 0.089459 - 0.39225*t120
-    t141 = -0.089459 + t140
-    t142 = t106*t139 + t110*t141
-    t143 = t106*t141 - t110*t139
-    t144 = t142**2 + t143**2
-    t145 = t139**2 + t141**2
+    t121 = 0.089459 - 0.39225*t120
+    t122 = -0.089459 + t121
+    t123 = 5.99857533835714*t112
+    t124 = xp.where(t119, t123, xp.where(xp.greater(t123, 0), xp.asarray(1, dtype=dtype), -1))
+    t125 = xp.atan2(t120, t124)
+    t126 = 3.141592653589793 - t125
+    t127 = -0.425 + 0.39225*t124
+    t128 = t106*t127 + t110*t122
+    t129 = t106*t122 - t110*t127
+    t130 = t128**2 + t129**2
+    t131 = t127**2 + t122**2
+    t132 = t126 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t126))
+    t133 = t132 - 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t132))
+    t134 = 3.141592653589793 + t125
+    t135 = -1.0*t124
+    t136 = -1.0*t120
+    t137 = 0.425 + 0.39225*t135
+    t138 = 0.089459 - 0.39225*t136
+    t139 = -0.089459 + t138
+    t140 = t110*t139 - t106*t137
+    t141 = t106*t139 + t110*t137
+    t142 = t140**2 + t141**2
+    t143 = t137**2 + t139**2
+    t144 = t134 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t134))
+    t145 = t144 - 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t144))
     t146 = t116**2
     t147 = 1 - 35.98290608994648*t146
     t148 = xp.greater(t147, 1e-12)
@@ -2538,7 +2541,7 @@ def ik_branches(T):
     t209 = t206 + t37*t205
     t210 = t207**2 + t209**2
     t211 = t210
-    t212 = t210 + t208**2
+    t212 = t208**2 + t210
     t213 = xp.less_equal(t211, 1e-24*t212)
     t214 = xp.where(t213, 1, 1/xp.sqrt(t211))
     t215 = xp.where(t213, 1, -t207*t214)
@@ -2617,13 +2620,13 @@ def ik_branches(T):
     t288 = t286**2 + t287**2
     t289 = t285**2 + t273**2
     t290 = 1e-24*t111
-    t291 = xp.where(xp.less_equal(t137, t138*t290), 0, xp.atan2(-t136, t135))
+    t291 = xp.where(xp.less_equal(t142, t143*t290), 0, xp.atan2(-t141, t140))
     t292 = t291
     t293 = t292 - 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t292))
     t294 = -xp.where(t94, 0, xp.atan2(-t90, -t88))
     t295 = 3.141592653589793 + t294
-    t296 = t124 + t291
-    t297 = t294 + t296 + 6.283185307179586*xp.ceil(-0.15915494309189535*(t295 + t296))
+    t296 = t134 + t291
+    t297 = t294 + 6.283185307179586*xp.ceil(-0.15915494309189535*(t295 + t296)) + t296
     t298 = -t297
     t299 = t297 + 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t298))
     t300 = xp.where(t75, 0, xp.atan2(-t80, t69))
@@ -2631,11 +2634,11 @@ def ik_branches(T):
     t302 = t301 - 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t301))
     t303 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t300) + t300
     t304 = t303 - 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t303))
-    t305 = xp.where(xp.less_equal(t144, t145*t290), 0, xp.atan2(-t143, t142))
+    t305 = xp.where(xp.less_equal(t130, t131*t290), 0, xp.atan2(-t129, t128))
     t306 = t305
     t307 = t306 - 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t306))
-    t308 = t125 + t305
-    t309 = t294 + t308 + 6.283185307179586*xp.ceil(-0.15915494309189535*(t295 + t308))
+    t308 = t126 + t305
+    t309 = t294 + 6.283185307179586*xp.ceil(-0.15915494309189535*(t295 + t308)) + t308
     t310 = -t309
     t311 = t309 + 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t310))
     t312 = 1e-24*t115
@@ -2645,8 +2648,8 @@ def ik_branches(T):
     t316 = -3.141592653589793 + t158
     t317 = t158 - 6.283185307179586*xp.ceil(0.15915494309189535*t316)
     t318 = t317 - 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t317))
-    t319 = t294 + t313
-    t320 = t316 + t319 + 6.283185307179586*xp.ceil(-0.15915494309189535*(t158 + t319))
+    t319 = t313 + t294
+    t320 = 6.283185307179586*xp.ceil(-0.15915494309189535*(t158 + t319)) + t316 + t319
     t321 = -t320
     t322 = t320 + 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t321))
     t323 = -t61
@@ -2658,7 +2661,7 @@ def ik_branches(T):
     t329 = t160 - 6.283185307179586*xp.ceil(0.15915494309189535*t328)
     t330 = t329 - 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t329))
     t331 = t294 + t325
-    t332 = t328 + t331 + 6.283185307179586*xp.ceil(-0.15915494309189535*(t160 + t331))
+    t332 = 6.283185307179586*xp.ceil(-0.15915494309189535*(t160 + t331)) + t328 + t331
     t333 = -t332
     t334 = t332 + 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t333))
     t335 = 1e-24*t230
@@ -2668,7 +2671,7 @@ def ik_branches(T):
     t339 = -xp.where(t213, 0, xp.atan2(-t209, -t207))
     t340 = 3.141592653589793 + t339
     t341 = t248 + t336
-    t342 = t339 + t341 + 6.283185307179586*xp.ceil(-0.15915494309189535*(t340 + t341))
+    t342 = t339 + 6.283185307179586*xp.ceil(-0.15915494309189535*(t340 + t341)) + t341
     t343 = -t342
     t344 = t342 + 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t343))
     t345 = xp.where(t194, 0, xp.atan2(-t199, t188))
@@ -2680,7 +2683,7 @@ def ik_branches(T):
     t351 = t350
     t352 = t351 - 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t351))
     t353 = t250 + t350
-    t354 = t339 + t353 + 6.283185307179586*xp.ceil(-0.15915494309189535*(t340 + t353))
+    t354 = t339 + 6.283185307179586*xp.ceil(-0.15915494309189535*(t340 + t353)) + t353
     t355 = -t354
     t356 = t354 + 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t355))
     t357 = 1e-24*t234
@@ -2690,8 +2693,8 @@ def ik_branches(T):
     t361 = -3.141592653589793 + t277
     t362 = t277 - 6.283185307179586*xp.ceil(0.15915494309189535*t361)
     t363 = t362 - 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t362))
-    t364 = t339 + t358
-    t365 = t361 + t364 + 6.283185307179586*xp.ceil(-0.15915494309189535*(t277 + t364))
+    t364 = t358 + t339
+    t365 = 6.283185307179586*xp.ceil(-0.15915494309189535*(t277 + t364)) + t361 + t364
     t366 = -t365
     t367 = t365 + 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t366))
     t368 = -t185
@@ -2703,7 +2706,7 @@ def ik_branches(T):
     t374 = t279 - 6.283185307179586*xp.ceil(0.15915494309189535*t373)
     t375 = t374 - 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t374))
     t376 = t339 + t370
-    t377 = t376 + t373 + 6.283185307179586*xp.ceil(-0.15915494309189535*(t279 + t376))
+    t377 = 6.283185307179586*xp.ceil(-0.15915494309189535*(t279 + t376)) + t373 + t376
     t378 = -t377
     t379 = t377 + 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t378))
     t380 = xp.less_equal(t29, 6.283185307179586)
@@ -2711,8 +2714,8 @@ def ik_branches(T):
     t382 = xp.where(t380 & xp.logical_not(t381), t29, t28)
     t383 = xp.less_equal(t293, 6.283185307179586)
     t384 = xp.greater_equal(t292, -6.283185307179586) & xp.less_equal(t292, 6.283185307179586)
-    t385 = xp.less_equal(t127, 6.283185307179586)
-    t386 = xp.greater_equal(t126, -6.283185307179586) & xp.less_equal(t126, 6.283185307179586)
+    t385 = xp.less_equal(t145, 6.283185307179586)
+    t386 = xp.greater_equal(t144, -6.283185307179586) & xp.less_equal(t144, 6.283185307179586)
     t387 = -t299
     t388 = xp.less_equal(t387, 6.283185307179586)
     t389 = xp.greater_equal(t298, -6.283185307179586) & xp.less_equal(t298, 6.283185307179586)
@@ -2724,8 +2727,8 @@ def ik_branches(T):
     t395 = xp.where(t393 & xp.logical_not(t394), t302, t301)
     t396 = xp.less_equal(t307, 6.283185307179586)
     t397 = xp.greater_equal(t306, -6.283185307179586) & xp.less_equal(t306, 6.283185307179586)
-    t398 = xp.less_equal(t129, 6.283185307179586)
-    t399 = xp.greater_equal(t128, -6.283185307179586) & xp.less_equal(t128, 6.283185307179586)
+    t398 = xp.less_equal(t133, 6.283185307179586)
+    t399 = xp.greater_equal(t132, -6.283185307179586) & xp.less_equal(t132, 6.283185307179586)
     t400 = -t311
     t401 = xp.less_equal(t400, 6.283185307179586)
     t402 = xp.greater_equal(t310, -6.283185307179586) & xp.less_equal(t310, 6.283185307179586)
@@ -2797,7 +2800,7 @@ def ik_branches(T):
     t468 = xp.isfinite(t0)
     t469 = xp.greater_equal(t56, -1e-12)
     t470 = xp.greater(t15, t17)
-    t471 = (t18 & xp.less_equal(0.0119137225, 1e-12*t16)) | (t470 & xp.greater_equal(t20, -1e-12))
+    t471 = (xp.greater_equal(t20, -1e-12) & t470) | (xp.less_equal(0.0119137225, 1e-12*t16) & t18)
     t472 = xp.greater_equal(t175, -1e-12)
     t473 = t380 | t381
     t474 = t390 | t391
@@ -2812,13 +2815,13 @@ def ik_branches(T):
     q = _stack(xp, [
         t382,  # 0, 0
         xp.where(t383 & xp.logical_not(t384), t293, t292),  # 0, 1
-        xp.where(t385 & xp.logical_not(t386), t127, t126),  # 0, 2
+        xp.where(t385 & xp.logical_not(t386), t145, t144),  # 0, 2
         xp.where(t388 & xp.logical_not(t389), t387, t298),  # 0, 3
         t392,  # 0, 4
         t395,  # 0, 5
         t382,  # 1, 0
         xp.where(t396 & xp.logical_not(t397), t307, t306),  # 1, 1
-        xp.where(t398 & xp.logical_not(t399), t129, t128),  # 1, 2
+        xp.where(t398 & xp.logical_not(t399), t133, t132),  # 1, 2
         xp.where(t401 & xp.logical_not(t402), t400, t310),  # 1, 3
         t392,  # 1, 4
         t395,  # 1, 5
@@ -2861,23 +2864,23 @@ def ik_branches(T):
     ], (8, 6))
     valid = _stack(xp, [
         t468 & t469 & t471 & xp.greater_equal(t118, -1e-12),  # 0
-        t468 & t469 & t471 & t119,  # 1
-        t57 & t468 & t471 & xp.greater_equal(t147, -1e-12),  # 2
-        t57 & t468 & t471 & t148,  # 3
-        t468 & t470 & t472 & t21 & xp.greater_equal(t237, -1e-12),  # 4
-        t468 & t470 & t472 & t238 & t21,  # 5
-        t468 & t470 & t176 & t21 & xp.greater_equal(t266, -1e-12),  # 6
-        t468 & t470 & t176 & t21 & t267,  # 7
+        t468 & t119 & t469 & t471,  # 1
+        t468 & t57 & t471 & xp.greater_equal(t147, -1e-12),  # 2
+        t468 & t57 & t148 & t471,  # 3
+        t468 & t21 & t470 & t472 & xp.greater_equal(t237, -1e-12),  # 4
+        t468 & t21 & t238 & t470 & t472,  # 5
+        t468 & t21 & t176 & t470 & xp.greater_equal(t266, -1e-12),  # 6
+        t468 & t21 & t176 & t267 & t470,  # 7
     ], (8,))
     in_limits = _stack(xp, [
-        t473 & t474 & t475 & (t383 | t384) & (t385 | t386) & (t388 | t389),  # 0
+        t473 & (t383 | t384) & (t385 | t386) & t474 & t475 & (t388 | t389),  # 0
         t473 & t474 & t475 & (t396 | t397) & (t398 | t399) & (t401 | t402),  # 1
-        t473 & t476 & t477 & (t403 | t404) & (t405 | t406) & (t408 | t409),  # 2
-        t473 & t476 & t477 & (t417 | t418) & (t419 | t420) & (t422 | t423),  # 3
-        t478 & t479 & t480 & (t427 | t428) & (t429 | t430) & (t432 | t433),  # 4
+        t473 & (t403 | t404) & (t405 | t406) & t476 & (t408 | t409) & t477,  # 2
+        t473 & t476 & (t417 | t418) & (t419 | t420) & t477 & (t422 | t423),  # 3
+        t478 & (t427 | t428) & (t429 | t430) & t479 & t480 & (t432 | t433),  # 4
         t478 & t479 & t480 & (t440 | t441) & (t442 | t443) & (t445 | t446),  # 5
-        t478 & t481 & t482 & (t447 | t448) & (t449 | t450) & (t452 | t453),  # 6
-        t478 & t481 & t482 & (t461 | t462) & (t463 | t464) & (t466 | t467),  # 7
+        t478 & (t447 | t448) & (t449 | t450) & t481 & (t452 | t453) & t482,  # 6
+        t478 & t481 & (t461 | t462) & (t463 | t464) & t482 & (t466 | t467),  # 7
     ], (8,))
     return q, valid, in_limits
 

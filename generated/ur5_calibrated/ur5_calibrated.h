@@ -39,15 +39,15 @@ typedef double ur5_calibrated_real;
 void ur5_calibrated_fk(const ur5_calibrated_real q[UR5_CALIBRATED_DOF], ur5_calibrated_real T[16]);
 
 /* Geometric Jacobian in the world frame (6 x DOF, rows vx vy vz wx wy wz).
- * Result: J: 6 x 6 row-major, element (r, c) at J[r * 6 + c]. 290 operations. */
+ * Result: J: 6 x 6 row-major, element (r, c) at J[r * 6 + c]. 289 operations. */
 void ur5_calibrated_jacobian(const ur5_calibrated_real q[UR5_CALIBRATED_DOF], ur5_calibrated_real J[6 * UR5_CALIBRATED_DOF]);
 
 /* Fk and jacobian in one pass, sharing their terms.
- * Result: T: 4 x 4 row-major, element (r, c) at T[r * 4 + c]; J: 6 x 6 row-major, element (r, c) at J[r * 6 + c]. 325 operations. */
+ * Result: T: 4 x 4 row-major, element (r, c) at T[r * 4 + c]; J: 6 x 6 row-major, element (r, c) at J[r * 6 + c]. 324 operations. */
 void ur5_calibrated_fk_jacobian(const ur5_calibrated_real q[UR5_CALIBRATED_DOF], ur5_calibrated_real T[16], ur5_calibrated_real J[6 * UR5_CALIBRATED_DOF]);
 
 /* Geometric Jacobian in the tool frame (6 x DOF, rows vx vy vz wx wy wz).
- * Result: J: 6 x 6 row-major, element (r, c) at J[r * 6 + c]. 481 operations. */
+ * Result: J: 6 x 6 row-major, element (r, c) at J[r * 6 + c]. 480 operations. */
 void ur5_calibrated_jacobian_tool(const ur5_calibrated_real q[UR5_CALIBRATED_DOF], ur5_calibrated_real J[6 * UR5_CALIBRATED_DOF]);
 
 /* Task vector mu = (x, y, z, roll, pitch, yaw).
@@ -55,59 +55,59 @@ void ur5_calibrated_jacobian_tool(const ur5_calibrated_real q[UR5_CALIBRATED_DOF
 void ur5_calibrated_task(const ur5_calibrated_real q[UR5_CALIBRATED_DOF], ur5_calibrated_real mu[UR5_CALIBRATED_TASK_DIM]);
 
 /* Analytic Jacobian d mu / d q (6 x DOF).
- * Result: J: 6 x 6 row-major, element (r, c) at J[r * 6 + c]. 355 operations. */
+ * Result: J: 6 x 6 row-major, element (r, c) at J[r * 6 + c]. 353 operations. */
 void ur5_calibrated_task_jacobian(const ur5_calibrated_real q[UR5_CALIBRATED_DOF], ur5_calibrated_real J[UR5_CALIBRATED_TASK_DIM * UR5_CALIBRATED_DOF]);
 
 /* Fk, jacobian and bias_acceleration in one pass, sharing their terms.
- * Result: T: 4 x 4 row-major, element (r, c) at T[r * 4 + c]; J: 6 x 6 row-major, element (r, c) at J[r * 6 + c]; a[i], i < 6. 568 operations. */
+ * Result: T: 4 x 4 row-major, element (r, c) at T[r * 4 + c]; J: 6 x 6 row-major, element (r, c) at J[r * 6 + c]; a[i], i < 6. 567 operations. */
 void ur5_calibrated_fk_jacobian_dot(const ur5_calibrated_real q[UR5_CALIBRATED_DOF], const ur5_calibrated_real q_dot[UR5_CALIBRATED_DOF], ur5_calibrated_real T[16], ur5_calibrated_real J[6 * UR5_CALIBRATED_DOF], ur5_calibrated_real a[6]);
 
 /* Time derivative dJ/dt of the world geometric Jacobian along q_dot (6 x DOF).
- * Result: Jd: 6 x 6 row-major, element (r, c) at Jd[r * 6 + c]. 477 operations. */
+ * Result: Jd: 6 x 6 row-major, element (r, c) at Jd[r * 6 + c]. 474 operations. */
 void ur5_calibrated_jacobian_dot(const ur5_calibrated_real q[UR5_CALIBRATED_DOF], const ur5_calibrated_real q_dot[UR5_CALIBRATED_DOF], ur5_calibrated_real Jd[6 * UR5_CALIBRATED_DOF]);
 
 /* J' q_dot: the tool's classical linear and angular acceleration at zero joint acceleration, world frame (6).
- * Result: a[i], i < 6. 530 operations. */
+ * Result: a[i], i < 6. 529 operations. */
 void ur5_calibrated_bias_acceleration(const ur5_calibrated_real q[UR5_CALIBRATED_DOF], const ur5_calibrated_real q_dot[UR5_CALIBRATED_DOF], ur5_calibrated_real a[6]);
 
 /* Time derivative of the analytic Jacobian along q_dot (6 x DOF): mu'' = J_a q'' + J_a' q'.
- * Result: Jd: 6 x 6 row-major, element (r, c) at Jd[r * 6 + c]. 776 operations. */
+ * Result: Jd: 6 x 6 row-major, element (r, c) at Jd[r * 6 + c]. 775 operations. */
 void ur5_calibrated_task_jacobian_dot(const ur5_calibrated_real q[UR5_CALIBRATED_DOF], const ur5_calibrated_real q_dot[UR5_CALIBRATED_DOF], ur5_calibrated_real Jd[UR5_CALIBRATED_TASK_DIM * UR5_CALIBRATED_DOF]);
 
 /* Partial derivatives dJ/dq_k of the world geometric Jacobian (DOF x 6 x DOF, indexed [k, r, c]).
- * Result: H: 6 x 6 x 6 row-major, element (k, r, c) at H[k * 36 + r * 6 + c]. 533 operations. */
+ * Result: H: 6 x 6 x 6 row-major, element (k, r, c) at H[k * 36 + r * 6 + c]. 524 operations. */
 void ur5_calibrated_hessian(const ur5_calibrated_real q[UR5_CALIBRATED_DOF], ur5_calibrated_real H[UR5_CALIBRATED_DOF * 6 * UR5_CALIBRATED_DOF]);
 
 /* Factors of det(Js): the robot is singular where one is 0.
- * Result: f[i], i < 1. 548 operations. */
+ * Result: f[i], i < 1. 547 operations. */
 void ur5_calibrated_singularity_factors(const ur5_calibrated_real q[UR5_CALIBRATED_DOF], ur5_calibrated_real f[UR5_CALIBRATED_NUM_SINGULARITY_FACTORS]);
 
 /* Manipulability |det(Js)|.
- * Result: returned as a scalar. 549 operations. */
+ * Result: returned as a scalar. 548 operations. */
 ur5_calibrated_real ur5_calibrated_manipulability(const ur5_calibrated_real q[UR5_CALIBRATED_DOF]);
 
 /* Det(Js).
- * Result: returned as a scalar. 548 operations. */
+ * Result: returned as a scalar. 547 operations. */
 ur5_calibrated_real ur5_calibrated_jacobian_det(const ur5_calibrated_real q[UR5_CALIBRATED_DOF]);
 
 /* Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status.
- * Result: q_dot[i], i < 6; returned as a scalar. 1623 operations. */
+ * Result: q_dot[i], i < 6; returned as a scalar. 1621 operations. */
 int ur5_calibrated_velocity_ik(const ur5_calibrated_real q[UR5_CALIBRATED_DOF], const ur5_calibrated_real mu_dot[UR5_CALIBRATED_TASK_DIM], ur5_calibrated_real damping, ur5_calibrated_real q_dot[UR5_CALIBRATED_DOF]);
 
 /* One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite).
- * Result: q_start[i], i < 6; q_next[i], i < 6; returned as a scalar. 1260 operations. */
+ * Result: q_start[i], i < 6; q_next[i], i < 6; returned as a scalar. 1259 operations. */
 ur5_calibrated_real ur5_calibrated_ik_numeric_step(const ur5_calibrated_real target[16], const ur5_calibrated_real q[UR5_CALIBRATED_DOF], ur5_calibrated_real damping, ur5_calibrated_real q_start[UR5_CALIBRATED_DOF], ur5_calibrated_real q_next[UR5_CALIBRATED_DOF]);
 
 /* The general 6R solver's equations at T: (P0 + s Ps + c Pc) v_bc = Q v_gh, P = [P0; Ps; Pc] (42 x 9).
- * Result: P: 42 x 9 row-major, element (r, c) at P[r * 9 + c]; Q: 14 x 8 row-major, element (r, c) at Q[r * 8 + c]. 1362 operations. */
+ * Result: P: 42 x 9 row-major, element (r, c) at P[r * 9 + c]; Q: 14 x 8 row-major, element (r, c) at Q[r * 8 + c]. 1358 operations. */
 void ur5_calibrated_ik_general_equations(const ur5_calibrated_real T[16], ur5_calibrated_real P[378], ur5_calibrated_real Q[112]);
 
 /* The configuration of one root's loop angles (a - shift, b, c, g, h; the loop's free joint from the loop).
- * Result: q[i], i < 6. 146 operations. */
+ * Result: q[i], i < 6. 145 operations. */
 void ur5_calibrated_ik_general_start(const ur5_calibrated_real T[16], const ur5_calibrated_real angles[5], ur5_calibrated_real q[UR5_CALIBRATED_DOF]);
 
 /* The pose error e at q (the position error and the rotation vector of R_target R^T, world frame) and the geometric Jacobian J of the six joints ik solves: the Newton step of the solver's polish is q + J^-1 e.
- * Result: e[i], i < 6; J: 6 x 6 row-major, element (r, c) at J[r * 6 + c]. 440 operations. */
+ * Result: e[i], i < 6; J: 6 x 6 row-major, element (r, c) at J[r * 6 + c]. 439 operations. */
 void ur5_calibrated_ik_general_residual(const ur5_calibrated_real target[16], const ur5_calibrated_real q[UR5_CALIBRATED_DOF], ur5_calibrated_real e[6], ur5_calibrated_real J[6 * 6]);
 
 /* Ik's form of q (revolute angles wrapped, or into the limits) and whether it is inside the joint limits.
@@ -115,7 +115,7 @@ void ur5_calibrated_ik_general_residual(const ur5_calibrated_real target[16], co
 int ur5_calibrated_ik_general_limits(const ur5_calibrated_real q_solution[UR5_CALIBRATED_DOF], ur5_calibrated_real q[UR5_CALIBRATED_DOF]);
 
 /* The fast path's starting points: every branch of the nearest special class's closed form (the nominal arm's), whether its target allows it, and the least margin of its subproblems.
- * Result: q: 8 x 6 row-major, element (r, c) at q[r * 6 + c]; valid[i], i < 8; returned as a scalar. 1970 operations. */
+ * Result: q: 8 x 6 row-major, element (r, c) at q[r * 6 + c]; valid[i], i < 8; returned as a scalar. 1939 operations. */
 ur5_calibrated_real ur5_calibrated_ik_general_nominal(const ur5_calibrated_real T[16], ur5_calibrated_real q[48], int valid[8]);
 
 /* The closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status.

@@ -2,23 +2,24 @@
 
 The algorithms (`kinematics`, `subproblems`, `ik`, `differential`) name every intermediate
 value with `Lowering.name`, so that no expression they build grows with the chain; a
-function's outputs are then lowered to a `Body`: the named values and trig symbols they read,
-common-subexpression elimination, constants folded, temporaries numbered in a fixed order
-(the output does not depend on hashing). Every printer turns a Body into its language.
+function's outputs are then lowered to a `Body` on the value graph (`graph.py`): the named
+values and trig symbols they read, common-subexpression elimination, temporaries numbered in
+a fixed order (the output does not depend on hashing). Every printer turns a Body into its
+language.
 """
 
 import heapq
+from fractions import Fraction
 from dataclasses import dataclass
 from functools import cached_property
 
 import sympy
-from sympy.core.operations import LatticeOp
-from sympy.core.parameters import distribute
-from sympy.logic.boolalg import Boolean, BooleanFunction
+from sympy.logic.boolalg import Boolean
 from sympy.simplify.cse_main import Unevaluated, match_common_args
 
+from jacgen.emission.graph import (ADD, AND, FINITE, MUL, NOT, NUMBER, OR, POW, RELATION, SELECT, TRUTH, CALL,
+                                   TOLERANCE_VALUES, Graph, Node, evaluate, negative_coefficient)
 from jacgen.inputs import names
-from jacgen.model.nodes import TOLERANCES
 
 
 @dataclass(frozen=True)
@@ -26,8 +27,8 @@ class Body:
     """Straight-line code: definitions in order, then the outputs (selects, no branches)."""
 
     read: frozenset  # the input symbols the body reads
-    definitions: tuple[tuple[sympy.Symbol, sympy.Expr], ...]
-    outputs: tuple[sympy.Expr, ...]  # row-major
+    definitions: tuple[tuple[sympy.Symbol, Node], ...]
+    outputs: tuple[Node, ...]  # row-major
     names: dict[sympy.Symbol, str]  # the temporaries' printed names (t0, t1, ...), in definition order
 
     def name(self, symbol: sympy.Symbol) -> str:
@@ -39,129 +40,109 @@ class Body:
         return operation_count([e for _, e in self.definitions] + list(self.outputs))
 
 
-def fold_constants(expr: sympy.Expr, _folded: dict | None = None) -> sympy.Expr:
-    """Replace constant subexpressions (2159/5000, sqrt(2)/2, pi/4) by one Float each.
-
-    Integers stay integers and exponents stay exact, so x**(1/2) still prints as sqrt(x).
-    Shared subtrees are folded once (the DH chain is a DAG far smaller than its tree).
-    """
-    folded = {} if _folded is None else _folded
-    if expr not in folded:
-        if expr.is_number:
-            folded[expr] = expr if expr.is_Integer else sympy.Float(expr.evalf(30), 30)
-        elif expr.is_Atom:
-            folded[expr] = expr
-        elif expr.is_Pow:
-            base = fold_constants(expr.base, folded)
-            folded[expr] = expr if base is expr.base else sympy.Pow(base, expr.exp)
-        else:  # rebuilt only when an argument changed
-            args = tuple(fold_constants(arg, folded) for arg in expr.args)
-            changed = any(new is not old and new != old for new, old in zip(args, expr.args))
-            folded[expr] = expr.func(*args) if changed else expr
-    return folded[expr]
-
-
-def operation_count(exprs) -> int:
-    """sympy's `count_ops` of `exprs`, the figure every report and bench shows, by its rules
-    (quirks included: a sum under a product's -1 adds no operations), counted once per node
-    and without building the negations and fractions that count_ops builds for each.
+def operation_count(nodes) -> int:
+    """sympy's `count_ops` of `nodes`, the figure every report and bench shows, by its rules
+    (quirks included: a sum under a product's -1 adds no operations), counted once per node.
 
     Its rules are one table in one function, in count_ops' order, so that a test can hold
     the two equal rule by rule (tests/test_lowering.py)."""
-    counts: dict[sympy.Basic, int] = {}
+    counts: dict[Node, int] = {}
 
-    def count(expr) -> int:  # count_ops' walk of an expression
-        if expr not in counts:
-            if expr.is_Rational:
-                counts[expr] = 0 if expr is sympy.S.One else (expr.p < 0) + (expr.q != 1)
-            elif expr.is_Mul:
-                negative = _negative_coefficient(expr)
-                counts[expr] = negative + _unsigned(_negated(expr) if negative else expr)
-            elif expr.is_Add:
-                terms = expr.args
-                negatives = [_negative_coefficient(term) for term in terms]
-                counts[expr] = (len(terms) - 1 + all(negatives)
-                                + sum(count(_negated(t) if n else t) for t, n in zip(terms, negatives)))
-            elif expr.is_Pow and expr.exp is sympy.S.NegativeOne:
-                counts[expr] = 1 + count(expr.base)
+    def count(node: Node) -> int:  # count_ops' walk of an expression
+        if node not in counts:
+            if node.kind == NUMBER:
+                counts[node] = _number_count(node.value)
+            elif node.kind == MUL:
+                counts[node] = 1 + unsigned(_negated(node)) if negative_coefficient(node) else unsigned(node.args)
+            elif node.kind == ADD:
+                terms = node.args
+                negatives = [negative_coefficient(term) for term in terms]
+                counts[node] = (len(terms) - 1 + all(negatives)
+                                + sum(negated_count(t) if n else count(t) for t, n in zip(terms, negatives)))
+            elif node.kind == POW and node.args[1].value == -1:
+                counts[node] = 1 + count(node.args[0])
             else:
-                counts[expr] = _fallthrough(expr)
-        return counts[expr]
+                counts[node] = fallthrough(node)
+        return counts[node]
 
-    def _fallthrough(expr) -> int:
-        own = len(expr.args) - 1 if expr.is_Mul or isinstance(expr, LatticeOp) else \
-            int(bool(expr.args) and (expr.is_Pow or expr.is_Function))
-        return own + (0 if expr.is_Symbol else sum(count(arg) for arg in expr.args))
+    def negated_count(term: Node) -> int:  # count of -term, for a term with a negative number
+        if term.kind == NUMBER:
+            return _number_count(-term.value)
+        factors = _negated(term)
+        return count(factors[0]) if len(factors) == 1 else unsigned(factors)
 
-    def _unsigned(expr) -> int:  # a product without its sign, as numerator / denominator
+    def fallthrough(node: Node) -> int:
+        own = len(node.args) - 1 if node.kind in (MUL, AND, OR) else \
+            int(bool(node.args) and node.kind in (POW, CALL, SELECT, NOT, FINITE))
+        return own + sum(count(arg) for arg in node.args)
+
+    def unsigned(factors) -> int:  # a product without its sign, as numerator / denominator
         numerator, denominator = [], []
-        for factor in sympy.Mul.make_args(expr):
-            if factor.is_Pow and factor.exp.is_negative:
-                denominator.append(factor.base if factor.exp is sympy.S.NegativeOne else (factor.base, -factor.exp))
-            elif factor.is_Rational and not factor.is_integer:
-                numerator += [sympy.Integer(factor.p)] * (factor.p != 1)
-                denominator.append(sympy.Integer(factor.q))
+        for factor in factors:
+            if factor.kind == POW and factor.args[1].value < 0:
+                base, exponent = factor.args[0], factor.args[1].value
+                denominator.append(base if exponent == -1 else (base, -exponent))
             else:
                 numerator.append(factor)
-        numerator = [f for f in numerator if f is not sympy.S.One]
-        if all(f.is_Integer for f in numerator):  # 1/d, 2/d
+        numerator = [f for f in numerator if not (f.kind == NUMBER and _is_integer(f.value) and f.value == 1)]
+        if all(f.kind == NUMBER and _is_integer(f.value) for f in numerator):  # 1/d, 2/d
             return 1 + group(denominator)
         if denominator:
-            integer = all(isinstance(f, sympy.Integer) for f in denominator)
+            integer = all(not isinstance(f, tuple) and f.kind == NUMBER and _is_integer(f.value) for f in denominator)
             return (0 if integer else group(denominator)) + 1 + group(numerator)
-        return _fallthrough(expr)
+        return fallthrough(factors[0]) if len(factors) == 1 else len(factors) - 1 + sum(map(count, factors))
 
     def group(factors) -> int:  # the product of `factors`
         total = len(factors) - 1 if len(factors) > 1 else 0
         for factor in factors:
             if isinstance(factor, tuple):  # base ** positive exponent
                 base, exponent = factor
-                total += 1 + count(base) + count(exponent)
+                total += 1 + count(base) + _number_count(exponent)
             else:
                 total += count(factor)
         return total
 
-    def top(expr) -> int:  # count_ops of a truth value: one per function, whatever its arguments
-        if isinstance(expr, sympy.Expr) and not expr.is_Relational:
-            return count(expr)
-        if isinstance(expr, (sympy.core.relational.Relational, BooleanFunction)):
-            return 1 + sum(top(arg) for arg in expr.args)
-        if expr.args:
-            raise TypeError(f"no operation count for {type(expr).__name__}")
+    def top(node: Node) -> int:  # count_ops of a truth value: one per function, whatever its arguments
+        if node.kind in (RELATION, AND, OR, NOT, FINITE):
+            return 1 + sum(top(arg) for arg in node.args)
+        return 0 if node.kind == TRUTH else count(node)
+
+    return sum(top(node) for node in nodes)
+
+
+def _is_integer(value) -> bool:
+    return isinstance(value, (int, sympy.Integer))
+
+
+def _number_count(value) -> int:
+    """count_ops of a number: a folded constant (sympy's Float) none, a rational its sign and its division."""
+    if isinstance(value, Fraction) or value == 1:
         return 0
-
-    return sum(top(expr) for expr in exprs)
-
-
-def _negative_coefficient(expr: sympy.Expr) -> bool:
-    coefficient = expr.args[0] if expr.is_Mul else expr
-    return bool(coefficient.is_Number and coefficient.is_extended_negative)
+    return int(bool(value < 0)) + (getattr(value, "q", 1) != 1)
 
 
-def _negated(expr: sympy.Expr) -> sympy.Expr:
-    """-expr of a number or of a product with a negative coefficient, without sympy's flattening."""
-    if not expr.is_Mul:
-        return -expr
-    coefficient, *rest = expr.args
-    if coefficient is sympy.S.NegativeOne:
-        return rest[0] if len(rest) == 1 else sympy.Mul._from_args(rest)
-    return sympy.Mul._from_args((-coefficient, *rest))
+def _negated(product: Node) -> list[Node]:
+    """The factors of -product, for a product with a negative number (-1 dropped)."""
+    coefficient, *rest = product.args
+    return rest if coefficient.value == -1 else [Node(NUMBER, (), -coefficient.value), *rest]
 
 
 def is_boolean(value: sympy.Basic) -> bool:
-    """A truth value (a comparison, And, Or, ...): an `int` in C, a bool array in numpy."""
+    """A truth value of sympy's (a comparison, And, Or, ...)."""
     return isinstance(value, Boolean) and not isinstance(value, sympy.Expr)
 
 
 class Lowering:
-    """The named values of one robot (trig symbols defined first, by `define`) and the Bodies
-    lowered from them, each once per outputs and bindings."""
+    """The named values of one robot (trig symbols defined first, by `define`), the value graph
+    they are lowered on, and the Bodies lowered from them, each once per outputs and bindings."""
 
     def __init__(self):
         self.definitions: list[tuple[sympy.Symbol, sympy.Expr]] = []  # in an order that defines before use
+        self.graph = Graph()
         self._names: dict[sympy.Expr, sympy.Symbol] = {}  # named values (see `name`)
-        self._folded: dict[sympy.Expr, sympy.Expr] = {}  # fold_constants' results, shared by every lowering
-        self._negations: dict[sympy.Expr, sympy.Expr | None] = {}  # eliminate_common's, likewise
+        self._named: set[sympy.Symbol] = set()
+        self._nodes: dict[sympy.Symbol, Node] = {}  # each definition's value on the graph, taken over once
+        self._negations: dict[Node, Node | None] = {}  # eliminate_common's, shared by every lowering
         self._lowered: dict[tuple, Body] = {}
 
     def define(self, symbol: sympy.Symbol, value: sympy.Expr):
@@ -171,8 +152,8 @@ class Lowering:
     def name(self, value: sympy.Expr) -> sympy.Expr:
         """`value` as a symbol of its own (an atom, a number or a product of atoms stays as it
         is; -x is named as x). The chain names its rotations, steps and levers, so that every
-        expression CSE sees has a bounded size: written out, sympy flattens the nested sums
-        and each lever would repeat the rest of the chain."""
+        expression the algorithms build has a bounded size: written out, sympy flattens the
+        nested sums and each lever would repeat the rest of the chain."""
         if value.is_Atom or (value.is_Mul and all(arg.is_Atom for arg in value.args)):
             return value
         if value in self._names:
@@ -185,6 +166,7 @@ class Lowering:
         symbol = sympy.Symbol(f"{names.INTERNAL_PREFIX}n{len(self.definitions)}", real=True)
         self.definitions.append((symbol, value))
         self._names[value] = symbol
+        self._named.add(symbol)
         return symbol
 
     def lower(self, outputs: list[sympy.Basic], bindings: dict | None = None) -> Body:
@@ -192,37 +174,51 @@ class Lowering:
         compare its two forms, then again as a function)."""
         key = (tuple(outputs), tuple((bindings or {}).items()))
         if key not in self._lowered:
-            self._lowered[key] = self._lower(outputs, bindings)
+            self._lowered[key] = self._lower(outputs, bindings or {})
         return self._lowered[key]
 
-    def _lower(self, outputs: list[sympy.Basic], bindings: dict | None = None) -> Body:
+    def _lower(self, outputs: list[sympy.Basic], bindings: dict) -> Body:
         """The outputs as straight-line code: the trig symbols and named values they need,
         then temporaries (t0, t1, ...) after common-subexpression elimination, in an order
         that defines before use."""
-        bindings = bindings or {}
-        values = dict(self.definitions) | bindings
+        graph = self.graph
+        values = dict(self.definitions)
+        bound = {symbol: graph.convert(value) for symbol, value in bindings.items()}
+        outputs = [graph.convert(e) for e in outputs]
         needed, frontier = set(), set().union(*(e.free_symbols for e in outputs))
         while frontier:
             symbol = frontier.pop()
-            if symbol in values and symbol not in needed:
+            if symbol in needed:
+                continue
+            if symbol in bound:
                 needed.add(symbol)
-                frontier |= values[symbol].free_symbols
-        named_symbols = set(self._names.values())
-        fold = lambda value: fold_constants(value, self._folded)  # noqa: E731
-        trig = [(s, fold(v)) for s, v in self.definitions
-                if s in needed and s not in named_symbols and s not in bindings]
-        named = [(s, v) for s, v in self.definitions if s in needed and s in named_symbols]
-        with distribute(False):
-            replacements, reduced = eliminate_common([fold(v) for _, v in named] + [fold(e) for e in outputs],
-                                                     sympy.numbered_symbols(f"{names.INTERNAL_PREFIX}r", real=True), self._negations)
-        bound = [(s, fold(v)) for s, v in bindings.items() if s in needed]
-        definitions = _in_dependency_order(bound + trig + list(zip((s for s, _ in named), reduced)) + replacements)
-        definitions, reduced = _without_constants(definitions, reduced[len(named):])
-        # The temporaries are named when printed: renaming them here would rebuild every expression.
+                frontier |= bound[symbol].free_symbols
+            elif symbol in values:
+                needed.add(symbol)
+                frontier |= self._node(symbol, values[symbol]).free_symbols
+        # Constants (a subproblem's scale of a constant vector) go into their readers before CSE,
+        # so that their numbers fold with the readers' own; CSE's temporaries that are constants, after.
+        ordered = [(s, bound[s]) for s in bound if s in needed] + [(s, self._nodes[s]) for s, _ in self.definitions
+                                                                   if s in needed and s not in bound]
+        definitions, outputs = _without_constants(graph, _in_dependency_order(ordered), outputs, distribute=False)
+        named = [(s, v) for s, v in definitions if s in self._named]
+        replacements, reduced = eliminate_common(graph, [v for _, v in named] + outputs,
+                                                 sympy.numbered_symbols(f"{names.INTERNAL_PREFIX}r", real=True),
+                                                 self._negations)
+        definitions = _in_dependency_order([(s, v) for s, v in definitions if s not in self._named]
+                                           + list(zip((s for s, _ in named), reduced)) + replacements)
+        definitions, reduced = _without_constants(graph, definitions, reduced[len(named):], distribute=True)
         temporaries = [symbol for symbol, _ in definitions if symbol.name.startswith(names.INTERNAL_PREFIX)]
         read = set().union(*(e.free_symbols for _, e in definitions), *(e.free_symbols for e in reduced))
         return Body(frozenset(read - {symbol for symbol, _ in definitions}), tuple(definitions), tuple(reduced),
                     {symbol: f"t{k}" for k, symbol in enumerate(temporaries)})
+
+    def _node(self, symbol: sympy.Symbol, value: sympy.Expr) -> Node:
+        """A definition's value on the graph, taken over on first use."""
+        node = self._nodes.get(symbol)
+        if node is None:
+            node = self._nodes[symbol] = self.graph.convert(value)
+        return node
 
 
 def _mostly_negative(value: sympy.Expr) -> bool:
@@ -234,23 +230,24 @@ def _mostly_negative(value: sympy.Expr) -> bool:
     return 2 * negative > len(terms)
 
 
-def _without_constants(definitions: list[tuple[sympy.Symbol, sympy.Expr]], outputs: list[sympy.Basic]):
+def _without_constants(graph: Graph, definitions: list[tuple[sympy.Symbol, Node]], outputs: list[Node],
+                       distribute: bool):
     """The definitions that are constants (numbers, truth values, the IK's tolerances) put
-    into their readers, which sympy then folds: a select on a condition that is always false
+    into their readers, which are evaluated again: a select on a condition that is always false
     is its other side, and the definitions no longer read are dropped. A comparison of
     tolerances and numbers is decided when it holds, or fails, in every real type."""
     constants, kept = {}, []
     for symbol, value in definitions:
-        if not constants.keys().isdisjoint(value.free_symbols):
-            value = value.xreplace(constants)
-        if is_boolean(value) and value.free_symbols and value.free_symbols <= TOLERANCES["double"].keys():
-            truths = {value.xreplace(numbers) for numbers in TOLERANCES.values()}
-            value = truths.pop() if len(truths) == 1 else value
-        if value.free_symbols <= TOLERANCES["double"].keys():
-            constants[symbol] = value
+        if not value.free_symbols.isdisjoint(constants):
+            value = graph.substitute(value, constants, distribute)
+        if value.boolean and value.free_symbols and value.constant:
+            truths = {evaluate(value, numbers) for numbers in TOLERANCE_VALUES.values()}
+            value = graph.truth(truths.pop()) if len(truths) == 1 else value
+        if value.constant:
+            constants[symbol] = graph.settled(value)
         else:
             kept.append((symbol, value))
-    outputs = [e.xreplace(constants) if not constants.keys().isdisjoint(e.free_symbols) else e for e in outputs]
+    outputs = [graph.substitute(e, constants, distribute) if not e.free_symbols.isdisjoint(constants) else e for e in outputs]
     # A folded select may leave the terms of its other side unread: those go too.
     read = set().union(*(e.free_symbols for e in outputs))
     for symbol, value in reversed(kept):
@@ -259,7 +256,7 @@ def _without_constants(definitions: list[tuple[sympy.Symbol, sympy.Expr]], outpu
     return [(symbol, value) for symbol, value in kept if symbol in read], outputs
 
 
-def _in_dependency_order(definitions: list[tuple[sympy.Symbol, sympy.Expr]]) -> list[tuple[sympy.Symbol, sympy.Expr]]:
+def _in_dependency_order(definitions: list[tuple[sympy.Symbol, Node]]) -> list[tuple[sympy.Symbol, Node]]:
     """Each definition after those it reads; among the ready ones, the earliest listed first
     (so the order is fixed, whatever the hashing)."""
     index = {symbol: k for k, (symbol, _) in enumerate(definitions)}
@@ -283,57 +280,62 @@ def _in_dependency_order(definitions: list[tuple[sympy.Symbol, sympy.Expr]]) -> 
     return ordered
 
 
-def eliminate_common(exprs: list[sympy.Basic], symbols, negations: dict) -> tuple[list, list]:
-    """sympy's `cse(exprs, symbols, order="none")` (its opt_cse, then tree_cse) at a fraction
-    of its cost, with the same temporaries: a sum or product with more negative terms is
-    shared with its negation, x**-n is 1/x**n, sums and products that share two or more terms
-    share their sum or product (sympy's own `match_common_args`), and every node reached twice
-    becomes a temporary. What costs less: the sign of a sum is decided from its terms'
-    coefficients (sympy compares sort keys of whole expressions), products are not rebuilt to
-    split commutative factors (all are), arguments keep their stored order, what is rebuilt
-    is not evaluated again where nothing in it can combine (`_rebuilt`), and `negations`
-    keeps each node's negation for the robot's other functions.
+def eliminate_common(graph: Graph, exprs: list[Node], symbols, negations: dict) -> tuple[list, list[Node]]:
+    """sympy's `cse(exprs, symbols, order="none")` (its opt_cse, then tree_cse) on the graph,
+    with the same temporaries: a sum or product with more negative terms is shared with its
+    negation, x**-n is 1/x**n, sums and products that share two or more terms share their
+    sum or product (sympy's own `match_common_args`, which reads nothing but `args`), and
+    every node reached twice becomes a temporary. The sign of a sum is decided from its
+    terms' numbers (sympy compares sort keys of whole expressions), what is rebuilt keeps its
+    order and is evaluated only where something in it can combine (`_rebuilt`), and
+    `negations` keeps each node's negation for the robot's other functions.
+
+    Returns [(temporary symbol, value)] and the expressions over them.
 
     One function, longer than most, because it follows sympy's cse_main step by step (opt_cse's
     passes, then tree_cse's walk): read side by side with it, a difference is a choice."""
     rewritten: dict = {}  # node -> the form tree_cse walks (sympy's opt_subs)
     adds, muls = {}, {}  # candidates for common arguments, in the order first met
     seen = set()
+    power = lambda base, exponent: graph.node(POW, (base, exponent))  # noqa: E731
+    minus_one = graph.number(sympy.S.NegativeOne)
 
-    def find_rewrites(expr):
-        if not isinstance(expr, sympy.Basic) or expr.is_Atom or expr in seen:
+    def find_rewrites(node):
+        if not node.args or node in seen:
             return
-        seen.add(expr)
-        for arg in expr.args:
+        seen.add(node)
+        for arg in node.args:
             find_rewrites(arg)
-        if expr.is_Add or expr.is_Mul:
-            if expr not in negations:
-                negations[expr] = _negation(expr)
-            negated = negations[expr]
-            if negated is not None and not negated.is_Atom:
-                rewritten[expr] = Unevaluated(sympy.Mul, (sympy.S.NegativeOne, negated))
+        if node.kind in (ADD, MUL):
+            if node not in negations:
+                negations[node] = _negation(graph, node)
+            negated = negations[node]
+            if negated is not None and negated.args:
+                rewritten[node] = Unevaluated(graph.mul, (graph.minus_one, negated))
                 seen.add(negated)
-                expr = negated
-            if (expr.is_Add or expr.is_Mul) and len(expr.args) > 1:
-                (adds if expr.is_Add else muls)[expr] = None
-        elif expr.is_Pow and _negative_coefficient(expr.exp):
-            rewritten[expr] = Unevaluated(sympy.Pow, (sympy.Pow(expr.base, -expr.exp), -1))
+                node = negated
+            if node.kind in (ADD, MUL) and len(node.args) > 1:
+                (adds if node.kind == ADD else muls)[node] = None
+        elif node.kind == POW and node.args[1].value < 0:
+            base, exponent = node.args[0], -node.args[1].value
+            rewritten[node] = Unevaluated(power, (base if exponent == 1 else power(base, graph.number(exponent)),
+                                                  minus_one))
 
     for expr in exprs:
         find_rewrites(expr)
-    match_common_args(sympy.Add, list(adds), rewritten)
-    match_common_args(sympy.Mul, list(muls), rewritten)
+    match_common_args(graph.add, list(adds), rewritten)
+    match_common_args(graph.mul, list(muls), rewritten)
 
     repeated, reached = set(), set()
 
-    def find_repeated(expr):
-        if not isinstance(expr, Unevaluated) and (not isinstance(expr, sympy.Basic) or expr.is_Atom):
+    def find_repeated(node):
+        if not isinstance(node, Unevaluated) and not node.args:
             return
-        if expr in reached:
-            repeated.add(expr)
+        if node in reached:
+            repeated.add(node)
             return
-        reached.add(expr)
-        for arg in rewritten.get(expr, expr).args:
+        reached.add(node)
+        for arg in rewritten.get(node, node).args:
             find_repeated(arg)
 
     for expr in exprs:
@@ -341,49 +343,47 @@ def eliminate_common(exprs: list[sympy.Basic], symbols, negations: dict) -> tupl
 
     replacements, named = [], {}
 
-    def rebuild(expr):
-        if not isinstance(expr, Unevaluated) and (not isinstance(expr, sympy.Basic) or not expr.args):
-            return expr
-        if expr in named:
-            return named[expr]
-        form = rewritten.get(expr, expr)
+    def rebuild(node):
+        if not isinstance(node, Unevaluated) and not node.args:
+            return node
+        if node in named:
+            return named[node]
+        form = rewritten.get(node, node)
         args = [rebuild(arg) for arg in form.args]
         if isinstance(form, Unevaluated):
             new = form.func(*args)
         elif all(new is old for new, old in zip(args, form.args)):
             new = form
         else:
-            new = _rebuilt(form, args)
-        if expr in repeated:
+            new = _rebuilt(graph, form, args)
+        if node in repeated:
             symbol = next(symbols)
-            named[expr] = symbol
+            named[node] = graph.symbol(symbol)
             replacements.append((symbol, new))
-            return symbol
+            return named[node]
         return new
 
     return replacements, [rebuild(expr) for expr in exprs]
 
 
-def _negation(expr: sympy.Expr) -> sympy.Expr | None:
-    """-expr when sympy's cse would share expr with it (`could_extract_minus_sign`): a
-    product with a negative coefficient or a sum with more such terms than others, else None.
+def _negation(graph: Graph, node: Node) -> Node | None:
+    """-node when sympy's cse would share node with it (`could_extract_minus_sign`): a
+    product with a negative number or a sum with more such terms than others, else None.
     (On a tie sympy compares the sort keys of the sum and its negation; without distribution
     the negation is -1 times the sum, whose key is the larger: never.)"""
-    if expr.is_Mul:
-        return _negated(expr) if _negative_coefficient(expr) else None
-    if 2 * sum(map(_negative_coefficient, expr.args)) <= len(expr.args):
+    if node.kind == MUL:
+        return graph.negate(node) if negative_coefficient(node) else None
+    if 2 * sum(map(negative_coefficient, node.args)) <= len(node.args):
         return None
-    return sympy.Add(*(-term for term in expr.args))
+    return graph.node(ADD, tuple(graph.negate(term) for term in node.args))
 
 
-def _rebuilt(form: sympy.Basic, args: list) -> sympy.Basic:
-    """form with new arguments, without evaluating what cannot change: a function of
-    temporaries (a function of numbers was folded before), or a sum or product whose
+def _rebuilt(graph: Graph, form: Node, args: list[Node]) -> Node:
+    """form with new arguments, evaluated only where something can combine: a call or select
+    of temporaries as it is (one of numbers was folded before), a sum or product whose
     arguments cannot combine (no repeats, no nested sum or product of its kind, no number
-    after the first). Anything else by sympy's constructor."""
-    if isinstance(form, sympy.Function):
-        return form.func(*args, evaluate=False)
-    if (form.is_Add or form.is_Mul) and len(set(args)) == len(args) and not any(
-            arg.func is form.func or (k and arg.is_Number) for k, arg in enumerate(args)):
-        return form.func._from_args(args)
-    return form.func(*args)
+    after the first) as it is; anything else as its kind evaluates (`Graph.rebuilt`)."""
+    if form.kind in (CALL, SELECT) or (form.kind in (ADD, MUL) and len(set(args)) == len(args) and not any(
+            arg.kind == form.kind or (k and arg.kind == NUMBER) for k, arg in enumerate(args))):
+        return graph.node(form.kind, tuple(args), form.value)
+    return graph.rebuilt(form, tuple(args))

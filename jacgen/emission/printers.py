@@ -1,20 +1,23 @@
 """Expression printers: one walk over a lowered Body's nodes, with the rules of each language.
 
-A Body holds few kinds of node: sums, products, powers, the math functions, selects, comparisons, and/or/not, `isfinite`. `Printer` walks them once each (the
-text of a node is kept for every later reader of it) and prints the arguments of sums and
-products in the order sympy stores them, which it sorts by structure, never by hash: the
-text is deterministic and nothing is re-sorted or rebuilt while printing. Each language
-is a subclass that says how a function, a literal, a power, a select and the logic read.
+A Body is nodes of the value graph (`graph.py`): sums, products, powers, the math functions,
+selects, comparisons, and/or/not, `isfinite`. `Printer` walks them once each (the text of a
+node is kept for every later reader of it) and prints the arguments of sums and products in
+the order the graph keeps them, never by hash: the text is deterministic and nothing is
+re-sorted or rebuilt while printing. Each language is a subclass that says how a function,
+a literal, a power, a select and the logic read.
 
-Every number that is not a small integer (EXACT_INTEGER), and every subexpression of the IK's tolerances alone
-(EPS, TINY, RANK, replaced by the numbers of the build's real type), prints as one literal:
-the shortest decimal that reads back as the same value of that type.
+Every number that is not a small integer (EXACT_INTEGER), and every subexpression of the IK's
+tolerances alone (EPS, TINY, RANK, replaced by the numbers of the build's real type), prints
+as one literal: the shortest decimal that reads back as the same value of that type.
 """
 
 import sympy
 
-from jacgen.emission.lowering import Body, is_boolean
-from jacgen.model.nodes import TOLERANCE_SYMBOLS, TOLERANCES, Select
+from jacgen.emission import graph
+from jacgen.emission.graph import TOLERANCE_VALUES, Node, evaluate
+from jacgen.emission.lowering import Body
+from jacgen.model.nodes import TOLERANCE_SYMBOLS
 
 # Integers up to this size print as integer literals (exact in float and double, and an `int`
 # in C); larger ones as floating literals, which cannot overflow an integer type.
@@ -32,13 +35,12 @@ class Printer:
     one = "1"  # the numerator of a reciprocal
 
     def __init__(self, real: str = "double"):
-        self.tolerances = TOLERANCES[real]
-        self._printed: dict[sympy.Basic, tuple[str, int]] = {}
-        self._constants: dict[sympy.Basic, bool] = {}
+        self.tolerances = TOLERANCE_VALUES[real]
+        self._printed: dict[Node, tuple[str, int]] = {}
         self._names: dict[sympy.Symbol, str] = {}  # the temporaries of the Body being printed
 
-    def doprint(self, expr: sympy.Basic) -> str:
-        return self._print(expr)[0]
+    def doprint(self, node: Node) -> str:
+        return self._print(node)[0]
 
     def body(self, body: Body) -> tuple[list[str], list[str]]:
         """The texts of a Body's definitions and outputs, its temporaries by their names."""
@@ -48,55 +50,42 @@ class Printer:
         finally:
             self._names, self._printed = {}, {}
 
-    def _print(self, expr: sympy.Basic) -> tuple[str, int]:
+    def _print(self, node: Node) -> tuple[str, int]:
         """(text, binding strength), once per node."""
-        printed = self._printed.get(expr)
+        printed = self._printed.get(node)
         if printed is None:
-            printed = self._printed[expr] = self._node(expr)
+            printed = self._printed[node] = self._node(node)
         return printed
 
-    def _operand(self, expr: sympy.Basic, strength: int) -> str:
-        """The text of `expr`, in parentheses when it binds more loosely than `strength`."""
-        text, binding = self._print(expr)
+    def _operand(self, node: Node, strength: int) -> str:
+        """The text of `node`, in parentheses when it binds more loosely than `strength`."""
+        text, binding = self._print(node)
         return f"({text})" if binding < strength else text
 
-    def _node(self, expr: sympy.Basic) -> tuple[str, int]:
-        if expr.is_Symbol and expr not in TOLERANCE_SYMBOLS:
-            return self._names.get(expr, expr.name), ATOM
-        if expr.is_Integer and abs(expr) <= EXACT_INTEGER:
-            return str(expr), SUM if expr < 0 else ATOM
-        constant = self._constant(expr)
-        if is_boolean(expr):
-            if constant:
-                expr = expr.xreplace(self.tolerances)
-                return self.truth(bool(expr)), ATOM
-            return self._boolean(expr)
-        if constant:
-            text = self.literal(float(expr.xreplace(self.tolerances)))
+    def _node(self, node: Node) -> tuple[str, int]:
+        kind = node.kind
+        if kind == graph.SYMBOL and node.value not in TOLERANCE_SYMBOLS:
+            return self._names.get(node.value, node.value.name), ATOM
+        if kind == graph.NUMBER and isinstance(node.value, int) and abs(node.value) <= EXACT_INTEGER:
+            return str(node.value), SUM if node.value < 0 else ATOM
+        if node.boolean:
+            if node.constant:
+                return self.truth(bool(evaluate(node, self.tolerances))), ATOM
+            return self._boolean(node)
+        if node.constant:
+            text = self.literal(float(evaluate(node, self.tolerances)))
             return text, SUM if text.startswith("-") else ATOM
-        if expr.is_Add:
-            return self._sum(expr.args), SUM
-        if expr.is_Mul:
-            return self._product(expr.args)
-        if expr.is_Pow:
-            return self._power(expr.base, expr.exp)
-        if isinstance(expr, Select):
-            return self._select(expr.pairs, expr.args[-1]), ATOM
-        name = type(expr).__name__
-        if name not in self.functions:
-            raise ValueError(f"unsupported in {type(self).__name__}: {name} ({expr})")
-        return f"{self.functions[name]}({', '.join(self._print(arg)[0] for arg in expr.args)})", ATOM
-
-    def _constant(self, expr: sympy.Basic) -> bool:
-        """Whether `expr` reads nothing but numbers and tolerances, once per node."""
-        constant = self._constants.get(expr)
-        if constant is None:
-            if expr.is_Symbol:
-                constant = expr in TOLERANCE_SYMBOLS
-            else:
-                constant = expr.is_Atom or all(self._constant(arg) for arg in expr.args)
-            self._constants[expr] = constant
-        return constant
+        if kind == graph.ADD:
+            return self._sum(node.args), SUM
+        if kind == graph.MUL:
+            return self._product(node.args)
+        if kind == graph.POW:
+            return self._power(*node.args)
+        if kind == graph.SELECT:
+            return self._select(list(zip(node.args[:-1:2], node.args[1:-1:2])), node.args[-1]), ATOM
+        if kind != graph.CALL or node.value not in self.functions:
+            raise ValueError(f"unsupported in {type(self).__name__}: {node.value}")
+        return f"{self.functions[node.value]}({', '.join(self._print(arg)[0] for arg in node.args)})", ATOM
 
     def _sum(self, terms) -> str:
         text = []
@@ -112,11 +101,11 @@ class Printer:
         """`-a*b/(c*d)`: a leading negative coefficient as the sign, powers with a negative
         exponent as the denominator."""
         sign, numerator, denominator = "", [], []
-        for factor in sorted(factors, key=lambda factor: not self._constant(factor)):  # numbers first
-            if factor.is_Pow and factor.exp.is_Rational and factor.exp < 0 and not self._constant(factor):
-                denominator.append(self._power(factor.base, -factor.exp))
+        for factor in sorted(factors, key=lambda factor: not factor.constant):  # numbers first
+            if factor.kind == graph.POW and factor.args[1].value < 0 and not factor.constant:
+                denominator.append(self._power(factor.args[0], -factor.args[1].value))
                 continue
-            number = self._constant(factor)
+            number = factor.constant
             text = self._print(factor)[0] if number else self._operand(factor, PRODUCT)
             if number and text.startswith("-"):
                 sign, text = "-", text[1:]
@@ -130,7 +119,10 @@ class Printer:
             text += "/(" + "*".join(f"({t})" if b < PRODUCT else t for t, b in denominator) + ")"
         return sign + text, SUM if sign else PRODUCT
 
-    def _power(self, base: sympy.Expr, exponent: sympy.Rational) -> tuple[str, int]:
+    def _power(self, base: Node, exponent) -> tuple[str, int]:
+        """base ** exponent (a sympy Rational, or the node of one)."""
+        if isinstance(exponent, Node):
+            exponent = exponent.value
         if exponent == 1:
             return self._print(base)
         if exponent == sympy.S.Half:
@@ -144,20 +136,24 @@ class Printer:
         """Nested selects, one per condition."""
         (condition, value), *rest = pairs
         other = self._select(rest, otherwise) if rest else self.doprint(otherwise)
-        numbers = value.is_number and not rest and otherwise.is_number
+        numbers = value.kind == graph.NUMBER and not rest and otherwise.kind == graph.NUMBER
         return self.select(self.doprint(condition), self.doprint(value), other, numbers)
 
-    def _boolean(self, expr) -> tuple[str, int]:
-        name = type(expr).__name__
-        if name in ("And", "Or"):
-            return self.logic(name, expr.args), AND if name == "And" else OR
-        if name == "Not":
-            return self.negation(expr.args[0]), ATOM
-        if name == "IsFinite":
-            return self.finite(self.doprint(expr.args[0])), ATOM
-        if isinstance(expr, sympy.core.relational.Relational):
-            return self.relation(self.doprint(expr.lhs), expr.rel_op, self.doprint(expr.rhs))
-        raise ValueError(f"unsupported in {type(self).__name__}: {name} ({expr})")
+    def _boolean(self, node: Node) -> tuple[str, int]:
+        if node.kind in (graph.AND, graph.OR):
+            return self.logic("And" if node.kind == graph.AND else "Or", node.args), \
+                AND if node.kind == graph.AND else OR
+        if node.kind == graph.NOT:
+            return self.negation(node.args[0]), ATOM
+        if node.kind == graph.FINITE:
+            return self.finite(self.doprint(node.args[0])), ATOM
+        if node.kind == graph.RELATION:
+            return self.relation(self.doprint(node.args[0]), node.value, self.doprint(node.args[1]))
+        raise ValueError(f"unsupported in {type(self).__name__}: {node.kind}")
+
+    def number(self, value) -> str:
+        """The literal of a template's constant (REACHED squared, 10)."""
+        return self.literal(float(value))
 
     # What each language says.
     def literal(self, value: float) -> str:

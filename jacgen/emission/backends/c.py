@@ -8,7 +8,6 @@ from jacgen.emission.backends.common import (Backend, common_context, ik_context
                                              parameters_read, sentence, task_lines, velocity_ik_context)
 from jacgen.emission.catalogue import Argument, Call, Function, Output
 from jacgen.emission.generator import Generator
-from jacgen.emission.lowering import is_boolean
 from jacgen.emission.printers import AND, ATOM, MATH_FUNCTIONS, PRODUCT, RELATION, Printer
 from jacgen.inputs import names
 from jacgen.inputs.robot import Robot
@@ -144,7 +143,7 @@ def _c_function(function: Function, robot: Robot, printer: CPrinter, macros: dic
         "calls": [_c_call(call, functions[call.function], robot, macros) for call in function.calls],
         "inputs": [(types.get(argument.name, real), str(symbol), f"{argument.name}[{row * argument.symbols.cols + col}]")
                    for symbol, argument, row, col in inputs] + [(real, name, f"p->{name}") for name in parameters],
-        "definitions": [("int" if is_boolean(e) else real, body.name(symbol), text)
+        "definitions": [("int" if e.boolean else real, body.name(symbol), text)
                         for (symbol, e), text in zip(body.definitions, definitions)],
         "outputs": [(f"{output.name}[{k}]", text) for output in arrays for k, text in enumerate(values[output])],
         "result": values[returned][0] if returned else None,
@@ -175,8 +174,8 @@ def c_context(robot: Robot, generator: Generator, printer: CPrinter, real: str) 
         "joint_lines": joint_lines(robot),
         "task_lines": task_lines(robot),
         "functions": [_c_function(f, robot, printer, macros, by_name) for f in functions],
-        "ik": ik_context(robot, generator, real, printer.doprint, f"{robot.name.upper()}_MAX_IK_SOLUTIONS"),
-        "ik_numeric": generator.generates("ik_numeric") and ik_numeric_context(robot, printer.doprint),
+        "ik": ik_context(robot, generator, real, printer.number, f"{robot.name.upper()}_MAX_IK_SOLUTIONS"),
+        "ik_numeric": generator.generates("ik_numeric") and ik_numeric_context(robot, printer.number),
         "velocity_ik": generator.generates("velocity_ik") and velocity_ik_context(robot, real),
     })
     return dict(sorted(context.items()))

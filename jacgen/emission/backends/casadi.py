@@ -1,12 +1,11 @@
 """The CasADi backend: Python that builds each function as an SX graph (`templates/casadi/`),
 its printer, and its reserved words (Python's)."""
 
-import sympy
-
 from jacgen.emission.backends.common import Backend, common_context, ik_numeric_context, parameters_read, sentence
 from jacgen.emission.backends.python import python_number
 from jacgen.emission.catalogue import Function
 from jacgen.emission.generator import Generator
+from jacgen.emission.graph import is_zero
 from jacgen.emission.printers import MATH_FUNCTIONS, Printer
 from jacgen.inputs import names
 from jacgen.inputs.robot import Robot
@@ -50,7 +49,7 @@ def _casadi_function(function: Function, robot: Robot, printer: CasadiPrinter) -
         # Zeros stay structural zeros of the sparse SX result.
         results.append({"name": output.name, "rows": output.rows, "cols": output.cols,
                         "values": [(row, col, text) for (row, col), e, text in zip(positions, values, texts)
-                                   if e != sympy.S.Zero]})
+                                   if not is_zero(e)]})
     return {
         "name": function.name,
         "summary": sentence(function.summary),

@@ -4,7 +4,6 @@ documentation, and the Backend record each language module fills in (`backends/c
 from dataclasses import dataclass
 from typing import Callable
 
-import sympy
 
 from jacgen.emission.catalogue import Output
 from jacgen.emission.generator import Generator
@@ -107,14 +106,14 @@ def ik_context(robot: Robot, generator: Generator, real: str, number: Callable, 
             "monomials": general6r.MONOMIALS.astype(int).tolist(), "along_b": general6r.ALONG_B,
             "along_c": general6r.ALONG_C, "newton_steps": general6r.NEWTON_STEPS,
             "tolerance": REACHED[real], "imaginary": general6r.IMAGINARY[real], "q_rank": general6r.Q_RANK,
-            "squared": number(sympy.Float(REACHED[real] ** 2)),
-            "converged_squared": number(sympy.Float((general6r.CONVERGED[real] * (1 + robot.reach)) ** 2)),
+            "squared": number(REACHED[real] ** 2),
+            "converged_squared": number((general6r.CONVERGED[real] * (1 + robot.reach)) ** 2),
             "work_bytes": general6r.work_bytes(real),
             "joints": form.joints,
             "fast": form.fast_path and {
                 "rows": form.fast_path.form.info.max_solutions, "steps": general6r.FAST_STEPS,
-                "band_squared": number(sympy.Float(form.fast_path.band ** 2)),
-                "margin": number(sympy.Float(form.fast_path.margin))}},
+                "band_squared": number(form.fast_path.band ** 2),
+                "margin": number(form.fast_path.margin)}},
     }
 
 
@@ -135,12 +134,12 @@ def ik_numeric_context(robot: Robot, number: Callable) -> dict:
         else "target - mu(q), angles wrapped into (-pi, pi]",
         "jacobian": "the geometric Jacobian" if pose else "the task Jacobian",
         "step_text": "q += J^T (J J^T + damping I)^-1 e" if m <= n else "q += (J^T J + damping I)^-1 J^T e",
-        "damping": {key: number(sympy.Float(value)) for key, value in differential.IK_NUMERIC_DAMPING.items()},
-        "tenth": number(sympy.Float(0.1)),
+        "damping": {key: number(value) for key, value in differential.IK_NUMERIC_DAMPING.items()},
+        "tenth": number(0.1),
         "iterations": differential.IK_NUMERIC_ITERATIONS,
         "statuses": differential.IK_NUMERIC_STATUSES,
         "defaults": {key: repr(value) for key, value in differential.IK_NUMERIC_DEFAULTS.items()},
-        "ten": number(sympy.Float(10)),
+        "ten": number(10),
         "signature": ", ".join(arguments),
     }
 

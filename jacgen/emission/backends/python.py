@@ -8,10 +8,10 @@ from jacgen.emission.backends.common import (Backend, common_context, dimensions
                                              velocity_ik_context)
 from jacgen.emission.catalogue import Function
 from jacgen.emission.generator import Generator
+from jacgen.emission.graph import ADD, CALL, NUMBER, SELECT, SYMBOL
 from jacgen.emission.printers import ATOM, MATH_FUNCTIONS, RELATION, Printer
 from jacgen.inputs import names
 from jacgen.inputs.robot import Robot
-from jacgen.model.nodes import Select
 
 
 class PythonPrinter(Printer):
@@ -90,7 +90,7 @@ def _python_function(function: Function, printer: PythonPrinter, parameters: lis
                      + [(p["name"], "()") for p in parameters],
         "signature": ", ".join([f"{a.name}={a.default}" if a.default else a.name for a in function.arguments] + ["*"] * bool(parameters)
                                + [f"{p['name']}={p['value']}" for p in parameters]),
-        "selects": any(e.has(Select) for e in [v for _, v in body.definitions] + list(body.outputs)),
+        "selects": any(e.contains(SELECT) for e in [v for _, v in body.definitions] + list(body.outputs)),
         "calls": [(", ".join(r.name for r in call.results), f"{call.function}({', '.join(call.passes)}"
                    + "".join(f", {p['name']}={p['name']}" for p in parameters) + ")") for call in function.calls],
         "inputs": [(str(symbol), f"{argument.name}[..., {row}]" if argument.vector else f"{argument.name}[..., {row}, {col}]")
@@ -118,12 +118,13 @@ def _joint_trig(function: Function) -> tuple[dict, list]:
         return {}, []
     offsets, trig = [0.0] * function.arguments[0].size, {}
     for symbol, value in function.body.definitions:
-        if isinstance(value, (sympy.cos, sympy.sin)):
-            offset, angle = value.args[0].as_independent(*joints, as_Add=True)
-            if angle in joints and offset.is_number:
-                row = joints[angle]
-                offsets[row] = float(offset)
-                trig[symbol] = f"trig[..., {2 * row + isinstance(value, sympy.sin)}]"
+        if value.kind == CALL and value.value in ("cos", "sin"):
+            angle = value.args[0]
+            offset, angle = angle.args if angle.kind == ADD and len(angle.args) == 2 else (None, angle)
+            if angle.kind == SYMBOL and angle.value in joints and (offset is None or offset.kind == NUMBER):
+                row = joints[angle.value]
+                offsets[row] = float(offset.value) if offset else 0.0
+                trig[symbol] = f"trig[..., {2 * row + (value.value == 'sin')}]"
     return trig, offsets
 
 
@@ -131,7 +132,7 @@ def python_context(robot: Robot, generator: Generator, printer: PythonPrinter, r
     """The numpy module's templates: every function and the IK documentation (double only)."""
     context = common_context(robot)
     context["functions"] = [_python_function(f, printer, context["parameters"]) for f in generator.functions()]
-    context["ik"] = ik_context(robot, generator, "double", repr, "MAX_IK_SOLUTIONS")
+    context["ik"] = ik_context(robot, generator, "double", python_number, "MAX_IK_SOLUTIONS")
     context["ik_numeric"] = generator.generates("ik_numeric") and (
         ik_numeric_context(robot, python_number) | {"python": LOOP_SYNTAX})
     context["velocity_ik"] = generator.generates("velocity_ik") and velocity_ik_context(robot, "double")

@@ -1,0 +1,353 @@
+"""The value graph: the generated code's expressions as interned nodes.
+
+A node is built once per graph (one per robot): equal values are the same object, so a
+node's identity is its value, hashing is free and a shared subexpression is one node however
+many functions read it. The algorithms build their values in sympy; `Graph.convert` takes
+them over once each, every constant subexpression folded to one number (integers stay
+integers, exponents stay exact), and the lowering (`lowering.py`: CSE, constants, the
+operation count) and the printers work on the graph alone: no sympy object is built,
+evaluated or asked about its assumptions after that.
+
+Sums and products keep the order of their terms (sympy's order, for converted values), with
+their number first; what the lowering builds (a negated sum, a shared part of two sums) keeps
+the order it is built in, so the output does not depend on hashing.
+"""
+
+import math
+import operator
+from fractions import Fraction
+
+import sympy
+from sympy.logic.boolalg import Boolean
+
+from jacgen.model.nodes import TOLERANCE_SYMBOLS, TOLERANCES, IsFinite, Select
+
+# The kinds of node. A number's value is an int, a Fraction (a folded constant: its value to
+# FOLDED_DIGITS digits, held exactly, so that constants added or multiplied together round once,
+# when printed) or, as a power's exponent, a sympy Rational; a symbol's is its sympy Symbol; a
+# call's the function's name (sympy's class name: sin, atan2, Abs, Floor, ...); a relation's its
+# operator (">=", ...).
+NUMBER, SYMBOL, TRUTH = "number", "symbol", "truth"
+ADD, MUL, POW, CALL, SELECT = "add", "mul", "pow", "call", "select"
+RELATION, AND, OR, NOT, FINITE = "relation", "and", "or", "not", "finite"
+FOLDED_DIGITS = 30
+BOOLEAN_KINDS = frozenset((TRUTH, RELATION, AND, OR, NOT, FINITE))
+
+RELATIONS = {">=": operator.ge, ">": operator.gt, "<=": operator.le, "<": operator.lt, "==": operator.eq,
+             "!=": operator.ne}
+MATH = {"sin": math.sin, "cos": math.cos, "tan": math.tan, "asin": math.asin, "acos": math.acos, "atan": math.atan,
+        "atan2": math.atan2, "exp": math.exp, "log": math.log, "Abs": abs, "Floor": math.floor, "Ceiling": math.ceil}
+BOOLEANS = {sympy.And: AND, sympy.Or: OR, sympy.Not: NOT, IsFinite: FINITE}
+
+
+class Node:
+    """One value of the graph; build it with `Graph.node` (or the constructors), never directly."""
+
+    __slots__ = ("kind", "args", "value", "_free")
+
+    def __init__(self, kind: str, args: tuple, value):
+        self.kind, self.args, self.value, self._free = kind, args, value, None
+
+    @property
+    def free_symbols(self) -> frozenset:
+        """The sympy Symbols the value reads (the tolerances included)."""
+        if self._free is None:
+            if self.kind == SYMBOL:
+                self._free = frozenset((self.value,))
+            else:
+                self._free = frozenset().union(*(arg.free_symbols for arg in self.args))
+        return self._free
+
+    @property
+    def constant(self) -> bool:
+        """Whether the value reads nothing but numbers and the tolerances."""
+        return self.free_symbols <= TOLERANCE_SYMBOLS
+
+    @property
+    def boolean(self) -> bool:
+        """A truth value (an `int` in C, a bool array in numpy)."""
+        return self.kind in BOOLEAN_KINDS
+
+    def contains(self, kind: str, _seen: set | None = None) -> bool:
+        """Whether a node of `kind` is among this one and those it reads."""
+        seen = set() if _seen is None else _seen
+        seen.add(self)
+        return self.kind == kind or any(arg.contains(kind, seen) for arg in self.args if arg not in seen)
+
+    def __repr__(self):
+        return f"{self.kind}({self.value!r}, {len(self.args)} args)" if self.args else f"{self.kind}({self.value!r})"
+
+
+def is_zero(node: Node) -> bool:
+    """The exact number 0 (a structural zero of a matrix)."""
+    return node.kind == NUMBER and node.value == 0 and not isinstance(node.value, Fraction)
+
+
+def negative_coefficient(node: Node) -> bool:
+    """A negative number, or a product whose number is negative."""
+    coefficient = node.args[0] if node.kind == MUL else node
+    return coefficient.kind == NUMBER and coefficient.value < 0
+
+
+class Graph:
+    """The interned nodes of one robot, and sympy's values taken over once each."""
+
+    def __init__(self):
+        self._nodes: dict[tuple, Node] = {}
+        self._converted: dict[sympy.Basic, Node] = {}
+        self.true, self.false = self.node(TRUTH, (), True), self.node(TRUTH, (), False)
+        self.minus_one = self.number(-1)
+
+    def node(self, kind: str, args: tuple = (), value=None) -> Node:
+        """The node of `kind`, `args` and `value`, built on first use (args as given: no evaluation)."""
+        key = (kind, value, type(value), args)
+        node = self._nodes.get(key)
+        if node is None:
+            node = self._nodes[key] = Node(kind, args, value)
+        return node
+
+    def number(self, value) -> Node:
+        return self.node(NUMBER, (), value)
+
+    def symbol(self, symbol: sympy.Symbol) -> Node:
+        return self.node(SYMBOL, (), symbol)
+
+    def truth(self, value: bool) -> Node:
+        return self.true if value else self.false
+
+    # -- sympy's values, once each ------------------------------------------------------------------
+    def convert(self, expr: sympy.Basic) -> Node:
+        """`expr` as a node, its constant subexpressions (2159/5000, sqrt(2)/2, pi/4) folded to
+        one number each: integers stay integers, exponents exact, so x**(1/2) prints as sqrt(x)."""
+        node = self._converted.get(expr)
+        if node is None:
+            node = self._converted[expr] = self._convert(expr)
+        return node
+
+    def _convert(self, expr: sympy.Basic) -> Node:
+        if expr.is_Symbol:
+            return self.symbol(expr)
+        if isinstance(expr, Boolean) and not isinstance(expr, sympy.Expr):
+            if expr is sympy.true or expr is sympy.false:
+                return self.truth(bool(expr))
+            if expr.is_Relational:
+                return self.node(RELATION, (self.convert(expr.lhs), self.convert(expr.rhs)), expr.rel_op)
+            kind = BOOLEANS.get(type(expr))
+            if kind is None:
+                raise ValueError(f"unsupported in generated code: {type(expr).__name__} ({expr})")
+            return self.node(kind, tuple(self.convert(arg) for arg in expr.args))
+        if expr.is_number:
+            return self.number(int(expr) if expr.is_Integer else Fraction(str(expr.evalf(FOLDED_DIGITS))))
+        if expr.is_Pow:
+            if not expr.exp.is_Rational:
+                raise ValueError(f"unsupported in generated code: a power to {expr.exp}")
+            return self.node(POW, (self.convert(expr.base), self.number(expr.exp)))
+        if expr.is_Add or expr.is_Mul:  # numbers folded one by one, then added or multiplied exactly
+            args = [self.convert(arg) for arg in expr.args]
+            return self.add(*args) if expr.is_Add else self.mul(*args)
+        args = tuple(self.convert(arg) for arg in expr.args)
+        if isinstance(expr, Select):
+            return self.node(SELECT, args)
+        if isinstance(expr, sympy.Function):
+            return self.node(CALL, args, type(expr).__name__)
+        raise ValueError(f"unsupported in generated code: {type(expr).__name__} ({expr})")
+
+    # -- building, with sympy's evaluation where values combine ---------------------------------------
+    def add(self, *terms: Node) -> Node:
+        """The sum: nested sums flattened, numbers added, equal terms collected (x + 2x = 3x)."""
+        number, collected = 0, {}
+        for term in _flattened(ADD, terms):
+            if term.kind == NUMBER:
+                number += term.value
+                continue
+            coefficient, rest = self._split(term)
+            collected[rest] = collected.get(rest, 0) + coefficient
+        parts = [rest if c == 1 else self.mul(self.number(c), rest) for rest, c in collected.items() if c != 0]
+        if number != 0:
+            parts.insert(0, self.number(number))
+        if not parts:
+            return self.number(number)
+        return parts[0] if len(parts) == 1 else self.node(ADD, tuple(parts))
+
+    def _split(self, term: Node) -> tuple:
+        """(number, the rest) of a term: 3*x*y is (3, x*y)."""
+        if term.kind == MUL and term.args[0].kind == NUMBER:
+            rest = term.args[1:]
+            return term.args[0].value, rest[0] if len(rest) == 1 else self.node(MUL, rest)
+        return 1, term
+
+    def mul(self, *factors: Node, distribute: bool = False) -> Node:
+        """The product: nested products flattened, numbers multiplied, equal bases collected;
+        with `distribute`, a number times one sum is the sum of its terms times the number
+        (sympy's `distribute`, on where a constant is substituted, off where the algorithms
+        build and CSE shares a - b with b - a)."""
+        number, collected = 1, {}
+        for factor in _flattened(MUL, factors):
+            if factor.kind == NUMBER:
+                number *= factor.value
+                continue
+            base, exponent = (factor.args[0], factor.args[1].value) if factor.kind == POW else (factor, 1)
+            collected[base] = collected.get(base, 0) + exponent
+        if number == 0:
+            return self.number(number)
+        parts = [base if e == 1 else self.node(POW, (base, self.number(sympy.Rational(e))))
+                 for base, e in collected.items() if e != 0]
+        if distribute and number != 1 and len(parts) == 1 and parts[0].kind == ADD:
+            return self.add(*(self.mul(self.number(number), term) for term in parts[0].args))
+        if number != 1 or not parts:
+            parts.insert(0, self.number(number))
+        return parts[0] if len(parts) == 1 else self.node(MUL, tuple(parts))
+
+    def negate(self, node: Node) -> Node:
+        """-node: a number negated, a product's number negated (-1 dropped), else -1 * node."""
+        if node.kind == NUMBER:
+            return self.number(-node.value)
+        if node.kind == MUL and node.args[0].kind == NUMBER:
+            coefficient, *rest = node.args
+            if coefficient.value == -1:
+                return rest[0] if len(rest) == 1 else self.node(MUL, tuple(rest))
+            return self.node(MUL, (self.number(-coefficient.value), *rest))
+        return self.node(MUL, (self.minus_one, node))
+
+    def select(self, *args: Node) -> Node:
+        """`Select`'s evaluation: false pairs dropped, a true one ends the list, a select in the
+        otherwise position joined, one value for every case is that value."""
+        *pairs, otherwise = args
+        pairs = list(zip(pairs[::2], pairs[1::2]))
+        if otherwise.kind == SELECT:
+            pairs += list(zip(otherwise.args[:-1:2], otherwise.args[1:-1:2]))
+            otherwise = otherwise.args[-1]
+        kept = []
+        for condition, value in pairs:
+            if condition is self.true:
+                otherwise = value
+                break
+            if condition is not self.false:
+                kept.append((condition, value))
+        if all(value is otherwise for _, value in kept):
+            return otherwise
+        return self.node(SELECT, (*(arg for pair in kept for arg in pair), otherwise))
+
+    def relation(self, operator_: str, lhs: Node, rhs: Node) -> Node:
+        """lhs `operator_` rhs, decided where both sides are the same value, or constants whose
+        comparison holds, or fails, in every real type."""
+        if lhs is rhs:
+            return self.truth(operator_ in (">=", "<=", "=="))
+        if lhs.constant and rhs.constant:
+            truths = {RELATIONS[operator_](evaluate(lhs, numbers), evaluate(rhs, numbers))
+                      for numbers in TOLERANCE_VALUES.values()}
+            if len(truths) == 1:
+                return self.truth(truths.pop())
+        return self.node(RELATION, (lhs, rhs), operator_)
+
+    def logic(self, kind: str, *operands: Node) -> Node:
+        """And, Or: nested ones flattened, a deciding truth value decides, the others dropped."""
+        deciding = self.false if kind == AND else self.true
+        kept = []
+        for operand in _flattened(kind, operands):
+            if operand is deciding:
+                return deciding
+            if operand.kind != TRUTH and operand not in kept:
+                kept.append(operand)
+        if not kept:
+            return self.truth(kind == AND)
+        return kept[0] if len(kept) == 1 else self.node(kind, tuple(kept))
+
+    def rebuilt(self, node: Node, args: tuple, distribute: bool = False) -> Node:
+        """`node` of new arguments, evaluated as its kind's constructor evaluates."""
+        kind = node.kind
+        if kind == ADD:
+            return self.add(*args)
+        if kind == MUL:
+            return self.mul(*args, distribute=distribute)
+        if kind == POW and args[0].kind == NUMBER:
+            base, exponent = Fraction(args[0].value), args[1].value
+            if exponent.q == 1:
+                return self.number(base ** int(exponent))
+            return self.convert(sympy.Rational(base.numerator, base.denominator) ** exponent)
+        if kind == SELECT:
+            return self.select(*args)
+        if kind == RELATION:
+            return self.relation(node.value, *args)
+        if kind in (AND, OR):
+            return self.logic(kind, *args)
+        if kind == NOT and args[0].kind == TRUTH:
+            return self.truth(not args[0].value)
+        return self.node(kind, args, node.value)
+
+    def settled(self, node: Node, _done: dict | None = None) -> Node:
+        """A constant rebuilt by the evaluating constructors: its comparisons decided where every
+        real type agrees, the selects on them resolved, its numbers combined."""
+        done = {} if _done is None else _done
+        if node not in done:
+            args = tuple(self.settled(arg, done) for arg in node.args)
+            done[node] = self.rebuilt(node, args, distribute=True) if node.args else node
+        return done[node]
+
+    def substitute(self, node: Node, values: dict, distribute: bool, _done: dict | None = None) -> Node:
+        """`node` with the symbols of `values` (sympy Symbol -> Node) replaced, evaluated again
+        (with `distribute`, numbers distributed over sums)."""
+        done = {} if _done is None else _done
+        if node not in done:
+            if node.kind == SYMBOL:
+                done[node] = values.get(node.value, node)
+            elif node.free_symbols.isdisjoint(values):
+                done[node] = node
+            else:
+                args = tuple(self.substitute(arg, values, distribute, done) for arg in node.args)
+                done[node] = self.rebuilt(node, args, distribute)
+        return done[node]
+
+
+def _flattened(kind: str, nodes) -> list[Node]:
+    flat = []
+    for node in nodes:
+        if node.kind == kind:
+            flat.extend(node.args)
+        else:
+            flat.append(node)
+    return flat
+
+
+# -- numbers ----------------------------------------------------------------------------------------
+TOLERANCE_VALUES = {real: {symbol: float(value) for symbol, value in numbers.items()}
+                    for real, numbers in TOLERANCES.items()}
+
+
+def evaluate(node: Node, values: dict, _done: dict | None = None):
+    """The value of `node` in floats (truth values as bools), `values` giving each symbol's."""
+    done = {} if _done is None else _done
+    if node in done:
+        return done[node]
+    kind, args = node.kind, node.args
+    if kind == NUMBER:
+        result = float(node.value)
+    elif kind == SYMBOL:
+        result = values[node.value]
+    elif kind == TRUTH:
+        result = node.value
+    else:
+        operands = [evaluate(arg, values, done) for arg in args]
+        if kind == ADD:
+            result = math.fsum(operands)
+        elif kind == MUL:
+            result = math.prod(operands)
+        elif kind == POW:
+            result = operands[0] ** operands[1]
+        elif kind == CALL:
+            result = MATH[node.value](*operands)
+        elif kind == SELECT:
+            result = next((value for condition, value in zip(operands[:-1:2], operands[1:-1:2]) if condition),
+                          operands[-1])
+        elif kind == RELATION:
+            result = RELATIONS[node.value](*operands)
+        elif kind == AND:
+            result = all(operands)
+        elif kind == OR:
+            result = any(operands)
+        elif kind == NOT:
+            result = not operands[0]
+        else:  # FINITE
+            result = math.isfinite(operands[0])
+    done[node] = result
+    return result

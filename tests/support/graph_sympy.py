@@ -1,0 +1,50 @@
+"""A value-graph node (jacgen.emission.graph) as the sympy expression of the same structure,
+built without evaluation, so that sympy's own `count_ops` and `cse` can be the reference for
+the graph's operation count and common-subexpression elimination."""
+
+from fractions import Fraction
+
+import sympy
+
+from jacgen.emission import graph
+from jacgen.model.nodes import PLAIN, Ceiling, Floor, IsFinite, Select
+
+CALLS = {"Floor": Floor, "Ceiling": Ceiling}
+RELATIONS = {cls.kind.rel_op: cls for cls in PLAIN.values()}
+
+
+def to_sympy(node: graph.Node, _done: dict | None = None) -> sympy.Basic:
+    done = {} if _done is None else _done
+    if node in done:
+        return done[node]
+    kind, value = node.kind, node.value
+    args = [to_sympy(arg, done) for arg in node.args]
+    if kind == graph.NUMBER:
+        result = sympy.Float(float(value)) if isinstance(value, Fraction) else sympy.sympify(value)
+    elif kind == graph.SYMBOL:
+        result = value
+    elif kind == graph.TRUTH:
+        result = sympy.true if value else sympy.false
+    elif kind == graph.ADD:
+        result = sympy.Add(*args, evaluate=False)
+    elif kind == graph.MUL:
+        result = sympy.Mul(*args, evaluate=False)
+    elif kind == graph.POW:
+        result = sympy.Pow(*args, evaluate=False)
+    elif kind == graph.CALL:
+        result = (CALLS[value] if value in CALLS else getattr(sympy, value))(*args, evaluate=False)
+    elif kind == graph.SELECT:
+        result = Select(*args, evaluate=False)
+    elif kind == graph.RELATION:
+        result = RELATIONS[value](*args, evaluate=False)
+    elif kind == graph.FINITE:
+        result = IsFinite(*args)
+    else:
+        result = {graph.AND: sympy.And, graph.OR: sympy.Or, graph.NOT: sympy.Not}[kind](*args, evaluate=False)
+    done[node] = result
+    return result
+
+
+def printed(printer, expr: sympy.Basic) -> str:
+    """What `printer` prints for a sympy expression, taken onto a graph of its own."""
+    return printer.doprint(graph.Graph().convert(expr))
