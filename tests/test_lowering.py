@@ -7,7 +7,7 @@ import sympy
 from sympy.core.parameters import distribute
 
 from jacgen.emission.generator import Generator
-from jacgen.emission.graph import Graph, evaluate
+from jacgen.model.graph import Graph, evaluate
 from jacgen.emission.lowering import eliminate_common, operation_count
 from jacgen.inputs.robot import load_robot, parse_robot
 from jacgen.model.nodes import AtLeast, Below, IsFinite, Select

@@ -17,7 +17,7 @@ import sympy
 from sympy.logic.boolalg import Boolean
 from sympy.simplify.cse_main import Unevaluated, match_common_args
 
-from jacgen.emission.graph import (ADD, AND, FINITE, MUL, NOT, NUMBER, OR, POW, RELATION, SELECT, TRUTH, CALL,
+from jacgen.model.graph import (ADD, AND, FINITE, MUL, NOT, NUMBER, OR, POW, RELATION, SELECT, TRUTH, CALL,
                                    TOLERANCE_VALUES, Graph, Node, evaluate, negative_coefficient)
 from jacgen.inputs import names
 

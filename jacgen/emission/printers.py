@@ -14,8 +14,8 @@ as one literal: the shortest decimal that reads back as the same value of that t
 
 import sympy
 
-from jacgen.emission import graph
-from jacgen.emission.graph import TOLERANCE_VALUES, Node, evaluate
+from jacgen.model import graph
+from jacgen.model.graph import TOLERANCE_VALUES, Node, evaluate
 from jacgen.emission.lowering import Body
 from jacgen.model.nodes import TOLERANCE_SYMBOLS
 

@@ -5,12 +5,13 @@ writes be atomic (`files.py`). The "generated, do not edit" header is added here
 not by each template, and holds no date, host or absolute path.
 """
 
+import functools
 from pathlib import Path
 from typing import Callable
 
 import jinja2
 
-from jacgen import sources
+from jacgen import cache, sources
 from jacgen.emission.backends import DEFAULT_LANGUAGES, backend
 from jacgen.emission.generator import Generator
 from jacgen.errors import JacgenError
@@ -19,9 +20,31 @@ from jacgen.parallel import for_each_robot
 from jacgen.version import __version__
 
 
+class CompiledTemplates(jinja2.FileSystemBytecodeCache):
+    """The templates compiled once per machine, in jacgen's cache folder (`cache.folder()`):
+    jinja keys each by its source's checksum and its own version. A folder that cannot be
+    read or written is no error: the templates are compiled again."""
+
+    def load_bytecode(self, bucket):
+        try:
+            super().load_bytecode(bucket)
+        except OSError:
+            pass
+
+    def dump_bytecode(self, bucket):
+        try:
+            Path(self.directory).mkdir(parents=True, exist_ok=True)
+            super().dump_bytecode(bucket)
+        except OSError:
+            pass
+
+
+@functools.cache
 def environment() -> jinja2.Environment:
+    """The templates, compiled once per process (and, through the cache folder, per machine)."""
     return jinja2.Environment(
         loader=jinja2.FileSystemLoader(str(sources.template_folder())),
+        bytecode_cache=CompiledTemplates(str(cache.folder() / "templates")),
         undefined=jinja2.StrictUndefined,
         trim_blocks=True,
         lstrip_blocks=True,

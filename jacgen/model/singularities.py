@@ -31,9 +31,13 @@ from sympy.polys.rings import PolyElement
 
 from jacgen.inputs import numeric_chain
 from jacgen.inputs.robot import EULER_ANGLES, TASK_COMPONENTS, Robot
+from jacgen.model.graph import ADD, Graph, evaluate
 from jacgen.model.joint_ring import (READABLE_TERMS, JointRing, TooLarge, factorise, frames_about, geometric_columns,
                                      maximal_minors, multiply, permutation_sign, term_count)
 from jacgen.tolerances import PARALLEL, ROOT
+
+# What `evaluate` calls over numpy arrays (the zero sets of factors, on a grid of one joint).
+NUMPY = {"sin": np.sin, "cos": np.cos, "tan": np.tan, "atan2": np.arctan2, "Abs": np.abs, ADD: sum}
 
 # The exact analysis is bounded by counts, never by a clock, so its outcome is the same on
 # every machine: the monomial products of all polynomial multiplications of one robot
@@ -269,16 +273,19 @@ class _Numeric:
             values = [sympy.Float(float(r.real), 17) for r in np.roots(coefficients)
                       if abs(r.imag) <= 1e-6 * (1 + abs(r))]
         roots = [2 * sympy.atan(v) for v in values] if len(atoms) == 2 else list(values)
-        value = sympy.lambdify(atoms, expr, "math")
+        value = Graph().convert(expr)
         unique = {}
         for root in roots + at_pi:
             point = (math.cos(float(root)), math.sin(float(root))) if len(atoms) == 2 else (float(root),)
-            if abs(value(*point)) <= ROOT * scale and round(float(root), 9) not in unique:
+            if abs(evaluate(value, dict(zip(atoms, point)))) <= ROOT * scale and round(float(root), 9) not in unique:
                 unique[round(float(root), 9)] = root
         return tuple(unique[key] for key in sorted(unique))
 
     def _function(self, condition: sympy.Expr):
-        return sympy.lambdify([self.ring.q], condition.xreplace(self.nominal), "numpy")
+        """The condition as a function of q, over numpy arrays (on the value graph: sympy's
+        lambdify imports half of numpy the first time)."""
+        value = Graph().convert(condition.xreplace(self.nominal))
+        return lambda q: evaluate(value, dict(zip(self.ring.q, q)), NUMPY)
 
     def _configuration(self) -> np.ndarray:
         return np.array([self.rng.uniform(lo, hi) for lo, hi in self.robot.ranges])

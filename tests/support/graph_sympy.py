@@ -1,4 +1,4 @@
-"""A value-graph node (jacgen.emission.graph) as the sympy expression of the same structure,
+"""A value-graph node (jacgen.model.graph) as the sympy expression of the same structure,
 built without evaluation, so that sympy's own `count_ops` and `cse` can be the reference for
 the graph's operation count and common-subexpression elimination."""
 
@@ -6,7 +6,7 @@ from fractions import Fraction
 
 import sympy
 
-from jacgen.emission import graph
+from jacgen.model import graph
 from jacgen.model.nodes import PLAIN, Ceiling, Floor, IsFinite, Select
 
 CALLS = {"Floor": Floor, "Ceiling": Ceiling}

@@ -35,8 +35,10 @@ BOOLEAN_KINDS = frozenset((TRUTH, RELATION, AND, OR, NOT, FINITE))
 
 RELATIONS = {">=": operator.ge, ">": operator.gt, "<=": operator.le, "<": operator.lt, "==": operator.eq,
              "!=": operator.ne}
+# The functions `evaluate` calls, by call name, and how it adds (in floats: fsum, rounded once).
 MATH = {"sin": math.sin, "cos": math.cos, "tan": math.tan, "asin": math.asin, "acos": math.acos, "atan": math.atan,
-        "atan2": math.atan2, "exp": math.exp, "log": math.log, "Abs": abs, "Floor": math.floor, "Ceiling": math.ceil}
+        "atan2": math.atan2, "exp": math.exp, "log": math.log, "Abs": abs, "Floor": math.floor, "Ceiling": math.ceil,
+        ADD: math.fsum}
 BOOLEANS = {sympy.And: AND, sympy.Or: OR, sympy.Not: NOT, IsFinite: FINITE}
 
 
@@ -314,8 +316,9 @@ TOLERANCE_VALUES = {real: {symbol: float(value) for symbol, value in numbers.ite
                     for real, numbers in TOLERANCES.items()}
 
 
-def evaluate(node: Node, values: dict, _done: dict | None = None):
-    """The value of `node` in floats (truth values as bools), `values` giving each symbol's."""
+def evaluate(node: Node, values: dict, functions: dict = MATH, _done: dict | None = None):
+    """The value of `node`, `values` giving each symbol's: in floats (truth values as bools),
+    or with `functions` of another library (numpy's, over arrays: arithmetic and calls only)."""
     done = {} if _done is None else _done
     if node in done:
         return done[node]
@@ -327,15 +330,15 @@ def evaluate(node: Node, values: dict, _done: dict | None = None):
     elif kind == TRUTH:
         result = node.value
     else:
-        operands = [evaluate(arg, values, done) for arg in args]
+        operands = [evaluate(arg, values, functions, done) for arg in args]
         if kind == ADD:
-            result = math.fsum(operands)
+            result = functions[ADD](operands)
         elif kind == MUL:
             result = math.prod(operands)
         elif kind == POW:
             result = operands[0] ** operands[1]
         elif kind == CALL:
-            result = MATH[node.value](*operands)
+            result = functions[node.value](*operands)
         elif kind == SELECT:
             result = next((value for condition, value in zip(operands[:-1:2], operands[1:-1:2]) if condition),
                           operands[-1])
