@@ -9,11 +9,11 @@ velocity_ik and the second-order functions, now and then. The runs alternate (no
 now, ...) so that a load on the machine falls on both.
 
     python bench/bench_generate.py [ROBOT.yaml ...] [--baseline 70175b8] [--random 6,11,16,32]
-        [--repeats 1] [--timeout 300]
+        [--radians] [--repeats 1] [--timeout 300]
 
 Without robot files: every shipped robot. `--random` adds arms of those joint counts from
 the test suite's `random_arm_text` (seed 1000 * n, written to a temporary folder and read by
-both).
+both; `--radians`: their angles in radians). The last line sums the robots both finished.
 """
 
 import argparse
@@ -52,6 +52,8 @@ def main() -> None:
     parser.add_argument("robots", nargs="*", type=Path)
     parser.add_argument("--baseline", default="70175b8")
     parser.add_argument("--random", default="", help="joint counts of random arms to add, e.g. 6,11,16,32")
+    parser.add_argument("--radians", action="store_true",
+                        help="the random arms' angles in radians (irrational twists: the slow case of issue 21)")
     parser.add_argument("--repeats", type=int, default=1)
     parser.add_argument("--timeout", type=float, default=300.0, help="seconds per rendering")
     options = parser.parse_args()
@@ -60,8 +62,8 @@ def main() -> None:
         scratch = Path(scratch)
         if options.random:
             for dof in map(int, options.random.split(",")):
-                path = scratch / f"random{dof}.yaml"
-                path.write_text(random_arm_text(1000 * dof, dof=dof))
+                path = scratch / f"random{dof}{'_rad' * options.radians}.yaml"
+                path.write_text(random_arm_text(1000 * dof, dof=dof, radians=options.radians))
                 robots.append(path)
         baseline = scratch / "baseline"
         subprocess.run(["git", "-C", str(common.ROOT), "worktree", "add", "--detach", "-q", str(baseline),
@@ -69,6 +71,7 @@ def main() -> None:
         try:
             print(f"{'robot':<14} {'now s':>7} {'then s':>7} {'ratio':>6} {'MB now':>7} {'MB then':>7}  "
                   + "  ".join(f"{name} now/then" for name in COUNTED))
+            totals = [0.0, 0.0]
             for robot in robots:
                 now, then = [], []
                 for _ in range(options.repeats):
@@ -81,6 +84,10 @@ def main() -> None:
                 memory = [f"{r['peak_mb']:.0f}" if r else "-" for r in (now, then)]
                 print(f"{robot.stem:<14} {seconds[0]:>7} {seconds[1]:>7} {text(ratio, '{:.1f}x'):>6} {memory[0]:>7} "
                       f"{memory[1]:>7}  " + "  ".join(operations), flush=True)
+                if ratio:
+                    totals = [totals[0] + now["seconds"], totals[1] + then["seconds"]]
+            print(f"{'all finished':<14} {totals[0]:>7.2f} {totals[1]:>7.2f} "
+                  f"{text(totals[1] / totals[0] if totals[0] else None, '{:.1f}x'):>6}")
         finally:
             subprocess.run(["git", "-C", str(common.ROOT), "worktree", "remove", "--force", str(baseline)], check=True)
 

@@ -1177,7 +1177,7 @@ def bias_acceleration(q, q_dot):
 
 
 def task_jacobian_dot(q, q_dot):
-    """time derivative of the analytic Jacobian along q_dot (6 x DOF): mu'' = J_a q'' + J_a' q': (6 x 7), 695 operations."""
+    """time derivative of the analytic Jacobian along q_dot (6 x DOF): mu'' = J_a q'' + J_a' q': (6 x 7), 639 operations."""
     xp, dtype, device, batch, (q, q_dot,) = _arguments(("q", q, (7,)), ("q_dot", q_dot, (7,)))
     qd1 = q_dot[..., 0]
     qd2 = q_dot[..., 1]
@@ -1225,232 +1225,218 @@ def task_jacobian_dot(q, q_dot):
     t21 = t19*c6 - t18*s6
     t22 = t18*c6 + t19*s6
     t23 = t20*s7 + t21*c7
-    t24 = c3*s2
-    t25 = c2*s4 - c4*t24
-    t26 = c2*c4 + s4*t24
-    t27 = s3*s2
-    t28 = t25*c5 + s5*t27
-    t29 = -t25*s5 + c5*t27
-    t30 = t28*c6 - t26*s6
-    t31 = t26*c6 + t28*s6
-    t32 = t29*s7 + t30*c7
-    t33 = 0.126*t14
-    t34 = 0.4*t10 + t33
-    t35 = t34 + 0.42*t8
-    t36 = 0.126*t22
-    t37 = 0.4*t18 + t36
-    t38 = t37 + 0.42*t16
-    t39 = t35*c1 + t38*s1
-    t40 = t38*t8 - t35*t16
-    t41 = t34*t3 + t37*t6
-    t42 = t10*t37 - t18*t34
-    t43 = t12*t36 + t20*t33
-    t44 = t42*qd5 - t43*qd6
-    t45 = t44 + t41*qd4
-    t46 = t45 + t40*qd3
-    t47 = t46 - t39*qd2
-    t48 = 0.126*t31
-    t49 = 0.4*t26 + t48
-    t50 = t49 + 0.42*c2
-    t51 = -t38*c2 + t50*t16
-    t52 = -t49*t3 + t37*t27
-    t53 = t18*t49 - t26*t37
-    t54 = -t29*t36 + t20*t48
-    t55 = t35*c2 - t50*t8
-    t56 = t49*t6 + t34*t27
-    t57 = t26*t34 - t10*t49
-    t58 = t12*t48 + t29*t33
-    t59 = t53*qd5 + t54*qd6
-    t60 = t57*qd5 + t58*qd6
-    t61 = t59 + t52*qd4
-    t62 = t60 - t56*qd4
-    t63 = t61 + t51*qd3
-    t64 = t62 + t55*qd3
-    t65 = qd2*s1
-    t66 = t64 + t50*t65
-    t67 = t66 + t35*qd1
-    t68 = t51*qd1 + t63*c2 + t40*t65 - t46*t8
-    t69 = qd1*t8 + c2*t65
-    t70 = -t65 + qd3*t8
-    t71 = t70
-    t72 = c1*qd2
-    t73 = t63 + t50*t72
-    t74 = t73 - t38*qd1
-    t75 = -t55*qd1 - t64*c2 + t40*t72 + t46*t16
-    t76 = t73*c1 + t66*s1
-    t77 = t51*t72 + t55*t65 + t63*t16 - t64*t8
-    t78 = c2*t72 - qd1*t16
-    t79 = t72 + qd3*t16
-    t80 = t79
-    t81 = t6*t62 + t61*t3 - t52*t80 - t56*t71
-    t82 = t71*t3 + t6*t80
-    t83 = qd1 + c2*qd3
-    t84 = t83
-    t85 = t56*t84 + t41*t80 - t45*t3 + t62*t27
-    t86 = t41*t71 + t6*t45 - t52*t84 + t61*t27
-    t87 = t84*t3 - t80*t27
-    t88 = t6*t84 + t71*t27
-    t89 = t6*qd4
-    t90 = t71 + t89
-    t91 = -t3*qd4
-    t92 = t80 + t91
-    t93 = t10*t60 + t57*t90 - t18*t59 - t53*t92
-    t94 = t18*t90 - t10*t92
-    t95 = -qd4*t27
-    t96 = t84 + t95
-    t97 = t18*t44 + t42*t92 - t26*t60 - t57*t96
-    t98 = t26*t59 + t53*t96 - t10*t44 - t42*t90
-    t99 = t26*t92 - t18*t96
-    t100 = t10*t96 - t26*t90
-    t101 = t10*qd5
-    t102 = t90 + t101
-    t103 = t18*qd5
+    t24 = t15**2 + t23**2
+    t25 = xp.sqrt(t24)
+    t26 = c3*s2
+    t27 = c2*s4 - c4*t26
+    t28 = c2*c4 + s4*t26
+    t29 = s3*s2
+    t30 = t27*c5 + s5*t29
+    t31 = -t27*s5 + c5*t29
+    t32 = t30*c6 - t28*s6
+    t33 = t28*c6 + t30*s6
+    t34 = t31*s7 + t32*c7
+    t35 = 0.126*t14
+    t36 = 0.4*t10 + t35
+    t37 = t36 + 0.42*t8
+    t38 = 0.126*t22
+    t39 = 0.4*t18 + t38
+    t40 = t39 + 0.42*t16
+    t41 = t37*c1 + t40*s1
+    t42 = t40*t8 - t37*t16
+    t43 = t36*t3 + t39*t6
+    t44 = t10*t39 - t18*t36
+    t45 = t12*t38 + t20*t35
+    t46 = t44*qd5 - t45*qd6
+    t47 = t46 + t43*qd4
+    t48 = t47 + t42*qd3
+    t49 = t48 - t41*qd2
+    t50 = 0.126*t33
+    t51 = 0.4*t28 + t50
+    t52 = t51 + 0.42*c2
+    t53 = -t40*c2 + t52*t16
+    t54 = -t51*t3 + t39*t29
+    t55 = t18*t51 - t28*t39
+    t56 = -t31*t38 + t20*t50
+    t57 = t37*c2 - t52*t8
+    t58 = t51*t6 + t36*t29
+    t59 = t28*t36 - t10*t51
+    t60 = t12*t50 + t31*t35
+    t61 = t55*qd5 + t56*qd6
+    t62 = t59*qd5 + t60*qd6
+    t63 = t61 + t54*qd4
+    t64 = t62 - t58*qd4
+    t65 = t63 + t53*qd3
+    t66 = t64 + t57*qd3
+    t67 = qd2*s1
+    t68 = t66 + t52*t67
+    t69 = t68 + t37*qd1
+    t70 = t53*qd1 + t65*c2 + t42*t67 - t48*t8
+    t71 = qd1*t8 + c2*t67
+    t72 = -t67 + qd3*t8
+    t73 = t72
+    t74 = c1*qd2
+    t75 = t65 + t52*t74
+    t76 = t75 - t40*qd1
+    t77 = -t57*qd1 - t66*c2 + t42*t74 + t48*t16
+    t78 = t75*c1 + t68*s1
+    t79 = t53*t74 + t57*t67 + t65*t16 - t66*t8
+    t80 = c2*t74 - qd1*t16
+    t81 = t74 + qd3*t16
+    t82 = t81
+    t83 = t6*t64 + t63*t3 - t54*t82 - t58*t73
+    t84 = t73*t3 + t6*t82
+    t85 = qd1 + c2*qd3
+    t86 = t85
+    t87 = t58*t86 + t43*t82 - t47*t3 + t64*t29
+    t88 = t43*t73 + t6*t47 - t54*t86 + t63*t29
+    t89 = t86*t3 - t82*t29
+    t90 = t6*t86 + t73*t29
+    t91 = t6*qd4
+    t92 = t73 + t91
+    t93 = -t3*qd4
+    t94 = t82 + t93
+    t95 = t10*t62 + t59*t92 - t18*t61 - t55*t94
+    t96 = t18*t92 - t10*t94
+    t97 = -qd4*t29
+    t98 = t86 + t97
+    t99 = t18*t46 + t44*t94 - t28*t62 - t59*t98
+    t100 = t28*t61 + t55*t98 - t10*t46 - t44*t92
+    t101 = t28*t94 - t18*t98
+    t102 = t10*t98 - t28*t92
+    t103 = t10*qd5
     t104 = t92 + t103
-    t105 = t12*t104 + t20*t102
-    t106 = t26*qd5
-    t107 = t96 + t106
-    t108 = t29*t104 - t20*t107
-    t109 = t12*t107 + t29*t102
-    t110 = t12*qd6
-    t111 = -t110
-    t112 = t102 + t111
-    t113 = t89 + t101 + t111 + t14*qd7 + t70
-    t114 = t20*qd6
-    t115 = t104 + t114
-    t116 = t54*t104 - t58*t102 + t58*t110 + t54*t114
-    t117 = t22*t112 - t14*t115
-    t118 = t91 + t103 + t114 + t22*qd7 + t79
-    t119 = t113*t23 - t118*t15
-    t120 = t29*qd6
-    t121 = t107 + t120
-    t122 = t58*t107 + t43*t104 + t43*t114 + t58*t120
-    t123 = t54*t107 + t43*t102 + t54*t120 - t43*t110
-    t124 = t31*t115 - t22*t121
-    t125 = t14*t121 - t31*t112
-    t126 = t95 + t106 + t120 + t31*qd7 + t83
-    t127 = t118*t32 - t126*t23
-    t128 = t126*t15 - t113*t32
-    t129 = qd1*t50
-    t130 = t47*c1 - s1*t129
-    t131 = t47*s1 + c1*t129
-    t132 = qd2*s2
-    t133 = c1**2*t132 + s1**2*t132
-    t134 = t15**2 + t23**2
-    t135 = 1/t134
-    t136 = s1*t135
-    t137 = t23*c1
-    t138 = t15*s1
-    t139 = t137 - t138
-    t140 = 2/t134**2
-    t141 = t139*t140
-    t142 = t15*t141
-    t143 = c1*t135
-    t144 = t23*t141
-    t145 = qd1*t15
-    t146 = qd1*t23
-    t147 = s2*t143
-    t148 = t15*c1
-    t149 = t23*s1
-    t150 = s2*t148 + s2*t149
-    t151 = t150*t140
-    t152 = t15*t151
-    t153 = s2*t136
-    t154 = t23*t151
-    t155 = t15*t135
-    t156 = t78*t155
-    t157 = t23*t135
-    t158 = t69*t157
-    t159 = t6*t135
-    t160 = t15*t6 - t23*t3
-    t161 = t160*t140
-    t162 = t15*t161
-    t163 = t3*t135
-    t164 = t23*t161
-    t165 = t87*t155
-    t166 = t88*t157
-    t167 = t10*t135
-    t168 = t10*t15 + t18*t23
-    t169 = t168*t140
-    t170 = t15*t169
-    t171 = t18*t135
-    t172 = t23*t169
-    t173 = t99*t155
-    t174 = t100*t157
-    t175 = t12*t135
-    t176 = t20*t23 - t12*t15
-    t177 = t176*t140
-    t178 = t15*t177
-    t179 = t20*t135
-    t180 = t23*t177
-    t181 = t108*t155
-    t182 = t109*t157
-    t183 = t14*t135
-    t184 = t14*t15 + t22*t23
-    t185 = t184*t140
-    t186 = t15*t185
-    t187 = t22*t135
-    t188 = t23*t185
-    t189 = t124*t155
-    t190 = t125*t157
-    t191 = 1/xp.sqrt(t134)
-    t192 = c1*t191
-    t193 = 1/t134**1.5
-    t194 = t193*(t148 + t149)
-    t195 = s1*t191
-    t196 = qd1*t191
-    t197 = t193*(s2*t138 - s2*t137)
-    t198 = t15*t191
-    t199 = t23*t191
-    t200 = -t193*(t15*t3 + t23*t6)
-    t201 = t193*(t18*t15 - t10*t23)
-    t202 = t193*(t12*t23 + t20*t15)
-    t203 = t193*(t22*t15 - t14*t23)
-    t204 = t32*t136
-    t205 = t32*t143
-    t206 = t135*t119
+    t105 = t18*qd5
+    t106 = t94 + t105
+    t107 = t12*t106 + t20*t104
+    t108 = t28*qd5
+    t109 = t98 + t108
+    t110 = t31*t106 - t20*t109
+    t111 = t12*t109 + t31*t104
+    t112 = t12*qd6
+    t113 = -t112
+    t114 = t104 + t113
+    t115 = t91 + t103 + t113 + t14*qd7 + t72
+    t116 = t20*qd6
+    t117 = t106 + t116
+    t118 = t56*t106 - t60*t104 + t60*t112 + t56*t116
+    t119 = t22*t114 - t14*t117
+    t120 = t93 + t105 + t116 + t22*qd7 + t81
+    t121 = t115*t23 - t120*t15
+    t122 = t31*qd6
+    t123 = t109 + t122
+    t124 = t60*t109 + t45*t106 + t45*t116 + t60*t122
+    t125 = t56*t109 + t45*t104 + t56*t122 - t45*t112
+    t126 = t33*t117 - t22*t123
+    t127 = t14*t123 - t33*t114
+    t128 = t97 + t108 + t122 + t33*qd7 + t85
+    t129 = t120*t34 - t128*t23
+    t130 = t128*t15 - t115*t34
+    t131 = qd1*t52
+    t132 = t49*c1 - s1*t131
+    t133 = t49*s1 + c1*t131
+    t134 = qd2*s2
+    t135 = c1**2*t134 + s1**2*t134
+    t136 = 1/t24
+    t137 = t136*(t15*t6 - t23*t3)
+    t138 = t136*(t10*t15 + t18*t23)
+    t139 = t136*(t20*t23 - t12*t15)
+    t140 = t136*(t14*t15 + t22*t23)
+    t141 = t23*c1
+    t142 = t15*s1
+    t143 = t136*(t141 - t142)
+    t144 = t15*c1
+    t145 = t23*s1
+    t146 = t136*(s2*t144 + s2*t145)
+    t147 = 1/t25
+    t148 = t136*t147
+    t149 = (t144 + t145)*t148
+    t150 = (s2*t142 - s2*t141)*t148
+    t151 = -(t15*t3 + t23*t6)*t148
+    t152 = (t18*t15 - t10*t23)*t148
+    t153 = (t12*t23 + t20*t15)*t148
+    t154 = (t22*t15 - t14*t23)*t148
+    t155 = 2*t143
+    t156 = t136*t129
+    t157 = -(s1 + t15*t155)*t156
+    t158 = t136*t130
+    t159 = (c1 - t23*t155)*t158
+    t160 = qd1*t136
+    t161 = t144*t160
+    t162 = t145*t160
+    t163 = t15*t136
+    t164 = t80*t163
+    t165 = t23*t136
+    t166 = t71*t165
+    t167 = 2*t146
+    t168 = (t8 - t15*t167)*t156
+    t169 = (t16 - t23*t167)*t158
+    t170 = t89*t163
+    t171 = t90*t165
+    t172 = 2*t137
+    t173 = (t6 - t15*t172)*t156
+    t174 = -(t3 + t23*t172)*t158
+    t175 = t101*t163
+    t176 = t102*t165
+    t177 = 2*t138
+    t178 = (t10 - t15*t177)*t156
+    t179 = (t18 - t23*t177)*t158
+    t180 = t110*t163
+    t181 = 2*t139
+    t182 = -(t12 + t15*t181)*t156
+    t183 = (t20 - t23*t181)*t158
+    t184 = t111*t165
+    t185 = t126*t163
+    t186 = t127*t165
+    t187 = 2*t140
+    t188 = (t14 - t15*t187)*t156
+    t189 = (t22 - t23*t187)*t158
+    t190 = qd1*t147
+    t191 = t15*t147
+    t192 = t23*t147
     Jd = _stack(xp, [
-        xp.broadcast_to(-t67, batch),  # 0, 0
-        xp.broadcast_to(t130, batch),  # 0, 1
-        xp.broadcast_to(t75, batch),  # 0, 2
-        xp.broadcast_to(t85, batch),  # 0, 3
-        xp.broadcast_to(t97, batch),  # 0, 4
-        xp.broadcast_to(-t122, batch),  # 0, 5
+        xp.broadcast_to(-t69, batch),  # 0, 0
+        xp.broadcast_to(t132, batch),  # 0, 1
+        xp.broadcast_to(t77, batch),  # 0, 2
+        xp.broadcast_to(t87, batch),  # 0, 3
+        xp.broadcast_to(t99, batch),  # 0, 4
+        xp.broadcast_to(-t124, batch),  # 0, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 6
-        xp.broadcast_to(t74, batch),  # 1, 0
-        xp.broadcast_to(t131, batch),  # 1, 1
-        xp.broadcast_to(t68, batch),  # 1, 2
-        xp.broadcast_to(-t86, batch),  # 1, 3
-        xp.broadcast_to(t98, batch),  # 1, 4
-        xp.broadcast_to(t123, batch),  # 1, 5
+        xp.broadcast_to(t76, batch),  # 1, 0
+        xp.broadcast_to(t133, batch),  # 1, 1
+        xp.broadcast_to(t70, batch),  # 1, 2
+        xp.broadcast_to(-t88, batch),  # 1, 3
+        xp.broadcast_to(t100, batch),  # 1, 4
+        xp.broadcast_to(t125, batch),  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
-        xp.broadcast_to(-t76, batch),  # 2, 1
-        xp.broadcast_to(-t77, batch),  # 2, 2
-        xp.broadcast_to(t81, batch),  # 2, 3
-        xp.broadcast_to(t93, batch),  # 2, 4
-        xp.broadcast_to(-t116, batch),  # 2, 5
+        xp.broadcast_to(-t78, batch),  # 2, 1
+        xp.broadcast_to(-t79, batch),  # 2, 2
+        xp.broadcast_to(t83, batch),  # 2, 3
+        xp.broadcast_to(t95, batch),  # 2, 4
+        xp.broadcast_to(-t118, batch),  # 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
-        xp.broadcast_to(-t127*(t136 + t142) + t128*(t143 - t144) - t143*t145 - t136*t146, batch),  # 3, 1
-        xp.broadcast_to(t127*(t147 - t152) + t128*(t153 - t154) + t156 + t158, batch),  # 3, 2
-        xp.broadcast_to(t127*(t159 - t162) - t128*(t163 + t164) + t165 + t166, batch),  # 3, 3
-        xp.broadcast_to(t127*(t167 - t170) + t128*(t171 - t172) + t173 + t174, batch),  # 3, 4
-        xp.broadcast_to(-t127*(t175 + t178) + t128*(t179 - t180) + t181 - t182, batch),  # 3, 5
-        xp.broadcast_to(t127*(t183 - t186) + t128*(t187 - t188) + t189 + t190, batch),  # 3, 6
+        xp.broadcast_to(t157 + t159 - t161 - t162, batch),  # 3, 1
+        xp.broadcast_to(t164 + t166 + t168 + t169, batch),  # 3, 2
+        xp.broadcast_to(t170 + t171 + t173 + t174, batch),  # 3, 3
+        xp.broadcast_to(t175 + t176 + t178 + t179, batch),  # 3, 4
+        xp.broadcast_to(t180 + t182 + t183 - t184, batch),  # 3, 5
+        xp.broadcast_to(t185 + t186 + t188 + t189, batch),  # 3, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
-        xp.broadcast_to(t127*(t192 - t15*t194) + t128*(t195 - t23*t194) + t137*t196 - t138*t196, batch),  # 4, 1
-        xp.broadcast_to(t127*(s2*t195 - t15*t197) - t128*(t23*t197 + s2*t192) + t69*t198 - t78*t199, batch),  # 4, 2
-        xp.broadcast_to(-t127*(t3*t191 + t15*t200) - t128*(t6*t191 + t23*t200) + t88*t198 - t87*t199, batch),  # 4, 3
-        xp.broadcast_to(t127*(t18*t191 - t15*t201) - t128*(t10*t191 + t23*t201) + t100*t198 - t99*t199, batch),  # 4, 4
-        xp.broadcast_to(t127*(t20*t191 - t15*t202) + t128*(t12*t191 - t23*t202) - t108*t199 - t109*t198, batch),  # 4, 5
-        xp.broadcast_to(t127*(t22*t191 - t15*t203) - t128*(t14*t191 + t23*t203) + t125*t198 - t124*t199, batch),  # 4, 6
+        xp.broadcast_to(t129*(c1*t147 - t149*t15) + t130*(s1*t147 - t149*t23) + t141*t190 - t142*t190, batch),  # 4, 1
+        xp.broadcast_to(t129*(-t150*t15 + t147*t16) - t130*(t150*t23 + t147*t8) + t71*t191 - t80*t192, batch),  # 4, 2
+        xp.broadcast_to(-t129*(t151*t15 + t3*t147) - t130*(t151*t23 + t6*t147) + t90*t191 - t89*t192, batch),  # 4, 3
+        xp.broadcast_to(t129*(t18*t147 - t152*t15) - t130*(t10*t147 + t152*t23) + t102*t191 - t101*t192, batch),  # 4, 4
+        xp.broadcast_to(t129*(t20*t147 - t153*t15) + t130*(t12*t147 - t153*t23) - t110*t192 - t111*t191, batch),  # 4, 5
+        xp.broadcast_to(t129*(t22*t147 - t154*t15) - t130*(t154*t23 + t14*t147) + t127*t191 - t126*t192, batch),  # 4, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 0
-        xp.broadcast_to(t127*(t204 + t32*t142) + t128*(-t205 + t32*t144) - t139*t206 + t205*t145 + t204*t146, batch),  # 5, 1
-        xp.broadcast_to(-(t133 - t127*(-t32*t147 + t32*t152) - t128*(-t32*t153 + t32*t154) + t150*t206 + t32*t156 + t32*t158), batch),  # 5, 2
-        xp.broadcast_to(-(t82 - t127*(-t32*t159 + t32*t162) - t128*(t32*t163 + t32*t164) + t160*t206 + t32*t165 + t32*t166), batch),  # 5, 3
-        xp.broadcast_to(t94 + t127*(-t32*t167 + t32*t170) + t128*(-t32*t171 + t32*t172) - t168*t206 - t32*t173 - t32*t174, batch),  # 5, 4
-        xp.broadcast_to(t105 + t127*(t32*t175 + t32*t178) + t128*(-t32*t179 + t32*t180) - t176*t206 + t32*t182 - t32*t181, batch),  # 5, 5
-        xp.broadcast_to(t117 + t127*(-t32*t183 + t32*t186) + t128*(-t32*t187 + t32*t188) - t184*t206 - t32*t189 - t32*t190, batch),  # 5, 6
+        xp.broadcast_to(-(t121*t143 + t34*t157 + t34*t159 - t34*t161 - t34*t162), batch),  # 5, 1
+        xp.broadcast_to(-(t135 + t121*t146 + t34*t164 + t34*t166 + t34*t168 + t34*t169), batch),  # 5, 2
+        xp.broadcast_to(-(t84 + t121*t137 + t34*t170 + t34*t171 + t34*t173 + t34*t174), batch),  # 5, 3
+        xp.broadcast_to(-(-t96 + t121*t138 + t34*t175 + t34*t176 + t34*t178 + t34*t179), batch),  # 5, 4
+        xp.broadcast_to(-(-t107 + t121*t139 - t34*t184 + t34*t180 + t34*t182 + t34*t183), batch),  # 5, 5
+        xp.broadcast_to(-(-t119 + t121*t140 + t34*t185 + t34*t186 + t34*t188 + t34*t189), batch),  # 5, 6
     ], (6, 7))
     return Jd
 

@@ -1314,7 +1314,7 @@ def bias_acceleration(q, q_dot):
 
 
 def task_jacobian_dot(q, q_dot):
-    """time derivative of the analytic Jacobian along q_dot (6 x DOF): mu'' = J_a q'' + J_a' q': (6 x 6), 624 operations."""
+    """time derivative of the analytic Jacobian along q_dot (6 x DOF): mu'' = J_a q'' + J_a' q': (6 x 6), 600 operations."""
     xp, dtype, device, batch, (q, q_dot,) = _arguments(("q", q, (6,)), ("q_dot", q_dot, (6,)))
     q2 = q[..., 1]
     q3 = q[..., 2]
@@ -1374,213 +1374,204 @@ def task_jacobian_dot(q, q_dot):
     t32 = t7*c5 + s5*t31
     t33 = c5*t31 - t7*s5
     t34 = t32*c6 + s6*(0.5*t33 - 0.8660254037844386*t21)
-    t35 = 0.8660254037844386*t4 - 0.5*t23
-    t36 = c4*t14
-    t37 = s5*t35 + c5*t36
-    t38 = c5*t35 - s5*t36
-    t39 = t37*c6 + s6*(0.5*t38 + 0.8660254037844386*t25)
-    t40 = 0.5*t18 + 0.8660254037844386*t29
-    t41 = t40
-    t42 = 0.2115971250007892*t40
-    t43 = t42 - t19
-    t44 = t43 - t15
-    t45 = t44 - 0.0098*s1
-    t46 = 0.5*t21 + 0.8660254037844386*t33
-    t47 = t46
-    t48 = 0.2115971250007892*t46
-    t49 = t48 - t22
-    t50 = t49 - t16
-    t51 = t50 - 0.0098*c1
-    t52 = t51*s1 - t45*c1
-    t53 = t13*t44 - t50*t12
-    t54 = t21*t43 - t18*t49
-    t55 = t47*t42 - t41*t48
-    t56 = 0.5*t25 - 0.8660254037844386*t38
-    t57 = t56
-    t58 = -0.2115971250007892*t56
-    t59 = t58 - t26
-    t60 = t9 + t59
-    t61 = t60 + 0.41*s2
-    t62 = t13*t60 + t4*t50
-    t63 = t21*t59 + t25*t49
-    t64 = t47*t58 + t57*t48
-    t65 = t4*t44 + t60*t12
-    t66 = t18*t59 + t25*t43
-    t67 = t41*t58 + t57*t42
-    t68 = 0.41*c2
-    t69 = t45 + c1*t68
-    t70 = t51 - s1*t68
-    t71 = t69*c1 - t70*s1
-    t72 = qd3*s1
-    t73 = qd2*s1
-    t74 = t72 - t73
-    t75 = t12*qd1 - t4*t74
-    t76 = c1*qd3
-    t77 = c1*qd2
-    t78 = t76 - t77
-    t79 = t4*t78 - t13*qd1
-    t80 = t12*t78 - t13*t74
-    t81 = t12*qd4
-    t82 = t74 - t81
-    t83 = t13*qd4
-    t84 = t78 - t83
-    t85 = t18*t84 - t21*t82
-    t86 = -qd1 + t4*qd4
-    t87 = t86
-    t88 = t21*t87 + t25*t84
-    t89 = t18*t87 + t25*t82
-    t90 = t18*qd5
-    t91 = t82 - t90
-    t92 = t90 + t41*qd6 + t81 + t73 - t72
-    t93 = t21*qd5
-    t94 = t84 - t93
-    t95 = t41*t94 - t47*t91
-    t96 = t83 + t93 + t47*qd6 + t77 - t76
-    t97 = t96*t30 - t92*t34
-    t98 = t25*qd5
-    t99 = t87 + t98
-    t100 = t47*t99 + t57*t94
-    t101 = t41*t99 + t57*t91
-    t102 = t98 + t57*qd6 + t86
-    t103 = t96*t39 + t102*t34
-    t104 = t92*t39 + t102*t30
-    t105 = t64*qd6
-    t106 = t63*qd5 + t105
-    t107 = t106 + t62*qd4
-    t108 = -t107 + t60*t76
-    t109 = t108 - t61*t77
-    t110 = t109 + t70*qd1
-    t111 = t67*qd6
-    t112 = t66*qd5 + t111
-    t113 = t112 + t65*qd4
-    t114 = t113 - t60*t72
-    t115 = t114 + t61*t73
-    t116 = t115 - t69*qd1
-    t117 = t109*c1 - t115*s1
-    t118 = t62*t78 + t65*t74 - t13*t107 - t113*t12
-    t119 = t63*t84 + t66*t82 - t106*t21 - t112*t18
-    t120 = t64*t94 + t67*t91 - t41*t111 - t47*t105
-    t121 = t55*qd6
-    t122 = t54*qd5 + t121
-    t123 = t122 + t53*qd4
-    t124 = t123 + t52*qd3
-    t125 = t124 + t71*qd2
-    t126 = t65*qd1 + t53*t78 - t13*t123 - t113*t4
-    t127 = t112*t25 + t122*t21 + t66*t87 - t54*t84
-    t128 = t67*t99 - t55*t94 + t47*t121 + t57*t111
-    t129 = t123*t12 + t62*qd1 - t107*t4 - t53*t74
-    t130 = t106*t25 + t63*t87 + t54*t82 - t122*t18
-    t131 = t64*t99 + t55*t91 + t57*t105 - t41*t121
-    t132 = s1*qd1
-    t133 = -t125*c1 + t61*t132
-    t134 = -t124*c1 + t60*t132 + t52*t77
-    t135 = c1*qd1
-    t136 = t125*s1 + t61*t135
-    t137 = t124*s1 + t60*t135 - t52*t73
-    t138 = t60*qd2
-    t139 = t114*s1 - t108*c1 + c1**2*t138 + s1**2*t138
-    t140 = t30**2 + t34**2
-    t141 = 1/t140
-    t142 = c1*t141
-    t143 = t30*s1
-    t144 = t34*c1
-    t145 = t143 + t144
-    t146 = -t145
-    t147 = 2/t140**2
-    t148 = t146*t147
-    t149 = t34*t148
-    t150 = s1*t141
-    t151 = t30*t148
-    t152 = qd1*t34
-    t153 = t150*t152
-    t154 = qd1*t30
-    t155 = t142*t154
-    t156 = t145*t147
-    t157 = t34*t156
-    t158 = t30*t156
-    t159 = t13*t141
-    t160 = -(t13*t34 + t30*t12)
-    t161 = t160*t147
-    t162 = t34*t161
-    t163 = t12*t141
-    t164 = t30*t161
-    t165 = t30*t141
-    t166 = t79*t165
-    t167 = t34*t141
-    t168 = t75*t167
-    t169 = t21*t141
-    t170 = -(t18*t30 + t21*t34)
-    t171 = t170*t147
-    t172 = t34*t171
-    t173 = t18*t141
-    t174 = t30*t171
-    t175 = t88*t165
-    t176 = t89*t167
-    t177 = t47*t141
-    t178 = -(t41*t30 + t47*t34)
-    t179 = t178*t147
-    t180 = t34*t179
-    t181 = t41*t141
-    t182 = t30*t179
-    t183 = t100*t165
-    t184 = t101*t167
-    t185 = 1/xp.sqrt(t140)
-    t186 = s1*t185
-    t187 = 1/t140**1.5
-    t188 = t34*s1
-    t189 = t30*c1
-    t190 = t187*(t188 - t189)
-    t191 = c1*t185
-    t192 = qd1*t185
-    t193 = t143*t192 + t144*t192
-    t194 = t187*(t189 - t188)
-    t195 = t187*(t34*t12 - t13*t30)
-    t196 = t30*t185
-    t197 = t34*t185
-    t198 = t187*(t18*t34 - t21*t30)
-    t199 = t187*(t41*t34 - t47*t30)
-    t200 = t39*t142
-    t201 = t39*t150
-    t202 = t141*t97
-    t203 = t200*t154
-    t204 = t201*t152
+    t35 = t30**2 + t34**2
+    t36 = xp.sqrt(t35)
+    t37 = 0.8660254037844386*t4 - 0.5*t23
+    t38 = c4*t14
+    t39 = s5*t37 + c5*t38
+    t40 = c5*t37 - s5*t38
+    t41 = t39*c6 + s6*(0.5*t40 + 0.8660254037844386*t25)
+    t42 = 0.5*t18 + 0.8660254037844386*t29
+    t43 = t42
+    t44 = 0.2115971250007892*t42
+    t45 = t44 - t19
+    t46 = t45 - t15
+    t47 = t46 - 0.0098*s1
+    t48 = 0.5*t21 + 0.8660254037844386*t33
+    t49 = t48
+    t50 = 0.2115971250007892*t48
+    t51 = t50 - t22
+    t52 = t51 - t16
+    t53 = t52 - 0.0098*c1
+    t54 = t53*s1 - t47*c1
+    t55 = t13*t46 - t52*t12
+    t56 = t21*t45 - t18*t51
+    t57 = t49*t44 - t43*t50
+    t58 = 0.5*t25 - 0.8660254037844386*t40
+    t59 = t58
+    t60 = -0.2115971250007892*t58
+    t61 = t60 - t26
+    t62 = t9 + t61
+    t63 = t62 + 0.41*s2
+    t64 = t13*t62 + t4*t52
+    t65 = t21*t61 + t25*t51
+    t66 = t49*t60 + t59*t50
+    t67 = t4*t46 + t62*t12
+    t68 = t18*t61 + t25*t45
+    t69 = t43*t60 + t59*t44
+    t70 = 0.41*c2
+    t71 = t47 + c1*t70
+    t72 = t53 - s1*t70
+    t73 = t71*c1 - t72*s1
+    t74 = qd3*s1
+    t75 = qd2*s1
+    t76 = t74 - t75
+    t77 = t12*qd1 - t4*t76
+    t78 = c1*qd3
+    t79 = c1*qd2
+    t80 = t78 - t79
+    t81 = t4*t80 - t13*qd1
+    t82 = t12*t80 - t13*t76
+    t83 = t12*qd4
+    t84 = t76 - t83
+    t85 = t13*qd4
+    t86 = t80 - t85
+    t87 = t18*t86 - t21*t84
+    t88 = -qd1 + t4*qd4
+    t89 = t88
+    t90 = t21*t89 + t25*t86
+    t91 = t18*t89 + t25*t84
+    t92 = t18*qd5
+    t93 = t84 - t92
+    t94 = t92 + t43*qd6 + t83 + t75 - t74
+    t95 = t21*qd5
+    t96 = t86 - t95
+    t97 = t43*t96 - t49*t93
+    t98 = t85 + t95 + t49*qd6 + t79 - t78
+    t99 = t98*t30 - t94*t34
+    t100 = t25*qd5
+    t101 = t89 + t100
+    t102 = t49*t101 + t59*t96
+    t103 = t43*t101 + t59*t93
+    t104 = t100 + t59*qd6 + t88
+    t105 = t98*t41 + t104*t34
+    t106 = t94*t41 + t104*t30
+    t107 = t66*qd6
+    t108 = t65*qd5 + t107
+    t109 = t108 + t64*qd4
+    t110 = -t109 + t62*t78
+    t111 = t110 - t63*t79
+    t112 = t111 + t72*qd1
+    t113 = t69*qd6
+    t114 = t68*qd5 + t113
+    t115 = t114 + t67*qd4
+    t116 = t115 - t62*t74
+    t117 = t116 + t63*t75
+    t118 = t117 - t71*qd1
+    t119 = t111*c1 - t117*s1
+    t120 = t64*t80 + t67*t76 - t13*t109 - t115*t12
+    t121 = t65*t86 + t68*t84 - t108*t21 - t114*t18
+    t122 = t66*t96 + t69*t93 - t43*t113 - t49*t107
+    t123 = t57*qd6
+    t124 = t56*qd5 + t123
+    t125 = t124 + t55*qd4
+    t126 = t125 + t54*qd3
+    t127 = t126 + t73*qd2
+    t128 = t67*qd1 + t55*t80 - t13*t125 - t115*t4
+    t129 = t114*t25 + t124*t21 + t68*t89 - t56*t86
+    t130 = t69*t101 - t57*t96 + t49*t123 + t59*t113
+    t131 = t125*t12 + t64*qd1 - t109*t4 - t55*t76
+    t132 = t108*t25 + t65*t89 + t56*t84 - t124*t18
+    t133 = t66*t101 + t57*t93 + t59*t107 - t43*t123
+    t134 = s1*qd1
+    t135 = -t127*c1 + t63*t134
+    t136 = -t126*c1 + t62*t134 + t54*t79
+    t137 = c1*qd1
+    t138 = t127*s1 + t63*t137
+    t139 = t126*s1 + t62*t137 - t54*t75
+    t140 = t62*qd2
+    t141 = t116*s1 - t110*c1 + c1**2*t140 + s1**2*t140
+    t142 = 1/t35
+    t143 = -t142*(t13*t34 + t30*t12)
+    t144 = -t142*(t18*t30 + t21*t34)
+    t145 = -t142*(t43*t30 + t49*t34)
+    t146 = t30*s1
+    t147 = t34*c1
+    t148 = t146 + t147
+    t149 = -t142*t148
+    t150 = t142*t148
+    t151 = t34*s1
+    t152 = t30*c1
+    t153 = 1/t36
+    t154 = t142*t153
+    t155 = (t151 - t152)*t154
+    t156 = (t152 - t151)*t154
+    t157 = (t34*t12 - t13*t30)*t154
+    t158 = (t18*t34 - t21*t30)*t154
+    t159 = (t43*t34 - t49*t30)*t154
+    t160 = 2*t149
+    t161 = t142*t106
+    t162 = -(c1 + t34*t160)*t161
+    t163 = t142*t105
+    t164 = -(s1 + t30*t160)*t163
+    t165 = qd1*t142
+    t166 = t151*t165
+    t167 = t152*t165
+    t168 = 2*t150
+    t169 = (c1 - t34*t168)*t161
+    t170 = (s1 - t30*t168)*t163
+    t171 = t30*t142
+    t172 = t81*t171
+    t173 = t34*t142
+    t174 = t77*t173
+    t175 = 2*t143
+    t176 = -(t13 + t34*t175)*t161
+    t177 = -(t12 + t30*t175)*t163
+    t178 = t90*t171
+    t179 = 2*t144
+    t180 = -(t21 + t34*t179)*t161
+    t181 = t91*t173
+    t182 = -(t18 + t30*t179)*t163
+    t183 = t102*t171
+    t184 = 2*t145
+    t185 = -(t49 + t34*t184)*t161
+    t186 = t103*t173
+    t187 = -(t43 + t30*t184)*t163
+    t188 = s1*t153
+    t189 = c1*t153
+    t190 = qd1*t153
+    t191 = t146*t190 + t147*t190
+    t192 = t30*t153
+    t193 = t34*t153
+    t194 = t41*t167
+    t195 = t41*t166
     Jd = _stack(xp, [
-        xp.broadcast_to(t116, batch),  # 0, 0
-        xp.broadcast_to(t133, batch),  # 0, 1
-        xp.broadcast_to(-t134, batch),  # 0, 2
-        xp.broadcast_to(t126, batch),  # 0, 3
-        xp.broadcast_to(-t127, batch),  # 0, 4
-        xp.broadcast_to(-t128, batch),  # 0, 5
-        xp.broadcast_to(-t110, batch),  # 1, 0
-        xp.broadcast_to(t136, batch),  # 1, 1
-        xp.broadcast_to(-t137, batch),  # 1, 2
-        xp.broadcast_to(t129, batch),  # 1, 3
-        xp.broadcast_to(-t130, batch),  # 1, 4
-        xp.broadcast_to(-t131, batch),  # 1, 5
+        xp.broadcast_to(t118, batch),  # 0, 0
+        xp.broadcast_to(t135, batch),  # 0, 1
+        xp.broadcast_to(-t136, batch),  # 0, 2
+        xp.broadcast_to(t128, batch),  # 0, 3
+        xp.broadcast_to(-t129, batch),  # 0, 4
+        xp.broadcast_to(-t130, batch),  # 0, 5
+        xp.broadcast_to(-t112, batch),  # 1, 0
+        xp.broadcast_to(t138, batch),  # 1, 1
+        xp.broadcast_to(-t139, batch),  # 1, 2
+        xp.broadcast_to(t131, batch),  # 1, 3
+        xp.broadcast_to(-t132, batch),  # 1, 4
+        xp.broadcast_to(-t133, batch),  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
-        xp.broadcast_to(t117, batch),  # 2, 1
-        xp.broadcast_to(t139, batch),  # 2, 2
-        xp.broadcast_to(t118, batch),  # 2, 3
-        xp.broadcast_to(t119, batch),  # 2, 4
-        xp.broadcast_to(t120, batch),  # 2, 5
+        xp.broadcast_to(t119, batch),  # 2, 1
+        xp.broadcast_to(t141, batch),  # 2, 2
+        xp.broadcast_to(t120, batch),  # 2, 3
+        xp.broadcast_to(t121, batch),  # 2, 4
+        xp.broadcast_to(t122, batch),  # 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
-        xp.broadcast_to(-t104*(t142 + t149) + t103*(t150 + t151) + t153 - t155, batch),  # 3, 1
-        xp.broadcast_to(t104*(t142 - t157) - t103*(t150 - t158) + t155 - t153, batch),  # 3, 2
-        xp.broadcast_to(-t104*(t159 + t162) + t103*(t163 + t164) + t166 + t168, batch),  # 3, 3
-        xp.broadcast_to(-t104*(t169 + t172) + t103*(t173 + t174) + t175 - t176, batch),  # 3, 4
-        xp.broadcast_to(-t104*(t177 + t180) + t103*(t181 + t182) + t183 - t184, batch),  # 3, 5
+        xp.broadcast_to(t162 - t164 + t166 - t167, batch),  # 3, 1
+        xp.broadcast_to(t169 - t170 + t167 - t166, batch),  # 3, 2
+        xp.broadcast_to(t172 + t174 + t176 - t177, batch),  # 3, 3
+        xp.broadcast_to(t178 + t180 - t181 - t182, batch),  # 3, 4
+        xp.broadcast_to(t183 + t185 - t186 - t187, batch),  # 3, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
-        xp.broadcast_to(t104*(t186 - t34*t190) + t103*(t191 + t30*t190) + t193, batch),  # 4, 1
-        xp.broadcast_to(-(t104*(t186 + t34*t194) + t103*(t191 - t30*t194) + t193), batch),  # 4, 2
-        xp.broadcast_to(t104*(t12*t185 - t34*t195) + t103*(t13*t185 + t30*t195) + t75*t196 - t79*t197, batch),  # 4, 3
-        xp.broadcast_to(-(-t104*(t18*t185 - t34*t198) - t103*(t21*t185 + t30*t198) + t88*t197 + t89*t196), batch),  # 4, 4
-        xp.broadcast_to(-(-t104*(t41*t185 - t34*t199) - t103*(t47*t185 + t30*t199) + t100*t197 + t101*t196), batch),  # 4, 5
+        xp.broadcast_to(t106*(t188 - t155*t34) + t105*(t155*t30 + t189) + t191, batch),  # 4, 1
+        xp.broadcast_to(-(t106*(t156*t34 + t188) + t105*(t189 - t156*t30) + t191), batch),  # 4, 2
+        xp.broadcast_to(t106*(t12*t153 - t157*t34) + t105*(t13*t153 + t157*t30) + t77*t192 - t81*t193, batch),  # 4, 3
+        xp.broadcast_to(-(-t106*(t18*t153 - t158*t34) - t105*(t158*t30 + t21*t153) + t90*t193 + t91*t192), batch),  # 4, 4
+        xp.broadcast_to(-(-t106*(t43*t153 - t159*t34) - t105*(t159*t30 + t49*t153) + t102*t193 + t103*t192), batch),  # 4, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 0
-        xp.broadcast_to(-(-t104*(t200 + t39*t149) + t103*(t201 + t39*t151) + t146*t202 - t203 + t204), batch),  # 5, 1
-        xp.broadcast_to(-(-t104*(-t200 + t39*t157) + t103*(-t201 + t39*t158) + t145*t202 - t204 + t203), batch),  # 5, 2
-        xp.broadcast_to(-(-t80 - t104*(t39*t159 + t39*t162) + t103*(t39*t163 + t39*t164) + t160*t202 + t39*t166 + t39*t168), batch),  # 5, 3
-        xp.broadcast_to(t85 + t104*(t39*t169 + t39*t172) - t103*(t39*t173 + t39*t174) - t170*t202 + t39*t176 - t39*t175, batch),  # 5, 4
-        xp.broadcast_to(t95 + t104*(t39*t177 + t39*t180) - t103*(t39*t181 + t39*t182) - t178*t202 + t39*t184 - t39*t183, batch),  # 5, 5
+        xp.broadcast_to(-(t99*t149 - t41*t164 + t41*t162 - t194 + t195), batch),  # 5, 1
+        xp.broadcast_to(-(t99*t150 - t41*t170 + t41*t169 - t195 + t194), batch),  # 5, 2
+        xp.broadcast_to(-(-t82 + t99*t143 - t41*t177 + t41*t172 + t41*t174 + t41*t176), batch),  # 5, 3
+        xp.broadcast_to(t87 - t99*t144 + t41*t181 + t41*t182 - t41*t178 - t41*t180, batch),  # 5, 4
+        xp.broadcast_to(t97 - t99*t145 + t41*t186 + t41*t187 - t41*t183 - t41*t185, batch),  # 5, 5
     ], (6, 6))
     return Jd
 

@@ -1068,7 +1068,7 @@ def bias_acceleration(q, q_dot):
 
 
 def task_jacobian_dot(q, q_dot):
-    """time derivative of the analytic Jacobian along q_dot (6 x DOF): mu'' = J_a q'' + J_a' q': (6 x 6), 499 operations."""
+    """time derivative of the analytic Jacobian along q_dot (6 x DOF): mu'' = J_a q'' + J_a' q': (6 x 6), 466 operations."""
     xp, dtype, device, batch, (q, q_dot,) = _arguments(("q", q, (6,)), ("q_dot", q_dot, (6,)))
     qd1 = q_dot[..., 0]
     qd2 = q_dot[..., 1]
@@ -1107,193 +1107,183 @@ def task_jacobian_dot(q, q_dot):
     t13 = t7*c5 - s5*t12
     t14 = t7*s5 + c5*t12
     t15 = t3*s6 + t13*c6
-    t16 = c4*s23
-    t17 = c23*s5 + c5*t16
-    t18 = -c23*c5 + s5*t16
-    t19 = s4*s23
-    t20 = -t17*c6 + s6*t19
-    t21 = 0.115*t10
-    t22 = t21 + 0.62*t8
-    t23 = 0.115*t14
-    t24 = t23 + 0.62*t12
-    t25 = t22*t12 - t24*t8
-    t26 = t6*t23 + t3*t21
-    t27 = t25*qd4 + t26*qd5
-    t28 = 0.115*t18
-    t29 = -0.62*c23 + t28
-    t30 = t29 - 0.12*s23
-    t31 = t30 - 0.6*s2
-    t32 = t24*c23 + t29*t12
-    t33 = t3*t28 + t23*t19
-    t34 = t22*c23 + t29*t8
-    t35 = t6*t28 - t21*t19
-    t36 = 0.12*c23
-    t37 = -t22 + c1*t36
-    t38 = -t24 + s1*t36
-    t39 = t37*c1 + t38*s1
-    t40 = t27 - t39*qd3
-    t41 = 0.6*c2
-    t42 = t37 + c1*t41
-    t43 = t38 + s1*t41
-    t44 = t42 + 0.18*c1
-    t45 = t43 + 0.18*s1
-    t46 = t42*c1 + t43*s1
-    t47 = t40 - t46*qd2
-    t48 = qd2*s1
-    t49 = qd3*s1
-    t50 = t48 + t49
-    t51 = t50
-    t52 = t51*c23 + qd1*t8
-    t53 = c1*qd2
-    t54 = c1*qd3
-    t55 = t53 + t54
-    t56 = t55
-    t57 = t56*c23 - qd1*t12
-    t58 = t51*t12 + t56*t8
-    t59 = qd4*t8
-    t60 = -t51 + t59
-    t61 = qd4*t12
-    t62 = t56 + t61
-    t63 = t6*t62 + t3*t60
-    t64 = qd1 + c23*qd4
-    t65 = t64
-    t66 = -t3*t65 + t62*t19
-    t67 = t6*t65 + t60*t19
-    t68 = t6*qd5
-    t69 = t60 - t68
-    t70 = t68 - t10*qd6 - t59 + t50
-    t71 = t3*qd5
-    t72 = t62 + t71
-    t73 = t33*t62 - t35*t60 + t35*t68 + t33*t71
-    t74 = t14*t69 - t10*t72
-    t75 = t61 + t71 + t14*qd6 + t55
-    t76 = t70*t15 + t75*t11
-    t77 = qd5*t19
-    t78 = t65 + t77
-    t79 = t14*t78 + t18*t72
-    t80 = t10*t78 + t18*t69
-    t81 = t77 - t18*qd6 + t64
-    t82 = t75*t20 - t81*t15
-    t83 = t70*t20 + t81*t11
-    t84 = t33*qd5
-    t85 = t32*qd4 + t84
-    t86 = t85 + t30*t54
-    t87 = t86 + t31*t53
-    t88 = t87 - t45*qd1
-    t89 = t32*qd1 + t25*t51 + t85*c23 - t27*t8
-    t90 = t33*t65 - t26*t60 + t26*t68 + t84*t19
-    t91 = t35*qd5
-    t92 = t91 - t34*qd4
-    t93 = t92 + t30*t49
-    t94 = t93 + t31*t48
-    t95 = t94 + t44*qd1
-    t96 = t34*qd1 + t25*t56 - t92*c23 + t27*t12
-    t97 = t26*t62 - t35*t65 + t26*t71 - t91*t19
-    t98 = t87*c1 + t94*s1
-    t99 = t34*t51 - t32*t56 + t92*t8 - t85*t12
-    t100 = s1*qd1
-    t101 = t47*c1 - t31*t100
-    t102 = -t40*c1 + t30*t100 + t39*t53
-    t103 = c1*qd1
-    t104 = t47*s1 + t31*t103
-    t105 = t40*s1 + t30*t103 - t39*t48
-    t106 = qd2*t30
-    t107 = t86*c1 + t93*s1 + c1**2*t106 + s1**2*t106
-    t108 = t11**2 + t15**2
-    t109 = 1/t108
-    t110 = s1*t109
-    t111 = t15*c1
-    t112 = t11*s1
-    t113 = t111 - t112
-    t114 = 2/t108**2
-    t115 = t113*t114
-    t116 = t11*t115
-    t117 = c1*t109
-    t118 = t15*t115
-    t119 = qd1*t11
-    t120 = qd1*t15
-    t121 = -t82*(t110 + t116) + t83*(t117 - t118) - t117*t119 - t110*t120
-    t122 = s23*t117
-    t123 = t11*c1
-    t124 = t15*s1
-    t125 = s23*t123 + s23*t124
-    t126 = t125*t114
-    t127 = t11*t126
-    t128 = s23*t110
-    t129 = t15*t126
-    t130 = t11*t109
-    t131 = t57*t130
-    t132 = t15*t109
-    t133 = t52*t132
-    t134 = t6*t109
-    t135 = t3*t15 - t6*t11
-    t136 = t135*t114
-    t137 = t11*t136
-    t138 = t3*t109
-    t139 = t15*t136
-    t140 = t66*t130
-    t141 = t67*t132
-    t142 = t10*t109
-    t143 = t10*t11 + t14*t15
-    t144 = t143*t114
-    t145 = t11*t144
-    t146 = t14*t109
-    t147 = t15*t144
-    t148 = t80*t132
-    t149 = t79*t130
-    t150 = 1/xp.sqrt(t108)
-    t151 = c1*t150
-    t152 = 1/t108**1.5
-    t153 = t152*(t123 + t124)
-    t154 = s1*t150
-    t155 = qd1*t150
-    t156 = t82*(t151 - t11*t153) + t83*(t154 - t15*t153) + t111*t155 - t112*t155
-    t157 = t152*(s23*t112 - s23*t111)
-    t158 = t11*t150
-    t159 = t15*t150
-    t160 = t152*(t6*t15 + t3*t11)
-    t161 = t152*(t14*t11 - t10*t15)
-    t162 = t20*t110
-    t163 = t20*t117
-    t164 = t109*t76
-    t165 = t82*(t162 + t20*t116) + t83*(-t163 + t20*t118) + t113*t164 + t163*t119 + t162*t120
+    t16 = t11**2 + t15**2
+    t17 = xp.sqrt(t16)
+    t18 = c4*s23
+    t19 = c23*s5 + c5*t18
+    t20 = -c23*c5 + s5*t18
+    t21 = s4*s23
+    t22 = -t19*c6 + s6*t21
+    t23 = 0.115*t10
+    t24 = t23 + 0.62*t8
+    t25 = 0.115*t14
+    t26 = t25 + 0.62*t12
+    t27 = t24*t12 - t26*t8
+    t28 = t6*t25 + t3*t23
+    t29 = t27*qd4 + t28*qd5
+    t30 = 0.115*t20
+    t31 = -0.62*c23 + t30
+    t32 = t31 - 0.12*s23
+    t33 = t32 - 0.6*s2
+    t34 = t26*c23 + t31*t12
+    t35 = t3*t30 + t25*t21
+    t36 = t24*c23 + t31*t8
+    t37 = t6*t30 - t23*t21
+    t38 = 0.12*c23
+    t39 = -t24 + c1*t38
+    t40 = -t26 + s1*t38
+    t41 = t39*c1 + t40*s1
+    t42 = t29 - t41*qd3
+    t43 = 0.6*c2
+    t44 = t39 + c1*t43
+    t45 = t40 + s1*t43
+    t46 = t44 + 0.18*c1
+    t47 = t45 + 0.18*s1
+    t48 = t44*c1 + t45*s1
+    t49 = t42 - t48*qd2
+    t50 = qd2*s1
+    t51 = qd3*s1
+    t52 = t50 + t51
+    t53 = t52
+    t54 = t53*c23 + qd1*t8
+    t55 = c1*qd2
+    t56 = c1*qd3
+    t57 = t55 + t56
+    t58 = t57
+    t59 = t58*c23 - qd1*t12
+    t60 = t53*t12 + t58*t8
+    t61 = qd4*t8
+    t62 = -t53 + t61
+    t63 = qd4*t12
+    t64 = t58 + t63
+    t65 = t6*t64 + t3*t62
+    t66 = qd1 + c23*qd4
+    t67 = t66
+    t68 = -t3*t67 + t64*t21
+    t69 = t6*t67 + t62*t21
+    t70 = t6*qd5
+    t71 = t62 - t70
+    t72 = t70 - t10*qd6 - t61 + t52
+    t73 = t3*qd5
+    t74 = t64 + t73
+    t75 = t35*t64 - t37*t62 + t37*t70 + t35*t73
+    t76 = t14*t71 - t10*t74
+    t77 = t63 + t73 + t14*qd6 + t57
+    t78 = t72*t15 + t77*t11
+    t79 = qd5*t21
+    t80 = t67 + t79
+    t81 = t14*t80 + t20*t74
+    t82 = t10*t80 + t20*t71
+    t83 = t79 - t20*qd6 + t66
+    t84 = t77*t22 - t83*t15
+    t85 = t72*t22 + t83*t11
+    t86 = t35*qd5
+    t87 = t34*qd4 + t86
+    t88 = t87 + t32*t56
+    t89 = t88 + t33*t55
+    t90 = t89 - t47*qd1
+    t91 = t34*qd1 + t27*t53 + t87*c23 - t29*t8
+    t92 = t35*t67 - t28*t62 + t28*t70 + t86*t21
+    t93 = t37*qd5
+    t94 = t93 - t36*qd4
+    t95 = t94 + t32*t51
+    t96 = t95 + t33*t50
+    t97 = t96 + t46*qd1
+    t98 = t36*qd1 + t27*t58 - t94*c23 + t29*t12
+    t99 = t28*t64 - t37*t67 + t28*t73 - t93*t21
+    t100 = t89*c1 + t96*s1
+    t101 = t36*t53 - t34*t58 + t94*t8 - t87*t12
+    t102 = s1*qd1
+    t103 = t49*c1 - t33*t102
+    t104 = -t42*c1 + t32*t102 + t41*t55
+    t105 = c1*qd1
+    t106 = t49*s1 + t33*t105
+    t107 = t42*s1 + t32*t105 - t41*t50
+    t108 = qd2*t32
+    t109 = t88*c1 + t95*s1 + c1**2*t108 + s1**2*t108
+    t110 = 1/t16
+    t111 = t110*(t3*t15 - t6*t11)
+    t112 = t110*(t10*t11 + t14*t15)
+    t113 = t15*c1
+    t114 = t11*s1
+    t115 = t110*(t113 - t114)
+    t116 = t11*c1
+    t117 = t15*s1
+    t118 = t110*(s23*t116 + s23*t117)
+    t119 = 1/t17
+    t120 = t110*t119
+    t121 = (t116 + t117)*t120
+    t122 = (s23*t114 - s23*t113)*t120
+    t123 = (t6*t15 + t3*t11)*t120
+    t124 = (t14*t11 - t10*t15)*t120
+    t125 = 2*t115
+    t126 = t110*t84
+    t127 = -(s1 + t11*t125)*t126
+    t128 = t110*t85
+    t129 = (c1 - t15*t125)*t128
+    t130 = qd1*t110
+    t131 = t116*t130
+    t132 = t117*t130
+    t133 = t127 + t129 - t131 - t132
+    t134 = 2*t118
+    t135 = (t8 - t11*t134)*t126
+    t136 = (t12 - t15*t134)*t128
+    t137 = t11*t110
+    t138 = t59*t137
+    t139 = t15*t110
+    t140 = t54*t139
+    t141 = 2*t111
+    t142 = -(t6 + t11*t141)*t126
+    t143 = (t3 - t15*t141)*t128
+    t144 = t68*t137
+    t145 = t69*t139
+    t146 = t82*t139
+    t147 = 2*t112
+    t148 = (t10 - t11*t147)*t126
+    t149 = (t14 - t15*t147)*t128
+    t150 = t81*t137
+    t151 = qd1*t119
+    t152 = t84*(c1*t119 - t121*t11) + t85*(s1*t119 - t121*t15) + t113*t151 - t114*t151
+    t153 = t11*t119
+    t154 = t15*t119
+    t155 = t78*t115 - t22*t127 - t22*t129 + t22*t131 + t22*t132
     Jd = _stack(xp, [
-        xp.broadcast_to(-t95, batch),  # 0, 0
-        xp.broadcast_to(t101, batch),  # 0, 1
-        xp.broadcast_to(-t102, batch),  # 0, 2
-        xp.broadcast_to(t96, batch),  # 0, 3
-        xp.broadcast_to(t97, batch),  # 0, 4
+        xp.broadcast_to(-t97, batch),  # 0, 0
+        xp.broadcast_to(t103, batch),  # 0, 1
+        xp.broadcast_to(-t104, batch),  # 0, 2
+        xp.broadcast_to(t98, batch),  # 0, 3
+        xp.broadcast_to(t99, batch),  # 0, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5
-        xp.broadcast_to(t88, batch),  # 1, 0
-        xp.broadcast_to(t104, batch),  # 1, 1
-        xp.broadcast_to(t105, batch),  # 1, 2
-        xp.broadcast_to(t89, batch),  # 1, 3
-        xp.broadcast_to(t90, batch),  # 1, 4
+        xp.broadcast_to(t90, batch),  # 1, 0
+        xp.broadcast_to(t106, batch),  # 1, 1
+        xp.broadcast_to(t107, batch),  # 1, 2
+        xp.broadcast_to(t91, batch),  # 1, 3
+        xp.broadcast_to(t92, batch),  # 1, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
-        xp.broadcast_to(-t98, batch),  # 2, 1
-        xp.broadcast_to(-t107, batch),  # 2, 2
-        xp.broadcast_to(t99, batch),  # 2, 3
-        xp.broadcast_to(-t73, batch),  # 2, 4
+        xp.broadcast_to(-t100, batch),  # 2, 1
+        xp.broadcast_to(-t109, batch),  # 2, 2
+        xp.broadcast_to(t101, batch),  # 2, 3
+        xp.broadcast_to(-t75, batch),  # 2, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
-        xp.broadcast_to(t121, batch),  # 3, 1
-        xp.broadcast_to(t121, batch),  # 3, 2
-        xp.broadcast_to(t82*(t122 - t127) + t83*(t128 - t129) + t131 + t133, batch),  # 3, 3
-        xp.broadcast_to(-t82*(t134 + t137) + t83*(t138 - t139) + t140 - t141, batch),  # 3, 4
-        xp.broadcast_to(t82*(t142 - t145) + t83*(t146 - t147) + t148 - t149, batch),  # 3, 5
+        xp.broadcast_to(t133, batch),  # 3, 1
+        xp.broadcast_to(t133, batch),  # 3, 2
+        xp.broadcast_to(t135 + t136 + t138 + t140, batch),  # 3, 3
+        xp.broadcast_to(t142 + t143 + t144 - t145, batch),  # 3, 4
+        xp.broadcast_to(t146 + t148 + t149 - t150, batch),  # 3, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
-        xp.broadcast_to(t156, batch),  # 4, 1
-        xp.broadcast_to(t156, batch),  # 4, 2
-        xp.broadcast_to(t82*(s23*t154 - t11*t157) - t83*(t15*t157 + s23*t151) + t52*t158 - t57*t159, batch),  # 4, 3
-        xp.broadcast_to(t82*(t3*t150 - t11*t160) + t83*(t6*t150 - t15*t160) - t67*t158 - t66*t159, batch),  # 4, 4
-        xp.broadcast_to(t82*(t14*t150 - t11*t161) - t83*(t10*t150 + t15*t161) + t80*t158 + t79*t159, batch),  # 4, 5
+        xp.broadcast_to(t152, batch),  # 4, 1
+        xp.broadcast_to(t152, batch),  # 4, 2
+        xp.broadcast_to(t84*(-t122*t11 + t119*t12) - t85*(t122*t15 + t119*t8) + t54*t153 - t59*t154, batch),  # 4, 3
+        xp.broadcast_to(t84*(t3*t119 - t123*t11) + t85*(t6*t119 - t123*t15) - t69*t153 - t68*t154, batch),  # 4, 4
+        xp.broadcast_to(t84*(t14*t119 - t124*t11) - t85*(t124*t15 + t10*t119) + t82*t153 + t81*t154, batch),  # 4, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 0
-        xp.broadcast_to(t165, batch),  # 5, 1
-        xp.broadcast_to(t165, batch),  # 5, 2
-        xp.broadcast_to(-t58 + t82*(-t20*t122 + t20*t127) + t83*(-t20*t128 + t20*t129) + t125*t164 - t20*t131 - t20*t133, batch),  # 5, 3
-        xp.broadcast_to(t63 + t82*(t20*t134 + t20*t137) + t83*(-t20*t138 + t20*t139) + t135*t164 + t20*t141 - t20*t140, batch),  # 5, 4
-        xp.broadcast_to(t74 + t82*(-t20*t142 + t20*t145) + t83*(-t20*t146 + t20*t147) + t143*t164 + t20*t149 - t20*t148, batch),  # 5, 5
+        xp.broadcast_to(t155, batch),  # 5, 1
+        xp.broadcast_to(t155, batch),  # 5, 2
+        xp.broadcast_to(-(t60 - t78*t118 + t22*t135 + t22*t136 + t22*t138 + t22*t140), batch),  # 5, 3
+        xp.broadcast_to(t65 + t78*t111 + t22*t145 - t22*t142 - t22*t143 - t22*t144, batch),  # 5, 4
+        xp.broadcast_to(t76 + t78*t112 + t22*t150 - t22*t146 - t22*t148 - t22*t149, batch),  # 5, 5
     ], (6, 6))
     return Jd
 
@@ -1921,7 +1911,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t239 = t233 + t237*t32 - t238*t33
     t240 = t233*c23 + t236*t17 + t238*t23 - t237*t24 + t234*t11 + t235*t9
     t241 = t4*t234 + t236*t18 + t237*t37 + t238*t36 - t7*t235 + t233*t35
-    t242 = t10*t235 + t234*t12 - t233*t0
+    t242 = t10*t235 + t12*t234 - t233*t0
     t243 = t22*s1
     t244 = t234*c1 - t235*s1
     t245 = -t236*t34 + t237*t243 + t238*t58 + t244
@@ -2382,7 +2372,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t263 = xp.where(xp.not_equal(t118, 0), -(t122 - (t130*t262 + t148*t261 + t198*t259 + t228*t258 - t171*t260))/t118, 0)
     t264 = t258 + q1 + t64*t262 - t65*t263
     t265 = q4 + t52*t263 + t258*c23 + t261*t44 - t54*t262 + t259*t17 + t260*t9
-    t266 = q5 + t4*t259 + t53*t263 + t261*t45 + t262*t55 - t7*t260 + t258*t29
+    t266 = q5 + t4*t259 + t53*t263 + t55*t262 + t261*t45 - t7*t260 + t258*t29
     t267 = q6 + t11*t260 + t19*t259 - t28*t258
     t268 = s1*t262
     t269 = c1*t263

@@ -1235,7 +1235,7 @@ def bias_acceleration(q, q_dot):
 
 
 def task_jacobian_dot(q, q_dot):
-    """time derivative of the analytic Jacobian along q_dot (6 x DOF): mu'' = J_a q'' + J_a' q': (6 x 6), 575 operations."""
+    """time derivative of the analytic Jacobian along q_dot (6 x DOF): mu'' = J_a q'' + J_a' q': (6 x 6), 533 operations."""
     xp, dtype, device, batch, (q, q_dot,) = _arguments(("q", q, (6,)), ("q_dot", q_dot, (6,)))
     qd1 = q_dot[..., 0]
     qd2 = q_dot[..., 1]
@@ -1324,159 +1324,151 @@ def task_jacobian_dot(q, q_dot):
     t65 = t38*c5 + s5*t64
     t66 = c5*t64 - t38*s5
     t67 = t65*c6 - t23*s6
-    t68 = -(0.01745240643728351*t26 + 0.9998476951563913*t27)
-    t69 = t50*c5 + s5*t68
-    t70 = c5*t68 - t50*s5
-    t71 = t28*s6 + t69*c6
-    t72 = t5*qd3
-    t73 = qd2*s1
-    t74 = t72 + t73
-    t75 = t59 - t53*t73
-    t76 = t75 + t35*qd1
-    t77 = t0*t58 + t5*t46 - t54*qd1 + t44*t73
-    t78 = t5*qd1 + t0*t73
-    t79 = t10*qd3
-    t80 = c1*qd2
-    t81 = t79 - t80
-    t82 = t58 - t53*t80
-    t83 = t82 - t42*qd1
-    t84 = t0*t59 + t56*qd1 + t10*t46 - t44*t80
-    t85 = t82*c1 + t75*s1
-    t86 = t5*t59 - t10*t58 + t54*t80 - t56*t73
-    t87 = -t10*qd1 + t0*t80
-    t88 = t5*t80 + t10*t73
-    t89 = t15*t81 - t21*t74
-    t90 = t0*qd3
-    t91 = qd1 - t90
-    t92 = t21*t91 - t26*t81
-    t93 = t26*t74 - t15*t91
-    t94 = t15*qd4
-    t95 = t74 - t94
-    t96 = t21*qd4
-    t97 = t81 - t96
-    t98 = t57*t74 - t55*t81 + t55*t96 - t57*t94
-    t99 = t17*t97 - t23*t95
-    t100 = t26*qd4
-    t101 = t91 - t100
-    t102 = t45*t81 - t57*t91 + t57*t100 - t45*t96
-    t103 = t55*t91 - t45*t74 + t45*t94 - t55*t100
-    t104 = t23*t101 + t28*t97
-    t105 = t17*t101 + t28*t95
-    t106 = t17*qd5
-    t107 = t95 - t106
-    t108 = t94 + t106 + t62*qd6 - t72 - t73
-    t109 = t23*qd5
-    t110 = t97 - t109
-    t111 = t62*t110 - t66*t107
-    t112 = t96 + t109 + t66*qd6 + t80 - t79
-    t113 = t112*t63 - t108*t67
-    t114 = t28*qd5
-    t115 = t101 + t114
-    t116 = t66*t115 - t70*t110
-    t117 = t70*t107 - t62*t115
-    t118 = -qd1 + t90 + t100 + t70*qd6 - t114
-    t119 = t118*t67 - t112*t71
-    t120 = t108*t71 - t118*t63
-    t121 = qd1*t53
-    t122 = -t47*c1 + s1*t121
-    t123 = t47*s1 + c1*t121
-    t124 = t63**2 + t67**2
-    t125 = 1/t124
-    t126 = s1*t125
-    t127 = t63*s1
-    t128 = t67*c1
-    t129 = t127 - t128
-    t130 = 2/t124**2
-    t131 = t129*t130
-    t132 = t63*t131
-    t133 = c1*t125
-    t134 = t67*t131
-    t135 = qd1*t63
-    t136 = qd1*t67
-    t137 = t5*t125
-    t138 = t63*t5 + t67*t10
-    t139 = t138*t130
-    t140 = t63*t139
-    t141 = t10*t125
-    t142 = t67*t139
-    t143 = t63*t125
-    t144 = t87*t143
-    t145 = t67*t125
-    t146 = t78*t145
-    t147 = t15*t125
-    t148 = -(t15*t63 + t21*t67)
-    t149 = t148*t130
-    t150 = t63*t149
-    t151 = t21*t125
-    t152 = t67*t149
-    t153 = t92*t143
-    t154 = t93*t145
-    t155 = t17*t125
-    t156 = -(t17*t63 + t23*t67)
-    t157 = t156*t130
-    t158 = t63*t157
-    t159 = t23*t125
-    t160 = t67*t157
-    t161 = t104*t143
-    t162 = t105*t145
-    t163 = t62*t125
-    t164 = -(t62*t63 + t66*t67)
-    t165 = t164*t130
-    t166 = t63*t165
-    t167 = t66*t125
-    t168 = t67*t165
-    t169 = t116*t143
-    t170 = t117*t145
-    t171 = 1/xp.sqrt(t124)
-    t172 = 1/t124**1.5
-    t173 = -t172*(t63*c1 + t67*s1)
-    t174 = qd1*t171
-    t175 = t172*(t63*t10 - t67*t5)
-    t176 = t63*t171
-    t177 = t67*t171
-    t178 = t172*(t15*t67 - t21*t63)
-    t179 = t172*(t17*t67 - t23*t63)
-    t180 = t172*(t62*t67 - t66*t63)
-    t181 = t71*t126
-    t182 = t71*t133
-    t183 = t125*t113
+    t68 = t63**2 + t67**2
+    t69 = xp.sqrt(t68)
+    t70 = -(0.01745240643728351*t26 + 0.9998476951563913*t27)
+    t71 = t50*c5 + s5*t70
+    t72 = c5*t70 - t50*s5
+    t73 = t28*s6 + t71*c6
+    t74 = t5*qd3
+    t75 = qd2*s1
+    t76 = t74 + t75
+    t77 = t59 - t53*t75
+    t78 = t77 + t35*qd1
+    t79 = t0*t58 + t5*t46 - t54*qd1 + t44*t75
+    t80 = t5*qd1 + t0*t75
+    t81 = t10*qd3
+    t82 = c1*qd2
+    t83 = t81 - t82
+    t84 = t58 - t53*t82
+    t85 = t84 - t42*qd1
+    t86 = t0*t59 + t56*qd1 + t10*t46 - t44*t82
+    t87 = t84*c1 + t77*s1
+    t88 = t5*t59 - t10*t58 + t54*t82 - t56*t75
+    t89 = -t10*qd1 + t0*t82
+    t90 = t5*t82 + t10*t75
+    t91 = t15*t83 - t21*t76
+    t92 = t0*qd3
+    t93 = qd1 - t92
+    t94 = t21*t93 - t26*t83
+    t95 = t26*t76 - t15*t93
+    t96 = t15*qd4
+    t97 = t76 - t96
+    t98 = t21*qd4
+    t99 = t83 - t98
+    t100 = t57*t76 - t55*t83 + t55*t98 - t57*t96
+    t101 = t17*t99 - t23*t97
+    t102 = t26*qd4
+    t103 = t93 - t102
+    t104 = t45*t83 - t57*t93 + t57*t102 - t45*t98
+    t105 = t55*t93 - t45*t76 + t45*t96 - t55*t102
+    t106 = t23*t103 + t28*t99
+    t107 = t17*t103 + t28*t97
+    t108 = t17*qd5
+    t109 = t97 - t108
+    t110 = t96 + t108 + t62*qd6 - t74 - t75
+    t111 = t23*qd5
+    t112 = t99 - t111
+    t113 = t62*t112 - t66*t109
+    t114 = t98 + t111 + t66*qd6 + t82 - t81
+    t115 = t114*t63 - t110*t67
+    t116 = t28*qd5
+    t117 = t103 + t116
+    t118 = t66*t117 - t72*t112
+    t119 = t72*t109 - t62*t117
+    t120 = -qd1 + t92 + t102 + t72*qd6 - t116
+    t121 = t120*t67 - t114*t73
+    t122 = t110*t73 - t120*t63
+    t123 = qd1*t53
+    t124 = -t47*c1 + s1*t123
+    t125 = t47*s1 + c1*t123
+    t126 = 1/t68
+    t127 = t126*(t63*t5 + t67*t10)
+    t128 = -t126*(t15*t63 + t21*t67)
+    t129 = -t126*(t17*t63 + t23*t67)
+    t130 = -t126*(t62*t63 + t66*t67)
+    t131 = t63*s1
+    t132 = t67*c1
+    t133 = t126*(t131 - t132)
+    t134 = t63*c1
+    t135 = t67*s1
+    t136 = 1/t69
+    t137 = t126*t136
+    t138 = -(t134 + t135)*t137
+    t139 = (t63*t10 - t67*t5)*t137
+    t140 = (t15*t67 - t21*t63)*t137
+    t141 = (t17*t67 - t23*t63)*t137
+    t142 = (t62*t67 - t66*t63)*t137
+    t143 = 2*t133
+    t144 = t126*t121
+    t145 = (s1 - t63*t143)*t144
+    t146 = t126*t122
+    t147 = -(c1 + t67*t143)*t146
+    t148 = qd1*t126
+    t149 = t134*t148
+    t150 = t135*t148
+    t151 = t63*t126
+    t152 = t89*t151
+    t153 = t67*t126
+    t154 = t80*t153
+    t155 = 2*t127
+    t156 = (t5 - t63*t155)*t144
+    t157 = (t10 - t67*t155)*t146
+    t158 = t94*t151
+    t159 = t95*t153
+    t160 = 2*t128
+    t161 = -(t15 + t63*t160)*t144
+    t162 = -(t21 + t67*t160)*t146
+    t163 = t106*t151
+    t164 = 2*t129
+    t165 = -(t17 + t63*t164)*t144
+    t166 = -(t23 + t67*t164)*t146
+    t167 = t107*t153
+    t168 = t118*t151
+    t169 = t119*t153
+    t170 = 2*t130
+    t171 = -(t62 + t63*t170)*t144
+    t172 = -(t66 + t67*t170)*t146
+    t173 = qd1*t136
+    t174 = t63*t136
+    t175 = t67*t136
     Jd = _stack(xp, [
-        xp.broadcast_to(-t76, batch),  # 0, 0
-        xp.broadcast_to(t122, batch),  # 0, 1
-        xp.broadcast_to(t84, batch),  # 0, 2
-        xp.broadcast_to(t102, batch),  # 0, 3
+        xp.broadcast_to(-t78, batch),  # 0, 0
+        xp.broadcast_to(t124, batch),  # 0, 1
+        xp.broadcast_to(t86, batch),  # 0, 2
+        xp.broadcast_to(t104, batch),  # 0, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5
-        xp.broadcast_to(t83, batch),  # 1, 0
-        xp.broadcast_to(-t123, batch),  # 1, 1
-        xp.broadcast_to(-t77, batch),  # 1, 2
-        xp.broadcast_to(t103, batch),  # 1, 3
+        xp.broadcast_to(t85, batch),  # 1, 0
+        xp.broadcast_to(-t125, batch),  # 1, 1
+        xp.broadcast_to(-t79, batch),  # 1, 2
+        xp.broadcast_to(t105, batch),  # 1, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
-        xp.broadcast_to(t85, batch),  # 2, 1
-        xp.broadcast_to(t86, batch),  # 2, 2
-        xp.broadcast_to(t98, batch),  # 2, 3
+        xp.broadcast_to(t87, batch),  # 2, 1
+        xp.broadcast_to(t88, batch),  # 2, 2
+        xp.broadcast_to(t100, batch),  # 2, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
-        xp.broadcast_to(t119*(t126 - t132) - t120*(t133 + t134) + t133*t135 + t126*t136, batch),  # 3, 1
-        xp.broadcast_to(t119*(t137 - t140) + t120*(t141 - t142) + t144 + t146, batch),  # 3, 2
-        xp.broadcast_to(-t119*(t147 + t150) - t120*(t151 + t152) + t153 + t154, batch),  # 3, 3
-        xp.broadcast_to(-t119*(t155 + t158) - t120*(t159 + t160) + t161 - t162, batch),  # 3, 4
-        xp.broadcast_to(-t119*(t163 + t166) - t120*(t167 + t168) + t169 + t170, batch),  # 3, 5
+        xp.broadcast_to(t145 + t147 + t149 + t150, batch),  # 3, 1
+        xp.broadcast_to(t152 + t154 + t156 + t157, batch),  # 3, 2
+        xp.broadcast_to(t158 + t159 + t161 + t162, batch),  # 3, 3
+        xp.broadcast_to(t163 + t165 + t166 - t167, batch),  # 3, 4
+        xp.broadcast_to(t168 + t169 + t171 + t172, batch),  # 3, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
-        xp.broadcast_to(-t119*(c1*t171 + t63*t173) - t120*(s1*t171 + t67*t173) + t127*t174 - t128*t174, batch),  # 4, 1
-        xp.broadcast_to(t119*(t10*t171 - t63*t175) - t120*(t5*t171 + t67*t175) + t78*t176 - t87*t177, batch),  # 4, 2
-        xp.broadcast_to(-t119*(t21*t171 + t63*t178) + t120*(t15*t171 - t67*t178) + t93*t176 - t92*t177, batch),  # 4, 3
-        xp.broadcast_to(-t119*(t23*t171 + t63*t179) + t120*(t17*t171 - t67*t179) - t104*t177 - t105*t176, batch),  # 4, 4
-        xp.broadcast_to(-t119*(t66*t171 + t63*t180) + t120*(t62*t171 - t67*t180) + t117*t176 - t116*t177, batch),  # 4, 5
+        xp.broadcast_to(-t121*(t138*t63 + c1*t136) - t122*(t138*t67 + s1*t136) + t131*t173 - t132*t173, batch),  # 4, 1
+        xp.broadcast_to(t121*(t10*t136 - t139*t63) - t122*(t139*t67 + t5*t136) + t80*t174 - t89*t175, batch),  # 4, 2
+        xp.broadcast_to(-t121*(t140*t63 + t21*t136) + t122*(t15*t136 - t140*t67) + t95*t174 - t94*t175, batch),  # 4, 3
+        xp.broadcast_to(-t121*(t141*t63 + t23*t136) + t122*(t17*t136 - t141*t67) - t106*t175 - t107*t174, batch),  # 4, 4
+        xp.broadcast_to(-t121*(t142*t63 + t66*t136) + t122*(t62*t136 - t142*t67) + t119*t174 - t118*t175, batch),  # 4, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 0
-        xp.broadcast_to(-(-t119*(-t181 + t71*t132) - t120*(t182 + t71*t134) + t129*t183 + t182*t135 + t181*t136), batch),  # 5, 1
-        xp.broadcast_to(t88 + t119*(-t71*t137 + t71*t140) + t120*(-t71*t141 + t71*t142) - t138*t183 - t71*t144 - t71*t146, batch),  # 5, 2
-        xp.broadcast_to(t89 + t119*(t71*t147 + t71*t150) + t120*(t71*t151 + t71*t152) - t148*t183 - t71*t153 - t71*t154, batch),  # 5, 3
-        xp.broadcast_to(t99 + t119*(t71*t155 + t71*t158) + t120*(t71*t159 + t71*t160) - t156*t183 + t71*t162 - t71*t161, batch),  # 5, 4
-        xp.broadcast_to(t111 + t119*(t71*t163 + t71*t166) + t120*(t71*t167 + t71*t168) - t164*t183 - t71*t169 - t71*t170, batch),  # 5, 5
+        xp.broadcast_to(-(t115*t133 + t73*t145 + t73*t147 + t73*t149 + t73*t150), batch),  # 5, 1
+        xp.broadcast_to(-(-t90 + t115*t127 + t73*t152 + t73*t154 + t73*t156 + t73*t157), batch),  # 5, 2
+        xp.broadcast_to(-(-t91 + t115*t128 + t73*t158 + t73*t159 + t73*t161 + t73*t162), batch),  # 5, 3
+        xp.broadcast_to(-(-t101 + t115*t129 - t73*t167 + t73*t163 + t73*t165 + t73*t166), batch),  # 5, 4
+        xp.broadcast_to(-(-t113 + t115*t130 + t73*t168 + t73*t169 + t73*t171 + t73*t172), batch),  # 5, 5
     ], (6, 6))
     return Jd
 

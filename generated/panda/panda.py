@@ -1320,7 +1320,7 @@ def bias_acceleration(q, q_dot):
 
 
 def task_jacobian_dot(q, q_dot):
-    """time derivative of the analytic Jacobian along q_dot (6 x DOF): mu'' = J_a q'' + J_a' q': (6 x 7), 732 operations."""
+    """time derivative of the analytic Jacobian along q_dot (6 x DOF): mu'' = J_a q'' + J_a' q': (6 x 7), 678 operations."""
     xp, dtype, device, batch, (q, q_dot,) = _arguments(("q", q, (7,)), ("q_dot", q_dot, (7,)))
     qd1 = q_dot[..., 0]
     qd2 = q_dot[..., 1]
@@ -1352,262 +1352,247 @@ def task_jacobian_dot(q, q_dot):
     t5 = c1*s3
     t6 = t4 + c2*t5
     t7 = t5 + c2*t4
-    t8 = 0.316*s2
-    t9 = 0.0825*t2 + c1*t8
-    t10 = 0.0825*t7 + s1*t8
-    t11 = c3*s2
-    t12 = 0.316*c2 - 0.0825*t11
-    t13 = c2*s4 - c4*t11
-    t14 = c2*c4 + s4*t11
-    t15 = c1*s2
-    t16 = t2*c4 + s4*t15
-    t17 = -t2*s4 + c4*t15
-    t18 = t16*c5 - t6*s5
-    t19 = t16*s5 + t6*c5
-    t20 = t17*s6 + t18*c6
-    t21 = t17*c6 - t18*s6
-    t22 = t19*s7 + t20*c7
-    t23 = t19*c7 - t20*s7
-    t24 = -0.21*t21 + 0.088*t20
-    t25 = t24 + 0.384*t17
-    t26 = t25 - 0.0825*t16
-    t27 = t9 + t26
-    t28 = 0.7071067811865476*t22 - 0.7071067811865476*t23
-    t29 = s1*s2
-    t30 = t7*c4 + s4*t29
-    t31 = -t7*s4 + c4*t29
-    t32 = t30*c5 + t3*s5
-    t33 = t3*c5 - t30*s5
-    t34 = t31*s6 + t32*c6
-    t35 = t31*c6 - t32*s6
-    t36 = t34*c7 - t33*s7
-    t37 = t33*c7 + t34*s7
-    t38 = -0.21*t35 + 0.088*t34
-    t39 = t38 + 0.384*t31
-    t40 = t39 - 0.0825*t30
-    t41 = t10 + t40
-    t42 = 0.7071067811865476*t36 + 0.7071067811865476*t37
-    t43 = t27*c1 + t41*s1
-    t44 = t41*t15 - t27*t29
-    t45 = t26*t3 + t40*t6
-    t46 = t17*t39 - t31*t25
-    t47 = t19*t38 + t33*t24
-    t48 = t46*qd5 + t47*qd6
-    t49 = t48 + t45*qd4
-    t50 = t49 + t44*qd3
-    t51 = t50 - t43*qd2
-    t52 = s3*s2
-    t53 = t13*c5 + s5*t52
-    t54 = -t13*s5 + c5*t52
-    t55 = t14*s6 + t53*c6
-    t56 = t14*c6 - t53*s6
-    t57 = t55*c7 - t54*s7
-    t58 = t54*c7 + t55*s7
-    t59 = -0.21*t56 + 0.088*t55
-    t60 = t59 + 0.384*t14
-    t61 = t60 - 0.0825*t13
-    t62 = t12 + t61
-    t63 = 0.7071067811865476*t57 + 0.7071067811865476*t58
-    t64 = -t41*c2 + t62*t29
-    t65 = -t61*t3 + t40*t52
-    t66 = t31*t60 - t14*t39
-    t67 = t54*t38 - t33*t59
-    t68 = t27*c2 - t62*t15
-    t69 = t61*t6 + t26*t52
-    t70 = t14*t25 - t17*t60
-    t71 = t19*t59 + t54*t24
-    t72 = t66*qd5 + t67*qd6
-    t73 = t70*qd5 - t71*qd6
-    t74 = t72 + t65*qd4
-    t75 = t73 - t69*qd4
-    t76 = t74 + t64*qd3
-    t77 = t75 + t68*qd3
-    t78 = qd2*s1
-    t79 = t77 + t62*t78
-    t80 = t79 + t27*qd1
-    t81 = t76*c2 + t64*qd1 + t44*t78 - t50*t15
-    t82 = qd1*t15 + c2*t78
-    t83 = -t78 + qd3*t15
-    t84 = t83
-    t85 = c1*qd2
-    t86 = t76 + t62*t85
-    t87 = t86 - t41*qd1
-    t88 = -t77*c2 - t68*qd1 + t50*t29 + t44*t85
-    t89 = t86*c1 + t79*s1
-    t90 = t76*t29 + t64*t85 + t68*t78 - t77*t15
-    t91 = c2*t85 - qd1*t29
-    t92 = t85 + qd3*t29
-    t93 = t92
-    t94 = t74*t3 + t75*t6 - t65*t93 - t69*t84
-    t95 = t6*t93 + t3*t84
-    t96 = qd1 + c2*qd3
-    t97 = t96
-    t98 = t69*t97 + t45*t93 - t49*t3 + t75*t52
-    t99 = t49*t6 + t45*t84 - t65*t97 + t74*t52
-    t100 = t3*t97 - t93*t52
-    t101 = t6*t97 + t84*t52
-    t102 = t6*qd4
-    t103 = t84 + t102
-    t104 = -t3*qd4
-    t105 = t93 + t104
-    t106 = t73*t17 + t70*t103 - t72*t31 - t66*t105
-    t107 = t31*t103 - t17*t105
-    t108 = -qd4*t52
-    t109 = t97 + t108
-    t110 = t48*t31 + t46*t105 - t73*t14 - t70*t109
-    t111 = t72*t14 + t66*t109 - t48*t17 - t46*t103
-    t112 = t14*t105 - t31*t109
-    t113 = t17*t109 - t14*t103
-    t114 = t17*qd5
-    t115 = t103 + t114
-    t116 = t31*qd5
-    t117 = t105 + t116
-    t118 = t19*t117 + t33*t115
-    t119 = t14*qd5
-    t120 = t109 + t119
-    t121 = t33*t120 - t54*t117
-    t122 = t19*t120 + t54*t115
-    t123 = t19*qd6
-    t124 = t115 + t123
-    t125 = t102 + t114 + t123 - t21*qd7 + t83
-    t126 = t33*qd6
-    t127 = t67*t117 + t71*t115 + t71*t123 - t67*t126
-    t128 = -t126
-    t129 = t117 + t128
-    t130 = t129*t21 - t35*t124
-    t131 = t104 + t116 + t128 - t35*qd7 + t92
-    t132 = t125*t42 - t131*t28
-    t133 = t54*qd6
-    t134 = t71*t120 + t47*t117 - t47*t126 - t71*t133
-    t135 = t47*t115 - t67*t120 + t47*t123 + t67*t133
-    t136 = -t133
-    t137 = t120 + t136
-    t138 = t137*t35 - t129*t56
-    t139 = t56*t124 - t137*t21
-    t140 = t108 + t119 + t136 - t56*qd7 + t96
-    t141 = t131*t63 - t140*t42
-    t142 = t140*t28 - t125*t63
-    t143 = qd1*t62
-    t144 = t51*c1 - s1*t143
-    t145 = t51*s1 + c1*t143
-    t146 = qd2*s2
-    t147 = c1**2*t146 + s1**2*t146
-    t148 = t28**2 + t42**2
-    t149 = 1/t148
-    t150 = s1*t149
-    t151 = t42*c1
-    t152 = t28*s1
-    t153 = t151 - t152
-    t154 = 2/t148**2
-    t155 = t153*t154
-    t156 = t28*t155
-    t157 = c1*t149
-    t158 = t42*t155
-    t159 = qd1*t28
-    t160 = qd1*t42
-    t161 = s2*t157
-    t162 = t28*c1
-    t163 = t42*s1
-    t164 = s2*t162 + s2*t163
-    t165 = t164*t154
-    t166 = t28*t165
-    t167 = s2*t150
-    t168 = t42*t165
-    t169 = t28*t149
-    t170 = t91*t169
-    t171 = t42*t149
-    t172 = t82*t171
-    t173 = t6*t149
-    t174 = t6*t28 - t42*t3
-    t175 = t174*t154
-    t176 = t28*t175
-    t177 = t3*t149
-    t178 = t42*t175
-    t179 = t100*t169
-    t180 = t101*t171
-    t181 = t17*t149
-    t182 = t17*t28 + t31*t42
-    t183 = t182*t154
-    t184 = t28*t183
-    t185 = t31*t149
-    t186 = t42*t183
-    t187 = t112*t169
-    t188 = t113*t171
-    t189 = t19*t149
-    t190 = t19*t28 - t33*t42
-    t191 = t190*t154
-    t192 = t28*t191
-    t193 = t33*t149
-    t194 = t42*t191
-    t195 = t121*t169
-    t196 = t122*t171
-    t197 = t21*t149
-    t198 = -(t21*t28 + t35*t42)
-    t199 = t198*t154
-    t200 = t28*t199
-    t201 = t35*t149
-    t202 = t42*t199
-    t203 = t138*t169
-    t204 = t139*t171
-    t205 = 1/xp.sqrt(t148)
-    t206 = c1*t205
-    t207 = 1/t148**1.5
-    t208 = t207*(t162 + t163)
-    t209 = s1*t205
-    t210 = qd1*t205
-    t211 = t207*(s2*t152 - s2*t151)
-    t212 = t28*t205
-    t213 = t42*t205
-    t214 = -t207*(t6*t42 + t28*t3)
-    t215 = t207*(t31*t28 - t17*t42)
-    t216 = -t207*(t19*t42 + t33*t28)
-    t217 = t207*(t21*t42 - t35*t28)
-    t218 = t63*t150
-    t219 = t63*t157
-    t220 = t149*t132
+    t8 = c1*s2
+    t9 = 0.0825*t2 + 0.316*t8
+    t10 = t2*c4 + s4*t8
+    t11 = -t2*s4 + c4*t8
+    t12 = t10*c5 - t6*s5
+    t13 = t10*s5 + t6*c5
+    t14 = t11*s6 + t12*c6
+    t15 = t11*c6 - t12*s6
+    t16 = t13*s7 + t14*c7
+    t17 = t13*c7 - t14*s7
+    t18 = -0.21*t15 + 0.088*t14
+    t19 = t18 + 0.384*t11
+    t20 = t19 - 0.0825*t10
+    t21 = t9 + t20
+    t22 = 0.7071067811865476*t16 - 0.7071067811865476*t17
+    t23 = s1*s2
+    t24 = 0.0825*t7 + 0.316*t23
+    t25 = t7*c4 + s4*t23
+    t26 = -t7*s4 + c4*t23
+    t27 = t25*c5 + t3*s5
+    t28 = t3*c5 - t25*s5
+    t29 = t26*s6 + t27*c6
+    t30 = t26*c6 - t27*s6
+    t31 = t29*c7 - t28*s7
+    t32 = t28*c7 + t29*s7
+    t33 = -0.21*t30 + 0.088*t29
+    t34 = t33 + 0.384*t26
+    t35 = t34 - 0.0825*t25
+    t36 = t24 + t35
+    t37 = 0.7071067811865476*t31 + 0.7071067811865476*t32
+    t38 = t21*c1 + t36*s1
+    t39 = t36*t8 - t21*t23
+    t40 = t20*t3 + t35*t6
+    t41 = t11*t34 - t26*t19
+    t42 = t13*t33 + t28*t18
+    t43 = t41*qd5 + t42*qd6
+    t44 = t43 + t40*qd4
+    t45 = t44 + t39*qd3
+    t46 = t45 - t38*qd2
+    t47 = t22**2 + t37**2
+    t48 = xp.sqrt(t47)
+    t49 = c3*s2
+    t50 = 0.316*c2 - 0.0825*t49
+    t51 = c2*s4 - c4*t49
+    t52 = c2*c4 + s4*t49
+    t53 = s3*s2
+    t54 = t51*c5 + s5*t53
+    t55 = -t51*s5 + c5*t53
+    t56 = t52*s6 + t54*c6
+    t57 = t52*c6 - t54*s6
+    t58 = t56*c7 - t55*s7
+    t59 = t55*c7 + t56*s7
+    t60 = -0.21*t57 + 0.088*t56
+    t61 = t60 + 0.384*t52
+    t62 = t61 - 0.0825*t51
+    t63 = t50 + t62
+    t64 = 0.7071067811865476*t58 + 0.7071067811865476*t59
+    t65 = -t36*c2 + t63*t23
+    t66 = -t62*t3 + t35*t53
+    t67 = t26*t61 - t52*t34
+    t68 = t55*t33 - t28*t60
+    t69 = t21*c2 - t63*t8
+    t70 = t62*t6 + t20*t53
+    t71 = t52*t19 - t11*t61
+    t72 = t13*t60 + t55*t18
+    t73 = t67*qd5 + t68*qd6
+    t74 = t71*qd5 - t72*qd6
+    t75 = t73 + t66*qd4
+    t76 = t74 - t70*qd4
+    t77 = t75 + t65*qd3
+    t78 = t76 + t69*qd3
+    t79 = qd2*s1
+    t80 = t78 + t63*t79
+    t81 = t80 + t21*qd1
+    t82 = t77*c2 + t65*qd1 + t39*t79 - t45*t8
+    t83 = qd1*t8 + c2*t79
+    t84 = -t79 + qd3*t8
+    t85 = t84
+    t86 = c1*qd2
+    t87 = t77 + t63*t86
+    t88 = t87 - t36*qd1
+    t89 = -t78*c2 - t69*qd1 + t45*t23 + t39*t86
+    t90 = t87*c1 + t80*s1
+    t91 = t77*t23 + t65*t86 + t69*t79 - t78*t8
+    t92 = c2*t86 - qd1*t23
+    t93 = t86 + qd3*t23
+    t94 = t93
+    t95 = t75*t3 + t76*t6 - t66*t94 - t70*t85
+    t96 = t6*t94 + t3*t85
+    t97 = qd1 + c2*qd3
+    t98 = t97
+    t99 = t70*t98 + t40*t94 - t44*t3 + t76*t53
+    t100 = t44*t6 + t40*t85 - t66*t98 + t75*t53
+    t101 = t3*t98 - t94*t53
+    t102 = t6*t98 + t85*t53
+    t103 = t6*qd4
+    t104 = t85 + t103
+    t105 = -t3*qd4
+    t106 = t94 + t105
+    t107 = t74*t11 + t71*t104 - t73*t26 - t67*t106
+    t108 = t26*t104 - t11*t106
+    t109 = -qd4*t53
+    t110 = t98 + t109
+    t111 = t43*t26 + t41*t106 - t74*t52 - t71*t110
+    t112 = t73*t52 + t67*t110 - t43*t11 - t41*t104
+    t113 = t52*t106 - t26*t110
+    t114 = t11*t110 - t52*t104
+    t115 = t11*qd5
+    t116 = t104 + t115
+    t117 = t26*qd5
+    t118 = t106 + t117
+    t119 = t13*t118 + t28*t116
+    t120 = t52*qd5
+    t121 = t110 + t120
+    t122 = t28*t121 - t55*t118
+    t123 = t13*t121 + t55*t116
+    t124 = t13*qd6
+    t125 = t116 + t124
+    t126 = t103 + t115 + t124 - t15*qd7 + t84
+    t127 = t28*qd6
+    t128 = t68*t118 + t72*t116 + t72*t124 - t68*t127
+    t129 = -t127
+    t130 = t118 + t129
+    t131 = t130*t15 - t30*t125
+    t132 = t105 + t117 + t129 - t30*qd7 + t93
+    t133 = t126*t37 - t132*t22
+    t134 = t55*qd6
+    t135 = t72*t121 + t42*t118 - t42*t127 - t72*t134
+    t136 = t42*t116 - t68*t121 + t42*t124 + t68*t134
+    t137 = -t134
+    t138 = t121 + t137
+    t139 = t138*t30 - t130*t57
+    t140 = t57*t125 - t138*t15
+    t141 = t109 + t120 + t137 - t57*qd7 + t97
+    t142 = t132*t64 - t141*t37
+    t143 = t141*t22 - t126*t64
+    t144 = qd1*t63
+    t145 = t46*c1 - s1*t144
+    t146 = t46*s1 + c1*t144
+    t147 = qd2*s2
+    t148 = c1**2*t147 + s1**2*t147
+    t149 = 1/t47
+    t150 = t149*(t6*t22 - t37*t3)
+    t151 = t149*(t11*t22 + t26*t37)
+    t152 = t149*(t13*t22 - t28*t37)
+    t153 = -t149*(t15*t22 + t30*t37)
+    t154 = t37*c1
+    t155 = t22*s1
+    t156 = t149*(t154 - t155)
+    t157 = t22*c1
+    t158 = t37*s1
+    t159 = t149*(s2*t157 + s2*t158)
+    t160 = 1/t48
+    t161 = t149*t160
+    t162 = (t157 + t158)*t161
+    t163 = (s2*t155 - s2*t154)*t161
+    t164 = -(t6*t37 + t22*t3)*t161
+    t165 = (t26*t22 - t11*t37)*t161
+    t166 = -(t13*t37 + t28*t22)*t161
+    t167 = (t15*t37 - t30*t22)*t161
+    t168 = 2*t156
+    t169 = t149*t142
+    t170 = -(s1 + t22*t168)*t169
+    t171 = t149*t143
+    t172 = (c1 - t37*t168)*t171
+    t173 = qd1*t149
+    t174 = t157*t173
+    t175 = t158*t173
+    t176 = t22*t149
+    t177 = t92*t176
+    t178 = t37*t149
+    t179 = t83*t178
+    t180 = 2*t159
+    t181 = (t8 - t22*t180)*t169
+    t182 = (t23 - t37*t180)*t171
+    t183 = t101*t176
+    t184 = t102*t178
+    t185 = 2*t150
+    t186 = (t6 - t22*t185)*t169
+    t187 = -(t3 + t37*t185)*t171
+    t188 = t113*t176
+    t189 = t114*t178
+    t190 = 2*t151
+    t191 = (t11 - t22*t190)*t169
+    t192 = (t26 - t37*t190)*t171
+    t193 = t122*t176
+    t194 = t123*t178
+    t195 = 2*t152
+    t196 = (t13 - t22*t195)*t169
+    t197 = -(t28 + t37*t195)*t171
+    t198 = t139*t176
+    t199 = t140*t178
+    t200 = 2*t153
+    t201 = -(t15 + t22*t200)*t169
+    t202 = -(t30 + t37*t200)*t171
+    t203 = qd1*t160
+    t204 = t22*t160
+    t205 = t37*t160
     Jd = _stack(xp, [
-        xp.broadcast_to(-t80, batch),  # 0, 0
-        xp.broadcast_to(t144, batch),  # 0, 1
-        xp.broadcast_to(t88, batch),  # 0, 2
-        xp.broadcast_to(t98, batch),  # 0, 3
-        xp.broadcast_to(t110, batch),  # 0, 4
-        xp.broadcast_to(t134, batch),  # 0, 5
+        xp.broadcast_to(-t81, batch),  # 0, 0
+        xp.broadcast_to(t145, batch),  # 0, 1
+        xp.broadcast_to(t89, batch),  # 0, 2
+        xp.broadcast_to(t99, batch),  # 0, 3
+        xp.broadcast_to(t111, batch),  # 0, 4
+        xp.broadcast_to(t135, batch),  # 0, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 6
-        xp.broadcast_to(t87, batch),  # 1, 0
-        xp.broadcast_to(t145, batch),  # 1, 1
-        xp.broadcast_to(t81, batch),  # 1, 2
-        xp.broadcast_to(-t99, batch),  # 1, 3
-        xp.broadcast_to(t111, batch),  # 1, 4
-        xp.broadcast_to(-t135, batch),  # 1, 5
+        xp.broadcast_to(t88, batch),  # 1, 0
+        xp.broadcast_to(t146, batch),  # 1, 1
+        xp.broadcast_to(t82, batch),  # 1, 2
+        xp.broadcast_to(-t100, batch),  # 1, 3
+        xp.broadcast_to(t112, batch),  # 1, 4
+        xp.broadcast_to(-t136, batch),  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
-        xp.broadcast_to(-t89, batch),  # 2, 1
-        xp.broadcast_to(-t90, batch),  # 2, 2
-        xp.broadcast_to(t94, batch),  # 2, 3
-        xp.broadcast_to(t106, batch),  # 2, 4
-        xp.broadcast_to(-t127, batch),  # 2, 5
+        xp.broadcast_to(-t90, batch),  # 2, 1
+        xp.broadcast_to(-t91, batch),  # 2, 2
+        xp.broadcast_to(t95, batch),  # 2, 3
+        xp.broadcast_to(t107, batch),  # 2, 4
+        xp.broadcast_to(-t128, batch),  # 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
-        xp.broadcast_to(-t141*(t150 + t156) + t142*(t157 - t158) - t157*t159 - t150*t160, batch),  # 3, 1
-        xp.broadcast_to(t141*(t161 - t166) + t142*(t167 - t168) + t170 + t172, batch),  # 3, 2
-        xp.broadcast_to(t141*(t173 - t176) - t142*(t177 + t178) + t179 + t180, batch),  # 3, 3
-        xp.broadcast_to(t141*(t181 - t184) + t142*(t185 - t186) + t187 + t188, batch),  # 3, 4
-        xp.broadcast_to(t141*(t189 - t192) - t142*(t193 + t194) + t195 + t196, batch),  # 3, 5
-        xp.broadcast_to(-t141*(t197 + t200) - t142*(t201 + t202) + t203 + t204, batch),  # 3, 6
+        xp.broadcast_to(t170 + t172 - t174 - t175, batch),  # 3, 1
+        xp.broadcast_to(t177 + t179 + t181 + t182, batch),  # 3, 2
+        xp.broadcast_to(t183 + t184 + t186 + t187, batch),  # 3, 3
+        xp.broadcast_to(t188 + t189 + t191 + t192, batch),  # 3, 4
+        xp.broadcast_to(t193 + t194 + t196 + t197, batch),  # 3, 5
+        xp.broadcast_to(t198 + t199 + t201 + t202, batch),  # 3, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
-        xp.broadcast_to(t141*(t206 - t28*t208) + t142*(t209 - t42*t208) + t151*t210 - t152*t210, batch),  # 4, 1
-        xp.broadcast_to(t141*(s2*t209 - t28*t211) - t142*(t42*t211 + s2*t206) + t82*t212 - t91*t213, batch),  # 4, 2
-        xp.broadcast_to(-t141*(t3*t205 + t28*t214) - t142*(t6*t205 + t42*t214) + t101*t212 - t100*t213, batch),  # 4, 3
-        xp.broadcast_to(t141*(t31*t205 - t28*t215) - t142*(t17*t205 + t42*t215) + t113*t212 - t112*t213, batch),  # 4, 4
-        xp.broadcast_to(-t141*(t33*t205 + t28*t216) - t142*(t19*t205 + t42*t216) + t122*t212 - t121*t213, batch),  # 4, 5
-        xp.broadcast_to(-t141*(t35*t205 + t28*t217) + t142*(t21*t205 - t42*t217) + t139*t212 - t138*t213, batch),  # 4, 6
+        xp.broadcast_to(t142*(c1*t160 - t162*t22) + t143*(s1*t160 - t162*t37) + t154*t203 - t155*t203, batch),  # 4, 1
+        xp.broadcast_to(t142*(-t163*t22 + t160*t23) - t143*(t163*t37 + t160*t8) + t83*t204 - t92*t205, batch),  # 4, 2
+        xp.broadcast_to(-t142*(t164*t22 + t3*t160) - t143*(t164*t37 + t6*t160) + t102*t204 - t101*t205, batch),  # 4, 3
+        xp.broadcast_to(t142*(t26*t160 - t165*t22) - t143*(t165*t37 + t11*t160) + t114*t204 - t113*t205, batch),  # 4, 4
+        xp.broadcast_to(-t142*(t166*t22 + t28*t160) - t143*(t166*t37 + t13*t160) + t123*t204 - t122*t205, batch),  # 4, 5
+        xp.broadcast_to(-t142*(t167*t22 + t30*t160) + t143*(t15*t160 - t167*t37) + t140*t204 - t139*t205, batch),  # 4, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 0
-        xp.broadcast_to(t141*(t218 + t63*t156) + t142*(-t219 + t63*t158) - t153*t220 + t219*t159 + t218*t160, batch),  # 5, 1
-        xp.broadcast_to(-(t147 - t141*(-t63*t161 + t63*t166) - t142*(-t63*t167 + t63*t168) + t164*t220 + t63*t170 + t63*t172), batch),  # 5, 2
-        xp.broadcast_to(-(t95 - t141*(-t63*t173 + t63*t176) - t142*(t63*t177 + t63*t178) + t174*t220 + t63*t179 + t63*t180), batch),  # 5, 3
-        xp.broadcast_to(t107 + t141*(-t63*t181 + t63*t184) + t142*(-t63*t185 + t63*t186) - t182*t220 - t63*t187 - t63*t188, batch),  # 5, 4
-        xp.broadcast_to(-(t118 - t141*(-t63*t189 + t63*t192) - t142*(t63*t193 + t63*t194) + t190*t220 + t63*t195 + t63*t196), batch),  # 5, 5
-        xp.broadcast_to(t130 + t141*(t63*t197 + t63*t200) + t142*(t63*t201 + t63*t202) - t198*t220 - t63*t203 - t63*t204, batch),  # 5, 6
+        xp.broadcast_to(-(t133*t156 + t64*t170 + t64*t172 - t64*t174 - t64*t175), batch),  # 5, 1
+        xp.broadcast_to(-(t148 + t133*t159 + t64*t177 + t64*t179 + t64*t181 + t64*t182), batch),  # 5, 2
+        xp.broadcast_to(-(t96 + t133*t150 + t64*t183 + t64*t184 + t64*t186 + t64*t187), batch),  # 5, 3
+        xp.broadcast_to(-(-t108 + t133*t151 + t64*t188 + t64*t189 + t64*t191 + t64*t192), batch),  # 5, 4
+        xp.broadcast_to(-(t119 + t133*t152 + t64*t193 + t64*t194 + t64*t196 + t64*t197), batch),  # 5, 5
+        xp.broadcast_to(-(-t131 + t133*t153 + t64*t198 + t64*t199 + t64*t201 + t64*t202), batch),  # 5, 6
     ], (6, 7))
     return Jd
 
@@ -4076,7 +4061,7 @@ def ik_nearest(T, q_seed, q_free, weights=(1.0,) * DOF):
     t159 = xp.where(xp.greater_equal(t20, -0.0175) & xp.less_equal(t20, 3.7525000000000004), t20, xp.where(xp.greater_equal(t157, -0.0175) & xp.less_equal(t157, 3.7525000000000004), t157, xp.where(xp.greater_equal(t158, -0.0175) & xp.less_equal(t158, 3.7525000000000004), t158, qb2_5)))
     t160 = qw1*(t139 + t82)**2 + qw2*(t143 + t83)**2 + qw3*(t147 + t84)**2 + qw4*(t151 + t85)**2 + qw5*(t155 + t86)**2 + qw6*(t159 + t87)**2 + qw7*(qb2_6 + t88)**2
     t161 = xp.greater(t21, 0)
-    t162 = xp.where(t161 & (xp.less(t160, t135) | xp.less(t126, 1)), xp.asarray(1, dtype=dtype), 0)
+    t162 = xp.where(t161 & (xp.less(t126, 1) | xp.less(t160, t135)), xp.asarray(1, dtype=dtype), 0)
     t163 = xp.where(t161, 1, t126)
     t164 = xp.greater(t162, 0)
     t165 = xp.where(t164, t139, t128)

@@ -769,7 +769,7 @@ int planar_3r_velocity_ik(const planar_3r_real q[PLANAR_3R_DOF], const planar_3r
     const planar_3r_real t91 = t90*(t84 >= 0 ? 1 : -1);
     const planar_3r_real t92 = t91 + t84;
     const planar_3r_real t93 = (t90 > 0 ? 1/(t90*(t90 + t89)) : 0);
-    const planar_3r_real t94 = t87 - t93*t87*(t92*t92);
+    const planar_3r_real t94 = t87 - t87*t93*(t92*t92);
     const planar_3r_real t95 = (t91 != 0 ? -t94/t91 : 0);
     const planar_3r_real t96 = (t79 != 0 ? -(t86 - t95*t83)/t79 : 0);
     const planar_3r_real t97 = (t11 != 0 ? -(t75 + t95*t71 + t96*t67)/t11 : 0);

@@ -770,7 +770,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t91 = t90*xp.where(xp.greater_equal(t84, 0), xp.asarray(1, dtype=dtype), -1)
     t92 = t91 + t84
     t93 = xp.where(xp.greater(t90, 0), 1/(t90*(t90 + t89)), 0)
-    t94 = t87 - t93*t87*t92**2
+    t94 = t87 - t87*t93*t92**2
     t95 = xp.where(xp.not_equal(t91, 0), -t94/t91, 0)
     t96 = xp.where(xp.not_equal(t79, 0), -(t86 - t95*t83)/t79, 0)
     t97 = xp.where(xp.not_equal(t11, 0), -(t75 + t95*t71 + t96*t67)/t11, 0)

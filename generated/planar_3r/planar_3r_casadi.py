@@ -589,7 +589,7 @@ def _velocity_ik(q, mu_dot, damping):
     t91 = t90*casadi.if_else((t84 >= 0), 1, -1)
     t92 = t91 + t84
     t93 = casadi.if_else((t90 > 0), 1/(t90*(t90 + t89)), 0)
-    t94 = t87 - t93*t87*t92**2
+    t94 = t87 - t87*t93*t92**2
     t95 = casadi.if_else((t91 != 0), -t94/t91, 0)
     t96 = casadi.if_else((t79 != 0), -(t86 - t95*t83)/t79, 0)
     t97 = casadi.if_else((t11 != 0), -(t75 + t95*t71 + t96*t67)/t11, 0)

@@ -963,7 +963,7 @@ def bias_acceleration(q, q_dot):
 
 
 def task_jacobian_dot(q, q_dot):
-    """time derivative of the analytic Jacobian along q_dot (6 x DOF): mu'' = J_a q'' + J_a' q': (6 x 6), 419 operations."""
+    """time derivative of the analytic Jacobian along q_dot (6 x DOF): mu'' = J_a q'' + J_a' q': (6 x 6), 395 operations."""
     xp, dtype, device, batch, (q, q_dot,) = _arguments(("q", q, (6,)), ("q_dot", q_dot, (6,)))
     qd1 = q_dot[..., 0]
     qd2 = q_dot[..., 1]
@@ -1010,162 +1010,152 @@ def task_jacobian_dot(q, q_dot):
     t21 = t8*s6 + t19*c6
     t22 = t4 - 0.4318*t18
     t23 = t17*c1 + t22*s1
-    t24 = c4*s23
-    t25 = c23*s5 + c5*t24
-    t26 = c23*c5 - s5*t24
-    t27 = s4*s23
-    t28 = t25*c6 - s6*t27
-    t29 = 0.4318*c2
-    t30 = t17 + c1*t29
-    t31 = t22 + s1*t29
-    t32 = t30*c1 + t31*s1
-    t33 = t32*qd2 + t23*qd3
-    t34 = qd2*s1
-    t35 = qd3*s1
-    t36 = t0*t35 + t1*t34
-    t37 = -t36 + t30*qd1
-    t38 = t34 + t35
-    t39 = t38
-    t40 = t39*c23 + qd1*t13
-    t41 = c1*qd2
-    t42 = c1*qd3
-    t43 = t0*t42 + t1*t41
-    t44 = t43 + t31*qd1
-    t45 = t43*c1 + t36*s1
-    t46 = t41 + t42
-    t47 = t46
-    t48 = -t47*c23 + qd1*t18
-    t49 = t39*t18 + t47*t13
-    t50 = -qd4*t13
-    t51 = t39 + t50
-    t52 = qd4*t18
-    t53 = t47 + t52
-    t54 = t11*t53 - t8*t51
-    t55 = qd1 + c23*qd4
-    t56 = t55
-    t57 = t8*t56 - t53*t27
-    t58 = t11*t56 - t51*t27
-    t59 = t11*qd5
-    t60 = t51 + t59
-    t61 = t50 + t59 - t15*qd6 + t38
-    t62 = t8*qd5
-    t63 = t53 + t62
-    t64 = t15*t63 + t20*t60
-    t65 = t52 + t62 + t20*qd6 + t46
-    t66 = t16*t65 + t21*t61
-    t67 = qd5*t27
-    t68 = t56 + t67
-    t69 = t20*t68 - t26*t63
-    t70 = t15*t68 + t26*t60
-    t71 = t67 + t26*qd6 + t55
-    t72 = t21*t71 + t28*t65
-    t73 = t16*t71 - t28*t61
-    t74 = s1*qd1
-    t75 = -t33*c1 + t1*t74
-    t76 = t23*t41 + t23*t42 - t0*t74
-    t77 = c1*qd1
-    t78 = t33*s1 + t1*t77
-    t79 = t0*t77 + t23*t34 + t23*t35
-    t80 = c1**2
-    t81 = qd2*t0
-    t82 = s1**2
-    t83 = qd3*t0
-    t84 = t80*t81 + t82*t81 + t80*t83 + t82*t83
-    t85 = t16**2 + t21**2
-    t86 = 1/t85
-    t87 = c1*t86
-    t88 = t16*s1
-    t89 = t21*c1
-    t90 = t88 - t89
-    t91 = 2/t85**2
-    t92 = t90*t91
-    t93 = t21*t92
-    t94 = s1*t86
-    t95 = t16*t92
-    t96 = qd1*t16
-    t97 = qd1*t21
-    t98 = -t73*(t87 + t93) - t72*(t94 - t95) + t87*t96 + t94*t97
-    t99 = s23*t94
-    t100 = t16*c1
-    t101 = t21*s1
-    t102 = -(s23*t100 + s23*t101)
-    t103 = t102*t91
-    t104 = t21*t103
-    t105 = s23*t87
-    t106 = t16*t103
-    t107 = t16*t86
-    t108 = t48*t107
-    t109 = t21*t86
-    t110 = t40*t109
-    t111 = t8*t86
-    t112 = t11*t16 - t8*t21
-    t113 = t112*t91
-    t114 = t21*t113
-    t115 = t11*t86
-    t116 = t16*t113
-    t117 = t57*t107
-    t118 = t58*t109
-    t119 = t20*t86
-    t120 = -(t15*t16 + t20*t21)
-    t121 = t120*t91
-    t122 = t21*t121
-    t123 = t15*t86
-    t124 = t16*t121
-    t125 = t69*t107
-    t126 = t70*t109
-    t127 = 1/xp.sqrt(t85)
-    t128 = s1*t127
-    t129 = 1/t85**1.5
-    t130 = -t129*(t100 + t101)
-    t131 = c1*t127
-    t132 = qd1*t127
-    t133 = -t73*(t128 + t21*t130) + t72*(t131 + t16*t130) + t88*t132 - t89*t132
-    t134 = t129*(s23*t89 - s23*t88)
-    t135 = t16*t127
-    t136 = t21*t127
-    t137 = -t129*(t11*t21 + t8*t16)
-    t138 = t129*(t15*t21 - t20*t16)
-    t139 = t28*t87
-    t140 = t28*t94
-    t141 = t86*t66
-    t142 = -(-t73*(t139 + t28*t93) + t72*(-t140 + t28*t95) + t90*t141 + t139*t96 + t140*t97)
+    t24 = t16**2 + t21**2
+    t25 = xp.sqrt(t24)
+    t26 = c4*s23
+    t27 = c23*s5 + c5*t26
+    t28 = c23*c5 - s5*t26
+    t29 = s4*s23
+    t30 = t27*c6 - s6*t29
+    t31 = 0.4318*c2
+    t32 = t17 + c1*t31
+    t33 = t22 + s1*t31
+    t34 = t32*c1 + t33*s1
+    t35 = t34*qd2 + t23*qd3
+    t36 = qd2*s1
+    t37 = qd3*s1
+    t38 = t0*t37 + t1*t36
+    t39 = -t38 + t32*qd1
+    t40 = t36 + t37
+    t41 = t40
+    t42 = t41*c23 + qd1*t13
+    t43 = c1*qd2
+    t44 = c1*qd3
+    t45 = t0*t44 + t1*t43
+    t46 = t45 + t33*qd1
+    t47 = t45*c1 + t38*s1
+    t48 = t43 + t44
+    t49 = t48
+    t50 = -t49*c23 + qd1*t18
+    t51 = t41*t18 + t49*t13
+    t52 = -qd4*t13
+    t53 = t41 + t52
+    t54 = qd4*t18
+    t55 = t49 + t54
+    t56 = t11*t55 - t8*t53
+    t57 = qd1 + c23*qd4
+    t58 = t57
+    t59 = t8*t58 - t55*t29
+    t60 = t11*t58 - t53*t29
+    t61 = t11*qd5
+    t62 = t53 + t61
+    t63 = t52 + t61 - t15*qd6 + t40
+    t64 = t8*qd5
+    t65 = t55 + t64
+    t66 = t15*t65 + t20*t62
+    t67 = t54 + t64 + t20*qd6 + t48
+    t68 = t16*t67 + t21*t63
+    t69 = qd5*t29
+    t70 = t58 + t69
+    t71 = t20*t70 - t28*t65
+    t72 = t15*t70 + t28*t62
+    t73 = t69 + t28*qd6 + t57
+    t74 = t21*t73 + t30*t67
+    t75 = t16*t73 - t30*t63
+    t76 = s1*qd1
+    t77 = -t35*c1 + t1*t76
+    t78 = t23*t43 + t23*t44 - t0*t76
+    t79 = c1*qd1
+    t80 = t35*s1 + t1*t79
+    t81 = t0*t79 + t23*t36 + t23*t37
+    t82 = c1**2
+    t83 = qd2*t0
+    t84 = s1**2
+    t85 = qd3*t0
+    t86 = t82*t83 + t84*t83 + t82*t85 + t84*t85
+    t87 = 1/t24
+    t88 = t87*(t11*t16 - t8*t21)
+    t89 = -t87*(t15*t16 + t20*t21)
+    t90 = t16*s1
+    t91 = t21*c1
+    t92 = t87*(t90 - t91)
+    t93 = t16*c1
+    t94 = t21*s1
+    t95 = -t87*(s23*t93 + s23*t94)
+    t96 = 1/t25
+    t97 = t87*t96
+    t98 = -(t93 + t94)*t97
+    t99 = (s23*t91 - s23*t90)*t97
+    t100 = -(t11*t21 + t8*t16)*t97
+    t101 = (t15*t21 - t20*t16)*t97
+    t102 = 2*t92
+    t103 = t87*t75
+    t104 = -(c1 + t21*t102)*t103
+    t105 = t87*t74
+    t106 = (s1 - t16*t102)*t105
+    t107 = qd1*t87
+    t108 = t93*t107
+    t109 = t94*t107
+    t110 = t104 - t106 + t108 + t109
+    t111 = t16*t87
+    t112 = t50*t111
+    t113 = 2*t95
+    t114 = -(t18 + t21*t113)*t103
+    t115 = t21*t87
+    t116 = t42*t115
+    t117 = -(t13 + t16*t113)*t105
+    t118 = t59*t111
+    t119 = t60*t115
+    t120 = 2*t88
+    t121 = -(t8 + t21*t120)*t103
+    t122 = (t11 - t16*t120)*t105
+    t123 = t71*t111
+    t124 = 2*t89
+    t125 = -(t20 + t21*t124)*t103
+    t126 = t72*t115
+    t127 = -(t15 + t16*t124)*t105
+    t128 = qd1*t96
+    t129 = -t75*(t21*t98 + s1*t96) + t74*(t16*t98 + c1*t96) + t90*t128 - t91*t128
+    t130 = t16*t96
+    t131 = t21*t96
+    t132 = -(t68*t92 - t30*t106 + t30*t104 + t30*t108 + t30*t109)
     Jd = _stack(xp, [
-        xp.broadcast_to(-t37, batch),  # 0, 0
-        xp.broadcast_to(t75, batch),  # 0, 1
-        xp.broadcast_to(-t76, batch),  # 0, 2
+        xp.broadcast_to(-t39, batch),  # 0, 0
+        xp.broadcast_to(t77, batch),  # 0, 1
+        xp.broadcast_to(-t78, batch),  # 0, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5
-        xp.broadcast_to(-t44, batch),  # 1, 0
-        xp.broadcast_to(-t78, batch),  # 1, 1
-        xp.broadcast_to(-t79, batch),  # 1, 2
+        xp.broadcast_to(-t46, batch),  # 1, 0
+        xp.broadcast_to(-t80, batch),  # 1, 1
+        xp.broadcast_to(-t81, batch),  # 1, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
-        xp.broadcast_to(-t45, batch),  # 2, 1
-        xp.broadcast_to(-t84, batch),  # 2, 2
+        xp.broadcast_to(-t47, batch),  # 2, 1
+        xp.broadcast_to(-t86, batch),  # 2, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
-        xp.broadcast_to(t98, batch),  # 3, 1
-        xp.broadcast_to(t98, batch),  # 3, 2
-        xp.broadcast_to(-t73*(t99 + t104) + t72*(t105 + t106) + t108 - t110, batch),  # 3, 3
-        xp.broadcast_to(-t73*(t111 + t114) - t72*(t115 - t116) + t117 + t118, batch),  # 3, 4
-        xp.broadcast_to(-t73*(t119 + t122) + t72*(t123 + t124) + t125 - t126, batch),  # 3, 5
+        xp.broadcast_to(t110, batch),  # 3, 1
+        xp.broadcast_to(t110, batch),  # 3, 2
+        xp.broadcast_to(t112 + t114 - t116 - t117, batch),  # 3, 3
+        xp.broadcast_to(t118 + t119 + t121 - t122, batch),  # 3, 4
+        xp.broadcast_to(t123 + t125 - t126 - t127, batch),  # 3, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
-        xp.broadcast_to(t133, batch),  # 4, 1
-        xp.broadcast_to(t133, batch),  # 4, 2
-        xp.broadcast_to(-(-t73*(s23*t131 - t21*t134) - t72*(t16*t134 + s23*t128) + t40*t135 + t48*t136), batch),  # 4, 3
-        xp.broadcast_to(-t73*(t11*t127 + t21*t137) + t72*(t8*t127 + t16*t137) + t58*t135 - t57*t136, batch),  # 4, 4
-        xp.broadcast_to(-(-t73*(t15*t127 - t21*t138) - t72*(t20*t127 + t16*t138) + t70*t135 + t69*t136), batch),  # 4, 5
+        xp.broadcast_to(t129, batch),  # 4, 1
+        xp.broadcast_to(t129, batch),  # 4, 2
+        xp.broadcast_to(-(-t75*(-t21*t99 + t96*t13) - t74*(t16*t99 + t96*t18) + t42*t130 + t50*t131), batch),  # 4, 3
+        xp.broadcast_to(-t75*(t11*t96 + t21*t100) + t74*(t8*t96 + t16*t100) + t60*t130 - t59*t131, batch),  # 4, 4
+        xp.broadcast_to(-(-t75*(t15*t96 - t21*t101) - t74*(t20*t96 + t16*t101) + t72*t130 + t71*t131), batch),  # 4, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 0
-        xp.broadcast_to(t142, batch),  # 5, 1
-        xp.broadcast_to(t142, batch),  # 5, 2
-        xp.broadcast_to(-(t49 - t73*(t28*t99 + t28*t104) + t72*(t28*t105 + t28*t106) + t102*t141 - t28*t110 + t28*t108), batch),  # 5, 3
-        xp.broadcast_to(-(-t54 - t73*(t28*t111 + t28*t114) + t72*(-t28*t115 + t28*t116) + t112*t141 + t28*t117 + t28*t118), batch),  # 5, 4
-        xp.broadcast_to(-(t64 - t73*(t28*t119 + t28*t122) + t72*(t28*t123 + t28*t124) + t120*t141 - t28*t126 + t28*t125), batch),  # 5, 5
+        xp.broadcast_to(t132, batch),  # 5, 1
+        xp.broadcast_to(t132, batch),  # 5, 2
+        xp.broadcast_to(-(t51 + t68*t95 - t30*t116 - t30*t117 + t30*t112 + t30*t114), batch),  # 5, 3
+        xp.broadcast_to(-(-t56 + t68*t88 - t30*t122 + t30*t118 + t30*t119 + t30*t121), batch),  # 5, 4
+        xp.broadcast_to(-(t66 + t68*t89 - t30*t126 - t30*t127 + t30*t123 + t30*t125), batch),  # 5, 5
     ], (6, 6))
     return Jd
 
@@ -1600,59 +1590,59 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t68 = t67
     t69 = xp.sqrt(t55 + t30 + t48 + t58 + t65 + t67)
     t70 = damping**2
-    t71 = t66 + t70
-    t72 = t68 + t70
-    t73 = t31 + t70
-    t74 = t73**2
-    t75 = t49 + t70
-    t76 = t56 + t70
-    t77 = t59 + t70
-    t78 = t34**2
-    t79 = t37**2
-    t80 = t28**2
+    t71 = t49 + t70
+    t72 = t56 + t70
+    t73 = t59 + t70
+    t74 = t66 + t70
+    t75 = t68 + t70
+    t76 = t31 + t70
+    t77 = t76**2
+    t78 = t28**2
+    t79 = t34**2
+    t80 = t37**2
     t81 = t41**2
-    t82 = xp.sqrt(t71**2 + t72**2 + t74 + t75**2 + t76**2 + t77**2 + 2*t64**2 + 2*t42 + 2*t25 + 2*t78 + 2*t79 + 2*t80 + 2*t52**2 + 2*t47**2 + 2*t53**2 + 2*t38**2 + 2*t61**2 + 2*t63**2 + 4*t81)
-    t83 = xp.sqrt(t25 + t78 + t79 + t81 + t80 + t74)
-    t84 = t83*xp.where(xp.greater_equal(t73, 0), xp.asarray(1, dtype=dtype), -1)
-    t85 = t84 + t73
-    t86 = xp.where(xp.greater(t83, 0), 1/(t83*(t83 + xp.abs(t73))), 0)
-    t87 = t86*(t85*t34 + t34*t75 + t37*t52 + t41*t28 + t41*t47 + t32)
+    t82 = xp.sqrt(t71**2 + t72**2 + t73**2 + t74**2 + t75**2 + t77 + 2*t78 + 2*t52**2 + 2*t47**2 + 2*t53**2 + 2*t38**2 + 2*t61**2 + 2*t63**2 + 2*t64**2 + 2*t42 + 2*t25 + 2*t79 + 2*t80 + 4*t81)
+    t83 = xp.sqrt(t78 + t25 + t79 + t80 + t81 + t77)
+    t84 = t83*xp.where(xp.greater_equal(t76, 0), xp.asarray(1, dtype=dtype), -1)
+    t85 = t84 + t76
+    t86 = xp.where(xp.greater(t83, 0), 1/(t83*(t83 + xp.abs(t76))), 0)
+    t87 = t86*(t28*t41 + t52*t37 + t47*t41 + t85*t34 + t34*t71 + t32)
     t88 = t34 - t85*t87
-    t89 = -t87*t34 + t75
+    t89 = -t87*t34 + t71
     t90 = -t52 + t87*t37
     t91 = -t47 + t87*t41
-    t92 = t41 - t87*t28
+    t92 = t41 - t28*t87
     t93 = t22 + t87*t23
-    t94 = -t86*(t85*t37 + t34*t52 + t37*t76 + t41*t53 + t28*t38)
+    t94 = -t86*(t28*t38 + t52*t34 + t53*t41 + t85*t37 + t37*t72)
     t95 = t37 + t85*t94
     t96 = t52 + t94*t34
-    t97 = t94*t37 + t76
+    t97 = t94*t37 + t72
     t98 = t53 + t94*t41
-    t99 = t38 + t94*t28
-    t100 = -t86*(-t23*t63 - t28*t61 + t85*t41 + t34*t47 + t37*t53 + t41*t77)
+    t99 = t38 + t28*t94
+    t100 = -t86*(-t28*t61 - t63*t23 + t47*t34 + t53*t37 + t85*t41 + t41*t73)
     t101 = t41 + t85*t100
     t102 = t47 + t100*t34
     t103 = t53 + t100*t37
-    t104 = t100*t41 + t77
-    t105 = t61 - t100*t28
-    t106 = t86*(t64*t23 + t85*t28 + t34*t41 + t37*t38 + t28*t71 - t41*t61)
+    t104 = t100*t41 + t73
+    t105 = t61 - t28*t100
+    t106 = t86*(t28*t85 + t28*t74 + t38*t37 + t64*t23 + t34*t41 - t61*t41)
     t107 = t28 - t85*t106
     t108 = t41 - t106*t34
     t109 = -t38 + t106*t37
     t110 = t61 + t106*t41
-    t111 = -t106*t28 + t71
+    t111 = -t28*t106 + t74
     t112 = -t64 + t106*t23
-    t113 = -t86*(-t22*t34 - t41*t63 + t64*t28 + t85*t23 + t23*t72)
+    t113 = -t86*(-t63*t41 - t22*t34 + t28*t64 + t85*t23 + t23*t75)
     t114 = t23 + t85*t113
     t115 = t22 - t113*t34
-    t116 = t64 + t113*t28
-    t117 = t113*t23 + t72
-    t118 = t86*(t85*mu_dot0 + t34*mu_dot1 + t28*mu_dot4 - t23*mu_dot5 - t37*mu_dot2 - t41*mu_dot3)
+    t116 = t64 + t28*t113
+    t117 = t113*t23 + t75
+    t118 = t86*(t28*mu_dot4 + t85*mu_dot0 + t34*mu_dot1 - t23*mu_dot5 - t37*mu_dot2 - t41*mu_dot3)
     t119 = mu_dot0 - t85*t118
     t120 = mu_dot1 - t118*t34
     t121 = mu_dot2 + t118*t37
     t122 = mu_dot3 + t118*t41
-    t123 = mu_dot4 - t118*t28
+    t123 = mu_dot4 - t28*t118
     t124 = mu_dot5 + t118*t23
     t125 = xp.sqrt(t89**2 + t90**2 + t91**2 + t92**2 + t93**2)
     t126 = t125*xp.where(xp.greater_equal(t89, 0), xp.asarray(1, dtype=dtype), -1)
@@ -1823,7 +1813,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t291 = -t9
     t292 = t291 + t287*c1
     t293 = t22*t251
-    t294 = -t257*(-t18*c1 + t237*t252 + t15*s1 + t256*t293)
+    t294 = -t257*(-t18*c1 + t15*s1 + t237*t252 + t256*t293)
     t295 = t256*t294 + t293
     t296 = t15 + t294*s1
     t297 = t252 + t237*t294
@@ -2048,24 +2038,24 @@ def ik_numeric_step(target, q, damping=0.0):
     t98 = xp.where(t94, t35*t86, t91*t95)
     t99 = t96**2 + t97**2 + t98**2 + t55**2 + t56**2 + t3**2
     t100 = t62 + damping
-    t101 = xp.sqrt(t57 + t65**2 + t69**2 + t66**2 + t60**2 + t100**2)
+    t101 = xp.sqrt(t60**2 + t57 + t65**2 + t69**2 + t66**2 + t100**2)
     t102 = t101*xp.where(xp.greater_equal(t100, 0), xp.asarray(1, dtype=dtype), -1)
     t103 = t102 + t100
     t104 = xp.where(xp.greater(t101, 0), 1/(t101*(t101 + xp.abs(t100))), 0)
-    t105 = t104*(t97*t60 + t55*t103 + t56*t65 - t96*t66 - t98*t52 - t3*t69)
+    t105 = t104*(t60*t97 + t55*t103 + t56*t65 - t96*t66 - t98*t52 - t3*t69)
     t106 = t55 - t103*t105
     t107 = t56 - t105*t65
     t108 = t3 + t105*t69
     t109 = t96 + t105*t66
-    t110 = t97 - t105*t60
-    t111 = t98 + t105*t52
+    t110 = t97 - t60*t105
+    t111 = t98 + t52*t105
     t112 = t72 + damping
-    t113 = t104*(t103*t65 + t65*t112 + t69*t76 + t66*t60 + t66*t73 + t63)
+    t113 = t104*(t60*t66 + t76*t69 + t73*t66 + t103*t65 + t65*t112 + t63)
     t114 = t65 - t103*t113
     t115 = -t113*t65 + t112
     t116 = -t76 + t113*t69
     t117 = -t73 + t113*t66
-    t118 = t66 - t113*t60
+    t118 = t66 - t60*t113
     t119 = t51 + t113*t52
     t120 = xp.sqrt(t115**2 + t116**2 + t117**2 + t118**2 + t119**2)
     t121 = t120*xp.where(xp.greater_equal(t115, 0), xp.asarray(1, dtype=dtype), -1)
@@ -2078,19 +2068,19 @@ def ik_numeric_step(target, q, damping=0.0):
     t128 = t110 - t118*t124
     t129 = t111 - t119*t124
     t130 = t54 + damping
-    t131 = -t104*(t103*t69 + t65*t76 + t69*t130 + t66*t77 + t60*t70)
+    t131 = -t104*(t60*t70 + t76*t65 + t77*t66 + t103*t69 + t69*t130)
     t132 = t69 + t103*t131
     t133 = t76 + t131*t65
     t134 = t131*t69 + t130
     t135 = t77 + t131*t66
-    t136 = t70 + t131*t60
+    t136 = t70 + t60*t131
     t137 = t79 + damping
-    t138 = -t104*(-t52*t42 - t60*t80 + t103*t66 + t65*t73 + t69*t77 + t66*t137)
+    t138 = -t104*(-t60*t80 - t42*t52 + t73*t65 + t77*t69 + t103*t66 + t66*t137)
     t139 = t66 + t103*t138
     t140 = t73 + t138*t65
     t141 = t77 + t138*t69
     t142 = t138*t66 + t137
-    t143 = t80 - t138*t60
+    t143 = t80 - t60*t138
     t144 = -t42
     t145 = t144 + t138*t52
     t146 = t123*(t116*t141 + t117*t142 + t118*t143 + t119*t145 - t140*t122)
@@ -2100,12 +2090,12 @@ def ik_numeric_step(target, q, damping=0.0):
     t150 = t143 - t118*t146
     t151 = t145 - t119*t146
     t152 = t81 + damping
-    t153 = t104*(t43*t52 + t103*t60 + t65*t66 + t69*t70 + t60*t152 - t66*t80)
+    t153 = t104*(t60*t103 + t60*t152 + t70*t69 + t43*t52 + t65*t66 - t80*t66)
     t154 = t60 - t103*t153
     t155 = t66 - t153*t65
     t156 = -t70 + t153*t69
     t157 = t80 + t153*t66
-    t158 = -t153*t60 + t152
+    t158 = -t60*t153 + t152
     t159 = -t43 + t153*t52
     t160 = t123*(t116*t156 + t117*t157 + t118*t158 + t119*t159 + t155*t122)
     t161 = t155 - t122*t160
@@ -2114,11 +2104,11 @@ def ik_numeric_step(target, q, damping=0.0):
     t164 = t158 - t118*t160
     t165 = t159 - t119*t160
     t166 = t82 + damping
-    t167 = -t104*(-t51*t65 - t66*t42 + t43*t60 + t103*t52 + t52*t166)
+    t167 = -t104*(-t42*t66 - t51*t65 + t60*t43 + t103*t52 + t52*t166)
     t168 = t52 + t103*t167
     t169 = t51 - t167*t65
     t170 = t144 + t167*t66
-    t171 = t43 + t167*t60
+    t171 = t43 + t60*t167
     t172 = t167*t52 + t166
     t173 = t131*t52
     t174 = t123*(t116*t134 + t117*t135 - t118*t136 - t133*t122 + t119*t173)
@@ -3097,7 +3087,7 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     t156 = xp.where(xp.greater_equal(t20, -4.642575810304916) & xp.less_equal(t20, 4.642575810304916), t20, xp.where(xp.greater_equal(t154, -4.642575810304916) & xp.less_equal(t154, 4.642575810304916), t154, xp.where(xp.greater_equal(t155, -4.642575810304916) & xp.less_equal(t155, 4.642575810304916), t155, qb2_5)))
     t157 = qw1*(t136 + t82)**2 + qw2*(t140 + t83)**2 + qw3*(t144 + t84)**2 + qw4*(t148 + t85)**2 + qw5*(t152 + t86)**2 + qw6*(t156 + t87)**2
     t158 = xp.greater(t21, 0)
-    t159 = xp.where(t158 & (xp.less(t157, t132) | xp.less(t124, 1)), xp.asarray(1, dtype=dtype), 0)
+    t159 = xp.where(t158 & (xp.less(t124, 1) | xp.less(t157, t132)), xp.asarray(1, dtype=dtype), 0)
     t160 = xp.where(t158, 1, t124)
     t161 = xp.greater(t159, 0)
     t162 = xp.where(t161, t136, t126)

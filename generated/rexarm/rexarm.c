@@ -660,7 +660,7 @@ void rexarm_bias_acceleration(const rexarm_real q[REXARM_DOF], const rexarm_real
 
 void rexarm_task_jacobian_dot(const rexarm_real q[REXARM_DOF], const rexarm_real q_dot[REXARM_DOF], rexarm_real Jd[REXARM_TASK_DIM * REXARM_DOF])
 {
-    /* 167 operations */
+    /* 166 operations */
 
     /* Inputs */
     const rexarm_real q1 = q[0];
@@ -739,9 +739,11 @@ void rexarm_task_jacobian_dot(const rexarm_real q[REXARM_DOF], const rexarm_real
     const rexarm_real t51 = s1*t19*t8 + c1*t23*t8 + t11*t50 + t13*t50;
     const rexarm_real t52 = (c234*c234);
     const rexarm_real t53 = t11*t52 + t52*t13;
-    const rexarm_real t54 = 1.0/sqrt(t53);
-    const rexarm_real t55 = -c234*(t12 + t14)/(sqrt(t53)*t53);
-    const rexarm_real t56 = -t47*(s1*t54 + s1*t55) + t42*(c1*t54 + c1*t55);
+    const rexarm_real t54 = sqrt(t53);
+    const rexarm_real t55 = 1.0/t54;
+    const rexarm_real t56 = -t55*(t12 + t14)/t53;
+    const rexarm_real t57 = c234*t56;
+    const rexarm_real t58 = -t47*(s1*t55 + s1*t57) + t42*(c1*t55 + c1*t57);
 
     /* Outputs */
     Jd[0] = -t32;
@@ -757,9 +759,9 @@ void rexarm_task_jacobian_dot(const rexarm_real q[REXARM_DOF], const rexarm_real
     Jd[10] = -t49;
     Jd[11] = -t51;
     Jd[12] = 0;
-    Jd[13] = t56;
-    Jd[14] = t56;
-    Jd[15] = t56;
+    Jd[13] = t58;
+    Jd[14] = t58;
+    Jd[15] = t58;
 }
 
 void rexarm_hessian(const rexarm_real q[REXARM_DOF], rexarm_real H[REXARM_DOF * 6 * REXARM_DOF])
@@ -1111,9 +1113,9 @@ int rexarm_velocity_ik(const rexarm_real q[REXARM_DOF], const rexarm_real mu_dot
     const rexarm_real t82 = t62 + t81;
     const rexarm_real t83 = (t80 > 0 ? 1/(t80*(t80 + fabs(t62))) : 0);
     const rexarm_real t84 = t83*(t63*t68 + t64*t69 - t67*t82);
-    const rexarm_real t85 = t67 + t82*t84;
-    const rexarm_real t86 = t68 - t63*t84;
-    const rexarm_real t87 = t69 - t64*t84;
+    const rexarm_real t85 = t67 + t84*t82;
+    const rexarm_real t86 = t68 - t84*t63;
+    const rexarm_real t87 = t69 - t84*t64;
     const rexarm_real t88 = t83*(t63*t73 + t64*t74 - t72*t82);
     const rexarm_real t89 = t72 + t88*t82;
     const rexarm_real t90 = t73 - t88*t63;
@@ -1122,9 +1124,9 @@ int rexarm_velocity_ik(const rexarm_real q[REXARM_DOF], const rexarm_real mu_dot
     const rexarm_real t93 = t77 - t92*t82;
     const rexarm_real t94 = t78 - t92*t63;
     const rexarm_real t95 = t79 - t92*t64;
-    const rexarm_real t96 = sqrt((t87*t87) + (t86*t86));
+    const rexarm_real t96 = sqrt((t86*t86) + (t87*t87));
     const rexarm_real t97 = t96*(t86 >= 0 ? 1 : -1);
-    const rexarm_real t98 = t97 + t86;
+    const rexarm_real t98 = t86 + t97;
     const rexarm_real t99 = (t96 > 0 ? 1/(t96*(t96 + fabs(t86))) : 0);
     const rexarm_real t100 = t99*(t87*t91 + t90*t98);
     const rexarm_real t101 = t90 - t98*t100;
@@ -1140,7 +1142,7 @@ int rexarm_velocity_ik(const rexarm_real q[REXARM_DOF], const rexarm_real mu_dot
     const rexarm_real t111 = t105 - t105*t110*(t109*t109);
     const rexarm_real t112 = (t108 != 0 ? -t111/t108 : 0);
     const rexarm_real t113 = (t97 != 0 ? -(t104 - t101*t112)/t97 : 0);
-    const rexarm_real t114 = (t81 != 0 ? -(t93 + t89*t112 + t113*t85)/t81 : 0);
+    const rexarm_real t114 = (t81 != 0 ? -(t93 + t85*t113 + t89*t112)/t81 : 0);
     const rexarm_real t115 = (t57 != 0 ? -(t76 - t114*t61 + t112*t71 + t113*t66)/t57 : 0);
     const rexarm_real t116 = t114*t2 - t115*t5;
     const rexarm_real t117 = t112*t17;

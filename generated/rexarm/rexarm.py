@@ -689,7 +689,7 @@ def bias_acceleration(q, q_dot):
 
 
 def task_jacobian_dot(q, q_dot):
-    """time derivative of the analytic Jacobian along q_dot (4 x DOF): mu'' = J_a q'' + J_a' q': (4 x 4), 167 operations."""
+    """time derivative of the analytic Jacobian along q_dot (4 x DOF): mu'' = J_a q'' + J_a' q': (4 x 4), 166 operations."""
     xp, dtype, device, batch, (q, q_dot,) = _arguments(("q", q, (4,)), ("q_dot", q_dot, (4,)))
     q2 = q[..., 1]
     qd1 = q_dot[..., 0]
@@ -763,9 +763,11 @@ def task_jacobian_dot(q, q_dot):
     t51 = s1*t19*t8 + c1*t23*t8 + t11*t50 + t13*t50
     t52 = c234**2
     t53 = t11*t52 + t52*t13
-    t54 = 1/xp.sqrt(t53)
-    t55 = -c234*(t12 + t14)/t53**1.5
-    t56 = -t47*(s1*t54 + s1*t55) + t42*(c1*t54 + c1*t55)
+    t54 = xp.sqrt(t53)
+    t55 = 1/t54
+    t56 = -t55*(t12 + t14)/t53
+    t57 = c234*t56
+    t58 = -t47*(s1*t55 + s1*t57) + t42*(c1*t55 + c1*t57)
     Jd = _stack(xp, [
         xp.broadcast_to(-t32, batch),  # 0, 0
         xp.broadcast_to(t39, batch),  # 0, 1
@@ -780,9 +782,9 @@ def task_jacobian_dot(q, q_dot):
         xp.broadcast_to(-t49, batch),  # 2, 2
         xp.broadcast_to(-t51, batch),  # 2, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
-        xp.broadcast_to(t56, batch),  # 3, 1
-        xp.broadcast_to(t56, batch),  # 3, 2
-        xp.broadcast_to(t56, batch),  # 3, 3
+        xp.broadcast_to(t58, batch),  # 3, 1
+        xp.broadcast_to(t58, batch),  # 3, 2
+        xp.broadcast_to(t58, batch),  # 3, 3
     ], (4, 4))
     return Jd
 
@@ -1111,9 +1113,9 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t82 = t62 + t81
     t83 = xp.where(xp.greater(t80, 0), 1/(t80*(t80 + xp.abs(t62))), 0)
     t84 = t83*(t63*t68 + t64*t69 - t67*t82)
-    t85 = t67 + t82*t84
-    t86 = t68 - t63*t84
-    t87 = t69 - t64*t84
+    t85 = t67 + t84*t82
+    t86 = t68 - t84*t63
+    t87 = t69 - t84*t64
     t88 = t83*(t63*t73 + t64*t74 - t72*t82)
     t89 = t72 + t88*t82
     t90 = t73 - t88*t63
@@ -1122,9 +1124,9 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t93 = t77 - t92*t82
     t94 = t78 - t92*t63
     t95 = t79 - t92*t64
-    t96 = xp.sqrt(t87**2 + t86**2)
+    t96 = xp.sqrt(t86**2 + t87**2)
     t97 = t96*xp.where(xp.greater_equal(t86, 0), xp.asarray(1, dtype=dtype), -1)
-    t98 = t97 + t86
+    t98 = t86 + t97
     t99 = xp.where(xp.greater(t96, 0), 1/(t96*(t96 + xp.abs(t86))), 0)
     t100 = t99*(t87*t91 + t90*t98)
     t101 = t90 - t98*t100
@@ -1140,7 +1142,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t111 = t105 - t105*t110*t109**2
     t112 = xp.where(xp.not_equal(t108, 0), -t111/t108, 0)
     t113 = xp.where(xp.not_equal(t97, 0), -(t104 - t101*t112)/t97, 0)
-    t114 = xp.where(xp.not_equal(t81, 0), -(t93 + t89*t112 + t113*t85)/t81, 0)
+    t114 = xp.where(xp.not_equal(t81, 0), -(t93 + t85*t113 + t89*t112)/t81, 0)
     t115 = xp.where(xp.not_equal(t57, 0), -(t76 - t114*t61 + t112*t71 + t113*t66)/t57, 0)
     t116 = t114*t2 - t115*t5
     t117 = t112*t17

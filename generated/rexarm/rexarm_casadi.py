@@ -581,7 +581,7 @@ def _bias_acceleration(q, q_dot):
 
 
 def _task_jacobian_dot(q, q_dot):
-    """Time derivative of the analytic Jacobian along q_dot (4 x DOF): mu'' = J_a q'' + J_a' q': 167 operations."""
+    """Time derivative of the analytic Jacobian along q_dot (4 x DOF): mu'' = J_a q'' + J_a' q': 166 operations."""
     q1 = q[0]
     q2 = q[1]
     q3 = q[2]
@@ -656,9 +656,11 @@ def _task_jacobian_dot(q, q_dot):
     t51 = s1*t19*t8 + c1*t23*t8 + t11*t50 + t13*t50
     t52 = c234**2
     t53 = t11*t52 + t52*t13
-    t54 = 1/casadi.sqrt(t53)
-    t55 = -c234*(t12 + t14)/t53**1.5
-    t56 = -t47*(s1*t54 + s1*t55) + t42*(c1*t54 + c1*t55)
+    t54 = casadi.sqrt(t53)
+    t55 = 1/t54
+    t56 = -t55*(t12 + t14)/t53
+    t57 = c234*t56
+    t58 = -t47*(s1*t55 + s1*t57) + t42*(c1*t55 + c1*t57)
     Jd = casadi.SX(4, 4)
     Jd[0, 0] = -t32
     Jd[0, 1] = t39
@@ -671,9 +673,9 @@ def _task_jacobian_dot(q, q_dot):
     Jd[2, 1] = -t33
     Jd[2, 2] = -t49
     Jd[2, 3] = -t51
-    Jd[3, 1] = t56
-    Jd[3, 2] = t56
-    Jd[3, 3] = t56
+    Jd[3, 1] = t58
+    Jd[3, 2] = t58
+    Jd[3, 3] = t58
     return [Jd]
 
 
@@ -952,9 +954,9 @@ def _velocity_ik(q, mu_dot, damping):
     t82 = t62 + t81
     t83 = casadi.if_else((t80 > 0), 1/(t80*(t80 + casadi.fabs(t62))), 0)
     t84 = t83*(t63*t68 + t64*t69 - t67*t82)
-    t85 = t67 + t82*t84
-    t86 = t68 - t63*t84
-    t87 = t69 - t64*t84
+    t85 = t67 + t84*t82
+    t86 = t68 - t84*t63
+    t87 = t69 - t84*t64
     t88 = t83*(t63*t73 + t64*t74 - t72*t82)
     t89 = t72 + t88*t82
     t90 = t73 - t88*t63
@@ -963,9 +965,9 @@ def _velocity_ik(q, mu_dot, damping):
     t93 = t77 - t92*t82
     t94 = t78 - t92*t63
     t95 = t79 - t92*t64
-    t96 = casadi.sqrt(t87**2 + t86**2)
+    t96 = casadi.sqrt(t86**2 + t87**2)
     t97 = t96*casadi.if_else((t86 >= 0), 1, -1)
-    t98 = t97 + t86
+    t98 = t86 + t97
     t99 = casadi.if_else((t96 > 0), 1/(t96*(t96 + casadi.fabs(t86))), 0)
     t100 = t99*(t87*t91 + t90*t98)
     t101 = t90 - t98*t100
@@ -981,7 +983,7 @@ def _velocity_ik(q, mu_dot, damping):
     t111 = t105 - t105*t110*t109**2
     t112 = casadi.if_else((t108 != 0), -t111/t108, 0)
     t113 = casadi.if_else((t97 != 0), -(t104 - t101*t112)/t97, 0)
-    t114 = casadi.if_else((t81 != 0), -(t93 + t89*t112 + t113*t85)/t81, 0)
+    t114 = casadi.if_else((t81 != 0), -(t93 + t85*t113 + t89*t112)/t81, 0)
     t115 = casadi.if_else((t57 != 0), -(t76 - t114*t61 + t112*t71 + t113*t66)/t57, 0)
     t116 = t114*t2 - t115*t5
     t117 = t112*t17

@@ -1252,7 +1252,7 @@ def bias_acceleration(q, q_dot):
 
 
 def task_jacobian_dot(q, q_dot):
-    """time derivative of the analytic Jacobian along q_dot (6 x DOF): mu'' = J_a q'' + J_a' q': (6 x 7), 717 operations."""
+    """time derivative of the analytic Jacobian along q_dot (6 x DOF): mu'' = J_a q'' + J_a' q': (6 x 7), 674 operations."""
     xp, dtype, device, batch, (q, q_dot,) = _arguments(("q", q, (7,)), ("q_dot", q_dot, (7,)))
     qd1 = q_dot[..., 0]
     qd2 = q_dot[..., 1]
@@ -1321,218 +1321,204 @@ def task_jacobian_dot(q, q_dot):
     t42 = t41 + t38*qd4
     t43 = t42 + t37*qd3
     t44 = t43 - t36*qd2
-    t45 = c3*s2
-    t46 = c2*s4 - c4*t45
-    t47 = c2*c4 + s4*t45
-    t48 = s3*s2
-    t49 = t46*c5 - s5*t48
-    t50 = t46*s5 + c5*t48
-    t51 = t49*c6 - t47*s6
-    t52 = t47*c6 + t49*s6
-    t53 = t50*s7 + t51*c7
-    t54 = 0.13375*t52 + 0.1363*t50
-    t55 = -t54 + 0.4*t47
-    t56 = t55 + 0.1685*t48
-    t57 = t56 - 0.4*c2
-    t58 = t33*c2 - t57*t22
-    t59 = t3*t56 + t32*t48
-    t60 = t24*t55 - t47*t31
-    t61 = t50*t30 - t26*t54
-    t62 = -t19*c2 + t57*t8
-    t63 = -t56*t6 + t18*t48
-    t64 = t47*t17 - t10*t55
-    t65 = t50*t16 - t12*t54
-    t66 = t60*qd5 + t61*qd6
-    t67 = t64*qd5 + t65*qd6
-    t68 = t66 - t59*qd4
-    t69 = t67 + t63*qd4
-    t70 = t68 + t58*qd3
-    t71 = t69 + t62*qd3
-    t72 = qd2*s1
-    t73 = t71 + t57*t72
-    t74 = t73 + t21*qd1
-    t75 = t58*qd1 - t70*c2 + t43*t8 + t37*t72
-    t76 = qd1*t8 + c2*t72
-    t77 = t72 + qd3*t8
-    t78 = t77
-    t79 = c1*qd2
-    t80 = t70 + t57*t79
-    t81 = t80 - t35*qd1
-    t82 = t71*c2 - t62*qd1 + t37*t79 - t43*t22
-    t83 = t80*c1 + t73*s1
-    t84 = t71*t8 + t58*t79 + t62*t72 - t70*t22
-    t85 = qd1*t22 - c2*t79
-    t86 = t79 - qd3*t22
-    t87 = t86
-    t88 = t68*t3 + t69*t6 + t59*t87 - t63*t78
-    t89 = t3*t78 - t6*t87
-    t90 = qd1 - c2*qd3
-    t91 = t90
-    t92 = t42*t3 + t63*t91 - t38*t87 + t69*t48
-    t93 = t38*t78 - t42*t6 - t59*t91 + t68*t48
-    t94 = t3*t91 + t87*t48
-    t95 = t6*t91 + t78*t48
-    t96 = t6*qd4
-    t97 = -t78 + t96
-    t98 = -t3*qd4
-    t99 = t87 + t98
-    t100 = t67*t10 + t64*t97 - t66*t24 - t60*t99
-    t101 = t24*t97 - t10*t99
-    t102 = qd4*t48
-    t103 = t91 + t102
-    t104 = t41*t24 + t39*t99 - t67*t47 - t64*t103
-    t105 = t66*t47 + t60*t103 - t41*t10 - t39*t97
-    t106 = t47*t99 - t24*t103
-    t107 = t10*t103 - t47*t97
-    t108 = t10*qd5
-    t109 = t97 + t108
-    t110 = t24*qd5
+    t45 = t15**2 + t29**2
+    t46 = xp.sqrt(t45)
+    t47 = c3*s2
+    t48 = c2*s4 - c4*t47
+    t49 = c2*c4 + s4*t47
+    t50 = s3*s2
+    t51 = t48*c5 - s5*t50
+    t52 = t48*s5 + c5*t50
+    t53 = t51*c6 - t49*s6
+    t54 = t49*c6 + t51*s6
+    t55 = t52*s7 + t53*c7
+    t56 = 0.13375*t54 + 0.1363*t52
+    t57 = -t56 + 0.4*t49
+    t58 = t57 + 0.1685*t50
+    t59 = t58 - 0.4*c2
+    t60 = t33*c2 - t59*t22
+    t61 = t3*t58 + t32*t50
+    t62 = t24*t57 - t49*t31
+    t63 = t52*t30 - t26*t56
+    t64 = -t19*c2 + t59*t8
+    t65 = -t58*t6 + t18*t50
+    t66 = t49*t17 - t10*t57
+    t67 = t52*t16 - t12*t56
+    t68 = t62*qd5 + t63*qd6
+    t69 = t66*qd5 + t67*qd6
+    t70 = t68 - t61*qd4
+    t71 = t69 + t65*qd4
+    t72 = t70 + t60*qd3
+    t73 = t71 + t64*qd3
+    t74 = qd2*s1
+    t75 = t73 + t59*t74
+    t76 = t75 + t21*qd1
+    t77 = t60*qd1 - t72*c2 + t43*t8 + t37*t74
+    t78 = qd1*t8 + c2*t74
+    t79 = t74 + qd3*t8
+    t80 = t79
+    t81 = c1*qd2
+    t82 = t72 + t59*t81
+    t83 = t82 - t35*qd1
+    t84 = t73*c2 - t64*qd1 + t37*t81 - t43*t22
+    t85 = t82*c1 + t75*s1
+    t86 = t73*t8 + t60*t81 + t64*t74 - t72*t22
+    t87 = qd1*t22 - c2*t81
+    t88 = t81 - qd3*t22
+    t89 = t88
+    t90 = t70*t3 + t71*t6 + t61*t89 - t65*t80
+    t91 = t3*t80 - t6*t89
+    t92 = qd1 - c2*qd3
+    t93 = t92
+    t94 = t42*t3 + t65*t93 - t38*t89 + t71*t50
+    t95 = t38*t80 - t42*t6 - t61*t93 + t70*t50
+    t96 = t3*t93 + t89*t50
+    t97 = t6*t93 + t80*t50
+    t98 = t6*qd4
+    t99 = -t80 + t98
+    t100 = -t3*qd4
+    t101 = t89 + t100
+    t102 = t69*t10 + t66*t99 - t68*t24 - t62*t101
+    t103 = t24*t99 - t10*t101
+    t104 = qd4*t50
+    t105 = t93 + t104
+    t106 = t41*t24 + t39*t101 - t69*t49 - t66*t105
+    t107 = t68*t49 + t62*t105 - t41*t10 - t39*t99
+    t108 = t49*t101 - t24*t105
+    t109 = t10*t105 - t49*t99
+    t110 = t10*qd5
     t111 = t99 + t110
-    t112 = t12*t111 + t26*t109
-    t113 = t47*qd5
-    t114 = t103 + t113
-    t115 = t26*t114 + t50*t111
-    t116 = t50*t109 - t12*t114
-    t117 = t12*qd6
-    t118 = t109 - t117
-    t119 = t117 + t14*qd7 - t108 - t96 + t77
-    t120 = t26*qd6
-    t121 = t111 + t120
-    t122 = t61*t111 - t65*t109 + t65*t117 + t61*t120
-    t123 = t14*t121 - t28*t118
-    t124 = t98 + t110 + t120 - t28*qd7 + t86
-    t125 = t119*t29 + t124*t15
-    t126 = t50*qd6
-    t127 = t40*t111 - t65*t114 + t40*t120 + t65*t126
-    t128 = t61*t114 - t40*t109 + t40*t117 - t61*t126
-    t129 = -t126
-    t130 = t114 + t129
-    t131 = t130*t28 - t52*t121
-    t132 = t52*t118 - t130*t14
-    t133 = t102 + t113 + t129 - t52*qd7 + t90
-    t134 = t124*t53 - t133*t29
-    t135 = t119*t53 + t133*t15
-    t136 = qd1*t57
-    t137 = t44*c1 - s1*t136
-    t138 = t44*s1 + c1*t136
-    t139 = qd2*s2
-    t140 = c1**2*t139 + s1**2*t139
-    t141 = t15**2 + t29**2
-    t142 = 1/t141
-    t143 = s1*t142
-    t144 = t29*c1
-    t145 = t15*s1
-    t146 = t144 - t145
-    t147 = 2/t141**2
-    t148 = t146*t147
-    t149 = t15*t148
-    t150 = c1*t142
-    t151 = t29*t148
-    t152 = qd1*t15
-    t153 = qd1*t29
-    t154 = s2*t150
-    t155 = t15*c1
-    t156 = t29*s1
-    t157 = -(s2*t155 + s2*t156)
-    t158 = t157*t147
-    t159 = t15*t158
-    t160 = s2*t143
-    t161 = t29*t158
-    t162 = t15*t142
-    t163 = t85*t162
-    t164 = t29*t142
-    t165 = t76*t164
-    t166 = t6*t142
-    t167 = t15*t6 - t3*t29
-    t168 = t167*t147
-    t169 = t15*t168
-    t170 = t3*t142
-    t171 = t29*t168
-    t172 = t94*t162
-    t173 = t95*t164
-    t174 = t10*t142
-    t175 = t10*t15 + t24*t29
-    t176 = t175*t147
-    t177 = t15*t176
-    t178 = t24*t142
-    t179 = t29*t176
-    t180 = t106*t162
-    t181 = t107*t164
-    t182 = t12*t142
-    t183 = t26*t29 - t12*t15
-    t184 = t183*t147
-    t185 = t15*t184
-    t186 = t26*t142
-    t187 = t29*t184
-    t188 = t116*t164
-    t189 = t115*t162
-    t190 = t14*t142
-    t191 = -(t14*t15 + t28*t29)
-    t192 = t191*t147
-    t193 = t15*t192
-    t194 = t28*t142
-    t195 = t29*t192
-    t196 = t131*t162
-    t197 = t132*t164
-    t198 = 1/xp.sqrt(t141)
-    t199 = c1*t198
-    t200 = 1/t141**1.5
-    t201 = t200*(t155 + t156)
-    t202 = s1*t198
-    t203 = qd1*t198
-    t204 = t200*(s2*t144 - s2*t145)
-    t205 = t29*t198
-    t206 = t15*t198
-    t207 = -t200*(t3*t15 + t29*t6)
-    t208 = t200*(t24*t15 - t10*t29)
-    t209 = t200*(t12*t29 + t26*t15)
-    t210 = t200*(t14*t29 - t28*t15)
-    t211 = t53*t143
-    t212 = t53*t150
-    t213 = t142*t125
+    t112 = t24*qd5
+    t113 = t101 + t112
+    t114 = t12*t113 + t26*t111
+    t115 = t49*qd5
+    t116 = t105 + t115
+    t117 = t26*t116 + t52*t113
+    t118 = t52*t111 - t12*t116
+    t119 = t12*qd6
+    t120 = t111 - t119
+    t121 = t119 + t14*qd7 - t110 - t98 + t79
+    t122 = t26*qd6
+    t123 = t113 + t122
+    t124 = t63*t113 - t67*t111 + t67*t119 + t63*t122
+    t125 = t14*t123 - t28*t120
+    t126 = t100 + t112 + t122 - t28*qd7 + t88
+    t127 = t121*t29 + t126*t15
+    t128 = t52*qd6
+    t129 = t40*t113 - t67*t116 + t40*t122 + t67*t128
+    t130 = t63*t116 - t40*t111 + t40*t119 - t63*t128
+    t131 = -t128
+    t132 = t116 + t131
+    t133 = t132*t28 - t54*t123
+    t134 = t54*t120 - t132*t14
+    t135 = t104 + t115 + t131 - t54*qd7 + t92
+    t136 = t126*t55 - t135*t29
+    t137 = t121*t55 + t135*t15
+    t138 = qd1*t59
+    t139 = t44*c1 - s1*t138
+    t140 = t44*s1 + c1*t138
+    t141 = qd2*s2
+    t142 = c1**2*t141 + s1**2*t141
+    t143 = 1/t45
+    t144 = t143*(t15*t6 - t3*t29)
+    t145 = t143*(t10*t15 + t24*t29)
+    t146 = t143*(t26*t29 - t12*t15)
+    t147 = -t143*(t14*t15 + t28*t29)
+    t148 = t29*c1
+    t149 = t15*s1
+    t150 = t143*(t148 - t149)
+    t151 = t15*c1
+    t152 = t29*s1
+    t153 = -t143*(s2*t151 + s2*t152)
+    t154 = 1/t46
+    t155 = t143*t154
+    t156 = (t151 + t152)*t155
+    t157 = (s2*t148 - s2*t149)*t155
+    t158 = -(t3*t15 + t29*t6)*t155
+    t159 = (t24*t15 - t10*t29)*t155
+    t160 = (t12*t29 + t26*t15)*t155
+    t161 = (t14*t29 - t28*t15)*t155
+    t162 = 2*t150
+    t163 = t143*t136
+    t164 = -(s1 + t15*t162)*t163
+    t165 = t143*t137
+    t166 = (c1 - t29*t162)*t165
+    t167 = qd1*t143
+    t168 = t151*t167
+    t169 = t152*t167
+    t170 = t15*t143
+    t171 = t87*t170
+    t172 = 2*t153
+    t173 = -(t8 + t15*t172)*t163
+    t174 = -(t22 + t29*t172)*t165
+    t175 = t29*t143
+    t176 = t78*t175
+    t177 = t96*t170
+    t178 = t97*t175
+    t179 = 2*t144
+    t180 = (t6 - t15*t179)*t163
+    t181 = -(t3 + t29*t179)*t165
+    t182 = t108*t170
+    t183 = t109*t175
+    t184 = 2*t145
+    t185 = (t10 - t15*t184)*t163
+    t186 = (t24 - t29*t184)*t165
+    t187 = t118*t175
+    t188 = 2*t146
+    t189 = -(t12 + t15*t188)*t163
+    t190 = (t26 - t29*t188)*t165
+    t191 = t117*t170
+    t192 = t133*t170
+    t193 = t134*t175
+    t194 = 2*t147
+    t195 = -(t14 + t15*t194)*t163
+    t196 = -(t28 + t29*t194)*t165
+    t197 = qd1*t154
+    t198 = t29*t154
+    t199 = t15*t154
     Jd = _stack(xp, [
-        xp.broadcast_to(-t74, batch),  # 0, 0
-        xp.broadcast_to(t137, batch),  # 0, 1
-        xp.broadcast_to(t82, batch),  # 0, 2
-        xp.broadcast_to(-t92, batch),  # 0, 3
-        xp.broadcast_to(t104, batch),  # 0, 4
-        xp.broadcast_to(t127, batch),  # 0, 5
+        xp.broadcast_to(-t76, batch),  # 0, 0
+        xp.broadcast_to(t139, batch),  # 0, 1
+        xp.broadcast_to(t84, batch),  # 0, 2
+        xp.broadcast_to(-t94, batch),  # 0, 3
+        xp.broadcast_to(t106, batch),  # 0, 4
+        xp.broadcast_to(t129, batch),  # 0, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 6
-        xp.broadcast_to(t81, batch),  # 1, 0
-        xp.broadcast_to(t138, batch),  # 1, 1
-        xp.broadcast_to(t75, batch),  # 1, 2
-        xp.broadcast_to(t93, batch),  # 1, 3
-        xp.broadcast_to(t105, batch),  # 1, 4
-        xp.broadcast_to(t128, batch),  # 1, 5
+        xp.broadcast_to(t83, batch),  # 1, 0
+        xp.broadcast_to(t140, batch),  # 1, 1
+        xp.broadcast_to(t77, batch),  # 1, 2
+        xp.broadcast_to(t95, batch),  # 1, 3
+        xp.broadcast_to(t107, batch),  # 1, 4
+        xp.broadcast_to(t130, batch),  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
-        xp.broadcast_to(-t83, batch),  # 2, 1
-        xp.broadcast_to(-t84, batch),  # 2, 2
-        xp.broadcast_to(t88, batch),  # 2, 3
-        xp.broadcast_to(t100, batch),  # 2, 4
-        xp.broadcast_to(-t122, batch),  # 2, 5
+        xp.broadcast_to(-t85, batch),  # 2, 1
+        xp.broadcast_to(-t86, batch),  # 2, 2
+        xp.broadcast_to(t90, batch),  # 2, 3
+        xp.broadcast_to(t102, batch),  # 2, 4
+        xp.broadcast_to(-t124, batch),  # 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
-        xp.broadcast_to(-t134*(t143 + t149) + t135*(t150 - t151) - t150*t152 - t143*t153, batch),  # 3, 1
-        xp.broadcast_to(-t134*(t154 + t159) - t135*(t160 + t161) + t163 - t165, batch),  # 3, 2
-        xp.broadcast_to(t134*(t166 - t169) - t135*(t170 + t171) + t172 + t173, batch),  # 3, 3
-        xp.broadcast_to(t134*(t174 - t177) + t135*(t178 - t179) + t180 + t181, batch),  # 3, 4
-        xp.broadcast_to(-t134*(t182 + t185) + t135*(t186 - t187) + t188 - t189, batch),  # 3, 5
-        xp.broadcast_to(-t134*(t190 + t193) - t135*(t194 + t195) + t196 + t197, batch),  # 3, 6
+        xp.broadcast_to(t164 + t166 - t168 - t169, batch),  # 3, 1
+        xp.broadcast_to(t171 + t173 + t174 - t176, batch),  # 3, 2
+        xp.broadcast_to(t177 + t178 + t180 + t181, batch),  # 3, 3
+        xp.broadcast_to(t182 + t183 + t185 + t186, batch),  # 3, 4
+        xp.broadcast_to(t187 + t189 + t190 - t191, batch),  # 3, 5
+        xp.broadcast_to(t192 + t193 + t195 + t196, batch),  # 3, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
-        xp.broadcast_to(t134*(t199 - t15*t201) + t135*(t202 - t29*t201) + t144*t203 - t145*t203, batch),  # 4, 1
-        xp.broadcast_to(-t134*(t15*t204 + s2*t202) + t135*(s2*t199 - t29*t204) - t85*t205 - t76*t206, batch),  # 4, 2
-        xp.broadcast_to(-t134*(t3*t198 + t15*t207) - t135*(t6*t198 + t29*t207) + t95*t206 - t94*t205, batch),  # 4, 3
-        xp.broadcast_to(t134*(t24*t198 - t15*t208) - t135*(t10*t198 + t29*t208) + t107*t206 - t106*t205, batch),  # 4, 4
-        xp.broadcast_to(t134*(t26*t198 - t15*t209) + t135*(t12*t198 - t29*t209) + t115*t205 + t116*t206, batch),  # 4, 5
-        xp.broadcast_to(-t134*(t28*t198 + t15*t210) + t135*(t14*t198 - t29*t210) + t132*t206 - t131*t205, batch),  # 4, 6
+        xp.broadcast_to(t136*(c1*t154 - t156*t15) + t137*(s1*t154 - t156*t29) + t148*t197 - t149*t197, batch),  # 4, 1
+        xp.broadcast_to(-t136*(t157*t15 + t154*t22) + t137*(-t157*t29 + t154*t8) - t87*t198 - t78*t199, batch),  # 4, 2
+        xp.broadcast_to(-t136*(t3*t154 + t158*t15) - t137*(t158*t29 + t6*t154) + t97*t199 - t96*t198, batch),  # 4, 3
+        xp.broadcast_to(t136*(t24*t154 - t159*t15) - t137*(t159*t29 + t10*t154) + t109*t199 - t108*t198, batch),  # 4, 4
+        xp.broadcast_to(t136*(t26*t154 - t160*t15) + t137*(t12*t154 - t160*t29) + t117*t198 + t118*t199, batch),  # 4, 5
+        xp.broadcast_to(-t136*(t161*t15 + t28*t154) + t137*(t14*t154 - t161*t29) + t134*t199 - t133*t198, batch),  # 4, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 0
-        xp.broadcast_to(t134*(t211 + t53*t149) + t135*(-t212 + t53*t151) + t146*t213 + t212*t152 + t211*t153, batch),  # 5, 1
-        xp.broadcast_to(t140 + t134*(t53*t154 + t53*t159) + t135*(t53*t160 + t53*t161) + t157*t213 + t53*t165 - t53*t163, batch),  # 5, 2
-        xp.broadcast_to(t89 + t134*(-t53*t166 + t53*t169) + t135*(t53*t170 + t53*t171) + t167*t213 - t53*t172 - t53*t173, batch),  # 5, 3
-        xp.broadcast_to(t101 + t134*(-t53*t174 + t53*t177) + t135*(-t53*t178 + t53*t179) + t175*t213 - t53*t180 - t53*t181, batch),  # 5, 4
-        xp.broadcast_to(t112 + t134*(t53*t182 + t53*t185) + t135*(-t53*t186 + t53*t187) + t183*t213 + t53*t189 - t53*t188, batch),  # 5, 5
-        xp.broadcast_to(t123 + t134*(t53*t190 + t53*t193) + t135*(t53*t194 + t53*t195) + t191*t213 - t53*t196 - t53*t197, batch),  # 5, 6
+        xp.broadcast_to(t127*t150 - t55*t164 - t55*t166 + t55*t168 + t55*t169, batch),  # 5, 1
+        xp.broadcast_to(t142 + t127*t153 + t55*t176 - t55*t171 - t55*t173 - t55*t174, batch),  # 5, 2
+        xp.broadcast_to(-(-t91 - t127*t144 + t55*t177 + t55*t178 + t55*t180 + t55*t181), batch),  # 5, 3
+        xp.broadcast_to(-(-t103 - t127*t145 + t55*t182 + t55*t183 + t55*t185 + t55*t186), batch),  # 5, 4
+        xp.broadcast_to(t114 + t127*t146 + t55*t191 - t55*t187 - t55*t189 - t55*t190, batch),  # 5, 5
+        xp.broadcast_to(-(-t125 - t127*t147 + t55*t192 + t55*t193 + t55*t195 + t55*t196), batch),  # 5, 6
     ], (6, 7))
     return Jd
 
@@ -2607,7 +2593,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t246 = t241*t33 + t242*t62 + t243*t59 - t238*c2 - t239*t20 - t240*t8
     t247 = t240*t6 + t241*t34 + t242*t52 - t3*t239 - t243*t49 + t238*t41
     t248 = t10*t240 + t22*t239 + t40*t238 + t241*t35 + t242*t53 + t243*t50
-    t249 = t24*t239 + t241*t36 + t242*t54 + t243*t51 - t12*t240 - t238*t43
+    t249 = t24*t239 + t241*t36 + t242*t54 + t243*t51 - t12*t240 - t43*t238
     t250 = t238*t44 + t239*t25 + t240*t13
     t251 = xp.isfinite(t64)
     t252 = xp.greater_equal(damping, 0)
@@ -4649,7 +4635,7 @@ def ik_nearest(T, q_seed, q_free, weights=(1.0,) * DOF):
     t585 = xp.where(xp.greater_equal(t90, -2.9670597283903604) & xp.less_equal(t90, 2.9670597283903604), t90, xp.where(xp.greater_equal(t583, -2.9670597283903604) & xp.less_equal(t583, 2.9670597283903604), t583, xp.where(xp.greater_equal(t584, -2.9670597283903604) & xp.less_equal(t584, 2.9670597283903604), t584, qb12_5)))
     t586 = qw1*(t565 + t138)**2 + qw2*(t569 + t139)**2 + qw3*(t573 + t140)**2 + qw4*(t577 + t141)**2 + qw5*(t581 + t142)**2 + qw6*(t585 + t143)**2 + qw7*(qb12_6 + t144)**2
     t587 = xp.greater(t91, 0)
-    t588 = xp.where(t587 & (xp.less(t586, t561) | xp.less(t552, 1)), xp.asarray(1, dtype=dtype), 0)
+    t588 = xp.where(t587 & (xp.less(t552, 1) | xp.less(t586, t561)), xp.asarray(1, dtype=dtype), 0)
     t589 = xp.where(t587, 1, t552)
     t590 = xp.greater(t588, 0)
     t591 = xp.where(t590, t565, t554)

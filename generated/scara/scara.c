@@ -812,8 +812,8 @@ int scara_velocity_ik(const scara_real q[SCARA_DOF], const scara_real mu_dot[SCA
     const scara_real t99 = (t96 > 0 ? 1/(t96*(t96 + t95)) : 0);
     const scara_real t100 = t89 - t89*t99*(t98*t98);
     const scara_real t101 = (t97 != 0 ? -t100/t97 : 0);
-    const scara_real t102 = (t84 != 0 ? -(t88 - t93*t101)/t84 : 0);
-    const scara_real t103 = (t11 != 0 ? -(t80 - (-t102*t76 + t74*t12*t101))/t11 : 0);
+    const scara_real t102 = (t84 != 0 ? -(t88 - t101*t93)/t84 : 0);
+    const scara_real t103 = (t11 != 0 ? -(t80 - (-t102*t76 + t101*t74*t12))/t11 : 0);
     const int t104 = isfinite(t90);
     const int t105 = damping >= 0;
     const scara_real t106 = 1e-12*t16;

@@ -531,8 +531,8 @@ def _velocity_ik(q, mu_dot, damping):
     t99 = casadi.if_else((t96 > 0), 1/(t96*(t96 + t95)), 0)
     t100 = t89 - t89*t99*t98**2
     t101 = casadi.if_else((t97 != 0), -t100/t97, 0)
-    t102 = casadi.if_else((t84 != 0), -(t88 - t93*t101)/t84, 0)
-    t103 = casadi.if_else((t11 != 0), -(t80 - (-t102*t76 + t74*t12*t101))/t11, 0)
+    t102 = casadi.if_else((t84 != 0), -(t88 - t101*t93)/t84, 0)
+    t103 = casadi.if_else((t11 != 0), -(t80 - (-t102*t76 + t101*t74*t12))/t11, 0)
     t104 = (casadi.fabs(t90) < casadi.inf)
     t105 = (damping >= 0)
     t106 = 1e-12*t16

@@ -844,7 +844,7 @@ def bias_acceleration(q, q_dot):
 
 
 def task_jacobian_dot(q, q_dot):
-    """time derivative of the analytic Jacobian along q_dot (6 x DOF): mu'' = J_a q'' + J_a' q': (6 x 6), 371 operations."""
+    """time derivative of the analytic Jacobian along q_dot (6 x DOF): mu'' = J_a q'' + J_a' q': (6 x 6), 337 operations."""
     xp, dtype, device, batch, (q, q_dot,) = _arguments(("q", q, (6,)), ("q_dot", q_dot, (6,)))
     q3 = q[..., 2]
     qd1 = q_dot[..., 0]
@@ -864,165 +864,154 @@ def task_jacobian_dot(q, q_dot):
     s5 = trig[..., 9]
     c6 = trig[..., 10]
     s6 = trig[..., 11]
-    t0 = q3*s2
-    t1 = -0.1337*s1 + c1*t0
-    t2 = 0.1337*c1 + s1*t0
-    t3 = t1*c1 + t2*s1
-    t4 = c2*qd3 - t3*qd2
-    t5 = c4*s1
-    t6 = c1*s4
-    t7 = t5 + c2*t6
-    t8 = t6 + c2*t5
-    t9 = s1*s4
-    t10 = c1*c4
-    t11 = -t9 + c2*t10
-    t12 = -t10 + c2*t9
-    t13 = c1*s2
-    t14 = t7*c5 - s5*t13
-    t15 = t7*s5 + c5*t13
-    t16 = t11*s6 + t14*c6
-    t17 = s1*s2
-    t18 = t12*c5 - s5*t17
-    t19 = t12*s5 + c5*t17
-    t20 = t8*s6 + t18*c6
-    t21 = s4*s2
-    t22 = c2*s5 + c5*t21
-    t23 = -c2*c5 + s5*t21
-    t24 = c4*s2
-    t25 = t22*c6 + s6*t24
-    t26 = qd2*s1
-    t27 = -t26 + qd4*t13
-    t28 = t27
-    t29 = c1*qd2
-    t30 = t29 + qd4*t17
-    t31 = t30
-    t32 = t8*t28 - t11*t31
-    t33 = qd1 + c2*qd4
-    t34 = t33
-    t35 = t8*t34 + t31*t24
-    t36 = t11*t34 + t28*t24
-    t37 = t11*qd5
-    t38 = t28 + t37
-    t39 = t37 + t15*qd6 + t27
-    t40 = t8*qd5
-    t41 = t31 + t40
-    t42 = t19*t38 - t15*t41
-    t43 = t40 + t19*qd6 + t30
-    t44 = t20*t39 - t16*t43
-    t45 = -qd5*t24
-    t46 = t34 + t45
-    t47 = t19*t46 + t23*t41
-    t48 = t15*t46 + t23*t38
-    t49 = t45 - t23*qd6 + t33
-    t50 = t20*t49 + t25*t43
-    t51 = t16*t49 + t25*t39
-    t52 = c2*t29
-    t53 = qd3*t13 + q3*t52
-    t54 = t53 - t2*qd1
-    t55 = t52 - qd1*t17
-    t56 = c2*t26
-    t57 = qd3*t17 + q3*t56
-    t58 = t57 + t1*qd1
-    t59 = qd1*t13 + t56
-    t60 = t53*c1 + t57*s1
-    t61 = c2*qd1*q3
-    t62 = t4*c1 - s1*t61
-    t63 = t4*s1 + c1*t61
-    t64 = qd2*s2
-    t65 = c1**2*t64 + s1**2*t64
-    t66 = -t65
-    t67 = t16**2 + t20**2
-    t68 = 1/t67
-    t69 = c1*t68
-    t70 = t20*c1
-    t71 = t16*s1
-    t72 = t70 - t71
-    t73 = 2/t67**2
-    t74 = t72*t73
-    t75 = t20*t74
-    t76 = s1*t68
-    t77 = t16*t74
-    t78 = qd1*t16
-    t79 = qd1*t20
-    t80 = s2*t76
-    t81 = t16*c1
-    t82 = t20*s1
-    t83 = s2*t81 + s2*t82
-    t84 = t83*t73
-    t85 = t20*t84
-    t86 = s2*t69
-    t87 = t16*t84
-    t88 = t16*t68
-    t89 = t55*t88
-    t90 = t20*t68
-    t91 = t59*t90
-    t92 = t8*t68
-    t93 = t11*t16 + t8*t20
-    t94 = t93*t73
-    t95 = t20*t94
-    t96 = t11*t68
-    t97 = t16*t94
-    t98 = t36*t90
-    t99 = t35*t88
-    t100 = t19*t68
-    t101 = t15*t16 + t19*t20
-    t102 = t101*t73
-    t103 = t20*t102
-    t104 = t15*t68
-    t105 = t16*t102
-    t106 = t48*t90
-    t107 = t47*t88
-    t108 = 1/xp.sqrt(t67)
-    t109 = s1*t108
-    t110 = 1/t67**1.5
-    t111 = t110*(t81 + t82)
-    t112 = c1*t108
-    t113 = qd1*t108
-    t114 = t110*(s2*t71 - s2*t70)
-    t115 = t16*t108
-    t116 = t20*t108
-    t117 = t110*(t8*t16 - t11*t20)
-    t118 = t110*(t19*t16 - t15*t20)
-    t119 = t25*t69
-    t120 = t25*t76
-    t121 = t68*t44
+    t0 = c1*s2
+    t1 = -0.1337*s1 + q3*t0
+    t2 = s1*s2
+    t3 = 0.1337*c1 + q3*t2
+    t4 = t1*c1 + t3*s1
+    t5 = c2*qd3 - t4*qd2
+    t6 = c4*s1
+    t7 = c1*s4
+    t8 = t6 + c2*t7
+    t9 = t7 + c2*t6
+    t10 = t8*c5 - s5*t0
+    t11 = t8*s5 + c5*t0
+    t12 = s1*s4
+    t13 = c1*c4
+    t14 = -t12 + c2*t13
+    t15 = -t13 + c2*t12
+    t16 = t15*c5 - s5*t2
+    t17 = t15*s5 + c5*t2
+    t18 = t14*s6 + t10*c6
+    t19 = t9*s6 + t16*c6
+    t20 = t18**2 + t19**2
+    t21 = xp.sqrt(t20)
+    t22 = s4*s2
+    t23 = c2*s5 + c5*t22
+    t24 = -c2*c5 + s5*t22
+    t25 = c4*s2
+    t26 = t23*c6 + s6*t25
+    t27 = qd2*s1
+    t28 = -t27 + qd4*t0
+    t29 = t28
+    t30 = c1*qd2
+    t31 = t30 + qd4*t2
+    t32 = t31
+    t33 = t9*t29 - t14*t32
+    t34 = qd1 + c2*qd4
+    t35 = t34
+    t36 = t9*t35 + t32*t25
+    t37 = t14*t35 + t29*t25
+    t38 = t14*qd5
+    t39 = t29 + t38
+    t40 = t38 + t11*qd6 + t28
+    t41 = t9*qd5
+    t42 = t32 + t41
+    t43 = t17*t39 - t11*t42
+    t44 = t41 + t17*qd6 + t31
+    t45 = t19*t40 - t18*t44
+    t46 = -qd5*t25
+    t47 = t35 + t46
+    t48 = t17*t47 + t24*t42
+    t49 = t11*t47 + t24*t39
+    t50 = t46 - t24*qd6 + t34
+    t51 = t19*t50 + t26*t44
+    t52 = t18*t50 + t26*t40
+    t53 = c2*t30
+    t54 = qd3*t0 + q3*t53
+    t55 = t54 - t3*qd1
+    t56 = t53 - qd1*t2
+    t57 = c2*t27
+    t58 = qd3*t2 + q3*t57
+    t59 = t58 + t1*qd1
+    t60 = qd1*t0 + t57
+    t61 = t54*c1 + t58*s1
+    t62 = c2*qd1*q3
+    t63 = t5*c1 - s1*t62
+    t64 = t5*s1 + c1*t62
+    t65 = qd2*s2
+    t66 = c1**2*t65 + s1**2*t65
+    t67 = 1/t20
+    t68 = t67*(t14*t18 + t9*t19)
+    t69 = t67*(t11*t18 + t17*t19)
+    t70 = t19*c1
+    t71 = t18*s1
+    t72 = t67*(t70 - t71)
+    t73 = t18*c1
+    t74 = t19*s1
+    t75 = t67*(s2*t73 + s2*t74)
+    t76 = 1/t21
+    t77 = t67*t76
+    t78 = (t73 + t74)*t77
+    t79 = (s2*t71 - s2*t70)*t77
+    t80 = (t9*t18 - t14*t19)*t77
+    t81 = (t17*t18 - t11*t19)*t77
+    t82 = -t66
+    t83 = 2*t72
+    t84 = t67*t52
+    t85 = (c1 - t19*t83)*t84
+    t86 = t67*t51
+    t87 = -(s1 + t18*t83)*t86
+    t88 = qd1*t67
+    t89 = t73*t88
+    t90 = t74*t88
+    t91 = t18*t67
+    t92 = t56*t91
+    t93 = t19*t67
+    t94 = t60*t93
+    t95 = 2*t75
+    t96 = (t2 - t19*t95)*t84
+    t97 = (t0 - t18*t95)*t86
+    t98 = t37*t93
+    t99 = 2*t68
+    t100 = (t9 - t19*t99)*t84
+    t101 = t36*t91
+    t102 = (t14 - t18*t99)*t86
+    t103 = t49*t93
+    t104 = 2*t69
+    t105 = (t17 - t19*t104)*t84
+    t106 = t48*t91
+    t107 = (t11 - t18*t104)*t86
+    t108 = qd1*t76
+    t109 = t18*t76
+    t110 = t19*t76
     Jd = _stack(xp, [
-        xp.broadcast_to(-t58, batch),  # 0, 0
-        xp.broadcast_to(t62, batch),  # 0, 1
-        xp.broadcast_to(t55, batch),  # 0, 2
+        xp.broadcast_to(-t59, batch),  # 0, 0
+        xp.broadcast_to(t63, batch),  # 0, 1
+        xp.broadcast_to(t56, batch),  # 0, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5
-        xp.broadcast_to(t54, batch),  # 1, 0
-        xp.broadcast_to(t63, batch),  # 1, 1
-        xp.broadcast_to(t59, batch),  # 1, 2
+        xp.broadcast_to(t55, batch),  # 1, 0
+        xp.broadcast_to(t64, batch),  # 1, 1
+        xp.broadcast_to(t60, batch),  # 1, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
-        xp.broadcast_to(-t60, batch),  # 2, 1
-        xp.broadcast_to(t66, batch),  # 2, 2
+        xp.broadcast_to(-t61, batch),  # 2, 1
+        xp.broadcast_to(t82, batch),  # 2, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
-        xp.broadcast_to(-(-t51*(t69 - t75) - t50*(t76 + t77) + t69*t78 + t76*t79), batch),  # 3, 1
+        xp.broadcast_to(-(-t85 + t87 + t89 + t90), batch),  # 3, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 2
-        xp.broadcast_to(t51*(t80 - t85) - t50*(t86 - t87) + t89 + t91, batch),  # 3, 3
-        xp.broadcast_to(t51*(t92 - t95) - t50*(t96 - t97) + t98 - t99, batch),  # 3, 4
-        xp.broadcast_to(t51*(t100 - t103) - t50*(t104 - t105) + t106 - t107, batch),  # 3, 5
+        xp.broadcast_to(t92 + t94 + t96 - t97, batch),  # 3, 3
+        xp.broadcast_to(t98 + t100 - t101 - t102, batch),  # 3, 4
+        xp.broadcast_to(t103 + t105 - t106 - t107, batch),  # 3, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
-        xp.broadcast_to(t51*(t109 - t20*t111) - t50*(t112 - t16*t111) + t70*t113 - t71*t113, batch),  # 4, 1
+        xp.broadcast_to(t52*(s1*t76 - t19*t78) - t51*(c1*t76 - t18*t78) + t70*t108 - t71*t108, batch),  # 4, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 2
-        xp.broadcast_to(-t51*(t20*t114 + s2*t112) - t50*(s2*t109 - t16*t114) + t59*t115 - t55*t116, batch),  # 4, 3
-        xp.broadcast_to(-t51*(t11*t108 + t20*t117) - t50*(t8*t108 - t16*t117) + t36*t115 + t35*t116, batch),  # 4, 4
-        xp.broadcast_to(-t51*(t15*t108 + t20*t118) - t50*(t19*t108 - t16*t118) + t48*t115 + t47*t116, batch),  # 4, 5
+        xp.broadcast_to(-t52*(t19*t79 + t76*t0) - t51*(-t18*t79 + t76*t2) + t60*t109 - t56*t110, batch),  # 4, 3
+        xp.broadcast_to(-t52*(t14*t76 + t19*t80) - t51*(t9*t76 - t18*t80) + t37*t109 + t36*t110, batch),  # 4, 4
+        xp.broadcast_to(-t52*(t11*t76 + t19*t81) - t51*(t17*t76 - t18*t81) + t49*t109 + t48*t110, batch),  # 4, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 0
-        xp.broadcast_to(-(-t51*(t119 - t25*t75) - t50*(t120 + t25*t77) + t72*t121 + t119*t78 + t120*t79), batch),  # 5, 1
+        xp.broadcast_to(-(t45*t72 - t26*t85 + t26*t87 + t26*t89 + t26*t90), batch),  # 5, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 2
-        xp.broadcast_to(t66 + t51*(t25*t80 - t25*t85) - t50*(t25*t86 - t25*t87) - t83*t121 + t25*t89 + t25*t91, batch),  # 5, 3
-        xp.broadcast_to(t32 + t51*(t25*t92 - t25*t95) - t50*(t25*t96 - t25*t97) - t93*t121 + t25*t98 - t25*t99, batch),  # 5, 4
-        xp.broadcast_to(t42 + t51*(t25*t100 - t25*t103) - t50*(t25*t104 - t25*t105) - t101*t121 + t25*t106 - t25*t107, batch),  # 5, 5
+        xp.broadcast_to(t82 - t45*t75 + t26*t92 + t26*t94 + t26*t96 - t26*t97, batch),  # 5, 3
+        xp.broadcast_to(t33 - t45*t68 + t26*t98 + t26*t100 - t26*t101 - t26*t102, batch),  # 5, 4
+        xp.broadcast_to(t43 - t45*t69 + t26*t103 + t26*t105 - t26*t106 - t26*t107, batch),  # 5, 5
     ], (6, 6))
     return Jd
 
@@ -1444,11 +1433,11 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t90 = t2 + t4*t84
     t91 = t44 + t78*t83
     t92 = t77*(t4*t53 + t34*t29 - t28*t47 + t33*t44 - t76*t83 - t65*t83)
-    t93 = t76*t92 + t83
-    t94 = t47 + t28*t92
-    t95 = t44 - t33*t92
+    t93 = t92*t76 + t83
+    t94 = t47 + t92*t28
+    t95 = t44 - t92*t33
     t96 = t92*t83 + t65
-    t97 = t29 - t34*t92
+    t97 = t29 - t92*t34
     t98 = t77*(t4*t54 + t34*t76 + t34*t66 - t33*t31 + t28*t83 - t29*t83)
     t99 = t34 - t98*t76
     t100 = -t98*t28 + t83
@@ -1485,16 +1474,16 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t131 = t115 - t127*t89
     t132 = t116 - t127*t90
     t133 = -t53
-    t134 = t133 + t4*t92
+    t134 = t133 + t92*t4
     t135 = t133 + t105*t83
-    t136 = t120*(t97*t89 + t134*t90 + t87*t95 + t88*t96 - t119*t94)
+    t136 = t120*(t95*t87 + t96*t88 + t97*t89 + t134*t90 - t94*t119)
     t137 = t94 + t119*t136
     t138 = t95 - t136*t87
     t139 = t96 - t136*t88
     t140 = t97 - t136*t89
     t141 = t134 - t136*t90
     t142 = t4*t78
-    t143 = t120*(t119*t80 + t87*t81 + t88*t91 - t89*t82 + t90*t142)
+    t143 = t120*(t80*t119 + t81*t87 + t91*t88 - t82*t89 + t90*t142)
     t144 = t80 - t119*t143
     t145 = t81 - t143*t87
     t146 = t91 - t143*t88
@@ -1568,7 +1557,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t214 = xp.where(xp.not_equal(t169, 0), -(t177 - (t173*t213 + t200*t212))/t169, 0)
     t215 = xp.where(xp.not_equal(t150, 0), -(t164 - t154*t214 + t159*t213 + t195*t212)/t150, 0)
     t216 = xp.where(xp.not_equal(t118, 0), -(t128 - (t144*t215 + t122*t213 + t189*t212 - t137*t214))/t118, 0)
-    t217 = xp.where(xp.not_equal(t75, 0), -(t111 - (t99*t213 + t215*t79 + t216*t85 - t106*t212 - t214*t93))/t75, 0)
+    t217 = xp.where(xp.not_equal(t75, 0), -(t111 - (t79*t215 + t99*t213 + t216*t85 - t93*t214 - t106*t212))/t75, 0)
     t218 = t212 + t216*t2 - t217*t4
     t219 = t215*c2 + t216*t3 + t217*t1
     t220 = t212*c2 + t213*t3 + t214*t1
@@ -2000,7 +1989,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t242 = xp.where(xp.not_equal(t177, 0), -(t191 - t181*t241 + t186*t240 + t222*t239)/t177, 0)
     t243 = xp.where(xp.not_equal(t117, 0), -(t121 - (t171*t242 + t157*t240 + t216*t239 - t143*t241))/t117, 0)
     t244 = xp.where(xp.not_equal(t97, 0), -(t110 - (t103*t243 + t128*t242 + t150*t240 - t135*t241 - t164*t239))/t97, 0)
-    t245 = t239 + q1 + t2*t243 - t244*t3
+    t245 = t239 + q1 + t2*t243 - t3*t244
     t246 = q2 + t240*c1 - t4*t242 - t241*s1 + s1*t243*t7 + c1*t244*t7
     t247 = q3 + t242*c2 + t243*t26 + t244*t18
     t248 = q4 + t239*c2 + t240*t26 + t241*t18
@@ -2897,7 +2886,7 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     t264 = xp.where(xp.greater_equal(t41, -2.9670597283903604) & xp.less_equal(t41, 2.9670597283903604), t41, xp.where(xp.greater_equal(t262, -2.9670597283903604) & xp.less_equal(t262, 2.9670597283903604), t262, xp.where(xp.greater_equal(t263, -2.9670597283903604) & xp.less_equal(t263, 2.9670597283903604), t263, qb6_5)))
     t265 = qw1*(t248 + t70)**2 + qw2*(t252 + t71)**2 + qw3*(qb6_2 + t72)**2 + qw4*(t256 + t73)**2 + qw5*(t260 + t74)**2 + qw6*(t264 + t75)**2
     t266 = xp.greater(t42, 0)
-    t267 = xp.where(t266 & (xp.less(t265, t244) | xp.less(t236, 1)), xp.asarray(1, dtype=dtype), 0)
+    t267 = xp.where(t266 & (xp.less(t236, 1) | xp.less(t265, t244)), xp.asarray(1, dtype=dtype), 0)
     t268 = xp.where(t266, 1, t236)
     t269 = xp.greater(t267, 0)
     t270 = xp.where(t269, t248, t238)

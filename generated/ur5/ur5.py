@@ -1003,7 +1003,7 @@ def bias_acceleration(q, q_dot):
 
 
 def task_jacobian_dot(q, q_dot):
-    """time derivative of the analytic Jacobian along q_dot (6 x DOF): mu'' = J_a q'' + J_a' q': (6 x 6), 426 operations."""
+    """time derivative of the analytic Jacobian along q_dot (6 x DOF): mu'' = J_a q'' + J_a' q': (6 x 6), 400 operations."""
     xp, dtype, device, batch, (q, q_dot,) = _arguments(("q", q, (6,)), ("q_dot", q_dot, (6,)))
     qd1 = q_dot[..., 0]
     qd2 = q_dot[..., 1]
@@ -1037,180 +1037,169 @@ def task_jacobian_dot(q, q_dot):
     t6 = c1*s5
     t7 = t5 - c234*t6
     t8 = -t6 + c234*t5
-    t9 = s6*s234
-    t10 = t3*c6 - c1*t9
-    t11 = t8*c6 - s1*t9
-    t12 = 0.09465*s234
-    t13 = 0.0823*t7 + c1*t12
-    t14 = -0.0823*t4 + s1*t12
-    t15 = t13 + 0.10915*s1
-    t16 = t14 - 0.10915*c1
-    t17 = t15*c1 + t16*s1
-    t18 = s5*s234
-    t19 = 0.09465*c234 + 0.0823*t18
-    t20 = t19 + 0.39225*s23
-    t21 = t20 + 0.425*s2
-    t22 = 0.39225*c23
-    t23 = t15 - c1*t22
-    t24 = t16 - s1*t22
-    t25 = t23*c1 + t24*s1
-    t26 = 0.425*c2
-    t27 = t23 - c1*t26
-    t28 = t24 - s1*t26
-    t29 = t27*c1 + t28*s1
-    t30 = s234*t19
-    t31 = t14*c234 - s1*t30
-    t32 = -t13*c234 + c1*t30
-    t33 = c1*s234
-    t34 = s1*s234
-    t35 = t14*t33 - t13*t34
-    t36 = qd2*s1
-    t37 = qd3*s1
-    t38 = t36 + t37
-    t39 = t38
-    t40 = c1*qd2
-    t41 = c1*qd3
-    t42 = t40 + t41
-    t43 = t42
-    t44 = t43*s1 - t39*c1
-    t45 = qd4*s1
-    t46 = t39 + t45
-    t47 = t46*c234 + qd1*t33
-    t48 = c1*qd4
-    t49 = t43 + t48
-    t50 = t49*c234 - qd1*t34
-    t51 = t46*t34 + t49*t33
-    t52 = qd5*t33
-    t53 = t46 + t52
-    t54 = t45 + t52 + t7*qd6 + t38
-    t55 = qd5*t34
-    t56 = -t49 + t55
-    t57 = t7*t56 + t4*t53
-    t58 = t48 + t4*qd6 - t55 + t42
-    t59 = t10*t58 + t11*t54
-    t60 = c234*qd5
-    t61 = qd1 - t60
-    t62 = t4*t61 - t56*t18
-    t63 = t7*t61 + t53*t18
-    t64 = -qd1 + t60 + qd6*t18
-    t65 = t11*t64 - t0*t58
-    t66 = t10*t64 + t0*t54
-    t67 = t31*qd5
-    t68 = t67 + t19*t48
-    t69 = t68 + t20*t41
-    t70 = t69 + t21*t40
-    t71 = t70 - t28*qd1
-    t72 = t32*qd5
-    t73 = t72 + t19*t45
-    t74 = t73 + t20*t37
-    t75 = t74 + t21*t36
-    t76 = t75 + t27*qd1
-    t77 = t70*c1 + t75*s1
-    t78 = t68*c1 + t73*s1 + t19*t39*s1 + t19*t43*c1
-    t79 = t31*t49 + t32*t46 + t72*t33 - t67*t34
-    t80 = t35*qd5
-    t81 = t17*qd4 + t80
-    t82 = t81 + t25*qd3
-    t83 = t82 + t29*qd2
-    t84 = -t32*qd1 - t35*t49 + t32*t60 + t80*t34
-    t85 = t35*t46 - t31*qd1 + t31*t60 + t80*t33
-    t86 = s1*qd1
-    t87 = t83*c1 + t21*t86
-    t88 = t82*c1 + t20*t86 + t25*t40
-    t89 = t17*t43 + t81*c1 + t19*t86
-    t90 = c1*qd1
-    t91 = -t83*s1 + t21*t90
-    t92 = t82*s1 + t25*t36 - t20*t90
-    t93 = t17*t39 + t81*s1 - t19*t90
-    t94 = qd2*t20
-    t95 = t69*c1 + t74*s1 + c1**2*t94 + s1**2*t94
-    t96 = t10**2 + t11**2
-    t97 = 1/t96
-    t98 = s1*t97
-    t99 = t10*s1
-    t100 = t11*c1
-    t101 = t99 - t100
-    t102 = 2/t96**2
-    t103 = t101*t102
-    t104 = t10*t103
-    t105 = c1*t97
-    t106 = t11*t103
-    t107 = qd1*t10
-    t108 = qd1*t11
-    t109 = t65*(t98 - t104) + t66*(t105 + t106) + t105*t107 + t98*t108
-    t110 = s234*t105
-    t111 = t10*c1
-    t112 = t11*s1
-    t113 = s234*t111 + s234*t112
-    t114 = t113*t102
-    t115 = t10*t114
-    t116 = s234*t98
-    t117 = t11*t114
-    t118 = t10*t97
-    t119 = t50*t118
-    t120 = t11*t97
-    t121 = t47*t120
-    t122 = t7*t97
-    t123 = t7*t10 - t4*t11
-    t124 = t123*t102
-    t125 = t10*t124
-    t126 = t4*t97
-    t127 = t11*t124
-    t128 = t62*t118
-    t129 = t63*t120
-    t130 = 1/xp.sqrt(t96)
-    t131 = c1*t130
-    t132 = 1/t96**1.5
-    t133 = -t132*(t111 + t112)
-    t134 = s1*t130
-    t135 = qd1*t130
-    t136 = -t65*(t131 + t10*t133) + t66*(t134 + t11*t133) + t99*t135 - t100*t135
-    t137 = t132*(s234*t99 - s234*t100)
-    t138 = t10*t130
-    t139 = t11*t130
-    t140 = -t132*(t7*t11 + t4*t10)
-    t141 = t0*t98
-    t142 = t0*t105
-    t143 = t97*t59
-    t144 = -t65*(-t141 + t0*t104) + t66*(t142 + t0*t106) + t101*t143 + t142*t107 + t141*t108
-    t145 = -t144
+    t9 = c1*s234
+    t10 = t3*c6 - s6*t9
+    t11 = 0.0823*t7 + 0.09465*t9
+    t12 = t11 + 0.10915*s1
+    t13 = s1*s234
+    t14 = t8*c6 - s6*t13
+    t15 = -0.0823*t4 + 0.09465*t13
+    t16 = t15 - 0.10915*c1
+    t17 = t12*c1 + t16*s1
+    t18 = t15*t9 - t11*t13
+    t19 = t10**2 + t14**2
+    t20 = xp.sqrt(t19)
+    t21 = s5*s234
+    t22 = 0.09465*c234 + 0.0823*t21
+    t23 = t22 + 0.39225*s23
+    t24 = t23 + 0.425*s2
+    t25 = t15*c234 - t22*t13
+    t26 = -t11*c234 + t22*t9
+    t27 = 0.39225*c23
+    t28 = t12 - c1*t27
+    t29 = t16 - s1*t27
+    t30 = t28*c1 + t29*s1
+    t31 = 0.425*c2
+    t32 = t28 - c1*t31
+    t33 = t29 - s1*t31
+    t34 = t32*c1 + t33*s1
+    t35 = qd2*s1
+    t36 = qd3*s1
+    t37 = t35 + t36
+    t38 = t37
+    t39 = c1*qd2
+    t40 = c1*qd3
+    t41 = t39 + t40
+    t42 = t41
+    t43 = t42*s1 - t38*c1
+    t44 = qd4*s1
+    t45 = t38 + t44
+    t46 = t45*c234 + qd1*t9
+    t47 = c1*qd4
+    t48 = t42 + t47
+    t49 = t48*c234 - qd1*t13
+    t50 = t45*t13 + t48*t9
+    t51 = qd5*t9
+    t52 = t45 + t51
+    t53 = t44 + t51 + t7*qd6 + t37
+    t54 = qd5*t13
+    t55 = -t48 + t54
+    t56 = t7*t55 + t4*t52
+    t57 = t47 + t4*qd6 - t54 + t41
+    t58 = t10*t57 + t14*t53
+    t59 = c234*qd5
+    t60 = qd1 - t59
+    t61 = t4*t60 - t55*t21
+    t62 = t7*t60 + t52*t21
+    t63 = -qd1 + t59 + qd6*t21
+    t64 = t14*t63 - t0*t57
+    t65 = t10*t63 + t0*t53
+    t66 = t25*qd5
+    t67 = t66 + t22*t47
+    t68 = t67 + t23*t40
+    t69 = t68 + t24*t39
+    t70 = t69 - t33*qd1
+    t71 = t26*qd5
+    t72 = t71 + t22*t44
+    t73 = t72 + t23*t36
+    t74 = t73 + t24*t35
+    t75 = t74 + t32*qd1
+    t76 = t69*c1 + t74*s1
+    t77 = t67*c1 + t72*s1 + t22*t38*s1 + t22*t42*c1
+    t78 = t25*t48 + t26*t45 + t71*t9 - t66*t13
+    t79 = t18*qd5
+    t80 = t17*qd4 + t79
+    t81 = t80 + t30*qd3
+    t82 = t81 + t34*qd2
+    t83 = -t26*qd1 - t18*t48 + t26*t59 + t79*t13
+    t84 = t18*t45 - t25*qd1 + t25*t59 + t79*t9
+    t85 = s1*qd1
+    t86 = t82*c1 + t24*t85
+    t87 = t81*c1 + t23*t85 + t30*t39
+    t88 = t17*t42 + t80*c1 + t22*t85
+    t89 = c1*qd1
+    t90 = -t82*s1 + t24*t89
+    t91 = t81*s1 + t30*t35 - t23*t89
+    t92 = t17*t38 + t80*s1 - t22*t89
+    t93 = qd2*t23
+    t94 = t68*c1 + t73*s1 + c1**2*t93 + s1**2*t93
+    t95 = 1/t19
+    t96 = t95*(t7*t10 - t4*t14)
+    t97 = t10*s1
+    t98 = t14*c1
+    t99 = t95*(t97 - t98)
+    t100 = t10*c1
+    t101 = t14*s1
+    t102 = t95*(s234*t100 + s234*t101)
+    t103 = 1/t20
+    t104 = t95*t103
+    t105 = -(t100 + t101)*t104
+    t106 = (s234*t97 - s234*t98)*t104
+    t107 = -(t7*t14 + t4*t10)*t104
+    t108 = 2*t99
+    t109 = t95*t64
+    t110 = (s1 - t10*t108)*t109
+    t111 = t95*t65
+    t112 = -(c1 + t14*t108)*t111
+    t113 = qd1*t95
+    t114 = t100*t113
+    t115 = t101*t113
+    t116 = t110 - t112 + t114 + t115
+    t117 = t10*t95
+    t118 = t49*t117
+    t119 = t14*t95
+    t120 = t46*t119
+    t121 = 2*t102
+    t122 = (t9 - t10*t121)*t109
+    t123 = (t13 - t14*t121)*t111
+    t124 = t61*t117
+    t125 = t62*t119
+    t126 = 2*t96
+    t127 = (t7 - t10*t126)*t109
+    t128 = -(t4 + t14*t126)*t111
+    t129 = qd1*t103
+    t130 = -t64*(t105*t10 + c1*t103) + t65*(t105*t14 + s1*t103) + t97*t129 - t98*t129
+    t131 = t10*t103
+    t132 = t14*t103
+    t133 = t58*t99 - t0*t112 + t0*t110 + t0*t114 + t0*t115
+    t134 = -t133
     Jd = _stack(xp, [
-        xp.broadcast_to(-t76, batch),  # 0, 0
-        xp.broadcast_to(-t87, batch),  # 0, 1
-        xp.broadcast_to(-t88, batch),  # 0, 2
-        xp.broadcast_to(-t89, batch),  # 0, 3
-        xp.broadcast_to(t84, batch),  # 0, 4
+        xp.broadcast_to(-t75, batch),  # 0, 0
+        xp.broadcast_to(-t86, batch),  # 0, 1
+        xp.broadcast_to(-t87, batch),  # 0, 2
+        xp.broadcast_to(-t88, batch),  # 0, 3
+        xp.broadcast_to(t83, batch),  # 0, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5
-        xp.broadcast_to(t71, batch),  # 1, 0
-        xp.broadcast_to(t91, batch),  # 1, 1
-        xp.broadcast_to(-t92, batch),  # 1, 2
-        xp.broadcast_to(-t93, batch),  # 1, 3
-        xp.broadcast_to(-t85, batch),  # 1, 4
+        xp.broadcast_to(t70, batch),  # 1, 0
+        xp.broadcast_to(t90, batch),  # 1, 1
+        xp.broadcast_to(-t91, batch),  # 1, 2
+        xp.broadcast_to(-t92, batch),  # 1, 3
+        xp.broadcast_to(-t84, batch),  # 1, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
-        xp.broadcast_to(t77, batch),  # 2, 1
-        xp.broadcast_to(t95, batch),  # 2, 2
-        xp.broadcast_to(t78, batch),  # 2, 3
-        xp.broadcast_to(t79, batch),  # 2, 4
+        xp.broadcast_to(t76, batch),  # 2, 1
+        xp.broadcast_to(t94, batch),  # 2, 2
+        xp.broadcast_to(t77, batch),  # 2, 3
+        xp.broadcast_to(t78, batch),  # 2, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
-        xp.broadcast_to(t109, batch),  # 3, 1
-        xp.broadcast_to(t109, batch),  # 3, 2
-        xp.broadcast_to(t109, batch),  # 3, 3
-        xp.broadcast_to(t65*(t110 - t115) - t66*(t116 - t117) + t119 + t121, batch),  # 3, 4
-        xp.broadcast_to(t65*(t122 - t125) + t66*(t126 + t127) + t128 + t129, batch),  # 3, 5
+        xp.broadcast_to(t116, batch),  # 3, 1
+        xp.broadcast_to(t116, batch),  # 3, 2
+        xp.broadcast_to(t116, batch),  # 3, 3
+        xp.broadcast_to(t118 + t120 + t122 - t123, batch),  # 3, 4
+        xp.broadcast_to(t124 + t125 + t127 - t128, batch),  # 3, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
-        xp.broadcast_to(t136, batch),  # 4, 1
-        xp.broadcast_to(t136, batch),  # 4, 2
-        xp.broadcast_to(t136, batch),  # 4, 3
-        xp.broadcast_to(t65*(s234*t134 - t10*t137) + t66*(t11*t137 + s234*t131) + t47*t138 - t50*t139, batch),  # 4, 4
-        xp.broadcast_to(-t65*(t4*t130 + t10*t140) + t66*(t7*t130 + t11*t140) + t63*t138 - t62*t139, batch),  # 4, 5
+        xp.broadcast_to(t130, batch),  # 4, 1
+        xp.broadcast_to(t130, batch),  # 4, 2
+        xp.broadcast_to(t130, batch),  # 4, 3
+        xp.broadcast_to(t64*(-t106*t10 + t103*t13) + t65*(t106*t14 + t103*t9) + t46*t131 - t49*t132, batch),  # 4, 4
+        xp.broadcast_to(-t64*(t107*t10 + t4*t103) + t65*(t107*t14 + t7*t103) + t62*t131 - t61*t132, batch),  # 4, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 0
-        xp.broadcast_to(t145, batch),  # 5, 1
-        xp.broadcast_to(t145, batch),  # 5, 2
-        xp.broadcast_to(-(-t44 + t144), batch),  # 5, 3
-        xp.broadcast_to(-(-t51 - t65*(-t0*t110 + t0*t115) + t66*(-t0*t116 + t0*t117) + t113*t143 + t0*t119 + t0*t121), batch),  # 5, 4
-        xp.broadcast_to(-(t57 - t65*(-t0*t122 + t0*t125) + t66*(t0*t126 + t0*t127) + t123*t143 + t0*t128 + t0*t129), batch),  # 5, 5
+        xp.broadcast_to(t134, batch),  # 5, 1
+        xp.broadcast_to(t134, batch),  # 5, 2
+        xp.broadcast_to(-(-t43 + t133), batch),  # 5, 3
+        xp.broadcast_to(-(-t50 + t58*t102 - t0*t123 + t0*t118 + t0*t120 + t0*t122), batch),  # 5, 4
+        xp.broadcast_to(-(t56 + t58*t96 - t0*t128 + t0*t124 + t0*t125 + t0*t127), batch),  # 5, 5
     ], (6, 6))
     return Jd
 

@@ -286,22 +286,35 @@ def task_jacobian(robot: Robot, pose: Matrix, jacobian: Matrix) -> Matrix:
     return Matrix.vstack(*(rows[name] for name in robot.task))
 
 
+def rpy_rate_partials(column, angular, name=lambda e: e) -> tuple[Matrix, Matrix]:
+    """The partial derivatives of `rpy_rates`' three rows by r, the first column of R, and by w,
+    one column of angular rows, written out (sympy's differentiation costs more than the rest
+    of the function): with c = r0^2 + r1^2 and the heading rate h = (r0 wx + r1 wy) / c, the
+    rows are h, (r0 wy - r1 wx) / sqrt(c) and wz - r2 h."""
+    (r0, r1, r2), (wx, wy, _) = column, angular
+    c = name(r0**2 + r1**2)
+    root = name(sympy.sqrt(c))
+    heading = name((r0 * wx + r1 * wy) / c)
+    pitch_over_c = name((r0 * wy - r1 * wx) / (c * root))
+    dh = [(wx - 2 * r0 * heading) / c, (wy - 2 * r1 * heading) / c, 0]
+    by_r = Matrix([dh, [wy / root - r0 * pitch_over_c, -wx / root - r1 * pitch_over_c, 0],
+                   [-r2 * dh[0], -r2 * dh[1], -heading]])
+    by_w = Matrix([[r0 / c, r1 / c, 0], [-r1 / root, r0 / root, 0], [-r2 * r0 / c, -r2 * r1 / c, 1]])
+    return by_r, by_w
+
+
 def task_jacobian_dot(robot: Robot, pose: Matrix, jacobian: Matrix, jacobian_dot: Matrix, q_dot,
                       name=lambda e: e) -> Matrix:
     """d/dt of task_jacobian: the position rows of J', and for the angles the Euler-angle rates
     differentiated through what they read, the first column r of R (r' = w x r with
     w = Jw q_dot) and the angular rows of J (whose rate is that of J')."""
-    r = sympy.symbols(f"{names.INTERNAL_PREFIX}r0:3", real=True)
-    w = sympy.symbols(f"{names.INTERNAL_PREFIX}w0:3", real=True)
-    rates = rpy_rates(Matrix([[r[0], 0, 0], [r[1], 0, 0], [r[2], 0, 0]]), Matrix(w))
-    by_r, by_w = rates.jacobian(r), rates.jacobian(w)
     column = pose[:3, 0]
     omega = (jacobian[3:, :] * Matrix(q_dot)).applyfunc(name)
     column_rate = omega.cross(column).applyfunc(name)
     angle_rows = []
     for c in range(robot.dof):
-        values = dict(zip(r, column)) | dict(zip(w, jacobian[3:, c]))
-        angle_rows.append((by_r.xreplace(values) * column_rate + by_w.xreplace(values) * jacobian_dot[3:, c]))
+        by_r, by_w = rpy_rate_partials(column, jacobian[3:, c], name)
+        angle_rows.append(by_r * column_rate + by_w * jacobian_dot[3:, c])
     rates_dot = Matrix.hstack(*angle_rows)
     rows = {name_: jacobian_dot[i, :] for i, name_ in enumerate(("x", "y", "z"))}
     rows.update({name_: rates_dot[i, :] for i, name_ in enumerate(("roll", "pitch", "yaw"))})
