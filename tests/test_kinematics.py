@@ -8,6 +8,7 @@ from jacgen import Kinematics
 from jacgen.model import kinematics
 from jacgen.checking import reference
 from jacgen.emission.generator import Generator
+from jacgen.model.graph import evaluate
 
 from conftest import ROBOT_NAMES, random_configurations, robot
 
@@ -44,9 +45,9 @@ def test_column_formula_agrees_with_velocity_propagation(name):
     symbols = [s for s, _ in generator.lowering.definitions] + list(generator.q)
     by_columns, by_propagation = numeric(by_columns, symbols), numeric(by_propagation, symbols)
     for q in random_configurations(arm, 10, seed=2):
-        known = {s: sympy.Float(v) for s, v in zip(generator.q, q)}
+        known = dict(zip(generator.q, q))
         for symbol, value in generator.lowering.definitions:  # in order: sums after their terms
-            known[symbol] = sympy.Float(float(value.xreplace(known)))
+            known[symbol] = evaluate(value, known)
         values = [known[s] for s in symbols]
         np.testing.assert_allclose(by_columns(values), by_propagation(values), atol=1e-12, rtol=0)
 

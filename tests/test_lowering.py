@@ -61,16 +61,17 @@ COMMON = [x * y + z, -x * y - z, sympy.sin(x * y + z), x + y + z, x + y + w, 1 -
 @pytest.mark.parametrize("exprs", [SHAPES[:-3] + COMMON,
                                    _dh_chain_jacobian(3), _dh_chain_jacobian(4)], ids=["shapes", "dh3", "dh4"])
 def test_eliminate_common_as_sympy_cse(exprs):
-    """eliminate_common finds what sympy's cse finds: as many temporaries, the same operation
-    count, and the same values (at a point)."""
+    """eliminate_common does at least as well as sympy's cse: no more operations than sympy's
+    cse of the same expressions, as sympy writes them and as the graph does (its sums and
+    products ordered by when their terms were built), and the same values (at a point)."""
     graph = Graph()
     nodes = [graph.convert(e) for e in exprs]
     replacements, reduced = eliminate_common(graph, nodes, sympy.numbered_symbols("_r", real=True), {})
+    ours = operation_count([v for _, v in replacements] + reduced)
     with distribute(False):
-        theirs = sympy.cse([to_sympy(node) for node in nodes], sympy.numbered_symbols("_s", real=True), order="none")
-    assert len(replacements) == len(theirs[0])
-    assert operation_count([v for _, v in replacements] + reduced) == \
-        sympy.count_ops([v for _, v in theirs[0]] + theirs[1])
+        for written in (exprs, [to_sympy(node) for node in nodes]):
+            theirs = sympy.cse(written, sympy.numbered_symbols("_s", real=True), order="none")
+            assert ours <= sympy.count_ops([v for _, v in theirs[0]] + theirs[1])
     point = {s: 0.1 + 0.37 * k for k, s in enumerate(sorted(set().union(*(e.free_symbols for e in exprs)), key=str))}
     values = dict(point)
     for symbol, value in replacements:

@@ -95,44 +95,44 @@ def fk(q):
     t1 = c1*c3
     t2 = -t0 + c2*t1
     t3 = t1 - c2*t0
-    t4 = c3*s1
-    t5 = c1*s3
+    t4 = s1*c3
+    t5 = s3*c1
     t6 = t4 + c2*t5
     t7 = t5 + c2*t4
     t8 = c1*s2
     t9 = t2*c4 + s4*t8
     t10 = -t2*s4 + c4*t8
     t11 = t9*c5 - t6*s5
-    t12 = t9*s5 + t6*c5
+    t12 = t9*s5 + c5*t6
     t13 = t11*c6 - t10*s6
     t14 = t10*c6 + t11*s6
     t15 = t13*c7 - t12*s7
-    t16 = t12*c7 + t13*s7
+    t16 = c7*t12 + t13*s7
     t17 = 0.4*t10 + 0.126*t14
-    t18 = t17 + 0.42*t8
+    t18 = 0.42*t8 + t17
     t19 = s1*s2
-    t20 = t7*c4 + s4*t19
-    t21 = -t7*s4 + c4*t19
-    t22 = t20*c5 + t3*s5
-    t23 = t3*c5 - t20*s5
-    t24 = t22*c6 - t21*s6
-    t25 = t21*c6 + t22*s6
-    t26 = t23*s7 + t24*c7
-    t27 = t23*c7 - t24*s7
+    t20 = c4*t7 + s4*t19
+    t21 = -s4*t7 + c4*t19
+    t22 = c5*t20 + s5*t3
+    t23 = c5*t3 - s5*t20
+    t24 = c6*t22 - t21*s6
+    t25 = t21*c6 + s6*t22
+    t26 = s7*t23 + c7*t24
+    t27 = c7*t23 - s7*t24
     t28 = 0.4*t21 + 0.126*t25
-    t29 = t28 + 0.42*t19
+    t29 = 0.42*t19 + t28
     t30 = c3*s2
     t31 = c2*s4 - c4*t30
     t32 = c2*c4 + s4*t30
     t33 = s3*s2
-    t34 = t31*c5 + s5*t33
-    t35 = -t31*s5 + c5*t33
-    t36 = t34*c6 - t32*s6
-    t37 = t32*c6 + t34*s6
-    t38 = t35*s7 + t36*c7
-    t39 = t35*c7 - t36*s7
+    t34 = c5*t31 + s5*t33
+    t35 = -s5*t31 + c5*t33
+    t36 = c6*t34 - t32*s6
+    t37 = t32*c6 + s6*t34
+    t38 = s7*t35 + c7*t36
+    t39 = c7*t35 - s7*t36
     t40 = 0.4*t32 + 0.126*t37
-    t41 = t40 + 0.42*c2
+    t41 = 0.42*c2 + t40
     t42 = 0.36 + t41
     T = _stack(xp, [
         t15,  # 0, 0
@@ -175,59 +175,59 @@ def jacobian(q):
     t1 = c1*c3
     t2 = -t0 + c2*t1
     t3 = t1 - c2*t0
-    t4 = c3*s1
-    t5 = c1*s3
+    t4 = s1*c3
+    t5 = s3*c1
     t6 = t4 + c2*t5
     t7 = t5 + c2*t4
     t8 = c1*s2
     t9 = t2*c4 + s4*t8
     t10 = -t2*s4 + c4*t8
     t11 = t9*c5 - t6*s5
-    t12 = t9*s5 + t6*c5
+    t12 = t9*s5 + c5*t6
     t13 = t10*c6 + t11*s6
     t14 = s1*s2
-    t15 = t7*c4 + s4*t14
-    t16 = -t7*s4 + c4*t14
-    t17 = t15*c5 + t3*s5
-    t18 = t3*c5 - t15*s5
-    t19 = t16*c6 + t17*s6
+    t15 = c4*t7 + s4*t14
+    t16 = -s4*t7 + c4*t14
+    t17 = c5*t15 + s5*t3
+    t18 = c5*t3 - s5*t15
+    t19 = t16*c6 + s6*t17
     t20 = c3*s2
     t21 = c2*s4 - c4*t20
     t22 = c2*c4 + s4*t20
-    t23 = s2*s3
-    t24 = t21*c5 + s5*t23
-    t25 = -t21*s5 + c5*t23
-    t26 = t22*c6 + t24*s6
+    t23 = s3*s2
+    t24 = c5*t21 + s5*t23
+    t25 = -s5*t21 + c5*t23
+    t26 = t22*c6 + s6*t24
     t27 = 0.126*t13
     t28 = 0.4*t10 + t27
-    t29 = t28 + 0.42*t8
+    t29 = 0.42*t8 + t28
     t30 = 0.126*t19
     t31 = 0.4*t16 + t30
-    t32 = t31 + 0.42*t14
+    t32 = 0.42*t14 + t31
     t33 = 0.126*t26
     t34 = 0.4*t22 + t33
-    t35 = t34 + 0.42*c2
-    t36 = t35*c1
-    t37 = t35*s1
+    t35 = 0.42*c2 + t34
+    t36 = c1*t35
+    t37 = s1*t35
     J = _stack(xp, [
         -t32,  # 0, 0
         t36,  # 0, 1
-        -t32*c2 + s2*t37,  # 0, 2
-        -t34*t3 + t31*t23,  # 0, 3
+        -c2*t32 + s2*t37,  # 0, 2
+        -t3*t34 + t31*t23,  # 0, 3
         t16*t34 - t22*t31,  # 0, 4
         -t25*t30 + t18*t33,  # 0, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 6
         t29,  # 1, 0
         t37,  # 1, 1
-        t29*c2 - s2*t36,  # 1, 2
-        -(t34*t6 + t28*t23),  # 1, 3
+        c2*t29 - s2*t36,  # 1, 2
+        -(t6*t34 + t28*t23),  # 1, 3
         t22*t28 - t10*t34,  # 1, 4
         t12*t33 + t25*t27,  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
-        -(t29*c1 + t32*s1),  # 2, 1
+        -(c1*t29 + s1*t32),  # 2, 1
         t32*t8 - t29*t14,  # 2, 2
-        t28*t3 + t31*t6,  # 2, 3
+        t3*t28 + t6*t31,  # 2, 3
         t10*t31 - t16*t28,  # 2, 4
         -(t12*t30 + t18*t27),  # 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 6
@@ -278,50 +278,50 @@ def fk_jacobian(q):
     t1 = c1*c3
     t2 = -t0 + c2*t1
     t3 = t1 - c2*t0
-    t4 = c3*s1
-    t5 = c1*s3
+    t4 = s1*c3
+    t5 = s3*c1
     t6 = t4 + c2*t5
     t7 = t5 + c2*t4
     t8 = c1*s2
     t9 = t2*c4 + s4*t8
     t10 = -t2*s4 + c4*t8
     t11 = t9*c5 - t6*s5
-    t12 = t9*s5 + t6*c5
+    t12 = t9*s5 + c5*t6
     t13 = t11*c6 - t10*s6
     t14 = t10*c6 + t11*s6
     t15 = t13*c7 - t12*s7
-    t16 = t12*c7 + t13*s7
+    t16 = c7*t12 + t13*s7
     t17 = s1*s2
-    t18 = t7*c4 + s4*t17
-    t19 = -t7*s4 + c4*t17
-    t20 = t18*c5 + t3*s5
-    t21 = t3*c5 - t18*s5
-    t22 = t20*c6 - t19*s6
-    t23 = t19*c6 + t20*s6
-    t24 = t21*s7 + t22*c7
-    t25 = t21*c7 - t22*s7
+    t18 = c4*t7 + s4*t17
+    t19 = -s4*t7 + c4*t17
+    t20 = c5*t18 + s5*t3
+    t21 = c5*t3 - s5*t18
+    t22 = c6*t20 - t19*s6
+    t23 = t19*c6 + s6*t20
+    t24 = s7*t21 + c7*t22
+    t25 = c7*t21 - s7*t22
     t26 = c3*s2
     t27 = c2*s4 - c4*t26
     t28 = c2*c4 + s4*t26
-    t29 = s2*s3
-    t30 = t27*c5 + s5*t29
-    t31 = -t27*s5 + c5*t29
-    t32 = t30*c6 - t28*s6
-    t33 = t28*c6 + t30*s6
-    t34 = t31*s7 + t32*c7
-    t35 = t31*c7 - t32*s7
+    t29 = s3*s2
+    t30 = c5*t27 + s5*t29
+    t31 = -s5*t27 + c5*t29
+    t32 = c6*t30 - t28*s6
+    t33 = t28*c6 + s6*t30
+    t34 = s7*t31 + c7*t32
+    t35 = c7*t31 - s7*t32
     t36 = 0.126*t14
     t37 = 0.4*t10 + t36
-    t38 = t37 + 0.42*t8
+    t38 = 0.42*t8 + t37
     t39 = 0.126*t23
     t40 = 0.4*t19 + t39
-    t41 = t40 + 0.42*t17
+    t41 = 0.42*t17 + t40
     t42 = 0.126*t33
     t43 = 0.4*t28 + t42
-    t44 = t43 + 0.42*c2
+    t44 = 0.42*c2 + t43
     t45 = 0.36 + t44
-    t46 = t44*c1
-    t47 = t44*s1
+    t46 = c1*t44
+    t47 = s1*t44
     T = _stack(xp, [
         t15,  # 0, 0
         -t16,  # 0, 1
@@ -343,22 +343,22 @@ def fk_jacobian(q):
     J = _stack(xp, [
         -t41,  # 0, 0
         t46,  # 0, 1
-        -t41*c2 + s2*t47,  # 0, 2
-        -t43*t3 + t40*t29,  # 0, 3
+        -c2*t41 + s2*t47,  # 0, 2
+        -t3*t43 + t40*t29,  # 0, 3
         t19*t43 - t28*t40,  # 0, 4
         -t31*t39 + t21*t42,  # 0, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 6
         t38,  # 1, 0
         t47,  # 1, 1
-        t38*c2 - s2*t46,  # 1, 2
-        -(t43*t6 + t37*t29),  # 1, 3
+        c2*t38 - s2*t46,  # 1, 2
+        -(t6*t43 + t37*t29),  # 1, 3
         t28*t37 - t10*t43,  # 1, 4
         t12*t42 + t31*t36,  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
-        -(t38*c1 + t41*s1),  # 2, 1
+        -(c1*t38 + s1*t41),  # 2, 1
         t41*t8 - t38*t17,  # 2, 2
-        t37*t3 + t40*t6,  # 2, 3
+        t3*t37 + t6*t40,  # 2, 3
         t10*t40 - t19*t37,  # 2, 4
         -(t12*t39 + t21*t36),  # 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 6
@@ -409,56 +409,56 @@ def jacobian_tool(q):
     t1 = c1*c3
     t2 = -t0 + c2*t1
     t3 = t1 - c2*t0
-    t4 = c3*s1
-    t5 = c1*s3
+    t4 = s1*c3
+    t5 = s3*c1
     t6 = t4 + c2*t5
     t7 = t5 + c2*t4
     t8 = c1*s2
     t9 = t2*c4 + s4*t8
     t10 = -t2*s4 + c4*t8
     t11 = t9*c5 - t6*s5
-    t12 = t9*s5 + t6*c5
+    t12 = t9*s5 + c5*t6
     t13 = t11*c6 - t10*s6
     t14 = t10*c6 + t11*s6
     t15 = t13*c7 - t12*s7
-    t16 = t12*c7 + t13*s7
+    t16 = c7*t12 + t13*s7
     t17 = s1*s2
-    t18 = t7*c4 + s4*t17
-    t19 = -t7*s4 + c4*t17
-    t20 = t18*c5 + t3*s5
-    t21 = t3*c5 - t18*s5
-    t22 = t20*c6 - t19*s6
-    t23 = t19*c6 + t20*s6
-    t24 = t21*s7 + t22*c7
-    t25 = t21*c7 - t22*s7
+    t18 = c4*t7 + s4*t17
+    t19 = -s4*t7 + c4*t17
+    t20 = c5*t18 + s5*t3
+    t21 = c5*t3 - s5*t18
+    t22 = c6*t20 - t19*s6
+    t23 = t19*c6 + s6*t20
+    t24 = s7*t21 + c7*t22
+    t25 = c7*t21 - s7*t22
     t26 = c3*s2
     t27 = c2*s4 - c4*t26
     t28 = c2*c4 + s4*t26
     t29 = s3*s2
-    t30 = t27*c5 + s5*t29
-    t31 = -t27*s5 + c5*t29
-    t32 = t30*c6 - t28*s6
-    t33 = t28*c6 + t30*s6
-    t34 = t31*s7 + t32*c7
-    t35 = t31*c7 - t32*s7
+    t30 = c5*t27 + s5*t29
+    t31 = -s5*t27 + c5*t29
+    t32 = c6*t30 - t28*s6
+    t33 = t28*c6 + s6*t30
+    t34 = s7*t31 + c7*t32
+    t35 = c7*t31 - s7*t32
     t36 = 0.126*t14
     t37 = 0.4*t10 + t36
-    t38 = t37 + 0.42*t8
+    t38 = 0.42*t8 + t37
     t39 = 0.126*t23
     t40 = 0.4*t19 + t39
-    t41 = t40 + 0.42*t17
+    t41 = 0.42*t17 + t40
     t42 = 0.126*t33
     t43 = 0.4*t28 + t42
-    t44 = t43 + 0.42*c2
-    t45 = -(t38*c1 + t41*s1)
+    t44 = 0.42*c2 + t43
+    t45 = -(c1*t38 + s1*t41)
     t46 = c1*t44
     t47 = s1*t44
-    t48 = -t41*c2 + t44*t17
-    t49 = t38*c2 - t44*t8
+    t48 = -c2*t41 + t44*t17
+    t49 = c2*t38 - t44*t8
     t50 = t41*t8 - t38*t17
-    t51 = -t43*t3 + t40*t29
-    t52 = -(t43*t6 + t37*t29)
-    t53 = t37*t3 + t40*t6
+    t51 = -t3*t43 + t40*t29
+    t52 = -(t6*t43 + t37*t29)
+    t53 = t3*t37 + t6*t40
     t54 = t19*t43 - t28*t40
     t55 = t28*t37 - t10*t43
     t56 = t10*t40 - t19*t37
@@ -466,14 +466,14 @@ def jacobian_tool(q):
     t58 = t12*t42 + t31*t36
     t59 = -(t12*t39 + t21*t36)
     J = _stack(xp, [
-        t24*t38 - t15*t41,  # 0, 0
+        t38*t24 - t15*t41,  # 0, 0
         t34*t45 + t15*t46 + t24*t47,  # 0, 1
         t15*t48 + t24*t49 + t34*t50,  # 0, 2
         t15*t51 + t24*t52 + t34*t53,  # 0, 3
         t15*t54 + t24*t55 + t34*t56,  # 0, 4
         t15*t57 + t24*t58 + t34*t59,  # 0, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 6
-        t16*t41 + t25*t38,  # 1, 0
+        t16*t41 + t38*t25,  # 1, 0
         t35*t45 + t25*t47 - t16*t46,  # 1, 1
         t25*t49 + t35*t50 - t16*t48,  # 1, 2
         t25*t52 + t35*t53 - t16*t51,  # 1, 3
@@ -488,23 +488,23 @@ def jacobian_tool(q):
         t14*t57 + t23*t58 + t33*t59,  # 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 6
         t34,  # 3, 0
-        t24*c1 - t15*s1,  # 3, 1
-        t34*c2 + t15*t8 + t24*t17,  # 3, 2
-        -(-t15*t6 + t24*t3 + t34*t29),  # 3, 3
+        c1*t24 - s1*t15,  # 3, 1
+        c2*t34 + t15*t8 + t24*t17,  # 3, 2
+        -(-t6*t15 + t3*t24 + t34*t29),  # 3, 3
         t10*t15 + t19*t24 + t28*t34,  # 3, 4
         t21*t24 + t31*t34 - t12*t15,  # 3, 5
         t14*t15 + t23*t24 + t33*t34,  # 3, 6
         t35,  # 4, 0
-        t16*s1 + t25*c1,  # 4, 1
-        t35*c2 + t25*t17 - t16*t8,  # 4, 2
-        -(t16*t6 + t25*t3 + t35*t29),  # 4, 3
+        s1*t16 + c1*t25,  # 4, 1
+        c2*t35 + t25*t17 - t16*t8,  # 4, 2
+        -(t6*t16 + t3*t25 + t35*t29),  # 4, 3
         t19*t25 + t28*t35 - t10*t16,  # 4, 4
         t12*t16 + t21*t25 + t31*t35,  # 4, 5
         t23*t25 + t33*t35 - t14*t16,  # 4, 6
         t33,  # 5, 0
-        t23*c1 - t14*s1,  # 5, 1
-        t33*c2 + t14*t8 + t23*t17,  # 5, 2
-        -(-t14*t6 + t23*t3 + t33*t29),  # 5, 3
+        c1*t23 - s1*t14,  # 5, 1
+        c2*t33 + t14*t8 + t23*t17,  # 5, 2
+        -(-t6*t14 + t3*t23 + t33*t29),  # 5, 3
         t10*t14 + t19*t23 + t28*t33,  # 5, 4
         t21*t23 + t31*t33 - t12*t14,  # 5, 5
         t14**2 + t23**2 + t33**2,  # 5, 6
@@ -534,42 +534,42 @@ def task(q):
     t1 = c1*c3
     t2 = -t0 + c2*t1
     t3 = t1 - c2*t0
-    t4 = c3*s1
-    t5 = c1*s3
+    t4 = s1*c3
+    t5 = s3*c1
     t6 = t4 + c2*t5
     t7 = t5 + c2*t4
     t8 = c1*s2
     t9 = t2*c4 + s4*t8
     t10 = -t2*s4 + c4*t8
     t11 = t9*c5 - t6*s5
-    t12 = t9*s5 + t6*c5
+    t12 = t9*s5 + c5*t6
     t13 = t11*c6 - t10*s6
     t14 = t10*c6 + t11*s6
     t15 = t13*c7 - t12*s7
     t16 = 0.4*t10 + 0.126*t14
-    t17 = t16 + 0.42*t8
+    t17 = 0.42*t8 + t16
     t18 = s1*s2
-    t19 = t7*c4 + s4*t18
-    t20 = -t7*s4 + c4*t18
-    t21 = t19*c5 + t3*s5
-    t22 = t3*c5 - t19*s5
-    t23 = t21*c6 - t20*s6
-    t24 = t20*c6 + t21*s6
-    t25 = t22*s7 + t23*c7
+    t19 = c4*t7 + s4*t18
+    t20 = -s4*t7 + c4*t18
+    t21 = c5*t19 + s5*t3
+    t22 = c5*t3 - s5*t19
+    t23 = c6*t21 - t20*s6
+    t24 = t20*c6 + s6*t21
+    t25 = s7*t22 + c7*t23
     t26 = 0.4*t20 + 0.126*t24
-    t27 = t26 + 0.42*t18
+    t27 = 0.42*t18 + t26
     t28 = c3*s2
     t29 = c2*s4 - c4*t28
     t30 = c2*c4 + s4*t28
     t31 = s3*s2
-    t32 = t29*c5 + s5*t31
-    t33 = -t29*s5 + c5*t31
-    t34 = t32*c6 - t30*s6
-    t35 = t30*c6 + t32*s6
-    t36 = t33*s7 + t34*c7
-    t37 = t33*c7 - t34*s7
+    t32 = c5*t29 + s5*t31
+    t33 = -s5*t29 + c5*t31
+    t34 = c6*t32 - t30*s6
+    t35 = t30*c6 + s6*t32
+    t36 = s7*t33 + c7*t34
+    t37 = c7*t33 - s7*t34
     t38 = 0.4*t30 + 0.126*t35
-    t39 = t38 + 0.42*c2
+    t39 = 0.42*c2 + t38
     t40 = 0.36 + t39
     mu = _stack(xp, [
         t17,  # 0
@@ -604,78 +604,78 @@ def task_jacobian(q):
     t1 = c1*c3
     t2 = -t0 + c2*t1
     t3 = t1 - c2*t0
-    t4 = c3*s1
-    t5 = c1*s3
+    t4 = s1*c3
+    t5 = s3*c1
     t6 = t4 + c2*t5
     t7 = t5 + c2*t4
     t8 = c1*s2
     t9 = t2*c4 + s4*t8
     t10 = -t2*s4 + c4*t8
     t11 = t9*c5 - t6*s5
-    t12 = t9*s5 + t6*c5
+    t12 = t9*s5 + c5*t6
     t13 = t11*c6 - t10*s6
     t14 = t10*c6 + t11*s6
     t15 = t13*c7 - t12*s7
     t16 = s1*s2
-    t17 = t7*c4 + s4*t16
-    t18 = -t7*s4 + c4*t16
-    t19 = t17*c5 + t3*s5
-    t20 = t3*c5 - t17*s5
-    t21 = t19*c6 - t18*s6
-    t22 = t18*c6 + t19*s6
-    t23 = t20*s7 + t21*c7
+    t17 = c4*t7 + s4*t16
+    t18 = -s4*t7 + c4*t16
+    t19 = c5*t17 + s5*t3
+    t20 = c5*t3 - s5*t17
+    t21 = c6*t19 - t18*s6
+    t22 = t18*c6 + s6*t19
+    t23 = s7*t20 + c7*t21
     t24 = c3*s2
     t25 = c2*s4 - c4*t24
     t26 = c2*c4 + s4*t24
-    t27 = s2*s3
-    t28 = t25*c5 + s5*t27
-    t29 = -t25*s5 + c5*t27
-    t30 = t28*c6 - t26*s6
-    t31 = t26*c6 + t28*s6
-    t32 = t29*s7 + t30*c7
+    t27 = s3*s2
+    t28 = c5*t25 + s5*t27
+    t29 = -s5*t25 + c5*t27
+    t30 = c6*t28 - t26*s6
+    t31 = t26*c6 + s6*t28
+    t32 = s7*t29 + c7*t30
     t33 = 0.126*t14
     t34 = 0.4*t10 + t33
-    t35 = t34 + 0.42*t8
+    t35 = 0.42*t8 + t34
     t36 = 0.126*t22
     t37 = 0.4*t18 + t36
-    t38 = t37 + 0.42*t16
+    t38 = 0.42*t16 + t37
     t39 = 0.126*t31
     t40 = 0.4*t26 + t39
-    t41 = t40 + 0.42*c2
-    t42 = t41*c1
-    t43 = t41*s1
-    t44 = t15**2 + t23**2
-    t45 = 1/t44
-    t46 = t23*c1
-    t47 = t15*s1
-    t48 = t45*(t46 - t47)
-    t49 = t15*c1
-    t50 = t23*s1
-    t51 = t45*(s2*t49 + s2*t50)
-    t52 = t45*(t15*t6 - t23*t3)
-    t53 = t45*(t10*t15 + t18*t23)
-    t54 = t45*(t20*t23 - t12*t15)
-    t55 = t45*(t14*t15 + t22*t23)
-    t56 = 1/xp.sqrt(t44)
+    t41 = 0.42*c2 + t40
+    t42 = c1*t41
+    t43 = s1*t41
+    t44 = c1*t23
+    t45 = s1*t15
+    t46 = t15**2 + t23**2
+    t47 = 1/t46
+    t48 = (t44 - t45)*t47
+    t49 = c1*t15
+    t50 = s1*t23
+    t51 = t47*(s2*t49 + s2*t50)
+    t52 = t47*(t6*t15 - t3*t23)
+    t53 = t47*(t10*t15 + t18*t23)
+    t54 = t47*(t20*t23 - t12*t15)
+    t55 = t47*(t14*t15 + t22*t23)
+    t56 = 1/xp.sqrt(t46)
     J = _stack(xp, [
         -t38,  # 0, 0
         t42,  # 0, 1
-        -t38*c2 + s2*t43,  # 0, 2
-        -t40*t3 + t37*t27,  # 0, 3
+        -c2*t38 + s2*t43,  # 0, 2
+        -t3*t40 + t37*t27,  # 0, 3
         t18*t40 - t26*t37,  # 0, 4
         -t29*t36 + t20*t39,  # 0, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 6
         t35,  # 1, 0
         t43,  # 1, 1
-        t35*c2 - s2*t42,  # 1, 2
-        -(t40*t6 + t34*t27),  # 1, 3
+        c2*t35 - s2*t42,  # 1, 2
+        -(t6*t40 + t34*t27),  # 1, 3
         t26*t34 - t10*t40,  # 1, 4
         t12*t39 + t29*t33,  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
-        -(t35*c1 + t38*s1),  # 2, 1
+        -(c1*t35 + s1*t38),  # 2, 1
         t38*t8 - t35*t16,  # 2, 2
-        t34*t3 + t37*t6,  # 2, 3
+        t3*t34 + t6*t37,  # 2, 3
         t10*t37 - t18*t34,  # 2, 4
         -(t12*t36 + t20*t33),  # 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 6
@@ -688,8 +688,8 @@ def task_jacobian(q):
         t55,  # 3, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
         t56*(t49 + t50),  # 4, 1
-        t56*(s2*t47 - s2*t46),  # 4, 2
-        -t56*(t15*t3 + t23*t6),  # 4, 3
+        t56*(s2*t45 - s2*t44),  # 4, 2
+        -t56*(t3*t15 + t6*t23),  # 4, 3
         t56*(t18*t15 - t10*t23),  # 4, 4
         t56*(t12*t23 + t20*t15),  # 4, 5
         t56*(t22*t15 - t14*t23),  # 4, 6
@@ -734,96 +734,96 @@ def fk_jacobian_dot(q, q_dot):
     t2 = c1*c3
     t3 = -t1 + c2*t2
     t4 = t2 - c2*t1
-    t5 = c3*s1
-    t6 = c1*s3
+    t5 = s1*c3
+    t6 = s3*c1
     t7 = t5 + c2*t6
     t8 = t6 + c2*t5
     t9 = c1*s2
     t10 = t3*c4 + s4*t9
     t11 = -t3*s4 + c4*t9
     t12 = t10*c5 - t7*s5
-    t13 = t10*s5 + t7*c5
+    t13 = t10*s5 + c5*t7
     t14 = t12*c6 - t11*s6
     t15 = t11*c6 + t12*s6
     t16 = t14*c7 - t13*s7
-    t17 = t13*c7 + t14*s7
+    t17 = c7*t13 + t14*s7
     t18 = s1*s2
-    t19 = t8*c4 + s4*t18
-    t20 = -t8*s4 + c4*t18
-    t21 = t19*c5 + t4*s5
-    t22 = t4*c5 - t19*s5
-    t23 = t21*c6 - t20*s6
-    t24 = t20*c6 + t21*s6
-    t25 = t22*s7 + t23*c7
-    t26 = t22*c7 - t23*s7
+    t19 = c4*t8 + s4*t18
+    t20 = -s4*t8 + c4*t18
+    t21 = c5*t19 + s5*t4
+    t22 = c5*t4 - s5*t19
+    t23 = c6*t21 - t20*s6
+    t24 = t20*c6 + s6*t21
+    t25 = s7*t22 + c7*t23
+    t26 = c7*t22 - s7*t23
     t27 = c3*s2
     t28 = c2*s4 - c4*t27
     t29 = c2*c4 + s4*t27
-    t30 = s2*s3
-    t31 = t28*c5 + s5*t30
-    t32 = -t28*s5 + c5*t30
-    t33 = t31*c6 - t29*s6
-    t34 = t29*c6 + t31*s6
-    t35 = t32*s7 + t33*c7
-    t36 = t32*c7 - t33*s7
-    t37 = t0 - qd4*t30
+    t30 = s3*s2
+    t31 = c5*t28 + s5*t30
+    t32 = -s5*t28 + c5*t30
+    t33 = c6*t31 - t29*s6
+    t34 = t29*c6 + s6*t31
+    t35 = s7*t32 + c7*t33
+    t36 = c7*t32 - s7*t33
+    t37 = t0 - t30*qd4
     t38 = t37 + t29*qd5
     t39 = 0.126*t15
     t40 = 0.4*t11 + t39
-    t41 = t40 + 0.42*t9
+    t41 = 0.42*t9 + t40
     t42 = 0.126*t24
     t43 = 0.4*t20 + t42
-    t44 = t43 + 0.42*t18
+    t44 = 0.42*t18 + t43
     t45 = 0.126*t34
     t46 = 0.4*t29 + t45
-    t47 = t46 + 0.42*c2
+    t47 = 0.42*c2 + t46
     t48 = 0.36 + t47
-    t49 = t47*s1
-    t50 = -t44*c2 + s2*t49
+    t49 = s1*t47
+    t50 = -c2*t44 + s2*t49
     t51 = t50
-    t52 = -t46*t4 + t43*t30
+    t52 = -t4*t46 + t43*t30
     t53 = t52
     t54 = t20*t46 - t29*t43
     t55 = t54
     t56 = -t32*t42 + t22*t45
     t57 = t56
-    t58 = t55*qd5 + t57*qd6
-    t59 = t58 + t53*qd4
-    t60 = t59 + t51*qd3
-    t61 = t47*c1
-    t62 = t41*c2 - s2*t61
+    t58 = qd5*t55 + qd6*t57
+    t59 = t58 + qd4*t53
+    t60 = t59 + qd3*t51
+    t61 = c1*t47
+    t62 = c2*t41 - s2*t61
     t63 = t62
-    t64 = t46*t7 + t40*t30
+    t64 = t7*t46 + t40*t30
     t65 = t64
     t66 = t29*t40 - t11*t46
     t67 = t66
     t68 = t13*t45 + t32*t39
     t69 = t68
-    t70 = t67*qd5 + t69*qd6
-    t71 = t70 - t65*qd4
-    t72 = t71 + t63*qd3
-    t73 = t41*c1 + t44*s1
+    t70 = qd5*t67 + qd6*t69
+    t71 = t70 - qd4*t65
+    t72 = t71 + qd3*t63
+    t73 = c1*t41 + s1*t44
     t74 = t73
     t75 = t44*t9 - t41*t18
     t76 = t75
-    t77 = t40*t4 + t43*t7
+    t77 = t4*t40 + t7*t43
     t78 = t77
     t79 = t11*t43 - t20*t40
     t80 = t79
     t81 = t13*t42 + t22*t39
     t82 = t81
-    t83 = t80*qd5 - t82*qd6
-    t84 = t83 + t78*qd4
-    t85 = t84 + t76*qd3
-    t86 = t85 - t74*qd2
-    t87 = qd2*s1
-    t88 = -t87 + qd3*t9
+    t83 = qd5*t80 - qd6*t82
+    t84 = t83 + qd4*t78
+    t85 = t84 + qd3*t76
+    t86 = t85 - qd2*t74
+    t87 = s1*qd2
+    t88 = -t87 + t9*qd3
     t89 = t88 + t7*qd4
     t90 = t89 + t11*qd5
     t91 = t72 + t47*t87
     t92 = t91 + t41*qd1
     t93 = c1*qd2
-    t94 = t93 + qd3*t18
+    t94 = t93 + t18*qd3
     t95 = t94 - t4*qd4
     t96 = t95 + t20*qd5
     t97 = t60 + t47*t93
@@ -834,7 +834,7 @@ def fk_jacobian_dot(q, q_dot):
     t102 = t96 + t101
     t103 = t32*qd6
     t104 = t38 + t103
-    t105 = qd2*s2
+    t105 = s2*qd2
     T = _stack(xp, [
         xp.broadcast_to(t16, batch),  # 0, 0
         xp.broadcast_to(-t17, batch),  # 0, 1
@@ -898,12 +898,12 @@ def fk_jacobian_dot(q, q_dot):
         xp.broadcast_to(t34, batch),  # 5, 6
     ], (6, 7))
     a = _stack(xp, [
-        xp.broadcast_to(qd2*(t86*c1 - qd1*t49) + qd3*(-t63*qd1 - t72*c2 + t76*t93 + t85*t18) + qd4*(t65*t0 + t78*t94 - t84*t4 + t71*t30) + qd5*(t20*t83 + t80*t95 - t29*t70 - t67*t37) - qd6*(t69*t38 + t82*t96 + t82*t101 + t69*t103) - t92*qd1, batch),  # 0
-        xp.broadcast_to(t98*qd1 + qd2*(t86*s1 + qd1*t61) + qd3*(t51*qd1 + t60*c2 + t76*t87 - t85*t9) - qd4*(-t53*t0 + t78*t88 + t7*t84 + t59*t30) + qd5*(t29*t58 + t55*t37 - t11*t83 - t80*t89) + qd6*(t57*t38 + t82*t90 + t57*t103 - t82*t99), batch),  # 1
-        xp.broadcast_to(-qd2*(t97*c1 + t91*s1) - qd3*(-t72*t9 + t51*t93 + t63*t87 + t60*t18) + qd4*(t7*t71 + t59*t4 - t53*t94 - t65*t88) + qd5*(t11*t70 + t67*t89 - t20*t58 - t55*t95) - qd6*(-t69*t90 + t57*t96 + t69*t99 + t57*t101), batch),  # 2
-        xp.broadcast_to(qd3*(c2*t93 - qd1*t18) + qd4*(t0*t4 - t94*t30) + qd5*(t29*t95 - t20*t37) + qd6*(t32*t96 - t22*t38) + qd7*(t34*t102 - t24*t104) - qd1*t93, batch),  # 3
-        xp.broadcast_to(qd3*(qd1*t9 + c2*t87) + qd4*(t7*t0 + t88*t30) + qd5*(t11*t37 - t29*t89) - qd6*(t13*t38 + t32*t90) + qd7*(t15*t104 - t34*t100) - qd1*t87, batch),  # 4
-        xp.broadcast_to(-qd3*(c1**2*t105 + s1**2*t105) - qd4*(t88*t4 + t7*t94) + qd5*(t20*t89 - t11*t95) + qd6*(t13*t96 + t22*t90) + qd7*(t24*t100 - t15*t102), batch),  # 5
+        xp.broadcast_to(qd2*(c1*t86 - t49*qd1) + qd3*(-qd1*t63 - c2*t72 + t76*t93 + t18*t85) + qd4*(t0*t65 + t94*t78 - t4*t84 + t30*t71) + qd5*(t20*t83 + t95*t80 - t29*t70 - t37*t67) - qd6*(t38*t69 + t96*t82 + t82*t101 + t69*t103) - qd1*t92, batch),  # 0
+        xp.broadcast_to(qd1*t98 + qd2*(s1*t86 + t61*qd1) + qd3*(qd1*t51 + c2*t60 + t76*t87 - t9*t85) - qd4*(-t0*t53 + t88*t78 + t7*t84 + t30*t59) + qd5*(t29*t58 + t37*t55 - t11*t83 - t89*t80) + qd6*(t38*t57 + t90*t82 + t57*t103 - t82*t99), batch),  # 1
+        xp.broadcast_to(-qd2*(c1*t97 + s1*t91) - qd3*(-t9*t72 + t51*t93 + t63*t87 + t18*t60) + qd4*(t7*t71 + t4*t59 - t94*t53 - t88*t65) + qd5*(t11*t70 + t89*t67 - t20*t58 - t95*t55) - qd6*(-t90*t69 + t96*t57 + t69*t99 + t57*t101), batch),  # 2
+        xp.broadcast_to(qd3*(c2*t93 - t18*qd1) + qd4*(t4*t0 - t30*t94) + qd5*(t29*t95 - t20*t37) + qd6*(t32*t96 - t22*t38) + qd7*(t34*t102 - t24*t104) - qd1*t93, batch),  # 3
+        xp.broadcast_to(qd3*(t9*qd1 + c2*t87) + qd4*(t7*t0 + t30*t88) + qd5*(t11*t37 - t29*t89) - qd6*(t13*t38 + t32*t90) + qd7*(t15*t104 - t34*t100) - qd1*t87, batch),  # 4
+        xp.broadcast_to(-qd3*(c1**2*t105 + s1**2*t105) - qd4*(t4*t88 + t7*t94) + qd5*(t20*t89 - t11*t95) + qd6*(t13*t96 + t22*t90) + qd7*(t24*t100 - t15*t102), batch),  # 5
     ], (6,))
     return T, J, a
 
@@ -935,71 +935,71 @@ def jacobian_dot(q, q_dot):
     t2 = c1*c3
     t3 = -t1 + c2*t2
     t4 = t2 - c2*t1
-    t5 = c3*s1
-    t6 = c1*s3
+    t5 = s1*c3
+    t6 = s3*c1
     t7 = t5 + c2*t6
     t8 = t6 + c2*t5
     t9 = c1*s2
     t10 = t3*c4 + s4*t9
     t11 = -t3*s4 + c4*t9
     t12 = t10*c5 - t7*s5
-    t13 = t10*s5 + t7*c5
+    t13 = t10*s5 + c5*t7
     t14 = t11*c6 + t12*s6
     t15 = s1*s2
-    t16 = t8*c4 + s4*t15
-    t17 = -t8*s4 + c4*t15
-    t18 = t16*c5 + t4*s5
-    t19 = t4*c5 - t16*s5
-    t20 = t17*c6 + t18*s6
+    t16 = c4*t8 + s4*t15
+    t17 = -s4*t8 + c4*t15
+    t18 = c5*t16 + s5*t4
+    t19 = c5*t4 - s5*t16
+    t20 = t17*c6 + s6*t18
     t21 = c3*s2
     t22 = c2*s4 - c4*t21
     t23 = c2*c4 + s4*t21
     t24 = s3*s2
-    t25 = t22*c5 + s5*t24
-    t26 = -t22*s5 + c5*t24
-    t27 = t23*c6 + t25*s6
-    t28 = t0 - qd4*t24
+    t25 = c5*t22 + s5*t24
+    t26 = -s5*t22 + c5*t24
+    t27 = t23*c6 + s6*t25
+    t28 = t0 - t24*qd4
     t29 = t28 + t23*qd5
     t30 = 0.126*t14
     t31 = 0.4*t11 + t30
-    t32 = t31 + 0.42*t9
+    t32 = 0.42*t9 + t31
     t33 = 0.126*t20
     t34 = 0.4*t17 + t33
-    t35 = t34 + 0.42*t15
-    t36 = t32*c1 + t35*s1
+    t35 = 0.42*t15 + t34
+    t36 = c1*t32 + s1*t35
     t37 = t35*t9 - t32*t15
-    t38 = t31*t4 + t34*t7
+    t38 = t4*t31 + t7*t34
     t39 = t11*t34 - t17*t31
     t40 = t13*t33 + t19*t30
-    t41 = t39*qd5 - t40*qd6
-    t42 = t41 + t38*qd4
-    t43 = t42 + t37*qd3
-    t44 = t43 - t36*qd2
+    t41 = qd5*t39 - qd6*t40
+    t42 = t41 + qd4*t38
+    t43 = t42 + qd3*t37
+    t44 = t43 - qd2*t36
     t45 = 0.126*t27
     t46 = 0.4*t23 + t45
-    t47 = t46 + 0.42*c2
-    t48 = -t35*c2 + t47*t15
-    t49 = -t46*t4 + t34*t24
+    t47 = 0.42*c2 + t46
+    t48 = -c2*t35 + t47*t15
+    t49 = -t4*t46 + t34*t24
     t50 = t17*t46 - t23*t34
     t51 = -t26*t33 + t19*t45
-    t52 = t32*c2 - t47*t9
-    t53 = t46*t7 + t31*t24
+    t52 = c2*t32 - t47*t9
+    t53 = t7*t46 + t31*t24
     t54 = t23*t31 - t11*t46
     t55 = t13*t45 + t26*t30
-    t56 = t50*qd5 + t51*qd6
-    t57 = t54*qd5 + t55*qd6
-    t58 = t56 + t49*qd4
-    t59 = t57 - t53*qd4
-    t60 = t58 + t48*qd3
-    t61 = t59 + t52*qd3
-    t62 = qd2*s1
-    t63 = -t62 + qd3*t9
+    t56 = qd5*t50 + qd6*t51
+    t57 = qd5*t54 + qd6*t55
+    t58 = t56 + qd4*t49
+    t59 = t57 - qd4*t53
+    t60 = t58 + qd3*t48
+    t61 = t59 + qd3*t52
+    t62 = s1*qd2
+    t63 = -t62 + t9*qd3
     t64 = t63 + t7*qd4
     t65 = t64 + t11*qd5
     t66 = t61 + t47*t62
     t67 = t66 + t32*qd1
     t68 = c1*qd2
-    t69 = t68 + qd3*t15
+    t69 = t68 + t15*qd3
     t70 = t69 - t4*qd4
     t71 = t70 + t17*qd5
     t72 = t60 + t47*t68
@@ -1010,49 +1010,49 @@ def jacobian_dot(q, q_dot):
     t77 = t71 + t76
     t78 = t26*qd6
     t79 = t29 + t78
-    t80 = qd1*s1
+    t80 = s1*qd1
     t81 = c1*qd1
-    t82 = qd2*s2
+    t82 = s2*qd2
     Jd = _stack(xp, [
         xp.broadcast_to(-t67, batch),  # 0, 0
-        xp.broadcast_to(t44*c1 - t47*t80, batch),  # 0, 1
-        xp.broadcast_to(-t52*qd1 - t61*c2 + t37*t68 + t43*t15, batch),  # 0, 2
-        xp.broadcast_to(t53*t0 + t38*t69 - t42*t4 + t59*t24, batch),  # 0, 3
-        xp.broadcast_to(t17*t41 + t39*t70 - t23*t57 - t54*t28, batch),  # 0, 4
-        xp.broadcast_to(-(t55*t29 + t40*t71 + t40*t76 + t55*t78), batch),  # 0, 5
+        xp.broadcast_to(c1*t44 - t47*t80, batch),  # 0, 1
+        xp.broadcast_to(-qd1*t52 - c2*t61 + t68*t37 + t15*t43, batch),  # 0, 2
+        xp.broadcast_to(t0*t53 + t69*t38 - t4*t42 + t24*t59, batch),  # 0, 3
+        xp.broadcast_to(t17*t41 + t70*t39 - t23*t57 - t28*t54, batch),  # 0, 4
+        xp.broadcast_to(-(t29*t55 + t71*t40 + t76*t40 + t78*t55), batch),  # 0, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 6
         xp.broadcast_to(t73, batch),  # 1, 0
-        xp.broadcast_to(t44*s1 + t47*t81, batch),  # 1, 1
-        xp.broadcast_to(t48*qd1 + t60*c2 + t37*t62 - t43*t9, batch),  # 1, 2
-        xp.broadcast_to(-(-t49*t0 + t38*t63 + t7*t42 + t58*t24), batch),  # 1, 3
-        xp.broadcast_to(t23*t56 + t50*t28 - t11*t41 - t39*t64, batch),  # 1, 4
-        xp.broadcast_to(t51*t29 + t40*t65 + t51*t78 - t40*t74, batch),  # 1, 5
+        xp.broadcast_to(s1*t44 + t47*t81, batch),  # 1, 1
+        xp.broadcast_to(qd1*t48 + c2*t60 + t62*t37 - t9*t43, batch),  # 1, 2
+        xp.broadcast_to(-(-t0*t49 + t63*t38 + t7*t42 + t24*t58), batch),  # 1, 3
+        xp.broadcast_to(t23*t56 + t28*t50 - t11*t41 - t64*t39, batch),  # 1, 4
+        xp.broadcast_to(t29*t51 + t65*t40 + t78*t51 - t74*t40, batch),  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
-        xp.broadcast_to(-(t72*c1 + t66*s1), batch),  # 2, 1
-        xp.broadcast_to(-(-t61*t9 + t48*t68 + t52*t62 + t60*t15), batch),  # 2, 2
-        xp.broadcast_to(t7*t59 + t58*t4 - t49*t69 - t53*t63, batch),  # 2, 3
-        xp.broadcast_to(t11*t57 + t54*t64 - t17*t56 - t50*t70, batch),  # 2, 4
-        xp.broadcast_to(-(-t55*t65 + t51*t71 + t55*t74 + t51*t76), batch),  # 2, 5
+        xp.broadcast_to(-(c1*t72 + s1*t66), batch),  # 2, 1
+        xp.broadcast_to(-(-t9*t61 + t68*t48 + t62*t52 + t15*t60), batch),  # 2, 2
+        xp.broadcast_to(t7*t59 + t4*t58 - t69*t49 - t63*t53, batch),  # 2, 3
+        xp.broadcast_to(t11*t57 + t64*t54 - t17*t56 - t70*t50, batch),  # 2, 4
+        xp.broadcast_to(-(-t65*t55 + t71*t51 + t74*t55 + t76*t51), batch),  # 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
         xp.broadcast_to(-t81, batch),  # 3, 1
         xp.broadcast_to(c2*t68 - s2*t80, batch),  # 3, 2
-        xp.broadcast_to(t0*t4 - t69*t24, batch),  # 3, 3
+        xp.broadcast_to(t4*t0 - t24*t69, batch),  # 3, 3
         xp.broadcast_to(t23*t70 - t17*t28, batch),  # 3, 4
         xp.broadcast_to(t26*t71 - t19*t29, batch),  # 3, 5
         xp.broadcast_to(t27*t77 - t20*t79, batch),  # 3, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
         xp.broadcast_to(-t80, batch),  # 4, 1
         xp.broadcast_to(s2*t81 + c2*t62, batch),  # 4, 2
-        xp.broadcast_to(t7*t0 + t63*t24, batch),  # 4, 3
+        xp.broadcast_to(t7*t0 + t24*t63, batch),  # 4, 3
         xp.broadcast_to(t11*t28 - t23*t64, batch),  # 4, 4
         xp.broadcast_to(-(t13*t29 + t26*t65), batch),  # 4, 5
         xp.broadcast_to(t14*t79 - t27*t75, batch),  # 4, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 1
         xp.broadcast_to(-(c1**2*t82 + s1**2*t82), batch),  # 5, 2
-        xp.broadcast_to(-(t63*t4 + t7*t69), batch),  # 5, 3
+        xp.broadcast_to(-(t4*t63 + t7*t69), batch),  # 5, 3
         xp.broadcast_to(t17*t64 - t11*t70, batch),  # 5, 4
         xp.broadcast_to(t13*t71 + t19*t65, batch),  # 5, 5
         xp.broadcast_to(t20*t75 - t14*t77, batch),  # 5, 6
@@ -1088,71 +1088,71 @@ def bias_acceleration(q, q_dot):
     t2 = c1*c3
     t3 = -t1 + c2*t2
     t4 = t2 - c2*t1
-    t5 = c3*s1
-    t6 = c1*s3
+    t5 = s1*c3
+    t6 = s3*c1
     t7 = t5 + c2*t6
     t8 = t6 + c2*t5
     t9 = c1*s2
     t10 = t3*c4 + s4*t9
     t11 = -t3*s4 + c4*t9
     t12 = t10*c5 - t7*s5
-    t13 = t10*s5 + t7*c5
+    t13 = t10*s5 + c5*t7
     t14 = t11*c6 + t12*s6
     t15 = s1*s2
-    t16 = t8*c4 + s4*t15
-    t17 = -t8*s4 + c4*t15
-    t18 = t16*c5 + t4*s5
-    t19 = t4*c5 - t16*s5
-    t20 = t17*c6 + t18*s6
+    t16 = c4*t8 + s4*t15
+    t17 = -s4*t8 + c4*t15
+    t18 = c5*t16 + s5*t4
+    t19 = c5*t4 - s5*t16
+    t20 = t17*c6 + s6*t18
     t21 = c3*s2
     t22 = c2*s4 - c4*t21
     t23 = c2*c4 + s4*t21
     t24 = s3*s2
-    t25 = t22*c5 + s5*t24
-    t26 = -t22*s5 + c5*t24
-    t27 = t23*c6 + t25*s6
-    t28 = t0 - qd4*t24
+    t25 = c5*t22 + s5*t24
+    t26 = -s5*t22 + c5*t24
+    t27 = t23*c6 + s6*t25
+    t28 = t0 - t24*qd4
     t29 = t28 + t23*qd5
     t30 = 0.126*t14
     t31 = 0.4*t11 + t30
-    t32 = t31 + 0.42*t9
+    t32 = 0.42*t9 + t31
     t33 = 0.126*t20
     t34 = 0.4*t17 + t33
-    t35 = t34 + 0.42*t15
-    t36 = t32*c1 + t35*s1
+    t35 = 0.42*t15 + t34
+    t36 = c1*t32 + s1*t35
     t37 = t35*t9 - t32*t15
-    t38 = t31*t4 + t34*t7
+    t38 = t4*t31 + t7*t34
     t39 = t11*t34 - t17*t31
     t40 = t13*t33 + t19*t30
-    t41 = t39*qd5 - t40*qd6
-    t42 = t41 + t38*qd4
-    t43 = t42 + t37*qd3
-    t44 = t43 - t36*qd2
+    t41 = qd5*t39 - qd6*t40
+    t42 = t41 + qd4*t38
+    t43 = t42 + qd3*t37
+    t44 = t43 - qd2*t36
     t45 = 0.126*t27
     t46 = 0.4*t23 + t45
-    t47 = t46 + 0.42*c2
-    t48 = -t35*c2 + t47*t15
-    t49 = -t46*t4 + t34*t24
+    t47 = 0.42*c2 + t46
+    t48 = -c2*t35 + t47*t15
+    t49 = -t4*t46 + t34*t24
     t50 = t17*t46 - t23*t34
     t51 = -t26*t33 + t19*t45
-    t52 = t32*c2 - t47*t9
-    t53 = t46*t7 + t31*t24
+    t52 = c2*t32 - t47*t9
+    t53 = t7*t46 + t31*t24
     t54 = t23*t31 - t11*t46
     t55 = t13*t45 + t26*t30
-    t56 = t50*qd5 + t51*qd6
-    t57 = t54*qd5 + t55*qd6
-    t58 = t56 + t49*qd4
-    t59 = t57 - t53*qd4
-    t60 = t58 + t48*qd3
-    t61 = t59 + t52*qd3
-    t62 = qd2*s1
-    t63 = -t62 + qd3*t9
+    t56 = qd5*t50 + qd6*t51
+    t57 = qd5*t54 + qd6*t55
+    t58 = t56 + qd4*t49
+    t59 = t57 - qd4*t53
+    t60 = t58 + qd3*t48
+    t61 = t59 + qd3*t52
+    t62 = s1*qd2
+    t63 = -t62 + t9*qd3
     t64 = t63 + t7*qd4
     t65 = t64 + t11*qd5
     t66 = t61 + t47*t62
     t67 = t66 + t32*qd1
     t68 = c1*qd2
-    t69 = t68 + qd3*t15
+    t69 = t68 + t15*qd3
     t70 = t69 - t4*qd4
     t71 = t70 + t17*qd5
     t72 = t60 + t47*t68
@@ -1163,15 +1163,15 @@ def bias_acceleration(q, q_dot):
     t77 = t71 + t76
     t78 = t26*qd6
     t79 = t29 + t78
-    t80 = qd1*t47
-    t81 = qd2*s2
+    t80 = t47*qd1
+    t81 = s2*qd2
     a = _stack(xp, [
-        xp.broadcast_to(qd2*(t44*c1 - s1*t80) + qd3*(-t52*qd1 - t61*c2 + t37*t68 + t43*t15) + qd4*(t53*t0 + t38*t69 - t42*t4 + t59*t24) + qd5*(t17*t41 + t39*t70 - t23*t57 - t54*t28) - qd6*(t55*t29 + t40*t71 + t40*t76 + t55*t78) - t67*qd1, batch),  # 0
-        xp.broadcast_to(t73*qd1 + qd2*(t44*s1 + c1*t80) + qd3*(t48*qd1 + t60*c2 + t37*t62 - t43*t9) - qd4*(-t49*t0 + t38*t63 + t7*t42 + t58*t24) + qd5*(t23*t56 + t50*t28 - t11*t41 - t39*t64) + qd6*(t51*t29 + t40*t65 + t51*t78 - t40*t74), batch),  # 1
-        xp.broadcast_to(-qd2*(t72*c1 + t66*s1) - qd3*(-t61*t9 + t48*t68 + t52*t62 + t60*t15) + qd4*(t7*t59 + t58*t4 - t49*t69 - t53*t63) + qd5*(t11*t57 + t54*t64 - t17*t56 - t50*t70) - qd6*(-t55*t65 + t51*t71 + t55*t74 + t51*t76), batch),  # 2
-        xp.broadcast_to(qd3*(c2*t68 - qd1*t15) + qd4*(t0*t4 - t69*t24) + qd5*(t23*t70 - t17*t28) + qd6*(t26*t71 - t19*t29) + qd7*(t27*t77 - t20*t79) - qd1*t68, batch),  # 3
-        xp.broadcast_to(qd3*(qd1*t9 + c2*t62) + qd4*(t7*t0 + t63*t24) + qd5*(t11*t28 - t23*t64) - qd6*(t13*t29 + t26*t65) + qd7*(t14*t79 - t27*t75) - qd1*t62, batch),  # 4
-        xp.broadcast_to(-qd3*(c1**2*t81 + s1**2*t81) - qd4*(t63*t4 + t7*t69) + qd5*(t17*t64 - t11*t70) + qd6*(t13*t71 + t19*t65) + qd7*(t20*t75 - t14*t77), batch),  # 5
+        xp.broadcast_to(qd2*(c1*t44 - s1*t80) + qd3*(-qd1*t52 - c2*t61 + t68*t37 + t15*t43) + qd4*(t0*t53 + t69*t38 - t4*t42 + t24*t59) + qd5*(t17*t41 + t70*t39 - t23*t57 - t28*t54) - qd6*(t29*t55 + t71*t40 + t76*t40 + t78*t55) - qd1*t67, batch),  # 0
+        xp.broadcast_to(qd1*t73 + qd2*(s1*t44 + c1*t80) + qd3*(qd1*t48 + c2*t60 + t62*t37 - t9*t43) - qd4*(-t0*t49 + t63*t38 + t7*t42 + t24*t58) + qd5*(t23*t56 + t28*t50 - t11*t41 - t64*t39) + qd6*(t29*t51 + t65*t40 + t78*t51 - t74*t40), batch),  # 1
+        xp.broadcast_to(-qd2*(c1*t72 + s1*t66) - qd3*(-t9*t61 + t68*t48 + t62*t52 + t15*t60) + qd4*(t7*t59 + t4*t58 - t69*t49 - t63*t53) + qd5*(t11*t57 + t64*t54 - t17*t56 - t70*t50) - qd6*(-t65*t55 + t71*t51 + t74*t55 + t76*t51), batch),  # 2
+        xp.broadcast_to(qd3*(c2*t68 - t15*qd1) + qd4*(t4*t0 - t24*t69) + qd5*(t23*t70 - t17*t28) + qd6*(t26*t71 - t19*t29) + qd7*(t27*t77 - t20*t79) - t68*qd1, batch),  # 3
+        xp.broadcast_to(qd3*(t9*qd1 + c2*t62) + qd4*(t7*t0 + t24*t63) + qd5*(t11*t28 - t23*t64) - qd6*(t13*t29 + t26*t65) + qd7*(t14*t79 - t27*t75) - t62*qd1, batch),  # 4
+        xp.broadcast_to(-qd3*(c1**2*t81 + s1**2*t81) - qd4*(t4*t63 + t7*t69) + qd5*(t17*t64 - t11*t70) + qd6*(t13*t71 + t19*t65) + qd7*(t20*t75 - t14*t77), batch),  # 5
     ], (6,))
     return a
 
@@ -1205,103 +1205,103 @@ def task_jacobian_dot(q, q_dot):
     t1 = c1*c3
     t2 = -t0 + c2*t1
     t3 = t1 - c2*t0
-    t4 = c3*s1
-    t5 = c1*s3
+    t4 = s1*c3
+    t5 = s3*c1
     t6 = t4 + c2*t5
     t7 = t5 + c2*t4
     t8 = c1*s2
     t9 = t2*c4 + s4*t8
     t10 = -t2*s4 + c4*t8
     t11 = t9*c5 - t6*s5
-    t12 = t9*s5 + t6*c5
+    t12 = t9*s5 + c5*t6
     t13 = t11*c6 - t10*s6
     t14 = t10*c6 + t11*s6
     t15 = t13*c7 - t12*s7
     t16 = s1*s2
-    t17 = t7*c4 + s4*t16
-    t18 = -t7*s4 + c4*t16
-    t19 = t17*c5 + t3*s5
-    t20 = t3*c5 - t17*s5
-    t21 = t19*c6 - t18*s6
-    t22 = t18*c6 + t19*s6
-    t23 = t20*s7 + t21*c7
+    t17 = c4*t7 + s4*t16
+    t18 = -s4*t7 + c4*t16
+    t19 = c5*t17 + s5*t3
+    t20 = c5*t3 - s5*t17
+    t21 = c6*t19 - t18*s6
+    t22 = t18*c6 + s6*t19
+    t23 = s7*t20 + c7*t21
     t24 = t15**2 + t23**2
     t25 = xp.sqrt(t24)
     t26 = c3*s2
     t27 = c2*s4 - c4*t26
     t28 = c2*c4 + s4*t26
     t29 = s3*s2
-    t30 = t27*c5 + s5*t29
-    t31 = -t27*s5 + c5*t29
-    t32 = t30*c6 - t28*s6
-    t33 = t28*c6 + t30*s6
-    t34 = t31*s7 + t32*c7
+    t30 = c5*t27 + s5*t29
+    t31 = -s5*t27 + c5*t29
+    t32 = c6*t30 - t28*s6
+    t33 = t28*c6 + s6*t30
+    t34 = s7*t31 + c7*t32
     t35 = 0.126*t14
     t36 = 0.4*t10 + t35
-    t37 = t36 + 0.42*t8
+    t37 = 0.42*t8 + t36
     t38 = 0.126*t22
     t39 = 0.4*t18 + t38
-    t40 = t39 + 0.42*t16
-    t41 = t37*c1 + t40*s1
+    t40 = 0.42*t16 + t39
+    t41 = c1*t37 + s1*t40
     t42 = t40*t8 - t37*t16
-    t43 = t36*t3 + t39*t6
+    t43 = t3*t36 + t6*t39
     t44 = t10*t39 - t18*t36
     t45 = t12*t38 + t20*t35
-    t46 = t44*qd5 - t45*qd6
-    t47 = t46 + t43*qd4
-    t48 = t47 + t42*qd3
-    t49 = t48 - t41*qd2
+    t46 = qd5*t44 - qd6*t45
+    t47 = t46 + qd4*t43
+    t48 = t47 + qd3*t42
+    t49 = t48 - qd2*t41
     t50 = 0.126*t33
     t51 = 0.4*t28 + t50
-    t52 = t51 + 0.42*c2
-    t53 = -t40*c2 + t52*t16
-    t54 = -t51*t3 + t39*t29
+    t52 = 0.42*c2 + t51
+    t53 = -c2*t40 + t52*t16
+    t54 = -t3*t51 + t39*t29
     t55 = t18*t51 - t28*t39
     t56 = -t31*t38 + t20*t50
-    t57 = t37*c2 - t52*t8
-    t58 = t51*t6 + t36*t29
+    t57 = c2*t37 - t52*t8
+    t58 = t6*t51 + t36*t29
     t59 = t28*t36 - t10*t51
     t60 = t12*t50 + t31*t35
-    t61 = t55*qd5 + t56*qd6
-    t62 = t59*qd5 + t60*qd6
-    t63 = t61 + t54*qd4
-    t64 = t62 - t58*qd4
-    t65 = t63 + t53*qd3
-    t66 = t64 + t57*qd3
-    t67 = qd2*s1
+    t61 = qd5*t55 + qd6*t56
+    t62 = qd5*t59 + qd6*t60
+    t63 = t61 + qd4*t54
+    t64 = t62 - qd4*t58
+    t65 = t63 + qd3*t53
+    t66 = t64 + qd3*t57
+    t67 = s1*qd2
     t68 = t66 + t52*t67
     t69 = t68 + t37*qd1
-    t70 = t53*qd1 + t65*c2 + t42*t67 - t48*t8
-    t71 = qd1*t8 + c2*t67
-    t72 = -t67 + qd3*t8
+    t70 = qd1*t53 + c2*t65 + t67*t42 - t8*t48
+    t71 = t8*qd1 + c2*t67
+    t72 = -t67 + t8*qd3
     t73 = t72
     t74 = c1*qd2
     t75 = t65 + t52*t74
     t76 = t75 - t40*qd1
-    t77 = -t57*qd1 - t66*c2 + t42*t74 + t48*t16
-    t78 = t75*c1 + t68*s1
-    t79 = t53*t74 + t57*t67 + t65*t16 - t66*t8
-    t80 = c2*t74 - qd1*t16
-    t81 = t74 + qd3*t16
+    t77 = -qd1*t57 - c2*t66 + t74*t42 + t16*t48
+    t78 = c1*t75 + s1*t68
+    t79 = t74*t53 + t67*t57 + t16*t65 - t8*t66
+    t80 = c2*t74 - t16*qd1
+    t81 = t74 + t16*qd3
     t82 = t81
-    t83 = t6*t64 + t63*t3 - t54*t82 - t58*t73
-    t84 = t73*t3 + t6*t82
+    t83 = t6*t64 + t3*t63 - t82*t54 - t73*t58
+    t84 = t3*t73 + t6*t82
     t85 = qd1 + c2*qd3
     t86 = t85
-    t87 = t58*t86 + t43*t82 - t47*t3 + t64*t29
-    t88 = t43*t73 + t6*t47 - t54*t86 + t63*t29
-    t89 = t86*t3 - t82*t29
-    t90 = t6*t86 + t73*t29
+    t87 = t86*t58 + t82*t43 - t3*t47 + t29*t64
+    t88 = t73*t43 + t6*t47 - t86*t54 + t29*t63
+    t89 = t3*t86 - t29*t82
+    t90 = t6*t86 + t29*t73
     t91 = t6*qd4
     t92 = t73 + t91
     t93 = -t3*qd4
     t94 = t82 + t93
-    t95 = t10*t62 + t59*t92 - t18*t61 - t55*t94
+    t95 = t10*t62 + t92*t59 - t18*t61 - t94*t55
     t96 = t18*t92 - t10*t94
-    t97 = -qd4*t29
+    t97 = -t29*qd4
     t98 = t86 + t97
-    t99 = t18*t46 + t44*t94 - t28*t62 - t59*t98
-    t100 = t28*t61 + t55*t98 - t10*t46 - t44*t92
+    t99 = t18*t46 + t94*t44 - t28*t62 - t98*t59
+    t100 = t28*t61 + t98*t55 - t10*t46 - t92*t44
     t101 = t28*t94 - t18*t98
     t102 = t10*t98 - t28*t92
     t103 = t10*qd5
@@ -1316,81 +1316,81 @@ def task_jacobian_dot(q, q_dot):
     t112 = t12*qd6
     t113 = -t112
     t114 = t104 + t113
-    t115 = t91 + t103 + t113 + t14*qd7 + t72
+    t115 = t72 + t91 + t103 + t113 + t14*qd7
     t116 = t20*qd6
     t117 = t106 + t116
-    t118 = t56*t106 - t60*t104 + t60*t112 + t56*t116
+    t118 = t106*t56 - t104*t60 + t112*t60 + t116*t56
     t119 = t22*t114 - t14*t117
-    t120 = t93 + t105 + t116 + t22*qd7 + t81
-    t121 = t115*t23 - t120*t15
+    t120 = t81 + t93 + t105 + t116 + t22*qd7
+    t121 = t23*t115 - t15*t120
     t122 = t31*qd6
     t123 = t109 + t122
-    t124 = t60*t109 + t45*t106 + t45*t116 + t60*t122
-    t125 = t56*t109 + t45*t104 + t56*t122 - t45*t112
+    t124 = t109*t60 + t106*t45 + t116*t45 + t122*t60
+    t125 = t109*t56 + t104*t45 + t122*t56 - t112*t45
     t126 = t33*t117 - t22*t123
     t127 = t14*t123 - t33*t114
-    t128 = t97 + t108 + t122 + t33*qd7 + t85
-    t129 = t120*t34 - t128*t23
-    t130 = t128*t15 - t115*t34
-    t131 = qd1*t52
-    t132 = t49*c1 - s1*t131
-    t133 = t49*s1 + c1*t131
-    t134 = qd2*s2
+    t128 = t85 + t97 + t108 + t122 + t33*qd7
+    t129 = t34*t120 - t23*t128
+    t130 = t15*t128 - t34*t115
+    t131 = t52*qd1
+    t132 = c1*t49 - s1*t131
+    t133 = s1*t49 + c1*t131
+    t134 = s2*qd2
     t135 = c1**2*t134 + s1**2*t134
-    t136 = 1/t24
-    t137 = t136*(t15*t6 - t23*t3)
-    t138 = t136*(t10*t15 + t18*t23)
-    t139 = t136*(t20*t23 - t12*t15)
-    t140 = t136*(t14*t15 + t22*t23)
-    t141 = t23*c1
-    t142 = t15*s1
-    t143 = t136*(t141 - t142)
-    t144 = t15*c1
-    t145 = t23*s1
-    t146 = t136*(s2*t144 + s2*t145)
+    t136 = c1*t23
+    t137 = s1*t15
+    t138 = 1/t24
+    t139 = (t136 - t137)*t138
+    t140 = (t6*t15 - t3*t23)*t138
+    t141 = (t10*t15 + t18*t23)*t138
+    t142 = (t20*t23 - t12*t15)*t138
+    t143 = (t14*t15 + t22*t23)*t138
+    t144 = c1*t15
+    t145 = s1*t23
+    t146 = (s2*t144 + s2*t145)*t138
     t147 = 1/t25
-    t148 = t136*t147
+    t148 = t138*t147
     t149 = (t144 + t145)*t148
-    t150 = (s2*t142 - s2*t141)*t148
-    t151 = -(t15*t3 + t23*t6)*t148
+    t150 = t148*(s2*t137 - s2*t136)
+    t151 = -(t3*t15 + t6*t23)*t148
     t152 = (t18*t15 - t10*t23)*t148
     t153 = (t12*t23 + t20*t15)*t148
     t154 = (t22*t15 - t14*t23)*t148
-    t155 = 2*t143
-    t156 = t136*t129
+    t155 = 2*t139
+    t156 = t138*t129
     t157 = -(s1 + t15*t155)*t156
-    t158 = t136*t130
+    t158 = t138*t130
     t159 = (c1 - t23*t155)*t158
-    t160 = qd1*t136
+    t160 = qd1*t138
     t161 = t144*t160
     t162 = t145*t160
-    t163 = t15*t136
+    t163 = t15*t138
     t164 = t80*t163
-    t165 = t23*t136
+    t165 = t23*t138
     t166 = t71*t165
     t167 = 2*t146
-    t168 = (t8 - t15*t167)*t156
-    t169 = (t16 - t23*t167)*t158
+    t168 = t156*(t8 - t15*t167)
+    t169 = t158*(t16 - t23*t167)
     t170 = t89*t163
     t171 = t90*t165
-    t172 = 2*t137
-    t173 = (t6 - t15*t172)*t156
-    t174 = -(t3 + t23*t172)*t158
+    t172 = 2*t140
+    t173 = t156*(t6 - t15*t172)
+    t174 = -t158*(t3 + t23*t172)
     t175 = t101*t163
     t176 = t102*t165
-    t177 = 2*t138
-    t178 = (t10 - t15*t177)*t156
-    t179 = (t18 - t23*t177)*t158
+    t177 = 2*t141
+    t178 = t156*(t10 - t15*t177)
+    t179 = t158*(t18 - t23*t177)
     t180 = t110*t163
-    t181 = 2*t139
-    t182 = -(t12 + t15*t181)*t156
-    t183 = (t20 - t23*t181)*t158
+    t181 = 2*t142
+    t182 = -t156*(t12 + t15*t181)
+    t183 = t158*(t20 - t23*t181)
     t184 = t111*t165
     t185 = t126*t163
     t186 = t127*t165
-    t187 = 2*t140
-    t188 = (t14 - t15*t187)*t156
-    t189 = (t22 - t23*t187)*t158
+    t187 = 2*t143
+    t188 = t156*(t14 - t15*t187)
+    t189 = t158*(t22 - t23*t187)
     t190 = qd1*t147
     t191 = t15*t147
     t192 = t23*t147
@@ -1424,19 +1424,19 @@ def task_jacobian_dot(q, q_dot):
         xp.broadcast_to(t180 + t182 + t183 - t184, batch),  # 3, 5
         xp.broadcast_to(t185 + t186 + t188 + t189, batch),  # 3, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
-        xp.broadcast_to(t129*(c1*t147 - t149*t15) + t130*(s1*t147 - t149*t23) + t141*t190 - t142*t190, batch),  # 4, 1
-        xp.broadcast_to(t129*(-t150*t15 + t147*t16) - t130*(t150*t23 + t147*t8) + t71*t191 - t80*t192, batch),  # 4, 2
-        xp.broadcast_to(-t129*(t151*t15 + t3*t147) - t130*(t151*t23 + t6*t147) + t90*t191 - t89*t192, batch),  # 4, 3
-        xp.broadcast_to(t129*(t18*t147 - t152*t15) - t130*(t10*t147 + t152*t23) + t102*t191 - t101*t192, batch),  # 4, 4
-        xp.broadcast_to(t129*(t20*t147 - t153*t15) + t130*(t12*t147 - t153*t23) - t110*t192 - t111*t191, batch),  # 4, 5
-        xp.broadcast_to(t129*(t22*t147 - t154*t15) - t130*(t154*t23 + t14*t147) + t127*t191 - t126*t192, batch),  # 4, 6
+        xp.broadcast_to(t129*(c1*t147 - t15*t149) + t130*(s1*t147 - t23*t149) + t136*t190 - t137*t190, batch),  # 4, 1
+        xp.broadcast_to(t129*(-t15*t150 + t16*t147) - t130*(t23*t150 + t8*t147) + t71*t191 - t80*t192, batch),  # 4, 2
+        xp.broadcast_to(-t129*(t15*t151 + t3*t147) - t130*(t23*t151 + t6*t147) + t90*t191 - t89*t192, batch),  # 4, 3
+        xp.broadcast_to(t129*(t18*t147 - t15*t152) - t130*(t10*t147 + t23*t152) + t102*t191 - t101*t192, batch),  # 4, 4
+        xp.broadcast_to(t129*(t20*t147 - t15*t153) + t130*(t12*t147 - t23*t153) - t110*t192 - t111*t191, batch),  # 4, 5
+        xp.broadcast_to(t129*(t22*t147 - t15*t154) - t130*(t23*t154 + t14*t147) + t127*t191 - t126*t192, batch),  # 4, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 0
-        xp.broadcast_to(-(t121*t143 + t34*t157 + t34*t159 - t34*t161 - t34*t162), batch),  # 5, 1
-        xp.broadcast_to(-(t135 + t121*t146 + t34*t164 + t34*t166 + t34*t168 + t34*t169), batch),  # 5, 2
-        xp.broadcast_to(-(t84 + t121*t137 + t34*t170 + t34*t171 + t34*t173 + t34*t174), batch),  # 5, 3
-        xp.broadcast_to(-(-t96 + t121*t138 + t34*t175 + t34*t176 + t34*t178 + t34*t179), batch),  # 5, 4
-        xp.broadcast_to(-(-t107 + t121*t139 - t34*t184 + t34*t180 + t34*t182 + t34*t183), batch),  # 5, 5
-        xp.broadcast_to(-(-t119 + t121*t140 + t34*t185 + t34*t186 + t34*t188 + t34*t189), batch),  # 5, 6
+        xp.broadcast_to(-(t139*t121 + t34*t157 + t34*t159 - t34*t161 - t34*t162), batch),  # 5, 1
+        xp.broadcast_to(-(t135 + t146*t121 + t34*t164 + t34*t166 + t34*t168 + t34*t169), batch),  # 5, 2
+        xp.broadcast_to(-(t84 + t140*t121 + t34*t170 + t34*t171 + t34*t173 + t34*t174), batch),  # 5, 3
+        xp.broadcast_to(-(-t96 + t141*t121 + t34*t175 + t34*t176 + t34*t178 + t34*t179), batch),  # 5, 4
+        xp.broadcast_to(-(-t107 + t142*t121 - t34*t184 + t34*t180 + t34*t182 + t34*t183), batch),  # 5, 5
+        xp.broadcast_to(-(-t119 + t143*t121 + t34*t185 + t34*t186 + t34*t188 + t34*t189), batch),  # 5, 6
     ], (6, 7))
     return Jd
 
@@ -1461,87 +1461,87 @@ def hessian(q):
     t1 = c1*c3
     t2 = -t0 + c2*t1
     t3 = t1 - c2*t0
-    t4 = c3*s1
-    t5 = c1*s3
+    t4 = s1*c3
+    t5 = s3*c1
     t6 = t4 + c2*t5
     t7 = t5 + c2*t4
     t8 = c1*s2
     t9 = t2*c4 + s4*t8
     t10 = -t2*s4 + c4*t8
     t11 = t9*c5 - t6*s5
-    t12 = t9*s5 + t6*c5
+    t12 = t9*s5 + c5*t6
     t13 = t10*c6 + t11*s6
     t14 = s1*s2
-    t15 = t7*c4 + s4*t14
-    t16 = -t7*s4 + c4*t14
-    t17 = t15*c5 + t3*s5
-    t18 = t3*c5 - t15*s5
-    t19 = t16*c6 + t17*s6
+    t15 = c4*t7 + s4*t14
+    t16 = -s4*t7 + c4*t14
+    t17 = c5*t15 + s5*t3
+    t18 = c5*t3 - s5*t15
+    t19 = t16*c6 + s6*t17
     t20 = c3*s2
     t21 = c2*s4 - c4*t20
     t22 = c2*c4 + s4*t20
     t23 = s3*s2
-    t24 = t21*c5 + s5*t23
-    t25 = -t21*s5 + c5*t23
-    t26 = t22*c6 + t24*s6
+    t24 = c5*t21 + s5*t23
+    t25 = -s5*t21 + c5*t23
+    t26 = t22*c6 + s6*t24
     t27 = 0.126*t13
     t28 = 0.4*t10 + t27
-    t29 = t28 + 0.42*t8
+    t29 = 0.42*t8 + t28
     t30 = 0.126*t19
     t31 = 0.4*t16 + t30
-    t32 = t31 + 0.42*t14
-    t33 = t29*c1 + t32*s1
+    t32 = 0.42*t14 + t31
+    t33 = c1*t29 + s1*t32
     t34 = t32*t8 - t29*t14
-    t35 = t28*t3 + t31*t6
+    t35 = t3*t28 + t6*t31
     t36 = t10*t31 - t16*t28
     t37 = t12*t30 + t18*t27
     t38 = 0.126*t26
     t39 = 0.4*t22 + t38
-    t40 = t39 + 0.42*c2
-    t41 = -t39*t3 + t31*t23
+    t40 = 0.42*c2 + t39
+    t41 = -t3*t39 + t31*t23
     t42 = t16*t39 - t22*t31
     t43 = -t25*t30 + t18*t38
-    t44 = t39*t6 + t28*t23
+    t44 = t6*t39 + t28*t23
     t45 = t22*t28 - t10*t39
     t46 = t12*t38 + t25*t27
-    t47 = t40*s1
-    t48 = -t32*c2 + s2*t47
-    t49 = t40*c1
-    t50 = t29*c2 - s2*t49
+    t47 = s1*t40
+    t48 = -c2*t32 + s2*t47
+    t49 = c1*t40
+    t50 = c2*t29 - s2*t49
     t51 = -t47
     t52 = -t50
     t53 = -t45
     t54 = -t46
-    t55 = t34*c1
-    t56 = t35*c1
-    t57 = t36*c1
-    t58 = -t37*c1
-    t59 = t34*s1
-    t60 = t35*s1
-    t61 = t36*s1
-    t62 = -t37*s1
+    t55 = c1*t34
+    t56 = c1*t35
+    t57 = c1*t36
+    t58 = -c1*t37
+    t59 = s1*t34
+    t60 = s1*t35
+    t61 = s1*t36
+    t62 = -s1*t37
     t63 = c1**2
     t64 = s1**2
-    t65 = -(t48*c1 + t50*s1)
-    t66 = t44*s1 - t41*c1
-    t67 = -(t42*c1 + t45*s1)
-    t68 = -(t43*c1 + t46*s1)
-    t69 = t44*c2 + t35*t14
-    t70 = -t45*c2 + t36*t14
-    t71 = -(t46*c2 + t37*t14)
-    t72 = t41*c2 - t35*t8
-    t73 = t42*c2 - t36*t8
-    t74 = t43*c2 + t37*t8
-    t75 = -(t41*t14 + t44*t8)
-    t76 = t45*t8 - t42*t14
-    t77 = t46*t8 - t43*t14
+    t65 = -(c1*t48 + s1*t50)
+    t66 = s1*t44 - c1*t41
+    t67 = -(c1*t42 + s1*t45)
+    t68 = -(c1*t43 + s1*t46)
+    t69 = c2*t44 + t14*t35
+    t70 = -c2*t45 + t14*t36
+    t71 = -(c2*t46 + t14*t37)
+    t72 = c2*t41 - t8*t35
+    t73 = c2*t42 - t8*t36
+    t74 = c2*t43 + t8*t37
+    t75 = -(t14*t41 + t8*t44)
+    t76 = t8*t45 - t14*t42
+    t77 = t8*t46 - t14*t43
     t78 = s2**2
-    t79 = -t36*t3 + t45*t23
-    t80 = t37*t3 + t46*t23
-    t81 = -(t36*t6 + t42*t23)
-    t82 = t37*t6 - t43*t23
-    t83 = t42*t3 + t45*t6
-    t84 = t43*t3 + t46*t6
+    t79 = -t3*t36 + t23*t45
+    t80 = t3*t37 + t23*t46
+    t81 = -(t6*t36 + t23*t42)
+    t82 = t6*t37 - t23*t43
+    t83 = t3*t42 + t6*t45
+    t84 = t3*t43 + t6*t46
     t85 = -(t16*t37 + t22*t46)
     t86 = t10*t37 + t22*t43
     t87 = t10*t46 - t16*t43
@@ -1589,21 +1589,21 @@ def hessian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5, 6
         t51,  # 1, 0, 0
-        -t33*c1,  # 1, 0, 1
+        -c1*t33,  # 1, 0, 1
         t55,  # 1, 0, 2
         t56,  # 1, 0, 3
         t57,  # 1, 0, 4
         t58,  # 1, 0, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 0, 6
         t49,  # 1, 1, 0
-        -t33*s1,  # 1, 1, 1
+        -s1*t33,  # 1, 1, 1
         t59,  # 1, 1, 2
         t60,  # 1, 1, 3
         t61,  # 1, 1, 4
         t62,  # 1, 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 1, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 2, 0
-        -(t40*t63 + t40*t64),  # 1, 2, 1
+        -(t63*t40 + t64*t40),  # 1, 2, 1
         t65,  # 1, 2, 2
         t66,  # 1, 2, 3
         t67,  # 1, 2, 4
@@ -1613,40 +1613,40 @@ def hessian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 3, 1
         c1*c2,  # 1, 3, 2
         -s2*t5,  # 1, 3, 3
-        t22*c1,  # 1, 3, 4
-        t25*c1,  # 1, 3, 5
-        t26*c1,  # 1, 3, 6
+        c1*t22,  # 1, 3, 4
+        c1*t25,  # 1, 3, 5
+        c1*t26,  # 1, 3, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 4, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 4, 1
-        c2*s1,  # 1, 4, 2
+        s1*c2,  # 1, 4, 2
         -s2*t0,  # 1, 4, 3
-        t22*s1,  # 1, 4, 4
-        t25*s1,  # 1, 4, 5
-        t26*s1,  # 1, 4, 6
+        s1*t22,  # 1, 4, 4
+        s1*t25,  # 1, 4, 5
+        s1*t26,  # 1, 4, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5, 1
-        -(s2*t63 + s2*t64),  # 1, 5, 2
-        t3*s1 - t6*c1,  # 1, 5, 3
-        -(t10*c1 + t16*s1),  # 1, 5, 4
-        t12*c1 - t18*s1,  # 1, 5, 5
-        -(t13*c1 + t19*s1),  # 1, 5, 6
+        -(t63*s2 + t64*s2),  # 1, 5, 2
+        s1*t3 - c1*t6,  # 1, 5, 3
+        -(c1*t10 + s1*t16),  # 1, 5, 4
+        c1*t12 - s1*t18,  # 1, 5, 5
+        -(c1*t13 + s1*t19),  # 1, 5, 6
         t52,  # 2, 0, 0
         t55,  # 2, 0, 1
-        -t50*c2 + t34*t14,  # 2, 0, 2
+        -c2*t50 + t14*t34,  # 2, 0, 2
         t69,  # 2, 0, 3
         t70,  # 2, 0, 4
         t71,  # 2, 0, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0, 6
         t48,  # 2, 1, 0
         t59,  # 2, 1, 1
-        t48*c2 - t34*t8,  # 2, 1, 2
+        c2*t48 - t8*t34,  # 2, 1, 2
         t72,  # 2, 1, 3
         t73,  # 2, 1, 4
         t74,  # 2, 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 1, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 2, 0
         t65,  # 2, 2, 1
-        t50*t8 - t48*t14,  # 2, 2, 2
+        t8*t50 - t14*t48,  # 2, 2, 2
         t75,  # 2, 2, 3
         t76,  # 2, 2, 4
         t77,  # 2, 2, 5
@@ -1654,17 +1654,17 @@ def hessian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 3, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 3, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 3, 2
-        t3*c2 - t78*t0,  # 2, 3, 3
-        -t16*c2 + t22*t14,  # 2, 3, 4
-        -t18*c2 + t25*t14,  # 2, 3, 5
-        -t19*c2 + t26*t14,  # 2, 3, 6
+        c2*t3 - t0*t78,  # 2, 3, 3
+        -c2*t16 + t22*t14,  # 2, 3, 4
+        -c2*t18 + t25*t14,  # 2, 3, 5
+        -c2*t19 + t26*t14,  # 2, 3, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 4, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 4, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 4, 2
-        t6*c2 + t78*t5,  # 2, 4, 3
-        t10*c2 - t22*t8,  # 2, 4, 4
-        -(t12*c2 + t25*t8),  # 2, 4, 5
-        t13*c2 - t26*t8,  # 2, 4, 6
+        c2*t6 + t5*t78,  # 2, 4, 3
+        c2*t10 - t22*t8,  # 2, 4, 4
+        -(c2*t12 + t25*t8),  # 2, 4, 5
+        c2*t13 - t26*t8,  # 2, 4, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 5, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 5, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 5, 2
@@ -1675,21 +1675,21 @@ def hessian(q):
         t44,  # 3, 0, 0
         t56,  # 3, 0, 1
         t69,  # 3, 0, 2
-        -(t35*t3 + t44*t23),  # 3, 0, 3
+        -(t3*t35 + t23*t44),  # 3, 0, 3
         t79,  # 3, 0, 4
         t80,  # 3, 0, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0, 6
         t41,  # 3, 1, 0
         t60,  # 3, 1, 1
         t72,  # 3, 1, 2
-        -(t35*t6 + t41*t23),  # 3, 1, 3
+        -(t6*t35 + t23*t41),  # 3, 1, 3
         t81,  # 3, 1, 4
         t82,  # 3, 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 1, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 2, 0
         t66,  # 3, 2, 1
         t75,  # 3, 2, 2
-        t41*t3 - t44*t6,  # 3, 2, 3
+        t3*t41 - t6*t44,  # 3, 2, 3
         t83,  # 3, 2, 4
         t84,  # 3, 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 2, 6
@@ -1697,23 +1697,23 @@ def hessian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 3, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 3, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 3, 3
-        -t22*t3 + t16*t23,  # 3, 3, 4
-        -t25*t3 + t18*t23,  # 3, 3, 5
-        -t26*t3 + t19*t23,  # 3, 3, 6
+        -t3*t22 + t16*t23,  # 3, 3, 4
+        -t3*t25 + t18*t23,  # 3, 3, 5
+        -t3*t26 + t19*t23,  # 3, 3, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 4, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 4, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 4, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 4, 3
-        -(t22*t6 + t10*t23),  # 3, 4, 4
-        -t25*t6 + t12*t23,  # 3, 4, 5
-        -(t26*t6 + t13*t23),  # 3, 4, 6
+        -(t6*t22 + t10*t23),  # 3, 4, 4
+        -t6*t25 + t12*t23,  # 3, 4, 5
+        -(t6*t26 + t13*t23),  # 3, 4, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 5, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 5, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 5, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 5, 3
-        t10*t3 + t16*t6,  # 3, 5, 4
-        t18*t6 - t12*t3,  # 3, 5, 5
-        t13*t3 + t19*t6,  # 3, 5, 6
+        t3*t10 + t6*t16,  # 3, 5, 4
+        t6*t18 - t3*t12,  # 3, 5, 5
+        t3*t13 + t6*t19,  # 3, 5, 6
         t53,  # 4, 0, 0
         t57,  # 4, 0, 1
         t70,  # 4, 0, 2
@@ -1864,163 +1864,163 @@ def singularity_factors(q):
     t1 = c1*c3
     t2 = -t0 + c2*t1
     t3 = t1 - c2*t0
-    t4 = c3*s1
-    t5 = c1*s3
+    t4 = s1*c3
+    t5 = s3*c1
     t6 = t4 + c2*t5
     t7 = t5 + c2*t4
     t8 = c1*s2
     t9 = t2*c4 + s4*t8
     t10 = -t2*s4 + c4*t8
     t11 = t9*c5 - t6*s5
-    t12 = t9*s5 + t6*c5
+    t12 = t9*s5 + c5*t6
     t13 = t10*c6 + t11*s6
     t14 = s1*s2
-    t15 = t7*c4 + s4*t14
-    t16 = -t7*s4 + c4*t14
-    t17 = t15*c5 + t3*s5
-    t18 = t3*c5 - t15*s5
-    t19 = t16*c6 + t17*s6
+    t15 = c4*t7 + s4*t14
+    t16 = -s4*t7 + c4*t14
+    t17 = c5*t15 + s5*t3
+    t18 = c5*t3 - s5*t15
+    t19 = t16*c6 + s6*t17
     t20 = c3*s2
     t21 = c2*s4 - c4*t20
     t22 = c2*c4 + s4*t20
     t23 = s3*s2
-    t24 = t21*c5 + s5*t23
-    t25 = -t21*s5 + c5*t23
-    t26 = t22*c6 + t24*s6
+    t24 = c5*t21 + s5*t23
+    t25 = -s5*t21 + c5*t23
+    t26 = t22*c6 + s6*t24
     t27 = 0.126*t13
     t28 = 0.4*t10 + t27
-    t29 = t28 + 0.42*t8
+    t29 = 0.42*t8 + t28
     t30 = 0.126*t19
     t31 = 0.4*t16 + t30
-    t32 = t31 + 0.42*t14
-    t33 = t29*c1 + t32*s1
+    t32 = 0.42*t14 + t31
+    t33 = c1*t29 + s1*t32
     t34 = t32*t8 - t29*t14
-    t35 = t28*t3 + t31*t6
+    t35 = t3*t28 + t6*t31
     t36 = t10*t31 - t16*t28
     t37 = t12*t30 + t18*t27
     t38 = 0.126*t26
     t39 = 0.4*t22 + t38
-    t40 = t39 + 0.42*c2
-    t41 = -t32*c2 + t40*t14
-    t42 = -t39*t3 + t31*t23
+    t40 = 0.42*c2 + t39
+    t41 = -c2*t32 + t40*t14
+    t42 = -t3*t39 + t31*t23
     t43 = t16*t39 - t22*t31
     t44 = -t25*t30 + t18*t38
-    t45 = t29*c2 - t40*t8
-    t46 = t39*t6 + t28*t23
+    t45 = c2*t29 - t40*t8
+    t46 = t6*t39 + t28*t23
     t47 = t22*t28 - t10*t39
     t48 = t12*t38 + t25*t27
-    t49 = -t16*c2 + t22*t14
-    t50 = t10*c1
+    t49 = -c2*t16 + t22*t14
+    t50 = c1*t10
     t51 = c1**2
-    t52 = s2*t51
+    t52 = t51*s2
     t53 = -(s1*t49 - c2*t50 + t22*t52)
     t54 = s2**2
-    t55 = t3*c2 - t54*t0
-    t56 = -t22*t3 + t16*t23
-    t57 = t10*t55 - t6*t49 + t56*t8
-    t58 = t6*c1
+    t55 = c2*t3 - t0*t54
+    t56 = -t3*t22 + t16*t23
+    t57 = t10*t55 - t6*t49 + t8*t56
+    t58 = c1*t6
     t59 = s2*t5
     t60 = -(s1*t56 + t22*t58 + t10*t59)
     t61 = -s1*t55 + c2*t58 + s3*t51*t54
-    t62 = -(-t35*t53 + t33*t57 + t34*t60 + t36*t61)
-    t63 = -t25*t3 + t18*t23
+    t62 = -(-t53*t35 + t33*t57 + t34*t60 + t36*t61)
+    t63 = -t3*t25 + t18*t23
     t64 = -(s1*t63 + t25*t58 - t12*t59)
     t65 = t16*t25 - t22*t18
     t66 = -(-t6*t65 + t10*t63 + t12*t56)
-    t67 = t12*c1
+    t67 = c1*t12
     t68 = -(s1*t65 + t25*t50 + t22*t67)
     t69 = t36*t64 + t37*t60 - t33*t66 - t35*t68
-    t70 = -t18*c2 + t25*t14
+    t70 = -c2*t18 + t25*t14
     t71 = -(s1*t70 + c2*t67 + t25*t52)
-    t72 = -(t10*t70 + t12*t49 - t65*t8)
+    t72 = -(t10*t70 + t12*t49 - t8*t65)
     t73 = t36*t71 + t37*t53 - t33*t72 - t34*t68
-    t74 = -(t12*t55 + t6*t70 - t63*t8)
+    t74 = -(t12*t55 + t6*t70 - t8*t63)
     t75 = t35*t71 + t37*t61 - t33*t74 - t34*t64
     t76 = t34*t66 + t36*t74 + t37*t57 - t35*t72
     t77 = s1*t40
     t78 = t10*t18 + t16*t12
-    t79 = t67 - t18*s1
-    t80 = -(t50 + t16*s1)
+    t79 = t67 - s1*t18
+    t80 = -(t50 + s1*t16)
     t81 = t33*t78 + t36*t79 + t37*t80
     t82 = t16*t8 - t10*t14
-    t83 = -(t52 + s2*s1**2)
+    t83 = -(t52 + s1**2*s2)
     t84 = t33*t82 + t34*t80 - t36*t83
     t85 = t12*t14 + t18*t8
     t86 = t33*t85 + t34*t79 + t37*t83
     t87 = t36*t85 + t37*t82 - t34*t78
-    t88 = t10*t3 + t16*t6
-    t89 = t3*s1 - t58
+    t88 = t3*t10 + t6*t16
+    t89 = s1*t3 - t58
     t90 = t33*t88 + t35*t80 - t36*t89
     t91 = -(t6*t14 + t3*t8)
     t92 = t33*t91 + t34*t89 - t35*t83
     t93 = -(-t35*t82 + t34*t88 + t36*t91)
-    t94 = t18*t6 - t12*t3
+    t94 = t6*t18 - t3*t12
     t95 = t33*t94 + t35*t79 + t37*t89
     t96 = t36*t94 + t37*t88 - t35*t78
     t97 = t35*t85 + t37*t91 - t34*t94
     t98 = c1*t40
-    t99 = -t32*(-t48*t62 + t45*t69 + t46*t73 + t47*t75 - t76*t77) + t42*(t29*t73 + t45*t81 + t48*t84 - t47*t86 - t87*t77) + t44*(t29*t62 + t45*t90 + t46*t84 + t47*t92 - t93*t77) + t41*(-t29*t69 - t48*t90 + t46*t81 + t47*t95 + t96*t77) - t43*(t29*t75 + t45*t95 + t46*t86 + t48*t92 - t97*t77) - (-t29*t76 - t48*t93 + t45*t96 + t46*t87 + t47*t97)*t98
-    t100 = -t26*t3 + t19*t23
+    t99 = -t32*(-t62*t48 + t45*t69 + t46*t73 + t47*t75 - t76*t77) + t42*(t29*t73 + t45*t81 + t48*t84 - t47*t86 - t77*t87) + t44*(t29*t62 + t45*t90 + t46*t84 + t47*t92 - t77*t93) + t41*(-t29*t69 - t48*t90 + t46*t81 + t47*t95 + t77*t96) - t43*(t29*t75 + t45*t95 + t46*t86 + t48*t92 - t77*t97) - t98*(-t29*t76 - t48*t93 + t45*t96 + t46*t87 + t47*t97)
+    t100 = -t3*t26 + t19*t23
     t101 = -(s1*t100 + t26*t58 + t13*t59)
     t102 = t16*t26 - t22*t19
     t103 = t13*t56 + t6*t102 - t10*t100
-    t104 = t13*c1
+    t104 = c1*t13
     t105 = -(s1*t102 - t22*t104 + t26*t50)
     t106 = -(-t36*t101 + t33*t103 + t35*t105)
-    t107 = -t19*c2 + t26*t14
+    t107 = -c2*t19 + t26*t14
     t108 = -(s1*t107 - c2*t104 + t26*t52)
-    t109 = t13*t49 - t10*t107 + t102*t8
+    t109 = t13*t49 - t10*t107 + t8*t102
     t110 = -(-t36*t108 + t33*t109 + t34*t105)
-    t111 = t13*t55 - t6*t107 + t100*t8
+    t111 = t13*t55 - t6*t107 + t8*t100
     t112 = -(-t35*t108 + t33*t111 + t34*t101)
     t113 = t34*t103 + t36*t111 - t35*t109
-    t114 = -(t45*t106 + t46*t110 + t47*t112 - t113*t77)
+    t114 = -(t45*t106 + t46*t110 + t47*t112 - t77*t113)
     t115 = t10*t19 - t16*t13
-    t116 = -(t104 + t19*s1)
+    t116 = -(t104 + s1*t19)
     t117 = t33*t115 + t36*t116
     t118 = t19*t8 - t13*t14
     t119 = t33*t118 + t34*t116
     t120 = t36*t118 - t34*t115
-    t121 = t29*t110 + t45*t117 - t47*t119 - t120*t77
-    t122 = t13*t3 + t19*t6
+    t121 = t29*t110 + t45*t117 - t47*t119 - t77*t120
+    t122 = t3*t13 + t6*t19
     t123 = t33*t122 + t35*t116
     t124 = t36*t122 - t35*t115
-    t125 = -(-t29*t106 + t46*t117 + t47*t123 + t124*t77)
+    t125 = -(-t29*t106 + t46*t117 + t47*t123 + t77*t124)
     t126 = t35*t118 - t34*t122
-    t127 = t29*t112 + t45*t123 + t46*t119 - t126*t77
+    t127 = t29*t112 + t45*t123 + t46*t119 - t77*t126
     t128 = -(-t29*t113 + t45*t124 + t46*t120 + t47*t126)
-    t129 = t32*t114 + t42*t121 - t41*t125 - t43*t127 + t128*t98
+    t129 = t32*t114 + t42*t121 - t41*t125 - t43*t127 + t98*t128
     t130 = t18*t26 - t25*t19
     t131 = t12*t100 + t13*t63 + t6*t130
     t132 = -s1*t130 + t26*t67 + t25*t104
     t133 = -(t33*t131 + t35*t132 + t37*t101)
-    t134 = t12*t107 + t13*t70 + t130*t8
+    t134 = t12*t107 + t13*t70 + t8*t130
     t135 = -(t33*t134 + t34*t132 + t37*t108)
     t136 = -(-t34*t131 + t35*t134 + t37*t111)
-    t137 = -(t45*t133 + t46*t135 + t48*t112 - t136*t77)
+    t137 = -(t45*t133 + t46*t135 + t48*t112 - t77*t136)
     t138 = -(t12*t19 + t18*t13)
     t139 = t33*t138 - t37*t116
     t140 = -(t34*t138 + t37*t118)
-    t141 = t29*t135 + t45*t139 - t48*t119 - t140*t77
+    t141 = t29*t135 + t45*t139 - t48*t119 - t77*t140
     t142 = -(t35*t138 + t37*t122)
-    t143 = -(-t29*t133 + t46*t139 + t48*t123 + t142*t77)
+    t143 = -(-t29*t133 + t46*t139 + t48*t123 + t77*t142)
     t144 = -(-t29*t136 + t45*t142 + t46*t140 + t48*t126)
-    t145 = t32*t137 + t42*t141 - t41*t143 - t44*t127 + t144*t98
+    t145 = t32*t137 + t42*t141 - t41*t143 - t44*t127 + t98*t144
     t146 = t10*t130 + t12*t102 + t13*t65
     t147 = -(t33*t146 + t36*t132 + t37*t105)
     t148 = -(-t34*t146 + t36*t134 + t37*t109)
-    t149 = t47*t135 - t45*t147 - t48*t110 + t148*t77
+    t149 = t47*t135 - t45*t147 - t48*t110 + t77*t148
     t150 = -(t36*t138 + t37*t115)
-    t151 = t29*t147 + t47*t139 - t48*t117 - t150*t77
+    t151 = t29*t147 + t47*t139 - t48*t117 - t77*t150
     t152 = t29*t148 + t47*t140 - t45*t150 - t48*t120
-    t153 = t32*t149 + t43*t141 - t41*t151 - t44*t121 + t152*t98
+    t153 = t32*t149 + t43*t141 - t41*t151 - t44*t121 + t98*t152
     t154 = -(-t35*t146 + t36*t131 + t37*t103)
-    t155 = t46*t147 + t47*t133 - t48*t106 + t154*t77
+    t155 = t46*t147 + t47*t133 - t48*t106 + t77*t154
     t156 = t29*t154 + t46*t150 + t47*t142 - t48*t124
-    t157 = t32*t155 + t43*t143 - t42*t151 - t44*t125 + t156*t98
+    t157 = t32*t155 + t43*t143 - t42*t151 - t44*t125 + t98*t156
     t158 = t45*t154 + t46*t148 + t47*t136 - t48*t113
     t159 = t32*t158 + t41*t156 + t43*t144 - t42*t152 - t44*t128
-    t160 = t42*t149 + t44*t114 - t41*t155 - t43*t137 + t158*t98
+    t160 = t42*t149 + t44*t114 - t41*t155 - t43*t137 + t98*t158
     f = _stack(xp, [
         s4,  # 0
         t99**2 + t129**2 + t145**2 + t153**2 + t157**2 + t159**2 + t160**2,  # 1
@@ -2048,163 +2048,163 @@ def manipulability(q):
     t1 = c1*c3
     t2 = -t0 + c2*t1
     t3 = t1 - c2*t0
-    t4 = c3*s1
-    t5 = c1*s3
+    t4 = s1*c3
+    t5 = s3*c1
     t6 = t4 + c2*t5
     t7 = t5 + c2*t4
     t8 = c1*s2
     t9 = t2*c4 + s4*t8
     t10 = -t2*s4 + c4*t8
     t11 = t9*c5 - t6*s5
-    t12 = t9*s5 + t6*c5
+    t12 = t9*s5 + c5*t6
     t13 = t10*c6 + t11*s6
     t14 = s1*s2
-    t15 = t7*c4 + s4*t14
-    t16 = -t7*s4 + c4*t14
-    t17 = t15*c5 + t3*s5
-    t18 = t3*c5 - t15*s5
-    t19 = t16*c6 + t17*s6
+    t15 = c4*t7 + s4*t14
+    t16 = -s4*t7 + c4*t14
+    t17 = c5*t15 + s5*t3
+    t18 = c5*t3 - s5*t15
+    t19 = t16*c6 + s6*t17
     t20 = c3*s2
     t21 = c2*s4 - c4*t20
     t22 = c2*c4 + s4*t20
     t23 = s3*s2
-    t24 = t21*c5 + s5*t23
-    t25 = -t21*s5 + c5*t23
-    t26 = t22*c6 + t24*s6
+    t24 = c5*t21 + s5*t23
+    t25 = -s5*t21 + c5*t23
+    t26 = t22*c6 + s6*t24
     t27 = 0.126*t13
     t28 = 0.4*t10 + t27
-    t29 = t28 + 0.42*t8
+    t29 = 0.42*t8 + t28
     t30 = 0.126*t19
     t31 = 0.4*t16 + t30
-    t32 = t31 + 0.42*t14
-    t33 = t29*c1 + t32*s1
+    t32 = 0.42*t14 + t31
+    t33 = c1*t29 + s1*t32
     t34 = t32*t8 - t29*t14
-    t35 = t28*t3 + t31*t6
+    t35 = t3*t28 + t6*t31
     t36 = t10*t31 - t16*t28
     t37 = t12*t30 + t18*t27
     t38 = 0.126*t26
     t39 = 0.4*t22 + t38
-    t40 = t39 + 0.42*c2
-    t41 = -t32*c2 + t40*t14
-    t42 = -t39*t3 + t31*t23
+    t40 = 0.42*c2 + t39
+    t41 = -c2*t32 + t40*t14
+    t42 = -t3*t39 + t31*t23
     t43 = t16*t39 - t22*t31
     t44 = -t25*t30 + t18*t38
-    t45 = t29*c2 - t40*t8
-    t46 = t39*t6 + t28*t23
+    t45 = c2*t29 - t40*t8
+    t46 = t6*t39 + t28*t23
     t47 = t22*t28 - t10*t39
     t48 = t12*t38 + t25*t27
-    t49 = -t16*c2 + t22*t14
-    t50 = t10*c1
+    t49 = -c2*t16 + t22*t14
+    t50 = c1*t10
     t51 = c1**2
-    t52 = s2*t51
+    t52 = t51*s2
     t53 = -(s1*t49 - c2*t50 + t22*t52)
     t54 = s2**2
-    t55 = t3*c2 - t54*t0
-    t56 = -t22*t3 + t16*t23
-    t57 = t10*t55 - t6*t49 + t56*t8
-    t58 = t6*c1
+    t55 = c2*t3 - t0*t54
+    t56 = -t3*t22 + t16*t23
+    t57 = t10*t55 - t6*t49 + t8*t56
+    t58 = c1*t6
     t59 = s2*t5
     t60 = -(s1*t56 + t22*t58 + t10*t59)
     t61 = -s1*t55 + c2*t58 + s3*t51*t54
-    t62 = -(-t35*t53 + t33*t57 + t34*t60 + t36*t61)
-    t63 = -t25*t3 + t18*t23
+    t62 = -(-t53*t35 + t33*t57 + t34*t60 + t36*t61)
+    t63 = -t3*t25 + t18*t23
     t64 = -(s1*t63 + t25*t58 - t12*t59)
     t65 = t16*t25 - t22*t18
     t66 = -(-t6*t65 + t10*t63 + t12*t56)
-    t67 = t12*c1
+    t67 = c1*t12
     t68 = -(s1*t65 + t25*t50 + t22*t67)
     t69 = t36*t64 + t37*t60 - t33*t66 - t35*t68
-    t70 = -t18*c2 + t25*t14
+    t70 = -c2*t18 + t25*t14
     t71 = -(s1*t70 + c2*t67 + t25*t52)
-    t72 = -(t10*t70 + t12*t49 - t65*t8)
+    t72 = -(t10*t70 + t12*t49 - t8*t65)
     t73 = t36*t71 + t37*t53 - t33*t72 - t34*t68
-    t74 = -(t12*t55 + t6*t70 - t63*t8)
+    t74 = -(t12*t55 + t6*t70 - t8*t63)
     t75 = t35*t71 + t37*t61 - t33*t74 - t34*t64
     t76 = t34*t66 + t36*t74 + t37*t57 - t35*t72
     t77 = s1*t40
     t78 = t10*t18 + t16*t12
-    t79 = t67 - t18*s1
-    t80 = -(t50 + t16*s1)
+    t79 = t67 - s1*t18
+    t80 = -(t50 + s1*t16)
     t81 = t33*t78 + t36*t79 + t37*t80
     t82 = t16*t8 - t10*t14
-    t83 = -(t52 + s2*s1**2)
+    t83 = -(t52 + s1**2*s2)
     t84 = t33*t82 + t34*t80 - t36*t83
     t85 = t12*t14 + t18*t8
     t86 = t33*t85 + t34*t79 + t37*t83
     t87 = t36*t85 + t37*t82 - t34*t78
-    t88 = t10*t3 + t16*t6
-    t89 = t3*s1 - t58
+    t88 = t3*t10 + t6*t16
+    t89 = s1*t3 - t58
     t90 = t33*t88 + t35*t80 - t36*t89
     t91 = -(t6*t14 + t3*t8)
     t92 = t33*t91 + t34*t89 - t35*t83
     t93 = -(-t35*t82 + t34*t88 + t36*t91)
-    t94 = t18*t6 - t12*t3
+    t94 = t6*t18 - t3*t12
     t95 = t33*t94 + t35*t79 + t37*t89
     t96 = t36*t94 + t37*t88 - t35*t78
     t97 = t35*t85 + t37*t91 - t34*t94
     t98 = c1*t40
-    t99 = -t32*(-t48*t62 + t45*t69 + t46*t73 + t47*t75 - t76*t77) + t42*(t29*t73 + t45*t81 + t48*t84 - t47*t86 - t87*t77) + t44*(t29*t62 + t45*t90 + t46*t84 + t47*t92 - t93*t77) + t41*(-t29*t69 - t48*t90 + t46*t81 + t47*t95 + t96*t77) - t43*(t29*t75 + t45*t95 + t46*t86 + t48*t92 - t97*t77) - (-t29*t76 - t48*t93 + t45*t96 + t46*t87 + t47*t97)*t98
-    t100 = -t26*t3 + t19*t23
+    t99 = -t32*(-t62*t48 + t45*t69 + t46*t73 + t47*t75 - t76*t77) + t42*(t29*t73 + t45*t81 + t48*t84 - t47*t86 - t77*t87) + t44*(t29*t62 + t45*t90 + t46*t84 + t47*t92 - t77*t93) + t41*(-t29*t69 - t48*t90 + t46*t81 + t47*t95 + t77*t96) - t43*(t29*t75 + t45*t95 + t46*t86 + t48*t92 - t77*t97) - t98*(-t29*t76 - t48*t93 + t45*t96 + t46*t87 + t47*t97)
+    t100 = -t3*t26 + t19*t23
     t101 = -(s1*t100 + t26*t58 + t13*t59)
     t102 = t16*t26 - t22*t19
     t103 = t13*t56 + t6*t102 - t10*t100
-    t104 = t13*c1
+    t104 = c1*t13
     t105 = -(s1*t102 - t22*t104 + t26*t50)
     t106 = -(-t36*t101 + t33*t103 + t35*t105)
-    t107 = -t19*c2 + t26*t14
+    t107 = -c2*t19 + t26*t14
     t108 = -(s1*t107 - c2*t104 + t26*t52)
-    t109 = t13*t49 - t10*t107 + t102*t8
+    t109 = t13*t49 - t10*t107 + t8*t102
     t110 = -(-t36*t108 + t33*t109 + t34*t105)
-    t111 = t13*t55 - t6*t107 + t100*t8
+    t111 = t13*t55 - t6*t107 + t8*t100
     t112 = -(-t35*t108 + t33*t111 + t34*t101)
     t113 = t34*t103 + t36*t111 - t35*t109
-    t114 = -(t45*t106 + t46*t110 + t47*t112 - t113*t77)
+    t114 = -(t45*t106 + t46*t110 + t47*t112 - t77*t113)
     t115 = t10*t19 - t16*t13
-    t116 = -(t104 + t19*s1)
+    t116 = -(t104 + s1*t19)
     t117 = t33*t115 + t36*t116
     t118 = t19*t8 - t13*t14
     t119 = t33*t118 + t34*t116
     t120 = t36*t118 - t34*t115
-    t121 = t29*t110 + t45*t117 - t47*t119 - t120*t77
-    t122 = t13*t3 + t19*t6
+    t121 = t29*t110 + t45*t117 - t47*t119 - t77*t120
+    t122 = t3*t13 + t6*t19
     t123 = t33*t122 + t35*t116
     t124 = t36*t122 - t35*t115
-    t125 = -(-t29*t106 + t46*t117 + t47*t123 + t124*t77)
+    t125 = -(-t29*t106 + t46*t117 + t47*t123 + t77*t124)
     t126 = t35*t118 - t34*t122
-    t127 = t29*t112 + t45*t123 + t46*t119 - t126*t77
+    t127 = t29*t112 + t45*t123 + t46*t119 - t77*t126
     t128 = -(-t29*t113 + t45*t124 + t46*t120 + t47*t126)
-    t129 = t32*t114 + t42*t121 - t41*t125 - t43*t127 + t128*t98
+    t129 = t32*t114 + t42*t121 - t41*t125 - t43*t127 + t98*t128
     t130 = t18*t26 - t25*t19
     t131 = t12*t100 + t13*t63 + t6*t130
     t132 = -s1*t130 + t26*t67 + t25*t104
     t133 = -(t33*t131 + t35*t132 + t37*t101)
-    t134 = t12*t107 + t13*t70 + t130*t8
+    t134 = t12*t107 + t13*t70 + t8*t130
     t135 = -(t33*t134 + t34*t132 + t37*t108)
     t136 = -(-t34*t131 + t35*t134 + t37*t111)
-    t137 = -(t45*t133 + t46*t135 + t48*t112 - t136*t77)
+    t137 = -(t45*t133 + t46*t135 + t48*t112 - t77*t136)
     t138 = -(t12*t19 + t18*t13)
     t139 = t33*t138 - t37*t116
     t140 = -(t34*t138 + t37*t118)
-    t141 = t29*t135 + t45*t139 - t48*t119 - t140*t77
+    t141 = t29*t135 + t45*t139 - t48*t119 - t77*t140
     t142 = -(t35*t138 + t37*t122)
-    t143 = -(-t29*t133 + t46*t139 + t48*t123 + t142*t77)
+    t143 = -(-t29*t133 + t46*t139 + t48*t123 + t77*t142)
     t144 = -(-t29*t136 + t45*t142 + t46*t140 + t48*t126)
-    t145 = t32*t137 + t42*t141 - t41*t143 - t44*t127 + t144*t98
+    t145 = t32*t137 + t42*t141 - t41*t143 - t44*t127 + t98*t144
     t146 = t10*t130 + t12*t102 + t13*t65
     t147 = -(t33*t146 + t36*t132 + t37*t105)
     t148 = -(-t34*t146 + t36*t134 + t37*t109)
-    t149 = t47*t135 - t45*t147 - t48*t110 + t148*t77
+    t149 = t47*t135 - t45*t147 - t48*t110 + t77*t148
     t150 = -(t36*t138 + t37*t115)
-    t151 = t29*t147 + t47*t139 - t48*t117 - t150*t77
+    t151 = t29*t147 + t47*t139 - t48*t117 - t77*t150
     t152 = t29*t148 + t47*t140 - t45*t150 - t48*t120
-    t153 = t32*t149 + t43*t141 - t41*t151 - t44*t121 + t152*t98
+    t153 = t32*t149 + t43*t141 - t41*t151 - t44*t121 + t98*t152
     t154 = -(-t35*t146 + t36*t131 + t37*t103)
-    t155 = t46*t147 + t47*t133 - t48*t106 + t154*t77
+    t155 = t46*t147 + t47*t133 - t48*t106 + t77*t154
     t156 = t29*t154 + t46*t150 + t47*t142 - t48*t124
-    t157 = t32*t155 + t43*t143 - t42*t151 - t44*t125 + t156*t98
+    t157 = t32*t155 + t43*t143 - t42*t151 - t44*t125 + t98*t156
     t158 = t45*t154 + t46*t148 + t47*t136 - t48*t113
     t159 = t32*t158 + t41*t156 + t43*t144 - t42*t152 - t44*t128
-    t160 = t42*t149 + t44*t114 - t41*t155 - t43*t137 + t158*t98
+    t160 = t42*t149 + t44*t114 - t41*t155 - t43*t137 + t98*t158
     t161 = t99**2 + t129**2 + t145**2 + t153**2 + t157**2 + t159**2 + t160**2
     w = xp.broadcast_to(xp.sqrt(xp.abs(t161)), batch)
     return w
@@ -2244,260 +2244,260 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t1 = c1*c3
     t2 = -t0 + c2*t1
     t3 = t1 - c2*t0
-    t4 = c3*s1
-    t5 = c1*s3
+    t4 = s1*c3
+    t5 = s3*c1
     t6 = t4 + c2*t5
     t7 = t5 + c2*t4
     t8 = c1*s2
     t9 = t2*c4 + s4*t8
     t10 = -t2*s4 + c4*t8
     t11 = t9*c5 - t6*s5
-    t12 = t9*s5 + t6*c5
+    t12 = t9*s5 + c5*t6
     t13 = t10*c6 + t11*s6
     t14 = s1*s2
-    t15 = t7*c4 + s4*t14
-    t16 = -t7*s4 + c4*t14
-    t17 = t15*c5 + t3*s5
-    t18 = t3*c5 - t15*s5
-    t19 = t16*c6 + t17*s6
+    t15 = c4*t7 + s4*t14
+    t16 = -s4*t7 + c4*t14
+    t17 = c5*t15 + s5*t3
+    t18 = c5*t3 - s5*t15
+    t19 = t16*c6 + s6*t17
     t20 = c3*s2
     t21 = c2*s4 - c4*t20
     t22 = c2*c4 + s4*t20
-    t23 = s2*s3
-    t24 = t21*c5 + s5*t23
-    t25 = -t21*s5 + c5*t23
-    t26 = t22*c6 + t24*s6
-    t27 = t10*t22 + t13*t26 - t12*t25 + c2*t8 - t6*t23
-    t28 = t16*t22 + t18*t25 + t19*t26 + t3*t23 + c2*t14
+    t23 = s3*s2
+    t24 = c5*t21 + s5*t23
+    t25 = -s5*t21 + c5*t23
+    t26 = t22*c6 + s6*t24
+    t27 = c2*t8 - t6*t23 + t10*t22 - t12*t25 + t13*t26
+    t28 = c2*t14 + t3*t23 + t16*t22 + t18*t25 + t19*t26
     t29 = 0.126*t13
     t30 = 0.4*t10 + t29
-    t31 = t30 + 0.42*t8
+    t31 = 0.42*t8 + t30
     t32 = 0.126*t19
     t33 = 0.4*t16 + t32
-    t34 = t33 + 0.42*t14
-    t35 = t31*c1 + t34*s1
+    t34 = 0.42*t14 + t33
+    t35 = c1*t31 + s1*t34
     t36 = t34*t8 - t31*t14
-    t37 = t30*t3 + t33*t6
+    t37 = t3*t30 + t6*t33
     t38 = t10*t33 - t16*t30
     t39 = t12*t32 + t18*t29
     t40 = t35**2 + t36**2 + t37**2 + t38**2 + t39**2
-    t41 = t22*t38 + t36*c2 - t25*t39 - t37*t23
+    t41 = c2*t36 - t23*t37 + t22*t38 - t25*t39
     t42 = 0.126*t26
     t43 = 0.4*t22 + t42
-    t44 = t43 + 0.42*c2
-    t45 = -t43*t3 + t33*t23
-    t46 = t16*t43 - t22*t33
-    t47 = -t25*t32 + t18*t42
-    t48 = t43*t6 + t30*t23
-    t49 = t22*t30 - t10*t43
-    t50 = t12*t42 + t25*t29
-    t51 = t44*s1
-    t52 = -t34*c2 + s2*t51
-    t53 = t44*c1
-    t54 = t31*c2 - s2*t53
-    t55 = t31 + t22*t49 + t25*t50 + t54*c2 + t48*t23
+    t44 = 0.42*c2 + t43
+    t45 = -c2*t34 + t44*t14
+    t46 = -t3*t43 + t33*t23
+    t47 = t16*t43 - t22*t33
+    t48 = -t25*t32 + t18*t42
+    t49 = c2*t31 - t44*t8
+    t50 = t6*t43 + t30*t23
+    t51 = t22*t30 - t10*t43
+    t52 = t12*t42 + t25*t29
+    t53 = t31 + c2*t49 + t23*t50 + t22*t51 + t25*t52
+    t54 = c1**2
+    t55 = t54*t44 + t14*t45 - t3*t46 + t16*t47 + t18*t48
     t56 = t44**2
-    t57 = c1**2
-    t58 = t34**2 + t52**2 + t45**2 + t46**2 + t47**2 + t56*t57
-    t59 = t16*t46 + t18*t47 + t44*t57 - t45*t3 + t52*t14
-    t60 = c1*s1
-    t61 = t52*t54 + t46*t49 + t47*t50 - t31*t34 - t45*t48 + t56*t60
-    t62 = -t34
-    t63 = t62 + t22*t46 + t25*t47 + t52*c2 - t45*t23
-    t64 = 1 + t10 + t16 + t22 + t18 + t25 + t13 + t19 + t26 + t31 + t52 + t45 + t46 + t47 + t54 + t49 + t50 + t36 + t37 + t38 + t6 + c1 + c2 + damping + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + q1 + q2 + q3 + q4 + q5 + q6 + q7 - t12 + t62 - t48 - t35 - t39 - t3 - s1 + t53 + t51 + t8 + t14 - t23
-    t65 = t35*c1
-    t66 = t52*t36 + t45*t37 + t46*t38 - t47*t39 - t44*t65
-    t67 = t18*t39 + t65 + t37*t3 - t16*t38 - t36*t14
-    t68 = t44*t60
-    t69 = t10*t46 + t45*t6 - t12*t47 + t52*t8 - t68
-    t70 = t16*t49 + t18*t50 + t48*t3 + t68 + t54*t14
-    t71 = s1**2
-    t72 = t31**2 + t54**2 + t48**2 + t49**2 + t50**2 + t56*t71
-    t73 = t12*t50 + t44*t71 + t48*t6 - t10*t49 - t54*t8
-    t74 = t35*s1
-    t75 = t48*t37 + t50*t39 - t54*t36 - t49*t38 + t44*t74
-    t76 = t10*t38 + t12*t39 + t74 + t37*t6 + t36*t8
-    t77 = s2**2
-    t78 = t10**2 + t12**2 + t13**2 + t6**2 + t71 + t57*t77
-    t79 = t10*t16 + t13*t19 - t12*t18 - t6*t3 - t60 + t77*t60
-    t80 = t16**2 + t18**2 + t19**2 + t3**2 + t57 + t71*t77
-    t81 = 1 + t22**2 + t25**2 + t26**2 + c2**2 + t77*s3**2
-    t82 = damping**2
-    t83 = t58 + t82
-    t84 = t83**2
-    t85 = t72 + t82
-    t86 = t40 + t82
-    t87 = t78 + t82
-    t88 = t80 + t82
-    t89 = t81 + t82
-    t90 = t61**2
-    t91 = t63**2
-    t92 = t66**2
-    t93 = t69**2
-    t94 = t59**2
-    t95 = xp.sqrt(t84 + t85**2 + t86**2 + t87**2 + t88**2 + t89**2 + 2*t90 + 2*t91 + 2*t92 + 2*t93 + 2*t94 + 2*t55**2 + 2*t75**2 + 2*t73**2 + 2*t70**2 + 2*t76**2 + 2*t67**2 + 2*t41**2 + 2*t79**2 + 2*t27**2 + 2*t28**2)
-    t96 = xp.sqrt(t90 + t91 + t92 + t93 + t94 + t84)
-    t97 = t96*xp.where(xp.greater_equal(t83, 0), xp.asarray(1, dtype=dtype), -1)
-    t98 = t97 + t83
-    t99 = xp.where(xp.greater(t96, 0), 1/(t96*(t96 + xp.abs(t83))), 0)
-    t100 = t99*(t61*t98 + t61*t85 + t63*t55 + t59*t70 - t66*t75 - t69*t73)
-    t101 = t61 - t98*t100
-    t102 = -t61*t100 + t85
-    t103 = t75 + t66*t100
-    t104 = t73 + t69*t100
-    t105 = t70 - t59*t100
-    t106 = t55 - t63*t100
-    t107 = t99*(t63*t41 + t66*t98 + t66*t86 + t69*t76 - t61*t75 - t59*t67)
-    t108 = t66 - t98*t107
-    t109 = t75 + t61*t107
-    t110 = -t66*t107 + t86
-    t111 = t76 - t69*t107
-    t112 = t67 + t59*t107
-    t113 = t41 - t63*t107
-    t114 = t99*(t63*t27 + t66*t76 + t69*t98 + t69*t87 + t59*t79 - t61*t73)
-    t115 = t69 - t98*t114
-    t116 = t73 + t61*t114
-    t117 = t76 - t66*t114
-    t118 = -t69*t114 + t87
-    t119 = t79 - t59*t114
-    t120 = t27 - t63*t114
-    t121 = t99*(t61*t70 + t63*t28 + t69*t79 + t59*t98 + t59*t88 - t66*t67)
-    t122 = t59 - t98*t121
-    t123 = t70 - t61*t121
-    t124 = t67 + t66*t121
-    t125 = t79 - t69*t121
-    t126 = -t59*t121 + t88
-    t127 = t28 - t63*t121
-    t128 = t99*(t61*t55 + t63*t98 + t63*t89 + t66*t41 + t69*t27 + t59*t28)
-    t129 = t63 - t98*t128
-    t130 = t55 - t61*t128
-    t131 = t41 - t66*t128
-    t132 = t27 - t69*t128
-    t133 = t28 - t59*t128
-    t134 = -t63*t128 + t89
-    t135 = t99*(t61*mu_dot1 + t63*mu_dot5 + t66*mu_dot2 + t69*mu_dot3 + t59*mu_dot4 + t98*mu_dot0)
-    t136 = mu_dot0 - t98*t135
-    t137 = mu_dot1 - t61*t135
-    t138 = mu_dot2 - t66*t135
-    t139 = mu_dot3 - t69*t135
-    t140 = mu_dot4 - t59*t135
-    t141 = mu_dot5 - t63*t135
-    t142 = xp.sqrt(t102**2 + t103**2 + t104**2 + t105**2 + t106**2)
-    t143 = t142*xp.where(xp.greater_equal(t102, 0), xp.asarray(1, dtype=dtype), -1)
-    t144 = t102 + t143
-    t145 = xp.where(xp.greater(t142, 0), 1/(t142*(t142 + xp.abs(t102))), 0)
-    t146 = -t145*(-t106*t113 + t103*t110 + t104*t111 + t105*t112 + t109*t144)
-    t147 = t109 + t144*t146
-    t148 = t110 + t103*t146
-    t149 = t111 + t104*t146
-    t150 = t112 + t105*t146
-    t151 = t113 - t106*t146
-    t152 = -t145*(-t105*t119 - t106*t120 + t103*t117 + t104*t118 + t116*t144)
-    t153 = t116 + t144*t152
-    t154 = t117 + t103*t152
-    t155 = t118 + t104*t152
-    t156 = t119 - t105*t152
-    t157 = t120 - t106*t152
-    t158 = t145*(t103*t124 + t105*t126 + t106*t127 + t123*t144 - t104*t125)
-    t159 = t123 - t144*t158
-    t160 = -t124 + t103*t158
-    t161 = t125 + t104*t158
-    t162 = t126 - t105*t158
-    t163 = t127 - t106*t158
-    t164 = t145*(t105*t133 + t106*t134 + t130*t144 - t103*t131 - t104*t132)
-    t165 = t130 - t144*t164
-    t166 = t131 + t103*t164
-    t167 = t132 + t104*t164
-    t168 = t133 - t105*t164
-    t169 = t134 - t106*t164
-    t170 = t145*(t105*t140 + t106*t141 + t137*t144 - t103*t138 - t104*t139)
-    t171 = t137 - t144*t170
-    t172 = t138 + t103*t170
-    t173 = t139 + t104*t170
-    t174 = t140 - t105*t170
-    t175 = t141 - t106*t170
-    t176 = xp.sqrt(t148**2 + t149**2 + t150**2 + t151**2)
-    t177 = t176*xp.where(xp.greater_equal(t148, 0), xp.asarray(1, dtype=dtype), -1)
-    t178 = t148 + t177
-    t179 = xp.where(xp.greater(t176, 0), 1/(t176*(t176 + xp.abs(t148))), 0)
-    t180 = t179*(t149*t155 + t151*t157 + t154*t178 - t150*t156)
-    t181 = t154 - t178*t180
-    t182 = t155 - t149*t180
-    t183 = t156 + t150*t180
-    t184 = t157 - t151*t180
-    t185 = t179*(t149*t161 + t151*t163 + t160*t178 - t150*t162)
-    t186 = t160 - t178*t185
-    t187 = t161 - t149*t185
-    t188 = t162 + t150*t185
-    t189 = t163 - t151*t185
-    t190 = t179*(t149*t167 + t151*t169 + t166*t178 - t150*t168)
-    t191 = t166 - t178*t190
-    t192 = t167 - t149*t190
-    t193 = t168 + t150*t190
-    t194 = t169 - t151*t190
-    t195 = t179*(t149*t173 + t151*t175 + t172*t178 - t150*t174)
-    t196 = t172 - t178*t195
-    t197 = t173 - t149*t195
-    t198 = t174 + t150*t195
-    t199 = t175 - t151*t195
-    t200 = xp.sqrt(t182**2 + t183**2 + t184**2)
-    t201 = t200*xp.where(xp.greater_equal(t182, 0), xp.asarray(1, dtype=dtype), -1)
-    t202 = t182 + t201
-    t203 = xp.where(xp.greater(t200, 0), 1/(t200*(t200 + xp.abs(t182))), 0)
-    t204 = t203*(t183*t188 + t184*t189 + t187*t202)
-    t205 = t187 - t202*t204
-    t206 = t188 - t183*t204
-    t207 = t189 - t184*t204
-    t208 = t203*(t183*t193 + t184*t194 + t192*t202)
-    t209 = t192 - t202*t208
-    t210 = t193 - t183*t208
-    t211 = t194 - t184*t208
-    t212 = t203*(t183*t198 + t184*t199 + t197*t202)
-    t213 = t197 - t202*t212
-    t214 = t198 - t183*t212
-    t215 = t199 - t184*t212
-    t216 = xp.sqrt(t206**2 + t207**2)
-    t217 = t216*xp.where(xp.greater_equal(t206, 0), xp.asarray(1, dtype=dtype), -1)
-    t218 = t206 + t217
-    t219 = xp.where(xp.greater(t216, 0), 1/(t216*(t216 + xp.abs(t206))), 0)
-    t220 = t219*(t207*t211 + t210*t218)
-    t221 = t210 - t218*t220
-    t222 = t211 - t207*t220
-    t223 = t219*(t207*t215 + t214*t218)
-    t224 = t214 - t218*t223
-    t225 = t215 - t207*t223
-    t226 = xp.abs(t222)
-    t227 = t226
-    t228 = t227*xp.where(xp.greater_equal(t222, 0), xp.asarray(1, dtype=dtype), -1)
-    t229 = t222 + t228
-    t230 = xp.where(xp.greater(t227, 0), 1/(t227*(t227 + t226)), 0)
-    t231 = t225 - t225*t230*t229**2
-    t232 = xp.where(xp.not_equal(t228, 0), -t231/t228, 0)
-    t233 = xp.where(xp.not_equal(t217, 0), -(t224 - t221*t232)/t217, 0)
-    t234 = xp.where(xp.not_equal(t201, 0), -(t213 - (t205*t233 + t209*t232))/t201, 0)
-    t235 = xp.where(xp.not_equal(t177, 0), -(t196 - (t181*t234 + t186*t233 + t191*t232))/t177, 0)
-    t236 = xp.where(xp.not_equal(t143, 0), -(t171 - (t159*t233 + t165*t232 - t147*t235 - t153*t234))/t143, 0)
-    t237 = xp.where(xp.not_equal(t97, 0), -(t136 - (t101*t236 + t108*t235 + t115*t234 + t122*t233 + t129*t232))/t97, 0)
-    t238 = t232 + t236*t31 - t237*t34
-    t239 = t233*c1 - t234*s1 - t235*t35 + t236*t51 + t237*t53
-    t240 = t232*c2 + t235*t36 + t236*t54 + t237*t52 + t233*t14 + t234*t8
-    t241 = t234*t6 + t235*t37 + t237*t45 - t233*t3 - t236*t48 - t232*t23
-    t242 = t10*t234 + t16*t233 + t22*t232 + t235*t38 + t236*t49 + t237*t46
-    t243 = t18*t233 + t25*t232 + t236*t50 + t237*t47 - t12*t234 - t235*t39
-    t244 = t232*t26 + t233*t19 + t234*t13
-    t245 = xp.isfinite(t64)
+    t57 = t34**2 + t45**2 + t46**2 + t47**2 + t48**2 + t54*t56
+    t58 = s1*c1
+    t59 = -t31*t34 + t56*t58 + t45*t49 - t46*t50 + t47*t51 + t48*t52
+    t60 = c1*t35
+    t61 = -t44*t60 + t45*t36 + t46*t37 + t47*t38 - t48*t39
+    t62 = t60 - t14*t36 + t3*t37 - t16*t38 + t18*t39
+    t63 = t44*t58
+    t64 = -t63 + t8*t45 + t6*t46 + t10*t47 - t12*t48
+    t65 = t63 + t14*t49 + t3*t50 + t16*t51 + t18*t52
+    t66 = -t34
+    t67 = t66 + c2*t45 - t23*t46 + t22*t47 + t25*t48
+    t68 = s1**2
+    t69 = t31**2 + t49**2 + t50**2 + t51**2 + t52**2 + t68*t56
+    t70 = t68*t44 - t8*t49 + t6*t50 - t10*t51 + t12*t52
+    t71 = s1*t35
+    t72 = t44*t71 - t49*t36 + t50*t37 - t51*t38 + t52*t39
+    t73 = t71 + t8*t36 + t6*t37 + t10*t38 + t12*t39
+    t74 = s2**2
+    t75 = t68 + t6**2 + t10**2 + t12**2 + t13**2 + t54*t74
+    t76 = -t58 + t58*t74 - t6*t3 + t10*t16 - t12*t18 + t13*t19
+    t77 = t54 + t3**2 + t16**2 + t18**2 + t19**2 + t68*t74
+    t78 = 1 + c2**2 + t22**2 + t25**2 + t26**2 + s3**2*t74
+    t79 = t59**2
+    t80 = t61**2
+    t81 = t64**2
+    t82 = t55**2
+    t83 = t67**2
+    t84 = damping**2
+    t85 = t84 + t57
+    t86 = t85**2
+    t87 = xp.sqrt(t79 + t80 + t81 + t82 + t83 + t86)
+    t88 = t87*xp.where(xp.greater_equal(t85, 0), xp.asarray(1, dtype=dtype), -1)
+    t89 = t85 + t88
+    t90 = xp.where(xp.greater(t87, 0), 1/(t87*(t87 + xp.abs(t85))), 0)
+    t91 = t90*(mu_dot0*t89 + mu_dot1*t59 + mu_dot2*t61 + mu_dot3*t64 + mu_dot4*t55 + mu_dot5*t67)
+    t92 = mu_dot0 - t89*t91
+    t93 = mu_dot1 - t59*t91
+    t94 = mu_dot2 - t61*t91
+    t95 = mu_dot3 - t64*t91
+    t96 = mu_dot4 - t55*t91
+    t97 = mu_dot5 - t67*t91
+    t98 = t84 + t69
+    t99 = t90*(t59*t89 + t59*t98 - t61*t72 - t64*t70 + t55*t65 + t67*t53)
+    t100 = t59 - t89*t99
+    t101 = t98 - t59*t99
+    t102 = t72 + t61*t99
+    t103 = t70 + t64*t99
+    t104 = t65 - t55*t99
+    t105 = t53 - t67*t99
+    t106 = xp.sqrt(t101**2 + t102**2 + t103**2 + t104**2 + t105**2)
+    t107 = t106*xp.where(xp.greater_equal(t101, 0), xp.asarray(1, dtype=dtype), -1)
+    t108 = t101 + t107
+    t109 = xp.where(xp.greater(t106, 0), 1/(t106*(t106 + xp.abs(t101))), 0)
+    t110 = t109*(t93*t108 - t102*t94 - t103*t95 + t104*t96 + t105*t97)
+    t111 = t93 - t108*t110
+    t112 = t94 + t102*t110
+    t113 = t95 + t103*t110
+    t114 = t96 - t104*t110
+    t115 = t97 - t105*t110
+    t116 = t84 + t40
+    t117 = t90*(t61*t89 - t59*t72 + t61*t116 + t64*t73 - t55*t62 + t67*t41)
+    t118 = t61 - t89*t117
+    t119 = t72 + t59*t117
+    t120 = t116 - t61*t117
+    t121 = t73 - t64*t117
+    t122 = t62 + t55*t117
+    t123 = t41 - t67*t117
+    t124 = -t109*(t119*t108 + t102*t120 + t103*t121 + t104*t122 - t105*t123)
+    t125 = t119 + t108*t124
+    t126 = t120 + t102*t124
+    t127 = t121 + t103*t124
+    t128 = t122 + t104*t124
+    t129 = t123 - t105*t124
+    t130 = xp.sqrt(t126**2 + t127**2 + t128**2 + t129**2)
+    t131 = t130*xp.where(xp.greater_equal(t126, 0), xp.asarray(1, dtype=dtype), -1)
+    t132 = t126 + t131
+    t133 = xp.where(xp.greater(t130, 0), 1/(t130*(t130 + xp.abs(t126))), 0)
+    t134 = t133*(t112*t132 + t127*t113 - t128*t114 + t129*t115)
+    t135 = t112 - t132*t134
+    t136 = t113 - t127*t134
+    t137 = t114 + t128*t134
+    t138 = t115 - t129*t134
+    t139 = t84 + t75
+    t140 = t90*(t64*t89 - t59*t70 + t61*t73 + t64*t139 + t55*t76 + t67*t27)
+    t141 = t64 - t89*t140
+    t142 = t70 + t59*t140
+    t143 = t73 - t61*t140
+    t144 = t139 - t64*t140
+    t145 = t76 - t55*t140
+    t146 = t27 - t67*t140
+    t147 = -t109*(t142*t108 + t102*t143 + t103*t144 - t104*t145 - t105*t146)
+    t148 = t142 + t108*t147
+    t149 = t143 + t102*t147
+    t150 = t144 + t103*t147
+    t151 = t145 - t104*t147
+    t152 = t146 - t105*t147
+    t153 = t133*(t149*t132 + t127*t150 - t128*t151 + t129*t152)
+    t154 = t149 - t132*t153
+    t155 = t150 - t127*t153
+    t156 = t151 + t128*t153
+    t157 = t152 - t129*t153
+    t158 = xp.sqrt(t155**2 + t156**2 + t157**2)
+    t159 = t158*xp.where(xp.greater_equal(t155, 0), xp.asarray(1, dtype=dtype), -1)
+    t160 = t155 + t159
+    t161 = xp.where(xp.greater(t158, 0), 1/(t158*(t158 + xp.abs(t155))), 0)
+    t162 = t161*(t136*t160 + t156*t137 + t157*t138)
+    t163 = t136 - t160*t162
+    t164 = t137 - t156*t162
+    t165 = t138 - t157*t162
+    t166 = t84 + t77
+    t167 = t90*(t55*t89 + t59*t65 - t61*t62 + t64*t76 + t55*t166 + t67*t28)
+    t168 = t55 - t89*t167
+    t169 = t65 - t59*t167
+    t170 = t62 + t61*t167
+    t171 = t76 - t64*t167
+    t172 = t166 - t55*t167
+    t173 = t28 - t67*t167
+    t174 = t109*(t169*t108 + t102*t170 - t103*t171 + t104*t172 + t105*t173)
+    t175 = t169 - t108*t174
+    t176 = -t170 + t102*t174
+    t177 = t171 + t103*t174
+    t178 = t172 - t104*t174
+    t179 = t173 - t105*t174
+    t180 = t133*(t176*t132 + t127*t177 - t128*t178 + t129*t179)
+    t181 = t176 - t132*t180
+    t182 = t177 - t127*t180
+    t183 = t178 + t128*t180
+    t184 = t179 - t129*t180
+    t185 = t161*(t182*t160 + t156*t183 + t157*t184)
+    t186 = t182 - t160*t185
+    t187 = t183 - t156*t185
+    t188 = t184 - t157*t185
+    t189 = xp.sqrt(t187**2 + t188**2)
+    t190 = t189*xp.where(xp.greater_equal(t187, 0), xp.asarray(1, dtype=dtype), -1)
+    t191 = t187 + t190
+    t192 = xp.where(xp.greater(t189, 0), 1/(t189*(t189 + xp.abs(t187))), 0)
+    t193 = t192*(t164*t191 + t188*t165)
+    t194 = t164 - t191*t193
+    t195 = t165 - t188*t193
+    t196 = t84 + t78
+    t197 = xp.sqrt(2*t79 + 2*t80 + 2*t72**2 + 2*t81 + 2*t70**2 + 2*t73**2 + 2*t82 + 2*t65**2 + 2*t62**2 + 2*t76**2 + 2*t83 + 2*t53**2 + 2*t41**2 + 2*t27**2 + 2*t28**2 + t86 + t98**2 + t116**2 + t139**2 + t166**2 + t196**2)
+    t198 = t90*(t67*t89 + t59*t53 + t61*t41 + t64*t27 + t55*t28 + t67*t196)
+    t199 = t67 - t89*t198
+    t200 = t53 - t59*t198
+    t201 = t41 - t61*t198
+    t202 = t27 - t64*t198
+    t203 = t28 - t55*t198
+    t204 = t196 - t67*t198
+    t205 = t109*(t200*t108 - t102*t201 - t103*t202 + t104*t203 + t105*t204)
+    t206 = t200 - t108*t205
+    t207 = t201 + t102*t205
+    t208 = t202 + t103*t205
+    t209 = t203 - t104*t205
+    t210 = t204 - t105*t205
+    t211 = t133*(t207*t132 + t127*t208 - t128*t209 + t129*t210)
+    t212 = t207 - t132*t211
+    t213 = t208 - t127*t211
+    t214 = t209 + t128*t211
+    t215 = t210 - t129*t211
+    t216 = t161*(t213*t160 + t156*t214 + t157*t215)
+    t217 = t213 - t160*t216
+    t218 = t214 - t156*t216
+    t219 = t215 - t157*t216
+    t220 = t192*(t218*t191 + t188*t219)
+    t221 = t218 - t191*t220
+    t222 = t219 - t188*t220
+    t223 = xp.abs(t222)
+    t224 = t223
+    t225 = t224*xp.where(xp.greater_equal(t222, 0), xp.asarray(1, dtype=dtype), -1)
+    t226 = t222 + t225
+    t227 = xp.where(xp.greater(t224, 0), 1/(t224*(t223 + t224)), 0)
+    t228 = t195 - t195*t226**2*t227
+    t229 = xp.where(xp.not_equal(t225, 0), -t228/t225, 0)
+    t230 = xp.where(xp.not_equal(t190, 0), -(t194 - t221*t229)/t190, 0)
+    t231 = xp.where(xp.not_equal(t159, 0), -(-(t186*t230 + t217*t229) + t163)/t159, 0)
+    t232 = xp.where(xp.not_equal(t131, 0), -(-(t154*t231 + t181*t230 + t212*t229) + t135)/t131, 0)
+    t233 = xp.where(xp.not_equal(t107, 0), -(-(-t125*t232 - t148*t231 + t175*t230 + t206*t229) + t111)/t107, 0)
+    t234 = xp.where(xp.not_equal(t88, 0), -(-(t100*t233 + t118*t232 + t141*t231 + t168*t230 + t199*t229) + t92)/t88, 0)
+    t235 = t229 - t34*t234 + t31*t233
+    t236 = t45*t234 + t49*t233 + t36*t232 + t8*t231 + t14*t230 + c2*t229
+    t237 = t46*t234 - t50*t233 + t37*t232 + t6*t231 - t3*t230 - t23*t229
+    t238 = t47*t234 + t51*t233 + t38*t232 + t10*t231 + t16*t230 + t22*t229
+    t239 = t48*t234 + t52*t233 - t39*t232 - t12*t231 + t18*t230 + t25*t229
+    t240 = t13*t231 + t19*t230 + t26*t229
+    t241 = c1*t44
+    t242 = s1*t44
+    t243 = t241*t234 + t242*t233 - t35*t232 - s1*t231 + c1*t230
+    t244 = 1 + t66 - t50 - t35 - t39 - s1 - t12 - t3 + q1 + q2 + q3 + c1 + c2 + q4 + q5 + t6 + t10 + t8 + t16 + t14 + t22 + q6 + q7 + t18 + t25 + t13 + t19 + t26 + t31 + t241 + t242 - t23 + t45 + t46 + t47 + t48 + t49 + t51 + t52 + t36 + t37 + t38 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + damping
+    t245 = xp.isfinite(t244)
     t246 = xp.greater_equal(damping, 0)
-    t247 = 1e-12*t95
-    t248 = xp.less_equal(t96, t247) | xp.less_equal(t142, t247) | xp.less_equal(t176, t247) | xp.less_equal(t200, t247) | xp.less_equal(t216, t247) | xp.less_equal(t227, t247)
+    t247 = 1e-12*t197
+    t248 = xp.less_equal(t87, t247) | xp.less_equal(t106, t247) | xp.less_equal(t130, t247) | xp.less_equal(t158, t247) | xp.less_equal(t189, t247) | xp.less_equal(t224, t247)
     t249 = t245 & t246 & xp.logical_not(t248)
     q_dot = _stack(xp, [
-        xp.broadcast_to(xp.where(t249, t238, 0), batch),  # 0
-        xp.broadcast_to(xp.where(t249, t239, 0), batch),  # 1
-        xp.broadcast_to(xp.where(t249, t240, 0), batch),  # 2
-        xp.broadcast_to(xp.where(t249, t241, 0), batch),  # 3
-        xp.broadcast_to(xp.where(t249, t242, 0), batch),  # 4
-        xp.broadcast_to(xp.where(t249, t243, 0), batch),  # 5
-        xp.broadcast_to(xp.where(t249, t244, 0), batch),  # 6
+        xp.broadcast_to(xp.where(t249, t235, 0), batch),  # 0
+        xp.broadcast_to(xp.where(t249, t243, 0), batch),  # 1
+        xp.broadcast_to(xp.where(t249, t236, 0), batch),  # 2
+        xp.broadcast_to(xp.where(t249, t237, 0), batch),  # 3
+        xp.broadcast_to(xp.where(t249, t238, 0), batch),  # 4
+        xp.broadcast_to(xp.where(t249, t239, 0), batch),  # 5
+        xp.broadcast_to(xp.where(t249, t240, 0), batch),  # 6
     ], (7,))
     status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t245 & t246), 2, xp.where(t248, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
     return q_dot, status
@@ -2547,115 +2547,115 @@ def ik_numeric_step(target, q, damping=0.0):
     s6 = xp.sin(q6)
     c7 = xp.cos(q7)
     s7 = xp.sin(q7)
-    t0 = T00 + T01 + T02 + T03 + T10 + T11 + T12 + T13 + T20 + T21 + T22 + T23 + qs1 + qs2 + qs3 + qs4 + qs5 + qs6 + qs7
+    t0 = qs1 + qs2 + qs3 + qs4 + qs5 + qs6 + qs7 + T00 + T01 + T02 + T10 + T11 + T12 + T20 + T21 + T22 + T03 + T13 + T23
     t1 = s1*s3
     t2 = c1*c3
     t3 = -t1 + c2*t2
     t4 = t2 - c2*t1
-    t5 = c3*s1
-    t6 = c1*s3
+    t5 = s1*c3
+    t6 = s3*c1
     t7 = t5 + c2*t6
     t8 = t6 + c2*t5
     t9 = c1*s2
     t10 = t3*c4 + s4*t9
     t11 = -t3*s4 + c4*t9
     t12 = t10*c5 - t7*s5
-    t13 = t10*s5 + t7*c5
+    t13 = t10*s5 + c5*t7
     t14 = t12*c6 - t11*s6
     t15 = t11*c6 + t12*s6
     t16 = t14*c7 - t13*s7
-    t17 = t13*c7 + t14*s7
-    t18 = T00*t16 + T02*t15 - T01*t17
-    t19 = T10*t16 + T12*t15 - T11*t17
-    t20 = T20*t16 + T22*t15 - T21*t17
+    t17 = c7*t13 + t14*s7
+    t18 = t16*T00 - t17*T01 + t15*T02
+    t19 = t16*T10 - t17*T11 + t15*T12
+    t20 = t16*T20 - t17*T21 + t15*T22
     t21 = s1*s2
-    t22 = t8*c4 + s4*t21
-    t23 = -t8*s4 + c4*t21
-    t24 = t22*c5 + t4*s5
-    t25 = t4*c5 - t22*s5
-    t26 = t24*c6 - t23*s6
-    t27 = t23*c6 + t24*s6
-    t28 = t25*s7 + t26*c7
-    t29 = t25*c7 - t26*s7
-    t30 = T00*t28 + T01*t29 + T02*t27
-    t31 = T10*t28 + T11*t29 + T12*t27
-    t32 = T20*t28 + T21*t29 + T22*t27
-    t33 = 0.5*(t19 - t30)
+    t22 = c4*t8 + s4*t21
+    t23 = -s4*t8 + c4*t21
+    t24 = c5*t22 + s5*t4
+    t25 = c5*t4 - s5*t22
+    t26 = c6*t24 - t23*s6
+    t27 = t23*c6 + s6*t24
+    t28 = s7*t25 + c7*t26
+    t29 = c7*t25 - s7*t26
+    t30 = t28*T00 + t29*T01 + t27*T02
+    t31 = t28*T10 + t29*T11 + t27*T12
+    t32 = t28*T20 + t29*T21 + t27*T22
+    t33 = 0.5*(-t30 + t19)
     t34 = c3*s2
     t35 = c2*s4 - c4*t34
     t36 = c2*c4 + s4*t34
     t37 = s3*s2
-    t38 = t35*c5 + s5*t37
-    t39 = -t35*s5 + c5*t37
-    t40 = t38*c6 - t36*s6
-    t41 = t36*c6 + t38*s6
-    t42 = t39*s7 + t40*c7
-    t43 = t39*c7 - t40*s7
-    t44 = t11*t36 + t15*t41 - t13*t39 + c2*t9 - t7*t37
-    t45 = t23*t36 + t25*t39 + t27*t41 + t4*t37 + c2*t21
-    t46 = T00*t42 + T01*t43 + T02*t41
-    t47 = T10*t42 + T11*t43 + T12*t41
-    t48 = T20*t42 + T21*t43 + T22*t41
-    t49 = 0.5*(t32 - t47)
-    t50 = 0.5*(t46 - t20)
+    t38 = c5*t35 + s5*t37
+    t39 = -s5*t35 + c5*t37
+    t40 = c6*t38 - t36*s6
+    t41 = t36*c6 + s6*t38
+    t42 = s7*t39 + c7*t40
+    t43 = c7*t39 - s7*t40
+    t44 = c2*t9 - t7*t37 + t11*t36 - t13*t39 + t15*t41
+    t45 = c2*t21 + t4*t37 + t23*t36 + t25*t39 + t27*t41
+    t46 = t42*T00 + t43*T01 + t41*T02
+    t47 = t42*T10 + t43*T11 + t41*T12
+    t48 = t42*T20 + t43*T21 + t41*T22
+    t49 = 0.5*(-t47 + t32)
+    t50 = 0.5*(-t20 + t46)
     t51 = 0.5*(-1 + t18 + t31 + t48)
     t52 = xp.sqrt(t49**2 + t50**2 + t33**2)
     t53 = xp.atan2(t52, t51)
     t54 = xp.where(xp.greater(t52, 0), t53/t52, 1)
     t55 = 0.126*t15
     t56 = 0.4*t11 + t55
-    t57 = t56 + 0.42*t9
-    t58 = T03 - t57
+    t57 = 0.42*t9 + t56
+    t58 = -t57 + T03
     t59 = 0.126*t27
     t60 = 0.4*t23 + t59
-    t61 = t60 + 0.42*t21
-    t62 = t57*c1 + t61*s1
+    t61 = 0.42*t21 + t60
+    t62 = c1*t57 + s1*t61
     t63 = t61*t9 - t57*t21
-    t64 = t56*t4 + t60*t7
+    t64 = t4*t56 + t7*t60
     t65 = t11*t60 - t23*t56
     t66 = t13*t59 + t25*t55
     t67 = t62**2 + t63**2 + t64**2 + t65**2 + t66**2
-    t68 = t36*t65 + t63*c2 - t39*t66 - t64*t37
+    t68 = c2*t63 - t37*t64 + t36*t65 - t39*t66
     t69 = 0.126*t41
     t70 = 0.4*t36 + t69
-    t71 = t70 + 0.42*c2
+    t71 = 0.42*c2 + t70
     t72 = 0.36 + t71
-    t73 = -t61*c2 + t71*t21
-    t74 = -t70*t4 + t60*t37
+    t73 = -c2*t61 + t71*t21
+    t74 = -t4*t70 + t60*t37
     t75 = t23*t70 - t36*t60
     t76 = -t39*t59 + t25*t69
-    t77 = t57*c2 - t71*t9
-    t78 = t70*t7 + t56*t37
+    t77 = c2*t57 - t71*t9
+    t78 = t7*t70 + t56*t37
     t79 = t36*t56 - t11*t70
     t80 = t13*t69 + t39*t55
-    t81 = t57 + t36*t79 + t39*t80 + t77*c2 + t78*t37
-    t82 = T23 - t72
-    t83 = t71**2
-    t84 = c1**2
-    t85 = t61**2 + t73**2 + t74**2 + t75**2 + t76**2 + t83*t84
-    t86 = t23*t75 + t25*t76 + t71*t84 - t74*t4 + t73*t21
-    t87 = c1*s1
-    t88 = t73*t77 + t75*t79 + t76*t80 - t57*t61 - t74*t78 + t83*t87
-    t89 = -t61
-    t90 = t89 + t36*t75 + t39*t76 + t73*c2 - t74*t37
-    t91 = T13 + t89
-    t92 = t62*c1
-    t93 = t73*t63 + t74*t64 + t75*t65 - t76*t66 - t71*t92
-    t94 = t25*t66 + t92 + t64*t4 - t23*t65 - t63*t21
-    t95 = t71*t87
-    t96 = t11*t75 + t74*t7 - t13*t76 + t73*t9 - t95
-    t97 = t23*t79 + t25*t80 + t78*t4 + t95 + t77*t21
+    t81 = t57 + c2*t77 + t37*t78 + t36*t79 + t39*t80
+    t82 = -t72 + T23
+    t83 = c1**2
+    t84 = t83*t71 + t21*t73 - t4*t74 + t23*t75 + t25*t76
+    t85 = t71**2
+    t86 = t61**2 + t73**2 + t74**2 + t75**2 + t76**2 + t83*t85
+    t87 = s1*c1
+    t88 = -t57*t61 + t85*t87 + t73*t77 - t74*t78 + t75*t79 + t76*t80
+    t89 = c1*t62
+    t90 = -t71*t89 + t73*t63 + t74*t64 + t75*t65 - t76*t66
+    t91 = t89 - t21*t63 + t4*t64 - t23*t65 + t25*t66
+    t92 = t71*t87
+    t93 = -t92 + t9*t73 + t7*t74 + t11*t75 - t13*t76
+    t94 = t92 + t21*t77 + t4*t78 + t23*t79 + t25*t80
+    t95 = -t61
+    t96 = t95 + c2*t73 - t37*t74 + t36*t75 + t39*t76
+    t97 = t95 + T13
     t98 = s1**2
-    t99 = t57**2 + t77**2 + t78**2 + t79**2 + t80**2 + t83*t98
-    t100 = t13*t80 + t71*t98 + t78*t7 - t11*t79 - t77*t9
-    t101 = t62*s1
-    t102 = t78*t64 + t80*t66 - t77*t63 - t79*t65 + t71*t101
-    t103 = t11*t65 + t13*t66 + t101 + t64*t7 + t63*t9
+    t99 = t57**2 + t77**2 + t78**2 + t79**2 + t80**2 + t98*t85
+    t100 = t98*t71 - t9*t77 + t7*t78 - t11*t79 + t13*t80
+    t101 = s1*t62
+    t102 = t71*t101 - t77*t63 + t78*t64 - t79*t65 + t80*t66
+    t103 = t101 + t9*t63 + t7*t64 + t11*t65 + t13*t66
     t104 = s2**2
-    t105 = t11**2 + t13**2 + t15**2 + t7**2 + t98 + t84*t104
-    t106 = t11*t23 + t15*t27 - t13*t25 - t7*t4 - t87 + t104*t87
-    t107 = t23**2 + t25**2 + t27**2 + t4**2 + t84 + t98*t104
-    t108 = 1 + t36**2 + t39**2 + t41**2 + c2**2 + t104*s3**2
+    t105 = t98 + t7**2 + t11**2 + t13**2 + t15**2 + t83*t104
+    t106 = -t87 + t87*t104 - t7*t4 + t11*t23 - t13*t25 + t15*t27
+    t107 = t83 + t4**2 + t23**2 + t25**2 + t27**2 + t98*t104
+    t108 = 1 + c2**2 + t36**2 + t39**2 + t41**2 + s3**2*t104
     t109 = xp.greater_equal(t18, t31) & xp.greater_equal(t18, t48)
     t110 = xp.greater_equal(t31, t48)
     t111 = xp.where(t109, 0.5*(1 + t18), xp.where(t110, 0.5*t30, 0.5*t46))
@@ -2665,49 +2665,49 @@ def ik_numeric_step(target, q, damping=0.0):
     t115 = xp.where(xp.greater_equal(t49*t111 + t50*t112 + t33*t113, 0), xp.asarray(1, dtype=dtype), -1)
     t116 = xp.greater(t52, 1e-06) | xp.greater(t51, 0)
     t117 = t53*t115/t114
-    t118 = xp.where(t116, t49*t54, t111*t117)
-    t119 = xp.where(t116, t50*t54, t112*t117)
-    t120 = xp.where(t116, t33*t54, t113*t117)
-    t121 = t118**2 + t119**2 + t120**2 + t58**2 + t91**2 + t82**2
-    t122 = t85 + damping
-    t123 = xp.sqrt(t88**2 + t90**2 + t93**2 + t96**2 + t86**2 + t122**2)
+    t118 = xp.where(t116, t49*t54, t117*t111)
+    t119 = xp.where(t116, t50*t54, t117*t112)
+    t120 = xp.where(t116, t33*t54, t117*t113)
+    t121 = t118**2 + t119**2 + t120**2 + t58**2 + t97**2 + t82**2
+    t122 = damping + t86
+    t123 = xp.sqrt(t88**2 + t90**2 + t93**2 + t84**2 + t96**2 + t122**2)
     t124 = t123*xp.where(xp.greater_equal(t122, 0), xp.asarray(1, dtype=dtype), -1)
-    t125 = t124 + t122
+    t125 = t122 + t124
     t126 = xp.where(xp.greater(t123, 0), 1/(t123*(t123 + xp.abs(t122))), 0)
-    t127 = t126*(t88*t91 + t90*t120 + t93*t82 + t96*t118 + t86*t119 + t58*t125)
+    t127 = t126*(t58*t125 + t88*t97 + t90*t82 + t93*t118 + t84*t119 + t96*t120)
     t128 = t58 - t125*t127
-    t129 = t91 - t88*t127
-    t130 = t82 - t93*t127
-    t131 = t118 - t96*t127
-    t132 = t119 - t86*t127
-    t133 = t120 - t90*t127
-    t134 = t99 + damping
-    t135 = t126*(t88*t125 + t88*t134 + t90*t81 + t86*t97 - t93*t102 - t96*t100)
+    t129 = t97 - t88*t127
+    t130 = t82 - t90*t127
+    t131 = t118 - t93*t127
+    t132 = t119 - t84*t127
+    t133 = t120 - t96*t127
+    t134 = damping + t99
+    t135 = t126*(-t90*t102 - t93*t100 + t84*t94 + t96*t81 + t88*t125 + t88*t134)
     t136 = t88 - t125*t135
-    t137 = -t88*t135 + t134
-    t138 = t102 + t93*t135
-    t139 = t100 + t96*t135
-    t140 = t97 - t86*t135
-    t141 = t81 - t90*t135
+    t137 = t134 - t88*t135
+    t138 = t102 + t90*t135
+    t139 = t100 + t93*t135
+    t140 = t94 - t84*t135
+    t141 = t81 - t96*t135
     t142 = xp.sqrt(t137**2 + t138**2 + t139**2 + t140**2 + t141**2)
     t143 = t142*xp.where(xp.greater_equal(t137, 0), xp.asarray(1, dtype=dtype), -1)
     t144 = t137 + t143
     t145 = xp.where(xp.greater(t142, 0), 1/(t142*(t142 + xp.abs(t137))), 0)
-    t146 = t145*(t140*t132 + t141*t133 + t129*t144 - t138*t130 - t139*t131)
+    t146 = t145*(t129*t144 - t138*t130 - t139*t131 + t140*t132 + t141*t133)
     t147 = t129 - t144*t146
     t148 = t130 + t138*t146
     t149 = t131 + t139*t146
     t150 = t132 - t140*t146
     t151 = t133 - t141*t146
-    t152 = t67 + damping
-    t153 = t126*(t90*t68 + t93*t125 + t93*t152 + t96*t103 - t88*t102 - t86*t94)
-    t154 = t93 - t125*t153
+    t152 = damping + t67
+    t153 = t126*(-t88*t102 + t93*t103 - t84*t91 + t96*t68 + t90*t125 + t90*t152)
+    t154 = t90 - t125*t153
     t155 = t102 + t88*t153
-    t156 = -t93*t153 + t152
-    t157 = t103 - t96*t153
-    t158 = t94 + t86*t153
-    t159 = t68 - t90*t153
-    t160 = -t145*(-t141*t159 + t138*t156 + t139*t157 + t140*t158 + t155*t144)
+    t156 = t152 - t90*t153
+    t157 = t103 - t93*t153
+    t158 = t91 + t84*t153
+    t159 = t68 - t96*t153
+    t160 = -t145*(t155*t144 + t138*t156 + t139*t157 + t140*t158 - t141*t159)
     t161 = t155 + t144*t160
     t162 = t156 + t138*t160
     t163 = t157 + t139*t160
@@ -2717,26 +2717,26 @@ def ik_numeric_step(target, q, damping=0.0):
     t167 = t166*xp.where(xp.greater_equal(t162, 0), xp.asarray(1, dtype=dtype), -1)
     t168 = t162 + t167
     t169 = xp.where(xp.greater(t166, 0), 1/(t166*(t166 + xp.abs(t162))), 0)
-    t170 = t169*(t163*t149 + t165*t151 + t148*t168 - t164*t150)
+    t170 = t169*(t148*t168 + t163*t149 - t164*t150 + t165*t151)
     t171 = t148 - t168*t170
     t172 = t149 - t163*t170
     t173 = t150 + t164*t170
     t174 = t151 - t165*t170
-    t175 = t105 + damping
-    t176 = t126*(t90*t44 + t93*t103 + t96*t125 + t96*t175 + t86*t106 - t88*t100)
-    t177 = t96 - t125*t176
+    t175 = damping + t105
+    t176 = t126*(-t88*t100 + t90*t103 + t84*t106 + t96*t44 + t93*t125 + t93*t175)
+    t177 = t93 - t125*t176
     t178 = t100 + t88*t176
-    t179 = t103 - t93*t176
-    t180 = -t96*t176 + t175
-    t181 = t106 - t86*t176
-    t182 = t44 - t90*t176
-    t183 = -t145*(-t140*t181 - t141*t182 + t138*t179 + t139*t180 + t178*t144)
+    t179 = t103 - t90*t176
+    t180 = t175 - t93*t176
+    t181 = t106 - t84*t176
+    t182 = t44 - t96*t176
+    t183 = -t145*(t178*t144 + t138*t179 + t139*t180 - t140*t181 - t141*t182)
     t184 = t178 + t144*t183
     t185 = t179 + t138*t183
     t186 = t180 + t139*t183
     t187 = t181 - t140*t183
     t188 = t182 - t141*t183
-    t189 = t169*(t163*t186 + t165*t188 + t185*t168 - t164*t187)
+    t189 = t169*(t185*t168 + t163*t186 - t164*t187 + t165*t188)
     t190 = t185 - t168*t189
     t191 = t186 - t163*t189
     t192 = t187 + t164*t189
@@ -2745,30 +2745,30 @@ def ik_numeric_step(target, q, damping=0.0):
     t195 = t194*xp.where(xp.greater_equal(t191, 0), xp.asarray(1, dtype=dtype), -1)
     t196 = t191 + t195
     t197 = xp.where(xp.greater(t194, 0), 1/(t194*(t194 + xp.abs(t191))), 0)
-    t198 = t197*(t192*t173 + t193*t174 + t172*t196)
+    t198 = t197*(t172*t196 + t192*t173 + t193*t174)
     t199 = t172 - t196*t198
     t200 = t173 - t192*t198
     t201 = t174 - t193*t198
-    t202 = t107 + damping
-    t203 = t126*(t88*t97 + t90*t45 + t96*t106 + t86*t125 + t86*t202 - t93*t94)
-    t204 = t86 - t125*t203
-    t205 = t97 - t88*t203
-    t206 = t94 + t93*t203
-    t207 = t106 - t96*t203
-    t208 = -t86*t203 + t202
-    t209 = t45 - t90*t203
-    t210 = t145*(t138*t206 + t140*t208 + t141*t209 + t205*t144 - t139*t207)
+    t202 = damping + t107
+    t203 = t126*(t88*t94 - t90*t91 + t93*t106 + t96*t45 + t84*t125 + t84*t202)
+    t204 = t84 - t125*t203
+    t205 = t94 - t88*t203
+    t206 = t91 + t90*t203
+    t207 = t106 - t93*t203
+    t208 = t202 - t84*t203
+    t209 = t45 - t96*t203
+    t210 = t145*(t205*t144 + t138*t206 - t139*t207 + t140*t208 + t141*t209)
     t211 = t205 - t144*t210
     t212 = -t206 + t138*t210
     t213 = t207 + t139*t210
     t214 = t208 - t140*t210
     t215 = t209 - t141*t210
-    t216 = t169*(t163*t213 + t165*t215 + t212*t168 - t164*t214)
+    t216 = t169*(t212*t168 + t163*t213 - t164*t214 + t165*t215)
     t217 = t212 - t168*t216
     t218 = t213 - t163*t216
     t219 = t214 + t164*t216
     t220 = t215 - t165*t216
-    t221 = t197*(t192*t219 + t193*t220 + t218*t196)
+    t221 = t197*(t218*t196 + t192*t219 + t193*t220)
     t222 = t218 - t196*t221
     t223 = t219 - t192*t221
     t224 = t220 - t193*t221
@@ -2776,53 +2776,53 @@ def ik_numeric_step(target, q, damping=0.0):
     t226 = t225*xp.where(xp.greater_equal(t223, 0), xp.asarray(1, dtype=dtype), -1)
     t227 = t223 + t226
     t228 = xp.where(xp.greater(t225, 0), 1/(t225*(t225 + xp.abs(t223))), 0)
-    t229 = t228*(t224*t201 + t200*t227)
+    t229 = t228*(t200*t227 + t224*t201)
     t230 = t200 - t227*t229
     t231 = t201 - t224*t229
-    t232 = t108 + damping
-    t233 = t126*(t88*t81 + t90*t125 + t90*t232 + t93*t68 + t96*t44 + t86*t45)
-    t234 = t90 - t125*t233
+    t232 = damping + t108
+    t233 = t126*(t88*t81 + t90*t68 + t93*t44 + t84*t45 + t96*t125 + t96*t232)
+    t234 = t96 - t125*t233
     t235 = t81 - t88*t233
-    t236 = t68 - t93*t233
-    t237 = t44 - t96*t233
-    t238 = t45 - t86*t233
-    t239 = -t90*t233 + t232
-    t240 = t145*(t140*t238 + t141*t239 + t235*t144 - t138*t236 - t139*t237)
+    t236 = t68 - t90*t233
+    t237 = t44 - t93*t233
+    t238 = t45 - t84*t233
+    t239 = t232 - t96*t233
+    t240 = t145*(t235*t144 - t138*t236 - t139*t237 + t140*t238 + t141*t239)
     t241 = t235 - t144*t240
     t242 = t236 + t138*t240
     t243 = t237 + t139*t240
     t244 = t238 - t140*t240
     t245 = t239 - t141*t240
-    t246 = t169*(t163*t243 + t165*t245 + t242*t168 - t164*t244)
+    t246 = t169*(t242*t168 + t163*t243 - t164*t244 + t165*t245)
     t247 = t242 - t168*t246
     t248 = t243 - t163*t246
     t249 = t244 + t164*t246
     t250 = t245 - t165*t246
-    t251 = t197*(t192*t249 + t193*t250 + t248*t196)
+    t251 = t197*(t248*t196 + t192*t249 + t193*t250)
     t252 = t248 - t196*t251
     t253 = t249 - t192*t251
     t254 = t250 - t193*t251
-    t255 = t228*(t224*t254 + t253*t227)
+    t255 = t228*(t253*t227 + t224*t254)
     t256 = t253 - t227*t255
     t257 = t254 - t224*t255
     t258 = xp.abs(t257)
     t259 = t258
     t260 = t259*xp.where(xp.greater_equal(t257, 0), xp.asarray(1, dtype=dtype), -1)
     t261 = t257 + t260
-    t262 = xp.where(xp.greater(t259, 0), 1/(t259*(t259 + t258)), 0)
-    t263 = t231 - t231*t262*t261**2
+    t262 = xp.where(xp.greater(t259, 0), 1/(t259*(t258 + t259)), 0)
+    t263 = t231 - t231*t261**2*t262
     t264 = xp.where(xp.not_equal(t260, 0), -t263/t260, 0)
     t265 = xp.where(xp.not_equal(t226, 0), -(t230 - t256*t264)/t226, 0)
-    t266 = xp.where(xp.not_equal(t195, 0), -(t199 - (t222*t265 + t252*t264))/t195, 0)
-    t267 = xp.where(xp.not_equal(t167, 0), -(t171 - (t190*t266 + t217*t265 + t247*t264))/t167, 0)
-    t268 = xp.where(xp.not_equal(t143, 0), -(t147 - (t211*t265 + t241*t264 - t161*t267 - t184*t266))/t143, 0)
-    t269 = xp.where(xp.not_equal(t124, 0), -(t128 - (t136*t268 + t154*t267 + t177*t266 + t204*t265 + t234*t264))/t124, 0)
-    t270 = t264 + q1 + t268*t57 - t269*t61
-    t271 = q2 + t265*c1 - t266*s1 - t267*t62 + t268*t71*s1 + t269*t71*c1
-    t272 = q3 + t264*c2 + t267*t63 + t268*t77 + t269*t73 + t265*t21 + t266*t9
-    t273 = q4 + t266*t7 + t267*t64 + t269*t74 - t265*t4 - t268*t78 - t264*t37
-    t274 = q5 + t11*t266 + t23*t265 + t36*t264 + t267*t65 + t268*t79 + t269*t75
-    t275 = q6 + t25*t265 + t39*t264 + t268*t80 + t269*t76 - t13*t266 - t267*t66
+    t266 = xp.where(xp.not_equal(t195, 0), -(-(t222*t265 + t252*t264) + t199)/t195, 0)
+    t267 = xp.where(xp.not_equal(t167, 0), -(-(t190*t266 + t217*t265 + t247*t264) + t171)/t167, 0)
+    t268 = xp.where(xp.not_equal(t143, 0), -(-(-t161*t267 - t184*t266 + t211*t265 + t241*t264) + t147)/t143, 0)
+    t269 = xp.where(xp.not_equal(t124, 0), -(-(t136*t268 + t154*t267 + t177*t266 + t204*t265 + t234*t264) + t128)/t124, 0)
+    t270 = q1 + t264 - t61*t269 + t57*t268
+    t271 = q2 + c1*t71*t269 + s1*t71*t268 - t62*t267 - s1*t266 + c1*t265
+    t272 = q3 + t73*t269 + t77*t268 + t63*t267 + t9*t266 + t21*t265 + c2*t264
+    t273 = q4 + t74*t269 - t78*t268 + t64*t267 + t7*t266 - t4*t265 - t37*t264
+    t274 = q5 + t75*t269 + t79*t268 + t65*t267 + t11*t266 + t23*t265 + t36*t264
+    t275 = q6 + t76*t269 + t80*t268 - t66*t267 - t13*t266 + t25*t265 + t39*t264
     t276 = q7 + t15*t266 + t27*t265 + t41*t264
     q_start = _stack(xp, [
         xp.broadcast_to(q1, batch),  # 0
@@ -2848,7 +2848,7 @@ def ik_numeric_step(target, q, damping=0.0):
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def ik_branches(T, q_free):
-    """every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits: (8 x 7 and 8 x 1 and 8 x 1), 1623 operations."""
+    """every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits: (8 x 7 and 8 x 1 and 8 x 1), 1621 operations."""
     xp, dtype, device, batch, (T, q_free,) = _arguments(("T", T, (4, 4)), ("q_free", q_free, ()))
     T00 = T[..., 0, 0]
     T01 = T[..., 0, 1]
@@ -2865,23 +2865,23 @@ def ik_branches(T, q_free):
     q3 = q_free
     c3 = xp.cos(q3)
     s3 = xp.sin(q3)
-    t0 = T00*c3 - T01*s3
-    t1 = T00*s3 + T01*c3
-    t2 = T10*c3 - T11*s3
-    t3 = T10*s3 + T11*c3
-    t4 = T20*c3 - T21*s3
-    t5 = T20*s3 + T21*c3
+    t0 = c3*T00 - s3*T01
+    t1 = s3*T00 + c3*T01
+    t2 = c3*T10 - s3*T11
+    t3 = s3*T10 + c3*T11
+    t4 = c3*T20 - s3*T21
+    t5 = s3*T20 + c3*T21
     t6 = T03 - 1.306*T02
     t7 = T13 - 1.306*T12
     t8 = T23 - 1.306*T22
     t9 = t6 + 1.18*T02
-    t10 = t7 + 1.18*T12
-    t11 = t8 + 1.18*T22
+    t10 = 1.18*T12 + t7
+    t11 = 1.18*T22 + t8
     t12 = -0.36 + t11
-    t13 = t0*c3 + t1*s3
-    t14 = t2*c3 + t3*s3
-    t15 = t4*c3 + t5*s3
-    t16 = T00 + T01 + T02 + T03 + T10 + T11 + T12 + T13 + T20 + T21 + T22 + T23
+    t13 = c3*t0 + s3*t1
+    t14 = c3*t2 + s3*t3
+    t15 = c3*t4 + s3*t5
+    t16 = T00 + T01 + T02 + T10 + T11 + T12 + T20 + T21 + T22 + T03 + T13 + T23
     t17 = t12**2
     t18 = t9**2 + t10**2 + t17
     t19 = 0.5*(0.3364 - t18)
@@ -2895,681 +2895,679 @@ def ik_branches(T, q_free):
     t27 = 3.141592653589793 - t26
     t28 = 0.78 - 0.4*t25
     t29 = -0.36 + t28
-    t30 = t27 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t27))
-    t31 = t30 - 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t30))
+    t30 = -6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t27)) + t27
+    t31 = -6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t30)) + t30
     t32 = 3.141592653589793 + t26
-    t33 = t32 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t32))
-    t34 = t33 - 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t33))
-    t35 = 1.0*t25
-    t36 = -t35
-    t37 = 0.78 + 0.4*t36
-    t38 = -0.36 + t37
-    t39 = 1.0*t23
-    t40 = -t39
-    t41 = c3**2
-    t42 = 0.16*t40**2
-    t43 = s3**2
-    t44 = t41 + t43
-    t45 = t43*t42
-    t46 = t38**2 + t41*t42 + t45
-    t47 = t17 + t45
-    t48 = -t46 + t47
-    t49 = -t48
-    t50 = 1e-12*t46
-    t51 = xp.greater(t49, t50)
-    t52 = xp.where(t51, xp.sqrt(t49), 0)
-    t53 = t52**2 + t47
-    t54 = -t17
-    t55 = t9*t52
-    t56 = 0.4*t40
-    t57 = s3*t10
-    t58 = t56*t57
-    t59 = t54 + t55 + t58
-    t60 = t59 + t17
-    t61 = t17 + t55 - t58
-    t62 = t61 + t54
-    t63 = t10*t52
-    t64 = s3*t9
-    t65 = t56*t64
-    t66 = -t63 + t65
-    t67 = t60**2 + t66**2
-    t68 = t63 + t65
-    t69 = t62**2 + t68**2
-    t70 = 1e-24*t53
-    t71 = t18*t70
-    t72 = xp.less_equal(t67, t71)
-    t73 = xp.where(t72, 1, 1/xp.sqrt(t67))
-    t74 = xp.where(t72, 1, -t60*t73)
-    t75 = xp.where(t72, 0, t66*t73)
-    t76 = T02*t74 + T12*t75
-    t77 = T12*t74 - T02*t75
-    t78 = t74*t13 + t75*t14
-    t79 = t74*t14 - t75*t13
-    t80 = xp.where(t72, 0, xp.atan2(t66, -t60))
-    t81 = t80 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t80))
-    t82 = c3*t56
-    t83 = t52*t82
-    t84 = t45 + t12*t38
-    t85 = t83 + t84
-    t86 = -t83 + t84
-    t87 = -t45
-    t88 = t85 + t87
-    t89 = t86 + t87
-    t90 = t38*t52
-    t91 = t12*t82
-    t92 = -t90 + t91
-    t93 = t88**2 + t92**2
-    t94 = t90 + t91
-    t95 = t89**2 + t94**2
-    t96 = t46*t70
-    t97 = xp.less_equal(t93, t96)
-    t98 = xp.where(t97, 1, 1/xp.sqrt(t93))
-    t99 = xp.where(t97, 1, t88*t98)
-    t100 = xp.where(t97, 0, t92*t98)
-    t101 = xp.where(t97, 0, xp.atan2(t92, t88))
-    t102 = t101 - 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t101))
-    t103 = xp.less_equal(t69, t71)
-    t104 = xp.where(t103, 1, 1/xp.sqrt(t69))
-    t105 = xp.where(t103, 1, t62*t104)
-    t106 = xp.where(t103, 0, t68*t104)
-    t107 = T02*t105 + T12*t106
-    t108 = T12*t105 - T02*t106
-    t109 = t105*t13 + t106*t14
-    t110 = t105*t14 - t106*t13
-    t111 = xp.where(t103, 0, xp.atan2(t68, t62))
-    t112 = t111 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t111))
-    t113 = xp.less_equal(t95, t96)
-    t114 = xp.where(t113, 1, 1/xp.sqrt(t95))
-    t115 = xp.where(t113, 1, t89*t114)
-    t116 = xp.where(t113, 0, t94*t114)
-    t117 = xp.where(t113, 0, xp.atan2(t94, t89))
-    t118 = t117 - 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t117))
-    t119 = 1 - t74
-    t120 = T22*t119
-    t121 = t120 + T22*t74
-    t122 = t15*t119
-    t123 = t122 + t74*t15
-    t124 = t99*t76 - t100*t121
-    t125 = t99*t121 + t100*t76
-    t126 = t99*t78 - t100*t123
-    t127 = t99*t123 + t100*t78
-    t128 = 1 - t99
-    t129 = t77*t128
-    t130 = t129 + t99*t77
-    t131 = t79*t128
-    t132 = t131 + t99*t79
-    t133 = t124*c3 + t130*s3
-    t134 = t124*s3 - t130*c3
-    t135 = t36*t125 - t40*t133
-    t136 = t126*c3 + t132*s3
-    t137 = t126*s3 - t132*c3
-    t138 = t36*t127 - t40*t136
-    t139 = 1 - t36
-    t140 = t134*t139
-    t141 = t137*t139
-    t142 = t125*t40
-    t143 = t36*t124 + t140*s3 + c3*t142
-    t144 = t36*t130 - t140*c3 + s3*t142
-    t145 = t40*t127
-    t146 = t36*t126 + t141*s3 + c3*t145
-    t147 = t36*t132 - t141*c3 + s3*t145
-    t148 = t135**2
-    t149 = t143**2 + t144**2 + t148
-    t150 = -t148
-    t151 = 1 + t150
-    t152 = xp.greater(t151, 1e-12)
-    t153 = xp.where(t152, xp.sqrt(t151), 0)
-    t154 = t153*t41 + t153*t43
-    t155 = t148 + t154**2
-    t156 = t153*t143
-    t157 = t153*t144
-    t158 = t150 + c3*t156 + s3*t157
-    t159 = t158 + t148
-    t160 = s3*t156 - c3*t157
-    t161 = t159**2 + t160**2
-    t162 = t153**2
-    t163 = t148 + t162*t41 + t162*t43
-    t164 = 1e-24*t163
-    t165 = xp.less_equal(t161, t149*t164)
-    t166 = xp.where(t165, 1, 1/xp.sqrt(t161))
-    t167 = xp.where(t165, 1, -t159*t166)
-    t168 = xp.where(t165, 0, t160*t166)
-    t169 = t138*(1 - t167)
-    t170 = t146*t167 + t147*t168
-    t171 = t147*t167 - t146*t168
-    t172 = t169 + t138*t167
-    t173 = t170*c3 + t171*s3
-    t174 = t171*c3 - t170*s3
-    t175 = xp.less_equal(t155, t164)
-    t176 = xp.where(t175, 1, 1/xp.sqrt(t155))
-    t177 = xp.where(t175, 1, t135*t176)
-    t178 = xp.where(t175, 0, -t154*t176)
-    t179 = t174*(1 - t177)
-    t180 = t177*t172 + t178*t173
-    t181 = t172*t178
-    t182 = t179*s3 - t177*t170 + c3*t181
-    t183 = t177*t171 + t179*c3 - s3*t181
-    t184 = t183*s3 - t182*c3
-    t185 = t182*s3 + t183*c3
-    t186 = t184**2 + t185**2
-    t187 = t182**2 + t183**2 + t180**2
-    t188 = 1 - t105
-    t189 = T22*t188
-    t190 = t189 + T22*t105
-    t191 = t15*t188
-    t192 = t191 + t105*t15
-    t193 = t115*t107 - t116*t190
-    t194 = t115*t190 + t116*t107
-    t195 = t115*t109 - t116*t192
-    t196 = t115*t192 + t116*t109
-    t197 = 1 - t115
-    t198 = t108*t197
-    t199 = t198 + t115*t108
-    t200 = t110*t197
-    t201 = t200 + t115*t110
-    t202 = t193*c3 + t199*s3
-    t203 = t193*s3 - t199*c3
-    t204 = t203*t139
-    t205 = t36*t194 - t40*t202
-    t206 = t195*c3 + t201*s3
-    t207 = t195*s3 - t201*c3
-    t208 = t207*t139
-    t209 = t36*t196 - t40*t206
-    t210 = t40*t194
-    t211 = t36*t193 + t204*s3 + c3*t210
-    t212 = t36*t199 - t204*c3 + s3*t210
-    t213 = t40*t196
-    t214 = t36*t195 + t208*s3 + c3*t213
-    t215 = t36*t201 - t208*c3 + s3*t213
-    t216 = t205**2
-    t217 = t211**2 + t212**2 + t216
-    t218 = -t216
-    t219 = 1 + t218
-    t220 = xp.greater(t219, 1e-12)
-    t221 = xp.where(t220, xp.sqrt(t219), 0)
-    t222 = t221*t41 + t221*t43
-    t223 = t216 + t222**2
-    t224 = t221*t211
-    t225 = t221*t212
-    t226 = t218 + c3*t224 + s3*t225
-    t227 = t226 + t216
-    t228 = s3*t224 - c3*t225
-    t229 = t227**2 + t228**2
-    t230 = t221**2
-    t231 = t216 + t230*t41 + t230*t43
-    t232 = 1e-24*t231
-    t233 = xp.less_equal(t229, t217*t232)
-    t234 = xp.where(t233, 1, 1/xp.sqrt(t229))
-    t235 = xp.where(t233, 1, -t227*t234)
-    t236 = xp.where(t233, 0, t228*t234)
-    t237 = t209*(1 - t235)
-    t238 = t214*t235 + t215*t236
-    t239 = t215*t235 - t214*t236
-    t240 = t237 + t209*t235
-    t241 = t238*c3 + t239*s3
-    t242 = t239*c3 - t238*s3
-    t243 = xp.less_equal(t223, t232)
-    t244 = xp.where(t243, 1, 1/xp.sqrt(t223))
-    t245 = xp.where(t243, 1, t205*t244)
-    t246 = xp.where(t243, 0, -t222*t244)
-    t247 = t242*(1 - t245)
-    t248 = t245*t240 + t246*t241
-    t249 = t240*t246
-    t250 = t247*s3 - t245*t238 + c3*t249
-    t251 = t245*t239 + t247*c3 - s3*t249
-    t252 = t251*s3 - t250*c3
-    t253 = t250*s3 + t251*c3
-    t254 = t252**2 + t253**2
-    t255 = t250**2 + t251**2 + t248**2
-    t256 = 0.16*t23**2
-    t257 = t43*t256
-    t258 = t29**2 + t41*t256 + t257
-    t259 = t17 + t257
-    t260 = -t258 + t259
-    t261 = -t260
-    t262 = 1e-12*t258
-    t263 = xp.greater(t261, t262)
-    t264 = xp.where(t263, xp.sqrt(t261), 0)
-    t265 = t264**2 + t259
-    t266 = t9*t264
-    t267 = 0.4*t23
-    t268 = t57*t267
-    t269 = t54 + t266 + t268
-    t270 = t269 + t17
-    t271 = t17 + t266 - t268
-    t272 = t271 + t54
-    t273 = t10*t264
-    t274 = t64*t267
-    t275 = -t273 + t274
+    t33 = -t25
+    t34 = -t23
+    t35 = 0.78 + 0.4*t33
+    t36 = -0.36 + t35
+    t37 = -6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t32)) + t32
+    t38 = -6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t37)) + t37
+    t39 = c3**2
+    t40 = 0.16*t34**2
+    t41 = s3**2
+    t42 = t41 + t39
+    t43 = t40*t41
+    t44 = t36**2 + t39*t40 + t43
+    t45 = t17 + t43
+    t46 = -t44 + t45
+    t47 = -t46
+    t48 = 1e-12*t44
+    t49 = xp.greater(t47, t48)
+    t50 = xp.where(t49, xp.sqrt(t47), 0)
+    t51 = t45 + t50**2
+    t52 = -t17
+    t53 = t9*t50
+    t54 = 0.4*t34
+    t55 = s3*t54
+    t56 = t55*t10
+    t57 = t52 + t53 + t56
+    t58 = t17 + t57
+    t59 = t17 + t53 - t56
+    t60 = t52 + t59
+    t61 = t10*t50
+    t62 = t55*t9
+    t63 = -t61 + t62
+    t64 = t58**2 + t63**2
+    t65 = t62 + t61
+    t66 = t60**2 + t65**2
+    t67 = 1e-24*t51
+    t68 = t67*t18
+    t69 = xp.less_equal(t64, t68)
+    t70 = xp.where(t69, 1, 1/xp.sqrt(t64))
+    t71 = xp.where(t69, 1, -t58*t70)
+    t72 = xp.where(t69, 0, t63*t70)
+    t73 = T02*t71 + T12*t72
+    t74 = T12*t71 - T02*t72
+    t75 = t71*t13 + t72*t14
+    t76 = t71*t14 - t72*t13
+    t77 = xp.where(t69, 0, xp.atan2(t63, -t58))
+    t78 = t77 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t77))
+    t79 = c3*t54
+    t80 = t79*t50
+    t81 = t43 + t12*t36
+    t82 = t80 + t81
+    t83 = -t80 + t81
+    t84 = -t43
+    t85 = t82 + t84
+    t86 = t84 + t83
+    t87 = t36*t50
+    t88 = t79*t12
+    t89 = -t87 + t88
+    t90 = t85**2 + t89**2
+    t91 = t88 + t87
+    t92 = t86**2 + t91**2
+    t93 = t67*t44
+    t94 = xp.less_equal(t90, t93)
+    t95 = xp.where(t94, 1, 1/xp.sqrt(t90))
+    t96 = xp.where(t94, 1, t85*t95)
+    t97 = xp.where(t94, 0, t89*t95)
+    t98 = xp.where(t94, 0, xp.atan2(t89, t85))
+    t99 = -6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t98)) + t98
+    t100 = xp.less_equal(t66, t68)
+    t101 = xp.where(t100, 1, 1/xp.sqrt(t66))
+    t102 = xp.where(t100, 1, t60*t101)
+    t103 = xp.where(t100, 0, t65*t101)
+    t104 = T02*t102 + T12*t103
+    t105 = T12*t102 - T02*t103
+    t106 = t13*t102 + t14*t103
+    t107 = t14*t102 - t13*t103
+    t108 = xp.where(t100, 0, xp.atan2(t65, t60))
+    t109 = -6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t108)) + t108
+    t110 = xp.less_equal(t92, t93)
+    t111 = xp.where(t110, 1, 1/xp.sqrt(t92))
+    t112 = xp.where(t110, 1, t86*t111)
+    t113 = xp.where(t110, 0, t91*t111)
+    t114 = xp.where(t110, 0, xp.atan2(t91, t86))
+    t115 = -6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t114)) + t114
+    t116 = 1 - t71
+    t117 = T22*t116
+    t118 = t117 + T22*t71
+    t119 = t116*t15
+    t120 = t119 + t71*t15
+    t121 = t96*t73 - t97*t118
+    t122 = t96*t118 + t73*t97
+    t123 = t96*t75 - t97*t120
+    t124 = t96*t120 + t97*t75
+    t125 = 1 - t96
+    t126 = t74*t125
+    t127 = t126 + t74*t96
+    t128 = t125*t76
+    t129 = t128 + t96*t76
+    t130 = c3*t121 + s3*t127
+    t131 = s3*t121 - c3*t127
+    t132 = t33*t122 - t34*t130
+    t133 = c3*t123 + s3*t129
+    t134 = s3*t123 - c3*t129
+    t135 = t33*t124 - t34*t133
+    t136 = 1 - t33
+    t137 = t131*t136
+    t138 = t136*t134
+    t139 = t34*t122
+    t140 = t33*t121 + s3*t137 + c3*t139
+    t141 = t33*t127 - c3*t137 + s3*t139
+    t142 = t34*t124
+    t143 = t33*t123 + s3*t138 + c3*t142
+    t144 = t33*t129 - c3*t138 + s3*t142
+    t145 = t132**2
+    t146 = t145 + t140**2 + t141**2
+    t147 = -t145
+    t148 = 1 + t147
+    t149 = xp.greater(t148, 1e-12)
+    t150 = xp.where(t149, xp.sqrt(t148), 0)
+    t151 = t39*t150 + t41*t150
+    t152 = t145 + t151**2
+    t153 = t140*t150
+    t154 = t150*t141
+    t155 = t147 + c3*t153 + s3*t154
+    t156 = t145 + t155
+    t157 = s3*t153 - c3*t154
+    t158 = t156**2 + t157**2
+    t159 = t150**2
+    t160 = t145 + t39*t159 + t41*t159
+    t161 = 1e-24*t160
+    t162 = xp.less_equal(t158, t161*t146)
+    t163 = xp.where(t162, 1, 1/xp.sqrt(t158))
+    t164 = xp.where(t162, 1, -t156*t163)
+    t165 = xp.where(t162, 0, t157*t163)
+    t166 = t135*(1 - t164)
+    t167 = t164*t143 + t144*t165
+    t168 = t164*t144 - t143*t165
+    t169 = t166 + t135*t164
+    t170 = c3*t167 + s3*t168
+    t171 = c3*t168 - s3*t167
+    t172 = xp.less_equal(t152, t161)
+    t173 = xp.where(t172, 1, 1/xp.sqrt(t152))
+    t174 = xp.where(t172, 1, t132*t173)
+    t175 = xp.where(t172, 0, -t151*t173)
+    t176 = t171*(1 - t174)
+    t177 = t174*t169 + t175*t170
+    t178 = t175*t169
+    t179 = s3*t176 - t167*t174 + c3*t178
+    t180 = t168*t174 + c3*t176 - s3*t178
+    t181 = s3*t180 - c3*t179
+    t182 = s3*t179 + c3*t180
+    t183 = t181**2 + t182**2
+    t184 = t180**2 + t179**2 + t177**2
+    t185 = 1 - t102
+    t186 = T22*t185
+    t187 = t186 + T22*t102
+    t188 = t15*t185
+    t189 = t188 + t15*t102
+    t190 = t112*t104 - t113*t187
+    t191 = t112*t187 + t104*t113
+    t192 = t112*t106 - t113*t189
+    t193 = t112*t189 + t113*t106
+    t194 = 1 - t112
+    t195 = t105*t194
+    t196 = t195 + t105*t112
+    t197 = t194*t107
+    t198 = t197 + t112*t107
+    t199 = c3*t190 + s3*t196
+    t200 = s3*t190 - c3*t196
+    t201 = t136*t200
+    t202 = t33*t191 - t34*t199
+    t203 = c3*t192 + s3*t198
+    t204 = s3*t192 - c3*t198
+    t205 = t136*t204
+    t206 = t33*t193 - t34*t203
+    t207 = t34*t191
+    t208 = t33*t190 + s3*t201 + c3*t207
+    t209 = t33*t196 - c3*t201 + s3*t207
+    t210 = t34*t193
+    t211 = t33*t192 + s3*t205 + c3*t210
+    t212 = t33*t198 - c3*t205 + s3*t210
+    t213 = t202**2
+    t214 = t213 + t208**2 + t209**2
+    t215 = -t213
+    t216 = 1 + t215
+    t217 = xp.greater(t216, 1e-12)
+    t218 = xp.where(t217, xp.sqrt(t216), 0)
+    t219 = t39*t218 + t41*t218
+    t220 = t213 + t219**2
+    t221 = t208*t218
+    t222 = t218*t209
+    t223 = t215 + c3*t221 + s3*t222
+    t224 = t213 + t223
+    t225 = s3*t221 - c3*t222
+    t226 = t224**2 + t225**2
+    t227 = t218**2
+    t228 = t213 + t39*t227 + t41*t227
+    t229 = 1e-24*t228
+    t230 = xp.less_equal(t226, t229*t214)
+    t231 = xp.where(t230, 1, 1/xp.sqrt(t226))
+    t232 = xp.where(t230, 1, -t224*t231)
+    t233 = xp.where(t230, 0, t225*t231)
+    t234 = t206*(1 - t232)
+    t235 = t232*t211 + t212*t233
+    t236 = t232*t212 - t211*t233
+    t237 = t234 + t206*t232
+    t238 = c3*t235 + s3*t236
+    t239 = c3*t236 - s3*t235
+    t240 = xp.less_equal(t220, t229)
+    t241 = xp.where(t240, 1, 1/xp.sqrt(t220))
+    t242 = xp.where(t240, 1, t202*t241)
+    t243 = xp.where(t240, 0, -t219*t241)
+    t244 = t239*(1 - t242)
+    t245 = t242*t237 + t243*t238
+    t246 = t243*t237
+    t247 = s3*t244 - t235*t242 + c3*t246
+    t248 = t236*t242 + c3*t244 - s3*t246
+    t249 = s3*t248 - c3*t247
+    t250 = s3*t247 + c3*t248
+    t251 = t249**2 + t250**2
+    t252 = t248**2 + t247**2 + t245**2
+    t253 = 0.16*t23**2
+    t254 = t41*t253
+    t255 = t29**2 + t39*t253 + t254
+    t256 = t17 + t254
+    t257 = -t255 + t256
+    t258 = -t257
+    t259 = 1e-12*t255
+    t260 = xp.greater(t258, t259)
+    t261 = xp.where(t260, xp.sqrt(t258), 0)
+    t262 = t256 + t261**2
+    t263 = t9*t261
+    t264 = 0.4*t23
+    t265 = s3*t264
+    t266 = t265*t10
+    t267 = t52 + t263 + t266
+    t268 = t17 + t267
+    t269 = t17 + t263 - t266
+    t270 = t52 + t269
+    t271 = t10*t261
+    t272 = t265*t9
+    t273 = -t271 + t272
+    t274 = t268**2 + t273**2
+    t275 = t271 + t272
     t276 = t270**2 + t275**2
-    t277 = t273 + t274
-    t278 = t272**2 + t277**2
-    t279 = 1e-24*t265
-    t280 = t18*t279
-    t281 = xp.less_equal(t276, t280)
-    t282 = xp.where(t281, 1, 1/xp.sqrt(t276))
-    t283 = xp.where(t281, 1, -t270*t282)
-    t284 = xp.where(t281, 0, t275*t282)
-    t285 = T02*t283 + T12*t284
-    t286 = T12*t283 - T02*t284
-    t287 = t13*t283 + t14*t284
-    t288 = t14*t283 - t13*t284
-    t289 = xp.where(t281, 0, xp.atan2(t275, -t270))
-    t290 = t289 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t289))
-    t291 = c3*t267
-    t292 = t264*t291
-    t293 = t257 + t12*t29
-    t294 = t292 + t293
-    t295 = -t292 + t293
-    t296 = -t257
-    t297 = t294 + t296
-    t298 = t295 + t296
-    t299 = t29*t264
-    t300 = t12*t291
-    t301 = -t299 + t300
-    t302 = t297**2 + t301**2
-    t303 = t299 + t300
-    t304 = t298**2 + t303**2
-    t305 = t258*t279
-    t306 = xp.less_equal(t302, t305)
-    t307 = xp.where(t306, 1, 1/xp.sqrt(t302))
-    t308 = xp.where(t306, 1, t297*t307)
-    t309 = xp.where(t306, 0, t301*t307)
-    t310 = xp.where(t306, 0, xp.atan2(t301, t297))
-    t311 = t310 - 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t310))
-    t312 = xp.less_equal(t278, t280)
-    t313 = xp.where(t312, 1, 1/xp.sqrt(t278))
-    t314 = xp.where(t312, 1, t272*t313)
-    t315 = xp.where(t312, 0, t277*t313)
-    t316 = T02*t314 + T12*t315
-    t317 = T12*t314 - T02*t315
-    t318 = t13*t314 + t14*t315
-    t319 = t14*t314 - t13*t315
-    t320 = xp.where(t312, 0, xp.atan2(t277, t272))
-    t321 = t320 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t320))
-    t322 = xp.less_equal(t304, t305)
-    t323 = xp.where(t322, 1, 1/xp.sqrt(t304))
-    t324 = xp.where(t322, 1, t298*t323)
-    t325 = xp.where(t322, 0, t303*t323)
-    t326 = xp.where(t322, 0, xp.atan2(t303, t298))
-    t327 = t326 - 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t326))
-    t328 = 1 - t283
-    t329 = T22*t328
-    t330 = t329 + T22*t283
-    t331 = t15*t328
-    t332 = t331 + t15*t283
-    t333 = t308*t285 - t309*t330
-    t334 = t308*t330 + t309*t285
-    t335 = t308*t287 - t309*t332
-    t336 = t308*t332 + t309*t287
-    t337 = 1 - t308
-    t338 = t286*t337
-    t339 = t338 + t308*t286
-    t340 = t288*t337
-    t341 = t340 + t308*t288
-    t342 = t333*c3 + t339*s3
-    t343 = t333*s3 - t339*c3
-    t344 = t334*t35 + t342*t39
-    t345 = t335*c3 + t341*s3
-    t346 = t335*s3 - t341*c3
-    t347 = t336*t35 + t345*t39
-    t348 = 1 + t35
-    t349 = t343*t348
-    t350 = t346*t348
-    t351 = t334*t39
-    t352 = t349*s3 - t333*t35 + c3*t351
-    t353 = t349*c3 + t339*t35 - s3*t351
-    t354 = t336*t39
-    t355 = t350*s3 - t335*t35 + c3*t354
-    t356 = t350*c3 + t341*t35 - s3*t354
-    t357 = t344**2
-    t358 = t352**2 + t353**2 + t357
-    t359 = -t357
-    t360 = 1 + t359
-    t361 = xp.greater(t360, 1e-12)
-    t362 = xp.where(t361, xp.sqrt(t360), 0)
-    t363 = t362*t41 + t362*t43
-    t364 = t357 + t363**2
-    t365 = s3*t362
-    t366 = c3*t362
-    t367 = t357 + t353*t365 - t352*t366
-    t368 = t367 + t359
-    t369 = t352*t365 + t353*t366
-    t370 = t368**2 + t369**2
-    t371 = t362**2
-    t372 = t357 + t371*t41 + t371*t43
-    t373 = 1e-24*t372
-    t374 = xp.less_equal(t370, t358*t373)
-    t375 = xp.where(t374, 1, 1/xp.sqrt(t370))
-    t376 = xp.where(t374, 1, t368*t375)
-    t377 = xp.where(t374, 0, t369*t375)
-    t378 = t347*(1 - t376)
-    t379 = t355*t376 - t356*t377
-    t380 = t355*t377 + t356*t376
-    t381 = t378 + t347*t376
-    t382 = t380*s3 - t379*c3
-    t383 = t379*s3 + t380*c3
-    t384 = xp.less_equal(t364, t373)
-    t385 = xp.where(t384, 1, 1/xp.sqrt(t364))
-    t386 = xp.where(t384, 1, -t344*t385)
-    t387 = xp.where(t384, 0, -t363*t385)
-    t388 = t383*(1 - t386)
-    t389 = t386*t381 + t387*t382
-    t390 = t381*t387
-    t391 = t386*t379 + t388*s3 + c3*t390
-    t392 = t386*t380 + t388*c3 - s3*t390
-    t393 = t391*c3 - t392*s3
-    t394 = t391*s3 + t392*c3
-    t395 = t393**2 + t394**2
-    t396 = t391**2 + t392**2 + t389**2
-    t397 = 1 - t314
-    t398 = T22*t397
-    t399 = t398 + T22*t314
-    t400 = t15*t397
-    t401 = t400 + t15*t314
-    t402 = t324*t316 - t325*t399
-    t403 = t324*t399 + t325*t316
-    t404 = t324*t318 - t325*t401
-    t405 = t324*t401 + t325*t318
-    t406 = 1 - t324
-    t407 = t317*t406
-    t408 = t407 + t324*t317
-    t409 = t319*t406
-    t410 = t409 + t324*t319
-    t411 = t402*c3 + t408*s3
-    t412 = t402*s3 - t408*c3
-    t413 = t412*t348
-    t414 = t403*t35 + t411*t39
-    t415 = t404*c3 + t410*s3
-    t416 = t404*s3 - t410*c3
-    t417 = t416*t348
-    t418 = t405*t35 + t415*t39
-    t419 = t403*t39
-    t420 = t413*s3 - t402*t35 + c3*t419
-    t421 = t413*c3 + t408*t35 - s3*t419
-    t422 = t405*t39
-    t423 = t417*s3 - t404*t35 + c3*t422
-    t424 = t417*c3 + t410*t35 - s3*t422
-    t425 = t414**2
-    t426 = t420**2 + t421**2 + t425
-    t427 = -t425
-    t428 = 1 + t427
-    t429 = xp.greater(t428, 1e-12)
-    t430 = xp.where(t429, xp.sqrt(t428), 0)
-    t431 = t430*t41 + t430*t43
-    t432 = t425 + t431**2
-    t433 = s3*t430
-    t434 = c3*t430
-    t435 = t425 + t421*t433 - t420*t434
-    t436 = t435 + t427
-    t437 = t420*t433 + t421*t434
-    t438 = t436**2 + t437**2
-    t439 = t430**2
-    t440 = t425 + t439*t41 + t439*t43
-    t441 = 1e-24*t440
-    t442 = xp.less_equal(t438, t426*t441)
-    t443 = xp.where(t442, 1, 1/xp.sqrt(t438))
-    t444 = xp.where(t442, 1, t436*t443)
-    t445 = xp.where(t442, 0, t437*t443)
-    t446 = t418*(1 - t444)
-    t447 = t423*t444 - t424*t445
-    t448 = t423*t445 + t424*t444
-    t449 = t446 + t418*t444
-    t450 = t448*s3 - t447*c3
-    t451 = t447*s3 + t448*c3
-    t452 = xp.less_equal(t432, t441)
-    t453 = xp.where(t452, 1, 1/xp.sqrt(t432))
-    t454 = xp.where(t452, 1, -t414*t453)
-    t455 = xp.where(t452, 0, -t431*t453)
-    t456 = t451*(1 - t454)
-    t457 = t454*t449 + t455*t450
-    t458 = t449*t455
-    t459 = t454*t447 + t456*s3 + c3*t458
-    t460 = t454*t448 + t456*c3 - s3*t458
-    t461 = t459*c3 - t460*s3
-    t462 = t459*s3 + t460*c3
-    t463 = t461**2 + t462**2
-    t464 = t459**2 + t460**2 + t457**2
-    t465 = xp.where(t165, 0, xp.atan2(t160, -t159))
-    t466 = t465
-    t467 = t466 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t466))
-    t468 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t465) + t465
-    t469 = t468 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t468))
-    t470 = xp.where(t175, 0, xp.atan2(-t154, t135))
-    t471 = t470
-    t472 = t471 - 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t471))
-    t473 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t470)) + t470
-    t474 = 1e-24*t44
-    t475 = xp.where(xp.less_equal(t186, t187*t474), 0, xp.atan2(t185, t184))
-    t476 = t475
-    t477 = t476 - 6.283185307179586*xp.floor(0.15915494309189535*(3.0543261909900767 + t476))
-    t478 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t475) + t475
-    t479 = t478 - 6.283185307179586*xp.floor(0.15915494309189535*(3.0543261909900767 + t478))
-    t480 = -t473
-    t481 = t473 + 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t480))
-    t482 = xp.where(t233, 0, xp.atan2(t228, -t227))
-    t483 = t482
-    t484 = t483 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t483))
-    t485 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t482) + t482
-    t486 = t485 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t485))
-    t487 = xp.where(t243, 0, xp.atan2(-t222, t205))
-    t488 = t487
-    t489 = t488 - 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t488))
-    t490 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t487)) + t487
-    t491 = xp.where(xp.less_equal(t254, t255*t474), 0, xp.atan2(t253, t252))
-    t492 = t491
-    t493 = t492 - 6.283185307179586*xp.floor(0.15915494309189535*(3.0543261909900767 + t492))
-    t494 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t491) + t491
-    t495 = t494 - 6.283185307179586*xp.floor(0.15915494309189535*(3.0543261909900767 + t494))
-    t496 = -t490
-    t497 = t490 + 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t496))
-    t498 = xp.where(t374, 0, xp.atan2(t369, t368))
-    t499 = t498
-    t500 = t499 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t499))
-    t501 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t498) + t498
-    t502 = t501 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t501))
-    t503 = xp.where(t384, 0, xp.atan2(-t363, -t344))
-    t504 = t503
-    t505 = t504 - 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t504))
-    t506 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t503)) + t503
-    t507 = xp.where(xp.less_equal(t395, t396*t474), 0, xp.atan2(-t394, t393))
-    t508 = t507
-    t509 = t508 - 6.283185307179586*xp.floor(0.15915494309189535*(3.0543261909900767 + t508))
-    t510 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t507) + t507
-    t511 = t510 - 6.283185307179586*xp.floor(0.15915494309189535*(3.0543261909900767 + t510))
-    t512 = -t506
-    t513 = t506 + 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t512))
-    t514 = xp.where(t442, 0, xp.atan2(t437, t436))
-    t515 = t514
-    t516 = t515 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t515))
-    t517 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t514) + t514
-    t518 = t517 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t517))
-    t519 = xp.where(t452, 0, xp.atan2(-t431, -t414))
-    t520 = t519
-    t521 = t520 - 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t520))
-    t522 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t519)) + t519
-    t523 = xp.where(xp.less_equal(t463, t464*t474), 0, xp.atan2(-t462, t461))
-    t524 = t523
-    t525 = t524 - 6.283185307179586*xp.floor(0.15915494309189535*(3.0543261909900767 + t524))
-    t526 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t523) + t523
-    t527 = t526 - 6.283185307179586*xp.floor(0.15915494309189535*(3.0543261909900767 + t526))
-    t528 = -t522
-    t529 = t522 + 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t528))
-    t530 = xp.less_equal(t81, 2.9670597283903604)
-    t531 = xp.greater_equal(t80, -2.9670597283903604) & xp.less_equal(t80, 2.9670597283903604)
-    t532 = xp.where(t530 & xp.logical_not(t531), t81, t80)
-    t533 = xp.less_equal(t102, 2.0943951023931953)
-    t534 = xp.greater_equal(t101, -2.0943951023931953) & xp.less_equal(t101, 2.0943951023931953)
-    t535 = xp.where(t533 & xp.logical_not(t534), t102, t101)
-    t536 = xp.less_equal(t34, 2.0943951023931953)
-    t537 = xp.greater_equal(t33, -2.0943951023931953) & xp.less_equal(t33, 2.0943951023931953)
-    t538 = xp.where(t536 & xp.logical_not(t537), t34, t33)
-    t539 = xp.less_equal(t467, 2.9670597283903604)
-    t540 = xp.greater_equal(t466, -2.9670597283903604) & xp.less_equal(t466, 2.9670597283903604)
-    t541 = xp.less_equal(t472, 2.0943951023931953)
-    t542 = xp.greater_equal(t471, -2.0943951023931953) & xp.less_equal(t471, 2.0943951023931953)
-    t543 = xp.less_equal(t477, 3.0543261909900767)
-    t544 = xp.greater_equal(t476, -3.0543261909900767) & xp.less_equal(t476, 3.0543261909900767)
-    t545 = xp.less_equal(t469, 2.9670597283903604)
-    t546 = xp.greater_equal(t468, -2.9670597283903604) & xp.less_equal(t468, 2.9670597283903604)
-    t547 = -t481
-    t548 = xp.less_equal(t547, 2.0943951023931953)
-    t549 = xp.greater_equal(t480, -2.0943951023931953) & xp.less_equal(t480, 2.0943951023931953)
-    t550 = xp.less_equal(t479, 3.0543261909900767)
-    t551 = xp.greater_equal(t478, -3.0543261909900767) & xp.less_equal(t478, 3.0543261909900767)
-    t552 = xp.less_equal(t112, 2.9670597283903604)
-    t553 = xp.greater_equal(t111, -2.9670597283903604) & xp.less_equal(t111, 2.9670597283903604)
-    t554 = xp.where(t552 & xp.logical_not(t553), t112, t111)
-    t555 = xp.less_equal(t118, 2.0943951023931953)
-    t556 = xp.greater_equal(t117, -2.0943951023931953) & xp.less_equal(t117, 2.0943951023931953)
-    t557 = xp.where(t555 & xp.logical_not(t556), t118, t117)
-    t558 = xp.less_equal(t484, 2.9670597283903604)
-    t559 = xp.greater_equal(t483, -2.9670597283903604) & xp.less_equal(t483, 2.9670597283903604)
-    t560 = xp.less_equal(t489, 2.0943951023931953)
-    t561 = xp.greater_equal(t488, -2.0943951023931953) & xp.less_equal(t488, 2.0943951023931953)
-    t562 = xp.less_equal(t493, 3.0543261909900767)
-    t563 = xp.greater_equal(t492, -3.0543261909900767) & xp.less_equal(t492, 3.0543261909900767)
-    t564 = xp.less_equal(t486, 2.9670597283903604)
-    t565 = xp.greater_equal(t485, -2.9670597283903604) & xp.less_equal(t485, 2.9670597283903604)
-    t566 = -t497
-    t567 = xp.less_equal(t566, 2.0943951023931953)
-    t568 = xp.greater_equal(t496, -2.0943951023931953) & xp.less_equal(t496, 2.0943951023931953)
-    t569 = xp.less_equal(t495, 3.0543261909900767)
-    t570 = xp.greater_equal(t494, -3.0543261909900767) & xp.less_equal(t494, 3.0543261909900767)
-    t571 = xp.less_equal(t290, 2.9670597283903604)
-    t572 = xp.greater_equal(t289, -2.9670597283903604) & xp.less_equal(t289, 2.9670597283903604)
-    t573 = xp.where(t571 & xp.logical_not(t572), t290, t289)
-    t574 = xp.less_equal(t311, 2.0943951023931953)
-    t575 = xp.greater_equal(t310, -2.0943951023931953) & xp.less_equal(t310, 2.0943951023931953)
-    t576 = xp.where(t574 & xp.logical_not(t575), t311, t310)
-    t577 = xp.less_equal(t31, 2.0943951023931953)
-    t578 = xp.greater_equal(t30, -2.0943951023931953) & xp.less_equal(t30, 2.0943951023931953)
-    t579 = xp.where(t577 & xp.logical_not(t578), t31, t30)
-    t580 = xp.less_equal(t500, 2.9670597283903604)
-    t581 = xp.greater_equal(t499, -2.9670597283903604) & xp.less_equal(t499, 2.9670597283903604)
-    t582 = xp.less_equal(t505, 2.0943951023931953)
-    t583 = xp.greater_equal(t504, -2.0943951023931953) & xp.less_equal(t504, 2.0943951023931953)
-    t584 = xp.less_equal(t509, 3.0543261909900767)
-    t585 = xp.greater_equal(t508, -3.0543261909900767) & xp.less_equal(t508, 3.0543261909900767)
-    t586 = xp.less_equal(t502, 2.9670597283903604)
-    t587 = xp.greater_equal(t501, -2.9670597283903604) & xp.less_equal(t501, 2.9670597283903604)
-    t588 = -t513
-    t589 = xp.less_equal(t588, 2.0943951023931953)
-    t590 = xp.greater_equal(t512, -2.0943951023931953) & xp.less_equal(t512, 2.0943951023931953)
-    t591 = xp.less_equal(t511, 3.0543261909900767)
-    t592 = xp.greater_equal(t510, -3.0543261909900767) & xp.less_equal(t510, 3.0543261909900767)
-    t593 = xp.less_equal(t321, 2.9670597283903604)
-    t594 = xp.greater_equal(t320, -2.9670597283903604) & xp.less_equal(t320, 2.9670597283903604)
-    t595 = xp.where(t593 & xp.logical_not(t594), t321, t320)
-    t596 = xp.less_equal(t327, 2.0943951023931953)
-    t597 = xp.greater_equal(t326, -2.0943951023931953) & xp.less_equal(t326, 2.0943951023931953)
-    t598 = xp.where(t596 & xp.logical_not(t597), t327, t326)
-    t599 = xp.less_equal(t516, 2.9670597283903604)
-    t600 = xp.greater_equal(t515, -2.9670597283903604) & xp.less_equal(t515, 2.9670597283903604)
-    t601 = xp.less_equal(t521, 2.0943951023931953)
-    t602 = xp.greater_equal(t520, -2.0943951023931953) & xp.less_equal(t520, 2.0943951023931953)
-    t603 = xp.less_equal(t525, 3.0543261909900767)
-    t604 = xp.greater_equal(t524, -3.0543261909900767) & xp.less_equal(t524, 3.0543261909900767)
-    t605 = xp.less_equal(t518, 2.9670597283903604)
-    t606 = xp.greater_equal(t517, -2.9670597283903604) & xp.less_equal(t517, 2.9670597283903604)
-    t607 = -t529
-    t608 = xp.less_equal(t607, 2.0943951023931953)
-    t609 = xp.greater_equal(t528, -2.0943951023931953) & xp.less_equal(t528, 2.0943951023931953)
-    t610 = xp.less_equal(t527, 3.0543261909900767)
-    t611 = xp.greater_equal(t526, -3.0543261909900767) & xp.less_equal(t526, 3.0543261909900767)
-    t612 = xp.isfinite(t16)
-    t613 = xp.greater_equal(t49, -t50)
-    t614 = xp.greater_equal(t21, -1e-12)
-    t615 = xp.greater_equal(t261, -t262)
-    t616 = xp.greater_equal(q3, -2.9670597283903604)
-    t617 = xp.less_equal(q3, 2.9670597283903604)
-    t618 = t530 | t531
-    t619 = t533 | t534
-    t620 = t536 | t537
-    t621 = t552 | t553
-    t622 = t555 | t556
-    t623 = t571 | t572
-    t624 = t574 | t575
-    t625 = t577 | t578
-    t626 = t593 | t594
-    t627 = t596 | t597
+    t277 = 1e-24*t262
+    t278 = t277*t18
+    t279 = xp.less_equal(t274, t278)
+    t280 = xp.where(t279, 1, 1/xp.sqrt(t274))
+    t281 = xp.where(t279, 1, -t268*t280)
+    t282 = xp.where(t279, 0, t273*t280)
+    t283 = T02*t281 + T12*t282
+    t284 = T12*t281 - T02*t282
+    t285 = t13*t281 + t14*t282
+    t286 = t14*t281 - t13*t282
+    t287 = xp.where(t279, 0, xp.atan2(t273, -t268))
+    t288 = -6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t287)) + t287
+    t289 = c3*t264
+    t290 = t289*t261
+    t291 = t254 + t12*t29
+    t292 = t290 + t291
+    t293 = -t290 + t291
+    t294 = -t254
+    t295 = t292 + t294
+    t296 = t293 + t294
+    t297 = t29*t261
+    t298 = t289*t12
+    t299 = -t297 + t298
+    t300 = t295**2 + t299**2
+    t301 = t297 + t298
+    t302 = t296**2 + t301**2
+    t303 = t277*t255
+    t304 = xp.less_equal(t300, t303)
+    t305 = xp.where(t304, 1, 1/xp.sqrt(t300))
+    t306 = xp.where(t304, 1, t295*t305)
+    t307 = xp.where(t304, 0, t299*t305)
+    t308 = xp.where(t304, 0, xp.atan2(t299, t295))
+    t309 = -6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t308)) + t308
+    t310 = xp.less_equal(t276, t278)
+    t311 = xp.where(t310, 1, 1/xp.sqrt(t276))
+    t312 = xp.where(t310, 1, t270*t311)
+    t313 = xp.where(t310, 0, t275*t311)
+    t314 = T02*t312 + T12*t313
+    t315 = T12*t312 - T02*t313
+    t316 = t13*t312 + t14*t313
+    t317 = t14*t312 - t13*t313
+    t318 = xp.where(t310, 0, xp.atan2(t275, t270))
+    t319 = -6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t318)) + t318
+    t320 = xp.less_equal(t302, t303)
+    t321 = xp.where(t320, 1, 1/xp.sqrt(t302))
+    t322 = xp.where(t320, 1, t296*t321)
+    t323 = xp.where(t320, 0, t301*t321)
+    t324 = xp.where(t320, 0, xp.atan2(t301, t296))
+    t325 = -6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t324)) + t324
+    t326 = 1 - t281
+    t327 = T22*t326
+    t328 = t327 + T22*t281
+    t329 = t15*t326
+    t330 = t329 + t15*t281
+    t331 = t306*t283 - t307*t328
+    t332 = t306*t328 + t283*t307
+    t333 = t306*t285 - t307*t330
+    t334 = t306*t330 + t307*t285
+    t335 = 1 - t306
+    t336 = t284*t335
+    t337 = t336 + t284*t306
+    t338 = t335*t286
+    t339 = t338 + t306*t286
+    t340 = c3*t331 + s3*t337
+    t341 = s3*t331 - c3*t337
+    t342 = t25*t332 + t23*t340
+    t343 = c3*t333 + s3*t339
+    t344 = s3*t333 - c3*t339
+    t345 = t25*t334 + t23*t343
+    t346 = 1 + t25
+    t347 = t341*t346
+    t348 = t344*t346
+    t349 = t23*t332
+    t350 = s3*t347 - t25*t331 + c3*t349
+    t351 = c3*t347 + t25*t337 - s3*t349
+    t352 = t23*t334
+    t353 = s3*t348 - t25*t333 + c3*t352
+    t354 = c3*t348 + t25*t339 - s3*t352
+    t355 = t342**2
+    t356 = t355 + t351**2 + t350**2
+    t357 = -t355
+    t358 = 1 + t357
+    t359 = xp.greater(t358, 1e-12)
+    t360 = xp.where(t359, xp.sqrt(t358), 0)
+    t361 = t39*t360 + t41*t360
+    t362 = t355 + t361**2
+    t363 = s3*t360
+    t364 = c3*t360
+    t365 = t355 + t363*t351 - t364*t350
+    t366 = t357 + t365
+    t367 = t363*t350 + t364*t351
+    t368 = t366**2 + t367**2
+    t369 = t360**2
+    t370 = t355 + t39*t369 + t41*t369
+    t371 = 1e-24*t370
+    t372 = xp.less_equal(t368, t371*t356)
+    t373 = xp.where(t372, 1, 1/xp.sqrt(t368))
+    t374 = xp.where(t372, 1, t366*t373)
+    t375 = xp.where(t372, 0, t367*t373)
+    t376 = t345*(1 - t374)
+    t377 = t374*t353 - t354*t375
+    t378 = t353*t375 + t374*t354
+    t379 = t376 + t345*t374
+    t380 = s3*t378 - c3*t377
+    t381 = s3*t377 + c3*t378
+    t382 = xp.less_equal(t362, t371)
+    t383 = xp.where(t382, 1, 1/xp.sqrt(t362))
+    t384 = xp.where(t382, 1, -t342*t383)
+    t385 = xp.where(t382, 0, -t361*t383)
+    t386 = t381*(1 - t384)
+    t387 = t384*t379 + t385*t380
+    t388 = t385*t379
+    t389 = t377*t384 + s3*t386 + c3*t388
+    t390 = t378*t384 + c3*t386 - s3*t388
+    t391 = c3*t389 - s3*t390
+    t392 = s3*t389 + c3*t390
+    t393 = t391**2 + t392**2
+    t394 = t389**2 + t390**2 + t387**2
+    t395 = 1 - t312
+    t396 = T22*t395
+    t397 = t396 + T22*t312
+    t398 = t15*t395
+    t399 = t398 + t15*t312
+    t400 = t322*t314 - t323*t397
+    t401 = t322*t397 + t314*t323
+    t402 = t322*t316 - t323*t399
+    t403 = t322*t399 + t323*t316
+    t404 = 1 - t322
+    t405 = t315*t404
+    t406 = t405 + t315*t322
+    t407 = t404*t317
+    t408 = t407 + t322*t317
+    t409 = c3*t400 + s3*t406
+    t410 = s3*t400 - c3*t406
+    t411 = t410*t346
+    t412 = t25*t401 + t23*t409
+    t413 = c3*t402 + s3*t408
+    t414 = s3*t402 - c3*t408
+    t415 = t414*t346
+    t416 = t25*t403 + t23*t413
+    t417 = t23*t401
+    t418 = s3*t411 - t25*t400 + c3*t417
+    t419 = c3*t411 + t25*t406 - s3*t417
+    t420 = t23*t403
+    t421 = s3*t415 - t25*t402 + c3*t420
+    t422 = c3*t415 + t25*t408 - s3*t420
+    t423 = t412**2
+    t424 = t423 + t419**2 + t418**2
+    t425 = -t423
+    t426 = 1 + t425
+    t427 = xp.greater(t426, 1e-12)
+    t428 = xp.where(t427, xp.sqrt(t426), 0)
+    t429 = t39*t428 + t41*t428
+    t430 = t423 + t429**2
+    t431 = s3*t428
+    t432 = c3*t428
+    t433 = t423 + t431*t419 - t432*t418
+    t434 = t425 + t433
+    t435 = t431*t418 + t432*t419
+    t436 = t434**2 + t435**2
+    t437 = t428**2
+    t438 = t423 + t39*t437 + t41*t437
+    t439 = 1e-24*t438
+    t440 = xp.less_equal(t436, t439*t424)
+    t441 = xp.where(t440, 1, 1/xp.sqrt(t436))
+    t442 = xp.where(t440, 1, t434*t441)
+    t443 = xp.where(t440, 0, t435*t441)
+    t444 = t416*(1 - t442)
+    t445 = t442*t421 - t422*t443
+    t446 = t421*t443 + t442*t422
+    t447 = t444 + t416*t442
+    t448 = s3*t446 - c3*t445
+    t449 = s3*t445 + c3*t446
+    t450 = xp.less_equal(t430, t439)
+    t451 = xp.where(t450, 1, 1/xp.sqrt(t430))
+    t452 = xp.where(t450, 1, -t412*t451)
+    t453 = xp.where(t450, 0, -t429*t451)
+    t454 = t449*(1 - t452)
+    t455 = t452*t447 + t453*t448
+    t456 = t453*t447
+    t457 = t445*t452 + s3*t454 + c3*t456
+    t458 = t446*t452 + c3*t454 - s3*t456
+    t459 = c3*t457 - s3*t458
+    t460 = s3*t457 + c3*t458
+    t461 = t459**2 + t460**2
+    t462 = t457**2 + t458**2 + t455**2
+    t463 = xp.where(t162, 0, xp.atan2(t157, -t156))
+    t464 = t463
+    t465 = -6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t464)) + t464
+    t466 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t463) + t463
+    t467 = -6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t466)) + t466
+    t468 = xp.where(t172, 0, xp.atan2(-t151, t132))
+    t469 = t468
+    t470 = -6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t469)) + t469
+    t471 = t468 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t468))
+    t472 = 1e-24*t42
+    t473 = xp.where(xp.less_equal(t183, t184*t472), 0, xp.atan2(t182, t181))
+    t474 = t473
+    t475 = -6.283185307179586*xp.floor(0.15915494309189535*(3.0543261909900767 + t474)) + t474
+    t476 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t473) + t473
+    t477 = -6.283185307179586*xp.floor(0.15915494309189535*(3.0543261909900767 + t476)) + t476
+    t478 = -t471
+    t479 = 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t478)) + t471
+    t480 = xp.where(t230, 0, xp.atan2(t225, -t224))
+    t481 = t480
+    t482 = -6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t481)) + t481
+    t483 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t480) + t480
+    t484 = -6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t483)) + t483
+    t485 = xp.where(t240, 0, xp.atan2(-t219, t202))
+    t486 = t485
+    t487 = -6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t486)) + t486
+    t488 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t485)) + t485
+    t489 = xp.where(xp.less_equal(t251, t252*t472), 0, xp.atan2(t250, t249))
+    t490 = t489
+    t491 = -6.283185307179586*xp.floor(0.15915494309189535*(3.0543261909900767 + t490)) + t490
+    t492 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t489) + t489
+    t493 = -6.283185307179586*xp.floor(0.15915494309189535*(3.0543261909900767 + t492)) + t492
+    t494 = -t488
+    t495 = 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t494)) + t488
+    t496 = xp.where(t372, 0, xp.atan2(t367, t366))
+    t497 = t496
+    t498 = -6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t497)) + t497
+    t499 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t496) + t496
+    t500 = -6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t499)) + t499
+    t501 = xp.where(t382, 0, xp.atan2(-t361, -t342))
+    t502 = t501
+    t503 = -6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t502)) + t502
+    t504 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t501)) + t501
+    t505 = xp.where(xp.less_equal(t393, t394*t472), 0, xp.atan2(-t392, t391))
+    t506 = t505
+    t507 = -6.283185307179586*xp.floor(0.15915494309189535*(3.0543261909900767 + t506)) + t506
+    t508 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t505) + t505
+    t509 = -6.283185307179586*xp.floor(0.15915494309189535*(3.0543261909900767 + t508)) + t508
+    t510 = -t504
+    t511 = 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t510)) + t504
+    t512 = xp.where(t440, 0, xp.atan2(t435, t434))
+    t513 = t512
+    t514 = -6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t513)) + t513
+    t515 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t512) + t512
+    t516 = -6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t515)) + t515
+    t517 = xp.where(t450, 0, xp.atan2(-t429, -t412))
+    t518 = t517
+    t519 = -6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t518)) + t518
+    t520 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t517)) + t517
+    t521 = xp.where(xp.less_equal(t461, t462*t472), 0, xp.atan2(-t460, t459))
+    t522 = t521
+    t523 = -6.283185307179586*xp.floor(0.15915494309189535*(3.0543261909900767 + t522)) + t522
+    t524 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t521) + t521
+    t525 = -6.283185307179586*xp.floor(0.15915494309189535*(3.0543261909900767 + t524)) + t524
+    t526 = -t520
+    t527 = 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t526)) + t520
+    t528 = xp.less_equal(t78, 2.9670597283903604)
+    t529 = xp.greater_equal(t77, -2.9670597283903604) & xp.less_equal(t77, 2.9670597283903604)
+    t530 = xp.where(t528 & xp.logical_not(t529), t78, t77)
+    t531 = xp.less_equal(t99, 2.0943951023931953)
+    t532 = xp.greater_equal(t98, -2.0943951023931953) & xp.less_equal(t98, 2.0943951023931953)
+    t533 = xp.where(t531 & xp.logical_not(t532), t99, t98)
+    t534 = xp.less_equal(t38, 2.0943951023931953)
+    t535 = xp.greater_equal(t37, -2.0943951023931953) & xp.less_equal(t37, 2.0943951023931953)
+    t536 = xp.where(t534 & xp.logical_not(t535), t38, t37)
+    t537 = xp.less_equal(t465, 2.9670597283903604)
+    t538 = xp.greater_equal(t464, -2.9670597283903604) & xp.less_equal(t464, 2.9670597283903604)
+    t539 = xp.less_equal(t470, 2.0943951023931953)
+    t540 = xp.greater_equal(t469, -2.0943951023931953) & xp.less_equal(t469, 2.0943951023931953)
+    t541 = xp.less_equal(t475, 3.0543261909900767)
+    t542 = xp.greater_equal(t474, -3.0543261909900767) & xp.less_equal(t474, 3.0543261909900767)
+    t543 = xp.less_equal(t467, 2.9670597283903604)
+    t544 = xp.greater_equal(t466, -2.9670597283903604) & xp.less_equal(t466, 2.9670597283903604)
+    t545 = -t479
+    t546 = xp.less_equal(t545, 2.0943951023931953)
+    t547 = xp.greater_equal(t478, -2.0943951023931953) & xp.less_equal(t478, 2.0943951023931953)
+    t548 = xp.less_equal(t477, 3.0543261909900767)
+    t549 = xp.greater_equal(t476, -3.0543261909900767) & xp.less_equal(t476, 3.0543261909900767)
+    t550 = xp.less_equal(t109, 2.9670597283903604)
+    t551 = xp.greater_equal(t108, -2.9670597283903604) & xp.less_equal(t108, 2.9670597283903604)
+    t552 = xp.where(t550 & xp.logical_not(t551), t109, t108)
+    t553 = xp.less_equal(t115, 2.0943951023931953)
+    t554 = xp.greater_equal(t114, -2.0943951023931953) & xp.less_equal(t114, 2.0943951023931953)
+    t555 = xp.where(t553 & xp.logical_not(t554), t115, t114)
+    t556 = xp.less_equal(t482, 2.9670597283903604)
+    t557 = xp.greater_equal(t481, -2.9670597283903604) & xp.less_equal(t481, 2.9670597283903604)
+    t558 = xp.less_equal(t487, 2.0943951023931953)
+    t559 = xp.greater_equal(t486, -2.0943951023931953) & xp.less_equal(t486, 2.0943951023931953)
+    t560 = xp.less_equal(t491, 3.0543261909900767)
+    t561 = xp.greater_equal(t490, -3.0543261909900767) & xp.less_equal(t490, 3.0543261909900767)
+    t562 = xp.less_equal(t484, 2.9670597283903604)
+    t563 = xp.greater_equal(t483, -2.9670597283903604) & xp.less_equal(t483, 2.9670597283903604)
+    t564 = -t495
+    t565 = xp.less_equal(t564, 2.0943951023931953)
+    t566 = xp.greater_equal(t494, -2.0943951023931953) & xp.less_equal(t494, 2.0943951023931953)
+    t567 = xp.less_equal(t493, 3.0543261909900767)
+    t568 = xp.greater_equal(t492, -3.0543261909900767) & xp.less_equal(t492, 3.0543261909900767)
+    t569 = xp.less_equal(t288, 2.9670597283903604)
+    t570 = xp.greater_equal(t287, -2.9670597283903604) & xp.less_equal(t287, 2.9670597283903604)
+    t571 = xp.where(t569 & xp.logical_not(t570), t288, t287)
+    t572 = xp.less_equal(t309, 2.0943951023931953)
+    t573 = xp.greater_equal(t308, -2.0943951023931953) & xp.less_equal(t308, 2.0943951023931953)
+    t574 = xp.where(t572 & xp.logical_not(t573), t309, t308)
+    t575 = xp.less_equal(t31, 2.0943951023931953)
+    t576 = xp.greater_equal(t30, -2.0943951023931953) & xp.less_equal(t30, 2.0943951023931953)
+    t577 = xp.where(t575 & xp.logical_not(t576), t31, t30)
+    t578 = xp.less_equal(t498, 2.9670597283903604)
+    t579 = xp.greater_equal(t497, -2.9670597283903604) & xp.less_equal(t497, 2.9670597283903604)
+    t580 = xp.less_equal(t503, 2.0943951023931953)
+    t581 = xp.greater_equal(t502, -2.0943951023931953) & xp.less_equal(t502, 2.0943951023931953)
+    t582 = xp.less_equal(t507, 3.0543261909900767)
+    t583 = xp.greater_equal(t506, -3.0543261909900767) & xp.less_equal(t506, 3.0543261909900767)
+    t584 = xp.less_equal(t500, 2.9670597283903604)
+    t585 = xp.greater_equal(t499, -2.9670597283903604) & xp.less_equal(t499, 2.9670597283903604)
+    t586 = -t511
+    t587 = xp.less_equal(t586, 2.0943951023931953)
+    t588 = xp.greater_equal(t510, -2.0943951023931953) & xp.less_equal(t510, 2.0943951023931953)
+    t589 = xp.less_equal(t509, 3.0543261909900767)
+    t590 = xp.greater_equal(t508, -3.0543261909900767) & xp.less_equal(t508, 3.0543261909900767)
+    t591 = xp.less_equal(t319, 2.9670597283903604)
+    t592 = xp.greater_equal(t318, -2.9670597283903604) & xp.less_equal(t318, 2.9670597283903604)
+    t593 = xp.where(t591 & xp.logical_not(t592), t319, t318)
+    t594 = xp.less_equal(t325, 2.0943951023931953)
+    t595 = xp.greater_equal(t324, -2.0943951023931953) & xp.less_equal(t324, 2.0943951023931953)
+    t596 = xp.where(t594 & xp.logical_not(t595), t325, t324)
+    t597 = xp.less_equal(t514, 2.9670597283903604)
+    t598 = xp.greater_equal(t513, -2.9670597283903604) & xp.less_equal(t513, 2.9670597283903604)
+    t599 = xp.less_equal(t519, 2.0943951023931953)
+    t600 = xp.greater_equal(t518, -2.0943951023931953) & xp.less_equal(t518, 2.0943951023931953)
+    t601 = xp.less_equal(t523, 3.0543261909900767)
+    t602 = xp.greater_equal(t522, -3.0543261909900767) & xp.less_equal(t522, 3.0543261909900767)
+    t603 = xp.less_equal(t516, 2.9670597283903604)
+    t604 = xp.greater_equal(t515, -2.9670597283903604) & xp.less_equal(t515, 2.9670597283903604)
+    t605 = -t527
+    t606 = xp.less_equal(t605, 2.0943951023931953)
+    t607 = xp.greater_equal(t526, -2.0943951023931953) & xp.less_equal(t526, 2.0943951023931953)
+    t608 = xp.less_equal(t525, 3.0543261909900767)
+    t609 = xp.greater_equal(t524, -3.0543261909900767) & xp.less_equal(t524, 3.0543261909900767)
+    t610 = xp.isfinite(t16)
+    t611 = xp.greater_equal(t47, -t48)
+    t612 = xp.greater_equal(t21, -1e-12)
+    t613 = xp.greater_equal(t258, -t259)
+    t614 = xp.greater_equal(q3, -2.9670597283903604)
+    t615 = xp.less_equal(q3, 2.9670597283903604)
+    t616 = t528 | t529
+    t617 = t531 | t532
+    t618 = t534 | t535
+    t619 = t550 | t551
+    t620 = t553 | t554
+    t621 = t569 | t570
+    t622 = t572 | t573
+    t623 = t575 | t576
+    t624 = t591 | t592
+    t625 = t594 | t595
     q = _stack(xp, [
-        t532,  # 0, 0
-        t535,  # 0, 1
+        t530,  # 0, 0
+        t533,  # 0, 1
         q3,  # 0, 2
-        t538,  # 0, 3
-        xp.where(t539 & xp.logical_not(t540), t467, t466),  # 0, 4
-        xp.where(t541 & xp.logical_not(t542), t472, t471),  # 0, 5
-        xp.where(t543 & xp.logical_not(t544), t477, t476),  # 0, 6
-        t532,  # 1, 0
-        t535,  # 1, 1
+        t536,  # 0, 3
+        xp.where(t537 & xp.logical_not(t538), t465, t464),  # 0, 4
+        xp.where(t539 & xp.logical_not(t540), t470, t469),  # 0, 5
+        xp.where(t541 & xp.logical_not(t542), t475, t474),  # 0, 6
+        t530,  # 1, 0
+        t533,  # 1, 1
         q3,  # 1, 2
-        t538,  # 1, 3
-        xp.where(t545 & xp.logical_not(t546), t469, t468),  # 1, 4
-        xp.where(t548 & xp.logical_not(t549), t547, t480),  # 1, 5
-        xp.where(t550 & xp.logical_not(t551), t479, t478),  # 1, 6
-        t554,  # 2, 0
-        t557,  # 2, 1
+        t536,  # 1, 3
+        xp.where(t543 & xp.logical_not(t544), t467, t466),  # 1, 4
+        xp.where(t546 & xp.logical_not(t547), t545, t478),  # 1, 5
+        xp.where(t548 & xp.logical_not(t549), t477, t476),  # 1, 6
+        t552,  # 2, 0
+        t555,  # 2, 1
         q3,  # 2, 2
-        t538,  # 2, 3
-        xp.where(t558 & xp.logical_not(t559), t484, t483),  # 2, 4
-        xp.where(t560 & xp.logical_not(t561), t489, t488),  # 2, 5
-        xp.where(t562 & xp.logical_not(t563), t493, t492),  # 2, 6
-        t554,  # 3, 0
-        t557,  # 3, 1
+        t536,  # 2, 3
+        xp.where(t556 & xp.logical_not(t557), t482, t481),  # 2, 4
+        xp.where(t558 & xp.logical_not(t559), t487, t486),  # 2, 5
+        xp.where(t560 & xp.logical_not(t561), t491, t490),  # 2, 6
+        t552,  # 3, 0
+        t555,  # 3, 1
         q3,  # 3, 2
-        t538,  # 3, 3
-        xp.where(t564 & xp.logical_not(t565), t486, t485),  # 3, 4
-        xp.where(t567 & xp.logical_not(t568), t566, t496),  # 3, 5
-        xp.where(t569 & xp.logical_not(t570), t495, t494),  # 3, 6
-        t573,  # 4, 0
-        t576,  # 4, 1
+        t536,  # 3, 3
+        xp.where(t562 & xp.logical_not(t563), t484, t483),  # 3, 4
+        xp.where(t565 & xp.logical_not(t566), t564, t494),  # 3, 5
+        xp.where(t567 & xp.logical_not(t568), t493, t492),  # 3, 6
+        t571,  # 4, 0
+        t574,  # 4, 1
         q3,  # 4, 2
-        t579,  # 4, 3
-        xp.where(t580 & xp.logical_not(t581), t500, t499),  # 4, 4
-        xp.where(t582 & xp.logical_not(t583), t505, t504),  # 4, 5
-        xp.where(t584 & xp.logical_not(t585), t509, t508),  # 4, 6
-        t573,  # 5, 0
-        t576,  # 5, 1
+        t577,  # 4, 3
+        xp.where(t578 & xp.logical_not(t579), t498, t497),  # 4, 4
+        xp.where(t580 & xp.logical_not(t581), t503, t502),  # 4, 5
+        xp.where(t582 & xp.logical_not(t583), t507, t506),  # 4, 6
+        t571,  # 5, 0
+        t574,  # 5, 1
         q3,  # 5, 2
-        t579,  # 5, 3
-        xp.where(t586 & xp.logical_not(t587), t502, t501),  # 5, 4
-        xp.where(t589 & xp.logical_not(t590), t588, t512),  # 5, 5
-        xp.where(t591 & xp.logical_not(t592), t511, t510),  # 5, 6
-        t595,  # 6, 0
-        t598,  # 6, 1
+        t577,  # 5, 3
+        xp.where(t584 & xp.logical_not(t585), t500, t499),  # 5, 4
+        xp.where(t587 & xp.logical_not(t588), t586, t510),  # 5, 5
+        xp.where(t589 & xp.logical_not(t590), t509, t508),  # 5, 6
+        t593,  # 6, 0
+        t596,  # 6, 1
         q3,  # 6, 2
-        t579,  # 6, 3
-        xp.where(t599 & xp.logical_not(t600), t516, t515),  # 6, 4
-        xp.where(t601 & xp.logical_not(t602), t521, t520),  # 6, 5
-        xp.where(t603 & xp.logical_not(t604), t525, t524),  # 6, 6
-        t595,  # 7, 0
-        t598,  # 7, 1
+        t577,  # 6, 3
+        xp.where(t597 & xp.logical_not(t598), t514, t513),  # 6, 4
+        xp.where(t599 & xp.logical_not(t600), t519, t518),  # 6, 5
+        xp.where(t601 & xp.logical_not(t602), t523, t522),  # 6, 6
+        t593,  # 7, 0
+        t596,  # 7, 1
         q3,  # 7, 2
-        t579,  # 7, 3
-        xp.where(t605 & xp.logical_not(t606), t518, t517),  # 7, 4
-        xp.where(t608 & xp.logical_not(t609), t607, t528),  # 7, 5
-        xp.where(t610 & xp.logical_not(t611), t527, t526),  # 7, 6
+        t577,  # 7, 3
+        xp.where(t603 & xp.logical_not(t604), t516, t515),  # 7, 4
+        xp.where(t606 & xp.logical_not(t607), t605, t526),  # 7, 5
+        xp.where(t608 & xp.logical_not(t609), t525, t524),  # 7, 6
     ], (8, 7))
     valid = _stack(xp, [
-        t612 & xp.greater_equal(t151, -1e-12) & t613 & t614,  # 0
-        t612 & t152 & t613 & t614,  # 1
-        t612 & xp.greater_equal(t219, -1e-12) & t51 & t614,  # 2
-        t612 & t220 & t51 & t614,  # 3
-        t612 & t22 & xp.greater_equal(t360, -1e-12) & t615,  # 4
-        t612 & t22 & t361 & t615,  # 5
-        t612 & t22 & xp.greater_equal(t428, -1e-12) & t263,  # 6
-        t612 & t22 & t429 & t263,  # 7
+        t610 & xp.greater_equal(t148, -1e-12) & t611 & t612,  # 0
+        t610 & t149 & t611 & t612,  # 1
+        t610 & xp.greater_equal(t216, -1e-12) & t49 & t612,  # 2
+        t610 & t217 & t49 & t612,  # 3
+        t610 & t22 & xp.greater_equal(t358, -1e-12) & t613,  # 4
+        t610 & t22 & t359 & t613,  # 5
+        t610 & t22 & xp.greater_equal(t426, -1e-12) & t260,  # 6
+        t610 & t22 & t427 & t260,  # 7
     ], (8,))
     in_limits = _stack(xp, [
-        t616 & t617 & t618 & t619 & t620 & (t539 | t540) & (t541 | t542) & (t543 | t544),  # 0
-        t616 & t617 & t618 & t619 & t620 & (t545 | t546) & (t550 | t551) & (t548 | t549),  # 1
-        t616 & t617 & t620 & t621 & t622 & (t558 | t559) & (t560 | t561) & (t562 | t563),  # 2
-        t616 & t617 & t620 & t621 & t622 & (t564 | t565) & (t569 | t570) & (t567 | t568),  # 3
-        t616 & t617 & t623 & t624 & t625 & (t580 | t581) & (t582 | t583) & (t584 | t585),  # 4
-        t616 & t617 & t623 & t624 & t625 & (t586 | t587) & (t591 | t592) & (t589 | t590),  # 5
-        t616 & t617 & t625 & t626 & t627 & (t599 | t600) & (t601 | t602) & (t603 | t604),  # 6
-        t616 & t617 & t625 & t626 & t627 & (t605 | t606) & (t610 | t611) & (t608 | t609),  # 7
+        t614 & t615 & t616 & t617 & t618 & (t537 | t538) & (t539 | t540) & (t541 | t542),  # 0
+        t614 & t615 & t616 & t617 & t618 & (t543 | t544) & (t548 | t549) & (t546 | t547),  # 1
+        t614 & t615 & t618 & t619 & t620 & (t556 | t557) & (t558 | t559) & (t560 | t561),  # 2
+        t614 & t615 & t618 & t619 & t620 & (t562 | t563) & (t567 | t568) & (t565 | t566),  # 3
+        t614 & t615 & t621 & t622 & t623 & (t578 | t579) & (t580 | t581) & (t582 | t583),  # 4
+        t614 & t615 & t621 & t622 & t623 & (t584 | t585) & (t589 | t590) & (t587 | t588),  # 5
+        t614 & t615 & t623 & t624 & t625 & (t597 | t598) & (t599 | t600) & (t601 | t602),  # 6
+        t614 & t615 & t623 & t624 & t625 & (t603 | t604) & (t608 | t609) & (t606 | t607),  # 7
     ], (8,))
     return q, valid, in_limits
 
@@ -3677,87 +3675,87 @@ def ik_nearest(T, q_seed, q_free, weights=(1.0,) * DOF):
     lb5 = branches_in_limits[..., 5]
     lb6 = branches_in_limits[..., 6]
     lb7 = branches_in_limits[..., 7]
-    t0 = qb0_0 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn1 - qb0_0))
-    t1 = qb0_1 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn2 - qb0_1))
-    t2 = qb0_3 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn4 - qb0_3))
-    t3 = qb0_4 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn5 - qb0_4))
-    t4 = qb0_5 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn6 - qb0_5))
-    t5 = qb0_6 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn7 - qb0_6))
+    t0 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_0 + qn1)) + qb0_0
+    t1 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_1 + qn2)) + qb0_1
+    t2 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_3 + qn4)) + qb0_3
+    t3 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_4 + qn5)) + qb0_4
+    t4 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_5 + qn6)) + qb0_5
+    t5 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_6 + qn7)) + qb0_6
     t6 = xp.where(lb0 & vb0, xp.asarray(1, dtype=dtype), 0)
     t7 = xp.where(xp.greater(t6, 0), xp.asarray(1, dtype=dtype), 0)
-    t8 = qb1_0 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn1 - qb1_0))
-    t9 = qb1_1 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn2 - qb1_1))
-    t10 = qb1_3 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn4 - qb1_3))
-    t11 = qb1_4 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn5 - qb1_4))
-    t12 = qb1_5 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn6 - qb1_5))
-    t13 = qb1_6 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn7 - qb1_6))
+    t8 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_0 + qn1)) + qb1_0
+    t9 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_1 + qn2)) + qb1_1
+    t10 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_3 + qn4)) + qb1_3
+    t11 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_4 + qn5)) + qb1_4
+    t12 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_5 + qn6)) + qb1_5
+    t13 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_6 + qn7)) + qb1_6
     t14 = xp.where(lb1 & vb1, xp.asarray(1, dtype=dtype), 0)
-    t15 = qb2_0 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn1 - qb2_0))
-    t16 = qb2_1 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn2 - qb2_1))
-    t17 = qb2_3 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn4 - qb2_3))
-    t18 = qb2_4 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn5 - qb2_4))
-    t19 = qb2_5 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn6 - qb2_5))
-    t20 = qb2_6 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn7 - qb2_6))
+    t15 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_0 + qn1)) + qb2_0
+    t16 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_1 + qn2)) + qb2_1
+    t17 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_3 + qn4)) + qb2_3
+    t18 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_4 + qn5)) + qb2_4
+    t19 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_5 + qn6)) + qb2_5
+    t20 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_6 + qn7)) + qb2_6
     t21 = xp.where(lb2 & vb2, xp.asarray(1, dtype=dtype), 0)
-    t22 = qb3_0 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn1 - qb3_0))
-    t23 = qb3_1 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn2 - qb3_1))
-    t24 = qb3_3 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn4 - qb3_3))
-    t25 = qb3_4 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn5 - qb3_4))
-    t26 = qb3_5 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn6 - qb3_5))
-    t27 = qb3_6 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn7 - qb3_6))
+    t22 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_0 + qn1)) + qb3_0
+    t23 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_1 + qn2)) + qb3_1
+    t24 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_3 + qn4)) + qb3_3
+    t25 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_4 + qn5)) + qb3_4
+    t26 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_5 + qn6)) + qb3_5
+    t27 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_6 + qn7)) + qb3_6
     t28 = xp.where(lb3 & vb3, xp.asarray(1, dtype=dtype), 0)
-    t29 = qb4_0 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn1 - qb4_0))
-    t30 = qb4_1 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn2 - qb4_1))
-    t31 = qb4_3 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn4 - qb4_3))
-    t32 = qb4_4 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn5 - qb4_4))
-    t33 = qb4_5 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn6 - qb4_5))
-    t34 = qb4_6 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn7 - qb4_6))
+    t29 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_0 + qn1)) + qb4_0
+    t30 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_1 + qn2)) + qb4_1
+    t31 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_3 + qn4)) + qb4_3
+    t32 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_4 + qn5)) + qb4_4
+    t33 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_5 + qn6)) + qb4_5
+    t34 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_6 + qn7)) + qb4_6
     t35 = xp.where(lb4 & vb4, xp.asarray(1, dtype=dtype), 0)
-    t36 = qb5_0 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn1 - qb5_0))
-    t37 = qb5_1 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn2 - qb5_1))
-    t38 = qb5_3 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn4 - qb5_3))
-    t39 = qb5_4 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn5 - qb5_4))
-    t40 = qb5_5 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn6 - qb5_5))
-    t41 = qb5_6 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn7 - qb5_6))
+    t36 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_0 + qn1)) + qb5_0
+    t37 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_1 + qn2)) + qb5_1
+    t38 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_3 + qn4)) + qb5_3
+    t39 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_4 + qn5)) + qb5_4
+    t40 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_5 + qn6)) + qb5_5
+    t41 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_6 + qn7)) + qb5_6
     t42 = xp.where(lb5 & vb5, xp.asarray(1, dtype=dtype), 0)
-    t43 = qb6_0 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn1 - qb6_0))
-    t44 = qb6_1 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn2 - qb6_1))
-    t45 = qb6_3 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn4 - qb6_3))
-    t46 = qb6_4 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn5 - qb6_4))
-    t47 = qb6_5 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn6 - qb6_5))
-    t48 = qb6_6 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn7 - qb6_6))
+    t43 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_0 + qn1)) + qb6_0
+    t44 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_1 + qn2)) + qb6_1
+    t45 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_3 + qn4)) + qb6_3
+    t46 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_4 + qn5)) + qb6_4
+    t47 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_5 + qn6)) + qb6_5
+    t48 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_6 + qn7)) + qb6_6
     t49 = xp.where(lb6 & vb6, xp.asarray(1, dtype=dtype), 0)
-    t50 = qb7_0 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn1 - qb7_0))
-    t51 = qb7_1 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn2 - qb7_1))
-    t52 = qb7_3 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn4 - qb7_3))
-    t53 = qb7_4 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn5 - qb7_4))
-    t54 = qb7_5 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn6 - qb7_5))
-    t55 = qb7_6 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn7 - qb7_6))
+    t50 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_0 + qn1)) + qb7_0
+    t51 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_1 + qn2)) + qb7_1
+    t52 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_3 + qn4)) + qb7_3
+    t53 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_4 + qn5)) + qb7_4
+    t54 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_5 + qn6)) + qb7_5
+    t55 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_6 + qn7)) + qb7_6
     t56 = xp.where(lb7 & vb7, xp.asarray(1, dtype=dtype), 0)
-    t57 = T00 + T01 + T02 + T03 + T10 + T11 + T12 + T13 + T20 + T21 + T22 + T23 + qn1 + qn2 + qn3 + qn4 + qn5 + qn6 + qn7 + qw1 + qw2 + qw3 + qw4 + qw5 + qw6 + qw7
+    t57 = T00 + T01 + T02 + T10 + T11 + T12 + T20 + T21 + T22 + T03 + T13 + T23 + qn1 + qn2 + qn4 + qn5 + qn6 + qn7 + qw1 + qw2 + qw3 + qn3 + qw4 + qw5 + qw6 + qw7
     t58 = xp.where(xp.less(t0, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t59 = t0 + t58
-    t60 = t0 - t58
+    t60 = -t58 + t0
     t61 = xp.where(xp.greater_equal(t0, -2.9670597283903604) & xp.less_equal(t0, 2.9670597283903604), t0, xp.where(xp.greater_equal(t59, -2.9670597283903604) & xp.less_equal(t59, 2.9670597283903604), t59, xp.where(xp.greater_equal(t60, -2.9670597283903604) & xp.less_equal(t60, 2.9670597283903604), t60, qb0_0)))
     t62 = xp.where(xp.less(t1, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t63 = t1 + t62
-    t64 = t1 - t62
+    t64 = -t62 + t1
     t65 = xp.where(xp.greater_equal(t1, -2.0943951023931953) & xp.less_equal(t1, 2.0943951023931953), t1, xp.where(xp.greater_equal(t63, -2.0943951023931953) & xp.less_equal(t63, 2.0943951023931953), t63, xp.where(xp.greater_equal(t64, -2.0943951023931953) & xp.less_equal(t64, 2.0943951023931953), t64, qb0_1)))
     t66 = xp.where(xp.less(t2, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t67 = t2 + t66
-    t68 = t2 - t66
+    t68 = -t66 + t2
     t69 = xp.where(xp.greater_equal(t2, -2.0943951023931953) & xp.less_equal(t2, 2.0943951023931953), t2, xp.where(xp.greater_equal(t67, -2.0943951023931953) & xp.less_equal(t67, 2.0943951023931953), t67, xp.where(xp.greater_equal(t68, -2.0943951023931953) & xp.less_equal(t68, 2.0943951023931953), t68, qb0_3)))
     t70 = xp.where(xp.less(t3, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t71 = t3 + t70
-    t72 = t3 - t70
+    t72 = -t70 + t3
     t73 = xp.where(xp.greater_equal(t3, -2.9670597283903604) & xp.less_equal(t3, 2.9670597283903604), t3, xp.where(xp.greater_equal(t71, -2.9670597283903604) & xp.less_equal(t71, 2.9670597283903604), t71, xp.where(xp.greater_equal(t72, -2.9670597283903604) & xp.less_equal(t72, 2.9670597283903604), t72, qb0_4)))
     t74 = xp.where(xp.less(t4, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t75 = t4 + t74
-    t76 = t4 - t74
+    t76 = -t74 + t4
     t77 = xp.where(xp.greater_equal(t4, -2.0943951023931953) & xp.less_equal(t4, 2.0943951023931953), t4, xp.where(xp.greater_equal(t75, -2.0943951023931953) & xp.less_equal(t75, 2.0943951023931953), t75, xp.where(xp.greater_equal(t76, -2.0943951023931953) & xp.less_equal(t76, 2.0943951023931953), t76, qb0_5)))
     t78 = xp.where(xp.less(t5, qn7), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t79 = t5 + t78
-    t80 = t5 - t78
+    t80 = -t78 + t5
     t81 = xp.where(xp.greater_equal(t5, -3.0543261909900767) & xp.less_equal(t5, 3.0543261909900767), t5, xp.where(xp.greater_equal(t79, -3.0543261909900767) & xp.less_equal(t79, 3.0543261909900767), t79, xp.where(xp.greater_equal(t80, -3.0543261909900767) & xp.less_equal(t80, 3.0543261909900767), t80, qb0_6)))
     t82 = -qn1
     t83 = -qn2
@@ -3766,7 +3764,7 @@ def ik_nearest(T, q_seed, q_free, weights=(1.0,) * DOF):
     t86 = -qn5
     t87 = -qn6
     t88 = -qn7
-    t89 = qw1*(t61 + t82)**2 + qw2*(t65 + t83)**2 + qw3*(qb0_2 + t84)**2 + qw4*(t69 + t85)**2 + qw5*(t73 + t86)**2 + qw6*(t77 + t87)**2 + qw7*(t81 + t88)**2
+    t89 = qw1*(t82 + t61)**2 + qw2*(t83 + t65)**2 + qw3*(t84 + qb0_2)**2 + qw4*(t85 + t69)**2 + qw5*(t86 + t73)**2 + qw6*(t87 + t77)**2 + qw7*(t88 + t81)**2
     t90 = xp.greater(t7, 0)
     t91 = xp.where(t90, t61, qn1)
     t92 = xp.where(t90, t65, qn2)
@@ -3778,31 +3776,31 @@ def ik_nearest(T, q_seed, q_free, weights=(1.0,) * DOF):
     t98 = xp.where(t90, t89, 0)
     t99 = xp.where(xp.less(t8, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t100 = t8 + t99
-    t101 = t8 - t99
+    t101 = -t99 + t8
     t102 = xp.where(xp.greater_equal(t8, -2.9670597283903604) & xp.less_equal(t8, 2.9670597283903604), t8, xp.where(xp.greater_equal(t100, -2.9670597283903604) & xp.less_equal(t100, 2.9670597283903604), t100, xp.where(xp.greater_equal(t101, -2.9670597283903604) & xp.less_equal(t101, 2.9670597283903604), t101, qb1_0)))
     t103 = xp.where(xp.less(t9, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t104 = t9 + t103
-    t105 = t9 - t103
+    t105 = -t103 + t9
     t106 = xp.where(xp.greater_equal(t9, -2.0943951023931953) & xp.less_equal(t9, 2.0943951023931953), t9, xp.where(xp.greater_equal(t104, -2.0943951023931953) & xp.less_equal(t104, 2.0943951023931953), t104, xp.where(xp.greater_equal(t105, -2.0943951023931953) & xp.less_equal(t105, 2.0943951023931953), t105, qb1_1)))
     t107 = xp.where(xp.less(t10, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t108 = t10 + t107
-    t109 = t10 - t107
+    t109 = -t107 + t10
     t110 = xp.where(xp.greater_equal(t10, -2.0943951023931953) & xp.less_equal(t10, 2.0943951023931953), t10, xp.where(xp.greater_equal(t108, -2.0943951023931953) & xp.less_equal(t108, 2.0943951023931953), t108, xp.where(xp.greater_equal(t109, -2.0943951023931953) & xp.less_equal(t109, 2.0943951023931953), t109, qb1_3)))
     t111 = xp.where(xp.less(t11, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t112 = t11 + t111
-    t113 = t11 - t111
+    t113 = -t111 + t11
     t114 = xp.where(xp.greater_equal(t11, -2.9670597283903604) & xp.less_equal(t11, 2.9670597283903604), t11, xp.where(xp.greater_equal(t112, -2.9670597283903604) & xp.less_equal(t112, 2.9670597283903604), t112, xp.where(xp.greater_equal(t113, -2.9670597283903604) & xp.less_equal(t113, 2.9670597283903604), t113, qb1_4)))
     t115 = xp.where(xp.less(t12, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t116 = t12 + t115
-    t117 = t12 - t115
+    t117 = -t115 + t12
     t118 = xp.where(xp.greater_equal(t12, -2.0943951023931953) & xp.less_equal(t12, 2.0943951023931953), t12, xp.where(xp.greater_equal(t116, -2.0943951023931953) & xp.less_equal(t116, 2.0943951023931953), t116, xp.where(xp.greater_equal(t117, -2.0943951023931953) & xp.less_equal(t117, 2.0943951023931953), t117, qb1_5)))
     t119 = xp.where(xp.less(t13, qn7), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t120 = t13 + t119
-    t121 = t13 - t119
+    t121 = -t119 + t13
     t122 = xp.where(xp.greater_equal(t13, -3.0543261909900767) & xp.less_equal(t13, 3.0543261909900767), t13, xp.where(xp.greater_equal(t120, -3.0543261909900767) & xp.less_equal(t120, 3.0543261909900767), t120, xp.where(xp.greater_equal(t121, -3.0543261909900767) & xp.less_equal(t121, 3.0543261909900767), t121, qb1_6)))
-    t123 = qw1*(t102 + t82)**2 + qw2*(t106 + t83)**2 + qw3*(qb1_2 + t84)**2 + qw4*(t110 + t85)**2 + qw5*(t114 + t86)**2 + qw6*(t118 + t87)**2 + qw7*(t122 + t88)**2
+    t123 = qw1*(t82 + t102)**2 + qw2*(t83 + t106)**2 + qw3*(t84 + qb1_2)**2 + qw4*(t85 + t110)**2 + qw5*(t86 + t114)**2 + qw6*(t87 + t118)**2 + qw7*(t88 + t122)**2
     t124 = xp.greater(t14, 0)
-    t125 = xp.where(t124 & (xp.less(t123, t98) | xp.less(t7, 1)), xp.asarray(1, dtype=dtype), 0)
+    t125 = xp.where(t124 & (xp.less(t7, 1) | xp.less(t123, t98)), xp.asarray(1, dtype=dtype), 0)
     t126 = xp.where(t124, 1, t7)
     t127 = xp.greater(t125, 0)
     t128 = xp.where(t127, t102, t91)
@@ -3815,29 +3813,29 @@ def ik_nearest(T, q_seed, q_free, weights=(1.0,) * DOF):
     t135 = xp.where(t127, t123, t98)
     t136 = xp.where(xp.less(t15, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t137 = t15 + t136
-    t138 = t15 - t136
+    t138 = -t136 + t15
     t139 = xp.where(xp.greater_equal(t15, -2.9670597283903604) & xp.less_equal(t15, 2.9670597283903604), t15, xp.where(xp.greater_equal(t137, -2.9670597283903604) & xp.less_equal(t137, 2.9670597283903604), t137, xp.where(xp.greater_equal(t138, -2.9670597283903604) & xp.less_equal(t138, 2.9670597283903604), t138, qb2_0)))
     t140 = xp.where(xp.less(t16, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t141 = t16 + t140
-    t142 = t16 - t140
+    t142 = -t140 + t16
     t143 = xp.where(xp.greater_equal(t16, -2.0943951023931953) & xp.less_equal(t16, 2.0943951023931953), t16, xp.where(xp.greater_equal(t141, -2.0943951023931953) & xp.less_equal(t141, 2.0943951023931953), t141, xp.where(xp.greater_equal(t142, -2.0943951023931953) & xp.less_equal(t142, 2.0943951023931953), t142, qb2_1)))
     t144 = xp.where(xp.less(t17, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t145 = t17 + t144
-    t146 = t17 - t144
+    t146 = -t144 + t17
     t147 = xp.where(xp.greater_equal(t17, -2.0943951023931953) & xp.less_equal(t17, 2.0943951023931953), t17, xp.where(xp.greater_equal(t145, -2.0943951023931953) & xp.less_equal(t145, 2.0943951023931953), t145, xp.where(xp.greater_equal(t146, -2.0943951023931953) & xp.less_equal(t146, 2.0943951023931953), t146, qb2_3)))
     t148 = xp.where(xp.less(t18, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t149 = t18 + t148
-    t150 = t18 - t148
+    t150 = -t148 + t18
     t151 = xp.where(xp.greater_equal(t18, -2.9670597283903604) & xp.less_equal(t18, 2.9670597283903604), t18, xp.where(xp.greater_equal(t149, -2.9670597283903604) & xp.less_equal(t149, 2.9670597283903604), t149, xp.where(xp.greater_equal(t150, -2.9670597283903604) & xp.less_equal(t150, 2.9670597283903604), t150, qb2_4)))
     t152 = xp.where(xp.less(t19, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t153 = t19 + t152
-    t154 = t19 - t152
+    t154 = -t152 + t19
     t155 = xp.where(xp.greater_equal(t19, -2.0943951023931953) & xp.less_equal(t19, 2.0943951023931953), t19, xp.where(xp.greater_equal(t153, -2.0943951023931953) & xp.less_equal(t153, 2.0943951023931953), t153, xp.where(xp.greater_equal(t154, -2.0943951023931953) & xp.less_equal(t154, 2.0943951023931953), t154, qb2_5)))
     t156 = xp.where(xp.less(t20, qn7), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t157 = t20 + t156
-    t158 = t20 - t156
+    t158 = -t156 + t20
     t159 = xp.where(xp.greater_equal(t20, -3.0543261909900767) & xp.less_equal(t20, 3.0543261909900767), t20, xp.where(xp.greater_equal(t157, -3.0543261909900767) & xp.less_equal(t157, 3.0543261909900767), t157, xp.where(xp.greater_equal(t158, -3.0543261909900767) & xp.less_equal(t158, 3.0543261909900767), t158, qb2_6)))
-    t160 = qw1*(t139 + t82)**2 + qw2*(t143 + t83)**2 + qw3*(qb2_2 + t84)**2 + qw4*(t147 + t85)**2 + qw5*(t151 + t86)**2 + qw6*(t155 + t87)**2 + qw7*(t159 + t88)**2
+    t160 = qw1*(t82 + t139)**2 + qw2*(t83 + t143)**2 + qw3*(t84 + qb2_2)**2 + qw4*(t85 + t147)**2 + qw5*(t86 + t151)**2 + qw6*(t87 + t155)**2 + qw7*(t88 + t159)**2
     t161 = xp.greater(t21, 0)
     t162 = xp.where(t161 & (xp.less(t126, 1) | xp.less(t160, t135)), xp.asarray(1, dtype=dtype), 0)
     t163 = xp.where(t161, 1, t126)
@@ -3852,29 +3850,29 @@ def ik_nearest(T, q_seed, q_free, weights=(1.0,) * DOF):
     t172 = xp.where(t164, t160, t135)
     t173 = xp.where(xp.less(t22, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t174 = t22 + t173
-    t175 = t22 - t173
+    t175 = -t173 + t22
     t176 = xp.where(xp.greater_equal(t22, -2.9670597283903604) & xp.less_equal(t22, 2.9670597283903604), t22, xp.where(xp.greater_equal(t174, -2.9670597283903604) & xp.less_equal(t174, 2.9670597283903604), t174, xp.where(xp.greater_equal(t175, -2.9670597283903604) & xp.less_equal(t175, 2.9670597283903604), t175, qb3_0)))
     t177 = xp.where(xp.less(t23, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t178 = t23 + t177
-    t179 = t23 - t177
+    t179 = -t177 + t23
     t180 = xp.where(xp.greater_equal(t23, -2.0943951023931953) & xp.less_equal(t23, 2.0943951023931953), t23, xp.where(xp.greater_equal(t178, -2.0943951023931953) & xp.less_equal(t178, 2.0943951023931953), t178, xp.where(xp.greater_equal(t179, -2.0943951023931953) & xp.less_equal(t179, 2.0943951023931953), t179, qb3_1)))
     t181 = xp.where(xp.less(t24, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t182 = t24 + t181
-    t183 = t24 - t181
+    t183 = -t181 + t24
     t184 = xp.where(xp.greater_equal(t24, -2.0943951023931953) & xp.less_equal(t24, 2.0943951023931953), t24, xp.where(xp.greater_equal(t182, -2.0943951023931953) & xp.less_equal(t182, 2.0943951023931953), t182, xp.where(xp.greater_equal(t183, -2.0943951023931953) & xp.less_equal(t183, 2.0943951023931953), t183, qb3_3)))
     t185 = xp.where(xp.less(t25, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t186 = t25 + t185
-    t187 = t25 - t185
+    t187 = -t185 + t25
     t188 = xp.where(xp.greater_equal(t25, -2.9670597283903604) & xp.less_equal(t25, 2.9670597283903604), t25, xp.where(xp.greater_equal(t186, -2.9670597283903604) & xp.less_equal(t186, 2.9670597283903604), t186, xp.where(xp.greater_equal(t187, -2.9670597283903604) & xp.less_equal(t187, 2.9670597283903604), t187, qb3_4)))
     t189 = xp.where(xp.less(t26, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t190 = t26 + t189
-    t191 = t26 - t189
+    t191 = -t189 + t26
     t192 = xp.where(xp.greater_equal(t26, -2.0943951023931953) & xp.less_equal(t26, 2.0943951023931953), t26, xp.where(xp.greater_equal(t190, -2.0943951023931953) & xp.less_equal(t190, 2.0943951023931953), t190, xp.where(xp.greater_equal(t191, -2.0943951023931953) & xp.less_equal(t191, 2.0943951023931953), t191, qb3_5)))
     t193 = xp.where(xp.less(t27, qn7), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t194 = t27 + t193
-    t195 = t27 - t193
+    t195 = -t193 + t27
     t196 = xp.where(xp.greater_equal(t27, -3.0543261909900767) & xp.less_equal(t27, 3.0543261909900767), t27, xp.where(xp.greater_equal(t194, -3.0543261909900767) & xp.less_equal(t194, 3.0543261909900767), t194, xp.where(xp.greater_equal(t195, -3.0543261909900767) & xp.less_equal(t195, 3.0543261909900767), t195, qb3_6)))
-    t197 = qw1*(t176 + t82)**2 + qw2*(t180 + t83)**2 + qw3*(qb3_2 + t84)**2 + qw4*(t184 + t85)**2 + qw5*(t188 + t86)**2 + qw6*(t192 + t87)**2 + qw7*(t196 + t88)**2
+    t197 = qw1*(t82 + t176)**2 + qw2*(t83 + t180)**2 + qw3*(t84 + qb3_2)**2 + qw4*(t85 + t184)**2 + qw5*(t86 + t188)**2 + qw6*(t87 + t192)**2 + qw7*(t88 + t196)**2
     t198 = xp.greater(t28, 0)
     t199 = xp.where(t198 & (xp.less(t163, 1) | xp.less(t197, t172)), xp.asarray(1, dtype=dtype), 0)
     t200 = xp.where(t198, 1, t163)
@@ -3889,29 +3887,29 @@ def ik_nearest(T, q_seed, q_free, weights=(1.0,) * DOF):
     t209 = xp.where(t201, t197, t172)
     t210 = xp.where(xp.less(t29, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t211 = t29 + t210
-    t212 = t29 - t210
+    t212 = -t210 + t29
     t213 = xp.where(xp.greater_equal(t29, -2.9670597283903604) & xp.less_equal(t29, 2.9670597283903604), t29, xp.where(xp.greater_equal(t211, -2.9670597283903604) & xp.less_equal(t211, 2.9670597283903604), t211, xp.where(xp.greater_equal(t212, -2.9670597283903604) & xp.less_equal(t212, 2.9670597283903604), t212, qb4_0)))
     t214 = xp.where(xp.less(t30, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t215 = t30 + t214
-    t216 = t30 - t214
+    t216 = -t214 + t30
     t217 = xp.where(xp.greater_equal(t30, -2.0943951023931953) & xp.less_equal(t30, 2.0943951023931953), t30, xp.where(xp.greater_equal(t215, -2.0943951023931953) & xp.less_equal(t215, 2.0943951023931953), t215, xp.where(xp.greater_equal(t216, -2.0943951023931953) & xp.less_equal(t216, 2.0943951023931953), t216, qb4_1)))
     t218 = xp.where(xp.less(t31, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t219 = t31 + t218
-    t220 = t31 - t218
+    t220 = -t218 + t31
     t221 = xp.where(xp.greater_equal(t31, -2.0943951023931953) & xp.less_equal(t31, 2.0943951023931953), t31, xp.where(xp.greater_equal(t219, -2.0943951023931953) & xp.less_equal(t219, 2.0943951023931953), t219, xp.where(xp.greater_equal(t220, -2.0943951023931953) & xp.less_equal(t220, 2.0943951023931953), t220, qb4_3)))
     t222 = xp.where(xp.less(t32, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t223 = t32 + t222
-    t224 = t32 - t222
+    t224 = -t222 + t32
     t225 = xp.where(xp.greater_equal(t32, -2.9670597283903604) & xp.less_equal(t32, 2.9670597283903604), t32, xp.where(xp.greater_equal(t223, -2.9670597283903604) & xp.less_equal(t223, 2.9670597283903604), t223, xp.where(xp.greater_equal(t224, -2.9670597283903604) & xp.less_equal(t224, 2.9670597283903604), t224, qb4_4)))
     t226 = xp.where(xp.less(t33, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t227 = t33 + t226
-    t228 = t33 - t226
+    t228 = -t226 + t33
     t229 = xp.where(xp.greater_equal(t33, -2.0943951023931953) & xp.less_equal(t33, 2.0943951023931953), t33, xp.where(xp.greater_equal(t227, -2.0943951023931953) & xp.less_equal(t227, 2.0943951023931953), t227, xp.where(xp.greater_equal(t228, -2.0943951023931953) & xp.less_equal(t228, 2.0943951023931953), t228, qb4_5)))
     t230 = xp.where(xp.less(t34, qn7), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t231 = t34 + t230
-    t232 = t34 - t230
+    t232 = -t230 + t34
     t233 = xp.where(xp.greater_equal(t34, -3.0543261909900767) & xp.less_equal(t34, 3.0543261909900767), t34, xp.where(xp.greater_equal(t231, -3.0543261909900767) & xp.less_equal(t231, 3.0543261909900767), t231, xp.where(xp.greater_equal(t232, -3.0543261909900767) & xp.less_equal(t232, 3.0543261909900767), t232, qb4_6)))
-    t234 = qw1*(t213 + t82)**2 + qw2*(t217 + t83)**2 + qw3*(qb4_2 + t84)**2 + qw4*(t221 + t85)**2 + qw5*(t225 + t86)**2 + qw6*(t229 + t87)**2 + qw7*(t233 + t88)**2
+    t234 = qw1*(t82 + t213)**2 + qw2*(t83 + t217)**2 + qw3*(t84 + qb4_2)**2 + qw4*(t85 + t221)**2 + qw5*(t86 + t225)**2 + qw6*(t87 + t229)**2 + qw7*(t88 + t233)**2
     t235 = xp.greater(t35, 0)
     t236 = xp.where(t235 & (xp.less(t200, 1) | xp.less(t234, t209)), xp.asarray(1, dtype=dtype), 0)
     t237 = xp.where(t235, 1, t200)
@@ -3926,29 +3924,29 @@ def ik_nearest(T, q_seed, q_free, weights=(1.0,) * DOF):
     t246 = xp.where(t238, t234, t209)
     t247 = xp.where(xp.less(t36, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t248 = t36 + t247
-    t249 = t36 - t247
+    t249 = -t247 + t36
     t250 = xp.where(xp.greater_equal(t36, -2.9670597283903604) & xp.less_equal(t36, 2.9670597283903604), t36, xp.where(xp.greater_equal(t248, -2.9670597283903604) & xp.less_equal(t248, 2.9670597283903604), t248, xp.where(xp.greater_equal(t249, -2.9670597283903604) & xp.less_equal(t249, 2.9670597283903604), t249, qb5_0)))
     t251 = xp.where(xp.less(t37, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t252 = t37 + t251
-    t253 = t37 - t251
+    t253 = -t251 + t37
     t254 = xp.where(xp.greater_equal(t37, -2.0943951023931953) & xp.less_equal(t37, 2.0943951023931953), t37, xp.where(xp.greater_equal(t252, -2.0943951023931953) & xp.less_equal(t252, 2.0943951023931953), t252, xp.where(xp.greater_equal(t253, -2.0943951023931953) & xp.less_equal(t253, 2.0943951023931953), t253, qb5_1)))
     t255 = xp.where(xp.less(t38, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t256 = t38 + t255
-    t257 = t38 - t255
+    t257 = -t255 + t38
     t258 = xp.where(xp.greater_equal(t38, -2.0943951023931953) & xp.less_equal(t38, 2.0943951023931953), t38, xp.where(xp.greater_equal(t256, -2.0943951023931953) & xp.less_equal(t256, 2.0943951023931953), t256, xp.where(xp.greater_equal(t257, -2.0943951023931953) & xp.less_equal(t257, 2.0943951023931953), t257, qb5_3)))
     t259 = xp.where(xp.less(t39, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t260 = t39 + t259
-    t261 = t39 - t259
+    t261 = -t259 + t39
     t262 = xp.where(xp.greater_equal(t39, -2.9670597283903604) & xp.less_equal(t39, 2.9670597283903604), t39, xp.where(xp.greater_equal(t260, -2.9670597283903604) & xp.less_equal(t260, 2.9670597283903604), t260, xp.where(xp.greater_equal(t261, -2.9670597283903604) & xp.less_equal(t261, 2.9670597283903604), t261, qb5_4)))
     t263 = xp.where(xp.less(t40, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t264 = t40 + t263
-    t265 = t40 - t263
+    t265 = -t263 + t40
     t266 = xp.where(xp.greater_equal(t40, -2.0943951023931953) & xp.less_equal(t40, 2.0943951023931953), t40, xp.where(xp.greater_equal(t264, -2.0943951023931953) & xp.less_equal(t264, 2.0943951023931953), t264, xp.where(xp.greater_equal(t265, -2.0943951023931953) & xp.less_equal(t265, 2.0943951023931953), t265, qb5_5)))
     t267 = xp.where(xp.less(t41, qn7), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t268 = t41 + t267
-    t269 = t41 - t267
+    t269 = -t267 + t41
     t270 = xp.where(xp.greater_equal(t41, -3.0543261909900767) & xp.less_equal(t41, 3.0543261909900767), t41, xp.where(xp.greater_equal(t268, -3.0543261909900767) & xp.less_equal(t268, 3.0543261909900767), t268, xp.where(xp.greater_equal(t269, -3.0543261909900767) & xp.less_equal(t269, 3.0543261909900767), t269, qb5_6)))
-    t271 = qw1*(t250 + t82)**2 + qw2*(t254 + t83)**2 + qw3*(qb5_2 + t84)**2 + qw4*(t258 + t85)**2 + qw5*(t262 + t86)**2 + qw6*(t266 + t87)**2 + qw7*(t270 + t88)**2
+    t271 = qw1*(t82 + t250)**2 + qw2*(t83 + t254)**2 + qw3*(t84 + qb5_2)**2 + qw4*(t85 + t258)**2 + qw5*(t86 + t262)**2 + qw6*(t87 + t266)**2 + qw7*(t88 + t270)**2
     t272 = xp.greater(t42, 0)
     t273 = xp.where(t272 & (xp.less(t237, 1) | xp.less(t271, t246)), xp.asarray(1, dtype=dtype), 0)
     t274 = xp.where(t272, 1, t237)
@@ -3963,29 +3961,29 @@ def ik_nearest(T, q_seed, q_free, weights=(1.0,) * DOF):
     t283 = xp.where(t275, t271, t246)
     t284 = xp.where(xp.less(t43, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t285 = t43 + t284
-    t286 = t43 - t284
+    t286 = -t284 + t43
     t287 = xp.where(xp.greater_equal(t43, -2.9670597283903604) & xp.less_equal(t43, 2.9670597283903604), t43, xp.where(xp.greater_equal(t285, -2.9670597283903604) & xp.less_equal(t285, 2.9670597283903604), t285, xp.where(xp.greater_equal(t286, -2.9670597283903604) & xp.less_equal(t286, 2.9670597283903604), t286, qb6_0)))
     t288 = xp.where(xp.less(t44, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t289 = t44 + t288
-    t290 = t44 - t288
+    t290 = -t288 + t44
     t291 = xp.where(xp.greater_equal(t44, -2.0943951023931953) & xp.less_equal(t44, 2.0943951023931953), t44, xp.where(xp.greater_equal(t289, -2.0943951023931953) & xp.less_equal(t289, 2.0943951023931953), t289, xp.where(xp.greater_equal(t290, -2.0943951023931953) & xp.less_equal(t290, 2.0943951023931953), t290, qb6_1)))
     t292 = xp.where(xp.less(t45, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t293 = t45 + t292
-    t294 = t45 - t292
+    t294 = -t292 + t45
     t295 = xp.where(xp.greater_equal(t45, -2.0943951023931953) & xp.less_equal(t45, 2.0943951023931953), t45, xp.where(xp.greater_equal(t293, -2.0943951023931953) & xp.less_equal(t293, 2.0943951023931953), t293, xp.where(xp.greater_equal(t294, -2.0943951023931953) & xp.less_equal(t294, 2.0943951023931953), t294, qb6_3)))
     t296 = xp.where(xp.less(t46, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t297 = t46 + t296
-    t298 = t46 - t296
+    t298 = -t296 + t46
     t299 = xp.where(xp.greater_equal(t46, -2.9670597283903604) & xp.less_equal(t46, 2.9670597283903604), t46, xp.where(xp.greater_equal(t297, -2.9670597283903604) & xp.less_equal(t297, 2.9670597283903604), t297, xp.where(xp.greater_equal(t298, -2.9670597283903604) & xp.less_equal(t298, 2.9670597283903604), t298, qb6_4)))
     t300 = xp.where(xp.less(t47, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t301 = t47 + t300
-    t302 = t47 - t300
+    t302 = -t300 + t47
     t303 = xp.where(xp.greater_equal(t47, -2.0943951023931953) & xp.less_equal(t47, 2.0943951023931953), t47, xp.where(xp.greater_equal(t301, -2.0943951023931953) & xp.less_equal(t301, 2.0943951023931953), t301, xp.where(xp.greater_equal(t302, -2.0943951023931953) & xp.less_equal(t302, 2.0943951023931953), t302, qb6_5)))
     t304 = xp.where(xp.less(t48, qn7), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t305 = t48 + t304
-    t306 = t48 - t304
+    t306 = -t304 + t48
     t307 = xp.where(xp.greater_equal(t48, -3.0543261909900767) & xp.less_equal(t48, 3.0543261909900767), t48, xp.where(xp.greater_equal(t305, -3.0543261909900767) & xp.less_equal(t305, 3.0543261909900767), t305, xp.where(xp.greater_equal(t306, -3.0543261909900767) & xp.less_equal(t306, 3.0543261909900767), t306, qb6_6)))
-    t308 = qw1*(t287 + t82)**2 + qw2*(t291 + t83)**2 + qw3*(qb6_2 + t84)**2 + qw4*(t295 + t85)**2 + qw5*(t299 + t86)**2 + qw6*(t303 + t87)**2 + qw7*(t307 + t88)**2
+    t308 = qw1*(t82 + t287)**2 + qw2*(t83 + t291)**2 + qw3*(t84 + qb6_2)**2 + qw4*(t85 + t295)**2 + qw5*(t86 + t299)**2 + qw6*(t87 + t303)**2 + qw7*(t88 + t307)**2
     t309 = xp.greater(t49, 0)
     t310 = xp.where(t309 & (xp.less(t274, 1) | xp.less(t308, t283)), xp.asarray(1, dtype=dtype), 0)
     t311 = xp.where(t309, 1, t274)
@@ -4000,29 +3998,29 @@ def ik_nearest(T, q_seed, q_free, weights=(1.0,) * DOF):
     t320 = xp.where(t312, t308, t283)
     t321 = xp.where(xp.less(t50, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t322 = t50 + t321
-    t323 = t50 - t321
+    t323 = -t321 + t50
     t324 = xp.where(xp.greater_equal(t50, -2.9670597283903604) & xp.less_equal(t50, 2.9670597283903604), t50, xp.where(xp.greater_equal(t322, -2.9670597283903604) & xp.less_equal(t322, 2.9670597283903604), t322, xp.where(xp.greater_equal(t323, -2.9670597283903604) & xp.less_equal(t323, 2.9670597283903604), t323, qb7_0)))
     t325 = xp.where(xp.less(t51, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t326 = t51 + t325
-    t327 = t51 - t325
+    t327 = -t325 + t51
     t328 = xp.where(xp.greater_equal(t51, -2.0943951023931953) & xp.less_equal(t51, 2.0943951023931953), t51, xp.where(xp.greater_equal(t326, -2.0943951023931953) & xp.less_equal(t326, 2.0943951023931953), t326, xp.where(xp.greater_equal(t327, -2.0943951023931953) & xp.less_equal(t327, 2.0943951023931953), t327, qb7_1)))
     t329 = xp.where(xp.less(t52, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t330 = t52 + t329
-    t331 = t52 - t329
+    t331 = -t329 + t52
     t332 = xp.where(xp.greater_equal(t52, -2.0943951023931953) & xp.less_equal(t52, 2.0943951023931953), t52, xp.where(xp.greater_equal(t330, -2.0943951023931953) & xp.less_equal(t330, 2.0943951023931953), t330, xp.where(xp.greater_equal(t331, -2.0943951023931953) & xp.less_equal(t331, 2.0943951023931953), t331, qb7_3)))
     t333 = xp.where(xp.less(t53, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t334 = t53 + t333
-    t335 = t53 - t333
+    t335 = -t333 + t53
     t336 = xp.where(xp.greater_equal(t53, -2.9670597283903604) & xp.less_equal(t53, 2.9670597283903604), t53, xp.where(xp.greater_equal(t334, -2.9670597283903604) & xp.less_equal(t334, 2.9670597283903604), t334, xp.where(xp.greater_equal(t335, -2.9670597283903604) & xp.less_equal(t335, 2.9670597283903604), t335, qb7_4)))
     t337 = xp.where(xp.less(t54, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t338 = t54 + t337
-    t339 = t54 - t337
+    t339 = -t337 + t54
     t340 = xp.where(xp.greater_equal(t54, -2.0943951023931953) & xp.less_equal(t54, 2.0943951023931953), t54, xp.where(xp.greater_equal(t338, -2.0943951023931953) & xp.less_equal(t338, 2.0943951023931953), t338, xp.where(xp.greater_equal(t339, -2.0943951023931953) & xp.less_equal(t339, 2.0943951023931953), t339, qb7_5)))
     t341 = xp.where(xp.less(t55, qn7), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t342 = t55 + t341
-    t343 = t55 - t341
+    t343 = -t341 + t55
     t344 = xp.where(xp.greater_equal(t55, -3.0543261909900767) & xp.less_equal(t55, 3.0543261909900767), t55, xp.where(xp.greater_equal(t342, -3.0543261909900767) & xp.less_equal(t342, 3.0543261909900767), t342, xp.where(xp.greater_equal(t343, -3.0543261909900767) & xp.less_equal(t343, 3.0543261909900767), t343, qb7_6)))
-    t345 = qw1*(t324 + t82)**2 + qw2*(t328 + t83)**2 + qw3*(qb7_2 + t84)**2 + qw4*(t332 + t85)**2 + qw5*(t336 + t86)**2 + qw6*(t340 + t87)**2 + qw7*(t344 + t88)**2
+    t345 = qw1*(t82 + t324)**2 + qw2*(t83 + t328)**2 + qw3*(t84 + qb7_2)**2 + qw4*(t85 + t332)**2 + qw5*(t86 + t336)**2 + qw6*(t87 + t340)**2 + qw7*(t88 + t344)**2
     t346 = xp.greater(t56, 0)
     t347 = xp.where(t346 & (xp.less(t311, 1) | xp.less(t345, t320)), xp.asarray(1, dtype=dtype), 0)
     t348 = xp.where(t346, 1, t311)

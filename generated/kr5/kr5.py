@@ -84,7 +84,7 @@ def fk(q):
     c3 = trig[..., 4]
     s3 = trig[..., 5]
     c23 = c2*c3 - s2*s3
-    s23 = c2*s3 + c3*s2
+    s23 = c2*s3 + s2*c3
     c4 = trig[..., 6]
     s4 = trig[..., 7]
     c5 = trig[..., 8]
@@ -95,7 +95,7 @@ def fk(q):
     t1 = c1*c4
     t2 = -t0 + c23*t1
     t3 = t1 - c23*t0
-    t4 = c4*s1
+    t4 = s1*c4
     t5 = c1*s4
     t6 = t4 + c23*t5
     t7 = t5 + c23*t4
@@ -103,32 +103,32 @@ def fk(q):
     t9 = t2*c5 - s5*t8
     t10 = t2*s5 + c5*t8
     t11 = t9*c6 - t6*s6
-    t12 = t6*c6 + t9*s6
+    t12 = c6*t6 + t9*s6
     t13 = 0.115*t10 + 0.62*t8
     t14 = s1*s23
-    t15 = t7*c5 - s5*t14
-    t16 = t7*s5 + c5*t14
-    t17 = t3*s6 + t15*c6
-    t18 = t3*c6 - t15*s6
+    t15 = c5*t7 - s5*t14
+    t16 = s5*t7 + c5*t14
+    t17 = s6*t3 + c6*t15
+    t18 = c6*t3 - s6*t15
     t19 = 0.115*t16 + 0.62*t14
-    t20 = c4*s23
+    t20 = s23*c4
     t21 = c23*s5 + c5*t20
     t22 = -c23*c5 + s5*t20
     t23 = -0.62*c23 + 0.115*t22
-    t24 = t23 - 0.12*s23
-    t25 = t24 - 0.6*s2
+    t24 = -0.12*s23 + t23
+    t25 = -0.6*s2 + t24
     t26 = 0.4 + t25
-    t27 = s4*s23
-    t28 = -t21*c6 + s6*t27
-    t29 = t21*s6 + c6*t27
+    t27 = s23*s4
+    t28 = -c6*t21 + s6*t27
+    t29 = s6*t21 + c6*t27
     t30 = 0.12*c23
     t31 = -t13 + c1*t30
     t32 = -t19 + s1*t30
     t33 = 0.6*c2
-    t34 = t31 + c1*t33
-    t35 = t32 + s1*t33
-    t36 = t34 + 0.18*c1
-    t37 = t35 + 0.18*s1
+    t34 = c1*t33 + t31
+    t35 = s1*t33 + t32
+    t36 = 0.18*c1 + t34
+    t37 = 0.18*s1 + t35
     T = _stack(xp, [
         t11,  # 0, 0
         t12,  # 0, 1
@@ -161,58 +161,58 @@ def jacobian(q):
     c3 = trig[..., 4]
     s3 = trig[..., 5]
     c23 = c2*c3 - s2*s3
-    s23 = c2*s3 + c3*s2
+    s23 = c2*s3 + s2*c3
     c4 = trig[..., 6]
     s4 = trig[..., 7]
     c5 = trig[..., 8]
     s5 = trig[..., 9]
-    t0 = -c23*c5 + c4*s23*s5
+    t0 = -c23*c5 + s23*c4*s5
     t1 = s1*s4
     t2 = c1*c4
     t3 = -t1 + c23*t2
     t4 = t2 - c23*t1
-    t5 = c4*s1
+    t5 = s1*c4
     t6 = c1*s4
     t7 = t5 + c23*t6
     t8 = t6 + c23*t5
     t9 = c1*s23
     t10 = t3*s5 + c5*t9
     t11 = s1*s23
-    t12 = t8*s5 + c5*t11
+    t12 = s5*t8 + c5*t11
     t13 = 0.115*t10
     t14 = t13 + 0.62*t9
     t15 = 0.115*t12
     t16 = t15 + 0.62*t11
     t17 = 0.115*t0
     t18 = -0.62*c23 + t17
-    t19 = t18 - 0.12*s23
-    t20 = t19 - 0.6*s2
+    t19 = -0.12*s23 + t18
+    t20 = -0.6*s2 + t19
     t21 = 0.12*c23
     t22 = -t14 + c1*t21
     t23 = -t16 + s1*t21
     t24 = 0.6*c2
-    t25 = t22 + c1*t24
-    t26 = t23 + s1*t24
-    t27 = t25 + 0.18*c1
-    t28 = t26 + 0.18*s1
+    t25 = c1*t24 + t22
+    t26 = s1*t24 + t23
+    t27 = 0.18*c1 + t25
+    t28 = 0.18*s1 + t26
     t29 = s23*s4
     t30 = -s1
     J = _stack(xp, [
         -t28,  # 0, 0
-        t20*c1,  # 0, 1
-        t19*c1,  # 0, 2
-        t16*c23 + t18*t11,  # 0, 3
+        c1*t20,  # 0, 1
+        c1*t19,  # 0, 2
+        c23*t16 + t18*t11,  # 0, 3
         t4*t17 + t15*t29,  # 0, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5
         t27,  # 1, 0
-        t20*s1,  # 1, 1
-        t19*s1,  # 1, 2
-        -(t14*c23 + t18*t9),  # 1, 3
+        s1*t20,  # 1, 1
+        s1*t19,  # 1, 2
+        -(c23*t14 + t18*t9),  # 1, 3
         t7*t17 - t13*t29,  # 1, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
-        -(t25*c1 + t26*s1),  # 2, 1
-        -(t22*c1 + t23*s1),  # 2, 2
+        -(c1*t25 + s1*t26),  # 2, 1
+        -(c1*t22 + s1*t23),  # 2, 2
         t14*t11 - t16*t9,  # 2, 3
         t7*t15 + t4*t13,  # 2, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 5
@@ -249,7 +249,7 @@ def fk_jacobian(q):
     c3 = trig[..., 4]
     s3 = trig[..., 5]
     c23 = c2*c3 - s2*s3
-    s23 = c2*s3 + c3*s2
+    s23 = c2*s3 + s2*c3
     c4 = trig[..., 6]
     s4 = trig[..., 7]
     c5 = trig[..., 8]
@@ -260,7 +260,7 @@ def fk_jacobian(q):
     t1 = c1*c4
     t2 = -t0 + c23*t1
     t3 = t1 - c23*t0
-    t4 = c4*s1
+    t4 = s1*c4
     t5 = c1*s4
     t6 = t4 + c23*t5
     t7 = t5 + c23*t4
@@ -268,35 +268,35 @@ def fk_jacobian(q):
     t9 = t2*c5 - s5*t8
     t10 = t2*s5 + c5*t8
     t11 = t9*c6 - t6*s6
-    t12 = t6*c6 + t9*s6
+    t12 = c6*t6 + t9*s6
     t13 = s1*s23
-    t14 = t7*c5 - s5*t13
-    t15 = t7*s5 + c5*t13
-    t16 = t3*s6 + t14*c6
-    t17 = t3*c6 - t14*s6
-    t18 = c4*s23
+    t14 = c5*t7 - s5*t13
+    t15 = s5*t7 + c5*t13
+    t16 = s6*t3 + c6*t14
+    t17 = c6*t3 - s6*t14
+    t18 = s23*c4
     t19 = c23*s5 + c5*t18
     t20 = -c23*c5 + s5*t18
     t21 = s23*s4
-    t22 = -t19*c6 + s6*t21
-    t23 = t19*s6 + c6*t21
+    t22 = -c6*t19 + s6*t21
+    t23 = s6*t19 + c6*t21
     t24 = 0.115*t10
     t25 = t24 + 0.62*t8
     t26 = 0.115*t15
     t27 = t26 + 0.62*t13
     t28 = 0.115*t20
     t29 = -0.62*c23 + t28
-    t30 = t29 - 0.12*s23
-    t31 = t30 - 0.6*s2
+    t30 = -0.12*s23 + t29
+    t31 = -0.6*s2 + t30
     t32 = 0.4 + t31
     t33 = 0.12*c23
     t34 = -t25 + c1*t33
     t35 = -t27 + s1*t33
     t36 = 0.6*c2
-    t37 = t34 + c1*t36
-    t38 = t35 + s1*t36
-    t39 = t37 + 0.18*c1
-    t40 = t38 + 0.18*s1
+    t37 = c1*t36 + t34
+    t38 = s1*t36 + t35
+    t39 = 0.18*c1 + t37
+    t40 = 0.18*s1 + t38
     t41 = -s1
     T = _stack(xp, [
         t11,  # 0, 0
@@ -318,20 +318,20 @@ def fk_jacobian(q):
     ], (4, 4))
     J = _stack(xp, [
         -t40,  # 0, 0
-        t31*c1,  # 0, 1
-        t30*c1,  # 0, 2
-        t27*c23 + t29*t13,  # 0, 3
-        t3*t28 + t26*t21,  # 0, 4
+        c1*t31,  # 0, 1
+        c1*t30,  # 0, 2
+        c23*t27 + t29*t13,  # 0, 3
+        t3*t28 + t21*t26,  # 0, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5
         t39,  # 1, 0
-        t31*s1,  # 1, 1
-        t30*s1,  # 1, 2
-        -(t25*c23 + t29*t8),  # 1, 3
-        t6*t28 - t24*t21,  # 1, 4
+        s1*t31,  # 1, 1
+        s1*t30,  # 1, 2
+        -(c23*t25 + t29*t8),  # 1, 3
+        t6*t28 - t21*t24,  # 1, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
-        -(t37*c1 + t38*s1),  # 2, 1
-        -(t34*c1 + t35*s1),  # 2, 2
+        -(c1*t37 + s1*t38),  # 2, 1
+        -(c1*t34 + s1*t35),  # 2, 2
         t25*t13 - t27*t8,  # 2, 3
         t6*t26 + t3*t24,  # 2, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 5
@@ -368,7 +368,7 @@ def jacobian_tool(q):
     c3 = trig[..., 4]
     s3 = trig[..., 5]
     c23 = c2*c3 - s2*s3
-    s23 = c2*s3 + c3*s2
+    s23 = c2*s3 + s2*c3
     c4 = trig[..., 6]
     s4 = trig[..., 7]
     c5 = trig[..., 8]
@@ -379,7 +379,7 @@ def jacobian_tool(q):
     t1 = c1*c4
     t2 = -t0 + c23*t1
     t3 = t1 - c23*t0
-    t4 = c4*s1
+    t4 = s1*c4
     t5 = c1*s4
     t6 = t4 + c23*t5
     t7 = t5 + c23*t4
@@ -387,59 +387,59 @@ def jacobian_tool(q):
     t9 = t2*c5 - s5*t8
     t10 = t2*s5 + c5*t8
     t11 = t9*c6 - t6*s6
-    t12 = t6*c6 + t9*s6
+    t12 = c6*t6 + t9*s6
     t13 = s1*s23
-    t14 = t7*c5 - s5*t13
-    t15 = t7*s5 + c5*t13
-    t16 = t3*s6 + t14*c6
-    t17 = t3*c6 - t14*s6
-    t18 = c4*s23
+    t14 = c5*t7 - s5*t13
+    t15 = s5*t7 + c5*t13
+    t16 = s6*t3 + c6*t14
+    t17 = c6*t3 - s6*t14
+    t18 = s23*c4
     t19 = c23*s5 + c5*t18
     t20 = -c23*c5 + s5*t18
-    t21 = s4*s23
-    t22 = -t19*c6 + s6*t21
-    t23 = t19*s6 + c6*t21
+    t21 = s23*s4
+    t22 = -c6*t19 + s6*t21
+    t23 = s6*t19 + c6*t21
     t24 = 0.115*t10
     t25 = t24 + 0.62*t8
     t26 = 0.115*t15
     t27 = t26 + 0.62*t13
     t28 = 0.115*t20
     t29 = -0.62*c23 + t28
-    t30 = t29 - 0.12*s23
-    t31 = t30 - 0.6*s2
+    t30 = -0.12*s23 + t29
+    t31 = -0.6*s2 + t30
     t32 = 0.12*c23
     t33 = -t25 + c1*t32
     t34 = -t27 + s1*t32
     t35 = 0.6*c2
-    t36 = t33 + c1*t35
-    t37 = t34 + s1*t35
-    t38 = t36 + 0.18*c1
-    t39 = t37 + 0.18*s1
-    t40 = -(t36*c1 + t37*s1)
+    t36 = c1*t35 + t33
+    t37 = s1*t35 + t34
+    t38 = 0.18*c1 + t36
+    t39 = 0.18*s1 + t37
+    t40 = -(c1*t36 + s1*t37)
     t41 = c1*t11
     t42 = s1*t16
-    t43 = -(t33*c1 + t34*s1)
-    t44 = t27*c23 + t29*t13
-    t45 = -(t25*c23 + t29*t8)
+    t43 = -(c1*t33 + s1*t34)
+    t44 = c23*t27 + t29*t13
+    t45 = -(c23*t25 + t29*t8)
     t46 = t25*t13 - t27*t8
-    t47 = t3*t28 + t26*t21
-    t48 = t6*t28 - t24*t21
+    t47 = t3*t28 + t21*t26
+    t48 = t6*t28 - t21*t24
     t49 = t6*t26 + t3*t24
     t50 = c1*t12
     t51 = s1*t17
     t52 = c1*t10
     t53 = s1*t15
-    t54 = t16*c1 - t11*s1
-    t55 = -(t12*s1 + t17*c1)
-    t56 = t10*s1 - t15*c1
+    t54 = c1*t16 - s1*t11
+    t55 = -(s1*t12 + c1*t17)
+    t56 = s1*t10 - c1*t15
     J = _stack(xp, [
-        t16*t38 - t11*t39,  # 0, 0
+        t38*t16 - t11*t39,  # 0, 0
         t22*t40 + t31*t41 + t31*t42,  # 0, 1
         t22*t43 + t30*t41 + t30*t42,  # 0, 2
         t11*t44 + t16*t45 + t22*t46,  # 0, 3
         t11*t47 + t16*t48 + t22*t49,  # 0, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5
-        -(t12*t39 + t17*t38),  # 1, 0
+        -(t12*t39 + t38*t17),  # 1, 0
         -(t23*t40 - t31*t50 + t31*t51),  # 1, 1
         -(t23*t43 - t30*t50 + t30*t51),  # 1, 2
         -(-t12*t44 + t17*t45 + t23*t46),  # 1, 3
@@ -454,19 +454,19 @@ def jacobian_tool(q):
         t22,  # 3, 0
         t54,  # 3, 1
         t54,  # 3, 2
-        t22*c23 + t11*t8 + t16*t13,  # 3, 3
+        c23*t22 + t11*t8 + t16*t13,  # 3, 3
         t3*t16 - t6*t11 + t22*t21,  # 3, 4
         t10*t11 + t15*t16 - t20*t22,  # 3, 5
         -t23,  # 4, 0
         t55,  # 4, 1
         t55,  # 4, 2
-        -(t23*c23 - t12*t8 + t17*t13),  # 4, 3
+        -(c23*t23 - t12*t8 + t17*t13),  # 4, 3
         -(t6*t12 + t3*t17 + t23*t21),  # 4, 4
         t10*t12 + t20*t23 - t15*t17,  # 4, 5
         t20,  # 5, 0
         t56,  # 5, 1
         t56,  # 5, 2
-        -(-t20*c23 + t10*t8 + t15*t13),  # 5, 3
+        -(-c23*t20 + t10*t8 + t15*t13),  # 5, 3
         t6*t10 - t3*t15 + t20*t21,  # 5, 4
         -(t10**2 + t15**2 + t20**2),  # 5, 5
     ], (6, 6))
@@ -484,7 +484,7 @@ def task(q):
     c3 = trig[..., 4]
     s3 = trig[..., 5]
     c23 = c2*c3 - s2*s3
-    s23 = c2*s3 + c3*s2
+    s23 = c2*s3 + s2*c3
     c4 = trig[..., 6]
     s4 = trig[..., 7]
     c5 = trig[..., 8]
@@ -495,7 +495,7 @@ def task(q):
     t1 = c1*c4
     t2 = -t0 + c23*t1
     t3 = t1 - c23*t0
-    t4 = c4*s1
+    t4 = s1*c4
     t5 = c1*s4
     t6 = t4 + c23*t5
     t7 = t5 + c23*t4
@@ -505,28 +505,28 @@ def task(q):
     t11 = t9*c6 - t6*s6
     t12 = 0.115*t10 + 0.62*t8
     t13 = s1*s23
-    t14 = t7*c5 - s5*t13
-    t15 = t7*s5 + c5*t13
-    t16 = t3*s6 + t14*c6
+    t14 = c5*t7 - s5*t13
+    t15 = s5*t7 + c5*t13
+    t16 = s6*t3 + c6*t14
     t17 = 0.115*t15 + 0.62*t13
-    t18 = c4*s23
+    t18 = s23*c4
     t19 = c23*s5 + c5*t18
     t20 = -c23*c5 + s5*t18
     t21 = -0.62*c23 + 0.115*t20
-    t22 = t21 - 0.12*s23
-    t23 = t22 - 0.6*s2
+    t22 = -0.12*s23 + t21
+    t23 = -0.6*s2 + t22
     t24 = 0.4 + t23
-    t25 = s4*s23
-    t26 = -t19*c6 + s6*t25
-    t27 = t19*s6 + c6*t25
+    t25 = s23*s4
+    t26 = -c6*t19 + s6*t25
+    t27 = s6*t19 + c6*t25
     t28 = 0.12*c23
     t29 = -t12 + c1*t28
     t30 = -t17 + s1*t28
     t31 = 0.6*c2
-    t32 = t29 + c1*t31
-    t33 = t30 + s1*t31
-    t34 = t32 + 0.18*c1
-    t35 = t33 + 0.18*s1
+    t32 = c1*t31 + t29
+    t33 = s1*t31 + t30
+    t34 = 0.18*c1 + t32
+    t35 = 0.18*s1 + t33
     mu = _stack(xp, [
         t34,  # 0
         t35,  # 1
@@ -549,7 +549,7 @@ def task_jacobian(q):
     c3 = trig[..., 4]
     s3 = trig[..., 5]
     c23 = c2*c3 - s2*s3
-    s23 = c2*s3 + c3*s2
+    s23 = c2*s3 + s2*c3
     c4 = trig[..., 6]
     s4 = trig[..., 7]
     c5 = trig[..., 8]
@@ -560,7 +560,7 @@ def task_jacobian(q):
     t1 = c1*c4
     t2 = -t0 + c23*t1
     t3 = t1 - c23*t0
-    t4 = c4*s1
+    t4 = s1*c4
     t5 = c1*s4
     t6 = t4 + c23*t5
     t7 = t5 + c23*t4
@@ -569,59 +569,59 @@ def task_jacobian(q):
     t10 = t2*s5 + c5*t8
     t11 = t9*c6 - t6*s6
     t12 = s1*s23
-    t13 = t7*c5 - s5*t12
-    t14 = t7*s5 + c5*t12
-    t15 = t3*s6 + t13*c6
-    t16 = c4*s23
+    t13 = c5*t7 - s5*t12
+    t14 = s5*t7 + c5*t12
+    t15 = s6*t3 + c6*t13
+    t16 = s23*c4
     t17 = c23*s5 + c5*t16
     t18 = -c23*c5 + s5*t16
     t19 = s23*s4
-    t20 = -t17*c6 + s6*t19
+    t20 = -c6*t17 + s6*t19
     t21 = 0.115*t10
     t22 = t21 + 0.62*t8
     t23 = 0.115*t14
     t24 = t23 + 0.62*t12
     t25 = 0.115*t18
     t26 = -0.62*c23 + t25
-    t27 = t26 - 0.12*s23
-    t28 = t27 - 0.6*s2
+    t27 = -0.12*s23 + t26
+    t28 = -0.6*s2 + t27
     t29 = 0.12*c23
     t30 = -t22 + c1*t29
     t31 = -t24 + s1*t29
     t32 = 0.6*c2
-    t33 = t30 + c1*t32
-    t34 = t31 + s1*t32
-    t35 = t33 + 0.18*c1
-    t36 = t34 + 0.18*s1
-    t37 = t11**2 + t15**2
-    t38 = 1/t37
-    t39 = t15*c1
-    t40 = t11*s1
-    t41 = t38*(t39 - t40)
-    t42 = t11*c1
-    t43 = t15*s1
-    t44 = t38*(s23*t42 + s23*t43)
-    t45 = t38*(t3*t15 - t6*t11)
-    t46 = t38*(t10*t11 + t14*t15)
-    t47 = 1/xp.sqrt(t37)
+    t33 = c1*t32 + t30
+    t34 = s1*t32 + t31
+    t35 = 0.18*c1 + t33
+    t36 = 0.18*s1 + t34
+    t37 = c1*t15
+    t38 = s1*t11
+    t39 = t11**2 + t15**2
+    t40 = 1/t39
+    t41 = (t37 - t38)*t40
+    t42 = c1*t11
+    t43 = s1*t15
+    t44 = t40*(s23*t42 + s23*t43)
+    t45 = t40*(t3*t15 - t6*t11)
+    t46 = t40*(t10*t11 + t14*t15)
+    t47 = 1/xp.sqrt(t39)
     t48 = t47*(t42 + t43)
     t49 = -t20*t41
     J = _stack(xp, [
         -t36,  # 0, 0
-        t28*c1,  # 0, 1
-        t27*c1,  # 0, 2
-        t24*c23 + t26*t12,  # 0, 3
-        t3*t25 + t23*t19,  # 0, 4
+        c1*t28,  # 0, 1
+        c1*t27,  # 0, 2
+        c23*t24 + t26*t12,  # 0, 3
+        t3*t25 + t19*t23,  # 0, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5
         t35,  # 1, 0
-        t28*s1,  # 1, 1
-        t27*s1,  # 1, 2
-        -(t22*c23 + t26*t8),  # 1, 3
-        t6*t25 - t21*t19,  # 1, 4
+        s1*t28,  # 1, 1
+        s1*t27,  # 1, 2
+        -(c23*t22 + t26*t8),  # 1, 3
+        t6*t25 - t19*t21,  # 1, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
-        -(t33*c1 + t34*s1),  # 2, 1
-        -(t30*c1 + t31*s1),  # 2, 2
+        -(c1*t33 + s1*t34),  # 2, 1
+        -(c1*t30 + s1*t31),  # 2, 2
         t22*t12 - t24*t8,  # 2, 3
         t6*t23 + t3*t21,  # 2, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 5
@@ -634,7 +634,7 @@ def task_jacobian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
         t48,  # 4, 1
         t48,  # 4, 2
-        t47*(s23*t40 - s23*t39),  # 4, 3
+        t47*(s23*t38 - s23*t37),  # 4, 3
         t47*(t6*t15 + t3*t11),  # 4, 4
         t47*(t14*t11 - t10*t15),  # 4, 5
         xp.full(batch, 1, dtype=dtype, device=device),  # 5, 0
@@ -664,7 +664,7 @@ def fk_jacobian_dot(q, q_dot):
     c3 = trig[..., 4]
     s3 = trig[..., 5]
     c23 = c2*c3 - s2*s3
-    s23 = c2*s3 + c3*s2
+    s23 = c2*s3 + s2*c3
     c4 = trig[..., 6]
     s4 = trig[..., 7]
     c5 = trig[..., 8]
@@ -676,7 +676,7 @@ def fk_jacobian_dot(q, q_dot):
     t2 = c1*c4
     t3 = -t1 + c23*t2
     t4 = t2 - c23*t1
-    t5 = c4*s1
+    t5 = s1*c4
     t6 = c1*s4
     t7 = t5 + c23*t6
     t8 = t6 + c23*t5
@@ -684,83 +684,83 @@ def fk_jacobian_dot(q, q_dot):
     t10 = t3*c5 - s5*t9
     t11 = t3*s5 + c5*t9
     t12 = t10*c6 - t7*s6
-    t13 = t7*c6 + t10*s6
+    t13 = c6*t7 + t10*s6
     t14 = s1*s23
-    t15 = t8*c5 - s5*t14
-    t16 = t8*s5 + c5*t14
-    t17 = t4*s6 + t15*c6
-    t18 = t4*c6 - t15*s6
-    t19 = c4*s23
+    t15 = c5*t8 - s5*t14
+    t16 = s5*t8 + c5*t14
+    t17 = s6*t4 + c6*t15
+    t18 = c6*t4 - s6*t15
+    t19 = s23*c4
     t20 = c23*s5 + c5*t19
     t21 = -c23*c5 + s5*t19
     t22 = s23*s4
-    t23 = -t20*c6 + s6*t22
-    t24 = t20*s6 + c6*t22
-    t25 = t0 + qd5*t22
+    t23 = -c6*t20 + s6*t22
+    t24 = s6*t20 + c6*t22
+    t25 = t0 + t22*qd5
     t26 = 0.115*t11
     t27 = t26 + 0.62*t9
     t28 = 0.115*t16
     t29 = t28 + 0.62*t14
     t30 = 0.115*t21
     t31 = -0.62*c23 + t30
-    t32 = t31 - 0.12*s23
-    t33 = t32 - 0.6*s2
+    t32 = -0.12*s23 + t31
+    t33 = -0.6*s2 + t32
     t34 = 0.4 + t33
     t35 = 0.12*c23
     t36 = -t27 + c1*t35
     t37 = -t29 + s1*t35
     t38 = 0.6*c2
-    t39 = t36 + c1*t38
-    t40 = t37 + s1*t38
-    t41 = t39 + 0.18*c1
-    t42 = t40 + 0.18*s1
-    t43 = t29*c23 + t31*t14
+    t39 = c1*t38 + t36
+    t40 = s1*t38 + t37
+    t41 = 0.18*c1 + t39
+    t42 = 0.18*s1 + t40
+    t43 = c23*t29 + t31*t14
     t44 = t43
-    t45 = t4*t30 + t28*t22
+    t45 = t4*t30 + t22*t28
     t46 = t45
-    t47 = t27*c23 + t31*t9
+    t47 = c23*t27 + t31*t9
     t48 = t47
-    t49 = t7*t30 - t26*t22
+    t49 = t7*t30 - t22*t26
     t50 = t49
-    t51 = t39*c1 + t40*s1
+    t51 = c1*t39 + s1*t40
     t52 = t51
-    t53 = t36*c1 + t37*s1
+    t53 = c1*t36 + s1*t37
     t54 = t53
     t55 = t27*t14 - t29*t9
     t56 = t55
     t57 = t7*t28 + t4*t26
     t58 = t57
-    t59 = t56*qd4 + t58*qd5
-    t60 = t59 - t54*qd3
-    t61 = t60 - t52*qd2
-    t62 = qd2*s1
-    t63 = qd3*s1
+    t59 = qd4*t56 + qd5*t58
+    t60 = t59 - qd3*t54
+    t61 = t60 - qd2*t52
+    t62 = s1*qd2
+    t63 = s1*qd3
     t64 = t62 + t63
-    t65 = -t64 + qd4*t9
+    t65 = -t64 + t9*qd4
     t66 = c1*qd2
     t67 = c1*qd3
     t68 = t66 + t67
-    t69 = t68 + qd4*t14
+    t69 = t68 + t14*qd4
     t70 = t7*qd5
     t71 = t65 - t70
     t72 = t4*qd5
     t73 = t69 + t72
-    t74 = t46*qd5
-    t75 = t44*qd4 + t74
+    t74 = qd5*t46
+    t75 = qd4*t44 + t74
     t76 = t75 + t32*t67
     t77 = t76 + t33*t66
     t78 = t77 - t42*qd1
-    t79 = t50*qd5
-    t80 = t79 - t48*qd4
+    t79 = qd5*t50
+    t80 = t79 - qd4*t48
     t81 = t80 + t32*t63
     t82 = t81 + t33*t62
     t83 = t82 + t41*qd1
-    t84 = t33*c1
-    t85 = t32*c1
-    t86 = t33*s1
-    t87 = t32*s1
+    t84 = c1*t33
+    t85 = c1*t32
+    t86 = s1*t33
+    t87 = s1*t32
     t88 = -s1
-    t89 = qd2*t32
+    t89 = t32*qd2
     T = _stack(xp, [
         xp.broadcast_to(t12, batch),  # 0, 0
         xp.broadcast_to(t13, batch),  # 0, 1
@@ -818,12 +818,12 @@ def fk_jacobian_dot(q, q_dot):
         xp.broadcast_to(-t21, batch),  # 5, 5
     ], (6, 6))
     a = _stack(xp, [
-        xp.broadcast_to(qd2*(t61*c1 - qd1*t86) - qd3*(-t60*c1 + qd1*t87 + t54*t66) + qd4*(t48*qd1 + t56*t68 - t80*c23 + t59*t14) + qd5*(t58*t69 - t50*t0 + t58*t72 - t79*t22) - t83*qd1, batch),  # 0
-        xp.broadcast_to(t78*qd1 + qd2*(t61*s1 + qd1*t84) + qd3*(t60*s1 + qd1*t85 - t54*t62) + qd4*(t44*qd1 + t56*t64 + t75*c23 - t59*t9) + qd5*(t46*t0 - t58*t65 + t58*t70 + t74*t22), batch),  # 1
-        xp.broadcast_to(-qd2*(t77*c1 + t82*s1) - qd3*(t76*c1 + t81*s1 + c1**2*t89 + s1**2*t89) + qd4*(t48*t64 - t44*t68 + t80*t9 - t75*t14) - qd5*(-t50*t65 + t46*t69 + t50*t70 + t46*t72), batch),  # 2
-        xp.broadcast_to(qd4*(t68*c23 - qd1*t14) + qd5*(-t4*t0 + t69*t22) - qd6*(t16*t25 + t21*t73) - qd1*t66 - qd1*t67, batch),  # 3
-        xp.broadcast_to(qd4*(t64*c23 + qd1*t9) - qd5*(t7*t0 + t65*t22) + qd6*(t11*t25 + t21*t71) - qd1*t62 - qd1*t63, batch),  # 4
-        xp.broadcast_to(-qd4*(t64*t14 + t68*t9) + qd5*(t7*t69 + t4*t65) + qd6*(t16*t71 - t11*t73), batch),  # 5
+        xp.broadcast_to(qd2*(c1*t61 - qd1*t86) - qd3*(-c1*t60 + qd1*t87 + t66*t54) + qd4*(qd1*t48 + t68*t56 - c23*t80 + t14*t59) + qd5*(t69*t58 - t0*t50 + t72*t58 - t22*t79) - qd1*t83, batch),  # 0
+        xp.broadcast_to(qd1*t78 + qd2*(s1*t61 + t84*qd1) + qd3*(s1*t60 + qd1*t85 - t62*t54) + qd4*(qd1*t44 + t64*t56 + c23*t75 - t9*t59) + qd5*(t0*t46 - t65*t58 + t70*t58 + t22*t74), batch),  # 1
+        xp.broadcast_to(-qd2*(c1*t77 + s1*t82) - qd3*(c1*t76 + s1*t81 + c1**2*t89 + s1**2*t89) + qd4*(t64*t48 - t68*t44 + t9*t80 - t14*t75) - qd5*(-t65*t50 + t69*t46 + t70*t50 + t72*t46), batch),  # 2
+        xp.broadcast_to(qd4*(c23*t68 - t14*qd1) + qd5*(-t4*t0 + t22*t69) - qd6*(t16*t25 + t21*t73) - t66*qd1 - t67*qd1, batch),  # 3
+        xp.broadcast_to(qd4*(c23*t64 + t9*qd1) - qd5*(t7*t0 + t22*t65) + qd6*(t11*t25 + t21*t71) - t62*qd1 - t63*qd1, batch),  # 4
+        xp.broadcast_to(-qd4*(t14*t64 + t9*t68) + qd5*(t7*t69 + t4*t65) + qd6*(t16*t71 - t11*t73), batch),  # 5
     ], (6,))
     return T, J, a
 
@@ -844,24 +844,24 @@ def jacobian_dot(q, q_dot):
     c3 = trig[..., 4]
     s3 = trig[..., 5]
     c23 = c2*c3 - s2*s3
-    s23 = c2*s3 + c3*s2
+    s23 = c2*s3 + s2*c3
     c4 = trig[..., 6]
     s4 = trig[..., 7]
     c5 = trig[..., 8]
     s5 = trig[..., 9]
-    t0 = -c23*c5 + c4*s23*s5
+    t0 = -c23*c5 + s23*c4*s5
     t1 = qd1 + c23*qd4
     t2 = s1*s4
     t3 = c1*c4
     t4 = -t2 + c23*t3
     t5 = t3 - c23*t2
-    t6 = c4*s1
+    t6 = s1*c4
     t7 = c1*s4
     t8 = t6 + c23*t7
     t9 = t7 + c23*t6
-    t10 = c5*s23
+    t10 = s23*c5
     t11 = t4*s5 + c1*t10
-    t12 = t9*s5 + s1*t10
+    t12 = s5*t9 + s1*t10
     t13 = 0.115*t11
     t14 = 0.62*s23
     t15 = t13 + c1*t14
@@ -870,93 +870,93 @@ def jacobian_dot(q, q_dot):
     t18 = t8*t16 + t5*t13
     t19 = 0.115*t0
     t20 = -0.62*c23 + t19
-    t21 = t20 - 0.12*s23
-    t22 = t21 - 0.6*s2
+    t21 = -0.12*s23 + t20
+    t22 = -0.6*s2 + t21
     t23 = 0.12*c23
     t24 = -t15 + c1*t23
     t25 = -t17 + s1*t23
-    t26 = t24*c1 + t25*s1
+    t26 = c1*t24 + s1*t25
     t27 = 0.6*c2
-    t28 = t24 + c1*t27
-    t29 = t25 + s1*t27
-    t30 = t28 + 0.18*c1
-    t31 = t29 + 0.18*s1
-    t32 = t28*c1 + t29*s1
+    t28 = c1*t27 + t24
+    t29 = s1*t27 + t25
+    t30 = 0.18*c1 + t28
+    t31 = 0.18*s1 + t29
+    t32 = c1*t28 + s1*t29
     t33 = s23*t20
-    t34 = t17*c23 + s1*t33
-    t35 = t15*c23 + c1*t33
-    t36 = s4*s23
+    t34 = c23*t17 + s1*t33
+    t35 = c23*t15 + c1*t33
+    t36 = s23*s4
     t37 = t5*t19 + t16*t36
     t38 = t8*t19 - t13*t36
-    t39 = t1 + qd5*t36
+    t39 = t1 + t36*qd5
     t40 = s1*s23
     t41 = c1*s23
     t42 = t15*t40 - t17*t41
-    t43 = t42*qd4 + t18*qd5
-    t44 = t43 - t26*qd3
-    t45 = t44 - t32*qd2
-    t46 = qd2*s1
-    t47 = qd3*s1
+    t43 = qd4*t42 + qd5*t18
+    t44 = t43 - qd3*t26
+    t45 = t44 - qd2*t32
+    t46 = s1*qd2
+    t47 = s1*qd3
     t48 = t46 + t47
-    t49 = -t48 + qd4*t41
+    t49 = -t48 + t41*qd4
     t50 = c1*qd2
     t51 = c1*qd3
     t52 = t50 + t51
-    t53 = t52 + qd4*t40
+    t53 = t52 + t40*qd4
     t54 = t8*qd5
     t55 = t49 - t54
     t56 = t5*qd5
     t57 = t53 + t56
-    t58 = t37*qd5
-    t59 = t34*qd4 + t58
+    t58 = qd5*t37
+    t59 = qd4*t34 + t58
     t60 = t59 + t21*t51
     t61 = t60 + t22*t50
     t62 = t61 - t31*qd1
-    t63 = t38*qd5
-    t64 = t63 - t35*qd4
+    t63 = qd5*t38
+    t64 = t63 - qd4*t35
     t65 = t64 + t21*t47
     t66 = t65 + t22*t46
     t67 = t66 + t30*qd1
-    t68 = qd1*s1
+    t68 = s1*qd1
     t69 = c1*qd1
-    t70 = qd2*t21
+    t70 = t21*qd2
     t71 = -t69
     t72 = -t68
     Jd = _stack(xp, [
         xp.broadcast_to(-t67, batch),  # 0, 0
-        xp.broadcast_to(t45*c1 - t22*t68, batch),  # 0, 1
-        xp.broadcast_to(-(-t44*c1 + t21*t68 + t26*t50), batch),  # 0, 2
-        xp.broadcast_to(t35*qd1 + t42*t52 - t64*c23 + t43*t40, batch),  # 0, 3
-        xp.broadcast_to(t18*t53 - t38*t1 + t18*t56 - t63*t36, batch),  # 0, 4
+        xp.broadcast_to(c1*t45 - t22*t68, batch),  # 0, 1
+        xp.broadcast_to(-(-c1*t44 + t21*t68 + t50*t26), batch),  # 0, 2
+        xp.broadcast_to(qd1*t35 + t52*t42 - c23*t64 + t40*t43, batch),  # 0, 3
+        xp.broadcast_to(t53*t18 - t1*t38 + t56*t18 - t36*t63, batch),  # 0, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5
         xp.broadcast_to(t62, batch),  # 1, 0
-        xp.broadcast_to(t45*s1 + t22*t69, batch),  # 1, 1
-        xp.broadcast_to(t44*s1 + t21*t69 - t26*t46, batch),  # 1, 2
-        xp.broadcast_to(t34*qd1 + t42*t48 + t59*c23 - t43*t41, batch),  # 1, 3
-        xp.broadcast_to(t37*t1 - t18*t49 + t18*t54 + t58*t36, batch),  # 1, 4
+        xp.broadcast_to(s1*t45 + t22*t69, batch),  # 1, 1
+        xp.broadcast_to(s1*t44 + t21*t69 - t46*t26, batch),  # 1, 2
+        xp.broadcast_to(qd1*t34 + t48*t42 + c23*t59 - t41*t43, batch),  # 1, 3
+        xp.broadcast_to(t1*t37 - t49*t18 + t54*t18 + t36*t58, batch),  # 1, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
-        xp.broadcast_to(-(t61*c1 + t66*s1), batch),  # 2, 1
-        xp.broadcast_to(-(t60*c1 + t65*s1 + c1**2*t70 + s1**2*t70), batch),  # 2, 2
-        xp.broadcast_to(t35*t48 - t34*t52 + t64*t41 - t59*t40, batch),  # 2, 3
-        xp.broadcast_to(-(-t38*t49 + t37*t53 + t38*t54 + t37*t56), batch),  # 2, 4
+        xp.broadcast_to(-(c1*t61 + s1*t66), batch),  # 2, 1
+        xp.broadcast_to(-(c1*t60 + s1*t65 + c1**2*t70 + s1**2*t70), batch),  # 2, 2
+        xp.broadcast_to(t48*t35 - t52*t34 + t41*t64 - t40*t59, batch),  # 2, 3
+        xp.broadcast_to(-(-t49*t38 + t53*t37 + t54*t38 + t56*t37), batch),  # 2, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
         xp.broadcast_to(t71, batch),  # 3, 1
         xp.broadcast_to(t71, batch),  # 3, 2
-        xp.broadcast_to(t52*c23 - s23*t68, batch),  # 3, 3
-        xp.broadcast_to(-t5*t1 + t53*t36, batch),  # 3, 4
+        xp.broadcast_to(c23*t52 - s23*t68, batch),  # 3, 3
+        xp.broadcast_to(-t5*t1 + t36*t53, batch),  # 3, 4
         xp.broadcast_to(-(t12*t39 + t0*t57), batch),  # 3, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
         xp.broadcast_to(t72, batch),  # 4, 1
         xp.broadcast_to(t72, batch),  # 4, 2
-        xp.broadcast_to(t48*c23 + s23*t69, batch),  # 4, 3
-        xp.broadcast_to(-(t8*t1 + t49*t36), batch),  # 4, 4
+        xp.broadcast_to(c23*t48 + s23*t69, batch),  # 4, 3
+        xp.broadcast_to(-(t8*t1 + t36*t49), batch),  # 4, 4
         xp.broadcast_to(t11*t39 + t0*t55, batch),  # 4, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 2
-        xp.broadcast_to(-(t48*t40 + t52*t41), batch),  # 5, 3
+        xp.broadcast_to(-(t40*t48 + t41*t52), batch),  # 5, 3
         xp.broadcast_to(t8*t53 + t5*t49, batch),  # 5, 4
         xp.broadcast_to(t12*t55 - t11*t57, batch),  # 5, 5
     ], (6, 6))
@@ -980,24 +980,24 @@ def bias_acceleration(q, q_dot):
     c3 = trig[..., 4]
     s3 = trig[..., 5]
     c23 = c2*c3 - s2*s3
-    s23 = c2*s3 + c3*s2
+    s23 = c2*s3 + s2*c3
     c4 = trig[..., 6]
     s4 = trig[..., 7]
     c5 = trig[..., 8]
     s5 = trig[..., 9]
-    t0 = -c23*c5 + c4*s23*s5
+    t0 = -c23*c5 + s23*c4*s5
     t1 = qd1 + c23*qd4
     t2 = s1*s4
     t3 = c1*c4
     t4 = -t2 + c23*t3
     t5 = t3 - c23*t2
-    t6 = c4*s1
+    t6 = s1*c4
     t7 = c1*s4
     t8 = t6 + c23*t7
     t9 = t7 + c23*t6
-    t10 = c5*s23
+    t10 = s23*c5
     t11 = t4*s5 + c1*t10
-    t12 = t9*s5 + s1*t10
+    t12 = s5*t9 + s1*t10
     t13 = 0.115*t11
     t14 = 0.62*s23
     t15 = t13 + c1*t14
@@ -1006,63 +1006,63 @@ def bias_acceleration(q, q_dot):
     t18 = t8*t16 + t5*t13
     t19 = 0.115*t0
     t20 = -0.62*c23 + t19
-    t21 = t20 - 0.12*s23
-    t22 = t21 - 0.6*s2
+    t21 = -0.12*s23 + t20
+    t22 = -0.6*s2 + t21
     t23 = 0.12*c23
     t24 = -t15 + c1*t23
     t25 = -t17 + s1*t23
-    t26 = t24*c1 + t25*s1
+    t26 = c1*t24 + s1*t25
     t27 = 0.6*c2
-    t28 = t24 + c1*t27
-    t29 = t25 + s1*t27
-    t30 = t28 + 0.18*c1
-    t31 = t29 + 0.18*s1
-    t32 = t28*c1 + t29*s1
+    t28 = c1*t27 + t24
+    t29 = s1*t27 + t25
+    t30 = 0.18*c1 + t28
+    t31 = 0.18*s1 + t29
+    t32 = c1*t28 + s1*t29
     t33 = s23*t20
-    t34 = t17*c23 + s1*t33
-    t35 = t15*c23 + c1*t33
-    t36 = s4*s23
+    t34 = c23*t17 + s1*t33
+    t35 = c23*t15 + c1*t33
+    t36 = s23*s4
     t37 = t5*t19 + t16*t36
     t38 = t8*t19 - t13*t36
-    t39 = t1 + qd5*t36
+    t39 = t1 + t36*qd5
     t40 = s1*s23
     t41 = c1*s23
     t42 = t15*t40 - t17*t41
-    t43 = t42*qd4 + t18*qd5
-    t44 = t43 - t26*qd3
-    t45 = t44 - t32*qd2
-    t46 = qd2*s1
-    t47 = qd3*s1
+    t43 = qd4*t42 + qd5*t18
+    t44 = t43 - qd3*t26
+    t45 = t44 - qd2*t32
+    t46 = s1*qd2
+    t47 = s1*qd3
     t48 = t46 + t47
-    t49 = -t48 + qd4*t41
+    t49 = -t48 + t41*qd4
     t50 = c1*qd2
     t51 = c1*qd3
     t52 = t50 + t51
-    t53 = t52 + qd4*t40
+    t53 = t52 + t40*qd4
     t54 = t8*qd5
     t55 = t49 - t54
     t56 = t5*qd5
     t57 = t53 + t56
-    t58 = t37*qd5
-    t59 = t34*qd4 + t58
+    t58 = qd5*t37
+    t59 = qd4*t34 + t58
     t60 = t59 + t21*t51
     t61 = t60 + t22*t50
     t62 = t61 - t31*qd1
-    t63 = t38*qd5
-    t64 = t63 - t35*qd4
+    t63 = qd5*t38
+    t64 = t63 - qd4*t35
     t65 = t64 + t21*t47
     t66 = t65 + t22*t46
     t67 = t66 + t30*qd1
     t68 = s1*qd1
     t69 = c1*qd1
-    t70 = qd2*t21
+    t70 = t21*qd2
     a = _stack(xp, [
-        xp.broadcast_to(qd2*(t45*c1 - t22*t68) - qd3*(-t44*c1 + t21*t68 + t26*t50) + qd4*(t35*qd1 + t42*t52 - t64*c23 + t43*t40) + qd5*(t18*t53 - t38*t1 + t18*t56 - t63*t36) - t67*qd1, batch),  # 0
-        xp.broadcast_to(t62*qd1 + qd2*(t45*s1 + t22*t69) + qd3*(t44*s1 + t21*t69 - t26*t46) + qd4*(t34*qd1 + t42*t48 + t59*c23 - t43*t41) + qd5*(t37*t1 - t18*t49 + t18*t54 + t58*t36), batch),  # 1
-        xp.broadcast_to(-qd2*(t61*c1 + t66*s1) - qd3*(t60*c1 + t65*s1 + c1**2*t70 + s1**2*t70) + qd4*(t35*t48 - t34*t52 + t64*t41 - t59*t40) - qd5*(-t38*t49 + t37*t53 + t38*t54 + t37*t56), batch),  # 2
-        xp.broadcast_to(qd4*(t52*c23 - qd1*t40) + qd5*(-t5*t1 + t53*t36) - qd6*(t12*t39 + t0*t57) - qd1*t50 - qd1*t51, batch),  # 3
-        xp.broadcast_to(qd4*(t48*c23 + qd1*t41) - qd5*(t8*t1 + t49*t36) + qd6*(t11*t39 + t0*t55) - qd1*t46 - qd1*t47, batch),  # 4
-        xp.broadcast_to(-qd4*(t48*t40 + t52*t41) + qd5*(t8*t53 + t5*t49) + qd6*(t12*t55 - t11*t57), batch),  # 5
+        xp.broadcast_to(qd2*(c1*t45 - t22*t68) - qd3*(-c1*t44 + t21*t68 + t50*t26) + qd4*(qd1*t35 + t52*t42 - c23*t64 + t40*t43) + qd5*(t53*t18 - t1*t38 + t56*t18 - t36*t63) - qd1*t67, batch),  # 0
+        xp.broadcast_to(qd1*t62 + qd2*(s1*t45 + t22*t69) + qd3*(s1*t44 + t21*t69 - t46*t26) + qd4*(qd1*t34 + t48*t42 + c23*t59 - t41*t43) + qd5*(t1*t37 - t49*t18 + t54*t18 + t36*t58), batch),  # 1
+        xp.broadcast_to(-qd2*(c1*t61 + s1*t66) - qd3*(c1*t60 + s1*t65 + c1**2*t70 + s1**2*t70) + qd4*(t48*t35 - t52*t34 + t41*t64 - t40*t59) - qd5*(-t49*t38 + t53*t37 + t54*t38 + t56*t37), batch),  # 2
+        xp.broadcast_to(qd4*(c23*t52 - t40*qd1) + qd5*(-t5*t1 + t36*t53) - qd6*(t12*t39 + t0*t57) - t50*qd1 - t51*qd1, batch),  # 3
+        xp.broadcast_to(qd4*(c23*t48 + t41*qd1) - qd5*(t8*t1 + t36*t49) + qd6*(t11*t39 + t0*t55) - t46*qd1 - t47*qd1, batch),  # 4
+        xp.broadcast_to(-qd4*(t40*t48 + t41*t52) + qd5*(t8*t53 + t5*t49) + qd6*(t12*t55 - t11*t57), batch),  # 5
     ], (6,))
     return a
 
@@ -1084,7 +1084,7 @@ def task_jacobian_dot(q, q_dot):
     c3 = trig[..., 4]
     s3 = trig[..., 5]
     c23 = c2*c3 - s2*s3
-    s23 = c2*s3 + c3*s2
+    s23 = c2*s3 + s2*c3
     c4 = trig[..., 6]
     s4 = trig[..., 7]
     c5 = trig[..., 8]
@@ -1095,7 +1095,7 @@ def task_jacobian_dot(q, q_dot):
     t1 = c1*c4
     t2 = -t0 + c23*t1
     t3 = t1 - c23*t0
-    t4 = c4*s1
+    t4 = s1*c4
     t5 = c1*s4
     t6 = t4 + c23*t5
     t7 = t5 + c23*t4
@@ -1104,149 +1104,149 @@ def task_jacobian_dot(q, q_dot):
     t10 = t2*s5 + c5*t8
     t11 = t9*c6 - t6*s6
     t12 = s1*s23
-    t13 = t7*c5 - s5*t12
-    t14 = t7*s5 + c5*t12
-    t15 = t3*s6 + t13*c6
+    t13 = c5*t7 - s5*t12
+    t14 = s5*t7 + c5*t12
+    t15 = s6*t3 + c6*t13
     t16 = t11**2 + t15**2
     t17 = xp.sqrt(t16)
-    t18 = c4*s23
+    t18 = s23*c4
     t19 = c23*s5 + c5*t18
     t20 = -c23*c5 + s5*t18
-    t21 = s4*s23
-    t22 = -t19*c6 + s6*t21
+    t21 = s23*s4
+    t22 = -c6*t19 + s6*t21
     t23 = 0.115*t10
     t24 = t23 + 0.62*t8
     t25 = 0.115*t14
     t26 = t25 + 0.62*t12
     t27 = t24*t12 - t26*t8
     t28 = t6*t25 + t3*t23
-    t29 = t27*qd4 + t28*qd5
+    t29 = qd4*t27 + qd5*t28
     t30 = 0.115*t20
     t31 = -0.62*c23 + t30
-    t32 = t31 - 0.12*s23
-    t33 = t32 - 0.6*s2
-    t34 = t26*c23 + t31*t12
-    t35 = t3*t30 + t25*t21
-    t36 = t24*c23 + t31*t8
-    t37 = t6*t30 - t23*t21
+    t32 = -0.12*s23 + t31
+    t33 = -0.6*s2 + t32
+    t34 = c23*t26 + t31*t12
+    t35 = t3*t30 + t21*t25
+    t36 = c23*t24 + t31*t8
+    t37 = t6*t30 - t21*t23
     t38 = 0.12*c23
     t39 = -t24 + c1*t38
     t40 = -t26 + s1*t38
-    t41 = t39*c1 + t40*s1
-    t42 = t29 - t41*qd3
+    t41 = c1*t39 + s1*t40
+    t42 = t29 - qd3*t41
     t43 = 0.6*c2
-    t44 = t39 + c1*t43
-    t45 = t40 + s1*t43
-    t46 = t44 + 0.18*c1
-    t47 = t45 + 0.18*s1
-    t48 = t44*c1 + t45*s1
-    t49 = t42 - t48*qd2
-    t50 = qd2*s1
-    t51 = qd3*s1
+    t44 = c1*t43 + t39
+    t45 = s1*t43 + t40
+    t46 = 0.18*c1 + t44
+    t47 = 0.18*s1 + t45
+    t48 = c1*t44 + s1*t45
+    t49 = t42 - qd2*t48
+    t50 = s1*qd2
+    t51 = s1*qd3
     t52 = t50 + t51
     t53 = t52
-    t54 = t53*c23 + qd1*t8
+    t54 = c23*t53 + t8*qd1
     t55 = c1*qd2
     t56 = c1*qd3
     t57 = t55 + t56
     t58 = t57
-    t59 = t58*c23 - qd1*t12
-    t60 = t53*t12 + t58*t8
-    t61 = qd4*t8
+    t59 = c23*t58 - t12*qd1
+    t60 = t12*t53 + t8*t58
+    t61 = t8*qd4
     t62 = -t53 + t61
-    t63 = qd4*t12
+    t63 = t12*qd4
     t64 = t58 + t63
     t65 = t6*t64 + t3*t62
     t66 = qd1 + c23*qd4
     t67 = t66
-    t68 = -t3*t67 + t64*t21
-    t69 = t6*t67 + t62*t21
+    t68 = -t3*t67 + t21*t64
+    t69 = t6*t67 + t21*t62
     t70 = t6*qd5
     t71 = t62 - t70
-    t72 = t70 - t10*qd6 - t61 + t52
+    t72 = -t61 + t52 + t70 - t10*qd6
     t73 = t3*qd5
     t74 = t64 + t73
-    t75 = t35*t64 - t37*t62 + t37*t70 + t35*t73
+    t75 = t64*t35 - t62*t37 + t70*t37 + t73*t35
     t76 = t14*t71 - t10*t74
-    t77 = t63 + t73 + t14*qd6 + t57
-    t78 = t72*t15 + t77*t11
-    t79 = qd5*t21
+    t77 = t57 + t63 + t73 + t14*qd6
+    t78 = t15*t72 + t11*t77
+    t79 = t21*qd5
     t80 = t67 + t79
     t81 = t14*t80 + t20*t74
     t82 = t10*t80 + t20*t71
-    t83 = t79 - t20*qd6 + t66
-    t84 = t77*t22 - t83*t15
-    t85 = t72*t22 + t83*t11
-    t86 = t35*qd5
-    t87 = t34*qd4 + t86
+    t83 = t66 + t79 - t20*qd6
+    t84 = t22*t77 - t15*t83
+    t85 = t22*t72 + t11*t83
+    t86 = qd5*t35
+    t87 = qd4*t34 + t86
     t88 = t87 + t32*t56
     t89 = t88 + t33*t55
     t90 = t89 - t47*qd1
-    t91 = t34*qd1 + t27*t53 + t87*c23 - t29*t8
-    t92 = t35*t67 - t28*t62 + t28*t70 + t86*t21
-    t93 = t37*qd5
-    t94 = t93 - t36*qd4
+    t91 = qd1*t34 + t53*t27 + c23*t87 - t8*t29
+    t92 = t67*t35 - t62*t28 + t70*t28 + t21*t86
+    t93 = qd5*t37
+    t94 = t93 - qd4*t36
     t95 = t94 + t32*t51
     t96 = t95 + t33*t50
     t97 = t96 + t46*qd1
-    t98 = t36*qd1 + t27*t58 - t94*c23 + t29*t12
-    t99 = t28*t64 - t37*t67 + t28*t73 - t93*t21
-    t100 = t89*c1 + t96*s1
-    t101 = t36*t53 - t34*t58 + t94*t8 - t87*t12
+    t98 = qd1*t36 + t58*t27 - c23*t94 + t12*t29
+    t99 = t64*t28 - t67*t37 + t73*t28 - t21*t93
+    t100 = c1*t89 + s1*t96
+    t101 = t53*t36 - t58*t34 + t8*t94 - t12*t87
     t102 = s1*qd1
-    t103 = t49*c1 - t33*t102
-    t104 = -t42*c1 + t32*t102 + t41*t55
+    t103 = c1*t49 - t33*t102
+    t104 = -c1*t42 + t32*t102 + t55*t41
     t105 = c1*qd1
-    t106 = t49*s1 + t33*t105
-    t107 = t42*s1 + t32*t105 - t41*t50
-    t108 = qd2*t32
-    t109 = t88*c1 + t95*s1 + c1**2*t108 + s1**2*t108
-    t110 = 1/t16
-    t111 = t110*(t3*t15 - t6*t11)
-    t112 = t110*(t10*t11 + t14*t15)
-    t113 = t15*c1
-    t114 = t11*s1
-    t115 = t110*(t113 - t114)
-    t116 = t11*c1
-    t117 = t15*s1
-    t118 = t110*(s23*t116 + s23*t117)
+    t106 = s1*t49 + t33*t105
+    t107 = s1*t42 + t32*t105 - t50*t41
+    t108 = t32*qd2
+    t109 = c1*t88 + s1*t95 + c1**2*t108 + s1**2*t108
+    t110 = c1*t15
+    t111 = s1*t11
+    t112 = 1/t16
+    t113 = (t110 - t111)*t112
+    t114 = (t3*t15 - t6*t11)*t112
+    t115 = (t10*t11 + t14*t15)*t112
+    t116 = c1*t11
+    t117 = s1*t15
+    t118 = (s23*t116 + s23*t117)*t112
     t119 = 1/t17
-    t120 = t110*t119
+    t120 = t112*t119
     t121 = (t116 + t117)*t120
-    t122 = (s23*t114 - s23*t113)*t120
+    t122 = t120*(s23*t111 - s23*t110)
     t123 = (t6*t15 + t3*t11)*t120
     t124 = (t14*t11 - t10*t15)*t120
-    t125 = 2*t115
-    t126 = t110*t84
+    t125 = 2*t113
+    t126 = t112*t84
     t127 = -(s1 + t11*t125)*t126
-    t128 = t110*t85
+    t128 = t112*t85
     t129 = (c1 - t15*t125)*t128
-    t130 = qd1*t110
+    t130 = qd1*t112
     t131 = t116*t130
     t132 = t117*t130
     t133 = t127 + t129 - t131 - t132
     t134 = 2*t118
-    t135 = (t8 - t11*t134)*t126
-    t136 = (t12 - t15*t134)*t128
-    t137 = t11*t110
+    t135 = t126*(t8 - t11*t134)
+    t136 = t128*(t12 - t15*t134)
+    t137 = t11*t112
     t138 = t59*t137
-    t139 = t15*t110
+    t139 = t15*t112
     t140 = t54*t139
-    t141 = 2*t111
-    t142 = -(t6 + t11*t141)*t126
-    t143 = (t3 - t15*t141)*t128
+    t141 = 2*t114
+    t142 = -t126*(t6 + t11*t141)
+    t143 = t128*(t3 - t15*t141)
     t144 = t68*t137
     t145 = t69*t139
     t146 = t82*t139
-    t147 = 2*t112
-    t148 = (t10 - t11*t147)*t126
-    t149 = (t14 - t15*t147)*t128
+    t147 = 2*t115
+    t148 = t126*(t10 - t11*t147)
+    t149 = t128*(t14 - t15*t147)
     t150 = t81*t137
     t151 = qd1*t119
-    t152 = t84*(c1*t119 - t121*t11) + t85*(s1*t119 - t121*t15) + t113*t151 - t114*t151
+    t152 = t84*(c1*t119 - t11*t121) + t85*(s1*t119 - t15*t121) + t110*t151 - t111*t151
     t153 = t11*t119
     t154 = t15*t119
-    t155 = t78*t115 - t22*t127 - t22*t129 + t22*t131 + t22*t132
+    t155 = t113*t78 - t22*t127 - t22*t129 + t22*t131 + t22*t132
     Jd = _stack(xp, [
         xp.broadcast_to(-t97, batch),  # 0, 0
         xp.broadcast_to(t103, batch),  # 0, 1
@@ -1275,15 +1275,15 @@ def task_jacobian_dot(q, q_dot):
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
         xp.broadcast_to(t152, batch),  # 4, 1
         xp.broadcast_to(t152, batch),  # 4, 2
-        xp.broadcast_to(t84*(-t122*t11 + t119*t12) - t85*(t122*t15 + t119*t8) + t54*t153 - t59*t154, batch),  # 4, 3
-        xp.broadcast_to(t84*(t3*t119 - t123*t11) + t85*(t6*t119 - t123*t15) - t69*t153 - t68*t154, batch),  # 4, 4
-        xp.broadcast_to(t84*(t14*t119 - t124*t11) - t85*(t124*t15 + t10*t119) + t82*t153 + t81*t154, batch),  # 4, 5
+        xp.broadcast_to(t84*(-t11*t122 + t12*t119) - t85*(t15*t122 + t8*t119) + t54*t153 - t59*t154, batch),  # 4, 3
+        xp.broadcast_to(t84*(t3*t119 - t11*t123) + t85*(t6*t119 - t15*t123) - t69*t153 - t68*t154, batch),  # 4, 4
+        xp.broadcast_to(t84*(t14*t119 - t11*t124) - t85*(t15*t124 + t10*t119) + t82*t153 + t81*t154, batch),  # 4, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 0
         xp.broadcast_to(t155, batch),  # 5, 1
         xp.broadcast_to(t155, batch),  # 5, 2
-        xp.broadcast_to(-(t60 - t78*t118 + t22*t135 + t22*t136 + t22*t138 + t22*t140), batch),  # 5, 3
-        xp.broadcast_to(t65 + t78*t111 + t22*t145 - t22*t142 - t22*t143 - t22*t144, batch),  # 5, 4
-        xp.broadcast_to(t76 + t78*t112 + t22*t150 - t22*t146 - t22*t148 - t22*t149, batch),  # 5, 5
+        xp.broadcast_to(-(t60 - t118*t78 + t22*t135 + t22*t136 + t22*t138 + t22*t140), batch),  # 5, 3
+        xp.broadcast_to(t65 + t114*t78 + t22*t145 - t22*t142 - t22*t143 - t22*t144, batch),  # 5, 4
+        xp.broadcast_to(t76 + t115*t78 + t22*t150 - t22*t146 - t22*t148 - t22*t149, batch),  # 5, 5
     ], (6, 6))
     return Jd
 
@@ -1299,24 +1299,24 @@ def hessian(q):
     c3 = trig[..., 4]
     s3 = trig[..., 5]
     c23 = c2*c3 - s2*s3
-    s23 = c2*s3 + c3*s2
+    s23 = c2*s3 + s2*c3
     c4 = trig[..., 6]
     s4 = trig[..., 7]
     c5 = trig[..., 8]
     s5 = trig[..., 9]
-    t0 = -c23*c5 + c4*s23*s5
+    t0 = -c23*c5 + s23*c4*s5
     t1 = s1*s4
     t2 = c1*c4
     t3 = -t1 + c23*t2
     t4 = t2 - c23*t1
-    t5 = c4*s1
+    t5 = s1*c4
     t6 = c1*s4
     t7 = t5 + c23*t6
     t8 = t6 + c23*t5
     t9 = c1*s23
     t10 = t3*s5 + c5*t9
     t11 = s1*s23
-    t12 = t8*s5 + c5*t11
+    t12 = s5*t8 + c5*t11
     t13 = 0.115*t10
     t14 = t13 + 0.62*t9
     t15 = 0.115*t12
@@ -1325,52 +1325,52 @@ def hessian(q):
     t18 = t7*t15 + t4*t13
     t19 = 0.115*t0
     t20 = -0.62*c23 + t19
-    t21 = t20 - 0.12*s23
-    t22 = t21 - 0.6*s2
-    t23 = t16*c23 + t20*t11
-    t24 = t14*c23 + t20*t9
+    t21 = -0.12*s23 + t20
+    t22 = -0.6*s2 + t21
+    t23 = c23*t16 + t20*t11
+    t24 = c23*t14 + t20*t9
     t25 = c1*c23
     t26 = -t14 + 0.12*t25
-    t27 = c23*s1
+    t27 = s1*c23
     t28 = -t16 + 0.12*t27
-    t29 = t26*c1 + t28*s1
+    t29 = c1*t26 + s1*t28
     t30 = 0.6*c2
-    t31 = t26 + c1*t30
-    t32 = t28 + s1*t30
-    t33 = t31 + 0.18*c1
-    t34 = t32 + 0.18*s1
-    t35 = t31*c1 + t32*s1
-    t36 = s4*s23
+    t31 = c1*t30 + t26
+    t32 = s1*t30 + t28
+    t33 = 0.18*c1 + t31
+    t34 = 0.18*s1 + t32
+    t35 = c1*t31 + s1*t32
+    t36 = s23*s4
     t37 = t4*t19 + t15*t36
     t38 = t7*t19 - t13*t36
-    t39 = -t22*s1
-    t40 = -t21*s1
+    t39 = -s1*t22
+    t40 = -s1*t21
     t41 = -t38
-    t42 = t22*c1
-    t43 = t21*c1
+    t42 = c1*t22
+    t43 = c1*t21
     t44 = -c1
     t45 = -s1
-    t46 = -t29*c1
-    t47 = t17*c1
-    t48 = t18*c1
-    t49 = -t29*s1
-    t50 = t17*s1
-    t51 = t18*s1
+    t46 = -c1*t29
+    t47 = c1*t17
+    t48 = c1*t18
+    t49 = -s1*t29
+    t50 = s1*t17
+    t51 = s1*t18
     t52 = c1**2
     t53 = s1**2
-    t54 = -(t21*t52 + t21*t53)
-    t55 = t24*s1 - t23*c1
-    t56 = -(t37*c1 + t38*s1)
+    t54 = -(t52*t21 + t53*t21)
+    t55 = s1*t24 - c1*t23
+    t56 = -(c1*t37 + s1*t38)
     t57 = s23*t6
-    t58 = -t0*c1
+    t58 = -c1*t0
     t59 = s23*t1
-    t60 = -t0*s1
-    t61 = -(s23*t52 + s23*t53)
-    t62 = t7*c1 - t4*s1
-    t63 = -(t10*c1 + t12*s1)
-    t64 = -t38*c23 + t18*t11
-    t65 = t37*c23 - t18*t9
-    t66 = t38*t9 - t37*t11
+    t60 = -s1*t0
+    t61 = -(t52*s23 + t53*s23)
+    t62 = c1*t7 - s1*t4
+    t63 = -(c1*t10 + s1*t12)
+    t64 = -c23*t38 + t11*t18
+    t65 = c23*t37 - t9*t18
+    t66 = t9*t38 - t11*t37
     t67 = s23**2
     H = _stack(xp, [
         -t33,  # 0, 0, 0
@@ -1410,19 +1410,19 @@ def hessian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5, 5
         t39,  # 1, 0, 0
-        -t35*c1,  # 1, 0, 1
+        -c1*t35,  # 1, 0, 1
         t46,  # 1, 0, 2
         t47,  # 1, 0, 3
         t48,  # 1, 0, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 0, 5
         t42,  # 1, 1, 0
-        -t35*s1,  # 1, 1, 1
+        -s1*t35,  # 1, 1, 1
         t49,  # 1, 1, 2
         t50,  # 1, 1, 3
         t51,  # 1, 1, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 2, 0
-        -(t22*t52 + t22*t53),  # 1, 2, 1
+        -(t52*t22 + t53*t22),  # 1, 2, 1
         t54,  # 1, 2, 2
         t55,  # 1, 2, 3
         t56,  # 1, 2, 4
@@ -1484,33 +1484,33 @@ def hessian(q):
         t24,  # 3, 0, 0
         t47,  # 3, 0, 1
         t47,  # 3, 0, 2
-        t24*c23 + t17*t11,  # 3, 0, 3
+        c23*t24 + t11*t17,  # 3, 0, 3
         t64,  # 3, 0, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0, 5
         t23,  # 3, 1, 0
         t50,  # 3, 1, 1
         t50,  # 3, 1, 2
-        t23*c23 - t17*t9,  # 3, 1, 3
+        c23*t23 - t9*t17,  # 3, 1, 3
         t65,  # 3, 1, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 2, 0
         t55,  # 3, 2, 1
         t55,  # 3, 2, 2
-        -(t23*t11 + t24*t9),  # 3, 2, 3
+        -(t11*t23 + t9*t24),  # 3, 2, 3
         t66,  # 3, 2, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 3, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 3, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 3, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 3, 3
-        -t4*c23 + t67*t1,  # 3, 3, 4
-        -(t12*c23 + t0*t11),  # 3, 3, 5
+        -c23*t4 + t1*t67,  # 3, 3, 4
+        -(c23*t12 + t0*t11),  # 3, 3, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 4, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 4, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 4, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 4, 3
-        -(t7*c23 + t67*t6),  # 3, 4, 4
-        t10*c23 + t0*t9,  # 3, 4, 5
+        -(c23*t7 + t6*t67),  # 3, 4, 4
+        c23*t10 + t0*t9,  # 3, 4, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 5, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 5, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 5, 2
@@ -1521,13 +1521,13 @@ def hessian(q):
         t48,  # 4, 0, 1
         t48,  # 4, 0, 2
         t64,  # 4, 0, 3
-        t4*t18 - t38*t36,  # 4, 0, 4
+        t4*t18 - t36*t38,  # 4, 0, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0, 5
         t37,  # 4, 1, 0
         t51,  # 4, 1, 1
         t51,  # 4, 1, 2
         t65,  # 4, 1, 3
-        t7*t18 + t37*t36,  # 4, 1, 4
+        t7*t18 + t36*t37,  # 4, 1, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 2, 0
         t56,  # 4, 2, 1
@@ -1546,7 +1546,7 @@ def hessian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 4, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 4, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 4, 4
-        -t7*t0 + t10*t36,  # 4, 4, 5
+        t10*t36 - t7*t0,  # 4, 4, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 5, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 5, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 5, 2
@@ -1606,7 +1606,7 @@ def singularity_factors(q):
     f = _stack(xp, [
         c3 + t0,  # 0
         s5,  # 1
-        0.2903225806451613 + 0.967741935483871*c2 - c2*s3 - c3*s2 - s2*t0 + 0.1935483870967742*c2*c3,  # 2
+        0.2903225806451613 + 0.967741935483871*c2 - c2*s3 - s2*c3 - s2*t0 + 0.1935483870967742*c2*c3,  # 2
     ], (3,))
     return f
 
@@ -1621,7 +1621,7 @@ def manipulability(q):
     s3 = trig[..., 5]
     s5 = trig[..., 9]
     t0 = 0.1935483870967742*s3
-    t1 = 0.23064*s5*(c3 + t0)*(0.2903225806451613 + 0.967741935483871*c2 - c2*s3 - c3*s2 - s2*t0 + 0.1935483870967742*c2*c3)
+    t1 = 0.23064*s5*(c3 + t0)*(0.2903225806451613 + 0.967741935483871*c2 - c2*s3 - s2*c3 - s2*t0 + 0.1935483870967742*c2*c3)
     w = xp.broadcast_to(xp.abs(t1), batch)
     return w
 
@@ -1636,7 +1636,7 @@ def jacobian_det(q):
     s3 = trig[..., 5]
     s5 = trig[..., 9]
     t0 = 0.1935483870967742*s3
-    d = xp.broadcast_to(-0.23064*s5*(c3 + t0)*(0.2903225806451613 + 0.967741935483871*c2 - c2*s3 - c3*s2 - s2*t0 + 0.1935483870967742*c2*c3), batch)
+    d = xp.broadcast_to(-0.23064*s5*(c3 + t0)*(0.2903225806451613 + 0.967741935483871*c2 - c2*s3 - s2*c3 - s2*t0 + 0.1935483870967742*c2*c3), batch)
     return d
 
 
@@ -1664,24 +1664,24 @@ def velocity_ik(q, mu_dot, damping=0.0):
     c3 = trig[..., 4]
     s3 = trig[..., 5]
     c23 = c2*c3 - s2*s3
-    s23 = c2*s3 + c3*s2
+    s23 = c2*s3 + s2*c3
     c4 = trig[..., 6]
     s4 = trig[..., 7]
     c5 = trig[..., 8]
     s5 = trig[..., 9]
-    t0 = -c23*c5 + c4*s23*s5
+    t0 = -c23*c5 + s23*c4*s5
     t1 = s1*s4
     t2 = c1*c4
     t3 = -t1 + c23*t2
     t4 = t2 - c23*t1
-    t5 = c4*s1
+    t5 = s1*c4
     t6 = c1*s4
     t7 = t5 + c23*t6
     t8 = t6 + c23*t5
     t9 = c1*s23
     t10 = t3*s5 + c5*t9
     t11 = s1*s23
-    t12 = t8*s5 + c5*t11
+    t12 = s5*t8 + c5*t11
     t13 = 0.115*t10
     t14 = t13 + 0.62*t9
     t15 = 0.115*t12
@@ -1690,299 +1690,299 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t18 = t7*t15 + t4*t13
     t19 = 0.115*t0
     t20 = -0.62*c23 + t19
-    t21 = t20 - 0.12*s23
-    t22 = t21 - 0.6*s2
-    t23 = t16*c23 + t20*t11
-    t24 = t14*c23 + t20*t9
+    t21 = -0.12*s23 + t20
+    t22 = -0.6*s2 + t21
+    t23 = c23*t16 + t20*t11
+    t24 = c23*t14 + t20*t9
     t25 = 0.12*c23
     t26 = -t14 + c1*t25
     t27 = -t16 + s1*t25
-    t28 = t26*c1 + t27*s1
+    t28 = c1*t26 + s1*t27
     t29 = 0.6*c2
-    t30 = t26 + c1*t29
-    t31 = t27 + s1*t29
-    t32 = t30 + 0.18*c1
-    t33 = t31 + 0.18*s1
-    t34 = t30*c1 + t31*s1
+    t30 = c1*t29 + t26
+    t31 = s1*t29 + t27
+    t32 = 0.18*c1 + t30
+    t33 = 0.18*s1 + t31
+    t34 = c1*t30 + s1*t31
     t35 = s23*s4
     t36 = t4*t19 + t15*t35
     t37 = t7*t19 - t13*t35
-    t38 = t32 - t24*c23 + t37*t35
-    t39 = t17*c23 + t18*t35
-    t40 = t10*t0 + t7*t35 - c23*t9
-    t41 = -t12*t0 + t4*t35 + c23*t11
+    t38 = t32 - c23*t24 + t35*t37
+    t39 = c23*t17 + t35*t18
+    t40 = -c23*t9 + t7*t35 + t10*t0
+    t41 = c23*t11 + t4*t35 - t12*t0
     t42 = t33**2
-    t43 = t21**2
-    t44 = c1**2
-    t45 = t4*t36 + t21*t44 + t22*t44 + t23*t11
-    t46 = t22**2
-    t47 = t23**2 + t36**2 + t43*t44 + t46*t44
+    t43 = c1**2
+    t44 = t43*t22 + t43*t21 + t11*t23 + t4*t36
+    t45 = t22**2
+    t46 = t21**2
+    t47 = t23**2 + t36**2 + t43*t45 + t43*t46
     t48 = t42 + t47
-    t49 = s1*c1
-    t50 = t36*t37 - t32*t33 - t23*t24 + t43*t49 + t46*t49
-    t51 = -t33
-    t52 = t51 + t23*c23 + t36*t35
-    t53 = t28*c1
-    t54 = t34*c1
-    t55 = t23*t17 + t36*t18 - t21*t53 - t22*t54
-    t56 = t4*t18 - t54 - t53 + t17*t11
-    t57 = t21*c1
-    t58 = t22*c1
-    t59 = s1*t57 + s1*t58
-    t60 = t7*t36 - t23*t9 + t59
-    t61 = t4*t37 - t24*t11 + t59
+    t49 = c1*s1
+    t50 = -t32*t33 + t45*t49 + t46*t49 - t23*t24 + t36*t37
+    t51 = c1*t34
+    t52 = c1*t28
+    t53 = -t22*t51 - t21*t52 + t23*t17 + t36*t18
+    t54 = -t51 - t52 + t11*t17 + t4*t18
+    t55 = c1*t22
+    t56 = c1*t21
+    t57 = s1*t55 + s1*t56
+    t58 = t57 + t7*t36 - t9*t23
+    t59 = t57 + t4*t37 - t11*t24
+    t60 = -t33
+    t61 = t60 + c23*t23 + t35*t36
     t62 = t32**2
     t63 = s1**2
-    t64 = t7*t37 + t21*t63 + t22*t63 + t24*t9
-    t65 = t24**2 + t37**2 + t43*t63 + t46*t63
+    t64 = t63*t22 + t63*t21 + t9*t24 + t7*t37
+    t65 = t24**2 + t37**2 + t63*t45 + t63*t46
     t66 = t62 + t65
-    t67 = t28*s1
-    t68 = t34*s1
-    t69 = t24*t17 - t37*t18 + t21*t67 + t22*t68
-    t70 = t68 + t67 - t7*t18 + t17*t9
+    t67 = s1*t34
+    t68 = s1*t28
+    t69 = t22*t67 + t21*t68 + t24*t17 - t37*t18
+    t70 = t67 + t68 + t9*t17 - t7*t18
     t71 = t34**2
     t72 = t71 + t28**2 + t17**2 + t18**2
     t73 = t72
     t74 = s23**2
-    t75 = t7**2 + t10**2 + 2*t63 + t44*t74
+    t75 = t7**2 + t10**2 + 2*t63 + t43*t74
     t76 = t75
     t77 = 2*s1
-    t78 = t10*t12 - t7*t4 - c1*t77 + t74*t49
-    t79 = t4**2 + t12**2 + 2*t44 + t63*t74
+    t78 = -c1*t77 + t49*t74 - t7*t4 + t10*t12
+    t79 = t4**2 + t12**2 + 2*t43 + t63*t74
     t80 = t79
-    t81 = t0**2 + c23**2 + t74*s4**2
+    t81 = c23**2 + t0**2 + t74*s4**2
     t82 = 1 + t81
-    t83 = damping**2
-    t84 = t48 + t83
-    t85 = t84**2
-    t86 = t66 + t83
-    t87 = t73 + t83
-    t88 = t76 + t83
-    t89 = t80 + t83
-    t90 = t82 + t83
-    t91 = t50**2
-    t92 = t52**2
-    t93 = t55**2
-    t94 = t60**2
-    t95 = t45**2
-    t96 = xp.sqrt(t85 + t86**2 + t87**2 + t88**2 + t89**2 + t90**2 + 2*t91 + 2*t92 + 2*t93 + 2*t94 + 2*t95 + 2*t38**2 + 2*t69**2 + 2*t64**2 + 2*t61**2 + 2*t70**2 + 2*t56**2 + 2*t39**2 + 2*t78**2 + 2*t40**2 + 2*t41**2)
-    t97 = xp.sqrt(t91 + t92 + t93 + t94 + t95 + t85)
-    t98 = t97*xp.where(xp.greater_equal(t84, 0), xp.asarray(1, dtype=dtype), -1)
-    t99 = t98 + t84
-    t100 = xp.where(xp.greater(t97, 0), 1/(t97*(t97 + xp.abs(t84))), 0)
-    t101 = t100*(t50*t99 + t50*t86 + t52*t38 + t60*t64 + t45*t61 - t55*t69)
-    t102 = t50 - t99*t101
-    t103 = -t50*t101 + t86
-    t104 = t69 + t55*t101
-    t105 = -t64 + t60*t101
-    t106 = t61 - t45*t101
-    t107 = t38 - t52*t101
-    t108 = t100*(t52*t39 + t55*t99 + t55*t87 + t45*t56 - t50*t69 - t60*t70)
-    t109 = t55 - t99*t108
-    t110 = t69 + t50*t108
-    t111 = -t55*t108 + t87
-    t112 = t70 + t60*t108
-    t113 = t56 - t45*t108
-    t114 = t39 - t52*t108
-    t115 = -t100*(-t55*t70 - t45*t78 + t50*t64 + t52*t40 + t60*t99 + t60*t88)
-    t116 = t60 + t99*t115
-    t117 = t64 + t50*t115
-    t118 = t70 - t55*t115
-    t119 = t60*t115 + t88
-    t120 = t78 - t45*t115
-    t121 = t40 + t52*t115
-    t122 = t100*(t50*t61 + t52*t41 + t55*t56 + t45*t99 + t45*t89 - t60*t78)
-    t123 = t45 - t99*t122
-    t124 = t61 - t50*t122
-    t125 = t56 - t55*t122
-    t126 = t78 + t60*t122
-    t127 = -t45*t122 + t89
-    t128 = t41 - t52*t122
-    t129 = t100*(t50*t38 + t52*t99 + t52*t90 + t55*t39 + t60*t40 + t45*t41)
-    t130 = t52 - t99*t129
-    t131 = t38 - t50*t129
-    t132 = t39 - t55*t129
-    t133 = -t40 + t60*t129
-    t134 = t41 - t45*t129
-    t135 = -t52*t129 + t90
-    t136 = t100*(t50*mu_dot1 + t52*mu_dot5 + t55*mu_dot2 + t45*mu_dot4 + t99*mu_dot0 - t60*mu_dot3)
-    t137 = mu_dot0 - t99*t136
-    t138 = mu_dot1 - t50*t136
-    t139 = mu_dot2 - t55*t136
-    t140 = mu_dot3 + t60*t136
-    t141 = mu_dot4 - t45*t136
-    t142 = mu_dot5 - t52*t136
-    t143 = xp.sqrt(t103**2 + t104**2 + t105**2 + t106**2 + t107**2)
-    t144 = t143*xp.where(xp.greater_equal(t103, 0), xp.asarray(1, dtype=dtype), -1)
-    t145 = t103 + t144
-    t146 = xp.where(xp.greater(t143, 0), 1/(t143*(t143 + xp.abs(t103))), 0)
-    t147 = t146*(t105*t112 + t106*t113 + t107*t114 - t104*t111 - t110*t145)
-    t148 = t110 + t145*t147
-    t149 = t111 + t104*t147
-    t150 = t112 - t105*t147
-    t151 = t113 - t106*t147
-    t152 = t114 - t107*t147
-    t153 = -t146*(-t105*t119 - t106*t120 + t104*t118 + t107*t121 + t117*t145)
-    t154 = t117 + t145*t153
-    t155 = t118 + t104*t153
-    t156 = t119 - t105*t153
-    t157 = t120 - t106*t153
-    t158 = t121 + t107*t153
-    t159 = t146*(t105*t126 + t106*t127 + t107*t128 + t124*t145 - t104*t125)
-    t160 = t124 - t145*t159
-    t161 = t125 + t104*t159
-    t162 = t126 - t105*t159
-    t163 = t127 - t106*t159
-    t164 = t128 - t107*t159
-    t165 = t146*(t105*t133 + t106*t134 + t107*t135 + t131*t145 - t104*t132)
-    t166 = t131 - t145*t165
-    t167 = t132 + t104*t165
-    t168 = t133 - t105*t165
-    t169 = t134 - t106*t165
-    t170 = t135 - t107*t165
-    t171 = t146*(t105*t140 + t106*t141 + t107*t142 + t138*t145 - t104*t139)
-    t172 = t138 - t145*t171
-    t173 = t139 + t104*t171
-    t174 = t140 - t105*t171
-    t175 = t141 - t106*t171
-    t176 = t142 - t107*t171
-    t177 = xp.sqrt(t149**2 + t150**2 + t151**2 + t152**2)
-    t178 = t177*xp.where(xp.greater_equal(t149, 0), xp.asarray(1, dtype=dtype), -1)
-    t179 = t149 + t178
-    t180 = xp.where(xp.greater(t177, 0), 1/(t177*(t177 + xp.abs(t149))), 0)
-    t181 = t180*(t150*t156 + t151*t157 + t155*t179 - t152*t158)
-    t182 = t155 - t179*t181
-    t183 = t156 - t150*t181
-    t184 = t157 - t151*t181
-    t185 = t158 + t152*t181
-    t186 = t180*(t150*t162 + t151*t163 + t152*t164 + t161*t179)
-    t187 = t161 - t179*t186
-    t188 = t162 - t150*t186
-    t189 = t163 - t151*t186
-    t190 = t164 - t152*t186
-    t191 = t180*(t150*t168 + t151*t169 + t152*t170 + t167*t179)
-    t192 = t167 - t179*t191
-    t193 = t168 - t150*t191
-    t194 = t169 - t151*t191
-    t195 = t170 - t152*t191
-    t196 = t180*(t150*t174 + t151*t175 + t152*t176 + t173*t179)
-    t197 = t173 - t179*t196
-    t198 = t174 - t150*t196
-    t199 = t175 - t151*t196
-    t200 = t176 - t152*t196
-    t201 = xp.sqrt(t183**2 + t184**2 + t185**2)
-    t202 = t201*xp.where(xp.greater_equal(t183, 0), xp.asarray(1, dtype=dtype), -1)
-    t203 = t183 + t202
-    t204 = xp.where(xp.greater(t201, 0), 1/(t201*(t201 + xp.abs(t183))), 0)
-    t205 = t204*(t184*t189 + t188*t203 - t185*t190)
-    t206 = t188 - t203*t205
-    t207 = t189 - t184*t205
-    t208 = t190 + t185*t205
-    t209 = t204*(t184*t194 + t193*t203 - t185*t195)
-    t210 = t193 - t203*t209
-    t211 = t194 - t184*t209
-    t212 = t195 + t185*t209
-    t213 = t204*(t184*t199 + t198*t203 - t185*t200)
-    t214 = t198 - t203*t213
-    t215 = t199 - t184*t213
-    t216 = t200 + t185*t213
-    t217 = xp.sqrt(t207**2 + t208**2)
-    t218 = t217*xp.where(xp.greater_equal(t207, 0), xp.asarray(1, dtype=dtype), -1)
-    t219 = t207 + t218
-    t220 = xp.where(xp.greater(t217, 0), 1/(t217*(t217 + xp.abs(t207))), 0)
-    t221 = t220*(t208*t212 + t211*t219)
-    t222 = t211 - t219*t221
-    t223 = t212 - t208*t221
-    t224 = t220*(t208*t216 + t215*t219)
-    t225 = t215 - t219*t224
-    t226 = t216 - t208*t224
-    t227 = xp.abs(t223)
+    t83 = t50**2
+    t84 = t53**2
+    t85 = t58**2
+    t86 = t44**2
+    t87 = t61**2
+    t88 = damping**2
+    t89 = t88 + t48
+    t90 = t89**2
+    t91 = xp.sqrt(t83 + t84 + t85 + t86 + t87 + t90)
+    t92 = t91*xp.where(xp.greater_equal(t89, 0), xp.asarray(1, dtype=dtype), -1)
+    t93 = t89 + t92
+    t94 = xp.where(xp.greater(t91, 0), 1/(t91*(t91 + xp.abs(t89))), 0)
+    t95 = t94*(mu_dot0*t93 + mu_dot1*t50 + mu_dot2*t53 - mu_dot3*t58 + mu_dot4*t44 + mu_dot5*t61)
+    t96 = mu_dot0 - t93*t95
+    t97 = mu_dot1 - t50*t95
+    t98 = mu_dot2 - t53*t95
+    t99 = mu_dot3 + t58*t95
+    t100 = mu_dot4 - t44*t95
+    t101 = mu_dot5 - t61*t95
+    t102 = t88 + t66
+    t103 = t94*(t50*t93 + t50*t102 - t53*t69 + t58*t64 + t44*t59 + t61*t38)
+    t104 = t50 - t93*t103
+    t105 = t102 - t50*t103
+    t106 = t69 + t53*t103
+    t107 = -t64 + t58*t103
+    t108 = t59 - t44*t103
+    t109 = t38 - t61*t103
+    t110 = xp.sqrt(t105**2 + t106**2 + t107**2 + t108**2 + t109**2)
+    t111 = t110*xp.where(xp.greater_equal(t105, 0), xp.asarray(1, dtype=dtype), -1)
+    t112 = t105 + t111
+    t113 = xp.where(xp.greater(t110, 0), 1/(t110*(t110 + xp.abs(t105))), 0)
+    t114 = t113*(t97*t112 - t106*t98 + t107*t99 + t108*t100 + t109*t101)
+    t115 = t97 - t112*t114
+    t116 = t98 + t106*t114
+    t117 = t99 - t107*t114
+    t118 = t100 - t108*t114
+    t119 = t101 - t109*t114
+    t120 = t88 + t73
+    t121 = t94*(t53*t93 - t50*t69 + t53*t120 - t58*t70 + t44*t54 + t61*t39)
+    t122 = t53 - t93*t121
+    t123 = t69 + t50*t121
+    t124 = t120 - t53*t121
+    t125 = t70 + t58*t121
+    t126 = t54 - t44*t121
+    t127 = t39 - t61*t121
+    t128 = t113*(-t123*t112 - t106*t124 + t107*t125 + t108*t126 + t109*t127)
+    t129 = t123 + t112*t128
+    t130 = t124 + t106*t128
+    t131 = t125 - t107*t128
+    t132 = t126 - t108*t128
+    t133 = t127 - t109*t128
+    t134 = xp.sqrt(t130**2 + t131**2 + t132**2 + t133**2)
+    t135 = t134*xp.where(xp.greater_equal(t130, 0), xp.asarray(1, dtype=dtype), -1)
+    t136 = t130 + t135
+    t137 = xp.where(xp.greater(t134, 0), 1/(t134*(t134 + xp.abs(t130))), 0)
+    t138 = t137*(t116*t136 + t131*t117 + t132*t118 + t133*t119)
+    t139 = t116 - t136*t138
+    t140 = t117 - t131*t138
+    t141 = t118 - t132*t138
+    t142 = t119 - t133*t138
+    t143 = t88 + t76
+    t144 = -t94*(t58*t93 + t50*t64 - t53*t70 + t58*t143 - t44*t78 + t61*t40)
+    t145 = t58 + t93*t144
+    t146 = t64 + t50*t144
+    t147 = t70 - t53*t144
+    t148 = t143 + t58*t144
+    t149 = t78 - t44*t144
+    t150 = t40 + t61*t144
+    t151 = -t113*(t146*t112 + t106*t147 - t107*t148 - t108*t149 + t109*t150)
+    t152 = t146 + t112*t151
+    t153 = t147 + t106*t151
+    t154 = t148 - t107*t151
+    t155 = t149 - t108*t151
+    t156 = t150 + t109*t151
+    t157 = t137*(t153*t136 + t131*t154 + t132*t155 - t133*t156)
+    t158 = t153 - t136*t157
+    t159 = t154 - t131*t157
+    t160 = t155 - t132*t157
+    t161 = t156 + t133*t157
+    t162 = xp.sqrt(t159**2 + t160**2 + t161**2)
+    t163 = t162*xp.where(xp.greater_equal(t159, 0), xp.asarray(1, dtype=dtype), -1)
+    t164 = t159 + t163
+    t165 = xp.where(xp.greater(t162, 0), 1/(t162*(t162 + xp.abs(t159))), 0)
+    t166 = t165*(t140*t164 + t160*t141 - t161*t142)
+    t167 = t140 - t164*t166
+    t168 = t141 - t160*t166
+    t169 = t142 + t161*t166
+    t170 = t88 + t80
+    t171 = t94*(t44*t93 + t50*t59 + t53*t54 - t58*t78 + t44*t170 + t61*t41)
+    t172 = t44 - t93*t171
+    t173 = t59 - t50*t171
+    t174 = t54 - t53*t171
+    t175 = t78 + t58*t171
+    t176 = t170 - t44*t171
+    t177 = t41 - t61*t171
+    t178 = t113*(t173*t112 - t106*t174 + t107*t175 + t108*t176 + t109*t177)
+    t179 = t173 - t112*t178
+    t180 = t174 + t106*t178
+    t181 = t175 - t107*t178
+    t182 = t176 - t108*t178
+    t183 = t177 - t109*t178
+    t184 = t137*(t180*t136 + t131*t181 + t132*t182 + t133*t183)
+    t185 = t180 - t136*t184
+    t186 = t181 - t131*t184
+    t187 = t182 - t132*t184
+    t188 = t183 - t133*t184
+    t189 = t165*(t186*t164 + t160*t187 - t161*t188)
+    t190 = t186 - t164*t189
+    t191 = t187 - t160*t189
+    t192 = t188 + t161*t189
+    t193 = xp.sqrt(t191**2 + t192**2)
+    t194 = t193*xp.where(xp.greater_equal(t191, 0), xp.asarray(1, dtype=dtype), -1)
+    t195 = t191 + t194
+    t196 = xp.where(xp.greater(t193, 0), 1/(t193*(t193 + xp.abs(t191))), 0)
+    t197 = t196*(t168*t195 + t192*t169)
+    t198 = t168 - t195*t197
+    t199 = t169 - t192*t197
+    t200 = t88 + t82
+    t201 = xp.sqrt(2*t83 + 2*t84 + 2*t69**2 + 2*t85 + 2*t64**2 + 2*t70**2 + 2*t86 + 2*t59**2 + 2*t54**2 + 2*t78**2 + 2*t87 + 2*t38**2 + 2*t39**2 + 2*t40**2 + 2*t41**2 + t90 + t102**2 + t120**2 + t143**2 + t170**2 + t200**2)
+    t202 = t94*(t61*t93 + t50*t38 + t53*t39 + t58*t40 + t44*t41 + t61*t200)
+    t203 = t61 - t93*t202
+    t204 = t38 - t50*t202
+    t205 = t39 - t53*t202
+    t206 = -t40 + t58*t202
+    t207 = t41 - t44*t202
+    t208 = t200 - t61*t202
+    t209 = t113*(t204*t112 - t106*t205 + t107*t206 + t108*t207 + t109*t208)
+    t210 = t204 - t112*t209
+    t211 = t205 + t106*t209
+    t212 = t206 - t107*t209
+    t213 = t207 - t108*t209
+    t214 = t208 - t109*t209
+    t215 = t137*(t211*t136 + t131*t212 + t132*t213 + t133*t214)
+    t216 = t211 - t136*t215
+    t217 = t212 - t131*t215
+    t218 = t213 - t132*t215
+    t219 = t214 - t133*t215
+    t220 = t165*(t217*t164 + t160*t218 - t161*t219)
+    t221 = t217 - t164*t220
+    t222 = t218 - t160*t220
+    t223 = t219 + t161*t220
+    t224 = t196*(t222*t195 + t192*t223)
+    t225 = t222 - t195*t224
+    t226 = t223 - t192*t224
+    t227 = xp.abs(t226)
     t228 = t227
-    t229 = t228*xp.where(xp.greater_equal(t223, 0), xp.asarray(1, dtype=dtype), -1)
-    t230 = t223 + t229
-    t231 = xp.where(xp.greater(t228, 0), 1/(t228*(t228 + t227)), 0)
-    t232 = t226 - t226*t231*t230**2
+    t229 = t228*xp.where(xp.greater_equal(t226, 0), xp.asarray(1, dtype=dtype), -1)
+    t230 = t226 + t229
+    t231 = xp.where(xp.greater(t228, 0), 1/(t228*(t227 + t228)), 0)
+    t232 = t199 - t199*t230**2*t231
     t233 = xp.where(xp.not_equal(t229, 0), -t232/t229, 0)
-    t234 = xp.where(xp.not_equal(t218, 0), -(t225 - t222*t233)/t218, 0)
-    t235 = xp.where(xp.not_equal(t202, 0), -(t214 - (t206*t234 + t210*t233))/t202, 0)
-    t236 = xp.where(xp.not_equal(t178, 0), -(t197 - (t182*t235 + t187*t234 + t192*t233))/t178, 0)
-    t237 = xp.where(xp.not_equal(t144, 0), -(t172 - (t160*t234 + t166*t233 - t148*t236 - t154*t235))/t144, 0)
-    t238 = xp.where(xp.not_equal(t98, 0), -(t137 - (t102*t237 + t109*t236 + t123*t234 + t130*t233 - t116*t235))/t98, 0)
-    t239 = t233 + t237*t32 - t238*t33
-    t240 = t233*c23 + t236*t17 + t238*t23 - t237*t24 + t234*t11 + t235*t9
-    t241 = t4*t234 + t236*t18 + t237*t37 + t238*t36 - t7*t235 + t233*t35
-    t242 = t10*t235 + t12*t234 - t233*t0
-    t243 = t22*s1
-    t244 = t234*c1 - t235*s1
-    t245 = -t236*t34 + t237*t243 + t238*t58 + t244
-    t246 = t21*s1
-    t247 = -t236*t28 + t237*t246 + t238*t57 + t244
+    t234 = xp.where(xp.not_equal(t194, 0), -(t198 - t225*t233)/t194, 0)
+    t235 = xp.where(xp.not_equal(t163, 0), -(-(t190*t234 + t221*t233) + t167)/t163, 0)
+    t236 = xp.where(xp.not_equal(t135, 0), -(-(t158*t235 + t185*t234 + t216*t233) + t139)/t135, 0)
+    t237 = xp.where(xp.not_equal(t111, 0), -(-(-t129*t236 - t152*t235 + t179*t234 + t210*t233) + t115)/t111, 0)
+    t238 = xp.where(xp.not_equal(t92, 0), -(-(t104*t237 + t122*t236 - t145*t235 + t172*t234 + t203*t233) + t96)/t92, 0)
+    t239 = t233 - t33*t238 + t32*t237
+    t240 = t23*t238 - t24*t237 + t17*t236 + t9*t235 + t11*t234 + c23*t233
+    t241 = t36*t238 + t37*t237 + t18*t236 - t7*t235 + t4*t234 + t35*t233
+    t242 = t10*t235 + t12*t234 - t0*t233
+    t243 = s1*t22
+    t244 = -s1*t235 + c1*t234
+    t245 = t244 - t34*t236 + t55*t238 + t243*t237
+    t246 = s1*t21
+    t247 = t244 - t28*t236 + t56*t238 + t246*t237
     t248 = 1 + t62 + t42
-    t249 = xp.sqrt(t248 + t72 + t75 + t79 + t81 + t47 + t65)
+    t249 = xp.sqrt(t47 + t65 + t72 + t75 + t79 + t81 + t248)
     t250 = xp.sqrt(t248)
     t251 = t250*xp.where(xp.less_equal(t33, 0), xp.asarray(1, dtype=dtype), -1)
-    t252 = t251 + t51
-    t253 = xp.where(xp.greater(t250, 0), 1/(t250*(t250 + xp.abs(t33))), 0)
-    t254 = t253*(t252*t58 + t32*t243)
-    t255 = t58 - t252*t254
-    t256 = t243 - t254*t32
-    t257 = t253*(t252*t57 + t32*t246)
-    t258 = t57 - t252*t257
-    t259 = t246 - t257*t32
-    t260 = t253*(c23 + t252*t23 - t32*t24)
+    t252 = t60 + t251
+    t253 = xp.where(xp.greater(t250, 0), 1/(t250*(t250 + xp.abs(t60))), 0)
+    t254 = t253*(t55*t252 + t32*t243)
+    t255 = t55 - t252*t254
+    t256 = t243 - t32*t254
+    t257 = t253*(t56*t252 + t32*t246)
+    t258 = t56 - t252*t257
+    t259 = t246 - t32*t257
+    t260 = t253*(c23 + t23*t252 - t32*t24)
     t261 = t23 - t252*t260
-    t262 = t24 + t260*t32
-    t263 = c23 - t260
-    t264 = t253*(t252*t36 + t32*t37 + t35)
+    t262 = t24 + t32*t260
+    t263 = -t260 + c23
+    t264 = t253*(t35 + t36*t252 + t32*t37)
     t265 = t36 - t252*t264
-    t266 = t37 - t264*t32
+    t266 = t37 - t32*t264
     t267 = -t264 + t35
-    t268 = t253*(mu_dot5 + t252*mu_dot0 + t32*mu_dot1)
+    t268 = t253*(mu_dot5 + mu_dot0*t252 + t32*mu_dot1)
     t269 = mu_dot0 - t252*t268
-    t270 = mu_dot1 - t268*t32
-    t271 = mu_dot5 - t268
+    t270 = mu_dot1 - t32*t268
+    t271 = -t268 + mu_dot5
     t272 = -t0
-    t273 = t253*t0
+    t273 = t0*t253
     t274 = t272 + t273
-    t275 = t44 + t63
-    t276 = xp.sqrt(t71 + t254**2 + t256**2 + t275)
+    t275 = t43 + t63
+    t276 = xp.sqrt(t71 + t275 + t254**2 + t256**2)
     t277 = t276*xp.where(xp.greater_equal(t256, 0), xp.asarray(1, dtype=dtype), -1)
     t278 = t256 + t277
     t279 = xp.where(xp.greater(t276, 0), 1/(t276*(t276 + xp.abs(t256))), 0)
-    t280 = t279*(t254*t257 + t259*t278 + t34*t28 + t275)
+    t280 = t279*(t275 + t259*t278 + t34*t28 + t254*t257)
     t281 = t259 - t278*t280
-    t282 = -s1 + t280*s1
-    t283 = c1 - t280*c1
+    t282 = -s1 + s1*t280
+    t283 = c1 - c1*t280
     t284 = -t257 + t254*t280
-    t285 = -t279*(t254*t263 + t262*t278 + t34*t17)
+    t285 = -t279*(t262*t278 + t34*t17 + t254*t263)
     t286 = t262 + t278*t285
-    t287 = t17 + t285*t34
-    t288 = t285*s1 + t9
-    t289 = t11 - t285*c1
+    t287 = t17 + t34*t285
+    t288 = t9 + s1*t285
+    t289 = t11 - c1*t285
     t290 = t263 + t254*t285
-    t291 = t279*(t7*s1 + t4*c1 + t266*t278 - t254*t267 - t34*t18)
+    t291 = t279*(t266*t278 - t34*t18 + s1*t7 + c1*t4 - t254*t267)
     t292 = t266 - t278*t291
-    t293 = t18 + t291*t34
-    t294 = t4 - t291*c1
+    t293 = t18 + t34*t291
+    t294 = t4 - c1*t291
     t295 = t267 + t254*t291
-    t296 = -t279*(-t270*t278 - c1*mu_dot4 + t254*t271 + t34*mu_dot2 + mu_dot3*s1)
+    t296 = -t279*(-t270*t278 + t34*mu_dot2 + s1*mu_dot3 - c1*mu_dot4 + t254*t271)
     t297 = t270 - t278*t296
-    t298 = mu_dot2 + t296*t34
-    t299 = mu_dot3 + t296*s1
-    t300 = mu_dot4 - t296*c1
+    t298 = mu_dot2 + t34*t296
+    t299 = mu_dot3 + s1*t296
+    t300 = mu_dot4 - c1*t296
     t301 = t271 + t254*t296
     t302 = -t28
-    t303 = t302 + t280*t34
+    t303 = t302 + t34*t280
     t304 = xp.sqrt(t303**2 + t282**2 + t283**2 + t284**2)
     t305 = t304*xp.where(xp.greater_equal(t303, 0), xp.asarray(1, dtype=dtype), -1)
     t306 = t303 + t305
     t307 = xp.where(xp.greater(t304, 0), 1/(t304*(t304 + xp.abs(t303))), 0)
-    t308 = t307*(t282*t288 + t283*t289 + t284*t290 + t287*t306)
+    t308 = t307*(t287*t306 + t282*t288 + t283*t289 + t284*t290)
     t309 = t287 - t306*t308
     t310 = t288 - t282*t308
     t311 = t289 - t283*t308
     t312 = t290 - t284*t308
-    t313 = t307*(t282*t299 + t283*t300 + t284*t301 + t298*t306)
+    t313 = t307*(t298*t306 + t282*t299 + t283*t300 + t284*t301)
     t314 = t298 - t306*t313
     t315 = t299 - t282*t313
     t316 = t300 - t283*t313
@@ -1991,18 +1991,18 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t319 = t318*xp.where(xp.greater_equal(t310, 0), xp.asarray(1, dtype=dtype), -1)
     t320 = t310 + t319
     t321 = xp.where(xp.greater(t318, 0), 1/(t318*(t318 + xp.abs(t310))), 0)
-    t322 = t321*(t311*t316 + t312*t317 + t315*t320)
+    t322 = t321*(t315*t320 + t311*t316 + t312*t317)
     t323 = t315 - t320*t322
     t324 = t316 - t311*t322
     t325 = t317 - t312*t322
     t326 = -t7
-    t327 = t326 + t291*s1
-    t328 = t307*(t282*t327 + t283*t294 + t284*t295 + t293*t306)
+    t327 = t326 + s1*t291
+    t328 = t307*(t293*t306 + t282*t327 + t283*t294 + t284*t295)
     t329 = t293 - t306*t328
     t330 = t327 - t282*t328
     t331 = t294 - t283*t328
     t332 = t295 - t284*t328
-    t333 = t321*(t311*t331 + t312*t332 + t330*t320)
+    t333 = t321*(t330*t320 + t311*t331 + t312*t332)
     t334 = t330 - t320*t333
     t335 = t331 - t311*t333
     t336 = t332 - t312*t333
@@ -2010,55 +2010,55 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t338 = t337*xp.where(xp.greater_equal(t335, 0), xp.asarray(1, dtype=dtype), -1)
     t339 = t335 + t338
     t340 = xp.where(xp.greater(t337, 0), 1/(t337*(t337 + xp.abs(t335))), 0)
-    t341 = t340*(t336*t325 + t324*t339)
+    t341 = t340*(t324*t339 + t336*t325)
     t342 = t324 - t339*t341
     t343 = t325 - t336*t341
-    t344 = 1 + t4 + t10 + t12 + t32 + t23 + t36 + t37 + t17 + t18 + c23 + damping + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + q1 + q2 + q3 + q4 + q5 + q6 + t326 + t272 + t51 - t24 - t34 + t302 - t77 + 2*c1 + t57 + t246 + t58 + t243 + t9 + t11 + t35
+    t344 = 1 + t60 - t24 - t34 + t302 + t326 + t272 + q1 + q2 + q3 + c23 + q4 + t9 + t11 + q5 + q6 + t4 + t10 + t12 + t32 + t35 + t55 + t56 + t243 + t246 - t77 + 2*c1 + t23 + t36 + t37 + t17 + t18 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + damping
     t345 = t32*t273
-    t346 = t279*(t12*c1 - t10*s1 - t254*t274 + t278*t345)
-    t347 = -t278*t346 + t345
-    t348 = t10 + t346*s1
-    t349 = t12 - t346*c1
+    t346 = t279*(c1*t12 + t345*t278 - s1*t10 - t254*t274)
+    t347 = t345 - t278*t346
+    t348 = t10 + s1*t346
+    t349 = t12 - c1*t346
     t350 = t274 + t254*t346
-    t351 = t346*t34
-    t352 = t307*(t282*t348 + t283*t349 + t284*t350 + t306*t351)
+    t351 = t34*t346
+    t352 = t307*(t351*t306 + t282*t348 + t283*t349 + t284*t350)
     t353 = t351 - t306*t352
     t354 = t348 - t282*t352
     t355 = t349 - t283*t352
     t356 = t350 - t284*t352
-    t357 = t321*(t311*t355 + t312*t356 + t354*t320)
+    t357 = t321*(t354*t320 + t311*t355 + t312*t356)
     t358 = t354 - t320*t357
     t359 = t355 - t311*t357
     t360 = t356 - t312*t357
-    t361 = t340*(t336*t360 + t359*t339)
+    t361 = t340*(t359*t339 + t336*t360)
     t362 = t359 - t339*t361
     t363 = t360 - t336*t361
     t364 = xp.abs(t363)
     t365 = t364
     t366 = t365*xp.where(xp.greater_equal(t363, 0), xp.asarray(1, dtype=dtype), -1)
     t367 = t363 + t366
-    t368 = xp.where(xp.greater(t365, 0), 1/(t365*(t365 + t364)), 0)
-    t369 = t343 - t343*t368*t367**2
+    t368 = xp.where(xp.greater(t365, 0), 1/(t365*(t364 + t365)), 0)
+    t369 = t343 - t343*t367**2*t368
     t370 = xp.where(xp.not_equal(t366, 0), -t369/t366, 0)
     t371 = xp.where(xp.not_equal(t338, 0), -(t342 - t362*t370)/t338, 0)
-    t372 = xp.where(xp.not_equal(t319, 0), -(t323 - (t334*t371 + t358*t370))/t319, 0)
-    t373 = xp.where(xp.not_equal(t305, 0), -(t314 - (t309*t372 + t329*t371 + t353*t370))/t305, 0)
-    t374 = xp.where(xp.not_equal(t277, 0), -(t297 - (t281*t373 + t292*t371 + t347*t370 - t286*t372))/t277, 0)
-    t375 = xp.where(xp.not_equal(t251, 0), -(t269 - (t255*t374 + t258*t373 + t261*t372 + t265*t371 + t252*t370*t273))/t251, 0)
+    t372 = xp.where(xp.not_equal(t319, 0), -(-(t334*t371 + t358*t370) + t323)/t319, 0)
+    t373 = xp.where(xp.not_equal(t305, 0), -(-(t309*t372 + t329*t371 + t353*t370) + t314)/t305, 0)
+    t374 = xp.where(xp.not_equal(t277, 0), -(-(t281*t373 - t286*t372 + t292*t371 + t347*t370) + t297)/t277, 0)
+    t375 = xp.where(xp.not_equal(t251, 0), -(-(t255*t374 + t258*t373 + t261*t372 + t265*t371 + t273*t252*t370) + t269)/t251, 0)
     t376 = xp.isfinite(t344)
     t377 = xp.greater_equal(damping, 0)
-    t378 = 1e-12*t249
-    t379 = xp.greater(damping, 0)
-    t380 = 1e-12*t96
-    t381 = (xp.less_equal(damping, 0) & (xp.less_equal(t250, t378) | xp.less_equal(t276, t378) | xp.less_equal(t304, t378) | xp.less_equal(t318, t378) | xp.less_equal(t337, t378) | xp.less_equal(t365, t378))) | (t379 & (xp.less_equal(t97, t380) | xp.less_equal(t143, t380) | xp.less_equal(t177, t380) | xp.less_equal(t201, t380) | xp.less_equal(t217, t380) | xp.less_equal(t228, t380)))
+    t378 = xp.greater(damping, 0)
+    t379 = 1e-12*t201
+    t380 = 1e-12*t249
+    t381 = (t378 & (xp.less_equal(t91, t379) | xp.less_equal(t110, t379) | xp.less_equal(t134, t379) | xp.less_equal(t162, t379) | xp.less_equal(t193, t379) | xp.less_equal(t228, t379))) | (xp.less_equal(damping, 0) & (xp.less_equal(t250, t380) | xp.less_equal(t276, t380) | xp.less_equal(t304, t380) | xp.less_equal(t318, t380) | xp.less_equal(t337, t380) | xp.less_equal(t365, t380)))
     t382 = t376 & t377 & xp.logical_not(t381)
     q_dot = _stack(xp, [
-        xp.broadcast_to(xp.where(t382, xp.where(t379, t239, t375), 0), batch),  # 0
-        xp.broadcast_to(xp.where(t382, xp.where(t379, t245, t374), 0), batch),  # 1
-        xp.broadcast_to(xp.where(t382, xp.where(t379, t247, t373), 0), batch),  # 2
-        xp.broadcast_to(xp.where(t382, xp.where(t379, t240, t372), 0), batch),  # 3
-        xp.broadcast_to(xp.where(t382, xp.where(t379, t241, t371), 0), batch),  # 4
-        xp.broadcast_to(xp.where(t382, xp.where(t379, t242, t370), 0), batch),  # 5
+        xp.broadcast_to(xp.where(t382, xp.where(t378, t239, t375), 0), batch),  # 0
+        xp.broadcast_to(xp.where(t382, xp.where(t378, t245, t374), 0), batch),  # 1
+        xp.broadcast_to(xp.where(t382, xp.where(t378, t247, t373), 0), batch),  # 2
+        xp.broadcast_to(xp.where(t382, xp.where(t378, t240, t372), 0), batch),  # 3
+        xp.broadcast_to(xp.where(t382, xp.where(t378, t241, t371), 0), batch),  # 4
+        xp.broadcast_to(xp.where(t382, xp.where(t378, t242, t370), 0), batch),  # 5
     ], (6,))
     status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t376 & t377), 2, xp.where(t381, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
     return q_dot, status
@@ -2099,19 +2099,19 @@ def ik_numeric_step(target, q, damping=0.0):
     c3 = xp.cos(q3)
     s3 = xp.sin(q3)
     c23 = c2*c3 - s2*s3
-    s23 = c2*s3 + c3*s2
+    s23 = c2*s3 + s2*c3
     c4 = xp.cos(q4)
     s4 = xp.sin(q4)
     c5 = xp.cos(q5)
     s5 = xp.sin(q5)
     c6 = xp.cos(q6)
     s6 = xp.sin(q6)
-    t0 = T00 + T01 + T02 + T03 + T10 + T11 + T12 + T13 + T20 + T21 + T22 + T23 + qs1 + qs2 + qs3 + qs4 + qs5 + qs6
+    t0 = qs1 + qs2 + qs3 + qs4 + qs5 + qs6 + T00 + T01 + T02 + T10 + T11 + T12 + T20 + T21 + T22 + T03 + T13 + T23
     t1 = s1*s4
     t2 = c1*c4
     t3 = -t1 + c23*t2
     t4 = t2 - c23*t1
-    t5 = c4*s1
+    t5 = s1*c4
     t6 = c1*s4
     t7 = t5 + c23*t6
     t8 = t6 + c23*t5
@@ -2119,32 +2119,32 @@ def ik_numeric_step(target, q, damping=0.0):
     t10 = t3*c5 - s5*t9
     t11 = t3*s5 + c5*t9
     t12 = t10*c6 - t7*s6
-    t13 = t7*c6 + t10*s6
-    t14 = T00*t12 + T01*t13 - T02*t11
-    t15 = T10*t12 + T11*t13 - T12*t11
-    t16 = T20*t12 + T21*t13 - T22*t11
+    t13 = c6*t7 + t10*s6
+    t14 = t12*T00 + t13*T01 - t11*T02
+    t15 = t12*T10 + t13*T11 - t11*T12
+    t16 = t12*T20 + t13*T21 - t11*T22
     t17 = s1*s23
-    t18 = t8*c5 - s5*t17
-    t19 = t8*s5 + c5*t17
-    t20 = t4*s6 + t18*c6
-    t21 = t4*c6 - t18*s6
-    t22 = T01*t21 + T02*t19 - T00*t20
-    t23 = T11*t21 + T12*t19 - T10*t20
-    t24 = T21*t21 + T22*t19 - T20*t20
+    t18 = c5*t8 - s5*t17
+    t19 = s5*t8 + c5*t17
+    t20 = s6*t4 + c6*t18
+    t21 = c6*t4 - s6*t18
+    t22 = -t20*T00 + t21*T01 + t19*T02
+    t23 = -t20*T10 + t21*T11 + t19*T12
+    t24 = -t20*T20 + t21*T21 + t19*T22
     t25 = 0.5*(t22 + t15)
-    t26 = c4*s23
+    t26 = s23*c4
     t27 = c23*s5 + c5*t26
     t28 = -c23*c5 + s5*t26
-    t29 = s4*s23
-    t30 = -t27*c6 + s6*t29
-    t31 = t27*s6 + c6*t29
-    t32 = t11*t28 + t7*t29 - c23*t9
-    t33 = -t19*t28 + t4*t29 + c23*t17
-    t34 = T00*t30 + T02*t28 - T01*t31
-    t35 = T10*t30 + T12*t28 - T11*t31
-    t36 = T20*t30 + T22*t28 - T21*t31
-    t37 = -0.5*(t35 + t24)
-    t38 = 0.5*(t34 - t16)
+    t29 = s23*s4
+    t30 = -c6*t27 + s6*t29
+    t31 = s6*t27 + c6*t29
+    t32 = -c23*t9 + t7*t29 + t11*t28
+    t33 = c23*t17 + t4*t29 - t19*t28
+    t34 = t30*T00 - t31*T01 + t28*T02
+    t35 = t30*T10 - t31*T11 + t28*T12
+    t36 = t30*T20 - t31*T21 + t28*T22
+    t37 = -0.5*(t24 + t35)
+    t38 = 0.5*(-t16 + t34)
     t39 = xp.sqrt(t37**2 + t38**2 + t25**2)
     t40 = 0.115*t11
     t41 = t40 + 0.62*t9
@@ -2152,64 +2152,64 @@ def ik_numeric_step(target, q, damping=0.0):
     t43 = t42 + 0.62*t17
     t44 = t41*t17 - t43*t9
     t45 = t7*t42 + t4*t40
-    t46 = t44*c23 + t45*t29
+    t46 = c23*t44 + t29*t45
     t47 = 0.115*t28
     t48 = -0.62*c23 + t47
-    t49 = t48 - 0.12*s23
-    t50 = t49 - 0.6*s2
+    t49 = -0.12*s23 + t48
+    t50 = -0.6*s2 + t49
     t51 = 0.4 + t50
-    t52 = t43*c23 + t48*t17
-    t53 = t4*t47 + t42*t29
-    t54 = t41*c23 + t48*t9
-    t55 = t7*t47 - t40*t29
-    t56 = T23 - t51
+    t52 = c23*t43 + t48*t17
+    t53 = t4*t47 + t29*t42
+    t54 = c23*t41 + t48*t9
+    t55 = t7*t47 - t29*t40
+    t56 = -t51 + T23
     t57 = 0.12*c23
     t58 = -t41 + c1*t57
     t59 = -t43 + s1*t57
-    t60 = t58*c1 + t59*s1
+    t60 = c1*t58 + s1*t59
     t61 = 0.6*c2
-    t62 = t58 + c1*t61
-    t63 = t59 + s1*t61
-    t64 = t62 + 0.18*c1
-    t65 = t63 + 0.18*s1
-    t66 = t62*c1 + t63*s1
-    t67 = t64 - t54*c23 + t55*t29
+    t62 = c1*t61 + t58
+    t63 = s1*t61 + t59
+    t64 = 0.18*c1 + t62
+    t65 = 0.18*s1 + t63
+    t66 = c1*t62 + s1*t63
+    t67 = t64 - c23*t54 + t29*t55
     t68 = t66**2 + t60**2 + t44**2 + t45**2
-    t69 = T03 - t64
-    t70 = t49**2
-    t71 = c1**2
-    t72 = t4*t53 + t49*t71 + t50*t71 + t52*t17
-    t73 = t50**2
-    t74 = t65**2 + t52**2 + t53**2 + t70*t71 + t73*t71
-    t75 = s1*c1
-    t76 = t53*t55 - t64*t65 - t52*t54 + t70*t75 + t73*t75
-    t77 = -t65
-    t78 = t77 + t52*c23 + t53*t29
-    t79 = T13 + t77
-    t80 = t60*c1
-    t81 = t66*c1
-    t82 = t52*t44 + t53*t45 - t49*t80 - t50*t81
-    t83 = t4*t45 - t81 - t80 + t44*t17
-    t84 = t49*t75 + t50*t75
-    t85 = t7*t53 - t52*t9 + t84
-    t86 = t4*t55 - t54*t17 + t84
+    t69 = -t64 + T03
+    t70 = c1**2
+    t71 = t70*t50 + t70*t49 + t17*t52 + t4*t53
+    t72 = t50**2
+    t73 = t49**2
+    t74 = t65**2 + t52**2 + t53**2 + t70*t72 + t70*t73
+    t75 = c1*s1
+    t76 = -t64*t65 + t72*t75 + t73*t75 - t52*t54 + t53*t55
+    t77 = c1*t66
+    t78 = c1*t60
+    t79 = -t50*t77 - t49*t78 + t52*t44 + t53*t45
+    t80 = -t77 - t78 + t17*t44 + t4*t45
+    t81 = t49*t75 + t50*t75
+    t82 = t81 + t7*t53 - t9*t52
+    t83 = t81 + t4*t55 - t17*t54
+    t84 = -t65
+    t85 = t84 + c23*t52 + t29*t53
+    t86 = t84 + T13
     t87 = s1**2
-    t88 = t64**2 + t54**2 + t55**2 + t70*t87 + t73*t87
-    t89 = t7*t55 + t49*t87 + t50*t87 + t54*t9
-    t90 = t60*s1
-    t91 = t66*s1
-    t92 = t54*t44 - t55*t45 + t49*t90 + t50*t91
-    t93 = t91 + t90 - t7*t45 + t44*t9
+    t88 = t64**2 + t54**2 + t55**2 + t87*t72 + t87*t73
+    t89 = t87*t50 + t87*t49 + t9*t54 + t7*t55
+    t90 = s1*t66
+    t91 = s1*t60
+    t92 = t50*t90 + t49*t91 + t54*t44 - t55*t45
+    t93 = t90 + t91 + t9*t44 - t7*t45
     t94 = s23**2
-    t95 = t7**2 + t11**2 + 2*t87 + t71*t94
-    t96 = t11*t19 - t7*t4 - 2*t75 + t94*t75
-    t97 = t4**2 + t19**2 + 2*t71 + t87*t94
-    t98 = 1 + t28**2 + c23**2 + t94*s4**2
+    t95 = t7**2 + t11**2 + 2*t87 + t70*t94
+    t96 = -2*t75 + t75*t94 - t7*t4 + t11*t19
+    t97 = t4**2 + t19**2 + 2*t70 + t87*t94
+    t98 = 1 + c23**2 + t28**2 + t94*s4**2
     t99 = -t23
-    t100 = 0.5*(-1 + t14 + t36 + t99)
+    t100 = 0.5*(-1 + t99 + t14 + t36)
     t101 = xp.atan2(t39, t100)
     t102 = xp.where(xp.greater(t39, 0), t101/t39, 1)
-    t103 = xp.greater_equal(t14, t36) & xp.greater_equal(t14, t99)
+    t103 = xp.greater_equal(t14, t99) & xp.greater_equal(t14, t36)
     t104 = xp.greater_equal(t99, t36)
     t105 = xp.where(t103, 0.5*(1 + t14), xp.where(t104, -0.5*t22, 0.5*t34))
     t106 = xp.where(t103, 0.5*t15, xp.where(t104, 0.5*(1 + t99), 0.5*t35))
@@ -2218,49 +2218,49 @@ def ik_numeric_step(target, q, damping=0.0):
     t109 = xp.where(xp.greater_equal(t37*t105 + t38*t106 + t25*t107, 0), xp.asarray(1, dtype=dtype), -1)
     t110 = xp.greater(t39, 1e-06) | xp.greater(t100, 0)
     t111 = t101*t109/t108
-    t112 = xp.where(t110, t37*t102, t105*t111)
-    t113 = xp.where(t110, t38*t102, t106*t111)
-    t114 = xp.where(t110, t25*t102, t107*t111)
-    t115 = t112**2 + t113**2 + t114**2 + t69**2 + t79**2 + t56**2
-    t116 = t74 + damping
-    t117 = xp.sqrt(t76**2 + t78**2 + t82**2 + t85**2 + t72**2 + t116**2)
+    t112 = xp.where(t110, t37*t102, t111*t105)
+    t113 = xp.where(t110, t38*t102, t111*t106)
+    t114 = xp.where(t110, t25*t102, t111*t107)
+    t115 = t112**2 + t113**2 + t114**2 + t69**2 + t86**2 + t56**2
+    t116 = damping + t74
+    t117 = xp.sqrt(t76**2 + t79**2 + t82**2 + t71**2 + t85**2 + t116**2)
     t118 = t117*xp.where(xp.greater_equal(t116, 0), xp.asarray(1, dtype=dtype), -1)
-    t119 = t118 + t116
+    t119 = t116 + t118
     t120 = xp.where(xp.greater(t117, 0), 1/(t117*(t117 + xp.abs(t116))), 0)
-    t121 = t120*(t76*t79 + t78*t114 + t82*t56 + t72*t113 + t69*t119 - t85*t112)
+    t121 = t120*(t69*t119 + t76*t86 + t79*t56 - t82*t112 + t71*t113 + t85*t114)
     t122 = t69 - t119*t121
-    t123 = t79 - t76*t121
-    t124 = t56 - t82*t121
-    t125 = t112 + t85*t121
-    t126 = t113 - t72*t121
-    t127 = t114 - t78*t121
-    t128 = t88 + damping
-    t129 = t120*(t76*t119 + t76*t128 + t78*t67 + t85*t89 + t72*t86 - t82*t92)
+    t123 = t86 - t76*t121
+    t124 = t56 - t79*t121
+    t125 = t112 + t82*t121
+    t126 = t113 - t71*t121
+    t127 = t114 - t85*t121
+    t128 = damping + t88
+    t129 = t120*(-t79*t92 + t82*t89 + t71*t83 + t85*t67 + t76*t119 + t76*t128)
     t130 = t76 - t119*t129
-    t131 = -t76*t129 + t128
-    t132 = t92 + t82*t129
-    t133 = -t89 + t85*t129
-    t134 = t86 - t72*t129
-    t135 = t67 - t78*t129
+    t131 = t128 - t76*t129
+    t132 = t92 + t79*t129
+    t133 = -t89 + t82*t129
+    t134 = t83 - t71*t129
+    t135 = t67 - t85*t129
     t136 = xp.sqrt(t131**2 + t132**2 + t133**2 + t134**2 + t135**2)
     t137 = t136*xp.where(xp.greater_equal(t131, 0), xp.asarray(1, dtype=dtype), -1)
     t138 = t131 + t137
     t139 = xp.where(xp.greater(t136, 0), 1/(t136*(t136 + xp.abs(t131))), 0)
-    t140 = t139*(t133*t125 + t134*t126 + t135*t127 + t123*t138 - t132*t124)
+    t140 = t139*(t123*t138 - t132*t124 + t133*t125 + t134*t126 + t135*t127)
     t141 = t123 - t138*t140
     t142 = t124 + t132*t140
     t143 = t125 - t133*t140
     t144 = t126 - t134*t140
     t145 = t127 - t135*t140
-    t146 = t68 + damping
-    t147 = t120*(t78*t46 + t82*t119 + t82*t146 + t72*t83 - t76*t92 - t85*t93)
-    t148 = t82 - t119*t147
+    t146 = damping + t68
+    t147 = t120*(-t76*t92 - t82*t93 + t71*t80 + t85*t46 + t79*t119 + t79*t146)
+    t148 = t79 - t119*t147
     t149 = t92 + t76*t147
-    t150 = -t82*t147 + t146
-    t151 = t93 + t85*t147
-    t152 = t83 - t72*t147
-    t153 = t46 - t78*t147
-    t154 = t139*(t133*t151 + t134*t152 + t135*t153 - t132*t150 - t149*t138)
+    t150 = t146 - t79*t147
+    t151 = t93 + t82*t147
+    t152 = t80 - t71*t147
+    t153 = t46 - t85*t147
+    t154 = t139*(-t149*t138 - t132*t150 + t133*t151 + t134*t152 + t135*t153)
     t155 = t149 + t138*t154
     t156 = t150 + t132*t154
     t157 = t151 - t133*t154
@@ -2270,26 +2270,26 @@ def ik_numeric_step(target, q, damping=0.0):
     t161 = t160*xp.where(xp.greater_equal(t156, 0), xp.asarray(1, dtype=dtype), -1)
     t162 = t156 + t161
     t163 = xp.where(xp.greater(t160, 0), 1/(t160*(t160 + xp.abs(t156))), 0)
-    t164 = t163*(t157*t143 + t158*t144 + t159*t145 + t142*t162)
+    t164 = t163*(t142*t162 + t157*t143 + t158*t144 + t159*t145)
     t165 = t142 - t162*t164
     t166 = t143 - t157*t164
     t167 = t144 - t158*t164
     t168 = t145 - t159*t164
-    t169 = t95 + damping
-    t170 = -t120*(-t82*t93 - t72*t96 + t76*t89 + t78*t32 + t85*t119 + t85*t169)
-    t171 = t85 + t119*t170
+    t169 = damping + t95
+    t170 = -t120*(t76*t89 - t79*t93 - t71*t96 + t85*t32 + t82*t119 + t82*t169)
+    t171 = t82 + t119*t170
     t172 = t89 + t76*t170
-    t173 = t93 - t82*t170
-    t174 = t85*t170 + t169
-    t175 = t96 - t72*t170
-    t176 = t32 + t78*t170
-    t177 = -t139*(-t133*t174 - t134*t175 + t132*t173 + t135*t176 + t172*t138)
+    t173 = t93 - t79*t170
+    t174 = t169 + t82*t170
+    t175 = t96 - t71*t170
+    t176 = t32 + t85*t170
+    t177 = -t139*(t172*t138 + t132*t173 - t133*t174 - t134*t175 + t135*t176)
     t178 = t172 + t138*t177
     t179 = t173 + t132*t177
     t180 = t174 - t133*t177
     t181 = t175 - t134*t177
     t182 = t176 + t135*t177
-    t183 = t163*(t157*t180 + t158*t181 + t179*t162 - t159*t182)
+    t183 = t163*(t179*t162 + t157*t180 + t158*t181 - t159*t182)
     t184 = t179 - t162*t183
     t185 = t180 - t157*t183
     t186 = t181 - t158*t183
@@ -2298,30 +2298,30 @@ def ik_numeric_step(target, q, damping=0.0):
     t189 = t188*xp.where(xp.greater_equal(t185, 0), xp.asarray(1, dtype=dtype), -1)
     t190 = t185 + t189
     t191 = xp.where(xp.greater(t188, 0), 1/(t188*(t188 + xp.abs(t185))), 0)
-    t192 = t191*(t186*t167 + t166*t190 - t187*t168)
+    t192 = t191*(t166*t190 + t186*t167 - t187*t168)
     t193 = t166 - t190*t192
     t194 = t167 - t186*t192
     t195 = t168 + t187*t192
-    t196 = t97 + damping
-    t197 = t120*(t76*t86 + t78*t33 + t82*t83 + t72*t119 + t72*t196 - t85*t96)
-    t198 = t72 - t119*t197
-    t199 = t86 - t76*t197
-    t200 = t83 - t82*t197
-    t201 = t96 + t85*t197
-    t202 = -t72*t197 + t196
-    t203 = t33 - t78*t197
-    t204 = t139*(t133*t201 + t134*t202 + t135*t203 + t199*t138 - t132*t200)
+    t196 = damping + t97
+    t197 = t120*(t76*t83 + t79*t80 - t82*t96 + t85*t33 + t71*t119 + t71*t196)
+    t198 = t71 - t119*t197
+    t199 = t83 - t76*t197
+    t200 = t80 - t79*t197
+    t201 = t96 + t82*t197
+    t202 = t196 - t71*t197
+    t203 = t33 - t85*t197
+    t204 = t139*(t199*t138 - t132*t200 + t133*t201 + t134*t202 + t135*t203)
     t205 = t199 - t138*t204
     t206 = t200 + t132*t204
     t207 = t201 - t133*t204
     t208 = t202 - t134*t204
     t209 = t203 - t135*t204
-    t210 = t163*(t157*t207 + t158*t208 + t159*t209 + t206*t162)
+    t210 = t163*(t206*t162 + t157*t207 + t158*t208 + t159*t209)
     t211 = t206 - t162*t210
     t212 = t207 - t157*t210
     t213 = t208 - t158*t210
     t214 = t209 - t159*t210
-    t215 = t191*(t186*t213 + t212*t190 - t187*t214)
+    t215 = t191*(t212*t190 + t186*t213 - t187*t214)
     t216 = t212 - t190*t215
     t217 = t213 - t186*t215
     t218 = t214 + t187*t215
@@ -2329,56 +2329,56 @@ def ik_numeric_step(target, q, damping=0.0):
     t220 = t219*xp.where(xp.greater_equal(t217, 0), xp.asarray(1, dtype=dtype), -1)
     t221 = t217 + t220
     t222 = xp.where(xp.greater(t219, 0), 1/(t219*(t219 + xp.abs(t217))), 0)
-    t223 = t222*(t218*t195 + t194*t221)
+    t223 = t222*(t194*t221 + t218*t195)
     t224 = t194 - t221*t223
     t225 = t195 - t218*t223
-    t226 = t98 + damping
-    t227 = t120*(t76*t67 + t78*t119 + t78*t226 + t82*t46 + t85*t32 + t72*t33)
-    t228 = t78 - t119*t227
+    t226 = damping + t98
+    t227 = t120*(t76*t67 + t79*t46 + t82*t32 + t71*t33 + t85*t119 + t85*t226)
+    t228 = t85 - t119*t227
     t229 = t67 - t76*t227
-    t230 = t46 - t82*t227
-    t231 = -t32 + t85*t227
-    t232 = t33 - t72*t227
-    t233 = -t78*t227 + t226
-    t234 = t139*(t133*t231 + t134*t232 + t135*t233 + t229*t138 - t132*t230)
+    t230 = t46 - t79*t227
+    t231 = -t32 + t82*t227
+    t232 = t33 - t71*t227
+    t233 = t226 - t85*t227
+    t234 = t139*(t229*t138 - t132*t230 + t133*t231 + t134*t232 + t135*t233)
     t235 = t229 - t138*t234
     t236 = t230 + t132*t234
     t237 = t231 - t133*t234
     t238 = t232 - t134*t234
     t239 = t233 - t135*t234
-    t240 = t163*(t157*t237 + t158*t238 + t159*t239 + t236*t162)
+    t240 = t163*(t236*t162 + t157*t237 + t158*t238 + t159*t239)
     t241 = t236 - t162*t240
     t242 = t237 - t157*t240
     t243 = t238 - t158*t240
     t244 = t239 - t159*t240
-    t245 = t191*(t186*t243 + t242*t190 - t187*t244)
+    t245 = t191*(t242*t190 + t186*t243 - t187*t244)
     t246 = t242 - t190*t245
     t247 = t243 - t186*t245
     t248 = t244 + t187*t245
-    t249 = t222*(t218*t248 + t247*t221)
+    t249 = t222*(t247*t221 + t218*t248)
     t250 = t247 - t221*t249
     t251 = t248 - t218*t249
     t252 = xp.abs(t251)
     t253 = t252
     t254 = t253*xp.where(xp.greater_equal(t251, 0), xp.asarray(1, dtype=dtype), -1)
     t255 = t251 + t254
-    t256 = xp.where(xp.greater(t253, 0), 1/(t253*(t253 + t252)), 0)
-    t257 = t225 - t225*t256*t255**2
+    t256 = xp.where(xp.greater(t253, 0), 1/(t253*(t252 + t253)), 0)
+    t257 = t225 - t225*t255**2*t256
     t258 = xp.where(xp.not_equal(t254, 0), -t257/t254, 0)
     t259 = xp.where(xp.not_equal(t220, 0), -(t224 - t250*t258)/t220, 0)
-    t260 = xp.where(xp.not_equal(t189, 0), -(t193 - (t216*t259 + t246*t258))/t189, 0)
-    t261 = xp.where(xp.not_equal(t161, 0), -(t165 - (t184*t260 + t211*t259 + t241*t258))/t161, 0)
-    t262 = xp.where(xp.not_equal(t137, 0), -(t141 - (t205*t259 + t235*t258 - t155*t261 - t178*t260))/t137, 0)
-    t263 = xp.where(xp.not_equal(t118, 0), -(t122 - (t130*t262 + t148*t261 + t198*t259 + t228*t258 - t171*t260))/t118, 0)
-    t264 = t258 + q1 + t64*t262 - t65*t263
-    t265 = q4 + t52*t263 + t258*c23 + t261*t44 - t54*t262 + t259*t17 + t260*t9
-    t266 = q5 + t4*t259 + t53*t263 + t55*t262 + t261*t45 - t7*t260 + t258*t29
+    t260 = xp.where(xp.not_equal(t189, 0), -(-(t216*t259 + t246*t258) + t193)/t189, 0)
+    t261 = xp.where(xp.not_equal(t161, 0), -(-(t184*t260 + t211*t259 + t241*t258) + t165)/t161, 0)
+    t262 = xp.where(xp.not_equal(t137, 0), -(-(-t155*t261 - t178*t260 + t205*t259 + t235*t258) + t141)/t137, 0)
+    t263 = xp.where(xp.not_equal(t118, 0), -(-(t130*t262 + t148*t261 - t171*t260 + t198*t259 + t228*t258) + t122)/t118, 0)
+    t264 = q1 + t258 - t65*t263 + t64*t262
+    t265 = q4 + t52*t263 - t54*t262 + t44*t261 + t9*t260 + t17*t259 + c23*t258
+    t266 = q5 + t53*t263 + t55*t262 + t45*t261 - t7*t260 + t4*t259 + t29*t258
     t267 = q6 + t11*t260 + t19*t259 - t28*t258
-    t268 = s1*t262
-    t269 = c1*t263
-    t270 = t259*c1 - t260*s1
-    t271 = q2 - t261*t66 + t50*t268 + t50*t269 + t270
-    t272 = q3 - t261*t60 + t49*t268 + t49*t269 + t270
+    t268 = c1*t263
+    t269 = s1*t262
+    t270 = -s1*t260 + c1*t259
+    t271 = q2 + t270 - t66*t261 + t50*t268 + t50*t269
+    t272 = q3 + t270 - t60*t261 + t49*t268 + t49*t269
     q_start = _stack(xp, [
         xp.broadcast_to(q1, batch),  # 0
         xp.broadcast_to(q2, batch),  # 1
@@ -2415,32 +2415,32 @@ def ik_branches(T):
     T21 = T[..., 2, 1]
     T22 = T[..., 2, 2]
     T23 = T[..., 2, 3]
-    t0 = T00 + T01 + T02 + T03 + T10 + T11 + T12 + T13 + T20 + T21 + T22 + T23
+    t0 = T00 + T01 + T02 + T10 + T11 + T12 + T20 + T21 + T22 + T03 + T13 + T23
     t1 = 0.9*T00
-    t2 = T03 - (t1 + 0.335*T02)
+    t2 = -(t1 + 0.335*T02) + T03
     t3 = t1 + 0.22*T02
     t4 = t2 + t3
     t5 = 0.9*T10
-    t6 = T13 - (t5 + 0.335*T12)
+    t6 = -(t5 + 0.335*T12) + T13
     t7 = t5 + 0.22*T12
     t8 = t6 + t7
     t9 = xp.atan2(-t4, t8)
     t10 = 0.9*T20
-    t11 = T23 - (t10 + 0.335*T22)
+    t11 = -(t10 + 0.335*T22) + T23
     t12 = t10 + 0.22*T22
     t13 = t11 + t12
     t14 = t4**2 + t8**2
     t15 = t14
-    t16 = t13**2 + t14
+    t16 = t14 + t13**2
     t17 = 1e-24*t16
     t18 = xp.less_equal(t15, t17)
     t19 = xp.where(t18, 1, 1/xp.sqrt(t15))
     t20 = xp.where(t18, 0, t9 + 1.5707963267948966)
-    t21 = t9 - 1.5707963267948966
+    t21 = -1.5707963267948966 + t9
     t22 = t20 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t20))
-    t23 = t22 - 6.283185307179586*xp.floor(0.15915494309189535*(2.705260340591211 + t22))
-    t24 = t21 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t21))
-    t25 = t24 - 6.283185307179586*xp.floor(0.15915494309189535*(2.705260340591211 + t24))
+    t23 = -6.283185307179586*xp.floor(0.15915494309189535*(2.705260340591211 + t22)) + t22
+    t24 = -6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t21)) + t21
+    t25 = -6.283185307179586*xp.floor(0.15915494309189535*(2.705260340591211 + t24)) + t24
     t26 = t4*t19
     t27 = xp.where(t18, 1, t26)
     t28 = -t26
@@ -2479,11 +2479,11 @@ def ik_branches(T):
     t61 = xp.where(t58, t60, xp.where(xp.greater(t60, 0), xp.asarray(1, dtype=dtype), -1))
     t62 = xp.atan2(t59, t61)
     t63 = 1.761980786391911 - t62
-    t64 = t63 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t63))
-    t65 = t64 - 6.283185307179586*xp.floor(0.15915494309189535*(0.2617993877991494 + t64))
+    t64 = -6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t63)) + t63
+    t65 = -6.283185307179586*xp.floor(0.15915494309189535*(0.2617993877991494 + t64)) + t64
     t66 = 1.761980786391911 + t62
-    t67 = t66 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t66))
-    t68 = t67 - 6.283185307179586*xp.floor(0.15915494309189535*(0.2617993877991494 + t67))
+    t67 = -6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t66)) + t66
+    t68 = -6.283185307179586*xp.floor(0.15915494309189535*(0.2617993877991494 + t67)) + t67
     t69 = 0.9817798505902814*t59
     t70 = 0.1900219065658609*t61
     t71 = -(t69 + t70)
@@ -2491,8 +2491,8 @@ def ik_branches(T):
     t73 = 0.1900219065658609*t59
     t74 = 0.9817798505902814*t61
     t75 = -t73 + t74
-    t76 = t73 + t74
-    t77 = -0.62*t75 + 0.12*t71
+    t76 = t74 + t73
+    t77 = 0.12*t71 - 0.62*t75
     t78 = 0.12*t75 + 0.62*t71
     t79 = 0.78 + t77
     t80 = 0.4 - t78
@@ -2502,7 +2502,7 @@ def ik_branches(T):
     t84 = t34*t82 - t49*t81
     t85 = t83**2 + t84**2
     t86 = t81**2 + t82**2
-    t87 = -0.62*t76 + 0.12*t72
+    t87 = 0.12*t72 - 0.62*t76
     t88 = 0.12*t76 + 0.62*t72
     t89 = 0.78 + t87
     t90 = 0.4 - t88
@@ -2513,7 +2513,7 @@ def ik_branches(T):
     t95 = t93**2 + t94**2
     t96 = t91**2 + t92**2
     t97 = 1e-24*t50
-    t98 = xp.less_equal(t85, t86*t97)
+    t98 = xp.less_equal(t85, t97*t86)
     t99 = xp.where(t98, 1, 1/xp.sqrt(t85))
     t100 = xp.where(t98, 1, t83*t99)
     t101 = xp.where(t98, 0, t84*t99)
@@ -2524,11 +2524,11 @@ def ik_branches(T):
     t106 = t102*t37 - t103*t55
     t107 = t102*t55 + t103*t37
     t108 = xp.where(t98, 0, xp.atan2(t84, t83))
-    t109 = t108 - 6.283185307179586*xp.floor(0.15915494309189535*(3.141592653589793 + t108))
+    t109 = -6.283185307179586*xp.floor(0.15915494309189535*(3.141592653589793 + t108)) + t108
     t110 = 1 - t102
     t111 = t36*t110
-    t112 = t111 + t102*t36
-    t113 = t38*t110
+    t112 = t111 + t36*t102
+    t113 = t110*t38
     t114 = t113 + t102*t38
     t115 = t105**2
     t116 = -t115
@@ -2536,34 +2536,34 @@ def ik_branches(T):
     t118 = xp.greater(t117, 1e-12)
     t119 = xp.where(t118, xp.sqrt(t117), 0)
     t120 = t115 - t104*t119
-    t121 = t120 + t116
-    t122 = t112**2
-    t123 = t104**2 + t122 + t115
-    t124 = t119**2
+    t121 = t116 + t120
+    t122 = t119**2
+    t123 = t115 + t122
+    t124 = t112**2
     t125 = t121**2 + t122*t124
-    t126 = t115 + t124
-    t127 = 1e-24*t126
-    t128 = xp.less_equal(t125, t123*t127)
+    t126 = t115 + t104**2 + t124
+    t127 = 1e-24*t123
+    t128 = xp.less_equal(t125, t127*t126)
     t129 = xp.where(t128, 1, 1/xp.sqrt(t125))
     t130 = xp.where(t128, 1, t121*t129)
     t131 = t107*(1 - t130)
     t132 = t131 + t107*t130
-    t133 = t112*t119
-    t134 = xp.where(t128, 0, -t129*t133)
-    t135 = t106*t130 + t114*t134
-    t136 = t114*t130 - t106*t134
-    t137 = xp.less_equal(t126, t127)
-    t138 = xp.where(t137, 1, 1/xp.sqrt(t126))
+    t133 = t119*t112
+    t134 = xp.where(t128, 0, -t133*t129)
+    t135 = t130*t106 + t114*t134
+    t136 = t130*t114 - t106*t134
+    t137 = xp.less_equal(t123, t127)
+    t138 = xp.where(t137, 1, 1/xp.sqrt(t123))
     t139 = xp.where(t137, 1, -t105*t138)
     t140 = xp.where(t137, 0, -t119*t138)
     t141 = t136*(1 - t139)
     t142 = t139*t135 - t140*t132
-    t143 = t141 + t139*t136
-    t144 = t139*t132 + t140*t135
+    t143 = t141 + t136*t139
+    t144 = t139*t132 + t135*t140
     t145 = t142**2 + t143**2
     t146 = t145
-    t147 = t144**2 + t145
-    t148 = xp.less_equal(t95, t96*t97)
+    t147 = t145 + t144**2
+    t148 = xp.less_equal(t95, t97*t96)
     t149 = xp.where(t148, 1, 1/xp.sqrt(t95))
     t150 = xp.where(t148, 1, t93*t149)
     t151 = xp.where(t148, 0, t94*t149)
@@ -2574,7 +2574,7 @@ def ik_branches(T):
     t156 = t37*t152 - t55*t153
     t157 = t37*t153 + t55*t152
     t158 = xp.where(t148, 0, xp.atan2(t94, t93))
-    t159 = t158 - 6.283185307179586*xp.floor(0.15915494309189535*(3.141592653589793 + t158))
+    t159 = -6.283185307179586*xp.floor(0.15915494309189535*(3.141592653589793 + t158)) + t158
     t160 = 1 - t152
     t161 = t36*t160
     t162 = t161 + t36*t152
@@ -2586,33 +2586,33 @@ def ik_branches(T):
     t168 = xp.greater(t167, 1e-12)
     t169 = xp.where(t168, xp.sqrt(t167), 0)
     t170 = t165 - t154*t169
-    t171 = t170 + t166
-    t172 = t162**2
-    t173 = t154**2 + t172 + t165
-    t174 = t169**2
+    t171 = t166 + t170
+    t172 = t169**2
+    t173 = t165 + t172
+    t174 = t162**2
     t175 = t171**2 + t172*t174
-    t176 = t165 + t174
-    t177 = 1e-24*t176
-    t178 = xp.less_equal(t175, t173*t177)
+    t176 = t165 + t154**2 + t174
+    t177 = 1e-24*t173
+    t178 = xp.less_equal(t175, t177*t176)
     t179 = xp.where(t178, 1, 1/xp.sqrt(t175))
     t180 = xp.where(t178, 1, t171*t179)
     t181 = t157*(1 - t180)
     t182 = t181 + t157*t180
-    t183 = t162*t169
-    t184 = xp.where(t178, 0, -t179*t183)
-    t185 = t156*t180 + t164*t184
-    t186 = t164*t180 - t156*t184
-    t187 = xp.less_equal(t176, t177)
-    t188 = xp.where(t187, 1, 1/xp.sqrt(t176))
+    t183 = t169*t162
+    t184 = xp.where(t178, 0, -t183*t179)
+    t185 = t180*t156 + t164*t184
+    t186 = t180*t164 - t156*t184
+    t187 = xp.less_equal(t173, t177)
+    t188 = xp.where(t187, 1, 1/xp.sqrt(t173))
     t189 = xp.where(t187, 1, -t155*t188)
     t190 = xp.where(t187, 0, -t169*t188)
     t191 = t186*(1 - t189)
     t192 = t189*t185 - t190*t182
-    t193 = t191 + t189*t186
-    t194 = t189*t182 + t190*t185
+    t193 = t191 + t186*t189
+    t194 = t189*t182 + t185*t190
     t195 = t192**2 + t193**2
     t196 = t195
-    t197 = t194**2 + t195
+    t197 = t195 + t194**2
     t198 = 1 - t28
     t199 = t13*t198
     t200 = t199 + t13*t28
@@ -2632,10 +2632,10 @@ def ik_branches(T):
     t214 = xp.atan2(t211, t213)
     t215 = 1.761980786391911 + t214
     t216 = 1.761980786391911 - t214
-    t217 = t215 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t215))
-    t218 = t217 - 6.283185307179586*xp.floor(0.15915494309189535*(0.2617993877991494 + t217))
-    t219 = t216 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t216))
-    t220 = t219 - 6.283185307179586*xp.floor(0.15915494309189535*(0.2617993877991494 + t219))
+    t217 = -6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t215)) + t215
+    t218 = -6.283185307179586*xp.floor(0.15915494309189535*(0.2617993877991494 + t217)) + t217
+    t219 = -6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t216)) + t216
+    t220 = -6.283185307179586*xp.floor(0.15915494309189535*(0.2617993877991494 + t219)) + t219
     t221 = 0.9817798505902814*t211
     t222 = 0.1900219065658609*t213
     t223 = -(t221 + t222)
@@ -2643,8 +2643,8 @@ def ik_branches(T):
     t225 = 0.1900219065658609*t211
     t226 = 0.9817798505902814*t213
     t227 = -t225 + t226
-    t228 = t225 + t226
-    t229 = -0.62*t227 + 0.12*t223
+    t228 = t226 + t225
+    t229 = 0.12*t223 - 0.62*t227
     t230 = 0.12*t227 + 0.62*t223
     t231 = 0.78 + t229
     t232 = 0.4 - t230
@@ -2654,7 +2654,7 @@ def ik_branches(T):
     t236 = t41*t234 - t201*t233
     t237 = t235**2 + t236**2
     t238 = t233**2 + t234**2
-    t239 = -0.62*t228 + 0.12*t224
+    t239 = 0.12*t224 - 0.62*t228
     t240 = 0.12*t228 + 0.62*t224
     t241 = 0.78 + t239
     t242 = 0.4 - t240
@@ -2665,22 +2665,22 @@ def ik_branches(T):
     t247 = t245**2 + t246**2
     t248 = t243**2 + t244**2
     t249 = 1e-24*t202
-    t250 = xp.less_equal(t237, t238*t249)
+    t250 = xp.less_equal(t237, t249*t238)
     t251 = xp.where(t250, 1, 1/xp.sqrt(t237))
     t252 = xp.where(t250, 1, t235*t251)
     t253 = xp.where(t250, 0, t236*t251)
     t254 = t223*t252 - t227*t253
     t255 = t223*t253 + t227*t252
     t256 = t254*t42 + t255*t205
-    t257 = t255*t42 - t254*t205
+    t257 = t42*t255 - t254*t205
     t258 = t254*t44 - t255*t207
     t259 = t254*t207 + t255*t44
     t260 = xp.where(t250, 0, xp.atan2(t236, t235))
-    t261 = t260 - 6.283185307179586*xp.floor(0.15915494309189535*(3.141592653589793 + t260))
+    t261 = -6.283185307179586*xp.floor(0.15915494309189535*(3.141592653589793 + t260)) + t260
     t262 = 1 - t254
     t263 = t43*t262
-    t264 = t263 + t254*t43
-    t265 = t45*t262
+    t264 = t263 + t43*t254
+    t265 = t262*t45
     t266 = t265 + t254*t45
     t267 = t257**2
     t268 = -t267
@@ -2688,34 +2688,34 @@ def ik_branches(T):
     t270 = xp.greater(t269, 1e-12)
     t271 = xp.where(t270, xp.sqrt(t269), 0)
     t272 = t267 - t256*t271
-    t273 = t272 + t268
-    t274 = t264**2
-    t275 = t256**2 + t274 + t267
-    t276 = t271**2
+    t273 = t268 + t272
+    t274 = t271**2
+    t275 = t267 + t274
+    t276 = t264**2
     t277 = t273**2 + t274*t276
-    t278 = t267 + t276
-    t279 = 1e-24*t278
-    t280 = xp.less_equal(t277, t275*t279)
+    t278 = t267 + t256**2 + t276
+    t279 = 1e-24*t275
+    t280 = xp.less_equal(t277, t279*t278)
     t281 = xp.where(t280, 1, 1/xp.sqrt(t277))
     t282 = xp.where(t280, 1, t273*t281)
     t283 = t259*(1 - t282)
     t284 = t283 + t259*t282
-    t285 = t264*t271
-    t286 = xp.where(t280, 0, t281*t285)
-    t287 = t258*t282 + t266*t286
-    t288 = t266*t282 - t258*t286
-    t289 = xp.less_equal(t278, t279)
-    t290 = xp.where(t289, 1, 1/xp.sqrt(t278))
+    t285 = t271*t264
+    t286 = xp.where(t280, 0, t285*t281)
+    t287 = t282*t258 + t266*t286
+    t288 = t282*t266 - t258*t286
+    t289 = xp.less_equal(t275, t279)
+    t290 = xp.where(t289, 1, 1/xp.sqrt(t275))
     t291 = xp.where(t289, 1, t257*t290)
     t292 = xp.where(t289, 0, -t271*t290)
     t293 = t288*(1 - t291)
     t294 = t291*t287 - t292*t284
-    t295 = t293 + t291*t288
-    t296 = t291*t284 + t292*t287
+    t295 = t293 + t288*t291
+    t296 = t291*t284 + t287*t292
     t297 = t294**2 + t295**2
     t298 = t297
-    t299 = t296**2 + t297
-    t300 = xp.less_equal(t247, t248*t249)
+    t299 = t297 + t296**2
+    t300 = xp.less_equal(t247, t249*t248)
     t301 = xp.where(t300, 1, 1/xp.sqrt(t247))
     t302 = xp.where(t300, 1, t245*t301)
     t303 = xp.where(t300, 0, t246*t301)
@@ -2726,7 +2726,7 @@ def ik_branches(T):
     t308 = t44*t304 - t207*t305
     t309 = t44*t305 + t207*t304
     t310 = xp.where(t300, 0, xp.atan2(t246, t245))
-    t311 = t310 - 6.283185307179586*xp.floor(0.15915494309189535*(3.141592653589793 + t310))
+    t311 = -6.283185307179586*xp.floor(0.15915494309189535*(3.141592653589793 + t310)) + t310
     t312 = 1 - t304
     t313 = t43*t312
     t314 = t313 + t43*t304
@@ -2738,97 +2738,97 @@ def ik_branches(T):
     t320 = xp.greater(t319, 1e-12)
     t321 = xp.where(t320, xp.sqrt(t319), 0)
     t322 = t317 - t306*t321
-    t323 = t322 + t318
-    t324 = t314**2
-    t325 = t306**2 + t324 + t317
-    t326 = t321**2
+    t323 = t318 + t322
+    t324 = t321**2
+    t325 = t317 + t324
+    t326 = t314**2
     t327 = t323**2 + t324*t326
-    t328 = t317 + t326
-    t329 = 1e-24*t328
-    t330 = xp.less_equal(t327, t325*t329)
+    t328 = t317 + t306**2 + t326
+    t329 = 1e-24*t325
+    t330 = xp.less_equal(t327, t328*t329)
     t331 = xp.where(t330, 1, 1/xp.sqrt(t327))
     t332 = xp.where(t330, 1, t323*t331)
     t333 = t309*(1 - t332)
     t334 = t333 + t309*t332
-    t335 = t314*t321
+    t335 = t321*t314
     t336 = xp.where(t330, 0, t331*t335)
-    t337 = t308*t332 + t316*t336
-    t338 = t316*t332 - t308*t336
-    t339 = xp.less_equal(t328, t329)
-    t340 = xp.where(t339, 1, 1/xp.sqrt(t328))
+    t337 = t332*t308 + t316*t336
+    t338 = t332*t316 - t308*t336
+    t339 = xp.less_equal(t325, t329)
+    t340 = xp.where(t339, 1, 1/xp.sqrt(t325))
     t341 = xp.where(t339, 1, t307*t340)
     t342 = xp.where(t339, 0, -t321*t340)
     t343 = t338*(1 - t341)
     t344 = t341*t337 - t342*t334
-    t345 = t343 + t341*t338
-    t346 = t341*t334 + t342*t337
+    t345 = t343 + t338*t341
+    t346 = t341*t334 + t337*t342
     t347 = t344**2 + t345**2
     t348 = t347
     t349 = t346**2 + t347
     t350 = xp.where(t128, 0, xp.atan2(-t133, t121))
     t351 = t350
-    t352 = t351 - 6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t351))
+    t352 = -6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t351)) + t351
     t353 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t350) + t350
-    t354 = t353 - 6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t353))
+    t354 = -6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t353)) + t353
     t355 = xp.where(t137, 0, xp.atan2(-t119, -t105))
     t356 = t355
-    t357 = t356 - 6.283185307179586*xp.floor(0.15915494309189535*(2.2689280275926285 + t356))
-    t358 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t355)) + t355
+    t357 = -6.283185307179586*xp.floor(0.15915494309189535*(2.2689280275926285 + t356)) + t356
+    t358 = t355 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t355))
     t359 = xp.where(xp.less_equal(t146, 1e-24*t147), 0, xp.atan2(t143, t142))
     t360 = t359
-    t361 = t360 - 6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t360))
+    t361 = -6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t360)) + t360
     t362 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t359) + t359
-    t363 = t362 - 6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t362))
+    t363 = -6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t362)) + t362
     t364 = -t358
-    t365 = t358 + 6.283185307179586*xp.floor(0.15915494309189535*(2.2689280275926285 + t364))
+    t365 = 6.283185307179586*xp.floor(0.15915494309189535*(2.2689280275926285 + t364)) + t358
     t366 = xp.where(t178, 0, xp.atan2(-t183, t171))
     t367 = t366
-    t368 = t367 - 6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t367))
+    t368 = -6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t367)) + t367
     t369 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t366) + t366
-    t370 = t369 - 6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t369))
+    t370 = -6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t369)) + t369
     t371 = xp.where(t187, 0, xp.atan2(-t169, -t155))
     t372 = t371
-    t373 = t372 - 6.283185307179586*xp.floor(0.15915494309189535*(2.2689280275926285 + t372))
+    t373 = -6.283185307179586*xp.floor(0.15915494309189535*(2.2689280275926285 + t372)) + t372
     t374 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t371)) + t371
     t375 = xp.where(xp.less_equal(t196, 1e-24*t197), 0, xp.atan2(t193, t192))
     t376 = t375
-    t377 = t376 - 6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t376))
+    t377 = -6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t376)) + t376
     t378 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t375) + t375
-    t379 = t378 - 6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t378))
+    t379 = -6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t378)) + t378
     t380 = -t374
-    t381 = t374 + 6.283185307179586*xp.floor(0.15915494309189535*(2.2689280275926285 + t380))
+    t381 = 6.283185307179586*xp.floor(0.15915494309189535*(2.2689280275926285 + t380)) + t374
     t382 = xp.where(t280, 0, xp.atan2(t285, t273))
     t383 = t382
-    t384 = t383 - 6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t383))
+    t384 = -6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t383)) + t383
     t385 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t382) + t382
-    t386 = t385 - 6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t385))
+    t386 = -6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t385)) + t385
     t387 = xp.where(t289, 0, xp.atan2(-t271, t257))
     t388 = t387
-    t389 = t388 - 6.283185307179586*xp.floor(0.15915494309189535*(2.2689280275926285 + t388))
+    t389 = -6.283185307179586*xp.floor(0.15915494309189535*(2.2689280275926285 + t388)) + t388
     t390 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t387)) + t387
     t391 = xp.where(xp.less_equal(t298, 1e-24*t299), 0, xp.atan2(t295, t294))
     t392 = t391
-    t393 = t392 - 6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t392))
+    t393 = -6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t392)) + t392
     t394 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t391) + t391
-    t395 = t394 - 6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t394))
+    t395 = -6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t394)) + t394
     t396 = -t390
-    t397 = t390 + 6.283185307179586*xp.floor(0.15915494309189535*(2.2689280275926285 + t396))
+    t397 = 6.283185307179586*xp.floor(0.15915494309189535*(2.2689280275926285 + t396)) + t390
     t398 = xp.where(t330, 0, xp.atan2(t335, t323))
     t399 = t398
-    t400 = t399 - 6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t399))
+    t400 = -6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t399)) + t399
     t401 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t398) + t398
-    t402 = t401 - 6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t401))
+    t402 = -6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t401)) + t401
     t403 = xp.where(t339, 0, xp.atan2(-t321, t307))
     t404 = t403
-    t405 = t404 - 6.283185307179586*xp.floor(0.15915494309189535*(2.2689280275926285 + t404))
+    t405 = -6.283185307179586*xp.floor(0.15915494309189535*(2.2689280275926285 + t404)) + t404
     t406 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t403)) + t403
     t407 = xp.where(xp.less_equal(t348, 1e-24*t349), 0, xp.atan2(t345, t344))
     t408 = t407
-    t409 = t408 - 6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t408))
+    t409 = -6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t408)) + t408
     t410 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t407) + t407
-    t411 = t410 - 6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t410))
+    t411 = -6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t410)) + t410
     t412 = -t406
-    t413 = t406 + 6.283185307179586*xp.floor(0.15915494309189535*(2.2689280275926285 + t412))
+    t413 = 6.283185307179586*xp.floor(0.15915494309189535*(2.2689280275926285 + t412)) + t406
     t414 = xp.less_equal(t23, 2.705260340591211)
     t415 = xp.greater_equal(t22, -2.705260340591211) & xp.less_equal(t22, 2.705260340591211)
     t416 = xp.where(t414 & xp.logical_not(t415), t23, t22)
@@ -3092,87 +3092,87 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     lb5 = branches_in_limits[..., 5]
     lb6 = branches_in_limits[..., 6]
     lb7 = branches_in_limits[..., 7]
-    t0 = qb0_0 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn1 - qb0_0))
-    t1 = qb0_1 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn2 - qb0_1))
-    t2 = qb0_2 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn3 - qb0_2))
-    t3 = qb0_3 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn4 - qb0_3))
-    t4 = qb0_4 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn5 - qb0_4))
-    t5 = qb0_5 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn6 - qb0_5))
+    t0 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_0 + qn1)) + qb0_0
+    t1 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_1 + qn2)) + qb0_1
+    t2 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_2 + qn3)) + qb0_2
+    t3 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_3 + qn4)) + qb0_3
+    t4 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_4 + qn5)) + qb0_4
+    t5 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_5 + qn6)) + qb0_5
     t6 = xp.where(lb0 & vb0, xp.asarray(1, dtype=dtype), 0)
     t7 = xp.where(xp.greater(t6, 0), xp.asarray(1, dtype=dtype), 0)
-    t8 = qb1_0 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn1 - qb1_0))
-    t9 = qb1_1 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn2 - qb1_1))
-    t10 = qb1_2 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn3 - qb1_2))
-    t11 = qb1_3 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn4 - qb1_3))
-    t12 = qb1_4 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn5 - qb1_4))
-    t13 = qb1_5 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn6 - qb1_5))
+    t8 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_0 + qn1)) + qb1_0
+    t9 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_1 + qn2)) + qb1_1
+    t10 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_2 + qn3)) + qb1_2
+    t11 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_3 + qn4)) + qb1_3
+    t12 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_4 + qn5)) + qb1_4
+    t13 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_5 + qn6)) + qb1_5
     t14 = xp.where(lb1 & vb1, xp.asarray(1, dtype=dtype), 0)
-    t15 = qb2_0 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn1 - qb2_0))
-    t16 = qb2_1 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn2 - qb2_1))
-    t17 = qb2_2 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn3 - qb2_2))
-    t18 = qb2_3 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn4 - qb2_3))
-    t19 = qb2_4 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn5 - qb2_4))
-    t20 = qb2_5 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn6 - qb2_5))
+    t15 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_0 + qn1)) + qb2_0
+    t16 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_1 + qn2)) + qb2_1
+    t17 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_2 + qn3)) + qb2_2
+    t18 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_3 + qn4)) + qb2_3
+    t19 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_4 + qn5)) + qb2_4
+    t20 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_5 + qn6)) + qb2_5
     t21 = xp.where(lb2 & vb2, xp.asarray(1, dtype=dtype), 0)
-    t22 = qb3_0 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn1 - qb3_0))
-    t23 = qb3_1 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn2 - qb3_1))
-    t24 = qb3_2 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn3 - qb3_2))
-    t25 = qb3_3 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn4 - qb3_3))
-    t26 = qb3_4 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn5 - qb3_4))
-    t27 = qb3_5 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn6 - qb3_5))
+    t22 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_0 + qn1)) + qb3_0
+    t23 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_1 + qn2)) + qb3_1
+    t24 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_2 + qn3)) + qb3_2
+    t25 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_3 + qn4)) + qb3_3
+    t26 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_4 + qn5)) + qb3_4
+    t27 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_5 + qn6)) + qb3_5
     t28 = xp.where(lb3 & vb3, xp.asarray(1, dtype=dtype), 0)
-    t29 = qb4_0 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn1 - qb4_0))
-    t30 = qb4_1 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn2 - qb4_1))
-    t31 = qb4_2 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn3 - qb4_2))
-    t32 = qb4_3 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn4 - qb4_3))
-    t33 = qb4_4 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn5 - qb4_4))
-    t34 = qb4_5 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn6 - qb4_5))
+    t29 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_0 + qn1)) + qb4_0
+    t30 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_1 + qn2)) + qb4_1
+    t31 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_2 + qn3)) + qb4_2
+    t32 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_3 + qn4)) + qb4_3
+    t33 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_4 + qn5)) + qb4_4
+    t34 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_5 + qn6)) + qb4_5
     t35 = xp.where(lb4 & vb4, xp.asarray(1, dtype=dtype), 0)
-    t36 = qb5_0 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn1 - qb5_0))
-    t37 = qb5_1 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn2 - qb5_1))
-    t38 = qb5_2 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn3 - qb5_2))
-    t39 = qb5_3 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn4 - qb5_3))
-    t40 = qb5_4 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn5 - qb5_4))
-    t41 = qb5_5 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn6 - qb5_5))
+    t36 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_0 + qn1)) + qb5_0
+    t37 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_1 + qn2)) + qb5_1
+    t38 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_2 + qn3)) + qb5_2
+    t39 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_3 + qn4)) + qb5_3
+    t40 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_4 + qn5)) + qb5_4
+    t41 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_5 + qn6)) + qb5_5
     t42 = xp.where(lb5 & vb5, xp.asarray(1, dtype=dtype), 0)
-    t43 = qb6_0 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn1 - qb6_0))
-    t44 = qb6_1 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn2 - qb6_1))
-    t45 = qb6_2 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn3 - qb6_2))
-    t46 = qb6_3 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn4 - qb6_3))
-    t47 = qb6_4 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn5 - qb6_4))
-    t48 = qb6_5 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn6 - qb6_5))
+    t43 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_0 + qn1)) + qb6_0
+    t44 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_1 + qn2)) + qb6_1
+    t45 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_2 + qn3)) + qb6_2
+    t46 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_3 + qn4)) + qb6_3
+    t47 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_4 + qn5)) + qb6_4
+    t48 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_5 + qn6)) + qb6_5
     t49 = xp.where(lb6 & vb6, xp.asarray(1, dtype=dtype), 0)
-    t50 = qb7_0 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn1 - qb7_0))
-    t51 = qb7_1 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn2 - qb7_1))
-    t52 = qb7_2 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn3 - qb7_2))
-    t53 = qb7_3 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn4 - qb7_3))
-    t54 = qb7_4 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn5 - qb7_4))
-    t55 = qb7_5 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn6 - qb7_5))
+    t50 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_0 + qn1)) + qb7_0
+    t51 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_1 + qn2)) + qb7_1
+    t52 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_2 + qn3)) + qb7_2
+    t53 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_3 + qn4)) + qb7_3
+    t54 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_4 + qn5)) + qb7_4
+    t55 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_5 + qn6)) + qb7_5
     t56 = xp.where(lb7 & vb7, xp.asarray(1, dtype=dtype), 0)
-    t57 = T00 + T01 + T02 + T03 + T10 + T11 + T12 + T13 + T20 + T21 + T22 + T23 + qn1 + qn2 + qn3 + qn4 + qn5 + qn6 + qw1 + qw2 + qw3 + qw4 + qw5 + qw6
+    t57 = T00 + T01 + T02 + T10 + T11 + T12 + T20 + T21 + T22 + T03 + T13 + T23 + qn1 + qn2 + qn3 + qn4 + qn5 + qn6 + qw1 + qw2 + qw3 + qw4 + qw5 + qw6
     t58 = xp.where(xp.less(t0, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t59 = t0 + t58
-    t60 = t0 - t58
+    t60 = -t58 + t0
     t61 = xp.where(xp.greater_equal(t0, -2.705260340591211) & xp.less_equal(t0, 2.705260340591211), t0, xp.where(xp.greater_equal(t59, -2.705260340591211) & xp.less_equal(t59, 2.705260340591211), t59, xp.where(xp.greater_equal(t60, -2.705260340591211) & xp.less_equal(t60, 2.705260340591211), t60, qb0_0)))
     t62 = xp.where(xp.less(t1, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t63 = t1 + t62
-    t64 = t1 - t62
+    t64 = -t62 + t1
     t65 = xp.where(xp.greater_equal(t1, -3.141592653589793) & xp.less_equal(t1, 1.1344640137963142), t1, xp.where(xp.greater_equal(t63, -3.141592653589793) & xp.less_equal(t63, 1.1344640137963142), t63, xp.where(xp.greater_equal(t64, -3.141592653589793) & xp.less_equal(t64, 1.1344640137963142), t64, qb0_1)))
     t66 = xp.where(xp.less(t2, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t67 = t2 + t66
-    t68 = t2 - t66
+    t68 = -t66 + t2
     t69 = xp.where(xp.greater_equal(t2, -0.2617993877991494) & xp.less_equal(t2, 2.7576202181510405), t2, xp.where(xp.greater_equal(t67, -0.2617993877991494) & xp.less_equal(t67, 2.7576202181510405), t67, xp.where(xp.greater_equal(t68, -0.2617993877991494) & xp.less_equal(t68, 2.7576202181510405), t68, qb0_2)))
     t70 = xp.where(xp.less(t3, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t71 = t3 + t70
-    t72 = t3 - t70
+    t72 = -t70 + t3
     t73 = xp.where(xp.greater_equal(t3, -6.1086523819801535) & xp.less_equal(t3, 6.1086523819801535), t3, xp.where(xp.greater_equal(t71, -6.1086523819801535) & xp.less_equal(t71, 6.1086523819801535), t71, xp.where(xp.greater_equal(t72, -6.1086523819801535) & xp.less_equal(t72, 6.1086523819801535), t72, qb0_3)))
     t74 = xp.where(xp.less(t4, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t75 = t4 + t74
-    t76 = t4 - t74
+    t76 = -t74 + t4
     t77 = xp.where(xp.greater_equal(t4, -2.2689280275926285) & xp.less_equal(t4, 2.2689280275926285), t4, xp.where(xp.greater_equal(t75, -2.2689280275926285) & xp.less_equal(t75, 2.2689280275926285), t75, xp.where(xp.greater_equal(t76, -2.2689280275926285) & xp.less_equal(t76, 2.2689280275926285), t76, qb0_4)))
     t78 = xp.where(xp.less(t5, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t79 = t5 + t78
-    t80 = t5 - t78
+    t80 = -t78 + t5
     t81 = xp.where(xp.greater_equal(t5, -6.1086523819801535) & xp.less_equal(t5, 6.1086523819801535), t5, xp.where(xp.greater_equal(t79, -6.1086523819801535) & xp.less_equal(t79, 6.1086523819801535), t79, xp.where(xp.greater_equal(t80, -6.1086523819801535) & xp.less_equal(t80, 6.1086523819801535), t80, qb0_5)))
     t82 = -qn1
     t83 = -qn2
@@ -3180,7 +3180,7 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     t85 = -qn4
     t86 = -qn5
     t87 = -qn6
-    t88 = qw1*(t61 + t82)**2 + qw2*(t65 + t83)**2 + qw3*(t69 + t84)**2 + qw4*(t73 + t85)**2 + qw5*(t77 + t86)**2 + qw6*(t81 + t87)**2
+    t88 = qw1*(t82 + t61)**2 + qw2*(t83 + t65)**2 + qw3*(t84 + t69)**2 + qw4*(t85 + t73)**2 + qw5*(t86 + t77)**2 + qw6*(t87 + t81)**2
     t89 = xp.greater(t7, 0)
     t90 = xp.where(t89, t61, qn1)
     t91 = xp.where(t89, t65, qn2)
@@ -3191,29 +3191,29 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     t96 = xp.where(t89, t88, 0)
     t97 = xp.where(xp.less(t8, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t98 = t8 + t97
-    t99 = t8 - t97
+    t99 = -t97 + t8
     t100 = xp.where(xp.greater_equal(t8, -2.705260340591211) & xp.less_equal(t8, 2.705260340591211), t8, xp.where(xp.greater_equal(t98, -2.705260340591211) & xp.less_equal(t98, 2.705260340591211), t98, xp.where(xp.greater_equal(t99, -2.705260340591211) & xp.less_equal(t99, 2.705260340591211), t99, qb1_0)))
     t101 = xp.where(xp.less(t9, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t102 = t9 + t101
-    t103 = t9 - t101
+    t103 = -t101 + t9
     t104 = xp.where(xp.greater_equal(t9, -3.141592653589793) & xp.less_equal(t9, 1.1344640137963142), t9, xp.where(xp.greater_equal(t102, -3.141592653589793) & xp.less_equal(t102, 1.1344640137963142), t102, xp.where(xp.greater_equal(t103, -3.141592653589793) & xp.less_equal(t103, 1.1344640137963142), t103, qb1_1)))
     t105 = xp.where(xp.less(t10, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t106 = t10 + t105
-    t107 = t10 - t105
+    t107 = -t105 + t10
     t108 = xp.where(xp.greater_equal(t10, -0.2617993877991494) & xp.less_equal(t10, 2.7576202181510405), t10, xp.where(xp.greater_equal(t106, -0.2617993877991494) & xp.less_equal(t106, 2.7576202181510405), t106, xp.where(xp.greater_equal(t107, -0.2617993877991494) & xp.less_equal(t107, 2.7576202181510405), t107, qb1_2)))
     t109 = xp.where(xp.less(t11, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t110 = t11 + t109
-    t111 = t11 - t109
+    t111 = -t109 + t11
     t112 = xp.where(xp.greater_equal(t11, -6.1086523819801535) & xp.less_equal(t11, 6.1086523819801535), t11, xp.where(xp.greater_equal(t110, -6.1086523819801535) & xp.less_equal(t110, 6.1086523819801535), t110, xp.where(xp.greater_equal(t111, -6.1086523819801535) & xp.less_equal(t111, 6.1086523819801535), t111, qb1_3)))
     t113 = xp.where(xp.less(t12, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t114 = t12 + t113
-    t115 = t12 - t113
+    t115 = -t113 + t12
     t116 = xp.where(xp.greater_equal(t12, -2.2689280275926285) & xp.less_equal(t12, 2.2689280275926285), t12, xp.where(xp.greater_equal(t114, -2.2689280275926285) & xp.less_equal(t114, 2.2689280275926285), t114, xp.where(xp.greater_equal(t115, -2.2689280275926285) & xp.less_equal(t115, 2.2689280275926285), t115, qb1_4)))
     t117 = xp.where(xp.less(t13, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t118 = t13 + t117
-    t119 = t13 - t117
+    t119 = -t117 + t13
     t120 = xp.where(xp.greater_equal(t13, -6.1086523819801535) & xp.less_equal(t13, 6.1086523819801535), t13, xp.where(xp.greater_equal(t118, -6.1086523819801535) & xp.less_equal(t118, 6.1086523819801535), t118, xp.where(xp.greater_equal(t119, -6.1086523819801535) & xp.less_equal(t119, 6.1086523819801535), t119, qb1_5)))
-    t121 = qw1*(t100 + t82)**2 + qw2*(t104 + t83)**2 + qw3*(t108 + t84)**2 + qw4*(t112 + t85)**2 + qw5*(t116 + t86)**2 + qw6*(t120 + t87)**2
+    t121 = qw1*(t82 + t100)**2 + qw2*(t83 + t104)**2 + qw3*(t84 + t108)**2 + qw4*(t85 + t112)**2 + qw5*(t86 + t116)**2 + qw6*(t87 + t120)**2
     t122 = xp.greater(t14, 0)
     t123 = xp.where(t122 & (xp.less(t121, t96) | xp.less(t7, 1)), xp.asarray(1, dtype=dtype), 0)
     t124 = xp.where(t122, 1, t7)
@@ -3227,29 +3227,29 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     t132 = xp.where(t125, t121, t96)
     t133 = xp.where(xp.less(t15, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t134 = t15 + t133
-    t135 = t15 - t133
+    t135 = -t133 + t15
     t136 = xp.where(xp.greater_equal(t15, -2.705260340591211) & xp.less_equal(t15, 2.705260340591211), t15, xp.where(xp.greater_equal(t134, -2.705260340591211) & xp.less_equal(t134, 2.705260340591211), t134, xp.where(xp.greater_equal(t135, -2.705260340591211) & xp.less_equal(t135, 2.705260340591211), t135, qb2_0)))
     t137 = xp.where(xp.less(t16, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t138 = t16 + t137
-    t139 = t16 - t137
+    t139 = -t137 + t16
     t140 = xp.where(xp.greater_equal(t16, -3.141592653589793) & xp.less_equal(t16, 1.1344640137963142), t16, xp.where(xp.greater_equal(t138, -3.141592653589793) & xp.less_equal(t138, 1.1344640137963142), t138, xp.where(xp.greater_equal(t139, -3.141592653589793) & xp.less_equal(t139, 1.1344640137963142), t139, qb2_1)))
     t141 = xp.where(xp.less(t17, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t142 = t17 + t141
-    t143 = t17 - t141
+    t143 = -t141 + t17
     t144 = xp.where(xp.greater_equal(t17, -0.2617993877991494) & xp.less_equal(t17, 2.7576202181510405), t17, xp.where(xp.greater_equal(t142, -0.2617993877991494) & xp.less_equal(t142, 2.7576202181510405), t142, xp.where(xp.greater_equal(t143, -0.2617993877991494) & xp.less_equal(t143, 2.7576202181510405), t143, qb2_2)))
     t145 = xp.where(xp.less(t18, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t146 = t18 + t145
-    t147 = t18 - t145
+    t147 = -t145 + t18
     t148 = xp.where(xp.greater_equal(t18, -6.1086523819801535) & xp.less_equal(t18, 6.1086523819801535), t18, xp.where(xp.greater_equal(t146, -6.1086523819801535) & xp.less_equal(t146, 6.1086523819801535), t146, xp.where(xp.greater_equal(t147, -6.1086523819801535) & xp.less_equal(t147, 6.1086523819801535), t147, qb2_3)))
     t149 = xp.where(xp.less(t19, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t150 = t19 + t149
-    t151 = t19 - t149
+    t151 = -t149 + t19
     t152 = xp.where(xp.greater_equal(t19, -2.2689280275926285) & xp.less_equal(t19, 2.2689280275926285), t19, xp.where(xp.greater_equal(t150, -2.2689280275926285) & xp.less_equal(t150, 2.2689280275926285), t150, xp.where(xp.greater_equal(t151, -2.2689280275926285) & xp.less_equal(t151, 2.2689280275926285), t151, qb2_4)))
     t153 = xp.where(xp.less(t20, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t154 = t20 + t153
-    t155 = t20 - t153
+    t155 = -t153 + t20
     t156 = xp.where(xp.greater_equal(t20, -6.1086523819801535) & xp.less_equal(t20, 6.1086523819801535), t20, xp.where(xp.greater_equal(t154, -6.1086523819801535) & xp.less_equal(t154, 6.1086523819801535), t154, xp.where(xp.greater_equal(t155, -6.1086523819801535) & xp.less_equal(t155, 6.1086523819801535), t155, qb2_5)))
-    t157 = qw1*(t136 + t82)**2 + qw2*(t140 + t83)**2 + qw3*(t144 + t84)**2 + qw4*(t148 + t85)**2 + qw5*(t152 + t86)**2 + qw6*(t156 + t87)**2
+    t157 = qw1*(t82 + t136)**2 + qw2*(t83 + t140)**2 + qw3*(t84 + t144)**2 + qw4*(t85 + t148)**2 + qw5*(t86 + t152)**2 + qw6*(t87 + t156)**2
     t158 = xp.greater(t21, 0)
     t159 = xp.where(t158 & (xp.less(t124, 1) | xp.less(t157, t132)), xp.asarray(1, dtype=dtype), 0)
     t160 = xp.where(t158, 1, t124)
@@ -3263,29 +3263,29 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     t168 = xp.where(t161, t157, t132)
     t169 = xp.where(xp.less(t22, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t170 = t22 + t169
-    t171 = t22 - t169
+    t171 = -t169 + t22
     t172 = xp.where(xp.greater_equal(t22, -2.705260340591211) & xp.less_equal(t22, 2.705260340591211), t22, xp.where(xp.greater_equal(t170, -2.705260340591211) & xp.less_equal(t170, 2.705260340591211), t170, xp.where(xp.greater_equal(t171, -2.705260340591211) & xp.less_equal(t171, 2.705260340591211), t171, qb3_0)))
     t173 = xp.where(xp.less(t23, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t174 = t23 + t173
-    t175 = t23 - t173
+    t175 = -t173 + t23
     t176 = xp.where(xp.greater_equal(t23, -3.141592653589793) & xp.less_equal(t23, 1.1344640137963142), t23, xp.where(xp.greater_equal(t174, -3.141592653589793) & xp.less_equal(t174, 1.1344640137963142), t174, xp.where(xp.greater_equal(t175, -3.141592653589793) & xp.less_equal(t175, 1.1344640137963142), t175, qb3_1)))
     t177 = xp.where(xp.less(t24, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t178 = t24 + t177
-    t179 = t24 - t177
+    t179 = -t177 + t24
     t180 = xp.where(xp.greater_equal(t24, -0.2617993877991494) & xp.less_equal(t24, 2.7576202181510405), t24, xp.where(xp.greater_equal(t178, -0.2617993877991494) & xp.less_equal(t178, 2.7576202181510405), t178, xp.where(xp.greater_equal(t179, -0.2617993877991494) & xp.less_equal(t179, 2.7576202181510405), t179, qb3_2)))
     t181 = xp.where(xp.less(t25, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t182 = t25 + t181
-    t183 = t25 - t181
+    t183 = -t181 + t25
     t184 = xp.where(xp.greater_equal(t25, -6.1086523819801535) & xp.less_equal(t25, 6.1086523819801535), t25, xp.where(xp.greater_equal(t182, -6.1086523819801535) & xp.less_equal(t182, 6.1086523819801535), t182, xp.where(xp.greater_equal(t183, -6.1086523819801535) & xp.less_equal(t183, 6.1086523819801535), t183, qb3_3)))
     t185 = xp.where(xp.less(t26, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t186 = t26 + t185
-    t187 = t26 - t185
+    t187 = -t185 + t26
     t188 = xp.where(xp.greater_equal(t26, -2.2689280275926285) & xp.less_equal(t26, 2.2689280275926285), t26, xp.where(xp.greater_equal(t186, -2.2689280275926285) & xp.less_equal(t186, 2.2689280275926285), t186, xp.where(xp.greater_equal(t187, -2.2689280275926285) & xp.less_equal(t187, 2.2689280275926285), t187, qb3_4)))
     t189 = xp.where(xp.less(t27, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t190 = t27 + t189
-    t191 = t27 - t189
+    t191 = -t189 + t27
     t192 = xp.where(xp.greater_equal(t27, -6.1086523819801535) & xp.less_equal(t27, 6.1086523819801535), t27, xp.where(xp.greater_equal(t190, -6.1086523819801535) & xp.less_equal(t190, 6.1086523819801535), t190, xp.where(xp.greater_equal(t191, -6.1086523819801535) & xp.less_equal(t191, 6.1086523819801535), t191, qb3_5)))
-    t193 = qw1*(t172 + t82)**2 + qw2*(t176 + t83)**2 + qw3*(t180 + t84)**2 + qw4*(t184 + t85)**2 + qw5*(t188 + t86)**2 + qw6*(t192 + t87)**2
+    t193 = qw1*(t82 + t172)**2 + qw2*(t83 + t176)**2 + qw3*(t84 + t180)**2 + qw4*(t85 + t184)**2 + qw5*(t86 + t188)**2 + qw6*(t87 + t192)**2
     t194 = xp.greater(t28, 0)
     t195 = xp.where(t194 & (xp.less(t160, 1) | xp.less(t193, t168)), xp.asarray(1, dtype=dtype), 0)
     t196 = xp.where(t194, 1, t160)
@@ -3299,29 +3299,29 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     t204 = xp.where(t197, t193, t168)
     t205 = xp.where(xp.less(t29, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t206 = t29 + t205
-    t207 = t29 - t205
+    t207 = -t205 + t29
     t208 = xp.where(xp.greater_equal(t29, -2.705260340591211) & xp.less_equal(t29, 2.705260340591211), t29, xp.where(xp.greater_equal(t206, -2.705260340591211) & xp.less_equal(t206, 2.705260340591211), t206, xp.where(xp.greater_equal(t207, -2.705260340591211) & xp.less_equal(t207, 2.705260340591211), t207, qb4_0)))
     t209 = xp.where(xp.less(t30, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t210 = t30 + t209
-    t211 = t30 - t209
+    t211 = -t209 + t30
     t212 = xp.where(xp.greater_equal(t30, -3.141592653589793) & xp.less_equal(t30, 1.1344640137963142), t30, xp.where(xp.greater_equal(t210, -3.141592653589793) & xp.less_equal(t210, 1.1344640137963142), t210, xp.where(xp.greater_equal(t211, -3.141592653589793) & xp.less_equal(t211, 1.1344640137963142), t211, qb4_1)))
     t213 = xp.where(xp.less(t31, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t214 = t31 + t213
-    t215 = t31 - t213
+    t215 = -t213 + t31
     t216 = xp.where(xp.greater_equal(t31, -0.2617993877991494) & xp.less_equal(t31, 2.7576202181510405), t31, xp.where(xp.greater_equal(t214, -0.2617993877991494) & xp.less_equal(t214, 2.7576202181510405), t214, xp.where(xp.greater_equal(t215, -0.2617993877991494) & xp.less_equal(t215, 2.7576202181510405), t215, qb4_2)))
     t217 = xp.where(xp.less(t32, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t218 = t32 + t217
-    t219 = t32 - t217
+    t219 = -t217 + t32
     t220 = xp.where(xp.greater_equal(t32, -6.1086523819801535) & xp.less_equal(t32, 6.1086523819801535), t32, xp.where(xp.greater_equal(t218, -6.1086523819801535) & xp.less_equal(t218, 6.1086523819801535), t218, xp.where(xp.greater_equal(t219, -6.1086523819801535) & xp.less_equal(t219, 6.1086523819801535), t219, qb4_3)))
     t221 = xp.where(xp.less(t33, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t222 = t33 + t221
-    t223 = t33 - t221
+    t223 = -t221 + t33
     t224 = xp.where(xp.greater_equal(t33, -2.2689280275926285) & xp.less_equal(t33, 2.2689280275926285), t33, xp.where(xp.greater_equal(t222, -2.2689280275926285) & xp.less_equal(t222, 2.2689280275926285), t222, xp.where(xp.greater_equal(t223, -2.2689280275926285) & xp.less_equal(t223, 2.2689280275926285), t223, qb4_4)))
     t225 = xp.where(xp.less(t34, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t226 = t34 + t225
-    t227 = t34 - t225
+    t227 = -t225 + t34
     t228 = xp.where(xp.greater_equal(t34, -6.1086523819801535) & xp.less_equal(t34, 6.1086523819801535), t34, xp.where(xp.greater_equal(t226, -6.1086523819801535) & xp.less_equal(t226, 6.1086523819801535), t226, xp.where(xp.greater_equal(t227, -6.1086523819801535) & xp.less_equal(t227, 6.1086523819801535), t227, qb4_5)))
-    t229 = qw1*(t208 + t82)**2 + qw2*(t212 + t83)**2 + qw3*(t216 + t84)**2 + qw4*(t220 + t85)**2 + qw5*(t224 + t86)**2 + qw6*(t228 + t87)**2
+    t229 = qw1*(t82 + t208)**2 + qw2*(t83 + t212)**2 + qw3*(t84 + t216)**2 + qw4*(t85 + t220)**2 + qw5*(t86 + t224)**2 + qw6*(t87 + t228)**2
     t230 = xp.greater(t35, 0)
     t231 = xp.where(t230 & (xp.less(t196, 1) | xp.less(t229, t204)), xp.asarray(1, dtype=dtype), 0)
     t232 = xp.where(t230, 1, t196)
@@ -3335,29 +3335,29 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     t240 = xp.where(t233, t229, t204)
     t241 = xp.where(xp.less(t36, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t242 = t36 + t241
-    t243 = t36 - t241
+    t243 = -t241 + t36
     t244 = xp.where(xp.greater_equal(t36, -2.705260340591211) & xp.less_equal(t36, 2.705260340591211), t36, xp.where(xp.greater_equal(t242, -2.705260340591211) & xp.less_equal(t242, 2.705260340591211), t242, xp.where(xp.greater_equal(t243, -2.705260340591211) & xp.less_equal(t243, 2.705260340591211), t243, qb5_0)))
     t245 = xp.where(xp.less(t37, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t246 = t37 + t245
-    t247 = t37 - t245
+    t247 = -t245 + t37
     t248 = xp.where(xp.greater_equal(t37, -3.141592653589793) & xp.less_equal(t37, 1.1344640137963142), t37, xp.where(xp.greater_equal(t246, -3.141592653589793) & xp.less_equal(t246, 1.1344640137963142), t246, xp.where(xp.greater_equal(t247, -3.141592653589793) & xp.less_equal(t247, 1.1344640137963142), t247, qb5_1)))
     t249 = xp.where(xp.less(t38, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t250 = t38 + t249
-    t251 = t38 - t249
+    t251 = -t249 + t38
     t252 = xp.where(xp.greater_equal(t38, -0.2617993877991494) & xp.less_equal(t38, 2.7576202181510405), t38, xp.where(xp.greater_equal(t250, -0.2617993877991494) & xp.less_equal(t250, 2.7576202181510405), t250, xp.where(xp.greater_equal(t251, -0.2617993877991494) & xp.less_equal(t251, 2.7576202181510405), t251, qb5_2)))
     t253 = xp.where(xp.less(t39, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t254 = t39 + t253
-    t255 = t39 - t253
+    t255 = -t253 + t39
     t256 = xp.where(xp.greater_equal(t39, -6.1086523819801535) & xp.less_equal(t39, 6.1086523819801535), t39, xp.where(xp.greater_equal(t254, -6.1086523819801535) & xp.less_equal(t254, 6.1086523819801535), t254, xp.where(xp.greater_equal(t255, -6.1086523819801535) & xp.less_equal(t255, 6.1086523819801535), t255, qb5_3)))
     t257 = xp.where(xp.less(t40, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t258 = t40 + t257
-    t259 = t40 - t257
+    t259 = -t257 + t40
     t260 = xp.where(xp.greater_equal(t40, -2.2689280275926285) & xp.less_equal(t40, 2.2689280275926285), t40, xp.where(xp.greater_equal(t258, -2.2689280275926285) & xp.less_equal(t258, 2.2689280275926285), t258, xp.where(xp.greater_equal(t259, -2.2689280275926285) & xp.less_equal(t259, 2.2689280275926285), t259, qb5_4)))
     t261 = xp.where(xp.less(t41, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t262 = t41 + t261
-    t263 = t41 - t261
+    t263 = -t261 + t41
     t264 = xp.where(xp.greater_equal(t41, -6.1086523819801535) & xp.less_equal(t41, 6.1086523819801535), t41, xp.where(xp.greater_equal(t262, -6.1086523819801535) & xp.less_equal(t262, 6.1086523819801535), t262, xp.where(xp.greater_equal(t263, -6.1086523819801535) & xp.less_equal(t263, 6.1086523819801535), t263, qb5_5)))
-    t265 = qw1*(t244 + t82)**2 + qw2*(t248 + t83)**2 + qw3*(t252 + t84)**2 + qw4*(t256 + t85)**2 + qw5*(t260 + t86)**2 + qw6*(t264 + t87)**2
+    t265 = qw1*(t82 + t244)**2 + qw2*(t83 + t248)**2 + qw3*(t84 + t252)**2 + qw4*(t85 + t256)**2 + qw5*(t86 + t260)**2 + qw6*(t87 + t264)**2
     t266 = xp.greater(t42, 0)
     t267 = xp.where(t266 & (xp.less(t232, 1) | xp.less(t265, t240)), xp.asarray(1, dtype=dtype), 0)
     t268 = xp.where(t266, 1, t232)
@@ -3371,29 +3371,29 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     t276 = xp.where(t269, t265, t240)
     t277 = xp.where(xp.less(t43, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t278 = t43 + t277
-    t279 = t43 - t277
+    t279 = -t277 + t43
     t280 = xp.where(xp.greater_equal(t43, -2.705260340591211) & xp.less_equal(t43, 2.705260340591211), t43, xp.where(xp.greater_equal(t278, -2.705260340591211) & xp.less_equal(t278, 2.705260340591211), t278, xp.where(xp.greater_equal(t279, -2.705260340591211) & xp.less_equal(t279, 2.705260340591211), t279, qb6_0)))
     t281 = xp.where(xp.less(t44, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t282 = t44 + t281
-    t283 = t44 - t281
+    t283 = -t281 + t44
     t284 = xp.where(xp.greater_equal(t44, -3.141592653589793) & xp.less_equal(t44, 1.1344640137963142), t44, xp.where(xp.greater_equal(t282, -3.141592653589793) & xp.less_equal(t282, 1.1344640137963142), t282, xp.where(xp.greater_equal(t283, -3.141592653589793) & xp.less_equal(t283, 1.1344640137963142), t283, qb6_1)))
     t285 = xp.where(xp.less(t45, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t286 = t45 + t285
-    t287 = t45 - t285
+    t287 = -t285 + t45
     t288 = xp.where(xp.greater_equal(t45, -0.2617993877991494) & xp.less_equal(t45, 2.7576202181510405), t45, xp.where(xp.greater_equal(t286, -0.2617993877991494) & xp.less_equal(t286, 2.7576202181510405), t286, xp.where(xp.greater_equal(t287, -0.2617993877991494) & xp.less_equal(t287, 2.7576202181510405), t287, qb6_2)))
     t289 = xp.where(xp.less(t46, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t290 = t46 + t289
-    t291 = t46 - t289
+    t291 = -t289 + t46
     t292 = xp.where(xp.greater_equal(t46, -6.1086523819801535) & xp.less_equal(t46, 6.1086523819801535), t46, xp.where(xp.greater_equal(t290, -6.1086523819801535) & xp.less_equal(t290, 6.1086523819801535), t290, xp.where(xp.greater_equal(t291, -6.1086523819801535) & xp.less_equal(t291, 6.1086523819801535), t291, qb6_3)))
     t293 = xp.where(xp.less(t47, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t294 = t47 + t293
-    t295 = t47 - t293
+    t295 = -t293 + t47
     t296 = xp.where(xp.greater_equal(t47, -2.2689280275926285) & xp.less_equal(t47, 2.2689280275926285), t47, xp.where(xp.greater_equal(t294, -2.2689280275926285) & xp.less_equal(t294, 2.2689280275926285), t294, xp.where(xp.greater_equal(t295, -2.2689280275926285) & xp.less_equal(t295, 2.2689280275926285), t295, qb6_4)))
     t297 = xp.where(xp.less(t48, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t298 = t48 + t297
-    t299 = t48 - t297
+    t299 = -t297 + t48
     t300 = xp.where(xp.greater_equal(t48, -6.1086523819801535) & xp.less_equal(t48, 6.1086523819801535), t48, xp.where(xp.greater_equal(t298, -6.1086523819801535) & xp.less_equal(t298, 6.1086523819801535), t298, xp.where(xp.greater_equal(t299, -6.1086523819801535) & xp.less_equal(t299, 6.1086523819801535), t299, qb6_5)))
-    t301 = qw1*(t280 + t82)**2 + qw2*(t284 + t83)**2 + qw3*(t288 + t84)**2 + qw4*(t292 + t85)**2 + qw5*(t296 + t86)**2 + qw6*(t300 + t87)**2
+    t301 = qw1*(t82 + t280)**2 + qw2*(t83 + t284)**2 + qw3*(t84 + t288)**2 + qw4*(t85 + t292)**2 + qw5*(t86 + t296)**2 + qw6*(t87 + t300)**2
     t302 = xp.greater(t49, 0)
     t303 = xp.where(t302 & (xp.less(t268, 1) | xp.less(t301, t276)), xp.asarray(1, dtype=dtype), 0)
     t304 = xp.where(t302, 1, t268)
@@ -3407,29 +3407,29 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     t312 = xp.where(t305, t301, t276)
     t313 = xp.where(xp.less(t50, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t314 = t50 + t313
-    t315 = t50 - t313
+    t315 = -t313 + t50
     t316 = xp.where(xp.greater_equal(t50, -2.705260340591211) & xp.less_equal(t50, 2.705260340591211), t50, xp.where(xp.greater_equal(t314, -2.705260340591211) & xp.less_equal(t314, 2.705260340591211), t314, xp.where(xp.greater_equal(t315, -2.705260340591211) & xp.less_equal(t315, 2.705260340591211), t315, qb7_0)))
     t317 = xp.where(xp.less(t51, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t318 = t51 + t317
-    t319 = t51 - t317
+    t319 = -t317 + t51
     t320 = xp.where(xp.greater_equal(t51, -3.141592653589793) & xp.less_equal(t51, 1.1344640137963142), t51, xp.where(xp.greater_equal(t318, -3.141592653589793) & xp.less_equal(t318, 1.1344640137963142), t318, xp.where(xp.greater_equal(t319, -3.141592653589793) & xp.less_equal(t319, 1.1344640137963142), t319, qb7_1)))
     t321 = xp.where(xp.less(t52, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t322 = t52 + t321
-    t323 = t52 - t321
+    t323 = -t321 + t52
     t324 = xp.where(xp.greater_equal(t52, -0.2617993877991494) & xp.less_equal(t52, 2.7576202181510405), t52, xp.where(xp.greater_equal(t322, -0.2617993877991494) & xp.less_equal(t322, 2.7576202181510405), t322, xp.where(xp.greater_equal(t323, -0.2617993877991494) & xp.less_equal(t323, 2.7576202181510405), t323, qb7_2)))
     t325 = xp.where(xp.less(t53, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t326 = t53 + t325
-    t327 = t53 - t325
+    t327 = -t325 + t53
     t328 = xp.where(xp.greater_equal(t53, -6.1086523819801535) & xp.less_equal(t53, 6.1086523819801535), t53, xp.where(xp.greater_equal(t326, -6.1086523819801535) & xp.less_equal(t326, 6.1086523819801535), t326, xp.where(xp.greater_equal(t327, -6.1086523819801535) & xp.less_equal(t327, 6.1086523819801535), t327, qb7_3)))
     t329 = xp.where(xp.less(t54, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t330 = t54 + t329
-    t331 = t54 - t329
+    t331 = -t329 + t54
     t332 = xp.where(xp.greater_equal(t54, -2.2689280275926285) & xp.less_equal(t54, 2.2689280275926285), t54, xp.where(xp.greater_equal(t330, -2.2689280275926285) & xp.less_equal(t330, 2.2689280275926285), t330, xp.where(xp.greater_equal(t331, -2.2689280275926285) & xp.less_equal(t331, 2.2689280275926285), t331, qb7_4)))
     t333 = xp.where(xp.less(t55, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t334 = t55 + t333
-    t335 = t55 - t333
+    t335 = -t333 + t55
     t336 = xp.where(xp.greater_equal(t55, -6.1086523819801535) & xp.less_equal(t55, 6.1086523819801535), t55, xp.where(xp.greater_equal(t334, -6.1086523819801535) & xp.less_equal(t334, 6.1086523819801535), t334, xp.where(xp.greater_equal(t335, -6.1086523819801535) & xp.less_equal(t335, 6.1086523819801535), t335, qb7_5)))
-    t337 = qw1*(t316 + t82)**2 + qw2*(t320 + t83)**2 + qw3*(t324 + t84)**2 + qw4*(t328 + t85)**2 + qw5*(t332 + t86)**2 + qw6*(t336 + t87)**2
+    t337 = qw1*(t82 + t316)**2 + qw2*(t83 + t320)**2 + qw3*(t84 + t324)**2 + qw4*(t85 + t328)**2 + qw5*(t86 + t332)**2 + qw6*(t87 + t336)**2
     t338 = xp.greater(t56, 0)
     t339 = xp.where(t338 & (xp.less(t304, 1) | xp.less(t337, t312)), xp.asarray(1, dtype=dtype), 0)
     t340 = xp.where(t338, 1, t304)

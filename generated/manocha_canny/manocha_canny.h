@@ -79,19 +79,19 @@ void manocha_canny_task_jacobian_dot(const manocha_canny_real q[MANOCHA_CANNY_DO
 void manocha_canny_hessian(const manocha_canny_real q[MANOCHA_CANNY_DOF], manocha_canny_real H[MANOCHA_CANNY_DOF * 6 * MANOCHA_CANNY_DOF]);
 
 /* Factors of det(Js): the robot is singular where one is 0.
- * Result: f[i], i < 1. 96 operations. */
+ * Result: f[i], i < 1. 97 operations. */
 void manocha_canny_singularity_factors(const manocha_canny_real q[MANOCHA_CANNY_DOF], manocha_canny_real f[MANOCHA_CANNY_NUM_SINGULARITY_FACTORS]);
 
 /* Manipulability |det(Js)|.
- * Result: returned as a scalar. 96 operations. */
+ * Result: returned as a scalar. 94 operations. */
 manocha_canny_real manocha_canny_manipulability(const manocha_canny_real q[MANOCHA_CANNY_DOF]);
 
 /* Det(Js).
- * Result: returned as a scalar. 96 operations. */
+ * Result: returned as a scalar. 97 operations. */
 manocha_canny_real manocha_canny_jacobian_det(const manocha_canny_real q[MANOCHA_CANNY_DOF]);
 
 /* Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status.
- * Result: q_dot[i], i < 6; returned as a scalar. 1373 operations. */
+ * Result: q_dot[i], i < 6; returned as a scalar. 1375 operations. */
 int manocha_canny_velocity_ik(const manocha_canny_real q[MANOCHA_CANNY_DOF], const manocha_canny_real mu_dot[MANOCHA_CANNY_TASK_DIM], manocha_canny_real damping, manocha_canny_real q_dot[MANOCHA_CANNY_DOF]);
 
 /* One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite).

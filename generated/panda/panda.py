@@ -95,8 +95,8 @@ def fk(q):
     t1 = c1*c3
     t2 = -t0 + c2*t1
     t3 = t1 - c2*t0
-    t4 = c3*s1
-    t5 = c1*s3
+    t4 = s1*c3
+    t5 = s3*c1
     t6 = t4 + c2*t5
     t7 = t5 + c2*t4
     t8 = 0.316*s2
@@ -110,38 +110,38 @@ def fk(q):
     t16 = t2*c4 + s4*t15
     t17 = -t2*s4 + c4*t15
     t18 = t16*c5 - t6*s5
-    t19 = t16*s5 + t6*c5
+    t19 = t16*s5 + c5*t6
     t20 = t17*s6 + t18*c6
-    t21 = t17*c6 - t18*s6
+    t21 = t17*c6 - s6*t18
     t22 = t19*s7 + t20*c7
     t23 = t19*c7 - t20*s7
-    t24 = -0.21*t21 + 0.088*t20
-    t25 = t24 + 0.384*t17
-    t26 = t25 - 0.0825*t16
+    t24 = 0.088*t20 - 0.21*t21
+    t25 = 0.384*t17 + t24
+    t26 = -0.0825*t16 + t25
     t27 = t9 + t26
     t28 = s1*s2
     t29 = t7*c4 + s4*t28
     t30 = -t7*s4 + c4*t28
-    t31 = t29*c5 + t3*s5
-    t32 = t3*c5 - t29*s5
-    t33 = t30*s6 + t31*c6
-    t34 = t30*c6 - t31*s6
-    t35 = t33*c7 - t32*s7
-    t36 = t32*c7 + t33*s7
-    t37 = -0.21*t34 + 0.088*t33
-    t38 = t37 + 0.384*t30
-    t39 = t38 - 0.0825*t29
+    t31 = t29*c5 + s5*t3
+    t32 = c5*t3 - t29*s5
+    t33 = t30*s6 + c6*t31
+    t34 = t30*c6 - s6*t31
+    t35 = t33*c7 - s7*t32
+    t36 = c7*t32 + t33*s7
+    t37 = 0.088*t33 - 0.21*t34
+    t38 = 0.384*t30 + t37
+    t39 = -0.0825*t29 + t38
     t40 = t10 + t39
     t41 = s3*s2
     t42 = t13*c5 + s5*t41
     t43 = -t13*s5 + c5*t41
-    t44 = t14*s6 + t42*c6
-    t45 = t14*c6 - t42*s6
-    t46 = t44*c7 - t43*s7
-    t47 = t43*c7 + t44*s7
-    t48 = -0.21*t45 + 0.088*t44
-    t49 = t48 + 0.384*t14
-    t50 = t49 - 0.0825*t13
+    t44 = t14*s6 + c6*t42
+    t45 = t14*c6 - s6*t42
+    t46 = t44*c7 - s7*t43
+    t47 = c7*t43 + t44*s7
+    t48 = 0.088*t44 - 0.21*t45
+    t49 = 0.384*t14 + t48
+    t50 = -0.0825*t13 + t49
     t51 = t12 + t50
     t52 = 0.333 + t51
     t53 = 0.7071067811865476*t22
@@ -197,8 +197,8 @@ def jacobian(q):
     t1 = c1*c3
     t2 = -t0 + c2*t1
     t3 = t1 - c2*t0
-    t4 = c3*s1
-    t5 = c1*s3
+    t4 = s1*c3
+    t5 = s3*c1
     t6 = t4 + c2*t5
     t7 = t5 + c2*t4
     t8 = c1*s2
@@ -206,59 +206,59 @@ def jacobian(q):
     t10 = t2*c4 + s4*t8
     t11 = -t2*s4 + c4*t8
     t12 = t10*c5 - t6*s5
-    t13 = t10*s5 + t6*c5
+    t13 = t10*s5 + c5*t6
     t14 = t11*s6 + t12*c6
-    t15 = t11*c6 - t12*s6
-    t16 = -0.21*t15 + 0.088*t14
-    t17 = t16 + 0.384*t11
-    t18 = t17 - 0.0825*t10
+    t15 = t11*c6 - s6*t12
+    t16 = 0.088*t14 - 0.21*t15
+    t17 = 0.384*t11 + t16
+    t18 = -0.0825*t10 + t17
     t19 = t9 + t18
     t20 = s1*s2
     t21 = 0.0825*t7 + 0.316*t20
     t22 = t7*c4 + s4*t20
     t23 = -t7*s4 + c4*t20
-    t24 = t22*c5 + t3*s5
-    t25 = t3*c5 - t22*s5
-    t26 = t23*s6 + t24*c6
-    t27 = t23*c6 - t24*s6
-    t28 = -0.21*t27 + 0.088*t26
-    t29 = t28 + 0.384*t23
-    t30 = t29 - 0.0825*t22
+    t24 = t22*c5 + s5*t3
+    t25 = c5*t3 - t22*s5
+    t26 = t23*s6 + c6*t24
+    t27 = t23*c6 - s6*t24
+    t28 = 0.088*t26 - 0.21*t27
+    t29 = 0.384*t23 + t28
+    t30 = -0.0825*t22 + t29
     t31 = t21 + t30
     t32 = c3*s2
     t33 = 0.316*c2 - 0.0825*t32
     t34 = c2*s4 - c4*t32
     t35 = c2*c4 + s4*t32
-    t36 = s2*s3
+    t36 = s3*s2
     t37 = t34*c5 + s5*t36
     t38 = -t34*s5 + c5*t36
-    t39 = t35*s6 + t37*c6
-    t40 = t35*c6 - t37*s6
-    t41 = -0.21*t40 + 0.088*t39
-    t42 = t41 + 0.384*t35
-    t43 = t42 - 0.0825*t34
+    t39 = t35*s6 + c6*t37
+    t40 = t35*c6 - s6*t37
+    t41 = 0.088*t39 - 0.21*t40
+    t42 = 0.384*t35 + t41
+    t43 = -0.0825*t34 + t42
     t44 = t33 + t43
-    t45 = t44*c1
-    t46 = t44*s1
+    t45 = c1*t44
+    t46 = s1*t44
     J = _stack(xp, [
         -t31,  # 0, 0
         t45,  # 0, 1
-        -t31*c2 + s2*t46,  # 0, 2
-        -t43*t3 + t30*t36,  # 0, 3
+        -c2*t31 + s2*t46,  # 0, 2
+        -t3*t43 + t30*t36,  # 0, 3
         t23*t42 - t35*t29,  # 0, 4
         t38*t28 - t25*t41,  # 0, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 6
         t19,  # 1, 0
         t46,  # 1, 1
-        t19*c2 - s2*t45,  # 1, 2
-        -(t43*t6 + t18*t36),  # 1, 3
+        c2*t19 - s2*t45,  # 1, 2
+        -(t6*t43 + t18*t36),  # 1, 3
         t35*t17 - t11*t42,  # 1, 4
         -(t13*t41 + t38*t16),  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
-        -(t19*c1 + t31*s1),  # 2, 1
+        -(c1*t19 + s1*t31),  # 2, 1
         t31*t8 - t19*t20,  # 2, 2
-        t18*t3 + t30*t6,  # 2, 3
+        t3*t18 + t6*t30,  # 2, 3
         t11*t29 - t23*t17,  # 2, 4
         t13*t28 + t25*t16,  # 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 6
@@ -309,8 +309,8 @@ def fk_jacobian(q):
     t1 = c1*c3
     t2 = -t0 + c2*t1
     t3 = t1 - c2*t0
-    t4 = c3*s1
-    t5 = c1*s3
+    t4 = s1*c3
+    t5 = s3*c1
     t6 = t4 + c2*t5
     t7 = t5 + c2*t4
     t8 = c1*s2
@@ -318,43 +318,43 @@ def fk_jacobian(q):
     t10 = t2*c4 + s4*t8
     t11 = -t2*s4 + c4*t8
     t12 = t10*c5 - t6*s5
-    t13 = t10*s5 + t6*c5
+    t13 = t10*s5 + c5*t6
     t14 = t11*s6 + t12*c6
-    t15 = t11*c6 - t12*s6
+    t15 = t11*c6 - s6*t12
     t16 = t13*s7 + t14*c7
     t17 = t13*c7 - t14*s7
-    t18 = -0.21*t15 + 0.088*t14
-    t19 = t18 + 0.384*t11
-    t20 = t19 - 0.0825*t10
+    t18 = 0.088*t14 - 0.21*t15
+    t19 = 0.384*t11 + t18
+    t20 = -0.0825*t10 + t19
     t21 = t9 + t20
     t22 = s1*s2
     t23 = 0.0825*t7 + 0.316*t22
     t24 = t7*c4 + s4*t22
     t25 = -t7*s4 + c4*t22
-    t26 = t24*c5 + t3*s5
-    t27 = t3*c5 - t24*s5
-    t28 = t25*s6 + t26*c6
-    t29 = t25*c6 - t26*s6
-    t30 = t28*c7 - t27*s7
-    t31 = t27*c7 + t28*s7
-    t32 = -0.21*t29 + 0.088*t28
-    t33 = t32 + 0.384*t25
-    t34 = t33 - 0.0825*t24
+    t26 = t24*c5 + s5*t3
+    t27 = c5*t3 - t24*s5
+    t28 = t25*s6 + c6*t26
+    t29 = t25*c6 - s6*t26
+    t30 = t28*c7 - s7*t27
+    t31 = c7*t27 + t28*s7
+    t32 = 0.088*t28 - 0.21*t29
+    t33 = 0.384*t25 + t32
+    t34 = -0.0825*t24 + t33
     t35 = t23 + t34
     t36 = c3*s2
     t37 = 0.316*c2 - 0.0825*t36
     t38 = c2*s4 - c4*t36
     t39 = c2*c4 + s4*t36
-    t40 = s2*s3
+    t40 = s3*s2
     t41 = t38*c5 + s5*t40
     t42 = -t38*s5 + c5*t40
-    t43 = t39*s6 + t41*c6
-    t44 = t39*c6 - t41*s6
-    t45 = t43*c7 - t42*s7
-    t46 = t42*c7 + t43*s7
-    t47 = -0.21*t44 + 0.088*t43
-    t48 = t47 + 0.384*t39
-    t49 = t48 - 0.0825*t38
+    t43 = t39*s6 + c6*t41
+    t44 = t39*c6 - s6*t41
+    t45 = t43*c7 - s7*t42
+    t46 = c7*t42 + t43*s7
+    t47 = 0.088*t43 - 0.21*t44
+    t48 = 0.384*t39 + t47
+    t49 = -0.0825*t38 + t48
     t50 = t37 + t49
     t51 = 0.333 + t50
     t52 = 0.7071067811865476*t16
@@ -372,8 +372,8 @@ def fk_jacobian(q):
     t64 = -t15
     t65 = -t29
     t66 = -t44
-    t67 = t50*c1
-    t68 = t50*s1
+    t67 = c1*t50
+    t68 = s1*t50
     T = _stack(xp, [
         t54,  # 0, 0
         t55,  # 0, 1
@@ -395,22 +395,22 @@ def fk_jacobian(q):
     J = _stack(xp, [
         -t35,  # 0, 0
         t67,  # 0, 1
-        -t35*c2 + s2*t68,  # 0, 2
-        -t49*t3 + t34*t40,  # 0, 3
+        -c2*t35 + s2*t68,  # 0, 2
+        -t3*t49 + t34*t40,  # 0, 3
         t25*t48 - t39*t33,  # 0, 4
         t42*t32 - t27*t47,  # 0, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 6
         t21,  # 1, 0
         t68,  # 1, 1
-        t21*c2 - s2*t67,  # 1, 2
-        -(t49*t6 + t20*t40),  # 1, 3
+        c2*t21 - s2*t67,  # 1, 2
+        -(t6*t49 + t20*t40),  # 1, 3
         t39*t19 - t11*t48,  # 1, 4
         -(t13*t47 + t42*t18),  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
-        -(t21*c1 + t35*s1),  # 2, 1
+        -(c1*t21 + s1*t35),  # 2, 1
         t35*t8 - t21*t22,  # 2, 2
-        t20*t3 + t34*t6,  # 2, 3
+        t3*t20 + t6*t34,  # 2, 3
         t11*t33 - t25*t19,  # 2, 4
         t13*t32 + t27*t18,  # 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 6
@@ -461,8 +461,8 @@ def jacobian_tool(q):
     t1 = c1*c3
     t2 = -t0 + c2*t1
     t3 = t1 - c2*t0
-    t4 = c3*s1
-    t5 = c1*s3
+    t4 = s1*c3
+    t5 = s3*c1
     t6 = t4 + c2*t5
     t7 = t5 + c2*t4
     t8 = 0.316*s2
@@ -476,38 +476,38 @@ def jacobian_tool(q):
     t16 = t2*c4 + s4*t15
     t17 = -t2*s4 + c4*t15
     t18 = t16*c5 - t6*s5
-    t19 = t16*s5 + t6*c5
+    t19 = t16*s5 + c5*t6
     t20 = t17*s6 + t18*c6
-    t21 = t17*c6 - t18*s6
+    t21 = t17*c6 - s6*t18
     t22 = t19*s7 + t20*c7
     t23 = t19*c7 - t20*s7
-    t24 = -0.21*t21 + 0.088*t20
-    t25 = t24 + 0.384*t17
-    t26 = t25 - 0.0825*t16
+    t24 = 0.088*t20 - 0.21*t21
+    t25 = 0.384*t17 + t24
+    t26 = -0.0825*t16 + t25
     t27 = t9 + t26
     t28 = s1*s2
     t29 = t7*c4 + s4*t28
     t30 = -t7*s4 + c4*t28
-    t31 = t29*c5 + t3*s5
-    t32 = t3*c5 - t29*s5
-    t33 = t30*s6 + t31*c6
-    t34 = t30*c6 - t31*s6
-    t35 = t33*c7 - t32*s7
-    t36 = t32*c7 + t33*s7
-    t37 = -0.21*t34 + 0.088*t33
-    t38 = t37 + 0.384*t30
-    t39 = t38 - 0.0825*t29
+    t31 = t29*c5 + s5*t3
+    t32 = c5*t3 - t29*s5
+    t33 = t30*s6 + c6*t31
+    t34 = t30*c6 - s6*t31
+    t35 = t33*c7 - s7*t32
+    t36 = c7*t32 + t33*s7
+    t37 = 0.088*t33 - 0.21*t34
+    t38 = 0.384*t30 + t37
+    t39 = -0.0825*t29 + t38
     t40 = t10 + t39
     t41 = s3*s2
     t42 = t13*c5 + s5*t41
     t43 = -t13*s5 + c5*t41
-    t44 = t14*s6 + t42*c6
-    t45 = t14*c6 - t42*s6
-    t46 = t44*c7 - t43*s7
-    t47 = t43*c7 + t44*s7
-    t48 = -0.21*t45 + 0.088*t44
-    t49 = t48 + 0.384*t14
-    t50 = t49 - 0.0825*t13
+    t44 = t14*s6 + c6*t42
+    t45 = t14*c6 - s6*t42
+    t46 = t44*c7 - s7*t43
+    t47 = c7*t43 + t44*s7
+    t48 = 0.088*t44 - 0.21*t45
+    t49 = 0.384*t14 + t48
+    t50 = -0.0825*t13 + t49
     t51 = t12 + t50
     t52 = 0.7071067811865476*t22
     t53 = 0.7071067811865476*t23
@@ -521,15 +521,15 @@ def jacobian_tool(q):
     t61 = 0.7071067811865476*t47
     t62 = t60 + t61
     t63 = t60 - t61
-    t64 = -(t27*c1 + t40*s1)
+    t64 = -(c1*t27 + s1*t40)
     t65 = c1*t51
     t66 = s1*t51
-    t67 = -t40*c2 + t51*t28
-    t68 = t27*c2 - t51*t15
+    t67 = -c2*t40 + t51*t28
+    t68 = c2*t27 - t51*t15
     t69 = t40*t15 - t27*t28
-    t70 = -t50*t3 + t39*t41
-    t71 = -(t50*t6 + t26*t41)
-    t72 = t26*t3 + t39*t6
+    t70 = -t3*t50 + t39*t41
+    t71 = -(t6*t50 + t26*t41)
+    t72 = t3*t26 + t6*t39
     t73 = t30*t49 - t14*t38
     t74 = t14*t25 - t17*t49
     t75 = t17*t38 - t30*t25
@@ -537,14 +537,14 @@ def jacobian_tool(q):
     t77 = -(t19*t48 + t43*t24)
     t78 = t19*t37 + t32*t24
     J = _stack(xp, [
-        t27*t58 - t40*t54,  # 0, 0
+        t27*t58 - t54*t40,  # 0, 0
         t62*t64 + t54*t65 + t58*t66,  # 0, 1
         t54*t67 + t58*t68 + t62*t69,  # 0, 2
         t54*t70 + t58*t71 + t62*t72,  # 0, 3
         t54*t73 + t58*t74 + t62*t75,  # 0, 4
         t54*t76 + t58*t77 + t62*t78,  # 0, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 6
-        t27*t59 - t40*t55,  # 1, 0
+        t27*t59 - t55*t40,  # 1, 0
         t63*t64 + t55*t65 + t59*t66,  # 1, 1
         t55*t67 + t59*t68 + t63*t69,  # 1, 2
         t55*t70 + t59*t71 + t63*t72,  # 1, 3
@@ -559,23 +559,23 @@ def jacobian_tool(q):
         -(t21*t76 + t34*t77 + t45*t78),  # 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 6
         t62,  # 3, 0
-        t58*c1 - t54*s1,  # 3, 1
-        t62*c2 + t54*t15 + t58*t28,  # 3, 2
-        -(-t6*t54 + t58*t3 + t62*t41),  # 3, 3
+        c1*t58 - s1*t54,  # 3, 1
+        c2*t62 + t54*t15 + t58*t28,  # 3, 2
+        -(-t6*t54 + t3*t58 + t62*t41),  # 3, 3
         t17*t54 + t30*t58 + t14*t62,  # 3, 4
         -(-t19*t54 + t32*t58 + t43*t62),  # 3, 5
         -(t21*t54 + t34*t58 + t45*t62),  # 3, 6
         t63,  # 4, 0
-        t59*c1 - t55*s1,  # 4, 1
-        t63*c2 + t55*t15 + t59*t28,  # 4, 2
-        -(-t6*t55 + t59*t3 + t63*t41),  # 4, 3
+        c1*t59 - s1*t55,  # 4, 1
+        c2*t63 + t55*t15 + t59*t28,  # 4, 2
+        -(-t6*t55 + t3*t59 + t63*t41),  # 4, 3
         t17*t55 + t30*t59 + t14*t63,  # 4, 4
         -(-t19*t55 + t32*t59 + t43*t63),  # 4, 5
         -(t21*t55 + t34*t59 + t45*t63),  # 4, 6
         -t45,  # 5, 0
-        t21*s1 - t34*c1,  # 5, 1
-        -(t45*c2 + t21*t15 + t34*t28),  # 5, 2
-        t34*t3 - t21*t6 + t45*t41,  # 5, 3
+        s1*t21 - c1*t34,  # 5, 1
+        -(c2*t45 + t21*t15 + t34*t28),  # 5, 2
+        t3*t34 - t6*t21 + t45*t41,  # 5, 3
         -(t17*t21 + t30*t34 + t14*t45),  # 5, 4
         t32*t34 + t43*t45 - t19*t21,  # 5, 5
         t21**2 + t34**2 + t45**2,  # 5, 6
@@ -605,8 +605,8 @@ def task(q):
     t1 = c1*c3
     t2 = -t0 + c2*t1
     t3 = t1 - c2*t0
-    t4 = c3*s1
-    t5 = c1*s3
+    t4 = s1*c3
+    t5 = s3*c1
     t6 = t4 + c2*t5
     t7 = t5 + c2*t4
     t8 = 0.316*s2
@@ -620,40 +620,40 @@ def task(q):
     t16 = t2*c4 + s4*t15
     t17 = -t2*s4 + c4*t15
     t18 = t16*c5 - t6*s5
-    t19 = t16*s5 + t6*c5
+    t19 = t16*s5 + c5*t6
     t20 = t17*s6 + t18*c6
-    t21 = t17*c6 - t18*s6
+    t21 = t17*c6 - s6*t18
     t22 = t19*s7 + t20*c7
     t23 = t19*c7 - t20*s7
-    t24 = -0.21*t21 + 0.088*t20
-    t25 = t24 + 0.384*t17
-    t26 = t25 - 0.0825*t16
+    t24 = 0.088*t20 - 0.21*t21
+    t25 = 0.384*t17 + t24
+    t26 = -0.0825*t16 + t25
     t27 = t9 + t26
     t28 = 0.7071067811865476*t22 - 0.7071067811865476*t23
     t29 = s1*s2
     t30 = t7*c4 + s4*t29
     t31 = -t7*s4 + c4*t29
-    t32 = t30*c5 + t3*s5
-    t33 = t3*c5 - t30*s5
-    t34 = t31*s6 + t32*c6
-    t35 = t31*c6 - t32*s6
-    t36 = t34*c7 - t33*s7
-    t37 = t33*c7 + t34*s7
-    t38 = -0.21*t35 + 0.088*t34
-    t39 = t38 + 0.384*t31
-    t40 = t39 - 0.0825*t30
+    t32 = t30*c5 + s5*t3
+    t33 = c5*t3 - t30*s5
+    t34 = t31*s6 + c6*t32
+    t35 = t31*c6 - s6*t32
+    t36 = t34*c7 - s7*t33
+    t37 = c7*t33 + t34*s7
+    t38 = 0.088*t34 - 0.21*t35
+    t39 = 0.384*t31 + t38
+    t40 = -0.0825*t30 + t39
     t41 = t10 + t40
     t42 = 0.7071067811865476*t36 + 0.7071067811865476*t37
     t43 = s3*s2
     t44 = t13*c5 + s5*t43
     t45 = -t13*s5 + c5*t43
-    t46 = t14*s6 + t44*c6
-    t47 = t14*c6 - t44*s6
-    t48 = t46*c7 - t45*s7
-    t49 = t45*c7 + t46*s7
-    t50 = -0.21*t47 + 0.088*t46
-    t51 = t50 + 0.384*t14
-    t52 = t51 - 0.0825*t13
+    t46 = t14*s6 + c6*t44
+    t47 = t14*c6 - s6*t44
+    t48 = t46*c7 - s7*t45
+    t49 = c7*t45 + t46*s7
+    t50 = 0.088*t46 - 0.21*t47
+    t51 = 0.384*t14 + t50
+    t52 = -0.0825*t13 + t51
     t53 = t12 + t52
     t54 = 0.333 + t53
     t55 = 0.7071067811865476*t48
@@ -693,8 +693,8 @@ def task_jacobian(q):
     t1 = c1*c3
     t2 = -t0 + c2*t1
     t3 = t1 - c2*t0
-    t4 = c3*s1
-    t5 = c1*s3
+    t4 = s1*c3
+    t5 = s3*c1
     t6 = t4 + c2*t5
     t7 = t5 + c2*t4
     t8 = 0.316*s2
@@ -708,76 +708,76 @@ def task_jacobian(q):
     t16 = t2*c4 + s4*t15
     t17 = -t2*s4 + c4*t15
     t18 = t16*c5 - t6*s5
-    t19 = t16*s5 + t6*c5
+    t19 = t16*s5 + c5*t6
     t20 = t17*s6 + t18*c6
-    t21 = t17*c6 - t18*s6
+    t21 = t17*c6 - s6*t18
     t22 = t19*s7 + t20*c7
     t23 = t19*c7 - t20*s7
-    t24 = -0.21*t21 + 0.088*t20
-    t25 = t24 + 0.384*t17
-    t26 = t25 - 0.0825*t16
+    t24 = 0.088*t20 - 0.21*t21
+    t25 = 0.384*t17 + t24
+    t26 = -0.0825*t16 + t25
     t27 = t9 + t26
     t28 = 0.7071067811865476*t22 - 0.7071067811865476*t23
     t29 = s1*s2
     t30 = t7*c4 + s4*t29
     t31 = -t7*s4 + c4*t29
-    t32 = t30*c5 + t3*s5
-    t33 = t3*c5 - t30*s5
-    t34 = t31*s6 + t32*c6
-    t35 = t31*c6 - t32*s6
-    t36 = t34*c7 - t33*s7
-    t37 = t33*c7 + t34*s7
-    t38 = -0.21*t35 + 0.088*t34
-    t39 = t38 + 0.384*t31
-    t40 = t39 - 0.0825*t30
+    t32 = t30*c5 + s5*t3
+    t33 = c5*t3 - t30*s5
+    t34 = t31*s6 + c6*t32
+    t35 = t31*c6 - s6*t32
+    t36 = t34*c7 - s7*t33
+    t37 = c7*t33 + t34*s7
+    t38 = 0.088*t34 - 0.21*t35
+    t39 = 0.384*t31 + t38
+    t40 = -0.0825*t30 + t39
     t41 = t10 + t40
     t42 = 0.7071067811865476*t36 + 0.7071067811865476*t37
-    t43 = s2*s3
+    t43 = s3*s2
     t44 = t13*c5 + s5*t43
     t45 = -t13*s5 + c5*t43
-    t46 = t14*s6 + t44*c6
-    t47 = t14*c6 - t44*s6
-    t48 = t46*c7 - t45*s7
-    t49 = t45*c7 + t46*s7
-    t50 = -0.21*t47 + 0.088*t46
-    t51 = t50 + 0.384*t14
-    t52 = t51 - 0.0825*t13
+    t46 = t14*s6 + c6*t44
+    t47 = t14*c6 - s6*t44
+    t48 = t46*c7 - s7*t45
+    t49 = c7*t45 + t46*s7
+    t50 = 0.088*t46 - 0.21*t47
+    t51 = 0.384*t14 + t50
+    t52 = -0.0825*t13 + t51
     t53 = t12 + t52
     t54 = 0.7071067811865476*t48 + 0.7071067811865476*t49
-    t55 = t53*c1
-    t56 = t53*s1
-    t57 = t28**2 + t42**2
-    t58 = 1/t57
-    t59 = t42*c1
-    t60 = t28*s1
-    t61 = t58*(t59 - t60)
-    t62 = t28*c1
-    t63 = t42*s1
-    t64 = t58*(s2*t62 + s2*t63)
-    t65 = t58*(t6*t28 - t42*t3)
-    t66 = t58*(t17*t28 + t31*t42)
-    t67 = t58*(t19*t28 - t33*t42)
-    t68 = -t58*(t21*t28 + t35*t42)
-    t69 = 1/xp.sqrt(t57)
+    t55 = c1*t53
+    t56 = s1*t53
+    t57 = c1*t42
+    t58 = s1*t28
+    t59 = t28**2 + t42**2
+    t60 = 1/t59
+    t61 = (t57 - t58)*t60
+    t62 = c1*t28
+    t63 = s1*t42
+    t64 = t60*(s2*t62 + s2*t63)
+    t65 = t60*(t6*t28 - t3*t42)
+    t66 = t60*(t17*t28 + t31*t42)
+    t67 = t60*(t19*t28 - t33*t42)
+    t68 = -t60*(t21*t28 + t35*t42)
+    t69 = 1/xp.sqrt(t59)
     J = _stack(xp, [
         -t41,  # 0, 0
         t55,  # 0, 1
-        -t41*c2 + s2*t56,  # 0, 2
-        -t52*t3 + t40*t43,  # 0, 3
+        -c2*t41 + s2*t56,  # 0, 2
+        -t3*t52 + t40*t43,  # 0, 3
         t31*t51 - t14*t39,  # 0, 4
         t45*t38 - t33*t50,  # 0, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 6
         t27,  # 1, 0
         t56,  # 1, 1
-        t27*c2 - s2*t55,  # 1, 2
-        -(t52*t6 + t26*t43),  # 1, 3
+        c2*t27 - s2*t55,  # 1, 2
+        -(t6*t52 + t26*t43),  # 1, 3
         t14*t25 - t17*t51,  # 1, 4
         -(t19*t50 + t45*t24),  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
-        -(t27*c1 + t41*s1),  # 2, 1
+        -(c1*t27 + s1*t41),  # 2, 1
         t41*t15 - t27*t29,  # 2, 2
-        t26*t3 + t40*t6,  # 2, 3
+        t3*t26 + t6*t40,  # 2, 3
         t17*t39 - t31*t25,  # 2, 4
         t19*t38 + t33*t24,  # 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 6
@@ -790,8 +790,8 @@ def task_jacobian(q):
         t68,  # 3, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
         t69*(t62 + t63),  # 4, 1
-        t69*(s2*t60 - s2*t59),  # 4, 2
-        -t69*(t6*t42 + t28*t3),  # 4, 3
+        t69*(s2*t58 - s2*t57),  # 4, 2
+        -t69*(t6*t42 + t3*t28),  # 4, 3
         t69*(t31*t28 - t17*t42),  # 4, 4
         -t69*(t19*t42 + t33*t28),  # 4, 5
         t69*(t21*t42 - t35*t28),  # 4, 6
@@ -836,8 +836,8 @@ def fk_jacobian_dot(q, q_dot):
     t2 = c1*c3
     t3 = -t1 + c2*t2
     t4 = t2 - c2*t1
-    t5 = c3*s1
-    t6 = c1*s3
+    t5 = s1*c3
+    t6 = s3*c1
     t7 = t5 + c2*t6
     t8 = t6 + c2*t5
     t9 = c1*s2
@@ -845,46 +845,46 @@ def fk_jacobian_dot(q, q_dot):
     t11 = t3*c4 + s4*t9
     t12 = -t3*s4 + c4*t9
     t13 = t11*c5 - t7*s5
-    t14 = t11*s5 + t7*c5
+    t14 = t11*s5 + c5*t7
     t15 = t12*s6 + t13*c6
-    t16 = t12*c6 - t13*s6
+    t16 = t12*c6 - s6*t13
     t17 = t14*s7 + t15*c7
     t18 = t14*c7 - t15*s7
-    t19 = -0.21*t16 + 0.088*t15
-    t20 = t19 + 0.384*t12
-    t21 = t20 - 0.0825*t11
+    t19 = 0.088*t15 - 0.21*t16
+    t20 = 0.384*t12 + t19
+    t21 = -0.0825*t11 + t20
     t22 = t10 + t21
     t23 = s1*s2
     t24 = 0.0825*t8 + 0.316*t23
     t25 = t8*c4 + s4*t23
     t26 = -t8*s4 + c4*t23
-    t27 = t25*c5 + t4*s5
-    t28 = t4*c5 - t25*s5
-    t29 = t26*s6 + t27*c6
-    t30 = t26*c6 - t27*s6
-    t31 = t29*c7 - t28*s7
-    t32 = t28*c7 + t29*s7
-    t33 = -0.21*t30 + 0.088*t29
-    t34 = t33 + 0.384*t26
-    t35 = t34 - 0.0825*t25
+    t27 = t25*c5 + s5*t4
+    t28 = c5*t4 - t25*s5
+    t29 = t26*s6 + c6*t27
+    t30 = t26*c6 - s6*t27
+    t31 = t29*c7 - s7*t28
+    t32 = c7*t28 + t29*s7
+    t33 = 0.088*t29 - 0.21*t30
+    t34 = 0.384*t26 + t33
+    t35 = -0.0825*t25 + t34
     t36 = t24 + t35
     t37 = c3*s2
     t38 = 0.316*c2 - 0.0825*t37
     t39 = c2*s4 - c4*t37
     t40 = c2*c4 + s4*t37
-    t41 = s2*s3
+    t41 = s3*s2
     t42 = t39*c5 + s5*t41
     t43 = -t39*s5 + c5*t41
-    t44 = t40*s6 + t42*c6
-    t45 = t40*c6 - t42*s6
-    t46 = t44*c7 - t43*s7
-    t47 = t43*c7 + t44*s7
-    t48 = -0.21*t45 + 0.088*t44
-    t49 = t48 + 0.384*t40
-    t50 = t49 - 0.0825*t39
+    t44 = t40*s6 + c6*t42
+    t45 = t40*c6 - s6*t42
+    t46 = t44*c7 - s7*t43
+    t47 = c7*t43 + t44*s7
+    t48 = 0.088*t44 - 0.21*t45
+    t49 = 0.384*t40 + t48
+    t50 = -0.0825*t39 + t49
     t51 = t38 + t50
     t52 = 0.333 + t51
-    t53 = t0 - qd4*t41
+    t53 = t0 - t41*qd4
     t54 = t53 + t40*qd5
     t55 = 0.7071067811865476*t17
     t56 = 0.7071067811865476*t18
@@ -898,52 +898,52 @@ def fk_jacobian_dot(q, q_dot):
     t64 = 0.7071067811865476*t47
     t65 = t63 + t64
     t66 = t63 - t64
-    t67 = t51*s1
-    t68 = -t36*c2 + s2*t67
+    t67 = s1*t51
+    t68 = -c2*t36 + s2*t67
     t69 = t68
-    t70 = -t50*t4 + t35*t41
+    t70 = -t4*t50 + t35*t41
     t71 = t70
     t72 = t26*t49 - t40*t34
     t73 = t72
     t74 = t43*t33 - t28*t48
     t75 = t74
-    t76 = t73*qd5 + t75*qd6
-    t77 = t76 + t71*qd4
-    t78 = t77 + t69*qd3
-    t79 = t51*c1
-    t80 = t22*c2 - s2*t79
+    t76 = qd5*t73 + qd6*t75
+    t77 = t76 + qd4*t71
+    t78 = t77 + qd3*t69
+    t79 = c1*t51
+    t80 = c2*t22 - s2*t79
     t81 = t80
-    t82 = t50*t7 + t21*t41
+    t82 = t7*t50 + t21*t41
     t83 = t82
     t84 = t40*t20 - t12*t49
     t85 = t84
     t86 = t14*t48 + t43*t19
     t87 = t86
-    t88 = t85*qd5 - t87*qd6
-    t89 = t88 - t83*qd4
-    t90 = t89 + t81*qd3
-    t91 = t22*c1 + t36*s1
+    t88 = qd5*t85 - qd6*t87
+    t89 = t88 - qd4*t83
+    t90 = t89 + qd3*t81
+    t91 = c1*t22 + s1*t36
     t92 = t91
     t93 = t36*t9 - t22*t23
     t94 = t93
-    t95 = t21*t4 + t35*t7
+    t95 = t4*t21 + t7*t35
     t96 = t95
     t97 = t12*t34 - t26*t20
     t98 = t97
     t99 = t14*t33 + t28*t19
     t100 = t99
-    t101 = t98*qd5 + t100*qd6
-    t102 = t101 + t96*qd4
-    t103 = t102 + t94*qd3
-    t104 = t103 - t92*qd2
-    t105 = qd2*s1
-    t106 = -t105 + qd3*t9
+    t101 = qd5*t98 + qd6*t100
+    t102 = t101 + qd4*t96
+    t103 = t102 + qd3*t94
+    t104 = t103 - qd2*t92
+    t105 = s1*qd2
+    t106 = -t105 + t9*qd3
     t107 = t106 + t7*qd4
     t108 = t107 + t12*qd5
     t109 = t90 + t51*t105
     t110 = t109 + t22*qd1
     t111 = c1*qd2
-    t112 = t111 + qd3*t23
+    t112 = t111 + t23*qd3
     t113 = t112 - t4*qd4
     t114 = t113 + t26*qd5
     t115 = t78 + t51*t111
@@ -957,7 +957,7 @@ def fk_jacobian_dot(q, q_dot):
     t123 = -t16
     t124 = -t30
     t125 = -t45
-    t126 = qd2*s2
+    t126 = s2*qd2
     T = _stack(xp, [
         xp.broadcast_to(t57, batch),  # 0, 0
         xp.broadcast_to(t58, batch),  # 0, 1
@@ -1021,12 +1021,12 @@ def fk_jacobian_dot(q, q_dot):
         xp.broadcast_to(t125, batch),  # 5, 6
     ], (6, 7))
     a = _stack(xp, [
-        xp.broadcast_to(qd2*(t104*c1 - qd1*t67) + qd3*(-t90*c2 - t81*qd1 + t103*t23 + t94*t111) + qd4*(t83*t0 + t96*t112 - t102*t4 + t89*t41) + qd5*(t101*t26 + t98*t113 - t88*t40 - t85*t53) + qd6*(t87*t54 + t100*t114 - t100*t119 - t87*t121) - t110*qd1, batch),  # 0
-        xp.broadcast_to(t116*qd1 + qd2*(t104*s1 + qd1*t79) + qd3*(t78*c2 + t69*qd1 + t94*t105 - t103*t9) - qd4*(-t71*t0 + t102*t7 + t96*t106 + t77*t41) + qd5*(t76*t40 + t73*t53 - t101*t12 - t98*t107) - qd6*(-t75*t54 + t100*t108 + t100*t117 + t75*t121), batch),  # 1
-        xp.broadcast_to(-qd2*(t115*c1 + t109*s1) - qd3*(-t90*t9 + t78*t23 + t69*t111 + t81*t105) + qd4*(t77*t4 + t89*t7 - t71*t112 - t83*t106) + qd5*(t88*t12 + t85*t107 - t76*t26 - t73*t113) - qd6*(t75*t114 + t87*t108 - t75*t119 + t87*t117), batch),  # 2
-        xp.broadcast_to(qd3*(c2*t111 - qd1*t23) + qd4*(t4*t0 - t112*t41) + qd5*(t40*t113 - t26*t53) + qd6*(t28*t54 - t43*t114) + qd7*(t122*t30 - t120*t45) - qd1*t111, batch),  # 3
-        xp.broadcast_to(qd3*(qd1*t9 + c2*t105) + qd4*(t7*t0 + t106*t41) + qd5*(t12*t53 - t40*t107) + qd6*(t14*t54 + t43*t108) + qd7*(t45*t118 - t122*t16) - qd1*t105, batch),  # 4
-        xp.broadcast_to(-qd3*(c1**2*t126 + s1**2*t126) - qd4*(t7*t112 + t4*t106) + qd5*(t26*t107 - t12*t113) - qd6*(t14*t114 + t28*t108) + qd7*(t120*t16 - t30*t118), batch),  # 5
+        xp.broadcast_to(qd2*(c1*t104 - t67*qd1) + qd3*(-c2*t90 - qd1*t81 + t23*t103 + t94*t111) + qd4*(t0*t83 + t112*t96 - t4*t102 + t41*t89) + qd5*(t26*t101 + t113*t98 - t40*t88 - t53*t85) + qd6*(t54*t87 + t114*t100 - t100*t119 - t87*t121) - qd1*t110, batch),  # 0
+        xp.broadcast_to(qd1*t116 + qd2*(s1*t104 + t79*qd1) + qd3*(c2*t78 + qd1*t69 + t105*t94 - t9*t103) - qd4*(-t0*t71 + t7*t102 + t106*t96 + t41*t77) + qd5*(t40*t76 + t53*t73 - t12*t101 - t107*t98) - qd6*(-t54*t75 + t108*t100 + t100*t117 + t75*t121), batch),  # 1
+        xp.broadcast_to(-qd2*(c1*t115 + s1*t109) - qd3*(-t9*t90 + t23*t78 + t69*t111 + t105*t81) + qd4*(t4*t77 + t7*t89 - t112*t71 - t106*t83) + qd5*(t12*t88 + t107*t85 - t26*t76 - t113*t73) - qd6*(-t75*t119 + t114*t75 + t108*t87 + t87*t117), batch),  # 2
+        xp.broadcast_to(qd3*(c2*t111 - t23*qd1) + qd4*(t4*t0 - t41*t112) + qd5*(t40*t113 - t26*t53) + qd6*(t28*t54 - t43*t114) + qd7*(t30*t122 - t45*t120) - qd1*t111, batch),  # 3
+        xp.broadcast_to(qd3*(t9*qd1 + c2*t105) + qd4*(t7*t0 + t41*t106) + qd5*(t12*t53 - t40*t107) + qd6*(t14*t54 + t43*t108) + qd7*(t45*t118 - t16*t122) - t105*qd1, batch),  # 4
+        xp.broadcast_to(-qd3*(c1**2*t126 + s1**2*t126) - qd4*(t7*t112 + t4*t106) + qd5*(t26*t107 - t12*t113) - qd6*(t14*t114 + t28*t108) + qd7*(t16*t120 - t30*t118), batch),  # 5
     ], (6,))
     return T, J, a
 
@@ -1058,8 +1058,8 @@ def jacobian_dot(q, q_dot):
     t2 = c1*c3
     t3 = -t1 + c2*t2
     t4 = t2 - c2*t1
-    t5 = c3*s1
-    t6 = c1*s3
+    t5 = s1*c3
+    t6 = s3*c1
     t7 = t5 + c2*t6
     t8 = t6 + c2*t5
     t9 = 0.316*s2
@@ -1073,66 +1073,66 @@ def jacobian_dot(q, q_dot):
     t17 = t3*c4 + s4*t16
     t18 = -t3*s4 + c4*t16
     t19 = t17*c5 - t7*s5
-    t20 = t17*s5 + t7*c5
+    t20 = t17*s5 + c5*t7
     t21 = t18*s6 + t19*c6
-    t22 = t18*c6 - t19*s6
-    t23 = -0.21*t22 + 0.088*t21
-    t24 = t23 + 0.384*t18
-    t25 = t24 - 0.0825*t17
+    t22 = t18*c6 - s6*t19
+    t23 = 0.088*t21 - 0.21*t22
+    t24 = 0.384*t18 + t23
+    t25 = -0.0825*t17 + t24
     t26 = t10 + t25
     t27 = s1*s2
     t28 = t8*c4 + s4*t27
     t29 = -t8*s4 + c4*t27
-    t30 = t28*c5 + t4*s5
-    t31 = t4*c5 - t28*s5
-    t32 = t29*s6 + t30*c6
-    t33 = t29*c6 - t30*s6
-    t34 = -0.21*t33 + 0.088*t32
-    t35 = t34 + 0.384*t29
-    t36 = t35 - 0.0825*t28
+    t30 = t28*c5 + s5*t4
+    t31 = c5*t4 - t28*s5
+    t32 = t29*s6 + c6*t30
+    t33 = t29*c6 - s6*t30
+    t34 = 0.088*t32 - 0.21*t33
+    t35 = 0.384*t29 + t34
+    t36 = -0.0825*t28 + t35
     t37 = t11 + t36
-    t38 = t26*c1 + t37*s1
+    t38 = c1*t26 + s1*t37
     t39 = t37*t16 - t26*t27
-    t40 = t25*t4 + t36*t7
+    t40 = t4*t25 + t7*t36
     t41 = t18*t35 - t29*t24
     t42 = t20*t34 + t31*t23
-    t43 = t41*qd5 + t42*qd6
-    t44 = t43 + t40*qd4
-    t45 = t44 + t39*qd3
-    t46 = t45 - t38*qd2
+    t43 = qd5*t41 + qd6*t42
+    t44 = t43 + qd4*t40
+    t45 = t44 + qd3*t39
+    t46 = t45 - qd2*t38
     t47 = s3*s2
     t48 = t14*c5 + s5*t47
     t49 = -t14*s5 + c5*t47
-    t50 = t15*s6 + t48*c6
-    t51 = t15*c6 - t48*s6
-    t52 = -0.21*t51 + 0.088*t50
-    t53 = t52 + 0.384*t15
-    t54 = t53 - 0.0825*t14
+    t50 = t15*s6 + c6*t48
+    t51 = t15*c6 - s6*t48
+    t52 = 0.088*t50 - 0.21*t51
+    t53 = 0.384*t15 + t52
+    t54 = -0.0825*t14 + t53
     t55 = t13 + t54
-    t56 = -t37*c2 + t55*t27
-    t57 = -t54*t4 + t36*t47
+    t56 = -c2*t37 + t55*t27
+    t57 = -t4*t54 + t36*t47
     t58 = t29*t53 - t15*t35
     t59 = t49*t34 - t31*t52
-    t60 = t26*c2 - t55*t16
-    t61 = t54*t7 + t25*t47
+    t60 = c2*t26 - t55*t16
+    t61 = t7*t54 + t25*t47
     t62 = t15*t24 - t18*t53
     t63 = t20*t52 + t49*t23
-    t64 = t0 - qd4*t47
+    t64 = t0 - t47*qd4
     t65 = t64 + t15*qd5
-    t66 = t58*qd5 + t59*qd6
-    t67 = t62*qd5 - t63*qd6
-    t68 = t66 + t57*qd4
-    t69 = t67 - t61*qd4
-    t70 = t68 + t56*qd3
-    t71 = t69 + t60*qd3
-    t72 = qd2*s1
-    t73 = -t72 + qd3*t16
+    t66 = qd5*t58 + qd6*t59
+    t67 = qd5*t62 - qd6*t63
+    t68 = t66 + qd4*t57
+    t69 = t67 - qd4*t61
+    t70 = t68 + qd3*t56
+    t71 = t69 + qd3*t60
+    t72 = s1*qd2
+    t73 = -t72 + t16*qd3
     t74 = t73 + t7*qd4
     t75 = t74 + t18*qd5
     t76 = t71 + t55*t72
     t77 = t76 + t26*qd1
     t78 = c1*qd2
-    t79 = t78 + qd3*t27
+    t79 = t78 + t27*qd3
     t80 = t79 - t4*qd4
     t81 = t80 + t29*qd5
     t82 = t70 + t55*t78
@@ -1143,52 +1143,52 @@ def jacobian_dot(q, q_dot):
     t87 = t81 - t86
     t88 = t49*qd6
     t89 = t65 - t88
-    t90 = qd1*s1
+    t90 = s1*qd1
     t91 = c1*qd1
-    t92 = qd2*s2
+    t92 = s2*qd2
     Jd = _stack(xp, [
         xp.broadcast_to(-t77, batch),  # 0, 0
-        xp.broadcast_to(t46*c1 - t55*t90, batch),  # 0, 1
-        xp.broadcast_to(-t71*c2 - t60*qd1 + t45*t27 + t39*t78, batch),  # 0, 2
-        xp.broadcast_to(t61*t0 + t40*t79 - t44*t4 + t69*t47, batch),  # 0, 3
-        xp.broadcast_to(t43*t29 + t41*t80 - t67*t15 - t62*t64, batch),  # 0, 4
-        xp.broadcast_to(t63*t65 + t42*t81 - t42*t86 - t63*t88, batch),  # 0, 5
+        xp.broadcast_to(c1*t46 - t55*t90, batch),  # 0, 1
+        xp.broadcast_to(-c2*t71 - qd1*t60 + t27*t45 + t78*t39, batch),  # 0, 2
+        xp.broadcast_to(t0*t61 + t79*t40 - t4*t44 + t47*t69, batch),  # 0, 3
+        xp.broadcast_to(t29*t43 + t80*t41 - t15*t67 - t64*t62, batch),  # 0, 4
+        xp.broadcast_to(t65*t63 + t81*t42 - t86*t42 - t88*t63, batch),  # 0, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 6
         xp.broadcast_to(t83, batch),  # 1, 0
-        xp.broadcast_to(t46*s1 + t55*t91, batch),  # 1, 1
-        xp.broadcast_to(t70*c2 + t56*qd1 + t39*t72 - t45*t16, batch),  # 1, 2
-        xp.broadcast_to(-(-t57*t0 + t44*t7 + t40*t73 + t68*t47), batch),  # 1, 3
-        xp.broadcast_to(t66*t15 + t58*t64 - t43*t18 - t41*t74, batch),  # 1, 4
-        xp.broadcast_to(-(-t59*t65 + t42*t75 + t42*t84 + t59*t88), batch),  # 1, 5
+        xp.broadcast_to(s1*t46 + t55*t91, batch),  # 1, 1
+        xp.broadcast_to(c2*t70 + qd1*t56 + t72*t39 - t16*t45, batch),  # 1, 2
+        xp.broadcast_to(-(-t0*t57 + t7*t44 + t73*t40 + t47*t68), batch),  # 1, 3
+        xp.broadcast_to(t15*t66 + t64*t58 - t18*t43 - t74*t41, batch),  # 1, 4
+        xp.broadcast_to(-(-t65*t59 + t75*t42 + t84*t42 + t88*t59), batch),  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
-        xp.broadcast_to(-(t82*c1 + t76*s1), batch),  # 2, 1
-        xp.broadcast_to(-(-t71*t16 + t70*t27 + t56*t78 + t60*t72), batch),  # 2, 2
-        xp.broadcast_to(t68*t4 + t69*t7 - t57*t79 - t61*t73, batch),  # 2, 3
-        xp.broadcast_to(t67*t18 + t62*t74 - t66*t29 - t58*t80, batch),  # 2, 4
-        xp.broadcast_to(-(t59*t81 + t63*t75 - t59*t86 + t63*t84), batch),  # 2, 5
+        xp.broadcast_to(-(c1*t82 + s1*t76), batch),  # 2, 1
+        xp.broadcast_to(-(-t16*t71 + t27*t70 + t78*t56 + t72*t60), batch),  # 2, 2
+        xp.broadcast_to(t4*t68 + t7*t69 - t79*t57 - t73*t61, batch),  # 2, 3
+        xp.broadcast_to(t18*t67 + t74*t62 - t29*t66 - t80*t58, batch),  # 2, 4
+        xp.broadcast_to(-(-t86*t59 + t81*t59 + t75*t63 + t84*t63), batch),  # 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
         xp.broadcast_to(-t91, batch),  # 3, 1
         xp.broadcast_to(c2*t78 - s2*t90, batch),  # 3, 2
-        xp.broadcast_to(t4*t0 - t79*t47, batch),  # 3, 3
+        xp.broadcast_to(t4*t0 - t47*t79, batch),  # 3, 3
         xp.broadcast_to(t15*t80 - t29*t64, batch),  # 3, 4
         xp.broadcast_to(t31*t65 - t49*t81, batch),  # 3, 5
-        xp.broadcast_to(t89*t33 - t87*t51, batch),  # 3, 6
+        xp.broadcast_to(t33*t89 - t51*t87, batch),  # 3, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
         xp.broadcast_to(-t90, batch),  # 4, 1
         xp.broadcast_to(s2*t91 + c2*t72, batch),  # 4, 2
-        xp.broadcast_to(t7*t0 + t73*t47, batch),  # 4, 3
+        xp.broadcast_to(t7*t0 + t47*t73, batch),  # 4, 3
         xp.broadcast_to(t18*t64 - t15*t74, batch),  # 4, 4
         xp.broadcast_to(t20*t65 + t49*t75, batch),  # 4, 5
-        xp.broadcast_to(t51*t85 - t89*t22, batch),  # 4, 6
+        xp.broadcast_to(t51*t85 - t22*t89, batch),  # 4, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 1
         xp.broadcast_to(-(c1**2*t92 + s1**2*t92), batch),  # 5, 2
         xp.broadcast_to(-(t7*t79 + t4*t73), batch),  # 5, 3
         xp.broadcast_to(t29*t74 - t18*t80, batch),  # 5, 4
         xp.broadcast_to(-(t20*t81 + t31*t75), batch),  # 5, 5
-        xp.broadcast_to(t87*t22 - t33*t85, batch),  # 5, 6
+        xp.broadcast_to(t22*t87 - t33*t85, batch),  # 5, 6
     ], (6, 7))
     return Jd
 
@@ -1221,8 +1221,8 @@ def bias_acceleration(q, q_dot):
     t2 = c1*c3
     t3 = -t1 + c2*t2
     t4 = t2 - c2*t1
-    t5 = c3*s1
-    t6 = c1*s3
+    t5 = s1*c3
+    t6 = s3*c1
     t7 = t5 + c2*t6
     t8 = t6 + c2*t5
     t9 = 0.316*s2
@@ -1236,66 +1236,66 @@ def bias_acceleration(q, q_dot):
     t17 = t3*c4 + s4*t16
     t18 = -t3*s4 + c4*t16
     t19 = t17*c5 - t7*s5
-    t20 = t17*s5 + t7*c5
+    t20 = t17*s5 + c5*t7
     t21 = t18*s6 + t19*c6
-    t22 = t18*c6 - t19*s6
-    t23 = -0.21*t22 + 0.088*t21
-    t24 = t23 + 0.384*t18
-    t25 = t24 - 0.0825*t17
+    t22 = t18*c6 - s6*t19
+    t23 = 0.088*t21 - 0.21*t22
+    t24 = 0.384*t18 + t23
+    t25 = -0.0825*t17 + t24
     t26 = t10 + t25
     t27 = s1*s2
     t28 = t8*c4 + s4*t27
     t29 = -t8*s4 + c4*t27
-    t30 = t28*c5 + t4*s5
-    t31 = t4*c5 - t28*s5
-    t32 = t29*s6 + t30*c6
-    t33 = t29*c6 - t30*s6
-    t34 = -0.21*t33 + 0.088*t32
-    t35 = t34 + 0.384*t29
-    t36 = t35 - 0.0825*t28
+    t30 = t28*c5 + s5*t4
+    t31 = c5*t4 - t28*s5
+    t32 = t29*s6 + c6*t30
+    t33 = t29*c6 - s6*t30
+    t34 = 0.088*t32 - 0.21*t33
+    t35 = 0.384*t29 + t34
+    t36 = -0.0825*t28 + t35
     t37 = t11 + t36
-    t38 = t26*c1 + t37*s1
+    t38 = c1*t26 + s1*t37
     t39 = t37*t16 - t26*t27
-    t40 = t25*t4 + t36*t7
+    t40 = t4*t25 + t7*t36
     t41 = t18*t35 - t29*t24
     t42 = t20*t34 + t31*t23
-    t43 = t41*qd5 + t42*qd6
-    t44 = t43 + t40*qd4
-    t45 = t44 + t39*qd3
-    t46 = t45 - t38*qd2
+    t43 = qd5*t41 + qd6*t42
+    t44 = t43 + qd4*t40
+    t45 = t44 + qd3*t39
+    t46 = t45 - qd2*t38
     t47 = s3*s2
     t48 = t14*c5 + s5*t47
     t49 = -t14*s5 + c5*t47
-    t50 = t15*s6 + t48*c6
-    t51 = t15*c6 - t48*s6
-    t52 = -0.21*t51 + 0.088*t50
-    t53 = t52 + 0.384*t15
-    t54 = t53 - 0.0825*t14
+    t50 = t15*s6 + c6*t48
+    t51 = t15*c6 - s6*t48
+    t52 = 0.088*t50 - 0.21*t51
+    t53 = 0.384*t15 + t52
+    t54 = -0.0825*t14 + t53
     t55 = t13 + t54
-    t56 = -t37*c2 + t55*t27
-    t57 = -t54*t4 + t36*t47
+    t56 = -c2*t37 + t55*t27
+    t57 = -t4*t54 + t36*t47
     t58 = t29*t53 - t15*t35
     t59 = t49*t34 - t31*t52
-    t60 = t26*c2 - t55*t16
-    t61 = t54*t7 + t25*t47
+    t60 = c2*t26 - t55*t16
+    t61 = t7*t54 + t25*t47
     t62 = t15*t24 - t18*t53
     t63 = t20*t52 + t49*t23
-    t64 = t0 - qd4*t47
+    t64 = t0 - t47*qd4
     t65 = t64 + t15*qd5
-    t66 = t58*qd5 + t59*qd6
-    t67 = t62*qd5 - t63*qd6
-    t68 = t66 + t57*qd4
-    t69 = t67 - t61*qd4
-    t70 = t68 + t56*qd3
-    t71 = t69 + t60*qd3
-    t72 = qd2*s1
-    t73 = -t72 + qd3*t16
+    t66 = qd5*t58 + qd6*t59
+    t67 = qd5*t62 - qd6*t63
+    t68 = t66 + qd4*t57
+    t69 = t67 - qd4*t61
+    t70 = t68 + qd3*t56
+    t71 = t69 + qd3*t60
+    t72 = s1*qd2
+    t73 = -t72 + t16*qd3
     t74 = t73 + t7*qd4
     t75 = t74 + t18*qd5
     t76 = t71 + t55*t72
     t77 = t76 + t26*qd1
     t78 = c1*qd2
-    t79 = t78 + qd3*t27
+    t79 = t78 + t27*qd3
     t80 = t79 - t4*qd4
     t81 = t80 + t29*qd5
     t82 = t70 + t55*t78
@@ -1306,15 +1306,15 @@ def bias_acceleration(q, q_dot):
     t87 = t81 - t86
     t88 = t49*qd6
     t89 = t65 - t88
-    t90 = qd1*t55
-    t91 = qd2*s2
+    t90 = t55*qd1
+    t91 = s2*qd2
     a = _stack(xp, [
-        xp.broadcast_to(qd2*(t46*c1 - s1*t90) + qd3*(-t71*c2 - t60*qd1 + t45*t27 + t39*t78) + qd4*(t61*t0 + t40*t79 - t44*t4 + t69*t47) + qd5*(t43*t29 + t41*t80 - t67*t15 - t62*t64) + qd6*(t63*t65 + t42*t81 - t42*t86 - t63*t88) - t77*qd1, batch),  # 0
-        xp.broadcast_to(t83*qd1 + qd2*(t46*s1 + c1*t90) + qd3*(t70*c2 + t56*qd1 + t39*t72 - t45*t16) - qd4*(-t57*t0 + t44*t7 + t40*t73 + t68*t47) + qd5*(t66*t15 + t58*t64 - t43*t18 - t41*t74) - qd6*(-t59*t65 + t42*t75 + t42*t84 + t59*t88), batch),  # 1
-        xp.broadcast_to(-qd2*(t82*c1 + t76*s1) - qd3*(-t71*t16 + t70*t27 + t56*t78 + t60*t72) + qd4*(t68*t4 + t69*t7 - t57*t79 - t61*t73) + qd5*(t67*t18 + t62*t74 - t66*t29 - t58*t80) - qd6*(t59*t81 + t63*t75 - t59*t86 + t63*t84), batch),  # 2
-        xp.broadcast_to(qd3*(c2*t78 - qd1*t27) + qd4*(t4*t0 - t79*t47) + qd5*(t15*t80 - t29*t64) + qd6*(t31*t65 - t49*t81) + qd7*(t89*t33 - t87*t51) - qd1*t78, batch),  # 3
-        xp.broadcast_to(qd3*(qd1*t16 + c2*t72) + qd4*(t7*t0 + t73*t47) + qd5*(t18*t64 - t15*t74) + qd6*(t20*t65 + t49*t75) + qd7*(t51*t85 - t89*t22) - qd1*t72, batch),  # 4
-        xp.broadcast_to(-qd3*(c1**2*t91 + s1**2*t91) - qd4*(t7*t79 + t4*t73) + qd5*(t29*t74 - t18*t80) - qd6*(t20*t81 + t31*t75) + qd7*(t87*t22 - t33*t85), batch),  # 5
+        xp.broadcast_to(qd2*(c1*t46 - s1*t90) + qd3*(-c2*t71 - qd1*t60 + t27*t45 + t78*t39) + qd4*(t0*t61 + t79*t40 - t4*t44 + t47*t69) + qd5*(t29*t43 + t80*t41 - t15*t67 - t64*t62) + qd6*(t65*t63 + t81*t42 - t86*t42 - t88*t63) - qd1*t77, batch),  # 0
+        xp.broadcast_to(qd1*t83 + qd2*(s1*t46 + c1*t90) + qd3*(c2*t70 + qd1*t56 + t72*t39 - t16*t45) - qd4*(-t0*t57 + t7*t44 + t73*t40 + t47*t68) + qd5*(t15*t66 + t64*t58 - t18*t43 - t74*t41) - qd6*(-t65*t59 + t75*t42 + t84*t42 + t88*t59), batch),  # 1
+        xp.broadcast_to(-qd2*(c1*t82 + s1*t76) - qd3*(-t16*t71 + t27*t70 + t78*t56 + t72*t60) + qd4*(t4*t68 + t7*t69 - t79*t57 - t73*t61) + qd5*(t18*t67 + t74*t62 - t29*t66 - t80*t58) - qd6*(-t86*t59 + t81*t59 + t75*t63 + t84*t63), batch),  # 2
+        xp.broadcast_to(qd3*(c2*t78 - t27*qd1) + qd4*(t4*t0 - t47*t79) + qd5*(t15*t80 - t29*t64) + qd6*(t31*t65 - t49*t81) + qd7*(t33*t89 - t51*t87) - t78*qd1, batch),  # 3
+        xp.broadcast_to(qd3*(t16*qd1 + c2*t72) + qd4*(t7*t0 + t47*t73) + qd5*(t18*t64 - t15*t74) + qd6*(t20*t65 + t49*t75) + qd7*(t51*t85 - t22*t89) - t72*qd1, batch),  # 4
+        xp.broadcast_to(-qd3*(c1**2*t91 + s1**2*t91) - qd4*(t7*t79 + t4*t73) + qd5*(t29*t74 - t18*t80) - qd6*(t20*t81 + t31*t75) + qd7*(t22*t87 - t33*t85), batch),  # 5
     ], (6,))
     return a
 
@@ -1348,8 +1348,8 @@ def task_jacobian_dot(q, q_dot):
     t1 = c1*c3
     t2 = -t0 + c2*t1
     t3 = t1 - c2*t0
-    t4 = c3*s1
-    t5 = c1*s3
+    t4 = s1*c3
+    t5 = s3*c1
     t6 = t4 + c2*t5
     t7 = t5 + c2*t4
     t8 = c1*s2
@@ -1357,40 +1357,40 @@ def task_jacobian_dot(q, q_dot):
     t10 = t2*c4 + s4*t8
     t11 = -t2*s4 + c4*t8
     t12 = t10*c5 - t6*s5
-    t13 = t10*s5 + t6*c5
+    t13 = t10*s5 + c5*t6
     t14 = t11*s6 + t12*c6
-    t15 = t11*c6 - t12*s6
+    t15 = t11*c6 - s6*t12
     t16 = t13*s7 + t14*c7
     t17 = t13*c7 - t14*s7
-    t18 = -0.21*t15 + 0.088*t14
-    t19 = t18 + 0.384*t11
-    t20 = t19 - 0.0825*t10
+    t18 = 0.088*t14 - 0.21*t15
+    t19 = 0.384*t11 + t18
+    t20 = -0.0825*t10 + t19
     t21 = t9 + t20
     t22 = 0.7071067811865476*t16 - 0.7071067811865476*t17
     t23 = s1*s2
     t24 = 0.0825*t7 + 0.316*t23
     t25 = t7*c4 + s4*t23
     t26 = -t7*s4 + c4*t23
-    t27 = t25*c5 + t3*s5
-    t28 = t3*c5 - t25*s5
-    t29 = t26*s6 + t27*c6
-    t30 = t26*c6 - t27*s6
-    t31 = t29*c7 - t28*s7
-    t32 = t28*c7 + t29*s7
-    t33 = -0.21*t30 + 0.088*t29
-    t34 = t33 + 0.384*t26
-    t35 = t34 - 0.0825*t25
+    t27 = t25*c5 + s5*t3
+    t28 = c5*t3 - t25*s5
+    t29 = t26*s6 + c6*t27
+    t30 = t26*c6 - s6*t27
+    t31 = t29*c7 - s7*t28
+    t32 = c7*t28 + t29*s7
+    t33 = 0.088*t29 - 0.21*t30
+    t34 = 0.384*t26 + t33
+    t35 = -0.0825*t25 + t34
     t36 = t24 + t35
     t37 = 0.7071067811865476*t31 + 0.7071067811865476*t32
-    t38 = t21*c1 + t36*s1
+    t38 = c1*t21 + s1*t36
     t39 = t36*t8 - t21*t23
-    t40 = t20*t3 + t35*t6
+    t40 = t3*t20 + t6*t35
     t41 = t11*t34 - t26*t19
     t42 = t13*t33 + t28*t18
-    t43 = t41*qd5 + t42*qd6
-    t44 = t43 + t40*qd4
-    t45 = t44 + t39*qd3
-    t46 = t45 - t38*qd2
+    t43 = qd5*t41 + qd6*t42
+    t44 = t43 + qd4*t40
+    t45 = t44 + qd3*t39
+    t46 = t45 - qd2*t38
     t47 = t22**2 + t37**2
     t48 = xp.sqrt(t47)
     t49 = c3*s2
@@ -1400,63 +1400,63 @@ def task_jacobian_dot(q, q_dot):
     t53 = s3*s2
     t54 = t51*c5 + s5*t53
     t55 = -t51*s5 + c5*t53
-    t56 = t52*s6 + t54*c6
-    t57 = t52*c6 - t54*s6
-    t58 = t56*c7 - t55*s7
-    t59 = t55*c7 + t56*s7
-    t60 = -0.21*t57 + 0.088*t56
-    t61 = t60 + 0.384*t52
-    t62 = t61 - 0.0825*t51
+    t56 = t52*s6 + c6*t54
+    t57 = t52*c6 - s6*t54
+    t58 = t56*c7 - s7*t55
+    t59 = c7*t55 + t56*s7
+    t60 = 0.088*t56 - 0.21*t57
+    t61 = 0.384*t52 + t60
+    t62 = -0.0825*t51 + t61
     t63 = t50 + t62
     t64 = 0.7071067811865476*t58 + 0.7071067811865476*t59
-    t65 = -t36*c2 + t63*t23
-    t66 = -t62*t3 + t35*t53
+    t65 = -c2*t36 + t63*t23
+    t66 = -t3*t62 + t35*t53
     t67 = t26*t61 - t52*t34
     t68 = t55*t33 - t28*t60
-    t69 = t21*c2 - t63*t8
-    t70 = t62*t6 + t20*t53
+    t69 = c2*t21 - t63*t8
+    t70 = t6*t62 + t20*t53
     t71 = t52*t19 - t11*t61
     t72 = t13*t60 + t55*t18
-    t73 = t67*qd5 + t68*qd6
-    t74 = t71*qd5 - t72*qd6
-    t75 = t73 + t66*qd4
-    t76 = t74 - t70*qd4
-    t77 = t75 + t65*qd3
-    t78 = t76 + t69*qd3
-    t79 = qd2*s1
+    t73 = qd5*t67 + qd6*t68
+    t74 = qd5*t71 - qd6*t72
+    t75 = t73 + qd4*t66
+    t76 = t74 - qd4*t70
+    t77 = t75 + qd3*t65
+    t78 = t76 + qd3*t69
+    t79 = s1*qd2
     t80 = t78 + t63*t79
     t81 = t80 + t21*qd1
-    t82 = t77*c2 + t65*qd1 + t39*t79 - t45*t8
-    t83 = qd1*t8 + c2*t79
-    t84 = -t79 + qd3*t8
+    t82 = c2*t77 + qd1*t65 + t79*t39 - t8*t45
+    t83 = t8*qd1 + c2*t79
+    t84 = -t79 + t8*qd3
     t85 = t84
     t86 = c1*qd2
     t87 = t77 + t63*t86
     t88 = t87 - t36*qd1
-    t89 = -t78*c2 - t69*qd1 + t45*t23 + t39*t86
-    t90 = t87*c1 + t80*s1
-    t91 = t77*t23 + t65*t86 + t69*t79 - t78*t8
-    t92 = c2*t86 - qd1*t23
-    t93 = t86 + qd3*t23
+    t89 = -c2*t78 - qd1*t69 + t23*t45 + t86*t39
+    t90 = c1*t87 + s1*t80
+    t91 = t23*t77 + t86*t65 + t79*t69 - t8*t78
+    t92 = c2*t86 - t23*qd1
+    t93 = t86 + t23*qd3
     t94 = t93
-    t95 = t75*t3 + t76*t6 - t66*t94 - t70*t85
+    t95 = t3*t75 + t6*t76 - t94*t66 - t85*t70
     t96 = t6*t94 + t3*t85
     t97 = qd1 + c2*qd3
     t98 = t97
-    t99 = t70*t98 + t40*t94 - t44*t3 + t76*t53
-    t100 = t44*t6 + t40*t85 - t66*t98 + t75*t53
-    t101 = t3*t98 - t94*t53
-    t102 = t6*t98 + t85*t53
+    t99 = t98*t70 + t94*t40 - t3*t44 + t53*t76
+    t100 = t6*t44 + t85*t40 - t98*t66 + t53*t75
+    t101 = t3*t98 - t53*t94
+    t102 = t6*t98 + t53*t85
     t103 = t6*qd4
     t104 = t85 + t103
     t105 = -t3*qd4
     t106 = t94 + t105
-    t107 = t74*t11 + t71*t104 - t73*t26 - t67*t106
+    t107 = t11*t74 + t104*t71 - t26*t73 - t106*t67
     t108 = t26*t104 - t11*t106
-    t109 = -qd4*t53
+    t109 = -t53*qd4
     t110 = t98 + t109
-    t111 = t43*t26 + t41*t106 - t74*t52 - t71*t110
-    t112 = t73*t52 + t67*t110 - t43*t11 - t41*t104
+    t111 = t26*t43 + t106*t41 - t52*t74 - t110*t71
+    t112 = t52*t73 + t110*t67 - t11*t43 - t104*t41
     t113 = t52*t106 - t26*t110
     t114 = t11*t110 - t52*t104
     t115 = t11*qd5
@@ -1470,83 +1470,83 @@ def task_jacobian_dot(q, q_dot):
     t123 = t13*t121 + t55*t116
     t124 = t13*qd6
     t125 = t116 + t124
-    t126 = t103 + t115 + t124 - t15*qd7 + t84
+    t126 = t84 + t103 + t115 + t124 - t15*qd7
     t127 = t28*qd6
-    t128 = t68*t118 + t72*t116 + t72*t124 - t68*t127
+    t128 = t118*t68 + t116*t72 + t124*t72 - t127*t68
     t129 = -t127
     t130 = t118 + t129
-    t131 = t130*t15 - t30*t125
-    t132 = t105 + t117 + t129 - t30*qd7 + t93
-    t133 = t126*t37 - t132*t22
+    t131 = t15*t130 - t30*t125
+    t132 = t93 + t105 + t117 + t129 - t30*qd7
+    t133 = t37*t126 - t22*t132
     t134 = t55*qd6
-    t135 = t72*t121 + t42*t118 - t42*t127 - t72*t134
-    t136 = t42*t116 - t68*t121 + t42*t124 + t68*t134
+    t135 = t121*t72 + t118*t42 - t127*t42 - t134*t72
+    t136 = t116*t42 - t121*t68 + t124*t42 + t134*t68
     t137 = -t134
     t138 = t121 + t137
-    t139 = t138*t30 - t130*t57
-    t140 = t57*t125 - t138*t15
-    t141 = t109 + t120 + t137 - t57*qd7 + t97
-    t142 = t132*t64 - t141*t37
-    t143 = t141*t22 - t126*t64
-    t144 = qd1*t63
-    t145 = t46*c1 - s1*t144
-    t146 = t46*s1 + c1*t144
-    t147 = qd2*s2
+    t139 = t30*t138 - t57*t130
+    t140 = t57*t125 - t15*t138
+    t141 = t97 + t109 + t120 + t137 - t57*qd7
+    t142 = t64*t132 - t37*t141
+    t143 = t22*t141 - t64*t126
+    t144 = t63*qd1
+    t145 = c1*t46 - s1*t144
+    t146 = s1*t46 + c1*t144
+    t147 = s2*qd2
     t148 = c1**2*t147 + s1**2*t147
-    t149 = 1/t47
-    t150 = t149*(t6*t22 - t37*t3)
-    t151 = t149*(t11*t22 + t26*t37)
-    t152 = t149*(t13*t22 - t28*t37)
-    t153 = -t149*(t15*t22 + t30*t37)
-    t154 = t37*c1
-    t155 = t22*s1
-    t156 = t149*(t154 - t155)
-    t157 = t22*c1
-    t158 = t37*s1
-    t159 = t149*(s2*t157 + s2*t158)
+    t149 = c1*t37
+    t150 = s1*t22
+    t151 = 1/t47
+    t152 = (t149 - t150)*t151
+    t153 = (t6*t22 - t3*t37)*t151
+    t154 = (t11*t22 + t26*t37)*t151
+    t155 = (t13*t22 - t28*t37)*t151
+    t156 = -t151*(t15*t22 + t30*t37)
+    t157 = c1*t22
+    t158 = s1*t37
+    t159 = (s2*t157 + s2*t158)*t151
     t160 = 1/t48
-    t161 = t149*t160
-    t162 = (t157 + t158)*t161
-    t163 = (s2*t155 - s2*t154)*t161
-    t164 = -(t6*t37 + t22*t3)*t161
+    t161 = t151*t160
+    t162 = t161*(t157 + t158)
+    t163 = t161*(s2*t150 - s2*t149)
+    t164 = -(t6*t37 + t3*t22)*t161
     t165 = (t26*t22 - t11*t37)*t161
     t166 = -(t13*t37 + t28*t22)*t161
     t167 = (t15*t37 - t30*t22)*t161
-    t168 = 2*t156
-    t169 = t149*t142
-    t170 = -(s1 + t22*t168)*t169
-    t171 = t149*t143
-    t172 = (c1 - t37*t168)*t171
-    t173 = qd1*t149
+    t168 = 2*t152
+    t169 = t151*t142
+    t170 = -t169*(s1 + t22*t168)
+    t171 = t151*t143
+    t172 = t171*(c1 - t37*t168)
+    t173 = t151*qd1
     t174 = t157*t173
     t175 = t158*t173
-    t176 = t22*t149
+    t176 = t22*t151
     t177 = t92*t176
-    t178 = t37*t149
+    t178 = t37*t151
     t179 = t83*t178
     t180 = 2*t159
-    t181 = (t8 - t22*t180)*t169
-    t182 = (t23 - t37*t180)*t171
+    t181 = t169*(t8 - t22*t180)
+    t182 = t171*(t23 - t37*t180)
     t183 = t101*t176
     t184 = t102*t178
-    t185 = 2*t150
-    t186 = (t6 - t22*t185)*t169
-    t187 = -(t3 + t37*t185)*t171
+    t185 = 2*t153
+    t186 = t169*(t6 - t22*t185)
+    t187 = -t171*(t3 + t37*t185)
     t188 = t113*t176
     t189 = t114*t178
-    t190 = 2*t151
-    t191 = (t11 - t22*t190)*t169
-    t192 = (t26 - t37*t190)*t171
+    t190 = 2*t154
+    t191 = t169*(t11 - t22*t190)
+    t192 = t171*(t26 - t37*t190)
     t193 = t122*t176
     t194 = t123*t178
-    t195 = 2*t152
-    t196 = (t13 - t22*t195)*t169
-    t197 = -(t28 + t37*t195)*t171
+    t195 = 2*t155
+    t196 = t169*(t13 - t22*t195)
+    t197 = -t171*(t28 + t37*t195)
     t198 = t139*t176
     t199 = t140*t178
-    t200 = 2*t153
-    t201 = -(t15 + t22*t200)*t169
-    t202 = -(t30 + t37*t200)*t171
+    t200 = 2*t156
+    t201 = -t169*(t15 + t22*t200)
+    t202 = -t171*(t30 + t37*t200)
     t203 = qd1*t160
     t204 = t22*t160
     t205 = t37*t160
@@ -1580,19 +1580,19 @@ def task_jacobian_dot(q, q_dot):
         xp.broadcast_to(t193 + t194 + t196 + t197, batch),  # 3, 5
         xp.broadcast_to(t198 + t199 + t201 + t202, batch),  # 3, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
-        xp.broadcast_to(t142*(c1*t160 - t162*t22) + t143*(s1*t160 - t162*t37) + t154*t203 - t155*t203, batch),  # 4, 1
-        xp.broadcast_to(t142*(-t163*t22 + t160*t23) - t143*(t163*t37 + t160*t8) + t83*t204 - t92*t205, batch),  # 4, 2
-        xp.broadcast_to(-t142*(t164*t22 + t3*t160) - t143*(t164*t37 + t6*t160) + t102*t204 - t101*t205, batch),  # 4, 3
-        xp.broadcast_to(t142*(t26*t160 - t165*t22) - t143*(t165*t37 + t11*t160) + t114*t204 - t113*t205, batch),  # 4, 4
-        xp.broadcast_to(-t142*(t166*t22 + t28*t160) - t143*(t166*t37 + t13*t160) + t123*t204 - t122*t205, batch),  # 4, 5
-        xp.broadcast_to(-t142*(t167*t22 + t30*t160) + t143*(t15*t160 - t167*t37) + t140*t204 - t139*t205, batch),  # 4, 6
+        xp.broadcast_to(t142*(c1*t160 - t22*t162) + t143*(s1*t160 - t37*t162) + t149*t203 - t150*t203, batch),  # 4, 1
+        xp.broadcast_to(t142*(-t22*t163 + t23*t160) - t143*(t37*t163 + t8*t160) + t83*t204 - t92*t205, batch),  # 4, 2
+        xp.broadcast_to(-t142*(t22*t164 + t3*t160) - t143*(t37*t164 + t6*t160) + t102*t204 - t101*t205, batch),  # 4, 3
+        xp.broadcast_to(t142*(t26*t160 - t22*t165) - t143*(t37*t165 + t11*t160) + t114*t204 - t113*t205, batch),  # 4, 4
+        xp.broadcast_to(-t142*(t22*t166 + t28*t160) - t143*(t37*t166 + t13*t160) + t123*t204 - t122*t205, batch),  # 4, 5
+        xp.broadcast_to(-t142*(t22*t167 + t30*t160) + t143*(t15*t160 - t37*t167) + t140*t204 - t139*t205, batch),  # 4, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 0
-        xp.broadcast_to(-(t133*t156 + t64*t170 + t64*t172 - t64*t174 - t64*t175), batch),  # 5, 1
-        xp.broadcast_to(-(t148 + t133*t159 + t64*t177 + t64*t179 + t64*t181 + t64*t182), batch),  # 5, 2
-        xp.broadcast_to(-(t96 + t133*t150 + t64*t183 + t64*t184 + t64*t186 + t64*t187), batch),  # 5, 3
-        xp.broadcast_to(-(-t108 + t133*t151 + t64*t188 + t64*t189 + t64*t191 + t64*t192), batch),  # 5, 4
-        xp.broadcast_to(-(t119 + t133*t152 + t64*t193 + t64*t194 + t64*t196 + t64*t197), batch),  # 5, 5
-        xp.broadcast_to(-(-t131 + t133*t153 + t64*t198 + t64*t199 + t64*t201 + t64*t202), batch),  # 5, 6
+        xp.broadcast_to(-(t152*t133 + t64*t170 + t64*t172 - t64*t174 - t64*t175), batch),  # 5, 1
+        xp.broadcast_to(-(t148 + t159*t133 + t64*t177 + t64*t179 + t64*t181 + t64*t182), batch),  # 5, 2
+        xp.broadcast_to(-(t96 + t153*t133 + t64*t183 + t64*t184 + t64*t186 + t64*t187), batch),  # 5, 3
+        xp.broadcast_to(-(-t108 + t154*t133 + t64*t188 + t64*t189 + t64*t191 + t64*t192), batch),  # 5, 4
+        xp.broadcast_to(-(t119 + t155*t133 + t64*t193 + t64*t194 + t64*t196 + t64*t197), batch),  # 5, 5
+        xp.broadcast_to(-(-t131 + t156*t133 + t64*t198 + t64*t199 + t64*t201 + t64*t202), batch),  # 5, 6
     ], (6, 7))
     return Jd
 
@@ -1617,8 +1617,8 @@ def hessian(q):
     t1 = c1*c3
     t2 = -t0 + c2*t1
     t3 = t1 - c2*t0
-    t4 = c3*s1
-    t5 = c1*s3
+    t4 = s1*c3
+    t5 = s3*c1
     t6 = t4 + c2*t5
     t7 = t5 + c2*t4
     t8 = c1*s2
@@ -1626,28 +1626,28 @@ def hessian(q):
     t10 = t2*c4 + s4*t8
     t11 = -t2*s4 + c4*t8
     t12 = t10*c5 - t6*s5
-    t13 = t10*s5 + t6*c5
+    t13 = t10*s5 + c5*t6
     t14 = t11*s6 + t12*c6
-    t15 = t11*c6 - t12*s6
-    t16 = -0.21*t15 + 0.088*t14
-    t17 = t16 + 0.384*t11
-    t18 = t17 - 0.0825*t10
+    t15 = t11*c6 - s6*t12
+    t16 = 0.088*t14 - 0.21*t15
+    t17 = 0.384*t11 + t16
+    t18 = -0.0825*t10 + t17
     t19 = t9 + t18
     t20 = s1*s2
     t21 = 0.0825*t7 + 0.316*t20
     t22 = t7*c4 + s4*t20
     t23 = -t7*s4 + c4*t20
-    t24 = t22*c5 + t3*s5
-    t25 = t3*c5 - t22*s5
-    t26 = t23*s6 + t24*c6
-    t27 = t23*c6 - t24*s6
-    t28 = -0.21*t27 + 0.088*t26
-    t29 = t28 + 0.384*t23
-    t30 = t29 - 0.0825*t22
+    t24 = t22*c5 + s5*t3
+    t25 = c5*t3 - t22*s5
+    t26 = t23*s6 + c6*t24
+    t27 = t23*c6 - s6*t24
+    t28 = 0.088*t26 - 0.21*t27
+    t29 = 0.384*t23 + t28
+    t30 = -0.0825*t22 + t29
     t31 = t21 + t30
-    t32 = t19*c1 + t31*s1
+    t32 = c1*t19 + s1*t31
     t33 = t31*t8 - t19*t20
-    t34 = t18*t3 + t30*t6
+    t34 = t3*t18 + t6*t30
     t35 = t11*t29 - t23*t17
     t36 = t13*t28 + t25*t16
     t37 = c3*s2
@@ -1657,55 +1657,55 @@ def hessian(q):
     t41 = s3*s2
     t42 = t39*c5 + s5*t41
     t43 = -t39*s5 + c5*t41
-    t44 = t40*s6 + t42*c6
-    t45 = t40*c6 - t42*s6
-    t46 = -0.21*t45 + 0.088*t44
-    t47 = t46 + 0.384*t40
-    t48 = t47 - 0.0825*t39
+    t44 = t40*s6 + c6*t42
+    t45 = t40*c6 - s6*t42
+    t46 = 0.088*t44 - 0.21*t45
+    t47 = 0.384*t40 + t46
+    t48 = -0.0825*t39 + t47
     t49 = t38 + t48
-    t50 = -t48*t3 + t30*t41
+    t50 = -t3*t48 + t30*t41
     t51 = t23*t47 - t40*t29
     t52 = t43*t28 - t25*t46
-    t53 = t48*t6 + t18*t41
+    t53 = t6*t48 + t18*t41
     t54 = t40*t17 - t11*t47
     t55 = t13*t46 + t43*t16
-    t56 = t49*s1
-    t57 = -t31*c2 + s2*t56
-    t58 = t49*c1
-    t59 = t19*c2 - s2*t58
+    t56 = s1*t49
+    t57 = -c2*t31 + s2*t56
+    t58 = c1*t49
+    t59 = c2*t19 - s2*t58
     t60 = -t56
     t61 = -t59
     t62 = -t54
-    t63 = t33*c1
-    t64 = t34*c1
-    t65 = t35*c1
-    t66 = t36*c1
-    t67 = t33*s1
-    t68 = t34*s1
-    t69 = t35*s1
-    t70 = t36*s1
+    t63 = c1*t33
+    t64 = c1*t34
+    t65 = c1*t35
+    t66 = c1*t36
+    t67 = s1*t33
+    t68 = s1*t34
+    t69 = s1*t35
+    t70 = s1*t36
     t71 = c1**2
     t72 = s1**2
-    t73 = -(t57*c1 + t59*s1)
-    t74 = t53*s1 - t50*c1
-    t75 = -(t51*c1 + t54*s1)
-    t76 = t55*s1 - t52*c1
-    t77 = t53*c2 + t34*t20
-    t78 = -t54*c2 + t35*t20
-    t79 = t55*c2 + t36*t20
-    t80 = t50*c2 - t34*t8
-    t81 = t51*c2 - t35*t8
-    t82 = t52*c2 - t36*t8
-    t83 = -(t50*t20 + t53*t8)
-    t84 = t54*t8 - t51*t20
-    t85 = -(t52*t20 + t55*t8)
+    t73 = -(c1*t57 + s1*t59)
+    t74 = s1*t53 - c1*t50
+    t75 = -(c1*t51 + s1*t54)
+    t76 = s1*t55 - c1*t52
+    t77 = c2*t53 + t20*t34
+    t78 = -c2*t54 + t20*t35
+    t79 = c2*t55 + t20*t36
+    t80 = c2*t50 - t8*t34
+    t81 = c2*t51 - t8*t35
+    t82 = c2*t52 - t8*t36
+    t83 = -(t20*t50 + t8*t53)
+    t84 = t8*t54 - t20*t51
+    t85 = -(t20*t52 + t8*t55)
     t86 = s2**2
-    t87 = -t35*t3 + t54*t41
-    t88 = -(t36*t3 + t55*t41)
-    t89 = -(t6*t35 + t51*t41)
-    t90 = -(t6*t36 + t52*t41)
-    t91 = t6*t54 + t51*t3
-    t92 = t52*t3 - t6*t55
+    t87 = -t3*t35 + t41*t54
+    t88 = -(t3*t36 + t41*t55)
+    t89 = -(t6*t35 + t41*t51)
+    t90 = -(t6*t36 + t41*t52)
+    t91 = t6*t54 + t3*t51
+    t92 = t3*t52 - t6*t55
     t93 = t23*t36 + t40*t55
     t94 = t40*t52 - t11*t36
     t95 = -(t11*t55 + t23*t52)
@@ -1753,21 +1753,21 @@ def hessian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5, 6
         t60,  # 1, 0, 0
-        -t32*c1,  # 1, 0, 1
+        -c1*t32,  # 1, 0, 1
         t63,  # 1, 0, 2
         t64,  # 1, 0, 3
         t65,  # 1, 0, 4
         t66,  # 1, 0, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 0, 6
         t58,  # 1, 1, 0
-        -t32*s1,  # 1, 1, 1
+        -s1*t32,  # 1, 1, 1
         t67,  # 1, 1, 2
         t68,  # 1, 1, 3
         t69,  # 1, 1, 4
         t70,  # 1, 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 1, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 2, 0
-        -(t49*t71 + t49*t72),  # 1, 2, 1
+        -(t71*t49 + t72*t49),  # 1, 2, 1
         t73,  # 1, 2, 2
         t74,  # 1, 2, 3
         t75,  # 1, 2, 4
@@ -1777,40 +1777,40 @@ def hessian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 3, 1
         c1*c2,  # 1, 3, 2
         -s2*t5,  # 1, 3, 3
-        t40*c1,  # 1, 3, 4
-        -t43*c1,  # 1, 3, 5
-        -t45*c1,  # 1, 3, 6
+        c1*t40,  # 1, 3, 4
+        -c1*t43,  # 1, 3, 5
+        -c1*t45,  # 1, 3, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 4, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 4, 1
-        c2*s1,  # 1, 4, 2
+        s1*c2,  # 1, 4, 2
         -s2*t0,  # 1, 4, 3
-        t40*s1,  # 1, 4, 4
-        -t43*s1,  # 1, 4, 5
-        -t45*s1,  # 1, 4, 6
+        s1*t40,  # 1, 4, 4
+        -s1*t43,  # 1, 4, 5
+        -s1*t45,  # 1, 4, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5, 1
-        -(s2*t71 + s2*t72),  # 1, 5, 2
-        t3*s1 - t6*c1,  # 1, 5, 3
-        -(t11*c1 + t23*s1),  # 1, 5, 4
-        t25*s1 - t13*c1,  # 1, 5, 5
-        t15*c1 + t27*s1,  # 1, 5, 6
+        -(t71*s2 + t72*s2),  # 1, 5, 2
+        s1*t3 - c1*t6,  # 1, 5, 3
+        -(c1*t11 + s1*t23),  # 1, 5, 4
+        s1*t25 - c1*t13,  # 1, 5, 5
+        c1*t15 + s1*t27,  # 1, 5, 6
         t61,  # 2, 0, 0
         t63,  # 2, 0, 1
-        -t59*c2 + t33*t20,  # 2, 0, 2
+        -c2*t59 + t20*t33,  # 2, 0, 2
         t77,  # 2, 0, 3
         t78,  # 2, 0, 4
         t79,  # 2, 0, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0, 6
         t57,  # 2, 1, 0
         t67,  # 2, 1, 1
-        t57*c2 - t33*t8,  # 2, 1, 2
+        c2*t57 - t8*t33,  # 2, 1, 2
         t80,  # 2, 1, 3
         t81,  # 2, 1, 4
         t82,  # 2, 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 1, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 2, 0
         t73,  # 2, 2, 1
-        t59*t8 - t57*t20,  # 2, 2, 2
+        t8*t59 - t20*t57,  # 2, 2, 2
         t83,  # 2, 2, 3
         t84,  # 2, 2, 4
         t85,  # 2, 2, 5
@@ -1818,17 +1818,17 @@ def hessian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 3, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 3, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 3, 2
-        t3*c2 - t86*t0,  # 2, 3, 3
-        -t23*c2 + t40*t20,  # 2, 3, 4
-        t25*c2 - t43*t20,  # 2, 3, 5
-        t27*c2 - t45*t20,  # 2, 3, 6
+        c2*t3 - t0*t86,  # 2, 3, 3
+        -c2*t23 + t40*t20,  # 2, 3, 4
+        c2*t25 - t43*t20,  # 2, 3, 5
+        c2*t27 - t45*t20,  # 2, 3, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 4, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 4, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 4, 2
-        t6*c2 + t86*t5,  # 2, 4, 3
-        t11*c2 - t40*t8,  # 2, 4, 4
-        t13*c2 + t43*t8,  # 2, 4, 5
-        -t15*c2 + t45*t8,  # 2, 4, 6
+        c2*t6 + t5*t86,  # 2, 4, 3
+        c2*t11 - t40*t8,  # 2, 4, 4
+        c2*t13 + t43*t8,  # 2, 4, 5
+        -c2*t15 + t45*t8,  # 2, 4, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 5, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 5, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 5, 2
@@ -1839,21 +1839,21 @@ def hessian(q):
         t53,  # 3, 0, 0
         t64,  # 3, 0, 1
         t77,  # 3, 0, 2
-        -(t34*t3 + t53*t41),  # 3, 0, 3
+        -(t3*t34 + t41*t53),  # 3, 0, 3
         t87,  # 3, 0, 4
         t88,  # 3, 0, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0, 6
         t50,  # 3, 1, 0
         t68,  # 3, 1, 1
         t80,  # 3, 1, 2
-        -(t6*t34 + t50*t41),  # 3, 1, 3
+        -(t6*t34 + t41*t50),  # 3, 1, 3
         t89,  # 3, 1, 4
         t90,  # 3, 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 1, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 2, 0
         t74,  # 3, 2, 1
         t83,  # 3, 2, 2
-        t50*t3 - t6*t53,  # 3, 2, 3
+        t3*t50 - t6*t53,  # 3, 2, 3
         t91,  # 3, 2, 4
         t92,  # 3, 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 2, 6
@@ -1861,23 +1861,23 @@ def hessian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 3, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 3, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 3, 3
-        -t40*t3 + t23*t41,  # 3, 3, 4
-        t43*t3 - t25*t41,  # 3, 3, 5
-        t45*t3 - t27*t41,  # 3, 3, 6
+        -t3*t40 + t23*t41,  # 3, 3, 4
+        t3*t43 - t25*t41,  # 3, 3, 5
+        t3*t45 - t27*t41,  # 3, 3, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 4, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 4, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 4, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 4, 3
-        -(t40*t6 + t11*t41),  # 3, 4, 4
-        t43*t6 - t13*t41,  # 3, 4, 5
-        t45*t6 + t15*t41,  # 3, 4, 6
+        -(t6*t40 + t11*t41),  # 3, 4, 4
+        t6*t43 - t13*t41,  # 3, 4, 5
+        t6*t45 + t15*t41,  # 3, 4, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 5, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 5, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 5, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 5, 3
-        t11*t3 + t23*t6,  # 3, 5, 4
-        t13*t3 - t25*t6,  # 3, 5, 5
-        -(t15*t3 + t27*t6),  # 3, 5, 6
+        t3*t11 + t6*t23,  # 3, 5, 4
+        t3*t13 - t6*t25,  # 3, 5, 5
+        -(t3*t15 + t6*t27),  # 3, 5, 6
         t62,  # 4, 0, 0
         t65,  # 4, 0, 1
         t78,  # 4, 0, 2
@@ -2028,8 +2028,8 @@ def singularity_factors(q):
     t1 = c1*c3
     t2 = -t0 + c2*t1
     t3 = t1 - c2*t0
-    t4 = c3*s1
-    t5 = c1*s3
+    t4 = s1*c3
+    t5 = s3*c1
     t6 = t4 + c2*t5
     t7 = t5 + c2*t4
     t8 = 0.316*s2
@@ -2043,158 +2043,158 @@ def singularity_factors(q):
     t16 = t2*c4 + s4*t15
     t17 = -t2*s4 + c4*t15
     t18 = t16*c5 - t6*s5
-    t19 = t16*s5 + t6*c5
+    t19 = t16*s5 + c5*t6
     t20 = t17*s6 + t18*c6
-    t21 = t17*c6 - t18*s6
-    t22 = -0.21*t21 + 0.088*t20
-    t23 = t22 + 0.384*t17
-    t24 = t23 - 0.0825*t16
+    t21 = t17*c6 - s6*t18
+    t22 = 0.088*t20 - 0.21*t21
+    t23 = 0.384*t17 + t22
+    t24 = -0.0825*t16 + t23
     t25 = t9 + t24
     t26 = s1*s2
     t27 = t7*c4 + s4*t26
     t28 = -t7*s4 + c4*t26
-    t29 = t27*c5 + t3*s5
-    t30 = t3*c5 - t27*s5
-    t31 = t28*s6 + t29*c6
-    t32 = t28*c6 - t29*s6
-    t33 = -0.21*t32 + 0.088*t31
-    t34 = t33 + 0.384*t28
-    t35 = t34 - 0.0825*t27
+    t29 = t27*c5 + s5*t3
+    t30 = c5*t3 - t27*s5
+    t31 = t28*s6 + c6*t29
+    t32 = t28*c6 - s6*t29
+    t33 = 0.088*t31 - 0.21*t32
+    t34 = 0.384*t28 + t33
+    t35 = -0.0825*t27 + t34
     t36 = t10 + t35
-    t37 = t25*c1 + t36*s1
+    t37 = c1*t25 + s1*t36
     t38 = t36*t15 - t25*t26
-    t39 = t24*t3 + t35*t6
+    t39 = t3*t24 + t6*t35
     t40 = t17*t34 - t28*t23
     t41 = t19*t33 + t30*t22
     t42 = s3*s2
     t43 = t13*c5 + s5*t42
     t44 = -t13*s5 + c5*t42
-    t45 = t14*s6 + t43*c6
-    t46 = t14*c6 - t43*s6
-    t47 = -0.21*t46 + 0.088*t45
-    t48 = t47 + 0.384*t14
-    t49 = t48 - 0.0825*t13
+    t45 = t14*s6 + c6*t43
+    t46 = t14*c6 - s6*t43
+    t47 = 0.088*t45 - 0.21*t46
+    t48 = 0.384*t14 + t47
+    t49 = -0.0825*t13 + t48
     t50 = t12 + t49
-    t51 = -t36*c2 + t50*t26
-    t52 = -t49*t3 + t35*t42
+    t51 = -c2*t36 + t50*t26
+    t52 = -t3*t49 + t35*t42
     t53 = t28*t48 - t14*t34
     t54 = t44*t33 - t30*t47
-    t55 = t25*c2 - t50*t15
-    t56 = t49*t6 + t24*t42
+    t55 = c2*t25 - t50*t15
+    t56 = t6*t49 + t24*t42
     t57 = t14*t23 - t17*t48
     t58 = t19*t47 + t44*t22
-    t59 = t44*t3 - t30*t42
-    t60 = t6*c1
+    t59 = t3*t44 - t30*t42
+    t60 = c1*t6
     t61 = s2*t5
     t62 = -(s1*t59 - t44*t60 + t19*t61)
-    t63 = -t14*t3 + t28*t42
+    t63 = -t3*t14 + t28*t42
     t64 = t14*t30 - t28*t44
     t65 = t19*t63 + t6*t64 - t17*t59
-    t66 = t17*c1
-    t67 = t19*c1
+    t66 = c1*t17
+    t67 = c1*t19
     t68 = -s1*t64 + t44*t66 + t14*t67
     t69 = -(s1*t63 + t14*t60 + t17*t61)
-    t70 = -(-t40*t62 + t37*t65 + t39*t68 + t41*t69)
-    t71 = t30*c2 - t44*t26
+    t70 = -(-t62*t40 + t37*t65 + t39*t68 + t41*t69)
+    t71 = c2*t30 - t44*t26
     t72 = c1**2
-    t73 = s2*t72
+    t73 = t72*s2
     t74 = -s1*t71 + c2*t67 + t44*t73
-    t75 = -t28*c2 + t14*t26
-    t76 = t19*t75 - t17*t71 + t64*t15
+    t75 = -c2*t28 + t14*t26
+    t76 = t19*t75 - t17*t71 + t15*t64
     t77 = -(s1*t75 - c2*t66 + t14*t73)
-    t78 = -(-t40*t74 + t37*t76 + t38*t68 + t41*t77)
+    t78 = -(-t74*t40 + t37*t76 + t38*t68 + t41*t77)
     t79 = s2**2
-    t80 = t3*c2 - t79*t0
-    t81 = t19*t80 - t6*t71 + t59*t15
+    t80 = c2*t3 - t0*t79
+    t81 = t19*t80 - t6*t71 + t15*t59
     t82 = -s1*t80 + c2*t60 + s3*t72*t79
-    t83 = -(-t39*t74 + t37*t81 + t38*t62 + t41*t82)
-    t84 = t17*t80 - t6*t75 + t63*t15
-    t85 = -(-t39*t77 + t37*t84 + t38*t69 + t40*t82)
-    t86 = t38*t65 + t40*t81 - t39*t76 - t41*t84
+    t83 = -(-t74*t39 + t37*t81 + t38*t62 + t41*t82)
+    t84 = t17*t80 - t6*t75 + t15*t63
+    t85 = -(-t77*t39 + t37*t84 + t38*t69 + t40*t82)
+    t86 = t38*t65 + t40*t81 - t76*t39 - t41*t84
     t87 = s1*t50
     t88 = -(t17*t30 + t28*t19)
-    t89 = t30*s1 - t67
-    t90 = -(t66 + t28*s1)
+    t89 = s1*t30 - t67
+    t90 = -(t66 + s1*t28)
     t91 = t37*t88 + t40*t89 - t41*t90
     t92 = -(t19*t26 + t30*t15)
-    t93 = -(t73 + s2*s1**2)
+    t93 = -(t73 + s1**2*s2)
     t94 = t37*t92 + t38*t89 - t41*t93
     t95 = t28*t15 - t17*t26
     t96 = t37*t95 + t38*t90 - t40*t93
     t97 = -(-t40*t92 + t38*t88 + t41*t95)
-    t98 = t17*t3 + t28*t6
-    t99 = t3*s1 - t60
+    t98 = t3*t17 + t6*t28
+    t99 = s1*t3 - t60
     t100 = t37*t98 + t39*t90 - t40*t99
     t101 = -(t6*t26 + t3*t15)
     t102 = t37*t101 + t38*t99 - t39*t93
     t103 = -(-t39*t95 + t38*t98 + t40*t101)
-    t104 = t19*t3 - t30*t6
+    t104 = t3*t19 - t6*t30
     t105 = t37*t104 + t39*t89 - t41*t99
     t106 = -(-t40*t104 + t39*t88 + t41*t98)
     t107 = -(-t39*t92 + t38*t104 + t41*t101)
     t108 = c1*t50
-    t109 = -t36*(t55*t70 + t56*t78 + t57*t83 + t58*t85 - t86*t87) - t52*(-t25*t78 - t55*t91 + t57*t94 + t58*t96 + t97*t87) + t54*(t25*t85 + t55*t100 + t56*t96 + t57*t102 - t103*t87) + t51*(-t25*t70 + t56*t91 + t57*t105 + t58*t100 + t106*t87) - t53*(t25*t83 + t55*t105 + t56*t94 - t58*t102 - t107*t87) - (-t25*t86 + t55*t106 + t56*t97 + t57*t107 + t58*t103)*t108
-    t110 = t46*t3 - t32*t42
+    t109 = -t36*(t55*t70 + t56*t78 + t57*t83 + t58*t85 - t86*t87) - t52*(-t25*t78 - t55*t91 + t57*t94 + t58*t96 + t87*t97) + t54*(t25*t85 + t55*t100 + t56*t96 + t57*t102 - t87*t103) + t51*(-t25*t70 + t56*t91 + t57*t105 + t58*t100 + t87*t106) - t53*(t25*t83 + t55*t105 + t56*t94 - t58*t102 - t87*t107) - t108*(-t25*t86 + t55*t106 + t56*t97 + t57*t107 + t58*t103)
+    t110 = t3*t46 - t32*t42
     t111 = -s1*t110 + t46*t60 + t21*t61
     t112 = t14*t32 - t28*t46
     t113 = -(-t6*t112 + t17*t110 + t21*t63)
-    t114 = t21*c1
+    t114 = c1*t21
     t115 = -(s1*t112 - t46*t66 + t14*t114)
     t116 = -(-t40*t111 + t37*t113 + t39*t115)
-    t117 = t32*c2 - t46*t26
+    t117 = c2*t32 - t46*t26
     t118 = -(s1*t117 - t46*t73 + c2*t114)
-    t119 = -(t17*t117 + t21*t75 - t112*t15)
+    t119 = -(t17*t117 + t21*t75 - t15*t112)
     t120 = -(-t40*t118 + t37*t119 + t38*t115)
-    t121 = -(t21*t80 + t6*t117 - t110*t15)
+    t121 = -(t21*t80 + t6*t117 - t15*t110)
     t122 = -(-t39*t118 + t37*t121 + t38*t111)
     t123 = t38*t113 + t40*t121 - t39*t119
-    t124 = -(t55*t116 + t56*t120 + t57*t122 - t123*t87)
+    t124 = -(t55*t116 + t56*t120 + t57*t122 - t87*t123)
     t125 = t28*t21 - t17*t32
-    t126 = t114 + t32*s1
+    t126 = t114 + s1*t32
     t127 = t37*t125 + t40*t126
     t128 = t21*t26 - t32*t15
     t129 = t37*t128 + t38*t126
     t130 = t40*t128 - t38*t125
-    t131 = t25*t120 + t55*t127 - t57*t129 - t130*t87
-    t132 = -(t21*t3 + t32*t6)
+    t131 = t25*t120 + t55*t127 - t57*t129 - t87*t130
+    t132 = -(t3*t21 + t6*t32)
     t133 = t37*t132 + t39*t126
     t134 = t40*t132 - t39*t125
-    t135 = -(-t25*t116 + t56*t127 + t57*t133 + t134*t87)
+    t135 = -(-t25*t116 + t56*t127 + t57*t133 + t87*t134)
     t136 = t39*t128 - t38*t132
-    t137 = t25*t122 + t55*t133 + t56*t129 - t136*t87
+    t137 = t25*t122 + t55*t133 + t56*t129 - t87*t136
     t138 = -(-t25*t123 + t55*t134 + t56*t130 + t57*t136)
-    t139 = t36*t124 + t52*t131 - t51*t135 - t53*t137 + t138*t108
+    t139 = t36*t124 + t52*t131 - t51*t135 - t53*t137 + t108*t138
     t140 = t30*t46 - t44*t32
     t141 = -(-t6*t140 + t19*t110 + t21*t59)
     t142 = -s1*t140 + t46*t67 + t44*t114
     t143 = -(-t41*t111 + t37*t141 + t39*t142)
-    t144 = -(t19*t117 + t21*t71 - t140*t15)
+    t144 = -(t19*t117 + t21*t71 - t15*t140)
     t145 = -(-t41*t118 + t37*t144 + t38*t142)
     t146 = t38*t141 + t41*t121 - t39*t144
-    t147 = t58*t122 - t55*t143 - t56*t145 + t146*t87
+    t147 = t58*t122 - t55*t143 - t56*t145 + t87*t146
     t148 = -(t19*t32 + t30*t21)
     t149 = t37*t148 + t41*t126
     t150 = t41*t128 - t38*t148
-    t151 = t25*t145 + t55*t149 + t58*t129 - t150*t87
+    t151 = t25*t145 + t55*t149 + t58*t129 - t87*t150
     t152 = t41*t132 - t39*t148
-    t153 = t25*t143 + t58*t133 - t56*t149 - t152*t87
+    t153 = t25*t143 + t58*t133 - t56*t149 - t87*t152
     t154 = t25*t146 + t58*t136 - t55*t152 - t56*t150
-    t155 = t36*t147 + t52*t151 - t51*t153 - t54*t137 + t154*t108
+    t155 = t36*t147 + t52*t151 - t51*t153 - t54*t137 + t108*t154
     t156 = -(-t17*t140 + t19*t112 + t21*t64)
     t157 = -(-t41*t115 + t37*t156 + t40*t142)
     t158 = t38*t156 + t41*t119 - t40*t144
-    t159 = t57*t145 + t58*t120 - t55*t157 + t158*t87
+    t159 = t57*t145 + t58*t120 - t55*t157 + t87*t158
     t160 = t41*t125 - t40*t148
-    t161 = t25*t157 + t57*t149 + t58*t127 - t160*t87
+    t161 = t25*t157 + t57*t149 + t58*t127 - t87*t160
     t162 = t25*t158 + t57*t150 + t58*t130 - t55*t160
-    t163 = t36*t159 + t53*t151 - t51*t161 - t54*t131 + t162*t108
+    t163 = t36*t159 + t53*t151 - t51*t161 - t54*t131 + t108*t162
     t164 = t39*t156 + t41*t113 - t40*t141
-    t165 = t56*t157 + t57*t143 + t58*t116 + t164*t87
+    t165 = t56*t157 + t57*t143 + t58*t116 + t87*t164
     t166 = t25*t164 + t56*t160 + t57*t152 + t58*t134
-    t167 = t36*t165 + t53*t153 - t52*t161 - t54*t135 + t166*t108
+    t167 = t36*t165 + t53*t153 - t52*t161 - t54*t135 + t108*t166
     t168 = t55*t164 + t56*t158 + t57*t146 + t58*t123
     t169 = t36*t168 + t51*t166 + t53*t154 - t52*t162 - t54*t138
-    t170 = t52*t159 + t54*t124 - t51*t165 - t53*t147 + t168*t108
+    t170 = t52*t159 + t54*t124 - t51*t165 - t53*t147 + t108*t168
     f = _stack(xp, [
         t109**2 + t139**2 + t155**2 + t163**2 + t167**2 + t169**2 + t170**2,  # 0
     ], (1,))
@@ -2221,8 +2221,8 @@ def manipulability(q):
     t1 = c1*c3
     t2 = -t0 + c2*t1
     t3 = t1 - c2*t0
-    t4 = c3*s1
-    t5 = c1*s3
+    t4 = s1*c3
+    t5 = s3*c1
     t6 = t4 + c2*t5
     t7 = t5 + c2*t4
     t8 = 0.316*s2
@@ -2236,158 +2236,158 @@ def manipulability(q):
     t16 = t2*c4 + s4*t15
     t17 = -t2*s4 + c4*t15
     t18 = t16*c5 - t6*s5
-    t19 = t16*s5 + t6*c5
+    t19 = t16*s5 + c5*t6
     t20 = t17*s6 + t18*c6
-    t21 = t17*c6 - t18*s6
-    t22 = -0.21*t21 + 0.088*t20
-    t23 = t22 + 0.384*t17
-    t24 = t23 - 0.0825*t16
+    t21 = t17*c6 - s6*t18
+    t22 = 0.088*t20 - 0.21*t21
+    t23 = 0.384*t17 + t22
+    t24 = -0.0825*t16 + t23
     t25 = t9 + t24
     t26 = s1*s2
     t27 = t7*c4 + s4*t26
     t28 = -t7*s4 + c4*t26
-    t29 = t27*c5 + t3*s5
-    t30 = t3*c5 - t27*s5
-    t31 = t28*s6 + t29*c6
-    t32 = t28*c6 - t29*s6
-    t33 = -0.21*t32 + 0.088*t31
-    t34 = t33 + 0.384*t28
-    t35 = t34 - 0.0825*t27
+    t29 = t27*c5 + s5*t3
+    t30 = c5*t3 - t27*s5
+    t31 = t28*s6 + c6*t29
+    t32 = t28*c6 - s6*t29
+    t33 = 0.088*t31 - 0.21*t32
+    t34 = 0.384*t28 + t33
+    t35 = -0.0825*t27 + t34
     t36 = t10 + t35
-    t37 = t25*c1 + t36*s1
+    t37 = c1*t25 + s1*t36
     t38 = t36*t15 - t25*t26
-    t39 = t24*t3 + t35*t6
+    t39 = t3*t24 + t6*t35
     t40 = t17*t34 - t28*t23
     t41 = t19*t33 + t30*t22
     t42 = s3*s2
     t43 = t13*c5 + s5*t42
     t44 = -t13*s5 + c5*t42
-    t45 = t14*s6 + t43*c6
-    t46 = t14*c6 - t43*s6
-    t47 = -0.21*t46 + 0.088*t45
-    t48 = t47 + 0.384*t14
-    t49 = t48 - 0.0825*t13
+    t45 = t14*s6 + c6*t43
+    t46 = t14*c6 - s6*t43
+    t47 = 0.088*t45 - 0.21*t46
+    t48 = 0.384*t14 + t47
+    t49 = -0.0825*t13 + t48
     t50 = t12 + t49
-    t51 = -t36*c2 + t50*t26
-    t52 = -t49*t3 + t35*t42
+    t51 = -c2*t36 + t50*t26
+    t52 = -t3*t49 + t35*t42
     t53 = t28*t48 - t14*t34
     t54 = t44*t33 - t30*t47
-    t55 = t25*c2 - t50*t15
-    t56 = t49*t6 + t24*t42
+    t55 = c2*t25 - t50*t15
+    t56 = t6*t49 + t24*t42
     t57 = t14*t23 - t17*t48
     t58 = t19*t47 + t44*t22
-    t59 = t44*t3 - t30*t42
-    t60 = t6*c1
+    t59 = t3*t44 - t30*t42
+    t60 = c1*t6
     t61 = s2*t5
     t62 = -(s1*t59 - t44*t60 + t19*t61)
-    t63 = -t14*t3 + t28*t42
+    t63 = -t3*t14 + t28*t42
     t64 = t14*t30 - t28*t44
     t65 = t19*t63 + t6*t64 - t17*t59
-    t66 = t17*c1
-    t67 = t19*c1
+    t66 = c1*t17
+    t67 = c1*t19
     t68 = -s1*t64 + t44*t66 + t14*t67
     t69 = -(s1*t63 + t14*t60 + t17*t61)
-    t70 = -(-t40*t62 + t37*t65 + t39*t68 + t41*t69)
-    t71 = t30*c2 - t44*t26
+    t70 = -(-t62*t40 + t37*t65 + t39*t68 + t41*t69)
+    t71 = c2*t30 - t44*t26
     t72 = c1**2
-    t73 = s2*t72
+    t73 = t72*s2
     t74 = -s1*t71 + c2*t67 + t44*t73
-    t75 = -t28*c2 + t14*t26
-    t76 = t19*t75 - t17*t71 + t64*t15
+    t75 = -c2*t28 + t14*t26
+    t76 = t19*t75 - t17*t71 + t15*t64
     t77 = -(s1*t75 - c2*t66 + t14*t73)
-    t78 = -(-t40*t74 + t37*t76 + t38*t68 + t41*t77)
+    t78 = -(-t74*t40 + t37*t76 + t38*t68 + t41*t77)
     t79 = s2**2
-    t80 = t3*c2 - t79*t0
-    t81 = t19*t80 - t6*t71 + t59*t15
+    t80 = c2*t3 - t0*t79
+    t81 = t19*t80 - t6*t71 + t15*t59
     t82 = -s1*t80 + c2*t60 + s3*t72*t79
-    t83 = -(-t39*t74 + t37*t81 + t38*t62 + t41*t82)
-    t84 = t17*t80 - t6*t75 + t63*t15
-    t85 = -(-t39*t77 + t37*t84 + t38*t69 + t40*t82)
-    t86 = t38*t65 + t40*t81 - t39*t76 - t41*t84
+    t83 = -(-t74*t39 + t37*t81 + t38*t62 + t41*t82)
+    t84 = t17*t80 - t6*t75 + t15*t63
+    t85 = -(-t77*t39 + t37*t84 + t38*t69 + t40*t82)
+    t86 = t38*t65 + t40*t81 - t76*t39 - t41*t84
     t87 = s1*t50
     t88 = -(t17*t30 + t28*t19)
-    t89 = t30*s1 - t67
-    t90 = -(t66 + t28*s1)
+    t89 = s1*t30 - t67
+    t90 = -(t66 + s1*t28)
     t91 = t37*t88 + t40*t89 - t41*t90
     t92 = -(t19*t26 + t30*t15)
-    t93 = -(t73 + s2*s1**2)
+    t93 = -(t73 + s1**2*s2)
     t94 = t37*t92 + t38*t89 - t41*t93
     t95 = t28*t15 - t17*t26
     t96 = t37*t95 + t38*t90 - t40*t93
     t97 = -(-t40*t92 + t38*t88 + t41*t95)
-    t98 = t17*t3 + t28*t6
-    t99 = t3*s1 - t60
+    t98 = t3*t17 + t6*t28
+    t99 = s1*t3 - t60
     t100 = t37*t98 + t39*t90 - t40*t99
     t101 = -(t6*t26 + t3*t15)
     t102 = t37*t101 + t38*t99 - t39*t93
     t103 = -(-t39*t95 + t38*t98 + t40*t101)
-    t104 = t19*t3 - t30*t6
+    t104 = t3*t19 - t6*t30
     t105 = t37*t104 + t39*t89 - t41*t99
     t106 = -(-t40*t104 + t39*t88 + t41*t98)
     t107 = -(-t39*t92 + t38*t104 + t41*t101)
     t108 = c1*t50
-    t109 = -t36*(t55*t70 + t56*t78 + t57*t83 + t58*t85 - t86*t87) - t52*(-t25*t78 - t55*t91 + t57*t94 + t58*t96 + t97*t87) + t54*(t25*t85 + t55*t100 + t56*t96 + t57*t102 - t103*t87) + t51*(-t25*t70 + t56*t91 + t57*t105 + t58*t100 + t106*t87) - t53*(t25*t83 + t55*t105 + t56*t94 - t58*t102 - t107*t87) - (-t25*t86 + t55*t106 + t56*t97 + t57*t107 + t58*t103)*t108
-    t110 = t46*t3 - t32*t42
+    t109 = -t36*(t55*t70 + t56*t78 + t57*t83 + t58*t85 - t86*t87) - t52*(-t25*t78 - t55*t91 + t57*t94 + t58*t96 + t87*t97) + t54*(t25*t85 + t55*t100 + t56*t96 + t57*t102 - t87*t103) + t51*(-t25*t70 + t56*t91 + t57*t105 + t58*t100 + t87*t106) - t53*(t25*t83 + t55*t105 + t56*t94 - t58*t102 - t87*t107) - t108*(-t25*t86 + t55*t106 + t56*t97 + t57*t107 + t58*t103)
+    t110 = t3*t46 - t32*t42
     t111 = -s1*t110 + t46*t60 + t21*t61
     t112 = t14*t32 - t28*t46
     t113 = -(-t6*t112 + t17*t110 + t21*t63)
-    t114 = t21*c1
+    t114 = c1*t21
     t115 = -(s1*t112 - t46*t66 + t14*t114)
     t116 = -(-t40*t111 + t37*t113 + t39*t115)
-    t117 = t32*c2 - t46*t26
+    t117 = c2*t32 - t46*t26
     t118 = -(s1*t117 - t46*t73 + c2*t114)
-    t119 = -(t17*t117 + t21*t75 - t112*t15)
+    t119 = -(t17*t117 + t21*t75 - t15*t112)
     t120 = -(-t40*t118 + t37*t119 + t38*t115)
-    t121 = -(t21*t80 + t6*t117 - t110*t15)
+    t121 = -(t21*t80 + t6*t117 - t15*t110)
     t122 = -(-t39*t118 + t37*t121 + t38*t111)
     t123 = t38*t113 + t40*t121 - t39*t119
-    t124 = -(t55*t116 + t56*t120 + t57*t122 - t123*t87)
+    t124 = -(t55*t116 + t56*t120 + t57*t122 - t87*t123)
     t125 = t28*t21 - t17*t32
-    t126 = t114 + t32*s1
+    t126 = t114 + s1*t32
     t127 = t37*t125 + t40*t126
     t128 = t21*t26 - t32*t15
     t129 = t37*t128 + t38*t126
     t130 = t40*t128 - t38*t125
-    t131 = t25*t120 + t55*t127 - t57*t129 - t130*t87
-    t132 = -(t21*t3 + t32*t6)
+    t131 = t25*t120 + t55*t127 - t57*t129 - t87*t130
+    t132 = -(t3*t21 + t6*t32)
     t133 = t37*t132 + t39*t126
     t134 = t40*t132 - t39*t125
-    t135 = -(-t25*t116 + t56*t127 + t57*t133 + t134*t87)
+    t135 = -(-t25*t116 + t56*t127 + t57*t133 + t87*t134)
     t136 = t39*t128 - t38*t132
-    t137 = t25*t122 + t55*t133 + t56*t129 - t136*t87
+    t137 = t25*t122 + t55*t133 + t56*t129 - t87*t136
     t138 = -(-t25*t123 + t55*t134 + t56*t130 + t57*t136)
-    t139 = t36*t124 + t52*t131 - t51*t135 - t53*t137 + t138*t108
+    t139 = t36*t124 + t52*t131 - t51*t135 - t53*t137 + t108*t138
     t140 = t30*t46 - t44*t32
     t141 = -(-t6*t140 + t19*t110 + t21*t59)
     t142 = -s1*t140 + t46*t67 + t44*t114
     t143 = -(-t41*t111 + t37*t141 + t39*t142)
-    t144 = -(t19*t117 + t21*t71 - t140*t15)
+    t144 = -(t19*t117 + t21*t71 - t15*t140)
     t145 = -(-t41*t118 + t37*t144 + t38*t142)
     t146 = t38*t141 + t41*t121 - t39*t144
-    t147 = t58*t122 - t55*t143 - t56*t145 + t146*t87
+    t147 = t58*t122 - t55*t143 - t56*t145 + t87*t146
     t148 = -(t19*t32 + t30*t21)
     t149 = t37*t148 + t41*t126
     t150 = t41*t128 - t38*t148
-    t151 = t25*t145 + t55*t149 + t58*t129 - t150*t87
+    t151 = t25*t145 + t55*t149 + t58*t129 - t87*t150
     t152 = t41*t132 - t39*t148
-    t153 = t25*t143 + t58*t133 - t56*t149 - t152*t87
+    t153 = t25*t143 + t58*t133 - t56*t149 - t87*t152
     t154 = t25*t146 + t58*t136 - t55*t152 - t56*t150
-    t155 = t36*t147 + t52*t151 - t51*t153 - t54*t137 + t154*t108
+    t155 = t36*t147 + t52*t151 - t51*t153 - t54*t137 + t108*t154
     t156 = -(-t17*t140 + t19*t112 + t21*t64)
     t157 = -(-t41*t115 + t37*t156 + t40*t142)
     t158 = t38*t156 + t41*t119 - t40*t144
-    t159 = t57*t145 + t58*t120 - t55*t157 + t158*t87
+    t159 = t57*t145 + t58*t120 - t55*t157 + t87*t158
     t160 = t41*t125 - t40*t148
-    t161 = t25*t157 + t57*t149 + t58*t127 - t160*t87
+    t161 = t25*t157 + t57*t149 + t58*t127 - t87*t160
     t162 = t25*t158 + t57*t150 + t58*t130 - t55*t160
-    t163 = t36*t159 + t53*t151 - t51*t161 - t54*t131 + t162*t108
+    t163 = t36*t159 + t53*t151 - t51*t161 - t54*t131 + t108*t162
     t164 = t39*t156 + t41*t113 - t40*t141
-    t165 = t56*t157 + t57*t143 + t58*t116 + t164*t87
+    t165 = t56*t157 + t57*t143 + t58*t116 + t87*t164
     t166 = t25*t164 + t56*t160 + t57*t152 + t58*t134
-    t167 = t36*t165 + t53*t153 - t52*t161 - t54*t135 + t166*t108
+    t167 = t36*t165 + t53*t153 - t52*t161 - t54*t135 + t108*t166
     t168 = t55*t164 + t56*t158 + t57*t146 + t58*t123
     t169 = t36*t168 + t51*t166 + t53*t154 - t52*t162 - t54*t138
-    t170 = t52*t159 + t54*t124 - t51*t165 - t53*t147 + t168*t108
+    t170 = t52*t159 + t54*t124 - t51*t165 - t53*t147 + t108*t168
     t171 = t109**2 + t139**2 + t155**2 + t163**2 + t167**2 + t169**2 + t170**2
     w = xp.broadcast_to(xp.sqrt(xp.abs(t171)), batch)
     return w
@@ -2427,8 +2427,8 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t1 = c1*c3
     t2 = -t0 + c2*t1
     t3 = t1 - c2*t0
-    t4 = c3*s1
-    t5 = c1*s3
+    t4 = s1*c3
+    t5 = s3*c1
     t6 = t4 + c2*t5
     t7 = t5 + c2*t4
     t8 = c1*s2
@@ -2436,28 +2436,28 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t10 = t2*c4 + s4*t8
     t11 = -t2*s4 + c4*t8
     t12 = t10*c5 - t6*s5
-    t13 = t10*s5 + t6*c5
+    t13 = t10*s5 + c5*t6
     t14 = t11*s6 + t12*c6
-    t15 = t11*c6 - t12*s6
-    t16 = -0.21*t15 + 0.088*t14
-    t17 = t16 + 0.384*t11
-    t18 = t17 - 0.0825*t10
+    t15 = t11*c6 - s6*t12
+    t16 = 0.088*t14 - 0.21*t15
+    t17 = 0.384*t11 + t16
+    t18 = -0.0825*t10 + t17
     t19 = t9 + t18
     t20 = s1*s2
     t21 = 0.0825*t7 + 0.316*t20
     t22 = t7*c4 + s4*t20
     t23 = -t7*s4 + c4*t20
-    t24 = t22*c5 + t3*s5
-    t25 = t3*c5 - t22*s5
-    t26 = t23*s6 + t24*c6
-    t27 = t23*c6 - t24*s6
-    t28 = -0.21*t27 + 0.088*t26
-    t29 = t28 + 0.384*t23
-    t30 = t29 - 0.0825*t22
+    t24 = t22*c5 + s5*t3
+    t25 = c5*t3 - t22*s5
+    t26 = t23*s6 + c6*t24
+    t27 = t23*c6 - s6*t24
+    t28 = 0.088*t26 - 0.21*t27
+    t29 = 0.384*t23 + t28
+    t30 = -0.0825*t22 + t29
     t31 = t21 + t30
-    t32 = t19*c1 + t31*s1
+    t32 = c1*t19 + s1*t31
     t33 = t31*t8 - t19*t20
-    t34 = t18*t3 + t30*t6
+    t34 = t3*t18 + t6*t30
     t35 = t11*t29 - t23*t17
     t36 = t13*t28 + t25*t16
     t37 = t32**2 + t33**2 + t34**2 + t35**2 + t36**2
@@ -2465,230 +2465,230 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t39 = 0.316*c2 - 0.0825*t38
     t40 = c2*s4 - c4*t38
     t41 = c2*c4 + s4*t38
-    t42 = s2*s3
+    t42 = s3*s2
     t43 = t40*c5 + s5*t42
     t44 = -t40*s5 + c5*t42
-    t45 = t41*s6 + t43*c6
-    t46 = t41*c6 - t43*s6
-    t47 = -0.21*t46 + 0.088*t45
-    t48 = t47 + 0.384*t41
-    t49 = t48 - 0.0825*t40
+    t45 = t41*s6 + c6*t43
+    t46 = t41*c6 - s6*t43
+    t47 = 0.088*t45 - 0.21*t46
+    t48 = 0.384*t41 + t47
+    t49 = -0.0825*t40 + t48
     t50 = t39 + t49
-    t51 = -t49*t3 + t30*t42
-    t52 = t23*t48 - t41*t29
-    t53 = t44*t28 - t25*t47
-    t54 = t49*t6 + t18*t42
-    t55 = t41*t17 - t11*t48
-    t56 = t13*t47 + t44*t16
-    t57 = t41*t35 + t33*c2 - t44*t36 - t34*t42
-    t58 = t11*t41 + t15*t46 - t13*t44 + c2*t8 - t6*t42
-    t59 = t23*t41 + t25*t44 + t27*t46 + t3*t42 + c2*t20
-    t60 = t50*s1
-    t61 = -t31*c2 + s2*t60
-    t62 = t31 + t44*t53 - t41*t52 - t61*c2 + t51*t42
-    t63 = t50*c1
-    t64 = t19*c2 - s2*t63
-    t65 = t19 + t41*t55 + t44*t56 + t64*c2 + t54*t42
-    t66 = 1 + t11 + t23 + t41 + t13 + t19 + t6 + t61 + t51 + t52 + t53 + t64 + t55 + t33 + t34 + t35 + t36 + c1 + c2 + damping + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + q1 + q2 + q3 + q4 + q5 + q6 + q7 - t25 - t44 - t15 - t27 - t46 - t31 - t54 - t56 - t32 - t3 - s1 + t63 + t60 + t8 + t20 - t42
-    t67 = t50**2
-    t68 = c1**2
-    t69 = t31**2 + t61**2 + t51**2 + t52**2 + t53**2 + t67*t68
-    t70 = t23*t52 + t50*t68 - t25*t53 - t51*t3 + t61*t20
-    t71 = c1*s1
-    t72 = t61*t64 + t52*t55 - t19*t31 - t51*t54 - t53*t56 + t67*t71
-    t73 = t32*c1
-    t74 = t61*t33 + t51*t34 + t52*t35 + t53*t36 - t50*t73
-    t75 = t25*t36 + t73 + t34*t3 - t23*t35 - t33*t20
-    t76 = t50*t71
-    t77 = t11*t52 + t13*t53 + t6*t51 + t61*t8 - t76
-    t78 = t23*t55 + t25*t56 + t54*t3 + t76 + t64*t20
-    t79 = s1**2
-    t80 = t19**2 + t64**2 + t54**2 + t55**2 + t56**2 + t67*t79
-    t81 = t13*t56 + t50*t79 + t6*t54 - t11*t55 - t64*t8
-    t82 = t32*s1
-    t83 = t54*t34 + t56*t36 - t64*t33 - t55*t35 + t50*t82
-    t84 = t11*t35 + t13*t36 + t6*t34 + t82 + t33*t8
-    t85 = s2**2
-    t86 = t11**2 + t13**2 + t15**2 + t6**2 + t79 + t68*t85
-    t87 = t11*t23 + t15*t27 - t13*t25 - t6*t3 - t71 + t85*t71
-    t88 = t23**2 + t25**2 + t27**2 + t3**2 + t68 + t79*t85
-    t89 = 1 + t41**2 + t44**2 + t46**2 + c2**2 + t85*s3**2
-    t90 = damping**2
-    t91 = t69 + t90
-    t92 = t91**2
-    t93 = t80 + t90
-    t94 = t37 + t90
-    t95 = t86 + t90
-    t96 = t88 + t90
-    t97 = t89 + t90
-    t98 = t72**2
-    t99 = t62**2
-    t100 = t74**2
-    t101 = t77**2
-    t102 = t70**2
-    t103 = xp.sqrt(t92 + t93**2 + t94**2 + t95**2 + t96**2 + t97**2 + 2*t98 + 2*t99 + 2*t100 + 2*t101 + 2*t102 + 2*t65**2 + 2*t83**2 + 2*t81**2 + 2*t78**2 + 2*t84**2 + 2*t75**2 + 2*t57**2 + 2*t87**2 + 2*t58**2 + 2*t59**2)
-    t104 = xp.sqrt(t98 + t99 + t100 + t101 + t102 + t92)
-    t105 = t104*xp.where(xp.greater_equal(t91, 0), xp.asarray(1, dtype=dtype), -1)
-    t106 = t105 + t91
-    t107 = xp.where(xp.greater(t104, 0), 1/(t104*(t104 + xp.abs(t91))), 0)
-    t108 = t107*(t72*t106 + t72*t93 + t70*t78 - t62*t65 - t74*t83 - t77*t81)
-    t109 = t72 - t106*t108
-    t110 = -t72*t108 + t93
-    t111 = t83 + t74*t108
-    t112 = t81 + t77*t108
-    t113 = t78 - t70*t108
-    t114 = t65 + t62*t108
-    t115 = t107*(t74*t106 + t74*t94 + t77*t84 - t72*t83 - t62*t57 - t70*t75)
-    t116 = t74 - t106*t115
-    t117 = t83 + t72*t115
-    t118 = -t74*t115 + t94
-    t119 = t84 - t77*t115
-    t120 = t75 + t70*t115
-    t121 = t57 + t62*t115
-    t122 = t107*(t74*t84 + t77*t106 + t77*t95 + t70*t87 - t72*t81 - t62*t58)
-    t123 = t77 - t106*t122
-    t124 = t81 + t72*t122
-    t125 = t84 - t74*t122
-    t126 = -t77*t122 + t95
-    t127 = t87 - t70*t122
-    t128 = t58 + t62*t122
-    t129 = t107*(t72*t78 + t77*t87 + t70*t106 + t70*t96 - t62*t59 - t74*t75)
-    t130 = t70 - t106*t129
-    t131 = t78 - t72*t129
-    t132 = t75 + t74*t129
-    t133 = t87 - t77*t129
-    t134 = -t70*t129 + t96
-    t135 = t59 + t62*t129
-    t136 = t107*(t72*t65 + t74*t57 + t77*t58 + t70*t59 - t62*t106 - t62*t97)
-    t137 = t62 + t106*t136
-    t138 = t65 - t72*t136
-    t139 = t57 - t74*t136
-    t140 = t58 - t77*t136
-    t141 = t59 - t70*t136
-    t142 = t62*t136 + t97
-    t143 = t107*(t72*mu_dot1 + t74*mu_dot2 + t77*mu_dot3 + t70*mu_dot4 + t106*mu_dot0 - t62*mu_dot5)
-    t144 = mu_dot0 - t106*t143
-    t145 = mu_dot1 - t72*t143
-    t146 = mu_dot2 - t74*t143
-    t147 = mu_dot3 - t77*t143
-    t148 = mu_dot4 - t70*t143
-    t149 = mu_dot5 + t62*t143
-    t150 = xp.sqrt(t110**2 + t111**2 + t112**2 + t113**2 + t114**2)
-    t151 = t150*xp.where(xp.greater_equal(t110, 0), xp.asarray(1, dtype=dtype), -1)
-    t152 = t110 + t151
-    t153 = xp.where(xp.greater(t150, 0), 1/(t150*(t150 + xp.abs(t110))), 0)
-    t154 = -t153*(-t114*t121 + t111*t118 + t112*t119 + t113*t120 + t117*t152)
-    t155 = t117 + t152*t154
-    t156 = t118 + t111*t154
-    t157 = t119 + t112*t154
-    t158 = t120 + t113*t154
-    t159 = t121 - t114*t154
-    t160 = -t153*(-t113*t127 - t114*t128 + t111*t125 + t112*t126 + t124*t152)
-    t161 = t124 + t152*t160
-    t162 = t125 + t111*t160
-    t163 = t126 + t112*t160
-    t164 = t127 - t113*t160
-    t165 = t128 - t114*t160
-    t166 = t153*(t111*t132 + t113*t134 + t114*t135 + t131*t152 - t112*t133)
-    t167 = t131 - t152*t166
-    t168 = -t132 + t111*t166
-    t169 = t133 + t112*t166
-    t170 = t134 - t113*t166
-    t171 = t135 - t114*t166
-    t172 = t153*(t113*t141 + t114*t142 + t138*t152 - t111*t139 - t112*t140)
-    t173 = t138 - t152*t172
-    t174 = t139 + t111*t172
-    t175 = t140 + t112*t172
-    t176 = t141 - t113*t172
-    t177 = t142 - t114*t172
-    t178 = t153*(t113*t148 + t114*t149 + t145*t152 - t111*t146 - t112*t147)
-    t179 = t145 - t152*t178
-    t180 = t146 + t111*t178
-    t181 = t147 + t112*t178
-    t182 = t148 - t113*t178
-    t183 = t149 - t114*t178
-    t184 = xp.sqrt(t156**2 + t157**2 + t158**2 + t159**2)
-    t185 = t184*xp.where(xp.greater_equal(t156, 0), xp.asarray(1, dtype=dtype), -1)
-    t186 = t156 + t185
-    t187 = xp.where(xp.greater(t184, 0), 1/(t184*(t184 + xp.abs(t156))), 0)
-    t188 = t187*(t157*t163 + t159*t165 + t162*t186 - t158*t164)
-    t189 = t162 - t186*t188
-    t190 = t163 - t157*t188
-    t191 = t164 + t158*t188
-    t192 = t165 - t159*t188
-    t193 = t187*(t157*t169 + t159*t171 + t168*t186 - t158*t170)
-    t194 = t168 - t186*t193
-    t195 = t169 - t157*t193
-    t196 = t170 + t158*t193
-    t197 = t171 - t159*t193
-    t198 = t187*(t157*t175 + t159*t177 + t174*t186 - t158*t176)
-    t199 = t174 - t186*t198
-    t200 = t175 - t157*t198
-    t201 = t176 + t158*t198
-    t202 = t177 - t159*t198
-    t203 = t187*(t157*t181 + t159*t183 + t180*t186 - t158*t182)
-    t204 = t180 - t186*t203
-    t205 = t181 - t157*t203
-    t206 = t182 + t158*t203
-    t207 = t183 - t159*t203
-    t208 = xp.sqrt(t190**2 + t191**2 + t192**2)
-    t209 = t208*xp.where(xp.greater_equal(t190, 0), xp.asarray(1, dtype=dtype), -1)
-    t210 = t190 + t209
-    t211 = xp.where(xp.greater(t208, 0), 1/(t208*(t208 + xp.abs(t190))), 0)
-    t212 = t211*(t191*t196 + t192*t197 + t195*t210)
-    t213 = t195 - t210*t212
-    t214 = t196 - t191*t212
-    t215 = t197 - t192*t212
-    t216 = t211*(t191*t201 + t192*t202 + t200*t210)
-    t217 = t200 - t210*t216
-    t218 = t201 - t191*t216
-    t219 = t202 - t192*t216
-    t220 = t211*(t191*t206 + t192*t207 + t205*t210)
-    t221 = t205 - t210*t220
-    t222 = t206 - t191*t220
-    t223 = t207 - t192*t220
-    t224 = xp.sqrt(t214**2 + t215**2)
-    t225 = t224*xp.where(xp.greater_equal(t214, 0), xp.asarray(1, dtype=dtype), -1)
-    t226 = t214 + t225
-    t227 = xp.where(xp.greater(t224, 0), 1/(t224*(t224 + xp.abs(t214))), 0)
-    t228 = t227*(t215*t219 + t218*t226)
-    t229 = t218 - t226*t228
-    t230 = t219 - t215*t228
-    t231 = t227*(t215*t223 + t222*t226)
-    t232 = t222 - t226*t231
-    t233 = t223 - t215*t231
-    t234 = xp.abs(t230)
-    t235 = t234
-    t236 = t235*xp.where(xp.greater_equal(t230, 0), xp.asarray(1, dtype=dtype), -1)
-    t237 = t230 + t236
-    t238 = xp.where(xp.greater(t235, 0), 1/(t235*(t235 + t234)), 0)
-    t239 = t233 - t233*t238*t237**2
-    t240 = xp.where(xp.not_equal(t236, 0), -t239/t236, 0)
-    t241 = xp.where(xp.not_equal(t225, 0), -(t232 - t229*t240)/t225, 0)
-    t242 = xp.where(xp.not_equal(t209, 0), -(t221 - (t213*t241 + t217*t240))/t209, 0)
-    t243 = xp.where(xp.not_equal(t185, 0), -(t204 - (t189*t242 + t194*t241 + t199*t240))/t185, 0)
-    t244 = xp.where(xp.not_equal(t151, 0), -(t179 - (t167*t241 + t173*t240 - t155*t243 - t161*t242))/t151, 0)
-    t245 = xp.where(xp.not_equal(t105, 0), -(t144 - (t109*t244 + t116*t243 + t123*t242 + t130*t241 - t137*t240))/t105, 0)
-    t246 = t240 + t244*t19 - t245*t31
-    t247 = t241*c1 - t242*s1 - t243*t32 + t244*t60 + t245*t63
-    t248 = t240*c2 + t243*t33 + t244*t64 + t245*t61 + t241*t20 + t242*t8
-    t249 = t242*t6 + t243*t34 + t245*t51 - t241*t3 - t244*t54 - t240*t42
-    t250 = t11*t242 + t23*t241 + t41*t240 + t243*t35 + t244*t55 + t245*t52
-    t251 = t13*t242 + t243*t36 + t245*t53 - t25*t241 - t44*t240 - t244*t56
-    t252 = t240*t46 + t241*t27 + t242*t15
-    t253 = xp.isfinite(t66)
+    t51 = -c2*t31 + t50*t20
+    t52 = -t3*t49 + t30*t42
+    t53 = t23*t48 - t41*t29
+    t54 = t44*t28 - t25*t47
+    t55 = c2*t19 - t50*t8
+    t56 = t6*t49 + t18*t42
+    t57 = t41*t17 - t11*t48
+    t58 = t13*t47 + t44*t16
+    t59 = t31 - c2*t51 + t42*t52 - t41*t53 + t44*t54
+    t60 = t19 + c2*t55 + t42*t56 + t41*t57 + t44*t58
+    t61 = c2*t33 - t42*t34 + t41*t35 - t44*t36
+    t62 = c2*t8 - t6*t42 + t11*t41 - t13*t44 + t15*t46
+    t63 = c2*t20 + t3*t42 + t23*t41 + t25*t44 + t27*t46
+    t64 = c1**2
+    t65 = t64*t50 + t20*t51 - t3*t52 + t23*t53 - t25*t54
+    t66 = t50**2
+    t67 = t31**2 + t51**2 + t52**2 + t53**2 + t54**2 + t64*t66
+    t68 = s1*c1
+    t69 = -t19*t31 + t66*t68 + t51*t55 - t52*t56 + t53*t57 - t54*t58
+    t70 = c1*t32
+    t71 = -t50*t70 + t51*t33 + t52*t34 + t53*t35 + t54*t36
+    t72 = t70 - t20*t33 + t3*t34 - t23*t35 + t25*t36
+    t73 = t50*t68
+    t74 = -t73 + t8*t51 + t6*t52 + t11*t53 + t13*t54
+    t75 = t73 + t20*t55 + t3*t56 + t23*t57 + t25*t58
+    t76 = s1**2
+    t77 = t19**2 + t55**2 + t56**2 + t57**2 + t58**2 + t76*t66
+    t78 = t76*t50 - t8*t55 + t6*t56 - t11*t57 + t13*t58
+    t79 = s1*t32
+    t80 = t50*t79 - t55*t33 + t56*t34 - t57*t35 + t58*t36
+    t81 = t79 + t8*t33 + t6*t34 + t11*t35 + t13*t36
+    t82 = s2**2
+    t83 = t76 + t6**2 + t11**2 + t13**2 + t15**2 + t64*t82
+    t84 = -t68 + t68*t82 - t6*t3 + t11*t23 - t13*t25 + t15*t27
+    t85 = t64 + t3**2 + t23**2 + t25**2 + t27**2 + t76*t82
+    t86 = 1 + c2**2 + t41**2 + t44**2 + t46**2 + s3**2*t82
+    t87 = t69**2
+    t88 = t71**2
+    t89 = t74**2
+    t90 = t65**2
+    t91 = t59**2
+    t92 = damping**2
+    t93 = t92 + t67
+    t94 = t93**2
+    t95 = xp.sqrt(t87 + t88 + t89 + t90 + t91 + t94)
+    t96 = t95*xp.where(xp.greater_equal(t93, 0), xp.asarray(1, dtype=dtype), -1)
+    t97 = t93 + t96
+    t98 = xp.where(xp.greater(t95, 0), 1/(t95*(t95 + xp.abs(t93))), 0)
+    t99 = t98*(mu_dot0*t97 + mu_dot1*t69 + mu_dot2*t71 + mu_dot3*t74 + mu_dot4*t65 - mu_dot5*t59)
+    t100 = mu_dot0 - t97*t99
+    t101 = mu_dot1 - t69*t99
+    t102 = mu_dot2 - t71*t99
+    t103 = mu_dot3 - t74*t99
+    t104 = mu_dot4 - t65*t99
+    t105 = mu_dot5 + t59*t99
+    t106 = t92 + t77
+    t107 = t98*(t69*t97 + t69*t106 - t71*t80 - t74*t78 + t65*t75 - t59*t60)
+    t108 = t69 - t97*t107
+    t109 = t106 - t69*t107
+    t110 = t80 + t71*t107
+    t111 = t78 + t74*t107
+    t112 = t75 - t65*t107
+    t113 = t60 + t59*t107
+    t114 = xp.sqrt(t109**2 + t110**2 + t111**2 + t112**2 + t113**2)
+    t115 = t114*xp.where(xp.greater_equal(t109, 0), xp.asarray(1, dtype=dtype), -1)
+    t116 = t109 + t115
+    t117 = xp.where(xp.greater(t114, 0), 1/(t114*(t114 + xp.abs(t109))), 0)
+    t118 = t117*(t101*t116 - t110*t102 - t111*t103 + t112*t104 + t113*t105)
+    t119 = t101 - t116*t118
+    t120 = t102 + t110*t118
+    t121 = t103 + t111*t118
+    t122 = t104 - t112*t118
+    t123 = t105 - t113*t118
+    t124 = t92 + t37
+    t125 = t98*(t71*t97 - t69*t80 + t71*t124 + t74*t81 - t65*t72 - t59*t61)
+    t126 = t71 - t97*t125
+    t127 = t80 + t69*t125
+    t128 = t124 - t71*t125
+    t129 = t81 - t74*t125
+    t130 = t72 + t65*t125
+    t131 = t61 + t59*t125
+    t132 = -t117*(t127*t116 + t110*t128 + t111*t129 + t112*t130 - t113*t131)
+    t133 = t127 + t116*t132
+    t134 = t128 + t110*t132
+    t135 = t129 + t111*t132
+    t136 = t130 + t112*t132
+    t137 = t131 - t113*t132
+    t138 = xp.sqrt(t134**2 + t135**2 + t136**2 + t137**2)
+    t139 = t138*xp.where(xp.greater_equal(t134, 0), xp.asarray(1, dtype=dtype), -1)
+    t140 = t134 + t139
+    t141 = xp.where(xp.greater(t138, 0), 1/(t138*(t138 + xp.abs(t134))), 0)
+    t142 = t141*(t120*t140 + t135*t121 - t136*t122 + t137*t123)
+    t143 = t120 - t140*t142
+    t144 = t121 - t135*t142
+    t145 = t122 + t136*t142
+    t146 = t123 - t137*t142
+    t147 = t92 + t83
+    t148 = t98*(t74*t97 - t69*t78 + t71*t81 + t74*t147 + t65*t84 - t59*t62)
+    t149 = t74 - t97*t148
+    t150 = t78 + t69*t148
+    t151 = t81 - t71*t148
+    t152 = t147 - t74*t148
+    t153 = t84 - t65*t148
+    t154 = t62 + t59*t148
+    t155 = -t117*(t150*t116 + t110*t151 + t111*t152 - t112*t153 - t113*t154)
+    t156 = t150 + t116*t155
+    t157 = t151 + t110*t155
+    t158 = t152 + t111*t155
+    t159 = t153 - t112*t155
+    t160 = t154 - t113*t155
+    t161 = t141*(t157*t140 + t135*t158 - t136*t159 + t137*t160)
+    t162 = t157 - t140*t161
+    t163 = t158 - t135*t161
+    t164 = t159 + t136*t161
+    t165 = t160 - t137*t161
+    t166 = xp.sqrt(t163**2 + t164**2 + t165**2)
+    t167 = t166*xp.where(xp.greater_equal(t163, 0), xp.asarray(1, dtype=dtype), -1)
+    t168 = t163 + t167
+    t169 = xp.where(xp.greater(t166, 0), 1/(t166*(t166 + xp.abs(t163))), 0)
+    t170 = t169*(t144*t168 + t164*t145 + t165*t146)
+    t171 = t144 - t168*t170
+    t172 = t145 - t164*t170
+    t173 = t146 - t165*t170
+    t174 = t92 + t85
+    t175 = t98*(t65*t97 + t69*t75 - t71*t72 + t74*t84 + t65*t174 - t59*t63)
+    t176 = t65 - t97*t175
+    t177 = t75 - t69*t175
+    t178 = t72 + t71*t175
+    t179 = t84 - t74*t175
+    t180 = t174 - t65*t175
+    t181 = t63 + t59*t175
+    t182 = t117*(t177*t116 + t110*t178 - t111*t179 + t112*t180 + t113*t181)
+    t183 = t177 - t116*t182
+    t184 = -t178 + t110*t182
+    t185 = t179 + t111*t182
+    t186 = t180 - t112*t182
+    t187 = t181 - t113*t182
+    t188 = t141*(t184*t140 + t135*t185 - t136*t186 + t137*t187)
+    t189 = t184 - t140*t188
+    t190 = t185 - t135*t188
+    t191 = t186 + t136*t188
+    t192 = t187 - t137*t188
+    t193 = t169*(t190*t168 + t164*t191 + t165*t192)
+    t194 = t190 - t168*t193
+    t195 = t191 - t164*t193
+    t196 = t192 - t165*t193
+    t197 = xp.sqrt(t195**2 + t196**2)
+    t198 = t197*xp.where(xp.greater_equal(t195, 0), xp.asarray(1, dtype=dtype), -1)
+    t199 = t195 + t198
+    t200 = xp.where(xp.greater(t197, 0), 1/(t197*(t197 + xp.abs(t195))), 0)
+    t201 = t200*(t172*t199 + t196*t173)
+    t202 = t172 - t199*t201
+    t203 = t173 - t196*t201
+    t204 = t92 + t86
+    t205 = xp.sqrt(2*t87 + 2*t88 + 2*t80**2 + 2*t89 + 2*t78**2 + 2*t81**2 + 2*t90 + 2*t75**2 + 2*t72**2 + 2*t84**2 + 2*t91 + 2*t60**2 + 2*t61**2 + 2*t62**2 + 2*t63**2 + t94 + t106**2 + t124**2 + t147**2 + t174**2 + t204**2)
+    t206 = t98*(-t59*t97 + t69*t60 + t71*t61 + t74*t62 + t65*t63 - t204*t59)
+    t207 = t59 + t97*t206
+    t208 = t60 - t69*t206
+    t209 = t61 - t71*t206
+    t210 = t62 - t74*t206
+    t211 = t63 - t65*t206
+    t212 = t204 + t59*t206
+    t213 = t117*(t208*t116 - t110*t209 - t111*t210 + t112*t211 + t113*t212)
+    t214 = t208 - t116*t213
+    t215 = t209 + t110*t213
+    t216 = t210 + t111*t213
+    t217 = t211 - t112*t213
+    t218 = t212 - t113*t213
+    t219 = t141*(t215*t140 + t135*t216 - t136*t217 + t137*t218)
+    t220 = t215 - t140*t219
+    t221 = t216 - t135*t219
+    t222 = t217 + t136*t219
+    t223 = t218 - t137*t219
+    t224 = t169*(t221*t168 + t164*t222 + t165*t223)
+    t225 = t221 - t168*t224
+    t226 = t222 - t164*t224
+    t227 = t223 - t165*t224
+    t228 = t200*(t226*t199 + t196*t227)
+    t229 = t226 - t199*t228
+    t230 = t227 - t196*t228
+    t231 = xp.abs(t230)
+    t232 = t231
+    t233 = t232*xp.where(xp.greater_equal(t230, 0), xp.asarray(1, dtype=dtype), -1)
+    t234 = t230 + t233
+    t235 = xp.where(xp.greater(t232, 0), 1/(t232*(t231 + t232)), 0)
+    t236 = t203 - t203*t234**2*t235
+    t237 = xp.where(xp.not_equal(t233, 0), -t236/t233, 0)
+    t238 = xp.where(xp.not_equal(t198, 0), -(t202 - t229*t237)/t198, 0)
+    t239 = xp.where(xp.not_equal(t167, 0), -(-(t194*t238 + t225*t237) + t171)/t167, 0)
+    t240 = xp.where(xp.not_equal(t139, 0), -(-(t162*t239 + t189*t238 + t220*t237) + t143)/t139, 0)
+    t241 = xp.where(xp.not_equal(t115, 0), -(-(-t133*t240 - t156*t239 + t183*t238 + t214*t237) + t119)/t115, 0)
+    t242 = xp.where(xp.not_equal(t96, 0), -(-(t108*t241 + t126*t240 + t149*t239 + t176*t238 - t207*t237) + t100)/t96, 0)
+    t243 = t237 - t31*t242 + t19*t241
+    t244 = t51*t242 + t55*t241 + t33*t240 + t8*t239 + t20*t238 + c2*t237
+    t245 = t52*t242 - t56*t241 + t34*t240 + t6*t239 - t3*t238 - t42*t237
+    t246 = t53*t242 + t57*t241 + t35*t240 + t11*t239 + t23*t238 + t41*t237
+    t247 = t54*t242 - t58*t241 + t36*t240 + t13*t239 - t25*t238 - t44*t237
+    t248 = t15*t239 + t27*t238 + t46*t237
+    t249 = c1*t50
+    t250 = s1*t50
+    t251 = t249*t242 + t250*t241 - t32*t240 - s1*t239 + c1*t238
+    t252 = 1 - t31 - t56 - t58 - t32 - s1 - t15 - t3 - t25 - t27 - t44 - t46 + q1 + q2 + q3 + c1 + c2 + t8 + t20 + q4 + q5 + t6 + t11 + t23 + t41 + q6 + q7 + t13 + t19 + t249 + t250 - t42 + t51 + t52 + t53 + t54 + t55 + t57 + t33 + t34 + t35 + t36 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + damping
+    t253 = xp.isfinite(t252)
     t254 = xp.greater_equal(damping, 0)
-    t255 = 1e-12*t103
-    t256 = xp.less_equal(t104, t255) | xp.less_equal(t150, t255) | xp.less_equal(t184, t255) | xp.less_equal(t208, t255) | xp.less_equal(t224, t255) | xp.less_equal(t235, t255)
+    t255 = 1e-12*t205
+    t256 = xp.less_equal(t95, t255) | xp.less_equal(t114, t255) | xp.less_equal(t138, t255) | xp.less_equal(t166, t255) | xp.less_equal(t197, t255) | xp.less_equal(t232, t255)
     t257 = t253 & t254 & xp.logical_not(t256)
     q_dot = _stack(xp, [
-        xp.broadcast_to(xp.where(t257, t246, 0), batch),  # 0
-        xp.broadcast_to(xp.where(t257, t247, 0), batch),  # 1
-        xp.broadcast_to(xp.where(t257, t248, 0), batch),  # 2
-        xp.broadcast_to(xp.where(t257, t249, 0), batch),  # 3
-        xp.broadcast_to(xp.where(t257, t250, 0), batch),  # 4
-        xp.broadcast_to(xp.where(t257, t251, 0), batch),  # 5
-        xp.broadcast_to(xp.where(t257, -t252, 0), batch),  # 6
+        xp.broadcast_to(xp.where(t257, t243, 0), batch),  # 0
+        xp.broadcast_to(xp.where(t257, t251, 0), batch),  # 1
+        xp.broadcast_to(xp.where(t257, t244, 0), batch),  # 2
+        xp.broadcast_to(xp.where(t257, t245, 0), batch),  # 3
+        xp.broadcast_to(xp.where(t257, t246, 0), batch),  # 4
+        xp.broadcast_to(xp.where(t257, t247, 0), batch),  # 5
+        xp.broadcast_to(xp.where(t257, -t248, 0), batch),  # 6
     ], (7,))
     status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t253 & t254), 2, xp.where(t256, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
     return q_dot, status
@@ -2738,13 +2738,13 @@ def ik_numeric_step(target, q, damping=0.0):
     s6 = xp.sin(q6)
     c7 = xp.cos(q7)
     s7 = xp.sin(q7)
-    t0 = T00 + T01 + T02 + T03 + T10 + T11 + T12 + T13 + T20 + T21 + T22 + T23 + qs1 + qs2 + qs3 + qs4 + qs5 + qs6 + qs7
+    t0 = qs1 + qs2 + qs3 + qs4 + qs5 + qs6 + qs7 + T00 + T01 + T02 + T10 + T11 + T12 + T20 + T21 + T22 + T03 + T13 + T23
     t1 = s1*s3
     t2 = c1*c3
     t3 = -t1 + c2*t2
     t4 = t2 - c2*t1
-    t5 = c3*s1
-    t6 = c1*s3
+    t5 = s1*c3
+    t6 = s3*c1
     t7 = t5 + c2*t6
     t8 = t6 + c2*t5
     t9 = 0.316*s2
@@ -2758,113 +2758,113 @@ def ik_numeric_step(target, q, damping=0.0):
     t17 = t3*c4 + s4*t16
     t18 = -t3*s4 + c4*t16
     t19 = t17*c5 - t7*s5
-    t20 = t17*s5 + t7*c5
+    t20 = t17*s5 + c5*t7
     t21 = t18*s6 + t19*c6
-    t22 = t18*c6 - t19*s6
+    t22 = t18*c6 - s6*t19
     t23 = t20*s7 + t21*c7
     t24 = t20*c7 - t21*s7
-    t25 = -0.21*t22 + 0.088*t21
-    t26 = t25 + 0.384*t18
-    t27 = t26 - 0.0825*t17
+    t25 = 0.088*t21 - 0.21*t22
+    t26 = 0.384*t18 + t25
+    t27 = -0.0825*t17 + t26
     t28 = t10 + t27
-    t29 = T03 - t28
+    t29 = -t28 + T03
     t30 = s1*s2
     t31 = t8*c4 + s4*t30
     t32 = -t8*s4 + c4*t30
-    t33 = t31*c5 + t4*s5
-    t34 = t4*c5 - t31*s5
-    t35 = t32*s6 + t33*c6
-    t36 = t32*c6 - t33*s6
-    t37 = t35*c7 - t34*s7
-    t38 = t34*c7 + t35*s7
-    t39 = -0.21*t36 + 0.088*t35
-    t40 = t39 + 0.384*t32
-    t41 = t40 - 0.0825*t31
+    t33 = t31*c5 + s5*t4
+    t34 = c5*t4 - t31*s5
+    t35 = t32*s6 + c6*t33
+    t36 = t32*c6 - s6*t33
+    t37 = t35*c7 - s7*t34
+    t38 = c7*t34 + t35*s7
+    t39 = 0.088*t35 - 0.21*t36
+    t40 = 0.384*t32 + t39
+    t41 = -0.0825*t31 + t40
     t42 = t11 + t41
-    t43 = t28*c1 + t42*s1
+    t43 = c1*t28 + s1*t42
     t44 = t42*t16 - t28*t30
-    t45 = t27*t4 + t41*t7
+    t45 = t4*t27 + t7*t41
     t46 = t18*t40 - t32*t26
     t47 = t20*t39 + t34*t25
     t48 = t43**2 + t44**2 + t45**2 + t46**2 + t47**2
-    t49 = T13 - t42
+    t49 = -t42 + T13
     t50 = s3*s2
     t51 = t14*c5 + s5*t50
     t52 = -t14*s5 + c5*t50
-    t53 = t15*s6 + t51*c6
-    t54 = t15*c6 - t51*s6
-    t55 = t53*c7 - t52*s7
-    t56 = t52*c7 + t53*s7
-    t57 = -0.21*t54 + 0.088*t53
-    t58 = t57 + 0.384*t15
-    t59 = t58 - 0.0825*t14
+    t53 = t15*s6 + c6*t51
+    t54 = t15*c6 - s6*t51
+    t55 = t53*c7 - s7*t52
+    t56 = c7*t52 + t53*s7
+    t57 = 0.088*t53 - 0.21*t54
+    t58 = 0.384*t15 + t57
+    t59 = -0.0825*t14 + t58
     t60 = t13 + t59
     t61 = 0.333 + t60
-    t62 = -t42*c2 + t60*t30
-    t63 = -t59*t4 + t41*t50
+    t62 = -c2*t42 + t60*t30
+    t63 = -t4*t59 + t41*t50
     t64 = t32*t58 - t15*t40
     t65 = t52*t39 - t34*t57
-    t66 = t28*c2 - t60*t16
-    t67 = t59*t7 + t27*t50
+    t66 = c2*t28 - t60*t16
+    t67 = t7*t59 + t27*t50
     t68 = t15*t26 - t18*t58
     t69 = t20*t57 + t52*t25
-    t70 = t42 + t52*t65 - t15*t64 - t62*c2 + t63*t50
-    t71 = t28 + t15*t68 + t52*t69 + t66*c2 + t67*t50
-    t72 = t15*t46 + t44*c2 - t52*t47 - t45*t50
-    t73 = t18*t15 + t22*t54 - t20*t52 + c2*t16 - t7*t50
-    t74 = t32*t15 + t34*t52 + t36*t54 + t4*t50 + c2*t30
-    t75 = T23 - t61
+    t70 = t42 - c2*t62 + t50*t63 - t15*t64 + t52*t65
+    t71 = t28 + c2*t66 + t50*t67 + t15*t68 + t52*t69
+    t72 = c2*t44 - t50*t45 + t15*t46 - t52*t47
+    t73 = c2*t16 - t7*t50 + t18*t15 - t20*t52 + t22*t54
+    t74 = c2*t30 + t4*t50 + t32*t15 + t34*t52 + t36*t54
+    t75 = -t61 + T23
     t76 = 0.7071067811865476*t23
     t77 = 0.7071067811865476*t24
     t78 = t76 - t77
     t79 = t76 + t77
-    t80 = T00*t78 + T01*t79 - T02*t22
-    t81 = T10*t78 + T11*t79 - T12*t22
-    t82 = T20*t78 + T21*t79 - T22*t22
+    t80 = t78*T00 + t79*T01 - t22*T02
+    t81 = t78*T10 + t79*T11 - t22*T12
+    t82 = t78*T20 + t79*T21 - t22*T22
     t83 = 0.7071067811865476*t37
     t84 = 0.7071067811865476*t38
     t85 = t83 + t84
     t86 = t83 - t84
-    t87 = T00*t85 + T01*t86 - T02*t36
-    t88 = T10*t85 + T11*t86 - T12*t36
-    t89 = T20*t85 + T21*t86 - T22*t36
-    t90 = 0.5*(t81 - t87)
+    t87 = t85*T00 + t86*T01 - t36*T02
+    t88 = t85*T10 + t86*T11 - t36*T12
+    t89 = t85*T20 + t86*T21 - t36*T22
+    t90 = 0.5*(-t87 + t81)
     t91 = 0.7071067811865476*t55
     t92 = 0.7071067811865476*t56
     t93 = t91 + t92
     t94 = t91 - t92
-    t95 = T00*t93 + T01*t94 - T02*t54
-    t96 = T10*t93 + T11*t94 - T12*t54
-    t97 = T20*t93 + T21*t94 - T22*t54
-    t98 = 0.5*(t89 - t96)
-    t99 = 0.5*(t95 - t82)
+    t95 = t93*T00 + t94*T01 - t54*T02
+    t96 = t93*T10 + t94*T11 - t54*T12
+    t97 = t93*T20 + t94*T21 - t54*T22
+    t98 = 0.5*(-t96 + t89)
+    t99 = 0.5*(-t82 + t95)
     t100 = 0.5*(-1 + t80 + t88 + t97)
     t101 = xp.sqrt(t98**2 + t99**2 + t90**2)
     t102 = xp.atan2(t101, t100)
     t103 = xp.where(xp.greater(t101, 0), t102/t101, 1)
-    t104 = t60**2
-    t105 = c1**2
-    t106 = t42**2 + t62**2 + t63**2 + t64**2 + t65**2 + t104*t105
-    t107 = t32*t64 + t60*t105 - t34*t65 - t63*t4 + t62*t30
-    t108 = c1*s1
-    t109 = t62*t66 + t64*t68 - t28*t42 - t63*t67 - t65*t69 + t104*t108
-    t110 = t43*c1
-    t111 = t62*t44 + t63*t45 + t64*t46 + t65*t47 - t60*t110
-    t112 = t34*t47 + t110 + t45*t4 - t32*t46 - t44*t30
+    t104 = c1**2
+    t105 = t104*t60 + t30*t62 - t4*t63 + t32*t64 - t34*t65
+    t106 = t60**2
+    t107 = t42**2 + t62**2 + t63**2 + t64**2 + t65**2 + t104*t106
+    t108 = s1*c1
+    t109 = -t28*t42 + t106*t108 + t62*t66 - t63*t67 + t64*t68 - t65*t69
+    t110 = c1*t43
+    t111 = -t60*t110 + t62*t44 + t63*t45 + t64*t46 + t65*t47
+    t112 = t110 - t30*t44 + t4*t45 - t32*t46 + t34*t47
     t113 = t60*t108
-    t114 = t18*t64 + t20*t65 + t7*t63 + t62*t16 - t113
-    t115 = t32*t68 + t34*t69 + t67*t4 + t113 + t66*t30
+    t114 = -t113 + t16*t62 + t7*t63 + t18*t64 + t20*t65
+    t115 = t113 + t30*t66 + t4*t67 + t32*t68 + t34*t69
     t116 = s1**2
-    t117 = t28**2 + t66**2 + t67**2 + t68**2 + t69**2 + t104*t116
-    t118 = t20*t69 + t60*t116 + t7*t67 - t18*t68 - t66*t16
-    t119 = t43*s1
-    t120 = t67*t45 + t69*t47 - t66*t44 - t68*t46 + t60*t119
-    t121 = t18*t46 + t20*t47 + t7*t45 + t119 + t44*t16
+    t117 = t28**2 + t66**2 + t67**2 + t68**2 + t69**2 + t116*t106
+    t118 = t116*t60 - t16*t66 + t7*t67 - t18*t68 + t20*t69
+    t119 = s1*t43
+    t120 = t60*t119 - t66*t44 + t67*t45 - t68*t46 + t69*t47
+    t121 = t119 + t16*t44 + t7*t45 + t18*t46 + t20*t47
     t122 = s2**2
-    t123 = t18**2 + t20**2 + t22**2 + t7**2 + t116 + t105*t122
-    t124 = t18*t32 + t22*t36 - t20*t34 - t7*t4 - t108 + t122*t108
-    t125 = t32**2 + t34**2 + t36**2 + t4**2 + t105 + t116*t122
-    t126 = 1 + t15**2 + t52**2 + t54**2 + c2**2 + t122*s3**2
+    t123 = t116 + t7**2 + t18**2 + t20**2 + t22**2 + t104*t122
+    t124 = -t108 + t108*t122 - t7*t4 + t18*t32 - t20*t34 + t22*t36
+    t125 = t104 + t4**2 + t32**2 + t34**2 + t36**2 + t116*t122
+    t126 = 1 + c2**2 + t15**2 + t52**2 + t54**2 + s3**2*t122
     t127 = xp.greater_equal(t80, t88) & xp.greater_equal(t80, t97)
     t128 = xp.greater_equal(t88, t97)
     t129 = xp.where(t127, 0.5*(1 + t80), xp.where(t128, 0.5*t87, 0.5*t95))
@@ -2874,49 +2874,49 @@ def ik_numeric_step(target, q, damping=0.0):
     t133 = xp.where(xp.greater_equal(t98*t129 + t99*t130 + t90*t131, 0), xp.asarray(1, dtype=dtype), -1)
     t134 = xp.greater(t101, 1e-06) | xp.greater(t100, 0)
     t135 = t102*t133/t132
-    t136 = xp.where(t134, t98*t103, t129*t135)
-    t137 = xp.where(t134, t99*t103, t130*t135)
-    t138 = xp.where(t134, t90*t103, t131*t135)
+    t136 = xp.where(t134, t98*t103, t135*t129)
+    t137 = xp.where(t134, t99*t103, t135*t130)
+    t138 = xp.where(t134, t90*t103, t135*t131)
     t139 = t136**2 + t137**2 + t138**2 + t29**2 + t49**2 + t75**2
-    t140 = t106 + damping
-    t141 = xp.sqrt(t109**2 + t70**2 + t111**2 + t114**2 + t107**2 + t140**2)
+    t140 = damping + t107
+    t141 = xp.sqrt(t109**2 + t111**2 + t114**2 + t105**2 + t70**2 + t140**2)
     t142 = t141*xp.where(xp.greater_equal(t140, 0), xp.asarray(1, dtype=dtype), -1)
-    t143 = t142 + t140
+    t143 = t140 + t142
     t144 = xp.where(xp.greater(t141, 0), 1/(t141*(t141 + xp.abs(t140))), 0)
-    t145 = t144*(t109*t49 + t111*t75 + t114*t136 + t107*t137 + t29*t143 - t70*t138)
+    t145 = t144*(t29*t143 + t109*t49 + t111*t75 + t114*t136 + t105*t137 - t70*t138)
     t146 = t29 - t143*t145
     t147 = t49 - t109*t145
     t148 = t75 - t111*t145
     t149 = t136 - t114*t145
-    t150 = t137 - t107*t145
+    t150 = t137 - t105*t145
     t151 = t138 + t70*t145
-    t152 = t117 + damping
-    t153 = t144*(t109*t143 + t109*t152 + t107*t115 - t70*t71 - t111*t120 - t114*t118)
+    t152 = damping + t117
+    t153 = t144*(-t111*t120 - t114*t118 + t105*t115 - t70*t71 + t109*t143 + t109*t152)
     t154 = t109 - t143*t153
-    t155 = -t109*t153 + t152
+    t155 = t152 - t109*t153
     t156 = t120 + t111*t153
     t157 = t118 + t114*t153
-    t158 = t115 - t107*t153
+    t158 = t115 - t105*t153
     t159 = t71 + t70*t153
     t160 = xp.sqrt(t155**2 + t156**2 + t157**2 + t158**2 + t159**2)
     t161 = t160*xp.where(xp.greater_equal(t155, 0), xp.asarray(1, dtype=dtype), -1)
     t162 = t155 + t161
     t163 = xp.where(xp.greater(t160, 0), 1/(t160*(t160 + xp.abs(t155))), 0)
-    t164 = t163*(t158*t150 + t159*t151 + t147*t162 - t156*t148 - t157*t149)
+    t164 = t163*(t147*t162 - t156*t148 - t157*t149 + t158*t150 + t159*t151)
     t165 = t147 - t162*t164
     t166 = t148 + t156*t164
     t167 = t149 + t157*t164
     t168 = t150 - t158*t164
     t169 = t151 - t159*t164
-    t170 = t48 + damping
-    t171 = t144*(t111*t143 + t111*t170 + t114*t121 - t109*t120 - t70*t72 - t107*t112)
+    t170 = damping + t48
+    t171 = t144*(-t109*t120 + t114*t121 - t105*t112 - t70*t72 + t111*t143 + t111*t170)
     t172 = t111 - t143*t171
     t173 = t120 + t109*t171
-    t174 = -t111*t171 + t170
+    t174 = t170 - t111*t171
     t175 = t121 - t114*t171
-    t176 = t112 + t107*t171
+    t176 = t112 + t105*t171
     t177 = t72 + t70*t171
-    t178 = -t163*(-t159*t177 + t156*t174 + t157*t175 + t158*t176 + t173*t162)
+    t178 = -t163*(t173*t162 + t156*t174 + t157*t175 + t158*t176 - t159*t177)
     t179 = t173 + t162*t178
     t180 = t174 + t156*t178
     t181 = t175 + t157*t178
@@ -2926,26 +2926,26 @@ def ik_numeric_step(target, q, damping=0.0):
     t185 = t184*xp.where(xp.greater_equal(t180, 0), xp.asarray(1, dtype=dtype), -1)
     t186 = t180 + t185
     t187 = xp.where(xp.greater(t184, 0), 1/(t184*(t184 + xp.abs(t180))), 0)
-    t188 = t187*(t181*t167 + t183*t169 + t166*t186 - t182*t168)
+    t188 = t187*(t166*t186 + t181*t167 - t182*t168 + t183*t169)
     t189 = t166 - t186*t188
     t190 = t167 - t181*t188
     t191 = t168 + t182*t188
     t192 = t169 - t183*t188
-    t193 = t123 + damping
-    t194 = t144*(t111*t121 + t114*t143 + t114*t193 + t107*t124 - t109*t118 - t70*t73)
+    t193 = damping + t123
+    t194 = t144*(-t109*t118 + t111*t121 + t105*t124 - t70*t73 + t114*t143 + t114*t193)
     t195 = t114 - t143*t194
     t196 = t118 + t109*t194
     t197 = t121 - t111*t194
-    t198 = -t114*t194 + t193
-    t199 = t124 - t107*t194
+    t198 = t193 - t114*t194
+    t199 = t124 - t105*t194
     t200 = t73 + t70*t194
-    t201 = -t163*(-t158*t199 - t159*t200 + t156*t197 + t157*t198 + t196*t162)
+    t201 = -t163*(t196*t162 + t156*t197 + t157*t198 - t158*t199 - t159*t200)
     t202 = t196 + t162*t201
     t203 = t197 + t156*t201
     t204 = t198 + t157*t201
     t205 = t199 - t158*t201
     t206 = t200 - t159*t201
-    t207 = t187*(t181*t204 + t183*t206 + t203*t186 - t182*t205)
+    t207 = t187*(t203*t186 + t181*t204 - t182*t205 + t183*t206)
     t208 = t203 - t186*t207
     t209 = t204 - t181*t207
     t210 = t205 + t182*t207
@@ -2954,30 +2954,30 @@ def ik_numeric_step(target, q, damping=0.0):
     t213 = t212*xp.where(xp.greater_equal(t209, 0), xp.asarray(1, dtype=dtype), -1)
     t214 = t209 + t213
     t215 = xp.where(xp.greater(t212, 0), 1/(t212*(t212 + xp.abs(t209))), 0)
-    t216 = t215*(t210*t191 + t211*t192 + t190*t214)
+    t216 = t215*(t190*t214 + t210*t191 + t211*t192)
     t217 = t190 - t214*t216
     t218 = t191 - t210*t216
     t219 = t192 - t211*t216
-    t220 = t125 + damping
-    t221 = t144*(t109*t115 + t114*t124 + t107*t143 + t107*t220 - t70*t74 - t111*t112)
-    t222 = t107 - t143*t221
+    t220 = damping + t125
+    t221 = t144*(t109*t115 - t111*t112 + t114*t124 - t70*t74 + t105*t143 + t105*t220)
+    t222 = t105 - t143*t221
     t223 = t115 - t109*t221
     t224 = t112 + t111*t221
     t225 = t124 - t114*t221
-    t226 = -t107*t221 + t220
+    t226 = t220 - t105*t221
     t227 = t74 + t70*t221
-    t228 = t163*(t156*t224 + t158*t226 + t159*t227 + t223*t162 - t157*t225)
+    t228 = t163*(t223*t162 + t156*t224 - t157*t225 + t158*t226 + t159*t227)
     t229 = t223 - t162*t228
     t230 = -t224 + t156*t228
     t231 = t225 + t157*t228
     t232 = t226 - t158*t228
     t233 = t227 - t159*t228
-    t234 = t187*(t181*t231 + t183*t233 + t230*t186 - t182*t232)
+    t234 = t187*(t230*t186 + t181*t231 - t182*t232 + t183*t233)
     t235 = t230 - t186*t234
     t236 = t231 - t181*t234
     t237 = t232 + t182*t234
     t238 = t233 - t183*t234
-    t239 = t215*(t210*t237 + t211*t238 + t236*t214)
+    t239 = t215*(t236*t214 + t210*t237 + t211*t238)
     t240 = t236 - t214*t239
     t241 = t237 - t210*t239
     t242 = t238 - t211*t239
@@ -2985,53 +2985,53 @@ def ik_numeric_step(target, q, damping=0.0):
     t244 = t243*xp.where(xp.greater_equal(t241, 0), xp.asarray(1, dtype=dtype), -1)
     t245 = t241 + t244
     t246 = xp.where(xp.greater(t243, 0), 1/(t243*(t243 + xp.abs(t241))), 0)
-    t247 = t246*(t242*t219 + t218*t245)
+    t247 = t246*(t218*t245 + t242*t219)
     t248 = t218 - t245*t247
     t249 = t219 - t242*t247
-    t250 = t126 + damping
-    t251 = t144*(t109*t71 + t111*t72 + t114*t73 + t107*t74 - t70*t143 - t70*t250)
+    t250 = damping + t126
+    t251 = t144*(t109*t71 + t111*t72 + t114*t73 + t105*t74 - t70*t143 - t250*t70)
     t252 = t70 + t143*t251
     t253 = t71 - t109*t251
     t254 = t72 - t111*t251
     t255 = t73 - t114*t251
-    t256 = t74 - t107*t251
-    t257 = t70*t251 + t250
-    t258 = t163*(t158*t256 + t159*t257 + t253*t162 - t156*t254 - t157*t255)
+    t256 = t74 - t105*t251
+    t257 = t250 + t70*t251
+    t258 = t163*(t253*t162 - t156*t254 - t157*t255 + t158*t256 + t159*t257)
     t259 = t253 - t162*t258
     t260 = t254 + t156*t258
     t261 = t255 + t157*t258
     t262 = t256 - t158*t258
     t263 = t257 - t159*t258
-    t264 = t187*(t181*t261 + t183*t263 + t260*t186 - t182*t262)
+    t264 = t187*(t260*t186 + t181*t261 - t182*t262 + t183*t263)
     t265 = t260 - t186*t264
     t266 = t261 - t181*t264
     t267 = t262 + t182*t264
     t268 = t263 - t183*t264
-    t269 = t215*(t210*t267 + t211*t268 + t266*t214)
+    t269 = t215*(t266*t214 + t210*t267 + t211*t268)
     t270 = t266 - t214*t269
     t271 = t267 - t210*t269
     t272 = t268 - t211*t269
-    t273 = t246*(t242*t272 + t271*t245)
+    t273 = t246*(t271*t245 + t242*t272)
     t274 = t271 - t245*t273
     t275 = t272 - t242*t273
     t276 = xp.abs(t275)
     t277 = t276
     t278 = t277*xp.where(xp.greater_equal(t275, 0), xp.asarray(1, dtype=dtype), -1)
     t279 = t275 + t278
-    t280 = xp.where(xp.greater(t277, 0), 1/(t277*(t277 + t276)), 0)
-    t281 = t249 - t249*t280*t279**2
+    t280 = xp.where(xp.greater(t277, 0), 1/(t277*(t276 + t277)), 0)
+    t281 = t249 - t249*t279**2*t280
     t282 = xp.where(xp.not_equal(t278, 0), -t281/t278, 0)
     t283 = xp.where(xp.not_equal(t244, 0), -(t248 - t274*t282)/t244, 0)
-    t284 = xp.where(xp.not_equal(t213, 0), -(t217 - (t240*t283 + t270*t282))/t213, 0)
-    t285 = xp.where(xp.not_equal(t185, 0), -(t189 - (t208*t284 + t235*t283 + t265*t282))/t185, 0)
-    t286 = xp.where(xp.not_equal(t161, 0), -(t165 - (t229*t283 + t259*t282 - t179*t285 - t202*t284))/t161, 0)
-    t287 = xp.where(xp.not_equal(t142, 0), -(t146 - (t154*t286 + t172*t285 + t195*t284 + t222*t283 - t252*t282))/t142, 0)
-    t288 = t282 + q1 + t286*t28 - t287*t42
-    t289 = q2 + t283*c1 - t284*s1 - t285*t43 + t286*t60*s1 + t287*t60*c1
-    t290 = q3 + t282*c2 + t285*t44 + t286*t66 + t287*t62 + t283*t30 + t284*t16
-    t291 = q4 + t284*t7 + t285*t45 + t287*t63 - t283*t4 - t286*t67 - t282*t50
-    t292 = q5 + t18*t284 + t32*t283 + t15*t282 + t285*t46 + t286*t68 + t287*t64
-    t293 = q6 + t20*t284 + t285*t47 + t287*t65 - t34*t283 - t52*t282 - t286*t69
+    t284 = xp.where(xp.not_equal(t213, 0), -(-(t240*t283 + t270*t282) + t217)/t213, 0)
+    t285 = xp.where(xp.not_equal(t185, 0), -(-(t208*t284 + t235*t283 + t265*t282) + t189)/t185, 0)
+    t286 = xp.where(xp.not_equal(t161, 0), -(-(-t179*t285 - t202*t284 + t229*t283 + t259*t282) + t165)/t161, 0)
+    t287 = xp.where(xp.not_equal(t142, 0), -(-(t154*t286 + t172*t285 + t195*t284 + t222*t283 - t252*t282) + t146)/t142, 0)
+    t288 = q1 + t282 - t42*t287 + t28*t286
+    t289 = q2 + c1*t60*t287 + s1*t60*t286 - t43*t285 - s1*t284 + c1*t283
+    t290 = q3 + t62*t287 + t66*t286 + t44*t285 + t16*t284 + t30*t283 + c2*t282
+    t291 = q4 + t63*t287 - t67*t286 + t45*t285 + t7*t284 - t4*t283 - t50*t282
+    t292 = q5 + t64*t287 + t68*t286 + t46*t285 + t18*t284 + t32*t283 + t15*t282
+    t293 = q6 + t65*t287 - t69*t286 + t47*t285 + t20*t284 - t34*t283 - t52*t282
     t294 = -q7 + t22*t284 + t36*t283 + t54*t282
     t295 = -t294
     q_start = _stack(xp, [
@@ -3078,7 +3078,7 @@ def ik_branches(T, q_free):
     t0 = 0.823 + T02*T03 + T12*T13 + T22*T23
     t1 = t0 - 0.333*T22
     t2 = -1.033 + t1
-    t3 = T00 + T01 + T02 + T03 + T10 + T11 + T12 + T13 + T20 + T21 + T22 + T23
+    t3 = T00 + T01 + T02 + T10 + T11 + T12 + T20 + T21 + T22 + T03 + T13 + T23
     t4 = 0.7071067811865476*s7
     t5 = 0.7071067811865476*c7
     t6 = t4 + t5
@@ -3087,7 +3087,7 @@ def ik_branches(T, q_free):
     t9 = T10*t6 + T11*t7
     t10 = T20*t6 + T21*t7
     t11 = 0.088 - (T03*t8 + T13*t9 + T23*t10)
-    t12 = t11 + 0.333*t10
+    t12 = 0.333*t10 + t11
     t13 = -t6
     t14 = T00*t7 + T01*t13
     t15 = T10*t7 + T11*t13
@@ -3105,9 +3105,9 @@ def ik_branches(T, q_free):
     t27 = xp.where(t24, t26, xp.where(xp.greater(t26, 0), xp.asarray(1, dtype=dtype), -1))
     t28 = xp.atan2(t25, t27)
     t29 = -(2.6745902299367814 + t28)
-    t30 = t29 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t29))
+    t30 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t29)) + t29
     t31 = -2.6745902299367814 + t28
-    t32 = t31 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t31))
+    t32 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t31)) + t31
     t33 = 0.892921841804845*t27
     t34 = 0.45021171067381544*t25
     t35 = -t33 + t34
@@ -3116,33 +3116,33 @@ def ik_branches(T, q_free):
     t38 = 0.45021171067381544*t27
     t39 = -(t37 + t38)
     t40 = -t38 + t37
-    t41 = -0.0825*t35 + 0.316*t39
+    t41 = 0.316*t39 - 0.0825*t35
     t42 = 0.0825*t39 + 0.316*t35
     t43 = 0.0825 + t41
     t44 = 0.649 - t42
     t45 = -1.033 + t44
     t46 = 0.0825*t36 + 0.316*t40
-    t47 = -0.0825*t40 + 0.316*t36
+    t47 = 0.316*t36 - 0.0825*t40
     t48 = 0.0825 + t46
     t49 = 0.649 + t47
     t50 = -1.033 + t49
     t51 = t43**2
     t52 = t45**2
     t53 = t51 + t52
-    t54 = t52 + t19
+    t54 = t19 + t52
     t55 = -t53 + t54
     t56 = -t55
     t57 = 1e-12*t53
     t58 = xp.greater(t56, t57)
     t59 = xp.where(t58, xp.sqrt(t56), 0)
-    t60 = t59**2 + t54
+    t60 = t54 + t59**2
     t61 = t12*t59
     t62 = t19 + t2*t45
     t63 = -t61 + t62
     t64 = t61 + t62
     t65 = -t19
-    t66 = t63 + t65
-    t67 = t64 + t65
+    t66 = t65 + t63
+    t67 = t65 + t64
     t68 = t12*t45
     t69 = t2*t59
     t70 = t68 + t69
@@ -3150,7 +3150,7 @@ def ik_branches(T, q_free):
     t72 = t68 - t69
     t73 = t67**2 + t72**2
     t74 = 1e-24*t60
-    t75 = t20*t74
+    t75 = t74*t20
     t76 = xp.less_equal(t71, t75)
     t77 = xp.where(t76, 1, 1/xp.sqrt(t71))
     t78 = xp.where(t76, 1, t66*t77)
@@ -3163,17 +3163,17 @@ def ik_branches(T, q_free):
     t85 = t52 - t84
     t86 = t52 + t84
     t87 = -t52
-    t88 = t85 + t87
-    t89 = t86 + t87
+    t88 = t87 + t85
+    t89 = t87 + t86
     t90 = t19*t51
     t91 = t88**2 + t90
-    t92 = t89**2 + t90
-    t93 = t53*t74
+    t92 = t90 + t89**2
+    t93 = t74*t53
     t94 = xp.less_equal(t91, t93)
     t95 = xp.where(t94, 1, 1/xp.sqrt(t91))
     t96 = xp.where(t94, 1, t88*t95)
     t97 = t18*t43
-    t98 = xp.where(t94, 0, t95*t97)
+    t98 = xp.where(t94, 0, t97*t95)
     t99 = xp.less_equal(t73, t75)
     t100 = xp.where(t99, 1, 1/xp.sqrt(t73))
     t101 = xp.where(t99, 1, t67*t100)
@@ -3185,20 +3185,20 @@ def ik_branches(T, q_free):
     t107 = xp.less_equal(t92, t93)
     t108 = xp.where(t107, 1, 1/xp.sqrt(t92))
     t109 = xp.where(t107, 1, t89*t108)
-    t110 = xp.where(t107, 0, t108*t97)
+    t110 = xp.where(t107, 0, t97*t108)
     t111 = 1 - t78
     t112 = t16*t111
     t113 = t112 + t16*t78
     t114 = t14*t111
     t115 = t114 + t14*t78
     t116 = t96*t80 + t98*t113
-    t117 = t96*t113 - t98*t80
+    t117 = t96*t113 - t80*t98
     t118 = t96*t82 + t98*t115
     t119 = t96*t115 - t98*t82
     t120 = 1 - t96
     t121 = t81*t120
-    t122 = t121 + t96*t81
-    t123 = t83*t120
+    t122 = t121 + t81*t96
+    t123 = t120*t83
     t124 = t123 + t96*t83
     t125 = t35*t116 - t39*t122
     t126 = t35*t122 + t39*t116
@@ -3207,7 +3207,7 @@ def ik_branches(T, q_free):
     t129 = 1 - t35
     t130 = t117*t129
     t131 = t130 + t35*t117
-    t132 = t119*t129
+    t132 = t129*t119
     t133 = t132 + t35*t119
     t134 = t126**2
     t135 = -t134
@@ -3215,50 +3215,50 @@ def ik_branches(T, q_free):
     t137 = xp.greater(t136, 1e-12)
     t138 = xp.where(t137, xp.sqrt(t136), 0)
     t139 = t134 - t125*t138
-    t140 = t139 + t135
-    t141 = t131**2
-    t142 = t125**2 + t141 + t134
-    t143 = t138**2
+    t140 = t135 + t139
+    t141 = t138**2
+    t142 = t134 + t141
+    t143 = t131**2
     t144 = t140**2 + t141*t143
-    t145 = t134 + t143
-    t146 = 1e-24*t145
-    t147 = xp.less_equal(t144, t142*t146)
+    t145 = t134 + t125**2 + t143
+    t146 = 1e-24*t142
+    t147 = xp.less_equal(t144, t146*t145)
     t148 = xp.where(t147, 1, 1/xp.sqrt(t144))
     t149 = xp.where(t147, 1, t140*t148)
     t150 = t128*(1 - t149)
     t151 = t150 + t128*t149
-    t152 = t131*t138
-    t153 = xp.where(t147, 0, -t148*t152)
-    t154 = t127*t149 + t133*t153
-    t155 = t133*t149 - t127*t153
-    t156 = xp.less_equal(t145, t146)
-    t157 = xp.where(t156, 1, 1/xp.sqrt(t145))
+    t152 = t138*t131
+    t153 = xp.where(t147, 0, -t152*t148)
+    t154 = t149*t127 + t133*t153
+    t155 = t149*t133 - t127*t153
+    t156 = xp.less_equal(t142, t146)
+    t157 = xp.where(t156, 1, 1/xp.sqrt(t142))
     t158 = xp.where(t156, 1, -t126*t157)
     t159 = xp.where(t156, 0, -t138*t157)
     t160 = t155*(1 - t158)
     t161 = t158*t154 + t159*t151
-    t162 = t160 + t158*t155
-    t163 = t159*t154 - t158*t151
+    t162 = t160 + t155*t158
+    t163 = t154*t159 - t158*t151
     t164 = t161**2 + t162**2
     t165 = t164
-    t166 = t163**2 + t164
+    t166 = t164 + t163**2
     t167 = 1 - t101
     t168 = t16*t167
     t169 = t168 + t16*t101
     t170 = t14*t167
     t171 = t170 + t14*t101
     t172 = t109*t103 + t110*t169
-    t173 = t109*t169 - t110*t103
+    t173 = t109*t169 - t103*t110
     t174 = t109*t105 + t110*t171
     t175 = t109*t171 - t110*t105
-    t176 = t173*t129
+    t176 = t129*t173
     t177 = t176 + t35*t173
-    t178 = t175*t129
+    t178 = t129*t175
     t179 = t178 + t35*t175
     t180 = 1 - t109
     t181 = t104*t180
-    t182 = t181 + t109*t104
-    t183 = t106*t180
+    t182 = t181 + t104*t109
+    t183 = t180*t106
     t184 = t183 + t109*t106
     t185 = t35*t172 - t39*t182
     t186 = t35*t182 + t39*t172
@@ -3270,49 +3270,49 @@ def ik_branches(T, q_free):
     t192 = xp.greater(t191, 1e-12)
     t193 = xp.where(t192, xp.sqrt(t191), 0)
     t194 = t189 - t185*t193
-    t195 = t194 + t190
-    t196 = t177**2
-    t197 = t185**2 + t196 + t189
-    t198 = t193**2
+    t195 = t190 + t194
+    t196 = t193**2
+    t197 = t189 + t196
+    t198 = t177**2
     t199 = t195**2 + t196*t198
-    t200 = t189 + t198
-    t201 = 1e-24*t200
-    t202 = xp.less_equal(t199, t197*t201)
+    t200 = t189 + t185**2 + t198
+    t201 = 1e-24*t197
+    t202 = xp.less_equal(t199, t201*t200)
     t203 = xp.where(t202, 1, 1/xp.sqrt(t199))
     t204 = xp.where(t202, 1, t195*t203)
     t205 = t188*(1 - t204)
     t206 = t205 + t188*t204
-    t207 = t177*t193
-    t208 = xp.where(t202, 0, -t203*t207)
-    t209 = t187*t204 + t179*t208
-    t210 = t179*t204 - t187*t208
-    t211 = xp.less_equal(t200, t201)
-    t212 = xp.where(t211, 1, 1/xp.sqrt(t200))
+    t207 = t193*t177
+    t208 = xp.where(t202, 0, -t207*t203)
+    t209 = t204*t187 + t179*t208
+    t210 = t204*t179 - t187*t208
+    t211 = xp.less_equal(t197, t201)
+    t212 = xp.where(t211, 1, 1/xp.sqrt(t197))
     t213 = xp.where(t211, 1, -t186*t212)
     t214 = xp.where(t211, 0, -t193*t212)
     t215 = t210*(1 - t213)
     t216 = t213*t209 + t214*t206
-    t217 = t215 + t213*t210
-    t218 = t214*t209 - t213*t206
+    t217 = t215 + t210*t213
+    t218 = t209*t214 - t213*t206
     t219 = t216**2 + t217**2
     t220 = t219
-    t221 = t218**2 + t219
+    t221 = t219 + t218**2
     t222 = t48**2
     t223 = t50**2
     t224 = t222 + t223
-    t225 = t223 + t19
+    t225 = t19 + t223
     t226 = -t224 + t225
     t227 = -t226
     t228 = 1e-12*t224
     t229 = xp.greater(t227, t228)
     t230 = xp.where(t229, xp.sqrt(t227), 0)
-    t231 = t230**2 + t225
+    t231 = t225 + t230**2
     t232 = t12*t230
     t233 = t19 + t2*t50
     t234 = -t232 + t233
-    t235 = t234 + t65
+    t235 = t65 + t234
     t236 = t232 + t233
-    t237 = t236 + t65
+    t237 = t65 + t236
     t238 = t12*t50
     t239 = t2*t230
     t240 = t238 + t239
@@ -3320,7 +3320,7 @@ def ik_branches(T, q_free):
     t242 = t238 - t239
     t243 = t237**2 + t242**2
     t244 = 1e-24*t231
-    t245 = t20*t244
+    t245 = t244*t20
     t246 = xp.less_equal(t241, t245)
     t247 = xp.where(t246, 1, 1/xp.sqrt(t241))
     t248 = xp.where(t246, 1, t235*t247)
@@ -3333,17 +3333,17 @@ def ik_branches(T, q_free):
     t255 = t223 - t254
     t256 = t223 + t254
     t257 = -t223
-    t258 = t255 + t257
-    t259 = t256 + t257
+    t258 = t257 + t255
+    t259 = t257 + t256
     t260 = t19*t222
     t261 = t258**2 + t260
-    t262 = t259**2 + t260
-    t263 = t224*t244
+    t262 = t260 + t259**2
+    t263 = t244*t224
     t264 = xp.less_equal(t261, t263)
     t265 = xp.where(t264, 1, 1/xp.sqrt(t261))
     t266 = xp.where(t264, 1, t258*t265)
     t267 = t18*t48
-    t268 = xp.where(t264, 0, t265*t267)
+    t268 = xp.where(t264, 0, t267*t265)
     t269 = xp.less_equal(t243, t245)
     t270 = xp.where(t269, 1, 1/xp.sqrt(t243))
     t271 = xp.where(t269, 1, t237*t270)
@@ -3355,20 +3355,20 @@ def ik_branches(T, q_free):
     t277 = xp.less_equal(t262, t263)
     t278 = xp.where(t277, 1, 1/xp.sqrt(t262))
     t279 = xp.where(t277, 1, t259*t278)
-    t280 = xp.where(t277, 0, t278*t267)
+    t280 = xp.where(t277, 0, t267*t278)
     t281 = 1 - t248
     t282 = t16*t281
     t283 = t282 + t16*t248
     t284 = t14*t281
     t285 = t284 + t14*t248
     t286 = t266*t250 + t268*t283
-    t287 = t266*t283 - t268*t250
+    t287 = t266*t283 - t250*t268
     t288 = t266*t252 + t268*t285
     t289 = t266*t285 - t268*t252
     t290 = 1 - t266
     t291 = t251*t290
-    t292 = t291 + t266*t251
-    t293 = t253*t290
+    t292 = t291 + t251*t266
+    t293 = t290*t253
     t294 = t293 + t266*t253
     t295 = t36*t286 + t40*t292
     t296 = t36*t292 - t40*t286
@@ -3377,7 +3377,7 @@ def ik_branches(T, q_free):
     t299 = 1 + t36
     t300 = t287*t299
     t301 = t300 - t36*t287
-    t302 = t289*t299
+    t302 = t299*t289
     t303 = t302 - t36*t289
     t304 = t296**2
     t305 = -t304
@@ -3385,50 +3385,50 @@ def ik_branches(T, q_free):
     t307 = xp.greater(t306, 1e-12)
     t308 = xp.where(t307, xp.sqrt(t306), 0)
     t309 = t304 + t295*t308
-    t310 = t309 + t305
-    t311 = t301**2
-    t312 = t295**2 + t311 + t304
-    t313 = t308**2
+    t310 = t305 + t309
+    t311 = t308**2
+    t312 = t304 + t311
+    t313 = t301**2
     t314 = t310**2 + t311*t313
-    t315 = t304 + t313
-    t316 = 1e-24*t315
-    t317 = xp.less_equal(t314, t312*t316)
+    t315 = t304 + t295**2 + t313
+    t316 = 1e-24*t312
+    t317 = xp.less_equal(t314, t316*t315)
     t318 = xp.where(t317, 1, 1/xp.sqrt(t314))
     t319 = xp.where(t317, 1, t310*t318)
     t320 = t298*(1 - t319)
     t321 = t320 + t298*t319
-    t322 = t301*t308
-    t323 = xp.where(t317, 0, -t318*t322)
-    t324 = t303*t323 - t297*t319
-    t325 = t297*t323 + t303*t319
-    t326 = xp.less_equal(t315, t316)
-    t327 = xp.where(t326, 1, 1/xp.sqrt(t315))
+    t322 = t308*t301
+    t323 = xp.where(t317, 0, -t322*t318)
+    t324 = t303*t323 - t319*t297
+    t325 = t323*t297 + t319*t303
+    t326 = xp.less_equal(t312, t316)
+    t327 = xp.where(t326, 1, 1/xp.sqrt(t312))
     t328 = xp.where(t326, 1, t296*t327)
     t329 = xp.where(t326, 0, -t308*t327)
     t330 = t325*(1 - t328)
     t331 = t328*t324 - t329*t321
-    t332 = t330 + t328*t325
-    t333 = t328*t321 + t329*t324
+    t332 = t330 + t325*t328
+    t333 = t328*t321 + t324*t329
     t334 = t331**2 + t332**2
     t335 = t334
-    t336 = t333**2 + t334
+    t336 = t334 + t333**2
     t337 = 1 - t271
     t338 = t16*t337
     t339 = t338 + t16*t271
     t340 = t14*t337
     t341 = t340 + t14*t271
     t342 = t279*t273 + t280*t339
-    t343 = t279*t339 - t280*t273
+    t343 = t279*t339 - t273*t280
     t344 = t279*t275 + t280*t341
     t345 = t279*t341 - t280*t275
-    t346 = t343*t299
+    t346 = t299*t343
     t347 = t346 - t36*t343
-    t348 = t345*t299
+    t348 = t299*t345
     t349 = t348 - t36*t345
     t350 = 1 - t279
     t351 = t274*t350
-    t352 = t351 + t279*t274
-    t353 = t276*t350
+    t352 = t351 + t274*t279
+    t353 = t350*t276
     t354 = t353 + t279*t276
     t355 = t36*t342 + t40*t352
     t356 = t36*t352 - t40*t342
@@ -3440,157 +3440,157 @@ def ik_branches(T, q_free):
     t362 = xp.greater(t361, 1e-12)
     t363 = xp.where(t362, xp.sqrt(t361), 0)
     t364 = t359 + t355*t363
-    t365 = t364 + t360
-    t366 = t347**2
-    t367 = t355**2 + t366 + t359
-    t368 = t363**2
+    t365 = t360 + t364
+    t366 = t363**2
+    t367 = t359 + t366
+    t368 = t347**2
     t369 = t365**2 + t366*t368
-    t370 = t359 + t368
-    t371 = 1e-24*t370
-    t372 = xp.less_equal(t369, t367*t371)
+    t370 = t359 + t355**2 + t368
+    t371 = 1e-24*t367
+    t372 = xp.less_equal(t369, t371*t370)
     t373 = xp.where(t372, 1, 1/xp.sqrt(t369))
     t374 = xp.where(t372, 1, t365*t373)
     t375 = t358*(1 - t374)
     t376 = t375 + t358*t374
-    t377 = t347*t363
-    t378 = xp.where(t372, 0, -t373*t377)
-    t379 = t349*t378 - t357*t374
-    t380 = t357*t378 + t349*t374
-    t381 = xp.less_equal(t370, t371)
-    t382 = xp.where(t381, 1, 1/xp.sqrt(t370))
+    t377 = t363*t347
+    t378 = xp.where(t372, 0, -t377*t373)
+    t379 = t349*t378 - t374*t357
+    t380 = t378*t357 + t374*t349
+    t381 = xp.less_equal(t367, t371)
+    t382 = xp.where(t381, 1, 1/xp.sqrt(t367))
     t383 = xp.where(t381, 1, t356*t382)
     t384 = xp.where(t381, 0, -t363*t382)
     t385 = t380*(1 - t383)
     t386 = t383*t379 - t384*t376
-    t387 = t385 + t383*t380
-    t388 = t383*t376 + t384*t379
+    t387 = t385 + t380*t383
+    t388 = t383*t376 + t379*t384
     t389 = t386**2 + t387**2
     t390 = t389
-    t391 = t388**2 + t389
+    t391 = t389 + t388**2
     t392 = xp.where(t76, 0, xp.atan2(-t70, t66))
-    t393 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t392)) + t392
+    t393 = t392 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t392))
     t394 = -t393
-    t395 = t393 + 6.283185307179586*xp.floor(0.15915494309189535*(0.0175 + t394))
+    t395 = 6.283185307179586*xp.floor(0.15915494309189535*(0.0175 + t394)) + t393
     t396 = xp.where(t94, 0, xp.atan2(t97, t88))
     t397 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t396)) + t396
     t398 = -t397
-    t399 = t397 + 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t398))
+    t399 = 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t398)) + t397
     t400 = -t32
-    t401 = t32 + 6.283185307179586*xp.floor(0.15915494309189535*(3.0718 + t400))
+    t401 = 6.283185307179586*xp.floor(0.15915494309189535*(3.0718 + t400)) + t32
     t402 = xp.where(t147, 0, xp.atan2(-t152, t140))
     t403 = 3.141592653589793 + t402
     t404 = 6.283185307179586*xp.ceil(-0.15915494309189535*t403) + t402
-    t405 = t403 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t403))
+    t405 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t403)) + t403
     t406 = -t404
-    t407 = t404 + 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t406))
+    t407 = 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t406)) + t404
     t408 = xp.where(t156, 0, xp.atan2(-t138, -t126))
     t409 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t408)) + t408
     t410 = t408
     t411 = t410 - 6.283185307179586*xp.floor(0.15915494309189535*(1.7627999999999997 + t410))
     t412 = -t409
-    t413 = t409 + 6.283185307179586*xp.floor(0.15915494309189535*(1.7627999999999997 + t412))
+    t413 = 6.283185307179586*xp.floor(0.15915494309189535*(1.7627999999999997 + t412)) + t409
     t414 = xp.where(xp.less_equal(t165, 1e-24*t166), 0, xp.atan2(t162, t161))
     t415 = 3.141592653589793 + t414
     t416 = 6.283185307179586*xp.ceil(-0.15915494309189535*t415) + t414
-    t417 = t415 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t415))
+    t417 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t415)) + t415
     t418 = -t416
-    t419 = t416 + 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t418))
+    t419 = 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t418)) + t416
     t420 = -t405
-    t421 = t405 + 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t420))
+    t421 = 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t420)) + t405
     t422 = -t417
-    t423 = t417 + 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t422))
+    t423 = 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t422)) + t417
     t424 = xp.where(t99, 0, xp.atan2(-t72, t67))
     t425 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t424)) + t424
     t426 = -t425
-    t427 = t425 + 6.283185307179586*xp.floor(0.15915494309189535*(0.0175 + t426))
+    t427 = 6.283185307179586*xp.floor(0.15915494309189535*(0.0175 + t426)) + t425
     t428 = xp.where(t107, 0, xp.atan2(t97, t89))
     t429 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t428)) + t428
     t430 = -t429
-    t431 = t429 + 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t430))
+    t431 = 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t430)) + t429
     t432 = xp.where(t202, 0, xp.atan2(-t207, t195))
     t433 = 3.141592653589793 + t432
     t434 = 6.283185307179586*xp.ceil(-0.15915494309189535*t433) + t432
-    t435 = t433 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t433))
+    t435 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t433)) + t433
     t436 = -t434
-    t437 = t434 + 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t436))
+    t437 = 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t436)) + t434
     t438 = xp.where(t211, 0, xp.atan2(-t193, -t186))
     t439 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t438)) + t438
     t440 = t438
-    t441 = t440 - 6.283185307179586*xp.floor(0.15915494309189535*(1.7627999999999997 + t440))
+    t441 = -6.283185307179586*xp.floor(0.15915494309189535*(1.7627999999999997 + t440)) + t440
     t442 = -t439
-    t443 = t439 + 6.283185307179586*xp.floor(0.15915494309189535*(1.7627999999999997 + t442))
+    t443 = 6.283185307179586*xp.floor(0.15915494309189535*(1.7627999999999997 + t442)) + t439
     t444 = xp.where(xp.less_equal(t220, 1e-24*t221), 0, xp.atan2(t217, t216))
     t445 = 3.141592653589793 + t444
     t446 = 6.283185307179586*xp.ceil(-0.15915494309189535*t445) + t444
-    t447 = t445 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t445))
+    t447 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t445)) + t445
     t448 = -t446
-    t449 = t446 + 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t448))
+    t449 = 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t448)) + t446
     t450 = -t435
-    t451 = t435 + 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t450))
+    t451 = 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t450)) + t435
     t452 = -t447
-    t453 = t447 + 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t452))
+    t453 = 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t452)) + t447
     t454 = xp.where(t246, 0, xp.atan2(-t240, t235))
     t455 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t454)) + t454
     t456 = -t455
-    t457 = t455 + 6.283185307179586*xp.floor(0.15915494309189535*(0.0175 + t456))
+    t457 = 6.283185307179586*xp.floor(0.15915494309189535*(0.0175 + t456)) + t455
     t458 = xp.where(t264, 0, xp.atan2(t267, t258))
     t459 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t458)) + t458
     t460 = -t459
-    t461 = t459 + 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t460))
+    t461 = 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t460)) + t459
     t462 = -t30
-    t463 = t30 + 6.283185307179586*xp.floor(0.15915494309189535*(3.0718 + t462))
+    t463 = 6.283185307179586*xp.floor(0.15915494309189535*(3.0718 + t462)) + t30
     t464 = xp.where(t317, 0, xp.atan2(-t322, t310))
     t465 = 3.141592653589793 + t464
     t466 = 6.283185307179586*xp.ceil(-0.15915494309189535*t465) + t464
-    t467 = t465 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t465))
+    t467 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t465)) + t465
     t468 = -t466
-    t469 = t466 + 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t468))
+    t469 = 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t468)) + t466
     t470 = xp.where(t326, 0, xp.atan2(-t308, t296))
     t471 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t470)) + t470
     t472 = t470
-    t473 = t472 - 6.283185307179586*xp.floor(0.15915494309189535*(1.7627999999999997 + t472))
+    t473 = -6.283185307179586*xp.floor(0.15915494309189535*(1.7627999999999997 + t472)) + t472
     t474 = -t471
-    t475 = t471 + 6.283185307179586*xp.floor(0.15915494309189535*(1.7627999999999997 + t474))
+    t475 = 6.283185307179586*xp.floor(0.15915494309189535*(1.7627999999999997 + t474)) + t471
     t476 = xp.where(xp.less_equal(t335, 1e-24*t336), 0, xp.atan2(t332, t331))
     t477 = 3.141592653589793 + t476
     t478 = 6.283185307179586*xp.ceil(-0.15915494309189535*t477) + t476
-    t479 = t477 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t477))
+    t479 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t477)) + t477
     t480 = -t478
-    t481 = t478 + 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t480))
+    t481 = 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t480)) + t478
     t482 = -t467
-    t483 = t467 + 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t482))
+    t483 = 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t482)) + t467
     t484 = -t479
-    t485 = t479 + 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t484))
+    t485 = 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t484)) + t479
     t486 = xp.where(t269, 0, xp.atan2(-t242, t237))
     t487 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t486)) + t486
     t488 = -t487
-    t489 = t487 + 6.283185307179586*xp.floor(0.15915494309189535*(0.0175 + t488))
+    t489 = 6.283185307179586*xp.floor(0.15915494309189535*(0.0175 + t488)) + t487
     t490 = xp.where(t277, 0, xp.atan2(t267, t259))
     t491 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t490)) + t490
     t492 = -t491
-    t493 = t491 + 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t492))
+    t493 = 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t492)) + t491
     t494 = xp.where(t372, 0, xp.atan2(-t377, t365))
     t495 = 3.141592653589793 + t494
     t496 = 6.283185307179586*xp.ceil(-0.15915494309189535*t495) + t494
-    t497 = t495 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t495))
+    t497 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t495)) + t495
     t498 = -t496
-    t499 = t496 + 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t498))
+    t499 = 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t498)) + t496
     t500 = xp.where(t381, 0, xp.atan2(-t363, t356))
     t501 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t500)) + t500
     t502 = t500
-    t503 = t502 - 6.283185307179586*xp.floor(0.15915494309189535*(1.7627999999999997 + t502))
+    t503 = -6.283185307179586*xp.floor(0.15915494309189535*(1.7627999999999997 + t502)) + t502
     t504 = -t501
-    t505 = t501 + 6.283185307179586*xp.floor(0.15915494309189535*(1.7627999999999997 + t504))
+    t505 = 6.283185307179586*xp.floor(0.15915494309189535*(1.7627999999999997 + t504)) + t501
     t506 = xp.where(xp.less_equal(t390, 1e-24*t391), 0, xp.atan2(t387, t386))
     t507 = 3.141592653589793 + t506
     t508 = 6.283185307179586*xp.ceil(-0.15915494309189535*t507) + t506
-    t509 = t507 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t507))
+    t509 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t507)) + t507
     t510 = -t508
-    t511 = t508 + 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t510))
+    t511 = 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t510)) + t508
     t512 = -t497
-    t513 = t497 + 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t512))
+    t513 = 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t512)) + t497
     t514 = -t509
-    t515 = t509 + 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t514))
+    t515 = 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t514)) + t509
     t516 = -t419
     t517 = xp.less_equal(t516, 2.8973)
     t518 = xp.greater_equal(t418, -2.8973) & xp.less_equal(t418, 2.8973)
@@ -3899,87 +3899,87 @@ def ik_nearest(T, q_seed, q_free, weights=(1.0,) * DOF):
     lb5 = branches_in_limits[..., 5]
     lb6 = branches_in_limits[..., 6]
     lb7 = branches_in_limits[..., 7]
-    t0 = qb0_0 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn1 - qb0_0))
-    t1 = qb0_1 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn2 - qb0_1))
-    t2 = qb0_2 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn3 - qb0_2))
-    t3 = qb0_3 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn4 - qb0_3))
-    t4 = qb0_4 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn5 - qb0_4))
-    t5 = qb0_5 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn6 - qb0_5))
+    t0 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_0 + qn1)) + qb0_0
+    t1 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_1 + qn2)) + qb0_1
+    t2 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_2 + qn3)) + qb0_2
+    t3 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_3 + qn4)) + qb0_3
+    t4 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_4 + qn5)) + qb0_4
+    t5 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_5 + qn6)) + qb0_5
     t6 = xp.where(lb0 & vb0, xp.asarray(1, dtype=dtype), 0)
     t7 = xp.where(xp.greater(t6, 0), xp.asarray(1, dtype=dtype), 0)
-    t8 = qb1_0 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn1 - qb1_0))
-    t9 = qb1_1 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn2 - qb1_1))
-    t10 = qb1_2 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn3 - qb1_2))
-    t11 = qb1_3 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn4 - qb1_3))
-    t12 = qb1_4 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn5 - qb1_4))
-    t13 = qb1_5 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn6 - qb1_5))
+    t8 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_0 + qn1)) + qb1_0
+    t9 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_1 + qn2)) + qb1_1
+    t10 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_2 + qn3)) + qb1_2
+    t11 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_3 + qn4)) + qb1_3
+    t12 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_4 + qn5)) + qb1_4
+    t13 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_5 + qn6)) + qb1_5
     t14 = xp.where(lb1 & vb1, xp.asarray(1, dtype=dtype), 0)
-    t15 = qb2_0 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn1 - qb2_0))
-    t16 = qb2_1 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn2 - qb2_1))
-    t17 = qb2_2 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn3 - qb2_2))
-    t18 = qb2_3 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn4 - qb2_3))
-    t19 = qb2_4 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn5 - qb2_4))
-    t20 = qb2_5 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn6 - qb2_5))
+    t15 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_0 + qn1)) + qb2_0
+    t16 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_1 + qn2)) + qb2_1
+    t17 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_2 + qn3)) + qb2_2
+    t18 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_3 + qn4)) + qb2_3
+    t19 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_4 + qn5)) + qb2_4
+    t20 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_5 + qn6)) + qb2_5
     t21 = xp.where(lb2 & vb2, xp.asarray(1, dtype=dtype), 0)
-    t22 = qb3_0 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn1 - qb3_0))
-    t23 = qb3_1 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn2 - qb3_1))
-    t24 = qb3_2 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn3 - qb3_2))
-    t25 = qb3_3 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn4 - qb3_3))
-    t26 = qb3_4 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn5 - qb3_4))
-    t27 = qb3_5 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn6 - qb3_5))
+    t22 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_0 + qn1)) + qb3_0
+    t23 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_1 + qn2)) + qb3_1
+    t24 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_2 + qn3)) + qb3_2
+    t25 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_3 + qn4)) + qb3_3
+    t26 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_4 + qn5)) + qb3_4
+    t27 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_5 + qn6)) + qb3_5
     t28 = xp.where(lb3 & vb3, xp.asarray(1, dtype=dtype), 0)
-    t29 = qb4_0 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn1 - qb4_0))
-    t30 = qb4_1 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn2 - qb4_1))
-    t31 = qb4_2 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn3 - qb4_2))
-    t32 = qb4_3 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn4 - qb4_3))
-    t33 = qb4_4 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn5 - qb4_4))
-    t34 = qb4_5 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn6 - qb4_5))
+    t29 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_0 + qn1)) + qb4_0
+    t30 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_1 + qn2)) + qb4_1
+    t31 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_2 + qn3)) + qb4_2
+    t32 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_3 + qn4)) + qb4_3
+    t33 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_4 + qn5)) + qb4_4
+    t34 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_5 + qn6)) + qb4_5
     t35 = xp.where(lb4 & vb4, xp.asarray(1, dtype=dtype), 0)
-    t36 = qb5_0 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn1 - qb5_0))
-    t37 = qb5_1 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn2 - qb5_1))
-    t38 = qb5_2 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn3 - qb5_2))
-    t39 = qb5_3 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn4 - qb5_3))
-    t40 = qb5_4 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn5 - qb5_4))
-    t41 = qb5_5 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn6 - qb5_5))
+    t36 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_0 + qn1)) + qb5_0
+    t37 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_1 + qn2)) + qb5_1
+    t38 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_2 + qn3)) + qb5_2
+    t39 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_3 + qn4)) + qb5_3
+    t40 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_4 + qn5)) + qb5_4
+    t41 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_5 + qn6)) + qb5_5
     t42 = xp.where(lb5 & vb5, xp.asarray(1, dtype=dtype), 0)
-    t43 = qb6_0 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn1 - qb6_0))
-    t44 = qb6_1 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn2 - qb6_1))
-    t45 = qb6_2 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn3 - qb6_2))
-    t46 = qb6_3 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn4 - qb6_3))
-    t47 = qb6_4 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn5 - qb6_4))
-    t48 = qb6_5 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn6 - qb6_5))
+    t43 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_0 + qn1)) + qb6_0
+    t44 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_1 + qn2)) + qb6_1
+    t45 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_2 + qn3)) + qb6_2
+    t46 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_3 + qn4)) + qb6_3
+    t47 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_4 + qn5)) + qb6_4
+    t48 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_5 + qn6)) + qb6_5
     t49 = xp.where(lb6 & vb6, xp.asarray(1, dtype=dtype), 0)
-    t50 = qb7_0 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn1 - qb7_0))
-    t51 = qb7_1 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn2 - qb7_1))
-    t52 = qb7_2 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn3 - qb7_2))
-    t53 = qb7_3 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn4 - qb7_3))
-    t54 = qb7_4 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn5 - qb7_4))
-    t55 = qb7_5 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn6 - qb7_5))
+    t50 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_0 + qn1)) + qb7_0
+    t51 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_1 + qn2)) + qb7_1
+    t52 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_2 + qn3)) + qb7_2
+    t53 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_3 + qn4)) + qb7_3
+    t54 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_4 + qn5)) + qb7_4
+    t55 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_5 + qn6)) + qb7_5
     t56 = xp.where(lb7 & vb7, xp.asarray(1, dtype=dtype), 0)
-    t57 = T00 + T01 + T02 + T03 + T10 + T11 + T12 + T13 + T20 + T21 + T22 + T23 + qn1 + qn2 + qn3 + qn4 + qn5 + qn6 + qn7 + qw1 + qw2 + qw3 + qw4 + qw5 + qw6 + qw7
+    t57 = T00 + T01 + T02 + T10 + T11 + T12 + T20 + T21 + T22 + T03 + T13 + T23 + qn1 + qn2 + qn3 + qn4 + qn5 + qn6 + qw1 + qw2 + qw3 + qw4 + qw5 + qw6 + qw7 + qn7
     t58 = xp.where(xp.less(t0, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t59 = t0 + t58
-    t60 = t0 - t58
+    t60 = -t58 + t0
     t61 = xp.where(xp.greater_equal(t0, -2.8973) & xp.less_equal(t0, 2.8973), t0, xp.where(xp.greater_equal(t59, -2.8973) & xp.less_equal(t59, 2.8973), t59, xp.where(xp.greater_equal(t60, -2.8973) & xp.less_equal(t60, 2.8973), t60, qb0_0)))
     t62 = xp.where(xp.less(t1, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t63 = t1 + t62
-    t64 = t1 - t62
+    t64 = -t62 + t1
     t65 = xp.where(xp.greater_equal(t1, -1.7627999999999997) & xp.less_equal(t1, 1.7627999999999997), t1, xp.where(xp.greater_equal(t63, -1.7627999999999997) & xp.less_equal(t63, 1.7627999999999997), t63, xp.where(xp.greater_equal(t64, -1.7627999999999997) & xp.less_equal(t64, 1.7627999999999997), t64, qb0_1)))
     t66 = xp.where(xp.less(t2, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t67 = t2 + t66
-    t68 = t2 - t66
+    t68 = -t66 + t2
     t69 = xp.where(xp.greater_equal(t2, -2.8973) & xp.less_equal(t2, 2.8973), t2, xp.where(xp.greater_equal(t67, -2.8973) & xp.less_equal(t67, 2.8973), t67, xp.where(xp.greater_equal(t68, -2.8973) & xp.less_equal(t68, 2.8973), t68, qb0_2)))
     t70 = xp.where(xp.less(t3, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t71 = t3 + t70
-    t72 = t3 - t70
+    t72 = -t70 + t3
     t73 = xp.where(xp.greater_equal(t3, -3.0718) & xp.less_equal(t3, -0.0698), t3, xp.where(xp.greater_equal(t71, -3.0718) & xp.less_equal(t71, -0.0698), t71, xp.where(xp.greater_equal(t72, -3.0718) & xp.less_equal(t72, -0.0698), t72, qb0_3)))
     t74 = xp.where(xp.less(t4, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t75 = t4 + t74
-    t76 = t4 - t74
+    t76 = -t74 + t4
     t77 = xp.where(xp.greater_equal(t4, -2.8973) & xp.less_equal(t4, 2.8973), t4, xp.where(xp.greater_equal(t75, -2.8973) & xp.less_equal(t75, 2.8973), t75, xp.where(xp.greater_equal(t76, -2.8973) & xp.less_equal(t76, 2.8973), t76, qb0_4)))
     t78 = xp.where(xp.less(t5, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t79 = t5 + t78
-    t80 = t5 - t78
+    t80 = -t78 + t5
     t81 = xp.where(xp.greater_equal(t5, -0.0175) & xp.less_equal(t5, 3.7525000000000004), t5, xp.where(xp.greater_equal(t79, -0.0175) & xp.less_equal(t79, 3.7525000000000004), t79, xp.where(xp.greater_equal(t80, -0.0175) & xp.less_equal(t80, 3.7525000000000004), t80, qb0_5)))
     t82 = -qn1
     t83 = -qn2
@@ -3988,7 +3988,7 @@ def ik_nearest(T, q_seed, q_free, weights=(1.0,) * DOF):
     t86 = -qn5
     t87 = -qn6
     t88 = -qn7
-    t89 = qw1*(t61 + t82)**2 + qw2*(t65 + t83)**2 + qw3*(t69 + t84)**2 + qw4*(t73 + t85)**2 + qw5*(t77 + t86)**2 + qw6*(t81 + t87)**2 + qw7*(qb0_6 + t88)**2
+    t89 = qw1*(t82 + t61)**2 + qw2*(t83 + t65)**2 + qw3*(t84 + t69)**2 + qw4*(t85 + t73)**2 + qw5*(t86 + t77)**2 + qw6*(t87 + t81)**2 + qw7*(t88 + qb0_6)**2
     t90 = xp.greater(t7, 0)
     t91 = xp.where(t90, t61, qn1)
     t92 = xp.where(t90, t65, qn2)
@@ -4000,31 +4000,31 @@ def ik_nearest(T, q_seed, q_free, weights=(1.0,) * DOF):
     t98 = xp.where(t90, t89, 0)
     t99 = xp.where(xp.less(t8, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t100 = t8 + t99
-    t101 = t8 - t99
+    t101 = -t99 + t8
     t102 = xp.where(xp.greater_equal(t8, -2.8973) & xp.less_equal(t8, 2.8973), t8, xp.where(xp.greater_equal(t100, -2.8973) & xp.less_equal(t100, 2.8973), t100, xp.where(xp.greater_equal(t101, -2.8973) & xp.less_equal(t101, 2.8973), t101, qb1_0)))
     t103 = xp.where(xp.less(t9, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t104 = t9 + t103
-    t105 = t9 - t103
+    t105 = -t103 + t9
     t106 = xp.where(xp.greater_equal(t9, -1.7627999999999997) & xp.less_equal(t9, 1.7627999999999997), t9, xp.where(xp.greater_equal(t104, -1.7627999999999997) & xp.less_equal(t104, 1.7627999999999997), t104, xp.where(xp.greater_equal(t105, -1.7627999999999997) & xp.less_equal(t105, 1.7627999999999997), t105, qb1_1)))
     t107 = xp.where(xp.less(t10, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t108 = t10 + t107
-    t109 = t10 - t107
+    t109 = -t107 + t10
     t110 = xp.where(xp.greater_equal(t10, -2.8973) & xp.less_equal(t10, 2.8973), t10, xp.where(xp.greater_equal(t108, -2.8973) & xp.less_equal(t108, 2.8973), t108, xp.where(xp.greater_equal(t109, -2.8973) & xp.less_equal(t109, 2.8973), t109, qb1_2)))
     t111 = xp.where(xp.less(t11, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t112 = t11 + t111
-    t113 = t11 - t111
+    t113 = -t111 + t11
     t114 = xp.where(xp.greater_equal(t11, -3.0718) & xp.less_equal(t11, -0.0698), t11, xp.where(xp.greater_equal(t112, -3.0718) & xp.less_equal(t112, -0.0698), t112, xp.where(xp.greater_equal(t113, -3.0718) & xp.less_equal(t113, -0.0698), t113, qb1_3)))
     t115 = xp.where(xp.less(t12, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t116 = t12 + t115
-    t117 = t12 - t115
+    t117 = -t115 + t12
     t118 = xp.where(xp.greater_equal(t12, -2.8973) & xp.less_equal(t12, 2.8973), t12, xp.where(xp.greater_equal(t116, -2.8973) & xp.less_equal(t116, 2.8973), t116, xp.where(xp.greater_equal(t117, -2.8973) & xp.less_equal(t117, 2.8973), t117, qb1_4)))
     t119 = xp.where(xp.less(t13, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t120 = t13 + t119
-    t121 = t13 - t119
+    t121 = -t119 + t13
     t122 = xp.where(xp.greater_equal(t13, -0.0175) & xp.less_equal(t13, 3.7525000000000004), t13, xp.where(xp.greater_equal(t120, -0.0175) & xp.less_equal(t120, 3.7525000000000004), t120, xp.where(xp.greater_equal(t121, -0.0175) & xp.less_equal(t121, 3.7525000000000004), t121, qb1_5)))
-    t123 = qw1*(t102 + t82)**2 + qw2*(t106 + t83)**2 + qw3*(t110 + t84)**2 + qw4*(t114 + t85)**2 + qw5*(t118 + t86)**2 + qw6*(t122 + t87)**2 + qw7*(qb1_6 + t88)**2
+    t123 = qw1*(t82 + t102)**2 + qw2*(t83 + t106)**2 + qw3*(t84 + t110)**2 + qw4*(t85 + t114)**2 + qw5*(t86 + t118)**2 + qw6*(t87 + t122)**2 + qw7*(t88 + qb1_6)**2
     t124 = xp.greater(t14, 0)
-    t125 = xp.where(t124 & (xp.less(t7, 1) | xp.less(t123, t98)), xp.asarray(1, dtype=dtype), 0)
+    t125 = xp.where(t124 & (xp.less(t123, t98) | xp.less(t7, 1)), xp.asarray(1, dtype=dtype), 0)
     t126 = xp.where(t124, 1, t7)
     t127 = xp.greater(t125, 0)
     t128 = xp.where(t127, t102, t91)
@@ -4037,29 +4037,29 @@ def ik_nearest(T, q_seed, q_free, weights=(1.0,) * DOF):
     t135 = xp.where(t127, t123, t98)
     t136 = xp.where(xp.less(t15, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t137 = t15 + t136
-    t138 = t15 - t136
+    t138 = -t136 + t15
     t139 = xp.where(xp.greater_equal(t15, -2.8973) & xp.less_equal(t15, 2.8973), t15, xp.where(xp.greater_equal(t137, -2.8973) & xp.less_equal(t137, 2.8973), t137, xp.where(xp.greater_equal(t138, -2.8973) & xp.less_equal(t138, 2.8973), t138, qb2_0)))
     t140 = xp.where(xp.less(t16, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t141 = t16 + t140
-    t142 = t16 - t140
+    t142 = -t140 + t16
     t143 = xp.where(xp.greater_equal(t16, -1.7627999999999997) & xp.less_equal(t16, 1.7627999999999997), t16, xp.where(xp.greater_equal(t141, -1.7627999999999997) & xp.less_equal(t141, 1.7627999999999997), t141, xp.where(xp.greater_equal(t142, -1.7627999999999997) & xp.less_equal(t142, 1.7627999999999997), t142, qb2_1)))
     t144 = xp.where(xp.less(t17, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t145 = t17 + t144
-    t146 = t17 - t144
+    t146 = -t144 + t17
     t147 = xp.where(xp.greater_equal(t17, -2.8973) & xp.less_equal(t17, 2.8973), t17, xp.where(xp.greater_equal(t145, -2.8973) & xp.less_equal(t145, 2.8973), t145, xp.where(xp.greater_equal(t146, -2.8973) & xp.less_equal(t146, 2.8973), t146, qb2_2)))
     t148 = xp.where(xp.less(t18, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t149 = t18 + t148
-    t150 = t18 - t148
+    t150 = -t148 + t18
     t151 = xp.where(xp.greater_equal(t18, -3.0718) & xp.less_equal(t18, -0.0698), t18, xp.where(xp.greater_equal(t149, -3.0718) & xp.less_equal(t149, -0.0698), t149, xp.where(xp.greater_equal(t150, -3.0718) & xp.less_equal(t150, -0.0698), t150, qb2_3)))
     t152 = xp.where(xp.less(t19, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t153 = t19 + t152
-    t154 = t19 - t152
+    t154 = -t152 + t19
     t155 = xp.where(xp.greater_equal(t19, -2.8973) & xp.less_equal(t19, 2.8973), t19, xp.where(xp.greater_equal(t153, -2.8973) & xp.less_equal(t153, 2.8973), t153, xp.where(xp.greater_equal(t154, -2.8973) & xp.less_equal(t154, 2.8973), t154, qb2_4)))
     t156 = xp.where(xp.less(t20, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t157 = t20 + t156
-    t158 = t20 - t156
+    t158 = -t156 + t20
     t159 = xp.where(xp.greater_equal(t20, -0.0175) & xp.less_equal(t20, 3.7525000000000004), t20, xp.where(xp.greater_equal(t157, -0.0175) & xp.less_equal(t157, 3.7525000000000004), t157, xp.where(xp.greater_equal(t158, -0.0175) & xp.less_equal(t158, 3.7525000000000004), t158, qb2_5)))
-    t160 = qw1*(t139 + t82)**2 + qw2*(t143 + t83)**2 + qw3*(t147 + t84)**2 + qw4*(t151 + t85)**2 + qw5*(t155 + t86)**2 + qw6*(t159 + t87)**2 + qw7*(qb2_6 + t88)**2
+    t160 = qw1*(t82 + t139)**2 + qw2*(t83 + t143)**2 + qw3*(t84 + t147)**2 + qw4*(t85 + t151)**2 + qw5*(t86 + t155)**2 + qw6*(t87 + t159)**2 + qw7*(t88 + qb2_6)**2
     t161 = xp.greater(t21, 0)
     t162 = xp.where(t161 & (xp.less(t126, 1) | xp.less(t160, t135)), xp.asarray(1, dtype=dtype), 0)
     t163 = xp.where(t161, 1, t126)
@@ -4074,29 +4074,29 @@ def ik_nearest(T, q_seed, q_free, weights=(1.0,) * DOF):
     t172 = xp.where(t164, t160, t135)
     t173 = xp.where(xp.less(t22, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t174 = t22 + t173
-    t175 = t22 - t173
+    t175 = -t173 + t22
     t176 = xp.where(xp.greater_equal(t22, -2.8973) & xp.less_equal(t22, 2.8973), t22, xp.where(xp.greater_equal(t174, -2.8973) & xp.less_equal(t174, 2.8973), t174, xp.where(xp.greater_equal(t175, -2.8973) & xp.less_equal(t175, 2.8973), t175, qb3_0)))
     t177 = xp.where(xp.less(t23, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t178 = t23 + t177
-    t179 = t23 - t177
+    t179 = -t177 + t23
     t180 = xp.where(xp.greater_equal(t23, -1.7627999999999997) & xp.less_equal(t23, 1.7627999999999997), t23, xp.where(xp.greater_equal(t178, -1.7627999999999997) & xp.less_equal(t178, 1.7627999999999997), t178, xp.where(xp.greater_equal(t179, -1.7627999999999997) & xp.less_equal(t179, 1.7627999999999997), t179, qb3_1)))
     t181 = xp.where(xp.less(t24, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t182 = t24 + t181
-    t183 = t24 - t181
+    t183 = -t181 + t24
     t184 = xp.where(xp.greater_equal(t24, -2.8973) & xp.less_equal(t24, 2.8973), t24, xp.where(xp.greater_equal(t182, -2.8973) & xp.less_equal(t182, 2.8973), t182, xp.where(xp.greater_equal(t183, -2.8973) & xp.less_equal(t183, 2.8973), t183, qb3_2)))
     t185 = xp.where(xp.less(t25, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t186 = t25 + t185
-    t187 = t25 - t185
+    t187 = -t185 + t25
     t188 = xp.where(xp.greater_equal(t25, -3.0718) & xp.less_equal(t25, -0.0698), t25, xp.where(xp.greater_equal(t186, -3.0718) & xp.less_equal(t186, -0.0698), t186, xp.where(xp.greater_equal(t187, -3.0718) & xp.less_equal(t187, -0.0698), t187, qb3_3)))
     t189 = xp.where(xp.less(t26, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t190 = t26 + t189
-    t191 = t26 - t189
+    t191 = -t189 + t26
     t192 = xp.where(xp.greater_equal(t26, -2.8973) & xp.less_equal(t26, 2.8973), t26, xp.where(xp.greater_equal(t190, -2.8973) & xp.less_equal(t190, 2.8973), t190, xp.where(xp.greater_equal(t191, -2.8973) & xp.less_equal(t191, 2.8973), t191, qb3_4)))
     t193 = xp.where(xp.less(t27, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t194 = t27 + t193
-    t195 = t27 - t193
+    t195 = -t193 + t27
     t196 = xp.where(xp.greater_equal(t27, -0.0175) & xp.less_equal(t27, 3.7525000000000004), t27, xp.where(xp.greater_equal(t194, -0.0175) & xp.less_equal(t194, 3.7525000000000004), t194, xp.where(xp.greater_equal(t195, -0.0175) & xp.less_equal(t195, 3.7525000000000004), t195, qb3_5)))
-    t197 = qw1*(t176 + t82)**2 + qw2*(t180 + t83)**2 + qw3*(t184 + t84)**2 + qw4*(t188 + t85)**2 + qw5*(t192 + t86)**2 + qw6*(t196 + t87)**2 + qw7*(qb3_6 + t88)**2
+    t197 = qw1*(t82 + t176)**2 + qw2*(t83 + t180)**2 + qw3*(t84 + t184)**2 + qw4*(t85 + t188)**2 + qw5*(t86 + t192)**2 + qw6*(t87 + t196)**2 + qw7*(t88 + qb3_6)**2
     t198 = xp.greater(t28, 0)
     t199 = xp.where(t198 & (xp.less(t163, 1) | xp.less(t197, t172)), xp.asarray(1, dtype=dtype), 0)
     t200 = xp.where(t198, 1, t163)
@@ -4111,29 +4111,29 @@ def ik_nearest(T, q_seed, q_free, weights=(1.0,) * DOF):
     t209 = xp.where(t201, t197, t172)
     t210 = xp.where(xp.less(t29, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t211 = t29 + t210
-    t212 = t29 - t210
+    t212 = -t210 + t29
     t213 = xp.where(xp.greater_equal(t29, -2.8973) & xp.less_equal(t29, 2.8973), t29, xp.where(xp.greater_equal(t211, -2.8973) & xp.less_equal(t211, 2.8973), t211, xp.where(xp.greater_equal(t212, -2.8973) & xp.less_equal(t212, 2.8973), t212, qb4_0)))
     t214 = xp.where(xp.less(t30, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t215 = t30 + t214
-    t216 = t30 - t214
+    t216 = -t214 + t30
     t217 = xp.where(xp.greater_equal(t30, -1.7627999999999997) & xp.less_equal(t30, 1.7627999999999997), t30, xp.where(xp.greater_equal(t215, -1.7627999999999997) & xp.less_equal(t215, 1.7627999999999997), t215, xp.where(xp.greater_equal(t216, -1.7627999999999997) & xp.less_equal(t216, 1.7627999999999997), t216, qb4_1)))
     t218 = xp.where(xp.less(t31, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t219 = t31 + t218
-    t220 = t31 - t218
+    t220 = -t218 + t31
     t221 = xp.where(xp.greater_equal(t31, -2.8973) & xp.less_equal(t31, 2.8973), t31, xp.where(xp.greater_equal(t219, -2.8973) & xp.less_equal(t219, 2.8973), t219, xp.where(xp.greater_equal(t220, -2.8973) & xp.less_equal(t220, 2.8973), t220, qb4_2)))
     t222 = xp.where(xp.less(t32, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t223 = t32 + t222
-    t224 = t32 - t222
+    t224 = -t222 + t32
     t225 = xp.where(xp.greater_equal(t32, -3.0718) & xp.less_equal(t32, -0.0698), t32, xp.where(xp.greater_equal(t223, -3.0718) & xp.less_equal(t223, -0.0698), t223, xp.where(xp.greater_equal(t224, -3.0718) & xp.less_equal(t224, -0.0698), t224, qb4_3)))
     t226 = xp.where(xp.less(t33, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t227 = t33 + t226
-    t228 = t33 - t226
+    t228 = -t226 + t33
     t229 = xp.where(xp.greater_equal(t33, -2.8973) & xp.less_equal(t33, 2.8973), t33, xp.where(xp.greater_equal(t227, -2.8973) & xp.less_equal(t227, 2.8973), t227, xp.where(xp.greater_equal(t228, -2.8973) & xp.less_equal(t228, 2.8973), t228, qb4_4)))
     t230 = xp.where(xp.less(t34, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t231 = t34 + t230
-    t232 = t34 - t230
+    t232 = -t230 + t34
     t233 = xp.where(xp.greater_equal(t34, -0.0175) & xp.less_equal(t34, 3.7525000000000004), t34, xp.where(xp.greater_equal(t231, -0.0175) & xp.less_equal(t231, 3.7525000000000004), t231, xp.where(xp.greater_equal(t232, -0.0175) & xp.less_equal(t232, 3.7525000000000004), t232, qb4_5)))
-    t234 = qw1*(t213 + t82)**2 + qw2*(t217 + t83)**2 + qw3*(t221 + t84)**2 + qw4*(t225 + t85)**2 + qw5*(t229 + t86)**2 + qw6*(t233 + t87)**2 + qw7*(qb4_6 + t88)**2
+    t234 = qw1*(t82 + t213)**2 + qw2*(t83 + t217)**2 + qw3*(t84 + t221)**2 + qw4*(t85 + t225)**2 + qw5*(t86 + t229)**2 + qw6*(t87 + t233)**2 + qw7*(t88 + qb4_6)**2
     t235 = xp.greater(t35, 0)
     t236 = xp.where(t235 & (xp.less(t200, 1) | xp.less(t234, t209)), xp.asarray(1, dtype=dtype), 0)
     t237 = xp.where(t235, 1, t200)
@@ -4148,29 +4148,29 @@ def ik_nearest(T, q_seed, q_free, weights=(1.0,) * DOF):
     t246 = xp.where(t238, t234, t209)
     t247 = xp.where(xp.less(t36, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t248 = t36 + t247
-    t249 = t36 - t247
+    t249 = -t247 + t36
     t250 = xp.where(xp.greater_equal(t36, -2.8973) & xp.less_equal(t36, 2.8973), t36, xp.where(xp.greater_equal(t248, -2.8973) & xp.less_equal(t248, 2.8973), t248, xp.where(xp.greater_equal(t249, -2.8973) & xp.less_equal(t249, 2.8973), t249, qb5_0)))
     t251 = xp.where(xp.less(t37, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t252 = t37 + t251
-    t253 = t37 - t251
+    t253 = -t251 + t37
     t254 = xp.where(xp.greater_equal(t37, -1.7627999999999997) & xp.less_equal(t37, 1.7627999999999997), t37, xp.where(xp.greater_equal(t252, -1.7627999999999997) & xp.less_equal(t252, 1.7627999999999997), t252, xp.where(xp.greater_equal(t253, -1.7627999999999997) & xp.less_equal(t253, 1.7627999999999997), t253, qb5_1)))
     t255 = xp.where(xp.less(t38, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t256 = t38 + t255
-    t257 = t38 - t255
+    t257 = -t255 + t38
     t258 = xp.where(xp.greater_equal(t38, -2.8973) & xp.less_equal(t38, 2.8973), t38, xp.where(xp.greater_equal(t256, -2.8973) & xp.less_equal(t256, 2.8973), t256, xp.where(xp.greater_equal(t257, -2.8973) & xp.less_equal(t257, 2.8973), t257, qb5_2)))
     t259 = xp.where(xp.less(t39, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t260 = t39 + t259
-    t261 = t39 - t259
+    t261 = -t259 + t39
     t262 = xp.where(xp.greater_equal(t39, -3.0718) & xp.less_equal(t39, -0.0698), t39, xp.where(xp.greater_equal(t260, -3.0718) & xp.less_equal(t260, -0.0698), t260, xp.where(xp.greater_equal(t261, -3.0718) & xp.less_equal(t261, -0.0698), t261, qb5_3)))
     t263 = xp.where(xp.less(t40, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t264 = t40 + t263
-    t265 = t40 - t263
+    t265 = -t263 + t40
     t266 = xp.where(xp.greater_equal(t40, -2.8973) & xp.less_equal(t40, 2.8973), t40, xp.where(xp.greater_equal(t264, -2.8973) & xp.less_equal(t264, 2.8973), t264, xp.where(xp.greater_equal(t265, -2.8973) & xp.less_equal(t265, 2.8973), t265, qb5_4)))
     t267 = xp.where(xp.less(t41, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t268 = t41 + t267
-    t269 = t41 - t267
+    t269 = -t267 + t41
     t270 = xp.where(xp.greater_equal(t41, -0.0175) & xp.less_equal(t41, 3.7525000000000004), t41, xp.where(xp.greater_equal(t268, -0.0175) & xp.less_equal(t268, 3.7525000000000004), t268, xp.where(xp.greater_equal(t269, -0.0175) & xp.less_equal(t269, 3.7525000000000004), t269, qb5_5)))
-    t271 = qw1*(t250 + t82)**2 + qw2*(t254 + t83)**2 + qw3*(t258 + t84)**2 + qw4*(t262 + t85)**2 + qw5*(t266 + t86)**2 + qw6*(t270 + t87)**2 + qw7*(qb5_6 + t88)**2
+    t271 = qw1*(t82 + t250)**2 + qw2*(t83 + t254)**2 + qw3*(t84 + t258)**2 + qw4*(t85 + t262)**2 + qw5*(t86 + t266)**2 + qw6*(t87 + t270)**2 + qw7*(t88 + qb5_6)**2
     t272 = xp.greater(t42, 0)
     t273 = xp.where(t272 & (xp.less(t237, 1) | xp.less(t271, t246)), xp.asarray(1, dtype=dtype), 0)
     t274 = xp.where(t272, 1, t237)
@@ -4185,29 +4185,29 @@ def ik_nearest(T, q_seed, q_free, weights=(1.0,) * DOF):
     t283 = xp.where(t275, t271, t246)
     t284 = xp.where(xp.less(t43, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t285 = t43 + t284
-    t286 = t43 - t284
+    t286 = -t284 + t43
     t287 = xp.where(xp.greater_equal(t43, -2.8973) & xp.less_equal(t43, 2.8973), t43, xp.where(xp.greater_equal(t285, -2.8973) & xp.less_equal(t285, 2.8973), t285, xp.where(xp.greater_equal(t286, -2.8973) & xp.less_equal(t286, 2.8973), t286, qb6_0)))
     t288 = xp.where(xp.less(t44, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t289 = t44 + t288
-    t290 = t44 - t288
+    t290 = -t288 + t44
     t291 = xp.where(xp.greater_equal(t44, -1.7627999999999997) & xp.less_equal(t44, 1.7627999999999997), t44, xp.where(xp.greater_equal(t289, -1.7627999999999997) & xp.less_equal(t289, 1.7627999999999997), t289, xp.where(xp.greater_equal(t290, -1.7627999999999997) & xp.less_equal(t290, 1.7627999999999997), t290, qb6_1)))
     t292 = xp.where(xp.less(t45, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t293 = t45 + t292
-    t294 = t45 - t292
+    t294 = -t292 + t45
     t295 = xp.where(xp.greater_equal(t45, -2.8973) & xp.less_equal(t45, 2.8973), t45, xp.where(xp.greater_equal(t293, -2.8973) & xp.less_equal(t293, 2.8973), t293, xp.where(xp.greater_equal(t294, -2.8973) & xp.less_equal(t294, 2.8973), t294, qb6_2)))
     t296 = xp.where(xp.less(t46, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t297 = t46 + t296
-    t298 = t46 - t296
+    t298 = -t296 + t46
     t299 = xp.where(xp.greater_equal(t46, -3.0718) & xp.less_equal(t46, -0.0698), t46, xp.where(xp.greater_equal(t297, -3.0718) & xp.less_equal(t297, -0.0698), t297, xp.where(xp.greater_equal(t298, -3.0718) & xp.less_equal(t298, -0.0698), t298, qb6_3)))
     t300 = xp.where(xp.less(t47, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t301 = t47 + t300
-    t302 = t47 - t300
+    t302 = -t300 + t47
     t303 = xp.where(xp.greater_equal(t47, -2.8973) & xp.less_equal(t47, 2.8973), t47, xp.where(xp.greater_equal(t301, -2.8973) & xp.less_equal(t301, 2.8973), t301, xp.where(xp.greater_equal(t302, -2.8973) & xp.less_equal(t302, 2.8973), t302, qb6_4)))
     t304 = xp.where(xp.less(t48, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t305 = t48 + t304
-    t306 = t48 - t304
+    t306 = -t304 + t48
     t307 = xp.where(xp.greater_equal(t48, -0.0175) & xp.less_equal(t48, 3.7525000000000004), t48, xp.where(xp.greater_equal(t305, -0.0175) & xp.less_equal(t305, 3.7525000000000004), t305, xp.where(xp.greater_equal(t306, -0.0175) & xp.less_equal(t306, 3.7525000000000004), t306, qb6_5)))
-    t308 = qw1*(t287 + t82)**2 + qw2*(t291 + t83)**2 + qw3*(t295 + t84)**2 + qw4*(t299 + t85)**2 + qw5*(t303 + t86)**2 + qw6*(t307 + t87)**2 + qw7*(qb6_6 + t88)**2
+    t308 = qw1*(t82 + t287)**2 + qw2*(t83 + t291)**2 + qw3*(t84 + t295)**2 + qw4*(t85 + t299)**2 + qw5*(t86 + t303)**2 + qw6*(t87 + t307)**2 + qw7*(t88 + qb6_6)**2
     t309 = xp.greater(t49, 0)
     t310 = xp.where(t309 & (xp.less(t274, 1) | xp.less(t308, t283)), xp.asarray(1, dtype=dtype), 0)
     t311 = xp.where(t309, 1, t274)
@@ -4222,29 +4222,29 @@ def ik_nearest(T, q_seed, q_free, weights=(1.0,) * DOF):
     t320 = xp.where(t312, t308, t283)
     t321 = xp.where(xp.less(t50, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t322 = t50 + t321
-    t323 = t50 - t321
+    t323 = -t321 + t50
     t324 = xp.where(xp.greater_equal(t50, -2.8973) & xp.less_equal(t50, 2.8973), t50, xp.where(xp.greater_equal(t322, -2.8973) & xp.less_equal(t322, 2.8973), t322, xp.where(xp.greater_equal(t323, -2.8973) & xp.less_equal(t323, 2.8973), t323, qb7_0)))
     t325 = xp.where(xp.less(t51, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t326 = t51 + t325
-    t327 = t51 - t325
+    t327 = -t325 + t51
     t328 = xp.where(xp.greater_equal(t51, -1.7627999999999997) & xp.less_equal(t51, 1.7627999999999997), t51, xp.where(xp.greater_equal(t326, -1.7627999999999997) & xp.less_equal(t326, 1.7627999999999997), t326, xp.where(xp.greater_equal(t327, -1.7627999999999997) & xp.less_equal(t327, 1.7627999999999997), t327, qb7_1)))
     t329 = xp.where(xp.less(t52, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t330 = t52 + t329
-    t331 = t52 - t329
+    t331 = -t329 + t52
     t332 = xp.where(xp.greater_equal(t52, -2.8973) & xp.less_equal(t52, 2.8973), t52, xp.where(xp.greater_equal(t330, -2.8973) & xp.less_equal(t330, 2.8973), t330, xp.where(xp.greater_equal(t331, -2.8973) & xp.less_equal(t331, 2.8973), t331, qb7_2)))
     t333 = xp.where(xp.less(t53, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t334 = t53 + t333
-    t335 = t53 - t333
+    t335 = -t333 + t53
     t336 = xp.where(xp.greater_equal(t53, -3.0718) & xp.less_equal(t53, -0.0698), t53, xp.where(xp.greater_equal(t334, -3.0718) & xp.less_equal(t334, -0.0698), t334, xp.where(xp.greater_equal(t335, -3.0718) & xp.less_equal(t335, -0.0698), t335, qb7_3)))
     t337 = xp.where(xp.less(t54, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t338 = t54 + t337
-    t339 = t54 - t337
+    t339 = -t337 + t54
     t340 = xp.where(xp.greater_equal(t54, -2.8973) & xp.less_equal(t54, 2.8973), t54, xp.where(xp.greater_equal(t338, -2.8973) & xp.less_equal(t338, 2.8973), t338, xp.where(xp.greater_equal(t339, -2.8973) & xp.less_equal(t339, 2.8973), t339, qb7_4)))
     t341 = xp.where(xp.less(t55, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t342 = t55 + t341
-    t343 = t55 - t341
+    t343 = -t341 + t55
     t344 = xp.where(xp.greater_equal(t55, -0.0175) & xp.less_equal(t55, 3.7525000000000004), t55, xp.where(xp.greater_equal(t342, -0.0175) & xp.less_equal(t342, 3.7525000000000004), t342, xp.where(xp.greater_equal(t343, -0.0175) & xp.less_equal(t343, 3.7525000000000004), t343, qb7_5)))
-    t345 = qw1*(t324 + t82)**2 + qw2*(t328 + t83)**2 + qw3*(t332 + t84)**2 + qw4*(t336 + t85)**2 + qw5*(t340 + t86)**2 + qw6*(t344 + t87)**2 + qw7*(qb7_6 + t88)**2
+    t345 = qw1*(t82 + t324)**2 + qw2*(t83 + t328)**2 + qw3*(t84 + t332)**2 + qw4*(t85 + t336)**2 + qw5*(t86 + t340)**2 + qw6*(t87 + t344)**2 + qw7*(t88 + qb7_6)**2
     t346 = xp.greater(t56, 0)
     t347 = xp.where(t346 & (xp.less(t311, 1) | xp.less(t345, t320)), xp.asarray(1, dtype=dtype), 0)
     t348 = xp.where(t346, 1, t311)

@@ -196,9 +196,9 @@ def jacobian_tool(q):
     t0 = c1 + c12
     t1 = s1 + s12
     J = _stack(xp, [
-        t0*s12 - t1*c12,  # 0, 0
+        s12*t0 - c12*t1,  # 0, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 1
-        t0*c12 + t1*s12,  # 1, 0
+        c12*t0 + s12*t1,  # 1, 0
         c12**2 + s12**2,  # 1, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 1
@@ -266,7 +266,7 @@ def fk_jacobian_dot(q, q_dot):
     s12 = c1*s2 + c2*s1
     t0 = c1 + c12
     t1 = s1 + s12
-    t2 = qd2*s12
+    t2 = s12*qd2
     t3 = t1*qd1 + t2
     t4 = c12*qd2
     t5 = t0*qd1 + t4
@@ -304,8 +304,8 @@ def fk_jacobian_dot(q, q_dot):
         xp.full(batch, 1, dtype=dtype, device=device),  # 5, 1
     ], (6, 2))
     a = _stack(xp, [
-        xp.broadcast_to(-qd2*(c12*qd1 + t4) - t5*qd1, batch),  # 0
-        xp.broadcast_to(-qd2*(qd1*s12 + t2) - t3*qd1, batch),  # 1
+        xp.broadcast_to(-qd2*(c12*qd1 + t4) - qd1*t5, batch),  # 0
+        xp.broadcast_to(-qd2*(s12*qd1 + t2) - qd1*t3, batch),  # 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 4
@@ -328,7 +328,7 @@ def jacobian_dot(q, q_dot):
     s12 = c1*s2 + c2*s1
     t0 = c1 + c12
     t1 = s1 + s12
-    t2 = qd2*s12
+    t2 = s12*qd2
     t3 = t1*qd1 + t2
     t4 = c12*qd2
     t5 = t0*qd1 + t4
@@ -336,7 +336,7 @@ def jacobian_dot(q, q_dot):
         xp.broadcast_to(-t5, batch),  # 0, 0
         xp.broadcast_to(-(c12*qd1 + t4), batch),  # 0, 1
         xp.broadcast_to(-t3, batch),  # 1, 0
-        xp.broadcast_to(-(qd1*s12 + t2), batch),  # 1, 1
+        xp.broadcast_to(-(s12*qd1 + t2), batch),  # 1, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
@@ -363,13 +363,13 @@ def bias_acceleration(q, q_dot):
     s12 = c1*s2 + c2*s1
     t0 = c1 + c12
     t1 = s1 + s12
-    t2 = qd2*s12
+    t2 = s12*qd2
     t3 = t1*qd1 + t2
     t4 = c12*qd2
     t5 = t0*qd1 + t4
     a = _stack(xp, [
-        xp.broadcast_to(-qd2*(c12*qd1 + t4) - t5*qd1, batch),  # 0
-        xp.broadcast_to(-qd2*(qd1*s12 + t2) - t3*qd1, batch),  # 1
+        xp.broadcast_to(-qd2*(c12*qd1 + t4) - qd1*t5, batch),  # 0
+        xp.broadcast_to(-qd2*(s12*qd1 + t2) - qd1*t3, batch),  # 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 4
@@ -392,12 +392,12 @@ def task_jacobian_dot(q, q_dot):
     s12 = c1*s2 + c2*s1
     t0 = c1 + c12
     t1 = s1 + s12
-    t2 = qd2*s12
+    t2 = s12*qd2
     t3 = t1*qd1 + t2
-    t4 = qd1*s12 + t2
+    t4 = t2 + s12*qd1
     t5 = c12*qd2
     t6 = t0*qd1 + t5
-    t7 = c12*qd1 + t5
+    t7 = t5 + c12*qd1
     Jd = _stack(xp, [
         xp.broadcast_to(-t6, batch),  # 0, 0
         xp.broadcast_to(-t7, batch),  # 0, 1
@@ -498,68 +498,68 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t1 = s1 + s12
     t2 = t0*t1 + c12*s12
     t3 = t1**2
-    t4 = t3 + s12**2
+    t4 = s12**2 + t3
     t5 = t4
     t6 = t0**2
     t7 = xp.sqrt(t6 + t3)
     t8 = t7*xp.where(xp.less_equal(t1, 0), xp.asarray(1, dtype=dtype), -1)
-    t9 = xp.where(xp.greater(t7, 0), 1/(t7*(t7 + xp.abs(t1))), 0)
-    t10 = t6 + c12**2
-    t11 = t10
-    t12 = xp.sqrt(t4 + t10)
-    t13 = damping**2
-    t14 = t5 + t13
-    t15 = t14**2
-    t16 = t11 + t13
-    t17 = t2**2
-    t18 = xp.sqrt(t15 + t16**2 + 2*t17)
-    t19 = xp.sqrt(t17 + t15)
-    t20 = t19*xp.where(xp.greater_equal(t14, 0), xp.asarray(1, dtype=dtype), -1)
-    t21 = t20 + t14
-    t22 = xp.where(xp.greater(t19, 0), 1/(t19*(t19 + xp.abs(t14))), 0)
-    t23 = -t22*(t2*t21 + t2*t16)
-    t24 = t2 + t21*t23
-    t25 = t2*t23 + t16
-    t26 = t22*(t21*mu_dot0 - t2*mu_dot1)
-    t27 = mu_dot0 - t21*t26
-    t28 = mu_dot1 + t2*t26
-    t29 = xp.abs(t25)
-    t30 = t29
-    t31 = t30*xp.where(xp.greater_equal(t25, 0), xp.asarray(1, dtype=dtype), -1)
-    t32 = t25 + t31
-    t33 = xp.where(xp.greater(t30, 0), 1/(t30*(t30 + t29)), 0)
-    t34 = t28 - t28*t33*t32**2
-    t35 = xp.where(xp.not_equal(t31, 0), -t34/t31, 0)
-    t36 = xp.where(xp.not_equal(t20, 0), -(t27 + t24*t35)/t20, 0)
-    t37 = t35*t0 - t36*t1
-    t38 = t35*c12 - t36*s12
-    t39 = -t1
-    t40 = t8 + t39
-    t41 = t9*(t0*c12 - t40*s12)
-    t42 = s12 + t40*t41
-    t43 = c12 - t41*t0
-    t44 = t9*(t40*mu_dot0 + t0*mu_dot1)
-    t45 = mu_dot0 - t40*t44
-    t46 = mu_dot1 - t44*t0
-    t47 = t0 + c12 + damping + mu_dot0 + mu_dot1 + q1 + q2 + t39 - s12
+    t9 = c12**2 + t6
+    t10 = t9
+    t11 = xp.sqrt(t4 + t9)
+    t12 = damping**2
+    t13 = t12 + t5
+    t14 = t13**2
+    t15 = t12 + t10
+    t16 = t2**2
+    t17 = xp.sqrt(t14 + t15**2 + 2*t16)
+    t18 = xp.sqrt(t16 + t14)
+    t19 = t18*xp.where(xp.greater_equal(t13, 0), xp.asarray(1, dtype=dtype), -1)
+    t20 = t19 + t13
+    t21 = xp.where(xp.greater(t18, 0), 1/(t18*(t18 + xp.abs(t13))), 0)
+    t22 = -t21*(t2*t20 + t2*t15)
+    t23 = t2 + t20*t22
+    t24 = t2*t22 + t15
+    t25 = t21*(mu_dot0*t20 - mu_dot1*t2)
+    t26 = mu_dot0 - t20*t25
+    t27 = mu_dot1 + t2*t25
+    t28 = xp.abs(t24)
+    t29 = t28
+    t30 = t29*xp.where(xp.greater_equal(t24, 0), xp.asarray(1, dtype=dtype), -1)
+    t31 = t24 + t30
+    t32 = xp.where(xp.greater(t29, 0), 1/(t29*(t28 + t29)), 0)
+    t33 = t27 - t27*t31**2*t32
+    t34 = xp.where(xp.not_equal(t30, 0), -t33/t30, 0)
+    t35 = xp.where(xp.not_equal(t19, 0), -(t26 + t23*t34)/t19, 0)
+    t36 = -t1*t35 + t0*t34
+    t37 = -s12*t35 + c12*t34
+    t38 = -t1
+    t39 = t38 + t8
+    t40 = xp.where(xp.greater(t7, 0), 1/(t7*(t7 + xp.abs(t38))), 0)
+    t41 = t40*(c12*t0 - s12*t39)
+    t42 = s12 + t39*t41
+    t43 = c12 - t0*t41
+    t44 = t40*(mu_dot0*t39 + t0*mu_dot1)
+    t45 = mu_dot0 - t39*t44
+    t46 = mu_dot1 - t0*t44
+    t47 = t38 - s12 + q1 + q2 + c12 + t0 + mu_dot0 + mu_dot1 + damping
     t48 = xp.abs(t43)
     t49 = t48
     t50 = t49*xp.where(xp.greater_equal(t43, 0), xp.asarray(1, dtype=dtype), -1)
     t51 = t43 + t50
-    t52 = xp.where(xp.greater(t49, 0), 1/(t49*(t49 + t48)), 0)
-    t53 = t46 - t46*t52*t51**2
+    t52 = xp.where(xp.greater(t49, 0), 1/(t49*(t48 + t49)), 0)
+    t53 = t46 - t46*t51**2*t52
     t54 = xp.where(xp.not_equal(t50, 0), -t53/t50, 0)
     t55 = xp.where(xp.not_equal(t8, 0), -(t45 + t42*t54)/t8, 0)
     t56 = xp.isfinite(t47)
     t57 = xp.greater_equal(damping, 0)
-    t58 = 1e-12*t12
-    t59 = xp.greater(damping, 0)
-    t60 = 1e-12*t18
-    t61 = (xp.less_equal(damping, 0) & (xp.less_equal(t7, t58) | xp.less_equal(t49, t58))) | (t59 & (xp.less_equal(t19, t60) | xp.less_equal(t30, t60)))
+    t58 = xp.greater(damping, 0)
+    t59 = 1e-12*t17
+    t60 = 1e-12*t11
+    t61 = (t58 & (xp.less_equal(t18, t59) | xp.less_equal(t29, t59))) | (xp.less_equal(damping, 0) & (xp.less_equal(t7, t60) | xp.less_equal(t49, t60)))
     t62 = t56 & t57 & xp.logical_not(t61)
     q_dot = _stack(xp, [
-        xp.broadcast_to(xp.where(t62, xp.where(t59, t37, t55), 0), batch),  # 0
-        xp.broadcast_to(xp.where(t62, xp.where(t59, t38, t54), 0), batch),  # 1
+        xp.broadcast_to(xp.where(t62, xp.where(t58, t36, t55), 0), batch),  # 0
+        xp.broadcast_to(xp.where(t62, xp.where(t58, t37, t54), 0), batch),  # 1
     ], (2,))
     status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t56 & t57), 2, xp.where(t61, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
     return q_dot, status
@@ -583,35 +583,35 @@ def ik_numeric_step(target, q, damping=0.0):
     s12 = c1*s2 + c2*s1
     t0 = c1 + c12
     t1 = s1 + s12
-    t2 = t1**2 + s12**2
+    t2 = s12**2 + t1**2
     t3 = t0*t1 + c12*s12
-    t4 = t0**2 + c12**2
-    t5 = mu0 - t0
-    t6 = mu1 - t1
+    t4 = c12**2 + t0**2
+    t5 = -t0 + mu0
+    t6 = -t1 + mu1
     t7 = t5**2 + t6**2
-    t8 = mu0 + mu1 + qs1 + qs2
-    t9 = t2 + damping
+    t8 = qs1 + qs2 + mu0 + mu1
+    t9 = damping + t2
     t10 = xp.sqrt(t3**2 + t9**2)
     t11 = t10*xp.where(xp.greater_equal(t9, 0), xp.asarray(1, dtype=dtype), -1)
-    t12 = t11 + t9
+    t12 = t9 + t11
     t13 = xp.where(xp.greater(t10, 0), 1/(t10*(t10 + xp.abs(t9))), 0)
     t14 = t13*(t5*t12 - t3*t6)
     t15 = t5 - t12*t14
     t16 = t6 + t3*t14
-    t17 = t4 + damping
+    t17 = damping + t4
     t18 = -t13*(t3*t12 + t3*t17)
     t19 = t3 + t12*t18
-    t20 = t3*t18 + t17
+    t20 = t17 + t3*t18
     t21 = xp.abs(t20)
     t22 = t21
     t23 = t22*xp.where(xp.greater_equal(t20, 0), xp.asarray(1, dtype=dtype), -1)
     t24 = t20 + t23
-    t25 = xp.where(xp.greater(t22, 0), 1/(t22*(t22 + t21)), 0)
-    t26 = t16 - t16*t25*t24**2
+    t25 = xp.where(xp.greater(t22, 0), 1/(t22*(t21 + t22)), 0)
+    t26 = t16 - t16*t24**2*t25
     t27 = xp.where(xp.not_equal(t23, 0), -t26/t23, 0)
     t28 = xp.where(xp.not_equal(t11, 0), -(t15 + t19*t27)/t11, 0)
-    t29 = q1 + t0*t27 - t1*t28
-    t30 = q2 + t27*c12 - t28*s12
+    t29 = q1 - t1*t28 + t0*t27
+    t30 = q2 - s12*t28 + c12*t27
     q_start = _stack(xp, [
         xp.broadcast_to(q1, batch),  # 0
         xp.broadcast_to(q2, batch),  # 1
@@ -645,22 +645,22 @@ def ik_branches(mu):
     t12 = -t6
     t13 = t12
     t14 = 1 + t13
-    t15 = t11*mu1 + t14*mu0
-    t16 = t14*mu1 - t11*mu0
+    t15 = mu1*t11 + mu0*t14
+    t16 = mu1*t14 - mu0*t11
     t17 = t15**2 + t16**2
     t18 = t11**2 + t14**2
     t19 = 1 + t12
-    t20 = t7*mu1 + t19*mu0
-    t21 = t19*mu1 - t7*mu0
+    t20 = mu1*t7 + mu0*t19
+    t21 = mu1*t19 - mu0*t7
     t22 = t20**2 + t21**2
     t23 = t7**2 + t19**2
     t24 = 1e-24*t0
     t25 = xp.isfinite(t2)
     q = _stack(xp, [
-        xp.where(xp.less_equal(t17, t18*t24), 0, xp.atan2(t16, t15)),  # 0, 0
+        xp.where(xp.less_equal(t17, t24*t18), 0, xp.atan2(t16, t15)),  # 0, 0
         t10 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t10)),  # 0, 1
-        xp.where(xp.less_equal(t22, t23*t24), 0, xp.atan2(t21, t20)),  # 1, 0
-        t9 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t9)),  # 1, 1
+        xp.where(xp.less_equal(t22, t24*t23), 0, xp.atan2(t21, t20)),  # 1, 0
+        -6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t9)) + t9,  # 1, 1
     ], (2, 2))
     valid = _stack(xp, [
         t25 & xp.greater_equal(t4, -1e-12),  # 0
@@ -692,18 +692,18 @@ def ik_nearest(mu, q_seed, weights=(1.0,) * DOF):
     vb1 = branches_valid[..., 1]
     lb0 = branches_in_limits[..., 0]
     lb1 = branches_in_limits[..., 1]
-    t0 = qb0_0 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn1 - qb0_0))
-    t1 = qb0_1 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn2 - qb0_1))
+    t0 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_0 + qn1)) + qb0_0
+    t1 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_1 + qn2)) + qb0_1
     t2 = xp.where(lb0 & vb0, xp.asarray(1, dtype=dtype), 0)
     t3 = xp.where(xp.greater(t2, 0), xp.asarray(1, dtype=dtype), 0)
-    t4 = qb1_0 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn1 - qb1_0))
-    t5 = qb1_1 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn2 - qb1_1))
+    t4 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_0 + qn1)) + qb1_0
+    t5 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_1 + qn2)) + qb1_1
     t6 = xp.where(lb1 & vb1, xp.asarray(1, dtype=dtype), 0)
     t7 = mu0 + mu1 + qn1 + qn2 + qw1 + qw2
     t8 = -qn1
     t9 = -qn2
-    t10 = qw1*(t0 + t8)**2 + qw2*(t1 + t9)**2
-    t11 = qw1*(t4 + t8)**2 + qw2*(t5 + t9)**2
+    t10 = qw1*(t8 + t0)**2 + qw2*(t9 + t1)**2
+    t11 = qw1*(t8 + t4)**2 + qw2*(t9 + t5)**2
     t12 = xp.greater(t3, 0)
     t13 = xp.where(t12, t0, qn1)
     t14 = xp.where(t12, t1, qn2)

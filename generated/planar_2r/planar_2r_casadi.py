@@ -107,8 +107,8 @@ def _jacobian_tool(q):
     t0 = c1 + c12
     t1 = s1 + s12
     J = casadi.SX(6, 2)
-    J[0, 0] = t0*s12 - t1*c12
-    J[1, 0] = t0*c12 + t1*s12
+    J[0, 0] = s12*t0 - c12*t1
+    J[1, 0] = c12*t0 + s12*t1
     J[1, 1] = c12**2 + s12**2
     J[5, 0] = 1
     J[5, 1] = 1
@@ -167,7 +167,7 @@ def _fk_jacobian_dot(q, q_dot):
     s12 = c1*s2 + c2*s1
     t0 = c1 + c12
     t1 = s1 + s12
-    t2 = qd2*s12
+    t2 = s12*qd2
     t3 = t1*qd1 + t2
     t4 = c12*qd2
     t5 = t0*qd1 + t4
@@ -189,8 +189,8 @@ def _fk_jacobian_dot(q, q_dot):
     J[5, 0] = 1
     J[5, 1] = 1
     a = casadi.SX(6, 1)
-    a[0, 0] = -qd2*(c12*qd1 + t4) - t5*qd1
-    a[1, 0] = -qd2*(qd1*s12 + t2) - t3*qd1
+    a[0, 0] = -qd2*(c12*qd1 + t4) - qd1*t5
+    a[1, 0] = -qd2*(s12*qd1 + t2) - qd1*t3
     return [T, J, a]
 
 
@@ -208,7 +208,7 @@ def _jacobian_dot(q, q_dot):
     s12 = c1*s2 + c2*s1
     t0 = c1 + c12
     t1 = s1 + s12
-    t2 = qd2*s12
+    t2 = s12*qd2
     t3 = t1*qd1 + t2
     t4 = c12*qd2
     t5 = t0*qd1 + t4
@@ -216,7 +216,7 @@ def _jacobian_dot(q, q_dot):
     Jd[0, 0] = -t5
     Jd[0, 1] = -(c12*qd1 + t4)
     Jd[1, 0] = -t3
-    Jd[1, 1] = -(qd1*s12 + t2)
+    Jd[1, 1] = -(s12*qd1 + t2)
     return [Jd]
 
 
@@ -234,13 +234,13 @@ def _bias_acceleration(q, q_dot):
     s12 = c1*s2 + c2*s1
     t0 = c1 + c12
     t1 = s1 + s12
-    t2 = qd2*s12
+    t2 = s12*qd2
     t3 = t1*qd1 + t2
     t4 = c12*qd2
     t5 = t0*qd1 + t4
     a = casadi.SX(6, 1)
-    a[0, 0] = -qd2*(c12*qd1 + t4) - t5*qd1
-    a[1, 0] = -qd2*(qd1*s12 + t2) - t3*qd1
+    a[0, 0] = -qd2*(c12*qd1 + t4) - qd1*t5
+    a[1, 0] = -qd2*(s12*qd1 + t2) - qd1*t3
     return [a]
 
 
@@ -258,12 +258,12 @@ def _task_jacobian_dot(q, q_dot):
     s12 = c1*s2 + c2*s1
     t0 = c1 + c12
     t1 = s1 + s12
-    t2 = qd2*s12
+    t2 = s12*qd2
     t3 = t1*qd1 + t2
-    t4 = qd1*s12 + t2
+    t4 = t2 + s12*qd1
     t5 = c12*qd2
     t6 = t0*qd1 + t5
-    t7 = c12*qd1 + t5
+    t7 = t5 + c12*qd1
     Jd = casadi.SX(2, 2)
     Jd[0, 0] = -t6
     Jd[0, 1] = -t7
@@ -341,68 +341,68 @@ def _velocity_ik(q, mu_dot, damping):
     t1 = s1 + s12
     t2 = t0*t1 + c12*s12
     t3 = t1**2
-    t4 = t3 + s12**2
+    t4 = s12**2 + t3
     t5 = t4
     t6 = t0**2
     t7 = casadi.sqrt(t6 + t3)
     t8 = t7*casadi.if_else((t1 <= 0), 1, -1)
-    t9 = casadi.if_else((t7 > 0), 1/(t7*(t7 + casadi.fabs(t1))), 0)
-    t10 = t6 + c12**2
-    t11 = t10
-    t12 = casadi.sqrt(t4 + t10)
-    t13 = damping**2
-    t14 = t5 + t13
-    t15 = t14**2
-    t16 = t11 + t13
-    t17 = t2**2
-    t18 = casadi.sqrt(t15 + t16**2 + 2*t17)
-    t19 = casadi.sqrt(t17 + t15)
-    t20 = t19*casadi.if_else((t14 >= 0), 1, -1)
-    t21 = t20 + t14
-    t22 = casadi.if_else((t19 > 0), 1/(t19*(t19 + casadi.fabs(t14))), 0)
-    t23 = -t22*(t2*t21 + t2*t16)
-    t24 = t2 + t21*t23
-    t25 = t2*t23 + t16
-    t26 = t22*(t21*mu_dot0 - t2*mu_dot1)
-    t27 = mu_dot0 - t21*t26
-    t28 = mu_dot1 + t2*t26
-    t29 = casadi.fabs(t25)
-    t30 = t29
-    t31 = t30*casadi.if_else((t25 >= 0), 1, -1)
-    t32 = t25 + t31
-    t33 = casadi.if_else((t30 > 0), 1/(t30*(t30 + t29)), 0)
-    t34 = t28 - t28*t33*t32**2
-    t35 = casadi.if_else((t31 != 0), -t34/t31, 0)
-    t36 = casadi.if_else((t20 != 0), -(t27 + t24*t35)/t20, 0)
-    t37 = t35*t0 - t36*t1
-    t38 = t35*c12 - t36*s12
-    t39 = -t1
-    t40 = t8 + t39
-    t41 = t9*(t0*c12 - t40*s12)
-    t42 = s12 + t40*t41
-    t43 = c12 - t41*t0
-    t44 = t9*(t40*mu_dot0 + t0*mu_dot1)
-    t45 = mu_dot0 - t40*t44
-    t46 = mu_dot1 - t44*t0
-    t47 = t0 + c12 + damping + mu_dot0 + mu_dot1 + q1 + q2 + t39 - s12
+    t9 = c12**2 + t6
+    t10 = t9
+    t11 = casadi.sqrt(t4 + t9)
+    t12 = damping**2
+    t13 = t12 + t5
+    t14 = t13**2
+    t15 = t12 + t10
+    t16 = t2**2
+    t17 = casadi.sqrt(t14 + t15**2 + 2*t16)
+    t18 = casadi.sqrt(t16 + t14)
+    t19 = t18*casadi.if_else((t13 >= 0), 1, -1)
+    t20 = t19 + t13
+    t21 = casadi.if_else((t18 > 0), 1/(t18*(t18 + casadi.fabs(t13))), 0)
+    t22 = -t21*(t2*t20 + t2*t15)
+    t23 = t2 + t20*t22
+    t24 = t2*t22 + t15
+    t25 = t21*(mu_dot0*t20 - mu_dot1*t2)
+    t26 = mu_dot0 - t20*t25
+    t27 = mu_dot1 + t2*t25
+    t28 = casadi.fabs(t24)
+    t29 = t28
+    t30 = t29*casadi.if_else((t24 >= 0), 1, -1)
+    t31 = t24 + t30
+    t32 = casadi.if_else((t29 > 0), 1/(t29*(t28 + t29)), 0)
+    t33 = t27 - t27*t31**2*t32
+    t34 = casadi.if_else((t30 != 0), -t33/t30, 0)
+    t35 = casadi.if_else((t19 != 0), -(t26 + t23*t34)/t19, 0)
+    t36 = -t1*t35 + t0*t34
+    t37 = -s12*t35 + c12*t34
+    t38 = -t1
+    t39 = t38 + t8
+    t40 = casadi.if_else((t7 > 0), 1/(t7*(t7 + casadi.fabs(t38))), 0)
+    t41 = t40*(c12*t0 - s12*t39)
+    t42 = s12 + t39*t41
+    t43 = c12 - t0*t41
+    t44 = t40*(mu_dot0*t39 + t0*mu_dot1)
+    t45 = mu_dot0 - t39*t44
+    t46 = mu_dot1 - t0*t44
+    t47 = t38 - s12 + q1 + q2 + c12 + t0 + mu_dot0 + mu_dot1 + damping
     t48 = casadi.fabs(t43)
     t49 = t48
     t50 = t49*casadi.if_else((t43 >= 0), 1, -1)
     t51 = t43 + t50
-    t52 = casadi.if_else((t49 > 0), 1/(t49*(t49 + t48)), 0)
-    t53 = t46 - t46*t52*t51**2
+    t52 = casadi.if_else((t49 > 0), 1/(t49*(t48 + t49)), 0)
+    t53 = t46 - t46*t51**2*t52
     t54 = casadi.if_else((t50 != 0), -t53/t50, 0)
     t55 = casadi.if_else((t8 != 0), -(t45 + t42*t54)/t8, 0)
     t56 = (casadi.fabs(t47) < casadi.inf)
     t57 = (damping >= 0)
-    t58 = 1e-12*t12
-    t59 = (damping > 0)
-    t60 = 1e-12*t18
-    t61 = casadi.logic_or(casadi.logic_and((damping <= 0), casadi.logic_or((t7 <= t58), (t49 <= t58))), casadi.logic_and(t59, casadi.logic_or((t19 <= t60), (t30 <= t60))))
+    t58 = (damping > 0)
+    t59 = 1e-12*t17
+    t60 = 1e-12*t11
+    t61 = casadi.logic_or(casadi.logic_and(t58, casadi.logic_or((t18 <= t59), (t29 <= t59))), casadi.logic_and((damping <= 0), casadi.logic_or((t7 <= t60), (t49 <= t60))))
     t62 = casadi.logic_and(casadi.logic_and(t56, t57), casadi.logic_not(t61))
     q_dot = casadi.SX(2, 1)
-    q_dot[0, 0] = casadi.if_else(t62, casadi.if_else(t59, t37, t55), 0)
-    q_dot[1, 0] = casadi.if_else(t62, casadi.if_else(t59, t38, t54), 0)
+    q_dot[0, 0] = casadi.if_else(t62, casadi.if_else(t58, t36, t55), 0)
+    q_dot[1, 0] = casadi.if_else(t62, casadi.if_else(t58, t37, t54), 0)
     status = casadi.SX(1, 1)
     status[0, 0] = casadi.if_else(casadi.logic_not(casadi.logic_and(t56, t57)), 2, casadi.if_else(t61, 1, 0))
     return [q_dot, status]
@@ -424,35 +424,35 @@ def _ik_numeric_step(target, q, damping):
     s12 = c1*s2 + c2*s1
     t0 = c1 + c12
     t1 = s1 + s12
-    t2 = t1**2 + s12**2
+    t2 = s12**2 + t1**2
     t3 = t0*t1 + c12*s12
-    t4 = t0**2 + c12**2
-    t5 = mu0 - t0
-    t6 = mu1 - t1
+    t4 = c12**2 + t0**2
+    t5 = -t0 + mu0
+    t6 = -t1 + mu1
     t7 = t5**2 + t6**2
-    t8 = mu0 + mu1 + qs1 + qs2
-    t9 = t2 + damping
+    t8 = qs1 + qs2 + mu0 + mu1
+    t9 = damping + t2
     t10 = casadi.sqrt(t3**2 + t9**2)
     t11 = t10*casadi.if_else((t9 >= 0), 1, -1)
-    t12 = t11 + t9
+    t12 = t9 + t11
     t13 = casadi.if_else((t10 > 0), 1/(t10*(t10 + casadi.fabs(t9))), 0)
     t14 = t13*(t5*t12 - t3*t6)
     t15 = t5 - t12*t14
     t16 = t6 + t3*t14
-    t17 = t4 + damping
+    t17 = damping + t4
     t18 = -t13*(t3*t12 + t3*t17)
     t19 = t3 + t12*t18
-    t20 = t3*t18 + t17
+    t20 = t17 + t3*t18
     t21 = casadi.fabs(t20)
     t22 = t21
     t23 = t22*casadi.if_else((t20 >= 0), 1, -1)
     t24 = t20 + t23
-    t25 = casadi.if_else((t22 > 0), 1/(t22*(t22 + t21)), 0)
-    t26 = t16 - t16*t25*t24**2
+    t25 = casadi.if_else((t22 > 0), 1/(t22*(t21 + t22)), 0)
+    t26 = t16 - t16*t24**2*t25
     t27 = casadi.if_else((t23 != 0), -t26/t23, 0)
     t28 = casadi.if_else((t11 != 0), -(t15 + t19*t27)/t11, 0)
-    t29 = q1 + t0*t27 - t1*t28
-    t30 = q2 + t27*c12 - t28*s12
+    t29 = q1 - t1*t28 + t0*t27
+    t30 = q2 - s12*t28 + c12*t27
     q_start = casadi.SX(2, 1)
     q_start[0, 0] = q1
     q_start[1, 0] = q2
@@ -483,22 +483,22 @@ def _ik_branches(mu):
     t12 = -t6
     t13 = t12
     t14 = 1 + t13
-    t15 = t11*mu1 + t14*mu0
-    t16 = t14*mu1 - t11*mu0
+    t15 = mu1*t11 + mu0*t14
+    t16 = mu1*t14 - mu0*t11
     t17 = t15**2 + t16**2
     t18 = t11**2 + t14**2
     t19 = 1 + t12
-    t20 = t7*mu1 + t19*mu0
-    t21 = t19*mu1 - t7*mu0
+    t20 = mu1*t7 + mu0*t19
+    t21 = mu1*t19 - mu0*t7
     t22 = t20**2 + t21**2
     t23 = t7**2 + t19**2
     t24 = 1e-24*t0
     t25 = (casadi.fabs(t2) < casadi.inf)
     q = casadi.SX(2, 2)
-    q[0, 0] = casadi.if_else((t17 <= t18*t24), 0, casadi.atan2(t16, t15))
+    q[0, 0] = casadi.if_else((t17 <= t24*t18), 0, casadi.atan2(t16, t15))
     q[0, 1] = t10 - 6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t10))
-    q[1, 0] = casadi.if_else((t22 <= t23*t24), 0, casadi.atan2(t21, t20))
-    q[1, 1] = t9 - 6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t9))
+    q[1, 0] = casadi.if_else((t22 <= t24*t23), 0, casadi.atan2(t21, t20))
+    q[1, 1] = -6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t9)) + t9
     valid = casadi.SX(2, 1)
     valid[0, 0] = casadi.logic_and(t25, (t4 >= -1e-12))
     valid[1, 0] = casadi.logic_and(t25, t5)
@@ -525,18 +525,18 @@ def _ik_nearest(mu, q_seed, weights):
     vb1 = branches_valid[1]
     lb0 = branches_in_limits[0]
     lb1 = branches_in_limits[1]
-    t0 = qb0_0 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn1 - qb0_0))
-    t1 = qb0_1 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn2 - qb0_1))
+    t0 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb0_0 + qn1)) + qb0_0
+    t1 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb0_1 + qn2)) + qb0_1
     t2 = casadi.if_else(casadi.logic_and(lb0, vb0), 1, 0)
     t3 = casadi.if_else((t2 > 0), 1, 0)
-    t4 = qb1_0 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn1 - qb1_0))
-    t5 = qb1_1 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn2 - qb1_1))
+    t4 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb1_0 + qn1)) + qb1_0
+    t5 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb1_1 + qn2)) + qb1_1
     t6 = casadi.if_else(casadi.logic_and(lb1, vb1), 1, 0)
     t7 = mu0 + mu1 + qn1 + qn2 + qw1 + qw2
     t8 = -qn1
     t9 = -qn2
-    t10 = qw1*(t0 + t8)**2 + qw2*(t1 + t9)**2
-    t11 = qw1*(t4 + t8)**2 + qw2*(t5 + t9)**2
+    t10 = qw1*(t8 + t0)**2 + qw2*(t9 + t1)**2
+    t11 = qw1*(t8 + t4)**2 + qw2*(t9 + t5)**2
     t12 = (t3 > 0)
     t13 = casadi.if_else(t12, t0, qn1)
     t14 = casadi.if_else(t12, t1, qn2)

@@ -30,11 +30,11 @@ def _fk(q):
     c3 = casadi.cos(q3)
     s3 = casadi.sin(q3)
     c123 = c12*c3 - s12*s3
-    s123 = c12*s3 + c3*s12
+    s123 = c12*s3 + s12*c3
     t0 = c12 + c123
     t1 = s12 + s123
-    t2 = t0 + c1
-    t3 = t1 + s1
+    t2 = c1 + t0
+    t3 = s1 + t1
     T = casadi.SX(4, 4)
     T[0, 0] = c123
     T[0, 1] = -s123
@@ -61,11 +61,11 @@ def _jacobian(q):
     c3 = casadi.cos(q3)
     s3 = casadi.sin(q3)
     c123 = c12*c3 - s12*s3
-    s123 = c12*s3 + c3*s12
+    s123 = c12*s3 + s12*c3
     t0 = c12 + c123
     t1 = s12 + s123
-    t2 = t0 + c1
-    t3 = t1 + s1
+    t2 = c1 + t0
+    t3 = s1 + t1
     J = casadi.SX(6, 3)
     J[0, 0] = -t3
     J[0, 1] = -t1
@@ -93,11 +93,11 @@ def _fk_jacobian(q):
     c3 = casadi.cos(q3)
     s3 = casadi.sin(q3)
     c123 = c12*c3 - s12*s3
-    s123 = c12*s3 + c3*s12
+    s123 = c12*s3 + s12*c3
     t0 = c12 + c123
     t1 = s12 + s123
-    t2 = t0 + c1
-    t3 = t1 + s1
+    t2 = c1 + t0
+    t3 = s1 + t1
     t4 = -s123
     T = casadi.SX(4, 4)
     T[0, 0] = c123
@@ -135,16 +135,16 @@ def _jacobian_tool(q):
     c3 = casadi.cos(q3)
     s3 = casadi.sin(q3)
     c123 = c12*c3 - s12*s3
-    s123 = c12*s3 + c3*s12
+    s123 = c12*s3 + s12*c3
     t0 = c12 + c123
     t1 = s12 + s123
-    t2 = t0 + c1
-    t3 = t1 + s1
+    t2 = c1 + t0
+    t3 = s1 + t1
     J = casadi.SX(6, 3)
-    J[0, 0] = t2*s123 - t3*c123
-    J[0, 1] = t0*s123 - t1*c123
-    J[1, 0] = t2*c123 + t3*s123
-    J[1, 1] = t0*c123 + t1*s123
+    J[0, 0] = s123*t2 - c123*t3
+    J[0, 1] = s123*t0 - c123*t1
+    J[1, 0] = c123*t2 + s123*t3
+    J[1, 1] = c123*t0 + s123*t1
     J[1, 2] = c123**2 + s123**2
     J[5, 0] = 1
     J[5, 1] = 1
@@ -166,11 +166,11 @@ def _task(q):
     c3 = casadi.cos(q3)
     s3 = casadi.sin(q3)
     c123 = c12*c3 - s12*s3
-    s123 = c12*s3 + c3*s12
+    s123 = c12*s3 + s12*c3
     t0 = c12 + c123
     t1 = s12 + s123
-    t2 = t0 + c1
-    t3 = t1 + s1
+    t2 = c1 + t0
+    t3 = s1 + t1
     mu = casadi.SX(3, 1)
     mu[0, 0] = t2
     mu[1, 0] = t3
@@ -192,11 +192,11 @@ def _task_jacobian(q):
     c3 = casadi.cos(q3)
     s3 = casadi.sin(q3)
     c123 = c12*c3 - s12*s3
-    s123 = c12*s3 + c3*s12
+    s123 = c12*s3 + s12*c3
     t0 = c12 + c123
     t1 = s12 + s123
-    t2 = t0 + c1
-    t3 = t1 + s1
+    t2 = c1 + t0
+    t3 = s1 + t1
     J = casadi.SX(3, 3)
     J[0, 0] = -t3
     J[0, 1] = -t1
@@ -227,13 +227,13 @@ def _fk_jacobian_dot(q, q_dot):
     c3 = casadi.cos(q3)
     s3 = casadi.sin(q3)
     c123 = c12*c3 - s12*s3
-    s123 = c12*s3 + c3*s12
+    s123 = c12*s3 + s12*c3
     t0 = c12 + c123
     t1 = s12 + s123
-    t2 = t0 + c1
-    t3 = t1 + s1
+    t2 = c1 + t0
+    t3 = s1 + t1
     t4 = qd1 + qd2
-    t5 = qd3*s123
+    t5 = s123*qd3
     t6 = t1*qd2 + t5
     t7 = t6 + t3*qd1
     t8 = c123*qd3
@@ -260,8 +260,8 @@ def _fk_jacobian_dot(q, q_dot):
     J[5, 1] = 1
     J[5, 2] = 1
     a = casadi.SX(6, 1)
-    a[0, 0] = -qd2*(t9 + t0*qd1) - qd3*(t4*c123 + t8) - t10*qd1
-    a[1, 0] = -qd2*(t6 + t1*qd1) - qd3*(t4*s123 + t5) - t7*qd1
+    a[0, 0] = -qd2*(t9 + t0*qd1) - qd3*(c123*t4 + t8) - qd1*t10
+    a[1, 0] = -qd2*(t6 + t1*qd1) - qd3*(s123*t4 + t5) - qd1*t7
     return [T, J, a]
 
 
@@ -282,13 +282,13 @@ def _jacobian_dot(q, q_dot):
     c3 = casadi.cos(q3)
     s3 = casadi.sin(q3)
     c123 = c12*c3 - s12*s3
-    s123 = c12*s3 + c3*s12
+    s123 = c12*s3 + s12*c3
     t0 = c12 + c123
     t1 = s12 + s123
-    t2 = t0 + c1
-    t3 = t1 + s1
+    t2 = c1 + t0
+    t3 = s1 + t1
     t4 = qd1 + qd2
-    t5 = qd3*s123
+    t5 = s123*qd3
     t6 = t1*qd2 + t5
     t7 = t6 + t3*qd1
     t8 = c123*qd3
@@ -297,10 +297,10 @@ def _jacobian_dot(q, q_dot):
     Jd = casadi.SX(6, 3)
     Jd[0, 0] = -t10
     Jd[0, 1] = -(t9 + t0*qd1)
-    Jd[0, 2] = -(t4*c123 + t8)
+    Jd[0, 2] = -(c123*t4 + t8)
     Jd[1, 0] = -t7
     Jd[1, 1] = -(t6 + t1*qd1)
-    Jd[1, 2] = -(t4*s123 + t5)
+    Jd[1, 2] = -(s123*t4 + t5)
     return [Jd]
 
 
@@ -321,21 +321,21 @@ def _bias_acceleration(q, q_dot):
     c3 = casadi.cos(q3)
     s3 = casadi.sin(q3)
     c123 = c12*c3 - s12*s3
-    s123 = c12*s3 + c3*s12
+    s123 = c12*s3 + s12*c3
     t0 = c12 + c123
     t1 = s12 + s123
-    t2 = t0 + c1
-    t3 = t1 + s1
+    t2 = c1 + t0
+    t3 = s1 + t1
     t4 = qd1 + qd2
-    t5 = qd3*s123
+    t5 = s123*qd3
     t6 = t1*qd2 + t5
     t7 = t6 + t3*qd1
     t8 = c123*qd3
     t9 = t0*qd2 + t8
     t10 = t9 + t2*qd1
     a = casadi.SX(6, 1)
-    a[0, 0] = -qd2*(t9 + t0*qd1) - qd3*(t4*c123 + t8) - t10*qd1
-    a[1, 0] = -qd2*(t6 + t1*qd1) - qd3*(t4*s123 + t5) - t7*qd1
+    a[0, 0] = -qd2*(t9 + t0*qd1) - qd3*(c123*t4 + t8) - qd1*t10
+    a[1, 0] = -qd2*(t6 + t1*qd1) - qd3*(s123*t4 + t5) - qd1*t7
     return [a]
 
 
@@ -356,22 +356,22 @@ def _task_jacobian_dot(q, q_dot):
     c3 = casadi.cos(q3)
     s3 = casadi.sin(q3)
     c123 = c12*c3 - s12*s3
-    s123 = c12*s3 + c3*s12
+    s123 = c12*s3 + s12*c3
     t0 = c12 + c123
     t1 = s12 + s123
-    t2 = t0 + c1
-    t3 = t1 + s1
+    t2 = c1 + t0
+    t3 = s1 + t1
     t4 = qd1 + qd2
-    t5 = qd3*s123
+    t5 = s123*qd3
     t6 = t1*qd2 + t5
     t7 = t6 + t3*qd1
     t8 = t6 + t1*qd1
-    t9 = t4*s123 + t5
+    t9 = t5 + s123*t4
     t10 = c123*qd3
     t11 = t0*qd2 + t10
     t12 = t11 + t2*qd1
     t13 = t11 + t0*qd1
-    t14 = t4*c123 + t10
+    t14 = t10 + c123*t4
     Jd = casadi.SX(3, 3)
     Jd[0, 0] = -t12
     Jd[0, 1] = -t13
@@ -396,11 +396,11 @@ def _hessian(q):
     c3 = casadi.cos(q3)
     s3 = casadi.sin(q3)
     c123 = c12*c3 - s12*s3
-    s123 = c12*s3 + c3*s12
+    s123 = c12*s3 + s12*c3
     t0 = c12 + c123
     t1 = s12 + s123
-    t2 = t0 + c1
-    t3 = t1 + s1
+    t2 = c1 + t0
+    t3 = s1 + t1
     t4 = -t0
     t5 = -c123
     t6 = -t1
@@ -450,7 +450,7 @@ def _manipulability(q):
     c3 = casadi.cos(q3)
     s3 = casadi.sin(q3)
     c123 = c12*c3 - s12*s3
-    s123 = c12*s3 + c3*s12
+    s123 = c12*s3 + s12*c3
     t0 = s2/(c123**2 + s123**2)
     w = casadi.SX(1, 1)
     w[0, 0] = casadi.fabs(t0)
@@ -471,7 +471,7 @@ def _jacobian_det(q):
     c3 = casadi.cos(q3)
     s3 = casadi.sin(q3)
     c123 = c12*c3 - s12*s3
-    s123 = c12*s3 + c3*s12
+    s123 = c12*s3 + s12*c3
     d = casadi.SX(1, 1)
     d[0, 0] = s2/(c123**2 + s123**2)
     return [d]
@@ -494,116 +494,116 @@ def _velocity_ik(q, mu_dot, damping):
     c3 = casadi.cos(q3)
     s3 = casadi.sin(q3)
     c123 = c12*c3 - s12*s3
-    s123 = c12*s3 + c3*s12
+    s123 = c12*s3 + s12*c3
     t0 = c12 + c123
     t1 = s12 + s123
-    t2 = t0 + c1
-    t3 = t1 + s1
-    t4 = t0*t1 + t2*t3 + c123*s123
-    t5 = t1 + t3 + s123
+    t2 = c1 + t0
+    t3 = s1 + t1
+    t4 = t2*t3 + t0*t1 + c123*s123
+    t5 = t3 + t1 + s123
     t6 = t3**2
-    t7 = t1**2 + t6 + s123**2
+    t7 = s123**2 + t1**2 + t6
     t8 = t7
     t9 = t2**2
     t10 = casadi.sqrt(1 + t9 + t6)
     t11 = t10*casadi.if_else((t3 <= 0), 1, -1)
-    t12 = casadi.if_else((t10 > 0), 1/(t10*(t10 + casadi.fabs(t3))), 0)
-    t13 = t0**2 + t9 + c123**2
-    t14 = t13
-    t15 = casadi.sqrt(3 + t7 + t13)
-    t16 = t0 + t2 + c123
-    t17 = t16
-    t18 = damping**2
-    t19 = 3 + t18
-    t20 = t8 + t18
+    t12 = c123**2 + t0**2 + t9
+    t13 = t12
+    t14 = casadi.sqrt(3 + t7 + t12)
+    t15 = c123 + t0 + t2
+    t16 = t15
+    t17 = t4**2
+    t18 = t5**2
+    t19 = damping**2
+    t20 = t19 + t8
     t21 = t20**2
-    t22 = t14 + t18
-    t23 = t4**2
-    t24 = t5**2
-    t25 = casadi.sqrt(t19**2 + t21 + t22**2 + 2*t23 + 2*t24 + 2*t17**2)
-    t26 = casadi.sqrt(t23 + t24 + t21)
-    t27 = t26*casadi.if_else((t20 >= 0), 1, -1)
-    t28 = t27 + t20
-    t29 = casadi.if_else((t26 > 0), 1/(t26*(t26 + casadi.fabs(t20))), 0)
-    t30 = -t29*(t4*t28 + t4*t22 + t5*t17)
-    t31 = t4 + t28*t30
-    t32 = t4*t30 + t22
-    t33 = t17 + t5*t30
-    t34 = -t29*(t4*t17 + t5*t28 + t5*t19)
-    t35 = t5 + t28*t34
-    t36 = t17 + t4*t34
-    t37 = t5*t34 + t19
-    t38 = -t29*(-t28*mu_dot0 + t4*mu_dot1 + t5*mu_dot2)
-    t39 = mu_dot0 - t28*t38
-    t40 = mu_dot1 + t4*t38
-    t41 = mu_dot2 + t5*t38
-    t42 = casadi.sqrt(t32**2 + t33**2)
-    t43 = t42*casadi.if_else((t32 >= 0), 1, -1)
-    t44 = t32 + t43
-    t45 = casadi.if_else((t42 > 0), 1/(t42*(t42 + casadi.fabs(t32))), 0)
-    t46 = t45*(t33*t37 + t36*t44)
-    t47 = t36 - t44*t46
-    t48 = t37 - t33*t46
-    t49 = t45*(t33*t41 + t40*t44)
-    t50 = t40 - t44*t49
-    t51 = t41 - t33*t49
-    t52 = casadi.fabs(t48)
-    t53 = t52
-    t54 = t53*casadi.if_else((t48 >= 0), 1, -1)
-    t55 = t48 + t54
-    t56 = casadi.if_else((t53 > 0), 1/(t53*(t53 + t52)), 0)
-    t57 = t51 - t51*t56*t55**2
-    t58 = casadi.if_else((t54 != 0), -t57/t54, 0)
-    t59 = casadi.if_else((t43 != 0), -(t50 - t47*t58)/t43, 0)
-    t60 = casadi.if_else((t27 != 0), -(t39 + t31*t59 + t35*t58)/t27, 0)
-    t61 = t58 + t2*t59 - t3*t60
-    t62 = t58 + t0*t59 - t1*t60
-    t63 = t58 + t59*c123 - t60*s123
-    t64 = -t3
-    t65 = t11 + t64
-    t66 = t12*(1 + t0*t2 - t1*t65)
-    t67 = t1 + t65*t66
+    t22 = casadi.sqrt(t17 + t18 + t21)
+    t23 = t22*casadi.if_else((t20 >= 0), 1, -1)
+    t24 = t23 + t20
+    t25 = casadi.if_else((t22 > 0), 1/(t22*(t22 + casadi.fabs(t20))), 0)
+    t26 = -t25*(-mu_dot0*t24 + mu_dot1*t4 + mu_dot2*t5)
+    t27 = mu_dot0 - t24*t26
+    t28 = mu_dot1 + t4*t26
+    t29 = mu_dot2 + t5*t26
+    t30 = t19 + t13
+    t31 = -t25*(t4*t24 + t4*t30 + t5*t16)
+    t32 = t4 + t24*t31
+    t33 = t4*t31 + t30
+    t34 = t16 + t5*t31
+    t35 = casadi.sqrt(t33**2 + t34**2)
+    t36 = t35*casadi.if_else((t33 >= 0), 1, -1)
+    t37 = t33 + t36
+    t38 = casadi.if_else((t35 > 0), 1/(t35*(t35 + casadi.fabs(t33))), 0)
+    t39 = t38*(t28*t37 + t34*t29)
+    t40 = t28 - t37*t39
+    t41 = t29 - t34*t39
+    t42 = 3 + t19
+    t43 = casadi.sqrt(2*t17 + 2*t18 + 2*t16**2 + t21 + t30**2 + t42**2)
+    t44 = -t25*(t5*t24 + t4*t16 + t5*t42)
+    t45 = t5 + t24*t44
+    t46 = t16 + t4*t44
+    t47 = t5*t44 + t42
+    t48 = t38*(t46*t37 + t34*t47)
+    t49 = t46 - t37*t48
+    t50 = t47 - t34*t48
+    t51 = casadi.fabs(t50)
+    t52 = t51
+    t53 = t52*casadi.if_else((t50 >= 0), 1, -1)
+    t54 = t50 + t53
+    t55 = casadi.if_else((t52 > 0), 1/(t52*(t51 + t52)), 0)
+    t56 = t41 - t41*t54**2*t55
+    t57 = casadi.if_else((t53 != 0), -t56/t53, 0)
+    t58 = casadi.if_else((t36 != 0), -(t40 - t49*t57)/t36, 0)
+    t59 = casadi.if_else((t23 != 0), -(t27 + t32*t58 + t45*t57)/t23, 0)
+    t60 = t57 - t3*t59 + t2*t58
+    t61 = t57 - t1*t59 + t0*t58
+    t62 = t57 - s123*t59 + c123*t58
+    t63 = -t3
+    t64 = t63 + t11
+    t65 = casadi.if_else((t10 > 0), 1/(t10*(t10 + casadi.fabs(t63))), 0)
+    t66 = t65*(1 - t1*t64 + t0*t2)
+    t67 = t1 + t64*t66
     t68 = t0 - t2*t66
     t69 = 1 - t66
-    t70 = t12*(1 + t2*c123 - t65*s123)
-    t71 = s123 + t65*t70
+    t70 = t65*(1 + c123*t2 - s123*t64)
+    t71 = s123 + t64*t70
     t72 = c123 - t2*t70
     t73 = 1 - t70
-    t74 = t12*(mu_dot2 + t2*mu_dot1 + t65*mu_dot0)
-    t75 = mu_dot0 - t65*t74
+    t74 = t65*(mu_dot2 + mu_dot0*t64 + t2*mu_dot1)
+    t75 = mu_dot0 - t64*t74
     t76 = mu_dot1 - t2*t74
-    t77 = mu_dot2 - t74
+    t77 = -t74 + mu_dot2
     t78 = casadi.sqrt(t68**2 + t69**2)
     t79 = t78*casadi.if_else((t68 >= 0), 1, -1)
     t80 = t68 + t79
     t81 = casadi.if_else((t78 > 0), 1/(t78*(t78 + casadi.fabs(t68))), 0)
-    t82 = t81*(t69*t73 + t72*t80)
+    t82 = t81*(t72*t80 + t69*t73)
     t83 = t72 - t80*t82
     t84 = t73 - t69*t82
-    t85 = t81*(t69*t77 + t76*t80)
+    t85 = t81*(t76*t80 + t69*t77)
     t86 = t76 - t80*t85
     t87 = t77 - t69*t85
-    t88 = 3 + mu_dot0 + mu_dot1 + mu_dot2 + t64 + damping + q1 + q2 + q3 - t1 - s123 + t16
+    t88 = 3 - t1 - s123 + q1 + q2 + q3 + mu_dot0 + mu_dot1 + mu_dot2 + damping + t15 + t63
     t89 = casadi.fabs(t84)
     t90 = t89
     t91 = t90*casadi.if_else((t84 >= 0), 1, -1)
-    t92 = t91 + t84
-    t93 = casadi.if_else((t90 > 0), 1/(t90*(t90 + t89)), 0)
-    t94 = t87 - t87*t93*t92**2
+    t92 = t84 + t91
+    t93 = casadi.if_else((t90 > 0), 1/(t90*(t89 + t90)), 0)
+    t94 = t87 - t87*t92**2*t93
     t95 = casadi.if_else((t91 != 0), -t94/t91, 0)
-    t96 = casadi.if_else((t79 != 0), -(t86 - t95*t83)/t79, 0)
-    t97 = casadi.if_else((t11 != 0), -(t75 + t95*t71 + t96*t67)/t11, 0)
+    t96 = casadi.if_else((t79 != 0), -(t86 - t83*t95)/t79, 0)
+    t97 = casadi.if_else((t11 != 0), -(t75 + t67*t96 + t71*t95)/t11, 0)
     t98 = (casadi.fabs(t88) < casadi.inf)
     t99 = (damping >= 0)
-    t100 = 1e-12*t15
-    t101 = (damping > 0)
-    t102 = 1e-12*t25
-    t103 = casadi.logic_or(casadi.logic_and((damping <= 0), casadi.logic_or(casadi.logic_or((t90 <= t100), (t10 <= t100)), (t78 <= t100))), casadi.logic_and(t101, casadi.logic_or(casadi.logic_or((t26 <= t102), (t42 <= t102)), (t53 <= t102))))
+    t100 = (damping > 0)
+    t101 = 1e-12*t43
+    t102 = 1e-12*t14
+    t103 = casadi.logic_or(casadi.logic_and(t100, casadi.logic_or(casadi.logic_or((t22 <= t101), (t35 <= t101)), (t52 <= t101))), casadi.logic_and((damping <= 0), casadi.logic_or(casadi.logic_or((t10 <= t102), (t78 <= t102)), (t90 <= t102))))
     t104 = casadi.logic_and(casadi.logic_and(t98, t99), casadi.logic_not(t103))
     q_dot = casadi.SX(3, 1)
-    q_dot[0, 0] = casadi.if_else(t104, casadi.if_else(t101, t61, t97), 0)
-    q_dot[1, 0] = casadi.if_else(t104, casadi.if_else(t101, t62, t96), 0)
-    q_dot[2, 0] = casadi.if_else(t104, casadi.if_else(t101, t63, t95), 0)
+    q_dot[0, 0] = casadi.if_else(t104, casadi.if_else(t100, t60, t97), 0)
+    q_dot[1, 0] = casadi.if_else(t104, casadi.if_else(t100, t61, t96), 0)
+    q_dot[2, 0] = casadi.if_else(t104, casadi.if_else(t100, t62, t95), 0)
     status = casadi.SX(1, 1)
     status[0, 0] = casadi.if_else(casadi.logic_not(casadi.logic_and(t98, t99)), 2, casadi.if_else(t103, 1, 0))
     return [q_dot, status]
@@ -629,63 +629,63 @@ def _ik_numeric_step(target, q, damping):
     c3 = casadi.cos(q3)
     s3 = casadi.sin(q3)
     c123 = c12*c3 - s12*s3
-    s123 = c12*s3 + c3*s12
+    s123 = c12*s3 + s12*c3
     t0 = c12 + c123
     t1 = s12 + s123
-    t2 = t0 + c1
-    t3 = t1 + s1
-    t4 = t1**2 + t3**2 + s123**2
-    t5 = t0*t1 + t2*t3 + c123*s123
-    t6 = t1 + t3 + s123
-    t7 = t0**2 + t2**2 + c123**2
-    t8 = t0 + t2 + c123
-    t9 = mu0 - t2
-    t10 = mu1 - t3
-    t11 = mu0 + mu1 + mu2 + qs1 + qs2 + qs3
+    t2 = c1 + t0
+    t3 = s1 + t1
+    t4 = s123**2 + t1**2 + t3**2
+    t5 = t2*t3 + t0*t1 + c123*s123
+    t6 = t3 + t1 + s123
+    t7 = c123**2 + t0**2 + t2**2
+    t8 = c123 + t0 + t2
+    t9 = -t2 + mu0
+    t10 = -t3 + mu1
+    t11 = qs1 + qs2 + qs3 + mu0 + mu1 + mu2
     t12 = -mu2 + casadi.atan2(s123, c123)
-    t13 = 6.283185307179586*casadi.ceil(-0.15915494309189535*(3.141592653589793 + t12)) + t12
+    t13 = t12 + 6.283185307179586*casadi.ceil(-0.15915494309189535*(3.141592653589793 + t12))
     t14 = t9**2 + t10**2 + t13**2
-    t15 = t4 + damping
+    t15 = damping + t4
     t16 = casadi.sqrt(t5**2 + t6**2 + t15**2)
     t17 = t16*casadi.if_else((t15 >= 0), 1, -1)
-    t18 = t17 + t15
+    t18 = t15 + t17
     t19 = casadi.if_else((t16 > 0), 1/(t16*(t16 + casadi.fabs(t15))), 0)
-    t20 = t19*(t9*t18 + t13*t6 - t10*t5)
+    t20 = t19*(t9*t18 - t5*t10 + t6*t13)
     t21 = t9 - t18*t20
-    t22 = t10 + t20*t5
-    t23 = -t13 + t20*t6
-    t24 = t7 + damping
-    t25 = -t19*(t18*t5 + t5*t24 + t6*t8)
+    t22 = t10 + t5*t20
+    t23 = -t13 + t6*t20
+    t24 = damping + t7
+    t25 = -t19*(t6*t8 + t5*t18 + t5*t24)
     t26 = t5 + t18*t25
-    t27 = t25*t5 + t24
-    t28 = t8 + t25*t6
+    t27 = t24 + t5*t25
+    t28 = t8 + t6*t25
     t29 = casadi.sqrt(t27**2 + t28**2)
     t30 = t29*casadi.if_else((t27 >= 0), 1, -1)
     t31 = t27 + t30
     t32 = casadi.if_else((t29 > 0), 1/(t29*(t29 + casadi.fabs(t27))), 0)
-    t33 = t32*(t28*t23 + t22*t31)
+    t33 = t32*(t22*t31 + t28*t23)
     t34 = t22 - t31*t33
     t35 = t23 - t28*t33
     t36 = 3 + damping
-    t37 = -t19*(t18*t6 + t5*t8 + t6*t36)
+    t37 = -t19*(t5*t8 + t6*t18 + t6*t36)
     t38 = t6 + t18*t37
-    t39 = t8 + t37*t5
-    t40 = t37*t6 + t36
-    t41 = t32*(t28*t40 + t39*t31)
+    t39 = t8 + t5*t37
+    t40 = t36 + t6*t37
+    t41 = t32*(t39*t31 + t28*t40)
     t42 = t39 - t31*t41
     t43 = t40 - t28*t41
     t44 = casadi.fabs(t43)
     t45 = t44
     t46 = t45*casadi.if_else((t43 >= 0), 1, -1)
     t47 = t43 + t46
-    t48 = casadi.if_else((t45 > 0), 1/(t45*(t45 + t44)), 0)
-    t49 = t35 - t35*t48*t47**2
+    t48 = casadi.if_else((t45 > 0), 1/(t45*(t44 + t45)), 0)
+    t49 = t35 - t35*t47**2*t48
     t50 = casadi.if_else((t46 != 0), -t49/t46, 0)
     t51 = casadi.if_else((t30 != 0), -(t34 - t42*t50)/t30, 0)
     t52 = casadi.if_else((t17 != 0), -(t21 + t26*t51 + t38*t50)/t17, 0)
-    t53 = t50 + q1 + t51*t2 - t52*t3
-    t54 = t50 + q2 + t0*t51 - t52*t1
-    t55 = t50 + q3 + t51*c123 - t52*s123
+    t53 = q1 + t50 - t3*t52 + t2*t51
+    t54 = q2 + t50 - t1*t52 + t0*t51
+    t55 = q3 + t50 - s123*t52 + c123*t51
     q_start = casadi.SX(3, 1)
     q_start[0, 0] = q1
     q_start[1, 0] = q2
@@ -706,8 +706,8 @@ def _ik_branches(mu):
     mu2 = mu[2]
     t0 = casadi.cos(mu2)
     t1 = casadi.sin(mu2)
-    t2 = mu0 - t0
-    t3 = mu1 - t1
+    t2 = -t0 + mu0
+    t3 = -t1 + mu1
     t4 = t2**2 + t3**2
     t5 = 0.5*(2 - t4)
     t6 = mu0 + mu1 + mu2
@@ -726,27 +726,27 @@ def _ik_branches(mu):
     t19 = t2*t18 + t3*t15
     t20 = t3*t18 - t2*t15
     t21 = t19**2 + t20**2
-    t22 = t15**2 + t18**2
+    t22 = t18**2 + t15**2
     t23 = 1 + t16
     t24 = t2*t23 + t3*t11
     t25 = t3*t23 - t2*t11
     t26 = t24**2 + t25**2
     t27 = t11**2 + t23**2
     t28 = 1e-24*t4
-    t29 = casadi.if_else((t21 <= t22*t28), 0, casadi.atan2(t20, t19))
+    t29 = casadi.if_else((t21 <= t28*t22), 0, casadi.atan2(t20, t19))
     t30 = -mu2
     t31 = 3.141592653589793 + t30
-    t32 = t14 + t29
-    t33 = casadi.if_else((t26 <= t27*t28), 0, casadi.atan2(t25, t24))
-    t34 = t13 + t33
+    t32 = t29 + t14
+    t33 = casadi.if_else((t26 <= t28*t27), 0, casadi.atan2(t25, t24))
+    t34 = t33 + t13
     t35 = (casadi.fabs(t6) < casadi.inf)
     q = casadi.SX(2, 3)
     q[0, 0] = t29
-    q[0, 1] = t14 - 6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t14))
-    q[0, 2] = -(t30 + 6.283185307179586*casadi.ceil(-0.15915494309189535*(t31 + t32)) + t32)
+    q[0, 1] = -6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t14)) + t14
+    q[0, 2] = -(t30 + t32 + 6.283185307179586*casadi.ceil(-0.15915494309189535*(t31 + t32)))
     q[1, 0] = t33
-    q[1, 1] = t13 - 6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t13))
-    q[1, 2] = -(t30 + 6.283185307179586*casadi.ceil(-0.15915494309189535*(t31 + t34)) + t34)
+    q[1, 1] = -6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t13)) + t13
+    q[1, 2] = -(t30 + t34 + 6.283185307179586*casadi.ceil(-0.15915494309189535*(t31 + t34)))
     valid = casadi.SX(2, 1)
     valid[0, 0] = casadi.logic_and(t35, (t8 >= -1e-12))
     valid[1, 0] = casadi.logic_and(t35, t9)
@@ -778,21 +778,21 @@ def _ik_nearest(mu, q_seed, weights):
     vb1 = branches_valid[1]
     lb0 = branches_in_limits[0]
     lb1 = branches_in_limits[1]
-    t0 = qb0_0 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn1 - qb0_0))
-    t1 = qb0_1 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn2 - qb0_1))
-    t2 = qb0_2 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn3 - qb0_2))
+    t0 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb0_0 + qn1)) + qb0_0
+    t1 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb0_1 + qn2)) + qb0_1
+    t2 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb0_2 + qn3)) + qb0_2
     t3 = casadi.if_else(casadi.logic_and(lb0, vb0), 1, 0)
     t4 = casadi.if_else((t3 > 0), 1, 0)
-    t5 = qb1_0 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn1 - qb1_0))
-    t6 = qb1_1 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn2 - qb1_1))
-    t7 = qb1_2 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn3 - qb1_2))
+    t5 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb1_0 + qn1)) + qb1_0
+    t6 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb1_1 + qn2)) + qb1_1
+    t7 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb1_2 + qn3)) + qb1_2
     t8 = casadi.if_else(casadi.logic_and(lb1, vb1), 1, 0)
     t9 = mu0 + mu1 + mu2 + qn1 + qn2 + qn3 + qw1 + qw2 + qw3
     t10 = -qn1
     t11 = -qn2
     t12 = -qn3
-    t13 = qw1*(t0 + t10)**2 + qw2*(t1 + t11)**2 + qw3*(t2 + t12)**2
-    t14 = qw1*(t5 + t10)**2 + qw2*(t6 + t11)**2 + qw3*(t7 + t12)**2
+    t13 = qw1*(t10 + t0)**2 + qw2*(t11 + t1)**2 + qw3*(t12 + t2)**2
+    t14 = qw1*(t10 + t5)**2 + qw2*(t11 + t6)**2 + qw3*(t12 + t7)**2
     t15 = (t4 > 0)
     t16 = casadi.if_else(t15, t0, qn1)
     t17 = casadi.if_else(t15, t1, qn2)

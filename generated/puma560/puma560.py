@@ -84,15 +84,15 @@ def fk(q):
     c3 = trig[..., 4]
     s3 = trig[..., 5]
     c23 = c2*c3 - s2*s3
-    s23 = c2*s3 + c3*s2
+    s23 = c2*s3 + s2*c3
     c4 = trig[..., 6]
     s4 = trig[..., 7]
     c5 = trig[..., 8]
     s5 = trig[..., 9]
     c6 = trig[..., 10]
     s6 = trig[..., 11]
-    t0 = 0.0203*s23 + 0.4318*c23
-    t1 = t0 + 0.4318*s2
+    t0 = 0.4318*c23 + 0.0203*s23
+    t1 = 0.4318*s2 + t0
     t2 = 0.67183 + t1
     t3 = 0.0203*c23
     t4 = 0.15005*s1 + c1*t3
@@ -101,7 +101,7 @@ def fk(q):
     t7 = c1*c4
     t8 = -t6 + c23*t7
     t9 = t7 - c23*t6
-    t10 = c4*s1
+    t10 = s1*c4
     t11 = c1*s4
     t12 = t10 + c23*t11
     t13 = t11 + c23*t10
@@ -109,23 +109,23 @@ def fk(q):
     t15 = t8*c5 - s5*t14
     t16 = t8*s5 + c5*t14
     t17 = t15*c6 - t12*s6
-    t18 = t12*c6 + t15*s6
+    t18 = c6*t12 + t15*s6
     t19 = t4 - 0.4318*t14
     t20 = s1*s23
-    t21 = t13*c5 - s5*t20
-    t22 = t13*s5 + c5*t20
-    t23 = t9*s6 + t21*c6
-    t24 = t9*c6 - t21*s6
+    t21 = c5*t13 - s5*t20
+    t22 = s5*t13 + c5*t20
+    t23 = s6*t9 + c6*t21
+    t24 = c6*t9 - s6*t21
     t25 = t5 - 0.4318*t20
-    t26 = c4*s23
+    t26 = s23*c4
     t27 = c23*s5 + c5*t26
     t28 = c23*c5 - s5*t26
-    t29 = s4*s23
-    t30 = t27*c6 - s6*t29
-    t31 = t27*s6 + c6*t29
+    t29 = s23*s4
+    t30 = c6*t27 - s6*t29
+    t31 = s6*t27 + c6*t29
     t32 = 0.4318*c2
-    t33 = t19 + c1*t32
-    t34 = t25 + s1*t32
+    t33 = c1*t32 + t19
+    t34 = s1*t32 + t25
     T = _stack(xp, [
         t17,  # 0, 0
         -t18,  # 0, 1
@@ -158,14 +158,14 @@ def jacobian(q):
     c3 = trig[..., 4]
     s3 = trig[..., 5]
     c23 = c2*c3 - s2*s3
-    s23 = c2*s3 + c3*s2
+    s23 = c2*s3 + s2*c3
     c4 = trig[..., 6]
     s4 = trig[..., 7]
     c5 = trig[..., 8]
     s5 = trig[..., 9]
-    t0 = c23*c5 - c4*s23*s5
-    t1 = 0.0203*s23 + 0.4318*c23
-    t2 = t1 + 0.4318*s2
+    t0 = c23*c5 - s23*c4*s5
+    t1 = 0.4318*c23 + 0.0203*s23
+    t2 = 0.4318*s2 + t1
     t3 = 0.0203*c23
     t4 = 0.15005*s1 + c1*t3
     t5 = -0.15005*c1 + s1*t3
@@ -173,7 +173,7 @@ def jacobian(q):
     t7 = c1*c4
     t8 = -t6 + c23*t7
     t9 = t7 - c23*t6
-    t10 = c4*s1
+    t10 = s1*c4
     t11 = c1*s4
     t12 = t10 + c23*t11
     t13 = t11 + c23*t10
@@ -181,28 +181,28 @@ def jacobian(q):
     t15 = t8*s5 + c5*t14
     t16 = t4 - 0.4318*t14
     t17 = s1*s23
-    t18 = t13*s5 + c5*t17
+    t18 = s5*t13 + c5*t17
     t19 = t5 - 0.4318*t17
     t20 = 0.4318*c2
-    t21 = t16 + c1*t20
-    t22 = t19 + s1*t20
+    t21 = c1*t20 + t16
+    t22 = s1*t20 + t19
     t23 = -c1
     J = _stack(xp, [
         -t22,  # 0, 0
-        -t2*c1,  # 0, 1
-        -t1*c1,  # 0, 2
+        -c1*t2,  # 0, 1
+        -c1*t1,  # 0, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5
         t21,  # 1, 0
-        -t2*s1,  # 1, 1
-        -t1*s1,  # 1, 2
+        -s1*t2,  # 1, 1
+        -s1*t1,  # 1, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
-        t21*c1 + t22*s1,  # 2, 1
-        t16*c1 + t19*s1,  # 2, 2
+        c1*t21 + s1*t22,  # 2, 1
+        c1*t16 + s1*t19,  # 2, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 5
@@ -239,15 +239,15 @@ def fk_jacobian(q):
     c3 = trig[..., 4]
     s3 = trig[..., 5]
     c23 = c2*c3 - s2*s3
-    s23 = c2*s3 + c3*s2
+    s23 = c2*s3 + s2*c3
     c4 = trig[..., 6]
     s4 = trig[..., 7]
     c5 = trig[..., 8]
     s5 = trig[..., 9]
     c6 = trig[..., 10]
     s6 = trig[..., 11]
-    t0 = 0.0203*s23 + 0.4318*c23
-    t1 = t0 + 0.4318*s2
+    t0 = 0.4318*c23 + 0.0203*s23
+    t1 = 0.4318*s2 + t0
     t2 = 0.67183 + t1
     t3 = 0.0203*c23
     t4 = 0.15005*s1 + c1*t3
@@ -256,7 +256,7 @@ def fk_jacobian(q):
     t7 = c1*c4
     t8 = -t6 + c23*t7
     t9 = t7 - c23*t6
-    t10 = c4*s1
+    t10 = s1*c4
     t11 = c1*s4
     t12 = t10 + c23*t11
     t13 = t11 + c23*t10
@@ -264,23 +264,23 @@ def fk_jacobian(q):
     t15 = t8*c5 - s5*t14
     t16 = t8*s5 + c5*t14
     t17 = t15*c6 - t12*s6
-    t18 = t12*c6 + t15*s6
+    t18 = c6*t12 + t15*s6
     t19 = t4 - 0.4318*t14
     t20 = s1*s23
-    t21 = t13*c5 - s5*t20
-    t22 = t13*s5 + c5*t20
-    t23 = t9*s6 + t21*c6
-    t24 = t9*c6 - t21*s6
+    t21 = c5*t13 - s5*t20
+    t22 = s5*t13 + c5*t20
+    t23 = s6*t9 + c6*t21
+    t24 = c6*t9 - s6*t21
     t25 = t5 - 0.4318*t20
-    t26 = c4*s23
+    t26 = s23*c4
     t27 = c23*s5 + c5*t26
     t28 = c23*c5 - s5*t26
     t29 = s23*s4
-    t30 = t27*c6 - s6*t29
-    t31 = t27*s6 + c6*t29
+    t30 = c6*t27 - s6*t29
+    t31 = s6*t27 + c6*t29
     t32 = 0.4318*c2
-    t33 = t19 + c1*t32
-    t34 = t25 + s1*t32
+    t33 = c1*t32 + t19
+    t34 = s1*t32 + t25
     t35 = -t16
     t36 = -t22
     t37 = -c1
@@ -304,20 +304,20 @@ def fk_jacobian(q):
     ], (4, 4))
     J = _stack(xp, [
         -t34,  # 0, 0
-        -t1*c1,  # 0, 1
-        -t0*c1,  # 0, 2
+        -c1*t1,  # 0, 1
+        -c1*t0,  # 0, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5
         t33,  # 1, 0
-        -t1*s1,  # 1, 1
-        -t0*s1,  # 1, 2
+        -s1*t1,  # 1, 1
+        -s1*t0,  # 1, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
-        t33*c1 + t34*s1,  # 2, 1
-        t19*c1 + t25*s1,  # 2, 2
+        c1*t33 + s1*t34,  # 2, 1
+        c1*t19 + s1*t25,  # 2, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 5
@@ -354,15 +354,15 @@ def jacobian_tool(q):
     c3 = trig[..., 4]
     s3 = trig[..., 5]
     c23 = c2*c3 - s2*s3
-    s23 = c2*s3 + c3*s2
+    s23 = c2*s3 + s2*c3
     c4 = trig[..., 6]
     s4 = trig[..., 7]
     c5 = trig[..., 8]
     s5 = trig[..., 9]
     c6 = trig[..., 10]
     s6 = trig[..., 11]
-    t0 = 0.0203*s23 + 0.4318*c23
-    t1 = t0 + 0.4318*s2
+    t0 = 0.4318*c23 + 0.0203*s23
+    t1 = 0.4318*s2 + t0
     t2 = 0.0203*c23
     t3 = 0.15005*s1 + c1*t2
     t4 = -0.15005*c1 + s1*t2
@@ -370,7 +370,7 @@ def jacobian_tool(q):
     t6 = c1*c4
     t7 = -t5 + c23*t6
     t8 = t6 - c23*t5
-    t9 = c4*s1
+    t9 = s1*c4
     t10 = c1*s4
     t11 = t9 + c23*t10
     t12 = t10 + c23*t9
@@ -378,48 +378,48 @@ def jacobian_tool(q):
     t14 = t7*c5 - s5*t13
     t15 = t7*s5 + c5*t13
     t16 = t14*c6 - t11*s6
-    t17 = t11*c6 + t14*s6
+    t17 = c6*t11 + t14*s6
     t18 = t3 - 0.4318*t13
     t19 = s1*s23
-    t20 = t12*c5 - s5*t19
-    t21 = t12*s5 + c5*t19
-    t22 = t8*s6 + t20*c6
-    t23 = t8*c6 - t20*s6
+    t20 = c5*t12 - s5*t19
+    t21 = s5*t12 + c5*t19
+    t22 = s6*t8 + c6*t20
+    t23 = c6*t8 - s6*t20
     t24 = t4 - 0.4318*t19
-    t25 = c4*s23
+    t25 = s23*c4
     t26 = c23*s5 + c5*t25
     t27 = c23*c5 - s5*t25
-    t28 = s4*s23
-    t29 = t26*c6 - s6*t28
-    t30 = t26*s6 + c6*t28
+    t28 = s23*s4
+    t29 = c6*t26 - s6*t28
+    t30 = s6*t26 + c6*t28
     t31 = 0.4318*c2
-    t32 = t18 + c1*t31
-    t33 = t24 + s1*t31
-    t34 = t32*c1 + t33*s1
+    t32 = c1*t31 + t18
+    t33 = s1*t31 + t24
+    t34 = c1*t32 + s1*t33
     t35 = c1*t16
     t36 = s1*t22
-    t37 = t18*c1 + t24*s1
+    t37 = c1*t18 + s1*t24
     t38 = c1*t17
     t39 = s1*t23
     t40 = c1*t15
     t41 = s1*t21
-    t42 = t16*s1 - t22*c1
-    t43 = -(t17*s1 + t23*c1)
-    t44 = t21*c1 - t15*s1
+    t42 = s1*t16 - c1*t22
+    t43 = -(s1*t17 + c1*t23)
+    t44 = c1*t21 - s1*t15
     J = _stack(xp, [
-        t22*t32 - t16*t33,  # 0, 0
+        t32*t22 - t16*t33,  # 0, 0
         -(-t29*t34 + t1*t35 + t1*t36),  # 0, 1
         -(-t29*t37 + t0*t35 + t0*t36),  # 0, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5
-        t17*t33 + t23*t32,  # 1, 0
+        t17*t33 + t32*t23,  # 1, 0
         -(t30*t34 - t1*t38 + t1*t39),  # 1, 1
         -(t30*t37 - t0*t38 + t0*t39),  # 1, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5
-        t15*t33 - t21*t32,  # 2, 0
+        t15*t33 - t32*t21,  # 2, 0
         t27*t34 + t1*t40 + t1*t41,  # 2, 1
         t27*t37 + t0*t40 + t0*t41,  # 2, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 3
@@ -428,19 +428,19 @@ def jacobian_tool(q):
         t29,  # 3, 0
         t42,  # 3, 1
         t42,  # 3, 2
-        -(-t29*c23 + t16*t13 + t22*t19),  # 3, 3
+        -(-c23*t29 + t16*t13 + t22*t19),  # 3, 3
         t11*t16 - t8*t22 + t29*t28,  # 3, 4
-        -(-t27*t29 + t15*t16 + t21*t22),  # 3, 5
+        -(-t29*t27 + t16*t15 + t22*t21),  # 3, 5
         -t30,  # 4, 0
         t43,  # 4, 1
         t43,  # 4, 2
-        -(t30*c23 - t17*t13 + t23*t19),  # 4, 3
+        -(c23*t30 - t17*t13 + t23*t19),  # 4, 3
         -(t11*t17 + t8*t23 + t30*t28),  # 4, 4
-        -(-t15*t17 + t21*t23 + t27*t30),  # 4, 5
+        -(-t17*t15 + t23*t21 + t30*t27),  # 4, 5
         t27,  # 5, 0
         t44,  # 5, 1
         t44,  # 5, 2
-        t27*c23 + t15*t13 + t21*t19,  # 5, 3
+        c23*t27 + t15*t13 + t21*t19,  # 5, 3
         t8*t21 - t11*t15 + t27*t28,  # 5, 4
         t15**2 + t21**2 + t27**2,  # 5, 5
     ], (6, 6))
@@ -458,16 +458,16 @@ def task(q):
     c3 = trig[..., 4]
     s3 = trig[..., 5]
     c23 = c2*c3 - s2*s3
-    s23 = c2*s3 + c3*s2
+    s23 = c2*s3 + s2*c3
     c4 = trig[..., 6]
     s4 = trig[..., 7]
     c5 = trig[..., 8]
     s5 = trig[..., 9]
     c6 = trig[..., 10]
     s6 = trig[..., 11]
-    t0 = c23*s5 + c4*c5*s23
-    t1 = 0.0203*s23 + 0.4318*c23
-    t2 = t1 + 0.4318*s2
+    t0 = c23*s5 + s23*c4*c5
+    t1 = 0.4318*c23 + 0.0203*s23
+    t2 = 0.4318*s2 + t1
     t3 = 0.67183 + t2
     t4 = 0.0203*c23
     t5 = 0.15005*s1 + c1*t4
@@ -476,25 +476,25 @@ def task(q):
     t8 = c1*c4
     t9 = -t7 + c23*t8
     t10 = t8 - c23*t7
-    t11 = c4*s1
+    t11 = s1*c4
     t12 = c1*s4
     t13 = t11 + c23*t12
     t14 = t12 + c23*t11
-    t15 = s5*s23
+    t15 = s23*s5
     t16 = t9*c5 - c1*t15
-    t17 = t14*c5 - s1*t15
+    t17 = c5*t14 - s1*t15
     t18 = c23*c5 - c4*t15
     t19 = t16*c6 - t13*s6
-    t20 = t10*s6 + t17*c6
-    t21 = s4*s23
-    t22 = t0*c6 - s6*t21
-    t23 = t0*s6 + c6*t21
+    t20 = s6*t10 + c6*t17
+    t21 = s23*s4
+    t22 = c6*t0 - s6*t21
+    t23 = s6*t0 + c6*t21
     t24 = 0.4318*s23
     t25 = t5 - c1*t24
     t26 = t6 - s1*t24
     t27 = 0.4318*c2
-    t28 = t25 + c1*t27
-    t29 = t26 + s1*t27
+    t28 = c1*t27 + t25
+    t29 = s1*t27 + t26
     mu = _stack(xp, [
         t28,  # 0
         t29,  # 1
@@ -517,15 +517,15 @@ def task_jacobian(q):
     c3 = trig[..., 4]
     s3 = trig[..., 5]
     c23 = c2*c3 - s2*s3
-    s23 = c2*s3 + c3*s2
+    s23 = c2*s3 + s2*c3
     c4 = trig[..., 6]
     s4 = trig[..., 7]
     c5 = trig[..., 8]
     s5 = trig[..., 9]
     c6 = trig[..., 10]
     s6 = trig[..., 11]
-    t0 = 0.0203*s23 + 0.4318*c23
-    t1 = t0 + 0.4318*s2
+    t0 = 0.4318*c23 + 0.0203*s23
+    t1 = 0.4318*s2 + t0
     t2 = 0.0203*c23
     t3 = 0.15005*s1 + c1*t2
     t4 = -0.15005*c1 + s1*t2
@@ -533,7 +533,7 @@ def task_jacobian(q):
     t6 = c1*c4
     t7 = -t5 + c23*t6
     t8 = t6 - c23*t5
-    t9 = c4*s1
+    t9 = s1*c4
     t10 = c1*s4
     t11 = t9 + c23*t10
     t12 = t10 + c23*t9
@@ -543,47 +543,47 @@ def task_jacobian(q):
     t16 = t14*c6 - t11*s6
     t17 = t3 - 0.4318*t13
     t18 = s1*s23
-    t19 = t12*c5 - s5*t18
-    t20 = t12*s5 + c5*t18
-    t21 = t8*s6 + t19*c6
+    t19 = c5*t12 - s5*t18
+    t20 = s5*t12 + c5*t18
+    t21 = s6*t8 + c6*t19
     t22 = t4 - 0.4318*t18
-    t23 = c4*s23
+    t23 = s23*c4
     t24 = c23*s5 + c5*t23
     t25 = c23*c5 - s5*t23
     t26 = s23*s4
-    t27 = t24*c6 - s6*t26
+    t27 = c6*t24 - s6*t26
     t28 = 0.4318*c2
-    t29 = t17 + c1*t28
-    t30 = t22 + s1*t28
-    t31 = t16**2 + t21**2
-    t32 = 1/t31
-    t33 = t16*s1
-    t34 = t21*c1
-    t35 = t32*(t33 - t34)
-    t36 = t16*c1
-    t37 = t21*s1
-    t38 = -t32*(s23*t36 + s23*t37)
-    t39 = t32*(t11*t16 - t8*t21)
-    t40 = -t32*(t15*t16 + t20*t21)
-    t41 = 1/xp.sqrt(t31)
+    t29 = c1*t28 + t17
+    t30 = s1*t28 + t22
+    t31 = s1*t16
+    t32 = c1*t21
+    t33 = t16**2 + t21**2
+    t34 = 1/t33
+    t35 = (t31 - t32)*t34
+    t36 = c1*t16
+    t37 = s1*t21
+    t38 = -t34*(s23*t36 + s23*t37)
+    t39 = t34*(t11*t16 - t8*t21)
+    t40 = -t34*(t16*t15 + t21*t20)
+    t41 = 1/xp.sqrt(t33)
     t42 = -t41*(t36 + t37)
     t43 = -t27*t35
     J = _stack(xp, [
         -t30,  # 0, 0
-        -t1*c1,  # 0, 1
-        -t0*c1,  # 0, 2
+        -c1*t1,  # 0, 1
+        -c1*t0,  # 0, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5
         t29,  # 1, 0
-        -t1*s1,  # 1, 1
-        -t0*s1,  # 1, 2
+        -s1*t1,  # 1, 1
+        -s1*t0,  # 1, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
-        t29*c1 + t30*s1,  # 2, 1
-        t17*c1 + t22*s1,  # 2, 2
+        c1*t29 + s1*t30,  # 2, 1
+        c1*t17 + s1*t22,  # 2, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 5
@@ -596,9 +596,9 @@ def task_jacobian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
         t42,  # 4, 1
         t42,  # 4, 2
-        t41*(s23*t34 - s23*t33),  # 4, 3
+        t41*(s23*t32 - s23*t31),  # 4, 3
         -t41*(t11*t21 + t8*t16),  # 4, 4
-        t41*(t15*t21 - t20*t16),  # 4, 5
+        t41*(t15*t21 - t16*t20),  # 4, 5
         xp.full(batch, 1, dtype=dtype, device=device),  # 5, 0
         t43,  # 5, 1
         t43,  # 5, 2
@@ -626,15 +626,15 @@ def fk_jacobian_dot(q, q_dot):
     c3 = trig[..., 4]
     s3 = trig[..., 5]
     c23 = c2*c3 - s2*s3
-    s23 = c2*s3 + c3*s2
+    s23 = c2*s3 + s2*c3
     c4 = trig[..., 6]
     s4 = trig[..., 7]
     c5 = trig[..., 8]
     s5 = trig[..., 9]
     c6 = trig[..., 10]
     s6 = trig[..., 11]
-    t0 = 0.0203*s23 + 0.4318*c23
-    t1 = t0 + 0.4318*s2
+    t0 = 0.4318*c23 + 0.0203*s23
+    t1 = 0.4318*s2 + t0
     t2 = 0.67183 + t1
     t3 = qd1 + c23*qd4
     t4 = 0.0203*c23
@@ -644,7 +644,7 @@ def fk_jacobian_dot(q, q_dot):
     t8 = c1*c4
     t9 = -t7 + c23*t8
     t10 = t8 - c23*t7
-    t11 = c4*s1
+    t11 = s1*c4
     t12 = c1*s4
     t13 = t11 + c23*t12
     t14 = t12 + c23*t11
@@ -652,54 +652,54 @@ def fk_jacobian_dot(q, q_dot):
     t16 = t9*c5 - s5*t15
     t17 = t9*s5 + c5*t15
     t18 = t16*c6 - t13*s6
-    t19 = t13*c6 + t16*s6
+    t19 = c6*t13 + t16*s6
     t20 = t5 - 0.4318*t15
     t21 = s1*s23
-    t22 = t14*c5 - s5*t21
-    t23 = t14*s5 + c5*t21
-    t24 = t10*s6 + t22*c6
-    t25 = t10*c6 - t22*s6
+    t22 = c5*t14 - s5*t21
+    t23 = s5*t14 + c5*t21
+    t24 = s6*t10 + c6*t22
+    t25 = c6*t10 - s6*t22
     t26 = t6 - 0.4318*t21
-    t27 = c4*s23
+    t27 = s23*c4
     t28 = c23*s5 + c5*t27
     t29 = c23*c5 - s5*t27
     t30 = s23*s4
-    t31 = t28*c6 - s6*t30
-    t32 = t28*s6 + c6*t30
-    t33 = t3 + qd5*t30
+    t31 = c6*t28 - s6*t30
+    t32 = s6*t28 + c6*t30
+    t33 = t3 + t30*qd5
     t34 = 0.4318*c2
-    t35 = t20 + c1*t34
-    t36 = t26 + s1*t34
-    t37 = t35*c1 + t36*s1
+    t35 = c1*t34 + t20
+    t36 = s1*t34 + t26
+    t37 = c1*t35 + s1*t36
     t38 = t37
-    t39 = t20*c1 + t26*s1
+    t39 = c1*t20 + s1*t26
     t40 = t39
-    t41 = t38*qd2 + t40*qd3
-    t42 = qd2*s1
-    t43 = qd3*s1
+    t41 = qd2*t38 + qd3*t40
+    t42 = s1*qd2
+    t43 = s1*qd3
     t44 = t42 + t43
-    t45 = t44 - qd4*t15
+    t45 = t44 - t15*qd4
     t46 = t45 + t13*qd5
     t47 = t0*t43 + t1*t42
     t48 = -t47 + t35*qd1
     t49 = c1*qd2
     t50 = c1*qd3
     t51 = t49 + t50
-    t52 = t51 + qd4*t21
+    t52 = t51 + t21*qd4
     t53 = t52 + t10*qd5
     t54 = t0*t50 + t1*t49
     t55 = t54 + t36*qd1
     t56 = -t17
     t57 = -t23
-    t58 = t1*c1
-    t59 = t0*c1
-    t60 = t1*s1
-    t61 = t0*s1
+    t58 = c1*t1
+    t59 = c1*t0
+    t60 = s1*t1
+    t61 = s1*t0
     t62 = -c1
     t63 = c1**2
-    t64 = qd2*t0
+    t64 = t0*qd2
     t65 = s1**2
-    t66 = qd3*t0
+    t66 = t0*qd3
     T = _stack(xp, [
         xp.broadcast_to(t18, batch),  # 0, 0
         xp.broadcast_to(-t19, batch),  # 0, 1
@@ -757,12 +757,12 @@ def fk_jacobian_dot(q, q_dot):
         xp.broadcast_to(t29, batch),  # 5, 5
     ], (6, 6))
     a = _stack(xp, [
-        xp.broadcast_to(qd2*(-t41*c1 + qd1*t60) - qd3*(-qd1*t61 + t40*t49 + t40*t50) - t48*qd1, batch),  # 0
-        xp.broadcast_to(-qd2*(t41*s1 + qd1*t58) - qd3*(qd1*t59 + t40*t42 + t40*t43) - t55*qd1, batch),  # 1
-        xp.broadcast_to(-qd2*(t54*c1 + t47*s1) - qd3*(t63*t64 + t65*t64 + t63*t66 + t65*t66), batch),  # 2
-        xp.broadcast_to(qd4*(-t51*c23 + qd1*t21) + qd5*(t10*t3 - t52*t30) + qd6*(t23*t33 - t29*t53) + qd1*t49 + qd1*t50, batch),  # 3
-        xp.broadcast_to(-qd4*(t44*c23 + qd1*t15) + qd5*(t13*t3 - t45*t30) - qd6*(t17*t33 + t29*t46) + qd1*t42 + qd1*t43, batch),  # 4
-        xp.broadcast_to(-qd4*(t44*t21 + t51*t15) + qd5*(t13*t52 - t10*t45) - qd6*(t17*t53 + t23*t46), batch),  # 5
+        xp.broadcast_to(qd2*(-c1*t41 + t60*qd1) - qd3*(-t61*qd1 + t49*t40 + t50*t40) - qd1*t48, batch),  # 0
+        xp.broadcast_to(-qd2*(s1*t41 + t58*qd1) - qd3*(t59*qd1 + t42*t40 + t43*t40) - qd1*t55, batch),  # 1
+        xp.broadcast_to(-qd2*(c1*t54 + s1*t47) - qd3*(t63*t64 + t64*t65 + t63*t66 + t65*t66), batch),  # 2
+        xp.broadcast_to(qd4*(-c23*t51 + t21*qd1) + qd5*(t10*t3 - t30*t52) + qd6*(t23*t33 - t29*t53) + t49*qd1 + t50*qd1, batch),  # 3
+        xp.broadcast_to(-qd4*(c23*t44 + t15*qd1) + qd5*(t13*t3 - t30*t45) - qd6*(t17*t33 + t29*t46) + t42*qd1 + t43*qd1, batch),  # 4
+        xp.broadcast_to(-qd4*(t21*t44 + t15*t51) + qd5*(t13*t52 - t10*t45) - qd6*(t17*t53 + t23*t46), batch),  # 5
     ], (6,))
     return T, J, a
 
@@ -783,14 +783,14 @@ def jacobian_dot(q, q_dot):
     c3 = trig[..., 4]
     s3 = trig[..., 5]
     c23 = c2*c3 - s2*s3
-    s23 = c2*s3 + c3*s2
+    s23 = c2*s3 + s2*c3
     c4 = trig[..., 6]
     s4 = trig[..., 7]
     c5 = trig[..., 8]
     s5 = trig[..., 9]
-    t0 = c23*c5 - c4*s23*s5
-    t1 = 0.0203*s23 + 0.4318*c23
-    t2 = t1 + 0.4318*s2
+    t0 = c23*c5 - s23*c4*s5
+    t1 = 0.4318*c23 + 0.0203*s23
+    t2 = 0.4318*s2 + t1
     t3 = qd1 + c23*qd4
     t4 = 0.0203*c23
     t5 = 0.15005*s1 + c1*t4
@@ -799,24 +799,24 @@ def jacobian_dot(q, q_dot):
     t8 = c1*c4
     t9 = -t7 + c23*t8
     t10 = t8 - c23*t7
-    t11 = c4*s1
+    t11 = s1*c4
     t12 = c1*s4
     t13 = t11 + c23*t12
     t14 = t12 + c23*t11
-    t15 = c5*s23
+    t15 = s23*c5
     t16 = t9*s5 + c1*t15
-    t17 = t14*s5 + s1*t15
+    t17 = s5*t14 + s1*t15
     t18 = 0.4318*s23
     t19 = t5 - c1*t18
     t20 = t6 - s1*t18
-    t21 = t19*c1 + t20*s1
+    t21 = c1*t19 + s1*t20
     t22 = 0.4318*c2
-    t23 = t19 + c1*t22
-    t24 = t20 + s1*t22
-    t25 = t23*c1 + t24*s1
-    t26 = t25*qd2 + t21*qd3
-    t27 = qd2*s1
-    t28 = qd3*s1
+    t23 = c1*t22 + t19
+    t24 = s1*t22 + t20
+    t25 = c1*t23 + s1*t24
+    t26 = qd2*t25 + qd3*t21
+    t27 = s1*qd2
+    t28 = s1*qd3
     t29 = t27 + t28
     t30 = t1*t28 + t2*t27
     t31 = -t30 + t23*qd1
@@ -830,49 +830,49 @@ def jacobian_dot(q, q_dot):
     t39 = t34 + s1*t37
     t40 = t38 + t13*qd5
     t41 = t39 + t10*qd5
-    t42 = s4*s23
-    t43 = t3 + qd5*t42
-    t44 = qd1*s1
+    t42 = s23*s4
+    t43 = t3 + t42*qd5
+    t44 = s1*qd1
     t45 = c1*qd1
     t46 = c1**2
-    t47 = qd2*t1
+    t47 = t1*qd2
     t48 = s1**2
-    t49 = qd3*t1
+    t49 = t1*qd3
     Jd = _stack(xp, [
         xp.broadcast_to(-t31, batch),  # 0, 0
-        xp.broadcast_to(-t26*c1 + t2*t44, batch),  # 0, 1
-        xp.broadcast_to(-(-t1*t44 + t21*t32 + t21*t33), batch),  # 0, 2
+        xp.broadcast_to(-c1*t26 + t2*t44, batch),  # 0, 1
+        xp.broadcast_to(-(-t1*t44 + t32*t21 + t33*t21), batch),  # 0, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5
         xp.broadcast_to(-t36, batch),  # 1, 0
-        xp.broadcast_to(-(t26*s1 + t2*t45), batch),  # 1, 1
-        xp.broadcast_to(-(t1*t45 + t21*t27 + t21*t28), batch),  # 1, 2
+        xp.broadcast_to(-(s1*t26 + t2*t45), batch),  # 1, 1
+        xp.broadcast_to(-(t1*t45 + t27*t21 + t28*t21), batch),  # 1, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
-        xp.broadcast_to(-(t35*c1 + t30*s1), batch),  # 2, 1
-        xp.broadcast_to(-(t46*t47 + t48*t47 + t46*t49 + t48*t49), batch),  # 2, 2
+        xp.broadcast_to(-(c1*t35 + s1*t30), batch),  # 2, 1
+        xp.broadcast_to(-(t46*t47 + t47*t48 + t46*t49 + t48*t49), batch),  # 2, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
         xp.broadcast_to(t45, batch),  # 3, 1
         xp.broadcast_to(t45, batch),  # 3, 2
-        xp.broadcast_to(-t34*c23 + s23*t44, batch),  # 3, 3
-        xp.broadcast_to(t10*t3 - t39*t42, batch),  # 3, 4
+        xp.broadcast_to(-c23*t34 + s23*t44, batch),  # 3, 3
+        xp.broadcast_to(t10*t3 - t42*t39, batch),  # 3, 4
         xp.broadcast_to(t17*t43 - t0*t41, batch),  # 3, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
         xp.broadcast_to(t44, batch),  # 4, 1
         xp.broadcast_to(t44, batch),  # 4, 2
-        xp.broadcast_to(-(t29*c23 + s23*t45), batch),  # 4, 3
-        xp.broadcast_to(t13*t3 - t38*t42, batch),  # 4, 4
+        xp.broadcast_to(-(c23*t29 + s23*t45), batch),  # 4, 3
+        xp.broadcast_to(t13*t3 - t42*t38, batch),  # 4, 4
         xp.broadcast_to(-(t16*t43 + t0*t40), batch),  # 4, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 2
-        xp.broadcast_to(-(t29*s1*s23 + t34*c1*s23), batch),  # 5, 3
+        xp.broadcast_to(-(s1*s23*t29 + c1*s23*t34), batch),  # 5, 3
         xp.broadcast_to(t13*t39 - t10*t38, batch),  # 5, 4
         xp.broadcast_to(-(t16*t41 + t17*t40), batch),  # 5, 5
     ], (6, 6))
@@ -896,14 +896,14 @@ def bias_acceleration(q, q_dot):
     c3 = trig[..., 4]
     s3 = trig[..., 5]
     c23 = c2*c3 - s2*s3
-    s23 = c2*s3 + c3*s2
+    s23 = c2*s3 + s2*c3
     c4 = trig[..., 6]
     s4 = trig[..., 7]
     c5 = trig[..., 8]
     s5 = trig[..., 9]
-    t0 = c23*c5 - c4*s23*s5
-    t1 = 0.0203*s23 + 0.4318*c23
-    t2 = t1 + 0.4318*s2
+    t0 = c23*c5 - s23*c4*s5
+    t1 = 0.4318*c23 + 0.0203*s23
+    t2 = 0.4318*s2 + t1
     t3 = qd1 + c23*qd4
     t4 = 0.0203*c23
     t5 = 0.15005*s1 + c1*t4
@@ -912,24 +912,24 @@ def bias_acceleration(q, q_dot):
     t8 = c1*c4
     t9 = -t7 + c23*t8
     t10 = t8 - c23*t7
-    t11 = c4*s1
+    t11 = s1*c4
     t12 = c1*s4
     t13 = t11 + c23*t12
     t14 = t12 + c23*t11
-    t15 = c5*s23
+    t15 = s23*c5
     t16 = t9*s5 + c1*t15
-    t17 = t14*s5 + s1*t15
+    t17 = s5*t14 + s1*t15
     t18 = 0.4318*s23
     t19 = t5 - c1*t18
     t20 = t6 - s1*t18
-    t21 = t19*c1 + t20*s1
+    t21 = c1*t19 + s1*t20
     t22 = 0.4318*c2
-    t23 = t19 + c1*t22
-    t24 = t20 + s1*t22
-    t25 = t23*c1 + t24*s1
-    t26 = t25*qd2 + t21*qd3
-    t27 = qd2*s1
-    t28 = qd3*s1
+    t23 = c1*t22 + t19
+    t24 = s1*t22 + t20
+    t25 = c1*t23 + s1*t24
+    t26 = qd2*t25 + qd3*t21
+    t27 = s1*qd2
+    t28 = s1*qd3
     t29 = t27 + t28
     t30 = t1*t28 + t2*t27
     t31 = -t30 + t23*qd1
@@ -943,21 +943,21 @@ def bias_acceleration(q, q_dot):
     t39 = t34 + s1*t37
     t40 = t38 + t13*qd5
     t41 = t39 + t10*qd5
-    t42 = s4*s23
-    t43 = t3 + qd5*t42
+    t42 = s23*s4
+    t43 = t3 + t42*qd5
     t44 = s1*qd1
     t45 = c1*qd1
     t46 = c1**2
-    t47 = qd2*t1
+    t47 = t1*qd2
     t48 = s1**2
-    t49 = qd3*t1
+    t49 = t1*qd3
     a = _stack(xp, [
-        xp.broadcast_to(qd2*(-t26*c1 + t2*t44) - qd3*(-t1*t44 + t21*t32 + t21*t33) - t31*qd1, batch),  # 0
-        xp.broadcast_to(-qd2*(t26*s1 + t2*t45) - qd3*(t1*t45 + t21*t27 + t21*t28) - t36*qd1, batch),  # 1
-        xp.broadcast_to(-qd2*(t35*c1 + t30*s1) - qd3*(t46*t47 + t48*t47 + t46*t49 + t48*t49), batch),  # 2
-        xp.broadcast_to(qd4*(-t34*c23 + s23*t44) + qd5*(t10*t3 - t39*t42) + qd6*(t17*t43 - t0*t41) + qd1*t32 + qd1*t33, batch),  # 3
-        xp.broadcast_to(-qd4*(t29*c23 + s23*t45) + qd5*(t13*t3 - t38*t42) - qd6*(t16*t43 + t0*t40) + qd1*t27 + qd1*t28, batch),  # 4
-        xp.broadcast_to(-qd4*(t29*s1*s23 + t34*c1*s23) + qd5*(t13*t39 - t10*t38) - qd6*(t16*t41 + t17*t40), batch),  # 5
+        xp.broadcast_to(qd2*(-c1*t26 + t2*t44) - qd3*(-t1*t44 + t32*t21 + t33*t21) - qd1*t31, batch),  # 0
+        xp.broadcast_to(-qd2*(s1*t26 + t2*t45) - qd3*(t1*t45 + t27*t21 + t28*t21) - qd1*t36, batch),  # 1
+        xp.broadcast_to(-qd2*(c1*t35 + s1*t30) - qd3*(t46*t47 + t47*t48 + t46*t49 + t48*t49), batch),  # 2
+        xp.broadcast_to(qd4*(-c23*t34 + s23*t44) + qd5*(t10*t3 - t42*t39) + qd6*(t17*t43 - t0*t41) + t32*qd1 + t33*qd1, batch),  # 3
+        xp.broadcast_to(-qd4*(c23*t29 + s23*t45) + qd5*(t13*t3 - t42*t38) - qd6*(t16*t43 + t0*t40) + t27*qd1 + t28*qd1, batch),  # 4
+        xp.broadcast_to(-qd4*(s1*s23*t29 + c1*s23*t34) + qd5*(t13*t39 - t10*t38) - qd6*(t16*t41 + t17*t40), batch),  # 5
     ], (6,))
     return a
 
@@ -979,15 +979,15 @@ def task_jacobian_dot(q, q_dot):
     c3 = trig[..., 4]
     s3 = trig[..., 5]
     c23 = c2*c3 - s2*s3
-    s23 = c2*s3 + c3*s2
+    s23 = c2*s3 + s2*c3
     c4 = trig[..., 6]
     s4 = trig[..., 7]
     c5 = trig[..., 8]
     s5 = trig[..., 9]
     c6 = trig[..., 10]
     s6 = trig[..., 11]
-    t0 = 0.0203*s23 + 0.4318*c23
-    t1 = t0 + 0.4318*s2
+    t0 = 0.4318*c23 + 0.0203*s23
+    t1 = 0.4318*s2 + t0
     t2 = 0.0203*c23
     t3 = 0.15005*s1 + c1*t2
     t4 = -0.15005*c1 + s1*t2
@@ -995,7 +995,7 @@ def task_jacobian_dot(q, q_dot):
     t6 = c1*c4
     t7 = -t5 + c23*t6
     t8 = t6 - c23*t5
-    t9 = c4*s1
+    t9 = s1*c4
     t10 = c1*s4
     t11 = t9 + c23*t10
     t12 = t10 + c23*t9
@@ -1005,120 +1005,120 @@ def task_jacobian_dot(q, q_dot):
     t16 = t14*c6 - t11*s6
     t17 = t3 - 0.4318*t13
     t18 = s1*s23
-    t19 = t12*c5 - s5*t18
-    t20 = t12*s5 + c5*t18
-    t21 = t8*s6 + t19*c6
+    t19 = c5*t12 - s5*t18
+    t20 = s5*t12 + c5*t18
+    t21 = s6*t8 + c6*t19
     t22 = t4 - 0.4318*t18
-    t23 = t17*c1 + t22*s1
+    t23 = c1*t17 + s1*t22
     t24 = t16**2 + t21**2
     t25 = xp.sqrt(t24)
-    t26 = c4*s23
+    t26 = s23*c4
     t27 = c23*s5 + c5*t26
     t28 = c23*c5 - s5*t26
-    t29 = s4*s23
-    t30 = t27*c6 - s6*t29
+    t29 = s23*s4
+    t30 = c6*t27 - s6*t29
     t31 = 0.4318*c2
-    t32 = t17 + c1*t31
-    t33 = t22 + s1*t31
-    t34 = t32*c1 + t33*s1
-    t35 = t34*qd2 + t23*qd3
-    t36 = qd2*s1
-    t37 = qd3*s1
+    t32 = c1*t31 + t17
+    t33 = s1*t31 + t22
+    t34 = c1*t32 + s1*t33
+    t35 = qd2*t34 + qd3*t23
+    t36 = s1*qd2
+    t37 = s1*qd3
     t38 = t0*t37 + t1*t36
     t39 = -t38 + t32*qd1
     t40 = t36 + t37
     t41 = t40
-    t42 = t41*c23 + qd1*t13
+    t42 = c23*t41 + t13*qd1
     t43 = c1*qd2
     t44 = c1*qd3
     t45 = t0*t44 + t1*t43
     t46 = t45 + t33*qd1
-    t47 = t45*c1 + t38*s1
+    t47 = c1*t45 + s1*t38
     t48 = t43 + t44
     t49 = t48
-    t50 = -t49*c23 + qd1*t18
-    t51 = t41*t18 + t49*t13
-    t52 = -qd4*t13
+    t50 = -c23*t49 + t18*qd1
+    t51 = t18*t41 + t13*t49
+    t52 = -t13*qd4
     t53 = t41 + t52
-    t54 = qd4*t18
+    t54 = t18*qd4
     t55 = t49 + t54
     t56 = t11*t55 - t8*t53
     t57 = qd1 + c23*qd4
     t58 = t57
-    t59 = t8*t58 - t55*t29
-    t60 = t11*t58 - t53*t29
+    t59 = t8*t58 - t29*t55
+    t60 = t11*t58 - t29*t53
     t61 = t11*qd5
     t62 = t53 + t61
-    t63 = t52 + t61 - t15*qd6 + t40
+    t63 = t40 + t52 + t61 - t15*qd6
     t64 = t8*qd5
     t65 = t55 + t64
     t66 = t15*t65 + t20*t62
-    t67 = t54 + t64 + t20*qd6 + t48
+    t67 = t48 + t54 + t64 + t20*qd6
     t68 = t16*t67 + t21*t63
-    t69 = qd5*t29
+    t69 = t29*qd5
     t70 = t58 + t69
     t71 = t20*t70 - t28*t65
     t72 = t15*t70 + t28*t62
-    t73 = t69 + t28*qd6 + t57
+    t73 = t57 + t69 + t28*qd6
     t74 = t21*t73 + t30*t67
     t75 = t16*t73 - t30*t63
     t76 = s1*qd1
-    t77 = -t35*c1 + t1*t76
-    t78 = t23*t43 + t23*t44 - t0*t76
+    t77 = -c1*t35 + t1*t76
+    t78 = t43*t23 + t44*t23 - t0*t76
     t79 = c1*qd1
-    t80 = t35*s1 + t1*t79
-    t81 = t0*t79 + t23*t36 + t23*t37
+    t80 = s1*t35 + t1*t79
+    t81 = t0*t79 + t36*t23 + t37*t23
     t82 = c1**2
-    t83 = qd2*t0
+    t83 = t0*qd2
     t84 = s1**2
-    t85 = qd3*t0
-    t86 = t82*t83 + t84*t83 + t82*t85 + t84*t85
-    t87 = 1/t24
-    t88 = t87*(t11*t16 - t8*t21)
-    t89 = -t87*(t15*t16 + t20*t21)
-    t90 = t16*s1
-    t91 = t21*c1
-    t92 = t87*(t90 - t91)
-    t93 = t16*c1
-    t94 = t21*s1
-    t95 = -t87*(s23*t93 + s23*t94)
+    t85 = t0*qd3
+    t86 = t82*t83 + t83*t84 + t82*t85 + t84*t85
+    t87 = s1*t16
+    t88 = c1*t21
+    t89 = 1/t24
+    t90 = (t87 - t88)*t89
+    t91 = (t11*t16 - t8*t21)*t89
+    t92 = -(t16*t15 + t21*t20)*t89
+    t93 = c1*t16
+    t94 = s1*t21
+    t95 = -t89*(s23*t93 + s23*t94)
     t96 = 1/t25
-    t97 = t87*t96
+    t97 = t89*t96
     t98 = -(t93 + t94)*t97
-    t99 = (s23*t91 - s23*t90)*t97
+    t99 = t97*(s23*t88 - s23*t87)
     t100 = -(t11*t21 + t8*t16)*t97
-    t101 = (t15*t21 - t20*t16)*t97
-    t102 = 2*t92
-    t103 = t87*t75
+    t101 = (t15*t21 - t16*t20)*t97
+    t102 = 2*t90
+    t103 = t75*t89
     t104 = -(c1 + t21*t102)*t103
-    t105 = t87*t74
+    t105 = t74*t89
     t106 = (s1 - t16*t102)*t105
-    t107 = qd1*t87
+    t107 = qd1*t89
     t108 = t93*t107
     t109 = t94*t107
     t110 = t104 - t106 + t108 + t109
-    t111 = t16*t87
+    t111 = t16*t89
     t112 = t50*t111
     t113 = 2*t95
-    t114 = -(t18 + t21*t113)*t103
-    t115 = t21*t87
+    t114 = -t103*(t18 + t21*t113)
+    t115 = t21*t89
     t116 = t42*t115
-    t117 = -(t13 + t16*t113)*t105
+    t117 = -t105*(t13 + t16*t113)
     t118 = t59*t111
     t119 = t60*t115
-    t120 = 2*t88
-    t121 = -(t8 + t21*t120)*t103
-    t122 = (t11 - t16*t120)*t105
+    t120 = 2*t91
+    t121 = -t103*(t8 + t21*t120)
+    t122 = t105*(t11 - t16*t120)
     t123 = t71*t111
-    t124 = 2*t89
-    t125 = -(t20 + t21*t124)*t103
+    t124 = 2*t92
+    t125 = -t103*(t20 + t21*t124)
     t126 = t72*t115
-    t127 = -(t15 + t16*t124)*t105
+    t127 = -t105*(t15 + t16*t124)
     t128 = qd1*t96
-    t129 = -t75*(t21*t98 + s1*t96) + t74*(t16*t98 + c1*t96) + t90*t128 - t91*t128
+    t129 = -t75*(t21*t98 + s1*t96) + t74*(t16*t98 + c1*t96) + t87*t128 - t88*t128
     t130 = t16*t96
     t131 = t21*t96
-    t132 = -(t68*t92 - t30*t106 + t30*t104 + t30*t108 + t30*t109)
+    t132 = -(t90*t68 - t30*t106 + t30*t104 + t30*t108 + t30*t109)
     Jd = _stack(xp, [
         xp.broadcast_to(-t39, batch),  # 0, 0
         xp.broadcast_to(t77, batch),  # 0, 1
@@ -1147,15 +1147,15 @@ def task_jacobian_dot(q, q_dot):
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
         xp.broadcast_to(t129, batch),  # 4, 1
         xp.broadcast_to(t129, batch),  # 4, 2
-        xp.broadcast_to(-(-t75*(-t21*t99 + t96*t13) - t74*(t16*t99 + t96*t18) + t42*t130 + t50*t131), batch),  # 4, 3
+        xp.broadcast_to(-(-t75*(-t21*t99 + t13*t96) - t74*(t16*t99 + t18*t96) + t42*t130 + t50*t131), batch),  # 4, 3
         xp.broadcast_to(-t75*(t11*t96 + t21*t100) + t74*(t8*t96 + t16*t100) + t60*t130 - t59*t131, batch),  # 4, 4
         xp.broadcast_to(-(-t75*(t15*t96 - t21*t101) - t74*(t20*t96 + t16*t101) + t72*t130 + t71*t131), batch),  # 4, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 0
         xp.broadcast_to(t132, batch),  # 5, 1
         xp.broadcast_to(t132, batch),  # 5, 2
-        xp.broadcast_to(-(t51 + t68*t95 - t30*t116 - t30*t117 + t30*t112 + t30*t114), batch),  # 5, 3
-        xp.broadcast_to(-(-t56 + t68*t88 - t30*t122 + t30*t118 + t30*t119 + t30*t121), batch),  # 5, 4
-        xp.broadcast_to(-(t66 + t68*t89 - t30*t126 - t30*t127 + t30*t123 + t30*t125), batch),  # 5, 5
+        xp.broadcast_to(-(t51 + t95*t68 - t30*t116 - t30*t117 + t30*t112 + t30*t114), batch),  # 5, 3
+        xp.broadcast_to(-(-t56 + t91*t68 - t30*t122 + t30*t118 + t30*t119 + t30*t121), batch),  # 5, 4
+        xp.broadcast_to(-(t66 + t92*t68 - t30*t126 - t30*t127 + t30*t123 + t30*t125), batch),  # 5, 5
     ], (6, 6))
     return Jd
 
@@ -1171,23 +1171,23 @@ def hessian(q):
     c3 = trig[..., 4]
     s3 = trig[..., 5]
     c23 = c2*c3 - s2*s3
-    s23 = c2*s3 + c3*s2
+    s23 = c2*s3 + s2*c3
     c4 = trig[..., 6]
     s4 = trig[..., 7]
     c5 = trig[..., 8]
     s5 = trig[..., 9]
-    t0 = c23*c5 - c4*s23*s5
-    t1 = 0.0203*s23 + 0.4318*c23
-    t2 = t1 + 0.4318*s2
+    t0 = c23*c5 - s23*c4*s5
+    t1 = 0.4318*c23 + 0.0203*s23
+    t2 = 0.4318*s2 + t1
     t3 = c1*c23
     t4 = 0.15005*s1 + 0.0203*t3
-    t5 = c23*s1
+    t5 = s1*c23
     t6 = -0.15005*c1 + 0.0203*t5
     t7 = s1*s4
     t8 = c1*c4
     t9 = -t7 + c23*t8
     t10 = t8 - c23*t7
-    t11 = c4*s1
+    t11 = s1*c4
     t12 = c1*s4
     t13 = t11 + c23*t12
     t14 = t12 + c23*t11
@@ -1195,33 +1195,33 @@ def hessian(q):
     t16 = t9*s5 + c5*t15
     t17 = t4 - 0.4318*t15
     t18 = s1*s23
-    t19 = t14*s5 + c5*t18
+    t19 = s5*t14 + c5*t18
     t20 = t6 - 0.4318*t18
-    t21 = t17*c1 + t20*s1
+    t21 = c1*t17 + s1*t20
     t22 = 0.4318*c2
-    t23 = t17 + c1*t22
-    t24 = t20 + s1*t22
-    t25 = t23*c1 + t24*s1
-    t26 = t2*s1
-    t27 = t1*s1
-    t28 = -t2*c1
-    t29 = -t1*c1
-    t30 = -t21*c1
-    t31 = -t21*s1
+    t23 = c1*t22 + t17
+    t24 = s1*t22 + t20
+    t25 = c1*t23 + s1*t24
+    t26 = s1*t2
+    t27 = s1*t1
+    t28 = -c1*t2
+    t29 = -c1*t1
+    t30 = -c1*t21
+    t31 = -s1*t21
     t32 = c1**2
     t33 = s1**2
-    t34 = -(t1*t32 + t1*t33)
+    t34 = -(t32*t1 + t33*t1)
     t35 = -t3
     t36 = -s23*t12
-    t37 = -t0*c1
+    t37 = -c1*t0
     t38 = -t5
     t39 = -s23*t7
-    t40 = -t0*s1
-    t41 = -(s23*t32 + s23*t33)
-    t42 = t13*c1 - t10*s1
-    t43 = -(t16*c1 + t19*s1)
+    t40 = -s1*t0
+    t41 = -(t32*s23 + t33*s23)
+    t42 = c1*t13 - s1*t10
+    t43 = -(c1*t16 + s1*t19)
     t44 = s23**2
-    t45 = s4*s23
+    t45 = s23*s4
     H = _stack(xp, [
         -t23,  # 0, 0, 0
         t26,  # 0, 0, 1
@@ -1260,19 +1260,19 @@ def hessian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5, 5
         t26,  # 1, 0, 0
-        -t25*c1,  # 1, 0, 1
+        -c1*t25,  # 1, 0, 1
         t30,  # 1, 0, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 0, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 0, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 0, 5
         t28,  # 1, 1, 0
-        -t25*s1,  # 1, 1, 1
+        -s1*t25,  # 1, 1, 1
         t31,  # 1, 1, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 1, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 1, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 2, 0
-        -(t2*t32 + t2*t33),  # 1, 2, 1
+        -(t32*t2 + t33*t2),  # 1, 2, 1
         t34,  # 1, 2, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 2, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 2, 4
@@ -1353,14 +1353,14 @@ def hessian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 3, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 3, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 3, 3
-        t10*c23 - t44*t7,  # 3, 3, 4
-        t19*c23 - t0*t18,  # 3, 3, 5
+        c23*t10 - t7*t44,  # 3, 3, 4
+        c23*t19 - t0*t18,  # 3, 3, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 4, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 4, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 4, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 4, 3
-        t13*c23 + t44*t12,  # 3, 4, 4
-        -t16*c23 + t0*t15,  # 3, 4, 5
+        c23*t13 + t12*t44,  # 3, 4, 4
+        -c23*t16 + t0*t15,  # 3, 4, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 5, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 5, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 5, 2
@@ -1456,7 +1456,7 @@ def singularity_factors(q):
     f = _stack(xp, [
         c3 + t0,  # 0
         s5,  # 1
-        -(-c2 + c2*s3 + c3*s2 + s2*t0 - 0.04701250578971746*c2*c3),  # 2
+        -(-c2 + c2*s3 + s2*c3 + s2*t0 - 0.04701250578971746*c2*c3),  # 2
     ], (3,))
     return f
 
@@ -1471,7 +1471,7 @@ def manipulability(q):
     s3 = trig[..., 5]
     s5 = trig[..., 9]
     t0 = 0.04701250578971746*s3
-    t1 = -0.080509645432*s5*(c3 + t0)*(-c2 + c2*s3 + c3*s2 + s2*t0 - 0.04701250578971746*c2*c3)
+    t1 = -0.080509645432*s5*(c3 + t0)*(-c2 + c2*s3 + s2*c3 + s2*t0 - 0.04701250578971746*c2*c3)
     w = xp.broadcast_to(xp.abs(t1), batch)
     return w
 
@@ -1486,13 +1486,13 @@ def jacobian_det(q):
     s3 = trig[..., 5]
     s5 = trig[..., 9]
     t0 = 0.04701250578971746*s3
-    d = xp.broadcast_to(-0.080509645432*s5*(c3 + t0)*(-c2 + c2*s3 + c3*s2 + s2*t0 - 0.04701250578971746*c2*c3), batch)
+    d = xp.broadcast_to(-0.080509645432*s5*(c3 + t0)*(-c2 + c2*s3 + s2*c3 + s2*t0 - 0.04701250578971746*c2*c3), batch)
     return d
 
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def velocity_ik(q, mu_dot, damping=0.0):
-    """joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: (6 x 1 and 1 x 1), 1219 operations."""
+    """joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: (6 x 1 and 1 x 1), 1221 operations."""
     xp, dtype, device, batch, (q, mu_dot, damping,) = _arguments(("q", q, (6,)), ("mu_dot", mu_dot, (6,)), ("damping", damping, ()))
     q1 = q[..., 0]
     q2 = q[..., 1]
@@ -1514,14 +1514,14 @@ def velocity_ik(q, mu_dot, damping=0.0):
     c3 = trig[..., 4]
     s3 = trig[..., 5]
     c23 = c2*c3 - s2*s3
-    s23 = c2*s3 + c3*s2
+    s23 = c2*s3 + s2*c3
     c4 = trig[..., 6]
     s4 = trig[..., 7]
     c5 = trig[..., 8]
     s5 = trig[..., 9]
-    t0 = c23*c5 - c4*s23*s5
-    t1 = 0.0203*s23 + 0.4318*c23
-    t2 = t1 + 0.4318*s2
+    t0 = c23*c5 - s23*c4*s5
+    t1 = 0.4318*c23 + 0.0203*s23
+    t2 = 0.4318*s2 + t1
     t3 = 0.0203*c23
     t4 = 0.15005*s1 + c1*t3
     t5 = -0.15005*c1 + s1*t3
@@ -1529,7 +1529,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t7 = c1*c4
     t8 = -t6 + c23*t7
     t9 = t7 - c23*t6
-    t10 = c4*s1
+    t10 = s1*c4
     t11 = c1*s4
     t12 = t10 + c23*t11
     t13 = t11 + c23*t10
@@ -1537,361 +1537,363 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t15 = t8*s5 + c5*t14
     t16 = t4 - 0.4318*t14
     t17 = s1*s23
-    t18 = t13*s5 + c5*t17
+    t18 = s5*t13 + c5*t17
     t19 = t5 - 0.4318*t17
-    t20 = t16*c1 + t19*s1
+    t20 = c1*t16 + s1*t19
     t21 = 0.4318*c2
-    t22 = t16 + c1*t21
-    t23 = t19 + s1*t21
-    t24 = t22*c1 + t23*s1
+    t22 = c1*t21 + t16
+    t23 = s1*t21 + t19
+    t24 = c1*t22 + s1*t23
     t25 = t23**2
-    t26 = t1**2
-    t27 = c1**2
-    t28 = t1*t27 + t2*t27
-    t29 = t2**2
-    t30 = t25 + t26*t27 + t29*t27
+    t26 = c1**2
+    t27 = t26*t2 + t26*t1
+    t28 = t2**2
+    t29 = t1**2
+    t30 = t25 + t26*t28 + t26*t29
     t31 = t30
     t32 = -t22*t23
     t33 = s1*c1
-    t34 = t32 + t26*t33 + t29*t33
-    t35 = t20*c1
-    t36 = t24*c1
-    t37 = t1*t35 + t2*t36
-    t38 = t36 + t35
-    t39 = t1*c1
-    t40 = t2*c1
+    t34 = t32 + t28*t33 + t29*t33
+    t35 = c1*t24
+    t36 = c1*t20
+    t37 = t2*t35 + t1*t36
+    t38 = t35 + t36
+    t39 = c1*t2
+    t40 = c1*t1
     t41 = s1*t39 + s1*t40
     t42 = t22**2
     t43 = xp.sqrt(1 + t42 + t25)
     t44 = t43*xp.where(xp.less_equal(t23, 0), xp.asarray(1, dtype=dtype), -1)
-    t45 = xp.where(xp.greater(t43, 0), 1/(t43*(t43 + xp.abs(t23))), 0)
-    t46 = s1**2
-    t47 = t1*t46 + t2*t46
-    t48 = t42 + t26*t46 + t29*t46
-    t49 = t48
-    t50 = t20*s1
-    t51 = t24*s1
-    t52 = t1*t50 + t2*t51
-    t53 = t51 + t50
-    t54 = t24**2
-    t55 = t54 + t20**2
-    t56 = t55
-    t57 = s23**2
-    t58 = t12**2 + t15**2 + 2*t46 + t27*t57
-    t59 = t58
-    t60 = 2*c1
-    t61 = t15*t18 - t12*t9 - s1*t60 + t57*t33
-    t62 = s23*s4
-    t63 = t15*t0 + c23*t14 - t12*t62
-    t64 = t18*t0 + t9*t62 + c23*t17
-    t65 = t9**2 + t18**2 + 2*t27 + t46*t57
-    t66 = t65
-    t67 = 1 + t0**2 + c23**2 + t57*s4**2
-    t68 = t67
-    t69 = xp.sqrt(t55 + t30 + t48 + t58 + t65 + t67)
-    t70 = damping**2
-    t71 = t49 + t70
-    t72 = t56 + t70
-    t73 = t59 + t70
-    t74 = t66 + t70
-    t75 = t68 + t70
-    t76 = t31 + t70
-    t77 = t76**2
-    t78 = t28**2
-    t79 = t34**2
-    t80 = t37**2
-    t81 = t41**2
-    t82 = xp.sqrt(t71**2 + t72**2 + t73**2 + t74**2 + t75**2 + t77 + 2*t78 + 2*t52**2 + 2*t47**2 + 2*t53**2 + 2*t38**2 + 2*t61**2 + 2*t63**2 + 2*t64**2 + 2*t42 + 2*t25 + 2*t79 + 2*t80 + 4*t81)
-    t83 = xp.sqrt(t78 + t25 + t79 + t80 + t81 + t77)
-    t84 = t83*xp.where(xp.greater_equal(t76, 0), xp.asarray(1, dtype=dtype), -1)
-    t85 = t84 + t76
-    t86 = xp.where(xp.greater(t83, 0), 1/(t83*(t83 + xp.abs(t76))), 0)
-    t87 = t86*(t28*t41 + t52*t37 + t47*t41 + t85*t34 + t34*t71 + t32)
-    t88 = t34 - t85*t87
-    t89 = -t87*t34 + t71
-    t90 = -t52 + t87*t37
-    t91 = -t47 + t87*t41
-    t92 = t41 - t28*t87
-    t93 = t22 + t87*t23
-    t94 = -t86*(t28*t38 + t52*t34 + t53*t41 + t85*t37 + t37*t72)
-    t95 = t37 + t85*t94
-    t96 = t52 + t94*t34
-    t97 = t94*t37 + t72
-    t98 = t53 + t94*t41
-    t99 = t38 + t28*t94
-    t100 = -t86*(-t28*t61 - t63*t23 + t47*t34 + t53*t37 + t85*t41 + t41*t73)
-    t101 = t41 + t85*t100
-    t102 = t47 + t100*t34
-    t103 = t53 + t100*t37
-    t104 = t100*t41 + t73
-    t105 = t61 - t28*t100
-    t106 = t86*(t28*t85 + t28*t74 + t38*t37 + t64*t23 + t34*t41 - t61*t41)
-    t107 = t28 - t85*t106
-    t108 = t41 - t106*t34
-    t109 = -t38 + t106*t37
-    t110 = t61 + t106*t41
-    t111 = -t28*t106 + t74
-    t112 = -t64 + t106*t23
-    t113 = -t86*(-t63*t41 - t22*t34 + t28*t64 + t85*t23 + t23*t75)
-    t114 = t23 + t85*t113
-    t115 = t22 - t113*t34
-    t116 = t64 + t28*t113
-    t117 = t113*t23 + t75
-    t118 = t86*(t28*mu_dot4 + t85*mu_dot0 + t34*mu_dot1 - t23*mu_dot5 - t37*mu_dot2 - t41*mu_dot3)
-    t119 = mu_dot0 - t85*t118
-    t120 = mu_dot1 - t118*t34
-    t121 = mu_dot2 + t118*t37
-    t122 = mu_dot3 + t118*t41
-    t123 = mu_dot4 - t28*t118
-    t124 = mu_dot5 + t118*t23
-    t125 = xp.sqrt(t89**2 + t90**2 + t91**2 + t92**2 + t93**2)
-    t126 = t125*xp.where(xp.greater_equal(t89, 0), xp.asarray(1, dtype=dtype), -1)
-    t127 = t89 + t126
-    t128 = xp.where(xp.greater(t125, 0), 1/(t125*(t125 + xp.abs(t89))), 0)
-    t129 = t128*(t90*t109 + t91*t110 + t92*t111 + t93*t112 + t108*t127)
-    t130 = t108 - t127*t129
-    t131 = t109 - t90*t129
-    t132 = t110 - t91*t129
-    t133 = t111 - t92*t129
-    t134 = t112 - t93*t129
-    t135 = t128*(t90*t121 + t91*t122 + t92*t123 + t93*t124 + t120*t127)
-    t136 = t120 - t127*t135
-    t137 = t121 - t90*t135
-    t138 = t122 - t91*t135
-    t139 = t123 - t92*t135
-    t140 = t124 - t93*t135
-    t141 = -t63
-    t142 = t141 + t100*t23
-    t143 = t141 + t113*t41
-    t144 = t128*(t90*t103 + t91*t104 + t92*t105 + t93*t142 - t102*t127)
-    t145 = t102 + t127*t144
-    t146 = t103 - t90*t144
-    t147 = t104 - t91*t144
-    t148 = t105 - t92*t144
-    t149 = t142 - t93*t144
-    t150 = t94*t23
-    t151 = t128*(t90*t97 + t91*t98 - t92*t99 - t96*t127 + t93*t150)
-    t152 = t96 + t127*t151
-    t153 = t97 - t90*t151
-    t154 = t98 - t91*t151
-    t155 = t99 + t92*t151
-    t156 = t150 - t93*t151
-    t157 = xp.sqrt(t153**2 + t154**2 + t155**2 + t156**2)
-    t158 = t157*xp.where(xp.greater_equal(t153, 0), xp.asarray(1, dtype=dtype), -1)
-    t159 = t153 + t158
-    t160 = xp.where(xp.greater(t157, 0), 1/(t157*(t157 + xp.abs(t153))), 0)
-    t161 = t160*(t154*t147 + t156*t149 + t146*t159 - t155*t148)
-    t162 = t146 - t159*t161
-    t163 = t147 - t154*t161
-    t164 = t148 + t155*t161
-    t165 = t149 - t156*t161
-    t166 = t160*(t154*t132 + t156*t134 + t131*t159 - t155*t133)
-    t167 = t131 - t159*t166
-    t168 = t132 - t154*t166
-    t169 = t133 + t155*t166
-    t170 = t134 - t156*t166
-    t171 = t160*(t154*t138 + t156*t140 + t137*t159 - t155*t139)
-    t172 = t137 - t159*t171
-    t173 = t138 - t154*t171
-    t174 = t139 + t155*t171
-    t175 = t140 - t156*t171
-    t176 = xp.sqrt(t163**2 + t164**2 + t165**2)
-    t177 = t176*xp.where(xp.greater_equal(t163, 0), xp.asarray(1, dtype=dtype), -1)
-    t178 = t163 + t177
-    t179 = xp.where(xp.greater(t176, 0), 1/(t176*(t176 + xp.abs(t163))), 0)
-    t180 = t179*(t164*t169 + t165*t170 + t168*t178)
-    t181 = t168 - t178*t180
-    t182 = t169 - t164*t180
-    t183 = t170 - t165*t180
-    t184 = t179*(t164*t174 + t165*t175 + t173*t178)
-    t185 = t173 - t178*t184
-    t186 = t174 - t164*t184
-    t187 = t175 - t165*t184
-    t188 = xp.sqrt(t182**2 + t183**2)
-    t189 = t188*xp.where(xp.greater_equal(t182, 0), xp.asarray(1, dtype=dtype), -1)
-    t190 = t182 + t189
-    t191 = xp.where(xp.greater(t188, 0), 1/(t188*(t188 + xp.abs(t182))), 0)
-    t192 = t191*(t183*t187 + t186*t190)
-    t193 = t186 - t190*t192
-    t194 = t187 - t183*t192
-    t195 = t113*t37
-    t196 = t128*(t91*t143 + t93*t117 + t115*t127 - t92*t116 + t90*t195)
-    t197 = t115 - t127*t196
-    t198 = t195 - t90*t196
-    t199 = t143 - t91*t196
-    t200 = t116 + t92*t196
-    t201 = t117 - t93*t196
-    t202 = t160*(t154*t199 + t155*t200 + t156*t201 + t198*t159)
-    t203 = t198 - t159*t202
-    t204 = t199 - t154*t202
-    t205 = -t200 + t155*t202
-    t206 = t201 - t156*t202
-    t207 = t179*(t164*t205 + t165*t206 + t204*t178)
-    t208 = t204 - t178*t207
-    t209 = t205 - t164*t207
-    t210 = t206 - t165*t207
-    t211 = t191*(t183*t210 + t209*t190)
-    t212 = t209 - t190*t211
-    t213 = t210 - t183*t211
-    t214 = xp.abs(t213)
-    t215 = t214
-    t216 = t215*xp.where(xp.greater_equal(t213, 0), xp.asarray(1, dtype=dtype), -1)
-    t217 = t213 + t216
-    t218 = xp.where(xp.greater(t215, 0), 1/(t215*(t215 + t214)), 0)
-    t219 = t194 - t194*t218*t217**2
-    t220 = xp.where(xp.not_equal(t216, 0), -t219/t216, 0)
-    t221 = xp.where(xp.not_equal(t189, 0), -(t193 - t212*t220)/t189, 0)
-    t222 = xp.where(xp.not_equal(t177, 0), -(t185 - (t181*t221 + t208*t220))/t177, 0)
-    t223 = xp.where(xp.not_equal(t158, 0), -(t172 - (t162*t222 + t167*t221 + t203*t220))/t158, 0)
-    t224 = xp.where(xp.not_equal(t126, 0), -(t136 - (t130*t221 + t197*t220 - t152*t223 - t145*t222))/t126, 0)
-    t225 = xp.where(xp.not_equal(t84, 0), -(t119 - t88*t224 - t107*t221 + t95*t223 + t101*t222 + t114*t220)/t84, 0)
-    t226 = t220 + t224*t22 - t225*t23
-    t227 = -t220*c23 + t221*t17 + t222*t14
-    t228 = t12*t222 - t9*t221 + t220*t62
-    t229 = t221*t18 + t222*t15 - t220*t0
-    t230 = t2*s1
-    t231 = t221*c1 - t222*s1
-    t232 = -t223*t24 + t224*t230 + t225*t40 + t231
-    t233 = t1*s1
-    t234 = -t223*t20 + t224*t233 + t225*t39 + t231
-    t235 = -t23
-    t236 = t44 + t235
-    t237 = -t45*(t236*t40 + t22*t230)
-    t238 = t236*t237 + t40
-    t239 = t237*t22 + t230
-    t240 = -t45*(t236*t39 + t22*t233)
-    t241 = t236*t240 + t39
-    t242 = t240*t22 + t233
-    t243 = t45*(mu_dot5 + t236*mu_dot0 + t22*mu_dot1)
-    t244 = mu_dot0 - t236*t243
-    t245 = mu_dot1 - t243*t22
-    t246 = mu_dot5 - t243
-    t247 = t45*c23
+    t45 = s1**2
+    t46 = t45*t2 + t45*t1
+    t47 = t42 + t45*t28 + t45*t29
+    t48 = t47
+    t49 = s1*t24
+    t50 = s1*t20
+    t51 = t2*t49 + t1*t50
+    t52 = t49 + t50
+    t53 = t24**2
+    t54 = t53 + t20**2
+    t55 = t54
+    t56 = s23**2
+    t57 = t12**2 + t15**2 + 2*t45 + t26*t56
+    t58 = t57
+    t59 = 2*c1
+    t60 = -s1*t59 + t33*t56 - t12*t9 + t15*t18
+    t61 = s23*s4
+    t62 = c23*t14 - t12*t61 + t15*t0
+    t63 = c23*t17 + t9*t61 + t18*t0
+    t64 = t9**2 + t18**2 + 2*t26 + t45*t56
+    t65 = t64
+    t66 = 1 + c23**2 + t0**2 + t56*s4**2
+    t67 = t66
+    t68 = xp.sqrt(t30 + t47 + t54 + t57 + t64 + t66)
+    t69 = t34**2
+    t70 = t37**2
+    t71 = t27**2
+    t72 = damping**2
+    t73 = t72 + t31
+    t74 = t73**2
+    t75 = t72 + t48
+    t76 = t72 + t55
+    t77 = t72 + t58
+    t78 = t72 + t65
+    t79 = t72 + t67
+    t80 = t41**2
+    t81 = xp.sqrt(2*t42 + 2*t25 + 2*t69 + 2*t70 + 2*t51**2 + 2*t46**2 + 2*t52**2 + 2*t71 + 2*t38**2 + 2*t60**2 + 2*t62**2 + 2*t63**2 + t74 + t75**2 + t76**2 + t77**2 + t78**2 + t79**2 + 4*t80)
+    t82 = xp.sqrt(t25 + t69 + t70 + t80 + t71 + t74)
+    t83 = t82*xp.where(xp.greater_equal(t73, 0), xp.asarray(1, dtype=dtype), -1)
+    t84 = t73 + t83
+    t85 = xp.where(xp.greater(t82, 0), 1/(t82*(t82 + xp.abs(t73))), 0)
+    t86 = t85*(t32 + t34*t84 + t34*t75 + t37*t51 + t41*t46 + t41*t27)
+    t87 = t34 - t84*t86
+    t88 = t75 - t34*t86
+    t89 = -t51 + t37*t86
+    t90 = -t46 + t41*t86
+    t91 = t41 - t27*t86
+    t92 = t22 + t23*t86
+    t93 = -t85*(t37*t84 + t34*t51 + t37*t76 + t41*t52 + t27*t38)
+    t94 = t37 + t84*t93
+    t95 = t51 + t34*t93
+    t96 = t76 + t37*t93
+    t97 = t52 + t41*t93
+    t98 = t38 + t27*t93
+    t99 = -t85*(t41*t84 + t34*t46 + t37*t52 + t41*t77 - t27*t60 - t23*t62)
+    t100 = t41 + t84*t99
+    t101 = t46 + t34*t99
+    t102 = t52 + t37*t99
+    t103 = t77 + t41*t99
+    t104 = t60 - t27*t99
+    t105 = t85*(t27*t84 + t34*t41 + t37*t38 - t41*t60 + t27*t78 + t23*t63)
+    t106 = t27 - t84*t105
+    t107 = t41 - t34*t105
+    t108 = -t38 + t37*t105
+    t109 = t60 + t41*t105
+    t110 = t78 - t27*t105
+    t111 = -t63 + t23*t105
+    t112 = -t85*(t23*t84 - t22*t34 - t41*t62 + t27*t63 + t23*t79)
+    t113 = t23 + t84*t112
+    t114 = t22 - t34*t112
+    t115 = t63 + t27*t112
+    t116 = t79 + t23*t112
+    t117 = t85*(mu_dot0*t84 + mu_dot1*t34 - mu_dot2*t37 - mu_dot3*t41 + mu_dot4*t27 - t23*mu_dot5)
+    t118 = mu_dot0 - t84*t117
+    t119 = mu_dot1 - t34*t117
+    t120 = mu_dot2 + t37*t117
+    t121 = mu_dot3 + t41*t117
+    t122 = mu_dot4 - t27*t117
+    t123 = mu_dot5 + t23*t117
+    t124 = xp.sqrt(t88**2 + t89**2 + t90**2 + t91**2 + t92**2)
+    t125 = t124*xp.where(xp.greater_equal(t88, 0), xp.asarray(1, dtype=dtype), -1)
+    t126 = t88 + t125
+    t127 = xp.where(xp.greater(t124, 0), 1/(t124*(t124 + xp.abs(t88))), 0)
+    t128 = t127*(t107*t126 + t89*t108 + t90*t109 + t91*t110 + t92*t111)
+    t129 = t107 - t126*t128
+    t130 = t108 - t89*t128
+    t131 = t109 - t90*t128
+    t132 = t110 - t91*t128
+    t133 = t111 - t92*t128
+    t134 = t127*(t119*t126 + t89*t120 + t90*t121 + t91*t122 + t92*t123)
+    t135 = t119 - t126*t134
+    t136 = t120 - t89*t134
+    t137 = t121 - t90*t134
+    t138 = t122 - t91*t134
+    t139 = t123 - t92*t134
+    t140 = -t62
+    t141 = t140 + t23*t99
+    t142 = t140 + t41*t112
+    t143 = t127*(-t101*t126 + t89*t102 + t90*t103 + t91*t104 + t92*t141)
+    t144 = t101 + t126*t143
+    t145 = t102 - t89*t143
+    t146 = t103 - t90*t143
+    t147 = t104 - t91*t143
+    t148 = t141 - t92*t143
+    t149 = t23*t93
+    t150 = t127*(-t95*t126 + t89*t96 + t90*t97 - t91*t98 + t149*t92)
+    t151 = t95 + t126*t150
+    t152 = t96 - t89*t150
+    t153 = t97 - t90*t150
+    t154 = t98 + t91*t150
+    t155 = t149 - t92*t150
+    t156 = xp.sqrt(t152**2 + t153**2 + t154**2 + t155**2)
+    t157 = t156*xp.where(xp.greater_equal(t152, 0), xp.asarray(1, dtype=dtype), -1)
+    t158 = t152 + t157
+    t159 = xp.where(xp.greater(t156, 0), 1/(t156*(t156 + xp.abs(t152))), 0)
+    t160 = t159*(t145*t158 + t153*t146 - t154*t147 + t155*t148)
+    t161 = t145 - t158*t160
+    t162 = t146 - t153*t160
+    t163 = t147 + t154*t160
+    t164 = t148 - t155*t160
+    t165 = t159*(t130*t158 + t153*t131 - t154*t132 + t155*t133)
+    t166 = t130 - t158*t165
+    t167 = t131 - t153*t165
+    t168 = t132 + t154*t165
+    t169 = t133 - t155*t165
+    t170 = t159*(t136*t158 + t153*t137 - t154*t138 + t155*t139)
+    t171 = t136 - t158*t170
+    t172 = t137 - t153*t170
+    t173 = t138 + t154*t170
+    t174 = t139 - t155*t170
+    t175 = xp.sqrt(t162**2 + t163**2 + t164**2)
+    t176 = t175*xp.where(xp.greater_equal(t162, 0), xp.asarray(1, dtype=dtype), -1)
+    t177 = t162 + t176
+    t178 = xp.where(xp.greater(t175, 0), 1/(t175*(t175 + xp.abs(t162))), 0)
+    t179 = t178*(t167*t177 + t163*t168 + t164*t169)
+    t180 = t167 - t177*t179
+    t181 = t168 - t163*t179
+    t182 = t169 - t164*t179
+    t183 = t178*(t172*t177 + t163*t173 + t164*t174)
+    t184 = t172 - t177*t183
+    t185 = t173 - t163*t183
+    t186 = t174 - t164*t183
+    t187 = xp.sqrt(t181**2 + t182**2)
+    t188 = t187*xp.where(xp.greater_equal(t181, 0), xp.asarray(1, dtype=dtype), -1)
+    t189 = t181 + t188
+    t190 = xp.where(xp.greater(t187, 0), 1/(t187*(t187 + xp.abs(t181))), 0)
+    t191 = t190*(t185*t189 + t182*t186)
+    t192 = t185 - t189*t191
+    t193 = t186 - t182*t191
+    t194 = t37*t112
+    t195 = t127*(t114*t126 + t194*t89 + t90*t142 - t91*t115 + t92*t116)
+    t196 = t114 - t126*t195
+    t197 = t194 - t89*t195
+    t198 = t142 - t90*t195
+    t199 = t115 + t91*t195
+    t200 = t116 - t92*t195
+    t201 = t159*(t197*t158 + t153*t198 + t154*t199 + t155*t200)
+    t202 = t197 - t158*t201
+    t203 = t198 - t153*t201
+    t204 = -t199 + t154*t201
+    t205 = t200 - t155*t201
+    t206 = t178*(t203*t177 + t163*t204 + t164*t205)
+    t207 = t203 - t177*t206
+    t208 = t204 - t163*t206
+    t209 = t205 - t164*t206
+    t210 = t190*(t208*t189 + t182*t209)
+    t211 = t208 - t189*t210
+    t212 = t209 - t182*t210
+    t213 = xp.abs(t212)
+    t214 = t213
+    t215 = t214*xp.where(xp.greater_equal(t212, 0), xp.asarray(1, dtype=dtype), -1)
+    t216 = t212 + t215
+    t217 = xp.where(xp.greater(t214, 0), 1/(t214*(t213 + t214)), 0)
+    t218 = t193 - t193*t216**2*t217
+    t219 = xp.where(xp.not_equal(t215, 0), -t218/t215, 0)
+    t220 = xp.where(xp.not_equal(t188, 0), -(t192 - t211*t219)/t188, 0)
+    t221 = xp.where(xp.not_equal(t176, 0), -(-(t180*t220 + t207*t219) + t184)/t176, 0)
+    t222 = xp.where(xp.not_equal(t157, 0), -(-(t161*t221 + t166*t220 + t202*t219) + t171)/t157, 0)
+    t223 = xp.where(xp.not_equal(t125, 0), -(-(-t151*t222 - t144*t221 + t129*t220 + t196*t219) + t135)/t125, 0)
+    t224 = xp.where(xp.not_equal(t83, 0), -(t118 + t94*t222 + t100*t221 + t113*t219 - t87*t223 - t106*t220)/t83, 0)
+    t225 = t219 - t23*t224 + t22*t223
+    t226 = t14*t221 + t17*t220 - c23*t219
+    t227 = t12*t221 - t9*t220 + t61*t219
+    t228 = t15*t221 + t18*t220 - t0*t219
+    t229 = s1*t2
+    t230 = c1*t220 - s1*t221
+    t231 = t230 + t39*t224 + t229*t223 - t24*t222
+    t232 = s1*t1
+    t233 = t230 + t40*t224 + t232*t223 - t20*t222
+    t234 = -t23
+    t235 = t234 + t44
+    t236 = xp.where(xp.greater(t43, 0), 1/(t43*(t43 + xp.abs(t234))), 0)
+    t237 = -t236*(t39*t235 + t22*t229)
+    t238 = t39 + t235*t237
+    t239 = t229 + t22*t237
+    t240 = -t236*(t40*t235 + t22*t232)
+    t241 = t40 + t235*t240
+    t242 = t232 + t22*t240
+    t243 = t236*(mu_dot5 + mu_dot0*t235 + t22*mu_dot1)
+    t244 = mu_dot0 - t235*t243
+    t245 = mu_dot1 - t22*t243
+    t246 = -t243 + mu_dot5
+    t247 = c23*t236
     t248 = c23 - t247
-    t249 = t45*t62
-    t250 = t62 - t249
-    t251 = t45*t0
+    t249 = t61*t236
+    t250 = t61 - t249
+    t251 = t0*t236
     t252 = t0 - t251
-    t253 = t27 + t46
-    t254 = xp.sqrt(t54 + t237**2 + t239**2 + t253)
+    t253 = t26 + t45
+    t254 = xp.sqrt(t53 + t253 + t237**2 + t239**2)
     t255 = t254*xp.where(xp.less_equal(t239, 0), xp.asarray(1, dtype=dtype), -1)
-    t256 = t255 - t239
-    t257 = xp.where(xp.greater(t254, 0), 1/(t254*(t254 + xp.abs(t239))), 0)
-    t258 = t257*(t237*t240 + t24*t20 - t242*t256 + t253)
-    t259 = t242 + t256*t258
-    t260 = t20 - t258*t24
-    t261 = s1 - t258*s1
-    t262 = -c1 + t258*c1
-    t263 = -t240 + t237*t258
-    t264 = t257*(t245*t256 + t24*mu_dot2 + mu_dot3*s1 - t237*t246 - c1*mu_dot4)
-    t265 = t245 - t256*t264
-    t266 = mu_dot2 - t264*t24
-    t267 = mu_dot3 - t264*s1
-    t268 = mu_dot4 + t264*c1
-    t269 = t246 + t237*t264
-    t270 = xp.sqrt(t260**2 + t261**2 + t262**2 + t263**2)
-    t271 = t270*xp.where(xp.greater_equal(t260, 0), xp.asarray(1, dtype=dtype), -1)
-    t272 = t260 + t271
-    t273 = xp.where(xp.greater(t270, 0), 1/(t270*(t270 + xp.abs(t260))), 0)
-    t274 = t273*(t261*t267 + t262*t268 + t263*t269 + t266*t272)
-    t275 = t266 - t272*t274
-    t276 = t267 - t261*t274
-    t277 = t268 - t262*t274
-    t278 = t269 - t263*t274
-    t279 = t22*t247
-    t280 = -t257*(t237*t248 + t256*t279)
-    t281 = t256*t280 + t279
-    t282 = t280*s1 + t14
-    t283 = t248 + t237*t280
-    t284 = -t17
-    t285 = t280*c1 + t284
-    t286 = t22*t249
-    t287 = t257*(t12*s1 + t9*c1 - t237*t250 - t256*t286)
-    t288 = t256*t287 + t286
-    t289 = t12 - t287*s1
-    t290 = t250 + t237*t287
-    t291 = -t9
-    t292 = t291 + t287*c1
-    t293 = t22*t251
-    t294 = -t257*(-t18*c1 + t15*s1 + t237*t252 + t256*t293)
-    t295 = t256*t294 + t293
-    t296 = t15 + t294*s1
-    t297 = t252 + t237*t294
-    t298 = -t18
-    t299 = t298 + t294*c1
-    t300 = 1 + t12 + t0 + t22 + t24 + t20 + c23 + damping + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + q1 + q2 + q3 + q4 + q5 + q6 + t291 - t15 + t298 + t235 - t60 + 2*s1 + t62 - t39 - t233 - t40 - t230 - t14 + t284
-    t301 = t280*t24
-    t302 = t273*(t262*t285 + t263*t283 - t261*t282 - t272*t301)
-    t303 = t301 + t272*t302
-    t304 = t282 + t261*t302
-    t305 = t285 - t262*t302
-    t306 = t283 - t263*t302
-    t307 = xp.sqrt(t304**2 + t305**2 + t306**2)
-    t308 = t307*xp.where(xp.less_equal(t304, 0), xp.asarray(1, dtype=dtype), -1)
-    t309 = t308 - t304
-    t310 = xp.where(xp.greater(t307, 0), 1/(t307*(t307 + xp.abs(t304))), 0)
-    t311 = t310*(t305*t277 + t306*t278 + t276*t309)
-    t312 = t276 - t309*t311
-    t313 = t277 - t305*t311
-    t314 = t278 - t306*t311
-    t315 = t287*t24
-    t316 = t273*(t261*t289 + t262*t292 + t263*t290 - t272*t315)
-    t317 = t315 + t272*t316
-    t318 = t289 - t261*t316
-    t319 = t292 - t262*t316
-    t320 = t290 - t263*t316
-    t321 = t310*(t305*t319 + t306*t320 + t318*t309)
-    t322 = t318 - t309*t321
-    t323 = t319 - t305*t321
-    t324 = t320 - t306*t321
-    t325 = xp.sqrt(t323**2 + t324**2)
-    t326 = t325*xp.where(xp.greater_equal(t323, 0), xp.asarray(1, dtype=dtype), -1)
-    t327 = t323 + t326
-    t328 = xp.where(xp.greater(t325, 0), 1/(t325*(t325 + xp.abs(t323))), 0)
-    t329 = t328*(t324*t314 + t313*t327)
-    t330 = t313 - t327*t329
-    t331 = t314 - t324*t329
-    t332 = t294*t24
-    t333 = t273*(t262*t299 + t263*t297 - t261*t296 - t272*t332)
-    t334 = t332 + t272*t333
-    t335 = t296 + t261*t333
-    t336 = t299 - t262*t333
-    t337 = t297 - t263*t333
-    t338 = t310*(t305*t336 + t306*t337 - t335*t309)
-    t339 = t335 + t309*t338
-    t340 = t336 - t305*t338
-    t341 = t337 - t306*t338
-    t342 = t328*(t324*t341 + t340*t327)
-    t343 = t340 - t327*t342
-    t344 = t341 - t324*t342
-    t345 = xp.abs(t344)
-    t346 = t345
-    t347 = t346*xp.where(xp.greater_equal(t344, 0), xp.asarray(1, dtype=dtype), -1)
-    t348 = t344 + t347
-    t349 = xp.where(xp.greater(t346, 0), 1/(t346*(t346 + t345)), 0)
-    t350 = t331 - t331*t349*t348**2
-    t351 = xp.where(xp.not_equal(t347, 0), -t350/t347, 0)
-    t352 = xp.where(xp.not_equal(t326, 0), -(t330 - t343*t351)/t326, 0)
-    t353 = xp.where(xp.not_equal(t308, 0), -(t312 - (t322*t352 - t339*t351))/t308, 0)
-    t354 = xp.where(xp.not_equal(t271, 0), -(t275 + t303*t353 + t317*t352 + t334*t351)/t271, 0)
-    t355 = xp.where(xp.not_equal(t255, 0), -(t265 + t259*t354 + t281*t353 + t288*t352 + t295*t351)/t255, 0)
-    t356 = xp.where(xp.not_equal(t44, 0), -(t244 + t238*t355 + t241*t354 + t236*t351*t251 + t236*t353*t247 + t236*t352*t249)/t44, 0)
-    t357 = xp.isfinite(t300)
-    t358 = xp.greater_equal(damping, 0)
-    t359 = 1e-12*t69
-    t360 = xp.greater(damping, 0)
-    t361 = 1e-12*t82
-    t362 = (xp.less_equal(damping, 0) & (xp.less_equal(t43, t359) | xp.less_equal(t254, t359) | xp.less_equal(t270, t359) | xp.less_equal(t307, t359) | xp.less_equal(t325, t359) | xp.less_equal(t346, t359))) | (t360 & (xp.less_equal(t83, t361) | xp.less_equal(t125, t361) | xp.less_equal(t157, t361) | xp.less_equal(t176, t361) | xp.less_equal(t188, t361) | xp.less_equal(t215, t361)))
-    t363 = t357 & t358 & xp.logical_not(t362)
+    t256 = -t239
+    t257 = t256 + t255
+    t258 = xp.where(xp.greater(t254, 0), 1/(t254*(t254 + xp.abs(t256))), 0)
+    t259 = t258*(t253 - t242*t257 + t24*t20 + t237*t240)
+    t260 = t242 + t257*t259
+    t261 = t20 - t24*t259
+    t262 = s1 - s1*t259
+    t263 = -c1 + c1*t259
+    t264 = -t240 + t237*t259
+    t265 = t258*(t245*t257 + t24*mu_dot2 + s1*mu_dot3 - c1*mu_dot4 - t237*t246)
+    t266 = t245 - t257*t265
+    t267 = mu_dot2 - t24*t265
+    t268 = mu_dot3 - s1*t265
+    t269 = mu_dot4 + c1*t265
+    t270 = t246 + t237*t265
+    t271 = xp.sqrt(t261**2 + t262**2 + t263**2 + t264**2)
+    t272 = t271*xp.where(xp.greater_equal(t261, 0), xp.asarray(1, dtype=dtype), -1)
+    t273 = t261 + t272
+    t274 = xp.where(xp.greater(t271, 0), 1/(t271*(t271 + xp.abs(t261))), 0)
+    t275 = t274*(t267*t273 + t262*t268 + t263*t269 + t264*t270)
+    t276 = t267 - t273*t275
+    t277 = t268 - t262*t275
+    t278 = t269 - t263*t275
+    t279 = t270 - t264*t275
+    t280 = t22*t247
+    t281 = -t258*(t280*t257 + t237*t248)
+    t282 = t280 + t257*t281
+    t283 = t14 + s1*t281
+    t284 = t248 + t237*t281
+    t285 = -t17
+    t286 = t285 + c1*t281
+    t287 = t22*t249
+    t288 = t258*(-t287*t257 + s1*t12 + c1*t9 - t237*t250)
+    t289 = t287 + t257*t288
+    t290 = t12 - s1*t288
+    t291 = t250 + t237*t288
+    t292 = -t9
+    t293 = t292 + c1*t288
+    t294 = t22*t251
+    t295 = -t258*(-c1*t18 + s1*t15 + t294*t257 + t237*t252)
+    t296 = t294 + t257*t295
+    t297 = t15 + s1*t295
+    t298 = t252 + t237*t295
+    t299 = -t18
+    t300 = t299 + c1*t295
+    t301 = 1 + t234 - t15 + t292 + t299 + q1 + q2 + q3 + c23 + q4 + q5 + q6 + t12 + t22 + t0 + t61 - t39 - t40 - t229 - t232 - t14 + t285 - t59 + 2*s1 + t24 + t20 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + damping
+    t302 = t24*t281
+    t303 = t274*(-t302*t273 - t262*t283 + t263*t286 + t264*t284)
+    t304 = t302 + t273*t303
+    t305 = t283 + t262*t303
+    t306 = t286 - t263*t303
+    t307 = t284 - t264*t303
+    t308 = xp.sqrt(t305**2 + t306**2 + t307**2)
+    t309 = t308*xp.where(xp.less_equal(t305, 0), xp.asarray(1, dtype=dtype), -1)
+    t310 = t24*t288
+    t311 = t274*(-t310*t273 + t262*t290 + t263*t293 + t264*t291)
+    t312 = t310 + t273*t311
+    t313 = t290 - t262*t311
+    t314 = t293 - t263*t311
+    t315 = t291 - t264*t311
+    t316 = t24*t295
+    t317 = t274*(-t316*t273 - t262*t297 + t263*t300 + t264*t298)
+    t318 = t316 + t273*t317
+    t319 = t297 + t262*t317
+    t320 = t300 - t263*t317
+    t321 = t298 - t264*t317
+    t322 = -t305
+    t323 = t322 + t309
+    t324 = xp.where(xp.greater(t308, 0), 1/(t308*(t308 + xp.abs(t322))), 0)
+    t325 = t324*(t313*t323 + t306*t314 + t307*t315)
+    t326 = t313 - t323*t325
+    t327 = t314 - t306*t325
+    t328 = t315 - t307*t325
+    t329 = t324*(-t319*t323 + t306*t320 + t307*t321)
+    t330 = t319 + t323*t329
+    t331 = t320 - t306*t329
+    t332 = t321 - t307*t329
+    t333 = t324*(t277*t323 + t306*t278 + t307*t279)
+    t334 = t277 - t323*t333
+    t335 = t278 - t306*t333
+    t336 = t279 - t307*t333
+    t337 = xp.sqrt(t327**2 + t328**2)
+    t338 = t337*xp.where(xp.greater_equal(t327, 0), xp.asarray(1, dtype=dtype), -1)
+    t339 = t327 + t338
+    t340 = xp.where(xp.greater(t337, 0), 1/(t337*(t337 + xp.abs(t327))), 0)
+    t341 = t340*(t331*t339 + t328*t332)
+    t342 = t331 - t339*t341
+    t343 = t332 - t328*t341
+    t344 = t340*(t335*t339 + t328*t336)
+    t345 = t335 - t339*t344
+    t346 = t336 - t328*t344
+    t347 = xp.abs(t343)
+    t348 = t347
+    t349 = t348*xp.where(xp.greater_equal(t343, 0), xp.asarray(1, dtype=dtype), -1)
+    t350 = t343 + t349
+    t351 = xp.where(xp.greater(t348, 0), 1/(t348*(t347 + t348)), 0)
+    t352 = t346 - t346*t350**2*t351
+    t353 = xp.where(xp.not_equal(t349, 0), -t352/t349, 0)
+    t354 = xp.where(xp.not_equal(t338, 0), -(t345 - t342*t353)/t338, 0)
+    t355 = xp.where(xp.not_equal(t309, 0), -(-(t326*t354 - t330*t353) + t334)/t309, 0)
+    t356 = xp.where(xp.not_equal(t272, 0), -(t276 + t304*t355 + t312*t354 + t318*t353)/t272, 0)
+    t357 = xp.where(xp.not_equal(t255, 0), -(t266 + t260*t356 + t282*t355 + t289*t354 + t296*t353)/t255, 0)
+    t358 = xp.where(xp.not_equal(t44, 0), -(t244 + t238*t357 + t241*t356 + t247*t235*t355 + t249*t235*t354 + t251*t235*t353)/t44, 0)
+    t359 = xp.isfinite(t301)
+    t360 = xp.greater_equal(damping, 0)
+    t361 = xp.greater(damping, 0)
+    t362 = 1e-12*t81
+    t363 = 1e-12*t68
+    t364 = (t361 & (xp.less_equal(t82, t362) | xp.less_equal(t124, t362) | xp.less_equal(t156, t362) | xp.less_equal(t175, t362) | xp.less_equal(t187, t362) | xp.less_equal(t214, t362))) | (xp.less_equal(damping, 0) & (xp.less_equal(t43, t363) | xp.less_equal(t254, t363) | xp.less_equal(t271, t363) | xp.less_equal(t308, t363) | xp.less_equal(t337, t363) | xp.less_equal(t348, t363)))
+    t365 = t359 & t360 & xp.logical_not(t364)
     q_dot = _stack(xp, [
-        xp.broadcast_to(xp.where(t363, xp.where(t360, t226, t356), 0), batch),  # 0
-        xp.broadcast_to(xp.where(t363, xp.where(t360, -t232, t355), 0), batch),  # 1
-        xp.broadcast_to(xp.where(t363, xp.where(t360, -t234, t354), 0), batch),  # 2
-        xp.broadcast_to(xp.where(t363, xp.where(t360, -t227, t353), 0), batch),  # 3
-        xp.broadcast_to(xp.where(t363, xp.where(t360, t228, t352), 0), batch),  # 4
-        xp.broadcast_to(xp.where(t363, xp.where(t360, -t229, t351), 0), batch),  # 5
+        xp.broadcast_to(xp.where(t365, xp.where(t361, t225, t358), 0), batch),  # 0
+        xp.broadcast_to(xp.where(t365, xp.where(t361, -t231, t357), 0), batch),  # 1
+        xp.broadcast_to(xp.where(t365, xp.where(t361, -t233, t356), 0), batch),  # 2
+        xp.broadcast_to(xp.where(t365, xp.where(t361, -t226, t355), 0), batch),  # 3
+        xp.broadcast_to(xp.where(t365, xp.where(t361, t227, t354), 0), batch),  # 4
+        xp.broadcast_to(xp.where(t365, xp.where(t361, -t228, t353), 0), batch),  # 5
     ], (6,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t357 & t358), 2, xp.where(t362, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t359 & t360), 2, xp.where(t364, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
     return q_dot, status
 
 
@@ -1930,18 +1932,18 @@ def ik_numeric_step(target, q, damping=0.0):
     c3 = xp.cos(q3)
     s3 = xp.sin(q3)
     c23 = c2*c3 - s2*s3
-    s23 = c2*s3 + c3*s2
+    s23 = c2*s3 + s2*c3
     c4 = xp.cos(q4)
     s4 = xp.sin(q4)
     c5 = xp.cos(q5)
     s5 = xp.sin(q5)
     c6 = xp.cos(q6)
     s6 = xp.sin(q6)
-    t0 = 0.0203*s23 + 0.4318*c23
-    t1 = t0 + 0.4318*s2
+    t0 = 0.4318*c23 + 0.0203*s23
+    t1 = 0.4318*s2 + t0
     t2 = 0.67183 + t1
-    t3 = T23 - t2
-    t4 = T00 + T01 + T02 + T03 + T10 + T11 + T12 + T13 + T20 + T21 + T22 + T23 + qs1 + qs2 + qs3 + qs4 + qs5 + qs6
+    t3 = -t2 + T23
+    t4 = qs1 + qs2 + qs3 + qs4 + qs5 + qs6 + T00 + T01 + T02 + T10 + T11 + T12 + T20 + T21 + T22 + T03 + T13 + T23
     t5 = 0.0203*c23
     t6 = 0.15005*s1 + c1*t5
     t7 = -0.15005*c1 + s1*t5
@@ -1949,7 +1951,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t9 = c1*c4
     t10 = -t8 + c23*t9
     t11 = t9 - c23*t8
-    t12 = c4*s1
+    t12 = s1*c4
     t13 = c1*s4
     t14 = t12 + c23*t13
     t15 = t13 + c23*t12
@@ -1957,71 +1959,71 @@ def ik_numeric_step(target, q, damping=0.0):
     t17 = t10*c5 - s5*t16
     t18 = t10*s5 + c5*t16
     t19 = t17*c6 - t14*s6
-    t20 = t14*c6 + t17*s6
+    t20 = c6*t14 + t17*s6
     t21 = t6 - 0.4318*t16
-    t22 = T01*t20 + T02*t18 - T00*t19
-    t23 = T11*t20 + T12*t18 - T10*t19
-    t24 = T21*t20 + T22*t18 - T20*t19
+    t22 = -t19*T00 + t20*T01 + t18*T02
+    t23 = -t19*T10 + t20*T11 + t18*T12
+    t24 = -t19*T20 + t20*T21 + t18*T22
     t25 = s1*s23
-    t26 = t15*c5 - s5*t25
-    t27 = t15*s5 + c5*t25
-    t28 = t11*s6 + t26*c6
-    t29 = t11*c6 - t26*s6
+    t26 = c5*t15 - s5*t25
+    t27 = s5*t15 + c5*t25
+    t28 = s6*t11 + c6*t26
+    t29 = c6*t11 - s6*t26
     t30 = t7 - 0.4318*t25
-    t31 = t21*c1 + t30*s1
-    t32 = T00*t28 + T01*t29 - T02*t27
-    t33 = T10*t28 + T11*t29 - T12*t27
-    t34 = T20*t28 + T21*t29 - T22*t27
-    t35 = -0.5*(t32 + t23)
-    t36 = c4*s23
+    t31 = c1*t21 + s1*t30
+    t32 = t28*T00 + t29*T01 - t27*T02
+    t33 = t28*T10 + t29*T11 - t27*T12
+    t34 = t28*T20 + t29*T21 - t27*T22
+    t35 = -0.5*(t23 + t32)
+    t36 = s23*c4
     t37 = c23*s5 + c5*t36
     t38 = c23*c5 - s5*t36
-    t39 = s4*s23
-    t40 = t37*c6 - s6*t39
-    t41 = t37*s6 + c6*t39
-    t42 = t18*t38 + c23*t16 - t14*t39
-    t43 = t27*t38 + t11*t39 + c23*t25
-    t44 = T00*t40 + T02*t38 - T01*t41
-    t45 = T10*t40 + T12*t38 - T11*t41
-    t46 = T20*t40 + T22*t38 - T21*t41
-    t47 = 0.5*(t34 - t45)
+    t39 = s23*s4
+    t40 = c6*t37 - s6*t39
+    t41 = s6*t37 + c6*t39
+    t42 = c23*t16 - t14*t39 + t18*t38
+    t43 = c23*t25 + t11*t39 + t27*t38
+    t44 = t40*T00 - t41*T01 + t38*T02
+    t45 = t40*T10 - t41*T11 + t38*T12
+    t46 = t40*T20 - t41*T21 + t38*T22
+    t47 = 0.5*(-t45 + t34)
     t48 = 0.5*(t44 + t24)
     t49 = xp.sqrt(t47**2 + t48**2 + t35**2)
     t50 = 0.4318*c2
-    t51 = t21 + c1*t50
-    t52 = t30 + s1*t50
-    t53 = t51*c1 + t52*s1
+    t51 = c1*t50 + t21
+    t52 = s1*t50 + t30
+    t53 = c1*t51 + s1*t52
     t54 = t53**2 + t31**2
-    t55 = T03 - t51
-    t56 = T13 - t52
+    t55 = -t51 + T03
+    t56 = -t52 + T13
     t57 = t52**2
-    t58 = t0**2
-    t59 = c1**2
-    t60 = t0*t59 + t1*t59
-    t61 = t1**2
-    t62 = t57 + t58*t59 + t61*t59
+    t58 = c1**2
+    t59 = t58*t1 + t58*t0
+    t60 = t1**2
+    t61 = t0**2
+    t62 = t57 + t58*t60 + t58*t61
     t63 = -t51*t52
     t64 = s1*c1
-    t65 = t63 + t58*t64 + t61*t64
-    t66 = t0*t64 + t1*t64
-    t67 = t31*c1
-    t68 = t53*c1
-    t69 = t0*t67 + t1*t68
-    t70 = t68 + t67
+    t65 = t63 + t60*t64 + t61*t64
+    t66 = t1*t64 + t0*t64
+    t67 = c1*t53
+    t68 = c1*t31
+    t69 = t1*t67 + t0*t68
+    t70 = t67 + t68
     t71 = s1**2
-    t72 = t51**2 + t58*t71 + t61*t71
-    t73 = t0*t71 + t1*t71
-    t74 = t31*s1
-    t75 = t53*s1
-    t76 = t0*t74 + t1*t75
-    t77 = t75 + t74
+    t72 = t51**2 + t71*t60 + t71*t61
+    t73 = t71*t1 + t71*t0
+    t74 = s1*t53
+    t75 = s1*t31
+    t76 = t1*t74 + t0*t75
+    t77 = t74 + t75
     t78 = s23**2
-    t79 = t14**2 + t18**2 + 2*t71 + t59*t78
-    t80 = t18*t27 - t14*t11 - 2*t64 + t78*t64
-    t81 = t11**2 + t27**2 + 2*t59 + t71*t78
-    t82 = 1 + t38**2 + c23**2 + t78*s4**2
+    t79 = t14**2 + t18**2 + 2*t71 + t58*t78
+    t80 = -2*t64 + t64*t78 - t14*t11 + t18*t27
+    t81 = t11**2 + t27**2 + 2*t58 + t71*t78
+    t82 = 1 + c23**2 + t38**2 + t78*s4**2
     t83 = -t22
-    t84 = 0.5*(-1 + t33 + t46 + t83)
+    t84 = 0.5*(-1 + t83 + t33 + t46)
     t85 = xp.atan2(t49, t84)
     t86 = xp.where(xp.greater(t49, 0), t85/t49, 1)
     t87 = xp.greater_equal(t83, t33) & xp.greater_equal(t83, t46)
@@ -2033,85 +2035,85 @@ def ik_numeric_step(target, q, damping=0.0):
     t93 = xp.where(xp.greater_equal(t47*t89 + t48*t90 + t35*t91, 0), xp.asarray(1, dtype=dtype), -1)
     t94 = xp.greater(t49, 1e-06) | xp.greater(t84, 0)
     t95 = t85*t93/t92
-    t96 = xp.where(t94, t47*t86, t89*t95)
-    t97 = xp.where(t94, t48*t86, t90*t95)
-    t98 = xp.where(t94, t35*t86, t91*t95)
+    t96 = xp.where(t94, t47*t86, t95*t89)
+    t97 = xp.where(t94, t48*t86, t95*t90)
+    t98 = xp.where(t94, t35*t86, t95*t91)
     t99 = t96**2 + t97**2 + t98**2 + t55**2 + t56**2 + t3**2
-    t100 = t62 + damping
-    t101 = xp.sqrt(t60**2 + t57 + t65**2 + t69**2 + t66**2 + t100**2)
+    t100 = damping + t62
+    t101 = xp.sqrt(t57 + t65**2 + t69**2 + t66**2 + t59**2 + t100**2)
     t102 = t101*xp.where(xp.greater_equal(t100, 0), xp.asarray(1, dtype=dtype), -1)
-    t103 = t102 + t100
+    t103 = t100 + t102
     t104 = xp.where(xp.greater(t101, 0), 1/(t101*(t101 + xp.abs(t100))), 0)
-    t105 = t104*(t60*t97 + t55*t103 + t56*t65 - t96*t66 - t98*t52 - t3*t69)
+    t105 = t104*(t55*t103 + t65*t56 - t69*t3 - t66*t96 + t59*t97 - t52*t98)
     t106 = t55 - t103*t105
-    t107 = t56 - t105*t65
-    t108 = t3 + t105*t69
-    t109 = t96 + t105*t66
-    t110 = t97 - t60*t105
+    t107 = t56 - t65*t105
+    t108 = t3 + t69*t105
+    t109 = t96 + t66*t105
+    t110 = t97 - t59*t105
     t111 = t98 + t52*t105
-    t112 = t72 + damping
-    t113 = t104*(t60*t66 + t76*t69 + t73*t66 + t103*t65 + t65*t112 + t63)
+    t112 = damping + t72
+    t113 = t104*(t63 + t69*t76 + t66*t73 + t66*t59 + t65*t103 + t65*t112)
     t114 = t65 - t103*t113
-    t115 = -t113*t65 + t112
-    t116 = -t76 + t113*t69
-    t117 = -t73 + t113*t66
-    t118 = t66 - t60*t113
-    t119 = t51 + t113*t52
+    t115 = t112 - t65*t113
+    t116 = -t76 + t69*t113
+    t117 = -t73 + t66*t113
+    t118 = t66 - t59*t113
+    t119 = t51 + t52*t113
     t120 = xp.sqrt(t115**2 + t116**2 + t117**2 + t118**2 + t119**2)
     t121 = t120*xp.where(xp.greater_equal(t115, 0), xp.asarray(1, dtype=dtype), -1)
     t122 = t115 + t121
     t123 = xp.where(xp.greater(t120, 0), 1/(t120*(t120 + xp.abs(t115))), 0)
-    t124 = t123*(t116*t108 + t117*t109 + t118*t110 + t119*t111 + t107*t122)
+    t124 = t123*(t107*t122 + t116*t108 + t117*t109 + t118*t110 + t119*t111)
     t125 = t107 - t122*t124
     t126 = t108 - t116*t124
     t127 = t109 - t117*t124
     t128 = t110 - t118*t124
     t129 = t111 - t119*t124
-    t130 = t54 + damping
-    t131 = -t104*(t60*t70 + t76*t65 + t77*t66 + t103*t69 + t69*t130)
+    t130 = damping + t54
+    t131 = -t104*(t65*t76 + t66*t77 + t59*t70 + t69*t103 + t69*t130)
     t132 = t69 + t103*t131
-    t133 = t76 + t131*t65
-    t134 = t131*t69 + t130
-    t135 = t77 + t131*t66
-    t136 = t70 + t60*t131
-    t137 = t79 + damping
-    t138 = -t104*(-t60*t80 - t42*t52 + t73*t65 + t77*t69 + t103*t66 + t66*t137)
+    t133 = t76 + t65*t131
+    t134 = t130 + t69*t131
+    t135 = t77 + t66*t131
+    t136 = t70 + t59*t131
+    t137 = damping + t79
+    t138 = -t104*(t65*t73 + t69*t77 - t59*t80 - t52*t42 + t66*t103 + t66*t137)
     t139 = t66 + t103*t138
-    t140 = t73 + t138*t65
-    t141 = t77 + t138*t69
-    t142 = t138*t66 + t137
-    t143 = t80 - t60*t138
+    t140 = t73 + t65*t138
+    t141 = t77 + t69*t138
+    t142 = t137 + t66*t138
+    t143 = t80 - t59*t138
     t144 = -t42
-    t145 = t144 + t138*t52
-    t146 = t123*(t116*t141 + t117*t142 + t118*t143 + t119*t145 - t140*t122)
+    t145 = t144 + t52*t138
+    t146 = t123*(-t140*t122 + t116*t141 + t117*t142 + t118*t143 + t119*t145)
     t147 = t140 + t122*t146
     t148 = t141 - t116*t146
     t149 = t142 - t117*t146
     t150 = t143 - t118*t146
     t151 = t145 - t119*t146
-    t152 = t81 + damping
-    t153 = t104*(t60*t103 + t60*t152 + t70*t69 + t43*t52 + t65*t66 - t80*t66)
-    t154 = t60 - t103*t153
-    t155 = t66 - t153*t65
-    t156 = -t70 + t153*t69
-    t157 = t80 + t153*t66
-    t158 = -t60*t153 + t152
-    t159 = -t43 + t153*t52
-    t160 = t123*(t116*t156 + t117*t157 + t118*t158 + t119*t159 + t155*t122)
+    t152 = damping + t81
+    t153 = t104*(t65*t66 + t69*t70 - t66*t80 + t52*t43 + t59*t103 + t59*t152)
+    t154 = t59 - t103*t153
+    t155 = t66 - t65*t153
+    t156 = -t70 + t69*t153
+    t157 = t80 + t66*t153
+    t158 = t152 - t59*t153
+    t159 = -t43 + t52*t153
+    t160 = t123*(t155*t122 + t116*t156 + t117*t157 + t118*t158 + t119*t159)
     t161 = t155 - t122*t160
     t162 = t156 - t116*t160
     t163 = t157 - t117*t160
     t164 = t158 - t118*t160
     t165 = t159 - t119*t160
-    t166 = t82 + damping
-    t167 = -t104*(-t42*t66 - t51*t65 + t60*t43 + t103*t52 + t52*t166)
+    t166 = damping + t82
+    t167 = -t104*(-t51*t65 - t66*t42 + t59*t43 + t52*t103 + t52*t166)
     t168 = t52 + t103*t167
-    t169 = t51 - t167*t65
-    t170 = t144 + t167*t66
-    t171 = t43 + t60*t167
-    t172 = t167*t52 + t166
-    t173 = t131*t52
-    t174 = t123*(t116*t134 + t117*t135 - t118*t136 - t133*t122 + t119*t173)
+    t169 = t51 - t65*t167
+    t170 = t144 + t66*t167
+    t171 = t43 + t59*t167
+    t172 = t166 + t52*t167
+    t173 = t52*t131
+    t174 = t123*(-t133*t122 + t116*t134 + t117*t135 - t118*t136 + t173*t119)
     t175 = t133 + t122*t174
     t176 = t134 - t116*t174
     t177 = t135 - t117*t174
@@ -2121,17 +2123,17 @@ def ik_numeric_step(target, q, damping=0.0):
     t181 = t180*xp.where(xp.greater_equal(t176, 0), xp.asarray(1, dtype=dtype), -1)
     t182 = t176 + t181
     t183 = xp.where(xp.greater(t180, 0), 1/(t180*(t180 + xp.abs(t176))), 0)
-    t184 = t183*(t177*t149 + t179*t151 + t148*t182 - t178*t150)
+    t184 = t183*(t148*t182 + t177*t149 - t178*t150 + t179*t151)
     t185 = t148 - t182*t184
     t186 = t149 - t177*t184
     t187 = t150 + t178*t184
     t188 = t151 - t179*t184
-    t189 = t183*(t177*t163 + t179*t165 + t162*t182 - t178*t164)
+    t189 = t183*(t162*t182 + t177*t163 - t178*t164 + t179*t165)
     t190 = t162 - t182*t189
     t191 = t163 - t177*t189
     t192 = t164 + t178*t189
     t193 = t165 - t179*t189
-    t194 = t183*(t177*t127 + t179*t129 + t126*t182 - t178*t128)
+    t194 = t183*(t126*t182 + t177*t127 - t178*t128 + t179*t129)
     t195 = t126 - t182*t194
     t196 = t127 - t177*t194
     t197 = t128 + t178*t194
@@ -2140,11 +2142,11 @@ def ik_numeric_step(target, q, damping=0.0):
     t200 = t199*xp.where(xp.greater_equal(t186, 0), xp.asarray(1, dtype=dtype), -1)
     t201 = t186 + t200
     t202 = xp.where(xp.greater(t199, 0), 1/(t199*(t199 + xp.abs(t186))), 0)
-    t203 = t202*(t187*t192 + t188*t193 + t191*t201)
+    t203 = t202*(t191*t201 + t187*t192 + t188*t193)
     t204 = t191 - t201*t203
     t205 = t192 - t187*t203
     t206 = t193 - t188*t203
-    t207 = t202*(t187*t197 + t188*t198 + t196*t201)
+    t207 = t202*(t196*t201 + t187*t197 + t188*t198)
     t208 = t196 - t201*t207
     t209 = t197 - t187*t207
     t210 = t198 - t188*t207
@@ -2152,49 +2154,49 @@ def ik_numeric_step(target, q, damping=0.0):
     t212 = t211*xp.where(xp.greater_equal(t205, 0), xp.asarray(1, dtype=dtype), -1)
     t213 = t205 + t212
     t214 = xp.where(xp.greater(t211, 0), 1/(t211*(t211 + xp.abs(t205))), 0)
-    t215 = t214*(t206*t210 + t209*t213)
+    t215 = t214*(t209*t213 + t206*t210)
     t216 = t209 - t213*t215
     t217 = t210 - t206*t215
-    t218 = t167*t69
-    t219 = t123*(t117*t170 + t119*t172 + t169*t122 - t118*t171 + t116*t218)
+    t218 = t69*t167
+    t219 = t123*(t169*t122 + t218*t116 + t117*t170 - t118*t171 + t119*t172)
     t220 = t169 - t122*t219
     t221 = t218 - t116*t219
     t222 = t170 - t117*t219
     t223 = t171 + t118*t219
     t224 = t172 - t119*t219
-    t225 = t183*(t177*t222 + t178*t223 + t179*t224 + t221*t182)
+    t225 = t183*(t221*t182 + t177*t222 + t178*t223 + t179*t224)
     t226 = t221 - t182*t225
     t227 = t222 - t177*t225
     t228 = -t223 + t178*t225
     t229 = t224 - t179*t225
-    t230 = t202*(t187*t228 + t188*t229 + t227*t201)
+    t230 = t202*(t227*t201 + t187*t228 + t188*t229)
     t231 = t227 - t201*t230
     t232 = t228 - t187*t230
     t233 = t229 - t188*t230
-    t234 = t214*(t206*t233 + t232*t213)
+    t234 = t214*(t232*t213 + t206*t233)
     t235 = t232 - t213*t234
     t236 = t233 - t206*t234
     t237 = xp.abs(t236)
     t238 = t237
     t239 = t238*xp.where(xp.greater_equal(t236, 0), xp.asarray(1, dtype=dtype), -1)
     t240 = t236 + t239
-    t241 = xp.where(xp.greater(t238, 0), 1/(t238*(t238 + t237)), 0)
-    t242 = t217 - t217*t241*t240**2
+    t241 = xp.where(xp.greater(t238, 0), 1/(t238*(t237 + t238)), 0)
+    t242 = t217 - t217*t240**2*t241
     t243 = xp.where(xp.not_equal(t239, 0), -t242/t239, 0)
     t244 = xp.where(xp.not_equal(t212, 0), -(t216 - t235*t243)/t212, 0)
-    t245 = xp.where(xp.not_equal(t200, 0), -(t208 - (t204*t244 + t231*t243))/t200, 0)
-    t246 = xp.where(xp.not_equal(t181, 0), -(t195 - (t185*t245 + t190*t244 + t226*t243))/t181, 0)
-    t247 = xp.where(xp.not_equal(t121, 0), -(t125 - (t161*t244 + t220*t243 - t175*t246 - t147*t245))/t121, 0)
-    t248 = xp.where(xp.not_equal(t102, 0), -(t106 - t114*t247 - t154*t244 + t132*t246 + t139*t245 + t168*t243)/t102, 0)
-    t249 = t243 + q1 + t51*t247 - t52*t248
-    t250 = q4 + t243*c23 - t244*t25 - t245*t16
-    t251 = q5 + t14*t245 - t11*t244 + t243*t39
-    t252 = q6 + t38*t243 - t18*t245 - t27*t244
-    t253 = s1*t247
-    t254 = c1*t248
-    t255 = t245*s1 - t244*c1
-    t256 = q2 + t53*t246 - t1*t253 - t1*t254 + t255
-    t257 = q3 + t31*t246 - t0*t253 - t0*t254 + t255
+    t245 = xp.where(xp.not_equal(t200, 0), -(-(t204*t244 + t231*t243) + t208)/t200, 0)
+    t246 = xp.where(xp.not_equal(t181, 0), -(-(t185*t245 + t190*t244 + t226*t243) + t195)/t181, 0)
+    t247 = xp.where(xp.not_equal(t121, 0), -(-(-t175*t246 - t147*t245 + t161*t244 + t220*t243) + t125)/t121, 0)
+    t248 = xp.where(xp.not_equal(t102, 0), -(t106 + t132*t246 + t139*t245 + t168*t243 - t114*t247 - t154*t244)/t102, 0)
+    t249 = q1 + t243 - t52*t248 + t51*t247
+    t250 = q4 - t16*t245 - t25*t244 + c23*t243
+    t251 = q5 + t14*t245 - t11*t244 + t39*t243
+    t252 = q6 - t18*t245 - t27*t244 + t38*t243
+    t253 = c1*t248
+    t254 = s1*t247
+    t255 = s1*t245 - c1*t244
+    t256 = q2 + t255 + t53*t246 - t1*t253 - t1*t254
+    t257 = q3 + t255 + t31*t246 - t0*t253 - t0*t254
     q_start = _stack(xp, [
         xp.broadcast_to(q1, batch),  # 0
         xp.broadcast_to(q2, batch),  # 1
@@ -2231,23 +2233,23 @@ def ik_branches(T):
     T21 = T[..., 2, 1]
     T22 = T[..., 2, 2]
     T23 = T[..., 2, 3]
-    t0 = T00 + T01 + T02 + T03 + T10 + T11 + T12 + T13 + T20 + T21 + T22 + T23
+    t0 = T00 + T01 + T02 + T10 + T11 + T12 + T20 + T21 + T22 + T03 + T13 + T23
     t1 = -0.15005*T01 + 0.4521*T00 + 1.10363*T02
-    t2 = T03 - t1
+    t2 = -t1 + T03
     t3 = t1
     t4 = t2 + t3
     t5 = -0.15005*T11 + 0.4521*T10 + 1.10363*T12
-    t6 = T13 - t5
+    t6 = -t5 + T13
     t7 = t5
     t8 = t6 + t7
     t9 = xp.atan2(t4, -t8)
     t10 = -0.15005*T21 + 0.4521*T20 + 1.10363*T22
-    t11 = T23 - t10
+    t11 = -t10 + T23
     t12 = t10
     t13 = t11 + t12
     t14 = t4**2 + t8**2
     t15 = t14
-    t16 = t13**2 + t14
+    t16 = t14 + t13**2
     t17 = 1e-24*t16
     t18 = xp.less_equal(t15, t17)
     t19 = xp.where(t18, 1, 1/xp.sqrt(t15))
@@ -2258,19 +2260,19 @@ def ik_branches(T):
     t24 = xp.where(t21, t23, xp.where(xp.greater(t23, 0), xp.asarray(1, dtype=dtype), -1))
     t25 = xp.atan2(t22, t24)
     t26 = xp.where(t18, 0, t9 + t25)
-    t27 = t9 - t25
+    t27 = -t25 + t9
     t28 = t26 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t26))
-    t29 = t28 - 6.283185307179586*xp.floor(0.15915494309189535*(2.792526803190927 + t28))
-    t30 = t27 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t27))
-    t31 = t30 - 6.283185307179586*xp.floor(0.15915494309189535*(2.792526803190927 + t30))
-    t32 = t19*t4
-    t33 = t22*t32
-    t34 = t19*t8
-    t35 = t24*t34
+    t29 = -6.283185307179586*xp.floor(0.15915494309189535*(2.792526803190927 + t28)) + t28
+    t30 = -6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t27)) + t27
+    t31 = -6.283185307179586*xp.floor(0.15915494309189535*(2.792526803190927 + t30)) + t30
+    t32 = t4*t19
+    t33 = t32*t22
+    t34 = t8*t19
+    t35 = t34*t24
     t36 = xp.where(t18, 1, -(t33 + t35))
-    t37 = t33 - t35
-    t38 = t24*t32
-    t39 = t22*t34
+    t37 = -t35 + t33
+    t38 = t32*t24
+    t39 = t34*t22
     t40 = xp.where(t18, 0, t38 - t39)
     t41 = t38 + t39
     t42 = t4*t36 + t8*t40
@@ -2303,58 +2305,58 @@ def ik_branches(T):
     t69 = xp.where(t66, t68, xp.where(xp.greater(t68, 0), xp.asarray(1, dtype=dtype), -1))
     t70 = xp.atan2(t67, t69)
     t71 = 1.6177742431429796 - t70
-    t72 = t71 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t71))
-    t73 = t72 - 6.283185307179586*xp.floor(0.15915494309189535*(3.9269908169872414 + t72))
+    t72 = -6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t71)) + t71
+    t73 = -6.283185307179586*xp.floor(0.15915494309189535*(3.9269908169872414 + t72)) + t72
     t74 = 1.6177742431429796 + t70
-    t75 = t74 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t74))
-    t76 = t75 - 6.283185307179586*xp.floor(0.15915494309189535*(3.9269908169872414 + t75))
+    t75 = -6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t74)) + t74
+    t76 = -6.283185307179586*xp.floor(0.15915494309189535*(3.9269908169872414 + t75)) + t75
     t77 = 0.9988967406110469*t67
     t78 = 0.04696063880130675*t69
     t79 = -(t77 + t78)
     t80 = -t78 + t77
     t81 = 0.15005*(1 - t79)
-    t82 = t81 + 0.15005*t79
+    t82 = 0.15005*t79 + t81
     t83 = 0.15005*(1 - t80)
-    t84 = t83 + 0.15005*t80
+    t84 = 0.15005*t80 + t83
     t85 = 0.04696063880130675*t67
     t86 = 0.9988967406110469*t69
     t87 = -t85 + t86
-    t88 = t85 + t86
-    t89 = -0.4318*t87 + 0.0203*t79
-    t90 = 0.0203*t87 + 0.4318*t79
+    t88 = t86 + t85
+    t89 = 0.0203*t79 - 0.4318*t87
+    t90 = 0.4318*t79 + 0.0203*t87
     t91 = 0.4318 + t89
     t92 = 0.67183 + t90
     t93 = -0.67183 + t92
     t94 = t42*t93 - t57*t91
-    t95 = t82**2 + t91**2 + t93**2
-    t96 = -0.4318*t88 + 0.0203*t80
-    t97 = 0.0203*t88 + 0.4318*t80
+    t95 = t91**2 + t93**2 + t82**2
+    t96 = 0.0203*t80 - 0.4318*t88
+    t97 = 0.4318*t80 + 0.0203*t88
     t98 = 0.4318 + t96
     t99 = 0.67183 + t97
     t100 = -0.67183 + t99
     t101 = t42*t100 - t57*t98
-    t102 = t84**2 + t98**2 + t100**2
+    t102 = t98**2 + t100**2 + t84**2
     t103 = t43*t82
     t104 = t42*t91 + t57*t93 - t103
-    t105 = t104 + t103
+    t105 = t103 + t104
     t106 = t105**2 + t94**2
     t107 = 1e-24*t58
-    t108 = xp.less_equal(t106, t95*t107)
+    t108 = xp.less_equal(t106, t107*t95)
     t109 = xp.where(t108, 1, 1/xp.sqrt(t106))
     t110 = xp.where(t108, 1, t105*t109)
     t111 = xp.where(t108, 0, -t94*t109)
     t112 = t79*t110 - t87*t111
     t113 = t79*t111 + t87*t110
     t114 = t112*t44 + t113*t61
-    t115 = t112*t61 - t113*t44
+    t115 = t112*t61 - t44*t113
     t116 = t112*t46 + t113*t63
     t117 = t112*t63 - t113*t46
     t118 = xp.where(t108, 0, xp.atan2(-t94, t105))
-    t119 = t118 - 6.283185307179586*xp.floor(0.15915494309189535*(0.7853981633974483 + t118))
+    t119 = -6.283185307179586*xp.floor(0.15915494309189535*(0.7853981633974483 + t118)) + t118
     t120 = 1 - t112
     t121 = t45*t120
-    t122 = t121 + t112*t45
-    t123 = t47*t120
+    t122 = t121 + t45*t112
+    t123 = t120*t47
     t124 = t123 + t112*t47
     t125 = t115**2
     t126 = -t125
@@ -2362,38 +2364,38 @@ def ik_branches(T):
     t128 = xp.greater(t127, 1e-12)
     t129 = xp.where(t128, xp.sqrt(t127), 0)
     t130 = t125 + t114*t129
-    t131 = t130 + t126
-    t132 = t122**2
-    t133 = t114**2 + t132 + t125
-    t134 = t129**2
+    t131 = t126 + t130
+    t132 = t129**2
+    t133 = t125 + t132
+    t134 = t122**2
     t135 = t131**2 + t132*t134
-    t136 = t125 + t134
-    t137 = 1e-24*t136
-    t138 = xp.less_equal(t135, t133*t137)
+    t136 = t125 + t114**2 + t134
+    t137 = 1e-24*t133
+    t138 = xp.less_equal(t135, t137*t136)
     t139 = xp.where(t138, 1, 1/xp.sqrt(t135))
     t140 = xp.where(t138, 1, t131*t139)
     t141 = t117*(1 - t140)
     t142 = t141 + t117*t140
-    t143 = t122*t129
-    t144 = xp.where(t138, 0, t139*t143)
-    t145 = t116*t140 + t124*t144
-    t146 = t124*t140 - t116*t144
-    t147 = xp.less_equal(t136, t137)
-    t148 = xp.where(t147, 1, 1/xp.sqrt(t136))
+    t143 = t129*t122
+    t144 = xp.where(t138, 0, t143*t139)
+    t145 = t140*t116 + t124*t144
+    t146 = t140*t124 - t116*t144
+    t147 = xp.less_equal(t133, t137)
+    t148 = xp.where(t147, 1, 1/xp.sqrt(t133))
     t149 = xp.where(t147, 1, t115*t148)
     t150 = xp.where(t147, 0, -t129*t148)
     t151 = t146*(1 - t149)
     t152 = t149*t145 + t150*t142
-    t153 = t151 + t149*t146
-    t154 = t149*t142 - t150*t145
+    t153 = t151 + t146*t149
+    t154 = t149*t142 - t145*t150
     t155 = t152**2 + t153**2
     t156 = t155
-    t157 = t154**2 + t155
+    t157 = t155 + t154**2
     t158 = t43*t84
     t159 = t42*t98 + t57*t100 - t158
-    t160 = t159 + t158
+    t160 = t158 + t159
     t161 = t160**2 + t101**2
-    t162 = xp.less_equal(t161, t102*t107)
+    t162 = xp.less_equal(t161, t107*t102)
     t163 = xp.where(t162, 1, 1/xp.sqrt(t161))
     t164 = xp.where(t162, 1, t160*t163)
     t165 = xp.where(t162, 0, -t101*t163)
@@ -2404,7 +2406,7 @@ def ik_branches(T):
     t170 = t46*t166 + t63*t167
     t171 = t63*t166 - t46*t167
     t172 = xp.where(t162, 0, xp.atan2(-t101, t160))
-    t173 = t172 - 6.283185307179586*xp.floor(0.15915494309189535*(0.7853981633974483 + t172))
+    t173 = -6.283185307179586*xp.floor(0.15915494309189535*(0.7853981633974483 + t172)) + t172
     t174 = 1 - t166
     t175 = t45*t174
     t176 = t175 + t45*t166
@@ -2416,33 +2418,33 @@ def ik_branches(T):
     t182 = xp.greater(t181, 1e-12)
     t183 = xp.where(t182, xp.sqrt(t181), 0)
     t184 = t179 + t168*t183
-    t185 = t184 + t180
-    t186 = t176**2
-    t187 = t168**2 + t186 + t179
-    t188 = t183**2
+    t185 = t180 + t184
+    t186 = t183**2
+    t187 = t179 + t186
+    t188 = t176**2
     t189 = t185**2 + t186*t188
-    t190 = t179 + t188
-    t191 = 1e-24*t190
-    t192 = xp.less_equal(t189, t187*t191)
+    t190 = t179 + t168**2 + t188
+    t191 = 1e-24*t187
+    t192 = xp.less_equal(t189, t191*t190)
     t193 = xp.where(t192, 1, 1/xp.sqrt(t189))
     t194 = xp.where(t192, 1, t185*t193)
     t195 = t171*(1 - t194)
     t196 = t195 + t171*t194
-    t197 = t176*t183
-    t198 = xp.where(t192, 0, t193*t197)
-    t199 = t170*t194 + t178*t198
-    t200 = t178*t194 - t170*t198
-    t201 = xp.less_equal(t190, t191)
-    t202 = xp.where(t201, 1, 1/xp.sqrt(t190))
+    t197 = t183*t176
+    t198 = xp.where(t192, 0, t197*t193)
+    t199 = t194*t170 + t178*t198
+    t200 = t194*t178 - t170*t198
+    t201 = xp.less_equal(t187, t191)
+    t202 = xp.where(t201, 1, 1/xp.sqrt(t187))
     t203 = xp.where(t201, 1, t169*t202)
     t204 = xp.where(t201, 0, -t183*t202)
     t205 = t200*(1 - t203)
     t206 = t203*t199 + t204*t196
-    t207 = t205 + t203*t200
-    t208 = t203*t196 - t204*t199
+    t207 = t205 + t200*t203
+    t208 = t203*t196 - t199*t204
     t209 = t206**2 + t207**2
     t210 = t209
-    t211 = t208**2 + t209
+    t211 = t209 + t208**2
     t212 = 1 - t37
     t213 = t13*t212
     t214 = t213 + t13*t37
@@ -2462,57 +2464,57 @@ def ik_branches(T):
     t228 = xp.atan2(t225, t227)
     t229 = 1.6177742431429796 + t228
     t230 = 1.6177742431429796 - t228
-    t231 = t229 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t229))
-    t232 = t231 - 6.283185307179586*xp.floor(0.15915494309189535*(3.9269908169872414 + t231))
-    t233 = t230 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t230))
-    t234 = t233 - 6.283185307179586*xp.floor(0.15915494309189535*(3.9269908169872414 + t233))
+    t231 = -6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t229)) + t229
+    t232 = -6.283185307179586*xp.floor(0.15915494309189535*(3.9269908169872414 + t231)) + t231
+    t233 = -6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t230)) + t230
+    t234 = -6.283185307179586*xp.floor(0.15915494309189535*(3.9269908169872414 + t233)) + t233
     t235 = 0.9988967406110469*t225
     t236 = 0.04696063880130675*t227
     t237 = -(t235 + t236)
     t238 = -t236 + t235
     t239 = 0.15005*(1 - t237)
-    t240 = t239 + 0.15005*t237
+    t240 = 0.15005*t237 + t239
     t241 = 0.15005*(1 - t238)
-    t242 = t241 + 0.15005*t238
+    t242 = 0.15005*t238 + t241
     t243 = 0.04696063880130675*t225
     t244 = 0.9988967406110469*t227
     t245 = -t243 + t244
-    t246 = t243 + t244
-    t247 = -0.4318*t245 + 0.0203*t237
-    t248 = 0.0203*t245 + 0.4318*t237
+    t246 = t244 + t243
+    t247 = 0.0203*t237 - 0.4318*t245
+    t248 = 0.4318*t237 + 0.0203*t245
     t249 = 0.4318 + t247
     t250 = 0.67183 + t248
     t251 = -0.67183 + t250
     t252 = t48*t251 - t215*t249
-    t253 = t240**2 + t249**2 + t251**2
-    t254 = -0.4318*t246 + 0.0203*t238
-    t255 = 0.0203*t246 + 0.4318*t238
+    t253 = t249**2 + t251**2 + t240**2
+    t254 = 0.0203*t238 - 0.4318*t246
+    t255 = 0.4318*t238 + 0.0203*t246
     t256 = 0.4318 + t254
     t257 = 0.67183 + t255
     t258 = -0.67183 + t257
     t259 = t48*t258 - t215*t256
-    t260 = t242**2 + t256**2 + t258**2
+    t260 = t256**2 + t258**2 + t242**2
     t261 = t49*t240
     t262 = t48*t249 + t215*t251 - t261
-    t263 = t262 + t261
+    t263 = t261 + t262
     t264 = t263**2 + t252**2
     t265 = 1e-24*t216
-    t266 = xp.less_equal(t264, t253*t265)
+    t266 = xp.less_equal(t264, t265*t253)
     t267 = xp.where(t266, 1, 1/xp.sqrt(t264))
     t268 = xp.where(t266, 1, t263*t267)
     t269 = xp.where(t266, 0, -t252*t267)
     t270 = t237*t268 - t245*t269
     t271 = t237*t269 + t245*t268
     t272 = t270*t50 + t271*t219
-    t273 = t270*t219 - t271*t50
+    t273 = t270*t219 - t50*t271
     t274 = t270*t52 + t271*t221
     t275 = t270*t221 - t271*t52
     t276 = xp.where(t266, 0, xp.atan2(-t252, t263))
-    t277 = t276 - 6.283185307179586*xp.floor(0.15915494309189535*(0.7853981633974483 + t276))
+    t277 = -6.283185307179586*xp.floor(0.15915494309189535*(0.7853981633974483 + t276)) + t276
     t278 = 1 - t270
     t279 = t51*t278
-    t280 = t279 + t270*t51
-    t281 = t53*t278
+    t280 = t279 + t51*t270
+    t281 = t278*t53
     t282 = t281 + t270*t53
     t283 = t273**2
     t284 = -t283
@@ -2520,38 +2522,38 @@ def ik_branches(T):
     t286 = xp.greater(t285, 1e-12)
     t287 = xp.where(t286, xp.sqrt(t285), 0)
     t288 = t283 + t272*t287
-    t289 = t288 + t284
-    t290 = t280**2
-    t291 = t272**2 + t290 + t283
-    t292 = t287**2
+    t289 = t284 + t288
+    t290 = t287**2
+    t291 = t283 + t290
+    t292 = t280**2
     t293 = t289**2 + t290*t292
-    t294 = t283 + t292
-    t295 = 1e-24*t294
-    t296 = xp.less_equal(t293, t291*t295)
+    t294 = t283 + t272**2 + t292
+    t295 = 1e-24*t291
+    t296 = xp.less_equal(t293, t295*t294)
     t297 = xp.where(t296, 1, 1/xp.sqrt(t293))
     t298 = xp.where(t296, 1, t289*t297)
     t299 = t275*(1 - t298)
     t300 = t299 + t275*t298
-    t301 = t280*t287
-    t302 = xp.where(t296, 0, t297*t301)
-    t303 = t274*t298 + t282*t302
-    t304 = t282*t298 - t274*t302
-    t305 = xp.less_equal(t294, t295)
-    t306 = xp.where(t305, 1, 1/xp.sqrt(t294))
+    t301 = t287*t280
+    t302 = xp.where(t296, 0, t301*t297)
+    t303 = t298*t274 + t282*t302
+    t304 = t298*t282 - t274*t302
+    t305 = xp.less_equal(t291, t295)
+    t306 = xp.where(t305, 1, 1/xp.sqrt(t291))
     t307 = xp.where(t305, 1, t273*t306)
     t308 = xp.where(t305, 0, -t287*t306)
     t309 = t304*(1 - t307)
     t310 = t307*t303 + t308*t300
-    t311 = t309 + t307*t304
-    t312 = t307*t300 - t308*t303
+    t311 = t309 + t304*t307
+    t312 = t307*t300 - t303*t308
     t313 = t310**2 + t311**2
     t314 = t313
-    t315 = t312**2 + t313
+    t315 = t313 + t312**2
     t316 = t49*t242
     t317 = t48*t256 + t215*t258 - t316
-    t318 = t317 + t316
+    t318 = t316 + t317
     t319 = t318**2 + t259**2
-    t320 = xp.less_equal(t319, t260*t265)
+    t320 = xp.less_equal(t319, t265*t260)
     t321 = xp.where(t320, 1, 1/xp.sqrt(t319))
     t322 = xp.where(t320, 1, t318*t321)
     t323 = xp.where(t320, 0, -t259*t321)
@@ -2562,7 +2564,7 @@ def ik_branches(T):
     t328 = t52*t324 + t221*t325
     t329 = t221*t324 - t52*t325
     t330 = xp.where(t320, 0, xp.atan2(-t259, t318))
-    t331 = t330 - 6.283185307179586*xp.floor(0.15915494309189535*(0.7853981633974483 + t330))
+    t331 = -6.283185307179586*xp.floor(0.15915494309189535*(0.7853981633974483 + t330)) + t330
     t332 = 1 - t324
     t333 = t51*t332
     t334 = t333 + t51*t324
@@ -2574,97 +2576,97 @@ def ik_branches(T):
     t340 = xp.greater(t339, 1e-12)
     t341 = xp.where(t340, xp.sqrt(t339), 0)
     t342 = t337 + t326*t341
-    t343 = t342 + t338
-    t344 = t334**2
-    t345 = t326**2 + t344 + t337
-    t346 = t341**2
+    t343 = t338 + t342
+    t344 = t341**2
+    t345 = t337 + t344
+    t346 = t334**2
     t347 = t343**2 + t344*t346
-    t348 = t337 + t346
-    t349 = 1e-24*t348
-    t350 = xp.less_equal(t347, t345*t349)
+    t348 = t337 + t326**2 + t346
+    t349 = 1e-24*t345
+    t350 = xp.less_equal(t347, t348*t349)
     t351 = xp.where(t350, 1, 1/xp.sqrt(t347))
     t352 = xp.where(t350, 1, t343*t351)
     t353 = t329*(1 - t352)
     t354 = t353 + t329*t352
-    t355 = t334*t341
+    t355 = t341*t334
     t356 = xp.where(t350, 0, t351*t355)
-    t357 = t328*t352 + t336*t356
-    t358 = t336*t352 - t328*t356
-    t359 = xp.less_equal(t348, t349)
-    t360 = xp.where(t359, 1, 1/xp.sqrt(t348))
+    t357 = t352*t328 + t336*t356
+    t358 = t352*t336 - t328*t356
+    t359 = xp.less_equal(t345, t349)
+    t360 = xp.where(t359, 1, 1/xp.sqrt(t345))
     t361 = xp.where(t359, 1, t327*t360)
     t362 = xp.where(t359, 0, -t341*t360)
     t363 = t358*(1 - t361)
     t364 = t361*t357 + t362*t354
-    t365 = t363 + t361*t358
-    t366 = t361*t354 - t362*t357
+    t365 = t363 + t358*t361
+    t366 = t361*t354 - t357*t362
     t367 = t364**2 + t365**2
     t368 = t367
     t369 = t366**2 + t367
     t370 = xp.where(t138, 0, xp.atan2(t143, t131))
     t371 = t370
-    t372 = t371 - 6.283185307179586*xp.floor(0.15915494309189535*(1.9198621771937625 + t371))
+    t372 = -6.283185307179586*xp.floor(0.15915494309189535*(1.9198621771937625 + t371)) + t371
     t373 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t370) + t370
-    t374 = t373 - 6.283185307179586*xp.floor(0.15915494309189535*(1.9198621771937625 + t373))
+    t374 = -6.283185307179586*xp.floor(0.15915494309189535*(1.9198621771937625 + t373)) + t373
     t375 = xp.where(t147, 0, xp.atan2(-t129, t115))
     t376 = t375
-    t377 = t376 - 6.283185307179586*xp.floor(0.15915494309189535*(1.7453292519943295 + t376))
-    t378 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t375)) + t375
+    t377 = -6.283185307179586*xp.floor(0.15915494309189535*(1.7453292519943295 + t376)) + t376
+    t378 = t375 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t375))
     t379 = xp.where(xp.less_equal(t156, 1e-24*t157), 0, xp.atan2(t153, t152))
     t380 = t379
-    t381 = t380 - 6.283185307179586*xp.floor(0.15915494309189535*(4.642575810304916 + t380))
+    t381 = -6.283185307179586*xp.floor(0.15915494309189535*(4.642575810304916 + t380)) + t380
     t382 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t379) + t379
-    t383 = t382 - 6.283185307179586*xp.floor(0.15915494309189535*(4.642575810304916 + t382))
+    t383 = -6.283185307179586*xp.floor(0.15915494309189535*(4.642575810304916 + t382)) + t382
     t384 = -t378
-    t385 = t378 + 6.283185307179586*xp.floor(0.15915494309189535*(1.7453292519943295 + t384))
+    t385 = 6.283185307179586*xp.floor(0.15915494309189535*(1.7453292519943295 + t384)) + t378
     t386 = xp.where(t192, 0, xp.atan2(t197, t185))
     t387 = t386
-    t388 = t387 - 6.283185307179586*xp.floor(0.15915494309189535*(1.9198621771937625 + t387))
+    t388 = -6.283185307179586*xp.floor(0.15915494309189535*(1.9198621771937625 + t387)) + t387
     t389 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t386) + t386
-    t390 = t389 - 6.283185307179586*xp.floor(0.15915494309189535*(1.9198621771937625 + t389))
+    t390 = -6.283185307179586*xp.floor(0.15915494309189535*(1.9198621771937625 + t389)) + t389
     t391 = xp.where(t201, 0, xp.atan2(-t183, t169))
     t392 = t391
-    t393 = t392 - 6.283185307179586*xp.floor(0.15915494309189535*(1.7453292519943295 + t392))
+    t393 = -6.283185307179586*xp.floor(0.15915494309189535*(1.7453292519943295 + t392)) + t392
     t394 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t391)) + t391
     t395 = xp.where(xp.less_equal(t210, 1e-24*t211), 0, xp.atan2(t207, t206))
     t396 = t395
-    t397 = t396 - 6.283185307179586*xp.floor(0.15915494309189535*(4.642575810304916 + t396))
+    t397 = -6.283185307179586*xp.floor(0.15915494309189535*(4.642575810304916 + t396)) + t396
     t398 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t395) + t395
-    t399 = t398 - 6.283185307179586*xp.floor(0.15915494309189535*(4.642575810304916 + t398))
+    t399 = -6.283185307179586*xp.floor(0.15915494309189535*(4.642575810304916 + t398)) + t398
     t400 = -t394
-    t401 = t394 + 6.283185307179586*xp.floor(0.15915494309189535*(1.7453292519943295 + t400))
+    t401 = 6.283185307179586*xp.floor(0.15915494309189535*(1.7453292519943295 + t400)) + t394
     t402 = xp.where(t296, 0, xp.atan2(t301, t289))
     t403 = t402
-    t404 = t403 - 6.283185307179586*xp.floor(0.15915494309189535*(1.9198621771937625 + t403))
+    t404 = -6.283185307179586*xp.floor(0.15915494309189535*(1.9198621771937625 + t403)) + t403
     t405 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t402) + t402
-    t406 = t405 - 6.283185307179586*xp.floor(0.15915494309189535*(1.9198621771937625 + t405))
+    t406 = -6.283185307179586*xp.floor(0.15915494309189535*(1.9198621771937625 + t405)) + t405
     t407 = xp.where(t305, 0, xp.atan2(-t287, t273))
     t408 = t407
-    t409 = t408 - 6.283185307179586*xp.floor(0.15915494309189535*(1.7453292519943295 + t408))
+    t409 = -6.283185307179586*xp.floor(0.15915494309189535*(1.7453292519943295 + t408)) + t408
     t410 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t407)) + t407
     t411 = xp.where(xp.less_equal(t314, 1e-24*t315), 0, xp.atan2(t311, t310))
     t412 = t411
-    t413 = t412 - 6.283185307179586*xp.floor(0.15915494309189535*(4.642575810304916 + t412))
+    t413 = -6.283185307179586*xp.floor(0.15915494309189535*(4.642575810304916 + t412)) + t412
     t414 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t411) + t411
-    t415 = t414 - 6.283185307179586*xp.floor(0.15915494309189535*(4.642575810304916 + t414))
+    t415 = -6.283185307179586*xp.floor(0.15915494309189535*(4.642575810304916 + t414)) + t414
     t416 = -t410
-    t417 = t410 + 6.283185307179586*xp.floor(0.15915494309189535*(1.7453292519943295 + t416))
+    t417 = 6.283185307179586*xp.floor(0.15915494309189535*(1.7453292519943295 + t416)) + t410
     t418 = xp.where(t350, 0, xp.atan2(t355, t343))
     t419 = t418
-    t420 = t419 - 6.283185307179586*xp.floor(0.15915494309189535*(1.9198621771937625 + t419))
+    t420 = -6.283185307179586*xp.floor(0.15915494309189535*(1.9198621771937625 + t419)) + t419
     t421 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t418) + t418
-    t422 = t421 - 6.283185307179586*xp.floor(0.15915494309189535*(1.9198621771937625 + t421))
+    t422 = -6.283185307179586*xp.floor(0.15915494309189535*(1.9198621771937625 + t421)) + t421
     t423 = xp.where(t359, 0, xp.atan2(-t341, t327))
     t424 = t423
-    t425 = t424 - 6.283185307179586*xp.floor(0.15915494309189535*(1.7453292519943295 + t424))
+    t425 = -6.283185307179586*xp.floor(0.15915494309189535*(1.7453292519943295 + t424)) + t424
     t426 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t423)) + t423
     t427 = xp.where(xp.less_equal(t368, 1e-24*t369), 0, xp.atan2(t365, t364))
     t428 = t427
-    t429 = t428 - 6.283185307179586*xp.floor(0.15915494309189535*(4.642575810304916 + t428))
+    t429 = -6.283185307179586*xp.floor(0.15915494309189535*(4.642575810304916 + t428)) + t428
     t430 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t427) + t427
-    t431 = t430 - 6.283185307179586*xp.floor(0.15915494309189535*(4.642575810304916 + t430))
+    t431 = -6.283185307179586*xp.floor(0.15915494309189535*(4.642575810304916 + t430)) + t430
     t432 = -t426
-    t433 = t426 + 6.283185307179586*xp.floor(0.15915494309189535*(1.7453292519943295 + t432))
+    t433 = 6.283185307179586*xp.floor(0.15915494309189535*(1.7453292519943295 + t432)) + t426
     t434 = xp.less_equal(t29, 2.792526803190927)
     t435 = xp.greater_equal(t28, -2.792526803190927) & xp.less_equal(t28, 2.792526803190927)
     t436 = xp.where(t434 & xp.logical_not(t435), t29, t28)
@@ -2928,87 +2930,87 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     lb5 = branches_in_limits[..., 5]
     lb6 = branches_in_limits[..., 6]
     lb7 = branches_in_limits[..., 7]
-    t0 = qb0_0 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn1 - qb0_0))
-    t1 = qb0_1 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn2 - qb0_1))
-    t2 = qb0_2 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn3 - qb0_2))
-    t3 = qb0_3 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn4 - qb0_3))
-    t4 = qb0_4 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn5 - qb0_4))
-    t5 = qb0_5 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn6 - qb0_5))
+    t0 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_0 + qn1)) + qb0_0
+    t1 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_1 + qn2)) + qb0_1
+    t2 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_2 + qn3)) + qb0_2
+    t3 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_3 + qn4)) + qb0_3
+    t4 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_4 + qn5)) + qb0_4
+    t5 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_5 + qn6)) + qb0_5
     t6 = xp.where(lb0 & vb0, xp.asarray(1, dtype=dtype), 0)
     t7 = xp.where(xp.greater(t6, 0), xp.asarray(1, dtype=dtype), 0)
-    t8 = qb1_0 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn1 - qb1_0))
-    t9 = qb1_1 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn2 - qb1_1))
-    t10 = qb1_2 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn3 - qb1_2))
-    t11 = qb1_3 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn4 - qb1_3))
-    t12 = qb1_4 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn5 - qb1_4))
-    t13 = qb1_5 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn6 - qb1_5))
+    t8 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_0 + qn1)) + qb1_0
+    t9 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_1 + qn2)) + qb1_1
+    t10 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_2 + qn3)) + qb1_2
+    t11 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_3 + qn4)) + qb1_3
+    t12 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_4 + qn5)) + qb1_4
+    t13 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_5 + qn6)) + qb1_5
     t14 = xp.where(lb1 & vb1, xp.asarray(1, dtype=dtype), 0)
-    t15 = qb2_0 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn1 - qb2_0))
-    t16 = qb2_1 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn2 - qb2_1))
-    t17 = qb2_2 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn3 - qb2_2))
-    t18 = qb2_3 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn4 - qb2_3))
-    t19 = qb2_4 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn5 - qb2_4))
-    t20 = qb2_5 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn6 - qb2_5))
+    t15 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_0 + qn1)) + qb2_0
+    t16 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_1 + qn2)) + qb2_1
+    t17 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_2 + qn3)) + qb2_2
+    t18 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_3 + qn4)) + qb2_3
+    t19 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_4 + qn5)) + qb2_4
+    t20 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_5 + qn6)) + qb2_5
     t21 = xp.where(lb2 & vb2, xp.asarray(1, dtype=dtype), 0)
-    t22 = qb3_0 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn1 - qb3_0))
-    t23 = qb3_1 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn2 - qb3_1))
-    t24 = qb3_2 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn3 - qb3_2))
-    t25 = qb3_3 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn4 - qb3_3))
-    t26 = qb3_4 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn5 - qb3_4))
-    t27 = qb3_5 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn6 - qb3_5))
+    t22 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_0 + qn1)) + qb3_0
+    t23 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_1 + qn2)) + qb3_1
+    t24 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_2 + qn3)) + qb3_2
+    t25 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_3 + qn4)) + qb3_3
+    t26 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_4 + qn5)) + qb3_4
+    t27 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_5 + qn6)) + qb3_5
     t28 = xp.where(lb3 & vb3, xp.asarray(1, dtype=dtype), 0)
-    t29 = qb4_0 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn1 - qb4_0))
-    t30 = qb4_1 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn2 - qb4_1))
-    t31 = qb4_2 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn3 - qb4_2))
-    t32 = qb4_3 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn4 - qb4_3))
-    t33 = qb4_4 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn5 - qb4_4))
-    t34 = qb4_5 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn6 - qb4_5))
+    t29 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_0 + qn1)) + qb4_0
+    t30 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_1 + qn2)) + qb4_1
+    t31 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_2 + qn3)) + qb4_2
+    t32 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_3 + qn4)) + qb4_3
+    t33 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_4 + qn5)) + qb4_4
+    t34 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_5 + qn6)) + qb4_5
     t35 = xp.where(lb4 & vb4, xp.asarray(1, dtype=dtype), 0)
-    t36 = qb5_0 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn1 - qb5_0))
-    t37 = qb5_1 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn2 - qb5_1))
-    t38 = qb5_2 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn3 - qb5_2))
-    t39 = qb5_3 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn4 - qb5_3))
-    t40 = qb5_4 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn5 - qb5_4))
-    t41 = qb5_5 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn6 - qb5_5))
+    t36 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_0 + qn1)) + qb5_0
+    t37 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_1 + qn2)) + qb5_1
+    t38 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_2 + qn3)) + qb5_2
+    t39 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_3 + qn4)) + qb5_3
+    t40 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_4 + qn5)) + qb5_4
+    t41 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_5 + qn6)) + qb5_5
     t42 = xp.where(lb5 & vb5, xp.asarray(1, dtype=dtype), 0)
-    t43 = qb6_0 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn1 - qb6_0))
-    t44 = qb6_1 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn2 - qb6_1))
-    t45 = qb6_2 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn3 - qb6_2))
-    t46 = qb6_3 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn4 - qb6_3))
-    t47 = qb6_4 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn5 - qb6_4))
-    t48 = qb6_5 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn6 - qb6_5))
+    t43 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_0 + qn1)) + qb6_0
+    t44 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_1 + qn2)) + qb6_1
+    t45 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_2 + qn3)) + qb6_2
+    t46 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_3 + qn4)) + qb6_3
+    t47 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_4 + qn5)) + qb6_4
+    t48 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_5 + qn6)) + qb6_5
     t49 = xp.where(lb6 & vb6, xp.asarray(1, dtype=dtype), 0)
-    t50 = qb7_0 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn1 - qb7_0))
-    t51 = qb7_1 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn2 - qb7_1))
-    t52 = qb7_2 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn3 - qb7_2))
-    t53 = qb7_3 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn4 - qb7_3))
-    t54 = qb7_4 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn5 - qb7_4))
-    t55 = qb7_5 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn6 - qb7_5))
+    t50 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_0 + qn1)) + qb7_0
+    t51 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_1 + qn2)) + qb7_1
+    t52 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_2 + qn3)) + qb7_2
+    t53 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_3 + qn4)) + qb7_3
+    t54 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_4 + qn5)) + qb7_4
+    t55 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_5 + qn6)) + qb7_5
     t56 = xp.where(lb7 & vb7, xp.asarray(1, dtype=dtype), 0)
-    t57 = T00 + T01 + T02 + T03 + T10 + T11 + T12 + T13 + T20 + T21 + T22 + T23 + qn1 + qn2 + qn3 + qn4 + qn5 + qn6 + qw1 + qw2 + qw3 + qw4 + qw5 + qw6
+    t57 = T00 + T01 + T02 + T10 + T11 + T12 + T20 + T21 + T22 + T03 + T13 + T23 + qn1 + qn2 + qn3 + qn4 + qn5 + qn6 + qw1 + qw2 + qw3 + qw4 + qw5 + qw6
     t58 = xp.where(xp.less(t0, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t59 = t0 + t58
-    t60 = t0 - t58
+    t60 = -t58 + t0
     t61 = xp.where(xp.greater_equal(t0, -2.792526803190927) & xp.less_equal(t0, 2.792526803190927), t0, xp.where(xp.greater_equal(t59, -2.792526803190927) & xp.less_equal(t59, 2.792526803190927), t59, xp.where(xp.greater_equal(t60, -2.792526803190927) & xp.less_equal(t60, 2.792526803190927), t60, qb0_0)))
     t62 = xp.where(xp.less(t1, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t63 = t1 + t62
-    t64 = t1 - t62
+    t64 = -t62 + t1
     t65 = xp.where(xp.greater_equal(t1, -0.7853981633974483) & xp.less_equal(t1, 3.9269908169872414), t1, xp.where(xp.greater_equal(t63, -0.7853981633974483) & xp.less_equal(t63, 3.9269908169872414), t63, xp.where(xp.greater_equal(t64, -0.7853981633974483) & xp.less_equal(t64, 3.9269908169872414), t64, qb0_1)))
     t66 = xp.where(xp.less(t2, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t67 = t2 + t66
-    t68 = t2 - t66
+    t68 = -t66 + t2
     t69 = xp.where(xp.greater_equal(t2, -3.9269908169872414) & xp.less_equal(t2, 0.7853981633974483), t2, xp.where(xp.greater_equal(t67, -3.9269908169872414) & xp.less_equal(t67, 0.7853981633974483), t67, xp.where(xp.greater_equal(t68, -3.9269908169872414) & xp.less_equal(t68, 0.7853981633974483), t68, qb0_2)))
     t70 = xp.where(xp.less(t3, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t71 = t3 + t70
-    t72 = t3 - t70
+    t72 = -t70 + t3
     t73 = xp.where(xp.greater_equal(t3, -1.9198621771937625) & xp.less_equal(t3, 2.9670597283903604), t3, xp.where(xp.greater_equal(t71, -1.9198621771937625) & xp.less_equal(t71, 2.9670597283903604), t71, xp.where(xp.greater_equal(t72, -1.9198621771937625) & xp.less_equal(t72, 2.9670597283903604), t72, qb0_3)))
     t74 = xp.where(xp.less(t4, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t75 = t4 + t74
-    t76 = t4 - t74
+    t76 = -t74 + t4
     t77 = xp.where(xp.greater_equal(t4, -1.7453292519943295) & xp.less_equal(t4, 1.7453292519943295), t4, xp.where(xp.greater_equal(t75, -1.7453292519943295) & xp.less_equal(t75, 1.7453292519943295), t75, xp.where(xp.greater_equal(t76, -1.7453292519943295) & xp.less_equal(t76, 1.7453292519943295), t76, qb0_4)))
     t78 = xp.where(xp.less(t5, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t79 = t5 + t78
-    t80 = t5 - t78
+    t80 = -t78 + t5
     t81 = xp.where(xp.greater_equal(t5, -4.642575810304916) & xp.less_equal(t5, 4.642575810304916), t5, xp.where(xp.greater_equal(t79, -4.642575810304916) & xp.less_equal(t79, 4.642575810304916), t79, xp.where(xp.greater_equal(t80, -4.642575810304916) & xp.less_equal(t80, 4.642575810304916), t80, qb0_5)))
     t82 = -qn1
     t83 = -qn2
@@ -3016,7 +3018,7 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     t85 = -qn4
     t86 = -qn5
     t87 = -qn6
-    t88 = qw1*(t61 + t82)**2 + qw2*(t65 + t83)**2 + qw3*(t69 + t84)**2 + qw4*(t73 + t85)**2 + qw5*(t77 + t86)**2 + qw6*(t81 + t87)**2
+    t88 = qw1*(t82 + t61)**2 + qw2*(t83 + t65)**2 + qw3*(t84 + t69)**2 + qw4*(t85 + t73)**2 + qw5*(t86 + t77)**2 + qw6*(t87 + t81)**2
     t89 = xp.greater(t7, 0)
     t90 = xp.where(t89, t61, qn1)
     t91 = xp.where(t89, t65, qn2)
@@ -3027,29 +3029,29 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     t96 = xp.where(t89, t88, 0)
     t97 = xp.where(xp.less(t8, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t98 = t8 + t97
-    t99 = t8 - t97
+    t99 = -t97 + t8
     t100 = xp.where(xp.greater_equal(t8, -2.792526803190927) & xp.less_equal(t8, 2.792526803190927), t8, xp.where(xp.greater_equal(t98, -2.792526803190927) & xp.less_equal(t98, 2.792526803190927), t98, xp.where(xp.greater_equal(t99, -2.792526803190927) & xp.less_equal(t99, 2.792526803190927), t99, qb1_0)))
     t101 = xp.where(xp.less(t9, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t102 = t9 + t101
-    t103 = t9 - t101
+    t103 = -t101 + t9
     t104 = xp.where(xp.greater_equal(t9, -0.7853981633974483) & xp.less_equal(t9, 3.9269908169872414), t9, xp.where(xp.greater_equal(t102, -0.7853981633974483) & xp.less_equal(t102, 3.9269908169872414), t102, xp.where(xp.greater_equal(t103, -0.7853981633974483) & xp.less_equal(t103, 3.9269908169872414), t103, qb1_1)))
     t105 = xp.where(xp.less(t10, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t106 = t10 + t105
-    t107 = t10 - t105
+    t107 = -t105 + t10
     t108 = xp.where(xp.greater_equal(t10, -3.9269908169872414) & xp.less_equal(t10, 0.7853981633974483), t10, xp.where(xp.greater_equal(t106, -3.9269908169872414) & xp.less_equal(t106, 0.7853981633974483), t106, xp.where(xp.greater_equal(t107, -3.9269908169872414) & xp.less_equal(t107, 0.7853981633974483), t107, qb1_2)))
     t109 = xp.where(xp.less(t11, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t110 = t11 + t109
-    t111 = t11 - t109
+    t111 = -t109 + t11
     t112 = xp.where(xp.greater_equal(t11, -1.9198621771937625) & xp.less_equal(t11, 2.9670597283903604), t11, xp.where(xp.greater_equal(t110, -1.9198621771937625) & xp.less_equal(t110, 2.9670597283903604), t110, xp.where(xp.greater_equal(t111, -1.9198621771937625) & xp.less_equal(t111, 2.9670597283903604), t111, qb1_3)))
     t113 = xp.where(xp.less(t12, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t114 = t12 + t113
-    t115 = t12 - t113
+    t115 = -t113 + t12
     t116 = xp.where(xp.greater_equal(t12, -1.7453292519943295) & xp.less_equal(t12, 1.7453292519943295), t12, xp.where(xp.greater_equal(t114, -1.7453292519943295) & xp.less_equal(t114, 1.7453292519943295), t114, xp.where(xp.greater_equal(t115, -1.7453292519943295) & xp.less_equal(t115, 1.7453292519943295), t115, qb1_4)))
     t117 = xp.where(xp.less(t13, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t118 = t13 + t117
-    t119 = t13 - t117
+    t119 = -t117 + t13
     t120 = xp.where(xp.greater_equal(t13, -4.642575810304916) & xp.less_equal(t13, 4.642575810304916), t13, xp.where(xp.greater_equal(t118, -4.642575810304916) & xp.less_equal(t118, 4.642575810304916), t118, xp.where(xp.greater_equal(t119, -4.642575810304916) & xp.less_equal(t119, 4.642575810304916), t119, qb1_5)))
-    t121 = qw1*(t100 + t82)**2 + qw2*(t104 + t83)**2 + qw3*(t108 + t84)**2 + qw4*(t112 + t85)**2 + qw5*(t116 + t86)**2 + qw6*(t120 + t87)**2
+    t121 = qw1*(t82 + t100)**2 + qw2*(t83 + t104)**2 + qw3*(t84 + t108)**2 + qw4*(t85 + t112)**2 + qw5*(t86 + t116)**2 + qw6*(t87 + t120)**2
     t122 = xp.greater(t14, 0)
     t123 = xp.where(t122 & (xp.less(t7, 1) | xp.less(t121, t96)), xp.asarray(1, dtype=dtype), 0)
     t124 = xp.where(t122, 1, t7)
@@ -3063,29 +3065,29 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     t132 = xp.where(t125, t121, t96)
     t133 = xp.where(xp.less(t15, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t134 = t15 + t133
-    t135 = t15 - t133
+    t135 = -t133 + t15
     t136 = xp.where(xp.greater_equal(t15, -2.792526803190927) & xp.less_equal(t15, 2.792526803190927), t15, xp.where(xp.greater_equal(t134, -2.792526803190927) & xp.less_equal(t134, 2.792526803190927), t134, xp.where(xp.greater_equal(t135, -2.792526803190927) & xp.less_equal(t135, 2.792526803190927), t135, qb2_0)))
     t137 = xp.where(xp.less(t16, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t138 = t16 + t137
-    t139 = t16 - t137
+    t139 = -t137 + t16
     t140 = xp.where(xp.greater_equal(t16, -0.7853981633974483) & xp.less_equal(t16, 3.9269908169872414), t16, xp.where(xp.greater_equal(t138, -0.7853981633974483) & xp.less_equal(t138, 3.9269908169872414), t138, xp.where(xp.greater_equal(t139, -0.7853981633974483) & xp.less_equal(t139, 3.9269908169872414), t139, qb2_1)))
     t141 = xp.where(xp.less(t17, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t142 = t17 + t141
-    t143 = t17 - t141
+    t143 = -t141 + t17
     t144 = xp.where(xp.greater_equal(t17, -3.9269908169872414) & xp.less_equal(t17, 0.7853981633974483), t17, xp.where(xp.greater_equal(t142, -3.9269908169872414) & xp.less_equal(t142, 0.7853981633974483), t142, xp.where(xp.greater_equal(t143, -3.9269908169872414) & xp.less_equal(t143, 0.7853981633974483), t143, qb2_2)))
     t145 = xp.where(xp.less(t18, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t146 = t18 + t145
-    t147 = t18 - t145
+    t147 = -t145 + t18
     t148 = xp.where(xp.greater_equal(t18, -1.9198621771937625) & xp.less_equal(t18, 2.9670597283903604), t18, xp.where(xp.greater_equal(t146, -1.9198621771937625) & xp.less_equal(t146, 2.9670597283903604), t146, xp.where(xp.greater_equal(t147, -1.9198621771937625) & xp.less_equal(t147, 2.9670597283903604), t147, qb2_3)))
     t149 = xp.where(xp.less(t19, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t150 = t19 + t149
-    t151 = t19 - t149
+    t151 = -t149 + t19
     t152 = xp.where(xp.greater_equal(t19, -1.7453292519943295) & xp.less_equal(t19, 1.7453292519943295), t19, xp.where(xp.greater_equal(t150, -1.7453292519943295) & xp.less_equal(t150, 1.7453292519943295), t150, xp.where(xp.greater_equal(t151, -1.7453292519943295) & xp.less_equal(t151, 1.7453292519943295), t151, qb2_4)))
     t153 = xp.where(xp.less(t20, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t154 = t20 + t153
-    t155 = t20 - t153
+    t155 = -t153 + t20
     t156 = xp.where(xp.greater_equal(t20, -4.642575810304916) & xp.less_equal(t20, 4.642575810304916), t20, xp.where(xp.greater_equal(t154, -4.642575810304916) & xp.less_equal(t154, 4.642575810304916), t154, xp.where(xp.greater_equal(t155, -4.642575810304916) & xp.less_equal(t155, 4.642575810304916), t155, qb2_5)))
-    t157 = qw1*(t136 + t82)**2 + qw2*(t140 + t83)**2 + qw3*(t144 + t84)**2 + qw4*(t148 + t85)**2 + qw5*(t152 + t86)**2 + qw6*(t156 + t87)**2
+    t157 = qw1*(t82 + t136)**2 + qw2*(t83 + t140)**2 + qw3*(t84 + t144)**2 + qw4*(t85 + t148)**2 + qw5*(t86 + t152)**2 + qw6*(t87 + t156)**2
     t158 = xp.greater(t21, 0)
     t159 = xp.where(t158 & (xp.less(t124, 1) | xp.less(t157, t132)), xp.asarray(1, dtype=dtype), 0)
     t160 = xp.where(t158, 1, t124)
@@ -3099,29 +3101,29 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     t168 = xp.where(t161, t157, t132)
     t169 = xp.where(xp.less(t22, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t170 = t22 + t169
-    t171 = t22 - t169
+    t171 = -t169 + t22
     t172 = xp.where(xp.greater_equal(t22, -2.792526803190927) & xp.less_equal(t22, 2.792526803190927), t22, xp.where(xp.greater_equal(t170, -2.792526803190927) & xp.less_equal(t170, 2.792526803190927), t170, xp.where(xp.greater_equal(t171, -2.792526803190927) & xp.less_equal(t171, 2.792526803190927), t171, qb3_0)))
     t173 = xp.where(xp.less(t23, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t174 = t23 + t173
-    t175 = t23 - t173
+    t175 = -t173 + t23
     t176 = xp.where(xp.greater_equal(t23, -0.7853981633974483) & xp.less_equal(t23, 3.9269908169872414), t23, xp.where(xp.greater_equal(t174, -0.7853981633974483) & xp.less_equal(t174, 3.9269908169872414), t174, xp.where(xp.greater_equal(t175, -0.7853981633974483) & xp.less_equal(t175, 3.9269908169872414), t175, qb3_1)))
     t177 = xp.where(xp.less(t24, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t178 = t24 + t177
-    t179 = t24 - t177
+    t179 = -t177 + t24
     t180 = xp.where(xp.greater_equal(t24, -3.9269908169872414) & xp.less_equal(t24, 0.7853981633974483), t24, xp.where(xp.greater_equal(t178, -3.9269908169872414) & xp.less_equal(t178, 0.7853981633974483), t178, xp.where(xp.greater_equal(t179, -3.9269908169872414) & xp.less_equal(t179, 0.7853981633974483), t179, qb3_2)))
     t181 = xp.where(xp.less(t25, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t182 = t25 + t181
-    t183 = t25 - t181
+    t183 = -t181 + t25
     t184 = xp.where(xp.greater_equal(t25, -1.9198621771937625) & xp.less_equal(t25, 2.9670597283903604), t25, xp.where(xp.greater_equal(t182, -1.9198621771937625) & xp.less_equal(t182, 2.9670597283903604), t182, xp.where(xp.greater_equal(t183, -1.9198621771937625) & xp.less_equal(t183, 2.9670597283903604), t183, qb3_3)))
     t185 = xp.where(xp.less(t26, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t186 = t26 + t185
-    t187 = t26 - t185
+    t187 = -t185 + t26
     t188 = xp.where(xp.greater_equal(t26, -1.7453292519943295) & xp.less_equal(t26, 1.7453292519943295), t26, xp.where(xp.greater_equal(t186, -1.7453292519943295) & xp.less_equal(t186, 1.7453292519943295), t186, xp.where(xp.greater_equal(t187, -1.7453292519943295) & xp.less_equal(t187, 1.7453292519943295), t187, qb3_4)))
     t189 = xp.where(xp.less(t27, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t190 = t27 + t189
-    t191 = t27 - t189
+    t191 = -t189 + t27
     t192 = xp.where(xp.greater_equal(t27, -4.642575810304916) & xp.less_equal(t27, 4.642575810304916), t27, xp.where(xp.greater_equal(t190, -4.642575810304916) & xp.less_equal(t190, 4.642575810304916), t190, xp.where(xp.greater_equal(t191, -4.642575810304916) & xp.less_equal(t191, 4.642575810304916), t191, qb3_5)))
-    t193 = qw1*(t172 + t82)**2 + qw2*(t176 + t83)**2 + qw3*(t180 + t84)**2 + qw4*(t184 + t85)**2 + qw5*(t188 + t86)**2 + qw6*(t192 + t87)**2
+    t193 = qw1*(t82 + t172)**2 + qw2*(t83 + t176)**2 + qw3*(t84 + t180)**2 + qw4*(t85 + t184)**2 + qw5*(t86 + t188)**2 + qw6*(t87 + t192)**2
     t194 = xp.greater(t28, 0)
     t195 = xp.where(t194 & (xp.less(t160, 1) | xp.less(t193, t168)), xp.asarray(1, dtype=dtype), 0)
     t196 = xp.where(t194, 1, t160)
@@ -3135,29 +3137,29 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     t204 = xp.where(t197, t193, t168)
     t205 = xp.where(xp.less(t29, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t206 = t29 + t205
-    t207 = t29 - t205
+    t207 = -t205 + t29
     t208 = xp.where(xp.greater_equal(t29, -2.792526803190927) & xp.less_equal(t29, 2.792526803190927), t29, xp.where(xp.greater_equal(t206, -2.792526803190927) & xp.less_equal(t206, 2.792526803190927), t206, xp.where(xp.greater_equal(t207, -2.792526803190927) & xp.less_equal(t207, 2.792526803190927), t207, qb4_0)))
     t209 = xp.where(xp.less(t30, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t210 = t30 + t209
-    t211 = t30 - t209
+    t211 = -t209 + t30
     t212 = xp.where(xp.greater_equal(t30, -0.7853981633974483) & xp.less_equal(t30, 3.9269908169872414), t30, xp.where(xp.greater_equal(t210, -0.7853981633974483) & xp.less_equal(t210, 3.9269908169872414), t210, xp.where(xp.greater_equal(t211, -0.7853981633974483) & xp.less_equal(t211, 3.9269908169872414), t211, qb4_1)))
     t213 = xp.where(xp.less(t31, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t214 = t31 + t213
-    t215 = t31 - t213
+    t215 = -t213 + t31
     t216 = xp.where(xp.greater_equal(t31, -3.9269908169872414) & xp.less_equal(t31, 0.7853981633974483), t31, xp.where(xp.greater_equal(t214, -3.9269908169872414) & xp.less_equal(t214, 0.7853981633974483), t214, xp.where(xp.greater_equal(t215, -3.9269908169872414) & xp.less_equal(t215, 0.7853981633974483), t215, qb4_2)))
     t217 = xp.where(xp.less(t32, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t218 = t32 + t217
-    t219 = t32 - t217
+    t219 = -t217 + t32
     t220 = xp.where(xp.greater_equal(t32, -1.9198621771937625) & xp.less_equal(t32, 2.9670597283903604), t32, xp.where(xp.greater_equal(t218, -1.9198621771937625) & xp.less_equal(t218, 2.9670597283903604), t218, xp.where(xp.greater_equal(t219, -1.9198621771937625) & xp.less_equal(t219, 2.9670597283903604), t219, qb4_3)))
     t221 = xp.where(xp.less(t33, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t222 = t33 + t221
-    t223 = t33 - t221
+    t223 = -t221 + t33
     t224 = xp.where(xp.greater_equal(t33, -1.7453292519943295) & xp.less_equal(t33, 1.7453292519943295), t33, xp.where(xp.greater_equal(t222, -1.7453292519943295) & xp.less_equal(t222, 1.7453292519943295), t222, xp.where(xp.greater_equal(t223, -1.7453292519943295) & xp.less_equal(t223, 1.7453292519943295), t223, qb4_4)))
     t225 = xp.where(xp.less(t34, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t226 = t34 + t225
-    t227 = t34 - t225
+    t227 = -t225 + t34
     t228 = xp.where(xp.greater_equal(t34, -4.642575810304916) & xp.less_equal(t34, 4.642575810304916), t34, xp.where(xp.greater_equal(t226, -4.642575810304916) & xp.less_equal(t226, 4.642575810304916), t226, xp.where(xp.greater_equal(t227, -4.642575810304916) & xp.less_equal(t227, 4.642575810304916), t227, qb4_5)))
-    t229 = qw1*(t208 + t82)**2 + qw2*(t212 + t83)**2 + qw3*(t216 + t84)**2 + qw4*(t220 + t85)**2 + qw5*(t224 + t86)**2 + qw6*(t228 + t87)**2
+    t229 = qw1*(t82 + t208)**2 + qw2*(t83 + t212)**2 + qw3*(t84 + t216)**2 + qw4*(t85 + t220)**2 + qw5*(t86 + t224)**2 + qw6*(t87 + t228)**2
     t230 = xp.greater(t35, 0)
     t231 = xp.where(t230 & (xp.less(t196, 1) | xp.less(t229, t204)), xp.asarray(1, dtype=dtype), 0)
     t232 = xp.where(t230, 1, t196)
@@ -3171,29 +3173,29 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     t240 = xp.where(t233, t229, t204)
     t241 = xp.where(xp.less(t36, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t242 = t36 + t241
-    t243 = t36 - t241
+    t243 = -t241 + t36
     t244 = xp.where(xp.greater_equal(t36, -2.792526803190927) & xp.less_equal(t36, 2.792526803190927), t36, xp.where(xp.greater_equal(t242, -2.792526803190927) & xp.less_equal(t242, 2.792526803190927), t242, xp.where(xp.greater_equal(t243, -2.792526803190927) & xp.less_equal(t243, 2.792526803190927), t243, qb5_0)))
     t245 = xp.where(xp.less(t37, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t246 = t37 + t245
-    t247 = t37 - t245
+    t247 = -t245 + t37
     t248 = xp.where(xp.greater_equal(t37, -0.7853981633974483) & xp.less_equal(t37, 3.9269908169872414), t37, xp.where(xp.greater_equal(t246, -0.7853981633974483) & xp.less_equal(t246, 3.9269908169872414), t246, xp.where(xp.greater_equal(t247, -0.7853981633974483) & xp.less_equal(t247, 3.9269908169872414), t247, qb5_1)))
     t249 = xp.where(xp.less(t38, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t250 = t38 + t249
-    t251 = t38 - t249
+    t251 = -t249 + t38
     t252 = xp.where(xp.greater_equal(t38, -3.9269908169872414) & xp.less_equal(t38, 0.7853981633974483), t38, xp.where(xp.greater_equal(t250, -3.9269908169872414) & xp.less_equal(t250, 0.7853981633974483), t250, xp.where(xp.greater_equal(t251, -3.9269908169872414) & xp.less_equal(t251, 0.7853981633974483), t251, qb5_2)))
     t253 = xp.where(xp.less(t39, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t254 = t39 + t253
-    t255 = t39 - t253
+    t255 = -t253 + t39
     t256 = xp.where(xp.greater_equal(t39, -1.9198621771937625) & xp.less_equal(t39, 2.9670597283903604), t39, xp.where(xp.greater_equal(t254, -1.9198621771937625) & xp.less_equal(t254, 2.9670597283903604), t254, xp.where(xp.greater_equal(t255, -1.9198621771937625) & xp.less_equal(t255, 2.9670597283903604), t255, qb5_3)))
     t257 = xp.where(xp.less(t40, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t258 = t40 + t257
-    t259 = t40 - t257
+    t259 = -t257 + t40
     t260 = xp.where(xp.greater_equal(t40, -1.7453292519943295) & xp.less_equal(t40, 1.7453292519943295), t40, xp.where(xp.greater_equal(t258, -1.7453292519943295) & xp.less_equal(t258, 1.7453292519943295), t258, xp.where(xp.greater_equal(t259, -1.7453292519943295) & xp.less_equal(t259, 1.7453292519943295), t259, qb5_4)))
     t261 = xp.where(xp.less(t41, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t262 = t41 + t261
-    t263 = t41 - t261
+    t263 = -t261 + t41
     t264 = xp.where(xp.greater_equal(t41, -4.642575810304916) & xp.less_equal(t41, 4.642575810304916), t41, xp.where(xp.greater_equal(t262, -4.642575810304916) & xp.less_equal(t262, 4.642575810304916), t262, xp.where(xp.greater_equal(t263, -4.642575810304916) & xp.less_equal(t263, 4.642575810304916), t263, qb5_5)))
-    t265 = qw1*(t244 + t82)**2 + qw2*(t248 + t83)**2 + qw3*(t252 + t84)**2 + qw4*(t256 + t85)**2 + qw5*(t260 + t86)**2 + qw6*(t264 + t87)**2
+    t265 = qw1*(t82 + t244)**2 + qw2*(t83 + t248)**2 + qw3*(t84 + t252)**2 + qw4*(t85 + t256)**2 + qw5*(t86 + t260)**2 + qw6*(t87 + t264)**2
     t266 = xp.greater(t42, 0)
     t267 = xp.where(t266 & (xp.less(t232, 1) | xp.less(t265, t240)), xp.asarray(1, dtype=dtype), 0)
     t268 = xp.where(t266, 1, t232)
@@ -3207,29 +3209,29 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     t276 = xp.where(t269, t265, t240)
     t277 = xp.where(xp.less(t43, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t278 = t43 + t277
-    t279 = t43 - t277
+    t279 = -t277 + t43
     t280 = xp.where(xp.greater_equal(t43, -2.792526803190927) & xp.less_equal(t43, 2.792526803190927), t43, xp.where(xp.greater_equal(t278, -2.792526803190927) & xp.less_equal(t278, 2.792526803190927), t278, xp.where(xp.greater_equal(t279, -2.792526803190927) & xp.less_equal(t279, 2.792526803190927), t279, qb6_0)))
     t281 = xp.where(xp.less(t44, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t282 = t44 + t281
-    t283 = t44 - t281
+    t283 = -t281 + t44
     t284 = xp.where(xp.greater_equal(t44, -0.7853981633974483) & xp.less_equal(t44, 3.9269908169872414), t44, xp.where(xp.greater_equal(t282, -0.7853981633974483) & xp.less_equal(t282, 3.9269908169872414), t282, xp.where(xp.greater_equal(t283, -0.7853981633974483) & xp.less_equal(t283, 3.9269908169872414), t283, qb6_1)))
     t285 = xp.where(xp.less(t45, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t286 = t45 + t285
-    t287 = t45 - t285
+    t287 = -t285 + t45
     t288 = xp.where(xp.greater_equal(t45, -3.9269908169872414) & xp.less_equal(t45, 0.7853981633974483), t45, xp.where(xp.greater_equal(t286, -3.9269908169872414) & xp.less_equal(t286, 0.7853981633974483), t286, xp.where(xp.greater_equal(t287, -3.9269908169872414) & xp.less_equal(t287, 0.7853981633974483), t287, qb6_2)))
     t289 = xp.where(xp.less(t46, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t290 = t46 + t289
-    t291 = t46 - t289
+    t291 = -t289 + t46
     t292 = xp.where(xp.greater_equal(t46, -1.9198621771937625) & xp.less_equal(t46, 2.9670597283903604), t46, xp.where(xp.greater_equal(t290, -1.9198621771937625) & xp.less_equal(t290, 2.9670597283903604), t290, xp.where(xp.greater_equal(t291, -1.9198621771937625) & xp.less_equal(t291, 2.9670597283903604), t291, qb6_3)))
     t293 = xp.where(xp.less(t47, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t294 = t47 + t293
-    t295 = t47 - t293
+    t295 = -t293 + t47
     t296 = xp.where(xp.greater_equal(t47, -1.7453292519943295) & xp.less_equal(t47, 1.7453292519943295), t47, xp.where(xp.greater_equal(t294, -1.7453292519943295) & xp.less_equal(t294, 1.7453292519943295), t294, xp.where(xp.greater_equal(t295, -1.7453292519943295) & xp.less_equal(t295, 1.7453292519943295), t295, qb6_4)))
     t297 = xp.where(xp.less(t48, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t298 = t48 + t297
-    t299 = t48 - t297
+    t299 = -t297 + t48
     t300 = xp.where(xp.greater_equal(t48, -4.642575810304916) & xp.less_equal(t48, 4.642575810304916), t48, xp.where(xp.greater_equal(t298, -4.642575810304916) & xp.less_equal(t298, 4.642575810304916), t298, xp.where(xp.greater_equal(t299, -4.642575810304916) & xp.less_equal(t299, 4.642575810304916), t299, qb6_5)))
-    t301 = qw1*(t280 + t82)**2 + qw2*(t284 + t83)**2 + qw3*(t288 + t84)**2 + qw4*(t292 + t85)**2 + qw5*(t296 + t86)**2 + qw6*(t300 + t87)**2
+    t301 = qw1*(t82 + t280)**2 + qw2*(t83 + t284)**2 + qw3*(t84 + t288)**2 + qw4*(t85 + t292)**2 + qw5*(t86 + t296)**2 + qw6*(t87 + t300)**2
     t302 = xp.greater(t49, 0)
     t303 = xp.where(t302 & (xp.less(t268, 1) | xp.less(t301, t276)), xp.asarray(1, dtype=dtype), 0)
     t304 = xp.where(t302, 1, t268)
@@ -3243,29 +3245,29 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     t312 = xp.where(t305, t301, t276)
     t313 = xp.where(xp.less(t50, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t314 = t50 + t313
-    t315 = t50 - t313
+    t315 = -t313 + t50
     t316 = xp.where(xp.greater_equal(t50, -2.792526803190927) & xp.less_equal(t50, 2.792526803190927), t50, xp.where(xp.greater_equal(t314, -2.792526803190927) & xp.less_equal(t314, 2.792526803190927), t314, xp.where(xp.greater_equal(t315, -2.792526803190927) & xp.less_equal(t315, 2.792526803190927), t315, qb7_0)))
     t317 = xp.where(xp.less(t51, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t318 = t51 + t317
-    t319 = t51 - t317
+    t319 = -t317 + t51
     t320 = xp.where(xp.greater_equal(t51, -0.7853981633974483) & xp.less_equal(t51, 3.9269908169872414), t51, xp.where(xp.greater_equal(t318, -0.7853981633974483) & xp.less_equal(t318, 3.9269908169872414), t318, xp.where(xp.greater_equal(t319, -0.7853981633974483) & xp.less_equal(t319, 3.9269908169872414), t319, qb7_1)))
     t321 = xp.where(xp.less(t52, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t322 = t52 + t321
-    t323 = t52 - t321
+    t323 = -t321 + t52
     t324 = xp.where(xp.greater_equal(t52, -3.9269908169872414) & xp.less_equal(t52, 0.7853981633974483), t52, xp.where(xp.greater_equal(t322, -3.9269908169872414) & xp.less_equal(t322, 0.7853981633974483), t322, xp.where(xp.greater_equal(t323, -3.9269908169872414) & xp.less_equal(t323, 0.7853981633974483), t323, qb7_2)))
     t325 = xp.where(xp.less(t53, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t326 = t53 + t325
-    t327 = t53 - t325
+    t327 = -t325 + t53
     t328 = xp.where(xp.greater_equal(t53, -1.9198621771937625) & xp.less_equal(t53, 2.9670597283903604), t53, xp.where(xp.greater_equal(t326, -1.9198621771937625) & xp.less_equal(t326, 2.9670597283903604), t326, xp.where(xp.greater_equal(t327, -1.9198621771937625) & xp.less_equal(t327, 2.9670597283903604), t327, qb7_3)))
     t329 = xp.where(xp.less(t54, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t330 = t54 + t329
-    t331 = t54 - t329
+    t331 = -t329 + t54
     t332 = xp.where(xp.greater_equal(t54, -1.7453292519943295) & xp.less_equal(t54, 1.7453292519943295), t54, xp.where(xp.greater_equal(t330, -1.7453292519943295) & xp.less_equal(t330, 1.7453292519943295), t330, xp.where(xp.greater_equal(t331, -1.7453292519943295) & xp.less_equal(t331, 1.7453292519943295), t331, qb7_4)))
     t333 = xp.where(xp.less(t55, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t334 = t55 + t333
-    t335 = t55 - t333
+    t335 = -t333 + t55
     t336 = xp.where(xp.greater_equal(t55, -4.642575810304916) & xp.less_equal(t55, 4.642575810304916), t55, xp.where(xp.greater_equal(t334, -4.642575810304916) & xp.less_equal(t334, 4.642575810304916), t334, xp.where(xp.greater_equal(t335, -4.642575810304916) & xp.less_equal(t335, 4.642575810304916), t335, qb7_5)))
-    t337 = qw1*(t316 + t82)**2 + qw2*(t320 + t83)**2 + qw3*(t324 + t84)**2 + qw4*(t328 + t85)**2 + qw5*(t332 + t86)**2 + qw6*(t336 + t87)**2
+    t337 = qw1*(t82 + t316)**2 + qw2*(t83 + t320)**2 + qw3*(t84 + t324)**2 + qw4*(t85 + t328)**2 + qw5*(t86 + t332)**2 + qw6*(t87 + t336)**2
     t338 = xp.greater(t56, 0)
     t339 = xp.where(t338 & (xp.less(t304, 1) | xp.less(t337, t312)), xp.asarray(1, dtype=dtype), 0)
     t340 = xp.where(t338, 1, t304)

@@ -89,7 +89,7 @@ rexarm_real rexarm_manipulability(const rexarm_real q[REXARM_DOF]);
 rexarm_real rexarm_jacobian_det(const rexarm_real q[REXARM_DOF]);
 
 /* Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status.
- * Result: q_dot[i], i < 4; returned as a scalar. 599 operations. */
+ * Result: q_dot[i], i < 4; returned as a scalar. 600 operations. */
 int rexarm_velocity_ik(const rexarm_real q[REXARM_DOF], const rexarm_real mu_dot[REXARM_TASK_DIM], rexarm_real damping, rexarm_real q_dot[REXARM_DOF]);
 
 /* One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite).

@@ -85,22 +85,22 @@ def fk(q):
     c3 = trig[..., 4]
     s3 = trig[..., 5]
     c23 = c2*c3 - s2*s3
-    s23 = c2*s3 + c3*s2
+    s23 = c2*s3 + s2*c3
     c4 = trig[..., 6]
     s4 = trig[..., 7]
     c234 = c23*c4 - s23*s4
-    s234 = c23*s4 + c4*s23
+    s234 = c23*s4 + s23*c4
     t0 = 0.1*s23 + 0.1*s234
-    t1 = t0 + 0.1*s2
+    t1 = 0.1*s2 + t0
     t2 = 0.12 + t1
     t3 = 0.1*c23
     t4 = c1*c234
     t5 = c1*t3 + 0.1*t4
-    t6 = c234*s1
+    t6 = s1*c234
     t7 = s1*t3 + 0.1*t6
     t8 = 0.1*c2
-    t9 = t5 + c1*t8
-    t10 = t7 + s1*t8
+    t9 = c1*t8 + t5
+    t10 = s1*t8 + t7
     T = _stack(xp, [
         t4,  # 0, 0
         -s1,  # 0, 1
@@ -134,34 +134,34 @@ def jacobian(q):
     c3 = trig[..., 4]
     s3 = trig[..., 5]
     c23 = c2*c3 - s2*s3
-    s23 = c2*s3 + c3*s2
+    s23 = c2*s3 + s2*c3
     c4 = trig[..., 6]
     s4 = trig[..., 7]
     c234 = c23*c4 - s23*s4
-    s234 = c23*s4 + c4*s23
+    s234 = c23*s4 + s23*c4
     t0 = 0.1*c1
     t1 = c23*t0 + c234*t0
-    t2 = t1 + c2*t0
+    t2 = c2*t0 + t1
     t3 = 0.1*s1
     t4 = c23*t3 + c234*t3
-    t5 = t4 + c2*t3
+    t5 = c2*t3 + t4
     t6 = 0.1*s234
     t7 = 0.1*s23 + t6
-    t8 = t7 + 0.1*s2
+    t8 = 0.1*s2 + t7
     t9 = 0.1*c234
     t10 = -c1
     J = _stack(xp, [
         -t5,  # 0, 0
-        -t8*c1,  # 0, 1
-        -t7*c1,  # 0, 2
+        -c1*t8,  # 0, 1
+        -c1*t7,  # 0, 2
         -c1*t6,  # 0, 3
         t2,  # 1, 0
-        -t8*s1,  # 1, 1
-        -t7*s1,  # 1, 2
+        -s1*t8,  # 1, 1
+        -s1*t7,  # 1, 2
         -s1*t6,  # 1, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
-        t2*c1 + t5*s1,  # 2, 1
-        t1*c1 + t4*s1,  # 2, 2
+        c1*t2 + s1*t5,  # 2, 1
+        c1*t1 + s1*t4,  # 2, 2
         c1**2*t9 + s1**2*t9,  # 2, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
         s1,  # 3, 1
@@ -191,23 +191,23 @@ def fk_jacobian(q):
     c3 = trig[..., 4]
     s3 = trig[..., 5]
     c23 = c2*c3 - s2*s3
-    s23 = c2*s3 + c3*s2
+    s23 = c2*s3 + s2*c3
     c4 = trig[..., 6]
     s4 = trig[..., 7]
     c234 = c23*c4 - s23*s4
-    s234 = c23*s4 + c4*s23
+    s234 = c23*s4 + s23*c4
     t0 = 0.1*c23
     t1 = c1*c234
     t2 = c1*t0 + 0.1*t1
-    t3 = c234*s1
+    t3 = s1*c234
     t4 = s1*t0 + 0.1*t3
     t5 = 0.1*s234
     t6 = 0.1*s23 + t5
-    t7 = t6 + 0.1*s2
+    t7 = 0.1*s2 + t6
     t8 = 0.12 + t7
     t9 = 0.1*c2
-    t10 = t2 + c1*t9
-    t11 = t4 + s1*t9
+    t10 = c1*t9 + t2
+    t11 = s1*t9 + t4
     t12 = 0.1*c234
     t13 = -c1
     T = _stack(xp, [
@@ -230,16 +230,16 @@ def fk_jacobian(q):
     ], (4, 4))
     J = _stack(xp, [
         -t11,  # 0, 0
-        -t7*c1,  # 0, 1
-        -t6*c1,  # 0, 2
+        -c1*t7,  # 0, 1
+        -c1*t6,  # 0, 2
         -c1*t5,  # 0, 3
         t10,  # 1, 0
-        -t7*s1,  # 1, 1
-        -t6*s1,  # 1, 2
+        -s1*t7,  # 1, 1
+        -s1*t6,  # 1, 2
         -s1*t5,  # 1, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
-        t10*c1 + t11*s1,  # 2, 1
-        t2*c1 + t4*s1,  # 2, 2
+        c1*t10 + s1*t11,  # 2, 1
+        c1*t2 + s1*t4,  # 2, 2
         c1**2*t12 + s1**2*t12,  # 2, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
         s1,  # 3, 1
@@ -269,27 +269,27 @@ def jacobian_tool(q):
     c3 = trig[..., 4]
     s3 = trig[..., 5]
     c23 = c2*c3 - s2*s3
-    s23 = c2*s3 + c3*s2
+    s23 = c2*s3 + s2*c3
     c4 = trig[..., 6]
     s4 = trig[..., 7]
     c234 = c23*c4 - s23*s4
-    s234 = c23*s4 + c4*s23
+    s234 = c23*s4 + s23*c4
     t0 = 0.1*c1
     t1 = c23*t0 + c234*t0
-    t2 = t1 + c2*t0
+    t2 = c2*t0 + t1
     t3 = 0.1*s1
     t4 = c23*t3 + c234*t3
-    t5 = t4 + c2*t3
+    t5 = c2*t3 + t4
     t6 = 0.1*s234
     t7 = 0.1*s23 + t6
-    t8 = t7 + 0.1*s2
-    t9 = t2*s1
+    t8 = 0.1*s2 + t7
+    t9 = s1*t2
     t10 = c1*t5
-    t11 = t2*c1 + t5*s1
+    t11 = c1*t2 + s1*t5
     t12 = c1**2
     t13 = c234*t8
     t14 = s1**2
-    t15 = t1*c1 + t4*s1
+    t15 = c1*t1 + s1*t4
     t16 = c234*t7
     t17 = 0.1*c234
     t18 = t12*t17 + t14*t17
@@ -300,7 +300,7 @@ def jacobian_tool(q):
     t23 = -(t12 + t14)
     J = _stack(xp, [
         c234*t9 - c234*t10,  # 0, 0
-        -(-s234*t11 + t12*t13 + t14*t13),  # 0, 1
+        -(-s234*t11 + t12*t13 + t13*t14),  # 0, 1
         -(-s234*t15 + t12*t16 + t14*t16),  # 0, 2
         -(-s234*t18 + t12*t19 + t14*t19),  # 0, 3
         t11,  # 1, 0
@@ -339,26 +339,26 @@ def task(q):
     c3 = trig[..., 4]
     s3 = trig[..., 5]
     c23 = c2*c3 - s2*s3
-    s23 = c2*s3 + c3*s2
+    s23 = c2*s3 + s2*c3
     c4 = trig[..., 6]
     s4 = trig[..., 7]
     c234 = c23*c4 - s23*s4
-    s234 = c23*s4 + c4*s23
+    s234 = c23*s4 + s23*c4
     t0 = 0.1*s23 + 0.1*s234
-    t1 = t0 + 0.1*s2
+    t1 = 0.1*s2 + t0
     t2 = 0.12 + t1
     t3 = 0.1*c1
     t4 = c23*t3 + c234*t3
-    t5 = t4 + c2*t3
+    t5 = c2*t3 + t4
     t6 = 0.1*s1
     t7 = c23*t6 + c234*t6
-    t8 = t7 + c2*t6
+    t8 = c2*t6 + t7
     t9 = c234**2
     mu = _stack(xp, [
         t5,  # 0
         t8,  # 1
         t2,  # 2
-        xp.atan2(-s234, xp.sqrt(c1**2*t9 + t9*s1**2)),  # 3
+        xp.atan2(-s234, xp.sqrt(c1**2*t9 + s1**2*t9)),  # 3
     ], (4,))
     return mu
 
@@ -375,38 +375,38 @@ def task_jacobian(q):
     c3 = trig[..., 4]
     s3 = trig[..., 5]
     c23 = c2*c3 - s2*s3
-    s23 = c2*s3 + c3*s2
+    s23 = c2*s3 + s2*c3
     c4 = trig[..., 6]
     s4 = trig[..., 7]
     c234 = c23*c4 - s23*s4
-    s234 = c23*s4 + c4*s23
+    s234 = c23*s4 + s23*c4
     t0 = 0.1*c1
     t1 = c23*t0 + c234*t0
-    t2 = t1 + c2*t0
+    t2 = c2*t0 + t1
     t3 = 0.1*s1
     t4 = c23*t3 + c234*t3
-    t5 = t4 + c2*t3
+    t5 = c2*t3 + t4
     t6 = 0.1*s234
     t7 = 0.1*s23 + t6
-    t8 = t7 + 0.1*s2
+    t8 = 0.1*s2 + t7
     t9 = c1**2
-    t10 = c234*t9
+    t10 = t9*c234
     t11 = s1**2
-    t12 = c234*t11
+    t12 = t11*c234
     t13 = c234**2
-    t14 = -(t10 + t12)/xp.sqrt(t9*t13 + t13*t11)
+    t14 = -(t10 + t12)/xp.sqrt(t9*t13 + t11*t13)
     J = _stack(xp, [
         -t5,  # 0, 0
-        -t8*c1,  # 0, 1
-        -t7*c1,  # 0, 2
+        -c1*t8,  # 0, 1
+        -c1*t7,  # 0, 2
         -c1*t6,  # 0, 3
         t2,  # 1, 0
-        -t8*s1,  # 1, 1
-        -t7*s1,  # 1, 2
+        -s1*t8,  # 1, 1
+        -s1*t7,  # 1, 2
         -s1*t6,  # 1, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
-        t2*c1 + t5*s1,  # 2, 1
-        t1*c1 + t4*s1,  # 2, 2
+        c1*t2 + s1*t5,  # 2, 1
+        c1*t1 + s1*t4,  # 2, 2
         0.1*t10 + 0.1*t12,  # 2, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
         t14,  # 3, 1
@@ -432,56 +432,56 @@ def fk_jacobian_dot(q, q_dot):
     c3 = trig[..., 4]
     s3 = trig[..., 5]
     c23 = c2*c3 - s2*s3
-    s23 = c2*s3 + c3*s2
+    s23 = c2*s3 + s2*c3
     c4 = trig[..., 6]
     s4 = trig[..., 7]
     c234 = c23*c4 - s23*s4
-    s234 = c23*s4 + c4*s23
+    s234 = c23*s4 + s23*c4
     t0 = 0.1*c23
     t1 = c1*c234
     t2 = c1*t0 + 0.1*t1
-    t3 = c234*s1
+    t3 = s1*c234
     t4 = s1*t0 + 0.1*t3
     t5 = 0.1*s234
     t6 = 0.1*s23 + t5
-    t7 = t6 + 0.1*s2
+    t7 = 0.1*s2 + t6
     t8 = 0.12 + t7
     t9 = 0.1*c2
-    t10 = t2 + c1*t9
-    t11 = t4 + s1*t9
-    t12 = t10*c1 + t11*s1
+    t10 = c1*t9 + t2
+    t11 = s1*t9 + t4
+    t12 = c1*t10 + s1*t11
     t13 = t12
-    t14 = t2*c1 + t4*s1
+    t14 = c1*t2 + s1*t4
     t15 = t14
     t16 = c1**2
     t17 = 0.1*c234
     t18 = s1**2
-    t19 = t16*t17 + t18*t17
+    t19 = t16*t17 + t17*t18
     t20 = t19
-    t21 = qd2*s1
-    t22 = qd3*s1
+    t21 = s1*qd2
+    t22 = s1*qd3
     t23 = t21 + t22
     t24 = c1*qd2
     t25 = c1*qd3
     t26 = t24 + t25
     t27 = c1*t5
-    t28 = t6*t25 + qd4*t27
+    t28 = t6*t25 + t27*qd4
     t29 = t28 + t7*t24
     t30 = t29 + t11*qd1
     t31 = s1*t5
-    t32 = t6*t22 + qd4*t31
+    t32 = t6*t22 + t31*qd4
     t33 = t32 + t7*t21
     t34 = -t33 + t10*qd1
-    t35 = t20*qd4
-    t36 = t15*qd3 + t35
-    t37 = t36 + t13*qd2
-    t38 = t7*c1
-    t39 = t6*c1
-    t40 = t7*s1
-    t41 = t6*s1
+    t35 = qd4*t20
+    t36 = qd3*t15 + t35
+    t37 = t36 + qd2*t13
+    t38 = c1*t7
+    t39 = c1*t6
+    t40 = s1*t7
+    t41 = s1*t6
     t42 = -c1
-    t43 = qd2*t6
-    t44 = qd4*t5
+    t43 = t6*qd2
+    t44 = t5*qd4
     t45 = qd4*qd1
     T = _stack(xp, [
         xp.broadcast_to(t1, batch),  # 0, 0
@@ -528,12 +528,12 @@ def fk_jacobian_dot(q, q_dot):
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 3
     ], (6, 4))
     a = _stack(xp, [
-        xp.broadcast_to(qd2*(-t37*c1 + qd1*t40) - qd3*(t36*c1 - qd1*t41 + t15*t24) - qd4*(t20*t26 + c1*t35 - 0.1*qd1*s1*s234) - t34*qd1, batch),  # 0
-        xp.broadcast_to(-qd2*(t37*s1 + qd1*t38) - qd3*(t36*s1 + qd1*t39 + t15*t21) - qd4*(t20*t23 + s1*t35 + qd1*t27) - t30*qd1, batch),  # 1
-        xp.broadcast_to(-qd2*(t29*c1 + t33*s1) - qd3*(t28*c1 + t32*s1 + t16*t43 + t18*t43) - qd4*(t23*t31 + t26*t27 + t16*t44 + t18*t44), batch),  # 2
-        xp.broadcast_to(qd1*t24 + qd1*t25 + c1*t45, batch),  # 3
-        xp.broadcast_to(qd1*t21 + qd1*t22 + s1*t45, batch),  # 4
-        xp.broadcast_to(qd4*(t26*s1 - t23*c1), batch),  # 5
+        xp.broadcast_to(qd2*(-c1*t37 + qd1*t40) - qd3*(-qd1*t41 + c1*t36 + t24*t15) - qd4*(t26*t20 + c1*t35 - 0.1*s1*s234*qd1) - qd1*t34, batch),  # 0
+        xp.broadcast_to(-qd2*(s1*t37 + qd1*t38) - qd3*(s1*t36 + qd1*t39 + t21*t15) - qd4*(t23*t20 + s1*t35 + t27*qd1) - qd1*t30, batch),  # 1
+        xp.broadcast_to(-qd2*(c1*t29 + s1*t33) - qd3*(c1*t28 + s1*t32 + t16*t43 + t18*t43) - qd4*(t31*t23 + t27*t26 + t16*t44 + t18*t44), batch),  # 2
+        xp.broadcast_to(t24*qd1 + t25*qd1 + c1*t45, batch),  # 3
+        xp.broadcast_to(t21*qd1 + t22*qd1 + s1*t45, batch),  # 4
+        xp.broadcast_to(qd4*(s1*t26 - c1*t23), batch),  # 5
     ], (6,))
     return T, J, a
 
@@ -554,58 +554,58 @@ def jacobian_dot(q, q_dot):
     c3 = trig[..., 4]
     s3 = trig[..., 5]
     c23 = c2*c3 - s2*s3
-    s23 = c2*s3 + c3*s2
+    s23 = c2*s3 + s2*c3
     c4 = trig[..., 6]
     s4 = trig[..., 7]
     c234 = c23*c4 - s23*s4
-    s234 = c23*s4 + c4*s23
+    s234 = c23*s4 + s23*c4
     t0 = 0.1*c1
     t1 = c23*t0 + c234*t0
-    t2 = t1 + c2*t0
+    t2 = c2*t0 + t1
     t3 = 0.1*s1
     t4 = c23*t3 + c234*t3
-    t5 = t4 + c2*t3
-    t6 = t2*c1 + t5*s1
-    t7 = t1*c1 + t4*s1
+    t5 = c2*t3 + t4
+    t6 = c1*t2 + s1*t5
+    t7 = c1*t1 + s1*t4
     t8 = 0.1*s234
     t9 = 0.1*s23 + t8
-    t10 = t9 + 0.1*s2
+    t10 = 0.1*s2 + t9
     t11 = c1**2
     t12 = 0.1*c234
     t13 = s1**2
-    t14 = t11*t12 + t13*t12
-    t15 = qd2*s1
-    t16 = qd3*s1
+    t14 = t11*t12 + t12*t13
+    t15 = s1*qd2
+    t16 = s1*qd3
     t17 = t15 + t16
     t18 = c1*qd2
     t19 = c1*qd3
     t20 = t18 + t19
-    t21 = qd4*t8
+    t21 = t8*qd4
     t22 = t9*t19 + c1*t21
     t23 = t9*t16 + s1*t21
     t24 = t22 + t10*t18
     t25 = t23 + t10*t15
     t26 = t24 + t5*qd1
     t27 = -t25 + t2*qd1
-    t28 = t14*qd4
-    t29 = t7*qd3 + t28
-    t30 = t29 + t6*qd2
-    t31 = qd1*s1
+    t28 = qd4*t14
+    t29 = qd3*t7 + t28
+    t30 = t29 + qd2*t6
+    t31 = s1*qd1
     t32 = c1*qd1
-    t33 = qd2*t9
+    t33 = t9*qd2
     Jd = _stack(xp, [
         xp.broadcast_to(-t27, batch),  # 0, 0
-        xp.broadcast_to(-t30*c1 + t10*t31, batch),  # 0, 1
-        xp.broadcast_to(-(t29*c1 - t9*t31 + t7*t18), batch),  # 0, 2
-        xp.broadcast_to(-(t14*t20 + c1*t28 - 0.1*qd1*s1*s234), batch),  # 0, 3
+        xp.broadcast_to(-c1*t30 + t10*t31, batch),  # 0, 1
+        xp.broadcast_to(-(-t9*t31 + c1*t29 + t18*t7), batch),  # 0, 2
+        xp.broadcast_to(-(t20*t14 + c1*t28 - 0.1*s1*s234*qd1), batch),  # 0, 3
         xp.broadcast_to(-t26, batch),  # 1, 0
-        xp.broadcast_to(-(t30*s1 + t10*t32), batch),  # 1, 1
-        xp.broadcast_to(-(t29*s1 + t9*t32 + t7*t15), batch),  # 1, 2
-        xp.broadcast_to(-(t14*t17 + s1*t28 + t8*t32), batch),  # 1, 3
+        xp.broadcast_to(-(s1*t30 + t10*t32), batch),  # 1, 1
+        xp.broadcast_to(-(s1*t29 + t9*t32 + t15*t7), batch),  # 1, 2
+        xp.broadcast_to(-(t17*t14 + s1*t28 + t8*t32), batch),  # 1, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
-        xp.broadcast_to(-(t24*c1 + t25*s1), batch),  # 2, 1
-        xp.broadcast_to(-(t22*c1 + t23*s1 + t11*t33 + t13*t33), batch),  # 2, 2
-        xp.broadcast_to(-(s1*t17*t8 + c1*t20*t8 + t11*t21 + t13*t21), batch),  # 2, 3
+        xp.broadcast_to(-(c1*t24 + s1*t25), batch),  # 2, 1
+        xp.broadcast_to(-(c1*t22 + s1*t23 + t11*t33 + t13*t33), batch),  # 2, 2
+        xp.broadcast_to(-(s1*t8*t17 + c1*t8*t20 + t11*t21 + t13*t21), batch),  # 2, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
         xp.broadcast_to(t32, batch),  # 3, 1
         xp.broadcast_to(t32, batch),  # 3, 2
@@ -617,7 +617,7 @@ def jacobian_dot(q, q_dot):
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 2
-        xp.broadcast_to(t20*s1 - t17*c1, batch),  # 5, 3
+        xp.broadcast_to(s1*t20 - c1*t17, batch),  # 5, 3
     ], (6, 4))
     return Jd
 
@@ -638,52 +638,52 @@ def bias_acceleration(q, q_dot):
     c3 = trig[..., 4]
     s3 = trig[..., 5]
     c23 = c2*c3 - s2*s3
-    s23 = c2*s3 + c3*s2
+    s23 = c2*s3 + s2*c3
     c4 = trig[..., 6]
     s4 = trig[..., 7]
     c234 = c23*c4 - s23*s4
-    s234 = c23*s4 + c4*s23
+    s234 = c23*s4 + s23*c4
     t0 = 0.1*c1
     t1 = c23*t0 + c234*t0
-    t2 = t1 + c2*t0
+    t2 = c2*t0 + t1
     t3 = 0.1*s1
     t4 = c23*t3 + c234*t3
-    t5 = t4 + c2*t3
-    t6 = t2*c1 + t5*s1
-    t7 = t1*c1 + t4*s1
+    t5 = c2*t3 + t4
+    t6 = c1*t2 + s1*t5
+    t7 = c1*t1 + s1*t4
     t8 = 0.1*s234
     t9 = 0.1*s23 + t8
-    t10 = t9 + 0.1*s2
+    t10 = 0.1*s2 + t9
     t11 = c1**2
     t12 = 0.1*c234
     t13 = s1**2
-    t14 = t11*t12 + t13*t12
-    t15 = qd2*s1
-    t16 = qd3*s1
+    t14 = t11*t12 + t12*t13
+    t15 = s1*qd2
+    t16 = s1*qd3
     t17 = t15 + t16
     t18 = c1*qd2
     t19 = c1*qd3
     t20 = t18 + t19
-    t21 = qd4*t8
+    t21 = t8*qd4
     t22 = t9*t19 + c1*t21
     t23 = t9*t16 + s1*t21
     t24 = t22 + t10*t18
     t25 = t23 + t10*t15
     t26 = t24 + t5*qd1
     t27 = -t25 + t2*qd1
-    t28 = t14*qd4
-    t29 = t7*qd3 + t28
-    t30 = t29 + t6*qd2
+    t28 = qd4*t14
+    t29 = qd3*t7 + t28
+    t30 = t29 + qd2*t6
     t31 = s1*qd1
     t32 = c1*qd1
-    t33 = qd2*t9
+    t33 = t9*qd2
     a = _stack(xp, [
-        xp.broadcast_to(qd2*(-t30*c1 + t10*t31) - qd3*(t29*c1 - t9*t31 + t7*t18) - qd4*(t14*t20 + c1*t28 - 0.1*qd1*s1*s234) - t27*qd1, batch),  # 0
-        xp.broadcast_to(-qd2*(t30*s1 + t10*t32) - qd3*(t29*s1 + t9*t32 + t7*t15) - qd4*(t14*t17 + s1*t28 + t8*t32) - t26*qd1, batch),  # 1
-        xp.broadcast_to(-qd2*(t24*c1 + t25*s1) - qd3*(t22*c1 + t23*s1 + t11*t33 + t13*t33) - qd4*(s1*t17*t8 + c1*t20*t8 + t11*t21 + t13*t21), batch),  # 2
-        xp.broadcast_to(qd1*t18 + qd1*t19 + qd4*t32, batch),  # 3
-        xp.broadcast_to(qd1*t15 + qd1*t16 + qd4*t31, batch),  # 4
-        xp.broadcast_to(qd4*(t20*s1 - t17*c1), batch),  # 5
+        xp.broadcast_to(qd2*(-c1*t30 + t10*t31) - qd3*(-t9*t31 + c1*t29 + t18*t7) - qd4*(t20*t14 + c1*t28 - 0.1*s1*s234*qd1) - qd1*t27, batch),  # 0
+        xp.broadcast_to(-qd2*(s1*t30 + t10*t32) - qd3*(s1*t29 + t9*t32 + t15*t7) - qd4*(t17*t14 + s1*t28 + t8*t32) - qd1*t26, batch),  # 1
+        xp.broadcast_to(-qd2*(c1*t24 + s1*t25) - qd3*(c1*t22 + s1*t23 + t11*t33 + t13*t33) - qd4*(s1*t8*t17 + c1*t8*t20 + t11*t21 + t13*t21), batch),  # 2
+        xp.broadcast_to(t18*qd1 + t19*qd1 + t32*qd4, batch),  # 3
+        xp.broadcast_to(t15*qd1 + t16*qd1 + t31*qd4, batch),  # 4
+        xp.broadcast_to(qd4*(s1*t20 - c1*t17), batch),  # 5
     ], (6,))
     return a
 
@@ -704,29 +704,29 @@ def task_jacobian_dot(q, q_dot):
     c3 = trig[..., 4]
     s3 = trig[..., 5]
     c23 = c2*c3 - s2*s3
-    s23 = c2*s3 + c3*s2
+    s23 = c2*s3 + s2*c3
     c4 = trig[..., 6]
     s4 = trig[..., 7]
     c234 = c23*c4 - s23*s4
-    s234 = c23*s4 + c4*s23
+    s234 = c23*s4 + s23*c4
     t0 = 0.1*c1
     t1 = c23*t0 + c234*t0
-    t2 = t1 + c2*t0
+    t2 = c2*t0 + t1
     t3 = 0.1*s1
     t4 = c23*t3 + c234*t3
-    t5 = t4 + c2*t3
-    t6 = t2*c1 + t5*s1
-    t7 = t1*c1 + t4*s1
+    t5 = c2*t3 + t4
+    t6 = c1*t2 + s1*t5
+    t7 = c1*t1 + s1*t4
     t8 = 0.1*s234
     t9 = 0.1*s23 + t8
-    t10 = t9 + 0.1*s2
+    t10 = 0.1*s2 + t9
     t11 = c1**2
-    t12 = c234*t11
+    t12 = t11*c234
     t13 = s1**2
-    t14 = c234*t13
+    t14 = t13*c234
     t15 = 0.1*t12 + 0.1*t14
-    t16 = qd2*s1
-    t17 = qd3*s1
+    t16 = s1*qd2
+    t17 = s1*qd3
     t18 = t16 + t17
     t19 = t18
     t20 = c1*qd2
@@ -737,35 +737,35 @@ def task_jacobian_dot(q, q_dot):
     t25 = t9*t21 + t8*t24
     t26 = t25 + t10*t20
     t27 = t26 + t5*qd1
-    t28 = t24 + t22
-    t29 = qd4*s1
+    t28 = t22 + t24
+    t29 = s1*qd4
     t30 = t9*t17 + t8*t29
     t31 = t30 + t10*t16
     t32 = -t31 + t2*qd1
-    t33 = t26*c1 + t31*s1
-    t34 = t29 + t18
-    t35 = t15*qd4
-    t36 = t7*qd3 + t35
-    t37 = t36 + t6*qd2
+    t33 = c1*t26 + s1*t31
+    t34 = t18 + t29
+    t35 = qd4*t15
+    t36 = qd3*t7 + t35
+    t37 = t36 + qd2*t6
     t38 = s1*qd1
-    t39 = -t37*c1 + t10*t38
-    t40 = t36*c1 + t7*t20 - t9*t38
-    t41 = t15*t23 + c1*t35 - t8*t38
-    t42 = t28*s234 + c234*t38
+    t39 = -c1*t37 + t10*t38
+    t40 = c1*t36 + t20*t7 - t9*t38
+    t41 = t23*t15 + c1*t35 - t8*t38
+    t42 = s234*t28 + c234*t38
     t43 = c1*qd1
-    t44 = t37*s1 + t10*t43
-    t45 = t36*s1 + t9*t43 + t7*t16
-    t46 = t15*t19 + s1*t35 + t8*t43
-    t47 = -t34*s234 + c234*t43
-    t48 = qd2*t9
-    t49 = t25*c1 + t30*s1 + t11*t48 + t13*t48
-    t50 = qd4*t8
-    t51 = s1*t19*t8 + c1*t23*t8 + t11*t50 + t13*t50
+    t44 = s1*t37 + t10*t43
+    t45 = s1*t36 + t9*t43 + t16*t7
+    t46 = t19*t15 + s1*t35 + t8*t43
+    t47 = -s234*t34 + c234*t43
+    t48 = t9*qd2
+    t49 = c1*t25 + s1*t30 + t11*t48 + t13*t48
+    t50 = t8*qd4
+    t51 = s1*t8*t19 + c1*t8*t23 + t11*t50 + t13*t50
     t52 = c234**2
-    t53 = t11*t52 + t52*t13
+    t53 = t11*t52 + t13*t52
     t54 = xp.sqrt(t53)
     t55 = 1/t54
-    t56 = -t55*(t12 + t14)/t53
+    t56 = -(t12 + t14)*t55/t53
     t57 = c234*t56
     t58 = -t47*(s1*t55 + s1*t57) + t42*(c1*t55 + c1*t57)
     Jd = _stack(xp, [
@@ -801,38 +801,38 @@ def hessian(q):
     c3 = trig[..., 4]
     s3 = trig[..., 5]
     c23 = c2*c3 - s2*s3
-    s23 = c2*s3 + c3*s2
+    s23 = c2*s3 + s2*c3
     c4 = trig[..., 6]
     s4 = trig[..., 7]
     c234 = c23*c4 - s23*s4
-    s234 = c23*s4 + c4*s23
+    s234 = c23*s4 + s23*c4
     t0 = 0.1*c1
     t1 = c23*t0 + c234*t0
-    t2 = t1 + c2*t0
+    t2 = c2*t0 + t1
     t3 = 0.1*s1
     t4 = c23*t3 + c234*t3
-    t5 = t4 + c2*t3
-    t6 = t2*c1 + t5*s1
-    t7 = t1*c1 + t4*s1
+    t5 = c2*t3 + t4
+    t6 = c1*t2 + s1*t5
+    t7 = c1*t1 + s1*t4
     t8 = 0.1*s234
     t9 = 0.1*s23 + t8
-    t10 = t9 + 0.1*s2
+    t10 = 0.1*s2 + t9
     t11 = c1**2
     t12 = 0.1*c234
     t13 = s1**2
-    t14 = t11*t12 + t13*t12
-    t15 = t10*s1
-    t16 = t9*s1
+    t14 = t11*t12 + t12*t13
+    t15 = s1*t10
+    t16 = s1*t9
     t17 = s1*t8
-    t18 = -t10*c1
-    t19 = -t9*c1
+    t18 = -c1*t10
+    t19 = -c1*t9
     t20 = -c1*t8
-    t21 = -t7*c1
-    t22 = -t14*c1
-    t23 = -t7*s1
-    t24 = -t14*s1
-    t25 = -(t9*t11 + t9*t13)
-    t26 = -(t11*t8 + t13*t8)
+    t21 = -c1*t7
+    t22 = -c1*t14
+    t23 = -s1*t7
+    t24 = -s1*t14
+    t25 = -(t11*t9 + t13*t9)
+    t26 = -(t8*t11 + t8*t13)
     H = _stack(xp, [
         -t2,  # 0, 0, 0
         t15,  # 0, 0, 1
@@ -859,15 +859,15 @@ def hessian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5, 3
         t15,  # 1, 0, 0
-        -t6*c1,  # 1, 0, 1
+        -c1*t6,  # 1, 0, 1
         t21,  # 1, 0, 2
         t22,  # 1, 0, 3
         t18,  # 1, 1, 0
-        -t6*s1,  # 1, 1, 1
+        -s1*t6,  # 1, 1, 1
         t23,  # 1, 1, 2
         t24,  # 1, 1, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 2, 0
-        -(t10*t11 + t10*t13),  # 1, 2, 1
+        -(t11*t10 + t13*t10),  # 1, 2, 1
         t25,  # 1, 2, 2
         t26,  # 1, 2, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 3, 0
@@ -949,7 +949,7 @@ def singularity_factors(q):
     t1 = s2*s3
     f = _stack(xp, [
         s3,  # 0
-        -(-c2 - t0 + t1 - c4*t0 + c2*s3*s4 + c3*s2*s4 + c4*t1),  # 1
+        -(-c2 - t0 + t1 - c4*t0 + c2*s3*s4 + s2*c3*s4 + c4*t1),  # 1
     ], (2,))
     return f
 
@@ -966,15 +966,15 @@ def manipulability(q):
     c3 = trig[..., 4]
     s3 = trig[..., 5]
     c23 = c2*c3 - s2*s3
-    s23 = c2*s3 + c3*s2
+    s23 = c2*s3 + s2*c3
     c4 = trig[..., 6]
     s4 = trig[..., 7]
     c234 = c23*c4 - s23*s4
     t0 = c234**2
     t1 = c2*c3
     t2 = s2*s3
-    t3 = -c4*t1 + c2*s3*s4 + c3*s2*s4 + c4*t2
-    t4 = 0.001*s3*t3*(-c2 - t1 + t2 + t3)/xp.sqrt(c1**2*t0 + t0*s1**2)
+    t3 = -c4*t1 + c2*s3*s4 + s2*c3*s4 + c4*t2
+    t4 = 0.001*s3*t3*(-c2 - t1 + t2 + t3)/xp.sqrt(c1**2*t0 + s1**2*t0)
     w = xp.broadcast_to(xp.abs(t4), batch)
     return w
 
@@ -991,21 +991,21 @@ def jacobian_det(q):
     c3 = trig[..., 4]
     s3 = trig[..., 5]
     c23 = c2*c3 - s2*s3
-    s23 = c2*s3 + c3*s2
+    s23 = c2*s3 + s2*c3
     c4 = trig[..., 6]
     s4 = trig[..., 7]
     c234 = c23*c4 - s23*s4
     t0 = c234**2
     t1 = c2*c3
     t2 = s2*s3
-    t3 = -c4*t1 + c2*s3*s4 + c3*s2*s4 + c4*t2
-    d = xp.broadcast_to(0.001*s3*t3*(-c2 - t1 + t2 + t3)/xp.sqrt(c1**2*t0 + t0*s1**2), batch)
+    t3 = -c4*t1 + c2*s3*s4 + s2*c3*s4 + c4*t2
+    d = xp.broadcast_to(0.001*s3*t3*(-c2 - t1 + t2 + t3)/xp.sqrt(c1**2*t0 + s1**2*t0), batch)
     return d
 
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def velocity_ik(q, mu_dot, damping=0.0):
-    """joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: (4 x 1 and 1 x 1), 599 operations."""
+    """joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: (4 x 1 and 1 x 1), 600 operations."""
     xp, dtype, device, batch, (q, mu_dot, damping,) = _arguments(("q", q, (4,)), ("mu_dot", mu_dot, (4,)), ("damping", damping, ()))
     q1 = q[..., 0]
     q2 = q[..., 1]
@@ -1023,202 +1023,203 @@ def velocity_ik(q, mu_dot, damping=0.0):
     c3 = trig[..., 4]
     s3 = trig[..., 5]
     c23 = c2*c3 - s2*s3
-    s23 = c2*s3 + c3*s2
+    s23 = c2*s3 + s2*c3
     c4 = trig[..., 6]
     s4 = trig[..., 7]
     c234 = c23*c4 - s23*s4
-    s234 = c23*s4 + c4*s23
+    s234 = c23*s4 + s23*c4
     t0 = 0.1*c1
     t1 = c23*t0 + c234*t0
-    t2 = t1 + c2*t0
+    t2 = c2*t0 + t1
     t3 = 0.1*s1
     t4 = c23*t3 + c234*t3
-    t5 = t4 + c2*t3
-    t6 = t2*c1 + t5*s1
-    t7 = t1*c1 + t4*s1
+    t5 = c2*t3 + t4
+    t6 = c1*t2 + s1*t5
+    t7 = c1*t1 + s1*t4
     t8 = 0.1*s234
     t9 = 0.1*s23 + t8
-    t10 = t9 + 0.1*s2
+    t10 = 0.1*s2 + t9
     t11 = c1**2
-    t12 = c234*t11
+    t12 = t11*c234
     t13 = s1**2
-    t14 = c234*t13
+    t14 = t13*c234
     t15 = 0.1*t12 + 0.1*t14
     t16 = c234**2
-    t17 = -(t12 + t14)/xp.sqrt(t11*t16 + t16*t13)
+    t17 = -(t12 + t14)/xp.sqrt(t11*t16 + t13*t16)
     t18 = t6*t17 + t7*t17 + t15*t17
     t19 = t5**2
-    t20 = t9**2
-    t21 = t10**2
+    t20 = t10**2
+    t21 = t9**2
     t22 = 0.01*s234**2
-    t23 = t20*t11 + t21*t11 + t11*t22
+    t23 = t11*t21 + t11*t22 + t11*t20
     t24 = t19 + t23
     t25 = c1*s1
     t26 = -t2*t5 + t20*t25 + t21*t25 + t22*t25
-    t27 = t9*c1
-    t28 = t10*c1
+    t27 = c1*t10
+    t28 = c1*t9
     t29 = c1*t8
-    t30 = t7*t27 + t6*t28 + t15*t29
-    t31 = t17*t27 + t17*t28 + t17*t29
+    t30 = t27*t6 + t28*t7 + t29*t15
+    t31 = t27*t17 + t28*t17 + t29*t17
     t32 = t2**2
-    t33 = t20*t13 + t21*t13 + t13*t22
+    t33 = t13*t21 + t13*t20 + t13*t22
     t34 = t32 + t33
-    t35 = t9*s1
-    t36 = t10*s1
+    t35 = s1*t10
+    t36 = s1*t9
     t37 = s1*t8
-    t38 = t7*t35 + t6*t36 + t15*t37
-    t39 = t17*t35 + t17*t36 + t17*t37
+    t38 = t35*t6 + t36*t7 + t37*t15
+    t39 = t35*t17 + t36*t17 + t37*t17
     t40 = t6**2
     t41 = t40 + t7**2 + t15**2
     t42 = t41
     t43 = t17**2
     t44 = 3*t43
     t45 = t44
-    t46 = damping**2
-    t47 = t24 + t46
-    t48 = t47**2
-    t49 = t34 + t46
-    t50 = t42 + t46
-    t51 = t45 + t46
-    t52 = t26**2
-    t53 = t30**2
-    t54 = t31**2
-    t55 = xp.sqrt(t48 + t49**2 + t50**2 + t51**2 + 2*t52 + 2*t53 + 2*t54 + 2*t38**2 + 2*t39**2 + 2*t18**2)
-    t56 = xp.sqrt(t52 + t53 + t54 + t48)
-    t57 = t56*xp.where(xp.greater_equal(t47, 0), xp.asarray(1, dtype=dtype), -1)
-    t58 = t57 + t47
-    t59 = xp.where(xp.greater(t56, 0), 1/(t56*(t56 + xp.abs(t47))), 0)
-    t60 = t59*(t26*t58 + t26*t49 + t30*t38 + t31*t39)
-    t61 = t26 - t58*t60
-    t62 = -t26*t60 + t49
-    t63 = -t38 + t30*t60
-    t64 = -t39 + t31*t60
-    t65 = -t59*(t26*t38 + t30*t58 + t30*t50 + t31*t18)
-    t66 = t30 + t58*t65
-    t67 = t38 + t26*t65
-    t68 = t30*t65 + t50
-    t69 = t18 + t31*t65
-    t70 = -t59*(t26*t39 + t30*t18 + t31*t58 + t31*t51)
-    t71 = t31 + t58*t70
-    t72 = t39 + t26*t70
-    t73 = t18 + t30*t70
-    t74 = t31*t70 + t51
-    t75 = t59*(t26*mu_dot1 + t58*mu_dot0 - t30*mu_dot2 - t31*mu_dot3)
-    t76 = mu_dot0 - t58*t75
-    t77 = mu_dot1 - t26*t75
-    t78 = mu_dot2 + t30*t75
-    t79 = mu_dot3 + t31*t75
-    t80 = xp.sqrt(t62**2 + t63**2 + t64**2)
-    t81 = t80*xp.where(xp.greater_equal(t62, 0), xp.asarray(1, dtype=dtype), -1)
-    t82 = t62 + t81
-    t83 = xp.where(xp.greater(t80, 0), 1/(t80*(t80 + xp.abs(t62))), 0)
-    t84 = t83*(t63*t68 + t64*t69 - t67*t82)
-    t85 = t67 + t84*t82
-    t86 = t68 - t84*t63
-    t87 = t69 - t84*t64
-    t88 = t83*(t63*t73 + t64*t74 - t72*t82)
-    t89 = t72 + t88*t82
-    t90 = t73 - t88*t63
-    t91 = t74 - t88*t64
-    t92 = t83*(t63*t78 + t64*t79 + t77*t82)
-    t93 = t77 - t92*t82
-    t94 = t78 - t92*t63
-    t95 = t79 - t92*t64
-    t96 = xp.sqrt(t86**2 + t87**2)
-    t97 = t96*xp.where(xp.greater_equal(t86, 0), xp.asarray(1, dtype=dtype), -1)
-    t98 = t86 + t97
-    t99 = xp.where(xp.greater(t96, 0), 1/(t96*(t96 + xp.abs(t86))), 0)
-    t100 = t99*(t87*t91 + t90*t98)
-    t101 = t90 - t98*t100
-    t102 = t91 - t87*t100
-    t103 = t99*(t87*t95 + t94*t98)
-    t104 = t94 - t98*t103
-    t105 = t95 - t87*t103
-    t106 = xp.abs(t102)
+    t46 = t26**2
+    t47 = t30**2
+    t48 = t31**2
+    t49 = damping**2
+    t50 = t49 + t24
+    t51 = t50**2
+    t52 = xp.sqrt(t46 + t47 + t48 + t51)
+    t53 = t52*xp.where(xp.greater_equal(t50, 0), xp.asarray(1, dtype=dtype), -1)
+    t54 = t53 + t50
+    t55 = xp.where(xp.greater(t52, 0), 1/(t52*(t52 + xp.abs(t50))), 0)
+    t56 = t55*(mu_dot0*t54 + mu_dot1*t26 - mu_dot2*t30 - mu_dot3*t31)
+    t57 = mu_dot0 - t54*t56
+    t58 = mu_dot1 - t26*t56
+    t59 = mu_dot2 + t30*t56
+    t60 = mu_dot3 + t31*t56
+    t61 = t49 + t34
+    t62 = t55*(t26*t54 + t26*t61 + t30*t38 + t31*t39)
+    t63 = t26 - t54*t62
+    t64 = -t26*t62 + t61
+    t65 = -t38 + t30*t62
+    t66 = -t39 + t31*t62
+    t67 = xp.sqrt(t64**2 + t65**2 + t66**2)
+    t68 = t67*xp.where(xp.greater_equal(t64, 0), xp.asarray(1, dtype=dtype), -1)
+    t69 = t64 + t68
+    t70 = xp.where(xp.greater(t67, 0), 1/(t67*(t67 + xp.abs(t64))), 0)
+    t71 = t70*(t58*t69 + t65*t59 + t66*t60)
+    t72 = t58 - t69*t71
+    t73 = t59 - t65*t71
+    t74 = t60 - t66*t71
+    t75 = t49 + t42
+    t76 = -t55*(t30*t54 + t26*t38 + t30*t75 + t31*t18)
+    t77 = t30 + t54*t76
+    t78 = t38 + t26*t76
+    t79 = t30*t76 + t75
+    t80 = t18 + t31*t76
+    t81 = t70*(-t78*t69 + t65*t79 + t66*t80)
+    t82 = t78 + t69*t81
+    t83 = t79 - t65*t81
+    t84 = t80 - t66*t81
+    t85 = xp.sqrt(t83**2 + t84**2)
+    t86 = t85*xp.where(xp.greater_equal(t83, 0), xp.asarray(1, dtype=dtype), -1)
+    t87 = t83 + t86
+    t88 = xp.where(xp.greater(t85, 0), 1/(t85*(t85 + xp.abs(t83))), 0)
+    t89 = t88*(t73*t87 + t84*t74)
+    t90 = t73 - t87*t89
+    t91 = t74 - t84*t89
+    t92 = t49 + t45
+    t93 = xp.sqrt(2*t46 + 2*t47 + 2*t38**2 + 2*t48 + 2*t39**2 + 2*t18**2 + t51 + t61**2 + t75**2 + t92**2)
+    t94 = -t55*(t31*t54 + t26*t39 + t30*t18 + t31*t92)
+    t95 = t31 + t54*t94
+    t96 = t39 + t26*t94
+    t97 = t18 + t30*t94
+    t98 = t31*t94 + t92
+    t99 = t70*(-t96*t69 + t65*t97 + t66*t98)
+    t100 = t96 + t69*t99
+    t101 = t97 - t65*t99
+    t102 = t98 - t66*t99
+    t103 = t88*(t101*t87 + t84*t102)
+    t104 = t101 - t87*t103
+    t105 = t102 - t84*t103
+    t106 = xp.abs(t105)
     t107 = t106
-    t108 = t107*xp.where(xp.greater_equal(t102, 0), xp.asarray(1, dtype=dtype), -1)
-    t109 = t102 + t108
-    t110 = xp.where(xp.greater(t107, 0), 1/(t107*(t107 + t106)), 0)
-    t111 = t105 - t105*t110*t109**2
+    t108 = t107*xp.where(xp.greater_equal(t105, 0), xp.asarray(1, dtype=dtype), -1)
+    t109 = t105 + t108
+    t110 = xp.where(xp.greater(t107, 0), 1/(t107*(t106 + t107)), 0)
+    t111 = t91 - t91*t109**2*t110
     t112 = xp.where(xp.not_equal(t108, 0), -t111/t108, 0)
-    t113 = xp.where(xp.not_equal(t97, 0), -(t104 - t101*t112)/t97, 0)
-    t114 = xp.where(xp.not_equal(t81, 0), -(t93 + t85*t113 + t89*t112)/t81, 0)
-    t115 = xp.where(xp.not_equal(t57, 0), -(t76 - t114*t61 + t112*t71 + t113*t66)/t57, 0)
-    t116 = t114*t2 - t115*t5
-    t117 = t112*t17
-    t118 = t117 + t113*t6 - t114*t36 - t115*t28
-    t119 = t117 + t113*t7 - t114*t35 - t115*t27
-    t120 = t117 + t113*t15 - t114*t37 - t115*t29
+    t113 = xp.where(xp.not_equal(t86, 0), -(t90 - t104*t112)/t86, 0)
+    t114 = xp.where(xp.not_equal(t68, 0), -(t72 + t82*t113 + t100*t112)/t68, 0)
+    t115 = xp.where(xp.not_equal(t53, 0), -(t57 + t77*t113 + t95*t112 - t63*t114)/t53, 0)
+    t116 = -t5*t115 + t2*t114
+    t117 = t17*t112
+    t118 = -t27*t115 - t35*t114 + t6*t113 + t117
+    t119 = t117 - t28*t115 - t36*t114 + t7*t113
+    t120 = t117 - t29*t115 - t37*t114 + t15*t113
     t121 = t32 + t19
-    t122 = xp.sqrt(t44 + t121 + t41 + t23 + t33)
+    t122 = xp.sqrt(t23 + t33 + t41 + t44 + t121)
     t123 = xp.sqrt(t121)
     t124 = t123*xp.where(xp.less_equal(t5, 0), xp.asarray(1, dtype=dtype), -1)
-    t125 = xp.where(xp.greater(t123, 0), 1/(t123*(t123 + xp.abs(t5))), 0)
-    t126 = -t5
-    t127 = t124 + t126
-    t128 = -t125*(t127*t28 + t2*t36)
-    t129 = t127*t128 + t28
-    t130 = t128*t2 + t36
-    t131 = -t125*(t127*t27 + t2*t35)
-    t132 = t127*t131 + t27
-    t133 = t131*t2 + t35
-    t134 = -t125*(t127*t29 + t2*t37)
-    t135 = t127*t134 + t29
-    t136 = t134*t2 + t37
-    t137 = t125*(t127*mu_dot0 + t2*mu_dot1)
-    t138 = mu_dot0 - t127*t137
-    t139 = mu_dot1 - t137*t2
-    t140 = xp.sqrt(t130**2 + t40 + t43)
+    t125 = -t5
+    t126 = t125 + t124
+    t127 = xp.where(xp.greater(t123, 0), 1/(t123*(t123 + xp.abs(t125))), 0)
+    t128 = -t127*(t27*t126 + t2*t35)
+    t129 = t27 + t126*t128
+    t130 = t35 + t2*t128
+    t131 = -t127*(t28*t126 + t2*t36)
+    t132 = t28 + t126*t131
+    t133 = t36 + t2*t131
+    t134 = -t127*(t29*t126 + t2*t37)
+    t135 = t29 + t126*t134
+    t136 = t37 + t2*t134
+    t137 = t127*(mu_dot0*t126 + t2*mu_dot1)
+    t138 = mu_dot0 - t126*t137
+    t139 = mu_dot1 - t2*t137
+    t140 = xp.sqrt(t40 + t43 + t130**2)
     t141 = t140*xp.where(xp.less_equal(t130, 0), xp.asarray(1, dtype=dtype), -1)
-    t142 = t141 - t130
-    t143 = xp.where(xp.greater(t140, 0), 1/(t140*(t140 + xp.abs(t130))), 0)
-    t144 = t143*(t43 + t6*t7 - t133*t142)
-    t145 = t133 + t142*t144
-    t146 = t7 - t144*t6
-    t147 = t17 - t144*t17
-    t148 = t143*(t43 + t6*t15 - t136*t142)
-    t149 = t136 + t142*t148
-    t150 = t15 - t148*t6
-    t151 = t17 - t148*t17
-    t152 = t143*(t139*t142 + t6*mu_dot2 + t17*mu_dot3)
-    t153 = t139 - t142*t152
-    t154 = mu_dot2 - t152*t6
-    t155 = mu_dot3 - t152*t17
-    t156 = xp.sqrt(t146**2 + t147**2)
-    t157 = t156*xp.where(xp.greater_equal(t146, 0), xp.asarray(1, dtype=dtype), -1)
-    t158 = t146 + t157
-    t159 = xp.where(xp.greater(t156, 0), 1/(t156*(t156 + xp.abs(t146))), 0)
-    t160 = t159*(t147*t151 + t150*t158)
-    t161 = t150 - t158*t160
-    t162 = t151 - t147*t160
-    t163 = t159*(t147*t155 + t154*t158)
-    t164 = t154 - t158*t163
-    t165 = t155 - t147*t163
-    t166 = t2 + t6 + t7 + t15 + damping + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + q1 + q2 + q3 + q4 + t126 + 3*t17 - t27 - t35 - t28 - t36 - t29 - t37
-    t167 = xp.abs(t162)
-    t168 = t167
-    t169 = t168*xp.where(xp.greater_equal(t162, 0), xp.asarray(1, dtype=dtype), -1)
-    t170 = t162 + t169
-    t171 = xp.where(xp.greater(t168, 0), 1/(t168*(t168 + t167)), 0)
-    t172 = t165 - t165*t171*t170**2
-    t173 = xp.where(xp.not_equal(t169, 0), -t172/t169, 0)
-    t174 = xp.where(xp.not_equal(t157, 0), -(t164 - t161*t173)/t157, 0)
-    t175 = xp.where(xp.not_equal(t141, 0), -(t153 + t145*t174 + t149*t173)/t141, 0)
-    t176 = xp.where(xp.not_equal(t124, 0), -(t138 + t129*t175 + t132*t174 + t135*t173)/t124, 0)
-    t177 = xp.isfinite(t166)
-    t178 = xp.greater_equal(damping, 0)
-    t179 = 1e-12*t122
+    t142 = t125 + q1 + q2 + q3 + q4 + t2 - t27 - t28 - t29 - t35 - t36 - t37 + t6 + t7 + t15 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + damping + 3*t17
+    t143 = -t130
+    t144 = t143 + t141
+    t145 = xp.where(xp.greater(t140, 0), 1/(t140*(t140 + xp.abs(t143))), 0)
+    t146 = t145*(t43 - t133*t144 + t6*t7)
+    t147 = t133 + t144*t146
+    t148 = t7 - t6*t146
+    t149 = t17 - t17*t146
+    t150 = t145*(t43 - t136*t144 + t6*t15)
+    t151 = t136 + t144*t150
+    t152 = t15 - t6*t150
+    t153 = t17 - t17*t150
+    t154 = t145*(t139*t144 + t6*mu_dot2 + t17*mu_dot3)
+    t155 = t139 - t144*t154
+    t156 = mu_dot2 - t6*t154
+    t157 = mu_dot3 - t17*t154
+    t158 = xp.sqrt(t148**2 + t149**2)
+    t159 = t158*xp.where(xp.greater_equal(t148, 0), xp.asarray(1, dtype=dtype), -1)
+    t160 = t148 + t159
+    t161 = xp.where(xp.greater(t158, 0), 1/(t158*(t158 + xp.abs(t148))), 0)
+    t162 = t161*(t152*t160 + t149*t153)
+    t163 = t152 - t160*t162
+    t164 = t153 - t149*t162
+    t165 = t161*(t156*t160 + t149*t157)
+    t166 = t156 - t160*t165
+    t167 = t157 - t149*t165
+    t168 = xp.abs(t164)
+    t169 = t168
+    t170 = t169*xp.where(xp.greater_equal(t164, 0), xp.asarray(1, dtype=dtype), -1)
+    t171 = t164 + t170
+    t172 = xp.where(xp.greater(t169, 0), 1/(t169*(t168 + t169)), 0)
+    t173 = t167 - t167*t171**2*t172
+    t174 = xp.where(xp.not_equal(t170, 0), -t173/t170, 0)
+    t175 = xp.where(xp.not_equal(t159, 0), -(t166 - t163*t174)/t159, 0)
+    t176 = xp.where(xp.not_equal(t141, 0), -(t155 + t147*t175 + t151*t174)/t141, 0)
+    t177 = xp.where(xp.not_equal(t124, 0), -(t138 + t129*t176 + t132*t175 + t135*t174)/t124, 0)
+    t178 = xp.isfinite(t142)
+    t179 = xp.greater_equal(damping, 0)
     t180 = xp.greater(damping, 0)
-    t181 = 1e-12*t55
-    t182 = (xp.less_equal(damping, 0) & (xp.less_equal(t123, t179) | xp.less_equal(t140, t179) | xp.less_equal(t156, t179) | xp.less_equal(t168, t179))) | (t180 & (xp.less_equal(t96, t181) | xp.less_equal(t107, t181) | xp.less_equal(t56, t181) | xp.less_equal(t80, t181)))
-    t183 = t177 & t178 & xp.logical_not(t182)
+    t181 = 1e-12*t93
+    t182 = 1e-12*t122
+    t183 = (t180 & (xp.less_equal(t52, t181) | xp.less_equal(t67, t181) | xp.less_equal(t85, t181) | xp.less_equal(t107, t181))) | (xp.less_equal(damping, 0) & (xp.less_equal(t123, t182) | xp.less_equal(t140, t182) | xp.less_equal(t158, t182) | xp.less_equal(t169, t182)))
+    t184 = t178 & t179 & xp.logical_not(t183)
     q_dot = _stack(xp, [
-        xp.broadcast_to(xp.where(t183, xp.where(t180, t116, t176), 0), batch),  # 0
-        xp.broadcast_to(xp.where(t183, xp.where(t180, t118, t175), 0), batch),  # 1
-        xp.broadcast_to(xp.where(t183, xp.where(t180, t119, t174), 0), batch),  # 2
-        xp.broadcast_to(xp.where(t183, xp.where(t180, t120, t173), 0), batch),  # 3
+        xp.broadcast_to(xp.where(t184, xp.where(t180, t116, t177), 0), batch),  # 0
+        xp.broadcast_to(xp.where(t184, xp.where(t180, t118, t176), 0), batch),  # 1
+        xp.broadcast_to(xp.where(t184, xp.where(t180, t119, t175), 0), batch),  # 2
+        xp.broadcast_to(xp.where(t184, xp.where(t180, t120, t174), 0), batch),  # 3
     ], (4,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t177 & t178), 2, xp.where(t182, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t178 & t179), 2, xp.where(t183, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
     return q_dot, status
 
 
@@ -1245,89 +1246,89 @@ def ik_numeric_step(target, q, damping=0.0):
     c3 = xp.cos(q3)
     s3 = xp.sin(q3)
     c23 = c2*c3 - s2*s3
-    s23 = c2*s3 + c3*s2
+    s23 = c2*s3 + s2*c3
     c4 = xp.cos(q4)
     s4 = xp.sin(q4)
     c234 = c23*c4 - s23*s4
-    s234 = c23*s4 + c4*s23
-    t0 = mu0 + mu1 + mu2 + mu3 + qs1 + qs2 + qs3 + qs4
+    s234 = c23*s4 + s23*c4
+    t0 = qs1 + qs2 + qs3 + qs4 + mu0 + mu1 + mu2 + mu3
     t1 = 0.1*c1
     t2 = c23*t1 + c234*t1
-    t3 = t2 + c2*t1
-    t4 = mu0 - t3
+    t3 = c2*t1 + t2
+    t4 = -t3 + mu0
     t5 = 0.1*s1
     t6 = c23*t5 + c234*t5
-    t7 = t6 + c2*t5
-    t8 = t3*c1 + t7*s1
-    t9 = t2*c1 + t6*s1
-    t10 = mu1 - t7
+    t7 = c2*t5 + t6
+    t8 = c1*t3 + s1*t7
+    t9 = c1*t2 + s1*t6
+    t10 = -t7 + mu1
     t11 = 0.1*s234
     t12 = 0.1*s23 + t11
-    t13 = t12 + 0.1*s2
+    t13 = 0.1*s2 + t12
     t14 = 0.12 + t13
-    t15 = mu2 - t14
+    t15 = -t14 + mu2
     t16 = c1**2
-    t17 = c234*t16
+    t17 = t16*c234
     t18 = s1**2
-    t19 = c234*t18
+    t19 = t18*c234
     t20 = 0.1*t17 + 0.1*t19
     t21 = t8**2 + t9**2 + t20**2
     t22 = c234**2
-    t23 = xp.sqrt(t16*t22 + t22*t18)
+    t23 = xp.sqrt(t16*t22 + t18*t22)
     t24 = -(t17 + t19)/t23
     t25 = t8*t24 + t9*t24 + t20*t24
     t26 = 3*t24**2
-    t27 = t12**2
-    t28 = t13**2
+    t27 = t13**2
+    t28 = t12**2
     t29 = 0.01*s234**2
-    t30 = t7**2 + t27*t16 + t28*t16 + t16*t29
-    t31 = t3**2 + t27*t18 + t28*t18 + t18*t29
+    t30 = t7**2 + t16*t27 + t16*t28 + t16*t29
+    t31 = t3**2 + t18*t27 + t18*t28 + t18*t29
     t32 = c1*s1
     t33 = -t3*t7 + t27*t32 + t28*t32 + t29*t32
-    t34 = c1*t12
-    t35 = c1*t13
+    t34 = c1*t13
+    t35 = c1*t12
     t36 = c1*t11
-    t37 = t9*t34 + t8*t35 + t20*t36
-    t38 = t24*t34 + t24*t35 + t24*t36
-    t39 = s1*t12
-    t40 = s1*t13
+    t37 = t34*t8 + t35*t9 + t36*t20
+    t38 = t34*t24 + t35*t24 + t36*t24
+    t39 = s1*t13
+    t40 = s1*t12
     t41 = s1*t11
-    t42 = t9*t39 + t8*t40 + t20*t41
-    t43 = t24*t39 + t24*t40 + t24*t41
+    t42 = t39*t8 + t40*t9 + t41*t20
+    t43 = t39*t24 + t40*t24 + t41*t24
     t44 = -mu3 + xp.atan2(-s234, t23)
-    t45 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t44)) + t44
+    t45 = t44 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t44))
     t46 = t4**2 + t10**2 + t15**2 + t45**2
-    t47 = t30 + damping
+    t47 = damping + t30
     t48 = xp.sqrt(t33**2 + t37**2 + t38**2 + t47**2)
     t49 = t48*xp.where(xp.greater_equal(t47, 0), xp.asarray(1, dtype=dtype), -1)
-    t50 = t49 + t47
+    t50 = t47 + t49
     t51 = xp.where(xp.greater(t48, 0), 1/(t48*(t48 + xp.abs(t47))), 0)
-    t52 = t51*(t4*t50 + t10*t33 + t45*t38 - t15*t37)
+    t52 = t51*(t4*t50 + t33*t10 - t37*t15 + t38*t45)
     t53 = t4 - t50*t52
-    t54 = t10 - t52*t33
-    t55 = t15 + t52*t37
-    t56 = -t45 + t52*t38
-    t57 = t31 + damping
-    t58 = t51*(t50*t33 + t33*t57 + t37*t42 + t38*t43)
+    t54 = t10 - t33*t52
+    t55 = t15 + t37*t52
+    t56 = -t45 + t38*t52
+    t57 = damping + t31
+    t58 = t51*(t37*t42 + t38*t43 + t33*t50 + t33*t57)
     t59 = t33 - t50*t58
-    t60 = -t58*t33 + t57
-    t61 = -t42 + t58*t37
-    t62 = -t43 + t58*t38
+    t60 = t57 - t33*t58
+    t61 = -t42 + t37*t58
+    t62 = -t43 + t38*t58
     t63 = xp.sqrt(t60**2 + t61**2 + t62**2)
     t64 = t63*xp.where(xp.greater_equal(t60, 0), xp.asarray(1, dtype=dtype), -1)
     t65 = t60 + t64
     t66 = xp.where(xp.greater(t63, 0), 1/(t63*(t63 + xp.abs(t60))), 0)
-    t67 = t66*(t61*t55 + t62*t56 + t54*t65)
+    t67 = t66*(t54*t65 + t61*t55 + t62*t56)
     t68 = t54 - t65*t67
     t69 = t55 - t61*t67
     t70 = t56 - t62*t67
-    t71 = t21 + damping
-    t72 = -t51*(t50*t37 + t33*t42 + t37*t71 + t38*t25)
+    t71 = damping + t21
+    t72 = -t51*(t33*t42 + t38*t25 + t37*t50 + t37*t71)
     t73 = t37 + t50*t72
-    t74 = t42 + t72*t33
-    t75 = t72*t37 + t71
-    t76 = t25 + t72*t38
-    t77 = t66*(t61*t75 + t62*t76 - t74*t65)
+    t74 = t42 + t33*t72
+    t75 = t71 + t37*t72
+    t76 = t25 + t38*t72
+    t77 = t66*(-t74*t65 + t61*t75 + t62*t76)
     t78 = t74 + t65*t77
     t79 = t75 - t61*t77
     t80 = t76 - t62*t77
@@ -1335,37 +1336,37 @@ def ik_numeric_step(target, q, damping=0.0):
     t82 = t81*xp.where(xp.greater_equal(t79, 0), xp.asarray(1, dtype=dtype), -1)
     t83 = t79 + t82
     t84 = xp.where(xp.greater(t81, 0), 1/(t81*(t81 + xp.abs(t79))), 0)
-    t85 = t84*(t80*t70 + t69*t83)
+    t85 = t84*(t69*t83 + t80*t70)
     t86 = t69 - t83*t85
     t87 = t70 - t80*t85
-    t88 = t26 + damping
-    t89 = -t51*(t50*t38 + t33*t43 + t37*t25 + t38*t88)
+    t88 = damping + t26
+    t89 = -t51*(t33*t43 + t37*t25 + t38*t50 + t38*t88)
     t90 = t38 + t50*t89
-    t91 = t43 + t89*t33
-    t92 = t25 + t89*t37
-    t93 = t89*t38 + t88
-    t94 = t66*(t61*t92 + t62*t93 - t91*t65)
+    t91 = t43 + t33*t89
+    t92 = t25 + t37*t89
+    t93 = t88 + t38*t89
+    t94 = t66*(-t91*t65 + t61*t92 + t62*t93)
     t95 = t91 + t65*t94
     t96 = t92 - t61*t94
     t97 = t93 - t62*t94
-    t98 = t84*(t80*t97 + t96*t83)
+    t98 = t84*(t96*t83 + t80*t97)
     t99 = t96 - t83*t98
     t100 = t97 - t80*t98
     t101 = xp.abs(t100)
     t102 = t101
     t103 = t102*xp.where(xp.greater_equal(t100, 0), xp.asarray(1, dtype=dtype), -1)
     t104 = t100 + t103
-    t105 = xp.where(xp.greater(t102, 0), 1/(t102*(t102 + t101)), 0)
-    t106 = t87 - t87*t105*t104**2
+    t105 = xp.where(xp.greater(t102, 0), 1/(t102*(t101 + t102)), 0)
+    t106 = t87 - t87*t104**2*t105
     t107 = xp.where(xp.not_equal(t103, 0), -t106/t103, 0)
     t108 = xp.where(xp.not_equal(t82, 0), -(t86 - t99*t107)/t82, 0)
     t109 = xp.where(xp.not_equal(t64, 0), -(t68 + t78*t108 + t95*t107)/t64, 0)
-    t110 = xp.where(xp.not_equal(t49, 0), -(t53 - t59*t109 + t73*t108 + t90*t107)/t49, 0)
-    t111 = q1 + t3*t109 - t7*t110
-    t112 = t107*t24
-    t113 = q2 + t112 + t108*t8 - t109*t40 - t110*t35
-    t114 = q3 + t112 + t108*t9 - t109*t39 - t110*t34
-    t115 = q4 + t112 + t108*t20 - t109*t41 - t110*t36
+    t110 = xp.where(xp.not_equal(t49, 0), -(t53 + t73*t108 + t90*t107 - t59*t109)/t49, 0)
+    t111 = q1 - t7*t110 + t3*t109
+    t112 = t24*t107
+    t113 = q2 - t34*t110 - t39*t109 + t8*t108 + t112
+    t114 = q3 + t112 - t35*t110 - t40*t109 + t9*t108
+    t115 = q4 + t112 - t36*t110 - t41*t109 + t20*t108
     q_start = _stack(xp, [
         xp.broadcast_to(q1, batch),  # 0
         xp.broadcast_to(q2, batch),  # 1
@@ -1404,43 +1405,43 @@ def ik_branches(mu):
     t11 = t7
     t12 = mu0**2 + mu1**2
     t13 = t12
-    t14 = mu2**2 + t12
+    t14 = t12 + mu2**2
     t15 = 1e-24*t14
     t16 = xp.less_equal(t13, t15)
     t17 = xp.where(t16, 1, 1/xp.sqrt(t13))
     t18 = xp.where(t16, 0, t1 + 1.5707963267948966)
-    t19 = t1 - 1.5707963267948966
-    t20 = t18 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t18))
-    t21 = t20 - 6.283185307179586*xp.floor(0.15915494309189535*(3.141592653589793 + t20))
-    t22 = t19 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t19))
-    t23 = t22 - 6.283185307179586*xp.floor(0.15915494309189535*(3.141592653589793 + t22))
-    t24 = t17*mu0
+    t19 = -1.5707963267948966 + t1
+    t20 = -6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t18)) + t18
+    t21 = -6.283185307179586*xp.floor(0.15915494309189535*(3.141592653589793 + t20)) + t20
+    t22 = -6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t19)) + t19
+    t23 = -6.283185307179586*xp.floor(0.15915494309189535*(3.141592653589793 + t22)) + t22
+    t24 = mu0*t17
     t25 = xp.where(t16, 1, -t24)
     t26 = t24
     t27 = mu2*(1 - t25)
-    t28 = t27 + t25*mu2
+    t28 = t27 + mu2*t25
     t29 = mu2*(1 - t26)
-    t30 = t29 + t26*mu2
-    t31 = t17*mu1
+    t30 = t29 + mu2*t26
+    t31 = mu1*t17
     t32 = xp.where(t16, 0, -t31)
     t33 = t31
-    t34 = t25*mu0 + t32*mu1
-    t35 = t25*mu1 - t32*mu0
-    t36 = t26*mu0 + t33*mu1
-    t37 = t26*mu1 - t33*mu0
+    t34 = mu0*t25 + mu1*t32
+    t35 = mu1*t25 - mu0*t32
+    t36 = mu0*t26 + mu1*t33
+    t37 = mu1*t26 - mu0*t33
     t38 = 0.1*t11
-    t39 = t34 + t38
-    t40 = t36 + t38
+    t39 = t38 + t34
+    t40 = t38 + t36
     t41 = -0.1*t10
-    t42 = t28 + t41
+    t42 = t41 + t28
     t43 = -0.12 + t42
-    t44 = t30 + t41
+    t44 = t41 + t30
     t45 = -0.12 + t44
     t46 = t35**2
     t47 = t46 + t39**2 + t43**2
     t48 = 0.5*(0.02 - t47)
     t49 = t48**2
-    t50 = 1 - 10000.0*t49
+    t50 = 1 - 10000*t49
     t51 = xp.greater(t50, 1e-12)
     t52 = xp.where(t51, xp.sqrt(t50), 0)
     t53 = 100*t48
@@ -1449,63 +1450,63 @@ def ik_branches(mu):
     t56 = 3.141592653589793 - t55
     t57 = 0.22 - 0.1*t54
     t58 = -0.12 + t57
-    t59 = t58**2 + 0.01*t52**2
-    t60 = t56 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t56))
-    t61 = t60 - 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t60))
+    t59 = 0.01*t52**2 + t58**2
+    t60 = -6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t56)) + t56
+    t61 = -6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t60)) + t60
     t62 = 3.141592653589793 + t55
-    t63 = -1.0*t54
-    t64 = -1.0*t52
+    t63 = -t54
+    t64 = -t52
     t65 = 0.22 + 0.1*t63
     t66 = -0.12 + t65
-    t67 = t66**2 + 0.01*t64**2
-    t68 = t62 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t62))
-    t69 = t68 - 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t68))
+    t67 = 0.01*t64**2 + t66**2
+    t68 = -6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t62)) + t62
+    t69 = -6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t68)) + t68
     t70 = 0.1*t64
-    t71 = t43*t66 - t39*t70
-    t72 = t39*t66 + t43*t70
+    t71 = t43*t66 - t70*t39
+    t72 = t39*t66 + t70*t43
     t73 = t71**2 + t72**2
     t74 = 0.1*t52
-    t75 = t43*t58 - t39*t74
-    t76 = t39*t58 + t43*t74
+    t75 = t43*t58 - t74*t39
+    t76 = t39*t58 + t74*t43
     t77 = t75**2 + t76**2
     t78 = -0.1*t7
-    t79 = t34 + t78
-    t80 = t36 + t78
+    t79 = t78 + t34
+    t80 = t78 + t36
     t81 = -0.1*t6
-    t82 = t28 + t81
+    t82 = t81 + t28
     t83 = -0.12 + t82
     t84 = t46 + t79**2 + t83**2
     t85 = 0.5*(0.02 - t84)
-    t86 = t30 + t81
+    t86 = t81 + t30
     t87 = -0.12 + t86
     t88 = t85**2
-    t89 = 1 - 10000.0*t88
+    t89 = 1 - 10000*t88
     t90 = xp.greater(t89, 1e-12)
     t91 = xp.where(t90, xp.sqrt(t89), 0)
-    t92 = -1.0*t91
+    t92 = -t91
     t93 = 100*t85
     t94 = xp.where(t90, t93, xp.where(xp.greater(t93, 0), xp.asarray(1, dtype=dtype), -1))
     t95 = xp.atan2(t91, t94)
     t96 = 3.141592653589793 + t95
-    t97 = -1.0*t94
+    t97 = -t94
     t98 = 3.141592653589793 - t95
     t99 = 0.22 + 0.1*t97
     t100 = -0.12 + t99
-    t101 = t100**2 + 0.01*t92**2
+    t101 = 0.01*t92**2 + t100**2
     t102 = 0.22 - 0.1*t94
     t103 = -0.12 + t102
-    t104 = t103**2 + 0.01*t91**2
-    t105 = t96 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t96))
-    t106 = t105 - 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t105))
-    t107 = t98 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t98))
-    t108 = t107 - 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t107))
+    t104 = 0.01*t91**2 + t103**2
+    t105 = -6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t96)) + t96
+    t106 = -6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t105)) + t105
+    t107 = -6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t98)) + t98
+    t108 = -6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t107)) + t107
     t109 = 0.1*t92
-    t110 = t83*t100 - t79*t109
-    t111 = t79*t100 + t83*t109
+    t110 = t83*t100 - t109*t79
+    t111 = t79*t100 + t109*t83
     t112 = t110**2 + t111**2
     t113 = 0.1*t91
-    t114 = t83*t103 - t79*t113
-    t115 = t79*t103 + t83*t113
+    t114 = t83*t103 - t113*t79
+    t115 = t79*t103 + t113*t83
     t116 = t114**2 + t115**2
     t117 = t37**2
     t118 = t117 + t40**2 + t45**2
@@ -1513,126 +1514,126 @@ def ik_branches(mu):
     t120 = t117 + t80**2 + t87**2
     t121 = 0.5*(0.02 - t120)
     t122 = t119**2
-    t123 = 1 - 10000.0*t122
+    t123 = 1 - 10000*t122
     t124 = xp.greater(t123, 1e-12)
     t125 = xp.where(t124, xp.sqrt(t123), 0)
-    t126 = -1.0*t125
+    t126 = -t125
     t127 = 100*t119
     t128 = xp.where(t124, t127, xp.where(xp.greater(t127, 0), xp.asarray(1, dtype=dtype), -1))
     t129 = xp.atan2(t125, t128)
     t130 = 3.141592653589793 + t129
-    t131 = -1.0*t128
+    t131 = -t128
     t132 = 3.141592653589793 - t129
     t133 = 0.22 + 0.1*t131
     t134 = -0.12 + t133
-    t135 = t134**2 + 0.01*t126**2
+    t135 = 0.01*t126**2 + t134**2
     t136 = 0.22 - 0.1*t128
     t137 = -0.12 + t136
-    t138 = t137**2 + 0.01*t125**2
-    t139 = t130 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t130))
-    t140 = t139 - 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t139))
-    t141 = t132 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t132))
-    t142 = t141 - 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t141))
+    t138 = 0.01*t125**2 + t137**2
+    t139 = -6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t130)) + t130
+    t140 = -6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t139)) + t139
+    t141 = -6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t132)) + t132
+    t142 = -6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t141)) + t141
     t143 = 0.1*t126
-    t144 = t45*t134 - t40*t143
-    t145 = t40*t134 + t45*t143
+    t144 = t45*t134 - t143*t40
+    t145 = t40*t134 + t143*t45
     t146 = t144**2 + t145**2
     t147 = 0.1*t125
-    t148 = t45*t137 - t40*t147
-    t149 = t40*t137 + t45*t147
+    t148 = t45*t137 - t147*t40
+    t149 = t40*t137 + t147*t45
     t150 = t148**2 + t149**2
     t151 = t121**2
-    t152 = 1 - 10000.0*t151
+    t152 = 1 - 10000*t151
     t153 = xp.greater(t152, 1e-12)
     t154 = xp.where(t153, xp.sqrt(t152), 0)
-    t155 = -1.0*t154
+    t155 = -t154
     t156 = 100*t121
     t157 = xp.where(t153, t156, xp.where(xp.greater(t156, 0), xp.asarray(1, dtype=dtype), -1))
     t158 = xp.atan2(t154, t157)
     t159 = 3.141592653589793 + t158
-    t160 = -1.0*t157
+    t160 = -t157
     t161 = 3.141592653589793 - t158
     t162 = 0.22 + 0.1*t160
     t163 = -0.12 + t162
-    t164 = t163**2 + 0.01*t155**2
+    t164 = 0.01*t155**2 + t163**2
     t165 = 0.22 - 0.1*t157
     t166 = -0.12 + t165
-    t167 = t166**2 + 0.01*t154**2
-    t168 = t159 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t159))
-    t169 = t168 - 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t168))
-    t170 = t161 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t161))
-    t171 = t170 - 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t170))
+    t167 = 0.01*t154**2 + t166**2
+    t168 = -6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t159)) + t159
+    t169 = -6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t168)) + t168
+    t170 = -6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t161)) + t161
+    t171 = -6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t170)) + t170
     t172 = 0.1*t155
-    t173 = t87*t163 - t80*t172
-    t174 = t80*t163 + t87*t172
+    t173 = t87*t163 - t172*t80
+    t174 = t80*t163 + t172*t87
     t175 = t173**2 + t174**2
     t176 = 0.1*t154
-    t177 = t87*t166 - t80*t176
-    t178 = t80*t166 + t87*t176
+    t177 = t87*t166 - t176*t80
+    t178 = t80*t166 + t176*t87
     t179 = t177**2 + t178**2
     t180 = 1e-24*t47
-    t181 = xp.where(xp.less_equal(t73, t67*t180), 0, xp.atan2(-t72, t71))
+    t181 = xp.where(xp.less_equal(t73, t180*t67), 0, xp.atan2(-t72, t71))
     t182 = t181
-    t183 = t182 - 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t182))
+    t183 = -6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t182)) + t182
     t184 = -t9
     t185 = 3.141592653589793 + t184
-    t186 = t62 + t181
-    t187 = t184 + 6.283185307179586*xp.ceil(-0.15915494309189535*(t185 + t186)) + t186
+    t186 = t181 + t62
+    t187 = t184 + t186 + 6.283185307179586*xp.ceil(-0.15915494309189535*(t185 + t186))
     t188 = -t187
-    t189 = t187 + 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t188))
-    t190 = xp.where(xp.less_equal(t77, t59*t180), 0, xp.atan2(-t76, t75))
+    t189 = 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t188)) + t187
+    t190 = xp.where(xp.less_equal(t77, t180*t59), 0, xp.atan2(-t76, t75))
     t191 = t190
-    t192 = t191 - 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t191))
-    t193 = t56 + t190
-    t194 = t184 + 6.283185307179586*xp.ceil(-0.15915494309189535*(t185 + t193)) + t193
+    t192 = -6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t191)) + t191
+    t193 = t190 + t56
+    t194 = t184 + t193 + 6.283185307179586*xp.ceil(-0.15915494309189535*(t185 + t193))
     t195 = -t194
-    t196 = t194 + 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t195))
+    t196 = 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t195)) + t194
     t197 = 1e-24*t84
-    t198 = xp.where(xp.less_equal(t112, t101*t197), 0, xp.atan2(-t111, t110))
+    t198 = xp.where(xp.less_equal(t112, t197*t101), 0, xp.atan2(-t111, t110))
     t199 = t198
-    t200 = t199 - 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t199))
+    t200 = -6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t199)) + t199
     t201 = 3.141592653589793 + t8
-    t202 = t96 + t198
-    t203 = t8 + 6.283185307179586*xp.ceil(-0.15915494309189535*(t201 + t202)) + t202
+    t202 = t198 + t96
+    t203 = 6.283185307179586*xp.ceil(-0.15915494309189535*(t201 + t202)) + t8 + t202
     t204 = -t203
-    t205 = t203 + 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t204))
-    t206 = xp.where(xp.less_equal(t116, t104*t197), 0, xp.atan2(-t115, t114))
+    t205 = 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t204)) + t203
+    t206 = xp.where(xp.less_equal(t116, t197*t104), 0, xp.atan2(-t115, t114))
     t207 = t206
-    t208 = t207 - 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t207))
+    t208 = -6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t207)) + t207
     t209 = t98 + t206
-    t210 = t8 + 6.283185307179586*xp.ceil(-0.15915494309189535*(t201 + t209)) + t209
+    t210 = 6.283185307179586*xp.ceil(-0.15915494309189535*(t201 + t209)) + t8 + t209
     t211 = -t210
-    t212 = t210 + 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t211))
+    t212 = 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t211)) + t210
     t213 = 1e-24*t118
     t214 = xp.where(xp.less_equal(t146, t135*t213), 0, xp.atan2(-t145, t144))
     t215 = t214
-    t216 = t215 - 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t215))
+    t216 = -6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t215)) + t215
     t217 = t130 + t214
     t218 = t184 + 6.283185307179586*xp.ceil(-0.15915494309189535*(t185 + t217)) + t217
     t219 = -t218
-    t220 = t218 + 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t219))
+    t220 = 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t219)) + t218
     t221 = xp.where(xp.less_equal(t150, t138*t213), 0, xp.atan2(-t149, t148))
     t222 = t221
-    t223 = t222 - 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t222))
+    t223 = -6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t222)) + t222
     t224 = t132 + t221
     t225 = t184 + 6.283185307179586*xp.ceil(-0.15915494309189535*(t185 + t224)) + t224
     t226 = -t225
-    t227 = t225 + 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t226))
+    t227 = 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t226)) + t225
     t228 = 1e-24*t120
     t229 = xp.where(xp.less_equal(t175, t164*t228), 0, xp.atan2(-t174, t173))
     t230 = t229
-    t231 = t230 - 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t230))
+    t231 = -6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t230)) + t230
     t232 = t159 + t229
-    t233 = t8 + 6.283185307179586*xp.ceil(-0.15915494309189535*(t201 + t232)) + t232
+    t233 = 6.283185307179586*xp.ceil(-0.15915494309189535*(t201 + t232)) + t8 + t232
     t234 = -t233
-    t235 = t233 + 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t234))
+    t235 = 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t234)) + t233
     t236 = xp.where(xp.less_equal(t179, t167*t228), 0, xp.atan2(-t178, t177))
     t237 = t236
-    t238 = t237 - 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t237))
+    t238 = -6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t237)) + t237
     t239 = t161 + t236
-    t240 = t8 + 6.283185307179586*xp.ceil(-0.15915494309189535*(t201 + t239)) + t239
+    t240 = 6.283185307179586*xp.ceil(-0.15915494309189535*(t201 + t239)) + t8 + t239
     t241 = -t240
-    t242 = t240 + 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t241))
+    t242 = 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t241)) + t240
     t243 = xp.less_equal(t21, 3.141592653589793)
     t244 = xp.greater_equal(t20, -3.141592653589793) & xp.less_equal(t20, 3.141592653589793)
     t245 = xp.where(t243 & xp.logical_not(t244), t21, t20)
@@ -1824,69 +1825,69 @@ def ik_nearest(mu, q_seed, weights=(1.0,) * DOF):
     lb5 = branches_in_limits[..., 5]
     lb6 = branches_in_limits[..., 6]
     lb7 = branches_in_limits[..., 7]
-    t0 = qb0_0 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn1 - qb0_0))
-    t1 = qb0_1 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn2 - qb0_1))
-    t2 = qb0_2 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn3 - qb0_2))
-    t3 = qb0_3 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn4 - qb0_3))
+    t0 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_0 + qn1)) + qb0_0
+    t1 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_1 + qn2)) + qb0_1
+    t2 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_2 + qn3)) + qb0_2
+    t3 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_3 + qn4)) + qb0_3
     t4 = xp.where(lb0 & vb0, xp.asarray(1, dtype=dtype), 0)
     t5 = xp.where(xp.greater(t4, 0), xp.asarray(1, dtype=dtype), 0)
-    t6 = qb1_0 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn1 - qb1_0))
-    t7 = qb1_1 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn2 - qb1_1))
-    t8 = qb1_2 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn3 - qb1_2))
-    t9 = qb1_3 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn4 - qb1_3))
+    t6 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_0 + qn1)) + qb1_0
+    t7 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_1 + qn2)) + qb1_1
+    t8 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_2 + qn3)) + qb1_2
+    t9 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_3 + qn4)) + qb1_3
     t10 = xp.where(lb1 & vb1, xp.asarray(1, dtype=dtype), 0)
-    t11 = qb2_0 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn1 - qb2_0))
-    t12 = qb2_1 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn2 - qb2_1))
-    t13 = qb2_2 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn3 - qb2_2))
-    t14 = qb2_3 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn4 - qb2_3))
+    t11 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_0 + qn1)) + qb2_0
+    t12 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_1 + qn2)) + qb2_1
+    t13 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_2 + qn3)) + qb2_2
+    t14 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_3 + qn4)) + qb2_3
     t15 = xp.where(lb2 & vb2, xp.asarray(1, dtype=dtype), 0)
-    t16 = qb3_0 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn1 - qb3_0))
-    t17 = qb3_1 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn2 - qb3_1))
-    t18 = qb3_2 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn3 - qb3_2))
-    t19 = qb3_3 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn4 - qb3_3))
+    t16 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_0 + qn1)) + qb3_0
+    t17 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_1 + qn2)) + qb3_1
+    t18 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_2 + qn3)) + qb3_2
+    t19 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_3 + qn4)) + qb3_3
     t20 = xp.where(lb3 & vb3, xp.asarray(1, dtype=dtype), 0)
-    t21 = qb4_0 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn1 - qb4_0))
-    t22 = qb4_1 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn2 - qb4_1))
-    t23 = qb4_2 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn3 - qb4_2))
-    t24 = qb4_3 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn4 - qb4_3))
+    t21 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_0 + qn1)) + qb4_0
+    t22 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_1 + qn2)) + qb4_1
+    t23 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_2 + qn3)) + qb4_2
+    t24 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_3 + qn4)) + qb4_3
     t25 = xp.where(lb4 & vb4, xp.asarray(1, dtype=dtype), 0)
-    t26 = qb5_0 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn1 - qb5_0))
-    t27 = qb5_1 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn2 - qb5_1))
-    t28 = qb5_2 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn3 - qb5_2))
-    t29 = qb5_3 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn4 - qb5_3))
+    t26 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_0 + qn1)) + qb5_0
+    t27 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_1 + qn2)) + qb5_1
+    t28 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_2 + qn3)) + qb5_2
+    t29 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_3 + qn4)) + qb5_3
     t30 = xp.where(lb5 & vb5, xp.asarray(1, dtype=dtype), 0)
-    t31 = qb6_0 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn1 - qb6_0))
-    t32 = qb6_1 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn2 - qb6_1))
-    t33 = qb6_2 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn3 - qb6_2))
-    t34 = qb6_3 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn4 - qb6_3))
+    t31 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_0 + qn1)) + qb6_0
+    t32 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_1 + qn2)) + qb6_1
+    t33 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_2 + qn3)) + qb6_2
+    t34 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_3 + qn4)) + qb6_3
     t35 = xp.where(lb6 & vb6, xp.asarray(1, dtype=dtype), 0)
-    t36 = qb7_0 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn1 - qb7_0))
-    t37 = qb7_1 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn2 - qb7_1))
-    t38 = qb7_2 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn3 - qb7_2))
-    t39 = qb7_3 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn4 - qb7_3))
+    t36 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_0 + qn1)) + qb7_0
+    t37 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_1 + qn2)) + qb7_1
+    t38 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_2 + qn3)) + qb7_2
+    t39 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_3 + qn4)) + qb7_3
     t40 = xp.where(lb7 & vb7, xp.asarray(1, dtype=dtype), 0)
     t41 = mu0 + mu1 + mu2 + mu3 + qn1 + qn2 + qn3 + qn4 + qw1 + qw2 + qw3 + qw4
     t42 = xp.where(xp.less(t0, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t43 = t0 + t42
-    t44 = t0 - t42
+    t44 = -t42 + t0
     t45 = xp.where(xp.greater_equal(t0, -3.141592653589793) & xp.less_equal(t0, 3.141592653589793), t0, xp.where(xp.greater_equal(t43, -3.141592653589793) & xp.less_equal(t43, 3.141592653589793), t43, xp.where(xp.greater_equal(t44, -3.141592653589793) & xp.less_equal(t44, 3.141592653589793), t44, qb0_0)))
     t46 = xp.where(xp.less(t1, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t47 = t1 + t46
-    t48 = t1 - t46
+    t48 = -t46 + t1
     t49 = xp.where(xp.greater_equal(t1, -2.0943951023931953) & xp.less_equal(t1, 2.0943951023931953), t1, xp.where(xp.greater_equal(t47, -2.0943951023931953) & xp.less_equal(t47, 2.0943951023931953), t47, xp.where(xp.greater_equal(t48, -2.0943951023931953) & xp.less_equal(t48, 2.0943951023931953), t48, qb0_1)))
     t50 = xp.where(xp.less(t2, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t51 = t2 + t50
-    t52 = t2 - t50
+    t52 = -t50 + t2
     t53 = xp.where(xp.greater_equal(t2, -2.0943951023931953) & xp.less_equal(t2, 2.0943951023931953), t2, xp.where(xp.greater_equal(t51, -2.0943951023931953) & xp.less_equal(t51, 2.0943951023931953), t51, xp.where(xp.greater_equal(t52, -2.0943951023931953) & xp.less_equal(t52, 2.0943951023931953), t52, qb0_2)))
     t54 = xp.where(xp.less(t3, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t55 = t3 + t54
-    t56 = t3 - t54
+    t56 = -t54 + t3
     t57 = xp.where(xp.greater_equal(t3, -2.0943951023931953) & xp.less_equal(t3, 2.0943951023931953), t3, xp.where(xp.greater_equal(t55, -2.0943951023931953) & xp.less_equal(t55, 2.0943951023931953), t55, xp.where(xp.greater_equal(t56, -2.0943951023931953) & xp.less_equal(t56, 2.0943951023931953), t56, qb0_3)))
     t58 = -qn1
     t59 = -qn2
     t60 = -qn3
     t61 = -qn4
-    t62 = qw1*(t45 + t58)**2 + qw2*(t49 + t59)**2 + qw3*(t53 + t60)**2 + qw4*(t57 + t61)**2
+    t62 = qw1*(t58 + t45)**2 + qw2*(t59 + t49)**2 + qw3*(t60 + t53)**2 + qw4*(t61 + t57)**2
     t63 = xp.greater(t5, 0)
     t64 = xp.where(t63, t45, qn1)
     t65 = xp.where(t63, t49, qn2)
@@ -1895,21 +1896,21 @@ def ik_nearest(mu, q_seed, weights=(1.0,) * DOF):
     t68 = xp.where(t63, t62, 0)
     t69 = xp.where(xp.less(t6, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t70 = t6 + t69
-    t71 = t6 - t69
+    t71 = -t69 + t6
     t72 = xp.where(xp.greater_equal(t6, -3.141592653589793) & xp.less_equal(t6, 3.141592653589793), t6, xp.where(xp.greater_equal(t70, -3.141592653589793) & xp.less_equal(t70, 3.141592653589793), t70, xp.where(xp.greater_equal(t71, -3.141592653589793) & xp.less_equal(t71, 3.141592653589793), t71, qb1_0)))
     t73 = xp.where(xp.less(t7, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t74 = t7 + t73
-    t75 = t7 - t73
+    t75 = -t73 + t7
     t76 = xp.where(xp.greater_equal(t7, -2.0943951023931953) & xp.less_equal(t7, 2.0943951023931953), t7, xp.where(xp.greater_equal(t74, -2.0943951023931953) & xp.less_equal(t74, 2.0943951023931953), t74, xp.where(xp.greater_equal(t75, -2.0943951023931953) & xp.less_equal(t75, 2.0943951023931953), t75, qb1_1)))
     t77 = xp.where(xp.less(t8, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t78 = t8 + t77
-    t79 = t8 - t77
+    t79 = -t77 + t8
     t80 = xp.where(xp.greater_equal(t8, -2.0943951023931953) & xp.less_equal(t8, 2.0943951023931953), t8, xp.where(xp.greater_equal(t78, -2.0943951023931953) & xp.less_equal(t78, 2.0943951023931953), t78, xp.where(xp.greater_equal(t79, -2.0943951023931953) & xp.less_equal(t79, 2.0943951023931953), t79, qb1_2)))
     t81 = xp.where(xp.less(t9, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t82 = t9 + t81
-    t83 = t9 - t81
+    t83 = -t81 + t9
     t84 = xp.where(xp.greater_equal(t9, -2.0943951023931953) & xp.less_equal(t9, 2.0943951023931953), t9, xp.where(xp.greater_equal(t82, -2.0943951023931953) & xp.less_equal(t82, 2.0943951023931953), t82, xp.where(xp.greater_equal(t83, -2.0943951023931953) & xp.less_equal(t83, 2.0943951023931953), t83, qb1_3)))
-    t85 = qw1*(t72 + t58)**2 + qw2*(t76 + t59)**2 + qw3*(t80 + t60)**2 + qw4*(t84 + t61)**2
+    t85 = qw1*(t58 + t72)**2 + qw2*(t59 + t76)**2 + qw3*(t60 + t80)**2 + qw4*(t61 + t84)**2
     t86 = xp.greater(t10, 0)
     t87 = xp.where(t86 & (xp.less(t5, 1) | xp.less(t85, t68)), xp.asarray(1, dtype=dtype), 0)
     t88 = xp.where(t86, 1, t5)
@@ -1921,21 +1922,21 @@ def ik_nearest(mu, q_seed, weights=(1.0,) * DOF):
     t94 = xp.where(t89, t85, t68)
     t95 = xp.where(xp.less(t11, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t96 = t11 + t95
-    t97 = t11 - t95
+    t97 = -t95 + t11
     t98 = xp.where(xp.greater_equal(t11, -3.141592653589793) & xp.less_equal(t11, 3.141592653589793), t11, xp.where(xp.greater_equal(t96, -3.141592653589793) & xp.less_equal(t96, 3.141592653589793), t96, xp.where(xp.greater_equal(t97, -3.141592653589793) & xp.less_equal(t97, 3.141592653589793), t97, qb2_0)))
     t99 = xp.where(xp.less(t12, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t100 = t12 + t99
-    t101 = t12 - t99
+    t101 = -t99 + t12
     t102 = xp.where(xp.greater_equal(t12, -2.0943951023931953) & xp.less_equal(t12, 2.0943951023931953), t12, xp.where(xp.greater_equal(t100, -2.0943951023931953) & xp.less_equal(t100, 2.0943951023931953), t100, xp.where(xp.greater_equal(t101, -2.0943951023931953) & xp.less_equal(t101, 2.0943951023931953), t101, qb2_1)))
     t103 = xp.where(xp.less(t13, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t104 = t13 + t103
-    t105 = t13 - t103
+    t105 = -t103 + t13
     t106 = xp.where(xp.greater_equal(t13, -2.0943951023931953) & xp.less_equal(t13, 2.0943951023931953), t13, xp.where(xp.greater_equal(t104, -2.0943951023931953) & xp.less_equal(t104, 2.0943951023931953), t104, xp.where(xp.greater_equal(t105, -2.0943951023931953) & xp.less_equal(t105, 2.0943951023931953), t105, qb2_2)))
     t107 = xp.where(xp.less(t14, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t108 = t14 + t107
-    t109 = t14 - t107
+    t109 = -t107 + t14
     t110 = xp.where(xp.greater_equal(t14, -2.0943951023931953) & xp.less_equal(t14, 2.0943951023931953), t14, xp.where(xp.greater_equal(t108, -2.0943951023931953) & xp.less_equal(t108, 2.0943951023931953), t108, xp.where(xp.greater_equal(t109, -2.0943951023931953) & xp.less_equal(t109, 2.0943951023931953), t109, qb2_3)))
-    t111 = qw1*(t98 + t58)**2 + qw2*(t102 + t59)**2 + qw3*(t106 + t60)**2 + qw4*(t110 + t61)**2
+    t111 = qw1*(t58 + t98)**2 + qw2*(t59 + t102)**2 + qw3*(t60 + t106)**2 + qw4*(t61 + t110)**2
     t112 = xp.greater(t15, 0)
     t113 = xp.where(t112 & (xp.less(t88, 1) | xp.less(t111, t94)), xp.asarray(1, dtype=dtype), 0)
     t114 = xp.where(t112, 1, t88)
@@ -1947,21 +1948,21 @@ def ik_nearest(mu, q_seed, weights=(1.0,) * DOF):
     t120 = xp.where(t115, t111, t94)
     t121 = xp.where(xp.less(t16, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t122 = t16 + t121
-    t123 = t16 - t121
+    t123 = -t121 + t16
     t124 = xp.where(xp.greater_equal(t16, -3.141592653589793) & xp.less_equal(t16, 3.141592653589793), t16, xp.where(xp.greater_equal(t122, -3.141592653589793) & xp.less_equal(t122, 3.141592653589793), t122, xp.where(xp.greater_equal(t123, -3.141592653589793) & xp.less_equal(t123, 3.141592653589793), t123, qb3_0)))
     t125 = xp.where(xp.less(t17, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t126 = t17 + t125
-    t127 = t17 - t125
+    t127 = -t125 + t17
     t128 = xp.where(xp.greater_equal(t17, -2.0943951023931953) & xp.less_equal(t17, 2.0943951023931953), t17, xp.where(xp.greater_equal(t126, -2.0943951023931953) & xp.less_equal(t126, 2.0943951023931953), t126, xp.where(xp.greater_equal(t127, -2.0943951023931953) & xp.less_equal(t127, 2.0943951023931953), t127, qb3_1)))
     t129 = xp.where(xp.less(t18, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t130 = t18 + t129
-    t131 = t18 - t129
+    t131 = -t129 + t18
     t132 = xp.where(xp.greater_equal(t18, -2.0943951023931953) & xp.less_equal(t18, 2.0943951023931953), t18, xp.where(xp.greater_equal(t130, -2.0943951023931953) & xp.less_equal(t130, 2.0943951023931953), t130, xp.where(xp.greater_equal(t131, -2.0943951023931953) & xp.less_equal(t131, 2.0943951023931953), t131, qb3_2)))
     t133 = xp.where(xp.less(t19, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t134 = t19 + t133
-    t135 = t19 - t133
+    t135 = -t133 + t19
     t136 = xp.where(xp.greater_equal(t19, -2.0943951023931953) & xp.less_equal(t19, 2.0943951023931953), t19, xp.where(xp.greater_equal(t134, -2.0943951023931953) & xp.less_equal(t134, 2.0943951023931953), t134, xp.where(xp.greater_equal(t135, -2.0943951023931953) & xp.less_equal(t135, 2.0943951023931953), t135, qb3_3)))
-    t137 = qw1*(t124 + t58)**2 + qw2*(t128 + t59)**2 + qw3*(t132 + t60)**2 + qw4*(t136 + t61)**2
+    t137 = qw1*(t58 + t124)**2 + qw2*(t59 + t128)**2 + qw3*(t60 + t132)**2 + qw4*(t61 + t136)**2
     t138 = xp.greater(t20, 0)
     t139 = xp.where(t138 & (xp.less(t114, 1) | xp.less(t137, t120)), xp.asarray(1, dtype=dtype), 0)
     t140 = xp.where(t138, 1, t114)
@@ -1973,21 +1974,21 @@ def ik_nearest(mu, q_seed, weights=(1.0,) * DOF):
     t146 = xp.where(t141, t137, t120)
     t147 = xp.where(xp.less(t21, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t148 = t21 + t147
-    t149 = t21 - t147
+    t149 = -t147 + t21
     t150 = xp.where(xp.greater_equal(t21, -3.141592653589793) & xp.less_equal(t21, 3.141592653589793), t21, xp.where(xp.greater_equal(t148, -3.141592653589793) & xp.less_equal(t148, 3.141592653589793), t148, xp.where(xp.greater_equal(t149, -3.141592653589793) & xp.less_equal(t149, 3.141592653589793), t149, qb4_0)))
     t151 = xp.where(xp.less(t22, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t152 = t22 + t151
-    t153 = t22 - t151
+    t153 = -t151 + t22
     t154 = xp.where(xp.greater_equal(t22, -2.0943951023931953) & xp.less_equal(t22, 2.0943951023931953), t22, xp.where(xp.greater_equal(t152, -2.0943951023931953) & xp.less_equal(t152, 2.0943951023931953), t152, xp.where(xp.greater_equal(t153, -2.0943951023931953) & xp.less_equal(t153, 2.0943951023931953), t153, qb4_1)))
     t155 = xp.where(xp.less(t23, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t156 = t23 + t155
-    t157 = t23 - t155
+    t157 = -t155 + t23
     t158 = xp.where(xp.greater_equal(t23, -2.0943951023931953) & xp.less_equal(t23, 2.0943951023931953), t23, xp.where(xp.greater_equal(t156, -2.0943951023931953) & xp.less_equal(t156, 2.0943951023931953), t156, xp.where(xp.greater_equal(t157, -2.0943951023931953) & xp.less_equal(t157, 2.0943951023931953), t157, qb4_2)))
     t159 = xp.where(xp.less(t24, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t160 = t24 + t159
-    t161 = t24 - t159
+    t161 = -t159 + t24
     t162 = xp.where(xp.greater_equal(t24, -2.0943951023931953) & xp.less_equal(t24, 2.0943951023931953), t24, xp.where(xp.greater_equal(t160, -2.0943951023931953) & xp.less_equal(t160, 2.0943951023931953), t160, xp.where(xp.greater_equal(t161, -2.0943951023931953) & xp.less_equal(t161, 2.0943951023931953), t161, qb4_3)))
-    t163 = qw1*(t150 + t58)**2 + qw2*(t154 + t59)**2 + qw3*(t158 + t60)**2 + qw4*(t162 + t61)**2
+    t163 = qw1*(t58 + t150)**2 + qw2*(t59 + t154)**2 + qw3*(t60 + t158)**2 + qw4*(t61 + t162)**2
     t164 = xp.greater(t25, 0)
     t165 = xp.where(t164 & (xp.less(t140, 1) | xp.less(t163, t146)), xp.asarray(1, dtype=dtype), 0)
     t166 = xp.where(t164, 1, t140)
@@ -1999,21 +2000,21 @@ def ik_nearest(mu, q_seed, weights=(1.0,) * DOF):
     t172 = xp.where(t167, t163, t146)
     t173 = xp.where(xp.less(t26, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t174 = t26 + t173
-    t175 = t26 - t173
+    t175 = -t173 + t26
     t176 = xp.where(xp.greater_equal(t26, -3.141592653589793) & xp.less_equal(t26, 3.141592653589793), t26, xp.where(xp.greater_equal(t174, -3.141592653589793) & xp.less_equal(t174, 3.141592653589793), t174, xp.where(xp.greater_equal(t175, -3.141592653589793) & xp.less_equal(t175, 3.141592653589793), t175, qb5_0)))
     t177 = xp.where(xp.less(t27, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t178 = t27 + t177
-    t179 = t27 - t177
+    t179 = -t177 + t27
     t180 = xp.where(xp.greater_equal(t27, -2.0943951023931953) & xp.less_equal(t27, 2.0943951023931953), t27, xp.where(xp.greater_equal(t178, -2.0943951023931953) & xp.less_equal(t178, 2.0943951023931953), t178, xp.where(xp.greater_equal(t179, -2.0943951023931953) & xp.less_equal(t179, 2.0943951023931953), t179, qb5_1)))
     t181 = xp.where(xp.less(t28, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t182 = t28 + t181
-    t183 = t28 - t181
+    t183 = -t181 + t28
     t184 = xp.where(xp.greater_equal(t28, -2.0943951023931953) & xp.less_equal(t28, 2.0943951023931953), t28, xp.where(xp.greater_equal(t182, -2.0943951023931953) & xp.less_equal(t182, 2.0943951023931953), t182, xp.where(xp.greater_equal(t183, -2.0943951023931953) & xp.less_equal(t183, 2.0943951023931953), t183, qb5_2)))
     t185 = xp.where(xp.less(t29, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t186 = t29 + t185
-    t187 = t29 - t185
+    t187 = -t185 + t29
     t188 = xp.where(xp.greater_equal(t29, -2.0943951023931953) & xp.less_equal(t29, 2.0943951023931953), t29, xp.where(xp.greater_equal(t186, -2.0943951023931953) & xp.less_equal(t186, 2.0943951023931953), t186, xp.where(xp.greater_equal(t187, -2.0943951023931953) & xp.less_equal(t187, 2.0943951023931953), t187, qb5_3)))
-    t189 = qw1*(t176 + t58)**2 + qw2*(t180 + t59)**2 + qw3*(t184 + t60)**2 + qw4*(t188 + t61)**2
+    t189 = qw1*(t58 + t176)**2 + qw2*(t59 + t180)**2 + qw3*(t60 + t184)**2 + qw4*(t61 + t188)**2
     t190 = xp.greater(t30, 0)
     t191 = xp.where(t190 & (xp.less(t166, 1) | xp.less(t189, t172)), xp.asarray(1, dtype=dtype), 0)
     t192 = xp.where(t190, 1, t166)
@@ -2025,21 +2026,21 @@ def ik_nearest(mu, q_seed, weights=(1.0,) * DOF):
     t198 = xp.where(t193, t189, t172)
     t199 = xp.where(xp.less(t31, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t200 = t31 + t199
-    t201 = t31 - t199
+    t201 = -t199 + t31
     t202 = xp.where(xp.greater_equal(t31, -3.141592653589793) & xp.less_equal(t31, 3.141592653589793), t31, xp.where(xp.greater_equal(t200, -3.141592653589793) & xp.less_equal(t200, 3.141592653589793), t200, xp.where(xp.greater_equal(t201, -3.141592653589793) & xp.less_equal(t201, 3.141592653589793), t201, qb6_0)))
     t203 = xp.where(xp.less(t32, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t204 = t32 + t203
-    t205 = t32 - t203
+    t205 = -t203 + t32
     t206 = xp.where(xp.greater_equal(t32, -2.0943951023931953) & xp.less_equal(t32, 2.0943951023931953), t32, xp.where(xp.greater_equal(t204, -2.0943951023931953) & xp.less_equal(t204, 2.0943951023931953), t204, xp.where(xp.greater_equal(t205, -2.0943951023931953) & xp.less_equal(t205, 2.0943951023931953), t205, qb6_1)))
     t207 = xp.where(xp.less(t33, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t208 = t33 + t207
-    t209 = t33 - t207
+    t209 = -t207 + t33
     t210 = xp.where(xp.greater_equal(t33, -2.0943951023931953) & xp.less_equal(t33, 2.0943951023931953), t33, xp.where(xp.greater_equal(t208, -2.0943951023931953) & xp.less_equal(t208, 2.0943951023931953), t208, xp.where(xp.greater_equal(t209, -2.0943951023931953) & xp.less_equal(t209, 2.0943951023931953), t209, qb6_2)))
     t211 = xp.where(xp.less(t34, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t212 = t34 + t211
-    t213 = t34 - t211
+    t213 = -t211 + t34
     t214 = xp.where(xp.greater_equal(t34, -2.0943951023931953) & xp.less_equal(t34, 2.0943951023931953), t34, xp.where(xp.greater_equal(t212, -2.0943951023931953) & xp.less_equal(t212, 2.0943951023931953), t212, xp.where(xp.greater_equal(t213, -2.0943951023931953) & xp.less_equal(t213, 2.0943951023931953), t213, qb6_3)))
-    t215 = qw1*(t202 + t58)**2 + qw2*(t206 + t59)**2 + qw3*(t210 + t60)**2 + qw4*(t214 + t61)**2
+    t215 = qw1*(t58 + t202)**2 + qw2*(t59 + t206)**2 + qw3*(t60 + t210)**2 + qw4*(t61 + t214)**2
     t216 = xp.greater(t35, 0)
     t217 = xp.where(t216 & (xp.less(t192, 1) | xp.less(t215, t198)), xp.asarray(1, dtype=dtype), 0)
     t218 = xp.where(t216, 1, t192)
@@ -2051,21 +2052,21 @@ def ik_nearest(mu, q_seed, weights=(1.0,) * DOF):
     t224 = xp.where(t219, t215, t198)
     t225 = xp.where(xp.less(t36, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t226 = t36 + t225
-    t227 = t36 - t225
+    t227 = -t225 + t36
     t228 = xp.where(xp.greater_equal(t36, -3.141592653589793) & xp.less_equal(t36, 3.141592653589793), t36, xp.where(xp.greater_equal(t226, -3.141592653589793) & xp.less_equal(t226, 3.141592653589793), t226, xp.where(xp.greater_equal(t227, -3.141592653589793) & xp.less_equal(t227, 3.141592653589793), t227, qb7_0)))
     t229 = xp.where(xp.less(t37, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t230 = t37 + t229
-    t231 = t37 - t229
+    t231 = -t229 + t37
     t232 = xp.where(xp.greater_equal(t37, -2.0943951023931953) & xp.less_equal(t37, 2.0943951023931953), t37, xp.where(xp.greater_equal(t230, -2.0943951023931953) & xp.less_equal(t230, 2.0943951023931953), t230, xp.where(xp.greater_equal(t231, -2.0943951023931953) & xp.less_equal(t231, 2.0943951023931953), t231, qb7_1)))
     t233 = xp.where(xp.less(t38, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t234 = t38 + t233
-    t235 = t38 - t233
+    t235 = -t233 + t38
     t236 = xp.where(xp.greater_equal(t38, -2.0943951023931953) & xp.less_equal(t38, 2.0943951023931953), t38, xp.where(xp.greater_equal(t234, -2.0943951023931953) & xp.less_equal(t234, 2.0943951023931953), t234, xp.where(xp.greater_equal(t235, -2.0943951023931953) & xp.less_equal(t235, 2.0943951023931953), t235, qb7_2)))
     t237 = xp.where(xp.less(t39, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t238 = t39 + t237
-    t239 = t39 - t237
+    t239 = -t237 + t39
     t240 = xp.where(xp.greater_equal(t39, -2.0943951023931953) & xp.less_equal(t39, 2.0943951023931953), t39, xp.where(xp.greater_equal(t238, -2.0943951023931953) & xp.less_equal(t238, 2.0943951023931953), t238, xp.where(xp.greater_equal(t239, -2.0943951023931953) & xp.less_equal(t239, 2.0943951023931953), t239, qb7_3)))
-    t241 = qw1*(t228 + t58)**2 + qw2*(t232 + t59)**2 + qw3*(t236 + t60)**2 + qw4*(t240 + t61)**2
+    t241 = qw1*(t58 + t228)**2 + qw2*(t59 + t232)**2 + qw3*(t60 + t236)**2 + qw4*(t61 + t240)**2
     t242 = xp.greater(t40, 0)
     t243 = xp.where(t242 & (xp.less(t218, 1) | xp.less(t241, t224)), xp.asarray(1, dtype=dtype), 0)
     t244 = xp.where(t242, 1, t218)

@@ -95,7 +95,7 @@ def fk(q):
     t1 = c1*c3
     t2 = t0 + c2*t1
     t3 = t1 + c2*t0
-    t4 = c3*s1
+    t4 = s1*c3
     t5 = c1*s3
     t6 = t4 - c2*t5
     t7 = -t5 + c2*t4
@@ -107,42 +107,42 @@ def fk(q):
     t13 = t11*c6 - t10*s6
     t14 = t10*c6 + t11*s6
     t15 = t12*s7 + t13*c7
-    t16 = t12*c7 - t13*s7
-    t17 = 0.13375*t14 + 0.1363*t12
+    t16 = t12*c7 - s7*t13
+    t17 = 0.1363*t12 + 0.13375*t14
     t18 = -t17 + 0.4*t10
-    t19 = t18 + 0.1685*t6
-    t20 = t19 - 0.4*t8
-    t21 = t20 - 0.1925*s1
-    t22 = t21 + 0.081*c1
+    t19 = 0.1685*t6 + t18
+    t20 = -0.4*t8 + t19
+    t21 = -0.1925*s1 + t20
+    t22 = 0.081*c1 + t21
     t23 = s1*s2
-    t24 = t7*c4 + s4*t23
-    t25 = -t7*s4 + c4*t23
-    t26 = t3*s5 + t24*c5
-    t27 = t3*c5 - t24*s5
-    t28 = t26*c6 - t25*s6
-    t29 = t25*c6 + t26*s6
-    t30 = t28*c7 - t27*s7
-    t31 = t27*c7 + t28*s7
-    t32 = -0.13375*t29 + 0.1363*t27
-    t33 = t32 + 0.4*t25
-    t34 = t33 - 0.1685*t3
-    t35 = t34 - 0.4*t23
-    t36 = t35 + 0.1925*c1
-    t37 = t36 + 0.081*s1
+    t24 = c4*t7 + s4*t23
+    t25 = -s4*t7 + c4*t23
+    t26 = t3*s5 + c5*t24
+    t27 = t3*c5 - s5*t24
+    t28 = c6*t26 - t25*s6
+    t29 = t25*c6 + s6*t26
+    t30 = c7*t28 - t27*s7
+    t31 = t27*c7 + s7*t28
+    t32 = 0.1363*t27 - 0.13375*t29
+    t33 = 0.4*t25 + t32
+    t34 = -0.1685*t3 + t33
+    t35 = -0.4*t23 + t34
+    t36 = 0.1925*c1 + t35
+    t37 = 0.081*s1 + t36
     t38 = c3*s2
     t39 = c2*s4 - c4*t38
     t40 = c2*c4 + s4*t38
     t41 = s3*s2
-    t42 = t39*c5 - s5*t41
-    t43 = t39*s5 + c5*t41
-    t44 = t42*c6 - t40*s6
-    t45 = t40*c6 + t42*s6
-    t46 = t43*s7 + t44*c7
-    t47 = t43*c7 - t44*s7
-    t48 = 0.13375*t45 + 0.1363*t43
+    t42 = c5*t39 - s5*t41
+    t43 = s5*t39 + c5*t41
+    t44 = c6*t42 - t40*s6
+    t45 = t40*c6 + s6*t42
+    t46 = t43*s7 + c7*t44
+    t47 = t43*c7 - s7*t44
+    t48 = 0.1363*t43 + 0.13375*t45
     t49 = -t48 + 0.4*t40
-    t50 = t49 + 0.1685*t41
-    t51 = t50 - 0.4*c2
+    t50 = 0.1685*t41 + t49
+    t51 = -0.4*c2 + t50
     t52 = 0.317 + t51
     T = _stack(xp, [
         t15,  # 0, 0
@@ -185,7 +185,7 @@ def jacobian(q):
     t1 = c1*c3
     t2 = t0 + c2*t1
     t3 = t1 + c2*t0
-    t4 = c3*s1
+    t4 = s1*c3
     t5 = c1*s3
     t6 = t4 - c2*t5
     t7 = -t5 + c2*t4
@@ -195,56 +195,56 @@ def jacobian(q):
     t11 = t9*c5 - t6*s5
     t12 = t9*s5 + t6*c5
     t13 = t10*c6 + t11*s6
-    t14 = 0.13375*t13 + 0.1363*t12
+    t14 = 0.1363*t12 + 0.13375*t13
     t15 = -t14 + 0.4*t10
-    t16 = t15 + 0.1685*t6
-    t17 = t16 - 0.4*t8
-    t18 = t17 - 0.1925*s1
-    t19 = t18 + 0.081*c1
+    t16 = 0.1685*t6 + t15
+    t17 = -0.4*t8 + t16
+    t18 = -0.1925*s1 + t17
+    t19 = 0.081*c1 + t18
     t20 = s1*s2
-    t21 = t7*c4 + s4*t20
-    t22 = -t7*s4 + c4*t20
-    t23 = t3*s5 + t21*c5
-    t24 = t3*c5 - t21*s5
-    t25 = t22*c6 + t23*s6
-    t26 = -0.13375*t25 + 0.1363*t24
-    t27 = t26 + 0.4*t22
-    t28 = t27 - 0.1685*t3
-    t29 = t28 - 0.4*t20
-    t30 = t29 + 0.1925*c1
-    t31 = t30 + 0.081*s1
+    t21 = c4*t7 + s4*t20
+    t22 = -s4*t7 + c4*t20
+    t23 = t3*s5 + c5*t21
+    t24 = t3*c5 - s5*t21
+    t25 = t22*c6 + s6*t23
+    t26 = 0.1363*t24 - 0.13375*t25
+    t27 = 0.4*t22 + t26
+    t28 = -0.1685*t3 + t27
+    t29 = -0.4*t20 + t28
+    t30 = 0.1925*c1 + t29
+    t31 = 0.081*s1 + t30
     t32 = c3*s2
     t33 = c2*s4 - c4*t32
     t34 = c2*c4 + s4*t32
-    t35 = s2*s3
-    t36 = t33*c5 - s5*t35
-    t37 = t33*s5 + c5*t35
-    t38 = t34*c6 + t36*s6
-    t39 = 0.13375*t38 + 0.1363*t37
+    t35 = s3*s2
+    t36 = c5*t33 - s5*t35
+    t37 = s5*t33 + c5*t35
+    t38 = t34*c6 + s6*t36
+    t39 = 0.1363*t37 + 0.13375*t38
     t40 = -t39 + 0.4*t34
-    t41 = t40 + 0.1685*t35
-    t42 = t41 - 0.4*c2
-    t43 = t42*c1
-    t44 = t42*s1
+    t41 = 0.1685*t35 + t40
+    t42 = -0.4*c2 + t41
+    t43 = c1*t42
+    t44 = s1*t42
     J = _stack(xp, [
         -t31,  # 0, 0
         t43,  # 0, 1
-        t29*c2 - s2*t44,  # 0, 2
+        c2*t29 - s2*t44,  # 0, 2
         -(t3*t41 + t28*t35),  # 0, 3
         t22*t40 - t34*t27,  # 0, 4
         t37*t26 - t24*t39,  # 0, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 6
         t19,  # 1, 0
         t44,  # 1, 1
-        -t17*c2 + s2*t43,  # 1, 2
-        -t41*t6 + t16*t35,  # 1, 3
+        -c2*t17 + s2*t43,  # 1, 2
+        -t6*t41 + t16*t35,  # 1, 3
         t34*t15 - t10*t40,  # 1, 4
         t37*t14 - t12*t39,  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
-        -(t18*c1 + t30*s1),  # 2, 1
+        -(c1*t18 + s1*t30),  # 2, 1
         t17*t20 - t29*t8,  # 2, 2
-        t3*t16 + t28*t6,  # 2, 3
+        t3*t16 + t6*t28,  # 2, 3
         t10*t27 - t22*t15,  # 2, 4
         t24*t14 - t12*t26,  # 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 6
@@ -295,7 +295,7 @@ def fk_jacobian(q):
     t1 = c1*c3
     t2 = t0 + c2*t1
     t3 = t1 + c2*t0
-    t4 = c3*s1
+    t4 = s1*c3
     t5 = c1*s3
     t6 = t4 - c2*t5
     t7 = -t5 + c2*t4
@@ -307,48 +307,48 @@ def fk_jacobian(q):
     t13 = t11*c6 - t10*s6
     t14 = t10*c6 + t11*s6
     t15 = t12*s7 + t13*c7
-    t16 = t12*c7 - t13*s7
-    t17 = 0.13375*t14 + 0.1363*t12
+    t16 = t12*c7 - s7*t13
+    t17 = 0.1363*t12 + 0.13375*t14
     t18 = -t17 + 0.4*t10
-    t19 = t18 + 0.1685*t6
-    t20 = t19 - 0.4*t8
-    t21 = t20 - 0.1925*s1
-    t22 = t21 + 0.081*c1
+    t19 = 0.1685*t6 + t18
+    t20 = -0.4*t8 + t19
+    t21 = -0.1925*s1 + t20
+    t22 = 0.081*c1 + t21
     t23 = s1*s2
-    t24 = t7*c4 + s4*t23
-    t25 = -t7*s4 + c4*t23
-    t26 = t3*s5 + t24*c5
-    t27 = t3*c5 - t24*s5
-    t28 = t26*c6 - t25*s6
-    t29 = t25*c6 + t26*s6
-    t30 = t28*c7 - t27*s7
-    t31 = t27*c7 + t28*s7
-    t32 = -0.13375*t29 + 0.1363*t27
-    t33 = t32 + 0.4*t25
-    t34 = t33 - 0.1685*t3
-    t35 = t34 - 0.4*t23
-    t36 = t35 + 0.1925*c1
-    t37 = t36 + 0.081*s1
+    t24 = c4*t7 + s4*t23
+    t25 = -s4*t7 + c4*t23
+    t26 = t3*s5 + c5*t24
+    t27 = t3*c5 - s5*t24
+    t28 = c6*t26 - t25*s6
+    t29 = t25*c6 + s6*t26
+    t30 = c7*t28 - t27*s7
+    t31 = t27*c7 + s7*t28
+    t32 = 0.1363*t27 - 0.13375*t29
+    t33 = 0.4*t25 + t32
+    t34 = -0.1685*t3 + t33
+    t35 = -0.4*t23 + t34
+    t36 = 0.1925*c1 + t35
+    t37 = 0.081*s1 + t36
     t38 = c3*s2
     t39 = c2*s4 - c4*t38
     t40 = c2*c4 + s4*t38
-    t41 = s2*s3
-    t42 = t39*c5 - s5*t41
-    t43 = t39*s5 + c5*t41
-    t44 = t42*c6 - t40*s6
-    t45 = t40*c6 + t42*s6
-    t46 = t43*s7 + t44*c7
-    t47 = t43*c7 - t44*s7
-    t48 = 0.13375*t45 + 0.1363*t43
+    t41 = s3*s2
+    t42 = c5*t39 - s5*t41
+    t43 = s5*t39 + c5*t41
+    t44 = c6*t42 - t40*s6
+    t45 = t40*c6 + s6*t42
+    t46 = t43*s7 + c7*t44
+    t47 = t43*c7 - s7*t44
+    t48 = 0.1363*t43 + 0.13375*t45
     t49 = -t48 + 0.4*t40
-    t50 = t49 + 0.1685*t41
-    t51 = t50 - 0.4*c2
+    t50 = 0.1685*t41 + t49
+    t51 = -0.4*c2 + t50
     t52 = 0.317 + t51
     t53 = -t14
     t54 = -t29
     t55 = -t45
-    t56 = t51*c1
-    t57 = t51*s1
+    t56 = c1*t51
+    t57 = s1*t51
     T = _stack(xp, [
         t15,  # 0, 0
         t16,  # 0, 1
@@ -370,22 +370,22 @@ def fk_jacobian(q):
     J = _stack(xp, [
         -t37,  # 0, 0
         t56,  # 0, 1
-        t35*c2 - s2*t57,  # 0, 2
+        c2*t35 - s2*t57,  # 0, 2
         -(t3*t50 + t34*t41),  # 0, 3
         t25*t49 - t40*t33,  # 0, 4
         t43*t32 - t27*t48,  # 0, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 6
         t22,  # 1, 0
         t57,  # 1, 1
-        -t20*c2 + s2*t56,  # 1, 2
-        -t50*t6 + t19*t41,  # 1, 3
+        -c2*t20 + s2*t56,  # 1, 2
+        -t6*t50 + t19*t41,  # 1, 3
         t40*t18 - t10*t49,  # 1, 4
         t43*t17 - t12*t48,  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
-        -(t21*c1 + t36*s1),  # 2, 1
+        -(c1*t21 + s1*t36),  # 2, 1
         t20*t23 - t35*t8,  # 2, 2
-        t3*t19 + t34*t6,  # 2, 3
+        t3*t19 + t6*t34,  # 2, 3
         t10*t33 - t25*t18,  # 2, 4
         t27*t17 - t12*t32,  # 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 6
@@ -436,7 +436,7 @@ def jacobian_tool(q):
     t1 = c1*c3
     t2 = t0 + c2*t1
     t3 = t1 + c2*t0
-    t4 = c3*s1
+    t4 = s1*c3
     t5 = c1*s3
     t6 = t4 - c2*t5
     t7 = -t5 + c2*t4
@@ -448,51 +448,51 @@ def jacobian_tool(q):
     t13 = t11*c6 - t10*s6
     t14 = t10*c6 + t11*s6
     t15 = t12*s7 + t13*c7
-    t16 = t12*c7 - t13*s7
-    t17 = 0.13375*t14 + 0.1363*t12
+    t16 = t12*c7 - s7*t13
+    t17 = 0.1363*t12 + 0.13375*t14
     t18 = -t17 + 0.4*t10
-    t19 = t18 + 0.1685*t6
-    t20 = t19 - 0.4*t8
-    t21 = t20 - 0.1925*s1
-    t22 = t21 + 0.081*c1
+    t19 = 0.1685*t6 + t18
+    t20 = -0.4*t8 + t19
+    t21 = -0.1925*s1 + t20
+    t22 = 0.081*c1 + t21
     t23 = s1*s2
-    t24 = t7*c4 + s4*t23
-    t25 = -t7*s4 + c4*t23
-    t26 = t3*s5 + t24*c5
-    t27 = t3*c5 - t24*s5
-    t28 = t26*c6 - t25*s6
-    t29 = t25*c6 + t26*s6
-    t30 = t28*c7 - t27*s7
-    t31 = t27*c7 + t28*s7
-    t32 = -0.13375*t29 + 0.1363*t27
-    t33 = t32 + 0.4*t25
-    t34 = t33 - 0.1685*t3
-    t35 = t34 - 0.4*t23
-    t36 = t35 + 0.1925*c1
-    t37 = t36 + 0.081*s1
+    t24 = c4*t7 + s4*t23
+    t25 = -s4*t7 + c4*t23
+    t26 = t3*s5 + c5*t24
+    t27 = t3*c5 - s5*t24
+    t28 = c6*t26 - t25*s6
+    t29 = t25*c6 + s6*t26
+    t30 = c7*t28 - t27*s7
+    t31 = t27*c7 + s7*t28
+    t32 = 0.1363*t27 - 0.13375*t29
+    t33 = 0.4*t25 + t32
+    t34 = -0.1685*t3 + t33
+    t35 = -0.4*t23 + t34
+    t36 = 0.1925*c1 + t35
+    t37 = 0.081*s1 + t36
     t38 = c3*s2
     t39 = c2*s4 - c4*t38
     t40 = c2*c4 + s4*t38
     t41 = s3*s2
-    t42 = t39*c5 - s5*t41
-    t43 = t39*s5 + c5*t41
-    t44 = t42*c6 - t40*s6
-    t45 = t40*c6 + t42*s6
-    t46 = t43*s7 + t44*c7
-    t47 = t43*c7 - t44*s7
-    t48 = 0.13375*t45 + 0.1363*t43
+    t42 = c5*t39 - s5*t41
+    t43 = s5*t39 + c5*t41
+    t44 = c6*t42 - t40*s6
+    t45 = t40*c6 + s6*t42
+    t46 = t43*s7 + c7*t44
+    t47 = t43*c7 - s7*t44
+    t48 = 0.1363*t43 + 0.13375*t45
     t49 = -t48 + 0.4*t40
-    t50 = t49 + 0.1685*t41
-    t51 = t50 - 0.4*c2
-    t52 = -(t21*c1 + t36*s1)
+    t50 = 0.1685*t41 + t49
+    t51 = -0.4*c2 + t50
+    t52 = -(c1*t21 + s1*t36)
     t53 = c1*t51
     t54 = s1*t51
-    t55 = t35*c2 - t51*t23
-    t56 = -t20*c2 + t51*t8
+    t55 = c2*t35 - t51*t23
+    t56 = -c2*t20 + t51*t8
     t57 = t20*t23 - t35*t8
     t58 = -(t3*t50 + t34*t41)
-    t59 = -t50*t6 + t19*t41
-    t60 = t3*t19 + t34*t6
+    t59 = -t6*t50 + t19*t41
+    t60 = t3*t19 + t6*t34
     t61 = t25*t49 - t40*t33
     t62 = t40*t18 - t10*t49
     t63 = t10*t33 - t25*t18
@@ -500,14 +500,14 @@ def jacobian_tool(q):
     t65 = t43*t17 - t12*t48
     t66 = t27*t17 - t12*t32
     J = _stack(xp, [
-        t30*t22 - t15*t37,  # 0, 0
+        t22*t30 - t15*t37,  # 0, 0
         t46*t52 + t15*t53 + t30*t54,  # 0, 1
         t15*t55 + t30*t56 + t46*t57,  # 0, 2
         t15*t58 + t30*t59 + t46*t60,  # 0, 3
         t15*t61 + t30*t62 + t46*t63,  # 0, 4
         t15*t64 + t30*t65 + t46*t66,  # 0, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 6
-        -(t16*t37 + t31*t22),  # 1, 0
+        -(t16*t37 + t22*t31),  # 1, 0
         t47*t52 + t16*t53 - t31*t54,  # 1, 1
         t16*t55 + t47*t57 - t31*t56,  # 1, 2
         t16*t58 + t47*t60 - t31*t59,  # 1, 3
@@ -522,23 +522,23 @@ def jacobian_tool(q):
         -(t14*t64 + t29*t65 + t45*t66),  # 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 6
         t46,  # 3, 0
-        t30*c1 - t15*s1,  # 3, 1
-        -(t46*c2 + t15*t8 + t30*t23),  # 3, 2
-        t15*t6 - t3*t30 + t46*t41,  # 3, 3
+        c1*t30 - s1*t15,  # 3, 1
+        -(c2*t46 + t15*t8 + t30*t23),  # 3, 2
+        t6*t15 - t3*t30 + t46*t41,  # 3, 3
         t10*t15 + t25*t30 + t40*t46,  # 3, 4
         -(-t27*t30 + t12*t15 + t43*t46),  # 3, 5
         -(t14*t15 + t29*t30 + t45*t46),  # 3, 6
         t47,  # 4, 0
-        -(t16*s1 + t31*c1),  # 4, 1
-        -(t47*c2 - t31*t23 + t16*t8),  # 4, 2
-        t3*t31 + t16*t6 + t47*t41,  # 4, 3
+        -(s1*t16 + c1*t31),  # 4, 1
+        -(c2*t47 - t31*t23 + t16*t8),  # 4, 2
+        t3*t31 + t6*t16 + t47*t41,  # 4, 3
         t10*t16 + t40*t47 - t25*t31,  # 4, 4
         -(t12*t16 + t27*t31 + t43*t47),  # 4, 5
         -(-t29*t31 + t14*t16 + t45*t47),  # 4, 6
         -t45,  # 5, 0
-        t14*s1 - t29*c1,  # 5, 1
-        t45*c2 + t14*t8 + t29*t23,  # 5, 2
-        -(-t3*t29 + t14*t6 + t45*t41),  # 5, 3
+        s1*t14 - c1*t29,  # 5, 1
+        c2*t45 + t14*t8 + t29*t23,  # 5, 2
+        -(-t3*t29 + t6*t14 + t45*t41),  # 5, 3
         -(t10*t14 + t25*t29 + t40*t45),  # 5, 4
         t12*t14 + t43*t45 - t27*t29,  # 5, 5
         t14**2 + t29**2 + t45**2,  # 5, 6
@@ -568,7 +568,7 @@ def task(q):
     t1 = c1*c3
     t2 = t0 + c2*t1
     t3 = t1 + c2*t0
-    t4 = c3*s1
+    t4 = s1*c3
     t5 = c1*s3
     t6 = t4 - c2*t5
     t7 = -t5 + c2*t4
@@ -580,40 +580,40 @@ def task(q):
     t13 = t11*c6 - t10*s6
     t14 = t10*c6 + t11*s6
     t15 = t12*s7 + t13*c7
-    t16 = 0.13375*t14 + 0.1363*t12
+    t16 = 0.1363*t12 + 0.13375*t14
     t17 = -t16 + 0.4*t10
-    t18 = t17 + 0.1685*t6
-    t19 = t18 - 0.4*t8
-    t20 = t19 - 0.1925*s1
-    t21 = t20 + 0.081*c1
+    t18 = 0.1685*t6 + t17
+    t19 = -0.4*t8 + t18
+    t20 = -0.1925*s1 + t19
+    t21 = 0.081*c1 + t20
     t22 = s1*s2
-    t23 = t7*c4 + s4*t22
-    t24 = -t7*s4 + c4*t22
-    t25 = t3*s5 + t23*c5
-    t26 = t3*c5 - t23*s5
-    t27 = t25*c6 - t24*s6
-    t28 = t24*c6 + t25*s6
-    t29 = t27*c7 - t26*s7
-    t30 = -0.13375*t28 + 0.1363*t26
-    t31 = t30 + 0.4*t24
-    t32 = t31 - 0.1685*t3
-    t33 = t32 - 0.4*t22
-    t34 = t33 + 0.1925*c1
-    t35 = t34 + 0.081*s1
+    t23 = c4*t7 + s4*t22
+    t24 = -s4*t7 + c4*t22
+    t25 = t3*s5 + c5*t23
+    t26 = t3*c5 - s5*t23
+    t27 = c6*t25 - t24*s6
+    t28 = t24*c6 + s6*t25
+    t29 = c7*t27 - t26*s7
+    t30 = 0.1363*t26 - 0.13375*t28
+    t31 = 0.4*t24 + t30
+    t32 = -0.1685*t3 + t31
+    t33 = -0.4*t22 + t32
+    t34 = 0.1925*c1 + t33
+    t35 = 0.081*s1 + t34
     t36 = c3*s2
     t37 = c2*s4 - c4*t36
     t38 = c2*c4 + s4*t36
     t39 = s3*s2
-    t40 = t37*c5 - s5*t39
-    t41 = t37*s5 + c5*t39
-    t42 = t40*c6 - t38*s6
-    t43 = t38*c6 + t40*s6
-    t44 = t41*s7 + t42*c7
-    t45 = t41*c7 - t42*s7
-    t46 = 0.13375*t43 + 0.1363*t41
+    t40 = c5*t37 - s5*t39
+    t41 = s5*t37 + c5*t39
+    t42 = c6*t40 - t38*s6
+    t43 = t38*c6 + s6*t40
+    t44 = t41*s7 + c7*t42
+    t45 = t41*c7 - s7*t42
+    t46 = 0.1363*t41 + 0.13375*t43
     t47 = -t46 + 0.4*t38
-    t48 = t47 + 0.1685*t39
-    t49 = t48 - 0.4*c2
+    t48 = 0.1685*t39 + t47
+    t49 = -0.4*c2 + t48
     t50 = 0.317 + t49
     mu = _stack(xp, [
         t21,  # 0
@@ -648,7 +648,7 @@ def task_jacobian(q):
     t1 = c1*c3
     t2 = t0 + c2*t1
     t3 = t1 + c2*t0
-    t4 = c3*s1
+    t4 = s1*c3
     t5 = c1*s3
     t6 = t4 - c2*t5
     t7 = -t5 + c2*t4
@@ -660,73 +660,73 @@ def task_jacobian(q):
     t13 = t11*c6 - t10*s6
     t14 = t10*c6 + t11*s6
     t15 = t12*s7 + t13*c7
-    t16 = 0.13375*t14 + 0.1363*t12
+    t16 = 0.1363*t12 + 0.13375*t14
     t17 = -t16 + 0.4*t10
-    t18 = t17 + 0.1685*t6
-    t19 = t18 - 0.4*t8
-    t20 = t19 - 0.1925*s1
-    t21 = t20 + 0.081*c1
+    t18 = 0.1685*t6 + t17
+    t19 = -0.4*t8 + t18
+    t20 = -0.1925*s1 + t19
+    t21 = 0.081*c1 + t20
     t22 = s1*s2
-    t23 = t7*c4 + s4*t22
-    t24 = -t7*s4 + c4*t22
-    t25 = t3*s5 + t23*c5
-    t26 = t3*c5 - t23*s5
-    t27 = t25*c6 - t24*s6
-    t28 = t24*c6 + t25*s6
-    t29 = t27*c7 - t26*s7
-    t30 = -0.13375*t28 + 0.1363*t26
-    t31 = t30 + 0.4*t24
-    t32 = t31 - 0.1685*t3
-    t33 = t32 - 0.4*t22
-    t34 = t33 + 0.1925*c1
-    t35 = t34 + 0.081*s1
+    t23 = c4*t7 + s4*t22
+    t24 = -s4*t7 + c4*t22
+    t25 = t3*s5 + c5*t23
+    t26 = t3*c5 - s5*t23
+    t27 = c6*t25 - t24*s6
+    t28 = t24*c6 + s6*t25
+    t29 = c7*t27 - t26*s7
+    t30 = 0.1363*t26 - 0.13375*t28
+    t31 = 0.4*t24 + t30
+    t32 = -0.1685*t3 + t31
+    t33 = -0.4*t22 + t32
+    t34 = 0.1925*c1 + t33
+    t35 = 0.081*s1 + t34
     t36 = c3*s2
     t37 = c2*s4 - c4*t36
     t38 = c2*c4 + s4*t36
-    t39 = s2*s3
-    t40 = t37*c5 - s5*t39
-    t41 = t37*s5 + c5*t39
-    t42 = t40*c6 - t38*s6
-    t43 = t38*c6 + t40*s6
-    t44 = t41*s7 + t42*c7
-    t45 = 0.13375*t43 + 0.1363*t41
+    t39 = s3*s2
+    t40 = c5*t37 - s5*t39
+    t41 = s5*t37 + c5*t39
+    t42 = c6*t40 - t38*s6
+    t43 = t38*c6 + s6*t40
+    t44 = t41*s7 + c7*t42
+    t45 = 0.1363*t41 + 0.13375*t43
     t46 = -t45 + 0.4*t38
-    t47 = t46 + 0.1685*t39
-    t48 = t47 - 0.4*c2
-    t49 = t48*c1
-    t50 = t48*s1
-    t51 = t15**2 + t29**2
-    t52 = 1/t51
-    t53 = t29*c1
-    t54 = t15*s1
-    t55 = t52*(t53 - t54)
-    t56 = t15*c1
-    t57 = t29*s1
-    t58 = -t52*(s2*t56 + s2*t57)
-    t59 = t52*(t15*t6 - t3*t29)
-    t60 = t52*(t10*t15 + t24*t29)
-    t61 = t52*(t26*t29 - t12*t15)
-    t62 = -t52*(t14*t15 + t28*t29)
-    t63 = 1/xp.sqrt(t51)
+    t47 = 0.1685*t39 + t46
+    t48 = -0.4*c2 + t47
+    t49 = c1*t48
+    t50 = s1*t48
+    t51 = c1*t29
+    t52 = s1*t15
+    t53 = t15**2 + t29**2
+    t54 = 1/t53
+    t55 = (t51 - t52)*t54
+    t56 = c1*t15
+    t57 = s1*t29
+    t58 = -t54*(s2*t56 + s2*t57)
+    t59 = t54*(t6*t15 - t3*t29)
+    t60 = t54*(t10*t15 + t24*t29)
+    t61 = t54*(t26*t29 - t12*t15)
+    t62 = -t54*(t14*t15 + t28*t29)
+    t63 = 1/xp.sqrt(t53)
     J = _stack(xp, [
         -t35,  # 0, 0
         t49,  # 0, 1
-        t33*c2 - s2*t50,  # 0, 2
+        c2*t33 - s2*t50,  # 0, 2
         -(t3*t47 + t32*t39),  # 0, 3
         t24*t46 - t38*t31,  # 0, 4
         t41*t30 - t26*t45,  # 0, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 6
         t21,  # 1, 0
         t50,  # 1, 1
-        -t19*c2 + s2*t49,  # 1, 2
-        -t47*t6 + t18*t39,  # 1, 3
+        -c2*t19 + s2*t49,  # 1, 2
+        -t6*t47 + t18*t39,  # 1, 3
         t38*t17 - t10*t46,  # 1, 4
         t41*t16 - t12*t45,  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
-        -(t20*c1 + t34*s1),  # 2, 1
+        -(c1*t20 + s1*t34),  # 2, 1
         t19*t22 - t33*t8,  # 2, 2
-        t3*t18 + t32*t6,  # 2, 3
+        t3*t18 + t6*t32,  # 2, 3
         t10*t31 - t24*t17,  # 2, 4
         t26*t16 - t12*t30,  # 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 6
@@ -739,8 +739,8 @@ def task_jacobian(q):
         t62,  # 3, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
         t63*(t56 + t57),  # 4, 1
-        t63*(s2*t53 - s2*t54),  # 4, 2
-        -t63*(t3*t15 + t29*t6),  # 4, 3
+        t63*(s2*t51 - s2*t52),  # 4, 2
+        -t63*(t3*t15 + t6*t29),  # 4, 3
         t63*(t24*t15 - t10*t29),  # 4, 4
         t63*(t12*t29 + t26*t15),  # 4, 5
         t63*(t14*t29 - t28*t15),  # 4, 6
@@ -785,7 +785,7 @@ def fk_jacobian_dot(q, q_dot):
     t2 = c1*c3
     t3 = t1 + c2*t2
     t4 = t2 + c2*t1
-    t5 = c3*s1
+    t5 = s1*c3
     t6 = c1*s3
     t7 = t5 - c2*t6
     t8 = -t6 + c2*t5
@@ -797,47 +797,47 @@ def fk_jacobian_dot(q, q_dot):
     t14 = t12*c6 - t11*s6
     t15 = t11*c6 + t12*s6
     t16 = t13*s7 + t14*c7
-    t17 = t13*c7 - t14*s7
-    t18 = 0.13375*t15 + 0.1363*t13
+    t17 = t13*c7 - s7*t14
+    t18 = 0.1363*t13 + 0.13375*t15
     t19 = -t18 + 0.4*t11
-    t20 = t19 + 0.1685*t7
-    t21 = t20 - 0.4*t9
-    t22 = t21 - 0.1925*s1
-    t23 = t22 + 0.081*c1
+    t20 = 0.1685*t7 + t19
+    t21 = -0.4*t9 + t20
+    t22 = -0.1925*s1 + t21
+    t23 = 0.081*c1 + t22
     t24 = s1*s2
-    t25 = t8*c4 + s4*t24
-    t26 = -t8*s4 + c4*t24
-    t27 = t4*s5 + t25*c5
-    t28 = t4*c5 - t25*s5
-    t29 = t27*c6 - t26*s6
-    t30 = t26*c6 + t27*s6
-    t31 = t29*c7 - t28*s7
-    t32 = t28*c7 + t29*s7
-    t33 = -0.13375*t30 + 0.1363*t28
-    t34 = t33 + 0.4*t26
-    t35 = t34 - 0.1685*t4
-    t36 = t35 - 0.4*t24
-    t37 = t36 + 0.1925*c1
-    t38 = t37 + 0.081*s1
+    t25 = c4*t8 + s4*t24
+    t26 = -s4*t8 + c4*t24
+    t27 = t4*s5 + c5*t25
+    t28 = t4*c5 - s5*t25
+    t29 = c6*t27 - t26*s6
+    t30 = t26*c6 + s6*t27
+    t31 = c7*t29 - t28*s7
+    t32 = t28*c7 + s7*t29
+    t33 = 0.1363*t28 - 0.13375*t30
+    t34 = 0.4*t26 + t33
+    t35 = -0.1685*t4 + t34
+    t36 = -0.4*t24 + t35
+    t37 = 0.1925*c1 + t36
+    t38 = 0.081*s1 + t37
     t39 = c3*s2
     t40 = c2*s4 - c4*t39
     t41 = c2*c4 + s4*t39
-    t42 = s2*s3
-    t43 = t40*c5 - s5*t42
-    t44 = t40*s5 + c5*t42
-    t45 = t43*c6 - t41*s6
-    t46 = t41*c6 + t43*s6
-    t47 = t44*s7 + t45*c7
-    t48 = t44*c7 - t45*s7
-    t49 = 0.13375*t46 + 0.1363*t44
+    t42 = s3*s2
+    t43 = c5*t40 - s5*t42
+    t44 = s5*t40 + c5*t42
+    t45 = c6*t43 - t41*s6
+    t46 = t41*c6 + s6*t43
+    t47 = t44*s7 + c7*t45
+    t48 = t44*c7 - s7*t45
+    t49 = 0.1363*t44 + 0.13375*t46
     t50 = -t49 + 0.4*t41
-    t51 = t50 + 0.1685*t42
-    t52 = t51 - 0.4*c2
+    t51 = 0.1685*t42 + t50
+    t52 = -0.4*c2 + t51
     t53 = 0.317 + t52
-    t54 = t0 + qd4*t42
+    t54 = t0 + t42*qd4
     t55 = t54 + t41*qd5
-    t56 = t52*s1
-    t57 = t36*c2 - s2*t56
+    t56 = s1*t52
+    t57 = c2*t36 - s2*t56
     t58 = t57
     t59 = t4*t51 + t35*t42
     t60 = t59
@@ -845,43 +845,43 @@ def fk_jacobian_dot(q, q_dot):
     t62 = t61
     t63 = t44*t33 - t28*t49
     t64 = t63
-    t65 = t62*qd5 + t64*qd6
-    t66 = t65 - t60*qd4
-    t67 = t66 + t58*qd3
-    t68 = t52*c1
-    t69 = -t21*c2 + s2*t68
+    t65 = qd5*t62 + qd6*t64
+    t66 = t65 - qd4*t60
+    t67 = t66 + qd3*t58
+    t68 = c1*t52
+    t69 = -c2*t21 + s2*t68
     t70 = t69
-    t71 = -t51*t7 + t20*t42
+    t71 = -t7*t51 + t20*t42
     t72 = t71
     t73 = t41*t19 - t11*t50
     t74 = t73
     t75 = t44*t18 - t13*t49
     t76 = t75
-    t77 = t74*qd5 + t76*qd6
-    t78 = t77 + t72*qd4
-    t79 = t78 + t70*qd3
-    t80 = t22*c1 + t37*s1
+    t77 = qd5*t74 + qd6*t76
+    t78 = t77 + qd4*t72
+    t79 = t78 + qd3*t70
+    t80 = c1*t22 + s1*t37
     t81 = t80
     t82 = t21*t24 - t36*t9
     t83 = t82
-    t84 = t4*t20 + t35*t7
+    t84 = t4*t20 + t7*t35
     t85 = t84
     t86 = t11*t34 - t26*t19
     t87 = t86
     t88 = t28*t18 - t13*t33
     t89 = t88
-    t90 = t87*qd5 + t89*qd6
-    t91 = t90 + t85*qd4
-    t92 = t91 + t83*qd3
-    t93 = t92 - t81*qd2
-    t94 = qd2*s1
-    t95 = t94 + qd3*t9
+    t90 = qd5*t87 + qd6*t89
+    t91 = t90 + qd4*t85
+    t92 = t91 + qd3*t83
+    t93 = t92 - qd2*t81
+    t94 = s1*qd2
+    t95 = t94 + t9*qd3
     t96 = -t95 + t7*qd4
     t97 = t96 + t11*qd5
     t98 = t79 + t52*t94
     t99 = t98 + t23*qd1
     t100 = c1*qd2
-    t101 = t100 - qd3*t24
+    t101 = t100 - t24*qd3
     t102 = t101 - t4*qd4
     t103 = t102 + t26*qd5
     t104 = t67 + t52*t100
@@ -895,7 +895,7 @@ def fk_jacobian_dot(q, q_dot):
     t112 = -t15
     t113 = -t30
     t114 = -t46
-    t115 = qd2*s2
+    t115 = s2*qd2
     T = _stack(xp, [
         xp.broadcast_to(t16, batch),  # 0, 0
         xp.broadcast_to(t17, batch),  # 0, 1
@@ -959,11 +959,11 @@ def fk_jacobian_dot(q, q_dot):
         xp.broadcast_to(t114, batch),  # 5, 6
     ], (6, 7))
     a = _stack(xp, [
-        xp.broadcast_to(qd2*(t93*c1 - qd1*t56) + qd3*(t79*c2 - t70*qd1 + t83*t100 - t92*t24) - qd4*(-t85*t101 + t91*t4 + t72*t0 + t78*t42) + qd5*(t90*t26 + t87*t102 - t77*t41 - t74*t54) + qd6*(t89*t103 - t76*t55 + t89*t108 + t76*t110) - t99*qd1, batch),  # 0
-        xp.broadcast_to(t105*qd1 + qd2*(t93*s1 + qd1*t68) + qd3*(t58*qd1 - t67*c2 + t92*t9 + t83*t94) + qd4*(t85*t95 - t91*t7 - t60*t0 + t66*t42) + qd5*(t65*t41 + t62*t54 - t90*t11 - t87*t96) + qd6*(t64*t55 - t89*t97 + t89*t106 - t64*t110), batch),  # 1
-        xp.broadcast_to(-qd2*(t104*c1 + t98*s1) - qd3*(-t67*t24 + t79*t9 + t58*t100 + t70*t94) + qd4*(t66*t4 + t78*t7 + t60*t101 - t72*t95) + qd5*(t77*t11 + t74*t96 - t65*t26 - t62*t102) - qd6*(-t76*t97 + t64*t103 + t76*t106 + t64*t108), batch),  # 2
-        xp.broadcast_to(qd3*(qd1*t24 - c2*t100) + qd4*(t4*t0 + t101*t42) + qd5*(t41*t102 - t26*t54) - qd6*(t28*t55 + t44*t103) + qd7*(t111*t30 - t46*t109) - qd1*t100, batch),  # 3
-        xp.broadcast_to(-qd3*(qd1*t9 + c2*t94) + qd4*(t7*t0 + t95*t42) + qd5*(t11*t54 - t41*t96) + qd6*(t44*t97 - t13*t55) + qd7*(t46*t107 - t111*t15) - qd1*t94, batch),  # 4
+        xp.broadcast_to(qd2*(c1*t93 - t56*qd1) + qd3*(c2*t79 - qd1*t70 + t83*t100 - t24*t92) - qd4*(-t101*t85 + t4*t91 + t0*t72 + t42*t78) + qd5*(t26*t90 + t102*t87 - t41*t77 - t54*t74) + qd6*(t103*t89 - t55*t76 + t89*t108 + t76*t110) - qd1*t99, batch),  # 0
+        xp.broadcast_to(qd1*t105 + qd2*(s1*t93 + t68*qd1) + qd3*(qd1*t58 - c2*t67 + t9*t92 + t83*t94) + qd4*(t95*t85 - t7*t91 - t0*t60 + t42*t66) + qd5*(t41*t65 + t54*t62 - t11*t90 - t96*t87) + qd6*(t55*t64 - t97*t89 + t89*t106 - t64*t110), batch),  # 1
+        xp.broadcast_to(-qd2*(c1*t104 + s1*t98) - qd3*(-t24*t67 + t9*t79 + t58*t100 + t70*t94) + qd4*(t4*t66 + t7*t78 + t101*t60 - t95*t72) + qd5*(t11*t77 + t96*t74 - t26*t65 - t102*t62) - qd6*(-t97*t76 + t103*t64 + t76*t106 + t64*t108), batch),  # 2
+        xp.broadcast_to(qd3*(t24*qd1 - c2*t100) + qd4*(t4*t0 + t42*t101) + qd5*(t41*t102 - t26*t54) - qd6*(t28*t55 + t44*t103) + qd7*(t30*t111 - t46*t109) - qd1*t100, batch),  # 3
+        xp.broadcast_to(-qd3*(t9*qd1 + c2*t94) + qd4*(t7*t0 + t42*t95) + qd5*(t11*t54 - t41*t96) + qd6*(t44*t97 - t13*t55) + qd7*(t46*t107 - t15*t111) - qd1*t94, batch),  # 4
         xp.broadcast_to(qd3*(c1**2*t115 + s1**2*t115) + qd4*(t4*t95 - t7*t101) + qd5*(t26*t96 - t11*t102) + qd6*(t13*t103 + t28*t97) + qd7*(t15*t109 - t30*t107), batch),  # 5
     ], (6,))
     return T, J, a
@@ -996,7 +996,7 @@ def jacobian_dot(q, q_dot):
     t2 = c1*c3
     t3 = t1 + c2*t2
     t4 = t2 + c2*t1
-    t5 = c3*s1
+    t5 = s1*c3
     t6 = c1*s3
     t7 = t5 - c2*t6
     t8 = -t6 + c2*t5
@@ -1006,68 +1006,68 @@ def jacobian_dot(q, q_dot):
     t12 = t10*c5 - t7*s5
     t13 = t10*s5 + t7*c5
     t14 = t11*c6 + t12*s6
-    t15 = 0.13375*t14 + 0.1363*t13
+    t15 = 0.1363*t13 + 0.13375*t14
     t16 = -t15 + 0.4*t11
-    t17 = t16 + 0.1685*t7
-    t18 = t17 - 0.4*t9
-    t19 = t18 - 0.1925*s1
-    t20 = t19 + 0.081*c1
+    t17 = 0.1685*t7 + t16
+    t18 = -0.4*t9 + t17
+    t19 = -0.1925*s1 + t18
+    t20 = 0.081*c1 + t19
     t21 = s1*s2
-    t22 = t8*c4 + s4*t21
-    t23 = -t8*s4 + c4*t21
-    t24 = t4*s5 + t22*c5
-    t25 = t4*c5 - t22*s5
-    t26 = t23*c6 + t24*s6
-    t27 = -0.13375*t26 + 0.1363*t25
-    t28 = t27 + 0.4*t23
-    t29 = t28 - 0.1685*t4
-    t30 = t29 - 0.4*t21
-    t31 = t30 + 0.1925*c1
-    t32 = t31 + 0.081*s1
-    t33 = t19*c1 + t31*s1
+    t22 = c4*t8 + s4*t21
+    t23 = -s4*t8 + c4*t21
+    t24 = t4*s5 + c5*t22
+    t25 = t4*c5 - s5*t22
+    t26 = t23*c6 + s6*t24
+    t27 = 0.1363*t25 - 0.13375*t26
+    t28 = 0.4*t23 + t27
+    t29 = -0.1685*t4 + t28
+    t30 = -0.4*t21 + t29
+    t31 = 0.1925*c1 + t30
+    t32 = 0.081*s1 + t31
+    t33 = c1*t19 + s1*t31
     t34 = t18*t21 - t30*t9
-    t35 = t4*t17 + t29*t7
+    t35 = t4*t17 + t7*t29
     t36 = t11*t28 - t23*t16
     t37 = t25*t15 - t13*t27
-    t38 = t36*qd5 + t37*qd6
-    t39 = t38 + t35*qd4
-    t40 = t39 + t34*qd3
-    t41 = t40 - t33*qd2
+    t38 = qd5*t36 + qd6*t37
+    t39 = t38 + qd4*t35
+    t40 = t39 + qd3*t34
+    t41 = t40 - qd2*t33
     t42 = c3*s2
     t43 = c2*s4 - c4*t42
     t44 = c2*c4 + s4*t42
     t45 = s3*s2
-    t46 = t43*c5 - s5*t45
-    t47 = t43*s5 + c5*t45
-    t48 = t44*c6 + t46*s6
-    t49 = 0.13375*t48 + 0.1363*t47
+    t46 = c5*t43 - s5*t45
+    t47 = s5*t43 + c5*t45
+    t48 = t44*c6 + s6*t46
+    t49 = 0.1363*t47 + 0.13375*t48
     t50 = -t49 + 0.4*t44
-    t51 = t50 + 0.1685*t45
-    t52 = t51 - 0.4*c2
-    t53 = t30*c2 - t52*t21
+    t51 = 0.1685*t45 + t50
+    t52 = -0.4*c2 + t51
+    t53 = c2*t30 - t52*t21
     t54 = t4*t51 + t29*t45
     t55 = t23*t50 - t44*t28
     t56 = t47*t27 - t25*t49
-    t57 = -t18*c2 + t52*t9
-    t58 = -t51*t7 + t17*t45
+    t57 = -c2*t18 + t52*t9
+    t58 = -t7*t51 + t17*t45
     t59 = t44*t16 - t11*t50
     t60 = t47*t15 - t13*t49
-    t61 = t0 + qd4*t45
+    t61 = t0 + t45*qd4
     t62 = t61 + t44*qd5
-    t63 = t55*qd5 + t56*qd6
-    t64 = t59*qd5 + t60*qd6
-    t65 = t63 - t54*qd4
-    t66 = t64 + t58*qd4
-    t67 = t65 + t53*qd3
-    t68 = t66 + t57*qd3
-    t69 = qd2*s1
-    t70 = t69 + qd3*t9
+    t63 = qd5*t55 + qd6*t56
+    t64 = qd5*t59 + qd6*t60
+    t65 = t63 - qd4*t54
+    t66 = t64 + qd4*t58
+    t67 = t65 + qd3*t53
+    t68 = t66 + qd3*t57
+    t69 = s1*qd2
+    t70 = t69 + t9*qd3
     t71 = -t70 + t7*qd4
     t72 = t71 + t11*qd5
     t73 = t68 + t52*t69
     t74 = t73 + t20*qd1
     t75 = c1*qd2
-    t76 = t75 - qd3*t21
+    t76 = t75 - t21*qd3
     t77 = t76 - t4*qd4
     t78 = t77 + t23*qd5
     t79 = t67 + t52*t75
@@ -1078,45 +1078,45 @@ def jacobian_dot(q, q_dot):
     t84 = t78 + t83
     t85 = t47*qd6
     t86 = t62 - t85
-    t87 = qd1*s1
+    t87 = s1*qd1
     t88 = c1*qd1
-    t89 = qd2*s2
+    t89 = s2*qd2
     Jd = _stack(xp, [
         xp.broadcast_to(-t74, batch),  # 0, 0
-        xp.broadcast_to(t41*c1 - t52*t87, batch),  # 0, 1
-        xp.broadcast_to(t68*c2 - t57*qd1 + t34*t75 - t40*t21, batch),  # 0, 2
-        xp.broadcast_to(-(-t35*t76 + t39*t4 + t58*t0 + t66*t45), batch),  # 0, 3
-        xp.broadcast_to(t38*t23 + t36*t77 - t64*t44 - t59*t61, batch),  # 0, 4
-        xp.broadcast_to(t37*t78 - t60*t62 + t37*t83 + t60*t85, batch),  # 0, 5
+        xp.broadcast_to(c1*t41 - t52*t87, batch),  # 0, 1
+        xp.broadcast_to(c2*t68 - qd1*t57 + t75*t34 - t21*t40, batch),  # 0, 2
+        xp.broadcast_to(-(-t76*t35 + t4*t39 + t0*t58 + t45*t66), batch),  # 0, 3
+        xp.broadcast_to(t23*t38 + t77*t36 - t44*t64 - t61*t59, batch),  # 0, 4
+        xp.broadcast_to(t78*t37 - t62*t60 + t83*t37 + t85*t60, batch),  # 0, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 6
         xp.broadcast_to(t80, batch),  # 1, 0
-        xp.broadcast_to(t41*s1 + t52*t88, batch),  # 1, 1
-        xp.broadcast_to(t53*qd1 - t67*c2 + t40*t9 + t34*t69, batch),  # 1, 2
-        xp.broadcast_to(t35*t70 - t39*t7 - t54*t0 + t65*t45, batch),  # 1, 3
-        xp.broadcast_to(t63*t44 + t55*t61 - t38*t11 - t36*t71, batch),  # 1, 4
-        xp.broadcast_to(t56*t62 - t37*t72 + t37*t81 - t56*t85, batch),  # 1, 5
+        xp.broadcast_to(s1*t41 + t52*t88, batch),  # 1, 1
+        xp.broadcast_to(qd1*t53 - c2*t67 + t9*t40 + t69*t34, batch),  # 1, 2
+        xp.broadcast_to(t70*t35 - t7*t39 - t0*t54 + t45*t65, batch),  # 1, 3
+        xp.broadcast_to(t44*t63 + t61*t55 - t11*t38 - t71*t36, batch),  # 1, 4
+        xp.broadcast_to(t62*t56 - t72*t37 + t81*t37 - t85*t56, batch),  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
-        xp.broadcast_to(-(t79*c1 + t73*s1), batch),  # 2, 1
-        xp.broadcast_to(-(-t67*t21 + t68*t9 + t53*t75 + t57*t69), batch),  # 2, 2
-        xp.broadcast_to(t65*t4 + t66*t7 + t54*t76 - t58*t70, batch),  # 2, 3
-        xp.broadcast_to(t64*t11 + t59*t71 - t63*t23 - t55*t77, batch),  # 2, 4
-        xp.broadcast_to(-(-t60*t72 + t56*t78 + t60*t81 + t56*t83), batch),  # 2, 5
+        xp.broadcast_to(-(c1*t79 + s1*t73), batch),  # 2, 1
+        xp.broadcast_to(-(-t21*t67 + t9*t68 + t75*t53 + t69*t57), batch),  # 2, 2
+        xp.broadcast_to(t4*t65 + t7*t66 + t76*t54 - t70*t58, batch),  # 2, 3
+        xp.broadcast_to(t11*t64 + t71*t59 - t23*t63 - t77*t55, batch),  # 2, 4
+        xp.broadcast_to(-(-t72*t60 + t78*t56 + t81*t60 + t83*t56), batch),  # 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
         xp.broadcast_to(-t88, batch),  # 3, 1
         xp.broadcast_to(s2*t87 - c2*t75, batch),  # 3, 2
-        xp.broadcast_to(t4*t0 + t76*t45, batch),  # 3, 3
+        xp.broadcast_to(t4*t0 + t45*t76, batch),  # 3, 3
         xp.broadcast_to(t44*t77 - t23*t61, batch),  # 3, 4
         xp.broadcast_to(-(t25*t62 + t47*t78), batch),  # 3, 5
-        xp.broadcast_to(t86*t26 - t48*t84, batch),  # 3, 6
+        xp.broadcast_to(t26*t86 - t48*t84, batch),  # 3, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
         xp.broadcast_to(-t87, batch),  # 4, 1
         xp.broadcast_to(-(s2*t88 + c2*t69), batch),  # 4, 2
-        xp.broadcast_to(t7*t0 + t70*t45, batch),  # 4, 3
+        xp.broadcast_to(t7*t0 + t45*t70, batch),  # 4, 3
         xp.broadcast_to(t11*t61 - t44*t71, batch),  # 4, 4
         xp.broadcast_to(t47*t72 - t13*t62, batch),  # 4, 5
-        xp.broadcast_to(t48*t82 - t86*t14, batch),  # 4, 6
+        xp.broadcast_to(t48*t82 - t14*t86, batch),  # 4, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 1
         xp.broadcast_to(c1**2*t89 + s1**2*t89, batch),  # 5, 2
@@ -1156,7 +1156,7 @@ def bias_acceleration(q, q_dot):
     t2 = c1*c3
     t3 = t1 + c2*t2
     t4 = t2 + c2*t1
-    t5 = c3*s1
+    t5 = s1*c3
     t6 = c1*s3
     t7 = t5 - c2*t6
     t8 = -t6 + c2*t5
@@ -1166,68 +1166,68 @@ def bias_acceleration(q, q_dot):
     t12 = t10*c5 - t7*s5
     t13 = t10*s5 + t7*c5
     t14 = t11*c6 + t12*s6
-    t15 = 0.13375*t14 + 0.1363*t13
+    t15 = 0.1363*t13 + 0.13375*t14
     t16 = -t15 + 0.4*t11
-    t17 = t16 + 0.1685*t7
-    t18 = t17 - 0.4*t9
-    t19 = t18 - 0.1925*s1
-    t20 = t19 + 0.081*c1
+    t17 = 0.1685*t7 + t16
+    t18 = -0.4*t9 + t17
+    t19 = -0.1925*s1 + t18
+    t20 = 0.081*c1 + t19
     t21 = s1*s2
-    t22 = t8*c4 + s4*t21
-    t23 = -t8*s4 + c4*t21
-    t24 = t4*s5 + t22*c5
-    t25 = t4*c5 - t22*s5
-    t26 = t23*c6 + t24*s6
-    t27 = -0.13375*t26 + 0.1363*t25
-    t28 = t27 + 0.4*t23
-    t29 = t28 - 0.1685*t4
-    t30 = t29 - 0.4*t21
-    t31 = t30 + 0.1925*c1
-    t32 = t31 + 0.081*s1
-    t33 = t19*c1 + t31*s1
+    t22 = c4*t8 + s4*t21
+    t23 = -s4*t8 + c4*t21
+    t24 = t4*s5 + c5*t22
+    t25 = t4*c5 - s5*t22
+    t26 = t23*c6 + s6*t24
+    t27 = 0.1363*t25 - 0.13375*t26
+    t28 = 0.4*t23 + t27
+    t29 = -0.1685*t4 + t28
+    t30 = -0.4*t21 + t29
+    t31 = 0.1925*c1 + t30
+    t32 = 0.081*s1 + t31
+    t33 = c1*t19 + s1*t31
     t34 = t18*t21 - t30*t9
-    t35 = t4*t17 + t29*t7
+    t35 = t4*t17 + t7*t29
     t36 = t11*t28 - t23*t16
     t37 = t25*t15 - t13*t27
-    t38 = t36*qd5 + t37*qd6
-    t39 = t38 + t35*qd4
-    t40 = t39 + t34*qd3
-    t41 = t40 - t33*qd2
+    t38 = qd5*t36 + qd6*t37
+    t39 = t38 + qd4*t35
+    t40 = t39 + qd3*t34
+    t41 = t40 - qd2*t33
     t42 = c3*s2
     t43 = c2*s4 - c4*t42
     t44 = c2*c4 + s4*t42
     t45 = s3*s2
-    t46 = t43*c5 - s5*t45
-    t47 = t43*s5 + c5*t45
-    t48 = t44*c6 + t46*s6
-    t49 = 0.13375*t48 + 0.1363*t47
+    t46 = c5*t43 - s5*t45
+    t47 = s5*t43 + c5*t45
+    t48 = t44*c6 + s6*t46
+    t49 = 0.1363*t47 + 0.13375*t48
     t50 = -t49 + 0.4*t44
-    t51 = t50 + 0.1685*t45
-    t52 = t51 - 0.4*c2
-    t53 = t30*c2 - t52*t21
+    t51 = 0.1685*t45 + t50
+    t52 = -0.4*c2 + t51
+    t53 = c2*t30 - t52*t21
     t54 = t4*t51 + t29*t45
     t55 = t23*t50 - t44*t28
     t56 = t47*t27 - t25*t49
-    t57 = -t18*c2 + t52*t9
-    t58 = -t51*t7 + t17*t45
+    t57 = -c2*t18 + t52*t9
+    t58 = -t7*t51 + t17*t45
     t59 = t44*t16 - t11*t50
     t60 = t47*t15 - t13*t49
-    t61 = t0 + qd4*t45
+    t61 = t0 + t45*qd4
     t62 = t61 + t44*qd5
-    t63 = t55*qd5 + t56*qd6
-    t64 = t59*qd5 + t60*qd6
-    t65 = t63 - t54*qd4
-    t66 = t64 + t58*qd4
-    t67 = t65 + t53*qd3
-    t68 = t66 + t57*qd3
-    t69 = qd2*s1
-    t70 = t69 + qd3*t9
+    t63 = qd5*t55 + qd6*t56
+    t64 = qd5*t59 + qd6*t60
+    t65 = t63 - qd4*t54
+    t66 = t64 + qd4*t58
+    t67 = t65 + qd3*t53
+    t68 = t66 + qd3*t57
+    t69 = s1*qd2
+    t70 = t69 + t9*qd3
     t71 = -t70 + t7*qd4
     t72 = t71 + t11*qd5
     t73 = t68 + t52*t69
     t74 = t73 + t20*qd1
     t75 = c1*qd2
-    t76 = t75 - qd3*t21
+    t76 = t75 - t21*qd3
     t77 = t76 - t4*qd4
     t78 = t77 + t23*qd5
     t79 = t67 + t52*t75
@@ -1238,14 +1238,14 @@ def bias_acceleration(q, q_dot):
     t84 = t78 + t83
     t85 = t47*qd6
     t86 = t62 - t85
-    t87 = qd1*t52
-    t88 = qd2*s2
+    t87 = t52*qd1
+    t88 = s2*qd2
     a = _stack(xp, [
-        xp.broadcast_to(qd2*(t41*c1 - s1*t87) + qd3*(t68*c2 - t57*qd1 + t34*t75 - t40*t21) - qd4*(-t35*t76 + t39*t4 + t58*t0 + t66*t45) + qd5*(t38*t23 + t36*t77 - t64*t44 - t59*t61) + qd6*(t37*t78 - t60*t62 + t37*t83 + t60*t85) - t74*qd1, batch),  # 0
-        xp.broadcast_to(t80*qd1 + qd2*(t41*s1 + c1*t87) + qd3*(t53*qd1 - t67*c2 + t40*t9 + t34*t69) + qd4*(t35*t70 - t39*t7 - t54*t0 + t65*t45) + qd5*(t63*t44 + t55*t61 - t38*t11 - t36*t71) + qd6*(t56*t62 - t37*t72 + t37*t81 - t56*t85), batch),  # 1
-        xp.broadcast_to(-qd2*(t79*c1 + t73*s1) - qd3*(-t67*t21 + t68*t9 + t53*t75 + t57*t69) + qd4*(t65*t4 + t66*t7 + t54*t76 - t58*t70) + qd5*(t64*t11 + t59*t71 - t63*t23 - t55*t77) - qd6*(-t60*t72 + t56*t78 + t60*t81 + t56*t83), batch),  # 2
-        xp.broadcast_to(qd3*(qd1*t21 - c2*t75) + qd4*(t4*t0 + t76*t45) + qd5*(t44*t77 - t23*t61) - qd6*(t25*t62 + t47*t78) + qd7*(t86*t26 - t48*t84) - qd1*t75, batch),  # 3
-        xp.broadcast_to(-qd3*(qd1*t9 + c2*t69) + qd4*(t7*t0 + t70*t45) + qd5*(t11*t61 - t44*t71) + qd6*(t47*t72 - t13*t62) + qd7*(t48*t82 - t86*t14) - qd1*t69, batch),  # 4
+        xp.broadcast_to(qd2*(c1*t41 - s1*t87) + qd3*(c2*t68 - qd1*t57 + t75*t34 - t21*t40) - qd4*(-t76*t35 + t4*t39 + t0*t58 + t45*t66) + qd5*(t23*t38 + t77*t36 - t44*t64 - t61*t59) + qd6*(t78*t37 - t62*t60 + t83*t37 + t85*t60) - qd1*t74, batch),  # 0
+        xp.broadcast_to(qd1*t80 + qd2*(s1*t41 + c1*t87) + qd3*(qd1*t53 - c2*t67 + t9*t40 + t69*t34) + qd4*(t70*t35 - t7*t39 - t0*t54 + t45*t65) + qd5*(t44*t63 + t61*t55 - t11*t38 - t71*t36) + qd6*(t62*t56 - t72*t37 + t81*t37 - t85*t56), batch),  # 1
+        xp.broadcast_to(-qd2*(c1*t79 + s1*t73) - qd3*(-t21*t67 + t9*t68 + t75*t53 + t69*t57) + qd4*(t4*t65 + t7*t66 + t76*t54 - t70*t58) + qd5*(t11*t64 + t71*t59 - t23*t63 - t77*t55) - qd6*(-t72*t60 + t78*t56 + t81*t60 + t83*t56), batch),  # 2
+        xp.broadcast_to(qd3*(t21*qd1 - c2*t75) + qd4*(t4*t0 + t45*t76) + qd5*(t44*t77 - t23*t61) - qd6*(t25*t62 + t47*t78) + qd7*(t26*t86 - t48*t84) - t75*qd1, batch),  # 3
+        xp.broadcast_to(-qd3*(t9*qd1 + c2*t69) + qd4*(t7*t0 + t45*t70) + qd5*(t11*t61 - t44*t71) + qd6*(t47*t72 - t13*t62) + qd7*(t48*t82 - t14*t86) - t69*qd1, batch),  # 4
         xp.broadcast_to(qd3*(c1**2*t88 + s1**2*t88) + qd4*(t4*t70 - t7*t76) + qd5*(t23*t71 - t11*t77) + qd6*(t13*t78 + t25*t72) + qd7*(t14*t84 - t26*t82), batch),  # 5
     ], (6,))
     return a
@@ -1280,7 +1280,7 @@ def task_jacobian_dot(q, q_dot):
     t1 = c1*c3
     t2 = t0 + c2*t1
     t3 = t1 + c2*t0
-    t4 = c3*s1
+    t4 = s1*c3
     t5 = c1*s3
     t6 = t4 - c2*t5
     t7 = -t5 + c2*t4
@@ -1292,98 +1292,98 @@ def task_jacobian_dot(q, q_dot):
     t13 = t11*c6 - t10*s6
     t14 = t10*c6 + t11*s6
     t15 = t12*s7 + t13*c7
-    t16 = 0.13375*t14 + 0.1363*t12
+    t16 = 0.1363*t12 + 0.13375*t14
     t17 = -t16 + 0.4*t10
-    t18 = t17 + 0.1685*t6
-    t19 = t18 - 0.4*t8
-    t20 = t19 - 0.1925*s1
-    t21 = t20 + 0.081*c1
+    t18 = 0.1685*t6 + t17
+    t19 = -0.4*t8 + t18
+    t20 = -0.1925*s1 + t19
+    t21 = 0.081*c1 + t20
     t22 = s1*s2
-    t23 = t7*c4 + s4*t22
-    t24 = -t7*s4 + c4*t22
-    t25 = t3*s5 + t23*c5
-    t26 = t3*c5 - t23*s5
-    t27 = t25*c6 - t24*s6
-    t28 = t24*c6 + t25*s6
-    t29 = t27*c7 - t26*s7
-    t30 = -0.13375*t28 + 0.1363*t26
-    t31 = t30 + 0.4*t24
-    t32 = t31 - 0.1685*t3
-    t33 = t32 - 0.4*t22
-    t34 = t33 + 0.1925*c1
-    t35 = t34 + 0.081*s1
-    t36 = t20*c1 + t34*s1
+    t23 = c4*t7 + s4*t22
+    t24 = -s4*t7 + c4*t22
+    t25 = t3*s5 + c5*t23
+    t26 = t3*c5 - s5*t23
+    t27 = c6*t25 - t24*s6
+    t28 = t24*c6 + s6*t25
+    t29 = c7*t27 - t26*s7
+    t30 = 0.1363*t26 - 0.13375*t28
+    t31 = 0.4*t24 + t30
+    t32 = -0.1685*t3 + t31
+    t33 = -0.4*t22 + t32
+    t34 = 0.1925*c1 + t33
+    t35 = 0.081*s1 + t34
+    t36 = c1*t20 + s1*t34
     t37 = t19*t22 - t33*t8
-    t38 = t3*t18 + t32*t6
+    t38 = t3*t18 + t6*t32
     t39 = t10*t31 - t24*t17
     t40 = t26*t16 - t12*t30
-    t41 = t39*qd5 + t40*qd6
-    t42 = t41 + t38*qd4
-    t43 = t42 + t37*qd3
-    t44 = t43 - t36*qd2
+    t41 = qd5*t39 + qd6*t40
+    t42 = t41 + qd4*t38
+    t43 = t42 + qd3*t37
+    t44 = t43 - qd2*t36
     t45 = t15**2 + t29**2
     t46 = xp.sqrt(t45)
     t47 = c3*s2
     t48 = c2*s4 - c4*t47
     t49 = c2*c4 + s4*t47
     t50 = s3*s2
-    t51 = t48*c5 - s5*t50
-    t52 = t48*s5 + c5*t50
-    t53 = t51*c6 - t49*s6
-    t54 = t49*c6 + t51*s6
-    t55 = t52*s7 + t53*c7
-    t56 = 0.13375*t54 + 0.1363*t52
+    t51 = c5*t48 - s5*t50
+    t52 = s5*t48 + c5*t50
+    t53 = c6*t51 - t49*s6
+    t54 = t49*c6 + s6*t51
+    t55 = t52*s7 + c7*t53
+    t56 = 0.1363*t52 + 0.13375*t54
     t57 = -t56 + 0.4*t49
-    t58 = t57 + 0.1685*t50
-    t59 = t58 - 0.4*c2
-    t60 = t33*c2 - t59*t22
+    t58 = 0.1685*t50 + t57
+    t59 = -0.4*c2 + t58
+    t60 = c2*t33 - t59*t22
     t61 = t3*t58 + t32*t50
     t62 = t24*t57 - t49*t31
     t63 = t52*t30 - t26*t56
-    t64 = -t19*c2 + t59*t8
-    t65 = -t58*t6 + t18*t50
+    t64 = -c2*t19 + t59*t8
+    t65 = -t6*t58 + t18*t50
     t66 = t49*t17 - t10*t57
     t67 = t52*t16 - t12*t56
-    t68 = t62*qd5 + t63*qd6
-    t69 = t66*qd5 + t67*qd6
-    t70 = t68 - t61*qd4
-    t71 = t69 + t65*qd4
-    t72 = t70 + t60*qd3
-    t73 = t71 + t64*qd3
-    t74 = qd2*s1
+    t68 = qd5*t62 + qd6*t63
+    t69 = qd5*t66 + qd6*t67
+    t70 = t68 - qd4*t61
+    t71 = t69 + qd4*t65
+    t72 = t70 + qd3*t60
+    t73 = t71 + qd3*t64
+    t74 = s1*qd2
     t75 = t73 + t59*t74
     t76 = t75 + t21*qd1
-    t77 = t60*qd1 - t72*c2 + t43*t8 + t37*t74
-    t78 = qd1*t8 + c2*t74
-    t79 = t74 + qd3*t8
+    t77 = qd1*t60 - c2*t72 + t8*t43 + t74*t37
+    t78 = t8*qd1 + c2*t74
+    t79 = t74 + t8*qd3
     t80 = t79
     t81 = c1*qd2
     t82 = t72 + t59*t81
     t83 = t82 - t35*qd1
-    t84 = t73*c2 - t64*qd1 + t37*t81 - t43*t22
-    t85 = t82*c1 + t75*s1
-    t86 = t73*t8 + t60*t81 + t64*t74 - t72*t22
-    t87 = qd1*t22 - c2*t81
-    t88 = t81 - qd3*t22
+    t84 = c2*t73 - qd1*t64 + t81*t37 - t22*t43
+    t85 = c1*t82 + s1*t75
+    t86 = t8*t73 + t81*t60 + t74*t64 - t22*t72
+    t87 = t22*qd1 - c2*t81
+    t88 = t81 - t22*qd3
     t89 = t88
-    t90 = t70*t3 + t71*t6 + t61*t89 - t65*t80
+    t90 = t3*t70 + t6*t71 + t89*t61 - t80*t65
     t91 = t3*t80 - t6*t89
     t92 = qd1 - c2*qd3
     t93 = t92
-    t94 = t42*t3 + t65*t93 - t38*t89 + t71*t50
-    t95 = t38*t80 - t42*t6 - t61*t93 + t70*t50
-    t96 = t3*t93 + t89*t50
-    t97 = t6*t93 + t80*t50
+    t94 = t3*t42 + t93*t65 - t89*t38 + t50*t71
+    t95 = t80*t38 - t6*t42 - t93*t61 + t50*t70
+    t96 = t3*t93 + t50*t89
+    t97 = t6*t93 + t50*t80
     t98 = t6*qd4
     t99 = -t80 + t98
     t100 = -t3*qd4
     t101 = t89 + t100
-    t102 = t69*t10 + t66*t99 - t68*t24 - t62*t101
+    t102 = t10*t69 + t99*t66 - t24*t68 - t101*t62
     t103 = t24*t99 - t10*t101
-    t104 = qd4*t50
+    t104 = t50*qd4
     t105 = t93 + t104
-    t106 = t41*t24 + t39*t101 - t69*t49 - t66*t105
-    t107 = t68*t49 + t62*t105 - t41*t10 - t39*t99
+    t106 = t24*t41 + t101*t39 - t49*t69 - t105*t66
+    t107 = t49*t68 + t105*t62 - t10*t41 - t99*t39
     t108 = t49*t101 - t24*t105
     t109 = t10*t105 - t49*t99
     t110 = t10*qd5
@@ -1397,82 +1397,82 @@ def task_jacobian_dot(q, q_dot):
     t118 = t52*t111 - t12*t116
     t119 = t12*qd6
     t120 = t111 - t119
-    t121 = t119 + t14*qd7 - t110 - t98 + t79
+    t121 = -t110 - t98 + t79 + t119 + t14*qd7
     t122 = t26*qd6
     t123 = t113 + t122
-    t124 = t63*t113 - t67*t111 + t67*t119 + t63*t122
+    t124 = t113*t63 - t111*t67 + t119*t67 + t122*t63
     t125 = t14*t123 - t28*t120
-    t126 = t100 + t112 + t122 - t28*qd7 + t88
-    t127 = t121*t29 + t126*t15
+    t126 = t88 + t100 + t112 + t122 - t28*qd7
+    t127 = t29*t121 + t15*t126
     t128 = t52*qd6
-    t129 = t40*t113 - t67*t116 + t40*t122 + t67*t128
-    t130 = t63*t116 - t40*t111 + t40*t119 - t63*t128
+    t129 = t113*t40 - t116*t67 + t122*t40 + t128*t67
+    t130 = t116*t63 - t111*t40 + t119*t40 - t128*t63
     t131 = -t128
     t132 = t116 + t131
-    t133 = t132*t28 - t54*t123
-    t134 = t54*t120 - t132*t14
-    t135 = t104 + t115 + t131 - t54*qd7 + t92
-    t136 = t126*t55 - t135*t29
-    t137 = t121*t55 + t135*t15
-    t138 = qd1*t59
-    t139 = t44*c1 - s1*t138
-    t140 = t44*s1 + c1*t138
-    t141 = qd2*s2
+    t133 = t28*t132 - t54*t123
+    t134 = t54*t120 - t14*t132
+    t135 = t92 + t104 + t115 + t131 - t54*qd7
+    t136 = t55*t126 - t29*t135
+    t137 = t55*t121 + t15*t135
+    t138 = t59*qd1
+    t139 = c1*t44 - s1*t138
+    t140 = s1*t44 + c1*t138
+    t141 = s2*qd2
     t142 = c1**2*t141 + s1**2*t141
-    t143 = 1/t45
-    t144 = t143*(t15*t6 - t3*t29)
-    t145 = t143*(t10*t15 + t24*t29)
-    t146 = t143*(t26*t29 - t12*t15)
-    t147 = -t143*(t14*t15 + t28*t29)
-    t148 = t29*c1
-    t149 = t15*s1
-    t150 = t143*(t148 - t149)
-    t151 = t15*c1
-    t152 = t29*s1
-    t153 = -t143*(s2*t151 + s2*t152)
+    t143 = c1*t29
+    t144 = s1*t15
+    t145 = 1/t45
+    t146 = (t143 - t144)*t145
+    t147 = (t6*t15 - t3*t29)*t145
+    t148 = (t10*t15 + t24*t29)*t145
+    t149 = (t26*t29 - t12*t15)*t145
+    t150 = -(t14*t15 + t28*t29)*t145
+    t151 = c1*t15
+    t152 = s1*t29
+    t153 = -t145*(s2*t151 + s2*t152)
     t154 = 1/t46
-    t155 = t143*t154
-    t156 = (t151 + t152)*t155
-    t157 = (s2*t148 - s2*t149)*t155
-    t158 = -(t3*t15 + t29*t6)*t155
+    t155 = t145*t154
+    t156 = t155*(t151 + t152)
+    t157 = t155*(s2*t143 - s2*t144)
+    t158 = -(t3*t15 + t6*t29)*t155
     t159 = (t24*t15 - t10*t29)*t155
     t160 = (t12*t29 + t26*t15)*t155
     t161 = (t14*t29 - t28*t15)*t155
-    t162 = 2*t150
-    t163 = t143*t136
+    t162 = 2*t146
+    t163 = t145*t136
     t164 = -(s1 + t15*t162)*t163
-    t165 = t143*t137
+    t165 = t145*t137
     t166 = (c1 - t29*t162)*t165
-    t167 = qd1*t143
+    t167 = qd1*t145
     t168 = t151*t167
     t169 = t152*t167
-    t170 = t15*t143
+    t170 = t15*t145
     t171 = t87*t170
     t172 = 2*t153
-    t173 = -(t8 + t15*t172)*t163
-    t174 = -(t22 + t29*t172)*t165
-    t175 = t29*t143
+    t173 = -t163*(t8 + t15*t172)
+    t174 = -t165*(t22 + t29*t172)
+    t175 = t29*t145
     t176 = t78*t175
     t177 = t96*t170
     t178 = t97*t175
-    t179 = 2*t144
-    t180 = (t6 - t15*t179)*t163
-    t181 = -(t3 + t29*t179)*t165
+    t179 = 2*t147
+    t180 = t163*(t6 - t15*t179)
+    t181 = -t165*(t3 + t29*t179)
     t182 = t108*t170
     t183 = t109*t175
-    t184 = 2*t145
-    t185 = (t10 - t15*t184)*t163
-    t186 = (t24 - t29*t184)*t165
+    t184 = 2*t148
+    t185 = t163*(t10 - t15*t184)
+    t186 = t165*(t24 - t29*t184)
     t187 = t118*t175
-    t188 = 2*t146
-    t189 = -(t12 + t15*t188)*t163
-    t190 = (t26 - t29*t188)*t165
+    t188 = 2*t149
+    t189 = -t163*(t12 + t15*t188)
+    t190 = t165*(t26 - t29*t188)
     t191 = t117*t170
     t192 = t133*t170
     t193 = t134*t175
-    t194 = 2*t147
-    t195 = -(t14 + t15*t194)*t163
-    t196 = -(t28 + t29*t194)*t165
+    t194 = 2*t150
+    t195 = -t163*(t14 + t15*t194)
+    t196 = -t165*(t28 + t29*t194)
     t197 = qd1*t154
     t198 = t29*t154
     t199 = t15*t154
@@ -1506,19 +1506,19 @@ def task_jacobian_dot(q, q_dot):
         xp.broadcast_to(t187 + t189 + t190 - t191, batch),  # 3, 5
         xp.broadcast_to(t192 + t193 + t195 + t196, batch),  # 3, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
-        xp.broadcast_to(t136*(c1*t154 - t156*t15) + t137*(s1*t154 - t156*t29) + t148*t197 - t149*t197, batch),  # 4, 1
-        xp.broadcast_to(-t136*(t157*t15 + t154*t22) + t137*(-t157*t29 + t154*t8) - t87*t198 - t78*t199, batch),  # 4, 2
-        xp.broadcast_to(-t136*(t3*t154 + t158*t15) - t137*(t158*t29 + t6*t154) + t97*t199 - t96*t198, batch),  # 4, 3
-        xp.broadcast_to(t136*(t24*t154 - t159*t15) - t137*(t159*t29 + t10*t154) + t109*t199 - t108*t198, batch),  # 4, 4
-        xp.broadcast_to(t136*(t26*t154 - t160*t15) + t137*(t12*t154 - t160*t29) + t117*t198 + t118*t199, batch),  # 4, 5
-        xp.broadcast_to(-t136*(t161*t15 + t28*t154) + t137*(t14*t154 - t161*t29) + t134*t199 - t133*t198, batch),  # 4, 6
+        xp.broadcast_to(t136*(c1*t154 - t15*t156) + t137*(s1*t154 - t29*t156) + t143*t197 - t144*t197, batch),  # 4, 1
+        xp.broadcast_to(-t136*(t15*t157 + t22*t154) + t137*(-t29*t157 + t8*t154) - t87*t198 - t78*t199, batch),  # 4, 2
+        xp.broadcast_to(-t136*(t3*t154 + t15*t158) - t137*(t29*t158 + t6*t154) + t97*t199 - t96*t198, batch),  # 4, 3
+        xp.broadcast_to(t136*(t24*t154 - t15*t159) - t137*(t29*t159 + t10*t154) + t109*t199 - t108*t198, batch),  # 4, 4
+        xp.broadcast_to(t136*(t26*t154 - t15*t160) + t137*(t12*t154 - t29*t160) + t117*t198 + t118*t199, batch),  # 4, 5
+        xp.broadcast_to(-t136*(t15*t161 + t28*t154) + t137*(t14*t154 - t29*t161) + t134*t199 - t133*t198, batch),  # 4, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 0
-        xp.broadcast_to(t127*t150 - t55*t164 - t55*t166 + t55*t168 + t55*t169, batch),  # 5, 1
-        xp.broadcast_to(t142 + t127*t153 + t55*t176 - t55*t171 - t55*t173 - t55*t174, batch),  # 5, 2
-        xp.broadcast_to(-(-t91 - t127*t144 + t55*t177 + t55*t178 + t55*t180 + t55*t181), batch),  # 5, 3
-        xp.broadcast_to(-(-t103 - t127*t145 + t55*t182 + t55*t183 + t55*t185 + t55*t186), batch),  # 5, 4
-        xp.broadcast_to(t114 + t127*t146 + t55*t191 - t55*t187 - t55*t189 - t55*t190, batch),  # 5, 5
-        xp.broadcast_to(-(-t125 - t127*t147 + t55*t192 + t55*t193 + t55*t195 + t55*t196), batch),  # 5, 6
+        xp.broadcast_to(t146*t127 - t55*t164 - t55*t166 + t55*t168 + t55*t169, batch),  # 5, 1
+        xp.broadcast_to(t142 + t153*t127 + t55*t176 - t55*t171 - t55*t173 - t55*t174, batch),  # 5, 2
+        xp.broadcast_to(-(-t91 - t147*t127 + t55*t177 + t55*t178 + t55*t180 + t55*t181), batch),  # 5, 3
+        xp.broadcast_to(-(-t103 - t148*t127 + t55*t182 + t55*t183 + t55*t185 + t55*t186), batch),  # 5, 4
+        xp.broadcast_to(t114 + t149*t127 + t55*t191 - t55*t187 - t55*t189 - t55*t190, batch),  # 5, 5
+        xp.broadcast_to(-(-t125 - t150*t127 + t55*t192 + t55*t193 + t55*t195 + t55*t196), batch),  # 5, 6
     ], (6, 7))
     return Jd
 
@@ -1543,7 +1543,7 @@ def hessian(q):
     t1 = c1*c3
     t2 = t0 + c2*t1
     t3 = t1 + c2*t0
-    t4 = c3*s1
+    t4 = s1*c3
     t5 = c1*s3
     t6 = t4 - c2*t5
     t7 = -t5 + c2*t4
@@ -1553,86 +1553,86 @@ def hessian(q):
     t11 = t9*c5 - t6*s5
     t12 = t9*s5 + t6*c5
     t13 = t10*c6 + t11*s6
-    t14 = 0.13375*t13 + 0.1363*t12
+    t14 = 0.1363*t12 + 0.13375*t13
     t15 = -t14 + 0.4*t10
-    t16 = t15 + 0.1685*t6
-    t17 = t16 - 0.4*t8
-    t18 = t17 - 0.1925*s1
-    t19 = t18 + 0.081*c1
+    t16 = 0.1685*t6 + t15
+    t17 = -0.4*t8 + t16
+    t18 = -0.1925*s1 + t17
+    t19 = 0.081*c1 + t18
     t20 = s1*s2
-    t21 = t7*c4 + s4*t20
-    t22 = -t7*s4 + c4*t20
-    t23 = t3*s5 + t21*c5
-    t24 = t3*c5 - t21*s5
-    t25 = t22*c6 + t23*s6
-    t26 = -0.13375*t25 + 0.1363*t24
-    t27 = t26 + 0.4*t22
-    t28 = t27 - 0.1685*t3
-    t29 = t28 - 0.4*t20
-    t30 = t29 + 0.1925*c1
-    t31 = t30 + 0.081*s1
-    t32 = t18*c1 + t30*s1
+    t21 = c4*t7 + s4*t20
+    t22 = -s4*t7 + c4*t20
+    t23 = t3*s5 + c5*t21
+    t24 = t3*c5 - s5*t21
+    t25 = t22*c6 + s6*t23
+    t26 = 0.1363*t24 - 0.13375*t25
+    t27 = 0.4*t22 + t26
+    t28 = -0.1685*t3 + t27
+    t29 = -0.4*t20 + t28
+    t30 = 0.1925*c1 + t29
+    t31 = 0.081*s1 + t30
+    t32 = c1*t18 + s1*t30
     t33 = t17*t20 - t29*t8
-    t34 = t3*t16 + t28*t6
+    t34 = t3*t16 + t6*t28
     t35 = t10*t27 - t22*t15
     t36 = t24*t14 - t12*t26
     t37 = c3*s2
     t38 = c2*s4 - c4*t37
     t39 = c2*c4 + s4*t37
     t40 = s3*s2
-    t41 = t38*c5 - s5*t40
-    t42 = t38*s5 + c5*t40
-    t43 = t39*c6 + t41*s6
-    t44 = 0.13375*t43 + 0.1363*t42
+    t41 = c5*t38 - s5*t40
+    t42 = s5*t38 + c5*t40
+    t43 = t39*c6 + s6*t41
+    t44 = 0.1363*t42 + 0.13375*t43
     t45 = -t44 + 0.4*t39
-    t46 = t45 + 0.1685*t40
-    t47 = t46 - 0.4*c2
+    t46 = 0.1685*t40 + t45
+    t47 = -0.4*c2 + t46
     t48 = t3*t46 + t28*t40
     t49 = t22*t45 - t39*t27
     t50 = t42*t26 - t24*t44
-    t51 = -t46*t6 + t16*t40
+    t51 = -t6*t46 + t16*t40
     t52 = t39*t15 - t10*t45
     t53 = t42*t14 - t12*t44
-    t54 = t47*s1
-    t55 = t29*c2 - s2*t54
-    t56 = t47*c1
-    t57 = -t17*c2 + s2*t56
+    t54 = s1*t47
+    t55 = c2*t29 - s2*t54
+    t56 = c1*t47
+    t57 = -c2*t17 + s2*t56
     t58 = -t54
     t59 = -t57
     t60 = -t51
     t61 = -t52
     t62 = -t53
     t63 = -t48
-    t64 = t33*c1
-    t65 = t34*c1
-    t66 = t35*c1
-    t67 = t36*c1
-    t68 = t33*s1
-    t69 = t34*s1
-    t70 = t35*s1
-    t71 = t36*s1
+    t64 = c1*t33
+    t65 = c1*t34
+    t66 = c1*t35
+    t67 = c1*t36
+    t68 = s1*t33
+    t69 = s1*t34
+    t70 = s1*t35
+    t71 = s1*t36
     t72 = c1**2
     t73 = s1**2
-    t74 = -(t55*c1 + t57*s1)
-    t75 = t48*c1 - t51*s1
-    t76 = -(t49*c1 + t52*s1)
-    t77 = -(t50*c1 + t53*s1)
-    t78 = t51*c2 - t34*t20
-    t79 = t52*c2 - t35*t20
-    t80 = t53*c2 - t36*t20
-    t81 = t48*c2 + t34*t8
-    t82 = -t49*c2 + t35*t8
-    t83 = -t50*c2 + t36*t8
-    t84 = -(t48*t20 + t51*t8)
-    t85 = t49*t20 - t52*t8
-    t86 = t50*t20 - t53*t8
+    t74 = -(c1*t55 + s1*t57)
+    t75 = c1*t48 - s1*t51
+    t76 = -(c1*t49 + s1*t52)
+    t77 = -(c1*t50 + s1*t53)
+    t78 = c2*t51 - t20*t34
+    t79 = c2*t52 - t20*t35
+    t80 = c2*t53 - t20*t36
+    t81 = c2*t48 + t8*t34
+    t82 = -c2*t49 + t8*t35
+    t83 = -c2*t50 + t8*t36
+    t84 = -(t20*t48 + t8*t51)
+    t85 = t20*t49 - t8*t52
+    t86 = t20*t50 - t8*t53
     t87 = s2**2
-    t88 = -(t3*t35 + t52*t40)
-    t89 = -(t3*t36 + t53*t40)
-    t90 = -t35*t6 + t49*t40
-    t91 = -t36*t6 + t50*t40
-    t92 = t3*t49 + t52*t6
-    t93 = t3*t50 + t53*t6
+    t88 = -(t3*t35 + t40*t52)
+    t89 = -(t3*t36 + t40*t53)
+    t90 = -t6*t35 + t40*t49
+    t91 = -t6*t36 + t40*t50
+    t92 = t3*t49 + t6*t52
+    t93 = t3*t50 + t6*t53
     t94 = t22*t36 - t39*t53
     t95 = t39*t50 - t10*t36
     t96 = t10*t53 - t22*t50
@@ -1680,21 +1680,21 @@ def hessian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5, 6
         t58,  # 1, 0, 0
-        -t32*c1,  # 1, 0, 1
+        -c1*t32,  # 1, 0, 1
         t64,  # 1, 0, 2
         t65,  # 1, 0, 3
         t66,  # 1, 0, 4
         t67,  # 1, 0, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 0, 6
         t56,  # 1, 1, 0
-        -t32*s1,  # 1, 1, 1
+        -s1*t32,  # 1, 1, 1
         t68,  # 1, 1, 2
         t69,  # 1, 1, 3
         t70,  # 1, 1, 4
         t71,  # 1, 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 1, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 2, 0
-        -(t47*t72 + t47*t73),  # 1, 2, 1
+        -(t72*t47 + t73*t47),  # 1, 2, 1
         t74,  # 1, 2, 2
         t75,  # 1, 2, 3
         t76,  # 1, 2, 4
@@ -1704,40 +1704,40 @@ def hessian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 3, 1
         -c1*c2,  # 1, 3, 2
         s2*t5,  # 1, 3, 3
-        t39*c1,  # 1, 3, 4
-        -t42*c1,  # 1, 3, 5
-        -t43*c1,  # 1, 3, 6
+        c1*t39,  # 1, 3, 4
+        -c1*t42,  # 1, 3, 5
+        -c1*t43,  # 1, 3, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 4, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 4, 1
-        -c2*s1,  # 1, 4, 2
+        -s1*c2,  # 1, 4, 2
         s2*t0,  # 1, 4, 3
-        t39*s1,  # 1, 4, 4
-        -t42*s1,  # 1, 4, 5
-        -t43*s1,  # 1, 4, 6
+        s1*t39,  # 1, 4, 4
+        -s1*t42,  # 1, 4, 5
+        -s1*t43,  # 1, 4, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5, 1
-        s2*t72 + s2*t73,  # 1, 5, 2
-        t3*s1 - t6*c1,  # 1, 5, 3
-        -(t10*c1 + t22*s1),  # 1, 5, 4
-        t12*c1 - t24*s1,  # 1, 5, 5
-        t13*c1 + t25*s1,  # 1, 5, 6
+        t72*s2 + t73*s2,  # 1, 5, 2
+        s1*t3 - c1*t6,  # 1, 5, 3
+        -(c1*t10 + s1*t22),  # 1, 5, 4
+        c1*t12 - s1*t24,  # 1, 5, 5
+        c1*t13 + s1*t25,  # 1, 5, 6
         t59,  # 2, 0, 0
         t64,  # 2, 0, 1
-        t57*c2 - t33*t20,  # 2, 0, 2
+        c2*t57 - t20*t33,  # 2, 0, 2
         t78,  # 2, 0, 3
         t79,  # 2, 0, 4
         t80,  # 2, 0, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0, 6
         t55,  # 2, 1, 0
         t68,  # 2, 1, 1
-        -t55*c2 + t33*t8,  # 2, 1, 2
+        -c2*t55 + t8*t33,  # 2, 1, 2
         t81,  # 2, 1, 3
         t82,  # 2, 1, 4
         t83,  # 2, 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 1, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 2, 0
         t74,  # 2, 2, 1
-        t55*t20 - t57*t8,  # 2, 2, 2
+        t20*t55 - t8*t57,  # 2, 2, 2
         t84,  # 2, 2, 3
         t85,  # 2, 2, 4
         t86,  # 2, 2, 5
@@ -1745,17 +1745,17 @@ def hessian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 3, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 3, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 3, 2
-        -(t3*c2 + t87*t0),  # 2, 3, 3
-        t22*c2 - t39*t20,  # 2, 3, 4
-        t24*c2 + t42*t20,  # 2, 3, 5
-        -t25*c2 + t43*t20,  # 2, 3, 6
+        -(c2*t3 + t0*t87),  # 2, 3, 3
+        c2*t22 - t39*t20,  # 2, 3, 4
+        c2*t24 + t42*t20,  # 2, 3, 5
+        -c2*t25 + t43*t20,  # 2, 3, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 4, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 4, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 4, 2
-        -t6*c2 + t87*t5,  # 2, 4, 3
-        -t10*c2 + t39*t8,  # 2, 4, 4
-        t12*c2 - t42*t8,  # 2, 4, 5
-        t13*c2 - t43*t8,  # 2, 4, 6
+        -c2*t6 + t5*t87,  # 2, 4, 3
+        -c2*t10 + t39*t8,  # 2, 4, 4
+        c2*t12 - t42*t8,  # 2, 4, 5
+        c2*t13 - t43*t8,  # 2, 4, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 5, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 5, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 5, 2
@@ -1766,21 +1766,21 @@ def hessian(q):
         t60,  # 3, 0, 0
         t65,  # 3, 0, 1
         t78,  # 3, 0, 2
-        -(t3*t34 + t51*t40),  # 3, 0, 3
+        -(t3*t34 + t40*t51),  # 3, 0, 3
         t88,  # 3, 0, 4
         t89,  # 3, 0, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0, 6
         t63,  # 3, 1, 0
         t69,  # 3, 1, 1
         t81,  # 3, 1, 2
-        -(t34*t6 + t48*t40),  # 3, 1, 3
+        -(t6*t34 + t40*t48),  # 3, 1, 3
         t90,  # 3, 1, 4
         t91,  # 3, 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 1, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 2, 0
         t75,  # 3, 2, 1
         t84,  # 3, 2, 2
-        t51*t6 - t3*t48,  # 3, 2, 3
+        t6*t51 - t3*t48,  # 3, 2, 3
         t92,  # 3, 2, 4
         t93,  # 3, 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 2, 6
@@ -1795,16 +1795,16 @@ def hessian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 4, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 4, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 4, 3
-        -t39*t6 + t10*t40,  # 3, 4, 4
-        t42*t6 - t12*t40,  # 3, 4, 5
-        t43*t6 - t13*t40,  # 3, 4, 6
+        -t6*t39 + t10*t40,  # 3, 4, 4
+        t6*t42 - t12*t40,  # 3, 4, 5
+        t6*t43 - t13*t40,  # 3, 4, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 5, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 5, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 5, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 5, 3
-        t3*t10 + t22*t6,  # 3, 5, 4
-        t24*t6 - t3*t12,  # 3, 5, 5
-        -(t3*t13 + t25*t6),  # 3, 5, 6
+        t3*t10 + t6*t22,  # 3, 5, 4
+        t6*t24 - t3*t12,  # 3, 5, 5
+        -(t3*t13 + t6*t25),  # 3, 5, 6
         t61,  # 4, 0, 0
         t66,  # 4, 0, 1
         t79,  # 4, 0, 2
@@ -1955,7 +1955,7 @@ def singularity_factors(q):
     t1 = c1*c3
     t2 = t0 + c2*t1
     t3 = t1 + c2*t0
-    t4 = c3*s1
+    t4 = s1*c3
     t5 = c1*s3
     t6 = t4 - c2*t5
     t7 = -t5 + c2*t4
@@ -1965,129 +1965,129 @@ def singularity_factors(q):
     t11 = t9*c5 - t6*s5
     t12 = t9*s5 + t6*c5
     t13 = t10*c6 + t11*s6
-    t14 = 0.13375*t13 + 0.1363*t12
+    t14 = 0.1363*t12 + 0.13375*t13
     t15 = -t14 + 0.4*t10
-    t16 = t15 + 0.1685*t6
-    t17 = t16 - 0.4*t8
-    t18 = t17 - 0.1925*s1
-    t19 = t18 + 0.081*c1
+    t16 = 0.1685*t6 + t15
+    t17 = -0.4*t8 + t16
+    t18 = -0.1925*s1 + t17
+    t19 = 0.081*c1 + t18
     t20 = s1*s2
-    t21 = t7*c4 + s4*t20
-    t22 = -t7*s4 + c4*t20
-    t23 = t3*s5 + t21*c5
-    t24 = t3*c5 - t21*s5
-    t25 = t22*c6 + t23*s6
-    t26 = -0.13375*t25 + 0.1363*t24
-    t27 = t26 + 0.4*t22
-    t28 = t27 - 0.1685*t3
-    t29 = t28 - 0.4*t20
-    t30 = t29 + 0.1925*c1
-    t31 = t30 + 0.081*s1
-    t32 = t18*c1 + t30*s1
+    t21 = c4*t7 + s4*t20
+    t22 = -s4*t7 + c4*t20
+    t23 = t3*s5 + c5*t21
+    t24 = t3*c5 - s5*t21
+    t25 = t22*c6 + s6*t23
+    t26 = 0.1363*t24 - 0.13375*t25
+    t27 = 0.4*t22 + t26
+    t28 = -0.1685*t3 + t27
+    t29 = -0.4*t20 + t28
+    t30 = 0.1925*c1 + t29
+    t31 = 0.081*s1 + t30
+    t32 = c1*t18 + s1*t30
     t33 = t17*t20 - t29*t8
-    t34 = t3*t16 + t28*t6
+    t34 = t3*t16 + t6*t28
     t35 = t10*t27 - t22*t15
     t36 = t24*t14 - t12*t26
     t37 = c3*s2
     t38 = c2*s4 - c4*t37
     t39 = c2*c4 + s4*t37
     t40 = s3*s2
-    t41 = t38*c5 - s5*t40
-    t42 = t38*s5 + c5*t40
-    t43 = t39*c6 + t41*s6
-    t44 = 0.13375*t43 + 0.1363*t42
+    t41 = c5*t38 - s5*t40
+    t42 = s5*t38 + c5*t40
+    t43 = t39*c6 + s6*t41
+    t44 = 0.1363*t42 + 0.13375*t43
     t45 = -t44 + 0.4*t39
-    t46 = t45 + 0.1685*t40
-    t47 = t46 - 0.4*c2
-    t48 = t29*c2 - t47*t20
+    t46 = 0.1685*t40 + t45
+    t47 = -0.4*c2 + t46
+    t48 = c2*t29 - t47*t20
     t49 = t3*t46 + t28*t40
     t50 = t22*t45 - t39*t27
     t51 = t42*t26 - t24*t44
-    t52 = -t17*c2 + t47*t8
-    t53 = -t46*t6 + t16*t40
+    t52 = -c2*t17 + t47*t8
+    t53 = -t6*t46 + t16*t40
     t54 = t39*t15 - t10*t45
     t55 = t42*t14 - t12*t44
     t56 = t3*t42 - t24*t40
-    t57 = t6*c1
+    t57 = c1*t6
     t58 = s2*t5
     t59 = -(s1*t56 - t42*t57 + t12*t58)
     t60 = -(t22*t42 + t39*t24)
     t61 = -(t3*t39 + t22*t40)
     t62 = -(-t6*t60 + t10*t56 + t12*t61)
-    t63 = t10*c1
-    t64 = t12*c1
+    t63 = c1*t10
+    t64 = c1*t12
     t65 = -(s1*t60 - t42*t63 + t39*t64)
     t66 = -(s1*t61 + t39*t57 - t10*t58)
-    t67 = -(-t35*t59 + t32*t62 + t34*t65 + t36*t66)
+    t67 = -(-t59*t35 + t32*t62 + t34*t65 + t36*t66)
     t68 = t10*t24 + t22*t12
-    t69 = t64 - t24*s1
-    t70 = -(t63 + t22*s1)
-    t71 = t32*t68 + t35*t69 - t36*t70
-    t72 = t3*t10 + t22*t6
-    t73 = t3*s1 - t57
+    t69 = t64 - s1*t24
+    t70 = -(t63 + s1*t22)
+    t71 = t32*t68 + t35*t69 - t70*t36
+    t72 = t3*t10 + t6*t22
+    t73 = s1*t3 - t57
     t74 = t32*t72 + t34*t70 - t35*t73
-    t75 = t24*t6 - t3*t12
+    t75 = t6*t24 - t3*t12
     t76 = t32*t75 + t34*t69 - t36*t73
     t77 = -(-t35*t75 + t34*t68 + t36*t72)
     t78 = s1*t47
-    t79 = t24*c2 + t42*t20
+    t79 = c2*t24 + t42*t20
     t80 = c1**2
-    t81 = s2*t80
+    t81 = t80*s2
     t82 = -(s1*t79 - c2*t64 + t42*t81)
-    t83 = t22*c2 - t39*t20
-    t84 = -(t10*t79 + t12*t83 + t60*t8)
+    t83 = c2*t22 - t39*t20
+    t84 = -(t10*t79 + t12*t83 + t8*t60)
     t85 = -(s1*t83 - t39*t81 + c2*t63)
     t86 = -(-t35*t82 + t32*t84 + t33*t65 + t36*t85)
     t87 = t10*t20 - t22*t8
-    t88 = t81 + s2*s1**2
+    t88 = t81 + s1**2*s2
     t89 = t32*t87 + t33*t70 - t35*t88
     t90 = -(t12*t20 + t24*t8)
     t91 = t32*t90 + t33*t69 - t36*t88
     t92 = -(-t35*t90 + t33*t68 + t36*t87)
     t93 = s2**2
-    t94 = -(t3*c2 + t93*t0)
-    t95 = -(t12*t94 + t6*t79 + t56*t8)
+    t94 = -(c2*t3 + t0*t93)
+    t95 = -(t12*t94 + t6*t79 + t8*t56)
     t96 = -(s1*t94 - s3*t80*t93 + c2*t57)
     t97 = -(-t34*t82 + t32*t95 + t33*t59 + t36*t96)
     t98 = t3*t8 + t6*t20
     t99 = t32*t98 + t33*t73 - t34*t88
     t100 = -(-t34*t90 + t33*t75 + t36*t98)
-    t101 = -(-t10*t94 + t6*t83 + t61*t8)
+    t101 = -(-t10*t94 + t6*t83 + t8*t61)
     t102 = -(-t34*t85 + t32*t101 + t33*t66 + t35*t96)
     t103 = t33*t62 + t35*t95 - t34*t84 - t36*t101
     t104 = -(-t34*t87 + t33*t72 + t35*t98)
     t105 = c1*t47
-    t106 = t48*(t19*t67 + t53*t71 + t55*t74 - t54*t76 - t77*t78) + t49*(t19*t86 + t52*t71 + t55*t89 - t54*t91 - t92*t78) + t50*(t19*t97 + t52*t76 + t55*t99 - t53*t91 - t100*t78) - t31*(t53*t86 + t55*t102 - t52*t67 - t54*t97 + t103*t78) - t51*(t19*t102 + t52*t74 + t54*t99 - t53*t89 - t104*t78) - (t19*t103 + t53*t92 + t55*t104 - t52*t77 - t54*t100)*t105
+    t106 = t48*(t19*t67 + t53*t71 + t55*t74 - t54*t76 - t77*t78) + t49*(t19*t86 + t52*t71 + t55*t89 - t54*t91 - t78*t92) + t50*(t19*t97 + t52*t76 + t55*t99 - t53*t91 - t78*t100) - t31*(t53*t86 + t55*t102 - t67*t52 - t54*t97 + t78*t103) - t51*(t19*t102 + t52*t74 + t54*t99 - t53*t89 - t78*t104) - t105*(t19*t103 + t53*t92 + t55*t104 - t52*t77 - t54*t100)
     t107 = t3*t43 + t25*t40
     t108 = -(s1*t107 - t43*t57 + t13*t58)
     t109 = t39*t25 - t22*t43
     t110 = -(-t6*t109 + t10*t107 + t13*t61)
-    t111 = t13*c1
+    t111 = c1*t13
     t112 = -(s1*t109 - t43*t63 + t39*t111)
     t113 = -(-t35*t108 + t32*t110 + t34*t112)
     t114 = t22*t13 - t10*t25
-    t115 = t111 + t25*s1
+    t115 = t111 + s1*t25
     t116 = t32*t114 + t35*t115
-    t117 = -(t3*t13 + t25*t6)
+    t117 = -(t3*t13 + t6*t25)
     t118 = t32*t117 + t34*t115
     t119 = t35*t117 - t34*t114
-    t120 = t19*t113 + t53*t116 - t54*t118 - t119*t78
-    t121 = -t25*c2 + t43*t20
+    t120 = t19*t113 + t53*t116 - t54*t118 - t78*t119
+    t121 = -c2*t25 + t43*t20
     t122 = -(s1*t121 - c2*t111 + t43*t81)
-    t123 = -(t10*t121 + t13*t83 + t109*t8)
+    t123 = -(t10*t121 + t13*t83 + t8*t109)
     t124 = -(-t35*t122 + t32*t123 + t33*t112)
     t125 = t25*t8 - t13*t20
     t126 = t32*t125 + t33*t115
     t127 = t35*t125 - t33*t114
-    t128 = t19*t124 + t52*t116 - t54*t126 - t127*t78
-    t129 = -(t13*t94 + t6*t121 + t107*t8)
+    t128 = t19*t124 + t52*t116 - t54*t126 - t78*t127
+    t129 = -(t13*t94 + t6*t121 + t8*t107)
     t130 = -(-t34*t122 + t32*t129 + t33*t108)
     t131 = t34*t125 - t33*t117
-    t132 = t19*t130 + t52*t118 - t53*t126 - t131*t78
+    t132 = t19*t130 + t52*t118 - t53*t126 - t78*t131
     t133 = t33*t110 + t35*t129 - t34*t123
-    t134 = t53*t124 - t52*t113 - t54*t130 + t133*t78
+    t134 = t53*t124 - t52*t113 - t54*t130 + t78*t133
     t135 = t19*t133 + t53*t127 - t52*t119 - t54*t131
-    t136 = t48*t120 + t49*t128 + t50*t132 - t31*t134 - t135*t105
+    t136 = t48*t120 + t49*t128 + t50*t132 - t31*t134 - t105*t135
     t137 = -(t24*t43 + t42*t25)
     t138 = t12*t107 + t6*t137 - t13*t56
     t139 = -(s1*t137 - t42*t111 + t43*t64)
@@ -2095,30 +2095,30 @@ def singularity_factors(q):
     t141 = t12*t25 + t24*t13
     t142 = t32*t141 + t36*t115
     t143 = t36*t117 - t34*t141
-    t144 = t19*t140 + t53*t142 - t55*t118 - t143*t78
-    t145 = -(-t12*t121 + t13*t79 + t137*t8)
+    t144 = t19*t140 + t53*t142 - t55*t118 - t78*t143
+    t145 = -(-t12*t121 + t13*t79 + t8*t137)
     t146 = -(-t36*t122 + t32*t145 + t33*t139)
     t147 = t36*t125 - t33*t141
-    t148 = t19*t146 + t52*t142 - t55*t126 - t147*t78
+    t148 = t19*t146 + t52*t142 - t55*t126 - t78*t147
     t149 = t33*t138 + t36*t129 - t34*t145
-    t150 = t53*t146 - t52*t140 - t55*t130 + t149*t78
+    t150 = t53*t146 - t52*t140 - t55*t130 + t78*t149
     t151 = t19*t149 + t53*t147 - t52*t143 - t55*t131
-    t152 = t48*t144 + t49*t148 + t51*t132 - t31*t150 - t151*t105
+    t152 = t48*t144 + t49*t148 + t51*t132 - t31*t150 - t105*t151
     t153 = t10*t137 + t12*t109 - t13*t60
     t154 = -(-t36*t112 + t32*t153 + t35*t139)
     t155 = t33*t153 + t36*t123 - t35*t145
-    t156 = t54*t146 - t52*t154 - t55*t124 + t155*t78
+    t156 = t54*t146 - t52*t154 - t55*t124 + t78*t155
     t157 = t36*t114 - t35*t141
-    t158 = t19*t154 + t54*t142 - t55*t116 - t157*t78
+    t158 = t19*t154 + t54*t142 - t55*t116 - t78*t157
     t159 = t19*t155 + t54*t147 - t52*t157 - t55*t127
-    t160 = t31*t156 + t50*t148 - t48*t158 - t51*t128 + t159*t105
+    t160 = t31*t156 + t50*t148 - t48*t158 - t51*t128 + t105*t159
     t161 = t34*t153 + t36*t110 - t35*t138
-    t162 = t54*t140 - t53*t154 - t55*t113 + t161*t78
+    t162 = t54*t140 - t53*t154 - t55*t113 + t78*t161
     t163 = t19*t161 + t54*t143 - t53*t157 - t55*t119
-    t164 = t31*t162 + t49*t158 + t50*t144 - t51*t120 + t163*t105
+    t164 = t31*t162 + t49*t158 + t50*t144 - t51*t120 + t105*t163
     t165 = t52*t161 + t54*t149 - t53*t155 - t55*t133
     t166 = t31*t165 + t48*t163 + t49*t159 + t50*t151 - t51*t135
-    t167 = t48*t162 + t49*t156 + t50*t150 - t51*t134 - t165*t105
+    t167 = t48*t162 + t49*t156 + t50*t150 - t51*t134 - t105*t165
     f = _stack(xp, [
         t106**2 + t136**2 + t152**2 + t160**2 + t164**2 + t166**2 + t167**2,  # 0
     ], (1,))
@@ -2145,7 +2145,7 @@ def manipulability(q):
     t1 = c1*c3
     t2 = t0 + c2*t1
     t3 = t1 + c2*t0
-    t4 = c3*s1
+    t4 = s1*c3
     t5 = c1*s3
     t6 = t4 - c2*t5
     t7 = -t5 + c2*t4
@@ -2155,129 +2155,129 @@ def manipulability(q):
     t11 = t9*c5 - t6*s5
     t12 = t9*s5 + t6*c5
     t13 = t10*c6 + t11*s6
-    t14 = 0.13375*t13 + 0.1363*t12
+    t14 = 0.1363*t12 + 0.13375*t13
     t15 = -t14 + 0.4*t10
-    t16 = t15 + 0.1685*t6
-    t17 = t16 - 0.4*t8
-    t18 = t17 - 0.1925*s1
-    t19 = t18 + 0.081*c1
+    t16 = 0.1685*t6 + t15
+    t17 = -0.4*t8 + t16
+    t18 = -0.1925*s1 + t17
+    t19 = 0.081*c1 + t18
     t20 = s1*s2
-    t21 = t7*c4 + s4*t20
-    t22 = -t7*s4 + c4*t20
-    t23 = t3*s5 + t21*c5
-    t24 = t3*c5 - t21*s5
-    t25 = t22*c6 + t23*s6
-    t26 = -0.13375*t25 + 0.1363*t24
-    t27 = t26 + 0.4*t22
-    t28 = t27 - 0.1685*t3
-    t29 = t28 - 0.4*t20
-    t30 = t29 + 0.1925*c1
-    t31 = t30 + 0.081*s1
-    t32 = t18*c1 + t30*s1
+    t21 = c4*t7 + s4*t20
+    t22 = -s4*t7 + c4*t20
+    t23 = t3*s5 + c5*t21
+    t24 = t3*c5 - s5*t21
+    t25 = t22*c6 + s6*t23
+    t26 = 0.1363*t24 - 0.13375*t25
+    t27 = 0.4*t22 + t26
+    t28 = -0.1685*t3 + t27
+    t29 = -0.4*t20 + t28
+    t30 = 0.1925*c1 + t29
+    t31 = 0.081*s1 + t30
+    t32 = c1*t18 + s1*t30
     t33 = t17*t20 - t29*t8
-    t34 = t3*t16 + t28*t6
+    t34 = t3*t16 + t6*t28
     t35 = t10*t27 - t22*t15
     t36 = t24*t14 - t12*t26
     t37 = c3*s2
     t38 = c2*s4 - c4*t37
     t39 = c2*c4 + s4*t37
     t40 = s3*s2
-    t41 = t38*c5 - s5*t40
-    t42 = t38*s5 + c5*t40
-    t43 = t39*c6 + t41*s6
-    t44 = 0.13375*t43 + 0.1363*t42
+    t41 = c5*t38 - s5*t40
+    t42 = s5*t38 + c5*t40
+    t43 = t39*c6 + s6*t41
+    t44 = 0.1363*t42 + 0.13375*t43
     t45 = -t44 + 0.4*t39
-    t46 = t45 + 0.1685*t40
-    t47 = t46 - 0.4*c2
-    t48 = t29*c2 - t47*t20
+    t46 = 0.1685*t40 + t45
+    t47 = -0.4*c2 + t46
+    t48 = c2*t29 - t47*t20
     t49 = t3*t46 + t28*t40
     t50 = t22*t45 - t39*t27
     t51 = t42*t26 - t24*t44
-    t52 = -t17*c2 + t47*t8
-    t53 = -t46*t6 + t16*t40
+    t52 = -c2*t17 + t47*t8
+    t53 = -t6*t46 + t16*t40
     t54 = t39*t15 - t10*t45
     t55 = t42*t14 - t12*t44
     t56 = t3*t42 - t24*t40
-    t57 = t6*c1
+    t57 = c1*t6
     t58 = s2*t5
     t59 = -(s1*t56 - t42*t57 + t12*t58)
     t60 = -(t22*t42 + t39*t24)
     t61 = -(t3*t39 + t22*t40)
     t62 = -(-t6*t60 + t10*t56 + t12*t61)
-    t63 = t10*c1
-    t64 = t12*c1
+    t63 = c1*t10
+    t64 = c1*t12
     t65 = -(s1*t60 - t42*t63 + t39*t64)
     t66 = -(s1*t61 + t39*t57 - t10*t58)
-    t67 = -(-t35*t59 + t32*t62 + t34*t65 + t36*t66)
+    t67 = -(-t59*t35 + t32*t62 + t34*t65 + t36*t66)
     t68 = t10*t24 + t22*t12
-    t69 = t64 - t24*s1
-    t70 = -(t63 + t22*s1)
-    t71 = t32*t68 + t35*t69 - t36*t70
-    t72 = t3*t10 + t22*t6
-    t73 = t3*s1 - t57
+    t69 = t64 - s1*t24
+    t70 = -(t63 + s1*t22)
+    t71 = t32*t68 + t35*t69 - t70*t36
+    t72 = t3*t10 + t6*t22
+    t73 = s1*t3 - t57
     t74 = t32*t72 + t34*t70 - t35*t73
-    t75 = t24*t6 - t3*t12
+    t75 = t6*t24 - t3*t12
     t76 = t32*t75 + t34*t69 - t36*t73
     t77 = -(-t35*t75 + t34*t68 + t36*t72)
     t78 = s1*t47
-    t79 = t24*c2 + t42*t20
+    t79 = c2*t24 + t42*t20
     t80 = c1**2
-    t81 = s2*t80
+    t81 = t80*s2
     t82 = -(s1*t79 - c2*t64 + t42*t81)
-    t83 = t22*c2 - t39*t20
-    t84 = -(t10*t79 + t12*t83 + t60*t8)
+    t83 = c2*t22 - t39*t20
+    t84 = -(t10*t79 + t12*t83 + t8*t60)
     t85 = -(s1*t83 - t39*t81 + c2*t63)
     t86 = -(-t35*t82 + t32*t84 + t33*t65 + t36*t85)
     t87 = t10*t20 - t22*t8
-    t88 = t81 + s2*s1**2
+    t88 = t81 + s1**2*s2
     t89 = t32*t87 + t33*t70 - t35*t88
     t90 = -(t12*t20 + t24*t8)
     t91 = t32*t90 + t33*t69 - t36*t88
     t92 = -(-t35*t90 + t33*t68 + t36*t87)
     t93 = s2**2
-    t94 = -(t3*c2 + t93*t0)
-    t95 = -(t12*t94 + t6*t79 + t56*t8)
+    t94 = -(c2*t3 + t0*t93)
+    t95 = -(t12*t94 + t6*t79 + t8*t56)
     t96 = -(s1*t94 - s3*t80*t93 + c2*t57)
     t97 = -(-t34*t82 + t32*t95 + t33*t59 + t36*t96)
     t98 = t3*t8 + t6*t20
     t99 = t32*t98 + t33*t73 - t34*t88
     t100 = -(-t34*t90 + t33*t75 + t36*t98)
-    t101 = -(-t10*t94 + t6*t83 + t61*t8)
+    t101 = -(-t10*t94 + t6*t83 + t8*t61)
     t102 = -(-t34*t85 + t32*t101 + t33*t66 + t35*t96)
     t103 = t33*t62 + t35*t95 - t34*t84 - t36*t101
     t104 = -(-t34*t87 + t33*t72 + t35*t98)
     t105 = c1*t47
-    t106 = t48*(t19*t67 + t53*t71 + t55*t74 - t54*t76 - t77*t78) + t49*(t19*t86 + t52*t71 + t55*t89 - t54*t91 - t92*t78) + t50*(t19*t97 + t52*t76 + t55*t99 - t53*t91 - t100*t78) - t31*(t53*t86 + t55*t102 - t52*t67 - t54*t97 + t103*t78) - t51*(t19*t102 + t52*t74 + t54*t99 - t53*t89 - t104*t78) - (t19*t103 + t53*t92 + t55*t104 - t52*t77 - t54*t100)*t105
+    t106 = t48*(t19*t67 + t53*t71 + t55*t74 - t54*t76 - t77*t78) + t49*(t19*t86 + t52*t71 + t55*t89 - t54*t91 - t78*t92) + t50*(t19*t97 + t52*t76 + t55*t99 - t53*t91 - t78*t100) - t31*(t53*t86 + t55*t102 - t67*t52 - t54*t97 + t78*t103) - t51*(t19*t102 + t52*t74 + t54*t99 - t53*t89 - t78*t104) - t105*(t19*t103 + t53*t92 + t55*t104 - t52*t77 - t54*t100)
     t107 = t3*t43 + t25*t40
     t108 = -(s1*t107 - t43*t57 + t13*t58)
     t109 = t39*t25 - t22*t43
     t110 = -(-t6*t109 + t10*t107 + t13*t61)
-    t111 = t13*c1
+    t111 = c1*t13
     t112 = -(s1*t109 - t43*t63 + t39*t111)
     t113 = -(-t35*t108 + t32*t110 + t34*t112)
     t114 = t22*t13 - t10*t25
-    t115 = t111 + t25*s1
+    t115 = t111 + s1*t25
     t116 = t32*t114 + t35*t115
-    t117 = -(t3*t13 + t25*t6)
+    t117 = -(t3*t13 + t6*t25)
     t118 = t32*t117 + t34*t115
     t119 = t35*t117 - t34*t114
-    t120 = t19*t113 + t53*t116 - t54*t118 - t119*t78
-    t121 = -t25*c2 + t43*t20
+    t120 = t19*t113 + t53*t116 - t54*t118 - t78*t119
+    t121 = -c2*t25 + t43*t20
     t122 = -(s1*t121 - c2*t111 + t43*t81)
-    t123 = -(t10*t121 + t13*t83 + t109*t8)
+    t123 = -(t10*t121 + t13*t83 + t8*t109)
     t124 = -(-t35*t122 + t32*t123 + t33*t112)
     t125 = t25*t8 - t13*t20
     t126 = t32*t125 + t33*t115
     t127 = t35*t125 - t33*t114
-    t128 = t19*t124 + t52*t116 - t54*t126 - t127*t78
-    t129 = -(t13*t94 + t6*t121 + t107*t8)
+    t128 = t19*t124 + t52*t116 - t54*t126 - t78*t127
+    t129 = -(t13*t94 + t6*t121 + t8*t107)
     t130 = -(-t34*t122 + t32*t129 + t33*t108)
     t131 = t34*t125 - t33*t117
-    t132 = t19*t130 + t52*t118 - t53*t126 - t131*t78
+    t132 = t19*t130 + t52*t118 - t53*t126 - t78*t131
     t133 = t33*t110 + t35*t129 - t34*t123
-    t134 = t53*t124 - t52*t113 - t54*t130 + t133*t78
+    t134 = t53*t124 - t52*t113 - t54*t130 + t78*t133
     t135 = t19*t133 + t53*t127 - t52*t119 - t54*t131
-    t136 = t48*t120 + t49*t128 + t50*t132 - t31*t134 - t135*t105
+    t136 = t48*t120 + t49*t128 + t50*t132 - t31*t134 - t105*t135
     t137 = -(t24*t43 + t42*t25)
     t138 = t12*t107 + t6*t137 - t13*t56
     t139 = -(s1*t137 - t42*t111 + t43*t64)
@@ -2285,30 +2285,30 @@ def manipulability(q):
     t141 = t12*t25 + t24*t13
     t142 = t32*t141 + t36*t115
     t143 = t36*t117 - t34*t141
-    t144 = t19*t140 + t53*t142 - t55*t118 - t143*t78
-    t145 = -(-t12*t121 + t13*t79 + t137*t8)
+    t144 = t19*t140 + t53*t142 - t55*t118 - t78*t143
+    t145 = -(-t12*t121 + t13*t79 + t8*t137)
     t146 = -(-t36*t122 + t32*t145 + t33*t139)
     t147 = t36*t125 - t33*t141
-    t148 = t19*t146 + t52*t142 - t55*t126 - t147*t78
+    t148 = t19*t146 + t52*t142 - t55*t126 - t78*t147
     t149 = t33*t138 + t36*t129 - t34*t145
-    t150 = t53*t146 - t52*t140 - t55*t130 + t149*t78
+    t150 = t53*t146 - t52*t140 - t55*t130 + t78*t149
     t151 = t19*t149 + t53*t147 - t52*t143 - t55*t131
-    t152 = t48*t144 + t49*t148 + t51*t132 - t31*t150 - t151*t105
+    t152 = t48*t144 + t49*t148 + t51*t132 - t31*t150 - t105*t151
     t153 = t10*t137 + t12*t109 - t13*t60
     t154 = -(-t36*t112 + t32*t153 + t35*t139)
     t155 = t33*t153 + t36*t123 - t35*t145
-    t156 = t54*t146 - t52*t154 - t55*t124 + t155*t78
+    t156 = t54*t146 - t52*t154 - t55*t124 + t78*t155
     t157 = t36*t114 - t35*t141
-    t158 = t19*t154 + t54*t142 - t55*t116 - t157*t78
+    t158 = t19*t154 + t54*t142 - t55*t116 - t78*t157
     t159 = t19*t155 + t54*t147 - t52*t157 - t55*t127
-    t160 = t31*t156 + t50*t148 - t48*t158 - t51*t128 + t159*t105
+    t160 = t31*t156 + t50*t148 - t48*t158 - t51*t128 + t105*t159
     t161 = t34*t153 + t36*t110 - t35*t138
-    t162 = t54*t140 - t53*t154 - t55*t113 + t161*t78
+    t162 = t54*t140 - t53*t154 - t55*t113 + t78*t161
     t163 = t19*t161 + t54*t143 - t53*t157 - t55*t119
-    t164 = t31*t162 + t49*t158 + t50*t144 - t51*t120 + t163*t105
+    t164 = t31*t162 + t49*t158 + t50*t144 - t51*t120 + t105*t163
     t165 = t52*t161 + t54*t149 - t53*t155 - t55*t133
     t166 = t31*t165 + t48*t163 + t49*t159 + t50*t151 - t51*t135
-    t167 = t48*t162 + t49*t156 + t50*t150 - t51*t134 - t165*t105
+    t167 = t48*t162 + t49*t156 + t50*t150 - t51*t134 - t105*t165
     t168 = t106**2 + t136**2 + t152**2 + t160**2 + t164**2 + t166**2 + t167**2
     w = xp.broadcast_to(xp.sqrt(xp.abs(t168)), batch)
     return w
@@ -2348,7 +2348,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t1 = c1*c3
     t2 = t0 + c2*t1
     t3 = t1 + c2*t0
-    t4 = c3*s1
+    t4 = s1*c3
     t5 = c1*s3
     t6 = t4 - c2*t5
     t7 = -t5 + c2*t4
@@ -2358,247 +2358,247 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t11 = t9*c5 - t6*s5
     t12 = t9*s5 + t6*c5
     t13 = t10*c6 + t11*s6
-    t14 = 0.13375*t13 + 0.1363*t12
+    t14 = 0.1363*t12 + 0.13375*t13
     t15 = -t14 + 0.4*t10
-    t16 = t15 + 0.1685*t6
-    t17 = t16 - 0.4*t8
-    t18 = t17 - 0.1925*s1
-    t19 = t18 + 0.081*c1
+    t16 = 0.1685*t6 + t15
+    t17 = -0.4*t8 + t16
+    t18 = -0.1925*s1 + t17
+    t19 = 0.081*c1 + t18
     t20 = s1*s2
-    t21 = t7*c4 + s4*t20
-    t22 = -t7*s4 + c4*t20
-    t23 = t3*s5 + t21*c5
-    t24 = t3*c5 - t21*s5
-    t25 = t22*c6 + t23*s6
-    t26 = -0.13375*t25 + 0.1363*t24
-    t27 = t26 + 0.4*t22
-    t28 = t27 - 0.1685*t3
-    t29 = t28 - 0.4*t20
-    t30 = t29 + 0.1925*c1
-    t31 = t30 + 0.081*s1
-    t32 = t18*c1 + t30*s1
+    t21 = c4*t7 + s4*t20
+    t22 = -s4*t7 + c4*t20
+    t23 = t3*s5 + c5*t21
+    t24 = t3*c5 - s5*t21
+    t25 = t22*c6 + s6*t23
+    t26 = 0.1363*t24 - 0.13375*t25
+    t27 = 0.4*t22 + t26
+    t28 = -0.1685*t3 + t27
+    t29 = -0.4*t20 + t28
+    t30 = 0.1925*c1 + t29
+    t31 = 0.081*s1 + t30
+    t32 = c1*t18 + s1*t30
     t33 = t17*t20 - t29*t8
-    t34 = t3*t16 + t28*t6
+    t34 = t3*t16 + t6*t28
     t35 = t10*t27 - t22*t15
     t36 = t24*t14 - t12*t26
     t37 = t32**2 + t33**2 + t34**2 + t35**2 + t36**2
     t38 = c3*s2
     t39 = c2*s4 - c4*t38
     t40 = c2*c4 + s4*t38
-    t41 = s2*s3
-    t42 = t39*c5 - s5*t41
-    t43 = t39*s5 + c5*t41
-    t44 = t40*c6 + t42*s6
-    t45 = 0.13375*t44 + 0.1363*t43
+    t41 = s3*s2
+    t42 = c5*t39 - s5*t41
+    t43 = s5*t39 + c5*t41
+    t44 = t40*c6 + s6*t42
+    t45 = 0.1363*t43 + 0.13375*t44
     t46 = -t45 + 0.4*t40
-    t47 = t46 + 0.1685*t41
-    t48 = t47 - 0.4*c2
+    t47 = 0.1685*t41 + t46
+    t48 = -0.4*c2 + t47
     t49 = t3*t47 + t28*t41
     t50 = t22*t46 - t40*t27
     t51 = t43*t26 - t24*t45
-    t52 = -t47*t6 + t16*t41
+    t52 = -t6*t47 + t16*t41
     t53 = t40*t15 - t10*t46
     t54 = t43*t14 - t12*t45
-    t55 = t40*t35 - t43*t36 - t33*c2 + t34*t41
-    t56 = t10*t40 + t12*t43 + t13*t44 + t6*t41 + c2*t8
-    t57 = t22*t40 + t25*t44 - t24*t43 + c2*t20 - t3*t41
-    t58 = t48*s1
-    t59 = t29*c2 - s2*t58
-    t60 = t31 + t43*t51 + t59*c2 - t40*t50 + t49*t41
-    t61 = t48*c1
-    t62 = -t17*c2 + s2*t61
-    t63 = t19 + t40*t53 - t43*t54 - t62*c2 + t52*t41
-    t64 = 1 + t10 + t22 + t40 + t24 + t19 + t59 + t50 + t51 + t62 + t52 + t53 + t54 + t33 + t34 + t35 + t36 + t6 + c1 + damping + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + q1 + q2 + q3 + q4 + q5 + q6 + q7 - t3 - t12 - t43 - t13 - t25 - t44 - t31 - t49 - t32 - c2 - s1 + t61 + t58 + t41 - t8 - t20
-    t65 = t48**2
-    t66 = c1**2
-    t67 = t31**2 + t59**2 + t49**2 + t50**2 + t51**2 + t65*t66
-    t68 = t3*t49 + t22*t50 + t24*t51 + t48*t66 - t59*t20
-    t69 = c1*s1
-    t70 = t59*t62 + t50*t53 + t51*t54 - t19*t31 - t49*t52 + t65*t69
-    t71 = t32*c1
-    t72 = t59*t33 + t50*t35 + t51*t36 - t49*t34 - t48*t71
-    t73 = t3*t34 + t71 - t22*t35 - t24*t36 + t33*t20
+    t55 = -c2*t33 + t41*t34 + t40*t35 - t43*t36
+    t56 = c2*t8 + t6*t41 + t10*t40 + t12*t43 + t13*t44
+    t57 = c2*t20 - t3*t41 + t22*t40 - t24*t43 + t25*t44
+    t58 = s1*t48
+    t59 = c2*t29 - s2*t58
+    t60 = t31 + c2*t59 + t41*t49 - t40*t50 + t43*t51
+    t61 = c1*t48
+    t62 = -c2*t17 + s2*t61
+    t63 = t19 - c2*t62 + t41*t52 + t40*t53 - t43*t54
+    t64 = 1 - t31 - t49 - t32 - s1 - t12 - t13 - t3 - t25 - c2 - t43 - t44 + q1 + q2 + c1 + q3 + q4 + t6 + t41 + q5 + t10 + t22 + t40 + q6 + t24 + q7 + t19 + t61 + t58 - t8 - t20 + t59 + t50 + t51 + t62 + t52 + t53 + t54 + t33 + t34 + t35 + t36 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + damping
+    t65 = c1**2
+    t66 = t65*t48 - t20*t59 + t3*t49 + t22*t50 + t24*t51
+    t67 = t48**2
+    t68 = t31**2 + t59**2 + t49**2 + t50**2 + t51**2 + t65*t67
+    t69 = s1*c1
+    t70 = -t19*t31 + t67*t69 + t59*t62 - t49*t52 + t50*t53 + t51*t54
+    t71 = c1*t32
+    t72 = -t48*t71 + t59*t33 - t49*t34 + t50*t35 + t51*t36
+    t73 = t71 + t20*t33 + t3*t34 - t22*t35 - t24*t36
     t74 = t48*t69
-    t75 = t12*t51 + t49*t6 - t10*t50 + t74 + t59*t8
-    t76 = t22*t53 + t24*t54 - t3*t52 + t74 - t62*t20
+    t75 = t74 + t8*t59 + t6*t49 - t10*t50 + t12*t51
+    t76 = t74 - t20*t62 - t3*t52 + t22*t53 + t24*t54
     t77 = s1**2
-    t78 = t19**2 + t62**2 + t52**2 + t53**2 + t54**2 + t65*t77
-    t79 = t12*t54 + t48*t77 - t10*t53 - t52*t6 + t62*t8
-    t80 = t32*s1
-    t81 = t62*t33 + t52*t34 + t53*t35 + t54*t36 - t48*t80
-    t82 = t10*t35 + t80 + t34*t6 - t12*t36 - t33*t8
+    t78 = t19**2 + t62**2 + t52**2 + t53**2 + t54**2 + t77*t67
+    t79 = t77*t48 + t8*t62 - t6*t52 - t10*t53 + t12*t54
+    t80 = s1*t32
+    t81 = -t48*t80 + t62*t33 + t52*t34 + t53*t35 + t54*t36
+    t82 = t80 - t8*t33 + t6*t34 + t10*t35 - t12*t36
     t83 = s2**2
-    t84 = t10**2 + t12**2 + t13**2 + t6**2 + t77 + t66*t83
-    t85 = t10*t22 + t13*t25 - t3*t6 - t12*t24 - t69 + t83*t69
-    t86 = t3**2 + t22**2 + t24**2 + t25**2 + t66 + t77*t83
-    t87 = 1 + t40**2 + t43**2 + t44**2 + c2**2 + t83*s3**2
-    t88 = damping**2
-    t89 = t67 + t88
-    t90 = t89**2
-    t91 = t78 + t88
-    t92 = t37 + t88
-    t93 = t84 + t88
-    t94 = t86 + t88
-    t95 = t87 + t88
-    t96 = t70**2
-    t97 = t60**2
-    t98 = t72**2
-    t99 = t75**2
-    t100 = t68**2
-    t101 = xp.sqrt(t90 + t91**2 + t92**2 + t93**2 + t94**2 + t95**2 + 2*t96 + 2*t97 + 2*t98 + 2*t99 + 2*t100 + 2*t63**2 + 2*t81**2 + 2*t79**2 + 2*t76**2 + 2*t82**2 + 2*t73**2 + 2*t55**2 + 2*t85**2 + 2*t56**2 + 2*t57**2)
-    t102 = xp.sqrt(t96 + t97 + t98 + t99 + t100 + t90)
-    t103 = t102*xp.where(xp.greater_equal(t89, 0), xp.asarray(1, dtype=dtype), -1)
-    t104 = t103 + t89
-    t105 = xp.where(xp.greater(t102, 0), 1/(t102*(t102 + xp.abs(t89))), 0)
-    t106 = t105*(t70*t104 + t70*t91 + t72*t81 + t75*t79 + t68*t76 - t60*t63)
-    t107 = t70 - t104*t106
-    t108 = -t70*t106 + t91
-    t109 = t81 - t72*t106
-    t110 = -t79 + t75*t106
-    t111 = t76 - t68*t106
-    t112 = t63 + t60*t106
-    t113 = t105*(t70*t81 + t72*t104 + t72*t92 - t60*t55 - t75*t82 - t68*t73)
-    t114 = t72 - t104*t113
-    t115 = t81 - t70*t113
-    t116 = -t72*t113 + t92
-    t117 = t82 + t75*t113
-    t118 = t73 + t68*t113
-    t119 = t55 + t60*t113
-    t120 = -t105*(-t72*t82 - t68*t85 + t70*t79 + t60*t56 + t75*t104 + t75*t93)
-    t121 = t75 + t104*t120
-    t122 = t79 + t70*t120
-    t123 = t82 - t72*t120
-    t124 = t75*t120 + t93
-    t125 = t85 - t68*t120
-    t126 = t56 + t60*t120
-    t127 = t105*(t70*t76 + t68*t104 + t68*t94 - t60*t57 - t72*t73 - t75*t85)
-    t128 = t68 - t104*t127
-    t129 = t76 - t70*t127
-    t130 = t73 + t72*t127
-    t131 = t85 + t75*t127
-    t132 = -t68*t127 + t94
-    t133 = t57 + t60*t127
-    t134 = t105*(t70*t63 + t72*t55 + t68*t57 - t60*t104 - t60*t95 - t75*t56)
-    t135 = t60 + t104*t134
-    t136 = t63 - t70*t134
-    t137 = t55 - t72*t134
-    t138 = t56 + t75*t134
-    t139 = t57 - t68*t134
-    t140 = t60*t134 + t95
-    t141 = t105*(t70*mu_dot1 + t72*mu_dot2 + t68*mu_dot4 + t104*mu_dot0 - t60*mu_dot5 - t75*mu_dot3)
-    t142 = mu_dot0 - t104*t141
-    t143 = mu_dot1 - t70*t141
-    t144 = mu_dot2 - t72*t141
-    t145 = mu_dot3 + t75*t141
-    t146 = mu_dot4 - t68*t141
-    t147 = mu_dot5 + t60*t141
-    t148 = xp.sqrt(t108**2 + t109**2 + t110**2 + t111**2 + t112**2)
-    t149 = t148*xp.where(xp.greater_equal(t108, 0), xp.asarray(1, dtype=dtype), -1)
-    t150 = t108 + t149
-    t151 = xp.where(xp.greater(t148, 0), 1/(t148*(t148 + xp.abs(t108))), 0)
-    t152 = t151*(t109*t116 + t110*t117 + t112*t119 + t115*t150 - t111*t118)
-    t153 = t115 - t150*t152
-    t154 = t116 - t109*t152
-    t155 = t117 - t110*t152
-    t156 = t118 + t111*t152
-    t157 = t119 - t112*t152
-    t158 = t151*(t109*t123 + t110*t124 + t111*t125 + t112*t126 - t122*t150)
-    t159 = t122 + t150*t158
-    t160 = t123 - t109*t158
-    t161 = t124 - t110*t158
-    t162 = t125 - t111*t158
-    t163 = t126 - t112*t158
-    t164 = t151*(t110*t131 + t111*t132 + t112*t133 + t129*t150 - t109*t130)
-    t165 = t129 - t150*t164
-    t166 = t130 + t109*t164
-    t167 = t131 - t110*t164
-    t168 = t132 - t111*t164
-    t169 = t133 - t112*t164
-    t170 = t151*(t109*t137 + t110*t138 + t111*t139 + t112*t140 + t136*t150)
-    t171 = t136 - t150*t170
-    t172 = t137 - t109*t170
-    t173 = t138 - t110*t170
-    t174 = t139 - t111*t170
-    t175 = t140 - t112*t170
-    t176 = t151*(t109*t144 + t110*t145 + t111*t146 + t112*t147 + t143*t150)
-    t177 = t143 - t150*t176
-    t178 = t144 - t109*t176
-    t179 = t145 - t110*t176
-    t180 = t146 - t111*t176
-    t181 = t147 - t112*t176
-    t182 = xp.sqrt(t154**2 + t155**2 + t156**2 + t157**2)
-    t183 = t182*xp.where(xp.greater_equal(t154, 0), xp.asarray(1, dtype=dtype), -1)
-    t184 = t154 + t183
-    t185 = xp.where(xp.greater(t182, 0), 1/(t182*(t182 + xp.abs(t154))), 0)
-    t186 = t185*(t155*t161 + t157*t163 + t160*t184 - t156*t162)
-    t187 = t160 - t184*t186
-    t188 = t161 - t155*t186
-    t189 = t162 + t156*t186
-    t190 = t163 - t157*t186
-    t191 = t185*(t155*t167 + t157*t169 - t156*t168 - t166*t184)
-    t192 = t166 + t184*t191
-    t193 = t167 - t155*t191
-    t194 = t168 + t156*t191
-    t195 = t169 - t157*t191
-    t196 = t185*(t155*t173 + t157*t175 + t172*t184 - t156*t174)
-    t197 = t172 - t184*t196
-    t198 = t173 - t155*t196
-    t199 = t174 + t156*t196
-    t200 = t175 - t157*t196
-    t201 = t185*(t155*t179 + t157*t181 + t178*t184 - t156*t180)
-    t202 = t178 - t184*t201
-    t203 = t179 - t155*t201
-    t204 = t180 + t156*t201
-    t205 = t181 - t157*t201
-    t206 = xp.sqrt(t188**2 + t189**2 + t190**2)
-    t207 = t206*xp.where(xp.greater_equal(t188, 0), xp.asarray(1, dtype=dtype), -1)
-    t208 = t188 + t207
-    t209 = xp.where(xp.greater(t206, 0), 1/(t206*(t206 + xp.abs(t188))), 0)
-    t210 = t209*(t189*t194 + t190*t195 + t193*t208)
-    t211 = t193 - t208*t210
-    t212 = t194 - t189*t210
-    t213 = t195 - t190*t210
-    t214 = t209*(t189*t199 + t190*t200 + t198*t208)
-    t215 = t198 - t208*t214
-    t216 = t199 - t189*t214
-    t217 = t200 - t190*t214
-    t218 = t209*(t189*t204 + t190*t205 + t203*t208)
-    t219 = t203 - t208*t218
-    t220 = t204 - t189*t218
-    t221 = t205 - t190*t218
-    t222 = xp.sqrt(t212**2 + t213**2)
-    t223 = t222*xp.where(xp.greater_equal(t212, 0), xp.asarray(1, dtype=dtype), -1)
-    t224 = t212 + t223
-    t225 = xp.where(xp.greater(t222, 0), 1/(t222*(t222 + xp.abs(t212))), 0)
-    t226 = t225*(t213*t217 + t216*t224)
-    t227 = t216 - t224*t226
-    t228 = t217 - t213*t226
-    t229 = t225*(t213*t221 + t220*t224)
-    t230 = t220 - t224*t229
-    t231 = t221 - t213*t229
-    t232 = xp.abs(t228)
+    t84 = t77 + t6**2 + t10**2 + t12**2 + t13**2 + t65*t83
+    t85 = -t69 + t69*t83 - t6*t3 + t10*t22 - t12*t24 + t13*t25
+    t86 = t65 + t3**2 + t22**2 + t24**2 + t25**2 + t77*t83
+    t87 = 1 + c2**2 + t40**2 + t43**2 + t44**2 + s3**2*t83
+    t88 = t70**2
+    t89 = t72**2
+    t90 = t75**2
+    t91 = t66**2
+    t92 = t60**2
+    t93 = damping**2
+    t94 = t93 + t68
+    t95 = t94**2
+    t96 = xp.sqrt(t88 + t89 + t90 + t91 + t92 + t95)
+    t97 = t96*xp.where(xp.greater_equal(t94, 0), xp.asarray(1, dtype=dtype), -1)
+    t98 = t94 + t97
+    t99 = xp.where(xp.greater(t96, 0), 1/(t96*(t96 + xp.abs(t94))), 0)
+    t100 = t99*(mu_dot0*t98 + mu_dot1*t70 + mu_dot2*t72 - mu_dot3*t75 + mu_dot4*t66 - mu_dot5*t60)
+    t101 = mu_dot0 - t98*t100
+    t102 = mu_dot1 - t70*t100
+    t103 = mu_dot2 - t72*t100
+    t104 = mu_dot3 + t75*t100
+    t105 = mu_dot4 - t66*t100
+    t106 = mu_dot5 + t60*t100
+    t107 = t93 + t78
+    t108 = t99*(t70*t98 + t70*t107 + t72*t81 + t75*t79 + t66*t76 - t60*t63)
+    t109 = t70 - t98*t108
+    t110 = t107 - t70*t108
+    t111 = t81 - t72*t108
+    t112 = -t79 + t75*t108
+    t113 = t76 - t66*t108
+    t114 = t63 + t60*t108
+    t115 = xp.sqrt(t110**2 + t111**2 + t112**2 + t113**2 + t114**2)
+    t116 = t115*xp.where(xp.greater_equal(t110, 0), xp.asarray(1, dtype=dtype), -1)
+    t117 = t110 + t116
+    t118 = xp.where(xp.greater(t115, 0), 1/(t115*(t115 + xp.abs(t110))), 0)
+    t119 = t118*(t102*t117 + t111*t103 + t112*t104 + t113*t105 + t114*t106)
+    t120 = t102 - t117*t119
+    t121 = t103 - t111*t119
+    t122 = t104 - t112*t119
+    t123 = t105 - t113*t119
+    t124 = t106 - t114*t119
+    t125 = t93 + t37
+    t126 = t99*(t72*t98 + t70*t81 + t72*t125 - t75*t82 - t66*t73 - t60*t55)
+    t127 = t72 - t98*t126
+    t128 = t81 - t70*t126
+    t129 = t125 - t72*t126
+    t130 = t82 + t75*t126
+    t131 = t73 + t66*t126
+    t132 = t55 + t60*t126
+    t133 = t118*(t128*t117 + t111*t129 + t112*t130 - t113*t131 + t114*t132)
+    t134 = t128 - t117*t133
+    t135 = t129 - t111*t133
+    t136 = t130 - t112*t133
+    t137 = t131 + t113*t133
+    t138 = t132 - t114*t133
+    t139 = xp.sqrt(t135**2 + t136**2 + t137**2 + t138**2)
+    t140 = t139*xp.where(xp.greater_equal(t135, 0), xp.asarray(1, dtype=dtype), -1)
+    t141 = t135 + t140
+    t142 = xp.where(xp.greater(t139, 0), 1/(t139*(t139 + xp.abs(t135))), 0)
+    t143 = t142*(t121*t141 + t136*t122 - t137*t123 + t138*t124)
+    t144 = t121 - t141*t143
+    t145 = t122 - t136*t143
+    t146 = t123 + t137*t143
+    t147 = t124 - t138*t143
+    t148 = t93 + t84
+    t149 = -t99*(t75*t98 + t70*t79 - t72*t82 + t75*t148 - t66*t85 + t60*t56)
+    t150 = t75 + t98*t149
+    t151 = t79 + t70*t149
+    t152 = t82 - t72*t149
+    t153 = t148 + t75*t149
+    t154 = t85 - t66*t149
+    t155 = t56 + t60*t149
+    t156 = t118*(-t151*t117 + t111*t152 + t112*t153 + t113*t154 + t114*t155)
+    t157 = t151 + t117*t156
+    t158 = t152 - t111*t156
+    t159 = t153 - t112*t156
+    t160 = t154 - t113*t156
+    t161 = t155 - t114*t156
+    t162 = t142*(t158*t141 + t136*t159 - t137*t160 + t138*t161)
+    t163 = t158 - t141*t162
+    t164 = t159 - t136*t162
+    t165 = t160 + t137*t162
+    t166 = t161 - t138*t162
+    t167 = xp.sqrt(t164**2 + t165**2 + t166**2)
+    t168 = t167*xp.where(xp.greater_equal(t164, 0), xp.asarray(1, dtype=dtype), -1)
+    t169 = t164 + t168
+    t170 = xp.where(xp.greater(t167, 0), 1/(t167*(t167 + xp.abs(t164))), 0)
+    t171 = t170*(t145*t169 + t165*t146 + t166*t147)
+    t172 = t145 - t169*t171
+    t173 = t146 - t165*t171
+    t174 = t147 - t166*t171
+    t175 = t93 + t86
+    t176 = t99*(t66*t98 + t70*t76 - t72*t73 - t75*t85 + t66*t175 - t60*t57)
+    t177 = t66 - t98*t176
+    t178 = t76 - t70*t176
+    t179 = t73 + t72*t176
+    t180 = t85 + t75*t176
+    t181 = t175 - t66*t176
+    t182 = t57 + t60*t176
+    t183 = t118*(t178*t117 - t111*t179 + t112*t180 + t113*t181 + t114*t182)
+    t184 = t178 - t117*t183
+    t185 = t179 + t111*t183
+    t186 = t180 - t112*t183
+    t187 = t181 - t113*t183
+    t188 = t182 - t114*t183
+    t189 = t142*(-t185*t141 + t136*t186 - t137*t187 + t138*t188)
+    t190 = t185 + t141*t189
+    t191 = t186 - t136*t189
+    t192 = t187 + t137*t189
+    t193 = t188 - t138*t189
+    t194 = t170*(t191*t169 + t165*t192 + t166*t193)
+    t195 = t191 - t169*t194
+    t196 = t192 - t165*t194
+    t197 = t193 - t166*t194
+    t198 = xp.sqrt(t196**2 + t197**2)
+    t199 = t198*xp.where(xp.greater_equal(t196, 0), xp.asarray(1, dtype=dtype), -1)
+    t200 = t196 + t199
+    t201 = xp.where(xp.greater(t198, 0), 1/(t198*(t198 + xp.abs(t196))), 0)
+    t202 = t201*(t173*t200 + t197*t174)
+    t203 = t173 - t200*t202
+    t204 = t174 - t197*t202
+    t205 = t93 + t87
+    t206 = xp.sqrt(2*t88 + 2*t89 + 2*t81**2 + 2*t90 + 2*t79**2 + 2*t82**2 + 2*t91 + 2*t76**2 + 2*t73**2 + 2*t85**2 + 2*t92 + 2*t63**2 + 2*t55**2 + 2*t56**2 + 2*t57**2 + t95 + t107**2 + t125**2 + t148**2 + t175**2 + t205**2)
+    t207 = t99*(-t60*t98 + t70*t63 + t72*t55 - t75*t56 + t66*t57 - t205*t60)
+    t208 = t60 + t98*t207
+    t209 = t63 - t70*t207
+    t210 = t55 - t72*t207
+    t211 = t56 + t75*t207
+    t212 = t57 - t66*t207
+    t213 = t205 + t60*t207
+    t214 = t118*(t209*t117 + t111*t210 + t112*t211 + t113*t212 + t114*t213)
+    t215 = t209 - t117*t214
+    t216 = t210 - t111*t214
+    t217 = t211 - t112*t214
+    t218 = t212 - t113*t214
+    t219 = t213 - t114*t214
+    t220 = t142*(t216*t141 + t136*t217 - t137*t218 + t138*t219)
+    t221 = t216 - t141*t220
+    t222 = t217 - t136*t220
+    t223 = t218 + t137*t220
+    t224 = t219 - t138*t220
+    t225 = t170*(t222*t169 + t165*t223 + t166*t224)
+    t226 = t222 - t169*t225
+    t227 = t223 - t165*t225
+    t228 = t224 - t166*t225
+    t229 = t201*(t227*t200 + t197*t228)
+    t230 = t227 - t200*t229
+    t231 = t228 - t197*t229
+    t232 = xp.abs(t231)
     t233 = t232
-    t234 = t233*xp.where(xp.greater_equal(t228, 0), xp.asarray(1, dtype=dtype), -1)
-    t235 = t228 + t234
-    t236 = xp.where(xp.greater(t233, 0), 1/(t233*(t233 + t232)), 0)
-    t237 = t231 - t231*t236*t235**2
+    t234 = t233*xp.where(xp.greater_equal(t231, 0), xp.asarray(1, dtype=dtype), -1)
+    t235 = t231 + t234
+    t236 = xp.where(xp.greater(t233, 0), 1/(t233*(t232 + t233)), 0)
+    t237 = t204 - t204*t235**2*t236
     t238 = xp.where(xp.not_equal(t234, 0), -t237/t234, 0)
-    t239 = xp.where(xp.not_equal(t223, 0), -(t230 - t227*t238)/t223, 0)
-    t240 = xp.where(xp.not_equal(t207, 0), -(t219 - (t211*t239 + t215*t238))/t207, 0)
-    t241 = xp.where(xp.not_equal(t183, 0), -(t202 - (t187*t240 + t197*t238 - t192*t239))/t183, 0)
-    t242 = xp.where(xp.not_equal(t149, 0), -(t177 - (t153*t241 + t165*t239 + t171*t238 - t159*t240))/t149, 0)
-    t243 = xp.where(xp.not_equal(t103, 0), -(t142 - (t107*t242 + t114*t241 + t128*t239 - t121*t240 - t135*t238))/t103, 0)
-    t244 = t238 + t242*t19 - t243*t31
-    t245 = t239*c1 - t240*s1 - t241*t32 + t242*t58 + t243*t61
-    t246 = t241*t33 + t242*t62 + t243*t59 - t238*c2 - t239*t20 - t240*t8
-    t247 = t240*t6 + t241*t34 + t242*t52 - t3*t239 - t243*t49 + t238*t41
-    t248 = t10*t240 + t22*t239 + t40*t238 + t241*t35 + t242*t53 + t243*t50
-    t249 = t24*t239 + t241*t36 + t242*t54 + t243*t51 - t12*t240 - t43*t238
-    t250 = t238*t44 + t239*t25 + t240*t13
+    t239 = xp.where(xp.not_equal(t199, 0), -(t203 - t230*t238)/t199, 0)
+    t240 = xp.where(xp.not_equal(t168, 0), -(-(t195*t239 + t226*t238) + t172)/t168, 0)
+    t241 = xp.where(xp.not_equal(t140, 0), -(-(t163*t240 - t190*t239 + t221*t238) + t144)/t140, 0)
+    t242 = xp.where(xp.not_equal(t116, 0), -(-(t134*t241 - t157*t240 + t184*t239 + t215*t238) + t120)/t116, 0)
+    t243 = xp.where(xp.not_equal(t97, 0), -(-(t109*t242 + t127*t241 - t150*t240 + t177*t239 - t208*t238) + t101)/t97, 0)
+    t244 = t238 - t31*t243 + t19*t242
+    t245 = t61*t243 + t58*t242 - t32*t241 - s1*t240 + c1*t239
+    t246 = t59*t243 + t62*t242 + t33*t241 - t8*t240 - t20*t239 - c2*t238
+    t247 = -t49*t243 + t52*t242 + t34*t241 + t6*t240 - t3*t239 + t41*t238
+    t248 = t50*t243 + t53*t242 + t35*t241 + t10*t240 + t22*t239 + t40*t238
+    t249 = t51*t243 + t54*t242 + t36*t241 - t12*t240 + t24*t239 - t43*t238
+    t250 = t13*t240 + t25*t239 + t44*t238
     t251 = xp.isfinite(t64)
     t252 = xp.greater_equal(damping, 0)
-    t253 = 1e-12*t101
-    t254 = xp.less_equal(t102, t253) | xp.less_equal(t148, t253) | xp.less_equal(t182, t253) | xp.less_equal(t206, t253) | xp.less_equal(t222, t253) | xp.less_equal(t233, t253)
+    t253 = 1e-12*t206
+    t254 = xp.less_equal(t96, t253) | xp.less_equal(t115, t253) | xp.less_equal(t139, t253) | xp.less_equal(t167, t253) | xp.less_equal(t198, t253) | xp.less_equal(t233, t253)
     t255 = t251 & t252 & xp.logical_not(t254)
     q_dot = _stack(xp, [
         xp.broadcast_to(xp.where(t255, t244, 0), batch),  # 0
@@ -2657,12 +2657,12 @@ def ik_numeric_step(target, q, damping=0.0):
     s6 = xp.sin(q6)
     c7 = xp.cos(q7)
     s7 = xp.sin(q7)
-    t0 = T00 + T01 + T02 + T03 + T10 + T11 + T12 + T13 + T20 + T21 + T22 + T23 + qs1 + qs2 + qs3 + qs4 + qs5 + qs6 + qs7
+    t0 = qs1 + qs2 + qs3 + qs4 + qs5 + qs6 + qs7 + T00 + T01 + T02 + T10 + T11 + T12 + T20 + T21 + T22 + T03 + T13 + T23
     t1 = s1*s3
     t2 = c1*c3
     t3 = t1 + c2*t2
     t4 = t2 + c2*t1
-    t5 = c3*s1
+    t5 = s1*c3
     t6 = c1*s3
     t7 = t5 - c2*t6
     t8 = -t6 + c2*t5
@@ -2674,106 +2674,106 @@ def ik_numeric_step(target, q, damping=0.0):
     t14 = t12*c6 - t11*s6
     t15 = t11*c6 + t12*s6
     t16 = t13*s7 + t14*c7
-    t17 = t13*c7 - t14*s7
-    t18 = 0.13375*t15 + 0.1363*t13
+    t17 = t13*c7 - s7*t14
+    t18 = 0.1363*t13 + 0.13375*t15
     t19 = -t18 + 0.4*t11
-    t20 = t19 + 0.1685*t7
-    t21 = t20 - 0.4*t9
-    t22 = t21 - 0.1925*s1
-    t23 = t22 + 0.081*c1
-    t24 = T00*t16 + T01*t17 - T02*t15
-    t25 = T10*t16 + T11*t17 - T12*t15
-    t26 = T20*t16 + T21*t17 - T22*t15
-    t27 = T03 - t23
+    t20 = 0.1685*t7 + t19
+    t21 = -0.4*t9 + t20
+    t22 = -0.1925*s1 + t21
+    t23 = 0.081*c1 + t22
+    t24 = t16*T00 + t17*T01 - t15*T02
+    t25 = t16*T10 + t17*T11 - t15*T12
+    t26 = t16*T20 + t17*T21 - t15*T22
+    t27 = -t23 + T03
     t28 = s1*s2
-    t29 = t8*c4 + s4*t28
-    t30 = -t8*s4 + c4*t28
-    t31 = t4*s5 + t29*c5
-    t32 = t4*c5 - t29*s5
-    t33 = t31*c6 - t30*s6
-    t34 = t30*c6 + t31*s6
-    t35 = t33*c7 - t32*s7
-    t36 = t32*c7 + t33*s7
-    t37 = -0.13375*t34 + 0.1363*t32
-    t38 = t37 + 0.4*t30
-    t39 = t38 - 0.1685*t4
-    t40 = t39 - 0.4*t28
-    t41 = t40 + 0.1925*c1
-    t42 = t41 + 0.081*s1
-    t43 = t22*c1 + t41*s1
+    t29 = c4*t8 + s4*t28
+    t30 = -s4*t8 + c4*t28
+    t31 = t4*s5 + c5*t29
+    t32 = t4*c5 - s5*t29
+    t33 = c6*t31 - t30*s6
+    t34 = t30*c6 + s6*t31
+    t35 = c7*t33 - t32*s7
+    t36 = t32*c7 + s7*t33
+    t37 = 0.1363*t32 - 0.13375*t34
+    t38 = 0.4*t30 + t37
+    t39 = -0.1685*t4 + t38
+    t40 = -0.4*t28 + t39
+    t41 = 0.1925*c1 + t40
+    t42 = 0.081*s1 + t41
+    t43 = c1*t22 + s1*t41
     t44 = t21*t28 - t40*t9
-    t45 = t4*t20 + t39*t7
+    t45 = t4*t20 + t7*t39
     t46 = t11*t38 - t30*t19
     t47 = t32*t18 - t13*t37
     t48 = t43**2 + t44**2 + t45**2 + t46**2 + t47**2
-    t49 = T01*t36 + T02*t34 - T00*t35
-    t50 = T11*t36 + T12*t34 - T10*t35
-    t51 = T21*t36 + T22*t34 - T20*t35
+    t49 = -t35*T00 + t36*T01 + t34*T02
+    t50 = -t35*T10 + t36*T11 + t34*T12
+    t51 = -t35*T20 + t36*T21 + t34*T22
     t52 = 0.5*(t49 + t25)
-    t53 = T13 - t42
+    t53 = -t42 + T13
     t54 = c3*s2
     t55 = c2*s4 - c4*t54
     t56 = c2*c4 + s4*t54
     t57 = s3*s2
-    t58 = t55*c5 - s5*t57
-    t59 = t55*s5 + c5*t57
-    t60 = t58*c6 - t56*s6
-    t61 = t56*c6 + t58*s6
-    t62 = t59*s7 + t60*c7
-    t63 = t59*c7 - t60*s7
-    t64 = 0.13375*t61 + 0.1363*t59
+    t58 = c5*t55 - s5*t57
+    t59 = s5*t55 + c5*t57
+    t60 = c6*t58 - t56*s6
+    t61 = t56*c6 + s6*t58
+    t62 = t59*s7 + c7*t60
+    t63 = t59*c7 - s7*t60
+    t64 = 0.1363*t59 + 0.13375*t61
     t65 = -t64 + 0.4*t56
-    t66 = t65 + 0.1685*t57
-    t67 = t66 - 0.4*c2
+    t66 = 0.1685*t57 + t65
+    t67 = -0.4*c2 + t66
     t68 = 0.317 + t67
-    t69 = t40*c2 - t67*t28
+    t69 = c2*t40 - t67*t28
     t70 = t4*t66 + t39*t57
     t71 = t30*t65 - t56*t38
     t72 = t59*t37 - t32*t64
-    t73 = -t21*c2 + t67*t9
-    t74 = -t66*t7 + t20*t57
+    t73 = -c2*t21 + t67*t9
+    t74 = -t7*t66 + t20*t57
     t75 = t56*t19 - t11*t65
     t76 = t59*t18 - t13*t64
-    t77 = t42 + t59*t72 + t69*c2 - t56*t71 + t70*t57
-    t78 = t23 + t56*t75 - t59*t76 - t73*c2 + t74*t57
-    t79 = t56*t46 - t59*t47 - t44*c2 + t45*t57
-    t80 = t11*t56 + t13*t59 + t15*t61 + t7*t57 + c2*t9
-    t81 = t30*t56 + t34*t61 - t32*t59 + c2*t28 - t4*t57
-    t82 = T00*t62 + T01*t63 - T02*t61
-    t83 = T10*t62 + T11*t63 - T12*t61
-    t84 = T20*t62 + T21*t63 - T22*t61
-    t85 = -0.5*(t83 + t51)
-    t86 = 0.5*(t82 - t26)
+    t77 = t42 + c2*t69 + t57*t70 - t56*t71 + t59*t72
+    t78 = t23 - c2*t73 + t57*t74 + t56*t75 - t59*t76
+    t79 = -c2*t44 + t57*t45 + t56*t46 - t59*t47
+    t80 = c2*t9 + t7*t57 + t11*t56 + t13*t59 + t15*t61
+    t81 = c2*t28 - t4*t57 + t30*t56 - t32*t59 + t34*t61
+    t82 = t62*T00 + t63*T01 - t61*T02
+    t83 = t62*T10 + t63*T11 - t61*T12
+    t84 = t62*T20 + t63*T21 - t61*T22
+    t85 = -0.5*(t51 + t83)
+    t86 = 0.5*(-t26 + t82)
     t87 = xp.sqrt(t85**2 + t86**2 + t52**2)
-    t88 = T23 - t68
-    t89 = t67**2
-    t90 = c1**2
-    t91 = t42**2 + t69**2 + t70**2 + t71**2 + t72**2 + t89*t90
-    t92 = t4*t70 + t30*t71 + t32*t72 + t67*t90 - t69*t28
-    t93 = c1*s1
-    t94 = t69*t73 + t71*t75 + t72*t76 - t23*t42 - t70*t74 + t89*t93
-    t95 = t43*c1
-    t96 = t69*t44 + t71*t46 + t72*t47 - t70*t45 - t67*t95
-    t97 = t4*t45 + t95 - t30*t46 - t32*t47 + t44*t28
+    t88 = -t68 + T23
+    t89 = c1**2
+    t90 = t89*t67 - t28*t69 + t4*t70 + t30*t71 + t32*t72
+    t91 = t67**2
+    t92 = t42**2 + t69**2 + t70**2 + t71**2 + t72**2 + t89*t91
+    t93 = s1*c1
+    t94 = -t23*t42 + t91*t93 + t69*t73 - t70*t74 + t71*t75 + t72*t76
+    t95 = c1*t43
+    t96 = -t67*t95 + t69*t44 - t70*t45 + t71*t46 + t72*t47
+    t97 = t95 + t28*t44 + t4*t45 - t30*t46 - t32*t47
     t98 = t67*t93
-    t99 = t13*t72 + t70*t7 - t11*t71 + t98 + t69*t9
-    t100 = t30*t75 + t32*t76 - t4*t74 + t98 - t73*t28
+    t99 = t98 + t9*t69 + t7*t70 - t11*t71 + t13*t72
+    t100 = t98 - t28*t73 - t4*t74 + t30*t75 + t32*t76
     t101 = s1**2
-    t102 = t23**2 + t73**2 + t74**2 + t75**2 + t76**2 + t89*t101
-    t103 = t13*t76 + t67*t101 - t11*t75 - t74*t7 + t73*t9
-    t104 = t43*s1
-    t105 = t73*t44 + t74*t45 + t75*t46 + t76*t47 - t67*t104
-    t106 = t11*t46 + t104 + t45*t7 - t13*t47 - t44*t9
+    t102 = t23**2 + t73**2 + t74**2 + t75**2 + t76**2 + t101*t91
+    t103 = t101*t67 + t9*t73 - t7*t74 - t11*t75 + t13*t76
+    t104 = s1*t43
+    t105 = -t67*t104 + t73*t44 + t74*t45 + t75*t46 + t76*t47
+    t106 = t104 - t9*t44 + t7*t45 + t11*t46 - t13*t47
     t107 = s2**2
-    t108 = t11**2 + t13**2 + t15**2 + t7**2 + t101 + t90*t107
-    t109 = t11*t30 + t15*t34 - t4*t7 - t13*t32 - t93 + t107*t93
-    t110 = t4**2 + t30**2 + t32**2 + t34**2 + t90 + t101*t107
-    t111 = 1 + t56**2 + t59**2 + t61**2 + c2**2 + t107*s3**2
+    t108 = t101 + t7**2 + t11**2 + t13**2 + t15**2 + t89*t107
+    t109 = -t93 + t93*t107 - t7*t4 + t11*t30 - t13*t32 + t15*t34
+    t110 = t89 + t4**2 + t30**2 + t32**2 + t34**2 + t101*t107
+    t111 = 1 + c2**2 + t56**2 + t59**2 + t61**2 + s3**2*t107
     t112 = -t50
-    t113 = 0.5*(-1 + t24 + t84 + t112)
+    t113 = 0.5*(-1 + t112 + t24 + t84)
     t114 = xp.atan2(t87, t113)
     t115 = xp.where(xp.greater(t87, 0), t114/t87, 1)
-    t116 = xp.greater_equal(t24, t84) & xp.greater_equal(t24, t112)
+    t116 = xp.greater_equal(t24, t112) & xp.greater_equal(t24, t84)
     t117 = xp.greater_equal(t112, t84)
     t118 = xp.where(t116, 0.5*(1 + t24), xp.where(t117, -0.5*t49, 0.5*t82))
     t119 = xp.where(t116, 0.5*t25, xp.where(t117, 0.5*(1 + t112), 0.5*t83))
@@ -2782,49 +2782,49 @@ def ik_numeric_step(target, q, damping=0.0):
     t122 = xp.where(xp.greater_equal(t85*t118 + t86*t119 + t52*t120, 0), xp.asarray(1, dtype=dtype), -1)
     t123 = xp.greater(t87, 1e-06) | xp.greater(t113, 0)
     t124 = t114*t122/t121
-    t125 = xp.where(t123, t85*t115, t118*t124)
-    t126 = xp.where(t123, t86*t115, t119*t124)
-    t127 = xp.where(t123, t52*t115, t120*t124)
+    t125 = xp.where(t123, t85*t115, t124*t118)
+    t126 = xp.where(t123, t86*t115, t124*t119)
+    t127 = xp.where(t123, t52*t115, t124*t120)
     t128 = t125**2 + t126**2 + t127**2 + t27**2 + t53**2 + t88**2
-    t129 = t91 + damping
-    t130 = xp.sqrt(t94**2 + t77**2 + t96**2 + t99**2 + t92**2 + t129**2)
+    t129 = damping + t92
+    t130 = xp.sqrt(t94**2 + t96**2 + t99**2 + t90**2 + t77**2 + t129**2)
     t131 = t130*xp.where(xp.greater_equal(t129, 0), xp.asarray(1, dtype=dtype), -1)
-    t132 = t131 + t129
+    t132 = t129 + t131
     t133 = xp.where(xp.greater(t130, 0), 1/(t130*(t130 + xp.abs(t129))), 0)
-    t134 = t133*(t94*t53 + t96*t88 + t92*t126 + t27*t132 - t77*t127 - t99*t125)
+    t134 = t133*(t27*t132 + t94*t53 + t96*t88 - t99*t125 + t90*t126 - t77*t127)
     t135 = t27 - t132*t134
     t136 = t53 - t94*t134
     t137 = t88 - t96*t134
     t138 = t125 + t99*t134
-    t139 = t126 - t92*t134
+    t139 = t126 - t90*t134
     t140 = t127 + t77*t134
-    t141 = t102 + damping
-    t142 = t133*(t94*t132 + t94*t141 + t96*t105 + t99*t103 + t92*t100 - t77*t78)
+    t141 = damping + t102
+    t142 = t133*(t96*t105 + t99*t103 + t90*t100 - t77*t78 + t94*t132 + t94*t141)
     t143 = t94 - t132*t142
-    t144 = -t94*t142 + t141
+    t144 = t141 - t94*t142
     t145 = t105 - t96*t142
     t146 = -t103 + t99*t142
-    t147 = t100 - t92*t142
+    t147 = t100 - t90*t142
     t148 = t78 + t77*t142
     t149 = xp.sqrt(t144**2 + t145**2 + t146**2 + t147**2 + t148**2)
     t150 = t149*xp.where(xp.greater_equal(t144, 0), xp.asarray(1, dtype=dtype), -1)
     t151 = t144 + t150
     t152 = xp.where(xp.greater(t149, 0), 1/(t149*(t149 + xp.abs(t144))), 0)
-    t153 = t152*(t145*t137 + t146*t138 + t147*t139 + t148*t140 + t136*t151)
+    t153 = t152*(t136*t151 + t145*t137 + t146*t138 + t147*t139 + t148*t140)
     t154 = t136 - t151*t153
     t155 = t137 - t145*t153
     t156 = t138 - t146*t153
     t157 = t139 - t147*t153
     t158 = t140 - t148*t153
-    t159 = t48 + damping
-    t160 = t133*(t94*t105 + t96*t132 + t96*t159 - t77*t79 - t99*t106 - t92*t97)
+    t159 = damping + t48
+    t160 = t133*(t94*t105 - t99*t106 - t90*t97 - t77*t79 + t96*t132 + t96*t159)
     t161 = t96 - t132*t160
     t162 = t105 - t94*t160
-    t163 = -t96*t160 + t159
+    t163 = t159 - t96*t160
     t164 = t106 + t99*t160
-    t165 = t97 + t92*t160
+    t165 = t97 + t90*t160
     t166 = t79 + t77*t160
-    t167 = t152*(t145*t163 + t146*t164 + t148*t166 + t162*t151 - t147*t165)
+    t167 = t152*(t162*t151 + t145*t163 + t146*t164 - t147*t165 + t148*t166)
     t168 = t162 - t151*t167
     t169 = t163 - t145*t167
     t170 = t164 - t146*t167
@@ -2834,26 +2834,26 @@ def ik_numeric_step(target, q, damping=0.0):
     t174 = t173*xp.where(xp.greater_equal(t169, 0), xp.asarray(1, dtype=dtype), -1)
     t175 = t169 + t174
     t176 = xp.where(xp.greater(t173, 0), 1/(t173*(t173 + xp.abs(t169))), 0)
-    t177 = t176*(t170*t156 + t172*t158 + t155*t175 - t171*t157)
+    t177 = t176*(t155*t175 + t170*t156 - t171*t157 + t172*t158)
     t178 = t155 - t175*t177
     t179 = t156 - t170*t177
     t180 = t157 + t171*t177
     t181 = t158 - t172*t177
-    t182 = t108 + damping
-    t183 = -t133*(-t96*t106 - t92*t109 + t94*t103 + t77*t80 + t99*t132 + t99*t182)
+    t182 = damping + t108
+    t183 = -t133*(t94*t103 - t96*t106 - t90*t109 + t77*t80 + t99*t132 + t99*t182)
     t184 = t99 + t132*t183
     t185 = t103 + t94*t183
     t186 = t106 - t96*t183
-    t187 = t99*t183 + t182
-    t188 = t109 - t92*t183
+    t187 = t182 + t99*t183
+    t188 = t109 - t90*t183
     t189 = t80 + t77*t183
-    t190 = t152*(t145*t186 + t146*t187 + t147*t188 + t148*t189 - t185*t151)
+    t190 = t152*(-t185*t151 + t145*t186 + t146*t187 + t147*t188 + t148*t189)
     t191 = t185 + t151*t190
     t192 = t186 - t145*t190
     t193 = t187 - t146*t190
     t194 = t188 - t147*t190
     t195 = t189 - t148*t190
-    t196 = t176*(t170*t193 + t172*t195 + t192*t175 - t171*t194)
+    t196 = t176*(t192*t175 + t170*t193 - t171*t194 + t172*t195)
     t197 = t192 - t175*t196
     t198 = t193 - t170*t196
     t199 = t194 + t171*t196
@@ -2862,30 +2862,30 @@ def ik_numeric_step(target, q, damping=0.0):
     t202 = t201*xp.where(xp.greater_equal(t198, 0), xp.asarray(1, dtype=dtype), -1)
     t203 = t198 + t202
     t204 = xp.where(xp.greater(t201, 0), 1/(t201*(t201 + xp.abs(t198))), 0)
-    t205 = t204*(t199*t180 + t200*t181 + t179*t203)
+    t205 = t204*(t179*t203 + t199*t180 + t200*t181)
     t206 = t179 - t203*t205
     t207 = t180 - t199*t205
     t208 = t181 - t200*t205
-    t209 = t110 + damping
-    t210 = t133*(t94*t100 + t92*t132 + t92*t209 - t77*t81 - t96*t97 - t99*t109)
-    t211 = t92 - t132*t210
+    t209 = damping + t110
+    t210 = t133*(t94*t100 - t96*t97 - t99*t109 - t77*t81 + t90*t132 + t90*t209)
+    t211 = t90 - t132*t210
     t212 = t100 - t94*t210
     t213 = t97 + t96*t210
     t214 = t109 + t99*t210
-    t215 = -t92*t210 + t209
+    t215 = t209 - t90*t210
     t216 = t81 + t77*t210
-    t217 = t152*(t146*t214 + t147*t215 + t148*t216 + t212*t151 - t145*t213)
+    t217 = t152*(t212*t151 - t145*t213 + t146*t214 + t147*t215 + t148*t216)
     t218 = t212 - t151*t217
     t219 = t213 + t145*t217
     t220 = t214 - t146*t217
     t221 = t215 - t147*t217
     t222 = t216 - t148*t217
-    t223 = t176*(t170*t220 + t172*t222 - t171*t221 - t219*t175)
+    t223 = t176*(-t219*t175 + t170*t220 - t171*t221 + t172*t222)
     t224 = t219 + t175*t223
     t225 = t220 - t170*t223
     t226 = t221 + t171*t223
     t227 = t222 - t172*t223
-    t228 = t204*(t199*t226 + t200*t227 + t225*t203)
+    t228 = t204*(t225*t203 + t199*t226 + t200*t227)
     t229 = t225 - t203*t228
     t230 = t226 - t199*t228
     t231 = t227 - t200*t228
@@ -2893,53 +2893,53 @@ def ik_numeric_step(target, q, damping=0.0):
     t233 = t232*xp.where(xp.greater_equal(t230, 0), xp.asarray(1, dtype=dtype), -1)
     t234 = t230 + t233
     t235 = xp.where(xp.greater(t232, 0), 1/(t232*(t232 + xp.abs(t230))), 0)
-    t236 = t235*(t231*t208 + t207*t234)
+    t236 = t235*(t207*t234 + t231*t208)
     t237 = t207 - t234*t236
     t238 = t208 - t231*t236
-    t239 = t111 + damping
-    t240 = t133*(t94*t78 + t96*t79 + t92*t81 - t77*t132 - t77*t239 - t99*t80)
+    t239 = damping + t111
+    t240 = t133*(t94*t78 + t96*t79 - t99*t80 + t90*t81 - t77*t132 - t239*t77)
     t241 = t77 + t132*t240
     t242 = t78 - t94*t240
     t243 = t79 - t96*t240
     t244 = t80 + t99*t240
-    t245 = t81 - t92*t240
-    t246 = t77*t240 + t239
-    t247 = t152*(t145*t243 + t146*t244 + t147*t245 + t148*t246 + t242*t151)
+    t245 = t81 - t90*t240
+    t246 = t239 + t77*t240
+    t247 = t152*(t242*t151 + t145*t243 + t146*t244 + t147*t245 + t148*t246)
     t248 = t242 - t151*t247
     t249 = t243 - t145*t247
     t250 = t244 - t146*t247
     t251 = t245 - t147*t247
     t252 = t246 - t148*t247
-    t253 = t176*(t170*t250 + t172*t252 + t249*t175 - t171*t251)
+    t253 = t176*(t249*t175 + t170*t250 - t171*t251 + t172*t252)
     t254 = t249 - t175*t253
     t255 = t250 - t170*t253
     t256 = t251 + t171*t253
     t257 = t252 - t172*t253
-    t258 = t204*(t199*t256 + t200*t257 + t255*t203)
+    t258 = t204*(t255*t203 + t199*t256 + t200*t257)
     t259 = t255 - t203*t258
     t260 = t256 - t199*t258
     t261 = t257 - t200*t258
-    t262 = t235*(t231*t261 + t260*t234)
+    t262 = t235*(t260*t234 + t231*t261)
     t263 = t260 - t234*t262
     t264 = t261 - t231*t262
     t265 = xp.abs(t264)
     t266 = t265
     t267 = t266*xp.where(xp.greater_equal(t264, 0), xp.asarray(1, dtype=dtype), -1)
     t268 = t264 + t267
-    t269 = xp.where(xp.greater(t266, 0), 1/(t266*(t266 + t265)), 0)
-    t270 = t238 - t238*t269*t268**2
+    t269 = xp.where(xp.greater(t266, 0), 1/(t266*(t265 + t266)), 0)
+    t270 = t238 - t238*t268**2*t269
     t271 = xp.where(xp.not_equal(t267, 0), -t270/t267, 0)
     t272 = xp.where(xp.not_equal(t233, 0), -(t237 - t263*t271)/t233, 0)
-    t273 = xp.where(xp.not_equal(t202, 0), -(t206 - (t229*t272 + t259*t271))/t202, 0)
-    t274 = xp.where(xp.not_equal(t174, 0), -(t178 - (t197*t273 + t254*t271 - t224*t272))/t174, 0)
-    t275 = xp.where(xp.not_equal(t150, 0), -(t154 - (t168*t274 + t218*t272 + t248*t271 - t191*t273))/t150, 0)
-    t276 = xp.where(xp.not_equal(t131, 0), -(t135 - (t143*t275 + t161*t274 + t211*t272 - t184*t273 - t241*t271))/t131, 0)
-    t277 = t271 + q1 + t275*t23 - t276*t42
-    t278 = q2 + t272*c1 - t273*s1 - t274*t43 + t275*t67*s1 + t276*t67*c1
-    t279 = q3 + t274*t44 + t275*t73 + t276*t69 - t271*c2 - t272*t28 - t273*t9
-    t280 = q4 + t273*t7 + t274*t45 + t275*t74 - t4*t272 - t276*t70 + t271*t57
-    t281 = q5 + t11*t273 + t30*t272 + t56*t271 + t274*t46 + t275*t75 + t276*t71
-    t282 = q6 + t32*t272 + t274*t47 + t275*t76 + t276*t72 - t13*t273 - t59*t271
+    t273 = xp.where(xp.not_equal(t202, 0), -(-(t229*t272 + t259*t271) + t206)/t202, 0)
+    t274 = xp.where(xp.not_equal(t174, 0), -(-(t197*t273 - t224*t272 + t254*t271) + t178)/t174, 0)
+    t275 = xp.where(xp.not_equal(t150, 0), -(-(t168*t274 - t191*t273 + t218*t272 + t248*t271) + t154)/t150, 0)
+    t276 = xp.where(xp.not_equal(t131, 0), -(-(t143*t275 + t161*t274 - t184*t273 + t211*t272 - t241*t271) + t135)/t131, 0)
+    t277 = q1 + t271 - t42*t276 + t23*t275
+    t278 = q2 + c1*t67*t276 + s1*t67*t275 - t43*t274 - s1*t273 + c1*t272
+    t279 = q3 + t69*t276 + t73*t275 + t44*t274 - t9*t273 - t28*t272 - c2*t271
+    t280 = q4 - t70*t276 + t74*t275 + t45*t274 + t7*t273 - t4*t272 + t57*t271
+    t281 = q5 + t71*t276 + t75*t275 + t46*t274 + t11*t273 + t30*t272 + t56*t271
+    t282 = q6 + t72*t276 + t76*t275 + t47*t274 - t13*t273 + t32*t272 - t59*t271
     t283 = -q7 + t15*t273 + t34*t272 + t61*t271
     t284 = -t283
     q_start = _stack(xp, [
@@ -2982,24 +2982,24 @@ def ik_general_equations(T, q_free):
     q7 = q_free
     c7 = xp.cos(q7)
     s7 = xp.sin(q7)
-    t0 = T00*c7 - T01*s7
-    t1 = T10*c7 - T11*s7
-    t2 = T20*c7 - T21*s7
-    t3 = T00*s7
-    t4 = T01*c7
+    t0 = c7*T00 - s7*T01
+    t1 = c7*T10 - s7*T11
+    t2 = c7*T20 - s7*T21
+    t3 = s7*T00
+    t4 = c7*T01
     t5 = t3 + t4
-    t6 = T03 - 0.13375*T02 + 0.1363*t3 + 0.1363*t4
-    t7 = T10*s7
-    t8 = T11*c7
+    t6 = -0.13375*T02 + T03 + 0.1363*t3 + 0.1363*t4
+    t7 = s7*T10
+    t8 = c7*T11
     t9 = t7 + t8
-    t10 = T13 - 0.13375*T12 + 0.1363*t7 + 0.1363*t8
-    t11 = T20*s7
-    t12 = T21*c7
+    t10 = -0.13375*T12 + T13 + 0.1363*t7 + 0.1363*t8
+    t11 = s7*T20
+    t12 = c7*T21
     t13 = t11 + t12
-    t14 = T23 - 0.13375*T22 + 0.1363*t11 + 0.1363*t12
+    t14 = -0.13375*T22 + T23 + 0.1363*t11 + 0.1363*t12
     t15 = t0*t6 + t1*t10 + t2*t14
     t16 = T02*t6 + T12*t10 + T22*t14
-    t17 = t5*t6 + t9*t10 + t13*t14
+    t17 = t6*t5 + t10*t9 + t14*t13
     t18 = t15**2
     t19 = t16**2
     t20 = t17**2
@@ -3035,13 +3035,13 @@ def ik_general_equations(T, q_free):
     t50 = 0.4*T12
     t51 = t5*t15
     t52 = t0*t17
-    t53 = 0.317*T12 + t52
+    t53 = t52 + 0.317*T12
     t54 = t5*t16
     t55 = T02*t17
     t56 = 0.317*t1 + t54 - t55
     t57 = t1*t17
     t58 = t9*t15
-    t59 = 0.317*T02 + t58
+    t59 = t58 + 0.317*T02
     t60 = t9*t16
     t61 = T12*t17
     t62 = -(0.317*t0 - t60 + t61)
@@ -3088,11 +3088,11 @@ def ik_general_equations(T, q_free):
     t103 = t39*t85
     t104 = t67*t72
     t105 = t57*t80
-    t106 = T02*t26
-    t107 = T02*t40
-    t108 = T12*t30
-    t109 = T12*t42
-    t110 = t0*t24 + t0*t40 - t1*t28 - t1*t42
+    t106 = t26*T02
+    t107 = t40*T02
+    t108 = t30*T12
+    t109 = t42*T12
+    t110 = t24*t0 + t40*t0 - t28*t1 - t42*t1
     t111 = 0.2536*t13
     t112 = 2.0*t17
     P = _stack(xp, [
@@ -3203,7 +3203,7 @@ def ik_general_equations(T, q_free):
         xp.full(batch, 0, dtype=dtype, device=device),  # 11, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 11, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 11, 7
-        T02*t21 - t0*t22,  # 11, 8
+        t21*T02 - t22*t0,  # 11, 8
         xp.full(batch, 0, dtype=dtype, device=device),  # 12, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 12, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 12, 2
@@ -3212,7 +3212,7 @@ def ik_general_equations(T, q_free):
         xp.full(batch, 0, dtype=dtype, device=device),  # 12, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 12, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 12, 7
-        t5*t24 + t5*t26 - t9*t28 - t9*t30,  # 12, 8
+        t24*t5 + t26*t5 - t28*t9 - t30*t9,  # 12, 8
         xp.full(batch, 0.151336, dtype=dtype, device=device),  # 13, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 13, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 13, 2
@@ -3568,24 +3568,24 @@ def ik_general_equations(T, q_free):
         0.26705*t0 + t82 + t83 - t84 + t27*t78 + t41*t78 - t86 - t87 - t88 - t89,  # 11, 1
         0.26705*T12 + t90 + t91 - t92 + t93 + t94 - t95 - t96 - t97 - t98,  # 11, 2
         0.26705*t1 + t99 + t100 - t101 + t23*t78 + t39*t78 - t102 - t103 - t104 - t105,  # 11, 3
-        t0*t45 + T02*t43 - T02*t44 - t0*t46,  # 11, 4
-        t1*t45 + T12*t43 - T12*t44 - t1*t46,  # 11, 5
+        t45*t0 + t43*T02 - t44*T02 - t46*t0,  # 11, 4
+        t45*t1 + t43*T12 - t44*T12 - t46*t1,  # 11, 5
         t106 + t107 - t108 - t109,  # 11, 6
         t110,  # 11, 7
-        t5*t44 + t0*t111 - 0.8*t52 - t5*t43,  # 12, 0
-        0.8*t55 + t5*t46 - t5*t45 - T02*t111,  # 12, 1
-        t9*t44 + t1*t111 - 0.8*t57 - t9*t43,  # 12, 2
-        0.8*t61 + t9*t46 - t9*t45 - T12*t111,  # 12, 3
-        -0.26705*t5 + t5*t20 - t5*t18 - t5*t19 + t27*t112 + t29*t112 + t54*t72 + t51*t78 - t27*t80 - t29*t80,  # 12, 4
-        -0.26705*t9 + t9*t20 - t9*t18 - t9*t19 + t23*t112 + t25*t112 + t60*t72 + t58*t78 - t23*t80 - t25*t80,  # 12, 5
-        t5*t21 - t9*t37,  # 12, 6
-        t9*t38 - t5*t22,  # 12, 7
-        -(0.05295*t0 - t82 - t83 + t84 - 0.634*T02*t2*t16 - 0.634*t5*t2*t17 + t86 + t87 + t88 + t89),  # 13, 0
-        0.05295*T02 + t71 - t69 - t70 + t76 + t77 + t79 + t81 - t73 - t74,  # 13, 1
-        -(0.05295*t1 - t99 - t100 + t101 - 0.634*T12*t2*t16 - 0.634*t9*t2*t17 + t102 + t103 + t104 + t105),  # 13, 2
-        0.05295*T12 + t92 - t90 - t91 + t95 + t96 + t97 + t98 - t93 - t94,  # 13, 3
-        T02*t45 + t0*t44 + 0.8*t41,  # 13, 4
-        T12*t45 + t1*t44 + 0.8*t39,  # 13, 5
+        t44*t5 + t111*t0 - 0.8*t52 - t43*t5,  # 12, 0
+        0.8*t55 + t46*t5 - t45*t5 - t111*T02,  # 12, 1
+        t44*t9 + t111*t1 - 0.8*t57 - t43*t9,  # 12, 2
+        0.8*t61 + t46*t9 - t45*t9 - t111*T12,  # 12, 3
+        -0.26705*t5 + t5*t20 - t18*t5 - t19*t5 + t27*t112 + t29*t112 + t54*t72 + t51*t78 - t27*t80 - t29*t80,  # 12, 4
+        -0.26705*t9 + t9*t20 - t18*t9 - t19*t9 + t23*t112 + t25*t112 + t60*t72 + t58*t78 - t23*t80 - t25*t80,  # 12, 5
+        t21*t5 - t37*t9,  # 12, 6
+        t38*t9 - t22*t5,  # 12, 7
+        -(-t82 - t83 + t84 - 0.634*T02*t2*t16 - 0.634*t2*t5*t17 + t86 + t87 + t88 + t89 + 0.05295*t0),  # 13, 0
+        t71 + 0.05295*T02 - t69 - t70 + t76 + t77 + t79 + t81 - t73 - t74,  # 13, 1
+        -(-t99 - t100 + t101 - 0.634*T12*t2*t16 - 0.634*t2*t9*t17 + t102 + t103 + t104 + t105 + 0.05295*t1),  # 13, 2
+        t92 + 0.05295*T12 - t90 - t91 + t95 + t96 + t97 + t98 - t93 - t94,  # 13, 3
+        t45*T02 + t44*t0 + 0.8*t41,  # 13, 4
+        t45*T12 + t44*t1 + 0.8*t39,  # 13, 5
         t110,  # 13, 6
         t108 + t109 - t106 - t107,  # 13, 7
     ], (14, 8))
@@ -3612,12 +3612,12 @@ def ik_general_start(T, q_free, angles):
     q7 = q_free
     c7 = xp.cos(q7)
     s7 = xp.sin(q7)
-    t0 = T00*c7 - T01*s7
-    t1 = T00*s7 + T01*c7
-    t2 = T10*c7 - T11*s7
-    t3 = T10*s7 + T11*c7
-    t4 = T20*c7 - T21*s7
-    t5 = T20*s7 + T21*c7
+    t0 = c7*T00 - s7*T01
+    t1 = s7*T00 + c7*T01
+    t2 = c7*T10 - s7*T11
+    t3 = s7*T10 + c7*T11
+    t4 = c7*T20 - s7*T21
+    t5 = s7*T20 + c7*T21
     t6 = xp.cos(ga3)
     t7 = xp.sin(ga3)
     t8 = xp.cos(ga2)
@@ -3627,11 +3627,11 @@ def ik_general_start(T, q_free, angles):
     t12 = xp.sin(ga0)
     t13 = xp.cos(ga0)
     t14 = t9*t12 + t10*t13
-    t15 = t10*t12 - t9*t13
+    t15 = t12*t10 - t13*t9
     t16 = xp.sin(ga4)
     t17 = xp.cos(ga4)
     t18 = t11*t16 + t14*t17
-    t19 = t14*t16 - t11*t17
+    t19 = t16*t14 - t17*t11
     t20 = t15*(t3*t7 - t1*t6) + t18*(t0*t6 - t2*t7) + t19*(T02*t6 - T12*t7)
     t21 = T22*t19 + t4*t18 - t5*t15
     q = _stack(xp, [
@@ -3694,7 +3694,7 @@ def ik_general_residual(target, q):
     t1 = c1*c3
     t2 = t0 + c2*t1
     t3 = t1 + c2*t0
-    t4 = c3*s1
+    t4 = s1*c3
     t5 = c1*s3
     t6 = t4 - c2*t5
     t7 = -t5 + c2*t4
@@ -3706,61 +3706,61 @@ def ik_general_residual(target, q):
     t13 = t11*c6 - t10*s6
     t14 = t10*c6 + t11*s6
     t15 = t12*s7 + t13*c7
-    t16 = t12*c7 - t13*s7
-    t17 = 0.13375*t14 + 0.1363*t12
+    t16 = t12*c7 - s7*t13
+    t17 = 0.1363*t12 + 0.13375*t14
     t18 = -t17 + 0.4*t10
-    t19 = t18 + 0.1685*t6
-    t20 = t19 - 0.4*t8
-    t21 = t20 - 0.1925*s1
-    t22 = t21 + 0.081*c1
-    t23 = T00*t15 + T01*t16 - T02*t14
-    t24 = T10*t15 + T11*t16 - T12*t14
-    t25 = T20*t15 + T21*t16 - T22*t14
+    t19 = 0.1685*t6 + t18
+    t20 = -0.4*t8 + t19
+    t21 = -0.1925*s1 + t20
+    t22 = 0.081*c1 + t21
+    t23 = t15*T00 + t16*T01 - t14*T02
+    t24 = t15*T10 + t16*T11 - t14*T12
+    t25 = t15*T20 + t16*T21 - t14*T22
     t26 = s1*s2
-    t27 = t7*c4 + s4*t26
-    t28 = -t7*s4 + c4*t26
-    t29 = t3*s5 + t27*c5
-    t30 = t3*c5 - t27*s5
-    t31 = t29*c6 - t28*s6
-    t32 = t28*c6 + t29*s6
-    t33 = t31*c7 - t30*s7
-    t34 = t30*c7 + t31*s7
-    t35 = -0.13375*t32 + 0.1363*t30
-    t36 = t35 + 0.4*t28
-    t37 = t36 - 0.1685*t3
-    t38 = t37 - 0.4*t26
-    t39 = t38 + 0.1925*c1
-    t40 = t39 + 0.081*s1
-    t41 = T01*t34 + T02*t32 - T00*t33
-    t42 = T11*t34 + T12*t32 - T10*t33
-    t43 = T21*t34 + T22*t32 - T20*t33
+    t27 = c4*t7 + s4*t26
+    t28 = -s4*t7 + c4*t26
+    t29 = t3*s5 + c5*t27
+    t30 = t3*c5 - s5*t27
+    t31 = c6*t29 - t28*s6
+    t32 = t28*c6 + s6*t29
+    t33 = c7*t31 - t30*s7
+    t34 = t30*c7 + s7*t31
+    t35 = 0.1363*t30 - 0.13375*t32
+    t36 = 0.4*t28 + t35
+    t37 = -0.1685*t3 + t36
+    t38 = -0.4*t26 + t37
+    t39 = 0.1925*c1 + t38
+    t40 = 0.081*s1 + t39
+    t41 = -t33*T00 + t34*T01 + t32*T02
+    t42 = -t33*T10 + t34*T11 + t32*T12
+    t43 = -t33*T20 + t34*T21 + t32*T22
     t44 = 0.5*(t41 + t24)
     t45 = c3*s2
     t46 = c2*s4 - c4*t45
     t47 = c2*c4 + s4*t45
-    t48 = s2*s3
-    t49 = t46*c5 - s5*t48
-    t50 = t46*s5 + c5*t48
-    t51 = t49*c6 - t47*s6
-    t52 = t47*c6 + t49*s6
-    t53 = t50*s7 + t51*c7
-    t54 = t50*c7 - t51*s7
-    t55 = 0.13375*t52 + 0.1363*t50
+    t48 = s3*s2
+    t49 = c5*t46 - s5*t48
+    t50 = s5*t46 + c5*t48
+    t51 = c6*t49 - t47*s6
+    t52 = t47*c6 + s6*t49
+    t53 = t50*s7 + c7*t51
+    t54 = t50*c7 - s7*t51
+    t55 = 0.1363*t50 + 0.13375*t52
     t56 = -t55 + 0.4*t47
-    t57 = t56 + 0.1685*t48
-    t58 = t57 - 0.4*c2
+    t57 = 0.1685*t48 + t56
+    t58 = -0.4*c2 + t57
     t59 = 0.317 + t58
-    t60 = T00*t53 + T01*t54 - T02*t52
-    t61 = T10*t53 + T11*t54 - T12*t52
-    t62 = T20*t53 + T21*t54 - T22*t52
-    t63 = -0.5*(t61 + t43)
-    t64 = 0.5*(t60 - t25)
+    t60 = t53*T00 + t54*T01 - t52*T02
+    t61 = t53*T10 + t54*T11 - t52*T12
+    t62 = t53*T20 + t54*T21 - t52*T22
+    t63 = -0.5*(t43 + t61)
+    t64 = 0.5*(-t25 + t60)
     t65 = xp.sqrt(t63**2 + t64**2 + t44**2)
     t66 = -t42
-    t67 = 0.5*(-1 + t23 + t62 + t66)
+    t67 = 0.5*(-1 + t66 + t23 + t62)
     t68 = xp.atan2(t65, t67)
     t69 = xp.where(xp.greater(t65, 0), t68/t65, 1)
-    t70 = xp.greater_equal(t23, t62) & xp.greater_equal(t23, t66)
+    t70 = xp.greater_equal(t23, t66) & xp.greater_equal(t23, t62)
     t71 = xp.greater_equal(t66, t62)
     t72 = xp.where(t70, 0.5*(1 + t23), xp.where(t71, -0.5*t41, 0.5*t60))
     t73 = xp.where(t70, 0.5*t24, xp.where(t71, 0.5*(1 + t66), 0.5*t61))
@@ -3769,16 +3769,16 @@ def ik_general_residual(target, q):
     t76 = xp.where(xp.greater_equal(t63*t72 + t64*t73 + t44*t74, 0), xp.asarray(1, dtype=dtype), -1)
     t77 = xp.greater(t65, 1e-06) | xp.greater(t67, 0)
     t78 = t68*t76/t75
-    t79 = xp.where(t77, t63*t69, t72*t78)
-    t80 = xp.where(t77, t64*t69, t73*t78)
-    t81 = xp.where(t77, t44*t69, t74*t78)
+    t79 = xp.where(t77, t63*t69, t78*t72)
+    t80 = xp.where(t77, t64*t69, t78*t73)
+    t81 = xp.where(t77, t44*t69, t78*t74)
     t82 = -t40
-    t83 = t58*c1
-    t84 = t58*s1
+    t83 = c1*t58
+    t84 = s1*t58
     e = _stack(xp, [
-        xp.broadcast_to(T03 - t22, batch),  # 0
-        xp.broadcast_to(T13 + t82, batch),  # 1
-        xp.broadcast_to(T23 - t59, batch),  # 2
+        xp.broadcast_to(-t22 + T03, batch),  # 0
+        xp.broadcast_to(t82 + T13, batch),  # 1
+        xp.broadcast_to(-t59 + T23, batch),  # 2
         xp.broadcast_to(t79, batch),  # 3
         xp.broadcast_to(t80, batch),  # 4
         xp.broadcast_to(t81, batch),  # 5
@@ -3786,20 +3786,20 @@ def ik_general_residual(target, q):
     J = _stack(xp, [
         xp.broadcast_to(t82, batch),  # 0, 0
         xp.broadcast_to(t83, batch),  # 0, 1
-        xp.broadcast_to(t38*c2 - s2*t84, batch),  # 0, 2
+        xp.broadcast_to(c2*t38 - s2*t84, batch),  # 0, 2
         xp.broadcast_to(-(t3*t57 + t37*t48), batch),  # 0, 3
         xp.broadcast_to(t28*t56 - t47*t36, batch),  # 0, 4
         xp.broadcast_to(t50*t35 - t30*t55, batch),  # 0, 5
         xp.broadcast_to(t22, batch),  # 1, 0
         xp.broadcast_to(t84, batch),  # 1, 1
-        xp.broadcast_to(-t20*c2 + s2*t83, batch),  # 1, 2
-        xp.broadcast_to(-t57*t6 + t19*t48, batch),  # 1, 3
+        xp.broadcast_to(-c2*t20 + s2*t83, batch),  # 1, 2
+        xp.broadcast_to(-t6*t57 + t19*t48, batch),  # 1, 3
         xp.broadcast_to(t47*t18 - t10*t56, batch),  # 1, 4
         xp.broadcast_to(t50*t17 - t12*t55, batch),  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
-        xp.broadcast_to(-(t21*c1 + t39*s1), batch),  # 2, 1
+        xp.broadcast_to(-(c1*t21 + s1*t39), batch),  # 2, 1
         xp.broadcast_to(t20*t26 - t38*t8, batch),  # 2, 2
-        xp.broadcast_to(t3*t19 + t37*t6, batch),  # 2, 3
+        xp.broadcast_to(t3*t19 + t6*t37, batch),  # 2, 3
         xp.broadcast_to(t10*t36 - t28*t18, batch),  # 2, 4
         xp.broadcast_to(t30*t17 - t12*t35, batch),  # 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
@@ -3836,17 +3836,17 @@ def ik_general_limits(q_solution):
     qg6 = q_solution[..., 5]
     qg7 = q_solution[..., 6]
     t0 = qg1 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + qg1))
-    t1 = t0 - 6.283185307179586*xp.floor(0.15915494309189535*(3.0543261909900767 + t0))
-    t2 = qg2 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + qg2))
-    t3 = t2 - 6.283185307179586*xp.floor(0.15915494309189535*(3.822271061867582 + t2))
-    t4 = qg3 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + qg3))
-    t5 = t4 - 6.283185307179586*xp.floor(0.15915494309189535*(3.0543261909900767 + t4))
-    t6 = qg4 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + qg4))
-    t7 = t6 - 6.283185307179586*xp.floor(0.15915494309189535*(3.0543261909900767 + t6))
-    t8 = qg5 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + qg5))
-    t9 = t8 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t8))
-    t10 = qg6 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + qg6))
-    t11 = t10 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t10))
+    t1 = -6.283185307179586*xp.floor(0.15915494309189535*(3.0543261909900767 + t0)) + t0
+    t2 = -6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + qg2)) + qg2
+    t3 = -6.283185307179586*xp.floor(0.15915494309189535*(3.822271061867582 + t2)) + t2
+    t4 = -6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + qg3)) + qg3
+    t5 = -6.283185307179586*xp.floor(0.15915494309189535*(3.0543261909900767 + t4)) + t4
+    t6 = -6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + qg4)) + qg4
+    t7 = -6.283185307179586*xp.floor(0.15915494309189535*(3.0543261909900767 + t6)) + t6
+    t8 = -6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + qg5)) + qg5
+    t9 = -6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t8)) + t8
+    t10 = -6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + qg6)) + qg6
+    t11 = -6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t10)) + t10
     t12 = xp.less_equal(t1, 3.0543261909900767)
     t13 = xp.greater_equal(t0, -3.0543261909900767) & xp.less_equal(t0, 3.0543261909900767)
     t14 = xp.less_equal(t3, 2.2863813201125716)
@@ -4047,143 +4047,143 @@ def ik_nearest(T, q_seed, q_free, weights=(1.0,) * DOF):
     lb13 = branches_in_limits[..., 13]
     lb14 = branches_in_limits[..., 14]
     lb15 = branches_in_limits[..., 15]
-    t0 = qb0_0 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn1 - qb0_0))
-    t1 = qb0_1 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn2 - qb0_1))
-    t2 = qb0_2 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn3 - qb0_2))
-    t3 = qb0_3 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn4 - qb0_3))
-    t4 = qb0_4 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn5 - qb0_4))
-    t5 = qb0_5 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn6 - qb0_5))
+    t0 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_0 + qn1)) + qb0_0
+    t1 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_1 + qn2)) + qb0_1
+    t2 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_2 + qn3)) + qb0_2
+    t3 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_3 + qn4)) + qb0_3
+    t4 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_4 + qn5)) + qb0_4
+    t5 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_5 + qn6)) + qb0_5
     t6 = xp.where(lb0 & vb0, xp.asarray(1, dtype=dtype), 0)
     t7 = xp.where(xp.greater(t6, 0), xp.asarray(1, dtype=dtype), 0)
-    t8 = qb1_0 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn1 - qb1_0))
-    t9 = qb1_1 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn2 - qb1_1))
-    t10 = qb1_2 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn3 - qb1_2))
-    t11 = qb1_3 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn4 - qb1_3))
-    t12 = qb1_4 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn5 - qb1_4))
-    t13 = qb1_5 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn6 - qb1_5))
+    t8 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_0 + qn1)) + qb1_0
+    t9 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_1 + qn2)) + qb1_1
+    t10 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_2 + qn3)) + qb1_2
+    t11 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_3 + qn4)) + qb1_3
+    t12 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_4 + qn5)) + qb1_4
+    t13 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_5 + qn6)) + qb1_5
     t14 = xp.where(lb1 & vb1, xp.asarray(1, dtype=dtype), 0)
-    t15 = qb2_0 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn1 - qb2_0))
-    t16 = qb2_1 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn2 - qb2_1))
-    t17 = qb2_2 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn3 - qb2_2))
-    t18 = qb2_3 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn4 - qb2_3))
-    t19 = qb2_4 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn5 - qb2_4))
-    t20 = qb2_5 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn6 - qb2_5))
+    t15 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_0 + qn1)) + qb2_0
+    t16 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_1 + qn2)) + qb2_1
+    t17 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_2 + qn3)) + qb2_2
+    t18 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_3 + qn4)) + qb2_3
+    t19 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_4 + qn5)) + qb2_4
+    t20 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_5 + qn6)) + qb2_5
     t21 = xp.where(lb2 & vb2, xp.asarray(1, dtype=dtype), 0)
-    t22 = qb3_0 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn1 - qb3_0))
-    t23 = qb3_1 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn2 - qb3_1))
-    t24 = qb3_2 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn3 - qb3_2))
-    t25 = qb3_3 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn4 - qb3_3))
-    t26 = qb3_4 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn5 - qb3_4))
-    t27 = qb3_5 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn6 - qb3_5))
+    t22 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_0 + qn1)) + qb3_0
+    t23 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_1 + qn2)) + qb3_1
+    t24 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_2 + qn3)) + qb3_2
+    t25 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_3 + qn4)) + qb3_3
+    t26 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_4 + qn5)) + qb3_4
+    t27 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_5 + qn6)) + qb3_5
     t28 = xp.where(lb3 & vb3, xp.asarray(1, dtype=dtype), 0)
-    t29 = qb4_0 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn1 - qb4_0))
-    t30 = qb4_1 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn2 - qb4_1))
-    t31 = qb4_2 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn3 - qb4_2))
-    t32 = qb4_3 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn4 - qb4_3))
-    t33 = qb4_4 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn5 - qb4_4))
-    t34 = qb4_5 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn6 - qb4_5))
+    t29 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_0 + qn1)) + qb4_0
+    t30 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_1 + qn2)) + qb4_1
+    t31 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_2 + qn3)) + qb4_2
+    t32 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_3 + qn4)) + qb4_3
+    t33 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_4 + qn5)) + qb4_4
+    t34 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_5 + qn6)) + qb4_5
     t35 = xp.where(lb4 & vb4, xp.asarray(1, dtype=dtype), 0)
-    t36 = qb5_0 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn1 - qb5_0))
-    t37 = qb5_1 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn2 - qb5_1))
-    t38 = qb5_2 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn3 - qb5_2))
-    t39 = qb5_3 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn4 - qb5_3))
-    t40 = qb5_4 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn5 - qb5_4))
-    t41 = qb5_5 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn6 - qb5_5))
+    t36 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_0 + qn1)) + qb5_0
+    t37 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_1 + qn2)) + qb5_1
+    t38 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_2 + qn3)) + qb5_2
+    t39 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_3 + qn4)) + qb5_3
+    t40 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_4 + qn5)) + qb5_4
+    t41 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_5 + qn6)) + qb5_5
     t42 = xp.where(lb5 & vb5, xp.asarray(1, dtype=dtype), 0)
-    t43 = qb6_0 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn1 - qb6_0))
-    t44 = qb6_1 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn2 - qb6_1))
-    t45 = qb6_2 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn3 - qb6_2))
-    t46 = qb6_3 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn4 - qb6_3))
-    t47 = qb6_4 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn5 - qb6_4))
-    t48 = qb6_5 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn6 - qb6_5))
+    t43 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_0 + qn1)) + qb6_0
+    t44 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_1 + qn2)) + qb6_1
+    t45 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_2 + qn3)) + qb6_2
+    t46 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_3 + qn4)) + qb6_3
+    t47 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_4 + qn5)) + qb6_4
+    t48 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_5 + qn6)) + qb6_5
     t49 = xp.where(lb6 & vb6, xp.asarray(1, dtype=dtype), 0)
-    t50 = qb7_0 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn1 - qb7_0))
-    t51 = qb7_1 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn2 - qb7_1))
-    t52 = qb7_2 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn3 - qb7_2))
-    t53 = qb7_3 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn4 - qb7_3))
-    t54 = qb7_4 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn5 - qb7_4))
-    t55 = qb7_5 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn6 - qb7_5))
+    t50 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_0 + qn1)) + qb7_0
+    t51 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_1 + qn2)) + qb7_1
+    t52 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_2 + qn3)) + qb7_2
+    t53 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_3 + qn4)) + qb7_3
+    t54 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_4 + qn5)) + qb7_4
+    t55 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_5 + qn6)) + qb7_5
     t56 = xp.where(lb7 & vb7, xp.asarray(1, dtype=dtype), 0)
-    t57 = qb8_0 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn1 - qb8_0))
-    t58 = qb8_1 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn2 - qb8_1))
-    t59 = qb8_2 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn3 - qb8_2))
-    t60 = qb8_3 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn4 - qb8_3))
-    t61 = qb8_4 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn5 - qb8_4))
-    t62 = qb8_5 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn6 - qb8_5))
+    t57 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb8_0 + qn1)) + qb8_0
+    t58 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb8_1 + qn2)) + qb8_1
+    t59 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb8_2 + qn3)) + qb8_2
+    t60 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb8_3 + qn4)) + qb8_3
+    t61 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb8_4 + qn5)) + qb8_4
+    t62 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb8_5 + qn6)) + qb8_5
     t63 = xp.where(lb8 & vb8, xp.asarray(1, dtype=dtype), 0)
-    t64 = qb9_0 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn1 - qb9_0))
-    t65 = qb9_1 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn2 - qb9_1))
-    t66 = qb9_2 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn3 - qb9_2))
-    t67 = qb9_3 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn4 - qb9_3))
-    t68 = qb9_4 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn5 - qb9_4))
-    t69 = qb9_5 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn6 - qb9_5))
+    t64 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb9_0 + qn1)) + qb9_0
+    t65 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb9_1 + qn2)) + qb9_1
+    t66 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb9_2 + qn3)) + qb9_2
+    t67 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb9_3 + qn4)) + qb9_3
+    t68 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb9_4 + qn5)) + qb9_4
+    t69 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb9_5 + qn6)) + qb9_5
     t70 = xp.where(lb9 & vb9, xp.asarray(1, dtype=dtype), 0)
-    t71 = qb10_0 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn1 - qb10_0))
-    t72 = qb10_1 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn2 - qb10_1))
-    t73 = qb10_2 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn3 - qb10_2))
-    t74 = qb10_3 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn4 - qb10_3))
-    t75 = qb10_4 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn5 - qb10_4))
-    t76 = qb10_5 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn6 - qb10_5))
+    t71 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb10_0 + qn1)) + qb10_0
+    t72 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb10_1 + qn2)) + qb10_1
+    t73 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb10_2 + qn3)) + qb10_2
+    t74 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb10_3 + qn4)) + qb10_3
+    t75 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb10_4 + qn5)) + qb10_4
+    t76 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb10_5 + qn6)) + qb10_5
     t77 = xp.where(lb10 & vb10, xp.asarray(1, dtype=dtype), 0)
-    t78 = qb11_0 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn1 - qb11_0))
-    t79 = qb11_1 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn2 - qb11_1))
-    t80 = qb11_2 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn3 - qb11_2))
-    t81 = qb11_3 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn4 - qb11_3))
-    t82 = qb11_4 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn5 - qb11_4))
-    t83 = qb11_5 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn6 - qb11_5))
+    t78 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb11_0 + qn1)) + qb11_0
+    t79 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb11_1 + qn2)) + qb11_1
+    t80 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb11_2 + qn3)) + qb11_2
+    t81 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb11_3 + qn4)) + qb11_3
+    t82 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb11_4 + qn5)) + qb11_4
+    t83 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb11_5 + qn6)) + qb11_5
     t84 = xp.where(lb11 & vb11, xp.asarray(1, dtype=dtype), 0)
-    t85 = qb12_0 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn1 - qb12_0))
-    t86 = qb12_1 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn2 - qb12_1))
-    t87 = qb12_2 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn3 - qb12_2))
-    t88 = qb12_3 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn4 - qb12_3))
-    t89 = qb12_4 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn5 - qb12_4))
-    t90 = qb12_5 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn6 - qb12_5))
+    t85 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb12_0 + qn1)) + qb12_0
+    t86 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb12_1 + qn2)) + qb12_1
+    t87 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb12_2 + qn3)) + qb12_2
+    t88 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb12_3 + qn4)) + qb12_3
+    t89 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb12_4 + qn5)) + qb12_4
+    t90 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb12_5 + qn6)) + qb12_5
     t91 = xp.where(lb12 & vb12, xp.asarray(1, dtype=dtype), 0)
-    t92 = qb13_0 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn1 - qb13_0))
-    t93 = qb13_1 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn2 - qb13_1))
-    t94 = qb13_2 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn3 - qb13_2))
-    t95 = qb13_3 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn4 - qb13_3))
-    t96 = qb13_4 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn5 - qb13_4))
-    t97 = qb13_5 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn6 - qb13_5))
+    t92 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb13_0 + qn1)) + qb13_0
+    t93 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb13_1 + qn2)) + qb13_1
+    t94 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb13_2 + qn3)) + qb13_2
+    t95 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb13_3 + qn4)) + qb13_3
+    t96 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb13_4 + qn5)) + qb13_4
+    t97 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb13_5 + qn6)) + qb13_5
     t98 = xp.where(lb13 & vb13, xp.asarray(1, dtype=dtype), 0)
-    t99 = qb14_0 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn1 - qb14_0))
-    t100 = qb14_1 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn2 - qb14_1))
-    t101 = qb14_2 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn3 - qb14_2))
-    t102 = qb14_3 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn4 - qb14_3))
-    t103 = qb14_4 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn5 - qb14_4))
-    t104 = qb14_5 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn6 - qb14_5))
+    t99 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb14_0 + qn1)) + qb14_0
+    t100 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb14_1 + qn2)) + qb14_1
+    t101 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb14_2 + qn3)) + qb14_2
+    t102 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb14_3 + qn4)) + qb14_3
+    t103 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb14_4 + qn5)) + qb14_4
+    t104 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb14_5 + qn6)) + qb14_5
     t105 = xp.where(lb14 & vb14, xp.asarray(1, dtype=dtype), 0)
-    t106 = qb15_0 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn1 - qb15_0))
-    t107 = qb15_1 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn2 - qb15_1))
-    t108 = qb15_2 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn3 - qb15_2))
-    t109 = qb15_3 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn4 - qb15_3))
-    t110 = qb15_4 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn5 - qb15_4))
-    t111 = qb15_5 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn6 - qb15_5))
+    t106 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb15_0 + qn1)) + qb15_0
+    t107 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb15_1 + qn2)) + qb15_1
+    t108 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb15_2 + qn3)) + qb15_2
+    t109 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb15_3 + qn4)) + qb15_3
+    t110 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb15_4 + qn5)) + qb15_4
+    t111 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb15_5 + qn6)) + qb15_5
     t112 = xp.where(lb15 & vb15, xp.asarray(1, dtype=dtype), 0)
-    t113 = T00 + T01 + T02 + T03 + T10 + T11 + T12 + T13 + T20 + T21 + T22 + T23 + qn1 + qn2 + qn3 + qn4 + qn5 + qn6 + qn7 + qw1 + qw2 + qw3 + qw4 + qw5 + qw6 + qw7
+    t113 = T00 + T01 + T02 + T10 + T11 + T12 + T20 + T21 + T22 + T03 + T13 + T23 + qn1 + qn2 + qn3 + qn4 + qn5 + qn6 + qw1 + qw2 + qw3 + qw4 + qw5 + qw6 + qw7 + qn7
     t114 = xp.where(xp.less(t0, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t115 = t0 + t114
-    t116 = t0 - t114
+    t116 = -t114 + t0
     t117 = xp.where(xp.greater_equal(t0, -3.0543261909900767) & xp.less_equal(t0, 3.0543261909900767), t0, xp.where(xp.greater_equal(t115, -3.0543261909900767) & xp.less_equal(t115, 3.0543261909900767), t115, xp.where(xp.greater_equal(t116, -3.0543261909900767) & xp.less_equal(t116, 3.0543261909900767), t116, qb0_0)))
     t118 = xp.where(xp.less(t1, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t119 = t1 + t118
-    t120 = t1 - t118
+    t120 = -t118 + t1
     t121 = xp.where(xp.greater_equal(t1, -3.822271061867582) & xp.less_equal(t1, 2.2863813201125716), t1, xp.where(xp.greater_equal(t119, -3.822271061867582) & xp.less_equal(t119, 2.2863813201125716), t119, xp.where(xp.greater_equal(t120, -3.822271061867582) & xp.less_equal(t120, 2.2863813201125716), t120, qb0_1)))
     t122 = xp.where(xp.less(t2, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t123 = t2 + t122
-    t124 = t2 - t122
+    t124 = -t122 + t2
     t125 = xp.where(xp.greater_equal(t2, -3.0543261909900767) & xp.less_equal(t2, 3.0543261909900767), t2, xp.where(xp.greater_equal(t123, -3.0543261909900767) & xp.less_equal(t123, 3.0543261909900767), t123, xp.where(xp.greater_equal(t124, -3.0543261909900767) & xp.less_equal(t124, 3.0543261909900767), t124, qb0_2)))
     t126 = xp.where(xp.less(t3, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t127 = t3 + t126
-    t128 = t3 - t126
+    t128 = -t126 + t3
     t129 = xp.where(xp.greater_equal(t3, -3.0543261909900767) & xp.less_equal(t3, 3.0543261909900767), t3, xp.where(xp.greater_equal(t127, -3.0543261909900767) & xp.less_equal(t127, 3.0543261909900767), t127, xp.where(xp.greater_equal(t128, -3.0543261909900767) & xp.less_equal(t128, 3.0543261909900767), t128, qb0_3)))
     t130 = xp.where(xp.less(t4, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t131 = t4 + t130
-    t132 = t4 - t130
+    t132 = -t130 + t4
     t133 = xp.where(xp.greater_equal(t4, -2.9670597283903604) & xp.less_equal(t4, 2.9670597283903604), t4, xp.where(xp.greater_equal(t131, -2.9670597283903604) & xp.less_equal(t131, 2.9670597283903604), t131, xp.where(xp.greater_equal(t132, -2.9670597283903604) & xp.less_equal(t132, 2.9670597283903604), t132, qb0_4)))
     t134 = xp.where(xp.less(t5, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t135 = t5 + t134
-    t136 = t5 - t134
+    t136 = -t134 + t5
     t137 = xp.where(xp.greater_equal(t5, -2.9670597283903604) & xp.less_equal(t5, 2.9670597283903604), t5, xp.where(xp.greater_equal(t135, -2.9670597283903604) & xp.less_equal(t135, 2.9670597283903604), t135, xp.where(xp.greater_equal(t136, -2.9670597283903604) & xp.less_equal(t136, 2.9670597283903604), t136, qb0_5)))
     t138 = -qn1
     t139 = -qn2
@@ -4192,7 +4192,7 @@ def ik_nearest(T, q_seed, q_free, weights=(1.0,) * DOF):
     t142 = -qn5
     t143 = -qn6
     t144 = -qn7
-    t145 = qw1*(t117 + t138)**2 + qw2*(t121 + t139)**2 + qw3*(t125 + t140)**2 + qw4*(t129 + t141)**2 + qw5*(t133 + t142)**2 + qw6*(t137 + t143)**2 + qw7*(qb0_6 + t144)**2
+    t145 = qw1*(t138 + t117)**2 + qw2*(t139 + t121)**2 + qw3*(t140 + t125)**2 + qw4*(t141 + t129)**2 + qw5*(t142 + t133)**2 + qw6*(t143 + t137)**2 + qw7*(t144 + qb0_6)**2
     t146 = xp.greater(t7, 0)
     t147 = xp.where(t146, t117, qn1)
     t148 = xp.where(t146, t121, qn2)
@@ -4204,29 +4204,29 @@ def ik_nearest(T, q_seed, q_free, weights=(1.0,) * DOF):
     t154 = xp.where(t146, t145, 0)
     t155 = xp.where(xp.less(t8, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t156 = t8 + t155
-    t157 = t8 - t155
+    t157 = -t155 + t8
     t158 = xp.where(xp.greater_equal(t8, -3.0543261909900767) & xp.less_equal(t8, 3.0543261909900767), t8, xp.where(xp.greater_equal(t156, -3.0543261909900767) & xp.less_equal(t156, 3.0543261909900767), t156, xp.where(xp.greater_equal(t157, -3.0543261909900767) & xp.less_equal(t157, 3.0543261909900767), t157, qb1_0)))
     t159 = xp.where(xp.less(t9, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t160 = t9 + t159
-    t161 = t9 - t159
+    t161 = -t159 + t9
     t162 = xp.where(xp.greater_equal(t9, -3.822271061867582) & xp.less_equal(t9, 2.2863813201125716), t9, xp.where(xp.greater_equal(t160, -3.822271061867582) & xp.less_equal(t160, 2.2863813201125716), t160, xp.where(xp.greater_equal(t161, -3.822271061867582) & xp.less_equal(t161, 2.2863813201125716), t161, qb1_1)))
     t163 = xp.where(xp.less(t10, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t164 = t10 + t163
-    t165 = t10 - t163
+    t165 = -t163 + t10
     t166 = xp.where(xp.greater_equal(t10, -3.0543261909900767) & xp.less_equal(t10, 3.0543261909900767), t10, xp.where(xp.greater_equal(t164, -3.0543261909900767) & xp.less_equal(t164, 3.0543261909900767), t164, xp.where(xp.greater_equal(t165, -3.0543261909900767) & xp.less_equal(t165, 3.0543261909900767), t165, qb1_2)))
     t167 = xp.where(xp.less(t11, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t168 = t11 + t167
-    t169 = t11 - t167
+    t169 = -t167 + t11
     t170 = xp.where(xp.greater_equal(t11, -3.0543261909900767) & xp.less_equal(t11, 3.0543261909900767), t11, xp.where(xp.greater_equal(t168, -3.0543261909900767) & xp.less_equal(t168, 3.0543261909900767), t168, xp.where(xp.greater_equal(t169, -3.0543261909900767) & xp.less_equal(t169, 3.0543261909900767), t169, qb1_3)))
     t171 = xp.where(xp.less(t12, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t172 = t12 + t171
-    t173 = t12 - t171
+    t173 = -t171 + t12
     t174 = xp.where(xp.greater_equal(t12, -2.9670597283903604) & xp.less_equal(t12, 2.9670597283903604), t12, xp.where(xp.greater_equal(t172, -2.9670597283903604) & xp.less_equal(t172, 2.9670597283903604), t172, xp.where(xp.greater_equal(t173, -2.9670597283903604) & xp.less_equal(t173, 2.9670597283903604), t173, qb1_4)))
     t175 = xp.where(xp.less(t13, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t176 = t13 + t175
-    t177 = t13 - t175
+    t177 = -t175 + t13
     t178 = xp.where(xp.greater_equal(t13, -2.9670597283903604) & xp.less_equal(t13, 2.9670597283903604), t13, xp.where(xp.greater_equal(t176, -2.9670597283903604) & xp.less_equal(t176, 2.9670597283903604), t176, xp.where(xp.greater_equal(t177, -2.9670597283903604) & xp.less_equal(t177, 2.9670597283903604), t177, qb1_5)))
-    t179 = qw1*(t158 + t138)**2 + qw2*(t162 + t139)**2 + qw3*(t166 + t140)**2 + qw4*(t170 + t141)**2 + qw5*(t174 + t142)**2 + qw6*(t178 + t143)**2 + qw7*(qb1_6 + t144)**2
+    t179 = qw1*(t138 + t158)**2 + qw2*(t139 + t162)**2 + qw3*(t140 + t166)**2 + qw4*(t141 + t170)**2 + qw5*(t142 + t174)**2 + qw6*(t143 + t178)**2 + qw7*(t144 + qb1_6)**2
     t180 = xp.greater(t14, 0)
     t181 = xp.where(t180 & (xp.less(t7, 1) | xp.less(t179, t154)), xp.asarray(1, dtype=dtype), 0)
     t182 = xp.where(t180, 1, t7)
@@ -4241,29 +4241,29 @@ def ik_nearest(T, q_seed, q_free, weights=(1.0,) * DOF):
     t191 = xp.where(t183, t179, t154)
     t192 = xp.where(xp.less(t15, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t193 = t15 + t192
-    t194 = t15 - t192
+    t194 = -t192 + t15
     t195 = xp.where(xp.greater_equal(t15, -3.0543261909900767) & xp.less_equal(t15, 3.0543261909900767), t15, xp.where(xp.greater_equal(t193, -3.0543261909900767) & xp.less_equal(t193, 3.0543261909900767), t193, xp.where(xp.greater_equal(t194, -3.0543261909900767) & xp.less_equal(t194, 3.0543261909900767), t194, qb2_0)))
     t196 = xp.where(xp.less(t16, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t197 = t16 + t196
-    t198 = t16 - t196
+    t198 = -t196 + t16
     t199 = xp.where(xp.greater_equal(t16, -3.822271061867582) & xp.less_equal(t16, 2.2863813201125716), t16, xp.where(xp.greater_equal(t197, -3.822271061867582) & xp.less_equal(t197, 2.2863813201125716), t197, xp.where(xp.greater_equal(t198, -3.822271061867582) & xp.less_equal(t198, 2.2863813201125716), t198, qb2_1)))
     t200 = xp.where(xp.less(t17, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t201 = t17 + t200
-    t202 = t17 - t200
+    t202 = -t200 + t17
     t203 = xp.where(xp.greater_equal(t17, -3.0543261909900767) & xp.less_equal(t17, 3.0543261909900767), t17, xp.where(xp.greater_equal(t201, -3.0543261909900767) & xp.less_equal(t201, 3.0543261909900767), t201, xp.where(xp.greater_equal(t202, -3.0543261909900767) & xp.less_equal(t202, 3.0543261909900767), t202, qb2_2)))
     t204 = xp.where(xp.less(t18, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t205 = t18 + t204
-    t206 = t18 - t204
+    t206 = -t204 + t18
     t207 = xp.where(xp.greater_equal(t18, -3.0543261909900767) & xp.less_equal(t18, 3.0543261909900767), t18, xp.where(xp.greater_equal(t205, -3.0543261909900767) & xp.less_equal(t205, 3.0543261909900767), t205, xp.where(xp.greater_equal(t206, -3.0543261909900767) & xp.less_equal(t206, 3.0543261909900767), t206, qb2_3)))
     t208 = xp.where(xp.less(t19, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t209 = t19 + t208
-    t210 = t19 - t208
+    t210 = -t208 + t19
     t211 = xp.where(xp.greater_equal(t19, -2.9670597283903604) & xp.less_equal(t19, 2.9670597283903604), t19, xp.where(xp.greater_equal(t209, -2.9670597283903604) & xp.less_equal(t209, 2.9670597283903604), t209, xp.where(xp.greater_equal(t210, -2.9670597283903604) & xp.less_equal(t210, 2.9670597283903604), t210, qb2_4)))
     t212 = xp.where(xp.less(t20, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t213 = t20 + t212
-    t214 = t20 - t212
+    t214 = -t212 + t20
     t215 = xp.where(xp.greater_equal(t20, -2.9670597283903604) & xp.less_equal(t20, 2.9670597283903604), t20, xp.where(xp.greater_equal(t213, -2.9670597283903604) & xp.less_equal(t213, 2.9670597283903604), t213, xp.where(xp.greater_equal(t214, -2.9670597283903604) & xp.less_equal(t214, 2.9670597283903604), t214, qb2_5)))
-    t216 = qw1*(t195 + t138)**2 + qw2*(t199 + t139)**2 + qw3*(t203 + t140)**2 + qw4*(t207 + t141)**2 + qw5*(t211 + t142)**2 + qw6*(t215 + t143)**2 + qw7*(qb2_6 + t144)**2
+    t216 = qw1*(t138 + t195)**2 + qw2*(t139 + t199)**2 + qw3*(t140 + t203)**2 + qw4*(t141 + t207)**2 + qw5*(t142 + t211)**2 + qw6*(t143 + t215)**2 + qw7*(t144 + qb2_6)**2
     t217 = xp.greater(t21, 0)
     t218 = xp.where(t217 & (xp.less(t182, 1) | xp.less(t216, t191)), xp.asarray(1, dtype=dtype), 0)
     t219 = xp.where(t217, 1, t182)
@@ -4278,29 +4278,29 @@ def ik_nearest(T, q_seed, q_free, weights=(1.0,) * DOF):
     t228 = xp.where(t220, t216, t191)
     t229 = xp.where(xp.less(t22, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t230 = t22 + t229
-    t231 = t22 - t229
+    t231 = -t229 + t22
     t232 = xp.where(xp.greater_equal(t22, -3.0543261909900767) & xp.less_equal(t22, 3.0543261909900767), t22, xp.where(xp.greater_equal(t230, -3.0543261909900767) & xp.less_equal(t230, 3.0543261909900767), t230, xp.where(xp.greater_equal(t231, -3.0543261909900767) & xp.less_equal(t231, 3.0543261909900767), t231, qb3_0)))
     t233 = xp.where(xp.less(t23, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t234 = t23 + t233
-    t235 = t23 - t233
+    t235 = -t233 + t23
     t236 = xp.where(xp.greater_equal(t23, -3.822271061867582) & xp.less_equal(t23, 2.2863813201125716), t23, xp.where(xp.greater_equal(t234, -3.822271061867582) & xp.less_equal(t234, 2.2863813201125716), t234, xp.where(xp.greater_equal(t235, -3.822271061867582) & xp.less_equal(t235, 2.2863813201125716), t235, qb3_1)))
     t237 = xp.where(xp.less(t24, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t238 = t24 + t237
-    t239 = t24 - t237
+    t239 = -t237 + t24
     t240 = xp.where(xp.greater_equal(t24, -3.0543261909900767) & xp.less_equal(t24, 3.0543261909900767), t24, xp.where(xp.greater_equal(t238, -3.0543261909900767) & xp.less_equal(t238, 3.0543261909900767), t238, xp.where(xp.greater_equal(t239, -3.0543261909900767) & xp.less_equal(t239, 3.0543261909900767), t239, qb3_2)))
     t241 = xp.where(xp.less(t25, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t242 = t25 + t241
-    t243 = t25 - t241
+    t243 = -t241 + t25
     t244 = xp.where(xp.greater_equal(t25, -3.0543261909900767) & xp.less_equal(t25, 3.0543261909900767), t25, xp.where(xp.greater_equal(t242, -3.0543261909900767) & xp.less_equal(t242, 3.0543261909900767), t242, xp.where(xp.greater_equal(t243, -3.0543261909900767) & xp.less_equal(t243, 3.0543261909900767), t243, qb3_3)))
     t245 = xp.where(xp.less(t26, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t246 = t26 + t245
-    t247 = t26 - t245
+    t247 = -t245 + t26
     t248 = xp.where(xp.greater_equal(t26, -2.9670597283903604) & xp.less_equal(t26, 2.9670597283903604), t26, xp.where(xp.greater_equal(t246, -2.9670597283903604) & xp.less_equal(t246, 2.9670597283903604), t246, xp.where(xp.greater_equal(t247, -2.9670597283903604) & xp.less_equal(t247, 2.9670597283903604), t247, qb3_4)))
     t249 = xp.where(xp.less(t27, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t250 = t27 + t249
-    t251 = t27 - t249
+    t251 = -t249 + t27
     t252 = xp.where(xp.greater_equal(t27, -2.9670597283903604) & xp.less_equal(t27, 2.9670597283903604), t27, xp.where(xp.greater_equal(t250, -2.9670597283903604) & xp.less_equal(t250, 2.9670597283903604), t250, xp.where(xp.greater_equal(t251, -2.9670597283903604) & xp.less_equal(t251, 2.9670597283903604), t251, qb3_5)))
-    t253 = qw1*(t232 + t138)**2 + qw2*(t236 + t139)**2 + qw3*(t240 + t140)**2 + qw4*(t244 + t141)**2 + qw5*(t248 + t142)**2 + qw6*(t252 + t143)**2 + qw7*(qb3_6 + t144)**2
+    t253 = qw1*(t138 + t232)**2 + qw2*(t139 + t236)**2 + qw3*(t140 + t240)**2 + qw4*(t141 + t244)**2 + qw5*(t142 + t248)**2 + qw6*(t143 + t252)**2 + qw7*(t144 + qb3_6)**2
     t254 = xp.greater(t28, 0)
     t255 = xp.where(t254 & (xp.less(t219, 1) | xp.less(t253, t228)), xp.asarray(1, dtype=dtype), 0)
     t256 = xp.where(t254, 1, t219)
@@ -4315,29 +4315,29 @@ def ik_nearest(T, q_seed, q_free, weights=(1.0,) * DOF):
     t265 = xp.where(t257, t253, t228)
     t266 = xp.where(xp.less(t29, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t267 = t29 + t266
-    t268 = t29 - t266
+    t268 = -t266 + t29
     t269 = xp.where(xp.greater_equal(t29, -3.0543261909900767) & xp.less_equal(t29, 3.0543261909900767), t29, xp.where(xp.greater_equal(t267, -3.0543261909900767) & xp.less_equal(t267, 3.0543261909900767), t267, xp.where(xp.greater_equal(t268, -3.0543261909900767) & xp.less_equal(t268, 3.0543261909900767), t268, qb4_0)))
     t270 = xp.where(xp.less(t30, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t271 = t30 + t270
-    t272 = t30 - t270
+    t272 = -t270 + t30
     t273 = xp.where(xp.greater_equal(t30, -3.822271061867582) & xp.less_equal(t30, 2.2863813201125716), t30, xp.where(xp.greater_equal(t271, -3.822271061867582) & xp.less_equal(t271, 2.2863813201125716), t271, xp.where(xp.greater_equal(t272, -3.822271061867582) & xp.less_equal(t272, 2.2863813201125716), t272, qb4_1)))
     t274 = xp.where(xp.less(t31, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t275 = t31 + t274
-    t276 = t31 - t274
+    t276 = -t274 + t31
     t277 = xp.where(xp.greater_equal(t31, -3.0543261909900767) & xp.less_equal(t31, 3.0543261909900767), t31, xp.where(xp.greater_equal(t275, -3.0543261909900767) & xp.less_equal(t275, 3.0543261909900767), t275, xp.where(xp.greater_equal(t276, -3.0543261909900767) & xp.less_equal(t276, 3.0543261909900767), t276, qb4_2)))
     t278 = xp.where(xp.less(t32, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t279 = t32 + t278
-    t280 = t32 - t278
+    t280 = -t278 + t32
     t281 = xp.where(xp.greater_equal(t32, -3.0543261909900767) & xp.less_equal(t32, 3.0543261909900767), t32, xp.where(xp.greater_equal(t279, -3.0543261909900767) & xp.less_equal(t279, 3.0543261909900767), t279, xp.where(xp.greater_equal(t280, -3.0543261909900767) & xp.less_equal(t280, 3.0543261909900767), t280, qb4_3)))
     t282 = xp.where(xp.less(t33, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t283 = t33 + t282
-    t284 = t33 - t282
+    t284 = -t282 + t33
     t285 = xp.where(xp.greater_equal(t33, -2.9670597283903604) & xp.less_equal(t33, 2.9670597283903604), t33, xp.where(xp.greater_equal(t283, -2.9670597283903604) & xp.less_equal(t283, 2.9670597283903604), t283, xp.where(xp.greater_equal(t284, -2.9670597283903604) & xp.less_equal(t284, 2.9670597283903604), t284, qb4_4)))
     t286 = xp.where(xp.less(t34, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t287 = t34 + t286
-    t288 = t34 - t286
+    t288 = -t286 + t34
     t289 = xp.where(xp.greater_equal(t34, -2.9670597283903604) & xp.less_equal(t34, 2.9670597283903604), t34, xp.where(xp.greater_equal(t287, -2.9670597283903604) & xp.less_equal(t287, 2.9670597283903604), t287, xp.where(xp.greater_equal(t288, -2.9670597283903604) & xp.less_equal(t288, 2.9670597283903604), t288, qb4_5)))
-    t290 = qw1*(t269 + t138)**2 + qw2*(t273 + t139)**2 + qw3*(t277 + t140)**2 + qw4*(t281 + t141)**2 + qw5*(t285 + t142)**2 + qw6*(t289 + t143)**2 + qw7*(qb4_6 + t144)**2
+    t290 = qw1*(t138 + t269)**2 + qw2*(t139 + t273)**2 + qw3*(t140 + t277)**2 + qw4*(t141 + t281)**2 + qw5*(t142 + t285)**2 + qw6*(t143 + t289)**2 + qw7*(t144 + qb4_6)**2
     t291 = xp.greater(t35, 0)
     t292 = xp.where(t291 & (xp.less(t256, 1) | xp.less(t290, t265)), xp.asarray(1, dtype=dtype), 0)
     t293 = xp.where(t291, 1, t256)
@@ -4352,29 +4352,29 @@ def ik_nearest(T, q_seed, q_free, weights=(1.0,) * DOF):
     t302 = xp.where(t294, t290, t265)
     t303 = xp.where(xp.less(t36, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t304 = t36 + t303
-    t305 = t36 - t303
+    t305 = -t303 + t36
     t306 = xp.where(xp.greater_equal(t36, -3.0543261909900767) & xp.less_equal(t36, 3.0543261909900767), t36, xp.where(xp.greater_equal(t304, -3.0543261909900767) & xp.less_equal(t304, 3.0543261909900767), t304, xp.where(xp.greater_equal(t305, -3.0543261909900767) & xp.less_equal(t305, 3.0543261909900767), t305, qb5_0)))
     t307 = xp.where(xp.less(t37, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t308 = t37 + t307
-    t309 = t37 - t307
+    t309 = -t307 + t37
     t310 = xp.where(xp.greater_equal(t37, -3.822271061867582) & xp.less_equal(t37, 2.2863813201125716), t37, xp.where(xp.greater_equal(t308, -3.822271061867582) & xp.less_equal(t308, 2.2863813201125716), t308, xp.where(xp.greater_equal(t309, -3.822271061867582) & xp.less_equal(t309, 2.2863813201125716), t309, qb5_1)))
     t311 = xp.where(xp.less(t38, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t312 = t38 + t311
-    t313 = t38 - t311
+    t313 = -t311 + t38
     t314 = xp.where(xp.greater_equal(t38, -3.0543261909900767) & xp.less_equal(t38, 3.0543261909900767), t38, xp.where(xp.greater_equal(t312, -3.0543261909900767) & xp.less_equal(t312, 3.0543261909900767), t312, xp.where(xp.greater_equal(t313, -3.0543261909900767) & xp.less_equal(t313, 3.0543261909900767), t313, qb5_2)))
     t315 = xp.where(xp.less(t39, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t316 = t39 + t315
-    t317 = t39 - t315
+    t317 = -t315 + t39
     t318 = xp.where(xp.greater_equal(t39, -3.0543261909900767) & xp.less_equal(t39, 3.0543261909900767), t39, xp.where(xp.greater_equal(t316, -3.0543261909900767) & xp.less_equal(t316, 3.0543261909900767), t316, xp.where(xp.greater_equal(t317, -3.0543261909900767) & xp.less_equal(t317, 3.0543261909900767), t317, qb5_3)))
     t319 = xp.where(xp.less(t40, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t320 = t40 + t319
-    t321 = t40 - t319
+    t321 = -t319 + t40
     t322 = xp.where(xp.greater_equal(t40, -2.9670597283903604) & xp.less_equal(t40, 2.9670597283903604), t40, xp.where(xp.greater_equal(t320, -2.9670597283903604) & xp.less_equal(t320, 2.9670597283903604), t320, xp.where(xp.greater_equal(t321, -2.9670597283903604) & xp.less_equal(t321, 2.9670597283903604), t321, qb5_4)))
     t323 = xp.where(xp.less(t41, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t324 = t41 + t323
-    t325 = t41 - t323
+    t325 = -t323 + t41
     t326 = xp.where(xp.greater_equal(t41, -2.9670597283903604) & xp.less_equal(t41, 2.9670597283903604), t41, xp.where(xp.greater_equal(t324, -2.9670597283903604) & xp.less_equal(t324, 2.9670597283903604), t324, xp.where(xp.greater_equal(t325, -2.9670597283903604) & xp.less_equal(t325, 2.9670597283903604), t325, qb5_5)))
-    t327 = qw1*(t306 + t138)**2 + qw2*(t310 + t139)**2 + qw3*(t314 + t140)**2 + qw4*(t318 + t141)**2 + qw5*(t322 + t142)**2 + qw6*(t326 + t143)**2 + qw7*(qb5_6 + t144)**2
+    t327 = qw1*(t138 + t306)**2 + qw2*(t139 + t310)**2 + qw3*(t140 + t314)**2 + qw4*(t141 + t318)**2 + qw5*(t142 + t322)**2 + qw6*(t143 + t326)**2 + qw7*(t144 + qb5_6)**2
     t328 = xp.greater(t42, 0)
     t329 = xp.where(t328 & (xp.less(t293, 1) | xp.less(t327, t302)), xp.asarray(1, dtype=dtype), 0)
     t330 = xp.where(t328, 1, t293)
@@ -4389,29 +4389,29 @@ def ik_nearest(T, q_seed, q_free, weights=(1.0,) * DOF):
     t339 = xp.where(t331, t327, t302)
     t340 = xp.where(xp.less(t43, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t341 = t43 + t340
-    t342 = t43 - t340
+    t342 = -t340 + t43
     t343 = xp.where(xp.greater_equal(t43, -3.0543261909900767) & xp.less_equal(t43, 3.0543261909900767), t43, xp.where(xp.greater_equal(t341, -3.0543261909900767) & xp.less_equal(t341, 3.0543261909900767), t341, xp.where(xp.greater_equal(t342, -3.0543261909900767) & xp.less_equal(t342, 3.0543261909900767), t342, qb6_0)))
     t344 = xp.where(xp.less(t44, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t345 = t44 + t344
-    t346 = t44 - t344
+    t346 = -t344 + t44
     t347 = xp.where(xp.greater_equal(t44, -3.822271061867582) & xp.less_equal(t44, 2.2863813201125716), t44, xp.where(xp.greater_equal(t345, -3.822271061867582) & xp.less_equal(t345, 2.2863813201125716), t345, xp.where(xp.greater_equal(t346, -3.822271061867582) & xp.less_equal(t346, 2.2863813201125716), t346, qb6_1)))
     t348 = xp.where(xp.less(t45, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t349 = t45 + t348
-    t350 = t45 - t348
+    t350 = -t348 + t45
     t351 = xp.where(xp.greater_equal(t45, -3.0543261909900767) & xp.less_equal(t45, 3.0543261909900767), t45, xp.where(xp.greater_equal(t349, -3.0543261909900767) & xp.less_equal(t349, 3.0543261909900767), t349, xp.where(xp.greater_equal(t350, -3.0543261909900767) & xp.less_equal(t350, 3.0543261909900767), t350, qb6_2)))
     t352 = xp.where(xp.less(t46, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t353 = t46 + t352
-    t354 = t46 - t352
+    t354 = -t352 + t46
     t355 = xp.where(xp.greater_equal(t46, -3.0543261909900767) & xp.less_equal(t46, 3.0543261909900767), t46, xp.where(xp.greater_equal(t353, -3.0543261909900767) & xp.less_equal(t353, 3.0543261909900767), t353, xp.where(xp.greater_equal(t354, -3.0543261909900767) & xp.less_equal(t354, 3.0543261909900767), t354, qb6_3)))
     t356 = xp.where(xp.less(t47, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t357 = t47 + t356
-    t358 = t47 - t356
+    t358 = -t356 + t47
     t359 = xp.where(xp.greater_equal(t47, -2.9670597283903604) & xp.less_equal(t47, 2.9670597283903604), t47, xp.where(xp.greater_equal(t357, -2.9670597283903604) & xp.less_equal(t357, 2.9670597283903604), t357, xp.where(xp.greater_equal(t358, -2.9670597283903604) & xp.less_equal(t358, 2.9670597283903604), t358, qb6_4)))
     t360 = xp.where(xp.less(t48, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t361 = t48 + t360
-    t362 = t48 - t360
+    t362 = -t360 + t48
     t363 = xp.where(xp.greater_equal(t48, -2.9670597283903604) & xp.less_equal(t48, 2.9670597283903604), t48, xp.where(xp.greater_equal(t361, -2.9670597283903604) & xp.less_equal(t361, 2.9670597283903604), t361, xp.where(xp.greater_equal(t362, -2.9670597283903604) & xp.less_equal(t362, 2.9670597283903604), t362, qb6_5)))
-    t364 = qw1*(t343 + t138)**2 + qw2*(t347 + t139)**2 + qw3*(t351 + t140)**2 + qw4*(t355 + t141)**2 + qw5*(t359 + t142)**2 + qw6*(t363 + t143)**2 + qw7*(qb6_6 + t144)**2
+    t364 = qw1*(t138 + t343)**2 + qw2*(t139 + t347)**2 + qw3*(t140 + t351)**2 + qw4*(t141 + t355)**2 + qw5*(t142 + t359)**2 + qw6*(t143 + t363)**2 + qw7*(t144 + qb6_6)**2
     t365 = xp.greater(t49, 0)
     t366 = xp.where(t365 & (xp.less(t330, 1) | xp.less(t364, t339)), xp.asarray(1, dtype=dtype), 0)
     t367 = xp.where(t365, 1, t330)
@@ -4426,29 +4426,29 @@ def ik_nearest(T, q_seed, q_free, weights=(1.0,) * DOF):
     t376 = xp.where(t368, t364, t339)
     t377 = xp.where(xp.less(t50, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t378 = t50 + t377
-    t379 = t50 - t377
+    t379 = -t377 + t50
     t380 = xp.where(xp.greater_equal(t50, -3.0543261909900767) & xp.less_equal(t50, 3.0543261909900767), t50, xp.where(xp.greater_equal(t378, -3.0543261909900767) & xp.less_equal(t378, 3.0543261909900767), t378, xp.where(xp.greater_equal(t379, -3.0543261909900767) & xp.less_equal(t379, 3.0543261909900767), t379, qb7_0)))
     t381 = xp.where(xp.less(t51, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t382 = t51 + t381
-    t383 = t51 - t381
+    t383 = -t381 + t51
     t384 = xp.where(xp.greater_equal(t51, -3.822271061867582) & xp.less_equal(t51, 2.2863813201125716), t51, xp.where(xp.greater_equal(t382, -3.822271061867582) & xp.less_equal(t382, 2.2863813201125716), t382, xp.where(xp.greater_equal(t383, -3.822271061867582) & xp.less_equal(t383, 2.2863813201125716), t383, qb7_1)))
     t385 = xp.where(xp.less(t52, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t386 = t52 + t385
-    t387 = t52 - t385
+    t387 = -t385 + t52
     t388 = xp.where(xp.greater_equal(t52, -3.0543261909900767) & xp.less_equal(t52, 3.0543261909900767), t52, xp.where(xp.greater_equal(t386, -3.0543261909900767) & xp.less_equal(t386, 3.0543261909900767), t386, xp.where(xp.greater_equal(t387, -3.0543261909900767) & xp.less_equal(t387, 3.0543261909900767), t387, qb7_2)))
     t389 = xp.where(xp.less(t53, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t390 = t53 + t389
-    t391 = t53 - t389
+    t391 = -t389 + t53
     t392 = xp.where(xp.greater_equal(t53, -3.0543261909900767) & xp.less_equal(t53, 3.0543261909900767), t53, xp.where(xp.greater_equal(t390, -3.0543261909900767) & xp.less_equal(t390, 3.0543261909900767), t390, xp.where(xp.greater_equal(t391, -3.0543261909900767) & xp.less_equal(t391, 3.0543261909900767), t391, qb7_3)))
     t393 = xp.where(xp.less(t54, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t394 = t54 + t393
-    t395 = t54 - t393
+    t395 = -t393 + t54
     t396 = xp.where(xp.greater_equal(t54, -2.9670597283903604) & xp.less_equal(t54, 2.9670597283903604), t54, xp.where(xp.greater_equal(t394, -2.9670597283903604) & xp.less_equal(t394, 2.9670597283903604), t394, xp.where(xp.greater_equal(t395, -2.9670597283903604) & xp.less_equal(t395, 2.9670597283903604), t395, qb7_4)))
     t397 = xp.where(xp.less(t55, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t398 = t55 + t397
-    t399 = t55 - t397
+    t399 = -t397 + t55
     t400 = xp.where(xp.greater_equal(t55, -2.9670597283903604) & xp.less_equal(t55, 2.9670597283903604), t55, xp.where(xp.greater_equal(t398, -2.9670597283903604) & xp.less_equal(t398, 2.9670597283903604), t398, xp.where(xp.greater_equal(t399, -2.9670597283903604) & xp.less_equal(t399, 2.9670597283903604), t399, qb7_5)))
-    t401 = qw1*(t380 + t138)**2 + qw2*(t384 + t139)**2 + qw3*(t388 + t140)**2 + qw4*(t392 + t141)**2 + qw5*(t396 + t142)**2 + qw6*(t400 + t143)**2 + qw7*(qb7_6 + t144)**2
+    t401 = qw1*(t138 + t380)**2 + qw2*(t139 + t384)**2 + qw3*(t140 + t388)**2 + qw4*(t141 + t392)**2 + qw5*(t142 + t396)**2 + qw6*(t143 + t400)**2 + qw7*(t144 + qb7_6)**2
     t402 = xp.greater(t56, 0)
     t403 = xp.where(t402 & (xp.less(t367, 1) | xp.less(t401, t376)), xp.asarray(1, dtype=dtype), 0)
     t404 = xp.where(t402, 1, t367)
@@ -4463,29 +4463,29 @@ def ik_nearest(T, q_seed, q_free, weights=(1.0,) * DOF):
     t413 = xp.where(t405, t401, t376)
     t414 = xp.where(xp.less(t57, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t415 = t57 + t414
-    t416 = t57 - t414
+    t416 = -t414 + t57
     t417 = xp.where(xp.greater_equal(t57, -3.0543261909900767) & xp.less_equal(t57, 3.0543261909900767), t57, xp.where(xp.greater_equal(t415, -3.0543261909900767) & xp.less_equal(t415, 3.0543261909900767), t415, xp.where(xp.greater_equal(t416, -3.0543261909900767) & xp.less_equal(t416, 3.0543261909900767), t416, qb8_0)))
     t418 = xp.where(xp.less(t58, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t419 = t58 + t418
-    t420 = t58 - t418
+    t420 = -t418 + t58
     t421 = xp.where(xp.greater_equal(t58, -3.822271061867582) & xp.less_equal(t58, 2.2863813201125716), t58, xp.where(xp.greater_equal(t419, -3.822271061867582) & xp.less_equal(t419, 2.2863813201125716), t419, xp.where(xp.greater_equal(t420, -3.822271061867582) & xp.less_equal(t420, 2.2863813201125716), t420, qb8_1)))
     t422 = xp.where(xp.less(t59, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t423 = t59 + t422
-    t424 = t59 - t422
+    t424 = -t422 + t59
     t425 = xp.where(xp.greater_equal(t59, -3.0543261909900767) & xp.less_equal(t59, 3.0543261909900767), t59, xp.where(xp.greater_equal(t423, -3.0543261909900767) & xp.less_equal(t423, 3.0543261909900767), t423, xp.where(xp.greater_equal(t424, -3.0543261909900767) & xp.less_equal(t424, 3.0543261909900767), t424, qb8_2)))
     t426 = xp.where(xp.less(t60, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t427 = t60 + t426
-    t428 = t60 - t426
+    t428 = -t426 + t60
     t429 = xp.where(xp.greater_equal(t60, -3.0543261909900767) & xp.less_equal(t60, 3.0543261909900767), t60, xp.where(xp.greater_equal(t427, -3.0543261909900767) & xp.less_equal(t427, 3.0543261909900767), t427, xp.where(xp.greater_equal(t428, -3.0543261909900767) & xp.less_equal(t428, 3.0543261909900767), t428, qb8_3)))
     t430 = xp.where(xp.less(t61, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t431 = t61 + t430
-    t432 = t61 - t430
+    t432 = -t430 + t61
     t433 = xp.where(xp.greater_equal(t61, -2.9670597283903604) & xp.less_equal(t61, 2.9670597283903604), t61, xp.where(xp.greater_equal(t431, -2.9670597283903604) & xp.less_equal(t431, 2.9670597283903604), t431, xp.where(xp.greater_equal(t432, -2.9670597283903604) & xp.less_equal(t432, 2.9670597283903604), t432, qb8_4)))
     t434 = xp.where(xp.less(t62, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t435 = t62 + t434
-    t436 = t62 - t434
+    t436 = -t434 + t62
     t437 = xp.where(xp.greater_equal(t62, -2.9670597283903604) & xp.less_equal(t62, 2.9670597283903604), t62, xp.where(xp.greater_equal(t435, -2.9670597283903604) & xp.less_equal(t435, 2.9670597283903604), t435, xp.where(xp.greater_equal(t436, -2.9670597283903604) & xp.less_equal(t436, 2.9670597283903604), t436, qb8_5)))
-    t438 = qw1*(t417 + t138)**2 + qw2*(t421 + t139)**2 + qw3*(t425 + t140)**2 + qw4*(t429 + t141)**2 + qw5*(t433 + t142)**2 + qw6*(t437 + t143)**2 + qw7*(qb8_6 + t144)**2
+    t438 = qw1*(t138 + t417)**2 + qw2*(t139 + t421)**2 + qw3*(t140 + t425)**2 + qw4*(t141 + t429)**2 + qw5*(t142 + t433)**2 + qw6*(t143 + t437)**2 + qw7*(t144 + qb8_6)**2
     t439 = xp.greater(t63, 0)
     t440 = xp.where(t439 & (xp.less(t404, 1) | xp.less(t438, t413)), xp.asarray(1, dtype=dtype), 0)
     t441 = xp.where(t439, 1, t404)
@@ -4500,29 +4500,29 @@ def ik_nearest(T, q_seed, q_free, weights=(1.0,) * DOF):
     t450 = xp.where(t442, t438, t413)
     t451 = xp.where(xp.less(t64, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t452 = t64 + t451
-    t453 = t64 - t451
+    t453 = -t451 + t64
     t454 = xp.where(xp.greater_equal(t64, -3.0543261909900767) & xp.less_equal(t64, 3.0543261909900767), t64, xp.where(xp.greater_equal(t452, -3.0543261909900767) & xp.less_equal(t452, 3.0543261909900767), t452, xp.where(xp.greater_equal(t453, -3.0543261909900767) & xp.less_equal(t453, 3.0543261909900767), t453, qb9_0)))
     t455 = xp.where(xp.less(t65, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t456 = t65 + t455
-    t457 = t65 - t455
+    t457 = -t455 + t65
     t458 = xp.where(xp.greater_equal(t65, -3.822271061867582) & xp.less_equal(t65, 2.2863813201125716), t65, xp.where(xp.greater_equal(t456, -3.822271061867582) & xp.less_equal(t456, 2.2863813201125716), t456, xp.where(xp.greater_equal(t457, -3.822271061867582) & xp.less_equal(t457, 2.2863813201125716), t457, qb9_1)))
     t459 = xp.where(xp.less(t66, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t460 = t66 + t459
-    t461 = t66 - t459
+    t461 = -t459 + t66
     t462 = xp.where(xp.greater_equal(t66, -3.0543261909900767) & xp.less_equal(t66, 3.0543261909900767), t66, xp.where(xp.greater_equal(t460, -3.0543261909900767) & xp.less_equal(t460, 3.0543261909900767), t460, xp.where(xp.greater_equal(t461, -3.0543261909900767) & xp.less_equal(t461, 3.0543261909900767), t461, qb9_2)))
     t463 = xp.where(xp.less(t67, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t464 = t67 + t463
-    t465 = t67 - t463
+    t465 = -t463 + t67
     t466 = xp.where(xp.greater_equal(t67, -3.0543261909900767) & xp.less_equal(t67, 3.0543261909900767), t67, xp.where(xp.greater_equal(t464, -3.0543261909900767) & xp.less_equal(t464, 3.0543261909900767), t464, xp.where(xp.greater_equal(t465, -3.0543261909900767) & xp.less_equal(t465, 3.0543261909900767), t465, qb9_3)))
     t467 = xp.where(xp.less(t68, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t468 = t68 + t467
-    t469 = t68 - t467
+    t469 = -t467 + t68
     t470 = xp.where(xp.greater_equal(t68, -2.9670597283903604) & xp.less_equal(t68, 2.9670597283903604), t68, xp.where(xp.greater_equal(t468, -2.9670597283903604) & xp.less_equal(t468, 2.9670597283903604), t468, xp.where(xp.greater_equal(t469, -2.9670597283903604) & xp.less_equal(t469, 2.9670597283903604), t469, qb9_4)))
     t471 = xp.where(xp.less(t69, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t472 = t69 + t471
-    t473 = t69 - t471
+    t473 = -t471 + t69
     t474 = xp.where(xp.greater_equal(t69, -2.9670597283903604) & xp.less_equal(t69, 2.9670597283903604), t69, xp.where(xp.greater_equal(t472, -2.9670597283903604) & xp.less_equal(t472, 2.9670597283903604), t472, xp.where(xp.greater_equal(t473, -2.9670597283903604) & xp.less_equal(t473, 2.9670597283903604), t473, qb9_5)))
-    t475 = qw1*(t454 + t138)**2 + qw2*(t458 + t139)**2 + qw3*(t462 + t140)**2 + qw4*(t466 + t141)**2 + qw5*(t470 + t142)**2 + qw6*(t474 + t143)**2 + qw7*(qb9_6 + t144)**2
+    t475 = qw1*(t138 + t454)**2 + qw2*(t139 + t458)**2 + qw3*(t140 + t462)**2 + qw4*(t141 + t466)**2 + qw5*(t142 + t470)**2 + qw6*(t143 + t474)**2 + qw7*(t144 + qb9_6)**2
     t476 = xp.greater(t70, 0)
     t477 = xp.where(t476 & (xp.less(t441, 1) | xp.less(t475, t450)), xp.asarray(1, dtype=dtype), 0)
     t478 = xp.where(t476, 1, t441)
@@ -4537,29 +4537,29 @@ def ik_nearest(T, q_seed, q_free, weights=(1.0,) * DOF):
     t487 = xp.where(t479, t475, t450)
     t488 = xp.where(xp.less(t71, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t489 = t71 + t488
-    t490 = t71 - t488
+    t490 = -t488 + t71
     t491 = xp.where(xp.greater_equal(t71, -3.0543261909900767) & xp.less_equal(t71, 3.0543261909900767), t71, xp.where(xp.greater_equal(t489, -3.0543261909900767) & xp.less_equal(t489, 3.0543261909900767), t489, xp.where(xp.greater_equal(t490, -3.0543261909900767) & xp.less_equal(t490, 3.0543261909900767), t490, qb10_0)))
     t492 = xp.where(xp.less(t72, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t493 = t72 + t492
-    t494 = t72 - t492
+    t494 = -t492 + t72
     t495 = xp.where(xp.greater_equal(t72, -3.822271061867582) & xp.less_equal(t72, 2.2863813201125716), t72, xp.where(xp.greater_equal(t493, -3.822271061867582) & xp.less_equal(t493, 2.2863813201125716), t493, xp.where(xp.greater_equal(t494, -3.822271061867582) & xp.less_equal(t494, 2.2863813201125716), t494, qb10_1)))
     t496 = xp.where(xp.less(t73, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t497 = t73 + t496
-    t498 = t73 - t496
+    t498 = -t496 + t73
     t499 = xp.where(xp.greater_equal(t73, -3.0543261909900767) & xp.less_equal(t73, 3.0543261909900767), t73, xp.where(xp.greater_equal(t497, -3.0543261909900767) & xp.less_equal(t497, 3.0543261909900767), t497, xp.where(xp.greater_equal(t498, -3.0543261909900767) & xp.less_equal(t498, 3.0543261909900767), t498, qb10_2)))
     t500 = xp.where(xp.less(t74, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t501 = t74 + t500
-    t502 = t74 - t500
+    t502 = -t500 + t74
     t503 = xp.where(xp.greater_equal(t74, -3.0543261909900767) & xp.less_equal(t74, 3.0543261909900767), t74, xp.where(xp.greater_equal(t501, -3.0543261909900767) & xp.less_equal(t501, 3.0543261909900767), t501, xp.where(xp.greater_equal(t502, -3.0543261909900767) & xp.less_equal(t502, 3.0543261909900767), t502, qb10_3)))
     t504 = xp.where(xp.less(t75, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t505 = t75 + t504
-    t506 = t75 - t504
+    t506 = -t504 + t75
     t507 = xp.where(xp.greater_equal(t75, -2.9670597283903604) & xp.less_equal(t75, 2.9670597283903604), t75, xp.where(xp.greater_equal(t505, -2.9670597283903604) & xp.less_equal(t505, 2.9670597283903604), t505, xp.where(xp.greater_equal(t506, -2.9670597283903604) & xp.less_equal(t506, 2.9670597283903604), t506, qb10_4)))
     t508 = xp.where(xp.less(t76, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t509 = t76 + t508
-    t510 = t76 - t508
+    t510 = -t508 + t76
     t511 = xp.where(xp.greater_equal(t76, -2.9670597283903604) & xp.less_equal(t76, 2.9670597283903604), t76, xp.where(xp.greater_equal(t509, -2.9670597283903604) & xp.less_equal(t509, 2.9670597283903604), t509, xp.where(xp.greater_equal(t510, -2.9670597283903604) & xp.less_equal(t510, 2.9670597283903604), t510, qb10_5)))
-    t512 = qw1*(t491 + t138)**2 + qw2*(t495 + t139)**2 + qw3*(t499 + t140)**2 + qw4*(t503 + t141)**2 + qw5*(t507 + t142)**2 + qw6*(t511 + t143)**2 + qw7*(qb10_6 + t144)**2
+    t512 = qw1*(t138 + t491)**2 + qw2*(t139 + t495)**2 + qw3*(t140 + t499)**2 + qw4*(t141 + t503)**2 + qw5*(t142 + t507)**2 + qw6*(t143 + t511)**2 + qw7*(t144 + qb10_6)**2
     t513 = xp.greater(t77, 0)
     t514 = xp.where(t513 & (xp.less(t478, 1) | xp.less(t512, t487)), xp.asarray(1, dtype=dtype), 0)
     t515 = xp.where(t513, 1, t478)
@@ -4574,31 +4574,31 @@ def ik_nearest(T, q_seed, q_free, weights=(1.0,) * DOF):
     t524 = xp.where(t516, t512, t487)
     t525 = xp.where(xp.less(t78, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t526 = t78 + t525
-    t527 = t78 - t525
+    t527 = -t525 + t78
     t528 = xp.where(xp.greater_equal(t78, -3.0543261909900767) & xp.less_equal(t78, 3.0543261909900767), t78, xp.where(xp.greater_equal(t526, -3.0543261909900767) & xp.less_equal(t526, 3.0543261909900767), t526, xp.where(xp.greater_equal(t527, -3.0543261909900767) & xp.less_equal(t527, 3.0543261909900767), t527, qb11_0)))
     t529 = xp.where(xp.less(t79, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t530 = t79 + t529
-    t531 = t79 - t529
+    t531 = -t529 + t79
     t532 = xp.where(xp.greater_equal(t79, -3.822271061867582) & xp.less_equal(t79, 2.2863813201125716), t79, xp.where(xp.greater_equal(t530, -3.822271061867582) & xp.less_equal(t530, 2.2863813201125716), t530, xp.where(xp.greater_equal(t531, -3.822271061867582) & xp.less_equal(t531, 2.2863813201125716), t531, qb11_1)))
     t533 = xp.where(xp.less(t80, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t534 = t80 + t533
-    t535 = t80 - t533
+    t535 = -t533 + t80
     t536 = xp.where(xp.greater_equal(t80, -3.0543261909900767) & xp.less_equal(t80, 3.0543261909900767), t80, xp.where(xp.greater_equal(t534, -3.0543261909900767) & xp.less_equal(t534, 3.0543261909900767), t534, xp.where(xp.greater_equal(t535, -3.0543261909900767) & xp.less_equal(t535, 3.0543261909900767), t535, qb11_2)))
     t537 = xp.where(xp.less(t81, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t538 = t81 + t537
-    t539 = t81 - t537
+    t539 = -t537 + t81
     t540 = xp.where(xp.greater_equal(t81, -3.0543261909900767) & xp.less_equal(t81, 3.0543261909900767), t81, xp.where(xp.greater_equal(t538, -3.0543261909900767) & xp.less_equal(t538, 3.0543261909900767), t538, xp.where(xp.greater_equal(t539, -3.0543261909900767) & xp.less_equal(t539, 3.0543261909900767), t539, qb11_3)))
     t541 = xp.where(xp.less(t82, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t542 = t82 + t541
-    t543 = t82 - t541
+    t543 = -t541 + t82
     t544 = xp.where(xp.greater_equal(t82, -2.9670597283903604) & xp.less_equal(t82, 2.9670597283903604), t82, xp.where(xp.greater_equal(t542, -2.9670597283903604) & xp.less_equal(t542, 2.9670597283903604), t542, xp.where(xp.greater_equal(t543, -2.9670597283903604) & xp.less_equal(t543, 2.9670597283903604), t543, qb11_4)))
     t545 = xp.where(xp.less(t83, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t546 = t83 + t545
-    t547 = t83 - t545
+    t547 = -t545 + t83
     t548 = xp.where(xp.greater_equal(t83, -2.9670597283903604) & xp.less_equal(t83, 2.9670597283903604), t83, xp.where(xp.greater_equal(t546, -2.9670597283903604) & xp.less_equal(t546, 2.9670597283903604), t546, xp.where(xp.greater_equal(t547, -2.9670597283903604) & xp.less_equal(t547, 2.9670597283903604), t547, qb11_5)))
-    t549 = qw1*(t528 + t138)**2 + qw2*(t532 + t139)**2 + qw3*(t536 + t140)**2 + qw4*(t540 + t141)**2 + qw5*(t544 + t142)**2 + qw6*(t548 + t143)**2 + qw7*(qb11_6 + t144)**2
+    t549 = qw1*(t138 + t528)**2 + qw2*(t139 + t532)**2 + qw3*(t140 + t536)**2 + qw4*(t141 + t540)**2 + qw5*(t142 + t544)**2 + qw6*(t143 + t548)**2 + qw7*(t144 + qb11_6)**2
     t550 = xp.greater(t84, 0)
-    t551 = xp.where(t550 & (xp.less(t515, 1) | xp.less(t549, t524)), xp.asarray(1, dtype=dtype), 0)
+    t551 = xp.where(t550 & (xp.less(t549, t524) | xp.less(t515, 1)), xp.asarray(1, dtype=dtype), 0)
     t552 = xp.where(t550, 1, t515)
     t553 = xp.greater(t551, 0)
     t554 = xp.where(t553, t528, t517)
@@ -4611,29 +4611,29 @@ def ik_nearest(T, q_seed, q_free, weights=(1.0,) * DOF):
     t561 = xp.where(t553, t549, t524)
     t562 = xp.where(xp.less(t85, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t563 = t85 + t562
-    t564 = t85 - t562
+    t564 = -t562 + t85
     t565 = xp.where(xp.greater_equal(t85, -3.0543261909900767) & xp.less_equal(t85, 3.0543261909900767), t85, xp.where(xp.greater_equal(t563, -3.0543261909900767) & xp.less_equal(t563, 3.0543261909900767), t563, xp.where(xp.greater_equal(t564, -3.0543261909900767) & xp.less_equal(t564, 3.0543261909900767), t564, qb12_0)))
     t566 = xp.where(xp.less(t86, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t567 = t86 + t566
-    t568 = t86 - t566
+    t568 = -t566 + t86
     t569 = xp.where(xp.greater_equal(t86, -3.822271061867582) & xp.less_equal(t86, 2.2863813201125716), t86, xp.where(xp.greater_equal(t567, -3.822271061867582) & xp.less_equal(t567, 2.2863813201125716), t567, xp.where(xp.greater_equal(t568, -3.822271061867582) & xp.less_equal(t568, 2.2863813201125716), t568, qb12_1)))
     t570 = xp.where(xp.less(t87, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t571 = t87 + t570
-    t572 = t87 - t570
+    t572 = -t570 + t87
     t573 = xp.where(xp.greater_equal(t87, -3.0543261909900767) & xp.less_equal(t87, 3.0543261909900767), t87, xp.where(xp.greater_equal(t571, -3.0543261909900767) & xp.less_equal(t571, 3.0543261909900767), t571, xp.where(xp.greater_equal(t572, -3.0543261909900767) & xp.less_equal(t572, 3.0543261909900767), t572, qb12_2)))
     t574 = xp.where(xp.less(t88, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t575 = t88 + t574
-    t576 = t88 - t574
+    t576 = -t574 + t88
     t577 = xp.where(xp.greater_equal(t88, -3.0543261909900767) & xp.less_equal(t88, 3.0543261909900767), t88, xp.where(xp.greater_equal(t575, -3.0543261909900767) & xp.less_equal(t575, 3.0543261909900767), t575, xp.where(xp.greater_equal(t576, -3.0543261909900767) & xp.less_equal(t576, 3.0543261909900767), t576, qb12_3)))
     t578 = xp.where(xp.less(t89, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t579 = t89 + t578
-    t580 = t89 - t578
+    t580 = -t578 + t89
     t581 = xp.where(xp.greater_equal(t89, -2.9670597283903604) & xp.less_equal(t89, 2.9670597283903604), t89, xp.where(xp.greater_equal(t579, -2.9670597283903604) & xp.less_equal(t579, 2.9670597283903604), t579, xp.where(xp.greater_equal(t580, -2.9670597283903604) & xp.less_equal(t580, 2.9670597283903604), t580, qb12_4)))
     t582 = xp.where(xp.less(t90, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t583 = t90 + t582
-    t584 = t90 - t582
+    t584 = -t582 + t90
     t585 = xp.where(xp.greater_equal(t90, -2.9670597283903604) & xp.less_equal(t90, 2.9670597283903604), t90, xp.where(xp.greater_equal(t583, -2.9670597283903604) & xp.less_equal(t583, 2.9670597283903604), t583, xp.where(xp.greater_equal(t584, -2.9670597283903604) & xp.less_equal(t584, 2.9670597283903604), t584, qb12_5)))
-    t586 = qw1*(t565 + t138)**2 + qw2*(t569 + t139)**2 + qw3*(t573 + t140)**2 + qw4*(t577 + t141)**2 + qw5*(t581 + t142)**2 + qw6*(t585 + t143)**2 + qw7*(qb12_6 + t144)**2
+    t586 = qw1*(t138 + t565)**2 + qw2*(t139 + t569)**2 + qw3*(t140 + t573)**2 + qw4*(t141 + t577)**2 + qw5*(t142 + t581)**2 + qw6*(t143 + t585)**2 + qw7*(t144 + qb12_6)**2
     t587 = xp.greater(t91, 0)
     t588 = xp.where(t587 & (xp.less(t552, 1) | xp.less(t586, t561)), xp.asarray(1, dtype=dtype), 0)
     t589 = xp.where(t587, 1, t552)
@@ -4648,29 +4648,29 @@ def ik_nearest(T, q_seed, q_free, weights=(1.0,) * DOF):
     t598 = xp.where(t590, t586, t561)
     t599 = xp.where(xp.less(t92, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t600 = t92 + t599
-    t601 = t92 - t599
+    t601 = -t599 + t92
     t602 = xp.where(xp.greater_equal(t92, -3.0543261909900767) & xp.less_equal(t92, 3.0543261909900767), t92, xp.where(xp.greater_equal(t600, -3.0543261909900767) & xp.less_equal(t600, 3.0543261909900767), t600, xp.where(xp.greater_equal(t601, -3.0543261909900767) & xp.less_equal(t601, 3.0543261909900767), t601, qb13_0)))
     t603 = xp.where(xp.less(t93, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t604 = t93 + t603
-    t605 = t93 - t603
+    t605 = -t603 + t93
     t606 = xp.where(xp.greater_equal(t93, -3.822271061867582) & xp.less_equal(t93, 2.2863813201125716), t93, xp.where(xp.greater_equal(t604, -3.822271061867582) & xp.less_equal(t604, 2.2863813201125716), t604, xp.where(xp.greater_equal(t605, -3.822271061867582) & xp.less_equal(t605, 2.2863813201125716), t605, qb13_1)))
     t607 = xp.where(xp.less(t94, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t608 = t94 + t607
-    t609 = t94 - t607
+    t609 = -t607 + t94
     t610 = xp.where(xp.greater_equal(t94, -3.0543261909900767) & xp.less_equal(t94, 3.0543261909900767), t94, xp.where(xp.greater_equal(t608, -3.0543261909900767) & xp.less_equal(t608, 3.0543261909900767), t608, xp.where(xp.greater_equal(t609, -3.0543261909900767) & xp.less_equal(t609, 3.0543261909900767), t609, qb13_2)))
     t611 = xp.where(xp.less(t95, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t612 = t95 + t611
-    t613 = t95 - t611
+    t613 = -t611 + t95
     t614 = xp.where(xp.greater_equal(t95, -3.0543261909900767) & xp.less_equal(t95, 3.0543261909900767), t95, xp.where(xp.greater_equal(t612, -3.0543261909900767) & xp.less_equal(t612, 3.0543261909900767), t612, xp.where(xp.greater_equal(t613, -3.0543261909900767) & xp.less_equal(t613, 3.0543261909900767), t613, qb13_3)))
     t615 = xp.where(xp.less(t96, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t616 = t96 + t615
-    t617 = t96 - t615
+    t617 = -t615 + t96
     t618 = xp.where(xp.greater_equal(t96, -2.9670597283903604) & xp.less_equal(t96, 2.9670597283903604), t96, xp.where(xp.greater_equal(t616, -2.9670597283903604) & xp.less_equal(t616, 2.9670597283903604), t616, xp.where(xp.greater_equal(t617, -2.9670597283903604) & xp.less_equal(t617, 2.9670597283903604), t617, qb13_4)))
     t619 = xp.where(xp.less(t97, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t620 = t97 + t619
-    t621 = t97 - t619
+    t621 = -t619 + t97
     t622 = xp.where(xp.greater_equal(t97, -2.9670597283903604) & xp.less_equal(t97, 2.9670597283903604), t97, xp.where(xp.greater_equal(t620, -2.9670597283903604) & xp.less_equal(t620, 2.9670597283903604), t620, xp.where(xp.greater_equal(t621, -2.9670597283903604) & xp.less_equal(t621, 2.9670597283903604), t621, qb13_5)))
-    t623 = qw1*(t602 + t138)**2 + qw2*(t606 + t139)**2 + qw3*(t610 + t140)**2 + qw4*(t614 + t141)**2 + qw5*(t618 + t142)**2 + qw6*(t622 + t143)**2 + qw7*(qb13_6 + t144)**2
+    t623 = qw1*(t138 + t602)**2 + qw2*(t139 + t606)**2 + qw3*(t140 + t610)**2 + qw4*(t141 + t614)**2 + qw5*(t142 + t618)**2 + qw6*(t143 + t622)**2 + qw7*(t144 + qb13_6)**2
     t624 = xp.greater(t98, 0)
     t625 = xp.where(t624 & (xp.less(t589, 1) | xp.less(t623, t598)), xp.asarray(1, dtype=dtype), 0)
     t626 = xp.where(t624, 1, t589)
@@ -4685,29 +4685,29 @@ def ik_nearest(T, q_seed, q_free, weights=(1.0,) * DOF):
     t635 = xp.where(t627, t623, t598)
     t636 = xp.where(xp.less(t99, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t637 = t99 + t636
-    t638 = t99 - t636
+    t638 = -t636 + t99
     t639 = xp.where(xp.greater_equal(t99, -3.0543261909900767) & xp.less_equal(t99, 3.0543261909900767), t99, xp.where(xp.greater_equal(t637, -3.0543261909900767) & xp.less_equal(t637, 3.0543261909900767), t637, xp.where(xp.greater_equal(t638, -3.0543261909900767) & xp.less_equal(t638, 3.0543261909900767), t638, qb14_0)))
     t640 = xp.where(xp.less(t100, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t641 = t100 + t640
-    t642 = t100 - t640
+    t642 = -t640 + t100
     t643 = xp.where(xp.greater_equal(t100, -3.822271061867582) & xp.less_equal(t100, 2.2863813201125716), t100, xp.where(xp.greater_equal(t641, -3.822271061867582) & xp.less_equal(t641, 2.2863813201125716), t641, xp.where(xp.greater_equal(t642, -3.822271061867582) & xp.less_equal(t642, 2.2863813201125716), t642, qb14_1)))
     t644 = xp.where(xp.less(t101, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t645 = t101 + t644
-    t646 = t101 - t644
+    t646 = -t644 + t101
     t647 = xp.where(xp.greater_equal(t101, -3.0543261909900767) & xp.less_equal(t101, 3.0543261909900767), t101, xp.where(xp.greater_equal(t645, -3.0543261909900767) & xp.less_equal(t645, 3.0543261909900767), t645, xp.where(xp.greater_equal(t646, -3.0543261909900767) & xp.less_equal(t646, 3.0543261909900767), t646, qb14_2)))
     t648 = xp.where(xp.less(t102, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t649 = t102 + t648
-    t650 = t102 - t648
+    t650 = -t648 + t102
     t651 = xp.where(xp.greater_equal(t102, -3.0543261909900767) & xp.less_equal(t102, 3.0543261909900767), t102, xp.where(xp.greater_equal(t649, -3.0543261909900767) & xp.less_equal(t649, 3.0543261909900767), t649, xp.where(xp.greater_equal(t650, -3.0543261909900767) & xp.less_equal(t650, 3.0543261909900767), t650, qb14_3)))
     t652 = xp.where(xp.less(t103, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t653 = t103 + t652
-    t654 = t103 - t652
+    t654 = -t652 + t103
     t655 = xp.where(xp.greater_equal(t103, -2.9670597283903604) & xp.less_equal(t103, 2.9670597283903604), t103, xp.where(xp.greater_equal(t653, -2.9670597283903604) & xp.less_equal(t653, 2.9670597283903604), t653, xp.where(xp.greater_equal(t654, -2.9670597283903604) & xp.less_equal(t654, 2.9670597283903604), t654, qb14_4)))
     t656 = xp.where(xp.less(t104, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t657 = t104 + t656
-    t658 = t104 - t656
+    t658 = -t656 + t104
     t659 = xp.where(xp.greater_equal(t104, -2.9670597283903604) & xp.less_equal(t104, 2.9670597283903604), t104, xp.where(xp.greater_equal(t657, -2.9670597283903604) & xp.less_equal(t657, 2.9670597283903604), t657, xp.where(xp.greater_equal(t658, -2.9670597283903604) & xp.less_equal(t658, 2.9670597283903604), t658, qb14_5)))
-    t660 = qw1*(t639 + t138)**2 + qw2*(t643 + t139)**2 + qw3*(t647 + t140)**2 + qw4*(t651 + t141)**2 + qw5*(t655 + t142)**2 + qw6*(t659 + t143)**2 + qw7*(qb14_6 + t144)**2
+    t660 = qw1*(t138 + t639)**2 + qw2*(t139 + t643)**2 + qw3*(t140 + t647)**2 + qw4*(t141 + t651)**2 + qw5*(t142 + t655)**2 + qw6*(t143 + t659)**2 + qw7*(t144 + qb14_6)**2
     t661 = xp.greater(t105, 0)
     t662 = xp.where(t661 & (xp.less(t626, 1) | xp.less(t660, t635)), xp.asarray(1, dtype=dtype), 0)
     t663 = xp.where(t661, 1, t626)
@@ -4722,29 +4722,29 @@ def ik_nearest(T, q_seed, q_free, weights=(1.0,) * DOF):
     t672 = xp.where(t664, t660, t635)
     t673 = xp.where(xp.less(t106, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t674 = t106 + t673
-    t675 = t106 - t673
+    t675 = -t673 + t106
     t676 = xp.where(xp.greater_equal(t106, -3.0543261909900767) & xp.less_equal(t106, 3.0543261909900767), t106, xp.where(xp.greater_equal(t674, -3.0543261909900767) & xp.less_equal(t674, 3.0543261909900767), t674, xp.where(xp.greater_equal(t675, -3.0543261909900767) & xp.less_equal(t675, 3.0543261909900767), t675, qb15_0)))
     t677 = xp.where(xp.less(t107, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t678 = t107 + t677
-    t679 = t107 - t677
+    t679 = -t677 + t107
     t680 = xp.where(xp.greater_equal(t107, -3.822271061867582) & xp.less_equal(t107, 2.2863813201125716), t107, xp.where(xp.greater_equal(t678, -3.822271061867582) & xp.less_equal(t678, 2.2863813201125716), t678, xp.where(xp.greater_equal(t679, -3.822271061867582) & xp.less_equal(t679, 2.2863813201125716), t679, qb15_1)))
     t681 = xp.where(xp.less(t108, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t682 = t108 + t681
-    t683 = t108 - t681
+    t683 = -t681 + t108
     t684 = xp.where(xp.greater_equal(t108, -3.0543261909900767) & xp.less_equal(t108, 3.0543261909900767), t108, xp.where(xp.greater_equal(t682, -3.0543261909900767) & xp.less_equal(t682, 3.0543261909900767), t682, xp.where(xp.greater_equal(t683, -3.0543261909900767) & xp.less_equal(t683, 3.0543261909900767), t683, qb15_2)))
     t685 = xp.where(xp.less(t109, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t686 = t109 + t685
-    t687 = t109 - t685
+    t687 = -t685 + t109
     t688 = xp.where(xp.greater_equal(t109, -3.0543261909900767) & xp.less_equal(t109, 3.0543261909900767), t109, xp.where(xp.greater_equal(t686, -3.0543261909900767) & xp.less_equal(t686, 3.0543261909900767), t686, xp.where(xp.greater_equal(t687, -3.0543261909900767) & xp.less_equal(t687, 3.0543261909900767), t687, qb15_3)))
     t689 = xp.where(xp.less(t110, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t690 = t110 + t689
-    t691 = t110 - t689
+    t691 = -t689 + t110
     t692 = xp.where(xp.greater_equal(t110, -2.9670597283903604) & xp.less_equal(t110, 2.9670597283903604), t110, xp.where(xp.greater_equal(t690, -2.9670597283903604) & xp.less_equal(t690, 2.9670597283903604), t690, xp.where(xp.greater_equal(t691, -2.9670597283903604) & xp.less_equal(t691, 2.9670597283903604), t691, qb15_4)))
     t693 = xp.where(xp.less(t111, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t694 = t111 + t693
-    t695 = t111 - t693
+    t695 = -t693 + t111
     t696 = xp.where(xp.greater_equal(t111, -2.9670597283903604) & xp.less_equal(t111, 2.9670597283903604), t111, xp.where(xp.greater_equal(t694, -2.9670597283903604) & xp.less_equal(t694, 2.9670597283903604), t694, xp.where(xp.greater_equal(t695, -2.9670597283903604) & xp.less_equal(t695, 2.9670597283903604), t695, qb15_5)))
-    t697 = qw1*(t676 + t138)**2 + qw2*(t680 + t139)**2 + qw3*(t684 + t140)**2 + qw4*(t688 + t141)**2 + qw5*(t692 + t142)**2 + qw6*(t696 + t143)**2 + qw7*(qb15_6 + t144)**2
+    t697 = qw1*(t138 + t676)**2 + qw2*(t139 + t680)**2 + qw3*(t140 + t684)**2 + qw4*(t141 + t688)**2 + qw5*(t142 + t692)**2 + qw6*(t143 + t696)**2 + qw7*(t144 + qb15_6)**2
     t698 = xp.greater(t112, 0)
     t699 = xp.where(t698 & (xp.less(t663, 1) | xp.less(t697, t672)), xp.asarray(1, dtype=dtype), 0)
     t700 = xp.where(t698, 1, t663)

@@ -34,7 +34,7 @@ def _fk(q):
     t1 = 0.275*s12 + 0.325*s1
     t2 = 0.387 - q3
     t3 = c12*c4 + s12*s4
-    t4 = c4*s12 - c12*s4
+    t4 = s12*c4 - c12*s4
     T = casadi.SX(4, 4)
     T[0, 0] = t3
     T[0, 1] = t4
@@ -90,7 +90,7 @@ def _fk_jacobian(q):
     s4 = casadi.sin(q4)
     t0 = 0.387 - q3
     t1 = c12*c4 + s12*s4
-    t2 = c4*s12 - c12*s4
+    t2 = s12*c4 - c12*s4
     t3 = 0.275*c12
     t4 = t3 + 0.325*c1
     t5 = 0.275*s12
@@ -131,7 +131,7 @@ def _jacobian_tool(q):
     c4 = casadi.cos(q4)
     s4 = casadi.sin(q4)
     t0 = c12*c4 + s12*s4
-    t1 = c4*s12 - c12*s4
+    t1 = s12*c4 - c12*s4
     t2 = 0.275*c12
     t3 = t2 + 0.325*c1
     t4 = 0.275*s12
@@ -166,7 +166,7 @@ def _task(q):
     t1 = 0.275*s12 + 0.325*s1
     t2 = 0.387 - q3
     t3 = c12*c4 + s12*s4
-    t4 = c4*s12 - c12*s4
+    t4 = s12*c4 - c12*s4
     mu = casadi.SX(4, 1)
     mu[0, 0] = t0
     mu[1, 0] = t1
@@ -219,14 +219,14 @@ def _fk_jacobian_dot(q, q_dot):
     s4 = casadi.sin(q4)
     t0 = 0.387 - q3
     t1 = c12*c4 + s12*s4
-    t2 = c4*s12 - c12*s4
+    t2 = s12*c4 - c12*s4
     t3 = 0.275*c12
     t4 = t3 + 0.325*c1
     t5 = 0.275*s12
     t6 = t5 + 0.325*s1
-    t7 = qd2*t5
+    t7 = t5*qd2
     t8 = t6*qd1 + t7
-    t9 = qd2*t3
+    t9 = t3*qd2
     t10 = t4*qd1 + t9
     T = casadi.SX(4, 4)
     T[0, 0] = t1
@@ -248,8 +248,8 @@ def _fk_jacobian_dot(q, q_dot):
     J[5, 1] = 1
     J[5, 3] = -1
     a = casadi.SX(6, 1)
-    a[0, 0] = -qd2*(qd1*t3 + t9) - t10*qd1
-    a[1, 0] = -qd2*(qd1*t5 + t7) - t8*qd1
+    a[0, 0] = -qd2*(t3*qd1 + t9) - qd1*t10
+    a[1, 0] = -qd2*(t5*qd1 + t7) - qd1*t8
     return [T, J, a]
 
 
@@ -269,15 +269,15 @@ def _jacobian_dot(q, q_dot):
     t1 = t0 + 0.325*c1
     t2 = 0.275*s12
     t3 = t2 + 0.325*s1
-    t4 = qd2*t2
+    t4 = t2*qd2
     t5 = t3*qd1 + t4
-    t6 = qd2*t0
+    t6 = t0*qd2
     t7 = t1*qd1 + t6
     Jd = casadi.SX(6, 4)
     Jd[0, 0] = -t7
-    Jd[0, 1] = -(qd1*t0 + t6)
+    Jd[0, 1] = -(t0*qd1 + t6)
     Jd[1, 0] = -t5
-    Jd[1, 1] = -(qd1*t2 + t4)
+    Jd[1, 1] = -(t2*qd1 + t4)
     return [Jd]
 
 
@@ -297,13 +297,13 @@ def _bias_acceleration(q, q_dot):
     t1 = t0 + 0.325*c1
     t2 = 0.275*s12
     t3 = t2 + 0.325*s1
-    t4 = qd2*t2
+    t4 = t2*qd2
     t5 = t3*qd1 + t4
-    t6 = qd2*t0
+    t6 = t0*qd2
     t7 = t1*qd1 + t6
     a = casadi.SX(6, 1)
-    a[0, 0] = -qd2*(qd1*t0 + t6) - t7*qd1
-    a[1, 0] = -qd2*(qd1*t2 + t4) - t5*qd1
+    a[0, 0] = -qd2*(t0*qd1 + t6) - qd1*t7
+    a[1, 0] = -qd2*(t2*qd1 + t4) - qd1*t5
     return [a]
 
 
@@ -323,12 +323,12 @@ def _task_jacobian_dot(q, q_dot):
     t1 = t0 + 0.325*c1
     t2 = 0.275*s12
     t3 = t2 + 0.325*s1
-    t4 = qd2*t2
+    t4 = t2*qd2
     t5 = t3*qd1 + t4
-    t6 = qd1*t2 + t4
-    t7 = qd2*t0
+    t6 = t4 + t2*qd1
+    t7 = t0*qd2
     t8 = t1*qd1 + t7
-    t9 = qd1*t0 + t7
+    t9 = t7 + t0*qd1
     Jd = casadi.SX(4, 4)
     Jd[0, 0] = -t8
     Jd[0, 1] = -t9
@@ -441,110 +441,110 @@ def _velocity_ik(q, mu_dot, damping):
     t9 = t1**2
     t10 = casadi.sqrt(1 + t9 + t6)
     t11 = t10*casadi.if_else((t3 <= 0), 1, -1)
-    t12 = casadi.if_else((t10 > 0), 1/(t10*(t10 + casadi.fabs(t3))), 0)
-    t13 = -1 + t12
-    t14 = t9 + 0.075625*c12**2
-    t15 = t14
-    t16 = casadi.sqrt(4 + t7 + t14)
-    t17 = t1 + t0
-    t18 = t17
+    t12 = t9 + 0.075625*c12**2
+    t13 = t12
+    t14 = casadi.sqrt(4 + t7 + t12)
+    t15 = t0 + t1
+    t16 = t15
+    t17 = t4**2
+    t18 = t5**2
     t19 = damping**2
-    t20 = 1 + t19
-    t21 = t20
-    t22 = 3 + t19
-    t23 = t8 + t19
-    t24 = t23**2
-    t25 = t15 + t19
-    t26 = t4**2
-    t27 = t5**2
-    t28 = casadi.sqrt(t20**2 + t22**2 + t24 + t25**2 + 2*t26 + 2*t27 + 2*t18**2)
-    t29 = casadi.sqrt(t26 + t27 + t24)
-    t30 = t29*casadi.if_else((t23 >= 0), 1, -1)
-    t31 = t30 + t23
-    t32 = casadi.if_else((t29 > 0), 1/(t29*(t29 + casadi.fabs(t23))), 0)
-    t33 = -t32*(t4*t31 + t4*t25 + t5*t18)
-    t34 = t4 + t31*t33
-    t35 = t4*t33 + t25
-    t36 = t18 + t5*t33
-    t37 = -t32*(t4*t18 + t5*t31 + t5*t22)
-    t38 = t5 + t31*t37
-    t39 = t18 + t4*t37
-    t40 = t5*t37 + t22
-    t41 = -t32*(-t31*mu_dot0 + t4*mu_dot1 + t5*mu_dot3)
-    t42 = mu_dot0 - t31*t41
-    t43 = mu_dot1 + t4*t41
-    t44 = mu_dot3 + t5*t41
-    t45 = casadi.sqrt(t35**2 + t36**2)
-    t46 = t45*casadi.if_else((t35 >= 0), 1, -1)
-    t47 = t35 + t46
-    t48 = casadi.if_else((t45 > 0), 1/(t45*(t45 + casadi.fabs(t35))), 0)
-    t49 = t48*(t36*t40 + t39*t47)
-    t50 = t39 - t47*t49
-    t51 = t40 - t36*t49
-    t52 = t48*(t36*t44 + t43*t47)
-    t53 = t43 - t47*t52
-    t54 = t44 - t36*t52
-    t55 = casadi.fabs(t21)
-    t56 = t55
-    t57 = t56*casadi.if_else((t21 >= 0), 1, -1)
-    t58 = t21 + t57
-    t59 = casadi.if_else((t56 > 0), 1/(t56*(t56 + t55)), 0)
-    t60 = mu_dot2 - t59*mu_dot2*t58**2
-    t61 = casadi.if_else((t57 != 0), -t60/t57, 0)
-    t62 = casadi.fabs(t51)
-    t63 = t62
-    t64 = t63*casadi.if_else((t51 >= 0), 1, -1)
-    t65 = t51 + t64
-    t66 = casadi.if_else((t63 > 0), 1/(t63*(t63 + t62)), 0)
-    t67 = t54 - t54*t66*t65**2
-    t68 = casadi.if_else((t64 != 0), -t67/t64, 0)
-    t69 = casadi.if_else((t46 != 0), -(t53 - t50*t68)/t46, 0)
-    t70 = casadi.if_else((t30 != 0), -(t42 + t34*t69 + t38*t68)/t30, 0)
-    t71 = t68 + t1*t69 - t70*t3
-    t72 = t68 - t70*t2 + t69*t0
-    t73 = -t3
-    t74 = t11 + t73
-    t75 = t12*(1 - t74*t2 + t1*t0)
-    t76 = t2 + t74*t75
-    t77 = t0 - t1*t75
-    t78 = 1 - t75
-    t79 = t12*(mu_dot3 + t1*mu_dot1 + t74*mu_dot0)
-    t80 = mu_dot0 - t74*t79
+    t20 = t19 + t8
+    t21 = t20**2
+    t22 = casadi.sqrt(t17 + t18 + t21)
+    t23 = t22*casadi.if_else((t20 >= 0), 1, -1)
+    t24 = t23 + t20
+    t25 = casadi.if_else((t22 > 0), 1/(t22*(t22 + casadi.fabs(t20))), 0)
+    t26 = -t25*(-mu_dot0*t24 + mu_dot1*t4 + mu_dot3*t5)
+    t27 = mu_dot0 - t24*t26
+    t28 = mu_dot1 + t4*t26
+    t29 = mu_dot3 + t5*t26
+    t30 = t19 + t13
+    t31 = -t25*(t4*t24 + t4*t30 + t5*t16)
+    t32 = t4 + t24*t31
+    t33 = t4*t31 + t30
+    t34 = t16 + t5*t31
+    t35 = casadi.sqrt(t33**2 + t34**2)
+    t36 = t35*casadi.if_else((t33 >= 0), 1, -1)
+    t37 = t33 + t36
+    t38 = casadi.if_else((t35 > 0), 1/(t35*(t35 + casadi.fabs(t33))), 0)
+    t39 = t38*(t28*t37 + t34*t29)
+    t40 = t28 - t37*t39
+    t41 = t29 - t34*t39
+    t42 = 1 + t19
+    t43 = t42
+    t44 = 3 + t19
+    t45 = casadi.sqrt(2*t17 + 2*t18 + 2*t16**2 + t21 + t30**2 + t42**2 + t44**2)
+    t46 = -t25*(t5*t24 + t4*t16 + t5*t44)
+    t47 = t5 + t24*t46
+    t48 = t16 + t4*t46
+    t49 = t5*t46 + t44
+    t50 = t38*(t48*t37 + t34*t49)
+    t51 = t48 - t37*t50
+    t52 = t49 - t34*t50
+    t53 = casadi.fabs(t43)
+    t54 = t53
+    t55 = t54*casadi.if_else((t43 >= 0), 1, -1)
+    t56 = t43 + t55
+    t57 = casadi.if_else((t54 > 0), 1/(t54*(t53 + t54)), 0)
+    t58 = mu_dot2 - mu_dot2*t56**2*t57
+    t59 = casadi.if_else((t55 != 0), -t58/t55, 0)
+    t60 = casadi.fabs(t52)
+    t61 = t60
+    t62 = t61*casadi.if_else((t52 >= 0), 1, -1)
+    t63 = t52 + t62
+    t64 = casadi.if_else((t61 > 0), 1/(t61*(t60 + t61)), 0)
+    t65 = t41 - t41*t63**2*t64
+    t66 = casadi.if_else((t62 != 0), -t65/t62, 0)
+    t67 = casadi.if_else((t36 != 0), -(t40 - t51*t66)/t36, 0)
+    t68 = casadi.if_else((t23 != 0), -(t27 + t32*t67 + t47*t66)/t23, 0)
+    t69 = t66 - t3*t68 + t1*t67
+    t70 = t66 - t2*t68 + t0*t67
+    t71 = -t3
+    t72 = t71 + t11
+    t73 = casadi.if_else((t10 > 0), 1/(t10*(t10 + casadi.fabs(t71))), 0)
+    t74 = t73*(1 - t2*t72 + t1*t0)
+    t75 = t2 + t72*t74
+    t76 = t0 - t1*t74
+    t77 = 1 - t74
+    t78 = -1 + t73
+    t79 = t73*(mu_dot3 + mu_dot0*t72 + t1*mu_dot1)
+    t80 = mu_dot0 - t72*t79
     t81 = mu_dot1 - t1*t79
-    t82 = mu_dot3 - t79
-    t83 = casadi.sqrt(t77**2 + t78**2)
-    t84 = t83*casadi.if_else((t77 >= 0), 1, -1)
-    t85 = t77 + t84
-    t86 = casadi.if_else((t83 > 0), 1/(t83*(t83 + casadi.fabs(t77))), 0)
-    t87 = t86*(t78*t82 + t81*t85)
+    t82 = -t79 + mu_dot3
+    t83 = casadi.sqrt(t76**2 + t77**2)
+    t84 = t83*casadi.if_else((t76 >= 0), 1, -1)
+    t85 = t76 + t84
+    t86 = casadi.if_else((t83 > 0), 1/(t83*(t83 + casadi.fabs(t76))), 0)
+    t87 = t86*(t81*t85 + t77*t82)
     t88 = t81 - t85*t87
-    t89 = t82 - t78*t87
-    t90 = mu_dot0 + mu_dot1 + mu_dot3 + mu_dot2 + t73 + damping + q1 + q2 + q3 + q4 - t2 + t17
-    t91 = t1*t12
-    t92 = t86*(t78*t13 + t85*t91)
+    t89 = t82 - t77*t87
+    t90 = -t2 + q1 + q2 + q3 + q4 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + damping + t15 + t71
+    t91 = t1*t73
+    t92 = t86*(t85*t91 + t77*t78)
     t93 = t91 - t85*t92
-    t94 = t13 - t78*t92
+    t94 = t78 - t77*t92
     t95 = casadi.fabs(t94)
     t96 = t95
     t97 = t96*casadi.if_else((t94 >= 0), 1, -1)
     t98 = t94 + t97
-    t99 = casadi.if_else((t96 > 0), 1/(t96*(t96 + t95)), 0)
-    t100 = t89 - t89*t99*t98**2
+    t99 = casadi.if_else((t96 > 0), 1/(t96*(t95 + t96)), 0)
+    t100 = t89 - t89*t98**2*t99
     t101 = casadi.if_else((t97 != 0), -t100/t97, 0)
-    t102 = casadi.if_else((t84 != 0), -(t88 - t101*t93)/t84, 0)
-    t103 = casadi.if_else((t11 != 0), -(t80 - (-t102*t76 + t101*t74*t12))/t11, 0)
+    t102 = casadi.if_else((t84 != 0), -(t88 - t93*t101)/t84, 0)
+    t103 = casadi.if_else((t11 != 0), -(-(-t75*t102 + t72*t73*t101) + t80)/t11, 0)
     t104 = (casadi.fabs(t90) < casadi.inf)
     t105 = (damping >= 0)
-    t106 = 1e-12*t16
-    t107 = (damping > 0)
-    t108 = 1e-12*t28
-    t109 = casadi.logic_or(casadi.logic_and((damping <= 0), casadi.logic_or(casadi.logic_or(casadi.logic_or((1 <= t106), (t10 <= t106)), (t83 <= t106)), (t96 <= t106))), casadi.logic_and(t107, casadi.logic_or(casadi.logic_or(casadi.logic_or((t29 <= t108), (t45 <= t108)), (t56 <= t108)), (t63 <= t108))))
+    t106 = (damping > 0)
+    t107 = 1e-12*t45
+    t108 = 1e-12*t14
+    t109 = casadi.logic_or(casadi.logic_and(t106, casadi.logic_or(casadi.logic_or(casadi.logic_or((t22 <= t107), (t35 <= t107)), (t54 <= t107)), (t61 <= t107))), casadi.logic_and((damping <= 0), casadi.logic_or(casadi.logic_or(casadi.logic_or((t10 <= t108), (t83 <= t108)), (1 <= t108)), (t96 <= t108))))
     t110 = casadi.logic_and(casadi.logic_and(t104, t105), casadi.logic_not(t109))
     q_dot = casadi.SX(4, 1)
-    q_dot[0, 0] = casadi.if_else(t110, casadi.if_else(t107, t71, t103), 0)
-    q_dot[1, 0] = casadi.if_else(t110, casadi.if_else(t107, t72, t102), 0)
-    q_dot[2, 0] = casadi.if_else(t110, casadi.if_else(t107, -t61, -mu_dot2), 0)
-    q_dot[3, 0] = casadi.if_else(t110, casadi.if_else(t107, -t68, t101), 0)
+    q_dot[0, 0] = casadi.if_else(t110, casadi.if_else(t106, t69, t103), 0)
+    q_dot[1, 0] = casadi.if_else(t110, casadi.if_else(t106, t70, t102), 0)
+    q_dot[2, 0] = casadi.if_else(t110, casadi.if_else(t106, -t59, -mu_dot2), 0)
+    q_dot[3, 0] = casadi.if_else(t110, casadi.if_else(t106, -t66, t101), 0)
     status = casadi.SX(1, 1)
     status[0, 0] = casadi.if_else(casadi.logic_not(casadi.logic_and(t104, t105)), 2, casadi.if_else(t109, 1, 0))
     return [q_dot, status]
@@ -574,73 +574,73 @@ def _ik_numeric_step(target, q, damping):
     s4 = casadi.sin(q4)
     t0 = 0.387 - q3
     t1 = c12*c4 + s12*s4
-    t2 = c4*s12 - c12*s4
-    t3 = mu2 - t0
+    t2 = s12*c4 - c12*s4
+    t3 = -t0 + mu2
     t4 = 1 + damping
-    t5 = mu0 + mu1 + mu2 + mu3 + qs1 + qs2 + qs3 + qs4
+    t5 = qs1 + qs2 + qs3 + qs4 + mu0 + mu1 + mu2 + mu3
     t6 = 0.275*c12
     t7 = t6 + 0.325*c1
     t8 = t7**2 + 0.075625*c12**2
-    t9 = t7 + t6
-    t10 = mu0 - t7
+    t9 = t6 + t7
+    t10 = -t7 + mu0
     t11 = 0.275*s12
     t12 = t11 + 0.325*s1
     t13 = t12**2 + 0.075625*s12**2
     t14 = t7*t12 + 0.075625*c12*s12
     t15 = t12 + t11
-    t16 = mu1 - t12
+    t16 = -t12 + mu1
     t17 = -mu3 + casadi.atan2(t2, t1)
-    t18 = 6.283185307179586*casadi.ceil(-0.15915494309189535*(3.141592653589793 + t17)) + t17
+    t18 = t17 + 6.283185307179586*casadi.ceil(-0.15915494309189535*(3.141592653589793 + t17))
     t19 = t10**2 + t16**2 + t3**2 + t18**2
-    t20 = t13 + damping
+    t20 = damping + t13
     t21 = casadi.sqrt(t14**2 + t15**2 + t20**2)
     t22 = t21*casadi.if_else((t20 >= 0), 1, -1)
-    t23 = t22 + t20
+    t23 = t20 + t22
     t24 = casadi.if_else((t21 > 0), 1/(t21*(t21 + casadi.fabs(t20))), 0)
-    t25 = t24*(t10*t23 + t18*t15 - t16*t14)
+    t25 = t24*(t10*t23 - t14*t16 + t15*t18)
     t26 = t10 - t23*t25
-    t27 = t16 + t25*t14
-    t28 = -t18 + t25*t15
-    t29 = t8 + damping
-    t30 = -t24*(t23*t14 + t14*t29 + t15*t9)
+    t27 = t16 + t14*t25
+    t28 = -t18 + t15*t25
+    t29 = damping + t8
+    t30 = -t24*(t15*t9 + t14*t23 + t14*t29)
     t31 = t14 + t23*t30
-    t32 = t30*t14 + t29
-    t33 = t9 + t30*t15
+    t32 = t29 + t14*t30
+    t33 = t9 + t15*t30
     t34 = casadi.sqrt(t32**2 + t33**2)
     t35 = t34*casadi.if_else((t32 >= 0), 1, -1)
     t36 = t32 + t35
     t37 = casadi.if_else((t34 > 0), 1/(t34*(t34 + casadi.fabs(t32))), 0)
-    t38 = t37*(t33*t28 + t27*t36)
+    t38 = t37*(t27*t36 + t33*t28)
     t39 = t27 - t36*t38
     t40 = t28 - t33*t38
     t41 = 3 + damping
-    t42 = -t24*(t23*t15 + t14*t9 + t15*t41)
+    t42 = -t24*(t14*t9 + t15*t23 + t15*t41)
     t43 = t15 + t23*t42
-    t44 = t9 + t42*t14
-    t45 = t42*t15 + t41
-    t46 = t37*(t33*t45 + t44*t36)
+    t44 = t9 + t14*t42
+    t45 = t41 + t15*t42
+    t46 = t37*(t44*t36 + t33*t45)
     t47 = t44 - t36*t46
     t48 = t45 - t33*t46
     t49 = casadi.fabs(t4)
     t50 = t49
     t51 = t50*casadi.if_else((t4 >= 0), 1, -1)
     t52 = t4 + t51
-    t53 = casadi.if_else((t50 > 0), 1/(t50*(t50 + t49)), 0)
-    t54 = t3 - t3*t53*t52**2
+    t53 = casadi.if_else((t50 > 0), 1/(t50*(t49 + t50)), 0)
+    t54 = t3 - t3*t52**2*t53
     t55 = casadi.if_else((t51 != 0), -t54/t51, 0)
-    t56 = q3 - t55
+    t56 = -t55 + q3
     t57 = casadi.fabs(t48)
     t58 = t57
     t59 = t58*casadi.if_else((t48 >= 0), 1, -1)
     t60 = t48 + t59
-    t61 = casadi.if_else((t58 > 0), 1/(t58*(t58 + t57)), 0)
-    t62 = t40 - t40*t61*t60**2
+    t61 = casadi.if_else((t58 > 0), 1/(t58*(t57 + t58)), 0)
+    t62 = t40 - t40*t60**2*t61
     t63 = casadi.if_else((t59 != 0), -t62/t59, 0)
     t64 = casadi.if_else((t35 != 0), -(t39 - t47*t63)/t35, 0)
     t65 = casadi.if_else((t22 != 0), -(t26 + t31*t64 + t43*t63)/t22, 0)
-    t66 = t63 + q1 + t64*t7 - t65*t12
-    t67 = t63 + q2 - t65*t11 + t64*t6
-    t68 = q4 - t63
+    t66 = q1 + t63 - t12*t65 + t7*t64
+    t67 = q2 + t63 - t11*t65 + t6*t64
+    t68 = -t63 + q4
     q_start = casadi.SX(4, 1)
     q_start[0, 0] = q1
     q_start[1, 0] = q2
@@ -657,7 +657,7 @@ def _ik_numeric_step(target, q, damping):
 
 
 def _ik_branches(mu):
-    """Every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits: 188 operations."""
+    """Every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits: 186 operations."""
     mu0 = mu[0]
     mu1 = mu[1]
     mu2 = mu[2]
@@ -674,42 +674,42 @@ def _ik_branches(mu):
     t9 = casadi.atan2(t6, t8)
     t10 = 3.141592653589793 - t9
     t11 = 0.325 - 0.275*t8
-    t12 = 0.149769 + t11**2 + 0.075625*t6**2
-    t13 = t10 - 6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t10))
-    t14 = t13 - 6.283185307179586*casadi.floor(0.15915494309189535*(1.53588974175501 + t13))
+    t12 = 0.149769 + 0.075625*t6**2 + t11**2
+    t13 = -6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t10)) + t10
+    t14 = -6.283185307179586*casadi.floor(0.15915494309189535*(1.53588974175501 + t13)) + t13
     t15 = 3.141592653589793 + t9
-    t16 = -1.0*t8
-    t17 = -1.0*t6
+    t16 = -t8
+    t17 = -t6
     t18 = 0.325 + 0.275*t16
-    t19 = 0.149769 + t18**2 + 0.075625*t17**2
-    t20 = t15 - 6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t15))
-    t21 = t20 - 6.283185307179586*casadi.floor(0.15915494309189535*(1.53588974175501 + t20))
+    t19 = 0.149769 + 0.075625*t17**2 + t18**2
+    t20 = -6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t15)) + t15
+    t21 = -6.283185307179586*casadi.floor(0.15915494309189535*(1.53588974175501 + t20)) + t20
     t22 = 0.275*t17
-    t23 = 0.149769 + t18*mu0 + mu1*t22
+    t23 = 0.149769 + mu0*t18 + t22*mu1
     t24 = -0.149769 + t23
-    t25 = t18*mu1 - mu0*t22
+    t25 = mu1*t18 - t22*mu0
     t26 = t24**2 + t25**2
     t27 = 0.275*t6
-    t28 = 0.149769 + t11*mu0 + mu1*t27
+    t28 = 0.149769 + mu0*t11 + t27*mu1
     t29 = -0.149769 + t28
-    t30 = t11*mu1 - mu0*t27
+    t30 = mu1*t11 - t27*mu0
     t31 = t29**2 + t30**2
     t32 = 1e-24*t0
-    t33 = casadi.if_else((t26 <= t19*t32), 0, casadi.atan2(t25, t24))
+    t33 = casadi.if_else((t26 <= t32*t19), 0, casadi.atan2(t25, t24))
     t34 = t33
-    t35 = t34 - 6.283185307179586*casadi.floor(0.15915494309189535*(0.8726646259971648 + t34))
+    t35 = -6.283185307179586*casadi.floor(0.15915494309189535*(0.8726646259971648 + t34)) + t34
     t36 = -mu3
-    t37 = -(t36 + t15 + t33)
+    t37 = -(t15 + t33 + t36)
     t38 = t37 + 6.283185307179586*casadi.ceil(-0.15915494309189535*(3.141592653589793 + t37))
     t39 = -t38
-    t40 = t38 + 6.283185307179586*casadi.floor(0.15915494309189535*(6.283185307179586 + t39))
-    t41 = casadi.if_else((t31 <= t12*t32), 0, casadi.atan2(t30, t29))
+    t40 = 6.283185307179586*casadi.floor(0.15915494309189535*(6.283185307179586 + t39)) + t38
+    t41 = casadi.if_else((t31 <= t32*t12), 0, casadi.atan2(t30, t29))
     t42 = t41
-    t43 = t42 - 6.283185307179586*casadi.floor(0.15915494309189535*(0.8726646259971648 + t42))
-    t44 = -(t36 + t10 + t41)
+    t43 = -6.283185307179586*casadi.floor(0.15915494309189535*(0.8726646259971648 + t42)) + t42
+    t44 = -(t10 + t41 + t36)
     t45 = t44 + 6.283185307179586*casadi.ceil(-0.15915494309189535*(3.141592653589793 + t44))
     t46 = -t45
-    t47 = t45 + 6.283185307179586*casadi.floor(0.15915494309189535*(6.283185307179586 + t46))
+    t47 = 6.283185307179586*casadi.floor(0.15915494309189535*(6.283185307179586 + t46)) + t45
     t48 = (t35 <= 0.8726646259971648)
     t49 = casadi.logic_and((t34 >= -0.8726646259971648), (t34 <= 0.8726646259971648))
     t50 = (t21 <= 1.53588974175501)
@@ -773,33 +773,33 @@ def _ik_nearest(mu, q_seed, weights):
     vb1 = branches_valid[1]
     lb0 = branches_in_limits[0]
     lb1 = branches_in_limits[1]
-    t0 = qb0_0 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn1 - qb0_0))
-    t1 = qb0_1 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn2 - qb0_1))
-    t2 = qb0_3 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn4 - qb0_3))
+    t0 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb0_0 + qn1)) + qb0_0
+    t1 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb0_1 + qn2)) + qb0_1
+    t2 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb0_3 + qn4)) + qb0_3
     t3 = casadi.if_else(casadi.logic_and(lb0, vb0), 1, 0)
     t4 = casadi.if_else((t3 > 0), 1, 0)
-    t5 = qb1_0 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn1 - qb1_0))
-    t6 = qb1_1 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn2 - qb1_1))
-    t7 = qb1_3 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(qn4 - qb1_3))
+    t5 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb1_0 + qn1)) + qb1_0
+    t6 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb1_1 + qn2)) + qb1_1
+    t7 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb1_3 + qn4)) + qb1_3
     t8 = casadi.if_else(casadi.logic_and(lb1, vb1), 1, 0)
-    t9 = mu0 + mu1 + mu2 + mu3 + qn1 + qn2 + qn3 + qn4 + qw1 + qw2 + qw3 + qw4
+    t9 = mu0 + mu1 + mu2 + mu3 + qn1 + qn2 + qn4 + qw1 + qw2 + qw3 + qn3 + qw4
     t10 = casadi.if_else((t0 < qn1), 6.283185307179586, -6.283185307179586)
     t11 = t0 + t10
-    t12 = t0 - t10
+    t12 = -t10 + t0
     t13 = casadi.if_else(casadi.logic_and((t0 >= -0.8726646259971648), (t0 <= 0.8726646259971648)), t0, casadi.if_else(casadi.logic_and((t11 >= -0.8726646259971648), (t11 <= 0.8726646259971648)), t11, casadi.if_else(casadi.logic_and((t12 >= -0.8726646259971648), (t12 <= 0.8726646259971648)), t12, qb0_0)))
     t14 = casadi.if_else((t1 < qn2), 6.283185307179586, -6.283185307179586)
     t15 = t1 + t14
-    t16 = t1 - t14
+    t16 = -t14 + t1
     t17 = casadi.if_else(casadi.logic_and((t1 >= -1.53588974175501), (t1 <= 1.53588974175501)), t1, casadi.if_else(casadi.logic_and((t15 >= -1.53588974175501), (t15 <= 1.53588974175501)), t15, casadi.if_else(casadi.logic_and((t16 >= -1.53588974175501), (t16 <= 1.53588974175501)), t16, qb0_1)))
     t18 = casadi.if_else((t2 < qn4), 6.283185307179586, -6.283185307179586)
     t19 = t2 + t18
-    t20 = t2 - t18
+    t20 = -t18 + t2
     t21 = casadi.if_else(casadi.logic_and((t2 >= -6.283185307179586), (t2 <= 6.283185307179586)), t2, casadi.if_else(casadi.logic_and((t19 >= -6.283185307179586), (t19 <= 6.283185307179586)), t19, casadi.if_else(casadi.logic_and((t20 >= -6.283185307179586), (t20 <= 6.283185307179586)), t20, qb0_3)))
     t22 = -qn1
     t23 = -qn2
     t24 = -qn3
     t25 = -qn4
-    t26 = qw1*(t13 + t22)**2 + qw2*(t17 + t23)**2 + qw3*(qb0_2 + t24)**2 + qw4*(t21 + t25)**2
+    t26 = qw1*(t22 + t13)**2 + qw2*(t23 + t17)**2 + qw3*(t24 + qb0_2)**2 + qw4*(t25 + t21)**2
     t27 = (t4 > 0)
     t28 = casadi.if_else(t27, t13, qn1)
     t29 = casadi.if_else(t27, t17, qn2)
@@ -808,17 +808,17 @@ def _ik_nearest(mu, q_seed, weights):
     t32 = casadi.if_else(t27, t26, 0)
     t33 = casadi.if_else((t5 < qn1), 6.283185307179586, -6.283185307179586)
     t34 = t5 + t33
-    t35 = t5 - t33
+    t35 = -t33 + t5
     t36 = casadi.if_else(casadi.logic_and((t5 >= -0.8726646259971648), (t5 <= 0.8726646259971648)), t5, casadi.if_else(casadi.logic_and((t34 >= -0.8726646259971648), (t34 <= 0.8726646259971648)), t34, casadi.if_else(casadi.logic_and((t35 >= -0.8726646259971648), (t35 <= 0.8726646259971648)), t35, qb1_0)))
     t37 = casadi.if_else((t6 < qn2), 6.283185307179586, -6.283185307179586)
     t38 = t6 + t37
-    t39 = t6 - t37
+    t39 = -t37 + t6
     t40 = casadi.if_else(casadi.logic_and((t6 >= -1.53588974175501), (t6 <= 1.53588974175501)), t6, casadi.if_else(casadi.logic_and((t38 >= -1.53588974175501), (t38 <= 1.53588974175501)), t38, casadi.if_else(casadi.logic_and((t39 >= -1.53588974175501), (t39 <= 1.53588974175501)), t39, qb1_1)))
     t41 = casadi.if_else((t7 < qn4), 6.283185307179586, -6.283185307179586)
     t42 = t7 + t41
-    t43 = t7 - t41
+    t43 = -t41 + t7
     t44 = casadi.if_else(casadi.logic_and((t7 >= -6.283185307179586), (t7 <= 6.283185307179586)), t7, casadi.if_else(casadi.logic_and((t42 >= -6.283185307179586), (t42 <= 6.283185307179586)), t42, casadi.if_else(casadi.logic_and((t43 >= -6.283185307179586), (t43 <= 6.283185307179586)), t43, qb1_3)))
-    t45 = qw1*(t36 + t22)**2 + qw2*(t40 + t23)**2 + qw3*(qb1_2 + t24)**2 + qw4*(t44 + t25)**2
+    t45 = qw1*(t22 + t36)**2 + qw2*(t23 + t40)**2 + qw3*(t24 + qb1_2)**2 + qw4*(t25 + t44)**2
     t46 = (t8 > 0)
     t47 = casadi.if_else(casadi.logic_and(t46, casadi.logic_or((t4 < 1), (t45 < t32))), 1, 0)
     t48 = casadi.if_else(t46, 1, t4)

@@ -88,11 +88,11 @@ def fk(q):
     s5 = trig[..., 9]
     c6 = trig[..., 10]
     s6 = trig[..., 11]
-    t0 = 0.412 + c2*q3
+    t0 = 0.412 + q3*c2
     t1 = q3*s2
     t2 = -0.1337*s1 + c1*t1
     t3 = 0.1337*c1 + s1*t1
-    t4 = c4*s1
+    t4 = s1*c4
     t5 = c1*s4
     t6 = t4 + c2*t5
     t7 = t5 + c2*t4
@@ -104,18 +104,18 @@ def fk(q):
     t13 = t6*c5 - s5*t12
     t14 = t6*s5 + c5*t12
     t15 = t10*s6 + t13*c6
-    t16 = t10*c6 - t13*s6
+    t16 = t10*c6 - s6*t13
     t17 = s1*s2
-    t18 = t11*c5 - s5*t17
-    t19 = t11*s5 + c5*t17
-    t20 = t7*s6 + t18*c6
-    t21 = t7*c6 - t18*s6
-    t22 = s4*s2
+    t18 = c5*t11 - s5*t17
+    t19 = s5*t11 + c5*t17
+    t20 = s6*t7 + c6*t18
+    t21 = c6*t7 - s6*t18
+    t22 = s2*s4
     t23 = c2*s5 + c5*t22
     t24 = -c2*c5 + s5*t22
-    t25 = c4*s2
-    t26 = t23*c6 + s6*t25
-    t27 = t23*s6 - c6*t25
+    t25 = s2*c4
+    t26 = c6*t23 + s6*t25
+    t27 = s6*t23 - c6*t25
     T = _stack(xp, [
         t15,  # 0, 0
         t16,  # 0, 1
@@ -155,7 +155,7 @@ def jacobian(q):
     t2 = -0.1337*s1 + q3*t1
     t3 = s1*s2
     t4 = 0.1337*c1 + q3*t3
-    t5 = c4*s1
+    t5 = s1*c4
     t6 = c1*s4
     t7 = t5 + c2*t6
     t8 = t6 + c2*t5
@@ -164,8 +164,8 @@ def jacobian(q):
     t11 = c1*c4
     t12 = -t10 + c2*t11
     t13 = -t11 + c2*t10
-    t14 = t13*s5 + c5*t3
-    t15 = c2*q3
+    t14 = s5*t13 + c5*t3
+    t15 = q3*c2
     J = _stack(xp, [
         -t4,  # 0, 0
         c1*t15,  # 0, 1
@@ -180,7 +180,7 @@ def jacobian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
-        -(t2*c1 + t4*s1),  # 2, 1
+        -(c1*t2 + s1*t4),  # 2, 1
         c2,  # 2, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 4
@@ -201,7 +201,7 @@ def jacobian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 2
         c2,  # 5, 3
-        -c4*s2,  # 5, 4
+        -s2*c4,  # 5, 4
         -t0,  # 5, 5
     ], (6, 6))
     return J
@@ -226,9 +226,9 @@ def fk_jacobian(q):
     t1 = -0.1337*s1 + q3*t0
     t2 = s1*s2
     t3 = 0.1337*c1 + q3*t2
-    t4 = c2*q3
+    t4 = q3*c2
     t5 = 0.412 + t4
-    t6 = c4*s1
+    t6 = s1*c4
     t7 = c1*s4
     t8 = t6 + c2*t7
     t9 = t7 + c2*t6
@@ -238,18 +238,18 @@ def fk_jacobian(q):
     t13 = c1*c4
     t14 = -t12 + c2*t13
     t15 = -t13 + c2*t12
-    t16 = t15*c5 - s5*t2
-    t17 = t15*s5 + c5*t2
+    t16 = c5*t15 - s5*t2
+    t17 = s5*t15 + c5*t2
     t18 = t14*s6 + t10*c6
-    t19 = t14*c6 - t10*s6
-    t20 = t9*s6 + t16*c6
-    t21 = t9*c6 - t16*s6
-    t22 = s4*s2
+    t19 = t14*c6 - s6*t10
+    t20 = s6*t9 + c6*t16
+    t21 = c6*t9 - s6*t16
+    t22 = s2*s4
     t23 = c2*s5 + c5*t22
     t24 = -c2*c5 + s5*t22
-    t25 = c4*s2
-    t26 = t23*c6 + s6*t25
-    t27 = t23*s6 - c6*t25
+    t25 = s2*c4
+    t26 = c6*t23 + s6*t25
+    t27 = s6*t23 - c6*t25
     t28 = -t24
     T = _stack(xp, [
         t18,  # 0, 0
@@ -283,7 +283,7 @@ def fk_jacobian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
-        -(t1*c1 + t3*s1),  # 2, 1
+        -(c1*t1 + s1*t3),  # 2, 1
         c2,  # 2, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 4
@@ -328,7 +328,7 @@ def jacobian_tool(q):
     t0 = q3*s2
     t1 = -0.1337*s1 + c1*t0
     t2 = 0.1337*c1 + s1*t0
-    t3 = c4*s1
+    t3 = s1*c4
     t4 = c1*s4
     t5 = t3 + c2*t4
     t6 = t4 + c2*t3
@@ -340,58 +340,58 @@ def jacobian_tool(q):
     t12 = t5*c5 - s5*t11
     t13 = t5*s5 + c5*t11
     t14 = t9*s6 + t12*c6
-    t15 = t9*c6 - t12*s6
+    t15 = t9*c6 - s6*t12
     t16 = s1*s2
-    t17 = t10*c5 - s5*t16
-    t18 = t10*s5 + c5*t16
-    t19 = t6*s6 + t17*c6
-    t20 = t6*c6 - t17*s6
-    t21 = s4*s2
+    t17 = c5*t10 - s5*t16
+    t18 = s5*t10 + c5*t16
+    t19 = s6*t6 + c6*t17
+    t20 = c6*t6 - s6*t17
+    t21 = s2*s4
     t22 = c2*s5 + c5*t21
     t23 = -c2*c5 + s5*t21
-    t24 = c4*s2
-    t25 = t22*c6 + s6*t24
-    t26 = t22*s6 - c6*t24
-    t27 = -(t1*c1 + t2*s1)
-    t28 = c2*q3
+    t24 = s2*c4
+    t25 = c6*t22 + s6*t24
+    t26 = s6*t22 - c6*t24
+    t27 = -(c1*t1 + s1*t2)
+    t28 = q3*c2
     t29 = c1*t28
     t30 = s1*t28
-    t31 = -t25*c2 + t14*t11 + t19*t16
-    t32 = t26*c2 + t15*t11 + t20*t16
-    t33 = -t23*c2 + t13*t11 + t18*t16
+    t31 = -c2*t25 + t14*t11 + t19*t16
+    t32 = c2*t26 + t15*t11 + t20*t16
+    t33 = -c2*t23 + t13*t11 + t18*t16
     J = _stack(xp, [
-        t19*t1 - t14*t2,  # 0, 0
+        t1*t19 - t14*t2,  # 0, 0
         -t25*t27 + t14*t29 + t19*t30,  # 0, 1
         t31,  # 0, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5
-        t20*t1 - t15*t2,  # 1, 0
+        t1*t20 - t15*t2,  # 1, 0
         t26*t27 + t15*t29 + t20*t30,  # 1, 1
         t32,  # 1, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5
-        t18*t1 - t13*t2,  # 2, 0
+        t1*t18 - t13*t2,  # 2, 0
         -t23*t27 + t13*t29 + t18*t30,  # 2, 1
         t33,  # 2, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 5
         -t25,  # 3, 0
-        t19*c1 - t14*s1,  # 3, 1
+        c1*t19 - s1*t14,  # 3, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 2
         t31,  # 3, 3
         t9*t14 + t6*t19 + t25*t24,  # 3, 4
-        t13*t14 + t18*t19 + t23*t25,  # 3, 5
+        t14*t13 + t19*t18 + t25*t23,  # 3, 5
         t26,  # 4, 0
-        t20*c1 - t15*s1,  # 4, 1
+        c1*t20 - s1*t15,  # 4, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 2
         t32,  # 4, 3
         t9*t15 + t6*t20 - t26*t24,  # 4, 4
-        t13*t15 + t18*t20 - t23*t26,  # 4, 5
+        t15*t13 + t20*t18 - t26*t23,  # 4, 5
         -t23,  # 5, 0
-        t18*c1 - t13*s1,  # 5, 1
+        c1*t18 - s1*t13,  # 5, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 2
         t33,  # 5, 3
         t9*t13 + t6*t18 + t23*t24,  # 5, 4
@@ -415,12 +415,12 @@ def task(q):
     s5 = trig[..., 9]
     c6 = trig[..., 10]
     s6 = trig[..., 11]
-    t0 = 0.412 + c2*q3
-    t1 = c2*s5 + c5*s2*s4
+    t0 = 0.412 + q3*c2
+    t1 = c2*s5 + s2*s4*c5
     t2 = q3*s2
     t3 = -0.1337*s1 + c1*t2
     t4 = 0.1337*c1 + s1*t2
-    t5 = c4*s1
+    t5 = s1*c4
     t6 = c1*s4
     t7 = t5 + c2*t6
     t8 = t6 + c2*t5
@@ -428,15 +428,15 @@ def task(q):
     t10 = c1*c4
     t11 = -t9 + c2*t10
     t12 = -t10 + c2*t9
-    t13 = s5*s2
+    t13 = s2*s5
     t14 = t7*c5 - c1*t13
-    t15 = t12*c5 - s1*t13
+    t15 = c5*t12 - s1*t13
     t16 = -c2*c5 + s4*t13
     t17 = t11*s6 + t14*c6
-    t18 = t8*s6 + t15*c6
-    t19 = c4*s2
-    t20 = t1*c6 + s6*t19
-    t21 = t1*s6 - c6*t19
+    t18 = s6*t8 + c6*t15
+    t19 = s2*c4
+    t20 = c6*t1 + s6*t19
+    t21 = s6*t1 - c6*t19
     mu = _stack(xp, [
         t3,  # 0
         t4,  # 1
@@ -467,7 +467,7 @@ def task_jacobian(q):
     t1 = -0.1337*s1 + q3*t0
     t2 = s1*s2
     t3 = 0.1337*c1 + q3*t2
-    t4 = c4*s1
+    t4 = s1*c4
     t5 = c1*s4
     t6 = t4 + c2*t5
     t7 = t5 + c2*t4
@@ -477,22 +477,22 @@ def task_jacobian(q):
     t11 = c1*c4
     t12 = -t10 + c2*t11
     t13 = -t11 + c2*t10
-    t14 = t13*c5 - s5*t2
-    t15 = t13*s5 + c5*t2
+    t14 = c5*t13 - s5*t2
+    t15 = s5*t13 + c5*t2
     t16 = t12*s6 + t8*c6
-    t17 = t7*s6 + t14*c6
-    t18 = s4*s2
+    t17 = s6*t7 + c6*t14
+    t18 = s2*s4
     t19 = c2*s5 + c5*t18
     t20 = -c2*c5 + s5*t18
-    t21 = c4*s2
-    t22 = t19*c6 + s6*t21
-    t23 = c2*q3
+    t21 = s2*c4
+    t22 = c6*t19 + s6*t21
+    t23 = q3*c2
     t24 = t16**2 + t17**2
     t25 = 1/t24
-    t26 = t25*(t17*c1 - t16*s1)
+    t26 = (c1*t17 - s1*t16)*t25
     t27 = t25*(t16*t0 + t17*t2)
     t28 = t25*(t12*t16 + t7*t17)
-    t29 = t25*(t9*t16 + t15*t17)
+    t29 = t25*(t16*t9 + t17*t15)
     t30 = 1/xp.sqrt(t24)
     J = _stack(xp, [
         -t3,  # 0, 0
@@ -508,7 +508,7 @@ def task_jacobian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
-        -(t1*c1 + t3*s1),  # 2, 1
+        -(c1*t1 + s1*t3),  # 2, 1
         c2,  # 2, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 4
@@ -520,11 +520,11 @@ def task_jacobian(q):
         t28,  # 3, 4
         t29,  # 3, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
-        t30*(t16*c1 + t17*s1),  # 4, 1
+        t30*(c1*t16 + s1*t17),  # 4, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 2
         t30*(t16*t2 - t17*t0),  # 4, 3
         t30*(t7*t16 - t12*t17),  # 4, 4
-        t30*(t15*t16 - t9*t17),  # 4, 5
+        t30*(t16*t15 - t9*t17),  # 4, 5
         xp.full(batch, 1, dtype=dtype, device=device),  # 5, 0
         t22*t26,  # 5, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 2
@@ -561,9 +561,9 @@ def fk_jacobian_dot(q, q_dot):
     t2 = -0.1337*s1 + q3*t1
     t3 = s1*s2
     t4 = 0.1337*c1 + q3*t3
-    t5 = c2*q3
+    t5 = q3*c2
     t6 = 0.412 + t5
-    t7 = c4*s1
+    t7 = s1*c4
     t8 = c1*s4
     t9 = t7 + c2*t8
     t10 = t8 + c2*t7
@@ -573,38 +573,38 @@ def fk_jacobian_dot(q, q_dot):
     t14 = c1*c4
     t15 = -t13 + c2*t14
     t16 = -t14 + c2*t13
-    t17 = t16*c5 - s5*t3
-    t18 = t16*s5 + c5*t3
+    t17 = c5*t16 - s5*t3
+    t18 = s5*t16 + c5*t3
     t19 = t15*s6 + t11*c6
-    t20 = t15*c6 - t11*s6
-    t21 = t10*s6 + t17*c6
-    t22 = t10*c6 - t17*s6
-    t23 = s4*s2
+    t20 = t15*c6 - s6*t11
+    t21 = s6*t10 + c6*t17
+    t22 = c6*t10 - s6*t17
+    t23 = s2*s4
     t24 = c2*s5 + c5*t23
     t25 = -c2*c5 + s5*t23
-    t26 = c4*s2
-    t27 = t24*c6 + s6*t26
-    t28 = t24*s6 - c6*t26
-    t29 = t0 - qd5*t26
-    t30 = t2*c1 + t4*s1
+    t26 = s2*c4
+    t27 = c6*t24 + s6*t26
+    t28 = s6*t24 - c6*t26
+    t29 = t0 - t26*qd5
+    t30 = c1*t2 + s1*t4
     t31 = t30
-    t32 = c2*qd3 - t31*qd2
-    t33 = qd2*s1
-    t34 = -t33 + qd4*t1
+    t32 = c2*qd3 - qd2*t31
+    t33 = s1*qd2
+    t34 = -t33 + t1*qd4
     t35 = t34 + t15*qd5
-    t36 = qd3*t3 + t5*t33
+    t36 = t3*qd3 + t5*t33
     t37 = t36 + t2*qd1
     t38 = c1*qd2
-    t39 = t38 + qd4*t3
+    t39 = t38 + t3*qd4
     t40 = t39 + t10*qd5
-    t41 = qd3*t1 + t5*t38
+    t41 = t1*qd3 + t5*t38
     t42 = t41 - t4*qd1
     t43 = -t25
     t44 = c1*t5
     t45 = s1*t5
-    t46 = c2*t38 - qd1*t3
-    t47 = qd1*t1 + c2*t33
-    t48 = qd2*s2
+    t46 = c2*t38 - t3*qd1
+    t47 = t1*qd1 + c2*t33
+    t48 = s2*qd2
     t49 = -(c1**2*t48 + s1**2*t48)
     T = _stack(xp, [
         xp.broadcast_to(t19, batch),  # 0, 0
@@ -663,11 +663,11 @@ def fk_jacobian_dot(q, q_dot):
         xp.broadcast_to(t43, batch),  # 5, 5
     ], (6, 6))
     a = _stack(xp, [
-        xp.broadcast_to(qd2*(t32*c1 - qd1*t45) + qd3*t46 - t37*qd1, batch),  # 0
-        xp.broadcast_to(t42*qd1 + qd2*(t32*s1 + qd1*t44) + qd3*t47, batch),  # 1
-        xp.broadcast_to(-qd2*(t41*c1 + t36*s1) + qd3*t49, batch),  # 2
-        xp.broadcast_to(qd4*t46 - qd5*(t10*t0 + t39*t26) - qd6*(t18*t29 + t25*t40) - qd1*t38, batch),  # 3
-        xp.broadcast_to(qd4*t47 + qd5*(t15*t0 + t34*t26) + qd6*(t12*t29 + t25*t35) - qd1*t33, batch),  # 4
+        xp.broadcast_to(qd2*(c1*t32 - t45*qd1) + qd3*t46 - qd1*t37, batch),  # 0
+        xp.broadcast_to(qd1*t42 + qd2*(s1*t32 + t44*qd1) + qd3*t47, batch),  # 1
+        xp.broadcast_to(-qd2*(c1*t41 + s1*t36) + qd3*t49, batch),  # 2
+        xp.broadcast_to(qd4*t46 - qd5*(t10*t0 + t26*t39) - qd6*(t18*t29 + t25*t40) - t38*qd1, batch),  # 3
+        xp.broadcast_to(qd4*t47 + qd5*(t15*t0 + t26*t34) + qd6*(t12*t29 + t25*t35) - t33*qd1, batch),  # 4
         xp.broadcast_to(qd4*t49 + qd5*(t10*t34 - t15*t39) + qd6*(t18*t35 - t12*t40), batch),  # 5
     ], (6,))
     return T, J, a
@@ -696,9 +696,9 @@ def jacobian_dot(q, q_dot):
     t2 = q3*s2
     t3 = -0.1337*s1 + c1*t2
     t4 = 0.1337*c1 + s1*t2
-    t5 = t3*c1 + t4*s1
-    t6 = c2*qd3 - t5*qd2
-    t7 = c4*s1
+    t5 = c1*t3 + s1*t4
+    t6 = c2*qd3 - qd2*t5
+    t7 = s1*c4
     t8 = c1*s4
     t9 = t7 + c2*t8
     t10 = t8 + c2*t7
@@ -706,47 +706,47 @@ def jacobian_dot(q, q_dot):
     t12 = c1*c4
     t13 = -t11 + c2*t12
     t14 = -t12 + c2*t11
-    t15 = c5*s2
+    t15 = s2*c5
     t16 = t9*s5 + c1*t15
-    t17 = t14*s5 + s1*t15
-    t18 = qd2*s1
-    t19 = qd4*s2
+    t17 = s5*t14 + s1*t15
+    t18 = s1*qd2
+    t19 = s2*qd4
     t20 = -t18 + c1*t19
     t21 = t20 + t13*qd5
     t22 = c1*qd2
     t23 = t22 + s1*t19
     t24 = t23 + t10*qd5
-    t25 = c4*s2
-    t26 = t1 - qd5*t25
-    t27 = qd3*s2
+    t25 = s2*c4
+    t26 = t1 - t25*qd5
+    t27 = s2*qd3
     t28 = c2*t22
     t29 = c1*t27 + q3*t28
     t30 = t29 - t4*qd1
     t31 = c2*t18
     t32 = s1*t27 + q3*t31
     t33 = t32 + t3*qd1
-    t34 = qd1*s1
-    t35 = c2*q3
+    t34 = s1*qd1
+    t35 = q3*c2
     t36 = t28 - s2*t34
     t37 = c1*qd1
     t38 = s2*t37 + t31
-    t39 = qd2*s2
+    t39 = s2*qd2
     t40 = -(c1**2*t39 + s1**2*t39)
     Jd = _stack(xp, [
         xp.broadcast_to(-t33, batch),  # 0, 0
-        xp.broadcast_to(t6*c1 - t34*t35, batch),  # 0, 1
+        xp.broadcast_to(c1*t6 - t34*t35, batch),  # 0, 1
         xp.broadcast_to(t36, batch),  # 0, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5
         xp.broadcast_to(t30, batch),  # 1, 0
-        xp.broadcast_to(t6*s1 + t37*t35, batch),  # 1, 1
+        xp.broadcast_to(s1*t6 + t35*t37, batch),  # 1, 1
         xp.broadcast_to(t38, batch),  # 1, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
-        xp.broadcast_to(-(t29*c1 + t32*s1), batch),  # 2, 1
+        xp.broadcast_to(-(c1*t29 + s1*t32), batch),  # 2, 1
         xp.broadcast_to(t40, batch),  # 2, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 4
@@ -755,13 +755,13 @@ def jacobian_dot(q, q_dot):
         xp.broadcast_to(-t37, batch),  # 3, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 2
         xp.broadcast_to(t36, batch),  # 3, 3
-        xp.broadcast_to(-(t10*t1 + t23*t25), batch),  # 3, 4
+        xp.broadcast_to(-(t10*t1 + t25*t23), batch),  # 3, 4
         xp.broadcast_to(-(t17*t26 + t0*t24), batch),  # 3, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
         xp.broadcast_to(-t34, batch),  # 4, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 2
         xp.broadcast_to(t38, batch),  # 4, 3
-        xp.broadcast_to(t13*t1 + t20*t25, batch),  # 4, 4
+        xp.broadcast_to(t13*t1 + t25*t20, batch),  # 4, 4
         xp.broadcast_to(t16*t26 + t0*t21, batch),  # 4, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 1
@@ -797,9 +797,9 @@ def bias_acceleration(q, q_dot):
     t2 = q3*s2
     t3 = -0.1337*s1 + c1*t2
     t4 = 0.1337*c1 + s1*t2
-    t5 = t3*c1 + t4*s1
-    t6 = c2*qd3 - t5*qd2
-    t7 = c4*s1
+    t5 = c1*t3 + s1*t4
+    t6 = c2*qd3 - qd2*t5
+    t7 = s1*c4
     t8 = c1*s4
     t9 = t7 + c2*t8
     t10 = t8 + c2*t7
@@ -807,37 +807,37 @@ def bias_acceleration(q, q_dot):
     t12 = c1*c4
     t13 = -t11 + c2*t12
     t14 = -t12 + c2*t11
-    t15 = c5*s2
+    t15 = s2*c5
     t16 = t9*s5 + c1*t15
-    t17 = t14*s5 + s1*t15
-    t18 = qd2*s1
-    t19 = qd4*s2
+    t17 = s5*t14 + s1*t15
+    t18 = s1*qd2
+    t19 = s2*qd4
     t20 = -t18 + c1*t19
     t21 = t20 + t13*qd5
     t22 = c1*qd2
     t23 = t22 + s1*t19
     t24 = t23 + t10*qd5
-    t25 = c4*s2
-    t26 = t1 - qd5*t25
-    t27 = qd3*s2
+    t25 = s2*c4
+    t26 = t1 - t25*qd5
+    t27 = s2*qd3
     t28 = c2*t22
     t29 = c1*t27 + q3*t28
     t30 = t29 - t4*qd1
     t31 = c2*t18
     t32 = s1*t27 + q3*t31
     t33 = t32 + t3*qd1
-    t34 = c2*qd1*q3
-    t35 = qd1*s2
+    t34 = q3*c2*qd1
+    t35 = s2*qd1
     t36 = t28 - s1*t35
     t37 = c1*t35 + t31
-    t38 = qd2*s2
+    t38 = s2*qd2
     t39 = -(c1**2*t38 + s1**2*t38)
     a = _stack(xp, [
-        xp.broadcast_to(qd2*(t6*c1 - s1*t34) + qd3*t36 - t33*qd1, batch),  # 0
-        xp.broadcast_to(t30*qd1 + qd2*(t6*s1 + c1*t34) + qd3*t37, batch),  # 1
-        xp.broadcast_to(-qd2*(t29*c1 + t32*s1) + qd3*t39, batch),  # 2
-        xp.broadcast_to(qd4*t36 - qd5*(t10*t1 + t23*t25) - qd6*(t17*t26 + t0*t24) - qd1*t22, batch),  # 3
-        xp.broadcast_to(qd4*t37 + qd5*(t13*t1 + t20*t25) + qd6*(t16*t26 + t0*t21) - qd1*t18, batch),  # 4
+        xp.broadcast_to(qd2*(c1*t6 - s1*t34) + qd3*t36 - qd1*t33, batch),  # 0
+        xp.broadcast_to(qd1*t30 + qd2*(s1*t6 + c1*t34) + qd3*t37, batch),  # 1
+        xp.broadcast_to(-qd2*(c1*t29 + s1*t32) + qd3*t39, batch),  # 2
+        xp.broadcast_to(qd4*t36 - qd5*(t10*t1 + t25*t23) - qd6*(t17*t26 + t0*t24) - t22*qd1, batch),  # 3
+        xp.broadcast_to(qd4*t37 + qd5*(t13*t1 + t25*t20) + qd6*(t16*t26 + t0*t21) - t18*qd1, batch),  # 4
         xp.broadcast_to(qd4*t39 + qd5*(t10*t20 - t13*t23) + qd6*(t17*t21 - t16*t24), batch),  # 5
     ], (6,))
     return a
@@ -868,9 +868,9 @@ def task_jacobian_dot(q, q_dot):
     t1 = -0.1337*s1 + q3*t0
     t2 = s1*s2
     t3 = 0.1337*c1 + q3*t2
-    t4 = t1*c1 + t3*s1
-    t5 = c2*qd3 - t4*qd2
-    t6 = c4*s1
+    t4 = c1*t1 + s1*t3
+    t5 = c2*qd3 - qd2*t4
+    t6 = s1*c4
     t7 = c1*s4
     t8 = t6 + c2*t7
     t9 = t7 + c2*t6
@@ -880,98 +880,98 @@ def task_jacobian_dot(q, q_dot):
     t13 = c1*c4
     t14 = -t12 + c2*t13
     t15 = -t13 + c2*t12
-    t16 = t15*c5 - s5*t2
-    t17 = t15*s5 + c5*t2
+    t16 = c5*t15 - s5*t2
+    t17 = s5*t15 + c5*t2
     t18 = t14*s6 + t10*c6
-    t19 = t9*s6 + t16*c6
+    t19 = s6*t9 + c6*t16
     t20 = t18**2 + t19**2
     t21 = xp.sqrt(t20)
-    t22 = s4*s2
+    t22 = s2*s4
     t23 = c2*s5 + c5*t22
     t24 = -c2*c5 + s5*t22
-    t25 = c4*s2
-    t26 = t23*c6 + s6*t25
-    t27 = qd2*s1
-    t28 = -t27 + qd4*t0
+    t25 = s2*c4
+    t26 = c6*t23 + s6*t25
+    t27 = s1*qd2
+    t28 = -t27 + t0*qd4
     t29 = t28
     t30 = c1*qd2
-    t31 = t30 + qd4*t2
+    t31 = t30 + t2*qd4
     t32 = t31
     t33 = t9*t29 - t14*t32
     t34 = qd1 + c2*qd4
     t35 = t34
-    t36 = t9*t35 + t32*t25
-    t37 = t14*t35 + t29*t25
+    t36 = t9*t35 + t25*t32
+    t37 = t14*t35 + t25*t29
     t38 = t14*qd5
     t39 = t29 + t38
-    t40 = t38 + t11*qd6 + t28
+    t40 = t28 + t38 + t11*qd6
     t41 = t9*qd5
     t42 = t32 + t41
     t43 = t17*t39 - t11*t42
-    t44 = t41 + t17*qd6 + t31
+    t44 = t31 + t41 + t17*qd6
     t45 = t19*t40 - t18*t44
-    t46 = -qd5*t25
+    t46 = -t25*qd5
     t47 = t35 + t46
     t48 = t17*t47 + t24*t42
     t49 = t11*t47 + t24*t39
-    t50 = t46 - t24*qd6 + t34
+    t50 = t34 + t46 - t24*qd6
     t51 = t19*t50 + t26*t44
     t52 = t18*t50 + t26*t40
     t53 = c2*t30
-    t54 = qd3*t0 + q3*t53
+    t54 = t0*qd3 + q3*t53
     t55 = t54 - t3*qd1
-    t56 = t53 - qd1*t2
+    t56 = t53 - t2*qd1
     t57 = c2*t27
-    t58 = qd3*t2 + q3*t57
+    t58 = t2*qd3 + q3*t57
     t59 = t58 + t1*qd1
-    t60 = qd1*t0 + t57
-    t61 = t54*c1 + t58*s1
-    t62 = c2*qd1*q3
-    t63 = t5*c1 - s1*t62
-    t64 = t5*s1 + c1*t62
-    t65 = qd2*s2
+    t60 = t0*qd1 + t57
+    t61 = c1*t54 + s1*t58
+    t62 = q3*c2*qd1
+    t63 = c1*t5 - s1*t62
+    t64 = s1*t5 + c1*t62
+    t65 = s2*qd2
     t66 = c1**2*t65 + s1**2*t65
-    t67 = 1/t20
-    t68 = t67*(t14*t18 + t9*t19)
-    t69 = t67*(t11*t18 + t17*t19)
-    t70 = t19*c1
-    t71 = t18*s1
-    t72 = t67*(t70 - t71)
-    t73 = t18*c1
-    t74 = t19*s1
-    t75 = t67*(s2*t73 + s2*t74)
+    t67 = c1*t19
+    t68 = s1*t18
+    t69 = 1/t20
+    t70 = (t67 - t68)*t69
+    t71 = (t14*t18 + t9*t19)*t69
+    t72 = (t18*t11 + t19*t17)*t69
+    t73 = c1*t18
+    t74 = s1*t19
+    t75 = (s2*t73 + s2*t74)*t69
     t76 = 1/t21
-    t77 = t67*t76
+    t77 = t69*t76
     t78 = (t73 + t74)*t77
-    t79 = (s2*t71 - s2*t70)*t77
+    t79 = t77*(s2*t68 - s2*t67)
     t80 = (t9*t18 - t14*t19)*t77
-    t81 = (t17*t18 - t11*t19)*t77
+    t81 = (t18*t17 - t11*t19)*t77
     t82 = -t66
-    t83 = 2*t72
-    t84 = t67*t52
+    t83 = 2*t70
+    t84 = t52*t69
     t85 = (c1 - t19*t83)*t84
-    t86 = t67*t51
+    t86 = t51*t69
     t87 = -(s1 + t18*t83)*t86
-    t88 = qd1*t67
+    t88 = qd1*t69
     t89 = t73*t88
     t90 = t74*t88
-    t91 = t18*t67
+    t91 = t18*t69
     t92 = t56*t91
-    t93 = t19*t67
+    t93 = t19*t69
     t94 = t60*t93
     t95 = 2*t75
-    t96 = (t2 - t19*t95)*t84
-    t97 = (t0 - t18*t95)*t86
+    t96 = t84*(t2 - t19*t95)
+    t97 = t86*(t0 - t18*t95)
     t98 = t37*t93
-    t99 = 2*t68
-    t100 = (t9 - t19*t99)*t84
+    t99 = 2*t71
+    t100 = t84*(t9 - t19*t99)
     t101 = t36*t91
-    t102 = (t14 - t18*t99)*t86
+    t102 = t86*(t14 - t18*t99)
     t103 = t49*t93
-    t104 = 2*t69
-    t105 = (t17 - t19*t104)*t84
+    t104 = 2*t72
+    t105 = t84*(t17 - t19*t104)
     t106 = t48*t91
-    t107 = (t11 - t18*t104)*t86
+    t107 = t86*(t11 - t18*t104)
     t108 = qd1*t76
     t109 = t18*t76
     t110 = t19*t76
@@ -1001,17 +1001,17 @@ def task_jacobian_dot(q, q_dot):
         xp.broadcast_to(t98 + t100 - t101 - t102, batch),  # 3, 4
         xp.broadcast_to(t103 + t105 - t106 - t107, batch),  # 3, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
-        xp.broadcast_to(t52*(s1*t76 - t19*t78) - t51*(c1*t76 - t18*t78) + t70*t108 - t71*t108, batch),  # 4, 1
+        xp.broadcast_to(t52*(s1*t76 - t19*t78) - t51*(c1*t76 - t18*t78) + t67*t108 - t68*t108, batch),  # 4, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 2
-        xp.broadcast_to(-t52*(t19*t79 + t76*t0) - t51*(-t18*t79 + t76*t2) + t60*t109 - t56*t110, batch),  # 4, 3
+        xp.broadcast_to(-t52*(t19*t79 + t0*t76) - t51*(-t18*t79 + t2*t76) + t60*t109 - t56*t110, batch),  # 4, 3
         xp.broadcast_to(-t52*(t14*t76 + t19*t80) - t51*(t9*t76 - t18*t80) + t37*t109 + t36*t110, batch),  # 4, 4
         xp.broadcast_to(-t52*(t11*t76 + t19*t81) - t51*(t17*t76 - t18*t81) + t49*t109 + t48*t110, batch),  # 4, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 0
-        xp.broadcast_to(-(t45*t72 - t26*t85 + t26*t87 + t26*t89 + t26*t90), batch),  # 5, 1
+        xp.broadcast_to(-(t70*t45 - t26*t85 + t26*t87 + t26*t89 + t26*t90), batch),  # 5, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 2
-        xp.broadcast_to(t82 - t45*t75 + t26*t92 + t26*t94 + t26*t96 - t26*t97, batch),  # 5, 3
-        xp.broadcast_to(t33 - t45*t68 + t26*t98 + t26*t100 - t26*t101 - t26*t102, batch),  # 5, 4
-        xp.broadcast_to(t43 - t45*t69 + t26*t103 + t26*t105 - t26*t106 - t26*t107, batch),  # 5, 5
+        xp.broadcast_to(t82 - t75*t45 + t26*t92 + t26*t94 + t26*t96 - t26*t97, batch),  # 5, 3
+        xp.broadcast_to(t33 - t71*t45 + t26*t98 + t26*t100 - t26*t101 - t26*t102, batch),  # 5, 4
+        xp.broadcast_to(t43 - t72*t45 + t26*t103 + t26*t105 - t26*t106 - t26*t107, batch),  # 5, 5
     ], (6, 6))
     return Jd
 
@@ -1034,8 +1034,8 @@ def hessian(q):
     t2 = -0.1337*s1 + q3*t1
     t3 = s1*s2
     t4 = 0.1337*c1 + q3*t3
-    t5 = t2*c1 + t4*s1
-    t6 = c4*s1
+    t5 = c1*t2 + s1*t4
+    t6 = s1*c4
     t7 = c1*s4
     t8 = t6 + c2*t7
     t9 = t7 + c2*t6
@@ -1044,18 +1044,18 @@ def hessian(q):
     t12 = c1*c4
     t13 = -t11 + c2*t12
     t14 = -t12 + c2*t11
-    t15 = t14*s5 + c5*t3
-    t16 = c2*s1
+    t15 = s5*t14 + c5*t3
+    t16 = s1*c2
     t17 = -q3*t16
     t18 = -t3
     t19 = c1*c2
     t20 = q3*t19
     t21 = c1**2
-    t22 = c2*q3
+    t22 = q3*c2
     t23 = s1**2
-    t24 = -(s2*t21 + s2*t23)
+    t24 = -(t21*s2 + t23*s2)
     t25 = s2**2
-    t26 = c4*s2
+    t26 = s2*c4
     H = _stack(xp, [
         -t2,  # 0, 0, 0
         t17,  # 0, 0, 1
@@ -1094,19 +1094,19 @@ def hessian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5, 5
         t17,  # 1, 0, 0
-        -t5*c1,  # 1, 0, 1
+        -c1*t5,  # 1, 0, 1
         t19,  # 1, 0, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 0, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 0, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 0, 5
         t20,  # 1, 1, 0
-        -t5*s1,  # 1, 1, 1
+        -s1*t5,  # 1, 1, 1
         t16,  # 1, 1, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 1, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 1, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 2, 0
-        -(t21*t22 + t23*t22),  # 1, 2, 1
+        -(t21*t22 + t22*t23),  # 1, 2, 1
         t24,  # 1, 2, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 2, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 2, 4
@@ -1116,19 +1116,19 @@ def hessian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 3, 2
         t19,  # 1, 3, 3
         -s2*t12,  # 1, 3, 4
-        -t0*c1,  # 1, 3, 5
+        -c1*t0,  # 1, 3, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 4, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 4, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 4, 2
         t16,  # 1, 4, 3
         -s2*t6,  # 1, 4, 4
-        -t0*s1,  # 1, 4, 5
+        -s1*t0,  # 1, 4, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5, 2
         t24,  # 1, 5, 3
-        -(t13*c1 + t9*s1),  # 1, 5, 4
-        -(t10*c1 + t15*s1),  # 1, 5, 5
+        -(c1*t13 + s1*t9),  # 1, 5, 4
+        -(c1*t10 + s1*t15),  # 1, 5, 5
         t18,  # 2, 0, 0
         t19,  # 2, 0, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0, 2
@@ -1187,14 +1187,14 @@ def hessian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 3, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 3, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 3, 3
-        -(t9*c2 + t25*t6),  # 3, 3, 4
-        -(t15*c2 + t0*t3),  # 3, 3, 5
+        -(c2*t9 + t6*t25),  # 3, 3, 4
+        -(c2*t15 + t0*t3),  # 3, 3, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 4, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 4, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 4, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 4, 3
-        t13*c2 + t25*t12,  # 3, 4, 4
-        t10*c2 + t0*t1,  # 3, 4, 5
+        c2*t13 + t12*t25,  # 3, 4, 4
+        c2*t10 + t0*t1,  # 3, 4, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 5, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 5, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 5, 2
@@ -1299,7 +1299,7 @@ def manipulability(q):
     trig = _cos_sin(xp, q, (0.0, 0.0, 0.0, 0.0, 0.0, 0.0), device)
     s2 = trig[..., 3]
     s5 = trig[..., 9]
-    t0 = s2*s5*q3**2
+    t0 = q3**2*s2*s5
     w = xp.broadcast_to(xp.abs(t0), batch)
     return w
 
@@ -1311,7 +1311,7 @@ def jacobian_det(q):
     trig = _cos_sin(xp, q, (0.0, 0.0, 0.0, 0.0, 0.0, 0.0), device)
     s2 = trig[..., 3]
     s5 = trig[..., 9]
-    d = xp.broadcast_to(s2*s5*q3**2, batch)
+    d = xp.broadcast_to(q3**2*s2*s5, batch)
     return d
 
 
@@ -1345,8 +1345,8 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t2 = -0.1337*s1 + q3*t1
     t3 = s1*s2
     t4 = 0.1337*c1 + q3*t3
-    t5 = t2*c1 + t4*s1
-    t6 = c4*s1
+    t5 = c1*t2 + s1*t4
+    t6 = s1*c4
     t7 = c1*s4
     t8 = t6 + c2*t7
     t9 = t7 + c2*t6
@@ -1355,303 +1355,303 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t12 = c1*c4
     t13 = -t11 + c2*t12
     t14 = -t12 + c2*t11
-    t15 = t14*s5 + c5*t3
+    t15 = s5*t14 + c5*t3
     t16 = c1**2
     t17 = s2**2
     t18 = t16*t17
     t19 = t4**2
     t20 = c2**2
-    t21 = t20*q3**2
+    t21 = q3**2*t20
     t22 = t16*t21
     t23 = t19 + t22
     t24 = t18 + t23
     t25 = -t2*t4
-    t26 = c1*s1
+    t26 = s1*c1
     t27 = t17*t26
-    t28 = t25 + t27 + t26*t21
-    t29 = t13*t9 + t10*t15 - t26 + t27
-    t30 = c2*t1
-    t31 = t5*c1
-    t32 = c2*q3
-    t33 = t30 - t31*t32
-    t34 = t16*t32
+    t28 = t25 + t21*t26 + t27
+    t29 = t27 - t26 + t13*t9 + t10*t15
+    t30 = c1*t5
+    t31 = q3*c2
+    t32 = t16*t31
+    t33 = c2*t1
+    t34 = -t30*t31 + t33
     t35 = s1**2
     t36 = t35*t17
     t37 = t2**2
     t38 = xp.sqrt(1 + t37 + t19)
     t39 = t38*xp.where(xp.less_equal(t4, 0), xp.asarray(1, dtype=dtype), -1)
-    t40 = xp.where(xp.greater(t38, 0), 1/(t38*(t38 + xp.abs(t4))), 0)
-    t41 = t37 + t35*t21
-    t42 = t36 + t41
+    t40 = t37 + t21*t35
+    t41 = t36 + t40
+    t42 = s1*t5
     t43 = c2*t3
-    t44 = t5*s1
-    t45 = t43 - t44*t32
-    t46 = t35*t32
-    t47 = t46
-    t48 = t5**2
-    t49 = t48 + t20
-    t50 = t13**2 + t10**2 + t35
-    t51 = t18 + t50
-    t52 = c4*s2
-    t53 = t10*t0 + t13*t52 - t30
-    t54 = t15*t0 + t9*t52 - t43
-    t55 = t9**2 + t15**2 + t16
-    t56 = t36 + t55
-    t57 = 1 + t0**2 + c4**2*t17
-    t58 = t20 + t57
-    t59 = xp.sqrt(t48 + 2*t20 + 2*t18 + 2*t36 + t23 + t41 + t50 + t55 + t57)
-    t60 = damping**2
-    t61 = t24 + t60
-    t62 = t61**2
-    t63 = t42 + t60
-    t64 = t49 + t60
-    t65 = t51 + t60
-    t66 = t56 + t60
-    t67 = t58 + t60
-    t68 = t28**2
-    t69 = t33**2
-    t70 = t34**2
-    t71 = 2*t48
-    t72 = t35*t22
-    t73 = xp.sqrt(t62 + t63**2 + t64**2 + t65**2 + t66**2 + t67**2 + 2*t37 + 2*t19 + 2*t68 + 2*t69 + 2*t70 + 2*t45**2 + 2*t47**2 + 2*t29**2 + 2*t53**2 + 2*t54**2 + t16*t71 + t35*t71 + 4*t72)
-    t74 = xp.sqrt(t19 + t68 + t69 + t70 + t62 + t72)
-    t75 = t74*xp.where(xp.greater_equal(t61, 0), xp.asarray(1, dtype=dtype), -1)
-    t76 = t75 + t61
-    t77 = xp.where(xp.greater(t74, 0), 1/(t74*(t74 + xp.abs(t61))), 0)
-    t78 = t77*(t28*t45 + t33*t76 + t33*t64 - t34*t31 - t31*t46)
-    t79 = t33 - t76*t78
-    t80 = t45 - t28*t78
-    t81 = -t33*t78 + t64
-    t82 = t31 + t34*t78
-    t83 = t26*t32
-    t84 = t77*(t28*t76 + t28*t63 + t33*t45 + t25 + t34*t83 + t47*t83)
-    t85 = t28 - t76*t84
-    t86 = -t28*t84 + t63
-    t87 = t45 - t33*t84
-    t88 = -t47 + t84*t83
-    t89 = -t34*t84 + t83
-    t90 = t2 + t4*t84
-    t91 = t44 + t78*t83
-    t92 = t77*(t4*t53 + t34*t29 - t28*t47 + t33*t44 - t76*t83 - t65*t83)
-    t93 = t92*t76 + t83
-    t94 = t47 + t92*t28
-    t95 = t44 - t92*t33
-    t96 = t92*t83 + t65
-    t97 = t29 - t92*t34
-    t98 = t77*(t4*t54 + t34*t76 + t34*t66 - t33*t31 + t28*t83 - t29*t83)
-    t99 = t34 - t98*t76
-    t100 = -t98*t28 + t83
-    t101 = t98*t33 + t31
-    t102 = t29 + t98*t83
-    t103 = -t98*t34 + t66
-    t104 = -t54 + t98*t4
-    t105 = -t77*(-t2*t28 + t4*t76 + t4*t67 + t34*t54 - t53*t83)
-    t106 = t4 + t105*t76
-    t107 = t2 - t105*t28
-    t108 = t54 + t105*t34
-    t109 = t105*t4 + t67
-    t110 = t77*(t28*mu_dot1 + t33*mu_dot2 + t34*mu_dot4 + t76*mu_dot0 - t4*mu_dot5 - mu_dot3*t83)
-    t111 = mu_dot0 - t110*t76
-    t112 = mu_dot1 - t110*t28
-    t113 = mu_dot2 - t110*t33
-    t114 = mu_dot3 + t110*t83
-    t115 = mu_dot4 - t110*t34
-    t116 = mu_dot5 + t110*t4
-    t117 = xp.sqrt(t86**2 + t87**2 + t88**2 + t89**2 + t90**2)
-    t118 = t117*xp.where(xp.greater_equal(t86, 0), xp.asarray(1, dtype=dtype), -1)
-    t119 = t118 + t86
-    t120 = xp.where(xp.greater(t117, 0), 1/(t117*(t117 + xp.abs(t86))), 0)
-    t121 = t120*(t100*t119 + t102*t88 + t103*t89 + t104*t90 - t101*t87)
-    t122 = t100 - t119*t121
-    t123 = t101 + t121*t87
-    t124 = t102 - t121*t88
-    t125 = t103 - t121*t89
-    t126 = t104 - t121*t90
-    t127 = t120*(t112*t119 + t113*t87 + t114*t88 + t115*t89 + t116*t90)
-    t128 = t112 - t119*t127
-    t129 = t113 - t127*t87
-    t130 = t114 - t127*t88
-    t131 = t115 - t127*t89
-    t132 = t116 - t127*t90
-    t133 = -t53
-    t134 = t133 + t92*t4
-    t135 = t133 + t105*t83
-    t136 = t120*(t95*t87 + t96*t88 + t97*t89 + t134*t90 - t94*t119)
-    t137 = t94 + t119*t136
-    t138 = t95 - t136*t87
-    t139 = t96 - t136*t88
-    t140 = t97 - t136*t89
-    t141 = t134 - t136*t90
-    t142 = t4*t78
-    t143 = t120*(t80*t119 + t81*t87 + t91*t88 - t82*t89 + t90*t142)
-    t144 = t80 - t119*t143
-    t145 = t81 - t143*t87
-    t146 = t91 - t143*t88
-    t147 = t82 + t143*t89
-    t148 = t142 - t143*t90
-    t149 = xp.sqrt(t145**2 + t146**2 + t147**2 + t148**2)
-    t150 = t149*xp.where(xp.greater_equal(t145, 0), xp.asarray(1, dtype=dtype), -1)
-    t151 = t145 + t150
-    t152 = xp.where(xp.greater(t149, 0), 1/(t149*(t149 + xp.abs(t145))), 0)
-    t153 = t152*(t146*t139 + t148*t141 + t138*t151 - t147*t140)
-    t154 = t138 - t151*t153
-    t155 = t139 - t146*t153
-    t156 = t140 + t147*t153
-    t157 = t141 - t148*t153
-    t158 = t152*(t146*t124 + t148*t126 - t147*t125 - t123*t151)
-    t159 = t123 + t151*t158
-    t160 = t124 - t146*t158
-    t161 = t125 + t147*t158
-    t162 = t126 - t148*t158
-    t163 = t152*(t146*t130 + t148*t132 + t129*t151 - t147*t131)
-    t164 = t129 - t151*t163
-    t165 = t130 - t146*t163
-    t166 = t131 + t147*t163
-    t167 = t132 - t148*t163
-    t168 = xp.sqrt(t155**2 + t156**2 + t157**2)
-    t169 = t168*xp.where(xp.greater_equal(t155, 0), xp.asarray(1, dtype=dtype), -1)
-    t170 = t155 + t169
-    t171 = xp.where(xp.greater(t168, 0), 1/(t168*(t168 + xp.abs(t155))), 0)
-    t172 = t171*(t156*t161 + t157*t162 + t160*t170)
-    t173 = t160 - t170*t172
-    t174 = t161 - t156*t172
-    t175 = t162 - t157*t172
-    t176 = t171*(t156*t166 + t157*t167 + t165*t170)
-    t177 = t165 - t170*t176
-    t178 = t166 - t156*t176
-    t179 = t167 - t157*t176
-    t180 = xp.sqrt(t174**2 + t175**2)
-    t181 = t180*xp.where(xp.greater_equal(t174, 0), xp.asarray(1, dtype=dtype), -1)
-    t182 = t174 + t181
-    t183 = xp.where(xp.greater(t180, 0), 1/(t180*(t180 + xp.abs(t174))), 0)
-    t184 = t183*(t175*t179 + t178*t182)
-    t185 = t178 - t182*t184
-    t186 = t179 - t175*t184
-    t187 = t105*t33
-    t188 = t120*(t107*t119 + t135*t88 + t109*t90 - t108*t89 - t87*t187)
-    t189 = t107 - t119*t188
-    t190 = t187 + t188*t87
-    t191 = t135 - t188*t88
-    t192 = t108 + t188*t89
-    t193 = t109 - t188*t90
-    t194 = t152*(t146*t191 + t147*t192 + t148*t193 - t190*t151)
-    t195 = t190 + t151*t194
-    t196 = t191 - t146*t194
-    t197 = -t192 + t147*t194
-    t198 = t193 - t148*t194
-    t199 = t171*(t156*t197 + t157*t198 + t196*t170)
-    t200 = t196 - t170*t199
-    t201 = t197 - t156*t199
-    t202 = t198 - t157*t199
-    t203 = t183*(t175*t202 + t201*t182)
-    t204 = t201 - t182*t203
-    t205 = t202 - t175*t203
-    t206 = xp.abs(t205)
-    t207 = t206
-    t208 = t207*xp.where(xp.greater_equal(t205, 0), xp.asarray(1, dtype=dtype), -1)
-    t209 = t205 + t208
-    t210 = xp.where(xp.greater(t207, 0), 1/(t207*(t207 + t206)), 0)
-    t211 = t186 - t186*t210*t209**2
-    t212 = xp.where(xp.not_equal(t208, 0), -t211/t208, 0)
-    t213 = xp.where(xp.not_equal(t181, 0), -(t185 - t204*t212)/t181, 0)
-    t214 = xp.where(xp.not_equal(t169, 0), -(t177 - (t173*t213 + t200*t212))/t169, 0)
-    t215 = xp.where(xp.not_equal(t150, 0), -(t164 - t154*t214 + t159*t213 + t195*t212)/t150, 0)
-    t216 = xp.where(xp.not_equal(t118, 0), -(t128 - (t144*t215 + t122*t213 + t189*t212 - t137*t214))/t118, 0)
-    t217 = xp.where(xp.not_equal(t75, 0), -(t111 - (t79*t215 + t99*t213 + t216*t85 - t93*t214 - t106*t212))/t75, 0)
-    t218 = t212 + t216*t2 - t217*t4
-    t219 = t215*c2 + t216*t3 + t217*t1
-    t220 = t212*c2 + t213*t3 + t214*t1
-    t221 = t13*t214 + t9*t213 - t212*t52
-    t222 = t10*t214 + t15*t213 - t0*t212
-    t223 = s1*t32
-    t224 = c1*t32
-    t225 = t213*c1 - t214*s1 - t215*t5 + t216*t223 + t217*t224
-    t226 = -t4
-    t227 = t39 + t226
-    t228 = t40*(t227*t224 + t2*t223)
-    t229 = -t227*t228 + t224
-    t230 = -t228*t2 + t223
-    t231 = t40*(t227*t1 + t2*t3)
-    t232 = t1 - t227*t231
-    t233 = t3 - t231*t2
-    t234 = t40*(mu_dot5 + t227*mu_dot0 + t2*mu_dot1)
-    t235 = mu_dot0 - t227*t234
-    t236 = mu_dot1 - t234*t2
-    t237 = mu_dot5 - t234
-    t238 = xp.sqrt(t228**2 + t230**2 + t48 + t16 + t35)
+    t44 = -t31*t42 + t43
+    t45 = t31*t35
+    t46 = t45
+    t47 = t5**2
+    t48 = t20 + t47
+    t49 = t13**2 + t10**2 + t35
+    t50 = t18 + t49
+    t51 = s2*c4
+    t52 = -t33 + t13*t51 + t10*t0
+    t53 = -t43 + t9*t51 + t15*t0
+    t54 = t9**2 + t15**2 + t16
+    t55 = t36 + t54
+    t56 = 1 + t0**2 + t17*c4**2
+    t57 = t20 + t56
+    t58 = xp.sqrt(t23 + 2*t20 + 2*t18 + 2*t36 + t40 + t47 + t49 + t54 + t56)
+    t59 = t28**2
+    t60 = t34**2
+    t61 = t32**2
+    t62 = damping**2
+    t63 = t62 + t24
+    t64 = t63**2
+    t65 = t62 + t41
+    t66 = t62 + t48
+    t67 = t62 + t50
+    t68 = t62 + t55
+    t69 = t62 + t57
+    t70 = 2*t47
+    t71 = t22*t35
+    t72 = xp.sqrt(2*t37 + 2*t19 + 2*t59 + 2*t60 + 2*t44**2 + 2*t46**2 + 2*t61 + 2*t29**2 + 2*t52**2 + 2*t53**2 + t64 + t65**2 + t66**2 + t67**2 + t68**2 + t69**2 + t35*t70 + 4*t71 + t16*t70)
+    t73 = xp.sqrt(t19 + t59 + t60 + t61 + t64 + t71)
+    t74 = t73*xp.where(xp.greater_equal(t63, 0), xp.asarray(1, dtype=dtype), -1)
+    t75 = t63 + t74
+    t76 = xp.where(xp.greater(t73, 0), 1/(t73*(t73 + xp.abs(t63))), 0)
+    t77 = t76*(t34*t75 + t28*t44 + t34*t66 - t30*t45 - t30*t32)
+    t78 = t34 - t75*t77
+    t79 = t44 - t28*t77
+    t80 = t66 - t34*t77
+    t81 = t30 + t32*t77
+    t82 = t26*t31
+    t83 = t76*(t25 + t28*t75 + t28*t65 + t34*t44 + t82*t46 + t82*t32)
+    t84 = t28 - t75*t83
+    t85 = t65 - t28*t83
+    t86 = t44 - t34*t83
+    t87 = -t46 + t82*t83
+    t88 = t82 - t32*t83
+    t89 = t2 + t4*t83
+    t90 = t42 + t82*t77
+    t91 = t76*(-t82*t75 - t28*t46 + t42*t34 - t67*t82 + t32*t29 + t4*t52)
+    t92 = t82 + t75*t91
+    t93 = t46 + t28*t91
+    t94 = t42 - t34*t91
+    t95 = t67 + t82*t91
+    t96 = t29 - t32*t91
+    t97 = t76*(t32*t75 + t82*t28 - t30*t34 - t82*t29 + t32*t68 + t4*t53)
+    t98 = t32 - t75*t97
+    t99 = t82 - t28*t97
+    t100 = t30 + t34*t97
+    t101 = t29 + t82*t97
+    t102 = t68 - t32*t97
+    t103 = -t53 + t4*t97
+    t104 = -t76*(t4*t75 - t2*t28 - t82*t52 + t32*t53 + t4*t69)
+    t105 = t4 + t75*t104
+    t106 = t2 - t28*t104
+    t107 = t53 + t32*t104
+    t108 = t69 + t4*t104
+    t109 = t76*(mu_dot0*t75 + mu_dot1*t28 + mu_dot2*t34 - t82*mu_dot3 + mu_dot4*t32 - t4*mu_dot5)
+    t110 = mu_dot0 - t75*t109
+    t111 = mu_dot1 - t28*t109
+    t112 = mu_dot2 - t34*t109
+    t113 = mu_dot3 + t82*t109
+    t114 = mu_dot4 - t32*t109
+    t115 = mu_dot5 + t4*t109
+    t116 = xp.sqrt(t85**2 + t86**2 + t87**2 + t88**2 + t89**2)
+    t117 = t116*xp.where(xp.greater_equal(t85, 0), xp.asarray(1, dtype=dtype), -1)
+    t118 = t85 + t117
+    t119 = xp.where(xp.greater(t116, 0), 1/(t116*(t116 + xp.abs(t85))), 0)
+    t120 = t119*(t99*t118 - t86*t100 + t87*t101 + t88*t102 + t89*t103)
+    t121 = t99 - t118*t120
+    t122 = t100 + t86*t120
+    t123 = t101 - t87*t120
+    t124 = t102 - t88*t120
+    t125 = t103 - t89*t120
+    t126 = t119*(t111*t118 + t86*t112 + t87*t113 + t88*t114 + t89*t115)
+    t127 = t111 - t118*t126
+    t128 = t112 - t86*t126
+    t129 = t113 - t87*t126
+    t130 = t114 - t88*t126
+    t131 = t115 - t89*t126
+    t132 = -t52
+    t133 = t132 + t4*t91
+    t134 = t132 + t82*t104
+    t135 = t119*(-t93*t118 + t86*t94 + t87*t95 + t88*t96 + t89*t133)
+    t136 = t93 + t118*t135
+    t137 = t94 - t86*t135
+    t138 = t95 - t87*t135
+    t139 = t96 - t88*t135
+    t140 = t133 - t89*t135
+    t141 = t4*t77
+    t142 = t119*(t79*t118 + t86*t80 + t87*t90 - t88*t81 + t141*t89)
+    t143 = t79 - t118*t142
+    t144 = t80 - t86*t142
+    t145 = t90 - t87*t142
+    t146 = t81 + t88*t142
+    t147 = t141 - t89*t142
+    t148 = xp.sqrt(t144**2 + t145**2 + t146**2 + t147**2)
+    t149 = t148*xp.where(xp.greater_equal(t144, 0), xp.asarray(1, dtype=dtype), -1)
+    t150 = t144 + t149
+    t151 = xp.where(xp.greater(t148, 0), 1/(t148*(t148 + xp.abs(t144))), 0)
+    t152 = t151*(t137*t150 + t145*t138 - t146*t139 + t147*t140)
+    t153 = t137 - t150*t152
+    t154 = t138 - t145*t152
+    t155 = t139 + t146*t152
+    t156 = t140 - t147*t152
+    t157 = t151*(-t122*t150 + t145*t123 - t146*t124 + t147*t125)
+    t158 = t122 + t150*t157
+    t159 = t123 - t145*t157
+    t160 = t124 + t146*t157
+    t161 = t125 - t147*t157
+    t162 = t151*(t128*t150 + t145*t129 - t146*t130 + t147*t131)
+    t163 = t128 - t150*t162
+    t164 = t129 - t145*t162
+    t165 = t130 + t146*t162
+    t166 = t131 - t147*t162
+    t167 = xp.sqrt(t154**2 + t155**2 + t156**2)
+    t168 = t167*xp.where(xp.greater_equal(t154, 0), xp.asarray(1, dtype=dtype), -1)
+    t169 = t154 + t168
+    t170 = xp.where(xp.greater(t167, 0), 1/(t167*(t167 + xp.abs(t154))), 0)
+    t171 = t170*(t159*t169 + t155*t160 + t156*t161)
+    t172 = t159 - t169*t171
+    t173 = t160 - t155*t171
+    t174 = t161 - t156*t171
+    t175 = t170*(t164*t169 + t155*t165 + t156*t166)
+    t176 = t164 - t169*t175
+    t177 = t165 - t155*t175
+    t178 = t166 - t156*t175
+    t179 = xp.sqrt(t173**2 + t174**2)
+    t180 = t179*xp.where(xp.greater_equal(t173, 0), xp.asarray(1, dtype=dtype), -1)
+    t181 = t173 + t180
+    t182 = xp.where(xp.greater(t179, 0), 1/(t179*(t179 + xp.abs(t173))), 0)
+    t183 = t182*(t177*t181 + t174*t178)
+    t184 = t177 - t181*t183
+    t185 = t178 - t174*t183
+    t186 = t34*t104
+    t187 = t119*(t106*t118 - t186*t86 + t87*t134 - t88*t107 + t89*t108)
+    t188 = t106 - t118*t187
+    t189 = t186 + t86*t187
+    t190 = t134 - t87*t187
+    t191 = t107 + t88*t187
+    t192 = t108 - t89*t187
+    t193 = t151*(-t189*t150 + t145*t190 + t146*t191 + t147*t192)
+    t194 = t189 + t150*t193
+    t195 = t190 - t145*t193
+    t196 = -t191 + t146*t193
+    t197 = t192 - t147*t193
+    t198 = t170*(t195*t169 + t155*t196 + t156*t197)
+    t199 = t195 - t169*t198
+    t200 = t196 - t155*t198
+    t201 = t197 - t156*t198
+    t202 = t182*(t200*t181 + t174*t201)
+    t203 = t200 - t181*t202
+    t204 = t201 - t174*t202
+    t205 = xp.abs(t204)
+    t206 = t205
+    t207 = t206*xp.where(xp.greater_equal(t204, 0), xp.asarray(1, dtype=dtype), -1)
+    t208 = t204 + t207
+    t209 = xp.where(xp.greater(t206, 0), 1/(t206*(t205 + t206)), 0)
+    t210 = t185 - t185*t208**2*t209
+    t211 = xp.where(xp.not_equal(t207, 0), -t210/t207, 0)
+    t212 = xp.where(xp.not_equal(t180, 0), -(t184 - t203*t211)/t180, 0)
+    t213 = xp.where(xp.not_equal(t168, 0), -(-(t172*t212 + t199*t211) + t176)/t168, 0)
+    t214 = xp.where(xp.not_equal(t149, 0), -(t163 + t158*t212 + t194*t211 - t153*t213)/t149, 0)
+    t215 = xp.where(xp.not_equal(t117, 0), -(-(t143*t214 - t136*t213 + t121*t212 + t188*t211) + t127)/t117, 0)
+    t216 = xp.where(xp.not_equal(t74, 0), -(-(t84*t215 + t78*t214 - t92*t213 + t98*t212 - t105*t211) + t110)/t74, 0)
+    t217 = t211 - t4*t216 + t2*t215
+    t218 = t1*t216 + t3*t215 + c2*t214
+    t219 = t1*t213 + t3*t212 + c2*t211
+    t220 = t13*t213 + t9*t212 - t51*t211
+    t221 = t10*t213 + t15*t212 - t0*t211
+    t222 = c1*t31
+    t223 = s1*t31
+    t224 = t222*t216 + t223*t215 - t5*t214 - s1*t213 + c1*t212
+    t225 = -t4
+    t226 = t225 + t39
+    t227 = xp.where(xp.greater(t38, 0), 1/(t38*(t38 + xp.abs(t225))), 0)
+    t228 = t227*(t222*t226 + t2*t223)
+    t229 = t222 - t226*t228
+    t230 = t223 - t2*t228
+    t231 = t227*(t1*t226 + t2*t3)
+    t232 = t1 - t226*t231
+    t233 = t3 - t2*t231
+    t234 = t227*(mu_dot5 + mu_dot0*t226 + t2*mu_dot1)
+    t235 = mu_dot0 - t226*t234
+    t236 = mu_dot1 - t2*t234
+    t237 = -t234 + mu_dot5
+    t238 = xp.sqrt(t35 + t16 + t47 + t228**2 + t230**2)
     t239 = t238*xp.where(xp.greater_equal(t230, 0), xp.asarray(1, dtype=dtype), -1)
     t240 = t230 + t239
     t241 = xp.where(xp.greater(t238, 0), 1/(t238*(t238 + xp.abs(t230))), 0)
-    t242 = t241*(t228*t231 + t233*t240 - t5*c2)
+    t242 = t241*(t233*t240 - c2*t5 + t228*t231)
     t243 = t233 - t240*t242
-    t244 = c2 + t242*t5
+    t244 = c2 + t5*t242
     t245 = -t231 + t228*t242
-    t246 = -t241*(-t236*t240 - c1*mu_dot4 + t228*t237 + t5*mu_dot2 + mu_dot3*s1)
+    t246 = -t241*(-t236*t240 + t5*mu_dot2 + s1*mu_dot3 - c1*mu_dot4 + t228*t237)
     t247 = t236 - t240*t246
-    t248 = mu_dot2 + t246*t5
-    t249 = mu_dot3 + t246*s1
-    t250 = mu_dot4 - t246*c1
+    t248 = mu_dot2 + t5*t246
+    t249 = mu_dot3 + s1*t246
+    t250 = mu_dot4 - c1*t246
     t251 = t237 + t228*t246
-    t252 = t40*c2
+    t252 = c2*t227
     t253 = c2 - t252
-    t254 = -t52
-    t255 = t40*t52
+    t254 = -t51
+    t255 = t51*t227
     t256 = t254 + t255
     t257 = -t0
-    t258 = 1 + t13 + t9 + t10 + t15 + t2 + c1 + damping + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + q1 + q2 + q3 + q4 + q5 + q6 + t257 - t5 + t226 - s1 + 2*c2 + t254 + 2*t1 + 2*t3 + t224 + t223
-    t259 = t0*t40
+    t258 = 1 + t225 - t5 - s1 + t257 + q1 + q2 + c1 + q3 + q4 + q5 + q6 + t13 + t9 + t10 + t2 + t15 + t222 + t223 + t254 + 2*c2 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + damping + 2*t1 + 2*t3
+    t259 = t0*t227
     t260 = t257 + t259
     t261 = t2*t252
-    t262 = -t241*(t228*t253 + t240*t261)
-    t263 = t240*t262 + t261
-    t264 = t262*s1 + t1
-    t265 = t3 - t262*c1
+    t262 = -t241*(t240*t261 + t228*t253)
+    t263 = t261 + t240*t262
+    t264 = t1 + s1*t262
+    t265 = t3 - c1*t262
     t266 = t253 + t228*t262
     t267 = t2*t255
-    t268 = t241*(t9*c1 - t13*s1 - t228*t256 + t240*t267)
-    t269 = -t240*t268 + t267
-    t270 = t13 + t268*s1
-    t271 = t9 - t268*c1
+    t268 = t241*(t240*t267 - s1*t13 + c1*t9 - t228*t256)
+    t269 = t267 - t240*t268
+    t270 = t13 + s1*t268
+    t271 = t9 - c1*t268
     t272 = t256 + t228*t268
     t273 = t2*t259
-    t274 = t241*(t15*c1 - t10*s1 - t228*t260 + t240*t273)
-    t275 = -t240*t274 + t273
-    t276 = t10 + t274*s1
-    t277 = t15 - t274*c1
+    t274 = t241*(c1*t15 - s1*t10 + t240*t273 - t228*t260)
+    t275 = t273 - t240*t274
+    t276 = t10 + s1*t274
+    t277 = t15 - c1*t274
     t278 = t260 + t228*t274
     t279 = t242**2
-    t280 = xp.sqrt(t244**2 + t245**2 + t279*t16 + t279*t35)
+    t280 = xp.sqrt(t244**2 + t245**2 + t35*t279 + t16*t279)
     t281 = t280*xp.where(xp.greater_equal(t244, 0), xp.asarray(1, dtype=dtype), -1)
     t282 = t244 + t281
     t283 = xp.where(xp.greater(t280, 0), 1/(t280*(t280 + xp.abs(t244))), 0)
-    t284 = s1*t242
-    t285 = t262*t5
+    t284 = t5*t262
+    t285 = s1*t242
     t286 = c1*t242
-    t287 = t283*(t245*t266 + t264*t284 + t282*t285 - t265*t286)
-    t288 = t285 - t282*t287
-    t289 = t264 - t287*t284
+    t287 = t283*(t282*t284 + t264*t285 - t265*t286 + t245*t266)
+    t288 = t284 - t282*t287
+    t289 = t264 - t287*t285
     t290 = t265 + t287*t286
     t291 = t266 - t245*t287
-    t292 = t283*(t245*t251 + t248*t282 + t249*t284 - t250*t286)
+    t292 = t283*(t248*t282 + t249*t285 - t250*t286 + t245*t251)
     t293 = t248 - t282*t292
-    t294 = t249 - t292*t284
+    t294 = t249 - t292*t285
     t295 = t250 + t292*t286
     t296 = t251 - t245*t292
     t297 = xp.sqrt(t289**2 + t290**2 + t291**2)
     t298 = t297*xp.where(xp.greater_equal(t289, 0), xp.asarray(1, dtype=dtype), -1)
     t299 = t289 + t298
     t300 = xp.where(xp.greater(t297, 0), 1/(t297*(t297 + xp.abs(t289))), 0)
-    t301 = t300*(t290*t295 + t291*t296 + t294*t299)
+    t301 = t300*(t294*t299 + t290*t295 + t291*t296)
     t302 = t294 - t299*t301
     t303 = t295 - t290*t301
     t304 = t296 - t291*t301
-    t305 = t268*t5
-    t306 = t283*(t245*t272 + t270*t284 + t282*t305 - t271*t286)
+    t305 = t5*t268
+    t306 = t283*(t282*t305 + t270*t285 - t271*t286 + t245*t272)
     t307 = t305 - t282*t306
-    t308 = t270 - t306*t284
+    t308 = t270 - t306*t285
     t309 = t271 + t306*t286
     t310 = t272 - t245*t306
-    t311 = t300*(t290*t309 + t291*t310 + t308*t299)
+    t311 = t300*(t308*t299 + t290*t309 + t291*t310)
     t312 = t308 - t299*t311
     t313 = t309 - t290*t311
     t314 = t310 - t291*t311
@@ -1659,48 +1659,48 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t316 = t315*xp.where(xp.greater_equal(t313, 0), xp.asarray(1, dtype=dtype), -1)
     t317 = t313 + t316
     t318 = xp.where(xp.greater(t315, 0), 1/(t315*(t315 + xp.abs(t313))), 0)
-    t319 = t318*(t314*t304 + t303*t317)
+    t319 = t318*(t303*t317 + t314*t304)
     t320 = t303 - t317*t319
     t321 = t304 - t314*t319
-    t322 = t274*t5
-    t323 = t283*(t245*t278 + t276*t284 + t282*t322 - t277*t286)
+    t322 = t5*t274
+    t323 = t283*(t282*t322 + t276*t285 - t277*t286 + t245*t278)
     t324 = t322 - t282*t323
-    t325 = t276 - t323*t284
+    t325 = t276 - t323*t285
     t326 = t277 + t323*t286
     t327 = t278 - t245*t323
-    t328 = t300*(t290*t326 + t291*t327 + t325*t299)
+    t328 = t300*(t325*t299 + t290*t326 + t291*t327)
     t329 = t325 - t299*t328
     t330 = t326 - t290*t328
     t331 = t327 - t291*t328
-    t332 = t318*(t314*t331 + t330*t317)
+    t332 = t318*(t330*t317 + t314*t331)
     t333 = t330 - t317*t332
     t334 = t331 - t314*t332
     t335 = xp.abs(t334)
     t336 = t335
     t337 = t336*xp.where(xp.greater_equal(t334, 0), xp.asarray(1, dtype=dtype), -1)
     t338 = t334 + t337
-    t339 = xp.where(xp.greater(t336, 0), 1/(t336*(t336 + t335)), 0)
-    t340 = t321 - t321*t339*t338**2
+    t339 = xp.where(xp.greater(t336, 0), 1/(t336*(t335 + t336)), 0)
+    t340 = t321 - t321*t338**2*t339
     t341 = xp.where(xp.not_equal(t337, 0), -t340/t337, 0)
     t342 = xp.where(xp.not_equal(t316, 0), -(t320 - t333*t341)/t316, 0)
-    t343 = xp.where(xp.not_equal(t298, 0), -(t302 - (t312*t342 + t329*t341))/t298, 0)
-    t344 = xp.where(xp.not_equal(t281, 0), -(t293 - (t288*t343 + t307*t342 + t324*t341))/t281, 0)
-    t345 = xp.where(xp.not_equal(t239, 0), -(t247 - (t243*t344 + t269*t342 + t275*t341 - t263*t343))/t239, 0)
-    t346 = xp.where(xp.not_equal(t39, 0), -(t235 - (t229*t345 + t232*t344 + t227*t341*t259 - t227*t343*t252 + t227*t342*t255))/t39, 0)
+    t343 = xp.where(xp.not_equal(t298, 0), -(-(t312*t342 + t329*t341) + t302)/t298, 0)
+    t344 = xp.where(xp.not_equal(t281, 0), -(-(t288*t343 + t307*t342 + t324*t341) + t293)/t281, 0)
+    t345 = xp.where(xp.not_equal(t239, 0), -(-(t243*t344 - t263*t343 + t269*t342 + t275*t341) + t247)/t239, 0)
+    t346 = xp.where(xp.not_equal(t39, 0), -(-(t229*t345 + t232*t344 - t252*t226*t343 + t255*t226*t342 + t226*t341*t259) + t235)/t39, 0)
     t347 = xp.isfinite(t258)
     t348 = xp.greater_equal(damping, 0)
-    t349 = 1e-12*t59
-    t350 = xp.greater(damping, 0)
-    t351 = 1e-12*t73
-    t352 = (xp.less_equal(damping, 0) & (xp.less_equal(t38, t349) | xp.less_equal(t238, t349) | xp.less_equal(t280, t349) | xp.less_equal(t297, t349) | xp.less_equal(t315, t349) | xp.less_equal(t336, t349))) | (t350 & (xp.less_equal(t117, t351) | xp.less_equal(t149, t351) | xp.less_equal(t168, t351) | xp.less_equal(t180, t351) | xp.less_equal(t207, t351) | xp.less_equal(t74, t351)))
+    t349 = xp.greater(damping, 0)
+    t350 = 1e-12*t72
+    t351 = 1e-12*t58
+    t352 = (t349 & (xp.less_equal(t73, t350) | xp.less_equal(t116, t350) | xp.less_equal(t148, t350) | xp.less_equal(t167, t350) | xp.less_equal(t179, t350) | xp.less_equal(t206, t350))) | (xp.less_equal(damping, 0) & (xp.less_equal(t38, t351) | xp.less_equal(t238, t351) | xp.less_equal(t280, t351) | xp.less_equal(t297, t351) | xp.less_equal(t315, t351) | xp.less_equal(t336, t351)))
     t353 = t347 & t348 & xp.logical_not(t352)
     q_dot = _stack(xp, [
-        xp.broadcast_to(xp.where(t353, xp.where(t350, t218, t346), 0), batch),  # 0
-        xp.broadcast_to(xp.where(t353, xp.where(t350, t225, t345), 0), batch),  # 1
-        xp.broadcast_to(xp.where(t353, xp.where(t350, t219, t344), 0), batch),  # 2
-        xp.broadcast_to(xp.where(t353, xp.where(t350, t220, t343), 0), batch),  # 3
-        xp.broadcast_to(xp.where(t353, xp.where(t350, t221, t342), 0), batch),  # 4
-        xp.broadcast_to(xp.where(t353, xp.where(t350, t222, t341), 0), batch),  # 5
+        xp.broadcast_to(xp.where(t353, xp.where(t349, t217, t346), 0), batch),  # 0
+        xp.broadcast_to(xp.where(t353, xp.where(t349, t224, t345), 0), batch),  # 1
+        xp.broadcast_to(xp.where(t353, xp.where(t349, t218, t344), 0), batch),  # 2
+        xp.broadcast_to(xp.where(t353, xp.where(t349, t219, t343), 0), batch),  # 3
+        xp.broadcast_to(xp.where(t353, xp.where(t349, t220, t342), 0), batch),  # 4
+        xp.broadcast_to(xp.where(t353, xp.where(t349, t221, t341), 0), batch),  # 5
     ], (6,))
     status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t347 & t348), 2, xp.where(t352, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
     return q_dot, status
@@ -1744,17 +1744,17 @@ def ik_numeric_step(target, q, damping=0.0):
     s5 = xp.sin(q5)
     c6 = xp.cos(q6)
     s6 = xp.sin(q6)
-    t0 = T00 + T01 + T02 + T03 + T10 + T11 + T12 + T13 + T20 + T21 + T22 + T23 + qs1 + qs2 + qs3 + qs4 + qs5 + qs6
+    t0 = qs1 + qs2 + qs3 + qs4 + qs5 + qs6 + T00 + T01 + T02 + T10 + T11 + T12 + T20 + T21 + T22 + T03 + T13 + T23
     t1 = q3*s2
     t2 = -0.1337*s1 + c1*t1
     t3 = 0.1337*c1 + s1*t1
-    t4 = t2*c1 + t3*s1
-    t5 = T03 - t2
-    t6 = T13 - t3
-    t7 = c2*q3
+    t4 = c1*t2 + s1*t3
+    t5 = -t2 + T03
+    t6 = -t3 + T13
+    t7 = q3*c2
     t8 = 0.412 + t7
-    t9 = T23 - t8
-    t10 = c4*s1
+    t9 = -t8 + T23
+    t10 = s1*c4
     t11 = c1*s4
     t12 = t10 + c2*t11
     t13 = t11 + c2*t10
@@ -1766,64 +1766,64 @@ def ik_numeric_step(target, q, damping=0.0):
     t19 = t12*c5 - s5*t18
     t20 = t12*s5 + c5*t18
     t21 = t16*s6 + t19*c6
-    t22 = t16*c6 - t19*s6
-    t23 = T00*t21 + T01*t22 + T02*t20
-    t24 = T10*t21 + T11*t22 + T12*t20
-    t25 = T20*t21 + T21*t22 + T22*t20
+    t22 = t16*c6 - s6*t19
+    t23 = t21*T00 + t22*T01 + t20*T02
+    t24 = t21*T10 + t22*T11 + t20*T12
+    t25 = t21*T20 + t22*T21 + t20*T22
     t26 = s1*s2
-    t27 = t17*c5 - s5*t26
-    t28 = t17*s5 + c5*t26
-    t29 = t13*s6 + t27*c6
-    t30 = t13*c6 - t27*s6
-    t31 = T00*t29 + T01*t30 + T02*t28
-    t32 = T10*t29 + T11*t30 + T12*t28
-    t33 = T20*t29 + T21*t30 + T22*t28
-    t34 = 0.5*(t24 - t31)
-    t35 = s4*s2
+    t27 = c5*t17 - s5*t26
+    t28 = s5*t17 + c5*t26
+    t29 = s6*t13 + c6*t27
+    t30 = c6*t13 - s6*t27
+    t31 = t29*T00 + t30*T01 + t28*T02
+    t32 = t29*T10 + t30*T11 + t28*T12
+    t33 = t29*T20 + t30*T21 + t28*T22
+    t34 = 0.5*(-t31 + t24)
+    t35 = s2*s4
     t36 = c2*s5 + c5*t35
     t37 = -c2*c5 + s5*t35
-    t38 = c4*s2
-    t39 = t36*c6 + s6*t38
-    t40 = t36*s6 - c6*t38
-    t41 = T00*t39 + T02*t37 - T01*t40
-    t42 = T10*t39 + T12*t37 - T11*t40
-    t43 = T20*t39 + T22*t37 - T21*t40
+    t38 = s2*c4
+    t39 = c6*t36 + s6*t38
+    t40 = s6*t36 - c6*t38
+    t41 = t39*T00 - t40*T01 + t37*T02
+    t42 = t39*T10 - t40*T11 + t37*T12
+    t43 = t39*T20 - t40*T21 + t37*T22
     t44 = 0.5*(t42 + t33)
     t45 = -0.5*(t41 + t25)
     t46 = xp.sqrt(t44**2 + t45**2 + t34**2)
     t47 = t3**2
     t48 = c1**2
-    t49 = t48*t7
-    t50 = s2**2
-    t51 = t48*t50
-    t52 = c2**2
-    t53 = t4**2 + t52
-    t54 = 1 + t37**2 + t52 + c4**2*t50
-    t55 = t52*q3**2
-    t56 = t48*t55
-    t57 = t47 + t51 + t56
+    t49 = t7*t48
+    t50 = c2**2
+    t51 = t50 + t4**2
+    t52 = q3**2*t50
+    t53 = t48*t52
+    t54 = s2**2
+    t55 = 1 + t50 + t37**2 + t54*c4**2
+    t56 = t48*t54
+    t57 = t47 + t53 + t56
     t58 = -t2*t3
-    t59 = c1*s1
-    t60 = t50*t59
-    t61 = t58 + t60 + t59*t55
-    t62 = t16*t13 + t20*t28 - t59 + t60
-    t63 = c2*t18
-    t64 = t20*t37 + t16*t38 - t63
-    t65 = t4*c1
-    t66 = t63 - t7*t65
+    t59 = s1*c1
+    t60 = t54*t59
+    t61 = t58 + t52*t59 + t60
+    t62 = t60 - t59 + t16*t13 + t20*t28
+    t63 = c1*t4
+    t64 = c2*t18
+    t65 = -t7*t63 + t64
+    t66 = -t64 + t16*t38 + t20*t37
     t67 = s1**2
-    t68 = t16**2 + t20**2 + t67 + t51
-    t69 = t67*t50
-    t70 = t2**2 + t69 + t67*t55
-    t71 = t13**2 + t28**2 + t48 + t69
-    t72 = c2*t26
-    t73 = t28*t37 + t13*t38 - t72
-    t74 = t4*s1
-    t75 = t72 - t7*t74
-    t76 = t67*t7
+    t68 = t67 + t16**2 + t20**2 + t56
+    t69 = t67*t54
+    t70 = t2**2 + t52*t67 + t69
+    t71 = t48 + t13**2 + t28**2 + t69
+    t72 = s1*t4
+    t73 = c2*t26
+    t74 = -t7*t72 + t73
+    t75 = -t73 + t13*t38 + t28*t37
+    t76 = t7*t67
     t77 = t76
     t78 = -t43
-    t79 = 0.5*(-1 + t23 + t32 + t78)
+    t79 = 0.5*(-1 + t78 + t23 + t32)
     t80 = xp.atan2(t46, t79)
     t81 = xp.where(xp.greater(t46, 0), t80/t46, 1)
     t82 = xp.greater_equal(t23, t32) & xp.greater_equal(t23, t78)
@@ -1835,106 +1835,106 @@ def ik_numeric_step(target, q, damping=0.0):
     t88 = xp.where(xp.greater_equal(t44*t84 + t45*t85 + t34*t86, 0), xp.asarray(1, dtype=dtype), -1)
     t89 = xp.greater(t46, 1e-06) | xp.greater(t79, 0)
     t90 = t80*t88/t87
-    t91 = xp.where(t89, t44*t81, t84*t90)
-    t92 = xp.where(t89, t45*t81, t85*t90)
-    t93 = xp.where(t89, t34*t81, t86*t90)
+    t91 = xp.where(t89, t44*t81, t90*t84)
+    t92 = xp.where(t89, t45*t81, t90*t85)
+    t93 = xp.where(t89, t34*t81, t90*t86)
     t94 = t91**2 + t92**2 + t93**2 + t5**2 + t6**2 + t9**2
-    t95 = t57 + damping
-    t96 = xp.sqrt(t47 + t61**2 + t66**2 + t49**2 + t95**2 + t67*t56)
+    t95 = damping + t57
+    t96 = xp.sqrt(t47 + t61**2 + t65**2 + t49**2 + t53*t67 + t95**2)
     t97 = t96*xp.where(xp.greater_equal(t95, 0), xp.asarray(1, dtype=dtype), -1)
-    t98 = t97 + t95
+    t98 = t95 + t97
     t99 = xp.where(xp.greater(t96, 0), 1/(t96*(t96 + xp.abs(t95))), 0)
-    t100 = t70 + damping
-    t101 = t7*t59
-    t102 = t99*(t98*t61 + t61*t100 + t66*t75 + t58 + t49*t101 + t77*t101)
-    t103 = t61 - t98*t102
-    t104 = -t102*t61 + t100
-    t105 = t75 - t102*t66
-    t106 = -t77 + t102*t101
-    t107 = -t102*t49 + t101
-    t108 = t2 + t102*t3
-    t109 = t99*(t92*t49 + t5*t98 + t6*t61 + t9*t66 - t93*t3 - t91*t101)
-    t110 = t5 - t98*t109
-    t111 = t6 - t109*t61
-    t112 = t9 - t109*t66
-    t113 = t91 + t109*t101
-    t114 = t92 - t109*t49
-    t115 = t93 + t109*t3
-    t116 = xp.sqrt(t104**2 + t105**2 + t106**2 + t107**2 + t108**2)
-    t117 = t116*xp.where(xp.greater_equal(t104, 0), xp.asarray(1, dtype=dtype), -1)
-    t118 = t104 + t117
-    t119 = xp.where(xp.greater(t116, 0), 1/(t116*(t116 + xp.abs(t104))), 0)
-    t120 = t119*(t105*t112 + t106*t113 + t107*t114 + t108*t115 + t111*t118)
-    t121 = t111 - t118*t120
-    t122 = t112 - t105*t120
-    t123 = t113 - t106*t120
-    t124 = t114 - t107*t120
-    t125 = t115 - t108*t120
-    t126 = t53 + damping
-    t127 = t99*(t98*t66 + t61*t75 + t66*t126 - t49*t65 - t65*t76)
-    t128 = t66 - t98*t127
-    t129 = t75 - t127*t61
-    t130 = -t127*t66 + t126
-    t131 = t74 + t127*t101
-    t132 = t65 + t127*t49
-    t133 = t68 + damping
-    t134 = t99*(t3*t64 + t49*t62 - t61*t77 + t66*t74 - t98*t101 - t133*t101)
-    t135 = t98*t134 + t101
-    t136 = t77 + t134*t61
-    t137 = t74 - t134*t66
-    t138 = t134*t101 + t133
-    t139 = t62 - t134*t49
-    t140 = -t64
-    t141 = t140 + t134*t3
-    t142 = t119*(t105*t137 + t106*t138 + t107*t139 + t108*t141 - t136*t118)
+    t100 = t7*t59
+    t101 = t99*(t5*t98 + t61*t6 + t65*t9 - t100*t91 + t49*t92 - t3*t93)
+    t102 = t5 - t98*t101
+    t103 = t6 - t61*t101
+    t104 = t9 - t65*t101
+    t105 = t91 + t100*t101
+    t106 = t92 - t49*t101
+    t107 = t93 + t3*t101
+    t108 = damping + t70
+    t109 = t99*(t58 + t65*t74 + t100*t77 + t100*t49 + t61*t98 + t61*t108)
+    t110 = t61 - t98*t109
+    t111 = t108 - t61*t109
+    t112 = t74 - t65*t109
+    t113 = -t77 + t100*t109
+    t114 = t100 - t49*t109
+    t115 = t2 + t3*t109
+    t116 = xp.sqrt(t111**2 + t112**2 + t113**2 + t114**2 + t115**2)
+    t117 = t116*xp.where(xp.greater_equal(t111, 0), xp.asarray(1, dtype=dtype), -1)
+    t118 = t111 + t117
+    t119 = xp.where(xp.greater(t116, 0), 1/(t116*(t116 + xp.abs(t111))), 0)
+    t120 = t119*(t103*t118 + t112*t104 + t113*t105 + t114*t106 + t115*t107)
+    t121 = t103 - t118*t120
+    t122 = t104 - t112*t120
+    t123 = t105 - t113*t120
+    t124 = t106 - t114*t120
+    t125 = t107 - t115*t120
+    t126 = damping + t51
+    t127 = t99*(t61*t74 - t63*t76 - t63*t49 + t65*t98 + t65*t126)
+    t128 = t65 - t98*t127
+    t129 = t74 - t61*t127
+    t130 = t126 - t65*t127
+    t131 = t72 + t100*t127
+    t132 = t63 + t49*t127
+    t133 = damping + t68
+    t134 = t99*(-t61*t77 + t72*t65 + t49*t62 + t3*t66 - t100*t98 - t100*t133)
+    t135 = t100 + t98*t134
+    t136 = t77 + t61*t134
+    t137 = t72 - t65*t134
+    t138 = t133 + t100*t134
+    t139 = t62 - t49*t134
+    t140 = -t66
+    t141 = t140 + t3*t134
+    t142 = t119*(-t136*t118 + t112*t137 + t113*t138 + t114*t139 + t115*t141)
     t143 = t136 + t118*t142
-    t144 = t137 - t105*t142
-    t145 = t138 - t106*t142
-    t146 = t139 - t107*t142
-    t147 = t141 - t108*t142
-    t148 = t71 + damping
-    t149 = t99*(t98*t49 + t3*t73 + t49*t148 - t66*t65 + t61*t101 - t62*t101)
+    t144 = t137 - t112*t142
+    t145 = t138 - t113*t142
+    t146 = t139 - t114*t142
+    t147 = t141 - t115*t142
+    t148 = damping + t71
+    t149 = t99*(t100*t61 - t63*t65 - t100*t62 + t3*t75 + t49*t98 + t49*t148)
     t150 = t49 - t98*t149
-    t151 = -t149*t61 + t101
-    t152 = t65 + t149*t66
-    t153 = t62 + t149*t101
-    t154 = -t149*t49 + t148
-    t155 = -t73 + t149*t3
-    t156 = t119*(t106*t153 + t107*t154 + t108*t155 + t151*t118 - t105*t152)
+    t151 = t100 - t61*t149
+    t152 = t63 + t65*t149
+    t153 = t62 + t100*t149
+    t154 = t148 - t49*t149
+    t155 = -t75 + t3*t149
+    t156 = t119*(t151*t118 - t112*t152 + t113*t153 + t114*t154 + t115*t155)
     t157 = t151 - t118*t156
-    t158 = t152 + t105*t156
-    t159 = t153 - t106*t156
-    t160 = t154 - t107*t156
-    t161 = t155 - t108*t156
-    t162 = t54 + damping
-    t163 = -t99*(-t2*t61 + t98*t3 + t3*t162 + t49*t73 - t64*t101)
+    t158 = t152 + t112*t156
+    t159 = t153 - t113*t156
+    t160 = t154 - t114*t156
+    t161 = t155 - t115*t156
+    t162 = damping + t55
+    t163 = -t99*(-t2*t61 - t100*t66 + t49*t75 + t3*t98 + t3*t162)
     t164 = t3 + t98*t163
-    t165 = t2 - t163*t61
-    t166 = t140 + t163*t101
-    t167 = t73 + t163*t49
-    t168 = t163*t3 + t162
-    t169 = t127*t3
-    t170 = t119*(t105*t130 + t106*t131 + t129*t118 - t107*t132 + t108*t169)
+    t165 = t2 - t61*t163
+    t166 = t140 + t100*t163
+    t167 = t75 + t49*t163
+    t168 = t162 + t3*t163
+    t169 = t3*t127
+    t170 = t119*(t129*t118 + t112*t130 + t113*t131 - t114*t132 + t169*t115)
     t171 = t129 - t118*t170
-    t172 = t130 - t105*t170
-    t173 = t131 - t106*t170
-    t174 = t132 + t107*t170
-    t175 = t169 - t108*t170
+    t172 = t130 - t112*t170
+    t173 = t131 - t113*t170
+    t174 = t132 + t114*t170
+    t175 = t169 - t115*t170
     t176 = xp.sqrt(t172**2 + t173**2 + t174**2 + t175**2)
     t177 = t176*xp.where(xp.greater_equal(t172, 0), xp.asarray(1, dtype=dtype), -1)
     t178 = t172 + t177
     t179 = xp.where(xp.greater(t176, 0), 1/(t176*(t176 + xp.abs(t172))), 0)
-    t180 = t179*(t173*t145 + t175*t147 + t144*t178 - t174*t146)
+    t180 = t179*(t144*t178 + t173*t145 - t174*t146 + t175*t147)
     t181 = t144 - t178*t180
     t182 = t145 - t173*t180
     t183 = t146 + t174*t180
     t184 = t147 - t175*t180
-    t185 = t179*(t173*t159 + t175*t161 - t174*t160 - t158*t178)
+    t185 = t179*(-t158*t178 + t173*t159 - t174*t160 + t175*t161)
     t186 = t158 + t178*t185
     t187 = t159 - t173*t185
     t188 = t160 + t174*t185
     t189 = t161 - t175*t185
-    t190 = t179*(t173*t123 + t175*t125 + t122*t178 - t174*t124)
+    t190 = t179*(t122*t178 + t173*t123 - t174*t124 + t175*t125)
     t191 = t122 - t178*t190
     t192 = t123 - t173*t190
     t193 = t124 + t174*t190
@@ -1943,11 +1943,11 @@ def ik_numeric_step(target, q, damping=0.0):
     t196 = t195*xp.where(xp.greater_equal(t182, 0), xp.asarray(1, dtype=dtype), -1)
     t197 = t182 + t196
     t198 = xp.where(xp.greater(t195, 0), 1/(t195*(t195 + xp.abs(t182))), 0)
-    t199 = t198*(t183*t188 + t184*t189 + t187*t197)
+    t199 = t198*(t187*t197 + t183*t188 + t184*t189)
     t200 = t187 - t197*t199
     t201 = t188 - t183*t199
     t202 = t189 - t184*t199
-    t203 = t198*(t183*t193 + t184*t194 + t192*t197)
+    t203 = t198*(t192*t197 + t183*t193 + t184*t194)
     t204 = t192 - t197*t203
     t205 = t193 - t183*t203
     t206 = t194 - t184*t203
@@ -1955,45 +1955,45 @@ def ik_numeric_step(target, q, damping=0.0):
     t208 = t207*xp.where(xp.greater_equal(t201, 0), xp.asarray(1, dtype=dtype), -1)
     t209 = t201 + t208
     t210 = xp.where(xp.greater(t207, 0), 1/(t207*(t207 + xp.abs(t201))), 0)
-    t211 = t210*(t202*t206 + t205*t209)
+    t211 = t210*(t205*t209 + t202*t206)
     t212 = t205 - t209*t211
     t213 = t206 - t202*t211
-    t214 = t163*t66
-    t215 = t119*(t106*t166 + t108*t168 + t165*t118 - t107*t167 - t105*t214)
+    t214 = t65*t163
+    t215 = t119*(t165*t118 - t214*t112 + t113*t166 - t114*t167 + t115*t168)
     t216 = t165 - t118*t215
-    t217 = t105*t215 + t214
-    t218 = t166 - t106*t215
-    t219 = t167 + t107*t215
-    t220 = t168 - t108*t215
-    t221 = t179*(t173*t218 + t174*t219 + t175*t220 - t217*t178)
+    t217 = t214 + t112*t215
+    t218 = t166 - t113*t215
+    t219 = t167 + t114*t215
+    t220 = t168 - t115*t215
+    t221 = t179*(-t217*t178 + t173*t218 + t174*t219 + t175*t220)
     t222 = t217 + t178*t221
     t223 = t218 - t173*t221
     t224 = -t219 + t174*t221
     t225 = t220 - t175*t221
-    t226 = t198*(t183*t224 + t184*t225 + t223*t197)
+    t226 = t198*(t223*t197 + t183*t224 + t184*t225)
     t227 = t223 - t197*t226
     t228 = t224 - t183*t226
     t229 = t225 - t184*t226
-    t230 = t210*(t202*t229 + t228*t209)
+    t230 = t210*(t228*t209 + t202*t229)
     t231 = t228 - t209*t230
     t232 = t229 - t202*t230
     t233 = xp.abs(t232)
     t234 = t233
     t235 = t234*xp.where(xp.greater_equal(t232, 0), xp.asarray(1, dtype=dtype), -1)
     t236 = t232 + t235
-    t237 = xp.where(xp.greater(t234, 0), 1/(t234*(t234 + t233)), 0)
-    t238 = t213 - t213*t237*t236**2
+    t237 = xp.where(xp.greater(t234, 0), 1/(t234*(t233 + t234)), 0)
+    t238 = t213 - t213*t236**2*t237
     t239 = xp.where(xp.not_equal(t235, 0), -t238/t235, 0)
     t240 = xp.where(xp.not_equal(t208, 0), -(t212 - t231*t239)/t208, 0)
-    t241 = xp.where(xp.not_equal(t196, 0), -(t204 - (t200*t240 + t227*t239))/t196, 0)
-    t242 = xp.where(xp.not_equal(t177, 0), -(t191 - t181*t241 + t186*t240 + t222*t239)/t177, 0)
-    t243 = xp.where(xp.not_equal(t117, 0), -(t121 - (t171*t242 + t157*t240 + t216*t239 - t143*t241))/t117, 0)
-    t244 = xp.where(xp.not_equal(t97, 0), -(t110 - (t103*t243 + t128*t242 + t150*t240 - t135*t241 - t164*t239))/t97, 0)
-    t245 = t239 + q1 + t2*t243 - t3*t244
-    t246 = q2 + t240*c1 - t4*t242 - t241*s1 + s1*t243*t7 + c1*t244*t7
-    t247 = q3 + t242*c2 + t243*t26 + t244*t18
-    t248 = q4 + t239*c2 + t240*t26 + t241*t18
-    t249 = q5 + t16*t241 + t13*t240 - t239*t38
+    t241 = xp.where(xp.not_equal(t196, 0), -(-(t200*t240 + t227*t239) + t204)/t196, 0)
+    t242 = xp.where(xp.not_equal(t177, 0), -(t191 + t186*t240 + t222*t239 - t181*t241)/t177, 0)
+    t243 = xp.where(xp.not_equal(t117, 0), -(-(t171*t242 - t143*t241 + t157*t240 + t216*t239) + t121)/t117, 0)
+    t244 = xp.where(xp.not_equal(t97, 0), -(-(t110*t243 + t128*t242 - t135*t241 + t150*t240 - t164*t239) + t102)/t97, 0)
+    t245 = q1 + t239 - t3*t244 + t2*t243
+    t246 = q2 + c1*t7*t244 + s1*t7*t243 - t4*t242 - s1*t241 + c1*t240
+    t247 = q3 + t18*t244 + t26*t243 + c2*t242
+    t248 = q4 + t18*t241 + t26*t240 + c2*t239
+    t249 = q5 + t16*t241 + t13*t240 - t38*t239
     t250 = q6 + t20*t241 + t28*t240 - t37*t239
     q_start = _stack(xp, [
         xp.broadcast_to(q1, batch),  # 0
@@ -2031,17 +2031,17 @@ def ik_branches(T):
     T21 = T[..., 2, 1]
     T22 = T[..., 2, 2]
     T23 = T[..., 2, 3]
-    t0 = T00 + T01 + T02 + T03 + T10 + T11 + T12 + T13 + T20 + T21 + T22 + T23
+    t0 = T00 + T01 + T02 + T10 + T11 + T12 + T20 + T21 + T22 + T03 + T13 + T23
     t1 = -0.1337*T00 + 0.412*T02
-    t2 = T03 - t1
+    t2 = -t1 + T03
     t3 = t1
     t4 = t2 + t3
     t5 = -0.1337*T10 + 0.412*T12
-    t6 = T13 - t5
+    t6 = -t5 + T13
     t7 = t5
     t8 = t6 + t7
     t9 = -0.1337*T20 + 0.412*T22
-    t10 = T23 - t9
+    t10 = -t9 + T23
     t11 = t9
     t12 = t10 + t11
     t13 = -0.412 + t12
@@ -2062,12 +2062,12 @@ def ik_branches(T):
     t28 = xp.greater(t26, t27)
     t29 = xp.where(t28, xp.sqrt(t26), 0)
     t30 = t4*t29
-    t31 = t14 + 0.1337*t8
+    t31 = 0.1337*t8 + t14
     t32 = -t30 + t31
     t33 = t30 + t31
     t34 = -t14
-    t35 = t32 + t34
-    t36 = t33 + t34
+    t35 = t34 + t32
+    t36 = t34 + t33
     t37 = 0.1337*t4
     t38 = t8*t29
     t39 = t37 + t38
@@ -2075,9 +2075,9 @@ def ik_branches(T):
     t41 = -t37 + t38
     t42 = t36**2 + t41**2
     t43 = t29**2
-    t44 = t43 + t24
+    t44 = t24 + t43
     t45 = 1e-24*t44
-    t46 = t15*t45
+    t46 = t45*t15
     t47 = xp.less_equal(t40, t46)
     t48 = xp.where(t47, 1, 1/xp.sqrt(t40))
     t49 = xp.where(t47, 1, t35*t48)
@@ -2095,15 +2095,15 @@ def ik_branches(T):
     t61 = -0.01787569 + t60
     t62 = t22*t43
     t63 = t59**2 + t62
-    t64 = t61**2 + t62
-    t65 = t23*t45
+    t64 = t62 + t61**2
+    t65 = t45*t23
     t66 = xp.less_equal(t63, t65)
     t67 = xp.where(t66, 1, 1/xp.sqrt(t63))
     t68 = xp.where(t66, 1, t59*t67)
     t69 = t21*t29
     t70 = xp.where(t66, 0, xp.atan2(t69, t59))
-    t71 = t70 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t70))
-    t72 = t67*t69
+    t71 = -6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t70)) + t70
+    t72 = t69*t67
     t73 = xp.where(t66, 0, -t72)
     t74 = xp.where(t66, 0, t72)
     t75 = xp.less_equal(t42, t46)
@@ -2115,24 +2115,24 @@ def ik_branches(T):
     t81 = T00*t77 + T10*t78
     t82 = T10*t77 - T00*t78
     t83 = xp.where(t75, 0, xp.atan2(t41, t36))
-    t84 = t83 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t83))
+    t84 = -6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t83)) + t83
     t85 = 1 - t49
     t86 = T22*t85
     t87 = t86 + T22*t49
     t88 = T20*t85
     t89 = t88 + T20*t49
     t90 = t68*t51 - t73*t87
-    t91 = t68*t87 + t73*t51
+    t91 = t68*t87 + t51*t73
     t92 = t68*t53 - t73*t89
     t93 = t68*t89 + t73*t53
     t94 = 1 - t68
     t95 = t52*t94
-    t96 = t95 + t68*t52
-    t97 = t54*t94
+    t96 = t95 + t52*t68
+    t97 = t94*t54
     t98 = t97 + t68*t54
-    t99 = t80*t94
+    t99 = t94*t80
     t100 = t99 + t68*t80
-    t101 = t82*t94
+    t101 = t94*t82
     t102 = t101 + t68*t82
     t103 = t91**2
     t104 = -t103
@@ -2140,40 +2140,40 @@ def ik_branches(T):
     t106 = xp.greater(t105, 1e-12)
     t107 = xp.where(t106, xp.sqrt(t105), 0)
     t108 = t103 + t96*t107
-    t109 = t108 + t104
-    t110 = t90**2
-    t111 = t110 + t96**2 + t103
-    t112 = t107**2
+    t109 = t104 + t108
+    t110 = t107**2
+    t111 = t103 + t110
+    t112 = t90**2
     t113 = t109**2 + t110*t112
-    t114 = t103 + t112
-    t115 = 1e-24*t114
-    t116 = xp.less_equal(t113, t111*t115)
+    t114 = t103 + t96**2 + t112
+    t115 = 1e-24*t111
+    t116 = xp.less_equal(t113, t115*t114)
     t117 = xp.where(t116, 1, 1/xp.sqrt(t113))
     t118 = xp.where(t116, 1, t109*t117)
     t119 = t93*(1 - t118)
     t120 = t119 + t93*t118
-    t121 = t90*t107
-    t122 = xp.where(t116, 0, -t117*t121)
-    t123 = t92*t118 + t98*t122
-    t124 = t98*t118 - t92*t122
-    t125 = xp.less_equal(t114, t115)
-    t126 = xp.where(t125, 1, 1/xp.sqrt(t114))
+    t121 = t107*t90
+    t122 = xp.where(t116, 0, -t121*t117)
+    t123 = t118*t92 + t98*t122
+    t124 = t118*t98 - t92*t122
+    t125 = xp.less_equal(t111, t115)
+    t126 = xp.where(t125, 1, 1/xp.sqrt(t111))
     t127 = xp.where(t125, 1, t91*t126)
     t128 = xp.where(t125, 0, -t107*t126)
     t129 = t123*(1 - t127)
-    t130 = t129 + t127*t123
+    t130 = t129 + t123*t127
     t131 = t127*t124 + t128*t120
-    t132 = t127*t120 - t128*t124
+    t132 = t127*t120 - t124*t128
     t133 = t130**2 + t131**2
     t134 = t133
-    t135 = t132**2 + t133
+    t135 = t133 + t132**2
     t136 = 1 - t77
     t137 = T22*t136
     t138 = t137 + T22*t77
     t139 = T20*t136
     t140 = t139 + T20*t77
     t141 = t68*t79 - t74*t138
-    t142 = t68*t138 + t74*t79
+    t142 = t68*t138 + t79*t74
     t143 = t68*t81 - t74*t140
     t144 = t68*t140 + t74*t81
     t145 = t142**2
@@ -2182,39 +2182,39 @@ def ik_branches(T):
     t148 = xp.greater(t147, 1e-12)
     t149 = xp.where(t148, xp.sqrt(t147), 0)
     t150 = t145 + t100*t149
-    t151 = t150 + t146
-    t152 = t141**2
-    t153 = t152 + t100**2 + t145
-    t154 = t149**2
+    t151 = t146 + t150
+    t152 = t149**2
+    t153 = t145 + t152
+    t154 = t141**2
     t155 = t151**2 + t152*t154
-    t156 = t145 + t154
-    t157 = 1e-24*t156
-    t158 = xp.less_equal(t155, t153*t157)
+    t156 = t145 + t100**2 + t154
+    t157 = 1e-24*t153
+    t158 = xp.less_equal(t155, t157*t156)
     t159 = xp.where(t158, 1, 1/xp.sqrt(t155))
     t160 = xp.where(t158, 1, t151*t159)
     t161 = t144*(1 - t160)
     t162 = t161 + t144*t160
-    t163 = t141*t149
-    t164 = xp.where(t158, 0, -t159*t163)
-    t165 = t143*t160 + t102*t164
-    t166 = t102*t160 - t143*t164
-    t167 = xp.less_equal(t156, t157)
-    t168 = xp.where(t167, 1, 1/xp.sqrt(t156))
+    t163 = t149*t141
+    t164 = xp.where(t158, 0, -t163*t159)
+    t165 = t160*t143 + t102*t164
+    t166 = t160*t102 - t143*t164
+    t167 = xp.less_equal(t153, t157)
+    t168 = xp.where(t167, 1, 1/xp.sqrt(t153))
     t169 = xp.where(t167, 1, t142*t168)
     t170 = xp.where(t167, 0, -t149*t168)
     t171 = t165*(1 - t169)
-    t172 = t171 + t169*t165
+    t172 = t171 + t165*t169
     t173 = t169*t166 + t170*t162
-    t174 = t169*t162 - t170*t166
+    t174 = t169*t162 - t166*t170
     t175 = t172**2 + t173**2
     t176 = t175
-    t177 = t174**2 + t175
+    t177 = t175 + t174**2
     t178 = xp.less_equal(t64, t65)
     t179 = xp.where(t178, 1, 1/xp.sqrt(t64))
     t180 = xp.where(t178, 1, t61*t179)
     t181 = xp.where(t178, 0, xp.atan2(t69, t61))
-    t182 = t181 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t181))
-    t183 = t179*t69
+    t182 = -6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t181)) + t181
+    t183 = t69*t179
     t184 = xp.where(t178, 0, t183)
     t185 = xp.where(t178, 0, -t183)
     t186 = t51*t180 - t87*t184
@@ -2240,135 +2240,135 @@ def ik_branches(T):
     t206 = xp.greater(t205, 1e-12)
     t207 = xp.where(t206, xp.sqrt(t205), 0)
     t208 = t203 + t196*t207
-    t209 = t208 + t204
-    t210 = t186**2
-    t211 = t210 + t196**2 + t203
-    t212 = t207**2
+    t209 = t204 + t208
+    t210 = t207**2
+    t211 = t203 + t210
+    t212 = t186**2
     t213 = t209**2 + t210*t212
-    t214 = t203 + t212
-    t215 = 1e-24*t214
-    t216 = xp.less_equal(t213, t211*t215)
+    t214 = t203 + t196**2 + t212
+    t215 = 1e-24*t211
+    t216 = xp.less_equal(t213, t215*t214)
     t217 = xp.where(t216, 1, 1/xp.sqrt(t213))
     t218 = xp.where(t216, 1, t209*t217)
     t219 = t189*(1 - t218)
     t220 = t219 + t189*t218
-    t221 = t186*t207
-    t222 = xp.where(t216, 0, -t217*t221)
-    t223 = t188*t218 + t198*t222
-    t224 = t198*t218 - t188*t222
-    t225 = xp.less_equal(t214, t215)
-    t226 = xp.where(t225, 1, 1/xp.sqrt(t214))
+    t221 = t207*t186
+    t222 = xp.where(t216, 0, -t221*t217)
+    t223 = t218*t188 + t198*t222
+    t224 = t218*t198 - t188*t222
+    t225 = xp.less_equal(t211, t215)
+    t226 = xp.where(t225, 1, 1/xp.sqrt(t211))
     t227 = xp.where(t225, 1, t187*t226)
     t228 = xp.where(t225, 0, -t207*t226)
     t229 = t223*(1 - t227)
-    t230 = t229 + t227*t223
+    t230 = t229 + t223*t227
     t231 = t227*t224 + t228*t220
-    t232 = t227*t220 - t228*t224
+    t232 = t227*t220 - t224*t228
     t233 = t230**2 + t231**2
     t234 = t233
-    t235 = t232**2 + t233
+    t235 = t233 + t232**2
     t236 = t191**2
     t237 = -t236
     t238 = 1 + t237
     t239 = xp.greater(t238, 1e-12)
     t240 = xp.where(t239, xp.sqrt(t238), 0)
     t241 = t236 + t200*t240
-    t242 = t241 + t237
-    t243 = t190**2
-    t244 = t243 + t200**2 + t236
-    t245 = t240**2
+    t242 = t237 + t241
+    t243 = t240**2
+    t244 = t236 + t243
+    t245 = t190**2
     t246 = t242**2 + t243*t245
-    t247 = t236 + t245
-    t248 = 1e-24*t247
-    t249 = xp.less_equal(t246, t244*t248)
+    t247 = t236 + t200**2 + t245
+    t248 = 1e-24*t244
+    t249 = xp.less_equal(t246, t248*t247)
     t250 = xp.where(t249, 1, 1/xp.sqrt(t246))
     t251 = xp.where(t249, 1, t242*t250)
     t252 = t193*(1 - t251)
     t253 = t252 + t193*t251
-    t254 = t190*t240
-    t255 = xp.where(t249, 0, -t250*t254)
-    t256 = t192*t251 + t202*t255
-    t257 = t202*t251 - t192*t255
-    t258 = xp.less_equal(t247, t248)
-    t259 = xp.where(t258, 1, 1/xp.sqrt(t247))
+    t254 = t240*t190
+    t255 = xp.where(t249, 0, -t254*t250)
+    t256 = t251*t192 + t202*t255
+    t257 = t251*t202 - t192*t255
+    t258 = xp.less_equal(t244, t248)
+    t259 = xp.where(t258, 1, 1/xp.sqrt(t244))
     t260 = xp.where(t258, 1, t191*t259)
     t261 = xp.where(t258, 0, -t240*t259)
     t262 = t256*(1 - t260)
-    t263 = t262 + t260*t256
+    t263 = t262 + t256*t260
     t264 = t260*t257 + t261*t253
-    t265 = t260*t253 - t261*t257
+    t265 = t260*t253 - t257*t261
     t266 = t263**2 + t264**2
     t267 = t266
-    t268 = t265**2 + t266
+    t268 = t266 + t265**2
     t269 = -t69
     t270 = xp.where(t66, 0, xp.atan2(t269, t59))
-    t271 = t270 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t270))
+    t271 = -6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t270)) + t270
     t272 = xp.where(t178, 0, xp.atan2(t269, t61))
-    t273 = t272 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t272))
+    t273 = -6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t272)) + t272
     t274 = xp.where(t116, 0, xp.atan2(-t121, t109))
     t275 = t274
-    t276 = t275 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t275))
+    t276 = -6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t275)) + t275
     t277 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t274) + t274
-    t278 = t277 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t277))
+    t278 = -6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t277)) + t277
     t279 = xp.where(t125, 0, xp.atan2(-t107, t91))
     t280 = t279
-    t281 = t280 - 6.283185307179586*xp.floor(0.15915494309189535*(1.5707963267948966 + t280))
-    t282 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t279)) + t279
+    t281 = -6.283185307179586*xp.floor(0.15915494309189535*(1.5707963267948966 + t280)) + t280
+    t282 = t279 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t279))
     t283 = xp.where(xp.less_equal(t134, 1e-24*t135), 0, xp.atan2(t130, -t131))
     t284 = t283
-    t285 = t284 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t284))
+    t285 = -6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t284)) + t284
     t286 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t283) + t283
-    t287 = t286 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t286))
+    t287 = -6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t286)) + t286
     t288 = -t282
-    t289 = t282 + 6.283185307179586*xp.floor(0.15915494309189535*(1.5707963267948966 + t288))
+    t289 = 6.283185307179586*xp.floor(0.15915494309189535*(1.5707963267948966 + t288)) + t282
     t290 = xp.where(t158, 0, xp.atan2(-t163, t151))
     t291 = t290
-    t292 = t291 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t291))
+    t292 = -6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t291)) + t291
     t293 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t290) + t290
-    t294 = t293 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t293))
+    t294 = -6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t293)) + t293
     t295 = xp.where(t167, 0, xp.atan2(-t149, t142))
     t296 = t295
-    t297 = t296 - 6.283185307179586*xp.floor(0.15915494309189535*(1.5707963267948966 + t296))
+    t297 = -6.283185307179586*xp.floor(0.15915494309189535*(1.5707963267948966 + t296)) + t296
     t298 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t295)) + t295
     t299 = xp.where(xp.less_equal(t176, 1e-24*t177), 0, xp.atan2(t172, -t173))
     t300 = t299
-    t301 = t300 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t300))
+    t301 = -6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t300)) + t300
     t302 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t299) + t299
-    t303 = t302 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t302))
+    t303 = -6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t302)) + t302
     t304 = -t298
-    t305 = t298 + 6.283185307179586*xp.floor(0.15915494309189535*(1.5707963267948966 + t304))
+    t305 = 6.283185307179586*xp.floor(0.15915494309189535*(1.5707963267948966 + t304)) + t298
     t306 = xp.where(t216, 0, xp.atan2(-t221, t209))
     t307 = t306
-    t308 = t307 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t307))
+    t308 = -6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t307)) + t307
     t309 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t306) + t306
-    t310 = t309 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t309))
+    t310 = -6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t309)) + t309
     t311 = xp.where(t225, 0, xp.atan2(-t207, t187))
     t312 = t311
-    t313 = t312 - 6.283185307179586*xp.floor(0.15915494309189535*(1.5707963267948966 + t312))
+    t313 = -6.283185307179586*xp.floor(0.15915494309189535*(1.5707963267948966 + t312)) + t312
     t314 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t311)) + t311
     t315 = xp.where(xp.less_equal(t234, 1e-24*t235), 0, xp.atan2(t230, -t231))
     t316 = t315
-    t317 = t316 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t316))
+    t317 = -6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t316)) + t316
     t318 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t315) + t315
-    t319 = t318 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t318))
+    t319 = -6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t318)) + t318
     t320 = -t314
-    t321 = t314 + 6.283185307179586*xp.floor(0.15915494309189535*(1.5707963267948966 + t320))
+    t321 = 6.283185307179586*xp.floor(0.15915494309189535*(1.5707963267948966 + t320)) + t314
     t322 = xp.where(t249, 0, xp.atan2(-t254, t242))
     t323 = t322
-    t324 = t323 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t323))
+    t324 = -6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t323)) + t323
     t325 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t322) + t322
-    t326 = t325 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t325))
+    t326 = -6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t325)) + t325
     t327 = xp.where(t258, 0, xp.atan2(-t240, t191))
     t328 = t327
-    t329 = t328 - 6.283185307179586*xp.floor(0.15915494309189535*(1.5707963267948966 + t328))
+    t329 = -6.283185307179586*xp.floor(0.15915494309189535*(1.5707963267948966 + t328)) + t328
     t330 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t327)) + t327
     t331 = xp.where(xp.less_equal(t267, 1e-24*t268), 0, xp.atan2(t263, -t264))
     t332 = t331
-    t333 = t332 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t332))
+    t333 = -6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t332)) + t332
     t334 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t331) + t331
-    t335 = t334 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t334))
+    t335 = -6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t334)) + t334
     t336 = -t330
-    t337 = t330 + 6.283185307179586*xp.floor(0.15915494309189535*(1.5707963267948966 + t336))
+    t337 = 6.283185307179586*xp.floor(0.15915494309189535*(1.5707963267948966 + t336)) + t330
     t338 = xp.less_equal(t56, 2.9670597283903604)
     t339 = xp.greater_equal(t55, -2.9670597283903604) & xp.less_equal(t55, 2.9670597283903604)
     t340 = xp.where(t338 & xp.logical_not(t339), t56, t55)
@@ -2619,75 +2619,75 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     lb5 = branches_in_limits[..., 5]
     lb6 = branches_in_limits[..., 6]
     lb7 = branches_in_limits[..., 7]
-    t0 = qb0_0 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn1 - qb0_0))
-    t1 = qb0_1 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn2 - qb0_1))
-    t2 = qb0_3 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn4 - qb0_3))
-    t3 = qb0_4 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn5 - qb0_4))
-    t4 = qb0_5 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn6 - qb0_5))
+    t0 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_0 + qn1)) + qb0_0
+    t1 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_1 + qn2)) + qb0_1
+    t2 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_3 + qn4)) + qb0_3
+    t3 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_4 + qn5)) + qb0_4
+    t4 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_5 + qn6)) + qb0_5
     t5 = xp.where(lb0 & vb0, xp.asarray(1, dtype=dtype), 0)
     t6 = xp.where(xp.greater(t5, 0), xp.asarray(1, dtype=dtype), 0)
-    t7 = qb1_0 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn1 - qb1_0))
-    t8 = qb1_1 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn2 - qb1_1))
-    t9 = qb1_3 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn4 - qb1_3))
-    t10 = qb1_4 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn5 - qb1_4))
-    t11 = qb1_5 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn6 - qb1_5))
+    t7 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_0 + qn1)) + qb1_0
+    t8 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_1 + qn2)) + qb1_1
+    t9 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_3 + qn4)) + qb1_3
+    t10 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_4 + qn5)) + qb1_4
+    t11 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_5 + qn6)) + qb1_5
     t12 = xp.where(lb1 & vb1, xp.asarray(1, dtype=dtype), 0)
-    t13 = qb2_0 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn1 - qb2_0))
-    t14 = qb2_1 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn2 - qb2_1))
-    t15 = qb2_3 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn4 - qb2_3))
-    t16 = qb2_4 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn5 - qb2_4))
-    t17 = qb2_5 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn6 - qb2_5))
+    t13 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_0 + qn1)) + qb2_0
+    t14 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_1 + qn2)) + qb2_1
+    t15 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_3 + qn4)) + qb2_3
+    t16 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_4 + qn5)) + qb2_4
+    t17 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_5 + qn6)) + qb2_5
     t18 = xp.where(lb2 & vb2, xp.asarray(1, dtype=dtype), 0)
-    t19 = qb3_0 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn1 - qb3_0))
-    t20 = qb3_1 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn2 - qb3_1))
-    t21 = qb3_3 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn4 - qb3_3))
-    t22 = qb3_4 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn5 - qb3_4))
-    t23 = qb3_5 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn6 - qb3_5))
+    t19 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_0 + qn1)) + qb3_0
+    t20 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_1 + qn2)) + qb3_1
+    t21 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_3 + qn4)) + qb3_3
+    t22 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_4 + qn5)) + qb3_4
+    t23 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_5 + qn6)) + qb3_5
     t24 = xp.where(lb3 & vb3, xp.asarray(1, dtype=dtype), 0)
-    t25 = qb4_0 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn1 - qb4_0))
-    t26 = qb4_1 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn2 - qb4_1))
-    t27 = qb4_3 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn4 - qb4_3))
-    t28 = qb4_4 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn5 - qb4_4))
-    t29 = qb4_5 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn6 - qb4_5))
+    t25 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_0 + qn1)) + qb4_0
+    t26 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_1 + qn2)) + qb4_1
+    t27 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_3 + qn4)) + qb4_3
+    t28 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_4 + qn5)) + qb4_4
+    t29 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_5 + qn6)) + qb4_5
     t30 = xp.where(lb4 & vb4, xp.asarray(1, dtype=dtype), 0)
-    t31 = qb5_0 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn1 - qb5_0))
-    t32 = qb5_1 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn2 - qb5_1))
-    t33 = qb5_3 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn4 - qb5_3))
-    t34 = qb5_4 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn5 - qb5_4))
-    t35 = qb5_5 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn6 - qb5_5))
+    t31 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_0 + qn1)) + qb5_0
+    t32 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_1 + qn2)) + qb5_1
+    t33 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_3 + qn4)) + qb5_3
+    t34 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_4 + qn5)) + qb5_4
+    t35 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_5 + qn6)) + qb5_5
     t36 = xp.where(lb5 & vb5, xp.asarray(1, dtype=dtype), 0)
-    t37 = qb6_0 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn1 - qb6_0))
-    t38 = qb6_1 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn2 - qb6_1))
-    t39 = qb6_3 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn4 - qb6_3))
-    t40 = qb6_4 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn5 - qb6_4))
-    t41 = qb6_5 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn6 - qb6_5))
+    t37 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_0 + qn1)) + qb6_0
+    t38 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_1 + qn2)) + qb6_1
+    t39 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_3 + qn4)) + qb6_3
+    t40 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_4 + qn5)) + qb6_4
+    t41 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_5 + qn6)) + qb6_5
     t42 = xp.where(lb6 & vb6, xp.asarray(1, dtype=dtype), 0)
-    t43 = qb7_0 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn1 - qb7_0))
-    t44 = qb7_1 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn2 - qb7_1))
-    t45 = qb7_3 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn4 - qb7_3))
-    t46 = qb7_4 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn5 - qb7_4))
-    t47 = qb7_5 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn6 - qb7_5))
+    t43 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_0 + qn1)) + qb7_0
+    t44 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_1 + qn2)) + qb7_1
+    t45 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_3 + qn4)) + qb7_3
+    t46 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_4 + qn5)) + qb7_4
+    t47 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_5 + qn6)) + qb7_5
     t48 = xp.where(lb7 & vb7, xp.asarray(1, dtype=dtype), 0)
-    t49 = T00 + T01 + T02 + T03 + T10 + T11 + T12 + T13 + T20 + T21 + T22 + T23 + qn1 + qn2 + qn3 + qn4 + qn5 + qn6 + qw1 + qw2 + qw3 + qw4 + qw5 + qw6
+    t49 = T00 + T01 + T02 + T10 + T11 + T12 + T20 + T21 + T22 + T03 + T13 + T23 + qn1 + qn2 + qn4 + qn5 + qn6 + qw1 + qw2 + qw3 + qn3 + qw4 + qw5 + qw6
     t50 = xp.where(xp.less(t0, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t51 = t0 + t50
-    t52 = t0 - t50
+    t52 = -t50 + t0
     t53 = xp.where(xp.greater_equal(t0, -2.9670597283903604) & xp.less_equal(t0, 2.9670597283903604), t0, xp.where(xp.greater_equal(t51, -2.9670597283903604) & xp.less_equal(t51, 2.9670597283903604), t51, xp.where(xp.greater_equal(t52, -2.9670597283903604) & xp.less_equal(t52, 2.9670597283903604), t52, qb0_0)))
     t54 = xp.where(xp.less(t1, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t55 = t1 + t54
-    t56 = t1 - t54
+    t56 = -t54 + t1
     t57 = xp.where(xp.greater_equal(t1, -2.9670597283903604) & xp.less_equal(t1, 2.9670597283903604), t1, xp.where(xp.greater_equal(t55, -2.9670597283903604) & xp.less_equal(t55, 2.9670597283903604), t55, xp.where(xp.greater_equal(t56, -2.9670597283903604) & xp.less_equal(t56, 2.9670597283903604), t56, qb0_1)))
     t58 = xp.where(xp.less(t2, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t59 = t2 + t58
-    t60 = t2 - t58
+    t60 = -t58 + t2
     t61 = xp.where(xp.greater_equal(t2, -2.9670597283903604) & xp.less_equal(t2, 2.9670597283903604), t2, xp.where(xp.greater_equal(t59, -2.9670597283903604) & xp.less_equal(t59, 2.9670597283903604), t59, xp.where(xp.greater_equal(t60, -2.9670597283903604) & xp.less_equal(t60, 2.9670597283903604), t60, qb0_3)))
     t62 = xp.where(xp.less(t3, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t63 = t3 + t62
-    t64 = t3 - t62
+    t64 = -t62 + t3
     t65 = xp.where(xp.greater_equal(t3, -1.5707963267948966) & xp.less_equal(t3, 1.5707963267948966), t3, xp.where(xp.greater_equal(t63, -1.5707963267948966) & xp.less_equal(t63, 1.5707963267948966), t63, xp.where(xp.greater_equal(t64, -1.5707963267948966) & xp.less_equal(t64, 1.5707963267948966), t64, qb0_4)))
     t66 = xp.where(xp.less(t4, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t67 = t4 + t66
-    t68 = t4 - t66
+    t68 = -t66 + t4
     t69 = xp.where(xp.greater_equal(t4, -2.9670597283903604) & xp.less_equal(t4, 2.9670597283903604), t4, xp.where(xp.greater_equal(t67, -2.9670597283903604) & xp.less_equal(t67, 2.9670597283903604), t67, xp.where(xp.greater_equal(t68, -2.9670597283903604) & xp.less_equal(t68, 2.9670597283903604), t68, qb0_5)))
     t70 = -qn1
     t71 = -qn2
@@ -2695,7 +2695,7 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     t73 = -qn4
     t74 = -qn5
     t75 = -qn6
-    t76 = qw1*(t53 + t70)**2 + qw2*(t57 + t71)**2 + qw3*(qb0_2 + t72)**2 + qw4*(t61 + t73)**2 + qw5*(t65 + t74)**2 + qw6*(t69 + t75)**2
+    t76 = qw1*(t70 + t53)**2 + qw2*(t71 + t57)**2 + qw3*(t72 + qb0_2)**2 + qw4*(t73 + t61)**2 + qw5*(t74 + t65)**2 + qw6*(t75 + t69)**2
     t77 = xp.greater(t6, 0)
     t78 = xp.where(t77, t53, qn1)
     t79 = xp.where(t77, t57, qn2)
@@ -2706,25 +2706,25 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     t84 = xp.where(t77, t76, 0)
     t85 = xp.where(xp.less(t7, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t86 = t7 + t85
-    t87 = t7 - t85
+    t87 = -t85 + t7
     t88 = xp.where(xp.greater_equal(t7, -2.9670597283903604) & xp.less_equal(t7, 2.9670597283903604), t7, xp.where(xp.greater_equal(t86, -2.9670597283903604) & xp.less_equal(t86, 2.9670597283903604), t86, xp.where(xp.greater_equal(t87, -2.9670597283903604) & xp.less_equal(t87, 2.9670597283903604), t87, qb1_0)))
     t89 = xp.where(xp.less(t8, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t90 = t8 + t89
-    t91 = t8 - t89
+    t91 = -t89 + t8
     t92 = xp.where(xp.greater_equal(t8, -2.9670597283903604) & xp.less_equal(t8, 2.9670597283903604), t8, xp.where(xp.greater_equal(t90, -2.9670597283903604) & xp.less_equal(t90, 2.9670597283903604), t90, xp.where(xp.greater_equal(t91, -2.9670597283903604) & xp.less_equal(t91, 2.9670597283903604), t91, qb1_1)))
     t93 = xp.where(xp.less(t9, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t94 = t9 + t93
-    t95 = t9 - t93
+    t95 = -t93 + t9
     t96 = xp.where(xp.greater_equal(t9, -2.9670597283903604) & xp.less_equal(t9, 2.9670597283903604), t9, xp.where(xp.greater_equal(t94, -2.9670597283903604) & xp.less_equal(t94, 2.9670597283903604), t94, xp.where(xp.greater_equal(t95, -2.9670597283903604) & xp.less_equal(t95, 2.9670597283903604), t95, qb1_3)))
     t97 = xp.where(xp.less(t10, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t98 = t10 + t97
-    t99 = t10 - t97
+    t99 = -t97 + t10
     t100 = xp.where(xp.greater_equal(t10, -1.5707963267948966) & xp.less_equal(t10, 1.5707963267948966), t10, xp.where(xp.greater_equal(t98, -1.5707963267948966) & xp.less_equal(t98, 1.5707963267948966), t98, xp.where(xp.greater_equal(t99, -1.5707963267948966) & xp.less_equal(t99, 1.5707963267948966), t99, qb1_4)))
     t101 = xp.where(xp.less(t11, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t102 = t11 + t101
-    t103 = t11 - t101
+    t103 = -t101 + t11
     t104 = xp.where(xp.greater_equal(t11, -2.9670597283903604) & xp.less_equal(t11, 2.9670597283903604), t11, xp.where(xp.greater_equal(t102, -2.9670597283903604) & xp.less_equal(t102, 2.9670597283903604), t102, xp.where(xp.greater_equal(t103, -2.9670597283903604) & xp.less_equal(t103, 2.9670597283903604), t103, qb1_5)))
-    t105 = qw1*(t88 + t70)**2 + qw2*(t92 + t71)**2 + qw3*(qb1_2 + t72)**2 + qw4*(t96 + t73)**2 + qw5*(t100 + t74)**2 + qw6*(t104 + t75)**2
+    t105 = qw1*(t70 + t88)**2 + qw2*(t71 + t92)**2 + qw3*(t72 + qb1_2)**2 + qw4*(t73 + t96)**2 + qw5*(t74 + t100)**2 + qw6*(t75 + t104)**2
     t106 = xp.greater(t12, 0)
     t107 = xp.where(t106 & (xp.less(t6, 1) | xp.less(t105, t84)), xp.asarray(1, dtype=dtype), 0)
     t108 = xp.where(t106, 1, t6)
@@ -2738,25 +2738,25 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     t116 = xp.where(t109, t105, t84)
     t117 = xp.where(xp.less(t13, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t118 = t13 + t117
-    t119 = t13 - t117
+    t119 = -t117 + t13
     t120 = xp.where(xp.greater_equal(t13, -2.9670597283903604) & xp.less_equal(t13, 2.9670597283903604), t13, xp.where(xp.greater_equal(t118, -2.9670597283903604) & xp.less_equal(t118, 2.9670597283903604), t118, xp.where(xp.greater_equal(t119, -2.9670597283903604) & xp.less_equal(t119, 2.9670597283903604), t119, qb2_0)))
     t121 = xp.where(xp.less(t14, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t122 = t14 + t121
-    t123 = t14 - t121
+    t123 = -t121 + t14
     t124 = xp.where(xp.greater_equal(t14, -2.9670597283903604) & xp.less_equal(t14, 2.9670597283903604), t14, xp.where(xp.greater_equal(t122, -2.9670597283903604) & xp.less_equal(t122, 2.9670597283903604), t122, xp.where(xp.greater_equal(t123, -2.9670597283903604) & xp.less_equal(t123, 2.9670597283903604), t123, qb2_1)))
     t125 = xp.where(xp.less(t15, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t126 = t15 + t125
-    t127 = t15 - t125
+    t127 = -t125 + t15
     t128 = xp.where(xp.greater_equal(t15, -2.9670597283903604) & xp.less_equal(t15, 2.9670597283903604), t15, xp.where(xp.greater_equal(t126, -2.9670597283903604) & xp.less_equal(t126, 2.9670597283903604), t126, xp.where(xp.greater_equal(t127, -2.9670597283903604) & xp.less_equal(t127, 2.9670597283903604), t127, qb2_3)))
     t129 = xp.where(xp.less(t16, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t130 = t16 + t129
-    t131 = t16 - t129
+    t131 = -t129 + t16
     t132 = xp.where(xp.greater_equal(t16, -1.5707963267948966) & xp.less_equal(t16, 1.5707963267948966), t16, xp.where(xp.greater_equal(t130, -1.5707963267948966) & xp.less_equal(t130, 1.5707963267948966), t130, xp.where(xp.greater_equal(t131, -1.5707963267948966) & xp.less_equal(t131, 1.5707963267948966), t131, qb2_4)))
     t133 = xp.where(xp.less(t17, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t134 = t17 + t133
-    t135 = t17 - t133
+    t135 = -t133 + t17
     t136 = xp.where(xp.greater_equal(t17, -2.9670597283903604) & xp.less_equal(t17, 2.9670597283903604), t17, xp.where(xp.greater_equal(t134, -2.9670597283903604) & xp.less_equal(t134, 2.9670597283903604), t134, xp.where(xp.greater_equal(t135, -2.9670597283903604) & xp.less_equal(t135, 2.9670597283903604), t135, qb2_5)))
-    t137 = qw1*(t120 + t70)**2 + qw2*(t124 + t71)**2 + qw3*(qb2_2 + t72)**2 + qw4*(t128 + t73)**2 + qw5*(t132 + t74)**2 + qw6*(t136 + t75)**2
+    t137 = qw1*(t70 + t120)**2 + qw2*(t71 + t124)**2 + qw3*(t72 + qb2_2)**2 + qw4*(t73 + t128)**2 + qw5*(t74 + t132)**2 + qw6*(t75 + t136)**2
     t138 = xp.greater(t18, 0)
     t139 = xp.where(t138 & (xp.less(t108, 1) | xp.less(t137, t116)), xp.asarray(1, dtype=dtype), 0)
     t140 = xp.where(t138, 1, t108)
@@ -2770,25 +2770,25 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     t148 = xp.where(t141, t137, t116)
     t149 = xp.where(xp.less(t19, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t150 = t19 + t149
-    t151 = t19 - t149
+    t151 = -t149 + t19
     t152 = xp.where(xp.greater_equal(t19, -2.9670597283903604) & xp.less_equal(t19, 2.9670597283903604), t19, xp.where(xp.greater_equal(t150, -2.9670597283903604) & xp.less_equal(t150, 2.9670597283903604), t150, xp.where(xp.greater_equal(t151, -2.9670597283903604) & xp.less_equal(t151, 2.9670597283903604), t151, qb3_0)))
     t153 = xp.where(xp.less(t20, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t154 = t20 + t153
-    t155 = t20 - t153
+    t155 = -t153 + t20
     t156 = xp.where(xp.greater_equal(t20, -2.9670597283903604) & xp.less_equal(t20, 2.9670597283903604), t20, xp.where(xp.greater_equal(t154, -2.9670597283903604) & xp.less_equal(t154, 2.9670597283903604), t154, xp.where(xp.greater_equal(t155, -2.9670597283903604) & xp.less_equal(t155, 2.9670597283903604), t155, qb3_1)))
     t157 = xp.where(xp.less(t21, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t158 = t21 + t157
-    t159 = t21 - t157
+    t159 = -t157 + t21
     t160 = xp.where(xp.greater_equal(t21, -2.9670597283903604) & xp.less_equal(t21, 2.9670597283903604), t21, xp.where(xp.greater_equal(t158, -2.9670597283903604) & xp.less_equal(t158, 2.9670597283903604), t158, xp.where(xp.greater_equal(t159, -2.9670597283903604) & xp.less_equal(t159, 2.9670597283903604), t159, qb3_3)))
     t161 = xp.where(xp.less(t22, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t162 = t22 + t161
-    t163 = t22 - t161
+    t163 = -t161 + t22
     t164 = xp.where(xp.greater_equal(t22, -1.5707963267948966) & xp.less_equal(t22, 1.5707963267948966), t22, xp.where(xp.greater_equal(t162, -1.5707963267948966) & xp.less_equal(t162, 1.5707963267948966), t162, xp.where(xp.greater_equal(t163, -1.5707963267948966) & xp.less_equal(t163, 1.5707963267948966), t163, qb3_4)))
     t165 = xp.where(xp.less(t23, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t166 = t23 + t165
-    t167 = t23 - t165
+    t167 = -t165 + t23
     t168 = xp.where(xp.greater_equal(t23, -2.9670597283903604) & xp.less_equal(t23, 2.9670597283903604), t23, xp.where(xp.greater_equal(t166, -2.9670597283903604) & xp.less_equal(t166, 2.9670597283903604), t166, xp.where(xp.greater_equal(t167, -2.9670597283903604) & xp.less_equal(t167, 2.9670597283903604), t167, qb3_5)))
-    t169 = qw1*(t152 + t70)**2 + qw2*(t156 + t71)**2 + qw3*(qb3_2 + t72)**2 + qw4*(t160 + t73)**2 + qw5*(t164 + t74)**2 + qw6*(t168 + t75)**2
+    t169 = qw1*(t70 + t152)**2 + qw2*(t71 + t156)**2 + qw3*(t72 + qb3_2)**2 + qw4*(t73 + t160)**2 + qw5*(t74 + t164)**2 + qw6*(t75 + t168)**2
     t170 = xp.greater(t24, 0)
     t171 = xp.where(t170 & (xp.less(t140, 1) | xp.less(t169, t148)), xp.asarray(1, dtype=dtype), 0)
     t172 = xp.where(t170, 1, t140)
@@ -2802,25 +2802,25 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     t180 = xp.where(t173, t169, t148)
     t181 = xp.where(xp.less(t25, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t182 = t25 + t181
-    t183 = t25 - t181
+    t183 = -t181 + t25
     t184 = xp.where(xp.greater_equal(t25, -2.9670597283903604) & xp.less_equal(t25, 2.9670597283903604), t25, xp.where(xp.greater_equal(t182, -2.9670597283903604) & xp.less_equal(t182, 2.9670597283903604), t182, xp.where(xp.greater_equal(t183, -2.9670597283903604) & xp.less_equal(t183, 2.9670597283903604), t183, qb4_0)))
     t185 = xp.where(xp.less(t26, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t186 = t26 + t185
-    t187 = t26 - t185
+    t187 = -t185 + t26
     t188 = xp.where(xp.greater_equal(t26, -2.9670597283903604) & xp.less_equal(t26, 2.9670597283903604), t26, xp.where(xp.greater_equal(t186, -2.9670597283903604) & xp.less_equal(t186, 2.9670597283903604), t186, xp.where(xp.greater_equal(t187, -2.9670597283903604) & xp.less_equal(t187, 2.9670597283903604), t187, qb4_1)))
     t189 = xp.where(xp.less(t27, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t190 = t27 + t189
-    t191 = t27 - t189
+    t191 = -t189 + t27
     t192 = xp.where(xp.greater_equal(t27, -2.9670597283903604) & xp.less_equal(t27, 2.9670597283903604), t27, xp.where(xp.greater_equal(t190, -2.9670597283903604) & xp.less_equal(t190, 2.9670597283903604), t190, xp.where(xp.greater_equal(t191, -2.9670597283903604) & xp.less_equal(t191, 2.9670597283903604), t191, qb4_3)))
     t193 = xp.where(xp.less(t28, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t194 = t28 + t193
-    t195 = t28 - t193
+    t195 = -t193 + t28
     t196 = xp.where(xp.greater_equal(t28, -1.5707963267948966) & xp.less_equal(t28, 1.5707963267948966), t28, xp.where(xp.greater_equal(t194, -1.5707963267948966) & xp.less_equal(t194, 1.5707963267948966), t194, xp.where(xp.greater_equal(t195, -1.5707963267948966) & xp.less_equal(t195, 1.5707963267948966), t195, qb4_4)))
     t197 = xp.where(xp.less(t29, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t198 = t29 + t197
-    t199 = t29 - t197
+    t199 = -t197 + t29
     t200 = xp.where(xp.greater_equal(t29, -2.9670597283903604) & xp.less_equal(t29, 2.9670597283903604), t29, xp.where(xp.greater_equal(t198, -2.9670597283903604) & xp.less_equal(t198, 2.9670597283903604), t198, xp.where(xp.greater_equal(t199, -2.9670597283903604) & xp.less_equal(t199, 2.9670597283903604), t199, qb4_5)))
-    t201 = qw1*(t184 + t70)**2 + qw2*(t188 + t71)**2 + qw3*(qb4_2 + t72)**2 + qw4*(t192 + t73)**2 + qw5*(t196 + t74)**2 + qw6*(t200 + t75)**2
+    t201 = qw1*(t70 + t184)**2 + qw2*(t71 + t188)**2 + qw3*(t72 + qb4_2)**2 + qw4*(t73 + t192)**2 + qw5*(t74 + t196)**2 + qw6*(t75 + t200)**2
     t202 = xp.greater(t30, 0)
     t203 = xp.where(t202 & (xp.less(t172, 1) | xp.less(t201, t180)), xp.asarray(1, dtype=dtype), 0)
     t204 = xp.where(t202, 1, t172)
@@ -2834,25 +2834,25 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     t212 = xp.where(t205, t201, t180)
     t213 = xp.where(xp.less(t31, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t214 = t31 + t213
-    t215 = t31 - t213
+    t215 = -t213 + t31
     t216 = xp.where(xp.greater_equal(t31, -2.9670597283903604) & xp.less_equal(t31, 2.9670597283903604), t31, xp.where(xp.greater_equal(t214, -2.9670597283903604) & xp.less_equal(t214, 2.9670597283903604), t214, xp.where(xp.greater_equal(t215, -2.9670597283903604) & xp.less_equal(t215, 2.9670597283903604), t215, qb5_0)))
     t217 = xp.where(xp.less(t32, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t218 = t32 + t217
-    t219 = t32 - t217
+    t219 = -t217 + t32
     t220 = xp.where(xp.greater_equal(t32, -2.9670597283903604) & xp.less_equal(t32, 2.9670597283903604), t32, xp.where(xp.greater_equal(t218, -2.9670597283903604) & xp.less_equal(t218, 2.9670597283903604), t218, xp.where(xp.greater_equal(t219, -2.9670597283903604) & xp.less_equal(t219, 2.9670597283903604), t219, qb5_1)))
     t221 = xp.where(xp.less(t33, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t222 = t33 + t221
-    t223 = t33 - t221
+    t223 = -t221 + t33
     t224 = xp.where(xp.greater_equal(t33, -2.9670597283903604) & xp.less_equal(t33, 2.9670597283903604), t33, xp.where(xp.greater_equal(t222, -2.9670597283903604) & xp.less_equal(t222, 2.9670597283903604), t222, xp.where(xp.greater_equal(t223, -2.9670597283903604) & xp.less_equal(t223, 2.9670597283903604), t223, qb5_3)))
     t225 = xp.where(xp.less(t34, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t226 = t34 + t225
-    t227 = t34 - t225
+    t227 = -t225 + t34
     t228 = xp.where(xp.greater_equal(t34, -1.5707963267948966) & xp.less_equal(t34, 1.5707963267948966), t34, xp.where(xp.greater_equal(t226, -1.5707963267948966) & xp.less_equal(t226, 1.5707963267948966), t226, xp.where(xp.greater_equal(t227, -1.5707963267948966) & xp.less_equal(t227, 1.5707963267948966), t227, qb5_4)))
     t229 = xp.where(xp.less(t35, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t230 = t35 + t229
-    t231 = t35 - t229
+    t231 = -t229 + t35
     t232 = xp.where(xp.greater_equal(t35, -2.9670597283903604) & xp.less_equal(t35, 2.9670597283903604), t35, xp.where(xp.greater_equal(t230, -2.9670597283903604) & xp.less_equal(t230, 2.9670597283903604), t230, xp.where(xp.greater_equal(t231, -2.9670597283903604) & xp.less_equal(t231, 2.9670597283903604), t231, qb5_5)))
-    t233 = qw1*(t216 + t70)**2 + qw2*(t220 + t71)**2 + qw3*(qb5_2 + t72)**2 + qw4*(t224 + t73)**2 + qw5*(t228 + t74)**2 + qw6*(t232 + t75)**2
+    t233 = qw1*(t70 + t216)**2 + qw2*(t71 + t220)**2 + qw3*(t72 + qb5_2)**2 + qw4*(t73 + t224)**2 + qw5*(t74 + t228)**2 + qw6*(t75 + t232)**2
     t234 = xp.greater(t36, 0)
     t235 = xp.where(t234 & (xp.less(t204, 1) | xp.less(t233, t212)), xp.asarray(1, dtype=dtype), 0)
     t236 = xp.where(t234, 1, t204)
@@ -2866,25 +2866,25 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     t244 = xp.where(t237, t233, t212)
     t245 = xp.where(xp.less(t37, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t246 = t37 + t245
-    t247 = t37 - t245
+    t247 = -t245 + t37
     t248 = xp.where(xp.greater_equal(t37, -2.9670597283903604) & xp.less_equal(t37, 2.9670597283903604), t37, xp.where(xp.greater_equal(t246, -2.9670597283903604) & xp.less_equal(t246, 2.9670597283903604), t246, xp.where(xp.greater_equal(t247, -2.9670597283903604) & xp.less_equal(t247, 2.9670597283903604), t247, qb6_0)))
     t249 = xp.where(xp.less(t38, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t250 = t38 + t249
-    t251 = t38 - t249
+    t251 = -t249 + t38
     t252 = xp.where(xp.greater_equal(t38, -2.9670597283903604) & xp.less_equal(t38, 2.9670597283903604), t38, xp.where(xp.greater_equal(t250, -2.9670597283903604) & xp.less_equal(t250, 2.9670597283903604), t250, xp.where(xp.greater_equal(t251, -2.9670597283903604) & xp.less_equal(t251, 2.9670597283903604), t251, qb6_1)))
     t253 = xp.where(xp.less(t39, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t254 = t39 + t253
-    t255 = t39 - t253
+    t255 = -t253 + t39
     t256 = xp.where(xp.greater_equal(t39, -2.9670597283903604) & xp.less_equal(t39, 2.9670597283903604), t39, xp.where(xp.greater_equal(t254, -2.9670597283903604) & xp.less_equal(t254, 2.9670597283903604), t254, xp.where(xp.greater_equal(t255, -2.9670597283903604) & xp.less_equal(t255, 2.9670597283903604), t255, qb6_3)))
     t257 = xp.where(xp.less(t40, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t258 = t40 + t257
-    t259 = t40 - t257
+    t259 = -t257 + t40
     t260 = xp.where(xp.greater_equal(t40, -1.5707963267948966) & xp.less_equal(t40, 1.5707963267948966), t40, xp.where(xp.greater_equal(t258, -1.5707963267948966) & xp.less_equal(t258, 1.5707963267948966), t258, xp.where(xp.greater_equal(t259, -1.5707963267948966) & xp.less_equal(t259, 1.5707963267948966), t259, qb6_4)))
     t261 = xp.where(xp.less(t41, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t262 = t41 + t261
-    t263 = t41 - t261
+    t263 = -t261 + t41
     t264 = xp.where(xp.greater_equal(t41, -2.9670597283903604) & xp.less_equal(t41, 2.9670597283903604), t41, xp.where(xp.greater_equal(t262, -2.9670597283903604) & xp.less_equal(t262, 2.9670597283903604), t262, xp.where(xp.greater_equal(t263, -2.9670597283903604) & xp.less_equal(t263, 2.9670597283903604), t263, qb6_5)))
-    t265 = qw1*(t248 + t70)**2 + qw2*(t252 + t71)**2 + qw3*(qb6_2 + t72)**2 + qw4*(t256 + t73)**2 + qw5*(t260 + t74)**2 + qw6*(t264 + t75)**2
+    t265 = qw1*(t70 + t248)**2 + qw2*(t71 + t252)**2 + qw3*(t72 + qb6_2)**2 + qw4*(t73 + t256)**2 + qw5*(t74 + t260)**2 + qw6*(t75 + t264)**2
     t266 = xp.greater(t42, 0)
     t267 = xp.where(t266 & (xp.less(t236, 1) | xp.less(t265, t244)), xp.asarray(1, dtype=dtype), 0)
     t268 = xp.where(t266, 1, t236)
@@ -2898,25 +2898,25 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     t276 = xp.where(t269, t265, t244)
     t277 = xp.where(xp.less(t43, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t278 = t43 + t277
-    t279 = t43 - t277
+    t279 = -t277 + t43
     t280 = xp.where(xp.greater_equal(t43, -2.9670597283903604) & xp.less_equal(t43, 2.9670597283903604), t43, xp.where(xp.greater_equal(t278, -2.9670597283903604) & xp.less_equal(t278, 2.9670597283903604), t278, xp.where(xp.greater_equal(t279, -2.9670597283903604) & xp.less_equal(t279, 2.9670597283903604), t279, qb7_0)))
     t281 = xp.where(xp.less(t44, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t282 = t44 + t281
-    t283 = t44 - t281
+    t283 = -t281 + t44
     t284 = xp.where(xp.greater_equal(t44, -2.9670597283903604) & xp.less_equal(t44, 2.9670597283903604), t44, xp.where(xp.greater_equal(t282, -2.9670597283903604) & xp.less_equal(t282, 2.9670597283903604), t282, xp.where(xp.greater_equal(t283, -2.9670597283903604) & xp.less_equal(t283, 2.9670597283903604), t283, qb7_1)))
     t285 = xp.where(xp.less(t45, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t286 = t45 + t285
-    t287 = t45 - t285
+    t287 = -t285 + t45
     t288 = xp.where(xp.greater_equal(t45, -2.9670597283903604) & xp.less_equal(t45, 2.9670597283903604), t45, xp.where(xp.greater_equal(t286, -2.9670597283903604) & xp.less_equal(t286, 2.9670597283903604), t286, xp.where(xp.greater_equal(t287, -2.9670597283903604) & xp.less_equal(t287, 2.9670597283903604), t287, qb7_3)))
     t289 = xp.where(xp.less(t46, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t290 = t46 + t289
-    t291 = t46 - t289
+    t291 = -t289 + t46
     t292 = xp.where(xp.greater_equal(t46, -1.5707963267948966) & xp.less_equal(t46, 1.5707963267948966), t46, xp.where(xp.greater_equal(t290, -1.5707963267948966) & xp.less_equal(t290, 1.5707963267948966), t290, xp.where(xp.greater_equal(t291, -1.5707963267948966) & xp.less_equal(t291, 1.5707963267948966), t291, qb7_4)))
     t293 = xp.where(xp.less(t47, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t294 = t47 + t293
-    t295 = t47 - t293
+    t295 = -t293 + t47
     t296 = xp.where(xp.greater_equal(t47, -2.9670597283903604) & xp.less_equal(t47, 2.9670597283903604), t47, xp.where(xp.greater_equal(t294, -2.9670597283903604) & xp.less_equal(t294, 2.9670597283903604), t294, xp.where(xp.greater_equal(t295, -2.9670597283903604) & xp.less_equal(t295, 2.9670597283903604), t295, qb7_5)))
-    t297 = qw1*(t280 + t70)**2 + qw2*(t284 + t71)**2 + qw3*(qb7_2 + t72)**2 + qw4*(t288 + t73)**2 + qw5*(t292 + t74)**2 + qw6*(t296 + t75)**2
+    t297 = qw1*(t70 + t280)**2 + qw2*(t71 + t284)**2 + qw3*(t72 + qb7_2)**2 + qw4*(t73 + t288)**2 + qw5*(t74 + t292)**2 + qw6*(t75 + t296)**2
     t298 = xp.greater(t48, 0)
     t299 = xp.where(t298 & (xp.less(t268, 1) | xp.less(t297, t276)), xp.asarray(1, dtype=dtype), 0)
     t300 = xp.where(t298, 1, t268)

@@ -84,11 +84,11 @@ def fk(q):
     c3 = trig[..., 4]
     s3 = trig[..., 5]
     c23 = c2*c3 - s2*s3
-    s23 = c2*s3 + c3*s2
+    s23 = c2*s3 + s2*c3
     c4 = trig[..., 6]
     s4 = trig[..., 7]
     c234 = c23*c4 - s23*s4
-    s234 = c23*s4 + c4*s23
+    s234 = c23*s4 + s23*c4
     c5 = trig[..., 8]
     s5 = trig[..., 9]
     c6 = trig[..., 10]
@@ -97,27 +97,27 @@ def fk(q):
     t1 = c1*c5
     t2 = t0 + c234*t1
     t3 = t1 + c234*t0
-    t4 = c5*s1
+    t4 = s1*c5
     t5 = c1*s5
     t6 = t4 - c234*t5
     t7 = -t5 + c234*t4
     t8 = c1*s234
     t9 = t2*c6 - s6*t8
     t10 = t2*s6 + c6*t8
-    t11 = 0.0823*t6 + 0.09465*t8
-    t12 = t11 + 0.10915*s1
+    t11 = 0.09465*t8 + 0.0823*t6
+    t12 = 0.10915*s1 + t11
     t13 = s1*s234
-    t14 = t7*c6 - s6*t13
-    t15 = t7*s6 + c6*t13
-    t16 = -0.0823*t3 + 0.09465*t13
+    t14 = c6*t7 - s6*t13
+    t15 = s6*t7 + c6*t13
+    t16 = 0.09465*t13 - 0.0823*t3
     t17 = t16 - 0.10915*c1
     t18 = c5*s234
     t19 = c234*s6 + c6*t18
     t20 = c234*c6 - s6*t18
-    t21 = s234*s5
+    t21 = s5*s234
     t22 = 0.09465*c234 + 0.0823*t21
-    t23 = t22 + 0.39225*s23
-    t24 = t23 + 0.425*s2
+    t23 = 0.39225*s23 + t22
+    t24 = 0.425*s2 + t23
     t25 = 0.089459 - t24
     t26 = 0.39225*c23
     t27 = t12 - c1*t26
@@ -157,52 +157,52 @@ def jacobian(q):
     c3 = trig[..., 4]
     s3 = trig[..., 5]
     c23 = c2*c3 - s2*s3
-    s23 = c2*s3 + c3*s2
+    s23 = c2*s3 + s2*c3
     c4 = trig[..., 6]
     s4 = trig[..., 7]
     c234 = c23*c4 - s23*s4
-    s234 = c23*s4 + c4*s23
+    s234 = c23*s4 + s23*c4
     c5 = trig[..., 8]
     s5 = trig[..., 9]
-    t0 = c234*s5
-    t1 = c5*s1 - c1*t0
+    t0 = s5*c234
+    t1 = s1*c5 - c1*t0
     t2 = c1*c5 + s1*t0
     t3 = c1*s234
-    t4 = 0.0823*t1 + 0.09465*t3
-    t5 = t4 + 0.10915*s1
+    t4 = 0.09465*t3 + 0.0823*t1
+    t5 = 0.10915*s1 + t4
     t6 = s1*s234
-    t7 = -0.0823*t2 + 0.09465*t6
+    t7 = 0.09465*t6 - 0.0823*t2
     t8 = t7 - 0.10915*c1
-    t9 = s234*s5
+    t9 = s5*s234
     t10 = 0.09465*c234 + 0.0823*t9
-    t11 = t10 + 0.39225*s23
-    t12 = t11 + 0.425*s2
+    t11 = 0.39225*s23 + t10
+    t12 = 0.425*s2 + t11
     t13 = 0.39225*c23
     t14 = t5 - c1*t13
     t15 = t8 - s1*t13
     t16 = 0.425*c2
     t17 = t14 - c1*t16
     t18 = t15 - s1*t16
-    t19 = t10*c1
-    t20 = t10*s1
+    t19 = c1*t10
+    t20 = s1*t10
     t21 = -c1
     J = _stack(xp, [
         -t18,  # 0, 0
-        t12*c1,  # 0, 1
-        t11*c1,  # 0, 2
+        c1*t12,  # 0, 1
+        c1*t11,  # 0, 2
         t19,  # 0, 3
-        t7*c234 - s234*t20,  # 0, 4
+        c234*t7 - s234*t20,  # 0, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5
         t17,  # 1, 0
-        t12*s1,  # 1, 1
-        t11*s1,  # 1, 2
+        s1*t12,  # 1, 1
+        s1*t11,  # 1, 2
         t20,  # 1, 3
-        -t4*c234 + s234*t19,  # 1, 4
+        -c234*t4 + s234*t19,  # 1, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
-        t17*c1 + t18*s1,  # 2, 1
-        t14*c1 + t15*s1,  # 2, 2
-        t5*c1 + t8*s1,  # 2, 3
+        c1*t17 + s1*t18,  # 2, 1
+        c1*t14 + s1*t15,  # 2, 2
+        c1*t5 + s1*t8,  # 2, 3
         t7*t3 - t4*t6,  # 2, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
@@ -238,11 +238,11 @@ def fk_jacobian(q):
     c3 = trig[..., 4]
     s3 = trig[..., 5]
     c23 = c2*c3 - s2*s3
-    s23 = c2*s3 + c3*s2
+    s23 = c2*s3 + s2*c3
     c4 = trig[..., 6]
     s4 = trig[..., 7]
     c234 = c23*c4 - s23*s4
-    s234 = c23*s4 + c4*s23
+    s234 = c23*s4 + s23*c4
     c5 = trig[..., 8]
     s5 = trig[..., 9]
     c6 = trig[..., 10]
@@ -251,27 +251,27 @@ def fk_jacobian(q):
     t1 = c1*c5
     t2 = t0 + c234*t1
     t3 = t1 + c234*t0
-    t4 = c5*s1
+    t4 = s1*c5
     t5 = c1*s5
     t6 = t4 - c234*t5
     t7 = -t5 + c234*t4
     t8 = c1*s234
     t9 = t2*c6 - s6*t8
     t10 = t2*s6 + c6*t8
-    t11 = 0.0823*t6 + 0.09465*t8
-    t12 = t11 + 0.10915*s1
+    t11 = 0.09465*t8 + 0.0823*t6
+    t12 = 0.10915*s1 + t11
     t13 = s1*s234
-    t14 = t7*c6 - s6*t13
-    t15 = t7*s6 + c6*t13
-    t16 = -0.0823*t3 + 0.09465*t13
+    t14 = c6*t7 - s6*t13
+    t15 = s6*t7 + c6*t13
+    t16 = 0.09465*t13 - 0.0823*t3
     t17 = t16 - 0.10915*c1
     t18 = c5*s234
     t19 = c234*s6 + c6*t18
     t20 = c234*c6 - s6*t18
-    t21 = s234*s5
+    t21 = s5*s234
     t22 = 0.09465*c234 + 0.0823*t21
-    t23 = t22 + 0.39225*s23
-    t24 = t23 + 0.425*s2
+    t23 = 0.39225*s23 + t22
+    t24 = 0.425*s2 + t23
     t25 = 0.089459 - t24
     t26 = 0.39225*c23
     t27 = t12 - c1*t26
@@ -281,8 +281,8 @@ def fk_jacobian(q):
     t31 = t28 - s1*t29
     t32 = -t3
     t33 = -t21
-    t34 = t22*c1
-    t35 = t22*s1
+    t34 = c1*t22
+    t35 = s1*t22
     t36 = -c1
     T = _stack(xp, [
         t9,  # 0, 0
@@ -304,21 +304,21 @@ def fk_jacobian(q):
     ], (4, 4))
     J = _stack(xp, [
         -t31,  # 0, 0
-        t24*c1,  # 0, 1
-        t23*c1,  # 0, 2
+        c1*t24,  # 0, 1
+        c1*t23,  # 0, 2
         t34,  # 0, 3
-        t16*c234 - s234*t35,  # 0, 4
+        c234*t16 - s234*t35,  # 0, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5
         t30,  # 1, 0
-        t24*s1,  # 1, 1
-        t23*s1,  # 1, 2
+        s1*t24,  # 1, 1
+        s1*t23,  # 1, 2
         t35,  # 1, 3
-        -t11*c234 + s234*t34,  # 1, 4
+        -c234*t11 + s234*t34,  # 1, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
-        t30*c1 + t31*s1,  # 2, 1
-        t27*c1 + t28*s1,  # 2, 2
-        t12*c1 + t17*s1,  # 2, 3
+        c1*t30 + s1*t31,  # 2, 1
+        c1*t27 + s1*t28,  # 2, 2
+        c1*t12 + s1*t17,  # 2, 3
         t16*t8 - t11*t13,  # 2, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
@@ -354,11 +354,11 @@ def jacobian_tool(q):
     c3 = trig[..., 4]
     s3 = trig[..., 5]
     c23 = c2*c3 - s2*s3
-    s23 = c2*s3 + c3*s2
+    s23 = c2*s3 + s2*c3
     c4 = trig[..., 6]
     s4 = trig[..., 7]
     c234 = c23*c4 - s23*s4
-    s234 = c23*s4 + c4*s23
+    s234 = c23*s4 + s23*c4
     c5 = trig[..., 8]
     s5 = trig[..., 9]
     c6 = trig[..., 10]
@@ -367,85 +367,85 @@ def jacobian_tool(q):
     t1 = c1*c5
     t2 = t0 + c234*t1
     t3 = t1 + c234*t0
-    t4 = c5*s1
+    t4 = s1*c5
     t5 = c1*s5
     t6 = t4 - c234*t5
     t7 = -t5 + c234*t4
     t8 = c1*s234
     t9 = t2*c6 - s6*t8
     t10 = t2*s6 + c6*t8
-    t11 = 0.0823*t6 + 0.09465*t8
-    t12 = t11 + 0.10915*s1
+    t11 = 0.09465*t8 + 0.0823*t6
+    t12 = 0.10915*s1 + t11
     t13 = s1*s234
-    t14 = t7*c6 - s6*t13
-    t15 = t7*s6 + c6*t13
-    t16 = -0.0823*t3 + 0.09465*t13
+    t14 = c6*t7 - s6*t13
+    t15 = s6*t7 + c6*t13
+    t16 = 0.09465*t13 - 0.0823*t3
     t17 = t16 - 0.10915*c1
     t18 = c5*s234
     t19 = c234*s6 + c6*t18
     t20 = c234*c6 - s6*t18
-    t21 = s234*s5
+    t21 = s5*s234
     t22 = 0.09465*c234 + 0.0823*t21
-    t23 = t22 + 0.39225*s23
-    t24 = t23 + 0.425*s2
+    t23 = 0.39225*s23 + t22
+    t24 = 0.425*s2 + t23
     t25 = 0.39225*c23
     t26 = t12 - c1*t25
     t27 = t17 - s1*t25
     t28 = 0.425*c2
     t29 = t26 - c1*t28
     t30 = t27 - s1*t28
-    t31 = t29*c1 + t30*s1
+    t31 = c1*t29 + s1*t30
     t32 = c1*t9
     t33 = s1*t14
-    t34 = t26*c1 + t27*s1
-    t35 = t12*c1 + t17*s1
-    t36 = t16*c234 - t22*t13
-    t37 = -t11*c234 + t22*t8
+    t34 = c1*t26 + s1*t27
+    t35 = c1*t12 + s1*t17
+    t36 = c234*t16 - t22*t13
+    t37 = -c234*t11 + t22*t8
     t38 = t16*t8 - t11*t13
     t39 = c1*t10
     t40 = s1*t15
     t41 = c1*t6
     t42 = s1*t3
-    t43 = t9*s1 - t14*c1
-    t44 = t15*c1 - t10*s1
-    t45 = t6*s1 + t3*c1
+    t43 = s1*t9 - c1*t14
+    t44 = c1*t15 - s1*t10
+    t45 = s1*t6 + c1*t3
     J = _stack(xp, [
-        t14*t29 - t9*t30,  # 0, 0
+        t29*t14 - t9*t30,  # 0, 0
         t19*t31 + t24*t32 + t24*t33,  # 0, 1
         t19*t34 + t23*t32 + t23*t33,  # 0, 2
         t19*t35 + t22*t32 + t22*t33,  # 0, 3
         t9*t36 + t14*t37 + t19*t38,  # 0, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5
-        t10*t30 - t15*t29,  # 1, 0
+        t10*t30 - t29*t15,  # 1, 0
         -(-t20*t31 + t24*t39 + t24*t40),  # 1, 1
         -(-t20*t34 + t23*t39 + t23*t40),  # 1, 2
         -(-t20*t35 + t22*t39 + t22*t40),  # 1, 3
         -(-t20*t38 + t10*t36 + t15*t37),  # 1, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5
         -(t6*t30 + t3*t29),  # 2, 0
-        -(-t24*t41 + t24*t42 + t31*t21),  # 2, 1
-        -(-t23*t41 + t23*t42 + t34*t21),  # 2, 2
-        -(-t22*t41 + t22*t42 + t35*t21),  # 2, 3
-        -(-t6*t36 + t3*t37 + t38*t21),  # 2, 4
+        -(-t24*t41 + t24*t42 + t21*t31),  # 2, 1
+        -(-t23*t41 + t23*t42 + t21*t34),  # 2, 2
+        -(-t22*t41 + t22*t42 + t21*t35),  # 2, 3
+        -(-t6*t36 + t3*t37 + t21*t38),  # 2, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 5
         t19,  # 3, 0
         t43,  # 3, 1
         t43,  # 3, 2
         t43,  # 3, 3
-        -t19*c234 + t9*t8 + t14*t13,  # 3, 4
+        -c234*t19 + t9*t8 + t14*t13,  # 3, 4
         -(-t6*t9 + t3*t14 + t19*t21),  # 3, 5
         t20,  # 4, 0
         t44,  # 4, 1
         t44,  # 4, 2
         t44,  # 4, 3
-        -(t20*c234 + t10*t8 + t15*t13),  # 4, 4
+        -(c234*t20 + t10*t8 + t15*t13),  # 4, 4
         -(-t3*t15 + t6*t10 + t20*t21),  # 4, 5
         -t21,  # 5, 0
         t45,  # 5, 1
         t45,  # 5, 2
         t45,  # 5, 3
         t6*t8 + c234*t21 - t3*t13,  # 5, 4
-        t6**2 + t3**2 + s234**2*s5**2,  # 5, 5
+        t6**2 + t3**2 + s5**2*s234**2,  # 5, 5
     ], (6, 6))
     return J
 
@@ -461,37 +461,37 @@ def task(q):
     c3 = trig[..., 4]
     s3 = trig[..., 5]
     c23 = c2*c3 - s2*s3
-    s23 = c2*s3 + c3*s2
+    s23 = c2*s3 + s2*c3
     c4 = trig[..., 6]
     s4 = trig[..., 7]
     c234 = c23*c4 - s23*s4
-    s234 = c23*s4 + c4*s23
+    s234 = c23*s4 + s23*c4
     c5 = trig[..., 8]
     s5 = trig[..., 9]
     c6 = trig[..., 10]
     s6 = trig[..., 11]
-    t0 = c234*s6 + c5*c6*s234
+    t0 = c234*s6 + c5*s234*c6
     t1 = s1*s5
     t2 = c1*c5
     t3 = t1 + c234*t2
     t4 = t2 + c234*t1
-    t5 = c5*s1
+    t5 = s1*c5
     t6 = c1*s5
     t7 = t5 - c234*t6
     t8 = -t6 + c234*t5
-    t9 = s6*s234
+    t9 = s234*s6
     t10 = t3*c6 - c1*t9
-    t11 = t8*c6 - s1*t9
+    t11 = c6*t8 - s1*t9
     t12 = c234*c6 - c5*t9
     t13 = 0.09465*s234
-    t14 = 0.0823*t7 + c1*t13
-    t15 = -0.0823*t4 + s1*t13
-    t16 = t14 + 0.10915*s1
+    t14 = c1*t13 + 0.0823*t7
+    t15 = s1*t13 - 0.0823*t4
+    t16 = 0.10915*s1 + t14
     t17 = t15 - 0.10915*c1
-    t18 = s234*s5
+    t18 = s5*s234
     t19 = 0.09465*c234 + 0.0823*t18
-    t20 = t19 + 0.39225*s23
-    t21 = t20 + 0.425*s2
+    t20 = 0.39225*s23 + t19
+    t21 = 0.425*s2 + t20
     t22 = 0.089459 - t21
     t23 = 0.39225*c23
     t24 = t16 - c1*t23
@@ -521,74 +521,74 @@ def task_jacobian(q):
     c3 = trig[..., 4]
     s3 = trig[..., 5]
     c23 = c2*c3 - s2*s3
-    s23 = c2*s3 + c3*s2
+    s23 = c2*s3 + s2*c3
     c4 = trig[..., 6]
     s4 = trig[..., 7]
     c234 = c23*c4 - s23*s4
-    s234 = c23*s4 + c4*s23
+    s234 = c23*s4 + s23*c4
     c5 = trig[..., 8]
     s5 = trig[..., 9]
     c6 = trig[..., 10]
     s6 = trig[..., 11]
-    t0 = c234*s6 + c5*c6*s234
+    t0 = c234*s6 + c5*s234*c6
     t1 = s1*s5
     t2 = c1*c5
     t3 = t1 + c234*t2
     t4 = t2 + c234*t1
-    t5 = c5*s1
+    t5 = s1*c5
     t6 = c1*s5
     t7 = t5 - c234*t6
     t8 = -t6 + c234*t5
-    t9 = s6*s234
+    t9 = s234*s6
     t10 = t3*c6 - c1*t9
-    t11 = t8*c6 - s1*t9
+    t11 = c6*t8 - s1*t9
     t12 = 0.09465*s234
-    t13 = 0.0823*t7 + c1*t12
-    t14 = -0.0823*t4 + s1*t12
-    t15 = t13 + 0.10915*s1
+    t13 = c1*t12 + 0.0823*t7
+    t14 = s1*t12 - 0.0823*t4
+    t15 = 0.10915*s1 + t13
     t16 = t14 - 0.10915*c1
-    t17 = s234*s5
+    t17 = s5*s234
     t18 = 0.09465*c234 + 0.0823*t17
-    t19 = t18 + 0.39225*s23
-    t20 = t19 + 0.425*s2
+    t19 = 0.39225*s23 + t18
+    t20 = 0.425*s2 + t19
     t21 = 0.39225*c23
     t22 = t15 - c1*t21
     t23 = t16 - s1*t21
     t24 = 0.425*c2
     t25 = t22 - c1*t24
     t26 = t23 - s1*t24
-    t27 = t18*c1
-    t28 = t18*s1
-    t29 = t10**2 + t11**2
-    t30 = 1/t29
-    t31 = t10*s1
-    t32 = t11*c1
-    t33 = t30*(t31 - t32)
-    t34 = t10*c1
-    t35 = t11*s1
-    t36 = t30*(s234*t34 + s234*t35)
-    t37 = t30*(t7*t10 - t4*t11)
-    t38 = 1/xp.sqrt(t29)
+    t27 = c1*t18
+    t28 = s1*t18
+    t29 = s1*t10
+    t30 = c1*t11
+    t31 = t10**2 + t11**2
+    t32 = 1/t31
+    t33 = (t29 - t30)*t32
+    t34 = c1*t10
+    t35 = s1*t11
+    t36 = t32*(s234*t34 + s234*t35)
+    t37 = t32*(t7*t10 - t4*t11)
+    t38 = 1/xp.sqrt(t31)
     t39 = -t38*(t34 + t35)
     t40 = -t0*t33
     J = _stack(xp, [
         -t26,  # 0, 0
-        t20*c1,  # 0, 1
-        t19*c1,  # 0, 2
+        c1*t20,  # 0, 1
+        c1*t19,  # 0, 2
         t27,  # 0, 3
-        t14*c234 - s234*t28,  # 0, 4
+        c234*t14 - s234*t28,  # 0, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5
         t25,  # 1, 0
-        t20*s1,  # 1, 1
-        t19*s1,  # 1, 2
+        s1*t20,  # 1, 1
+        s1*t19,  # 1, 2
         t28,  # 1, 3
-        -t13*c234 + s234*t27,  # 1, 4
+        -c234*t13 + s234*t27,  # 1, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
-        t25*c1 + t26*s1,  # 2, 1
-        t22*c1 + t23*s1,  # 2, 2
-        t15*c1 + t16*s1,  # 2, 3
-        t14*c1*s234 - t13*s1*s234,  # 2, 4
+        c1*t25 + s1*t26,  # 2, 1
+        c1*t22 + s1*t23,  # 2, 2
+        c1*t15 + s1*t16,  # 2, 3
+        c1*s234*t14 - s1*s234*t13,  # 2, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
         t33,  # 3, 1
@@ -600,7 +600,7 @@ def task_jacobian(q):
         t39,  # 4, 1
         t39,  # 4, 2
         t39,  # 4, 3
-        t38*(s234*t31 - s234*t32),  # 4, 4
+        t38*(s234*t29 - s234*t30),  # 4, 4
         -t38*(t7*t11 + t4*t10),  # 4, 5
         xp.full(batch, 1, dtype=dtype, device=device),  # 5, 0
         t40,  # 5, 1
@@ -629,11 +629,11 @@ def fk_jacobian_dot(q, q_dot):
     c3 = trig[..., 4]
     s3 = trig[..., 5]
     c23 = c2*c3 - s2*s3
-    s23 = c2*s3 + c3*s2
+    s23 = c2*s3 + s2*c3
     c4 = trig[..., 6]
     s4 = trig[..., 7]
     c234 = c23*c4 - s23*s4
-    s234 = c23*s4 + c4*s23
+    s234 = c23*s4 + s23*c4
     c5 = trig[..., 8]
     s5 = trig[..., 9]
     c6 = trig[..., 10]
@@ -642,27 +642,27 @@ def fk_jacobian_dot(q, q_dot):
     t1 = c1*c5
     t2 = t0 + c234*t1
     t3 = t1 + c234*t0
-    t4 = c5*s1
+    t4 = s1*c5
     t5 = c1*s5
     t6 = t4 - c234*t5
     t7 = -t5 + c234*t4
     t8 = c1*s234
     t9 = t2*c6 - s6*t8
     t10 = t2*s6 + c6*t8
-    t11 = 0.0823*t6 + 0.09465*t8
-    t12 = t11 + 0.10915*s1
+    t11 = 0.09465*t8 + 0.0823*t6
+    t12 = 0.10915*s1 + t11
     t13 = s1*s234
-    t14 = t7*c6 - s6*t13
-    t15 = t7*s6 + c6*t13
-    t16 = -0.0823*t3 + 0.09465*t13
+    t14 = c6*t7 - s6*t13
+    t15 = s6*t7 + c6*t13
+    t16 = 0.09465*t13 - 0.0823*t3
     t17 = t16 - 0.10915*c1
     t18 = c5*s234
     t19 = c234*s6 + c6*t18
     t20 = c234*c6 - s6*t18
-    t21 = s234*s5
+    t21 = s5*s234
     t22 = 0.09465*c234 + 0.0823*t21
-    t23 = t22 + 0.39225*s23
-    t24 = t23 + 0.425*s2
+    t23 = 0.39225*s23 + t22
+    t24 = 0.425*s2 + t23
     t25 = 0.089459 - t24
     t26 = 0.39225*c23
     t27 = t12 - c1*t26
@@ -670,56 +670,56 @@ def fk_jacobian_dot(q, q_dot):
     t29 = 0.425*c2
     t30 = t27 - c1*t29
     t31 = t28 - s1*t29
-    t32 = t22*s1
-    t33 = t16*c234 - s234*t32
+    t32 = s1*t22
+    t33 = c234*t16 - s234*t32
     t34 = t33
-    t35 = t22*c1
-    t36 = -t11*c234 + s234*t35
+    t35 = c1*t22
+    t36 = -c234*t11 + s234*t35
     t37 = t36
-    t38 = t30*c1 + t31*s1
+    t38 = c1*t30 + s1*t31
     t39 = t38
-    t40 = t27*c1 + t28*s1
+    t40 = c1*t27 + s1*t28
     t41 = t40
-    t42 = t12*c1 + t17*s1
+    t42 = c1*t12 + s1*t17
     t43 = t42
     t44 = t16*t8 - t11*t13
     t45 = t44
-    t46 = qd2*s1
-    t47 = qd3*s1
+    t46 = s1*qd2
+    t47 = s1*qd3
     t48 = t46 + t47
     t49 = c1*qd2
     t50 = c1*qd3
     t51 = t49 + t50
-    t52 = qd4*s1
+    t52 = s1*qd4
     t53 = t48 + t52
-    t54 = t53 + qd5*t8
+    t54 = t53 + t8*qd5
     t55 = c1*qd4
     t56 = t51 + t55
-    t57 = -t56 + qd5*t13
+    t57 = -t56 + t13*qd5
     t58 = c234*qd5
     t59 = qd1 - t58
-    t60 = t34*qd5
+    t60 = qd5*t34
     t61 = t60 + t22*t55
     t62 = t61 + t23*t50
     t63 = t62 + t24*t49
     t64 = t63 - t31*qd1
-    t65 = t37*qd5
+    t65 = qd5*t37
     t66 = t65 + t22*t52
     t67 = t66 + t23*t47
     t68 = t67 + t24*t46
     t69 = t68 + t30*qd1
-    t70 = t45*qd5
-    t71 = t43*qd4 + t70
-    t72 = t71 + t41*qd3
-    t73 = t72 + t39*qd2
+    t70 = qd5*t45
+    t71 = qd4*t43 + t70
+    t72 = t71 + qd3*t41
+    t73 = t72 + qd2*t39
     t74 = -t3
     t75 = -t21
-    t76 = t24*c1
-    t77 = t23*c1
-    t78 = t24*s1
-    t79 = t23*s1
+    t76 = c1*t24
+    t77 = c1*t23
+    t78 = s1*t24
+    t79 = s1*t23
     t80 = -c1
-    t81 = qd2*t23
+    t81 = t23*qd2
     T = _stack(xp, [
         xp.broadcast_to(t9, batch),  # 0, 0
         xp.broadcast_to(-t10, batch),  # 0, 1
@@ -777,12 +777,12 @@ def fk_jacobian_dot(q, q_dot):
         xp.broadcast_to(t75, batch),  # 5, 5
     ], (6, 6))
     a = _stack(xp, [
-        xp.broadcast_to(-qd2*(t73*c1 + qd1*t78) - qd3*(t72*c1 + qd1*t79 + t41*t49) - qd4*(t43*t51 + t71*c1 + qd1*t32) + qd5*(-t37*qd1 - t45*t56 + t37*t58 + t70*t13) - t69*qd1, batch),  # 0
-        xp.broadcast_to(t64*qd1 + qd2*(-t73*s1 + qd1*t76) - qd3*(t72*s1 - qd1*t77 + t41*t46) - qd4*(t43*t48 + t71*s1 - qd1*t35) - qd5*(-t34*qd1 + t45*t53 + t34*t58 + t70*t8), batch),  # 1
-        xp.broadcast_to(qd2*(t63*c1 + t68*s1) + qd3*(t62*c1 + t67*s1 + c1**2*t81 + s1**2*t81) + qd4*(t61*c1 + t66*s1 + t48*t32 + t51*t35) + qd5*(t34*t56 + t37*t53 + t65*t8 - t60*t13), batch),  # 2
-        xp.broadcast_to(qd5*(t56*c234 - qd1*t13) + qd6*(t3*t59 - t57*t21) + qd1*t49 + qd1*t50 + qd1*t55, batch),  # 3
-        xp.broadcast_to(qd5*(t53*c234 + qd1*t8) + qd6*(t6*t59 + t54*t21) + qd1*t46 + qd1*t47 + qd1*t52, batch),  # 4
-        xp.broadcast_to(qd4*(t51*s1 - t48*c1) + qd5*(t53*t13 + t56*t8) - qd6*(t6*t57 + t3*t54), batch),  # 5
+        xp.broadcast_to(-qd2*(c1*t73 + qd1*t78) - qd3*(c1*t72 + qd1*t79 + t49*t41) - qd4*(t51*t43 + c1*t71 + t32*qd1) + qd5*(-qd1*t37 - t56*t45 + t58*t37 + t13*t70) - qd1*t69, batch),  # 0
+        xp.broadcast_to(qd1*t64 + qd2*(-s1*t73 + qd1*t76) - qd3*(-qd1*t77 + s1*t72 + t46*t41) - qd4*(-t35*qd1 + t48*t43 + s1*t71) - qd5*(-qd1*t34 + t53*t45 + t58*t34 + t8*t70), batch),  # 1
+        xp.broadcast_to(qd2*(c1*t63 + s1*t68) + qd3*(c1*t62 + s1*t67 + c1**2*t81 + s1**2*t81) + qd4*(c1*t61 + s1*t66 + t32*t48 + t35*t51) + qd5*(t56*t34 + t53*t37 + t8*t65 - t13*t60), batch),  # 2
+        xp.broadcast_to(qd5*(c234*t56 - t13*qd1) + qd6*(t3*t59 - t21*t57) + t49*qd1 + t50*qd1 + t55*qd1, batch),  # 3
+        xp.broadcast_to(qd5*(c234*t53 + t8*qd1) + qd6*(t6*t59 + t21*t54) + t46*qd1 + t47*qd1 + t52*qd1, batch),  # 4
+        xp.broadcast_to(qd4*(s1*t51 - c1*t48) + qd5*(t13*t53 + t8*t56) - qd6*(t6*t57 + t3*t54), batch),  # 5
     ], (6,))
     return T, J, a
 
@@ -803,107 +803,107 @@ def jacobian_dot(q, q_dot):
     c3 = trig[..., 4]
     s3 = trig[..., 5]
     c23 = c2*c3 - s2*s3
-    s23 = c2*s3 + c3*s2
+    s23 = c2*s3 + s2*c3
     c4 = trig[..., 6]
     s4 = trig[..., 7]
     c234 = c23*c4 - s23*s4
-    s234 = c23*s4 + c4*s23
+    s234 = c23*s4 + s23*c4
     c5 = trig[..., 8]
     s5 = trig[..., 9]
-    t0 = c234*s5
-    t1 = c5*s1 - c1*t0
+    t0 = s5*c234
+    t1 = s1*c5 - c1*t0
     t2 = c1*c5 + s1*t0
     t3 = 0.09465*s234
-    t4 = 0.0823*t1 + c1*t3
-    t5 = -0.0823*t2 + s1*t3
-    t6 = t4 + 0.10915*s1
+    t4 = c1*t3 + 0.0823*t1
+    t5 = s1*t3 - 0.0823*t2
+    t6 = 0.10915*s1 + t4
     t7 = t5 - 0.10915*c1
-    t8 = t6*c1 + t7*s1
+    t8 = c1*t6 + s1*t7
     t9 = s5*s234
     t10 = 0.09465*c234 + 0.0823*t9
-    t11 = t10 + 0.39225*s23
-    t12 = t11 + 0.425*s2
+    t11 = 0.39225*s23 + t10
+    t12 = 0.425*s2 + t11
     t13 = 0.39225*c23
     t14 = t6 - c1*t13
     t15 = t7 - s1*t13
-    t16 = t14*c1 + t15*s1
+    t16 = c1*t14 + s1*t15
     t17 = 0.425*c2
     t18 = t14 - c1*t17
     t19 = t15 - s1*t17
-    t20 = t18*c1 + t19*s1
+    t20 = c1*t18 + s1*t19
     t21 = s234*t10
-    t22 = t5*c234 - s1*t21
-    t23 = -t4*c234 + c1*t21
+    t22 = c234*t5 - s1*t21
+    t23 = -c234*t4 + c1*t21
     t24 = c1*s234
     t25 = s1*s234
     t26 = t5*t24 - t4*t25
-    t27 = qd2*s1
-    t28 = qd3*s1
+    t27 = s1*qd2
+    t28 = s1*qd3
     t29 = t27 + t28
     t30 = c1*qd2
     t31 = c1*qd3
     t32 = t30 + t31
-    t33 = qd4*s1
+    t33 = s1*qd4
     t34 = t29 + t33
-    t35 = t34 + qd5*t24
+    t35 = t34 + t24*qd5
     t36 = c1*qd4
     t37 = t32 + t36
-    t38 = -t37 + qd5*t25
+    t38 = -t37 + t25*qd5
     t39 = c234*qd5
     t40 = qd1 - t39
-    t41 = t22*qd5
+    t41 = qd5*t22
     t42 = t41 + t10*t36
     t43 = t42 + t11*t31
     t44 = t43 + t12*t30
     t45 = t44 - t19*qd1
-    t46 = t23*qd5
+    t46 = qd5*t23
     t47 = t46 + t10*t33
     t48 = t47 + t11*t28
     t49 = t48 + t12*t27
     t50 = t49 + t18*qd1
-    t51 = t26*qd5
-    t52 = t8*qd4 + t51
-    t53 = t52 + t16*qd3
-    t54 = t53 + t20*qd2
-    t55 = qd1*s1
+    t51 = qd5*t26
+    t52 = qd4*t8 + t51
+    t53 = t52 + qd3*t16
+    t54 = t53 + qd2*t20
+    t55 = s1*qd1
     t56 = c1*qd1
-    t57 = qd2*t11
+    t57 = t11*qd2
     Jd = _stack(xp, [
         xp.broadcast_to(-t50, batch),  # 0, 0
-        xp.broadcast_to(-(t54*c1 + t12*t55), batch),  # 0, 1
-        xp.broadcast_to(-(t53*c1 + t11*t55 + t16*t30), batch),  # 0, 2
-        xp.broadcast_to(-(t8*t32 + t52*c1 + t10*t55), batch),  # 0, 3
-        xp.broadcast_to(-t23*qd1 - t26*t37 + t23*t39 + t51*t25, batch),  # 0, 4
+        xp.broadcast_to(-(c1*t54 + t12*t55), batch),  # 0, 1
+        xp.broadcast_to(-(c1*t53 + t11*t55 + t30*t16), batch),  # 0, 2
+        xp.broadcast_to(-(t32*t8 + c1*t52 + t10*t55), batch),  # 0, 3
+        xp.broadcast_to(-qd1*t23 - t37*t26 + t39*t23 + t25*t51, batch),  # 0, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5
         xp.broadcast_to(t45, batch),  # 1, 0
-        xp.broadcast_to(-t54*s1 + t12*t56, batch),  # 1, 1
-        xp.broadcast_to(-(t53*s1 - t11*t56 + t16*t27), batch),  # 1, 2
-        xp.broadcast_to(-(t8*t29 + t52*s1 - t10*t56), batch),  # 1, 3
-        xp.broadcast_to(-(-t22*qd1 + t26*t34 + t22*t39 + t51*t24), batch),  # 1, 4
+        xp.broadcast_to(-s1*t54 + t12*t56, batch),  # 1, 1
+        xp.broadcast_to(-(-t11*t56 + s1*t53 + t27*t16), batch),  # 1, 2
+        xp.broadcast_to(-(-t10*t56 + t29*t8 + s1*t52), batch),  # 1, 3
+        xp.broadcast_to(-(-qd1*t22 + t34*t26 + t39*t22 + t24*t51), batch),  # 1, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
-        xp.broadcast_to(t44*c1 + t49*s1, batch),  # 2, 1
-        xp.broadcast_to(t43*c1 + t48*s1 + c1**2*t57 + s1**2*t57, batch),  # 2, 2
-        xp.broadcast_to(t42*c1 + t47*s1 + t10*t29*s1 + t10*t32*c1, batch),  # 2, 3
-        xp.broadcast_to(t22*t37 + t23*t34 + t46*t24 - t41*t25, batch),  # 2, 4
+        xp.broadcast_to(c1*t44 + s1*t49, batch),  # 2, 1
+        xp.broadcast_to(c1*t43 + s1*t48 + c1**2*t57 + s1**2*t57, batch),  # 2, 2
+        xp.broadcast_to(c1*t42 + s1*t47 + s1*t10*t29 + c1*t10*t32, batch),  # 2, 3
+        xp.broadcast_to(t37*t22 + t34*t23 + t24*t46 - t25*t41, batch),  # 2, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
         xp.broadcast_to(t56, batch),  # 3, 1
         xp.broadcast_to(t56, batch),  # 3, 2
         xp.broadcast_to(t56, batch),  # 3, 3
-        xp.broadcast_to(t37*c234 - s234*t55, batch),  # 3, 4
-        xp.broadcast_to(t2*t40 - t38*t9, batch),  # 3, 5
+        xp.broadcast_to(c234*t37 - s234*t55, batch),  # 3, 4
+        xp.broadcast_to(t2*t40 - t9*t38, batch),  # 3, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
         xp.broadcast_to(t55, batch),  # 4, 1
         xp.broadcast_to(t55, batch),  # 4, 2
         xp.broadcast_to(t55, batch),  # 4, 3
-        xp.broadcast_to(t34*c234 + s234*t56, batch),  # 4, 4
-        xp.broadcast_to(t1*t40 + t35*t9, batch),  # 4, 5
+        xp.broadcast_to(c234*t34 + s234*t56, batch),  # 4, 4
+        xp.broadcast_to(t1*t40 + t9*t35, batch),  # 4, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 2
-        xp.broadcast_to(t32*s1 - t29*c1, batch),  # 5, 3
-        xp.broadcast_to(t34*t25 + t37*t24, batch),  # 5, 4
+        xp.broadcast_to(s1*t32 - c1*t29, batch),  # 5, 3
+        xp.broadcast_to(t25*t34 + t24*t37, batch),  # 5, 4
         xp.broadcast_to(-(t1*t38 + t2*t35), batch),  # 5, 5
     ], (6, 6))
     return Jd
@@ -926,78 +926,78 @@ def bias_acceleration(q, q_dot):
     c3 = trig[..., 4]
     s3 = trig[..., 5]
     c23 = c2*c3 - s2*s3
-    s23 = c2*s3 + c3*s2
+    s23 = c2*s3 + s2*c3
     c4 = trig[..., 6]
     s4 = trig[..., 7]
     c234 = c23*c4 - s23*s4
-    s234 = c23*s4 + c4*s23
+    s234 = c23*s4 + s23*c4
     c5 = trig[..., 8]
     s5 = trig[..., 9]
-    t0 = c234*s5
-    t1 = c5*s1 - c1*t0
+    t0 = s5*c234
+    t1 = s1*c5 - c1*t0
     t2 = c1*c5 + s1*t0
     t3 = 0.09465*s234
-    t4 = 0.0823*t1 + c1*t3
-    t5 = -0.0823*t2 + s1*t3
-    t6 = t4 + 0.10915*s1
+    t4 = c1*t3 + 0.0823*t1
+    t5 = s1*t3 - 0.0823*t2
+    t6 = 0.10915*s1 + t4
     t7 = t5 - 0.10915*c1
-    t8 = t6*c1 + t7*s1
+    t8 = c1*t6 + s1*t7
     t9 = s5*s234
     t10 = 0.09465*c234 + 0.0823*t9
-    t11 = t10 + 0.39225*s23
-    t12 = t11 + 0.425*s2
+    t11 = 0.39225*s23 + t10
+    t12 = 0.425*s2 + t11
     t13 = 0.39225*c23
     t14 = t6 - c1*t13
     t15 = t7 - s1*t13
-    t16 = t14*c1 + t15*s1
+    t16 = c1*t14 + s1*t15
     t17 = 0.425*c2
     t18 = t14 - c1*t17
     t19 = t15 - s1*t17
-    t20 = t18*c1 + t19*s1
+    t20 = c1*t18 + s1*t19
     t21 = s234*t10
-    t22 = t5*c234 - s1*t21
-    t23 = -t4*c234 + c1*t21
+    t22 = c234*t5 - s1*t21
+    t23 = -c234*t4 + c1*t21
     t24 = c1*s234
     t25 = s1*s234
     t26 = t5*t24 - t4*t25
-    t27 = qd2*s1
-    t28 = qd3*s1
+    t27 = s1*qd2
+    t28 = s1*qd3
     t29 = t27 + t28
     t30 = c1*qd2
     t31 = c1*qd3
     t32 = t30 + t31
-    t33 = qd4*s1
+    t33 = s1*qd4
     t34 = t29 + t33
-    t35 = t34 + qd5*t24
+    t35 = t34 + t24*qd5
     t36 = c1*qd4
     t37 = t32 + t36
-    t38 = -t37 + qd5*t25
+    t38 = -t37 + t25*qd5
     t39 = c234*qd5
     t40 = qd1 - t39
-    t41 = t22*qd5
+    t41 = qd5*t22
     t42 = t41 + t10*t36
     t43 = t42 + t11*t31
     t44 = t43 + t12*t30
     t45 = t44 - t19*qd1
-    t46 = t23*qd5
+    t46 = qd5*t23
     t47 = t46 + t10*t33
     t48 = t47 + t11*t28
     t49 = t48 + t12*t27
     t50 = t49 + t18*qd1
-    t51 = t26*qd5
-    t52 = t8*qd4 + t51
-    t53 = t52 + t16*qd3
-    t54 = t53 + t20*qd2
+    t51 = qd5*t26
+    t52 = qd4*t8 + t51
+    t53 = t52 + qd3*t16
+    t54 = t53 + qd2*t20
     t55 = s1*qd1
     t56 = c1*qd1
-    t57 = qd2*t11
+    t57 = t11*qd2
     a = _stack(xp, [
-        xp.broadcast_to(-qd2*(t54*c1 + t12*t55) - qd3*(t53*c1 + t11*t55 + t16*t30) - qd4*(t8*t32 + t52*c1 + t10*t55) + qd5*(-t23*qd1 - t26*t37 + t23*t39 + t51*t25) - t50*qd1, batch),  # 0
-        xp.broadcast_to(t45*qd1 + qd2*(-t54*s1 + t12*t56) - qd3*(t53*s1 - t11*t56 + t16*t27) - qd4*(t8*t29 + t52*s1 - t10*t56) - qd5*(-t22*qd1 + t26*t34 + t22*t39 + t51*t24), batch),  # 1
-        xp.broadcast_to(qd2*(t44*c1 + t49*s1) + qd3*(t43*c1 + t48*s1 + c1**2*t57 + s1**2*t57) + qd4*(t42*c1 + t47*s1 + t10*t29*s1 + t10*t32*c1) + qd5*(t22*t37 + t23*t34 + t46*t24 - t41*t25), batch),  # 2
-        xp.broadcast_to(qd5*(t37*c234 - qd1*t25) + qd6*(t2*t40 - t38*t9) + qd1*t30 + qd1*t31 + qd1*t36, batch),  # 3
-        xp.broadcast_to(qd5*(t34*c234 + qd1*t24) + qd6*(t1*t40 + t35*t9) + qd1*t27 + qd1*t28 + qd1*t33, batch),  # 4
-        xp.broadcast_to(qd4*(t32*s1 - t29*c1) + qd5*(t34*t25 + t37*t24) - qd6*(t1*t38 + t2*t35), batch),  # 5
+        xp.broadcast_to(-qd2*(c1*t54 + t12*t55) - qd3*(c1*t53 + t11*t55 + t30*t16) - qd4*(t32*t8 + c1*t52 + t10*t55) + qd5*(-qd1*t23 - t37*t26 + t39*t23 + t25*t51) - qd1*t50, batch),  # 0
+        xp.broadcast_to(qd1*t45 + qd2*(-s1*t54 + t12*t56) - qd3*(-t11*t56 + s1*t53 + t27*t16) - qd4*(-t10*t56 + t29*t8 + s1*t52) - qd5*(-qd1*t22 + t34*t26 + t39*t22 + t24*t51), batch),  # 1
+        xp.broadcast_to(qd2*(c1*t44 + s1*t49) + qd3*(c1*t43 + s1*t48 + c1**2*t57 + s1**2*t57) + qd4*(c1*t42 + s1*t47 + s1*t10*t29 + c1*t10*t32) + qd5*(t37*t22 + t34*t23 + t24*t46 - t25*t41), batch),  # 2
+        xp.broadcast_to(qd5*(c234*t37 - t25*qd1) + qd6*(t2*t40 - t9*t38) + t30*qd1 + t31*qd1 + t36*qd1, batch),  # 3
+        xp.broadcast_to(qd5*(c234*t34 + t24*qd1) + qd6*(t1*t40 + t9*t35) + t27*qd1 + t28*qd1 + t33*qd1, batch),  # 4
+        xp.broadcast_to(qd4*(s1*t32 - c1*t29) + qd5*(t25*t34 + t24*t37) - qd6*(t1*t38 + t2*t35), batch),  # 5
     ], (6,))
     return a
 
@@ -1019,149 +1019,149 @@ def task_jacobian_dot(q, q_dot):
     c3 = trig[..., 4]
     s3 = trig[..., 5]
     c23 = c2*c3 - s2*s3
-    s23 = c2*s3 + c3*s2
+    s23 = c2*s3 + s2*c3
     c4 = trig[..., 6]
     s4 = trig[..., 7]
     c234 = c23*c4 - s23*s4
-    s234 = c23*s4 + c4*s23
+    s234 = c23*s4 + s23*c4
     c5 = trig[..., 8]
     s5 = trig[..., 9]
     c6 = trig[..., 10]
     s6 = trig[..., 11]
-    t0 = c234*s6 + c5*c6*s234
+    t0 = c234*s6 + c5*s234*c6
     t1 = s1*s5
     t2 = c1*c5
     t3 = t1 + c234*t2
     t4 = t2 + c234*t1
-    t5 = c5*s1
+    t5 = s1*c5
     t6 = c1*s5
     t7 = t5 - c234*t6
     t8 = -t6 + c234*t5
     t9 = c1*s234
     t10 = t3*c6 - s6*t9
-    t11 = 0.0823*t7 + 0.09465*t9
-    t12 = t11 + 0.10915*s1
+    t11 = 0.09465*t9 + 0.0823*t7
+    t12 = 0.10915*s1 + t11
     t13 = s1*s234
-    t14 = t8*c6 - s6*t13
-    t15 = -0.0823*t4 + 0.09465*t13
+    t14 = c6*t8 - s6*t13
+    t15 = 0.09465*t13 - 0.0823*t4
     t16 = t15 - 0.10915*c1
-    t17 = t12*c1 + t16*s1
+    t17 = c1*t12 + s1*t16
     t18 = t15*t9 - t11*t13
     t19 = t10**2 + t14**2
     t20 = xp.sqrt(t19)
     t21 = s5*s234
     t22 = 0.09465*c234 + 0.0823*t21
-    t23 = t22 + 0.39225*s23
-    t24 = t23 + 0.425*s2
-    t25 = t15*c234 - t22*t13
-    t26 = -t11*c234 + t22*t9
+    t23 = 0.39225*s23 + t22
+    t24 = 0.425*s2 + t23
+    t25 = c234*t15 - t22*t13
+    t26 = -c234*t11 + t22*t9
     t27 = 0.39225*c23
     t28 = t12 - c1*t27
     t29 = t16 - s1*t27
-    t30 = t28*c1 + t29*s1
+    t30 = c1*t28 + s1*t29
     t31 = 0.425*c2
     t32 = t28 - c1*t31
     t33 = t29 - s1*t31
-    t34 = t32*c1 + t33*s1
-    t35 = qd2*s1
-    t36 = qd3*s1
+    t34 = c1*t32 + s1*t33
+    t35 = s1*qd2
+    t36 = s1*qd3
     t37 = t35 + t36
     t38 = t37
     t39 = c1*qd2
     t40 = c1*qd3
     t41 = t39 + t40
     t42 = t41
-    t43 = t42*s1 - t38*c1
-    t44 = qd4*s1
+    t43 = s1*t42 - c1*t38
+    t44 = s1*qd4
     t45 = t38 + t44
-    t46 = t45*c234 + qd1*t9
+    t46 = c234*t45 + t9*qd1
     t47 = c1*qd4
     t48 = t42 + t47
-    t49 = t48*c234 - qd1*t13
-    t50 = t45*t13 + t48*t9
-    t51 = qd5*t9
+    t49 = c234*t48 - t13*qd1
+    t50 = t13*t45 + t9*t48
+    t51 = t9*qd5
     t52 = t45 + t51
-    t53 = t44 + t51 + t7*qd6 + t37
-    t54 = qd5*t13
+    t53 = t37 + t44 + t51 + t7*qd6
+    t54 = t13*qd5
     t55 = -t48 + t54
     t56 = t7*t55 + t4*t52
-    t57 = t47 + t4*qd6 - t54 + t41
+    t57 = -t54 + t41 + t47 + t4*qd6
     t58 = t10*t57 + t14*t53
     t59 = c234*qd5
     t60 = qd1 - t59
-    t61 = t4*t60 - t55*t21
-    t62 = t7*t60 + t52*t21
-    t63 = -qd1 + t59 + qd6*t21
+    t61 = t4*t60 - t21*t55
+    t62 = t7*t60 + t21*t52
+    t63 = -qd1 + t59 + t21*qd6
     t64 = t14*t63 - t0*t57
     t65 = t10*t63 + t0*t53
-    t66 = t25*qd5
+    t66 = qd5*t25
     t67 = t66 + t22*t47
     t68 = t67 + t23*t40
     t69 = t68 + t24*t39
     t70 = t69 - t33*qd1
-    t71 = t26*qd5
+    t71 = qd5*t26
     t72 = t71 + t22*t44
     t73 = t72 + t23*t36
     t74 = t73 + t24*t35
     t75 = t74 + t32*qd1
-    t76 = t69*c1 + t74*s1
-    t77 = t67*c1 + t72*s1 + t22*t38*s1 + t22*t42*c1
-    t78 = t25*t48 + t26*t45 + t71*t9 - t66*t13
-    t79 = t18*qd5
-    t80 = t17*qd4 + t79
-    t81 = t80 + t30*qd3
-    t82 = t81 + t34*qd2
-    t83 = -t26*qd1 - t18*t48 + t26*t59 + t79*t13
-    t84 = t18*t45 - t25*qd1 + t25*t59 + t79*t9
+    t76 = c1*t69 + s1*t74
+    t77 = c1*t67 + s1*t72 + s1*t22*t38 + c1*t22*t42
+    t78 = t48*t25 + t45*t26 + t9*t71 - t13*t66
+    t79 = qd5*t18
+    t80 = qd4*t17 + t79
+    t81 = t80 + qd3*t30
+    t82 = t81 + qd2*t34
+    t83 = -qd1*t26 - t48*t18 + t59*t26 + t13*t79
+    t84 = t45*t18 - qd1*t25 + t59*t25 + t9*t79
     t85 = s1*qd1
-    t86 = t82*c1 + t24*t85
-    t87 = t81*c1 + t23*t85 + t30*t39
-    t88 = t17*t42 + t80*c1 + t22*t85
+    t86 = c1*t82 + t24*t85
+    t87 = c1*t81 + t23*t85 + t39*t30
+    t88 = t42*t17 + c1*t80 + t22*t85
     t89 = c1*qd1
-    t90 = -t82*s1 + t24*t89
-    t91 = t81*s1 + t30*t35 - t23*t89
-    t92 = t17*t38 + t80*s1 - t22*t89
-    t93 = qd2*t23
-    t94 = t68*c1 + t73*s1 + c1**2*t93 + s1**2*t93
-    t95 = 1/t19
-    t96 = t95*(t7*t10 - t4*t14)
-    t97 = t10*s1
-    t98 = t14*c1
-    t99 = t95*(t97 - t98)
-    t100 = t10*c1
-    t101 = t14*s1
-    t102 = t95*(s234*t100 + s234*t101)
+    t90 = -s1*t82 + t24*t89
+    t91 = s1*t81 + t35*t30 - t23*t89
+    t92 = t38*t17 + s1*t80 - t22*t89
+    t93 = t23*qd2
+    t94 = c1*t68 + s1*t73 + c1**2*t93 + s1**2*t93
+    t95 = s1*t10
+    t96 = c1*t14
+    t97 = 1/t19
+    t98 = (t95 - t96)*t97
+    t99 = (t7*t10 - t4*t14)*t97
+    t100 = c1*t10
+    t101 = s1*t14
+    t102 = (s234*t100 + s234*t101)*t97
     t103 = 1/t20
-    t104 = t95*t103
-    t105 = -(t100 + t101)*t104
-    t106 = (s234*t97 - s234*t98)*t104
+    t104 = t97*t103
+    t105 = -t104*(t100 + t101)
+    t106 = t104*(s234*t95 - s234*t96)
     t107 = -(t7*t14 + t4*t10)*t104
-    t108 = 2*t99
-    t109 = t95*t64
-    t110 = (s1 - t10*t108)*t109
-    t111 = t95*t65
+    t108 = 2*t98
+    t109 = t97*t64
+    t110 = t109*(s1 - t10*t108)
+    t111 = t97*t65
     t112 = -(c1 + t14*t108)*t111
-    t113 = qd1*t95
+    t113 = qd1*t97
     t114 = t100*t113
     t115 = t101*t113
     t116 = t110 - t112 + t114 + t115
-    t117 = t10*t95
+    t117 = t10*t97
     t118 = t49*t117
-    t119 = t14*t95
+    t119 = t14*t97
     t120 = t46*t119
     t121 = 2*t102
-    t122 = (t9 - t10*t121)*t109
-    t123 = (t13 - t14*t121)*t111
+    t122 = t109*(t9 - t10*t121)
+    t123 = t111*(t13 - t14*t121)
     t124 = t61*t117
     t125 = t62*t119
-    t126 = 2*t96
-    t127 = (t7 - t10*t126)*t109
-    t128 = -(t4 + t14*t126)*t111
+    t126 = 2*t99
+    t127 = t109*(t7 - t10*t126)
+    t128 = -t111*(t4 + t14*t126)
     t129 = qd1*t103
-    t130 = -t64*(t105*t10 + c1*t103) + t65*(t105*t14 + s1*t103) + t97*t129 - t98*t129
+    t130 = -t64*(t10*t105 + c1*t103) + t65*(t14*t105 + s1*t103) + t95*t129 - t96*t129
     t131 = t10*t103
     t132 = t14*t103
-    t133 = t58*t99 - t0*t112 + t0*t110 + t0*t114 + t0*t115
+    t133 = t98*t58 - t0*t112 + t0*t110 + t0*t114 + t0*t115
     t134 = -t133
     Jd = _stack(xp, [
         xp.broadcast_to(-t75, batch),  # 0, 0
@@ -1192,14 +1192,14 @@ def task_jacobian_dot(q, q_dot):
         xp.broadcast_to(t130, batch),  # 4, 1
         xp.broadcast_to(t130, batch),  # 4, 2
         xp.broadcast_to(t130, batch),  # 4, 3
-        xp.broadcast_to(t64*(-t106*t10 + t103*t13) + t65*(t106*t14 + t103*t9) + t46*t131 - t49*t132, batch),  # 4, 4
-        xp.broadcast_to(-t64*(t107*t10 + t4*t103) + t65*(t107*t14 + t7*t103) + t62*t131 - t61*t132, batch),  # 4, 5
+        xp.broadcast_to(t64*(-t10*t106 + t13*t103) + t65*(t14*t106 + t9*t103) + t46*t131 - t49*t132, batch),  # 4, 4
+        xp.broadcast_to(-t64*(t10*t107 + t4*t103) + t65*(t14*t107 + t7*t103) + t62*t131 - t61*t132, batch),  # 4, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 0
         xp.broadcast_to(t134, batch),  # 5, 1
         xp.broadcast_to(t134, batch),  # 5, 2
         xp.broadcast_to(-(-t43 + t133), batch),  # 5, 3
-        xp.broadcast_to(-(-t50 + t58*t102 - t0*t123 + t0*t118 + t0*t120 + t0*t122), batch),  # 5, 4
-        xp.broadcast_to(-(t56 + t58*t96 - t0*t128 + t0*t124 + t0*t125 + t0*t127), batch),  # 5, 5
+        xp.broadcast_to(-(-t50 + t102*t58 - t0*t123 + t0*t118 + t0*t120 + t0*t122), batch),  # 5, 4
+        xp.broadcast_to(-(t56 + t99*t58 - t0*t128 + t0*t124 + t0*t125 + t0*t127), batch),  # 5, 5
     ], (6, 6))
     return Jd
 
@@ -1215,61 +1215,61 @@ def hessian(q):
     c3 = trig[..., 4]
     s3 = trig[..., 5]
     c23 = c2*c3 - s2*s3
-    s23 = c2*s3 + c3*s2
+    s23 = c2*s3 + s2*c3
     c4 = trig[..., 6]
     s4 = trig[..., 7]
     c234 = c23*c4 - s23*s4
-    s234 = c23*s4 + c4*s23
+    s234 = c23*s4 + s23*c4
     c5 = trig[..., 8]
     s5 = trig[..., 9]
-    t0 = 0.09465*c234 + 0.0823*s234*s5
-    t1 = t0 + 0.39225*s23
-    t2 = t1 + 0.425*s2
+    t0 = 0.09465*c234 + 0.0823*s5*s234
+    t1 = 0.39225*s23 + t0
+    t2 = 0.425*s2 + t1
     t3 = c1*c234
-    t4 = c5*s1 - s5*t3
-    t5 = c234*s1
+    t4 = s1*c5 - s5*t3
+    t5 = s1*c234
     t6 = c1*c5 + s5*t5
     t7 = c1*s234
-    t8 = 0.0823*t4 + 0.09465*t7
-    t9 = t8 + 0.10915*s1
+    t8 = 0.09465*t7 + 0.0823*t4
+    t9 = 0.10915*s1 + t8
     t10 = s1*s234
-    t11 = -0.0823*t6 + 0.09465*t10
+    t11 = 0.09465*t10 - 0.0823*t6
     t12 = t11 - 0.10915*c1
-    t13 = t9*c1 + t12*s1
+    t13 = c1*t9 + s1*t12
     t14 = t11*t7 - t8*t10
     t15 = 0.39225*c23
     t16 = t9 - c1*t15
     t17 = t12 - s1*t15
-    t18 = t16*c1 + t17*s1
+    t18 = c1*t16 + s1*t17
     t19 = 0.425*c2
     t20 = t16 - c1*t19
     t21 = t17 - s1*t19
-    t22 = t20*c1 + t21*s1
-    t23 = t0*s1
-    t24 = t11*c234 - s234*t23
-    t25 = t0*c1
-    t26 = -t8*c234 + s234*t25
-    t27 = -t2*s1
-    t28 = -t1*s1
+    t22 = c1*t20 + s1*t21
+    t23 = s1*t0
+    t24 = c234*t11 - s234*t23
+    t25 = c1*t0
+    t26 = -c234*t8 + s234*t25
+    t27 = -s1*t2
+    t28 = -s1*t1
     t29 = -t23
     t30 = -t26
-    t31 = t2*c1
-    t32 = t1*c1
-    t33 = -t18*c1
-    t34 = -t13*c1
-    t35 = -t14*c1
-    t36 = -t18*s1
-    t37 = -t13*s1
-    t38 = -t14*s1
+    t31 = c1*t2
+    t32 = c1*t1
+    t33 = -c1*t18
+    t34 = -c1*t13
+    t35 = -c1*t14
+    t36 = -s1*t18
+    t37 = -s1*t13
+    t38 = -s1*t14
     t39 = c1**2
     t40 = s1**2
-    t41 = t1*t39 + t1*t40
-    t42 = t0*t39 + t0*t40
-    t43 = t24*c1 + t26*s1
+    t41 = t39*t1 + t40*t1
+    t42 = t39*t0 + t40*t0
+    t43 = c1*t24 + s1*t26
     t44 = s5*t7
     t45 = s5*t10
-    t46 = s234*t39 + s234*t40
-    t47 = t4*c1 - t6*s1
+    t46 = t39*s234 + t40*s234
+    t47 = c1*t4 - s1*t6
     t48 = s5*s234**2
     H = _stack(xp, [
         -t20,  # 0, 0, 0
@@ -1309,19 +1309,19 @@ def hessian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5, 5
         t27,  # 1, 0, 0
-        -t22*c1,  # 1, 0, 1
+        -c1*t22,  # 1, 0, 1
         t33,  # 1, 0, 2
         t34,  # 1, 0, 3
         t35,  # 1, 0, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 0, 5
         t31,  # 1, 1, 0
-        -t22*s1,  # 1, 1, 1
+        -s1*t22,  # 1, 1, 1
         t36,  # 1, 1, 2
         t37,  # 1, 1, 3
         t38,  # 1, 1, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 2, 0
-        t2*t39 + t2*t40,  # 1, 2, 1
+        t39*t2 + t40*t2,  # 1, 2, 1
         t41,  # 1, 2, 2
         t42,  # 1, 2, 3
         t43,  # 1, 2, 4
@@ -1420,32 +1420,32 @@ def hessian(q):
         t35,  # 4, 0, 1
         t35,  # 4, 0, 2
         t35,  # 4, 0, 3
-        t26*c234 + t14*t10,  # 4, 0, 4
+        c234*t26 + t10*t14,  # 4, 0, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0, 5
         t24,  # 4, 1, 0
         t38,  # 4, 1, 1
         t38,  # 4, 1, 2
         t38,  # 4, 1, 3
-        -(t24*c234 + t14*t7),  # 4, 1, 4
+        -(c234*t24 + t7*t14),  # 4, 1, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 2, 0
         t43,  # 4, 2, 1
         t43,  # 4, 2, 2
         t43,  # 4, 2, 3
-        t26*t7 - t24*t10,  # 4, 2, 4
+        t7*t26 - t10*t24,  # 4, 2, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 3, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 3, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 3, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 3, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 3, 4
-        -(t6*c234 + s1*t48),  # 4, 3, 5
+        -(c234*t6 + s1*t48),  # 4, 3, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 4, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 4, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 4, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 4, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 4, 4
-        -t4*c234 + c1*t48,  # 4, 4, 5
+        -c234*t4 + c1*t48,  # 4, 4, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 5, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 5, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 5, 2
@@ -1510,7 +1510,7 @@ def singularity_factors(q):
     f = _stack(xp, [
         s3,  # 0
         s5,  # 1
-        -c2 - 0.9229411764705883*t0 + 0.9229411764705883*t1 - t1*t2 + t0*t2 + c2*s3*t3 + c3*s2*t3,  # 2
+        -c2 - 0.9229411764705883*t0 + 0.9229411764705883*t1 - t1*t2 + t0*t2 + c2*s3*t3 + s2*c3*t3,  # 2
     ], (3,))
     return f
 
@@ -1530,7 +1530,7 @@ def manipulability(q):
     t1 = s2*s3
     t2 = 0.22270588235294117*s4
     t3 = 0.22270588235294117*c4
-    t4 = 0.07085015625*s3*s5*(-c2 - 0.9229411764705883*t0 + 0.9229411764705883*t1 - t1*t2 + t0*t2 + c2*s3*t3 + c3*s2*t3)
+    t4 = 0.07085015625*s3*s5*(-c2 - 0.9229411764705883*t0 + 0.9229411764705883*t1 - t1*t2 + t0*t2 + c2*s3*t3 + s2*c3*t3)
     w = xp.broadcast_to(xp.abs(t4), batch)
     return w
 
@@ -1550,7 +1550,7 @@ def jacobian_det(q):
     t1 = s2*s3
     t2 = 0.22270588235294117*s4
     t3 = 0.22270588235294117*c4
-    d = xp.broadcast_to(0.07085015625*s3*s5*(-c2 - 0.9229411764705883*t0 + 0.9229411764705883*t1 - t1*t2 + t0*t2 + c2*s3*t3 + c3*s2*t3), batch)
+    d = xp.broadcast_to(0.07085015625*s3*s5*(-c2 - 0.9229411764705883*t0 + 0.9229411764705883*t1 - t1*t2 + t0*t2 + c2*s3*t3 + s2*c3*t3), batch)
     return d
 
 
@@ -1578,220 +1578,220 @@ def velocity_ik(q, mu_dot, damping=0.0):
     c3 = trig[..., 4]
     s3 = trig[..., 5]
     c23 = c2*c3 - s2*s3
-    s23 = c2*s3 + c3*s2
+    s23 = c2*s3 + s2*c3
     c4 = trig[..., 6]
     s4 = trig[..., 7]
     c234 = c23*c4 - s23*s4
-    s234 = c23*s4 + c4*s23
+    s234 = c23*s4 + s23*c4
     c5 = trig[..., 8]
     s5 = trig[..., 9]
-    t0 = c234*s5
-    t1 = c5*s1 - c1*t0
+    t0 = s5*c234
+    t1 = s1*c5 - c1*t0
     t2 = c1*c5 + s1*t0
     t3 = c1*s234
-    t4 = 0.0823*t1 + 0.09465*t3
-    t5 = t4 + 0.10915*s1
+    t4 = 0.09465*t3 + 0.0823*t1
+    t5 = 0.10915*s1 + t4
     t6 = s1*s234
-    t7 = -0.0823*t2 + 0.09465*t6
+    t7 = 0.09465*t6 - 0.0823*t2
     t8 = t7 - 0.10915*c1
-    t9 = t5*c1 + t8*s1
+    t9 = c1*t5 + s1*t8
     t10 = t7*t3 - t4*t6
-    t11 = s234*s5
+    t11 = s5*s234
     t12 = 0.09465*c234 + 0.0823*t11
-    t13 = t12 + 0.39225*s23
-    t14 = t13 + 0.425*s2
-    t15 = t1*t11 + c234*t3
-    t16 = t2*t11 - c234*t6
+    t13 = 0.39225*s23 + t12
+    t14 = 0.425*s2 + t13
+    t15 = c234*t3 + t1*t11
+    t16 = -c234*t6 + t2*t11
     t17 = 0.39225*c23
     t18 = t5 - c1*t17
     t19 = t8 - s1*t17
-    t20 = t18*c1 + t19*s1
+    t20 = c1*t18 + s1*t19
     t21 = 0.425*c2
     t22 = t18 - c1*t21
     t23 = t19 - s1*t21
-    t24 = t22*c1 + t23*s1
-    t25 = t12*s1
-    t26 = t7*c234 - s234*t25
-    t27 = t23 + t26*c234
-    t28 = t12*c1
-    t29 = -t4*c234 + s234*t28
-    t30 = t22 - t29*c234
+    t24 = c1*t22 + s1*t23
+    t25 = s1*t12
+    t26 = c234*t7 - s234*t25
+    t27 = t23 + c234*t26
+    t28 = c1*t12
+    t29 = -c234*t4 + s234*t28
+    t30 = t22 - c234*t29
     t31 = t23**2
-    t32 = t12**2
-    t33 = c1**2
-    t34 = t12*t33 + t13*t33 + t14*t33 - t26*t6
+    t32 = c1**2
+    t33 = t32*t14 + t32*t13 + t32*t12 - t6*t26
+    t34 = t14**2
     t35 = t13**2
-    t36 = t14**2
-    t37 = t26**2 + t32*t33 + t35*t33 + t36*t33
+    t36 = t12**2
+    t37 = t26**2 + t32*t34 + t32*t35 + t32*t36
     t38 = t31 + t37
-    t39 = s1*c1
-    t40 = t26*t29 - t22*t23 + t32*t39 + t35*t39 + t36*t39
-    t41 = t9*c1
-    t42 = t20*c1
-    t43 = t24*c1
-    t44 = t26*t10 + t12*t41 + t13*t42 + t14*t43
-    t45 = t43 + t42 + t41 - t10*t6
-    t46 = t13*c1
-    t47 = t14*c1
+    t39 = c1*s1
+    t40 = -t22*t23 + t34*t39 + t35*t39 + t36*t39 + t26*t29
+    t41 = c1*t24
+    t42 = c1*t20
+    t43 = c1*t9
+    t44 = t14*t41 + t13*t42 + t12*t43 + t26*t10
+    t45 = t41 + t42 + t43 - t6*t10
+    t46 = c1*t14
+    t47 = c1*t13
     t48 = s1*t28 + s1*t46 + s1*t47
-    t49 = t26*t3 + t48
-    t50 = -t29*t6 + t48
+    t49 = t48 + t3*t26
+    t50 = t48 - t6*t29
     t51 = t22**2
     t52 = s1**2
-    t53 = t12*t52 + t13*t52 + t14*t52 + t29*t3
-    t54 = t29**2 + t32*t52 + t35*t52 + t36*t52
+    t53 = t52*t14 + t52*t13 + t52*t12 + t3*t29
+    t54 = t29**2 + t52*t34 + t52*t35 + t52*t36
     t55 = t51 + t54
-    t56 = t9*s1
-    t57 = t20*s1
-    t58 = t24*s1
-    t59 = t29*t10 + t12*t56 + t13*t57 + t14*t58
-    t60 = t58 + t57 + t56 + t10*t3
+    t56 = s1*t24
+    t57 = s1*t20
+    t58 = s1*t9
+    t59 = t14*t56 + t13*t57 + t12*t58 + t29*t10
+    t60 = t56 + t57 + t58 + t3*t10
     t61 = t24**2
     t62 = t10**2
     t63 = t61 + t20**2 + t9**2 + t62
     t64 = t63
     t65 = s234**2
-    t66 = t1**2 + 3*t52 + t33*t65
+    t66 = t1**2 + 3*t52 + t32*t65
     t67 = t66
-    t68 = 3*c1
-    t69 = t1*t2 + s1*t68 - t65*t39
-    t70 = t2**2 + 3*t33 + t52*t65
+    t68 = 3*s1
+    t69 = c1*t68 - t39*t65 + t1*t2
+    t70 = t2**2 + 3*t32 + t52*t65
     t71 = t70
     t72 = c234**2
-    t73 = 1 + t72 + t65*s5**2
+    t73 = 1 + t72 + s5**2*t65
     t74 = t73
-    t75 = damping**2
-    t76 = t38 + t75
-    t77 = t76**2
-    t78 = t55 + t75
-    t79 = t64 + t75
-    t80 = t67 + t75
-    t81 = t71 + t75
-    t82 = t74 + t75
-    t83 = t40**2
-    t84 = t27**2
-    t85 = t44**2
-    t86 = t49**2
-    t87 = t34**2
-    t88 = xp.sqrt(t77 + t78**2 + t79**2 + t80**2 + t81**2 + t82**2 + 2*t83 + 2*t84 + 2*t85 + 2*t86 + 2*t87 + 2*t30**2 + 2*t59**2 + 2*t53**2 + 2*t50**2 + 2*t60**2 + 2*t45**2 + 2*t69**2 + 2*t15**2 + 2*t16**2 + 2*t62*t72)
-    t89 = xp.sqrt(t83 + t84 + t85 + t86 + t87 + t77)
-    t90 = t89*xp.where(xp.greater_equal(t76, 0), xp.asarray(1, dtype=dtype), -1)
-    t91 = t90 + t76
-    t92 = xp.where(xp.greater(t89, 0), 1/(t89*(t89 + xp.abs(t76))), 0)
-    t93 = t92*(t40*t91 + t40*t78 + t44*t59 + t49*t53 + t34*t50 - t27*t30)
-    t94 = t40 - t91*t93
-    t95 = -t40*t93 + t78
-    t96 = t59 - t44*t93
-    t97 = t53 - t49*t93
-    t98 = -t50 + t34*t93
-    t99 = t30 + t27*t93
-    t100 = t92*(t40*t53 + t27*t15 + t44*t60 + t49*t91 + t49*t80 + t34*t69)
-    t101 = t49 - t91*t100
-    t102 = t53 - t40*t100
-    t103 = t60 - t44*t100
-    t104 = -t49*t100 + t80
-    t105 = -t69 + t34*t100
-    t106 = -t15 + t27*t100
-    t107 = -t92*(t40*t50 + t27*t16 + t44*t45 + t49*t69 + t34*t91 + t34*t81)
-    t108 = t34 + t91*t107
-    t109 = t50 + t40*t107
-    t110 = t45 + t44*t107
-    t111 = t69 + t49*t107
-    t112 = t34*t107 + t81
-    t113 = t16 + t27*t107
-    t114 = t92*(t40*mu_dot1 + t44*mu_dot2 + t49*mu_dot3 + t91*mu_dot0 - t27*mu_dot5 - t34*mu_dot4)
-    t115 = mu_dot0 - t91*t114
-    t116 = mu_dot1 - t40*t114
-    t117 = mu_dot2 - t44*t114
-    t118 = mu_dot3 - t49*t114
-    t119 = mu_dot4 + t34*t114
-    t120 = mu_dot5 + t27*t114
-    t121 = xp.sqrt(t95**2 + t96**2 + t97**2 + t98**2 + t99**2)
-    t122 = t121*xp.where(xp.greater_equal(t95, 0), xp.asarray(1, dtype=dtype), -1)
-    t123 = t95 + t122
-    t124 = xp.where(xp.greater(t121, 0), 1/(t121*(t121 + xp.abs(t95))), 0)
-    t125 = t124*(t96*t103 + t97*t104 + t98*t105 + t99*t106 + t102*t123)
-    t126 = t102 - t123*t125
-    t127 = t103 - t96*t125
-    t128 = t104 - t97*t125
-    t129 = t105 - t98*t125
-    t130 = t106 - t99*t125
-    t131 = -t124*(-t98*t112 - t99*t113 + t96*t110 + t97*t111 + t109*t123)
-    t132 = t109 + t123*t131
-    t133 = t110 + t96*t131
-    t134 = t111 + t97*t131
-    t135 = t112 - t98*t131
-    t136 = t113 - t99*t131
-    t137 = t124*(t96*t117 + t97*t118 + t98*t119 + t99*t120 + t116*t123)
-    t138 = t116 - t123*t137
-    t139 = t117 - t96*t137
-    t140 = t118 - t97*t137
-    t141 = t119 - t98*t137
-    t142 = t120 - t99*t137
-    t143 = t10*c234
-    t144 = t92*(t40*t59 + t44*t91 + t44*t79 + t49*t60 + t34*t45 + t27*t143)
-    t145 = t44 - t91*t144
+    t75 = t40**2
+    t76 = t44**2
+    t77 = t49**2
+    t78 = t33**2
+    t79 = t27**2
+    t80 = damping**2
+    t81 = t80 + t38
+    t82 = t81**2
+    t83 = xp.sqrt(t75 + t76 + t77 + t78 + t79 + t82)
+    t84 = t83*xp.where(xp.greater_equal(t81, 0), xp.asarray(1, dtype=dtype), -1)
+    t85 = t81 + t84
+    t86 = xp.where(xp.greater(t83, 0), 1/(t83*(t83 + xp.abs(t81))), 0)
+    t87 = t86*(mu_dot0*t85 + mu_dot1*t40 + mu_dot2*t44 + mu_dot3*t49 - mu_dot4*t33 - mu_dot5*t27)
+    t88 = mu_dot0 - t85*t87
+    t89 = mu_dot1 - t40*t87
+    t90 = mu_dot2 - t44*t87
+    t91 = mu_dot3 - t49*t87
+    t92 = mu_dot4 + t33*t87
+    t93 = mu_dot5 + t27*t87
+    t94 = t80 + t55
+    t95 = t86*(t40*t85 + t40*t94 + t44*t59 + t49*t53 + t33*t50 - t27*t30)
+    t96 = t40 - t85*t95
+    t97 = t94 - t40*t95
+    t98 = t59 - t44*t95
+    t99 = t53 - t49*t95
+    t100 = -t50 + t33*t95
+    t101 = t30 + t27*t95
+    t102 = xp.sqrt(t97**2 + t98**2 + t99**2 + t100**2 + t101**2)
+    t103 = t102*xp.where(xp.greater_equal(t97, 0), xp.asarray(1, dtype=dtype), -1)
+    t104 = t97 + t103
+    t105 = xp.where(xp.greater(t102, 0), 1/(t102*(t102 + xp.abs(t97))), 0)
+    t106 = t105*(t89*t104 + t98*t90 + t99*t91 + t100*t92 + t101*t93)
+    t107 = t89 - t104*t106
+    t108 = t90 - t98*t106
+    t109 = t91 - t99*t106
+    t110 = t92 - t100*t106
+    t111 = t93 - t101*t106
+    t112 = t80 + t64
+    t113 = t80 + t67
+    t114 = t86*(t49*t85 + t40*t53 + t44*t60 + t49*t113 + t33*t69 + t27*t15)
+    t115 = t49 - t85*t114
+    t116 = t53 - t40*t114
+    t117 = t60 - t44*t114
+    t118 = t113 - t49*t114
+    t119 = -t69 + t33*t114
+    t120 = -t15 + t27*t114
+    t121 = t105*(t116*t104 + t98*t117 + t99*t118 + t100*t119 + t101*t120)
+    t122 = t116 - t104*t121
+    t123 = t117 - t98*t121
+    t124 = t118 - t99*t121
+    t125 = t119 - t100*t121
+    t126 = t120 - t101*t121
+    t127 = t80 + t71
+    t128 = -t86*(t33*t85 + t40*t50 + t44*t45 + t49*t69 + t33*t127 + t27*t16)
+    t129 = t33 + t85*t128
+    t130 = t50 + t40*t128
+    t131 = t45 + t44*t128
+    t132 = t69 + t49*t128
+    t133 = t127 + t33*t128
+    t134 = t16 + t27*t128
+    t135 = -t105*(t130*t104 + t98*t131 + t99*t132 - t100*t133 - t101*t134)
+    t136 = t130 + t104*t135
+    t137 = t131 + t98*t135
+    t138 = t132 + t99*t135
+    t139 = t133 - t100*t135
+    t140 = t134 - t101*t135
+    t141 = t80 + t74
+    t142 = xp.sqrt(2*t75 + 2*t76 + 2*t59**2 + 2*t77 + 2*t53**2 + 2*t60**2 + 2*t78 + 2*t50**2 + 2*t45**2 + 2*t69**2 + 2*t79 + 2*t30**2 + 2*t15**2 + 2*t16**2 + t82 + t94**2 + t112**2 + t113**2 + t127**2 + t141**2 + 2*t72*t62)
+    t143 = c234*t10
+    t144 = t86*(t44*t85 + t40*t59 + t44*t112 + t49*t60 + t33*t45 + t143*t27)
+    t145 = t44 - t85*t144
     t146 = t59 - t40*t144
-    t147 = -t44*t144 + t79
+    t147 = t112 - t44*t144
     t148 = t60 - t49*t144
-    t149 = -t45 + t34*t144
-    t150 = t27*t144 - t143
-    t151 = -t92*(-t40*t30 + t27*t91 + t27*t82 + t49*t15 + t34*t16 + t44*t143)
-    t152 = t27 + t91*t151
+    t149 = -t45 + t33*t144
+    t150 = -t143 + t27*t144
+    t151 = -t86*(t27*t85 - t40*t30 + t143*t44 + t49*t15 + t33*t16 + t27*t141)
+    t152 = t27 + t85*t151
     t153 = t30 - t40*t151
-    t154 = t44*t151 + t143
+    t154 = t143 + t44*t151
     t155 = t15 + t49*t151
-    t156 = t16 + t34*t151
-    t157 = t27*t151 + t82
-    t158 = t124*(t96*t147 + t97*t148 + t98*t149 + t99*t150 + t146*t123)
-    t159 = t146 - t123*t158
-    t160 = t147 - t96*t158
-    t161 = t148 - t97*t158
-    t162 = t149 - t98*t158
-    t163 = t150 - t99*t158
-    t164 = t124*(t98*t156 + t99*t157 + t153*t123 - t96*t154 - t97*t155)
-    t165 = t153 - t123*t164
-    t166 = t154 + t96*t164
-    t167 = t155 + t97*t164
-    t168 = t156 - t98*t164
-    t169 = t157 - t99*t164
+    t156 = t16 + t33*t151
+    t157 = t141 + t27*t151
+    t158 = t105*(t146*t104 + t98*t147 + t99*t148 + t100*t149 + t101*t150)
+    t159 = t146 - t104*t158
+    t160 = t147 - t98*t158
+    t161 = t148 - t99*t158
+    t162 = t149 - t100*t158
+    t163 = t150 - t101*t158
+    t164 = t105*(t153*t104 - t98*t154 - t99*t155 + t100*t156 + t101*t157)
+    t165 = t153 - t104*t164
+    t166 = t154 + t98*t164
+    t167 = t155 + t99*t164
+    t168 = t156 - t100*t164
+    t169 = t157 - t101*t164
     t170 = xp.sqrt(t160**2 + t161**2 + t162**2 + t163**2)
     t171 = t170*xp.where(xp.greater_equal(t160, 0), xp.asarray(1, dtype=dtype), -1)
     t172 = t160 + t171
     t173 = xp.where(xp.greater(t170, 0), 1/(t170*(t170 + xp.abs(t160))), 0)
-    t174 = t173*(t161*t128 + t162*t129 + t163*t130 + t127*t172)
-    t175 = t127 - t172*t174
-    t176 = t128 - t161*t174
-    t177 = t129 - t162*t174
-    t178 = t130 - t163*t174
-    t179 = t173*(t162*t135 + t163*t136 - t161*t134 - t133*t172)
-    t180 = t133 + t172*t179
-    t181 = t134 + t161*t179
-    t182 = t135 - t162*t179
-    t183 = t136 - t163*t179
-    t184 = t173*(t162*t168 + t163*t169 - t161*t167 - t166*t172)
+    t174 = t173*(t123*t172 + t161*t124 + t162*t125 + t163*t126)
+    t175 = t123 - t172*t174
+    t176 = t124 - t161*t174
+    t177 = t125 - t162*t174
+    t178 = t126 - t163*t174
+    t179 = t173*(-t137*t172 - t161*t138 + t162*t139 + t163*t140)
+    t180 = t137 + t172*t179
+    t181 = t138 + t161*t179
+    t182 = t139 - t162*t179
+    t183 = t140 - t163*t179
+    t184 = t173*(-t166*t172 - t161*t167 + t162*t168 + t163*t169)
     t185 = t166 + t172*t184
     t186 = t167 + t161*t184
     t187 = t168 - t162*t184
     t188 = t169 - t163*t184
-    t189 = t173*(t161*t140 + t162*t141 + t163*t142 + t139*t172)
-    t190 = t139 - t172*t189
-    t191 = t140 - t161*t189
-    t192 = t141 - t162*t189
-    t193 = t142 - t163*t189
+    t189 = t173*(t108*t172 + t161*t109 + t162*t110 + t163*t111)
+    t190 = t108 - t172*t189
+    t191 = t109 - t161*t189
+    t192 = t110 - t162*t189
+    t193 = t111 - t163*t189
     t194 = xp.sqrt(t176**2 + t177**2 + t178**2)
     t195 = t194*xp.where(xp.greater_equal(t176, 0), xp.asarray(1, dtype=dtype), -1)
     t196 = t176 + t195
     t197 = xp.where(xp.greater(t194, 0), 1/(t194*(t194 + xp.abs(t176))), 0)
-    t198 = t197*(t177*t182 + t178*t183 - t181*t196)
+    t198 = t197*(-t181*t196 + t177*t182 + t178*t183)
     t199 = t181 + t196*t198
     t200 = t182 - t177*t198
     t201 = t183 - t178*t198
-    t202 = t197*(t177*t187 + t178*t188 - t186*t196)
+    t202 = t197*(-t186*t196 + t177*t187 + t178*t188)
     t203 = t186 + t196*t202
     t204 = t187 - t177*t202
     t205 = t188 - t178*t202
-    t206 = t197*(t177*t192 + t178*t193 + t191*t196)
+    t206 = t197*(t191*t196 + t177*t192 + t178*t193)
     t207 = t191 - t196*t206
     t208 = t192 - t177*t206
     t209 = t193 - t178*t206
@@ -1799,106 +1799,106 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t211 = t210*xp.where(xp.greater_equal(t200, 0), xp.asarray(1, dtype=dtype), -1)
     t212 = t200 + t211
     t213 = xp.where(xp.greater(t210, 0), 1/(t210*(t210 + xp.abs(t200))), 0)
-    t214 = t213*(t201*t205 + t204*t212)
+    t214 = t213*(t204*t212 + t201*t205)
     t215 = t204 - t212*t214
     t216 = t205 - t201*t214
-    t217 = t213*(t201*t209 + t208*t212)
+    t217 = t213*(t208*t212 + t201*t209)
     t218 = t208 - t212*t217
     t219 = t209 - t201*t217
     t220 = xp.abs(t216)
     t221 = t220
     t222 = t221*xp.where(xp.greater_equal(t216, 0), xp.asarray(1, dtype=dtype), -1)
     t223 = t216 + t222
-    t224 = xp.where(xp.greater(t221, 0), 1/(t221*(t221 + t220)), 0)
-    t225 = t219 - t219*t224*t223**2
+    t224 = xp.where(xp.greater(t221, 0), 1/(t221*(t220 + t221)), 0)
+    t225 = t219 - t219*t223**2*t224
     t226 = xp.where(xp.not_equal(t222, 0), -t225/t222, 0)
     t227 = xp.where(xp.not_equal(t211, 0), -(t218 - t215*t226)/t211, 0)
     t228 = xp.where(xp.not_equal(t195, 0), -(t207 + t199*t227 + t203*t226)/t195, 0)
-    t229 = xp.where(xp.not_equal(t171, 0), -(t190 - t175*t228 + t180*t227 + t185*t226)/t171, 0)
-    t230 = xp.where(xp.not_equal(t122, 0), -(t138 - (t159*t229 + t126*t228 + t165*t226 - t132*t227))/t122, 0)
-    t231 = xp.where(xp.not_equal(t90, 0), -(t115 - (t94*t230 + t145*t229 + t101*t228 - t108*t227 - t152*t226))/t90, 0)
-    t232 = t226 + t230*t22 - t231*t23
-    t233 = t229*t10 + t230*t29 + t231*t26 - t226*c234 + t227*t6 + t228*t3
-    t234 = t2*t227 - t1*t228 + t226*t11
-    t235 = t14*s1
-    t236 = t228*s1 - t227*c1
-    t237 = t229*t24 + t230*t235 + t231*t47 + t236
-    t238 = t229*t9 + t230*t25 + t231*t28 + t236
-    t239 = t13*s1
-    t240 = t229*t20 + t230*t239 + t231*t46 + t236
-    t241 = t51 + t31
-    t242 = xp.sqrt(t66 + t70 + t73 + t241 + t63 + t37 + t54)
+    t229 = xp.where(xp.not_equal(t171, 0), -(t190 + t180*t227 + t185*t226 - t175*t228)/t171, 0)
+    t230 = xp.where(xp.not_equal(t103, 0), -(-(t159*t229 + t122*t228 - t136*t227 + t165*t226) + t107)/t103, 0)
+    t231 = xp.where(xp.not_equal(t84, 0), -(-(t96*t230 + t145*t229 + t115*t228 - t129*t227 - t152*t226) + t88)/t84, 0)
+    t232 = t226 - t23*t231 + t22*t230
+    t233 = t26*t231 + t29*t230 + t10*t229 + t3*t228 + t6*t227 - c234*t226
+    t234 = -t1*t228 + t2*t227 + t11*t226
+    t235 = s1*t14
+    t236 = s1*t228 - c1*t227
+    t237 = t236 + t24*t229 + t46*t231 + t235*t230
+    t238 = t236 + t9*t229 + t28*t231 + t25*t230
+    t239 = s1*t13
+    t240 = t236 + t20*t229 + t47*t231 + t239*t230
+    t241 = t31 + t51
+    t242 = xp.sqrt(t37 + t54 + t63 + t66 + t70 + t73 + t241)
     t243 = xp.sqrt(1 + t241)
     t244 = t243*xp.where(xp.less_equal(t23, 0), xp.asarray(1, dtype=dtype), -1)
-    t245 = xp.where(xp.greater(t243, 0), 1/(t243*(t243 + xp.abs(t23))), 0)
-    t246 = -t23
-    t247 = t244 + t246
-    t248 = t245*(t247*t47 + t22*t235)
-    t249 = t47 - t247*t248
-    t250 = t235 - t248*t22
-    t251 = t245*(t247*t46 + t22*t239)
-    t252 = t46 - t247*t251
-    t253 = t239 - t251*t22
-    t254 = t245*(t247*t28 + t22*t25)
-    t255 = t28 - t247*t254
-    t256 = t25 - t254*t22
-    t257 = t245*(mu_dot5 + t247*mu_dot0 + t22*mu_dot1)
-    t258 = mu_dot0 - t247*t257
-    t259 = mu_dot1 - t257*t22
-    t260 = mu_dot5 - t257
+    t245 = -t23
+    t246 = t245 + t244
+    t247 = xp.where(xp.greater(t243, 0), 1/(t243*(t243 + xp.abs(t245))), 0)
+    t248 = t247*(t46*t246 + t22*t235)
+    t249 = t46 - t246*t248
+    t250 = t235 - t22*t248
+    t251 = t247*(t47*t246 + t22*t239)
+    t252 = t47 - t246*t251
+    t253 = t239 - t22*t251
+    t254 = t247*(t28*t246 + t22*t25)
+    t255 = t28 - t246*t254
+    t256 = t25 - t22*t254
+    t257 = t247*(mu_dot5 + mu_dot0*t246 + t22*mu_dot1)
+    t258 = mu_dot0 - t246*t257
+    t259 = mu_dot1 - t22*t257
+    t260 = -t257 + mu_dot5
     t261 = -c234
-    t262 = t245*(t261 + t247*t26 + t22*t29)
-    t263 = t26 - t247*t262
-    t264 = t29 - t262*t22
-    t265 = t262 + c234
+    t262 = t247*(t261 + t26*t246 + t22*t29)
+    t263 = t26 - t246*t262
+    t264 = t29 - t22*t262
+    t265 = c234 + t262
     t266 = -t11
-    t267 = t245*t11
+    t267 = t11*t247
     t268 = t266 + t267
-    t269 = t33 + t52
-    t270 = xp.sqrt(t61 + t248**2 + t250**2 + t269)
+    t269 = t32 + t52
+    t270 = xp.sqrt(t61 + t269 + t248**2 + t250**2)
     t271 = t270*xp.where(xp.greater_equal(t250, 0), xp.asarray(1, dtype=dtype), -1)
     t272 = t250 + t271
     t273 = xp.where(xp.greater(t270, 0), 1/(t270*(t270 + xp.abs(t250))), 0)
-    t274 = t273*(t248*t251 + t253*t272 + t24*t20 + t269)
+    t274 = t273*(t269 + t253*t272 + t24*t20 + t248*t251)
     t275 = t253 - t272*t274
-    t276 = t20 - t274*t24
-    t277 = s1 - t274*s1
+    t276 = t20 - t24*t274
+    t277 = s1 - s1*t274
     t278 = -t251 + t248*t274
-    t279 = t273*(t248*t254 + t256*t272 + t24*t9 + t269)
+    t279 = t273*(t269 + t256*t272 + t24*t9 + t248*t254)
     t280 = t256 - t272*t279
-    t281 = t9 - t279*t24
-    t282 = s1 - t279*s1
+    t281 = t9 - t24*t279
+    t282 = s1 - s1*t279
     t283 = -t254 + t248*t279
-    t284 = t273*(t248*t265 + t264*t272 + t24*t10)
+    t284 = t273*(t264*t272 + t24*t10 + t248*t265)
     t285 = t264 - t272*t284
-    t286 = t10 - t284*t24
-    t287 = t3 - t284*s1
-    t288 = t284*c1 + t6
+    t286 = t10 - t24*t284
+    t287 = t3 - s1*t284
+    t288 = t6 + c1*t284
     t289 = -t265 + t248*t284
-    t290 = t273*(t259*t272 + t24*mu_dot2 + mu_dot3*s1 - t248*t260 - c1*mu_dot4)
+    t290 = t273*(t259*t272 + t24*mu_dot2 + s1*mu_dot3 - c1*mu_dot4 - t248*t260)
     t291 = t259 - t272*t290
-    t292 = mu_dot2 - t290*t24
-    t293 = mu_dot3 - t290*s1
-    t294 = mu_dot4 + t290*c1
+    t292 = mu_dot2 - t24*t290
+    t293 = mu_dot3 - s1*t290
+    t294 = mu_dot4 + c1*t290
     t295 = t260 + t248*t290
     t296 = -c1
-    t297 = t296 + t274*c1
-    t298 = t296 + t279*c1
+    t297 = t296 + c1*t274
+    t298 = t296 + c1*t279
     t299 = xp.sqrt(t276**2 + t277**2 + t297**2 + t278**2)
     t300 = t299*xp.where(xp.greater_equal(t276, 0), xp.asarray(1, dtype=dtype), -1)
     t301 = t276 + t300
     t302 = xp.where(xp.greater(t299, 0), 1/(t299*(t299 + xp.abs(t276))), 0)
-    t303 = t302*(t277*t282 + t297*t298 + t278*t283 + t281*t301)
+    t303 = t302*(t281*t301 + t277*t282 + t297*t298 + t278*t283)
     t304 = t281 - t301*t303
     t305 = t282 - t277*t303
     t306 = t298 - t297*t303
     t307 = t283 - t278*t303
-    t308 = t302*(t277*t287 + t297*t288 + t278*t289 + t286*t301)
+    t308 = t302*(t286*t301 + t277*t287 + t297*t288 + t278*t289)
     t309 = t286 - t301*t308
     t310 = t287 - t277*t308
     t311 = t288 - t297*t308
     t312 = t289 - t278*t308
-    t313 = t302*(t277*t293 + t297*t294 + t278*t295 + t292*t301)
+    t313 = t302*(t292*t301 + t277*t293 + t297*t294 + t278*t295)
     t314 = t292 - t301*t313
     t315 = t293 - t277*t313
     t316 = t294 - t297*t313
@@ -1907,11 +1907,11 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t319 = t318*xp.where(xp.greater_equal(t305, 0), xp.asarray(1, dtype=dtype), -1)
     t320 = t305 + t319
     t321 = xp.where(xp.greater(t318, 0), 1/(t318*(t318 + xp.abs(t305))), 0)
-    t322 = t321*(t306*t311 + t307*t312 + t310*t320)
+    t322 = t321*(t310*t320 + t306*t311 + t307*t312)
     t323 = t310 - t320*t322
     t324 = t311 - t306*t322
     t325 = t312 - t307*t322
-    t326 = t321*(t306*t316 + t307*t317 + t315*t320)
+    t326 = t321*(t315*t320 + t306*t316 + t307*t317)
     t327 = t315 - t320*t326
     t328 = t316 - t306*t326
     t329 = t317 - t307*t326
@@ -1919,56 +1919,56 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t331 = t330*xp.where(xp.greater_equal(t324, 0), xp.asarray(1, dtype=dtype), -1)
     t332 = t324 + t331
     t333 = xp.where(xp.greater(t330, 0), 1/(t330*(t330 + xp.abs(t324))), 0)
-    t334 = t333*(t325*t329 + t328*t332)
+    t334 = t333*(t328*t332 + t325*t329)
     t335 = t328 - t332*t334
     t336 = t329 - t325*t334
     t337 = t22*t267
-    t338 = t273*(t1*s1 + t2*c1 - t248*t268 + t272*t337)
-    t339 = -t272*t338 + t337
-    t340 = t1 - t338*s1
+    t338 = t273*(s1*t1 + c1*t2 + t272*t337 - t248*t268)
+    t339 = t337 - t272*t338
+    t340 = t1 - s1*t338
     t341 = t268 + t248*t338
     t342 = -t2
-    t343 = t342 + t338*c1
-    t344 = 1 + t1 + t22 + t26 + t29 + t24 + t20 + t9 + t10 + damping + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + q1 + q2 + q3 + q4 + q5 + q6 + t342 + t246 + t261 - t68 + 3*s1 + t28 + t25 + t46 + t239 + t47 + t235 + t3 + t6 + t266
-    t345 = t338*t24
-    t346 = t302*(t277*t340 + t297*t343 + t278*t341 - t301*t345)
+    t343 = t342 + c1*t338
+    t344 = 1 + t245 + t342 + t261 + q1 + q2 + q3 + q4 + q5 + t3 + t6 + q6 + t1 + t22 + t266 + t46 + t47 + t28 + t235 + t239 + t25 + t26 + t29 + t24 + t20 + t9 + t10 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + damping + t68 - 3*c1
+    t345 = t24*t338
+    t346 = t302*(-t301*t345 + t277*t340 + t297*t343 + t278*t341)
     t347 = t345 + t301*t346
     t348 = t340 - t277*t346
     t349 = t343 - t297*t346
     t350 = t341 - t278*t346
-    t351 = t321*(t306*t349 + t307*t350 + t348*t320)
+    t351 = t321*(t348*t320 + t306*t349 + t307*t350)
     t352 = t348 - t320*t351
     t353 = t349 - t306*t351
     t354 = t350 - t307*t351
-    t355 = t333*(t325*t354 + t353*t332)
+    t355 = t333*(t353*t332 + t325*t354)
     t356 = t353 - t332*t355
     t357 = t354 - t325*t355
     t358 = xp.abs(t357)
     t359 = t358
     t360 = t359*xp.where(xp.greater_equal(t357, 0), xp.asarray(1, dtype=dtype), -1)
     t361 = t357 + t360
-    t362 = xp.where(xp.greater(t359, 0), 1/(t359*(t359 + t358)), 0)
-    t363 = t336 - t336*t362*t361**2
+    t362 = xp.where(xp.greater(t359, 0), 1/(t359*(t358 + t359)), 0)
+    t363 = t336 - t336*t361**2*t362
     t364 = xp.where(xp.not_equal(t360, 0), -t363/t360, 0)
     t365 = xp.where(xp.not_equal(t331, 0), -(t335 - t356*t364)/t331, 0)
-    t366 = xp.where(xp.not_equal(t319, 0), -(t327 - (t323*t365 + t352*t364))/t319, 0)
-    t367 = xp.where(xp.not_equal(t300, 0), -(t314 - (t304*t366 + t309*t365 - t347*t364))/t300, 0)
-    t368 = xp.where(xp.not_equal(t271, 0), -(t291 - (t275*t367 + t280*t366 + t285*t365 + t339*t364))/t271, 0)
-    t369 = xp.where(xp.not_equal(t244, 0), -(t258 - (t249*t368 + t252*t367 + t255*t366 + t263*t365 + t247*t364*t267))/t244, 0)
+    t366 = xp.where(xp.not_equal(t319, 0), -(-(t323*t365 + t352*t364) + t327)/t319, 0)
+    t367 = xp.where(xp.not_equal(t300, 0), -(-(t304*t366 + t309*t365 - t347*t364) + t314)/t300, 0)
+    t368 = xp.where(xp.not_equal(t271, 0), -(-(t275*t367 + t280*t366 + t285*t365 + t339*t364) + t291)/t271, 0)
+    t369 = xp.where(xp.not_equal(t244, 0), -(-(t249*t368 + t252*t367 + t255*t366 + t263*t365 + t267*t246*t364) + t258)/t244, 0)
     t370 = xp.isfinite(t344)
     t371 = xp.greater_equal(damping, 0)
-    t372 = 1e-12*t242
-    t373 = xp.greater(damping, 0)
-    t374 = 1e-12*t88
-    t375 = (xp.less_equal(damping, 0) & (xp.less_equal(t243, t372) | xp.less_equal(t270, t372) | xp.less_equal(t299, t372) | xp.less_equal(t318, t372) | xp.less_equal(t330, t372) | xp.less_equal(t359, t372))) | (t373 & (xp.less_equal(t89, t374) | xp.less_equal(t121, t374) | xp.less_equal(t170, t374) | xp.less_equal(t194, t374) | xp.less_equal(t210, t374) | xp.less_equal(t221, t374)))
+    t372 = xp.greater(damping, 0)
+    t373 = 1e-12*t142
+    t374 = 1e-12*t242
+    t375 = (t372 & (xp.less_equal(t83, t373) | xp.less_equal(t102, t373) | xp.less_equal(t170, t373) | xp.less_equal(t194, t373) | xp.less_equal(t210, t373) | xp.less_equal(t221, t373))) | (xp.less_equal(damping, 0) & (xp.less_equal(t243, t374) | xp.less_equal(t270, t374) | xp.less_equal(t299, t374) | xp.less_equal(t318, t374) | xp.less_equal(t330, t374) | xp.less_equal(t359, t374)))
     t376 = t370 & t371 & xp.logical_not(t375)
     q_dot = _stack(xp, [
-        xp.broadcast_to(xp.where(t376, xp.where(t373, t232, t369), 0), batch),  # 0
-        xp.broadcast_to(xp.where(t376, xp.where(t373, t237, t368), 0), batch),  # 1
-        xp.broadcast_to(xp.where(t376, xp.where(t373, t240, t367), 0), batch),  # 2
-        xp.broadcast_to(xp.where(t376, xp.where(t373, t238, t366), 0), batch),  # 3
-        xp.broadcast_to(xp.where(t376, xp.where(t373, t233, t365), 0), batch),  # 4
-        xp.broadcast_to(xp.where(t376, xp.where(t373, -t234, t364), 0), batch),  # 5
+        xp.broadcast_to(xp.where(t376, xp.where(t372, t232, t369), 0), batch),  # 0
+        xp.broadcast_to(xp.where(t376, xp.where(t372, t237, t368), 0), batch),  # 1
+        xp.broadcast_to(xp.where(t376, xp.where(t372, t240, t367), 0), batch),  # 2
+        xp.broadcast_to(xp.where(t376, xp.where(t372, t238, t366), 0), batch),  # 3
+        xp.broadcast_to(xp.where(t376, xp.where(t372, t233, t365), 0), batch),  # 4
+        xp.broadcast_to(xp.where(t376, xp.where(t372, -t234, t364), 0), batch),  # 5
     ], (6,))
     status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t370 & t371), 2, xp.where(t375, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
     return q_dot, status
@@ -2009,109 +2009,109 @@ def ik_numeric_step(target, q, damping=0.0):
     c3 = xp.cos(q3)
     s3 = xp.sin(q3)
     c23 = c2*c3 - s2*s3
-    s23 = c2*s3 + c3*s2
+    s23 = c2*s3 + s2*c3
     c4 = xp.cos(q4)
     s4 = xp.sin(q4)
     c234 = c23*c4 - s23*s4
-    s234 = c23*s4 + c4*s23
+    s234 = c23*s4 + s23*c4
     c5 = xp.cos(q5)
     s5 = xp.sin(q5)
     c6 = xp.cos(q6)
     s6 = xp.sin(q6)
-    t0 = T00 + T01 + T02 + T03 + T10 + T11 + T12 + T13 + T20 + T21 + T22 + T23 + qs1 + qs2 + qs3 + qs4 + qs5 + qs6
+    t0 = qs1 + qs2 + qs3 + qs4 + qs5 + qs6 + T00 + T01 + T02 + T10 + T11 + T12 + T20 + T21 + T22 + T03 + T13 + T23
     t1 = s1*s5
     t2 = c1*c5
     t3 = t1 + c234*t2
     t4 = t2 + c234*t1
-    t5 = c5*s1
+    t5 = s1*c5
     t6 = c1*s5
     t7 = t5 - c234*t6
     t8 = -t6 + c234*t5
     t9 = c1*s234
     t10 = t3*c6 - s6*t9
     t11 = t3*s6 + c6*t9
-    t12 = 0.0823*t7 + 0.09465*t9
-    t13 = t12 + 0.10915*s1
-    t14 = T00*t10 + T02*t7 - T01*t11
-    t15 = T10*t10 + T12*t7 - T11*t11
-    t16 = T20*t10 + T22*t7 - T21*t11
+    t12 = 0.09465*t9 + 0.0823*t7
+    t13 = 0.10915*s1 + t12
+    t14 = t10*T00 - t11*T01 + t7*T02
+    t15 = t10*T10 - t11*T11 + t7*T12
+    t16 = t10*T20 - t11*T21 + t7*T22
     t17 = s1*s234
-    t18 = t8*c6 - s6*t17
-    t19 = t8*s6 + c6*t17
-    t20 = -0.0823*t4 + 0.09465*t17
+    t18 = c6*t8 - s6*t17
+    t19 = s6*t8 + c6*t17
+    t20 = 0.09465*t17 - 0.0823*t4
     t21 = t20 - 0.10915*c1
-    t22 = t13*c1 + t21*s1
+    t22 = c1*t13 + s1*t21
     t23 = t20*t9 - t12*t17
-    t24 = T01*t19 + T02*t4 - T00*t18
-    t25 = T11*t19 + T12*t4 - T10*t18
-    t26 = T21*t19 + T22*t4 - T20*t18
+    t24 = -t18*T00 + t19*T01 + t4*T02
+    t25 = -t18*T10 + t19*T11 + t4*T12
+    t26 = -t18*T20 + t19*T21 + t4*T22
     t27 = 0.5*(t24 + t15)
     t28 = c5*s234
     t29 = c234*s6 + c6*t28
     t30 = c234*c6 - s6*t28
     t31 = s5*s234
     t32 = 0.09465*c234 + 0.0823*t31
-    t33 = t32 + 0.39225*s23
-    t34 = t33 + 0.425*s2
+    t33 = 0.39225*s23 + t32
+    t34 = 0.425*s2 + t33
     t35 = 0.089459 - t34
-    t36 = t20*c234 - t32*t17
-    t37 = -t12*c234 + t32*t9
-    t38 = t7*t31 + c234*t9
-    t39 = t4*t31 - c234*t17
-    t40 = T00*t29 + T01*t30 - T02*t31
-    t41 = T10*t29 + T11*t30 - T12*t31
-    t42 = T20*t29 + T21*t30 - T22*t31
-    t43 = -0.5*(t41 + t26)
-    t44 = 0.5*(t40 - t16)
+    t36 = c234*t20 - t32*t17
+    t37 = -c234*t12 + t32*t9
+    t38 = c234*t9 + t7*t31
+    t39 = -c234*t17 + t4*t31
+    t40 = t29*T00 + t30*T01 - t31*T02
+    t41 = t29*T10 + t30*T11 - t31*T12
+    t42 = t29*T20 + t30*T21 - t31*T22
+    t43 = -0.5*(t26 + t41)
+    t44 = 0.5*(-t16 + t40)
     t45 = xp.sqrt(t43**2 + t44**2 + t27**2)
-    t46 = T23 - t35
+    t46 = -t35 + T23
     t47 = 0.39225*c23
     t48 = t13 - c1*t47
     t49 = t21 - s1*t47
-    t50 = t48*c1 + t49*s1
+    t50 = c1*t48 + s1*t49
     t51 = 0.425*c2
     t52 = t48 - c1*t51
     t53 = t49 - s1*t51
-    t54 = t52*c1 + t53*s1
-    t55 = t53 + t36*c234
-    t56 = t52 - t37*c234
+    t54 = c1*t52 + s1*t53
+    t55 = t53 + c234*t36
+    t56 = t52 - c234*t37
     t57 = t54**2 + t50**2 + t22**2 + t23**2
-    t58 = T03 - t52
-    t59 = T13 - t53
-    t60 = t32**2
-    t61 = c1**2
-    t62 = t32*t61 + t33*t61 + t34*t61 - t36*t17
+    t58 = -t52 + T03
+    t59 = -t53 + T13
+    t60 = c1**2
+    t61 = t60*t34 + t60*t33 + t60*t32 - t17*t36
+    t62 = t34**2
     t63 = t33**2
-    t64 = t34**2
-    t65 = t53**2 + t36**2 + t60*t61 + t63*t61 + t64*t61
-    t66 = s1*c1
-    t67 = t36*t37 - t52*t53 + t60*t66 + t63*t66 + t64*t66
-    t68 = t22*c1
-    t69 = t50*c1
-    t70 = t54*c1
-    t71 = t36*t23 + t32*t68 + t33*t69 + t34*t70
-    t72 = t70 + t69 + t68 - t23*t17
-    t73 = t32*t66 + t33*t66 + t34*t66
-    t74 = t36*t9 + t73
-    t75 = -t37*t17 + t73
+    t64 = t32**2
+    t65 = t53**2 + t36**2 + t60*t62 + t60*t63 + t60*t64
+    t66 = c1*s1
+    t67 = -t52*t53 + t62*t66 + t63*t66 + t64*t66 + t36*t37
+    t68 = c1*t54
+    t69 = c1*t50
+    t70 = c1*t22
+    t71 = t34*t68 + t33*t69 + t32*t70 + t36*t23
+    t72 = t68 + t69 + t70 - t17*t23
+    t73 = t34*t66 + t33*t66 + t32*t66
+    t74 = t73 + t9*t36
+    t75 = t73 - t17*t37
     t76 = s1**2
-    t77 = t52**2 + t37**2 + t60*t76 + t63*t76 + t64*t76
-    t78 = t32*t76 + t33*t76 + t34*t76 + t37*t9
-    t79 = t22*s1
-    t80 = t50*s1
-    t81 = t54*s1
-    t82 = t37*t23 + t32*t79 + t33*t80 + t34*t81
-    t83 = t81 + t80 + t79 + t23*t9
+    t77 = t52**2 + t37**2 + t76*t62 + t76*t63 + t76*t64
+    t78 = t76*t34 + t76*t33 + t76*t32 + t9*t37
+    t79 = s1*t54
+    t80 = s1*t50
+    t81 = s1*t22
+    t82 = t34*t79 + t33*t80 + t32*t81 + t37*t23
+    t83 = t79 + t80 + t81 + t9*t23
     t84 = s234**2
-    t85 = t7**2 + 3*t76 + t61*t84
-    t86 = t7*t4 + 3*t66 - t84*t66
-    t87 = t4**2 + 3*t61 + t76*t84
-    t88 = 1 + c234**2 + t84*s5**2
+    t85 = t7**2 + 3*t76 + t60*t84
+    t86 = 3*t66 - t66*t84 + t7*t4
+    t87 = t4**2 + 3*t60 + t76*t84
+    t88 = 1 + c234**2 + s5**2*t84
     t89 = -t25
-    t90 = 0.5*(-1 + t14 + t42 + t89)
+    t90 = 0.5*(-1 + t89 + t14 + t42)
     t91 = xp.atan2(t45, t90)
     t92 = xp.where(xp.greater(t45, 0), t91/t45, 1)
-    t93 = xp.greater_equal(t14, t42) & xp.greater_equal(t14, t89)
+    t93 = xp.greater_equal(t14, t89) & xp.greater_equal(t14, t42)
     t94 = xp.greater_equal(t89, t42)
     t95 = xp.where(t93, 0.5*(1 + t14), xp.where(t94, -0.5*t24, 0.5*t40))
     t96 = xp.where(t93, 0.5*t15, xp.where(t94, 0.5*(1 + t89), 0.5*t41))
@@ -2120,50 +2120,50 @@ def ik_numeric_step(target, q, damping=0.0):
     t99 = xp.where(xp.greater_equal(t43*t95 + t44*t96 + t27*t97, 0), xp.asarray(1, dtype=dtype), -1)
     t100 = xp.greater(t45, 1e-06) | xp.greater(t90, 0)
     t101 = t91*t99/t98
-    t102 = xp.where(t100, t43*t92, t95*t101)
-    t103 = xp.where(t100, t44*t92, t96*t101)
-    t104 = xp.where(t100, t27*t92, t97*t101)
+    t102 = xp.where(t100, t43*t92, t101*t95)
+    t103 = xp.where(t100, t44*t92, t101*t96)
+    t104 = xp.where(t100, t27*t92, t101*t97)
     t105 = t102**2 + t103**2 + t104**2 + t58**2 + t59**2 + t46**2
-    t106 = t65 + damping
-    t107 = xp.sqrt(t67**2 + t55**2 + t71**2 + t74**2 + t62**2 + t106**2)
+    t106 = damping + t65
+    t107 = xp.sqrt(t67**2 + t71**2 + t74**2 + t61**2 + t55**2 + t106**2)
     t108 = t107*xp.where(xp.greater_equal(t106, 0), xp.asarray(1, dtype=dtype), -1)
-    t109 = t108 + t106
+    t109 = t106 + t108
     t110 = xp.where(xp.greater(t107, 0), 1/(t107*(t107 + xp.abs(t106))), 0)
-    t111 = t110*(t67*t59 + t71*t46 + t74*t102 + t58*t109 - t55*t104 - t62*t103)
+    t111 = t110*(t58*t109 + t67*t59 + t71*t46 + t74*t102 - t61*t103 - t55*t104)
     t112 = t58 - t109*t111
     t113 = t59 - t67*t111
     t114 = t46 - t71*t111
     t115 = t102 - t74*t111
-    t116 = t103 + t62*t111
+    t116 = t103 + t61*t111
     t117 = t104 + t55*t111
-    t118 = t77 + damping
-    t119 = t110*(t67*t109 + t67*t118 + t71*t82 + t74*t78 + t62*t75 - t55*t56)
+    t118 = damping + t77
+    t119 = t110*(t71*t82 + t74*t78 + t61*t75 - t55*t56 + t67*t109 + t67*t118)
     t120 = t67 - t109*t119
-    t121 = -t67*t119 + t118
+    t121 = t118 - t67*t119
     t122 = t82 - t71*t119
     t123 = t78 - t74*t119
-    t124 = -t75 + t62*t119
+    t124 = -t75 + t61*t119
     t125 = t56 + t55*t119
     t126 = xp.sqrt(t121**2 + t122**2 + t123**2 + t124**2 + t125**2)
     t127 = t126*xp.where(xp.greater_equal(t121, 0), xp.asarray(1, dtype=dtype), -1)
     t128 = t121 + t127
     t129 = xp.where(xp.greater(t126, 0), 1/(t126*(t126 + xp.abs(t121))), 0)
-    t130 = t129*(t122*t114 + t123*t115 + t124*t116 + t125*t117 + t113*t128)
+    t130 = t129*(t113*t128 + t122*t114 + t123*t115 + t124*t116 + t125*t117)
     t131 = t113 - t128*t130
     t132 = t114 - t122*t130
     t133 = t115 - t123*t130
     t134 = t116 - t124*t130
     t135 = t117 - t125*t130
-    t136 = t57 + damping
-    t137 = t23*c234
-    t138 = t110*(t67*t82 + t71*t109 + t71*t136 + t74*t83 + t62*t72 + t55*t137)
+    t136 = c234*t23
+    t137 = damping + t57
+    t138 = t110*(t67*t82 + t74*t83 + t61*t72 + t136*t55 + t71*t109 + t71*t137)
     t139 = t71 - t109*t138
     t140 = t82 - t67*t138
-    t141 = -t71*t138 + t136
+    t141 = t137 - t71*t138
     t142 = t83 - t74*t138
-    t143 = -t72 + t62*t138
-    t144 = t55*t138 - t137
-    t145 = t129*(t122*t141 + t123*t142 + t124*t143 + t125*t144 + t140*t128)
+    t143 = -t72 + t61*t138
+    t144 = -t136 + t55*t138
+    t145 = t129*(t140*t128 + t122*t141 + t123*t142 + t124*t143 + t125*t144)
     t146 = t140 - t128*t145
     t147 = t141 - t122*t145
     t148 = t142 - t123*t145
@@ -2173,26 +2173,26 @@ def ik_numeric_step(target, q, damping=0.0):
     t152 = t151*xp.where(xp.greater_equal(t147, 0), xp.asarray(1, dtype=dtype), -1)
     t153 = t147 + t152
     t154 = xp.where(xp.greater(t151, 0), 1/(t151*(t151 + xp.abs(t147))), 0)
-    t155 = t154*(t148*t133 + t149*t134 + t150*t135 + t132*t153)
+    t155 = t154*(t132*t153 + t148*t133 + t149*t134 + t150*t135)
     t156 = t132 - t153*t155
     t157 = t133 - t148*t155
     t158 = t134 - t149*t155
     t159 = t135 - t150*t155
-    t160 = t85 + damping
-    t161 = t110*(t67*t78 + t55*t38 + t71*t83 + t74*t109 + t74*t160 + t62*t86)
+    t160 = damping + t85
+    t161 = t110*(t67*t78 + t71*t83 + t61*t86 + t55*t38 + t74*t109 + t74*t160)
     t162 = t74 - t109*t161
     t163 = t78 - t67*t161
     t164 = t83 - t71*t161
-    t165 = -t74*t161 + t160
-    t166 = -t86 + t62*t161
+    t165 = t160 - t74*t161
+    t166 = -t86 + t61*t161
     t167 = -t38 + t55*t161
-    t168 = t129*(t122*t164 + t123*t165 + t124*t166 + t125*t167 + t163*t128)
+    t168 = t129*(t163*t128 + t122*t164 + t123*t165 + t124*t166 + t125*t167)
     t169 = t163 - t128*t168
     t170 = t164 - t122*t168
     t171 = t165 - t123*t168
     t172 = t166 - t124*t168
     t173 = t167 - t125*t168
-    t174 = t154*(t148*t171 + t149*t172 + t150*t173 + t170*t153)
+    t174 = t154*(t170*t153 + t148*t171 + t149*t172 + t150*t173)
     t175 = t170 - t153*t174
     t176 = t171 - t148*t174
     t177 = t172 - t149*t174
@@ -2201,30 +2201,30 @@ def ik_numeric_step(target, q, damping=0.0):
     t180 = t179*xp.where(xp.greater_equal(t176, 0), xp.asarray(1, dtype=dtype), -1)
     t181 = t176 + t180
     t182 = xp.where(xp.greater(t179, 0), 1/(t179*(t179 + xp.abs(t176))), 0)
-    t183 = t182*(t177*t158 + t178*t159 + t157*t181)
+    t183 = t182*(t157*t181 + t177*t158 + t178*t159)
     t184 = t157 - t181*t183
     t185 = t158 - t177*t183
     t186 = t159 - t178*t183
-    t187 = t87 + damping
-    t188 = -t110*(t67*t75 + t55*t39 + t71*t72 + t74*t86 + t62*t109 + t62*t187)
-    t189 = t62 + t109*t188
+    t187 = damping + t87
+    t188 = -t110*(t67*t75 + t71*t72 + t74*t86 + t55*t39 + t61*t109 + t61*t187)
+    t189 = t61 + t109*t188
     t190 = t75 + t67*t188
     t191 = t72 + t71*t188
     t192 = t86 + t74*t188
-    t193 = t62*t188 + t187
+    t193 = t187 + t61*t188
     t194 = t39 + t55*t188
-    t195 = -t129*(-t124*t193 - t125*t194 + t122*t191 + t123*t192 + t190*t128)
+    t195 = -t129*(t190*t128 + t122*t191 + t123*t192 - t124*t193 - t125*t194)
     t196 = t190 + t128*t195
     t197 = t191 + t122*t195
     t198 = t192 + t123*t195
     t199 = t193 - t124*t195
     t200 = t194 - t125*t195
-    t201 = t154*(t149*t199 + t150*t200 - t148*t198 - t197*t153)
+    t201 = t154*(-t197*t153 - t148*t198 + t149*t199 + t150*t200)
     t202 = t197 + t153*t201
     t203 = t198 + t148*t201
     t204 = t199 - t149*t201
     t205 = t200 - t150*t201
-    t206 = t182*(t177*t204 + t178*t205 - t203*t181)
+    t206 = t182*(-t203*t181 + t177*t204 + t178*t205)
     t207 = t203 + t181*t206
     t208 = t204 - t177*t206
     t209 = t205 - t178*t206
@@ -2232,56 +2232,56 @@ def ik_numeric_step(target, q, damping=0.0):
     t211 = t210*xp.where(xp.greater_equal(t208, 0), xp.asarray(1, dtype=dtype), -1)
     t212 = t208 + t211
     t213 = xp.where(xp.greater(t210, 0), 1/(t210*(t210 + xp.abs(t208))), 0)
-    t214 = t213*(t209*t186 + t185*t212)
+    t214 = t213*(t185*t212 + t209*t186)
     t215 = t185 - t212*t214
     t216 = t186 - t209*t214
-    t217 = t88 + damping
-    t218 = -t110*(-t67*t56 + t55*t109 + t55*t217 + t74*t38 + t62*t39 + t71*t137)
+    t217 = damping + t88
+    t218 = -t110*(-t67*t56 + t136*t71 + t74*t38 + t61*t39 + t55*t109 + t55*t217)
     t219 = t55 + t109*t218
     t220 = t56 - t67*t218
-    t221 = t71*t218 + t137
+    t221 = t136 + t71*t218
     t222 = t38 + t74*t218
-    t223 = t39 + t62*t218
-    t224 = t55*t218 + t217
-    t225 = t129*(t124*t223 + t125*t224 + t220*t128 - t122*t221 - t123*t222)
+    t223 = t39 + t61*t218
+    t224 = t217 + t55*t218
+    t225 = t129*(t220*t128 - t122*t221 - t123*t222 + t124*t223 + t125*t224)
     t226 = t220 - t128*t225
     t227 = t221 + t122*t225
     t228 = t222 + t123*t225
     t229 = t223 - t124*t225
     t230 = t224 - t125*t225
-    t231 = t154*(t149*t229 + t150*t230 - t148*t228 - t227*t153)
+    t231 = t154*(-t227*t153 - t148*t228 + t149*t229 + t150*t230)
     t232 = t227 + t153*t231
     t233 = t228 + t148*t231
     t234 = t229 - t149*t231
     t235 = t230 - t150*t231
-    t236 = t182*(t177*t234 + t178*t235 - t233*t181)
+    t236 = t182*(-t233*t181 + t177*t234 + t178*t235)
     t237 = t233 + t181*t236
     t238 = t234 - t177*t236
     t239 = t235 - t178*t236
-    t240 = t213*(t209*t239 + t238*t212)
+    t240 = t213*(t238*t212 + t209*t239)
     t241 = t238 - t212*t240
     t242 = t239 - t209*t240
     t243 = xp.abs(t242)
     t244 = t243
     t245 = t244*xp.where(xp.greater_equal(t242, 0), xp.asarray(1, dtype=dtype), -1)
     t246 = t242 + t245
-    t247 = xp.where(xp.greater(t244, 0), 1/(t244*(t244 + t243)), 0)
-    t248 = t216 - t216*t247*t246**2
+    t247 = xp.where(xp.greater(t244, 0), 1/(t244*(t243 + t244)), 0)
+    t248 = t216 - t216*t246**2*t247
     t249 = xp.where(xp.not_equal(t245, 0), -t248/t245, 0)
     t250 = xp.where(xp.not_equal(t211, 0), -(t215 - t241*t249)/t211, 0)
     t251 = xp.where(xp.not_equal(t180, 0), -(t184 + t207*t250 + t237*t249)/t180, 0)
-    t252 = xp.where(xp.not_equal(t152, 0), -(t156 - t175*t251 + t202*t250 + t232*t249)/t152, 0)
-    t253 = xp.where(xp.not_equal(t127, 0), -(t131 - (t146*t252 + t169*t251 + t226*t249 - t196*t250))/t127, 0)
-    t254 = xp.where(xp.not_equal(t108, 0), -(t112 - (t120*t253 + t139*t252 + t162*t251 - t189*t250 - t219*t249))/t108, 0)
-    t255 = t249 + q1 + t52*t253 - t53*t254
-    t256 = q5 + t36*t254 + t37*t253 + t23*t252 - t249*c234 + t250*t17 + t251*t9
-    t257 = q6 + t7*t251 - t4*t250 - t249*t31
-    t258 = s1*t253
-    t259 = c1*t254
-    t260 = t251*s1 - t250*c1
-    t261 = q2 + t54*t252 + t34*t258 + t34*t259 + t260
-    t262 = q3 + t50*t252 + t33*t258 + t33*t259 + t260
-    t263 = q4 + t22*t252 + t32*t258 + t32*t259 + t260
+    t252 = xp.where(xp.not_equal(t152, 0), -(t156 + t202*t250 + t232*t249 - t175*t251)/t152, 0)
+    t253 = xp.where(xp.not_equal(t127, 0), -(-(t146*t252 + t169*t251 - t196*t250 + t226*t249) + t131)/t127, 0)
+    t254 = xp.where(xp.not_equal(t108, 0), -(-(t120*t253 + t139*t252 + t162*t251 - t189*t250 - t219*t249) + t112)/t108, 0)
+    t255 = q1 + t249 - t53*t254 + t52*t253
+    t256 = q5 + t36*t254 + t37*t253 + t23*t252 + t9*t251 + t17*t250 - c234*t249
+    t257 = q6 + t7*t251 - t4*t250 - t31*t249
+    t258 = c1*t254
+    t259 = s1*t253
+    t260 = s1*t251 - c1*t250
+    t261 = q2 + t260 + t54*t252 + t34*t258 + t34*t259
+    t262 = q3 + t260 + t50*t252 + t33*t258 + t33*t259
+    t263 = q4 + t260 + t22*t252 + t32*t258 + t32*t259
     q_start = _stack(xp, [
         xp.broadcast_to(q1, batch),  # 0
         xp.broadcast_to(q2, batch),  # 1
@@ -2304,7 +2304,7 @@ def ik_numeric_step(target, q, damping=0.0):
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def ik_branches(T):
-    """every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits: (8 x 6 and 8 x 1 and 8 x 1), 1246 operations."""
+    """every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits: (8 x 6 and 8 x 1 and 8 x 1), 1238 operations."""
     xp, dtype, device, batch, (T,) = _arguments(("T", T, (4, 4)))
     T00 = T[..., 0, 0]
     T01 = T[..., 0, 1]
@@ -2318,23 +2318,23 @@ def ik_branches(T):
     T21 = T[..., 2, 1]
     T22 = T[..., 2, 2]
     T23 = T[..., 2, 3]
-    t0 = T00 + T01 + T02 + T03 + T10 + T11 + T12 + T13 + T20 + T21 + T22 + T23
-    t1 = 0.005191*T01 + 0.81725*T00
-    t2 = T03 - 0.19145*T02 + t1
+    t0 = T00 + T01 + T02 + T10 + T11 + T12 + T20 + T21 + T22 + T03 + T13 + T23
+    t1 = 0.81725*T00 + 0.005191*T01
+    t2 = t1 + T03 - 0.19145*T02
     t3 = -0.10915*T02 + t1
-    t4 = t2 - t3
-    t5 = 0.005191*T11 + 0.81725*T10
-    t6 = T13 - 0.19145*T12 + t5
+    t4 = -t3 + t2
+    t5 = 0.81725*T10 + 0.005191*T11
+    t6 = t5 + T13 - 0.19145*T12
     t7 = -0.10915*T12 + t5
-    t8 = t6 - t7
+    t8 = -t7 + t6
     t9 = xp.atan2(t4, -t8)
-    t10 = 0.005191*T21 + 0.81725*T20
-    t11 = T23 - 0.19145*T22 + t10
+    t10 = 0.81725*T20 + 0.005191*T21
+    t11 = t10 + T23 - 0.19145*T22
     t12 = -0.10915*T22 + t10
-    t13 = t11 - t12
+    t13 = -t12 + t11
     t14 = t4**2 + t8**2
     t15 = t14
-    t16 = t13**2 + t14
+    t16 = t14 + t13**2
     t17 = 1e-24*t16
     t18 = xp.less_equal(t15, t17)
     t19 = xp.where(t18, 1, 1/xp.sqrt(t15))
@@ -2345,19 +2345,19 @@ def ik_branches(T):
     t24 = xp.where(t21, t23, xp.where(xp.greater(t23, 0), xp.asarray(1, dtype=dtype), -1))
     t25 = xp.atan2(t22, t24)
     t26 = xp.where(t18, 0, t9 + t25)
-    t27 = t9 - t25
+    t27 = -t25 + t9
     t28 = t26 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t26))
-    t29 = t28 - 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t28))
-    t30 = t27 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t27))
-    t31 = t30 - 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t30))
-    t32 = t19*t4
-    t33 = t22*t32
-    t34 = t19*t8
-    t35 = t24*t34
+    t29 = -6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t28)) + t28
+    t30 = -6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t27)) + t27
+    t31 = -6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t30)) + t30
+    t32 = t4*t19
+    t33 = t32*t22
+    t34 = t8*t19
+    t35 = t34*t24
     t36 = xp.where(t18, 1, -(t33 + t35))
-    t37 = t33 - t35
-    t38 = t24*t32
-    t39 = t22*t34
+    t37 = -t35 + t33
+    t38 = t32*t24
+    t39 = t34*t22
     t40 = xp.where(t18, 0, t38 - t39)
     t41 = t38 + t39
     t42 = t4*t36 + t8*t40
@@ -2383,8 +2383,8 @@ def ik_branches(T):
     t62 = t60
     t63 = t58
     t64 = t59
-    t65 = t62 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t62))
-    t66 = t65 - 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t65))
+    t65 = -6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t62)) + t62
+    t66 = -6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t65)) + t65
     t67 = t44*t63
     t68 = t67 + t64*t45
     t69 = t68 - t67
@@ -2399,19 +2399,19 @@ def ik_branches(T):
     t78 = t64*(1 - t77)
     t79 = t78 + t64*t77
     t80 = t64*t46
-    t81 = xp.where(t75, 0, -t76*t80)
+    t81 = xp.where(t75, 0, -t80*t76)
     t82 = t63*t81
     t83 = t63*t77
-    t84 = T02*t79 + T01*t82 - T00*t83
-    t85 = T12*t79 + T11*t82 - T10*t83
-    t86 = T22*t79 + T21*t82 - T20*t83
-    t87 = t86*t52
+    t84 = T02*t79 + t82*T01 - t83*T00
+    t85 = T12*t79 + t82*T11 - t83*T10
+    t86 = T22*t79 + t82*T21 - t83*T20
+    t87 = t52*t86
     t88 = t36*t84 + t40*t85
     t89 = t40*t84 - t36*t85
     t90 = t87 + t36*t86
     t91 = t88**2 + t90**2
     t92 = t91
-    t93 = t89**2 + t91
+    t93 = t91 + t89**2
     t94 = xp.less_equal(t92, 1e-24*t93)
     t95 = xp.where(t94, 1, 1/xp.sqrt(t92))
     t96 = xp.where(t94, 1, -t88*t95)
@@ -2419,19 +2419,19 @@ def ik_branches(T):
     t98 = 0.10915*(1 - t96)
     t99 = 0.10915*(1 + t96)
     t100 = 0.10915*t96
-    t101 = t98 + t100
+    t101 = t100 + t98
     t102 = t43 + t101
     t103 = -t99 + t100
-    t104 = t43 - t103
+    t104 = -t103 + t43
     t105 = 0.09465*t97
-    t106 = t42 - t105
-    t107 = t42 + t105
+    t106 = -t105 + t42
+    t107 = t105 + t42
     t108 = 0.09465*t96
-    t109 = t54 + t108
+    t109 = t108 + t54
     t110 = -0.089459 + t109
     t111 = t106**2 + t102**2 + t110**2
     t112 = 0.5*(0.3344850625 - t111)
-    t113 = t54 - t108
+    t113 = -t108 + t54
     t114 = -0.089459 + t113
     t115 = t107**2 + t104**2 + t114**2
     t116 = 0.5*(0.3344850625 - t115)
@@ -2450,25 +2450,25 @@ def ik_branches(T):
     t129 = t106*t122 - t110*t127
     t130 = t128**2 + t129**2
     t131 = t127**2 + t122**2
-    t132 = t126 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t126))
-    t133 = t132 - 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t132))
+    t132 = -6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t126)) + t126
+    t133 = -6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t132)) + t132
     t134 = 3.141592653589793 + t125
-    t135 = -1.0*t124
-    t136 = -1.0*t120
+    t135 = -t124
+    t136 = -t120
     t137 = 0.425 + 0.39225*t135
     t138 = 0.089459 - 0.39225*t136
     t139 = -0.089459 + t138
     t140 = t110*t139 - t106*t137
     t141 = t106*t139 + t110*t137
     t142 = t140**2 + t141**2
-    t143 = t137**2 + t139**2
-    t144 = t134 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t134))
-    t145 = t144 - 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t144))
+    t143 = t139**2 + t137**2
+    t144 = -6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t134)) + t134
+    t145 = -6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t144)) + t144
     t146 = t116**2
     t147 = 1 - 35.98290608994648*t146
     t148 = xp.greater(t147, 1e-12)
     t149 = xp.where(t148, xp.sqrt(t147), 0)
-    t150 = -1.0*t149
+    t150 = -t149
     t151 = 0.089459 - 0.39225*t150
     t152 = -0.089459 + t151
     t153 = 0.089459 - 0.39225*t149
@@ -2477,13 +2477,13 @@ def ik_branches(T):
     t156 = xp.where(t148, t155, xp.where(xp.greater(t155, 0), xp.asarray(1, dtype=dtype), -1))
     t157 = xp.atan2(t149, t156)
     t158 = 3.141592653589793 + t157
-    t159 = -1.0*t156
+    t159 = -t156
     t160 = 3.141592653589793 - t157
     t161 = 0.425 + 0.39225*t159
     t162 = t114*t152 - t107*t161
     t163 = t107*t152 + t114*t161
     t164 = t162**2 + t163**2
-    t165 = t161**2 + t152**2
+    t165 = t152**2 + t161**2
     t166 = -0.425 + 0.39225*t156
     t167 = t107*t166 + t114*t154
     t168 = t107*t154 - t114*t166
@@ -2501,8 +2501,8 @@ def ik_branches(T):
     t180 = t179
     t181 = t177
     t182 = t178
-    t183 = t180 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t180))
-    t184 = t183 - 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t183))
+    t183 = -6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t180)) + t180
+    t184 = -6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t183)) + t183
     t185 = t179 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t179))
     t186 = t49*t181
     t187 = t186 + t182*t50
@@ -2518,19 +2518,19 @@ def ik_branches(T):
     t197 = t182*(1 - t196)
     t198 = t197 + t182*t196
     t199 = t182*t51
-    t200 = xp.where(t194, 0, -t195*t199)
+    t200 = xp.where(t194, 0, -t199*t195)
     t201 = t181*t200
     t202 = t181*t196
-    t203 = T02*t198 + T01*t201 - T00*t202
-    t204 = T12*t198 + T11*t201 - T10*t202
-    t205 = T22*t198 + T21*t201 - T20*t202
-    t206 = t205*t171
+    t203 = T02*t198 + t201*T01 - t202*T00
+    t204 = T12*t198 + t201*T11 - t202*T10
+    t205 = T22*t198 + t201*T21 - t202*T20
+    t206 = t171*t205
     t207 = t37*t203 + t41*t204
     t208 = t41*t203 - t37*t204
     t209 = t206 + t37*t205
     t210 = t207**2 + t209**2
     t211 = t210
-    t212 = t208**2 + t210
+    t212 = t210 + t208**2
     t213 = xp.less_equal(t211, 1e-24*t212)
     t214 = xp.where(t213, 1, 1/xp.sqrt(t211))
     t215 = xp.where(t213, 1, -t207*t214)
@@ -2538,19 +2538,19 @@ def ik_branches(T):
     t217 = 0.10915*(1 - t215)
     t218 = 0.10915*(1 + t215)
     t219 = 0.10915*t215
-    t220 = t217 + t219
+    t220 = t219 + t217
     t221 = t48 + t220
     t222 = -t218 + t219
-    t223 = t48 - t222
+    t223 = -t222 + t48
     t224 = 0.09465*t216
-    t225 = t47 - t224
-    t226 = t47 + t224
+    t225 = -t224 + t47
+    t226 = t224 + t47
     t227 = 0.09465*t215
-    t228 = t173 + t227
+    t228 = t227 + t173
     t229 = -0.089459 + t228
     t230 = t225**2 + t221**2 + t229**2
     t231 = 0.5*(0.3344850625 - t230)
-    t232 = t173 - t227
+    t232 = -t227 + t173
     t233 = -0.089459 + t232
     t234 = t226**2 + t223**2 + t233**2
     t235 = 0.5*(0.3344850625 - t234)
@@ -2558,7 +2558,7 @@ def ik_branches(T):
     t237 = 1 - 35.98290608994648*t236
     t238 = xp.greater(t237, 1e-12)
     t239 = xp.where(t238, xp.sqrt(t237), 0)
-    t240 = -1.0*t239
+    t240 = -t239
     t241 = 0.089459 - 0.39225*t240
     t242 = -0.089459 + t241
     t243 = 0.089459 - 0.39225*t239
@@ -2567,27 +2567,27 @@ def ik_branches(T):
     t246 = xp.where(t238, t245, xp.where(xp.greater(t245, 0), xp.asarray(1, dtype=dtype), -1))
     t247 = xp.atan2(t239, t246)
     t248 = 3.141592653589793 + t247
-    t249 = -1.0*t246
+    t249 = -t246
     t250 = 3.141592653589793 - t247
     t251 = 0.425 + 0.39225*t249
     t252 = t229*t242 - t225*t251
     t253 = t225*t242 + t229*t251
     t254 = t252**2 + t253**2
-    t255 = t251**2 + t242**2
+    t255 = t242**2 + t251**2
     t256 = -0.425 + 0.39225*t246
     t257 = t225*t256 + t229*t244
     t258 = t225*t244 - t229*t256
     t259 = t257**2 + t258**2
     t260 = t256**2 + t244**2
-    t261 = t248 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t248))
-    t262 = t261 - 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t261))
-    t263 = t250 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t250))
-    t264 = t263 - 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t263))
+    t261 = -6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t248)) + t248
+    t262 = -6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t261)) + t261
+    t263 = -6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t250)) + t250
+    t264 = -6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t263)) + t263
     t265 = t235**2
     t266 = 1 - 35.98290608994648*t265
     t267 = xp.greater(t266, 1e-12)
     t268 = xp.where(t267, xp.sqrt(t266), 0)
-    t269 = -1.0*t268
+    t269 = -t268
     t270 = 0.089459 - 0.39225*t269
     t271 = -0.089459 + t270
     t272 = 0.089459 - 0.39225*t268
@@ -2596,108 +2596,108 @@ def ik_branches(T):
     t275 = xp.where(t267, t274, xp.where(xp.greater(t274, 0), xp.asarray(1, dtype=dtype), -1))
     t276 = xp.atan2(t268, t275)
     t277 = 3.141592653589793 + t276
-    t278 = -1.0*t275
+    t278 = -t275
     t279 = 3.141592653589793 - t276
     t280 = 0.425 + 0.39225*t278
     t281 = t233*t271 - t226*t280
     t282 = t226*t271 + t233*t280
     t283 = t281**2 + t282**2
-    t284 = t280**2 + t271**2
+    t284 = t271**2 + t280**2
     t285 = -0.425 + 0.39225*t275
     t286 = t226*t285 + t233*t273
     t287 = t226*t273 - t233*t285
     t288 = t286**2 + t287**2
     t289 = t285**2 + t273**2
     t290 = 1e-24*t111
-    t291 = xp.where(xp.less_equal(t142, t143*t290), 0, xp.atan2(-t141, t140))
+    t291 = xp.where(xp.less_equal(t142, t290*t143), 0, xp.atan2(-t141, t140))
     t292 = t291
-    t293 = t292 - 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t292))
+    t293 = -6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t292)) + t292
     t294 = -xp.where(t94, 0, xp.atan2(-t90, -t88))
     t295 = 3.141592653589793 + t294
-    t296 = t134 + t291
-    t297 = t294 + 6.283185307179586*xp.ceil(-0.15915494309189535*(t295 + t296)) + t296
+    t296 = t291 + t134
+    t297 = t294 + t296 + 6.283185307179586*xp.ceil(-0.15915494309189535*(t295 + t296))
     t298 = -t297
-    t299 = t297 + 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t298))
+    t299 = 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t298)) + t297
     t300 = xp.where(t75, 0, xp.atan2(-t80, t69))
     t301 = t300
-    t302 = t301 - 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t301))
+    t302 = -6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t301)) + t301
     t303 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t300) + t300
-    t304 = t303 - 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t303))
-    t305 = xp.where(xp.less_equal(t130, t131*t290), 0, xp.atan2(-t129, t128))
+    t304 = -6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t303)) + t303
+    t305 = xp.where(xp.less_equal(t130, t290*t131), 0, xp.atan2(-t129, t128))
     t306 = t305
-    t307 = t306 - 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t306))
-    t308 = t126 + t305
-    t309 = t294 + 6.283185307179586*xp.ceil(-0.15915494309189535*(t295 + t308)) + t308
+    t307 = -6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t306)) + t306
+    t308 = t305 + t126
+    t309 = t294 + t308 + 6.283185307179586*xp.ceil(-0.15915494309189535*(t295 + t308))
     t310 = -t309
-    t311 = t309 + 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t310))
+    t311 = 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t310)) + t309
     t312 = 1e-24*t115
-    t313 = xp.where(xp.less_equal(t164, t165*t312), 0, xp.atan2(-t163, t162))
+    t313 = xp.where(xp.less_equal(t164, t312*t165), 0, xp.atan2(-t163, t162))
     t314 = t313
-    t315 = t314 - 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t314))
+    t315 = -6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t314)) + t314
     t316 = -3.141592653589793 + t158
-    t317 = t158 - 6.283185307179586*xp.ceil(0.15915494309189535*t316)
-    t318 = t317 - 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t317))
-    t319 = t313 + t294
-    t320 = 6.283185307179586*xp.ceil(-0.15915494309189535*(t158 + t319)) + t316 + t319
+    t317 = -6.283185307179586*xp.ceil(0.15915494309189535*t316) + t158
+    t318 = -6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t317)) + t317
+    t319 = t294 + t313
+    t320 = t316 + 6.283185307179586*xp.ceil(-0.15915494309189535*(t158 + t319)) + t319
     t321 = -t320
-    t322 = t320 + 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t321))
+    t322 = 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t321)) + t320
     t323 = -t61
-    t324 = t61 + 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t323))
-    t325 = xp.where(xp.less_equal(t169, t170*t312), 0, xp.atan2(-t168, t167))
+    t324 = 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t323)) + t61
+    t325 = xp.where(xp.less_equal(t169, t312*t170), 0, xp.atan2(-t168, t167))
     t326 = t325
-    t327 = t326 - 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t326))
+    t327 = -6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t326)) + t326
     t328 = -3.141592653589793 + t160
-    t329 = t160 - 6.283185307179586*xp.ceil(0.15915494309189535*t328)
-    t330 = t329 - 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t329))
+    t329 = -6.283185307179586*xp.ceil(0.15915494309189535*t328) + t160
+    t330 = -6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t329)) + t329
     t331 = t294 + t325
     t332 = 6.283185307179586*xp.ceil(-0.15915494309189535*(t160 + t331)) + t328 + t331
     t333 = -t332
-    t334 = t332 + 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t333))
+    t334 = 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t333)) + t332
     t335 = 1e-24*t230
     t336 = xp.where(xp.less_equal(t254, t255*t335), 0, xp.atan2(-t253, t252))
     t337 = t336
-    t338 = t337 - 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t337))
+    t338 = -6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t337)) + t337
     t339 = -xp.where(t213, 0, xp.atan2(-t209, -t207))
     t340 = 3.141592653589793 + t339
     t341 = t248 + t336
-    t342 = t339 + 6.283185307179586*xp.ceil(-0.15915494309189535*(t340 + t341)) + t341
+    t342 = 6.283185307179586*xp.ceil(-0.15915494309189535*(t340 + t341)) + t339 + t341
     t343 = -t342
-    t344 = t342 + 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t343))
+    t344 = 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t343)) + t342
     t345 = xp.where(t194, 0, xp.atan2(-t199, t188))
     t346 = t345
-    t347 = t346 - 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t346))
+    t347 = -6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t346)) + t346
     t348 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t345) + t345
-    t349 = t348 - 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t348))
+    t349 = -6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t348)) + t348
     t350 = xp.where(xp.less_equal(t259, t260*t335), 0, xp.atan2(-t258, t257))
     t351 = t350
-    t352 = t351 - 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t351))
+    t352 = -6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t351)) + t351
     t353 = t250 + t350
-    t354 = t339 + 6.283185307179586*xp.ceil(-0.15915494309189535*(t340 + t353)) + t353
+    t354 = 6.283185307179586*xp.ceil(-0.15915494309189535*(t340 + t353)) + t339 + t353
     t355 = -t354
-    t356 = t354 + 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t355))
+    t356 = 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t355)) + t354
     t357 = 1e-24*t234
     t358 = xp.where(xp.less_equal(t283, t284*t357), 0, xp.atan2(-t282, t281))
     t359 = t358
-    t360 = t359 - 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t359))
+    t360 = -6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t359)) + t359
     t361 = -3.141592653589793 + t277
-    t362 = t277 - 6.283185307179586*xp.ceil(0.15915494309189535*t361)
-    t363 = t362 - 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t362))
-    t364 = t358 + t339
+    t362 = -6.283185307179586*xp.ceil(0.15915494309189535*t361) + t277
+    t363 = -6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t362)) + t362
+    t364 = t339 + t358
     t365 = 6.283185307179586*xp.ceil(-0.15915494309189535*(t277 + t364)) + t361 + t364
     t366 = -t365
-    t367 = t365 + 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t366))
+    t367 = 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t366)) + t365
     t368 = -t185
-    t369 = t185 + 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t368))
+    t369 = 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t368)) + t185
     t370 = xp.where(xp.less_equal(t288, t289*t357), 0, xp.atan2(-t287, t286))
     t371 = t370
-    t372 = t371 - 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t371))
+    t372 = -6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t371)) + t371
     t373 = -3.141592653589793 + t279
-    t374 = t279 - 6.283185307179586*xp.ceil(0.15915494309189535*t373)
-    t375 = t374 - 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t374))
+    t374 = -6.283185307179586*xp.ceil(0.15915494309189535*t373) + t279
+    t375 = -6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t374)) + t374
     t376 = t339 + t370
     t377 = 6.283185307179586*xp.ceil(-0.15915494309189535*(t279 + t376)) + t373 + t376
     t378 = -t377
-    t379 = t377 + 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t378))
+    t379 = 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t378)) + t377
     t380 = xp.less_equal(t29, 6.283185307179586)
     t381 = xp.greater_equal(t28, -6.283185307179586) & xp.less_equal(t28, 6.283185307179586)
     t382 = xp.where(t380 & xp.logical_not(t381), t29, t28)
@@ -2967,87 +2967,87 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     lb5 = branches_in_limits[..., 5]
     lb6 = branches_in_limits[..., 6]
     lb7 = branches_in_limits[..., 7]
-    t0 = qb0_0 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn1 - qb0_0))
-    t1 = qb0_1 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn2 - qb0_1))
-    t2 = qb0_2 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn3 - qb0_2))
-    t3 = qb0_3 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn4 - qb0_3))
-    t4 = qb0_4 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn5 - qb0_4))
-    t5 = qb0_5 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn6 - qb0_5))
+    t0 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_0 + qn1)) + qb0_0
+    t1 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_1 + qn2)) + qb0_1
+    t2 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_2 + qn3)) + qb0_2
+    t3 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_3 + qn4)) + qb0_3
+    t4 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_4 + qn5)) + qb0_4
+    t5 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_5 + qn6)) + qb0_5
     t6 = xp.where(lb0 & vb0, xp.asarray(1, dtype=dtype), 0)
     t7 = xp.where(xp.greater(t6, 0), xp.asarray(1, dtype=dtype), 0)
-    t8 = qb1_0 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn1 - qb1_0))
-    t9 = qb1_1 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn2 - qb1_1))
-    t10 = qb1_2 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn3 - qb1_2))
-    t11 = qb1_3 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn4 - qb1_3))
-    t12 = qb1_4 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn5 - qb1_4))
-    t13 = qb1_5 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn6 - qb1_5))
+    t8 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_0 + qn1)) + qb1_0
+    t9 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_1 + qn2)) + qb1_1
+    t10 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_2 + qn3)) + qb1_2
+    t11 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_3 + qn4)) + qb1_3
+    t12 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_4 + qn5)) + qb1_4
+    t13 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_5 + qn6)) + qb1_5
     t14 = xp.where(lb1 & vb1, xp.asarray(1, dtype=dtype), 0)
-    t15 = qb2_0 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn1 - qb2_0))
-    t16 = qb2_1 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn2 - qb2_1))
-    t17 = qb2_2 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn3 - qb2_2))
-    t18 = qb2_3 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn4 - qb2_3))
-    t19 = qb2_4 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn5 - qb2_4))
-    t20 = qb2_5 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn6 - qb2_5))
+    t15 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_0 + qn1)) + qb2_0
+    t16 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_1 + qn2)) + qb2_1
+    t17 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_2 + qn3)) + qb2_2
+    t18 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_3 + qn4)) + qb2_3
+    t19 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_4 + qn5)) + qb2_4
+    t20 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_5 + qn6)) + qb2_5
     t21 = xp.where(lb2 & vb2, xp.asarray(1, dtype=dtype), 0)
-    t22 = qb3_0 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn1 - qb3_0))
-    t23 = qb3_1 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn2 - qb3_1))
-    t24 = qb3_2 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn3 - qb3_2))
-    t25 = qb3_3 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn4 - qb3_3))
-    t26 = qb3_4 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn5 - qb3_4))
-    t27 = qb3_5 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn6 - qb3_5))
+    t22 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_0 + qn1)) + qb3_0
+    t23 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_1 + qn2)) + qb3_1
+    t24 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_2 + qn3)) + qb3_2
+    t25 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_3 + qn4)) + qb3_3
+    t26 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_4 + qn5)) + qb3_4
+    t27 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_5 + qn6)) + qb3_5
     t28 = xp.where(lb3 & vb3, xp.asarray(1, dtype=dtype), 0)
-    t29 = qb4_0 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn1 - qb4_0))
-    t30 = qb4_1 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn2 - qb4_1))
-    t31 = qb4_2 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn3 - qb4_2))
-    t32 = qb4_3 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn4 - qb4_3))
-    t33 = qb4_4 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn5 - qb4_4))
-    t34 = qb4_5 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn6 - qb4_5))
+    t29 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_0 + qn1)) + qb4_0
+    t30 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_1 + qn2)) + qb4_1
+    t31 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_2 + qn3)) + qb4_2
+    t32 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_3 + qn4)) + qb4_3
+    t33 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_4 + qn5)) + qb4_4
+    t34 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_5 + qn6)) + qb4_5
     t35 = xp.where(lb4 & vb4, xp.asarray(1, dtype=dtype), 0)
-    t36 = qb5_0 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn1 - qb5_0))
-    t37 = qb5_1 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn2 - qb5_1))
-    t38 = qb5_2 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn3 - qb5_2))
-    t39 = qb5_3 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn4 - qb5_3))
-    t40 = qb5_4 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn5 - qb5_4))
-    t41 = qb5_5 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn6 - qb5_5))
+    t36 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_0 + qn1)) + qb5_0
+    t37 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_1 + qn2)) + qb5_1
+    t38 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_2 + qn3)) + qb5_2
+    t39 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_3 + qn4)) + qb5_3
+    t40 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_4 + qn5)) + qb5_4
+    t41 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_5 + qn6)) + qb5_5
     t42 = xp.where(lb5 & vb5, xp.asarray(1, dtype=dtype), 0)
-    t43 = qb6_0 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn1 - qb6_0))
-    t44 = qb6_1 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn2 - qb6_1))
-    t45 = qb6_2 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn3 - qb6_2))
-    t46 = qb6_3 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn4 - qb6_3))
-    t47 = qb6_4 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn5 - qb6_4))
-    t48 = qb6_5 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn6 - qb6_5))
+    t43 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_0 + qn1)) + qb6_0
+    t44 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_1 + qn2)) + qb6_1
+    t45 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_2 + qn3)) + qb6_2
+    t46 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_3 + qn4)) + qb6_3
+    t47 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_4 + qn5)) + qb6_4
+    t48 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_5 + qn6)) + qb6_5
     t49 = xp.where(lb6 & vb6, xp.asarray(1, dtype=dtype), 0)
-    t50 = qb7_0 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn1 - qb7_0))
-    t51 = qb7_1 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn2 - qb7_1))
-    t52 = qb7_2 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn3 - qb7_2))
-    t53 = qb7_3 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn4 - qb7_3))
-    t54 = qb7_4 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn5 - qb7_4))
-    t55 = qb7_5 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(qn6 - qb7_5))
+    t50 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_0 + qn1)) + qb7_0
+    t51 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_1 + qn2)) + qb7_1
+    t52 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_2 + qn3)) + qb7_2
+    t53 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_3 + qn4)) + qb7_3
+    t54 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_4 + qn5)) + qb7_4
+    t55 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_5 + qn6)) + qb7_5
     t56 = xp.where(lb7 & vb7, xp.asarray(1, dtype=dtype), 0)
-    t57 = T00 + T01 + T02 + T03 + T10 + T11 + T12 + T13 + T20 + T21 + T22 + T23 + qn1 + qn2 + qn3 + qn4 + qn5 + qn6 + qw1 + qw2 + qw3 + qw4 + qw5 + qw6
+    t57 = T00 + T01 + T02 + T10 + T11 + T12 + T20 + T21 + T22 + T03 + T13 + T23 + qn1 + qn2 + qn3 + qn4 + qn5 + qn6 + qw1 + qw2 + qw3 + qw4 + qw5 + qw6
     t58 = xp.where(xp.less(t0, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t59 = t0 + t58
-    t60 = t0 - t58
+    t60 = -t58 + t0
     t61 = xp.where(xp.greater_equal(t0, -6.283185307179586) & xp.less_equal(t0, 6.283185307179586), t0, xp.where(xp.greater_equal(t59, -6.283185307179586) & xp.less_equal(t59, 6.283185307179586), t59, xp.where(xp.greater_equal(t60, -6.283185307179586) & xp.less_equal(t60, 6.283185307179586), t60, qb0_0)))
     t62 = xp.where(xp.less(t1, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t63 = t1 + t62
-    t64 = t1 - t62
+    t64 = -t62 + t1
     t65 = xp.where(xp.greater_equal(t1, -6.283185307179586) & xp.less_equal(t1, 6.283185307179586), t1, xp.where(xp.greater_equal(t63, -6.283185307179586) & xp.less_equal(t63, 6.283185307179586), t63, xp.where(xp.greater_equal(t64, -6.283185307179586) & xp.less_equal(t64, 6.283185307179586), t64, qb0_1)))
     t66 = xp.where(xp.less(t2, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t67 = t2 + t66
-    t68 = t2 - t66
+    t68 = -t66 + t2
     t69 = xp.where(xp.greater_equal(t2, -6.283185307179586) & xp.less_equal(t2, 6.283185307179586), t2, xp.where(xp.greater_equal(t67, -6.283185307179586) & xp.less_equal(t67, 6.283185307179586), t67, xp.where(xp.greater_equal(t68, -6.283185307179586) & xp.less_equal(t68, 6.283185307179586), t68, qb0_2)))
     t70 = xp.where(xp.less(t3, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t71 = t3 + t70
-    t72 = t3 - t70
+    t72 = -t70 + t3
     t73 = xp.where(xp.greater_equal(t3, -6.283185307179586) & xp.less_equal(t3, 6.283185307179586), t3, xp.where(xp.greater_equal(t71, -6.283185307179586) & xp.less_equal(t71, 6.283185307179586), t71, xp.where(xp.greater_equal(t72, -6.283185307179586) & xp.less_equal(t72, 6.283185307179586), t72, qb0_3)))
     t74 = xp.where(xp.less(t4, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t75 = t4 + t74
-    t76 = t4 - t74
+    t76 = -t74 + t4
     t77 = xp.where(xp.greater_equal(t4, -6.283185307179586) & xp.less_equal(t4, 6.283185307179586), t4, xp.where(xp.greater_equal(t75, -6.283185307179586) & xp.less_equal(t75, 6.283185307179586), t75, xp.where(xp.greater_equal(t76, -6.283185307179586) & xp.less_equal(t76, 6.283185307179586), t76, qb0_4)))
     t78 = xp.where(xp.less(t5, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t79 = t5 + t78
-    t80 = t5 - t78
+    t80 = -t78 + t5
     t81 = xp.where(xp.greater_equal(t5, -6.283185307179586) & xp.less_equal(t5, 6.283185307179586), t5, xp.where(xp.greater_equal(t79, -6.283185307179586) & xp.less_equal(t79, 6.283185307179586), t79, xp.where(xp.greater_equal(t80, -6.283185307179586) & xp.less_equal(t80, 6.283185307179586), t80, qb0_5)))
     t82 = -qn1
     t83 = -qn2
@@ -3055,7 +3055,7 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     t85 = -qn4
     t86 = -qn5
     t87 = -qn6
-    t88 = qw1*(t61 + t82)**2 + qw2*(t65 + t83)**2 + qw3*(t69 + t84)**2 + qw4*(t73 + t85)**2 + qw5*(t77 + t86)**2 + qw6*(t81 + t87)**2
+    t88 = qw1*(t82 + t61)**2 + qw2*(t83 + t65)**2 + qw3*(t84 + t69)**2 + qw4*(t85 + t73)**2 + qw5*(t86 + t77)**2 + qw6*(t87 + t81)**2
     t89 = xp.greater(t7, 0)
     t90 = xp.where(t89, t61, qn1)
     t91 = xp.where(t89, t65, qn2)
@@ -3066,29 +3066,29 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     t96 = xp.where(t89, t88, 0)
     t97 = xp.where(xp.less(t8, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t98 = t8 + t97
-    t99 = t8 - t97
+    t99 = -t97 + t8
     t100 = xp.where(xp.greater_equal(t8, -6.283185307179586) & xp.less_equal(t8, 6.283185307179586), t8, xp.where(xp.greater_equal(t98, -6.283185307179586) & xp.less_equal(t98, 6.283185307179586), t98, xp.where(xp.greater_equal(t99, -6.283185307179586) & xp.less_equal(t99, 6.283185307179586), t99, qb1_0)))
     t101 = xp.where(xp.less(t9, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t102 = t9 + t101
-    t103 = t9 - t101
+    t103 = -t101 + t9
     t104 = xp.where(xp.greater_equal(t9, -6.283185307179586) & xp.less_equal(t9, 6.283185307179586), t9, xp.where(xp.greater_equal(t102, -6.283185307179586) & xp.less_equal(t102, 6.283185307179586), t102, xp.where(xp.greater_equal(t103, -6.283185307179586) & xp.less_equal(t103, 6.283185307179586), t103, qb1_1)))
     t105 = xp.where(xp.less(t10, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t106 = t10 + t105
-    t107 = t10 - t105
+    t107 = -t105 + t10
     t108 = xp.where(xp.greater_equal(t10, -6.283185307179586) & xp.less_equal(t10, 6.283185307179586), t10, xp.where(xp.greater_equal(t106, -6.283185307179586) & xp.less_equal(t106, 6.283185307179586), t106, xp.where(xp.greater_equal(t107, -6.283185307179586) & xp.less_equal(t107, 6.283185307179586), t107, qb1_2)))
     t109 = xp.where(xp.less(t11, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t110 = t11 + t109
-    t111 = t11 - t109
+    t111 = -t109 + t11
     t112 = xp.where(xp.greater_equal(t11, -6.283185307179586) & xp.less_equal(t11, 6.283185307179586), t11, xp.where(xp.greater_equal(t110, -6.283185307179586) & xp.less_equal(t110, 6.283185307179586), t110, xp.where(xp.greater_equal(t111, -6.283185307179586) & xp.less_equal(t111, 6.283185307179586), t111, qb1_3)))
     t113 = xp.where(xp.less(t12, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t114 = t12 + t113
-    t115 = t12 - t113
+    t115 = -t113 + t12
     t116 = xp.where(xp.greater_equal(t12, -6.283185307179586) & xp.less_equal(t12, 6.283185307179586), t12, xp.where(xp.greater_equal(t114, -6.283185307179586) & xp.less_equal(t114, 6.283185307179586), t114, xp.where(xp.greater_equal(t115, -6.283185307179586) & xp.less_equal(t115, 6.283185307179586), t115, qb1_4)))
     t117 = xp.where(xp.less(t13, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t118 = t13 + t117
-    t119 = t13 - t117
+    t119 = -t117 + t13
     t120 = xp.where(xp.greater_equal(t13, -6.283185307179586) & xp.less_equal(t13, 6.283185307179586), t13, xp.where(xp.greater_equal(t118, -6.283185307179586) & xp.less_equal(t118, 6.283185307179586), t118, xp.where(xp.greater_equal(t119, -6.283185307179586) & xp.less_equal(t119, 6.283185307179586), t119, qb1_5)))
-    t121 = qw1*(t100 + t82)**2 + qw2*(t104 + t83)**2 + qw3*(t108 + t84)**2 + qw4*(t112 + t85)**2 + qw5*(t116 + t86)**2 + qw6*(t120 + t87)**2
+    t121 = qw1*(t82 + t100)**2 + qw2*(t83 + t104)**2 + qw3*(t84 + t108)**2 + qw4*(t85 + t112)**2 + qw5*(t86 + t116)**2 + qw6*(t87 + t120)**2
     t122 = xp.greater(t14, 0)
     t123 = xp.where(t122 & (xp.less(t7, 1) | xp.less(t121, t96)), xp.asarray(1, dtype=dtype), 0)
     t124 = xp.where(t122, 1, t7)
@@ -3102,29 +3102,29 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     t132 = xp.where(t125, t121, t96)
     t133 = xp.where(xp.less(t15, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t134 = t15 + t133
-    t135 = t15 - t133
+    t135 = -t133 + t15
     t136 = xp.where(xp.greater_equal(t15, -6.283185307179586) & xp.less_equal(t15, 6.283185307179586), t15, xp.where(xp.greater_equal(t134, -6.283185307179586) & xp.less_equal(t134, 6.283185307179586), t134, xp.where(xp.greater_equal(t135, -6.283185307179586) & xp.less_equal(t135, 6.283185307179586), t135, qb2_0)))
     t137 = xp.where(xp.less(t16, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t138 = t16 + t137
-    t139 = t16 - t137
+    t139 = -t137 + t16
     t140 = xp.where(xp.greater_equal(t16, -6.283185307179586) & xp.less_equal(t16, 6.283185307179586), t16, xp.where(xp.greater_equal(t138, -6.283185307179586) & xp.less_equal(t138, 6.283185307179586), t138, xp.where(xp.greater_equal(t139, -6.283185307179586) & xp.less_equal(t139, 6.283185307179586), t139, qb2_1)))
     t141 = xp.where(xp.less(t17, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t142 = t17 + t141
-    t143 = t17 - t141
+    t143 = -t141 + t17
     t144 = xp.where(xp.greater_equal(t17, -6.283185307179586) & xp.less_equal(t17, 6.283185307179586), t17, xp.where(xp.greater_equal(t142, -6.283185307179586) & xp.less_equal(t142, 6.283185307179586), t142, xp.where(xp.greater_equal(t143, -6.283185307179586) & xp.less_equal(t143, 6.283185307179586), t143, qb2_2)))
     t145 = xp.where(xp.less(t18, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t146 = t18 + t145
-    t147 = t18 - t145
+    t147 = -t145 + t18
     t148 = xp.where(xp.greater_equal(t18, -6.283185307179586) & xp.less_equal(t18, 6.283185307179586), t18, xp.where(xp.greater_equal(t146, -6.283185307179586) & xp.less_equal(t146, 6.283185307179586), t146, xp.where(xp.greater_equal(t147, -6.283185307179586) & xp.less_equal(t147, 6.283185307179586), t147, qb2_3)))
     t149 = xp.where(xp.less(t19, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t150 = t19 + t149
-    t151 = t19 - t149
+    t151 = -t149 + t19
     t152 = xp.where(xp.greater_equal(t19, -6.283185307179586) & xp.less_equal(t19, 6.283185307179586), t19, xp.where(xp.greater_equal(t150, -6.283185307179586) & xp.less_equal(t150, 6.283185307179586), t150, xp.where(xp.greater_equal(t151, -6.283185307179586) & xp.less_equal(t151, 6.283185307179586), t151, qb2_4)))
     t153 = xp.where(xp.less(t20, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t154 = t20 + t153
-    t155 = t20 - t153
+    t155 = -t153 + t20
     t156 = xp.where(xp.greater_equal(t20, -6.283185307179586) & xp.less_equal(t20, 6.283185307179586), t20, xp.where(xp.greater_equal(t154, -6.283185307179586) & xp.less_equal(t154, 6.283185307179586), t154, xp.where(xp.greater_equal(t155, -6.283185307179586) & xp.less_equal(t155, 6.283185307179586), t155, qb2_5)))
-    t157 = qw1*(t136 + t82)**2 + qw2*(t140 + t83)**2 + qw3*(t144 + t84)**2 + qw4*(t148 + t85)**2 + qw5*(t152 + t86)**2 + qw6*(t156 + t87)**2
+    t157 = qw1*(t82 + t136)**2 + qw2*(t83 + t140)**2 + qw3*(t84 + t144)**2 + qw4*(t85 + t148)**2 + qw5*(t86 + t152)**2 + qw6*(t87 + t156)**2
     t158 = xp.greater(t21, 0)
     t159 = xp.where(t158 & (xp.less(t124, 1) | xp.less(t157, t132)), xp.asarray(1, dtype=dtype), 0)
     t160 = xp.where(t158, 1, t124)
@@ -3138,29 +3138,29 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     t168 = xp.where(t161, t157, t132)
     t169 = xp.where(xp.less(t22, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t170 = t22 + t169
-    t171 = t22 - t169
+    t171 = -t169 + t22
     t172 = xp.where(xp.greater_equal(t22, -6.283185307179586) & xp.less_equal(t22, 6.283185307179586), t22, xp.where(xp.greater_equal(t170, -6.283185307179586) & xp.less_equal(t170, 6.283185307179586), t170, xp.where(xp.greater_equal(t171, -6.283185307179586) & xp.less_equal(t171, 6.283185307179586), t171, qb3_0)))
     t173 = xp.where(xp.less(t23, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t174 = t23 + t173
-    t175 = t23 - t173
+    t175 = -t173 + t23
     t176 = xp.where(xp.greater_equal(t23, -6.283185307179586) & xp.less_equal(t23, 6.283185307179586), t23, xp.where(xp.greater_equal(t174, -6.283185307179586) & xp.less_equal(t174, 6.283185307179586), t174, xp.where(xp.greater_equal(t175, -6.283185307179586) & xp.less_equal(t175, 6.283185307179586), t175, qb3_1)))
     t177 = xp.where(xp.less(t24, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t178 = t24 + t177
-    t179 = t24 - t177
+    t179 = -t177 + t24
     t180 = xp.where(xp.greater_equal(t24, -6.283185307179586) & xp.less_equal(t24, 6.283185307179586), t24, xp.where(xp.greater_equal(t178, -6.283185307179586) & xp.less_equal(t178, 6.283185307179586), t178, xp.where(xp.greater_equal(t179, -6.283185307179586) & xp.less_equal(t179, 6.283185307179586), t179, qb3_2)))
     t181 = xp.where(xp.less(t25, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t182 = t25 + t181
-    t183 = t25 - t181
+    t183 = -t181 + t25
     t184 = xp.where(xp.greater_equal(t25, -6.283185307179586) & xp.less_equal(t25, 6.283185307179586), t25, xp.where(xp.greater_equal(t182, -6.283185307179586) & xp.less_equal(t182, 6.283185307179586), t182, xp.where(xp.greater_equal(t183, -6.283185307179586) & xp.less_equal(t183, 6.283185307179586), t183, qb3_3)))
     t185 = xp.where(xp.less(t26, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t186 = t26 + t185
-    t187 = t26 - t185
+    t187 = -t185 + t26
     t188 = xp.where(xp.greater_equal(t26, -6.283185307179586) & xp.less_equal(t26, 6.283185307179586), t26, xp.where(xp.greater_equal(t186, -6.283185307179586) & xp.less_equal(t186, 6.283185307179586), t186, xp.where(xp.greater_equal(t187, -6.283185307179586) & xp.less_equal(t187, 6.283185307179586), t187, qb3_4)))
     t189 = xp.where(xp.less(t27, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t190 = t27 + t189
-    t191 = t27 - t189
+    t191 = -t189 + t27
     t192 = xp.where(xp.greater_equal(t27, -6.283185307179586) & xp.less_equal(t27, 6.283185307179586), t27, xp.where(xp.greater_equal(t190, -6.283185307179586) & xp.less_equal(t190, 6.283185307179586), t190, xp.where(xp.greater_equal(t191, -6.283185307179586) & xp.less_equal(t191, 6.283185307179586), t191, qb3_5)))
-    t193 = qw1*(t172 + t82)**2 + qw2*(t176 + t83)**2 + qw3*(t180 + t84)**2 + qw4*(t184 + t85)**2 + qw5*(t188 + t86)**2 + qw6*(t192 + t87)**2
+    t193 = qw1*(t82 + t172)**2 + qw2*(t83 + t176)**2 + qw3*(t84 + t180)**2 + qw4*(t85 + t184)**2 + qw5*(t86 + t188)**2 + qw6*(t87 + t192)**2
     t194 = xp.greater(t28, 0)
     t195 = xp.where(t194 & (xp.less(t193, t168) | xp.less(t160, 1)), xp.asarray(1, dtype=dtype), 0)
     t196 = xp.where(t194, 1, t160)
@@ -3174,29 +3174,29 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     t204 = xp.where(t197, t193, t168)
     t205 = xp.where(xp.less(t29, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t206 = t29 + t205
-    t207 = t29 - t205
+    t207 = -t205 + t29
     t208 = xp.where(xp.greater_equal(t29, -6.283185307179586) & xp.less_equal(t29, 6.283185307179586), t29, xp.where(xp.greater_equal(t206, -6.283185307179586) & xp.less_equal(t206, 6.283185307179586), t206, xp.where(xp.greater_equal(t207, -6.283185307179586) & xp.less_equal(t207, 6.283185307179586), t207, qb4_0)))
     t209 = xp.where(xp.less(t30, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t210 = t30 + t209
-    t211 = t30 - t209
+    t211 = -t209 + t30
     t212 = xp.where(xp.greater_equal(t30, -6.283185307179586) & xp.less_equal(t30, 6.283185307179586), t30, xp.where(xp.greater_equal(t210, -6.283185307179586) & xp.less_equal(t210, 6.283185307179586), t210, xp.where(xp.greater_equal(t211, -6.283185307179586) & xp.less_equal(t211, 6.283185307179586), t211, qb4_1)))
     t213 = xp.where(xp.less(t31, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t214 = t31 + t213
-    t215 = t31 - t213
+    t215 = -t213 + t31
     t216 = xp.where(xp.greater_equal(t31, -6.283185307179586) & xp.less_equal(t31, 6.283185307179586), t31, xp.where(xp.greater_equal(t214, -6.283185307179586) & xp.less_equal(t214, 6.283185307179586), t214, xp.where(xp.greater_equal(t215, -6.283185307179586) & xp.less_equal(t215, 6.283185307179586), t215, qb4_2)))
     t217 = xp.where(xp.less(t32, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t218 = t32 + t217
-    t219 = t32 - t217
+    t219 = -t217 + t32
     t220 = xp.where(xp.greater_equal(t32, -6.283185307179586) & xp.less_equal(t32, 6.283185307179586), t32, xp.where(xp.greater_equal(t218, -6.283185307179586) & xp.less_equal(t218, 6.283185307179586), t218, xp.where(xp.greater_equal(t219, -6.283185307179586) & xp.less_equal(t219, 6.283185307179586), t219, qb4_3)))
     t221 = xp.where(xp.less(t33, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t222 = t33 + t221
-    t223 = t33 - t221
+    t223 = -t221 + t33
     t224 = xp.where(xp.greater_equal(t33, -6.283185307179586) & xp.less_equal(t33, 6.283185307179586), t33, xp.where(xp.greater_equal(t222, -6.283185307179586) & xp.less_equal(t222, 6.283185307179586), t222, xp.where(xp.greater_equal(t223, -6.283185307179586) & xp.less_equal(t223, 6.283185307179586), t223, qb4_4)))
     t225 = xp.where(xp.less(t34, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t226 = t34 + t225
-    t227 = t34 - t225
+    t227 = -t225 + t34
     t228 = xp.where(xp.greater_equal(t34, -6.283185307179586) & xp.less_equal(t34, 6.283185307179586), t34, xp.where(xp.greater_equal(t226, -6.283185307179586) & xp.less_equal(t226, 6.283185307179586), t226, xp.where(xp.greater_equal(t227, -6.283185307179586) & xp.less_equal(t227, 6.283185307179586), t227, qb4_5)))
-    t229 = qw1*(t208 + t82)**2 + qw2*(t212 + t83)**2 + qw3*(t216 + t84)**2 + qw4*(t220 + t85)**2 + qw5*(t224 + t86)**2 + qw6*(t228 + t87)**2
+    t229 = qw1*(t82 + t208)**2 + qw2*(t83 + t212)**2 + qw3*(t84 + t216)**2 + qw4*(t85 + t220)**2 + qw5*(t86 + t224)**2 + qw6*(t87 + t228)**2
     t230 = xp.greater(t35, 0)
     t231 = xp.where(t230 & (xp.less(t196, 1) | xp.less(t229, t204)), xp.asarray(1, dtype=dtype), 0)
     t232 = xp.where(t230, 1, t196)
@@ -3210,29 +3210,29 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     t240 = xp.where(t233, t229, t204)
     t241 = xp.where(xp.less(t36, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t242 = t36 + t241
-    t243 = t36 - t241
+    t243 = -t241 + t36
     t244 = xp.where(xp.greater_equal(t36, -6.283185307179586) & xp.less_equal(t36, 6.283185307179586), t36, xp.where(xp.greater_equal(t242, -6.283185307179586) & xp.less_equal(t242, 6.283185307179586), t242, xp.where(xp.greater_equal(t243, -6.283185307179586) & xp.less_equal(t243, 6.283185307179586), t243, qb5_0)))
     t245 = xp.where(xp.less(t37, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t246 = t37 + t245
-    t247 = t37 - t245
+    t247 = -t245 + t37
     t248 = xp.where(xp.greater_equal(t37, -6.283185307179586) & xp.less_equal(t37, 6.283185307179586), t37, xp.where(xp.greater_equal(t246, -6.283185307179586) & xp.less_equal(t246, 6.283185307179586), t246, xp.where(xp.greater_equal(t247, -6.283185307179586) & xp.less_equal(t247, 6.283185307179586), t247, qb5_1)))
     t249 = xp.where(xp.less(t38, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t250 = t38 + t249
-    t251 = t38 - t249
+    t251 = -t249 + t38
     t252 = xp.where(xp.greater_equal(t38, -6.283185307179586) & xp.less_equal(t38, 6.283185307179586), t38, xp.where(xp.greater_equal(t250, -6.283185307179586) & xp.less_equal(t250, 6.283185307179586), t250, xp.where(xp.greater_equal(t251, -6.283185307179586) & xp.less_equal(t251, 6.283185307179586), t251, qb5_2)))
     t253 = xp.where(xp.less(t39, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t254 = t39 + t253
-    t255 = t39 - t253
+    t255 = -t253 + t39
     t256 = xp.where(xp.greater_equal(t39, -6.283185307179586) & xp.less_equal(t39, 6.283185307179586), t39, xp.where(xp.greater_equal(t254, -6.283185307179586) & xp.less_equal(t254, 6.283185307179586), t254, xp.where(xp.greater_equal(t255, -6.283185307179586) & xp.less_equal(t255, 6.283185307179586), t255, qb5_3)))
     t257 = xp.where(xp.less(t40, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t258 = t40 + t257
-    t259 = t40 - t257
+    t259 = -t257 + t40
     t260 = xp.where(xp.greater_equal(t40, -6.283185307179586) & xp.less_equal(t40, 6.283185307179586), t40, xp.where(xp.greater_equal(t258, -6.283185307179586) & xp.less_equal(t258, 6.283185307179586), t258, xp.where(xp.greater_equal(t259, -6.283185307179586) & xp.less_equal(t259, 6.283185307179586), t259, qb5_4)))
     t261 = xp.where(xp.less(t41, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t262 = t41 + t261
-    t263 = t41 - t261
+    t263 = -t261 + t41
     t264 = xp.where(xp.greater_equal(t41, -6.283185307179586) & xp.less_equal(t41, 6.283185307179586), t41, xp.where(xp.greater_equal(t262, -6.283185307179586) & xp.less_equal(t262, 6.283185307179586), t262, xp.where(xp.greater_equal(t263, -6.283185307179586) & xp.less_equal(t263, 6.283185307179586), t263, qb5_5)))
-    t265 = qw1*(t244 + t82)**2 + qw2*(t248 + t83)**2 + qw3*(t252 + t84)**2 + qw4*(t256 + t85)**2 + qw5*(t260 + t86)**2 + qw6*(t264 + t87)**2
+    t265 = qw1*(t82 + t244)**2 + qw2*(t83 + t248)**2 + qw3*(t84 + t252)**2 + qw4*(t85 + t256)**2 + qw5*(t86 + t260)**2 + qw6*(t87 + t264)**2
     t266 = xp.greater(t42, 0)
     t267 = xp.where(t266 & (xp.less(t232, 1) | xp.less(t265, t240)), xp.asarray(1, dtype=dtype), 0)
     t268 = xp.where(t266, 1, t232)
@@ -3246,29 +3246,29 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     t276 = xp.where(t269, t265, t240)
     t277 = xp.where(xp.less(t43, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t278 = t43 + t277
-    t279 = t43 - t277
+    t279 = -t277 + t43
     t280 = xp.where(xp.greater_equal(t43, -6.283185307179586) & xp.less_equal(t43, 6.283185307179586), t43, xp.where(xp.greater_equal(t278, -6.283185307179586) & xp.less_equal(t278, 6.283185307179586), t278, xp.where(xp.greater_equal(t279, -6.283185307179586) & xp.less_equal(t279, 6.283185307179586), t279, qb6_0)))
     t281 = xp.where(xp.less(t44, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t282 = t44 + t281
-    t283 = t44 - t281
+    t283 = -t281 + t44
     t284 = xp.where(xp.greater_equal(t44, -6.283185307179586) & xp.less_equal(t44, 6.283185307179586), t44, xp.where(xp.greater_equal(t282, -6.283185307179586) & xp.less_equal(t282, 6.283185307179586), t282, xp.where(xp.greater_equal(t283, -6.283185307179586) & xp.less_equal(t283, 6.283185307179586), t283, qb6_1)))
     t285 = xp.where(xp.less(t45, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t286 = t45 + t285
-    t287 = t45 - t285
+    t287 = -t285 + t45
     t288 = xp.where(xp.greater_equal(t45, -6.283185307179586) & xp.less_equal(t45, 6.283185307179586), t45, xp.where(xp.greater_equal(t286, -6.283185307179586) & xp.less_equal(t286, 6.283185307179586), t286, xp.where(xp.greater_equal(t287, -6.283185307179586) & xp.less_equal(t287, 6.283185307179586), t287, qb6_2)))
     t289 = xp.where(xp.less(t46, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t290 = t46 + t289
-    t291 = t46 - t289
+    t291 = -t289 + t46
     t292 = xp.where(xp.greater_equal(t46, -6.283185307179586) & xp.less_equal(t46, 6.283185307179586), t46, xp.where(xp.greater_equal(t290, -6.283185307179586) & xp.less_equal(t290, 6.283185307179586), t290, xp.where(xp.greater_equal(t291, -6.283185307179586) & xp.less_equal(t291, 6.283185307179586), t291, qb6_3)))
     t293 = xp.where(xp.less(t47, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t294 = t47 + t293
-    t295 = t47 - t293
+    t295 = -t293 + t47
     t296 = xp.where(xp.greater_equal(t47, -6.283185307179586) & xp.less_equal(t47, 6.283185307179586), t47, xp.where(xp.greater_equal(t294, -6.283185307179586) & xp.less_equal(t294, 6.283185307179586), t294, xp.where(xp.greater_equal(t295, -6.283185307179586) & xp.less_equal(t295, 6.283185307179586), t295, qb6_4)))
     t297 = xp.where(xp.less(t48, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t298 = t48 + t297
-    t299 = t48 - t297
+    t299 = -t297 + t48
     t300 = xp.where(xp.greater_equal(t48, -6.283185307179586) & xp.less_equal(t48, 6.283185307179586), t48, xp.where(xp.greater_equal(t298, -6.283185307179586) & xp.less_equal(t298, 6.283185307179586), t298, xp.where(xp.greater_equal(t299, -6.283185307179586) & xp.less_equal(t299, 6.283185307179586), t299, qb6_5)))
-    t301 = qw1*(t280 + t82)**2 + qw2*(t284 + t83)**2 + qw3*(t288 + t84)**2 + qw4*(t292 + t85)**2 + qw5*(t296 + t86)**2 + qw6*(t300 + t87)**2
+    t301 = qw1*(t82 + t280)**2 + qw2*(t83 + t284)**2 + qw3*(t84 + t288)**2 + qw4*(t85 + t292)**2 + qw5*(t86 + t296)**2 + qw6*(t87 + t300)**2
     t302 = xp.greater(t49, 0)
     t303 = xp.where(t302 & (xp.less(t268, 1) | xp.less(t301, t276)), xp.asarray(1, dtype=dtype), 0)
     t304 = xp.where(t302, 1, t268)
@@ -3282,29 +3282,29 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     t312 = xp.where(t305, t301, t276)
     t313 = xp.where(xp.less(t50, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t314 = t50 + t313
-    t315 = t50 - t313
+    t315 = -t313 + t50
     t316 = xp.where(xp.greater_equal(t50, -6.283185307179586) & xp.less_equal(t50, 6.283185307179586), t50, xp.where(xp.greater_equal(t314, -6.283185307179586) & xp.less_equal(t314, 6.283185307179586), t314, xp.where(xp.greater_equal(t315, -6.283185307179586) & xp.less_equal(t315, 6.283185307179586), t315, qb7_0)))
     t317 = xp.where(xp.less(t51, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t318 = t51 + t317
-    t319 = t51 - t317
+    t319 = -t317 + t51
     t320 = xp.where(xp.greater_equal(t51, -6.283185307179586) & xp.less_equal(t51, 6.283185307179586), t51, xp.where(xp.greater_equal(t318, -6.283185307179586) & xp.less_equal(t318, 6.283185307179586), t318, xp.where(xp.greater_equal(t319, -6.283185307179586) & xp.less_equal(t319, 6.283185307179586), t319, qb7_1)))
     t321 = xp.where(xp.less(t52, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t322 = t52 + t321
-    t323 = t52 - t321
+    t323 = -t321 + t52
     t324 = xp.where(xp.greater_equal(t52, -6.283185307179586) & xp.less_equal(t52, 6.283185307179586), t52, xp.where(xp.greater_equal(t322, -6.283185307179586) & xp.less_equal(t322, 6.283185307179586), t322, xp.where(xp.greater_equal(t323, -6.283185307179586) & xp.less_equal(t323, 6.283185307179586), t323, qb7_2)))
     t325 = xp.where(xp.less(t53, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t326 = t53 + t325
-    t327 = t53 - t325
+    t327 = -t325 + t53
     t328 = xp.where(xp.greater_equal(t53, -6.283185307179586) & xp.less_equal(t53, 6.283185307179586), t53, xp.where(xp.greater_equal(t326, -6.283185307179586) & xp.less_equal(t326, 6.283185307179586), t326, xp.where(xp.greater_equal(t327, -6.283185307179586) & xp.less_equal(t327, 6.283185307179586), t327, qb7_3)))
     t329 = xp.where(xp.less(t54, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t330 = t54 + t329
-    t331 = t54 - t329
+    t331 = -t329 + t54
     t332 = xp.where(xp.greater_equal(t54, -6.283185307179586) & xp.less_equal(t54, 6.283185307179586), t54, xp.where(xp.greater_equal(t330, -6.283185307179586) & xp.less_equal(t330, 6.283185307179586), t330, xp.where(xp.greater_equal(t331, -6.283185307179586) & xp.less_equal(t331, 6.283185307179586), t331, qb7_4)))
     t333 = xp.where(xp.less(t55, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t334 = t55 + t333
-    t335 = t55 - t333
+    t335 = -t333 + t55
     t336 = xp.where(xp.greater_equal(t55, -6.283185307179586) & xp.less_equal(t55, 6.283185307179586), t55, xp.where(xp.greater_equal(t334, -6.283185307179586) & xp.less_equal(t334, 6.283185307179586), t334, xp.where(xp.greater_equal(t335, -6.283185307179586) & xp.less_equal(t335, 6.283185307179586), t335, qb7_5)))
-    t337 = qw1*(t316 + t82)**2 + qw2*(t320 + t83)**2 + qw3*(t324 + t84)**2 + qw4*(t328 + t85)**2 + qw5*(t332 + t86)**2 + qw6*(t336 + t87)**2
+    t337 = qw1*(t82 + t316)**2 + qw2*(t83 + t320)**2 + qw3*(t84 + t324)**2 + qw4*(t85 + t328)**2 + qw5*(t86 + t332)**2 + qw6*(t87 + t336)**2
     t338 = xp.greater(t56, 0)
     t339 = xp.where(t338 & (xp.less(t304, 1) | xp.less(t337, t312)), xp.asarray(1, dtype=dtype), 0)
     t340 = xp.where(t338, 1, t304)

@@ -19,6 +19,7 @@ from jacgen.inputs.robot import EULER_ANGLES, Robot
 from jacgen.inputs.transforms import rot_z, twist
 from jacgen.model import kinematics
 from jacgen.model.joint_ring import joint_atoms, maximal_minors
+from jacgen.model.graph import Node
 from jacgen.model.kinematics import generated_symbol
 from jacgen.model.nodes import Above, AtMost, select
 from jacgen.model.singularities import MINOR_LIMIT, Singularities, singularity_jacobian
@@ -45,16 +46,16 @@ def matrix(name: str, value: sympy.Matrix, equals: str = "", layers: int = 1) ->
 
 
 def vector(name: str, values, equals: str = "") -> Result:
-    values = [sympy.sympify(value) for value in values]
+    values = [value if isinstance(value, Node) else sympy.sympify(value) for value in values]
     return Result(name, values, len(values), 1, "vector", equals)
 
 
 def scalar(name: str, value) -> Result:
-    return Result(name, [sympy.sympify(value)], 1, 1, "scalar")
+    return Result(name, [value if isinstance(value, Node) else sympy.sympify(value)], 1, 1, "scalar")
 
 
 def status(name: str, value) -> Result:
-    return Result(name, [sympy.sympify(value)], 1, 1, "status")
+    return Result(name, [value if isinstance(value, Node) else sympy.sympify(value)], 1, 1, "status")
 
 
 class Generator:
@@ -68,7 +69,8 @@ class Generator:
         self.selection = None if selection is None else with_callees(selection)
         self.q = kinematics.joint_symbols(robot)
         self.lowering = Lowering()
-        self.name, self.lower = self.lowering.name, self.lowering.lower
+        self.name, self.lower, self.graph = self.lowering.name, self.lowering.lower, self.lowering.graph
+        self.name_node = self.lowering.name_node
         self._trig: dict[tuple[int, ...], tuple[sympy.Symbol, sympy.Symbol]] = {}  # each defined once
         with distribute(False):  # keep 0.0825*(a - b) whole, for CSE to share a - b
             self.chain = kinematics.build_chain(robot, lambda i: self.cos_sin((i,)), self.q, simplify=self.name,
@@ -244,7 +246,7 @@ class Generator:
         damping = Argument("damping", sympy.Matrix([sympy.Symbol("damping", real=True)]), scalar=True, default="0.0")
         with distribute(False):
             q_dot, outcome = differential.velocity_ik(js, list(self.q), list(mu_dot.symbols), damping.symbols[0],
-                                                      self.name)
+                                                      self.graph, self.name_node)
         form = "Js^-1 mu_dot (damping 0) or " if m == n else ""
         form += ("Js^T (Js Js^T + damping^2 I)^-1 mu_dot" if m <= n else "(Js^T Js + damping^2 I)^-1 Js^T mu_dot")
         return self.function("velocity_ik", f"joint rates q_dot solving Js q_dot = mu_dot: {form}; and the status",
@@ -258,13 +260,14 @@ class Generator:
         given = Argument("q", sympy.Matrix([generated_symbol("qs", i + 1) for i in range(n)]))
         damping = Argument("damping", sympy.Matrix([sympy.Symbol("damping", real=True)]), scalar=True, default="0.0")
         limits = [joint.limits for joint in robot.joints]
-        bindings = {qi: differential.clamp(given_i, bounds) for qi, given_i, bounds in zip(self.q, given.symbols, limits)}
+        bindings = {qi: differential.clamp(given_i, bounds, self.graph)
+                    for qi, given_i, bounds in zip(self.q, given.symbols, limits)}
         with distribute(False):
             error, jacobian = self._task_error(target, task_jacobian)
             trial, cost = differential.ik_numeric_step(error, jacobian, list(self.q), damping.symbols[0], limits,
-                                                       self.name)
+                                                       self.graph, self.name_node)
             read = target.symbols[:3, :] if len(robot.task) == 6 else target.symbols
-            cost = differential.flagged_cost(cost, [*given.symbols, *read], self.name)
+            cost = differential.flagged_cost(cost, [*given.symbols, *read], self.graph, self.name_node)
         step = "J^T (J J^T + damping I)^-1 e" if jacobian.rows <= n else "(J^T J + damping I)^-1 J^T e"
         summary = (f"one step of ik_numeric: q clamped to the limits, then q + {step} clamped, and |e|^2 at "
                    "the clamped q (-1 when target or q is not finite)")
@@ -284,8 +287,8 @@ class Generator:
         geometric Jacobian; else the task error (Euler angles wrapped) with the task Jacobian."""
         if len(self.robot.task) == 6:
             tool, goal = self.chain.tool, target.symbols
-            rotation = (goal[:3, :3] * tool[:3, :3].T).applyfunc(self.name)
-            return [goal[i, 3] - tool[i, 3] for i in range(3)] + differential.rotation_vector(rotation, self.name), \
+            rotation = self.graph.values(goal[:3, :3]) @ self.graph.values(tool[:3, :3]).T
+            return [goal[i, 3] - tool[i, 3] for i in range(3)] + differential.rotation_vector(rotation, self.graph, self.name_node), \
                 self.jacobian
         mu = kinematics.task_vector(self.robot, self.chain.tool)
         return [wrapped(goal - value) if component in EULER_ANGLES else goal - value

@@ -127,8 +127,10 @@ def _negated(product: Node) -> list[Node]:
     return rest if coefficient.value == -1 else [Node(NUMBER, (), -coefficient.value), *rest]
 
 
-def is_boolean(value: sympy.Basic) -> bool:
-    """A truth value of sympy's (a comparison, And, Or, ...)."""
+def is_boolean(value) -> bool:
+    """A truth value (a comparison, And, Or, ...), of sympy's or a node."""
+    if isinstance(value, Node):
+        return value.boolean
     return isinstance(value, Boolean) and not isinstance(value, sympy.Expr)
 
 
@@ -137,17 +139,18 @@ class Lowering:
     they are lowered on, and the Bodies lowered from them, each once per outputs and bindings."""
 
     def __init__(self):
-        self.definitions: list[tuple[sympy.Symbol, sympy.Expr]] = []  # in an order that defines before use
+        self.definitions: list[tuple[sympy.Symbol, Node]] = []  # in an order that defines before use
         self.graph = Graph()
         self._names: dict[sympy.Expr, sympy.Symbol] = {}  # named values (see `name`)
         self._named: set[sympy.Symbol] = set()
-        self._nodes: dict[sympy.Symbol, Node] = {}  # each definition's value on the graph, taken over once
         self._negations: dict[Node, Node | None] = {}  # eliminate_common's, shared by every lowering
         self._lowered: dict[tuple, Body] = {}
 
     def define(self, symbol: sympy.Symbol, value: sympy.Expr):
-        """A symbol of the generated code (a joint's cos) and its value."""
-        self.definitions.append((symbol, value))
+        """A symbol of the generated code (a joint's cos) and its value, taken onto the graph
+        now: nodes are ordered by when they were built (`graph._order`), so every value is
+        built in the algorithms' order, never in the order a set iterates."""
+        self.definitions.append((symbol, self.graph.convert(value)))
 
     def name(self, value: sympy.Expr) -> sympy.Expr:
         """`value` as a symbol of its own (an atom, a number or a product of atoms stays as it
@@ -164,10 +167,30 @@ class Lowering:
         if _mostly_negative(value):
             return -self.name(negated)
         symbol = sympy.Symbol(f"{names.INTERNAL_PREFIX}n{len(self.definitions)}", real=True)
-        self.definitions.append((symbol, value))
+        self.definitions.append((symbol, self.graph.convert(value)))
         self._names[value] = symbol
         self._named.add(symbol)
         return symbol
+
+    def name_node(self, node: Node) -> Node:
+        """`name` for a value on the graph: its symbol's node, or minus it (a sum is known by its
+        terms, whatever their order, and a mostly negative one is named as its negation)."""
+        if not node.args or (node.kind == MUL and all(not arg.args for arg in node.args)):
+            return node
+        graph, key = self.graph, _key(node)
+        if key in self._names:
+            return graph.symbol(self._names[key])
+        negated = graph.node(ADD, tuple(map(graph.negate, node.args))) if node.kind == ADD else graph.negate(node)
+        if _key(negated) in self._names:
+            return graph.negate(graph.symbol(self._names[_key(negated)]))
+        terms = node.args if node.kind == ADD else (node,)
+        if 2 * sum(map(negative_coefficient, terms)) > len(terms):
+            return graph.negate(self.name_node(negated))
+        symbol = sympy.Symbol(f"{names.INTERNAL_PREFIX}n{len(self.definitions)}", real=True)
+        self.definitions.append((symbol, node))
+        self._names[key] = symbol
+        self._named.add(symbol)
+        return graph.symbol(symbol)
 
     def lower(self, outputs: list[sympy.Basic], bindings: dict | None = None) -> Body:
         """`_lower`, once per outputs and bindings (jacobian_det's determinant is lowered to
@@ -183,23 +206,18 @@ class Lowering:
         that defines before use."""
         graph = self.graph
         values = dict(self.definitions)
-        bound = {symbol: graph.convert(value) for symbol, value in bindings.items()}
+        values.update((symbol, graph.convert(value)) for symbol, value in bindings.items())
         outputs = [graph.convert(e) for e in outputs]
         needed, frontier = set(), set().union(*(e.free_symbols for e in outputs))
         while frontier:
             symbol = frontier.pop()
-            if symbol in needed:
-                continue
-            if symbol in bound:
+            if symbol in values and symbol not in needed:
                 needed.add(symbol)
-                frontier |= bound[symbol].free_symbols
-            elif symbol in values:
-                needed.add(symbol)
-                frontier |= self._node(symbol, values[symbol]).free_symbols
+                frontier |= values[symbol].free_symbols
         # Constants (a subproblem's scale of a constant vector) go into their readers before CSE,
         # so that their numbers fold with the readers' own; CSE's temporaries that are constants, after.
-        ordered = [(s, bound[s]) for s in bound if s in needed] + [(s, self._nodes[s]) for s, _ in self.definitions
-                                                                   if s in needed and s not in bound]
+        ordered = [(s, values[s]) for s in bindings if s in needed] + [(s, v) for s, v in self.definitions
+                                                                       if s in needed and s not in bindings]
         definitions, outputs = _without_constants(graph, _in_dependency_order(ordered), outputs, distribute=False)
         named = [(s, v) for s, v in definitions if s in self._named]
         replacements, reduced = eliminate_common(graph, [v for _, v in named] + outputs,
@@ -213,12 +231,10 @@ class Lowering:
         return Body(frozenset(read - {symbol for symbol, _ in definitions}), tuple(definitions), tuple(reduced),
                     {symbol: f"t{k}" for k, symbol in enumerate(temporaries)})
 
-    def _node(self, symbol: sympy.Symbol, value: sympy.Expr) -> Node:
-        """A definition's value on the graph, taken over on first use."""
-        node = self._nodes.get(symbol)
-        if node is None:
-            node = self._nodes[symbol] = self.graph.convert(value)
-        return node
+
+def _key(node: Node):
+    """What names a value on the graph: a sum by its set of terms."""
+    return (ADD, frozenset(node.args)) if node.kind == ADD else node
 
 
 def _mostly_negative(value: sympy.Expr) -> bool:

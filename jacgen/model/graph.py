@@ -17,22 +17,25 @@ import math
 import operator
 from fractions import Fraction
 
+import numpy
 import sympy
 from sympy.logic.boolalg import Boolean
 
 from jacgen.model.nodes import TOLERANCE_SYMBOLS, TOLERANCES, IsFinite, Select
 
-# The kinds of node. A number's value is an int, a Fraction (a folded constant: its value to
-# FOLDED_DIGITS digits, held exactly, so that constants added or multiplied together round once,
-# when printed) or, as a power's exponent, a sympy Rational; a symbol's is its sympy Symbol; a
-# call's the function's name (sympy's class name: sin, atan2, Abs, Floor, ...); a relation's its
-# operator (">=", ...).
+# The kinds of node. A number's value is an int, a Fraction (an exact rational, as sympy's
+# Rational), a Folded (a constant folded from sympy's floats and irrationals, see Folded) or, as
+# a power's exponent, a sympy Rational; a symbol's is its sympy Symbol; a call's the function's
+# name (sympy's class name: sin, atan2, Abs, Floor, ...); a relation's its operator (">=", ...).
+# Every number but a small integer prints as a literal of the build's real type.
 NUMBER, SYMBOL, TRUTH = "number", "symbol", "truth"
 ADD, MUL, POW, CALL, SELECT = "add", "mul", "pow", "call", "select"
 RELATION, AND, OR, NOT, FINITE = "relation", "and", "or", "not", "finite"
 FOLDED_DIGITS = 30
 BOOLEAN_KINDS = frozenset((TRUTH, RELATION, AND, OR, NOT, FINITE))
 
+REVERSED = {">=": "<=", ">": "<", "<=": ">=", "<": ">", "==": "==", "!=": "!="}
+NEGATED = {">=": "<", ">": "<=", "<=": ">", "<": ">=", "==": "!=", "!=": "=="}
 RELATIONS = {">=": operator.ge, ">": operator.gt, "<=": operator.le, "<": operator.lt, "==": operator.eq,
              "!=": operator.ne}
 # The functions `evaluate` calls, by call name, and how it adds (in floats: fsum, rounded once).
@@ -42,13 +45,61 @@ MATH = {"sin": math.sin, "cos": math.cos, "tan": math.tan, "asin": math.asin, "a
 BOOLEANS = {sympy.And: AND, sympy.Or: OR, sympy.Not: NOT, IsFinite: FINITE}
 
 
+class Folded(Fraction):
+    """A constant folded from sympy's floats and irrationals (2159/5000 * sqrt(2), pi / 4): its
+    value to FOLDED_DIGITS digits, held exactly, so that constants added or multiplied together
+    round once, when printed. Arithmetic with one stays folded, as with sympy's Float: 0.5 * 2
+    is 1.0, not the integer 1."""
+
+    __slots__ = ()
+
+
+def number_of(value, folded: bool):
+    """The result of arithmetic on numbers: Folded if an operand was, else exact (an integer as an int)."""
+    if folded:
+        return Folded(value)
+    return int(value) if isinstance(value, Fraction) and value.denominator == 1 else value
+
+
 class Node:
-    """One value of the graph; build it with `Graph.node` (or the constructors), never directly."""
+    """One value of the graph; build it with `Graph.node` (or the constructors), never directly.
+    Arithmetic with another node or a number builds on the node's graph (`Graph.add`, `mul`,
+    `power`), so an algorithm written with + - * / ** runs on nodes as on sympy values."""
 
-    __slots__ = ("kind", "args", "value", "_free")
+    __slots__ = ("kind", "args", "value", "graph", "index", "_free")
 
-    def __init__(self, kind: str, args: tuple, value):
-        self.kind, self.args, self.value, self._free = kind, args, value, None
+    def __init__(self, kind: str, args: tuple, value, graph: "Graph | None" = None, index: int = 0):
+        self.kind, self.args, self.value, self.graph, self.index, self._free = kind, args, value, graph, index, None
+
+    def __add__(self, other):
+        return self.graph.add(self, self.graph.value(other))
+
+    def __radd__(self, other):
+        return self.graph.add(self.graph.value(other), self)
+
+    def __sub__(self, other):
+        return self.graph.add(self, self.graph.negate(self.graph.value(other)))
+
+    def __rsub__(self, other):
+        return self.graph.add(self.graph.value(other), self.graph.negate(self))
+
+    def __mul__(self, other):
+        return self.graph.mul(self, self.graph.value(other))
+
+    def __rmul__(self, other):
+        return self.graph.mul(self.graph.value(other), self)
+
+    def __neg__(self):
+        return self.graph.negate(self)
+
+    def __truediv__(self, other):
+        return self.graph.mul(self, self.graph.power(self.graph.value(other), -1))
+
+    def __rtruediv__(self, other):
+        return self.graph.mul(self.graph.value(other), self.graph.power(self, -1))
+
+    def __pow__(self, exponent):
+        return self.graph.power(self, exponent)
 
     @property
     def free_symbols(self) -> frozenset:
@@ -82,7 +133,7 @@ class Node:
 
 def is_zero(node: Node) -> bool:
     """The exact number 0 (a structural zero of a matrix)."""
-    return node.kind == NUMBER and node.value == 0 and not isinstance(node.value, Fraction)
+    return node.kind == NUMBER and node.value == 0 and not isinstance(node.value, Folded)
 
 
 def negative_coefficient(node: Node) -> bool:
@@ -105,7 +156,7 @@ class Graph:
         key = (kind, value, type(value), args)
         node = self._nodes.get(key)
         if node is None:
-            node = self._nodes[key] = Node(kind, args, value)
+            node = self._nodes[key] = Node(kind, args, value, self, len(self._nodes))
         return node
 
     def number(self, value) -> Node:
@@ -117,10 +168,71 @@ class Graph:
     def truth(self, value: bool) -> Node:
         return self.true if value else self.false
 
+    def value(self, value) -> Node:
+        """A node, a Python number (a float as its exact binary value) or a sympy value as a node."""
+        if isinstance(value, Node):
+            return value
+        if isinstance(value, bool):
+            return self.truth(value)
+        if isinstance(value, int):
+            return self.number(value)
+        if isinstance(value, float):
+            return self.number(Folded(value))
+        if isinstance(value, Fraction):
+            return self.number(number_of(value, isinstance(value, Folded)))
+        return self.convert(value)
+
+    def values(self, values):
+        """`values` (a sympy Matrix or nested lists) as an array of nodes, for + - * @ and .T."""
+        values = values.tolist() if isinstance(values, sympy.MatrixBase) else values
+        return numpy.vectorize(self.value, otypes=[object])(numpy.array(values, dtype=object))
+
+    # -- the functions an algorithm calls ---------------------------------------------------------
+    def power(self, base: Node, exponent) -> Node:
+        """base ** exponent (a rational): a number's folded; an integer power of a product is
+        the product of its factors' powers, and of a power, one power; the square root of an
+        even power of x is a power of |x| (as sympy's, every symbol being real)."""
+        exponent = sympy.Rational(exponent)
+        if exponent == 1:
+            return base
+        if base.kind == NUMBER:
+            return self.rebuilt(self.node(POW, (base, self.number(exponent))), (base, self.number(exponent)))
+        if exponent.q == 1 and base.kind == MUL:
+            return self.mul(*(self.power(factor, exponent) for factor in base.args))
+        if base.kind == POW and (exponent.q == 1 or (exponent == sympy.S.Half and base.args[1].value % 2 == 0)):
+            if exponent.q == 1:
+                return self.power(base.args[0], base.args[1].value * exponent)
+            return self.power(self.call("Abs", base.args[0]), base.args[1].value / 2)  # sqrt(x^2) = |x|, x real
+        return self.node(POW, (base, self.number(exponent)))
+
+    def sqrt(self, value: Node) -> Node:
+        return self.power(value, sympy.S.Half)
+
+    def call(self, name: str, *args: Node) -> Node:
+        """name(args) of MATH's functions: of numbers, folded exactly by sympy."""
+        if all(arg.kind == NUMBER for arg in args):
+            return self.convert(getattr(sympy, name)(*(sympy.Rational(arg.value) for arg in args)))
+        return self.node(CALL, args, name)
+
+    def negation(self, condition: Node) -> Node:
+        """not condition: a truth value flipped, a comparison reversed, else a Not node."""
+        if condition.kind == TRUTH:
+            return self.truth(not condition.value)
+        if condition.kind == RELATION:
+            return self.relation(NEGATED[condition.value], *condition.args)
+        if condition.kind == NOT:
+            return condition.args[0]
+        return self.node(NOT, (condition,))
+
+    def finite(self, value: Node) -> Node:
+        return self.node(FINITE, (value,))
+
     # -- sympy's values, once each ------------------------------------------------------------------
     def convert(self, expr: sympy.Basic) -> Node:
         """`expr` as a node, its constant subexpressions (2159/5000, sqrt(2)/2, pi/4) folded to
         one number each: integers stay integers, exponents exact, so x**(1/2) prints as sqrt(x)."""
+        if isinstance(expr, Node):
+            return expr
         node = self._converted.get(expr)
         if node is None:
             node = self._converted[expr] = self._convert(expr)
@@ -139,7 +251,9 @@ class Graph:
                 raise ValueError(f"unsupported in generated code: {type(expr).__name__} ({expr})")
             return self.node(kind, tuple(self.convert(arg) for arg in expr.args))
         if expr.is_number:
-            return self.number(int(expr) if expr.is_Integer else Fraction(str(expr.evalf(FOLDED_DIGITS))))
+            if expr.is_Rational:
+                return self.number(number_of(Fraction(int(expr.p), int(expr.q)), False))
+            return self.number(Folded(str(expr.evalf(FOLDED_DIGITS))))
         if expr.is_Pow:
             if not expr.exp.is_Rational:
                 raise ValueError(f"unsupported in generated code: a power to {expr.exp}")
@@ -157,14 +271,17 @@ class Graph:
     # -- building, with sympy's evaluation where values combine ---------------------------------------
     def add(self, *terms: Node) -> Node:
         """The sum: nested sums flattened, numbers added, equal terms collected (x + 2x = 3x)."""
-        number, collected = 0, {}
+        numbers, collected = [], {}
         for term in _flattened(ADD, terms):
             if term.kind == NUMBER:
-                number += term.value
+                numbers.append(term.value)
                 continue
             coefficient, rest = self._split(term)
-            collected[rest] = collected.get(rest, 0) + coefficient
+            collected.setdefault(rest, []).append(coefficient)
+        number = _combined(sum, numbers)
+        collected = {rest: _combined(sum, coefficients) for rest, coefficients in collected.items()}
         parts = [rest if c == 1 else self.mul(self.number(c), rest) for rest, c in collected.items() if c != 0]
+        parts.sort(key=_order)
         if number != 0:
             parts.insert(0, self.number(number))
         if not parts:
@@ -183,17 +300,18 @@ class Graph:
         with `distribute`, a number times one sum is the sum of its terms times the number
         (sympy's `distribute`, on where a constant is substituted, off where the algorithms
         build and CSE shares a - b with b - a)."""
-        number, collected = 1, {}
+        numbers, collected = [], {}
         for factor in _flattened(MUL, factors):
             if factor.kind == NUMBER:
-                number *= factor.value
+                numbers.append(factor.value)
                 continue
             base, exponent = (factor.args[0], factor.args[1].value) if factor.kind == POW else (factor, 1)
             collected[base] = collected.get(base, 0) + exponent
+        number = _combined(math.prod, numbers)
         if number == 0:
             return self.number(number)
-        parts = [base if e == 1 else self.node(POW, (base, self.number(sympy.Rational(e))))
-                 for base, e in collected.items() if e != 0]
+        parts = sorted((base if e == 1 else self.node(POW, (base, self.number(sympy.Rational(e))))
+                        for base, e in collected.items() if e != 0), key=_order)
         if distribute and number != 1 and len(parts) == 1 and parts[0].kind == ADD:
             return self.add(*(self.mul(self.number(number), term) for term in parts[0].args))
         if number != 1 or not parts:
@@ -203,12 +321,12 @@ class Graph:
     def negate(self, node: Node) -> Node:
         """-node: a number negated, a product's number negated (-1 dropped), else -1 * node."""
         if node.kind == NUMBER:
-            return self.number(-node.value)
+            return self.number(_combined(operator.neg, node.value))
         if node.kind == MUL and node.args[0].kind == NUMBER:
             coefficient, *rest = node.args
             if coefficient.value == -1:
                 return rest[0] if len(rest) == 1 else self.node(MUL, tuple(rest))
-            return self.node(MUL, (self.number(-coefficient.value), *rest))
+            return self.node(MUL, (self.number(_combined(operator.neg, coefficient.value)), *rest))
         return self.node(MUL, (self.minus_one, node))
 
     def select(self, *args: Node) -> Node:
@@ -235,6 +353,8 @@ class Graph:
         comparison holds, or fails, in every real type."""
         if lhs is rhs:
             return self.truth(operator_ in (">=", "<=", "=="))
+        if rhs.kind == NUMBER and rhs.value == 0 and lhs.kind == MUL and lhs.args[0].value == -1:
+            return self.relation(REVERSED[operator_], self.negate(lhs), rhs)  # -x >= 0 is x <= 0
         if lhs.constant and rhs.constant:
             truths = {RELATIONS[operator_](evaluate(lhs, numbers), evaluate(rhs, numbers))
                       for numbers in TOLERANCE_VALUES.values()}
@@ -262,11 +382,12 @@ class Graph:
             return self.add(*args)
         if kind == MUL:
             return self.mul(*args, distribute=distribute)
-        if kind == POW and args[0].kind == NUMBER:
-            base, exponent = Fraction(args[0].value), args[1].value
+        if kind == POW and args[0].kind == NUMBER and not (args[0].value == 0 and args[1].value < 0):  # 1/0 stays
+            base, exponent = args[0].value, args[1].value
             if exponent.q == 1:
-                return self.number(base ** int(exponent))
-            return self.convert(sympy.Rational(base.numerator, base.denominator) ** exponent)
+                return self.number(number_of(Fraction(base) ** int(exponent), isinstance(base, Folded)))
+            root = self.convert(sympy.Rational(Fraction(base).numerator, Fraction(base).denominator) ** exponent)
+            return self.number(number_of(root.value, isinstance(base, Folded)))
         if kind == SELECT:
             return self.select(*args)
         if kind == RELATION:
@@ -299,6 +420,20 @@ class Graph:
                 args = tuple(self.substitute(arg, values, distribute, done) for arg in node.args)
                 done[node] = self.rebuilt(node, args, distribute)
         return done[node]
+
+
+def _combined(operation, values):
+    """operation(values) of numbers (a sum, a product of a list; a negation of one), Folded if
+    one of them was."""
+    folded = any(isinstance(v, Folded) for v in values) if isinstance(values, list) else isinstance(values, Folded)
+    return number_of(operation(values), folded)
+
+
+def _order(node: Node) -> int:
+    """The order of a sum's terms and a product's factors: as their values were first built
+    (the base's, for a power), so that a*b and b*a are one node, whatever the order written."""
+    return node.args[0].index if node.kind == POW or (node.kind == MUL and node.args[0].kind == NUMBER
+                                                      and len(node.args) == 2) else node.index
 
 
 def _flattened(kind: str, nodes) -> list[Node]:
